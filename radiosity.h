@@ -1,0 +1,2600 @@
+/* radiosity.h - v0.1.0 - diffuse global illumination by the radiosity method
+   public domain or MIT, your choice (see end of file)
+
+   Do this:
+       #define RADIOSITY_IMPLEMENTATION
+   before you include this file in *one* C or C++ file to create the implementation.
+
+       // in every file that uses the library
+       #include "radiosity.h"
+
+       // in exactly one file
+       #define RADIOSITY_IMPLEMENTATION
+       #include "radiosity.h"
+
+   QUICK START (compiles as it is; renders nothing, prints the ceiling radiosity)
+
+       #define RADIOSITY_IMPLEMENTATION
+       #include "radiosity.h"
+       #include <stdio.h>
+       #include <stdlib.h>
+
+       int main(void) {
+           rad_scene_desc desc; rad_camera cam;
+           rad_scene *scene = NULL; rad_patches *patches = NULL; rad_bvh *bvh = NULL;
+           rad_form_factors *ff = NULL;
+           rad_patch_options popt; rad_form_factor_options fopt; rad_solve_options sopt;
+           rad_raycaster rc; rad_system sys; float *E, *B; uint32_t n;
+
+           rad_cornell_box(&desc, &cam);                        // built-in scene
+           if (rad_scene_create(&desc, NULL, &scene) != RAD_SUCCESS) return 1;
+           rad_patch_options_default(&popt); popt.target_count = 1000;
+           rad_patches_create(scene, &popt, NULL, &patches);    // ~1000 triangles
+           rad_bvh_create(scene, NULL, &bvh);
+           rad_bvh_raycaster(bvh, &rc);                          // built-in ray queries
+           rad_form_factor_options_default(&fopt);
+           rad_form_factors_dense(patches, &rc, &fopt, NULL, &ff);
+           n = patches->count;
+           E = (float *)malloc(sizeof(float) * 3 * n); B = (float *)malloc(sizeof(float) * 3 * n);
+           rad_sources(patches, RAD_SOURCE_EMISSION, NULL, E);  // E = pi * emitted radiance
+           rad_system_init(&sys, &ff->matrix, patches, E);
+           rad_solve_options_default(&sopt);
+           sopt.output = RAD_OUTPUT_TOTAL; sopt.bounces = 16;
+           rad_solve_jacobi(&sys, &sopt, B, NULL, NULL);        // B = E + L_16
+           printf("patch 0 radiosity %g %g %g\n", B[0], B[1], B[2]);
+           free(E); free(B);
+           rad_form_factors_destroy(ff); rad_bvh_destroy(bvh);
+           rad_patches_destroy(patches); rad_scene_destroy(scene);
+           return 0;
+       }
+
+   CONTENTS
+       1. OPTIONS                  compile-time macros
+       2. THE METHOD               what is computed, in one page
+       3. UNITS AND CONVENTIONS    colours, E, what each solver returns
+       4. MEMORY                   allocators, ownership, sizes
+       5. ERRORS                   rad_result, the logger
+       6. THREADING                parallel_for hook, progress and cancel, determinism
+       7. RAY QUERIES              the callback table, the built-in BVH, self-intersection
+       8. NUMERICAL ROBUSTNESS     epsilons, singularities, validation
+       9. WHAT radiosity.h DOES NOT DO
+      10. HISTORY
+
+   1. OPTIONS
+       macro                      default            where to set it
+       -------------------------  -----------------  -------------------------------------------
+       RADIOSITY_IMPLEMENTATION   (undefined)        one .c/.cpp file, before the include
+       RADIOSITY_STATIC           (undefined)        everywhere: every function becomes static
+       RAD_DLL                    (undefined)        everywhere (Windows): dllexport in the
+                                                     implementing file, dllimport elsewhere
+       RAD_MALLOC/REALLOC/FREE    malloc/realloc/free implementing file; all three or none
+       RAD_ASSERT(x)              assert(x)          implementing file (internal invariants only;
+                                                     bad input is an error code, never an assert)
+       RAD_NO_SIMD                (undefined)        implementing file: scalar code only. SIMD
+                                                     (SSE2/AVX) is used only when the compiler
+                                                     already enables it (-msse2 is the x86-64
+                                                     default, -mavx / -march=native for AVX).
+       _OPENMP                    (set by -fopenmp)  implementing file: the default parallel_for
+                                                     runs tasks on OpenMP threads
+
+   2. THE METHOD
+       A scene is a set of triangles with Lambertian materials. It is cut into patches (one per
+       triangle or finer). The form factor F_ij is the fraction of the energy leaving patch i
+       that reaches patch j. With albedo rho and a source term E, radiosity satisfies
+           B_i = E_i + rho_i * sum_j F_ij B_j            (per colour channel)
+       Bounces: B^0 = E, B^k = (rho o F) B^(k-1); the indirect light after K bounces is
+       L_K = sum_{k=1..K} B^k and the full solution is B = E + L_inf.
+
+   3. UNITS AND CONVENTIONS
+       - Colours are linear RGB, three floats per patch, interleaved (r0 g0 b0 r1 g1 b1 ...).
+       - Lengths are whatever the scene uses; nothing assumes metres. Epsilons are relative
+         to the scene's bounding-box diagonal.
+       - Material emission is RADIANCE L (W m^-2 sr^-1, as OBJ Ke and glTF emissive). The
+         exitance of a Lambertian emitter, the quantity radiosity works with, is pi * L.
+       - Radiosity B and the source E are exitances (W m^-2). A Lambertian surface of
+         radiosity B shows radiance B / pi.
+       - Irradiance D, H (W m^-2) is what arrives; a patch reflects rho * irradiance.
+       - WHAT E IS. rad_sources() builds E one of two explicit ways, never both:
+           RAD_SOURCE_EMISSION  E_i = pi * L_i (emitters only). The solution then holds the
+                                direct light at patch resolution.
+           RAD_SOURCE_DIRECT    E_i = rho_i * D_i, D_i the direct irradiance from every light
+                                (analytic lights and emissive triangles alike, with shadow
+                                rays). The emitters' own emission is NOT placed in the system.
+                                This is what engines want: they draw direct light per pixel and
+                                add rho/pi * (D_pixel + H_pixel), H = F (E + L) the irradiance
+                                from the secondary sources (rad_matrix_multiply).
+         Mixing the two counts the emitters twice (about 2x too bright in the Cornell box).
+       - WHAT THE SOLVERS RETURN. Every solver takes rad_solve_options.output:
+           RAD_OUTPUT_INDIRECT  L = B - E (the bounces only; the default)
+           RAD_OUTPUT_TOTAL     B = E + L
+       - Triangles are wound counter-clockwise seen from the front; the front is the side that
+         emits and receives. Patches are one-sided.
+
+   4. MEMORY
+       Every object is created by a rad_*_create call that returns RAD_SUCCESS and writes an
+       owning pointer, and freed by exactly one rad_*_destroy call (NULL is accepted). Inputs
+       are borrowed for the duration of the call and copied where kept; each function's
+       comment says so. Outputs the caller provides (float *out) are written only on success
+       unless the comment says otherwise.
+       Allocation goes through rad_context.allocator when set (its user pointer is passed to
+       every call), else through RAD_MALLOC / RAD_FREE. Every size computation is checked for
+       overflow before allocating: an N*N matrix that does not fit in size_t returns
+       RAD_ERROR_SIZE_OVERFLOW.
+
+   5. ERRORS
+       Every fallible function returns rad_result: RAD_SUCCESS (0) or a negative code;
+       rad_result_string() names it. Detail ("triangle 12 of mesh 'floor' has zero area")
+       goes to rad_context.log when set. There is no global error state.
+
+   6. THREADING
+       radiosity.h never starts a thread. Long calls split their work into tasks and run them
+       through rad_context.parallel_for; the default runs them one after another, or on OpenMP
+       threads when the implementing file is compiled with OpenMP. Tasks write disjoint
+       outputs and reductions happen in a fixed order, so results are bit-identical whatever
+       the number of threads (same inputs, same seed, same build).
+       rad_context.progress is called on the calling thread between batches of tasks with the
+       fraction done; returning non-zero cancels the call, which frees what it allocated and
+       returns RAD_ERROR_CANCELLED.
+       Objects are immutable after creation: any number of threads may read one (query a BVH,
+       read patches, solve with the same matrix) at the same time.
+
+   7. RAY QUERIES
+       All visibility goes through a rad_raycaster: two batched callbacks, occluded() and
+       intersect(), plus a user pointer. Both are called from several tasks at once and must be
+       thread-safe. The built-in BVH (rad_bvh_*) implements the table with a binned-SAH build
+       and a watertight ray/triangle test; it is the reference the tests use.
+       Self-intersection: rays that start or end on a surface are offset along the surface
+       normal by ray_epsilon (relative to the scene diagonal) and their [tmin, tmax] interval
+       excludes the same distance at both ends. The raycaster itself reports any hit in
+       (tmin, tmax) and adds no epsilon of its own.
+
+   8. NUMERICAL ROBUSTNESS
+       - rad_scene_create validates everything: NaN/Inf positions or normals, indices out of
+         range, zero-area triangles (rejected, or skipped and counted with
+         RAD_SCENE_SKIP_DEGENERATE), albedo outside [0,1), negative or non-finite emission,
+         material index out of range, empty scenes, sizes that overflow.
+       - Point-to-point form factors clamp |r|^2 from below by s_j / pi (the squared radius of
+         a disk of the area the point stands for), which bounds the kernel by
+         cos cos / s_j * s_j = 1 for coincident points.
+       - The polygon kernel clips the receiver to the sample point's upper half-space and
+         returns 0 when the point is behind the receiver, so there is no sign ambiguity.
+
+   9. WHAT radiosity.h DOES NOT DO
+       - Specular or glossy transport: radiosity is diffuse light exchange.
+       - Loading files: meshes come in as arrays (tools/ has an importer).
+       - Start threads, touch the GPU itself, or keep global state.
+
+  10. HISTORY
+       0.1.0  scene input and validation, patches, built-in BVH, form factors (analytic,
+              Monte Carlo, point-to-point; dense, sparse, row ranges), Jacobi, Gauss-Seidel,
+              progressive refinement, LU; direct light; built-in Cornell box.
+       The full history is in CHANGELOG.md.
+*/
+
+#ifndef RADIOSITY_H
+#define RADIOSITY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define RAD_VERSION_MAJOR 0
+#define RAD_VERSION_MINOR 1
+#define RAD_VERSION_PATCH 0
+#define RAD_VERSION_STRING "0.1.0"
+
+#ifndef RAD_API
+#  ifdef RADIOSITY_STATIC
+#    define RAD_API static
+#  elif defined(_WIN32) && defined(RAD_DLL)
+#    ifdef RADIOSITY_IMPLEMENTATION
+#      define RAD_API __declspec(dllexport)
+#    else
+#      define RAD_API __declspec(dllimport)
+#    endif
+#  else
+#    define RAD_API extern
+#  endif
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ======================================================================================== */
+/* >>api_core: results, allocators, logging, threading hooks                                */
+/* ======================================================================================== */
+
+typedef enum rad_result {
+    RAD_SUCCESS = 0,
+    RAD_ERROR_INVALID_ARGUMENT = -1,      /* NULL pointer, zero count, bad option value */
+    RAD_ERROR_OUT_OF_MEMORY = -2,         /* an allocation failed */
+    RAD_ERROR_SIZE_OVERFLOW = -3,         /* a size (often N*N) does not fit its type */
+    RAD_ERROR_EMPTY_SCENE = -4,           /* no triangles (or none left after skipping) */
+    RAD_ERROR_INDEX_OUT_OF_RANGE = -5,    /* a vertex index >= vertex_count */
+    RAD_ERROR_NON_FINITE = -6,            /* NaN or Inf in positions, normals, uvs, lights */
+    RAD_ERROR_DEGENERATE_TRIANGLE = -7,   /* a triangle of zero (or subnormal) area */
+    RAD_ERROR_ALBEDO_RANGE = -8,          /* albedo outside [0,1) (material or callback) */
+    RAD_ERROR_NEGATIVE_EMISSION = -9,     /* emission < 0 or not finite */
+    RAD_ERROR_MATERIAL_OUT_OF_RANGE = -10,/* a material index >= material_count */
+    RAD_ERROR_CANCELLED = -11,            /* the progress callback asked to stop */
+    RAD_ERROR_NOT_CONVERGED = -12,        /* an iterative solver hit max_iterations */
+    RAD_ERROR_SINGULAR = -13,             /* the direct solve met a zero pivot */
+    RAD_ERROR_UNAVAILABLE = -14,          /* a backend not compiled in */
+    RAD_ERROR_RAYCAST_FAILED = -15,       /* a ray callback returned an error */
+    RAD_ERROR_SIZE_MISMATCH = -16         /* arrays or matrices of incompatible sizes */
+} rad_result;
+
+/* A static English name and description of a result ("RAD_ERROR_NON_FINITE: ..."). */
+RAD_API const char *rad_result_string(rad_result result);
+
+typedef enum rad_log_level { RAD_LOG_ERROR = 0, RAD_LOG_WARNING = 1, RAD_LOG_INFO = 2 } rad_log_level;
+
+/* Allocation callbacks. alloc must return memory aligned for any type (like malloc) or NULL;
+   free accepts NULL. Both receive 'user'. Leave both NULL for RAD_MALLOC / RAD_FREE. */
+typedef struct rad_allocator {
+    void *(*alloc)(void *user, size_t size);
+    void (*free)(void *user, void *ptr);
+    void *user;
+} rad_allocator;
+
+/* A task function: runs task 'index' of a parallel_for. */
+typedef void (*rad_task_fn)(void *data, uint32_t index);
+
+/* Runs fn(data, i) for every i in [0, count), in any order, on any threads, and returns when
+   all have finished. Tasks never call back into parallel_for. */
+typedef void (*rad_parallel_for_fn)(void *user, uint32_t count, rad_task_fn fn, void *data);
+
+/* Hooks shared by every long call. Zero-initialise it (or pass NULL) for the defaults. */
+typedef struct rad_context {
+    rad_allocator allocator;
+    /* Detail messages for errors and warnings; called on the calling thread. */
+    void (*log)(void *user, rad_log_level level, const char *message);
+    void *log_user;
+    /* Default: serial, or OpenMP when the implementation is compiled with it. */
+    rad_parallel_for_fn parallel_for;
+    void *parallel_user;
+    /* Number of tasks a call splits into (0: 64). More tasks balance load better. */
+    uint32_t task_count;
+    /* fraction in [0,1]; return non-zero to cancel. Called on the calling thread. */
+    int (*progress)(void *user, float fraction);
+    void *progress_user;
+} rad_context;
+
+/* ======================================================================================== */
+/* >>api_scene: scene input and validation                                                  */
+/* ======================================================================================== */
+
+#define RAD_NONE 0xFFFFFFFFu
+
+/* Albedo lookup by texture coordinate: writes the linear RGB albedo at (u, v) of 'texture'
+   (the material's texture id, never 0). Must be thread-safe. Values must lie in [0,1). */
+typedef void (*rad_albedo_fn)(void *user, uint32_t texture, float u, float v, float out_rgb[3]);
+
+typedef struct rad_material {
+    float albedo[3];    /* diffuse reflectance, each channel in [0, 1) */
+    float emission[3];  /* emitted RADIANCE L (W m^-2 sr^-1), >= 0; exitance is pi * L */
+    uint32_t texture;   /* 0: none; else passed to rad_scene_desc.albedo_lookup, whose
+                           result replaces albedo (needs uvs on the mesh) */
+} rad_material;
+
+typedef struct rad_mesh_desc {
+    const char *name;              /* optional; copied */
+    const float *positions;        /* x y z floats, 'position_stride' bytes apart */
+    size_t position_stride;        /* 0: 3 * sizeof(float) */
+    uint32_t vertex_count;
+    const float *normals;          /* optional shading normals (unused by the solver) */
+    size_t normal_stride;          /* 0: 3 * sizeof(float) */
+    const float *uvs;              /* optional u v, needed for textured materials */
+    size_t uv_stride;              /* 0: 2 * sizeof(float) */
+    const uint32_t *indices;       /* 3 per triangle; NULL: vertices taken in threes */
+    uint32_t triangle_count;
+    const uint32_t *material_ids;  /* one per triangle; NULL: every triangle uses 'material' */
+    uint32_t material;
+} rad_mesh_desc;
+
+typedef enum rad_scene_flags {
+    RAD_SCENE_SKIP_DEGENERATE = 1  /* drop zero-area triangles instead of failing; counted in
+                                      rad_scene.skipped_triangles */
+} rad_scene_flags;
+
+typedef struct rad_scene_desc {
+    const rad_mesh_desc *meshes;
+    uint32_t mesh_count;
+    const rad_material *materials;
+    uint32_t material_count;
+    rad_albedo_fn albedo_lookup;   /* optional */
+    void *albedo_user;
+    uint32_t flags;                /* rad_scene_flags */
+} rad_scene_desc;
+
+/* The validated scene, flattened: one array of triangles with world positions. Read-only.
+   Triangle t has vertices positions[9t .. 9t+8] (three xyz), normal normals[3t..3t+2]
+   (geometric, unit, from the winding), area areas[t], material materials[t], mesh meshes[t],
+   and the index it had in its mesh, source_triangles[t]. */
+typedef struct rad_scene {
+    uint32_t triangle_count;
+    float *positions;
+    float *normals;
+    float *uvs;                    /* 6 per triangle, or NULL when no mesh had uvs */
+    float *areas;
+    uint32_t *materials;
+    uint32_t *meshes;
+    uint32_t *source_triangles;
+    uint32_t material_count;
+    rad_material *materials_table;
+    uint32_t mesh_count;
+    char **mesh_names;             /* mesh_count strings ("" when unnamed) */
+    rad_albedo_fn albedo_lookup;
+    void *albedo_user;
+    float bounds_min[3], bounds_max[3];
+    float diagonal;                /* |bounds_max - bounds_min| */
+    uint32_t skipped_triangles;    /* degenerate triangles dropped (RAD_SCENE_SKIP_DEGENERATE) */
+    rad_allocator allocator;       /* private: the allocator that made it */
+} rad_scene;
+
+/* Validates 'desc' and copies it into a new scene.
+   Parameters: desc (borrowed for the call), ctx (optional), out (receives an owning pointer).
+   Errors: INVALID_ARGUMENT, EMPTY_SCENE, INDEX_OUT_OF_RANGE, NON_FINITE, DEGENERATE_TRIANGLE,
+   ALBEDO_RANGE, NEGATIVE_EMISSION, MATERIAL_OUT_OF_RANGE, SIZE_OVERFLOW, OUT_OF_MEMORY; the
+   logger names the mesh and triangle. Thread safety: reentrant. Cost: O(triangles). SPEC §1. */
+RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_context *ctx, rad_scene **out);
+RAD_API void rad_scene_destroy(rad_scene *scene);
+
+/* Albedo of triangle t at barycentrics (b1, b2) (weights of vertices 1 and 2): the material's
+   albedo, or the texture lookup at the interpolated uv. */
+RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3]);
+
+/* A pinhole camera. fov_y_degrees is the full vertical field of view. */
+typedef struct rad_camera {
+    float position[3];
+    float target[3];
+    float up[3];
+    float fov_y_degrees;
+} rad_camera;
+
+/* The built-in Cornell box: the original Cornell geometry in metres (the same scene as
+   shared/data/cornell.obj: 16 quads, 32 triangles) with the common RGB materials
+   (white 0.725 0.71 0.68, red 0.63 0.065 0.05, green 0.14 0.45 0.091, light albedo 0.78 and
+   radiance 17 12 4, one-sided, facing down, 0.1 mm below the ceiling) and its camera
+   (0.278 0.273 -0.8 looking along +z, vertical fov 39.3077). Meshes: floor, ceiling, back,
+   green (x = 0, right in the image), red (x ~ 0.55, left), light, shortblock, tallblock.
+   Everything 'desc' points to is static and read-only. Either output may be NULL. */
+RAD_API void rad_cornell_box(rad_scene_desc *desc, rad_camera *camera);
+
+/* ======================================================================================== */
+/* >>api_patches: patches                                                                   */
+/* ======================================================================================== */
+
+typedef struct rad_patch {
+    float centroid[3];
+    float normal[3];
+    float area;
+    float albedo[3];      /* mean albedo over the patch (texture-averaged when textured) */
+    float emission[3];    /* emitted radiance L of the material */
+    uint32_t triangle;    /* scene triangle it lies on */
+    uint32_t vertices[3]; /* indices into rad_patches.vertices, counter-clockwise */
+} rad_patch;
+
+typedef struct rad_patch_options {
+    float max_area;       /* 0: no limit */
+    float max_edge;       /* 0: no limit */
+    uint32_t target_count;/* 0: none; else max_area is set to total area / target_count
+                             (the result is near, not equal to, the target) */
+    uint32_t albedo_samples; /* texture samples per patch when textured (0: 16) */
+} rad_patch_options;
+
+/* Patches: each scene triangle is cut into n*n congruent triangles (n >= 1, the smallest
+   that meets max_area and max_edge). Vertices shared by patches of the same plane orientation
+   are welded, so per-vertex values (rad_patches_vertex_values) are smooth across triangle
+   edges but not across creases. Read-only after creation. */
+typedef struct rad_patches {
+    uint32_t count;
+    rad_patch *patches;
+    uint32_t vertex_count;
+    float *vertices;          /* 3 floats per vertex */
+    uint32_t triangle_count;
+    uint32_t *first_patch;    /* per scene triangle: index of its first patch */
+    uint32_t *subdivision;    /* per scene triangle: n */
+    float *areas;             /* count floats, copies of patches[i].area (for rad_system) */
+    float *albedo;            /* 3*count floats (for rad_system) */
+    const rad_scene *scene;   /* borrowed: the scene must outlive the patches */
+    rad_allocator allocator;  /* private */
+} rad_patches;
+
+RAD_API void rad_patch_options_default(rad_patch_options *options);
+
+/* Cuts the scene into patches. scene is borrowed and must outlive the result.
+   Errors: INVALID_ARGUMENT (negative or non-finite option), SIZE_OVERFLOW (more than 2^32-2
+   patches), ALBEDO_RANGE (texture callback out of range), OUT_OF_MEMORY.
+   Thread safety: reentrant. Cost: O(patches). SPEC §1. */
+RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_options *options,
+                                      const rad_context *ctx, rad_patches **out);
+RAD_API void rad_patches_destroy(rad_patches *patches);
+
+/* The patch containing the point of scene triangle 'triangle' at barycentrics (b1, b2), and
+   the weights of that patch's three vertices at the point (for smooth interpolation).
+   Returns RAD_NONE when the triangle index is out of range. O(1). */
+RAD_API uint32_t rad_patches_locate(const rad_patches *patches, uint32_t triangle, float b1, float b2,
+                                    float out_weights[3]);
+
+/* Per-vertex values from per-patch values: each vertex gets the area-weighted mean of the
+   patches that share it. 'channels' floats per patch and per vertex. */
+RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const float *patch_values,
+                                             uint32_t channels, float *out_vertex_values);
+
+/* ======================================================================================== */
+/* >>api_rays: ray queries and the built-in BVH                                             */
+/* ======================================================================================== */
+
+typedef struct rad_ray {
+    float origin[3];
+    float tmin;
+    float dir[3];          /* need not be unit; t is in units of |dir| */
+    float tmax;
+} rad_ray;
+
+typedef struct rad_hit {
+    float t;               /* distance along the ray in units of |dir| */
+    uint32_t triangle;     /* scene triangle, RAD_NONE on a miss */
+    float b1, b2;          /* barycentric weights of vertices 1 and 2 */
+} rad_hit;
+
+/* The ray-query table. Both functions must be thread-safe and return RAD_SUCCESS, or an
+   error that the library passes on (as RAD_ERROR_RAYCAST_FAILED). */
+typedef struct rad_raycaster {
+    void *user;
+    /* out_occluded[i] = 1 when anything is hit with tmin < t < tmax, else 0. */
+    rad_result (*occluded)(void *user, const rad_ray *rays, uint32_t count, uint8_t *out_occluded);
+    /* out_hits[i] = the closest hit with tmin < t < tmax, triangle = RAD_NONE if none. */
+    rad_result (*intersect)(void *user, const rad_ray *rays, uint32_t count, rad_hit *out_hits);
+} rad_raycaster;
+
+typedef struct rad_bvh rad_bvh;
+
+/* Builds the BVH (binned SAH, 4 triangles per leaf at most) over the scene's triangles.
+   scene is borrowed only for the call (the BVH copies the triangles).
+   Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. Cost: O(T log T). */
+RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out);
+RAD_API void rad_bvh_destroy(rad_bvh *bvh);
+/* Fills a raycaster table that queries 'bvh' (which must outlive its use). */
+RAD_API void rad_bvh_raycaster(const rad_bvh *bvh, rad_raycaster *out);
+/* Bytes the BVH holds (nodes and triangles). */
+RAD_API size_t rad_bvh_memory(const rad_bvh *bvh);
+
+/* A camera ray through the point (px, py) of a width x height image, px right, py down,
+   pixel centres at +0.5. dir is unit, tmin 0, tmax +huge. */
+RAD_API void rad_camera_ray(const rad_camera *camera, uint32_t width, uint32_t height, float px, float py,
+                            rad_ray *out);
+
+/* ======================================================================================== */
+/* >>api_formfactor: form factors                                                           */
+/* ======================================================================================== */
+
+typedef enum rad_storage { RAD_STORAGE_DENSE = 0, RAD_STORAGE_SPARSE = 1 } rad_storage;
+
+/* A non-owning view of a rows x cols matrix of floats: dense row-major, or CSR. */
+typedef struct rad_matrix {
+    uint32_t rows, cols;
+    rad_storage storage;
+    const float *dense;            /* rows*cols floats, row-major */
+    const uint64_t *row_offsets;   /* CSR: rows+1 offsets into columns/values */
+    const uint32_t *columns;       /* CSR: ascending within a row */
+    const float *values;
+} rad_matrix;
+
+typedef enum rad_ff_method {
+    RAD_FF_ANALYTIC = 0,   /* analytic inner integral (point to polygon) at 'samples' points on
+                              the emitting patch, visibility from one ray per point (default) */
+    RAD_FF_MONTE_CARLO = 1 /* 'samples' point pairs on both patches, kernel and one ray each */
+} rad_ff_method;
+
+typedef struct rad_form_factor_options {
+    rad_ff_method method;
+    uint32_t samples;       /* points per patch pair (0: 16), Hammersley, rounded to a square
+                               for neither method; capped at 256 */
+    float ray_epsilon;      /* relative to the scene diagonal (0: 1e-5) */
+    float drop_threshold;   /* sparse: entries below it are dropped (0 keeps non-zeros) */
+    uint32_t seed;          /* decorrelates visibility sample points (any value) */
+    int skip_visibility;    /* non-zero: V = 1 everywhere (unoccluded form factors) */
+} rad_form_factor_options;
+
+/* An owning form-factor matrix; 'matrix' views its storage. */
+typedef struct rad_form_factors {
+    rad_matrix matrix;
+    uint64_t rays_cast;        /* visibility rays the build cast */
+    uint64_t pairs_evaluated;  /* unordered patch pairs whose value was computed */
+    rad_allocator allocator;   /* private */
+    void *storage;             /* private */
+} rad_form_factors;
+
+RAD_API void rad_form_factor_options_default(rad_form_factor_options *options);
+
+/* The row range [row_begin, row_end) of the N x N form-factor matrix, dense, into out_rows
+   ((row_end - row_begin) * N floats, row-major). Each unordered pair {i, j} is computed once
+   from the lower-indexed patch's sample points; the other entry follows by reciprocity, so
+   A_i F_ij = A_j F_ji holds exactly and any split of the rows gives the same bits as the full
+   matrix. raycaster may be NULL only with skip_visibility. Thread safety: reentrant; uses
+   ctx->parallel_for. Cost: O((row_end-row_begin) N samples). SPEC §2. */
+RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_raycaster *raycaster,
+                                        const rad_form_factor_options *options, uint32_t row_begin,
+                                        uint32_t row_end, float *out_rows, const rad_context *ctx);
+
+/* The dense N x N matrix (N = patches->count; SIZE_OVERFLOW when N*N*4 bytes does not fit).
+   Computes each unordered pair once: half the work of N rows. Same values as the rows call. */
+RAD_API rad_result rad_form_factors_dense(const rad_patches *patches, const rad_raycaster *raycaster,
+                                          const rad_form_factor_options *options, const rad_context *ctx,
+                                          rad_form_factors **out);
+
+/* The sparse (CSR) matrix: entries <= drop_threshold are dropped (exact zeros always).
+   Built row batch by row batch with rad_form_factor_rows, so it never holds N*N floats but
+   computes every pair twice. */
+RAD_API rad_result rad_form_factors_sparse(const rad_patches *patches, const rad_raycaster *raycaster,
+                                           const rad_form_factor_options *options, const rad_context *ctx,
+                                           rad_form_factors **out);
+RAD_API void rad_form_factors_destroy(rad_form_factors *ff);
+
+/* Point to polygon, unoccluded, analytic (Lambert's contour integral): the form factor from a
+   differential area at p with unit normal n to the convex or simple polygon 'vertices'
+   (count points, 3 floats each, counter-clockwise seen from its front). The polygon is clipped
+   to p's upper half-space; returns 0 when p is behind the polygon's plane. SPEC §2. */
+RAD_API float rad_ff_point_polygon(const float p[3], const float n[3], const float *vertices, uint32_t count);
+
+/* Point to point (SPEC §2, T eq. 5.1) without visibility:
+   s_j cos(r, n_i) cos(-r, n_j) / (pi max(|r|^2, s_j / pi)), 0 when either cosine is <= 0. */
+RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const float pj[3], const float nj[3],
+                                 float sj);
+
+/* ======================================================================================== */
+/* >>api_solve: classic solvers                                                             */
+/* ======================================================================================== */
+
+typedef enum rad_output { RAD_OUTPUT_INDIRECT = 0, RAD_OUTPUT_TOTAL = 1 } rad_output;
+
+/* The linear system B = E + (rho o F) B. All pointers borrowed. */
+typedef struct rad_system {
+    const rad_matrix *F;     /* N x N form factors */
+    const float *albedo;     /* 3N, each in [0,1) */
+    const float *E;          /* 3N source (see UNITS AND CONVENTIONS) */
+    const float *areas;      /* N, needed by progressive refinement only */
+    uint32_t n;
+} rad_system;
+
+/* Residual report: return non-zero to stop early (the solver then returns RAD_SUCCESS with
+   what it has). residual is the largest change of any B_i in the sweep divided by max_i |E_i|
+   for Gauss-Seidel, the total unshot power / the initial power for progressive refinement. */
+typedef int (*rad_residual_fn)(void *user, uint32_t iteration, double residual);
+
+typedef struct rad_solve_options {
+    rad_output output;         /* RAD_OUTPUT_INDIRECT (default) or RAD_OUTPUT_TOTAL */
+    uint32_t bounces;          /* Jacobi: K (0 returns 0 indirect / E total) */
+    double tolerance;          /* Gauss-Seidel, shooting: relative (0: 1e-6) */
+    uint32_t max_iterations;   /* GS sweeps (0: 1000), shooting steps (0: 100 N) */
+    rad_residual_fn on_residual;
+    void *residual_user;
+} rad_solve_options;
+
+typedef struct rad_solve_stats {
+    uint32_t iterations;       /* bounces, sweeps or shooting steps done */
+    double residual;           /* last residual (see rad_residual_fn) */
+} rad_solve_stats;
+
+RAD_API void rad_solve_options_default(rad_solve_options *options);
+/* Fills 'system' from patches (albedo, areas), a matrix and E. */
+RAD_API void rad_system_init(rad_system *system, const rad_matrix *F, const rad_patches *patches, const float *E);
+
+/* out = F x for RGB vectors (3 floats per row/column). Dense or CSR. Parallel over rows.
+   out must not alias x. Cost: one pass over F. */
+RAD_API rad_result rad_matrix_multiply(const rad_matrix *F, const float *x, float *out, const rad_context *ctx);
+
+/* Jacobi bounces: B^0 = E, B^k = (rho o F) B^(k-1); out = L_K or E + L_K. O(K N^2). SPEC §3. */
+RAD_API rad_result rad_solve_jacobi(const rad_system *system, const rad_solve_options *options, float *out,
+                                    rad_solve_stats *stats, const rad_context *ctx);
+/* Gauss-Seidel sweeps in patch order until the residual is below tolerance. Serial.
+   Returns NOT_CONVERGED (out still written) after max_iterations. */
+RAD_API rad_result rad_solve_gauss_seidel(const rad_system *system, const rad_solve_options *options, float *out,
+                                          rad_solve_stats *stats, const rad_context *ctx);
+/* Progressive refinement (Southwell shooting, Cohen et al. 1988): shoots the patch with the
+   largest unshot power A_i |dB_i| (summed over channels); dB_j += rho_j F_ij A_i / A_j dB_i.
+   Needs system->areas. Reports the residual after every step. O(N) per step. */
+RAD_API rad_result rad_solve_progressive(const rad_system *system, const rad_solve_options *options, float *out,
+                                         rad_solve_stats *stats, const rad_context *ctx);
+/* Direct solve of (I - rho o F) B = E by LU with partial pivoting in double precision, per
+   channel. O(N^3) time, 8 N^2 bytes. For small N, teaching, and as the reference. */
+RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_options *options, float *out,
+                                    const rad_context *ctx);
+
+/* ======================================================================================== */
+/* >>api_light: lights and the source term                                                  */
+/* ======================================================================================== */
+
+typedef enum rad_light_type {
+    RAD_LIGHT_DIRECTIONAL = 0, /* sun: 'color' is the irradiance on a surface facing it;
+                                  'direction' points from the light into the scene */
+    RAD_LIGHT_POINT = 1,       /* 'color' is the intensity (W/sr) */
+    RAD_LIGHT_SPOT = 2,        /* point light limited to a cone around 'direction' */
+    RAD_LIGHT_SKY = 3          /* constant sky: 'color' is its exitance E_0 (= pi * its
+                                  radiance), the irradiance on an unoccluded surface */
+} rad_light_type;
+
+typedef enum rad_falloff {
+    RAD_FALLOFF_QUADRATIC = 0, /* I / d^2 (physical) */
+    RAD_FALLOFF_LINEAR = 1     /* I / d (the seed's LINEAR_FALOFF option; not physical) */
+} rad_falloff;
+
+typedef struct rad_light {
+    rad_light_type type;
+    float color[3];
+    float position[3];         /* point, spot */
+    float direction[3];        /* directional, spot (need not be unit) */
+    rad_falloff falloff;       /* point, spot */
+    float min_distance;        /* point, spot: d is clamped from below to this (0: 1e-6 of
+                                  the scene diagonal) */
+    float inner_angle;         /* spot: half-angles in radians; full intensity inside inner, */
+    float outer_angle;         /* smoothstep to 0 at outer (outer > inner) */
+} rad_light;
+
+typedef struct rad_direct_options {
+    uint32_t samples;          /* points per patch (0: 16) */
+    uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
+    int include_emitters;      /* non-zero (default): emissive triangles are area lights */
+    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5) */
+    uint32_t seed;
+} rad_direct_options;
+
+RAD_API void rad_direct_options_default(rad_direct_options *options);
+
+/* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
+   sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
+   (analytic point-to-polygon irradiance pi L F times the fraction of 'light_samples'
+   unoccluded shadow rays). A point receives nothing from behind its normal. 'samples' is
+   unused here. Errors: INVALID_ARGUMENT, NON_FINITE (a light), RAYCAST_FAILED. */
+RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
+                                         const rad_light *lights, uint32_t light_count,
+                                         const rad_direct_options *options, const float *points,
+                                         const float *normals, uint32_t count, float *out_irradiance,
+                                         const rad_context *ctx);
+
+/* Mean direct irradiance over each patch ('samples' Hammersley points per patch), 3N floats.
+   A patch's own triangle never lights it. */
+RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster,
+                                      const rad_light *lights, uint32_t light_count,
+                                      const rad_direct_options *options, float *out_irradiance,
+                                      const rad_context *ctx);
+
+typedef enum rad_source_mode {
+    RAD_SOURCE_EMISSION = 0,   /* E_i = pi * L_i: emitters are the source */
+    RAD_SOURCE_DIRECT = 1      /* E_i = rho_i * D_i: direct light is the source; emission is
+                                  kept out of the system */
+} rad_source_mode;
+
+/* Builds E (3N floats) from the patches one of the two ways of UNITS AND CONVENTIONS.
+   direct_irradiance (3N) is required for RAD_SOURCE_DIRECT and must be NULL for
+   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT). */
+RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
+                               float *out_E);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RADIOSITY_H */
+
+/* ---- stop here if you only want the API; the implementation follows ---- */
+
+#if defined(RADIOSITY_IMPLEMENTATION) && !defined(RADIOSITY_IMPLEMENTATION_INCLUDED)
+#define RADIOSITY_IMPLEMENTATION_INCLUDED
+
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <float.h>
+#include <stdio.h>
+#include <stdarg.h>
+
+#if defined(RAD_MALLOC) && defined(RAD_REALLOC) && defined(RAD_FREE)
+/* all three given */
+#elif !defined(RAD_MALLOC) && !defined(RAD_REALLOC) && !defined(RAD_FREE)
+#  define RAD_MALLOC(size) malloc(size)
+#  define RAD_REALLOC(ptr, size) realloc(ptr, size)
+#  define RAD_FREE(ptr) free(ptr)
+#else
+#  error "radiosity.h: define all of RAD_MALLOC, RAD_REALLOC and RAD_FREE, or none of them"
+#endif
+
+#ifndef RAD_ASSERT
+#  include <assert.h>
+#  define RAD_ASSERT(x) assert(x)
+#endif
+
+#if !defined(RAD_NO_SIMD) && (defined(__SSE2__) || defined(_M_X64) || (defined(_M_IX86_FP) && _M_IX86_FP >= 2))
+#  define RAD__SSE2 1
+#  include <emmintrin.h>
+#endif
+#if !defined(RAD_NO_SIMD) && defined(__AVX__)
+#  define RAD__AVX 1
+#  include <immintrin.h>
+#endif
+
+#define RAD__PI 3.14159265358979323846
+#define RAD__MAX_SAMPLES 256u
+#define RAD__RAY_BATCH 1024u
+
+/* compile-time checks: layouts shaders and files will rely on */
+typedef char rad__check_ray_size[(sizeof(rad_ray) == 32) ? 1 : -1];
+typedef char rad__check_hit_size[(sizeof(rad_hit) == 16) ? 1 : -1];
+typedef char rad__check_float_size[(sizeof(float) == 4) ? 1 : -1];
+
+/* ======================================================================================== */
+/* >>core: results, allocation, logging, tasks                                              */
+/* ======================================================================================== */
+
+RAD_API const char *rad_result_string(rad_result result)
+{
+    switch (result) {
+    case RAD_SUCCESS: return "RAD_SUCCESS: no error";
+    case RAD_ERROR_INVALID_ARGUMENT: return "RAD_ERROR_INVALID_ARGUMENT: a NULL pointer, zero count or bad option";
+    case RAD_ERROR_OUT_OF_MEMORY: return "RAD_ERROR_OUT_OF_MEMORY: an allocation failed";
+    case RAD_ERROR_SIZE_OVERFLOW: return "RAD_ERROR_SIZE_OVERFLOW: a size does not fit its type";
+    case RAD_ERROR_EMPTY_SCENE: return "RAD_ERROR_EMPTY_SCENE: the scene has no triangles";
+    case RAD_ERROR_INDEX_OUT_OF_RANGE: return "RAD_ERROR_INDEX_OUT_OF_RANGE: a vertex index is out of range";
+    case RAD_ERROR_NON_FINITE: return "RAD_ERROR_NON_FINITE: NaN or infinity in the input";
+    case RAD_ERROR_DEGENERATE_TRIANGLE: return "RAD_ERROR_DEGENERATE_TRIANGLE: a triangle has zero area";
+    case RAD_ERROR_ALBEDO_RANGE: return "RAD_ERROR_ALBEDO_RANGE: an albedo is outside [0, 1)";
+    case RAD_ERROR_NEGATIVE_EMISSION: return "RAD_ERROR_NEGATIVE_EMISSION: an emission is negative or not finite";
+    case RAD_ERROR_MATERIAL_OUT_OF_RANGE: return "RAD_ERROR_MATERIAL_OUT_OF_RANGE: a material index is out of range";
+    case RAD_ERROR_CANCELLED: return "RAD_ERROR_CANCELLED: the progress callback cancelled the call";
+    case RAD_ERROR_NOT_CONVERGED: return "RAD_ERROR_NOT_CONVERGED: the iteration limit was reached";
+    case RAD_ERROR_SINGULAR: return "RAD_ERROR_SINGULAR: the system matrix is singular";
+    case RAD_ERROR_UNAVAILABLE: return "RAD_ERROR_UNAVAILABLE: the feature is not compiled in";
+    case RAD_ERROR_RAYCAST_FAILED: return "RAD_ERROR_RAYCAST_FAILED: a ray-query callback failed";
+    case RAD_ERROR_SIZE_MISMATCH: return "RAD_ERROR_SIZE_MISMATCH: sizes of the inputs do not match";
+    }
+    return "RAD_ERROR_UNKNOWN: not a rad_result value";
+}
+
+typedef struct rad__ctx {
+    rad_allocator allocator;
+    void (*log)(void *user, rad_log_level level, const char *message);
+    void *log_user;
+    rad_parallel_for_fn parallel_for;
+    void *parallel_user;
+    uint32_t tasks;
+    int (*progress)(void *user, float fraction);
+    void *progress_user;
+} rad__ctx;
+
+static void rad__parallel_default(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+#ifdef _OPENMP
+    int i, n = (int)count;
+    (void)user;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (i = 0; i < n; ++i) fn(data, (uint32_t)i);
+#else
+    uint32_t i;
+    (void)user;
+    for (i = 0; i < count; ++i) fn(data, i);
+#endif
+}
+
+static void rad__ctx_init(rad__ctx *c, const rad_context *ctx)
+{
+    memset(c, 0, sizeof(*c));
+    if (ctx) {
+        if (ctx->allocator.alloc && ctx->allocator.free) c->allocator = ctx->allocator;
+        c->log = ctx->log;
+        c->log_user = ctx->log_user;
+        c->parallel_for = ctx->parallel_for;
+        c->parallel_user = ctx->parallel_user;
+        c->tasks = ctx->task_count;
+        c->progress = ctx->progress;
+        c->progress_user = ctx->progress_user;
+    }
+    if (!c->parallel_for) c->parallel_for = rad__parallel_default;
+    if (c->tasks == 0) c->tasks = 64;
+    if (c->tasks > 4096) c->tasks = 4096;
+}
+
+static void *rad__alloc(const rad_allocator *a, size_t size)
+{
+    if (size == 0) size = 1;
+    if (a->alloc) return a->alloc(a->user, size);
+    return RAD_MALLOC(size);
+}
+
+static void rad__free(const rad_allocator *a, void *p)
+{
+    if (!p) return;
+    if (a->free) a->free(a->user, p);
+    else RAD_FREE(p);
+}
+
+/* Grows a buffer from old_size to new_size bytes, keeping the contents. */
+static void *rad__realloc(const rad_allocator *a, void *p, size_t old_size, size_t new_size)
+{
+    void *q;
+    if (!a->alloc) return RAD_REALLOC(p, new_size ? new_size : 1);
+    q = rad__alloc(a, new_size);
+    if (!q) return NULL;
+    if (p) {
+        memcpy(q, p, old_size < new_size ? old_size : new_size);
+        rad__free(a, p);
+    }
+    return q;
+}
+
+/* a * b into *out; returns 0 on overflow */
+static int rad__mul(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > (size_t)-1 / a) return 0;
+    *out = a * b;
+    return 1;
+}
+
+static int rad__mul3(size_t a, size_t b, size_t c, size_t *out)
+{
+    size_t t;
+    return rad__mul(a, b, &t) && rad__mul(t, c, out);
+}
+
+/* Allocates count * size bytes, checking the product. */
+static void *rad__alloc_array(const rad_allocator *a, size_t count, size_t size)
+{
+    size_t bytes;
+    if (!rad__mul(count, size, &bytes)) return NULL;
+    return rad__alloc(a, bytes);
+}
+
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static void rad__log(const rad__ctx *c, rad_log_level level, const char *fmt, ...)
+{
+    char buf[512];
+    va_list ap;
+    if (!c || !c->log) return;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof(buf), fmt, ap);
+    va_end(ap);
+    c->log(c->log_user, level, buf);
+}
+
+static int rad__finite(float x) { return x == x && x - x == 0.0f; }
+static int rad__finite3(const float *v) { return rad__finite(v[0]) && rad__finite(v[1]) && rad__finite(v[2]); }
+
+/* vector helpers */
+static void rad__sub(float *o, const float *a, const float *b) { o[0] = a[0] - b[0]; o[1] = a[1] - b[1]; o[2] = a[2] - b[2]; }
+static float rad__dot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static void rad__cross(float *o, const float *a, const float *b)
+{
+    float x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+    o[0] = x; o[1] = y; o[2] = z;
+}
+static float rad__len(const float *a) { return (float)sqrt((double)rad__dot(a, a)); }
+static void rad__normalize(float *a)
+{
+    float l = rad__len(a);
+    if (l > 0.0f) { a[0] /= l; a[1] /= l; a[2] /= l; }
+}
+
+/* ---- tasks over rows, with progress and cancel ---- */
+
+/* Processes one row on task 'task' (0 <= task < tasks). Returns RAD_SUCCESS or an error. */
+typedef rad_result (*rad__row_fn)(void *data, uint32_t row, uint32_t task);
+
+typedef struct rad__rows_job {
+    rad__row_fn fn;
+    void *data;
+    uint32_t begin, end, tasks;
+    rad_result *results;
+} rad__rows_job;
+
+static void rad__rows_task(void *d, uint32_t index)
+{
+    rad__rows_job *job = (rad__rows_job *)d;
+    uint32_t row;
+    rad_result r = RAD_SUCCESS;
+    /* cyclic distribution balances rows of unequal cost (triangular workloads) */
+    for (row = job->begin + index; row < job->end && r == RAD_SUCCESS; row += job->tasks) r = job->fn(job->data, row, index);
+    job->results[index] = r;
+}
+
+/* Runs fn over rows [0, count) in batches, parallel inside a batch; progress after each batch.
+   'tasks' is the number of task slots the caller prepared scratch for. */
+static rad_result rad__for_rows(const rad__ctx *c, uint32_t count, uint32_t tasks, rad__row_fn fn, void *data)
+{
+    rad__rows_job job;
+    uint32_t batches, b, t;
+    rad_result r = RAD_SUCCESS;
+    if (count == 0) return RAD_SUCCESS;
+    job.results = (rad_result *)rad__alloc_array(&c->allocator, tasks, sizeof(rad_result));
+    if (!job.results) return RAD_ERROR_OUT_OF_MEMORY;
+    job.fn = fn;
+    job.data = data;
+    job.tasks = tasks;
+    batches = count / (tasks * 4u);
+    if (batches < 1) batches = 1;
+    if (batches > 100) batches = 100;
+    if (!c->progress) batches = 1;
+    for (b = 0; b < batches && r == RAD_SUCCESS; ++b) {
+        job.begin = (uint32_t)((uint64_t)count * b / batches);
+        job.end = (uint32_t)((uint64_t)count * (b + 1) / batches);
+        for (t = 0; t < tasks; ++t) job.results[t] = RAD_SUCCESS;
+        c->parallel_for(c->parallel_user, tasks, rad__rows_task, &job);
+        for (t = 0; t < tasks; ++t)
+            if (job.results[t] != RAD_SUCCESS) { r = job.results[t]; break; }
+        if (r == RAD_SUCCESS && c->progress && c->progress(c->progress_user, (float)(b + 1) / (float)batches))
+            r = RAD_ERROR_CANCELLED;
+    }
+    rad__free(&c->allocator, job.results);
+    return r;
+}
+
+/* ---- sampling ---- */
+
+static float rad__radical_inverse(uint32_t i)
+{
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x00ff00ffu) << 8) | ((i & 0xff00ff00u) >> 8);
+    i = ((i & 0x0f0f0f0fu) << 4) | ((i & 0xf0f0f0f0u) >> 4);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xccccccccu) >> 2);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xaaaaaaaau) >> 1);
+    return (float)((double)i * (1.0 / 4294967296.0));
+}
+
+static uint32_t rad__hash(uint32_t x)
+{
+    x ^= x >> 16; x *= 0x7feb352du;
+    x ^= x >> 15; x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+static float rad__frac(float x) { return x - (float)floor((double)x); }
+
+/* Hammersley point s of n in the open unit square, Cranley-Patterson rotated by (r1, r2). */
+static void rad__hammersley(uint32_t s, uint32_t n, float r1, float r2, float *u1, float *u2)
+{
+    float a = ((float)s + 0.5f) / (float)n;
+    float b = rad__radical_inverse(s) + 0.5f / (float)n;
+    a = rad__frac(a + r1);
+    b = rad__frac(b + r2);
+    /* keep strictly inside (0,1) so triangle points never sit on an edge */
+    if (a < 1e-6f) a = 1e-6f;
+    if (a > 1.0f - 1e-6f) a = 1.0f - 1e-6f;
+    if (b < 1e-6f) b = 1e-6f;
+    if (b > 1.0f - 1e-6f) b = 1.0f - 1e-6f;
+    *u1 = a;
+    *u2 = b;
+}
+
+/* Uniform point on triangle (v0, v1, v2) from (u1, u2) by the square-root map. */
+static void rad__triangle_point(const float *v0, const float *v1, const float *v2, float u1, float u2, float *out)
+{
+    float su = (float)sqrt((double)u1);
+    float b0 = 1.0f - su, b1 = u2 * su, b2 = su * (1.0f - u2);
+    int k;
+    for (k = 0; k < 3; ++k) out[k] = b0 * v0[k] + b1 * v1[k] + b2 * v2[k];
+}
+
+/* ======================================================================================== */
+/* >>scene: scene input and validation                                                      */
+/* ======================================================================================== */
+
+static const float *rad__strided(const float *base, size_t stride, uint32_t i)
+{
+    return (const float *)(const void *)((const char *)base + stride * (size_t)i);
+}
+
+static const char *rad__mesh_name(const rad_mesh_desc *m) { return (m->name && m->name[0]) ? m->name : "(unnamed)"; }
+
+/* Twice the area vector of a triangle in double into cr (length into *len). Returns 0 when the
+   triangle is degenerate: zero area, collinear to within float precision relative to its
+   longest edge, or an area too small for float. */
+static int rad__triangle_cross(const float *p0, const float *p1, const float *p2, double *cr, double *len)
+{
+    double e1[3], e2[3], l1, l2, l3, lmax;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)p1[k] - (double)p0[k];
+        e2[k] = (double)p2[k] - (double)p0[k];
+    }
+    cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    *len = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+    l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    l3 = (e2[0] - e1[0]) * (e2[0] - e1[0]) + (e2[1] - e1[1]) * (e2[1] - e1[1]) + (e2[2] - e1[2]) * (e2[2] - e1[2]);
+    lmax = l1 > l2 ? l1 : l2;
+    lmax = lmax > l3 ? lmax : l3;
+    return (*len > 1e-10 * lmax) && (0.5 * *len >= (double)FLT_MIN);
+}
+
+static uint32_t rad__mesh_index(const rad_mesh_desc *m, uint32_t t, int k)
+{
+    return m->indices ? m->indices[3 * (size_t)t + (size_t)k] : 3 * t + (uint32_t)k;
+}
+
+RAD_API void rad_scene_destroy(rad_scene *scene)
+{
+    rad_allocator a;
+    uint32_t i;
+    if (!scene) return;
+    a = scene->allocator;
+    rad__free(&a, scene->positions);
+    rad__free(&a, scene->normals);
+    rad__free(&a, scene->uvs);
+    rad__free(&a, scene->areas);
+    rad__free(&a, scene->materials);
+    rad__free(&a, scene->meshes);
+    rad__free(&a, scene->source_triangles);
+    rad__free(&a, scene->materials_table);
+    if (scene->mesh_names)
+        for (i = 0; i < scene->mesh_count; ++i) rad__free(&a, scene->mesh_names[i]);
+    rad__free(&a, scene->mesh_names);
+    rad__free(&a, scene);
+}
+
+static rad_result rad__validate_materials(const rad_scene_desc *desc, const rad__ctx *c)
+{
+    uint32_t i;
+    int k;
+    if (desc->material_count > 0 && !desc->materials) {
+        rad__log(c, RAD_LOG_ERROR, "material_count is %u but materials is NULL", desc->material_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (i = 0; i < desc->material_count; ++i) {
+        const rad_material *m = &desc->materials[i];
+        for (k = 0; k < 3; ++k) {
+            if (!rad__finite(m->albedo[k]) || m->albedo[k] < 0.0f || m->albedo[k] >= 1.0f) {
+                rad__log(c, RAD_LOG_ERROR, "material %u: albedo channel %d is %g, outside [0, 1)", i, k, (double)m->albedo[k]);
+                return RAD_ERROR_ALBEDO_RANGE;
+            }
+            if (!rad__finite(m->emission[k]) || m->emission[k] < 0.0f) {
+                rad__log(c, RAD_LOG_ERROR, "material %u: emission channel %d is %g (must be finite and >= 0)", i, k,
+                         (double)m->emission[k]);
+                return RAD_ERROR_NEGATIVE_EMISSION;
+            }
+        }
+        if (m->texture != 0 && !desc->albedo_lookup) {
+            rad__log(c, RAD_LOG_ERROR, "material %u has texture %u but the scene has no albedo_lookup callback", i, m->texture);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+/* Validates one mesh; counts its usable triangles into *kept. */
+static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, const rad__ctx *c, uint32_t *kept)
+{
+    const rad_mesh_desc *m = &desc->meshes[mi];
+    size_t ps = m->position_stride ? m->position_stride : 3 * sizeof(float);
+    size_t ns = m->normal_stride ? m->normal_stride : 3 * sizeof(float);
+    size_t us = m->uv_stride ? m->uv_stride : 2 * sizeof(float);
+    uint32_t v, t;
+    int k;
+    *kept = 0;
+    if (m->triangle_count == 0) return RAD_SUCCESS;
+    if (!m->positions) {
+        rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': positions is NULL", mi, rad__mesh_name(m));
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (ps < 3 * sizeof(float) || (m->normals && ns < 3 * sizeof(float)) || (m->uvs && us < 2 * sizeof(float))) {
+        rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': a stride is smaller than its element", mi, rad__mesh_name(m));
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!m->indices && (uint64_t)m->triangle_count * 3u > (uint64_t)m->vertex_count) {
+        rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': %u triangles without indices need %llu vertices, have %u", mi,
+                 rad__mesh_name(m), m->triangle_count, (unsigned long long)m->triangle_count * 3u, m->vertex_count);
+        return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    }
+    for (v = 0; v < m->vertex_count; ++v) {
+        const float *p = rad__strided(m->positions, ps, v);
+        if (!rad__finite3(p)) {
+            rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': vertex %u has a non-finite position (%g %g %g)", mi,
+                     rad__mesh_name(m), v, (double)p[0], (double)p[1], (double)p[2]);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (m->normals && !rad__finite3(rad__strided(m->normals, ns, v))) {
+            rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': vertex %u has a non-finite normal", mi, rad__mesh_name(m), v);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (m->uvs) {
+            const float *uv = rad__strided(m->uvs, us, v);
+            if (!rad__finite(uv[0]) || !rad__finite(uv[1])) {
+                rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': vertex %u has a non-finite uv", mi, rad__mesh_name(m), v);
+                return RAD_ERROR_NON_FINITE;
+            }
+        }
+    }
+    for (t = 0; t < m->triangle_count; ++t) {
+        uint32_t idx[3], mat = m->material_ids ? m->material_ids[t] : m->material;
+        double cr[3], cl;
+        const float *p[3];
+        for (k = 0; k < 3; ++k) {
+            idx[k] = rad__mesh_index(m, t, k);
+            if (idx[k] >= m->vertex_count) {
+                rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u index %d is %u, vertex_count is %u", mi,
+                         rad__mesh_name(m), t, k, idx[k], m->vertex_count);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+            p[k] = rad__strided(m->positions, ps, idx[k]);
+        }
+        if (mat >= desc->material_count) {
+            rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u uses material %u, material_count is %u", mi,
+                     rad__mesh_name(m), t, mat, desc->material_count);
+            return RAD_ERROR_MATERIAL_OUT_OF_RANGE;
+        }
+        if (desc->materials[mat].texture != 0 && !m->uvs) {
+            rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u uses textured material %u but the mesh has no uvs", mi,
+                     rad__mesh_name(m), t, mat);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (!rad__triangle_cross(p[0], p[1], p[2], cr, &cl)) {
+            if (desc->flags & RAD_SCENE_SKIP_DEGENERATE) continue;
+            rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u has zero area (vertices %u %u %u)", mi, rad__mesh_name(m),
+                     t, idx[0], idx[1], idx[2]);
+            return RAD_ERROR_DEGENERATE_TRIANGLE;
+        }
+        ++*kept;
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_context *ctx, rad_scene **out)
+{
+    rad__ctx c;
+    rad_scene *s;
+    rad_result r;
+    uint64_t total = 0, input = 0;
+    uint32_t mi, t, n, dst;
+    int k, any_uv = 0;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!desc) return RAD_ERROR_INVALID_ARGUMENT;
+    if (desc->mesh_count > 0 && !desc->meshes) {
+        rad__log(&c, RAD_LOG_ERROR, "mesh_count is %u but meshes is NULL", desc->mesh_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    r = rad__validate_materials(desc, &c);
+    if (r != RAD_SUCCESS) return r;
+    for (mi = 0; mi < desc->mesh_count; ++mi) {
+        uint32_t kept;
+        r = rad__validate_mesh(desc, mi, &c, &kept);
+        if (r != RAD_SUCCESS) return r;
+        total += kept;
+        input += desc->meshes[mi].triangle_count;
+        if (desc->meshes[mi].uvs) any_uv = 1;
+    }
+    if (total == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "the scene has no triangles (%llu given, %llu degenerate)", (unsigned long long)input,
+                 (unsigned long long)(input - total));
+        return RAD_ERROR_EMPTY_SCENE;
+    }
+    if (total >= (uint64_t)RAD_NONE) {
+        rad__log(&c, RAD_LOG_ERROR, "%llu triangles: at most %u are supported", (unsigned long long)total, RAD_NONE - 1u);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    n = (uint32_t)total;
+    s = (rad_scene *)rad__alloc(&c.allocator, sizeof(rad_scene));
+    if (!s) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(s, 0, sizeof(*s));
+    s->allocator = c.allocator;
+    s->triangle_count = n;
+    s->material_count = desc->material_count;
+    s->skipped_triangles = (uint32_t)(input - total);
+    s->albedo_lookup = desc->albedo_lookup;
+    s->albedo_user = desc->albedo_user;
+    s->positions = (float *)rad__alloc_array(&c.allocator, (size_t)n * 9u, sizeof(float));
+    s->normals = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
+    s->areas = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
+    s->materials = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    s->meshes = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    s->source_triangles = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    s->materials_table = (rad_material *)rad__alloc_array(&c.allocator, desc->material_count, sizeof(rad_material));
+    s->mesh_names = (char **)rad__alloc_array(&c.allocator, desc->mesh_count, sizeof(char *));
+    if (any_uv) s->uvs = (float *)rad__alloc_array(&c.allocator, (size_t)n * 6u, sizeof(float));
+    if (!s->positions || !s->normals || !s->areas || !s->materials || !s->meshes || !s->source_triangles ||
+        !s->materials_table || !s->mesh_names || (any_uv && !s->uvs)) {
+        rad_scene_destroy(s);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(s->mesh_names, 0, sizeof(char *) * desc->mesh_count);
+    s->mesh_count = desc->mesh_count;
+    if (desc->material_count) memcpy(s->materials_table, desc->materials, sizeof(rad_material) * desc->material_count);
+    for (mi = 0; mi < desc->mesh_count; ++mi) {
+        const char *name = desc->meshes[mi].name ? desc->meshes[mi].name : "";
+        size_t len = strlen(name);
+        s->mesh_names[mi] = (char *)rad__alloc(&c.allocator, len + 1);
+        if (!s->mesh_names[mi]) { rad_scene_destroy(s); return RAD_ERROR_OUT_OF_MEMORY; }
+        memcpy(s->mesh_names[mi], name, len + 1);
+    }
+    for (k = 0; k < 3; ++k) { s->bounds_min[k] = FLT_MAX; s->bounds_max[k] = -FLT_MAX; }
+    dst = 0;
+    for (mi = 0; mi < desc->mesh_count; ++mi) {
+        const rad_mesh_desc *m = &desc->meshes[mi];
+        size_t ps = m->position_stride ? m->position_stride : 3 * sizeof(float);
+        size_t us = m->uv_stride ? m->uv_stride : 2 * sizeof(float);
+        for (t = 0; t < m->triangle_count; ++t) {
+            double cr[3], cl;
+            float *P = s->positions + 9 * (size_t)dst;
+            int v;
+            for (v = 0; v < 3; ++v) {
+                uint32_t id = rad__mesh_index(m, t, v);
+                const float *p = rad__strided(m->positions, ps, id);
+                P[3 * v] = p[0]; P[3 * v + 1] = p[1]; P[3 * v + 2] = p[2];
+                if (s->uvs) {
+                    const float *uv = m->uvs ? rad__strided(m->uvs, us, id) : NULL;
+                    s->uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
+                    s->uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
+                }
+            }
+            if (!rad__triangle_cross(P, P + 3, P + 6, cr, &cl)) continue; /* skipped (validation checked the flag) */
+            for (k = 0; k < 3; ++k) s->normals[3 * (size_t)dst + (size_t)k] = (float)(cr[k] / cl);
+            s->areas[dst] = (float)(0.5 * cl);
+            s->materials[dst] = m->material_ids ? m->material_ids[t] : m->material;
+            s->meshes[dst] = mi;
+            s->source_triangles[dst] = t;
+            for (v = 0; v < 3; ++v)
+                for (k = 0; k < 3; ++k) {
+                    if (P[3 * v + k] < s->bounds_min[k]) s->bounds_min[k] = P[3 * v + k];
+                    if (P[3 * v + k] > s->bounds_max[k]) s->bounds_max[k] = P[3 * v + k];
+                }
+            ++dst;
+        }
+    }
+    RAD_ASSERT(dst == n);
+    {
+        float d[3];
+        rad__sub(d, s->bounds_max, s->bounds_min);
+        s->diagonal = rad__len(d);
+        if (!(s->diagonal > 0.0f) || !rad__finite(s->diagonal)) {
+            rad__log(&c, RAD_LOG_ERROR, "the scene's bounding box diagonal is %g (too large for float)", (double)s->diagonal);
+            rad_scene_destroy(s);
+            return RAD_ERROR_NON_FINITE;
+        }
+    }
+    *out = s;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3])
+{
+    const rad_material *m;
+    out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
+    if (!scene || triangle >= scene->triangle_count) return;
+    m = &scene->materials_table[scene->materials[triangle]];
+    if (m->texture && scene->albedo_lookup && scene->uvs) {
+        const float *uv = scene->uvs + 6 * (size_t)triangle;
+        float b0 = 1.0f - b1 - b2;
+        float u = b0 * uv[0] + b1 * uv[2] + b2 * uv[4];
+        float v = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
+        scene->albedo_lookup(scene->albedo_user, m->texture, u, v, out_rgb);
+    } else {
+        out_rgb[0] = m->albedo[0];
+        out_rgb[1] = m->albedo[1];
+        out_rgb[2] = m->albedo[2];
+    }
+}
+
+/* ---- the built-in Cornell box (original Cornell data in metres, as shared/data/cornell.obj) ---- */
+
+static const float rad__cornell_positions[] = {
+    /* floor */ 0.5528f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.5592f, 0.5496f, 0.0f, 0.5592f,
+    /* ceiling */ 0.5560f, 0.5488f, 0.0f, 0.5560f, 0.5488f, 0.5592f, 0.0f, 0.5488f, 0.5592f, 0.0f, 0.5488f, 0.0f,
+    /* back */ 0.5496f, 0.0f, 0.5592f, 0.0f, 0.0f, 0.5592f, 0.0f, 0.5488f, 0.5592f, 0.5560f, 0.5488f, 0.5592f,
+    /* green */ 0.0f, 0.0f, 0.5592f, 0.0f, 0.0f, 0.0f, 0.0f, 0.5488f, 0.0f, 0.0f, 0.5488f, 0.5592f,
+    /* red */ 0.5528f, 0.0f, 0.0f, 0.5496f, 0.0f, 0.5592f, 0.5560f, 0.5488f, 0.5592f, 0.5560f, 0.5488f, 0.0f,
+    /* light */ 0.3430f, 0.5487f, 0.2270f, 0.3430f, 0.5487f, 0.3320f, 0.2130f, 0.5487f, 0.3320f, 0.2130f, 0.5487f, 0.2270f,
+    /* short block */
+    0.1300f, 0.1650f, 0.0650f, 0.0820f, 0.1650f, 0.2250f, 0.2400f, 0.1650f, 0.2720f, 0.2900f, 0.1650f, 0.1140f,
+    0.2900f, 0.0f, 0.1140f, 0.2900f, 0.1650f, 0.1140f, 0.2400f, 0.1650f, 0.2720f, 0.2400f, 0.0f, 0.2720f,
+    0.1300f, 0.0f, 0.0650f, 0.1300f, 0.1650f, 0.0650f, 0.2900f, 0.1650f, 0.1140f, 0.2900f, 0.0f, 0.1140f,
+    0.0820f, 0.0f, 0.2250f, 0.0820f, 0.1650f, 0.2250f, 0.1300f, 0.1650f, 0.0650f, 0.1300f, 0.0f, 0.0650f,
+    0.2400f, 0.0f, 0.2720f, 0.2400f, 0.1650f, 0.2720f, 0.0820f, 0.1650f, 0.2250f, 0.0820f, 0.0f, 0.2250f,
+    /* tall block */
+    0.4230f, 0.3300f, 0.2470f, 0.2650f, 0.3300f, 0.2960f, 0.3140f, 0.3300f, 0.4560f, 0.4720f, 0.3300f, 0.4060f,
+    0.4230f, 0.0f, 0.2470f, 0.4230f, 0.3300f, 0.2470f, 0.4720f, 0.3300f, 0.4060f, 0.4720f, 0.0f, 0.4060f,
+    0.4720f, 0.0f, 0.4060f, 0.4720f, 0.3300f, 0.4060f, 0.3140f, 0.3300f, 0.4560f, 0.3140f, 0.0f, 0.4560f,
+    0.3140f, 0.0f, 0.4560f, 0.3140f, 0.3300f, 0.4560f, 0.2650f, 0.3300f, 0.2960f, 0.2650f, 0.0f, 0.2960f,
+    0.2650f, 0.0f, 0.2960f, 0.2650f, 0.3300f, 0.2960f, 0.4230f, 0.3300f, 0.2470f, 0.4230f, 0.0f, 0.2470f
+};
+
+/* quads (a b c d) -> triangles (a b c) (a c d), vertices local to each mesh */
+static const uint32_t rad__cornell_quad_indices[] = {
+    0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7, 8, 9, 10, 8, 10, 11, 12, 13, 14, 12, 14, 15, 16, 17, 18, 16, 18, 19
+};
+
+static const rad_material rad__cornell_materials[4] = {
+    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0 },    /* white */
+    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0 },    /* red */
+    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0 },    /* green */
+    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0 }    /* light */
+};
+
+#define RAD__CORNELL_MESH(name, first_vertex, quads, mat)                                                      \
+    { name, rad__cornell_positions + 3 * (first_vertex), 0, 4 * (quads), NULL, 0, NULL, 0, rad__cornell_quad_indices, \
+      2 * (quads), NULL, mat }
+
+static const rad_mesh_desc rad__cornell_meshes[8] = {
+    RAD__CORNELL_MESH("floor", 0, 1, 0),      RAD__CORNELL_MESH("ceiling", 4, 1, 0),
+    RAD__CORNELL_MESH("back", 8, 1, 0),       RAD__CORNELL_MESH("green", 12, 1, 2),
+    RAD__CORNELL_MESH("red", 16, 1, 1),       RAD__CORNELL_MESH("light", 20, 1, 3),
+    RAD__CORNELL_MESH("shortblock", 24, 5, 0), RAD__CORNELL_MESH("tallblock", 44, 5, 0)
+};
+#undef RAD__CORNELL_MESH
+
+RAD_API void rad_cornell_box(rad_scene_desc *desc, rad_camera *camera)
+{
+    if (desc) {
+        memset(desc, 0, sizeof(*desc));
+        desc->meshes = rad__cornell_meshes;
+        desc->mesh_count = 8;
+        desc->materials = rad__cornell_materials;
+        desc->material_count = 4;
+    }
+    if (camera) {
+        camera->position[0] = 0.278f; camera->position[1] = 0.273f; camera->position[2] = -0.8f;
+        camera->target[0] = 0.278f; camera->target[1] = 0.273f; camera->target[2] = 0.0f;
+        camera->up[0] = 0.0f; camera->up[1] = 1.0f; camera->up[2] = 0.0f;
+        camera->fov_y_degrees = 39.3077f;
+    }
+}
+
+/* ======================================================================================== */
+/* >>patches: patches, welding, locating, per-vertex values                                 */
+/* ======================================================================================== */
+
+RAD_API void rad_patch_options_default(rad_patch_options *options)
+{
+    if (!options) return;
+    memset(options, 0, sizeof(*options));
+    options->albedo_samples = 16;
+}
+
+RAD_API void rad_patches_destroy(rad_patches *p)
+{
+    rad_allocator a;
+    if (!p) return;
+    a = p->allocator;
+    rad__free(&a, p->patches);
+    rad__free(&a, p->vertices);
+    rad__free(&a, p->first_patch);
+    rad__free(&a, p->subdivision);
+    rad__free(&a, p->areas);
+    rad__free(&a, p->albedo);
+    rad__free(&a, p);
+}
+
+/* local index of the up (i, j) and down (i, j) sub-triangles of an n x n subdivision: row j
+   holds n - j up triangles then n - j - 1 down triangles */
+static uint32_t rad__sub_row(uint32_t n, uint32_t j) { return j * (2u * n - 1u) - j * (j - 1u); }
+static uint32_t rad__sub_up(uint32_t n, uint32_t i, uint32_t j) { return rad__sub_row(n, j) + i; }
+static uint32_t rad__sub_down(uint32_t n, uint32_t i, uint32_t j) { return rad__sub_row(n, j) + (n - j) + i; }
+/* lattice point (i, j) of a triangle subdivided n times, i along v0->v1, j along v0->v2;
+   row j holds n + 1 - j points */
+static uint32_t rad__lattice(uint32_t n, uint32_t i, uint32_t j) { return j * (n + 1u) - (j * (j - 1u)) / 2u + i; }
+
+typedef struct rad__weld {
+    uint64_t *keys;      /* hash table of cell keys, 0 = empty */
+    uint32_t *heads;     /* first vertex in the cell */
+    uint32_t *next;      /* chain of vertices in a cell */
+    float *normals;      /* per welded vertex: the normal of the plane it was made on */
+    size_t capacity;     /* power of two */
+} rad__weld;
+
+static uint64_t rad__cell_key(int64_t x, int64_t y, int64_t z)
+{
+    uint64_t h = (uint64_t)x * 0x9E3779B97F4A7C15ull;
+    h ^= (uint64_t)y * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
+    h ^= (uint64_t)z * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
+    return h | 1u;
+}
+
+static size_t rad__weld_slot(const rad__weld *w, uint64_t key)
+{
+    size_t mask = w->capacity - 1, i = (size_t)(key ^ (key >> 29)) & mask;
+    while (w->keys[i] != 0 && w->keys[i] != key) i = (i + 1) & mask;
+    return i;
+}
+
+/* The welded vertex at p on a plane of normal tn, created when there is none within eps. */
+static uint32_t rad__weld_vertex(rad__weld *w, float *vertices, uint32_t *nv, const float *p, const float *tn, float eps)
+{
+    int64_t cx = (int64_t)floor((double)p[0] / (double)eps), cy = (int64_t)floor((double)p[1] / (double)eps),
+            cz = (int64_t)floor((double)p[2] / (double)eps), dx, dy, dz;
+    uint64_t key;
+    size_t slot;
+    uint32_t q;
+    for (dz = -1; dz <= 1; ++dz)
+        for (dy = -1; dy <= 1; ++dy)
+            for (dx = -1; dx <= 1; ++dx) {
+                key = rad__cell_key(cx + dx, cy + dy, cz + dz);
+                slot = rad__weld_slot(w, key);
+                if (w->keys[slot] != key) continue;
+                for (q = w->heads[slot]; q != RAD_NONE; q = w->next[q]) {
+                    float d[3];
+                    rad__sub(d, vertices + 3 * (size_t)q, p);
+                    if (rad__dot(d, d) <= eps * eps && rad__dot(w->normals + 3 * (size_t)q, tn) > 0.999f) return q;
+                }
+            }
+    key = rad__cell_key(cx, cy, cz);
+    slot = rad__weld_slot(w, key);
+    q = (*nv)++;
+    memcpy(vertices + 3 * (size_t)q, p, 3 * sizeof(float));
+    memcpy(w->normals + 3 * (size_t)q, tn, 3 * sizeof(float));
+    if (w->keys[slot] != key) { w->keys[slot] = key; w->heads[slot] = RAD_NONE; }
+    w->next[q] = w->heads[slot];
+    w->heads[slot] = q;
+    return q;
+}
+
+/* Mean textured albedo over the sub-triangle with corner barycentrics lb (of triangle t). */
+static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples,
+                                    const rad__ctx *c, float *out)
+{
+    double acc[3] = { 0.0, 0.0, 0.0 };
+    uint32_t s;
+    int k;
+    for (s = 0; s < samples; ++s) {
+        float u1, u2, su, c0, c1, c2, rgb[3];
+        rad__hammersley(s, samples, 0.0f, 0.0f, &u1, &u2);
+        su = (float)sqrt((double)u1);
+        c0 = 1.0f - su; c1 = u2 * su; c2 = su * (1.0f - u2);
+        rad_scene_albedo(scene, t, c0 * lb[0][0] + c1 * lb[1][0] + c2 * lb[2][0], c0 * lb[0][1] + c1 * lb[1][1] + c2 * lb[2][1],
+                         rgb);
+        for (k = 0; k < 3; ++k) {
+            if (!rad__finite(rgb[k]) || rgb[k] < 0.0f || rgb[k] >= 1.0f) {
+                rad__log(c, RAD_LOG_ERROR, "albedo_lookup returned %g (channel %d) on triangle %u: outside [0, 1)", (double)rgb[k],
+                         k, t);
+                return RAD_ERROR_ALBEDO_RANGE;
+            }
+            acc[k] += rgb[k];
+        }
+    }
+    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)samples);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_options *options, const rad_context *ctx,
+                                      rad_patches **out)
+{
+    rad__ctx c;
+    rad_patch_options o;
+    rad_patches *P;
+    rad__weld w;
+    uint64_t total = 0, lattice_total = 0;
+    uint32_t t, nv = 0;
+    float max_area, max_edge, eps;
+    uint32_t *lattice_ids = NULL;
+    size_t lattice_cap = 0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!scene) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) o = *options; else rad_patch_options_default(&o);
+    if (!rad__finite(o.max_area) || o.max_area < 0.0f || !rad__finite(o.max_edge) || o.max_edge < 0.0f) {
+        rad__log(&c, RAD_LOG_ERROR, "patch options: max_area %g and max_edge %g must be finite and >= 0", (double)o.max_area,
+                 (double)o.max_edge);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (o.albedo_samples == 0) o.albedo_samples = 16;
+    if (o.albedo_samples > RAD__MAX_SAMPLES) o.albedo_samples = RAD__MAX_SAMPLES;
+    max_area = o.max_area;
+    max_edge = o.max_edge;
+    if (o.target_count > 0) {
+        double sum = 0.0;
+        for (t = 0; t < scene->triangle_count; ++t) sum += scene->areas[t];
+        max_area = (float)(sum / (double)o.target_count);
+    }
+    P = (rad_patches *)rad__alloc(&c.allocator, sizeof(rad_patches));
+    if (!P) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(P, 0, sizeof(*P));
+    P->allocator = c.allocator;
+    P->scene = scene;
+    P->triangle_count = scene->triangle_count;
+    P->first_patch = (uint32_t *)rad__alloc_array(&c.allocator, scene->triangle_count, sizeof(uint32_t));
+    P->subdivision = (uint32_t *)rad__alloc_array(&c.allocator, scene->triangle_count, sizeof(uint32_t));
+    if (!P->first_patch || !P->subdivision) { rad_patches_destroy(P); return RAD_ERROR_OUT_OF_MEMORY; }
+    for (t = 0; t < scene->triangle_count; ++t) {
+        const float *v = scene->positions + 9 * (size_t)t;
+        float e[3][3];
+        double n = 1.0, le = 0.0;
+        int k;
+        rad__sub(e[0], v + 3, v);
+        rad__sub(e[1], v + 6, v + 3);
+        rad__sub(e[2], v, v + 6);
+        for (k = 0; k < 3; ++k) { double l = rad__len(e[k]); if (l > le) le = l; }
+        if (max_edge > 0.0f) { double m = ceil(le / (double)max_edge); if (m > n) n = m; }
+        if (max_area > 0.0f) { double m = ceil(sqrt((double)scene->areas[t] / (double)max_area)); if (m > n) n = m; }
+        if (!(n < 65536.0)) {
+            rad__log(&c, RAD_LOG_ERROR, "triangle %u would be cut %g times per edge (more than 65535)", t, n);
+            rad_patches_destroy(P);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        P->subdivision[t] = (uint32_t)n;
+        P->first_patch[t] = (uint32_t)total;
+        total += (uint64_t)n * (uint64_t)n;
+        lattice_total += ((uint64_t)n + 1u) * ((uint64_t)n + 2u) / 2u;
+        if (total >= (uint64_t)RAD_NONE || lattice_total >= (uint64_t)RAD_NONE) {
+            rad__log(&c, RAD_LOG_ERROR, "more than %u patches: reduce the subdivision", RAD_NONE - 1u);
+            rad_patches_destroy(P);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+    }
+    P->count = (uint32_t)total;
+    P->patches = (rad_patch *)rad__alloc_array(&c.allocator, P->count, sizeof(rad_patch));
+    P->areas = (float *)rad__alloc_array(&c.allocator, P->count, sizeof(float));
+    P->albedo = (float *)rad__alloc_array(&c.allocator, (size_t)P->count * 3u, sizeof(float));
+    P->vertices = (float *)rad__alloc_array(&c.allocator, (size_t)lattice_total * 3u, sizeof(float));
+    memset(&w, 0, sizeof(w));
+    w.capacity = 16;
+    while (w.capacity < (size_t)lattice_total * 2u) w.capacity <<= 1;
+    w.keys = (uint64_t *)rad__alloc_array(&c.allocator, w.capacity, sizeof(uint64_t));
+    w.heads = (uint32_t *)rad__alloc_array(&c.allocator, w.capacity, sizeof(uint32_t));
+    w.next = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)lattice_total, sizeof(uint32_t));
+    w.normals = (float *)rad__alloc_array(&c.allocator, (size_t)lattice_total * 3u, sizeof(float));
+    if (!P->patches || !P->areas || !P->albedo || !P->vertices || !w.keys || !w.heads || !w.next || !w.normals) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    memset(w.keys, 0, w.capacity * sizeof(uint64_t));
+    /* weld distance: far below any patch size, far above float rounding of the positions */
+    eps = scene->diagonal * 1e-6f;
+    for (t = 0; t < scene->triangle_count && r == RAD_SUCCESS; ++t) {
+        const float *v = scene->positions + 9 * (size_t)t, *tn = scene->normals + 3 * (size_t)t;
+        const rad_material *mat = &scene->materials_table[scene->materials[t]];
+        uint32_t n = P->subdivision[t], i, j, base = P->first_patch[t];
+        size_t lcount = ((size_t)n + 1u) * ((size_t)n + 2u) / 2u;
+        float sub_area = scene->areas[t] / ((float)n * (float)n);
+        if (lcount > lattice_cap) {
+            rad__free(&c.allocator, lattice_ids);
+            lattice_ids = (uint32_t *)rad__alloc_array(&c.allocator, lcount, sizeof(uint32_t));
+            lattice_cap = lcount;
+            if (!lattice_ids) { lattice_cap = 0; r = RAD_ERROR_OUT_OF_MEMORY; break; }
+        }
+        for (j = 0; j <= n; ++j)
+            for (i = 0; i + j <= n; ++i) {
+                float p[3], a = (float)i / (float)n, b = (float)j / (float)n;
+                int k;
+                for (k = 0; k < 3; ++k) p[k] = v[k] + a * (v[3 + k] - v[k]) + b * (v[6 + k] - v[k]);
+                if (i == n) memcpy(p, v + 3, sizeof(p)); /* corners exactly */
+                if (j == n) memcpy(p, v + 6, sizeof(p));
+                lattice_ids[rad__lattice(n, i, j)] = rad__weld_vertex(&w, P->vertices, &nv, p, tn, eps);
+            }
+        for (j = 0; j < n && r == RAD_SUCCESS; ++j)
+            for (i = 0; i + j < n && r == RAD_SUCCESS; ++i) {
+                int up;
+                for (up = 1; up >= 0 && r == RAD_SUCCESS; --up) {
+                    uint32_t idx, a0, a1, a2;
+                    float lb[3][2];
+                    rad_patch *pt;
+                    int k;
+                    if (up) {
+                        idx = base + rad__sub_up(n, i, j);
+                        a0 = lattice_ids[rad__lattice(n, i, j)];
+                        a1 = lattice_ids[rad__lattice(n, i + 1, j)];
+                        a2 = lattice_ids[rad__lattice(n, i, j + 1)];
+                        lb[0][0] = (float)i; lb[0][1] = (float)j;
+                        lb[1][0] = (float)(i + 1); lb[1][1] = (float)j;
+                        lb[2][0] = (float)i; lb[2][1] = (float)(j + 1);
+                    } else {
+                        if (i + j + 2 > n) continue;
+                        idx = base + rad__sub_down(n, i, j);
+                        a0 = lattice_ids[rad__lattice(n, i + 1, j)];
+                        a1 = lattice_ids[rad__lattice(n, i + 1, j + 1)];
+                        a2 = lattice_ids[rad__lattice(n, i, j + 1)];
+                        lb[0][0] = (float)(i + 1); lb[0][1] = (float)j;
+                        lb[1][0] = (float)(i + 1); lb[1][1] = (float)(j + 1);
+                        lb[2][0] = (float)i; lb[2][1] = (float)(j + 1);
+                    }
+                    pt = &P->patches[idx];
+                    pt->vertices[0] = a0; pt->vertices[1] = a1; pt->vertices[2] = a2;
+                    pt->triangle = t;
+                    pt->area = sub_area;
+                    memcpy(pt->normal, tn, 3 * sizeof(float));
+                    memcpy(pt->emission, mat->emission, 3 * sizeof(float));
+                    for (k = 0; k < 3; ++k)
+                        pt->centroid[k] = (P->vertices[3 * (size_t)a0 + (size_t)k] + P->vertices[3 * (size_t)a1 + (size_t)k] +
+                                           P->vertices[3 * (size_t)a2 + (size_t)k]) / 3.0f;
+                    if (mat->texture && scene->albedo_lookup && scene->uvs) {
+                        for (k = 0; k < 3; ++k) { lb[k][0] /= (float)n; lb[k][1] /= (float)n; }
+                        r = rad__patch_albedo(scene, t, (const float(*)[2])lb, o.albedo_samples, &c, pt->albedo);
+                    } else {
+                        memcpy(pt->albedo, mat->albedo, 3 * sizeof(float));
+                    }
+                    P->areas[idx] = pt->area;
+                    memcpy(P->albedo + 3 * (size_t)idx, pt->albedo, 3 * sizeof(float));
+                }
+            }
+    }
+    P->vertex_count = nv;
+done:
+    rad__free(&c.allocator, lattice_ids);
+    rad__free(&c.allocator, w.keys);
+    rad__free(&c.allocator, w.heads);
+    rad__free(&c.allocator, w.next);
+    rad__free(&c.allocator, w.normals);
+    if (r != RAD_SUCCESS) { rad_patches_destroy(P); return r; }
+    *out = P;
+    return RAD_SUCCESS;
+}
+
+RAD_API uint32_t rad_patches_locate(const rad_patches *patches, uint32_t triangle, float b1, float b2, float out_weights[3])
+{
+    uint32_t n, i, j;
+    float x, y, fx, fy, w[3];
+    if (out_weights) out_weights[0] = out_weights[1] = out_weights[2] = 0.0f;
+    if (!patches || triangle >= patches->triangle_count) return RAD_NONE;
+    if (!(b1 >= 0.0f)) b1 = 0.0f; /* also catches NaN */
+    if (!(b2 >= 0.0f)) b2 = 0.0f;
+    if (b1 + b2 > 1.0f) { float s = b1 + b2; b1 /= s; b2 /= s; }
+    n = patches->subdivision[triangle];
+    x = b1 * (float)n;
+    y = b2 * (float)n;
+    i = (uint32_t)x;
+    j = (uint32_t)y;
+    if (j > n - 1) j = n - 1;
+    if (i + j > n - 1) i = n - 1 - j;
+    fx = x - (float)i;
+    fy = y - (float)j;
+    if (fx + fy <= 1.0f || i + j + 2 > n) {
+        /* up triangle (i,j) (i+1,j) (i,j+1): p = corner + fx e1 + fy e2 */
+        w[1] = fx < 0.0f ? 0.0f : fx;
+        w[2] = fy < 0.0f ? 0.0f : fy;
+        if (w[1] + w[2] > 1.0f) { float s = w[1] + w[2]; w[1] /= s; w[2] /= s; }
+        w[0] = 1.0f - w[1] - w[2];
+        if (out_weights) memcpy(out_weights, w, sizeof(w));
+        return patches->first_patch[triangle] + rad__sub_up(n, i, j);
+    }
+    /* down triangle (i+1,j) (i+1,j+1) (i,j+1): p = (i+1,j) + a (0,1) + b (-1,1) */
+    w[2] = 1.0f - fx;
+    w[1] = fy - w[2];
+    if (w[1] < 0.0f) w[1] = 0.0f;
+    if (w[2] < 0.0f) w[2] = 0.0f;
+    if (w[1] + w[2] > 1.0f) { float s = w[1] + w[2]; w[1] /= s; w[2] /= s; }
+    w[0] = 1.0f - w[1] - w[2];
+    if (out_weights) memcpy(out_weights, w, sizeof(w));
+    return patches->first_patch[triangle] + rad__sub_down(n, i, j);
+}
+
+RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const float *patch_values, uint32_t channels,
+                                             float *out_vertex_values)
+{
+    double *acc;
+    size_t total;
+    uint32_t i, v, k;
+    rad_allocator a;
+    if (!patches || !patch_values || !out_vertex_values || channels == 0) return RAD_ERROR_INVALID_ARGUMENT;
+    a = patches->allocator;
+    if (!rad__mul((size_t)patches->vertex_count, (size_t)channels + 1u, &total)) return RAD_ERROR_SIZE_OVERFLOW;
+    acc = (double *)rad__alloc_array(&a, total, sizeof(double));
+    if (!acc) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(acc, 0, total * sizeof(double));
+    for (i = 0; i < patches->count; ++i) {
+        const rad_patch *p = &patches->patches[i];
+        for (v = 0; v < 3; ++v) {
+            double *dst = acc + (size_t)p->vertices[v] * ((size_t)channels + 1u);
+            for (k = 0; k < channels; ++k) dst[k] += (double)p->area * (double)patch_values[(size_t)i * channels + k];
+            dst[channels] += p->area;
+        }
+    }
+    for (v = 0; v < patches->vertex_count; ++v) {
+        const double *src = acc + (size_t)v * ((size_t)channels + 1u);
+        for (k = 0; k < channels; ++k)
+            out_vertex_values[(size_t)v * channels + k] = src[channels] > 0.0 ? (float)(src[k] / src[channels]) : 0.0f;
+    }
+    rad__free(&a, acc);
+    return RAD_SUCCESS;
+}
+
+/* ======================================================================================== */
+/* >>bvh: the built-in BVH (binned SAH, watertight triangle test)                           */
+/* ======================================================================================== */
+
+typedef struct rad__bvh_node {
+    float bmin[3];
+    uint32_t first;   /* leaf: first triangle; inner: left child (right = first + 1) */
+    float bmax[3];
+    uint32_t count;   /* triangles in a leaf, 0 for an inner node */
+} rad__bvh_node;
+
+struct rad_bvh {
+    rad__bvh_node *nodes;
+    uint32_t node_count;
+    float *tris;        /* 9 floats per triangle, in leaf order */
+    uint32_t *ids;      /* scene triangle of each */
+    uint32_t tri_count;
+    rad_allocator allocator;
+};
+
+#define RAD__BVH_BINS 16
+#define RAD__BVH_LEAF 4
+#define RAD__BVH_STACK 128
+#define RAD__BVH_SAH_DEPTH 64
+
+typedef struct rad__aabb { float lo[3], hi[3]; } rad__aabb;
+
+static void rad__aabb_empty(rad__aabb *b)
+{
+    b->lo[0] = b->lo[1] = b->lo[2] = FLT_MAX;
+    b->hi[0] = b->hi[1] = b->hi[2] = -FLT_MAX;
+}
+static void rad__aabb_grow(rad__aabb *b, const float *lo, const float *hi)
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        if (lo[k] < b->lo[k]) b->lo[k] = lo[k];
+        if (hi[k] > b->hi[k]) b->hi[k] = hi[k];
+    }
+}
+static float rad__aabb_area(const rad__aabb *b)
+{
+    float dx = b->hi[0] - b->lo[0], dy = b->hi[1] - b->lo[1], dz = b->hi[2] - b->lo[2];
+    if (dx < 0.0f) return 0.0f;
+    return dx * dy + dy * dz + dz * dx;
+}
+
+RAD_API void rad_bvh_destroy(rad_bvh *bvh)
+{
+    rad_allocator a;
+    if (!bvh) return;
+    a = bvh->allocator;
+    rad__free(&a, bvh->nodes);
+    rad__free(&a, bvh->tris);
+    rad__free(&a, bvh->ids);
+    rad__free(&a, bvh);
+}
+
+RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
+{
+    if (!bvh) return 0;
+    return sizeof(*bvh) + (size_t)bvh->node_count * sizeof(rad__bvh_node) +
+           (size_t)bvh->tri_count * (9 * sizeof(float) + sizeof(uint32_t));
+}
+
+static int rad__bvh_bin(const float *cen, uint32_t t, int axis, const rad__aabb *cb, float scale)
+{
+    int bin = (int)((cen[3 * (size_t)t + (size_t)axis] - cb->lo[axis]) * scale);
+    if (bin < 0) bin = 0;
+    if (bin >= RAD__BVH_BINS) bin = RAD__BVH_BINS - 1;
+    return bin;
+}
+
+RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out)
+{
+    rad__ctx c;
+    rad_bvh *b;
+    uint32_t n, i, sp = 0;
+    float *tlo = NULL, *thi = NULL, *cen = NULL;
+    uint32_t *order = NULL, *stack = NULL;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!scene || scene->triangle_count == 0) return RAD_ERROR_INVALID_ARGUMENT;
+    n = scene->triangle_count;
+    b = (rad_bvh *)rad__alloc(&c.allocator, sizeof(rad_bvh));
+    if (!b) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(b, 0, sizeof(*b));
+    b->allocator = c.allocator;
+    b->tri_count = n;
+    b->nodes = (rad__bvh_node *)rad__alloc_array(&c.allocator, 2u * (size_t)n, sizeof(rad__bvh_node));
+    b->tris = (float *)rad__alloc_array(&c.allocator, (size_t)n * 9u, sizeof(float));
+    b->ids = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    tlo = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
+    thi = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
+    cen = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
+    order = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    stack = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 4u, sizeof(uint32_t));
+    if (!b->nodes || !b->tris || !b->ids || !tlo || !thi || !cen || !order || !stack) {
+        rad__free(&c.allocator, tlo); rad__free(&c.allocator, thi); rad__free(&c.allocator, cen);
+        rad__free(&c.allocator, order); rad__free(&c.allocator, stack);
+        rad_bvh_destroy(b);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < n; ++i) {
+        const float *v = scene->positions + 9 * (size_t)i;
+        int k;
+        for (k = 0; k < 3; ++k) {
+            float lo = v[k], hi = v[k];
+            if (v[3 + k] < lo) lo = v[3 + k];
+            if (v[6 + k] < lo) lo = v[6 + k];
+            if (v[3 + k] > hi) hi = v[3 + k];
+            if (v[6 + k] > hi) hi = v[6 + k];
+            tlo[3 * (size_t)i + (size_t)k] = lo;
+            thi[3 * (size_t)i + (size_t)k] = hi;
+            cen[3 * (size_t)i + (size_t)k] = 0.5f * (lo + hi);
+        }
+        order[i] = i;
+    }
+    b->node_count = 1;
+    b->nodes[0].first = 0;
+    b->nodes[0].count = n;
+    stack[sp++] = 0; /* node */
+    stack[sp++] = 0; /* depth */
+    while (sp > 0) {
+        uint32_t depth = stack[--sp], ni = stack[--sp];
+        rad__bvh_node *node = &b->nodes[ni];
+        uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, k2;
+        rad__aabb nb, cb;
+        float best_cost = FLT_MAX, leaf_cost;
+        int axis;
+        rad__aabb_empty(&nb);
+        rad__aabb_empty(&cb);
+        for (i = first; i < first + count; ++i) {
+            rad__aabb_grow(&nb, tlo + 3 * (size_t)order[i], thi + 3 * (size_t)order[i]);
+            rad__aabb_grow(&cb, cen + 3 * (size_t)order[i], cen + 3 * (size_t)order[i]);
+        }
+        memcpy(node->bmin, nb.lo, sizeof(nb.lo));
+        memcpy(node->bmax, nb.hi, sizeof(nb.hi));
+        if (count <= 1) continue;
+        leaf_cost = (float)count * rad__aabb_area(&nb);
+        /* past RAD__BVH_SAH_DEPTH levels, ranges are split in half: the depth stays below
+           RAD__BVH_SAH_DEPTH + 32, so traversal stacks of RAD__BVH_STACK entries never overflow */
+        for (axis = 0; axis < 3 && depth < RAD__BVH_SAH_DEPTH; ++axis) {
+            rad__aabb bins[RAD__BVH_BINS], left, right;
+            uint32_t cnt[RAD__BVH_BINS], right_count[RAD__BVH_BINS], lc = 0, rc = 0, bi;
+            float extent = cb.hi[axis] - cb.lo[axis], scale, right_area[RAD__BVH_BINS];
+            if (!(extent > 0.0f)) continue;
+            scale = (float)RAD__BVH_BINS / extent;
+            for (bi = 0; bi < RAD__BVH_BINS; ++bi) { rad__aabb_empty(&bins[bi]); cnt[bi] = 0; }
+            for (i = first; i < first + count; ++i) {
+                int bin = rad__bvh_bin(cen, order[i], axis, &cb, scale);
+                cnt[bin]++;
+                rad__aabb_grow(&bins[bin], tlo + 3 * (size_t)order[i], thi + 3 * (size_t)order[i]);
+            }
+            rad__aabb_empty(&right);
+            for (bi = RAD__BVH_BINS - 1; bi > 0; --bi) {
+                rad__aabb_grow(&right, bins[bi].lo, bins[bi].hi);
+                rc += cnt[bi];
+                right_area[bi] = rad__aabb_area(&right);
+                right_count[bi] = rc;
+            }
+            rad__aabb_empty(&left);
+            for (bi = 0; bi + 1 < RAD__BVH_BINS; ++bi) {
+                float cost;
+                rad__aabb_grow(&left, bins[bi].lo, bins[bi].hi);
+                lc += cnt[bi];
+                if (lc == 0 || right_count[bi + 1] == 0) continue;
+                cost = (float)lc * rad__aabb_area(&left) + (float)right_count[bi + 1] * right_area[bi + 1];
+                if (cost < best_cost) { best_cost = cost; best_axis = (uint32_t)axis; best_split = bi + 1; }
+            }
+        }
+        /* SAH with a traversal step costing one triangle test: stop when splitting does not pay */
+        if (count <= RAD__BVH_LEAF && (best_axis == 3 || best_cost + rad__aabb_area(&nb) >= leaf_cost)) continue;
+        if (best_axis == 3) {
+            mid = first + count / 2; /* all centroids equal, or too deep: split the range */
+        } else {
+            float scale = (float)RAD__BVH_BINS / (cb.hi[best_axis] - cb.lo[best_axis]);
+            uint32_t lo = first, hi = first + count;
+            while (lo < hi) {
+                uint32_t t = order[lo];
+                if ((uint32_t)rad__bvh_bin(cen, t, (int)best_axis, &cb, scale) < best_split) ++lo;
+                else { --hi; order[lo] = order[hi]; order[hi] = t; }
+            }
+            mid = lo;
+            if (mid == first || mid == first + count) mid = first + count / 2;
+        }
+        k2 = b->node_count;
+        b->node_count += 2;
+        b->nodes[k2].first = first;
+        b->nodes[k2].count = mid - first;
+        b->nodes[k2 + 1].first = mid;
+        b->nodes[k2 + 1].count = first + count - mid;
+        node = &b->nodes[ni];
+        node->first = k2;
+        node->count = 0;
+        stack[sp++] = k2 + 1;
+        stack[sp++] = depth + 1;
+        stack[sp++] = k2;
+        stack[sp++] = depth + 1;
+    }
+    for (i = 0; i < n; ++i) {
+        memcpy(b->tris + 9 * (size_t)i, scene->positions + 9 * (size_t)order[i], 9 * sizeof(float));
+        b->ids[i] = order[i];
+    }
+    rad__free(&c.allocator, tlo);
+    rad__free(&c.allocator, thi);
+    rad__free(&c.allocator, cen);
+    rad__free(&c.allocator, order);
+    rad__free(&c.allocator, stack);
+    *out = b;
+    return RAD_SUCCESS;
+}
+
+/* Per-ray constants of the watertight test (Woop, Benthin, Wald 2013). */
+typedef struct rad__wray {
+    float o[3], d[3], inv[3];
+    float sx, sy, sz;
+    int kx, ky, kz;
+    float tmin, tmax;
+} rad__wray;
+
+static void rad__wray_init(rad__wray *w, const rad_ray *r)
+{
+    float ax = (float)fabs((double)r->dir[0]), ay = (float)fabs((double)r->dir[1]), az = (float)fabs((double)r->dir[2]);
+    int k;
+    for (k = 0; k < 3; ++k) {
+        w->o[k] = r->origin[k];
+        w->d[k] = r->dir[k];
+        w->inv[k] = 1.0f / r->dir[k]; /* +-inf for 0: the slab test handles it */
+    }
+    w->kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    w->kx = (w->kz + 1) % 3;
+    w->ky = (w->kx + 1) % 3;
+    if (w->d[w->kz] < 0.0f) { int t = w->kx; w->kx = w->ky; w->ky = t; }
+    w->sx = w->d[w->kx] / w->d[w->kz];
+    w->sy = w->d[w->ky] / w->d[w->kz];
+    w->sz = 1.0f / w->d[w->kz];
+    w->tmin = r->tmin;
+    w->tmax = r->tmax;
+}
+
+/* slab test; NaNs from 0 * inf compare false and drop out */
+static int rad__wray_box(const rad__wray *w, const rad__bvh_node *n, float tmax, float *tnear)
+{
+    float t0 = w->tmin, t1 = tmax;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        float a = (n->bmin[k] - w->o[k]) * w->inv[k], b = (n->bmax[k] - w->o[k]) * w->inv[k];
+        float lo = a < b ? a : b, hi = a < b ? b : a;
+        if (lo > t0) t0 = lo;
+        if (hi < t1) t1 = hi;
+    }
+    *tnear = t0;
+    /* widened by a few ulps (conservative): rays grazing a flat box are not lost */
+    return t0 <= t1 * 1.00000024f + 1e-30f;
+}
+
+/* Watertight ray/triangle test, both faces. Returns 1 with t, b1, b2 on a hit in (tmin, tmax). */
+static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *t_out, float *b1, float *b2)
+{
+    float A[3], B[3], C[3], Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T;
+    int k;
+    for (k = 0; k < 3; ++k) { A[k] = v[k] - w->o[k]; B[k] = v[3 + k] - w->o[k]; C[k] = v[6 + k] - w->o[k]; }
+    Ax = A[w->kx] - w->sx * A[w->kz]; Ay = A[w->ky] - w->sy * A[w->kz];
+    Bx = B[w->kx] - w->sx * B[w->kz]; By = B[w->ky] - w->sy * B[w->kz];
+    Cx = C[w->kx] - w->sx * C[w->kz]; Cy = C[w->ky] - w->sy * C[w->kz];
+    U = Cx * By - Cy * Bx;
+    V = Ax * Cy - Ay * Cx;
+    W = Bx * Ay - By * Ax;
+    if (U == 0.0f || V == 0.0f || W == 0.0f) {
+        /* on an edge in float: redo the 2D edge tests in double so shared edges are never missed */
+        U = (float)((double)Cx * (double)By - (double)Cy * (double)Bx);
+        V = (float)((double)Ax * (double)Cy - (double)Ay * (double)Cx);
+        W = (float)((double)Bx * (double)Ay - (double)By * (double)Ax);
+    }
+    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
+    det = U + V + W;
+    if (det == 0.0f) return 0;
+    T = (U * (w->sz * A[w->kz]) + V * (w->sz * B[w->kz]) + W * (w->sz * C[w->kz])) / det;
+    if (!(T > w->tmin && T < tmax)) return 0;
+    *t_out = T;
+    *b1 = V / det;
+    *b2 = W / det;
+    return 1;
+}
+
+static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_hit *hit)
+{
+    rad__wray w;
+    uint32_t stack[RAD__BVH_STACK], sp = 0, ni = 0;
+    float tmax = ray->tmax, tn;
+    int found = 0;
+    if (!(ray->tmax > ray->tmin)) return 0;
+    rad__wray_init(&w, ray);
+    if (!rad__wray_box(&w, &bvh->nodes[0], tmax, &tn)) return 0;
+    for (;;) {
+        const rad__bvh_node *n = &bvh->nodes[ni];
+        if (n->count) {
+            uint32_t i;
+            for (i = n->first; i < n->first + n->count; ++i) {
+                float t, b1, b2;
+                if (rad__wray_tri(&w, bvh->tris + 9 * (size_t)i, tmax, &t, &b1, &b2)) {
+                    found = 1;
+                    if (any) return 1;
+                    tmax = t;
+                    hit->t = t;
+                    hit->triangle = bvh->ids[i];
+                    hit->b1 = b1;
+                    hit->b2 = b2;
+                }
+            }
+        } else {
+            float tl, tr;
+            int hl = rad__wray_box(&w, &bvh->nodes[n->first], tmax, &tl);
+            int hr = rad__wray_box(&w, &bvh->nodes[n->first + 1], tmax, &tr);
+            if (hl && hr) {
+                if (tl <= tr) { stack[sp++] = n->first + 1; ni = n->first; }
+                else { stack[sp++] = n->first; ni = n->first + 1; }
+                continue;
+            }
+            if (hl) { ni = n->first; continue; }
+            if (hr) { ni = n->first + 1; continue; }
+        }
+        if (sp == 0) break;
+        ni = stack[--sp];
+    }
+    return found;
+}
+
+static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
+{
+    const rad_bvh *bvh = (const rad_bvh *)user;
+    uint32_t i;
+    rad_hit h;
+    for (i = 0; i < count; ++i) out[i] = (uint8_t)rad__bvh_trace(bvh, &rays[i], 1, &h);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__bvh_intersect(void *user, const rad_ray *rays, uint32_t count, rad_hit *out)
+{
+    const rad_bvh *bvh = (const rad_bvh *)user;
+    uint32_t i;
+    for (i = 0; i < count; ++i) {
+        out[i].t = rays[i].tmax;
+        out[i].triangle = RAD_NONE;
+        out[i].b1 = out[i].b2 = 0.0f;
+        rad__bvh_trace(bvh, &rays[i], 0, &out[i]);
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_bvh_raycaster(const rad_bvh *bvh, rad_raycaster *out)
+{
+    if (!out) return;
+    out->user = (void *)(uintptr_t)bvh;
+    out->occluded = rad__bvh_occluded;
+    out->intersect = rad__bvh_intersect;
+}
+
+RAD_API void rad_camera_ray(const rad_camera *cam, uint32_t width, uint32_t height, float px, float py, rad_ray *out)
+{
+    float f[3], r[3], u[3], h, x, y;
+    int k;
+    if (!out) return;
+    memset(out, 0, sizeof(*out));
+    if (!cam || width == 0 || height == 0) return;
+    rad__sub(f, cam->target, cam->position);
+    rad__normalize(f);
+    rad__cross(r, f, cam->up);
+    rad__normalize(r);
+    rad__cross(u, r, f);
+    h = (float)tan(0.5 * (double)cam->fov_y_degrees * RAD__PI / 180.0);
+    x = (2.0f * px / (float)width - 1.0f) * h * (float)width / (float)height;
+    y = (1.0f - 2.0f * py / (float)height) * h;
+    for (k = 0; k < 3; ++k) {
+        out->origin[k] = cam->position[k];
+        out->dir[k] = f[k] + x * r[k] + y * u[k];
+    }
+    rad__normalize(out->dir);
+    out->tmin = 0.0f;
+    out->tmax = FLT_MAX;
+}
+
+/* ======================================================================================== */
+/* >>formfactor: form factors                                                               */
+/* ======================================================================================== */
+
+/* Contour integral over one convex polygon q (points relative to the receiver point, in its
+   upper half-space), against unit normal n, in double. Signed by the winding. */
+static double rad__contour(const double (*q)[3], int count, const double *n)
+{
+    double sum = 0.0, r[4][3];
+    int i, k;
+    for (i = 0; i < count; ++i) {
+        double l = sqrt(q[i][0] * q[i][0] + q[i][1] * q[i][1] + q[i][2] * q[i][2]);
+        if (!(l > 0.0)) return 0.0; /* the point is on the polygon's boundary */
+        for (k = 0; k < 3; ++k) r[i][k] = q[i][k] / l;
+    }
+    for (i = 0; i < count; ++i) {
+        const double *a = r[i], *b = r[(i + 1) % count];
+        double c[3], cl, d;
+        c[0] = a[1] * b[2] - a[2] * b[1];
+        c[1] = a[2] * b[0] - a[0] * b[2];
+        c[2] = a[0] * b[1] - a[1] * b[0];
+        cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        if (!(cl > 1e-300)) continue;
+        d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        sum += atan2(cl, d) * (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / cl;
+    }
+    return sum;
+}
+
+/* Point-to-triangle kernel: p, n the receiver point and unit normal, v 9 floats. Clips the
+   triangle to n.(x - p) >= 0. Returns the signed contour sum / (2 pi). */
+static double rad__ff_point_tri(const double *p, const double *n, const float *v)
+{
+    double q[3][3], d[3], out[4][3];
+    int i, k, m = 0;
+    for (i = 0; i < 3; ++i) {
+        for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
+        d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
+    }
+    if (d[0] <= 0.0 && d[1] <= 0.0 && d[2] <= 0.0) return 0.0;
+    if (d[0] >= 0.0 && d[1] >= 0.0 && d[2] >= 0.0) return rad__contour((const double(*)[3])q, 3, n) / (2.0 * RAD__PI);
+    for (i = 0; i < 3; ++i) {
+        int j = (i + 1) % 3;
+        if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) out[m][k] = q[i][k]; ++m; }
+        if ((d[i] > 0.0 && d[j] < 0.0) || (d[i] < 0.0 && d[j] > 0.0)) {
+            double t = d[i] / (d[i] - d[j]);
+            for (k = 0; k < 3; ++k) out[m][k] = q[i][k] + t * (q[j][k] - q[i][k]);
+            ++m;
+        }
+    }
+    if (m < 3) return 0.0;
+    return rad__contour((const double(*)[3])out, m, n) / (2.0 * RAD__PI);
+}
+
+RAD_API float rad_ff_point_polygon(const float p[3], const float n[3], const float *vertices, uint32_t count)
+{
+    double P[3], N[3], pn[3] = { 0.0, 0.0, 0.0 }, sum = 0.0, side = 0.0, nl;
+    uint32_t i;
+    int k;
+    if (!p || !n || !vertices || count < 3) return 0.0f;
+    for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
+    nl = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+    if (!(nl > 0.0)) return 0.0f;
+    for (k = 0; k < 3; ++k) N[k] /= nl;
+    /* polygon normal (Newell) and the side p is on */
+    for (i = 0; i < count; ++i) {
+        const float *a = vertices + 3 * (size_t)i, *b = vertices + 3 * (size_t)((i + 1) % count);
+        pn[0] += ((double)a[1] - b[1]) * ((double)a[2] + b[2]);
+        pn[1] += ((double)a[2] - b[2]) * ((double)a[0] + b[0]);
+        pn[2] += ((double)a[0] - b[0]) * ((double)a[1] + b[1]);
+    }
+    for (k = 0; k < 3; ++k) side += pn[k] * ((double)p[k] - (double)vertices[k]);
+    if (!(side > 0.0)) return 0.0f;
+    /* fan of triangles: interior edges cancel in the contour sum */
+    for (i = 1; i + 1 < count; ++i) {
+        float tri[9];
+        for (k = 0; k < 3; ++k) {
+            tri[k] = vertices[k];
+            tri[3 + k] = vertices[3 * (size_t)i + (size_t)k];
+            tri[6 + k] = vertices[3 * (size_t)(i + 1) + (size_t)k];
+        }
+        sum += rad__ff_point_tri(P, N, tri);
+    }
+    return (float)fabs(sum);
+}
+
+RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const float pj[3], const float nj[3], float sj)
+{
+    float r[3], d2, d, ci, cj, floor2;
+    if (!pi_ || !ni || !pj || !nj || !(sj > 0.0f)) return 0.0f;
+    rad__sub(r, pj, pi_);
+    d2 = rad__dot(r, r);
+    if (!(d2 > 0.0f)) return 0.0f;
+    d = (float)sqrt((double)d2);
+    ci = rad__dot(r, ni) / d;
+    cj = -rad__dot(r, nj) / d;
+    if (!(ci > 0.0f) || !(cj > 0.0f)) return 0.0f;
+    floor2 = sj / (float)RAD__PI;
+    if (d2 < floor2) d2 = floor2;
+    return sj * ci * cj / ((float)RAD__PI * d2);
+}
+
+RAD_API void rad_form_factor_options_default(rad_form_factor_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->method = RAD_FF_ANALYTIC;
+    o->samples = 16;
+    o->ray_epsilon = 1e-5f;
+}
+
+/* shared state of one form-factor computation */
+typedef struct rad__ff {
+    const rad_patches *P;
+    const rad_raycaster *rc;
+    rad_form_factor_options o;
+    float eps;                    /* absolute ray epsilon */
+    float *pts;                   /* samples * 3 floats per patch: the emitter-side points */
+    /* per task scratch */
+    rad_ray *rays;                /* RAD__RAY_BATCH per task */
+    uint8_t *occ;
+    float *ray_w;                 /* contribution of each ray */
+    uint32_t *ray_slot;           /* column slot of each ray */
+    double *acc;                  /* N per task */
+    uint64_t *rays_cast, *pairs;  /* per task counters */
+    /* output */
+    float *out;
+    uint32_t row_begin;           /* rows call: matrix row of out's first row */
+    size_t out_stride;
+    int dense_mode;               /* 1: compute j > i and mirror into a full N x N 'out' */
+    uint32_t tasks;
+} rad__ff;
+
+static void rad__ff_patch_corners(const rad__ff *f, uint32_t i, float *v)
+{
+    const rad_patch *p = &f->P->patches[i];
+    int k, m;
+    for (m = 0; m < 3; ++m)
+        for (k = 0; k < 3; ++k) v[3 * m + k] = f->P->vertices[3 * (size_t)p->vertices[m] + (size_t)k];
+}
+
+/* 1 when the pair can exchange light at all: some corner of each patch strictly in front of
+   the other (a coplanar or back-to-back pair is 0 without any work) */
+static int rad__ff_facing(const float *vi, const float *ni, const float *vj, const float *nj)
+{
+    int m, a = 0, b = 0;
+    for (m = 0; m < 3; ++m) {
+        float d1[3], d2[3];
+        rad__sub(d1, vj + 3 * m, vi);
+        rad__sub(d2, vi + 3 * m, vj);
+        if (rad__dot(d1, ni) > 0.0f) a = 1;
+        if (rad__dot(d2, nj) > 0.0f) b = 1;
+    }
+    return a && b;
+}
+
+static rad_result rad__ff_flush(rad__ff *f, uint32_t task, uint32_t count)
+{
+    rad_ray *rays = f->rays + (size_t)task * RAD__RAY_BATCH;
+    uint8_t *occ = f->occ + (size_t)task * RAD__RAY_BATCH;
+    const float *w = f->ray_w + (size_t)task * RAD__RAY_BATCH;
+    const uint32_t *slot = f->ray_slot + (size_t)task * RAD__RAY_BATCH;
+    double *acc = f->acc + (size_t)task * f->P->count;
+    uint32_t k;
+    if (count == 0) return RAD_SUCCESS;
+    if (f->rc->occluded(f->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    f->rays_cast[task] += count;
+    for (k = 0; k < count; ++k)
+        if (!occ[k]) acc[slot[k]] += (double)w[k];
+    return RAD_SUCCESS;
+}
+
+/* Accumulates into acc[slot] S times the canonical value of the pair (lo, hi): the sum over
+   lo's S sample points of kernel * visibility. Rays go to the task's batch. */
+static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t slot, uint32_t task, uint32_t *nrays)
+{
+    const rad_patch *pl = &f->P->patches[lo], *ph = &f->P->patches[hi];
+    float vl[9], vh[9], r1, r2;
+    uint32_t S = f->o.samples, s, h;
+    double *acc = f->acc + (size_t)task * f->P->count, PN[3];
+    int k;
+    rad__ff_patch_corners(f, lo, vl);
+    rad__ff_patch_corners(f, hi, vh);
+    acc[slot] = 0.0;
+    if (!rad__ff_facing(vl, pl->normal, vh, ph->normal)) return RAD_SUCCESS;
+    f->pairs[task]++;
+    h = rad__hash(f->o.seed ^ rad__hash(lo * 0x9E3779B9u ^ rad__hash(hi)));
+    r1 = (float)(h & 0xFFFFu) / 65536.0f;
+    r2 = (float)(h >> 16) / 65536.0f;
+    for (k = 0; k < 3; ++k) PN[k] = pl->normal[k];
+    for (s = 0; s < S; ++s) {
+        const float *x = f->pts + ((size_t)lo * S + s) * 3u;
+        float y[3], u1, u2, w, dxy[3];
+        rad__sub(dxy, x, vh);
+        if (!(rad__dot(dxy, ph->normal) > 0.0f)) continue; /* x is behind the receiver */
+        rad__hammersley(s, S, r1, r2, &u1, &u2);
+        rad__triangle_point(vh, vh + 3, vh + 6, u1, u2, y);
+        if (f->o.method == RAD_FF_ANALYTIC) {
+            double P[3];
+            for (k = 0; k < 3; ++k) P[k] = x[k];
+            w = (float)fabs(rad__ff_point_tri(P, PN, vh));
+        } else {
+            w = rad_ff_point_point(x, pl->normal, y, ph->normal, ph->area);
+        }
+        if (!(w > 0.0f)) continue;
+        if (f->o.skip_visibility) {
+            acc[slot] += (double)w;
+            continue;
+        }
+        {
+            size_t at = (size_t)task * RAD__RAY_BATCH + *nrays;
+            rad_ray *ray = f->rays + at;
+            float len;
+            for (k = 0; k < 3; ++k) {
+                ray->origin[k] = x[k] + pl->normal[k] * f->eps;
+                ray->dir[k] = (y[k] + ph->normal[k] * f->eps) - ray->origin[k];
+            }
+            len = rad__len(ray->dir);
+            ray->tmin = 0.0f;
+            ray->tmax = len > 2.0f * f->eps ? 1.0f - f->eps / len : 0.5f;
+            f->ray_w[at] = w;
+            f->ray_slot[at] = slot;
+            if (++*nrays == RAD__RAY_BATCH) {
+                rad_result r = rad__ff_flush(f, task, *nrays);
+                *nrays = 0;
+                if (r != RAD_SUCCESS) return r;
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
+{
+    rad__ff *f = (rad__ff *)data;
+    uint32_t N = f->P->count, j, nrays = 0;
+    double *acc = f->acc + (size_t)task * N;
+    float inv_s = 1.0f / (float)f->o.samples;
+    rad_result r;
+    /* dense mode: only j > i, mirrored; rows mode: every j, the lower pairs computed as the
+       upper ones are (from the lower-indexed patch) and scaled by reciprocity */
+    for (j = f->dense_mode ? i + 1 : 0; j < N; ++j) {
+        if (j == i) { acc[j] = 0.0; continue; }
+        r = (j > i) ? rad__ff_pair(f, i, j, j, task, &nrays) : rad__ff_pair(f, j, i, j, task, &nrays);
+        if (r != RAD_SUCCESS) return r;
+    }
+    r = rad__ff_flush(f, task, nrays);
+    if (r != RAD_SUCCESS) return r;
+    if (f->dense_mode) {
+        float *row = f->out + (size_t)i * N;
+        row[i] = 0.0f;
+        for (j = i + 1; j < N; ++j) {
+            float v = (float)acc[j] * inv_s;
+            row[j] = v;
+            f->out[(size_t)j * N + i] = v * (f->P->areas[i] / f->P->areas[j]);
+        }
+    } else {
+        float *row = f->out + (size_t)(i - f->row_begin) * f->out_stride;
+        for (j = 0; j < N; ++j) {
+            float v = (float)acc[j] * inv_s;
+            if (j == i) row[j] = 0.0f;
+            else if (j > i) row[j] = v;
+            else row[j] = v * (f->P->areas[j] / f->P->areas[i]);
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static void rad__ff_release(rad__ff *f, const rad_allocator *a)
+{
+    rad__free(a, f->pts);
+    rad__free(a, f->rays);
+    rad__free(a, f->occ);
+    rad__free(a, f->ray_w);
+    rad__free(a, f->ray_slot);
+    rad__free(a, f->acc);
+    rad__free(a, f->rays_cast);
+    rad__free(a, f->pairs);
+    memset(f, 0, sizeof(*f));
+}
+
+static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_raycaster *rc, const rad_form_factor_options *o,
+                                const rad__ctx *c)
+{
+    uint32_t i, s, T;
+    memset(f, 0, sizeof(*f));
+    if (!P) return RAD_ERROR_INVALID_ARGUMENT;
+    if (o) f->o = *o; else rad_form_factor_options_default(&f->o);
+    if (f->o.samples == 0) f->o.samples = 16;
+    if (f->o.samples > RAD__MAX_SAMPLES) f->o.samples = RAD__MAX_SAMPLES;
+    if (f->o.ray_epsilon == 0.0f) f->o.ray_epsilon = 1e-5f;
+    if (!rad__finite(f->o.ray_epsilon) || f->o.ray_epsilon < 0.0f || !rad__finite(f->o.drop_threshold) ||
+        f->o.drop_threshold < 0.0f || (f->o.method != RAD_FF_ANALYTIC && f->o.method != RAD_FF_MONTE_CARLO)) {
+        rad__log(c, RAD_LOG_ERROR, "form factor options: bad method, ray_epsilon or drop_threshold");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!f->o.skip_visibility && (!rc || !rc->occluded)) {
+        rad__log(c, RAD_LOG_ERROR, "form factors need a raycaster with occluded() unless skip_visibility is set");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    f->P = P;
+    f->rc = rc;
+    f->eps = f->o.ray_epsilon * P->scene->diagonal;
+    T = c->tasks;
+    if (T > P->count) T = P->count;
+    if (T == 0) T = 1;
+    f->tasks = T;
+    f->pts = (float *)rad__alloc_array(&c->allocator, (size_t)P->count * f->o.samples, 3 * sizeof(float));
+    f->rays = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    f->occ = (uint8_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    f->ray_w = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(float));
+    f->ray_slot = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    f->acc = (double *)rad__alloc_array(&c->allocator, (size_t)T * P->count, sizeof(double));
+    f->rays_cast = (uint64_t *)rad__alloc_array(&c->allocator, T, sizeof(uint64_t));
+    f->pairs = (uint64_t *)rad__alloc_array(&c->allocator, T, sizeof(uint64_t));
+    if (!f->pts || !f->rays || !f->occ || !f->ray_w || !f->ray_slot || !f->acc || !f->rays_cast || !f->pairs) {
+        rad__ff_release(f, &c->allocator);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(f->rays_cast, 0, sizeof(uint64_t) * T);
+    memset(f->pairs, 0, sizeof(uint64_t) * T);
+    /* the emitter-side sample points of every patch: the same Hammersley points for every pair */
+    for (i = 0; i < P->count; ++i) {
+        float v[9];
+        rad__ff_patch_corners(f, i, v);
+        for (s = 0; s < f->o.samples; ++s) {
+            float u1, u2;
+            rad__hammersley(s, f->o.samples, 0.0f, 0.0f, &u1, &u2);
+            rad__triangle_point(v, v + 3, v + 6, u1, u2, f->pts + ((size_t)i * f->o.samples + s) * 3u);
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static void rad__ff_totals(const rad__ff *f, uint64_t *rays, uint64_t *pairs)
+{
+    uint32_t t;
+    *rays = 0;
+    *pairs = 0;
+    for (t = 0; t < f->tasks; ++t) { *rays += f->rays_cast[t]; *pairs += f->pairs[t]; }
+}
+
+/* rows call: task rows are numbered from 0; the matrix row is row_begin + that */
+static rad_result rad__ff_row_offset(void *data, uint32_t row, uint32_t task)
+{
+    rad__ff *f = (rad__ff *)data;
+    return rad__ff_row(data, f->row_begin + row, task);
+}
+
+RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_raycaster *raycaster,
+                                        const rad_form_factor_options *options, uint32_t row_begin, uint32_t row_end,
+                                        float *out_rows, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ff f;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !out_rows || row_begin > row_end || row_end > patches->count) return RAD_ERROR_INVALID_ARGUMENT;
+    if (row_end == row_begin) return RAD_SUCCESS;
+    if (row_end - row_begin < c.tasks) c.tasks = row_end - row_begin;
+    r = rad__ff_setup(&f, patches, raycaster, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    f.out = out_rows;
+    f.row_begin = row_begin;
+    f.out_stride = patches->count;
+    r = rad__for_rows(&c, row_end - row_begin, f.tasks, rad__ff_row_offset, &f);
+    rad__ff_release(&f, &c.allocator);
+    return r;
+}
+
+RAD_API void rad_form_factors_destroy(rad_form_factors *ff)
+{
+    rad_allocator a;
+    if (!ff) return;
+    a = ff->allocator;
+    rad__free(&a, ff->storage);
+    rad__free(&a, (void *)(uintptr_t)ff->matrix.row_offsets);
+    rad__free(&a, (void *)(uintptr_t)ff->matrix.columns);
+    rad__free(&a, (void *)(uintptr_t)ff->matrix.values);
+    rad__free(&a, ff);
+}
+
+RAD_API rad_result rad_form_factors_dense(const rad_patches *patches, const rad_raycaster *raycaster,
+                                          const rad_form_factor_options *options, const rad_context *ctx,
+                                          rad_form_factors **out)
+{
+    rad__ctx c;
+    rad__ff f;
+    rad_result r;
+    rad_form_factors *ff;
+    size_t bytes;
+    uint32_t N;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!patches) return RAD_ERROR_INVALID_ARGUMENT;
+    N = patches->count;
+    if (!rad__mul3(N, N, sizeof(float), &bytes)) {
+        rad__log(&c, RAD_LOG_ERROR, "a dense %u x %u matrix does not fit in memory addresses", N, N);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    ff = (rad_form_factors *)rad__alloc(&c.allocator, sizeof(rad_form_factors));
+    if (!ff) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(ff, 0, sizeof(*ff));
+    ff->allocator = c.allocator;
+    ff->storage = rad__alloc(&c.allocator, bytes);
+    if (!ff->storage) {
+        rad__log(&c, RAD_LOG_ERROR, "cannot allocate %llu bytes for a dense %u x %u matrix", (unsigned long long)bytes, N, N);
+        rad_form_factors_destroy(ff);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    r = rad__ff_setup(&f, patches, raycaster, options, &c);
+    if (r != RAD_SUCCESS) { rad_form_factors_destroy(ff); return r; }
+    f.out = (float *)ff->storage;
+    f.dense_mode = 1;
+    /* the last row has no j > i: write its diagonal here */
+    f.out[(size_t)N * N - 1] = 0.0f;
+    r = rad__for_rows(&c, N, f.tasks, rad__ff_row, &f);
+    rad__ff_totals(&f, &ff->rays_cast, &ff->pairs_evaluated);
+    rad__ff_release(&f, &c.allocator);
+    if (r != RAD_SUCCESS) { rad_form_factors_destroy(ff); return r; }
+    ff->matrix.rows = ff->matrix.cols = N;
+    ff->matrix.storage = RAD_STORAGE_DENSE;
+    ff->matrix.dense = (const float *)ff->storage;
+    *out = ff;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_form_factors_sparse(const rad_patches *patches, const rad_raycaster *raycaster,
+                                           const rad_form_factor_options *options, const rad_context *ctx,
+                                           rad_form_factors **out)
+{
+    rad__ctx c;
+    rad__ff f;
+    rad_result r = RAD_SUCCESS;
+    rad_form_factors *ff;
+    uint32_t N, batch, b0, j;
+    float *buf = NULL, thr;
+    uint64_t *offs = NULL, nnz = 0, cap = 0, rays = 0, pairs = 0;
+    uint32_t *cols = NULL;
+    float *vals = NULL;
+    int (*user_progress)(void *, float);
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!patches) return RAD_ERROR_INVALID_ARGUMENT;
+    N = patches->count;
+    r = rad__ff_setup(&f, patches, raycaster, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    thr = f.o.drop_threshold;
+    /* rows per batch: about 16M floats of scratch, at least one row per task */
+    batch = (uint32_t)(((size_t)1 << 24) / (N ? N : 1));
+    if (batch < f.tasks) batch = f.tasks;
+    if (batch > N) batch = N;
+    ff = (rad_form_factors *)rad__alloc(&c.allocator, sizeof(rad_form_factors));
+    buf = (float *)rad__alloc_array(&c.allocator, (size_t)batch * N, sizeof(float));
+    offs = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)N + 1u, sizeof(uint64_t));
+    if (!ff || !buf || !offs) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
+    memset(ff, 0, sizeof(*ff));
+    ff->allocator = c.allocator;
+    f.out = buf;
+    f.out_stride = N;
+    offs[0] = 0;
+    user_progress = c.progress;
+    c.progress = NULL; /* progress is reported per batch below */
+    for (b0 = 0; b0 < N && r == RAD_SUCCESS; b0 += batch) {
+        uint32_t b1 = b0 + batch > N ? N : b0 + batch, i;
+        f.row_begin = b0;
+        r = rad__for_rows(&c, b1 - b0, f.tasks, rad__ff_row_offset, &f);
+        if (r != RAD_SUCCESS) break;
+        for (i = b0; i < b1; ++i) {
+            const float *row = buf + (size_t)(i - b0) * N;
+            for (j = 0; j < N; ++j) {
+                if (!(row[j] > thr) || row[j] == 0.0f) continue;
+                if (nnz == cap) {
+                    uint64_t ncap = cap ? cap * 2u : 1024u;
+                    size_t ob, nb;
+                    uint32_t *nc;
+                    float *nv;
+                    if (!rad__mul((size_t)ncap, sizeof(float), &nb) || ncap != (uint64_t)(size_t)ncap) {
+                        r = RAD_ERROR_SIZE_OVERFLOW;
+                        goto fail;
+                    }
+                    ob = (size_t)cap * sizeof(float);
+                    nc = (uint32_t *)rad__realloc(&c.allocator, cols, ob, nb);
+                    if (!nc) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
+                    cols = nc;
+                    nv = (float *)rad__realloc(&c.allocator, vals, ob, nb);
+                    if (!nv) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
+                    vals = nv;
+                    cap = ncap;
+                }
+                cols[nnz] = j;
+                vals[nnz] = row[j];
+                ++nnz;
+            }
+            offs[i + 1] = nnz;
+        }
+        if (user_progress && user_progress(c.progress_user, (float)b1 / (float)N)) r = RAD_ERROR_CANCELLED;
+    }
+    if (r != RAD_SUCCESS) goto fail;
+    rad__ff_totals(&f, &rays, &pairs);
+    rad__ff_release(&f, &c.allocator);
+    rad__free(&c.allocator, buf);
+    ff->rays_cast = rays;
+    ff->pairs_evaluated = pairs;
+    ff->matrix.rows = ff->matrix.cols = N;
+    ff->matrix.storage = RAD_STORAGE_SPARSE;
+    ff->matrix.row_offsets = offs;
+    ff->matrix.columns = cols ? cols : (uint32_t *)rad__alloc(&c.allocator, sizeof(uint32_t));
+    ff->matrix.values = vals ? vals : (float *)rad__alloc(&c.allocator, sizeof(float));
+    if (!ff->matrix.columns || !ff->matrix.values) { rad_form_factors_destroy(ff); return RAD_ERROR_OUT_OF_MEMORY; }
+    *out = ff;
+    return RAD_SUCCESS;
+fail:
+    rad__ff_release(&f, &c.allocator);
+    rad__free(&c.allocator, buf);
+    rad__free(&c.allocator, offs);
+    rad__free(&c.allocator, cols);
+    rad__free(&c.allocator, vals);
+    rad__free(&c.allocator, ff);
+    return r;
+}
