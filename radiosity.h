@@ -2598,3 +2598,906 @@ fail:
     rad__free(&c.allocator, ff);
     return r;
 }
+
+/* ======================================================================================== */
+/* >>solve: classic solvers                                                                 */
+/* ======================================================================================== */
+
+RAD_API void rad_solve_options_default(rad_solve_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->output = RAD_OUTPUT_INDIRECT;
+    o->bounces = 8;
+    o->tolerance = 1e-6;
+}
+
+RAD_API void rad_system_init(rad_system *system, const rad_matrix *F, const rad_patches *patches, const float *E)
+{
+    if (!system) return;
+    memset(system, 0, sizeof(*system));
+    system->F = F;
+    system->E = E;
+    if (patches) {
+        system->albedo = patches->albedo;
+        system->areas = patches->areas;
+        system->n = patches->count;
+    } else if (F) {
+        system->n = F->rows;
+    }
+}
+
+static rad_result rad__check_matrix(const rad_matrix *F)
+{
+    if (!F) return RAD_ERROR_INVALID_ARGUMENT;
+    if (F->storage == RAD_STORAGE_DENSE) return F->dense ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
+    if (F->storage == RAD_STORAGE_SPARSE) return (F->row_offsets && F->columns && F->values) ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
+    return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+static rad_result rad__check_system(const rad_system *s, const rad__ctx *c)
+{
+    rad_result r;
+    if (!s || !s->albedo || !s->E) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__check_matrix(s->F);
+    if (r != RAD_SUCCESS) return r;
+    if (s->F->rows != s->n || s->F->cols != s->n || s->n == 0) {
+        rad__log(c, RAD_LOG_ERROR, "system: the matrix is %u x %u but n is %u", s->F->rows, s->F->cols, s->n);
+        return s->n == 0 ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_SIZE_MISMATCH;
+    }
+    return RAD_SUCCESS;
+}
+
+/* dot products of one dense row with three vectors (structure of arrays) */
+static void rad__dot3(const float *row, const float *xr, const float *xg, const float *xb, uint32_t n, float *o)
+{
+    uint32_t j = 0;
+    float sr = 0.0f, sg = 0.0f, sb = 0.0f;
+#if defined(RAD__AVX)
+    {
+        __m256 ar = _mm256_setzero_ps(), ag = _mm256_setzero_ps(), ab = _mm256_setzero_ps();
+        float t[8];
+        int k;
+        for (; j + 8 <= n; j += 8) {
+            __m256 f = _mm256_loadu_ps(row + j);
+            ar = _mm256_add_ps(ar, _mm256_mul_ps(f, _mm256_loadu_ps(xr + j)));
+            ag = _mm256_add_ps(ag, _mm256_mul_ps(f, _mm256_loadu_ps(xg + j)));
+            ab = _mm256_add_ps(ab, _mm256_mul_ps(f, _mm256_loadu_ps(xb + j)));
+        }
+        _mm256_storeu_ps(t, ar); for (k = 0; k < 8; ++k) sr += t[k];
+        _mm256_storeu_ps(t, ag); for (k = 0; k < 8; ++k) sg += t[k];
+        _mm256_storeu_ps(t, ab); for (k = 0; k < 8; ++k) sb += t[k];
+    }
+#elif defined(RAD__SSE2)
+    {
+        __m128 ar = _mm_setzero_ps(), ag = _mm_setzero_ps(), ab = _mm_setzero_ps();
+        __m128 ar2 = _mm_setzero_ps(), ag2 = _mm_setzero_ps(), ab2 = _mm_setzero_ps();
+        float t[4];
+        int k;
+        for (; j + 8 <= n; j += 8) {
+            __m128 f = _mm_loadu_ps(row + j), f2 = _mm_loadu_ps(row + j + 4);
+            ar = _mm_add_ps(ar, _mm_mul_ps(f, _mm_loadu_ps(xr + j)));
+            ag = _mm_add_ps(ag, _mm_mul_ps(f, _mm_loadu_ps(xg + j)));
+            ab = _mm_add_ps(ab, _mm_mul_ps(f, _mm_loadu_ps(xb + j)));
+            ar2 = _mm_add_ps(ar2, _mm_mul_ps(f2, _mm_loadu_ps(xr + j + 4)));
+            ag2 = _mm_add_ps(ag2, _mm_mul_ps(f2, _mm_loadu_ps(xg + j + 4)));
+            ab2 = _mm_add_ps(ab2, _mm_mul_ps(f2, _mm_loadu_ps(xb + j + 4)));
+        }
+        _mm_storeu_ps(t, _mm_add_ps(ar, ar2)); for (k = 0; k < 4; ++k) sr += t[k];
+        _mm_storeu_ps(t, _mm_add_ps(ag, ag2)); for (k = 0; k < 4; ++k) sg += t[k];
+        _mm_storeu_ps(t, _mm_add_ps(ab, ab2)); for (k = 0; k < 4; ++k) sb += t[k];
+    }
+#endif
+    for (; j < n; ++j) {
+        sr += row[j] * xr[j];
+        sg += row[j] * xg[j];
+        sb += row[j] * xb[j];
+    }
+    o[0] = sr;
+    o[1] = sg;
+    o[2] = sb;
+}
+
+typedef struct rad__mv {
+    const rad_matrix *F;
+    const float *x;          /* interleaved RGB */
+    const float *soa;        /* dense: x as three arrays of n */
+    float *out;
+    uint32_t tasks;
+} rad__mv;
+
+static void rad__mv_task(void *data, uint32_t t)
+{
+    const rad__mv *m = (const rad__mv *)data;
+    const rad_matrix *F = m->F;
+    uint32_t r0 = (uint32_t)((uint64_t)F->rows * t / m->tasks), r1 = (uint32_t)((uint64_t)F->rows * (t + 1) / m->tasks), i;
+    for (i = r0; i < r1; ++i) {
+        if (F->storage == RAD_STORAGE_DENSE) {
+            rad__dot3(F->dense + (size_t)i * F->cols, m->soa, m->soa + F->cols, m->soa + 2 * (size_t)F->cols, F->cols,
+                      m->out + 3 * (size_t)i);
+        } else {
+            uint64_t k;
+            float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+            for (k = F->row_offsets[i]; k < F->row_offsets[i + 1]; ++k) {
+                const float *xj = m->x + 3 * (size_t)F->columns[k];
+                float v = F->values[k];
+                s0 += v * xj[0];
+                s1 += v * xj[1];
+                s2 += v * xj[2];
+            }
+            m->out[3 * (size_t)i] = s0;
+            m->out[3 * (size_t)i + 1] = s1;
+            m->out[3 * (size_t)i + 2] = s2;
+        }
+    }
+}
+
+/* out = F x; soa is scratch of 3 * cols floats (dense only) */
+static void rad__matvec(const rad__ctx *c, const rad_matrix *F, const float *x, float *out, float *soa)
+{
+    rad__mv m;
+    uint32_t j, tasks = c->tasks;
+    if (F->storage == RAD_STORAGE_DENSE) {
+        for (j = 0; j < F->cols; ++j) {
+            soa[j] = x[3 * (size_t)j];
+            soa[(size_t)F->cols + j] = x[3 * (size_t)j + 1];
+            soa[2 * (size_t)F->cols + j] = x[3 * (size_t)j + 2];
+        }
+    }
+    if (tasks > F->rows) tasks = F->rows ? F->rows : 1;
+    m.F = F;
+    m.x = x;
+    m.soa = soa;
+    m.out = out;
+    m.tasks = tasks;
+    c->parallel_for(c->parallel_user, tasks, rad__mv_task, &m);
+}
+
+RAD_API rad_result rad_matrix_multiply(const rad_matrix *F, const float *x, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *soa = NULL;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    r = rad__check_matrix(F);
+    if (r != RAD_SUCCESS) return r;
+    if (!x || !out || x == out) return RAD_ERROR_INVALID_ARGUMENT;
+    if (F->rows == 0) return RAD_SUCCESS;
+    if (F->storage == RAD_STORAGE_DENSE) {
+        soa = (float *)rad__alloc_array(&c.allocator, (size_t)F->cols * 3u, sizeof(float));
+        if (!soa) return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    rad__matvec(&c, F, x, out, soa);
+    rad__free(&c.allocator, soa);
+    return RAD_SUCCESS;
+}
+
+static void rad__finish_output(const rad_system *s, rad_output output, float *B_total_or_L, int have_total)
+{
+    /* converts in place between B (total) and L = B - E as the caller asked */
+    size_t i, n3 = 3 * (size_t)s->n;
+    if (have_total && output == RAD_OUTPUT_INDIRECT)
+        for (i = 0; i < n3; ++i) B_total_or_L[i] -= s->E[i];
+    if (!have_total && output == RAD_OUTPUT_TOTAL)
+        for (i = 0; i < n3; ++i) B_total_or_L[i] += s->E[i];
+}
+
+RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options *options, float *out, rad_solve_stats *stats,
+                                    const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_solve_options o;
+    float *cur, *tmp, *soa = NULL;
+    size_t n3, i;
+    uint32_t k;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    r = rad__check_system(s, &c);
+    if (r != RAD_SUCCESS) return r;
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) o = *options; else rad_solve_options_default(&o);
+    n3 = 3 * (size_t)s->n;
+    cur = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
+    tmp = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
+    if (s->F->storage == RAD_STORAGE_DENSE) soa = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
+    if (!cur || !tmp || (s->F->storage == RAD_STORAGE_DENSE && !soa)) {
+        rad__free(&c.allocator, cur); rad__free(&c.allocator, tmp); rad__free(&c.allocator, soa);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memcpy(cur, s->E, n3 * sizeof(float));
+    for (i = 0; i < n3; ++i) out[i] = 0.0f;
+    for (k = 0; k < o.bounces; ++k) {
+        rad__matvec(&c, s->F, cur, tmp, soa);
+        for (i = 0; i < n3; ++i) {
+            cur[i] = s->albedo[i] * tmp[i];
+            out[i] += cur[i];
+        }
+        if (c.progress && c.progress(c.progress_user, (float)(k + 1) / (float)o.bounces)) { r = RAD_ERROR_CANCELLED; break; }
+    }
+    rad__free(&c.allocator, cur);
+    rad__free(&c.allocator, tmp);
+    rad__free(&c.allocator, soa);
+    if (r != RAD_SUCCESS) return r;
+    rad__finish_output(s, o.output, out, 0);
+    if (stats) { stats->iterations = o.bounces; stats->residual = 0.0; }
+    return RAD_SUCCESS;
+}
+
+/* sum_j F_ij x_j over j != i for RGB x; *diag receives F_ii */
+static void rad__row_gather(const rad_matrix *F, uint32_t i, const float *x, double *o, double *diag)
+{
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    *diag = 0.0;
+    if (F->storage == RAD_STORAGE_DENSE) {
+        const float *row = F->dense + (size_t)i * F->cols;
+        uint32_t j;
+        for (j = 0; j < F->cols; ++j) {
+            double v = row[j];
+            if (j == i) { *diag = v; continue; }
+            s0 += v * x[3 * (size_t)j];
+            s1 += v * x[3 * (size_t)j + 1];
+            s2 += v * x[3 * (size_t)j + 2];
+        }
+    } else {
+        uint64_t k;
+        for (k = F->row_offsets[i]; k < F->row_offsets[i + 1]; ++k) {
+            uint32_t j = F->columns[k];
+            double v = F->values[k];
+            if (j == i) { *diag = v; continue; }
+            s0 += v * x[3 * (size_t)j];
+            s1 += v * x[3 * (size_t)j + 1];
+            s2 += v * x[3 * (size_t)j + 2];
+        }
+    }
+    o[0] = s0; o[1] = s1; o[2] = s2;
+}
+
+RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_options *options, float *out,
+                                          rad_solve_stats *stats, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_solve_options o;
+    size_t n3, i;
+    uint32_t it, row, max_it;
+    double maxE = 0.0, residual = 0.0, tol;
+    rad_result r = RAD_ERROR_NOT_CONVERGED;
+    rad__ctx_init(&c, ctx);
+    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) o = *options; else rad_solve_options_default(&o);
+    tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
+    max_it = o.max_iterations ? o.max_iterations : 1000;
+    n3 = 3 * (size_t)s->n;
+    memcpy(out, s->E, n3 * sizeof(float));
+    for (i = 0; i < n3; ++i) if (fabs((double)s->E[i]) > maxE) maxE = fabs((double)s->E[i]);
+    if (maxE == 0.0) r = RAD_SUCCESS, it = 0;
+    else
+        for (it = 0; it < max_it;) {
+            double maxd = 0.0;
+            for (row = 0; row < s->n; ++row) {
+                double g[3], diag;
+                int k;
+                rad__row_gather(s->F, row, out, g, &diag);
+                for (k = 0; k < 3; ++k) {
+                    size_t at = 3 * (size_t)row + (size_t)k;
+                    double rho = s->albedo[at], nb = ((double)s->E[at] + rho * g[k]) / (1.0 - rho * diag);
+                    double d = fabs(nb - (double)out[at]);
+                    if (d > maxd) maxd = d;
+                    out[at] = (float)nb;
+                }
+            }
+            ++it;
+            residual = maxd / maxE;
+            if (residual < tol) { r = RAD_SUCCESS; break; }
+            if (o.on_residual && o.on_residual(o.residual_user, it, residual)) { r = RAD_SUCCESS; break; }
+            if (c.progress && c.progress(c.progress_user, (float)it / (float)max_it)) { r = RAD_ERROR_CANCELLED; break; }
+        }
+    if (stats) { stats->iterations = it; stats->residual = residual; }
+    if (r == RAD_ERROR_CANCELLED) return r;
+    rad__finish_output(s, o.output, out, 1);
+    if (r == RAD_ERROR_NOT_CONVERGED)
+        rad__log(&c, RAD_LOG_WARNING, "Gauss-Seidel: residual %g after %u sweeps (tolerance %g)", residual, it, tol);
+    return r;
+}
+
+RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_options *options, float *out,
+                                         rad_solve_stats *stats, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_solve_options o;
+    float *dB;
+    size_t n3;
+    uint32_t step = 0, i, max_steps;
+    double initial = 0.0, residual = 1.0, tol;
+    rad_result r = RAD_ERROR_NOT_CONVERGED;
+    rad__ctx_init(&c, ctx);
+    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
+    if (!out || !s->areas) {
+        rad__log(&c, RAD_LOG_ERROR, "progressive refinement needs system->areas");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else rad_solve_options_default(&o);
+    tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
+    max_steps = o.max_iterations ? o.max_iterations : (s->n > 42949672u ? 0xFFFFFFFFu : 100u * s->n);
+    n3 = 3 * (size_t)s->n;
+    dB = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
+    if (!dB) return RAD_ERROR_OUT_OF_MEMORY;
+    memcpy(out, s->E, n3 * sizeof(float));
+    memcpy(dB, s->E, n3 * sizeof(float));
+    for (i = 0; i < s->n; ++i)
+        initial += (double)s->areas[i] * (fabs((double)dB[3 * (size_t)i]) + fabs((double)dB[3 * (size_t)i + 1]) +
+                                          fabs((double)dB[3 * (size_t)i + 2]));
+    if (initial == 0.0) { r = RAD_SUCCESS; residual = 0.0; }
+    while (r == RAD_ERROR_NOT_CONVERGED) {
+        double best = -1.0, total = 0.0, shot[3], ai;
+        uint32_t bi = 0;
+        for (i = 0; i < s->n; ++i) {
+            double p = (double)s->areas[i] * (fabs((double)dB[3 * (size_t)i]) + fabs((double)dB[3 * (size_t)i + 1]) +
+                                              fabs((double)dB[3 * (size_t)i + 2]));
+            total += p;
+            if (p > best) { best = p; bi = i; }
+        }
+        residual = total / initial;
+        if (residual < tol) { r = RAD_SUCCESS; break; }
+        if (step >= max_steps) break;
+        if (step > 0 && o.on_residual && o.on_residual(o.residual_user, step, residual)) { r = RAD_SUCCESS; break; }
+        /* shoot bi: every j receives rho_j F_ji dB_bi with F_ji = F_ij A_i / A_j */
+        shot[0] = dB[3 * (size_t)bi]; shot[1] = dB[3 * (size_t)bi + 1]; shot[2] = dB[3 * (size_t)bi + 2];
+        dB[3 * (size_t)bi] = dB[3 * (size_t)bi + 1] = dB[3 * (size_t)bi + 2] = 0.0f;
+        ai = s->areas[bi];
+        if (s->F->storage == RAD_STORAGE_DENSE) {
+            const float *row = s->F->dense + (size_t)bi * s->F->cols;
+            uint32_t j;
+            for (j = 0; j < s->n; ++j) {
+                double f = row[j];
+                int k;
+                if (f == 0.0) continue;
+                f *= ai / (double)s->areas[j];
+                for (k = 0; k < 3; ++k) {
+                    size_t at = 3 * (size_t)j + (size_t)k;
+                    float d = (float)((double)s->albedo[at] * f * shot[k]);
+                    out[at] += d;
+                    dB[at] += d;
+                }
+            }
+        } else {
+            uint64_t q;
+            for (q = s->F->row_offsets[bi]; q < s->F->row_offsets[bi + 1]; ++q) {
+                uint32_t j = s->F->columns[q];
+                double f = (double)s->F->values[q] * ai / (double)s->areas[j];
+                int k;
+                for (k = 0; k < 3; ++k) {
+                    size_t at = 3 * (size_t)j + (size_t)k;
+                    float d = (float)((double)s->albedo[at] * f * shot[k]);
+                    out[at] += d;
+                    dB[at] += d;
+                }
+            }
+        }
+        ++step;
+        if (c.progress && (step & 1023u) == 0 && c.progress(c.progress_user, (float)(1.0 - residual))) {
+            r = RAD_ERROR_CANCELLED;
+            break;
+        }
+    }
+    rad__free(&c.allocator, dB);
+    if (stats) { stats->iterations = step; stats->residual = residual; }
+    if (r == RAD_ERROR_CANCELLED) return r;
+    rad__finish_output(s, o.output, out, 1);
+    if (r == RAD_ERROR_NOT_CONVERGED)
+        rad__log(&c, RAD_LOG_WARNING, "progressive refinement: residual %g after %u steps (tolerance %g)", residual, step, tol);
+    return r;
+}
+
+typedef struct rad__lu_job {
+    double *M;
+    uint32_t n, k, tasks;
+} rad__lu_job;
+
+static void rad__lu_task(void *data, uint32_t t)
+{
+    const rad__lu_job *j = (const rad__lu_job *)data;
+    uint32_t rows = j->n - j->k - 1, r0 = j->k + 1 + (uint32_t)((uint64_t)rows * t / j->tasks),
+             r1 = j->k + 1 + (uint32_t)((uint64_t)rows * (t + 1) / j->tasks), i, c;
+    const double *pk = j->M + (size_t)j->k * j->n;
+    for (i = r0; i < r1; ++i) {
+        double *ri = j->M + (size_t)i * j->n, l = ri[j->k] / pk[j->k];
+        ri[j->k] = l;
+        if (l == 0.0) continue;
+        for (c = j->k + 1; c < j->n; ++c) ri[c] -= l * pk[c];
+    }
+}
+
+RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options *options, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_solve_options o;
+    double *M = NULL, *b = NULL;
+    uint32_t *piv = NULL, n, ch, i, j, k;
+    size_t bytes;
+    rad_result r = RAD_SUCCESS;
+    int factored = -1;
+    rad__ctx_init(&c, ctx);
+    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) o = *options; else rad_solve_options_default(&o);
+    n = s->n;
+    if (!rad__mul3(n, n, sizeof(double), &bytes)) return RAD_ERROR_SIZE_OVERFLOW;
+    M = (double *)rad__alloc(&c.allocator, bytes);
+    b = (double *)rad__alloc_array(&c.allocator, n, sizeof(double));
+    piv = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    if (!M || !b || !piv) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (ch = 0; ch < 3 && r == RAD_SUCCESS; ++ch) {
+        /* reuse the factorization when this channel's albedo equals an earlier one's */
+        int same = factored >= 0;
+        for (i = 0; i < n && same; ++i) same = s->albedo[3 * (size_t)i + ch] == s->albedo[3 * (size_t)i + (uint32_t)factored];
+        if (!same) {
+            for (i = 0; i < n; ++i) {
+                double rho = s->albedo[3 * (size_t)i + ch];
+                double *row = M + (size_t)i * n;
+                if (s->F->storage == RAD_STORAGE_DENSE) {
+                    const float *fr = s->F->dense + (size_t)i * n;
+                    for (j = 0; j < n; ++j) row[j] = -rho * (double)fr[j];
+                } else {
+                    uint64_t q;
+                    for (j = 0; j < n; ++j) row[j] = 0.0;
+                    for (q = s->F->row_offsets[i]; q < s->F->row_offsets[i + 1]; ++q) row[s->F->columns[q]] = -rho * (double)s->F->values[q];
+                }
+                row[i] += 1.0;
+            }
+            for (k = 0; k < n; ++k) {
+                double best = fabs(M[(size_t)k * n + k]);
+                uint32_t p = k;
+                rad__lu_job job;
+                for (i = k + 1; i < n; ++i)
+                    if (fabs(M[(size_t)i * n + k]) > best) { best = fabs(M[(size_t)i * n + k]); p = i; }
+                if (!(best > 1e-14)) {
+                    rad__log(&c, RAD_LOG_ERROR, "direct solve: pivot %g in column %u (channel %u)", best, k, ch);
+                    r = RAD_ERROR_SINGULAR;
+                    break;
+                }
+                piv[k] = p;
+                if (p != k)
+                    for (j = 0; j < n; ++j) {
+                        double t = M[(size_t)k * n + j];
+                        M[(size_t)k * n + j] = M[(size_t)p * n + j];
+                        M[(size_t)p * n + j] = t;
+                    }
+                if (k + 1 < n) {
+                    job.M = M;
+                    job.n = n;
+                    job.k = k;
+                    job.tasks = c.tasks < n - k - 1 ? c.tasks : n - k - 1;
+                    c.parallel_for(c.parallel_user, job.tasks, rad__lu_task, &job);
+                }
+            }
+            if (r != RAD_SUCCESS) break;
+            factored = (int)ch;
+        }
+        for (i = 0; i < n; ++i) b[i] = s->E[3 * (size_t)i + ch];
+        for (k = 0; k < n; ++k) {
+            if (piv[k] != k) { double t = b[k]; b[k] = b[piv[k]]; b[piv[k]] = t; }
+        }
+        for (i = 0; i < n; ++i) {
+            const double *row = M + (size_t)i * n;
+            double acc = b[i];
+            for (j = 0; j < i; ++j) acc -= row[j] * b[j];
+            b[i] = acc;
+        }
+        for (i = n; i-- > 0;) {
+            const double *row = M + (size_t)i * n;
+            double acc = b[i];
+            for (j = i + 1; j < n; ++j) acc -= row[j] * b[j];
+            b[i] = acc / row[i];
+        }
+        for (i = 0; i < n; ++i) out[3 * (size_t)i + ch] = (float)b[i];
+        if (c.progress && c.progress(c.progress_user, (float)(ch + 1) / 3.0f)) r = RAD_ERROR_CANCELLED;
+    }
+    if (r == RAD_SUCCESS) {
+        if (o.output == RAD_OUTPUT_INDIRECT)
+            for (i = 0; i < 3 * n; ++i) out[i] -= s->E[i];
+    }
+done:
+    rad__free(&c.allocator, M);
+    rad__free(&c.allocator, b);
+    rad__free(&c.allocator, piv);
+    return r;
+}
+
+/* ======================================================================================== */
+/* >>light: direct light and the source term                                                */
+/* ======================================================================================== */
+
+RAD_API void rad_direct_options_default(rad_direct_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->samples = 16;
+    o->light_samples = 16;
+    o->include_emitters = 1;
+    o->ray_epsilon = 1e-5f;
+}
+
+#define RAD__DIRECT_GROUP 64u /* points per task row when lighting arbitrary points */
+
+typedef struct rad__direct {
+    const rad_scene *S;
+    const rad_raycaster *rc;
+    const rad_light *lights;
+    uint32_t light_count;
+    rad_direct_options o;
+    float eps;
+    uint32_t *emitters;          /* emissive triangles */
+    uint32_t emitter_count;
+    /* per task scratch */
+    rad_ray *rays;
+    uint8_t *occ;
+    float *ray_w;                /* 3 per ray */
+    uint32_t *ray_slot;
+    double *acc;                 /* 3 * RAD__DIRECT_GROUP per task */
+    /* job */
+    const float *points, *normals;
+    uint32_t count;
+    const rad_patches *P;        /* patch mode when set */
+    float *out;
+} rad__direct;
+
+static rad_result rad__direct_flush(rad__direct *d, uint32_t task, uint32_t count)
+{
+    rad_ray *rays = d->rays + (size_t)task * RAD__RAY_BATCH;
+    uint8_t *occ = d->occ + (size_t)task * RAD__RAY_BATCH;
+    const float *w = d->ray_w + (size_t)task * RAD__RAY_BATCH * 3u;
+    const uint32_t *slot = d->ray_slot + (size_t)task * RAD__RAY_BATCH;
+    double *acc = d->acc + (size_t)task * RAD__DIRECT_GROUP * 3u;
+    uint32_t k;
+    if (count == 0) return RAD_SUCCESS;
+    if (d->rc->occluded(d->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k)
+        if (!occ[k]) {
+            acc[3 * (size_t)slot[k]] += w[3 * (size_t)k];
+            acc[3 * (size_t)slot[k] + 1] += w[3 * (size_t)k + 1];
+            acc[3 * (size_t)slot[k] + 2] += w[3 * (size_t)k + 2];
+        }
+    return RAD_SUCCESS;
+}
+
+/* queues a shadow ray from p (offset along n) to 'to' (a point, offset along to_n when given)
+   or along 'dir' to infinity, carrying weight w (scaled by 'scale') into slot */
+static rad_result rad__direct_ray(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
+                                  const float *to, const float *to_n, const float *dir, const float *w, float scale,
+                                  uint32_t slot)
+{
+    size_t at = (size_t)task * RAD__RAY_BATCH + *nrays;
+    rad_ray *ray = d->rays + at;
+    int k;
+    for (k = 0; k < 3; ++k) ray->origin[k] = p[k] + n[k] * d->eps;
+    if (to) {
+        float len;
+        for (k = 0; k < 3; ++k) ray->dir[k] = to[k] + (to_n ? to_n[k] * d->eps : 0.0f) - ray->origin[k];
+        len = rad__len(ray->dir);
+        ray->tmin = 0.0f;
+        ray->tmax = len > 2.0f * d->eps ? 1.0f - d->eps / len : 0.5f;
+    } else {
+        for (k = 0; k < 3; ++k) ray->dir[k] = dir[k];
+        ray->tmin = 0.0f;
+        ray->tmax = FLT_MAX;
+    }
+    for (k = 0; k < 3; ++k) d->ray_w[3 * at + (size_t)k] = w[k] * scale;
+    d->ray_slot[at] = slot;
+    if (++*nrays == RAD__RAY_BATCH) {
+        rad_result r = rad__direct_flush(d, task, *nrays);
+        *nrays = 0;
+        return r;
+    }
+    return RAD_SUCCESS;
+}
+
+/* all lights at one point into slot, each contribution times 'scale' */
+static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
+                                    uint32_t slot, float scale, uint32_t seed)
+{
+    uint32_t l, s, L = d->o.light_samples;
+    rad_result r;
+    int k;
+    for (l = 0; l < d->light_count; ++l) {
+        const rad_light *li = &d->lights[l];
+        float v[3], w[3], dist, cosn;
+        if (li->type == RAD_LIGHT_DIRECTIONAL) {
+            for (k = 0; k < 3; ++k) v[k] = -li->direction[k];
+            rad__normalize(v);
+            cosn = rad__dot(v, n);
+            if (!(cosn > 0.0f)) continue;
+            for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn;
+            r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, v, w, scale, slot);
+            if (r != RAD_SUCCESS) return r;
+        } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
+            float dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * d->S->diagonal;
+            rad__sub(v, li->position, p);
+            dist = rad__len(v);
+            if (!(dist > 0.0f)) continue;
+            cosn = rad__dot(v, n) / dist;
+            if (!(cosn > 0.0f)) continue;
+            dc = dist > md ? dist : md;
+            atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
+            if (li->type == RAD_LIGHT_SPOT) {
+                float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
+                memcpy(axis, li->direction, sizeof(axis));
+                rad__normalize(axis);
+                ca = -rad__dot(v, axis) / dist;
+                if (ci > co) {
+                    t = (ca - co) / (ci - co);
+                    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+                    atten *= t * t * (3.0f - 2.0f * t);
+                } else if (!(ca >= co)) {
+                    atten = 0.0f;
+                }
+                if (!(atten > 0.0f)) continue;
+            }
+            for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn * atten;
+            r = rad__direct_ray(d, task, nrays, p, n, li->position, NULL, NULL, w, scale, slot);
+            if (r != RAD_SUCCESS) return r;
+        } else if (li->type == RAD_LIGHT_SKY) {
+            /* cosine-weighted directions: unoccluded fraction of the hemisphere times E_0 */
+            float t1[3], t2[3], a[3] = { 1.0f, 0.0f, 0.0f }, r1, r2;
+            uint32_t h = rad__hash(seed ^ 0x5bd1e995u ^ l);
+            if (fabs((double)n[0]) > 0.5) { a[0] = 0.0f; a[1] = 1.0f; }
+            rad__cross(t1, n, a);
+            rad__normalize(t1);
+            rad__cross(t2, n, t1);
+            r1 = (float)(h & 0xFFFFu) / 65536.0f;
+            r2 = (float)(h >> 16) / 65536.0f;
+            for (s = 0; s < L; ++s) {
+                float u1, u2, rr, ph, dir[3];
+                rad__hammersley(s, L, r1, r2, &u1, &u2);
+                rr = (float)sqrt((double)u1);
+                ph = (float)(2.0 * RAD__PI) * u2;
+                for (k = 0; k < 3; ++k)
+                    dir[k] = t1[k] * rr * (float)cos((double)ph) + t2[k] * rr * (float)sin((double)ph) +
+                             n[k] * (float)sqrt((double)(1.0f - u1));
+                r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, li->color, scale / (float)L, slot);
+                if (r != RAD_SUCCESS) return r;
+            }
+        }
+    }
+    if (d->o.include_emitters) {
+        double P[3], N[3];
+        for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
+        for (l = 0; l < d->emitter_count; ++l) {
+            uint32_t t = d->emitters[l], h;
+            const float *tv = d->S->positions + 9 * (size_t)t, *tn = d->S->normals + 3 * (size_t)t;
+            const float *Le = d->S->materials_table[d->S->materials[t]].emission;
+            float dv[3], F, w[3], r1, r2;
+            rad__sub(dv, p, tv);
+            if (!(rad__dot(dv, tn) > 0.0f)) continue; /* behind the emitter, or on its plane */
+            F = (float)fabs(rad__ff_point_tri(P, N, tv));
+            if (!(F > 0.0f)) continue;
+            for (k = 0; k < 3; ++k) w[k] = (float)RAD__PI * Le[k] * F;
+            h = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
+            r1 = (float)(h & 0xFFFFu) / 65536.0f;
+            r2 = (float)(h >> 16) / 65536.0f;
+            for (s = 0; s < L; ++s) {
+                float u1, u2, y[3];
+                rad__hammersley(s, L, r1, r2, &u1, &u2);
+                rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
+                r = rad__direct_ray(d, task, nrays, p, n, y, tn, NULL, w, scale / (float)L, slot);
+                if (r != RAD_SUCCESS) return r;
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__direct_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__direct *d = (rad__direct *)data;
+    double *acc = d->acc + (size_t)task * RAD__DIRECT_GROUP * 3u;
+    uint32_t nrays = 0, i, first, count;
+    rad_result r = RAD_SUCCESS;
+    uint32_t seed = rad__hash(d->o.seed + 0x9E3779B9u * (row + 1u));
+    if (d->P) {
+        /* patch mode: 'samples' points of patch 'row', averaged into slot 0 */
+        const rad_patch *pt = &d->P->patches[row];
+        float v[9];
+        uint32_t s, S = d->o.samples;
+        int m, k;
+        for (m = 0; m < 3; ++m)
+            for (k = 0; k < 3; ++k) v[3 * m + k] = d->P->vertices[3 * (size_t)pt->vertices[m] + (size_t)k];
+        acc[0] = acc[1] = acc[2] = 0.0;
+        for (s = 0; s < S && r == RAD_SUCCESS; ++s) {
+            float u1, u2, x[3];
+            rad__hammersley(s, S, 0.0f, 0.0f, &u1, &u2);
+            rad__triangle_point(v, v + 3, v + 6, u1, u2, x);
+            r = rad__direct_point(d, task, &nrays, x, pt->normal, 0, 1.0f / (float)S, rad__hash(seed + s));
+        }
+        if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
+        if (r != RAD_SUCCESS) return r;
+        for (k = 0; k < 3; ++k) d->out[3 * (size_t)row + (size_t)k] = (float)acc[k];
+        return RAD_SUCCESS;
+    }
+    first = row * RAD__DIRECT_GROUP;
+    count = d->count - first < RAD__DIRECT_GROUP ? d->count - first : RAD__DIRECT_GROUP;
+    for (i = 0; i < 3 * count; ++i) acc[i] = 0.0;
+    for (i = 0; i < count && r == RAD_SUCCESS; ++i) {
+        const float *p = d->points + 3 * (size_t)(first + i), *n = d->normals + 3 * (size_t)(first + i);
+        r = rad__direct_point(d, task, &nrays, p, n, i, 1.0f, rad__hash(seed + i));
+    }
+    if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
+    if (r != RAD_SUCCESS) return r;
+    for (i = 0; i < 3 * count; ++i) d->out[3 * (size_t)first + i] = (float)acc[i];
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__direct_run(rad__direct *d, const rad__ctx *c, uint32_t rows)
+{
+    uint32_t T = c->tasks < rows ? c->tasks : rows, t, ne = 0;
+    rad_result r;
+    if (T == 0) return RAD_SUCCESS;
+    d->rays = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    d->occ = (uint8_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    d->ray_w = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
+    d->ray_slot = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    d->acc = (double *)rad__alloc_array(&c->allocator, (size_t)T * RAD__DIRECT_GROUP, 3 * sizeof(double));
+    d->emitters = (uint32_t *)rad__alloc_array(&c->allocator, d->S->triangle_count, sizeof(uint32_t));
+    if (!d->rays || !d->occ || !d->ray_w || !d->ray_slot || !d->acc || !d->emitters) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        for (t = 0; t < d->S->triangle_count; ++t) {
+            const float *e = d->S->materials_table[d->S->materials[t]].emission;
+            if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) d->emitters[ne++] = t;
+        }
+        d->emitter_count = ne;
+        r = rad__for_rows(c, rows, T, rad__direct_row, d);
+    }
+    rad__free(&c->allocator, d->rays);
+    rad__free(&c->allocator, d->occ);
+    rad__free(&c->allocator, d->ray_w);
+    rad__free(&c->allocator, d->ray_slot);
+    rad__free(&c->allocator, d->acc);
+    rad__free(&c->allocator, d->emitters);
+    return r;
+}
+
+static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const rad_raycaster *rc, const rad_light *lights,
+                                    uint32_t light_count, const rad_direct_options *options, const rad__ctx *c)
+{
+    uint32_t l;
+    memset(d, 0, sizeof(*d));
+    if (!S || !rc || !rc->occluded || (light_count > 0 && !lights)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) d->o = *options; else rad_direct_options_default(&d->o);
+    if (d->o.samples == 0) d->o.samples = 16;
+    if (d->o.samples > RAD__MAX_SAMPLES) d->o.samples = RAD__MAX_SAMPLES;
+    if (d->o.light_samples == 0) d->o.light_samples = 16;
+    if (d->o.light_samples > RAD__MAX_SAMPLES) d->o.light_samples = RAD__MAX_SAMPLES;
+    if (d->o.ray_epsilon == 0.0f) d->o.ray_epsilon = 1e-5f;
+    if (!rad__finite(d->o.ray_epsilon) || d->o.ray_epsilon < 0.0f) return RAD_ERROR_INVALID_ARGUMENT;
+    for (l = 0; l < light_count; ++l) {
+        const rad_light *li = &lights[l];
+        if (!rad__finite3(li->color) || !rad__finite3(li->position) || !rad__finite3(li->direction) ||
+            !rad__finite(li->min_distance) || !rad__finite(li->inner_angle) || !rad__finite(li->outer_angle)) {
+            rad__log(c, RAD_LOG_ERROR, "light %u has a non-finite field", l);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (li->color[0] < 0.0f || li->color[1] < 0.0f || li->color[2] < 0.0f) {
+            rad__log(c, RAD_LOG_ERROR, "light %u has a negative colour", l);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+        if ((int)li->type < 0 || (int)li->type > RAD_LIGHT_SKY || (li->falloff != RAD_FALLOFF_QUADRATIC && li->falloff != RAD_FALLOFF_LINEAR) ||
+            ((li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_SPOT) && rad__dot(li->direction, li->direction) == 0.0f) ||
+            (li->type == RAD_LIGHT_SPOT && (li->inner_angle < 0.0f || li->outer_angle < li->inner_angle || li->outer_angle > (float)RAD__PI))) {
+            rad__log(c, RAD_LOG_ERROR, "light %u: bad type, falloff, direction or spot angles", l);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    d->S = S;
+    d->rc = rc;
+    d->lights = lights;
+    d->light_count = light_count;
+    d->eps = d->o.ray_epsilon * S->diagonal;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
+                                         uint32_t light_count, const rad_direct_options *options, const float *points,
+                                         const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__direct d;
+    rad_result r;
+    uint32_t i;
+    rad__ctx_init(&c, ctx);
+    if (!points || !normals || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__direct_setup(&d, scene, raycaster, lights, light_count, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    for (i = 0; i < count; ++i)
+        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
+            rad__log(&c, RAD_LOG_ERROR, "point %u or its normal is not finite", i);
+            return RAD_ERROR_NON_FINITE;
+        }
+    d.points = points;
+    d.normals = normals;
+    d.count = count;
+    d.out = out_irradiance;
+    return rad__direct_run(&d, &c, (count + RAD__DIRECT_GROUP - 1) / RAD__DIRECT_GROUP);
+}
+
+RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster, const rad_light *lights,
+                                      uint32_t light_count, const rad_direct_options *options, float *out_irradiance,
+                                      const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__direct d;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__direct_setup(&d, patches->scene, raycaster, lights, light_count, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    d.P = patches;
+    d.out = out_irradiance;
+    return rad__direct_run(&d, &c, patches->count);
+}
+
+RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance, float *out_E)
+{
+    uint32_t i;
+    int k;
+    if (!patches || !out_E) return RAD_ERROR_INVALID_ARGUMENT;
+    if (mode == RAD_SOURCE_EMISSION) {
+        if (direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT; /* that would count the lights twice */
+        for (i = 0; i < patches->count; ++i)
+            for (k = 0; k < 3; ++k) out_E[3 * (size_t)i + (size_t)k] = (float)RAD__PI * patches->patches[i].emission[k];
+        return RAD_SUCCESS;
+    }
+    if (mode == RAD_SOURCE_DIRECT) {
+        if (!direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
+        for (i = 0; i < 3 * patches->count; ++i) {
+            if (!rad__finite(direct_irradiance[i]) || direct_irradiance[i] < 0.0f) return RAD_ERROR_NON_FINITE;
+            out_E[i] = patches->albedo[i] * direct_irradiance[i];
+        }
+        return RAD_SUCCESS;
+    }
+    return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+#endif /* RADIOSITY_IMPLEMENTATION */
+
+/*
+------------------------------------------------------------------------------
+This software is available under 2 licenses -- choose whichever you prefer.
+------------------------------------------------------------------------------
+ALTERNATIVE A - MIT License
+Copyright (c) 2026 the radiosity.h authors
+Permission is hereby granted, free of charge, to any person obtaining a copy of
+this software and associated documentation files (the "Software"), to deal in
+the Software without restriction, including without limitation the rights to
+use, copy, modify, merge, publish, distribute, sublicense, and/or sell copies
+of the Software, and to permit persons to whom the Software is furnished to do
+so, subject to the following conditions:
+The above copyright notice and this permission notice shall be included in all
+copies or substantial portions of the Software.
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS OR COPYRIGHT HOLDERS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER
+LIABILITY, WHETHER IN AN ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM,
+OUT OF OR IN CONNECTION WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE
+SOFTWARE.
+------------------------------------------------------------------------------
+ALTERNATIVE B - Public Domain (www.unlicense.org)
+This is free and unencumbered software released into the public domain.
+Anyone is free to copy, modify, publish, use, compile, sell, or distribute this
+software, either in source code form or as a compiled binary, for any purpose,
+commercial or non-commercial, and by any means.
+In jurisdictions that recognize copyright laws, the author or authors of this
+software dedicate any and all copyright interest in the software to the public
+domain. We make this dedication for the benefit of the public at large and to
+the detriment of our heirs and successors. We intend this dedication to be an
+overt act of relinquishment in perpetuity of all present and future rights to
+this software under copyright law.
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER LIABILITY, WHETHER IN AN
+ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM, OUT OF OR IN CONNECTION
+WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE SOFTWARE.
+------------------------------------------------------------------------------
+*/
