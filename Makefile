@@ -1,0 +1,46 @@
+# radiosity.h - build, demo, tests and benchmarks.
+#   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
+#   make test    every test suite; ends with "N passed, N failed[, N skipped]"
+#   make bench   writes BENCHMARKS.md (long: minutes)
+#   make tools   builds the command-line tools in tools/
+#   make clean
+CC      ?= cc
+CXX     ?= c++
+BUILD   ?= build
+WARN     = -Wall -Wextra -Wpedantic -Wshadow
+CFLAGS  ?= -O2
+OPENMP  := $(shell printf 'int main(void){return 0;}' | $(CC) -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
+
+.PHONY: all demo test bench bench-quick tools clean
+
+all: $(BUILD)/cornell tools
+
+$(BUILD):
+	mkdir -p $(BUILD)
+
+$(BUILD)/cornell: examples/cornell.c examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/cornell.c -o $@ -lm
+
+demo: $(BUILD)/cornell
+	./$(BUILD)/cornell -o cornell.png
+
+test:
+	CC="$(CC)" CXX="$(CXX)" BUILD="$(BUILD)" bash tests/run.sh
+
+$(BUILD)/bench: bench/bench.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/bench.c -o $@ -lm
+
+bench: $(BUILD)/bench
+	./$(BUILD)/bench BENCHMARKS.md
+
+bench-quick: $(BUILD)/bench
+	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
+
+tools: $(BUILD)/rad
+
+$(BUILD)/rad: tools/rad.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. tools/rad.c -o $@ -lm
+	cp $@ tools/rad
+
+clean:
+	rm -rf $(BUILD) cornell.png tools/rad

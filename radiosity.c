@@ -1,0 +1,2 @@
+#define RADIOSITY_IMPLEMENTATION
+#include "radiosity.h"

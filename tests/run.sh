@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# Runs every test suite and ends with one line "N passed, N failed[, N skipped]".
+# A suite whose tool is missing is skipped (and named); with RAD_TEST_REQUIRE_ALL=1 a skipped
+# suite counts as failed. Optional packages are installed when we can (root with apt-get).
+set -u
+cd "$(dirname "$0")/.."
+CC=${CC:-cc}
+CXX=${CXX:-c++}
+BUILD=${BUILD:-build}/tests
+mkdir -p "$BUILD"
+WARN="-Wall -Wextra -Wpedantic -Wshadow -Werror"
+PASSED=0; FAILED=0; SKIPPED=0
+SKIPPED_NAMES=""; FAILED_NAMES=""
+
+have() { command -v "$1" >/dev/null 2>&1; }
+try_install() { # package...
+    if [ "$(id -u)" = 0 ] && have apt-get; then
+        echo "installing $* (optional test packages)"
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@" >/dev/null 2>&1 ||
+            { apt-get update -qq >/dev/null 2>&1 && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "$@" >/dev/null 2>&1; }
+    fi
+}
+pass() { PASSED=$((PASSED + 1)); echo "  ok    $1"; }
+fail() { FAILED=$((FAILED + 1)); FAILED_NAMES="$FAILED_NAMES $1"; echo "  FAIL  $1"; }
+skip() {
+    if [ "${RAD_TEST_REQUIRE_ALL:-0}" = 1 ]; then
+        fail "$1 (required but skipped: $2)"
+    else
+        SKIPPED=$((SKIPPED + 1)); SKIPPED_NAMES="$SKIPPED_NAMES $1"; echo "  SKIP  $1: $2"
+    fi
+}
+# compile step: name, then the command
+build() {
+    local name=$1; shift
+    if "$@" >"$BUILD/$name.log" 2>&1; then return 0; fi
+    echo "  build of $name failed:"; sed 's/^/    /' "$BUILD/$name.log" | head -40
+    return 1
+}
+# a unit-test binary: adds its own "N passed, N failed" counts
+unit() {
+    local name=$1; shift
+    local out="$BUILD/$name.out"
+    echo "== $name"
+    if ! build "$name" "$@" -o "$BUILD/$name" -lm; then fail "$name (build)"; return; fi
+    "$BUILD/$name" >"$out" 2>&1
+    local rc=$?
+    local line p f
+    line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$out" | tail -n 1)
+    if [ -z "$line" ]; then
+        tail -n 30 "$out" | sed 's/^/    /'
+        fail "$name (crashed or printed no summary, exit $rc)"; return
+    fi
+    p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/')
+    f=$(echo "$line" | sed -E 's/^[0-9]+ passed, ([0-9]+) failed.*/\1/')
+    PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
+    grep -E 'FAIL|error' "$out" | head -40 | sed 's/^/    /'
+    if [ "$rc" != 0 ] && [ "$f" = 0 ]; then fail "$name (exit $rc)"; fi
+    [ "$f" = 0 ] || FAILED_NAMES="$FAILED_NAMES $name"
+    echo "   $line"
+}
+# a compile-and-run test counted as one test
+compile_run() {
+    local name=$1; shift
+    if build "$name" "$@" && "$BUILD/$name" >"$BUILD/$name.out" 2>&1; then pass "$name"; else fail "$name"; fi
+}
+
+OMP=""
+printf 'int main(void){return 0;}' | $CC -fopenmp -x c - -o /dev/null 2>/dev/null && OMP="-fopenmp"
+
+# ---- unit tests with the default compiler -------------------------------------------------
+unit unit-O2 $CC -std=c99 $WARN -O2 -I. tests/test_main.c
+if [ -n "$OMP" ]; then
+    unit unit-O2-openmp $CC -std=c99 $WARN -O2 $OMP -I. tests/test_main.c
+else
+    skip unit-O2-openmp "$CC has no OpenMP"
+fi
+unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c
+unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c
+
+# ---- sanitizers ---------------------------------------------------------------------------
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+RAD_TEST_QUICK=1 unit unit-asan-ubsan $CC -std=c99 $WARN -O1 -g -fno-omit-frame-pointer \
+    -fsanitize=address,undefined -fno-sanitize-recover=all -I. tests/test_main.c
+
+# ---- compile tests ------------------------------------------------------------------------
+echo "== compile tests"
+compile_run compile-c99 $CC -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-c99" -lm
+compile_run compile-cpp11 $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-cpp11" -lm
+compile_run compile-static $CC -std=c99 $WARN -I. tests/static_build.c -o "$BUILD/compile-static" -lm
+compile_run compile-custom-alloc $CC -std=c99 $WARN -I. tests/custom_alloc.c -o "$BUILD/compile-custom-alloc" -lm
+if build link-a $CC -std=c99 $WARN -I. -c tests/link_a.c -o "$BUILD/link_a.o" &&
+   build link-b $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. -c tests/link_b.cpp -o "$BUILD/link_b.o" &&
+   build link-main $CC -std=c99 $WARN -I. -c tests/link_main.c -o "$BUILD/link_main.o" &&
+   build link-exe $CXX "$BUILD/link_a.o" "$BUILD/link_b.o" "$BUILD/link_main.o" -o "$BUILD/link-c-cpp" -lm &&
+   "$BUILD/link-c-cpp" >"$BUILD/link-c-cpp.out" 2>&1; then
+    pass link-c-and-cpp
+else
+    fail link-c-and-cpp
+fi
+
+# ---- clang (optional: installed when we can) ---------------------------------------------
+have clang || try_install clang libclang-rt-14-dev
+if have clang && have clang++; then
+    unit unit-clang-O2 clang -std=c99 $WARN -O2 -I. tests/test_main.c
+    compile_run compile-clang-c99 clang -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-clang-c99" -lm
+    compile_run compile-clang-cpp11 clang++ -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-clang-cpp11" -lm
+    if printf 'int main(void){return 0;}' | clang -fsanitize=address,undefined -x c - -o /dev/null 2>/dev/null; then
+        RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan clang -std=c99 $WARN -O2 -g -fno-omit-frame-pointer \
+            -fsanitize=address,undefined -fno-sanitize-recover=all -I. tests/test_main.c
+    else
+        skip unit-clang-asan-ubsan "clang's sanitizer runtime is missing (package libclang-rt-14-dev)"
+    fi
+else
+    skip clang-suites "clang is not installed (package clang)"
+fi
+
+echo
+[ -z "$SKIPPED_NAMES" ] || echo "skipped suites:$SKIPPED_NAMES"
+[ -z "$FAILED_NAMES" ] || echo "failed:$FAILED_NAMES"
+if [ "$SKIPPED" -gt 0 ]; then
+    echo "$PASSED passed, $FAILED failed, $SKIPPED skipped"
+else
+    echo "$PASSED passed, $FAILED failed"
+fi
+[ "$FAILED" = 0 ]
