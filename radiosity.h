@@ -2252,10 +2252,10 @@ static rad_result rad__ff_flush(rad__ff *f, uint32_t task, uint32_t count)
 static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t slot, uint32_t task, uint32_t *nrays)
 {
     const rad_patch *pl = &f->P->patches[lo], *ph = &f->P->patches[hi];
-    float vl[9], vh[9], r1, r2;
-    uint32_t S = f->o.samples, s, h;
+    float vl[9], vh[9], r1, r2, d[3], rl = 0.0f, rh = 0.0f, scale = 1.0f, xs[3];
+    uint32_t S = f->o.samples, s, h, m;
     double *acc = f->acc + (size_t)task * f->P->count, PN[3];
-    int k;
+    int k, near;
     rad__ff_patch_corners(f, lo, vl);
     rad__ff_patch_corners(f, hi, vh);
     acc[slot] = 0.0;
@@ -2265,9 +2265,31 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
     r1 = (float)(h & 0xFFFFu) / 65536.0f;
     r2 = (float)(h >> 16) / 65536.0f;
     for (k = 0; k < 3; ++k) PN[k] = pl->normal[k];
+    /* near pairs (closer than twice their sizes, e.g. sharing an edge) have a nearly singular
+       integrand: they get 4x the emitter points, computed here, each weighted S / (4S) */
+    for (m = 0; m < 3; ++m) {
+        rad__sub(d, vl + 3 * m, pl->centroid);
+        if (rad__dot(d, d) > rl) rl = rad__dot(d, d);
+        rad__sub(d, vh + 3 * m, ph->centroid);
+        if (rad__dot(d, d) > rh) rh = rad__dot(d, d);
+    }
+    rad__sub(d, pl->centroid, ph->centroid);
+    near = rad__dot(d, d) < 4.0f * (rl + rh + 2.0f * (float)sqrt((double)rl * (double)rh));
+    if (near && S < RAD__MAX_SAMPLES) {
+        S = 4u * S < RAD__MAX_SAMPLES ? 4u * S : RAD__MAX_SAMPLES;
+        scale = (float)f->o.samples / (float)S;
+    } else {
+        near = 0;
+    }
     for (s = 0; s < S; ++s) {
-        const float *x = f->pts + ((size_t)lo * S + s) * 3u;
+        const float *x = xs;
         float y[3], u1, u2, w, dxy[3];
+        if (near) {
+            rad__hammersley(s, S, 0.0f, 0.0f, &u1, &u2);
+            rad__triangle_point(vl, vl + 3, vl + 6, u1, u2, xs);
+        } else {
+            x = f->pts + ((size_t)lo * S + s) * 3u;
+        }
         rad__sub(dxy, x, vh);
         if (!(rad__dot(dxy, ph->normal) > 0.0f)) continue; /* x is behind the receiver */
         rad__hammersley(s, S, r1, r2, &u1, &u2);
@@ -2279,6 +2301,7 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
         } else {
             w = rad_ff_point_point(x, pl->normal, y, ph->normal, ph->area);
         }
+        w *= scale;
         if (!(w > 0.0f)) continue;
         if (f->o.skip_visibility) {
             acc[slot] += (double)w;
