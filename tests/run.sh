@@ -87,8 +87,16 @@ RAD_TEST_QUICK=1 unit unit-asan-ubsan $CC -std=c99 $WARN -O1 -g -fno-omit-frame-
 echo "== compile tests"
 compile_run compile-c99 $CC -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-c99" -lm
 compile_run compile-cpp11 $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-cpp11" -lm
-compile_run compile-static $CC -std=c99 $WARN -I. tests/static_build.c -o "$BUILD/compile-static" -lm
+compile_run compile-static $CC -std=c99 $WARN -Wno-unused-function -I. tests/static_build.c -o "$BUILD/compile-static" -lm
 compile_run compile-custom-alloc $CC -std=c99 $WARN -I. tests/custom_alloc.c -o "$BUILD/compile-custom-alloc" -lm
+compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+if build tool-rad $CC -std=c99 $WARN -O2 -I. tools/rad.c -o "$BUILD/rad" -lm &&
+   "$BUILD/rad" formfactors cornell --patches 200 >"$BUILD/rad-ff.txt" 2>/dev/null &&
+   [ "$(wc -l <"$BUILD/rad-ff.txt")" = 64 ] && grep -q '^light floor 0\.[0-9]' "$BUILD/rad-ff.txt"; then
+    pass tool-rad-formfactors
+else
+    fail tool-rad-formfactors
+fi
 if build link-a $CC -std=c99 $WARN -I. -c tests/link_a.c -o "$BUILD/link_a.o" &&
    build link-b $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. -c tests/link_b.cpp -o "$BUILD/link_b.o" &&
    build link-main $CC -std=c99 $WARN -I. -c tests/link_main.c -o "$BUILD/link_main.o" &&
