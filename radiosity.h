@@ -2699,14 +2699,23 @@ static void rad__dot3(const float *row, const float *xr, const float *xg, const 
 #if defined(RAD__AVX)
     {
         __m256 ar = _mm256_setzero_ps(), ag = _mm256_setzero_ps(), ab = _mm256_setzero_ps();
+        __m256 ar2 = _mm256_setzero_ps(), ag2 = _mm256_setzero_ps(), ab2 = _mm256_setzero_ps();
         float t[8];
         int k;
-        for (; j + 8 <= n; j += 8) {
-            __m256 f = _mm256_loadu_ps(row + j);
+        /* six independent sums keep the adders busy; the matrix row streams once */
+        for (; j + 16 <= n; j += 16) {
+            __m256 f = _mm256_loadu_ps(row + j), f2 = _mm256_loadu_ps(row + j + 8);
+            _mm_prefetch((const char *)(row + j + 256), _MM_HINT_T0); /* 1 KiB ahead */
             ar = _mm256_add_ps(ar, _mm256_mul_ps(f, _mm256_loadu_ps(xr + j)));
             ag = _mm256_add_ps(ag, _mm256_mul_ps(f, _mm256_loadu_ps(xg + j)));
             ab = _mm256_add_ps(ab, _mm256_mul_ps(f, _mm256_loadu_ps(xb + j)));
+            ar2 = _mm256_add_ps(ar2, _mm256_mul_ps(f2, _mm256_loadu_ps(xr + j + 8)));
+            ag2 = _mm256_add_ps(ag2, _mm256_mul_ps(f2, _mm256_loadu_ps(xg + j + 8)));
+            ab2 = _mm256_add_ps(ab2, _mm256_mul_ps(f2, _mm256_loadu_ps(xb + j + 8)));
         }
+        ar = _mm256_add_ps(ar, ar2);
+        ag = _mm256_add_ps(ag, ag2);
+        ab = _mm256_add_ps(ab, ab2);
         _mm256_storeu_ps(t, ar); for (k = 0; k < 8; ++k) sr += t[k];
         _mm256_storeu_ps(t, ag); for (k = 0; k < 8; ++k) sg += t[k];
         _mm256_storeu_ps(t, ab); for (k = 0; k < 8; ++k) sb += t[k];
@@ -2719,6 +2728,7 @@ static void rad__dot3(const float *row, const float *xr, const float *xg, const 
         int k;
         for (; j + 8 <= n; j += 8) {
             __m128 f = _mm_loadu_ps(row + j), f2 = _mm_loadu_ps(row + j + 4);
+            _mm_prefetch((const char *)(row + j + 256), _MM_HINT_T0); /* 1 KiB ahead */
             ar = _mm_add_ps(ar, _mm_mul_ps(f, _mm_loadu_ps(xr + j)));
             ag = _mm_add_ps(ag, _mm_mul_ps(f, _mm_loadu_ps(xg + j)));
             ab = _mm_add_ps(ab, _mm_mul_ps(f, _mm_loadu_ps(xb + j)));
