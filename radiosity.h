@@ -481,6 +481,33 @@ RAD_API void rad_bvh_raycaster(const rad_bvh *bvh, rad_raycaster *out);
 /* Bytes the BVH holds (nodes and triangles). */
 RAD_API size_t rad_bvh_memory(const rad_bvh *bvh);
 
+/* ---- Embree 3 backend (compiled only with RAD_EMBREE; always declared) ----
+   Define RAD_EMBREE in the implementing file and link Embree 3 (-lembree3) to use Embree for
+   every ray query. Without it these functions return RAD_ERROR_UNAVAILABLE (and
+   rad_embree_raycaster fills a table whose callbacks are NULL). The Embree headers are
+   included by the implementation only. Thread safety: queries from any number of threads. */
+typedef struct rad_embree rad_embree;
+
+/* 1 when the library was compiled with RAD_EMBREE, else 0. */
+RAD_API int rad_embree_available(void);
+/* Builds an Embree device and scene (RTC_SCENE_FLAG_ROBUST, high build quality) over the
+   scene's triangles, copied into Embree-owned buffers (scene is borrowed for the call).
+   Embree's errors are sent to ctx->log. Errors: UNAVAILABLE, INVALID_ARGUMENT,
+   OUT_OF_MEMORY, RAYCAST_FAILED (Embree could not create the device or the scene). */
+RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *ctx, rad_embree **out);
+/* Wraps a user's committed RTCScene (passed as void * so this header needs no Embree types).
+   A hit on (geomID, primID) is reported as triangle first_triangle[geomID] + primID; pass
+   first_triangle = NULL when geometry 0 holds the scene's triangles in order. The scene is
+   borrowed: it must outlive the returned object, which does not release it. */
+RAD_API rad_result rad_embree_wrap(void *rtc_scene, const uint32_t *first_triangle, uint32_t geometry_count,
+                                   const rad_context *ctx, rad_embree **out);
+RAD_API void rad_embree_destroy(rad_embree *embree);
+/* Fills a raycaster table that queries 'embree' (which must outlive its use). */
+RAD_API void rad_embree_raycaster(const rad_embree *embree, rad_raycaster *out);
+/* Bytes Embree reported allocating for the device and scene made by rad_embree_create
+   (through its memory monitor); 0 for a wrapped scene. */
+RAD_API size_t rad_embree_memory(const rad_embree *embree);
+
 /* A camera ray through the point (px, py) of a width x height image, px right, py down,
    pixel centres at +0.5. dir is unit, tmin 0, tmax +huge. */
 RAD_API void rad_camera_ray(const rad_camera *camera, uint32_t width, uint32_t height, float px, float py,
@@ -2070,6 +2097,223 @@ RAD_API void rad_bvh_raycaster(const rad_bvh *bvh, rad_raycaster *out)
     out->occluded = rad__bvh_occluded;
     out->intersect = rad__bvh_intersect;
 }
+
+/* ---- Embree 3 backend ---- */
+
+#ifdef RAD_EMBREE
+#include <embree3/rtcore.h>
+
+struct rad_embree {
+    RTCDevice device;        /* NULL for a wrapped scene */
+    RTCScene scene;
+    uint32_t *first;         /* per geometry: first triangle (wrapped scenes), or NULL */
+    uint32_t geometry_count;
+    rad_allocator allocator;
+    void (*log)(void *user, rad_log_level level, const char *message);
+    void *log_user;
+    size_t memory;           /* device memory reported by the monitor (bytes, >= 0) */
+};
+
+static void rad__embree_error(void *user, enum RTCError code, const char *str)
+{
+    rad_embree *e = (rad_embree *)user;
+    char buf[512];
+    if (!e || !e->log) return;
+    snprintf(buf, sizeof(buf), "Embree error %d: %s", (int)code, str ? str : "");
+    e->log(e->log_user, RAD_LOG_ERROR, buf);
+}
+
+static bool rad__embree_monitor(void *user, ssize_t bytes, bool post)
+{
+    rad_embree *e = (rad_embree *)user;
+    (void)post;
+    /* called from Embree's build threads: a plain counter, read only after the build */
+    if (bytes > 0) e->memory += (size_t)bytes;
+    else if ((size_t)(-bytes) <= e->memory) e->memory -= (size_t)(-bytes);
+    return true;
+}
+
+RAD_API int rad_embree_available(void) { return 1; }
+
+RAD_API void rad_embree_destroy(rad_embree *e)
+{
+    rad_allocator a;
+    if (!e) return;
+    a = e->allocator;
+    if (e->device) {
+        if (e->scene) rtcReleaseScene(e->scene);
+        rtcReleaseDevice(e->device);
+    }
+    rad__free(&a, e->first);
+    rad__free(&a, e);
+}
+
+RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *ctx, rad_embree **out)
+{
+    rad__ctx c;
+    rad_embree *e;
+    RTCGeometry g;
+    float *v;
+    unsigned int *idx;
+    uint32_t t;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!scene || scene->triangle_count == 0) return RAD_ERROR_INVALID_ARGUMENT;
+    e = (rad_embree *)rad__alloc(&c.allocator, sizeof(rad_embree));
+    if (!e) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(e, 0, sizeof(*e));
+    e->allocator = c.allocator;
+    e->log = c.log;
+    e->log_user = c.log_user;
+    e->device = rtcNewDevice(NULL);
+    if (!e->device) {
+        rad__log(&c, RAD_LOG_ERROR, "rtcNewDevice failed (Embree error %d)", (int)rtcGetDeviceError(NULL));
+        rad__free(&c.allocator, e);
+        return RAD_ERROR_RAYCAST_FAILED;
+    }
+    rtcSetDeviceErrorFunction(e->device, rad__embree_error, e);
+    rtcSetDeviceMemoryMonitorFunction(e->device, rad__embree_monitor, e);
+    e->scene = rtcNewScene(e->device);
+    g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!e->scene || !g) { rad_embree_destroy(e); return RAD_ERROR_RAYCAST_FAILED; }
+    rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(e->scene, RTC_BUILD_QUALITY_HIGH);
+    /* Embree-owned buffers: Embree pads them for its 16-byte loads */
+    v = (float *)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                         3 * (size_t)scene->triangle_count);
+    idx = (unsigned int *)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned int),
+                                                  scene->triangle_count);
+    if (!v || !idx) { rtcReleaseGeometry(g); rad_embree_destroy(e); return RAD_ERROR_OUT_OF_MEMORY; }
+    memcpy(v, scene->positions, 9 * sizeof(float) * (size_t)scene->triangle_count);
+    for (t = 0; t < 3 * scene->triangle_count; ++t) idx[t] = t;
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(e->scene, g, 0);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(e->scene);
+    if (rtcGetDeviceError(e->device) != RTC_ERROR_NONE) { rad_embree_destroy(e); return RAD_ERROR_RAYCAST_FAILED; }
+    *out = e;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_embree_wrap(void *rtc_scene, const uint32_t *first_triangle, uint32_t geometry_count,
+                                   const rad_context *ctx, rad_embree **out)
+{
+    rad__ctx c;
+    rad_embree *e;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!rtc_scene || (first_triangle && geometry_count == 0)) return RAD_ERROR_INVALID_ARGUMENT;
+    e = (rad_embree *)rad__alloc(&c.allocator, sizeof(rad_embree));
+    if (!e) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(e, 0, sizeof(*e));
+    e->allocator = c.allocator;
+    e->scene = (RTCScene)rtc_scene;
+    if (first_triangle) {
+        e->first = (uint32_t *)rad__alloc_array(&c.allocator, geometry_count, sizeof(uint32_t));
+        if (!e->first) { rad__free(&c.allocator, e); return RAD_ERROR_OUT_OF_MEMORY; }
+        memcpy(e->first, first_triangle, sizeof(uint32_t) * geometry_count);
+        e->geometry_count = geometry_count;
+    }
+    *out = e;
+    return RAD_SUCCESS;
+}
+
+RAD_API size_t rad_embree_memory(const rad_embree *e) { return e ? e->memory : 0; }
+
+static void rad__embree_ray(const rad_ray *r, struct RTCRay *er)
+{
+    er->org_x = r->origin[0]; er->org_y = r->origin[1]; er->org_z = r->origin[2];
+    er->dir_x = r->dir[0]; er->dir_y = r->dir[1]; er->dir_z = r->dir[2];
+    er->tnear = r->tmin;
+    er->tfar = r->tmax;
+    er->time = 0.0f;
+    er->mask = 0xFFFFFFFFu;
+    er->id = 0;
+    er->flags = 0;
+}
+
+static rad_result rad__embree_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
+{
+    const rad_embree *e = (const rad_embree *)user;
+    struct RTCIntersectContext ic;
+    uint32_t i;
+    rtcInitIntersectContext(&ic);
+    for (i = 0; i < count; ++i) {
+        struct RTCRay er;
+        if (!(rays[i].tmax > rays[i].tmin)) { out[i] = 0; continue; }
+        rad__embree_ray(&rays[i], &er);
+        rtcOccluded1(e->scene, &ic, &er);
+        out[i] = (uint8_t)(er.tfar < 0.0f && er.tfar == -INFINITY);
+    }
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__embree_intersect(void *user, const rad_ray *rays, uint32_t count, rad_hit *out)
+{
+    const rad_embree *e = (const rad_embree *)user;
+    struct RTCIntersectContext ic;
+    uint32_t i;
+    rtcInitIntersectContext(&ic);
+    for (i = 0; i < count; ++i) {
+        struct RTCRayHit rh;
+        out[i].t = rays[i].tmax;
+        out[i].triangle = RAD_NONE;
+        out[i].b1 = out[i].b2 = 0.0f;
+        if (!(rays[i].tmax > rays[i].tmin)) continue;
+        rad__embree_ray(&rays[i], &rh.ray);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(e->scene, &ic, &rh);
+        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+        if (e->first && rh.hit.geomID >= e->geometry_count) continue;
+        out[i].t = rh.ray.tfar;
+        out[i].triangle = (e->first ? e->first[rh.hit.geomID] : 0u) + rh.hit.primID;
+        out[i].b1 = rh.hit.u;
+        out[i].b2 = rh.hit.v;
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_embree_raycaster(const rad_embree *e, rad_raycaster *out)
+{
+    if (!out) return;
+    out->user = (void *)(uintptr_t)e;
+    out->occluded = e ? rad__embree_occluded : NULL;
+    out->intersect = e ? rad__embree_intersect : NULL;
+}
+
+#else /* !RAD_EMBREE */
+
+RAD_API int rad_embree_available(void) { return 0; }
+RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *ctx, rad_embree **out)
+{
+    (void)scene; (void)ctx;
+    if (out) *out = NULL;
+    return RAD_ERROR_UNAVAILABLE;
+}
+RAD_API rad_result rad_embree_wrap(void *rtc_scene, const uint32_t *first_triangle, uint32_t geometry_count,
+                                   const rad_context *ctx, rad_embree **out)
+{
+    (void)rtc_scene; (void)first_triangle; (void)geometry_count; (void)ctx;
+    if (out) *out = NULL;
+    return RAD_ERROR_UNAVAILABLE;
+}
+RAD_API void rad_embree_destroy(rad_embree *embree) { (void)embree; }
+RAD_API void rad_embree_raycaster(const rad_embree *embree, rad_raycaster *out)
+{
+    (void)embree;
+    if (!out) return;
+    out->user = NULL;
+    out->occluded = NULL;
+    out->intersect = NULL;
+}
+RAD_API size_t rad_embree_memory(const rad_embree *embree) { (void)embree; return 0; }
+
+#endif /* RAD_EMBREE */
+
+
 
 RAD_API void rad_camera_ray(const rad_camera *cam, uint32_t width, uint32_t height, float px, float py, rad_ray *out)
 {
