@@ -77,6 +77,14 @@ fi
 unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c
 unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c
 
+# ---- Embree backend (optional: installed when we can) -------------------------------------
+[ -f /usr/include/embree3/rtcore.h ] || try_install libembree-dev
+if [ -f /usr/include/embree3/rtcore.h ]; then
+    unit unit-embree $CC -std=c99 $WARN -O2 $OMP -DRAD_EMBREE -DRAD_TEST_EMBREE -I. tests/test_main.c -lembree3
+else
+    skip unit-embree "Embree 3 is not installed (package libembree-dev)"
+fi
+
 # ---- sanitizers ---------------------------------------------------------------------------
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

@@ -4,17 +4,72 @@
 #include "../radiosity.h"
 #include "test.h"
 
+static void rad__bvh_destroy_real(rad_bvh *bvh) { rad_bvh_destroy(bvh); }
+
+#ifdef RAD_TEST_EMBREE
+/* The Embree suite: every raycaster the tests take from a BVH is an Embree raycaster over the
+   same triangles, so the whole suite checks the Embree backend against the same expectations. */
+#define RAD_TEST_EMBREE_MAX 256
+static struct { const rad_bvh *bvh; rad_embree *embree; } rad_test_embree_map[RAD_TEST_EMBREE_MAX];
+
+static void rad_test_embree_raycaster(const rad_bvh *bvh, rad_raycaster *out)
+{
+    rad_scene fake;
+    float *pos;
+    uint32_t i, slot = RAD_TEST_EMBREE_MAX;
+    rad_embree *e = NULL;
+    rad_bvh_raycaster(bvh, out); /* a fallback that keeps tests running if Embree fails */
+    if (!bvh) return;
+    for (i = 0; i < RAD_TEST_EMBREE_MAX; ++i) {
+        if (rad_test_embree_map[i].bvh == bvh) { rad_embree_raycaster(rad_test_embree_map[i].embree, out); return; }
+        if (!rad_test_embree_map[i].bvh && slot == RAD_TEST_EMBREE_MAX) slot = i;
+    }
+    pos = (float *)malloc(sizeof(float) * 9 * bvh->tri_count);
+    if (!pos || slot == RAD_TEST_EMBREE_MAX) { free(pos); printf("    FAIL embree map full\n"); rad_test_failures++; return; }
+    for (i = 0; i < bvh->tri_count; ++i) memcpy(pos + 9 * (size_t)bvh->ids[i], bvh->tris + 9 * (size_t)i, 9 * sizeof(float));
+    memset(&fake, 0, sizeof(fake));
+    fake.positions = pos;
+    fake.triangle_count = bvh->tri_count;
+    if (rad_embree_create(&fake, NULL, &e) != RAD_SUCCESS) { printf("    FAIL rad_embree_create\n"); rad_test_failures++; free(pos); return; }
+    free(pos);
+    rad_test_embree_map[slot].bvh = bvh;
+    rad_test_embree_map[slot].embree = e;
+    rad_embree_raycaster(e, out);
+}
+
+static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
+{
+    uint32_t i;
+    for (i = 0; i < RAD_TEST_EMBREE_MAX; ++i)
+        if (bvh && rad_test_embree_map[i].bvh == bvh) {
+            rad_embree_destroy(rad_test_embree_map[i].embree);
+            rad_test_embree_map[i].bvh = NULL;
+            rad_test_embree_map[i].embree = NULL;
+        }
+    rad_bvh_destroy(bvh);
+}
+#define rad_bvh_raycaster(bvh, out) rad_test_embree_raycaster(bvh, out)
+#define rad_bvh_destroy(bvh) rad_test_embree_bvh_destroy(bvh)
+#endif
+
 #include "test_scene.c"
 #include "test_formfactor.c"
 #include "test_solve.c"
 #include "test_light.c"
+#include "test_embree.c"
 
-static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_solve, tests_light };
+static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_solve, tests_light, tests_embree };
 
 int main(int argc, char **argv)
 {
     int passed = 0, failed = 0;
     size_t t;
+    (void)&rad_test_quick; /* helpers some builds do not call */
+    (void)&rad__bvh_destroy_real;
+#ifdef RAD_TEST_EMBREE
+    (void)&rad_test_embree_raycaster;
+    (void)&rad_test_embree_bvh_destroy;
+#endif
     for (t = 0; t < sizeof(rad_test_tables) / sizeof(rad_test_tables[0]); ++t) {
         const rad_test_case *c;
         for (c = rad_test_tables[t]; c->name; ++c) {
