@@ -1749,8 +1749,17 @@ typedef struct rad__bvh_node {
     uint32_t count;   /* triangles in a leaf, 0 for an inner node */
 } rad__bvh_node;
 
+/* The traversal structure: 4-wide nodes collapsed from the binary SAH tree, so one SIMD slab
+   test checks four child boxes. Empty slots have child RAD_NONE. */
+typedef struct rad__bvh4 {
+    float lo[3][4], hi[3][4]; /* per axis, per child */
+    uint32_t child[4];        /* RAD__BVH4_LEAF | first triangle for a leaf, else node index */
+    uint32_t count[4];        /* triangles of a leaf child */
+} rad__bvh4;
+#define RAD__BVH4_LEAF 0x80000000u
+
 struct rad_bvh {
-    rad__bvh_node *nodes;
+    rad__bvh4 *nodes;
     uint32_t node_count;
     float *tris;        /* 9 floats per triangle, in leaf order */
     uint32_t *ids;      /* scene triangle of each */
@@ -1799,7 +1808,7 @@ RAD_API void rad_bvh_destroy(rad_bvh *bvh)
 RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
 {
     if (!bvh) return 0;
-    return sizeof(*bvh) + (size_t)bvh->node_count * sizeof(rad__bvh_node) +
+    return sizeof(*bvh) + (size_t)bvh->node_count * sizeof(rad__bvh4) +
            (size_t)bvh->tri_count * (9 * sizeof(float) + sizeof(uint32_t));
 }
 
@@ -1811,24 +1820,87 @@ static int rad__bvh_bin(const float *cen, uint32_t t, int axis, const rad__aabb 
     return bin;
 }
 
+/* Collapses the binary tree 'bin' into 4-wide nodes: each 4-wide node opens the largest inner
+   child of its binary node until it has four children. 'stack' has room for 2 * bin_count. */
+static rad_result rad__bvh4_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t bin_count, uint32_t *stack)
+{
+    uint32_t sp = 0;
+    (void)bin_count;
+    b->node_count = 1;
+    stack[sp++] = 0; /* binary node */
+    stack[sp++] = 0; /* its 4-wide node */
+    while (sp > 0) {
+        uint32_t n4 = stack[--sp], bi = stack[--sp], slots[4], ns = 0, k;
+        rad__bvh4 *node = &b->nodes[n4];
+        if (bin[bi].count) {
+            slots[ns++] = bi; /* a leaf root (tiny scenes) */
+        } else {
+            slots[ns++] = bin[bi].first;
+            slots[ns++] = bin[bi].first + 1;
+            while (ns < 4) {
+                float best = -1.0f;
+                uint32_t bk = 4;
+                for (k = 0; k < ns; ++k) {
+                    const rad__bvh_node *q = &bin[slots[k]];
+                    float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
+                    float area = dx * dy + dy * dz + dz * dx;
+                    if (q->count == 0 && area > best) { best = area; bk = k; }
+                }
+                if (bk == 4) break;
+                slots[ns++] = bin[slots[bk]].first + 1;
+                slots[bk] = bin[slots[bk]].first;
+            }
+        }
+        for (k = 0; k < 4; ++k) {
+            int a;
+            if (k >= ns) {
+                for (a = 0; a < 3; ++a) { node->lo[a][k] = 0.0f; node->hi[a][k] = 0.0f; }
+                node->child[k] = RAD_NONE;
+                node->count[k] = 0;
+                continue;
+            }
+            for (a = 0; a < 3; ++a) { node->lo[a][k] = bin[slots[k]].bmin[a]; node->hi[a][k] = bin[slots[k]].bmax[a]; }
+            if (bin[slots[k]].count) {
+                node->child[k] = RAD__BVH4_LEAF | bin[slots[k]].first;
+                node->count[k] = bin[slots[k]].count;
+            } else {
+                uint32_t m = b->node_count++;
+                node->child[k] = m;
+                node->count[k] = 0;
+                stack[sp++] = slots[k];
+                stack[sp++] = m;
+                node = &b->nodes[n4];
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
 RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out)
 {
     rad__ctx c;
     rad_bvh *b;
-    uint32_t n, i, sp = 0;
+    rad__bvh_node *tree = NULL;
+    uint32_t n, i, sp = 0, tree_count;
     float *tlo = NULL, *thi = NULL, *cen = NULL;
     uint32_t *order = NULL, *stack = NULL;
+    rad_result r;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!scene || scene->triangle_count == 0) return RAD_ERROR_INVALID_ARGUMENT;
     n = scene->triangle_count;
+    if (n >= RAD__BVH4_LEAF) {
+        rad__log(&c, RAD_LOG_ERROR, "the built-in BVH holds at most %u triangles", RAD__BVH4_LEAF - 1u);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
     b = (rad_bvh *)rad__alloc(&c.allocator, sizeof(rad_bvh));
     if (!b) return RAD_ERROR_OUT_OF_MEMORY;
     memset(b, 0, sizeof(*b));
     b->allocator = c.allocator;
     b->tri_count = n;
-    b->nodes = (rad__bvh_node *)rad__alloc_array(&c.allocator, 2u * (size_t)n, sizeof(rad__bvh_node));
+    tree = (rad__bvh_node *)rad__alloc_array(&c.allocator, 2u * (size_t)n, sizeof(rad__bvh_node));
+    b->nodes = (rad__bvh4 *)rad__alloc_array(&c.allocator, 2u * (size_t)n, sizeof(rad__bvh4));
     b->tris = (float *)rad__alloc_array(&c.allocator, (size_t)n * 9u, sizeof(float));
     b->ids = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
     tlo = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
@@ -1836,9 +1908,9 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     cen = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
     order = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
     stack = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 4u, sizeof(uint32_t));
-    if (!b->nodes || !b->tris || !b->ids || !tlo || !thi || !cen || !order || !stack) {
+    if (!tree || !b->nodes || !b->tris || !b->ids || !tlo || !thi || !cen || !order || !stack) {
         rad__free(&c.allocator, tlo); rad__free(&c.allocator, thi); rad__free(&c.allocator, cen);
-        rad__free(&c.allocator, order); rad__free(&c.allocator, stack);
+        rad__free(&c.allocator, order); rad__free(&c.allocator, stack); rad__free(&c.allocator, tree);
         rad_bvh_destroy(b);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -1857,14 +1929,14 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         }
         order[i] = i;
     }
-    b->node_count = 1;
-    b->nodes[0].first = 0;
-    b->nodes[0].count = n;
+    tree_count = 1;
+    tree[0].first = 0;
+    tree[0].count = n;
     stack[sp++] = 0; /* node */
     stack[sp++] = 0; /* depth */
     while (sp > 0) {
         uint32_t depth = stack[--sp], ni = stack[--sp];
-        rad__bvh_node *node = &b->nodes[ni];
+        rad__bvh_node *node = &tree[ni];
         uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, k2;
         rad__aabb nb, cb;
         float best_cost = FLT_MAX, leaf_cost;
@@ -1925,13 +1997,13 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
             mid = lo;
             if (mid == first || mid == first + count) mid = first + count / 2;
         }
-        k2 = b->node_count;
-        b->node_count += 2;
-        b->nodes[k2].first = first;
-        b->nodes[k2].count = mid - first;
-        b->nodes[k2 + 1].first = mid;
-        b->nodes[k2 + 1].count = first + count - mid;
-        node = &b->nodes[ni];
+        k2 = tree_count;
+        tree_count += 2;
+        tree[k2].first = first;
+        tree[k2].count = mid - first;
+        tree[k2 + 1].first = mid;
+        tree[k2 + 1].count = first + count - mid;
+        node = &tree[ni];
         node->first = k2;
         node->count = 0;
         stack[sp++] = k2 + 1;
@@ -1943,11 +2015,14 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         memcpy(b->tris + 9 * (size_t)i, scene->positions + 9 * (size_t)order[i], 9 * sizeof(float));
         b->ids[i] = order[i];
     }
+    r = rad__bvh4_collapse(b, tree, tree_count, stack);
     rad__free(&c.allocator, tlo);
     rad__free(&c.allocator, thi);
     rad__free(&c.allocator, cen);
     rad__free(&c.allocator, order);
     rad__free(&c.allocator, stack);
+    rad__free(&c.allocator, tree);
+    if (r != RAD_SUCCESS) { rad_bvh_destroy(b); return r; }
     *out = b;
     return RAD_SUCCESS;
 }
@@ -1980,22 +2055,6 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
     w->tmax = r->tmax;
 }
 
-/* slab test; NaNs from 0 * inf compare false and drop out */
-static int rad__wray_box(const rad__wray *w, const rad__bvh_node *n, float tmax, float *tnear)
-{
-    float t0 = w->tmin, t1 = tmax;
-    int k;
-    for (k = 0; k < 3; ++k) {
-        float a = (n->bmin[k] - w->o[k]) * w->inv[k], b = (n->bmax[k] - w->o[k]) * w->inv[k];
-        float lo = a < b ? a : b, hi = a < b ? b : a;
-        if (lo > t0) t0 = lo;
-        if (hi < t1) t1 = hi;
-    }
-    *tnear = t0;
-    /* widened by a few ulps (conservative): rays grazing a flat box are not lost */
-    return t0 <= t1 * 1.00000024f + 1e-30f;
-}
-
 /* Watertight ray/triangle test, both faces. Returns 1 with t, b1, b2 on a hit in (tmin, tmax). */
 static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *t_out, float *b1, float *b2)
 {
@@ -2025,45 +2084,95 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
     return 1;
 }
 
+/* Slab test of a ray against the four child boxes of a node: bit k of the result is set when
+   child k is hit within [tmin, tmax]; tnear[k] receives its entry distance. Zero direction
+   components were replaced by +-1e-30 in inv (no NaN from 0 * inf). */
+static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
+{
+#if defined(RAD__SSE2)
+    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax * 1.00000024f + 1e-30f);
+    int a;
+    for (a = 0; a < 3; ++a) {
+        __m128 oa = _mm_set1_ps(o[a]), ia = _mm_set1_ps(inv[a]);
+        __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->lo[a]), oa), ia);
+        __m128 y = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->hi[a]), oa), ia);
+        t0 = _mm_max_ps(t0, _mm_min_ps(x, y));
+        t1 = _mm_min_ps(t1, _mm_max_ps(x, y));
+    }
+    _mm_storeu_ps(tnear, t0);
+    return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
+#else
+    int k, a, mask = 0;
+    for (k = 0; k < 4; ++k) {
+        float t0 = tmin, t1 = tmax * 1.00000024f + 1e-30f;
+        for (a = 0; a < 3; ++a) {
+            float x = (n->lo[a][k] - o[a]) * inv[a], y = (n->hi[a][k] - o[a]) * inv[a];
+            float lo = x < y ? x : y, hi = x < y ? y : x;
+            if (lo > t0) t0 = lo;
+            if (hi < t1) t1 = hi;
+        }
+        tnear[k] = t0;
+        if (t0 <= t1) mask |= 1 << k;
+    }
+    return mask;
+#endif
+}
+
 static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_hit *hit)
 {
     rad__wray w;
-    uint32_t stack[RAD__BVH_STACK], sp = 0, ni = 0;
-    float tmax = ray->tmax, tn;
-    int found = 0;
+    uint32_t stack[3 * RAD__BVH_STACK], sp = 0;
+    float stack_t[3 * RAD__BVH_STACK], tmax = ray->tmax, inv[3];
+    int found = 0, a;
     if (!(ray->tmax > ray->tmin)) return 0;
     rad__wray_init(&w, ray);
-    if (!rad__wray_box(&w, &bvh->nodes[0], tmax, &tn)) return 0;
-    for (;;) {
-        const rad__bvh_node *n = &bvh->nodes[ni];
-        if (n->count) {
-            uint32_t i;
-            for (i = n->first; i < n->first + n->count; ++i) {
-                float t, b1, b2;
-                if (rad__wray_tri(&w, bvh->tris + 9 * (size_t)i, tmax, &t, &b1, &b2)) {
-                    found = 1;
-                    if (any) return 1;
-                    tmax = t;
-                    hit->t = t;
-                    hit->triangle = bvh->ids[i];
-                    hit->b1 = b1;
-                    hit->b2 = b2;
+    for (a = 0; a < 3; ++a) {
+        float d = ray->dir[a];
+        if (fabs((double)d) < 1e-30) d = d < 0.0f ? -1e-30f : 1e-30f;
+        inv[a] = 1.0f / d;
+    }
+    stack[sp] = 0;
+    stack_t[sp++] = ray->tmin;
+    while (sp > 0) {
+        const rad__bvh4 *n;
+        float tn[4];
+        uint32_t order[4], no = 0, k, ni;
+        int mask;
+        --sp;
+        if (stack_t[sp] > tmax) continue; /* entered beyond the closest hit found since */
+        ni = stack[sp];
+        n = &bvh->nodes[ni];
+        mask = rad__bvh4_boxes(n, w.o, inv, ray->tmin, tmax, tn);
+        for (k = 0; k < 4; ++k) {
+            uint32_t ch = n->child[k];
+            if (!(mask & (1 << k)) || ch == RAD_NONE) continue;
+            if (ch & RAD__BVH4_LEAF) {
+                uint32_t i, first = ch & ~RAD__BVH4_LEAF;
+                for (i = first; i < first + n->count[k]; ++i) {
+                    float t, b1, b2;
+                    if (rad__wray_tri(&w, bvh->tris + 9 * (size_t)i, tmax, &t, &b1, &b2)) {
+                        found = 1;
+                        if (any) return 1;
+                        tmax = t;
+                        hit->t = t;
+                        hit->triangle = bvh->ids[i];
+                        hit->b1 = b1;
+                        hit->b2 = b2;
+                    }
                 }
+            } else {
+                order[no++] = k;
             }
-        } else {
-            float tl, tr;
-            int hl = rad__wray_box(&w, &bvh->nodes[n->first], tmax, &tl);
-            int hr = rad__wray_box(&w, &bvh->nodes[n->first + 1], tmax, &tr);
-            if (hl && hr) {
-                if (tl <= tr) { stack[sp++] = n->first + 1; ni = n->first; }
-                else { stack[sp++] = n->first; ni = n->first + 1; }
-                continue;
-            }
-            if (hl) { ni = n->first; continue; }
-            if (hr) { ni = n->first + 1; continue; }
         }
-        if (sp == 0) break;
-        ni = stack[--sp];
+        /* push inner children far to near, so the nearest is visited first */
+        while (no > 0) {
+            uint32_t far = 0, q;
+            for (q = 1; q < no; ++q)
+                if (tn[order[q]] > tn[order[far]]) far = q;
+            stack[sp] = n->child[order[far]];
+            stack_t[sp++] = tn[order[far]];
+            order[far] = order[--no];
+        }
     }
     return found;
 }
