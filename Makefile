@@ -10,6 +10,10 @@ BUILD   ?= build
 WARN     = -Wall -Wextra -Wpedantic -Wshadow
 CFLAGS  ?= -O2
 OPENMP  := $(shell printf 'int main(void){return 0;}' | $(CC) -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
+# Embree 3 for the ray benchmark, when installed (package libembree-dev)
+EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
+EMBREE_LIB := $(if $(EMBREE),-lembree3,)
+RAD_DATA_DIR ?= ../shared/data
 
 .PHONY: all demo test bench bench-quick tools clean
 
@@ -30,11 +34,16 @@ test:
 $(BUILD)/bench: bench/bench.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/bench.c -o $@ -lm
 
-bench: $(BUILD)/bench
-	./$(BUILD)/bench BENCHMARKS.md
+$(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench-quick: $(BUILD)/bench
+bench: $(BUILD)/bench $(BUILD)/rays
+	./$(BUILD)/bench BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
+
+bench-quick: $(BUILD)/bench $(BUILD)/rays
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
 
 tools: $(BUILD)/rad
 

@@ -22,7 +22,7 @@ static void sc_log_fn(void *user, rad_log_level level, const char *message)
    without corrupting the heap. fail_at > 0 makes the fail_at-th allocation (1-based) fail. */
 #define SC_CANARY 64
 typedef struct sc_alloc_state {
-    long allocs, frees, failed, corrupt;
+    long calls, allocs, frees, failed, corrupt;
     long long live_bytes;
     long fail_at;
 } sc_alloc_state;
@@ -36,14 +36,13 @@ static void *sc_alloc_fn(void *user, size_t size)
 #pragma omp critical(sc_alloc_lock)
 #endif
     {
-        n = ++s->allocs;
+        n = ++s->calls;
     }
     if (s->fail_at > 0 && n == s->fail_at) {
 #ifdef _OPENMP
 #pragma omp critical(sc_alloc_lock)
 #endif
         {
-            s->allocs--; /* a failed allocation is not live */
             s->failed++;
         }
         return NULL;
@@ -56,6 +55,7 @@ static void *sc_alloc_fn(void *user, size_t size)
 #pragma omp critical(sc_alloc_lock)
 #endif
     {
+        s->allocs++;
         s->live_bytes += (long long)size;
     }
     return p + 16;
@@ -261,7 +261,7 @@ static void sc_test_validation_degenerate(void)
 
     /* every triangle degenerate and skipped: empty */
     sc_basic_init(&b);
-    b.idx[1] = 0; b.idx[4] = 2;
+    b.idx[1] = 0; b.idx[5] = 2;
     b.desc.flags = RAD_SCENE_SKIP_DEGENERATE;
     SC_FAIL(&b.desc, RAD_ERROR_EMPTY_SCENE, NULL, NULL);
     b.desc.flags = 0;
@@ -282,9 +282,8 @@ static void sc_test_validation_degenerate(void)
     }
     CHECK(st.allocs == st.frees);
     CHECK(st.live_bytes == 0);
-    CHECK(st.corrupt == 0);
     /* a skipped triangle at the end of the input must not make rad_scene_create write past
-       its arrays (sized for the kept triangles) */
+       its arrays (sized for the kept triangles; caught by the allocator's canaries) */
     CHECK(st.corrupt == 0);
 }
 
@@ -500,7 +499,8 @@ static void sc_test_patch_counts_areas(void)
     CHECK_OK(rad_patches_create(scene, &po, NULL, &P));
     if (P) {
         CHECK(P->subdivision[0] == 8); /* 0.5 / 64 = 0.0078 <= 0.01 < 0.5 / 49 */
-        CHECK(P->subdivision[1] == 10); /* area 0.5: same */
+        CHECK(P->subdivision[1] == 8); /* area 0.5: same */
+        CHECK(P->subdivision[2] == 8);
         rad_patches_destroy(P);
         P = NULL;
     }
@@ -748,7 +748,6 @@ static rad_result sc_pipeline(const rad_context *ctx, int *bad_code)
     so.bounces = 4;
     SC_STEP(rad_solve_jacobi(&sys, &so, B, NULL, ctx));
     SC_STEP(rad_solve_gauss_seidel(&sys, &so, B, NULL, ctx));
-    so.max_iterations = 200;
     SC_STEP(rad_solve_progressive(&sys, &so, B, NULL, ctx));
     SC_STEP(rad_solve_direct(&sys, &so, B, ctx));
     SC_STEP(rad_matrix_multiply(&ffd->matrix, E, B, ctx));
@@ -885,6 +884,7 @@ static void sc_test_progress_cancel(void)
     rad_form_factor_options_default(&fo);
     fo.samples = 4;
     memset(&ps, 0, sizeof(ps));
+    ctx.task_count = 8; /* progress comes between batches of 4 * task_count rows */
     ctx.progress = sc_progress_fn;
     ctx.progress_user = &ps;
     CHECK_OK(rad_form_factors_dense(P, &rc, &fo, &ctx, &ff));
