@@ -32,7 +32,7 @@ test:
 	CC="$(CC)" CXX="$(CXX)" BUILD="$(BUILD)" bash tests/run.sh
 
 $(BUILD)/bench: bench/bench.c radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/bench.c -o $@ -lm
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -DBENCH_CFLAGS='"-std=c99 -O3 -march=native $(OPENMP)"' -I. bench/bench.c -o $@ -lm
 
 $(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)

@@ -2639,7 +2639,8 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
     r2 = (float)(h >> 16) / 65536.0f;
     for (k = 0; k < 3; ++k) PN[k] = pl->normal[k];
     /* near pairs (closer than twice their sizes, e.g. sharing an edge) have a nearly singular
-       integrand: they get 4x the emitter points, computed here, each weighted S / (4S) */
+       integrand: they get 16x the emitter points (at most RAD__MAX_SAMPLES), computed here,
+       each weighted S / (16 S) */
     for (m = 0; m < 3; ++m) {
         rad__sub(d, vl + 3 * m, pl->centroid);
         if (rad__dot(d, d) > rl) rl = rad__dot(d, d);
@@ -2649,7 +2650,7 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
     rad__sub(d, pl->centroid, ph->centroid);
     near = rad__dot(d, d) < 4.0f * (rl + rh + 2.0f * (float)sqrt((double)rl * (double)rh));
     if (near && S < RAD__MAX_SAMPLES) {
-        S = 4u * S < RAD__MAX_SAMPLES ? 4u * S : RAD__MAX_SAMPLES;
+        S = 16u * S < RAD__MAX_SAMPLES ? 16u * S : RAD__MAX_SAMPLES;
         scale = (float)f->o.samples / (float)S;
     } else {
         near = 0;

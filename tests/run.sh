@@ -97,6 +97,13 @@ compile_run compile-c99 $CC -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/co
 compile_run compile-cpp11 $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-cpp11" -lm
 compile_run compile-static $CC -std=c99 $WARN -Wno-unused-function -I. tests/static_build.c -o "$BUILD/compile-static" -lm
 compile_run compile-custom-alloc $CC -std=c99 $WARN -I. tests/custom_alloc.c -o "$BUILD/compile-custom-alloc" -lm
+if build demo $CC -std=c99 $WARN -O2 $OMP -I. examples/cornell.c -o "$BUILD/cornell" -lm &&
+   "$BUILD/cornell" --patches 300 --size 96x96 -o "$BUILD/cornell-small.png" >"$BUILD/demo.out" 2>&1 &&
+   [ -s "$BUILD/cornell-small.png" ]; then
+    pass demo-small
+else
+    fail demo-small
+fi
 compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
 if build tool-rad $CC -std=c99 $WARN -O2 -I. tools/rad.c -o "$BUILD/rad" -lm &&
    "$BUILD/rad" formfactors cornell --patches 200 >"$BUILD/rad-ff.txt" 2>/dev/null &&

@@ -439,6 +439,71 @@ static void ff_test_c14_perpendicular(void)
     }
 }
 
+/* A regular n-gon of circumradius r centred at (0, 0, z) as a fan of triangles around its
+   centre, front facing +z (up != 0) or -z. pos: 3 (n + 1) floats, idx: 3 n. */
+static void ff_fan(float *pos, uint32_t *idx, int n, double r, float z, int up)
+{
+    int i;
+    pos[0] = 0.0f; pos[1] = 0.0f; pos[2] = z;
+    for (i = 0; i < n; ++i) {
+        double a = 2.0 * FF_PI * i / n;
+        pos[3 * (i + 1)] = (float)(r * cos(a));
+        pos[3 * (i + 1) + 1] = (float)(r * sin(a));
+        pos[3 * (i + 1) + 2] = z;
+    }
+    for (i = 0; i < n; ++i) {
+        uint32_t a = (uint32_t)i + 1, b = (uint32_t)((i + 1) % n) + 1;
+        idx[3 * i] = 0;
+        idx[3 * i + 1] = up ? a : b; /* counter-clockwise seen from +z when up */
+        idx[3 * i + 2] = up ? b : a;
+    }
+}
+
+static void ff_test_c41_disks(void)
+{
+    enum { NG = 64 };
+    static float pos1[3 * (NG + 1)], pos2[3 * (NG + 1)];
+    static uint32_t idx1[3 * NG], idx2[3 * NG];
+    rad_mesh_desc meshes[2];
+    rad_scene_desc d;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL;
+    ff_world w;
+    double reff = ff_equal_area_radius(1.0, NG), ref, f12, f21, a1, a2;
+    /* r1 = r2 = 1, h = 1 as 64-gons. Reference: C-41 for the disks of equal area to the
+       polygons, r_eff = sqrt(64/2 sin(2 pi/64) / pi) = 0.99839 (the circle itself gives
+       0.381966; the polygons are ~0.3% smaller in area) */
+    ff_fan(pos1, idx1, NG, 1.0, 0.0f, 1);
+    ff_fan(pos2, idx2, NG, 1.0, 1.0f, 0);
+    memset(meshes, 0, sizeof(meshes));
+    meshes[0].positions = pos1;
+    meshes[0].vertex_count = NG + 1;
+    meshes[0].indices = idx1;
+    meshes[0].triangle_count = NG;
+    meshes[1] = meshes[0];
+    meshes[1].positions = pos2;
+    meshes[1].indices = idx2;
+    ff_desc(&d, meshes, 2);
+    ref = ff_c41(reff, reff, 1.0);
+    CHECK_REL(ff_c41(1.0, 1.0, 1.0), 0.3819660112501051, 1e-12);
+    CHECK_REL(ff_c41(1.0, 2.0, 1.0), 0.76393202, 1e-7);
+    if (!ff_world_make(&d, rad_test_quick() ? 0.5f : 0.25f, 0, &w)) return;
+    rad_form_factor_options_default(&fo);
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &ff));
+    if (ff) {
+        f12 = ff_group(w.patches, ff->matrix.dense, 0, 1, &a1);
+        f21 = ff_group(w.patches, ff->matrix.dense, 1, 0, &a2);
+        ff_report("C-41 64-gons r=1 h=1", f12, ref);
+        /* the target at default quality */
+        CHECK_REL(f12, ref, 1e-3);
+        CHECK_REL(f21, ref, 1e-3);
+        CHECK_REL(a1 * f12, a2 * f21, 1e-6); /* reciprocity, float rounding */
+        CHECK_REL(a1, FF_PI * reff * reff, 1e-5);
+    }
+    rad_form_factors_destroy(ff);
+    ff_world_free(&w);
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* the test table                                                                           */
 /* ---------------------------------------------------------------------------------------- */
@@ -450,5 +515,6 @@ static const rad_test_case tests_formfactor[] = {
     { "formfactor_point_point", ff_test_point_point },
     { "formfactor_c11_parallel", ff_test_c11_parallel },
     { "formfactor_c14_perpendicular", ff_test_c14_perpendicular },
+    { "formfactor_c41_disks", ff_test_c41_disks },
     { NULL, NULL }
 };
