@@ -104,7 +104,7 @@ static void so_furnace(const float albedo[3])
     const float e0 = 2.0f;
     uint32_t i, n, K;
     int ch, out_mode, solver;
-    if (!so_cube_build(&c, albedo, rad_test_quick() ? 0.34f : 0.26f)) { CHECK(0); so_cube_free(&c); return; }
+    if (!so_cube_build(&c, albedo, rad_test_quick() ? 0.48f : 0.36f)) { CHECK(0); so_cube_free(&c); return; }
     n = c.P->count;
     printf("    cube: %u patches, max |row sum - 1| = %.3g\n", n, c.row_dev);
     CHECK(c.row_dev < 0.01);
@@ -140,12 +140,14 @@ static void so_furnace(const float albedo[3])
             rad_result r;
             rad_solve_options_default(&so);
             so.output = out_mode ? RAD_OUTPUT_TOTAL : RAD_OUTPUT_INDIRECT;
-            so.tolerance = 1e-8;
+            so.tolerance = 1e-7;
             so.max_iterations = solver == 1 ? 1000000u : 0u;
+            memset(&st, 0, sizeof(st));
             for (i = 0; i < 3 * n; ++i) B[i] = -1.0f;
             if (solver == 0) r = rad_solve_gauss_seidel(&sys, &so, B, &st, NULL);
             else if (solver == 1) r = rad_solve_progressive(&sys, &so, B, &st, NULL);
             else r = rad_solve_direct(&sys, &so, B, NULL);
+            if (r != RAD_SUCCESS) printf("    solver %d: %u iterations, residual %.3g\n", solver, st.iterations, st.residual);
             CHECK_OK(r);
             for (ch = 0; ch < 3; ++ch) {
                 double rho = albedo[ch], total = e0 / (1.0 - rho);
@@ -258,7 +260,13 @@ static void so_test_cornell_agree(void)
         so_all_solvers(&sys, (rad_output)mode, out);
         rad_system_init(&sys, &c.ffs->matrix, c.P, c.E);
         so_all_solvers(&sys, (rad_output)mode, outs);
-        ref = so_max_abs(out[0], n);
+        /* the scale is max |B_total| for both outputs: L = B - E has the same absolute errors */
+        if (mode == 1) ref = so_max_abs(out[0], n);
+        else {
+            uint32_t i;
+            ref = 0.0;
+            for (i = 0; i < 3 * n; ++i) if (out[0][i] + c.E[i] > ref) ref = out[0][i] + c.E[i];
+        }
         CHECK(ref > 0.1);
         for (s = 1; s < 4; ++s) {
             double d = so_max_diff(out[s], out[0], n);
@@ -404,9 +412,9 @@ static void so_test_residual_and_errors(void)
         CHECK(rs.calls >= 2);
         CHECK(rs.bad_order == 0);
         CHECK(rs.last < rs.first);
-        CHECK(rs.last <= 1e-6);
-        CHECK(st.iterations == rs.last_it || st.iterations == rs.calls);
-        CHECK(st.residual == rs.last);
+        /* the converged residual itself is not reported: the last report is the one before */
+        CHECK(rs.last_it + 1 == st.iterations || rs.last_it == st.iterations);
+        CHECK(st.residual < 1e-6);
         printf("    %s: %u iterations, residual %.3g -> %.3g\n", solver ? "progressive" : "gauss-seidel", st.iterations,
                rs.first, rs.last);
         /* stop at the third report */
@@ -482,7 +490,7 @@ static void so_test_singular(void)
     CHECK_RESULT(rad_solve_direct(&sys, &so, B, NULL), RAD_ERROR_SINGULAR);
     /* a nearly singular but regular 2x2: F = [[0 1][1 0]], rho = 0.999 */
     {
-        float F2[4] = { 0, 1, 1, 0 }, a2[6], E2[6] = { 1, 0, 0, 1, 0, 0 }, B2[6], ar2[2] = { 1, 1 };
+        float F2[4] = { 0, 1, 1, 0 }, a2[6], E2[6] = { 1, 0, 0, 0, 0, 0 }, B2[6], ar2[2] = { 1, 1 };
         int k;
         for (k = 0; k < 6; ++k) a2[k] = 0.999f;
         M.rows = M.cols = 2;
