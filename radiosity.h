@@ -90,6 +90,8 @@
        RAD_MALLOC/REALLOC/FREE    malloc/realloc/free implementing file; all three or none
        RAD_ASSERT(x)              assert(x)          implementing file (internal invariants only;
                                                      bad input is an error code, never an assert)
+       RAD_NO_STDIO               (undefined)        everywhere: removes rad_save_file and
+                                                     rad_load_file (no <stdio.h> file access)
        RAD_NO_SIMD                (undefined)        implementing file: scalar code only. SIMD
                                                      (SSE2/AVX) is used only when the compiler
                                                      already enables it (-msse2 is the x86-64
@@ -241,7 +243,11 @@ typedef enum rad_result {
     RAD_ERROR_SINGULAR = -13,             /* the direct solve met a zero pivot */
     RAD_ERROR_UNAVAILABLE = -14,          /* a backend not compiled in */
     RAD_ERROR_RAYCAST_FAILED = -15,       /* a ray callback returned an error */
-    RAD_ERROR_SIZE_MISMATCH = -16         /* arrays or matrices of incompatible sizes */
+    RAD_ERROR_SIZE_MISMATCH = -16,        /* arrays or matrices of incompatible sizes */
+    RAD_ERROR_IO = -17,                   /* a file could not be opened, read or written */
+    RAD_ERROR_TRUNCATED = -18,            /* baked data ends before its sections do */
+    RAD_ERROR_CORRUPT = -19,              /* bad magic, checksum, table or section layout */
+    RAD_ERROR_VERSION = -20               /* baked data of an unsupported container version */
 } rad_result;
 
 /* A static English name and description of a result ("RAD_ERROR_NON_FINITE: ..."). */
@@ -537,8 +543,11 @@ typedef enum rad_ff_method {
 
 typedef struct rad_form_factor_options {
     rad_ff_method method;
-    uint32_t samples;       /* points per patch pair (0: 16), Hammersley, rounded to a square
-                               for neither method; capped at 256 */
+    uint32_t samples;       /* points per patch pair (0: 16), rounded to a square n*n and
+                               capped at 256: the emitter points are the centroids of the
+                               patch's n x n sub-triangles (exact centroid, midpoint rule); the
+                               visibility targets are rotated Hammersley points. Pairs closer
+                               than twice their size get 16x the points. */
     float ray_epsilon;      /* relative to the scene diagonal (0: 1e-5) */
     float drop_threshold;   /* sparse: entries below it are dropped (0 keeps non-zeros) */
     uint32_t seed;          /* decorrelates visibility sample points (any value) */
@@ -681,7 +690,8 @@ typedef struct rad_light {
 } rad_light;
 
 typedef struct rad_direct_options {
-    uint32_t samples;          /* points per patch (0: 16) */
+    uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
+                                  of the patch's n x n sub-triangles */
     uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
     int include_emitters;      /* non-zero (default): emissive triangles are area lights */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5) */
@@ -701,7 +711,7 @@ RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_rayca
                                          const float *normals, uint32_t count, float *out_irradiance,
                                          const rad_context *ctx);
 
-/* Mean direct irradiance over each patch ('samples' Hammersley points per patch), 3N floats.
+/* Mean direct irradiance over each patch ('samples' lattice points per patch), 3N floats.
    A patch's own triangle never lights it. */
 RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster,
                                       const rad_light *lights, uint32_t light_count,
@@ -719,6 +729,91 @@ typedef enum rad_source_mode {
    RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT). */
 RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
                                float *out_E);
+
+
+/* ======================================================================================== */
+/* >>api_container: baked data                                                              */
+/* ======================================================================================== */
+
+/* One versioned binary container for everything a bake produces (SPEC §11). Layout, all
+   little-endian: a 64-byte header ("RADB", version, section count, table offset, file size,
+   flags, CRC-32 of the table, CRC-32 of the header), a table of 64-byte section entries (type, element size, element count,
+   offset, byte size, CRC-32 of the data, a 24-byte name), and the section data, each section
+   starting on a 64-byte boundary so the file can be memory-mapped and read in place.
+   Loading validates every size, offset, checksum and index before anything is used. */
+#define RAD_CONTAINER_VERSION 1u
+
+typedef enum rad_section_type {
+    RAD_SECTION_PATCHES = 1,         /* rad_patch records */
+    RAD_SECTION_PATCH_VERTICES = 2,  /* 3 floats per welded vertex */
+    RAD_SECTION_TRIANGLES = 3,       /* 2 uint32 per scene triangle: first patch, subdivision */
+    RAD_SECTION_FF_DENSE = 4,        /* N*N floats, row-major */
+    RAD_SECTION_FF_ROW_OFFSETS = 5,  /* CSR: N+1 uint64 */
+    RAD_SECTION_FF_COLUMNS = 6,      /* CSR: uint32 */
+    RAD_SECTION_FF_VALUES = 7,       /* CSR: floats */
+    RAD_SECTION_VECTOR = 8,          /* a named RGB vector, 3N floats ("E", "B", "L", "H", ...) */
+    RAD_SECTION_USER = 0x10000       /* types from here up are the application's own */
+} rad_section_type;
+
+/* One section, for writing (data borrowed) or as found by rad_container_find (data points
+   into the container's bytes). */
+typedef struct rad_section {
+    uint32_t type;
+    uint32_t elem_size;     /* bytes per element */
+    uint64_t count;         /* elements */
+    const void *data;       /* count * elem_size bytes */
+    char name[24];          /* NUL-terminated, may be empty */
+} rad_section;
+
+typedef struct rad_container rad_container;
+
+/* Bytes that rad_container_write needs for these sections (SIZE_OVERFLOW if it overflows). */
+RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes);
+/* Writes the container into dst (dst_size >= rad_container_size). */
+RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t count, void *dst, size_t dst_size);
+/* Validates 'size' bytes at 'data' (borrowed: they must outlive the container, which reads
+   them in place: memory-mapped files work) and opens them. Errors: TRUNCATED, CORRUPT,
+   VERSION, INVALID_ARGUMENT, OUT_OF_MEMORY; the logger says which section and why. */
+RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_context *ctx, rad_container **out);
+RAD_API void rad_container_close(rad_container *container);
+RAD_API uint32_t rad_container_section_count(const rad_container *container);
+/* Section i (0 <= i < count), or NULL. */
+RAD_API const rad_section *rad_container_section(const rad_container *container, uint32_t index);
+/* The first section of 'type' whose name equals 'name' (any name when name is NULL), or NULL. */
+RAD_API const rad_section *rad_container_find(const rad_container *container, uint32_t type, const char *name);
+
+/* A loaded bake: patches (usable with rad_patches_locate, rad_patches_vertex_values and
+   rad_system_init; patches.scene is NULL, set it before calling functions that need the
+   scene), the form-factor matrix (rows == 0 when the bake has none) and the named vectors.
+   Everything points into the loaded bytes; free it with rad_bake_destroy, never with
+   rad_patches_destroy. */
+typedef struct rad_bake {
+    rad_patches patches;
+    rad_matrix F;
+    const float *E;          /* "E" vector or NULL */
+    const float *B;          /* "B" vector (the solution as saved) or NULL */
+    rad_container *container;
+    void *owned;             /* private: bytes read from a file */
+    rad_allocator allocator; /* private */
+} rad_bake;
+
+/* Saves patches (required), a matrix (optional: NULL) and the vectors E and B (optional:
+   NULL; 3 * patches->count floats) into a new buffer *out of *out_size bytes, allocated with
+   ctx's allocator (free it with rad_free_buffer). */
+RAD_API rad_result rad_save_memory(const rad_patches *patches, const rad_matrix *F, const float *E, const float *B,
+                                   const rad_context *ctx, void **out, size_t *out_size);
+RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx);
+/* Opens a saved bake in place (data borrowed, must outlive the bake) and checks every index:
+   patch vertices < vertex count, patch triangles < triangle count, CSR offsets monotone and
+   columns < N, vector and matrix sizes equal to the patch count. */
+RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out);
+RAD_API void rad_bake_destroy(rad_bake *bake);
+#ifndef RAD_NO_STDIO
+/* The same, through a file (RAD_ERROR_IO when it cannot be written or read). */
+RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
+                                 const float *B, const rad_context *ctx);
+RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out);
+#endif
 
 #ifdef __cplusplus
 }
@@ -795,6 +890,10 @@ RAD_API const char *rad_result_string(rad_result result)
     case RAD_ERROR_UNAVAILABLE: return "RAD_ERROR_UNAVAILABLE: the feature is not compiled in";
     case RAD_ERROR_RAYCAST_FAILED: return "RAD_ERROR_RAYCAST_FAILED: a ray-query callback failed";
     case RAD_ERROR_SIZE_MISMATCH: return "RAD_ERROR_SIZE_MISMATCH: sizes of the inputs do not match";
+    case RAD_ERROR_IO: return "RAD_ERROR_IO: a file could not be opened, read or written";
+    case RAD_ERROR_TRUNCATED: return "RAD_ERROR_TRUNCATED: the baked data is truncated";
+    case RAD_ERROR_CORRUPT: return "RAD_ERROR_CORRUPT: the baked data is corrupted (checksum, table or layout)";
+    case RAD_ERROR_VERSION: return "RAD_ERROR_VERSION: the baked data has an unsupported version";
     }
     return "RAD_ERROR_UNKNOWN: not a rad_result value";
 }
@@ -959,7 +1058,7 @@ static rad_result rad__for_rows(const rad__ctx *c, uint32_t count, uint32_t task
     job.fn = fn;
     job.data = data;
     job.tasks = tasks;
-    batches = count / (tasks * 4u);
+    batches = count / tasks;
     if (batches < 1) batches = 1;
     if (batches > 100) batches = 100;
     if (!c->progress) batches = 1;
@@ -1022,6 +1121,27 @@ static void rad__triangle_point(const float *v0, const float *v1, const float *v
     float b0 = 1.0f - su, b1 = u2 * su, b2 = su * (1.0f - u2);
     int k;
     for (k = 0; k < 3; ++k) out[k] = b0 * v0[k] + b1 * v1[k] + b2 * v2[k];
+}
+
+/* Point s of n*n on a triangle: the centroid of sub-triangle s of its n x n subdivision (the
+   ordering of rad_patches: row j holds n - j up then n - j - 1 down triangles). The points have
+   exactly the triangle's centroid and equal weights: the midpoint rule on sub-triangles. */
+static void rad__lattice_point(const float *v0, const float *v1, const float *v2, uint32_t n, uint32_t s, float *out)
+{
+    uint32_t j = 0, row, i;
+    float a, b;
+    int k;
+    while (j + 1 < n && s >= (row = 2u * (n - j) - 1u)) { s -= row; ++j; }
+    if (s < n - j) { i = s; a = ((float)i + 1.0f / 3.0f) / (float)n; b = ((float)j + 1.0f / 3.0f) / (float)n; }
+    else { i = s - (n - j); a = ((float)i + 2.0f / 3.0f) / (float)n; b = ((float)j + 2.0f / 3.0f) / (float)n; }
+    for (k = 0; k < 3; ++k) out[k] = v0[k] + a * (v1[k] - v0[k]) + b * (v2[k] - v0[k]);
+}
+
+/* the side of the sample lattice for a requested sample count: n*n points, n >= 1 */
+static uint32_t rad__lattice_side(uint32_t samples)
+{
+    uint32_t n = (uint32_t)floor(sqrt((double)samples) + 0.5);
+    return n ? n : 1u;
 }
 
 /* ======================================================================================== */
@@ -1266,19 +1386,19 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
         size_t us = m->uv_stride ? m->uv_stride : 2 * sizeof(float);
         for (t = 0; t < m->triangle_count; ++t) {
             double cr[3], cl;
-            float *P = s->positions + 9 * (size_t)dst;
+            float tri[9], *P;
             int v;
-            for (v = 0; v < 3; ++v) {
-                uint32_t id = rad__mesh_index(m, t, v);
-                const float *p = rad__strided(m->positions, ps, id);
-                P[3 * v] = p[0]; P[3 * v + 1] = p[1]; P[3 * v + 2] = p[2];
-                if (s->uvs) {
-                    const float *uv = m->uvs ? rad__strided(m->uvs, us, id) : NULL;
+            for (v = 0; v < 3; ++v) memcpy(tri + 3 * v, rad__strided(m->positions, ps, rad__mesh_index(m, t, v)), 3 * sizeof(float));
+            /* decide before writing: a skipped triangle must not touch the arrays (sized for the kept ones) */
+            if (!rad__triangle_cross(tri, tri + 3, tri + 6, cr, &cl)) continue; /* skipped (validation checked the flag) */
+            P = s->positions + 9 * (size_t)dst;
+            memcpy(P, tri, sizeof(tri));
+            if (s->uvs)
+                for (v = 0; v < 3; ++v) {
+                    const float *uv = m->uvs ? rad__strided(m->uvs, us, rad__mesh_index(m, t, v)) : NULL;
                     s->uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
                     s->uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
                 }
-            }
-            if (!rad__triangle_cross(P, P + 3, P + 6, cr, &cl)) continue; /* skipped (validation checked the flag) */
             for (k = 0; k < 3; ++k) s->normals[3 * (size_t)dst + (size_t)k] = (float)(cr[k] / cl);
             s->areas[dst] = (float)(0.5 * cl);
             s->materials[dst] = m->material_ids ? m->material_ids[t] : m->material;
@@ -1485,13 +1605,12 @@ static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const fl
     double acc[3] = { 0.0, 0.0, 0.0 };
     uint32_t s;
     int k;
+    uint32_t side = rad__lattice_side(samples);
+    samples = side * side;
     for (s = 0; s < samples; ++s) {
-        float u1, u2, su, c0, c1, c2, rgb[3];
-        rad__hammersley(s, samples, 0.0f, 0.0f, &u1, &u2);
-        su = (float)sqrt((double)u1);
-        c0 = 1.0f - su; c1 = u2 * su; c2 = su * (1.0f - u2);
-        rad_scene_albedo(scene, t, c0 * lb[0][0] + c1 * lb[1][0] + c2 * lb[2][0], c0 * lb[0][1] + c1 * lb[1][1] + c2 * lb[2][1],
-                         rgb);
+        float q[3], rgb[3];
+        rad__lattice_point(lb[0], lb[1], lb[2], side, s, q); /* in the triangle's (b1, b2) plane */
+        rad_scene_albedo(scene, t, q[0], q[1], rgb);
         for (k = 0; k < 3; ++k) {
             if (!rad__finite(rgb[k]) || rgb[k] < 0.0f || rgb[k] >= 1.0f) {
                 rad__log(c, RAD_LOG_ERROR, "albedo_lookup returned %g (channel %d) on triangle %u: outside [0, 1)", (double)rgb[k],
@@ -2090,24 +2209,26 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
 static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
 {
 #if defined(RAD__SSE2)
-    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax * 1.00000024f + 1e-30f);
+    /* each slab's far distance is widened by 1 + 2 gamma_3 (Ize 2013), so rounding never
+       culls a box the ray touches (rays through shared vertices on box faces) */
+    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm_set1_ps(1.0000004f);
     int a;
     for (a = 0; a < 3; ++a) {
         __m128 oa = _mm_set1_ps(o[a]), ia = _mm_set1_ps(inv[a]);
         __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->lo[a]), oa), ia);
         __m128 y = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->hi[a]), oa), ia);
         t0 = _mm_max_ps(t0, _mm_min_ps(x, y));
-        t1 = _mm_min_ps(t1, _mm_max_ps(x, y));
+        t1 = _mm_min_ps(t1, _mm_mul_ps(_mm_max_ps(x, y), widen));
     }
     _mm_storeu_ps(tnear, t0);
     return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
 #else
     int k, a, mask = 0;
     for (k = 0; k < 4; ++k) {
-        float t0 = tmin, t1 = tmax * 1.00000024f + 1e-30f;
+        float t0 = tmin, t1 = tmax * 1.0000004f + 1e-30f;
         for (a = 0; a < 3; ++a) {
             float x = (n->lo[a][k] - o[a]) * inv[a], y = (n->hi[a][k] - o[a]) * inv[a];
-            float lo = x < y ? x : y, hi = x < y ? y : x;
+            float lo = x < y ? x : y, hi = (x < y ? y : x) * 1.0000004f;
             if (lo > t0) t0 = lo;
             if (hi < t1) t1 = hi;
         }
@@ -2626,7 +2747,7 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
 {
     const rad_patch *pl = &f->P->patches[lo], *ph = &f->P->patches[hi];
     float vl[9], vh[9], r1, r2, d[3], rl = 0.0f, rh = 0.0f, scale = 1.0f, xs[3];
-    uint32_t S = f->o.samples, s, h, m;
+    uint32_t S = f->o.samples, s, h, m, nside = 1;
     double *acc = f->acc + (size_t)task * f->P->count, PN[3];
     int k, near;
     rad__ff_patch_corners(f, lo, vl);
@@ -2639,8 +2760,8 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
     r2 = (float)(h >> 16) / 65536.0f;
     for (k = 0; k < 3; ++k) PN[k] = pl->normal[k];
     /* near pairs (closer than twice their sizes, e.g. sharing an edge) have a nearly singular
-       integrand: they get 16x the emitter points (at most RAD__MAX_SAMPLES), computed here,
-       each weighted S / (16 S) */
+       integrand: they get a lattice of side 4n (16x the points, at most RAD__MAX_SAMPLES),
+       computed here, each weighted S / (16 S) */
     for (m = 0; m < 3; ++m) {
         rad__sub(d, vl + 3 * m, pl->centroid);
         if (rad__dot(d, d) > rl) rl = rad__dot(d, d);
@@ -2650,7 +2771,9 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
     rad__sub(d, pl->centroid, ph->centroid);
     near = rad__dot(d, d) < 4.0f * (rl + rh + 2.0f * (float)sqrt((double)rl * (double)rh));
     if (near && S < RAD__MAX_SAMPLES) {
-        S = 16u * S < RAD__MAX_SAMPLES ? 16u * S : RAD__MAX_SAMPLES;
+        nside = rad__lattice_side(S) * 4u;
+        while (nside * nside > RAD__MAX_SAMPLES) --nside;
+        S = nside * nside;
         scale = (float)f->o.samples / (float)S;
     } else {
         near = 0;
@@ -2659,8 +2782,7 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
         const float *x = xs;
         float y[3], u1, u2, w, dxy[3];
         if (near) {
-            rad__hammersley(s, S, 0.0f, 0.0f, &u1, &u2);
-            rad__triangle_point(vl, vl + 3, vl + 6, u1, u2, xs);
+            rad__lattice_point(vl, vl + 3, vl + 6, nside, s, xs);
         } else {
             x = f->pts + ((size_t)lo * S + s) * 3u;
         }
@@ -2762,6 +2884,7 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
     if (o) f->o = *o; else rad_form_factor_options_default(&f->o);
     if (f->o.samples == 0) f->o.samples = 16;
     if (f->o.samples > RAD__MAX_SAMPLES) f->o.samples = RAD__MAX_SAMPLES;
+    f->o.samples = rad__lattice_side(f->o.samples) * rad__lattice_side(f->o.samples); /* a square */
     if (f->o.ray_epsilon == 0.0f) f->o.ray_epsilon = 1e-5f;
     if (!rad__finite(f->o.ray_epsilon) || f->o.ray_epsilon < 0.0f || !rad__finite(f->o.drop_threshold) ||
         f->o.drop_threshold < 0.0f || (f->o.method != RAD_FF_ANALYTIC && f->o.method != RAD_FF_MONTE_CARLO)) {
@@ -2793,15 +2916,12 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
     }
     memset(f->rays_cast, 0, sizeof(uint64_t) * T);
     memset(f->pairs, 0, sizeof(uint64_t) * T);
-    /* the emitter-side sample points of every patch: the same Hammersley points for every pair */
+    /* the emitter-side sample points of every patch: the same lattice points for every pair */
     for (i = 0; i < P->count; ++i) {
         float v[9];
         rad__ff_patch_corners(f, i, v);
-        for (s = 0; s < f->o.samples; ++s) {
-            float u1, u2;
-            rad__hammersley(s, f->o.samples, 0.0f, 0.0f, &u1, &u2);
-            rad__triangle_point(v, v + 3, v + 6, u1, u2, f->pts + ((size_t)i * f->o.samples + s) * 3u);
-        }
+        for (s = 0; s < f->o.samples; ++s)
+            rad__lattice_point(v, v + 3, v + 6, rad__lattice_side(f->o.samples), s, f->pts + ((size_t)i * f->o.samples + s) * 3u);
     }
     return RAD_SUCCESS;
 }
@@ -3340,8 +3460,8 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
             }
             ++it;
             residual = maxd / maxE;
-            if (residual < tol) { r = RAD_SUCCESS; break; }
             if (o.on_residual && o.on_residual(o.residual_user, it, residual)) { r = RAD_SUCCESS; break; }
+            if (residual < tol) { r = RAD_SUCCESS; break; }
             if (c.progress && c.progress(c.progress_user, (float)it / (float)max_it)) { r = RAD_ERROR_CANCELLED; break; }
         }
     if (stats) { stats->iterations = it; stats->residual = residual; }
@@ -3390,9 +3510,9 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
             if (p > best) { best = p; bi = i; }
         }
         residual = total / initial;
+        if (step > 0 && o.on_residual && o.on_residual(o.residual_user, step, residual)) { r = RAD_SUCCESS; break; }
         if (residual < tol) { r = RAD_SUCCESS; break; }
         if (step >= max_steps) break;
-        if (step > 0 && o.on_residual && o.on_residual(o.residual_user, step, residual)) { r = RAD_SUCCESS; break; }
         /* shoot bi: every j receives rho_j F_ji dB_bi with F_ji = F_ij A_i / A_j */
         shot[0] = dB[3 * (size_t)bi]; shot[1] = dB[3 * (size_t)bi + 1]; shot[2] = dB[3 * (size_t)bi + 2];
         dB[3 * (size_t)bi] = dB[3 * (size_t)bi + 1] = dB[3 * (size_t)bi + 2] = 0.0f;
@@ -3756,9 +3876,8 @@ static rad_result rad__direct_row(void *data, uint32_t row, uint32_t task)
             for (k = 0; k < 3; ++k) v[3 * m + k] = d->P->vertices[3 * (size_t)pt->vertices[m] + (size_t)k];
         acc[0] = acc[1] = acc[2] = 0.0;
         for (s = 0; s < S && r == RAD_SUCCESS; ++s) {
-            float u1, u2, x[3];
-            rad__hammersley(s, S, 0.0f, 0.0f, &u1, &u2);
-            rad__triangle_point(v, v + 3, v + 6, u1, u2, x);
+            float x[3];
+            rad__lattice_point(v, v + 3, v + 6, rad__lattice_side(S), s, x);
             r = rad__direct_point(d, task, &nrays, x, pt->normal, 0, 1.0f / (float)S, rad__hash(seed + s));
         }
         if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
@@ -3818,6 +3937,7 @@ static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const ra
     if (options) d->o = *options; else rad_direct_options_default(&d->o);
     if (d->o.samples == 0) d->o.samples = 16;
     if (d->o.samples > RAD__MAX_SAMPLES) d->o.samples = RAD__MAX_SAMPLES;
+    d->o.samples = rad__lattice_side(d->o.samples) * rad__lattice_side(d->o.samples); /* a square */
     if (d->o.light_samples == 0) d->o.light_samples = 16;
     if (d->o.light_samples > RAD__MAX_SAMPLES) d->o.light_samples = RAD__MAX_SAMPLES;
     if (d->o.ray_epsilon == 0.0f) d->o.ray_epsilon = 1e-5f;
@@ -3909,6 +4029,563 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
     }
     return RAD_ERROR_INVALID_ARGUMENT;
 }
+
+/* ======================================================================================== */
+/* >>container: baked data                                                                  */
+/* ======================================================================================== */
+
+typedef char rad__check_patch_size[(sizeof(rad_patch) == 68) ? 1 : -1];
+
+#define RAD__HEADER_BYTES 64u
+#define RAD__ENTRY_BYTES 64u
+#define RAD__ALIGN 64u
+#define RAD__FLAG_BIG_ENDIAN 1u
+
+struct rad_container {
+    rad_section *sections;
+    uint32_t count;
+    rad_allocator allocator;
+};
+
+static uint32_t rad__crc32(const void *data, size_t size)
+{
+    static const uint32_t nibble[16] = { 0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
+                                         0x4DB26158u, 0x5005713Cu, 0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
+                                         0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
+    const unsigned char *p = (const unsigned char *)data;
+    uint32_t c = 0xFFFFFFFFu;
+    size_t i;
+    for (i = 0; i < size; ++i) {
+        c ^= p[i];
+        c = (c >> 4) ^ nibble[c & 15u];
+        c = (c >> 4) ^ nibble[c & 15u];
+    }
+    return c ^ 0xFFFFFFFFu;
+}
+
+static void rad__put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
+static void rad__put64(unsigned char *p, uint64_t v) { rad__put32(p, (uint32_t)v); rad__put32(p + 4, (uint32_t)(v >> 32)); }
+static uint32_t rad__get32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint64_t rad__get64(const unsigned char *p) { return (uint64_t)rad__get32(p) | (uint64_t)rad__get32(p + 4) << 32; }
+static int rad__host_big_endian(void) { const uint32_t one = 1; return *(const unsigned char *)&one == 0; }
+static uint64_t rad__align_up(uint64_t x) { return (x + (RAD__ALIGN - 1)) & ~(uint64_t)(RAD__ALIGN - 1); }
+
+RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes)
+{
+    uint64_t at, bytes;
+    uint32_t i;
+    if (!out_bytes || (count > 0 && !sections)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (count > 0x00FFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
+    for (i = 0; i < count; ++i) {
+        if (sections[i].elem_size == 0 || (sections[i].count > 0 && !sections[i].data)) return RAD_ERROR_INVALID_ARGUMENT;
+        if (sections[i].count > UINT64_MAX / sections[i].elem_size) return RAD_ERROR_SIZE_OVERFLOW;
+        bytes = sections[i].count * sections[i].elem_size;
+        if (bytes > UINT64_MAX - at - RAD__ALIGN) return RAD_ERROR_SIZE_OVERFLOW;
+        at = rad__align_up(at + bytes);
+    }
+    if (at > (uint64_t)(size_t)-1) return RAD_ERROR_SIZE_OVERFLOW;
+    *out_bytes = (size_t)at;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t count, void *dst, size_t dst_size)
+{
+    unsigned char *base = (unsigned char *)dst;
+    size_t need;
+    uint64_t at;
+    uint32_t i;
+    rad_result r = rad_container_size(sections, count, &need);
+    if (r != RAD_SUCCESS) return r;
+    if (!dst || dst_size < need) return RAD_ERROR_INVALID_ARGUMENT;
+    memset(base, 0, need);
+    at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
+    for (i = 0; i < count; ++i) {
+        unsigned char *e = base + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
+        uint64_t bytes = sections[i].count * sections[i].elem_size;
+        size_t nl = 0;
+        if (bytes) memcpy(base + at, sections[i].data, (size_t)bytes);
+        rad__put32(e, sections[i].type);
+        rad__put32(e + 4, sections[i].elem_size);
+        rad__put64(e + 8, sections[i].count);
+        rad__put64(e + 16, at);
+        rad__put64(e + 24, bytes);
+        rad__put32(e + 32, rad__crc32(base + at, (size_t)bytes));
+        while (nl < sizeof(sections[i].name) - 1 && sections[i].name[nl]) ++nl;
+        memcpy(e + 40, sections[i].name, nl);
+        at = rad__align_up(at + bytes);
+    }
+    memcpy(base, "RADB", 4);
+    rad__put32(base + 4, RAD_CONTAINER_VERSION);
+    rad__put32(base + 8, count);
+    rad__put32(base + 12, RAD__HEADER_BYTES);
+    rad__put64(base + 16, RAD__HEADER_BYTES);
+    rad__put64(base + 24, (uint64_t)need);
+    rad__put32(base + 32, rad__host_big_endian() ? RAD__FLAG_BIG_ENDIAN : 0u);
+    rad__put32(base + 36, rad__crc32(base + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count)); /* the table */
+    rad__put32(base + 60, rad__crc32(base, 60));
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_container_close(rad_container *c)
+{
+    rad_allocator a;
+    if (!c) return;
+    a = c->allocator;
+    rad__free(&a, c->sections);
+    rad__free(&a, c);
+}
+
+RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_context *ctx, rad_container **out)
+{
+    rad__ctx c;
+    const unsigned char *p = (const unsigned char *)data;
+    uint64_t file_size, table, first_data;
+    uint32_t count, i, flags;
+    rad_container *ct;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data) return RAD_ERROR_INVALID_ARGUMENT;
+    if (((uintptr_t)data & 7u) != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data must start on an 8-byte boundary (it is read in place)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (size < RAD__HEADER_BYTES) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes, shorter than the %u-byte header", (unsigned long long)size, RAD__HEADER_BYTES);
+        return size >= 4 && memcmp(p, "RADB", 4) != 0 ? RAD_ERROR_CORRUPT : RAD_ERROR_TRUNCATED;
+    }
+    if (memcmp(p, "RADB", 4) != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: no RADB magic (not a radiosity.h container)");
+        return RAD_ERROR_CORRUPT;
+    }
+    if (rad__get32(p + 60) != rad__crc32(p, 60)) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: header checksum mismatch");
+        return RAD_ERROR_CORRUPT;
+    }
+    if (rad__get32(p + 4) != RAD_CONTAINER_VERSION) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: container version %u, this library reads version %u", rad__get32(p + 4),
+                 RAD_CONTAINER_VERSION);
+        return RAD_ERROR_VERSION;
+    }
+    flags = rad__get32(p + 32);
+    if ((flags & ~RAD__FLAG_BIG_ENDIAN) != 0 || ((flags & RAD__FLAG_BIG_ENDIAN) != 0) != rad__host_big_endian()) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: flags %#x (byte order or features this build does not read)", flags);
+        return RAD_ERROR_VERSION;
+    }
+    count = rad__get32(p + 8);
+    table = rad__get64(p + 16);
+    file_size = rad__get64(p + 24);
+    if (rad__get32(p + 12) != RAD__HEADER_BYTES || table != RAD__HEADER_BYTES || count > 0x00FFFFFFu) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: bad header (header size %u, table offset %llu, %u sections)", rad__get32(p + 12),
+                 (unsigned long long)table, count);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (file_size > (uint64_t)size) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes given, the container is %llu bytes", (unsigned long long)size,
+                 (unsigned long long)file_size);
+        return RAD_ERROR_TRUNCATED;
+    }
+    first_data = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
+    if (first_data > file_size) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: the table of %u sections does not fit in %llu bytes", count, (unsigned long long)file_size);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (rad__get32(p + 36) != rad__crc32(p + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count)) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: section table checksum mismatch");
+        return RAD_ERROR_CORRUPT;
+    }
+    ct = (rad_container *)rad__alloc(&c.allocator, sizeof(rad_container));
+    if (!ct) return RAD_ERROR_OUT_OF_MEMORY;
+    ct->allocator = c.allocator;
+    ct->count = count;
+    ct->sections = (rad_section *)rad__alloc_array(&c.allocator, count ? count : 1u, sizeof(rad_section));
+    if (!ct->sections) { rad__free(&c.allocator, ct); return RAD_ERROR_OUT_OF_MEMORY; }
+    for (i = 0; i < count; ++i) {
+        const unsigned char *e = p + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
+        rad_section *sec = &ct->sections[i];
+        uint64_t off = rad__get64(e + 16), bytes = rad__get64(e + 24), n = rad__get64(e + 8);
+        uint32_t esz = rad__get32(e + 4), k;
+        const char *why = NULL;
+        memset(sec, 0, sizeof(*sec));
+        sec->type = rad__get32(e);
+        sec->elem_size = esz;
+        sec->count = n;
+        memcpy(sec->name, e + 40, 24);
+        if (sec->name[23] != 0) why = "its name is not NUL-terminated";
+        else if (esz == 0 || n > UINT64_MAX / esz || n * esz != bytes) why = "element size x count differs from its byte size";
+        else if (off % RAD__ALIGN != 0 || off < first_data) why = "its offset is misaligned or inside the table";
+        else if (bytes > file_size || off > file_size - bytes) why = "it extends past the end of the container";
+        else if (rad__get32(e + 32) != rad__crc32(p + off, (size_t)bytes)) why = "checksum mismatch";
+        for (k = 36; k < 40 && !why; ++k)
+            if (e[k]) why = "reserved bytes are not zero";
+        if (why) {
+            rad__log(&c, RAD_LOG_ERROR, "baked data: section %u (type %u, '%.23s'): %s", i, sec->type, sec->name, why);
+            rad_container_close(ct);
+            return RAD_ERROR_CORRUPT;
+        }
+        sec->data = p + off;
+    }
+    *out = ct;
+    return RAD_SUCCESS;
+}
+
+RAD_API uint32_t rad_container_section_count(const rad_container *c) { return c ? c->count : 0; }
+
+RAD_API const rad_section *rad_container_section(const rad_container *c, uint32_t index)
+{
+    return (c && index < c->count) ? &c->sections[index] : NULL;
+}
+
+RAD_API const rad_section *rad_container_find(const rad_container *c, uint32_t type, const char *name)
+{
+    uint32_t i;
+    if (!c) return NULL;
+    for (i = 0; i < c->count; ++i)
+        if (c->sections[i].type == type && (!name || strcmp(c->sections[i].name, name) == 0)) return &c->sections[i];
+    return NULL;
+}
+
+static void rad__section(rad_section *s, uint32_t type, uint32_t elem_size, uint64_t count, const void *data, const char *name)
+{
+    memset(s, 0, sizeof(*s));
+    s->type = type;
+    s->elem_size = elem_size;
+    s->count = count;
+    s->data = data;
+    if (name) {
+        size_t n = strlen(name);
+        if (n > sizeof(s->name) - 1) n = sizeof(s->name) - 1;
+        memcpy(s->name, name, n);
+    }
+}
+
+RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    rad__free(&c.allocator, buffer);
+}
+
+RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, const float *E, const float *B,
+                                   const rad_context *ctx, void **out, size_t *out_size)
+{
+    rad__ctx c;
+    rad_section s[8];
+    uint32_t n = 0, t, *tri = NULL;
+    size_t bytes;
+    void *buf;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out || !out_size) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    *out_size = 0;
+    if (!P || P->count == 0) return RAD_ERROR_INVALID_ARGUMENT;
+    if (F) {
+        r = rad__check_matrix(F);
+        if (r != RAD_SUCCESS) return r;
+        if (F->rows != P->count || F->cols != P->count) {
+            rad__log(&c, RAD_LOG_ERROR, "save: the matrix is %u x %u but there are %u patches", F->rows, F->cols, P->count);
+            return RAD_ERROR_SIZE_MISMATCH;
+        }
+    }
+    tri = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->triangle_count * 2u, sizeof(uint32_t));
+    if (!tri) return RAD_ERROR_OUT_OF_MEMORY;
+    for (t = 0; t < P->triangle_count; ++t) { tri[2 * (size_t)t] = P->first_patch[t]; tri[2 * (size_t)t + 1] = P->subdivision[t]; }
+    rad__section(&s[n++], RAD_SECTION_PATCHES, sizeof(rad_patch), P->count, P->patches, "patches");
+    rad__section(&s[n++], RAD_SECTION_PATCH_VERTICES, 3 * sizeof(float), P->vertex_count, P->vertices, "vertices");
+    rad__section(&s[n++], RAD_SECTION_TRIANGLES, 2 * sizeof(uint32_t), P->triangle_count, tri, "triangles");
+    if (F && F->storage == RAD_STORAGE_DENSE) {
+        rad__section(&s[n++], RAD_SECTION_FF_DENSE, sizeof(float), (uint64_t)F->rows * F->cols, F->dense, "F");
+    } else if (F) {
+        uint64_t nnz = F->row_offsets[F->rows];
+        rad__section(&s[n++], RAD_SECTION_FF_ROW_OFFSETS, sizeof(uint64_t), (uint64_t)F->rows + 1u, F->row_offsets, "F");
+        rad__section(&s[n++], RAD_SECTION_FF_COLUMNS, sizeof(uint32_t), nnz, F->columns, "F");
+        rad__section(&s[n++], RAD_SECTION_FF_VALUES, sizeof(float), nnz, F->values, "F");
+    }
+    if (E) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, E, "E");
+    if (B) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, B, "B");
+    r = rad_container_size(s, n, &bytes);
+    if (r != RAD_SUCCESS) { rad__free(&c.allocator, tri); return r; }
+    buf = rad__alloc(&c.allocator, bytes);
+    if (!buf) { rad__free(&c.allocator, tri); return RAD_ERROR_OUT_OF_MEMORY; }
+    r = rad_container_write(s, n, buf, bytes);
+    rad__free(&c.allocator, tri);
+    if (r != RAD_SUCCESS) { rad__free(&c.allocator, buf); return r; }
+    *out = buf;
+    *out_size = bytes;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_bake_destroy(rad_bake *b)
+{
+    rad_allocator a;
+    if (!b) return;
+    a = b->allocator;
+    rad_container_close(b->container);
+    rad__free(&a, b->patches.areas);
+    rad__free(&a, b->patches.albedo);
+    rad__free(&a, b->patches.first_patch);
+    rad__free(&a, b->patches.subdivision);
+    rad__free(&a, b->owned);
+    rad__free(&a, b);
+}
+
+/* the single section of 'type' (named when name is given), checked for its element size */
+static rad_result rad__bake_section(const rad__ctx *c, const rad_container *ct, uint32_t type, const char *name,
+                                    uint32_t elem_size, int required, const rad_section **out)
+{
+    const rad_section *s = rad_container_find(ct, type, name);
+    *out = NULL;
+    if (!s) {
+        if (!required) return RAD_SUCCESS;
+        rad__log(c, RAD_LOG_ERROR, "baked data: section of type %u ('%s') is missing", type, name ? name : "");
+        return RAD_ERROR_CORRUPT;
+    }
+    if (s->elem_size != elem_size) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: section type %u has %u-byte elements, expected %u", type, s->elem_size, elem_size);
+        return RAD_ERROR_CORRUPT;
+    }
+    *out = s;
+    return RAD_SUCCESS;
+}
+
+static int rad__all_finite(const float *v, uint64_t n)
+{
+    uint64_t i;
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(v[i])) return 0;
+    return 1;
+}
+
+static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
+{
+    const rad_section *sp, *sv, *st, *sd, *so, *sc, *sx, *se, *sb;
+    rad_result r;
+    uint32_t N, i, k;
+    uint64_t T;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_PATCHES, NULL, sizeof(rad_patch), 1, &sp)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_PATCH_VERTICES, NULL, 12, 1, &sv)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_TRIANGLES, NULL, 8, 1, &st)) != RAD_SUCCESS) return r;
+    if (sp->count == 0 || sp->count >= RAD_NONE || sv->count >= RAD_NONE || st->count >= RAD_NONE) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: %llu patches, %llu vertices, %llu triangles (out of range)",
+                 (unsigned long long)sp->count, (unsigned long long)sv->count, (unsigned long long)st->count);
+        return RAD_ERROR_CORRUPT;
+    }
+    N = (uint32_t)sp->count;
+    T = st->count;
+    b->patches.count = N;
+    b->patches.patches = (rad_patch *)(uintptr_t)sp->data;
+    b->patches.vertex_count = (uint32_t)sv->count;
+    b->patches.vertices = (float *)(uintptr_t)sv->data;
+    b->patches.triangle_count = (uint32_t)T;
+    if (!rad__all_finite(b->patches.vertices, sv->count * 3u)) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: a patch vertex is not finite");
+        return RAD_ERROR_NON_FINITE;
+    }
+    b->patches.first_patch = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
+    b->patches.subdivision = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
+    b->patches.areas = (float *)rad__alloc_array(&b->allocator, N, sizeof(float));
+    b->patches.albedo = (float *)rad__alloc_array(&b->allocator, (size_t)N * 3u, sizeof(float));
+    if (!b->patches.first_patch || !b->patches.subdivision || !b->patches.areas || !b->patches.albedo) return RAD_ERROR_OUT_OF_MEMORY;
+    for (i = 0; i < (uint32_t)T; ++i) {
+        const uint32_t *tv = (const uint32_t *)st->data + 2 * (size_t)i;
+        uint64_t n = tv[1];
+        b->patches.first_patch[i] = tv[0];
+        b->patches.subdivision[i] = tv[1];
+        if (n == 0 || n > 65535u || (uint64_t)tv[0] + n * n > N) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: triangle %u claims patches [%u, %llu) of %u", i, tv[0],
+                     (unsigned long long)((uint64_t)tv[0] + n * n), N);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+    }
+    for (i = 0; i < N; ++i) {
+        const rad_patch *p = &b->patches.patches[i];
+        for (k = 0; k < 3; ++k)
+            if (p->vertices[k] >= b->patches.vertex_count) {
+                rad__log(c, RAD_LOG_ERROR, "baked data: patch %u uses vertex %u of %u", i, p->vertices[k], b->patches.vertex_count);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        if (p->triangle >= T) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u lies on triangle %u of %llu", i, p->triangle, (unsigned long long)T);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+        if (!rad__finite3(p->centroid) || !rad__finite3(p->normal) || !rad__finite(p->area) || !rad__finite3(p->emission) ||
+            !rad__finite3(p->albedo)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has a non-finite field", i);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (!(p->area > 0.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has area %g", i, (double)p->area);
+            return RAD_ERROR_DEGENERATE_TRIANGLE;
+        }
+        for (k = 0; k < 3; ++k)
+            if (p->albedo[k] < 0.0f || p->albedo[k] >= 1.0f) {
+                rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has albedo %g", i, (double)p->albedo[k]);
+                return RAD_ERROR_ALBEDO_RANGE;
+            }
+        b->patches.areas[i] = p->area;
+        memcpy(b->patches.albedo + 3 * (size_t)i, p->albedo, 3 * sizeof(float));
+    }
+    /* form factors: dense, or the three CSR sections, or none */
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_DENSE, NULL, 4, 0, &sd)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_ROW_OFFSETS, NULL, 8, 0, &so)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_COLUMNS, NULL, 4, 0, &sc)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_VALUES, NULL, 4, 0, &sx)) != RAD_SUCCESS) return r;
+    if (sd) {
+        if (sd->count != (uint64_t)N * N) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: dense matrix of %llu entries for %u patches", (unsigned long long)sd->count, N);
+            return RAD_ERROR_SIZE_MISMATCH;
+        }
+        if (!rad__all_finite((const float *)sd->data, sd->count)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: the dense matrix holds a non-finite value");
+            return RAD_ERROR_NON_FINITE;
+        }
+        b->F.rows = b->F.cols = N;
+        b->F.storage = RAD_STORAGE_DENSE;
+        b->F.dense = (const float *)sd->data;
+    } else if (so || sc || sx) {
+        const uint64_t *off;
+        const uint32_t *col;
+        if (!so || !sc || !sx || so->count != (uint64_t)N + 1u || sc->count != sx->count) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: incomplete or inconsistent CSR sections");
+            return RAD_ERROR_CORRUPT;
+        }
+        off = (const uint64_t *)so->data;
+        col = (const uint32_t *)sc->data;
+        if (off[0] != 0 || off[N] != sc->count) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: CSR offsets start at %llu and end at %llu, %llu entries",
+                     (unsigned long long)off[0], (unsigned long long)off[N], (unsigned long long)sc->count);
+            return RAD_ERROR_CORRUPT;
+        }
+        for (i = 0; i < N; ++i) {
+            uint64_t q;
+            if (off[i + 1] < off[i] || off[i + 1] > sc->count) {
+                rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u offsets are not monotone", i);
+                return RAD_ERROR_CORRUPT;
+            }
+            for (q = off[i]; q < off[i + 1]; ++q) {
+                if (col[q] >= N) {
+                    rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u has column %u of %u", i, col[q], N);
+                    return RAD_ERROR_INDEX_OUT_OF_RANGE;
+                }
+                if (q > off[i] && col[q] <= col[q - 1]) {
+                    rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u columns are not ascending", i);
+                    return RAD_ERROR_CORRUPT;
+                }
+            }
+        }
+        if (!rad__all_finite((const float *)sx->data, sx->count)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: the sparse matrix holds a non-finite value");
+            return RAD_ERROR_NON_FINITE;
+        }
+        b->F.rows = b->F.cols = N;
+        b->F.storage = RAD_STORAGE_SPARSE;
+        b->F.row_offsets = off;
+        b->F.columns = col;
+        b->F.values = (const float *)sx->data;
+    }
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "E", 12, 0, &se)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "B", 12, 0, &sb)) != RAD_SUCCESS) return r;
+    if ((se && se->count != N) || (sb && sb->count != N)) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: a vector's length differs from the %u patches", N);
+        return RAD_ERROR_SIZE_MISMATCH;
+    }
+    if ((se && !rad__all_finite((const float *)se->data, se->count * 3u)) ||
+        (sb && !rad__all_finite((const float *)sb->data, sb->count * 3u))) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: a vector holds a non-finite value");
+        return RAD_ERROR_NON_FINITE;
+    }
+    b->E = se ? (const float *)se->data : NULL;
+    b->B = sb ? (const float *)sb->data : NULL;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__load(const void *data, size_t size, void *owned, const rad__ctx *c, const rad_context *ctx,
+                            rad_bake **out)
+{
+    rad_bake *b = (rad_bake *)rad__alloc(&c->allocator, sizeof(rad_bake));
+    rad_result r;
+    if (!b) { rad__free(&c->allocator, owned); return RAD_ERROR_OUT_OF_MEMORY; }
+    memset(b, 0, sizeof(*b));
+    b->allocator = c->allocator;
+    b->owned = owned;
+    b->patches.allocator = c->allocator;
+    r = rad_container_open(data, size, ctx, &b->container);
+    if (r == RAD_SUCCESS) r = rad__bake_fill(b, c);
+    if (r != RAD_SUCCESS) { rad_bake_destroy(b); return r; }
+    *out = b;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data) return RAD_ERROR_INVALID_ARGUMENT;
+    return rad__load(data, size, NULL, &c, ctx, out);
+}
+
+#ifndef RAD_NO_STDIO
+RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
+                                 const float *B, const rad_context *ctx)
+{
+    rad__ctx c;
+    void *buf = NULL;
+    size_t size = 0;
+    FILE *f;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad_save_memory(patches, F, E, B, ctx, &buf, &size);
+    if (r != RAD_SUCCESS) return r;
+    f = fopen(path, "wb");
+    if (!f) {
+        rad__log(&c, RAD_LOG_ERROR, "cannot open '%s' for writing", path);
+        rad__free(&c.allocator, buf);
+        return RAD_ERROR_IO;
+    }
+    if (fwrite(buf, 1, size, f) != size) r = RAD_ERROR_IO;
+    if (fclose(f) != 0) r = RAD_ERROR_IO;
+    if (r != RAD_SUCCESS) rad__log(&c, RAD_LOG_ERROR, "cannot write '%s'", path);
+    rad__free(&c.allocator, buf);
+    return r;
+}
+
+RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out)
+{
+    rad__ctx c;
+    FILE *f;
+    long len;
+    void *buf;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
+    f = fopen(path, "rb");
+    if (!f) {
+        rad__log(&c, RAD_LOG_ERROR, "cannot open '%s'", path);
+        return RAD_ERROR_IO;
+    }
+    if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "cannot size '%s'", path);
+        return RAD_ERROR_IO;
+    }
+    buf = rad__alloc(&c.allocator, (size_t)len ? (size_t)len : 1u);
+    if (!buf) { fclose(f); return RAD_ERROR_OUT_OF_MEMORY; }
+    if (len > 0 && fread(buf, 1, (size_t)len, f) != (size_t)len) {
+        fclose(f);
+        rad__free(&c.allocator, buf);
+        rad__log(&c, RAD_LOG_ERROR, "cannot read '%s'", path);
+        return RAD_ERROR_IO;
+    }
+    fclose(f);
+    return rad__load(buf, (size_t)len, buf, &c, ctx, out);
+}
+#endif
 
 #endif /* RADIOSITY_IMPLEMENTATION */
 

@@ -494,7 +494,9 @@ static void ff_test_c41_disks(void)
         f12 = ff_group(w.patches, ff->matrix.dense, 0, 1, &a1);
         f21 = ff_group(w.patches, ff->matrix.dense, 1, 0, &a2);
         ff_report("C-41 64-gons r=1 h=1", f12, ref);
-        /* the target at default quality */
+        /* the issue's target at default quality. (Measured 2.1e-3 at max_edge 0.25: the 16
+           emitter points per patch have mean barycentrics (0.332, 0.360, 0.307), not 1/3 each,
+           so the rule is biased on these thin patches; a header bug, reported.) */
         CHECK_REL(f12, ref, 1e-3);
         CHECK_REL(f21, ref, 1e-3);
         CHECK_REL(a1 * f12, a2 * f21, 1e-6); /* reciprocity, float rounding */
@@ -502,6 +504,603 @@ static void ff_test_c41_disks(void)
     }
     rad_form_factors_destroy(ff);
     ff_world_free(&w);
+}
+
+/* Monte Carlo method (point-to-point kernel, one point pair and one ray per sample) on C-11
+   unit squares at gap 1, with the most samples (256). */
+static void ff_test_monte_carlo(void)
+{
+    ff_quad q1, q2;
+    rad_form_factor_options fo;
+    double f12 = 0, f21 = 0, a1 = 0, a2 = 0, ref = 0.19982489569838746;
+    ff_quad_set(&q1, 0, 0, 0, 1, 0, 0, 0, 1, 0);
+    ff_quad_set(&q2, 0, 0, 1, 0, 1, 0, 1, 0, 0);
+    rad_form_factor_options_default(&fo);
+    fo.method = RAD_FF_MONTE_CARLO;
+    fo.samples = 256;
+    if (!ff_two_quads(&q1, &q2, rad_test_quick() ? 0.5f : 0.25f, &fo, &f12, &f21, &a1, &a2)) return;
+    ff_report("C-11 1x1 gap 1, Monte Carlo 256", f12, ref);
+    /* point-pair sampling of a kernel whose value varies ~2x over a patch pair: 256 pairs per
+       patch pair over ~100 pairs per group leave ~1e-3 noise plus the point-set bias; 5e-3
+       relative is the stated tolerance for this method */
+    CHECK_REL(f12, ref, 5e-3);
+    CHECK_REL(a1 * f12, a2 * f21, 1e-6);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 4. enclosure: the closed unit cube                                                       */
+/* ---------------------------------------------------------------------------------------- */
+
+/* The 6 faces of [0,1]^3, fronts facing inwards. Face order: z=0, z=1, x=0, x=1, y=0, y=1
+   (so faces 2f and 2f+1 are parallel). */
+static void ff_cube_quads(ff_quad *q)
+{
+    ff_quad_set(&q[0], 0, 0, 0, 1, 0, 0, 0, 1, 0); /* +z */
+    ff_quad_set(&q[1], 0, 0, 1, 0, 1, 0, 1, 0, 0); /* -z */
+    ff_quad_set(&q[2], 0, 0, 0, 0, 1, 0, 0, 0, 1); /* +x */
+    ff_quad_set(&q[3], 1, 0, 0, 0, 0, 1, 0, 1, 0); /* -x */
+    ff_quad_set(&q[4], 0, 0, 0, 0, 0, 1, 1, 0, 0); /* +y */
+    ff_quad_set(&q[5], 0, 1, 0, 1, 0, 0, 0, 0, 1); /* -y */
+}
+
+static int ff_cube_world(ff_quad *q, rad_mesh_desc *meshes, ff_world *w)
+{
+    rad_scene_desc d;
+    int f;
+    ff_cube_quads(q);
+    for (f = 0; f < 6; ++f) ff_mesh_quad(&meshes[f], &q[f]);
+    ff_desc(&d, meshes, 6);
+    /* max_edge 0.25: each face triangle (legs 1) is cut 6 x 6; 432 patches */
+    return ff_world_make(&d, rad_test_quick() ? 0.5f : 0.25f, 0, w);
+}
+
+static void ff_test_enclosure_cube(void)
+{
+    ff_quad q[6];
+    rad_mesh_desc meshes[6];
+    ff_world w;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL, *ffu = NULL;
+    uint32_t i, j, N, negatives = 0, diag = 0, f, g;
+    double worst_row = 0.0, worst_recip = 0.0, worst_skip = 0.0;
+    if (!ff_cube_world(q, meshes, &w)) return;
+    N = w.patches->count;
+    rad_form_factor_options_default(&fo);
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &ff));
+    fo.skip_visibility = 1;
+    CHECK_OK(rad_form_factors_dense(w.patches, NULL, &fo, NULL, &ffu)); /* raycaster may be NULL */
+    if (!ff || !ffu) { rad_form_factors_destroy(ff); rad_form_factors_destroy(ffu); ff_world_free(&w); return; }
+    CHECK(ff->matrix.rows == N && ff->matrix.cols == N && ff->matrix.storage == RAD_STORAGE_DENSE);
+    for (i = 0; i < N; ++i) {
+        double row = 0.0;
+        const float *F = ff->matrix.dense + (size_t)i * N;
+        if (F[i] != 0.0f) diag++;
+        for (j = 0; j < N; ++j) {
+            double aij, aji, e;
+            row += F[j];
+            if (!(F[j] >= 0.0f)) negatives++;
+            aij = (double)w.patches->areas[i] * F[j];
+            aji = (double)w.patches->areas[j] * ff->matrix.dense[(size_t)j * N + i];
+            e = fabs(aij - aji) / (fabs(aij) > 1e-30 ? fabs(aij) : 1e-30);
+            if (aij != 0.0 || aji != 0.0)
+                if (e > worst_recip) worst_recip = e;
+            e = fabs((double)F[j] - (double)ffu->matrix.dense[(size_t)i * N + j]);
+            if (e > worst_skip) worst_skip = e;
+        }
+        if (fabs(row - 1.0) > worst_row) worst_row = fabs(row - 1.0);
+    }
+    printf("    cube: N %u, worst |row sum - 1| %.2e, worst reciprocity %.2e, worst |F_vis - F_novis| %.2e\n", N,
+           worst_row, worst_recip, worst_skip);
+    CHECK(negatives == 0);
+    CHECK(diag == 0); /* F_ii == 0 for planar patches */
+    /* a closed enclosure: every row sums to 1. Measured ~4e-3 (patches next to an edge, whose
+       integrand is nearly singular, carry the quadrature error); 1e-2 is the stated bound */
+    CHECK(worst_row < 1e-2);
+    /* reciprocity holds by construction (F_ji = F_ij A_i / A_j in float): 1e-6 relative */
+    CHECK(worst_recip < 1e-6);
+    /* convex enclosure: no occlusion, so visibility rays must all pass. The sample points are
+       the same with and without rays, so the only difference is a ray wrongly blocked; allow
+       float noise only */
+    CHECK(worst_skip < 1e-6);
+    /* face groups: F_parallel + 4 F_perpendicular = 1, and each against its closed form */
+    for (f = 0; f < 6; ++f) {
+        double sum = 0.0, par = ff_group(w.patches, ff->matrix.dense, f, f ^ 1u, NULL);
+        for (g = 0; g < 6; ++g)
+            if (g != f) sum += ff_group(w.patches, ff->matrix.dense, f, g, NULL);
+        CHECK_NEAR(sum, 1.0, 1e-3); /* the cube identity at the tolerance */
+        /* the faces against C-11 / C-14 with these coarse patches (max_edge 0.25; measured
+           1.7e-3 for the perpendicular faces; the fine-patch 1e-3 checks are in the c11/c14
+           tests): 3e-3 relative */
+        CHECK_REL(par, 0.19982489569838746, 3e-3);
+        for (g = 0; g < 6; ++g)
+            if (g != f && g != (f ^ 1u)) CHECK_REL(ff_group(w.patches, ff->matrix.dense, f, g, NULL), 0.20004377607540316, 3e-3);
+        CHECK(ff_group(w.patches, ff->matrix.dense, f, f, NULL) == 0.0); /* coplanar patches */
+    }
+    rad_form_factors_destroy(ff);
+    rad_form_factors_destroy(ffu);
+    ff_world_free(&w);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 5. row ranges and sparse storage                                                         */
+/* ---------------------------------------------------------------------------------------- */
+
+static void ff_test_rows_sparse(void)
+{
+    ff_quad q[6];
+    rad_mesh_desc meshes[6];
+    ff_world w;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL, *sp = NULL, *spt = NULL;
+    float *rows = NULL;
+    uint32_t N, i, j, cuts[4];
+    int k;
+    const float t = 1e-3f;
+    if (!ff_cube_world(q, meshes, &w)) return;
+    N = w.patches->count;
+    rad_form_factor_options_default(&fo);
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &ff));
+    rows = (float *)malloc(sizeof(float) * (size_t)N * N);
+    CHECK(rows != NULL);
+    if (!ff || !rows) goto done;
+    /* [0, N) in 3 uneven ranges */
+    cuts[0] = 0;
+    cuts[1] = N / 7;
+    cuts[2] = N / 7 + N / 2 + 3;
+    cuts[3] = N;
+    memset(rows, 0xAB, sizeof(float) * (size_t)N * N);
+    for (k = 0; k < 3; ++k)
+        CHECK_OK(rad_form_factor_rows(w.patches, &w.rc, &fo, cuts[k], cuts[k + 1], rows + (size_t)cuts[k] * N, NULL));
+    /* bit for bit: each pair is computed from the lower-indexed patch in both calls */
+    CHECK(memcmp(rows, ff->matrix.dense, sizeof(float) * (size_t)N * N) == 0);
+    /* an empty range and a bad range */
+    CHECK_OK(rad_form_factor_rows(w.patches, &w.rc, &fo, 5, 5, rows, NULL));
+    CHECK(rad_form_factor_rows(w.patches, &w.rc, &fo, 5, N + 1, rows, NULL) != RAD_SUCCESS);
+
+    /* sparse, threshold 0: exactly the non-zeros of dense, equal values */
+    CHECK_OK(rad_form_factors_sparse(w.patches, &w.rc, &fo, NULL, &sp));
+    fo.drop_threshold = t;
+    CHECK_OK(rad_form_factors_sparse(w.patches, &w.rc, &fo, NULL, &spt));
+    if (sp && spt) {
+        const rad_form_factors *m2[2];
+        int which;
+        m2[0] = sp;
+        m2[1] = spt;
+        for (which = 0; which < 2; ++which) {
+            const rad_matrix *M = &m2[which]->matrix;
+            float thr = which ? t : 0.0f;
+            uint32_t bad_struct = 0, bad_val = 0, bad_drop = 0;
+            uint64_t nnz_dense = 0;
+            CHECK(M->storage == RAD_STORAGE_SPARSE && M->rows == N && M->cols == N);
+            CHECK(M->row_offsets[0] == 0);
+            for (i = 0; i < N; ++i) {
+                uint64_t e, b = M->row_offsets[i], en = M->row_offsets[i + 1];
+                const float *D = ff->matrix.dense + (size_t)i * N;
+                uint32_t next = 0;
+                if (en < b) { bad_struct++; continue; }
+                for (e = b; e < en; ++e) {
+                    uint32_t c = M->columns[e];
+                    if (c >= N || (e > b && c <= M->columns[e - 1])) { bad_struct++; break; }
+                    /* columns skipped since the last stored one are dropped entries */
+                    for (j = next; j < c; ++j)
+                        if (!(D[j] <= thr)) bad_drop++;
+                    next = c + 1;
+                    if (M->values[e] != D[c]) bad_val++;  /* same computation: equal bits */
+                    if (!(M->values[e] > thr)) bad_val++; /* stored values exceed the threshold */
+                }
+                for (j = next; j < N; ++j)
+                    if (!(D[j] <= thr)) bad_drop++;
+                for (j = 0; j < N; ++j)
+                    if (D[j] > thr) nnz_dense++;
+            }
+            CHECK(bad_struct == 0);
+            CHECK(bad_val == 0);
+            CHECK(bad_drop == 0);
+            CHECK(M->row_offsets[N] == nnz_dense); /* row_offsets[N] == nnz == kept dense count */
+            printf("    sparse threshold %g: nnz %llu of %llu\n", (double)thr, (unsigned long long)M->row_offsets[N],
+                   (unsigned long long)N * N);
+        }
+        CHECK(spt->matrix.row_offsets[N] < sp->matrix.row_offsets[N]); /* the threshold dropped something */
+        CHECK(sp->matrix.row_offsets[N] < (uint64_t)N * N);            /* coplanar zeros are not stored */
+    }
+done:
+    free(rows);
+    rad_form_factors_destroy(ff);
+    rad_form_factors_destroy(sp);
+    rad_form_factors_destroy(spt);
+    ff_world_free(&w);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 6. determinism                                                                           */
+/* ---------------------------------------------------------------------------------------- */
+
+/* a parallel_for that runs the tasks serially in reverse order */
+static void ff_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+    uint32_t i = count;
+    (void)user;
+    while (i-- > 0) fn(data, i);
+}
+
+static void ff_test_determinism(void)
+{
+    rad_scene_desc d;
+    ff_world w;
+    rad_form_factor_options fo;
+    rad_form_factors *a = NULL, *b = NULL, *c = NULL, *e = NULL;
+    rad_context ctx;
+    uint32_t N;
+    rad_cornell_box(&d, NULL);
+    if (!ff_world_make(&d, 0.0f, rad_test_quick() ? 150 : 300, &w)) return;
+    N = w.patches->count;
+    rad_form_factor_options_default(&fo);
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.parallel_for = ff_reverse_for;
+    ctx.task_count = 7; /* a different split from the default 64 tasks */
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &a));
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &b));
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, &ctx, &c));
+    fo.seed = 12345u; /* the seed decorrelates the visibility points: different bits */
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &e));
+    if (a && b && c && e) {
+        CHECK(memcmp(a->matrix.dense, b->matrix.dense, sizeof(float) * (size_t)N * N) == 0);
+        CHECK(memcmp(a->matrix.dense, c->matrix.dense, sizeof(float) * (size_t)N * N) == 0);
+        CHECK(a->rays_cast == c->rays_cast && a->pairs_evaluated == c->pairs_evaluated);
+        /* control: the comparison can fail (the Cornell box has occlusion, so visibility
+           points matter) */
+        CHECK(memcmp(a->matrix.dense, e->matrix.dense, sizeof(float) * (size_t)N * N) != 0);
+    }
+    rad_form_factors_destroy(a);
+    rad_form_factors_destroy(b);
+    rad_form_factors_destroy(c);
+    rad_form_factors_destroy(e);
+    ff_world_free(&w);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 7. the Cornell box: general properties                                                   */
+/* ---------------------------------------------------------------------------------------- */
+
+static void ff_test_cornell(void)
+{
+    rad_scene_desc d;
+    ff_world w;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL;
+    uint32_t N, i, j, negatives = 0, diag = 0, over = 0, recip = 0;
+    double worst = 0.0, lowest = 2.0;
+    rad_cornell_box(&d, NULL);
+    if (!ff_world_make(&d, 0.0f, rad_test_quick() ? 200 : 500, &w)) return;
+    N = w.patches->count;
+    rad_form_factor_options_default(&fo);
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &ff));
+    if (!ff) { ff_world_free(&w); return; }
+    for (i = 0; i < N; ++i) {
+        const float *F = ff->matrix.dense + (size_t)i * N;
+        double row = 0.0;
+        if (F[i] != 0.0f) diag++;
+        for (j = 0; j < N; ++j) {
+            double aij = (double)w.patches->areas[i] * F[j], aji = (double)w.patches->areas[j] * ff->matrix.dense[(size_t)j * N + i];
+            if (!(F[j] >= 0.0f)) negatives++;
+            row += F[j];
+            if (fabs(aij - aji) > 1e-6 * fabs(aij)) recip++;
+        }
+        if (row > worst) worst = row;
+        if (row < lowest) lowest = row;
+        /* the box is open at the front (z = 0 side), so rows may be well below 1, never
+           above it except for quadrature error: near pairs (patches meeting at a wall corner
+           or a block's base) are sampled, so a row may overshoot by a few 1e-3; 1.03 bound */
+        if (row > 1.03) over++;
+    }
+    printf("    cornell: N %u, row sums in [%.4f, %.4f], rays %llu, pairs %llu\n", N, lowest, worst,
+           (unsigned long long)ff->rays_cast, (unsigned long long)ff->pairs_evaluated);
+    CHECK(negatives == 0);
+    CHECK(diag == 0);
+    CHECK(over == 0);
+    CHECK(recip == 0); /* by construction */
+    /* (no lower bound: ceiling patches right above the one-sided light, 0.1 mm below them,
+       see only its back and get a zero row) */
+    CHECK(ff->rays_cast > 0);
+    CHECK(ff->pairs_evaluated > 0);
+    CHECK(ff->pairs_evaluated <= (uint64_t)N * (N - 1) / 2); /* unordered pairs, each once */
+    rad_form_factors_destroy(ff);
+    ff_world_free(&w);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* 8. the built-in BVH against brute force                                                  */
+/* ---------------------------------------------------------------------------------------- */
+
+static uint32_t ff_lcg_state;
+static double ff_rand(void) /* [0, 1) */
+{
+    ff_lcg_state = ff_lcg_state * 1664525u + 1013904223u;
+    return (double)(ff_lcg_state >> 8) / 16777216.0;
+}
+
+/* Moller-Trumbore in double, two-sided; returns 1 and t, b1, b2 on a hit of the line */
+static int ff_mt(const rad_ray *ray, const float *v, double *t, double *b1, double *b2)
+{
+    double e1[3], e2[3], p[3], q[3], s[3], det, inv, u, w;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)v[3 + k] - v[k];
+        e2[k] = (double)v[6 + k] - v[k];
+        s[k] = (double)ray->origin[k] - v[k];
+    }
+    p[0] = (double)ray->dir[1] * e2[2] - (double)ray->dir[2] * e2[1];
+    p[1] = (double)ray->dir[2] * e2[0] - (double)ray->dir[0] * e2[2];
+    p[2] = (double)ray->dir[0] * e2[1] - (double)ray->dir[1] * e2[0];
+    det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (det == 0.0) return 0;
+    inv = 1.0 / det;
+    u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
+    if (u < 0.0 || u > 1.0) return 0;
+    q[0] = s[1] * e1[2] - s[2] * e1[1];
+    q[1] = s[2] * e1[0] - s[0] * e1[2];
+    q[2] = s[0] * e1[1] - s[1] * e1[0];
+    w = ((double)ray->dir[0] * q[0] + (double)ray->dir[1] * q[1] + (double)ray->dir[2] * q[2]) * inv;
+    if (w < 0.0 || u + w > 1.0) return 0;
+    *t = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) * inv;
+    *b1 = u;
+    *b2 = w;
+    return 1;
+}
+
+static int ff_close(double a, double b, double rel)
+{
+    double m = fabs(a) > fabs(b) ? fabs(a) : fabs(b);
+    return fabs(a - b) <= rel * (m > 1.0 ? m : 1.0);
+}
+
+static void ff_bvh_soup(uint32_t tri_count, uint32_t ray_count, uint32_t seed)
+{
+    float *pos = (float *)malloc(sizeof(float) * 9 * tri_count);
+    rad_ray *rays = (rad_ray *)malloc(sizeof(rad_ray) * ray_count);
+    rad_hit *hits = (rad_hit *)malloc(sizeof(rad_hit) * ray_count);
+    uint8_t *occ = (uint8_t *)malloc(ray_count);
+    rad_mesh_desc m;
+    rad_scene_desc d;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    uint32_t i, tr, bad_hit = 0, bad_occ = 0, ties = 0, grazing = 0, hits_n = 0, occ_n = 0, bad_bary = 0;
+    double worst_t = 0.0, worst_p = 0.0;
+    int k;
+    CHECK(pos && rays && hits && occ);
+    if (!pos || !rays || !hits || !occ) goto done;
+    ff_lcg_state = seed;
+    /* triangles of size ~0.02 .. 0.3 scattered in the unit box, some axis-aligned */
+    for (i = 0; i < tri_count; ++i) {
+        double c[3], size = tri_count == 1 ? 0.9 : 0.02 + 0.28 * ff_rand();
+        for (k = 0; k < 3; ++k) c[k] = ff_rand();
+        for (k = 0; k < 9; ++k) pos[9 * i + k] = (float)(c[k % 3] + size * (ff_rand() - 0.5));
+        if (i % 10 == 0) { int ax = (int)(i / 10 % 3); pos[9 * i + 3 + ax] = pos[9 * i + ax]; pos[9 * i + 6 + ax] = pos[9 * i + ax]; }
+    }
+    memset(&m, 0, sizeof(m));
+    m.positions = pos;
+    m.vertex_count = 3 * tri_count;
+    m.triangle_count = tri_count;
+    ff_desc(&d, &m, 1);
+    CHECK_OK(rad_scene_create(&d, NULL, &scene));
+    if (!scene) goto done;
+    CHECK(scene->triangle_count == tri_count);
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    if (!bvh) goto done;
+    CHECK(rad_bvh_memory(bvh) > 0);
+    rad_bvh_raycaster(bvh, &rc);
+    for (i = 0; i < ray_count; ++i) {
+        rad_ray *r = &rays[i];
+        int kind = (int)(i % 5);
+        for (k = 0; k < 3; ++k) {
+            r->origin[k] = (float)(kind == 2 ? ff_rand() : -0.5 + 2.0 * ff_rand()); /* kind 2 inside the box */
+            r->dir[k] = (float)(ff_rand() - 0.5) * (float)(0.5 + 2.0 * ff_rand());   /* not unit */
+        }
+        if (kind == 3) { /* axis-aligned: one or two zero components */
+            int keep = (int)(ff_rand() * 3.0);
+            for (k = 0; k < 3; ++k)
+                if (k != keep && (i % 2 == 0 || k != (keep + 1) % 3)) r->dir[k] = 0.0f;
+            if (r->dir[keep] == 0.0f) r->dir[keep] = 1.0f;
+        } else if (kind != 2) { /* aim at the box so most rays hit something */
+            double target[3];
+            for (k = 0; k < 3; ++k) { target[k] = 0.2 + 0.6 * ff_rand(); r->dir[k] = (float)(target[k] - r->origin[k]); }
+        }
+        r->tmin = (i % 7 == 0) ? (float)(0.3 * ff_rand()) : 0.0f;
+        r->tmax = (kind == 1 || i % 3 == 0) ? (float)(0.2 + ff_rand()) : 1e30f; /* limited or open */
+    }
+    CHECK_OK(rc.intersect(rc.user, rays, ray_count, hits));
+    CHECK_OK(rc.occluded(rc.user, rays, ray_count, occ));
+    for (i = 0; i < ray_count; ++i) {
+        const rad_ray *r = &rays[i];
+        double best = HUGE_VAL, bb1 = 0, bb2 = 0;
+        uint32_t best_tri = RAD_NONE;
+        int any = 0, near_bound = 0;
+        for (tr = 0; tr < tri_count; ++tr) {
+            double t, b1, b2;
+            if (!ff_mt(r, scene->positions + 9 * (size_t)tr, &t, &b1, &b2)) continue;
+            /* a hit within 1e-5 relative of tmin or tmax is grazing the interval's ends: the
+               float and double tests may decide it either way */
+            if (ff_close(t, r->tmin, 1e-5) || ff_close(t, r->tmax, 1e-5)) near_bound = 1;
+            if (!(t > r->tmin && t < r->tmax)) continue;
+            any = 1;
+            if (t < best) { best = t; best_tri = tr; bb1 = b1; bb2 = b2; }
+        }
+        (void)bb1;
+        (void)bb2;
+        if (any) hits_n++;
+        if (occ[i]) occ_n++;
+        if ((occ[i] != 0) != any) {
+            if (near_bound) grazing++;
+            else bad_occ++;
+        }
+        if (best_tri == RAD_NONE || hits[i].triangle == RAD_NONE) {
+            if (best_tri != hits[i].triangle) {
+                if (near_bound) grazing++;
+                else bad_hit++;
+            }
+            continue;
+        }
+        if (hits[i].triangle != best_tri) {
+            /* a near tie: two triangles at the same distance */
+            if (ff_close(hits[i].t, best, 1e-5)) ties++;
+            else if (near_bound) grazing++;
+            else bad_hit++;
+            continue;
+        }
+        {
+            /* the distance error as a position error |dt| |dir| (coordinates are O(1)) */
+            double dl = sqrt((double)r->dir[0] * r->dir[0] + (double)r->dir[1] * r->dir[1] + (double)r->dir[2] * r->dir[2]);
+            double e = fabs(hits[i].t - best) * dl;
+            if (e > worst_t) worst_t = e;
+        }
+        /* the barycentrics reproduce the hit point */
+        {
+            const float *v = scene->positions + 9 * (size_t)hits[i].triangle;
+            double e = 0.0;
+            for (k = 0; k < 3; ++k) {
+                double pb = (1.0 - hits[i].b1 - hits[i].b2) * v[k] + hits[i].b1 * v[3 + k] + hits[i].b2 * v[6 + k];
+                double pr = (double)r->origin[k] + (double)hits[i].t * r->dir[k];
+                if (fabs(pb - pr) > e) e = fabs(pb - pr);
+            }
+            if (e > worst_p) worst_p = e;
+            if (e > 1e-4) bad_bary++;
+        }
+    }
+    printf("    bvh %u tris, %u rays: %u hits, %u occluded, worst |dt||dir| %.2e, worst |p(b) - p(t)| %.2e, ties %u, grazing %u\n",
+           tri_count, ray_count, hits_n, occ_n, worst_t, worst_p, ties, grazing);
+    if (tri_count == 1) CHECK(hits_n > 0);
+    if (tri_count >= 100) {
+        CHECK(hits_n > ray_count / 10); /* the rays do hit things (the comparison is not vacuous) */
+        CHECK(hits_n < ray_count);      /* ... and miss things */
+    }
+    CHECK(bad_hit == 0);
+    CHECK(bad_occ == 0);
+    CHECK(bad_bary == 0);
+    /* the float watertight test vs double Moller-Trumbore, as a position error along the ray:
+       1e-5 (coordinates within [-0.5, 1.5]: some tens of float ulps) */
+    CHECK(worst_t < 1e-5);
+    CHECK(grazing < ray_count / 1000 + 1); /* allowed only as rare exceptions */
+done:
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+    free(pos);
+    free(rays);
+    free(hits);
+    free(occ);
+}
+
+static void ff_test_bvh_brute_force(void)
+{
+    uint32_t nr = rad_test_quick() ? 5000 : 20000;
+    ff_bvh_soup(200, nr, 12345u);
+    ff_bvh_soup(rad_test_quick() ? 1000 : 2000, nr, 777u);
+    ff_bvh_soup(1, 2000, 99u); /* a single triangle: the root is a leaf */
+}
+
+/* Watertightness: rays aimed exactly at shared edges and vertices must hit something. */
+static void ff_watertight_mesh(const float *pos, uint32_t vcount, const uint32_t *idx, uint32_t tcount,
+                               const uint32_t (*edges)[2], uint32_t ecount, const float *normal, int vertex_inside,
+                               uint32_t seed)
+{
+    rad_mesh_desc m;
+    rad_scene_desc d;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    enum { NR = 4000 };
+    static rad_ray rays[NR];
+    static rad_hit hits[NR];
+    static uint8_t occ[NR];
+    uint32_t i, misses = 0, omisses = 0;
+    int k;
+    memset(&m, 0, sizeof(m));
+    m.positions = pos;
+    m.vertex_count = vcount;
+    m.indices = idx;
+    m.triangle_count = tcount;
+    ff_desc(&d, &m, 1);
+    CHECK_OK(rad_scene_create(&d, NULL, &scene));
+    if (!scene) return;
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    if (!bvh) { rad_scene_destroy(scene); return; }
+    rad_bvh_raycaster(bvh, &rc);
+    ff_lcg_state = seed;
+    for (i = 0; i < NR; ++i) {
+        const uint32_t *e = edges[i % ecount];
+        const float *a = pos + 3 * e[0], *b = pos + 3 * e[1];
+        /* s = 0: the vertex a itself, when it is an interior vertex of the mesh */
+        float s = (vertex_inside && i % 16 == 0) ? 0.0f : (float)(0.02 + 0.96 * ff_rand());
+        float side = (i % 2) ? 1.0f : -1.0f;                              /* from both sides */
+        for (k = 0; k < 3; ++k) {
+            float p = a[k] + s * (b[k] - a[k]);
+            float o = p + side * (float)(0.5 + ff_rand()) * normal[k] + (float)(ff_rand() - 0.5);
+            rays[i].origin[k] = o;
+            rays[i].dir[k] = p - o; /* the target is at t = 1 */
+        }
+        rays[i].tmin = 0.0f;
+        rays[i].tmax = 1e30f;
+    }
+    CHECK_OK(rc.intersect(rc.user, rays, NR, hits));
+    CHECK_OK(rc.occluded(rc.user, rays, NR, occ));
+    for (i = 0; i < NR; ++i) {
+        if (hits[i].triangle == RAD_NONE) {
+            if (misses < 3)
+                printf("    miss: ray %u origin %.9g %.9g %.9g dir %.9g %.9g %.9g\n", i, rays[i].origin[0], rays[i].origin[1],
+                       rays[i].origin[2], rays[i].dir[0], rays[i].dir[1], rays[i].dir[2]);
+            misses++;
+        }
+        else CHECK_NEAR(hits[i].t, 1.0, 1e-4); /* the target point is on the surface */
+        if (!occ[i]) omisses++;
+    }
+    if (misses || omisses) printf("    watertight: %u intersect misses, %u occluded misses of %u rays\n", misses, omisses, (unsigned)NR);
+    CHECK(misses == 0);
+    CHECK(omisses == 0);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
+static void ff_test_bvh_watertight(void)
+{
+    /* a closed fan of 7 triangles around a shared vertex, in a tilted plane, with irregular
+       angles and radii */
+    enum { NF = 7 };
+    float fan[3 * (NF + 1)];
+    uint32_t fidx[3 * NF], fedges[NF][2];
+    const float e1[3] = { 0.8f, 0.36f, -0.48f }, e2[3] = { 0.0f, 0.8f, 0.6f };
+    float nrm[3];
+    static const double angles[NF] = { 0.0, 0.7, 1.9, 2.5, 3.4, 4.6, 5.5 };
+    static const double radii[NF] = { 1.0, 0.6, 1.3, 0.9, 0.75, 1.1, 0.5 };
+    uint32_t i;
+    int k;
+    nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    for (k = 0; k < 3; ++k) fan[k] = 0.3f + 0.1f * (float)k; /* the shared vertex, off the origin */
+    for (i = 0; i < NF; ++i)
+        for (k = 0; k < 3; ++k)
+            fan[3 * (i + 1) + k] = fan[k] + (float)(radii[i] * cos(angles[i])) * e1[k] + (float)(radii[i] * sin(angles[i])) * e2[k];
+    for (i = 0; i < NF; ++i) {
+        fidx[3 * i] = 0;
+        fidx[3 * i + 1] = i + 1;
+        fidx[3 * i + 2] = (i + 1) % NF + 1;
+        fedges[i][0] = 0; /* the spokes: each shared by two triangles */
+        fedges[i][1] = i + 1;
+    }
+    ff_watertight_mesh(fan, NF + 1, fidx, NF, (const uint32_t(*)[2])fedges, NF, nrm, 1, 4242u);
+    /* a (slightly non-planar) quad split on its diagonal 0-2: the diagonal is the only shared
+       edge, so only it is aimed at */
+    {
+        static const float quad[12] = { 0.1f, 0.2f, 0.3f, 1.3f, 0.25f, 0.45f, 1.5f, 1.1f, 0.9f, 0.3f, 1.05f, 0.75f };
+        static const uint32_t qidx[6] = { 0, 1, 2, 0, 2, 3 };
+        static const uint32_t qedge[1][2] = { { 0, 2 } };
+        float u[3], v[3], qn[3];
+        for (k = 0; k < 3; ++k) { u[k] = quad[3 + k] - quad[k]; v[k] = quad[6 + k] - quad[k]; }
+        qn[0] = u[1] * v[2] - u[2] * v[1];
+        qn[1] = u[2] * v[0] - u[0] * v[2];
+        qn[2] = u[0] * v[1] - u[1] * v[0];
+        ff_watertight_mesh(quad, 4, qidx, 2, qedge, 1, qn, 0, 5151u);
+    }
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -516,5 +1115,12 @@ static const rad_test_case tests_formfactor[] = {
     { "formfactor_c11_parallel", ff_test_c11_parallel },
     { "formfactor_c14_perpendicular", ff_test_c14_perpendicular },
     { "formfactor_c41_disks", ff_test_c41_disks },
+    { "formfactor_monte_carlo", ff_test_monte_carlo },
+    { "formfactor_enclosure_cube", ff_test_enclosure_cube },
+    { "formfactor_rows_sparse", ff_test_rows_sparse },
+    { "formfactor_determinism", ff_test_determinism },
+    { "formfactor_cornell", ff_test_cornell },
+    { "formfactor_bvh_brute_force", ff_test_bvh_brute_force },
+    { "formfactor_bvh_watertight", ff_test_bvh_watertight },
     { NULL, NULL }
 };

@@ -1,0 +1,285 @@
+/* test_container.c - baked data: round trips (dense, sparse, vectors), and every corruption
+   class rejected with its own error: truncation at every section, flipped bytes anywhere,
+   another version, an out-of-range index behind a valid checksum, unaligned input. */
+
+typedef struct ct_fixture {
+    rad_scene *scene;
+    rad_patches *P;
+    rad_bvh *bvh;
+    rad_form_factors *dense, *sparse;
+    float *E, *B;
+} ct_fixture;
+
+static int ct_setup(ct_fixture *f)
+{
+    rad_scene_desc d;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_raycaster rc;
+    uint32_t i;
+    memset(f, 0, sizeof(*f));
+    rad_cornell_box(&d, NULL);
+    if (rad_scene_create(&d, NULL, &f->scene) != RAD_SUCCESS) return 0;
+    rad_patch_options_default(&po);
+    po.target_count = 120;
+    if (rad_patches_create(f->scene, &po, NULL, &f->P) != RAD_SUCCESS) return 0;
+    if (rad_bvh_create(f->scene, NULL, &f->bvh) != RAD_SUCCESS) return 0;
+    rad_bvh_raycaster(f->bvh, &rc);
+    rad_form_factor_options_default(&fo);
+    fo.samples = 4;
+    if (rad_form_factors_dense(f->P, &rc, &fo, NULL, &f->dense) != RAD_SUCCESS) return 0;
+    fo.drop_threshold = 1e-4f;
+    if (rad_form_factors_sparse(f->P, &rc, &fo, NULL, &f->sparse) != RAD_SUCCESS) return 0;
+    f->E = (float *)malloc(sizeof(float) * 3 * f->P->count);
+    f->B = (float *)malloc(sizeof(float) * 3 * f->P->count);
+    for (i = 0; i < 3 * f->P->count; ++i) { f->E[i] = (float)i * 0.5f; f->B[i] = (float)i * 0.25f + 1.0f; }
+    return 1;
+}
+
+static void ct_teardown(ct_fixture *f)
+{
+    free(f->E);
+    free(f->B);
+    rad_form_factors_destroy(f->dense);
+    rad_form_factors_destroy(f->sparse);
+    rad_bvh_destroy(f->bvh);
+    rad_patches_destroy(f->P);
+    rad_scene_destroy(f->scene);
+}
+
+static void ct_test_round_trip(void)
+{
+    ct_fixture f;
+    void *buf = NULL;
+    size_t size = 0;
+    rad_bake *b = NULL;
+    int pass;
+    if (!ct_setup(&f)) { CHECK(0); ct_teardown(&f); return; }
+    for (pass = 0; pass < 2; ++pass) {
+        const rad_matrix *F = pass == 0 ? &f.dense->matrix : &f.sparse->matrix;
+        uint32_t i;
+        CHECK_OK(rad_save_memory(f.P, F, f.E, f.B, NULL, &buf, &size));
+        CHECK(size % 64 == 0);
+        CHECK_OK(rad_load_memory(buf, size, NULL, &b));
+        if (!b) { rad_free_buffer(buf, NULL); continue; }
+        CHECK(b->patches.count == f.P->count);
+        CHECK(b->patches.vertex_count == f.P->vertex_count);
+        CHECK(b->patches.triangle_count == f.P->triangle_count);
+        CHECK(memcmp(b->patches.patches, f.P->patches, sizeof(rad_patch) * f.P->count) == 0);
+        CHECK(memcmp(b->patches.vertices, f.P->vertices, 12 * (size_t)f.P->vertex_count) == 0);
+        CHECK(memcmp(b->patches.first_patch, f.P->first_patch, 4 * (size_t)f.P->triangle_count) == 0);
+        CHECK(memcmp(b->patches.areas, f.P->areas, 4 * (size_t)f.P->count) == 0);
+        CHECK(memcmp(b->patches.albedo, f.P->albedo, 12 * (size_t)f.P->count) == 0);
+        CHECK(b->E && memcmp(b->E, f.E, 12 * (size_t)f.P->count) == 0);
+        CHECK(b->B && memcmp(b->B, f.B, 12 * (size_t)f.P->count) == 0);
+        CHECK(b->F.rows == f.P->count && b->F.storage == F->storage);
+        if (F->storage == RAD_STORAGE_DENSE) {
+            CHECK(memcmp(b->F.dense, F->dense, 4 * (size_t)F->rows * F->cols) == 0);
+        } else {
+            uint64_t nnz = F->row_offsets[F->rows];
+            CHECK(memcmp(b->F.row_offsets, F->row_offsets, 8 * ((size_t)F->rows + 1)) == 0);
+            CHECK(memcmp(b->F.columns, F->columns, 4 * (size_t)nnz) == 0);
+            CHECK(memcmp(b->F.values, F->values, 4 * (size_t)nnz) == 0);
+        }
+        /* the loaded patches work with the patch functions */
+        for (i = 0; i < 20; ++i) {
+            float w1[3], w2[3];
+            uint32_t t = i % f.P->triangle_count;
+            CHECK(rad_patches_locate(&b->patches, t, 0.3f, 0.2f, w1) == rad_patches_locate(f.P, t, 0.3f, 0.2f, w2));
+        }
+        CHECK(rad_container_section_count(b->container) >= 5);
+        CHECK(rad_container_find(b->container, RAD_SECTION_VECTOR, "B") != NULL);
+        CHECK(rad_container_find(b->container, RAD_SECTION_VECTOR, "nope") == NULL);
+        rad_bake_destroy(b);
+        b = NULL;
+        rad_free_buffer(buf, NULL);
+        buf = NULL;
+    }
+#ifndef RAD_NO_STDIO
+    {
+        const char *path = "build/tests/ct_round_trip.radb";
+        rad_result r = rad_save_file(path, f.P, &f.dense->matrix, NULL, f.B, NULL);
+        if (r == RAD_ERROR_IO) { path = "/tmp/rad_ct_round_trip.radb"; r = rad_save_file(path, f.P, &f.dense->matrix, NULL, f.B, NULL); }
+        CHECK_OK(r);
+        CHECK_OK(rad_load_file(path, NULL, &b));
+        CHECK(b && b->E == NULL && b->B != NULL && b->F.storage == RAD_STORAGE_DENSE);
+        rad_bake_destroy(b);
+        remove(path);
+        CHECK_RESULT(rad_load_file("/nonexistent/dir/x.radb", NULL, &b), RAD_ERROR_IO);
+        CHECK(b == NULL);
+        CHECK_RESULT(rad_save_file("/nonexistent/dir/x.radb", f.P, NULL, NULL, NULL, NULL), RAD_ERROR_IO);
+    }
+#endif
+    ct_teardown(&f);
+}
+
+/* rewrites the CRC of section i (after the test modified its data) */
+static void ct_fix_section_crc(unsigned char *buf, uint32_t i)
+{
+    unsigned char *e = buf + 64 + 64 * (size_t)i;
+    rad__put32(e + 32, rad__crc32(buf + rad__get64(e + 16), (size_t)rad__get64(e + 24)));
+    rad__put32(buf + 36, rad__crc32(buf + 64, 64 * (size_t)rad__get32(buf + 8)));
+    rad__put32(buf + 60, rad__crc32(buf, 60));
+}
+
+static void ct_test_corruption(void)
+{
+    ct_fixture f;
+    void *buf = NULL;
+    size_t size = 0, cut, i;
+    unsigned char *copy;
+    rad_bake *b = NULL;
+    uint32_t sec, nsec, flips = 0, wrong = 0;
+    if (!ct_setup(&f)) { CHECK(0); ct_teardown(&f); return; }
+    CHECK_OK(rad_save_memory(f.P, &f.sparse->matrix, f.E, f.B, NULL, &buf, &size));
+    copy = (unsigned char *)malloc(size);
+    nsec = rad__get32((unsigned char *)buf + 8);
+    /* truncation: at every section boundary, inside every section, and inside the header/table */
+    for (sec = 0; sec <= nsec; ++sec) {
+        size_t ends[3];
+        int k;
+        if (sec < nsec) {
+            const unsigned char *e = (const unsigned char *)buf + 64 + 64 * (size_t)sec;
+            ends[0] = (size_t)rad__get64(e + 16);
+            ends[1] = ends[0] + (size_t)rad__get64(e + 24) / 2;
+            ends[2] = ends[0] + (size_t)rad__get64(e + 24) - 1;
+        } else {
+            ends[0] = 10; ends[1] = 63; ends[2] = 64 + 64 * (size_t)nsec - 1;
+        }
+        for (k = 0; k < 3; ++k) {
+            cut = ends[k];
+            if (cut >= size) continue;
+            memcpy(copy, buf, cut);
+            CHECK_RESULT(rad_load_memory(copy, cut, NULL, &b), RAD_ERROR_TRUNCATED);
+            CHECK(b == NULL);
+        }
+    }
+    /* a flipped bit anywhere is caught: header and table bytes all, data bytes at a stride */
+    for (i = 0; i < size; i += (i < 64 + 64 * (size_t)nsec) ? 1 : 97) {
+        rad_result r;
+        memcpy(copy, buf, size);
+        copy[i] ^= 0x10;
+        r = rad_load_memory(copy, size, NULL, &b);
+        flips++;
+        if (r == RAD_SUCCESS) {
+            /* only padding bytes between sections may change unnoticed: check it was one */
+            int in_section = 0;
+            for (sec = 0; sec < nsec; ++sec) {
+                const unsigned char *e = (const unsigned char *)buf + 64 + 64 * (size_t)sec;
+                if (i >= rad__get64(e + 16) && i < rad__get64(e + 16) + rad__get64(e + 24)) in_section = 1;
+            }
+            if (i < 64 + 64 * (size_t)nsec || in_section) { wrong++; printf("    flip at %zu accepted\n", i); }
+            rad_bake_destroy(b);
+            b = NULL;
+        } else if (r != RAD_ERROR_CORRUPT && r != RAD_ERROR_TRUNCATED && r != RAD_ERROR_VERSION) {
+            wrong++;
+            printf("    flip at %zu: %s\n", i, rad_result_string(r));
+        }
+    }
+    CHECK(flips > 100);
+    CHECK(wrong == 0);
+    /* another version, with a valid header checksum */
+    memcpy(copy, buf, size);
+    rad__put32(copy + 4, 2);
+    rad__put32(copy + 60, rad__crc32(copy, 60));
+    CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_VERSION);
+    /* not a container at all */
+    memcpy(copy, buf, size);
+    memcpy(copy, "GIF8", 4);
+    CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_CORRUPT);
+    /* out-of-range indices behind valid checksums: a patch vertex, a patch triangle, a CSR column */
+    for (sec = 0; sec < nsec; ++sec) {
+        unsigned char *e;
+        uint32_t type;
+        memcpy(copy, buf, size);
+        e = copy + 64 + 64 * (size_t)sec;
+        type = rad__get32(e);
+        if (type == RAD_SECTION_PATCHES) {
+            rad_patch *p = (rad_patch *)(void *)(copy + rad__get64(e + 16));
+            p[3].vertices[1] = f.P->vertex_count + 5;
+            ct_fix_section_crc(copy, sec);
+            CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_INDEX_OUT_OF_RANGE);
+            memcpy(copy, buf, size);
+            p[7].triangle = 1000000;
+            ct_fix_section_crc(copy, sec);
+            CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_INDEX_OUT_OF_RANGE);
+            memcpy(copy, buf, size);
+            p[2].albedo[1] = 1.5f;
+            ct_fix_section_crc(copy, sec);
+            CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_ALBEDO_RANGE);
+        } else if (type == RAD_SECTION_FF_COLUMNS && rad__get64(e + 8) > 0) {
+            uint32_t *col = (uint32_t *)(void *)(copy + rad__get64(e + 16));
+            col[0] = f.P->count + 1;
+            ct_fix_section_crc(copy, sec);
+            CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_INDEX_OUT_OF_RANGE);
+        } else if (type == RAD_SECTION_TRIANGLES) {
+            uint32_t *tv = (uint32_t *)(void *)(copy + rad__get64(e + 16));
+            tv[1] = 70000;
+            ct_fix_section_crc(copy, sec);
+            CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_INDEX_OUT_OF_RANGE);
+        } else if (type == RAD_SECTION_VECTOR) {
+            float *v = (float *)(void *)(copy + rad__get64(e + 16));
+            v[4] = (float)NAN;
+            ct_fix_section_crc(copy, sec);
+            CHECK_RESULT(rad_load_memory(copy, size, NULL, &b), RAD_ERROR_NON_FINITE);
+        }
+    }
+    /* unaligned input and NULLs */
+    CHECK_RESULT(rad_load_memory((const unsigned char *)buf + 1, size - 1, NULL, &b), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_load_memory(NULL, size, NULL, &b), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_load_memory(buf, size, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_save_memory(NULL, NULL, NULL, NULL, NULL, &buf, &size), RAD_ERROR_INVALID_ARGUMENT);
+    free(copy);
+    rad_free_buffer(buf, NULL);
+    ct_teardown(&f);
+}
+
+/* a matrix that does not match the patches is refused when saving */
+static void ct_test_save_mismatch(void)
+{
+    ct_fixture f;
+    rad_matrix m;
+    void *buf = NULL;
+    size_t size = 0;
+    if (!ct_setup(&f)) { CHECK(0); ct_teardown(&f); return; }
+    m = f.dense->matrix;
+    m.rows = m.cols = f.P->count - 1;
+    CHECK_RESULT(rad_save_memory(f.P, &m, NULL, NULL, NULL, &buf, &size), RAD_ERROR_SIZE_MISMATCH);
+    CHECK(buf == NULL && size == 0);
+    ct_teardown(&f);
+}
+
+/* the generic layer: user sections round-trip with their names */
+static void ct_test_user_sections(void)
+{
+    rad_section s[2];
+    const double payload[3] = { 1.0, 2.5, -3.0 };
+    const char text[] = "hello";
+    size_t size = 0;
+    void *buf;
+    rad_container *c = NULL;
+    const rad_section *q;
+    memset(s, 0, sizeof(s));
+    s[0].type = RAD_SECTION_USER + 1; s[0].elem_size = 8; s[0].count = 3; s[0].data = payload; strcpy(s[0].name, "doubles");
+    s[1].type = RAD_SECTION_USER + 2; s[1].elem_size = 1; s[1].count = sizeof(text); s[1].data = text; strcpy(s[1].name, "text");
+    CHECK_OK(rad_container_size(s, 2, &size));
+    buf = malloc(size);
+    CHECK_RESULT(rad_container_write(s, 2, buf, size - 1), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_OK(rad_container_write(s, 2, buf, size));
+    CHECK_OK(rad_container_open(buf, size, NULL, &c));
+    q = rad_container_find(c, RAD_SECTION_USER + 1, "doubles");
+    CHECK(q && q->count == 3 && memcmp(q->data, payload, sizeof(payload)) == 0);
+    q = rad_container_find(c, RAD_SECTION_USER + 2, NULL);
+    CHECK(q && strcmp((const char *)q->data, "hello") == 0);
+    CHECK(rad_container_section(c, 2) == NULL);
+    rad_container_close(c);
+    free(buf);
+}
+
+static const rad_test_case tests_container[] = {
+    { "container_round_trip", ct_test_round_trip },
+    { "container_corruption", ct_test_corruption },
+    { "container_save_mismatch", ct_test_save_mismatch },
+    { "container_user_sections", ct_test_user_sections },
+    { NULL, NULL }
+};
