@@ -3274,7 +3274,10 @@ static void rad__mv_task(void *data, uint32_t t)
 {
     const rad__mv *m = (const rad__mv *)data;
     const rad_matrix *F = m->F;
-    uint32_t r0 = (uint32_t)((uint64_t)F->rows * t / m->tasks), r1 = (uint32_t)((uint64_t)F->rows * (t + 1) / m->tasks), i;
+    /* chunk boundaries on even rows: rows 2k and 2k+1 always share the two-row kernel, so the
+       bits do not depend on the number of tasks */
+    uint32_t r0 = (uint32_t)((uint64_t)F->rows * t / m->tasks) & ~1u, r1 = (uint32_t)((uint64_t)F->rows * (t + 1) / m->tasks) & ~1u, i;
+    if (t + 1 == m->tasks) r1 = F->rows;
     for (i = r0; i < r1; ++i) {
         if (F->storage == RAD_STORAGE_DENSE) {
             const float *xr = m->soa, *xg = m->soa + F->cols, *xb = m->soa + 2 * (size_t)F->cols;

@@ -228,7 +228,12 @@ static void ct_test_corruption(void)
     CHECK_RESULT(rad_load_memory((const unsigned char *)buf + 1, size - 1, NULL, &b), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_load_memory(NULL, size, NULL, &b), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_load_memory(buf, size, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
-    CHECK_RESULT(rad_save_memory(NULL, NULL, NULL, NULL, NULL, &buf, &size), RAD_ERROR_INVALID_ARGUMENT);
+    {
+        void *none = (void *)1;
+        size_t none_size = 1;
+        CHECK_RESULT(rad_save_memory(NULL, NULL, NULL, NULL, NULL, &none, &none_size), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(none == NULL && none_size == 0);
+    }
     free(copy);
     rad_free_buffer(buf, NULL);
     ct_teardown(&f);
