@@ -183,13 +183,15 @@
 
    9. WHAT radiosity.h DOES NOT DO
        - Specular or glossy transport: radiosity is diffuse light exchange.
-       - Loading files: meshes come in as arrays (tools/ has an importer).
+       - Parse scene files: meshes come in as arrays (tools/rad imports OBJ, glTF, FBX, PLY
+         through assimp).
        - Start threads, touch the GPU itself, or keep global state.
 
   10. HISTORY
-       0.1.0  scene input and validation, patches, built-in BVH, form factors (analytic,
-              Monte Carlo, point-to-point; dense, sparse, row ranges), Jacobi, Gauss-Seidel,
-              progressive refinement, LU; direct light; built-in Cornell box.
+       0.1.0  scene input and validation, patches, built-in BVH (4-wide, SSE), Embree
+              backend, form factors (analytic, Monte Carlo, point-to-point; dense, sparse,
+              row ranges), Jacobi, Gauss-Seidel, progressive refinement, LU; direct light;
+              built-in Cornell box; baked-data container.
        The full history is in CHANGELOG.md.
 */
 
