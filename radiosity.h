@@ -76,9 +76,11 @@
        5. ERRORS                   rad_result, the logger
        6. THREADING                parallel_for hook, progress and cancel, determinism
        7. RAY QUERIES              the callback table, the built-in BVH, self-intersection
-       8. NUMERICAL ROBUSTNESS     epsilons, singularities, validation
-       9. WHAT radiosity.h DOES NOT DO
-      10. HISTORY
+       8. EMBREE                   the optional Embree 3 backend
+       9. BAKED DATA               the container format
+      10. NUMERICAL ROBUSTNESS     epsilons, singularities, validation
+      11. WHAT radiosity.h DOES NOT DO
+      12. HISTORY
 
    1. OPTIONS
        macro                      default            where to set it
@@ -170,7 +172,29 @@
        excludes the same distance at both ends. The raycaster itself reports any hit in
        (tmin, tmax) and adds no epsilon of its own.
 
-   8. NUMERICAL ROBUSTNESS
+   8. EMBREE
+       With RAD_EMBREE defined in the implementing file (and -lembree3), rad_embree_create
+       builds an Embree 3 device and scene from a rad_scene (robust flag, high build quality,
+       Embree-owned padded buffers) and rad_embree_raycaster fills the same rad_raycaster table
+       the BVH fills; rad_embree_wrap adopts a committed RTCScene you already have. Embree's
+       errors go to rad_context.log. Without RAD_EMBREE the functions exist and return
+       RAD_ERROR_UNAVAILABLE, so code can probe with rad_embree_available().
+
+   9. BAKED DATA
+       rad_save_memory / rad_save_file write patches, a form-factor matrix (dense or CSR) and
+       named RGB vectors ("E", "B") into one container; rad_load_memory reads it in place (the
+       bytes must be 8-byte aligned and outlive the rad_bake) and rad_load_file reads a file.
+       Layout: a 64-byte header (magic "RADB", version, section count, file size, flags, CRC-32
+       of the section table, CRC-32 of the header), 64-byte table entries (type, element size,
+       count, offset, bytes, CRC-32, name), then the sections, each on a 64-byte boundary.
+       Section data is in the writer's byte order, recorded in the flags; a reader of the other
+       byte order refuses it (RAD_ERROR_VERSION). Every size, offset, checksum and index is
+       checked before use: a truncated file gives RAD_ERROR_TRUNCATED, a damaged one
+       RAD_ERROR_CORRUPT, another version RAD_ERROR_VERSION, an index out of range
+       RAD_ERROR_INDEX_OUT_OF_RANGE; nothing is read outside the given bytes. Applications add
+       their own sections (types >= RAD_SECTION_USER) through rad_container_write.
+
+  10. NUMERICAL ROBUSTNESS
        - rad_scene_create validates everything: NaN/Inf positions or normals, indices out of
          range, zero-area triangles (rejected, or skipped and counted with
          RAD_SCENE_SKIP_DEGENERATE), albedo outside [0,1), negative or non-finite emission,
@@ -178,16 +202,24 @@
        - Point-to-point form factors clamp |r|^2 from below by s_j / pi (the squared radius of
          a disk of the area the point stands for), which bounds the kernel by
          cos cos / s_j * s_j = 1 for coincident points.
+       - Patch-to-patch form factors integrate the emitter side with the centroids of an n x n
+         sub-triangle lattice (the midpoint rule: no bias toward any corner) and the receiver
+         side analytically; pairs closer than twice their size get 16x the points, because the
+         integrand is nearly singular along a shared edge. Measured against the closed forms
+         of REFERENCE.md at default quality: relative errors below 1e-4.
+       - The BVH's box test widens every slab by 1 + 2 gamma_3 (Ize 2013) and its triangle
+         test is watertight (Woop, Benthin, Wald 2013), so rays through shared edges and
+         vertices are never lost.
        - The polygon kernel clips the receiver to the sample point's upper half-space and
          returns 0 when the point is behind the receiver, so there is no sign ambiguity.
 
-   9. WHAT radiosity.h DOES NOT DO
+  11. WHAT radiosity.h DOES NOT DO
        - Specular or glossy transport: radiosity is diffuse light exchange.
        - Parse scene files: meshes come in as arrays (tools/rad imports OBJ, glTF, FBX, PLY
          through assimp).
        - Start threads, touch the GPU itself, or keep global state.
 
-  10. HISTORY
+  12. HISTORY
        0.1.0  scene input and validation, patches, built-in BVH (4-wide, SSE), Embree
               backend, form factors (analytic, Monte Carlo, point-to-point; dense, sparse,
               row ranges), Jacobi, Gauss-Seidel, progressive refinement, LU; direct light;
