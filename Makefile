@@ -47,8 +47,9 @@ bench-quick: $(BUILD)/bench $(BUILD)/rays
 
 tools: $(BUILD)/rad
 
-$(BUILD)/rad: tools/rad.c radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. tools/rad.c -o $@ -lm
+# the tool needs assimp (scene import) and stb (images): Debian libassimp-dev libstb-dev
+$(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. tools/*.c -o $@ -lassimp -lm
 	cp $@ tools/rad
 
 clean:

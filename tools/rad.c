@@ -1,19 +1,25 @@
-/* rad - command-line tool built on radiosity.h.
+/* rad - command-line tool built on radiosity.h: one program with subcommands.
 
-   This first version knows the built-in Cornell box ("cornell") and prints group form
-   factors between its named objects, the quantity a radiosity course starts from:
+       rad help | rad CMD --help
+       rad formfactors SCENE   group form factors between the scene's named objects
+       rad bake SCENE -o FILE.radb     the classic solution, saved
+       rad render SCENE -o OUT.png|OUT.pfm     an image (classic radiosity or path tracing)
+       rad trace SCENE -o OUT  the reference path tracer
+       rad compare A B         image metrics
+       rad info FILE.radb      what a bake holds
 
-       rad formfactors cornell [--patches N] [--samples S] [--threads N]
-
-   prints one line "FROM TO VALUE" per ordered pair of objects, where VALUE is the
-   area-weighted group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i.
-   Reading scene files arrives with the importer (see the issues); the scene argument
-   accepts only "cornell" until then and says so. */
+   This file holds the implementation of radiosity.h, the dispatcher, the shared helpers of
+   tool.h and the formfactors command. Exit codes: 0 ok, 1 failure, 2 usage error. */
+#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 199309L /* clock_gettime, isatty */
+#endif
 #define RADIOSITY_IMPLEMENTATION
-#include "radiosity.h"
+#include "tool.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -24,54 +30,244 @@
 #define RAD_TOOL_ISATTY(fd) 0
 #endif
 
+/* ---- shared helpers ------------------------------------------------------------------- */
+
+static struct {
+    const void *label;
+    int last;     /* last percentage shown, -1: none */
+    int open;     /* a bar line is open on a terminal */
+} g_progress = {NULL, -1, 0};
+
+void rad_tool_progress_end(void)
+{
+    if (g_progress.open) fprintf(stderr, "\n");
+    g_progress.open = 0;
+    g_progress.last = -1;
+    g_progress.label = NULL;
+}
+
+int rad_tool_progress(void *user, float fraction)
+{
+    const char *label = user ? (const char *)user : "working";
+    int pct;
+    if (!(fraction >= 0.0f)) fraction = 0.0f;
+    if (fraction > 1.0f) fraction = 1.0f;
+    pct = (int)(fraction * 100.0f);
+    if (g_progress.label != user || pct < g_progress.last) {
+        rad_tool_progress_end();
+        g_progress.label = user;
+    }
+    if (pct == g_progress.last) return 0;
+    if (RAD_TOOL_ISATTY(2)) {
+        char bar[31];
+        int i, fill = pct * 30 / 100;
+        for (i = 0; i < 30; ++i) bar[i] = i < fill ? '#' : '.';
+        bar[30] = 0;
+        fprintf(stderr, "\r  %-14s [%s] %3d%%", label, bar, pct);
+        g_progress.open = 1;
+        if (pct >= 100) {
+            fprintf(stderr, "\n");
+            g_progress.open = 0;
+        }
+        fflush(stderr);
+        g_progress.last = pct;
+    } else {
+        /* a plain line every 10% */
+        if (g_progress.last < 0 || pct / 10 != g_progress.last / 10) {
+            fprintf(stderr, "  %s %d%%\n", label, pct / 10 * 10);
+            g_progress.last = pct / 10 * 10;
+        }
+    }
+    if (pct >= 100) g_progress.last = 100;
+    return 0;
+}
+
+void rad_tool_log(void *user, rad_log_level level, const char *message)
+{
+    (void)user;
+    if (g_progress.open) {
+        fprintf(stderr, "\n");
+        g_progress.open = 0;
+    }
+    fprintf(stderr, "rad: %s: %s\n", level == RAD_LOG_ERROR ? "error" : level == RAD_LOG_WARNING ? "warning" : "info",
+            message);
+}
+
+void rad_tool_context(rad_context *ctx, const char *label)
+{
+    memset(ctx, 0, sizeof *ctx);
+    ctx->log = rad_tool_log;
+    if (label) {
+        ctx->progress = rad_tool_progress;
+        ctx->progress_user = (void *)(size_t)label;
+    }
+}
+
+void rad_tool_set_threads(int threads)
+{
+#ifdef _OPENMP
+    if (threads > 0) omp_set_num_threads(threads);
+#else
+    (void)threads;
+#endif
+}
+
+int rad_tool_fail(const char *cmd, const char *what, rad_result r)
+{
+    rad_tool_progress_end();
+    fprintf(stderr, "rad %s: %s failed: %s\n", cmd, what, rad_result_string(r));
+    return 1;
+}
+
+int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out)
+{
+    char *end;
+    unsigned long v;
+    if (!text || !*text || *text == '-') goto bad;
+    v = strtoul(text, &end, 10);
+    if (*end != '\0' || v > 0xFFFFFFFFul) goto bad;
+    *out = (uint32_t)v;
+    return 0;
+bad:
+    fprintf(stderr, "rad %s: bad value '%s' for %s (want a whole number >= 0)\n", cmd, text ? text : "", opt);
+    return 2;
+}
+
+int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out)
+{
+    char *end;
+    float v;
+    if (!text || !*text) goto bad;
+    v = strtof(text, &end);
+    if (*end != '\0' || !(v == v) || fabsf(v) > 1e30f) goto bad;
+    *out = v;
+    return 0;
+bad:
+    fprintf(stderr, "rad %s: bad value '%s' for %s (want a number)\n", cmd, text ? text : "", opt);
+    return 2;
+}
+
+double rad_tool_seconds(void)
+{
+#if defined(_OPENMP)
+    return omp_get_wtime();
+#elif defined(CLOCK_MONOTONIC)
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#else
+    return (double)clock() / (double)CLOCKS_PER_SEC;
+#endif
+}
+
+int rad_tool_parse_camera(const char *text, rad_camera *out)
+{
+    float v[9];
+    char extra;
+    if (!text) return 1;
+    if (sscanf(text, "%f,%f,%f:%f,%f,%f:%f,%f,%f%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8],
+               &extra) != 9)
+        return 1;
+    {
+        int i;
+        float d2 = 0.0f, u2 = 0.0f;
+        for (i = 0; i < 9; ++i)
+            if (!(v[i] == v[i]) || fabsf(v[i]) > 1e30f) return 1;
+        for (i = 0; i < 3; ++i) {
+            d2 += (v[3 + i] - v[i]) * (v[3 + i] - v[i]);
+            u2 += v[6 + i] * v[6 + i];
+        }
+        if (!(d2 > 0.0f) || !(u2 > 0.0f)) return 1;
+    }
+    memcpy(out->position, v, 3 * sizeof(float));
+    memcpy(out->target, v + 3, 3 * sizeof(float));
+    memcpy(out->up, v + 6, 3 * sizeof(float));
+    return 0;
+}
+
+int rad_tool_parse_size(const char *text, int *w, int *h)
+{
+    unsigned long a, b;
+    char extra;
+    if (!text || sscanf(text, "%lux%lu%c", &a, &b, &extra) != 2) return 1;
+    if (a == 0 || b == 0 || a > 32768 || b > 32768) return 1;
+    *w = (int)a;
+    *h = (int)b;
+    return 0;
+}
+
+int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w)
+{
+    char err[1024];
+    rad_context ctx;
+    rad_result r;
+    memset(w, 0, sizeof *w);
+    if (rad_tool_load_scene(path_or_name, &w->file, err, sizeof err) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, err);
+        return 1;
+    }
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_scene_create(&w->file.desc, &ctx, &w->scene)) != RAD_SUCCESS) {
+        rad_tool_free_scene(&w->file);
+        return rad_tool_fail(cmd, "rad_scene_create", r);
+    }
+    if (w->scene->skipped_triangles)
+        fprintf(stderr, "rad: warning: %u degenerate triangles skipped\n", w->scene->skipped_triangles);
+    if ((r = rad_bvh_create(w->scene, &ctx, &w->bvh)) != RAD_SUCCESS) {
+        rad_tool_close_world(w);
+        return rad_tool_fail(cmd, "rad_bvh_create", r);
+    }
+    rad_bvh_raycaster(w->bvh, &w->rc);
+    return 0;
+}
+
+void rad_tool_close_world(rad_tool_world *w)
+{
+    rad_bvh_destroy(w->bvh);
+    rad_scene_destroy(w->scene);
+    rad_tool_free_scene(&w->file);
+    memset(w, 0, sizeof *w);
+}
+
+/* ---- help ------------------------------------------------------------------------------ */
+
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: rad COMMAND [options]\n"
+    fprintf(f, "usage: rad COMMAND [options]        (rad COMMAND --help for its options)\n"
                "commands:\n"
                "  help                     this text\n"
                "  version                  the library version\n"
                "  formfactors SCENE        group form factors between the scene's named objects\n"
-               "                           options: --patches N (default 2000), --samples S (default 16),\n"
-               "                                    --threads N (default: all)\n"
-               "SCENE is 'cornell' (the built-in Cornell box).\n");
+               "  bake SCENE -o FILE.radb  compute and save the classic radiosity solution\n"
+               "  render SCENE -o OUT      render an image (.png or .pfm): --method classic|pathtrace\n"
+               "  trace SCENE -o OUT       the reference path tracer\n"
+               "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
+               "  info FILE.radb           list what a bake holds and check it\n"
+               "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
+               "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all).\n");
 }
 
-static int progress(void *user, float fraction)
+static void formfactors_usage(FILE *f)
 {
-    static int last = -1;
-    int pct = (int)(fraction * 100.0f);
-    (void)user;
-    if (pct != last) {
-        last = pct;
-        if (RAD_TOOL_ISATTY(2)) fprintf(stderr, "\r  %3d%%", pct);
-        else if (pct % 10 == 0) fprintf(stderr, "  %d%%\n", pct);
-        if (pct >= 100 && RAD_TOOL_ISATTY(2)) fprintf(stderr, "\n");
-    }
-    return 0;
+    fprintf(f, "usage: rad formfactors SCENE [--patches N] [--max-edge L] [--samples S] [--threads N]\n"
+               "Prints one line 'FROM TO VALUE' per ordered pair of named objects: the area-weighted\n"
+               "group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i.\n"
+               "  --patches N   target patch count (default 2000)\n"
+               "  --max-edge L  longest patch edge (default: no limit)\n"
+               "  --samples S   points per patch pair (default 16, up to 256)\n"
+               "  --threads N   worker threads (default: all)\n");
 }
 
-static void log_message(void *user, rad_log_level level, const char *message)
-{
-    (void)user;
-    fprintf(stderr, "rad: %s: %s\n", level == RAD_LOG_ERROR ? "error" : "warning", message);
-}
+/* ---- formfactors ----------------------------------------------------------------------- */
 
-static int fail(const char *what, rad_result r)
+int rad_cmd_formfactors(int argc, char **argv)
 {
-    fprintf(stderr, "rad: %s failed: %s\n", what, rad_result_string(r));
-    return 1;
-}
-
-static int cmd_formfactors(int argc, char **argv)
-{
-    const char *scene_name = NULL;
-    uint32_t patches_target = 2000, samples = 16, G, H, i, j;
-    rad_scene_desc desc;
-    rad_scene *scene = NULL;
+    const char *scene_name = NULL, *cmd = "formfactors";
+    uint32_t patches_target = 2000, samples = 16, threads = 0, G, H, i, j, gc;
+    float max_edge = 0.0f;
+    rad_tool_world w;
     rad_patches *P = NULL;
-    rad_bvh *bvh = NULL;
     rad_form_factors *ff = NULL;
-    rad_raycaster rc;
     rad_patch_options po;
     rad_form_factor_options fo;
     rad_context ctx;
@@ -79,71 +275,95 @@ static int cmd_formfactors(int argc, char **argv)
     double *num, *den;
     int a;
     for (a = 0; a < argc; ++a) {
-        if (!strcmp(argv[a], "--help") || !strcmp(argv[a], "-h")) { usage(stdout); return 0; }
-        if (!strcmp(argv[a], "--patches") && a + 1 < argc) patches_target = (uint32_t)strtoul(argv[++a], NULL, 10);
-        else if (!strcmp(argv[a], "--samples") && a + 1 < argc) samples = (uint32_t)strtoul(argv[++a], NULL, 10);
-        else if (!strcmp(argv[a], "--threads") && a + 1 < argc) {
-            int t = atoi(argv[++a]);
-#ifdef _OPENMP
-            if (t > 0) omp_set_num_threads(t);
-#else
-            (void)t;
-#endif
-        } else if (argv[a][0] == '-') { fprintf(stderr, "rad formfactors: unknown option '%s'\n", argv[a]); return 2; }
-        else if (!scene_name) scene_name = argv[a];
-        else { fprintf(stderr, "rad formfactors: more than one scene given\n"); return 2; }
+        const char *o = argv[a];
+        int need = !strcmp(o, "--patches") || !strcmp(o, "--samples") || !strcmp(o, "--threads") || !strcmp(o, "--max-edge");
+        if (!strcmp(o, "--help") || !strcmp(o, "-h")) { formfactors_usage(stdout); return 0; }
+        if (need && a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
+        if (!strcmp(o, "--patches")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
+        else if (!strcmp(o, "--samples")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
+        else if (!strcmp(o, "--threads")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &threads)) return 2; }
+        else if (!strcmp(o, "--max-edge")) { if (rad_tool_parse_float(cmd, o, argv[++a], &max_edge)) return 2; }
+        else if (o[0] == '-' && o[1]) { fprintf(stderr, "rad %s: unknown option '%s'\n", cmd, o); return 2; }
+        else if (!scene_name) scene_name = o;
+        else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
     }
-    if (!scene_name) { fprintf(stderr, "rad formfactors: no scene given\n"); usage(stderr); return 2; }
-    if (strcmp(scene_name, "cornell") != 0) {
-        fprintf(stderr, "rad formfactors: '%s': only the built-in scene 'cornell' can be read so far "
-                        "(scene files need the importer, not built yet)\n", scene_name);
-        return 2;
-    }
-    if (patches_target == 0 || samples == 0) { fprintf(stderr, "rad formfactors: --patches and --samples must be > 0\n"); return 2; }
-    memset(&ctx, 0, sizeof(ctx));
-    ctx.log = log_message;
-    ctx.progress = progress;
-    rad_cornell_box(&desc, NULL);
-    if ((r = rad_scene_create(&desc, &ctx, &scene)) != RAD_SUCCESS) return fail("scene", r);
+    if (!scene_name) { fprintf(stderr, "rad %s: no scene given\n", cmd); formfactors_usage(stderr); return 2; }
+    if (samples == 0 || max_edge < 0.0f) { fprintf(stderr, "rad %s: --samples must be > 0, --max-edge >= 0\n", cmd); return 2; }
+    rad_tool_set_threads((int)threads);
+    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    rad_tool_context(&ctx, "form factors");
     rad_patch_options_default(&po);
     po.target_count = patches_target;
-    if ((r = rad_patches_create(scene, &po, &ctx, &P)) != RAD_SUCCESS) return fail("patches", r);
-    if ((r = rad_bvh_create(scene, &ctx, &bvh)) != RAD_SUCCESS) return fail("bvh", r);
-    rad_bvh_raycaster(bvh, &rc);
+    po.max_edge = max_edge;
+    if ((r = rad_patches_create(w.scene, &po, &ctx, &P)) != RAD_SUCCESS) {
+        rad_tool_close_world(&w);
+        return rad_tool_fail(cmd, "rad_patches_create", r);
+    }
     rad_form_factor_options_default(&fo);
     fo.samples = samples;
-    fprintf(stderr, "form factors of %u patches\n", P->count);
-    if ((r = rad_form_factors_dense(P, &rc, &fo, &ctx, &ff)) != RAD_SUCCESS) return fail("form factors", r);
-    G = scene->mesh_count;
-    num = (double *)calloc((size_t)G * G, sizeof(double));
-    den = (double *)calloc(G, sizeof(double));
-    if (!num || !den) { fprintf(stderr, "rad: out of memory\n"); return 1; }
-    for (i = 0; i < P->count; ++i) {
-        uint32_t gi = scene->meshes[P->patches[i].triangle];
-        const float *row = ff->matrix.dense + (size_t)i * P->count;
-        den[gi] += P->areas[i];
-        for (j = 0; j < P->count; ++j) num[(size_t)gi * G + scene->meshes[P->patches[j].triangle]] += (double)P->areas[i] * row[j];
+    fprintf(stderr, "rad %s: %u patches\n", cmd, P->count);
+    r = rad_form_factors_dense(P, &w.rc, &fo, &ctx, &ff);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_patches_destroy(P);
+        rad_tool_close_world(&w);
+        return rad_tool_fail(cmd, "rad_form_factors_dense", r);
     }
-    for (G = 0; G < scene->mesh_count; ++G)
-        for (H = 0; H < scene->mesh_count; ++H)
-            printf("%s %s %.6f\n", scene->mesh_names[G], scene->mesh_names[H], num[(size_t)G * scene->mesh_count + H] / den[G]);
+    gc = w.scene->mesh_count;
+    num = (double *)calloc((size_t)gc * gc, sizeof(double));
+    den = (double *)calloc(gc, sizeof(double));
+    if (!num || !den) { fprintf(stderr, "rad %s: out of memory\n", cmd); return 1; }
+    for (i = 0; i < P->count; ++i) {
+        uint32_t gi = w.scene->meshes[P->patches[i].triangle];
+        const float *row = ff->matrix.dense + (size_t)i * P->count;
+        double *nrow = num + (size_t)gi * gc;
+        den[gi] += P->areas[i];
+        for (j = 0; j < P->count; ++j)
+            if (row[j] != 0.0f) nrow[w.scene->meshes[P->patches[j].triangle]] += (double)P->areas[i] * row[j];
+    }
+    for (G = 0; G < gc; ++G)
+        for (H = 0; H < gc; ++H)
+            printf("%s %s %.6f\n", w.scene->mesh_names[G][0] ? w.scene->mesh_names[G] : "-",
+                   w.scene->mesh_names[H][0] ? w.scene->mesh_names[H] : "-",
+                   den[G] > 0.0 ? num[(size_t)G * gc + H] / den[G] : 0.0);
     free(num);
     free(den);
     rad_form_factors_destroy(ff);
-    rad_bvh_destroy(bvh);
     rad_patches_destroy(P);
-    rad_scene_destroy(scene);
+    rad_tool_close_world(&w);
     return 0;
 }
 
+/* ---- dispatch -------------------------------------------------------------------------- */
+
 int main(int argc, char **argv)
 {
-    if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
-        usage(argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
+    static const struct {
+        const char *name;
+        int (*fn)(int, char **);
+    } cmds[] = {{"formfactors", rad_cmd_formfactors}, {"bake", rad_cmd_bake},       {"render", rad_cmd_render},
+                {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info}};
+    size_t i;
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
     }
-    if (!strcmp(argv[1], "version")) { printf("radiosity.h %s\n", RAD_VERSION_STRING); return 0; }
-    if (!strcmp(argv[1], "formfactors")) return cmd_formfactors(argc - 2, argv + 2);
+    if (!strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        if (argc > 2 && strcmp(argv[1], "help") == 0) {
+            char *h[1];
+            h[0] = (char *)"--help";
+            for (i = 0; i < sizeof cmds / sizeof cmds[0]; ++i)
+                if (!strcmp(argv[2], cmds[i].name)) return cmds[i].fn(1, h);
+        }
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(argv[1], "version") || !strcmp(argv[1], "--version")) {
+        printf("rad (radiosity.h %s)\n", RAD_VERSION_STRING);
+        return 0;
+    }
+    for (i = 0; i < sizeof cmds / sizeof cmds[0]; ++i)
+        if (!strcmp(argv[1], cmds[i].name)) return cmds[i].fn(argc - 2, argv + 2);
     fprintf(stderr, "rad: unknown command '%s' (try 'rad help')\n", argv[1]);
     return 2;
 }

@@ -1,0 +1,330 @@
+/* cmd_bake.c - the classic radiosity solution (shared with rad render) and `rad bake`.
+
+   rad bake SCENE -o FILE.radb --method classic [--solver jacobi|gauss-seidel|direct]
+            [--bounces K] [--patches N] [--max-edge L] [--samples S] [--light-samples N]
+            [--threads N]
+
+   Way (b) of SPEC §0: the direct irradiance D of every patch (emissive triangles and the
+   file's analytic lights, with shadow rays) gives the source E = rho D; the emitters' own
+   emission stays out of the system. The solver gives the indirect light L, B = E + L, and
+   H = F B = F (E + L) is the irradiance from the secondary sources that the renderer adds to
+   its per-pixel direct light. The bake holds the patches, F, E and B (rad_save_memory), plus
+   the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
+   were made with, so `rad render --bake` can check that the file fits the scene. */
+#include "tool.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void *xcalloc(size_t n, size_t size)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p) {
+        fprintf(stderr, "rad: out of memory\n");
+        exit(1);
+    }
+    return p;
+}
+
+void rad_tool_classic_options_default(rad_tool_classic_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->patches = 2000;
+    o->max_edge = 0.0f;
+    o->samples = 16;
+    o->solver = RAD_TOOL_JACOBI;
+    o->bounces = 64;
+    o->light_samples = 16;
+}
+
+const char *rad_tool_classic_help(void)
+{
+    return "  --solver S         jacobi (default), gauss-seidel or direct (LU)\n"
+           "  --bounces K        Jacobi bounces of indirect light (default 64)\n"
+           "  --patches N        target patch count (default 2000)\n"
+           "  --max-edge L       longest patch edge (default: no limit)\n"
+           "  --samples S        form-factor points per patch pair (default 16, up to 256)\n"
+           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n";
+}
+
+int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o)
+{
+    const char *opt = argv[*a];
+    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples"};
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (!strcmp(opt, names[i])) break;
+    if (i == sizeof names / sizeof names[0]) return 0;
+    if (*a + 1 >= argc) {
+        fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+        return 2;
+    }
+    ++*a;
+    switch (i) {
+    case 0:
+        if (!strcmp(argv[*a], "jacobi")) o->solver = RAD_TOOL_JACOBI;
+        else if (!strcmp(argv[*a], "gauss-seidel") || !strcmp(argv[*a], "gs")) o->solver = RAD_TOOL_GAUSS_SEIDEL;
+        else if (!strcmp(argv[*a], "direct") || !strcmp(argv[*a], "lu")) o->solver = RAD_TOOL_DIRECT;
+        else {
+            fprintf(stderr, "rad %s: unknown solver '%s' (jacobi, gauss-seidel or direct)\n", cmd, argv[*a]);
+            return 2;
+        }
+        return 1;
+    case 1: return rad_tool_parse_uint(cmd, opt, argv[*a], &o->bounces) ? 2 : 1;
+    case 2:
+        if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->patches)) return 2;
+        if (o->patches == 0) { fprintf(stderr, "rad %s: --patches must be > 0\n", cmd); return 2; }
+        return 1;
+    case 3:
+        if (rad_tool_parse_float(cmd, opt, argv[*a], &o->max_edge)) return 2;
+        if (o->max_edge < 0.0f) { fprintf(stderr, "rad %s: --max-edge must be >= 0\n", cmd); return 2; }
+        return 1;
+    case 4:
+        if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
+        if (o->samples == 0) { fprintf(stderr, "rad %s: --samples must be > 0\n", cmd); return 2; }
+        return 1;
+    default:
+        if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
+        if (o->light_samples == 0) { fprintf(stderr, "rad %s: --light-samples must be > 0\n", cmd); return 2; }
+        return 1;
+    }
+}
+
+void rad_tool_classic_free(rad_tool_classic *c)
+{
+    rad_form_factors_destroy(c->ff);
+    rad_patches_destroy(c->patches);
+    free(c->D);
+    free(c->E);
+    free(c->L);
+    free(c->B);
+    free(c->H);
+    memset(c, 0, sizeof *c);
+}
+
+int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                           rad_tool_classic *out)
+{
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_direct_options dopt;
+    rad_solve_options so;
+    rad_solve_stats stats;
+    rad_system sys;
+    rad_context ctx;
+    rad_result r;
+    uint32_t n, i;
+    double t0;
+    memset(out, 0, sizeof *out);
+    rad_tool_context(&ctx, NULL);
+    rad_patch_options_default(&po);
+    po.target_count = o->patches;
+    po.max_edge = o->max_edge;
+    t0 = rad_tool_seconds();
+    if ((r = rad_patches_create(w->scene, &po, &ctx, &out->patches)) != RAD_SUCCESS)
+        return rad_tool_fail(cmd, "rad_patches_create", r);
+    n = out->patches->count;
+    fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w->scene->triangle_count, n);
+
+    rad_form_factor_options_default(&fo);
+    fo.samples = o->samples;
+    rad_tool_context(&ctx, "form factors");
+    r = rad_form_factors_dense(out->patches, &w->rc, &fo, &ctx, &out->ff);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_tool_classic_free(out);
+        return rad_tool_fail(cmd, "rad_form_factors_dense", r);
+    }
+    fprintf(stderr, "rad %s: form factors %u x %u (%.1f MB) in %.2f s\n", cmd, n, n, 4.0 * n * (double)n / 1e6,
+            rad_tool_seconds() - t0);
+
+    out->D = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    out->E = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    out->L = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    out->B = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    out->H = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    t0 = rad_tool_seconds();
+    rad_direct_options_default(&dopt);
+    dopt.include_emitters = 1;
+    dopt.light_samples = o->light_samples;
+    rad_tool_context(&ctx, "direct light");
+    r = rad_direct_patches(out->patches, &w->rc, w->file.lights, w->file.light_count, &dopt, out->D, &ctx);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_tool_classic_free(out);
+        return rad_tool_fail(cmd, "rad_direct_patches", r);
+    }
+    /* E = rho D: direct light is the source, emission stays out of the system (SPEC §0 (b)) */
+    if ((r = rad_sources(out->patches, RAD_SOURCE_DIRECT, out->D, out->E)) != RAD_SUCCESS) {
+        rad_tool_classic_free(out);
+        return rad_tool_fail(cmd, "rad_sources", r);
+    }
+
+    rad_system_init(&sys, &out->ff->matrix, out->patches, out->E);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    so.bounces = o->bounces;
+    memset(&stats, 0, sizeof stats);
+    rad_tool_context(&ctx, "solve");
+    switch (o->solver) {
+    case RAD_TOOL_GAUSS_SEIDEL:
+        r = rad_solve_gauss_seidel(&sys, &so, out->L, &stats, &ctx);
+        if (r == RAD_ERROR_NOT_CONVERGED) {
+            fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge (residual %g after %u sweeps)\n", cmd,
+                    stats.residual, stats.iterations);
+            r = RAD_SUCCESS;
+        }
+        break;
+    case RAD_TOOL_DIRECT: r = rad_solve_direct(&sys, &so, out->L, &ctx); break;
+    default: r = rad_solve_jacobi(&sys, &so, out->L, &stats, &ctx); break;
+    }
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_tool_classic_free(out);
+        return rad_tool_fail(cmd, "solve", r);
+    }
+    for (i = 0; i < 3 * n; ++i) out->B[i] = out->E[i] + out->L[i];
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_matrix_multiply(&out->ff->matrix, out->B, out->H, &ctx)) != RAD_SUCCESS) {
+        rad_tool_classic_free(out);
+        return rad_tool_fail(cmd, "rad_matrix_multiply", r);
+    }
+    fprintf(stderr, "rad %s: direct light and %s solve in %.2f s\n", cmd,
+            o->solver == RAD_TOOL_GAUSS_SEIDEL ? "Gauss-Seidel" : o->solver == RAD_TOOL_DIRECT ? "direct (LU)" : "Jacobi",
+            rad_tool_seconds() - t0);
+    return 0;
+}
+
+/* rad_save_memory's container plus our sections, written to 'path' */
+static int save_bake(const char *cmd, const char *path, const rad_tool_world *w, const rad_tool_classic_options *o,
+                     const rad_tool_classic *c)
+{
+    rad_context ctx;
+    void *buf = NULL, *dst = NULL;
+    size_t size = 0, dst_size = 0;
+    rad_container *ct = NULL;
+    rad_section *secs;
+    rad_tool_bake_info info;
+    uint32_t count, i, k = 0, n = c->patches->count;
+    rad_result r;
+    FILE *f;
+    int rc = 1;
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_save_memory(c->patches, &c->ff->matrix, c->E, c->B, &ctx, &buf, &size)) != RAD_SUCCESS)
+        return rad_tool_fail(cmd, "rad_save_memory", r);
+    if ((r = rad_container_open(buf, size, &ctx, &ct)) != RAD_SUCCESS) {
+        rad_free_buffer(buf, &ctx);
+        return rad_tool_fail(cmd, "rad_container_open", r);
+    }
+    count = rad_container_section_count(ct);
+    secs = (rad_section *)xcalloc((size_t)count + 4, sizeof(rad_section));
+    for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
+    memset(&info, 0, sizeof info);
+    info.magic = 0x52414442u;
+    info.patches = o->patches;
+    info.max_edge = o->max_edge;
+    info.samples = o->samples;
+    info.solver = (uint32_t)o->solver;
+    info.bounces = o->bounces;
+    info.light_samples = o->light_samples;
+    info.triangle_count = w->scene->triangle_count;
+    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->L;
+    strcpy(secs[k++].name, "L");
+    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->H;
+    strcpy(secs[k++].name, "H");
+    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->D;
+    strcpy(secs[k++].name, "D");
+    secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
+    strcpy(secs[k++].name, "rad.options");
+    if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_container_size", r);
+        goto done;
+    }
+    dst = xcalloc(dst_size, 1);
+    if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_container_write", r);
+        goto done;
+    }
+    f = fopen(path, "wb");
+    if (!f) {
+        fprintf(stderr, "rad %s: cannot write '%s'\n", cmd, path);
+        goto done;
+    }
+    if (fwrite(dst, 1, dst_size, f) != dst_size || fclose(f) != 0) {
+        fprintf(stderr, "rad %s: error writing '%s'\n", cmd, path);
+        goto done;
+    }
+    printf("wrote %s: %u patches, %u sections, %lu bytes\n", path, n, k, (unsigned long)dst_size);
+    rc = 0;
+done:
+    free(dst);
+    free(secs);
+    rad_container_close(ct);
+    rad_free_buffer(buf, &ctx);
+    return rc;
+}
+
+static void bake_usage(FILE *f)
+{
+    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic] [options]\n"
+               "Computes patches, form factors, the patches' direct light E = rho D and the indirect\n"
+               "solution L, and saves patches, F, E, B = E + L (and L, H = F B, D) in a .radb container.\n"
+               "  -o FILE            output file (required)\n"
+               "  --method classic   the only baking method (pathtrace needs no bake)\n"
+               "%s"
+               "  --threads N        worker threads (default: all)\n",
+            rad_tool_classic_help());
+}
+
+int rad_cmd_bake(int argc, char **argv)
+{
+    const char *cmd = "bake", *scene_name = NULL, *out_path = NULL;
+    rad_tool_classic_options o;
+    rad_tool_world w;
+    rad_tool_classic c;
+    uint32_t threads = 0;
+    double t0 = rad_tool_seconds();
+    int a, rc;
+    rad_tool_classic_options_default(&o);
+    for (a = 0; a < argc; ++a) {
+        const char *opt = argv[a];
+        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { bake_usage(stdout); return 0; }
+        rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        if ((!strcmp(opt, "-o") || !strcmp(opt, "--method") || !strcmp(opt, "--threads")) && a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+            return 2;
+        }
+        if (!strcmp(opt, "-o")) out_path = argv[++a];
+        else if (!strcmp(opt, "--method")) {
+            ++a;
+            if (strcmp(argv[a], "classic") != 0) {
+                fprintf(stderr, "rad %s: method '%s' cannot be baked (only 'classic')\n", cmd, argv[a]);
+                return 2;
+            }
+        } else if (!strcmp(opt, "--threads")) {
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
+        } else if (opt[0] == '-' && opt[1]) {
+            fprintf(stderr, "rad %s: unknown option '%s' (see rad bake --help)\n", cmd, opt);
+            return 2;
+        } else if (!scene_name) scene_name = opt;
+        else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
+    }
+    if (!scene_name || !out_path) {
+        fprintf(stderr, "rad %s: %s\n", cmd, !scene_name ? "no scene given" : "no output file given (-o FILE.radb)");
+        bake_usage(stderr);
+        return 2;
+    }
+    rad_tool_set_threads((int)threads);
+    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_classic_solve(cmd, &w, &o, &c)) {
+        rad_tool_close_world(&w);
+        return 1;
+    }
+    rc = save_bake(cmd, out_path, &w, &o, &c);
+    rad_tool_classic_free(&c);
+    rad_tool_close_world(&w);
+    if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    return rc;
+}

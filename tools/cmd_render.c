@@ -1,0 +1,455 @@
+/* cmd_render.c - `rad render`: an image of a scene by the classic radiosity method (per-pixel
+   direct light + indirect light from the patches) or by path tracing.
+
+   Classic (SPEC §0 way (b), as examples/cornell.c): a camera ray per sample finds the surface;
+   the direct irradiance D is computed at that point with shadow rays (rad_direct_irradiance:
+   the emissive triangles analytically times the unoccluded fraction, plus the file's analytic
+   lights); H = F (E + L) = F B, the irradiance from the secondary sources, is smoothed to the
+   patch vertices and interpolated; the sample's radiance is albedo/pi * (D + H), plus the
+   emitted radiance where the ray sees the front of an emitter. Each pixel is the box-filtered
+   mean of --aa stratified samples. The solution is computed in memory, or loaded from a bake
+   (--bake FILE.radb: its patches, F, E and B, checked against the scene). */
+#include "tool.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI_F 3.14159265358979323846f
+
+static void *xmalloc(size_t size)
+{
+    void *p = malloc(size ? size : 1);
+    if (!p) {
+        fprintf(stderr, "rad render: out of memory (%lu bytes)\n", (unsigned long)size);
+        exit(1);
+    }
+    return p;
+}
+
+static void render_usage(FILE *f)
+{
+    fprintf(f,
+            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|pathtrace] [options]\n"
+            "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
+            "  --method M         classic (default: radiosity + per-pixel direct light) or pathtrace\n"
+            "  --bake FILE.radb   classic: use a bake made by 'rad bake' instead of solving here\n"
+            "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
+            "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
+            "  --size WxH         image size (default 512x512)\n"
+            "  --aa N             classic: stratified samples per pixel, rounded down to a square (default 16)\n"
+            "  --spp N            pathtrace: samples per pixel (default 64)\n"
+            "  --seed S           pathtrace: random seed (default 0)\n"
+            "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
+            "  --pixel-light-samples N   classic: shadow rays per pixel sample and light (default 16)\n"
+            "classic solution options (ignored with --bake, which keeps its own):\n"
+            "%s"
+            "  --threads N        worker threads (default: all)\n",
+            rad_tool_classic_help());
+}
+
+/* Per-vertex H, with the halo fix of examples/cornell.c step 7: a patch partly covered (under
+   the light, under a block) has a small H only because part of it sees nothing; H is
+   interpolated as (mean radiosity seen) x (how much is seen, from uncovered patches). */
+static int vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, float *Hv)
+{
+    uint32_t n = P->count, nv = P->vertex_count, i, k;
+    float *ones = (float *)xmalloc(sizeof(float) * 3 * n), *rs = (float *)xmalloc(sizeof(float) * 3 * n);
+    float *S = (float *)xmalloc(sizeof(float) * n), *S_v = (float *)xmalloc(sizeof(float) * nv);
+    float *S_max = (float *)xmalloc(sizeof(float) * nv), *S_area = (float *)xmalloc(sizeof(float) * nv);
+    rad_context ctx;
+    rad_result r;
+    rad_tool_context(&ctx, NULL);
+    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
+    r = rad_matrix_multiply(F, ones, rs, &ctx);
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < n; ++i) S[i] = rs[3 * i];
+        r = rad_patches_vertex_values(P, H, 3, Hv);
+    }
+    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(P, S, 1, S_v);
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = P->patches[i].vertices[k];
+                if (S[i] > S_max[v]) S_max[v] = S[i];
+            }
+        for (i = 0; i < nv; ++i) {
+            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
+            Hv[3 * i] *= scale, Hv[3 * i + 1] *= scale, Hv[3 * i + 2] *= scale;
+            S_v[i] = 0.0f;
+        }
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = P->patches[i].vertices[k];
+                if (S[i] >= 0.75f * S_max[v]) {
+                    S_v[v] += P->patches[i].area * S[i];
+                    S_area[v] += P->patches[i].area;
+                }
+            }
+        for (i = 0; i < nv; ++i) {
+            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
+            Hv[3 * i] *= s_v, Hv[3 * i + 1] *= s_v, Hv[3 * i + 2] *= s_v;
+        }
+    }
+    free(ones);
+    free(rs);
+    free(S);
+    free(S_v);
+    free(S_max);
+    free(S_area);
+    return r == RAD_SUCCESS ? 0 : rad_tool_fail("render", "per-vertex H", r);
+}
+
+typedef struct isect_job {
+    const rad_raycaster *rc;
+    const rad_ray *rays;
+    rad_hit *hits;
+    uint32_t count;
+    int failed;
+} isect_job;
+
+static int render_classic(const rad_tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
+                          int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
+{
+    const rad_scene *scene = w->scene;
+    uint32_t strata, spp;
+    size_t batch_cap, total = (size_t)width * height, done_px = 0;
+    rad_ray *rays;
+    rad_hit *hits;
+    float *points, *normals, *irr;
+    uint32_t *valid;
+    rad_direct_options dopt;
+    rad_context quiet;
+    int y0, rows_per_batch, result = 0;
+    for (strata = 1; (strata + 1) * (strata + 1) <= aa; ++strata) {
+    }
+    spp = strata * strata;
+    rows_per_batch = (int)(65536 / ((size_t)width * spp));
+    if (rows_per_batch < 1) rows_per_batch = 1;
+    batch_cap = (size_t)rows_per_batch * width * spp;
+    rays = (rad_ray *)xmalloc(sizeof(rad_ray) * batch_cap);
+    hits = (rad_hit *)xmalloc(sizeof(rad_hit) * batch_cap);
+    points = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
+    rad_direct_options_default(&dopt);
+    dopt.include_emitters = 1;
+    dopt.light_samples = light_samples;
+    rad_tool_context(&quiet, NULL);
+
+    for (y0 = 0; y0 < height && result == 0; y0 += rows_per_batch) {
+        int y1 = y0 + rows_per_batch < height ? y0 + rows_per_batch : height, chunk, nchunks;
+        uint32_t count = 0, nvalid = 0, k, i;
+        int x, y;
+        uint32_t s;
+        rad_result r;
+        for (y = y0; y < y1; ++y)
+            for (x = 0; x < width; ++x)
+                for (s = 0; s < spp; ++s) {
+                    float px = (float)x + ((float)(s % strata) + 0.5f) / (float)strata;
+                    float py = (float)y + ((float)(s / strata) + 0.5f) / (float)strata;
+                    rad_camera_ray(cam, (uint32_t)width, (uint32_t)height, px, py, &rays[count++]);
+                }
+        /* primary rays in parallel chunks (the raycaster is thread-safe) */
+        nchunks = (int)((count + 4095) / 4096);
+        {
+            int failed = 0;
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+#endif
+            for (chunk = 0; chunk < nchunks; ++chunk) {
+                uint32_t b = (uint32_t)chunk * 4096u, e = b + 4096u < count ? b + 4096u : count;
+                if (w->rc.intersect(w->rc.user, rays + b, e - b, hits + b) != RAD_SUCCESS) failed |= 1;
+            }
+            if (failed) {
+                result = rad_tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
+                break;
+            }
+        }
+        for (k = 0; k < count; ++k) {
+            uint32_t t = hits[k].triangle;
+            const float *v, *nt;
+            if (t == RAD_NONE) continue;
+            nt = scene->normals + 3 * (size_t)t;
+            if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] >= 0.0f) {
+                hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
+                continue;
+            }
+            v = scene->positions + 9 * (size_t)t;
+            for (i = 0; i < 3; ++i) {
+                points[3 * nvalid + i] = v[i] + hits[k].b1 * (v[3 + i] - v[i]) + hits[k].b2 * (v[6 + i] - v[i]);
+                normals[3 * nvalid + i] = nt[i];
+            }
+            valid[nvalid++] = k;
+        }
+        if (nvalid > 0) {
+            r = rad_direct_irradiance(scene, &w->rc, w->file.lights, w->file.light_count, &dopt, points, normals, nvalid,
+                                      irr, &quiet);
+            if (r != RAD_SUCCESS) {
+                result = rad_tool_fail("render", "rad_direct_irradiance", r);
+                break;
+            }
+        }
+        for (k = 0; k < nvalid; ++k) {
+            uint32_t ray = valid[k];
+            size_t pixel = (size_t)y0 * width + ray / spp;
+            const rad_hit *h = &hits[ray];
+            const rad_material *m = &scene->materials_table[scene->materials[h->triangle]];
+            float albedo[3], wts[3];
+            uint32_t p = rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
+            const uint32_t *vi;
+            if (p == RAD_NONE) continue;
+            vi = P->patches[p].vertices;
+            rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
+            for (i = 0; i < 3; ++i) {
+                float hi = wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
+                           wts[2] * Hv[3 * (size_t)vi[2] + i];
+                img->rgb[3 * pixel + i] += albedo[i] / PI_F * (irr[3 * k + i] + hi) + m->emission[i];
+            }
+        }
+        done_px += (size_t)(y1 - y0) * width;
+        rad_tool_progress((void *)(size_t)"render", (float)((double)done_px / (double)total));
+    }
+    rad_tool_progress_end();
+    {
+        size_t q;
+        float inv = 1.0f / (float)spp;
+        for (q = 0; q < 3 * total; ++q) img->rgb[q] *= inv;
+    }
+    free(rays);
+    free(hits);
+    free(points);
+    free(normals);
+    free(irr);
+    free(valid);
+    return result;
+}
+
+/* the bake's options section, or NULL */
+static const rad_tool_bake_info *bake_info(const rad_bake *bake)
+{
+    const rad_section *s = rad_container_find(bake->container, RAD_TOOL_SECTION_OPTIONS, "rad.options");
+    const rad_tool_bake_info *info;
+    if (!s || s->elem_size != sizeof(rad_tool_bake_info) || s->count != 1) return NULL;
+    info = (const rad_tool_bake_info *)s->data;
+    return info->magic == 0x52414442u ? info : NULL;
+}
+
+int rad_cmd_render(int argc, char **argv)
+{
+    const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method = "classic";
+    rad_tool_classic_options o;
+    rad_tool_world w;
+    rad_camera cam;
+    rad_image img;
+    rad_context ctx;
+    int width = 512, height = 512, a, rc, have_cam = 0, pathtrace;
+    uint32_t aa = 16, spp = 64, seed = 0, threads = 0, pixel_light_samples = 16;
+    float fov = 0.0f, exposure = 1.0f;
+    double t0 = rad_tool_seconds();
+    rad_tool_classic_options_default(&o);
+    memset(&img, 0, sizeof img);
+    for (a = 0; a < argc; ++a) {
+        const char *opt = argv[a];
+        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { render_usage(stdout); return 0; }
+        rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        if (opt[0] == '-' && opt[1] && a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value (or is unknown; see rad render --help)\n", cmd, opt);
+            return 2;
+        }
+        if (!strcmp(opt, "-o")) out_path = argv[++a];
+        else if (!strcmp(opt, "--bake")) bake_path = argv[++a];
+        else if (!strcmp(opt, "--method")) method = argv[++a];
+        else if (!strcmp(opt, "--camera")) {
+            if (rad_tool_parse_camera(argv[++a], &cam)) {
+                fprintf(stderr, "rad %s: bad camera '%s' (want PX,PY,PZ:TX,TY,TZ:UX,UY,UZ)\n", cmd, argv[a]);
+                return 2;
+            }
+            have_cam = 1;
+        } else if (!strcmp(opt, "--fov")) {
+            if (rad_tool_parse_float(cmd, opt, argv[++a], &fov)) return 2;
+            if (!(fov > 0.0f && fov < 180.0f)) { fprintf(stderr, "rad %s: --fov must be in (0, 180)\n", cmd); return 2; }
+        } else if (!strcmp(opt, "--size")) {
+            if (rad_tool_parse_size(argv[++a], &width, &height)) {
+                fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, argv[a]);
+                return 2;
+            }
+        } else if (!strcmp(opt, "--aa")) {
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
+            if (aa == 0) { fprintf(stderr, "rad %s: --aa must be > 0\n", cmd); return 2; }
+        } else if (!strcmp(opt, "--spp")) {
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], &spp)) return 2;
+            if (spp == 0 || spp > 1u << 20) { fprintf(stderr, "rad %s: --spp must be in 1..1048576\n", cmd); return 2; }
+        } else if (!strcmp(opt, "--seed")) {
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], &seed)) return 2;
+        } else if (!strcmp(opt, "--pixel-light-samples")) {
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
+            if (pixel_light_samples == 0) { fprintf(stderr, "rad %s: %s must be > 0\n", cmd, opt); return 2; }
+        } else if (!strcmp(opt, "--exposure")) {
+            if (rad_tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
+            if (!(exposure > 0.0f)) { fprintf(stderr, "rad %s: --exposure must be > 0\n", cmd); return 2; }
+        } else if (!strcmp(opt, "--threads")) {
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
+        } else if (opt[0] == '-' && opt[1]) {
+            fprintf(stderr, "rad %s: unknown option '%s' (see rad render --help)\n", cmd, opt);
+            return 2;
+        } else if (!scene_name) scene_name = opt;
+        else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
+    }
+    if (!scene_name || !out_path) {
+        fprintf(stderr, "rad %s: %s\n", cmd, !scene_name ? "no scene given" : "no output file given (-o OUT.png|OUT.pfm)");
+        render_usage(stderr);
+        return 2;
+    }
+    if (strcmp(method, "classic") != 0 && strcmp(method, "pathtrace") != 0) {
+        fprintf(stderr, "rad %s: unknown method '%s' (classic or pathtrace)\n", cmd, method);
+        return 2;
+    }
+    pathtrace = !strcmp(method, "pathtrace");
+    if (pathtrace && bake_path) {
+        fprintf(stderr, "rad %s: --bake is for --method classic\n", cmd);
+        return 2;
+    }
+    {
+        size_t l = strlen(out_path);
+        if (l < 4 || (strcmp(out_path + l - 4, ".png") && strcmp(out_path + l - 4, ".pfm") &&
+                      strcmp(out_path + l - 4, ".PNG") && strcmp(out_path + l - 4, ".PFM"))) {
+            fprintf(stderr, "rad %s: output '%s' must end in .png or .pfm\n", cmd, out_path);
+            return 2;
+        }
+    }
+    rad_tool_set_threads((int)threads);
+    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (!have_cam) cam = w.file.camera;
+    else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
+    if (fov > 0.0f) cam.fov_y_degrees = fov;
+    if (rad_image_alloc(&img, width, height) != 0) {
+        fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
+        rad_tool_close_world(&w);
+        return 1;
+    }
+
+    if (pathtrace) {
+        rad_trace_options to;
+        rad_result r;
+        rad_trace_options_default(&to);
+        to.width = width;
+        to.height = height;
+        to.spp = (int)spp;
+        to.seed = seed;
+        rad_tool_context(&ctx, "path tracing");
+        r = (rad_result)rad_trace_image(w.scene, &w.rc, w.file.lights, w.file.light_count, &cam, &to, &ctx, &img);
+        rad_tool_progress_end();
+        if (r != RAD_SUCCESS) {
+            rad_image_free(&img);
+            rad_tool_close_world(&w);
+            return rad_tool_fail(cmd, "rad_trace_image", r);
+        }
+    } else {
+        rad_tool_classic sol;
+        rad_bake *bake = NULL;
+        const rad_patches *P;
+        const float *H;
+        float *Hv, *Hmine = NULL;
+        memset(&sol, 0, sizeof sol);
+        if (bake_path) {
+            const rad_tool_bake_info *info;
+            const rad_section *hs;
+            rad_result r;
+            rad_tool_context(&ctx, NULL);
+            if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
+                fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
+                rad_image_free(&img);
+                rad_tool_close_world(&w);
+                return 1;
+            }
+            info = bake_info(bake);
+            rc = 0;
+            if (bake->patches.triangle_count != w.scene->triangle_count) {
+                fprintf(stderr, "rad %s: bake '%s' was made from a scene of %u triangles, this one has %u\n", cmd,
+                        bake_path, bake->patches.triangle_count, w.scene->triangle_count);
+                rc = 1;
+            } else if (bake->F.rows == 0 || !bake->B) {
+                fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B\n", cmd, bake_path);
+                rc = 1;
+            } else if (info) {
+                /* the same patch options on this scene must give the same patches */
+                rad_patch_options po;
+                rad_patches *check = NULL;
+                rad_patch_options_default(&po);
+                po.target_count = info->patches;
+                po.max_edge = info->max_edge;
+                if ((r = rad_patches_create(w.scene, &po, &ctx, &check)) != RAD_SUCCESS) {
+                    rc = rad_tool_fail(cmd, "rad_patches_create", r);
+                } else if (check->count != bake->patches.count) {
+                    fprintf(stderr, "rad %s: bake '%s' has %u patches; this scene with its options (--patches %u) gives %u: "
+                                    "not the scene it was baked from\n",
+                            cmd, bake_path, bake->patches.count, info->patches, check->count);
+                    rc = 1;
+                }
+                rad_patches_destroy(check);
+            } else {
+                fprintf(stderr, "rad %s: warning: bake '%s' has no rad.options section; its patches are used as they are\n",
+                        cmd, bake_path);
+            }
+            if (rc) {
+                rad_bake_destroy(bake);
+                rad_image_free(&img);
+                rad_tool_close_world(&w);
+                return 1;
+            }
+            bake->patches.scene = w.scene;
+            P = &bake->patches;
+            hs = rad_container_find(bake->container, RAD_SECTION_VECTOR, "H");
+            if (hs && hs->elem_size == 12 && hs->count == P->count) {
+                H = (const float *)hs->data;
+            } else {
+                /* H = F (E + L) = F B */
+                Hmine = (float *)xmalloc(sizeof(float) * 3 * P->count);
+                if ((r = rad_matrix_multiply(&bake->F, bake->B, Hmine, &ctx)) != RAD_SUCCESS) {
+                    free(Hmine);
+                    rad_bake_destroy(bake);
+                    rad_image_free(&img);
+                    rad_tool_close_world(&w);
+                    return rad_tool_fail(cmd, "rad_matrix_multiply", r);
+                }
+                H = Hmine;
+            }
+            fprintf(stderr, "rad %s: bake '%s': %u patches\n", cmd, bake_path, P->count);
+        } else {
+            if (rad_tool_classic_solve(cmd, &w, &o, &sol)) {
+                rad_image_free(&img);
+                rad_tool_close_world(&w);
+                return 1;
+            }
+            P = sol.patches;
+            H = sol.H;
+        }
+        Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
+        rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
+        if (rc == 0) rc = render_classic(&w, P, Hv, &cam, width, height, aa, pixel_light_samples, &img);
+        free(Hv);
+        free(Hmine);
+        rad_bake_destroy(bake);
+        rad_tool_classic_free(&sol);
+        if (rc) {
+            rad_image_free(&img);
+            rad_tool_close_world(&w);
+            return 1;
+        }
+    }
+    if (rad_image_write(out_path, &img, exposure) != 0) {
+        fprintf(stderr, "rad %s: cannot write '%s'\n", cmd, out_path);
+        rad_image_free(&img);
+        rad_tool_close_world(&w);
+        return 1;
+    }
+    printf("wrote %s (%dx%d, %s) in %.2f s\n", out_path, width, height, method, rad_tool_seconds() - t0);
+    rad_image_free(&img);
+    rad_tool_close_world(&w);
+    return 0;
+}

@@ -1,0 +1,592 @@
+/* import.c - scenes for the rad tool: the built-in Cornell box, or any file assimp reads
+   (OBJ+MTL, glTF 2.0, FBX, PLY ...).
+
+   Geometry: assimp triangulates and joins identical vertices; the node graph is walked here
+   (instead of aiProcess_PreTransformVertices, which merges meshes of the same material and so
+   loses object names), every mesh's vertices are transformed by its node's accumulated
+   matrix, and meshes are grouped by name (the mesh's own name, else its node's name) into one
+   rad_mesh_desc per name, so `o floor` / `g floor` in an OBJ becomes the mesh "floor" even
+   when it uses several materials.
+   Materials: albedo = Kd / glTF base colour (times the base-colour texture, sRGB-decoded, when
+   there is one and the mesh has uvs: sampled through the albedo callback), clamped into
+   [0, 0.999] with a warning; emission = Ke / glTF emissive x emissive strength, as radiance.
+   Lights: point, spot and directional lights of the file become rad_light (their node's
+   transform applied). Camera: the file's first camera, else a default framing. */
+#include "tool.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#endif
+#include <assimp/cimport.h>
+#include <assimp/scene.h>
+#include <assimp/postprocess.h>
+#include <assimp/material.h>
+#define STB_IMAGE_STATIC /* private copy: image.c has its own */
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+/* stb_image.h with STB_IMAGE_STATIC declares stbi_set_unpremultiply_on_load_thread static and
+   never defines it: GCC reports that at the end of the file, outside the push/pop above */
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
+
+#define ALBEDO_MAX 0.999f
+
+typedef struct imp_texture {
+    int width, height;
+    float *rgb;           /* linear */
+    char path[256];
+} imp_texture;
+
+typedef struct imp_group {
+    char *name;
+    float *positions;     /* 3 per vertex */
+    float *uvs;           /* 2 per vertex, or NULL */
+    uint32_t *indices;
+    uint32_t *material_ids;
+    uint32_t vertex_count, vertex_cap;
+    uint32_t triangle_count, triangle_cap;
+    int any_uv;
+} imp_group;
+
+typedef struct imp_storage {
+    rad_mesh_desc *meshes;
+    imp_group *groups;
+    uint32_t group_count, group_cap;
+    rad_material *materials;
+    uint32_t material_count;
+    imp_texture *textures;
+    uint32_t texture_count;
+    int builtin;
+} imp_storage;
+
+static void set_err(char *err, size_t errlen, const char *fmt, const char *a, const char *b)
+{
+    if (err && errlen) snprintf(err, errlen, fmt, a ? a : "", b ? b : "");
+}
+
+static float srgb_to_linear(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+/* bilinear, repeat wrap, v up (assimp's convention: v = 0 is the bottom row of the image) */
+static void albedo_lookup(void *user, uint32_t texture, float u, float v, float out_rgb[3])
+{
+    const imp_storage *st = (const imp_storage *)user;
+    const imp_texture *t;
+    float x, y, fx, fy;
+    int x0, y0, x1, y1, c;
+    if (texture == 0 || texture > st->texture_count) { out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.5f; return; }
+    t = &st->textures[texture - 1];
+    if (!(u == u)) u = 0.0f; /* NaN */
+    if (!(v == v)) v = 0.0f;
+    u -= floorf(u);
+    v -= floorf(v);
+    x = u * (float)t->width - 0.5f;
+    y = (1.0f - v) * (float)t->height - 0.5f;
+    fx = x - floorf(x);
+    fy = y - floorf(y);
+    x0 = (int)floorf(x);
+    y0 = (int)floorf(y);
+    x0 = ((x0 % t->width) + t->width) % t->width;
+    y0 = ((y0 % t->height) + t->height) % t->height;
+    x1 = (x0 + 1) % t->width;
+    y1 = (y0 + 1) % t->height;
+    for (c = 0; c < 3; ++c) {
+        float a = t->rgb[3 * ((size_t)y0 * t->width + x0) + c], b = t->rgb[3 * ((size_t)y0 * t->width + x1) + c];
+        float d = t->rgb[3 * ((size_t)y1 * t->width + x0) + c], e = t->rgb[3 * ((size_t)y1 * t->width + x1) + c];
+        float val = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
+        out_rgb[c] = val < 0.0f ? 0.0f : (val > ALBEDO_MAX ? ALBEDO_MAX : val);
+    }
+}
+
+static void *xrealloc(void *p, size_t size)
+{
+    void *q = realloc(p, size ? size : 1);
+    if (!q) {
+        fprintf(stderr, "rad: out of memory\n");
+        exit(1);
+    }
+    return q;
+}
+
+static char *xstrdup(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = (char *)xrealloc(NULL, n);
+    memcpy(d, s, n);
+    return d;
+}
+
+static void free_storage(imp_storage *st)
+{
+    uint32_t i;
+    if (!st) return;
+    for (i = 0; i < st->group_count; ++i) {
+        free(st->groups[i].name);
+        free(st->groups[i].positions);
+        free(st->groups[i].uvs);
+        free(st->groups[i].indices);
+        free(st->groups[i].material_ids);
+    }
+    for (i = 0; i < st->texture_count; ++i) free(st->textures[i].rgb);
+    free(st->groups);
+    free(st->meshes);
+    free(st->materials);
+    free(st->textures);
+    free(st);
+}
+
+void rad_tool_free_scene(rad_tool_scene *scene)
+{
+    if (!scene) return;
+    free_storage((imp_storage *)scene->storage);
+    free(scene->lights);
+    memset(scene, 0, sizeof *scene);
+}
+
+/* ---- textures ---------------------------------------------------------------------------- */
+
+static const char *base_dir_join(const char *file, const char *rel, char *buf, size_t buflen)
+{
+    const char *slash = strrchr(file, '/');
+    size_t dl = slash ? (size_t)(slash - file + 1) : 0, rl = strlen(rel);
+    if (rel[0] == '/') dl = 0;
+    if (dl + rl + 1 > buflen) {
+        buf[0] = 0;
+        return buf;
+    }
+    memcpy(buf, file, dl);
+    memcpy(buf + dl, rel, rl + 1);
+    return buf;
+}
+
+/* index+1 of the texture, 0 when it cannot be loaded (warns) */
+static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const char *file, const char *tpath)
+{
+    unsigned char *px = NULL;
+    int w = 0, h = 0, comp = 0;
+    uint32_t i;
+    char full[1024];
+    imp_texture *t;
+    for (i = 0; i < st->texture_count; ++i)
+        if (!strncmp(st->textures[i].path, tpath, sizeof st->textures[i].path - 1)) return i + 1;
+    if (tpath[0] == '*') {
+        unsigned idx = (unsigned)atoi(tpath + 1);
+        if (idx < sc->mNumTextures) {
+            const struct aiTexture *tex = sc->mTextures[idx];
+            if (tex->mHeight == 0) {
+                px = stbi_load_from_memory((const unsigned char *)tex->pcData, (int)tex->mWidth, &w, &h, &comp, 3);
+            } else {
+                size_t k, n = (size_t)tex->mWidth * tex->mHeight;
+                w = (int)tex->mWidth;
+                h = (int)tex->mHeight;
+                px = (unsigned char *)malloc(3 * n);
+                if (px)
+                    for (k = 0; k < n; ++k) {
+                        px[3 * k] = tex->pcData[k].r;
+                        px[3 * k + 1] = tex->pcData[k].g;
+                        px[3 * k + 2] = tex->pcData[k].b;
+                    }
+            }
+        }
+    } else {
+        for (i = 0; i < sc->mNumTextures && !px; ++i) /* embedded, named by its file name */
+            if (sc->mTextures[i]->mHeight == 0 && !strcmp(sc->mTextures[i]->mFilename.data, tpath))
+                px = stbi_load_from_memory((const unsigned char *)sc->mTextures[i]->pcData, (int)sc->mTextures[i]->mWidth,
+                                           &w, &h, &comp, 3);
+        if (!px) px = stbi_load(base_dir_join(file, tpath, full, sizeof full), &w, &h, &comp, 3);
+    }
+    if (!px || w <= 0 || h <= 0) {
+        fprintf(stderr, "rad: warning: texture '%s' could not be loaded (%s); using the material colour\n", tpath,
+                stbi_failure_reason() ? stbi_failure_reason() : "unknown");
+        if (px) stbi_image_free(px);
+        return 0;
+    }
+    st->textures = (imp_texture *)xrealloc(st->textures, sizeof(imp_texture) * (st->texture_count + 1));
+    t = &st->textures[st->texture_count];
+    memset(t, 0, sizeof *t);
+    {
+        size_t pl = strlen(tpath);
+        if (pl >= sizeof t->path) pl = sizeof t->path - 1;
+        memcpy(t->path, tpath, pl);
+        t->path[pl] = 0;
+    }
+    t->width = w;
+    t->height = h;
+    t->rgb = (float *)xrealloc(NULL, sizeof(float) * 3 * (size_t)w * (size_t)h);
+    {
+        float lut[256];
+        size_t k, n = 3 * (size_t)w * (size_t)h;
+        for (i = 0; i < 256; ++i) lut[i] = srgb_to_linear((float)i / 255.0f);
+        for (k = 0; k < n; ++k) t->rgb[k] = lut[px[k]];
+    }
+    stbi_image_free(px);
+    return ++st->texture_count;
+}
+
+/* ---- materials --------------------------------------------------------------------------- */
+
+static void convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
+                             rad_material *out, int *warned_clamp)
+{
+    struct aiColor4D c;
+    struct aiString name, tpath;
+    float strength = 1.0f, scale[3] = {1, 1, 1};
+    ai_real fv;
+    unsigned int one = 1;
+    int k, have_base = 0, clamped = 0;
+    memset(out, 0, sizeof *out);
+    out->albedo[0] = out->albedo[1] = out->albedo[2] = 0.5f;
+    if (aiGetMaterialColor(m, AI_MATKEY_BASE_COLOR, &c) == aiReturn_SUCCESS) {
+        out->albedo[0] = c.r, out->albedo[1] = c.g, out->albedo[2] = c.b;
+        have_base = 1;
+    }
+    if (!have_base && aiGetMaterialColor(m, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS)
+        out->albedo[0] = c.r, out->albedo[1] = c.g, out->albedo[2] = c.b;
+    if (aiGetMaterialColor(m, AI_MATKEY_COLOR_EMISSIVE, &c) == aiReturn_SUCCESS)
+        out->emission[0] = c.r, out->emission[1] = c.g, out->emission[2] = c.b;
+    if (aiGetMaterialFloatArray(m, AI_MATKEY_EMISSIVE_INTENSITY, &fv, &one) == aiReturn_SUCCESS && fv >= 0) strength = (float)fv;
+    for (k = 0; k < 3; ++k) {
+        out->emission[k] *= strength;
+        if (!(out->emission[k] >= 0.0f) || out->emission[k] > 1e30f) out->emission[k] = 0.0f;
+    }
+    if (aiGetMaterialString(m, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS) name.length = 0, name.data[0] = 0;
+    /* texture: base colour (glTF) or diffuse (OBJ map_Kd ...) */
+    if (aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
+        aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) {
+        uint32_t id = load_texture(st, sc, file, tpath.data);
+        if (id) {
+            /* the texture is multiplied by the colour factor (glTF, MTL); bake the factor into
+               a private copy of the texels so the callback stays a plain lookup */
+            imp_texture *t = &st->textures[id - 1];
+            size_t q, n = (size_t)t->width * t->height;
+            for (k = 0; k < 3; ++k) scale[k] = out->albedo[k];
+            if (!(scale[0] == 1.0f && scale[1] == 1.0f && scale[2] == 1.0f)) {
+                /* a new texture entry for this factor */
+                st->textures = (imp_texture *)xrealloc(st->textures, sizeof(imp_texture) * (st->texture_count + 1));
+                t = &st->textures[id - 1];
+                {
+                    char tag[256];
+                    snprintf(tag, sizeof tag, "%.200s@%g,%g,%g", t->path, (double)scale[0], (double)scale[1],
+                             (double)scale[2]);
+                    st->textures[st->texture_count] = *t;
+                    memcpy(st->textures[st->texture_count].path, tag, sizeof tag);
+                }
+                st->textures[st->texture_count].rgb = (float *)xrealloc(NULL, sizeof(float) * 3 * n);
+                for (q = 0; q < n; ++q)
+                    for (k = 0; k < 3; ++k)
+                        st->textures[st->texture_count].rgb[3 * q + k] = t->rgb[3 * q + k] * scale[k];
+                id = ++st->texture_count;
+                t = &st->textures[id - 1];
+            }
+            for (q = 0; q < 3 * n; ++q)
+                if (t->rgb[q] > ALBEDO_MAX) t->rgb[q] = ALBEDO_MAX, clamped = 1;
+            out->texture = id;
+        }
+    }
+    for (k = 0; k < 3; ++k) {
+        if (!(out->albedo[k] >= 0.0f)) out->albedo[k] = 0.0f, clamped = 1;
+        if (out->albedo[k] > ALBEDO_MAX) out->albedo[k] = ALBEDO_MAX, clamped = 1;
+    }
+    if (clamped && !*warned_clamp) {
+        fprintf(stderr, "rad: warning: material '%s': albedo clamped into [0, %g] (radiosity needs albedo < 1)\n",
+                name.data, (double)ALBEDO_MAX);
+        *warned_clamp = 1;
+    }
+}
+
+/* ---- geometry ---------------------------------------------------------------------------- */
+
+static void mat_mul(const struct aiMatrix4x4 *a, const struct aiMatrix4x4 *b, struct aiMatrix4x4 *o)
+{
+    const float *A = &a->a1, *B = &b->a1;
+    float R[16];
+    int i, j, k;
+    for (i = 0; i < 4; ++i)
+        for (j = 0; j < 4; ++j) {
+            float s = 0.0f;
+            for (k = 0; k < 4; ++k) s += A[4 * i + k] * B[4 * k + j];
+            R[4 * i + j] = s;
+        }
+    memcpy(&o->a1, R, sizeof R);
+}
+
+static void xform_point(const struct aiMatrix4x4 *m, const float p[3], float o[3])
+{
+    o[0] = m->a1 * p[0] + m->a2 * p[1] + m->a3 * p[2] + m->a4;
+    o[1] = m->b1 * p[0] + m->b2 * p[1] + m->b3 * p[2] + m->b4;
+    o[2] = m->c1 * p[0] + m->c2 * p[1] + m->c3 * p[2] + m->c4;
+}
+
+static void xform_dir(const struct aiMatrix4x4 *m, const float p[3], float o[3])
+{
+    o[0] = m->a1 * p[0] + m->a2 * p[1] + m->a3 * p[2];
+    o[1] = m->b1 * p[0] + m->b2 * p[1] + m->b3 * p[2];
+    o[2] = m->c1 * p[0] + m->c2 * p[1] + m->c3 * p[2];
+}
+
+static imp_group *group_for(imp_storage *st, const char *name)
+{
+    uint32_t i;
+    for (i = 0; i < st->group_count; ++i)
+        if (!strcmp(st->groups[i].name, name)) return &st->groups[i];
+    if (st->group_count == st->group_cap) {
+        st->group_cap = st->group_cap ? 2 * st->group_cap : 16;
+        st->groups = (imp_group *)xrealloc(st->groups, sizeof(imp_group) * st->group_cap);
+    }
+    memset(&st->groups[st->group_count], 0, sizeof(imp_group));
+    st->groups[st->group_count].name = xstrdup(name);
+    return &st->groups[st->group_count++];
+}
+
+typedef struct walk_state {
+    imp_storage *st;
+    const struct aiScene *sc;
+    rad_tool_scene *out;
+    int camera_done;
+    unsigned unnamed;
+} walk_state;
+
+static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiNode *node, const struct aiMatrix4x4 *m)
+{
+    char fallback[32];
+    const char *name = mesh->mName.length ? mesh->mName.data : node->mName.length ? node->mName.data : NULL;
+    imp_group *g;
+    uint32_t base, f, v, tri = 0;
+    float det;
+    if (!name) {
+        snprintf(fallback, sizeof fallback, "mesh%u", ws->unnamed++);
+        name = fallback;
+    }
+    if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return;
+    g = group_for(ws->st, name);
+    if ((uint64_t)g->vertex_count + mesh->mNumVertices > 0xFFFFFFF0u) return;
+    base = g->vertex_count;
+    if (g->vertex_count + mesh->mNumVertices > g->vertex_cap) {
+        while (g->vertex_count + mesh->mNumVertices > g->vertex_cap) g->vertex_cap = g->vertex_cap ? 2 * g->vertex_cap : 256;
+        g->positions = (float *)xrealloc(g->positions, sizeof(float) * 3 * g->vertex_cap);
+        g->uvs = (float *)xrealloc(g->uvs, sizeof(float) * 2 * g->vertex_cap);
+    }
+    for (v = 0; v < mesh->mNumVertices; ++v) {
+        float p[3];
+        p[0] = mesh->mVertices[v].x, p[1] = mesh->mVertices[v].y, p[2] = mesh->mVertices[v].z;
+        xform_point(m, p, g->positions + 3 * (size_t)(base + v));
+        if (mesh->mTextureCoords[0]) {
+            g->uvs[2 * (size_t)(base + v)] = mesh->mTextureCoords[0][v].x;
+            g->uvs[2 * (size_t)(base + v) + 1] = mesh->mTextureCoords[0][v].y;
+        } else {
+            g->uvs[2 * (size_t)(base + v)] = g->uvs[2 * (size_t)(base + v) + 1] = 0.0f;
+        }
+    }
+    if (mesh->mTextureCoords[0]) g->any_uv = 1;
+    g->vertex_count += mesh->mNumVertices;
+    /* a mirroring transform flips the winding */
+    det = m->a1 * (m->b2 * m->c3 - m->b3 * m->c2) - m->a2 * (m->b1 * m->c3 - m->b3 * m->c1) +
+          m->a3 * (m->b1 * m->c2 - m->b2 * m->c1);
+    for (f = 0; f < mesh->mNumFaces; ++f)
+        if (mesh->mFaces[f].mNumIndices == 3) ++tri;
+    if (g->triangle_count + tri > g->triangle_cap) {
+        while (g->triangle_count + tri > g->triangle_cap) g->triangle_cap = g->triangle_cap ? 2 * g->triangle_cap : 256;
+        g->indices = (uint32_t *)xrealloc(g->indices, sizeof(uint32_t) * 3 * g->triangle_cap);
+        g->material_ids = (uint32_t *)xrealloc(g->material_ids, sizeof(uint32_t) * g->triangle_cap);
+    }
+    for (f = 0; f < mesh->mNumFaces; ++f) {
+        const struct aiFace *face = &mesh->mFaces[f];
+        uint32_t *ix;
+        if (face->mNumIndices != 3) continue;
+        ix = g->indices + 3 * (size_t)g->triangle_count;
+        ix[0] = base + face->mIndices[0];
+        ix[1] = base + (det < 0 ? face->mIndices[2] : face->mIndices[1]);
+        ix[2] = base + (det < 0 ? face->mIndices[1] : face->mIndices[2]);
+        g->material_ids[g->triangle_count++] = mesh->mMaterialIndex;
+    }
+}
+
+static void walk(walk_state *ws, const struct aiNode *node, const struct aiMatrix4x4 *parent)
+{
+    struct aiMatrix4x4 m;
+    uint32_t i;
+    mat_mul(parent, &node->mTransformation, &m);
+    for (i = 0; i < node->mNumMeshes; ++i)
+        if (node->mMeshes[i] < ws->sc->mNumMeshes) add_mesh(ws, ws->sc->mMeshes[node->mMeshes[i]], node, &m);
+    /* lights and the first camera named like this node */
+    for (i = 0; i < ws->sc->mNumLights; ++i) {
+        const struct aiLight *l = ws->sc->mLights[i];
+        rad_light *rl;
+        float p[3], d[3];
+        if (strcmp(l->mName.data, node->mName.data) != 0) continue;
+        if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_SPOT && l->mType != aiLightSource_DIRECTIONAL) {
+            fprintf(stderr, "rad: warning: light '%s' of an unsupported type is ignored\n", l->mName.data);
+            continue;
+        }
+        ws->out->lights = (rad_light *)xrealloc(ws->out->lights, sizeof(rad_light) * (ws->out->light_count + 1));
+        rl = &ws->out->lights[ws->out->light_count++];
+        memset(rl, 0, sizeof *rl);
+        p[0] = l->mPosition.x, p[1] = l->mPosition.y, p[2] = l->mPosition.z;
+        d[0] = l->mDirection.x, d[1] = l->mDirection.y, d[2] = l->mDirection.z;
+        xform_point(&m, p, rl->position);
+        xform_dir(&m, d, rl->direction);
+        rl->color[0] = l->mColorDiffuse.r, rl->color[1] = l->mColorDiffuse.g, rl->color[2] = l->mColorDiffuse.b;
+        rl->falloff = RAD_FALLOFF_QUADRATIC;
+        if (l->mType == aiLightSource_POINT) rl->type = RAD_LIGHT_POINT;
+        else if (l->mType == aiLightSource_DIRECTIONAL) rl->type = RAD_LIGHT_DIRECTIONAL;
+        else {
+            rl->type = RAD_LIGHT_SPOT;
+            rl->inner_angle = 0.5f * l->mAngleInnerCone; /* assimp: full cone angles */
+            rl->outer_angle = 0.5f * l->mAngleOuterCone;
+            if (!(rl->outer_angle > rl->inner_angle)) rl->outer_angle = rl->inner_angle + 1e-3f;
+        }
+    }
+    if (!ws->camera_done)
+        for (i = 0; i < ws->sc->mNumCameras; ++i) {
+            const struct aiCamera *c = ws->sc->mCameras[i];
+            float p[3], t[3], u[3], pos[3], dir[3], up[3], aspect;
+            if (strcmp(c->mName.data, node->mName.data) != 0) continue;
+            p[0] = c->mPosition.x, p[1] = c->mPosition.y, p[2] = c->mPosition.z;
+            t[0] = c->mLookAt.x, t[1] = c->mLookAt.y, t[2] = c->mLookAt.z;
+            u[0] = c->mUp.x, u[1] = c->mUp.y, u[2] = c->mUp.z;
+            xform_point(&m, p, pos);
+            xform_dir(&m, t, dir);
+            xform_dir(&m, u, up);
+            memcpy(ws->out->camera.position, pos, sizeof pos);
+            ws->out->camera.target[0] = pos[0] + dir[0];
+            ws->out->camera.target[1] = pos[1] + dir[1];
+            ws->out->camera.target[2] = pos[2] + dir[2];
+            memcpy(ws->out->camera.up, up, sizeof up);
+            aspect = c->mAspect > 0.0f ? c->mAspect : 1.0f;
+            /* mHorizontalFOV is half the horizontal angle */
+            ws->out->camera.fov_y_degrees = 2.0f * atanf(tanf(c->mHorizontalFOV) / aspect) * 57.29577951f;
+            ws->out->has_camera = 1;
+            ws->camera_done = 1;
+            break;
+        }
+    for (i = 0; i < node->mNumChildren; ++i) walk(ws, node->mChildren[i], &m);
+}
+
+static void default_camera(const float bmin[3], const float bmax[3], rad_camera *cam)
+{
+    float c[3], r = 0.0f, d;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        c[k] = 0.5f * (bmin[k] + bmax[k]);
+        r += (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
+    }
+    r = 0.5f * sqrtf(r);
+    cam->fov_y_degrees = 39.3077f;
+    d = r / sinf(0.5f * cam->fov_y_degrees / 57.29577951f);
+    /* in front of the scene, looking along +z (like the Cornell camera), y up */
+    cam->position[0] = c[0], cam->position[1] = c[1], cam->position[2] = c[2] - d;
+    memcpy(cam->target, c, sizeof c);
+    cam->up[0] = 0.0f, cam->up[1] = 1.0f, cam->up[2] = 0.0f;
+}
+
+int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err, size_t errlen)
+{
+    const struct aiScene *sc;
+    imp_storage *st;
+    walk_state ws;
+    struct aiMatrix4x4 id;
+    uint32_t i, k, tris = 0;
+    int warned = 0;
+    float bmin[3] = {1e30f, 1e30f, 1e30f}, bmax[3] = {-1e30f, -1e30f, -1e30f};
+    memset(out, 0, sizeof *out);
+    if (!path_or_name || !*path_or_name) {
+        set_err(err, errlen, "no scene given%s%s", NULL, NULL);
+        return 1;
+    }
+    if (!strcmp(path_or_name, "cornell")) {
+        st = (imp_storage *)calloc(1, sizeof *st);
+        if (!st) return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
+        st->builtin = 1;
+        rad_cornell_box(&out->desc, &out->camera);
+        out->has_camera = 1;
+        out->storage = st;
+        return 0;
+    }
+    sc = aiImportFile(path_or_name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    if (!sc) {
+        set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
+        return 1;
+    }
+    if (!sc->mRootNode || sc->mNumMeshes == 0) {
+        set_err(err, errlen, "'%s' has no meshes%s", path_or_name, NULL);
+        aiReleaseImport(sc);
+        return 1;
+    }
+    st = (imp_storage *)calloc(1, sizeof *st);
+    if (!st) {
+        aiReleaseImport(sc);
+        return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
+    }
+    out->storage = st;
+    /* materials */
+    st->material_count = sc->mNumMaterials ? sc->mNumMaterials : 1;
+    st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
+    memset(st->materials, 0, sizeof(rad_material) * st->material_count);
+    for (i = 0; i < st->material_count; ++i) {
+        if (i < sc->mNumMaterials) convert_material(st, sc, path_or_name, sc->mMaterials[i], &st->materials[i], &warned);
+        else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
+    }
+    /* geometry, lights, camera */
+    memset(&id, 0, sizeof id);
+    id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
+    memset(&ws, 0, sizeof ws);
+    ws.st = st;
+    ws.sc = sc;
+    ws.out = out;
+    walk(&ws, sc->mRootNode, &id);
+    aiReleaseImport(sc);
+    st->meshes = (rad_mesh_desc *)xrealloc(NULL, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
+    memset(st->meshes, 0, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
+    for (i = 0; i < st->group_count; ++i) {
+        imp_group *g = &st->groups[i];
+        rad_mesh_desc *md = &st->meshes[i];
+        uint32_t t;
+        md->name = g->name;
+        md->positions = g->positions;
+        md->vertex_count = g->vertex_count;
+        md->indices = g->indices;
+        md->triangle_count = g->triangle_count;
+        md->material_ids = g->material_ids;
+        for (t = 0; t < g->triangle_count; ++t)
+            if (st->materials[g->material_ids[t]].texture) {
+                md->uvs = g->uvs; /* zeros when the file had none */
+                if (!g->any_uv) fprintf(stderr, "rad: warning: mesh '%s' has a textured material but no uvs\n", g->name);
+                break;
+            }
+        tris += g->triangle_count;
+        for (k = 0; k < 3 * g->vertex_count; ++k) {
+            float v = g->positions[k];
+            if (v < bmin[k % 3]) bmin[k % 3] = v;
+            if (v > bmax[k % 3]) bmax[k % 3] = v;
+        }
+    }
+    if (tris == 0) {
+        set_err(err, errlen, "'%s' has no triangles%s", path_or_name, NULL);
+        rad_tool_free_scene(out);
+        return 1;
+    }
+    out->desc.meshes = st->meshes;
+    out->desc.mesh_count = st->group_count;
+    out->desc.materials = st->materials;
+    out->desc.material_count = st->material_count;
+    out->desc.albedo_lookup = st->texture_count ? albedo_lookup : NULL;
+    out->desc.albedo_user = st;
+    out->desc.flags = RAD_SCENE_SKIP_DEGENERATE;
+    if (!out->has_camera) default_camera(bmin, bmax, &out->camera);
+    return 0;
+}
