@@ -94,7 +94,10 @@ int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errle
 /* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
 unsigned char rad_image_srgb8(float linear);
 /* rad_image_write: .pfm ignores 'exposure' (PFM keeps the radiance); .png applies it. */
-/* Fills options with the defaults (256x256, 64 spp, seed 0, max_depth 64, rr_depth 16). */
+/* Fills options with the defaults (256x256, 64 spp, seed 0, max_depth 64, rr_depth 16).
+   rad_trace_image: 'out' must be zero-initialised or a live image (reallocated when its size
+   differs); returns 0 or a rad_result error (INVALID_ARGUMENT, OUT_OF_MEMORY,
+   RAYCAST_FAILED, CANCELLED by ctx->progress). Surfaces are one-sided like the patches. */
 void rad_trace_options_default(rad_trace_options *options);
 
 
