@@ -37,9 +37,10 @@ $(BUILD)/bench: bench/bench.c radiosity.h | $(BUILD)
 $(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench: $(BUILD)/bench $(BUILD)/rays
+bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
+	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
 
 bench-quick: $(BUILD)/bench $(BUILD)/rays
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
