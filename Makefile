@@ -15,7 +15,7 @@ EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 RAD_DATA_DIR ?= ../shared/data
 
-.PHONY: all demo test bench bench-quick tools clean
+.PHONY: all demo test bench bench-quick tools fuzz clean
 
 all: $(BUILD)/cornell tools
 
@@ -52,6 +52,18 @@ tools: $(BUILD)/rad
 $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. tools/*.c -o $@ -lassimp -lm
 	cp $@ tools/rad
+
+# libFuzzer harnesses (clang with libclang-rt-14-dev): FUZZ_SECONDS per fuzzer
+FUZZ_SECONDS ?= 300
+FUZZ_CC ?= clang
+fuzz: | $(BUILD)
+	mkdir -p $(BUILD)/fuzz/corpus_container $(BUILD)/fuzz/corpus_scene
+	$(CC) -std=c99 -O2 -I. fuzz/make_corpus.c -o $(BUILD)/fuzz/make_corpus -lm
+	./$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus_container $(BUILD)/fuzz/corpus_scene
+	for f in container scene; do \
+	    $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -I. fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm || exit 1; \
+	    ./$(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 $(BUILD)/fuzz/corpus_$$f || exit 1; \
+	done
 
 clean:
 	rm -rf $(BUILD) cornell.png tools/rad
