@@ -88,8 +88,9 @@ fi
 # ---- sanitizers ---------------------------------------------------------------------------
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-RAD_TEST_QUICK=1 unit unit-asan-ubsan $CC -std=c99 $WARN -O1 -g -fno-omit-frame-pointer \
-    -fsanitize=address,undefined -fno-sanitize-recover=all -I. tests/test_main.c
+SAN="-g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
+RAD_TEST_QUICK=1 unit unit-asan-ubsan-O0 $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c
+RAD_TEST_QUICK=1 unit unit-asan-ubsan-O2-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
 
 # ---- compile tests ------------------------------------------------------------------------
 echo "== compile tests"
@@ -149,13 +150,51 @@ if have clang && have clang++; then
     compile_run compile-clang-c99 clang -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-clang-c99" -lm
     compile_run compile-clang-cpp11 clang++ -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-clang-cpp11" -lm
     if printf 'int main(void){return 0;}' | clang -fsanitize=address,undefined -x c - -o /dev/null 2>/dev/null; then
-        RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan clang -std=c99 $WARN -O2 -g -fno-omit-frame-pointer \
-            -fsanitize=address,undefined -fno-sanitize-recover=all -I. tests/test_main.c
+        RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan-O2 clang -std=c99 $WARN -O2 $SAN -I. tests/test_main.c
+        RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan-O0-scalar clang -std=c99 $WARN -O0 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
     else
         skip unit-clang-asan-ubsan "clang's sanitizer runtime is missing (package libclang-rt-14-dev)"
     fi
+    # libFuzzer smoke runs (the long runs are `make fuzz`, recorded in FUZZING.md)
+    if printf 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n){(void)d;(void)n;return 0;}' |
+        clang -fsanitize=fuzzer -x c - -o /dev/null 2>/dev/null; then
+        echo "== fuzz smoke"
+        mkdir -p "$BUILD/fuzz/container" "$BUILD/fuzz/scene"
+        if build make-corpus $CC -std=c99 -O2 -I. fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
+           "$BUILD/make_corpus" "$BUILD/fuzz/container" "$BUILD/fuzz/scene"; then
+            for f in container scene; do
+                if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
+                   "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
+                    pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
+                else
+                    tail -20 "$BUILD/fuzz-$f.log" | sed 's/^/    /'
+                    fail "fuzz-$f"
+                fi
+            done
+        else
+            fail fuzz-corpus
+        fi
+    else
+        skip fuzz-smoke "clang has no libFuzzer runtime (package libclang-rt-14-dev)"
+    fi
 else
     skip clang-suites "clang is not installed (package clang)"
+fi
+
+# ---- valgrind memcheck (optional: installed when we can) ---------------------------------
+have valgrind || try_install valgrind
+if have valgrind; then
+    echo "== valgrind memcheck"
+    if build unit-valgrind $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-valgrind" -lm &&
+       RAD_TEST_QUICK=1 valgrind --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible \
+           --quiet "$BUILD/unit-valgrind" >"$BUILD/valgrind.out" 2>&1; then
+        pass "valgrind-memcheck ($(tail -n 1 "$BUILD/valgrind.out"))"
+    else
+        grep -E '==[0-9]+==' "$BUILD/valgrind.out" | head -30 | sed 's/^/    /'
+        fail valgrind-memcheck
+    fi
+else
+    skip valgrind-memcheck "valgrind is not installed (package valgrind)"
 fi
 
 echo
