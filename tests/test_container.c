@@ -281,10 +281,47 @@ static void ct_test_user_sections(void)
     free(buf);
 }
 
+/* every allocation of save and load fails in turn (the counting allocator of test_scene.c):
+   each call returns success or RAD_ERROR_OUT_OF_MEMORY and nothing leaks */
+static void ct_test_alloc_failure(void)
+{
+    ct_fixture f;
+    sc_alloc_state st;
+    rad_context ctx;
+    long total, n;
+    if (!ct_setup(&f)) { CHECK(0); ct_teardown(&f); return; }
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.allocator.alloc = sc_alloc_fn;
+    ctx.allocator.free = sc_free_fn;
+    ctx.allocator.user = &st;
+    for (n = 0, total = 1; n <= total; ++n) {
+        void *buf = NULL;
+        size_t size = 0;
+        rad_bake *b = NULL;
+        rad_result r1, r2 = RAD_SUCCESS;
+        memset(&st, 0, sizeof(st));
+        st.fail_at = n;
+        r1 = rad_save_memory(f.P, &f.sparse->matrix, f.E, f.B, &ctx, &buf, &size);
+        if (r1 == RAD_SUCCESS) {
+            r2 = rad_load_memory(buf, size, &ctx, &b);
+            rad_bake_destroy(b);
+            rad_free_buffer(buf, &ctx);
+        }
+        CHECK(r1 == RAD_SUCCESS || r1 == RAD_ERROR_OUT_OF_MEMORY);
+        CHECK(r2 == RAD_SUCCESS || r2 == RAD_ERROR_OUT_OF_MEMORY);
+        CHECK(n == 0 || r1 != RAD_SUCCESS || r2 != RAD_SUCCESS || n > st.calls);
+        CHECK(st.allocs == st.frees && st.live_bytes == 0 && st.corrupt == 0);
+        if (n == 0) total = st.calls;
+    }
+    CHECK(total >= 5);
+    ct_teardown(&f);
+}
+
 static const rad_test_case tests_container[] = {
     { "container_round_trip", ct_test_round_trip },
     { "container_corruption", ct_test_corruption },
     { "container_save_mismatch", ct_test_save_mismatch },
     { "container_user_sections", ct_test_user_sections },
+    { "container_alloc_failure", ct_test_alloc_failure },
     { NULL, NULL }
 };
