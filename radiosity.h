@@ -849,6 +849,212 @@ RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, c
 RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out);
 #endif
 
+/* ======================================================================================== */
+/* >>api_multibounce: multi-bounce matrix and its compression                               */
+/* ======================================================================================== */
+
+/* SPEC §4 (thesis ch. 3). The albedo and K bounces folded into one RGB matrix,
+       F_mb = sum_{k=1..K} (rho o F)^k        (K = inf: (I - rho o F)^-1 - I)
+   so that L_K = F_mb E costs one matrix-vector product whatever K is. Limits: the albedo is
+   baked in (changing a material means rebuilding) and K is fixed at build time.
+   Storage: three N x N planes (R, G, B), row-major, float or IEEE binary16. Optional row and
+   column permutations: plane entry (i', j') is F_mb[row_perm[i']][col_perm[j']].
+   Compression (rad_multibounce_blocks_*): outliers kept exactly in a sparse list, greedy
+   row/column reordering (thesis Listing 3.1), scaling into [0,1] per matrix or per tile, and
+   GPU block encoding, bit-exact with the Khronos Data Format specification: BC1 (one RGB
+   texture) or three BC4 planes. Texel (x, y) of the matrix image is entry (row y, column x) of
+   the permuted matrix; 4x4 blocks, block (bx, by) at byte 8 * (ceil(N/4) * by + bx); the image
+   is padded to a multiple of 4 with zeros. The bytes upload unchanged as
+   VK_FORMAT_BC1_RGB_UNORM_BLOCK / VK_FORMAT_BC4_UNORM_BLOCK images of ceil(N/4)*4 texels square. */
+
+#define RAD_MB_INFINITE 0xFFFFFFFFu   /* rad_multibounce_options.bounces: K = infinity */
+
+/* Container section types of the multi-bounce objects (16..31 are reserved for them). */
+#define RAD_SECTION_MB_INFO 16u            /* 16 uint32: see rad_multibounce_sections */
+#define RAD_SECTION_MB_FLOAT 17u           /* 3 N^2 floats: the R, G, B planes */
+#define RAD_SECTION_MB_HALF 18u            /* 3 N^2 binary16 values */
+#define RAD_SECTION_MB_ROW_PERM 19u        /* N uint32 */
+#define RAD_SECTION_MB_COL_PERM 20u        /* N uint32 */
+#define RAD_SECTION_MB_BC1 21u             /* ceil(N/4)^2 8-byte BC1 blocks */
+#define RAD_SECTION_MB_BC4 22u             /* 3 ceil(N/4)^2 8-byte BC4 blocks: R plane, G, B */
+#define RAD_SECTION_MB_SCALES 23u          /* 3 floats (R, G, B) per scale tile */
+#define RAD_SECTION_MB_OUTLIER_OFFSETS 24u /* N+1 uint64, CSR by original row */
+#define RAD_SECTION_MB_OUTLIER_COLUMNS 25u /* uint32 original columns */
+#define RAD_SECTION_MB_OUTLIER_VALUES 26u  /* 3 floats (exact RGB) per outlier */
+#define RAD_MB_MAX_SECTIONS 10u            /* most sections one object writes */
+
+typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
+
+typedef struct rad_multibounce_options {
+    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3) */
+    rad_mb_precision precision;/* storage of the result (default RAD_MB_FLOAT) */
+    double tolerance;          /* K = inf: Neumann doubling stops once max row sum of
+                                  (rho o F)^m <= tolerance (0: 1e-8) */
+    uint32_t max_doublings;    /* K = inf: NOT_CONVERGED after this many (0: 40) */
+} rad_multibounce_options;
+
+/* An owning multi-bounce matrix (or, after rad_multibounce_load, a view into container bytes). */
+typedef struct rad_multibounce {
+    uint32_t n;                /* N */
+    uint32_t bounces;          /* K (RAD_MB_INFINITE for the full solution) */
+    rad_mb_precision precision;
+    const float *planes;       /* RAD_MB_FLOAT: 3 N^2 floats, plane c at c * N^2; else NULL */
+    const uint16_t *half;      /* RAD_MB_HALF: 3 N^2 binary16 values; else NULL */
+    const uint32_t *row_perm;  /* NULL (identity) or N indices: new row i' is old row row_perm[i'] */
+    const uint32_t *col_perm;  /* NULL (identity) or N indices: new column j' is old column col_perm[j'] */
+    rad_allocator allocator;   /* private */
+    void *storage;             /* private (NULL for a view) */
+    uint32_t info[16];         /* private: the RAD_SECTION_MB_INFO record */
+} rad_multibounce;
+
+RAD_API void rad_multibounce_options_default(rad_multibounce_options *options);
+
+/* Builds F_mb from a form-factor matrix F (N x N, dense or CSR; borrowed) and the albedo
+   (3N floats, each in [0,1); borrowed). Finite K uses the doubling S_2m = S_m + A^m S_m,
+   A^2m = A^m A^m and S_m+1 = A + A S_m along the binary digits of K (K = 3: 2 products, K = 8: 5;
+   K = 1: none), K = inf doubles until the tail is below the tolerance; each product is a
+   packed, cache-blocked single-precision GEMM run through ctx->parallel_for (bits depend on the
+   build's SIMD, not on the number of threads). Progress is reported after each product.
+   Errors: INVALID_ARGUMENT, SIZE_MISMATCH, ALBEDO_RANGE, SIZE_OVERFLOW, OUT_OF_MEMORY,
+   NOT_CONVERGED (K = inf), CANCELLED. Thread safety: reentrant. Cost: O(N^3 log K) time per
+   channel, 16 N^2 bytes of scratch plus the 12 N^2 (6 N^2 half) bytes of the result. SPEC §4. */
+RAD_API rad_result rad_multibounce_create(const rad_matrix *F, const float *albedo,
+                                          const rad_multibounce_options *options, const rad_context *ctx,
+                                          rad_multibounce **out);
+/* A copy of 'src' in another precision (float -> half rounds to nearest even; half -> float
+   is exact), keeping its permutations. Cost: O(N^2). */
+RAD_API rad_result rad_multibounce_convert(const rad_multibounce *src, rad_mb_precision precision,
+                                           const rad_context *ctx, rad_multibounce **out);
+/* A copy of 'src' with rows and columns reordered greedily (thesis Listing 3.1, see
+   rad_block_options.reorder_samples); only for an unpermuted src. Cost: O(N^3) exact,
+   O(N^2 samples) sampled. */
+RAD_API rad_result rad_multibounce_reorder(const rad_multibounce *src, uint32_t samples, const rad_context *ctx,
+                                           rad_multibounce **out);
+RAD_API void rad_multibounce_destroy(rad_multibounce *mb);
+
+/* out = F_mb E (RAD_OUTPUT_INDIRECT: L_K) or E + F_mb E (RAD_OUTPUT_TOTAL), E and out 3N
+   interleaved RGB floats in the original patch order (permutations are applied inside). One
+   pass over the three planes, parallel over rows; half planes are widened on the fly (F16C
+   when the build has it). out must not alias E. Thread safety: reentrant (mb is read only).
+   Cost: O(N^2), 12 N^2 (6 N^2) bytes read. SPEC §4. */
+RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float *E, float *out, rad_output output,
+                                         const rad_context *ctx);
+
+/* IEEE 754 binary16 conversion: round to nearest, ties to even; overflow gives infinity,
+   subnormals are kept, NaN stays NaN. */
+RAD_API uint16_t rad_half_from_float(float value);
+RAD_API float rad_half_to_float(uint16_t value);
+
+/* ---- block compression ---- */
+
+typedef enum rad_block_format {
+    RAD_BLOCK_BC1 = 0,         /* one BC1 texture: RGB565 endpoints, 0.5 byte per entry (all 3 channels) */
+    RAD_BLOCK_BC4X3 = 1        /* three BC4 textures (R, G, B): 8-bit endpoints, 1.5 bytes per entry */
+} rad_block_format;
+
+typedef struct rad_block_options {
+    rad_block_format format;   /* default RAD_BLOCK_BC4X3 */
+    float outlier_fraction;    /* the largest fraction p of the N^2 entries (by their largest
+                                  channel) go exactly into the sparse list, zeros left in place;
+                                  0 disables the step (default 0.05) */
+    int reorder;               /* non-zero: greedy row and column reordering (default 1) */
+    uint32_t reorder_samples;  /* 0: L2 distances over all coordinates (the literal algorithm,
+                                  through a Gram matrix); else over this many evenly spaced
+                                  coordinates (faster, a little worse; default 0) */
+    uint32_t tile;             /* scales per tile x tile texels (a multiple of 4); 0: one scale
+                                  per channel for the whole matrix (default 64) */
+} rad_block_options;
+
+/* What rad_multibounce_blocks_create did, step by step. */
+typedef struct rad_block_report {
+    uint64_t outlier_count;
+    float outlier_threshold;   /* smallest magnitude that went to the outlier list */
+    int reordered;
+    uint32_t tiles;            /* scale tiles (1 when per matrix) */
+    size_t bytes_float_f;      /* the single-channel float F: 4 N^2 */
+    size_t bytes_float_mb;     /* the RGB float F_mb: 12 N^2 */
+    size_t bytes_blocks, bytes_scales, bytes_outliers, bytes_permutations;
+    size_t bytes_total;        /* everything rad_multibounce_blocks_apply reads */
+    double mse;                /* mean squared error of the decoded matrix against the source, over 3 N^2 entries */
+    double max_abs_error;
+    double source_mean_square; /* mean of the squared source entries (to put mse in scale) */
+} rad_block_report;
+
+/* A compressed multi-bounce matrix; all arrays owned (or views after _load). */
+typedef struct rad_multibounce_blocks {
+    uint32_t n, bounces;
+    rad_block_format format;
+    uint32_t blocks_per_row;         /* ceil(N/4): the image is blocks_per_row*4 texels square */
+    const uint8_t *blocks;           /* BC1: blocks_per_row^2 blocks; BC4X3: three such planes (R, G, B) */
+    uint32_t tile;                   /* scale tile in texels (0: per matrix) */
+    uint32_t tiles_per_row;          /* ceil(N / tile), 1 when per matrix */
+    const float *scales;             /* 3 floats per tile, tiles row-major: decoded * scale = value */
+    const uint32_t *row_perm;        /* NULL or N: texel row y holds original row row_perm[y] */
+    const uint32_t *col_perm;        /* NULL or N: texel column x holds original column col_perm[x] */
+    uint64_t outlier_count;
+    const uint64_t *outlier_offsets; /* N+1, CSR by original row (NULL when there are none) */
+    const uint32_t *outlier_columns; /* original columns */
+    const float *outlier_values;     /* 3 floats (exact RGB) per outlier */
+    rad_allocator allocator;         /* private */
+    void *storage;                   /* private */
+    uint32_t info[16];               /* private */
+} rad_multibounce_blocks;
+
+RAD_API void rad_block_options_default(rad_block_options *options);
+
+/* Compresses mb (float or half, unpermuted) by the pipeline of rad_block_options; report
+   (optional) says what each step did and the decoded-matrix error. Errors: INVALID_ARGUMENT,
+   OUT_OF_MEMORY, SIZE_OVERFLOW, CANCELLED. Thread safety: reentrant. Cost: O(N^2 log N) for
+   the outliers, O(N^3) for exact reordering (two Gram matrices) or O(N^2 samples), O(N^2)
+   encoding. SPEC §4. */
+RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
+                                                 const rad_context *ctx, rad_multibounce_blocks **out,
+                                                 rad_block_report *report);
+RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
+
+/* out = F~ E (or E + F~ E) with F~ the compressed matrix: E is permuted on input, blocks are
+   decoded on the fly block row by block row (never the whole matrix), the outliers added
+   exactly and the result un-permuted on output. Parallel over block rows. Thread safety:
+   reentrant. Cost: O(N^2) decode work, bytes_total bytes read. SPEC §4. */
+RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
+                                                rad_output output, const rad_context *ctx);
+/* The decoded matrix in the original order (3 N^2 floats: R, G, B planes) with outliers, for
+   tests and error measurements. Cost: O(N^2). */
+RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *blocks, float *out_planes,
+                                                 const rad_context *ctx);
+
+/* Single 4x4 blocks, texel (x, y) at index 4y + x. Decoders follow the specification's real
+   division (REFERENCE §4): BC1 writes 16 RGB triples (48 floats), BC4 16 values. The encoders
+   clamp their input to [0,1] and choose the better of the two modes of the format by squared
+   error against the exact decoder. Thread safety: pure functions. */
+RAD_API void rad_bc1_decode_block(const uint8_t block[8], float out_rgb[48]);
+RAD_API void rad_bc4_decode_block(const uint8_t block[8], float out_values[16]);
+RAD_API void rad_bc1_encode_block(const float rgb[48], uint8_t out_block[8]);
+RAD_API void rad_bc4_encode_block(const float values[16], uint8_t out_block[8]);
+
+/* ---- baked data ---- */
+
+/* Section descriptors (data borrowed from the object, which must outlive the write) for
+   rad_container_size / rad_container_write; every section carries 'name' (at most 23 bytes),
+   so several matrices can share a container. out_sections must hold RAD_MB_MAX_SECTIONS;
+   *out_count receives how many were written. The info record (RAD_SECTION_MB_INFO, 16 uint32):
+   version 1, kind (0 float, 1 half, 2 BC1, 3 BC4X3), N, K, tile, tiles_per_row, flags (1: row
+   and column permutations present, 2: outliers present), the rest 0. */
+RAD_API rad_result rad_multibounce_sections(const rad_multibounce *mb, const char *name, rad_section *out_sections,
+                                            uint32_t *out_count);
+RAD_API rad_result rad_multibounce_blocks_sections(const rad_multibounce_blocks *blocks, const char *name,
+                                                   rad_section *out_sections, uint32_t *out_count);
+/* Opens the object called 'name' from an open container as a view: its arrays point into the
+   container's bytes (which must outlive it); destroy it with the usual destroy call. Every
+   size is checked against N, permutations must be bijections of [0, N), outlier offsets
+   monotone and columns < N, scales and values finite. Errors: CORRUPT (a missing or malformed
+   section, a bad permutation), INDEX_OUT_OF_RANGE (an outlier column >= N), OUT_OF_MEMORY,
+   INVALID_ARGUMENT. Cost: O(N^2 / 4 + outliers) to validate. */
+RAD_API rad_result rad_multibounce_load(const rad_container *container, const char *name, const rad_context *ctx,
+                                        rad_multibounce **out);
+RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, const char *name,
+                                               const rad_context *ctx, rad_multibounce_blocks **out);
+
 #ifdef __cplusplus
 }
 #endif
@@ -4623,6 +4829,1766 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
     return rad__load(buf, (size_t)len, buf, &c, ctx, out);
 }
 #endif
+
+/* ======================================================================================== */
+/* >>multibounce: multi-bounce matrix, GEMM, binary16, BC1/BC4, compression, container      */
+/* ======================================================================================== */
+
+#if defined(RAD__AVX) && defined(__AVX2__)
+#  define RAD__MB_AVX2 1
+#endif
+#if defined(RAD__AVX) && defined(__FMA__)
+#  define RAD__MB_FMA 1
+#endif
+#if defined(RAD__AVX) && defined(__F16C__)
+#  define RAD__MB_F16C 1
+#endif
+
+#define RAD__MB_MR 6u
+#define RAD__MB_NR 16u
+#define RAD__MB_KC 256u
+#define RAD__MB_MC 96u
+#define RAD__MB_NC 2048u
+
+/* ---- binary16 ---- */
+
+RAD_API uint16_t rad_half_from_float(float value)
+{
+    uint32_t x, sign, h;
+    memcpy(&x, &value, sizeof(x));
+    sign = (x >> 16) & 0x8000u;
+    x &= 0x7FFFFFFFu;
+    if (x > 0x7F800000u) return (uint16_t)(sign | 0x7E00u | ((x >> 13) & 0x3FFu)); /* NaN stays NaN */
+    if (x >= 0x477FF000u) return (uint16_t)(sign | 0x7C00u);                     /* >= 65520: infinity */
+    if (x < 0x38800000u) {                                                         /* below 2^-14: subnormal */
+        uint32_t mant, shift, rem, half;
+        if (x < 0x33000000u) return (uint16_t)sign;                                /* <= 2^-25: zero */
+        mant = (x & 0x7FFFFFu) | 0x800000u;
+        shift = 126u - (x >> 23);                                                  /* 14..24 */
+        h = mant >> shift;
+        rem = mant & ((1u << shift) - 1u);
+        half = 1u << (shift - 1u);
+        if (rem > half || (rem == half && (h & 1u))) ++h;
+        return (uint16_t)(sign | h);
+    }
+    h = (x - 0x38000000u) >> 13;                                                   /* rebias 127 -> 15 */
+    if ((x & 0x1FFFu) > 0x1000u || ((x & 0x1FFFu) == 0x1000u && (h & 1u))) ++h;    /* carries into the exponent */
+    return (uint16_t)(sign | h);
+}
+
+RAD_API float rad_half_to_float(uint16_t value)
+{
+    uint32_t sign = ((uint32_t)value & 0x8000u) << 16, e = ((uint32_t)value >> 10) & 31u, m = (uint32_t)value & 0x3FFu, x;
+    float f;
+    if (e == 0) {
+        f = (float)m * 5.9604644775390625e-8f; /* m * 2^-24, exact */
+        return sign ? -f : f;
+    }
+    x = sign | (e == 31u ? 0x7F800000u | (m << 13) : ((e + 112u) << 23) | (m << 13));
+    memcpy(&f, &x, sizeof(f));
+    return f;
+}
+
+/* ---- objects ---- */
+
+RAD_API void rad_multibounce_options_default(rad_multibounce_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->bounces = 3;
+    o->precision = RAD_MB_FLOAT;
+    o->tolerance = 1e-8;
+    o->max_doublings = 40;
+}
+
+RAD_API void rad_block_options_default(rad_block_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->format = RAD_BLOCK_BC4X3;
+    o->outlier_fraction = 0.05f;
+    o->reorder = 1;
+    o->reorder_samples = 0;
+    o->tile = 64;
+}
+
+RAD_API void rad_multibounce_destroy(rad_multibounce *mb)
+{
+    rad_allocator a;
+    if (!mb) return;
+    a = mb->allocator;
+    rad__free(&a, mb->storage);
+    rad__free(&a, mb);
+}
+
+RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *b)
+{
+    rad_allocator a;
+    if (!b) return;
+    a = b->allocator;
+    rad__free(&a, b->storage);
+    rad__free(&a, b);
+}
+
+/* One allocation holding 'parts' arrays of the given byte sizes, each 64-byte aligned. */
+static void *rad__mb_carve(const rad__ctx *c, const size_t *bytes, uint32_t parts, void **out_parts, rad_result *r)
+{
+    size_t total = 0, at;
+    uint32_t i;
+    unsigned char *base;
+    for (i = 0; i < parts; ++i) {
+        size_t b = (bytes[i] + 63u) & ~(size_t)63u;
+        if (b < bytes[i] || total + b < total || total + b + 64u < total) { *r = RAD_ERROR_SIZE_OVERFLOW; return NULL; }
+        total += b;
+    }
+    base = (unsigned char *)rad__alloc(&c->allocator, total + 64u);
+    if (!base) { *r = RAD_ERROR_OUT_OF_MEMORY; return NULL; }
+    at = (size_t)((64u - ((uintptr_t)base & 63u)) & 63u);
+    for (i = 0; i < parts; ++i) {
+        out_parts[i] = bytes[i] ? (void *)(base + at) : NULL;
+        at += (bytes[i] + 63u) & ~(size_t)63u;
+    }
+    *r = RAD_SUCCESS;
+    return base;
+}
+
+static void rad__mb_info(uint32_t *info, uint32_t kind, uint32_t n, uint32_t k, uint32_t tile, uint32_t tiles, uint32_t flags)
+{
+    memset(info, 0, 16 * sizeof(uint32_t));
+    info[0] = 1u;
+    info[1] = kind;
+    info[2] = n;
+    info[3] = k;
+    info[4] = tile;
+    info[5] = tiles;
+    info[6] = flags;
+}
+
+/* ---- GEMM: C (m x n) += A (m x k) B (k x n), row-major, packed and cache-blocked ---- */
+
+typedef struct rad__gemm {
+    const float *A, *B;
+    float *C;
+    size_t lda, ldb, ldc;
+    uint32_t m, n, k;
+    uint32_t pc, kc, jc, nc;
+    const float *bp;   /* packed B block: ceil(nc/NR) panels of kc x NR */
+    float *ap;         /* packed A: one MC x KC slab per row chunk */
+} rad__gemm;
+
+static void rad__mb_kernel(uint32_t kc, const float *a, const float *b, float *c, size_t ldc, uint32_t mr, uint32_t nr)
+{
+    uint32_t i, j, p;
+#if defined(RAD__AVX)
+    __m256 c0[RAD__MB_MR], c1[RAD__MB_MR];
+    float tmp[RAD__MB_MR][RAD__MB_NR];
+    for (i = 0; i < RAD__MB_MR; ++i) { c0[i] = _mm256_setzero_ps(); c1[i] = _mm256_setzero_ps(); }
+    for (p = 0; p < kc; ++p) {
+        __m256 b0 = _mm256_loadu_ps(b + (size_t)p * RAD__MB_NR), b1 = _mm256_loadu_ps(b + (size_t)p * RAD__MB_NR + 8);
+        const float *ap = a + (size_t)p * RAD__MB_MR;
+        for (i = 0; i < RAD__MB_MR; ++i) {
+            __m256 av = _mm256_broadcast_ss(ap + i);
+#if defined(RAD__MB_FMA)
+            c0[i] = _mm256_fmadd_ps(av, b0, c0[i]);
+            c1[i] = _mm256_fmadd_ps(av, b1, c1[i]);
+#else
+            c0[i] = _mm256_add_ps(c0[i], _mm256_mul_ps(av, b0));
+            c1[i] = _mm256_add_ps(c1[i], _mm256_mul_ps(av, b1));
+#endif
+        }
+    }
+    if (mr == RAD__MB_MR && nr == RAD__MB_NR) {
+        for (i = 0; i < RAD__MB_MR; ++i) {
+            float *ci = c + (size_t)i * ldc;
+            _mm256_storeu_ps(ci, _mm256_add_ps(_mm256_loadu_ps(ci), c0[i]));
+            _mm256_storeu_ps(ci + 8, _mm256_add_ps(_mm256_loadu_ps(ci + 8), c1[i]));
+        }
+        return;
+    }
+    for (i = 0; i < RAD__MB_MR; ++i) { _mm256_storeu_ps(tmp[i], c0[i]); _mm256_storeu_ps(tmp[i] + 8, c1[i]); }
+#else
+    float tmp[RAD__MB_MR][RAD__MB_NR];
+    memset(tmp, 0, sizeof(tmp));
+    for (p = 0; p < kc; ++p) {
+        const float *ap = a + (size_t)p * RAD__MB_MR, *bq = b + (size_t)p * RAD__MB_NR;
+        for (i = 0; i < RAD__MB_MR; ++i) {
+            float av = ap[i];
+            for (j = 0; j < RAD__MB_NR; ++j) tmp[i][j] += av * bq[j];
+        }
+    }
+#endif
+    for (i = 0; i < mr; ++i)
+        for (j = 0; j < nr; ++j) c[(size_t)i * ldc + j] += tmp[i][j];
+}
+
+static void rad__gemm_task(void *data, uint32_t t)
+{
+    const rad__gemm *g = (const rad__gemm *)data;
+    uint32_t ic = t * RAD__MB_MC, mc = g->m - ic < RAD__MB_MC ? g->m - ic : RAD__MB_MC, q, p, i, kk;
+    float *ap = g->ap + (size_t)t * RAD__MB_MC * RAD__MB_KC;
+    uint32_t panels_a = (mc + RAD__MB_MR - 1) / RAD__MB_MR, panels_b = (g->nc + RAD__MB_NR - 1) / RAD__MB_NR;
+    for (q = 0; q < panels_a; ++q)
+        for (kk = 0; kk < g->kc; ++kk)
+            for (i = 0; i < RAD__MB_MR; ++i) {
+                uint32_t row = q * RAD__MB_MR + i;
+                ap[((size_t)q * g->kc + kk) * RAD__MB_MR + i] = row < mc ? g->A[(size_t)(ic + row) * g->lda + g->pc + kk] : 0.0f;
+            }
+    for (p = 0; p < panels_b; ++p) {
+        uint32_t nr = g->nc - p * RAD__MB_NR < RAD__MB_NR ? g->nc - p * RAD__MB_NR : RAD__MB_NR;
+        for (q = 0; q < panels_a; ++q) {
+            uint32_t mr = mc - q * RAD__MB_MR < RAD__MB_MR ? mc - q * RAD__MB_MR : RAD__MB_MR;
+            rad__mb_kernel(g->kc, ap + (size_t)q * g->kc * RAD__MB_MR, g->bp + (size_t)p * g->kc * RAD__MB_NR,
+                           g->C + (size_t)(ic + q * RAD__MB_MR) * g->ldc + g->jc + p * RAD__MB_NR, g->ldc, mr, nr);
+        }
+    }
+}
+
+/* C += A B. The summation order of every entry is fixed (k blocks in order), so the bits do
+   not depend on the number of tasks. */
+static rad_result rad__mb_gemm(const rad__ctx *c, uint32_t m, uint32_t n, uint32_t k, const float *A, size_t lda,
+                               const float *B, size_t ldb, float *C, size_t ldc)
+{
+    rad__gemm g;
+    float *bp, *ap;
+    uint32_t chunks = (m + RAD__MB_MC - 1) / RAD__MB_MC, jc, pc;
+    size_t bp_count = (size_t)RAD__MB_KC * (RAD__MB_NC + RAD__MB_NR), ap_count;
+    if (m == 0 || n == 0 || k == 0) return RAD_SUCCESS;
+    if (!rad__mul((size_t)chunks, (size_t)RAD__MB_MC * RAD__MB_KC, &ap_count)) return RAD_ERROR_SIZE_OVERFLOW;
+    bp = (float *)rad__alloc_array(&c->allocator, bp_count, sizeof(float));
+    ap = (float *)rad__alloc_array(&c->allocator, ap_count, sizeof(float));
+    if (!bp || !ap) { rad__free(&c->allocator, bp); rad__free(&c->allocator, ap); return RAD_ERROR_OUT_OF_MEMORY; }
+    g.A = A; g.B = B; g.C = C; g.lda = lda; g.ldb = ldb; g.ldc = ldc; g.m = m; g.n = n; g.k = k;
+    g.bp = bp; g.ap = ap;
+    for (jc = 0; jc < n; jc += RAD__MB_NC) {
+        g.jc = jc;
+        g.nc = n - jc < RAD__MB_NC ? n - jc : RAD__MB_NC;
+        for (pc = 0; pc < k; pc += RAD__MB_KC) {
+            uint32_t panels = (g.nc + RAD__MB_NR - 1) / RAD__MB_NR, p, kk, j;
+            g.pc = pc;
+            g.kc = k - pc < RAD__MB_KC ? k - pc : RAD__MB_KC;
+            for (p = 0; p < panels; ++p)
+                for (kk = 0; kk < g.kc; ++kk) {
+                    float *dst = bp + ((size_t)p * g.kc + kk) * RAD__MB_NR;
+                    const float *src = B + (size_t)(pc + kk) * ldb + jc + p * RAD__MB_NR;
+                    uint32_t cols = g.nc - p * RAD__MB_NR < RAD__MB_NR ? g.nc - p * RAD__MB_NR : RAD__MB_NR;
+                    for (j = 0; j < cols; ++j) dst[j] = src[j];
+                    for (; j < RAD__MB_NR; ++j) dst[j] = 0.0f;
+                }
+            c->parallel_for(c->parallel_user, chunks, rad__gemm_task, &g);
+        }
+    }
+    rad__free(&c->allocator, bp);
+    rad__free(&c->allocator, ap);
+    return RAD_SUCCESS;
+}
+
+/* ---- building F_mb ---- */
+
+static double rad__mb_max_row_sum(const float *M, uint32_t n)
+{
+    double best = 0.0;
+    uint32_t i, j;
+    for (i = 0; i < n; ++i) {
+        double s = 0.0;
+        const float *row = M + (size_t)i * n;
+        for (j = 0; j < n; ++j) s += fabs((double)row[j]);
+        if (s > best) best = s;
+    }
+    return best;
+}
+
+typedef struct rad__mb_build {
+    const rad__ctx *c;
+    uint32_t n, products, total;
+    size_t nn;
+} rad__mb_build;
+
+/* dst = add (or 0) + X Y */
+static rad_result rad__mb_product(rad__mb_build *b, float *dst, const float *add, const float *X, const float *Y)
+{
+    rad_result r;
+    if (add) memcpy(dst, add, b->nn * sizeof(float));
+    else memset(dst, 0, b->nn * sizeof(float));
+    r = rad__mb_gemm(b->c, b->n, b->n, b->n, X, b->n, Y, b->n, dst, b->n);
+    if (r != RAD_SUCCESS) return r;
+    ++b->products;
+    if (b->c->progress && b->c->progress(b->c->progress_user, b->total ? (float)b->products / (float)b->total : 0.5f))
+        return RAD_ERROR_CANCELLED;
+    return RAD_SUCCESS;
+}
+
+/* S = sum_{k=1..K} A^k into out (A, s, t, p, q are n*n scratch; A holds rho o F) */
+static rad_result rad__mb_series(rad__mb_build *b, uint32_t K, double tol, uint32_t max_doublings, float *A, float *s,
+                                 float *t, float *p, float *q, float *out)
+{
+    float *S = s, *T = t, *P = A, *Q = p, *R = q, *swap;
+    rad_result r = RAD_SUCCESS;
+    int bit = 31;
+    memcpy(S, A, b->nn * sizeof(float));
+    if (K == RAD_MB_INFINITE) {
+        uint32_t d = 0;
+        while (rad__mb_max_row_sum(P, b->n) > tol) {
+            if (d++ >= max_doublings) {
+                rad__log(b->c, RAD_LOG_ERROR, "multibounce: ||(rho o F)^m|| still above %g after %u doublings", tol, max_doublings);
+                return RAD_ERROR_NOT_CONVERGED;
+            }
+            r = rad__mb_product(b, T, S, P, S);                      /* S_2m = S_m + A^m S_m */
+            if (r != RAD_SUCCESS) return r;
+            swap = S; S = T; T = swap;
+            r = rad__mb_product(b, Q, NULL, P, P);                   /* A^2m */
+            if (r != RAD_SUCCESS) return r;
+            swap = P; P = Q; Q = (swap == A) ? R : swap;
+        }
+    } else {
+        while (bit > 0 && !((K >> bit) & 1u)) --bit;
+        for (--bit; bit >= 0; --bit) {
+            int more = bit > 0;
+            r = rad__mb_product(b, T, S, P, S);                      /* S_2m = S_m + A^m S_m */
+            if (r != RAD_SUCCESS) return r;
+            swap = S; S = T; T = swap;
+            if (more) {
+                r = rad__mb_product(b, Q, NULL, P, P);               /* A^2m */
+                if (r != RAD_SUCCESS) return r;
+                swap = P; P = Q; Q = (swap == A) ? R : swap;
+            }
+            if ((K >> bit) & 1u) {
+                r = rad__mb_product(b, T, A, A, S);                  /* S_m+1 = A + A S_m */
+                if (r != RAD_SUCCESS) return r;
+                swap = S; S = T; T = swap;
+                if (more) {
+                    r = rad__mb_product(b, Q, NULL, A, P);           /* A^m+1 */
+                    if (r != RAD_SUCCESS) return r;
+                    swap = P; P = Q; Q = swap;
+                }
+            }
+        }
+    }
+    memcpy(out, S, b->nn * sizeof(float));
+    return RAD_SUCCESS;
+}
+
+static uint32_t rad__mb_products(uint32_t K)
+{
+    uint32_t n = 0;
+    int bit = 31;
+    if (K == RAD_MB_INFINITE) return 0;
+    while (bit > 0 && !((K >> bit) & 1u)) --bit;
+    for (--bit; bit >= 0; --bit) n += (bit > 0 ? 2u : 1u) + (((K >> bit) & 1u) ? (bit > 0 ? 2u : 1u) : 0u);
+    return n;
+}
+
+RAD_API rad_result rad_multibounce_create(const rad_matrix *F, const float *albedo, const rad_multibounce_options *options,
+                                          const rad_context *ctx, rad_multibounce **out)
+{
+    rad__ctx c;
+    rad_multibounce_options o;
+    rad_multibounce *mb = NULL;
+    rad__mb_build b;
+    float *scratch = NULL, *planes = NULL;
+    size_t nn, bytes[1];
+    void *parts[1];
+    uint32_t n, ch, i, j;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    r = rad__check_matrix(F);
+    if (r != RAD_SUCCESS || !albedo) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) o = *options; else rad_multibounce_options_default(&o);
+    if (o.bounces == 0 || (o.precision != RAD_MB_FLOAT && o.precision != RAD_MB_HALF) || !(o.tolerance >= 0.0)) {
+        rad__log(&c, RAD_LOG_ERROR, "multibounce: bounces must be >= 1 (or RAD_MB_INFINITE), precision float or half");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (o.tolerance == 0.0) o.tolerance = 1e-8;
+    if (o.max_doublings == 0) o.max_doublings = 40;
+    n = F->rows;
+    if (n == 0 || F->cols != n) {
+        rad__log(&c, RAD_LOG_ERROR, "multibounce: the matrix is %u x %u, not square", F->rows, F->cols);
+        return n == 0 ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_SIZE_MISMATCH;
+    }
+    for (i = 0; i < 3 * n; ++i)
+        if (!(albedo[i] >= 0.0f && albedo[i] < 1.0f)) {
+            rad__log(&c, RAD_LOG_ERROR, "multibounce: albedo %g of patch %u is outside [0,1)", (double)albedo[i], i / 3u);
+            return RAD_ERROR_ALBEDO_RANGE;
+        }
+    if (!rad__mul((size_t)n, (size_t)n, &nn) || !rad__mul3(nn, 3, sizeof(float), &bytes[0])) return RAD_ERROR_SIZE_OVERFLOW;
+    mb = (rad_multibounce *)rad__alloc(&c.allocator, sizeof(*mb));
+    scratch = (float *)rad__alloc_array(&c.allocator, nn, 5 * sizeof(float));
+    if (!mb || !scratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
+    memset(mb, 0, sizeof(*mb));
+    mb->allocator = c.allocator;
+    mb->storage = rad__mb_carve(&c, bytes, 1, parts, &r);
+    if (!mb->storage) goto fail;
+    planes = (float *)parts[0];
+    b.c = &c; b.n = n; b.nn = nn; b.products = 0;
+    b.total = 3u * rad__mb_products(o.bounces);
+    for (ch = 0; ch < 3; ++ch) {
+        float *A = scratch;
+        for (i = 0; i < n; ++i) {
+            float rho = albedo[3 * (size_t)i + ch], *row = A + (size_t)i * n;
+            if (F->storage == RAD_STORAGE_DENSE) {
+                const float *fr = F->dense + (size_t)i * n;
+                for (j = 0; j < n; ++j) row[j] = rho * fr[j];
+            } else {
+                uint64_t q;
+                memset(row, 0, (size_t)n * sizeof(float));
+                for (q = F->row_offsets[i]; q < F->row_offsets[i + 1]; ++q)
+                    if (F->columns[q] < n) row[F->columns[q]] = rho * F->values[q];
+            }
+        }
+        r = rad__mb_series(&b, o.bounces, o.tolerance, o.max_doublings, A, scratch + nn, scratch + 2 * nn, scratch + 3 * nn,
+                           scratch + 4 * nn, planes + (size_t)ch * nn);
+        if (r != RAD_SUCCESS) goto fail;
+    }
+    rad__free(&c.allocator, scratch);
+    scratch = NULL;
+    mb->n = n;
+    mb->bounces = o.bounces;
+    mb->precision = RAD_MB_FLOAT;
+    mb->planes = planes;
+    rad__mb_info(mb->info, 0u, n, o.bounces, 0u, 0u, 0u);
+    if (o.precision == RAD_MB_HALF) {
+        rad_multibounce *h = NULL;
+        r = rad_multibounce_convert(mb, RAD_MB_HALF, ctx, &h);
+        rad_multibounce_destroy(mb);
+        if (r != RAD_SUCCESS) return r;
+        mb = h;
+    }
+    *out = mb;
+    return RAD_SUCCESS;
+fail:
+    rad__free(&c.allocator, scratch);
+    rad_multibounce_destroy(mb);
+    return r;
+}
+
+/* a new object of n, k, precision, with room for permutations when perms */
+static rad_result rad__mb_new(const rad__ctx *c, uint32_t n, uint32_t k, rad_mb_precision precision, int perms,
+                              rad_multibounce **out)
+{
+    rad_multibounce *mb;
+    size_t nn, bytes[3];
+    void *parts[3];
+    rad_result r;
+    if (!rad__mul((size_t)n, (size_t)n, &nn) || !rad__mul3(nn, 3, precision == RAD_MB_HALF ? 2u : 4u, &bytes[0]))
+        return RAD_ERROR_SIZE_OVERFLOW;
+    bytes[1] = bytes[2] = perms ? (size_t)n * sizeof(uint32_t) : 0;
+    mb = (rad_multibounce *)rad__alloc(&c->allocator, sizeof(*mb));
+    if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(mb, 0, sizeof(*mb));
+    mb->allocator = c->allocator;
+    mb->storage = rad__mb_carve(c, bytes, 3, parts, &r);
+    if (!mb->storage) { rad__free(&c->allocator, mb); return r; }
+    mb->n = n;
+    mb->bounces = k;
+    mb->precision = precision;
+    if (precision == RAD_MB_HALF) mb->half = (const uint16_t *)parts[0];
+    else mb->planes = (const float *)parts[0];
+    mb->row_perm = (const uint32_t *)parts[1];
+    mb->col_perm = (const uint32_t *)parts[2];
+    rad__mb_info(mb->info, precision == RAD_MB_HALF ? 1u : 0u, n, k, 0u, 0u, perms ? 1u : 0u);
+    *out = mb;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__mb_check(const rad_multibounce *mb)
+{
+    if (!mb || mb->n == 0) return RAD_ERROR_INVALID_ARGUMENT;
+    if (mb->precision == RAD_MB_FLOAT ? !mb->planes : (mb->precision != RAD_MB_HALF || !mb->half)) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((mb->row_perm == NULL) != (mb->col_perm == NULL)) return RAD_ERROR_INVALID_ARGUMENT;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_multibounce_convert(const rad_multibounce *src, rad_mb_precision precision, const rad_context *ctx,
+                                           rad_multibounce **out)
+{
+    rad__ctx c;
+    rad_multibounce *mb = NULL;
+    size_t i, total;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (rad__mb_check(src) != RAD_SUCCESS || (precision != RAD_MB_FLOAT && precision != RAD_MB_HALF)) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__mb_new(&c, src->n, src->bounces, precision, src->row_perm != NULL, &mb);
+    if (r != RAD_SUCCESS) return r;
+    total = 3 * (size_t)src->n * src->n;
+    if (precision == RAD_MB_HALF) {
+        uint16_t *h = (uint16_t *)mb->half;
+        for (i = 0; i < total; ++i) h[i] = src->planes ? rad_half_from_float(src->planes[i]) : src->half[i];
+    } else {
+        float *f = (float *)mb->planes;
+        for (i = 0; i < total; ++i) f[i] = src->planes ? src->planes[i] : rad_half_to_float(src->half[i]);
+    }
+    if (src->row_perm) {
+        memcpy((uint32_t *)mb->row_perm, src->row_perm, (size_t)src->n * sizeof(uint32_t));
+        memcpy((uint32_t *)mb->col_perm, src->col_perm, (size_t)src->n * sizeof(uint32_t));
+    }
+    *out = mb;
+    return RAD_SUCCESS;
+}
+
+/* ---- applying F_mb ---- */
+
+static float rad__mb_dot(const float *a, const float *x, uint32_t n)
+{
+    uint32_t j = 0;
+    float s = 0.0f;
+#if defined(RAD__AVX)
+    {
+        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
+        float t[8];
+        int k;
+        for (; j + 32 <= n; j += 32) {
+            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(x + j)));
+            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_loadu_ps(a + j + 8), _mm256_loadu_ps(x + j + 8)));
+            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_loadu_ps(a + j + 16), _mm256_loadu_ps(x + j + 16)));
+            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_loadu_ps(a + j + 24), _mm256_loadu_ps(x + j + 24)));
+        }
+        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
+        for (k = 0; k < 8; ++k) s += t[k];
+    }
+#endif
+    for (; j < n; ++j) s += a[j] * x[j];
+    return s;
+}
+
+static float rad__mb_dot_half(const uint16_t *a, const float *x, uint32_t n)
+{
+    uint32_t j = 0;
+    float s = 0.0f;
+#if defined(RAD__MB_F16C)
+    {
+        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
+        float t[8];
+        int k;
+        for (; j + 32 <= n; j += 32) {
+            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j))), _mm256_loadu_ps(x + j)));
+            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 8))), _mm256_loadu_ps(x + j + 8)));
+            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 16))), _mm256_loadu_ps(x + j + 16)));
+            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 24))), _mm256_loadu_ps(x + j + 24)));
+        }
+        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
+        for (k = 0; k < 8; ++k) s += t[k];
+    }
+#endif
+    for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
+    return s;
+}
+
+typedef struct rad__mb_apply {
+    const rad_multibounce *mb;
+    const float *x;    /* 3 n, SoA, permuted column order */
+    float *y;          /* 3 n, SoA, permuted row order */
+    uint32_t tasks;
+} rad__mb_apply;
+
+static void rad__mb_apply_task(void *data, uint32_t t)
+{
+    const rad__mb_apply *a = (const rad__mb_apply *)data;
+    uint32_t n = a->mb->n, i0 = (uint32_t)((uint64_t)n * t / a->tasks), i1 = (uint32_t)((uint64_t)n * (t + 1) / a->tasks), i, ch;
+    size_t nn = (size_t)n * n;
+    for (i = i0; i < i1; ++i)
+        for (ch = 0; ch < 3; ++ch) {
+            size_t at = ch * nn + (size_t)i * n;
+            a->y[ch * (size_t)n + i] = a->mb->planes ? rad__mb_dot(a->mb->planes + at, a->x + ch * (size_t)n, n)
+                                                     : rad__mb_dot_half(a->mb->half + at, a->x + ch * (size_t)n, n);
+        }
+}
+
+/* x (SoA, 3 * padded) = E permuted by col_perm (zero padding up to 'padded') */
+static void rad__mb_gather(const float *E, const uint32_t *col_perm, uint32_t n, uint32_t padded, float *x)
+{
+    uint32_t j, ch;
+    for (ch = 0; ch < 3; ++ch) {
+        float *xc = x + (size_t)ch * padded;
+        for (j = 0; j < n; ++j) xc[j] = E[3 * (size_t)(col_perm ? col_perm[j] : j) + ch];
+        for (; j < padded; ++j) xc[j] = 0.0f;
+    }
+}
+
+/* out (interleaved) = y (SoA, stride 'stride', permuted rows) un-permuted */
+static void rad__mb_scatter(const float *y, uint32_t stride, const uint32_t *row_perm, uint32_t n, float *out)
+{
+    uint32_t i, ch;
+    for (i = 0; i < n; ++i)
+        for (ch = 0; ch < 3; ++ch) out[3 * (size_t)(row_perm ? row_perm[i] : i) + ch] = y[(size_t)ch * stride + i];
+}
+
+RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float *E, float *out, rad_output output,
+                                         const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__mb_apply a;
+    float *x;
+    uint32_t n;
+    size_t i;
+    rad__ctx_init(&c, ctx);
+    if (rad__mb_check(mb) != RAD_SUCCESS || !E || !out || E == out) return RAD_ERROR_INVALID_ARGUMENT;
+    n = mb->n;
+    x = (float *)rad__alloc_array(&c.allocator, (size_t)n, 6 * sizeof(float));
+    if (!x) return RAD_ERROR_OUT_OF_MEMORY;
+    rad__mb_gather(E, mb->col_perm, n, n, x);
+    a.mb = mb;
+    a.x = x;
+    a.y = x + 3 * (size_t)n;
+    a.tasks = c.tasks < n ? c.tasks : n;
+    c.parallel_for(c.parallel_user, a.tasks, rad__mb_apply_task, &a);
+    rad__mb_scatter(a.y, n, mb->row_perm, n, out);
+    if (output == RAD_OUTPUT_TOTAL)
+        for (i = 0; i < 3 * (size_t)n; ++i) out[i] += E[i];
+    rad__free(&c.allocator, x);
+    return RAD_SUCCESS;
+}
+
+/* ---- greedy reordering (thesis Listing 3.1) ---- */
+
+/* Greedy chain over the n items whose Gram matrix is G (n x n): order[0] = 0, then each next
+   item is the unplaced one nearest (L2, |a|^2 + |b|^2 - 2 a.b) to the last placed. O(n^2). */
+static rad_result rad__mb_chain(const rad__ctx *c, const float *G, uint32_t n, uint32_t *order)
+{
+    unsigned char *used = (unsigned char *)rad__alloc(&c->allocator, n);
+    uint32_t p, j, cur = 0;
+    if (!used) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(used, 0, n);
+    order[0] = 0;
+    used[0] = 1;
+    for (p = 1; p < n; ++p) {
+        const float *g = G + (size_t)cur * n;
+        double best = DBL_MAX;
+        uint32_t bj = 0;
+        for (j = 0; j < n; ++j) {
+            double d;
+            if (used[j]) continue;
+            d = (double)G[(size_t)j * n + j] - 2.0 * (double)g[j];   /* |cur|^2 is the same for all j */
+            if (d < best) { best = d; bj = j; }
+        }
+        order[p] = bj;
+        used[bj] = 1;
+        cur = bj;
+    }
+    rad__free(&c->allocator, used);
+    return RAD_SUCCESS;
+}
+
+/* Row and column orders of the RGB planes W (3 n^2 floats) by the greedy chain, distances over
+   all 3n coordinates of a row/column (samples == 0) or over 'samples' evenly spaced ones. */
+static rad_result rad__mb_reorder_perms(const rad__ctx *c, const float *W, uint32_t n, uint32_t samples, uint32_t *row_perm,
+                                        uint32_t *col_perm)
+{
+    uint32_t coords = 3u * n, s, i, j, pass;
+    size_t nn = (size_t)n * n;
+    float *X = NULL, *XT = NULL, *G = NULL;
+    rad_result r = RAD_SUCCESS;
+    if (samples == 0 || samples > coords) samples = coords;
+    X = (float *)rad__alloc_array(&c->allocator, (size_t)samples * n, sizeof(float));
+    XT = (float *)rad__alloc_array(&c->allocator, (size_t)samples * n, sizeof(float));
+    G = (float *)rad__alloc_array(&c->allocator, nn, sizeof(float));
+    if (!X || !XT || !G) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (pass = 0; pass < 2 && r == RAD_SUCCESS; ++pass) {
+        /* pass 0, columns: X (samples x n) holds sampled rows (coordinates) of the stacked planes;
+           pass 1, rows: X holds sampled columns; G = X^T X */
+        for (s = 0; s < samples; ++s) {
+            uint32_t coord = (uint32_t)((uint64_t)s * coords / samples), ch = coord / n, k = coord % n;
+            const float *P = W + (size_t)ch * nn;
+            for (j = 0; j < n; ++j) X[(size_t)s * n + j] = pass == 0 ? P[(size_t)k * n + j] : P[(size_t)j * n + k];
+        }
+        for (s = 0; s < samples; ++s)
+            for (i = 0; i < n; ++i) XT[(size_t)i * samples + s] = X[(size_t)s * n + i];
+        memset(G, 0, nn * sizeof(float));
+        r = rad__mb_gemm(c, n, n, samples, XT, samples, X, n, G, n);
+        if (r == RAD_SUCCESS) r = rad__mb_chain(c, G, n, pass == 0 ? col_perm : row_perm);
+    }
+done:
+    rad__free(&c->allocator, X);
+    rad__free(&c->allocator, XT);
+    rad__free(&c->allocator, G);
+    return r;
+}
+
+/* float planes of mb (widened into *owned when half) */
+static const float *rad__mb_float_planes(const rad__ctx *c, const rad_multibounce *mb, float **owned)
+{
+    size_t i, total = 3 * (size_t)mb->n * mb->n;
+    *owned = NULL;
+    if (mb->planes) return mb->planes;
+    *owned = (float *)rad__alloc_array(&c->allocator, total, sizeof(float));
+    if (!*owned) return NULL;
+    for (i = 0; i < total; ++i) (*owned)[i] = rad_half_to_float(mb->half[i]);
+    return *owned;
+}
+
+RAD_API rad_result rad_multibounce_reorder(const rad_multibounce *src, uint32_t samples, const rad_context *ctx,
+                                           rad_multibounce **out)
+{
+    rad__ctx c;
+    rad_multibounce *mb = NULL;
+    float *owned = NULL;
+    const float *W;
+    uint32_t n, i, j, ch;
+    size_t nn;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (rad__mb_check(src) != RAD_SUCCESS || src->row_perm) return RAD_ERROR_INVALID_ARGUMENT;
+    n = src->n;
+    nn = (size_t)n * n;
+    r = rad__mb_new(&c, n, src->bounces, src->precision, 1, &mb);
+    if (r != RAD_SUCCESS) return r;
+    W = rad__mb_float_planes(&c, src, &owned);
+    if (!W) { rad_multibounce_destroy(mb); return RAD_ERROR_OUT_OF_MEMORY; }
+    r = rad__mb_reorder_perms(&c, W, n, samples, (uint32_t *)mb->row_perm, (uint32_t *)mb->col_perm);
+    if (r == RAD_SUCCESS)
+        for (ch = 0; ch < 3; ++ch)
+            for (i = 0; i < n; ++i) {
+                size_t to = ch * nn + (size_t)i * n, from = ch * nn + (size_t)mb->row_perm[i] * n;
+                for (j = 0; j < n; ++j) {
+                    size_t f = from + mb->col_perm[j];
+                    if (src->planes) ((float *)mb->planes)[to + j] = src->planes[f];
+                    else ((uint16_t *)mb->half)[to + j] = src->half[f];
+                }
+            }
+    rad__free(&c.allocator, owned);
+    if (r != RAD_SUCCESS) { rad_multibounce_destroy(mb); return r; }
+    *out = mb;
+    return RAD_SUCCESS;
+}
+
+/* ---- BC1 and BC4 blocks (REFERENCE §4) ---- */
+
+static void rad__bc1_color(uint32_t c, float *rgb)
+{
+    rgb[0] = (float)((c >> 11) & 31u) / 31.0f;
+    rgb[1] = (float)((c >> 5) & 63u) / 63.0f;
+    rgb[2] = (float)(c & 31u) / 31.0f;
+}
+
+static void rad__bc1_palette(uint32_t c0, uint32_t c1, float pal[4][3])
+{
+    int k;
+    rad__bc1_color(c0, pal[0]);
+    rad__bc1_color(c1, pal[1]);
+    for (k = 0; k < 3; ++k) {
+        if (c0 > c1) {
+            pal[2][k] = (2.0f * pal[0][k] + pal[1][k]) / 3.0f;
+            pal[3][k] = (pal[0][k] + 2.0f * pal[1][k]) / 3.0f;
+        } else {
+            pal[2][k] = (pal[0][k] + pal[1][k]) / 2.0f;
+            pal[3][k] = 0.0f;
+        }
+    }
+}
+
+static void rad__bc4_palette(uint32_t r0, uint32_t r1, float pal[8])
+{
+    int k;
+    pal[0] = (float)r0 / 255.0f;
+    pal[1] = (float)r1 / 255.0f;
+    if (r0 > r1) {
+        for (k = 2; k < 8; ++k) pal[k] = ((float)(8 - k) * pal[0] + (float)(k - 1) * pal[1]) / 7.0f;
+    } else {
+        for (k = 2; k < 6; ++k) pal[k] = ((float)(6 - k) * pal[0] + (float)(k - 1) * pal[1]) / 5.0f;
+        pal[6] = 0.0f;
+        pal[7] = 1.0f;
+    }
+}
+
+static uint64_t rad__bc4_bits(const uint8_t *b)
+{
+    return (uint64_t)b[2] | (uint64_t)b[3] << 8 | (uint64_t)b[4] << 16 | (uint64_t)b[5] << 24 | (uint64_t)b[6] << 32 |
+           (uint64_t)b[7] << 40;
+}
+
+RAD_API void rad_bc1_decode_block(const uint8_t block[8], float out_rgb[48])
+{
+    float pal[4][3];
+    uint32_t c0 = (uint32_t)block[0] | (uint32_t)block[1] << 8, c1 = (uint32_t)block[2] | (uint32_t)block[3] << 8;
+    uint32_t w = (uint32_t)block[4] | (uint32_t)block[5] << 8 | (uint32_t)block[6] << 16 | (uint32_t)block[7] << 24, t;
+    rad__bc1_palette(c0, c1, pal);
+    for (t = 0; t < 16; ++t) {
+        const float *p = pal[(w >> (2 * t)) & 3u];
+        out_rgb[3 * t] = p[0];
+        out_rgb[3 * t + 1] = p[1];
+        out_rgb[3 * t + 2] = p[2];
+    }
+}
+
+RAD_API void rad_bc4_decode_block(const uint8_t block[8], float out_values[16])
+{
+    float pal[8];
+    uint64_t bits = rad__bc4_bits(block);
+    uint32_t t;
+    rad__bc4_palette(block[0], block[1], pal);
+    for (t = 0; t < 16; ++t) out_values[t] = pal[(bits >> (3 * t)) & 7u];
+}
+
+static float rad__clamp01(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; } /* NaN -> 0 */
+
+static uint32_t rad__bc1_pack(const float *rgb)
+{
+    uint32_t r = (uint32_t)(rad__clamp01(rgb[0]) * 31.0f + 0.5f), g = (uint32_t)(rad__clamp01(rgb[1]) * 63.0f + 0.5f),
+             b = (uint32_t)(rad__clamp01(rgb[2]) * 31.0f + 0.5f);
+    return r << 11 | g << 5 | b;
+}
+
+/* squared error of endpoints (c0, c1) with the best code per texel; codes into *w */
+static float rad__bc1_eval(const float *rgb, uint32_t c0, uint32_t c1, uint32_t *w)
+{
+    float pal[4][3], err = 0.0f;
+    uint32_t t, k, codes = 0;
+    rad__bc1_palette(c0, c1, pal);
+    for (t = 0; t < 16; ++t) {
+        float best = FLT_MAX;
+        uint32_t bk = 0;
+        for (k = 0; k < 4; ++k) {
+            float d0 = pal[k][0] - rgb[3 * t], d1 = pal[k][1] - rgb[3 * t + 1], d2 = pal[k][2] - rgb[3 * t + 2];
+            float d = d0 * d0 + d1 * d1 + d2 * d2;
+            if (d < best) { best = d; bk = k; }
+        }
+        codes |= bk << (2 * t);
+        err += best;
+    }
+    *w = codes;
+    return err;
+}
+
+/* endpoints along the principal axis of the texels with mask bit set */
+static void rad__bc1_fit(const float *rgb, uint32_t mask, float *e0, float *e1)
+{
+    double mean[3] = { 0, 0, 0 }, cov[6] = { 0, 0, 0, 0, 0, 0 }, axis[3] = { 1, 1, 1 }, tmin = DBL_MAX, tmax = -DBL_MAX;
+    uint32_t t, cnt = 0, it;
+    int k;
+    for (t = 0; t < 16; ++t)
+        if (mask >> t & 1u) { for (k = 0; k < 3; ++k) mean[k] += rgb[3 * t + k]; ++cnt; }
+    for (k = 0; k < 3; ++k) mean[k] /= (double)cnt;
+    for (t = 0; t < 16; ++t)
+        if (mask >> t & 1u) {
+            double d0 = rgb[3 * t] - mean[0], d1 = rgb[3 * t + 1] - mean[1], d2 = rgb[3 * t + 2] - mean[2];
+            cov[0] += d0 * d0; cov[1] += d0 * d1; cov[2] += d0 * d2; cov[3] += d1 * d1; cov[4] += d1 * d2; cov[5] += d2 * d2;
+        }
+    for (it = 0; it < 8; ++it) {
+        double a0 = cov[0] * axis[0] + cov[1] * axis[1] + cov[2] * axis[2];
+        double a1 = cov[1] * axis[0] + cov[3] * axis[1] + cov[4] * axis[2];
+        double a2 = cov[2] * axis[0] + cov[4] * axis[1] + cov[5] * axis[2];
+        double l = sqrt(a0 * a0 + a1 * a1 + a2 * a2);
+        if (!(l > 1e-30)) break;
+        axis[0] = a0 / l; axis[1] = a1 / l; axis[2] = a2 / l;
+    }
+    for (t = 0; t < 16; ++t)
+        if (mask >> t & 1u) {
+            double p = (rgb[3 * t] - mean[0]) * axis[0] + (rgb[3 * t + 1] - mean[1]) * axis[1] + (rgb[3 * t + 2] - mean[2]) * axis[2];
+            if (p < tmin) tmin = p;
+            if (p > tmax) tmax = p;
+        }
+    for (k = 0; k < 3; ++k) {
+        e0[k] = (float)(mean[k] + tmax * axis[k]);
+        e1[k] = (float)(mean[k] + tmin * axis[k]);
+    }
+}
+
+/* least-squares endpoints for the codes w in the given mode; returns 0 when singular */
+static int rad__bc1_refit(const float *rgb, uint32_t w, int four, float *e0, float *e1)
+{
+    double aa = 0, ab = 0, bb = 0, ax[3] = { 0, 0, 0 }, bx[3] = { 0, 0, 0 }, det;
+    uint32_t t;
+    int k;
+    for (t = 0; t < 16; ++t) {
+        uint32_t code = (w >> (2 * t)) & 3u;
+        double a, b;
+        if (four) {
+            static const double wa[4] = { 1.0, 0.0, 2.0 / 3.0, 1.0 / 3.0 };
+            a = wa[code];
+        } else {
+            static const double wa[4] = { 1.0, 0.0, 0.5, -1.0 };
+            if (code == 3u) continue;
+            a = wa[code];
+        }
+        b = 1.0 - a;
+        aa += a * a; ab += a * b; bb += b * b;
+        for (k = 0; k < 3; ++k) { ax[k] += a * rgb[3 * t + k]; bx[k] += b * rgb[3 * t + k]; }
+    }
+    det = aa * bb - ab * ab;
+    if (!(fabs(det) > 1e-12)) return 0;
+    for (k = 0; k < 3; ++k) {
+        e0[k] = (float)((ax[k] * bb - bx[k] * ab) / det);
+        e1[k] = (float)((bx[k] * aa - ax[k] * ab) / det);
+    }
+    return 1;
+}
+
+RAD_API void rad_bc1_encode_block(const float rgb_in[48], uint8_t out[8])
+{
+    float rgb[48], e0[3], e1[3], best = FLT_MAX;
+    uint32_t t, mask = 0, bc0 = 0, bc1 = 0, bw = 0, mode, it;
+    for (t = 0; t < 48; ++t) rgb[t] = rad__clamp01(rgb_in[t]);
+    for (t = 0; t < 16; ++t)
+        if (rgb[3 * t] > 0.0f || rgb[3 * t + 1] > 0.0f || rgb[3 * t + 2] > 0.0f) mask |= 1u << t;
+    if (mask == 0) { memset(out, 0, 8); return; } /* all black: c0 = c1 = 0, codes 0 */
+    for (mode = 0; mode < 2; ++mode) {             /* 0: four colours (c0 > c1), 1: three + black */
+        rad__bc1_fit(rgb, mode == 0 ? 0xFFFFu : mask, e0, e1);
+        for (it = 0; it < 3; ++it) {
+            uint32_t c0 = rad__bc1_pack(e0), c1 = rad__bc1_pack(e1), w;
+            float err;
+            if (mode == 0 ? c0 < c1 : c0 > c1) { uint32_t s = c0; c0 = c1; c1 = s; }
+            err = rad__bc1_eval(rgb, c0, c1, &w);
+            if (err < best) { best = err; bc0 = c0; bc1 = c1; bw = w; }
+            if (!rad__bc1_refit(rgb, w, c0 > c1, e0, e1)) break;
+        }
+    }
+    out[0] = (uint8_t)bc0; out[1] = (uint8_t)(bc0 >> 8);
+    out[2] = (uint8_t)bc1; out[3] = (uint8_t)(bc1 >> 8);
+    out[4] = (uint8_t)bw; out[5] = (uint8_t)(bw >> 8); out[6] = (uint8_t)(bw >> 16); out[7] = (uint8_t)(bw >> 24);
+}
+
+static float rad__bc4_eval(const float *v, uint32_t r0, uint32_t r1, uint64_t *bits)
+{
+    float pal[8], err = 0.0f;
+    uint64_t codes = 0;
+    uint32_t t, k;
+    rad__bc4_palette(r0, r1, pal);
+    for (t = 0; t < 16; ++t) {
+        float best = FLT_MAX;
+        uint32_t bk = 0;
+        for (k = 0; k < 8; ++k) {
+            float d = (pal[k] - v[t]) * (pal[k] - v[t]);
+            if (d < best) { best = d; bk = k; }
+        }
+        codes |= (uint64_t)bk << (3 * t);
+        err += best;
+    }
+    *bits = codes;
+    return err;
+}
+
+RAD_API void rad_bc4_encode_block(const float values[16], uint8_t out[8])
+{
+    float v[16], lo = 1.0f, hi = 0.0f, ilo = 1.0f, ihi = 0.0f, best = FLT_MAX;
+    uint64_t bbits = 0, bits;
+    uint32_t t, br0 = 0, br1 = 0;
+    int a, b, inner = 0;
+    for (t = 0; t < 16; ++t) {
+        v[t] = rad__clamp01(values[t]);
+        if (v[t] < lo) lo = v[t];
+        if (v[t] > hi) hi = v[t];
+        if (v[t] > 0.0f && v[t] < 1.0f) {
+            if (v[t] < ilo) ilo = v[t];
+            if (v[t] > ihi) ihi = v[t];
+            inner = 1;
+        }
+    }
+    /* eight-value mode (r0 > r1): endpoints around the range */
+    for (a = -1; a <= 1; ++a)
+        for (b = -1; b <= 1; ++b) {
+            int r0 = (int)ceil((double)hi * 255.0) + a, r1 = (int)floor((double)lo * 255.0) + b;
+            float err;
+            if (r0 > 255) r0 = 255;
+            if (r1 < 0) r1 = 0;
+            if (r0 <= r1) continue;
+            err = rad__bc4_eval(v, (uint32_t)r0, (uint32_t)r1, &bits);
+            if (err < best) { best = err; br0 = (uint32_t)r0; br1 = (uint32_t)r1; bbits = bits; }
+        }
+    /* six values plus exact 0 and 1 (r0 <= r1): endpoints around the values strictly inside */
+    if (!inner) ilo = ihi = 0.0f;
+    for (a = 0; a <= 1; ++a)
+        for (b = 0; b <= 1; ++b) {
+            int r0 = a ? (int)ceil((double)ilo * 255.0) : (int)floor((double)ilo * 255.0);
+            int r1 = b ? (int)ceil((double)ihi * 255.0) : (int)floor((double)ihi * 255.0);
+            float err;
+            if (r0 > r1) continue;
+            err = rad__bc4_eval(v, (uint32_t)r0, (uint32_t)r1, &bits);
+            if (err < best) { best = err; br0 = (uint32_t)r0; br1 = (uint32_t)r1; bbits = bits; }
+        }
+    out[0] = (uint8_t)br0;
+    out[1] = (uint8_t)br1;
+    for (t = 0; t < 6; ++t) out[2 + t] = (uint8_t)(bbits >> (8 * t));
+}
+
+/* ---- compression ---- */
+
+static uint32_t rad__mb_tile_index(const rad_multibounce_blocks *b, uint32_t bx, uint32_t by)
+{
+    if (b->tile == 0) return 0;
+    return (by * 4u / b->tile) * b->tiles_per_row + bx * 4u / b->tile;
+}
+
+static uint32_t rad__f32_bits(float f) { uint32_t u; memcpy(&u, &f, sizeof(u)); return u; }
+
+typedef struct rad__mb_encode {
+    rad_multibounce_blocks *b;
+    const float *Wp;        /* permuted working planes, outliers removed */
+    double *sse;            /* per block row */
+    float *max_err;         /* per block row */
+} rad__mb_encode;
+
+static rad_result rad__mb_encode_row(void *data, uint32_t by, uint32_t task)
+{
+    const rad__mb_encode *e = (const rad__mb_encode *)data;
+    rad_multibounce_blocks *b = e->b;
+    uint32_t n = b->n, bpr = b->blocks_per_row, bx, t, ch;
+    size_t nn = (size_t)n * n, nblocks = (size_t)bpr * bpr;
+    double sse = 0.0;
+    float maxe = 0.0f;
+    (void)task;
+    for (bx = 0; bx < bpr; ++bx) {
+        const float *scale = b->scales + 3 * (size_t)rad__mb_tile_index(b, bx, by);
+        float tex[48], dec[48];
+        for (t = 0; t < 16; ++t) {
+            uint32_t y = by * 4u + t / 4u, x = bx * 4u + t % 4u;
+            for (ch = 0; ch < 3; ++ch) {
+                float v = (y < n && x < n) ? e->Wp[ch * nn + (size_t)y * n + x] : 0.0f;
+                tex[3 * t + ch] = scale[ch] > 0.0f ? v / scale[ch] : 0.0f;
+            }
+        }
+        if (b->format == RAD_BLOCK_BC1) {
+            uint8_t *blk = (uint8_t *)b->blocks + 8 * ((size_t)by * bpr + bx);
+            rad_bc1_encode_block(tex, blk);
+            rad_bc1_decode_block(blk, dec);
+        } else {
+            for (ch = 0; ch < 3; ++ch) {
+                float v[16], d[16];
+                uint8_t *blk = (uint8_t *)b->blocks + 8 * (ch * nblocks + (size_t)by * bpr + bx);
+                for (t = 0; t < 16; ++t) v[t] = tex[3 * t + ch];
+                rad_bc4_encode_block(v, blk);
+                rad_bc4_decode_block(blk, d);
+                for (t = 0; t < 16; ++t) dec[3 * t + ch] = d[t];
+            }
+        }
+        for (t = 0; t < 16; ++t) {
+            uint32_t y = by * 4u + t / 4u, x = bx * 4u + t % 4u;
+            if (y >= n || x >= n) continue;
+            for (ch = 0; ch < 3; ++ch) {
+                float err = dec[3 * t + ch] * scale[ch] - e->Wp[ch * nn + (size_t)y * n + x];
+                sse += (double)err * err;
+                if (fabsf(err) > maxe) maxe = fabsf(err);
+            }
+        }
+    }
+    e->sse[by] = sse;
+    e->max_err[by] = maxe;
+    return RAD_SUCCESS;
+}
+
+/* threshold bits T and how many entries equal to T to take so that 'target' entries of the
+   largest magnitude are chosen (radix select on the float bits; magnitudes are >= 0) */
+static rad_result rad__mb_select(const rad__ctx *c, const float *W, size_t nn, uint64_t target, uint32_t *T, uint64_t *take_equal)
+{
+    uint64_t *hist = (uint64_t *)rad__alloc_array(&c->allocator, 65536u, sizeof(uint64_t)), above = 0;
+    size_t i;
+    uint32_t hb, lb;
+    if (!hist) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(hist, 0, 65536u * sizeof(uint64_t));
+    for (i = 0; i < nn; ++i) {
+        float m = fabsf(W[i]);
+        if (fabsf(W[nn + i]) > m) m = fabsf(W[nn + i]);
+        if (fabsf(W[2 * nn + i]) > m) m = fabsf(W[2 * nn + i]);
+        hist[rad__f32_bits(m) >> 16]++;
+    }
+    for (hb = 65535u; hb > 0 && above + hist[hb] < target; --hb) above += hist[hb];
+    memset(hist, 0, 65536u * sizeof(uint64_t));
+    for (i = 0; i < nn; ++i) {
+        float m = fabsf(W[i]);
+        uint32_t u;
+        if (fabsf(W[nn + i]) > m) m = fabsf(W[nn + i]);
+        if (fabsf(W[2 * nn + i]) > m) m = fabsf(W[2 * nn + i]);
+        u = rad__f32_bits(m);
+        if (u >> 16 == hb) hist[u & 0xFFFFu]++;
+    }
+    for (lb = 65535u; lb > 0 && above + hist[lb] < target; --lb) above += hist[lb];
+    *T = hb << 16 | lb;
+    *take_equal = target > above ? target - above : 0;
+    if (*T == 0) *take_equal = 0; /* zeros stay in place */
+    rad__free(&c->allocator, hist);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
+                                                 const rad_context *ctx, rad_multibounce_blocks **out,
+                                                 rad_block_report *report)
+{
+    rad__ctx c;
+    rad_block_options o;
+    rad_multibounce_blocks *b = NULL;
+    float *owned = NULL, *W = NULL, *Wp = NULL, *max_err = NULL;
+    double *sse = NULL;
+    const float *src;
+    uint32_t n, bpr, tpr, planes, i, j, ch, T = 0;
+    uint64_t target = 0, take_equal = 0, taken = 0, count = 0, *row_count = NULL;
+    size_t nn, nblocks, total, bytes[7];
+    void *parts[7];
+    rad__mb_encode enc;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (report) memset(report, 0, sizeof(*report));
+    if (rad__mb_check(mb) != RAD_SUCCESS || mb->row_perm) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) o = *options; else rad_block_options_default(&o);
+    if ((o.format != RAD_BLOCK_BC1 && o.format != RAD_BLOCK_BC4X3) || !(o.outlier_fraction >= 0.0f && o.outlier_fraction < 1.0f) ||
+        (o.tile % 4u) != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "blocks: bad options (format %d, outlier fraction %g, tile %u: a multiple of 4)", (int)o.format,
+                 (double)o.outlier_fraction, o.tile);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    n = mb->n;
+    nn = (size_t)n * n;
+    bpr = (n + 3u) / 4u;
+    tpr = o.tile ? (n + o.tile - 1u) / o.tile : 1u;
+    planes = o.format == RAD_BLOCK_BC1 ? 1u : 3u;
+    if (!rad__mul((size_t)bpr, (size_t)bpr, &nblocks) || !rad__mul3(nblocks, planes, 8, &bytes[0]) ||
+        !rad__mul3(nn, 3, sizeof(float), &total))
+        return RAD_ERROR_SIZE_OVERFLOW;
+    src = rad__mb_float_planes(&c, mb, &owned);
+    W = (float *)rad__alloc(&c.allocator, total);
+    row_count = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)n + 1u, sizeof(uint64_t));
+    sse = (double *)rad__alloc_array(&c.allocator, bpr, sizeof(double));
+    max_err = (float *)rad__alloc_array(&c.allocator, bpr, sizeof(float));
+    b = (rad_multibounce_blocks *)rad__alloc(&c.allocator, sizeof(*b));
+    if (!src || !W || !row_count || !sse || !max_err || !b) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(b, 0, sizeof(*b));
+    b->allocator = c.allocator;
+    memcpy(W, src, total);
+
+    /* 1. outliers: count per row in the order they will be taken */
+    if (o.outlier_fraction > 0.0f) {
+        target = (uint64_t)((double)o.outlier_fraction * (double)nn);
+        if (target > 0) {
+            r = rad__mb_select(&c, W, nn, target, &T, &take_equal);
+            if (r != RAD_SUCCESS) goto done;
+        }
+    }
+    row_count[0] = 0;
+    for (i = 0; i < n; ++i) {
+        uint64_t k = 0;
+        if (target > 0)
+            for (j = 0; j < n; ++j) {
+                size_t at = (size_t)i * n + j;
+                float m = fabsf(W[at]);
+                uint32_t u;
+                if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
+                if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
+                u = rad__f32_bits(m);
+                if (u > T || (u == T && taken < take_equal)) { if (u == T) ++taken; ++k; }
+            }
+        row_count[i + 1] = row_count[i] + k;
+    }
+    count = row_count[n];
+
+    /* storage: blocks, scales, permutations, outliers */
+    if (!rad__mul3((size_t)tpr * tpr, 3, sizeof(float), &bytes[1])) { r = RAD_ERROR_SIZE_OVERFLOW; goto done; }
+    bytes[2] = bytes[3] = o.reorder ? (size_t)n * sizeof(uint32_t) : 0;
+    bytes[4] = count ? ((size_t)n + 1u) * sizeof(uint64_t) : 0;
+    if (!rad__mul((size_t)count, sizeof(uint32_t), &bytes[5]) || !rad__mul3((size_t)count, 3, sizeof(float), &bytes[6])) {
+        r = RAD_ERROR_SIZE_OVERFLOW;
+        goto done;
+    }
+    b->storage = rad__mb_carve(&c, bytes, 7, parts, &r);
+    if (!b->storage) goto done;
+    b->n = n;
+    b->bounces = mb->bounces;
+    b->format = o.format;
+    b->blocks_per_row = bpr;
+    b->blocks = (const uint8_t *)parts[0];
+    b->tile = o.tile;
+    b->tiles_per_row = tpr;
+    b->scales = (const float *)parts[1];
+    b->row_perm = (const uint32_t *)parts[2];
+    b->col_perm = (const uint32_t *)parts[3];
+    b->outlier_count = count;
+    b->outlier_offsets = (const uint64_t *)parts[4];
+    b->outlier_columns = (const uint32_t *)parts[5];
+    b->outlier_values = (const float *)parts[6];
+    if (count) {
+        uint64_t *off = (uint64_t *)b->outlier_offsets, k = 0;
+        uint32_t *cols = (uint32_t *)b->outlier_columns;
+        float *vals = (float *)b->outlier_values;
+        memcpy(off, row_count, ((size_t)n + 1u) * sizeof(uint64_t));
+        taken = 0;
+        for (i = 0; i < n; ++i)
+            for (j = 0; j < n; ++j) {
+                size_t at = (size_t)i * n + j;
+                float m = fabsf(W[at]);
+                uint32_t u;
+                if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
+                if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
+                u = rad__f32_bits(m);
+                if (u > T || (u == T && taken < take_equal)) {
+                    if (u == T) ++taken;
+                    cols[k] = j;
+                    for (ch = 0; ch < 3; ++ch) { vals[3 * k + ch] = W[ch * nn + at]; W[ch * nn + at] = 0.0f; }
+                    ++k;
+                }
+            }
+    }
+    if (report) {
+        report->outlier_count = count;
+        { float th; memcpy(&th, &T, sizeof(th)); report->outlier_threshold = count ? th : 0.0f; }
+    }
+
+    /* 2. greedy reordering */
+    if (o.reorder) {
+        r = rad__mb_reorder_perms(&c, W, n, o.reorder_samples, (uint32_t *)b->row_perm, (uint32_t *)b->col_perm);
+        if (r != RAD_SUCCESS) goto done;
+        Wp = (float *)rad__alloc(&c.allocator, total);
+        if (!Wp) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+        for (ch = 0; ch < 3; ++ch)
+            for (i = 0; i < n; ++i) {
+                const float *from = W + ch * nn + (size_t)b->row_perm[i] * n;
+                float *to = Wp + ch * nn + (size_t)i * n;
+                for (j = 0; j < n; ++j) to[j] = from[b->col_perm[j]];
+            }
+    }
+
+    /* 3. scales: the largest value of each channel in each tile */
+    {
+        float *s = (float *)b->scales;
+        const float *P = Wp ? Wp : W;
+        memset(s, 0, bytes[1]);
+        for (ch = 0; ch < 3; ++ch)
+            for (i = 0; i < n; ++i)
+                for (j = 0; j < n; ++j) {
+                    float v = P[ch * nn + (size_t)i * n + j];
+                    size_t t = o.tile ? (size_t)(i / o.tile) * tpr + j / o.tile : 0;
+                    if (v > s[3 * t + ch]) s[3 * t + ch] = v;
+                }
+    }
+
+    /* 4. block encoding, parallel over block rows, with the error of each */
+    enc.b = b;
+    enc.Wp = Wp ? Wp : W;
+    enc.sse = sse;
+    enc.max_err = max_err;
+    r = rad__for_rows(&c, bpr, c.tasks < bpr ? c.tasks : bpr, rad__mb_encode_row, &enc);
+    if (r != RAD_SUCCESS) goto done;
+    rad__mb_info(b->info, o.format == RAD_BLOCK_BC1 ? 2u : 3u, n, mb->bounces, o.tile, tpr,
+                 (o.reorder ? 1u : 0u) | (count ? 2u : 0u));
+    if (report) {
+        double s = 0.0, ms = 0.0;
+        float me = 0.0f;
+        size_t q;
+        for (i = 0; i < bpr; ++i) { s += sse[i]; if (max_err[i] > me) me = max_err[i]; }
+        for (q = 0; q < 3 * nn; ++q) ms += (double)src[q] * src[q];
+        report->reordered = o.reorder != 0;
+        report->tiles = tpr * tpr;
+        report->bytes_float_f = nn * sizeof(float);
+        report->bytes_float_mb = total;
+        report->bytes_blocks = bytes[0];
+        report->bytes_scales = bytes[1];
+        report->bytes_permutations = bytes[2] + bytes[3];
+        report->bytes_outliers = bytes[4] + bytes[5] + bytes[6];
+        report->bytes_total = bytes[0] + bytes[1] + bytes[2] + bytes[3] + bytes[4] + bytes[5] + bytes[6];
+        report->mse = s / (3.0 * (double)nn);
+        report->max_abs_error = me;
+        report->source_mean_square = ms / (3.0 * (double)nn);
+    }
+    *out = b;
+    b = NULL;
+    r = RAD_SUCCESS;
+done:
+    rad__free(&c.allocator, owned);
+    rad__free(&c.allocator, W);
+    rad__free(&c.allocator, Wp);
+    rad__free(&c.allocator, row_count);
+    rad__free(&c.allocator, sse);
+    rad__free(&c.allocator, max_err);
+    rad_multibounce_blocks_destroy(b);
+    return r;
+}
+
+/* ---- applying and decoding the compressed form ---- */
+
+typedef struct rad__mb_bapply {
+    const rad_multibounce_blocks *b;
+    const float *xp;     /* 3 * padded, SoA, permuted columns */
+    const float *xe;     /* 3 * bpr * 16: x expanded for the two-column SIMD lanes */
+    float *y;            /* 3 * padded, SoA, permuted rows */
+    uint32_t padded, tasks;
+    const uint32_t *tile_col; /* per block column: its tile column */
+    const float *E;      /* outliers: original order */
+    float *out;
+} rad__mb_bapply;
+
+#if !defined(RAD__MB_AVX2)
+static void rad__mb_block_palettes(const rad_multibounce_blocks *b, const uint8_t *blk, size_t nblocks, const float *scale,
+                                   float pal[3][8])
+{
+    uint32_t ch, k;
+    if (b->format == RAD_BLOCK_BC1) {
+        float p[4][3];
+        rad__bc1_palette((uint32_t)blk[0] | (uint32_t)blk[1] << 8, (uint32_t)blk[2] | (uint32_t)blk[3] << 8, p);
+        for (ch = 0; ch < 3; ++ch)
+            for (k = 0; k < 4; ++k) pal[ch][k] = p[k][ch] * scale[ch];
+    } else {
+        for (ch = 0; ch < 3; ++ch) {
+            const uint8_t *q = blk + 8 * ch * nblocks;
+            rad__bc4_palette(q[0], q[1], pal[ch]);
+            for (k = 0; k < 8; ++k) pal[ch][k] *= scale[ch];
+        }
+    }
+}
+#endif
+
+static void rad__mb_bapply_task(void *data, uint32_t t)
+{
+    const rad__mb_bapply *a = (const rad__mb_bapply *)data;
+    const rad_multibounce_blocks *b = a->b;
+    uint32_t bpr = b->blocks_per_row, by0 = (uint32_t)((uint64_t)bpr * t / a->tasks), by1 = (uint32_t)((uint64_t)bpr * (t + 1) / a->tasks);
+    uint32_t by, bx, ch, y, x, i;
+    size_t nblocks = (size_t)bpr * bpr;
+    for (by = by0; by < by1; ++by) {
+        float acc[3][4];
+        const uint8_t *row = b->blocks + 8 * (size_t)by * bpr;
+#if defined(RAD__MB_AVX2)
+        __m256 v0 = _mm256_setzero_ps(), v1 = _mm256_setzero_ps(), v2 = _mm256_setzero_ps();
+        float lanes[8];
+        const __m256i three = _mm256_set1_epi32(3), seven = _mm256_set1_epi32(7);
+        const __m256i s1a = _mm256_setr_epi32(0, 8, 16, 24, 2, 10, 18, 26), s1b = _mm256_setr_epi32(4, 12, 20, 28, 6, 14, 22, 30);
+        const __m256i s4a = _mm256_setr_epi32(0, 12, 0, 12, 3, 15, 3, 15), s4b = _mm256_setr_epi32(6, 18, 6, 18, 9, 21, 9, 21);
+        const float *srow = b->scales + 3 * (size_t)(b->tile ? (by * 4u / b->tile) * b->tiles_per_row : 0u);
+        const __m256 w0a = _mm256_setr_ps(1.0f, 0.0f, 6.0f / 7, 5.0f / 7, 4.0f / 7, 3.0f / 7, 2.0f / 7, 1.0f / 7);
+        const __m256 w1a = _mm256_setr_ps(0.0f, 1.0f, 1.0f / 7, 2.0f / 7, 3.0f / 7, 4.0f / 7, 5.0f / 7, 6.0f / 7);
+        const __m256 w0b = _mm256_setr_ps(1.0f, 0.0f, 4.0f / 5, 3.0f / 5, 2.0f / 5, 1.0f / 5, 0.0f, 0.0f);
+        const __m256 w1b = _mm256_setr_ps(0.0f, 1.0f, 1.0f / 5, 2.0f / 5, 3.0f / 5, 4.0f / 5, 0.0f, 0.0f);
+        const __m256 cb = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+        for (bx = 0; bx < bpr; ++bx) {
+            const uint8_t *blk = row + 8 * (size_t)bx;
+            const float *scale = srow + 3 * (size_t)a->tile_col[bx];
+            float pal[3][8];
+            const float *xe = a->xe + 16 * (size_t)bx;
+            size_t xs = 16 * (size_t)bpr;
+            if (b->format == RAD_BLOCK_BC1) {
+                /* palettes with reciprocal multiplies (the decoder divides; the difference is
+                   an ulp, far below the format's precision) */
+                uint32_t c0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, c1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
+                float e0[3], e1[3], m[3];
+                m[0] = scale[0] * (1.0f / 31.0f); m[1] = scale[1] * (1.0f / 63.0f); m[2] = scale[2] * (1.0f / 31.0f);
+                e0[0] = (float)(c0 >> 11) * m[0]; e0[1] = (float)((c0 >> 5) & 63u) * m[1]; e0[2] = (float)(c0 & 31u) * m[2];
+                e1[0] = (float)(c1 >> 11) * m[0]; e1[1] = (float)((c1 >> 5) & 63u) * m[1]; e1[2] = (float)(c1 & 31u) * m[2];
+                for (ch = 0; ch < 3; ++ch) {
+                    pal[ch][0] = e0[ch];
+                    pal[ch][1] = e1[ch];
+                    if (c0 > c1) {
+                        pal[ch][2] = (2.0f * e0[ch] + e1[ch]) * (1.0f / 3.0f);
+                        pal[ch][3] = (e0[ch] + 2.0f * e1[ch]) * (1.0f / 3.0f);
+                    } else {
+                        pal[ch][2] = (e0[ch] + e1[ch]) * 0.5f;
+                        pal[ch][3] = 0.0f;
+                    }
+                }
+            }
+            if (b->format == RAD_BLOCK_BC1) {
+                uint32_t w = (uint32_t)blk[4] | (uint32_t)blk[5] << 8 | (uint32_t)blk[6] << 16 | (uint32_t)blk[7] << 24;
+                __m256i wv = _mm256_set1_epi32((int)w);
+                __m256i ia = _mm256_and_si256(_mm256_srlv_epi32(wv, s1a), three), ib = _mm256_and_si256(_mm256_srlv_epi32(wv, s1b), three);
+                __m256 p0 = _mm256_broadcast_ps((const __m128 *)pal[0]), p1 = _mm256_broadcast_ps((const __m128 *)pal[1]),
+                       p2 = _mm256_broadcast_ps((const __m128 *)pal[2]);
+                v0 = _mm256_add_ps(v0, _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar_ps(p0, ia), _mm256_loadu_ps(xe)),
+                                                     _mm256_mul_ps(_mm256_permutevar_ps(p0, ib), _mm256_loadu_ps(xe + 8))));
+                v1 = _mm256_add_ps(v1, _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar_ps(p1, ia), _mm256_loadu_ps(xe + xs)),
+                                                     _mm256_mul_ps(_mm256_permutevar_ps(p1, ib), _mm256_loadu_ps(xe + xs + 8))));
+                v2 = _mm256_add_ps(v2, _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar_ps(p2, ia), _mm256_loadu_ps(xe + 2 * xs)),
+                                                     _mm256_mul_ps(_mm256_permutevar_ps(p2, ib), _mm256_loadu_ps(xe + 2 * xs + 8))));
+            } else {
+                __m256 *vv[3];
+                vv[0] = &v0; vv[1] = &v1; vv[2] = &v2;
+                for (ch = 0; ch < 3; ++ch) {
+                    const uint8_t *q = blk + 8 * ch * nblocks;
+                    int lo = (int)((uint32_t)q[2] | (uint32_t)q[3] << 8 | (uint32_t)q[4] << 16);
+                    int hi = (int)((uint32_t)q[5] | (uint32_t)q[6] << 8 | (uint32_t)q[7] << 16);
+                    __m256i wv = _mm256_setr_epi32(lo, lo, hi, hi, lo, lo, hi, hi);
+                    float sc = scale[ch] * (1.0f / 255.0f);
+                    __m256 r0 = _mm256_set1_ps((float)q[0] * sc), r1 = _mm256_set1_ps((float)q[1] * sc), p;
+                    if (q[0] > q[1]) p = _mm256_add_ps(_mm256_mul_ps(r0, w0a), _mm256_mul_ps(r1, w1a));
+                    else p = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r0, w0b), _mm256_mul_ps(r1, w1b)), _mm256_mul_ps(cb, _mm256_set1_ps(scale[ch])));
+                    __m256i ia = _mm256_and_si256(_mm256_srlv_epi32(wv, s4a), seven), ib = _mm256_and_si256(_mm256_srlv_epi32(wv, s4b), seven);
+                    *vv[ch] = _mm256_add_ps(*vv[ch], _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar8x32_ps(p, ia), _mm256_loadu_ps(xe + ch * xs)),
+                                                                   _mm256_mul_ps(_mm256_permutevar8x32_ps(p, ib), _mm256_loadu_ps(xe + ch * xs + 8))));
+                }
+            }
+        }
+        _mm256_storeu_ps(lanes, v0); for (y = 0; y < 4; ++y) acc[0][y] = lanes[y] + lanes[4 + y];
+        _mm256_storeu_ps(lanes, v1); for (y = 0; y < 4; ++y) acc[1][y] = lanes[y] + lanes[4 + y];
+        _mm256_storeu_ps(lanes, v2); for (y = 0; y < 4; ++y) acc[2][y] = lanes[y] + lanes[4 + y];
+        (void)x;
+#else
+        memset(acc, 0, sizeof(acc));
+        for (bx = 0; bx < bpr; ++bx) {
+            const uint8_t *blk = row + 8 * (size_t)bx;
+            const float *scale = b->scales + 3 * (size_t)rad__mb_tile_index(b, bx, by);
+            float pal[3][8];
+            rad__mb_block_palettes(b, blk, nblocks, scale, pal);
+            if (b->format == RAD_BLOCK_BC1) {
+                uint32_t w = (uint32_t)blk[4] | (uint32_t)blk[5] << 8 | (uint32_t)blk[6] << 16 | (uint32_t)blk[7] << 24;
+                for (y = 0; y < 4; ++y)
+                    for (x = 0; x < 4; ++x) {
+                        uint32_t code = (w >> (2 * (4 * y + x))) & 3u;
+                        for (ch = 0; ch < 3; ++ch) acc[ch][y] += pal[ch][code] * a->xp[(size_t)ch * a->padded + 4 * bx + x];
+                    }
+            } else {
+                for (ch = 0; ch < 3; ++ch) {
+                    uint64_t bits = rad__bc4_bits(blk + 8 * ch * nblocks);
+                    for (y = 0; y < 4; ++y)
+                        for (x = 0; x < 4; ++x)
+                            acc[ch][y] += pal[ch][(bits >> (3 * (4 * y + x))) & 7u] * a->xp[(size_t)ch * a->padded + 4 * bx + x];
+                }
+            }
+        }
+#endif
+        for (ch = 0; ch < 3; ++ch)
+            for (y = 0; y < 4; ++y) a->y[(size_t)ch * a->padded + 4 * by + y] = acc[ch][y];
+    }
+    (void)i;
+}
+
+static void rad__mb_outlier_task(void *data, uint32_t t)
+{
+    const rad__mb_bapply *a = (const rad__mb_bapply *)data;
+    const rad_multibounce_blocks *b = a->b;
+    uint32_t i0 = (uint32_t)((uint64_t)b->n * t / a->tasks), i1 = (uint32_t)((uint64_t)b->n * (t + 1) / a->tasks), i;
+    for (i = i0; i < i1; ++i) {
+        uint64_t k;
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        for (k = b->outlier_offsets[i]; k < b->outlier_offsets[i + 1]; ++k) {
+            const float *v = b->outlier_values + 3 * k, *e = a->E + 3 * (size_t)b->outlier_columns[k];
+            s0 += v[0] * e[0];
+            s1 += v[1] * e[1];
+            s2 += v[2] * e[2];
+        }
+        a->out[3 * (size_t)i] += s0;
+        a->out[3 * (size_t)i + 1] += s1;
+        a->out[3 * (size_t)i + 2] += s2;
+    }
+}
+
+static rad_result rad__mb_blocks_check(const rad_multibounce_blocks *b)
+{
+    if (!b || b->n == 0 || !b->blocks || !b->scales || b->blocks_per_row != (b->n + 3u) / 4u) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((b->row_perm == NULL) != (b->col_perm == NULL)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (b->outlier_count && (!b->outlier_offsets || !b->outlier_columns || !b->outlier_values)) return RAD_ERROR_INVALID_ARGUMENT;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b, const float *E, float *out, rad_output output,
+                                                const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__mb_bapply a;
+    float *scratch, *xe;
+    uint32_t *tile_col, n, padded, bpr, bx, ch, h, l;
+    size_t i;
+    rad__ctx_init(&c, ctx);
+    if (rad__mb_blocks_check(b) != RAD_SUCCESS || !E || !out || E == out) return RAD_ERROR_INVALID_ARGUMENT;
+    n = b->n;
+    bpr = b->blocks_per_row;
+    padded = 4u * bpr;
+    scratch = (float *)rad__alloc_array(&c.allocator, (size_t)padded, 6 * sizeof(float) + 12 * sizeof(float));
+    if (!scratch) return RAD_ERROR_OUT_OF_MEMORY;
+    rad__mb_gather(E, b->col_perm, n, padded, scratch);
+    xe = scratch + 6 * (size_t)padded;
+    for (ch = 0; ch < 3; ++ch)
+        for (bx = 0; bx < bpr; ++bx)
+            for (h = 0; h < 2; ++h)
+                for (l = 0; l < 8; ++l)
+                    xe[(size_t)ch * 16 * bpr + 16 * (size_t)bx + 8 * h + l] = scratch[(size_t)ch * padded + 4 * bx + 2 * h + l / 4];
+    tile_col = (uint32_t *)rad__alloc_array(&c.allocator, bpr, sizeof(uint32_t));
+    if (!tile_col) { rad__free(&c.allocator, scratch); return RAD_ERROR_OUT_OF_MEMORY; }
+    for (bx = 0; bx < bpr; ++bx) tile_col[bx] = b->tile ? bx * 4u / b->tile : 0u;
+    a.tile_col = tile_col;
+    a.b = b;
+    a.xp = scratch;
+    a.xe = xe;
+    a.y = scratch + 3 * (size_t)padded;
+    a.padded = padded;
+    a.E = E;
+    a.out = out;
+    a.tasks = c.tasks < bpr ? c.tasks : bpr;
+    c.parallel_for(c.parallel_user, a.tasks, rad__mb_bapply_task, &a);
+    rad__mb_scatter(a.y, padded, b->row_perm, n, out);
+    if (b->outlier_count) {
+        a.tasks = c.tasks < n ? c.tasks : n;
+        c.parallel_for(c.parallel_user, a.tasks, rad__mb_outlier_task, &a);
+    }
+    if (output == RAD_OUTPUT_TOTAL)
+        for (i = 0; i < 3 * (size_t)n; ++i) out[i] += E[i];
+    rad__free(&c.allocator, scratch);
+    rad__free(&c.allocator, tile_col);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *b, float *out_planes, const rad_context *ctx)
+{
+    uint32_t n, bpr, bx, by, t, ch, i;
+    size_t nn, nblocks;
+    (void)ctx;
+    if (rad__mb_blocks_check(b) != RAD_SUCCESS || !out_planes) return RAD_ERROR_INVALID_ARGUMENT;
+    n = b->n;
+    nn = (size_t)n * n;
+    bpr = b->blocks_per_row;
+    nblocks = (size_t)bpr * bpr;
+    for (by = 0; by < bpr; ++by)
+        for (bx = 0; bx < bpr; ++bx) {
+            const float *scale = b->scales + 3 * (size_t)rad__mb_tile_index(b, bx, by);
+            float dec[48];
+            if (b->format == RAD_BLOCK_BC1) {
+                rad_bc1_decode_block(b->blocks + 8 * ((size_t)by * bpr + bx), dec);
+            } else {
+                for (ch = 0; ch < 3; ++ch) {
+                    float d[16];
+                    rad_bc4_decode_block(b->blocks + 8 * (ch * nblocks + (size_t)by * bpr + bx), d);
+                    for (t = 0; t < 16; ++t) dec[3 * t + ch] = d[t];
+                }
+            }
+            for (t = 0; t < 16; ++t) {
+                uint32_t y = by * 4u + t / 4u, x = bx * 4u + t % 4u, oy, ox;
+                if (y >= n || x >= n) continue;
+                oy = b->row_perm ? b->row_perm[y] : y;
+                ox = b->col_perm ? b->col_perm[x] : x;
+                for (ch = 0; ch < 3; ++ch) out_planes[ch * nn + (size_t)oy * n + ox] = dec[3 * t + ch] * scale[ch];
+            }
+        }
+    for (i = 0; i < n && b->outlier_count; ++i) {
+        uint64_t k;
+        for (k = b->outlier_offsets[i]; k < b->outlier_offsets[i + 1]; ++k)
+            for (ch = 0; ch < 3; ++ch) out_planes[ch * nn + (size_t)i * n + b->outlier_columns[k]] += b->outlier_values[3 * k + ch];
+    }
+    return RAD_SUCCESS;
+}
+
+/* ---- container sections ---- */
+
+RAD_API rad_result rad_multibounce_sections(const rad_multibounce *mb, const char *name, rad_section *s, uint32_t *out_count)
+{
+    uint32_t k = 0;
+    uint64_t total;
+    if (!s || !out_count) return RAD_ERROR_INVALID_ARGUMENT;
+    *out_count = 0;
+    if (rad__mb_check(mb) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    total = 3u * (uint64_t)mb->n * mb->n;
+    rad__section(&s[k++], RAD_SECTION_MB_INFO, sizeof(uint32_t), 16, mb->info, name);
+    if (mb->planes) rad__section(&s[k++], RAD_SECTION_MB_FLOAT, sizeof(float), total, mb->planes, name);
+    else rad__section(&s[k++], RAD_SECTION_MB_HALF, sizeof(uint16_t), total, mb->half, name);
+    if (mb->row_perm) {
+        rad__section(&s[k++], RAD_SECTION_MB_ROW_PERM, sizeof(uint32_t), mb->n, mb->row_perm, name);
+        rad__section(&s[k++], RAD_SECTION_MB_COL_PERM, sizeof(uint32_t), mb->n, mb->col_perm, name);
+    }
+    *out_count = k;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_multibounce_blocks_sections(const rad_multibounce_blocks *b, const char *name, rad_section *s,
+                                                   uint32_t *out_count)
+{
+    uint32_t k = 0;
+    uint64_t nblocks;
+    if (!s || !out_count) return RAD_ERROR_INVALID_ARGUMENT;
+    *out_count = 0;
+    if (rad__mb_blocks_check(b) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    nblocks = (uint64_t)b->blocks_per_row * b->blocks_per_row;
+    rad__section(&s[k++], RAD_SECTION_MB_INFO, sizeof(uint32_t), 16, b->info, name);
+    if (b->format == RAD_BLOCK_BC1) rad__section(&s[k++], RAD_SECTION_MB_BC1, 8, nblocks, b->blocks, name);
+    else rad__section(&s[k++], RAD_SECTION_MB_BC4, 8, 3 * nblocks, b->blocks, name);
+    rad__section(&s[k++], RAD_SECTION_MB_SCALES, 3 * sizeof(float), (uint64_t)b->tiles_per_row * b->tiles_per_row, b->scales, name);
+    if (b->row_perm) {
+        rad__section(&s[k++], RAD_SECTION_MB_ROW_PERM, sizeof(uint32_t), b->n, b->row_perm, name);
+        rad__section(&s[k++], RAD_SECTION_MB_COL_PERM, sizeof(uint32_t), b->n, b->col_perm, name);
+    }
+    if (b->outlier_count) {
+        rad__section(&s[k++], RAD_SECTION_MB_OUTLIER_OFFSETS, sizeof(uint64_t), (uint64_t)b->n + 1u, b->outlier_offsets, name);
+        rad__section(&s[k++], RAD_SECTION_MB_OUTLIER_COLUMNS, sizeof(uint32_t), b->outlier_count, b->outlier_columns, name);
+        rad__section(&s[k++], RAD_SECTION_MB_OUTLIER_VALUES, 3 * sizeof(float), b->outlier_count, b->outlier_values, name);
+    }
+    *out_count = k;
+    return RAD_SUCCESS;
+}
+
+/* the section of 'type' called 'name' with elem_size and count as given (CORRUPT otherwise) */
+static rad_result rad__mb_section(const rad__ctx *c, const rad_container *ct, uint32_t type, const char *name, uint32_t elem_size,
+                                  uint64_t count, const void **out)
+{
+    const rad_section *s = rad_container_find(ct, type, name);
+    *out = NULL;
+    if (!s) {
+        rad__log(c, RAD_LOG_ERROR, "multibounce '%s': section type %u is missing", name ? name : "", type);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (s->elem_size != elem_size || s->count != count) {
+        rad__log(c, RAD_LOG_ERROR, "multibounce '%s': section type %u has %llu elements of %u bytes, expected %llu of %u",
+                 name ? name : "", type, (unsigned long long)s->count, s->elem_size, (unsigned long long)count, elem_size);
+        return RAD_ERROR_CORRUPT;
+    }
+    *out = s->data;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__mb_load_info(const rad__ctx *c, const rad_container *ct, const char *name, uint32_t *info)
+{
+    const void *p;
+    rad_result r = rad__mb_section(c, ct, RAD_SECTION_MB_INFO, name, sizeof(uint32_t), 16, &p);
+    if (r != RAD_SUCCESS) return r;
+    memcpy(info, p, 16 * sizeof(uint32_t));
+    if (info[0] != 1u) {
+        rad__log(c, RAD_LOG_ERROR, "multibounce '%s': info version %u (expected 1)", name ? name : "", info[0]);
+        return RAD_ERROR_VERSION;
+    }
+    if (info[2] == 0 || info[3] == 0 || info[1] > 3u || (info[6] & ~3u)) {
+        rad__log(c, RAD_LOG_ERROR, "multibounce '%s': bad info record (kind %u, N %u, K %u, flags %u)", name ? name : "", info[1],
+                 info[2], info[3], info[6]);
+        return RAD_ERROR_CORRUPT;
+    }
+    return RAD_SUCCESS;
+}
+
+/* both permutations (when flagged), checked to be bijections of [0, n) */
+static rad_result rad__mb_load_perms(const rad__ctx *c, const rad_container *ct, const char *name, uint32_t n, int present,
+                                     const uint32_t **row_perm, const uint32_t **col_perm)
+{
+    const void *p[2];
+    unsigned char *seen;
+    uint32_t k, i;
+    rad_result r = RAD_SUCCESS;
+    *row_perm = *col_perm = NULL;
+    if (!present) return RAD_SUCCESS;
+    if ((r = rad__mb_section(c, ct, RAD_SECTION_MB_ROW_PERM, name, sizeof(uint32_t), n, &p[0])) != RAD_SUCCESS) return r;
+    if ((r = rad__mb_section(c, ct, RAD_SECTION_MB_COL_PERM, name, sizeof(uint32_t), n, &p[1])) != RAD_SUCCESS) return r;
+    seen = (unsigned char *)rad__alloc(&c->allocator, n);
+    if (!seen) return RAD_ERROR_OUT_OF_MEMORY;
+    for (k = 0; k < 2 && r == RAD_SUCCESS; ++k) {
+        const uint32_t *perm = (const uint32_t *)p[k];
+        memset(seen, 0, n);
+        for (i = 0; i < n; ++i) {
+            if (perm[i] >= n || seen[perm[i]]) {
+                rad__log(c, RAD_LOG_ERROR, "multibounce '%s': the %s permutation is not a bijection (entry %u = %u)", name ? name : "",
+                         k == 0 ? "row" : "column", i, perm[i]);
+                r = RAD_ERROR_CORRUPT;
+                break;
+            }
+            seen[perm[i]] = 1;
+        }
+    }
+    rad__free(&c->allocator, seen);
+    if (r == RAD_SUCCESS) { *row_perm = (const uint32_t *)p[0]; *col_perm = (const uint32_t *)p[1]; }
+    return r;
+}
+
+RAD_API rad_result rad_multibounce_load(const rad_container *ct, const char *name, const rad_context *ctx, rad_multibounce **out)
+{
+    rad__ctx c;
+    rad_multibounce *mb;
+    uint32_t info[16];
+    const void *data;
+    uint64_t total;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!ct) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__mb_load_info(&c, ct, name, info);
+    if (r != RAD_SUCCESS) return r;
+    if (info[1] > 1u || (info[6] & 2u)) {
+        rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': kind %u is not a dense matrix", name ? name : "", info[1]);
+        return RAD_ERROR_CORRUPT;
+    }
+    total = 3u * (uint64_t)info[2] * info[2];
+    if (total / 3u / info[2] != info[2] || total > (uint64_t)((size_t)-1) / 4u) return RAD_ERROR_SIZE_OVERFLOW;
+    r = rad__mb_section(&c, ct, info[1] ? RAD_SECTION_MB_HALF : RAD_SECTION_MB_FLOAT, name, info[1] ? 2u : 4u, total, &data);
+    if (r != RAD_SUCCESS) return r;
+    mb = (rad_multibounce *)rad__alloc(&c.allocator, sizeof(*mb));
+    if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(mb, 0, sizeof(*mb));
+    mb->allocator = c.allocator;
+    mb->n = info[2];
+    mb->bounces = info[3];
+    mb->precision = info[1] ? RAD_MB_HALF : RAD_MB_FLOAT;
+    if (info[1]) mb->half = (const uint16_t *)data;
+    else mb->planes = (const float *)data;
+    memcpy(mb->info, info, sizeof(info));
+    r = rad__mb_load_perms(&c, ct, name, mb->n, (info[6] & 1u) != 0, &mb->row_perm, &mb->col_perm);
+    if (r != RAD_SUCCESS) { rad_multibounce_destroy(mb); return r; }
+    *out = mb;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_multibounce_blocks_load(const rad_container *ct, const char *name, const rad_context *ctx,
+                                               rad_multibounce_blocks **out)
+{
+    rad__ctx c;
+    rad_multibounce_blocks *b;
+    uint32_t info[16], n, bpr, tpr;
+    const void *p;
+    uint64_t nblocks, i;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!ct) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__mb_load_info(&c, ct, name, info);
+    if (r != RAD_SUCCESS) return r;
+    n = info[2];
+    bpr = (uint32_t)(((uint64_t)n + 3u) / 4u);
+    tpr = info[4] ? (uint32_t)(((uint64_t)n + info[4] - 1u) / info[4]) : 1u;
+    if (info[1] < 2u || (info[4] % 4u) != 0 || info[5] != tpr) {
+        rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': kind %u, tile %u, %u tiles per row do not describe blocks of N = %u",
+                 name ? name : "", info[1], info[4], info[5], n);
+        return RAD_ERROR_CORRUPT;
+    }
+    b = (rad_multibounce_blocks *)rad__alloc(&c.allocator, sizeof(*b));
+    if (!b) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(b, 0, sizeof(*b));
+    b->allocator = c.allocator;
+    b->n = n;
+    b->bounces = info[3];
+    b->format = info[1] == 2u ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
+    b->blocks_per_row = bpr;
+    b->tile = info[4];
+    b->tiles_per_row = tpr;
+    memcpy(b->info, info, sizeof(info));
+    nblocks = (uint64_t)bpr * bpr;
+    r = rad__mb_section(&c, ct, info[1] == 2u ? RAD_SECTION_MB_BC1 : RAD_SECTION_MB_BC4, name, 8, info[1] == 2u ? nblocks : 3u * nblocks, &p);
+    b->blocks = (const uint8_t *)p;
+    if (r == RAD_SUCCESS) {
+        r = rad__mb_section(&c, ct, RAD_SECTION_MB_SCALES, name, 3 * sizeof(float), (uint64_t)tpr * tpr, &p);
+        b->scales = (const float *)p;
+        if (r == RAD_SUCCESS && !rad__all_finite(b->scales, 3u * (uint64_t)tpr * tpr)) {
+            rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': a scale is not finite", name ? name : "");
+            r = RAD_ERROR_CORRUPT;
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad__mb_load_perms(&c, ct, name, n, (info[6] & 1u) != 0, &b->row_perm, &b->col_perm);
+    if (r == RAD_SUCCESS && (info[6] & 2u)) {
+        const rad_section *cols = rad_container_find(ct, RAD_SECTION_MB_OUTLIER_COLUMNS, name);
+        r = rad__mb_section(&c, ct, RAD_SECTION_MB_OUTLIER_OFFSETS, name, sizeof(uint64_t), (uint64_t)n + 1u, &p);
+        b->outlier_offsets = (const uint64_t *)p;
+        if (r == RAD_SUCCESS) {
+            b->outlier_count = b->outlier_offsets[n];
+            if (!cols || b->outlier_offsets[0] != 0) {
+                rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': outlier offsets do not start at 0 or columns are missing", name ? name : "");
+                r = RAD_ERROR_CORRUPT;
+            }
+            for (i = 0; i < n && r == RAD_SUCCESS; ++i)
+                if (b->outlier_offsets[i + 1] < b->outlier_offsets[i]) {
+                    rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': outlier offsets decrease at row %u", name ? name : "", (uint32_t)i);
+                    r = RAD_ERROR_CORRUPT;
+                }
+        }
+        if (r == RAD_SUCCESS) r = rad__mb_section(&c, ct, RAD_SECTION_MB_OUTLIER_COLUMNS, name, sizeof(uint32_t), b->outlier_count, &p);
+        b->outlier_columns = (const uint32_t *)p;
+        if (r == RAD_SUCCESS) r = rad__mb_section(&c, ct, RAD_SECTION_MB_OUTLIER_VALUES, name, 3 * sizeof(float), b->outlier_count, &p);
+        b->outlier_values = (const float *)p;
+        for (i = 0; i < b->outlier_count && r == RAD_SUCCESS; ++i)
+            if (b->outlier_columns[i] >= n) {
+                rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': outlier %llu has column %u >= N = %u", name ? name : "",
+                         (unsigned long long)i, b->outlier_columns[i], n);
+                r = RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        if (r == RAD_SUCCESS && !rad__all_finite(b->outlier_values, 3u * b->outlier_count)) {
+            rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': an outlier value is not finite", name ? name : "");
+            r = RAD_ERROR_CORRUPT;
+        }
+    }
+    if (r != RAD_SUCCESS) { rad_multibounce_blocks_destroy(b); return r; }
+    *out = b;
+    return RAD_SUCCESS;
+}
 
 #endif /* RADIOSITY_IMPLEMENTATION */
 

@@ -76,6 +76,7 @@ else
 fi
 unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c
 unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c
+unit unit-native $CC -std=c99 $WARN -O2 -march=native $OMP -I. tests/test_main.c
 
 # ---- Embree backend (optional: installed when we can) -------------------------------------
 [ -f /usr/include/embree3/rtcore.h ] || try_install libembree-dev

@@ -1,0 +1,598 @@
+/* test_multibounce.c - the multi-bounce matrix and its compression (SPEC §4): F_mb E against K
+   Jacobi bounces and the direct solve, binary16, hand-built BC1/BC4 blocks against the
+   decode rules of REFERENCE §4, encoder error bounds, permutations, the compressed apply, and
+   the container sections. Included by test_main.c after the implementation: every name is
+   static and prefixed mb_. */
+
+/* ---------------------------------------------------------------------------------------- */
+/* helpers                                                                                  */
+/* ---------------------------------------------------------------------------------------- */
+
+typedef struct mb_world {
+    rad_scene *scene;
+    rad_patches *patches;
+    rad_bvh *bvh;
+    rad_form_factors *ff;
+    float *E;
+} mb_world;
+
+static void mb_world_free(mb_world *w)
+{
+    free(w->E);
+    rad_form_factors_destroy(w->ff);
+    rad_bvh_destroy(w->bvh);
+    rad_patches_destroy(w->patches);
+    rad_scene_destroy(w->scene);
+    memset(w, 0, sizeof(*w));
+}
+
+/* The built-in Cornell box cut into about 'target' patches, dense form factors through the
+   BVH, E = emission. Returns 0 on failure (and records it). */
+static int mb_cornell(mb_world *w, uint32_t target)
+{
+    rad_scene_desc desc;
+    rad_camera cam;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_raycaster rc;
+    memset(w, 0, sizeof(*w));
+    rad_cornell_box(&desc, &cam);
+    rad_patch_options_default(&po);
+    po.target_count = target;
+    rad_form_factor_options_default(&fo);
+    if (rad_scene_create(&desc, NULL, &w->scene) != RAD_SUCCESS || rad_patches_create(w->scene, &po, NULL, &w->patches) != RAD_SUCCESS ||
+        rad_bvh_create(w->scene, NULL, &w->bvh) != RAD_SUCCESS) {
+        CHECK(!"cornell setup");
+        mb_world_free(w);
+        return 0;
+    }
+    rad_bvh_raycaster(w->bvh, &rc);
+    w->E = (float *)malloc(sizeof(float) * 3 * w->patches->count);
+    if (!w->E || rad_form_factors_dense(w->patches, &rc, &fo, NULL, &w->ff) != RAD_SUCCESS ||
+        rad_sources(w->patches, RAD_SOURCE_EMISSION, NULL, w->E) != RAD_SUCCESS) {
+        CHECK(!"cornell form factors");
+        mb_world_free(w);
+        return 0;
+    }
+    return 1;
+}
+
+static uint32_t mb_target(void) { return rad_test_quick() ? 120u : 300u; }
+
+/* max |a - b| / max |b| over n values */
+static double mb_rel(const float *a, const float *b, size_t n)
+{
+    double d = 0.0, m = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        if (fabs((double)a[i] - b[i]) > d) d = fabs((double)a[i] - b[i]);
+        if (fabs((double)b[i]) > m) m = fabs((double)b[i]);
+    }
+    return m > 0.0 ? d / m : d;
+}
+
+static int mb_is_permutation(const uint32_t *p, uint32_t n)
+{
+    unsigned char *seen = (unsigned char *)calloc(n, 1);
+    uint32_t i;
+    int ok = seen != NULL;
+    for (i = 0; i < n && ok; ++i) {
+        if (p[i] >= n || seen[p[i]]) ok = 0;
+        else seen[p[i]] = 1;
+    }
+    free(seen);
+    return ok;
+}
+
+static float mb_rand(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return (float)(*s >> 8) / 16777216.0f;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* tests                                                                                    */
+/* ---------------------------------------------------------------------------------------- */
+
+static void mb_half(void)
+{
+    uint32_t h;
+    int bad = 0;
+    CHECK(rad_half_from_float(1.0f) == 0x3C00u);
+    CHECK(rad_half_from_float(-2.0f) == 0xC000u);
+    CHECK(rad_half_from_float(65504.0f) == 0x7BFFu);
+    CHECK(rad_half_from_float(65519.0f) == 0x7BFFu);
+    CHECK(rad_half_from_float(65520.0f) == 0x7C00u);            /* tie rounds to even: infinity */
+    CHECK(rad_half_from_float(5.9604644775390625e-8f) == 0x0001u); /* 2^-24, smallest subnormal */
+    CHECK(rad_half_from_float(2.98023223876953125e-8f) == 0x0000u); /* 2^-25: tie to even 0 */
+    CHECK(rad_half_from_float(4.4703483581542969e-8f) == 0x0001u);  /* 1.5 * 2^-25 */
+    CHECK(rad_half_from_float(1.0f + 1.0f / 2048.0f) == 0x3C00u);   /* tie, even stays */
+    CHECK(rad_half_from_float(1.0f + 3.0f / 2048.0f) == 0x3C02u);   /* tie, odd rounds up */
+    CHECK(rad_half_from_float(6.103515625e-5f) == 0x0400u);         /* 2^-14, smallest normal */
+    CHECK((rad_half_from_float(sqrtf(-1.0f)) & 0x7C00u) == 0x7C00u && (rad_half_from_float(sqrtf(-1.0f)) & 0x3FFu) != 0);
+    for (h = 0; h < 65536u; ++h) {
+        if ((h & 0x7C00u) == 0x7C00u && (h & 0x3FFu)) continue; /* NaN */
+        if (rad_half_from_float(rad_half_to_float((uint16_t)h)) != h) bad++;
+    }
+    CHECK(bad == 0);
+    CHECK(rad_half_to_float(0x3555u) > 0.333f && rad_half_to_float(0x3555u) < 0.3334f);
+}
+
+static void mb_jacobi(void)
+{
+    mb_world w;
+    uint32_t ks[3] = { 1, 3, 8 }, k, n;
+    if (!mb_cornell(&w, mb_target())) return;
+    n = w.patches->count;
+    for (k = 0; k < 3; ++k) {
+        rad_multibounce_options o;
+        rad_multibounce *mb = NULL;
+        rad_solve_options so;
+        rad_system sys;
+        float *ref = (float *)malloc(sizeof(float) * 3 * n), *got = (float *)malloc(sizeof(float) * 3 * n);
+        rad_multibounce_options_default(&o);
+        o.bounces = ks[k];
+        CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, &o, NULL, &mb));
+        rad_system_init(&sys, &w.ff->matrix, w.patches, w.E);
+        rad_solve_options_default(&so);
+        so.bounces = ks[k];
+        so.output = RAD_OUTPUT_INDIRECT;
+        CHECK_OK(rad_solve_jacobi(&sys, &so, ref, NULL, NULL));
+        if (mb && ref && got) {
+            CHECK_OK(rad_multibounce_apply(mb, w.E, got, RAD_OUTPUT_INDIRECT, NULL));
+            CHECK(mb_rel(got, ref, 3 * (size_t)n) <= 1e-5);
+            CHECK_OK(rad_multibounce_apply(mb, w.E, got, RAD_OUTPUT_TOTAL, NULL));
+            CHECK_NEAR(got[0] - w.E[0], ref[0], 1e-5 * (fabs(ref[0]) + 1e-3));
+        }
+        rad_multibounce_destroy(mb);
+        free(ref);
+        free(got);
+    }
+    mb_world_free(&w);
+}
+
+static void mb_infinite(void)
+{
+    mb_world w;
+    rad_multibounce_options o;
+    rad_multibounce *mb = NULL;
+    rad_solve_options so;
+    rad_system sys;
+    float *ref, *got;
+    uint32_t n;
+    if (!mb_cornell(&w, rad_test_quick() ? 80u : 200u)) return;
+    n = w.patches->count;
+    ref = (float *)malloc(sizeof(float) * 3 * n);
+    got = (float *)malloc(sizeof(float) * 3 * n);
+    rad_multibounce_options_default(&o);
+    o.bounces = RAD_MB_INFINITE;
+    CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, &o, NULL, &mb));
+    rad_system_init(&sys, &w.ff->matrix, w.patches, w.E);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    CHECK_OK(rad_solve_direct(&sys, &so, ref, NULL));
+    if (mb && ref && got) {
+        CHECK_OK(rad_multibounce_apply(mb, w.E, got, RAD_OUTPUT_INDIRECT, NULL));
+        CHECK(mb_rel(got, ref, 3 * (size_t)n) <= 1e-5);
+    }
+    /* a tolerance that cannot be met in 2 doublings */
+    rad_multibounce_destroy(mb);
+    mb = NULL;
+    o.max_doublings = 2;
+    CHECK_RESULT(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, &o, NULL, &mb), RAD_ERROR_NOT_CONVERGED);
+    CHECK(mb == NULL);
+    free(ref);
+    free(got);
+    mb_world_free(&w);
+}
+
+static void mb_bc1_decode(void)
+{
+    /* four-colour mode: c0 = red 0xF800 > c1 = blue 0x001F; texels 0..3 take codes 0..3, the
+       rest code 0; texel 15 code 3 */
+    uint8_t blk[8] = { 0x00, 0xF8, 0x1F, 0x00, 0xE4, 0x00, 0x00, 0xC0 };
+    float rgb[48];
+    rad_bc1_decode_block(blk, rgb);
+    CHECK(rgb[0] == 1.0f && rgb[1] == 0.0f && rgb[2] == 0.0f);             /* C0 */
+    CHECK(rgb[3] == 0.0f && rgb[4] == 0.0f && rgb[5] == 1.0f);             /* C1 */
+    CHECK_NEAR(rgb[6], 2.0 / 3.0, 1e-7); CHECK_NEAR(rgb[8], 1.0 / 3.0, 1e-7); /* (2C0+C1)/3 */
+    CHECK_NEAR(rgb[9], 1.0 / 3.0, 1e-7); CHECK_NEAR(rgb[11], 2.0 / 3.0, 1e-7); /* (C0+2C1)/3 */
+    CHECK(rgb[12] == 1.0f);                                                  /* texel 4: code 0 */
+    CHECK_NEAR(rgb[45], 1.0 / 3.0, 1e-7);                                    /* texel 15: code 3 */
+    /* three-colour mode: c0 = blue 0x001F <= c1 = green 0x07E0; code 2 = (C0+C1)/2, code 3 black */
+    {
+        uint8_t b2[8] = { 0x1F, 0x00, 0xE0, 0x07, 0xE4, 0x00, 0x00, 0x00 };
+        rad_bc1_decode_block(b2, rgb);
+        CHECK(rgb[0] == 0.0f && rgb[1] == 0.0f && rgb[2] == 1.0f);
+        CHECK(rgb[3] == 0.0f && rgb[4] == 1.0f && rgb[5] == 0.0f);
+        CHECK(rgb[6] == 0.0f && rgb[7] == 0.5f && rgb[8] == 0.5f);
+        CHECK(rgb[9] == 0.0f && rgb[10] == 0.0f && rgb[11] == 0.0f);        /* black */
+    }
+    /* equal endpoints are the three-colour mode; 565 expansion uses /31 and /63 */
+    {
+        uint8_t b3[8] = { 0x21, 0x08, 0x21, 0x08, 0xFF, 0xFF, 0xFF, 0xFF };  /* 0x0821: r 1, g 1, b 1 */
+        rad_bc1_decode_block(b3, rgb);
+        CHECK(rgb[0] == 0.0f && rgb[47] == 0.0f);                          /* all code 3: black */
+        b3[4] = b3[5] = b3[6] = b3[7] = 0;
+        rad_bc1_decode_block(b3, rgb);
+        CHECK(rgb[0] == 1.0f / 31.0f && rgb[1] == 1.0f / 63.0f && rgb[2] == 1.0f / 31.0f);
+    }
+}
+
+static void mb_bc4_decode(void)
+{
+    /* eight-value mode: r0 = 200 > r1 = 10, texel t has code t % 8 */
+    uint8_t blk[8];
+    float v[16];
+    uint64_t bits = 0;
+    int t;
+    for (t = 0; t < 16; ++t) bits |= (uint64_t)(t % 8) << (3 * t);
+    blk[0] = 200; blk[1] = 10;
+    for (t = 0; t < 6; ++t) blk[2 + t] = (uint8_t)(bits >> (8 * t));
+    rad_bc4_decode_block(blk, v);
+    CHECK(v[0] == 200.0f / 255.0f && v[1] == 10.0f / 255.0f);
+    for (t = 2; t < 8; ++t) CHECK_NEAR(v[t], ((8.0 - t) * 200.0 / 255.0 + (t - 1.0) * 10.0 / 255.0) / 7.0, 1e-7);
+    CHECK_NEAR(v[2], (6.0 * 200.0 + 10.0) / 7.0 / 255.0, 1e-7);
+    CHECK(v[8] == v[0] && v[15] == v[7]);
+    /* six-value mode: r0 = 10 <= r1 = 200; codes 6 and 7 are exactly 0 and 1 */
+    blk[0] = 10; blk[1] = 200;
+    rad_bc4_decode_block(blk, v);
+    CHECK(v[0] == 10.0f / 255.0f && v[1] == 200.0f / 255.0f);
+    for (t = 2; t < 6; ++t) CHECK_NEAR(v[t], ((6.0 - t) * 10.0 / 255.0 + (t - 1.0) * 200.0 / 255.0) / 5.0, 1e-7);
+    CHECK_NEAR(v[2], (4.0 * 10.0 + 200.0) / 5.0 / 255.0, 1e-7);
+    CHECK(v[6] == 0.0f && v[7] == 1.0f);
+    /* equal endpoints are the six-value mode too */
+    blk[0] = blk[1] = 77;
+    rad_bc4_decode_block(blk, v);
+    CHECK(v[6] == 0.0f && v[7] == 1.0f && v[3] == 77.0f / 255.0f);
+}
+
+static void mb_encode_bounds(void)
+{
+    uint32_t seed = 12345u, trial, t;
+    double bc4_rand = 0.0, bc4_smooth = 0.0, bc1_smooth = 0.0, bc1_rand_rms = 0.0;
+    for (trial = 0; trial < 2000; ++trial) {
+        float v[16], d[16], rgb[48], drgb[48], base = mb_rand(&seed) * 0.8f, slope = mb_rand(&seed) * 0.1f;
+        uint8_t blk[8];
+        double sse = 0.0;
+        for (t = 0; t < 16; ++t) v[t] = mb_rand(&seed);
+        rad_bc4_encode_block(v, blk);
+        rad_bc4_decode_block(blk, d);
+        for (t = 0; t < 16; ++t) if (fabs((double)d[t] - v[t]) > bc4_rand) bc4_rand = fabs((double)d[t] - v[t]);
+        for (t = 0; t < 16; ++t) v[t] = base + slope * (float)(t % 4) / 3.0f + 0.5f * slope * (float)(t / 4) / 3.0f;
+        rad_bc4_encode_block(v, blk);
+        rad_bc4_decode_block(blk, d);
+        for (t = 0; t < 16; ++t) if (fabs((double)d[t] - v[t]) > bc4_smooth) bc4_smooth = fabs((double)d[t] - v[t]);
+        for (t = 0; t < 16; ++t) {
+            float g = base + slope * (float)(t % 4) / 3.0f + 0.5f * slope * (float)(t / 4) / 3.0f;
+            rgb[3 * t] = g; rgb[3 * t + 1] = 0.9f * g; rgb[3 * t + 2] = 0.7f * g + 0.05f;
+        }
+        rad_bc1_encode_block(rgb, blk);
+        rad_bc1_decode_block(blk, drgb);
+        for (t = 0; t < 48; ++t) if (fabs((double)drgb[t] - rgb[t]) > bc1_smooth) bc1_smooth = fabs((double)drgb[t] - rgb[t]);
+        for (t = 0; t < 48; ++t) rgb[t] = mb_rand(&seed);
+        rad_bc1_encode_block(rgb, blk);
+        rad_bc1_decode_block(blk, drgb);
+        for (t = 0; t < 48; ++t) sse += ((double)drgb[t] - rgb[t]) * ((double)drgb[t] - rgb[t]);
+        bc1_rand_rms += sse / 48.0;
+    }
+    bc1_rand_rms = sqrt(bc1_rand_rms / 2000.0);
+    /* BC4: 8 levels over a range of at most 1 (step 1/7); the encoder minimises the squared
+       error, so a single texel may sit up to one step from its value */
+    CHECK(bc4_rand <= 1.0 / 7.0);
+    /* smooth ramps of range <= 0.15: an eighth of a 1/255 step plus the interpolation step */
+    CHECK(bc4_smooth <= 0.15 / 14.0 + 1.0 / 255.0);
+    /* BC1 on smooth correlated colour: 5-bit endpoints (1/62) plus a third of the range */
+    CHECK(bc1_smooth <= 1.0 / 31.0 + 0.15 / 6.0 + 1e-3);
+    /* BC1 on white noise: 4 colours for 16 random RGB texels; rms well below uniform (0.41) */
+    CHECK(bc1_rand_rms <= 0.25);
+    /* exact cases: zeros, the endpoints, 0 and 1 in the six-value mode */
+    {
+        float v[16], d[16], rgb[48], drgb[48];
+        uint8_t blk[8];
+        for (t = 0; t < 16; ++t) v[t] = (t % 3 == 0) ? 0.0f : ((t % 3 == 1) ? 1.0f : 128.0f / 255.0f);
+        rad_bc4_encode_block(v, blk);
+        rad_bc4_decode_block(blk, d);
+        for (t = 0; t < 16; ++t) CHECK(d[t] == v[t]);
+        for (t = 0; t < 48; ++t) rgb[t] = (t / 3) % 2 ? 0.0f : 1.0f;
+        rad_bc1_encode_block(rgb, blk);
+        rad_bc1_decode_block(blk, drgb);
+        for (t = 0; t < 48; ++t) CHECK(drgb[t] == rgb[t]);
+    }
+}
+
+static void mb_permutations(void)
+{
+    /* dyadic entries and integer E: every partial sum is exact in float, so any summation
+       order gives the same bits and the permuted apply must equal the plain one exactly */
+    enum { N = 37 };
+    static float planes[3 * N * N];
+    float E[3 * N], a[3 * N], b[3 * N];
+    rad_multibounce view, *perm = NULL, *sampled = NULL;
+    uint32_t i, seed = 7u;
+    for (i = 0; i < 3 * N * N; ++i) planes[i] = (float)((uint32_t)(mb_rand(&seed) * 16.0f) * (uint32_t)(i % 5 == 0)) / 1024.0f;
+    for (i = 0; i < 3 * N; ++i) E[i] = (float)(uint32_t)(mb_rand(&seed) * 8.0f);
+    memset(&view, 0, sizeof(view));
+    view.n = N;
+    view.bounces = 1;
+    view.precision = RAD_MB_FLOAT;
+    view.planes = planes;
+    CHECK_OK(rad_multibounce_reorder(&view, 0, NULL, &perm));
+    CHECK_OK(rad_multibounce_reorder(&view, 10, NULL, &sampled));
+    if (!perm || !sampled) return;
+    CHECK(mb_is_permutation(perm->row_perm, N) && mb_is_permutation(perm->col_perm, N));
+    CHECK(mb_is_permutation(sampled->row_perm, N) && mb_is_permutation(sampled->col_perm, N));
+    CHECK_OK(rad_multibounce_apply(&view, E, a, RAD_OUTPUT_INDIRECT, NULL));
+    CHECK_OK(rad_multibounce_apply(perm, E, b, RAD_OUTPUT_INDIRECT, NULL));
+    CHECK(memcmp(a, b, sizeof(a)) == 0);
+    CHECK_OK(rad_multibounce_apply(sampled, E, b, RAD_OUTPUT_INDIRECT, NULL));
+    CHECK(memcmp(a, b, sizeof(a)) == 0);
+    rad_multibounce_destroy(sampled);
+    CHECK_RESULT(rad_multibounce_reorder(perm, 0, NULL, &sampled), RAD_ERROR_INVALID_ARGUMENT); /* already permuted */
+    CHECK(sampled == NULL);
+    rad_multibounce_destroy(perm);
+    /* on the Cornell matrix: bijections, and the same L up to float summation order */
+    {
+        mb_world w;
+        rad_multibounce *mb = NULL, *p = NULL;
+        float *x, *y;
+        uint32_t n;
+        if (!mb_cornell(&w, mb_target())) return;
+        n = w.patches->count;
+        x = (float *)malloc(sizeof(float) * 3 * n);
+        y = (float *)malloc(sizeof(float) * 3 * n);
+        CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, NULL, NULL, &mb));
+        CHECK_OK(rad_multibounce_reorder(mb, 0, NULL, &p));
+        if (mb && p && x && y) {
+            CHECK(mb_is_permutation(p->row_perm, n) && mb_is_permutation(p->col_perm, n));
+            CHECK_OK(rad_multibounce_apply(mb, w.E, x, RAD_OUTPUT_INDIRECT, NULL));
+            CHECK_OK(rad_multibounce_apply(p, w.E, y, RAD_OUTPUT_INDIRECT, NULL));
+            CHECK(mb_rel(y, x, 3 * (size_t)n) <= 1e-6);
+        }
+        rad_multibounce_destroy(mb);
+        rad_multibounce_destroy(p);
+        free(x);
+        free(y);
+        mb_world_free(&w);
+    }
+}
+
+static void mb_half_apply(void)
+{
+    mb_world w;
+    rad_multibounce *mb = NULL, *h = NULL, *back = NULL;
+    float *x, *y;
+    uint32_t n, i;
+    if (!mb_cornell(&w, mb_target())) return;
+    n = w.patches->count;
+    x = (float *)malloc(sizeof(float) * 3 * n);
+    y = (float *)malloc(sizeof(float) * 3 * n);
+    CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, NULL, NULL, &mb));
+    CHECK_OK(rad_multibounce_convert(mb, RAD_MB_HALF, NULL, &h));
+    CHECK_OK(rad_multibounce_convert(h, RAD_MB_FLOAT, NULL, &back));
+    if (mb && h && back && x && y) {
+        CHECK(h->precision == RAD_MB_HALF && h->half && !h->planes);
+        CHECK_OK(rad_multibounce_apply(mb, w.E, x, RAD_OUTPUT_INDIRECT, NULL));
+        CHECK_OK(rad_multibounce_apply(h, w.E, y, RAD_OUTPUT_INDIRECT, NULL));
+        /* every entry and E are >= 0, so each result is within the relative rounding of
+           binary16 (2^-11), plus subnormal flushes (below 6e-5 absolute per entry) */
+        for (i = 0; i < 3 * n; ++i) CHECK(fabs((double)y[i] - x[i]) <= 4.9e-4 * fabs((double)x[i]) + 1e-4);
+        for (i = 0; i < 3 * n * n; i += 97) CHECK(fabs((double)back->planes[i] - mb->planes[i]) <= 4.9e-4 * mb->planes[i] + 3e-8);
+    }
+    rad_multibounce_destroy(mb);
+    rad_multibounce_destroy(h);
+    rad_multibounce_destroy(back);
+    free(x);
+    free(y);
+    mb_world_free(&w);
+}
+
+static void mb_compressed(void)
+{
+    mb_world w;
+    rad_multibounce *mb = NULL;
+    uint32_t n, f, ro;
+    float *exact, *got, *dec, *viadec;
+    if (!mb_cornell(&w, mb_target())) return;
+    n = w.patches->count;
+    exact = (float *)malloc(sizeof(float) * 3 * n);
+    got = (float *)malloc(sizeof(float) * 3 * n);
+    viadec = (float *)malloc(sizeof(float) * 3 * n);
+    dec = (float *)malloc(sizeof(float) * 3 * n * n);
+    CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, NULL, NULL, &mb));
+    if (!mb || !exact || !got || !dec || !viadec) goto done;
+    CHECK_OK(rad_multibounce_apply(mb, w.E, exact, RAD_OUTPUT_INDIRECT, NULL));
+    for (f = 0; f < 2; ++f)
+        for (ro = 0; ro < 2; ++ro) {
+            rad_block_options o;
+            rad_block_report rep;
+            rad_multibounce_blocks *b = NULL;
+            rad_multibounce view;
+            double sse = 0.0, rel;
+            size_t i;
+            rad_block_options_default(&o);
+            o.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+            o.reorder = (int)ro;
+            CHECK_OK(rad_multibounce_blocks_create(mb, &o, NULL, &b, &rep));
+            if (!b) continue;
+            CHECK(rep.outlier_count == (uint64_t)(0.05 * (double)n * n) || rep.outlier_count < (uint64_t)(0.05 * (double)n * n));
+            CHECK(rep.outlier_count > 0);
+            if (ro) CHECK(mb_is_permutation(b->row_perm, n) && mb_is_permutation(b->col_perm, n));
+            CHECK_OK(rad_multibounce_blocks_decode(b, dec, NULL));
+            for (i = 0; i < 3 * (size_t)n * n; ++i) sse += ((double)dec[i] - mb->planes[i]) * ((double)dec[i] - mb->planes[i]);
+            CHECK_REL(sse / (3.0 * n * n), rep.mse, 1e-3);
+            /* the on-the-fly apply equals the decoded matrix times E */
+            memset(&view, 0, sizeof(view));
+            view.n = n; view.bounces = 3; view.precision = RAD_MB_FLOAT; view.planes = dec;
+            CHECK_OK(rad_multibounce_apply(&view, w.E, viadec, RAD_OUTPUT_INDIRECT, NULL));
+            CHECK_OK(rad_multibounce_blocks_apply(b, w.E, got, RAD_OUTPUT_INDIRECT, NULL));
+            CHECK(mb_rel(got, viadec, 3 * (size_t)n) <= 1e-5);
+            /* stated bounds for the Cornell E (measured: BC4x3 2.0-2.6%, BC1 3.4-3.7% of max |L|) */
+            rel = mb_rel(got, exact, 3 * (size_t)n);
+            printf("    %s%s: mse %.3g (mean square %.3g), L error %.3g, %zu bytes of %zu\n", f ? "BC4x3" : "BC1",
+                   ro ? " reordered" : "", rep.mse, rep.source_mean_square, rel, rep.bytes_total, rep.bytes_float_f);
+            CHECK(rel <= (f ? 0.04 : 0.06));
+            rad_multibounce_blocks_destroy(b);
+        }
+done:
+    rad_multibounce_destroy(mb);
+    free(exact);
+    free(got);
+    free(dec);
+    free(viadec);
+    mb_world_free(&w);
+}
+
+static void mb_container(void)
+{
+    mb_world w;
+    rad_multibounce *mb = NULL, *h = NULL, *lmb = NULL;
+    rad_multibounce_blocks *b = NULL, *lb = NULL;
+    rad_section s[3 * RAD_MB_MAX_SECTIONS];
+    uint32_t k1 = 0, k2 = 0, k3 = 0, n, i;
+    size_t bytes;
+    void *buf = NULL;
+    rad_container *ct = NULL;
+    float *x, *y;
+    rad_block_options o;
+    if (!mb_cornell(&w, rad_test_quick() ? 80u : 150u)) return;
+    n = w.patches->count;
+    x = (float *)malloc(sizeof(float) * 3 * n);
+    y = (float *)malloc(sizeof(float) * 3 * n);
+    CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, NULL, NULL, &mb));
+    CHECK_OK(rad_multibounce_reorder(mb, 0, NULL, &h));
+    rad_block_options_default(&o);
+    o.tile = 16;
+    CHECK_OK(rad_multibounce_blocks_create(mb, &o, NULL, &b, NULL));
+    if (!mb || !h || !b || !x || !y) goto done;
+    CHECK_OK(rad_multibounce_sections(mb, "Fmb", s, &k1));
+    CHECK_OK(rad_multibounce_sections(h, "Fmb-perm", s + k1, &k2));
+    CHECK_OK(rad_multibounce_blocks_sections(b, "Fmb-bc4", s + k1 + k2, &k3));
+    CHECK(k1 == 2 && k2 == 4 && k3 == 8);
+    CHECK_OK(rad_container_size(s, k1 + k2 + k3, &bytes));
+    buf = malloc(bytes);
+    CHECK_OK(rad_container_write(s, k1 + k2 + k3, buf, bytes));
+    CHECK_OK(rad_container_open(buf, bytes, NULL, &ct));
+    if (!ct) goto done;
+    CHECK_OK(rad_multibounce_blocks_load(ct, "Fmb-bc4", NULL, &lb));
+    CHECK_RESULT(rad_multibounce_load(ct, "Fmb-bc4", NULL, &lmb), RAD_ERROR_CORRUPT); /* wrong kind */
+    CHECK_RESULT(rad_multibounce_load(ct, "nothing", NULL, &lmb), RAD_ERROR_CORRUPT);
+    CHECK_OK(rad_multibounce_load(ct, "Fmb-perm", NULL, &lmb));
+    if (lmb && lb) {
+        CHECK(lmb->n == n && lmb->bounces == 3 && lmb->row_perm && lb->outlier_count == b->outlier_count);
+        CHECK_OK(rad_multibounce_apply(h, w.E, x, RAD_OUTPUT_INDIRECT, NULL));
+        CHECK_OK(rad_multibounce_apply(lmb, w.E, y, RAD_OUTPUT_INDIRECT, NULL));
+        CHECK(memcmp(x, y, sizeof(float) * 3 * n) == 0);
+        CHECK_OK(rad_multibounce_blocks_apply(b, w.E, x, RAD_OUTPUT_INDIRECT, NULL));
+        CHECK_OK(rad_multibounce_blocks_apply(lb, w.E, y, RAD_OUTPUT_INDIRECT, NULL));
+        CHECK(memcmp(x, y, sizeof(float) * 3 * n) == 0);
+    }
+    rad_multibounce_destroy(lmb);
+    lmb = NULL;
+    rad_multibounce_blocks_destroy(lb);
+    lb = NULL;
+    rad_container_close(ct);
+    ct = NULL;
+    /* a corrupted permutation (a repeated index, valid checksum) and an outlier column >= N */
+    {
+        uint32_t *bad = (uint32_t *)malloc(sizeof(uint32_t) * n), *badcol = (uint32_t *)malloc(sizeof(uint32_t) * b->outlier_count);
+        rad_section t[RAD_MB_MAX_SECTIONS];
+        uint32_t kt = 0;
+        if (bad && badcol) {
+            memcpy(bad, b->row_perm, sizeof(uint32_t) * n);
+            bad[1] = bad[0];
+            CHECK_OK(rad_multibounce_blocks_sections(b, "x", t, &kt));
+            for (i = 0; i < kt; ++i)
+                if (t[i].type == RAD_SECTION_MB_ROW_PERM) t[i].data = bad;
+            free(buf);
+            CHECK_OK(rad_container_size(t, kt, &bytes));
+            buf = malloc(bytes);
+            CHECK_OK(rad_container_write(t, kt, buf, bytes));
+            CHECK_OK(rad_container_open(buf, bytes, NULL, &ct));
+            CHECK_RESULT(rad_multibounce_blocks_load(ct, "x", NULL, &lb), RAD_ERROR_CORRUPT);
+            CHECK(lb == NULL);
+            rad_container_close(ct);
+            ct = NULL;
+            memcpy(badcol, b->outlier_columns, sizeof(uint32_t) * b->outlier_count);
+            badcol[b->outlier_count / 2] = n;
+            for (i = 0; i < kt; ++i) {
+                if (t[i].type == RAD_SECTION_MB_ROW_PERM) t[i].data = b->row_perm;
+                if (t[i].type == RAD_SECTION_MB_OUTLIER_COLUMNS) t[i].data = badcol;
+            }
+            CHECK_OK(rad_container_write(t, kt, buf, bytes));
+            CHECK_OK(rad_container_open(buf, bytes, NULL, &ct));
+            CHECK_RESULT(rad_multibounce_blocks_load(ct, "x", NULL, &lb), RAD_ERROR_INDEX_OUT_OF_RANGE);
+            rad_container_close(ct);
+            ct = NULL;
+        }
+        free(bad);
+        free(badcol);
+    }
+done:
+    rad_container_close(ct);
+    free(buf);
+    rad_multibounce_destroy(mb);
+    rad_multibounce_destroy(h);
+    rad_multibounce_blocks_destroy(b);
+    free(x);
+    free(y);
+    mb_world_free(&w);
+}
+
+static void mb_errors(void)
+{
+    float F[4] = { 0.0f, 0.5f, 0.5f, 0.0f }, albedo[6] = { 0.5f, 0.5f, 0.5f, 0.5f, 1.0f, 0.5f };
+    rad_matrix m;
+    rad_multibounce_options o;
+    rad_multibounce *mb = NULL;
+    memset(&m, 0, sizeof(m));
+    m.rows = m.cols = 2;
+    m.storage = RAD_STORAGE_DENSE;
+    m.dense = F;
+    rad_multibounce_options_default(&o);
+    CHECK_RESULT(rad_multibounce_create(&m, albedo, &o, NULL, &mb), RAD_ERROR_ALBEDO_RANGE);
+    albedo[4] = 0.5f;
+    o.bounces = 0;
+    CHECK_RESULT(rad_multibounce_create(&m, albedo, &o, NULL, &mb), RAD_ERROR_INVALID_ARGUMENT);
+    o.bounces = 2;
+    m.cols = 1;
+    CHECK_RESULT(rad_multibounce_create(&m, albedo, &o, NULL, &mb), RAD_ERROR_SIZE_MISMATCH);
+    m.cols = 2;
+    CHECK_RESULT(rad_multibounce_create(&m, NULL, &o, NULL, &mb), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_OK(rad_multibounce_create(&m, albedo, &o, NULL, &mb));
+    if (mb) {
+        /* K = 2 on a 2-patch exchange: A = 0.25 [0 1; 1 0] -> A + A^2 */
+        CHECK_NEAR(mb->planes[1], 0.25, 1e-7);
+        CHECK_NEAR(mb->planes[0], 0.0625, 1e-7);
+    }
+    {
+        rad_block_options bo;
+        rad_multibounce_blocks *b = NULL;
+        rad_block_options_default(&bo);
+        bo.tile = 6;
+        CHECK_RESULT(rad_multibounce_blocks_create(mb, &bo, NULL, &b, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        bo.tile = 4;
+        bo.outlier_fraction = 1.5f;
+        CHECK_RESULT(rad_multibounce_blocks_create(mb, &bo, NULL, &b, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        bo.outlier_fraction = 0.0f;
+        CHECK_OK(rad_multibounce_blocks_create(mb, &bo, NULL, &b, NULL));
+        if (b) CHECK(b->outlier_count == 0 && b->outlier_offsets == NULL);
+        rad_multibounce_blocks_destroy(b);
+    }
+    rad_multibounce_destroy(mb);
+}
+
+static const rad_test_case tests_multibounce[] = {
+    { "multibounce: binary16 conversion", mb_half },
+    { "multibounce: F_mb E equals K Jacobi bounces (K = 1, 3, 8)", mb_jacobi },
+    { "multibounce: K = infinity equals the direct solve", mb_infinite },
+    { "multibounce: BC1 blocks decode as the specification says", mb_bc1_decode },
+    { "multibounce: BC4 blocks decode as the specification says", mb_bc4_decode },
+    { "multibounce: BC1/BC4 encoder error bounds", mb_encode_bounds },
+    { "multibounce: reordering gives bijections and the same apply", mb_permutations },
+    { "multibounce: half-precision apply", mb_half_apply },
+    { "multibounce: compressed apply and its error", mb_compressed },
+    { "multibounce: container sections, round trip, corruption", mb_container },
+    { "multibounce: argument errors", mb_errors },
+    { NULL, NULL }
+};
