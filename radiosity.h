@@ -1055,6 +1055,211 @@ RAD_API rad_result rad_multibounce_load(const rad_container *container, const ch
 RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, const char *name,
                                                const rad_context *ctx, rad_multibounce_blocks **out);
 
+/* ======================================================================================== */
+/* >>api_temporal: temporal radiosity                                                       */
+/* ======================================================================================== */
+
+/* Temporal radiosity (SPEC §8; thesis T-6, preprint P-3.2 and P-4) spreads the O(N^2) gather
+   L = G E over frames at O(N k) per frame: each row G_i of a non-negative matrix (a row of F,
+   or one channel of the multi-bounce matrix F_mb) is read as a probability distribution over
+   its non-zero entries plus the ENVIRONMENT ENTRY G_i0 = max(0, 1 - S_i) (S_i = the row sum,
+   accumulated in double), whose value is the sky/ambient radiosity E_0. With
+   T_i = S_i + G_i0 (1 when S_i <= 1, S_i when the row sums to more than 1),
+   sum_{j=0..N} G_ij E_j = T_i * Expectation[E_J], J drawn with probability G_ij / T_i.
+   Every frame draws k indices J per row from an alias table, forms X_i = T_i * mean(E_J)
+   (times rho_i when G = F) and blends B_i = w B_i^prev + (1 - w) X_i.
+
+   ALIAS TABLES. One table per row over the row's entries with value > 0, in ascending column
+   order, followed by the environment entry when G_i0 > 0; a row always has at least one bin
+   (an all-zero row has only the environment entry, T_i = 1). Built by Vose's O(n) method,
+   robust variant (REFERENCE §3): q_b = n w_b / W with W accumulated in double; worklists
+   Small (q < 1) and Large (q >= 1) kept as stacks in ascending bin order; while both are
+   non-empty pop l from Small and g from Large, prob[l] = q_l, alias[l] = g,
+   q_g = (q_g + q_l) - 1, push g on Small if q_g < 1 else on Large; bins left in either list
+   get prob = 1 and alias = themselves. The probability becomes the 32-bit integer
+   threshold = min(floor(prob * 2^32 + 0.5), 2^32 - 1) (computed in double).
+
+   Column indices name patches 0..cols-1; the index 'cols' (== N) names the environment, so a
+   shader can append E_0 as element N of the sampled vector and never branch.
+
+   Two layouts of a bin (rad_alias_tables.format):
+     RAD_ALIAS_COMPACT (2 uint32 words, 8 bytes; needs cols <= 65535):
+        word0 = threshold, word1 = column | (alias_column << 16)
+     RAD_ALIAS_WIDE    (3 uint32 words, 12 bytes; any cols < 2^32 - 1):
+        word0 = threshold, word1 = column, word2 = alias_column
+   where 'column' is the bin's own column and 'alias_column' the column of its alias bin
+   (equal to 'column' when prob = 1), so a draw reads exactly one bin.
+
+   THE RANDOM NUMBERS (exact; a GLSL kernel reproduces them bit for bit). All arithmetic is
+   on uint32 with wrap-around (GLSL 'uint'):
+       h(v):  s = v * 747796405u + 2891336453u;
+              t = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+              return (t >> 22u) ^ t;                               (PCG-RXS-M-XS hash)
+       key   = h(h(h(seed) ^ frame) ^ row)
+       u1    = h(key ^ (sample * 0x9E3779B9u))
+       u2    = h(u1 ^ 0x68E31DA4u)
+   sample numbering: for table set c (c = 0 when one table serves every channel, else the
+   channel 0..2) and draw s (0..k-1) of row 'row', sample = c * k + s.
+   THE DRAW from a row with n bins starting at bin 'first':
+       b      = high 32 bits of the 64-bit product (uint64)u1 * n     (GLSL: umulExtended)
+       column = (u2 < threshold[first + b]) ? column[first + b] : alias_column[first + b]
+   Test vectors (rad_temporal_random(seed, frame, row, sample) -> u1, u2):
+       (0, 0, 0, 0)                    -> 0x8D324821, 0x5A5950DF
+       (1, 2, 3, 4)                    -> 0xBE9148C4, 0xB2A7FCBE
+       (0xDEADBEEF, 1000, 10421, 63)   -> 0xA62F1C1E, 0x399CE3D2
+   (checked by tests/test_temporal.c; see rad_temporal_random.)
+
+   THE STEP (rad_temporal_step), per row i, per channel set c, in this order and in float:
+       acc = 0 (float, RGB); for s = 0..k-1: J = draw; acc += V_J   (V = the sampled vector)
+       X_i = acc * (T_i / k)         (T_i / k computed in float)
+       mode SINGLE, FEEDBACK: X_i *= rho_i (per channel)
+       B_i = w_i * B_i^prev + (1 - w_i) * X_i
+   V_j = E_j (SINGLE, MULTIBOUNCE) or E_j + B_j^prev (FEEDBACK), V_N = E_0. With one table set
+   per channel (MULTIBOUNCE with 3 tables) channel c only accumulates its own component.
+   The OUTPUT IS THE INDIRECT LIGHT (never E itself): add E for the total. */
+
+#define RAD_SECTION_TEMPORAL_ROW_OFFSETS 32u /* alias tables: rows + 1 uint64, offsets in bins */
+#define RAD_SECTION_TEMPORAL_BINS 33u        /* alias tables: the bins, 2 or 3 uint32 words each */
+#define RAD_SECTION_TEMPORAL_TOTALS 34u      /* alias tables: T_i, one float per row */
+
+typedef enum rad_alias_format {
+    RAD_ALIAS_AUTO = 0,    /* compact when cols <= 65535, else wide (the builders' choice) */
+    RAD_ALIAS_COMPACT = 2, /* 8 bytes per bin (value = words per bin) */
+    RAD_ALIAS_WIDE = 3     /* 12 bytes per bin */
+} rad_alias_format;
+
+/* Alias tables for every row of an N x N matrix. Built by rad_alias_tables_* (owning: free
+   with rad_alias_tables_destroy) or viewed from a container (rad_alias_tables_view). */
+typedef struct rad_alias_tables {
+    uint32_t rows, cols;           /* cols = N: the environment's column index */
+    rad_alias_format format;       /* RAD_ALIAS_COMPACT or RAD_ALIAS_WIDE (never AUTO here) */
+    const uint64_t *row_offsets;   /* rows + 1: row i's bins are [row_offsets[i], row_offsets[i+1]) */
+    const uint32_t *bins;          /* row_offsets[rows] * format words */
+    const float *totals;           /* T_i per row */
+    uint64_t source_entries;       /* float entries of the source matrix (dense: rows*cols; CSR: nnz) */
+    void *storage;                 /* private */
+    rad_allocator allocator;       /* private */
+} rad_alias_tables;
+
+/* Tables for every row of F (dense or CSR). F is borrowed only during the call.
+   Rows are built in parallel (ctx->parallel_for); the result does not depend on threads.
+   Errors: INVALID_ARGUMENT (non-square F, a negative or non-finite entry: the logger names
+   it), SIZE_OVERFLOW, OUT_OF_MEMORY, CANCELLED. Cost: O(nnz), two passes over F.
+   Memory: 8 (compact) or 12 (wide) bytes per non-zero entry + 1 bin per row, 12 bytes per row.
+   Thread safety: reentrant. SPEC §8. */
+RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format format, const rad_context *ctx,
+                                           rad_alias_tables **out);
+
+/* Tables for one channel of a dense N x N row-major float plane (for instance channel c of a
+   multi-bounce matrix F_mb, whose rows may sum to more than 1: T_i then carries the sum).
+   plane is borrowed only during the call. Same errors and cost as rad_alias_tables_create. */
+RAD_API rad_result rad_alias_tables_create_dense(const float *plane, uint32_t n, rad_alias_format format,
+                                                 const rad_context *ctx, rad_alias_tables **out);
+
+RAD_API void rad_alias_tables_destroy(rad_alias_tables *tables);
+
+/* Bytes the tables' bins, offsets and totals take. */
+RAD_API size_t rad_alias_tables_memory(const rad_alias_tables *tables);
+
+/* STREAMED ROWS (P-4.3): the table of one row built at run time into caller memory.
+   columns: ascending column indices (< cols) of the 'count' values, or NULL when 'values' is
+   a dense row of count == cols entries. Entries <= 0 are skipped, exactly as the whole-matrix
+   builders do, so the bins are bit-identical to theirs. out_bins: room for count + 1 bins of
+   'format' words (COMPACT needs cols <= 65535; AUTO is resolved from cols as above).
+   scratch: rad_alias_row_scratch_size(count) bytes, 8-byte aligned. Writes the bin count to
+   *out_bin_count and T_i to *out_total. Errors: INVALID_ARGUMENT (negative, non-finite, a
+   column >= cols), SIZE_OVERFLOW. Cost: O(count). Thread safety: reentrant, no allocation. */
+RAD_API size_t rad_alias_row_scratch_size(uint32_t count);
+RAD_API rad_result rad_alias_build_row(const uint32_t *columns, const float *values, uint32_t count, uint32_t cols,
+                                       rad_alias_format format, uint32_t *out_bins, uint32_t *out_bin_count,
+                                       float *out_total, void *scratch);
+
+/* The generator of the doc block above: writes u1 and u2 of (seed, frame, row, sample).
+   Pure, 32-bit integer operations only. */
+RAD_API void rad_temporal_random(uint32_t seed, uint32_t frame, uint32_t row, uint32_t sample, uint32_t out[2]);
+
+/* One draw from n bins (in 'format' layout) with the random words u1, u2: the column
+   (== cols for the environment). Pure. */
+RAD_API uint32_t rad_alias_draw(const uint32_t *bins, uint32_t n, rad_alias_format format, uint32_t u1, uint32_t u2);
+
+/* Sections for writing the tables into a container (rad_container_write), named 'name'
+   (up to 23 characters; the three sections share it). Data borrowed from the tables. */
+RAD_API void rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section out[3]);
+
+/* A non-owning view of tables stored in a container under 'name', validated (offsets
+   monotone, bin counts >= 1, columns and aliases <= cols, totals finite and > 0). *out
+   points into the container, which must outlive it; do not destroy a view.
+   Errors: INVALID_ARGUMENT (missing sections), CORRUPT (the logger says why). */
+RAD_API rad_result rad_alias_tables_view(const rad_container *container, const char *name, const rad_context *ctx,
+                                         rad_alias_tables *out);
+
+typedef enum rad_temporal_mode {
+    RAD_TEMPORAL_SINGLE = 0,     /* G = F, X_i times rho_i: one bounce of E (L_1) */
+    RAD_TEMPORAL_FEEDBACK = 1,   /* G = F, samples E + B^prev: converges to L_inf (T-6.4, P-4.2) */
+    RAD_TEMPORAL_MULTIBOUNCE = 2 /* G = a channel of F_mb (albedo already inside): no rho */
+} rad_temporal_mode;
+
+typedef struct rad_temporal_options {
+    rad_temporal_mode mode;
+    uint32_t samples;      /* k draws per row and frame (default 10; >= 1) */
+    float weight;          /* fixed w in [0, 1) (default 0.998; 0 keeps no history) */
+    uint32_t seed;         /* generator seed */
+    int adaptive;          /* non-zero: per-row w from the estimator's variance (see below) */
+    float noise_target;    /* adaptive: target relative std of B_i in steady state (default 0.01) */
+    float weight_max;      /* adaptive: upper bound of w_i (default 0.999) */
+    float change_sigma;    /* adaptive: change test threshold in standard deviations (default 5) */
+} rad_temporal_options;
+
+/* ADAPTIVE WEIGHT (the preprint's open problem P-6). Per row, on the scalar x = sum of the
+   channels of X_i, with c_i = frames since the row's (re)start:
+     a = max(1/(c_i + 1), 1/64); m_i += a (x - m_i); v_i += a ((x - m_i)^2 - v_i)   (in float)
+     steady weight: r = (target m_i)^2 / v_i; w_ss = (1 - r) / (1 + r) clamped to
+       [0, weight_max] (w_ss = 0 when v_i = 0), because an exponential moving average of
+       independent X has Var(B) = (1 - w)/(1 + w) Var(X);
+     w_i = min(w_ss, c_i / (c_i + 1)): after a restart B is the plain mean of the samples so far.
+   Change test (from the 5th frame after a restart): with sd_i = sqrt(v_i), d_i = EMA at rate
+   1/4 of (x - b_i) clamped to [-3 sd_i, 3 sd_i] (b_i = the channel sum of B_i^prev; the clamp
+   keeps single heavy-tailed samples from triggering it); the EMA of independent values has a
+   standard deviation of sqrt(1/7) = 0.378 of theirs, so when |d_i| > change_sigma * 0.378 sd_i
+   and |d_i| > target * |b_i| the row restarts (c_i = 0: it drops w for the next frames).
+   rad_temporal_signal_change restarts every row at the next step. */
+RAD_API void rad_temporal_options_default(rad_temporal_options *options);
+
+typedef struct rad_temporal rad_temporal;
+
+/* Temporal state for N = tables[0]->rows patches. tables: table_count (1, or 3 in
+   MULTIBOUNCE mode: one per channel) borrowed tables, which must outlive the state; all of
+   the same size N x N. albedo: 3N floats, borrowed, required for SINGLE and FEEDBACK, unused
+   (may be NULL) for MULTIBOUNCE. B starts at 0. Errors: INVALID_ARGUMENT, SIZE_MISMATCH,
+   OUT_OF_MEMORY. Thread safety: reentrant. Memory: O(N). SPEC §8. */
+RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, uint32_t table_count, const float *albedo,
+                                       const rad_temporal_options *options, const rad_context *ctx,
+                                       rad_temporal **out);
+RAD_API void rad_temporal_destroy(rad_temporal *temporal);
+
+/* B = 0, frame = 0, adaptive statistics cleared: as just created. */
+RAD_API void rad_temporal_reset(rad_temporal *temporal);
+
+/* Adaptive mode: E changed sharply (a light moved or switched); every row restarts at the
+   next step. No effect with a fixed weight. */
+RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
+
+/* One frame: E (3N floats, borrowed during the call), E0 (the sky/environment RGB value, NULL
+   for 0). Advances the frame counter. Writes the new indirect light B (3N floats, never
+   including E) to out_indirect when it is not NULL; rad_temporal_indirect returns it too.
+   Parallel over rows through ctx->parallel_for; the bits do not depend on the thread count
+   or task split (each row's draws depend only on seed, frame, row and sample).
+   Errors: INVALID_ARGUMENT. Cost: O(N k) random reads into the tables and E.
+   Thread safety: one thread at a time per state. SPEC §8. */
+RAD_API rad_result rad_temporal_step(rad_temporal *temporal, const float *E, const float E0[3], float *out_indirect);
+
+/* The current indirect light (3N floats, owned by the state, valid until the next step). */
+RAD_API const float *rad_temporal_indirect(const rad_temporal *temporal);
+/* Frames stepped since create or reset (the 'frame' of the generator for the next step). */
+RAD_API uint32_t rad_temporal_frame(const rad_temporal *temporal);
+/* Adaptive mode: the weights w_i the last step used (N floats), else NULL. */
+RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
+
 #ifdef __cplusplus
 }
 #endif
@@ -6587,6 +6792,689 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *ct, const ch
     }
     if (r != RAD_SUCCESS) { rad_multibounce_blocks_destroy(b); return r; }
     *out = b;
+    return RAD_SUCCESS;
+}
+
+/* ======================================================================================== */
+/* >>temporal: temporal radiosity (alias tables, counter-based draws, the step)             */
+/* ======================================================================================== */
+
+static uint32_t rad__pcg(uint32_t v)
+{
+    uint32_t s = v * 747796405u + 2891336453u;
+    uint32_t t = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    return (t >> 22u) ^ t;
+}
+
+static uint32_t rad__temporal_key(uint32_t seed, uint32_t frame, uint32_t row)
+{
+    return rad__pcg(rad__pcg(rad__pcg(seed) ^ frame) ^ row);
+}
+
+RAD_API void rad_temporal_random(uint32_t seed, uint32_t frame, uint32_t row, uint32_t sample, uint32_t out[2])
+{
+    uint32_t u1 = rad__pcg(rad__temporal_key(seed, frame, row) ^ (sample * 0x9E3779B9u));
+    out[0] = u1;
+    out[1] = rad__pcg(u1 ^ 0x68E31DA4u);
+}
+
+static uint32_t rad__alias_pick(const uint32_t *bins, uint32_t n, uint32_t words, uint32_t u1, uint32_t u2)
+{
+    uint32_t b = (uint32_t)(((uint64_t)u1 * (uint64_t)n) >> 32);
+    const uint32_t *e = bins + (size_t)b * words;
+    if (words == 2u) return u2 < e[0] ? (e[1] & 0xFFFFu) : (e[1] >> 16);
+    return u2 < e[0] ? e[1] : e[2];
+}
+
+RAD_API uint32_t rad_alias_draw(const uint32_t *bins, uint32_t n, rad_alias_format format, uint32_t u1, uint32_t u2)
+{
+    if (!bins || n == 0 || (format != RAD_ALIAS_COMPACT && format != RAD_ALIAS_WIDE)) return RAD_NONE;
+    return rad__alias_pick(bins, n, (uint32_t)format, u1, u2);
+}
+
+RAD_API size_t rad_alias_row_scratch_size(uint32_t count)
+{
+    /* q (double) and one uint32 stack slot per bin, count + 1 bins */
+    return ((size_t)count + 1u) * (sizeof(double) + 2u * sizeof(uint32_t));
+}
+
+static rad_alias_format rad__alias_resolve(rad_alias_format format, uint32_t cols)
+{
+    if (format == RAD_ALIAS_AUTO) return cols <= 65535u ? RAD_ALIAS_COMPACT : RAD_ALIAS_WIDE;
+    return format;
+}
+
+/* One row's bins (shared by every builder, so all give the same bits). c: optional context for
+   messages, row: for messages. */
+static rad_result rad__alias_row(const uint32_t *columns, const float *values, uint32_t count, uint32_t cols,
+                                 rad_alias_format format, uint32_t *out_bins, uint32_t *out_n, float *out_total,
+                                 void *scratch, const rad__ctx *c, uint32_t row)
+{
+    double *q = (double *)scratch, W = 0.0, env, total;
+    uint32_t *colof = (uint32_t *)(q + (size_t)count + 1u), *stack = colof + (size_t)count + 1u;
+    uint32_t i, n = 0, small_top = 0, large_bottom, words = (uint32_t)format;
+    for (i = 0; i < count; ++i) {
+        float v = values[i];
+        uint32_t col = columns ? columns[i] : i;
+        if (!rad__finite(v) || v < 0.0f || col >= cols) {
+            rad__log(c, RAD_LOG_ERROR, "alias tables: row %u entry %u (column %u) is %g: entries must be finite, >= 0, column < %u",
+                     row, i, col, (double)v, cols);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (v > 0.0f) {
+            q[n] = (double)v;
+            colof[n] = col;
+            W += (double)v;
+            ++n;
+        }
+    }
+    env = 1.0 - W;
+    if (env > 0.0) {
+        q[n] = env;
+        colof[n] = cols;
+        ++n;
+        total = 1.0;
+    } else {
+        total = W;
+    }
+    W += env > 0.0 ? env : 0.0;
+    /* Vose, robust variant: Small grows up from stack[0], Large down from stack[n-1] */
+    large_bottom = n;
+    for (i = 0; i < n; ++i) {
+        q[i] = (double)n * q[i] / W;
+        if (q[i] < 1.0) stack[small_top++] = i;
+        else stack[--large_bottom] = i;
+    }
+    /* Large is stored in reverse; pop from its bottom end (the last pushed) */
+    for (i = 0; i < n; ++i) {
+        uint32_t *e = out_bins + (size_t)i * words;
+        e[0] = 0xFFFFFFFFu;
+        if (words == 2u) e[1] = colof[i] | (colof[i] << 16);
+        else { e[1] = colof[i]; e[2] = colof[i]; }
+    }
+    while (small_top > 0 && large_bottom < n) {
+        uint32_t l = stack[--small_top], g = stack[large_bottom++];
+        double p = q[l] * 4294967296.0 + 0.5;
+        uint32_t *e = out_bins + (size_t)l * words;
+        e[0] = p >= 4294967295.0 ? 0xFFFFFFFFu : (uint32_t)p;
+        if (words == 2u) e[1] = colof[l] | (colof[g] << 16);
+        else e[2] = colof[g];
+        q[g] = (q[g] + q[l]) - 1.0;
+        if (q[g] < 1.0) stack[small_top++] = g;
+        else stack[--large_bottom] = g;
+    }
+    /* leftovers keep prob = 1 (threshold 2^32-1 and alias = itself: always the own column) */
+    *out_n = n;
+    *out_total = (float)total;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_alias_build_row(const uint32_t *columns, const float *values, uint32_t count, uint32_t cols,
+                                       rad_alias_format format, uint32_t *out_bins, uint32_t *out_bin_count,
+                                       float *out_total, void *scratch)
+{
+    if ((!values && count) || !out_bins || !out_bin_count || !out_total || !scratch || cols == 0 || cols == 0xFFFFFFFFu)
+        return RAD_ERROR_INVALID_ARGUMENT;
+    if (!columns && count != cols) return RAD_ERROR_INVALID_ARGUMENT;
+    if (count == 0xFFFFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    format = rad__alias_resolve(format, cols);
+    if (format != RAD_ALIAS_COMPACT && format != RAD_ALIAS_WIDE) return RAD_ERROR_INVALID_ARGUMENT;
+    if (format == RAD_ALIAS_COMPACT && cols > 65535u) return RAD_ERROR_INVALID_ARGUMENT;
+    return rad__alias_row(columns, values, count, cols, format, out_bins, out_bin_count, out_total, scratch, NULL, 0);
+}
+
+RAD_API void rad_alias_tables_destroy(rad_alias_tables *t)
+{
+    rad_allocator a;
+    if (!t) return;
+    a = t->allocator;
+    rad__free(&a, t->storage);
+    rad__free(&a, t);
+}
+
+RAD_API size_t rad_alias_tables_memory(const rad_alias_tables *t)
+{
+    if (!t || !t->row_offsets) return 0;
+    return (size_t)t->row_offsets[t->rows] * (size_t)t->format * 4u + ((size_t)t->rows + 1u) * 8u + (size_t)t->rows * 4u;
+}
+
+typedef struct rad__alias_job {
+    const rad_matrix *F;        /* or NULL: 'plane' */
+    const float *plane;
+    uint32_t n;
+    rad_alias_format format;
+    uint64_t *offsets;          /* pass 1: bins per row at [i+1]; pass 2: prefix sums */
+    uint32_t *bins;
+    float *totals;
+    unsigned char *scratch;     /* per task */
+    size_t scratch_stride;
+    const rad__ctx *c;
+    int pass;
+} rad__alias_job;
+
+static rad_result rad__alias_job_row(void *data, uint32_t i, uint32_t task)
+{
+    rad__alias_job *j = (rad__alias_job *)data;
+    const uint32_t *cols = NULL;
+    const float *vals;
+    uint32_t count, k, nb;
+    float total;
+    if (j->F && j->F->storage == RAD_STORAGE_SPARSE) {
+        uint64_t a = j->F->row_offsets[i], b = j->F->row_offsets[i + 1];
+        cols = j->F->columns + a;
+        vals = j->F->values + a;
+        count = (uint32_t)(b - a);
+    } else {
+        vals = (j->F ? j->F->dense : j->plane) + (size_t)i * j->n;
+        count = j->n;
+    }
+    if (j->pass == 1) {
+        /* count the bins; validate */
+        double W = 0.0;
+        nb = 0;
+        for (k = 0; k < count; ++k) {
+            float v = vals[k];
+            uint32_t col = cols ? cols[k] : k;
+            if (!rad__finite(v) || v < 0.0f || col >= j->n) {
+                rad__log(j->c, RAD_LOG_ERROR, "alias tables: row %u entry %u (column %u) is %g: entries must be finite, >= 0, column < %u",
+                         i, k, col, (double)v, j->n);
+                return RAD_ERROR_INVALID_ARGUMENT;
+            }
+            if (v > 0.0f) { ++nb; W += (double)v; }
+        }
+        if (1.0 - W > 0.0) ++nb;
+        j->offsets[i + 1] = nb;
+        return RAD_SUCCESS;
+    }
+    {
+        rad_result r = rad__alias_row(cols, vals, count, j->n, j->format, j->bins + (size_t)j->offsets[i] * (uint32_t)j->format,
+                                      &nb, &total, j->scratch + (size_t)task * j->scratch_stride, j->c, i);
+        if (r != RAD_SUCCESS) return r;
+        j->totals[i] = total;
+        return nb == (uint32_t)(j->offsets[i + 1] - j->offsets[i]) ? RAD_SUCCESS : RAD_ERROR_CORRUPT;
+    }
+}
+
+static rad_result rad__alias_build(const rad_matrix *F, const float *plane, uint32_t n, rad_alias_format format,
+                                   const rad_context *ctx, rad_alias_tables **out)
+{
+    rad__ctx c;
+    rad__alias_job job;
+    rad_alias_tables *t;
+    rad_result r;
+    size_t off_bytes, tot_bytes, bin_bytes, total, words, bins_off, tot_off;
+    uint64_t sum = 0, maxrow;
+    uint32_t i, tasks;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (n == 0 || n == 0xFFFFFFFFu) return RAD_ERROR_INVALID_ARGUMENT;
+    format = rad__alias_resolve(format, n);
+    if (format != RAD_ALIAS_COMPACT && format != RAD_ALIAS_WIDE) return RAD_ERROR_INVALID_ARGUMENT;
+    if (format == RAD_ALIAS_COMPACT && n > 65535u) {
+        rad__log(&c, RAD_LOG_ERROR, "alias tables: the compact format needs N <= 65535 (N = %u)", n);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    tasks = c.tasks < n ? c.tasks : n;
+    memset(&job, 0, sizeof(job));
+    job.F = F;
+    job.plane = plane;
+    job.n = n;
+    job.format = format;
+    job.c = &c;
+    job.offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)n + 1u, sizeof(uint64_t));
+    if (!job.offsets) return RAD_ERROR_OUT_OF_MEMORY;
+    job.pass = 1;
+    {
+        rad__ctx quiet = c; /* progress is reported by the second pass only */
+        quiet.progress = NULL;
+        r = rad__for_rows(&quiet, n, tasks, rad__alias_job_row, &job);
+    }
+    if (r != RAD_SUCCESS) { rad__free(&c.allocator, job.offsets); return r; }
+    job.offsets[0] = 0;
+    maxrow = n; /* scratch is sized by a row's raw entry count */
+    if (F && F->storage == RAD_STORAGE_SPARSE) {
+        maxrow = 0;
+        for (i = 0; i < n; ++i)
+            if (F->row_offsets[i + 1] - F->row_offsets[i] > maxrow) maxrow = F->row_offsets[i + 1] - F->row_offsets[i];
+        if (maxrow > n) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_INVALID_ARGUMENT; }
+    }
+    for (i = 0; i < n; ++i) {
+        uint64_t nb = job.offsets[i + 1];
+        sum += nb;
+        job.offsets[i + 1] = sum;
+    }
+    words = (size_t)format;
+    if (!rad__mul((size_t)n + 1u, sizeof(uint64_t), &off_bytes) || !rad__mul((size_t)n, sizeof(float), &tot_bytes) ||
+        sum > (uint64_t)((size_t)-1) || !rad__mul3((size_t)sum, words, sizeof(uint32_t), &bin_bytes)) {
+        rad__free(&c.allocator, job.offsets);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    /* one block: offsets | totals | bins (each start 8-byte aligned) */
+    tot_off = off_bytes;
+    bins_off = tot_off + ((tot_bytes + 7u) & ~(size_t)7u);
+    total = bins_off + bin_bytes;
+    if (total < bin_bytes) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_SIZE_OVERFLOW; }
+    t = (rad_alias_tables *)rad__alloc(&c.allocator, sizeof(rad_alias_tables));
+    if (!t) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_OUT_OF_MEMORY; }
+    memset(t, 0, sizeof(*t));
+    t->allocator = c.allocator;
+    t->storage = rad__alloc(&c.allocator, total);
+    job.scratch_stride = (rad_alias_row_scratch_size((uint32_t)maxrow) + 7u) & ~(size_t)7u;
+    job.scratch = (unsigned char *)rad__alloc_array(&c.allocator, tasks, job.scratch_stride);
+    if (!t->storage || !job.scratch) {
+        rad__free(&c.allocator, job.scratch);
+        rad__free(&c.allocator, job.offsets);
+        rad_alias_tables_destroy(t);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memcpy(t->storage, job.offsets, off_bytes);
+    rad__free(&c.allocator, job.offsets);
+    job.offsets = (uint64_t *)t->storage;
+    job.totals = (float *)((unsigned char *)t->storage + tot_off);
+    job.bins = (uint32_t *)(void *)((unsigned char *)t->storage + bins_off);
+    job.pass = 2;
+    r = rad__for_rows(&c, n, tasks, rad__alias_job_row, &job);
+    rad__free(&c.allocator, job.scratch);
+    if (r != RAD_SUCCESS) { rad_alias_tables_destroy(t); return r; }
+    t->rows = n;
+    t->cols = n;
+    t->format = format;
+    t->row_offsets = job.offsets;
+    t->totals = job.totals;
+    t->bins = job.bins;
+    t->source_entries = (F && F->storage == RAD_STORAGE_SPARSE) ? F->row_offsets[n] : (uint64_t)n * n;
+    *out = t;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format format, const rad_context *ctx,
+                                           rad_alias_tables **out)
+{
+    rad__ctx c;
+    rad_result r = rad__check_matrix(F);
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (r != RAD_SUCCESS) return r;
+    if (F->rows != F->cols) {
+        rad__log(&c, RAD_LOG_ERROR, "alias tables: the matrix is %u x %u, not square", F->rows, F->cols);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return rad__alias_build(F, NULL, F->rows, format, ctx, out);
+}
+
+RAD_API rad_result rad_alias_tables_create_dense(const float *plane, uint32_t n, rad_alias_format format,
+                                                 const rad_context *ctx, rad_alias_tables **out)
+{
+    if (out) *out = NULL;
+    if (!plane) return RAD_ERROR_INVALID_ARGUMENT;
+    return rad__alias_build(NULL, plane, n, format, ctx, out);
+}
+
+RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section out[3])
+{
+    if (!out) return;
+    memset(out, 0, 3 * sizeof(rad_section));
+    if (!t) return;
+    rad__section(&out[0], RAD_SECTION_TEMPORAL_ROW_OFFSETS, 8u, (uint64_t)t->rows + 1u, t->row_offsets, name);
+    rad__section(&out[1], RAD_SECTION_TEMPORAL_BINS, 4u * (uint32_t)t->format, t->row_offsets[t->rows], t->bins, name);
+    rad__section(&out[2], RAD_SECTION_TEMPORAL_TOTALS, 4u, t->rows, t->totals, name);
+}
+
+RAD_API rad_result rad_alias_tables_view(const rad_container *ct, const char *name, const rad_context *ctx,
+                                         rad_alias_tables *out)
+{
+    rad__ctx c;
+    const rad_section *so, *sb, *st;
+    uint32_t n, words, i;
+    uint64_t b, nb;
+    rad__ctx_init(&c, ctx);
+    if (!ct || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof(*out));
+    so = rad_container_find(ct, RAD_SECTION_TEMPORAL_ROW_OFFSETS, name);
+    sb = rad_container_find(ct, RAD_SECTION_TEMPORAL_BINS, name);
+    st = rad_container_find(ct, RAD_SECTION_TEMPORAL_TOTALS, name);
+    if (!so || !sb || !st) {
+        rad__log(&c, RAD_LOG_ERROR, "alias tables: sections for '%s' not found", name ? name : "(any)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (so->elem_size != 8u || st->elem_size != 4u || (sb->elem_size != 8u && sb->elem_size != 12u) || so->count < 2u ||
+        so->count - 1u != st->count || st->count >= 0xFFFFFFFFu || ((uintptr_t)so->data & 7u) != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "alias tables: section sizes do not fit together");
+        return RAD_ERROR_CORRUPT;
+    }
+    n = (uint32_t)st->count;
+    words = sb->elem_size / 4u;
+    if (words == 2u && n > 65535u) {
+        rad__log(&c, RAD_LOG_ERROR, "alias tables: compact bins with N = %u > 65535", n);
+        return RAD_ERROR_CORRUPT;
+    }
+    {
+        const uint64_t *off = (const uint64_t *)so->data;
+        const uint32_t *bins = (const uint32_t *)sb->data;
+        const float *tot = (const float *)st->data;
+        if (off[0] != 0 || off[n] != sb->count) {
+            rad__log(&c, RAD_LOG_ERROR, "alias tables: offsets do not cover the %llu bins", (unsigned long long)sb->count);
+            return RAD_ERROR_CORRUPT;
+        }
+        for (i = 0; i < n; ++i) {
+            if (off[i + 1] <= off[i] || off[i + 1] - off[i] > (uint64_t)n + 1u) {
+                rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u has a bad bin range", i);
+                return RAD_ERROR_CORRUPT;
+            }
+            if (!rad__finite(tot[i]) || !(tot[i] > 0.0f)) {
+                rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u has total %g", i, (double)tot[i]);
+                return RAD_ERROR_CORRUPT;
+            }
+        }
+        for (b = 0, nb = sb->count; b < nb; ++b) {
+            const uint32_t *e = bins + (size_t)b * words;
+            uint32_t c0 = words == 2u ? (e[1] & 0xFFFFu) : e[1], c1 = words == 2u ? (e[1] >> 16) : e[2];
+            if (c0 > n || c1 > n) {
+                rad__log(&c, RAD_LOG_ERROR, "alias tables: bin %llu names column %u > N = %u", (unsigned long long)b,
+                         c0 > c1 ? c0 : c1, n);
+                return RAD_ERROR_CORRUPT;
+            }
+        }
+        out->rows = n;
+        out->cols = n;
+        out->format = (rad_alias_format)words;
+        out->row_offsets = off;
+        out->bins = bins;
+        out->totals = tot;
+        out->source_entries = 0;
+    }
+    return RAD_SUCCESS;
+}
+
+/* ---- the temporal state ---- */
+
+struct rad_temporal {
+    const rad_alias_tables *tables[3];
+    uint32_t table_count;
+    const float *albedo;
+    rad_temporal_options o;
+    uint32_t n, frame;
+    float *B, *B_next;     /* 3N each; B is the current result */
+    float *V;              /* FEEDBACK: 3N sampled vector E + B^prev */
+    float *w;              /* adaptive: N per-row weights of the last step */
+    float *mean, *var, *fast; /* adaptive: N each */
+    uint32_t *count;       /* adaptive: frames since restart */
+    int restart_all;
+    rad__ctx c;
+};
+
+RAD_API void rad_temporal_options_default(rad_temporal_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->mode = RAD_TEMPORAL_SINGLE;
+    o->samples = 10;
+    o->weight = 0.998f;
+    o->noise_target = 0.01f;
+    o->weight_max = 0.999f;
+    o->change_sigma = 5.0f;
+}
+
+RAD_API void rad_temporal_destroy(rad_temporal *t)
+{
+    rad_allocator a;
+    if (!t) return;
+    a = t->c.allocator;
+    rad__free(&a, t->B);
+    rad__free(&a, t->B_next);
+    rad__free(&a, t->V);
+    rad__free(&a, t->w);
+    rad__free(&a, t->mean);
+    rad__free(&a, t->var);
+    rad__free(&a, t->fast);
+    rad__free(&a, t->count);
+    rad__free(&a, t);
+}
+
+RAD_API void rad_temporal_reset(rad_temporal *t)
+{
+    size_t n3;
+    if (!t) return;
+    n3 = 3u * (size_t)t->n;
+    memset(t->B, 0, n3 * sizeof(float));
+    memset(t->B_next, 0, n3 * sizeof(float));
+    if (t->o.adaptive) {
+        memset(t->w, 0, (size_t)t->n * sizeof(float));
+        memset(t->mean, 0, (size_t)t->n * sizeof(float));
+        memset(t->var, 0, (size_t)t->n * sizeof(float));
+        memset(t->fast, 0, (size_t)t->n * sizeof(float));
+        memset(t->count, 0, (size_t)t->n * sizeof(uint32_t));
+    }
+    t->frame = 0;
+    t->restart_all = 0;
+}
+
+RAD_API void rad_temporal_signal_change(rad_temporal *t)
+{
+    if (t) t->restart_all = 1;
+}
+
+RAD_API const float *rad_temporal_indirect(const rad_temporal *t) { return t ? t->B : NULL; }
+RAD_API uint32_t rad_temporal_frame(const rad_temporal *t) { return t ? t->frame : 0; }
+RAD_API const float *rad_temporal_weights(const rad_temporal *t) { return (t && t->o.adaptive) ? t->w : NULL; }
+
+RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, uint32_t table_count, const float *albedo,
+                                       const rad_temporal_options *options, const rad_context *ctx, rad_temporal **out)
+{
+    rad__ctx c;
+    rad_temporal *t;
+    rad_temporal_options o;
+    uint32_t k, n;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (options) o = *options;
+    else rad_temporal_options_default(&o);
+    if (!tables || (table_count != 1u && table_count != 3u) || !tables[0]) return RAD_ERROR_INVALID_ARGUMENT;
+    if (o.mode != RAD_TEMPORAL_SINGLE && o.mode != RAD_TEMPORAL_FEEDBACK && o.mode != RAD_TEMPORAL_MULTIBOUNCE) {
+        rad__log(&c, RAD_LOG_ERROR, "temporal: unknown mode %d", (int)o.mode);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (table_count == 3u && o.mode != RAD_TEMPORAL_MULTIBOUNCE) {
+        rad__log(&c, RAD_LOG_ERROR, "temporal: three tables (one per channel) need RAD_TEMPORAL_MULTIBOUNCE");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (o.mode != RAD_TEMPORAL_MULTIBOUNCE && !albedo) {
+        rad__log(&c, RAD_LOG_ERROR, "temporal: modes SINGLE and FEEDBACK need the albedo");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (o.samples == 0 || o.samples > 0x01000000u || !(o.weight >= 0.0f && o.weight < 1.0f) ||
+        (o.adaptive && (!(o.noise_target > 0.0f) || !(o.weight_max >= 0.0f && o.weight_max < 1.0f) ||
+                        !(o.change_sigma > 0.0f) || !rad__finite(o.noise_target) || !rad__finite(o.change_sigma)))) {
+        rad__log(&c, RAD_LOG_ERROR, "temporal: bad options (samples %u, weight %g, target %g, weight_max %g, sigma %g)", o.samples,
+                 (double)o.weight, (double)o.noise_target, (double)o.weight_max, (double)o.change_sigma);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    n = tables[0]->rows;
+    for (k = 0; k < table_count; ++k) {
+        const rad_alias_tables *tb = tables[k];
+        if (!tb || !tb->row_offsets || !tb->bins || !tb->totals || (tb->format != RAD_ALIAS_COMPACT && tb->format != RAD_ALIAS_WIDE))
+            return RAD_ERROR_INVALID_ARGUMENT;
+        if (tb->rows != n || tb->cols != n || n == 0) {
+            rad__log(&c, RAD_LOG_ERROR, "temporal: table %u is %u x %u, expected %u x %u", k, tb->rows, tb->cols, n, n);
+            return RAD_ERROR_SIZE_MISMATCH;
+        }
+    }
+    if ((uint64_t)o.samples * table_count > 0xFFFFFFFFull) return RAD_ERROR_INVALID_ARGUMENT;
+    t = (rad_temporal *)rad__alloc(&c.allocator, sizeof(rad_temporal));
+    if (!t) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(t, 0, sizeof(*t));
+    t->c = c;
+    for (k = 0; k < table_count; ++k) t->tables[k] = tables[k];
+    t->table_count = table_count;
+    t->albedo = albedo;
+    t->o = o;
+    t->n = n;
+    t->B = (float *)rad__alloc_array(&c.allocator, (size_t)n, 3u * sizeof(float));
+    t->B_next = (float *)rad__alloc_array(&c.allocator, (size_t)n, 3u * sizeof(float));
+    if (o.mode == RAD_TEMPORAL_FEEDBACK) t->V = (float *)rad__alloc_array(&c.allocator, (size_t)n, 3u * sizeof(float));
+    if (o.adaptive) {
+        t->w = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
+        t->mean = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
+        t->var = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
+        t->fast = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
+        t->count = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    }
+    if (!t->B || !t->B_next || (o.mode == RAD_TEMPORAL_FEEDBACK && !t->V) ||
+        (o.adaptive && (!t->w || !t->mean || !t->var || !t->fast || !t->count))) {
+        rad_temporal_destroy(t);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    rad_temporal_reset(t);
+    *out = t;
+    return RAD_SUCCESS;
+}
+
+typedef struct rad__tstep {
+    rad_temporal *t;
+    const float *V;        /* sampled vector, 3N */
+    float env[3];
+    uint32_t tasks;
+} rad__tstep;
+
+#if defined(__GNUC__) || defined(__clang__)
+#  define RAD__PREFETCH(p) __builtin_prefetch(p)
+#else
+#  define RAD__PREFETCH(p) ((void)0)
+#endif
+#define RAD__TEMPORAL_BATCH 16u /* draws whose bins are prefetched together */
+
+/* acc (RGB, or channel ch only when ch < 3) += sum over draws s of V_J */
+static void rad__temporal_row(const rad_temporal *t, const rad_alias_tables *tb, uint32_t key, uint32_t sample0,
+                              uint32_t i, const float *V, const float *env, uint32_t ch, float *acc)
+{
+    const uint32_t k = t->o.samples, words = (uint32_t)tb->format, n = t->n;
+    const uint64_t first = tb->row_offsets[i];
+    const uint32_t nb = (uint32_t)(tb->row_offsets[i + 1] - first);
+    const uint32_t *bins = tb->bins + (size_t)first * words;
+    uint32_t s0, s, u1[RAD__TEMPORAL_BATCH], u2[RAD__TEMPORAL_BATCH], cols[RAD__TEMPORAL_BATCH];
+    for (s0 = 0; s0 < k; s0 += RAD__TEMPORAL_BATCH) {
+        uint32_t m = k - s0 < RAD__TEMPORAL_BATCH ? k - s0 : RAD__TEMPORAL_BATCH;
+        for (s = 0; s < m; ++s) {
+            uint32_t a = rad__pcg(key ^ ((sample0 + s0 + s) * 0x9E3779B9u));
+            u1[s] = a;
+            u2[s] = rad__pcg(a ^ 0x68E31DA4u);
+            RAD__PREFETCH(bins + (size_t)(((uint64_t)a * nb) >> 32) * words);
+        }
+        for (s = 0; s < m; ++s) {
+            cols[s] = rad__alias_pick(bins, nb, words, u1[s], u2[s]);
+            if (cols[s] < n) RAD__PREFETCH(V + 3u * (size_t)cols[s]);
+        }
+        for (s = 0; s < m; ++s) {
+            const float *v = cols[s] < n ? V + 3u * (size_t)cols[s] : env;
+            if (ch < 3u) acc[ch] += v[ch];
+            else { acc[0] += v[0]; acc[1] += v[1]; acc[2] += v[2]; }
+        }
+    }
+}
+
+static void rad__temporal_task(void *data, uint32_t task)
+{
+    const rad__tstep *st = (const rad__tstep *)data;
+    rad_temporal *t = st->t;
+    const uint32_t n = t->n, k = t->o.samples;
+    const uint32_t r0 = (uint32_t)((uint64_t)n * task / st->tasks), r1 = (uint32_t)((uint64_t)n * (task + 1u) / st->tasks);
+    const uint32_t seedframe = rad__pcg(rad__pcg(t->o.seed) ^ t->frame);
+    uint32_t i, ch;
+    for (i = r0; i < r1; ++i) {
+        const uint32_t key = rad__pcg(seedframe ^ i);
+        float acc[3] = { 0.0f, 0.0f, 0.0f }, X[3], w, *Bn = t->B_next + 3u * (size_t)i;
+        const float *Bp = t->B + 3u * (size_t)i;
+        if (t->table_count == 1u) {
+            float scale = t->tables[0]->totals[i] / (float)k;
+            rad__temporal_row(t, t->tables[0], key, 0u, i, st->V, st->env, 3u, acc);
+            X[0] = acc[0] * scale;
+            X[1] = acc[1] * scale;
+            X[2] = acc[2] * scale;
+        } else {
+            for (ch = 0; ch < 3u; ++ch) {
+                rad__temporal_row(t, t->tables[ch], key, ch * k, i, st->V, st->env, ch, acc);
+                X[ch] = acc[ch] * (t->tables[ch]->totals[i] / (float)k);
+            }
+        }
+        if (t->o.mode != RAD_TEMPORAL_MULTIBOUNCE) {
+            const float *rho = t->albedo + 3u * (size_t)i;
+            X[0] *= rho[0];
+            X[1] *= rho[1];
+            X[2] *= rho[2];
+        }
+        if (t->o.adaptive) {
+            float x = X[0] + X[1] + X[2], b = Bp[0] + Bp[1] + Bp[2], a, d, wss, sd, r, tgt = t->o.noise_target;
+            uint32_t c = t->count[i];
+            if (c > 0) {
+                /* change test against the current estimate, on x - b winsorized at 3 standard
+                   deviations so single heavy-tailed samples cannot trigger it */
+                sd = (float)sqrt((double)t->var[i]);
+                d = x - b;
+                if (d > 3.0f * sd) d = 3.0f * sd;
+                if (d < -3.0f * sd) d = -3.0f * sd;
+                t->fast[i] += 0.25f * (d - t->fast[i]);
+                d = t->fast[i] < 0.0f ? -t->fast[i] : t->fast[i];
+                if (c >= 4u && d > t->o.change_sigma * 0.378f * sd && d > tgt * (b < 0.0f ? -b : b)) c = 0;
+            }
+            if (c == 0) {
+                t->mean[i] = x;
+                t->var[i] = 0.0f;
+                t->fast[i] = 0.0f;
+            } else {
+                a = 1.0f / (float)(c + 1u);
+                if (a < 1.0f / 64.0f) a = 1.0f / 64.0f;
+                t->mean[i] += a * (x - t->mean[i]);
+                t->var[i] += a * ((x - t->mean[i]) * (x - t->mean[i]) - t->var[i]);
+            }
+            if (t->var[i] > 0.0f) {
+                r = tgt * t->mean[i] * tgt * t->mean[i] / t->var[i];
+                wss = (1.0f - r) / (1.0f + r);
+                if (wss < 0.0f) wss = 0.0f;
+                if (wss > t->o.weight_max) wss = t->o.weight_max;
+            } else {
+                wss = 0.0f;
+            }
+            w = (float)c / (float)(c + 1u);
+            if (w > wss) w = wss;
+            t->count[i] = c + 1u < c ? c : c + 1u;
+            t->w[i] = w;
+        } else {
+            w = t->o.weight;
+        }
+        Bn[0] = w * Bp[0] + (1.0f - w) * X[0];
+        Bn[1] = w * Bp[1] + (1.0f - w) * X[1];
+        Bn[2] = w * Bp[2] + (1.0f - w) * X[2];
+    }
+}
+
+RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const float E0[3], float *out_indirect)
+{
+    rad__tstep st;
+    float *tmp;
+    size_t n3, j;
+    if (!t || !E) return RAD_ERROR_INVALID_ARGUMENT;
+    n3 = 3u * (size_t)t->n;
+    st.t = t;
+    st.env[0] = E0 ? E0[0] : 0.0f;
+    st.env[1] = E0 ? E0[1] : 0.0f;
+    st.env[2] = E0 ? E0[2] : 0.0f;
+    if (t->o.mode == RAD_TEMPORAL_FEEDBACK) {
+        for (j = 0; j < n3; ++j) t->V[j] = E[j] + t->B[j];
+        st.V = t->V;
+    } else {
+        st.V = E;
+    }
+    if (t->restart_all && t->o.adaptive) memset(t->count, 0, (size_t)t->n * sizeof(uint32_t));
+    t->restart_all = 0;
+    st.tasks = t->c.tasks < t->n ? t->c.tasks : t->n;
+    t->c.parallel_for(t->c.parallel_user, st.tasks, rad__temporal_task, &st);
+    tmp = t->B;
+    t->B = t->B_next;
+    t->B_next = tmp;
+    t->frame++;
+    if (out_indirect) memcpy(out_indirect, t->B, n3 * sizeof(float));
     return RAD_SUCCESS;
 }
 
