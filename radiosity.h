@@ -1453,6 +1453,20 @@ static void rad__log(const rad__ctx *c, rad_log_level level, const char *fmt, ..
 static int rad__finite(float x) { return x == x && x - x == 0.0f; }
 static int rad__finite3(const float *v) { return rad__finite(v[0]) && rad__finite(v[1]) && rad__finite(v[2]); }
 
+/* Outputs never carry NaN or Inf: a value that overflowed float (an emitter or light far too
+   strong for the scene's scale, a system that diverges) is reported instead. */
+static rad_result rad__check_output(const rad__ctx *c, const char *what, const float *v, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(v[i])) {
+            rad__log(c, RAD_LOG_ERROR, "%s: value %llu is %g (overflows float: lights or emission too strong for this scene)",
+                     what, (unsigned long long)i, (double)v[i]);
+            return RAD_ERROR_NON_FINITE;
+        }
+    return RAD_SUCCESS;
+}
+
 /* vector helpers */
 static void rad__sub(float *o, const float *a, const float *b) { o[0] = a[0] - b[0]; o[1] = a[1] - b[1]; o[2] = a[2] - b[2]; }
 static float rad__dot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -3840,7 +3854,7 @@ RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options
     if (r != RAD_SUCCESS) return r;
     rad__finish_output(s, o.output, out, 0);
     if (stats) { stats->iterations = o.bounces; stats->residual = 0.0; }
-    return RAD_SUCCESS;
+    return rad__check_output(&c, "Jacobi", out, n3);
 }
 
 /* sum_j F_ij x_j over j != i for RGB x; *diag receives F_ii */
@@ -3915,6 +3929,7 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
     if (stats) { stats->iterations = it; stats->residual = residual; }
     if (r == RAD_ERROR_CANCELLED) return r;
     rad__finish_output(s, o.output, out, 1);
+    if (rad__check_output(&c, "Gauss-Seidel", out, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
     if (r == RAD_ERROR_NOT_CONVERGED)
         rad__log(&c, RAD_LOG_WARNING, "Gauss-Seidel: residual %g after %u sweeps (tolerance %g)", residual, it, tol);
     return r;
@@ -4004,6 +4019,7 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
     if (stats) { stats->iterations = step; stats->residual = residual; }
     if (r == RAD_ERROR_CANCELLED) return r;
     rad__finish_output(s, o.output, out, 1);
+    if (rad__check_output(&c, "progressive refinement", out, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
     if (r == RAD_ERROR_NOT_CONVERGED)
         rad__log(&c, RAD_LOG_WARNING, "progressive refinement: residual %g after %u steps (tolerance %g)", residual, step, tol);
     return r;
@@ -4116,6 +4132,7 @@ RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options
     if (r == RAD_SUCCESS) {
         if (o.output == RAD_OUTPUT_INDIRECT)
             for (i = 0; i < 3 * n; ++i) out[i] -= s->E[i];
+        r = rad__check_output(&c, "direct solve", out, 3 * (size_t)n);
     }
 done:
     rad__free(&c.allocator, M);
@@ -4437,7 +4454,8 @@ RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_rayca
     d.normals = normals;
     d.count = count;
     d.out = out_irradiance;
-    return rad__direct_run(&d, &c, (count + RAD__DIRECT_GROUP - 1) / RAD__DIRECT_GROUP);
+    r = rad__direct_run(&d, &c, (count + RAD__DIRECT_GROUP - 1) / RAD__DIRECT_GROUP);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "direct irradiance", out_irradiance, 3 * (size_t)count) : r;
 }
 
 RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster, const rad_light *lights,
@@ -4453,7 +4471,8 @@ RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_rayc
     if (r != RAD_SUCCESS) return r;
     d.P = patches;
     d.out = out_irradiance;
-    return rad__direct_run(&d, &c, patches->count);
+    r = rad__direct_run(&d, &c, patches->count);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "direct irradiance", out_irradiance, 3 * (size_t)patches->count) : r;
 }
 
 RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance, float *out_E)
@@ -4464,7 +4483,11 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
     if (mode == RAD_SOURCE_EMISSION) {
         if (direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT; /* that would count the lights twice */
         for (i = 0; i < patches->count; ++i)
-            for (k = 0; k < 3; ++k) out_E[3 * (size_t)i + (size_t)k] = (float)RAD__PI * patches->patches[i].emission[k];
+            for (k = 0; k < 3; ++k) {
+                float e = (float)RAD__PI * patches->patches[i].emission[k];
+                if (!rad__finite(e)) return RAD_ERROR_NON_FINITE; /* pi * L overflows float */
+                out_E[3 * (size_t)i + (size_t)k] = e;
+            }
         return RAD_SUCCESS;
     }
     if (mode == RAD_SOURCE_DIRECT) {

@@ -26,6 +26,19 @@ static size_t rb_nonfinite(const float *p, size_t n)
 
 static const char *rb_case = "";
 
+static void rb_serial_for(void *user, uint32_t count, rad_task_fn fn, void *data);
+
+/* the NaN scans and the scale test run serially: their subject is numerics, and with many
+   tiny calls the OpenMP default spends more time starting regions than working (determinism
+   covers the default context) */
+static const rad_context *rb_serial_ctx(void)
+{
+    static rad_context c;
+    memset(&c, 0, sizeof(c));
+    c.parallel_for = rb_serial_for;
+    return &c;
+}
+
 /* a scene from loose triangles: tris[9 t .. 9 t + 8], material mats[t] (NULL: 0) */
 static rad_result rb_scene(const float *tris, uint32_t count, const uint32_t *mats, const rad_material *materials,
                            uint32_t material_count, rad_scene **out)
@@ -128,17 +141,17 @@ static void rb_pipeline(const rad_scene *S, float max_edge_rel)
         fo.method = k ? RAD_FF_MONTE_CARLO : RAD_FF_ANALYTIC;
         rad_form_factors_destroy(ffd);
         ffd = NULL;
-        CHECK_OK(rad_form_factors_dense(P, &rc, &fo, NULL, &ffd));
+        CHECK_OK(rad_form_factors_dense(P, &rc, &fo, rb_serial_ctx(), &ffd));
         if (ffd) RB_SCAN(k ? "dense form factors (Monte Carlo)" : "dense form factors", ffd->matrix.dense, (size_t)n * n);
     }
-    CHECK_OK(rad_form_factors_sparse(P, &rc, &fo, NULL, &ffs));
+    CHECK_OK(rad_form_factors_sparse(P, &rc, &fo, rb_serial_ctx(), &ffs));
     if (ffs) RB_SCAN("sparse form factors", ffs->matrix.values, (size_t)ffs->matrix.row_offsets[n]);
     half = n / 2;
-    CHECK_OK(rad_form_factor_rows(P, &rc, &fo, 0, half, rows, NULL));
-    CHECK_OK(rad_form_factor_rows(P, &rc, &fo, half, n, rows + (size_t)half * n, NULL));
+    CHECK_OK(rad_form_factor_rows(P, &rc, &fo, 0, half, rows, rb_serial_ctx()));
+    CHECK_OK(rad_form_factor_rows(P, &rc, &fo, half, n, rows + (size_t)half * n, rb_serial_ctx()));
     RB_SCAN("form factor rows", rows, (size_t)n * n);
     fo.skip_visibility = 1;
-    CHECK_OK(rad_form_factor_rows(P, NULL, &fo, 0, n, rows, NULL));
+    CHECK_OK(rad_form_factor_rows(P, NULL, &fo, 0, n, rows, rb_serial_ctx()));
     RB_SCAN("unoccluded form factor rows", rows, (size_t)n * n);
     if (!ffd) goto done;
     /* direct light: emitters, a point light inside the bounds, the sky */
@@ -154,11 +167,11 @@ static void rb_pipeline(const rad_scene *S, float max_edge_rel)
     lights[2].type = RAD_LIGHT_DIRECTIONAL;
     lights[2].direction[0] = 0.3f; lights[2].direction[1] = -1.0f; lights[2].direction[2] = -0.2f;
     rad_direct_options_default(&dop);
-    CHECK_OK(rad_direct_patches(P, &rc, lights, 3, &dop, Dp, NULL));
+    CHECK_OK(rad_direct_patches(P, &rc, lights, 3, &dop, Dp, rb_serial_ctx()));
     RB_SCAN("direct irradiance (patches)", Dp, n3);
     for (i = 0; i < n; ++i)
         for (k = 0; k < 3; ++k) { pts[3 * i + k] = P->patches[i].centroid[k]; nrm[3 * i + k] = P->patches[i].normal[k]; }
-    CHECK_OK(rad_direct_irradiance(S, &rc, lights, 3, &dop, pts, nrm, n, D, NULL));
+    CHECK_OK(rad_direct_irradiance(S, &rc, lights, 3, &dop, pts, nrm, n, D, rb_serial_ctx()));
     RB_SCAN("direct irradiance (points)", D, n3);
     /* sources and solvers, both source modes */
     for (mode = 0; mode < 2; ++mode) {
@@ -167,7 +180,7 @@ static void rb_pipeline(const rad_scene *S, float max_edge_rel)
         RB_SCAN("E", E, n3);
         for (k = 0; k < 2; ++k) {
             rad_system_init(&sys, k ? &ffs->matrix : &ffd->matrix, P, E);
-            CHECK_OK(rad_matrix_multiply(sys.F, E, B, NULL));
+            CHECK_OK(rad_matrix_multiply(sys.F, E, B, rb_serial_ctx()));
             RB_SCAN("F E", B, n3);
             for (s = 0; s < 4; ++s) {
                 const char *names[4] = { "jacobi", "gauss-seidel", "progressive", "direct" };
@@ -175,10 +188,10 @@ static void rb_pipeline(const rad_scene *S, float max_edge_rel)
                 so.output = (s & 1) ? RAD_OUTPUT_TOTAL : RAD_OUTPUT_INDIRECT;
                 so.bounces = 50;
                 so.max_iterations = s == 2 ? 20000u : 0u;
-                if (s == 0) r = rad_solve_jacobi(&sys, &so, B, &st, NULL);
-                else if (s == 1) r = rad_solve_gauss_seidel(&sys, &so, B, &st, NULL);
-                else if (s == 2) r = rad_solve_progressive(&sys, &so, B, &st, NULL);
-                else r = rad_solve_direct(&sys, &so, B, NULL);
+                if (s == 0) r = rad_solve_jacobi(&sys, &so, B, &st, rb_serial_ctx());
+                else if (s == 1) r = rad_solve_gauss_seidel(&sys, &so, B, &st, rb_serial_ctx());
+                else if (s == 2) r = rad_solve_progressive(&sys, &so, B, &st, rb_serial_ctx());
+                else r = rad_solve_direct(&sys, &so, B, rb_serial_ctx());
                 if (r != RAD_SUCCESS && !(r == RAD_ERROR_NOT_CONVERGED && (s == 1 || s == 2)) &&
                     !(r == RAD_ERROR_SINGULAR && s == 3)) {
                     printf("    %s: solver %s returned %s\n", rb_case, names[s], rad_result_string(r));
@@ -288,7 +301,7 @@ static int rb_scaled_build(rb_scaled *c, float scale, uint32_t target)
     if (rad_bvh_create(c->scene, NULL, &c->bvh) != RAD_SUCCESS) return 0;
     rad_bvh_raycaster(c->bvh, &c->rc);
     rad_form_factor_options_default(&fo);
-    if (rad_form_factors_dense(c->P, &c->rc, &fo, NULL, &c->ff) != RAD_SUCCESS) return 0;
+    if (rad_form_factors_dense(c->P, &c->rc, &fo, rb_serial_ctx(), &c->ff) != RAD_SUCCESS) return 0;
     n = c->P->count;
     c->E = (float *)malloc(sizeof(float) * 3 * n);
     c->B = (float *)malloc(sizeof(float) * 3 * n);
@@ -299,17 +312,17 @@ static int rb_scaled_build(rb_scaled *c, float scale, uint32_t target)
     rad_system_init(&sys, &c->ff->matrix, c->P, c->E);
     rad_solve_options_default(&so);
     so.output = RAD_OUTPUT_TOTAL;
-    if (rad_solve_direct(&sys, &so, c->B, NULL) != RAD_SUCCESS) return 0;
+    if (rad_solve_direct(&sys, &so, c->B, rb_serial_ctx()) != RAD_SUCCESS) return 0;
     /* the area light alone */
     rad_direct_options_default(&dop);
-    if (rad_direct_patches(c->P, &c->rc, NULL, 0, &dop, c->D, NULL) != RAD_SUCCESS) return 0;
+    if (rad_direct_patches(c->P, &c->rc, NULL, 0, &dop, c->D, rb_serial_ctx()) != RAD_SUCCESS) return 0;
     /* a point light alone, at a scaled position */
     memset(&pl, 0, sizeof(pl));
     pl.type = RAD_LIGHT_POINT;
     for (k = 0; k < 3; ++k) pl.color[k] = 1.0f;
     pl.position[0] = 0.278f * scale; pl.position[1] = 0.45f * scale; pl.position[2] = 0.28f * scale;
     dop.include_emitters = 0;
-    if (rad_direct_patches(c->P, &c->rc, &pl, 1, &dop, c->Dpt, NULL) != RAD_SUCCESS) return 0;
+    if (rad_direct_patches(c->P, &c->rc, &pl, 1, &dop, c->Dpt, rb_serial_ctx()) != RAD_SUCCESS) return 0;
     return 1;
 }
 
