@@ -3,10 +3,10 @@
    smoke suite. */
 
 /* fuzz_scene, fuzz/crashes/scene-nonfinite-1: a point light 1e-20 from a surface gave
-   irradiance 1/d^2 = inf. Outputs must never carry Inf: the call reports NON_FINITE. */
+   irradiance 1/d^2 = inf (here a 1e-15 quad with the light 1e-21 above it). Outputs must never carry Inf: the call reports NON_FINITE. */
 static void rg_test_point_light_overflow(void)
 {
-    static const float quad[12] = { 0, 0, 0, 1e-20f, 0, 0, 1e-20f, 1e-20f, 0, 0, 1e-20f, 0 };
+    static const float quad[12] = { 0, 0, 0, 1e-15f, 0, 0, 1e-15f, 1e-15f, 0, 0, 1e-15f, 0 };
     static const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
     rad_material m = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0 };
     rad_mesh_desc mesh;
@@ -15,7 +15,7 @@ static void rg_test_point_light_overflow(void)
     rad_bvh *b = NULL;
     rad_raycaster rc;
     rad_light light;
-    float p[3] = { 5e-21f, 5e-21f, 0.0f }, n[3] = { 0.0f, 0.0f, 1.0f }, D[3] = { -1.0f, -1.0f, -1.0f };
+    float p[3] = { 5e-16f, 5e-16f, 0.0f }, n[3] = { 0.0f, 0.0f, 1.0f }, D[3] = { -1.0f, -1.0f, -1.0f };
     memset(&mesh, 0, sizeof(mesh));
     mesh.positions = quad;
     mesh.vertex_count = 4;
@@ -33,8 +33,8 @@ static void rg_test_point_light_overflow(void)
     memset(&light, 0, sizeof(light));
     light.type = RAD_LIGHT_POINT;
     light.color[0] = light.color[1] = light.color[2] = 1.0f;
-    light.position[0] = 5e-21f;
-    light.position[1] = 5e-21f;
+    light.position[0] = 5e-16f;
+    light.position[1] = 5e-16f;
     light.position[2] = 1e-21f;
     CHECK_RESULT(rad_direct_irradiance(s, &rc, &light, 1, NULL, p, n, 1, D, NULL), RAD_ERROR_NON_FINITE);
     rad_bvh_destroy(b);
