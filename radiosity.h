@@ -138,8 +138,9 @@
        Every object is created by a rad_*_create call that returns RAD_SUCCESS and writes an
        owning pointer, and freed by exactly one rad_*_destroy call (NULL is accepted). Inputs
        are borrowed for the duration of the call and copied where kept; each function's
-       comment says so. Outputs the caller provides (float *out) are written only on success
-       unless the comment says otherwise.
+       comment says so. Output arrays the caller provides (float *out) are filled during the
+       call: after an error or a cancel their contents are unspecified (partial results), never
+       out of bounds. Owning outputs (rad_x **out) are set to NULL on failure.
        Allocation goes through rad_context.allocator when set (its user pointer is passed to
        every call), else through RAD_MALLOC / RAD_FREE. Every size computation is checked for
        overflow before allocating: an N*N matrix that does not fit in size_t returns
@@ -738,7 +739,9 @@ RAD_API void rad_direct_options_default(rad_direct_options *options);
    sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
    (analytic point-to-polygon irradiance pi L F times the fraction of 'light_samples'
    unoccluded shadow rays). A point receives nothing from behind its normal. 'samples' is
-   unused here. Errors: INVALID_ARGUMENT, NON_FINITE (a light), RAYCAST_FAILED. */
+   unused here. Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles or a
+   negative min_distance), NON_FINITE (a non-finite light field or point, or irradiance that
+   overflows float), NEGATIVE_EMISSION (a negative light colour), RAYCAST_FAILED. */
 RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
                                          const rad_light *lights, uint32_t light_count,
                                          const rad_direct_options *options, const float *points,
@@ -1889,6 +1892,7 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
 RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3])
 {
     const rad_material *m;
+    if (!out_rgb) return;
     out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
     if (!scene || triangle >= scene->triangle_count) return;
     m = &scene->materials_table[scene->materials[triangle]];
@@ -2256,6 +2260,8 @@ RAD_API uint32_t rad_patches_locate(const rad_patches *patches, uint32_t triangl
     if (!patches || triangle >= patches->triangle_count) return RAD_NONE;
     if (!(b1 >= 0.0f)) b1 = 0.0f; /* also catches NaN */
     if (!(b2 >= 0.0f)) b2 = 0.0f;
+    if (b1 > 1.0f) b1 = 1.0f;     /* also catches +Inf */
+    if (b2 > 1.0f) b2 = 1.0f;
     if (b1 + b2 > 1.0f) { float s = b1 + b2; b1 /= s; b2 /= s; }
     n = patches->subdivision[triangle];
     x = b1 * (float)n;
@@ -3117,7 +3123,7 @@ RAD_API float rad_ff_point_polygon(const float p[3], const float n[3], const flo
 RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const float pj[3], const float nj[3], float sj)
 {
     float r[3], d2, d, ci, cj, floor2;
-    if (!pi_ || !ni || !pj || !nj || !(sj > 0.0f)) return 0.0f;
+    if (!pi_ || !ni || !pj || !nj || !(sj > 0.0f) || !rad__finite(sj)) return 0.0f;
     rad__sub(r, pj, pi_);
     d2 = rad__dot(r, r);
     if (!(d2 > 0.0f)) return 0.0f;
@@ -3352,6 +3358,10 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
     }
     if (!f->o.skip_visibility && (!rc || !rc->occluded)) {
         rad__log(c, RAD_LOG_ERROR, "form factors need a raycaster with occluded() unless skip_visibility is set");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!P->scene) {
+        rad__log(c, RAD_LOG_ERROR, "form factors need patches->scene (set it on loaded patches)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     f->P = P;
@@ -3611,6 +3621,18 @@ static rad_result rad__check_matrix(const rad_matrix *F)
     return RAD_ERROR_INVALID_ARGUMENT;
 }
 
+/* options every solver shares: a known output kind, a finite non-negative tolerance */
+static rad_result rad__check_solve_options(const rad_solve_options *o, const rad__ctx *c)
+{
+    if (!o) return RAD_SUCCESS;
+    if ((o->output != RAD_OUTPUT_INDIRECT && o->output != RAD_OUTPUT_TOTAL) || !(o->tolerance >= 0.0) ||
+        o->tolerance - o->tolerance != 0.0) {
+        rad__log(c, RAD_LOG_ERROR, "solve options: output must be RAD_OUTPUT_INDIRECT or RAD_OUTPUT_TOTAL and tolerance finite and >= 0");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return RAD_SUCCESS;
+}
+
 static rad_result rad__check_system(const rad_system *s, const rad__ctx *c)
 {
     rad_result r;
@@ -3830,6 +3852,7 @@ RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options
     if (r != RAD_SUCCESS) return r;
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     if (options) o = *options; else rad_solve_options_default(&o);
+    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     n3 = 3 * (size_t)s->n;
     cur = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
     tmp = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
@@ -3899,6 +3922,7 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
     if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     if (options) o = *options; else rad_solve_options_default(&o);
+    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_it = o.max_iterations ? o.max_iterations : 1000;
     n3 = 3 * (size_t)s->n;
@@ -3952,6 +3976,7 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (options) o = *options; else rad_solve_options_default(&o);
+    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_steps = o.max_iterations ? o.max_iterations : (s->n > 42949672u ? 0xFFFFFFFFu : 100u * s->n);
     n3 = 3 * (size_t)s->n;
@@ -4057,6 +4082,7 @@ RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options
     if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     if (options) o = *options; else rad_solve_options_default(&o);
+    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     n = s->n;
     if (!rad__mul3(n, n, sizeof(double), &bytes)) return RAD_ERROR_SIZE_OVERFLOW;
     M = (double *)rad__alloc(&c.allocator, bytes);
@@ -4104,7 +4130,13 @@ RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options
                     job.n = n;
                     job.k = k;
                     job.tasks = c.tasks < n - k - 1 ? c.tasks : n - k - 1;
-                    c.parallel_for(c.parallel_user, job.tasks, rad__lu_task, &job);
+                    /* small trailing blocks are not worth a parallel_for (its overhead dominates) */
+                    if ((uint64_t)(n - k - 1) * (n - k - 1) < 65536u) {
+                        job.tasks = 1;
+                        rad__lu_task(&job, 0);
+                    } else {
+                        c.parallel_for(c.parallel_user, job.tasks, rad__lu_task, &job);
+                    }
                 }
             }
             if (r != RAD_SUCCESS) break;
@@ -4419,6 +4451,7 @@ static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const ra
             return RAD_ERROR_NEGATIVE_EMISSION;
         }
         if ((int)li->type < 0 || (int)li->type > RAD_LIGHT_SKY || (li->falloff != RAD_FALLOFF_QUADRATIC && li->falloff != RAD_FALLOFF_LINEAR) ||
+            li->min_distance < 0.0f ||
             ((li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_SPOT) && rad__dot(li->direction, li->direction) == 0.0f) ||
             (li->type == RAD_LIGHT_SPOT && (li->inner_angle < 0.0f || li->outer_angle < li->inner_angle || li->outer_angle > (float)RAD__PI))) {
             rad__log(c, RAD_LOG_ERROR, "light %u: bad type, falloff, direction or spot angles", l);
@@ -4483,19 +4516,17 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
     if (mode == RAD_SOURCE_EMISSION) {
         if (direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT; /* that would count the lights twice */
         for (i = 0; i < patches->count; ++i)
-            for (k = 0; k < 3; ++k) {
-                float e = (float)RAD__PI * patches->patches[i].emission[k];
-                if (!rad__finite(e)) return RAD_ERROR_NON_FINITE; /* pi * L overflows float */
-                out_E[3 * (size_t)i + (size_t)k] = e;
-            }
+            for (k = 0; k < 3; ++k)
+                if (!rad__finite((float)RAD__PI * patches->patches[i].emission[k])) return RAD_ERROR_NON_FINITE; /* pi L overflows */
+        for (i = 0; i < patches->count; ++i)
+            for (k = 0; k < 3; ++k) out_E[3 * (size_t)i + (size_t)k] = (float)RAD__PI * patches->patches[i].emission[k];
         return RAD_SUCCESS;
     }
     if (mode == RAD_SOURCE_DIRECT) {
         if (!direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
-        for (i = 0; i < 3 * patches->count; ++i) {
+        for (i = 0; i < 3 * patches->count; ++i)
             if (!rad__finite(direct_irradiance[i]) || direct_irradiance[i] < 0.0f) return RAD_ERROR_NON_FINITE;
-            out_E[i] = patches->albedo[i] * direct_irradiance[i];
-        }
+        for (i = 0; i < 3 * patches->count; ++i) out_E[i] = patches->albedo[i] * direct_irradiance[i];
         return RAD_SUCCESS;
     }
     return RAD_ERROR_INVALID_ARGUMENT;
