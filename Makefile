@@ -71,7 +71,7 @@ fuzz: | $(BUILD)
 	$(CC) -std=c99 -O2 -I. fuzz/make_corpus.c -o $(BUILD)/fuzz/make_corpus -lm
 	./$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus_container $(BUILD)/fuzz/corpus_scene
 	for f in container scene; do \
-	    $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -I. fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm || exit 1; \
+	    $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm || exit 1; \
 	    ./$(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 $(BUILD)/fuzz/corpus_$$f || exit 1; \
 	done
 

@@ -2031,10 +2031,14 @@ static size_t rad__weld_slot(const rad__weld *w, uint64_t key)
 }
 
 /* The welded vertex at p on a plane of normal tn, created when there is none within eps. */
-static uint32_t rad__weld_vertex(rad__weld *w, float *vertices, uint32_t *nv, const float *p, const float *tn, float eps)
+static uint32_t rad__weld_vertex(rad__weld *w, float *vertices, uint32_t *nv, const float *p, const float *tn, float eps,
+                                 const float *origin)
 {
-    int64_t cx = (int64_t)floor((double)p[0] / (double)eps), cy = (int64_t)floor((double)p[1] / (double)eps),
-            cz = (int64_t)floor((double)p[2] / (double)eps), dx, dy, dz;
+    /* cells relative to the scene's bounds: at most diagonal / eps = 1e6 per axis, whatever
+       the absolute coordinates (no int64 overflow for scenes far from the origin) */
+    int64_t cx = (int64_t)floor(((double)p[0] - (double)origin[0]) / (double)eps),
+            cy = (int64_t)floor(((double)p[1] - (double)origin[1]) / (double)eps),
+            cz = (int64_t)floor(((double)p[2] - (double)origin[2]) / (double)eps), dx, dy, dz;
     uint64_t key;
     size_t slot;
     uint32_t q;
@@ -2192,7 +2196,7 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
                 for (k = 0; k < 3; ++k) p[k] = v[k] + a * (v[3 + k] - v[k]) + b * (v[6 + k] - v[k]);
                 if (i == n) memcpy(p, v + 3, sizeof(p)); /* corners exactly */
                 if (j == n) memcpy(p, v + 6, sizeof(p));
-                lattice_ids[rad__lattice(n, i, j)] = rad__weld_vertex(&w, P->vertices, &nv, p, tn, eps);
+                lattice_ids[rad__lattice(n, i, j)] = rad__weld_vertex(&w, P->vertices, &nv, p, tn, eps, scene->bounds_min);
             }
         for (j = 0; j < n && r == RAD_SUCCESS; ++j)
             for (i = 0; i + j < n && r == RAD_SUCCESS; ++i) {
@@ -2396,12 +2400,14 @@ RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
            (size_t)bvh->tri_count * (9 * sizeof(float) + sizeof(uint32_t));
 }
 
-static int rad__bvh_bin(const float *cen, uint32_t t, int axis, const rad__aabb *cb, float scale)
+/* bin of a centroid, in double so coordinates near +-FLT_MAX cannot overflow, and never
+   converting a NaN or out-of-range value to int */
+static int rad__bvh_bin(const float *cen, uint32_t t, int axis, const rad__aabb *cb, double scale)
 {
-    int bin = (int)((cen[3 * (size_t)t + (size_t)axis] - cb->lo[axis]) * scale);
-    if (bin < 0) bin = 0;
-    if (bin >= RAD__BVH_BINS) bin = RAD__BVH_BINS - 1;
-    return bin;
+    double x = ((double)cen[3 * (size_t)t + (size_t)axis] - (double)cb->lo[axis]) * scale;
+    if (!(x > 0.0)) return 0;
+    if (!(x < (double)RAD__BVH_BINS)) return RAD__BVH_BINS - 1;
+    return (int)x;
 }
 
 /* Collapses the binary tree 'bin' into 4-wide nodes: each 4-wide node opens the largest inner
@@ -2509,7 +2515,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
             if (v[6 + k] > hi) hi = v[6 + k];
             tlo[3 * (size_t)i + (size_t)k] = lo;
             thi[3 * (size_t)i + (size_t)k] = hi;
-            cen[3 * (size_t)i + (size_t)k] = 0.5f * (lo + hi);
+            cen[3 * (size_t)i + (size_t)k] = 0.5f * lo + 0.5f * hi; /* lo + hi may overflow */
         }
         order[i] = i;
     }
@@ -2540,9 +2546,10 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         for (axis = 0; axis < 3 && depth < RAD__BVH_SAH_DEPTH; ++axis) {
             rad__aabb bins[RAD__BVH_BINS], left, right;
             uint32_t cnt[RAD__BVH_BINS], right_count[RAD__BVH_BINS], lc = 0, rc = 0, bi;
-            float extent = cb.hi[axis] - cb.lo[axis], scale, right_area[RAD__BVH_BINS];
-            if (!(extent > 0.0f)) continue;
-            scale = (float)RAD__BVH_BINS / extent;
+            double extent = (double)cb.hi[axis] - (double)cb.lo[axis], scale;
+            float right_area[RAD__BVH_BINS];
+            if (!(extent > 0.0)) continue;
+            scale = (double)RAD__BVH_BINS / extent;
             for (bi = 0; bi < RAD__BVH_BINS; ++bi) { rad__aabb_empty(&bins[bi]); cnt[bi] = 0; }
             for (i = first; i < first + count; ++i) {
                 int bin = rad__bvh_bin(cen, order[i], axis, &cb, scale);
@@ -2571,7 +2578,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         if (best_axis == 3) {
             mid = first + count / 2; /* all centroids equal, or too deep: split the range */
         } else {
-            float scale = (float)RAD__BVH_BINS / (cb.hi[best_axis] - cb.lo[best_axis]);
+            double scale = (double)RAD__BVH_BINS / ((double)cb.hi[best_axis] - (double)cb.lo[best_axis]);
             uint32_t lo = first, hi = first + count;
             while (lo < hi) {
                 uint32_t t = order[lo];

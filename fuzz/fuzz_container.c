@@ -5,7 +5,7 @@
    index checks behind the checksums. When a bake loads, everything it claims is used: every
    patch is located and smoothed, the matrix multiplies a vector and drives two Jacobi
    bounces, so an index that validation let through would be caught by the sanitizers.
-   Build: clang -fsanitize=fuzzer,address,undefined -I. fuzz/fuzz_container.c */
+   Build: clang -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_container.c */
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include <stdlib.h>

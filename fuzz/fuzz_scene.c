@@ -3,7 +3,7 @@
    raw float bits for materials and positions (NaN, Inf and denormals included) and raw index
    bytes (often out of range). Whatever rad_scene_create accepts then goes through patches,
    the BVH, form factors, direct light and two solvers; every output is scanned for NaN/Inf.
-   Build: clang -fsanitize=fuzzer,address,undefined -I. fuzz/fuzz_scene.c */
+   Build: clang -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_scene.c */
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include <stdlib.h>

@@ -164,7 +164,7 @@ if have clang && have clang++; then
         if build make-corpus $CC -std=c99 -O2 -I. fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
            "$BUILD/make_corpus" "$BUILD/fuzz/container" "$BUILD/fuzz/scene"; then
             for f in container scene; do
-                if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
+                if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
                    { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f-crashes.log" 2>&1; } &&
                    "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
                     pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
