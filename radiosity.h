@@ -601,10 +601,10 @@ typedef struct rad_form_factors {
 RAD_API void rad_form_factor_options_default(rad_form_factor_options *options);
 
 /* The row range [row_begin, row_end) of the N x N form-factor matrix, dense, into out_rows
-   ((row_end - row_begin) * N floats, row-major). Each unordered pair {i, j} is computed once
-   from the lower-indexed patch's sample points; the other entry follows by reciprocity, so
-   A_i F_ij = A_j F_ji holds exactly and any split of the rows gives the same bits as the full
-   matrix. raycaster may be NULL only with skip_visibility. Thread safety: reentrant; uses
+   ((row_end - row_begin) * N floats, row-major). Each unordered pair {i, j} is computed once,
+   from the sample points of the smaller patch (the lower index on a tie); the other entry
+   follows by reciprocity, so A_i F_ij = A_j F_ji holds exactly, no area ratio can overflow,
+   and any split of the rows gives the same bits as the full matrix. raycaster may be NULL only with skip_visibility. Thread safety: reentrant; uses
    ctx->parallel_for. Cost: O((row_end-row_begin) N samples). SPEC §2. */
 RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_raycaster *raycaster,
                                         const rad_form_factor_options *options, uint32_t row_begin,
@@ -3298,6 +3298,16 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
     return RAD_SUCCESS;
 }
 
+/* The patch a pair is integrated from: the smaller one (the lower index on a tie). Its points
+   carry the outer integral and the larger one gets the analytic inner integral; the other
+   entry is F_ba = F_ab A_a / A_b with A_a / A_b <= 1, which cannot overflow whatever the area
+   ratio, and which is the more accurate direction. */
+static int rad__ff_from_i(const rad__ff *f, uint32_t i, uint32_t j)
+{
+    float ai = f->P->areas[i], aj = f->P->areas[j];
+    return ai < aj || (ai == aj && i < j);
+}
+
 static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
 {
     rad__ff *f = (rad__ff *)data;
@@ -3305,11 +3315,11 @@ static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
     double *acc = f->acc + (size_t)task * N;
     float inv_s = 1.0f / (float)f->o.samples;
     rad_result r;
-    /* dense mode: only j > i, mirrored; rows mode: every j, the lower pairs computed as the
-       upper ones are (from the lower-indexed patch) and scaled by reciprocity */
+    /* dense mode: only j > i, each pair written both ways; rows mode: every j. Either way a
+       pair is computed from the same side with the same points, so the bits agree. */
     for (j = f->dense_mode ? i + 1 : 0; j < N; ++j) {
         if (j == i) { acc[j] = 0.0; continue; }
-        r = (j > i) ? rad__ff_pair(f, i, j, j, task, &nrays) : rad__ff_pair(f, j, i, j, task, &nrays);
+        r = rad__ff_from_i(f, i, j) ? rad__ff_pair(f, i, j, j, task, &nrays) : rad__ff_pair(f, j, i, j, task, &nrays);
         if (r != RAD_SUCCESS) return r;
     }
     r = rad__ff_flush(f, task, nrays);
@@ -3319,15 +3329,20 @@ static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
         row[i] = 0.0f;
         for (j = i + 1; j < N; ++j) {
             float v = (float)acc[j] * inv_s;
-            row[j] = v;
-            f->out[(size_t)j * N + i] = v * (f->P->areas[i] / f->P->areas[j]);
+            if (rad__ff_from_i(f, i, j)) {
+                row[j] = v;
+                f->out[(size_t)j * N + i] = v * (f->P->areas[i] / f->P->areas[j]);
+            } else {
+                f->out[(size_t)j * N + i] = v;
+                row[j] = v * (f->P->areas[j] / f->P->areas[i]);
+            }
         }
     } else {
         float *row = f->out + (size_t)(i - f->row_begin) * f->out_stride;
         for (j = 0; j < N; ++j) {
             float v = (float)acc[j] * inv_s;
             if (j == i) row[j] = 0.0f;
-            else if (j > i) row[j] = v;
+            else if (rad__ff_from_i(f, i, j)) row[j] = v;
             else row[j] = v * (f->P->areas[j] / f->P->areas[i]);
         }
     }
