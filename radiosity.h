@@ -5494,10 +5494,11 @@ RAD_API rad_result rad_multibounce_create(const rad_matrix *F, const float *albe
         }
     if (!rad__mul((size_t)n, (size_t)n, &nn) || !rad__mul3(nn, 3, sizeof(float), &bytes[0])) return RAD_ERROR_SIZE_OVERFLOW;
     mb = (rad_multibounce *)rad__alloc(&c.allocator, sizeof(*mb));
-    scratch = (float *)rad__alloc_array(&c.allocator, nn, 5 * sizeof(float));
-    if (!mb || !scratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
-    memset(mb, 0, sizeof(*mb));
+    if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(mb, 0, sizeof(*mb)); /* before anything can fail: the fail path destroys it */
     mb->allocator = c.allocator;
+    scratch = (float *)rad__alloc_array(&c.allocator, nn, 5 * sizeof(float));
+    if (!scratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
     mb->storage = rad__mb_carve(&c, bytes, 1, parts, &r);
     if (!mb->storage) goto fail;
     planes = (float *)parts[0];
@@ -6225,9 +6226,8 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     sse = (double *)rad__alloc_array(&c.allocator, bpr, sizeof(double));
     max_err = (float *)rad__alloc_array(&c.allocator, bpr, sizeof(float));
     b = (rad_multibounce_blocks *)rad__alloc(&c.allocator, sizeof(*b));
+    if (b) { memset(b, 0, sizeof(*b)); b->allocator = c.allocator; } /* before the fail path destroys it */
     if (!src || !W || !row_count || !sse || !max_err || !b) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    memset(b, 0, sizeof(*b));
-    b->allocator = c.allocator;
     memcpy(W, src, total);
 
     /* 1. outliers: count per row in the order they will be taken */
