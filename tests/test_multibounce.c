@@ -427,11 +427,16 @@ static void mb_compressed(void)
             CHECK_OK(rad_multibounce_apply(&view, w.E, viadec, RAD_OUTPUT_INDIRECT, NULL));
             CHECK_OK(rad_multibounce_blocks_apply(b, w.E, got, RAD_OUTPUT_INDIRECT, NULL));
             CHECK(mb_rel(got, viadec, 3 * (size_t)n) <= 1e-5);
-            /* stated bounds for the Cornell E (measured: BC4x3 2.0-2.6%, BC1 3.4-3.7% of max |L|) */
+            /* stated bounds for the Cornell E, relative to max |L|. Measured: 3xBC4 1.8-2.6%; BC1
+               3.4-8.8% (one 5-6-5 palette shared by R, G and B per 4x4 block; reordering groups
+               rows by overall shape, which can put unlike colours in one block: with the
+               form factors integrated from the smaller patch of each pair the reordered BC1
+               case measures 8.8%). BC1 is the low-precision format: 3xBC4 is the one to use
+               when L matters. */
             rel = mb_rel(got, exact, 3 * (size_t)n);
             printf("    %s%s: mse %.3g (mean square %.3g), L error %.3g, %zu bytes of %zu\n", f ? "BC4x3" : "BC1",
                    ro ? " reordered" : "", rep.mse, rep.source_mean_square, rel, rep.bytes_total, rep.bytes_float_f);
-            CHECK(rel <= (f ? 0.04 : 0.06));
+            CHECK(rel <= (f ? 0.04 : 0.12));
             rad_multibounce_blocks_destroy(b);
         }
 done:
