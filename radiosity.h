@@ -2936,6 +2936,24 @@ static void rad__embree_ray(const rad_ray *r, struct RTCRay *er)
     er->flags = 0;
 }
 
+/* Embree accepts only rays it considers valid (debug builds assert): 1 = pass it on,
+   0 = NaN/Inf or empty interval (a miss, as for the built-in BVH), -1 = finite but outside
+   Embree's range (coordinates beyond about 1.8e18, or tmin < 0): reported as an error. */
+static int rad__embree_ray_ok(const rad_embree *e, const rad_ray *r)
+{
+    int k;
+    for (k = 0; k < 3; ++k)
+        if (!rad__finite(r->origin[k]) || !rad__finite(r->dir[k])) return 0;
+    if (r->tmin != r->tmin || r->tmax != r->tmax || !(r->tmax > r->tmin)) return 0;
+    for (k = 0; k < 3; ++k)
+        if (fabs((double)r->origin[k]) > 1.8e18 || fabs((double)r->dir[k]) > 1.8e18) break;
+    if (k < 3 || r->tmin < 0.0f) {
+        if (e->log) e->log(e->log_user, RAD_LOG_ERROR, "Embree: a ray has tmin < 0 or a coordinate beyond 1.8e18 (Embree's range)");
+        return -1;
+    }
+    return 1;
+}
+
 static rad_result rad__embree_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
 {
     const rad_embree *e = (const rad_embree *)user;
@@ -2944,7 +2962,9 @@ static rad_result rad__embree_occluded(void *user, const rad_ray *rays, uint32_t
     rtcInitIntersectContext(&ic);
     for (i = 0; i < count; ++i) {
         struct RTCRay er;
-        if (!(rays[i].tmax > rays[i].tmin)) { out[i] = 0; continue; }
+        int ok = rad__embree_ray_ok(e, &rays[i]);
+        if (ok < 0) return RAD_ERROR_RAYCAST_FAILED;
+        if (ok == 0) { out[i] = 0; continue; }
         rad__embree_ray(&rays[i], &er);
         rtcOccluded1(e->scene, &ic, &er);
         out[i] = (uint8_t)(er.tfar < 0.0f && er.tfar == -INFINITY);
@@ -2960,10 +2980,12 @@ static rad_result rad__embree_intersect(void *user, const rad_ray *rays, uint32_
     rtcInitIntersectContext(&ic);
     for (i = 0; i < count; ++i) {
         struct RTCRayHit rh;
+        int ok = rad__embree_ray_ok(e, &rays[i]);
         out[i].t = rays[i].tmax;
         out[i].triangle = RAD_NONE;
         out[i].b1 = out[i].b2 = 0.0f;
-        if (!(rays[i].tmax > rays[i].tmin)) continue;
+        if (ok < 0) return RAD_ERROR_RAYCAST_FAILED;
+        if (ok == 0) continue;
         rad__embree_ray(&rays[i], &rh.ray);
         rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
