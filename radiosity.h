@@ -178,7 +178,9 @@
        builds an Embree 3 device and scene from a rad_scene (robust flag, high build quality,
        Embree-owned padded buffers) and rad_embree_raycaster fills the same rad_raycaster table
        the BVH fills; rad_embree_wrap adopts a committed RTCScene you already have. Embree's
-       errors go to rad_context.log. Without RAD_EMBREE the functions exist and return
+       errors go to rad_context.log. Rays are checked before Embree sees them: a ray with NaN
+       or Inf is a miss (as in the built-in BVH); a ray with tmin < 0 or a coordinate beyond
+       Embree's range (about 1.8e18) makes the call return RAD_ERROR_RAYCAST_FAILED. Without RAD_EMBREE the functions exist and return
        RAD_ERROR_UNAVAILABLE, so code can probe with rad_embree_available().
 
    9. BAKED DATA
