@@ -15,10 +15,8 @@
            --quick bakes ~250 and ~1000 patches instead of 1k/4k/10k and uses N = 4000 for the
            bounce, so that it finishes in seconds. */
 
-#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
-#  define _POSIX_C_SOURCE 200809L /* clock_gettime, popen */
-#endif
 
+#include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
 
@@ -35,32 +33,6 @@
 
 /* ---- helpers ------------------------------------------------------------------------- */
 
-static double now_seconds(void)
-{
-#if defined(_OPENMP)
-    return omp_get_wtime();
-#elif defined(CLOCK_MONOTONIC)
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-#else
-    return (double)clock() / (double)CLOCKS_PER_SEC;
-#endif
-}
-
-static FILE *g_md; /* the report; every table line goes to stdout and here */
-
-static void emit(const char *fmt, ...)
-{
-    va_list ap, ap2;
-    va_start(ap, fmt);
-    va_copy(ap2, ap);
-    vfprintf(stdout, fmt, ap);
-    if (g_md) vfprintf(g_md, fmt, ap2);
-    va_end(ap2);
-    va_end(ap);
-    fflush(stdout);
-}
 
 static void check(rad_result r, const char *what)
 {
@@ -284,9 +256,9 @@ static bake_result bake(const rad_scene *scene, const rad_raycaster *rc, uint32_
     ctx.progress = on_progress;
     ctx.progress_user = &ps;
 
-    t0 = now_seconds();
+    t0 = now();
     check(rad_form_factors_dense(patches, rc, &fopt, &ctx, &ff), "rad_form_factors_dense");
-    res.seconds = now_seconds() - t0;
+    res.seconds = now() - t0;
     fprintf(stderr, "\r%48s\r", "");
 
     res.target = target;
@@ -374,7 +346,7 @@ int main(int argc, char **argv)
     char model[256], uname_str[512], flags[256], date[64], llc[64];
     double llc_bytes;
     int logical_cpus;
-    time_t now;
+    time_t started;
     rad_context ctx;
     rad_scene_desc desc;
     rad_scene *scene = NULL;
@@ -417,8 +389,8 @@ int main(int argc, char **argv)
     uname_all(uname_str, sizeof uname_str);
     detected_flags(flags, sizeof flags);
     last_level_cache(llc, sizeof llc, &llc_bytes);
-    now = time(NULL);
-    strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", gmtime(&now));
+    started = time(NULL);
+    strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", gmtime(&started));
 
     emit("# radiosity.h benchmarks\n\n");
     emit("Written by `bench/bench.c`%s. Every number below was measured in this run.\n\n",
@@ -523,17 +495,17 @@ int main(int argc, char **argv)
         sink += stream_sum(m, count);
         /* interleave the three so that they see the same machine state */
         for (i = 0; i < BENCH_REPEATS; ++i) {
-            t0 = now_seconds();
+            t0 = now();
             check(rad_matrix_multiply(&view, x, out, &ctx), "rad_matrix_multiply");
-            t_mul[i] = now_seconds() - t0;
+            t_mul[i] = now() - t0;
             sink += out[0];
-            t0 = now_seconds();
+            t0 = now();
             check(rad_solve_jacobi(&sys, &sopt, out, &st, &ctx), "rad_solve_jacobi");
-            t_jac[i] = now_seconds() - t0;
+            t_jac[i] = now() - t0;
             sink += out[0];
-            t0 = now_seconds();
+            t0 = now();
             sink += stream_sum(m, count);
-            t_str[i] = now_seconds() - t0;
+            t_str[i] = now() - t0;
         }
         qsort(t_mul, BENCH_REPEATS, sizeof(double), cmp_double);
         qsort(t_jac, BENCH_REPEATS, sizeof(double), cmp_double);

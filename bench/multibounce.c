@@ -12,6 +12,7 @@
    Build: cc -O3 -march=native -fopenmp -I. -Iwip bench/multibounce.c -lm
           (until the multi-bounce code is merged into radiosity.h it is taken from wip/)
    Run:   multibounce [--quick] [--append FILE.md]   (--quick: the 1.7k size only) */
+#include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include <stdio.h>
@@ -22,28 +23,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static FILE *g_md;
-static void emit(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    fflush(stdout);
-    if (g_md) {
-        va_start(ap, fmt);
-        vfprintf(g_md, fmt, ap);
-        va_end(ap);
-    }
-}
 
 static double rel_err(const float *a, const float *b, size_t n)
 {

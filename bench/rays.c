@@ -15,6 +15,7 @@
 
    Build: cc -O3 -march=native -fopenmp [-DRAD_EMBREE ... -lembree3] bench/rays.c
    Run:   rays [--append FILE.md]    (prints the tables, and appends them to FILE.md) */
+#include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include <stdio.h>
@@ -24,27 +25,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static FILE *g_md;
-static void emit(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    if (g_md) {
-        va_start(ap, fmt);
-        vfprintf(g_md, fmt, ap);
-        va_end(ap);
-    }
-}
 
 /* ---- recording ---- */
 typedef struct recorder {
@@ -141,7 +121,7 @@ static void run_scene(const char *name, const rad_scene *scene, uint32_t target,
     recorder rec;
     rad_context ctx;
     uint32_t r, step;
-    double tb = 1e30, te = 1e30, t;
+    double tb = 1e30, t;
     float *rowbuf;
     int k;
     size_t i;
@@ -195,6 +175,7 @@ static void run_scene(const char *name, const rad_scene *scene, uint32_t target,
             rad_embree *e = NULL;
             rad_raycaster re;
             uint64_t g1 = 0, g2 = 0;
+            double te = 1e30;
             for (k = 0; k < 3; ++k) {
                 rad_embree *e2 = NULL;
                 t = now();

@@ -17,6 +17,7 @@
 
    Build: cc -std=c99 -O3 -march=native -fopenmp -I. bench/temporal.c -o temporal -lm
    Run:   temporal [--quick] [--append FILE.md] [--csv FILE.csv] */
+#include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include <stdio.h>
@@ -26,28 +27,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static FILE *g_md;
-static void emit(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    fflush(stdout);
-    if (g_md) {
-        va_start(ap, fmt);
-        vfprintf(g_md, fmt, ap);
-        va_end(ap);
-    }
-}
 
 static void die(rad_result r, const char *what)
 {
