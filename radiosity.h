@@ -855,6 +855,117 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
 #endif
 
 /* ======================================================================================== */
+/* >>api_glsl: GLSL compute kernels                                                         */
+/* ======================================================================================== */
+
+/* SPEC §10. The compute kernels, as GLSL 4.50 source text the application compiles (with
+   glslang or shaderc) and dispatches on its own Vulkan (or OpenGL 4.5) device: radiosity.h
+   never touches a GPU. The canonical sources are the files glsl/<name> of the repository;
+   the text below the >>glsl section is generated from them (make glsl) and a test fails when
+   it is out of date. Every kernel is compiled and run by tests/test_vulkan.c on a Vulkan device
+   (Mesa's lavapipe in CI) and compared with the CPU function named in its entry.
+
+   COMMON RULES
+   - Compute only. Descriptor set 0, bindings as listed, every buffer a std430 storage buffer
+     of 32-bit scalars (float, uint) or uint64 row offsets read as uvec2 (low word first: the
+     little-endian layout of rad_matrix.row_offsets and rad_alias_tables.row_offsets, uploaded
+     unchanged). RGB vectors are 3N interleaved floats, as everywhere in radiosity.h.
+   - Workgroup: layout(local_size_x_id = 0): specialization constant RAD_GLSL_SPEC_LOCAL_SIZE
+     (id 0) sets the x size (default 1 when not specialized; 64 or 128 are good choices). One
+     invocation per row: dispatch ceil(row_count / local_size) groups in x. Nothing depends on
+     the subgroup size.
+   - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
+     by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
+     checked at compile time).
+   - CHUNKING. Every kernel processes rows [row_offset, row_offset + row_count) and reads the
+     big array (the matrix, its entries or bins) relative to a base, so a matrix larger than
+     one storage-buffer range (maxStorageBufferRange: 128 MiB on lavapipe, 4 GiB on most
+     desktop drivers) is processed as several dispatches, each binding only its rows: bind the
+     range from an offset rounded down to minStorageBufferOffsetAlignment and pass the
+     remainder, in elements, as the base. Small arrays (vectors, row offsets) are bound whole.
+   - Results agree with the CPU path to float rounding: the tests accept 1e-5 relative. The
+     temporal kernel draws the same indices as rad_temporal_step (same generator, same alias
+     draw, integer arithmetic), so it is compared directly.
+
+   THE KERNELS (binding: contents)
+   RAD_GLSL_GATHER_DENSE   one classic bounce, out_i = rho_i sum_j F_ij E_j (+ E_i),
+       as rad_solve_jacobi with bounces = 1. Push: rad_glsl_gather_dense_push.
+       0: F, row-major, rows of the chunk (F[row_offset][0] at element f_base)  1: E (3N)
+       2: albedo (3N)  3: out (3N; rows of the chunk written)
+   RAD_GLSL_GATHER_CSR     the same with a CSR matrix. Push: rad_glsl_gather_csr_push.
+       0: row offsets (N + 1 uint64)  1: columns  2: values (entry k at element k - entry_base)
+       3: E  4: albedo  5: out
+   RAD_GLSL_MB_APPLY_FLOAT out = F_mb E (+ E) as rad_multibounce_apply, float planes.
+       Push: rad_glsl_mb_apply_push; flags RAD_GLSL_FLAG_TOTAL, RAD_GLSL_FLAG_PERMUTED.
+       0, 1, 2: the R, G, B planes (rows of the chunk, plane row row_offset at element base)
+       3: E (original order)  4: col_perm  5: row_perm (bind any buffer when not PERMUTED)
+       6: out (original order; rows row_perm[row_offset ..] written)
+   RAD_GLSL_MB_APPLY_HALF  the same with binary16 planes (rad_multibounce.half uploaded
+       unchanged, read as uint words with unpackHalf2x16; base counted in halves).
+   RAD_GLSL_TEMPORAL_STEP  one frame of rad_temporal_step with a fixed weight (the adaptive
+       weight stays on the CPU). Push: rad_glsl_temporal_push.
+       0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
+       bin b at word (b - bin_base) * words)  2: totals T_i  3: E  4: albedo  5: B^prev
+       6: B^next (ping-pong the two buffers between frames). MULTIBOUNCE mode with three
+       table sets: three dispatches, channel c, sample_base c * k, table set c bound. */
+
+/* >>glsl ids begin */
+typedef enum rad_glsl_id {
+    RAD_GLSL_GATHER_DENSE = 0, /* glsl/gather_dense.comp */
+    RAD_GLSL_GATHER_CSR = 1, /* glsl/gather_csr.comp */
+    RAD_GLSL_MB_APPLY_FLOAT = 2, /* glsl/mb_apply_float.comp */
+    RAD_GLSL_MB_APPLY_HALF = 3, /* glsl/mb_apply_half.comp */
+    RAD_GLSL_TEMPORAL_STEP = 4, /* glsl/temporal_step.comp */
+    RAD_GLSL_COUNT = 5
+} rad_glsl_id;
+/* >>glsl ids end */
+
+#define RAD_GLSL_SPEC_LOCAL_SIZE 0u   /* specialization constant id of the workgroup x size */
+#define RAD_GLSL_FLAG_TOTAL 1u        /* gather, multi-bounce apply: add E (RAD_OUTPUT_TOTAL) */
+#define RAD_GLSL_FLAG_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
+#define RAD_GLSL_FLAG_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
+#define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
+
+/* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
+typedef struct rad_glsl_gather_dense_push {
+    uint32_t row_offset, row_count, cols, f_base, flags;
+} rad_glsl_gather_dense_push;
+typedef struct rad_glsl_gather_csr_push {
+    uint32_t row_offset, row_count, entry_base, flags;
+} rad_glsl_gather_csr_push;
+typedef struct rad_glsl_mb_apply_push {   /* RAD_GLSL_MB_APPLY_FLOAT and _HALF */
+    uint32_t n, row_offset, row_count, base, flags;
+} rad_glsl_mb_apply_push;
+typedef struct rad_glsl_temporal_push {
+    uint32_t seed, frame;          /* rad_temporal_options.seed; the frame being computed (0, 1, ...) */
+    uint32_t row_offset, row_count;
+    uint32_t n;                    /* N: the environment's column */
+    uint32_t samples;              /* k */
+    uint32_t words;                /* (uint32_t)rad_alias_tables.format: 2 or 3 */
+    uint32_t flags;                /* RAD_GLSL_FLAG_ALBEDO, RAD_GLSL_FLAG_FEEDBACK */
+    uint32_t channel;              /* 3: RGB from one table set; 0..2: this channel only */
+    uint32_t sample_base;          /* channel * k with three table sets, else 0 */
+    uint32_t bin_base;             /* low 32 bits of the bin at word 0 of binding 1 */
+    float weight;                  /* w */
+    float env[3];                  /* E_0 */
+} rad_glsl_temporal_push;
+
+/* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
+RAD_API const char *rad_glsl_name(rad_glsl_id id);
+
+/* The source of kernel 'id' in pieces: returns an array of *out_count string pointers (static
+   storage, never freed) whose concatenation is the source, or NULL (and 0) for an unknown id.
+   Each piece is at most 4000 characters and ends at a line end. Pure, thread-safe. */
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
+
+/* The whole source of kernel 'id' (the pieces concatenated), NUL-terminated, into dst.
+   *out_length (optional) receives the length without the NUL, on success and when dst is too
+   small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
+   INVALID_ARGUMENT (unknown id, out_length and dst both NULL), SIZE_MISMATCH (dst_size <=
+   length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). SPEC §10. */
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
+
+/* ======================================================================================== */
 /* >>api_multibounce: multi-bounce matrix and its compression                               */
 /* ======================================================================================== */
 
@@ -5134,6 +5245,334 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
     return rad__load(buf, (size_t)len, buf, &c, ctx, out);
 }
 #endif
+
+/* ======================================================================================== */
+/* >>glsl: GLSL compute kernels (generated sources, access)                                 */
+/* ======================================================================================== */
+
+/* push-constant mirrors: the GLSL blocks are 4-byte members in declaration order */
+typedef char rad__check_glsl_dense_push[(sizeof(rad_glsl_gather_dense_push) == 20 &&
+                                         offsetof(rad_glsl_gather_dense_push, f_base) == 12 &&
+                                         offsetof(rad_glsl_gather_dense_push, flags) == 16) ? 1 : -1];
+typedef char rad__check_glsl_csr_push[(sizeof(rad_glsl_gather_csr_push) == 16 &&
+                                       offsetof(rad_glsl_gather_csr_push, entry_base) == 8 &&
+                                       offsetof(rad_glsl_gather_csr_push, flags) == 12) ? 1 : -1];
+typedef char rad__check_glsl_mb_push[(sizeof(rad_glsl_mb_apply_push) == 20 &&
+                                      offsetof(rad_glsl_mb_apply_push, base) == 12 &&
+                                      offsetof(rad_glsl_mb_apply_push, flags) == 16) ? 1 : -1];
+typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60 &&
+                                            offsetof(rad_glsl_temporal_push, words) == 24 &&
+                                            offsetof(rad_glsl_temporal_push, bin_base) == 40 &&
+                                            offsetof(rad_glsl_temporal_push, weight) == 44 &&
+                                            offsetof(rad_glsl_temporal_push, env) == 48) ? 1 : -1];
+
+typedef struct rad__glsl_entry {
+    const char *name;
+    const char *const *pieces;
+    uint32_t count;
+    uint32_t length;
+} rad__glsl_entry;
+
+/* Generated by glsl/embed.c from the files glsl/<name>: edit those, then run make glsl. */
+/* >>glsl begin */
+static const char rad__glsl_0_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_GATHER_DENSE: one classic bounce with a dense form-factor matrix,\n"
+    "//   out_i = rho_i * sum_j F_ij E_j            (flags bit 0 clear: RAD_OUTPUT_INDIRECT)\n"
+    "//   out_i = E_i + rho_i * sum_j F_ij E_j      (flags bit 0 set:   RAD_OUTPUT_TOTAL)\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1, one invocation per row (RGB).\n"
+    "// Chunking: binding 0 holds the rows of this chunk only; F_ij is F[f_base + (i - row_offset) * cols + j],\n"
+    "// so a matrix larger than one storage-buffer range runs as several dispatches.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer MatrixF { float F[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer VectorE { float E[]; };      // 3 N, RGB interleaved\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Albedo { float rho[]; };     // 3 N\n"
+    "layout(std430, set = 0, binding = 3) buffer Output { float outv[]; };             // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch (global index)\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint cols;        // N\n"
+    "    uint f_base;      // element of binding 0 that holds F[row_offset][0]\n"
+    "    uint flags;       // bit 0: add E (total)\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint at = pc.f_base + r * pc.cols;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = 0u; j < pc.cols; ++j) {\n"
+    "        float f = F[at + j];\n"
+    "        acc += f * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
+    "    }\n"
+    "    precise vec3 o = acc * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_0[] = { rad__glsl_0_0 };
+static const char rad__glsl_1_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_GATHER_CSR: one classic bounce with a CSR (sparse) form-factor matrix,\n"
+    "//   out_i = rho_i * sum_k values[k] E_columns[k]  (+ E_i when flags bit 0 is set)\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1, one invocation per row (RGB).\n"
+    "// Binding 0 holds all N + 1 row offsets as uint64 (two uint words each, low word first, as\n"
+    "// rad_matrix.row_offsets stores them). Chunking: bindings 1 and 2 may hold only the entries of\n"
+    "// this chunk's rows; entry k of the matrix is element k - entry_base of them (entry_base = the\n"
+    "// low 32 bits of the first entry index the bound ranges start at; a chunk spans < 2^32 entries).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };      // 3 N\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };     // 3 N\n"
+    "layout(std430, set = 0, binding = 5) buffer Output { float outv[]; };             // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch (global index)\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
+    "    uint flags;       // bit 0: add E (total)\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint k0 = row_offsets[i].x - pc.entry_base;       // wraps correctly: only the difference matters\n"
+    "    uint k1 = row_offsets[i + 1u].x - pc.entry_base;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint k = k0; k != k1; ++k) {\n"
+    "        uint j = columns[k];\n"
+    "        acc += values[k] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
+    "    }\n"
+    "    precise vec3 o = acc * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_1[] = { rad__glsl_1_0 };
+static const char rad__glsl_2_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_FLOAT: the multi-bounce apply L = F_mb E with float planes\n"
+    "// (rad_multibounce with precision RAD_MB_FLOAT). Plane row i' (permuted order) is original row\n"
+    "// row_perm[i'], plane column j' is original column col_perm[j'] (identity when flags bit 1 is clear):\n"
+    "//   out[row_perm[i']] = sum_j' plane_c[i'][j'] * E[col_perm[j']]  (+ E[row_perm[i']] when flags bit 0)\n"
+    "// for plane rows i' = row_offset .. row_offset + row_count - 1, one invocation per row, channels c = R, G, B.\n"
+    "// Chunking: bindings 0..2 may hold only this chunk's rows; entry (i', j') of plane c is element\n"
+    "// base + (i' - row_offset) * n + j' of binding c.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };       // 3 N, original order\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; }; // N (unused without bit 1)\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; }; // N (unused without bit 1)\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };              // 3 N, original order\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;           // N\n"
+    "    uint row_offset;  // first plane row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint base;        // element of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u;\n"
+    "    uint ip = pc.row_offset + r;\n"
+    "    uint at = pc.base + r * pc.n;\n"
+    "    precise float sr = 0.0, sg = 0.0, sb = 0.0;\n"
+    "    for (uint j = 0u; j < pc.n; ++j) {\n"
+    "        uint e = 3u * (perm \? col_perm[j] : j);\n"
+    "        sr += R[at + j] * E[e];\n"
+    "        sg += G[at + j] * E[e + 1u];\n"
+    "        sb += B[at + j] * E[e + 2u];\n"
+    "    }\n"
+    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
+    "    if ((pc.flags & 1u) != 0u) { sr += E[o]; sg += E[o + 1u]; sb += E[o + 2u]; }\n"
+    "    outv[o] = sr;\n"
+    "    outv[o + 1u] = sg;\n"
+    "    outv[o + 2u] = sb;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_2[] = { rad__glsl_2_0 };
+static const char rad__glsl_3_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_HALF: the multi-bounce apply L = F_mb E with IEEE binary16\n"
+    "// planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint\n"
+    "// word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage\n"
+    "// feature is needed. Same bindings, push constants, permutations and chunking as\n"
+    "// RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may be odd).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { uint R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { uint G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { uint B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; };\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; };\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;\n"
+    "    uint row_offset;\n"
+    "    uint row_count;\n"
+    "    uint base;        // binary16 value of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
+    "} pc;\n"
+    "\n"
+    "float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u \? v.y : v.x; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u;\n"
+    "    uint ip = pc.row_offset + r;\n"
+    "    uint at = pc.base + r * pc.n;\n"
+    "    precise float sr = 0.0, sg = 0.0, sb = 0.0;\n"
+    "    for (uint j = 0u; j < pc.n; ++j) {\n"
+    "        uint e = 3u * (perm \? col_perm[j] : j), h = at + j;\n"
+    "        sr += half_at(R[h >> 1u], h) * E[e];\n"
+    "        sg += half_at(G[h >> 1u], h) * E[e + 1u];\n"
+    "        sb += half_at(B[h >> 1u], h) * E[e + 2u];\n"
+    "    }\n"
+    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
+    "    if ((pc.flags & 1u) != 0u) { sr += E[o]; sg += E[o + 1u]; sb += E[o + 2u]; }\n"
+    "    outv[o] = sr;\n"
+    "    outv[o + 1u] = sg;\n"
+    "    outv[o + 2u] = sb;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_3[] = { rad__glsl_3_0 };
+static const char rad__glsl_4_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_TEMPORAL_STEP: one frame of temporal radiosity (rad_temporal_step\n"
+    "// with a fixed weight), drawing exactly the indices the CPU draws: the counter-based generator\n"
+    "// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. Per row i:\n"
+    "//   acc = 0; for s = 0..k-1: J = draw(sample = sample_base + s); acc += V_J\n"
+    "//   X = acc * (T_i / k); X *= rho_i (flags bit 0); B_i = w B_i^prev + (1 - w) X\n"
+    "// V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).\n"
+    "// channel = 3: one table set serves R, G and B. channel = c < 3: this dispatch uses table set c\n"
+    "// (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.\n"
+    "// Chunking: binding 1 may hold only this chunk's bins; bin b of the tables is word\n"
+    "// (b - bin_base) * words of it (bin_base: low 32 bits; a chunk spans < 2^32 bins).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Totals { float totals[]; };         // T_i per row\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };             // 3 N\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };            // 3 N (flags bit 0)\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer Previous { float Bprev[]; };        // 3 N\n"
+    "layout(std430, set = 0, binding = 6) buffer Next { float Bnext[]; };                     // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint seed;        // rad_temporal_options.seed\n"
+    "    uint frame;       // rad_temporal_frame() before the step\n"
+    "    uint row_offset;  // first row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint n;           // N: the environment's column index\n"
+    "    uint samples;     // k\n"
+    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
+    "    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK)\n"
+    "    uint channel;     // 3: RGB from one table set; 0..2: this channel only\n"
+    "    uint sample_base; // channel * k with three table sets, else 0\n"
+    "    uint bin_base;    // low 32 bits of the bin index at word 0 of binding 1\n"
+    "    float weight;     // w in [0, 1)\n"
+    "    float env_r, env_g, env_b; // E_0\n"
+    "} pc;\n"
+    "\n"
+    "uint rad_pcg(uint v)\n"
+    "{\n"
+    "    uint s = v * 747796405u + 2891336453u;\n"
+    "    uint t = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;\n"
+    "    return (t >> 22u) ^ t;\n"
+    "}\n"
+    "\n"
+    "float value_at(uint j, uint c)\n"
+    "{\n"
+    "    if (j >= pc.n) return c == 0u \? pc.env_r : (c == 1u \? pc.env_g : pc.env_b);\n"
+    "    float v = E[3u * j + c];\n"
+    "    if ((pc.flags & 2u) != 0u) v += Bprev[3u * j + c];\n"
+    "    return v;\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);\n"
+    "    uint first = row_offsets[i].x - pc.bin_base;\n"
+    "    uint nb = row_offsets[i + 1u].x - row_offsets[i].x;\n"
+    "    uint c0 = pc.channel < 3u \? pc.channel : 0u, c1 = pc.channel < 3u \? pc.channel : 2u;\n"
+    "    precise float acc[3] = float[3](0.0, 0.0, 0.0);\n"
+    "    for (uint s = 0u; s < pc.samples; ++s) {\n"
+    "        uint u1 = rad_pcg(key ^ ((pc.sample_base + s) * 0x9E3779B9u));\n"
+    "        uint u2 = rad_pcg(u1 ^ 0x68E31DA4u);\n"
+    "        uint hi, lo;\n"
+    "        umulExtended(u1, nb, hi, lo);\n"
+    "        uint w = (first + hi) * pc.words, j;\n"
+    "        if (pc.words == 2u) j = u2 < bins[w] \? (bins[w + 1u] & 0xFFFFu) : (bins[w + 1u] >> 16u);\n"
+    "        else j = u2 < bins[w] \? bins[w + 1u] : bins[w + 2u];\n"
+    "        for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);\n"
+    "    }\n"
+    "    precise float scale = totals[i] / float(pc.samples);\n"
+    "    for (uint c = c0; c <= c1; ++c) {\n"
+    "        precise float x = acc[c] * scale;\n"
+    "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n";
+static const char rad__glsl_4_1[] =
+    "        precise float b = pc.weight * Bprev[3u * i + c] + (1.0 - pc.weight) * x;\n"
+    "        Bnext[3u * i + c] = b;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_4[] = { rad__glsl_4_0, rad__glsl_4_1 };
+static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
+    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 1844u },
+    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2221u },
+    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2353u },
+    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2104u },
+    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4080u }
+};
+/* >>glsl end */
+
+RAD_API const char *rad_glsl_name(rad_glsl_id id)
+{
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) return NULL;
+    return rad__glsl_table[id].name;
+}
+
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
+{
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) {
+        if (out_count) *out_count = 0;
+        return NULL;
+    }
+    if (out_count) *out_count = rad__glsl_table[id].count;
+    return rad__glsl_table[id].pieces;
+}
+
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
+{
+    const rad__glsl_entry *e;
+    uint32_t p;
+    size_t at = 0;
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT || (!dst && !out_length)) return RAD_ERROR_INVALID_ARGUMENT;
+    e = &rad__glsl_table[id];
+    if (out_length) *out_length = e->length;
+    if (!dst) return dst_size == 0 ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
+    if (dst_size <= e->length) return RAD_ERROR_SIZE_MISMATCH;
+    for (p = 0; p < e->count; ++p) {
+        size_t n = strlen(e->pieces[p]);
+        memcpy(dst + at, e->pieces[p], n);
+        at += n;
+    }
+    RAD_ASSERT(at == e->length);
+    dst[at] = '\0';
+    return RAD_SUCCESS;
+}
 
 /* ======================================================================================== */
 /* >>multibounce: multi-bounce matrix, GEMM, binary16, BC1/BC4, compression, container      */

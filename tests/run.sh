@@ -107,6 +107,14 @@ else
     fail demo-small
 fi
 compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+# ---- GLSL: the header holds the current glsl/ sources --------------------------------------
+if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
+   "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
+    pass glsl-embed-current
+else
+    cat "$BUILD/glsl-embed.out" 2>/dev/null | sed "s/^/    /"
+    fail glsl-embed-current
+fi
 # ---- the rad tool (needs assimp and stb: installed when we can) --------------------------
 { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
 if [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; then
