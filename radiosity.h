@@ -905,7 +905,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
    RAD_GLSL_TEMPORAL_STEP  one frame of rad_temporal_step with a fixed weight (the adaptive
        weight stays on the CPU). Push: rad_glsl_temporal_push.
        0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
-       bin b at word (b - bin_base) * words)  2: totals T_i  3: E  4: albedo  5: B^prev
+       word w of the tables, bin b starting at w = b * words, at element w - word_base)  2: totals T_i  3: E  4: albedo  5: B^prev
        6: B^next (ping-pong the two buffers between frames). MULTIBOUNCE mode with three
        table sets: three dispatches, channel c, sample_base c * k, table set c bound. */
 
@@ -945,7 +945,7 @@ typedef struct rad_glsl_temporal_push {
     uint32_t flags;                /* RAD_GLSL_FLAG_ALBEDO, RAD_GLSL_FLAG_FEEDBACK */
     uint32_t channel;              /* 3: RGB from one table set; 0..2: this channel only */
     uint32_t sample_base;          /* channel * k with three table sets, else 0 */
-    uint32_t bin_base;             /* low 32 bits of the bin at word 0 of binding 1 */
+    uint32_t word_base;            /* low 32 bits of the tables' word index at element 0 of binding 1 */
     float weight;                  /* w */
     float env[3];                  /* E_0 */
 } rad_glsl_temporal_push;
@@ -5262,7 +5262,7 @@ typedef char rad__check_glsl_mb_push[(sizeof(rad_glsl_mb_apply_push) == 20 &&
                                       offsetof(rad_glsl_mb_apply_push, flags) == 16) ? 1 : -1];
 typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60 &&
                                             offsetof(rad_glsl_temporal_push, words) == 24 &&
-                                            offsetof(rad_glsl_temporal_push, bin_base) == 40 &&
+                                            offsetof(rad_glsl_temporal_push, word_base) == 40 &&
                                             offsetof(rad_glsl_temporal_push, weight) == 44 &&
                                             offsetof(rad_glsl_temporal_push, env) == 48) ? 1 : -1];
 
@@ -5458,8 +5458,8 @@ static const char rad__glsl_4_0[] =
     "// V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).\n"
     "// channel = 3: one table set serves R, G and B. channel = c < 3: this dispatch uses table set c\n"
     "// (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.\n"
-    "// Chunking: binding 1 may hold only this chunk's bins; bin b of the tables is word\n"
-    "// (b - bin_base) * words of it (bin_base: low 32 bits; a chunk spans < 2^32 bins).\n"
+    "// Chunking: binding 1 may hold only this chunk's bins: word w of the tables (bin b starts at word\n"
+    "// b * words) is element w - word_base of it (word_base: low 32 bits; a chunk spans < 2^32 words).\n"
     "layout(local_size_x_id = 0) in;\n"
     "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins\n"
     "layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin\n"
@@ -5479,7 +5479,7 @@ static const char rad__glsl_4_0[] =
     "    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK)\n"
     "    uint channel;     // 3: RGB from one table set; 0..2: this channel only\n"
     "    uint sample_base; // channel * k with three table sets, else 0\n"
-    "    uint bin_base;    // low 32 bits of the bin index at word 0 of binding 1\n"
+    "    uint word_base;   // low 32 bits of the tables' word index at element 0 of binding 1\n"
     "    float weight;     // w in [0, 1)\n"
     "    float env_r, env_g, env_b; // E_0\n"
     "} pc;\n"
@@ -5505,7 +5505,7 @@ static const char rad__glsl_4_0[] =
     "    if (r >= pc.row_count) return;\n"
     "    uint i = pc.row_offset + r;\n"
     "    uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);\n"
-    "    uint first = row_offsets[i].x - pc.bin_base;\n"
+    "    uint first = row_offsets[i].x;\n"
     "    uint nb = row_offsets[i + 1u].x - row_offsets[i].x;\n"
     "    uint c0 = pc.channel < 3u \? pc.channel : 0u, c1 = pc.channel < 3u \? pc.channel : 2u;\n"
     "    precise float acc[3] = float[3](0.0, 0.0, 0.0);\n"
@@ -5514,16 +5514,16 @@ static const char rad__glsl_4_0[] =
     "        uint u2 = rad_pcg(u1 ^ 0x68E31DA4u);\n"
     "        uint hi, lo;\n"
     "        umulExtended(u1, nb, hi, lo);\n"
-    "        uint w = (first + hi) * pc.words, j;\n"
+    "        uint w = (first + hi) * pc.words - pc.word_base, j;   // wraps correctly: only the difference matters\n"
     "        if (pc.words == 2u) j = u2 < bins[w] \? (bins[w + 1u] & 0xFFFFu) : (bins[w + 1u] >> 16u);\n"
     "        else j = u2 < bins[w] \? bins[w + 1u] : bins[w + 2u];\n"
     "        for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);\n"
     "    }\n"
     "    precise float scale = totals[i] / float(pc.samples);\n"
     "    for (uint c = c0; c <= c1; ++c) {\n"
-    "        precise float x = acc[c] * scale;\n"
-    "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n";
+    "        precise float x = acc[c] * scale;\n";
 static const char rad__glsl_4_1[] =
+    "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n"
     "        precise float b = pc.weight * Bprev[3u * i + c] + (1.0 - pc.weight) * x;\n"
     "        Bnext[3u * i + c] = b;\n"
     "    }\n"
@@ -5534,7 +5534,7 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2221u },
     { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2353u },
     { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2104u },
-    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4080u }
+    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4173u }
 };
 /* >>glsl end */
 

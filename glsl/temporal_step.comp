@@ -7,8 +7,8 @@
 // V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).
 // channel = 3: one table set serves R, G and B. channel = c < 3: this dispatch uses table set c
 // (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.
-// Chunking: binding 1 may hold only this chunk's bins; bin b of the tables is word
-// (b - bin_base) * words of it (bin_base: low 32 bits; a chunk spans < 2^32 bins).
+// Chunking: binding 1 may hold only this chunk's bins: word w of the tables (bin b starts at word
+// b * words) is element w - word_base of it (word_base: low 32 bits; a chunk spans < 2^32 words).
 layout(local_size_x_id = 0) in;
 layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins
 layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin
@@ -28,7 +28,7 @@ layout(push_constant) uniform Push {
     uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK)
     uint channel;     // 3: RGB from one table set; 0..2: this channel only
     uint sample_base; // channel * k with three table sets, else 0
-    uint bin_base;    // low 32 bits of the bin index at word 0 of binding 1
+    uint word_base;   // low 32 bits of the tables' word index at element 0 of binding 1
     float weight;     // w in [0, 1)
     float env_r, env_g, env_b; // E_0
 } pc;
@@ -54,7 +54,7 @@ void main()
     if (r >= pc.row_count) return;
     uint i = pc.row_offset + r;
     uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);
-    uint first = row_offsets[i].x - pc.bin_base;
+    uint first = row_offsets[i].x;
     uint nb = row_offsets[i + 1u].x - row_offsets[i].x;
     uint c0 = pc.channel < 3u ? pc.channel : 0u, c1 = pc.channel < 3u ? pc.channel : 2u;
     precise float acc[3] = float[3](0.0, 0.0, 0.0);
@@ -63,7 +63,7 @@ void main()
         uint u2 = rad_pcg(u1 ^ 0x68E31DA4u);
         uint hi, lo;
         umulExtended(u1, nb, hi, lo);
-        uint w = (first + hi) * pc.words, j;
+        uint w = (first + hi) * pc.words - pc.word_base, j;   // wraps correctly: only the difference matters
         if (pc.words == 2u) j = u2 < bins[w] ? (bins[w + 1u] & 0xFFFFu) : (bins[w + 1u] >> 16u);
         else j = u2 < bins[w] ? bins[w + 1u] : bins[w + 2u];
         for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);

@@ -115,6 +115,19 @@ else
     cat "$BUILD/glsl-embed.out" 2>/dev/null | sed "s/^/    /"
     fail glsl-embed-current
 fi
+# ---- Vulkan: every GLSL kernel against the CPU path (lavapipe is enough; installed when we can)
+vk_ready() { [ -f /usr/include/vulkan/vulkan.h ] && have glslangValidator && ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; }
+vk_ready || try_install mesa-vulkan-drivers libvulkan-dev glslang-tools
+if vk_ready; then
+    echo "== GLSL sources compile on their own"
+    for f in glsl/*.comp; do
+        if glslangValidator -V "$f" -o "$BUILD/$(basename "$f").spv" >"$BUILD/glslang.log" 2>&1; then pass "glslang $f"
+        else sed 's/^/    /' "$BUILD/glslang.log" | head -20; fail "glslang $f"; fi
+    done
+    unit vulkan-kernels $CC -std=c99 $WARN -O2 -I. tests/test_vulkan.c -lvulkan
+else
+    skip vulkan "no Vulkan headers, Vulkan driver or glslangValidator (packages mesa-vulkan-drivers libvulkan-dev glslang-tools)"
+fi
 # ---- the rad tool (needs assimp and stb: installed when we can) --------------------------
 { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
 if [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; then

@@ -1,0 +1,460 @@
+/* test_vulkan.c - every GLSL kernel of radiosity.h compiled (from the header's embedded source,
+   by glslangValidator) and run on a Vulkan device (any: Mesa's lavapipe in CI), compared with
+   the CPU path on the same inputs (SPEC §10). Each kernel runs in row chunks bound at offsets
+   (the chunked processing of matrices larger than one storage-buffer range) and with two
+   workgroup sizes (specialization constant 0).
+
+       test_vulkan [WORKDIR [NAME]]   (WORKDIR: where .comp/.spv files are written, default the
+                                      binary's directory; NAME: run the tests whose name has it)
+
+   Ends with "N passed, N failed" like test_main. Exit 0 when nothing failed. */
+#define RADIOSITY_IMPLEMENTATION
+#include "../radiosity.h"
+#include "vk_util.h"
+#include <math.h>
+
+static int g_passed, g_failed, g_checks_failed;
+static double g_worst; /* largest relative error of the current test */
+static vk_ctx g_vk;
+static const uint32_t g_local_sizes[2] = { 64, 7 }; /* 7: not a power of two, not a subgroup multiple */
+
+#define T_CHECK(cond)                                                                                \
+    do {                                                                                             \
+        if (!(cond)) { printf("    FAIL %s:%d: %s\n", __FILE__, __LINE__, #cond); g_checks_failed++; } \
+    } while (0)
+
+static uint32_t g_rng = 12345u;
+static float frand(void)
+{
+    g_rng = g_rng * 1664525u + 1013904223u;
+    return (float)(g_rng >> 8) / 16777216.0f;
+}
+
+/* |gpu - cpu| <= rel * max(|cpu|, floor) elementwise, floor = 1e-3 of the largest |cpu| */
+static int compare(const char *what, const float *gpu, const float *cpu, size_t n, double rel)
+{
+    size_t i, worst = 0;
+    double mx = 0.0, err = 0.0;
+    for (i = 0; i < n; ++i) mx = fabs(cpu[i]) > mx ? fabs(cpu[i]) : mx;
+    for (i = 0; i < n; ++i) {
+        double s = fabs(cpu[i]) > 1e-3 * mx ? fabs(cpu[i]) : 1e-3 * mx, e = fabs((double)gpu[i] - cpu[i]) / (s > 0 ? s : 1.0);
+        if (!(e <= err)) { err = e; worst = i; }
+    }
+    if (err > g_worst) g_worst = err;
+    if (!(err <= rel)) {
+        printf("    FAIL %s: relative error %.3g > %.3g at %lu (gpu %.9g, cpu %.9g)\n", what, err, rel, (unsigned long)worst,
+               (double)gpu[worst], (double)cpu[worst]);
+        g_checks_failed++;
+        return 0;
+    }
+    return 1;
+}
+
+/* a random N x N form-factor-like matrix: non-negative, about 'density' non-zero, rows sum < 0.95 */
+static float *random_matrix(uint32_t n, float density)
+{
+    float *F = (float *)calloc((size_t)n * n, sizeof(float));
+    uint32_t i, j;
+    if (!F) return NULL;
+    for (i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (j = 0; j < n; ++j) {
+            float u = frand();
+            if (i != j && u < density) F[(size_t)i * n + j] = frand();
+            s += F[(size_t)i * n + j];
+        }
+        if (s > 0)
+            for (j = 0; j < n; ++j) F[(size_t)i * n + j] = (float)(F[(size_t)i * n + j] * (0.3 + 0.6 * frand()) / s);
+    }
+    return F;
+}
+
+static float *random_vector(size_t n, float zero_fraction)
+{
+    float *v = (float *)malloc(n * sizeof(float));
+    size_t i;
+    if (!v) return NULL;
+    for (i = 0; i < n; ++i) v[i] = frand() < zero_fraction ? 0.0f : frand() * 2.0f;
+    return v;
+}
+
+/* CSR view of a dense matrix (zeros dropped) */
+typedef struct csr { uint64_t *off; uint32_t *col; float *val; } csr;
+static rad_matrix make_csr(const float *F, uint32_t n, csr *c)
+{
+    rad_matrix m;
+    uint32_t i, j;
+    uint64_t k = 0;
+    c->off = (uint64_t *)malloc(((size_t)n + 1) * sizeof(uint64_t));
+    c->col = (uint32_t *)malloc((size_t)n * n * sizeof(uint32_t) + 4);
+    c->val = (float *)malloc((size_t)n * n * sizeof(float) + 4);
+    memset(&m, 0, sizeof(m));
+    if (!c->off || !c->col || !c->val) return m;
+    for (i = 0; i < n; ++i) {
+        c->off[i] = k;
+        for (j = 0; j < n; ++j)
+            if (F[(size_t)i * n + j] != 0.0f) { c->col[k] = j; c->val[k] = F[(size_t)i * n + j]; ++k; }
+    }
+    c->off[n] = k;
+    m.rows = m.cols = n;
+    m.storage = RAD_STORAGE_SPARSE;
+    m.row_offsets = c->off;
+    m.columns = c->col;
+    m.values = c->val;
+    return m;
+}
+
+/* row chunks used by every test: three uneven pieces */
+static void chunks(uint32_t n, uint32_t cut[4])
+{
+    cut[0] = 0;
+    cut[1] = n / 3 + 1;
+    cut[2] = (2 * n) / 3 + 3 < n ? (2 * n) / 3 + 3 : n;
+    cut[3] = n;
+}
+
+/* ---- dense and CSR gather: one classic bounce ------------------------------------------- */
+
+static void test_gather(int sparse)
+{
+    const uint32_t n = 150;
+    float *F = random_matrix(n, sparse ? 0.1f : 0.7f), *E = random_vector(3 * n, 0.5f), *rho = random_vector(3 * n, 0.0f);
+    float *cpu = (float *)malloc(3 * n * sizeof(float));
+    csr c;
+    rad_matrix m;
+    rad_system sys;
+    rad_solve_options so;
+    int ls, total;
+    memset(&c, 0, sizeof(c));
+    if (!F || !E || !rho || !cpu) { T_CHECK(0); goto done; }
+    {
+        size_t i;
+        for (i = 0; i < 3 * (size_t)n; ++i) rho[i] *= 0.45f; /* [0, 0.9) */
+    }
+    if (sparse) m = make_csr(F, n, &c);
+    else {
+        memset(&m, 0, sizeof(m));
+        m.rows = m.cols = n;
+        m.storage = RAD_STORAGE_DENSE;
+        m.dense = F;
+    }
+    memset(&sys, 0, sizeof(sys));
+    sys.F = &m;
+    sys.albedo = rho;
+    sys.E = E;
+    sys.n = n;
+    for (ls = 0; ls < 2; ++ls) {
+        vk_kernel k;
+        vk_buf bF, bC, bV, bO, bE, bR, bOut;
+        uint32_t nb = sparse ? 6u : 4u;
+        if (!vk_kernel_create(&g_vk, &k, sparse ? RAD_GLSL_GATHER_CSR : RAD_GLSL_GATHER_DENSE, nb,
+                              sparse ? (uint32_t)sizeof(rad_glsl_gather_csr_push) : (uint32_t)sizeof(rad_glsl_gather_dense_push),
+                              g_local_sizes[ls])) { T_CHECK(0); break; }
+        memset(&bC, 0, sizeof(bC)); memset(&bV, 0, sizeof(bV)); memset(&bO, 0, sizeof(bO)); memset(&bF, 0, sizeof(bF));
+        if (sparse) {
+            T_CHECK(vk_buffer(&g_vk, &bO, ((size_t)n + 1) * 8, c.off));
+            T_CHECK(vk_buffer(&g_vk, &bC, c.off[n] * 4, c.col));
+            T_CHECK(vk_buffer(&g_vk, &bV, c.off[n] * 4, c.val));
+        } else {
+            T_CHECK(vk_buffer(&g_vk, &bF, (size_t)n * n * 4, F));
+        }
+        T_CHECK(vk_buffer(&g_vk, &bE, 3 * n * 4, E));
+        T_CHECK(vk_buffer(&g_vk, &bR, 3 * n * 4, rho));
+        T_CHECK(vk_buffer(&g_vk, &bOut, 3 * n * 4, NULL));
+        for (total = 0; total < 2; ++total) {
+            uint32_t cut[4], q;
+            rad_solve_options_default(&so);
+            so.bounces = 1;
+            so.output = total ? RAD_OUTPUT_TOTAL : RAD_OUTPUT_INDIRECT;
+            T_CHECK(rad_solve_jacobi(&sys, &so, cpu, NULL, NULL) == RAD_SUCCESS);
+            memset(bOut.map, 0xFF, 3 * n * 4); /* NaN: every row must be written */
+            chunks(n, cut);
+            for (q = 0; q < 3; ++q) {
+                vk_range r[6];
+                if (cut[q + 1] == cut[q]) continue;
+                if (sparse) {
+                    rad_glsl_gather_csr_push p;
+                    uint32_t base = 0;
+                    uint64_t e0 = c.off[cut[q]], e1 = c.off[cut[q + 1]];
+                    r[0] = vk_whole(&bO);
+                    r[1] = vk_chunk(&g_vk, &bC, 4, e0, e1 - e0, &base);
+                    r[2] = vk_chunk(&g_vk, &bV, 4, e0, e1 - e0, &base);
+                    r[3] = vk_whole(&bE); r[4] = vk_whole(&bR); r[5] = vk_whole(&bOut);
+                    p.row_offset = cut[q];
+                    p.row_count = cut[q + 1] - cut[q];
+                    p.entry_base = (uint32_t)e0 - base;
+                    p.flags = total ? RAD_GLSL_FLAG_TOTAL : 0u;
+                    T_CHECK(vk_dispatch(&g_vk, &k, r, &p, p.row_count));
+                } else {
+                    rad_glsl_gather_dense_push p;
+                    r[0] = vk_chunk(&g_vk, &bF, 4, (VkDeviceSize)cut[q] * n, (VkDeviceSize)(cut[q + 1] - cut[q]) * n, &p.f_base);
+                    r[1] = vk_whole(&bE); r[2] = vk_whole(&bR); r[3] = vk_whole(&bOut);
+                    p.row_offset = cut[q];
+                    p.row_count = cut[q + 1] - cut[q];
+                    p.cols = n;
+                    p.flags = total ? RAD_GLSL_FLAG_TOTAL : 0u;
+                    T_CHECK(vk_dispatch(&g_vk, &k, r, &p, p.row_count));
+                }
+            }
+            compare(sparse ? "csr gather" : "dense gather", (const float *)bOut.map, cpu, 3 * (size_t)n, 1e-5);
+        }
+        vk_buffer_free(&g_vk, &bF); vk_buffer_free(&g_vk, &bC); vk_buffer_free(&g_vk, &bV); vk_buffer_free(&g_vk, &bO);
+        vk_buffer_free(&g_vk, &bE); vk_buffer_free(&g_vk, &bR); vk_buffer_free(&g_vk, &bOut);
+        vk_kernel_destroy(&g_vk, &k);
+    }
+done:
+    free(F); free(E); free(rho); free(cpu); free(c.off); free(c.col); free(c.val);
+}
+
+static void test_gather_dense(void) { test_gather(0); }
+static void test_gather_csr(void) { test_gather(1); }
+
+/* ---- multi-bounce apply, float and half, with and without permutations --------------------- */
+
+static int gpu_mb_apply(const rad_multibounce *mb, const float *E, rad_output output, uint32_t local_size, float *out)
+{
+    const uint32_t n = mb->n;
+    const int half = mb->precision == RAD_MB_HALF;
+    const size_t esz = half ? 2u : 4u, nn = (size_t)n * n;
+    vk_kernel k;
+    vk_buf planes[3], bE, bCol, bRow, bOut;
+    uint32_t ch, cut[4], q, idp[1] = { 0 };
+    int ok = 1;
+    if (!vk_kernel_create(&g_vk, &k, half ? RAD_GLSL_MB_APPLY_HALF : RAD_GLSL_MB_APPLY_FLOAT, 7,
+                          (uint32_t)sizeof(rad_glsl_mb_apply_push), local_size)) return 0;
+    for (ch = 0; ch < 3; ++ch)
+        ok &= vk_buffer(&g_vk, &planes[ch], nn * esz,
+                        half ? (const void *)(mb->half + ch * nn) : (const void *)(mb->planes + ch * nn));
+    ok &= vk_buffer(&g_vk, &bE, 3 * (size_t)n * 4, E);
+    ok &= vk_buffer(&g_vk, &bCol, mb->col_perm ? (size_t)n * 4 : 4, mb->col_perm ? (const void *)mb->col_perm : (const void *)idp);
+    ok &= vk_buffer(&g_vk, &bRow, mb->row_perm ? (size_t)n * 4 : 4, mb->row_perm ? (const void *)mb->row_perm : (const void *)idp);
+    ok &= vk_buffer(&g_vk, &bOut, 3 * (size_t)n * 4, NULL);
+    memset(bOut.map, 0xFF, 3 * (size_t)n * 4);
+    chunks(n, cut);
+    for (q = 0; q < 3 && ok; ++q) {
+        vk_range r[7];
+        rad_glsl_mb_apply_push p;
+        uint32_t base = 0;
+        for (ch = 0; ch < 3; ++ch)
+            r[ch] = vk_chunk(&g_vk, &planes[ch], esz, (VkDeviceSize)cut[q] * n, (VkDeviceSize)(cut[q + 1] - cut[q]) * n, &base);
+        r[3] = vk_whole(&bE); r[4] = vk_whole(&bCol); r[5] = vk_whole(&bRow); r[6] = vk_whole(&bOut);
+        p.n = n;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.base = base;
+        p.flags = (output == RAD_OUTPUT_TOTAL ? RAD_GLSL_FLAG_TOTAL : 0u) | (mb->row_perm ? RAD_GLSL_FLAG_PERMUTED : 0u);
+        if (p.row_count) ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+    }
+    if (ok) memcpy(out, bOut.map, 3 * (size_t)n * 4);
+    for (ch = 0; ch < 3; ++ch) vk_buffer_free(&g_vk, &planes[ch]);
+    vk_buffer_free(&g_vk, &bE); vk_buffer_free(&g_vk, &bCol); vk_buffer_free(&g_vk, &bRow); vk_buffer_free(&g_vk, &bOut);
+    vk_kernel_destroy(&g_vk, &k);
+    return ok;
+}
+
+static void test_mb_apply(void)
+{
+    const uint32_t n = 90;
+    float *F = random_matrix(n, 0.6f), *E = random_vector(3 * n, 0.4f), *rho = random_vector(3 * n, 0.0f);
+    float *cpu = (float *)malloc(3 * n * sizeof(float)), *gpu = (float *)malloc(3 * n * sizeof(float));
+    rad_matrix m;
+    rad_multibounce_options o;
+    rad_multibounce *mb = NULL, *mbh = NULL, *mbp = NULL, *mbph = NULL;
+    int v, ls, total;
+    size_t i;
+    if (!F || !E || !rho || !cpu || !gpu) { T_CHECK(0); goto done; }
+    for (i = 0; i < 3 * (size_t)n; ++i) rho[i] *= 0.45f;
+    memset(&m, 0, sizeof(m));
+    m.rows = m.cols = n;
+    m.storage = RAD_STORAGE_DENSE;
+    m.dense = F;
+    rad_multibounce_options_default(&o);
+    o.bounces = 3;
+    T_CHECK(rad_multibounce_create(&m, rho, &o, NULL, &mb) == RAD_SUCCESS);
+    T_CHECK(mb && rad_multibounce_convert(mb, RAD_MB_HALF, NULL, &mbh) == RAD_SUCCESS);
+    T_CHECK(mb && rad_multibounce_reorder(mb, 0, NULL, &mbp) == RAD_SUCCESS);
+    T_CHECK(mbp && rad_multibounce_convert(mbp, RAD_MB_HALF, NULL, &mbph) == RAD_SUCCESS);
+    if (!mb || !mbh || !mbp || !mbph) goto done;
+    T_CHECK(mbp->row_perm != NULL && mbp->col_perm != NULL);
+    for (v = 0; v < 4; ++v) {
+        const rad_multibounce *x = v == 0 ? mb : v == 1 ? mbh : v == 2 ? mbp : mbph;
+        for (ls = 0; ls < 2; ++ls)
+            for (total = 0; total < 2; ++total) {
+                rad_output out = total ? RAD_OUTPUT_TOTAL : RAD_OUTPUT_INDIRECT;
+                T_CHECK(rad_multibounce_apply(x, E, cpu, out, NULL) == RAD_SUCCESS);
+                T_CHECK(gpu_mb_apply(x, E, out, g_local_sizes[ls], gpu));
+                compare(v == 0 ? "mb float" : v == 1 ? "mb half" : v == 2 ? "mb float permuted" : "mb half permuted", gpu, cpu,
+                        3 * (size_t)n, 1e-5);
+            }
+    }
+done:
+    rad_multibounce_destroy(mb); rad_multibounce_destroy(mbh); rad_multibounce_destroy(mbp); rad_multibounce_destroy(mbph);
+    free(F); free(E); free(rho); free(cpu); free(gpu);
+}
+
+/* ---- temporal step: same draws as the CPU, several frames ----------------------------------- */
+
+/* runs 'frames' frames of the temporal state's configuration on the GPU and compares each with
+   rad_temporal_step on a twin CPU state */
+static void temporal_case(const char *what, const rad_alias_tables *const *tables, uint32_t table_count, const float *rho,
+                          const rad_temporal_options *o, const float *E, const float env[3], uint32_t frames, uint32_t local_size)
+{
+    const uint32_t n = tables[0]->rows;
+    rad_temporal *t = NULL;
+    vk_kernel k;
+    vk_buf bOff[3], bBins[3], bTot[3], bE, bR, bB[2];
+    uint32_t f, c, q, cut[4], ones[1] = { 0 };
+    float *cpu = (float *)malloc(3 * (size_t)n * sizeof(float));
+    int ok = 1;
+    char label[96];
+    if (!cpu || rad_temporal_create(tables, table_count, rho, o, NULL, &t) != RAD_SUCCESS) { T_CHECK(0); free(cpu); return; }
+    if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_TEMPORAL_STEP, 7, (uint32_t)sizeof(rad_glsl_temporal_push), local_size)) {
+        T_CHECK(0); rad_temporal_destroy(t); free(cpu); return;
+    }
+    for (c = 0; c < table_count; ++c) {
+        const rad_alias_tables *tb = tables[c];
+        ok &= vk_buffer(&g_vk, &bOff[c], ((size_t)n + 1) * 8, tb->row_offsets);
+        ok &= vk_buffer(&g_vk, &bBins[c], (size_t)tb->row_offsets[n] * (uint32_t)tb->format * 4, tb->bins);
+        ok &= vk_buffer(&g_vk, &bTot[c], (size_t)n * 4, tb->totals);
+    }
+    ok &= vk_buffer(&g_vk, &bE, 3 * (size_t)n * 4, E);
+    ok &= vk_buffer(&g_vk, &bR, rho ? 3 * (size_t)n * 4 : 4, rho ? (const void *)rho : (const void *)ones);
+    ok &= vk_buffer(&g_vk, &bB[0], 3 * (size_t)n * 4, NULL);
+    ok &= vk_buffer(&g_vk, &bB[1], 3 * (size_t)n * 4, NULL);
+    chunks(n, cut);
+    for (f = 0; f < frames && ok; ++f) {
+        const vk_buf *prev = &bB[f & 1u], *next = &bB[(f + 1u) & 1u];
+        T_CHECK(rad_temporal_step(t, E, env, cpu) == RAD_SUCCESS);
+        memset(next->map, 0xFF, 3 * (size_t)n * 4);
+        for (c = 0; c < table_count; ++c)
+            for (q = 0; q < 3; ++q) {
+                const rad_alias_tables *tb = tables[c];
+                rad_glsl_temporal_push p;
+                vk_range r[7];
+                uint32_t base = 0, words = (uint32_t)tb->format;
+                uint64_t b0 = tb->row_offsets[cut[q]], b1 = tb->row_offsets[cut[q + 1]];
+                if (cut[q + 1] == cut[q]) continue;
+                r[0] = vk_whole(&bOff[c]);
+                r[1] = vk_chunk(&g_vk, &bBins[c], 4, b0 * words, (b1 - b0) * words, &base);
+                r[2] = vk_whole(&bTot[c]); r[3] = vk_whole(&bE); r[4] = vk_whole(&bR);
+                r[5] = vk_whole(prev); r[6] = vk_whole(next);
+                memset(&p, 0, sizeof(p));
+                p.seed = o->seed;
+                p.frame = f;
+                p.row_offset = cut[q];
+                p.row_count = cut[q + 1] - cut[q];
+                p.n = n;
+                p.samples = o->samples;
+                p.words = words;
+                p.flags = (o->mode != RAD_TEMPORAL_MULTIBOUNCE ? RAD_GLSL_FLAG_ALBEDO : 0u) |
+                          (o->mode == RAD_TEMPORAL_FEEDBACK ? RAD_GLSL_FLAG_FEEDBACK : 0u);
+                p.channel = table_count == 1 ? 3u : c;
+                p.sample_base = table_count == 1 ? 0u : c * o->samples;
+                p.word_base = (uint32_t)(b0 * words) - base;
+                p.weight = o->weight;
+                p.env[0] = env ? env[0] : 0.0f;
+                p.env[1] = env ? env[1] : 0.0f;
+                p.env[2] = env ? env[2] : 0.0f;
+                ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+            }
+        snprintf(label, sizeof(label), "%s frame %u (local size %u)", what, f, local_size);
+        if (ok && !compare(label, (const float *)next->map, cpu, 3 * (size_t)n, 1e-5)) break;
+    }
+    T_CHECK(ok);
+    for (c = 0; c < table_count; ++c) { vk_buffer_free(&g_vk, &bOff[c]); vk_buffer_free(&g_vk, &bBins[c]); vk_buffer_free(&g_vk, &bTot[c]); }
+    vk_buffer_free(&g_vk, &bE); vk_buffer_free(&g_vk, &bR); vk_buffer_free(&g_vk, &bB[0]); vk_buffer_free(&g_vk, &bB[1]);
+    vk_kernel_destroy(&g_vk, &k);
+    rad_temporal_destroy(t);
+    free(cpu);
+}
+
+static void test_temporal(void)
+{
+    const uint32_t n = 120;
+    float *F = random_matrix(n, 0.3f), *E = random_vector(3 * n, 0.6f), *rho = random_vector(3 * n, 0.0f);
+    float env[3] = { 0.3f, 0.5f, 0.9f };
+    rad_matrix m;
+    rad_alias_tables *tb = NULL, *tw = NULL, *pl[3] = { NULL, NULL, NULL };
+    rad_multibounce *mb = NULL;
+    rad_multibounce_options mo;
+    rad_temporal_options o;
+    size_t i;
+    int ls;
+    if (!F || !E || !rho) { T_CHECK(0); goto done; }
+    for (i = 0; i < 3 * (size_t)n; ++i) rho[i] *= 0.45f;
+    memset(&m, 0, sizeof(m));
+    m.rows = m.cols = n;
+    m.storage = RAD_STORAGE_DENSE;
+    m.dense = F;
+    T_CHECK(rad_alias_tables_create(&m, RAD_ALIAS_COMPACT, NULL, &tb) == RAD_SUCCESS);
+    T_CHECK(rad_alias_tables_create(&m, RAD_ALIAS_WIDE, NULL, &tw) == RAD_SUCCESS);
+    rad_multibounce_options_default(&mo);
+    T_CHECK(rad_multibounce_create(&m, rho, &mo, NULL, &mb) == RAD_SUCCESS);
+    if (mb)
+        for (i = 0; i < 3; ++i)
+            T_CHECK(rad_alias_tables_create_dense(mb->planes + i * (size_t)n * n, n, RAD_ALIAS_AUTO, NULL, &pl[i]) == RAD_SUCCESS);
+    if (!tb || !tw || !pl[0] || !pl[1] || !pl[2]) goto done;
+    for (ls = 0; ls < 2; ++ls) {
+        const rad_alias_tables *one[1];
+        rad_temporal_options_default(&o);
+        o.seed = 0xC0FFEEu + (uint32_t)ls;
+        o.samples = 13;
+        o.weight = 0.9f;
+        o.mode = RAD_TEMPORAL_SINGLE;
+        one[0] = tb;
+        temporal_case("temporal single compact", one, 1, rho, &o, E, env, 4, g_local_sizes[ls]);
+        o.mode = RAD_TEMPORAL_FEEDBACK;
+        one[0] = tw;
+        temporal_case("temporal feedback wide", one, 1, rho, &o, E, env, 6, g_local_sizes[ls]);
+        o.mode = RAD_TEMPORAL_MULTIBOUNCE;
+        o.samples = 5;
+        temporal_case("temporal multibounce 3 tables", (const rad_alias_tables *const *)pl, 3, NULL, &o, E, NULL, 4,
+                      g_local_sizes[ls]);
+    }
+done:
+    rad_alias_tables_destroy(tb); rad_alias_tables_destroy(tw);
+    for (i = 0; i < 3; ++i) rad_alias_tables_destroy(pl[i]);
+    rad_multibounce_destroy(mb);
+    free(F); free(E); free(rho);
+}
+
+/* ---- the harness ---------------------------------------------------------------------------- */
+
+typedef struct vk_test { const char *name; void (*fn)(void); } vk_test;
+static const vk_test g_tests[] = {
+    { "vk_gather_dense", test_gather_dense },
+    { "vk_gather_csr", test_gather_csr },
+    { "vk_mb_apply_float_half_permuted", test_mb_apply },
+    { "vk_temporal_step", test_temporal },
+    { NULL, NULL }
+};
+
+int main(int argc, char **argv)
+{
+    const vk_test *t;
+    const char *filter = argc > 2 ? argv[2] : NULL;
+    char dir[512];
+    const char *slash = strrchr(argv[0], '/');
+    /* default work directory: the one the binary is in */
+    if (slash && (size_t)(slash - argv[0]) < sizeof(dir)) { memcpy(dir, argv[0], (size_t)(slash - argv[0])); dir[slash - argv[0]] = 0; }
+    else strcpy(dir, ".");
+    if (!vk_init(&g_vk, argc > 1 ? argv[1] : dir)) {
+        printf("no usable Vulkan device\n0 passed, 1 failed\n");
+        return 1;
+    }
+    printf("device: %s (Vulkan %u.%u), minStorageBufferOffsetAlignment %lu, maxStorageBufferRange %u\n", g_vk.props.deviceName,
+           VK_VERSION_MAJOR(g_vk.props.apiVersion), VK_VERSION_MINOR(g_vk.props.apiVersion),
+           (unsigned long)g_vk.props.limits.minStorageBufferOffsetAlignment, g_vk.props.limits.maxStorageBufferRange);
+    for (t = g_tests; t->name; ++t) {
+        if (filter && !strstr(t->name, filter)) continue;
+        g_checks_failed = 0;
+        g_worst = 0.0;
+        printf("%s\n", t->name);
+        t->fn();
+        if (g_checks_failed) { g_failed++; printf("  FAIL %s\n", t->name); }
+        else { g_passed++; printf("  ok (largest relative difference from the CPU path %.2g)\n", g_worst); }
+    }
+    vk_shutdown(&g_vk);
+    printf("%d passed, %d failed\n", g_passed, g_failed);
+    return g_failed ? 1 : 0;
+}
