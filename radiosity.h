@@ -907,7 +907,18 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
        word w of the tables, bin b starting at w = b * words, at element w - word_base)  2: totals T_i  3: E  4: albedo  5: B^prev
        6: B^next (ping-pong the two buffers between frames). MULTIBOUNCE mode with three
-       table sets: three dispatches, channel c, sample_base c * k, table set c bound. */
+       table sets: three dispatches, channel c, sample_base c * k, table set c bound.
+   RAD_GLSL_MB_APPLY_BLOCKS  out = F~ E (+ E) as rad_multibounce_blocks_apply: the blocks
+       uploaded unchanged as VK_FORMAT_BC1_RGB_UNORM_BLOCK or three VK_FORMAT_BC4_UNORM_BLOCK
+       images (feature textureCompressionBC), decoded by the texture unit with texelFetch
+       (decoders round differently: within 2/255 of rad_bc1_decode_block per channel), times
+       the tile scales, plus the exact outliers. Push: rad_glsl_mb_blocks_push; flags
+       RAD_GLSL_FLAG_TOTAL, _PERMUTED, _BC1, _OUTLIERS. 0, 1, 2: combined image samplers (BC1:
+       the one image at all three; BC4X3: R, G, B planes)  3: scales (3 per tile)  4: E
+       5: col_perm  6: row_perm  7: outlier offsets (N + 1 uint64)  8: outlier columns
+       9: outlier values (3 each)  10: out. Rows are texel rows (chunks of row_offset, row_count
+       with row_offset + row_count <= N); the outlier arrays are bound whole (indexed by
+       original row), which limits them to one storage range (N of about 14 000 at 5%). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -916,7 +927,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_MB_APPLY_FLOAT = 2, /* glsl/mb_apply_float.comp */
     RAD_GLSL_MB_APPLY_HALF = 3, /* glsl/mb_apply_half.comp */
     RAD_GLSL_TEMPORAL_STEP = 4, /* glsl/temporal_step.comp */
-    RAD_GLSL_COUNT = 5
+    RAD_GLSL_MB_APPLY_BLOCKS = 5, /* glsl/mb_apply_blocks.comp */
+    RAD_GLSL_COUNT = 6
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -925,6 +937,8 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_FLAG_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
 #define RAD_GLSL_FLAG_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
 #define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
+#define RAD_GLSL_FLAG_BC1 4u          /* block apply: one BC1 image (else three BC4 images) */
+#define RAD_GLSL_FLAG_OUTLIERS 8u     /* block apply: the outlier arrays are bound */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -949,6 +963,11 @@ typedef struct rad_glsl_temporal_push {
     float weight;                  /* w */
     float env[3];                  /* E_0 */
 } rad_glsl_temporal_push;
+typedef struct rad_glsl_mb_blocks_push {
+    uint32_t n, row_offset, row_count;
+    uint32_t tile, tiles_per_row;  /* rad_multibounce_blocks.tile, .tiles_per_row */
+    uint32_t flags;
+} rad_glsl_mb_blocks_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -5265,6 +5284,9 @@ typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60
                                             offsetof(rad_glsl_temporal_push, word_base) == 40 &&
                                             offsetof(rad_glsl_temporal_push, weight) == 44 &&
                                             offsetof(rad_glsl_temporal_push, env) == 48) ? 1 : -1];
+typedef char rad__check_glsl_blocks_push[(sizeof(rad_glsl_mb_blocks_push) == 24 &&
+                                          offsetof(rad_glsl_mb_blocks_push, tile) == 12 &&
+                                          offsetof(rad_glsl_mb_blocks_push, flags) == 20) ? 1 : -1];
 
 typedef struct rad__glsl_entry {
     const char *name;
@@ -5529,12 +5551,83 @@ static const char rad__glsl_4_1[] =
     "    }\n"
     "}\n";
 static const char *const rad__glsl_pieces_4[] = { rad__glsl_4_0, rad__glsl_4_1 };
+static const char rad__glsl_5_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_BLOCKS: the multi-bounce apply from the block-compressed\n"
+    "// matrix (rad_multibounce_blocks), as rad_multibounce_blocks_apply: the texture unit decodes the\n"
+    "// blocks (texelFetch), each texel is multiplied by its tile's scale, the outliers are added\n"
+    "// exactly and the permutations are applied:\n"
+    "//   out[row_perm[y]] = sum_x decoded(x, y) * scale(tile of x, y) * E[col_perm[x]]\n"
+    "//                      + sum over the outliers of original row row_perm[y] of value * E[column]\n"
+    "//                      (+ E[row_perm[y]] when flags bit 0 is set)\n"
+    "// for texel rows y = row_offset .. row_offset + row_count - 1, one invocation per row, RGB.\n"
+    "// Formats: RAD_BLOCK_BC1 (flags bit 2): one VK_FORMAT_BC1_RGB_UNORM_BLOCK image bound to\n"
+    "// bindings 0, 1 and 2 (its .rgb is read from binding 0); RAD_BLOCK_BC4X3: three\n"
+    "// VK_FORMAT_BC4_UNORM_BLOCK images (R, G, B planes) at bindings 0, 1, 2 (.r of each). The images\n"
+    "// are blocks_per_row * 4 texels square; texel (x, y) is entry (row y, column x).\n"
+    "// The outlier arrays are bound whole (they are indexed by original row, which a chunk of\n"
+    "// permuted rows does not keep contiguous): with the default 5% of N^2 they fit 128 MiB up to\n"
+    "// N of about 14 000.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(set = 0, binding = 0) uniform sampler2D texR;   // BC1: the RGB texture; BC4X3: R plane\n"
+    "layout(set = 0, binding = 1) uniform sampler2D texG;   // BC4X3: G plane (BC1: any, unused)\n"
+    "layout(set = 0, binding = 2) uniform sampler2D texB;   // BC4X3: B plane (BC1: any, unused)\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Scales { float scales[]; };          // 3 per tile\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VectorE { float E[]; };              // 3 N\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer ColPerm { uint col_perm[]; };        // N (flags bit 1)\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer RowPerm { uint row_perm[]; };        // N (flags bit 1)\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer OutlierOffsets { uvec2 out_off[]; }; // N + 1 uint64 (bit 3)\n"
+    "layout(std430, set = 0, binding = 8) readonly buffer OutlierColumns { uint out_col[]; };  // (bit 3)\n"
+    "layout(std430, set = 0, binding = 9) readonly buffer OutlierValues { float out_val[]; };  // 3 per outlier (bit 3)\n"
+    "layout(std430, set = 0, binding = 10) buffer Output { float outv[]; };                    // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;             // N\n"
+    "    uint row_offset;    // first texel row of this dispatch\n"
+    "    uint row_count;     // rows in this dispatch\n"
+    "    uint tile;          // scale tile in texels (0: one scale per channel)\n"
+    "    uint tiles_per_row; // ceil(N / tile), 1 when tile is 0\n"
+    "    uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u, bc1 = (pc.flags & 4u) != 0u;\n"
+    "    uint y = pc.row_offset + r;\n"
+    "    uint trow = pc.tile != 0u \? (y / pc.tile) * pc.tiles_per_row : 0u;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint x = 0u; x < pc.n; ++x) {\n"
+    "        ivec2 p = ivec2(int(x), int(y));\n"
+    "        vec3 d = bc1 \? texelFetch(texR, p, 0).rgb\n"
+    "                     : vec3(texelFetch(texR, p, 0).r, texelFetch(texG, p, 0).r, texelFetch(texB, p, 0).r);\n"
+    "        uint t = 3u * (trow + (pc.tile != 0u \? x / pc.tile : 0u));\n"
+    "        uint e = 3u * (perm \? col_perm[x] : x);\n"
+    "        acc += (d * vec3(scales[t], scales[t + 1u], scales[t + 2u])) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
+    "    }\n"
+    "    uint i = perm \? row_perm[y] : y;\n"
+    "    if ((pc.flags & 8u) != 0u) {\n"
+    "        precise vec3 s = vec3(0.0);\n"
+    "        for (uint k = out_off[i].x; k != out_off[i + 1u].x; ++k) {\n"
+    "            uint j = 3u * out_col[k];\n"
+    "            s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);\n"
+    "        }\n"
+    "        acc += s;\n"
+    "    }\n";
+static const char rad__glsl_5_1[] =
+    "    if ((pc.flags & 1u) != 0u) acc += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = acc.x;\n"
+    "    outv[3u * i + 1u] = acc.y;\n"
+    "    outv[3u * i + 2u] = acc.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_5[] = { rad__glsl_5_0, rad__glsl_5_1 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 1844u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2221u },
     { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2353u },
     { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2104u },
-    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4173u }
+    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4173u },
+    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4118u }
 };
 /* >>glsl end */
 

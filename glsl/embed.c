@@ -26,6 +26,7 @@ static const kernel kernels[] = {
     { "RAD_GLSL_MB_APPLY_FLOAT", "glsl/mb_apply_float.comp" },
     { "RAD_GLSL_MB_APPLY_HALF", "glsl/mb_apply_half.comp" },
     { "RAD_GLSL_TEMPORAL_STEP", "glsl/temporal_step.comp" },
+    { "RAD_GLSL_MB_APPLY_BLOCKS", "glsl/mb_apply_blocks.comp" },
 };
 #define KERNELS (sizeof(kernels) / sizeof(kernels[0]))
 

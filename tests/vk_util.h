@@ -18,6 +18,8 @@ typedef struct vk_ctx {
     VkCommandPool pool;
     VkPhysicalDeviceProperties props;
     VkPhysicalDeviceMemoryProperties mem;
+    int bc;              /* textureCompressionBC enabled */
+    VkSampler sampler;   /* nearest, for texelFetch */
     char workdir[512];   /* where .comp and .spv files go */
 } vk_ctx;
 
@@ -33,8 +35,14 @@ typedef struct vk_kernel {
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
     VkPipeline pipeline;
-    uint32_t bindings, push_size, local_size;
+    uint32_t images, bindings, push_size, local_size; /* bindings 0..images-1 are combined image samplers */
 } vk_kernel;
+
+typedef struct vk_image {
+    VkImage image;
+    VkDeviceMemory memory;
+    VkImageView view;
+} vk_image;
 
 /* one binding: a buffer range */
 typedef struct vk_range { const vk_buf *buf; VkDeviceSize offset, range; } vk_range;
@@ -55,6 +63,8 @@ static int vk_init(vk_ctx *v, const char *workdir)
     VkDeviceQueueCreateInfo qci;
     VkDeviceCreateInfo dci;
     VkCommandPoolCreateInfo pci;
+    VkPhysicalDeviceFeatures have, want;
+    VkSamplerCreateInfo sci;
     memset(v, 0, sizeof(*v));
     snprintf(v->workdir, sizeof(v->workdir), "%s", workdir);
     memset(&app, 0, sizeof(app));
@@ -82,11 +92,23 @@ static int vk_init(vk_ctx *v, const char *workdir)
     qci.queueFamilyIndex = v->family;
     qci.queueCount = 1;
     qci.pQueuePriorities = &prio;
+    vkGetPhysicalDeviceFeatures(v->phys, &have);
+    memset(&want, 0, sizeof(want));
+    want.textureCompressionBC = have.textureCompressionBC;
+    v->bc = have.textureCompressionBC == VK_TRUE;
     memset(&dci, 0, sizeof(dci));
     dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
+    dci.pEnabledFeatures = &want;
     VK_TRY(vkCreateDevice(v->phys, &dci, NULL, &v->device));
+    memset(&sci, 0, sizeof(sci));
+    sci.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+    sci.magFilter = VK_FILTER_NEAREST;
+    sci.minFilter = VK_FILTER_NEAREST;
+    sci.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    VK_TRY(vkCreateSampler(v->device, &sci, NULL, &v->sampler));
     vkGetDeviceQueue(v->device, v->family, 0, &v->queue);
     memset(&pci, 0, sizeof(pci));
     pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
@@ -99,6 +121,7 @@ static int vk_init(vk_ctx *v, const char *workdir)
 static void vk_shutdown(vk_ctx *v)
 {
     if (v->device) {
+        if (v->sampler) vkDestroySampler(v->device, v->sampler, NULL);
         vkDestroyCommandPool(v->device, v->pool, NULL);
         vkDestroyDevice(v->device, NULL);
     }
@@ -184,7 +207,8 @@ static uint32_t *vk_compile(vk_ctx *v, rad_glsl_id id, size_t *words)
 
 /* a compute pipeline for kernel 'id' with 'bindings' storage buffers (0..bindings-1), a push
    block of push_size bytes and the workgroup size given by specialization constant 0 */
-static int vk_kernel_create(vk_ctx *v, vk_kernel *k, rad_glsl_id id, uint32_t bindings, uint32_t push_size, uint32_t local_size)
+static int vk_kernel_create(vk_ctx *v, vk_kernel *k, rad_glsl_id id, uint32_t images, uint32_t bindings, uint32_t push_size,
+                            uint32_t local_size)
 {
     size_t words = 0;
     uint32_t *code = vk_compile(v, id, &words), b;
@@ -209,7 +233,7 @@ static int vk_kernel_create(vk_ctx *v, vk_kernel *k, rad_glsl_id id, uint32_t bi
     memset(lb, 0, sizeof(lb));
     for (b = 0; b < bindings; ++b) {
         lb[b].binding = b;
-        lb[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        lb[b].descriptorType = b < images ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         lb[b].descriptorCount = 1;
         lb[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     }
@@ -244,6 +268,7 @@ static int vk_kernel_create(vk_ctx *v, vk_kernel *k, rad_glsl_id id, uint32_t bi
     cpci.stage.pSpecializationInfo = &si;
     cpci.layout = k->layout;
     VK_TRY(vkCreateComputePipelines(v->device, VK_NULL_HANDLE, 1, &cpci, NULL, &k->pipeline));
+    k->images = images;
     k->bindings = bindings;
     k->push_size = push_size;
     k->local_size = local_size;
@@ -260,9 +285,11 @@ static void vk_kernel_destroy(vk_ctx *v, vk_kernel *k)
 }
 
 /* runs k over 'rows' invocations with the given bindings and push data, and waits */
-static int vk_dispatch(vk_ctx *v, const vk_kernel *k, const vk_range *ranges, const void *push, uint32_t rows)
+static int vk_dispatch_images(vk_ctx *v, const vk_kernel *k, const VkImageView *views, const vk_range *ranges, const void *push,
+                              uint32_t rows)
 {
-    VkDescriptorPoolSize ps;
+    VkDescriptorPoolSize ps[2];
+    VkDescriptorImageInfo ii[16];
     VkDescriptorPoolCreateInfo dpci;
     VkDescriptorPool dpool;
     VkDescriptorSetAllocateInfo dsai;
@@ -276,13 +303,15 @@ static int vk_dispatch(vk_ctx *v, const vk_kernel *k, const vk_range *ranges, co
     VkFenceCreateInfo fci;
     VkFence fence;
     uint32_t b;
-    ps.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    ps.descriptorCount = k->bindings;
+    ps[0].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    ps[0].descriptorCount = k->bindings;
+    ps[1].type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    ps[1].descriptorCount = k->images ? k->images : 1;
     memset(&dpci, 0, sizeof(dpci));
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     dpci.maxSets = 1;
-    dpci.poolSizeCount = 1;
-    dpci.pPoolSizes = &ps;
+    dpci.poolSizeCount = 2;
+    dpci.pPoolSizes = ps;
     VK_TRY(vkCreateDescriptorPool(v->device, &dpci, NULL, &dpool));
     memset(&dsai, 0, sizeof(dsai));
     dsai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
@@ -292,13 +321,21 @@ static int vk_dispatch(vk_ctx *v, const vk_kernel *k, const vk_range *ranges, co
     VK_TRY(vkAllocateDescriptorSets(v->device, &dsai, &set));
     memset(w, 0, sizeof(w));
     for (b = 0; b < k->bindings; ++b) {
-        bi[b].buffer = ranges[b].buf->buffer;
-        bi[b].offset = ranges[b].offset;
-        bi[b].range = ranges[b].range ? ranges[b].range : VK_WHOLE_SIZE;
         w[b].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
         w[b].dstSet = set;
         w[b].dstBinding = b;
         w[b].descriptorCount = 1;
+        if (b < k->images) {
+            ii[b].sampler = v->sampler;
+            ii[b].imageView = views[b];
+            ii[b].imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+            w[b].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+            w[b].pImageInfo = &ii[b];
+            continue;
+        }
+        bi[b].buffer = ranges[b].buf->buffer;
+        bi[b].offset = ranges[b].offset;
+        bi[b].range = ranges[b].range ? ranges[b].range : VK_WHOLE_SIZE;
         w[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         w[b].pBufferInfo = &bi[b];
     }
@@ -331,6 +368,127 @@ static int vk_dispatch(vk_ctx *v, const vk_kernel *k, const vk_range *ranges, co
     vkFreeCommandBuffers(v->device, v->pool, 1, &cb);
     vkDestroyDescriptorPool(v->device, dpool, NULL);
     return 1;
+}
+
+static int vk_dispatch(vk_ctx *v, const vk_kernel *k, const vk_range *ranges, const void *push, uint32_t rows)
+{
+    return vk_dispatch_images(v, k, NULL, ranges, push, rows);
+}
+
+/* one-time command buffer: begin / submit and wait */
+static VkCommandBuffer vk_begin(vk_ctx *v)
+{
+    VkCommandBufferAllocateInfo cbai;
+    VkCommandBufferBeginInfo cbbi;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    memset(&cbai, 0, sizeof(cbai));
+    cbai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    cbai.commandPool = v->pool;
+    cbai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cbai.commandBufferCount = 1;
+    if (vkAllocateCommandBuffers(v->device, &cbai, &cb) != VK_SUCCESS) return VK_NULL_HANDLE;
+    memset(&cbbi, 0, sizeof(cbbi));
+    cbbi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    cbbi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    vkBeginCommandBuffer(cb, &cbbi);
+    return cb;
+}
+
+static int vk_submit(vk_ctx *v, VkCommandBuffer cb)
+{
+    VkSubmitInfo sub;
+    VK_TRY(vkEndCommandBuffer(cb));
+    memset(&sub, 0, sizeof(sub));
+    sub.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+    sub.commandBufferCount = 1;
+    sub.pCommandBuffers = &cb;
+    VK_TRY(vkQueueSubmit(v->queue, 1, &sub, VK_NULL_HANDLE));
+    VK_TRY(vkQueueWaitIdle(v->queue));
+    vkFreeCommandBuffers(v->device, v->pool, 1, &cb);
+    return 1;
+}
+
+/* a size x size sampled image of a block-compressed 'format' filled with 'bytes' (the blocks,
+   row-major, as the header stores them), in SHADER_READ_ONLY_OPTIMAL layout */
+static int vk_image_blocks(vk_ctx *v, vk_image *im, VkFormat format, uint32_t size, const void *bytes, size_t nbytes)
+{
+    VkImageCreateInfo ici;
+    VkMemoryRequirements req;
+    VkMemoryAllocateInfo mai;
+    VkImageViewCreateInfo vci;
+    VkImageMemoryBarrier bar;
+    VkBufferImageCopy cp;
+    VkCommandBuffer cb;
+    vk_buf staging;
+    uint32_t t;
+    memset(im, 0, sizeof(*im));
+    memset(&ici, 0, sizeof(ici));
+    ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.format = format;
+    ici.extent.width = size;
+    ici.extent.height = size;
+    ici.extent.depth = 1;
+    ici.mipLevels = 1;
+    ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VK_TRY(vkCreateImage(v->device, &ici, NULL, &im->image));
+    vkGetImageMemoryRequirements(v->device, im->image, &req);
+    memset(&mai, 0, sizeof(mai));
+    mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    mai.allocationSize = req.size;
+    mai.memoryTypeIndex = 0xFFFFFFFFu;
+    for (t = 0; t < v->mem.memoryTypeCount; ++t)
+        if (req.memoryTypeBits & (1u << t)) { mai.memoryTypeIndex = t; break; }
+    if (mai.memoryTypeIndex == 0xFFFFFFFFu) return 0;
+    VK_TRY(vkAllocateMemory(v->device, &mai, NULL, &im->memory));
+    VK_TRY(vkBindImageMemory(v->device, im->image, im->memory, 0));
+    if (!vk_buffer(v, &staging, nbytes, bytes)) return 0;
+    cb = vk_begin(v);
+    if (!cb) { vk_buffer_free(v, &staging); return 0; }
+    memset(&bar, 0, sizeof(bar));
+    bar.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    bar.srcQueueFamilyIndex = bar.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    bar.image = im->image;
+    bar.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    bar.subresourceRange.levelCount = 1;
+    bar.subresourceRange.layerCount = 1;
+    bar.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    bar.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    bar.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1, &bar);
+    memset(&cp, 0, sizeof(cp));
+    cp.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    cp.imageSubresource.layerCount = 1;
+    cp.imageExtent = ici.extent;
+    vkCmdCopyBufferToImage(cb, staging.buffer, im->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &cp);
+    bar.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    bar.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    bar.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    bar.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, NULL, 0, NULL, 1, &bar);
+    t = (uint32_t)vk_submit(v, cb);
+    vk_buffer_free(v, &staging);
+    if (!t) return 0;
+    memset(&vci, 0, sizeof(vci));
+    vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+    vci.image = im->image;
+    vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vci.format = format;
+    vci.subresourceRange = bar.subresourceRange;
+    VK_TRY(vkCreateImageView(v->device, &vci, NULL, &im->view));
+    return 1;
+}
+
+static void vk_image_free(vk_ctx *v, vk_image *im)
+{
+    if (im->view) vkDestroyImageView(v->device, im->view, NULL);
+    if (im->image) vkDestroyImage(v->device, im->image, NULL);
+    if (im->memory) vkFreeMemory(v->device, im->memory, NULL);
+    memset(im, 0, sizeof(*im));
 }
 
 /* a range of 'count' elements of 'elem' bytes starting at element 'first' of b, bound from an
