@@ -918,7 +918,16 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        5: col_perm  6: row_perm  7: outlier offsets (N + 1 uint64)  8: outlier columns
        9: outlier values (3 each)  10: out. Rows are texel rows (chunks of row_offset, row_count
        with row_offset + row_count <= N); the outlier arrays are bound whole (indexed by
-       original row), which limits them to one storage range (N of about 14 000 at 5%). */
+       original row), which limits them to one storage range (N of about 14 000 at 5%).
+   RAD_GLSL_ALIAS_BUILD    alias tables of streamed rows (P-4.3), the bins of
+       rad_alias_build_row (Vose in double: needs the shaderFloat64 feature; bit-identical where
+       double arithmetic is IEEE, as on lavapipe). Push: rad_glsl_alias_build_push; flags
+       RAD_GLSL_FLAG_DENSE (rows of cols values, no column array). 0: input row offsets
+       (rows + 1 uint64)  1: columns  2: values (entry k at k - entry_base)  3: bins out, padded
+       layout: row i's bins from bin row_offsets[i] + i (room for its entries + 1), at word
+       (b - out_base) * words  4: scratch, one double per output bin  5: scratch, one uint per
+       output bin  6: bin count per row (0: a negative or non-finite entry, or a column >= cols)
+       7: T_i per row. Compact the rows (prefix sums of the counts) for RAD_GLSL_TEMPORAL_STEP. */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -928,7 +937,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_MB_APPLY_HALF = 3, /* glsl/mb_apply_half.comp */
     RAD_GLSL_TEMPORAL_STEP = 4, /* glsl/temporal_step.comp */
     RAD_GLSL_MB_APPLY_BLOCKS = 5, /* glsl/mb_apply_blocks.comp */
-    RAD_GLSL_COUNT = 6
+    RAD_GLSL_ALIAS_BUILD = 6, /* glsl/alias_build.comp */
+    RAD_GLSL_COUNT = 7
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -939,6 +949,7 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
 #define RAD_GLSL_FLAG_BC1 4u          /* block apply: one BC1 image (else three BC4 images) */
 #define RAD_GLSL_FLAG_OUTLIERS 8u     /* block apply: the outlier arrays are bound */
+#define RAD_GLSL_FLAG_DENSE 1u        /* alias build: dense rows, no column array */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -968,6 +979,14 @@ typedef struct rad_glsl_mb_blocks_push {
     uint32_t tile, tiles_per_row;  /* rad_multibounce_blocks.tile, .tiles_per_row */
     uint32_t flags;
 } rad_glsl_mb_blocks_push;
+typedef struct rad_glsl_alias_build_push {
+    uint32_t row_offset, row_count;
+    uint32_t cols;                 /* N: the environment's column */
+    uint32_t words;                /* 2 (RAD_ALIAS_COMPACT, cols <= 65535) or 3 (RAD_ALIAS_WIDE) */
+    uint32_t entry_base;           /* low 32 bits of the entry at element 0 of bindings 1, 2 */
+    uint32_t out_base;             /* low 32 bits of the bin at element 0 of bindings 3, 4, 5 */
+    uint32_t flags;                /* RAD_GLSL_FLAG_DENSE */
+} rad_glsl_alias_build_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -5287,6 +5306,9 @@ typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60
 typedef char rad__check_glsl_blocks_push[(sizeof(rad_glsl_mb_blocks_push) == 24 &&
                                           offsetof(rad_glsl_mb_blocks_push, tile) == 12 &&
                                           offsetof(rad_glsl_mb_blocks_push, flags) == 20) ? 1 : -1];
+typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28 &&
+                                         offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
+                                         offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
 
 typedef struct rad__glsl_entry {
     const char *name;
@@ -5621,13 +5643,110 @@ static const char rad__glsl_5_1[] =
     "    outv[3u * i + 2u] = acc.z;\n"
     "}\n";
 static const char *const rad__glsl_pieces_5[] = { rad__glsl_5_0, rad__glsl_5_1 };
+static const char rad__glsl_6_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_ALIAS_BUILD: alias tables of streamed rows built on the GPU\n"
+    "// (SPEC section 8, P-4.3), the same bins as rad_alias_build_row (Vose's robust variant in double, the\n"
+    "// order of operations of the >>api_temporal doc block; bit-identical where double arithmetic is\n"
+    "// IEEE, as on lavapipe), one invocation per row.\n"
+    "// Input rows in CSR form: row i's entries are k = in_off[i] .. in_off[i+1]-1 (uint64, global), at\n"
+    "// element k - entry_base of bindings 1 and 2; flags bit 0 (DENSE): no columns bound, the column\n"
+    "// of entry k is k - in_off[i]. Entries <= 0 are skipped; a negative or non-finite entry or a\n"
+    "// column >= cols makes the row's bin count 0 (the CPU builder returns INVALID_ARGUMENT).\n"
+    "// Output, padded layout: row i gets room for (its entry count + 1) bins starting at bin\n"
+    "// in_off[i] + i (bin b at word (b - out_base) * words of binding 3); counts[i] receives the bins\n"
+    "// written and totals[i] T_i. Binding 4 (double) and 5 (uint) are scratch of one element per\n"
+    "// output bin at the same positions. Needs the shaderFloat64 feature.\n"
+    "// To use the tables with RAD_GLSL_TEMPORAL_STEP, compact them (row offsets = prefix sums of counts).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 in_off[]; }; // rows + 1 uint64\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };    // (not DENSE)\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
+    "layout(std430, set = 0, binding = 3) buffer Bins { uint bins[]; };                   // 2 or 3 words per bin\n"
+    "layout(std430, set = 0, binding = 4) buffer ScratchQ { double q[]; };\n"
+    "layout(std430, set = 0, binding = 5) buffer ScratchStack { uint stack[]; };\n"
+    "layout(std430, set = 0, binding = 6) buffer Counts { uint counts[]; };               // per row (global index)\n"
+    "layout(std430, set = 0, binding = 7) buffer Totals { float totals[]; };              // per row (global index)\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint cols;        // N: the environment's column (COMPACT needs cols <= 65535)\n"
+    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
+    "    uint out_base;    // low 32 bits of the bin index at element 0 of bindings 3, 4 and 5\n"
+    "    uint flags;       // bit 0: DENSE rows (no column array)\n"
+    "} pc;\n"
+    "\n"
+    "void set_bin(uint b, uint threshold, uint col, uint alias_col)\n"
+    "{\n"
+    "    uint w = b * pc.words;\n"
+    "    bins[w] = threshold;\n"
+    "    if (pc.words == 2u) bins[w + 1u] = col | (alias_col << 16u);\n"
+    "    else { bins[w + 1u] = col; bins[w + 2u] = alias_col; }\n"
+    "}\n"
+    "\n"
+    "uint col_of(uint b) { return pc.words == 2u \? (bins[b * 2u + 1u] & 0xFFFFu) : bins[b * 3u + 1u]; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint k0 = in_off[i].x, count = in_off[i + 1u].x - k0;\n"
+    "    uint b0 = k0 + i - pc.out_base;          // this row's first bin (local)\n"
+    "    bool dense = (pc.flags & 1u) != 0u;\n"
+    "    precise double W = 0.0;\n"
+    "    uint n = 0u;\n"
+    "    for (uint e = 0u; e < count; ++e) {\n"
+    "        float v = values[k0 - pc.entry_base + e];\n"
+    "        uint col = dense \? e : columns[k0 - pc.entry_base + e];\n"
+    "        if (isnan(v) || isinf(v) || v < 0.0 || col >= pc.cols) { counts[i] = 0u; totals[i] = 0.0; return; }\n"
+    "        if (v > 0.0) {\n"
+    "            q[b0 + n] = double(v);\n"
+    "            set_bin(b0 + n, 0xFFFFFFFFu, col, col);\n"
+    "            W += double(v);\n"
+    "            ++n;\n"
+    "        }\n"
+    "    }\n"
+    "    precise double env = 1.0 - W;\n"
+    "    double total = W;\n"
+    "    if (env > 0.0) {\n"
+    "        q[b0 + n] = env;\n"
+    "        set_bin(b0 + n, 0xFFFFFFFFu, pc.cols, pc.cols);\n"
+    "        ++n;\n"
+    "        total = 1.0;\n"
+    "    }\n"
+    "    W += env > 0.0 \? env : 0.0;\n"
+    "    // Vose, robust variant: Small grows up from stack[0], Large down from stack[n-1]\n"
+    "    uint small_top = 0u, large_bottom = n;\n";
+static const char rad__glsl_6_1[] =
+    "    for (uint b = 0u; b < n; ++b) {\n"
+    "        precise double qb = double(n) * q[b0 + b] / W;\n"
+    "        q[b0 + b] = qb;\n"
+    "        if (qb < 1.0) stack[b0 + small_top++] = b;\n"
+    "        else stack[b0 + --large_bottom] = b;\n"
+    "    }\n"
+    "    while (small_top > 0u && large_bottom < n) {\n"
+    "        uint l = stack[b0 + --small_top], g = stack[b0 + large_bottom++];\n"
+    "        precise double p = q[b0 + l] * 4294967296.0 + 0.5;\n"
+    "        set_bin(b0 + l, p >= 4294967295.0 \? 0xFFFFFFFFu : uint(p), col_of(b0 + l), col_of(b0 + g));\n"
+    "        precise double qg = (q[b0 + g] + q[b0 + l]) - 1.0;\n"
+    "        q[b0 + g] = qg;\n"
+    "        if (qg < 1.0) stack[b0 + small_top++] = g;\n"
+    "        else stack[b0 + --large_bottom] = g;\n"
+    "    }\n"
+    "    counts[i] = n;\n"
+    "    totals[i] = float(total);\n"
+    "}\n";
+static const char *const rad__glsl_pieces_6[] = { rad__glsl_6_0, rad__glsl_6_1 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 1844u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2221u },
     { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2353u },
     { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2104u },
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4173u },
-    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4118u }
+    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4118u },
+    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4725u }
 };
 /* >>glsl end */
 

@@ -27,6 +27,7 @@ static const kernel kernels[] = {
     { "RAD_GLSL_MB_APPLY_HALF", "glsl/mb_apply_half.comp" },
     { "RAD_GLSL_TEMPORAL_STEP", "glsl/temporal_step.comp" },
     { "RAD_GLSL_MB_APPLY_BLOCKS", "glsl/mb_apply_blocks.comp" },
+    { "RAD_GLSL_ALIAS_BUILD", "glsl/alias_build.comp" },
 };
 #define KERNELS (sizeof(kernels) / sizeof(kernels[0]))
 

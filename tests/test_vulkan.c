@@ -592,6 +592,117 @@ done:
     free(F); free(E); free(rho);
 }
 
+/* ---- alias-table build for streamed rows ----------------------------------------------------- */
+
+static void test_alias_build(void)
+{
+    const uint32_t n = 97;
+    float *F = random_matrix(n, 0.2f);
+    csr c;
+    rad_matrix m;
+    uint64_t *padded_off = NULL;
+    uint32_t *cpu_bins = NULL;
+    void *scratch = NULL;
+    int fmt, dense, ls;
+    uint32_t i, j;
+    memset(&c, 0, sizeof(c));
+    if (!F) { T_CHECK(0); return; }
+    if (!g_vk.fp64) { printf("    FAIL the device has no shaderFloat64\n"); T_CHECK(0); free(F); return; }
+    g_worst_what = "rows whose bins differ from rad_alias_build_row";
+    /* rows of every kind: empty (only the environment bin), summing to more than 1 (no
+       environment bin), a single entry */
+    for (j = 0; j < n; ++j) { F[3 * n + j] = 0.0f; F[5 * n + j] *= 3.0f; }
+    for (j = 0; j < n; ++j) F[7 * n + j] = j == 11 ? 0.25f : 0.0f;
+    m = make_csr(F, n, &c);
+    cpu_bins = (uint32_t *)malloc(3 * ((size_t)n + 1) * sizeof(uint32_t));
+    scratch = malloc(rad_alias_row_scratch_size(n));
+    padded_off = (uint64_t *)malloc(((size_t)n + 1) * sizeof(uint64_t));
+    if (!m.rows || !cpu_bins || !scratch || !padded_off) { T_CHECK(0); goto done; }
+    for (dense = 0; dense < 2; ++dense) {
+        /* input offsets: CSR, or dense rows (entry k of row i at i * n + k) */
+        const uint64_t *in_off;
+        for (i = 0; i <= n; ++i) padded_off[i] = (uint64_t)i * n;
+        in_off = dense ? padded_off : c.off;
+        for (fmt = 0; fmt < 2; ++fmt)
+            for (ls = 0; ls < 2; ++ls) {
+                const uint32_t words = fmt ? 3u : 2u;
+                const uint64_t entries = in_off[n], out_bins = entries + n;
+                vk_kernel k;
+                vk_buf bOff, bCol, bVal, bBins, bQ, bS, bCnt, bTot;
+                uint32_t cut[4], q, zero = 0;
+                int ok = 1;
+                if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_ALIAS_BUILD, 0, 8, (uint32_t)sizeof(rad_glsl_alias_build_push), g_local_sizes[ls])) {
+                    T_CHECK(0); goto done;
+                }
+                ok &= vk_buffer(&g_vk, &bOff, ((size_t)n + 1) * 8, in_off);
+                ok &= vk_buffer(&g_vk, &bCol, dense ? 4 : entries * 4, dense ? (const void *)&zero : (const void *)c.col);
+                ok &= vk_buffer(&g_vk, &bVal, entries * 4, dense ? (const void *)F : (const void *)c.val);
+                ok &= vk_buffer(&g_vk, &bBins, out_bins * words * 4, NULL);
+                ok &= vk_buffer(&g_vk, &bQ, out_bins * 8, NULL);
+                ok &= vk_buffer(&g_vk, &bS, out_bins * 4, NULL);
+                ok &= vk_buffer(&g_vk, &bCnt, (size_t)n * 4, NULL);
+                ok &= vk_buffer(&g_vk, &bTot, (size_t)n * 4, NULL);
+                chunks(n, cut);
+                for (q = 0; q < 3 && ok; ++q) {
+                    rad_glsl_alias_build_push p;
+                    vk_range r[8];
+                    uint32_t ebase = 0, obase = 0, dummy = 0;
+                    uint64_t e0 = in_off[cut[q]], e1 = in_off[cut[q + 1]], o0 = e0 + cut[q], o1 = e1 + cut[q + 1];
+                    if (cut[q + 1] == cut[q]) continue;
+                    r[0] = vk_whole(&bOff);
+                    r[1] = dense ? vk_whole(&bCol) : vk_chunk(&g_vk, &bCol, 4, e0, e1 - e0, &ebase);
+                    r[2] = vk_chunk(&g_vk, &bVal, 4, e0, e1 - e0, &ebase);
+                    /* the three outputs must start at the same bin: bind them from a bin that
+                       all three alignments allow (a multiple of 16 bins is 16-byte aligned
+                       for 4-, 8- and 12-byte elements alike when the alignment is <= 64) */
+                    r[3] = vk_chunk(&g_vk, &bBins, (VkDeviceSize)words * 4, o0 / 16 * 16, o1 - o0 / 16 * 16, &dummy);
+                    r[4] = vk_chunk(&g_vk, &bQ, 8, o0 / 16 * 16, o1 - o0 / 16 * 16, &obase);
+                    r[5] = vk_chunk(&g_vk, &bS, 4, o0 / 16 * 16, o1 - o0 / 16 * 16, &dummy);
+                    r[6] = vk_whole(&bCnt);
+                    r[7] = vk_whole(&bTot);
+                    p.row_offset = cut[q];
+                    p.row_count = cut[q + 1] - cut[q];
+                    p.cols = n;
+                    p.words = words;
+                    p.entry_base = (uint32_t)e0 - ebase;
+                    p.out_base = (uint32_t)(o0 / 16 * 16);
+                    p.flags = dense ? RAD_GLSL_FLAG_DENSE : 0u;
+                    if (r[3].offset != (o0 / 16 * 16) * words * 4 || r[4].offset != (o0 / 16 * 16) * 8 || obase != 0) {
+                        printf("    alignment %lu too coarse for this test\n", (unsigned long)g_vk.props.limits.minStorageBufferOffsetAlignment);
+                        ok = 0;
+                        break;
+                    }
+                    ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+                }
+                T_CHECK(ok);
+                for (i = 0; i < n && ok; ++i) {
+                    uint32_t cnt = 0;
+                    float total = 0.0f;
+                    const uint32_t *gb = (const uint32_t *)bBins.map + (in_off[i] + i) * words;
+                    rad_result res = dense ? rad_alias_build_row(NULL, F + (size_t)i * n, n, n, fmt ? RAD_ALIAS_WIDE : RAD_ALIAS_COMPACT,
+                                                                 cpu_bins, &cnt, &total, scratch)
+                                           : rad_alias_build_row(c.col + c.off[i], c.val + c.off[i], (uint32_t)(c.off[i + 1] - c.off[i]), n,
+                                                                 fmt ? RAD_ALIAS_WIDE : RAD_ALIAS_COMPACT, cpu_bins, &cnt, &total, scratch);
+                    T_CHECK(res == RAD_SUCCESS);
+                    if (((const uint32_t *)bCnt.map)[i] != cnt || ((const float *)bTot.map)[i] != total ||
+                        memcmp(gb, cpu_bins, (size_t)cnt * words * 4) != 0) {
+                        printf("    FAIL alias build (%s, %s) row %u: %u bins (cpu %u), T %.9g (cpu %.9g)%s\n", dense ? "dense" : "csr",
+                               fmt ? "wide" : "compact", i, ((const uint32_t *)bCnt.map)[i], cnt, (double)((const float *)bTot.map)[i],
+                               (double)total, ((const uint32_t *)bCnt.map)[i] == cnt ? ", bins differ" : "");
+                        g_checks_failed++;
+                        g_worst += 1.0;
+                        break;
+                    }
+                }
+                vk_buffer_free(&g_vk, &bOff); vk_buffer_free(&g_vk, &bCol); vk_buffer_free(&g_vk, &bVal); vk_buffer_free(&g_vk, &bBins);
+                vk_buffer_free(&g_vk, &bQ); vk_buffer_free(&g_vk, &bS); vk_buffer_free(&g_vk, &bCnt); vk_buffer_free(&g_vk, &bTot);
+                vk_kernel_destroy(&g_vk, &k);
+            }
+    }
+done:
+    free(F); free(c.off); free(c.col); free(c.val); free(cpu_bins); free(scratch); free(padded_off);
+}
+
 /* ---- the harness ---------------------------------------------------------------------------- */
 
 typedef struct vk_test { const char *name; void (*fn)(void); } vk_test;
@@ -601,6 +712,7 @@ static const vk_test g_tests[] = {
     { "vk_mb_apply_float_half_permuted", test_mb_apply },
     { "vk_temporal_step", test_temporal },
     { "vk_mb_apply_bc1_bc4_outliers_permuted", test_mb_blocks },
+    { "vk_alias_build_streamed_rows", test_alias_build },
     { NULL, NULL }
 };
 

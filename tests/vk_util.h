@@ -19,6 +19,7 @@ typedef struct vk_ctx {
     VkPhysicalDeviceProperties props;
     VkPhysicalDeviceMemoryProperties mem;
     int bc;              /* textureCompressionBC enabled */
+    int fp64;            /* shaderFloat64 enabled */
     VkSampler sampler;   /* nearest, for texelFetch */
     char workdir[512];   /* where .comp and .spv files go */
 } vk_ctx;
@@ -95,7 +96,9 @@ static int vk_init(vk_ctx *v, const char *workdir)
     vkGetPhysicalDeviceFeatures(v->phys, &have);
     memset(&want, 0, sizeof(want));
     want.textureCompressionBC = have.textureCompressionBC;
+    want.shaderFloat64 = have.shaderFloat64;
     v->bc = have.textureCompressionBC == VK_TRUE;
+    v->fp64 = have.shaderFloat64 == VK_TRUE;
     memset(&dci, 0, sizeof(dci));
     dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
     dci.queueCreateInfoCount = 1;
