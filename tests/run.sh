@@ -125,6 +125,13 @@ if vk_ready; then
         else sed 's/^/    /' "$BUILD/glslang.log" | head -20; fail "glslang $f"; fi
     done
     unit vulkan-kernels $CC -std=c99 $WARN -O2 -I. tests/test_vulkan.c -lvulkan
+    if build vulkan-example $CC -std=c99 $WARN -O2 -I. examples/vulkan_temporal.c -o "$BUILD/vulkan_temporal" -lvulkan -lm &&
+       "$BUILD/vulkan_temporal" --patches 200 --frames 30 --tmp "$BUILD" >"$BUILD/vulkan-example.out" 2>&1; then
+        pass "vulkan-example ($(tail -n 1 "$BUILD/vulkan-example.out"))"
+    else
+        tail -n 20 "$BUILD/vulkan-example.out" 2>/dev/null | sed 's/^/    /'
+        fail vulkan-example
+    fi
 else
     skip vulkan "no Vulkan headers, Vulkan driver or glslangValidator (packages mesa-vulkan-drivers libvulkan-dev glslang-tools)"
 fi
