@@ -78,9 +78,10 @@
        7. RAY QUERIES              the callback table, the built-in BVH, self-intersection
        8. EMBREE                   the optional Embree 3 backend
        9. BAKED DATA               the container format
-      10. NUMERICAL ROBUSTNESS     epsilons, singularities, validation
-      11. WHAT radiosity.h DOES NOT DO
-      12. HISTORY
+      10. GLSL                     compute kernels for the GPU, as source text
+      11. NUMERICAL ROBUSTNESS     epsilons, singularities, validation
+      12. WHAT radiosity.h DOES NOT DO
+      13. HISTORY
 
    1. OPTIONS
        macro                      default            where to set it
@@ -197,7 +198,23 @@
        RAD_ERROR_INDEX_OUT_OF_RANGE; nothing is read outside the given bytes. Applications add
        their own sections (types >= RAD_SECTION_USER) through rad_container_write.
 
-  10. NUMERICAL ROBUSTNESS
+  10. GLSL
+       The GPU paths are GLSL 4.50 compute kernels embedded as text (SPEC §10): get one with
+       rad_glsl_source(RAD_GLSL_TEMPORAL_STEP, buf, size, &len) (or rad_glsl_pieces), compile
+       it with glslang or shaderc and dispatch it on your own Vulkan device; radiosity.h never
+       touches a GPU. Kernels: dense and CSR gather (one bounce), multi-bounce apply from
+       float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
+       step (the same random draws as the CPU) and the alias-table build for streamed rows.
+       Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
+       push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
+       specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), one invocation per row, and
+       row_offset / row_count / base in every kernel so a matrix larger than one storage-buffer
+       range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
+       sources: the .comp files in glsl/ of the repository (make glsl regenerates the header's copy);
+       tests/test_vulkan.c runs every kernel against the CPU path; examples/vulkan_temporal.c
+       is a complete program.
+
+  11. NUMERICAL ROBUSTNESS
        - rad_scene_create validates everything: NaN/Inf positions or normals, indices out of
          range, zero-area triangles (rejected, or skipped and counted with
          RAD_SCENE_SKIP_DEGENERATE), albedo outside [0,1), negative or non-finite emission,
@@ -216,13 +233,13 @@
        - The polygon kernel clips the receiver to the sample point's upper half-space and
          returns 0 when the point is behind the receiver, so there is no sign ambiguity.
 
-  11. WHAT radiosity.h DOES NOT DO
+  12. WHAT radiosity.h DOES NOT DO
        - Specular or glossy transport: radiosity is diffuse light exchange.
        - Parse scene files: meshes come in as arrays (tools/rad imports OBJ, glTF, FBX, PLY
          through assimp).
        - Start threads, touch the GPU itself, or keep global state.
 
-  12. HISTORY
+  13. HISTORY
        0.1.0  scene input and validation, patches, built-in BVH (4-wide, SSE), Embree
               backend, form factors (analytic, Monte Carlo, point-to-point; dense, sparse,
               row ranges), Jacobi, Gauss-Seidel, progressive refinement, LU; direct light;
