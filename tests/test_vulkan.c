@@ -12,6 +12,7 @@
 #include "../radiosity.h"
 #include "vk_util.h"
 #include <math.h>
+#include <stddef.h>
 
 static int g_passed, g_failed, g_checks_failed;
 static double g_worst; /* largest relative error of the current test */
@@ -703,10 +704,99 @@ done:
     free(F); free(c.off); free(c.col); free(c.val); free(cpu_bins); free(scratch); free(padded_off);
 }
 
+/* ---- the C mirrors of the push-constant blocks, against the compiled SPIR-V ------------------ */
+
+/* member names and byte offsets of the push-constant block of a SPIR-V module (from OpMemberName
+   and OpMemberDecorate Offset); returns the member count, or -1 */
+static int spirv_push_block(const uint32_t *code, size_t words, char names[24][32], uint32_t offsets[24])
+{
+    size_t at;
+    uint32_t ptr = 0, block = 0;
+    int count = 0;
+    if (words < 5 || code[0] != 0x07230203u) return -1;
+    for (at = 5; at < words; at += code[at] >> 16) /* OpVariable %ptr %id PushConstant */
+        if ((code[at] >> 16) == 0) return -1;
+        else if ((code[at] & 0xFFFFu) == 59u && code[at + 3] == 9u) ptr = code[at + 1];
+    for (at = 5; at < words; at += code[at] >> 16) /* OpTypePointer %ptr PushConstant %block */
+        if ((code[at] & 0xFFFFu) == 32u && code[at + 1] == ptr) block = code[at + 3];
+    if (!ptr || !block) return -1;
+    for (at = 5; at < words; at += code[at] >> 16) {
+        uint32_t op = code[at] & 0xFFFFu, len = code[at] >> 16;
+        if (op == 6u && code[at + 1] == block && code[at + 2] < 24u) { /* OpMemberName */
+            snprintf(names[code[at + 2]], 32, "%.*s", (int)((len - 3) * 4), (const char *)(code + at + 3));
+            if ((int)code[at + 2] + 1 > count) count = (int)code[at + 2] + 1;
+        }
+        if (op == 72u && code[at + 1] == block && code[at + 3] == 35u && code[at + 2] < 24u) /* Offset */
+            offsets[code[at + 2]] = code[at + 4];
+    }
+    return count;
+}
+
+typedef struct mirror_member { const char *name; size_t offset; } mirror_member;
+
+static void check_mirror(rad_glsl_id id, const mirror_member *m, size_t size)
+{
+    size_t words = 0;
+    uint32_t *code = vk_compile(&g_vk, id, &words), offsets[24];
+    char names[24][32];
+    int count, i;
+    memset(names, 0, sizeof(names));
+    memset(offsets, 0xFF, sizeof(offsets));
+    if (!code) { T_CHECK(0); return; }
+    count = spirv_push_block(code, words, names, offsets);
+    free(code);
+    if (count <= 0) { printf("    FAIL %s: no push-constant block found in the SPIR-V\n", rad_glsl_name(id)); g_checks_failed++; return; }
+    for (i = 0; m[i].name; ++i) {
+        if (i >= count || strcmp(names[i], m[i].name) != 0 || offsets[i] != m[i].offset) {
+            printf("    FAIL %s: member %d is '%s' at %u in GLSL, the C mirror has '%s' at %lu\n", rad_glsl_name(id), i,
+                   i < count ? names[i] : "(none)", i < count ? offsets[i] : 0u, m[i].name, (unsigned long)m[i].offset);
+            g_checks_failed++;
+            return;
+        }
+    }
+    /* every GLSL member mirrored, and the C struct ends where the last (4-byte) member does */
+    T_CHECK(i == count && offsets[count - 1] + 4u == size);
+    if (size > g_worst) g_worst = (double)size;
+}
+
+#define MM(type, field) { #field, offsetof(type, field) }
+static void test_push_mirrors(void)
+{
+    static const mirror_member dense[] = { MM(rad_glsl_gather_dense_push, row_offset), MM(rad_glsl_gather_dense_push, row_count),
+        MM(rad_glsl_gather_dense_push, cols), MM(rad_glsl_gather_dense_push, f_base), MM(rad_glsl_gather_dense_push, flags), { NULL, 0 } };
+    static const mirror_member sparse[] = { MM(rad_glsl_gather_csr_push, row_offset), MM(rad_glsl_gather_csr_push, row_count),
+        MM(rad_glsl_gather_csr_push, entry_base), MM(rad_glsl_gather_csr_push, flags), { NULL, 0 } };
+    static const mirror_member mb[] = { MM(rad_glsl_mb_apply_push, n), MM(rad_glsl_mb_apply_push, row_offset),
+        MM(rad_glsl_mb_apply_push, row_count), MM(rad_glsl_mb_apply_push, base), MM(rad_glsl_mb_apply_push, flags), { NULL, 0 } };
+    static const mirror_member temporal[] = { MM(rad_glsl_temporal_push, seed), MM(rad_glsl_temporal_push, frame),
+        MM(rad_glsl_temporal_push, row_offset), MM(rad_glsl_temporal_push, row_count), MM(rad_glsl_temporal_push, n),
+        MM(rad_glsl_temporal_push, samples), MM(rad_glsl_temporal_push, words), MM(rad_glsl_temporal_push, flags),
+        MM(rad_glsl_temporal_push, channel), MM(rad_glsl_temporal_push, sample_base), MM(rad_glsl_temporal_push, word_base),
+        MM(rad_glsl_temporal_push, weight), { "env_r", offsetof(rad_glsl_temporal_push, env) },
+        { "env_g", offsetof(rad_glsl_temporal_push, env) + 4 }, { "env_b", offsetof(rad_glsl_temporal_push, env) + 8 }, { NULL, 0 } };
+    static const mirror_member blocks[] = { MM(rad_glsl_mb_blocks_push, n), MM(rad_glsl_mb_blocks_push, row_offset),
+        MM(rad_glsl_mb_blocks_push, row_count), MM(rad_glsl_mb_blocks_push, tile), MM(rad_glsl_mb_blocks_push, tiles_per_row),
+        MM(rad_glsl_mb_blocks_push, flags), { NULL, 0 } };
+    static const mirror_member alias[] = { MM(rad_glsl_alias_build_push, row_offset), MM(rad_glsl_alias_build_push, row_count),
+        MM(rad_glsl_alias_build_push, cols), MM(rad_glsl_alias_build_push, words), MM(rad_glsl_alias_build_push, entry_base),
+        MM(rad_glsl_alias_build_push, out_base), MM(rad_glsl_alias_build_push, flags), { NULL, 0 } };
+    g_worst_what = "push-constant block, bytes";
+    check_mirror(RAD_GLSL_GATHER_DENSE, dense, sizeof(rad_glsl_gather_dense_push));
+    check_mirror(RAD_GLSL_GATHER_CSR, sparse, sizeof(rad_glsl_gather_csr_push));
+    check_mirror(RAD_GLSL_MB_APPLY_FLOAT, mb, sizeof(rad_glsl_mb_apply_push));
+    check_mirror(RAD_GLSL_MB_APPLY_HALF, mb, sizeof(rad_glsl_mb_apply_push));
+    check_mirror(RAD_GLSL_TEMPORAL_STEP, temporal, sizeof(rad_glsl_temporal_push));
+    check_mirror(RAD_GLSL_MB_APPLY_BLOCKS, blocks, sizeof(rad_glsl_mb_blocks_push));
+    check_mirror(RAD_GLSL_ALIAS_BUILD, alias, sizeof(rad_glsl_alias_build_push));
+    /* every kernel has a mirror above: a new kernel must be added here */
+    T_CHECK(RAD_GLSL_COUNT == 7);
+}
+
 /* ---- the harness ---------------------------------------------------------------------------- */
 
 typedef struct vk_test { const char *name; void (*fn)(void); } vk_test;
 static const vk_test g_tests[] = {
+    { "vk_push_constant_mirrors", test_push_mirrors },
     { "vk_gather_dense", test_gather_dense },
     { "vk_gather_csr", test_gather_csr },
     { "vk_mb_apply_float_half_permuted", test_mb_apply },
