@@ -207,8 +207,9 @@
        step (the same random draws as the CPU) and the alias-table build for streamed rows.
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
-       specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), one invocation per row, and
-       row_offset / row_count / base in every kernel so a matrix larger than one storage-buffer
+       specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), a workgroup (gathers, applies) or
+       an invocation (temporal step, alias build) per row, and row_offset / row_count / base in
+       every kernel so a matrix larger than one storage-buffer
        range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
        sources: the .comp files in glsl/ of the repository (make glsl regenerates the header's copy);
        tests/test_vulkan.c runs every kernel against the CPU path; examples/vulkan_temporal.c
@@ -888,9 +889,13 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
      little-endian layout of rad_matrix.row_offsets and rad_alias_tables.row_offsets, uploaded
      unchanged). RGB vectors are 3N interleaved floats, as everywhere in radiosity.h.
    - Workgroup: layout(local_size_x_id = 0): specialization constant RAD_GLSL_SPEC_LOCAL_SIZE
-     (id 0) sets the x size (default 1 when not specialized; 64 or 128 are good choices). One
-     invocation per row: dispatch ceil(row_count / local_size) groups in x. Nothing depends on
-     the subgroup size.
+     (id 0) sets the x size (default 1 when not specialized; 64 to 256 are good choices, any
+     size up to maxComputeWorkGroupInvocations works). Nothing depends on the subgroup size.
+   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*) run ONE WORKGROUP PER ROW:
+     dispatch row_count groups in x (at most maxComputeWorkGroupCount[0], 65535 guaranteed:
+     chunk longer runs); the group's invocations read the row at consecutive addresses with a
+     stride of the group size and sum in shared memory (12 bytes per invocation). The temporal
+     step and the alias build run ONE INVOCATION PER ROW: ceil(row_count / size) groups.
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
      checked at compile time).
@@ -5341,7 +5346,9 @@ static const char rad__glsl_0_0[] =
     "// radiosity.h kernel RAD_GLSL_GATHER_DENSE: one classic bounce with a dense form-factor matrix,\n"
     "//   out_i = rho_i * sum_j F_ij E_j            (flags bit 0 clear: RAD_OUTPUT_INDIRECT)\n"
     "//   out_i = E_i + rho_i * sum_j F_ij E_j      (flags bit 0 set:   RAD_OUTPUT_TOTAL)\n"
-    "// for rows i = row_offset .. row_offset + row_count - 1, one invocation per row (RGB).\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1. ONE WORKGROUP PER ROW: dispatch\n"
+    "// row_count groups; the invocations of a group read the row with a stride of the group size\n"
+    "// (consecutive invocations read consecutive columns) and sum in shared memory.\n"
     "// Chunking: binding 0 holds the rows of this chunk only; F_ij is F[f_base + (i - row_offset) * cols + j],\n"
     "// so a matrix larger than one storage-buffer range runs as several dispatches.\n"
     "layout(local_size_x_id = 0) in;\n"
@@ -5351,24 +5358,35 @@ static const char rad__glsl_0_0[] =
     "layout(std430, set = 0, binding = 3) buffer Output { float outv[]; };             // 3 N\n"
     "layout(push_constant) uniform Push {\n"
     "    uint row_offset;  // first row of this dispatch (global index)\n"
-    "    uint row_count;   // rows in this dispatch\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
     "    uint cols;        // N\n"
     "    uint f_base;      // element of binding 0 that holds F[row_offset][0]\n"
     "    uint flags;       // bit 0: add E (total)\n"
     "} pc;\n"
     "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
     "void main()\n"
     "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;               // the whole group: barriers stay uniform\n"
     "    uint i = pc.row_offset + r;\n"
     "    uint at = pc.f_base + r * pc.cols;\n"
     "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint j = 0u; j < pc.cols; ++j) {\n"
+    "    for (uint j = lid; j < pc.cols; j += gl_WorkGroupSize.x) {\n"
     "        float f = F[at + j];\n"
     "        acc += f * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
     "    }\n"
-    "    precise vec3 o = acc * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {   // any group size, no subgroup assumption\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -5379,7 +5397,8 @@ static const char rad__glsl_1_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_GATHER_CSR: one classic bounce with a CSR (sparse) form-factor matrix,\n"
     "//   out_i = rho_i * sum_k values[k] E_columns[k]  (+ E_i when flags bit 0 is set)\n"
-    "// for rows i = row_offset .. row_offset + row_count - 1, one invocation per row (RGB).\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1, ONE WORKGROUP PER ROW (dispatch\n"
+    "// row_count groups; the group strides over the row's entries and sums in shared memory).\n"
     "// Binding 0 holds all N + 1 row offsets as uint64 (two uint words each, low word first, as\n"
     "// rad_matrix.row_offsets stores them). Chunking: bindings 1 and 2 may hold only the entries of\n"
     "// this chunk's rows; entry k of the matrix is element k - entry_base of them (entry_base = the\n"
@@ -5393,24 +5412,35 @@ static const char rad__glsl_1_0[] =
     "layout(std430, set = 0, binding = 5) buffer Output { float outv[]; };             // 3 N\n"
     "layout(push_constant) uniform Push {\n"
     "    uint row_offset;  // first row of this dispatch (global index)\n"
-    "    uint row_count;   // rows in this dispatch\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
     "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
     "    uint flags;       // bit 0: add E (total)\n"
     "} pc;\n"
     "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
     "void main()\n"
     "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
     "    if (r >= pc.row_count) return;\n"
     "    uint i = pc.row_offset + r;\n"
     "    uint k0 = row_offsets[i].x - pc.entry_base;       // wraps correctly: only the difference matters\n"
-    "    uint k1 = row_offsets[i + 1u].x - pc.entry_base;\n"
+    "    uint count = row_offsets[i + 1u].x - row_offsets[i].x;\n"
     "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint k = k0; k != k1; ++k) {\n"
-    "        uint j = columns[k];\n"
-    "        acc += values[k] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
+    "    for (uint e = lid; e < count; e += gl_WorkGroupSize.x) {\n"
+    "        uint j = columns[k0 + e];\n"
+    "        acc += values[k0 + e] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
     "    }\n"
-    "    precise vec3 o = acc * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -5423,7 +5453,8 @@ static const char rad__glsl_2_0[] =
     "// (rad_multibounce with precision RAD_MB_FLOAT). Plane row i' (permuted order) is original row\n"
     "// row_perm[i'], plane column j' is original column col_perm[j'] (identity when flags bit 1 is clear):\n"
     "//   out[row_perm[i']] = sum_j' plane_c[i'][j'] * E[col_perm[j']]  (+ E[row_perm[i']] when flags bit 0)\n"
-    "// for plane rows i' = row_offset .. row_offset + row_count - 1, one invocation per row, channels c = R, G, B.\n"
+    "// for plane rows i' = row_offset .. row_offset + row_count - 1, channels c = R, G, B.\n"
+    "// ONE WORKGROUP PER ROW: dispatch row_count groups; the group strides over the columns.\n"
     "// Chunking: bindings 0..2 may hold only this chunk's rows; entry (i', j') of plane c is element\n"
     "// base + (i' - row_offset) * n + j' of binding c.\n"
     "layout(local_size_x_id = 0) in;\n"
@@ -5437,30 +5468,40 @@ static const char rad__glsl_2_0[] =
     "layout(push_constant) uniform Push {\n"
     "    uint n;           // N\n"
     "    uint row_offset;  // first plane row of this dispatch\n"
-    "    uint row_count;   // rows in this dispatch\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
     "    uint base;        // element of bindings 0..2 that holds plane row row_offset, column 0\n"
     "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
     "} pc;\n"
     "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
     "void main()\n"
     "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
     "    if (r >= pc.row_count) return;\n"
     "    bool perm = (pc.flags & 2u) != 0u;\n"
     "    uint ip = pc.row_offset + r;\n"
     "    uint at = pc.base + r * pc.n;\n"
-    "    precise float sr = 0.0, sg = 0.0, sb = 0.0;\n"
-    "    for (uint j = 0u; j < pc.n; ++j) {\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
     "        uint e = 3u * (perm \? col_perm[j] : j);\n"
-    "        sr += R[at + j] * E[e];\n"
-    "        sg += G[at + j] * E[e + 1u];\n"
-    "        sb += B[at + j] * E[e + 2u];\n"
+    "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
     "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
     "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    if ((pc.flags & 1u) != 0u) { sr += E[o]; sg += E[o + 1u]; sb += E[o + 2u]; }\n"
-    "    outv[o] = sr;\n"
-    "    outv[o + 1u] = sg;\n"
-    "    outv[o + 2u] = sb;\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
     "}\n";
 static const char *const rad__glsl_pieces_2[] = { rad__glsl_2_0 };
 static const char rad__glsl_3_0[] =
@@ -5468,8 +5509,8 @@ static const char rad__glsl_3_0[] =
     "// radiosity.h kernel RAD_GLSL_MB_APPLY_HALF: the multi-bounce apply L = F_mb E with IEEE binary16\n"
     "// planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint\n"
     "// word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage\n"
-    "// feature is needed. Same bindings, push constants, permutations and chunking as\n"
-    "// RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may be odd).\n"
+    "// feature is needed. Same bindings, push constants, permutations, dispatch (one workgroup per\n"
+    "// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may be odd).\n"
     "layout(local_size_x_id = 0) in;\n"
     "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { uint R[]; };\n"
     "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { uint G[]; };\n"
@@ -5486,34 +5527,46 @@ static const char rad__glsl_3_0[] =
     "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
     "} pc;\n"
     "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
     "float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u \? v.y : v.x; }\n"
     "\n"
     "void main()\n"
     "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
     "    if (r >= pc.row_count) return;\n"
     "    bool perm = (pc.flags & 2u) != 0u;\n"
     "    uint ip = pc.row_offset + r;\n"
     "    uint at = pc.base + r * pc.n;\n"
-    "    precise float sr = 0.0, sg = 0.0, sb = 0.0;\n"
-    "    for (uint j = 0u; j < pc.n; ++j) {\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
     "        uint e = 3u * (perm \? col_perm[j] : j), h = at + j;\n"
-    "        sr += half_at(R[h >> 1u], h) * E[e];\n"
-    "        sg += half_at(G[h >> 1u], h) * E[e + 1u];\n"
-    "        sb += half_at(B[h >> 1u], h) * E[e + 2u];\n"
+    "        vec3 f = vec3(half_at(R[h >> 1u], h), half_at(G[h >> 1u], h), half_at(B[h >> 1u], h));\n"
+    "        acc += f * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
     "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
     "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    if ((pc.flags & 1u) != 0u) { sr += E[o]; sg += E[o + 1u]; sb += E[o + 2u]; }\n"
-    "    outv[o] = sr;\n"
-    "    outv[o + 1u] = sg;\n"
-    "    outv[o + 2u] = sb;\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
     "}\n";
 static const char *const rad__glsl_pieces_3[] = { rad__glsl_3_0 };
 static const char rad__glsl_4_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_TEMPORAL_STEP: one frame of temporal radiosity (rad_temporal_step\n"
     "// with a fixed weight), drawing exactly the indices the CPU draws: the counter-based generator\n"
-    "// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. Per row i:\n"
+    "// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. One invocation per row i\n"
+    "// (dispatch ceil(row_count / group size) groups):\n"
     "//   acc = 0; for s = 0..k-1: J = draw(sample = sample_base + s); acc += V_J\n"
     "//   X = acc * (T_i / k); X *= rho_i (flags bit 0); B_i = w B_i^prev + (1 - w) X\n"
     "// V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).\n"
@@ -5580,10 +5633,10 @@ static const char rad__glsl_4_0[] =
     "        else j = u2 < bins[w] \? bins[w + 1u] : bins[w + 2u];\n"
     "        for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);\n"
     "    }\n"
-    "    precise float scale = totals[i] / float(pc.samples);\n"
-    "    for (uint c = c0; c <= c1; ++c) {\n"
-    "        precise float x = acc[c] * scale;\n";
+    "    precise float scale = totals[i] / float(pc.samples);\n";
 static const char rad__glsl_4_1[] =
+    "    for (uint c = c0; c <= c1; ++c) {\n"
+    "        precise float x = acc[c] * scale;\n"
     "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n"
     "        precise float b = pc.weight * Bprev[3u * i + c] + (1.0 - pc.weight) * x;\n"
     "        Bnext[3u * i + c] = b;\n"
@@ -5599,7 +5652,9 @@ static const char rad__glsl_5_0[] =
     "//   out[row_perm[y]] = sum_x decoded(x, y) * scale(tile of x, y) * E[col_perm[x]]\n"
     "//                      + sum over the outliers of original row row_perm[y] of value * E[column]\n"
     "//                      (+ E[row_perm[y]] when flags bit 0 is set)\n"
-    "// for texel rows y = row_offset .. row_offset + row_count - 1, one invocation per row, RGB.\n"
+    "// for texel rows y = row_offset .. row_offset + row_count - 1 (<= N), RGB. ONE WORKGROUP PER ROW:\n"
+    "// dispatch row_count groups; the group strides over the columns (neighbouring invocations fetch\n"
+    "// neighbouring texels) and sums in shared memory.\n"
     "// Formats: RAD_BLOCK_BC1 (flags bit 2): one VK_FORMAT_BC1_RGB_UNORM_BLOCK image bound to\n"
     "// bindings 0, 1 and 2 (its .rgb is read from binding 0); RAD_BLOCK_BC4X3: three\n"
     "// VK_FORMAT_BC4_UNORM_BLOCK images (R, G, B planes) at bindings 0, 1, 2 (.r of each). The images\n"
@@ -5628,15 +5683,17 @@ static const char rad__glsl_5_0[] =
     "    uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound\n"
     "} pc;\n"
     "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
     "void main()\n"
     "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
     "    if (r >= pc.row_count) return;\n"
     "    bool perm = (pc.flags & 2u) != 0u, bc1 = (pc.flags & 4u) != 0u;\n"
     "    uint y = pc.row_offset + r;\n"
     "    uint trow = pc.tile != 0u \? (y / pc.tile) * pc.tiles_per_row : 0u;\n"
     "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint x = 0u; x < pc.n; ++x) {\n"
+    "    for (uint x = lid; x < pc.n; x += gl_WorkGroupSize.x) {\n"
     "        ivec2 p = ivec2(int(x), int(y));\n"
     "        vec3 d = bc1 \? texelFetch(texR, p, 0).rgb\n"
     "                     : vec3(texelFetch(texR, p, 0).r, texelFetch(texG, p, 0).r, texelFetch(texB, p, 0).r);\n"
@@ -5645,19 +5702,29 @@ static const char rad__glsl_5_0[] =
     "        acc += (d * vec3(scales[t], scales[t + 1u], scales[t + 2u])) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
     "    }\n"
     "    uint i = perm \? row_perm[y] : y;\n"
+    "    precise vec3 s = vec3(0.0);\n"
     "    if ((pc.flags & 8u) != 0u) {\n"
-    "        precise vec3 s = vec3(0.0);\n"
-    "        for (uint k = out_off[i].x; k != out_off[i + 1u].x; ++k) {\n"
+    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n";
+static const char rad__glsl_5_1[] =
+    "        for (uint k = k0 + lid; k < k0 + count; k += gl_WorkGroupSize.x) {\n"
     "            uint j = 3u * out_col[k];\n"
     "            s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);\n"
     "        }\n"
-    "        acc += s;\n"
-    "    }\n";
-static const char rad__glsl_5_1[] =
-    "    if ((pc.flags & 1u) != 0u) acc += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
-    "    outv[3u * i] = acc.x;\n"
-    "    outv[3u * i + 1u] = acc.y;\n"
-    "    outv[3u * i + 2u] = acc.z;\n"
+    "    }\n"
+    "    partial[lid] = acc + s;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
     "}\n";
 static const char *const rad__glsl_pieces_5[] = { rad__glsl_5_0, rad__glsl_5_1 };
 static const char rad__glsl_6_0[] =
@@ -5757,12 +5824,12 @@ static const char rad__glsl_6_1[] =
     "}\n";
 static const char *const rad__glsl_pieces_6[] = { rad__glsl_6_0, rad__glsl_6_1 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
-    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 1844u },
-    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2221u },
-    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2353u },
-    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2104u },
-    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4173u },
-    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4118u },
+    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
+    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
+    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
+    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2505u },
+    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4238u },
+    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
     { "alias_build.comp", rad__glsl_pieces_6, 2u, 4725u }
 };
 /* >>glsl end */

@@ -340,12 +340,14 @@ static void kernel_destroy(gpu *g, kernel *k)
     vkDestroyDescriptorSetLayout(g->device, k->set_layout, NULL);
 }
 
-static void record(VkCommandBuffer cb, const kernel *k, const void *push, uint32_t rows, uint32_t local_size)
+/* groups: the temporal step runs one invocation per row (ceil(rows / local_size) groups), the
+   gathers and applies one workgroup per row (rows groups) */
+static void record(VkCommandBuffer cb, const kernel *k, const void *push, uint32_t groups)
 {
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, k->pipeline);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, k->layout, 0, 1, &k->set, 0, NULL);
     vkCmdPushConstants(cb, k->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, k->push_size, push);
-    vkCmdDispatch(cb, (rows + local_size - 1) / local_size, 1, 1);
+    vkCmdDispatch(cb, groups, 1, 1);
 }
 
 /* ---- the program ------------------------------------------------------------------------------ */
@@ -486,8 +488,8 @@ int main(int argc, char **argv)
         bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         CHECK_VK(vkBeginCommandBuffer(cb, &bi));
-        record(cb, &kt[f & 1u], &tpc, n, local_size);   /* reads B[f & 1], writes B[(f + 1) & 1] */
-        record(cb, &km, &mpc, n, local_size);            /* L_inf = F_mb E (E could change every frame) */
+        record(cb, &kt[f & 1u], &tpc, (n + local_size - 1) / local_size); /* reads B[f & 1], writes B[(f + 1) & 1] */
+        record(cb, &km, &mpc, n);                  /* L_inf = F_mb E (E could change every frame) */
         memset(&bar, 0, sizeof(bar));
         bar.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
         bar.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;

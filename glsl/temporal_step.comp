@@ -1,7 +1,8 @@
 #version 450
 // radiosity.h kernel RAD_GLSL_TEMPORAL_STEP: one frame of temporal radiosity (rad_temporal_step
 // with a fixed weight), drawing exactly the indices the CPU draws: the counter-based generator
-// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. Per row i:
+// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. One invocation per row i
+// (dispatch ceil(row_count / group size) groups):
 //   acc = 0; for s = 0..k-1: J = draw(sample = sample_base + s); acc += V_J
 //   X = acc * (T_i / k); X *= rho_i (flags bit 0); B_i = w B_i^prev + (1 - w) X
 // V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).

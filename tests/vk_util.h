@@ -37,6 +37,7 @@ typedef struct vk_kernel {
     VkPipelineLayout layout;
     VkPipeline pipeline;
     uint32_t images, bindings, push_size, local_size; /* bindings 0..images-1 are combined image samplers */
+    int group_per_row;   /* gathers and applies: one workgroup per row; else one invocation per row */
 } vk_kernel;
 
 typedef struct vk_image {
@@ -272,6 +273,8 @@ static int vk_kernel_create(vk_ctx *v, vk_kernel *k, rad_glsl_id id, uint32_t im
     cpci.layout = k->layout;
     VK_TRY(vkCreateComputePipelines(v->device, VK_NULL_HANDLE, 1, &cpci, NULL, &k->pipeline));
     k->images = images;
+    k->group_per_row = id == RAD_GLSL_GATHER_DENSE || id == RAD_GLSL_GATHER_CSR || id == RAD_GLSL_MB_APPLY_FLOAT ||
+                       id == RAD_GLSL_MB_APPLY_HALF || id == RAD_GLSL_MB_APPLY_BLOCKS;
     k->bindings = bindings;
     k->push_size = push_size;
     k->local_size = local_size;
@@ -356,7 +359,7 @@ static int vk_dispatch_images(vk_ctx *v, const vk_kernel *k, const VkImageView *
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, k->pipeline);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, k->layout, 0, 1, &set, 0, NULL);
     vkCmdPushConstants(cb, k->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, k->push_size, push);
-    vkCmdDispatch(cb, (rows + k->local_size - 1) / k->local_size, 1, 1);
+    vkCmdDispatch(cb, k->group_per_row ? rows : (rows + k->local_size - 1) / k->local_size, 1, 1);
     VK_TRY(vkEndCommandBuffer(cb));
     memset(&fci, 0, sizeof(fci));
     fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
