@@ -211,6 +211,78 @@ done:
 static void test_gather_dense(void) { test_gather(0); }
 static void test_gather_csr(void) { test_gather(1); }
 
+/* ---- chunked processing of a matrix larger than one storage-buffer range --------------------- */
+
+static void test_gather_over_range(void)
+{
+    const VkDeviceSize range = g_vk.props.limits.maxStorageBufferRange;
+    uint32_t n = 6000, rows_per_chunk, r0, i, j, dispatches = 0;
+    float *F, *E, *rho, *cpu;
+    rad_matrix m;
+    rad_system sys;
+    rad_solve_options so;
+    vk_kernel k;
+    vk_buf bF, bE, bR, bOut;
+    int ok = 1;
+    if ((VkDeviceSize)n * n * 4 <= range) {
+        /* a driver with a large range (4 GiB on most desktop GPUs): a matrix beyond it would not
+           fit memory here; still run the chunked path with 8 chunks */
+        n = 2000;
+    }
+    F = (float *)malloc((size_t)n * n * sizeof(float));
+    E = random_vector(3 * (size_t)n, 0.5f);
+    rho = random_vector(3 * (size_t)n, 0.0f);
+    cpu = (float *)malloc(3 * (size_t)n * sizeof(float));
+    if (!F || !E || !rho || !cpu) { T_CHECK(0); free(F); free(E); free(rho); free(cpu); return; }
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) F[(size_t)i * n + j] = (float)((i * 7u + j * 13u) % 17u) * (0.9f / (16.0f * (float)n));
+    for (i = 0; i < 3 * n; ++i) rho[i] *= 0.45f;
+    memset(&m, 0, sizeof(m));
+    m.rows = m.cols = n;
+    m.storage = RAD_STORAGE_DENSE;
+    m.dense = F;
+    memset(&sys, 0, sizeof(sys));
+    sys.F = &m;
+    sys.albedo = rho;
+    sys.E = E;
+    sys.n = n;
+    rad_solve_options_default(&so);
+    so.bounces = 1;
+    T_CHECK(rad_solve_jacobi(&sys, &so, cpu, NULL, NULL) == RAD_SUCCESS);
+    /* rows per dispatch: what one range holds, less the alignment slack */
+    rows_per_chunk = (uint32_t)((range - g_vk.props.limits.minStorageBufferOffsetAlignment) / ((VkDeviceSize)n * 4));
+    if ((VkDeviceSize)n * n * 4 <= range) rows_per_chunk = n / 8 + 1;
+    if (rows_per_chunk > g_vk.props.limits.maxComputeWorkGroupCount[0]) rows_per_chunk = g_vk.props.limits.maxComputeWorkGroupCount[0];
+    if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_GATHER_DENSE, 0, 4, (uint32_t)sizeof(rad_glsl_gather_dense_push), 128)) {
+        T_CHECK(0); free(F); free(E); free(rho); free(cpu); return;
+    }
+    ok &= vk_buffer(&g_vk, &bF, (VkDeviceSize)n * n * 4, F);
+    ok &= vk_buffer(&g_vk, &bE, 3 * (VkDeviceSize)n * 4, E);
+    ok &= vk_buffer(&g_vk, &bR, 3 * (VkDeviceSize)n * 4, rho);
+    ok &= vk_buffer(&g_vk, &bOut, 3 * (VkDeviceSize)n * 4, NULL);
+    if (ok) memset(bOut.map, 0xFF, 3 * (size_t)n * 4);
+    for (r0 = 0; r0 < n && ok; r0 += rows_per_chunk) {
+        rad_glsl_gather_dense_push p;
+        vk_range r[4];
+        p.row_offset = r0;
+        p.row_count = n - r0 < rows_per_chunk ? n - r0 : rows_per_chunk;
+        p.cols = n;
+        p.flags = 0;
+        r[0] = vk_chunk(&g_vk, &bF, 4, (VkDeviceSize)r0 * n, (VkDeviceSize)p.row_count * n, &p.f_base);
+        T_CHECK(r[0].range <= range);
+        r[1] = vk_whole(&bE); r[2] = vk_whole(&bR); r[3] = vk_whole(&bOut);
+        ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+        ++dispatches;
+    }
+    T_CHECK(ok && dispatches >= 2);
+    if (ok) compare("dense gather over the storage-buffer range", (const float *)bOut.map, cpu, 3 * (size_t)n, 1e-5);
+    printf("    N = %u: %.1f MiB matrix, maxStorageBufferRange %.1f MiB, %u dispatches\n", n, (double)n * n * 4 / 1048576.0,
+           (double)range / 1048576.0, dispatches);
+    vk_buffer_free(&g_vk, &bF); vk_buffer_free(&g_vk, &bE); vk_buffer_free(&g_vk, &bR); vk_buffer_free(&g_vk, &bOut);
+    vk_kernel_destroy(&g_vk, &k);
+    free(F); free(E); free(rho); free(cpu);
+}
+
 /* ---- multi-bounce apply, float and half, with and without permutations --------------------- */
 
 static int gpu_mb_apply(const rad_multibounce *mb, const float *E, rad_output output, uint32_t local_size, float *out)
@@ -799,6 +871,7 @@ static const vk_test g_tests[] = {
     { "vk_push_constant_mirrors", test_push_mirrors },
     { "vk_gather_dense", test_gather_dense },
     { "vk_gather_csr", test_gather_csr },
+    { "vk_gather_dense_beyond_one_storage_range", test_gather_over_range },
     { "vk_mb_apply_float_half_permuted", test_mb_apply },
     { "vk_temporal_step", test_temporal },
     { "vk_mb_apply_bc1_bc4_outliers_permuted", test_mb_blocks },
