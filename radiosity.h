@@ -928,8 +928,11 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        weight stays on the CPU). Push: rad_glsl_temporal_push.
        0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
        word w of the tables, bin b starting at w = b * words, at element w - word_base)
-       2: totals T_i  3: E  4: albedo  5: B^prev  6: B^next (ping-pong the two buffers between frames). MULTIBOUNCE mode with three
-       table sets: three dispatches, channel c, sample_base c * k, table set c bound.
+       2: totals T_i  3: E  4: albedo  5: B^prev  6: B^next (ping-pong the two buffers
+       between frames)  7: bins per row, RAD_GLSL_FLAG_PADDED only (else bind any buffer).
+       MULTIBOUNCE mode with three table sets: three dispatches, channel c, sample_base c * k,
+       table set c bound. PADDED: the tables as RAD_GLSL_ALIAS_BUILD writes them (binding 0 =
+       its input row offsets, 2 and 7 its totals and counts), sampled without compaction.
    RAD_GLSL_MB_APPLY_BLOCKS  out = F~ E (+ E) as rad_multibounce_blocks_apply: the blocks
        uploaded unchanged as VK_FORMAT_BC1_RGB_UNORM_BLOCK or three VK_FORMAT_BC4_UNORM_BLOCK
        images (feature textureCompressionBC), decoded by the texture unit with texelFetch
@@ -949,7 +952,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        layout: row i's bins from bin row_offsets[i] + i (room for its entries + 1), at word
        (b - out_base) * words  4: scratch, one double per output bin  5: scratch, one uint per
        output bin  6: bin count per row (0: a negative or non-finite entry, or a column >= cols)
-       7: T_i per row. Compact the rows (prefix sums of the counts) for RAD_GLSL_TEMPORAL_STEP. */
+       7: T_i per row. RAD_GLSL_TEMPORAL_STEP samples this layout directly (RAD_GLSL_FLAG_PADDED). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -969,6 +972,7 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_FLAG_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
 #define RAD_GLSL_FLAG_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
 #define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
+#define RAD_GLSL_FLAG_PADDED 4u       /* temporal: tables in the padded layout of RAD_GLSL_ALIAS_BUILD */
 #define RAD_GLSL_FLAG_BC1 4u          /* block apply: one BC1 image (else three BC4 images) */
 #define RAD_GLSL_FLAG_OUTLIERS 8u     /* block apply: the outlier arrays are bound */
 #define RAD_GLSL_FLAG_DENSE 1u        /* alias build: dense rows, no column array */
@@ -989,7 +993,7 @@ typedef struct rad_glsl_temporal_push {
     uint32_t n;                    /* N: the environment's column */
     uint32_t samples;              /* k */
     uint32_t words;                /* (uint32_t)rad_alias_tables.format: 2 or 3 */
-    uint32_t flags;                /* RAD_GLSL_FLAG_ALBEDO, RAD_GLSL_FLAG_FEEDBACK */
+    uint32_t flags;                /* RAD_GLSL_FLAG_ALBEDO, _FEEDBACK, _PADDED */
     uint32_t channel;              /* 3: RGB from one table set; 0..2: this channel only */
     uint32_t sample_base;          /* channel * k with three table sets, else 0 */
     uint32_t word_base;            /* low 32 bits of the tables' word index at element 0 of binding 1 */
@@ -5574,6 +5578,9 @@ static const char rad__glsl_4_0[] =
     "// (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.\n"
     "// Chunking: binding 1 may hold only this chunk's bins: word w of the tables (bin b starts at word\n"
     "// b * words) is element w - word_base of it (word_base: low 32 bits; a chunk spans < 2^32 words).\n"
+    "// PADDED tables (flags bit 2), as RAD_GLSL_ALIAS_BUILD writes them for streamed rows: row i's\n"
+    "// bins start at bin row_offsets[i] + i (binding 0 = the input entry offsets) and counts[i]\n"
+    "// (binding 7) says how many there are, so the build's output is sampled without compaction.\n"
     "layout(local_size_x_id = 0) in;\n"
     "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins\n"
     "layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin\n"
@@ -5582,6 +5589,7 @@ static const char rad__glsl_4_0[] =
     "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };            // 3 N (flags bit 0)\n"
     "layout(std430, set = 0, binding = 5) readonly buffer Previous { float Bprev[]; };        // 3 N\n"
     "layout(std430, set = 0, binding = 6) buffer Next { float Bnext[]; };                     // 3 N\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer Counts { uint counts[]; };          // bins per row (bit 2)\n"
     "layout(push_constant) uniform Push {\n"
     "    uint seed;        // rad_temporal_options.seed\n"
     "    uint frame;       // rad_temporal_frame() before the step\n"
@@ -5590,7 +5598,7 @@ static const char rad__glsl_4_0[] =
     "    uint n;           // N: the environment's column index\n"
     "    uint samples;     // k\n"
     "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
-    "    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK)\n"
+    "    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK); bit 2: PADDED\n"
     "    uint channel;     // 3: RGB from one table set; 0..2: this channel only\n"
     "    uint sample_base; // channel * k with three table sets, else 0\n"
     "    uint word_base;   // low 32 bits of the tables' word index at element 0 of binding 1\n"
@@ -5619,12 +5627,14 @@ static const char rad__glsl_4_0[] =
     "    if (r >= pc.row_count) return;\n"
     "    uint i = pc.row_offset + r;\n"
     "    uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);\n"
-    "    uint first = row_offsets[i].x;\n"
-    "    uint nb = row_offsets[i + 1u].x - row_offsets[i].x;\n"
+    "    bool padded = (pc.flags & 4u) != 0u;\n"
+    "    uint first = row_offsets[i].x + (padded \? i : 0u);\n"
+    "    uint nb = padded \? counts[i] : row_offsets[i + 1u].x - row_offsets[i].x;\n"
     "    uint c0 = pc.channel < 3u \? pc.channel : 0u, c1 = pc.channel < 3u \? pc.channel : 2u;\n"
     "    precise float acc[3] = float[3](0.0, 0.0, 0.0);\n"
     "    for (uint s = 0u; s < pc.samples; ++s) {\n"
-    "        uint u1 = rad_pcg(key ^ ((pc.sample_base + s) * 0x9E3779B9u));\n"
+    "        uint u1 = rad_pcg(key ^ ((pc.sample_base + s) * 0x9E3779B9u));\n";
+static const char rad__glsl_4_1[] =
     "        uint u2 = rad_pcg(u1 ^ 0x68E31DA4u);\n"
     "        uint hi, lo;\n"
     "        umulExtended(u1, nb, hi, lo);\n"
@@ -5633,8 +5643,7 @@ static const char rad__glsl_4_0[] =
     "        else j = u2 < bins[w] \? bins[w + 1u] : bins[w + 2u];\n"
     "        for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);\n"
     "    }\n"
-    "    precise float scale = totals[i] / float(pc.samples);\n";
-static const char rad__glsl_4_1[] =
+    "    precise float scale = totals[i] / float(pc.samples);\n"
     "    for (uint c = c0; c <= c1; ++c) {\n"
     "        precise float x = acc[c] * scale;\n"
     "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n"
@@ -5741,7 +5750,7 @@ static const char rad__glsl_6_0[] =
     "// in_off[i] + i (bin b at word (b - out_base) * words of binding 3); counts[i] receives the bins\n"
     "// written and totals[i] T_i. Binding 4 (double) and 5 (uint) are scratch of one element per\n"
     "// output bin at the same positions. Needs the shaderFloat64 feature.\n"
-    "// To use the tables with RAD_GLSL_TEMPORAL_STEP, compact them (row offsets = prefix sums of counts).\n"
+    "// RAD_GLSL_TEMPORAL_STEP samples this layout directly (its PADDED flag).\n"
     "layout(local_size_x_id = 0) in;\n"
     "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 in_off[]; }; // rows + 1 uint64\n"
     "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };    // (not DENSE)\n"
@@ -5802,9 +5811,9 @@ static const char rad__glsl_6_0[] =
     "    }\n"
     "    W += env > 0.0 \? env : 0.0;\n"
     "    // Vose, robust variant: Small grows up from stack[0], Large down from stack[n-1]\n"
-    "    uint small_top = 0u, large_bottom = n;\n";
+    "    uint small_top = 0u, large_bottom = n;\n"
+    "    for (uint b = 0u; b < n; ++b) {\n";
 static const char rad__glsl_6_1[] =
-    "    for (uint b = 0u; b < n; ++b) {\n"
     "        precise double qb = double(n) * q[b0 + b] / W;\n"
     "        q[b0 + b] = qb;\n"
     "        if (qb < 1.0) stack[b0 + small_top++] = b;\n"
@@ -5828,9 +5837,9 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
     { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
     { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2505u },
-    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4238u },
+    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
     { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
-    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4725u }
+    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4697u }
 };
 /* >>glsl end */
 

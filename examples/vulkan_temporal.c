@@ -433,12 +433,13 @@ int main(int argc, char **argv)
     bL = buffer_create(&g, (VkDeviceSize)n * 12, NULL);
     {
         /* two descriptor sets for the temporal kernel: B ping-pongs between frames */
-        const buffer *t0[7], *t1[7], *m[7];
+        const buffer *t0[8], *t1[8], *m[7];
         t0[0] = t1[0] = &bOff; t0[1] = t1[1] = &bBins; t0[2] = t1[2] = &bTot; t0[3] = t1[3] = &bE; t0[4] = t1[4] = &bAlb;
         t0[5] = &bB[0]; t0[6] = &bB[1];
         t1[5] = &bB[1]; t1[6] = &bB[0];
-        kt[0] = kernel_create(&g, RAD_GLSL_TEMPORAL_STEP, sizeof(rad_glsl_temporal_push), local_size, t0, 7);
-        kt[1] = kernel_create(&g, RAD_GLSL_TEMPORAL_STEP, sizeof(rad_glsl_temporal_push), local_size, t1, 7);
+        t0[7] = t1[7] = &bPerm; /* bins per row: only for padded tables (RAD_GLSL_FLAG_PADDED) */
+        kt[0] = kernel_create(&g, RAD_GLSL_TEMPORAL_STEP, sizeof(rad_glsl_temporal_push), local_size, t0, 8);
+        kt[1] = kernel_create(&g, RAD_GLSL_TEMPORAL_STEP, sizeof(rad_glsl_temporal_push), local_size, t1, 8);
         m[0] = &bPlanes[0]; m[1] = &bPlanes[1]; m[2] = &bPlanes[2]; m[3] = &bE; m[4] = &bPerm; m[5] = &bPerm; m[6] = &bL;
         km = kernel_create(&g, RAD_GLSL_MB_APPLY_FLOAT, sizeof(rad_glsl_mb_apply_push), local_size, m, 7);
     }

@@ -11,7 +11,7 @@
 // in_off[i] + i (bin b at word (b - out_base) * words of binding 3); counts[i] receives the bins
 // written and totals[i] T_i. Binding 4 (double) and 5 (uint) are scratch of one element per
 // output bin at the same positions. Needs the shaderFloat64 feature.
-// To use the tables with RAD_GLSL_TEMPORAL_STEP, compact them (row offsets = prefix sums of counts).
+// RAD_GLSL_TEMPORAL_STEP samples this layout directly (its PADDED flag).
 layout(local_size_x_id = 0) in;
 layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 in_off[]; }; // rows + 1 uint64
 layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };    // (not DENSE)

@@ -10,6 +10,9 @@
 // (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.
 // Chunking: binding 1 may hold only this chunk's bins: word w of the tables (bin b starts at word
 // b * words) is element w - word_base of it (word_base: low 32 bits; a chunk spans < 2^32 words).
+// PADDED tables (flags bit 2), as RAD_GLSL_ALIAS_BUILD writes them for streamed rows: row i's
+// bins start at bin row_offsets[i] + i (binding 0 = the input entry offsets) and counts[i]
+// (binding 7) says how many there are, so the build's output is sampled without compaction.
 layout(local_size_x_id = 0) in;
 layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins
 layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin
@@ -18,6 +21,7 @@ layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };    
 layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };            // 3 N (flags bit 0)
 layout(std430, set = 0, binding = 5) readonly buffer Previous { float Bprev[]; };        // 3 N
 layout(std430, set = 0, binding = 6) buffer Next { float Bnext[]; };                     // 3 N
+layout(std430, set = 0, binding = 7) readonly buffer Counts { uint counts[]; };          // bins per row (bit 2)
 layout(push_constant) uniform Push {
     uint seed;        // rad_temporal_options.seed
     uint frame;       // rad_temporal_frame() before the step
@@ -26,7 +30,7 @@ layout(push_constant) uniform Push {
     uint n;           // N: the environment's column index
     uint samples;     // k
     uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)
-    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK)
+    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK); bit 2: PADDED
     uint channel;     // 3: RGB from one table set; 0..2: this channel only
     uint sample_base; // channel * k with three table sets, else 0
     uint word_base;   // low 32 bits of the tables' word index at element 0 of binding 1
@@ -55,8 +59,9 @@ void main()
     if (r >= pc.row_count) return;
     uint i = pc.row_offset + r;
     uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);
-    uint first = row_offsets[i].x;
-    uint nb = row_offsets[i + 1u].x - row_offsets[i].x;
+    bool padded = (pc.flags & 4u) != 0u;
+    uint first = row_offsets[i].x + (padded ? i : 0u);
+    uint nb = padded ? counts[i] : row_offsets[i + 1u].x - row_offsets[i].x;
     uint c0 = pc.channel < 3u ? pc.channel : 0u, c1 = pc.channel < 3u ? pc.channel : 2u;
     precise float acc[3] = float[3](0.0, 0.0, 0.0);
     for (uint s = 0u; s < pc.samples; ++s) {
