@@ -937,8 +937,9 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        uploaded unchanged as VK_FORMAT_BC1_RGB_UNORM_BLOCK or three VK_FORMAT_BC4_UNORM_BLOCK
        images (feature textureCompressionBC), decoded by the texture unit with texelFetch
        (decoders round differently: within 2/255 per channel of rad_bc1_decode_block and
-       rad_bc4_decode_block, measured 1.6/255 on lavapipe), times the tile scales, plus the exact outliers. Push: rad_glsl_mb_blocks_push; flags
-       RAD_GLSL_FLAG_TOTAL, _PERMUTED, _BC1, _OUTLIERS. 0, 1, 2: combined image samplers (BC1:
+       rad_bc4_decode_block, measured 1.6/255 on lavapipe), times the tile scales, plus the
+       exact outliers. Push: rad_glsl_mb_blocks_push; flags RAD_GLSL_FLAG_TOTAL, _PERMUTED,
+       _BC1, _OUTLIERS. 0, 1, 2: combined image samplers (BC1:
        the one image at all three; BC4X3: R, G, B planes)  3: scales (3 per tile)  4: E
        5: col_perm  6: row_perm  7: outlier offsets (N + 1 uint64)  8: outlier columns
        9: outlier values (3 each)  10: out. Rows are texel rows (chunks of row_offset, row_count
@@ -956,13 +957,13 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
-    RAD_GLSL_GATHER_DENSE = 0, /* glsl/gather_dense.comp */
-    RAD_GLSL_GATHER_CSR = 1, /* glsl/gather_csr.comp */
-    RAD_GLSL_MB_APPLY_FLOAT = 2, /* glsl/mb_apply_float.comp */
-    RAD_GLSL_MB_APPLY_HALF = 3, /* glsl/mb_apply_half.comp */
-    RAD_GLSL_TEMPORAL_STEP = 4, /* glsl/temporal_step.comp */
-    RAD_GLSL_MB_APPLY_BLOCKS = 5, /* glsl/mb_apply_blocks.comp */
-    RAD_GLSL_ALIAS_BUILD = 6, /* glsl/alias_build.comp */
+    RAD_GLSL_GATHER_DENSE      =  0, /* glsl/gather_dense.comp */
+    RAD_GLSL_GATHER_CSR        =  1, /* glsl/gather_csr.comp */
+    RAD_GLSL_MB_APPLY_FLOAT    =  2, /* glsl/mb_apply_float.comp */
+    RAD_GLSL_MB_APPLY_HALF     =  3, /* glsl/mb_apply_half.comp */
+    RAD_GLSL_TEMPORAL_STEP     =  4, /* glsl/temporal_step.comp */
+    RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* glsl/mb_apply_blocks.comp */
+    RAD_GLSL_ALIAS_BUILD       =  6, /* glsl/alias_build.comp */
     RAD_GLSL_COUNT = 7
 } rad_glsl_id;
 /* >>glsl ids end */

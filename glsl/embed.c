@@ -95,7 +95,7 @@ static void gen_ids(buf *b)
     char line[256];
     puts_(b, "typedef enum rad_glsl_id {\n");
     for (k = 0; k < KERNELS; ++k) {
-        sprintf(line, "    %s = %u, /* %s */\n", kernels[k].id, (unsigned)k, kernels[k].path);
+        sprintf(line, "    %-26s = %2u, /* %s */\n", kernels[k].id, (unsigned)k, kernels[k].path);
         puts_(b, line);
     }
     sprintf(line, "    RAD_GLSL_COUNT = %u\n} rad_glsl_id;\n", (unsigned)KERNELS);
