@@ -489,6 +489,14 @@ int main(int argc, char **argv)
         bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         CHECK_VK(vkBeginCommandBuffer(cb, &bi));
+        /* the previous frame's B (and the host's writes of E) visible to this frame: needed as
+           soon as frames are not waited on one by one as they are here */
+        memset(&bar, 0, sizeof(bar));
+        bar.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+        bar.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_HOST_WRITE_BIT;
+        bar.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_HOST_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                             0, 1, &bar, 0, NULL, 0, NULL);
         record(cb, &kt[f & 1u], &tpc, (n + local_size - 1) / local_size); /* reads B[f & 1], writes B[(f + 1) & 1] */
         record(cb, &km, &mpc, n);                  /* L_inf = F_mb E (E could change every frame) */
         memset(&bar, 0, sizeof(bar));

@@ -118,6 +118,8 @@ fi
 # ---- Vulkan: every GLSL kernel against the CPU path (lavapipe is enough; installed when we can)
 vk_ready() { [ -f /usr/include/vulkan/vulkan.h ] && have glslangValidator && ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; }
 vk_ready || try_install mesa-vulkan-drivers libvulkan-dev glslang-tools
+# the Khronos validation layer: test_vulkan turns it on when installed and fails on its messages
+[ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ] || try_install vulkan-validationlayers
 if vk_ready; then
     echo "== GLSL sources compile on their own"
     for f in glsl/*.comp; do
@@ -126,7 +128,10 @@ if vk_ready; then
     done
     unit vulkan-kernels $CC -std=c99 $WARN -O2 -I. tests/test_vulkan.c -lvulkan
     if build vulkan-example $CC -std=c99 $WARN -O2 -I. examples/vulkan_temporal.c -o "$BUILD/vulkan_temporal" -lvulkan -lm &&
-       "$BUILD/vulkan_temporal" --patches 200 --frames 30 --tmp "$BUILD" >"$BUILD/vulkan-example.out" 2>&1; then
+       { if [ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ]; then
+             VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation "$BUILD/vulkan_temporal" --patches 200 --frames 30 --tmp "$BUILD"
+         else "$BUILD/vulkan_temporal" --patches 200 --frames 30 --tmp "$BUILD"; fi; } >"$BUILD/vulkan-example.out" 2>&1 &&
+       ! grep -q 'Validation Error' "$BUILD/vulkan-example.out"; then
         pass "vulkan-example ($(tail -n 1 "$BUILD/vulkan-example.out"))"
     else
         tail -n 20 "$BUILD/vulkan-example.out" 2>/dev/null | sed 's/^/    /'

@@ -945,16 +945,19 @@ int main(int argc, char **argv)
         printf("no usable Vulkan device\n0 passed, 1 failed\n");
         return 1;
     }
-    printf("device: %s (Vulkan %u.%u), minStorageBufferOffsetAlignment %lu, maxStorageBufferRange %u\n", g_vk.props.deviceName,
-           VK_VERSION_MAJOR(g_vk.props.apiVersion), VK_VERSION_MINOR(g_vk.props.apiVersion),
-           (unsigned long)g_vk.props.limits.minStorageBufferOffsetAlignment, g_vk.props.limits.maxStorageBufferRange);
+    printf("device: %s (Vulkan %u.%u), minStorageBufferOffsetAlignment %lu, maxStorageBufferRange %u, validation layer %s\n",
+           g_vk.props.deviceName, VK_VERSION_MAJOR(g_vk.props.apiVersion), VK_VERSION_MINOR(g_vk.props.apiVersion),
+           (unsigned long)g_vk.props.limits.minStorageBufferOffsetAlignment, g_vk.props.limits.maxStorageBufferRange,
+           g_vk.validation ? "on" : "not installed");
     for (t = g_tests; t->name; ++t) {
         if (filter && !strstr(t->name, filter)) continue;
         g_checks_failed = 0;
+        vk_validation_errors = 0;
         g_worst = 0.0;
         g_worst_what = "relative difference from the CPU path";
         printf("%s\n", t->name);
         t->fn();
+        if (vk_validation_errors) { printf("    FAIL %u validation-layer messages\n", vk_validation_errors); g_checks_failed++; }
         if (g_checks_failed) { g_failed++; printf("  FAIL %s\n", t->name); }
         else { g_passed++; printf("  ok (largest %s: %.2g)\n", g_worst_what, g_worst); }
     }

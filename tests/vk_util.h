@@ -9,7 +9,25 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* messages of the Khronos validation layer (enabled when installed: vulkan-validationlayers) */
+static unsigned vk_validation_errors;
+
+static VKAPI_ATTR VkBool32 VKAPI_CALL vk_on_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT type,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
+{
+    (void)type;
+    (void)user;
+    if (severity & (VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT)) {
+        printf("    vulkan validation %s: %s\n", (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning",
+               data && data->pMessage ? data->pMessage : "?");
+        vk_validation_errors++;
+    }
+    return VK_FALSE;
+}
+
 typedef struct vk_ctx {
+    int validation;      /* the Khronos validation layer is on */
+    VkDebugUtilsMessengerEXT messenger;
     VkInstance instance;
     VkPhysicalDevice phys;
     VkDevice device;
@@ -76,7 +94,37 @@ static int vk_init(vk_ctx *v, const char *workdir)
     memset(&ici, 0, sizeof(ici));
     ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     ici.pApplicationInfo = &app;
+    {
+        /* the validation layer when it is installed (RAD_VK_VALIDATION=0 turns it off) */
+        VkLayerProperties layers[64];
+        uint32_t nl = 64, l;
+        const char *env = getenv("RAD_VK_VALIDATION");
+        static const char *const layer_name[1] = { "VK_LAYER_KHRONOS_validation" };
+        static const char *const ext_name[1] = { VK_EXT_DEBUG_UTILS_EXTENSION_NAME };
+        if (!(env && env[0] == '0') && vkEnumerateInstanceLayerProperties(&nl, layers) >= 0)
+            for (l = 0; l < nl; ++l)
+                if (!strcmp(layers[l].layerName, layer_name[0])) v->validation = 1;
+        if (v->validation) {
+            ici.enabledLayerCount = 1;
+            ici.ppEnabledLayerNames = layer_name;
+            ici.enabledExtensionCount = 1;
+            ici.ppEnabledExtensionNames = ext_name;
+        }
+    }
     VK_TRY(vkCreateInstance(&ici, NULL, &v->instance));
+    if (v->validation) {
+        VkDebugUtilsMessengerCreateInfoEXT mci;
+        PFN_vkCreateDebugUtilsMessengerEXT create =
+            (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(v->instance, "vkCreateDebugUtilsMessengerEXT");
+        memset(&mci, 0, sizeof(mci));
+        mci.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+        mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+        mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                          VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+        mci.pfnUserCallback = vk_on_message;
+        if (!create) { printf("    vulkan: no vkCreateDebugUtilsMessengerEXT\n"); return 0; }
+        VK_TRY(create(v->instance, &mci, NULL, &v->messenger));
+    }
     if (vkEnumeratePhysicalDevices(v->instance, &ndev, devs) < 0 || ndev == 0) { printf("    vulkan: no physical device\n"); return 0; }
     v->family = 0xFFFFFFFFu;
     for (d = 0; d < ndev && v->family == 0xFFFFFFFFu; ++d) {
@@ -128,6 +176,11 @@ static void vk_shutdown(vk_ctx *v)
         if (v->sampler) vkDestroySampler(v->device, v->sampler, NULL);
         vkDestroyCommandPool(v->device, v->pool, NULL);
         vkDestroyDevice(v->device, NULL);
+    }
+    if (v->messenger) {
+        PFN_vkDestroyDebugUtilsMessengerEXT destroy =
+            (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(v->instance, "vkDestroyDebugUtilsMessengerEXT");
+        if (destroy) destroy(v->instance, v->messenger, NULL);
     }
     if (v->instance) vkDestroyInstance(v->instance, NULL);
 }
