@@ -1026,8 +1026,8 @@ RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
 /* The whole source of kernel 'id' (the pieces concatenated), NUL-terminated, into dst.
    *out_length (optional) receives the length without the NUL, on success and when dst is too
    small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
-   INVALID_ARGUMENT (unknown id, out_length and dst both NULL), SIZE_MISMATCH (dst_size <=
-   length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). SPEC §10. */
+   INVALID_ARGUMENT (unknown id; dst NULL with out_length NULL or dst_size > 0), SIZE_MISMATCH
+   (dst_size <= length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). SPEC §10. */
 RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
 
 /* ======================================================================================== */
