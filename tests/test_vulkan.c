@@ -970,6 +970,18 @@ int main(int argc, char **argv)
         if (g_checks_failed) { g_failed++; printf("  FAIL %s\n", t->name); }
         else { g_passed++; printf("  ok (largest %s: %.2g)\n", g_worst_what, g_worst); }
     }
+    if (!filter) { /* no kernel without its test */
+        uint32_t id;
+        int missing = 0;
+        for (id = 0; id < (uint32_t)RAD_GLSL_COUNT; ++id)
+            if (strstr(rad_glsl_name((rad_glsl_id)id), ".comp") && !vk_created[id]) {
+                printf("  FAIL kernel %s was not run by any test\n", rad_glsl_name((rad_glsl_id)id));
+                missing = 1;
+            }
+        if (missing) g_failed++;
+        else g_passed++;
+        printf("every kernel run by a test: %s\n", missing ? "no" : "yes");
+    }
     vk_shutdown(&g_vk);
     printf("%d passed, %d failed\n", g_passed, g_failed);
     return g_failed ? 1 : 0;

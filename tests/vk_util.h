@@ -9,6 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* pipelines created per kernel id (test_vulkan checks that every kernel ran) */
+static unsigned vk_created[64];
+
 /* messages of the Khronos validation layer (enabled when installed: vulkan-validationlayers) */
 static unsigned vk_validation_errors;
 
@@ -325,6 +328,7 @@ static int vk_kernel_create(vk_ctx *v, vk_kernel *k, rad_glsl_id id, uint32_t im
     cpci.stage.pSpecializationInfo = &si;
     cpci.layout = k->layout;
     VK_TRY(vkCreateComputePipelines(v->device, VK_NULL_HANDLE, 1, &cpci, NULL, &k->pipeline));
+    if ((unsigned)id < 64u) vk_created[id]++;
     k->images = images;
     k->group_per_row = id == RAD_GLSL_GATHER_DENSE || id == RAD_GLSL_GATHER_CSR || id == RAD_GLSL_MB_APPLY_FLOAT ||
                        id == RAD_GLSL_MB_APPLY_HALF || id == RAD_GLSL_MB_APPLY_BLOCKS;
