@@ -122,10 +122,14 @@ vk_ready || try_install mesa-vulkan-drivers libvulkan-dev glslang-tools
 [ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ] || try_install vulkan-validationlayers
 if vk_ready; then
     echo "== GLSL sources compile on their own"
+    have spirv-val || try_install spirv-tools
     for f in glsl/*.comp; do
-        if glslangValidator -V "$f" -o "$BUILD/$(basename "$f").spv" >"$BUILD/glslang.log" 2>&1; then pass "glslang $f"
+        spv="$BUILD/$(basename "$f").spv"
+        if glslangValidator -V --target-env vulkan1.1 "$f" -o "$spv" >"$BUILD/glslang.log" 2>&1 &&
+           { ! have spirv-val || spirv-val --target-env vulkan1.1 "$spv" >>"$BUILD/glslang.log" 2>&1; }; then pass "glslang $f"
         else sed 's/^/    /' "$BUILD/glslang.log" | head -20; fail "glslang $f"; fi
     done
+    have spirv-val || skip spirv-val "spirv-val is not installed (package spirv-tools)"
     unit vulkan-kernels $CC -std=c99 $WARN -O2 -I. tests/test_vulkan.c -lvulkan
     if build vulkan-example $CC -std=c99 $WARN -O2 -I. examples/vulkan_temporal.c -o "$BUILD/vulkan_temporal" -lvulkan -lm &&
        { if [ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ]; then
