@@ -944,7 +944,8 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        5: col_perm  6: row_perm  7: outlier offsets (N + 1 uint64)  8: outlier columns
        9: outlier values (3 each)  10: out. Rows are texel rows (chunks of row_offset, row_count
        with row_offset + row_count <= N); the outlier arrays are bound whole (indexed by
-       original row), which limits them to one storage range (N of about 14 000 at 5%).
+       original row), which limits them to one storage range (N of about 14 000 at 5%), and
+       the image to maxImageDimension2D texels (16384 on lavapipe).
    RAD_GLSL_ALIAS_BUILD    alias tables of streamed rows (P-4.3), the bins of
        rad_alias_build_row (Vose in double: needs the shaderFloat64 feature; bit-identical where
        double arithmetic is IEEE, as on lavapipe). Push: rad_glsl_alias_build_push; flags
