@@ -923,7 +923,10 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        3: E (original order)  4: col_perm  5: row_perm (bind any buffer when not PERMUTED)
        6: out (original order; rows row_perm[row_offset ..] written)
    RAD_GLSL_MB_APPLY_HALF  the same with binary16 planes (rad_multibounce.half uploaded
-       unchanged, read as uint words with unpackHalf2x16; base counted in halves).
+       unchanged, read as uint words with unpackHalf2x16; base counted in halves). Each plane's
+       buffer and each bound range must cover whole 4-byte words: pad a plane of odd N^2 to a
+       multiple of 4 bytes and round a chunk's range up, or the word holding its last value
+       reads as zero (robust buffer access).
    RAD_GLSL_TEMPORAL_STEP  one frame of rad_temporal_step with a fixed weight (the adaptive
        weight stays on the CPU). Push: rad_glsl_temporal_push.
        0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
@@ -5516,7 +5519,9 @@ static const char rad__glsl_3_0[] =
     "// planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint\n"
     "// word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage\n"
     "// feature is needed. Same bindings, push constants, permutations, dispatch (one workgroup per\n"
-    "// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may be odd).\n"
+    "// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may\n"
+    "// be odd). Buffers and bound ranges must cover whole 32-bit words: round a range's end up to a\n"
+    "// multiple of 4 bytes, or the word holding the last value reads as zero.\n"
     "layout(local_size_x_id = 0) in;\n"
     "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { uint R[]; };\n"
     "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { uint G[]; };\n"
@@ -5838,7 +5843,7 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
     { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
-    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2505u },
+    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
     { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
     { "alias_build.comp", rad__glsl_pieces_6, 2u, 4697u }

@@ -3,7 +3,9 @@
 // planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint
 // word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage
 // feature is needed. Same bindings, push constants, permutations, dispatch (one workgroup per
-// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may be odd).
+// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may
+// be odd). Buffers and bound ranges must cover whole 32-bit words: round a range's end up to a
+// multiple of 4 bytes, or the word holding the last value reads as zero.
 layout(local_size_x_id = 0) in;
 layout(std430, set = 0, binding = 0) readonly buffer PlaneR { uint R[]; };
 layout(std430, set = 0, binding = 1) readonly buffer PlaneG { uint G[]; };

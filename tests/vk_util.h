@@ -196,11 +196,12 @@ static int vk_buffer(vk_ctx *v, vk_buf *b, VkDeviceSize size, const void *data)
     VkMemoryAllocateInfo mai;
     uint32_t t;
     VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    VkDeviceSize alloc = (size + 3) / 4 * 4; /* whole 32-bit words: the kernels read uint words */
     memset(b, 0, sizeof(*b));
-    if (size == 0) size = 4;
+    if (alloc == 0) alloc = 4;
     memset(&bci, 0, sizeof(bci));
     bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-    bci.size = size;
+    bci.size = alloc;
     bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     VK_TRY(vkCreateBuffer(v->device, &bci, NULL, &b->buffer));
@@ -215,9 +216,9 @@ static int vk_buffer(vk_ctx *v, vk_buf *b, VkDeviceSize size, const void *data)
     VK_TRY(vkAllocateMemory(v->device, &mai, NULL, &b->memory));
     VK_TRY(vkBindBufferMemory(v->device, b->buffer, b->memory, 0));
     VK_TRY(vkMapMemory(v->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->map));
-    b->size = size;
+    b->size = alloc;
+    memset(b->map, 0, (size_t)alloc);
     if (data) memcpy(b->map, data, (size_t)size);
-    else memset(b->map, 0, (size_t)size);
     return 1;
 }
 
@@ -555,8 +556,10 @@ static void vk_image_free(vk_ctx *v, vk_image *im)
 }
 
 /* a range of 'count' elements of 'elem' bytes starting at element 'first' of b, bound from an
-   offset rounded down to minStorageBufferOffsetAlignment; *base receives the element the range
-   starts with (what the kernels call base) */
+   offset rounded down to minStorageBufferOffsetAlignment and ending on a whole 32-bit word (a
+   range ending inside a word would make the word it shares with the last binary16 value read as
+   zero under robust buffer access); *base receives the element the range starts with (what the
+   kernels call base) */
 static vk_range vk_chunk(const vk_ctx *v, const vk_buf *b, VkDeviceSize elem, VkDeviceSize first, VkDeviceSize count,
                          uint32_t *base)
 {
@@ -566,7 +569,7 @@ static vk_range vk_chunk(const vk_ctx *v, const vk_buf *b, VkDeviceSize elem, Vk
     off = byte / align * align;
     r.buf = b;
     r.offset = off;
-    r.range = byte + count * elem - off;
+    r.range = (byte + count * elem - off + 3) / 4 * 4; /* whole words: binary16 pairs share one */
     if (r.range == 0) r.range = elem;
     if (r.offset + r.range > b->size) r.range = b->size - r.offset;
     *base = (uint32_t)((byte - off) / elem);
