@@ -802,8 +802,11 @@ typedef enum rad_shading_model {
     RAD_SHADING_BANDED = 2,       /* R = albedo / pi * ceil(bands * max(n.l, 0)) / bands */
     RAD_SHADING_PHONG = 3,        /* f = kd / pi + ks (s + 2) / (2 pi) max(0, r.v)^s,
                                      r = 2 (n.l) n - l (normalized modified Phong, Lewis 1994) */
-    RAD_SHADING_BLINN_PHONG = 4,  /* f = kd / pi + ks (s + 8) / (8 pi) max(0, n.h)^s,
-                                     h = (l + v) / |l + v| */
+    RAD_SHADING_BLINN_PHONG = 4,  /* f = kd / pi + ks c(s) max(0, n.h)^s, h = (l + v) / |l + v|,
+                                     c(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s)): the
+                                     normalization that makes the lobe's albedo at normal
+                                     incidence exactly 1 (Real-Time Rendering; the common
+                                     (s + 8) / (8 pi) overshoots it by up to 4 %) */
     RAD_SHADING_MINNAERT = 5,     /* f = albedo (k + 1) / (2 pi) (max(n.l n.v, 1e-6))^(k - 1)
                                      (Minnaert 1941; albedo at normal incidence = albedo) */
     RAD_SHADING_OREN_NAYAR = 6,   /* f = albedo / pi (A + B max(0, cos(phi_l - phi_v)) sin(a) tan(b)),
@@ -5144,7 +5147,7 @@ static void rad__shade(const rad_shading_gpu *g, const float *l, const float *v,
                 for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
                 len = sqrtf(rad__sdot(h, h));
                 if (len > 0.0f) nh = rad__sdot(n, h) / len;
-                q = (s + 8.0f) * (0.125f * RAD__INV_PI) * powf(nh > 0.0f ? nh : 0.0f, s);
+                q = (s + 2.0f) * (s + 4.0f) * (0.125f * RAD__INV_PI) / (exp2f(-0.5f * s) + s) * powf(nh > 0.0f ? nh : 0.0f, s);
                 for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI + g->specular[k] * q;
             } else if (model == (int)RAD_SHADING_MINNAERT) {
                 float kk = g->p[2], c = nl * nv;
