@@ -76,7 +76,17 @@ float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha
     return 1.0 / (RAD_PI * alpha_x * alpha_y * d * d);
 }
 
-// B eq. 23, for a > 0 (pass a huge a for s = n)
+// B eq. 25 (eq. 19 when alpha_x = alpha_y): the Smith variable a; the largest float for
+// s = n (C returns +inf there; both give Lambda = 0)
+float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)
+{
+    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;
+    if (!(d2 > 0.0)) return 3.402823466e38;
+    return ns / sqrt(d2);
+}
+
+// B eq. 23, for a > 0
+// (Beckmann's exact Lambda, eq. 20, needs erf, which GLSL lacks: it is C only.)
 float rad_lambda_ggx(float a)
 {
     return 0.5 * (-1.0 + sqrt(1.0 + 1.0 / (a * a)));

@@ -2,7 +2,8 @@
    furnace for Smith G1, reciprocity, energy, Beckmann's rational Lambda against the exact
    erf form, hand-computed values, API errors. Integrals are midpoint sums in closed-form
    changes of variables; each tolerance below is the quadrature error measured at the
-   coarse (RAD_TEST_QUICK) grid with a margin, far below the errors the tests look for. */
+   coarse (RAD_TEST_QUICK) grid with a margin, far below the errors the tests look for
+   (a missing 1/pi, a wrong Lambda, a lobe normalized for the wrong exponent). */
 
 #define SH_PI 3.14159265358979323846
 
@@ -66,8 +67,9 @@ static void sh_test_g1_furnace(void)
                     A = rad_smith_a((float)v[2], (float)v[0], (float)v[1], ax, ay);
                     lambda = g ? rad_lambda_ggx(A) : (exact ? rad_lambda_beckmann_exact(A) : rad_lambda_beckmann(A));
                     I = sh_ndf_integral(g, ax, ay, v, nt, np) * rad_smith_g1(1.0f, lambda);
-                    /* the rational Beckmann Lambda carries its own 0.35 % (see below) */
-                    CHECK_NEAR(I, v[2], (!g && !exact ? 4e-3 : 1e-3) * (quick ? 2.0 : 1.0));
+                    /* quadrature: measured <= 7e-6 (4.5e-5 quick); the rational Beckmann Lambda
+                       adds its own error, G1 within 0.35 % (see below): measured 1.7e-3 */
+                    CHECK_NEAR(I, v[2], (!g && !exact ? 0.0035 * v[2] : 0.0) + 2e-4);
                 }
 }
 
@@ -178,7 +180,7 @@ static void sh_test_energy(void)
 {
     static const double thetas[] = { 0.0, 0.7, 1.2, 1.5 };
     rad_shading s;
-    int m, k, n = rad_test_quick() ? 96 : 256;
+    int m, k, n = rad_test_quick() ? 64 : 256;
     float v[3];
     for (m = 0; sh_material(m, &s); ++m)
         for (k = 0; k < 4; ++k) {
@@ -186,9 +188,24 @@ static void sh_test_energy(void)
             sh_dir(thetas[k], 0.3, v);
             a = sh_albedo(&s, v, n);
             CHECK(a > 0.0);
-            if (!(a <= 1.0 + 5e-3)) printf("    material %d theta %.2f: albedo %.5f\n", m, thetas[k], a);
-            CHECK(a <= 1.0 + 5e-3);
+            /* quadrature error about 1e-4; the Shirley diffuse term paired with GGX exceeds 1
+               by 0.15 % at albedo 1 and grazing view (measured 1.0015 on a 400^2 grid) */
+            if (!(a <= 1.0 + 2.5e-3)) printf("    material %d theta %.2f: albedo %.5f\n", m, thetas[k], a);
+            CHECK(a <= 1.0 + 2.5e-3);
         }
+    /* the test can tell: the thesis's Lambert diffuse term (1 - F(n,l)) rho / pi (eq. 27) is
+       not energy-conserving with the specular term at albedo 1 (measured 1.072) */
+    rad_shading_default(&s, RAD_SHADING_MICROFACET);
+    for (k = 0; k < 3; ++k) s.microfacet.albedo[k] = 1.0f;
+    {
+        double worst = 0.0, a;
+        for (k = 0; k < 4; ++k) {
+            sh_dir(thetas[k], 0.3, v);
+            a = sh_albedo(&s, v, n);
+            if (a > worst) worst = a;
+        }
+        CHECK(worst > 1.03);
+    }
     /* closed forms: Lambert's albedo is rho; normalized Phong's at v = n is kd + ks */
     rad_shading_default(&s, RAD_SHADING_LAMBERT);
     sh_dir(0.9, 0.0, v);
