@@ -2,8 +2,8 @@
    (radiosity.h >>shading) on a Vulkan 1.1 compute device (Mesa's lavapipe is enough).
    Builds a few thousand cases (every model, both NDFs, both G2 forms, every diffuse term,
    isotropic and anisotropic, random directions including back-facing ones), compiles
-   glsl/lighting_eval.comp with glslangValidator at run time, runs it, and compares f and R
-   channel by channel: |gpu - c| <= 1e-5 |c| + 1e-6 max|c of that case| + 1e-12. The second
+   glsl/lighting_eval.comp with glslangValidator at run time, runs it, and compares f, R and
+   every term function (sv_terms) value by value: |gpu - c| <= 1e-5 |c| + 1e-6 max|c of that case| + 1e-12. The second
    part matters only where a term cancels to nearly 0 inside a larger value; the third only
    far outside a specular lobe, where values below 1e-12 sr^-1 come from exp() of a large
    negative argument (whose relative error grows with the argument) or are denormals, which
@@ -40,6 +40,37 @@ static void sv_unit(double *d)
         len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
     } while (len < 0.1 || len > 1.0);
     d[0] /= len; d[1] /= len; d[2] /= len;
+}
+
+#define SV_OUT 24 /* floats per case: f, R and four vec4 of terms */
+
+/* the terms the kernel writes after f and R, in the same order and the same float math */
+static void sv_terms(const sv_case *c, float *o)
+{
+    const float *l = c->l, *v = c->v, *n = c->n, *t = c->t, *b = c->b;
+    float ax = c->params.p[0] > 0.0f ? c->params.p[0] : 0.3f, ay = c->params.p[1] > 0.0f ? c->params.p[1] : 0.3f;
+    float h[3], len, nh, th, bh, lh, vh, nl, nv, av, al, lv, ll, F;
+    int k;
+    for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
+    len = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+    for (k = 0; k < 3; ++k) h[k] = len > 0.0f ? h[k] / len : n[k];
+#define SV_DOT(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
+    nh = SV_DOT(n, h); th = SV_DOT(t, h); bh = SV_DOT(b, h); lh = SV_DOT(l, h); vh = SV_DOT(v, h);
+    nl = SV_DOT(n, l); nv = SV_DOT(n, v);
+    av = rad_smith_a(nv, SV_DOT(t, v), SV_DOT(b, v), ax, ay);
+    al = rad_smith_a(nl, SV_DOT(t, l), SV_DOT(b, l), ax, ay);
+#undef SV_DOT
+    lv = rad_lambda_ggx(av);
+    ll = rad_lambda_ggx(al);
+    F = rad_fresnel_schlick_f90(c->params.f0[0], c->params.f90[0], 5.0f, nl);
+    o[0] = av < HUGE_VALF ? av : 3.402823466e38f; o[1] = lv; o[2] = rad_lambda_beckmann(av); o[3] = rad_smith_g1(vh, lv);
+    o[4] = rad_ndf_beckmann(nh, ax); o[5] = rad_ndf_ggx(nh, ax);
+    o[6] = rad_ndf_beckmann_aniso(nh, th, bh, ax, ay); o[7] = rad_ndf_ggx_aniso(nh, th, bh, ax, ay);
+    o[8] = rad_fresnel_schlick(c->params.f0[0], lh); o[9] = F;
+    o[10] = rad_diffuse_lambert(c->params.albedo[0], F);
+    o[11] = rad_diffuse_shirley(c->params.albedo[0], c->params.f0[0], nl, nv);
+    o[12] = rad_smith_g2_separable(vh, lh, lv, ll); o[13] = rad_smith_g2_height_correlated(vh, lh, lv, ll);
+    o[14] = rad_lambda_beckmann(al); o[15] = 0.0f;
 }
 
 /* material number m (of sv_material_count) */
@@ -120,14 +151,14 @@ int main(int argc, char **argv)
     /* ---- the cases and the C answers ---- */
     while (sv_material(materials, &s)) ++materials;
     cases = (sv_case *)calloc((size_t)materials * per_material, sizeof(sv_case));
-    expect = (float *)calloc((size_t)materials * per_material * 8, sizeof(float));
+    expect = (float *)calloc((size_t)materials * per_material * SV_OUT, sizeof(float));
     if (!cases || !expect) goto fail;
     for (m = 0; m < materials; ++m) {
         sv_material(m, &s);
         for (i = 0; i < per_material; ++i) {
             double l[3], v[3], n[3], t[3], b[3], d;
             sv_case *c = &cases[count];
-            float *e = &expect[8 * count];
+            float *e = &expect[SV_OUT * count];
             sv_unit(n); sv_unit(l); sv_unit(v); sv_unit(t);
             /* most cases in front (n.l, n.v > 0), some behind */
             if (i % 8 != 0) {
@@ -152,6 +183,7 @@ int main(int argc, char **argv)
                 goto fail;
             }
             if (rad_shading_eval(&s, c->l, c->v, c->n, c->t, c->b, e + 4, NULL) != RAD_SUCCESS) goto fail;
+            sv_terms(c, e + 8);
             ++count;
         }
     }
@@ -215,7 +247,7 @@ int main(int argc, char **argv)
         VkFenceCreateInfo fci;
         void *map;
         float *got;
-        double worst = 0.0, worst_big = 0.0;
+        double worst = 0.0, worst_big = 0.0, worst_terms = 0.0;
         int bad = 0, worst_case = -1;
 
         memset(&app, 0, sizeof(app));
@@ -258,7 +290,7 @@ int main(int argc, char **argv)
         vkGetDeviceQueue(dev, qf, 0, &queue);
 
         sizes[0] = (VkDeviceSize)count * sizeof(sv_case);
-        sizes[1] = (VkDeviceSize)count * 8 * sizeof(float);
+        sizes[1] = (VkDeviceSize)count * SV_OUT * sizeof(float);
         for (k = 0; k < 2; ++k) {
             VkMemoryRequirements mr;
             VkMemoryAllocateInfo mai;
@@ -388,26 +420,33 @@ int main(int argc, char **argv)
         got = (float *)map;
         for (i = 0; i < (int)count; ++i) {
             double scale = 0.0;
-            for (k = 0; k < 8; ++k) if (k % 4 != 3 && fabs(expect[8 * i + k]) > scale) scale = fabs(expect[8 * i + k]);
-            for (k = 0; k < 8; ++k) {
+            for (k = 0; k < 8; ++k) if (k % 4 != 3 && fabs(expect[SV_OUT * i + k]) > scale) scale = fabs(expect[SV_OUT * i + k]);
+            for (k = 0; k < SV_OUT; ++k) {
                 double c, g, err;
-                if (k % 4 == 3) continue;
-                c = expect[8 * i + k];
-                g = got[8 * i + k];
+                if (k < 8 && k % 4 == 3) continue;
+                c = expect[SV_OUT * i + k];
+                g = got[SV_OUT * i + k];
+                /* terms: relative only (plus the 1e-12 floor), except the Lambert diffuse term
+                   (1 - F) albedo / pi, which cancels as F -> 1: its scale is albedo / pi */
+                if (k >= 8) scale = k == 18 ? cases[i].params.albedo[0] / 3.14159265358979 : 0.0;
                 err = fabs(g - c);
                 if (!(err <= 1e-5 * fabs(c) + 1e-6 * scale + 1e-12)) {
                     if (bad < 10) printf("FAIL case %d (model %d, ndf %d, masking %d, diffuse %d) %s[%d]: C %.9g GLSL %.9g\n", i,
                                          cases[i].params.mode[0], cases[i].params.mode[1], cases[i].params.mode[2],
-                                         cases[i].params.mode[3], k < 4 ? "f" : "R", k % 4, c, g);
+                                         cases[i].params.mode[3], k < 4 ? "f" : k < 8 ? "R" : "term", k < 8 ? k % 4 : k - 8, c, g);
                     ++bad;
+                }
+                if (k >= 8) {
+                    if (k != 18 && fabs(c) >= 1e-6 && err / fabs(c) > worst_terms) worst_terms = err / fabs(c);
+                    continue;
                 }
                 if (fabs(c) >= 1e-2 && err / fabs(c) > worst_big) { worst_big = err / fabs(c); if (getenv("SV_DEBUG")) printf("  worst >= 1e-2: case %d model %d ndf %d C %.9g GLSL %.9g\n", i, cases[i].params.mode[0], cases[i].params.mode[1], c, g); }
                 if (fabs(c) >= 1e-6 && err / fabs(c) > worst) { worst = err / fabs(c); worst_case = i; if (getenv("SV_DEBUG")) printf("  worst so far: case %d %s[%d] C %.9g GLSL %.9g (case max %.3g)\n", i, k < 4 ? "f" : "R", k % 4, c, g, scale); }
             }
         }
         vkUnmapMemory(dev, mem[1]);
-        printf("%u cases, %d materials: %d mismatches; largest relative difference %.3g for values >= 1e-2, %.3g for values >= 1e-6 (case %d, model %d)\n",
-               count, materials, bad, worst_big, worst, worst_case, worst_case >= 0 ? cases[worst_case].params.mode[0] : -1);
+        printf("%u cases, %d materials: %d mismatches; largest relative difference of f and R %.3g for values >= 1e-2, %.3g for values >= 1e-6 (case %d, model %d); of the terms (but the Lambert diffuse one) %.3g\n",
+               count, materials, bad, worst_big, worst, worst_case, worst_case >= 0 ? cases[worst_case].params.mode[0] : -1, worst_terms);
         status = bad ? 1 : 0;
     }
 fail:
