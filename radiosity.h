@@ -810,7 +810,7 @@ typedef enum rad_shading_model {
                                      c(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s)): the
                                      normalization that makes the lobe's albedo at normal
                                      incidence exactly 1 (Real-Time Rendering; the common
-                                     (s + 8) / (8 pi) overshoots it by up to 4 %) */
+                                     (s + 8) / (8 pi) overshoots it, by up to 7.5 % at s = 9) */
     RAD_SHADING_MINNAERT = 5,     /* f = albedo (k + 1) / (2 pi) (max(n.l n.v, 1e-6))^(k - 1)
                                      (Minnaert 1941; albedo at normal incidence = albedo) */
     RAD_SHADING_OREN_NAYAR = 6,   /* f = albedo / pi (A + B max(0, cos(phi_l - phi_v)) sin(a) tan(b)),
@@ -853,12 +853,12 @@ typedef struct rad_banded_params {
 typedef struct rad_phong_params {  /* Phong and Blinn-Phong */
     float diffuse[3];             /* kd; default 0.5 */
     float specular[3];            /* ks; default 0.3; physical when kd + ks <= 1 */
-    float shininess;              /* s in [0, 10000]; default 32 */
+    float shininess;              /* s in [1, 10000]; default 32 */
 } rad_phong_params;
 typedef struct rad_minnaert_params {
     float albedo[3];
-    float k;                      /* in [0, 4]; 1 is Lambert, < 1 flattens (the Moon: ~0.5 to
-                                     0.8); default 0.8 */
+    float k;                      /* in [0, 4]; 1 is Lambert; < 1 flattens the disc and
+                                     brightens the limb (lunar look); default 0.8 */
 } rad_minnaert_params;
 typedef struct rad_oren_nayar_params {
     float albedo[3];
@@ -922,7 +922,7 @@ RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context 
    Errors: INVALID_ARGUMENT (NULL pointer, bad parameters as rad_shading_validate, a zero
    vector, t missing or parallel to n for an anisotropic model, half-Lambert given to
    rad_shading_brdf), NON_FINITE (a non-finite vector component). Thread-safe, O(1), no
-   allocation. For a hot loop, validate once and call the term functions below or the GLSL. */
+   allocation. For a hot loop: rad_shading_pack once, then rad_shade. */
 RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], const float v[3], const float n[3],
                                     const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
 RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
@@ -973,8 +973,16 @@ typedef struct rad_shading_gpu {
     int32_t mode[4];
 } rad_shading_gpu;
 
-/* Packs a validated material for the GLSL functions. Errors as rad_shading_validate. */
+/* Validates a material and packs it for rad_shade and the GLSL functions. Errors as
+   rad_shading_validate. Thread-safe, O(1). */
 RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, const rad_context *ctx);
+
+/* The unchecked evaluator behind both entries, the C twin of GLSL rad_shade(): f (out_f)
+   and R (out_r; either may be NULL) for a material packed by rad_shading_pack and unit l, v,
+   n, with t, b an orthonormal tangent frame (read only when anisotropic; may be NULL then).
+   Garbage in, garbage out; no allocation; thread-safe; O(1). */
+RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
+                       const float b[3], float out_f[3], float out_r[3]);
 
 
 /* ======================================================================================== */
@@ -5278,6 +5286,13 @@ RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], cons
                                     const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx)
 {
     return rad__shading_entry(s, l, v, n, t, b, out_rgb, 0, ctx);
+}
+
+RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
+                       const float b[3], float out_f[3], float out_r[3])
+{
+    static const float zero[3] = { 0.0f, 0.0f, 0.0f };
+    rad__shade(g, l, v, n, t ? t : zero, b ? b : zero, out_f, out_r);
 }
 
 typedef char rad__check_shading_gpu_size[(sizeof(rad_shading_gpu) == 96) ? 1 : -1];

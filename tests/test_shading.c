@@ -311,6 +311,30 @@ static void sh_test_values(void)
     }
 }
 
+/* rad_shade on a packed material is what both entries evaluate */
+static void sh_test_packed(void)
+{
+    rad_shading s;
+    rad_shading_gpu g;
+    float l[3], v[3], f1[3], r1[3], f2[3], r2[3];
+    int m, k;
+    sh_dir(0.7, 0.2, l);
+    sh_dir(0.4, 2.9, v);
+    for (m = 0; m < (int)RAD_SHADING_MODEL_COUNT; ++m) {
+        rad_shading_default(&s, (rad_shading_model)m);
+        if (m == RAD_SHADING_MICROFACET) s.microfacet.alpha_y = 0.1f;
+        CHECK_OK(rad_shading_pack(&s, &g, NULL));
+        rad_shade(&g, l, v, sh_n, sh_t, sh_b, f1, r1);
+        if (m != RAD_SHADING_HALF_LAMBERT) CHECK_OK(rad_shading_brdf(&s, l, v, sh_n, sh_t, sh_b, f2, NULL));
+        CHECK_OK(rad_shading_eval(&s, l, v, sh_n, sh_t, sh_b, r2, NULL));
+        for (k = 0; k < 3; ++k) {
+            if (m != RAD_SHADING_HALF_LAMBERT) CHECK_NEAR(f1[k], f2[k], 1e-6 * fabs(f2[k]));
+            CHECK_NEAR(r1[k], r2[k], 1e-6 * fabs(r2[k]));
+            CHECK(r1[k] > 0.0f);
+        }
+    }
+}
+
 static void sh_test_errors(void)
 {
     rad_shading s;
@@ -375,6 +399,7 @@ static const rad_test_case tests_shading[] = {
     { "shading_reciprocity", sh_test_reciprocity },
     { "shading_energy", sh_test_energy },
     { "shading_values", sh_test_values },
+    { "shading_packed", sh_test_packed },
     { "shading_errors", sh_test_errors },
     { NULL, NULL }
 };
