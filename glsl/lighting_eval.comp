@@ -5,7 +5,9 @@
 // 6 vec4 per case: f, R, then the individual terms (see rad_terms below; the C harness
 // computes the same list). Push constant: the number of cases. Workgroup size: specialization
 // constant 0 (default 64). The include is resolved by glslangValidator
-// (GL_GOOGLE_include_directive, path relative to this file).
+// (GL_GOOGLE_include_directive, path relative to this file); a host compiling from memory
+// (an embedded string, shaderc without an includer) replaces the #include line with the
+// text of lighting.glsl and drops the #extension line: the result is the same shader.
 #extension GL_GOOGLE_include_directive : require
 #include "lighting.glsl"
 
