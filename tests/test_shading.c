@@ -76,7 +76,7 @@ static void sh_test_g1_furnace(void)
 /* Beckmann: the rational approximation of Lambda (B eq. 21) against the exact erf form
    (eq. 20). The bound is the 0.35 % relative error on G1 = 1/(1 + Lambda) quoted for Walter
    et al. 2007's rational G1 (quoted from memory: the paper itself is not in this repository's
-   sources); measured here: 0.313 % at a = 1.336, on a 1e-4..6 grid in a. (Lambda itself
+   sources); measured here: 0.313 % at a = 1.336, on a grid of a in (0, 6]. (Lambda itself
    differs by up to 0.76 as a -> 0, where both forms go to infinity: G1 is the fair measure.) */
 static void sh_test_beckmann_lambda(void)
 {
