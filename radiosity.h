@@ -791,8 +791,9 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
    lights points with n.l < 0, so it has no BRDF: rad_shading_brdf() refuses it.
    Physical (reciprocal f(l,v) = f(v,l) and energy-conserving Integral f (n.l) dl <= 1 for
    albedos <= 1; tests/test_shading.c measures both): Lambert; Phong and Blinn-Phong in their
-   normalized forms with kd + ks <= 1; Oren-Nayar (the qualitative model; measured albedo
-   <= 0.82 for sigma <= 1.5); the microfacet model with the Shirley diffuse term or none (with
+   normalized forms with kd + ks <= 1; Oren-Nayar nearly (the qualitative model: at albedo 1
+   its directional albedo reaches 1.0105 at grazing view for sigma = 0.25, and stays <= 1 for
+   sigma >= 0.5: 0.83 at sigma 1); the microfacet model with the Shirley diffuse term or none (with
    Shirley at albedo 1 the sum reaches 1.0015 at grazing view). The thesis's Lambert diffuse
    term (1 - F(n,l)) albedo / pi (eq. 27, the default because it is the thesis's) is neither
    reciprocal nor energy-conserving with the specular term (measured 1.07 at albedo 1).

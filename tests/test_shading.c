@@ -195,6 +195,16 @@ static void sh_test_energy(void)
             if (!(a <= 1.0 + 2.5e-3)) printf("    material %d theta %.2f: albedo %.5f\n", m, thetas[k], a);
             CHECK(a <= 1.0 + 2.5e-3);
         }
+    /* Oren-Nayar's qualitative model slightly exceeds 1 at grazing view for small sigma
+       (measured 1.0105 at sigma 0.25, theta_v 1.55, albedo 1): bounded, as documented */
+    rad_shading_default(&s, RAD_SHADING_OREN_NAYAR);
+    s.oren_nayar.sigma = 0.25f;
+    for (k = 0; k < 3; ++k) s.oren_nayar.albedo[k] = 1.0f;
+    sh_dir(1.55, 0.3, v);
+    {
+        double a = sh_albedo(&s, v, n);
+        CHECK(a > 1.0 && a < 1.015);
+    }
     /* the test can tell: the thesis's Lambert diffuse term (1 - F(n,l)) rho / pi (eq. 27) is
        not energy-conserving with the specular term at albedo 1 (measured 1.072) */
     rad_shading_default(&s, RAD_SHADING_MICROFACET);
