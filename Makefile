@@ -1,5 +1,6 @@
 # radiosity.h - build, demo, tests and benchmarks.
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
+#   make gallery every lighting model on rows of spheres, to gallery.png
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/
@@ -16,7 +17,7 @@ EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 RAD_DATA_DIR ?= ../shared/data
 
-.PHONY: all demo test bench bench-quick tools fuzz clean glsl
+.PHONY: all demo gallery test bench bench-quick tools fuzz clean glsl
 
 all: $(BUILD)/cornell tools
 
@@ -28,6 +29,12 @@ $(BUILD)/cornell: examples/cornell.c examples/png_write.h radiosity.h | $(BUILD)
 
 demo: $(BUILD)/cornell
 	./$(BUILD)/cornell -o cornell.png
+
+$(BUILD)/gallery: examples/gallery.c examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) -I. examples/gallery.c -o $@ -lm
+
+gallery: $(BUILD)/gallery
+	./$(BUILD)/gallery -o gallery.png
 
 test:
 	CC="$(CC)" CXX="$(CXX)" BUILD="$(BUILD)" bash tests/run.sh
@@ -41,21 +48,26 @@ $(BUILD)/multibounce: bench/multibounce.c radiosity.h | $(BUILD)
 $(BUILD)/temporal: bench/temporal.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/temporal.c -o $@ -lm
 
+$(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
+
 $(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal
+bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
 	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
 	./$(BUILD)/multibounce --append BENCHMARKS.md
 	./$(BUILD)/temporal --append BENCHMARKS.md
+	./$(BUILD)/shading --append BENCHMARKS.md
 
-bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal
+bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/multibounce --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/temporal --quick --append $(BUILD)/BENCHMARKS-quick.md
+	./$(BUILD)/shading --quick --append $(BUILD)/BENCHMARKS-quick.md
 
 tools: $(BUILD)/rad
 
@@ -77,7 +89,7 @@ fuzz: | $(BUILD)
 	done
 
 clean:
-	rm -rf $(BUILD) cornell.png tools/rad
+	rm -rf $(BUILD) cornell.png gallery.png tools/rad
 
 # the GLSL kernels: glsl/*.comp are the canonical sources, embedded into radiosity.h
 $(BUILD)/glsl_embed: glsl/embed.c | $(BUILD)

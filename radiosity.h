@@ -789,6 +789,222 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
 
 
 /* ======================================================================================== */
+/* >>api_shading: lighting models and BRDFs                                                 */
+/* ======================================================================================== */
+
+/* Local lighting models for the direct term and the final shading (SPEC §9, B-2.1, B-2.2).
+   Radiosity gives the indirect light of diffuse surfaces; these functions give the response
+   of a surface to one light direction, the same in C and in glsl/lighting.glsl.
+
+   CONVENTION. l (towards the light), v (towards the viewer) and n (the normal) are unit
+   vectors. Two quantities are offered:
+     f  the BRDF (sr^-1): outgoing radiance L_o = f * max(n.l, 0) * E, with E the light's
+        irradiance on a surface facing it (rad_light.color for a directional light,
+        I / d^2 for a point light). rad_shading_brdf() returns it.
+     R  the response: L_o = R * E. For every model that has a BRDF, R = f * max(n.l, 0).
+        rad_shading_eval() returns it; this is what a shader adds per light.
+   The models of B-2.1 that the thesis states as an "intensity" (a cosine-like number in
+   [0,1]) are scaled by albedo / pi so that a white model of intensity cos(theta) is exactly
+   Lambert: R = albedo / pi * intensity. For banded, f = R / (n.l). Half-Lambert (wrap)
+   lights points with n.l < 0, so it has no BRDF: rad_shading_brdf() refuses it.
+   Physical (reciprocal f(l,v) = f(v,l) and energy-conserving Integral f (n.l) dl <= 1 for
+   albedos <= 1; tests/test_shading.c measures both): Lambert; Phong and Blinn-Phong in their
+   normalized forms with kd + ks <= 1; Oren-Nayar nearly (the qualitative model: at albedo 1
+   its directional albedo reaches 1.0105 at grazing view for sigma = 0.25, and stays <= 1 for
+   sigma >= 0.5: 0.83 at sigma 1); the microfacet model with the Shirley diffuse term or none (with
+   Shirley at albedo 1 the sum reaches 1.0015 at grazing view). The thesis's Lambert diffuse
+   term (1 - F(n,l)) albedo / pi (eq. 27, the default because it is the thesis's) is neither
+   reciprocal nor energy-conserving with the specular term (measured 1.07 at albedo 1).
+   Minnaert is reciprocal, energy-conserving only for k >= 1. Banded and half-Lambert are
+   neither. Every model returns 0 (f and R) when n.v <= 0: surfaces are one-sided. */
+
+typedef enum rad_shading_model {
+    RAD_SHADING_LAMBERT = 0,      /* f = albedo / pi */
+    RAD_SHADING_HALF_LAMBERT = 1, /* R = albedo / pi * max(0, (n.l + w) / (1 + w))^p (Valve's
+                                     half-Lambert: w = 1, p = 2; w = 0, p = 1 is Lambert) */
+    RAD_SHADING_BANDED = 2,       /* R = albedo / pi * ceil(bands * max(n.l, 0)) / bands */
+    RAD_SHADING_PHONG = 3,        /* f = kd / pi + ks (s + 2) / (2 pi) max(0, r.v)^s,
+                                     r = 2 (n.l) n - l (normalized modified Phong, Lewis 1994) */
+    RAD_SHADING_BLINN_PHONG = 4,  /* f = kd / pi + ks c(s) max(0, n.h)^s, h = (l + v) / |l + v|,
+                                     c(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s)): the
+                                     normalization that makes the lobe's albedo at normal
+                                     incidence exactly 1 (Real-Time Rendering; the common
+                                     (s + 8) / (8 pi) overshoots it, by up to 7.5 % at s = 9) */
+    RAD_SHADING_MINNAERT = 5,     /* f = albedo (k + 1) / (2 pi) (max(n.l n.v, 1e-6))^(k - 1)
+                                     (Minnaert 1941; albedo at normal incidence = albedo) */
+    RAD_SHADING_OREN_NAYAR = 6,   /* f = albedo / pi (A + B max(0, cos(phi_l - phi_v)) sin(a) tan(b)),
+                                     A = 1 - 0.5 s^2 / (s^2 + 0.33), B = 0.45 s^2 / (s^2 + 0.09),
+                                     a = max(theta_l, theta_v), b = min (Oren, Nayar 1994,
+                                     qualitative model); computed as (l.v - n.l n.v) / max(n.l, n.v) */
+    RAD_SHADING_MICROFACET = 7,   /* f = F(h,l) G2(l,v,h) D(h) / (4 |n.l| |n.v|) + f_diffuse (B eq. 17) */
+    RAD_SHADING_MODEL_COUNT = 8
+} rad_shading_model;
+
+typedef enum rad_ndf {
+    RAD_NDF_BECKMANN = 0,         /* B eq. 18 / 24; Lambda: the rational approximation (21) */
+    RAD_NDF_GGX = 1               /* B eq. 22 / 26; Lambda: eq. 23 (exact) */
+} rad_ndf;
+
+typedef enum rad_masking {
+    RAD_MASKING_SEPARABLE = 0,         /* G2 = G1(v, h) G1(l, h)                (B eq. 13) */
+    RAD_MASKING_HEIGHT_CORRELATED = 1  /* G2 = chi(h.v) chi(h.l) / (1 + L(v) + L(l)) (eq. 14) */
+} rad_masking;
+
+typedef enum rad_diffuse_term {
+    RAD_DIFFUSE_NONE = 0,         /* specular only */
+    RAD_DIFFUSE_LAMBERT = 1,      /* (1 - F(n,l)) albedo / pi, F the Schlick term below (eq. 27) */
+    RAD_DIFFUSE_SHIRLEY = 2       /* (1 - F0) 21 albedo / (20 pi) (1 - (1 - n.l)^5) (1 - (1 - n.v)^5)
+                                     (Shirley et al. 1997, eq. 28) */
+} rad_diffuse_term;
+
+/* Ranges are checked by rad_shading_validate (and so by the two entries). Albedos, kd, ks,
+   f0 and f90 are per channel in [0, 1]. */
+typedef struct rad_lambert_params { float albedo[3]; } rad_lambert_params;
+typedef struct rad_half_lambert_params {
+    float albedo[3];
+    float wrap;                   /* w in [0, 1]; default 1 */
+    float exponent;               /* p in [1, 8]; default 2 */
+} rad_half_lambert_params;
+typedef struct rad_banded_params {
+    float albedo[3];
+    uint32_t bands;               /* in [1, 256]; default 4 */
+} rad_banded_params;
+typedef struct rad_phong_params {  /* Phong and Blinn-Phong */
+    float diffuse[3];             /* kd; default 0.5 */
+    float specular[3];            /* ks; default 0.3; physical when kd + ks <= 1 */
+    float shininess;              /* s in [1, 10000]; default 32 */
+} rad_phong_params;
+typedef struct rad_minnaert_params {
+    float albedo[3];
+    float k;                      /* in [0, 4]; 1 is Lambert; < 1 flattens the disc and
+                                     brightens the limb (lunar look); default 0.8 */
+} rad_minnaert_params;
+typedef struct rad_oren_nayar_params {
+    float albedo[3];
+    float sigma;                  /* roughness, standard deviation of facet slopes in radians,
+                                     in [0, 1.5]; 0 is Lambert; default 0.5 */
+} rad_oren_nayar_params;
+typedef struct rad_microfacet_params {
+    rad_ndf ndf;                  /* default GGX */
+    rad_masking masking;          /* default height-correlated */
+    rad_diffuse_term diffuse;     /* default Lambert */
+    float alpha_x, alpha_y;       /* roughness along t and b, each in [1e-3, 1]; equal values
+                                     make the model isotropic (t and b then unused); default 0.3 */
+    float f0[3];                  /* Fresnel reflectance at normal incidence; default 0.04 */
+    float f90[3];                 /* ... at grazing incidence (eq. 16); default 1 */
+    float fresnel_exponent;       /* 1/p of eq. 16, in [1, 10]; 5 is Schlick's eq. 15; default 5 */
+    float albedo[3];              /* rho of the diffuse term; default 0.5 */
+} rad_microfacet_params;
+
+/* A material for the shading entries: the model and its parameters (only model's member is
+   read). */
+typedef struct rad_shading {
+    rad_shading_model model;
+    rad_lambert_params lambert;
+    rad_half_lambert_params half_lambert;
+    rad_banded_params banded;
+    rad_phong_params phong;       /* RAD_SHADING_PHONG and RAD_SHADING_BLINN_PHONG */
+    rad_minnaert_params minnaert;
+    rad_oren_nayar_params oren_nayar;
+    rad_microfacet_params microfacet;
+} rad_shading;
+
+/* The documented defaults. Thread-safe, O(1). */
+RAD_API void rad_lambert_params_default(rad_lambert_params *p);
+RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p);
+RAD_API void rad_banded_params_default(rad_banded_params *p);
+RAD_API void rad_phong_params_default(rad_phong_params *p);
+RAD_API void rad_minnaert_params_default(rad_minnaert_params *p);
+RAD_API void rad_oren_nayar_params_default(rad_oren_nayar_params *p);
+RAD_API void rad_microfacet_params_default(rad_microfacet_params *p);
+/* Every member at its default and s->model = model. */
+RAD_API void rad_shading_default(rad_shading *s, rad_shading_model model);
+
+/* A model's name ("lambert", "half-lambert", "banded", "phong", "blinn-phong", "minnaert",
+   "oren-nayar", "microfacet"), or NULL for a value out of range; and the reverse (returns
+   INVALID_ARGUMENT for an unknown name). */
+RAD_API const char *rad_shading_model_name(rad_shading_model model);
+RAD_API rad_result rad_shading_model_from_name(const char *name, rad_shading_model *out_model);
+
+/* Checks the model and the ranges of its parameters (only the active model's struct).
+   Errors: INVALID_ARGUMENT (NULL, unknown model or enum, parameter out of range; the logger
+   names it), NON_FINITE (a NaN or Inf parameter). Thread-safe, O(1). */
+RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context *ctx);
+
+/* The two evaluation entries (see CONVENTION above; SPEC §9).
+   l, v, n: non-zero finite 3-vectors, normalized here. t, b: the tangent frame, used only
+   by an anisotropic microfacet model (alpha_x != alpha_y); there t is required, made
+   orthogonal to n here, and b may be NULL (then b = n x t) or is made orthogonal to n and t.
+   out_rgb: 3 floats, written on success.
+   rad_shading_brdf writes f; rad_shading_eval writes R (f * max(n.l, 0), or the half-Lambert
+   response).
+   Errors: INVALID_ARGUMENT (NULL pointer, bad parameters as rad_shading_validate, a zero
+   vector, t missing or parallel to n for an anisotropic model, half-Lambert given to
+   rad_shading_brdf), NON_FINITE (a non-finite vector component). Thread-safe, O(1), no
+   allocation. For a hot loop: rad_shading_pack once, then rad_shade. */
+RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
+RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
+
+/* Terms of the microfacet model, to compose your own (B-2.2.6 to 2.2.10). Plain float math:
+   the caller guarantees valid inputs (cosines in [-1, 1], roughness in (0, 1]); nothing is
+   checked. All thread-safe and O(1). 'nm' is n.m, 'tm' t.m, 'bm' b.m for the microfacet
+   normal m (usually h). */
+RAD_API float rad_ndf_beckmann(float nm, float alpha);                                   /* eq. 18 */
+RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y); /* eq. 24 */
+RAD_API float rad_ndf_ggx(float nm, float alpha);                                        /* eq. 22 */
+RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y);      /* eq. 26 */
+/* The Smith variable a = n.s / sqrt(alpha_x^2 (t.s)^2 + alpha_y^2 (b.s)^2) (eq. 25; with
+   alpha_x = alpha_y = alpha it is eq. 19, since (t.s)^2 + (b.s)^2 = 1 - (n.s)^2). Returns
+   +inf for s = n (no masking); requires n.s > 0. */
+RAD_API float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y);
+/* Lambda(a) for a > 0: GGX (eq. 23); Beckmann's rational approximation (eq. 21; 0 for
+   a >= 1.6); Beckmann's exact form (eq. 20, with erf; C only, the reference for the
+   approximation). Each returns 0 for a = +inf. */
+RAD_API float rad_lambda_ggx(float a);
+RAD_API float rad_lambda_beckmann(float a);
+RAD_API float rad_lambda_beckmann_exact(float a);
+/* G1 = chi+(m.s) / (1 + Lambda(s)) (eq. 11). */
+RAD_API float rad_smith_g1(float ms, float lambda_s);
+/* G2 separable G1(v) G1(l) (eq. 13) and height-correlated (eq. 14). */
+RAD_API float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l);
+RAD_API float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l);
+/* Schlick's Fresnel F0 + (1 - F0)(1 - max(c, 0))^5 (eq. 15) and its generalized form
+   F0 + (F90 - F0)(1 - max(c, 0))^exponent (eq. 16, exponent = 1/p). One channel. */
+RAD_API float rad_fresnel_schlick(float f0, float c);
+RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c);
+/* Diffuse terms, one channel: Lambert (1 - F) albedo / pi (eq. 27, F = F(n,l)), Shirley
+   et al. (1 - F0) 21 albedo / (20 pi) (1 - (1 - nl+)^5)(1 - (1 - nv+)^5) (eq. 28). */
+RAD_API float rad_diffuse_lambert(float albedo, float F);
+RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv);
+
+/* The std430 mirror of glsl/lighting.glsl's ShadingParams (96 bytes, vec4-aligned):
+   albedo (albedo, or kd for Phong), specular (ks), f0, f90, p = (alpha_x, alpha_y, model
+   parameter: wrap / shininess / k / sigma, second parameter: half-Lambert exponent / bands /
+   Fresnel exponent), mode = (model, ndf, masking, diffuse). */
+typedef struct rad_shading_gpu {
+    float albedo[4];
+    float specular[4];
+    float f0[4];
+    float f90[4];
+    float p[4];
+    int32_t mode[4];
+} rad_shading_gpu;
+
+/* Validates a material and packs it for rad_shade and the GLSL functions. Errors as
+   rad_shading_validate. Thread-safe, O(1). */
+RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, const rad_context *ctx);
+
+/* The unchecked evaluator behind both entries, the C twin of GLSL rad_shade(): f (out_f)
+   and R (out_r; either may be NULL) for a material packed by rad_shading_pack and unit l, v,
+   n, with t, b an orthonormal tangent frame (read only when anisotropic; may be NULL then).
+   Garbage in, garbage out; no allocation; thread-safe; O(1). */
+RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
+                       const float b[3], float out_f[3], float out_r[3]);
+
+
+/* ======================================================================================== */
 /* >>api_container: baked data                                                              */
 /* ======================================================================================== */
 
@@ -4757,6 +4973,510 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
     }
     return RAD_ERROR_INVALID_ARGUMENT;
 }
+
+/* ======================================================================================== */
+/* >>shading: lighting models and BRDFs                                                     */
+/* ======================================================================================== */
+
+/* Everything here is float arithmetic written in the same order as glsl/lighting.glsl, so
+   that the C and GLSL results agree to a few ulps (the tests compare them). */
+
+#define RAD__INV_PI 0.318309886183790671537767526745f
+
+RAD_API void rad_lambert_params_default(rad_lambert_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+}
+
+RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->wrap = 1.0f;
+    p->exponent = 2.0f;
+}
+
+RAD_API void rad_banded_params_default(rad_banded_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->bands = 4;
+}
+
+RAD_API void rad_phong_params_default(rad_phong_params *p)
+{
+    if (!p) return;
+    p->diffuse[0] = p->diffuse[1] = p->diffuse[2] = 0.5f;
+    p->specular[0] = p->specular[1] = p->specular[2] = 0.3f;
+    p->shininess = 32.0f;
+}
+
+RAD_API void rad_minnaert_params_default(rad_minnaert_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->k = 0.8f;
+}
+
+RAD_API void rad_oren_nayar_params_default(rad_oren_nayar_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->sigma = 0.5f;
+}
+
+RAD_API void rad_microfacet_params_default(rad_microfacet_params *p)
+{
+    int k;
+    if (!p) return;
+    p->ndf = RAD_NDF_GGX;
+    p->masking = RAD_MASKING_HEIGHT_CORRELATED;
+    p->diffuse = RAD_DIFFUSE_LAMBERT;
+    p->alpha_x = p->alpha_y = 0.3f;
+    for (k = 0; k < 3; ++k) {
+        p->f0[k] = 0.04f;
+        p->f90[k] = 1.0f;
+        p->albedo[k] = 0.5f;
+    }
+    p->fresnel_exponent = 5.0f;
+}
+
+RAD_API void rad_shading_default(rad_shading *s, rad_shading_model model)
+{
+    if (!s) return;
+    memset(s, 0, sizeof(*s));
+    s->model = model;
+    rad_lambert_params_default(&s->lambert);
+    rad_half_lambert_params_default(&s->half_lambert);
+    rad_banded_params_default(&s->banded);
+    rad_phong_params_default(&s->phong);
+    rad_minnaert_params_default(&s->minnaert);
+    rad_oren_nayar_params_default(&s->oren_nayar);
+    rad_microfacet_params_default(&s->microfacet);
+}
+
+static const char *const rad__shading_names[RAD_SHADING_MODEL_COUNT] = {
+    "lambert", "half-lambert", "banded", "phong", "blinn-phong", "minnaert", "oren-nayar", "microfacet"
+};
+
+RAD_API const char *rad_shading_model_name(rad_shading_model model)
+{
+    if ((int)model < 0 || (int)model >= (int)RAD_SHADING_MODEL_COUNT) return NULL;
+    return rad__shading_names[model];
+}
+
+RAD_API rad_result rad_shading_model_from_name(const char *name, rad_shading_model *out_model)
+{
+    int i;
+    if (!name || !out_model) return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < (int)RAD_SHADING_MODEL_COUNT; ++i)
+        if (strcmp(name, rad__shading_names[i]) == 0) {
+            *out_model = (rad_shading_model)i;
+            return RAD_SUCCESS;
+        }
+    return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+/* value in [lo, hi]: 0 ok, else the error (NON_FINITE or INVALID_ARGUMENT), logged */
+static rad_result rad__shading_range(const rad__ctx *c, const char *what, const float *x, int count, float lo, float hi)
+{
+    int k;
+    for (k = 0; k < count; ++k) {
+        if (!rad__finite(x[k])) {
+            rad__log(c, RAD_LOG_ERROR, "shading: %s[%d] is not finite", what, k);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (x[k] < lo || x[k] > hi) {
+            rad__log(c, RAD_LOG_ERROR, "shading: %s[%d] = %g is outside [%g, %g]", what, k, (double)x[k], (double)lo,
+                     (double)hi);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__shading_validate(const rad_shading *s, const rad__ctx *c)
+{
+    rad_result r = RAD_SUCCESS;
+    if (!s) return RAD_ERROR_INVALID_ARGUMENT;
+    switch (s->model) {
+    case RAD_SHADING_LAMBERT: return rad__shading_range(c, "lambert.albedo", s->lambert.albedo, 3, 0.0f, 1.0f);
+    case RAD_SHADING_HALF_LAMBERT:
+        if ((r = rad__shading_range(c, "half_lambert.albedo", s->half_lambert.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "half_lambert.wrap", &s->half_lambert.wrap, 1, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "half_lambert.exponent", &s->half_lambert.exponent, 1, 1.0f, 8.0f);
+    case RAD_SHADING_BANDED:
+        if (s->banded.bands < 1 || s->banded.bands > 256) {
+            rad__log(c, RAD_LOG_ERROR, "shading: banded.bands = %u is outside [1, 256]", s->banded.bands);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        return rad__shading_range(c, "banded.albedo", s->banded.albedo, 3, 0.0f, 1.0f);
+    case RAD_SHADING_PHONG:
+    case RAD_SHADING_BLINN_PHONG:
+        if ((r = rad__shading_range(c, "phong.diffuse", s->phong.diffuse, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "phong.specular", s->phong.specular, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "phong.shininess", &s->phong.shininess, 1, 1.0f, 10000.0f);
+    case RAD_SHADING_MINNAERT:
+        if ((r = rad__shading_range(c, "minnaert.albedo", s->minnaert.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "minnaert.k", &s->minnaert.k, 1, 0.0f, 4.0f);
+    case RAD_SHADING_OREN_NAYAR:
+        if ((r = rad__shading_range(c, "oren_nayar.albedo", s->oren_nayar.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "oren_nayar.sigma", &s->oren_nayar.sigma, 1, 0.0f, 1.5f);
+    case RAD_SHADING_MICROFACET: {
+        const rad_microfacet_params *m = &s->microfacet;
+        if ((int)m->ndf < 0 || (int)m->ndf > (int)RAD_NDF_GGX || (int)m->masking < 0 ||
+            (int)m->masking > (int)RAD_MASKING_HEIGHT_CORRELATED || (int)m->diffuse < 0 ||
+            (int)m->diffuse > (int)RAD_DIFFUSE_SHIRLEY) {
+            rad__log(c, RAD_LOG_ERROR, "shading: microfacet ndf %d, masking %d or diffuse %d is not a valid value",
+                     (int)m->ndf, (int)m->masking, (int)m->diffuse);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if ((r = rad__shading_range(c, "microfacet.alpha_x", &m->alpha_x, 1, 1e-3f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.alpha_y", &m->alpha_y, 1, 1e-3f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.f0", m->f0, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.f90", m->f90, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.fresnel_exponent", &m->fresnel_exponent, 1, 1.0f, 10.0f)) != RAD_SUCCESS)
+            return r;
+        return rad__shading_range(c, "microfacet.albedo", m->albedo, 3, 0.0f, 1.0f);
+    }
+    case RAD_SHADING_MODEL_COUNT: break;
+    }
+    rad__log(c, RAD_LOG_ERROR, "shading: unknown model %d", (int)s->model);
+    return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    return rad__shading_validate(s, &c);
+}
+
+static void rad__shading_pack(const rad_shading *s, rad_shading_gpu *g)
+{
+    int k;
+    const float *alb = s->lambert.albedo;
+    memset(g, 0, sizeof(*g));
+    g->mode[0] = (int32_t)s->model;
+    switch (s->model) {
+    case RAD_SHADING_HALF_LAMBERT:
+        alb = s->half_lambert.albedo;
+        g->p[2] = s->half_lambert.wrap;
+        g->p[3] = s->half_lambert.exponent;
+        break;
+    case RAD_SHADING_BANDED:
+        alb = s->banded.albedo;
+        g->p[3] = (float)s->banded.bands;
+        break;
+    case RAD_SHADING_PHONG:
+    case RAD_SHADING_BLINN_PHONG:
+        alb = s->phong.diffuse;
+        for (k = 0; k < 3; ++k) g->specular[k] = s->phong.specular[k];
+        g->p[2] = s->phong.shininess;
+        break;
+    case RAD_SHADING_MINNAERT: alb = s->minnaert.albedo; g->p[2] = s->minnaert.k; break;
+    case RAD_SHADING_OREN_NAYAR: alb = s->oren_nayar.albedo; g->p[2] = s->oren_nayar.sigma; break;
+    case RAD_SHADING_MICROFACET:
+        alb = s->microfacet.albedo;
+        for (k = 0; k < 3; ++k) {
+            g->f0[k] = s->microfacet.f0[k];
+            g->f90[k] = s->microfacet.f90[k];
+        }
+        g->p[0] = s->microfacet.alpha_x;
+        g->p[1] = s->microfacet.alpha_y;
+        g->p[3] = s->microfacet.fresnel_exponent;
+        g->mode[1] = (int32_t)s->microfacet.ndf;
+        g->mode[2] = (int32_t)s->microfacet.masking;
+        g->mode[3] = (int32_t)s->microfacet.diffuse;
+        break;
+    default: break;
+    }
+    for (k = 0; k < 3; ++k) g->albedo[k] = alb[k];
+}
+
+RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__shading_validate(s, &c)) != RAD_SUCCESS) return r;
+    rad__shading_pack(s, out);
+    return RAD_SUCCESS;
+}
+
+/* ---- terms (B-2.2.6 to 2.2.10) ---- */
+
+RAD_API float rad_ndf_beckmann(float nm, float alpha)
+{
+    float a2 = alpha * alpha, c2 = nm * nm;
+    if (!(nm > 0.0f)) return 0.0f;
+    return expf((c2 - 1.0f) / (a2 * c2)) / ((float)RAD__PI * a2 * c2 * c2);
+}
+
+RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
+{
+    float c2 = nm * nm, e;
+    if (!(nm > 0.0f)) return 0.0f;
+    e = (tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y)) / c2;
+    return expf(-e) / ((float)RAD__PI * alpha_x * alpha_y * c2 * c2);
+}
+
+RAD_API float rad_ndf_ggx(float nm, float alpha)
+{
+    float a2 = alpha * alpha, d;
+    if (!(nm > 0.0f)) return 0.0f;
+    d = 1.0f + nm * nm * (a2 - 1.0f);
+    return a2 / ((float)RAD__PI * d * d);
+}
+
+RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
+{
+    float d;
+    if (!(nm > 0.0f)) return 0.0f;
+    d = tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y) + nm * nm;
+    return 1.0f / ((float)RAD__PI * alpha_x * alpha_y * d * d);
+}
+
+RAD_API float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)
+{
+    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;
+    if (!(d2 > 0.0f)) return HUGE_VALF;
+    return ns / sqrtf(d2);
+}
+
+RAD_API float rad_lambda_ggx(float a)
+{
+    if (!(a < HUGE_VALF)) return 0.0f;
+    return 0.5f * (-1.0f + sqrtf(1.0f + 1.0f / (a * a)));
+}
+
+RAD_API float rad_lambda_beckmann(float a)
+{
+    if (!(a < 1.6f)) return 0.0f;
+    return (1.0f - 1.259f * a + 0.396f * a * a) / (3.535f * a + 2.181f * a * a);
+}
+
+RAD_API float rad_lambda_beckmann_exact(float a)
+{
+    double x = (double)a;
+    if (!(a < HUGE_VALF)) return 0.0f;
+    return (float)(0.5 * (erf(x) - 1.0) + exp(-x * x) / (2.0 * x * sqrt(RAD__PI)));
+}
+
+RAD_API float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0f ? 1.0f / (1.0f + lambda_s) : 0.0f; }
+
+RAD_API float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)
+{
+    return (mv > 0.0f && ml > 0.0f) ? 1.0f / ((1.0f + lambda_v) * (1.0f + lambda_l)) : 0.0f;
+}
+
+RAD_API float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)
+{
+    return (mv > 0.0f && ml > 0.0f) ? 1.0f / (1.0f + lambda_v + lambda_l) : 0.0f;
+}
+
+RAD_API float rad_fresnel_schlick(float f0, float c)
+{
+    float x = 1.0f - (c > 0.0f ? c : 0.0f), x2 = x * x;
+    return f0 + (1.0f - f0) * (x2 * x2 * x);
+}
+
+RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)
+{
+    return f0 + (f90 - f0) * powf(1.0f - (c > 0.0f ? c : 0.0f), exponent);
+}
+
+RAD_API float rad_diffuse_lambert(float albedo, float F) { return (1.0f - F) * albedo * RAD__INV_PI; }
+
+RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)
+{
+    float a = 1.0f - (nl > 0.0f ? nl : 0.0f), b = 1.0f - (nv > 0.0f ? nv : 0.0f);
+    float a5 = a * a * a * a * a, b5 = b * b * b * b * b;
+    return (1.0f - f0) * (21.0f / 20.0f) * albedo * RAD__INV_PI * (1.0f - a5) * (1.0f - b5);
+}
+
+/* ---- the evaluator, the mirror of glsl/lighting.glsl's shade() ---- */
+
+static float rad__sdot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Lambda from n.s, t.s, b.s without forming a (no division by zero at s = n) */
+static float rad__shading_lambda(int ndf, int iso, float ns, float ts, float bs, float ax, float ay)
+{
+    float d2 = iso ? ax * ax * (1.0f - ns * ns) : ax * ax * ts * ts + ay * ay * bs * bs;
+    float a;
+    if (!(d2 > 0.0f)) return 0.0f;
+    if (ndf == (int)RAD_NDF_GGX) return 0.5f * (-1.0f + sqrtf(1.0f + d2 / (ns * ns)));
+    a = ns / sqrtf(d2);
+    return rad_lambda_beckmann(a);
+}
+
+/* f and R of a packed material for unit l, v, n and orthonormal t, b (any when isotropic) */
+static void rad__shade(const rad_shading_gpu *g, const float *l, const float *v, const float *n, const float *t,
+                       const float *b, float *out_f, float *out_r)
+{
+    float nl = rad__sdot(n, l), nv = rad__sdot(n, v), f[3] = {0.0f, 0.0f, 0.0f}, rr[3] = {0.0f, 0.0f, 0.0f};
+    int k, model = g->mode[0];
+    if (nv > 0.0f) {
+        if (model == (int)RAD_SHADING_HALF_LAMBERT) {
+            float x = (nl + g->p[2]) / (1.0f + g->p[2]);
+            float q = powf(x > 0.0f ? x : 0.0f, g->p[3]);
+            for (k = 0; k < 3; ++k) rr[k] = g->albedo[k] * RAD__INV_PI * q;
+        } else if (nl > 0.0f) {
+            if (model == (int)RAD_SHADING_LAMBERT) {
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI;
+            } else if (model == (int)RAD_SHADING_BANDED) {
+                float q = ceilf(g->p[3] * nl) / g->p[3] / nl;
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI * q;
+            } else if (model == (int)RAD_SHADING_PHONG) {
+                float r[3], rv, s = g->p[2], q;
+                for (k = 0; k < 3; ++k) r[k] = 2.0f * nl * n[k] - l[k];
+                rv = rad__sdot(r, v);
+                q = (s + 2.0f) * (0.5f * RAD__INV_PI) * powf(rv > 0.0f ? rv : 0.0f, s);
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI + g->specular[k] * q;
+            } else if (model == (int)RAD_SHADING_BLINN_PHONG) {
+                float h[3], len, nh = 0.0f, s = g->p[2], q;
+                for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
+                len = sqrtf(rad__sdot(h, h));
+                if (len > 0.0f) nh = rad__sdot(n, h) / len;
+                q = (s + 2.0f) * (s + 4.0f) * (0.125f * RAD__INV_PI) / (exp2f(-0.5f * s) + s) * powf(nh > 0.0f ? nh : 0.0f, s);
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI + g->specular[k] * q;
+            } else if (model == (int)RAD_SHADING_MINNAERT) {
+                float kk = g->p[2], c = nl * nv;
+                float q = (kk + 1.0f) * (0.5f * RAD__INV_PI) * powf(c > 1e-6f ? c : 1e-6f, kk - 1.0f);
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * q;
+            } else if (model == (int)RAD_SHADING_OREN_NAYAR) {
+                float s2 = g->p[2] * g->p[2], A = 1.0f - 0.5f * s2 / (s2 + 0.33f), B = 0.45f * s2 / (s2 + 0.09f);
+                float s = rad__sdot(l, v) - nl * nv, q = s > 0.0f ? s / (nl > nv ? nl : nv) : 0.0f;
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI * (A + B * q);
+            } else if (model == (int)RAD_SHADING_MICROFACET) {
+                float h[3], len, nh, th, bh, lh, vh, ax = g->p[0], ay = g->p[1], D, G, lv, ll, sp;
+                int iso = ax == ay, ndf = g->mode[1];
+                for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
+                len = sqrtf(rad__sdot(h, h));
+                if (len > 0.0f) {
+                    for (k = 0; k < 3; ++k) h[k] /= len;
+                    nh = rad__sdot(n, h); lh = rad__sdot(l, h); vh = rad__sdot(v, h);
+                    if (iso) {
+                        th = bh = 0.0f;
+                        D = ndf == (int)RAD_NDF_GGX ? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);
+                    } else {
+                        th = rad__sdot(t, h); bh = rad__sdot(b, h);
+                        D = ndf == (int)RAD_NDF_GGX ? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)
+                                                    : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);
+                    }
+                    lv = rad__shading_lambda(ndf, iso, nv, iso ? 0.0f : rad__sdot(t, v), iso ? 0.0f : rad__sdot(b, v), ax, ay);
+                    ll = rad__shading_lambda(ndf, iso, nl, iso ? 0.0f : rad__sdot(t, l), iso ? 0.0f : rad__sdot(b, l), ax, ay);
+                    G = g->mode[2] == (int)RAD_MASKING_SEPARABLE ? rad_smith_g2_separable(vh, lh, lv, ll)
+                                                                : rad_smith_g2_height_correlated(vh, lh, lv, ll);
+                    sp = G * D / (4.0f * nl * nv);
+                    for (k = 0; k < 3; ++k) f[k] = rad_fresnel_schlick_f90(g->f0[k], g->f90[k], g->p[3], lh) * sp;
+                }
+                for (k = 0; k < 3; ++k) {
+                    if (g->mode[3] == (int)RAD_DIFFUSE_LAMBERT)
+                        f[k] += rad_diffuse_lambert(g->albedo[k], rad_fresnel_schlick_f90(g->f0[k], g->f90[k], g->p[3], nl));
+                    else if (g->mode[3] == (int)RAD_DIFFUSE_SHIRLEY)
+                        f[k] += rad_diffuse_shirley(g->albedo[k], g->f0[k], nl, nv);
+                }
+            }
+            for (k = 0; k < 3; ++k) rr[k] = f[k] * nl;
+        }
+    }
+    for (k = 0; k < 3; ++k) {
+        if (out_f) out_f[k] = f[k];
+        if (out_r) out_r[k] = rr[k];
+    }
+}
+
+/* normalizes src into dst; 0 on a zero or non-finite vector (result set) */
+static rad_result rad__shading_unit(const rad__ctx *c, const char *what, const float *src, float *dst)
+{
+    double len;
+    int k;
+    if (!rad__finite3(src)) {
+        rad__log(c, RAD_LOG_ERROR, "shading: vector %s is not finite", what);
+        return RAD_ERROR_NON_FINITE;
+    }
+    len = sqrt((double)src[0] * src[0] + (double)src[1] * src[1] + (double)src[2] * src[2]);
+    if (!(len > 1e-30)) {
+        rad__log(c, RAD_LOG_ERROR, "shading: vector %s has zero length", what);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (k = 0; k < 3; ++k) dst[k] = (float)(src[k] / len);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__shading_entry(const rad_shading *s, const float *l, const float *v, const float *n,
+                                     const float *t, const float *b, float *out, int want_f, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_result r;
+    rad_shading_gpu g;
+    float L[3], V[3], N[3], T[3] = {0.0f, 0.0f, 0.0f}, B[3] = {0.0f, 0.0f, 0.0f};
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!s || !l || !v || !n || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "shading: NULL material, vector or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((r = rad__shading_validate(s, &c)) != RAD_SUCCESS) return r;
+    if (want_f && s->model == RAD_SHADING_HALF_LAMBERT) {
+        rad__log(&c, RAD_LOG_ERROR, "shading: half-Lambert lights n.l < 0 and has no BRDF; use rad_shading_eval");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((r = rad__shading_unit(&c, "l", l, L)) != RAD_SUCCESS) return r;
+    if ((r = rad__shading_unit(&c, "v", v, V)) != RAD_SUCCESS) return r;
+    if ((r = rad__shading_unit(&c, "n", n, N)) != RAD_SUCCESS) return r;
+    if (s->model == RAD_SHADING_MICROFACET && s->microfacet.alpha_x != s->microfacet.alpha_y) {
+        float tt[3], d;
+        if (!t) {
+            rad__log(&c, RAD_LOG_ERROR, "shading: an anisotropic microfacet model needs the tangent t");
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (!rad__finite3(t) || (b && !rad__finite3(b))) {
+            rad__log(&c, RAD_LOG_ERROR, "shading: vector t or b is not finite");
+            return RAD_ERROR_NON_FINITE;
+        }
+        d = rad__sdot(t, N);
+        for (k = 0; k < 3; ++k) tt[k] = t[k] - d * N[k];
+        if ((r = rad__shading_unit(&c, "t (minus its n component)", tt, T)) != RAD_SUCCESS) return r;
+        if (b) {
+            float bb[3], e = rad__sdot(b, N), f = rad__sdot(b, T);
+            for (k = 0; k < 3; ++k) bb[k] = b[k] - e * N[k] - f * T[k];
+            if ((r = rad__shading_unit(&c, "b (minus its n and t components)", bb, B)) != RAD_SUCCESS) return r;
+        } else {
+            B[0] = N[1] * T[2] - N[2] * T[1];
+            B[1] = N[2] * T[0] - N[0] * T[2];
+            B[2] = N[0] * T[1] - N[1] * T[0];
+        }
+    }
+    rad__shading_pack(s, &g);
+    if (want_f) rad__shade(&g, L, V, N, T, B, out, NULL);
+    else rad__shade(&g, L, V, N, T, B, NULL, out);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx)
+{
+    return rad__shading_entry(s, l, v, n, t, b, out_rgb, 1, ctx);
+}
+
+RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx)
+{
+    return rad__shading_entry(s, l, v, n, t, b, out_rgb, 0, ctx);
+}
+
+RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
+                       const float b[3], float out_f[3], float out_r[3])
+{
+    static const float zero[3] = { 0.0f, 0.0f, 0.0f };
+    rad__shade(g, l, v, n, t ? t : zero, b ? b : zero, out_f, out_r);
+}
+
+typedef char rad__check_shading_gpu_size[(sizeof(rad_shading_gpu) == 96) ? 1 : -1];
 
 /* ======================================================================================== */
 /* >>container: baked data                                                                  */

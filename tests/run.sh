@@ -106,6 +106,13 @@ if build demo $CC -std=c99 $WARN -O2 $OMP -I. examples/cornell.c -o "$BUILD/corn
 else
     fail demo-small
 fi
+if build gallery $CC -std=c99 $WARN -O2 -I. examples/gallery.c -o "$BUILD/gallery" -lm &&
+   "$BUILD/gallery" --size 12 -o "$BUILD/gallery-small.png" >"$BUILD/gallery.out" 2>&1 &&
+   [ -s "$BUILD/gallery-small.png" ]; then
+    pass gallery-small
+else
+    fail gallery-small
+fi
 compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
 # ---- GLSL: the header holds the current glsl/ sources --------------------------------------
 if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
@@ -143,6 +150,22 @@ if vk_ready; then
     fi
 else
     skip vulkan "no Vulkan headers, Vulkan driver or glslangValidator (packages mesa-vulkan-drivers libvulkan-dev glslang-tools)"
+fi
+# ---- GLSL lighting models against C on a Vulkan device (lavapipe is enough) ----------------
+{ have glslangValidator && [ -f /usr/include/vulkan/vulkan.h ]; } || try_install glslang-tools libvulkan-dev mesa-vulkan-drivers
+if have glslangValidator && [ -f /usr/include/vulkan/vulkan.h ]; then
+    if build shading-vulkan $CC -std=c99 $WARN -O2 -I. tests/test_shading_vulkan.c -o "$BUILD/shading-vulkan" -lvulkan -lm; then
+        "$BUILD/shading-vulkan" . >"$BUILD/shading-vulkan.out" 2>&1
+        rc=$?
+        sed 's/^/    /' "$BUILD/shading-vulkan.out" | tail -n 12
+        if [ $rc = 0 ]; then pass shading-vulkan
+        elif [ $rc = 77 ]; then skip shading-vulkan "$(grep -m1 '^skip' "$BUILD/shading-vulkan.out")"
+        else fail shading-vulkan; fi
+    else
+        fail "shading-vulkan (build)"
+    fi
+else
+    skip shading-vulkan "glslangValidator or the Vulkan headers are missing (packages glslang-tools libvulkan-dev mesa-vulkan-drivers)"
 fi
 # ---- the rad tool (needs assimp and stb: installed when we can) --------------------------
 { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev

@@ -198,5 +198,21 @@ else
     fail "render pathtrace writes a PFM" "$(head -c 300 "$TMP/err.txt")"
 fi
 
+# --shading: the built-in box has only an area light, which stays Lambertian whatever the
+# model, so a microfacet render equals the default one up to float rounding
+if "$RAD" render cornell --patches 300 --size 32x32 --aa 1 -o "$TMP/sh-none.pfm" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" render cornell --patches 300 --size 32x32 --aa 1 --shading microfacet -o "$TMP/sh-mf.pfm" > /dev/null 2>> "$TMP/err.txt" &&
+    "$RAD" compare "$TMP/sh-none.pfm" "$TMP/sh-mf.pfm" > "$TMP/cmp.txt" 2>&1 &&
+    psnr=$(awk '/^PSNR/ { print $2 }' "$TMP/cmp.txt") &&
+    { [ "$psnr" = "inf" ] || awk -v p="$psnr" 'BEGIN { exit !(p + 0 > 100) }'; }; then
+    ok "render --shading leaves area lights Lambertian (PSNR $psnr dB: float rounding only)"
+else
+    fail "render --shading leaves area lights Lambertian" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" render cornell -o "$TMP/x.png" --shading gouraud > /dev/null 2>&1; rc=$?
+[ $rc = 2 ] && ok "render --shading rejects an unknown model" || fail "render --shading rejects an unknown model" "exit $rc"
+"$RAD" render cornell -o "$TMP/x.png" --method pathtrace --shading phong > /dev/null 2>&1; rc=$?
+[ $rc = 2 ] && ok "render --shading is refused with pathtrace" || fail "render --shading is refused with pathtrace" "exit $rc"
+
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

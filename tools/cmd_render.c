@@ -42,6 +42,10 @@ static void render_usage(FILE *f)
             "  --seed S           pathtrace: random seed (default 0)\n"
             "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
             "  --pixel-light-samples N   classic: shadow rays per pixel sample and light (default 16)\n"
+            "  --shading MODEL    classic: lighting model for the analytic lights' direct term: none (default:\n"
+            "                     Lambert through the irradiance), lambert, half-lambert, banded, phong,\n"
+            "                     blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says how it\n"
+            "                     combines with the diffuse radiosity solution)\n"
             "classic solution options (ignored with --bake, which keeps its own):\n"
             "%s"
             "  --threads N        worker threads (default: all)\n",
@@ -109,6 +113,9 @@ typedef struct isect_job {
     int failed;
 } isect_job;
 
+/* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
+static int render_shading = -1;
+
 static int render_classic(const rad_tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
                           int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
 {
@@ -117,7 +124,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     size_t batch_cap, total = (size_t)width * height, done_px = 0;
     rad_ray *rays;
     rad_hit *hits;
-    float *points, *normals, *irr;
+    float *points, *normals, *irr, *shade_v = NULL, *shade_a = NULL, *shaded = NULL;
     uint32_t *valid;
     rad_direct_options dopt;
     rad_context quiet;
@@ -134,6 +141,11 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
+    if (render_shading >= 0) {
+        shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+        shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+        shaded = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    }
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
     dopt.light_samples = light_samples;
@@ -192,6 +204,18 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
                 break;
             }
         }
+        if (shaded && nvalid > 0) {
+            for (k = 0; k < nvalid; ++k) {
+                const rad_ray *ry = &rays[valid[k]];
+                float len = sqrtf(ry->dir[0] * ry->dir[0] + ry->dir[1] * ry->dir[1] + ry->dir[2] * ry->dir[2]);
+                for (i = 0; i < 3; ++i) shade_v[3 * k + i] = -ry->dir[i] / len;
+                rad_scene_albedo(scene, hits[valid[k]].triangle, hits[valid[k]].b1, hits[valid[k]].b2, shade_a + 3 * k);
+            }
+            if (rad_tool_shade_direct(w, render_shading, light_samples, points, normals, shade_v, shade_a, nvalid, shaded)) {
+                result = 1;
+                break;
+            }
+        }
         for (k = 0; k < nvalid; ++k) {
             uint32_t ray = valid[k];
             size_t pixel = (size_t)y0 * width + ray / spp;
@@ -206,7 +230,8 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
             for (i = 0; i < 3; ++i) {
                 float hi = wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
                            wts[2] * Hv[3 * (size_t)vi[2] + i];
-                img->rgb[3 * pixel + i] += albedo[i] / PI_F * (irr[3 * k + i] + hi) + m->emission[i];
+                img->rgb[3 * pixel + i] += (shaded ? shaded[3 * k + i] + albedo[i] / PI_F * hi
+                                                   : albedo[i] / PI_F * (irr[3 * k + i] + hi)) + m->emission[i];
             }
         }
         done_px += (size_t)(y1 - y0) * width;
@@ -224,6 +249,9 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     free(normals);
     free(irr);
     free(valid);
+    free(shade_v);
+    free(shade_a);
+    free(shaded);
     return result;
 }
 
@@ -292,6 +320,8 @@ int rad_cmd_render(int argc, char **argv)
         } else if (!strcmp(opt, "--exposure")) {
             if (rad_tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
             if (!(exposure > 0.0f)) { fprintf(stderr, "rad %s: --exposure must be > 0\n", cmd); return 2; }
+        } else if (!strcmp(opt, "--shading")) {
+            if (rad_tool_parse_shading(cmd, argv[++a], &render_shading)) return 2;
         } else if (!strcmp(opt, "--threads")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
@@ -310,6 +340,10 @@ int rad_cmd_render(int argc, char **argv)
         return 2;
     }
     pathtrace = !strcmp(method, "pathtrace");
+    if (pathtrace && render_shading >= 0) {
+        fprintf(stderr, "rad %s: --shading is for --method classic (the path tracer is Lambertian)\n", cmd);
+        return 2;
+    }
     if (pathtrace && bake_path) {
         fprintf(stderr, "rad %s: --bake is for --method classic\n", cmd);
         return 2;

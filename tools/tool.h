@@ -167,4 +167,14 @@ typedef struct rad_tool_bake_info {
 } rad_tool_bake_info;
 #define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u)
 
+/* ---- lighting models for the direct term (shading.c) ------------------------------------ */
+/* "none" (-1) or a rad_shading_model name; 0 on success, else prints and returns 2 */
+int rad_tool_parse_shading(const char *cmd, const char *text, int *out_model);
+/* Direct radiance at 'count' points (normals n, unit directions to the viewer v, albedos):
+   sum over the analytic lights of E V R(l, v, n) for the model, plus albedo / pi times the
+   irradiance of the emissive triangles and the sky. 0 on success, 1 (message printed). */
+int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_samples, const float *points,
+                          const float *normals, const float *views, const float *albedos, uint32_t count,
+                          float *out_rgb);
+
 #endif
