@@ -204,7 +204,8 @@
        it with glslang or shaderc and dispatch it on your own Vulkan device; radiosity.h never
        touches a GPU. Kernels: dense and CSR gather (one bounce), multi-bounce apply from
        float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
-       step (the same random draws as the CPU) and the alias-table build for streamed rows.
+       step (the same random draws as the CPU) and the alias-table build for streamed rows;
+       RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
        specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), a workgroup (gathers, applies) or
@@ -1173,7 +1174,12 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        layout: row i's bins from bin row_offsets[i] + i (room for its entries + 1), at word
        (b - out_base) * words  4: scratch, one double per output bin  5: scratch, one uint per
        output bin  6: bin count per row (0: a negative or non-finite entry, or a column >= cols)
-       7: T_i per row. RAD_GLSL_TEMPORAL_STEP samples this layout directly (RAD_GLSL_FLAG_PADDED). */
+       7: T_i per row. RAD_GLSL_TEMPORAL_STEP samples this layout directly (RAD_GLSL_FLAG_PADDED).
+   RAD_GLSL_LIGHTING       an include, not a kernel: every lighting model and BRDF term of
+       >>api_shading as GLSL functions named as in C (rad_shade ...), no #version line: put
+       its text after yours (or resolve an #include to it). Its results agree with the C
+       functions to 1e-5 relative (tests/test_shading_vulkan.c, through glsl/lighting_eval.comp;
+       the header's copy is checked equal to glsl/lighting.glsl). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -1184,7 +1190,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_TEMPORAL_STEP     =  4, /* glsl/temporal_step.comp */
     RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* glsl/mb_apply_blocks.comp */
     RAD_GLSL_ALIAS_BUILD       =  6, /* glsl/alias_build.comp */
-    RAD_GLSL_COUNT = 7
+    RAD_GLSL_LIGHTING          =  7, /* glsl/lighting.glsl */
+    RAD_GLSL_COUNT = 8
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -6559,6 +6566,231 @@ static const char rad__glsl_6_1[] =
     "    totals[i] = float(total);\n"
     "}\n";
 static const char *const rad__glsl_pieces_6[] = { rad__glsl_6_0, rad__glsl_6_1 };
+static const char rad__glsl_7_0[] =
+    "// lighting.glsl - the lighting models and BRDF terms of radiosity.h (SPEC \302\2479, >>shading),\n"
+    "// GLSL 450. An include: no #version; it defines only functions and one struct, all named\n"
+    "// as their C counterparts (rad_ndf_ggx ...). The arithmetic is written in the same order as\n"
+    "// the C code so the results agree to float rounding (tests/test_shading_vulkan.c checks\n"
+    "// 1e-5 relative). Conventions (l, v, n unit; f the BRDF; R = f * max(n.l, 0) the response)\n"
+    "// are those of the >>api_shading comment in radiosity.h.\n"
+    "//\n"
+    "// Including it: either with GL_GOOGLE_include_directive (as glsl/lighting_eval.comp does:\n"
+    "// glslangValidator resolves it relative to the including file), or by pasting this file's\n"
+    "// text after your #version line.\n"
+    "#ifndef RAD_LIGHTING_GLSL\n"
+    "#define RAD_LIGHTING_GLSL\n"
+    "\n"
+    "#define RAD_SHADING_LAMBERT 0\n"
+    "#define RAD_SHADING_HALF_LAMBERT 1\n"
+    "#define RAD_SHADING_BANDED 2\n"
+    "#define RAD_SHADING_PHONG 3\n"
+    "#define RAD_SHADING_BLINN_PHONG 4\n"
+    "#define RAD_SHADING_MINNAERT 5\n"
+    "#define RAD_SHADING_OREN_NAYAR 6\n"
+    "#define RAD_SHADING_MICROFACET 7\n"
+    "#define RAD_NDF_BECKMANN 0\n"
+    "#define RAD_NDF_GGX 1\n"
+    "#define RAD_MASKING_SEPARABLE 0\n"
+    "#define RAD_MASKING_HEIGHT_CORRELATED 1\n"
+    "#define RAD_DIFFUSE_NONE 0\n"
+    "#define RAD_DIFFUSE_LAMBERT 1\n"
+    "#define RAD_DIFFUSE_SHIRLEY 2\n"
+    "\n"
+    "const float RAD_PI = 3.14159265358979323846;\n"
+    "const float RAD_INV_PI = 0.318309886183790671537767526745;\n"
+    "\n"
+    "// The std430 mirror of rad_shading_gpu (96 bytes), filled by rad_shading_pack():\n"
+    "// albedo (or kd), specular (ks), f0, f90, p = (alpha_x, alpha_y, wrap / shininess / k / sigma,\n"
+    "// half-Lambert exponent / bands / Fresnel exponent), mode = (model, ndf, masking, diffuse).\n"
+    "struct RadShadingParams {\n"
+    "    vec4 albedo;\n"
+    "    vec4 specular;\n"
+    "    vec4 f0;\n"
+    "    vec4 f90;\n"
+    "    vec4 p;\n"
+    "    ivec4 mode;\n"
+    "};\n"
+    "\n"
+    "// B eq. 18\n"
+    "float rad_ndf_beckmann(float nm, float alpha)\n"
+    "{\n"
+    "    float a2 = alpha * alpha, c2 = nm * nm;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    return exp((c2 - 1.0) / (a2 * c2)) / (RAD_PI * a2 * c2 * c2);\n"
+    "}\n"
+    "\n"
+    "// B eq. 24\n"
+    "float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    float c2 = nm * nm;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float e = (tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y)) / c2;\n"
+    "    return exp(-e) / (RAD_PI * alpha_x * alpha_y * c2 * c2);\n"
+    "}\n"
+    "\n"
+    "// B eq. 22\n"
+    "float rad_ndf_ggx(float nm, float alpha)\n"
+    "{\n"
+    "    float a2 = alpha * alpha;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float d = 1.0 + nm * nm * (a2 - 1.0);\n"
+    "    return a2 / (RAD_PI * d * d);\n"
+    "}\n"
+    "\n"
+    "// B eq. 26\n"
+    "float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float d = tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y) + nm * nm;\n"
+    "    return 1.0 / (RAD_PI * alpha_x * alpha_y * d * d);\n"
+    "}\n"
+    "\n"
+    "// B eq. 25 (eq. 19 when alpha_x = alpha_y): the Smith variable a; the largest float for\n"
+    "// s = n (C returns +inf there; both give Lambda = 0)\n"
+    "float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;\n"
+    "    if (!(d2 > 0.0)) return 3.402823466e38;\n"
+    "    return ns / sqrt(d2);\n"
+    "}\n"
+    "\n"
+    "// B eq. 23, for a > 0\n"
+    "// (Beckmann's exact Lambda, eq. 20, needs erf, which GLSL lacks: it is C only.)\n"
+    "float rad_lambda_ggx(float a)\n"
+    "{\n"
+    "    return 0.5 * (-1.0 + sqrt(1.0 + 1.0 / (a * a)));\n"
+    "}\n"
+    "\n"
+    "// B eq. 21 (Beckmann, rational approximation)\n"
+    "float rad_lambda_beckmann(float a)\n"
+    "{\n"
+    "    if (!(a < 1.6)) return 0.0;\n"
+    "    return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);\n"
+    "}\n"
+    "\n"
+    "// B eq. 11\n"
+    "float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0 \? 1.0 / (1.0 + lambda_s) : 0.0; }\n"
+    "\n"
+    "// B eq. 13 and 14\n"
+    "float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)\n"
+    "{\n"
+    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / ((1.0 + lambda_v) * (1.0 + lambda_l)) : 0.0;\n"
+    "}\n"
+    "\n"
+    "float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)\n"
+    "{\n"
+    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / (1.0 + lambda_v + lambda_l) : 0.0;\n"
+    "}\n"
+    "\n"
+    "// B eq. 15 and 16 (one channel)\n";
+static const char rad__glsl_7_1[] =
+    "float rad_fresnel_schlick(float f0, float c)\n"
+    "{\n"
+    "    float x = 1.0 - (c > 0.0 \? c : 0.0), x2 = x * x;\n"
+    "    return f0 + (1.0 - f0) * (x2 * x2 * x);\n"
+    "}\n"
+    "\n"
+    "float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)\n"
+    "{\n"
+    "    return f0 + (f90 - f0) * pow(1.0 - (c > 0.0 \? c : 0.0), exponent);\n"
+    "}\n"
+    "\n"
+    "// B eq. 27 and 28 (one channel)\n"
+    "float rad_diffuse_lambert(float albedo, float F) { return (1.0 - F) * albedo * RAD_INV_PI; }\n"
+    "\n"
+    "float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)\n"
+    "{\n"
+    "    float a = 1.0 - (nl > 0.0 \? nl : 0.0), b = 1.0 - (nv > 0.0 \? nv : 0.0);\n"
+    "    float a5 = a * a * a * a * a, b5 = b * b * b * b * b;\n"
+    "    return (1.0 - f0) * (21.0 / 20.0) * albedo * RAD_INV_PI * (1.0 - a5) * (1.0 - b5);\n"
+    "}\n"
+    "\n"
+    "// Lambda from n.s, t.s, b.s without forming a (no division by zero at s = n)\n"
+    "float rad_shading_lambda(int ndf, bool iso, float ns, float ts, float bs, float ax, float ay)\n"
+    "{\n"
+    "    float d2 = iso \? ax * ax * (1.0 - ns * ns) : ax * ax * ts * ts + ay * ay * bs * bs;\n"
+    "    if (!(d2 > 0.0)) return 0.0;\n"
+    "    if (ndf == RAD_NDF_GGX) return 0.5 * (-1.0 + sqrt(1.0 + d2 / (ns * ns)));\n"
+    "    return rad_lambda_beckmann(ns / sqrt(d2));\n"
+    "}\n"
+    "\n"
+    "// f (out_f) and R (return value) for unit l, v, n and an orthonormal t, b (anything when the\n"
+    "// model is isotropic). f is 0 for half-Lambert, which has no BRDF.\n"
+    "vec3 rad_shade(RadShadingParams g, vec3 l, vec3 v, vec3 n, vec3 t, vec3 b, out vec3 out_f)\n"
+    "{\n"
+    "    float nl = dot(n, l), nv = dot(n, v);\n"
+    "    vec3 f = vec3(0.0), rr = vec3(0.0);\n"
+    "    int model = g.mode.x;\n"
+    "    if (nv > 0.0) {\n"
+    "        if (model == RAD_SHADING_HALF_LAMBERT) {\n"
+    "            float x = (nl + g.p.z) / (1.0 + g.p.z);\n"
+    "            float q = pow(x > 0.0 \? x : 0.0, g.p.w);\n"
+    "            rr = g.albedo.xyz * RAD_INV_PI * q;\n"
+    "        } else if (nl > 0.0) {\n"
+    "            if (model == RAD_SHADING_LAMBERT) {\n"
+    "                f = g.albedo.xyz * RAD_INV_PI;\n"
+    "            } else if (model == RAD_SHADING_BANDED) {\n"
+    "                float q = ceil(g.p.w * nl) / g.p.w / nl;\n"
+    "                f = g.albedo.xyz * RAD_INV_PI * q;\n"
+    "            } else if (model == RAD_SHADING_PHONG) {\n"
+    "                vec3 r = 2.0 * nl * n - l;\n"
+    "                float rv = dot(r, v), s = g.p.z;\n"
+    "                float q = (s + 2.0) * (0.5 * RAD_INV_PI) * pow(rv > 0.0 \? rv : 0.0, s);\n"
+    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_BLINN_PHONG) {\n"
+    "                vec3 h = l + v;\n"
+    "                float len = sqrt(dot(h, h)), nh = 0.0, s = g.p.z;\n"
+    "                if (len > 0.0) nh = dot(n, h) / len;\n"
+    "                float q = (s + 2.0) * (s + 4.0) * (0.125 * RAD_INV_PI) / (exp2(-0.5 * s) + s) * pow(nh > 0.0 \? nh : 0.0, s);\n"
+    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_MINNAERT) {\n"
+    "                float kk = g.p.z, c = nl * nv;\n"
+    "                float q = (kk + 1.0) * (0.5 * RAD_INV_PI) * pow(c > 1e-6 \? c : 1e-6, kk - 1.0);\n"
+    "                f = g.albedo.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_OREN_NAYAR) {\n"
+    "                float s2 = g.p.z * g.p.z, A = 1.0 - 0.5 * s2 / (s2 + 0.33), B = 0.45 * s2 / (s2 + 0.09);\n"
+    "                float s = dot(l, v) - nl * nv, q = s > 0.0 \? s / (nl > nv \? nl : nv) : 0.0;\n"
+    "                f = g.albedo.xyz * RAD_INV_PI * (A + B * q);\n"
+    "            } else if (model == RAD_SHADING_MICROFACET) {\n"
+    "                float ax = g.p.x, ay = g.p.y;\n"
+    "                bool iso = ax == ay;\n"
+    "                int ndf = g.mode.y;\n"
+    "                vec3 h = l + v;\n"
+    "                float len = sqrt(dot(h, h));\n"
+    "                if (len > 0.0) {\n"
+    "                    h /= len;\n"
+    "                    float nh = dot(n, h), lh = dot(l, h), vh = dot(v, h), D;\n"
+    "                    if (iso) {\n"
+    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);\n"
+    "                    } else {\n"
+    "                        float th = dot(t, h), bh = dot(b, h);\n"
+    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)\n";
+static const char rad__glsl_7_2[] =
+    "                                               : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);\n"
+    "                    }\n"
+    "                    float lv = rad_shading_lambda(ndf, iso, nv, iso \? 0.0 : dot(t, v), iso \? 0.0 : dot(b, v), ax, ay);\n"
+    "                    float ll = rad_shading_lambda(ndf, iso, nl, iso \? 0.0 : dot(t, l), iso \? 0.0 : dot(b, l), ax, ay);\n"
+    "                    float G = g.mode.z == RAD_MASKING_SEPARABLE \? rad_smith_g2_separable(vh, lh, lv, ll)\n"
+    "                                                               : rad_smith_g2_height_correlated(vh, lh, lv, ll);\n"
+    "                    float sp = G * D / (4.0 * nl * nv);\n"
+    "                    for (int k = 0; k < 3; ++k) f[k] = rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, lh) * sp;\n"
+    "                }\n"
+    "                for (int k = 0; k < 3; ++k) {\n"
+    "                    if (g.mode.w == RAD_DIFFUSE_LAMBERT)\n"
+    "                        f[k] += rad_diffuse_lambert(g.albedo[k], rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, nl));\n"
+    "                    else if (g.mode.w == RAD_DIFFUSE_SHIRLEY)\n"
+    "                        f[k] += rad_diffuse_shirley(g.albedo[k], g.f0[k], nl, nv);\n"
+    "                }\n"
+    "            }\n"
+    "            rr = f * nl;\n"
+    "        }\n"
+    "    }\n"
+    "    out_f = f;\n"
+    "    return rr;\n"
+    "}\n"
+    "\n"
+    "#endif\n";
+static const char *const rad__glsl_pieces_7[] = { rad__glsl_7_0, rad__glsl_7_1, rad__glsl_7_2 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
@@ -6566,7 +6798,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
     { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
-    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4697u }
+    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4697u },
+    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9212u }
 };
 /* >>glsl end */
 

@@ -28,6 +28,7 @@ static const kernel kernels[] = {
     { "RAD_GLSL_TEMPORAL_STEP", "glsl/temporal_step.comp" },
     { "RAD_GLSL_MB_APPLY_BLOCKS", "glsl/mb_apply_blocks.comp" },
     { "RAD_GLSL_ALIAS_BUILD", "glsl/alias_build.comp" },
+    { "RAD_GLSL_LIGHTING", "glsl/lighting.glsl" }, /* an include: every lighting model (>>shading) */
 };
 #define KERNELS (sizeof(kernels) / sizeof(kernels[0]))
 
@@ -81,8 +82,12 @@ static void literal(buf *b, const char *s, size_t n)
         else if (ch == '\n') puts_(b, "\\n");
         else if (ch == '\t') puts_(b, "\\t");
         else if (ch == '?') puts_(b, "\\?"); /* no trigraphs */
-        else if (ch < 32 || ch > 126) {
-            fprintf(stderr, "glsl/embed: byte %u is not printable ASCII (keep the GLSL sources ASCII)\n", ch);
+        else if (ch > 126) { /* UTF-8 in comments: three-digit octal escapes, the same bytes */
+            char esc[8];
+            sprintf(esc, "\\%03o", (unsigned)ch);
+            puts_(b, esc);
+        } else if (ch < 32) {
+            fprintf(stderr, "glsl/embed: control byte %u in a GLSL source (only newline and tab are allowed)\n", ch);
             exit(1);
         } else put(b, (const char *)&ch, 1);
     }
