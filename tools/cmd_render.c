@@ -466,7 +466,7 @@ int rad_cmd_render(int argc, char **argv)
     seed = mo.seed;
     pathtrace = mo.method == RAD_TOOL_PATHTRACE;
     if (pathtrace && bake_path) {
-        fprintf(stderr, "rad %s: --bake is for --method classic\n", cmd);
+        fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
     }
     {

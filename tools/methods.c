@@ -85,8 +85,10 @@ const char *rad_tool_method_help(int render)
                     "temporal (these override the bake's):\n"
                     "  --frames N         frames to step; the image shows the last (default 64)\n"
                     "  --k K              draws per patch and frame (default 10)\n"
-                    "  --w W              fixed blend weight in [0, 1) (default 0.998)\n"
-                    "  --adaptive         per-patch blend weight from the estimator's variance\n"
+                    "  --w W              fixed blend weight in [0, 1) (default 0.998: B starts at 0 and\n"
+                    "                     reaches 1 - W^N of the solution after N frames, ~2300 for 99%)\n"
+                    "  --adaptive         per-patch blend weight from the estimator's variance (starts as the\n"
+                    "                     running mean of the frames: converges fast)\n"
                     "  --seed S           generator seed (default 0; also the path tracer's seed)\n"
                     "  --sequence DIR     also write DIR/frame_NNNNN.png every --every N frames (default 1)\n"
                   : "multibounce:\n"
@@ -638,8 +640,11 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
             fprintf(stderr, "rad %s: bake '%s': cannot open its multi-bounce matrix\n", cmd, bake_name);
             return rad_tool_fail(cmd, "rad_multibounce_load", r);
         }
-        fprintf(stderr, "rad %s: F_mb %s, bounces %s (+1 gather), %u patches\n", cmd, format_name(kind),
-                mi.bounces == RAD_MB_INFINITE ? "inf" : "K", n);
+        if (mi.bounces == RAD_MB_INFINITE)
+            fprintf(stderr, "rad %s: F_mb %s, bounces inf, %u patches\n", cmd, format_name(kind), n);
+        else
+            fprintf(stderr, "rad %s: F_mb %s, bounces %u (F_mb holds %u with the gather), %u patches\n", cmd,
+                    format_name(kind), mi.bounces, mi.bounces + 1u, n);
     } else {
         static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
         const rad_alias_tables *tp[3];
