@@ -222,6 +222,9 @@ if "$RAD" render cornell $M -o "$TMP/ref.pfm" > /dev/null 2> "$TMP/err.txt" &&
         "$RAD" render cornell --method multibounce --bake "$TMP/mbf.radb" $M -o "$TMP/mbf.pfm" > /dev/null 2>> "$TMP/err.txt"; then
         ok "multibounce float bakes and renders"
         psnr_check "multibounce float K=64 = classic K=64" "$TMP/ref.pfm" "$TMP/mbf.pfm" 90
+        "$RAD" render cornell --method multibounce --format float $M -o "$TMP/mbf_mem.pfm" > /dev/null 2>&1
+        cmp -s "$TMP/mbf.pfm" "$TMP/mbf_mem.pfm" && ok "multibounce render --bake equals the in-memory bake" ||
+            fail "multibounce render --bake equals the in-memory bake"
         "$RAD" info "$TMP/mbf.radb" > "$TMP/info.txt" 2>&1
         grep -q "MB_FLOAT" "$TMP/info.txt" && grep -q "USER(row sums)" "$TMP/info.txt" &&
             grep -q "method: multibounce, --bounces 64, --format float" "$TMP/info.txt" &&
