@@ -317,7 +317,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         sum += t;
         if (t < tmin) tmin = t;
         if (t > tmax) tmax = t;
-        if (rc == 0 && mo->sequence && (f % mo->every == 0 || f == frames)) {
+        if (rc == 0 && mo->sequence && f % mo->every == 0 && f != frames) { /* the last one: below */
             char path[4096];
             rad_image frame;
             memset(&frame, 0, sizeof frame);
@@ -344,6 +344,14 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
     }
     if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, img);
+    if (rc == 0 && mo->sequence) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
+        if (rad_image_write_png(path, img, exposure) != 0) {
+            fprintf(stderr, "rad %s: cannot write '%s' (does the directory exist?)\n", cmd, path);
+            rc = 1;
+        }
+    }
     free(H);
     free(Hv);
     rad_tool_indirect_close(m);
