@@ -396,9 +396,13 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
             what = "rad_multibounce_create";
             goto fail;
         }
-        fprintf(stderr, "rad %s: F_mb (%s bounces, %s) built in %.2f s\n", cmd,
-                mbo.bounces == RAD_MB_INFINITE ? "inf" : "K+1", mbo.precision == RAD_MB_HALF ? "half" : "float",
-                rad_tool_seconds() - t0);
+        if (mbo.bounces == RAD_MB_INFINITE)
+            fprintf(stderr, "rad %s: F_mb (inf bounces, %s) built in %.2f s\n", cmd,
+                    mbo.precision == RAD_MB_HALF ? "half" : "float", rad_tool_seconds() - t0);
+        else
+            fprintf(stderr, "rad %s: F_mb (%u bounces: --bounces %u and the renderer's gather, %s) built in %.2f s\n",
+                    cmd, mbo.bounces, mo->bounces, mbo.precision == RAD_MB_HALF ? "half" : "float",
+                    rad_tool_seconds() - t0);
     }
     if (mo->method == RAD_TOOL_MULTIBOUNCE) {
         if (mo->format >= RAD_TOOL_MB_BC1) {
