@@ -213,6 +213,149 @@ fi
 [ $rc = 2 ] && ok "render --shading rejects an unknown model" || fail "render --shading rejects an unknown model" "exit $rc"
 "$RAD" render cornell -o "$TMP/x.png" --method pathtrace --shading phong > /dev/null 2>&1; rc=$?
 [ $rc = 2 ] && ok "render --shading is refused with pathtrace" || fail "render --shading is refused with pathtrace" "exit $rc"
+# ---- multibounce and temporal (SPEC §4, §8) ------------------------------------------------
+# Small runs (~330 patches, 32x32 images) against the classic method with the same patches.
+# `--bounces K` means the same in all methods (the patch solution L_K; the image gathers once
+# more), so multibounce with float storage must reproduce classic to float rounding, compressed
+# storage to its compression error, and temporal approaches it as frames are averaged.
+psnr_of() { "$RAD" compare "$1" "$2" 2> /dev/null | awk '/^PSNR/ { print $2 }'; }
+ssim_of() { "$RAD" compare "$1" "$2" 2> /dev/null | awk '/^SSIM/ { print $2 }'; }
+# at_least VALUE MIN: inf counts as large
+at_least() { [ "$1" = "inf" ] || awk -v v="$1" -v m="$2" 'BEGIN { exit !(v != "" && v + 0 >= m) }'; }
+M="--patches 300 --size 32x32 --aa 4"
+# psnr_check NAME A B MIN_DB: ok when PSNR(A, B) >= MIN_DB
+psnr_check() {
+    local p
+    p=$(psnr_of "$2" "$3")
+    at_least "$p" "$4" && ok "$1 (PSNR $p dB >= $4)" || fail "$1" "PSNR '$p' dB, want >= $4"
+}
+if "$RAD" render cornell $M -o "$TMP/ref.pfm" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" render cornell $M --bounces 0 -o "$TMP/ref0.pfm" > /dev/null 2>> "$TMP/err.txt" &&
+    "$RAD" render cornell $M --bounces 1 -o "$TMP/ref1.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+    # multibounce: bake (float), info, render from the bake
+    if "$RAD" bake cornell --patches 300 --method multibounce --format float -o "$TMP/mbf.radb" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell --method multibounce --bake "$TMP/mbf.radb" $M -o "$TMP/mbf.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        ok "multibounce float bakes and renders"
+        psnr_check "multibounce float K=64 = classic K=64" "$TMP/ref.pfm" "$TMP/mbf.pfm" 90
+        "$RAD" render cornell --method multibounce --format float $M -o "$TMP/mbf_mem.pfm" > /dev/null 2>&1
+        cmp -s "$TMP/mbf.pfm" "$TMP/mbf_mem.pfm" && ok "multibounce render --bake equals the in-memory bake" ||
+            fail "multibounce render --bake equals the in-memory bake"
+        "$RAD" info "$TMP/mbf.radb" > "$TMP/info.txt" 2>&1
+        grep -q "MB_FLOAT" "$TMP/info.txt" && grep -q "USER(row sums)" "$TMP/info.txt" &&
+            grep -q "method: multibounce, --bounces 64, --format float" "$TMP/info.txt" &&
+            ! grep -q "FF_DENSE" "$TMP/info.txt" && ok "info shows a multibounce bake" ||
+            fail "info shows a multibounce bake" "$(head -c 600 "$TMP/info.txt")"
+        "$RAD" render cornell --bake "$TMP/mbf.radb" $M -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"
+        rc=$?
+        [ $rc -eq 1 ] && grep -q "render it with that --method" "$TMP/err.txt" &&
+            ok "classic render rejects a multibounce bake" || fail "classic render rejects a multibounce bake" "exit $rc"
+        "$RAD" render cornell --method temporal --bake "$TMP/mbf.radb" $M -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"
+        rc=$?
+        [ $rc -eq 1 ] && grep -q "was made with --method multibounce, not temporal" "$TMP/err.txt" &&
+            ok "temporal render rejects a multibounce bake" || fail "temporal render rejects a multibounce bake" "exit $rc"
+        "$RAD" render "$TMP/parallel.obj" --method multibounce --bake "$TMP/mbf.radb" --size 8x8 -o "$TMP/x.pfm" \
+            > /dev/null 2> "$TMP/err.txt"
+        rc=$?
+        [ $rc -eq 1 ] && grep -q "triangles" "$TMP/err.txt" && ok "multibounce render rejects another scene's bake" ||
+            fail "multibounce render rejects another scene's bake" "exit $rc"
+    else
+        fail "multibounce float bakes and renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
+    # one bounce: classic --bounces 1 = multibounce --bounces 1, and both differ from 64
+    if "$RAD" render cornell $M --method multibounce --format float --bounces 1 -o "$TMP/mb1.pfm" > /dev/null 2> "$TMP/err.txt"; then
+        psnr_check "multibounce float K=1 = classic K=1" "$TMP/ref1.pfm" "$TMP/mb1.pfm" 90
+        p=$(psnr_of "$TMP/ref.pfm" "$TMP/mb1.pfm")
+        at_least "$p" 60 && fail "K=1 differs from K=64" "PSNR $p dB: the comparison cannot tell bounces apart" ||
+            ok "K=1 differs from K=64 (PSNR $p dB < 60)"
+    else
+        fail "multibounce float K=1 = classic K=1" "$(head -c 300 "$TMP/err.txt")"
+    fi
+    # compressed and half storage, built in memory: close to classic within the compression error
+    for f in "bc4x3 --bounces inf:50" "bc1:45" "half:80"; do
+        fmt=${f%%:*}
+        "$RAD" render cornell $M --method multibounce --format $fmt -o "$TMP/mbc.pfm" > /dev/null 2> "$TMP/err.txt" &&
+            psnr_check "multibounce --format $fmt ~ classic" "$TMP/ref.pfm" "$TMP/mbc.pfm" "${f##*:}" ||
+            fail "multibounce --format $fmt ~ classic" "$(head -c 300 "$TMP/err.txt")"
+    done
+    s=$(ssim_of "$TMP/ref.pfm" "$TMP/mbc.pfm")
+    at_least "$s" 0.999 && ok "multibounce half SSIM $s >= 0.999" || fail "multibounce half SSIM" "'$s'"
+    grep -q "compressed to" "$TMP/err.txt" && fail "half storage reports no compression" || ok "half storage reports no compression"
+    "$RAD" render cornell $M --method multibounce --outliers 0.02 --tile 0 --no-reorder -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"
+    grep -q "compressed to bc4x3 .*RMS error" "$TMP/err.txt" && grep -q " 0 bytes\| permutations 0)" "$TMP/err.txt" &&
+        ok "bc4x3 --no-reorder reports its compression" || fail "bc4x3 --no-reorder reports its compression" "$(grep compressed "$TMP/err.txt")"
+
+    # temporal: bake, info, render; converges towards classic as frames average
+    if "$RAD" bake cornell --patches 300 --method temporal --adaptive -o "$TMP/t.radb" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell --method temporal --bake "$TMP/t.radb" --frames 100 $M -o "$TMP/t100.pfm" > /dev/null 2> "$TMP/err.txt"; then
+        ok "temporal bakes and renders"
+        grep -q "100 frames, temporal step .* ms per frame" "$TMP/err.txt" && ok "temporal prints the per-frame time" ||
+            fail "temporal prints the per-frame time"
+        "$RAD" info "$TMP/t.radb" > "$TMP/info.txt" 2>&1
+        grep -q "ALIAS_BINS" "$TMP/info.txt" && grep -q "method: temporal, --mode feedback, --k 10, --adaptive" "$TMP/info.txt" &&
+            ok "info shows a temporal bake" || fail "info shows a temporal bake" "$(head -c 600 "$TMP/info.txt")"
+        "$RAD" render cornell --method temporal --bake "$TMP/t.radb" --frames 4 $M -o "$TMP/t4.pfm" > /dev/null 2>&1
+        p4=$(psnr_of "$TMP/ref.pfm" "$TMP/t4.pfm")
+        p100=$(psnr_of "$TMP/ref.pfm" "$TMP/t100.pfm")
+        at_least "$p100" 45 && awk -v a="$p4" -v b="$p100" 'BEGIN { exit !(a != "" && b - a >= 6) }' &&
+            ok "temporal approaches classic (PSNR $p4 dB after 4 frames, $p100 dB after 100: >= 45 and 6 dB better)" ||
+            fail "temporal approaches classic" "PSNR $p4 dB after 4 frames, $p100 dB after 100"
+        "$RAD" render cornell --method temporal --bake "$TMP/t.radb" --frames 100 $M -o "$TMP/t100b.pfm" > /dev/null 2>&1
+        cmp -s "$TMP/t100.pfm" "$TMP/t100b.pfm" && ok "temporal is deterministic for a seed" || fail "temporal is deterministic for a seed"
+        "$RAD" render cornell --method temporal --bake "$TMP/t.radb" --frames 100 --seed 7 $M -o "$TMP/t100s.pfm" > /dev/null 2>&1
+        cmp -s "$TMP/t100.pfm" "$TMP/t100s.pfm" && fail "--seed changes the draws" || ok "--seed changes the draws"
+        "$RAD" render cornell --method temporal --bake "$TMP/t.radb" --frames 5 --sequence "$TMP/seq" --every 2 --size 16x16 --aa 1 \
+            -o "$TMP/seq.png" > /dev/null 2> "$TMP/err.txt"
+        [ -s "$TMP/seq/frame_00002.png" ] && [ -s "$TMP/seq/frame_00004.png" ] && [ -s "$TMP/seq/frame_00005.png" ] &&
+            [ ! -e "$TMP/seq/frame_00003.png" ] && ok "temporal --sequence writes every 2nd frame and the last" ||
+            fail "temporal --sequence writes every 2nd frame and the last" "$(ls "$TMP/seq" 2>&1 | tr '\n' ' ')"
+        "$RAD" render cornell --method multibounce --bake "$TMP/t.radb" $M -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"
+        rc=$?
+        [ $rc -eq 1 ] && grep -q "was made with --method temporal, not multibounce" "$TMP/err.txt" &&
+            ok "multibounce render rejects a temporal bake" || fail "multibounce render rejects a temporal bake" "exit $rc"
+    else
+        fail "temporal bakes and renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
+    # mode single is one bounce (classic --bounces 0); mode multibounce samples F_mb's channels
+    "$RAD" render cornell $M --method temporal --mode single --adaptive --frames 100 -o "$TMP/ts.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        psnr_check "temporal single ~ classic --bounces 0" "$TMP/ref0.pfm" "$TMP/ts.pfm" 50 ||
+        fail "temporal single ~ classic --bounces 0" "$(head -c 300 "$TMP/err.txt")"
+    "$RAD" render cornell $M --method temporal --mode multibounce --bounces 1 --adaptive --frames 100 -o "$TMP/tm.pfm" \
+        > /dev/null 2> "$TMP/err.txt" &&
+        psnr_check "temporal multibounce K=1 ~ classic K=1" "$TMP/ref1.pfm" "$TMP/tm.pfm" 50 ||
+        fail "temporal multibounce K=1 ~ classic K=1" "$(head -c 300 "$TMP/err.txt")"
+    # a classic bake holds no F_mb and no alias tables
+    if [ -s "$TMP/x.radb" ]; then
+        "$RAD" render cornell --method multibounce --bake "$TMP/x.radb" --size 8x8 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"
+        rc=$?
+        [ $rc -eq 1 ] && grep -q "holds no multibounce data" "$TMP/err.txt" &&
+            ok "multibounce render rejects a classic bake" || fail "multibounce render rejects a classic bake" "exit $rc"
+    fi
+else
+    fail "classic references for multibounce and temporal" "$(head -c 300 "$TMP/err.txt")"
+fi
+# bad options: exit 2 and a message naming the problem
+bad() { # bad NAME PATTERN ARGS...
+    local name=$1 pat=$2 rc
+    shift 2
+    "$RAD" "$@" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 2 ] && grep -q -- "$pat" "$TMP/err.txt" && ok "rejects $name" || fail "rejects $name" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+}
+bad "--format bc5" "unknown --format 'bc5'" bake cornell --method multibounce --format bc5 -o "$TMP/y.radb"
+bad "--format with classic" "--format is for --method multibounce, not classic" bake cornell --format half -o "$TMP/y.radb"
+bad "--outliers with half" "--outliers is for the compressed formats" bake cornell --method multibounce --format half --outliers 0.1 -o "$TMP/y.radb"
+bad "--outliers 1.5" "--outliers must be a fraction in \[0, 1)" bake cornell --method multibounce --outliers 1.5 -o "$TMP/y.radb"
+bad "--tile 6" "--tile must be a multiple of 4" bake cornell --method multibounce --tile 6 -o "$TMP/y.radb"
+bad "--bounces inf with classic" "--bounces inf is for --method multibounce" render cornell --bounces inf -o "$TMP/y.pfm"
+bad "--bounces with temporal feedback" "--bounces is for --mode multibounce" bake cornell --method temporal --bounces 3 -o "$TMP/y.radb"
+bad "--k with multibounce" "--k is for --method temporal, not multibounce" render cornell --method multibounce --k 3 -o "$TMP/y.pfm"
+bad "--w 1" "--w must be in \[0, 1)" render cornell --method temporal --w 1 -o "$TMP/y.pfm"
+bad "--w with --adaptive" "--w and --adaptive exclude each other" render cornell --method temporal --w 0.5 --adaptive -o "$TMP/y.pfm"
+bad "--frames 0" "--frames must be in 1.." render cornell --method temporal --frames 0 -o "$TMP/y.pfm"
+bad "--frames for bake" "--frames is an option of rad render" bake cornell --method temporal --frames 3 -o "$TMP/y.radb"
+bad "--mode bogus" "unknown --mode 'bogus'" bake cornell --method temporal --mode bogus -o "$TMP/y.radb"
+bad "--method bogus" "unknown method 'bogus'" render cornell --method bogus -o "$TMP/y.pfm"
+bad "bake --method pathtrace" "needs no bake" bake cornell --method pathtrace -o "$TMP/y.radb"
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

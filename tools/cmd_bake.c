@@ -1,8 +1,8 @@
 /* cmd_bake.c - the classic radiosity solution (shared with rad render) and `rad bake`.
 
-   rad bake SCENE -o FILE.radb --method classic [--solver jacobi|gauss-seidel|direct]
+   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal] [--solver jacobi|gauss-seidel|direct]
             [--bounces K] [--patches N] [--max-edge L] [--samples S] [--light-samples N]
-            [--threads N]
+            [method options, see methods.c] [--threads N]
 
    Way (b) of SPEC §0: the direct irradiance D of every patch (emissive triangles and the
    file's analytic lights, with shadow rays) gives the source E = rho D; the emitters' own
@@ -10,7 +10,8 @@
    H = F B = F (E + L) is the irradiance from the secondary sources that the renderer adds to
    its per-pixel direct light. The bake holds the patches, F, E and B (rad_save_memory), plus
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
-   were made with, so `rad render --bake` can check that the file fits the scene. */
+   were made with, so `rad render --bake` can check that the file fits the scene.
+   --method multibounce and temporal bake through methods.c (rad_tool_method_bake). */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -159,6 +160,12 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
         rad_tool_classic_free(out);
         return rad_tool_fail(cmd, "rad_sources", r);
     }
+    if (o->sources_only) {
+        free(out->L), free(out->B), free(out->H);
+        out->L = out->B = out->H = NULL;
+        fprintf(stderr, "rad %s: direct light in %.2f s\n", cmd, rad_tool_seconds() - t0);
+        return 0;
+    }
 
     rad_system_init(&sys, &out->ff->matrix, out->patches, out->E);
     rad_solve_options_default(&so);
@@ -264,46 +271,70 @@ done:
     return rc;
 }
 
+/* the bytes to 'path'; 0 or 1 (message printed) */
+static int write_bytes(const char *cmd, const char *path, const void *data, size_t size)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) {
+        fprintf(stderr, "rad %s: cannot write '%s'\n", cmd, path);
+        return 1;
+    }
+    if (fwrite(data, 1, size, f) != size) {
+        fclose(f);
+        fprintf(stderr, "rad %s: error writing '%s'\n", cmd, path);
+        return 1;
+    }
+    if (fclose(f) != 0) {
+        fprintf(stderr, "rad %s: error writing '%s'\n", cmd, path);
+        return 1;
+    }
+    return 0;
+}
+
 static void bake_usage(FILE *f)
 {
-    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic] [options]\n"
-               "Computes patches, form factors, the patches' direct light E = rho D and the indirect\n"
-               "solution L, and saves patches, F, E, B = E + L (and L, H = F B, D) in a .radb container.\n"
+    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal] [options]\n"
+               "Computes patches, form factors and the patches' direct light E = rho D, then by method:\n"
+               "  classic      the indirect solution L; saves patches, F, E, B = E + L (and L, H = F B, D)\n"
+               "  multibounce  F_mb = sum_k (rho o F)^k (SPEC 4), stored as float, half or compressed\n"
+               "               (BC1, 3xBC4); saves patches, E, D, F's row sums and F_mb (no F)\n"
+               "  temporal     alias tables over the rows of F (or of F_mb's channels) (SPEC 8); saves\n"
+               "               patches, E, D, F's row sums and the tables (no F)\n"
                "  -o FILE            output file (required)\n"
-               "  --method classic   the only baking method (pathtrace needs no bake)\n"
+               "  --method M         classic (default), multibounce or temporal\n"
+               "%s"
                "%s"
                "  --threads N        worker threads (default: all)\n",
-            rad_tool_classic_help());
+            rad_tool_classic_help(), rad_tool_method_help(0));
 }
 
 int rad_cmd_bake(int argc, char **argv)
 {
     const char *cmd = "bake", *scene_name = NULL, *out_path = NULL;
     rad_tool_classic_options o;
+    rad_tool_method_options mo;
     rad_tool_world w;
     rad_tool_classic c;
     uint32_t threads = 0;
     double t0 = rad_tool_seconds();
     int a, rc;
     rad_tool_classic_options_default(&o);
+    rad_tool_method_options_default(&mo);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { bake_usage(stdout); return 0; }
+        rc = rad_tool_method_option(cmd, argc, argv, &a, &mo);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        if ((!strcmp(opt, "-o") || !strcmp(opt, "--method") || !strcmp(opt, "--threads")) && a + 1 >= argc) {
+        if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads")) && a + 1 >= argc) {
             fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
             return 2;
         }
         if (!strcmp(opt, "-o")) out_path = argv[++a];
-        else if (!strcmp(opt, "--method")) {
-            ++a;
-            if (strcmp(argv[a], "classic") != 0) {
-                fprintf(stderr, "rad %s: method '%s' cannot be baked (only 'classic')\n", cmd, argv[a]);
-                return 2;
-            }
-        } else if (!strcmp(opt, "--threads")) {
+        else if (!strcmp(opt, "--threads")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad bake --help)\n", cmd, opt);
@@ -316,8 +347,20 @@ int rad_cmd_bake(int argc, char **argv)
         bake_usage(stderr);
         return 2;
     }
+    if (rad_tool_method_check(cmd, 0, &mo, &o)) return 2;
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (mo.method != RAD_TOOL_CLASSIC) {
+        void *buf = NULL;
+        size_t size = 0;
+        rc = rad_tool_method_bake(cmd, &w, &o, &mo, &buf, &size);
+        if (rc == 0) rc = write_bytes(cmd, out_path, buf, size);
+        if (rc == 0) printf("wrote %s: %s, %lu bytes\n", out_path, rad_tool_method_name(mo.method), (unsigned long)size);
+        free(buf);
+        rad_tool_close_world(&w);
+        if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+        return rc;
+    }
     if (rad_tool_classic_solve(cmd, &w, &o, &c)) {
         rad_tool_close_world(&w);
         return 1;

@@ -2,6 +2,7 @@
    (rad_container_open validates every size, offset and checksum; rad_load_memory every
    index). A damaged file gives the loader's error and detail and exit code 1. */
 #include "tool.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,16 +18,94 @@ static const char *type_name(uint32_t type)
     case RAD_SECTION_FF_COLUMNS: return "FF_COLUMNS";
     case RAD_SECTION_FF_VALUES: return "FF_VALUES";
     case RAD_SECTION_VECTOR: return "VECTOR";
+    case RAD_SECTION_MB_INFO: return "MB_INFO";
+    case RAD_SECTION_MB_FLOAT: return "MB_FLOAT";
+    case RAD_SECTION_MB_HALF: return "MB_HALF";
+    case RAD_SECTION_MB_ROW_PERM: return "MB_ROW_PERM";
+    case RAD_SECTION_MB_COL_PERM: return "MB_COL_PERM";
+    case RAD_SECTION_MB_BC1: return "MB_BC1";
+    case RAD_SECTION_MB_BC4: return "MB_BC4";
+    case RAD_SECTION_MB_SCALES: return "MB_SCALES";
+    case RAD_SECTION_MB_OUTLIER_OFFSETS: return "MB_OUTLIER_OFFSETS";
+    case RAD_SECTION_MB_OUTLIER_COLUMNS: return "MB_OUTLIER_COLUMNS";
+    case RAD_SECTION_MB_OUTLIER_VALUES: return "MB_OUTLIER_VALUES";
+    case RAD_SECTION_TEMPORAL_ROW_OFFSETS: return "ALIAS_ROW_OFFSETS";
+    case RAD_SECTION_TEMPORAL_BINS: return "ALIAS_BINS";
+    case RAD_SECTION_TEMPORAL_TOTALS: return "ALIAS_TOTALS";
     case RAD_TOOL_SECTION_OPTIONS: return "USER(rad options)";
+    case RAD_TOOL_SECTION_METHOD: return "USER(rad method)";
+    case RAD_TOOL_SECTION_ROWSUMS: return "USER(row sums)";
     default: return type >= RAD_SECTION_USER ? "USER" : "UNKNOWN";
     }
+}
+
+/* The rad.method record and the method's objects (opened and validated like render does);
+   0, or 1 when they do not open (message printed). */
+static int method_info(const rad_container *ct, const rad_context *ctx)
+{
+    const rad_section *s = rad_container_find(ct, RAD_TOOL_SECTION_METHOD, "rad.method");
+    rad_tool_method_info mi;
+    rad_result r = RAD_SUCCESS;
+    uint64_t bytes;
+    uint32_t i;
+    if (!s || s->elem_size != sizeof mi || s->count != 1) return 0;
+    memcpy(&mi, s->data, sizeof mi);
+    if (mi.magic != RAD_TOOL_METHOD_MAGIC || (mi.method != RAD_TOOL_MULTIBOUNCE && mi.method != RAD_TOOL_TEMPORAL)) {
+        fprintf(stderr, "rad info: the rad.method section is damaged\n");
+        return 1;
+    }
+    bytes = (uint64_t)mi.bytes_lo | ((uint64_t)mi.bytes_hi << 32);
+    if (mi.method == RAD_TOOL_MULTIBOUNCE) {
+        static const char *const fmt[] = {"float", "half", "bc1", "bc4x3"};
+        rad_multibounce *mb = NULL;
+        rad_multibounce_blocks *bl = NULL;
+        char kb[16];
+        if (mi.bounces == RAD_MB_INFINITE) strcpy(kb, "inf");
+        else snprintf(kb, sizeof kb, "%u", mi.bounces);
+        printf("method: multibounce, --bounces %s, --format %s", kb, mi.format < 4 ? fmt[mi.format] : "?");
+        if (mi.format >= 2)
+            printf(", --outliers %g, %s, --tile %u", (double)mi.outliers, mi.reorder ? "--reorder" : "--no-reorder",
+                   mi.tile);
+        printf("\n  F_mb 'Fmb': %llu bytes, built in %.2f s", (unsigned long long)bytes, (double)mi.build_seconds);
+        if (mi.format >= 2)
+            printf("; decoded-matrix RMS error %.3g (%.3g%% of the RMS entry), max %.3g", sqrt((double)mi.mse),
+                   mi.source_mean_square > 0.0f ? 100.0 * sqrt((double)mi.mse / (double)mi.source_mean_square) : 0.0,
+                   (double)mi.max_abs_error);
+        printf("\n");
+        r = mi.format >= 2 ? rad_multibounce_blocks_load(ct, "Fmb", ctx, &bl) : rad_multibounce_load(ct, "Fmb", ctx, &mb);
+        rad_multibounce_blocks_destroy(bl);
+        rad_multibounce_destroy(mb);
+    } else {
+        static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
+        static const char *const modes[3] = {"single", "feedback", "multibounce"};
+        uint32_t count = mi.mode == RAD_TEMPORAL_MULTIBOUNCE ? 3u : 1u;
+        printf("method: temporal, --mode %s, --k %u, ", mi.mode < 3 ? modes[mi.mode] : "?", mi.k);
+        if (mi.adaptive) printf("--adaptive");
+        else printf("--w %g", (double)mi.w);
+        printf(", --seed %u\n  alias tables:", mi.seed);
+        for (i = 0; i < count && r == RAD_SUCCESS; ++i) {
+            rad_alias_tables t;
+            if ((r = rad_alias_tables_view(ct, count == 3 ? names[i] : "F", ctx, &t)) == RAD_SUCCESS)
+                printf(" '%s' %llu bins (%s)", count == 3 ? names[i] : "F", (unsigned long long)t.row_offsets[t.rows],
+                       t.format == RAD_ALIAS_COMPACT ? "8 bytes each" : "12 bytes each");
+        }
+        printf(", %llu bytes, built in %.2f s\n", (unsigned long long)bytes, (double)mi.build_seconds);
+    }
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad info: the %s data does not open: %s\n", mi.method == RAD_TOOL_MULTIBOUNCE ? "multibounce" : "temporal",
+                rad_result_string(r));
+        return 1;
+    }
+    return 0;
 }
 
 static void info_usage(FILE *f)
 {
     fprintf(f, "usage: rad info FILE.radb\n"
                "Checks a bake (sizes, offsets, checksums, indices) and lists its sections, patch count,\n"
-               "form-factor matrix and vectors. Exit code 1 with the loader's error for damaged files.\n");
+               "form-factor matrix and vectors, and for multibounce and temporal bakes what was built (F_mb's\n"
+               "format, bytes and compression error; the alias tables). Exit code 1 with the loader's error\n"
+               "for damaged files.\n");
 }
 
 int rad_cmd_info(int argc, char **argv)
@@ -72,10 +151,10 @@ int rad_cmd_info(int argc, char **argv)
     }
     count = rad_container_section_count(ct);
     printf("%s: %ld bytes, container version %u, %u sections\n", path, len, RAD_CONTAINER_VERSION, count);
-    printf("  %-3s %-18s %-14s %9s %12s %14s  %s\n", "#", "type", "name", "elem size", "count", "bytes", "checksum");
+    printf("  %-3s %-20s %-14s %9s %12s %14s  %s\n", "#", "type", "name", "elem size", "count", "bytes", "checksum");
     for (i = 0; i < count; ++i) {
         const rad_section *s = rad_container_section(ct, i);
-        printf("  %-3u %-18s %-14s %9u %12llu %14llu  OK\n", i, type_name(s->type), s->name[0] ? s->name : "-",
+        printf("  %-3u %-20s %-14s %9u %12llu %14llu  OK\n", i, type_name(s->type), s->name[0] ? s->name : "-",
                s->elem_size, (unsigned long long)s->count, (unsigned long long)s->count * s->elem_size);
     }
     if ((r = rad_load_memory(data, (size_t)len, &ctx, &bake)) != RAD_SUCCESS) {
@@ -108,13 +187,22 @@ int rad_cmd_info(int argc, char **argv)
         if (s && s->elem_size == sizeof(rad_tool_bake_info) && s->count == 1) {
             rad_tool_bake_info info;
             memcpy(&info, s->data, sizeof info);
-            if (info.magic == 0x52414442u)
+            if (info.magic == 0x52414442u && rad_container_find(ct, RAD_TOOL_SECTION_METHOD, "rad.method"))
+                printf("baked with: --patches %u --max-edge %g --samples %u --light-samples %u (scene of %u triangles)\n",
+                       info.patches, (double)info.max_edge, info.samples, info.light_samples, info.triangle_count);
+            else if (info.magic == 0x52414442u)
                 printf("baked with: --patches %u --max-edge %g --samples %u --solver %s --bounces %u --light-samples %u "
                        "(scene of %u triangles)\n",
                        info.patches, (double)info.max_edge, info.samples,
                        info.solver == 1 ? "gauss-seidel" : info.solver == 2 ? "direct" : "jacobi", info.bounces,
                        info.light_samples, info.triangle_count);
         }
+    }
+    if (method_info(ct, &ctx)) {
+        rad_bake_destroy(bake);
+        rad_container_close(ct);
+        free(data);
+        return 1;
     }
     printf("checksums: all OK\n");
     rad_bake_destroy(bake);

@@ -8,12 +8,19 @@
    patch vertices and interpolated; the sample's radiance is albedo/pi * (D + H), plus the
    emitted radiance where the ray sees the front of an emitter. Each pixel is the box-filtered
    mean of --aa stratified samples. The solution is computed in memory, or loaded from a bake
-   (--bake FILE.radb: its patches, F, E and B, checked against the scene). */
+   (--bake FILE.radb: its patches, F, E and B, checked against the scene).
+
+   Multibounce and temporal (render_with_method, render_method): the same pixels, with the
+   patches' H from methods.c (L = F_mb E, or the temporal frames, H = L / rho) and the halo
+   correction from the bake's row sums of F. */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/stat.h> /* mkdir for --sequence */
+#endif
 
 #define PI_F 3.14159265358979323846f
 
@@ -30,46 +37,42 @@ static void *xmalloc(size_t size)
 static void render_usage(FILE *f)
 {
     fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|pathtrace] [options]\n"
+            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|pathtrace] [options]\n"
             "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
-            "  --method M         classic (default: radiosity + per-pixel direct light) or pathtrace\n"
-            "  --bake FILE.radb   classic: use a bake made by 'rad bake' instead of solving here\n"
+            "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
+            "                     indirect light L = F_mb E), temporal (alias-table frames) or pathtrace\n"
+            "  --bake FILE.radb   classic, multibounce, temporal: use a bake of that method made by\n"
+            "                     'rad bake' from this scene instead of computing it here\n"
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
             "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
             "  --size WxH         image size (default 512x512)\n"
-            "  --aa N             classic: stratified samples per pixel, rounded down to a square (default 16)\n"
+            "  --aa N             radiosity methods: stratified samples per pixel, rounded down to a square (default 16)\n"
             "  --spp N            pathtrace: samples per pixel (default 64)\n"
             "  --seed S           pathtrace: random seed (default 0)\n"
             "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
-            "  --pixel-light-samples N   classic: shadow rays per pixel sample and light (default 16)\n"
-            "  --shading MODEL    classic: lighting model for the analytic lights' direct term: none (default:\n"
-            "                     Lambert through the irradiance), lambert, half-lambert, banded, phong,\n"
-            "                     blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says how it\n"
-            "                     combines with the diffuse radiosity solution)\n"
-            "classic solution options (ignored with --bake, which keeps its own):\n"
+            "  --pixel-light-samples N   radiosity methods: shadow rays per pixel sample and light (default 16)\n"
+            "  --shading MODEL    radiosity methods: lighting model for the analytic lights' direct term: none\n"
+            "                     (default: Lambert through the irradiance), lambert, half-lambert, banded,\n"
+            "                     phong, blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says\n"
+            "                     how it combines with the diffuse radiosity solution)\n"
+            "patch and classic solution options (ignored with --bake, which keeps its own):\n"
+            "%s"
             "%s"
             "  --threads N        worker threads (default: all)\n",
-            rad_tool_classic_help());
+            rad_tool_classic_help(), rad_tool_method_help(1));
 }
 
 /* Per-vertex H, with the halo fix of examples/cornell.c step 7: a patch partly covered (under
    the light, under a block) has a small H only because part of it sees nothing; H is
-   interpolated as (mean radiosity seen) x (how much is seen, from uncovered patches). */
-static int vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, float *Hv)
+   interpolated as (mean radiosity seen) x (how much is seen, from uncovered patches).
+   S: the row sums of F (how much of its hemisphere each patch sees). */
+static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv)
 {
     uint32_t n = P->count, nv = P->vertex_count, i, k;
-    float *ones = (float *)xmalloc(sizeof(float) * 3 * n), *rs = (float *)xmalloc(sizeof(float) * 3 * n);
-    float *S = (float *)xmalloc(sizeof(float) * n), *S_v = (float *)xmalloc(sizeof(float) * nv);
+    float *S_v = (float *)xmalloc(sizeof(float) * nv);
     float *S_max = (float *)xmalloc(sizeof(float) * nv), *S_area = (float *)xmalloc(sizeof(float) * nv);
-    rad_context ctx;
     rad_result r;
-    rad_tool_context(&ctx, NULL);
-    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
-    r = rad_matrix_multiply(F, ones, rs, &ctx);
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < n; ++i) S[i] = rs[3 * i];
-        r = rad_patches_vertex_values(P, H, 3, Hv);
-    }
+    r = rad_patches_vertex_values(P, H, 3, Hv);
     if (r == RAD_SUCCESS) r = rad_patches_vertex_values(P, S, 1, S_v);
     if (r == RAD_SUCCESS) {
         for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
@@ -96,13 +99,30 @@ static int vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, f
             Hv[3 * i] *= s_v, Hv[3 * i + 1] *= s_v, Hv[3 * i + 2] *= s_v;
         }
     }
-    free(ones);
-    free(rs);
-    free(S);
     free(S_v);
     free(S_max);
     free(S_area);
     return r == RAD_SUCCESS ? 0 : rad_tool_fail("render", "per-vertex H", r);
+}
+
+/* the same with the row sums computed from F */
+static int vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, float *Hv)
+{
+    uint32_t n = P->count, i;
+    float *ones = (float *)xmalloc(sizeof(float) * 3 * n), *rs = (float *)xmalloc(sizeof(float) * 3 * n);
+    float *S = (float *)xmalloc(sizeof(float) * n);
+    rad_context ctx;
+    rad_result r;
+    int rc;
+    rad_tool_context(&ctx, NULL);
+    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
+    r = rad_matrix_multiply(F, ones, rs, &ctx);
+    for (i = 0; i < n; ++i) S[i] = rs[3 * i];
+    rc = r == RAD_SUCCESS ? vertex_H_rowsums(P, S, H, Hv) : rad_tool_fail("render", "per-vertex H", r);
+    free(ones);
+    free(rs);
+    free(S);
+    return rc;
 }
 
 typedef struct isect_job {
@@ -265,10 +285,153 @@ static const rad_tool_bake_info *bake_info(const rad_bake *bake)
     return info->magic == 0x52414442u ? info : NULL;
 }
 
+/* 0 when a loaded bake was made from this scene (its triangle count, and the patch count its
+   options give on this scene); else 1 with a message */
+static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bake *bake, const rad_tool_world *w)
+{
+    const rad_tool_bake_info *info = bake_info(bake);
+    rad_context ctx;
+    rad_result r;
+    int rc = 0;
+    rad_tool_context(&ctx, NULL);
+    if (bake->patches.triangle_count != w->scene->triangle_count) {
+        fprintf(stderr, "rad %s: bake '%s' was made from a scene of %u triangles, this one has %u\n", cmd, bake_path,
+                bake->patches.triangle_count, w->scene->triangle_count);
+        rc = 1;
+    } else if (info) {
+        /* the same patch options on this scene must give the same patches */
+        rad_patch_options po;
+        rad_patches *check = NULL;
+        rad_patch_options_default(&po);
+        po.target_count = info->patches;
+        po.max_edge = info->max_edge;
+        if ((r = rad_patches_create(w->scene, &po, &ctx, &check)) != RAD_SUCCESS) {
+            rc = rad_tool_fail(cmd, "rad_patches_create", r);
+        } else if (check->count != bake->patches.count) {
+            fprintf(stderr, "rad %s: bake '%s' has %u patches; this scene with its options (--patches %u) gives %u: "
+                            "not the scene it was baked from\n",
+                    cmd, bake_path, bake->patches.count, info->patches, check->count);
+            rc = 1;
+        }
+        rad_patches_destroy(check);
+    } else {
+        fprintf(stderr, "rad %s: warning: bake '%s' has no rad.options section; its patches are used as they are\n", cmd,
+                bake_path);
+    }
+    return rc;
+}
+
+/* --method multibounce|temporal: the patches' indirect light from the bake's F_mb (one
+   product) or alias tables (--frames steps), then the classic pixel pipeline (per-pixel direct
+   light + interpolated H). --sequence writes every --every-th frame (and the last) as a PNG. */
+static int render_method(const char *cmd, const rad_tool_world *w, const rad_bake *bake, const char *bake_name,
+                         const rad_tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
+                         uint32_t light_samples, float exposure, rad_image *img)
+{
+    rad_tool_indirect *m = NULL;
+    const rad_patches *P = &bake->patches;
+    uint32_t frames = mo->method == RAD_TOOL_TEMPORAL ? mo->frames : 1u, f;
+    double t = 0.0, sum = 0.0, tmin = 1e300, tmax = 0.0;
+    float *H, *Hv;
+    int rc = 0;
+    if (rad_tool_indirect_open(cmd, bake_name, bake, mo, &m)) return 1;
+    H = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->count);
+    Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
+#if defined(__unix__) || defined(__APPLE__)
+    if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
+#endif
+    for (f = 1; f <= frames && rc == 0; ++f) {
+        rc = rad_tool_indirect_step(m, H, &t);
+        sum += t;
+        if (t < tmin) tmin = t;
+        if (t > tmax) tmax = t;
+        if (rc == 0 && mo->sequence && f % mo->every == 0 && f != frames) { /* the last one: below */
+            char path[4096];
+            rad_image frame;
+            memset(&frame, 0, sizeof frame);
+            snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, f);
+            if (rad_image_alloc(&frame, width, height) != 0) {
+                fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
+                rc = 1;
+            }
+            if (rc == 0) rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
+            if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, &frame);
+            if (rc == 0 && rad_image_write_png(path, &frame, exposure) != 0) {
+                fprintf(stderr, "rad %s: cannot write '%s' (does the directory exist?)\n", cmd, path);
+                rc = 1;
+            }
+            rad_image_free(&frame);
+        }
+    }
+    if (rc == 0) {
+        if (mo->method == RAD_TOOL_TEMPORAL)
+            fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
+                    cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
+        else
+            fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
+        rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
+    }
+    if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, img);
+    if (rc == 0 && mo->sequence) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
+        if (rad_image_write_png(path, img, exposure) != 0) {
+            fprintf(stderr, "rad %s: cannot write '%s' (does the directory exist?)\n", cmd, path);
+            rc = 1;
+        }
+    }
+    free(H);
+    free(Hv);
+    rad_tool_indirect_close(m);
+    return rc;
+}
+
+/* the bake (--bake, checked against the scene) or one made here, then render_method */
+static int render_with_method(const char *cmd, const rad_tool_world *w, const char *bake_path,
+                              const rad_tool_classic_options *o, const rad_tool_method_options *mo,
+                              const rad_camera *cam, int width, int height, uint32_t aa, uint32_t light_samples,
+                              float exposure, rad_image *img)
+{
+    rad_bake *bake = NULL;
+    void *buf = NULL;
+    size_t size = 0;
+    rad_context ctx;
+    rad_result r;
+    int rc;
+    rad_tool_context(&ctx, NULL);
+    if (bake_path) {
+        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE))
+            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile "
+                            "and --mode; those given here are ignored\n",
+                    cmd, bake_path);
+        if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
+            fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
+            return 1;
+        }
+        if (bake_fits_scene(cmd, bake_path, bake, w)) {
+            rad_bake_destroy(bake);
+            return 1;
+        }
+    } else {
+        if (rad_tool_method_bake(cmd, w, o, mo, &buf, &size)) return 1;
+        if ((r = rad_load_memory(buf, size, &ctx, &bake)) != RAD_SUCCESS) {
+            free(buf);
+            return rad_tool_fail(cmd, "rad_load_memory", r);
+        }
+        bake_path = "(made here)";
+    }
+    bake->patches.scene = w->scene;
+    rc = render_method(cmd, w, bake, bake_path, mo, cam, width, height, aa, light_samples, exposure, img);
+    rad_bake_destroy(bake);
+    free(buf);
+    return rc;
+}
+
 int rad_cmd_render(int argc, char **argv)
 {
-    const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method = "classic";
+    const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
     rad_tool_classic_options o;
+    rad_tool_method_options mo;
     rad_tool_world w;
     rad_camera cam;
     rad_image img;
@@ -278,10 +441,14 @@ int rad_cmd_render(int argc, char **argv)
     float fov = 0.0f, exposure = 1.0f;
     double t0 = rad_tool_seconds();
     rad_tool_classic_options_default(&o);
+    rad_tool_method_options_default(&mo);
     memset(&img, 0, sizeof img);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { render_usage(stdout); return 0; }
+        rc = rad_tool_method_option(cmd, argc, argv, &a, &mo); /* --method, --seed and the methods' options */
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
         if (rc == 2) return 2;
         if (rc == 1) continue;
@@ -291,7 +458,6 @@ int rad_cmd_render(int argc, char **argv)
         }
         if (!strcmp(opt, "-o")) out_path = argv[++a];
         else if (!strcmp(opt, "--bake")) bake_path = argv[++a];
-        else if (!strcmp(opt, "--method")) method = argv[++a];
         else if (!strcmp(opt, "--camera")) {
             if (rad_tool_parse_camera(argv[++a], &cam)) {
                 fprintf(stderr, "rad %s: bad camera '%s' (want PX,PY,PZ:TX,TY,TZ:UX,UY,UZ)\n", cmd, argv[a]);
@@ -312,8 +478,6 @@ int rad_cmd_render(int argc, char **argv)
         } else if (!strcmp(opt, "--spp")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &spp)) return 2;
             if (spp == 0 || spp > 1u << 20) { fprintf(stderr, "rad %s: --spp must be in 1..1048576\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--seed")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &seed)) return 2;
         } else if (!strcmp(opt, "--pixel-light-samples")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
             if (pixel_light_samples == 0) { fprintf(stderr, "rad %s: %s must be > 0\n", cmd, opt); return 2; }
@@ -335,17 +499,16 @@ int rad_cmd_render(int argc, char **argv)
         render_usage(stderr);
         return 2;
     }
-    if (strcmp(method, "classic") != 0 && strcmp(method, "pathtrace") != 0) {
-        fprintf(stderr, "rad %s: unknown method '%s' (classic or pathtrace)\n", cmd, method);
-        return 2;
-    }
-    pathtrace = !strcmp(method, "pathtrace");
+    if (rad_tool_method_check(cmd, 1, &mo, &o)) return 2;
+    method = rad_tool_method_name(mo.method);
+    seed = mo.seed;
+    pathtrace = mo.method == RAD_TOOL_PATHTRACE;
     if (pathtrace && render_shading >= 0) {
-        fprintf(stderr, "rad %s: --shading is for --method classic (the path tracer is Lambertian)\n", cmd);
+        fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
     if (pathtrace && bake_path) {
-        fprintf(stderr, "rad %s: --bake is for --method classic\n", cmd);
+        fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
     }
     {
@@ -367,7 +530,15 @@ int rad_cmd_render(int argc, char **argv)
         return 1;
     }
 
-    if (pathtrace) {
+    if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL) {
+        rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
+                                &img);
+        if (rc) {
+            rad_image_free(&img);
+            rad_tool_close_world(&w);
+            return 1;
+        }
+    } else if (pathtrace) {
         rad_trace_options to;
         rad_result r;
         rad_trace_options_default(&to);
@@ -391,7 +562,6 @@ int rad_cmd_render(int argc, char **argv)
         float *Hv, *Hmine = NULL;
         memset(&sol, 0, sizeof sol);
         if (bake_path) {
-            const rad_tool_bake_info *info;
             const rad_section *hs;
             rad_result r;
             rad_tool_context(&ctx, NULL);
@@ -401,34 +571,13 @@ int rad_cmd_render(int argc, char **argv)
                 rad_tool_close_world(&w);
                 return 1;
             }
-            info = bake_info(bake);
-            rc = 0;
-            if (bake->patches.triangle_count != w.scene->triangle_count) {
-                fprintf(stderr, "rad %s: bake '%s' was made from a scene of %u triangles, this one has %u\n", cmd,
-                        bake_path, bake->patches.triangle_count, w.scene->triangle_count);
+            rc = bake_fits_scene(cmd, bake_path, bake, &w);
+            if (rc == 0 && (bake->F.rows == 0 || !bake->B)) {
+                fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B%s\n", cmd, bake_path,
+                        rad_container_find(bake->container, RAD_TOOL_SECTION_METHOD, "rad.method")
+                            ? " (it is a multibounce or temporal bake: render it with that --method)"
+                            : "");
                 rc = 1;
-            } else if (bake->F.rows == 0 || !bake->B) {
-                fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B\n", cmd, bake_path);
-                rc = 1;
-            } else if (info) {
-                /* the same patch options on this scene must give the same patches */
-                rad_patch_options po;
-                rad_patches *check = NULL;
-                rad_patch_options_default(&po);
-                po.target_count = info->patches;
-                po.max_edge = info->max_edge;
-                if ((r = rad_patches_create(w.scene, &po, &ctx, &check)) != RAD_SUCCESS) {
-                    rc = rad_tool_fail(cmd, "rad_patches_create", r);
-                } else if (check->count != bake->patches.count) {
-                    fprintf(stderr, "rad %s: bake '%s' has %u patches; this scene with its options (--patches %u) gives %u: "
-                                    "not the scene it was baked from\n",
-                            cmd, bake_path, bake->patches.count, info->patches, check->count);
-                    rc = 1;
-                }
-                rad_patches_destroy(check);
-            } else {
-                fprintf(stderr, "rad %s: warning: bake '%s' has no rad.options section; its patches are used as they are\n",
-                        cmd, bake_path);
             }
             if (rc) {
                 rad_bake_destroy(bake);

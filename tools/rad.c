@@ -2,8 +2,9 @@
 
        rad help | rad CMD --help
        rad formfactors SCENE   group form factors between the scene's named objects
-       rad bake SCENE -o FILE.radb     the classic solution, saved
-       rad render SCENE -o OUT.png|OUT.pfm     an image (classic radiosity or path tracing)
+       rad bake SCENE -o FILE.radb     a solution, saved (classic, multibounce or temporal)
+       rad render SCENE -o OUT.png|OUT.pfm     an image (classic, multibounce or temporal
+                                       radiosity, or path tracing)
        rad trace SCENE -o OUT  the reference path tracer
        rad compare A B         image metrics
        rad info FILE.radb      what a bake holds
@@ -238,8 +239,9 @@ static void usage(FILE *f)
                "  help                     this text\n"
                "  version                  the library version\n"
                "  formfactors SCENE        group form factors between the scene's named objects\n"
-               "  bake SCENE -o FILE.radb  compute and save the classic radiosity solution\n"
-               "  render SCENE -o OUT      render an image (.png or .pfm): --method classic|pathtrace\n"
+               "  bake SCENE -o FILE.radb  compute and save a solution: --method classic|multibounce|temporal\n"
+               "  render SCENE -o OUT      render an image (.png or .pfm):\n"
+               "                           --method classic|multibounce|temporal|pathtrace [--bake FILE.radb]\n"
                "  trace SCENE -o OUT       the reference path tracer\n"
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
                "  info FILE.radb           list what a bake holds and check it\n"

@@ -135,6 +135,7 @@ typedef struct rad_tool_classic_options {
     rad_tool_solver solver;  /* --solver jacobi|gauss-seidel|direct */
     uint32_t bounces;        /* --bounces K (Jacobi; default 64) */
     uint32_t light_samples;  /* --light-samples N: shadow rays per point (default 16) */
+    int sources_only;        /* 1: rad_tool_classic_solve stops after E (L, B, H stay NULL) */
 } rad_tool_classic_options;
 void rad_tool_classic_options_default(rad_tool_classic_options *o);
 /* argv[*a] is one of the options above: parses it (and its value, advancing *a) and returns
@@ -176,5 +177,96 @@ int rad_tool_parse_shading(const char *cmd, const char *text, int *out_model);
 int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_samples, const float *points,
                           const float *normals, const float *views, const float *albedos, uint32_t count,
                           float *out_rgb);
+/* ---- the multi-bounce and temporal methods (methods.c) ------------------------------------ */
+typedef enum rad_tool_method {
+    RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3
+} rad_tool_method;
+/* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
+typedef enum rad_tool_mb_format {
+    RAD_TOOL_MB_FLOAT = 0, RAD_TOOL_MB_HALF = 1, RAD_TOOL_MB_BC1 = 2, RAD_TOOL_MB_BC4X3 = 3
+} rad_tool_mb_format;
+
+/* Options of the two methods; 'given' has bit RAD_TOOL_OPT_x set for each option on the
+   command line (to reject options that do not apply and to let render override a bake). */
+typedef struct rad_tool_method_options {
+    rad_tool_method method;   /* --method */
+    uint32_t bounces;         /* --bounces K|inf (RAD_MB_INFINITE); default 64 like classic */
+    uint32_t format;          /* --format float|half|bc1|bc4x3 (default bc4x3) */
+    float outliers;           /* --outliers P: fraction of F_mb entries kept exactly (default 0.05) */
+    int reorder;              /* --reorder / --no-reorder (default on) */
+    uint32_t reorder_samples; /* --reorder-samples N (0: exact, the default) */
+    uint32_t tile;            /* --tile T: scales per T x T texels, 0: per matrix (default 64) */
+    rad_temporal_mode mode;   /* --mode feedback|single|multibounce (default feedback) */
+    uint32_t k;               /* --k K: draws per row and frame (default 10) */
+    float w;                  /* --w W: fixed blend weight (default 0.998) */
+    int adaptive;             /* --adaptive: per-row weight */
+    uint32_t seed;            /* --seed S (default 0) */
+    uint32_t frames;          /* --frames N (render; default 64) */
+    const char *sequence;     /* --sequence DIR (render) */
+    uint32_t every;           /* --every N (render; default 1) */
+    uint32_t given;           /* RAD_TOOL_OPT_* bits */
+} rad_tool_method_options;
+enum {
+    RAD_TOOL_OPT_BOUNCES = 1u << 0, RAD_TOOL_OPT_FORMAT = 1u << 1, RAD_TOOL_OPT_OUTLIERS = 1u << 2,
+    RAD_TOOL_OPT_REORDER = 1u << 3, RAD_TOOL_OPT_REORDER_SAMPLES = 1u << 4, RAD_TOOL_OPT_TILE = 1u << 5,
+    RAD_TOOL_OPT_MODE = 1u << 6, RAD_TOOL_OPT_K = 1u << 7, RAD_TOOL_OPT_W = 1u << 8, RAD_TOOL_OPT_ADAPTIVE = 1u << 9,
+    RAD_TOOL_OPT_SEED = 1u << 10, RAD_TOOL_OPT_FRAMES = 1u << 11, RAD_TOOL_OPT_SEQUENCE = 1u << 12,
+    RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14
+};
+#define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
+                               RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
+#define RAD_TOOL_OPT_TEMPORAL (RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_K | RAD_TOOL_OPT_W | RAD_TOOL_OPT_ADAPTIVE)
+#define RAD_TOOL_OPT_RENDER_ONLY (RAD_TOOL_OPT_FRAMES | RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY)
+
+void rad_tool_method_options_default(rad_tool_method_options *mo);
+/* argv[*a] is --method or one of the options above: parses it (and its value, advancing *a)
+   and returns 1; 0 when it is not one of them; 2 on a bad value (message printed). */
+int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo);
+/* After parsing: rejects options that do not apply to mo->method (and render-only options
+   when !render), moves a finite --bounces into o->bounces for classic; 0 or 2 (printed). */
+int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o);
+const char *rad_tool_method_help(int render);
+const char *rad_tool_method_name(rad_tool_method method);
+
+/* The user sections the two methods add: what was built, and the row sums S_i of F (the
+   halo correction of the per-vertex H needs them and these bakes hold no F). */
+typedef struct rad_tool_method_info {
+    uint32_t magic;           /* 0x5241444D */
+    uint32_t method;          /* RAD_TOOL_MULTIBOUNCE or RAD_TOOL_TEMPORAL */
+    uint32_t bounces;         /* as given (--bounces; F_mb holds bounces + 1, see methods.c) */
+    uint32_t format;          /* rad_tool_mb_format */
+    float outliers;
+    uint32_t reorder, reorder_samples, tile;
+    uint32_t mode;            /* rad_temporal_mode */
+    uint32_t k;
+    float w;
+    uint32_t adaptive, seed;
+    float build_seconds;      /* F_mb (+ compression) or alias tables */
+    float mse, max_abs_error, source_mean_square; /* compression report (bc1, bc4x3), else 0 */
+    uint32_t bytes_lo, bytes_hi; /* bytes the render reads: F_mb storage or alias tables */
+} rad_tool_method_info;
+#define RAD_TOOL_METHOD_MAGIC 0x5241444Du
+#define RAD_TOOL_SECTION_METHOD (RAD_SECTION_USER + 2u)  /* "rad.method": one rad_tool_method_info */
+#define RAD_TOOL_SECTION_ROWSUMS (RAD_SECTION_USER + 3u) /* "rad.rowsums": N floats */
+
+/* The bake of --method multibounce or temporal as container bytes (malloc'd, free with
+   free()): patches, E, D, the row sums, rad.options, rad.method and the method's sections
+   (F_mb as "Fmb"; alias tables "F", or "Fmb.r", "Fmb.g", "Fmb.b" in --mode multibounce).
+   Prints what was built to stderr. 0 or 1 (message printed). */
+int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                         const rad_tool_method_options *mo, void **out, size_t *out_size);
+
+/* The render side: the indirect light of a loaded bake, step by step. */
+typedef struct rad_tool_indirect rad_tool_indirect;
+/* mo: the render's options (method, and --k, --w, --adaptive, --seed overriding the bake's).
+   Errors name what the bake lacks. 0 or 1 (message printed). */
+int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
+                           const rad_tool_method_options *mo, rad_tool_indirect **out);
+/* multibounce: L = F_mb E (every call the same); temporal: one more frame. Writes the patches'
+   irradiance from the secondary sources H = L / rho (3N floats; 0 where rho is 0) and the
+   seconds the method's own work took. 0 or 1 (message printed). */
+int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds);
+const float *rad_tool_indirect_rowsums(const rad_tool_indirect *m);
+void rad_tool_indirect_close(rad_tool_indirect *m);
 
 #endif

@@ -1,0 +1,712 @@
+/* methods.c - the multi-bounce (SPEC §4) and temporal (SPEC §8) methods of `rad bake` and
+   `rad render`: their options, their bakes and the per-patch indirect light they give.
+
+   Both follow the classic method's way (b) of SPEC §0: the source is E = rho D (the patches'
+   direct light) and the renderer adds per pixel rho/pi (D + H), H being the irradiance from
+   the secondary sources. The classic method computes H = F (E + L_K) with F; these bakes hold
+   no F, so H comes from the indirect radiosity itself: L_{K+1} = rho o F (E + L_K), hence
+   H = L_{K+1} / rho (per channel; 0 where rho is 0, where the pixel's albedo is 0 as well).
+   That is why `--bounces K` builds F_mb with K + 1 bounces: the image is then the classic
+   image of `--bounces K` (K = inf: the same full solution). The temporal method in mode
+   feedback converges to L_inf (mode single gives L_1, i.e. classic --bounces 0; mode
+   multibounce samples the channels of F_mb with K + 1 bounces).
+
+   The environment entry of the alias tables (E_0, the sky's radiosity) is 0 here: the scene's
+   sky is part of the per-pixel direct light D and of E already, so adding it again would count
+   it twice. The halo correction of the per-vertex H needs the row sums S_i of F, stored in
+   the user section "rad.rowsums". */
+#include "tool.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void *xcalloc(size_t n, size_t size)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p) {
+        fprintf(stderr, "rad: out of memory\n");
+        exit(1);
+    }
+    return p;
+}
+
+/* ---- options ------------------------------------------------------------------------------ */
+
+void rad_tool_method_options_default(rad_tool_method_options *mo)
+{
+    memset(mo, 0, sizeof *mo);
+    mo->method = RAD_TOOL_CLASSIC;
+    mo->bounces = 64;
+    mo->format = RAD_TOOL_MB_BC4X3;
+    mo->outliers = 0.05f;
+    mo->reorder = 1;
+    mo->tile = 64;
+    mo->mode = RAD_TEMPORAL_FEEDBACK;
+    mo->k = 10;
+    mo->w = 0.998f;
+    mo->frames = 64;
+    mo->every = 1;
+}
+
+const char *rad_tool_method_name(rad_tool_method method)
+{
+    switch (method) {
+    case RAD_TOOL_MULTIBOUNCE: return "multibounce";
+    case RAD_TOOL_TEMPORAL: return "temporal";
+    case RAD_TOOL_PATHTRACE: return "pathtrace";
+    default: return "classic";
+    }
+}
+
+static const char *format_name(uint32_t f)
+{
+    static const char *const names[] = {"float", "half", "bc1", "bc4x3"};
+    return f < 4 ? names[f] : "?";
+}
+
+static const char *mode_name(uint32_t m)
+{
+    return m == RAD_TEMPORAL_SINGLE ? "single" : m == RAD_TEMPORAL_MULTIBOUNCE ? "multibounce" : "feedback";
+}
+
+const char *rad_tool_method_help(int render)
+{
+    return render ? "multibounce and temporal (without --bake: baked here first; with --bake the bake's own):\n"
+                    "  --bounces K|inf    multibounce, temporal --mode multibounce: bounces of the patch solution\n"
+                    "                     (as classic: the image of K equals classic --bounces K; default 64)\n"
+                    "  --format F         multibounce: F_mb storage float, half, bc1 or bc4x3 (default)\n"
+                    "  --outliers P       multibounce bc1/bc4x3: fraction of entries kept exactly (default 0.05)\n"
+                    "  --reorder, --no-reorder   multibounce bc1/bc4x3: greedy row/column reordering (default on)\n"
+                    "  --reorder-samples N   reordering distances on N coordinates (default 0: all)\n"
+                    "  --tile T           multibounce bc1/bc4x3: scales per T x T texels, 0: per matrix (default 64)\n"
+                    "  --mode M           temporal: feedback (default, converges to L_inf), single (one bounce)\n"
+                    "                     or multibounce (alias tables over the channels of F_mb)\n"
+                    "temporal (these override the bake's):\n"
+                    "  --frames N         frames to step; the image shows the last (default 64)\n"
+                    "  --k K              draws per patch and frame (default 10)\n"
+                    "  --w W              fixed blend weight in [0, 1) (default 0.998: B starts at 0 and\n"
+                    "                     reaches 1 - W^N of the solution after N frames, ~2300 for 99%)\n"
+                    "  --adaptive         per-patch blend weight from the estimator's variance (starts as the\n"
+                    "                     running mean of the frames: converges fast)\n"
+                    "  --seed S           generator seed (default 0; also the path tracer's seed)\n"
+                    "  --sequence DIR     also write DIR/frame_NNNNN.png every --every N frames (default 1)\n"
+                  : "multibounce:\n"
+                    "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
+                    "                     the renderer's gather; default 64)\n"
+                    "  --format F         F_mb storage: float, half, bc1 or bc4x3 (default)\n"
+                    "  --outliers P       bc1/bc4x3: fraction of the entries kept exactly (default 0.05)\n"
+                    "  --reorder, --no-reorder   bc1/bc4x3: greedy row/column reordering (default on)\n"
+                    "  --reorder-samples N   reordering distances on N coordinates (default 0: all)\n"
+                    "  --tile T           bc1/bc4x3: scales per T x T texels (multiple of 4), 0: per matrix (default 64)\n"
+                    "temporal (alias tables; k, w, adaptive and seed are the render's defaults):\n"
+                    "  --mode M           feedback (default: samples E + B, converges to L_inf), single (one\n"
+                    "                     bounce) or multibounce (tables over F_mb's channels, with --bounces)\n"
+                    "  --k K              draws per patch and frame (default 10)\n"
+                    "  --w W              fixed blend weight in [0, 1) (default 0.998)\n"
+                    "  --adaptive         per-patch blend weight from the estimator's variance\n"
+                    "  --seed S           generator seed (default 0)\n";
+}
+
+int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo)
+{
+    static const char *const names[] = {"--method", "--bounces", "--format",    "--outliers", "--reorder-samples",
+                                        "--tile",   "--mode",    "--k",         "--w",        "--seed",
+                                        "--frames", "--sequence", "--every",    "--reorder",  "--no-reorder",
+                                        "--adaptive"};
+    const char *opt = argv[*a], *v;
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (!strcmp(opt, names[i])) break;
+    if (i == sizeof names / sizeof names[0]) return 0;
+    if (i >= 13) { /* flags */
+        if (i == 15) mo->adaptive = 1, mo->given |= RAD_TOOL_OPT_ADAPTIVE;
+        else mo->reorder = i == 13, mo->given |= RAD_TOOL_OPT_REORDER;
+        return 1;
+    }
+    if (*a + 1 >= argc) {
+        fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+        return 2;
+    }
+    v = argv[++*a];
+    switch (i) {
+    case 0:
+        if (!strcmp(v, "classic")) mo->method = RAD_TOOL_CLASSIC;
+        else if (!strcmp(v, "multibounce")) mo->method = RAD_TOOL_MULTIBOUNCE;
+        else if (!strcmp(v, "temporal")) mo->method = RAD_TOOL_TEMPORAL;
+        else if (!strcmp(v, "pathtrace")) mo->method = RAD_TOOL_PATHTRACE;
+        else {
+            fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal%s)\n", cmd, v,
+                    strcmp(cmd, "render") ? "" : " or pathtrace");
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_METHOD;
+        return 1;
+    case 1:
+        mo->given |= RAD_TOOL_OPT_BOUNCES;
+        if (!strcmp(v, "inf")) {
+            mo->bounces = RAD_MB_INFINITE;
+            return 1;
+        }
+        if (rad_tool_parse_uint(cmd, opt, v, &mo->bounces)) return 2;
+        if (mo->bounces >= 0xFFFFFFF0u) {
+            fprintf(stderr, "rad %s: --bounces %s is too large (use 'inf' for the full solution)\n", cmd, v);
+            return 2;
+        }
+        return 1;
+    case 2: {
+        uint32_t f;
+        for (f = 0; f < 4; ++f)
+            if (!strcmp(v, format_name(f))) break;
+        if (f == 4) {
+            fprintf(stderr, "rad %s: unknown --format '%s' (float, half, bc1 or bc4x3)\n", cmd, v);
+            return 2;
+        }
+        mo->format = f;
+        mo->given |= RAD_TOOL_OPT_FORMAT;
+        return 1;
+    }
+    case 3:
+        if (rad_tool_parse_float(cmd, opt, v, &mo->outliers)) return 2;
+        if (!(mo->outliers >= 0.0f && mo->outliers < 1.0f)) {
+            fprintf(stderr, "rad %s: --outliers must be a fraction in [0, 1) (e.g. 0.05), not %s\n", cmd, v);
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_OUTLIERS;
+        return 1;
+    case 4:
+        mo->given |= RAD_TOOL_OPT_REORDER_SAMPLES;
+        return rad_tool_parse_uint(cmd, opt, v, &mo->reorder_samples) ? 2 : 1;
+    case 5:
+        if (rad_tool_parse_uint(cmd, opt, v, &mo->tile)) return 2;
+        if (mo->tile % 4 != 0) {
+            fprintf(stderr, "rad %s: --tile must be a multiple of 4 (0: one scale per matrix), not %s\n", cmd, v);
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_TILE;
+        return 1;
+    case 6:
+        if (!strcmp(v, "feedback")) mo->mode = RAD_TEMPORAL_FEEDBACK;
+        else if (!strcmp(v, "single")) mo->mode = RAD_TEMPORAL_SINGLE;
+        else if (!strcmp(v, "multibounce")) mo->mode = RAD_TEMPORAL_MULTIBOUNCE;
+        else {
+            fprintf(stderr, "rad %s: unknown --mode '%s' (feedback, single or multibounce)\n", cmd, v);
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_MODE;
+        return 1;
+    case 7:
+        if (rad_tool_parse_uint(cmd, opt, v, &mo->k)) return 2;
+        if (mo->k == 0 || mo->k > 65536) {
+            fprintf(stderr, "rad %s: --k must be in 1..65536, not %s\n", cmd, v);
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_K;
+        return 1;
+    case 8:
+        if (rad_tool_parse_float(cmd, opt, v, &mo->w)) return 2;
+        if (!(mo->w >= 0.0f && mo->w < 1.0f)) {
+            fprintf(stderr, "rad %s: --w must be in [0, 1), not %s\n", cmd, v);
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_W;
+        return 1;
+    case 9:
+        mo->given |= RAD_TOOL_OPT_SEED;
+        return rad_tool_parse_uint(cmd, opt, v, &mo->seed) ? 2 : 1;
+    case 10:
+        if (rad_tool_parse_uint(cmd, opt, v, &mo->frames)) return 2;
+        if (mo->frames == 0 || mo->frames > 10000000u) {
+            fprintf(stderr, "rad %s: --frames must be in 1..10000000, not %s\n", cmd, v);
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_FRAMES;
+        return 1;
+    case 11:
+        if (!*v) {
+            fprintf(stderr, "rad %s: --sequence needs a directory\n", cmd);
+            return 2;
+        }
+        mo->sequence = v;
+        mo->given |= RAD_TOOL_OPT_SEQUENCE;
+        return 1;
+    default:
+        if (rad_tool_parse_uint(cmd, opt, v, &mo->every)) return 2;
+        if (mo->every == 0) {
+            fprintf(stderr, "rad %s: --every must be > 0\n", cmd);
+            return 2;
+        }
+        mo->given |= RAD_TOOL_OPT_EVERY;
+        return 1;
+    }
+}
+
+/* the first option of 'bits' that was given */
+static const char *given_name(uint32_t bits)
+{
+    static const char *const names[] = {"--bounces", "--format", "--outliers", "--reorder/--no-reorder",
+                                        "--reorder-samples", "--tile", "--mode", "--k", "--w", "--adaptive",
+                                        "--seed", "--frames", "--sequence", "--every", "--method"};
+    uint32_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (bits & (1u << i)) return names[i];
+    return "?";
+}
+
+int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o)
+{
+    uint32_t g = mo->given, bad = 0;
+    const char *want = NULL;
+    if (!render && (g & RAD_TOOL_OPT_RENDER_ONLY)) {
+        fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & RAD_TOOL_OPT_RENDER_ONLY));
+        return 2;
+    }
+    if (!render && mo->method == RAD_TOOL_PATHTRACE) {
+        fprintf(stderr, "rad %s: method 'pathtrace' needs no bake (use rad render --method pathtrace)\n", cmd);
+        return 2;
+    }
+    switch (mo->method) {
+    case RAD_TOOL_CLASSIC:
+        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY |
+                   (render ? 0u : RAD_TOOL_OPT_SEED));
+        want = (bad & RAD_TOOL_OPT_MB_BUILD) ? "multibounce" : "temporal";
+        if (!bad && mo->bounces == RAD_MB_INFINITE) {
+            fprintf(stderr, "rad %s: --bounces inf is for --method multibounce (classic Jacobi needs a count)\n", cmd);
+            return 2;
+        }
+        if (g & RAD_TOOL_OPT_BOUNCES) o->bounces = mo->bounces;
+        break;
+    case RAD_TOOL_PATHTRACE:
+        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_BOUNCES);
+        want = (bad & RAD_TOOL_OPT_MB_BUILD) || (bad & RAD_TOOL_OPT_BOUNCES) ? "multibounce" : "temporal";
+        break;
+    case RAD_TOOL_MULTIBOUNCE:
+        bad = g & (RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED);
+        want = "temporal";
+        break;
+    default:
+        bad = g & RAD_TOOL_OPT_MB_BUILD;
+        want = "multibounce";
+        if (!bad && (g & RAD_TOOL_OPT_BOUNCES) && mo->mode != RAD_TEMPORAL_MULTIBOUNCE) {
+            fprintf(stderr, "rad %s: --bounces is for --mode multibounce with --method temporal (mode %s samples F)\n",
+                    cmd, mode_name(mo->mode));
+            return 2;
+        }
+        if (!bad && (g & RAD_TOOL_OPT_W) && (g & RAD_TOOL_OPT_ADAPTIVE)) {
+            fprintf(stderr, "rad %s: --w and --adaptive exclude each other\n", cmd);
+            return 2;
+        }
+        if (!bad && (g & RAD_TOOL_OPT_EVERY) && !(g & RAD_TOOL_OPT_SEQUENCE)) {
+            fprintf(stderr, "rad %s: --every needs --sequence DIR\n", cmd);
+            return 2;
+        }
+        break;
+    }
+    if (bad) {
+        fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd, given_name(bad), want,
+                rad_tool_method_name(mo->method));
+        return 2;
+    }
+    if (mo->method == RAD_TOOL_MULTIBOUNCE && mo->format <= RAD_TOOL_MB_HALF &&
+        (g & (RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE))) {
+        fprintf(stderr, "rad %s: %s is for the compressed formats (--format bc1 or bc4x3), not %s\n", cmd,
+                given_name(g & (RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | RAD_TOOL_OPT_REORDER_SAMPLES |
+                                RAD_TOOL_OPT_TILE)),
+                format_name(mo->format));
+        return 2;
+    }
+    return 0;
+}
+
+/* ---- bake ---------------------------------------------------------------------------------- */
+
+static uint32_t mb_bounces(uint32_t bounces)
+{
+    return bounces == RAD_MB_INFINITE ? RAD_MB_INFINITE : bounces + 1u;
+}
+
+int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                         const rad_tool_method_options *mo, void **out, size_t *out_size)
+{
+    rad_tool_classic_options so = *o;
+    rad_tool_classic c;
+    rad_context ctx;
+    rad_result r = RAD_SUCCESS;
+    rad_multibounce *mb = NULL;
+    rad_multibounce_blocks *blocks = NULL;
+    rad_alias_tables *tables[3] = {NULL, NULL, NULL};
+    rad_block_report report;
+    rad_tool_bake_info info;
+    rad_tool_method_info mi;
+    rad_container *ct = NULL;
+    rad_section *secs = NULL;
+    void *base = NULL, *dst = NULL;
+    size_t base_size = 0, dst_size = 0, bytes = 0;
+    uint32_t n, i, k = 0, count;
+    float *ones = NULL, *rows3 = NULL, *S = NULL;
+    double t0;
+    const char *what = NULL;
+    int rc = 1;
+
+    *out = NULL;
+    *out_size = 0;
+    so.sources_only = 1;
+    if (rad_tool_classic_solve(cmd, w, &so, &c)) return 1;
+    n = c.patches->count;
+    rad_tool_context(&ctx, NULL);
+
+    /* row sums of F for the halo correction */
+    ones = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    rows3 = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    S = (float *)xcalloc(n, sizeof(float));
+    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
+    if ((r = rad_matrix_multiply(&c.ff->matrix, ones, rows3, &ctx)) != RAD_SUCCESS) {
+        what = "rad_matrix_multiply";
+        goto fail;
+    }
+    for (i = 0; i < n; ++i) S[i] = rows3[3 * i];
+
+    memset(&mi, 0, sizeof mi);
+    mi.magic = RAD_TOOL_METHOD_MAGIC;
+    mi.method = (uint32_t)mo->method;
+    mi.bounces = mo->bounces;
+    mi.format = mo->format;
+    mi.outliers = mo->outliers;
+    mi.reorder = (uint32_t)mo->reorder;
+    mi.reorder_samples = mo->reorder_samples;
+    mi.tile = mo->tile;
+    mi.mode = (uint32_t)mo->mode;
+    mi.k = mo->k;
+    mi.w = mo->w;
+    mi.adaptive = (uint32_t)mo->adaptive;
+    mi.seed = mo->seed;
+
+    t0 = rad_tool_seconds();
+    if (mo->method == RAD_TOOL_MULTIBOUNCE ||
+        (mo->method == RAD_TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
+        rad_multibounce_options mbo;
+        rad_multibounce_options_default(&mbo);
+        mbo.bounces = mb_bounces(mo->bounces);
+        mbo.precision = mo->method == RAD_TOOL_MULTIBOUNCE && mo->format == RAD_TOOL_MB_HALF ? RAD_MB_HALF : RAD_MB_FLOAT;
+        rad_tool_context(&ctx, "F_mb");
+        r = rad_multibounce_create(&c.ff->matrix, c.patches->albedo, &mbo, &ctx, &mb);
+        rad_tool_progress_end();
+        rad_tool_context(&ctx, NULL);
+        if (r != RAD_SUCCESS) {
+            what = "rad_multibounce_create";
+            goto fail;
+        }
+        if (mbo.bounces == RAD_MB_INFINITE)
+            fprintf(stderr, "rad %s: F_mb (inf bounces, %s) built in %.2f s\n", cmd,
+                    mbo.precision == RAD_MB_HALF ? "half" : "float", rad_tool_seconds() - t0);
+        else
+            fprintf(stderr, "rad %s: F_mb (%u bounces: --bounces %u and the renderer's gather, %s) built in %.2f s\n",
+                    cmd, mbo.bounces, mo->bounces, mbo.precision == RAD_MB_HALF ? "half" : "float",
+                    rad_tool_seconds() - t0);
+    }
+    if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+        if (mo->format >= RAD_TOOL_MB_BC1) {
+            rad_block_options bo;
+            double t1 = rad_tool_seconds();
+            rad_block_options_default(&bo);
+            bo.format = mo->format == RAD_TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
+            bo.outlier_fraction = mo->outliers;
+            bo.reorder = mo->reorder;
+            bo.reorder_samples = mo->reorder_samples;
+            bo.tile = mo->tile;
+            memset(&report, 0, sizeof report);
+            rad_tool_context(&ctx, "compression");
+            r = rad_multibounce_blocks_create(mb, &bo, &ctx, &blocks, &report);
+            rad_tool_progress_end();
+            rad_tool_context(&ctx, NULL);
+            if (r != RAD_SUCCESS) {
+                what = "rad_multibounce_blocks_create";
+                goto fail;
+            }
+            bytes = report.bytes_total;
+            mi.mse = (float)report.mse;
+            mi.max_abs_error = (float)report.max_abs_error;
+            mi.source_mean_square = (float)report.source_mean_square;
+            fprintf(stderr,
+                    "rad %s: compressed to %s in %.2f s: %lu bytes (blocks %lu, scales %lu, %llu outliers %lu, "
+                    "permutations %lu) vs %lu float F_mb, %.1fx; decoded-matrix RMS error %.3g (%.3g%% of the "
+                    "RMS entry), max %.3g\n",
+                    cmd, format_name(mo->format), rad_tool_seconds() - t1, (unsigned long)report.bytes_total,
+                    (unsigned long)report.bytes_blocks, (unsigned long)report.bytes_scales,
+                    (unsigned long long)report.outlier_count, (unsigned long)report.bytes_outliers,
+                    (unsigned long)report.bytes_permutations, (unsigned long)report.bytes_float_mb,
+                    report.bytes_total ? (double)report.bytes_float_mb / (double)report.bytes_total : 0.0,
+                    sqrt(report.mse),
+                    report.source_mean_square > 0.0 ? 100.0 * sqrt(report.mse / report.source_mean_square) : 0.0,
+                    report.max_abs_error);
+        } else {
+            bytes = (size_t)3 * n * n * (mo->format == RAD_TOOL_MB_HALF ? 2u : 4u);
+            fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", cmd, format_name(mo->format), (unsigned long)bytes);
+        }
+    } else {
+        rad_tool_context(&ctx, "alias tables");
+        if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
+            for (i = 0; i < 3 && r == RAD_SUCCESS; ++i)
+                r = rad_alias_tables_create_dense(mb->planes + (size_t)i * n * n, n, RAD_ALIAS_AUTO, &ctx, &tables[i]);
+        } else {
+            r = rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, &ctx, &tables[0]);
+        }
+        rad_tool_progress_end();
+        rad_tool_context(&ctx, NULL);
+        if (r != RAD_SUCCESS) {
+            what = "alias tables";
+            goto fail;
+        }
+        {
+            uint64_t bins = 0, entries = 0;
+            for (i = 0; i < 3 && tables[i]; ++i) {
+                bytes += rad_alias_tables_memory(tables[i]);
+                bins += tables[i]->row_offsets[n];
+                entries += tables[i]->source_entries;
+            }
+            fprintf(stderr,
+                    "rad %s: alias tables (%s) built in %.2f s: %llu bins, %lu bytes (%.2f bytes per bin) from a "
+                    "%llu-entry float matrix (%lu bytes)\n",
+                    cmd, mode_name(mo->mode), rad_tool_seconds() - t0, (unsigned long long)bins, (unsigned long)bytes,
+                    bins ? (double)bytes / (double)bins : 0.0, (unsigned long long)entries,
+                    (unsigned long)(entries * 4u));
+        }
+    }
+    mi.build_seconds = (float)(rad_tool_seconds() - t0);
+    mi.bytes_lo = (uint32_t)((uint64_t)bytes & 0xFFFFFFFFu);
+    mi.bytes_hi = (uint32_t)((uint64_t)bytes >> 32);
+
+    /* patches and E (and D as a vector) from the library's writer, then ours */
+    if ((r = rad_save_memory(c.patches, NULL, c.E, NULL, &ctx, &base, &base_size)) != RAD_SUCCESS) {
+        what = "rad_save_memory";
+        goto fail;
+    }
+    if ((r = rad_container_open(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
+        what = "rad_container_open";
+        goto fail;
+    }
+    count = rad_container_section_count(ct);
+    secs = (rad_section *)xcalloc((size_t)count + 4 + 3 * 3 + RAD_MB_MAX_SECTIONS, sizeof(rad_section));
+    for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
+    memset(&info, 0, sizeof info);
+    info.magic = 0x52414442u;
+    info.patches = o->patches;
+    info.max_edge = o->max_edge;
+    info.samples = o->samples;
+    info.solver = (uint32_t)o->solver;
+    info.bounces = mo->bounces;
+    info.light_samples = o->light_samples;
+    info.triangle_count = w->scene->triangle_count;
+    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c.D;
+    strcpy(secs[k++].name, "D");
+    secs[k].type = RAD_TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;
+    strcpy(secs[k++].name, "rad.rowsums");
+    secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
+    strcpy(secs[k++].name, "rad.options");
+    secs[k].type = RAD_TOOL_SECTION_METHOD, secs[k].elem_size = sizeof mi, secs[k].count = 1, secs[k].data = &mi;
+    strcpy(secs[k++].name, "rad.method");
+    if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+        uint32_t added = 0;
+        r = blocks ? rad_multibounce_blocks_sections(blocks, "Fmb", secs + k, &added)
+                   : rad_multibounce_sections(mb, "Fmb", secs + k, &added);
+        if (r != RAD_SUCCESS) {
+            what = "multi-bounce sections";
+            goto fail;
+        }
+        k += added;
+    } else if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
+        static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
+        for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(tables[i], names[i], secs + k);
+    } else {
+        rad_alias_tables_sections(tables[0], "F", secs + k);
+        k += 3;
+    }
+    if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
+        what = "rad_container_size";
+        goto fail;
+    }
+    dst = xcalloc(dst_size, 1);
+    if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
+        what = "rad_container_write";
+        goto fail;
+    }
+    *out = dst;
+    *out_size = dst_size;
+    dst = NULL;
+    rc = 0;
+fail:
+    if (what) rad_tool_fail(cmd, what, r);
+    free(dst);
+    free(secs);
+    rad_container_close(ct);
+    rad_free_buffer(base, &ctx);
+    for (i = 0; i < 3; ++i) rad_alias_tables_destroy(tables[i]);
+    rad_multibounce_blocks_destroy(blocks);
+    rad_multibounce_destroy(mb);
+    free(ones);
+    free(rows3);
+    free(S);
+    rad_tool_classic_free(&c);
+    return rc;
+}
+
+/* ---- render side ---------------------------------------------------------------------------- */
+
+struct rad_tool_indirect {
+    const char *cmd;
+    rad_tool_method method;
+    uint32_t n;
+    const float *E, *albedo, *S;
+    rad_multibounce *mb;
+    rad_multibounce_blocks *blocks;
+    rad_alias_tables tables[3];
+    rad_temporal *temporal;
+    float *L;
+    rad_context ctx;
+};
+
+void rad_tool_indirect_close(rad_tool_indirect *m)
+{
+    if (!m) return;
+    rad_temporal_destroy(m->temporal);
+    rad_multibounce_blocks_destroy(m->blocks);
+    rad_multibounce_destroy(m->mb);
+    free(m->L);
+    free(m);
+}
+
+const float *rad_tool_indirect_rowsums(const rad_tool_indirect *m) { return m->S; }
+
+int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
+                           const rad_tool_method_options *mo, rad_tool_indirect **out)
+{
+    const rad_container *ct = bake->container;
+    const rad_section *s;
+    rad_tool_method_info mi;
+    rad_tool_indirect *m;
+    rad_result r;
+    uint32_t n = bake->patches.count;
+    const char *mname = rad_tool_method_name(mo->method);
+    *out = NULL;
+    s = rad_container_find(ct, RAD_TOOL_SECTION_METHOD, "rad.method");
+    if (!s || s->elem_size != sizeof mi || s->count != 1) {
+        fprintf(stderr, "rad %s: bake '%s' holds no %s data (no rad.method section: bake it with --method %s)\n", cmd,
+                bake_name, mname, mname);
+        return 1;
+    }
+    memcpy(&mi, s->data, sizeof mi);
+    if (mi.magic != RAD_TOOL_METHOD_MAGIC) {
+        fprintf(stderr, "rad %s: bake '%s' has a damaged rad.method section\n", cmd, bake_name);
+        return 1;
+    }
+    if (mi.method != (uint32_t)mo->method) {
+        fprintf(stderr, "rad %s: bake '%s' was made with --method %s, not %s\n", cmd, bake_name,
+                rad_tool_method_name((rad_tool_method)mi.method), mname);
+        return 1;
+    }
+    if (!bake->E) {
+        fprintf(stderr, "rad %s: bake '%s' holds no source vector E\n", cmd, bake_name);
+        return 1;
+    }
+    s = rad_container_find(ct, RAD_TOOL_SECTION_ROWSUMS, "rad.rowsums");
+    if (!s || s->elem_size != 4 || s->count != n) {
+        fprintf(stderr, "rad %s: bake '%s' holds no row sums of F for its %u patches (section rad.rowsums)\n", cmd,
+                bake_name, n);
+        return 1;
+    }
+    m = (rad_tool_indirect *)xcalloc(1, sizeof *m);
+    m->cmd = cmd;
+    m->method = mo->method;
+    m->n = n;
+    m->E = bake->E;
+    m->albedo = bake->patches.albedo;
+    m->S = (const float *)s->data;
+    m->L = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    rad_tool_context(&m->ctx, NULL);
+    if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+        const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
+        uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;
+        if (kind > 3) {
+            fprintf(stderr, "rad %s: bake '%s' holds no multi-bounce matrix 'Fmb'\n", cmd, bake_name);
+            rad_tool_indirect_close(m);
+            return 1;
+        }
+        r = kind >= 2 ? rad_multibounce_blocks_load(ct, "Fmb", &m->ctx, &m->blocks)
+                      : rad_multibounce_load(ct, "Fmb", &m->ctx, &m->mb);
+        if (r == RAD_SUCCESS && (kind >= 2 ? m->blocks->n : m->mb->n) != n) {
+            fprintf(stderr, "rad %s: bake '%s': F_mb is %u x %u for %u patches\n", cmd, bake_name,
+                    kind >= 2 ? m->blocks->n : m->mb->n, kind >= 2 ? m->blocks->n : m->mb->n, n);
+            rad_tool_indirect_close(m);
+            return 1;
+        }
+        if (r != RAD_SUCCESS) {
+            rad_tool_indirect_close(m);
+            fprintf(stderr, "rad %s: bake '%s': cannot open its multi-bounce matrix\n", cmd, bake_name);
+            return rad_tool_fail(cmd, "rad_multibounce_load", r);
+        }
+        if (mi.bounces == RAD_MB_INFINITE)
+            fprintf(stderr, "rad %s: F_mb %s, bounces inf, %u patches\n", cmd, format_name(kind), n);
+        else
+            fprintf(stderr, "rad %s: F_mb %s, bounces %u (F_mb holds %u with the gather), %u patches\n", cmd,
+                    format_name(kind), mi.bounces, mi.bounces + 1u, n);
+    } else {
+        static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
+        const rad_alias_tables *tp[3];
+        rad_temporal_options to;
+        uint32_t tcount = mi.mode == RAD_TEMPORAL_MULTIBOUNCE ? 3u : 1u, i;
+        for (i = 0; i < tcount; ++i) {
+            const char *name = tcount == 3 ? names[i] : "F";
+            if (!rad_container_find(ct, RAD_SECTION_TEMPORAL_BINS, name)) {
+                fprintf(stderr, "rad %s: bake '%s' holds no alias tables '%s'\n", cmd, bake_name, name);
+                rad_tool_indirect_close(m);
+                return 1;
+            }
+            if ((r = rad_alias_tables_view(ct, name, &m->ctx, &m->tables[i])) != RAD_SUCCESS) {
+                rad_tool_indirect_close(m);
+                return rad_tool_fail(cmd, "rad_alias_tables_view", r);
+            }
+            if (m->tables[i].rows != n) {
+                fprintf(stderr, "rad %s: bake '%s': alias tables '%s' have %u rows for %u patches\n", cmd, bake_name,
+                        name, m->tables[i].rows, n);
+                rad_tool_indirect_close(m);
+                return 1;
+            }
+            tp[i] = &m->tables[i];
+        }
+        rad_temporal_options_default(&to);
+        to.mode = (rad_temporal_mode)mi.mode;
+        to.samples = (mo->given & RAD_TOOL_OPT_K) ? mo->k : mi.k;
+        to.adaptive = (mo->given & RAD_TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & RAD_TOOL_OPT_W) ? 0 : (int)mi.adaptive;
+        to.weight = (mo->given & RAD_TOOL_OPT_W) ? mo->w : mi.w;
+        to.seed = (mo->given & RAD_TOOL_OPT_SEED) ? mo->seed : mi.seed;
+        if ((r = rad_temporal_create(tp, tcount, m->albedo, &to, &m->ctx, &m->temporal)) != RAD_SUCCESS) {
+            rad_tool_indirect_close(m);
+            return rad_tool_fail(cmd, "rad_temporal_create", r);
+        }
+        fprintf(stderr, "rad %s: temporal, mode %s, k %u, %s%.4g, seed %u, %u patches\n", cmd, mode_name(mi.mode),
+                to.samples, to.adaptive ? "adaptive w, max " : "w ", (double)(to.adaptive ? to.weight_max : to.weight),
+                to.seed, n);
+    }
+    *out = m;
+    return 0;
+}
+
+int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds)
+{
+    rad_result r;
+    uint32_t i;
+    double t0 = rad_tool_seconds();
+    const float *L = m->L;
+    if (m->blocks) r = rad_multibounce_blocks_apply(m->blocks, m->E, m->L, RAD_OUTPUT_INDIRECT, &m->ctx);
+    else if (m->mb) r = rad_multibounce_apply(m->mb, m->E, m->L, RAD_OUTPUT_INDIRECT, &m->ctx);
+    else {
+        r = rad_temporal_step(m->temporal, m->E, NULL, NULL);
+        L = rad_temporal_indirect(m->temporal);
+    }
+    *seconds = rad_tool_seconds() - t0;
+    if (r != RAD_SUCCESS)
+        return rad_tool_fail(m->cmd, m->temporal ? "rad_temporal_step" : "multi-bounce apply", r);
+    /* H = L_{K+1} / rho (see the top of this file) */
+    for (i = 0; i < 3 * m->n; ++i) H[i] = m->albedo[i] > 0.0f ? L[i] / m->albedo[i] : 0.0f;
+    return 0;
+}
