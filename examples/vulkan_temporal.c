@@ -31,7 +31,7 @@
 
 /* ---- step 1: the bake, into one container -------------------------------------------------- */
 
-static void *bake(uint32_t patch_target, uint32_t samples, size_t *out_size)
+static void *bake(uint32_t patch_target, size_t *out_size)
 {
     rad_scene_desc desc;
     rad_camera cam;
@@ -49,7 +49,6 @@ static void *bake(uint32_t patch_target, uint32_t samples, size_t *out_size)
     uint32_t count = 0, mb_count = 0;
     float *E;
     void *bytes;
-    (void)samples;
     rad_cornell_box(&desc, &cam);
     CHECK_RAD(rad_scene_create(&desc, NULL, &scene));
     rad_patch_options_default(&popt);
@@ -399,7 +398,7 @@ int main(int argc, char **argv)
         fclose(fl);
         size = (size_t)len;
     } else {
-        bytes = bake(patch_target, samples, &size);
+        bytes = bake(patch_target, &size);
         if (save) {
             FILE *fs = fopen(save, "wb");
             if (!fs || fwrite(bytes, 1, size, fs) != size || fclose(fs) != 0) { fprintf(stderr, "cannot write %s\n", save); return 1; }
