@@ -4,6 +4,7 @@
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/
+#   make glsl    regenerates the GLSL sources embedded in radiosity.h from glsl/
 #   make clean
 CC      ?= cc
 CXX     ?= c++
@@ -16,7 +17,7 @@ EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 RAD_DATA_DIR ?= ../shared/data
 
-.PHONY: all demo gallery test bench bench-quick tools fuzz clean
+.PHONY: all demo gallery test bench bench-quick tools fuzz clean glsl
 
 all: $(BUILD)/cornell tools
 
@@ -89,3 +90,10 @@ fuzz: | $(BUILD)
 
 clean:
 	rm -rf $(BUILD) cornell.png gallery.png tools/rad
+
+# the GLSL kernels: glsl/*.comp are the canonical sources, embedded into radiosity.h
+$(BUILD)/glsl_embed: glsl/embed.c | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O2 glsl/embed.c -o $@
+
+glsl: $(BUILD)/glsl_embed
+	./$(BUILD)/glsl_embed radiosity.h

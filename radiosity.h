@@ -78,9 +78,10 @@
        7. RAY QUERIES              the callback table, the built-in BVH, self-intersection
        8. EMBREE                   the optional Embree 3 backend
        9. BAKED DATA               the container format
-      10. NUMERICAL ROBUSTNESS     epsilons, singularities, validation
-      11. WHAT radiosity.h DOES NOT DO
-      12. HISTORY
+      10. GLSL                     compute kernels for the GPU, as source text
+      11. NUMERICAL ROBUSTNESS     epsilons, singularities, validation
+      12. WHAT radiosity.h DOES NOT DO
+      13. HISTORY
 
    1. OPTIONS
        macro                      default            where to set it
@@ -197,7 +198,25 @@
        RAD_ERROR_INDEX_OUT_OF_RANGE; nothing is read outside the given bytes. Applications add
        their own sections (types >= RAD_SECTION_USER) through rad_container_write.
 
-  10. NUMERICAL ROBUSTNESS
+  10. GLSL
+       The GPU paths are GLSL 4.50 compute kernels embedded as text (SPEC §10): get one with
+       rad_glsl_source(RAD_GLSL_TEMPORAL_STEP, buf, size, &len) (or rad_glsl_pieces), compile
+       it with glslang or shaderc and dispatch it on your own Vulkan device; radiosity.h never
+       touches a GPU. Kernels: dense and CSR gather (one bounce), multi-bounce apply from
+       float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
+       step (the same random draws as the CPU) and the alias-table build for streamed rows;
+       RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
+       Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
+       push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
+       specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), a workgroup (gathers, applies) or
+       an invocation (temporal step, alias build) per row, and row_offset / row_count / base in
+       every kernel so a matrix larger than one storage-buffer
+       range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
+       sources: the .comp files in glsl/ of the repository (make glsl regenerates the header's copy);
+       tests/test_vulkan.c runs every kernel against the CPU path; examples/vulkan_temporal.c
+       is a complete program.
+
+  11. NUMERICAL ROBUSTNESS
        - rad_scene_create validates everything: NaN/Inf positions or normals, indices out of
          range, zero-area triangles (rejected, or skipped and counted with
          RAD_SCENE_SKIP_DEGENERATE), albedo outside [0,1), negative or non-finite emission,
@@ -216,13 +235,13 @@
        - The polygon kernel clips the receiver to the sample point's upper half-space and
          returns 0 when the point is behind the receiver, so there is no sign ambiguity.
 
-  11. WHAT radiosity.h DOES NOT DO
+  12. WHAT radiosity.h DOES NOT DO
        - Specular or glossy transport: radiosity is diffuse light exchange.
        - Parse scene files: meshes come in as arrays (tools/rad imports OBJ, glTF, FBX, PLY
          through assimp).
        - Start threads, touch the GPU itself, or keep global state.
 
-  12. HISTORY
+  13. HISTORY
        0.1.0  scene input and validation, patches, built-in BVH (4-wide, SSE), Embree
               backend, form factors (analytic, Monte Carlo, point-to-point; dense, sparse,
               row ranges), Jacobi, Gauss-Seidel, progressive refinement, LU; direct light;
@@ -1069,6 +1088,174 @@ RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, c
                                  const float *B, const rad_context *ctx);
 RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out);
 #endif
+
+/* ======================================================================================== */
+/* >>api_glsl: GLSL compute kernels                                                         */
+/* ======================================================================================== */
+
+/* SPEC §10. The compute kernels, as GLSL 4.50 source text the application compiles (with
+   glslang or shaderc) and dispatches on its own Vulkan 1.1+ device (Vulkan GLSL: push
+   constants and specialization constants): radiosity.h never touches a GPU. The canonical
+   sources are the files glsl/<name> of the repository; the copy in the >>glsl section is
+   generated from them (make glsl) and a test fails when it is out of date. Every kernel is compiled and run by tests/test_vulkan.c on a Vulkan device
+   (Mesa's lavapipe in CI) and compared with the CPU function named in its entry.
+
+   COMMON RULES
+   - Compute only. Descriptor set 0, bindings as listed, every buffer a std430 storage buffer
+     of 32-bit scalars (float, uint) or uint64 row offsets read as uvec2 (low word first: the
+     little-endian layout of rad_matrix.row_offsets and rad_alias_tables.row_offsets, uploaded
+     unchanged). RGB vectors are 3N interleaved floats, as everywhere in radiosity.h.
+   - Workgroup: layout(local_size_x_id = 0): specialization constant RAD_GLSL_SPEC_LOCAL_SIZE
+     (id 0) sets the x size (default 1 when not specialized; 64 to 256 are good choices, any
+     size up to maxComputeWorkGroupInvocations works). Nothing depends on the subgroup size.
+   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*) run ONE WORKGROUP PER ROW:
+     dispatch row_count groups in x (at most maxComputeWorkGroupCount[0], 65535 guaranteed:
+     chunk longer runs); the group's invocations read the row at consecutive addresses with a
+     stride of the group size and sum in shared memory (12 bytes per invocation). The temporal
+     step and the alias build run ONE INVOCATION PER ROW: ceil(row_count / size) groups.
+   - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
+     by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
+     checked at compile time).
+   - CHUNKING. Every kernel processes rows [row_offset, row_offset + row_count) and reads the
+     big array (the matrix, its entries or bins) relative to a base, so a matrix larger than
+     one storage-buffer range (maxStorageBufferRange: 128 MiB on lavapipe, 4 GiB on most
+     desktop drivers) is processed as several dispatches, each binding only its rows: bind the
+     range from an offset rounded down to minStorageBufferOffsetAlignment and pass the
+     remainder, in elements, as the base. Small arrays (vectors, row offsets) are bound whole.
+   - Results agree with the CPU path to float rounding: the tests accept 1e-5 relative. The
+     temporal kernel draws the same indices as rad_temporal_step (same generator, same alias
+     draw, integer arithmetic), so it is compared directly.
+
+   THE KERNELS (binding: contents)
+   RAD_GLSL_GATHER_DENSE   one classic bounce, out_i = rho_i sum_j F_ij E_j (+ E_i),
+       as rad_solve_jacobi with bounces = 1. Push: rad_glsl_gather_dense_push.
+       0: F, row-major, rows of the chunk (F[row_offset][0] at element f_base)  1: E (3N)
+       2: albedo (3N)  3: out (3N; rows of the chunk written)
+   RAD_GLSL_GATHER_CSR     the same with a CSR matrix. Push: rad_glsl_gather_csr_push.
+       0: row offsets (N + 1 uint64)  1: columns  2: values (entry k at element k - entry_base)
+       3: E  4: albedo  5: out
+   RAD_GLSL_MB_APPLY_FLOAT out = F_mb E (+ E) as rad_multibounce_apply, float planes.
+       Push: rad_glsl_mb_apply_push; flags RAD_GLSL_FLAG_TOTAL, RAD_GLSL_FLAG_PERMUTED.
+       0, 1, 2: the R, G, B planes (rows of the chunk, plane row row_offset at element base)
+       3: E (original order)  4: col_perm  5: row_perm (bind any buffer when not PERMUTED)
+       6: out (original order; rows row_perm[row_offset ..] written)
+   RAD_GLSL_MB_APPLY_HALF  the same with binary16 planes (rad_multibounce.half uploaded
+       unchanged, read as uint words with unpackHalf2x16; base counted in halves). Each plane's
+       buffer and each bound range must cover whole 4-byte words: pad a plane of odd N^2 to a
+       multiple of 4 bytes and round a chunk's range up, or the word holding its last value
+       reads as zero (robust buffer access).
+   RAD_GLSL_TEMPORAL_STEP  one frame of rad_temporal_step with a fixed weight (the adaptive
+       weight stays on the CPU). Push: rad_glsl_temporal_push.
+       0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
+       word w of the tables, bin b starting at w = b * words, at element w - word_base)
+       2: totals T_i  3: E  4: albedo  5: B^prev  6: B^next (ping-pong the two buffers
+       between frames)  7: bins per row, RAD_GLSL_FLAG_PADDED only (else bind any buffer).
+       MULTIBOUNCE mode with three table sets: three dispatches, channel c, sample_base c * k,
+       table set c bound. PADDED: the tables as RAD_GLSL_ALIAS_BUILD writes them (binding 0 =
+       its input row offsets, 2 and 7 its totals and counts), sampled without compaction.
+   RAD_GLSL_MB_APPLY_BLOCKS  out = F~ E (+ E) as rad_multibounce_blocks_apply: the blocks
+       uploaded unchanged as VK_FORMAT_BC1_RGB_UNORM_BLOCK or three VK_FORMAT_BC4_UNORM_BLOCK
+       images (feature textureCompressionBC), decoded by the texture unit with texelFetch
+       (decoders round differently: within 2/255 per channel of rad_bc1_decode_block and
+       rad_bc4_decode_block, measured 1.6/255 on lavapipe), times the tile scales, plus the
+       exact outliers. Push: rad_glsl_mb_blocks_push; flags RAD_GLSL_FLAG_TOTAL, _PERMUTED,
+       _BC1, _OUTLIERS. 0, 1, 2: combined image samplers (BC1:
+       the one image at all three; BC4X3: R, G, B planes)  3: scales (3 per tile)  4: E
+       5: col_perm  6: row_perm  7: outlier offsets (N + 1 uint64)  8: outlier columns
+       9: outlier values (3 each)  10: out. Rows are texel rows (chunks of row_offset, row_count
+       with row_offset + row_count <= N); the outlier arrays are bound whole (indexed by
+       original row), which limits them to one storage range (N of about 14 000 at 5%), and
+       the image to maxImageDimension2D texels (16384 on lavapipe).
+   RAD_GLSL_ALIAS_BUILD    alias tables of streamed rows (P-4.3), the bins of
+       rad_alias_build_row (Vose in double: needs the shaderFloat64 feature; bit-identical where
+       double arithmetic is IEEE, as on lavapipe). Push: rad_glsl_alias_build_push; flags
+       RAD_GLSL_FLAG_DENSE (rows of cols values, no column array). 0: input row offsets
+       (rows + 1 uint64)  1: columns  2: values (entry k at k - entry_base)  3: bins out, padded
+       layout: row i's bins from bin row_offsets[i] + i (room for its entries + 1), at word
+       (b - out_base) * words  4: scratch, one double per output bin  5: scratch, one uint per
+       output bin  6: bin count per row (0: a negative or non-finite entry, or a column >= cols)
+       7: T_i per row. RAD_GLSL_TEMPORAL_STEP samples this layout directly (RAD_GLSL_FLAG_PADDED).
+   RAD_GLSL_LIGHTING       an include, not a kernel: every lighting model and BRDF term of
+       >>api_shading as GLSL functions named as in C (rad_shade ...), no #version line: put
+       its text after yours (or resolve an #include to it). Its results agree with the C
+       functions to 1e-5 relative (tests/test_shading_vulkan.c, through glsl/lighting_eval.comp;
+       the header's copy is checked equal to glsl/lighting.glsl). */
+
+/* >>glsl ids begin */
+typedef enum rad_glsl_id {
+    RAD_GLSL_GATHER_DENSE      =  0, /* glsl/gather_dense.comp */
+    RAD_GLSL_GATHER_CSR        =  1, /* glsl/gather_csr.comp */
+    RAD_GLSL_MB_APPLY_FLOAT    =  2, /* glsl/mb_apply_float.comp */
+    RAD_GLSL_MB_APPLY_HALF     =  3, /* glsl/mb_apply_half.comp */
+    RAD_GLSL_TEMPORAL_STEP     =  4, /* glsl/temporal_step.comp */
+    RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* glsl/mb_apply_blocks.comp */
+    RAD_GLSL_ALIAS_BUILD       =  6, /* glsl/alias_build.comp */
+    RAD_GLSL_LIGHTING          =  7, /* glsl/lighting.glsl */
+    RAD_GLSL_COUNT = 8
+} rad_glsl_id;
+/* >>glsl ids end */
+
+#define RAD_GLSL_SPEC_LOCAL_SIZE 0u   /* specialization constant id of the workgroup x size */
+#define RAD_GLSL_FLAG_TOTAL 1u        /* gather, multi-bounce apply: add E (RAD_OUTPUT_TOTAL) */
+#define RAD_GLSL_FLAG_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
+#define RAD_GLSL_FLAG_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
+#define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
+#define RAD_GLSL_FLAG_PADDED 4u       /* temporal: tables in the padded layout of RAD_GLSL_ALIAS_BUILD */
+#define RAD_GLSL_FLAG_BC1 4u          /* block apply: one BC1 image (else three BC4 images) */
+#define RAD_GLSL_FLAG_OUTLIERS 8u     /* block apply: the outlier arrays are bound */
+#define RAD_GLSL_FLAG_DENSE 1u        /* alias build: dense rows, no column array */
+
+/* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
+typedef struct rad_glsl_gather_dense_push {
+    uint32_t row_offset, row_count, cols, f_base, flags;
+} rad_glsl_gather_dense_push;
+typedef struct rad_glsl_gather_csr_push {
+    uint32_t row_offset, row_count, entry_base, flags;
+} rad_glsl_gather_csr_push;
+typedef struct rad_glsl_mb_apply_push {   /* RAD_GLSL_MB_APPLY_FLOAT and _HALF */
+    uint32_t n, row_offset, row_count, base, flags;
+} rad_glsl_mb_apply_push;
+typedef struct rad_glsl_temporal_push {
+    uint32_t seed, frame;          /* rad_temporal_options.seed; the frame being computed (0, 1, ...) */
+    uint32_t row_offset, row_count;
+    uint32_t n;                    /* N: the environment's column */
+    uint32_t samples;              /* k */
+    uint32_t words;                /* (uint32_t)rad_alias_tables.format: 2 or 3 */
+    uint32_t flags;                /* RAD_GLSL_FLAG_ALBEDO, _FEEDBACK, _PADDED */
+    uint32_t channel;              /* 3: RGB from one table set; 0..2: this channel only */
+    uint32_t sample_base;          /* channel * k with three table sets, else 0 */
+    uint32_t word_base;            /* low 32 bits of the tables' word index at element 0 of binding 1 */
+    float weight;                  /* w */
+    float env[3];                  /* E_0 */
+} rad_glsl_temporal_push;
+typedef struct rad_glsl_mb_blocks_push {
+    uint32_t n, row_offset, row_count;
+    uint32_t tile, tiles_per_row;  /* rad_multibounce_blocks.tile, .tiles_per_row */
+    uint32_t flags;
+} rad_glsl_mb_blocks_push;
+typedef struct rad_glsl_alias_build_push {
+    uint32_t row_offset, row_count;
+    uint32_t cols;                 /* N: the environment's column */
+    uint32_t words;                /* 2 (RAD_ALIAS_COMPACT, cols <= 65535) or 3 (RAD_ALIAS_WIDE) */
+    uint32_t entry_base;           /* low 32 bits of the entry at element 0 of bindings 1, 2 */
+    uint32_t out_base;             /* low 32 bits of the bin at element 0 of bindings 3, 4, 5 */
+    uint32_t flags;                /* RAD_GLSL_FLAG_DENSE */
+} rad_glsl_alias_build_push;
+
+/* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
+RAD_API const char *rad_glsl_name(rad_glsl_id id);
+
+/* The source of kernel 'id' in pieces: returns an array of *out_count string pointers (static
+   storage, never freed) whose concatenation is the source, or NULL (and 0) for an unknown id.
+   Each piece is at most 4000 characters and ends at a line end. Pure, thread-safe. */
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
+
+/* The whole source of kernel 'id' (the pieces concatenated), NUL-terminated, into dst.
+   *out_length (optional) receives the length without the NUL, on success and when dst is too
+   small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
+   INVALID_ARGUMENT (unknown id; dst NULL with out_length NULL or dst_size > 0), SIZE_MISMATCH
+   (dst_size <= length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). SPEC §10. */
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
 
 /* ======================================================================================== */
 /* >>api_multibounce: multi-bounce matrix and its compression                               */
@@ -5854,6 +6041,803 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
     return rad__load(buf, (size_t)len, buf, &c, ctx, out);
 }
 #endif
+
+/* ======================================================================================== */
+/* >>glsl: GLSL compute kernels (generated sources, access)                                 */
+/* ======================================================================================== */
+
+/* push-constant mirrors: the GLSL blocks are 4-byte members in declaration order */
+typedef char rad__check_glsl_dense_push[(sizeof(rad_glsl_gather_dense_push) == 20 &&
+                                         offsetof(rad_glsl_gather_dense_push, f_base) == 12 &&
+                                         offsetof(rad_glsl_gather_dense_push, flags) == 16) ? 1 : -1];
+typedef char rad__check_glsl_csr_push[(sizeof(rad_glsl_gather_csr_push) == 16 &&
+                                       offsetof(rad_glsl_gather_csr_push, entry_base) == 8 &&
+                                       offsetof(rad_glsl_gather_csr_push, flags) == 12) ? 1 : -1];
+typedef char rad__check_glsl_mb_push[(sizeof(rad_glsl_mb_apply_push) == 20 &&
+                                      offsetof(rad_glsl_mb_apply_push, base) == 12 &&
+                                      offsetof(rad_glsl_mb_apply_push, flags) == 16) ? 1 : -1];
+typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60 &&
+                                            offsetof(rad_glsl_temporal_push, words) == 24 &&
+                                            offsetof(rad_glsl_temporal_push, word_base) == 40 &&
+                                            offsetof(rad_glsl_temporal_push, weight) == 44 &&
+                                            offsetof(rad_glsl_temporal_push, env) == 48) ? 1 : -1];
+typedef char rad__check_glsl_blocks_push[(sizeof(rad_glsl_mb_blocks_push) == 24 &&
+                                          offsetof(rad_glsl_mb_blocks_push, tile) == 12 &&
+                                          offsetof(rad_glsl_mb_blocks_push, flags) == 20) ? 1 : -1];
+typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28 &&
+                                         offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
+                                         offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
+
+typedef struct rad__glsl_entry {
+    const char *name;
+    const char *const *pieces;
+    uint32_t count;
+    uint32_t length;
+} rad__glsl_entry;
+
+/* Generated by glsl/embed.c from the files glsl/<name>: edit those, then run make glsl. */
+/* >>glsl begin */
+static const char rad__glsl_0_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_GATHER_DENSE: one classic bounce with a dense form-factor matrix,\n"
+    "//   out_i = rho_i * sum_j F_ij E_j            (flags bit 0 clear: RAD_OUTPUT_INDIRECT)\n"
+    "//   out_i = E_i + rho_i * sum_j F_ij E_j      (flags bit 0 set:   RAD_OUTPUT_TOTAL)\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1. ONE WORKGROUP PER ROW: dispatch\n"
+    "// row_count groups; the invocations of a group read the row with a stride of the group size\n"
+    "// (consecutive invocations read consecutive columns) and sum in shared memory.\n"
+    "// Chunking: binding 0 holds the rows of this chunk only; F_ij is F[f_base + (i - row_offset) * cols + j],\n"
+    "// so a matrix larger than one storage-buffer range runs as several dispatches.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer MatrixF { float F[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer VectorE { float E[]; };      // 3 N, RGB interleaved\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Albedo { float rho[]; };     // 3 N\n"
+    "layout(std430, set = 0, binding = 3) buffer Output { float outv[]; };             // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch (global index)\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
+    "    uint cols;        // N\n"
+    "    uint f_base;      // element of binding 0 that holds F[row_offset][0]\n"
+    "    uint flags;       // bit 0: add E (total)\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;               // the whole group: barriers stay uniform\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint at = pc.f_base + r * pc.cols;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.cols; j += gl_WorkGroupSize.x) {\n"
+    "        float f = F[at + j];\n"
+    "        acc += f * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {   // any group size, no subgroup assumption\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_0[] = { rad__glsl_0_0 };
+static const char rad__glsl_1_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_GATHER_CSR: one classic bounce with a CSR (sparse) form-factor matrix,\n"
+    "//   out_i = rho_i * sum_k values[k] E_columns[k]  (+ E_i when flags bit 0 is set)\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1, ONE WORKGROUP PER ROW (dispatch\n"
+    "// row_count groups; the group strides over the row's entries and sums in shared memory).\n"
+    "// Binding 0 holds all N + 1 row offsets as uint64 (two uint words each, low word first, as\n"
+    "// rad_matrix.row_offsets stores them). Chunking: bindings 1 and 2 may hold only the entries of\n"
+    "// this chunk's rows; entry k of the matrix is element k - entry_base of them (entry_base = the\n"
+    "// low 32 bits of the first entry index the bound ranges start at; a chunk spans < 2^32 entries).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };      // 3 N\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };     // 3 N\n"
+    "layout(std430, set = 0, binding = 5) buffer Output { float outv[]; };             // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch (global index)\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
+    "    uint flags;       // bit 0: add E (total)\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint k0 = row_offsets[i].x - pc.entry_base;       // wraps correctly: only the difference matters\n"
+    "    uint count = row_offsets[i + 1u].x - row_offsets[i].x;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint e = lid; e < count; e += gl_WorkGroupSize.x) {\n"
+    "        uint j = columns[k0 + e];\n"
+    "        acc += values[k0 + e] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_1[] = { rad__glsl_1_0 };
+static const char rad__glsl_2_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_FLOAT: the multi-bounce apply L = F_mb E with float planes\n"
+    "// (rad_multibounce with precision RAD_MB_FLOAT). Plane row i' (permuted order) is original row\n"
+    "// row_perm[i'], plane column j' is original column col_perm[j'] (identity when flags bit 1 is clear):\n"
+    "//   out[row_perm[i']] = sum_j' plane_c[i'][j'] * E[col_perm[j']]  (+ E[row_perm[i']] when flags bit 0)\n"
+    "// for plane rows i' = row_offset .. row_offset + row_count - 1, channels c = R, G, B.\n"
+    "// ONE WORKGROUP PER ROW: dispatch row_count groups; the group strides over the columns.\n"
+    "// Chunking: bindings 0..2 may hold only this chunk's rows; entry (i', j') of plane c is element\n"
+    "// base + (i' - row_offset) * n + j' of binding c.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };       // 3 N, original order\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; }; // N (unused without bit 1)\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; }; // N (unused without bit 1)\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };              // 3 N, original order\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;           // N\n"
+    "    uint row_offset;  // first plane row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
+    "    uint base;        // element of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u;\n"
+    "    uint ip = pc.row_offset + r;\n"
+    "    uint at = pc.base + r * pc.n;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
+    "        uint e = 3u * (perm \? col_perm[j] : j);\n"
+    "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_2[] = { rad__glsl_2_0 };
+static const char rad__glsl_3_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_HALF: the multi-bounce apply L = F_mb E with IEEE binary16\n"
+    "// planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint\n"
+    "// word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage\n"
+    "// feature is needed. Same bindings, push constants, permutations, dispatch (one workgroup per\n"
+    "// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may\n"
+    "// be odd). Buffers and bound ranges must cover whole 32-bit words: round a range's end up to a\n"
+    "// multiple of 4 bytes, or the word holding the last value reads as zero.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { uint R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { uint G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { uint B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; };\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; };\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;\n"
+    "    uint row_offset;\n"
+    "    uint row_count;\n"
+    "    uint base;        // binary16 value of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u \? v.y : v.x; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u;\n"
+    "    uint ip = pc.row_offset + r;\n"
+    "    uint at = pc.base + r * pc.n;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
+    "        uint e = 3u * (perm \? col_perm[j] : j), h = at + j;\n"
+    "        vec3 f = vec3(half_at(R[h >> 1u], h), half_at(G[h >> 1u], h), half_at(B[h >> 1u], h));\n"
+    "        acc += f * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_3[] = { rad__glsl_3_0 };
+static const char rad__glsl_4_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_TEMPORAL_STEP: one frame of temporal radiosity (rad_temporal_step\n"
+    "// with a fixed weight), drawing exactly the indices the CPU draws: the counter-based generator\n"
+    "// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. One invocation per row i\n"
+    "// (dispatch ceil(row_count / group size) groups):\n"
+    "//   acc = 0; for s = 0..k-1: J = draw(sample = sample_base + s); acc += V_J\n"
+    "//   X = acc * (T_i / k); X *= rho_i (flags bit 0); B_i = w B_i^prev + (1 - w) X\n"
+    "// V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).\n"
+    "// channel = 3: one table set serves R, G and B. channel = c < 3: this dispatch uses table set c\n"
+    "// (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.\n"
+    "// Chunking: binding 1 may hold only this chunk's bins: word w of the tables (bin b starts at word\n"
+    "// b * words) is element w - word_base of it (word_base: low 32 bits; a chunk spans < 2^32 words).\n"
+    "// PADDED tables (flags bit 2), as RAD_GLSL_ALIAS_BUILD writes them for streamed rows: row i's\n"
+    "// bins start at bin row_offsets[i] + i (binding 0 = the input entry offsets) and counts[i]\n"
+    "// (binding 7) says how many there are, so the build's output is sampled without compaction.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Totals { float totals[]; };         // T_i per row\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };             // 3 N\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };            // 3 N (flags bit 0)\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer Previous { float Bprev[]; };        // 3 N\n"
+    "layout(std430, set = 0, binding = 6) buffer Next { float Bnext[]; };                     // 3 N\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer Counts { uint counts[]; };          // bins per row (bit 2)\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint seed;        // rad_temporal_options.seed\n"
+    "    uint frame;       // rad_temporal_frame() before the step\n"
+    "    uint row_offset;  // first row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint n;           // N: the environment's column index\n"
+    "    uint samples;     // k\n"
+    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
+    "    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK); bit 2: PADDED\n"
+    "    uint channel;     // 3: RGB from one table set; 0..2: this channel only\n"
+    "    uint sample_base; // channel * k with three table sets, else 0\n"
+    "    uint word_base;   // low 32 bits of the tables' word index at element 0 of binding 1\n"
+    "    float weight;     // w in [0, 1)\n"
+    "    float env_r, env_g, env_b; // E_0\n"
+    "} pc;\n"
+    "\n"
+    "uint rad_pcg(uint v)\n"
+    "{\n"
+    "    uint s = v * 747796405u + 2891336453u;\n"
+    "    uint t = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;\n"
+    "    return (t >> 22u) ^ t;\n"
+    "}\n"
+    "\n"
+    "float value_at(uint j, uint c)\n"
+    "{\n"
+    "    if (j >= pc.n) return c == 0u \? pc.env_r : (c == 1u \? pc.env_g : pc.env_b);\n"
+    "    float v = E[3u * j + c];\n"
+    "    if ((pc.flags & 2u) != 0u) v += Bprev[3u * j + c];\n"
+    "    return v;\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);\n"
+    "    bool padded = (pc.flags & 4u) != 0u;\n"
+    "    uint first = row_offsets[i].x + (padded \? i : 0u);\n"
+    "    uint nb = padded \? counts[i] : row_offsets[i + 1u].x - row_offsets[i].x;\n"
+    "    uint c0 = pc.channel < 3u \? pc.channel : 0u, c1 = pc.channel < 3u \? pc.channel : 2u;\n"
+    "    precise float acc[3] = float[3](0.0, 0.0, 0.0);\n"
+    "    for (uint s = 0u; s < pc.samples; ++s) {\n"
+    "        uint u1 = rad_pcg(key ^ ((pc.sample_base + s) * 0x9E3779B9u));\n";
+static const char rad__glsl_4_1[] =
+    "        uint u2 = rad_pcg(u1 ^ 0x68E31DA4u);\n"
+    "        uint hi, lo;\n"
+    "        umulExtended(u1, nb, hi, lo);\n"
+    "        uint w = (first + hi) * pc.words - pc.word_base, j;   // wraps correctly: only the difference matters\n"
+    "        if (pc.words == 2u) j = u2 < bins[w] \? (bins[w + 1u] & 0xFFFFu) : (bins[w + 1u] >> 16u);\n"
+    "        else j = u2 < bins[w] \? bins[w + 1u] : bins[w + 2u];\n"
+    "        for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);\n"
+    "    }\n"
+    "    precise float scale = totals[i] / float(pc.samples);\n"
+    "    for (uint c = c0; c <= c1; ++c) {\n"
+    "        precise float x = acc[c] * scale;\n"
+    "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n"
+    "        precise float b = pc.weight * Bprev[3u * i + c] + (1.0 - pc.weight) * x;\n"
+    "        Bnext[3u * i + c] = b;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_4[] = { rad__glsl_4_0, rad__glsl_4_1 };
+static const char rad__glsl_5_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_BLOCKS: the multi-bounce apply from the block-compressed\n"
+    "// matrix (rad_multibounce_blocks), as rad_multibounce_blocks_apply: the texture unit decodes the\n"
+    "// blocks (texelFetch), each texel is multiplied by its tile's scale, the outliers are added\n"
+    "// exactly and the permutations are applied:\n"
+    "//   out[row_perm[y]] = sum_x decoded(x, y) * scale(tile of x, y) * E[col_perm[x]]\n"
+    "//                      + sum over the outliers of original row row_perm[y] of value * E[column]\n"
+    "//                      (+ E[row_perm[y]] when flags bit 0 is set)\n"
+    "// for texel rows y = row_offset .. row_offset + row_count - 1 (<= N), RGB. ONE WORKGROUP PER ROW:\n"
+    "// dispatch row_count groups; the group strides over the columns (neighbouring invocations fetch\n"
+    "// neighbouring texels) and sums in shared memory.\n"
+    "// Formats: RAD_BLOCK_BC1 (flags bit 2): one VK_FORMAT_BC1_RGB_UNORM_BLOCK image bound to\n"
+    "// bindings 0, 1 and 2 (its .rgb is read from binding 0); RAD_BLOCK_BC4X3: three\n"
+    "// VK_FORMAT_BC4_UNORM_BLOCK images (R, G, B planes) at bindings 0, 1, 2 (.r of each). The images\n"
+    "// are blocks_per_row * 4 texels square; texel (x, y) is entry (row y, column x).\n"
+    "// The outlier arrays are bound whole (they are indexed by original row, which a chunk of\n"
+    "// permuted rows does not keep contiguous): with the default 5% of N^2 they fit 128 MiB up to\n"
+    "// N of about 14 000.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(set = 0, binding = 0) uniform sampler2D texR;   // BC1: the RGB texture; BC4X3: R plane\n"
+    "layout(set = 0, binding = 1) uniform sampler2D texG;   // BC4X3: G plane (BC1: any, unused)\n"
+    "layout(set = 0, binding = 2) uniform sampler2D texB;   // BC4X3: B plane (BC1: any, unused)\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Scales { float scales[]; };          // 3 per tile\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VectorE { float E[]; };              // 3 N\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer ColPerm { uint col_perm[]; };        // N (flags bit 1)\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer RowPerm { uint row_perm[]; };        // N (flags bit 1)\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer OutlierOffsets { uvec2 out_off[]; }; // N + 1 uint64 (bit 3)\n"
+    "layout(std430, set = 0, binding = 8) readonly buffer OutlierColumns { uint out_col[]; };  // (bit 3)\n"
+    "layout(std430, set = 0, binding = 9) readonly buffer OutlierValues { float out_val[]; };  // 3 per outlier (bit 3)\n"
+    "layout(std430, set = 0, binding = 10) buffer Output { float outv[]; };                    // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;             // N\n"
+    "    uint row_offset;    // first texel row of this dispatch\n"
+    "    uint row_count;     // rows in this dispatch\n"
+    "    uint tile;          // scale tile in texels (0: one scale per channel)\n"
+    "    uint tiles_per_row; // ceil(N / tile), 1 when tile is 0\n"
+    "    uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u, bc1 = (pc.flags & 4u) != 0u;\n"
+    "    uint y = pc.row_offset + r;\n"
+    "    uint trow = pc.tile != 0u \? (y / pc.tile) * pc.tiles_per_row : 0u;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint x = lid; x < pc.n; x += gl_WorkGroupSize.x) {\n"
+    "        ivec2 p = ivec2(int(x), int(y));\n"
+    "        vec3 d = bc1 \? texelFetch(texR, p, 0).rgb\n"
+    "                     : vec3(texelFetch(texR, p, 0).r, texelFetch(texG, p, 0).r, texelFetch(texB, p, 0).r);\n"
+    "        uint t = 3u * (trow + (pc.tile != 0u \? x / pc.tile : 0u));\n"
+    "        uint e = 3u * (perm \? col_perm[x] : x);\n"
+    "        acc += (d * vec3(scales[t], scales[t + 1u], scales[t + 2u])) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
+    "    }\n"
+    "    uint i = perm \? row_perm[y] : y;\n"
+    "    precise vec3 s = vec3(0.0);\n"
+    "    if ((pc.flags & 8u) != 0u) {\n"
+    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n";
+static const char rad__glsl_5_1[] =
+    "        for (uint k = k0 + lid; k < k0 + count; k += gl_WorkGroupSize.x) {\n"
+    "            uint j = 3u * out_col[k];\n"
+    "            s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);\n"
+    "        }\n"
+    "    }\n"
+    "    partial[lid] = acc + s;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_5[] = { rad__glsl_5_0, rad__glsl_5_1 };
+static const char rad__glsl_6_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_ALIAS_BUILD: alias tables of streamed rows built on the GPU\n"
+    "// (SPEC section 8, P-4.3), the same bins as rad_alias_build_row (Vose's robust variant in double, the\n"
+    "// order of operations of the >>api_temporal doc block; bit-identical where double arithmetic is\n"
+    "// IEEE, as on lavapipe), one invocation per row.\n"
+    "// Input rows in CSR form: row i's entries are k = in_off[i] .. in_off[i+1]-1 (uint64, global), at\n"
+    "// element k - entry_base of bindings 1 and 2; flags bit 0 (DENSE): no columns bound, the column\n"
+    "// of entry k is k - in_off[i]. Entries <= 0 are skipped; a negative or non-finite entry or a\n"
+    "// column >= cols makes the row's bin count 0 (the CPU builder returns INVALID_ARGUMENT).\n"
+    "// Output, padded layout: row i gets room for (its entry count + 1) bins starting at bin\n"
+    "// in_off[i] + i (bin b at word (b - out_base) * words of binding 3); counts[i] receives the bins\n"
+    "// written and totals[i] T_i. Binding 4 (double) and 5 (uint) are scratch of one element per\n"
+    "// output bin at the same positions. Needs the shaderFloat64 feature.\n"
+    "// RAD_GLSL_TEMPORAL_STEP samples this layout directly (its PADDED flag).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 in_off[]; }; // rows + 1 uint64\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };    // (not DENSE)\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
+    "layout(std430, set = 0, binding = 3) buffer Bins { uint bins[]; };                   // 2 or 3 words per bin\n"
+    "layout(std430, set = 0, binding = 4) buffer ScratchQ { double q[]; };\n"
+    "layout(std430, set = 0, binding = 5) buffer ScratchStack { uint stack[]; };\n"
+    "layout(std430, set = 0, binding = 6) buffer Counts { uint counts[]; };               // per row (global index)\n"
+    "layout(std430, set = 0, binding = 7) buffer Totals { float totals[]; };              // per row (global index)\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint cols;        // N: the environment's column (COMPACT needs cols <= 65535)\n"
+    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
+    "    uint out_base;    // low 32 bits of the bin index at element 0 of bindings 3, 4 and 5\n"
+    "    uint flags;       // bit 0: DENSE rows (no column array)\n"
+    "} pc;\n"
+    "\n"
+    "void set_bin(uint b, uint threshold, uint col, uint alias_col)\n"
+    "{\n"
+    "    uint w = b * pc.words;\n"
+    "    bins[w] = threshold;\n"
+    "    if (pc.words == 2u) bins[w + 1u] = col | (alias_col << 16u);\n"
+    "    else { bins[w + 1u] = col; bins[w + 2u] = alias_col; }\n"
+    "}\n"
+    "\n"
+    "uint col_of(uint b) { return pc.words == 2u \? (bins[b * 2u + 1u] & 0xFFFFu) : bins[b * 3u + 1u]; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint k0 = in_off[i].x, count = in_off[i + 1u].x - k0;\n"
+    "    uint b0 = k0 + i - pc.out_base;          // this row's first bin (local)\n"
+    "    bool dense = (pc.flags & 1u) != 0u;\n"
+    "    precise double W = 0.0;\n"
+    "    uint n = 0u;\n"
+    "    for (uint e = 0u; e < count; ++e) {\n"
+    "        float v = values[k0 - pc.entry_base + e];\n"
+    "        uint col = dense \? e : columns[k0 - pc.entry_base + e];\n"
+    "        if (isnan(v) || isinf(v) || v < 0.0 || col >= pc.cols) { counts[i] = 0u; totals[i] = 0.0; return; }\n"
+    "        if (v > 0.0) {\n"
+    "            q[b0 + n] = double(v);\n"
+    "            set_bin(b0 + n, 0xFFFFFFFFu, col, col);\n"
+    "            W += double(v);\n"
+    "            ++n;\n"
+    "        }\n"
+    "    }\n"
+    "    precise double env = 1.0 - W;\n"
+    "    double total = W;\n"
+    "    if (env > 0.0) {\n"
+    "        q[b0 + n] = env;\n"
+    "        set_bin(b0 + n, 0xFFFFFFFFu, pc.cols, pc.cols);\n"
+    "        ++n;\n"
+    "        total = 1.0;\n"
+    "    }\n"
+    "    W += env > 0.0 \? env : 0.0;\n"
+    "    // Vose, robust variant: Small grows up from stack[0], Large down from stack[n-1]\n"
+    "    uint small_top = 0u, large_bottom = n;\n"
+    "    for (uint b = 0u; b < n; ++b) {\n";
+static const char rad__glsl_6_1[] =
+    "        precise double qb = double(n) * q[b0 + b] / W;\n"
+    "        q[b0 + b] = qb;\n"
+    "        if (qb < 1.0) stack[b0 + small_top++] = b;\n"
+    "        else stack[b0 + --large_bottom] = b;\n"
+    "    }\n"
+    "    while (small_top > 0u && large_bottom < n) {\n"
+    "        uint l = stack[b0 + --small_top], g = stack[b0 + large_bottom++];\n"
+    "        precise double p = q[b0 + l] * 4294967296.0 + 0.5;\n"
+    "        set_bin(b0 + l, p >= 4294967295.0 \? 0xFFFFFFFFu : uint(p), col_of(b0 + l), col_of(b0 + g));\n"
+    "        precise double qg = (q[b0 + g] + q[b0 + l]) - 1.0;\n"
+    "        q[b0 + g] = qg;\n"
+    "        if (qg < 1.0) stack[b0 + small_top++] = g;\n"
+    "        else stack[b0 + --large_bottom] = g;\n"
+    "    }\n"
+    "    counts[i] = n;\n"
+    "    totals[i] = float(total);\n"
+    "}\n";
+static const char *const rad__glsl_pieces_6[] = { rad__glsl_6_0, rad__glsl_6_1 };
+static const char rad__glsl_7_0[] =
+    "// lighting.glsl - the lighting models and BRDF terms of radiosity.h (SPEC \302\2479, >>shading),\n"
+    "// GLSL 450. An include: no #version; it defines only functions and one struct, all named\n"
+    "// as their C counterparts (rad_ndf_ggx ...). The arithmetic is written in the same order as\n"
+    "// the C code so the results agree to float rounding (tests/test_shading_vulkan.c checks\n"
+    "// 1e-5 relative). Conventions (l, v, n unit; f the BRDF; R = f * max(n.l, 0) the response)\n"
+    "// are those of the >>api_shading comment in radiosity.h.\n"
+    "//\n"
+    "// Including it: either with GL_GOOGLE_include_directive (as glsl/lighting_eval.comp does:\n"
+    "// glslangValidator resolves it relative to the including file), or by pasting this file's\n"
+    "// text after your #version line.\n"
+    "#ifndef RAD_LIGHTING_GLSL\n"
+    "#define RAD_LIGHTING_GLSL\n"
+    "\n"
+    "#define RAD_SHADING_LAMBERT 0\n"
+    "#define RAD_SHADING_HALF_LAMBERT 1\n"
+    "#define RAD_SHADING_BANDED 2\n"
+    "#define RAD_SHADING_PHONG 3\n"
+    "#define RAD_SHADING_BLINN_PHONG 4\n"
+    "#define RAD_SHADING_MINNAERT 5\n"
+    "#define RAD_SHADING_OREN_NAYAR 6\n"
+    "#define RAD_SHADING_MICROFACET 7\n"
+    "#define RAD_NDF_BECKMANN 0\n"
+    "#define RAD_NDF_GGX 1\n"
+    "#define RAD_MASKING_SEPARABLE 0\n"
+    "#define RAD_MASKING_HEIGHT_CORRELATED 1\n"
+    "#define RAD_DIFFUSE_NONE 0\n"
+    "#define RAD_DIFFUSE_LAMBERT 1\n"
+    "#define RAD_DIFFUSE_SHIRLEY 2\n"
+    "\n"
+    "const float RAD_PI = 3.14159265358979323846;\n"
+    "const float RAD_INV_PI = 0.318309886183790671537767526745;\n"
+    "\n"
+    "// The std430 mirror of rad_shading_gpu (96 bytes), filled by rad_shading_pack():\n"
+    "// albedo (or kd), specular (ks), f0, f90, p = (alpha_x, alpha_y, wrap / shininess / k / sigma,\n"
+    "// half-Lambert exponent / bands / Fresnel exponent), mode = (model, ndf, masking, diffuse).\n"
+    "struct RadShadingParams {\n"
+    "    vec4 albedo;\n"
+    "    vec4 specular;\n"
+    "    vec4 f0;\n"
+    "    vec4 f90;\n"
+    "    vec4 p;\n"
+    "    ivec4 mode;\n"
+    "};\n"
+    "\n"
+    "// B eq. 18\n"
+    "float rad_ndf_beckmann(float nm, float alpha)\n"
+    "{\n"
+    "    float a2 = alpha * alpha, c2 = nm * nm;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    return exp((c2 - 1.0) / (a2 * c2)) / (RAD_PI * a2 * c2 * c2);\n"
+    "}\n"
+    "\n"
+    "// B eq. 24\n"
+    "float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    float c2 = nm * nm;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float e = (tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y)) / c2;\n"
+    "    return exp(-e) / (RAD_PI * alpha_x * alpha_y * c2 * c2);\n"
+    "}\n"
+    "\n"
+    "// B eq. 22\n"
+    "float rad_ndf_ggx(float nm, float alpha)\n"
+    "{\n"
+    "    float a2 = alpha * alpha;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float d = 1.0 + nm * nm * (a2 - 1.0);\n"
+    "    return a2 / (RAD_PI * d * d);\n"
+    "}\n"
+    "\n"
+    "// B eq. 26\n"
+    "float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float d = tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y) + nm * nm;\n"
+    "    return 1.0 / (RAD_PI * alpha_x * alpha_y * d * d);\n"
+    "}\n"
+    "\n"
+    "// B eq. 25 (eq. 19 when alpha_x = alpha_y): the Smith variable a; the largest float for\n"
+    "// s = n (C returns +inf there; both give Lambda = 0)\n"
+    "float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;\n"
+    "    if (!(d2 > 0.0)) return 3.402823466e38;\n"
+    "    return ns / sqrt(d2);\n"
+    "}\n"
+    "\n"
+    "// B eq. 23, for a > 0\n"
+    "// (Beckmann's exact Lambda, eq. 20, needs erf, which GLSL lacks: it is C only.)\n"
+    "float rad_lambda_ggx(float a)\n"
+    "{\n"
+    "    return 0.5 * (-1.0 + sqrt(1.0 + 1.0 / (a * a)));\n"
+    "}\n"
+    "\n"
+    "// B eq. 21 (Beckmann, rational approximation)\n"
+    "float rad_lambda_beckmann(float a)\n"
+    "{\n"
+    "    if (!(a < 1.6)) return 0.0;\n"
+    "    return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);\n"
+    "}\n"
+    "\n"
+    "// B eq. 11\n"
+    "float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0 \? 1.0 / (1.0 + lambda_s) : 0.0; }\n"
+    "\n"
+    "// B eq. 13 and 14\n"
+    "float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)\n"
+    "{\n"
+    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / ((1.0 + lambda_v) * (1.0 + lambda_l)) : 0.0;\n"
+    "}\n"
+    "\n"
+    "float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)\n"
+    "{\n"
+    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / (1.0 + lambda_v + lambda_l) : 0.0;\n"
+    "}\n"
+    "\n"
+    "// B eq. 15 and 16 (one channel)\n";
+static const char rad__glsl_7_1[] =
+    "float rad_fresnel_schlick(float f0, float c)\n"
+    "{\n"
+    "    float x = 1.0 - (c > 0.0 \? c : 0.0), x2 = x * x;\n"
+    "    return f0 + (1.0 - f0) * (x2 * x2 * x);\n"
+    "}\n"
+    "\n"
+    "float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)\n"
+    "{\n"
+    "    return f0 + (f90 - f0) * pow(1.0 - (c > 0.0 \? c : 0.0), exponent);\n"
+    "}\n"
+    "\n"
+    "// B eq. 27 and 28 (one channel)\n"
+    "float rad_diffuse_lambert(float albedo, float F) { return (1.0 - F) * albedo * RAD_INV_PI; }\n"
+    "\n"
+    "float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)\n"
+    "{\n"
+    "    float a = 1.0 - (nl > 0.0 \? nl : 0.0), b = 1.0 - (nv > 0.0 \? nv : 0.0);\n"
+    "    float a5 = a * a * a * a * a, b5 = b * b * b * b * b;\n"
+    "    return (1.0 - f0) * (21.0 / 20.0) * albedo * RAD_INV_PI * (1.0 - a5) * (1.0 - b5);\n"
+    "}\n"
+    "\n"
+    "// Lambda from n.s, t.s, b.s without forming a (no division by zero at s = n)\n"
+    "float rad_shading_lambda(int ndf, bool iso, float ns, float ts, float bs, float ax, float ay)\n"
+    "{\n"
+    "    float d2 = iso \? ax * ax * (1.0 - ns * ns) : ax * ax * ts * ts + ay * ay * bs * bs;\n"
+    "    if (!(d2 > 0.0)) return 0.0;\n"
+    "    if (ndf == RAD_NDF_GGX) return 0.5 * (-1.0 + sqrt(1.0 + d2 / (ns * ns)));\n"
+    "    return rad_lambda_beckmann(ns / sqrt(d2));\n"
+    "}\n"
+    "\n"
+    "// f (out_f) and R (return value) for unit l, v, n and an orthonormal t, b (anything when the\n"
+    "// model is isotropic). f is 0 for half-Lambert, which has no BRDF.\n"
+    "vec3 rad_shade(RadShadingParams g, vec3 l, vec3 v, vec3 n, vec3 t, vec3 b, out vec3 out_f)\n"
+    "{\n"
+    "    float nl = dot(n, l), nv = dot(n, v);\n"
+    "    vec3 f = vec3(0.0), rr = vec3(0.0);\n"
+    "    int model = g.mode.x;\n"
+    "    if (nv > 0.0) {\n"
+    "        if (model == RAD_SHADING_HALF_LAMBERT) {\n"
+    "            float x = (nl + g.p.z) / (1.0 + g.p.z);\n"
+    "            float q = pow(x > 0.0 \? x : 0.0, g.p.w);\n"
+    "            rr = g.albedo.xyz * RAD_INV_PI * q;\n"
+    "        } else if (nl > 0.0) {\n"
+    "            if (model == RAD_SHADING_LAMBERT) {\n"
+    "                f = g.albedo.xyz * RAD_INV_PI;\n"
+    "            } else if (model == RAD_SHADING_BANDED) {\n"
+    "                float q = ceil(g.p.w * nl) / g.p.w / nl;\n"
+    "                f = g.albedo.xyz * RAD_INV_PI * q;\n"
+    "            } else if (model == RAD_SHADING_PHONG) {\n"
+    "                vec3 r = 2.0 * nl * n - l;\n"
+    "                float rv = dot(r, v), s = g.p.z;\n"
+    "                float q = (s + 2.0) * (0.5 * RAD_INV_PI) * pow(rv > 0.0 \? rv : 0.0, s);\n"
+    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_BLINN_PHONG) {\n"
+    "                vec3 h = l + v;\n"
+    "                float len = sqrt(dot(h, h)), nh = 0.0, s = g.p.z;\n"
+    "                if (len > 0.0) nh = dot(n, h) / len;\n"
+    "                float q = (s + 2.0) * (s + 4.0) * (0.125 * RAD_INV_PI) / (exp2(-0.5 * s) + s) * pow(nh > 0.0 \? nh : 0.0, s);\n"
+    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_MINNAERT) {\n"
+    "                float kk = g.p.z, c = nl * nv;\n"
+    "                float q = (kk + 1.0) * (0.5 * RAD_INV_PI) * pow(c > 1e-6 \? c : 1e-6, kk - 1.0);\n"
+    "                f = g.albedo.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_OREN_NAYAR) {\n"
+    "                float s2 = g.p.z * g.p.z, A = 1.0 - 0.5 * s2 / (s2 + 0.33), B = 0.45 * s2 / (s2 + 0.09);\n"
+    "                float s = dot(l, v) - nl * nv, q = s > 0.0 \? s / (nl > nv \? nl : nv) : 0.0;\n"
+    "                f = g.albedo.xyz * RAD_INV_PI * (A + B * q);\n"
+    "            } else if (model == RAD_SHADING_MICROFACET) {\n"
+    "                float ax = g.p.x, ay = g.p.y;\n"
+    "                bool iso = ax == ay;\n"
+    "                int ndf = g.mode.y;\n"
+    "                vec3 h = l + v;\n"
+    "                float len = sqrt(dot(h, h));\n"
+    "                if (len > 0.0) {\n"
+    "                    h /= len;\n"
+    "                    float nh = dot(n, h), lh = dot(l, h), vh = dot(v, h), D;\n"
+    "                    if (iso) {\n"
+    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);\n"
+    "                    } else {\n"
+    "                        float th = dot(t, h), bh = dot(b, h);\n"
+    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)\n";
+static const char rad__glsl_7_2[] =
+    "                                               : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);\n"
+    "                    }\n"
+    "                    float lv = rad_shading_lambda(ndf, iso, nv, iso \? 0.0 : dot(t, v), iso \? 0.0 : dot(b, v), ax, ay);\n"
+    "                    float ll = rad_shading_lambda(ndf, iso, nl, iso \? 0.0 : dot(t, l), iso \? 0.0 : dot(b, l), ax, ay);\n"
+    "                    float G = g.mode.z == RAD_MASKING_SEPARABLE \? rad_smith_g2_separable(vh, lh, lv, ll)\n"
+    "                                                               : rad_smith_g2_height_correlated(vh, lh, lv, ll);\n"
+    "                    float sp = G * D / (4.0 * nl * nv);\n"
+    "                    for (int k = 0; k < 3; ++k) f[k] = rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, lh) * sp;\n"
+    "                }\n"
+    "                for (int k = 0; k < 3; ++k) {\n"
+    "                    if (g.mode.w == RAD_DIFFUSE_LAMBERT)\n"
+    "                        f[k] += rad_diffuse_lambert(g.albedo[k], rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, nl));\n"
+    "                    else if (g.mode.w == RAD_DIFFUSE_SHIRLEY)\n"
+    "                        f[k] += rad_diffuse_shirley(g.albedo[k], g.f0[k], nl, nv);\n"
+    "                }\n"
+    "            }\n"
+    "            rr = f * nl;\n"
+    "        }\n"
+    "    }\n"
+    "    out_f = f;\n"
+    "    return rr;\n"
+    "}\n"
+    "\n"
+    "#endif\n";
+static const char *const rad__glsl_pieces_7[] = { rad__glsl_7_0, rad__glsl_7_1, rad__glsl_7_2 };
+static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
+    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
+    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
+    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
+    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
+    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
+    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
+    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4697u },
+    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9212u }
+};
+/* >>glsl end */
+
+RAD_API const char *rad_glsl_name(rad_glsl_id id)
+{
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) return NULL;
+    return rad__glsl_table[id].name;
+}
+
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
+{
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) {
+        if (out_count) *out_count = 0;
+        return NULL;
+    }
+    if (out_count) *out_count = rad__glsl_table[id].count;
+    return rad__glsl_table[id].pieces;
+}
+
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
+{
+    const rad__glsl_entry *e;
+    uint32_t p;
+    size_t at = 0;
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT || (!dst && !out_length)) return RAD_ERROR_INVALID_ARGUMENT;
+    e = &rad__glsl_table[id];
+    if (out_length) *out_length = e->length;
+    if (!dst) return dst_size == 0 ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
+    if (dst_size <= e->length) return RAD_ERROR_SIZE_MISMATCH;
+    for (p = 0; p < e->count; ++p) {
+        size_t n = strlen(e->pieces[p]);
+        memcpy(dst + at, e->pieces[p], n);
+        at += n;
+    }
+    RAD_ASSERT(at == e->length);
+    dst[at] = '\0';
+    return RAD_SUCCESS;
+}
 
 /* ======================================================================================== */
 /* >>multibounce: multi-bounce matrix, GEMM, binary16, BC1/BC4, compression, container      */

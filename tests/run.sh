@@ -114,6 +114,43 @@ else
     fail gallery-small
 fi
 compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+# ---- GLSL: the header holds the current glsl/ sources --------------------------------------
+if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
+   "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
+    pass glsl-embed-current
+else
+    cat "$BUILD/glsl-embed.out" 2>/dev/null | sed "s/^/    /"
+    fail glsl-embed-current
+fi
+# ---- Vulkan: every GLSL kernel against the CPU path (lavapipe is enough; installed when we can)
+vk_ready() { [ -f /usr/include/vulkan/vulkan.h ] && have glslangValidator && ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; }
+vk_ready || try_install mesa-vulkan-drivers libvulkan-dev glslang-tools
+# the Khronos validation layer: test_vulkan turns it on when installed and fails on its messages
+[ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ] || try_install vulkan-validationlayers
+if vk_ready; then
+    echo "== GLSL sources compile on their own"
+    have spirv-val || try_install spirv-tools
+    for f in glsl/*.comp; do
+        spv="$BUILD/$(basename "$f").spv"
+        if glslangValidator -V --target-env vulkan1.1 "$f" -o "$spv" >"$BUILD/glslang.log" 2>&1 &&
+           { ! have spirv-val || spirv-val --target-env vulkan1.1 "$spv" >>"$BUILD/glslang.log" 2>&1; }; then pass "glslang $f"
+        else sed 's/^/    /' "$BUILD/glslang.log" | head -20; fail "glslang $f"; fi
+    done
+    have spirv-val || skip spirv-val "spirv-val is not installed (package spirv-tools)"
+    unit vulkan-kernels $CC -std=c99 $WARN -O2 -I. tests/test_vulkan.c -lvulkan
+    if build vulkan-example $CC -std=c99 $WARN -O2 -I. examples/vulkan_temporal.c -o "$BUILD/vulkan_temporal" -lvulkan -lm &&
+       { if [ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ]; then
+             VK_INSTANCE_LAYERS=VK_LAYER_KHRONOS_validation "$BUILD/vulkan_temporal" --patches 200 --frames 30 --tmp "$BUILD"
+         else "$BUILD/vulkan_temporal" --patches 200 --frames 30 --tmp "$BUILD"; fi; } >"$BUILD/vulkan-example.out" 2>&1 &&
+       ! grep -q 'Validation Error' "$BUILD/vulkan-example.out"; then
+        pass "vulkan-example ($(tail -n 1 "$BUILD/vulkan-example.out"))"
+    else
+        tail -n 20 "$BUILD/vulkan-example.out" 2>/dev/null | sed 's/^/    /'
+        fail vulkan-example
+    fi
+else
+    skip vulkan "no Vulkan headers, Vulkan driver or glslangValidator (packages mesa-vulkan-drivers libvulkan-dev glslang-tools)"
+fi
 # ---- GLSL lighting models against C on a Vulkan device (lavapipe is enough) ----------------
 { have glslangValidator && [ -f /usr/include/vulkan/vulkan.h ]; } || try_install glslang-tools libvulkan-dev mesa-vulkan-drivers
 if have glslangValidator && [ -f /usr/include/vulkan/vulkan.h ]; then
