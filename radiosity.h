@@ -1216,6 +1216,34 @@ RAD_API rad_result rad_local_apply(const rad_local *local, const float *E, const
 /* Bytes the object holds (planes, maps and scratch). */
 RAD_API size_t rad_local_memory(const rad_local *local);
 
+/* ---- choosing the sets ---- */
+
+/* The 'count' patches whose centroids are nearest 'position' (count <= patches->count),
+   nearest first, ties by index, into out_patches. Works on a loaded bake's patches.
+   Errors: INVALID_ARGUMENT, NON_FINITE (position), OUT_OF_MEMORY. Thread safety: reentrant.
+   Cost: O(n log n), 8n bytes of scratch. SPEC §5 (thesis fig. 4.1). */
+RAD_API rad_result rad_local_nearest(const rad_patches *patches, const float position[3], uint32_t count,
+                                     uint32_t *out_patches, const rad_context *ctx);
+/* P_Vis: the candidates that 'camera' (aspect = width / height) can see. A patch is visible
+   when its front faces the camera and one of four points on it (the centroid and the
+   midpoints between the centroid and each vertex) lies inside the view frustum with the
+   segment to the camera unoccluded (one occlusion ray per point inside the frustum, through
+   'raycaster', origin pushed off the surface by 1e-4 of the distance). out_visible (at
+   least count entries) receives the visible candidates in their input order, *out_count
+   how many. A patch seen only between the four points is missed (the test is conservative
+   for small patches, not for large ones). Errors: INVALID_ARGUMENT, NON_FINITE (camera),
+   INDEX_OUT_OF_RANGE (a candidate >= patches->count), RAYCAST_FAILED (the callback's error),
+   OUT_OF_MEMORY. Thread safety: reentrant. Cost: at most 4 rays per candidate, one batch. */
+RAD_API rad_result rad_local_visible(const rad_patches *patches, const rad_raycaster *raycaster,
+                                     const rad_camera *camera, float aspect, const uint32_t *candidates,
+                                     uint32_t count, uint32_t *out_visible, uint32_t *out_count,
+                                     const rad_context *ctx);
+/* P_Lit: the candidates whose source E (3n floats indexed by world patch) exceeds
+   'threshold' (>= 0) in some channel, in input order. Errors: INVALID_ARGUMENT (NULL, a
+   negative or non-finite threshold). Cost: O(count). */
+RAD_API rad_result rad_local_lit(const float *E, const uint32_t *candidates, uint32_t count, float threshold,
+                                 uint32_t *out_lit, uint32_t *out_count);
+
 /* ======================================================================================== */
 /* >>api_temporal: temporal radiosity                                                       */
 /* ======================================================================================== */
@@ -7778,6 +7806,154 @@ done:
     rad__free(&c.allocator, e);
     rad__free(&c.allocator, y);
     return r;
+}
+
+/* ---- choosing the sets ---- */
+
+typedef struct rad__local_key { double d; uint32_t index; } rad__local_key;
+
+static int rad__local_key_cmp(const void *pa, const void *pb)
+{
+    const rad__local_key *a = (const rad__local_key *)pa, *b = (const rad__local_key *)pb;
+    if (a->d != b->d) return a->d < b->d ? -1 : 1;
+    return a->index < b->index ? -1 : (a->index > b->index ? 1 : 0);
+}
+
+RAD_API rad_result rad_local_nearest(const rad_patches *patches, const float position[3], uint32_t count,
+                                     uint32_t *out_patches, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__local_key *keys;
+    uint32_t i;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !position || !out_patches || count > patches->count) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_local_nearest: NULL argument or count %u > patch count", count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!rad__finite3(position)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_local_nearest: the position is not finite");
+        return RAD_ERROR_NON_FINITE;
+    }
+    if (count == 0) return RAD_SUCCESS;
+    keys = (rad__local_key *)rad__alloc_array(&c.allocator, patches->count, sizeof(rad__local_key));
+    if (!keys) return RAD_ERROR_OUT_OF_MEMORY;
+    for (i = 0; i < patches->count; ++i) {
+        const float *q = patches->patches[i].centroid;
+        double dx = (double)q[0] - position[0], dy = (double)q[1] - position[1], dz = (double)q[2] - position[2];
+        keys[i].d = dx * dx + dy * dy + dz * dz;
+        keys[i].index = i;
+    }
+    qsort(keys, patches->count, sizeof(rad__local_key), rad__local_key_cmp);
+    for (i = 0; i < count; ++i) out_patches[i] = keys[i].index;
+    rad__free(&c.allocator, keys);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_local_visible(const rad_patches *patches, const rad_raycaster *raycaster,
+                                     const rad_camera *camera, float aspect, const uint32_t *candidates,
+                                     uint32_t count, uint32_t *out_visible, uint32_t *out_count,
+                                     const rad_context *ctx)
+{
+    rad__ctx c;
+    float f[3], r[3], u[3], th, tw;
+    rad_ray *rays = NULL;
+    uint8_t *occ = NULL;
+    uint32_t *owner = NULL, nrays = 0, i, k, s, nv = 0;
+    rad_result res = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !raycaster || !raycaster->occluded || !camera || !out_visible || !out_count || (count > 0 && !candidates) ||
+        !(aspect > 0.0f) || !rad__finite(aspect)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_local_visible: NULL argument or aspect %g not > 0", (double)aspect);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    *out_count = 0;
+    if (!rad__finite3(camera->position) || !rad__finite3(camera->target) || !rad__finite3(camera->up) ||
+        !rad__finite(camera->fov_y_degrees)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_local_visible: the camera is not finite");
+        return RAD_ERROR_NON_FINITE;
+    }
+    if (!(camera->fov_y_degrees > 0.0f && camera->fov_y_degrees < 180.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_local_visible: fov_y_degrees %g must be in (0, 180)", (double)camera->fov_y_degrees);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    rad__sub(f, camera->target, camera->position);
+    rad__normalize(f);
+    rad__cross(r, f, camera->up);
+    rad__normalize(r);
+    rad__cross(u, r, f);
+    th = (float)tan(0.5 * (double)camera->fov_y_degrees * RAD__PI / 180.0);
+    tw = th * aspect;
+    for (i = 0; i < count; ++i)
+        if (candidates[i] >= patches->count) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_local_visible: candidate %u is patch %u >= %u", i, candidates[i], patches->count);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+    if (count == 0) return RAD_SUCCESS;
+    rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)count * 4u, sizeof(rad_ray));
+    occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)count * 4u, 1);
+    owner = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)count * 4u, sizeof(uint32_t));
+    if (!rays || !occ || !owner) { res = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (i = 0; i < count; ++i) {
+        const rad_patch *p = &patches->patches[candidates[i]];
+        float to[3];
+        rad__sub(to, camera->position, p->centroid);
+        if (!(rad__dot(to, p->normal) > 0.0f)) continue; /* back face */
+        for (s = 0; s < 4; ++s) {
+            float q[3], d[3], z, x, y, dist;
+            for (k = 0; k < 3; ++k)
+                q[k] = s == 0 ? p->centroid[k] : 0.5f * (p->centroid[k] + patches->vertices[3 * (size_t)p->vertices[s - 1] + k]);
+            rad__sub(d, q, camera->position);
+            z = rad__dot(d, f);
+            if (!(z > 0.0f)) continue;
+            x = rad__dot(d, r) / z;
+            y = rad__dot(d, u) / z;
+            if (x < -tw || x > tw || y < -th || y > th) continue;
+            dist = rad__len(d);
+            for (k = 0; k < 3; ++k) {
+                rays[nrays].origin[k] = q[k] + p->normal[k] * 1e-4f * dist;
+                rays[nrays].dir[k] = camera->position[k] - rays[nrays].origin[k];
+            }
+            rays[nrays].tmin = 0.0f;
+            rays[nrays].tmax = 1.0f;
+            owner[nrays++] = i;
+        }
+    }
+    if (nrays > 0) {
+        res = raycaster->occluded(raycaster->user, rays, nrays, occ);
+        if (res != RAD_SUCCESS) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_local_visible: the occlusion callback failed: %s", rad_result_string(res));
+            res = RAD_ERROR_RAYCAST_FAILED;
+            goto done;
+        }
+    }
+    {
+        uint32_t last = RAD_NONE; /* a candidate's rays are consecutive: keep it once */
+        for (k = 0; k < nrays; ++k)
+            if (!occ[k] && owner[k] != last) {
+                out_visible[nv++] = candidates[owner[k]];
+                last = owner[k];
+            }
+    }
+    *out_count = nv;
+done:
+    rad__free(&c.allocator, rays);
+    rad__free(&c.allocator, occ);
+    rad__free(&c.allocator, owner);
+    return res;
+}
+
+RAD_API rad_result rad_local_lit(const float *E, const uint32_t *candidates, uint32_t count, float threshold,
+                                 uint32_t *out_lit, uint32_t *out_count)
+{
+    uint32_t i, n = 0;
+    if (!E || !out_lit || !out_count || (count > 0 && !candidates) || !(threshold >= 0.0f) || !rad__finite(threshold))
+        return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < count; ++i) {
+        const float *e = E + 3 * (size_t)candidates[i];
+        if (e[0] > threshold || e[1] > threshold || e[2] > threshold) out_lit[n++] = candidates[i];
+    }
+    *out_count = n;
+    return RAD_SUCCESS;
 }
 
 /* ======================================================================================== */

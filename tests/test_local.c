@@ -644,6 +644,94 @@ static void test_local_row_sources(void)
     lc_world_free(&w);
 }
 
+
+/* nearest-M against a brute-force count, P_Vis against per-pixel camera rays (every patch a
+   pixel hits is visible; a patch behind the camera or facing away never is), P_Lit */
+static void test_local_sets(void)
+{
+    lc_world w;
+    rad_scene_desc desc;
+    rad_camera cam;
+    rad_raycaster rc;
+    uint32_t *near = NULL, *all = NULL, *vis = NULL, *lit = NULL, *seen = NULL, i, j, nv = 0, nl = 0, M, W = 48, H = 48;
+    float pos[3] = {0.3f, 0.2f, 0.25f};
+    if (!lc_cornell(&w, 150u)) return;
+    rad_cornell_box(&desc, &cam);
+    rad_bvh_raycaster(w.bvh, &rc);
+    M = w.n / 3;
+    near = (uint32_t *)malloc(sizeof(uint32_t) * w.n);
+    all = (uint32_t *)calloc(w.n, sizeof(uint32_t));
+    vis = (uint32_t *)malloc(sizeof(uint32_t) * w.n);
+    lit = (uint32_t *)malloc(sizeof(uint32_t) * w.n);
+    seen = (uint32_t *)calloc(w.n, sizeof(uint32_t));
+    if (!near || !all || !vis || !lit || !seen) goto out;
+    CHECK_OK(rad_local_nearest(w.patches, pos, M, near, NULL));
+    {
+        /* every chosen patch is at most as far as every patch left out */
+        double worst_in = 0.0, best_out = 1e30;
+        for (i = 0; i < w.n; ++i) seen[i] = 0;
+        for (i = 0; i < M; ++i) seen[near[i]] = 1;
+        for (i = 0; i < w.n; ++i) {
+            const float *q = w.patches->patches[i].centroid;
+            double d = (q[0] - pos[0]) * (q[0] - pos[0]) + (q[1] - pos[1]) * (q[1] - pos[1]) + (q[2] - pos[2]) * (q[2] - pos[2]);
+            if (seen[i] && d > worst_in) worst_in = d;
+            if (!seen[i] && d < best_out) best_out = d;
+        }
+        CHECK(worst_in <= best_out);
+        for (i = 1; i < M; ++i) CHECK(near[i] != near[i - 1]);
+    }
+    CHECK_RESULT(rad_local_nearest(w.patches, pos, w.n + 1, near, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    pos[1] = (float)NAN;
+    CHECK_RESULT(rad_local_nearest(w.patches, pos, M, near, NULL), RAD_ERROR_NON_FINITE);
+    /* P_Vis of the whole box from the Cornell camera */
+    for (i = 0; i < w.n; ++i) all[i] = i;
+    CHECK_OK(rad_local_visible(w.patches, &rc, &cam, 1.0f, all, w.n, vis, &nv, NULL));
+    for (i = 0; i < w.n; ++i) seen[i] = 0;
+    for (i = 0; i < nv; ++i) seen[vis[i]] = 1;
+    {
+        uint32_t hit_patches = 0, missed = 0, x, y;
+        for (y = 0; y < H; ++y)
+            for (x = 0; x < W; ++x) {
+                rad_ray ray;
+                rad_hit hit;
+                float wts[3];
+                uint32_t p;
+                rad_camera_ray(&cam, W, H, (float)x + 0.5f, (float)y + 0.5f, &ray);
+                CHECK_OK(rc.intersect(rc.user, &ray, 1, &hit));
+                if (hit.triangle == RAD_NONE) continue;
+                p = rad_patches_locate(w.patches, hit.triangle, hit.b1, hit.b2, wts);
+                if (p == RAD_NONE) continue;
+                if (seen[p] == 1) { seen[p] = 2; hit_patches++; }
+                else if (seen[p] == 0) { seen[p] = 3; missed++; }
+            }
+        printf("    P_Vis: %u of %u patches; %u hit by %ux%u pixel rays, %u hit but not in P_Vis\n", nv, w.n, hit_patches, W, H, missed);
+        CHECK(nv < w.n && nv > w.n / 3);
+        CHECK(missed <= hit_patches / 20); /* patches seen only between the four test points */
+    }
+    /* from behind the box's open front looking away: nothing */
+    {
+        rad_camera back = cam;
+        back.target[2] = cam.position[2] - 1.0f;
+        CHECK_OK(rad_local_visible(w.patches, &rc, &back, 1.0f, all, w.n, vis, &nv, NULL));
+        CHECK(nv == 0);
+    }
+    all[0] = w.n;
+    CHECK_RESULT(rad_local_visible(w.patches, &rc, &cam, 1.0f, all, w.n, vis, &nv, NULL), RAD_ERROR_INDEX_OUT_OF_RANGE);
+    all[0] = 0;
+    CHECK_RESULT(rad_local_visible(w.patches, &rc, &cam, 0.0f, all, w.n, vis, &nv, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    /* P_Lit: E above a threshold */
+    CHECK_OK(rad_local_lit(w.E, all, w.n, 0.2f, lit, &nl));
+    for (i = 0, j = 0; i < w.n; ++i) {
+        const float *e = w.E + 3 * (size_t)i;
+        if (e[0] > 0.2f || e[1] > 0.2f || e[2] > 0.2f) { CHECK(j < nl && lit[j] == i); ++j; }
+    }
+    CHECK(j == nl && nl > 0 && nl < w.n);
+    CHECK_RESULT(rad_local_lit(w.E, all, w.n, -1.0f, lit, &nl), RAD_ERROR_INVALID_ARGUMENT);
+out:
+    free(near); free(all); free(vis); free(lit); free(seen);
+    lc_world_free(&w);
+}
+
 static const rad_test_case tests_local[] = {
     {"local_add_exact_and_first_order", test_local_add_exact_and_first_order},
     {"local_remove_and_evict", test_local_remove_and_evict},
@@ -652,4 +740,5 @@ static const rad_test_case tests_local[] = {
     {"local_apply_subsets", test_local_apply_subsets},
     {"local_bad_input", test_local_bad_input},
     {"local_row_sources", test_local_row_sources},
+    {"local_sets", test_local_sets},
     {NULL, NULL}};
