@@ -7146,6 +7146,7 @@ typedef struct rad__local_scratch {
     uint32_t *row_columns;   /* n: the fetched row */
     float *row_values;       /* n */
     double *a, *b, *u, *v;   /* 3 M each, channel-major: x[c * M + slot] */
+    float *vf;               /* 3 M: v rounded to float for the update passes */
     uint32_t *nz;            /* M: slots where the new row is non-zero */
 } rad__local_scratch;
 
@@ -7175,7 +7176,7 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     rad_local_options o;
     rad_local *L;
     rad__local_storage *st;
-    size_t sizes[11], total = 0, mm, off, part;
+    size_t sizes[12], total = 0, mm, off, part;
     unsigned char *mem;
     uint32_t i, M, k;
     rad__ctx_init(&c, ctx);
@@ -7220,8 +7221,9 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     sizes[8] = (size_t)M * sizeof(uint32_t);             /* nz */
     sizes[9] = (size_t)M;                                /* slot_hidden */
     sizes[10] = (size_t)M * sizeof(uint64_t);            /* hide_order */
+    sizes[11] = (size_t)M * 3 * sizeof(float);           /* vf */
     total = sizeof(rad__local_storage);
-    for (k = 0; k < 11; ++k) {
+    for (k = 0; k < 12; ++k) {
         part = (sizes[k] + 63u) & ~(size_t)63u;
         if (part < sizes[k] || total + part < total) return RAD_ERROR_SIZE_OVERFLOW;
         total += part;
@@ -7248,7 +7250,8 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     st->s.v = st->s.u + (size_t)3 * M; off += (sizes[7] + 63u) & ~(size_t)63u;
     st->s.nz = (uint32_t *)(mem + off); off += (sizes[8] + 63u) & ~(size_t)63u;
     st->slot_hidden = (uint8_t *)(mem + off); off += (sizes[9] + 63u) & ~(size_t)63u;
-    st->hide_order = (uint64_t *)(mem + off);
+    st->hide_order = (uint64_t *)(mem + off); off += (sizes[10] + 63u) & ~(size_t)63u;
+    st->s.vf = (float *)(mem + off);
     memset(st->slot_hidden, 0, M);
     st->bytes = total + 64u + sizeof(rad_local);
     memset(st->planes, 0, mm);
@@ -7335,7 +7338,8 @@ static void rad__local_v_task(void *data, uint32_t t)
     }
 }
 
-/* T_ij += cuv u_i v_j over the task's rows: one rounding to float per entry */
+/* T_ij += (cuv u_i) v_j over the task's rows, in float (u, v and s were accumulated in
+   double; this pass is bandwidth-bound and vectorises) */
 static void rad__local_update_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
@@ -7344,12 +7348,13 @@ static void rad__local_update_task(void *data, uint32_t t)
     uint32_t i0, i1, i, j, ch;
     rad__local_range(J->end, J->tasks, t, &i0, &i1);
     for (ch = 0; ch < 3; ++ch) {
-        const double *u = s->u + (size_t)ch * J->M, *v = s->v + (size_t)ch * J->M;
+        const double *u = s->u + (size_t)ch * J->M;
+        const float *v = s->vf + (size_t)ch * J->M;
         for (i = i0; i < i1; ++i) {
             float *row = J->st->planes + ch * MM + (size_t)i * J->M;
-            double ui = J->cuv[ch] * u[i];
-            if (ui == 0.0) continue;
-            for (j = 0; j < J->end; ++j) row[j] = (float)((double)row[j] + ui * v[j]);
+            float ui = (float)(J->cuv[ch] * u[i]);
+            if (ui == 0.0f) continue;
+            for (j = 0; j < J->end; ++j) row[j] += ui * v[j];
         }
     }
 }
@@ -7508,6 +7513,7 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
         }
     }
     rad__local_run(&c, J.tasks, rad__local_v_task, &J);
+    for (i = 0; i < 3 * M; ++i) s->vf[i] = (float)s->v[i];
     rad__local_run(&c, J.tasks, rad__local_update_task, &J);
     for (ch = 0; ch < 3; ++ch) {
         float *P = st->planes + ch * MM;
@@ -7561,12 +7567,12 @@ static void rad__local_downdate_task(void *data, uint32_t t)
     rad__local_range(J->end, J->tasks, t, &i0, &i1);
     for (ch = 0; ch < 3; ++ch) {
         float *P = J->st->planes + ch * MM;
-        const double *v = J->st->s.v + (size_t)ch * J->M;   /* row k / (1 + T_kk), in double */
+        const float *v = J->st->s.vf + (size_t)ch * J->M;   /* row k / (1 + T_kk) */
         for (i = i0; i < i1; ++i) {
             float *row = P + (size_t)i * J->M;
-            double tik = (double)row[k];
-            if (i == k || tik == 0.0) continue;
-            for (j = 0; j < J->end; ++j) row[j] = (float)((double)row[j] - tik * v[j]);
+            float tik = row[k];
+            if (i == k || tik == 0.0f) continue;
+            for (j = 0; j < J->end; ++j) row[j] -= tik * v[j];
             row[k] = 0.0f;
         }
     }
@@ -7597,8 +7603,8 @@ RAD_API rad_result rad_local_evict(rad_local *L, uint32_t patch, const rad_conte
         for (ch = 0; ch < 3; ++ch) {
             const float *rowk = st->planes + ch * MM + (size_t)k * M;
             double g = 1.0 + (double)rowk[k];
-            double *v = st->s.v + (size_t)ch * M;
-            for (j = 0; j < L->slot_end; ++j) v[j] = (double)rowk[j] / g;
+            float *v = st->s.vf + (size_t)ch * M;
+            for (j = 0; j < L->slot_end; ++j) v[j] = (float)((double)rowk[j] / g);
         }
         J.st = st;
         J.M = M;
