@@ -1125,6 +1125,26 @@ RAD_API rad_result rad_row_source_matrix(const rad_matrix *F, const float *areas
 /* The same over a loaded bake's matrix, areas and albedo. Errors: INVALID_ARGUMENT (no bake
    or a bake without a matrix). */
 RAD_API rad_result rad_row_source_bake(const rad_bake *bake, rad_row_source *out);
+#ifndef RAD_NO_STDIO
+/* Rows streamed from a container file saved by rad_save_file / rad_save_memory with a CSR
+   matrix: the header, the section table, the patches (areas and albedos kept: 16 bytes per
+   patch) and the row offsets (8 bytes per patch) are read and checked when it opens (magic,
+   version, checksums of the header, the table, the patches and the offsets; monotone
+   offsets that end at the column and value counts); each fetch then reads one row's columns
+   and values with two seeks and two reads, so the matrix is never in memory. The matrix
+   sections' checksums are not verified (that would read them whole): every fetched row is
+   checked instead (columns < N by this reader; values finite and >= 0 by rad_local).
+   Errors: IO (the file cannot be opened or read), TRUNCATED, CORRUPT, VERSION, ALBEDO_RANGE,
+   INVALID_ARGUMENT (no CSR matrix in the file), OUT_OF_MEMORY. Thread safety: one stream per
+   thread (fetches move the file position). */
+typedef struct rad_row_stream rad_row_stream;
+RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx, rad_row_stream **out);
+/* Fills a row source that reads through 'stream' (which must outlive it). */
+RAD_API void rad_row_stream_source(rad_row_stream *stream, rad_row_source *out);
+/* Bytes the stream holds in memory (areas, albedos, row offsets). */
+RAD_API size_t rad_row_stream_memory(const rad_row_stream *stream);
+RAD_API void rad_row_stream_close(rad_row_stream *stream);
+#endif
 
 typedef enum rad_local_update {
     RAD_LOCAL_EXACT = 0,       /* Sherman-Morrison: T is (I - A)^-1 - I of the set (default) */
@@ -1465,6 +1485,7 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
 #include <math.h>
 #include <float.h>
 #include <stdio.h>
+#include <limits.h>
 #include <stdarg.h>
 
 #if defined(RAD_MALLOC) && defined(RAD_REALLOC) && defined(RAD_FREE)
@@ -7131,6 +7152,206 @@ RAD_API rad_result rad_row_source_bake(const rad_bake *bake, rad_row_source *out
     if (!bake || !out || bake->F.rows == 0 || bake->F.rows != bake->patches.count) return RAD_ERROR_INVALID_ARGUMENT;
     return rad_row_source_matrix(&bake->F, bake->patches.areas, bake->patches.albedo, out);
 }
+
+#ifndef RAD_NO_STDIO
+struct rad_row_stream {
+    FILE *f;
+    uint32_t n;
+    float *areas, *albedo;
+    uint64_t *offsets;         /* n + 1 */
+    uint64_t col_at, val_at;   /* file offsets of the CSR columns and values */
+    size_t bytes;
+    rad_allocator allocator;
+};
+
+RAD_API void rad_row_stream_close(rad_row_stream *s)
+{
+    rad_allocator a;
+    if (!s) return;
+    a = s->allocator;
+    if (s->f) fclose(s->f);
+    rad__free(&a, s->areas);
+    rad__free(&a, s->albedo);
+    rad__free(&a, s->offsets);
+    rad__free(&a, s);
+}
+
+static int rad__stream_read(FILE *f, uint64_t at, void *dst, size_t bytes)
+{
+    if (at > (uint64_t)LONG_MAX || fseek(f, (long)at, SEEK_SET) != 0) return 0;
+    return fread(dst, 1, bytes, f) == bytes;
+}
+
+static rad_result rad__stream_fetch(void *user, uint32_t row, uint32_t capacity, uint32_t *out_columns, float *out_values,
+                                    uint32_t *out_count)
+{
+    rad_row_stream *s = (rad_row_stream *)user;
+    uint64_t b, e;
+    uint32_t k, count;
+    if (row >= s->n) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    b = s->offsets[row];
+    e = s->offsets[row + 1];
+    if (e - b > capacity) return RAD_ERROR_SIZE_MISMATCH;
+    count = (uint32_t)(e - b);
+    if (count > 0 && (!rad__stream_read(s->f, s->col_at + 4u * b, out_columns, 4u * (size_t)count) ||
+                      !rad__stream_read(s->f, s->val_at + 4u * b, out_values, 4u * (size_t)count)))
+        return RAD_ERROR_IO;
+    for (k = 0; k < count; ++k)
+        if (out_columns[k] >= s->n) return RAD_ERROR_CORRUPT;
+    *out_count = count;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_row_stream_source(rad_row_stream *s, rad_row_source *out)
+{
+    if (!out) return;
+    memset(out, 0, sizeof(*out));
+    if (!s) return;
+    out->n = s->n;
+    out->areas = s->areas;
+    out->albedo = s->albedo;
+    out->fetch = rad__stream_fetch;
+    out->user = s;
+}
+
+RAD_API size_t rad_row_stream_memory(const rad_row_stream *s) { return s ? s->bytes : 0; }
+
+RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx, rad_row_stream **out)
+{
+    rad__ctx c;
+    rad_row_stream *s;
+    unsigned char head[RAD__HEADER_BYTES], *table = NULL, *buf = NULL;
+    uint64_t file_size, actual, off[4] = {0, 0, 0, 0}, cnt[4] = {0, 0, 0, 0};
+    uint32_t count, i, crc[4] = {0, 0, 0, 0}, found = 0;
+    long end;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
+    s = (rad_row_stream *)rad__alloc(&c.allocator, sizeof(rad_row_stream));
+    if (!s) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(s, 0, sizeof(*s));
+    s->allocator = c.allocator;
+    s->f = fopen(path, "rb");
+    if (!s->f) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: cannot open '%s'", path);
+        rad_row_stream_close(s);
+        return RAD_ERROR_IO;
+    }
+    if (fseek(s->f, 0, SEEK_END) != 0 || (end = ftell(s->f)) < 0) { r = RAD_ERROR_IO; goto fail; }
+    actual = (uint64_t)end;
+    if (actual < RAD__HEADER_BYTES || !rad__stream_read(s->f, 0, head, RAD__HEADER_BYTES)) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' is shorter than the container header", path);
+        r = RAD_ERROR_TRUNCATED;
+        goto fail;
+    }
+    if (memcmp(head, "RADB", 4) != 0 || rad__get32(head + 60) != rad__crc32(head, 60)) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': no RADB magic or a bad header checksum", path);
+        r = RAD_ERROR_CORRUPT;
+        goto fail;
+    }
+    if (rad__get32(head + 4) != RAD_CONTAINER_VERSION || (rad__get32(head + 32) != 0u) != rad__host_big_endian()) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': container version %u or byte order this build does not read", path,
+                 rad__get32(head + 4));
+        r = RAD_ERROR_VERSION;
+        goto fail;
+    }
+    count = rad__get32(head + 8);
+    file_size = rad__get64(head + 24);
+    if (rad__get64(head + 16) != RAD__HEADER_BYTES || count > 0x00FFFFFFu) { r = RAD_ERROR_CORRUPT; goto fail; }
+    if (file_size > actual) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' has %llu bytes, the container %llu", path, (unsigned long long)actual,
+                 (unsigned long long)file_size);
+        r = RAD_ERROR_TRUNCATED;
+        goto fail;
+    }
+    table = (unsigned char *)rad__alloc_array(&c.allocator, count ? count : 1u, RAD__ENTRY_BYTES);
+    if (!table) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
+    if ((uint64_t)RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count > file_size ||
+        !rad__stream_read(s->f, RAD__HEADER_BYTES, table, (size_t)RAD__ENTRY_BYTES * count)) {
+        r = RAD_ERROR_TRUNCATED;
+        goto fail;
+    }
+    if (rad__get32(head + 36) != rad__crc32(table, (size_t)RAD__ENTRY_BYTES * count)) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': section table checksum mismatch", path);
+        r = RAD_ERROR_CORRUPT;
+        goto fail;
+    }
+    /* 0: patches, 1: row offsets, 2: columns, 3: values (the first of each type) */
+    for (i = 0; i < count; ++i) {
+        const unsigned char *e = table + (size_t)RAD__ENTRY_BYTES * i;
+        uint32_t type = rad__get32(e), esz = rad__get32(e + 4), want, slot;
+        uint64_t n = rad__get64(e + 8), at = rad__get64(e + 16), bytes = rad__get64(e + 24);
+        if (type == RAD_SECTION_PATCHES) { slot = 0; want = (uint32_t)sizeof(rad_patch); }
+        else if (type == RAD_SECTION_FF_ROW_OFFSETS) { slot = 1; want = 8u; }
+        else if (type == RAD_SECTION_FF_COLUMNS) { slot = 2; want = 4u; }
+        else if (type == RAD_SECTION_FF_VALUES) { slot = 3; want = 4u; }
+        else continue;
+        if (found & (1u << slot)) continue;
+        if (esz != want || n > UINT64_MAX / esz || n * esz != bytes || bytes > file_size || at > file_size - bytes) {
+            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': section %u (type %u) has a bad size or extends past the end", path, i, type);
+            r = RAD_ERROR_CORRUPT;
+            goto fail;
+        }
+        off[slot] = at;
+        cnt[slot] = n;
+        crc[slot] = rad__get32(e + 32);
+        found |= 1u << slot;
+    }
+    if (found != 15u || cnt[0] == 0 || cnt[0] > 0xFFFFFFFEu || cnt[1] != cnt[0] + 1 || cnt[2] != cnt[3]) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' holds no patches with a CSR form-factor matrix of matching size", path);
+        r = found != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
+        goto fail;
+    }
+    s->n = (uint32_t)cnt[0];
+    s->col_at = off[2];
+    s->val_at = off[3];
+    s->areas = (float *)rad__alloc_array(&c.allocator, s->n, sizeof(float));
+    s->albedo = (float *)rad__alloc_array(&c.allocator, s->n, 3 * sizeof(float));
+    s->offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)s->n + 1u, sizeof(uint64_t));
+    buf = (unsigned char *)rad__alloc_array(&c.allocator, s->n, sizeof(rad_patch));
+    if (!s->areas || !s->albedo || !s->offsets || !buf) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
+    s->bytes = sizeof(*s) + (size_t)s->n * 16u + ((size_t)s->n + 1u) * 8u;
+    if (!rad__stream_read(s->f, off[0], buf, (size_t)s->n * sizeof(rad_patch)) ||
+        !rad__stream_read(s->f, off[1], s->offsets, ((size_t)s->n + 1u) * 8u)) {
+        r = RAD_ERROR_IO;
+        goto fail;
+    }
+    if (rad__crc32(buf, (size_t)s->n * sizeof(rad_patch)) != crc[0] || rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != crc[1]) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': checksum mismatch in the patches or the row offsets", path);
+        r = RAD_ERROR_CORRUPT;
+        goto fail;
+    }
+    for (i = 0; i < s->n; ++i) {
+        rad_patch p;
+        uint32_t k;
+        memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
+        s->areas[i] = p.area;
+        for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
+        if (s->offsets[i + 1] < s->offsets[i]) {
+            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets decrease at row %u", path, i);
+            r = RAD_ERROR_CORRUPT;
+            goto fail;
+        }
+    }
+    if (s->offsets[0] != 0 || s->offsets[s->n] != cnt[2]) {
+        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets do not span the %llu entries", path, (unsigned long long)cnt[2]);
+        r = RAD_ERROR_CORRUPT;
+        goto fail;
+    }
+    rad__free(&c.allocator, table);
+    rad__free(&c.allocator, buf);
+    *out = s;
+    return RAD_SUCCESS;
+fail:
+    if (r == RAD_ERROR_IO) rad__log(&c, RAD_LOG_ERROR, "row stream: reading '%s' failed", path);
+    rad__free(&c.allocator, table);
+    rad__free(&c.allocator, buf);
+    rad_row_stream_close(s);
+    return r;
+}
+#endif
 
 RAD_API void rad_local_options_default(rad_local_options *options)
 {

@@ -635,6 +635,44 @@ static void test_local_row_sources(void)
         CHECK(rad_local_memory(Lb) >= planes * sizeof(float));
     }
     CHECK_RESULT(rad_row_source_bake(NULL, &sb), RAD_ERROR_INVALID_ARGUMENT);
+#ifndef RAD_NO_STDIO
+    /* the same rows streamed from a file: same planes; a damaged file is refused */
+    if (Ls && buf) {
+        const char *path = "build/test_local_stream.radb";
+        FILE *f = fopen(path, "wb");
+        rad_row_stream *st = NULL;
+        rad_row_source sf;
+        rad_local *Lf = NULL;
+        int wrote = f && fwrite(buf, 1, size, f) == size;
+        if (f) fclose(f);
+        if (!wrote) { path = "test_local_stream.radb"; f = fopen(path, "wb"); wrote = f && fwrite(buf, 1, size, f) == size; if (f) fclose(f); }
+        CHECK(wrote);
+        CHECK_OK(rad_row_stream_open(path, NULL, &st));
+        if (st) {
+            rad_row_stream_source(st, &sf);
+            CHECK(sf.n == w.n && rad_row_stream_memory(st) < 64u * w.n);
+            CHECK_OK(rad_local_create(&sf, &o, NULL, &Lf));
+            if (Lf) {
+                for (p = 0; p < o.capacity; ++p) CHECK_OK(rad_local_add(Lf, (p * 5) % w.n, NULL));
+                CHECK(memcmp(Lf->planes, Ls->planes, sizeof(float) * 3 * (size_t)o.capacity * o.capacity) == 0);
+            }
+            rad_local_destroy(Lf);
+            rad_row_stream_close(st);
+        }
+        /* truncated, then a flipped byte in the row offsets' region of the header table */
+        f = fopen(path, "wb");
+        if (f) { fwrite(buf, 1, size / 2, f); fclose(f); }
+        CHECK_RESULT(rad_row_stream_open(path, NULL, &st), RAD_ERROR_TRUNCATED);
+        ((unsigned char *)buf)[70] ^= 1u;
+        f = fopen(path, "wb");
+        if (f) { fwrite(buf, 1, size, f); fclose(f); }
+        CHECK_RESULT(rad_row_stream_open(path, NULL, &st), RAD_ERROR_CORRUPT);
+        ((unsigned char *)buf)[70] ^= 1u;
+        remove(path);
+        CHECK_RESULT(rad_row_stream_open(path, NULL, &st), RAD_ERROR_IO);
+        CHECK(st == NULL);
+    }
+#endif
     rad_local_destroy(Ld);
     rad_local_destroy(Ls);
     rad_local_destroy(Lb);
