@@ -107,6 +107,13 @@ else
     fail demo-small
 fi
 compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -lm &&
+   "$BUILD/walk" --grid 2 --m 256 --frames 2 --size 64x36 -o "$BUILD/walk-small" >"$BUILD/walk.out" 2>&1 &&
+   [ -s "$BUILD/walk-small_001.png" ]; then
+    pass walk-small
+else
+    fail walk-small
+fi
 # ---- the rad tool (needs assimp and stb: installed when we can) --------------------------
 { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
 if [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; then
