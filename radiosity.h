@@ -1156,10 +1156,17 @@ typedef enum rad_local_eviction {
     RAD_LOCAL_EVICT_DROP = 1      /* the seed's form: drop the row and column, keep the paths (see above) */
 } rad_local_eviction;
 
+typedef enum rad_local_rebuild_method {
+    RAD_LOCAL_REBUILD_INVERSE = 0, /* blocked Gauss-Jordan inverse of I - A: 2 M^3 flops per channel (default) */
+    RAD_LOCAL_REBUILD_NEUMANN = 1  /* the K = infinity multi-bounce build (rad_multibounce_create):
+                                      Neumann doubling, about 2 log2(K) GEMMs */
+} rad_local_rebuild_method;
+
 typedef struct rad_local_options {
     uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default 1024) */
     rad_local_update update;   /* default RAD_LOCAL_EXACT */
     rad_local_eviction evict;  /* default RAD_LOCAL_EVICT_DOWNDATE */
+    rad_local_rebuild_method rebuild; /* default RAD_LOCAL_REBUILD_INVERSE */
 } rad_local_options;
 
 /* A local multi-bounce matrix. Everything public is read-only. Slot s holds patch
@@ -1174,6 +1181,7 @@ typedef struct rad_local {
     uint32_t n;                /* patches in the world */
     rad_local_update update;
     rad_local_eviction evict;
+    rad_local_rebuild_method rebuild;
     const uint32_t *slot_patch;
     const uint8_t *slot_hidden;
     const uint32_t *patch_slot;
@@ -1216,11 +1224,15 @@ RAD_API rad_result rad_local_remove(rad_local *local, uint32_t patch, const rad_
    INDEX_OUT_OF_RANGE, INVALID_ARGUMENT (not a member). Thread safety: not on the same object;
    uses ctx->parallel_for. Cost: O(slot_end^2) per channel (downdate), O(slot_end) (drop). */
 RAD_API rad_result rad_local_evict(rad_local *local, uint32_t patch, const rad_context *ctx);
-/* Replaces the set by 'patches' (count <= M, no repeats) and computes T from scratch: the
-   rows are fetched, A = rho o F_S assembled densely and T = (I - A)^-1 - I built by the
-   K = infinity multi-bounce machinery (rad_multibounce_create). The reference an update is
-   measured against. Errors: those of rad_local_add and rad_multibounce_create. On error the
-   set is empty. Cost: O(count^3 log(1/tolerance)) per channel, 28 count^2 bytes of scratch. */
+/* Replaces the set by 'patches' (count <= M, no repeats; all visible) and computes T from
+   scratch: the rows are fetched, A = rho o F_S assembled densely and T = (I - A)^-1 - I
+   computed by 'rebuild' of the options: a blocked Gauss-Jordan inverse in float (no
+   pivoting: I - A is strictly diagonally dominant by rows), 64-wide pivot blocks, the
+   trailing updates through the multi-bounce GEMM (2 count^3 flops per channel), or the
+   K = infinity multi-bounce build. The reference an update is measured against. Errors:
+   those of rad_local_add, SINGULAR (a pivot block that cannot be inverted), and of
+   rad_multibounce_create. On error the set is empty. Cost: see the methods; 4 count^2 bytes
+   of scratch (inverse) or 28 count^2 (Neumann). */
 RAD_API rad_result rad_local_rebuild(rad_local *local, const uint32_t *patches, uint32_t count,
                                      const rad_context *ctx);
 /* out_i = sum_{j in lit} T_ij E_j (RAD_OUTPUT_INDIRECT) or E_i + that (RAD_OUTPUT_TOTAL) for
@@ -7360,6 +7372,7 @@ RAD_API void rad_local_options_default(rad_local_options *options)
     options->capacity = 1024;
     options->update = RAD_LOCAL_EXACT;
     options->evict = RAD_LOCAL_EVICT_DOWNDATE;
+    options->rebuild = RAD_LOCAL_REBUILD_INVERSE;
 }
 
 /* private scratch of a rad_local */
@@ -7409,7 +7422,8 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (o.capacity == 0 || o.capacity > source->n || (o.update != RAD_LOCAL_EXACT && o.update != RAD_LOCAL_FIRST_ORDER) ||
-        (o.evict != RAD_LOCAL_EVICT_DOWNDATE && o.evict != RAD_LOCAL_EVICT_DROP)) {
+        (o.evict != RAD_LOCAL_EVICT_DOWNDATE && o.evict != RAD_LOCAL_EVICT_DROP) ||
+        (o.rebuild != RAD_LOCAL_REBUILD_INVERSE && o.rebuild != RAD_LOCAL_REBUILD_NEUMANN)) {
         rad__log(&c, RAD_LOG_ERROR, "rad_local_create: capacity %u must be in [1, n = %u], update and evict 0 or 1 (got %d, %d)",
                  o.capacity, source->n, (int)o.update, (int)o.evict);
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -7482,6 +7496,7 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     L->n = source->n;
     L->update = o.update;
     L->evict = o.evict;
+    L->rebuild = o.rebuild;
     L->slot_hidden = st->slot_hidden;
     L->source = *source;
     L->slot_patch = st->slot_patch;
@@ -7863,6 +7878,75 @@ static void rad__local_clear(rad_local *L)
     L->hidden = 0;
 }
 
+#define RAD__LOCAL_NB 64u
+
+/* In-place inverse of the m x m matrix X (leading dimension ld) by blocked Gauss-Jordan
+   sweeps without pivoting (X = I - A is strictly diagonally dominant by rows, and so is
+   every Schur complement met on the way). For the pivot block D with row panel R, column
+   panel C and the rest O: D' = D^-1, R' = D^-1 R, C' = -C D^-1, O' = O - C D^-1 R; the last
+   update, the whole cost (2 m^2 nb per block), runs through the packed GEMM. */
+static rad_result rad__local_invert(const rad__ctx *c, float *X, uint32_t m, size_t ld)
+{
+    uint32_t kb, b, i, j, q;
+    float *cbuf, *rbuf, *rp, *dinv, *tmp;
+    double *d;
+    rad_result r = RAD_SUCCESS;
+    size_t mb = (size_t)m * RAD__LOCAL_NB;
+    cbuf = (float *)rad__alloc_array(&c->allocator, mb, sizeof(float));
+    rbuf = (float *)rad__alloc_array(&c->allocator, mb, sizeof(float));
+    rp = (float *)rad__alloc_array(&c->allocator, mb, sizeof(float));
+    tmp = (float *)rad__alloc_array(&c->allocator, mb, sizeof(float));
+    dinv = (float *)rad__alloc_array(&c->allocator, (size_t)RAD__LOCAL_NB * RAD__LOCAL_NB, sizeof(float));
+    d = (double *)rad__alloc_array(&c->allocator, (size_t)RAD__LOCAL_NB * 2u * RAD__LOCAL_NB, sizeof(double));
+    if (!cbuf || !rbuf || !rp || !tmp || !dinv || !d) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (kb = 0; kb < m && r == RAD_SUCCESS; kb += b) {
+        b = m - kb < RAD__LOCAL_NB ? m - kb : RAD__LOCAL_NB;
+        /* D^-1 by Gauss-Jordan in double on [D | I] */
+        for (i = 0; i < b; ++i)
+            for (j = 0; j < 2 * b; ++j) d[(size_t)i * 2 * b + j] = j < b ? (double)X[(size_t)(kb + i) * ld + kb + j] : (j - b == i ? 1.0 : 0.0);
+        for (q = 0; q < b && r == RAD_SUCCESS; ++q) {
+            double p = d[(size_t)q * 2 * b + q];
+            if (!(fabs(p) > 1e-30)) { r = RAD_ERROR_SINGULAR; break; }
+            for (j = 0; j < 2 * b; ++j) d[(size_t)q * 2 * b + j] /= p;
+            for (i = 0; i < b; ++i) {
+                double f = d[(size_t)i * 2 * b + q];
+                if (i == q || f == 0.0) continue;
+                for (j = 0; j < 2 * b; ++j) d[(size_t)i * 2 * b + j] -= f * d[(size_t)q * 2 * b + j];
+            }
+        }
+        if (r != RAD_SUCCESS) break;
+        for (i = 0; i < b; ++i)
+            for (j = 0; j < b; ++j) dinv[(size_t)i * b + j] = (float)d[(size_t)i * 2 * b + b + j];
+        /* R with the pivot columns zeroed; C negated with the pivot rows zeroed */
+        for (i = 0; i < b; ++i) {
+            memcpy(rbuf + (size_t)i * m, X + (size_t)(kb + i) * ld, sizeof(float) * m);
+            memset(rbuf + (size_t)i * m + kb, 0, sizeof(float) * b);
+        }
+        for (i = 0; i < m; ++i)
+            for (j = 0; j < b; ++j) cbuf[(size_t)i * b + j] = (i >= kb && i < kb + b) ? 0.0f : -X[(size_t)i * ld + kb + j];
+        memset(rp, 0, sizeof(float) * (size_t)b * m);
+        r = rad__mb_gemm(c, b, m, b, dinv, b, rbuf, m, rp, m);                 /* R' = D^-1 R */
+        if (r == RAD_SUCCESS) r = rad__mb_gemm(c, m, m, b, cbuf, b, rp, m, X, ld); /* O += (-C) R' */
+        memset(tmp, 0, sizeof(float) * (size_t)m * b);
+        if (r == RAD_SUCCESS) r = rad__mb_gemm(c, m, b, b, cbuf, b, dinv, b, tmp, b); /* C' = -C D^-1 */
+        if (r != RAD_SUCCESS) break;
+        for (i = 0; i < b; ++i)
+            for (j = 0; j < m; ++j)
+                if (j < kb || j >= kb + b) X[(size_t)(kb + i) * ld + j] = rp[(size_t)i * m + j];
+        for (i = 0; i < m; ++i)
+            for (j = 0; j < b; ++j)
+                X[(size_t)i * ld + kb + j] = (i >= kb && i < kb + b) ? dinv[(size_t)(i - kb) * b + j] : tmp[(size_t)i * b + j];
+    }
+done:
+    rad__free(&c->allocator, cbuf);
+    rad__free(&c->allocator, rbuf);
+    rad__free(&c->allocator, rp);
+    rad__free(&c->allocator, tmp);
+    rad__free(&c->allocator, dinv);
+    rad__free(&c->allocator, d);
+    return r;
+}
+
 RAD_API rad_result rad_local_rebuild(rad_local *L, const uint32_t *patches, uint32_t count, const rad_context *ctx)
 {
     rad__ctx c;
@@ -7918,7 +8002,26 @@ RAD_API rad_result rad_local_rebuild(rad_local *L, const uint32_t *patches, uint
         }
         for (ch = 0; ch < 3; ++ch) alb[3 * (size_t)i + ch] = L->source.albedo[3 * (size_t)patches[i] + ch];
     }
-    if (r == RAD_SUCCESS) {
+    if (r == RAD_SUCCESS && L->rebuild == RAD_LOCAL_REBUILD_INVERSE) {
+        /* X = I - A per channel, straight into the planes, inverted in place, minus I */
+        for (ch = 0; ch < 3 && r == RAD_SUCCESS; ++ch) {
+            float *P = st->planes + ch * MM;
+            for (i = 0; i < count; ++i) {
+                float rho = alb[3 * (size_t)i + ch];
+                for (k = 0; k < count; ++k) P[(size_t)i * M + k] = (i == k ? 1.0f : 0.0f) - rho * F[(size_t)i * count + k];
+            }
+            r = rad__local_invert(&c, P, count, M);
+            for (i = 0; i < count && r == RAD_SUCCESS; ++i) P[(size_t)i * M + i] -= 1.0f;
+        }
+        if (r == RAD_SUCCESS) {
+            L->slot_end = count;
+            L->count = count;
+        } else {
+            rad__log(&c, RAD_LOG_ERROR, "rad_local_rebuild: the inverse failed: %s", rad_result_string(r));
+            L->slot_end = count; /* so that the clear below zeroes what was written */
+            rad__local_clear(L);
+        }
+    } else if (r == RAD_SUCCESS) {
         memset(&Fm, 0, sizeof(Fm));
         Fm.rows = Fm.cols = count;
         Fm.storage = RAD_STORAGE_DENSE;
@@ -7927,14 +8030,14 @@ RAD_API rad_result rad_local_rebuild(rad_local *L, const uint32_t *patches, uint
         mo.bounces = RAD_MB_INFINITE;
         r = rad_multibounce_create(&Fm, alb, &mo, ctx, &mb);
     }
-    if (r == RAD_SUCCESS) {
+    if (r == RAD_SUCCESS && mb) {
         size_t nn = (size_t)count * count;
         for (ch = 0; ch < 3; ++ch)
             for (i = 0; i < count; ++i)
                 memcpy(st->planes + ch * MM + (size_t)i * M, mb->planes + ch * nn + (size_t)i * count, sizeof(float) * count);
         L->slot_end = count;
         L->count = count;
-    } else {
+    } else if (r != RAD_SUCCESS) {
         /* leave an empty set: undo the maps */
         for (i = 0; i < M; ++i)
             if (st->slot_patch[i] != RAD_NONE) { st->patch_slot[st->slot_patch[i]] = RAD_NONE; st->slot_patch[i] = RAD_NONE; }

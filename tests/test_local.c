@@ -159,10 +159,10 @@ static void test_local_add_exact_and_first_order(void)
     lc_world w;
     rad_row_source src;
     rad_local_options o;
-    rad_local *ex = NULL, *fo = NULL, *rb = NULL, *tk = NULL;
+    rad_local *ex = NULL, *fo = NULL, *rb = NULL, *tk = NULL, *rn = NULL;
     rad_context ctx;
     uint32_t *ids, i;
-    double e_ex, e_fo, e_rb;
+    double e_ex, e_fo, e_rb, e_rn;
     if (!lc_cornell(&w, lc_target())) return;
     ids = (uint32_t *)malloc(sizeof(uint32_t) * w.n);
     if (!ids || !lc_source(&w, &src)) { free(ids); lc_world_free(&w); return; }
@@ -172,12 +172,15 @@ static void test_local_add_exact_and_first_order(void)
     CHECK_OK(rad_local_create(&src, &o, NULL, &ex));
     CHECK_OK(rad_local_create(&src, &o, NULL, &rb));
     CHECK_OK(rad_local_create(&src, &o, NULL, &tk));
+    o.rebuild = RAD_LOCAL_REBUILD_NEUMANN;
+    CHECK_OK(rad_local_create(&src, &o, NULL, &rn));
+    o.rebuild = RAD_LOCAL_REBUILD_INVERSE;
     o.update = RAD_LOCAL_FIRST_ORDER;
     CHECK_OK(rad_local_create(&src, &o, NULL, &fo));
     memset(&ctx, 0, sizeof(ctx));
     ctx.parallel_for = lc_reverse_for;
     ctx.task_count = 5;
-    if (ex && fo && rb && tk) {
+    if (ex && fo && rb && tk && rn) {
         for (i = 0; i < w.n; ++i) {
             CHECK_OK(rad_local_add(ex, ids[i], NULL));
             CHECK_OK(rad_local_add(fo, ids[i], NULL));
@@ -187,13 +190,16 @@ static void test_local_add_exact_and_first_order(void)
         CHECK(memcmp(ex->planes, tk->planes, sizeof(float) * 3 * (size_t)w.n * w.n) == 0);
         CHECK(ex->count == w.n && ex->slot_end == w.n);
         CHECK_OK(rad_local_rebuild(rb, ids, w.n, NULL));
+        CHECK_OK(rad_local_rebuild(rn, ids, w.n, NULL));
         e_ex = lc_error(&w, ex, ids, w.n);
         e_fo = lc_error(&w, fo, ids, w.n);
         e_rb = lc_error(&w, rb, ids, w.n);
-        printf("    N = %u: exact add %.3g, first-order (thesis) %.3g, rebuild %.3g (max |T - T_ref| / max T_ref)\n", w.n, e_ex,
-               e_fo, e_rb);
+        e_rn = lc_error(&w, rn, ids, w.n);
+        printf("    N = %u: exact add %.3g, first-order (thesis) %.3g, rebuild: blocked inverse %.3g, Neumann %.3g "
+               "(max |T - T_ref| / max T_ref)\n", w.n, e_ex, e_fo, e_rb, e_rn);
         CHECK(e_ex < 1e-4);
         CHECK(e_rb < 1e-4);
+        CHECK(e_rn < 1e-4);
         CHECK(e_fo > 0.01);        /* the first-order form misses the return paths */
         CHECK(e_fo > 100.0 * e_ex);
     }
@@ -201,6 +207,7 @@ static void test_local_add_exact_and_first_order(void)
     rad_local_destroy(fo);
     rad_local_destroy(rb);
     rad_local_destroy(tk);
+    rad_local_destroy(rn);
     free(ids);
     lc_world_free(&w);
 }
