@@ -7381,6 +7381,7 @@ typedef struct rad__local_scratch {
     float *row_values;       /* n */
     double *a, *b, *u, *v;   /* 3 M each, channel-major: x[c * M + slot] */
     float *vf;               /* 3 M: v rounded to float for the update passes */
+    double *cc;              /* 3 M: column of the slot evicted by a fused add */
     uint32_t *nz;            /* M: slots where the new row is non-zero */
 } rad__local_scratch;
 
@@ -7410,7 +7411,7 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     rad_local_options o;
     rad_local *L;
     rad__local_storage *st;
-    size_t sizes[12], total = 0, mm, off, part;
+    size_t sizes[13], total = 0, mm, off, part;
     unsigned char *mem;
     uint32_t i, M, k;
     rad__ctx_init(&c, ctx);
@@ -7457,8 +7458,9 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     sizes[9] = (size_t)M;                                /* slot_hidden */
     sizes[10] = (size_t)M * sizeof(uint64_t);            /* hide_order */
     sizes[11] = (size_t)M * 3 * sizeof(float);           /* vf */
+    sizes[12] = (size_t)M * 3 * sizeof(double);          /* cc */
     total = sizeof(rad__local_storage);
-    for (k = 0; k < 12; ++k) {
+    for (k = 0; k < 13; ++k) {
         part = (sizes[k] + 63u) & ~(size_t)63u;
         if (part < sizes[k] || total + part < total) return RAD_ERROR_SIZE_OVERFLOW;
         total += part;
@@ -7486,7 +7488,8 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     st->s.nz = (uint32_t *)(mem + off); off += (sizes[8] + 63u) & ~(size_t)63u;
     st->slot_hidden = (uint8_t *)(mem + off); off += (sizes[9] + 63u) & ~(size_t)63u;
     st->hide_order = (uint64_t *)(mem + off); off += (sizes[10] + 63u) & ~(size_t)63u;
-    st->s.vf = (float *)(mem + off);
+    st->s.vf = (float *)(mem + off); off += (sizes[11] + 63u) & ~(size_t)63u;
+    st->s.cc = (double *)(mem + off);
     memset(st->slot_hidden, 0, M);
     st->bytes = total + 64u + sizeof(rad_local);
     memset(st->planes, 0, mm);
@@ -7517,6 +7520,8 @@ typedef struct rad__local_job {
     rad__local_storage *st;
     uint32_t M, end, tasks, nnz;
     double cuv[3];             /* rank-1 factor per channel */
+    uint32_t ev;               /* fused add: the slot evicted in the same pass, else RAD_NONE */
+    double g[3];               /* fused add: 1 + T_ee per channel */
     const uint32_t *rows;      /* apply: visible slots */
     uint32_t row_count;
     const float *e;            /* apply: 3 * end floats, channel-major */
@@ -7586,11 +7591,23 @@ static void rad__local_update_task(void *data, uint32_t t)
     for (ch = 0; ch < 3; ++ch) {
         const double *u = s->u + (size_t)ch * J->M;
         const float *v = s->vf + (size_t)ch * J->M;
-        for (i = i0; i < i1; ++i) {
-            float *row = J->st->planes + ch * MM + (size_t)i * J->M;
-            float ui = (float)(J->cuv[ch] * u[i]);
-            if (ui == 0.0f) continue;
-            for (j = 0; j < J->end; ++j) row[j] += ui * v[j];
+        if (J->ev == RAD_NONE) {
+            for (i = i0; i < i1; ++i) {
+                float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+                float ui = (float)(J->cuv[ch] * u[i]);
+                if (ui == 0.0f) continue;
+                for (j = 0; j < J->end; ++j) row[j] += ui * v[j];
+            }
+        } else {
+            /* rank 2: the downdate of slot e and the new patch's update in one pass */
+            const float *re = J->st->planes + ch * MM + (size_t)J->ev * J->M;
+            const double *cc = s->cc + (size_t)ch * J->M;
+            for (i = i0; i < i1; ++i) {
+                float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+                float ui = (float)(J->cuv[ch] * u[i]), ci = (float)(-cc[i] / J->g[ch]);
+                if (i == J->ev || (ui == 0.0f && ci == 0.0f)) continue;
+                for (j = 0; j < J->end; ++j) row[j] += ci * re[j] + ui * v[j];
+            }
         }
     }
 }
@@ -7656,7 +7673,7 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
     rad__local_storage *st;
     rad__local_scratch *s;
     rad__local_job J;
-    uint32_t k, count = 0, p, ch, i, end, M;
+    uint32_t k, count = 0, p, ch, i, end, M, evicted = RAD_NONE;
     double ann[3], coef_col[3], coef_row[3], tnn[3], an, rho_n[3];
     size_t MM;
     rad_result r;
@@ -7685,15 +7702,26 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
     MM = (size_t)M * M;
     r = rad__local_fetch(&c, L, patch, &count);
     if (r != RAD_SUCCESS) return r;
+    J.ev = RAD_NONE;
     if (L->count + L->hidden >= L->capacity) {
-        /* full: evict the member hidden longest ago (the fetched row stays in the scratch) */
+        /* full: evict the member hidden longest ago. The exact downdate is fused with this
+           add (one rank-2 pass instead of two rank-1 passes): with c = T[:, e], r = T[e, :],
+           g = 1 + T_ee, the add's vectors over the downdated T are u = a + T a - c (r.a) / g
+           and v = b + b T - (b.c) r / g, and T += -c r / g + u v / s. The seed's drop is
+           cheap and done first. */
         uint32_t oldest = RAD_NONE;
         for (i = 0; i < L->slot_end; ++i)
             if (st->slot_hidden[i] && (oldest == RAD_NONE || st->hide_order[i] < st->hide_order[oldest])) oldest = i;
-        r = rad_local_evict(L, st->slot_patch[oldest], ctx);
-        if (r != RAD_SUCCESS) return r;
+        if (L->evict == RAD_LOCAL_EVICT_DROP) {
+            r = rad_local_evict(L, st->slot_patch[oldest], ctx);
+            if (r != RAD_SUCCESS) return r;
+        } else {
+            J.ev = oldest;
+            evicted = st->slot_patch[oldest];
+            st->patch_slot[evicted] = RAD_NONE; /* its column is no longer part of the new row */
+        }
     }
-    k = rad__local_free_slot(L);
+    k = J.ev != RAD_NONE ? J.ev : rad__local_free_slot(L);
     end = k + 1 > L->slot_end ? k + 1 : L->slot_end;
     for (ch = 0; ch < 3; ++ch) {
         memset(s->a + (size_t)ch * M, 0, sizeof(double) * end);
@@ -7724,7 +7752,21 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
     J.M = M;
     J.end = end;
     J.tasks = rad__local_tasks(&c, end);
+    if (J.ev != RAD_NONE)
+        for (ch = 0; ch < 3; ++ch) {
+            const float *P = st->planes + ch * MM;
+            double *cc = s->cc + (size_t)ch * M;
+            J.g[ch] = 1.0 + (double)P[(size_t)J.ev * M + J.ev];
+            for (i = 0; i < end; ++i) cc[i] = i == J.ev ? 0.0 : (double)P[(size_t)i * M + J.ev];
+        }
     rad__local_run(&c, J.tasks, rad__local_u_task, &J);
+    if (J.ev != RAD_NONE)
+        for (ch = 0; ch < 3; ++ch) {
+            double *u = s->u + (size_t)ch * M, ra = u[J.ev] / J.g[ch]; /* a_e = 0: u_e = (T a)_e = r.a */
+            const double *cc = s->cc + (size_t)ch * M;
+            for (i = 0; i < end; ++i) u[i] -= cc[i] * ra;
+            u[J.ev] = 0.0;
+        }
     for (ch = 0; ch < 3; ++ch) {
         double bu = 0.0, ba = 0.0, sv, d;
         for (p = 0; p < J.nnz; ++p) {
@@ -7736,6 +7778,7 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
         if (!(sv > 1e-12) || sv != sv) {
             rad__log(&c, RAD_LOG_ERROR, "rad_local_add: patch %u channel %u: s = 1 - b.(I+T)a = %g <= 0 (the form factors or "
                      "albedos break energy conservation)", patch, ch, sv);
+            if (evicted != RAD_NONE) st->patch_slot[evicted] = J.ev; /* nothing was written: the set is unchanged */
             return RAD_ERROR_SINGULAR;
         }
         if (L->update == RAD_LOCAL_EXACT) {
@@ -7749,6 +7792,13 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
         }
     }
     rad__local_run(&c, J.tasks, rad__local_v_task, &J);
+    if (J.ev != RAD_NONE)
+        for (ch = 0; ch < 3; ++ch) {
+            double *v = s->v + (size_t)ch * M, bc = v[J.ev] / J.g[ch]; /* b_e = 0: v_e = (b T)_e = b.c */
+            const float *re = st->planes + ch * MM + (size_t)J.ev * M;
+            for (i = 0; i < end; ++i) v[i] -= bc * (double)re[i];
+            v[J.ev] = 0.0;
+        }
     for (i = 0; i < 3 * M; ++i) s->vf[i] = (float)s->v[i];
     rad__local_run(&c, J.tasks, rad__local_update_task, &J);
     for (ch = 0; ch < 3; ++ch) {
@@ -7759,6 +7809,11 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
             P[(size_t)i * M + k] = (float)(coef_col[ch] * u[i]);
         }
         P[(size_t)k * M + k] = (float)tnn[ch];
+    }
+    if (evicted != RAD_NONE) {
+        st->slot_hidden[k] = 0;
+        L->hidden--;
+        L->evictions++;
     }
     st->slot_patch[k] = patch;
     st->patch_slot[patch] = k;
