@@ -440,7 +440,7 @@ static void test_local_back_and_forth(void)
     rad_row_source src;
     rad_local_options o;
     rad_local *L = NULL;
-    uint32_t *want = NULL, *inset = NULL, i, V, mode, step, steps = rad_test_quick() ? 24u : 40u;
+    uint32_t *want = NULL, *inset = NULL, i, V, mode, step, steps = rad_test_quick() ? 18u : 40u;
     double rho_max = 0.0, bound;
     if (!lc_cornell(&w, rad_test_quick() ? 90u : 200u)) return;
     V = w.n * 6 / 10;
@@ -700,7 +700,7 @@ static void test_local_sets(void)
     rad_raycaster rc;
     uint32_t *near = NULL, *all = NULL, *vis = NULL, *lit = NULL, *seen = NULL, i, j, nv = 0, nl = 0, M, W = 48, H = 48;
     float pos[3] = {0.3f, 0.2f, 0.25f};
-    if (!lc_cornell(&w, 150u)) return;
+    if (!lc_cornell(&w, rad_test_quick() ? 100u : 150u)) return;
     rad_cornell_box(&desc, &cam);
     rad_bvh_raycaster(w.bvh, &rc);
     M = w.n / 3;
