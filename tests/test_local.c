@@ -777,6 +777,77 @@ out:
     lc_world_free(&w);
 }
 
+
+/* allocation failure injected at every allocation of create, add, evict, both rebuilds,
+   apply, nearest and visible: each call returns success or OUT_OF_MEMORY, nothing leaks and
+   no block is overrun (the counting allocator of test_scene.c) */
+static void test_local_alloc_failure(void)
+{
+    lc_world w;
+    rad_row_source src;
+    sc_alloc_state st;
+    rad_context ctx;
+    rad_scene_desc desc;
+    rad_camera cam;
+    rad_raycaster rc;
+    long n, total = 1;
+    uint32_t i, ids[48], vis[48], nv = 0;
+    float *out = NULL;
+    if (!lc_cornell(&w, 48u)) return;
+    rad_cornell_box(&desc, &cam);
+    rad_bvh_raycaster(w.bvh, &rc);
+    out = (float *)malloc(sizeof(float) * 3 * w.n);
+    if (!out || w.n < 40 || !lc_source(&w, &src)) { free(out); lc_world_free(&w); return; }
+    for (i = 0; i < 40; ++i) ids[i] = i;
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.allocator.alloc = sc_alloc_fn;
+    ctx.allocator.free = sc_free_fn;
+    ctx.allocator.user = &st;
+    for (n = 0; n <= total; ++n) {
+        rad_local_options o;
+        rad_local *L = NULL, *N = NULL;
+        rad_result r[8];
+        int k, failed = 0;
+        memset(&st, 0, sizeof(st));
+        st.fail_at = n;
+        for (k = 0; k < 8; ++k) r[k] = RAD_SUCCESS;
+        rad_local_options_default(&o);
+        o.capacity = 20;
+        r[0] = rad_local_create(&src, &o, &ctx, &L);
+        if (r[0] == RAD_SUCCESS) {
+            for (i = 0; i < 20 && r[1] == RAD_SUCCESS; ++i) r[1] = rad_local_add(L, ids[i], &ctx);
+            for (i = 0; i < 3 && r[1] == RAD_SUCCESS; ++i) r[1] = rad_local_remove(L, ids[i], &ctx);
+            for (i = 20; i < 23 && r[1] == RAD_SUCCESS; ++i) r[1] = rad_local_add(L, ids[i], &ctx);
+            r[2] = rad_local_apply(L, w.E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, out, &ctx);
+            r[3] = rad_local_rebuild(L, ids + 10, 20, &ctx);
+        }
+        o.rebuild = RAD_LOCAL_REBUILD_NEUMANN;
+        r[4] = rad_local_create(&src, &o, &ctx, &N);
+        if (r[4] == RAD_SUCCESS) r[5] = rad_local_rebuild(N, ids, 20, &ctx);
+        r[6] = rad_local_nearest(w.patches, cam.position, 10, vis, &ctx);
+        r[7] = rad_local_visible(w.patches, &rc, &cam, 1.0f, ids, 40, vis, &nv, &ctx);
+        for (k = 0; k < 8; ++k) {
+            if (r[k] != RAD_SUCCESS && r[k] != RAD_ERROR_OUT_OF_MEMORY) {
+                printf("    fail_at %ld: step %d returned %s\n", n, k, rad_result_string(r[k]));
+                CHECK(0);
+            }
+            if (r[k] != RAD_SUCCESS) failed = 1;
+        }
+        if (n > 0 && n <= st.calls) CHECK(failed);
+        rad_local_destroy(L);
+        rad_local_destroy(N);
+        if (st.allocs != st.frees || st.live_bytes != 0 || st.corrupt != 0) {
+            printf("    fail_at %ld: %ld allocs, %ld frees, %lld live bytes, %ld overruns\n", n, st.allocs, st.frees, st.live_bytes,
+                   st.corrupt);
+            CHECK(0);
+        }
+        if (n == 0) total = st.calls;
+    }
+    CHECK(total >= 10);
+    free(out);
+    lc_world_free(&w);
+}
+
 static const rad_test_case tests_local[] = {
     {"local_add_exact_and_first_order", test_local_add_exact_and_first_order},
     {"local_remove_and_evict", test_local_remove_and_evict},
@@ -786,4 +857,5 @@ static const rad_test_case tests_local[] = {
     {"local_bad_input", test_local_bad_input},
     {"local_row_sources", test_local_row_sources},
     {"local_sets", test_local_sets},
+    {"local_alloc_failure", test_local_alloc_failure},
     {NULL, NULL}};
