@@ -1141,7 +1141,8 @@ RAD_API rad_result rad_row_source_bake(const rad_bake *bake, rad_row_source *out
    checked instead (columns < N by this reader; values finite and >= 0 by rad_local).
    Errors: IO (the file cannot be opened or read), TRUNCATED, CORRUPT, VERSION, ALBEDO_RANGE,
    INVALID_ARGUMENT (no CSR matrix in the file), OUT_OF_MEMORY. Thread safety: one stream per
-   thread (fetches move the file position). */
+   thread (fetches move the file position). Seeks go through fseek, so where long is 32 bits
+   a row beyond 2 GiB into the file fails with IO. */
 typedef struct rad_row_stream rad_row_stream;
 RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx, rad_row_stream **out);
 /* Fills a row source that reads through 'stream' (which must outlive it). */

@@ -12,14 +12,15 @@
         the built-in BVH), P_Lit = members with a non-zero source E (the ceiling lights);
      3. L = T E over P_Vis x P_Lit (rad_local_apply), B = E + L;
      4. the frame is drawn with one camera ray per pixel: the hit patch shows B / pi (patches
-        outside P_Vis show black: they carry no light in this frame) and written as a PNG.
+        outside P_Vis show only their own emission: the far lamps glow over black walls,
+        which carry no light in this frame) and written as a PNG.
    The source is emission (SPEC §0 way (a)): the lamps are the only E, so every wall shows
    light that reached it through the local matrix. Timings of each step go to stdout.
 
    Build:  cc -std=c99 -O2 -fopenmp -I. examples/walk.c -o build/walk -lm
    Run:    build/walk [--grid G] [--m M] [--frames F] [--size WxH] [--exposure X] [-o PREFIX]
            (defaults: 10 x 10 rooms cut into patches of at most 0.2 m^2, about 56 000 patches;
-           M = 2048, 6 frames, 320x180, PREFIX "walk" -> walk_000.png) */
+           M = 2048, 16 frames along the first corridor, 320x180, PREFIX "walk" -> walk_000.png) */
 #if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
 #  define _POSIX_C_SOURCE 199309L /* clock_gettime */
 #endif
@@ -69,7 +70,7 @@ static unsigned char srgb8(float v)
 
 int main(int argc, char **argv)
 {
-    uint32_t grid = 10, M = 2048, frames = 6, W = 320, H = 180, V, n, i, f;
+    uint32_t grid = 10, M = 2048, frames = 16, W = 320, H = 180, V, n, i, f;
     float exposure = 1.0f;
     const char *prefix = "walk";
     rooms_geometry g;
@@ -172,7 +173,7 @@ int main(int argc, char **argv)
 
         /* 3. B = E + T E over P_Vis x P_Lit; everything else black */
         t0 = now_s();
-        memset(B, 0, sizeof(float) * 3 * n);
+        memcpy(B, E, sizeof(float) * 3 * n); /* the lamps glow everywhere; walls only through T */
         check(rad_local_apply(L, E, vis, nv, lit, nl, RAD_OUTPUT_TOTAL, B, NULL), "rad_local_apply");
         t_ap = now_s() - t0;
 
