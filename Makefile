@@ -1,6 +1,6 @@
 # radiosity.h - build, demo, tests and benchmarks.
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
-#   make walk    builds examples/walk.c (a camera walk through a 56k-patch scene, local matrix)
+#   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/

@@ -11,7 +11,8 @@
    patch's triangle is its cell.
 
    rooms_scene(nx, nz, &desc, &g) fills a rad_scene_desc (arrays owned by g, freed by
-   rooms_free). A 8 x 8 grid cut with max_area 0.1 m^2 gives about 55 000 patches.
+   rooms_free). An 8 x 8 grid cut with max_area 0.1 m^2 gives 72 160 patches, 10 x 10 with
+   0.2 m^2 69 372.
 
    The row source (rooms_rows_init, rooms_rows_source) is an approximation that makes rows
    cheap enough for a 50k-patch walk on a CPU: F_ij is the unoccluded point-to-point form

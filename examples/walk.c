@@ -1,7 +1,7 @@
 /* walk.c - a camera walk through a large generated scene with the local multi-bounce matrix
    (SPEC §5, thesis ch. 4): only the M patches nearest the camera carry multi-bounce
    transport, updated as the camera moves, and the global form factors are read one row at
-   a time, so the 56 000-patch scene never needs its N x N matrix (about 12 GiB as floats).
+   a time, so the 69 000-patch scene never needs its N x N matrix (about 18 GiB as floats).
 
    Per frame:
      1. the V = 3M/4 patches nearest the camera (rad_local_nearest) become the visible set:
@@ -19,7 +19,7 @@
 
    Build:  cc -std=c99 -O2 -fopenmp -I. examples/walk.c -o build/walk -lm
    Run:    build/walk [--grid G] [--m M] [--frames F] [--size WxH] [--exposure X] [-o PREFIX]
-           (defaults: 10 x 10 rooms cut into patches of at most 0.2 m^2, about 56 000 patches;
+           (defaults: 10 x 10 rooms cut into patches of at most 0.2 m^2, 69 372 patches;
            M = 2048, 16 frames along the first corridor, 320x180, PREFIX "walk" -> walk_000.png) */
 #if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
 #  define _POSIX_C_SOURCE 199309L /* clock_gettime */
