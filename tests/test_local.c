@@ -848,6 +848,76 @@ static void test_local_alloc_failure(void)
     lc_world_free(&w);
 }
 
+
+/* NULL and bad arguments everywhere: the documented error, no crash, nothing written */
+static void test_local_null_arguments(void)
+{
+    rad_row_source src;
+    rad_local_options o;
+    rad_local *L = (rad_local *)(void *)&src;
+    rad_matrix F;
+    float areas[2] = {1.0f, 1.0f}, albedo[6] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f}, dense[4] = {0.0f, 0.5f, 0.5f, 0.0f}, E[6] = {1, 1, 1, 1, 1, 1};
+    float pos[3] = {0.0f, 0.0f, 0.0f};
+    uint32_t ids[2] = {0, 1}, out[2] = {7, 7}, count = 9;
+    rad_row_stream *st = (rad_row_stream *)(void *)&src;
+    rad_local_options_default(NULL);
+    rad_local_destroy(NULL);
+    CHECK(rad_local_memory(NULL) == 0);
+    CHECK_RESULT(rad_local_add(NULL, 0, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_remove(NULL, 0, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_evict(NULL, 0, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_rebuild(NULL, ids, 2, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_apply(NULL, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, E, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_nearest(NULL, pos, 1, out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_visible(NULL, NULL, NULL, 1.0f, ids, 2, out, &count, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_lit(NULL, ids, 2, 0.0f, out, &count), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_lit(E, NULL, 2, 0.0f, out, &count), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(out[0] == 7 && count == 9);
+    CHECK_RESULT(rad_row_source_matrix(NULL, areas, albedo, &src), RAD_ERROR_INVALID_ARGUMENT);
+    memset(&F, 0, sizeof(F));
+    F.rows = 2; F.cols = 3; F.storage = RAD_STORAGE_DENSE; F.dense = dense;
+    CHECK_RESULT(rad_row_source_matrix(&F, areas, albedo, &src), RAD_ERROR_SIZE_MISMATCH);
+    F.cols = 2;
+    CHECK_RESULT(rad_row_source_matrix(&F, NULL, albedo, &src), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_OK(rad_row_source_matrix(&F, areas, albedo, &src));
+    CHECK_RESULT(rad_local_create(&src, NULL, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    rad_local_options_default(&o);
+    o.capacity = 2;
+    o.update = (rad_local_update)5;
+    CHECK_RESULT(rad_local_create(&src, &o, NULL, &L), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(L == NULL);
+    o.update = RAD_LOCAL_EXACT;
+    o.rebuild = (rad_local_rebuild_method)9;
+    CHECK_RESULT(rad_local_create(&src, &o, NULL, &L), RAD_ERROR_INVALID_ARGUMENT);
+    o.rebuild = RAD_LOCAL_REBUILD_INVERSE;
+    CHECK_OK(rad_local_create(&src, &o, NULL, &L));
+    if (L) {
+        CHECK_OK(rad_local_rebuild(L, ids, 2, NULL));
+        CHECK_NEAR(L->planes[1], 0.25 / (1.0 - 0.0625), 1e-6); /* T_01 = a / (1 - a^2), a = 0.25 */
+        CHECK_RESULT(rad_local_rebuild(L, ids, 3, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(L->count == 0);
+        ids[1] = 0;
+        CHECK_RESULT(rad_local_rebuild(L, ids, 2, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(L->count == 0 && L->patch_slot[0] == RAD_NONE);
+        CHECK_OK(rad_local_rebuild(L, ids, 0, NULL));
+        E[0] = (float)NAN;
+        CHECK_OK(rad_local_add(L, 0, NULL));
+        CHECK_RESULT(rad_local_apply(L, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, E + 3, NULL), RAD_ERROR_NON_FINITE);
+        CHECK_RESULT(rad_local_apply(L, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        rad_local_destroy(L);
+    }
+#ifndef RAD_NO_STDIO
+    CHECK_RESULT(rad_row_stream_open(NULL, NULL, &st), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(st == NULL);
+    CHECK_RESULT(rad_row_stream_open("no/such/file.radb", NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(rad_row_stream_memory(NULL) == 0);
+    rad_row_stream_source(NULL, &src);
+    CHECK(src.fetch == NULL && src.n == 0);
+    rad_row_stream_source(NULL, NULL);
+    rad_row_stream_close(NULL);
+#endif
+}
+
 static const rad_test_case tests_local[] = {
     {"local_add_exact_and_first_order", test_local_add_exact_and_first_order},
     {"local_remove_and_evict", test_local_remove_and_evict},
@@ -858,4 +928,5 @@ static const rad_test_case tests_local[] = {
     {"local_row_sources", test_local_row_sources},
     {"local_sets", test_local_sets},
     {"local_alloc_failure", test_local_alloc_failure},
+    {"local_null_arguments", test_local_null_arguments},
     {NULL, NULL}};
