@@ -7269,7 +7269,8 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
         r = RAD_ERROR_CORRUPT;
         goto fail;
     }
-    if (rad__get32(head + 4) != RAD_CONTAINER_VERSION || (rad__get32(head + 32) != 0u) != rad__host_big_endian()) {
+    if (rad__get32(head + 4) != RAD_CONTAINER_VERSION || (rad__get32(head + 32) & ~RAD__FLAG_BIG_ENDIAN) != 0u ||
+        ((rad__get32(head + 32) & RAD__FLAG_BIG_ENDIAN) != 0u) != rad__host_big_endian()) {
         rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': container version %u or byte order this build does not read", path,
                  rad__get32(head + 4));
         r = RAD_ERROR_VERSION;
