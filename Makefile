@@ -1,6 +1,7 @@
 # radiosity.h - build, demo, tests and benchmarks.
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
 #   make gallery every lighting model on rows of spheres, to gallery.png
+#   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/
@@ -17,9 +18,9 @@ EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 RAD_DATA_DIR ?= ../shared/data
 
-.PHONY: all demo gallery test bench bench-quick tools fuzz clean glsl
+.PHONY: all demo gallery walk test bench bench-quick tools fuzz clean glsl
 
-all: $(BUILD)/cornell tools
+all: $(BUILD)/cornell $(BUILD)/walk tools
 
 $(BUILD):
 	mkdir -p $(BUILD)
@@ -36,6 +37,8 @@ $(BUILD)/gallery: examples/gallery.c examples/png_write.h radiosity.h | $(BUILD)
 gallery: $(BUILD)/gallery
 	./$(BUILD)/gallery -o gallery.png
 
+walk: $(BUILD)/walk
+
 test:
 	CC="$(CC)" CXX="$(CXX)" BUILD="$(BUILD)" bash tests/run.sh
 
@@ -51,23 +54,31 @@ $(BUILD)/temporal: bench/temporal.c radiosity.h | $(BUILD)
 $(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
 
+$(BUILD)/local: bench/local.c examples/rooms.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/local.c -o $@ -lm
+
+$(BUILD)/walk: examples/walk.c examples/rooms.h examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/walk.c -o $@ -lm
+
 $(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading
+bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
 	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
 	./$(BUILD)/multibounce --append BENCHMARKS.md
 	./$(BUILD)/temporal --append BENCHMARKS.md
 	./$(BUILD)/shading --append BENCHMARKS.md
+	./$(BUILD)/local --append BENCHMARKS.md
 
-bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading
+bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/multibounce --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/temporal --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/shading --quick --append $(BUILD)/BENCHMARKS-quick.md
+	./$(BUILD)/local --quick --append $(BUILD)/BENCHMARKS-quick.md
 
 tools: $(BUILD)/rad
 

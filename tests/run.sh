@@ -114,6 +114,13 @@ else
     fail gallery-small
 fi
 compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -lm &&
+   "$BUILD/walk" --grid 2 --m 256 --frames 2 --size 64x36 -o "$BUILD/walk-small" >"$BUILD/walk.out" 2>&1 &&
+   [ -s "$BUILD/walk-small_001.png" ]; then
+    pass walk-small
+else
+    fail walk-small
+fi
 # ---- GLSL: the header holds the current glsl/ sources --------------------------------------
 if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
    "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
