@@ -829,6 +829,313 @@ done:
     free(F); free(c.off); free(c.col); free(c.val); free(cpu_bins); free(scratch); free(padded_off);
 }
 
+/* ---- local multi-bounce matrix: adds (rank-1, fused evict rank-2) and apply, T resident ------ */
+
+/* the GPU side of a rad_local: the three planes resident, and the per-add buffers */
+typedef struct gpu_local {
+    vk_kernel kv, ku, ka;
+    vk_buf planes[3], a, b, nz, work;
+    uint32_t m;
+} gpu_local;
+
+/* the row chunks of plane rows [0, end) for the kernels */
+static void local_chunk_ranges(const gpu_local *g, uint32_t r0, uint32_t r1, vk_range *r, uint32_t *base)
+{
+    uint32_t ch;
+    for (ch = 0; ch < 3; ++ch)
+        r[ch] = vk_chunk(&g_vk, &g->planes[ch], 4, (VkDeviceSize)r0 * g->m, (VkDeviceSize)(r1 - r0) * g->m, base);
+}
+
+/* what an engine streams for adding 'patch': the new row and column over the slots, from the
+   fetched row F[patch][.] and the slot map before the add (with the evicted member's slot ev
+   already out of it), as rad_local_add builds them; then the kernels on the resident planes */
+static int gpu_local_add(gpu_local *g, const float *F, uint32_t n, const float *areas, const float *rho,
+                         const uint32_t *slot_before, uint32_t patch, uint32_t k, uint32_t ev, uint32_t end, int first_order,
+                         const float *ann_override)
+{
+    float *a = (float *)g->a.map, *b = (float *)g->b.map;
+    uint32_t *nz = (uint32_t *)g->nz.map, nnz = 0, j, ch, cut[4], q, first = 1;
+    double an = areas[patch];
+    float ann[3] = { 0, 0, 0 };
+    int ok = 1;
+    memset(a, 0, 3 * (size_t)g->m * 4);
+    memset(b, 0, 3 * (size_t)g->m * 4);
+    for (j = 0; j < n; ++j) {
+        float f = F[(size_t)patch * n + j];
+        uint32_t sj = slot_before[j];
+        if (f == 0.0f) continue;
+        if (j == patch) {
+            for (ch = 0; ch < 3; ++ch) ann[ch] = (float)((double)rho[3 * patch + ch] * f);
+            continue;
+        }
+        if (sj == RAD_NONE || sj == ev) continue;
+        for (ch = 0; ch < 3; ++ch) {
+            a[ch * g->m + sj] = (float)((double)rho[3 * j + ch] * (an * f / (double)areas[j]));
+            b[ch * g->m + sj] = (float)((double)rho[3 * patch + ch] * f);
+        }
+        nz[nnz++] = sj;
+    }
+    if (ann_override) memcpy(ann, ann_override, sizeof(ann));
+    chunks(end, cut);
+    for (q = 0; q < 3 && ok; ++q) { /* pass 0, per row chunk */
+        rad_glsl_local_vectors_push p;
+        vk_range r[7];
+        if (cut[q + 1] == cut[q]) continue;
+        memset(&p, 0, sizeof(p));
+        local_chunk_ranges(g, cut[q], cut[q + 1], r, &p.base);
+        r[3] = vk_whole(&g->a); r[4] = vk_whole(&g->b); r[5] = vk_whole(&g->nz); r[6] = vk_whole(&g->work);
+        p.m = g->m;
+        p.end = end;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.nnz = nnz;
+        p.ev = ev;
+        p.pass = RAD_GLSL_LOCAL_PASS_GATHER;
+        p.flags = (first ? RAD_GLSL_FLAG_FIRST_CHUNK : 0u) | (first_order ? RAD_GLSL_FLAG_FIRST_ORDER : 0u);
+        memcpy(p.ann, ann, sizeof(ann));
+        first = 0;
+        ok &= vk_dispatch(&g_vk, &g->kv, r, &p, p.row_count > end ? p.row_count : end);
+    }
+    {
+        rad_glsl_local_vectors_push p;
+        vk_range r[7];
+        memset(&p, 0, sizeof(p));
+        local_chunk_ranges(g, 0, end, r, &p.base); /* passes 1 and 2 read no plane; any range */
+        r[3] = vk_whole(&g->a); r[4] = vk_whole(&g->b); r[5] = vk_whole(&g->nz); r[6] = vk_whole(&g->work);
+        p.m = g->m;
+        p.end = end;
+        p.nnz = nnz;
+        p.ev = ev;
+        p.flags = first_order ? RAD_GLSL_FLAG_FIRST_ORDER : 0u;
+        memcpy(p.ann, ann, sizeof(ann));
+        if (ev != RAD_NONE) {
+            p.pass = RAD_GLSL_LOCAL_PASS_EVICT;
+            ok &= vk_dispatch(&g_vk, &g->kv, r, &p, end);
+        }
+        p.pass = RAD_GLSL_LOCAL_PASS_SCALARS;
+        ok &= vk_dispatch(&g_vk, &g->kv, r, &p, 3);
+    }
+    for (q = 0; q < 3 && ok; ++q) { /* the update, per row chunk */
+        rad_glsl_local_update_push p;
+        vk_range r[4];
+        if (cut[q + 1] == cut[q]) continue;
+        local_chunk_ranges(g, cut[q], cut[q + 1], r, &p.base);
+        r[3] = vk_whole(&g->work);
+        p.m = g->m;
+        p.end = end;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.k = k;
+        p.ev = ev;
+        ok &= vk_dispatch(&g_vk, &g->ku, r, &p, p.row_count);
+    }
+    return ok;
+}
+
+static int gpu_local_init(gpu_local *g, uint32_t m, uint32_t local_size)
+{
+    int ok = 1, ch;
+    memset(g, 0, sizeof(*g));
+    g->m = m;
+    ok &= vk_kernel_create(&g_vk, &g->kv, RAD_GLSL_LOCAL_VECTORS, 0, 7, (uint32_t)sizeof(rad_glsl_local_vectors_push), local_size);
+    ok &= vk_kernel_create(&g_vk, &g->ku, RAD_GLSL_LOCAL_UPDATE, 0, 4, (uint32_t)sizeof(rad_glsl_local_update_push), local_size);
+    ok &= vk_kernel_create(&g_vk, &g->ka, RAD_GLSL_LOCAL_APPLY, 0, 8, (uint32_t)sizeof(rad_glsl_local_apply_push), local_size);
+    for (ch = 0; ch < 3; ++ch) {
+        ok &= vk_buffer(&g_vk, &g->planes[ch], (VkDeviceSize)m * m * 4, NULL);
+        if (ok) memset(g->planes[ch].map, 0, (size_t)m * m * 4); /* an empty set: T = 0 */
+    }
+    ok &= vk_buffer(&g_vk, &g->a, 3 * (VkDeviceSize)m * 4, NULL);
+    ok &= vk_buffer(&g_vk, &g->b, 3 * (VkDeviceSize)m * 4, NULL);
+    ok &= vk_buffer(&g_vk, &g->nz, (VkDeviceSize)m * 4, NULL);
+    ok &= vk_buffer(&g_vk, &g->work, RAD_GLSL_LOCAL_WORK_FLOATS(m) * 4, NULL);
+    return ok;
+}
+
+static void gpu_local_free(gpu_local *g)
+{
+    int ch;
+    for (ch = 0; ch < 3; ++ch) vk_buffer_free(&g_vk, &g->planes[ch]);
+    vk_buffer_free(&g_vk, &g->a); vk_buffer_free(&g_vk, &g->b); vk_buffer_free(&g_vk, &g->nz); vk_buffer_free(&g_vk, &g->work);
+    vk_kernel_destroy(&g_vk, &g->kv); vk_kernel_destroy(&g_vk, &g->ku); vk_kernel_destroy(&g_vk, &g->ka);
+}
+
+/* the resident planes against rad_local.planes */
+static int gpu_local_compare(const gpu_local *g, const rad_local *L, const char *what)
+{
+    size_t mm = (size_t)g->m * g->m;
+    float *gpu = (float *)malloc(3 * mm * sizeof(float));
+    int ch, r;
+    if (!gpu) return 0;
+    for (ch = 0; ch < 3; ++ch) memcpy(gpu + ch * mm, g->planes[ch].map, mm * 4);
+    r = compare(what, gpu, L->planes, 3 * mm, 1e-5);
+    free(gpu);
+    return r;
+}
+
+/* out = T E over the visible entries, the planes bound in three slot chunks */
+static int gpu_local_apply(gpu_local *g, const rad_local *L, const float *E, const uint32_t *visible, uint32_t nvis,
+                           const uint32_t *lit, uint32_t nlit, rad_output output, float *out)
+{
+    const uint32_t n = L->n, end = L->slot_end;
+    vk_buf bE, bLit, bSlot, bPatch, bOut;
+    uint32_t i, cut[4], q;
+    int ok = 1;
+    ok &= vk_buffer(&g_vk, &bE, 3 * (VkDeviceSize)n * 4, E);
+    ok &= vk_buffer(&g_vk, &bLit, (VkDeviceSize)end * 4 + 4, NULL);
+    ok &= vk_buffer(&g_vk, &bSlot, (VkDeviceSize)nvis * 4 + 4, NULL);
+    ok &= vk_buffer(&g_vk, &bPatch, (VkDeviceSize)nvis * 4 + 4, visible);
+    ok &= vk_buffer(&g_vk, &bOut, 3 * (VkDeviceSize)n * 4, NULL);
+    if (ok) {
+        uint32_t *lp = (uint32_t *)bLit.map, *vs = (uint32_t *)bSlot.map;
+        memset(lp, 0xFF, (size_t)end * 4);
+        for (i = 0; i < nlit; ++i) lp[L->patch_slot[lit[i]]] = lit[i];
+        for (i = 0; i < nvis; ++i) vs[i] = L->patch_slot[visible[i]];
+        memset(bOut.map, 0xFF, 3 * (size_t)n * 4); /* NaN: every visible entry must be written */
+    }
+    chunks(end, cut);
+    for (q = 0; q < 3 && ok; ++q) {
+        rad_glsl_local_apply_push p;
+        vk_range r[8];
+        if (cut[q + 1] == cut[q]) continue;
+        local_chunk_ranges(g, cut[q], cut[q + 1], r, &p.base);
+        r[3] = vk_whole(&bE); r[4] = vk_whole(&bLit); r[5] = vk_whole(&bSlot); r[6] = vk_whole(&bPatch); r[7] = vk_whole(&bOut);
+        p.m = g->m;
+        p.end = end;
+        p.row_offset = 0;
+        p.row_count = nvis; /* every entry, each chunk: the kernel skips rows it does not hold */
+        p.slot_offset = cut[q];
+        p.slot_count = cut[q + 1] - cut[q];
+        p.flags = output == RAD_OUTPUT_TOTAL ? RAD_GLSL_FLAG_TOTAL : 0u;
+        ok &= vk_dispatch(&g_vk, &g->ka, r, &p, nvis);
+    }
+    if (ok) memcpy(out, bOut.map, 3 * (size_t)n * 4);
+    vk_buffer_free(&g_vk, &bE); vk_buffer_free(&g_vk, &bLit); vk_buffer_free(&g_vk, &bSlot); vk_buffer_free(&g_vk, &bPatch);
+    vk_buffer_free(&g_vk, &bOut);
+    return ok;
+}
+
+/* a world with reciprocity (F_ij A_i = F_ji A_j), rows summing to at most 0.9, some F_ii > 0 */
+static void local_world(uint32_t n, float *F, float *areas, float *rho)
+{
+    uint32_t i, j;
+    double mx = 0.0;
+    for (i = 0; i < n; ++i) areas[i] = 1.0f + frand();
+    for (i = 0; i < 3 * n; ++i) rho[i] = 0.85f * frand();
+    for (i = 0; i < n; ++i)
+        for (j = i; j < n; ++j) {
+            float gij = (i == j ? frand() < 0.2f : frand() < 0.5f) ? frand() : 0.0f; /* G symmetric */
+            F[(size_t)i * n + j] = gij / areas[i];
+            F[(size_t)j * n + i] = gij / areas[j];
+        }
+    for (i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (j = 0; j < n; ++j) s += F[(size_t)i * n + j];
+        mx = s > mx ? s : mx;
+    }
+    for (i = 0; i < n * n; ++i) F[i] = (float)(F[i] * 0.9 / mx);
+}
+
+static void local_case(const float *F, uint32_t n, const float *areas, const float *rho, uint32_t m, uint32_t local_size,
+                       rad_local_update update, uint32_t *evicting_adds)
+{
+    rad_matrix mat;
+    rad_row_source src;
+    rad_local_options o;
+    rad_local *L = NULL;
+    gpu_local g;
+    uint32_t *before = (uint32_t *)malloc((size_t)n * 4), *order = (uint32_t *)malloc((size_t)n * 4), i, step = 0;
+    uint32_t *vis = (uint32_t *)malloc((size_t)n * 4), *lit = (uint32_t *)malloc((size_t)n * 4), nvis = 0, nlit = 0;
+    float *E = random_vector(3 * (size_t)n, 0.3f), *cpu = (float *)calloc(3 * (size_t)n, 4), *gpu = (float *)malloc(3 * (size_t)n * 4);
+    int ok = 1, total;
+    const char *what = update == RAD_LOCAL_EXACT ? "local T after adds (exact)" : "local T after adds (first order)";
+    memset(&mat, 0, sizeof(mat));
+    mat.rows = mat.cols = n;
+    mat.storage = RAD_STORAGE_DENSE;
+    mat.dense = F;
+    if (!before || !order || !vis || !lit || !E || !cpu || !gpu || !gpu_local_init(&g, m, local_size)) { T_CHECK(0); goto done; }
+    rad_local_options_default(&o);
+    o.capacity = m;
+    o.update = update;
+    T_CHECK(rad_row_source_matrix(&mat, areas, rho, &src) == RAD_SUCCESS);
+    T_CHECK(rad_local_create(&src, &o, NULL, &L) == RAD_SUCCESS);
+    if (!L) goto done;
+    for (i = 0; i < n; ++i) order[i] = (i * 37u + 11u) % n; /* n prime to 37: a permutation */
+    /* fill the set, hide 10 members, show one again, fill the free slots, then evict into adds */
+    for (i = 0; ok && i < m + 6; ++i) { /* m - 8 adds, 8 into the free slots, 6 evicting */
+        uint32_t patch = order[i], k, ev, end, had = L->slot_end;
+        int full;
+        if (i == m - 8) { /* hide 10 members (the 1st, 4th, ...), then show the 4th again */
+            uint32_t h;
+            for (h = 0; h < 10; ++h) T_CHECK(rad_local_remove(L, order[3 * h], NULL) == RAD_SUCCESS);
+            T_CHECK(rad_local_add(L, order[3], NULL) == RAD_SUCCESS); /* only shown: T unchanged */
+        }
+        memcpy(before, L->patch_slot, (size_t)n * 4);
+        full = L->count + L->hidden >= L->capacity;
+        {
+            rad_result r = rad_local_add(L, patch, NULL);
+            if (r != RAD_SUCCESS) { printf("    FAIL rad_local_add(%u): %s\n", patch, rad_result_string(r)); g_checks_failed++; break; }
+        }
+        k = L->patch_slot[patch];
+        ev = full ? k : RAD_NONE;
+        if (full) ++*evicting_adds;
+        end = k + 1 > had ? k + 1 : had;
+        ok &= gpu_local_add(&g, F, n, areas, rho, before, patch, k, ev, end, update == RAD_LOCAL_FIRST_ORDER, NULL);
+        if (++step % 8 == 0 || full) ok &= gpu_local_compare(&g, L, what);
+    }
+    T_CHECK(ok && L->evictions > 0 && L->hidden > 0);
+    ok &= gpu_local_compare(&g, L, what);
+    /* apply: every visible member receives, every member (hidden ones too) with E != 0 lights */
+    for (i = 0; i < n; ++i) {
+        uint32_t p = order[i], s = L->patch_slot[p];
+        if (s == RAD_NONE) continue;
+        if (!L->slot_hidden[s]) vis[nvis++] = p;
+        if (i % 3 != 1 || L->slot_hidden[s]) lit[nlit++] = p;
+    }
+    for (total = 0; ok && total < 2; ++total) {
+        rad_output out = total ? RAD_OUTPUT_TOTAL : RAD_OUTPUT_INDIRECT;
+        float *gv = (float *)malloc(3 * (size_t)nvis * 4), *cv = (float *)malloc(3 * (size_t)nvis * 4);
+        T_CHECK(rad_local_apply(L, E, vis, nvis, lit, nlit, out, cpu, NULL) == RAD_SUCCESS);
+        T_CHECK(gpu_local_apply(&g, L, E, vis, nvis, lit, nlit, out, gpu));
+        if (gv && cv) {
+            for (i = 0; i < 3 * nvis; ++i) { gv[i] = gpu[3 * vis[i / 3] + i % 3]; cv[i] = cpu[3 * vis[i / 3] + i % 3]; }
+            compare(total ? "local apply total" : "local apply", gv, cv, 3 * (size_t)nvis, 1e-5);
+        } else T_CHECK(0);
+        free(gv); free(cv);
+    }
+    /* rows that break energy conservation (s <= 0): the update leaves T as it was */
+    if (ok && update == RAD_LOCAL_EXACT) {
+        const float bad[3] = { 1.5f, 0.0f, 0.0f };
+        uint32_t k = 0; /* an evicting add (the set is full): slot k of a hidden member */
+        while (k < m && !(L->slot_patch[k] != RAD_NONE && L->slot_hidden[k])) ++k;
+        for (i = 0; i < n && L->patch_slot[order[i]] != RAD_NONE; ++i) {}
+        if (k < m && i < n) {
+            memcpy(before, L->patch_slot, (size_t)n * 4);
+            T_CHECK(gpu_local_add(&g, F, n, areas, rho, before, order[i], k, k, L->slot_end, 0, bad));
+            T_CHECK(((const float *)g.work.map)[12 * m] < 0.0f);
+            gpu_local_compare(&g, L, "local T unchanged after a singular add");
+        } else T_CHECK(0);
+    }
+done:
+    rad_local_destroy(L);
+    gpu_local_free(&g);
+    free(before); free(order); free(vis); free(lit); free(E); free(cpu); free(gpu);
+}
+
+static void test_local(void)
+{
+    const uint32_t n = 151, m = 48;
+    float *F = (float *)malloc((size_t)n * n * 4), *areas = (float *)malloc(n * 4), *rho = (float *)malloc(3 * n * 4);
+    uint32_t evicting = 0;
+    if (!F || !areas || !rho) { T_CHECK(0); free(F); free(areas); free(rho); return; }
+    local_world(n, F, areas, rho);
+    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_EXACT, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[1], RAD_LOCAL_EXACT, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_FIRST_ORDER, &evicting);
+    printf("    M = %u of n = %u, %u evicting (rank-2) adds in all\n", m, n, evicting);
+    T_CHECK(evicting >= 3);
+    free(F); free(areas); free(rho);
+}
+
 /* ---- the C mirrors of the push-constant blocks, against the compiled SPIR-V ------------------ */
 
 /* member names and byte offsets of the push-constant block of a SPIR-V module (from OpMemberName
@@ -907,6 +1214,17 @@ static void test_push_mirrors(void)
     static const mirror_member alias[] = { MM(rad_glsl_alias_build_push, row_offset), MM(rad_glsl_alias_build_push, row_count),
         MM(rad_glsl_alias_build_push, cols), MM(rad_glsl_alias_build_push, words), MM(rad_glsl_alias_build_push, entry_base),
         MM(rad_glsl_alias_build_push, out_base), MM(rad_glsl_alias_build_push, flags), { NULL, 0 } };
+    static const mirror_member lapply[] = { MM(rad_glsl_local_apply_push, m), MM(rad_glsl_local_apply_push, end),
+        MM(rad_glsl_local_apply_push, row_offset), MM(rad_glsl_local_apply_push, row_count), MM(rad_glsl_local_apply_push, slot_offset),
+        MM(rad_glsl_local_apply_push, slot_count), MM(rad_glsl_local_apply_push, base), MM(rad_glsl_local_apply_push, flags), { NULL, 0 } };
+    static const mirror_member lvec[] = { MM(rad_glsl_local_vectors_push, m), MM(rad_glsl_local_vectors_push, end),
+        MM(rad_glsl_local_vectors_push, row_offset), MM(rad_glsl_local_vectors_push, row_count), MM(rad_glsl_local_vectors_push, base),
+        MM(rad_glsl_local_vectors_push, nnz), MM(rad_glsl_local_vectors_push, ev), MM(rad_glsl_local_vectors_push, pass),
+        MM(rad_glsl_local_vectors_push, flags), { "ann_r", offsetof(rad_glsl_local_vectors_push, ann) },
+        { "ann_g", offsetof(rad_glsl_local_vectors_push, ann) + 4 }, { "ann_b", offsetof(rad_glsl_local_vectors_push, ann) + 8 }, { NULL, 0 } };
+    static const mirror_member lupd[] = { MM(rad_glsl_local_update_push, m), MM(rad_glsl_local_update_push, end),
+        MM(rad_glsl_local_update_push, row_offset), MM(rad_glsl_local_update_push, row_count), MM(rad_glsl_local_update_push, base),
+        MM(rad_glsl_local_update_push, k), MM(rad_glsl_local_update_push, ev), { NULL, 0 } };
     g_worst_what = "push-constant block, bytes";
     check_mirror(RAD_GLSL_GATHER_DENSE, dense, sizeof(rad_glsl_gather_dense_push));
     check_mirror(RAD_GLSL_GATHER_CSR, sparse, sizeof(rad_glsl_gather_csr_push));
@@ -915,6 +1233,9 @@ static void test_push_mirrors(void)
     check_mirror(RAD_GLSL_TEMPORAL_STEP, temporal, sizeof(rad_glsl_temporal_push));
     check_mirror(RAD_GLSL_MB_APPLY_BLOCKS, blocks, sizeof(rad_glsl_mb_blocks_push));
     check_mirror(RAD_GLSL_ALIAS_BUILD, alias, sizeof(rad_glsl_alias_build_push));
+    check_mirror(RAD_GLSL_LOCAL_APPLY, lapply, sizeof(rad_glsl_local_apply_push));
+    check_mirror(RAD_GLSL_LOCAL_VECTORS, lvec, sizeof(rad_glsl_local_vectors_push));
+    check_mirror(RAD_GLSL_LOCAL_UPDATE, lupd, sizeof(rad_glsl_local_update_push));
     /* every kernel (.comp; includes have no push block) has its mirror checked above */
     {
         uint32_t id;
@@ -982,6 +1303,7 @@ static const vk_test g_tests[] = {
     { "vk_temporal_step", test_temporal },
     { "vk_mb_apply_bc1_bc4_outliers_permuted", test_mb_blocks },
     { "vk_alias_build_streamed_rows_then_temporal", test_alias_build },
+    { "vk_local_adds_evictions_apply_resident", test_local },
     { NULL, NULL }
 };
 
