@@ -1210,7 +1210,9 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        4: b  5: nz  6: work. UPDATE bindings: 0, 1, 2 planes (read-write, the chunk's rows)
        3: work. A kernel cannot return an error: when s <= 1e-12 in some channel (rows that
        break energy conservation: the CPU's RAD_ERROR_SINGULAR) UPDATE writes nothing; read s
-       (work[12 m + c]) back to detect it. The standalone rad_local_evict (a rank-1 downdate)
+       (work[12 m + c]) back to detect it. With RAD_LOCAL_EVICT_DROP an add into a full set is
+       a plain add (ev = RAD_NONE) into the dropped member's slot k, with that member out of
+       the slot map: row and column k are overwritten as the drop would have zeroed them. The standalone rad_local_evict (a rank-1 downdate)
        has no kernel; hiding and showing members (rad_local_remove, re-adding a hidden member)
        touch no plane. Measured on lavapipe (tests/test_vulkan.c) after 46 adds, 6 of
        them evicting, into M = 48: at most 9.7e-7 relative from rad_local_add's planes (exact

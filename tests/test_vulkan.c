@@ -1036,7 +1036,7 @@ static void local_world(uint32_t n, float *F, float *areas, float *rho)
 }
 
 static void local_case(const float *F, uint32_t n, const float *areas, const float *rho, uint32_t m, uint32_t local_size,
-                       rad_local_update update, uint32_t *evicting_adds)
+                       rad_local_update update, rad_local_eviction evict, uint32_t *evicting_adds)
 {
     rad_matrix mat;
     rad_row_source src;
@@ -1047,7 +1047,8 @@ static void local_case(const float *F, uint32_t n, const float *areas, const flo
     uint32_t *vis = (uint32_t *)malloc((size_t)n * 4), *lit = (uint32_t *)malloc((size_t)n * 4), nvis = 0, nlit = 0;
     float *E = random_vector(3 * (size_t)n, 0.3f), *cpu = (float *)calloc(3 * (size_t)n, 4), *gpu = (float *)malloc(3 * (size_t)n * 4);
     int ok = 1, total;
-    const char *what = update == RAD_LOCAL_EXACT ? "local T after adds (exact)" : "local T after adds (first order)";
+    const char *what = update != RAD_LOCAL_EXACT ? "local T after adds (first order)"
+                       : evict == RAD_LOCAL_EVICT_DROP ? "local T after adds (exact, evictions by drop)" : "local T after adds (exact)";
     memset(&mat, 0, sizeof(mat));
     mat.rows = mat.cols = n;
     mat.storage = RAD_STORAGE_DENSE;
@@ -1056,6 +1057,7 @@ static void local_case(const float *F, uint32_t n, const float *areas, const flo
     rad_local_options_default(&o);
     o.capacity = m;
     o.update = update;
+    o.evict = evict;
     T_CHECK(rad_row_source_matrix(&mat, areas, rho, &src) == RAD_SUCCESS);
     T_CHECK(rad_local_create(&src, &o, NULL, &L) == RAD_SUCCESS);
     if (!L) goto done;
@@ -1076,8 +1078,15 @@ static void local_case(const float *F, uint32_t n, const float *areas, const flo
             if (r != RAD_SUCCESS) { printf("    FAIL rad_local_add(%u): %s\n", patch, rad_result_string(r)); g_checks_failed++; break; }
         }
         k = L->patch_slot[patch];
-        ev = full ? k : RAD_NONE;
-        if (full) ++*evicting_adds;
+        /* the member evicted from slot k is out of the slot map; with the seed's drop the add is a
+           plain one into slot k (its old row and column are overwritten, as the drop zeroed them) */
+        ev = full && evict == RAD_LOCAL_EVICT_DOWNDATE ? k : RAD_NONE;
+        if (full) {
+            uint32_t p;
+            for (p = 0; p < n; ++p)
+                if (before[p] == k) before[p] = RAD_NONE;
+            ++*evicting_adds;
+        }
         end = k + 1 > had ? k + 1 : had;
         ok &= gpu_local_add(&g, F, n, areas, rho, before, patch, k, ev, end, update == RAD_LOCAL_FIRST_ORDER, NULL);
         if (++step % 8 == 0 || full) ok &= gpu_local_compare(&g, L, what);
@@ -1128,10 +1137,11 @@ static void test_local(void)
     uint32_t evicting = 0;
     if (!F || !areas || !rho) { T_CHECK(0); free(F); free(areas); free(rho); return; }
     local_world(n, F, areas, rho);
-    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_EXACT, &evicting);
-    local_case(F, n, areas, rho, m, g_local_sizes[1], RAD_LOCAL_EXACT, &evicting);
-    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_FIRST_ORDER, &evicting);
-    printf("    M = %u of n = %u, %u evicting (rank-2) adds in all\n", m, n, evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_EXACT, RAD_LOCAL_EVICT_DOWNDATE, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[1], RAD_LOCAL_EXACT, RAD_LOCAL_EVICT_DOWNDATE, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_FIRST_ORDER, RAD_LOCAL_EVICT_DOWNDATE, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[1], RAD_LOCAL_EXACT, RAD_LOCAL_EVICT_DROP, &evicting);
+    printf("    M = %u of n = %u, %u adds into a full set (rank 2 with the downdate, plain after a drop)\n", m, n, evicting);
     T_CHECK(evicting >= 3);
     free(F); free(areas); free(rho);
 }
