@@ -1265,6 +1265,168 @@ RAD_API uint32_t rad_temporal_frame(const rad_temporal *temporal);
 /* Adaptive mode: the weights w_i the last step used (N floats), else NULL. */
 RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
 
+/* ======================================================================================== */
+/* >>api_vp: virtual patches for high-polygon scenes                                        */
+/* ======================================================================================== */
+
+/* Axis-aligned virtual patches (SPEC §6-§7; thesis T-5, preprint P-3.1): a radiosity proxy with
+   no geometry, built automatically from any mesh, so that a scene of 10^5-10^7 triangles is
+   solved with about 10^4 unknowns.
+   BUILD (rad_vp_create):
+     1. The scene bounds, widened by 0.4827 voxel on each side (walls on the bounds then lie
+        near voxel centres, never on a voxel face nor in a thin sliver of a voxel whose few
+        samples sit next to a perpendicular wall), are cut into voxels of size h = (hx, hy,
+        hz). Candidate voxels are those a triangle's bounding box overlaps.
+     2. On each of the 6 faces of a candidate voxel, 'face_points' Hammersley points
+        ((s + 1/2)/P, radical inverse of s) cast a ray inward, perpendicular to the face and
+        limited to the voxel. A hit is a SAMPLE: position, triangle t, the triangle's geometric
+        normal, albedo (rad_scene_albedo at the hit, so textures go through the albedo
+        callback). Voxels without a sample are dropped.
+     3. Sample area s_i = S_t / (number of samples on triangle t).
+     4. Each sample is split over the axes a = +x, -x, +y, -y, +z, -z with weights w_ia
+        summing to 1 (rad_vp_weights), and per voxel and axis merged into one patch:
+            A_a = sum_i w_ia s_i        c_a = sum_i w_ia s_i c_i / A_a       normal e_a
+        Patches with A_a = 0 are not created, so a voxel holds 1 to 6 patches.
+     5. Form factors, never stored per sample: with the symmetric point-to-point kernel
+            G_ij = s_i s_j cos_i cos_j / (pi max(|r|^2, max(s_i, s_j) / pi)) V(p_i, p_j)
+        (SPEC §2's kernel times s_i, its near-point clamp taken from the larger sample so the
+        kernel is symmetric), the exchanged energy P_ab = sum_i sum_j w_ia w_jb G_ij is
+        accumulated in double, one row voxel at a time, over the pairs i < j (one shadow ray
+        per pair with a non-zero kernel, always cast from the lower sample index), mirrored
+        (P_ba = P_ab) and divided: F_ab = P_ab / A_a. This is SPEC §7's merge (row
+        F_a,j = sum_i w_ia s_i F_ij / A_a, column F_j,a = sum_i w_ia F_ji) applied to both
+        indices, so A_a F_ab = A_b F_ba holds to float rounding.
+   MEMORY (peak, through ctx's allocator): the N x N float matrix, about 64 bytes per sample,
+   T x (6 N doubles + 1024 rays) of task scratch (T = the context's task count, at most the
+   voxel count), 4 bytes per triangle, 8 bytes per candidate voxel, and the face-ray hits of a
+   chunk of candidate voxels (at most 2^21 hits, 32 MiB). Nothing is O(samples^2).
+   COST: O(M^2) kernel evaluations and up to M^2/2 shadow rays for M samples; M grows with the
+   number of non-empty voxels times 6 face_points (times the hit rate).
+   USE: rad_vp_system makes a rad_system for every classic solver (the matrix is dense
+   row-major rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
+   brings any per-patch value (B, L, the irradiance H = F (E + L)) back to surface points with
+   normal weights and trilinear filtering that skips voxels without a patch facing the normal.
+   LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
+   sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
+   patch facing its normal gets 0. */
+
+typedef enum rad_vp_weights {
+    RAD_VP_WEIGHTS_SQUARED = 0, /* w_a = max(0, n . e_a)^2: sums to exactly 1 (SPEC §7 default) */
+    RAD_VP_WEIGHTS_COSINE = 1   /* the seed's max(0, n . e_a), divided by their sum (1 to sqrt 3) */
+} rad_vp_weights;
+
+/* The six axis directions, in patch order inside a voxel. */
+typedef enum rad_vp_axis {
+    RAD_VP_POS_X = 0, RAD_VP_NEG_X = 1, RAD_VP_POS_Y = 2, RAD_VP_NEG_Y = 3, RAD_VP_POS_Z = 4, RAD_VP_NEG_Z = 5
+} rad_vp_axis;
+
+typedef struct rad_vp_options {
+    float voxel_size[3];      /* per axis, world units; all 0 (default): cubes, 'resolution' of
+                                 them along the longest axis of the scene bounds */
+    uint32_t resolution;      /* default 16 */
+    uint32_t face_points;     /* Hammersley points per voxel face (default 16, at most 4096) */
+    rad_vp_weights weights;   /* default RAD_VP_WEIGHTS_SQUARED */
+    float ray_epsilon;        /* relative to the scene diagonal (0: 1e-5) */
+    int skip_visibility;      /* non-zero: V = 1 between samples (unoccluded form factors) */
+} rad_vp_options;
+
+/* Axis-aligned virtual patches with their form factors. Read-only after creation.
+   Patch p lies in voxel voxel[p] (an index into the voxel arrays) and faces axis axis[p];
+   the patches of voxel v are [voxel_first[v], voxel_first[v + 1]), in axis order.
+   Samples are grouped by voxel the same way ([sample_first[v], sample_first[v + 1])). */
+typedef struct rad_virtual_patches {
+    uint32_t count;             /* N: patches */
+    float *areas;               /* N: A_a */
+    float *albedo;              /* 3N: c_a */
+    float *normals;             /* 3N: the axis unit vectors */
+    uint8_t *axis;              /* N: rad_vp_axis */
+    uint32_t *voxel;            /* N */
+    rad_matrix matrix;          /* N x N dense row-major F_ab (a view of storage owned here) */
+    /* the grid */
+    float origin[3];            /* corner of voxel (0, 0, 0) */
+    float voxel_size[3];
+    uint32_t dims[3];           /* voxels per axis */
+    uint32_t voxel_count;       /* non-empty voxels */
+    uint64_t *voxel_keys;       /* ascending: ix + dims[0] * (iy + dims[1] * iz) */
+    uint32_t *voxel_first;      /* voxel_count + 1: first patch of each voxel */
+    uint32_t *voxel_patch;      /* 6 per voxel: the patch of each axis, or RAD_NONE */
+    uint32_t *sample_first;     /* voxel_count + 1: first sample of each voxel */
+    /* the samples */
+    uint32_t sample_count;      /* M */
+    float *sample_positions;    /* 3M */
+    float *sample_normals;      /* 3M: the geometric normals of their triangles */
+    float *sample_albedo;       /* 3M */
+    float *sample_areas;        /* M: s_i */
+    float *sample_weights;      /* 6M: w_ia */
+    uint32_t *sample_triangles; /* M */
+    /* what the build did */
+    uint32_t candidate_voxels;  /* voxels overlapped by triangle bounds (step 1) */
+    uint64_t face_rays;         /* rays cast from voxel faces */
+    uint64_t pair_rays;         /* shadow rays between samples */
+    const rad_scene *scene;     /* borrowed: must outlive this object */
+    rad_vp_weights weights;
+    rad_allocator allocator;    /* private */
+} rad_virtual_patches;
+
+RAD_API void rad_vp_options_default(rad_vp_options *options);
+
+/* Builds axis-aligned virtual patches for 'scene' (borrowed; must outlive the result).
+   raycaster: its intersect() casts the face rays, its occluded() the shadow rays between
+   samples (not needed with skip_visibility); borrowed for the call.
+   Errors: INVALID_ARGUMENT (NULL input, negative or non-finite voxel size, bad weights or
+   ray_epsilon), SIZE_OVERFLOW (a grid beyond 2^62 cells or an N x N matrix that does not fit:
+   use bigger voxels), EMPTY_SCENE (no face ray hit anything), RAYCAST_FAILED, CANCELLED,
+   OUT_OF_MEMORY. The logger says which. Thread safety: reentrant; uses ctx->parallel_for and
+   reports progress (face rays 10%, form factors 90%). Deterministic: the same bits whatever
+   the thread count. Cost and memory: see the section comment. SPEC §6-§7. */
+RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                 const rad_context *ctx, rad_virtual_patches **out);
+RAD_API void rad_vp_destroy(rad_virtual_patches *vp);
+/* Bytes the object holds (matrix, patches, voxels, samples). */
+RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
+
+/* Fills 'system' for the classic solvers (rad_solve_*): F = vp->matrix, albedo, areas, n, and
+   the source E (3N floats, borrowed). */
+RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E);
+
+/* Per-patch values from per-sample values (SPEC §6 primary light, normalized):
+   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel. sample_values: 3M floats
+   (for instance rho_i D_i from the engine's own shadow maps); out: 3N floats.
+   Errors: INVALID_ARGUMENT. O(M). */
+RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out);
+
+/* The source E per patch (3N floats) one of the two ways of UNITS AND CONVENTIONS, through
+   rad_vp_from_samples: RAD_SOURCE_DIRECT: v_i = rho_i D_i, D_i the direct irradiance at
+   sample i (rad_direct_irradiance with the lights; the emitters' own emission is kept out);
+   RAD_SOURCE_EMISSION: v_i = pi L_i of the sample's material (lights unused, raycaster may be
+   NULL). Errors: those of rad_direct_irradiance, OUT_OF_MEMORY. Cost: O(M) direct-light
+   evaluations. SPEC §6 (T-5.8). */
+RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
+                                  const rad_light *lights, uint32_t light_count, const rad_direct_options *options,
+                                  rad_source_mode mode, float *out_E, const rad_context *ctx);
+
+/* Gathering at one surface point p with unit normal n (SPEC §6-§7, T eq. 5.3, P eq. 9): in each
+   voxel of the 2x2x2 block around p (by voxel centres), L(v) = sum_a w_a(n) x_a / sum_a w_a(n)
+   over v's patches (w_a the split weights of rad_vp_weights); voxels missing or with no patch
+   facing n are skipped, and L = sum_v t_v L(v) / sum_v t_v with the trilinear weights t_v.
+   values: 3N floats per patch (B, L or H); out: 3 floats. Returns the number of voxels that
+   contributed (0: out is 0). Pure, thread-safe, O(1). */
+RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float *values, const float p[3],
+                                     const float n[3], float out[3]);
+
+/* The same at 'count' points (3 floats each) with unit normals, in parallel through
+   ctx->parallel_for. out: 3 * count floats. Errors: INVALID_ARGUMENT, NON_FINITE (a point or
+   normal). */
+RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *values, const float *points,
+                                 const float *normals, uint32_t count, float *out, const rad_context *ctx);
+
+/* Per-vertex values of a mesh (for instance one of the scene's own meshes): its vertices with
+   its normals, or, when mesh->normals is NULL, the area-weighted mean of the normals of the
+   triangles around each vertex. out: 3 * mesh->vertex_count floats (a vertex no triangle uses
+   gets 0). Errors: INVALID_ARGUMENT, INDEX_OUT_OF_RANGE, NON_FINITE, OUT_OF_MEMORY. */
+RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
+                                      float *out, const rad_context *ctx);
+
 #ifdef __cplusplus
 }
 #endif
@@ -7576,6 +7738,867 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
     t->frame++;
     if (out_indirect) memcpy(out_indirect, t->B, n3 * sizeof(float));
     return RAD_SUCCESS;
+}
+
+/* ======================================================================================== */
+/* >>vp: virtual patches (voxels, face-ray samples, axis-aligned patches, gathering)       */
+/* ======================================================================================== */
+
+#define RAD__VP_MARGIN 0.4827f           /* voxels of padding around the scene bounds */
+#define RAD__VP_CHUNK_RAYS (1u << 21)     /* face-ray hits kept at once */
+
+RAD_API void rad_vp_options_default(rad_vp_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->resolution = 16;
+    o->face_points = 16;
+    o->weights = RAD_VP_WEIGHTS_SQUARED;
+    o->ray_epsilon = 1e-5f;
+}
+
+/* the six split weights of a unit normal (sum 1) */
+static void rad__vp_weights(rad_vp_weights kind, const float *n, float *w)
+{
+    int k;
+    float sum = 0.0f;
+    for (k = 0; k < 3; ++k) {
+        float p = n[k] > 0.0f ? n[k] : 0.0f, m = n[k] < 0.0f ? -n[k] : 0.0f;
+        if (kind == RAD_VP_WEIGHTS_SQUARED) { p *= p; m *= m; }
+        w[2 * k] = p;
+        w[2 * k + 1] = m;
+        sum += p + m;
+    }
+    if (sum > 0.0f)
+        for (k = 0; k < 6; ++k) w[k] /= sum;
+}
+
+static int rad__vp_cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
+{
+    rad_allocator a;
+    if (!vp) return;
+    a = vp->allocator;
+    rad__free(&a, vp->areas);
+    rad__free(&a, vp->albedo);
+    rad__free(&a, vp->normals);
+    rad__free(&a, vp->axis);
+    rad__free(&a, vp->voxel);
+    rad__free(&a, (void *)vp->matrix.dense);
+    rad__free(&a, vp->voxel_keys);
+    rad__free(&a, vp->voxel_first);
+    rad__free(&a, vp->voxel_patch);
+    rad__free(&a, vp->sample_first);
+    rad__free(&a, vp->sample_positions);
+    rad__free(&a, vp->sample_normals);
+    rad__free(&a, vp->sample_albedo);
+    rad__free(&a, vp->sample_areas);
+    rad__free(&a, vp->sample_weights);
+    rad__free(&a, vp->sample_triangles);
+    rad__free(&a, vp);
+}
+
+RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp)
+{
+    size_t n, m, v;
+    if (!vp) return 0;
+    n = vp->count;
+    m = vp->sample_count;
+    v = vp->voxel_count;
+    return sizeof(*vp) + n * n * sizeof(float) + n * (8 * sizeof(float) + 1 + sizeof(uint32_t)) +
+           v * (sizeof(uint64_t) + 8 * sizeof(uint32_t)) + 2 * sizeof(uint32_t) +
+           m * (16 * sizeof(float) + sizeof(uint32_t));
+}
+
+/* ---- face rays ---- */
+
+typedef struct rad__vp_build {
+    const rad_scene *S;
+    const rad_raycaster *rc;
+    rad_vp_options o;
+    rad_virtual_patches *vp;
+    float eps;
+    uint32_t tasks;
+    /* face rays: candidate voxels [chunk_begin, chunk_begin + chunk_count) */
+    const uint64_t *cand;
+    uint32_t chunk_begin;
+    rad_hit *hits;               /* 6 P per voxel of the chunk */
+    rad_ray *rays;               /* RAD__RAY_BATCH per task */
+    /* pairs */
+    uint8_t *occ;                /* RAD__RAY_BATCH per task */
+    uint32_t *ray_i, *ray_j;     /* RAD__RAY_BATCH per task */
+    float *ray_g;
+    double *acc;                 /* 6 N per task */
+    uint32_t *sample_voxel;      /* M */
+    uint64_t *rays_cast;         /* per task */
+    float *P;                    /* N x N */
+} rad__vp_build;
+
+static void rad__vp_cell(const rad_virtual_patches *vp, uint64_t key, uint32_t *c)
+{
+    c[0] = (uint32_t)(key % vp->dims[0]);
+    key /= vp->dims[0];
+    c[1] = (uint32_t)(key % vp->dims[1]);
+    c[2] = (uint32_t)(key / vp->dims[1]);
+}
+
+/* the 6 P face rays of candidate voxel 'row' of the chunk */
+static rad_result rad__vp_face_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t P = b->o.face_points, c[3], f, s, n = 0;
+    rad_ray *rays = b->rays + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = b->hits + (size_t)row * 6u * P;
+    float lo[3];
+    int k;
+    rad__vp_cell(vp, b->cand[b->chunk_begin + row], c);
+    for (k = 0; k < 3; ++k) lo[k] = vp->origin[k] + (float)c[k] * vp->voxel_size[k];
+    for (f = 0; f < 6; ++f) {
+        int ax = (int)(f >> 1), a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
+        int neg = (int)(f & 1u); /* face f = 2 ax: the low face, rays go +ax; 2 ax + 1: high face, rays go -ax */
+        for (s = 0; s < P; ++s) {
+            rad_ray *r = &rays[n];
+            float u = ((float)s + 0.5f) / (float)P, v = rad__radical_inverse(s);
+            r->origin[ax] = neg ? lo[ax] + vp->voxel_size[ax] : lo[ax];
+            r->origin[a1] = lo[a1] + u * vp->voxel_size[a1];
+            r->origin[a2] = lo[a2] + v * vp->voxel_size[a2];
+            r->dir[0] = r->dir[1] = r->dir[2] = 0.0f;
+            r->dir[ax] = neg ? -vp->voxel_size[ax] : vp->voxel_size[ax];
+            r->tmin = 0.0f;
+            r->tmax = 1.0f;
+            if (++n == RAD__RAY_BATCH) {
+                if (b->rc->intersect(b->rc->user, rays, n, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+                hits += n;
+                n = 0;
+            }
+        }
+    }
+    if (n && b->rc->intersect(b->rc->user, rays, n, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    return RAD_SUCCESS;
+}
+
+/* ---- form factors: one row voxel per call ---- */
+
+static void rad__vp_pair_add(rad__vp_build *b, double *acc, uint32_t u, uint32_t i, uint32_t j, double g)
+{
+    const rad_virtual_patches *vp = b->vp;
+    const float *wi = vp->sample_weights + 6 * (size_t)i, *wj = vp->sample_weights + 6 * (size_t)j;
+    uint32_t vj = b->sample_voxel[j], a, c, N = vp->count;
+    for (a = 0; a < 6; ++a) {
+        double ga;
+        if (!(wi[a] > 0.0f)) continue;
+        ga = g * (double)wi[a];
+        for (c = 0; c < 6; ++c) {
+            double gac;
+            if (!(wj[c] > 0.0f)) continue;
+            gac = ga * (double)wj[c];
+            acc[(size_t)a * N + vp->voxel_patch[6 * (size_t)vj + c]] += gac;
+            /* both in the row voxel: the transposed entry is a row of this voxel too */
+            if (vj == u) acc[(size_t)c * N + vp->voxel_patch[6 * (size_t)u + a]] += gac;
+        }
+    }
+}
+
+static rad_result rad__vp_flush(rad__vp_build *b, uint32_t task, uint32_t u, uint32_t count)
+{
+    size_t at = (size_t)task * RAD__RAY_BATCH;
+    double *acc = b->acc + (size_t)task * 6u * b->vp->count;
+    uint32_t k;
+    if (count == 0) return RAD_SUCCESS;
+    if (b->rc->occluded(b->rc->user, b->rays + at, count, b->occ + at) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    b->rays_cast[task] += count;
+    for (k = 0; k < count; ++k)
+        if (!b->occ[at + k]) rad__vp_pair_add(b, acc, u, b->ray_i[at + k], b->ray_j[at + k], (double)b->ray_g[at + k]);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_ff_row(void *data, uint32_t u, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t N = vp->count, M = vp->sample_count, pf = vp->voxel_first[u], i, j, a, nrays = 0;
+    double *acc = b->acc + (size_t)task * 6u * N;
+    size_t at = (size_t)task * RAD__RAY_BATCH;
+    rad_result r = RAD_SUCCESS;
+    for (a = 0; a < 6; ++a) memset(acc + (size_t)a * N + pf, 0, sizeof(double) * (N - pf));
+    for (i = vp->sample_first[u]; i < vp->sample_first[u + 1] && r == RAD_SUCCESS; ++i) {
+        const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
+        float si = vp->sample_areas[i];
+        for (j = i + 1; j < M; ++j) {
+            const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
+            float d[3], d2, ci, cj, sj = vp->sample_areas[j], fl, g, len;
+            int k;
+            rad__sub(d, pj, pi_);
+            ci = rad__dot(d, ni);
+            if (!(ci > 0.0f)) continue;
+            cj = -rad__dot(d, nj);
+            if (!(cj > 0.0f)) continue;
+            d2 = rad__dot(d, d);
+            fl = (si > sj ? si : sj) / (float)RAD__PI;
+            /* cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2 */
+            g = si * sj * (ci / d2) * (cj / (d2 > fl ? d2 : fl)) / (float)RAD__PI;
+            if (!(g > 0.0f)) continue;
+            if (b->o.skip_visibility) {
+                rad__vp_pair_add(b, acc, u, i, j, (double)g);
+                continue;
+            }
+            {
+                rad_ray *ray = b->rays + at + nrays;
+                for (k = 0; k < 3; ++k) {
+                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
+                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
+                }
+                len = rad__len(ray->dir);
+                ray->tmin = 0.0f;
+                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+                b->ray_i[at + nrays] = i;
+                b->ray_j[at + nrays] = j;
+                b->ray_g[at + nrays] = g;
+                if (++nrays == RAD__RAY_BATCH) {
+                    r = rad__vp_flush(b, task, u, nrays);
+                    nrays = 0;
+                    if (r != RAD_SUCCESS) break;
+                }
+            }
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad__vp_flush(b, task, u, nrays);
+    if (r != RAD_SUCCESS) return r;
+    /* the rows of u's patches, columns from u's first patch on */
+    for (a = 0; a < 6; ++a) {
+        uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
+        if (p == RAD_NONE) continue;
+        for (c = pf; c < N; ++c) b->P[(size_t)p * N + c] = (float)acc[(size_t)a * N + c];
+    }
+    return RAD_SUCCESS;
+}
+
+/* mirror P into the columns left of each row's voxel, then divide by the row's area */
+static rad_result rad__vp_mirror_row(void *data, uint32_t p, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t N = vp->count, pf = vp->voxel_first[vp->voxel[p]], c;
+    (void)task;
+    for (c = 0; c < pf; ++c) b->P[(size_t)p * N + c] = b->P[(size_t)c * N + p];
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_divide_row(void *data, uint32_t p, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    uint32_t N = b->vp->count, c;
+    float *row = b->P + (size_t)p * N;
+    double inv = 1.0 / (double)b->vp->areas[p];
+    (void)task;
+    for (c = 0; c < N; ++c) row[c] = (float)((double)row[c] * inv);
+    return RAD_SUCCESS;
+}
+
+/* grows the sample arrays to hold 'need' samples */
+static int rad__vp_grow(rad__vp_build *b, uint32_t *cap, uint32_t need, float **pos, uint32_t **tri, uint32_t **vox,
+                        float **bary)
+{
+    uint32_t n = *cap ? *cap : 1024u;
+    float *p2, *b2;
+    uint32_t *t2, *v2;
+    const rad_allocator *A = &b->vp->allocator;
+    if (need <= *cap) return 1;
+    while (n < need) n = n > 0x7FFFFFFFu ? 0xFFFFFFFEu : 2u * n;
+    p2 = (float *)rad__realloc(A, *pos, sizeof(float) * 3u * *cap, sizeof(float) * 3u * n);
+    if (!p2) return 0;
+    *pos = p2;
+    b2 = (float *)rad__realloc(A, *bary, sizeof(float) * 2u * *cap, sizeof(float) * 2u * n);
+    if (!b2) return 0;
+    *bary = b2;
+    t2 = (uint32_t *)rad__realloc(A, *tri, sizeof(uint32_t) * *cap, sizeof(uint32_t) * n);
+    if (!t2) return 0;
+    *tri = t2;
+    v2 = (uint32_t *)rad__realloc(A, *vox, sizeof(uint32_t) * *cap, sizeof(uint32_t) * n);
+    if (!v2) return 0;
+    *vox = v2;
+    *cap = n;
+    return 1;
+}
+
+/* maps the form-factor stage's progress to [0.1, 1] */
+typedef struct rad__vp_progress {
+    int (*fn)(void *user, float fraction);
+    void *user;
+} rad__vp_progress;
+
+static int rad__vp_progress_fn(void *user, float fraction)
+{
+    const rad__vp_progress *p = (const rad__vp_progress *)user;
+    return p->fn(p->user, 0.1f + 0.9f * fraction);
+}
+
+static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_scene *S = b->S;
+    const rad_allocator *A = &vp->allocator;
+    uint64_t *cand = NULL, total = 0;
+    uint32_t ncand = 0, t, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
+    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL;
+    float *s_pos = NULL, *s_bary = NULL;
+    size_t bytes, q;
+    rad_result r = RAD_SUCCESS;
+    int k;
+
+    /* 1. candidate voxels from triangle bounds */
+    for (t = 0; t < S->triangle_count; ++t) {
+        const float *tv = S->positions + 9 * (size_t)t;
+        uint64_t n = 1;
+        for (k = 0; k < 3; ++k) {
+            float mn = tv[k], mx = tv[k];
+            int64_t i0, i1;
+            if (tv[3 + k] < mn) mn = tv[3 + k];
+            if (tv[6 + k] < mn) mn = tv[6 + k];
+            if (tv[3 + k] > mx) mx = tv[3 + k];
+            if (tv[6 + k] > mx) mx = tv[6 + k];
+            i0 = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+            i1 = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+            if (i0 < 0) i0 = 0;
+            if (i1 > (int64_t)vp->dims[k] - 1) i1 = (int64_t)vp->dims[k] - 1;
+            n *= (uint64_t)(i1 >= i0 ? i1 - i0 + 1 : 0);
+        }
+        total += n;
+        if (total > 0xFFFFFFF0u) {
+            rad__log(c, RAD_LOG_ERROR, "virtual patches: triangles overlap more than 2^32 voxels (use bigger voxels)");
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+    }
+    cand = (uint64_t *)rad__alloc_array(A, (size_t)total, sizeof(uint64_t));
+    if (!cand) return RAD_ERROR_OUT_OF_MEMORY;
+    for (t = 0, q = 0; t < S->triangle_count; ++t) {
+        const float *tv = S->positions + 9 * (size_t)t;
+        int64_t i0[3], i1[3], x, y, z;
+        for (k = 0; k < 3; ++k) {
+            float mn = tv[k], mx = tv[k];
+            if (tv[3 + k] < mn) mn = tv[3 + k];
+            if (tv[6 + k] < mn) mn = tv[6 + k];
+            if (tv[3 + k] > mx) mx = tv[3 + k];
+            if (tv[6 + k] > mx) mx = tv[6 + k];
+            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+            if (i0[k] < 0) i0[k] = 0;
+            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
+        }
+        for (z = i0[2]; z <= i1[2]; ++z)
+            for (y = i0[1]; y <= i1[1]; ++y)
+                for (x = i0[0]; x <= i1[0]; ++x)
+                    cand[q++] = (uint64_t)x + (uint64_t)vp->dims[0] * ((uint64_t)y + (uint64_t)vp->dims[1] * (uint64_t)z);
+    }
+    qsort(cand, (size_t)total, sizeof(uint64_t), rad__vp_cmp_u64);
+    for (q = 0; q < (size_t)total; ++q)
+        if (q == 0 || cand[q] != cand[q - 1]) cand[ncand++] = cand[q];
+    vp->candidate_voxels = ncand;
+    b->cand = cand;
+
+    /* 2. face rays, chunk by chunk; samples appended in voxel order */
+    chunk = RAD__VP_CHUNK_RAYS / (6u * P);
+    if (chunk < 1) chunk = 1;
+    if (chunk > ncand) chunk = ncand;
+    b->hits = (rad_hit *)rad__alloc_array(A, (size_t)chunk * 6u * P, sizeof(rad_hit));
+    b->rays = (rad_ray *)rad__alloc_array(A, (size_t)b->tasks * RAD__RAY_BATCH, sizeof(rad_ray));
+    tri_count = (uint32_t *)rad__alloc_array(A, S->triangle_count, sizeof(uint32_t));
+    cand_first = (uint32_t *)rad__alloc_array(A, (size_t)ncand + 1u, sizeof(uint32_t));
+    if (!b->hits || !b->rays || !tri_count || !cand_first) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(tri_count, 0, sizeof(uint32_t) * S->triangle_count);
+    for (begin = 0; begin < ncand && r == RAD_SUCCESS; begin += chunk) {
+        uint32_t cnt = ncand - begin < chunk ? ncand - begin : chunk, h;
+        rad__ctx cc = *c;
+        cc.progress = NULL; /* progress once per chunk, below */
+        b->chunk_begin = begin;
+        r = rad__for_rows(&cc, cnt, b->tasks < cnt ? b->tasks : cnt, rad__vp_face_row, b);
+        if (r != RAD_SUCCESS) break;
+        vp->face_rays += (uint64_t)cnt * 6u * P;
+        for (v = 0; v < cnt; ++v) {
+            cand_first[begin + v] = M;
+            for (h = 0; h < 6u * P; ++h) {
+                const rad_hit *hit = &b->hits[(size_t)v * 6u * P + h];
+                const float *tv;
+                float b0;
+                if (hit->triangle == RAD_NONE || hit->triangle >= S->triangle_count) continue;
+                if (M == 0xFFFFFFFEu) {
+                    rad__log(c, RAD_LOG_ERROR, "virtual patches: more than 2^32 - 2 samples (use fewer face points)");
+                    r = RAD_ERROR_SIZE_OVERFLOW;
+                    goto done;
+                }
+                if (!rad__vp_grow(b, &cap, M + 1u, &s_pos, &s_tri, &s_vox, &s_bary)) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+                tv = S->positions + 9 * (size_t)hit->triangle;
+                b0 = 1.0f - hit->b1 - hit->b2;
+                for (k = 0; k < 3; ++k) s_pos[3 * (size_t)M + k] = b0 * tv[k] + hit->b1 * tv[3 + k] + hit->b2 * tv[6 + k];
+                s_bary[2 * (size_t)M] = hit->b1;
+                s_bary[2 * (size_t)M + 1] = hit->b2;
+                s_tri[M] = hit->triangle;
+                s_vox[M] = begin + v;
+                tri_count[hit->triangle]++;
+                ++M;
+            }
+        }
+        if (c->progress && c->progress(c->progress_user, 0.1f * (float)(begin + cnt) / (float)ncand)) r = RAD_ERROR_CANCELLED;
+    }
+    if (r != RAD_SUCCESS) goto done;
+    cand_first[ncand] = M;
+    rad__free(A, b->hits);
+    b->hits = NULL;
+    if (M == 0) {
+        rad__log(c, RAD_LOG_ERROR, "virtual patches: no face ray hit the scene (%u candidate voxels)", ncand);
+        r = RAD_ERROR_EMPTY_SCENE;
+        goto done;
+    }
+
+    /* 3. non-empty voxels, samples and their split weights */
+    for (v = 0; v < ncand; ++v)
+        if (cand_first[v + 1] > cand_first[v]) vp->voxel_count++;
+    vp->sample_count = M;
+    vp->voxel_keys = (uint64_t *)rad__alloc_array(A, vp->voxel_count, sizeof(uint64_t));
+    vp->voxel_first = (uint32_t *)rad__alloc_array(A, (size_t)vp->voxel_count + 1u, sizeof(uint32_t));
+    vp->sample_first = (uint32_t *)rad__alloc_array(A, (size_t)vp->voxel_count + 1u, sizeof(uint32_t));
+    vp->voxel_patch = (uint32_t *)rad__alloc_array(A, vp->voxel_count, 6 * sizeof(uint32_t));
+    vp->sample_normals = (float *)rad__alloc_array(A, M, 3 * sizeof(float));
+    vp->sample_albedo = (float *)rad__alloc_array(A, M, 3 * sizeof(float));
+    vp->sample_areas = (float *)rad__alloc_array(A, M, sizeof(float));
+    vp->sample_weights = (float *)rad__alloc_array(A, M, 6 * sizeof(float));
+    b->sample_voxel = (uint32_t *)rad__alloc_array(A, M, sizeof(uint32_t));
+    if (!vp->voxel_keys || !vp->voxel_first || !vp->sample_first || !vp->voxel_patch || !vp->sample_normals ||
+        !vp->sample_albedo || !vp->sample_areas || !vp->sample_weights || !b->sample_voxel) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (v = 0, i = 0; v < ncand; ++v) {
+        uint32_t s;
+        if (cand_first[v + 1] == cand_first[v]) continue;
+        vp->voxel_keys[i] = cand[v];
+        vp->sample_first[i] = cand_first[v];
+        for (s = cand_first[v]; s < cand_first[v + 1]; ++s) b->sample_voxel[s] = i;
+        ++i;
+    }
+    vp->sample_first[vp->voxel_count] = M;
+    vp->sample_positions = s_pos;
+    vp->sample_triangles = s_tri;
+    s_pos = NULL;
+    s_tri = NULL;
+    for (i = 0; i < M; ++i) {
+        uint32_t tr = vp->sample_triangles[i];
+        memcpy(vp->sample_normals + 3 * (size_t)i, S->normals + 3 * (size_t)tr, 3 * sizeof(float));
+        rad_scene_albedo(S, tr, s_bary[2 * (size_t)i], s_bary[2 * (size_t)i + 1], vp->sample_albedo + 3 * (size_t)i);
+        for (k = 0; k < 3; ++k)
+            if (!(vp->sample_albedo[3 * (size_t)i + k] >= 0.0f && vp->sample_albedo[3 * (size_t)i + k] < 1.0f)) {
+                rad__log(c, RAD_LOG_ERROR, "virtual patches: the albedo of triangle %u is outside [0, 1)", tr);
+                r = RAD_ERROR_ALBEDO_RANGE;
+                goto done;
+            }
+        vp->sample_areas[i] = S->areas[tr] / (float)tri_count[tr];
+        rad__vp_weights(b->o.weights, vp->sample_normals + 3 * (size_t)i, vp->sample_weights + 6 * (size_t)i);
+    }
+
+    /* 4. patches: one per voxel and axis with a non-zero area */
+    for (v = 0; v < vp->voxel_count; ++v) {
+        vp->voxel_first[v] = N;
+        for (a = 0; a < 6; ++a) {
+            uint32_t s;
+            int any = 0;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1] && !any; ++s)
+                if (vp->sample_weights[6 * (size_t)s + a] > 0.0f) any = 1;
+            vp->voxel_patch[6 * (size_t)v + a] = any ? N++ : RAD_NONE;
+        }
+    }
+    vp->voxel_first[vp->voxel_count] = N;
+    vp->count = N;
+    if (!rad__mul3(N, N, sizeof(float), &bytes)) {
+        rad__log(c, RAD_LOG_ERROR, "virtual patches: the %u x %u matrix does not fit in memory (use bigger voxels)", N, N);
+        r = RAD_ERROR_SIZE_OVERFLOW;
+        goto done;
+    }
+    vp->areas = (float *)rad__alloc_array(A, N, sizeof(float));
+    vp->albedo = (float *)rad__alloc_array(A, N, 3 * sizeof(float));
+    vp->normals = (float *)rad__alloc_array(A, N, 3 * sizeof(float));
+    vp->axis = (uint8_t *)rad__alloc_array(A, N, 1);
+    vp->voxel = (uint32_t *)rad__alloc_array(A, N, sizeof(uint32_t));
+    if (!vp->areas || !vp->albedo || !vp->normals || !vp->axis || !vp->voxel) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (v = 0; v < vp->voxel_count; ++v)
+        for (a = 0; a < 6; ++a) {
+            uint32_t p = vp->voxel_patch[6 * (size_t)v + a], s;
+            double area = 0.0, col[3] = { 0.0, 0.0, 0.0 };
+            if (p == RAD_NONE) continue;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                area += w;
+                for (k = 0; k < 3; ++k) col[k] += w * (double)vp->sample_albedo[3 * (size_t)s + k];
+            }
+            vp->areas[p] = (float)area;
+            for (k = 0; k < 3; ++k) {
+                vp->albedo[3 * (size_t)p + k] = (float)(col[k] / area);
+                vp->normals[3 * (size_t)p + k] = 0.0f;
+            }
+            vp->normals[3 * (size_t)p + (a >> 1)] = (a & 1u) ? -1.0f : 1.0f;
+            vp->axis[p] = (uint8_t)a;
+            vp->voxel[p] = v;
+        }
+
+    /* 5. form factors, one row voxel per task */
+    rad__free(A, s_bary);
+    s_bary = NULL;
+    rad__free(A, tri_count);
+    tri_count = NULL;
+    rad__free(A, cand);
+    cand = NULL;
+    b->cand = NULL;
+    rad__free(A, cand_first);
+    cand_first = NULL;
+    b->P = (float *)rad__alloc(A, bytes);
+    if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    vp->matrix.rows = vp->matrix.cols = N;
+    vp->matrix.storage = RAD_STORAGE_DENSE;
+    vp->matrix.dense = b->P; /* owned by vp from here on */
+    {
+        uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
+        rad__ctx cc = *c;
+        rad__vp_progress prog;
+        prog.fn = c->progress;
+        prog.user = c->progress_user;
+        if (c->progress) {
+            cc.progress = rad__vp_progress_fn;
+            cc.progress_user = &prog;
+        }
+        b->occ = (uint8_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, 1);
+        b->ray_i = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+        b->ray_j = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+        b->ray_g = (float *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(float));
+        b->rays_cast = (uint64_t *)rad__alloc_array(A, T, sizeof(uint64_t));
+        b->acc = (double *)rad__alloc_array(A, (size_t)T * 6u, (size_t)N * sizeof(double));
+        if (!b->occ || !b->ray_i || !b->ray_j || !b->ray_g || !b->rays_cast || !b->acc) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+        memset(b->rays_cast, 0, sizeof(uint64_t) * T);
+        /* progress of this stage maps to [0.1, 1] */
+        if (c->progress && c->progress(c->progress_user, 0.1f)) { r = RAD_ERROR_CANCELLED; goto done; }
+        r = rad__for_rows(&cc, vp->voxel_count, T, rad__vp_ff_row, b);
+        for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+        if (r == RAD_SUCCESS) {
+            cc.progress = NULL;
+            r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
+            if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
+        }
+        if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
+    }
+done:
+    rad__free(A, cand);
+    rad__free(A, cand_first);
+    rad__free(A, tri_count);
+    rad__free(A, s_pos);
+    rad__free(A, s_tri);
+    rad__free(A, s_vox);
+    rad__free(A, s_bary);
+    rad__free(A, b->hits);
+    rad__free(A, b->rays);
+    rad__free(A, b->occ);
+    rad__free(A, b->ray_i);
+    rad__free(A, b->ray_j);
+    rad__free(A, b->ray_g);
+    rad__free(A, b->rays_cast);
+    rad__free(A, b->acc);
+    rad__free(A, b->sample_voxel);
+    return r;
+}
+
+RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                 const rad_context *ctx, rad_virtual_patches **out)
+{
+    rad__ctx c;
+    rad__vp_build b;
+    rad_virtual_patches *vp;
+    rad_result r;
+    double cells = 1.0;
+    int k, given = 0;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!scene || !raycaster || !out || !raycaster->intersect) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: NULL scene, raycaster, intersect callback or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    memset(&b, 0, sizeof(b));
+    if (options) b.o = *options; else rad_vp_options_default(&b.o);
+    if (b.o.resolution == 0) b.o.resolution = 16;
+    if (b.o.face_points == 0) b.o.face_points = 16;
+    if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
+    for (k = 0; k < 3; ++k) {
+        if (!rad__finite(b.o.voxel_size[k]) || b.o.voxel_size[k] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size[%d] = %g is negative or not finite", k, (double)b.o.voxel_size[k]);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (b.o.voxel_size[k] > 0.0f) given++;
+    }
+    if ((given != 0 && given != 3) || b.o.face_points > 4096u || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
+        !rad__finite(b.o.ray_epsilon) || b.o.ray_epsilon < 0.0f || (!b.o.skip_visibility && !raycaster->occluded)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size must be all 0 or all > 0; face_points <= 4096; weights, ray_epsilon "
+                 "valid; an occluded callback unless skip_visibility");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(vp, 0, sizeof(*vp));
+    vp->allocator = c.allocator;
+    vp->scene = scene;
+    vp->weights = b.o.weights;
+    for (k = 0; k < 3; ++k) {
+        float ext = scene->bounds_max[k] - scene->bounds_min[k], h;
+        float longest = scene->bounds_max[0] - scene->bounds_min[0];
+        if (scene->bounds_max[1] - scene->bounds_min[1] > longest) longest = scene->bounds_max[1] - scene->bounds_min[1];
+        if (scene->bounds_max[2] - scene->bounds_min[2] > longest) longest = scene->bounds_max[2] - scene->bounds_min[2];
+        h = given ? b.o.voxel_size[k] : longest / (float)b.o.resolution;
+        if (!(h > 0.0f)) h = 1.0f;
+        vp->voxel_size[k] = h;
+        vp->origin[k] = scene->bounds_min[k] - RAD__VP_MARGIN * h;
+        cells = floor((double)(ext + 2.0f * RAD__VP_MARGIN * h) / (double)h) + 1.0;
+        if (cells > 4194304.0) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: %g voxels along axis %d (use bigger voxels)", cells, k);
+            rad_vp_destroy(vp);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        vp->dims[k] = (uint32_t)cells;
+    }
+    b.S = scene;
+    b.rc = raycaster;
+    b.vp = vp;
+    b.eps = b.o.ray_epsilon * scene->diagonal;
+    b.tasks = c.tasks;
+    r = rad__vp_build_run(&b, &c);
+    if (r != RAD_SUCCESS) {
+        rad_vp_destroy(vp);
+        return r;
+    }
+    *out = vp;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E)
+{
+    if (!system) return;
+    memset(system, 0, sizeof(*system));
+    if (!vp) return;
+    system->F = &vp->matrix;
+    system->albedo = vp->albedo;
+    system->areas = vp->areas;
+    system->E = E;
+    system->n = vp->count;
+}
+
+RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out)
+{
+    uint32_t v, a, s;
+    int k;
+    if (!vp || !sample_values || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    for (v = 0; v < vp->voxel_count; ++v)
+        for (a = 0; a < 6; ++a) {
+            uint32_t p = vp->voxel_patch[6 * (size_t)v + a];
+            double acc[3] = { 0.0, 0.0, 0.0 }, wsum = 0.0;
+            if (p == RAD_NONE) continue;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                wsum += w;
+                for (k = 0; k < 3; ++k) acc[k] += w * (double)sample_values[3 * (size_t)s + k];
+            }
+            for (k = 0; k < 3; ++k) out[3 * (size_t)p + k] = wsum > 0.0 ? (float)(acc[k] / wsum) : 0.0f;
+        }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster, const rad_light *lights,
+                                  uint32_t light_count, const rad_direct_options *options, rad_source_mode mode,
+                                  float *out_E, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *v;
+    uint32_t i, M;
+    rad_result r = RAD_SUCCESS;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !out_E || (mode != RAD_SOURCE_DIRECT && mode != RAD_SOURCE_EMISSION)) return RAD_ERROR_INVALID_ARGUMENT;
+    M = vp->sample_count;
+    v = (float *)rad__alloc_array(&c.allocator, M, 3 * sizeof(float));
+    if (!v) return RAD_ERROR_OUT_OF_MEMORY;
+    if (mode == RAD_SOURCE_DIRECT) {
+        r = rad_direct_irradiance(vp->scene, raycaster, lights, light_count, options, vp->sample_positions,
+                                  vp->sample_normals, M, v, ctx);
+        if (r == RAD_SUCCESS)
+            for (i = 0; i < 3 * M; ++i) v[i] *= vp->sample_albedo[i];
+    } else {
+        const rad_scene *S = vp->scene;
+        for (i = 0; i < M; ++i) {
+            const float *L = S->materials_table[S->materials[vp->sample_triangles[i]]].emission;
+            for (k = 0; k < 3; ++k) v[3 * (size_t)i + k] = (float)RAD__PI * L[k];
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad_vp_from_samples(vp, v, out_E);
+    rad__free(&c.allocator, v);
+    if (r == RAD_SUCCESS) r = rad__check_output(&c, "virtual-patch sources", out_E, 3 * (size_t)vp->count);
+    return r;
+}
+
+/* index of the voxel with this key, or RAD_NONE */
+static uint32_t rad__vp_find(const rad_virtual_patches *vp, uint64_t key)
+{
+    uint32_t lo = 0, hi = vp->voxel_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (vp->voxel_keys[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < vp->voxel_count && vp->voxel_keys[lo] == key ? lo : RAD_NONE;
+}
+
+RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float *values, const float p[3],
+                                     const float n[3], float out[3])
+{
+    double g[3], acc[3] = { 0.0, 0.0, 0.0 }, tsum = 0.0, facc[3] = { 0.0, 0.0, 0.0 };
+    int64_t base[3];
+    float w[6];
+    uint32_t corner, used = 0;
+    int k;
+    if (!out) return 0;
+    out[0] = out[1] = out[2] = 0.0f;
+    if (!vp || !values || !p || !n || !rad__finite3(p) || !rad__finite3(n)) return 0;
+    rad__vp_weights(vp->weights, n, w);
+    for (k = 0; k < 3; ++k) {
+        double x = ((double)p[k] - (double)vp->origin[k]) / (double)vp->voxel_size[k] - 0.5;
+        if (x < -2.0) x = -2.0;
+        if (x > (double)vp->dims[k] + 1.0) x = (double)vp->dims[k] + 1.0;
+        base[k] = (int64_t)floor(x);
+        g[k] = x - (double)base[k];
+    }
+    for (corner = 0; corner < 8; ++corner) {
+        int64_t cell[3];
+        double t = 1.0, L[3] = { 0.0, 0.0, 0.0 }, ws = 0.0;
+        uint32_t v, a;
+        int inside = 1;
+        for (k = 0; k < 3; ++k) {
+            int bit = (int)((corner >> k) & 1u);
+            cell[k] = base[k] + bit;
+            t *= bit ? g[k] : 1.0 - g[k];
+            if (cell[k] < 0 || cell[k] >= (int64_t)vp->dims[k]) inside = 0;
+        }
+        if (!inside) continue;
+        v = rad__vp_find(vp, (uint64_t)cell[0] + (uint64_t)vp->dims[0] * ((uint64_t)cell[1] + (uint64_t)vp->dims[1] * (uint64_t)cell[2]));
+        if (v == RAD_NONE) continue;
+        for (a = 0; a < 6; ++a) {
+            uint32_t q = vp->voxel_patch[6 * (size_t)v + a];
+            if (q == RAD_NONE || !(w[a] > 0.0f)) continue;
+            ws += (double)w[a];
+            for (k = 0; k < 3; ++k) L[k] += (double)w[a] * (double)values[3 * (size_t)q + k];
+        }
+        if (!(ws > 0.0)) continue; /* nothing in this voxel faces n */
+        used++;
+        for (k = 0; k < 3; ++k) {
+            acc[k] += t * L[k] / ws;
+            facc[k] += L[k] / ws;
+        }
+        tsum += t;
+    }
+    if (!used) return 0;
+    for (k = 0; k < 3; ++k) out[k] = tsum > 0.0 ? (float)(acc[k] / tsum) : (float)(facc[k] / (double)used);
+    return used;
+}
+
+typedef struct rad__vp_gather_job {
+    const rad_virtual_patches *vp;
+    const float *values, *points, *normals;
+    float *out;
+    uint32_t count, tasks;
+} rad__vp_gather_job;
+
+static void rad__vp_gather_task(void *data, uint32_t task)
+{
+    rad__vp_gather_job *j = (rad__vp_gather_job *)data;
+    uint32_t i0 = (uint32_t)((uint64_t)j->count * task / j->tasks), i1 = (uint32_t)((uint64_t)j->count * (task + 1) / j->tasks), i;
+    for (i = i0; i < i1; ++i)
+        (void)rad_vp_gather_point(j->vp, j->values, j->points + 3 * (size_t)i, j->normals + 3 * (size_t)i, j->out + 3 * (size_t)i);
+}
+
+RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *values, const float *points,
+                                 const float *normals, uint32_t count, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__vp_gather_job j;
+    uint32_t i;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !values || (count && (!points || !normals || !out))) return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < count; ++i)
+        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather: point %u or its normal is not finite", i);
+            return RAD_ERROR_NON_FINITE;
+        }
+    if (count == 0) return RAD_SUCCESS;
+    j.vp = vp;
+    j.values = values;
+    j.points = points;
+    j.normals = normals;
+    j.out = out;
+    j.count = count;
+    j.tasks = c.tasks < count ? c.tasks : count;
+    c.parallel_for(c.parallel_user, j.tasks, rad__vp_gather_task, &j);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
+                                      float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *pts, *nrm;
+    size_t ps, ns;
+    uint32_t V, T, t, i;
+    rad_result r;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !values || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    V = mesh->vertex_count;
+    T = mesh->triangle_count;
+    if (!mesh->indices && (size_t)T * 3u > V) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    ps = mesh->position_stride ? mesh->position_stride : 3 * sizeof(float);
+    ns = mesh->normal_stride ? mesh->normal_stride : 3 * sizeof(float);
+    pts = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
+    if (!pts || !nrm) {
+        rad__free(&c.allocator, pts);
+        rad__free(&c.allocator, nrm);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < V; ++i) memcpy(pts + 3 * (size_t)i, (const char *)mesh->positions + ps * i, 3 * sizeof(float));
+    memset(nrm, 0, sizeof(float) * 3u * V);
+    if (mesh->normals) {
+        for (i = 0; i < V; ++i) memcpy(nrm + 3 * (size_t)i, (const char *)mesh->normals + ns * i, 3 * sizeof(float));
+    } else {
+        for (t = 0; t < T; ++t) {
+            uint32_t id[3], m;
+            float e1[3], e2[3], cr[3];
+            for (m = 0; m < 3; ++m) {
+                id[m] = mesh->indices ? mesh->indices[3 * (size_t)t + m] : 3u * t + m;
+                if (id[m] >= V) {
+                    rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_mesh: triangle %u has vertex index %u >= %u", t, id[m], V);
+                    rad__free(&c.allocator, pts);
+                    rad__free(&c.allocator, nrm);
+                    return RAD_ERROR_INDEX_OUT_OF_RANGE;
+                }
+            }
+            rad__sub(e1, pts + 3 * (size_t)id[1], pts + 3 * (size_t)id[0]);
+            rad__sub(e2, pts + 3 * (size_t)id[2], pts + 3 * (size_t)id[0]);
+            rad__cross(cr, e1, e2); /* twice the area times the unit normal */
+            for (m = 0; m < 3; ++m)
+                for (k = 0; k < 3; ++k) nrm[3 * (size_t)id[m] + k] += cr[k];
+        }
+    }
+    for (i = 0; i < V; ++i) rad__normalize(nrm + 3 * (size_t)i);
+    r = rad_vp_gather(vp, values, pts, nrm, V, out, ctx);
+    rad__free(&c.allocator, pts);
+    rad__free(&c.allocator, nrm);
+    return r;
 }
 
 #endif /* RADIOSITY_IMPLEMENTATION */

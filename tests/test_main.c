@@ -60,12 +60,13 @@ static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
 #include "test_container.c"
 #include "test_multibounce.c"
 #include "test_temporal.c"
+#include "test_vp.c"
 #include "test_regress.c"
 #include "test_robust.c"
 #include "test_api.c"
 #include "test_alloc.c"
 
-static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_solve, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_regress, tests_robust, tests_api, tests_alloc };
+static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_solve, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_vp, tests_regress, tests_robust, tests_api, tests_alloc };
 
 int main(int argc, char **argv)
 {
