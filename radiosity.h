@@ -8027,6 +8027,39 @@ static int rad__vp_grow(rad__vp_build *b, uint32_t *cap, uint32_t need, float **
     return 1;
 }
 
+/* area of triangle tv clipped to the box [lo, hi] (Sutherland-Hodgman in double) */
+static double rad__vp_clip_area(const float *tv, const double *lo, const double *hi)
+{
+    double poly[2][12][3], cr[3] = { 0.0, 0.0, 0.0 };
+    int n = 3, cur = 0, k, plane, i;
+    for (i = 0; i < 3; ++i)
+        for (k = 0; k < 3; ++k) poly[0][i][k] = tv[3 * i + k];
+    for (plane = 0; plane < 6 && n > 0; ++plane) {
+        int ax = plane >> 1, m = 0;
+        double bound = (plane & 1) ? hi[ax] : lo[ax], sgn = (plane & 1) ? -1.0 : 1.0;
+        for (i = 0; i < n; ++i) {
+            const double *a = poly[cur][i], *b = poly[cur][(i + 1) % n];
+            double da = sgn * (a[ax] - bound), db = sgn * (b[ax] - bound);
+            if (da >= 0.0) { memcpy(poly[1 - cur][m], a, sizeof(poly[0][0])); ++m; }
+            if ((da >= 0.0) != (db >= 0.0)) {
+                double t = da / (da - db);
+                for (k = 0; k < 3; ++k) poly[1 - cur][m][k] = a[k] + t * (b[k] - a[k]);
+                ++m;
+            }
+        }
+        n = m;
+        cur = 1 - cur;
+    }
+    for (i = 1; i + 1 < n; ++i) {
+        double e1[3], e2[3];
+        for (k = 0; k < 3; ++k) { e1[k] = poly[cur][i][k] - poly[cur][0][k]; e2[k] = poly[cur][i + 1][k] - poly[cur][0][k]; }
+        cr[0] += e1[1] * e2[2] - e1[2] * e2[1];
+        cr[1] += e1[2] * e2[0] - e1[0] * e2[2];
+        cr[2] += e1[0] * e2[1] - e1[1] * e2[0];
+    }
+    return 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+}
+
 /* maps the form-factor stage's progress to [0.1, 1] */
 typedef struct rad__vp_progress {
     int (*fn)(void *user, float fraction);
@@ -8046,7 +8079,8 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     const rad_allocator *A = &vp->allocator;
     uint64_t *cand = NULL, total = 0;
     uint32_t ncand = 0, t, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
-    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL;
+    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL, *voxel_cand = NULL;
+    double *cand_area = NULL;
     float *s_pos = NULL, *s_bary = NULL;
     size_t bytes, q;
     rad_result r = RAD_SUCCESS;
@@ -8101,6 +8135,51 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         if (q == 0 || cand[q] != cand[q - 1]) cand[ncand++] = cand[q];
     vp->candidate_voxels = ncand;
     b->cand = cand;
+
+    /* exact surface area per candidate voxel and axis: each triangle clipped to the voxels its
+       bounds overlap, times the split weights of its normal */
+    cand_area = (double *)rad__alloc_array(A, ncand, 6 * sizeof(double));
+    if (!cand_area) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(cand_area, 0, sizeof(double) * 6u * ncand);
+    for (t = 0; t < S->triangle_count; ++t) {
+        const float *tv = S->positions + 9 * (size_t)t;
+        int64_t i0[3], i1[3], x, y, z;
+        float wt[6];
+        rad__vp_weights(b->o.weights, S->normals + 3 * (size_t)t, wt);
+        for (k = 0; k < 3; ++k) {
+            float mn = tv[k], mx = tv[k];
+            if (tv[3 + k] < mn) mn = tv[3 + k];
+            if (tv[6 + k] < mn) mn = tv[6 + k];
+            if (tv[3 + k] > mx) mx = tv[3 + k];
+            if (tv[6 + k] > mx) mx = tv[6 + k];
+            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+            if (i0[k] < 0) i0[k] = 0;
+            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
+        }
+        for (z = i0[2]; z <= i1[2]; ++z)
+            for (y = i0[1]; y <= i1[1]; ++y)
+                for (x = i0[0]; x <= i1[0]; ++x) {
+                    uint64_t key = (uint64_t)x + (uint64_t)vp->dims[0] * ((uint64_t)y + (uint64_t)vp->dims[1] * (uint64_t)z);
+                    double lo[3], hi[3], ar;
+                    uint32_t lo_i = 0, hi_i = ncand;
+                    int64_t cell[3];
+                    cell[0] = x; cell[1] = y; cell[2] = z;
+                    for (k = 0; k < 3; ++k) {
+                        lo[k] = (double)vp->origin[k] + (double)cell[k] * (double)vp->voxel_size[k];
+                        hi[k] = lo[k] + (double)vp->voxel_size[k];
+                    }
+                    /* a triangle inside one voxel needs no clipping */
+                    ar = (i0[0] == i1[0] && i0[1] == i1[1] && i0[2] == i1[2]) ? (double)S->areas[t] : rad__vp_clip_area(tv, lo, hi);
+                    if (!(ar > 0.0)) continue;
+                    while (lo_i < hi_i) {
+                        uint32_t mid = lo_i + (hi_i - lo_i) / 2;
+                        if (cand[mid] < key) lo_i = mid + 1;
+                        else hi_i = mid;
+                    }
+                    for (k = 0; k < 6; ++k) cand_area[6 * (size_t)lo_i + k] += ar * (double)wt[k];
+                }
+    }
 
     /* 2. face rays, chunk by chunk; samples appended in voxel order */
     chunk = RAD__VP_CHUNK_RAYS / (6u * P);
@@ -8169,8 +8248,9 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     vp->sample_areas = (float *)rad__alloc_array(A, M, sizeof(float));
     vp->sample_weights = (float *)rad__alloc_array(A, M, 6 * sizeof(float));
     b->sample_voxel = (uint32_t *)rad__alloc_array(A, M, sizeof(uint32_t));
+    voxel_cand = (uint32_t *)rad__alloc_array(A, vp->voxel_count, sizeof(uint32_t));
     if (!vp->voxel_keys || !vp->voxel_first || !vp->sample_first || !vp->voxel_patch || !vp->sample_normals ||
-        !vp->sample_albedo || !vp->sample_areas || !vp->sample_weights || !b->sample_voxel) {
+        !vp->sample_albedo || !vp->sample_areas || !vp->sample_weights || !b->sample_voxel || !voxel_cand) {
         r = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
     }
@@ -8178,6 +8258,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         uint32_t s;
         if (cand_first[v + 1] == cand_first[v]) continue;
         vp->voxel_keys[i] = cand[v];
+        voxel_cand[i] = v;
         vp->sample_first[i] = cand_first[v];
         for (s = cand_first[v]; s < cand_first[v + 1]; ++s) b->sample_voxel[s] = i;
         ++i;
@@ -8201,17 +8282,26 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         rad__vp_weights(b->o.weights, vp->sample_normals + 3 * (size_t)i, vp->sample_weights + 6 * (size_t)i);
     }
 
-    /* 4. patches: one per voxel and axis with a non-zero area */
+    /* 4. patches: one per voxel and axis with samples; the weights of its samples are scaled
+       so that the patch area is the exact clipped area of the voxel's surface on that axis */
     for (v = 0; v < vp->voxel_count; ++v) {
         vp->voxel_first[v] = N;
         for (a = 0; a < 6; ++a) {
             uint32_t s;
-            int any = 0;
-            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1] && !any; ++s)
-                if (vp->sample_weights[6 * (size_t)s + a] > 0.0f) any = 1;
-            vp->voxel_patch[6 * (size_t)v + a] = any ? N++ : RAD_NONE;
+            double have = 0.0, exact = cand_area[6 * (size_t)voxel_cand[v] + a];
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s)
+                have += (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+            if (have > 0.0 && exact > 0.0) {
+                float scale = (float)(exact / have);
+                for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) vp->sample_weights[6 * (size_t)s + a] *= scale;
+            }
+            vp->voxel_patch[6 * (size_t)v + a] = have > 0.0 ? N++ : RAD_NONE;
         }
     }
+    rad__free(A, cand_area);
+    cand_area = NULL;
+    rad__free(A, voxel_cand);
+    voxel_cand = NULL;
     vp->voxel_first[vp->voxel_count] = N;
     vp->count = N;
     if (!rad__mul3(N, N, sizeof(float), &bytes)) {
@@ -8291,6 +8381,8 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     }
 done:
     rad__free(A, cand);
+    rad__free(A, cand_area);
+    rad__free(A, voxel_cand);
     rad__free(A, cand_first);
     rad__free(A, tri_count);
     rad__free(A, s_pos);

@@ -162,14 +162,15 @@ static void vp_test_reciprocity(void)
         CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
         if (!vp) break;
         vp_check_reciprocity(vp);
-        /* the split weights sum to 1: the patches hold exactly the sample area, which is the area
-           of every triangle some face ray hit */
+        /* the patches hold the exact clipped area of the surface in their voxels (less the
+           rare voxel axis that has area but no sample): at most the scene's area, and nearly
+           all of it, although the samples' own areas S_t / n_t miss every triangle no ray hit */
         for (p = 0; p < vp->sample_count; ++p) sample_area += vp->sample_areas[p];
         for (p = 0; p < vp->count; ++p) patch_area += vp->areas[p];
         for (p = 0; p < scene->triangle_count; ++p) scene_area += scene->areas[p];
-        CHECK_REL(patch_area, sample_area, 1e-5);
+        CHECK(patch_area <= scene_area * (1.0 + 1e-5));
+        CHECK(patch_area >= 0.99 * scene_area);
         CHECK(sample_area <= scene_area * (1.0 + 1e-5));
-        CHECK(sample_area >= 0.95 * scene_area);
         /* at most six patches per voxel, normals along the axes */
         for (v = 0; v < vp->voxel_count; ++v) CHECK(vp->voxel_first[v + 1] - vp->voxel_first[v] <= 6);
         for (p = 0; p < vp->count; ++p) CHECK_NEAR(fabs(vp->normals[3 * p + vp->axis[p] / 2]), 1.0, 0.0);
@@ -184,7 +185,8 @@ static void vp_test_reciprocity(void)
 
 /* A closed unit cube, rho = 0.5, every wall emitting E = pi L = 1: B = E / (1 - rho) = 2, and
    after K Jacobi bounces E sum_{k<=K} rho^k. The point-to-point row sums are a quadrature of
-   the enclosure's row sum 1; measured within 3% (the near-singular kernel along the edges). */
+   the enclosure's row sum 1: their area-weighted mean is within 3% of 1, single patches next
+   to an edge within 8% (the near-singular kernel is sampled at a few points there). */
 static void vp_test_furnace(void)
 {
     static vp_scene s;
@@ -205,8 +207,9 @@ static void vp_test_furnace(void)
     CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
     rad_bvh_raycaster(bvh, &rc);
     rad_vp_options_default(&o);
-    o.resolution = rad_test_quick() ? 3 : 5;
-    o.face_points = rad_test_quick() ? 9 : 16;
+    o.resolution = rad_test_quick() ? 4 : 5;
+    o.face_points = 16;
+    o.skip_visibility = 1; /* convex: V = 1 */
     CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
     if (!vp) goto out;
     N = vp->count;
@@ -233,7 +236,7 @@ static void vp_test_furnace(void)
         if (B[3 * i] > bmax) bmax = B[3 * i];
     }
     CHECK_NEAR(bmean, 2.0, 0.06);
-    CHECK(bmin > 1.8 && bmax < 2.2);
+    CHECK(bmin > 1.7 && bmax < 2.3); /* each patch within 15%: near-edge row sums are off by up to 8% */
     so.bounces = 3;
     CHECK_OK(rad_solve_jacobi(&sys, &so, B, NULL, NULL));
     bmean = 0.0;
@@ -317,9 +320,185 @@ static void vp_test_memory(void)
     rad_scene_destroy(scene);
 }
 
+/* ---- against classic radiosity on an axis-aligned box -------------------------------------- */
+
+/* A closed 1 x 0.8 x 1.2 box (rho 0.6) lit by a point light near a corner, E = rho D. Classic
+   radiosity on 1728 patches (analytic form factors) against AAVP on a 6-voxel grid with 16 face
+   points (214 patches): the indirect light L gathered at the classic patch centroids agrees to
+   a relative RMS error of 5% (measured 4.9%), the total indirect power sum A L to 3% (0.8%).
+   Quick mode: 432 classic patches, 5 voxels: 7% (measured 5.9%). The box is convex, so both
+   sides skip visibility (V = 1 exactly). */
+static void vp_test_classic(void)
+{
+    static vp_scene s;
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options o;
+    rad_virtual_patches *vp = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL;
+    rad_direct_options dopt;
+    rad_light light;
+    rad_system sys;
+    rad_solve_options so;
+    float *Ec = NULL, *Lc = NULL, *Dc = NULL, *Ev = NULL, *Lv = NULL, *pts = NULL, *nrm = NULL, *g = NULL;
+    double num = 0.0, den = 0.0, powc = 0.0, powv = 0.0;
+    uint32_t i, n;
+    int k;
+    vp_box(&s, 1.0f, 0.8f, 1.2f, 6, 0);
+    vp_desc(&s, &desc, 0.6f, 0.0f);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    memset(&light, 0, sizeof(light));
+    light.type = RAD_LIGHT_POINT;
+    light.color[0] = light.color[1] = light.color[2] = 1.0f;
+    light.position[0] = 0.25f; light.position[1] = 0.65f; light.position[2] = 0.3f;
+    rad_direct_options_default(&dopt);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    so.bounces = 40;
+    /* classic */
+    rad_patch_options_default(&po);
+    po.target_count = rad_test_quick() ? 150 : 600;
+    CHECK_OK(rad_patches_create(scene, &po, NULL, &P));
+    rad_form_factor_options_default(&fo);
+    fo.skip_visibility = 1;
+    fo.samples = 4;
+    CHECK_OK(rad_form_factors_dense(P, NULL, &fo, NULL, &ff));
+    if (!P || !ff) goto out;
+    n = P->count;
+    Ec = (float *)malloc(sizeof(float) * 3 * n);
+    Lc = (float *)malloc(sizeof(float) * 3 * n);
+    Dc = (float *)malloc(sizeof(float) * 3 * n);
+    pts = (float *)malloc(sizeof(float) * 3 * n);
+    nrm = (float *)malloc(sizeof(float) * 3 * n);
+    g = (float *)malloc(sizeof(float) * 3 * n);
+    if (!Ec || !Lc || !Dc || !pts || !nrm || !g) goto out;
+    CHECK_OK(rad_direct_patches(P, &rc, &light, 1, &dopt, Dc, NULL));
+    CHECK_OK(rad_sources(P, RAD_SOURCE_DIRECT, Dc, Ec));
+    rad_system_init(&sys, &ff->matrix, P, Ec);
+    CHECK_OK(rad_solve_jacobi(&sys, &so, Lc, NULL, NULL));
+    /* virtual patches */
+    rad_vp_options_default(&o);
+    o.resolution = rad_test_quick() ? 5 : 6;
+    o.face_points = 16;
+    o.skip_visibility = 1;
+    CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+    if (!vp) goto out;
+    Ev = (float *)malloc(sizeof(float) * 3 * vp->count);
+    Lv = (float *)malloc(sizeof(float) * 3 * vp->count);
+    if (!Ev || !Lv) goto out;
+    CHECK_OK(rad_vp_sources(vp, &rc, &light, 1, &dopt, RAD_SOURCE_DIRECT, Ev, NULL));
+    rad_vp_system(&sys, vp, Ev);
+    CHECK_OK(rad_solve_jacobi(&sys, &so, Lv, NULL, NULL));
+    for (i = 0; i < n; ++i)
+        for (k = 0; k < 3; ++k) {
+            pts[3 * i + k] = P->patches[i].centroid[k];
+            nrm[3 * i + k] = P->patches[i].normal[k];
+        }
+    CHECK_OK(rad_vp_gather(vp, Lv, pts, nrm, n, g, NULL));
+    for (i = 0; i < n; ++i) {
+        double d = g[3 * i] - Lc[3 * i];
+        num += P->patches[i].area * d * d;
+        den += P->patches[i].area * (double)Lc[3 * i] * Lc[3 * i];
+        powc += P->patches[i].area * (double)Lc[3 * i];
+    }
+    for (i = 0; i < vp->count; ++i) powv += vp->areas[i] * (double)Lv[3 * i];
+    printf("    classic %u patches, AAVP %u patches (%u samples): relative RMS error of L %.4f, power %.5f vs %.5f\n", n,
+           vp->count, vp->sample_count, sqrt(num / den), powv, powc);
+    CHECK(sqrt(num / den) < (rad_test_quick() ? 0.07 : 0.05));
+    CHECK_REL(powv, powc, 0.03);
+out:
+    free(Ec); free(Lc); free(Dc); free(Ev); free(Lv); free(pts); free(nrm); free(g);
+    rad_form_factors_destroy(ff);
+    rad_patches_destroy(P);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
+/* ---- continuity of the gathered light ------------------------------------------------------ */
+
+/* A floor whose patches carry arbitrary values (a hash of the voxel), gathered along a diagonal
+   line across many voxels in steps of 1/2000 of a voxel: bilinear filtering bounds every step's
+   change by 2 (max - min) step / h; a jump from a voxel switch would be of the order of
+   (max - min). Also, at a voxel centre the filter returns the voxel's own value. */
+static void vp_test_continuity(void)
+{
+    static vp_scene s;
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options o;
+    rad_virtual_patches *vp = NULL;
+    float *vals = NULL, p[3], n[3] = { 0.0f, 1.0f, 0.0f }, prev[3], cur[3];
+    float o0[3] = { 0, 0, 0 }, X[3] = { 4, 0, 0 }, Z[3] = { 0, 0, 4 }, Y[3] = { 0, 1, 0 };
+    double worst = 0.0, h;
+    uint32_t i, steps, used;
+    memset(&s, 0, sizeof(s));
+    vp_add_quad(&s, o0, Z, X, 0, 8);
+    vp_add_quad(&s, o0, Y, Z, 0, 2); /* a wall so that the grid has some height */
+    vp_desc(&s, &desc, 0.5f, 0.0f);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    rad_vp_options_default(&o);
+    o.resolution = 12;
+    o.face_points = 4;
+    o.skip_visibility = 1;
+    CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+    if (!vp) goto out;
+    vals = (float *)malloc(sizeof(float) * 3 * vp->count);
+    if (!vals) goto out;
+    for (i = 0; i < vp->count; ++i) {
+        uint32_t hsh = (vp->voxel[i] + 1u) * 2654435761u;
+        vals[3 * i] = vals[3 * i + 1] = vals[3 * i + 2] = (float)((hsh >> 8) & 1023u) / 1023.0f;
+    }
+    h = vp->voxel_size[0];
+    steps = rad_test_quick() ? 4000 : 20000;
+    p[1] = 0.0f;
+    for (i = 0; i <= steps; ++i) {
+        double t = 0.3 + 3.3 * (double)i / steps; /* from (0.3, 0.4) to (3.6, 3.8) */
+        p[0] = (float)t;
+        p[2] = (float)(0.4 + (t - 0.3) * 3.4 / 3.3);
+        used = rad_vp_gather_point(vp, vals, p, n, cur);
+        CHECK(used > 0);
+        if (i > 0 && fabs(cur[0] - prev[0]) > worst) worst = fabs(cur[0] - prev[0]);
+        memcpy(prev, cur, sizeof(prev));
+    }
+    printf("    largest step change %.5f, bound %.5f (h %.3f)\n", worst, 2.0 * 3.3 * 1.42 / steps / h, h);
+    CHECK(worst <= 2.0 * 3.3 * 1.42 / steps / h);
+    /* at a floor voxel's centre (in x and z; the floor is at the grid's lowest centre plane) */
+    for (i = 0; i < vp->count; ++i)
+        if (vp->axis[i] == RAD_VP_POS_Y) {
+            uint32_t c[3];
+            rad__vp_cell(vp, vp->voxel_keys[vp->voxel[i]], c);
+            p[0] = vp->origin[0] + ((float)c[0] + 0.5f) * vp->voxel_size[0];
+            p[1] = 0.0f;
+            p[2] = vp->origin[2] + ((float)c[2] + 0.5f) * vp->voxel_size[2];
+            if (p[0] < 0.5f || p[2] < 0.5f) continue; /* away from the wall */
+            CHECK(rad_vp_gather_point(vp, vals, p, n, cur) > 0);
+            CHECK_NEAR(cur[0], vals[3 * i], 2e-3);
+            break;
+        }
+out:
+    free(vals);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 static const rad_test_case tests_vp[] = {
     { "vp_reciprocity", vp_test_reciprocity },
     { "vp_furnace", vp_test_furnace },
     { "vp_memory", vp_test_memory },
+    { "vp_classic", vp_test_classic },
+    { "vp_continuity", vp_test_continuity },
     { NULL, NULL }
 };
