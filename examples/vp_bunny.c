@@ -1,0 +1,535 @@
+/* vp_bunny.c - virtual patches (SPEC §6-§7) on real high-polygon meshes: the Stanford bunny
+   (69 451 triangles) in the Cornell box, and with --ogre the bunny and the ogre (193 459
+   triangles together) side by side in it. The meshes come from ../shared/data (or
+   $RAD_DATA_DIR, or --data DIR); when they are missing the program says so and exits 0.
+
+   What it does, timing every stage and tracking the peak bytes allocated through the library
+   (a counting rad_context allocator):
+     1. loads the OBJ files, fits each model on the floor of the built-in Cornell box (the two
+        blocks removed), builds the scene and the BVH;
+     2. builds axis-aligned virtual patches (rad_vp_create: voxels, face rays, exact clipped
+        areas, then the form factors between samples merged per voxel and axis);
+     3. E = rho D from the ceiling light at the samples (rad_vp_sources), K Jacobi bounces,
+        H = F (E + L) per patch;
+     4. renders the image the way an engine would: per pixel, the direct irradiance D at the
+        visible point with shadow rays, the indirect irradiance H gathered from the virtual
+        patches (normal weights, trilinear filter), and radiance rho / pi (D + H) plus the
+        light's own radiance; writes a PFM (linear radiance);
+     5. with --classic N: the same with classic radiosity on about N subdivided triangle
+        patches (analytic form factors with visibility), H interpolated from patch vertices;
+     6. with --write-obj FILE: writes the combined scene (OBJ + MTL) so the reference path
+        tracer can render it: the exact `rad trace` and `rad compare` commands are printed.
+
+   Build:  cc -std=c99 -O2 -fopenmp -I. examples/vp_bunny.c -o build/vp_bunny -lm
+   Run:    build/vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P]
+                          [--bounces K] [--size WxH] [--spp N] [-o OUT.pfm]
+                          [--classic N] [--classic-out OUT.pfm] [--write-obj FILE.obj]  */
+
+#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
+#  define _POSIX_C_SOURCE 199309L /* clock_gettime */
+#endif
+
+#define RADIOSITY_IMPLEMENTATION
+#include "radiosity.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* ---- small helpers ------------------------------------------------------------------------ */
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void *xmalloc(size_t n)
+{
+    void *p = malloc(n ? n : 1);
+    if (!p) { fprintf(stderr, "vp_bunny: out of memory (%lu bytes)\n", (unsigned long)n); exit(1); }
+    return p;
+}
+
+static void check(rad_result r, const char *what)
+{
+    if (r != RAD_SUCCESS) { fprintf(stderr, "vp_bunny: %s: %s\n", what, rad_result_string(r)); exit(1); }
+}
+
+static void on_log(void *user, rad_log_level level, const char *message)
+{
+    (void)user;
+    fprintf(stderr, "  [%s] %s\n", level == RAD_LOG_ERROR ? "error" : level == RAD_LOG_WARNING ? "warning" : "info", message);
+}
+
+/* the counting allocator: live and peak bytes of everything the library allocates */
+typedef struct counter { long long live, peak; } counter;
+
+static void *count_alloc(void *user, size_t size)
+{
+    counter *c = (counter *)user;
+    unsigned char *p = (unsigned char *)malloc(size + 16);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof(size));
+#ifdef _OPENMP
+#pragma omp critical(vp_bunny_count)
+#endif
+    {
+        c->live += (long long)size;
+        if (c->live > c->peak) c->peak = c->live;
+    }
+    return p + 16;
+}
+
+static void count_free(void *user, void *ptr)
+{
+    counter *c = (counter *)user;
+    size_t size;
+    if (!ptr) return;
+    memcpy(&size, (unsigned char *)ptr - 16, sizeof(size));
+#ifdef _OPENMP
+#pragma omp critical(vp_bunny_count)
+#endif
+    {
+        c->live -= (long long)size;
+    }
+    free((unsigned char *)ptr - 16);
+}
+
+/* progress: remembers when rad_vp_create passes 10% (face rays done, form factors start) */
+typedef struct stage_clock { double face_done; } stage_clock;
+
+static int on_progress(void *user, float fraction)
+{
+    stage_clock *s = (stage_clock *)user;
+    if (fraction >= 0.1f && s->face_done == 0.0) s->face_done = now();
+    return 0;
+}
+
+/* ---- OBJ (positions and faces only; polygons as fans) ------------------------------------- */
+
+typedef struct mesh { float *pos; uint32_t nv, cap_v; uint32_t *idx; uint32_t nt, cap_t; } mesh;
+
+static int load_obj(const char *path, mesh *m)
+{
+    FILE *f = fopen(path, "r");
+    char line[4096];
+    memset(m, 0, sizeof(*m));
+    if (!f) return 0;
+    while (fgets(line, sizeof(line), f)) {
+        if (line[0] == 'v' && line[1] == ' ') {
+            float x, y, z;
+            if (sscanf(line + 2, "%f %f %f", &x, &y, &z) != 3) continue;
+            if (m->nv == m->cap_v) {
+                m->cap_v = m->cap_v ? 2 * m->cap_v : 4096;
+                m->pos = (float *)realloc(m->pos, sizeof(float) * 3 * m->cap_v);
+                if (!m->pos) { fclose(f); return 0; }
+            }
+            m->pos[3 * m->nv] = x; m->pos[3 * m->nv + 1] = y; m->pos[3 * m->nv + 2] = z;
+            m->nv++;
+        } else if (line[0] == 'f' && line[1] == ' ') {
+            uint32_t ids[64], n = 0;
+            char *p = line + 2;
+            while (*p && n < 64) {
+                long v;
+                char *end;
+                while (*p == ' ' || *p == '\t') ++p;
+                v = strtol(p, &end, 10);
+                if (end == p) break;
+                ids[n++] = (uint32_t)(v < 0 ? (long)m->nv + v : v - 1);
+                p = end;
+                while (*p && *p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') ++p;
+            }
+            for (; n >= 3; --n) {
+                if (m->nt == m->cap_t) {
+                    m->cap_t = m->cap_t ? 2 * m->cap_t : 8192;
+                    m->idx = (uint32_t *)realloc(m->idx, sizeof(uint32_t) * 3 * m->cap_t);
+                    if (!m->idx) { fclose(f); return 0; }
+                }
+                m->idx[3 * m->nt] = ids[0]; m->idx[3 * m->nt + 1] = ids[n - 2]; m->idx[3 * m->nt + 2] = ids[n - 1];
+                m->nt++;
+                if (n == 3) break;
+            }
+        }
+    }
+    fclose(f);
+    return m->nv > 0 && m->nt > 0;
+}
+
+/* scales the mesh to 'height' and puts its bottom centre at (x, 0, z) */
+static void fit(mesh *m, float height, float x, float z)
+{
+    float lo[3] = { 1e30f, 1e30f, 1e30f }, hi[3] = { -1e30f, -1e30f, -1e30f }, s;
+    uint32_t i;
+    int k;
+    for (i = 0; i < m->nv; ++i)
+        for (k = 0; k < 3; ++k) {
+            if (m->pos[3 * i + k] < lo[k]) lo[k] = m->pos[3 * i + k];
+            if (m->pos[3 * i + k] > hi[k]) hi[k] = m->pos[3 * i + k];
+        }
+    s = height / (hi[1] - lo[1]);
+    for (i = 0; i < m->nv; ++i) {
+        m->pos[3 * i] = (m->pos[3 * i] - 0.5f * (lo[0] + hi[0])) * s + x;
+        m->pos[3 * i + 1] = (m->pos[3 * i + 1] - lo[1]) * s + 0.0005f; /* just above the floor */
+        m->pos[3 * i + 2] = (m->pos[3 * i + 2] - 0.5f * (lo[2] + hi[2])) * s + z;
+    }
+}
+
+/* ---- the combined scene as OBJ + MTL, for `rad trace` --------------------------------------- */
+
+static int write_obj(const char *path, const rad_scene *S)
+{
+    char mtl[1024];
+    const char *base;
+    FILE *f, *g;
+    uint32_t t, m;
+    snprintf(mtl, sizeof(mtl), "%.*s.mtl", (int)(strlen(path) > 4 ? strlen(path) - 4 : strlen(path)), path);
+    base = strrchr(mtl, '/');
+    base = base ? base + 1 : mtl;
+    f = fopen(path, "w");
+    g = fopen(mtl, "w");
+    if (!f || !g) { if (f) fclose(f); if (g) fclose(g); return 0; }
+    for (m = 0; m < S->material_count; ++m) {
+        const rad_material *mt = &S->materials_table[m];
+        fprintf(g, "newmtl m%u\nKd %.6f %.6f %.6f\nKe %.6f %.6f %.6f\n\n", m, mt->albedo[0], mt->albedo[1], mt->albedo[2],
+                mt->emission[0], mt->emission[1], mt->emission[2]);
+    }
+    fprintf(f, "mtllib %s\n", base);
+    for (t = 0; t < S->triangle_count; ++t) {
+        const float *v = S->positions + 9 * (size_t)t;
+        fprintf(f, "v %.7g %.7g %.7g\nv %.7g %.7g %.7g\nv %.7g %.7g %.7g\n", v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]);
+    }
+    for (t = 0, m = RAD_NONE; t < S->triangle_count; ++t) {
+        if (S->materials[t] != m) { m = S->materials[t]; fprintf(f, "usemtl m%u\n", m); }
+        fprintf(f, "f %u %u %u\n", 3 * t + 1, 3 * t + 2, 3 * t + 3);
+    }
+    fclose(g);
+    return fclose(f) == 0;
+}
+
+static int write_pfm(const char *path, const float *rgb, uint32_t w, uint32_t h)
+{
+    FILE *f = fopen(path, "wb");
+    uint32_t y;
+    if (!f) return 0;
+    fprintf(f, "PF\n%u %u\n-1.0\n", w, h);
+    for (y = h; y-- > 0;) fwrite(rgb + (size_t)y * w * 3, sizeof(float), (size_t)w * 3, f);
+    return fclose(f) == 0;
+}
+
+/* ---- rendering ------------------------------------------------------------------------------ */
+
+/* the visible points of every sub-pixel sample: hit flag, triangle, barycentrics, point, normal */
+typedef struct view {
+    uint32_t count, w, h, spp;
+    rad_hit *hits;
+    float *pts, *nrm;
+} view;
+
+static void trace_view(view *v, const rad_scene *S, const rad_raycaster *rc, const rad_camera *cam, uint32_t w, uint32_t h,
+                       uint32_t spp)
+{
+    uint32_t n = w * h * spp, i, side = (uint32_t)floor(sqrt((double)spp) + 0.5);
+    rad_ray *rays = (rad_ray *)xmalloc(sizeof(rad_ray) * n);
+    if (side * side != spp) side = 1;
+    v->count = n; v->w = w; v->h = h; v->spp = spp;
+    v->hits = (rad_hit *)xmalloc(sizeof(rad_hit) * n);
+    v->pts = (float *)xmalloc(sizeof(float) * 3 * n);
+    v->nrm = (float *)xmalloc(sizeof(float) * 3 * n);
+    for (i = 0; i < n; ++i) {
+        uint32_t pix = i / spp, s = i % spp;
+        float jx = side > 1 ? ((float)(s % side) + 0.5f) / (float)side : 0.5f, jy = side > 1 ? ((float)(s / side) + 0.5f) / (float)side : 0.5f;
+        rad_camera_ray(cam, w, h, (float)(pix % w) + jx, (float)(pix / w) + jy, &rays[i]);
+    }
+    check(rc->intersect(rc->user, rays, n, v->hits), "camera rays");
+    for (i = 0; i < n; ++i) {
+        int k;
+        if (v->hits[i].triangle == RAD_NONE) {
+            for (k = 0; k < 3; ++k) { v->pts[3 * i + k] = 0.0f; v->nrm[3 * i + k] = (k == 1) ? 1.0f : 0.0f; }
+            continue;
+        }
+        for (k = 0; k < 3; ++k) {
+            v->pts[3 * i + k] = rays[i].origin[k] + v->hits[i].t * rays[i].dir[k];
+            v->nrm[3 * i + k] = S->normals[3 * (size_t)v->hits[i].triangle + k];
+        }
+        /* a back face is black (one-sided, as the reference tracer): mark it as a miss */
+        if (rays[i].dir[0] * v->nrm[3 * i] + rays[i].dir[1] * v->nrm[3 * i + 1] + rays[i].dir[2] * v->nrm[3 * i + 2] > 0.0f)
+            v->hits[i].triangle = RAD_NONE - 1u;
+    }
+    free(rays);
+}
+
+/* radiance rho / pi (D + H) + emission, averaged over the sub-pixel samples */
+static void shade(const view *v, const rad_scene *S, const float *D, const float *H, float *img)
+{
+    uint32_t i, k;
+    memset(img, 0, sizeof(float) * 3 * v->w * v->h);
+    for (i = 0; i < v->count; ++i) {
+        uint32_t t = v->hits[i].triangle, pix = i / v->spp;
+        float rho[3];
+        if (t >= S->triangle_count) continue;
+        rad_scene_albedo(S, t, v->hits[i].b1, v->hits[i].b2, rho);
+        for (k = 0; k < 3; ++k)
+            img[3 * pix + k] += (rho[k] / 3.14159265f * (D[3 * i + k] + H[3 * i + k]) +
+                                 S->materials_table[S->materials[t]].emission[k]) / (float)v->spp;
+    }
+}
+
+static void usage(void)
+{
+    fprintf(stderr, "usage: vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P] [--bounces K]\n"
+                    "                [--size WxH] [--spp N] [-o OUT.pfm] [--classic N] [--classic-out OUT.pfm]\n"
+                    "                [--write-obj FILE.obj]\n");
+    exit(2);
+}
+
+int main(int argc, char **argv)
+{
+    const char *data = getenv("RAD_DATA_DIR"), *out = "vp_bunny.pfm", *classic_out = "vp_bunny_classic.pfm", *obj_out = NULL;
+    char path[2048];
+    int ogre = 0, a;
+    uint32_t resolution = 32, face_points = 16, bounces = 16, W = 128, Hh = 128, spp = 4, classic = 0, i, k;
+    mesh bunny, ogre_mesh;
+    rad_scene_desc cornell, desc;
+    rad_camera cam;
+    rad_mesh_desc meshes[16];
+    rad_material materials[16];
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_context ctx;
+    counter cnt;
+    stage_clock sc;
+    rad_vp_options vo;
+    rad_virtual_patches *vp = NULL;
+    rad_direct_options dopt;
+    rad_solve_options so;
+    rad_system sys;
+    view v;
+    float *E, *L, *EL, *Hp, *D, *Hpix, *img;
+    double t0, t1, t_scene, t_bvh, t_vp_face, t_vp_ff, t_E, t_solve, t_direct, t_gather;
+    long long peak_vp;
+    uint32_t total_tris = 0;
+
+    if (!data) data = "../shared/data";
+    for (a = 1; a < argc; ++a) {
+        const char *s = argv[a];
+        if (!strcmp(s, "--data") && a + 1 < argc) data = argv[++a];
+        else if (!strcmp(s, "--ogre")) ogre = 1;
+        else if (!strcmp(s, "--resolution") && a + 1 < argc) resolution = (uint32_t)strtoul(argv[++a], NULL, 10);
+        else if (!strcmp(s, "--face-points") && a + 1 < argc) face_points = (uint32_t)strtoul(argv[++a], NULL, 10);
+        else if (!strcmp(s, "--bounces") && a + 1 < argc) bounces = (uint32_t)strtoul(argv[++a], NULL, 10);
+        else if (!strcmp(s, "--spp") && a + 1 < argc) spp = (uint32_t)strtoul(argv[++a], NULL, 10);
+        else if (!strcmp(s, "--size") && a + 1 < argc) { if (sscanf(argv[++a], "%ux%u", &W, &Hh) != 2) usage(); }
+        else if (!strcmp(s, "-o") && a + 1 < argc) out = argv[++a];
+        else if (!strcmp(s, "--classic") && a + 1 < argc) classic = (uint32_t)strtoul(argv[++a], NULL, 10);
+        else if (!strcmp(s, "--classic-out") && a + 1 < argc) classic_out = argv[++a];
+        else if (!strcmp(s, "--write-obj") && a + 1 < argc) obj_out = argv[++a];
+        else usage();
+    }
+    if (W == 0 || Hh == 0 || spp == 0 || resolution == 0) usage();
+
+    /* 1. meshes and scene */
+    t0 = now();
+    snprintf(path, sizeof(path), "%s/stanford-bunny.obj", data);
+    if (!load_obj(path, &bunny)) {
+        printf("vp_bunny: skipped: %s not found or unreadable (set RAD_DATA_DIR or --data to the shared data folder)\n", path);
+        return 0;
+    }
+    if (ogre) {
+        snprintf(path, sizeof(path), "%s/ogre.obj", data);
+        if (!load_obj(path, &ogre_mesh)) {
+            printf("vp_bunny: skipped: %s not found or unreadable (set RAD_DATA_DIR or --data)\n", path);
+            return 0;
+        }
+        fit(&bunny, 0.22f, 0.16f, 0.30f);
+        fit(&ogre_mesh, 0.30f, 0.40f, 0.30f);
+    } else {
+        fit(&bunny, 0.30f, 0.28f, 0.28f);
+    }
+    rad_cornell_box(&cornell, &cam);
+    memset(&desc, 0, sizeof(desc));
+    for (i = 0; i < cornell.mesh_count; ++i) {
+        if (cornell.meshes[i].name && strstr(cornell.meshes[i].name, "block")) continue; /* room for the models */
+        meshes[desc.mesh_count++] = cornell.meshes[i];
+        total_tris += cornell.meshes[i].triangle_count;
+    }
+    memcpy(materials, cornell.materials, sizeof(rad_material) * cornell.material_count);
+    memset(&materials[cornell.material_count], 0, sizeof(rad_material));
+    for (k = 0; k < 3; ++k) materials[cornell.material_count].albedo[k] = 0.7f;
+    memset(&meshes[desc.mesh_count], 0, sizeof(rad_mesh_desc));
+    meshes[desc.mesh_count].name = "bunny";
+    meshes[desc.mesh_count].positions = bunny.pos;
+    meshes[desc.mesh_count].vertex_count = bunny.nv;
+    meshes[desc.mesh_count].indices = bunny.idx;
+    meshes[desc.mesh_count].triangle_count = bunny.nt;
+    meshes[desc.mesh_count].material = cornell.material_count;
+    total_tris += bunny.nt;
+    desc.mesh_count++;
+    if (ogre) {
+        meshes[desc.mesh_count] = meshes[desc.mesh_count - 1];
+        meshes[desc.mesh_count].name = "ogre";
+        meshes[desc.mesh_count].positions = ogre_mesh.pos;
+        meshes[desc.mesh_count].vertex_count = ogre_mesh.nv;
+        meshes[desc.mesh_count].indices = ogre_mesh.idx;
+        meshes[desc.mesh_count].triangle_count = ogre_mesh.nt;
+        total_tris += ogre_mesh.nt;
+        desc.mesh_count++;
+    }
+    desc.meshes = meshes;
+    desc.materials = materials;
+    desc.material_count = cornell.material_count + 1;
+    desc.flags = RAD_SCENE_SKIP_DEGENERATE;
+
+    memset(&ctx, 0, sizeof(ctx));
+    memset(&cnt, 0, sizeof(cnt));
+    ctx.allocator.alloc = count_alloc;
+    ctx.allocator.free = count_free;
+    ctx.allocator.user = &cnt;
+    ctx.log = on_log;
+    check(rad_scene_create(&desc, &ctx, &scene), "scene");
+    t1 = now();
+    t_scene = t1 - t0;
+    printf("scene: %u triangles (%u degenerate skipped), load + validate %.2f s\n", scene->triangle_count,
+           scene->skipped_triangles, t_scene);
+    if (obj_out) {
+        if (!write_obj(obj_out, scene)) { fprintf(stderr, "vp_bunny: cannot write %s\n", obj_out); return 1; }
+        printf("wrote %s; reference: rad trace %s --camera %g,%g,%g:%g,%g,%g:%g,%g,%g --fov %g --size %ux%u --spp 256 -o ref.pfm\n",
+               obj_out, obj_out, cam.position[0], cam.position[1], cam.position[2], cam.target[0], cam.target[1],
+               cam.target[2], cam.up[0], cam.up[1], cam.up[2], cam.fov_y_degrees, W, Hh);
+    }
+    t0 = now();
+    check(rad_bvh_create(scene, &ctx, &bvh), "BVH");
+    rad_bvh_raycaster(bvh, &rc);
+    t_bvh = now() - t0;
+    printf("BVH: %.2f s, %.1f MiB\n", t_bvh, (double)rad_bvh_memory(bvh) / 1048576.0);
+
+    /* 2. virtual patches */
+    rad_vp_options_default(&vo);
+    vo.resolution = resolution;
+    vo.face_points = face_points;
+    memset(&sc, 0, sizeof(sc));
+    ctx.progress = on_progress;
+    ctx.progress_user = &sc;
+    cnt.peak = cnt.live;
+    t0 = now();
+    check(rad_vp_create(scene, &rc, &vo, &ctx, &vp), "virtual patches");
+    t1 = now();
+    ctx.progress = NULL;
+    peak_vp = cnt.peak;
+    t_vp_face = (sc.face_done > 0.0 ? sc.face_done : t1) - t0;
+    t_vp_ff = t1 - t0 - t_vp_face;
+    printf("virtual patches: grid %ux%ux%u (voxel %.4f), %u candidate and %u non-empty voxels, %llu face rays\n",
+           vp->dims[0], vp->dims[1], vp->dims[2], vp->voxel_size[0], vp->candidate_voxels, vp->voxel_count,
+           (unsigned long long)vp->face_rays);
+    printf("  %u samples, %u patches; voxelize + face rays %.2f s, form factors %.2f s (%llu shadow rays)\n",
+           vp->sample_count, vp->count, t_vp_face, t_vp_ff, (unsigned long long)vp->pair_rays);
+    printf("  peak memory during the build %.1f MiB (scene + BVH + build), held after %.1f MiB\n",
+           (double)peak_vp / 1048576.0, (double)rad_vp_memory(vp) / 1048576.0);
+
+    /* 3. E, bounces, H per patch */
+    rad_direct_options_default(&dopt);
+    E = (float *)xmalloc(sizeof(float) * 3 * vp->count);
+    L = (float *)xmalloc(sizeof(float) * 3 * vp->count);
+    EL = (float *)xmalloc(sizeof(float) * 3 * vp->count);
+    Hp = (float *)xmalloc(sizeof(float) * 3 * vp->count);
+    t0 = now();
+    check(rad_vp_sources(vp, &rc, NULL, 0, &dopt, RAD_SOURCE_DIRECT, E, &ctx), "sources");
+    t_E = now() - t0;
+    t0 = now();
+    rad_vp_system(&sys, vp, E);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    so.bounces = bounces;
+    check(rad_solve_jacobi(&sys, &so, L, NULL, &ctx), "Jacobi");
+    for (i = 0; i < 3 * vp->count; ++i) EL[i] = E[i] + L[i];
+    check(rad_matrix_multiply(&vp->matrix, EL, Hp, &ctx), "H = F (E + L)");
+    t_solve = now() - t0;
+    printf("  E at the samples %.2f s; %u Jacobi bounces + H %.2f s\n", t_E, bounces, t_solve);
+
+    /* 4. the image */
+    trace_view(&v, scene, &rc, &cam, W, Hh, spp);
+    D = (float *)xmalloc(sizeof(float) * 3 * v.count);
+    Hpix = (float *)xmalloc(sizeof(float) * 3 * v.count);
+    img = (float *)xmalloc(sizeof(float) * 3 * W * Hh);
+    t0 = now();
+    check(rad_direct_irradiance(scene, &rc, NULL, 0, &dopt, v.pts, v.nrm, v.count, D, &ctx), "direct light per pixel");
+    t_direct = now() - t0;
+    t0 = now();
+    check(rad_vp_gather(vp, Hp, v.pts, v.nrm, v.count, Hpix, &ctx), "gather");
+    t_gather = now() - t0;
+    shade(&v, scene, D, Hpix, img);
+    if (!write_pfm(out, img, W, Hh)) { fprintf(stderr, "vp_bunny: cannot write %s\n", out); return 1; }
+    printf("  image %ux%u, %u spp: direct light %.2f s, gathering %.3f s (%.0f ns per point) -> %s\n", W, Hh, spp, t_direct,
+           t_gather, 1e9 * t_gather / v.count, out);
+
+    /* 5. classic radiosity with about the same number of patches */
+    if (classic) {
+        rad_patches *P = NULL;
+        rad_patch_options po;
+        rad_form_factor_options fo;
+        rad_form_factors *ff = NULL;
+        float *Ec, *Lc, *ELc, *Hc, *Dc, *Hv, *Hpc;
+        uint32_t n;
+        rad_patch_options_default(&po);
+        po.target_count = classic;
+        cnt.peak = cnt.live;
+        t0 = now();
+        check(rad_patches_create(scene, &po, &ctx, &P), "patches");
+        n = P->count;
+        rad_form_factor_options_default(&fo);
+        fo.samples = 4;
+        check(rad_form_factors_dense(P, &rc, &fo, &ctx, &ff), "form factors");
+        t1 = now();
+        printf("classic: %u patches (target %u), patches + form factors %.2f s, peak %.1f MiB\n", n, classic, t1 - t0,
+               (double)cnt.peak / 1048576.0);
+        Ec = (float *)xmalloc(sizeof(float) * 3 * n);
+        Lc = (float *)xmalloc(sizeof(float) * 3 * n);
+        ELc = (float *)xmalloc(sizeof(float) * 3 * n);
+        Hc = (float *)xmalloc(sizeof(float) * 3 * n);
+        Dc = (float *)xmalloc(sizeof(float) * 3 * n);
+        Hv = (float *)xmalloc(sizeof(float) * 3 * P->vertex_count);
+        Hpc = (float *)xmalloc(sizeof(float) * 3 * v.count);
+        t0 = now();
+        check(rad_direct_patches(P, &rc, NULL, 0, &dopt, Dc, &ctx), "classic direct");
+        check(rad_sources(P, RAD_SOURCE_DIRECT, Dc, Ec), "classic sources");
+        rad_system_init(&sys, &ff->matrix, P, Ec);
+        check(rad_solve_jacobi(&sys, &so, Lc, NULL, &ctx), "classic Jacobi");
+        for (i = 0; i < 3 * n; ++i) ELc[i] = Ec[i] + Lc[i];
+        check(rad_matrix_multiply(&ff->matrix, ELc, Hc, &ctx), "classic H");
+        check(rad_patches_vertex_values(P, Hc, 3, Hv), "vertex values");
+        printf("  E + bounces + H %.2f s\n", now() - t0);
+        for (i = 0; i < v.count; ++i) {
+            float w[3];
+            uint32_t p, t = v.hits[i].triangle;
+            for (k = 0; k < 3; ++k) Hpc[3 * i + k] = 0.0f;
+            if (t >= scene->triangle_count) continue;
+            p = rad_patches_locate(P, t, v.hits[i].b1, v.hits[i].b2, w);
+            if (p == RAD_NONE) continue;
+            for (k = 0; k < 3; ++k)
+                Hpc[3 * i + k] = w[0] * Hv[3 * P->patches[p].vertices[0] + k] + w[1] * Hv[3 * P->patches[p].vertices[1] + k] +
+                                 w[2] * Hv[3 * P->patches[p].vertices[2] + k];
+        }
+        shade(&v, scene, D, Hpc, img);
+        if (!write_pfm(classic_out, img, W, Hh)) { fprintf(stderr, "vp_bunny: cannot write %s\n", classic_out); return 1; }
+        printf("  image -> %s\n", classic_out);
+        free(Ec); free(Lc); free(ELc); free(Hc); free(Dc); free(Hv); free(Hpc);
+        rad_form_factors_destroy(ff);
+        rad_patches_destroy(P);
+    }
+    if (obj_out) printf("compare: rad compare %s ref.pfm%s%s\n", out, classic ? "; rad compare " : "", classic ? classic_out : "");
+    printf("scene triangles %u -> %u virtual patches; overall peak through the allocator %.1f MiB\n", total_tris, vp->count,
+           (double)cnt.peak / 1048576.0);
+
+    free(E); free(L); free(EL); free(Hp); free(D); free(Hpix); free(img);
+    free(v.hits); free(v.pts); free(v.nrm);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+    free(bunny.pos); free(bunny.idx);
+    if (ogre) { free(ogre_mesh.pos); free(ogre_mesh.idx); }
+    return 0;
+}
