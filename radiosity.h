@@ -8043,6 +8043,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
             const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
             const float *wi = vp->sample_weights + 6 * (size_t)i;
             float si = vp->sample_areas[i];
+            double t6[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; /* sum_j g_ij w_jc */
             for (j = (v == u ? i + 1 : vp->sample_first[v]); j < vp->sample_first[v + 1]; ++j) {
                 const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
                 const float *wj = vp->sample_weights + 6 * (size_t)j;
@@ -8057,11 +8058,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
                 fl = (si > sj ? si : sj) / (float)RAD__PI;
                 g = si * sj * (ci / d2) * (cj / (d2 > fl ? d2 : fl)) / (float)RAD__PI;
                 if (!(g > 0.0f)) continue;
-                for (a = 0; a < 6; ++a) {
-                    if (!(wi[a] > 0.0f)) continue;
-                    for (c = 0; c < 6; ++c)
-                        if (wj[c] > 0.0f) p0[6 * a + c] += (double)g * (double)wi[a] * (double)wj[c];
-                }
+                for (c = 0; c < 6; ++c) t6[c] += (double)g * (double)wj[c];
                 if (b->o.skip_visibility) continue;
                 /* the pair list, thinned systematically when full */
                 if (seen++ % stride != 0) continue;
@@ -8077,6 +8074,9 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
                 list[n].g = g;
                 ++n;
             }
+            for (a = 0; a < 6; ++a)
+                if (wi[a] > 0.0f)
+                    for (j = 0; j < 6; ++j) p0[6 * a + j] += (double)wi[a] * t6[j];
         }
         if (b->o.skip_visibility || n == 0) {
             if (n == 0 && !b->o.skip_visibility) continue; /* nothing faces each other */
