@@ -15,15 +15,18 @@
         visible point with shadow rays, the indirect irradiance H gathered from the virtual
         patches (normal weights, trilinear filter), and radiance rho / pi (D + H) plus the
         light's own radiance; writes a PFM (linear radiance);
-     5. with --classic N: the same with classic radiosity on about N subdivided triangle
-        patches (analytic form factors with visibility), H interpolated from patch vertices;
+     5. with --classic N: the same with classic radiosity (at least one patch per triangle) on
+        a copy whose models are decimated by vertex clustering (--classic-cell, metres), cut
+        into about N patches (analytic form factors with visibility, 4 samples), rendered on
+        that copy with H interpolated from the patch vertices;
      6. with --write-obj FILE: writes the combined scene (OBJ + MTL) so the reference path
         tracer can render it: the exact `rad trace` and `rad compare` commands are printed.
 
    Build:  cc -std=c99 -O2 -fopenmp -I. examples/vp_bunny.c -o build/vp_bunny -lm
    Run:    build/vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P]
                           [--bounces K] [--size WxH] [--spp N] [-o OUT.pfm]
-                          [--classic N] [--classic-out OUT.pfm] [--write-obj FILE.obj]  */
+                          [--classic N] [--classic-cell C] [--classic-out OUT.pfm]
+                          [--write-obj FILE.obj]                                            */
 
 #if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
 #  define _POSIX_C_SOURCE 199309L /* clock_gettime */
@@ -178,6 +181,59 @@ static void fit(mesh *m, float height, float x, float z)
     }
 }
 
+/* Vertex clustering: every vertex moves to the mean of the vertices in its cell of side
+   'cell'; triangles that collapse are dropped. Classic radiosity needs at least one patch per
+   triangle, so it runs on this decimated copy. */
+typedef struct cell_key { uint64_t key; uint32_t vertex; } cell_key;
+
+static int cmp_cell(const void *a, const void *b)
+{
+    const cell_key *x = (const cell_key *)a, *y = (const cell_key *)b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return x->vertex < y->vertex ? -1 : (x->vertex > y->vertex ? 1 : 0);
+}
+
+static void decimate(const mesh *in, float cell, mesh *out)
+{
+    cell_key *keys = (cell_key *)xmalloc(sizeof(cell_key) * in->nv);
+    uint32_t *remap = (uint32_t *)xmalloc(sizeof(uint32_t) * in->nv), i, t, n = 0;
+    memset(out, 0, sizeof(*out));
+    out->pos = (float *)xmalloc(sizeof(float) * 3 * in->nv);
+    out->idx = (uint32_t *)xmalloc(sizeof(uint32_t) * 3 * in->nt);
+    for (i = 0; i < in->nv; ++i) {
+        uint64_t k = 0;
+        int c;
+        for (c = 0; c < 3; ++c) k = k * 2097152u + (uint64_t)(int64_t)(floor(in->pos[3 * i + c] / cell) + 1048576.0);
+        keys[i].key = k;
+        keys[i].vertex = i;
+    }
+    qsort(keys, in->nv, sizeof(cell_key), cmp_cell);
+    for (i = 0; i < in->nv;) {
+        uint32_t j = i;
+        double m[3] = { 0, 0, 0 };
+        while (j < in->nv && keys[j].key == keys[i].key) {
+            int c;
+            for (c = 0; c < 3; ++c) m[c] += in->pos[3 * keys[j].vertex + c];
+            remap[keys[j].vertex] = n;
+            ++j;
+        }
+        out->pos[3 * n] = (float)(m[0] / (j - i));
+        out->pos[3 * n + 1] = (float)(m[1] / (j - i));
+        out->pos[3 * n + 2] = (float)(m[2] / (j - i));
+        ++n;
+        i = j;
+    }
+    out->nv = n;
+    for (t = 0; t < in->nt; ++t) {
+        uint32_t a = remap[in->idx[3 * t]], b = remap[in->idx[3 * t + 1]], c = remap[in->idx[3 * t + 2]];
+        if (a == b || b == c || a == c) continue;
+        out->idx[3 * out->nt] = a; out->idx[3 * out->nt + 1] = b; out->idx[3 * out->nt + 2] = c;
+        out->nt++;
+    }
+    free(keys);
+    free(remap);
+}
+
 /* ---- the combined scene as OBJ + MTL, for `rad trace` --------------------------------------- */
 
 static int write_obj(const char *path, const rad_scene *S)
@@ -281,7 +337,8 @@ static void shade(const view *v, const rad_scene *S, const float *D, const float
 static void usage(void)
 {
     fprintf(stderr, "usage: vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P] [--bounces K]\n"
-                    "                [--size WxH] [--spp N] [-o OUT.pfm] [--classic N] [--classic-out OUT.pfm]\n"
+                    "                [--size WxH] [--spp N] [-o OUT.pfm] [--classic N] [--classic-cell C]\n"
+                    "                [--classic-out OUT.pfm]\n"
                     "                [--write-obj FILE.obj]\n");
     exit(2);
 }
@@ -292,6 +349,7 @@ int main(int argc, char **argv)
     char path[2048];
     int ogre = 0, a;
     uint32_t resolution = 32, face_points = 16, bounces = 16, W = 128, Hh = 128, spp = 4, classic = 0, i, k;
+    float classic_cell = 0.012f;
     mesh bunny, ogre_mesh;
     rad_scene_desc cornell, desc;
     rad_camera cam;
@@ -328,6 +386,7 @@ int main(int argc, char **argv)
         else if (!strcmp(s, "-o") && a + 1 < argc) out = argv[++a];
         else if (!strcmp(s, "--classic") && a + 1 < argc) classic = (uint32_t)strtoul(argv[++a], NULL, 10);
         else if (!strcmp(s, "--classic-out") && a + 1 < argc) classic_out = argv[++a];
+        else if (!strcmp(s, "--classic-cell") && a + 1 < argc) classic_cell = (float)atof(argv[++a]);
         else if (!strcmp(s, "--write-obj") && a + 1 < argc) obj_out = argv[++a];
         else usage();
     }
@@ -473,17 +532,45 @@ int main(int argc, char **argv)
         rad_patch_options po;
         rad_form_factor_options fo;
         rad_form_factors *ff = NULL;
-        float *Ec, *Lc, *ELc, *Hc, *Dc, *Hv, *Hpc;
-        uint32_t n;
+        rad_scene *cs = NULL;
+        rad_bvh *cbvh = NULL;
+        rad_raycaster crc;
+        rad_mesh_desc cmeshes[16];
+        rad_scene_desc cdesc = desc;
+        mesh dec[2];
+        view cv;
+        float *Ec, *Lc, *ELc, *Hc, *Dc, *Hv, *Hpc, *Dpix;
+        uint32_t n, m, nd = 0;
+        memcpy(cmeshes, meshes, sizeof(rad_mesh_desc) * desc.mesh_count);
+        for (m = 0; m < desc.mesh_count; ++m) {
+            mesh src;
+            if (strcmp(cmeshes[m].name, "bunny") && strcmp(cmeshes[m].name, "ogre")) continue;
+            src.pos = (float *)cmeshes[m].positions;
+            src.nv = cmeshes[m].vertex_count;
+            src.idx = (uint32_t *)cmeshes[m].indices;
+            src.nt = cmeshes[m].triangle_count;
+            decimate(&src, classic_cell, &dec[nd]);
+            cmeshes[m].positions = dec[nd].pos;
+            cmeshes[m].vertex_count = dec[nd].nv;
+            cmeshes[m].indices = dec[nd].idx;
+            cmeshes[m].triangle_count = dec[nd].nt;
+            printf("classic: '%s' decimated to %u triangles (vertex clustering, cell %.4f)\n", cmeshes[m].name, dec[nd].nt,
+                   classic_cell);
+            ++nd;
+        }
+        cdesc.meshes = cmeshes;
+        check(rad_scene_create(&cdesc, &ctx, &cs), "classic scene");
+        check(rad_bvh_create(cs, &ctx, &cbvh), "classic BVH");
+        rad_bvh_raycaster(cbvh, &crc);
         rad_patch_options_default(&po);
         po.target_count = classic;
         cnt.peak = cnt.live;
         t0 = now();
-        check(rad_patches_create(scene, &po, &ctx, &P), "patches");
+        check(rad_patches_create(cs, &po, &ctx, &P), "patches");
         n = P->count;
         rad_form_factor_options_default(&fo);
         fo.samples = 4;
-        check(rad_form_factors_dense(P, &rc, &fo, &ctx, &ff), "form factors");
+        check(rad_form_factors_dense(P, &crc, &fo, &ctx, &ff), "form factors");
         t1 = now();
         peak_classic = cnt.peak;
         printf("classic: %u patches (target %u), patches + form factors %.2f s, peak %.1f MiB\n", n, classic, t1 - t0,
@@ -494,9 +581,11 @@ int main(int argc, char **argv)
         Hc = (float *)xmalloc(sizeof(float) * 3 * n);
         Dc = (float *)xmalloc(sizeof(float) * 3 * n);
         Hv = (float *)xmalloc(sizeof(float) * 3 * P->vertex_count);
-        Hpc = (float *)xmalloc(sizeof(float) * 3 * v.count);
+        trace_view(&cv, cs, &crc, &cam, W, Hh, spp);
+        Hpc = (float *)xmalloc(sizeof(float) * 3 * cv.count);
+        Dpix = (float *)xmalloc(sizeof(float) * 3 * cv.count);
         t0 = now();
-        check(rad_direct_patches(P, &rc, NULL, 0, &dopt, Dc, &ctx), "classic direct");
+        check(rad_direct_patches(P, &crc, NULL, 0, &dopt, Dc, &ctx), "classic direct");
         check(rad_sources(P, RAD_SOURCE_DIRECT, Dc, Ec), "classic sources");
         rad_system_init(&sys, &ff->matrix, P, Ec);
         check(rad_solve_jacobi(&sys, &so, Lc, NULL, &ctx), "classic Jacobi");
@@ -504,23 +593,28 @@ int main(int argc, char **argv)
         check(rad_matrix_multiply(&ff->matrix, ELc, Hc, &ctx), "classic H");
         check(rad_patches_vertex_values(P, Hc, 3, Hv), "vertex values");
         printf("  E + bounces + H %.2f s\n", now() - t0);
-        for (i = 0; i < v.count; ++i) {
+        check(rad_direct_irradiance(cs, &crc, NULL, 0, &dopt, cv.pts, cv.nrm, cv.count, Dpix, &ctx), "classic direct per pixel");
+        for (i = 0; i < cv.count; ++i) {
             float w[3];
-            uint32_t p, t = v.hits[i].triangle;
+            uint32_t p, t = cv.hits[i].triangle;
             for (k = 0; k < 3; ++k) Hpc[3 * i + k] = 0.0f;
-            if (t >= scene->triangle_count) continue;
-            p = rad_patches_locate(P, t, v.hits[i].b1, v.hits[i].b2, w);
+            if (t >= cs->triangle_count) continue;
+            p = rad_patches_locate(P, t, cv.hits[i].b1, cv.hits[i].b2, w);
             if (p == RAD_NONE) continue;
             for (k = 0; k < 3; ++k)
                 Hpc[3 * i + k] = w[0] * Hv[3 * P->patches[p].vertices[0] + k] + w[1] * Hv[3 * P->patches[p].vertices[1] + k] +
                                  w[2] * Hv[3 * P->patches[p].vertices[2] + k];
         }
-        shade(&v, scene, D, Hpc, img);
+        shade(&cv, cs, Dpix, Hpc, img);
         if (!write_pfm(classic_out, img, W, Hh)) { fprintf(stderr, "vp_bunny: cannot write %s\n", classic_out); return 1; }
         printf("  image -> %s\n", classic_out);
-        free(Ec); free(Lc); free(ELc); free(Hc); free(Dc); free(Hv); free(Hpc);
+        free(Ec); free(Lc); free(ELc); free(Hc); free(Dc); free(Hv); free(Hpc); free(Dpix);
+        free(cv.hits); free(cv.pts); free(cv.nrm);
+        for (m = 0; m < nd; ++m) { free(dec[m].pos); free(dec[m].idx); }
         rad_form_factors_destroy(ff);
         rad_patches_destroy(P);
+        rad_bvh_destroy(cbvh);
+        rad_scene_destroy(cs);
     }
     if (obj_out) printf("compare: rad compare %s ref.pfm%s%s\n", out, classic ? "; rad compare " : "", classic ? classic_out : "");
     printf("scene triangles %u -> %u virtual patches; peak through the allocator: virtual patches %.1f MiB%s",

@@ -545,6 +545,86 @@ static void vp_test_sampled_visibility(void)
     rad_scene_destroy(scene);
 }
 
+/* ---- argument checks ----------------------------------------------------------------------- */
+
+static void vp_test_arguments(void)
+{
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc, bad;
+    rad_vp_options o;
+    rad_virtual_patches *vp = (rad_virtual_patches *)&o; /* must be set to NULL on failure */
+    float E[3], out[3], p[3] = { 0.2f, 0.0f, 0.2f }, n[3] = { 0.0f, 1.0f, 0.0f }, nan_p[3];
+    rad_system sys;
+    rad_cornell_box(&desc, NULL);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    rad_vp_options_default(&o);
+    CHECK_RESULT(rad_vp_create(NULL, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(vp == NULL);
+    CHECK_RESULT(rad_vp_create(scene, NULL, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    bad = rc;
+    bad.intersect = NULL;
+    CHECK_RESULT(rad_vp_create(scene, &bad, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    bad = rc;
+    bad.occluded = NULL;
+    CHECK_RESULT(rad_vp_create(scene, &bad, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    o.voxel_size[0] = -1.0f; o.voxel_size[1] = o.voxel_size[2] = 0.1f;
+    CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    o.voxel_size[0] = 0.1f; o.voxel_size[1] = 0.0f;
+    CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    o.voxel_size[1] = (float)HUGE_VAL;
+    CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    o.voxel_size[0] = o.voxel_size[1] = o.voxel_size[2] = 1e-7f; /* far too many voxels */
+    CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_SIZE_OVERFLOW);
+    rad_vp_options_default(&o);
+    o.visibility_rays = 5000;
+    CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    rad_vp_options_default(&o);
+    o.weights = (rad_vp_weights)7;
+    CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    /* per-axis voxel sizes work, and the gathering rejects bad points */
+    rad_vp_options_default(&o);
+    o.voxel_size[0] = 0.2f; o.voxel_size[1] = 0.15f; o.voxel_size[2] = 0.25f;
+    o.face_points = 4;
+    CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+    if (vp) {
+        CHECK_NEAR(vp->voxel_size[1], 0.15, 1e-7);
+        CHECK(vp->dims[1] == (uint32_t)floor((scene->bounds_max[1] - scene->bounds_min[1] + 0.9654 * 0.15) / 0.15) + 1);
+        CHECK_RESULT(rad_vp_from_samples(vp, NULL, E), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_vp_sources(vp, &rc, NULL, 0, NULL, (rad_source_mode)9, E, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        nan_p[0] = (float)(HUGE_VAL - HUGE_VAL); nan_p[1] = nan_p[2] = 0.0f;
+        CHECK(rad_vp_gather_point(vp, vp->albedo, nan_p, n, out) == 0 && out[0] == 0.0f);
+        CHECK_RESULT(rad_vp_gather(vp, vp->albedo, nan_p, n, 1, out, NULL), RAD_ERROR_NON_FINITE);
+        CHECK(rad_vp_gather_point(vp, vp->albedo, p, n, out) > 0);
+        CHECK(out[0] > 0.0f && out[0] < 1.0f); /* an albedo, gathered */
+        rad_vp_system(&sys, vp, E);
+        CHECK(sys.n == vp->count && sys.F == &vp->matrix && sys.areas == vp->areas);
+        /* per-vertex values of the floor mesh (normals from its triangles: +y) equal point gathers */
+        {
+            const rad_mesh_desc *floor_mesh = &desc.meshes[0];
+            float *vv = (float *)malloc(sizeof(float) * 3 * floor_mesh->vertex_count);
+            uint32_t i;
+            if (vv) {
+                CHECK_OK(rad_vp_gather_mesh(vp, vp->albedo, floor_mesh, vv, NULL));
+                for (i = 0; i < floor_mesh->vertex_count; ++i) {
+                    const float *q = (const float *)((const char *)floor_mesh->positions +
+                                                     i * (floor_mesh->position_stride ? floor_mesh->position_stride : 12));
+                    CHECK(rad_vp_gather_point(vp, vp->albedo, q, n, out) > 0);
+                    CHECK_NEAR(vv[3 * i], out[0], 1e-6);
+                }
+                free(vv);
+            }
+        }
+        rad_vp_destroy(vp);
+    }
+    rad_vp_destroy(NULL);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 static const rad_test_case tests_vp[] = {
     { "vp_reciprocity", vp_test_reciprocity },
     { "vp_furnace", vp_test_furnace },
@@ -552,5 +632,6 @@ static const rad_test_case tests_vp[] = {
     { "vp_sampled_visibility", vp_test_sampled_visibility },
     { "vp_classic", vp_test_classic },
     { "vp_continuity", vp_test_continuity },
+    { "vp_arguments", vp_test_arguments },
     { NULL, NULL }
 };
