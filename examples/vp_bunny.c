@@ -487,6 +487,19 @@ int main(int argc, char **argv)
            (unsigned long long)vp->face_rays);
     printf("  %u samples, %u patches; voxelize + face rays %.2f s, form factors %.2f s (%llu shadow rays)\n",
            vp->sample_count, vp->count, t_vp_face, t_vp_ff, (unsigned long long)vp->pair_rays);
+    {
+        double mean = 0.0, area = 0.0, mx = 0.0;
+        uint32_t r, c, worst = 0;
+        for (r = 0; r < vp->count; ++r) {
+            double sum = 0.0;
+            for (c = 0; c < vp->count; ++c) sum += vp->matrix.dense[(size_t)r * vp->count + c];
+            mean += vp->areas[r] * sum;
+            area += vp->areas[r];
+            if (sum > mx) { mx = sum; worst = r; }
+        }
+        printf("  row sums: area-weighted mean %.4f, largest %.4f (patch %u, area %.3g)\n", mean / area, mx, worst,
+               vp->areas[worst]);
+    }
     printf("  peak memory during the build %.1f MiB (scene + BVH + build), held after %.1f MiB\n",
            (double)peak_vp / 1048576.0, (double)rad_vp_memory(vp) / 1048576.0);
 

