@@ -1329,6 +1329,19 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    row-major rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
    brings any per-patch value (B, L, the irradiance H = F (E + L)) back to surface points with
    normal weights and trilinear filtering that skips voxels without a patch facing the normal.
+   GENERAL VIRTUAL PATCHES (kind RAD_VP_CLUSTERED, SPEC §6 step 7). Per voxel every sample
+   starts as a cluster (area e_i = s_i times the voxel's area correction: exact clipped area /
+   sum of s_i; colour, normal, form-factor row and column); the pair with the smallest
+       M(a,b) = (1 + |c_a - c_b|) (2 - n_a . n_b) (1 + sqrt(sum_k (F_ak - F_bk)^2 + (F_ka - F_kb)^2))
+   is merged (row: area-weighted mean, column: sum, colour: area-weighted mean, normal: the
+   normalized area-weighted mean, area: sum; T eq. 5.2) until max_clusters remain. DEPARTURE:
+   the metric's rows and columns are the unoccluded point-to-point form factors to
+   'metric_columns' samples spread over the scene (every M / metric_columns-th sample), not all
+   M: the full rows would cost M^2 per voxel pass. Each sample then belongs to one patch
+   (weight = the area correction), and the form factors are built by step 5 unchanged, so the
+   merged rows and columns are exactly T eq. 5.2 applied to the whole sample matrix, with
+   visibility. E uses w_ij = max(0, N_j . n_i) over the voxel's samples (rad_vp_from_samples)
+   and gathering w_j = max(0, N_j . n), both normalized (SPEC §6).
    LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
    sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
    patch facing its normal gets 0. */
@@ -1337,6 +1350,13 @@ typedef enum rad_vp_weights {
     RAD_VP_WEIGHTS_SQUARED = 0, /* w_a = max(0, n . e_a)^2: sums to exactly 1 (SPEC §7 default) */
     RAD_VP_WEIGHTS_COSINE = 1   /* the seed's max(0, n . e_a), divided by their sum (1 to sqrt 3) */
 } rad_vp_weights;
+
+/* Which proxy rad_vp_create builds. */
+typedef enum rad_vp_kind {
+    RAD_VP_AXIS_ALIGNED = 0,    /* at most six patches per voxel, one per axis direction (SPEC §7) */
+    RAD_VP_CLUSTERED = 1        /* general virtual patches: per voxel, greedy clustering of the
+                                   samples into at most max_clusters patches (SPEC §6 step 7) */
+} rad_vp_kind;
 
 /* The six axis directions, in patch order inside a voxel. */
 typedef enum rad_vp_axis {
@@ -1355,10 +1375,15 @@ typedef struct rad_vp_options {
                                  one ray per pair of samples (SPEC §6 step 5 literally: cost
                                  M^2 / 2 rays). See VISIBILITY in the section comment. */
     int keep_row_sums;        /* non-zero: skip step 6 (rows may then sum to more than 1) */
+    rad_vp_kind kind;         /* default RAD_VP_AXIS_ALIGNED */
+    uint32_t max_clusters;    /* RAD_VP_CLUSTERED: Q, patches per voxel at most (1..6, default 6) */
+    uint32_t metric_columns;  /* RAD_VP_CLUSTERED: samples used as the columns k of the metric's
+                                 form-factor term (default 64, at most 4096) */
 } rad_vp_options;
 
 /* Axis-aligned virtual patches with their form factors. Read-only after creation.
-   Patch p lies in voxel voxel[p] (an index into the voxel arrays) and faces axis axis[p];
+   Patch p lies in voxel voxel[p] (an index into the voxel arrays) and faces axis axis[p]
+   (RAD_VP_CLUSTERED: axis[p] is the cluster's slot 0..5 in its voxel and normals[p] its normal);
    the patches of voxel v are [voxel_first[v], voxel_first[v + 1]), in axis order.
    Samples are grouped by voxel the same way ([sample_first[v], sample_first[v + 1])). */
 typedef struct rad_virtual_patches {
@@ -1391,6 +1416,7 @@ typedef struct rad_virtual_patches {
     uint64_t face_rays;         /* rays cast from voxel faces */
     uint64_t pair_rays;         /* shadow rays between samples */
     const rad_scene *scene;     /* borrowed: must outlive this object */
+    rad_vp_kind kind;
     rad_vp_weights weights;
     rad_allocator allocator;    /* private */
 } rad_virtual_patches;
@@ -1417,7 +1443,8 @@ RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
 RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E);
 
 /* Per-patch values from per-sample values (SPEC §6 primary light, normalized):
-   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel. sample_values: 3M floats
+   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel (axis-aligned), or
+   out_j = sum_i w_ij s_i v_i / sum_i w_ij s_i with w_ij = max(0, N_j . n_i) (clustered). sample_values: 3M floats
    (for instance rho_i D_i from the engine's own shadow maps); out: 3N floats.
    Errors: INVALID_ARGUMENT. O(M). */
 RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out);
@@ -1434,7 +1461,8 @@ RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_rayca
 
 /* Gathering at one surface point p with unit normal n (SPEC §6-§7, T eq. 5.3, P eq. 9): in each
    voxel of the 2x2x2 block around p (by voxel centres), L(v) = sum_a w_a(n) x_a / sum_a w_a(n)
-   over v's patches (w_a the split weights of rad_vp_weights); voxels missing or with no patch
+   over v's patches (w_a the split weights of rad_vp_weights; clustered: w_j = max(0, N_j . n));
+   voxels missing or with no patch
    facing n are skipped, and L = sum_v t_v L(v) / sum_v t_v with the trilinear weights t_v.
    values: 3N floats per patch (B, L or H); out: 3 floats. Returns the number of voxels that
    contributed (0: out is 0). Pure, thread-safe, O(1). */
@@ -7789,6 +7817,9 @@ RAD_API void rad_vp_options_default(rad_vp_options *o)
     o->weights = RAD_VP_WEIGHTS_SQUARED;
     o->ray_epsilon = 1e-5f;
     o->visibility_rays = 16;
+    o->kind = RAD_VP_AXIS_ALIGNED;
+    o->max_clusters = 6;
+    o->metric_columns = 64;
 }
 
 /* the six split weights of a unit normal (sum 1) */
@@ -7871,6 +7902,12 @@ typedef struct rad__vp_build {
     uint32_t *sample_voxel;      /* M */
     float *eff;                  /* M: s_i times the sum of its corrected weights (the clamp) */
     float *rowf;                 /* N: 1 / max(1, row sum) */
+    /* clustering (RAD_VP_CLUSTERED) */
+    float *vscale;               /* per voxel: exact area / sum of s_i */
+    uint32_t *cols, kc, nmax;    /* the metric's column samples */
+    double *cscratch;            /* per task */
+    size_t cper;                 /* doubles per task */
+    uint8_t *slot, *ncl;         /* per sample: cluster slot; per voxel: cluster count */
     struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
     uint64_t *rays_cast;         /* per task */
     float *P;                    /* N x N */
@@ -8256,6 +8293,111 @@ static double rad__vp_clip_area(const float *tv, const double *lo, const double 
     return 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
 }
 
+/* unoccluded point-to-point form factor from sample i to sample k (area-corrected areas) */
+static double rad__vp_ff_pp(const rad__vp_build *b, uint32_t i, uint32_t k)
+{
+    const rad_virtual_patches *vp = b->vp;
+    float d[3], d2, ci, ck, ei = b->eff[i], ek = b->eff[k], fl;
+    if (i == k) return 0.0;
+    rad__sub(d, vp->sample_positions + 3 * (size_t)k, vp->sample_positions + 3 * (size_t)i);
+    ci = rad__dot(d, vp->sample_normals + 3 * (size_t)i);
+    ck = -rad__dot(d, vp->sample_normals + 3 * (size_t)k);
+    if (!(ci > 0.0f) || !(ck > 0.0f)) return 0.0;
+    d2 = rad__dot(d, d);
+    fl = (ei > ek ? ei : ek) / (float)RAD__PI;
+    return (double)ek * (double)(ci / d2) * (double)(ck / (d2 > fl ? d2 : fl)) / RAD__PI;
+}
+
+/* the clustering metric between clusters a and b of a task's scratch */
+static double rad__vp_metric(const double *R, const double *C, const double *col, const double *nrm, uint32_t kc, uint32_t a,
+                             uint32_t b)
+{
+    double dc = 0.0, dn, df = 0.0;
+    uint32_t t;
+    int k;
+    for (k = 0; k < 3; ++k) dc += (col[3 * a + k] - col[3 * b + k]) * (col[3 * a + k] - col[3 * b + k]);
+    dn = nrm[3 * a] * nrm[3 * b] + nrm[3 * a + 1] * nrm[3 * b + 1] + nrm[3 * a + 2] * nrm[3 * b + 2];
+    for (t = 0; t < kc; ++t) {
+        double x = R[(size_t)a * kc + t] - R[(size_t)b * kc + t], y = C[(size_t)a * kc + t] - C[(size_t)b * kc + t];
+        df += x * x + y * y;
+    }
+    return (1.0 + sqrt(dc)) * (2.0 - dn) * (1.0 + sqrt(df));
+}
+
+/* greedy clustering of voxel v's samples into at most max_clusters (SPEC §6 step 7) */
+static rad_result rad__vp_cluster_row(void *data, uint32_t v, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t s0 = vp->sample_first[v], n = vp->sample_first[v + 1] - s0, Q = b->o.max_clusters, kc = b->kc, i, j, t;
+    uint32_t nm = b->nmax, alive;
+    double *R = b->cscratch + (size_t)task * b->cper, *C = R + (size_t)nm * kc, *D = C + (size_t)nm * kc;
+    double *area = D + (size_t)nm * nm, *col = area + nm, *nrm = col + 3 * (size_t)nm, *label = nrm + 3 * (size_t)nm;
+    double *live = label + nm;
+    int k;
+    if (n <= Q) {
+        for (i = 0; i < n; ++i) b->slot[s0 + i] = (uint8_t)i;
+        b->ncl[v] = (uint8_t)n;
+        return RAD_SUCCESS;
+    }
+    for (i = 0; i < n; ++i) {
+        uint32_t si = s0 + i;
+        area[i] = (double)b->eff[si];
+        for (k = 0; k < 3; ++k) {
+            col[3 * i + k] = (double)vp->sample_albedo[3 * (size_t)si + k];
+            nrm[3 * i + k] = (double)vp->sample_normals[3 * (size_t)si + k];
+        }
+        for (t = 0; t < kc; ++t) {
+            R[(size_t)i * kc + t] = rad__vp_ff_pp(b, si, b->cols[t]);
+            C[(size_t)i * kc + t] = rad__vp_ff_pp(b, b->cols[t], si);
+        }
+        label[i] = (double)i;
+        live[i] = 1.0;
+    }
+    for (i = 0; i < n; ++i)
+        for (j = i + 1; j < n; ++j) D[(size_t)i * nm + j] = rad__vp_metric(R, C, col, nrm, kc, i, j);
+    for (alive = n; alive > Q; --alive) {
+        uint32_t ba = 0, bb = 0;
+        double best = -1.0, A;
+        for (i = 0; i < n; ++i) {
+            if (live[i] == 0.0) continue;
+            for (j = i + 1; j < n; ++j)
+                if (live[j] != 0.0 && (best < 0.0 || D[(size_t)i * nm + j] < best)) { best = D[(size_t)i * nm + j]; ba = i; bb = j; }
+        }
+        /* merge bb into ba (T eq. 5.2) */
+        A = area[ba] + area[bb];
+        for (t = 0; t < kc; ++t) {
+            R[(size_t)ba * kc + t] = (area[ba] * R[(size_t)ba * kc + t] + area[bb] * R[(size_t)bb * kc + t]) / A;
+            C[(size_t)ba * kc + t] += C[(size_t)bb * kc + t];
+        }
+        {
+            double nn[3], len;
+            for (k = 0; k < 3; ++k) {
+                col[3 * ba + k] = (area[ba] * col[3 * ba + k] + area[bb] * col[3 * bb + k]) / A;
+                nn[k] = area[ba] * nrm[3 * ba + k] + area[bb] * nrm[3 * bb + k];
+            }
+            len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+            if (len > 0.0)
+                for (k = 0; k < 3; ++k) nrm[3 * ba + k] = nn[k] / len;
+        }
+        area[ba] = A;
+        live[bb] = 0.0;
+        for (i = 0; i < n; ++i)
+            if (label[i] == (double)bb) label[i] = (double)ba;
+        for (i = 0; i < n; ++i) {
+            if (live[i] == 0.0 || i == ba) continue;
+            if (i < ba) D[(size_t)i * nm + ba] = rad__vp_metric(R, C, col, nrm, kc, i, ba);
+            else D[(size_t)ba * nm + i] = rad__vp_metric(R, C, col, nrm, kc, ba, i);
+        }
+    }
+    /* slots in order of the surviving clusters */
+    for (i = 0, t = 0; i < n; ++i)
+        if (live[i] != 0.0) live[i] = (double)(++t); /* slot + 1 */
+    for (i = 0; i < n; ++i) b->slot[s0 + i] = (uint8_t)(live[(uint32_t)label[i]] - 1.0);
+    b->ncl[v] = (uint8_t)t;
+    return RAD_SUCCESS;
+}
+
 /* maps the form-factor stage's progress to [0.1, 1] */
 typedef struct rad__vp_progress {
     int (*fn)(void *user, float fraction);
@@ -8479,8 +8621,45 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     }
 
     /* 4. patches: one per voxel and axis with samples; the weights of its samples are scaled
-       so that the patch area is the exact clipped area of the voxel's surface on that axis */
-    for (v = 0; v < vp->voxel_count; ++v) {
+       so that the patch area is the exact clipped area of the voxel's surface on that axis
+       (clustered: one per cluster, every sample scaled by its voxel's area correction) */
+    if (b->o.kind == RAD_VP_CLUSTERED) {
+        uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count, s;
+        rad__ctx cc = *c;
+        cc.progress = NULL;
+        b->vscale = (float *)rad__alloc_array(A, vp->voxel_count, sizeof(float));
+        b->eff = (float *)rad__alloc_array(A, M, sizeof(float));
+        b->slot = (uint8_t *)rad__alloc_array(A, M, 1);
+        b->ncl = (uint8_t *)rad__alloc_array(A, vp->voxel_count, 1);
+        b->kc = b->o.metric_columns < M ? b->o.metric_columns : M;
+        b->cols = (uint32_t *)rad__alloc_array(A, b->kc, sizeof(uint32_t));
+        b->nmax = 1;
+        for (v = 0; v < vp->voxel_count; ++v)
+            if (vp->sample_first[v + 1] - vp->sample_first[v] > b->nmax) b->nmax = vp->sample_first[v + 1] - vp->sample_first[v];
+        b->cper = 2 * (size_t)b->nmax * b->kc + (size_t)b->nmax * b->nmax + 9 * (size_t)b->nmax;
+        b->cscratch = (double *)rad__alloc_array(A, (size_t)T, b->cper * sizeof(double));
+        if (!b->vscale || !b->eff || !b->slot || !b->ncl || !b->cols || !b->cscratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+        for (v = 0; v < vp->voxel_count; ++v) {
+            double have = 0.0, exact = 0.0;
+            for (a = 0; a < 6; ++a) exact += cand_area[6 * (size_t)voxel_cand[v] + a];
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) have += (double)vp->sample_areas[s];
+            b->vscale[v] = have > 0.0 && exact > 0.0 ? (float)(exact / have) : 1.0f;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) b->eff[s] = vp->sample_areas[s] * b->vscale[v];
+        }
+        for (i = 0; i < b->kc; ++i) b->cols[i] = (uint32_t)(((uint64_t)2 * i + 1) * M / (2 * (uint64_t)b->kc));
+        r = rad__for_rows(&cc, vp->voxel_count, T, rad__vp_cluster_row, b);
+        if (r != RAD_SUCCESS) goto done;
+        for (v = 0; v < vp->voxel_count; ++v) {
+            vp->voxel_first[v] = N;
+            for (a = 0; a < 6; ++a) vp->voxel_patch[6 * (size_t)v + a] = a < b->ncl[v] ? N++ : RAD_NONE;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                for (a = 0; a < 6; ++a) vp->sample_weights[6 * (size_t)s + a] = 0.0f;
+                vp->sample_weights[6 * (size_t)s + b->slot[s]] = b->vscale[v];
+            }
+        }
+        rad__free(A, b->eff);
+        b->eff = NULL;
+    } else for (v = 0; v < vp->voxel_count; ++v) {
         vp->voxel_first[v] = N;
         for (a = 0; a < 6; ++a) {
             uint32_t s;
@@ -8532,7 +8711,17 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
                 vp->albedo[3 * (size_t)p + k] = (float)(col[k] / area);
                 vp->normals[3 * (size_t)p + k] = 0.0f;
             }
-            vp->normals[3 * (size_t)p + (a >> 1)] = (a & 1u) ? -1.0f : 1.0f;
+            if (b->o.kind == RAD_VP_CLUSTERED) {
+                double nn[3] = { 0.0, 0.0, 0.0 }, len;
+                for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                    double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                    for (k = 0; k < 3; ++k) nn[k] += w * (double)vp->sample_normals[3 * (size_t)s + k];
+                }
+                len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+                for (k = 0; k < 3; ++k) vp->normals[3 * (size_t)p + k] = len > 0.0 ? (float)(nn[k] / len) : 0.0f;
+            } else {
+                vp->normals[3 * (size_t)p + (a >> 1)] = (a & 1u) ? -1.0f : 1.0f;
+            }
             vp->axis[p] = (uint8_t)a;
             vp->voxel[p] = v;
         }
@@ -8612,6 +8801,11 @@ done:
     rad__free(A, b->pairs);
     rad__free(A, b->eff);
     rad__free(A, b->rowf);
+    rad__free(A, b->vscale);
+    rad__free(A, b->cols);
+    rad__free(A, b->cscratch);
+    rad__free(A, b->slot);
+    rad__free(A, b->ncl);
     rad__free(A, b->sample_voxel);
     return r;
 }
@@ -8636,6 +8830,12 @@ RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *ra
     if (b.o.resolution == 0) b.o.resolution = 16;
     if (b.o.face_points == 0) b.o.face_points = 16;
     if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
+    if (b.o.max_clusters == 0) b.o.max_clusters = 6;
+    if (b.o.metric_columns == 0) b.o.metric_columns = 64;
+    if ((b.o.kind != RAD_VP_AXIS_ALIGNED && b.o.kind != RAD_VP_CLUSTERED) || b.o.max_clusters > 6 || b.o.metric_columns > 4096) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: bad kind, max_clusters (1..6) or metric_columns (<= 4096)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     for (k = 0; k < 3; ++k) {
         if (!rad__finite(b.o.voxel_size[k]) || b.o.voxel_size[k] < 0.0f) {
             rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size[%d] = %g is negative or not finite", k, (double)b.o.voxel_size[k]);
@@ -8655,6 +8855,7 @@ RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *ra
     vp->allocator = c.allocator;
     vp->scene = scene;
     vp->weights = b.o.weights;
+    vp->kind = b.o.kind;
     for (k = 0; k < 3; ++k) {
         float ext = scene->bounds_max[k] - scene->bounds_min[k], h;
         float longest = scene->bounds_max[0] - scene->bounds_min[0];
@@ -8710,6 +8911,10 @@ RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const floa
             if (p == RAD_NONE) continue;
             for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
                 double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                if (vp->kind == RAD_VP_CLUSTERED) {
+                    double cosw = (double)rad__dot(vp->normals + 3 * (size_t)p, vp->sample_normals + 3 * (size_t)s);
+                    w = cosw > 0.0 ? cosw * (double)vp->sample_areas[s] : 0.0;
+                }
                 wsum += w;
                 for (k = 0; k < 3; ++k) acc[k] += w * (double)sample_values[3 * (size_t)s + k];
             }
@@ -8797,9 +9002,12 @@ RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float 
         if (v == RAD_NONE) continue;
         for (a = 0; a < 6; ++a) {
             uint32_t q = vp->voxel_patch[6 * (size_t)v + a];
-            if (q == RAD_NONE || !(w[a] > 0.0f)) continue;
-            ws += (double)w[a];
-            for (k = 0; k < 3; ++k) L[k] += (double)w[a] * (double)values[3 * (size_t)q + k];
+            float wa;
+            if (q == RAD_NONE) continue;
+            wa = vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)q, n) : w[a];
+            if (!(wa > 0.0f)) continue;
+            ws += (double)wa;
+            for (k = 0; k < 3; ++k) L[k] += (double)wa * (double)values[3 * (size_t)q + k];
         }
         if (!(ws > 0.0)) continue; /* nothing in this voxel faces n */
         used++;

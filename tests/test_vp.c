@@ -157,7 +157,7 @@ static void vp_test_reciprocity(void)
     CHECK_OK(rad_scene_create(&desc, NULL, &scene));
     CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
     rad_bvh_raycaster(bvh, &rc);
-    for (w = 0; w < 3; ++w) {
+    for (w = 0; w < 4; ++w) {
         uint32_t p, v;
         double sample_area = 0.0, patch_area = 0.0, scene_area = 0.0;
         rad_vp_options_default(&o);
@@ -165,6 +165,7 @@ static void vp_test_reciprocity(void)
         o.face_points = rad_test_quick() ? 4 : 9;
         o.weights = w == 1 ? RAD_VP_WEIGHTS_COSINE : RAD_VP_WEIGHTS_SQUARED;
         if (w == 2) o.visibility_rays = 0; /* a ray per sample pair */
+        if (w == 3) { o.kind = RAD_VP_CLUSTERED; o.max_clusters = 3; } /* general virtual patches */
         CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
         if (!vp) break;
         vp_check_reciprocity(vp);
@@ -178,8 +179,12 @@ static void vp_test_reciprocity(void)
         CHECK(patch_area >= 0.99 * scene_area);
         CHECK(sample_area <= scene_area * (1.0 + 1e-5));
         /* at most six patches per voxel, normals along the axes */
-        for (v = 0; v < vp->voxel_count; ++v) CHECK(vp->voxel_first[v + 1] - vp->voxel_first[v] <= 6);
-        for (p = 0; p < vp->count; ++p) CHECK_NEAR(fabs(vp->normals[3 * p + vp->axis[p] / 2]), 1.0, 0.0);
+        for (v = 0; v < vp->voxel_count; ++v) CHECK(vp->voxel_first[v + 1] - vp->voxel_first[v] <= (w == 3 ? 3u : 6u));
+        for (p = 0; p < vp->count; ++p) {
+            const float *nn = vp->normals + 3 * p;
+            if (w == 3) CHECK_NEAR(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2], 1.0, 1e-5);
+            else CHECK_NEAR(fabs(nn[vp->axis[p] / 2]), 1.0, 0.0);
+        }
         rad_vp_destroy(vp);
         vp = NULL;
     }
@@ -207,12 +212,19 @@ static void vp_test_furnace(void)
     float *E = NULL, *B = NULL;
     uint32_t N, i;
     double area = 0.0, sum_area = 0.0, bmean = 0.0, bmin = 1e30, bmax = 0.0;
+    int kind;
     vp_box(&s, 1.0f, 1.0f, 1.0f, 4, 0);
     vp_desc(&s, &desc, 0.5f, (float)(1.0 / FF_PI));
     CHECK_OK(rad_scene_create(&desc, NULL, &scene));
     CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
     rad_bvh_raycaster(bvh, &rc);
+    for (kind = 0; kind < 2; ++kind) {
+    area = sum_area = bmean = 0.0;
+    bmin = 1e30;
+    bmax = 0.0;
     rad_vp_options_default(&o);
+    o.kind = kind ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    o.max_clusters = 3; /* a voxel of the box holds at most three walls */
     o.resolution = rad_test_quick() ? 4 : 5;
     o.face_points = 16;
     o.skip_visibility = 1; /* convex: V = 1 */
@@ -242,14 +254,22 @@ static void vp_test_furnace(void)
         if (B[3 * i] > bmax) bmax = B[3 * i];
     }
     CHECK_NEAR(bmean, 2.0, 0.06);
-    CHECK(bmin > 1.7 && bmax < 2.3); /* each patch within 15%: near-edge row sums are off by up to 8% */
+    /* each patch within 15% (axis-aligned) or 25% (clustered: a cluster of a few samples next
+       to an edge gets a poor quadrature of its row; measured 1.55) */
+    CHECK(bmin > (kind ? 1.5 : 1.7) && bmax < 2.3);
     so.bounces = 3;
     CHECK_OK(rad_solve_jacobi(&sys, &so, B, NULL, NULL));
     bmean = 0.0;
     for (i = 0; i < N; ++i) bmean += vp->areas[i] * B[3 * i] / area;
     CHECK_NEAR(bmean, 1.875, 0.06);
-    printf("    furnace: %u patches, %u samples, area-weighted row sum %.4f, B %.4f (min %.3f max %.3f)\n", N,
-           vp->sample_count, sum_area / area, bmean, bmin, bmax);
+    printf("    furnace (%s): %u patches, %u samples, area-weighted row sum %.4f, B %.4f (min %.3f max %.3f)\n",
+           kind ? "clustered" : "axis-aligned", N, vp->sample_count, sum_area / area, bmean, bmin, bmax);
+    free(E);
+    free(B);
+    E = B = NULL;
+    rad_vp_destroy(vp);
+    vp = NULL;
+    }
 out:
     free(E);
     free(B);
@@ -333,7 +353,8 @@ static void vp_test_memory(void)
    points (214 patches): the indirect light L gathered at the classic patch centroids agrees to
    a relative RMS error of 6% (measured 5.4%; 4.9% with keep_row_sums), the total indirect power
    sum A L to 4% (3.2%; 0.7% with keep_row_sums). Quick mode (432 classic patches, 5 voxels):
-   7% and 6% (measured 6.7% and 4.6%). The box is convex, so both
+   7% and 6% (measured 6.7% and 4.6%). General virtual patches (3 clusters per voxel, 450
+   patches) on the same grid: 8% and 6% (measured 5.7% and 3.3%; quick 6.8% and 4.7%). The box is convex, so both
    sides skip visibility (V = 1 exactly). */
 static void vp_test_classic(void)
 {
@@ -420,6 +441,32 @@ static void vp_test_classic(void)
            vp->count, vp->sample_count, sqrt(num / den), powv, powc);
     CHECK(sqrt(num / den) < (rad_test_quick() ? 0.07 : 0.06));
     CHECK_REL(powv, powc, rad_test_quick() ? 0.06 : 0.04);
+    /* general virtual patches (3 clusters per voxel) on the same grid */
+    free(Ev); free(Lv);
+    Ev = Lv = NULL;
+    rad_vp_destroy(vp);
+    vp = NULL;
+    o.kind = RAD_VP_CLUSTERED;
+    o.max_clusters = 3;
+    CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+    if (!vp) goto out;
+    Ev = (float *)malloc(sizeof(float) * 3 * vp->count);
+    Lv = (float *)malloc(sizeof(float) * 3 * vp->count);
+    if (!Ev || !Lv) goto out;
+    CHECK_OK(rad_vp_sources(vp, &rc, &light, 1, &dopt, RAD_SOURCE_DIRECT, Ev, NULL));
+    rad_vp_system(&sys, vp, Ev);
+    CHECK_OK(rad_solve_jacobi(&sys, &so, Lv, NULL, NULL));
+    CHECK_OK(rad_vp_gather(vp, Lv, pts, nrm, n, g, NULL));
+    num = den = powv = 0.0;
+    for (i = 0; i < n; ++i) {
+        double d = g[3 * i] - Lc[3 * i];
+        num += P->patches[i].area * d * d;
+        den += P->patches[i].area * (double)Lc[3 * i] * Lc[3 * i];
+    }
+    for (i = 0; i < vp->count; ++i) powv += vp->areas[i] * (double)Lv[3 * i];
+    printf("    clustered: %u patches: relative RMS error of L %.4f, power %.5f vs %.5f\n", vp->count, sqrt(num / den), powv, powc);
+    CHECK(sqrt(num / den) < 0.08);
+    CHECK_REL(powv, powc, 0.06);
 out:
     free(Ec); free(Lc); free(Dc); free(Ev); free(Lv); free(pts); free(nrm); free(g);
     rad_form_factors_destroy(ff);
