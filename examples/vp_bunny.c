@@ -8,7 +8,8 @@
      1. loads the OBJ files, fits each model on the floor of the built-in Cornell box (the two
         blocks removed), builds the scene and the BVH;
      2. builds axis-aligned virtual patches (rad_vp_create: voxels, face rays, exact clipped
-        areas, then the form factors between samples merged per voxel and axis);
+        areas, then the form factors between samples merged per voxel and axis), or with
+        --clustered Q general virtual patches (at most Q clusters per voxel);
      3. E = rho D from the ceiling light at the samples (rad_vp_sources), K Jacobi bounces,
         H = F (E + L) per patch;
      4. renders the image the way an engine would: per pixel, the direct irradiance D at the
@@ -23,7 +24,7 @@
         tracer can render it: the exact `rad trace` and `rad compare` commands are printed.
 
    Build:  cc -std=c99 -O2 -fopenmp -I. examples/vp_bunny.c -o build/vp_bunny -lm
-   Run:    build/vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P]
+   Run:    build/vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P] [--clustered Q]
                           [--bounces K] [--size WxH] [--spp N] [-o OUT.pfm]
                           [--classic N] [--classic-cell C] [--classic-out OUT.pfm]
                           [--write-obj FILE.obj]                                            */
@@ -336,7 +337,7 @@ static void shade(const view *v, const rad_scene *S, const float *D, const float
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P] [--bounces K]\n"
+    fprintf(stderr, "usage: vp_bunny [--data DIR] [--ogre] [--resolution N] [--face-points P] [--clustered Q] [--bounces K]\n"
                     "                [--size WxH] [--spp N] [-o OUT.pfm] [--classic N] [--classic-cell C]\n"
                     "                [--classic-out OUT.pfm]\n"
                     "                [--write-obj FILE.obj]\n");
@@ -350,6 +351,7 @@ int main(int argc, char **argv)
     int ogre = 0, a;
     uint32_t resolution = 32, face_points = 16, bounces = 16, W = 128, Hh = 128, spp = 4, classic = 0, i, k;
     float classic_cell = 0.012f;
+    uint32_t clustered = 0;
     mesh bunny, ogre_mesh;
     rad_scene_desc cornell, desc;
     rad_camera cam;
@@ -378,6 +380,7 @@ int main(int argc, char **argv)
         const char *s = argv[a];
         if (!strcmp(s, "--data") && a + 1 < argc) data = argv[++a];
         else if (!strcmp(s, "--ogre")) ogre = 1;
+        else if (!strcmp(s, "--clustered") && a + 1 < argc) clustered = (uint32_t)strtoul(argv[++a], NULL, 10);
         else if (!strcmp(s, "--resolution") && a + 1 < argc) resolution = (uint32_t)strtoul(argv[++a], NULL, 10);
         else if (!strcmp(s, "--face-points") && a + 1 < argc) face_points = (uint32_t)strtoul(argv[++a], NULL, 10);
         else if (!strcmp(s, "--bounces") && a + 1 < argc) bounces = (uint32_t)strtoul(argv[++a], NULL, 10);
@@ -471,6 +474,10 @@ int main(int argc, char **argv)
     rad_vp_options_default(&vo);
     vo.resolution = resolution;
     vo.face_points = face_points;
+    if (clustered) {
+        vo.kind = RAD_VP_CLUSTERED;
+        vo.max_clusters = clustered;
+    }
     memset(&sc, 0, sizeof(sc));
     ctx.progress = on_progress;
     ctx.progress_user = &sc;
@@ -482,8 +489,8 @@ int main(int argc, char **argv)
     peak_vp = cnt.peak;
     t_vp_face = (sc.face_done > 0.0 ? sc.face_done : t1) - t0;
     t_vp_ff = t1 - t0 - t_vp_face;
-    printf("virtual patches: grid %ux%ux%u (voxel %.4f), %u candidate and %u non-empty voxels, %llu face rays\n",
-           vp->dims[0], vp->dims[1], vp->dims[2], vp->voxel_size[0], vp->candidate_voxels, vp->voxel_count,
+    printf("%s virtual patches: grid %ux%ux%u (voxel %.4f), %u candidate and %u non-empty voxels, %llu face rays\n",
+           clustered ? "general (clustered)" : "axis-aligned", vp->dims[0], vp->dims[1], vp->dims[2], vp->voxel_size[0], vp->candidate_voxels, vp->voxel_count,
            (unsigned long long)vp->face_rays);
     printf("  %u samples, %u patches; voxelize + face rays %.2f s, form factors %.2f s (%llu shadow rays)\n",
            vp->sample_count, vp->count, t_vp_face, t_vp_ff, (unsigned long long)vp->pair_rays);
