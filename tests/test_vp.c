@@ -678,6 +678,101 @@ static void vp_test_arguments(void)
     rad_scene_destroy(scene);
 }
 
+/* ---- determinism, cancel, allocation failure --------------------------------------------------- */
+
+typedef struct vp_fail_state {
+    vp_peak_state peak;
+    long calls, fail_at;
+} vp_fail_state;
+
+static void *vp_fail_alloc(void *user, size_t size)
+{
+    vp_fail_state *s = (vp_fail_state *)user;
+    long n;
+#ifdef _OPENMP
+#pragma omp critical(vp_fail_lock)
+#endif
+    {
+        n = ++s->calls;
+    }
+    if (n == s->fail_at) return NULL;
+    return vp_peak_alloc(&s->peak, size);
+}
+
+static void vp_fail_free(void *user, void *ptr) { vp_peak_free(&((vp_fail_state *)user)->peak, ptr); }
+
+static int vp_cancel_at_half(void *user, float fraction)
+{
+    (void)user;
+    return fraction >= 0.5f;
+}
+
+/* The same bits for 1 and 7 tasks; a cancel returns CANCELLED and frees everything; every
+   allocation of a build failing in turn gives OUT_OF_MEMORY and frees everything. */
+static void vp_test_robustness(void)
+{
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options o;
+    rad_virtual_patches *v1 = NULL, *v7 = NULL, *vf = NULL;
+    rad_context ctx;
+    vp_fail_state fs;
+    int kind;
+    rad_cornell_box(&desc, NULL);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    for (kind = 0; kind < 2; ++kind) {
+        long k, total;
+        rad_vp_options_default(&o);
+        o.resolution = 4;
+        o.face_points = 4;
+        o.kind = kind ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+        memset(&ctx, 0, sizeof(ctx));
+        ctx.task_count = 1;
+        CHECK_OK(rad_vp_create(scene, &rc, &o, &ctx, &v1));
+        ctx.task_count = 7;
+        CHECK_OK(rad_vp_create(scene, &rc, &o, &ctx, &v7));
+        if (v1 && v7) {
+            CHECK(v1->count == v7->count);
+            if (v1->count == v7->count)
+                CHECK(memcmp(v1->matrix.dense, v7->matrix.dense, sizeof(float) * v1->count * v1->count) == 0);
+        }
+        rad_vp_destroy(v1);
+        rad_vp_destroy(v7);
+        v1 = v7 = NULL;
+        /* cancel */
+        memset(&fs, 0, sizeof(fs));
+        ctx.allocator.alloc = vp_fail_alloc;
+        ctx.allocator.free = vp_fail_free;
+        ctx.allocator.user = &fs;
+        ctx.progress = vp_cancel_at_half;
+        CHECK_RESULT(rad_vp_create(scene, &rc, &o, &ctx, &vf), RAD_ERROR_CANCELLED);
+        CHECK(vf == NULL && fs.peak.live == 0);
+        ctx.progress = NULL;
+        /* count the allocations of a build, then fail each in turn */
+        memset(&fs, 0, sizeof(fs));
+        CHECK_OK(rad_vp_create(scene, &rc, &o, &ctx, &vf));
+        rad_vp_destroy(vf);
+        vf = NULL;
+        total = fs.calls;
+        for (k = 1; k <= total; ++k) {
+            rad_result r;
+            memset(&fs, 0, sizeof(fs));
+            fs.fail_at = k;
+            r = rad_vp_create(scene, &rc, &o, &ctx, &vf);
+            CHECK_RESULT(r, RAD_ERROR_OUT_OF_MEMORY);
+            if (r == RAD_SUCCESS) { rad_vp_destroy(vf); vf = NULL; continue; }
+            CHECK(vf == NULL);
+            CHECK(fs.peak.live == 0);
+        }
+    }
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 static const rad_test_case tests_vp[] = {
     { "vp_reciprocity", vp_test_reciprocity },
     { "vp_furnace", vp_test_furnace },
@@ -686,5 +781,6 @@ static const rad_test_case tests_vp[] = {
     { "vp_classic", vp_test_classic },
     { "vp_continuity", vp_test_continuity },
     { "vp_arguments", vp_test_arguments },
+    { "vp_robustness", vp_test_robustness },
     { NULL, NULL }
 };
