@@ -8090,7 +8090,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
     uint32_t N = vp->count, pf = vp->voxel_first[u], i, j, a, v, K = b->o.visibility_rays;
     double *acc = b->acc + (size_t)task * 6u * N;
     size_t at = (size_t)task * RAD__RAY_BATCH;
-    rad__vp_pair *list = b->pairs + (size_t)task * RAD__VP_PAIRS;
+    rad__vp_pair *list = b->pairs ? b->pairs + (size_t)task * RAD__VP_PAIRS : NULL; /* NULL: skip_visibility */
     for (a = 0; a < 6; ++a) memset(acc + (size_t)a * N + pf, 0, sizeof(double) * (N - pf));
     for (v = u; v < vp->voxel_count; ++v) {
         double p0[36], total = 0.0, vis;
