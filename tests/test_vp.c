@@ -773,6 +773,109 @@ static void vp_test_robustness(void)
     rad_scene_destroy(scene);
 }
 
+/* ---- every solver takes a virtual-patch set ------------------------------------------------- */
+
+/* Cornell box, E = rho D from the emitter at the samples: Jacobi (200 bounces), Gauss-Seidel,
+   progressive refinement, the multi-bounce matrix (K = infinity) and temporal radiosity
+   (feedback mode, the mean of frames 100..299) against the direct LU solve. */
+static void vp_test_solvers(void)
+{
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options o;
+    rad_virtual_patches *vp = NULL;
+    rad_system sys;
+    rad_solve_options so;
+    rad_direct_options dopt;
+    rad_multibounce_options mo;
+    rad_multibounce *mb = NULL;
+    rad_alias_tables *at = NULL;
+    rad_temporal *tp = NULL;
+    rad_temporal_options to;
+    float *E = NULL, *Ld = NULL, *L = NULL, *acc = NULL;
+    uint32_t N, i, f;
+    double pd = 0.0, pt = 0.0, worst;
+    rad_cornell_box(&desc, NULL);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    rad_vp_options_default(&o);
+    o.resolution = 4;
+    o.face_points = 4;
+    CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+    if (!vp) goto out;
+    N = vp->count;
+    E = (float *)malloc(sizeof(float) * 3 * N);
+    Ld = (float *)malloc(sizeof(float) * 3 * N);
+    L = (float *)malloc(sizeof(float) * 3 * N);
+    acc = (float *)calloc(3 * N, sizeof(float));
+    if (!E || !Ld || !L || !acc) goto out;
+    rad_direct_options_default(&dopt);
+    dopt.light_samples = 4;
+    CHECK_OK(rad_vp_sources(vp, &rc, NULL, 0, &dopt, RAD_SOURCE_DIRECT, E, NULL));
+    rad_vp_system(&sys, vp, E);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    CHECK_OK(rad_solve_direct(&sys, &so, Ld, NULL));
+#define VP_CLOSE(tol)                                                                                 \
+    do {                                                                                              \
+        double big = 0.0;                                                                             \
+        worst = 0.0;                                                                                  \
+        for (i = 0; i < 3 * N; ++i) {                                                                 \
+            if (fabs(Ld[i]) > big) big = fabs(Ld[i]);                                                 \
+            if (fabs(L[i] - Ld[i]) > worst) worst = fabs(L[i] - Ld[i]);                               \
+        }                                                                                             \
+        CHECK(worst <= (tol) * big);                                                                  \
+    } while (0)
+    so.bounces = 200;
+    CHECK_OK(rad_solve_jacobi(&sys, &so, L, NULL, NULL));
+    VP_CLOSE(1e-4);
+    so.tolerance = 1e-6;
+    CHECK_OK(rad_solve_gauss_seidel(&sys, &so, L, NULL, NULL));
+    VP_CLOSE(1e-4);
+    so.tolerance = 1e-7;
+    CHECK_OK(rad_solve_progressive(&sys, &so, L, NULL, NULL));
+    VP_CLOSE(1e-3);
+    rad_multibounce_options_default(&mo);
+    mo.bounces = RAD_MB_INFINITE;
+    CHECK_OK(rad_multibounce_create(&vp->matrix, vp->albedo, &mo, NULL, &mb));
+    if (mb) {
+        CHECK_OK(rad_multibounce_apply(mb, E, L, RAD_OUTPUT_INDIRECT, NULL));
+        VP_CLOSE(1e-3);
+    }
+#undef VP_CLOSE
+    CHECK_OK(rad_alias_tables_create(&vp->matrix, RAD_ALIAS_AUTO, NULL, &at));
+    if (at) {
+        const rad_alias_tables *tabs[1];
+        tabs[0] = at;
+        rad_temporal_options_default(&to);
+        to.mode = RAD_TEMPORAL_FEEDBACK;
+        to.weight = 0.9f;
+        to.samples = 16;
+        CHECK_OK(rad_temporal_create(tabs, 1, vp->albedo, &to, NULL, &tp));
+        for (f = 0; tp && f < 300; ++f) {
+            CHECK_OK(rad_temporal_step(tp, E, NULL, L));
+            if (f >= 100)
+                for (i = 0; i < 3 * N; ++i) acc[i] += L[i] / 200.0f;
+        }
+        for (i = 0; i < N; ++i) {
+            pd += vp->areas[i] * (double)(Ld[3 * i] + Ld[3 * i + 1] + Ld[3 * i + 2]);
+            pt += vp->areas[i] * (double)(acc[3 * i] + acc[3 * i + 1] + acc[3 * i + 2]);
+        }
+        CHECK_REL(pt, pd, 0.03);
+    }
+out:
+    free(E); free(Ld); free(L); free(acc);
+    rad_temporal_destroy(tp);
+    rad_alias_tables_destroy(at);
+    rad_multibounce_destroy(mb);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 static const rad_test_case tests_vp[] = {
     { "vp_reciprocity", vp_test_reciprocity },
     { "vp_furnace", vp_test_furnace },
@@ -782,5 +885,6 @@ static const rad_test_case tests_vp[] = {
     { "vp_continuity", vp_test_continuity },
     { "vp_arguments", vp_test_arguments },
     { "vp_robustness", vp_test_robustness },
+    { "vp_solvers", vp_test_solvers },
     { NULL, NULL }
 };
