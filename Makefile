@@ -28,6 +28,10 @@ $(BUILD):
 $(BUILD)/cornell: examples/cornell.c examples/png_write.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/cornell.c -o $@ -lm
 
+# virtual patches on the bunny in the Cornell box (needs $(RAD_DATA_DIR); --ogre for 193k triangles)
+$(BUILD)/vp_bunny: examples/vp_bunny.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/vp_bunny.c -o $@ -lm
+
 demo: $(BUILD)/cornell
 	./$(BUILD)/cornell -o cornell.png
 

@@ -1958,6 +1958,233 @@ RAD_API uint32_t rad_temporal_frame(const rad_temporal *temporal);
 /* Adaptive mode: the weights w_i the last step used (N floats), else NULL. */
 RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
 
+/* ======================================================================================== */
+/* >>api_vp: virtual patches for high-polygon scenes                                        */
+/* ======================================================================================== */
+
+/* Virtual patches (SPEC §6-§7; thesis T-5, preprint P-3.1): a radiosity proxy with no geometry,
+   built automatically from any mesh, so that a scene of 10^5-10^7 triangles is solved with
+   about 10^4 unknowns. Axis-aligned (the default, the preprint's recommended variant) or
+   general (clustered, below).
+   BUILD (rad_vp_create):
+     1. The scene bounds, widened by 0.4827 voxel on each side (walls on the bounds then lie
+        near voxel centres, never on a voxel face nor in a thin sliver of a voxel whose few
+        samples sit next to a perpendicular wall), are cut into voxels of size h = (hx, hy,
+        hz). Candidate voxels are those a triangle's bounding box overlaps.
+     2. On each of the 6 faces of a candidate voxel, 'face_points' Hammersley points
+        ((s + 1/2)/P, radical inverse of s) cast a ray inward, perpendicular to the face and
+        limited to the voxel. A hit is a SAMPLE: position, triangle t, the triangle's geometric
+        normal, albedo (rad_scene_albedo at the hit, so textures go through the albedo
+        callback). Voxels without a sample are dropped.
+     3. Sample area s_i = S_t / (number of samples on triangle t).
+     4. Each sample is split over the axes a = +x, -x, +y, -y, +z, -z with weights w_ia
+        summing to 1 (rad_vp_weights), and per voxel and axis merged into one patch:
+            A_a = sum_i w_ia s_i        c_a = sum_i w_ia s_i c_i / A_a       normal e_a
+        A voxel axis without samples has no patch, so a voxel holds 1 to 6 patches.
+        DEPARTURE (area correction): s_i = S_t / n_t counts only the triangles some face ray
+        hit; on a mesh finer than the face-point spacing most triangles get no sample and the
+        patches would hold a fraction of the surface (row sums far below 1). So every
+        triangle is clipped to the voxels its bounds overlap, and per voxel and axis the
+        weights w_ia of the voxel's samples are multiplied by (exact clipped area weighted by
+        the triangles' split weights) / (sum_i w_ia s_i): A_a is then the exact surface area
+        of that voxel and axis, and sample_weights holds the corrected weights.
+     5. Form factors, never stored per sample: with the symmetric point-to-point kernel
+            G_ij = s_i s_j cos_i cos_j / (pi max(|r|^2, max(e_i, e_j) / pi)) V(p_i, p_j)
+        (SPEC §2's kernel times s_i; the near-point clamp uses the larger of the two samples'
+        areas after the area correction above, e_i = s_i sum_a w_ia, so it is symmetric and
+        a pair of coincident samples transfers at most the smaller area), the exchanged
+        energy P_ab = sum_i sum_j w_ia w_jb G_ij is accumulated in double, one row voxel at a
+        time, over the pairs i < j (visibility: see VISIBILITY; rays always go from the lower
+        sample index to the higher), mirrored
+        (P_ba = P_ab) and divided: F_ab = P_ab / A_a. This is SPEC §7's merge (row
+        F_a,j = sum_i w_ia s_i F_ij / A_a, column F_j,a = sum_i w_ia F_ji) applied to both
+        indices, so A_a F_ab = A_b F_ba holds to float rounding.
+     6. Row sums above 1 (the point kernel next to a tiny patch overshoots: rows up to 1.68
+        in the bunny-and-ogre scene at 16 voxels) are scaled down without breaking
+        reciprocity: with c_a = 1 / max(1, sum_b P_ab / A_a),
+        F_ab = P_ab min(c_a, c_b) / A_a, so every row sums to at most 1 and every solver
+        converges. In a closed box this lowers the mean row sum by about 1% (keep_row_sums
+        turns it off).
+   VISIBILITY. One shadow ray per sample pair costs M^2 / 2 rays (a bunny in the Cornell box
+   at 47 000 samples: 7.8e8 rays, 157 s on 2 cores), so by default the kernel is summed over
+   every sample pair but visibility is estimated per pair of voxels (u, v): 'visibility_rays'
+   sample pairs are drawn with probability proportional to their kernel G_ij (stratified on
+   the cumulative sum, offsets from a hash of u and v, so the result is deterministic), one
+   shadow ray each, and the fraction unoccluded, V_uv, scales every P_ab with a in u and b in
+   v. When a voxel pair has at most that many pairs, every pair gets its ray and V_uv is the
+   kernel-weighted mean. V_uv is shared by both directions, so reciprocity is unchanged. The
+   pair list of one voxel pair is thinned systematically beyond 16384 entries.
+   MEMORY (peak, through ctx's allocator): the N x N float matrix, about 100 bytes per sample,
+   T x (6 N doubles + 1024 rays + 16384 12-byte pair records) of task scratch (T = the
+   context's task count, at most the voxel count), 4 bytes per triangle, 16 bytes per
+   triangle-voxel overlap and 64 per candidate voxel, the face-ray hits of a chunk of
+   candidate voxels (at most 2^21 hits, 32 MiB), and for clustering T x 8 (2 n kc + n^2 + 9 n)
+   bytes (n: the most samples in one voxel, at most 6 face_points; kc: metric_columns).
+   Nothing is O(samples^2).
+   MEASURED (examples/vp_bunny.c, 2 shared cores, BENCHMARKS.md): the bunny in the Cornell box
+   (69 463 triangles) at 24 voxels: 107 342 samples, 6 196 patches, 20 s, 212 MiB peak; the
+   bunny and the ogre (193 471 triangles) at 30 voxels: 168 602 samples, 9 638 patches, 103 s,
+   479 MiB; image SSIM against the path tracer 0.989 (classic radiosity on decimated copies
+   with a similar patch count: 0.984 and 0.979).
+   COST: O(M^2) kernel evaluations and up to M^2/2 shadow rays for M samples; M grows with the
+   number of non-empty voxels times 6 face_points (times the hit rate).
+   USE: rad_vp_system makes a rad_system for every classic solver (the matrix is dense
+   row-major rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
+   brings any per-patch value (B, L, the irradiance H = F (E + L)) back to surface points with
+   normal weights and trilinear filtering that skips voxels without a patch facing the normal.
+   GENERAL VIRTUAL PATCHES (kind RAD_VP_CLUSTERED, SPEC §6 step 7). Per voxel every sample
+   starts as a cluster (area e_i = s_i times the voxel's area correction: exact clipped area /
+   sum of s_i; colour, normal, form-factor row and column); the pair with the smallest
+       M(a,b) = (1 + |c_a - c_b|) (2 - n_a . n_b) (1 + sqrt(sum_k (F_ak - F_bk)^2 + (F_ka - F_kb)^2))
+   is merged (row: area-weighted mean, column: sum, colour: area-weighted mean, normal: the
+   normalized area-weighted mean, area: sum; T eq. 5.2) until max_clusters remain. DEPARTURE:
+   the metric's rows and columns are the unoccluded point-to-point form factors to
+   'metric_columns' samples spread over the scene (every M / metric_columns-th sample), not all
+   M: the full rows would cost M^2 per voxel pass. Each sample then belongs to one patch
+   (weight = the area correction), and the form factors are built by step 5 unchanged, so the
+   merged rows and columns are exactly T eq. 5.2 applied to the whole sample matrix, with
+   visibility. E uses w_ij = max(0, N_j . n_i) over the voxel's samples (rad_vp_from_samples)
+   and gathering w_j = max(0, N_j . n), both normalized (SPEC §6).
+   LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
+   sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
+   patch facing its normal gets 0. */
+
+typedef enum rad_vp_weights {
+    RAD_VP_WEIGHTS_SQUARED = 0, /* w_a = max(0, n . e_a)^2: sums to exactly 1 (SPEC §7 default) */
+    RAD_VP_WEIGHTS_COSINE = 1   /* the seed's max(0, n . e_a), divided by their sum (1 to sqrt 3) */
+} rad_vp_weights;
+
+/* Which proxy rad_vp_create builds. */
+typedef enum rad_vp_kind {
+    RAD_VP_AXIS_ALIGNED = 0,    /* at most six patches per voxel, one per axis direction (SPEC §7) */
+    RAD_VP_CLUSTERED = 1        /* general virtual patches: per voxel, greedy clustering of the
+                                   samples into at most max_clusters patches (SPEC §6 step 7) */
+} rad_vp_kind;
+
+/* The six axis directions, in patch order inside a voxel. */
+typedef enum rad_vp_axis {
+    RAD_VP_POS_X = 0, RAD_VP_NEG_X = 1, RAD_VP_POS_Y = 2, RAD_VP_NEG_Y = 3, RAD_VP_POS_Z = 4, RAD_VP_NEG_Z = 5
+} rad_vp_axis;
+
+typedef struct rad_vp_options {
+    float voxel_size[3];      /* per axis, world units; all 0 (default): cubes, 'resolution' of
+                                 them along the longest axis of the scene bounds */
+    uint32_t resolution;      /* default 16 */
+    uint32_t face_points;     /* Hammersley points per voxel face (default 16, at most 4096) */
+    rad_vp_weights weights;   /* default RAD_VP_WEIGHTS_SQUARED */
+    float ray_epsilon;        /* relative to the scene diagonal (0: 1e-5) */
+    int skip_visibility;      /* non-zero: V = 1 between samples (unoccluded form factors) */
+    uint32_t visibility_rays; /* shadow rays per pair of voxels (default 16, at most 1024); 0:
+                                 one ray per pair of samples (SPEC §6 step 5 literally: cost
+                                 M^2 / 2 rays). See VISIBILITY in the section comment. */
+    int keep_row_sums;        /* non-zero: skip step 6 (rows may then sum to more than 1) */
+    rad_vp_kind kind;         /* default RAD_VP_AXIS_ALIGNED */
+    uint32_t max_clusters;    /* RAD_VP_CLUSTERED: Q, patches per voxel at most (1..6, default 6) */
+    uint32_t metric_columns;  /* RAD_VP_CLUSTERED: samples used as the columns k of the metric's
+                                 form-factor term (default 64, at most 4096) */
+} rad_vp_options;
+
+/* Axis-aligned virtual patches with their form factors. Read-only after creation.
+   Patch p lies in voxel voxel[p] (an index into the voxel arrays) and faces axis axis[p]
+   (RAD_VP_CLUSTERED: axis[p] is the cluster's slot 0..5 in its voxel and normals[p] its normal);
+   the patches of voxel v are [voxel_first[v], voxel_first[v + 1]), in axis order.
+   Samples are grouped by voxel the same way ([sample_first[v], sample_first[v + 1])). */
+typedef struct rad_virtual_patches {
+    uint32_t count;             /* N: patches */
+    float *areas;               /* N: A_a */
+    float *albedo;              /* 3N: c_a */
+    float *normals;             /* 3N: the axis unit vectors */
+    uint8_t *axis;              /* N: rad_vp_axis */
+    uint32_t *voxel;            /* N */
+    rad_matrix matrix;          /* N x N dense row-major F_ab (a view of storage owned here) */
+    /* the grid */
+    float origin[3];            /* corner of voxel (0, 0, 0) */
+    float voxel_size[3];
+    uint32_t dims[3];           /* voxels per axis */
+    uint32_t voxel_count;       /* non-empty voxels */
+    uint64_t *voxel_keys;       /* ascending: ix + dims[0] * (iy + dims[1] * iz) */
+    uint32_t *voxel_first;      /* voxel_count + 1: first patch of each voxel */
+    uint32_t *voxel_patch;      /* 6 per voxel: the patch of each axis, or RAD_NONE */
+    uint32_t *sample_first;     /* voxel_count + 1: first sample of each voxel */
+    /* the samples */
+    uint32_t sample_count;      /* M */
+    float *sample_positions;    /* 3M */
+    float *sample_normals;      /* 3M: the geometric normals of their triangles */
+    float *sample_albedo;       /* 3M */
+    float *sample_areas;        /* M: s_i */
+    float *sample_weights;      /* 6M: w_ia times the area correction of (voxel, axis a) */
+    uint32_t *sample_triangles; /* M */
+    /* what the build did */
+    uint32_t candidate_voxels;  /* voxels overlapped by triangle bounds (step 1) */
+    uint64_t face_rays;         /* rays cast from voxel faces */
+    uint64_t pair_rays;         /* shadow rays between samples */
+    const rad_scene *scene;     /* borrowed: must outlive this object */
+    rad_vp_kind kind;
+    rad_vp_weights weights;
+    rad_allocator allocator;    /* private */
+} rad_virtual_patches;
+
+RAD_API void rad_vp_options_default(rad_vp_options *options);
+
+/* Builds axis-aligned virtual patches for 'scene' (borrowed; must outlive the result).
+   raycaster: its intersect() casts the face rays, its occluded() the shadow rays between
+   samples (not needed with skip_visibility); borrowed for the call.
+   Errors: INVALID_ARGUMENT (NULL input, negative or non-finite voxel size, bad weights or
+   ray_epsilon), SIZE_OVERFLOW (a grid beyond 2^62 cells or an N x N matrix that does not fit:
+   use bigger voxels), EMPTY_SCENE (no face ray hit anything), RAYCAST_FAILED, CANCELLED,
+   OUT_OF_MEMORY. The logger says which. Thread safety: reentrant; uses ctx->parallel_for and
+   reports progress (face rays 10%, form factors 90%). Deterministic: the same bits whatever
+   the thread count. Cost and memory: see the section comment. SPEC §6-§7. */
+RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                 const rad_context *ctx, rad_virtual_patches **out);
+RAD_API void rad_vp_destroy(rad_virtual_patches *vp);
+/* Bytes the object holds (matrix, patches, voxels, samples). */
+RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
+
+/* Fills 'system' for the classic solvers (rad_solve_*): F = vp->matrix, albedo, areas, n, and
+   the source E (3N floats, borrowed). */
+RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E);
+
+/* Per-patch values from per-sample values (SPEC §6 primary light, normalized):
+   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel (axis-aligned), or
+   out_j = sum_i w_ij s_i v_i / sum_i w_ij s_i with w_ij = max(0, N_j . n_i) (clustered). sample_values: 3M floats
+   (for instance rho_i D_i from the engine's own shadow maps); out: 3N floats.
+   Errors: INVALID_ARGUMENT. O(M). */
+RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out);
+
+/* The source E per patch (3N floats) one of the two ways of UNITS AND CONVENTIONS, through
+   rad_vp_from_samples: RAD_SOURCE_DIRECT: v_i = rho_i D_i, D_i the direct irradiance at
+   sample i (rad_direct_irradiance with the lights; the emitters' own emission is kept out);
+   RAD_SOURCE_EMISSION: v_i = pi L_i of the sample's material (lights unused, raycaster may be
+   NULL). Errors: those of rad_direct_irradiance, OUT_OF_MEMORY. Cost: O(M) direct-light
+   evaluations. SPEC §6 (T-5.8). */
+RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
+                                  const rad_light *lights, uint32_t light_count, const rad_direct_options *options,
+                                  rad_source_mode mode, float *out_E, const rad_context *ctx);
+
+/* Gathering at one surface point p with unit normal n (SPEC §6-§7, T eq. 5.3, P eq. 9): in each
+   voxel of the 2x2x2 block around p (by voxel centres), L(v) = sum_a w_a(n) x_a / sum_a w_a(n)
+   over v's patches (w_a the split weights of rad_vp_weights; clustered: w_j = max(0, N_j . n));
+   voxels missing or with no patch
+   facing n are skipped, and L = sum_v t_v L(v) / sum_v t_v with the trilinear weights t_v.
+   values: 3N floats per patch (B, L or H); out: 3 floats. Returns the number of voxels that
+   contributed (0: out is 0). Pure, thread-safe, O(1). */
+RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float *values, const float p[3],
+                                     const float n[3], float out[3]);
+
+/* The same at 'count' points (3 floats each) with unit normals, in parallel through
+   ctx->parallel_for. out: 3 * count floats. Errors: INVALID_ARGUMENT, NON_FINITE (a point or
+   normal). */
+RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *values, const float *points,
+                                 const float *normals, uint32_t count, float *out, const rad_context *ctx);
+
+/* Per-vertex values of a mesh (for instance one of the scene's own meshes): its vertices with
+   its normals, or, when mesh->normals is NULL, the area-weighted mean of the normals of the
+   triangles around each vertex. out: 3 * mesh->vertex_count floats (a vertex no triangle uses
+   gets 0). Errors: INVALID_ARGUMENT, INDEX_OUT_OF_RANGE, NON_FINITE, OUT_OF_MEMORY. */
+RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
+                                      float *out, const rad_context *ctx);
+
 #ifdef __cplusplus
 }
 #endif
@@ -11066,6 +11293,1327 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
     t->frame++;
     if (out_indirect) memcpy(out_indirect, t->B, n3 * sizeof(float));
     return RAD_SUCCESS;
+}
+
+/* ======================================================================================== */
+/* >>vp: virtual patches (voxels, face-ray samples, axis-aligned patches, gathering)       */
+/* ======================================================================================== */
+
+#define RAD__VP_MARGIN 0.4827f           /* voxels of padding around the scene bounds */
+#define RAD__VP_CHUNK_RAYS (1u << 21)     /* face-ray hits kept at once */
+#define RAD__VP_PAIRS 16384u              /* pair records per task for sampled visibility */
+
+typedef struct rad__vp_pair {
+    uint32_t i, j;
+    float g;
+} rad__vp_pair;
+
+RAD_API void rad_vp_options_default(rad_vp_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->resolution = 16;
+    o->face_points = 16;
+    o->weights = RAD_VP_WEIGHTS_SQUARED;
+    o->ray_epsilon = 1e-5f;
+    o->visibility_rays = 16;
+    o->kind = RAD_VP_AXIS_ALIGNED;
+    o->max_clusters = 6;
+    o->metric_columns = 64;
+}
+
+/* the six split weights of a unit normal (sum 1) */
+static void rad__vp_weights(rad_vp_weights kind, const float *n, float *w)
+{
+    int k;
+    float sum = 0.0f;
+    for (k = 0; k < 3; ++k) {
+        float p = n[k] > 0.0f ? n[k] : 0.0f, m = n[k] < 0.0f ? -n[k] : 0.0f;
+        if (kind == RAD_VP_WEIGHTS_SQUARED) { p *= p; m *= m; }
+        w[2 * k] = p;
+        w[2 * k + 1] = m;
+        sum += p + m;
+    }
+    if (sum > 0.0f)
+        for (k = 0; k < 6; ++k) w[k] /= sum;
+}
+
+static int rad__vp_cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : (x > y ? 1 : 0);
+}
+
+RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
+{
+    rad_allocator a;
+    if (!vp) return;
+    a = vp->allocator;
+    rad__free(&a, vp->areas);
+    rad__free(&a, vp->albedo);
+    rad__free(&a, vp->normals);
+    rad__free(&a, vp->axis);
+    rad__free(&a, vp->voxel);
+    rad__free(&a, (void *)vp->matrix.dense);
+    rad__free(&a, vp->voxel_keys);
+    rad__free(&a, vp->voxel_first);
+    rad__free(&a, vp->voxel_patch);
+    rad__free(&a, vp->sample_first);
+    rad__free(&a, vp->sample_positions);
+    rad__free(&a, vp->sample_normals);
+    rad__free(&a, vp->sample_albedo);
+    rad__free(&a, vp->sample_areas);
+    rad__free(&a, vp->sample_weights);
+    rad__free(&a, vp->sample_triangles);
+    rad__free(&a, vp);
+}
+
+RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp)
+{
+    size_t n, m, v;
+    if (!vp) return 0;
+    n = vp->count;
+    m = vp->sample_count;
+    v = vp->voxel_count;
+    return sizeof(*vp) + n * n * sizeof(float) + n * (8 * sizeof(float) + 1 + sizeof(uint32_t)) +
+           v * (sizeof(uint64_t) + 8 * sizeof(uint32_t)) + 2 * sizeof(uint32_t) +
+           m * (16 * sizeof(float) + sizeof(uint32_t));
+}
+
+/* ---- face rays ---- */
+
+typedef struct rad__vp_build {
+    const rad_scene *S;
+    const rad_raycaster *rc;
+    rad_vp_options o;
+    rad_virtual_patches *vp;
+    float eps;
+    uint32_t tasks;
+    /* face rays: candidate voxels [chunk_begin, chunk_begin + chunk_count) */
+    const uint64_t *cand;
+    uint32_t chunk_begin;
+    rad_hit *hits;               /* 6 P per voxel of the chunk */
+    rad_ray *rays;               /* RAD__RAY_BATCH per task */
+    /* pairs */
+    uint8_t *occ;                /* RAD__RAY_BATCH per task */
+    uint32_t *ray_i, *ray_j;     /* RAD__RAY_BATCH per task */
+    float *ray_g;
+    double *acc;                 /* 6 N per task */
+    uint32_t *sample_voxel;      /* M */
+    float *eff;                  /* M: s_i times the sum of its corrected weights (the clamp) */
+    float *rowf;                 /* N: 1 / max(1, row sum) */
+    /* clustering (RAD_VP_CLUSTERED) */
+    float *vscale;               /* per voxel: exact area / sum of s_i */
+    uint32_t *cols, kc, nmax;    /* the metric's column samples */
+    double *cscratch;            /* per task */
+    size_t cper;                 /* doubles per task */
+    uint8_t *slot, *ncl;         /* per sample: cluster slot; per voxel: cluster count */
+    struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
+    uint64_t *rays_cast;         /* per task */
+    float *P;                    /* N x N */
+} rad__vp_build;
+
+static void rad__vp_cell(const rad_virtual_patches *vp, uint64_t key, uint32_t *c)
+{
+    c[0] = (uint32_t)(key % vp->dims[0]);
+    key /= vp->dims[0];
+    c[1] = (uint32_t)(key % vp->dims[1]);
+    c[2] = (uint32_t)(key / vp->dims[1]);
+}
+
+/* the 6 P face rays of candidate voxel 'row' of the chunk */
+static rad_result rad__vp_face_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t P = b->o.face_points, c[3], f, s, n = 0;
+    rad_ray *rays = b->rays + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = b->hits + (size_t)row * 6u * P;
+    float lo[3];
+    int k;
+    rad__vp_cell(vp, b->cand[b->chunk_begin + row], c);
+    for (k = 0; k < 3; ++k) lo[k] = vp->origin[k] + (float)c[k] * vp->voxel_size[k];
+    for (f = 0; f < 6; ++f) {
+        int ax = (int)(f >> 1), a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
+        int neg = (int)(f & 1u); /* face f = 2 ax: the low face, rays go +ax; 2 ax + 1: high face, rays go -ax */
+        for (s = 0; s < P; ++s) {
+            rad_ray *r = &rays[n];
+            float u = ((float)s + 0.5f) / (float)P, v = rad__radical_inverse(s);
+            r->origin[ax] = neg ? lo[ax] + vp->voxel_size[ax] : lo[ax];
+            r->origin[a1] = lo[a1] + u * vp->voxel_size[a1];
+            r->origin[a2] = lo[a2] + v * vp->voxel_size[a2];
+            r->dir[0] = r->dir[1] = r->dir[2] = 0.0f;
+            r->dir[ax] = neg ? -vp->voxel_size[ax] : vp->voxel_size[ax];
+            r->tmin = 0.0f;
+            r->tmax = 1.0f;
+            if (++n == RAD__RAY_BATCH) {
+                if (b->rc->intersect(b->rc->user, rays, n, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+                hits += n;
+                n = 0;
+            }
+        }
+    }
+    if (n && b->rc->intersect(b->rc->user, rays, n, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    return RAD_SUCCESS;
+}
+
+/* ---- form factors: one row voxel per call ---- */
+
+static void rad__vp_pair_add(rad__vp_build *b, double *acc, uint32_t u, uint32_t i, uint32_t j, double g)
+{
+    const rad_virtual_patches *vp = b->vp;
+    const float *wi = vp->sample_weights + 6 * (size_t)i, *wj = vp->sample_weights + 6 * (size_t)j;
+    uint32_t vj = b->sample_voxel[j], a, c, N = vp->count;
+    for (a = 0; a < 6; ++a) {
+        double ga;
+        if (!(wi[a] > 0.0f)) continue;
+        ga = g * (double)wi[a];
+        for (c = 0; c < 6; ++c) {
+            double gac;
+            if (!(wj[c] > 0.0f)) continue;
+            gac = ga * (double)wj[c];
+            acc[(size_t)a * N + vp->voxel_patch[6 * (size_t)vj + c]] += gac;
+            /* both in the row voxel: the transposed entry is a row of this voxel too */
+            if (vj == u) acc[(size_t)c * N + vp->voxel_patch[6 * (size_t)u + a]] += gac;
+        }
+    }
+}
+
+static rad_result rad__vp_flush(rad__vp_build *b, uint32_t task, uint32_t u, uint32_t count)
+{
+    size_t at = (size_t)task * RAD__RAY_BATCH;
+    double *acc = b->acc + (size_t)task * 6u * b->vp->count;
+    uint32_t k;
+    if (count == 0) return RAD_SUCCESS;
+    if (b->rc->occluded(b->rc->user, b->rays + at, count, b->occ + at) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    b->rays_cast[task] += count;
+    for (k = 0; k < count; ++k)
+        if (!b->occ[at + k]) rad__vp_pair_add(b, acc, u, b->ray_i[at + k], b->ray_j[at + k], (double)b->ray_g[at + k]);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_ff_row(void *data, uint32_t u, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t N = vp->count, M = vp->sample_count, pf = vp->voxel_first[u], i, j, a, nrays = 0;
+    double *acc = b->acc + (size_t)task * 6u * N;
+    size_t at = (size_t)task * RAD__RAY_BATCH;
+    rad_result r = RAD_SUCCESS;
+    for (a = 0; a < 6; ++a) memset(acc + (size_t)a * N + pf, 0, sizeof(double) * (N - pf));
+    for (i = vp->sample_first[u]; i < vp->sample_first[u + 1] && r == RAD_SUCCESS; ++i) {
+        const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
+        float ei = b->eff[i];
+        for (j = i + 1; j < M; ++j) {
+            const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
+            float d[3], d2, ci, cj, ej = b->eff[j], fl, g, len;
+            int k;
+            rad__sub(d, pj, pi_);
+            ci = rad__dot(d, ni);
+            if (!(ci > 0.0f)) continue;
+            cj = -rad__dot(d, nj);
+            if (!(cj > 0.0f)) continue;
+            d2 = rad__dot(d, d);
+            fl = (ei > ej ? ei : ej) / (float)RAD__PI;
+            /* cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2 */
+            g = vp->sample_areas[i] * vp->sample_areas[j] * (ci / d2) * (cj / (d2 > fl ? d2 : fl)) / (float)RAD__PI;
+            if (!(g > 0.0f)) continue;
+            if (b->o.skip_visibility) {
+                rad__vp_pair_add(b, acc, u, i, j, (double)g);
+                continue;
+            }
+            {
+                rad_ray *ray = b->rays + at + nrays;
+                for (k = 0; k < 3; ++k) {
+                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
+                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
+                }
+                len = rad__len(ray->dir);
+                ray->tmin = 0.0f;
+                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+                b->ray_i[at + nrays] = i;
+                b->ray_j[at + nrays] = j;
+                b->ray_g[at + nrays] = g;
+                if (++nrays == RAD__RAY_BATCH) {
+                    r = rad__vp_flush(b, task, u, nrays);
+                    nrays = 0;
+                    if (r != RAD_SUCCESS) break;
+                }
+            }
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad__vp_flush(b, task, u, nrays);
+    if (r != RAD_SUCCESS) return r;
+    /* the rows of u's patches, columns from u's first patch on */
+    for (a = 0; a < 6; ++a) {
+        uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
+        if (p == RAD_NONE) continue;
+        for (c = pf; c < N; ++c) b->P[(size_t)p * N + c] = (float)acc[(size_t)a * N + c];
+    }
+    return RAD_SUCCESS;
+}
+
+/* adds 'scale' times the 6 x 6 block p0 (row axis of u, column axis of v) into the row voxel's
+   accumulator, and its transpose when v == u */
+static void rad__vp_add_block(rad__vp_build *b, double *acc, uint32_t u, uint32_t v, const double *p0, double scale)
+{
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t a, c, N = vp->count;
+    for (a = 0; a < 6; ++a) {
+        uint32_t pa = vp->voxel_patch[6 * (size_t)u + a];
+        if (pa == RAD_NONE) continue;
+        for (c = 0; c < 6; ++c) {
+            uint32_t pc = vp->voxel_patch[6 * (size_t)v + c];
+            double x = p0[6 * a + c] * scale;
+            if (pc == RAD_NONE || x == 0.0) continue;
+            acc[(size_t)a * N + pc] += x;
+            if (v == u) acc[(size_t)c * N + pa] += x;
+        }
+    }
+}
+
+/* row voxel u with visibility sampled per voxel pair (see VISIBILITY) */
+static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t N = vp->count, pf = vp->voxel_first[u], i, j, a, v, K = b->o.visibility_rays;
+    double *acc = b->acc + (size_t)task * 6u * N;
+    size_t at = (size_t)task * RAD__RAY_BATCH;
+    rad__vp_pair *list = b->pairs ? b->pairs + (size_t)task * RAD__VP_PAIRS : NULL; /* NULL: skip_visibility */
+    for (a = 0; a < 6; ++a) memset(acc + (size_t)a * N + pf, 0, sizeof(double) * (N - pf));
+    for (v = u; v < vp->voxel_count; ++v) {
+        double p0[36], total = 0.0, vis;
+        uint32_t n = 0, stride = 1, seen = 0, s, nr = 0;
+        memset(p0, 0, sizeof(p0));
+        for (i = vp->sample_first[u]; i < vp->sample_first[u + 1]; ++i) {
+            const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
+            const float *wi = vp->sample_weights + 6 * (size_t)i;
+            float si = vp->sample_areas[i], ei = b->eff[i];
+            double t6[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; /* sum_j g_ij w_jc */
+            for (j = (v == u ? i + 1 : vp->sample_first[v]); j < vp->sample_first[v + 1]; ++j) {
+                const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
+                const float *wj = vp->sample_weights + 6 * (size_t)j;
+                float d[3], d2, ci, cj, sj = vp->sample_areas[j], ej = b->eff[j], fl, g;
+                uint32_t c;
+                rad__sub(d, pj, pi_);
+                ci = rad__dot(d, ni);
+                if (!(ci > 0.0f)) continue;
+                cj = -rad__dot(d, nj);
+                if (!(cj > 0.0f)) continue;
+                d2 = rad__dot(d, d);
+                fl = (ei > ej ? ei : ej) / (float)RAD__PI;
+                g = si * sj * (ci / d2) * (cj / (d2 > fl ? d2 : fl)) / (float)RAD__PI;
+                if (!(g > 0.0f)) continue;
+                for (c = 0; c < 6; ++c) t6[c] += (double)g * (double)wj[c];
+                if (b->o.skip_visibility) continue;
+                /* the pair list, thinned systematically when full */
+                if (seen++ % stride != 0) continue;
+                if (n == RAD__VP_PAIRS) {
+                    uint32_t q;
+                    for (q = 0; q < n / 2; ++q) list[q] = list[2 * q];
+                    n /= 2;
+                    stride *= 2;
+                    if ((seen - 1) % stride != 0) continue;
+                }
+                list[n].i = i;
+                list[n].j = j;
+                list[n].g = g;
+                ++n;
+            }
+            for (a = 0; a < 6; ++a)
+                if (wi[a] > 0.0f)
+                    for (j = 0; j < 6; ++j) p0[6 * a + j] += (double)wi[a] * t6[j];
+        }
+        if (b->o.skip_visibility || n == 0) {
+            if (n == 0 && !b->o.skip_visibility) continue; /* nothing faces each other */
+            rad__vp_add_block(b, acc, u, v, p0, 1.0);
+            continue;
+        }
+        for (s = 0; s < n; ++s) total += (double)list[s].g;
+        if (n <= K) {
+            /* every pair its ray: the kernel-weighted visible fraction */
+            for (s = 0; s < n; ++s) {
+                const rad__vp_pair *q = &list[s];
+                rad_ray *ray = b->rays + at + s;
+                const float *pi_ = vp->sample_positions + 3 * (size_t)q->i, *ni = vp->sample_normals + 3 * (size_t)q->i;
+                const float *pj = vp->sample_positions + 3 * (size_t)q->j, *nj = vp->sample_normals + 3 * (size_t)q->j;
+                float len;
+                int k;
+                for (k = 0; k < 3; ++k) {
+                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
+                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
+                }
+                len = rad__len(ray->dir);
+                ray->tmin = 0.0f;
+                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+            }
+            nr = n;
+        } else {
+            /* K pairs drawn with probability proportional to g, stratified */
+            uint32_t h = rad__hash(u * 0x9E3779B9u ^ rad__hash(v + 0x632BE5ABu));
+            double r = (double)(h >> 8) / 16777216.0, cum = 0.0;
+            uint32_t q = 0;
+            for (s = 0; s < K; ++s) {
+                double target = ((double)s + r) / (double)K * total;
+                rad_ray *ray = b->rays + at + s;
+                const float *pi_, *ni, *pj, *nj;
+                float len;
+                int k;
+                while (q + 1 < n && cum + (double)list[q].g <= target) cum += (double)list[q++].g;
+                pi_ = vp->sample_positions + 3 * (size_t)list[q].i;
+                ni = vp->sample_normals + 3 * (size_t)list[q].i;
+                pj = vp->sample_positions + 3 * (size_t)list[q].j;
+                nj = vp->sample_normals + 3 * (size_t)list[q].j;
+                for (k = 0; k < 3; ++k) {
+                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
+                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
+                }
+                len = rad__len(ray->dir);
+                ray->tmin = 0.0f;
+                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+                b->ray_g[at + s] = 1.0f;
+            }
+            nr = K;
+        }
+        if (b->rc->occluded(b->rc->user, b->rays + at, nr, b->occ + at) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        b->rays_cast[task] += nr;
+        vis = 0.0;
+        if (n <= K) {
+            for (s = 0; s < n; ++s)
+                if (!b->occ[at + s]) vis += (double)list[s].g;
+            vis /= total;
+        } else {
+            for (s = 0; s < K; ++s)
+                if (!b->occ[at + s]) vis += 1.0;
+            vis /= (double)K;
+        }
+        if (vis > 0.0) rad__vp_add_block(b, acc, u, v, p0, vis);
+    }
+    for (a = 0; a < 6; ++a) {
+        uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
+        if (p == RAD_NONE) continue;
+        for (c = pf; c < N; ++c) b->P[(size_t)p * N + c] = (float)acc[(size_t)a * N + c];
+    }
+    return RAD_SUCCESS;
+}
+
+/* mirror P into the columns left of each row's voxel, then divide by the row's area */
+static rad_result rad__vp_mirror_row(void *data, uint32_t p, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t N = vp->count, pf = vp->voxel_first[vp->voxel[p]], c;
+    (void)task;
+    for (c = 0; c < pf; ++c) b->P[(size_t)p * N + c] = b->P[(size_t)c * N + p];
+    return RAD_SUCCESS;
+}
+
+/* c_p = 1 / max(1, row sum of p) from the symmetric P */
+static rad_result rad__vp_rowsum_row(void *data, uint32_t p, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    uint32_t N = b->vp->count, c;
+    const float *row = b->P + (size_t)p * N;
+    double sum = 0.0;
+    (void)task;
+    for (c = 0; c < N; ++c) sum += (double)row[c];
+    sum /= (double)b->vp->areas[p];
+    b->rowf[p] = sum > 1.0 ? (float)(1.0 / sum) : 1.0f;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_divide_row(void *data, uint32_t p, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    uint32_t N = b->vp->count, c;
+    float *row = b->P + (size_t)p * N, cp = b->rowf[p];
+    double inv = 1.0 / (double)b->vp->areas[p];
+    (void)task;
+    for (c = 0; c < N; ++c) row[c] = (float)((double)row[c] * (double)(cp < b->rowf[c] ? cp : b->rowf[c]) * inv);
+    return RAD_SUCCESS;
+}
+
+/* grows the sample arrays to hold 'need' samples */
+static int rad__vp_grow(rad__vp_build *b, uint32_t *cap, uint32_t need, float **pos, uint32_t **tri, uint32_t **vox,
+                        float **bary)
+{
+    uint32_t n = *cap ? *cap : 1024u;
+    float *p2, *b2;
+    uint32_t *t2, *v2;
+    const rad_allocator *A = &b->vp->allocator;
+    if (need <= *cap) return 1;
+    while (n < need) n = n > 0x7FFFFFFFu ? 0xFFFFFFFEu : 2u * n;
+    p2 = (float *)rad__realloc(A, *pos, sizeof(float) * 3u * *cap, sizeof(float) * 3u * n);
+    if (!p2) return 0;
+    *pos = p2;
+    b2 = (float *)rad__realloc(A, *bary, sizeof(float) * 2u * *cap, sizeof(float) * 2u * n);
+    if (!b2) return 0;
+    *bary = b2;
+    t2 = (uint32_t *)rad__realloc(A, *tri, sizeof(uint32_t) * *cap, sizeof(uint32_t) * n);
+    if (!t2) return 0;
+    *tri = t2;
+    v2 = (uint32_t *)rad__realloc(A, *vox, sizeof(uint32_t) * *cap, sizeof(uint32_t) * n);
+    if (!v2) return 0;
+    *vox = v2;
+    *cap = n;
+    return 1;
+}
+
+/* area of triangle tv clipped to the box [lo, hi] (Sutherland-Hodgman in double) */
+static double rad__vp_clip_area(const float *tv, const double *lo, const double *hi)
+{
+    double poly[2][12][3], cr[3] = { 0.0, 0.0, 0.0 };
+    int n = 3, cur = 0, k, plane, i;
+    for (i = 0; i < 3; ++i)
+        for (k = 0; k < 3; ++k) poly[0][i][k] = tv[3 * i + k];
+    for (plane = 0; plane < 6 && n > 0; ++plane) {
+        int ax = plane >> 1, m = 0;
+        double bound = (plane & 1) ? hi[ax] : lo[ax], sgn = (plane & 1) ? -1.0 : 1.0;
+        for (i = 0; i < n; ++i) {
+            const double *a = poly[cur][i], *b = poly[cur][(i + 1) % n];
+            double da = sgn * (a[ax] - bound), db = sgn * (b[ax] - bound);
+            if (da >= 0.0) { memcpy(poly[1 - cur][m], a, sizeof(poly[0][0])); ++m; }
+            if ((da >= 0.0) != (db >= 0.0)) {
+                double t = da / (da - db);
+                for (k = 0; k < 3; ++k) poly[1 - cur][m][k] = a[k] + t * (b[k] - a[k]);
+                ++m;
+            }
+        }
+        n = m;
+        cur = 1 - cur;
+    }
+    for (i = 1; i + 1 < n; ++i) {
+        double e1[3], e2[3];
+        for (k = 0; k < 3; ++k) { e1[k] = poly[cur][i][k] - poly[cur][0][k]; e2[k] = poly[cur][i + 1][k] - poly[cur][0][k]; }
+        cr[0] += e1[1] * e2[2] - e1[2] * e2[1];
+        cr[1] += e1[2] * e2[0] - e1[0] * e2[2];
+        cr[2] += e1[0] * e2[1] - e1[1] * e2[0];
+    }
+    return 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+}
+
+/* unoccluded point-to-point form factor from sample i to sample k (area-corrected areas) */
+static double rad__vp_ff_pp(const rad__vp_build *b, uint32_t i, uint32_t k)
+{
+    const rad_virtual_patches *vp = b->vp;
+    float d[3], d2, ci, ck, ei = b->eff[i], ek = b->eff[k], fl;
+    if (i == k) return 0.0;
+    rad__sub(d, vp->sample_positions + 3 * (size_t)k, vp->sample_positions + 3 * (size_t)i);
+    ci = rad__dot(d, vp->sample_normals + 3 * (size_t)i);
+    ck = -rad__dot(d, vp->sample_normals + 3 * (size_t)k);
+    if (!(ci > 0.0f) || !(ck > 0.0f)) return 0.0;
+    d2 = rad__dot(d, d);
+    fl = (ei > ek ? ei : ek) / (float)RAD__PI;
+    return (double)ek * (double)(ci / d2) * (double)(ck / (d2 > fl ? d2 : fl)) / RAD__PI;
+}
+
+/* the clustering metric between clusters a and b of a task's scratch */
+static double rad__vp_metric(const double *R, const double *C, const double *col, const double *nrm, uint32_t kc, uint32_t a,
+                             uint32_t b)
+{
+    double dc = 0.0, dn, df = 0.0;
+    uint32_t t;
+    int k;
+    for (k = 0; k < 3; ++k) dc += (col[3 * a + k] - col[3 * b + k]) * (col[3 * a + k] - col[3 * b + k]);
+    dn = nrm[3 * a] * nrm[3 * b] + nrm[3 * a + 1] * nrm[3 * b + 1] + nrm[3 * a + 2] * nrm[3 * b + 2];
+    for (t = 0; t < kc; ++t) {
+        double x = R[(size_t)a * kc + t] - R[(size_t)b * kc + t], y = C[(size_t)a * kc + t] - C[(size_t)b * kc + t];
+        df += x * x + y * y;
+    }
+    return (1.0 + sqrt(dc)) * (2.0 - dn) * (1.0 + sqrt(df));
+}
+
+/* greedy clustering of voxel v's samples into at most max_clusters (SPEC §6 step 7) */
+static rad_result rad__vp_cluster_row(void *data, uint32_t v, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t s0 = vp->sample_first[v], n = vp->sample_first[v + 1] - s0, Q = b->o.max_clusters, kc = b->kc, i, j, t;
+    uint32_t nm = b->nmax, alive;
+    double *R = b->cscratch + (size_t)task * b->cper, *C = R + (size_t)nm * kc, *D = C + (size_t)nm * kc;
+    double *area = D + (size_t)nm * nm, *col = area + nm, *nrm = col + 3 * (size_t)nm, *label = nrm + 3 * (size_t)nm;
+    double *live = label + nm;
+    int k;
+    if (n <= Q) {
+        for (i = 0; i < n; ++i) b->slot[s0 + i] = (uint8_t)i;
+        b->ncl[v] = (uint8_t)n;
+        return RAD_SUCCESS;
+    }
+    for (i = 0; i < n; ++i) {
+        uint32_t si = s0 + i;
+        area[i] = (double)b->eff[si];
+        for (k = 0; k < 3; ++k) {
+            col[3 * i + k] = (double)vp->sample_albedo[3 * (size_t)si + k];
+            nrm[3 * i + k] = (double)vp->sample_normals[3 * (size_t)si + k];
+        }
+        for (t = 0; t < kc; ++t) {
+            R[(size_t)i * kc + t] = rad__vp_ff_pp(b, si, b->cols[t]);
+            C[(size_t)i * kc + t] = rad__vp_ff_pp(b, b->cols[t], si);
+        }
+        label[i] = (double)i;
+        live[i] = 1.0;
+    }
+    for (i = 0; i < n; ++i)
+        for (j = i + 1; j < n; ++j) D[(size_t)i * nm + j] = rad__vp_metric(R, C, col, nrm, kc, i, j);
+    for (alive = n; alive > Q; --alive) {
+        uint32_t ba = 0, bb = 0;
+        double best = -1.0, A;
+        for (i = 0; i < n; ++i) {
+            if (live[i] == 0.0) continue;
+            for (j = i + 1; j < n; ++j)
+                if (live[j] != 0.0 && (best < 0.0 || D[(size_t)i * nm + j] < best)) { best = D[(size_t)i * nm + j]; ba = i; bb = j; }
+        }
+        /* merge bb into ba (T eq. 5.2) */
+        A = area[ba] + area[bb];
+        for (t = 0; t < kc; ++t) {
+            R[(size_t)ba * kc + t] = (area[ba] * R[(size_t)ba * kc + t] + area[bb] * R[(size_t)bb * kc + t]) / A;
+            C[(size_t)ba * kc + t] += C[(size_t)bb * kc + t];
+        }
+        {
+            double nn[3], len;
+            for (k = 0; k < 3; ++k) {
+                col[3 * ba + k] = (area[ba] * col[3 * ba + k] + area[bb] * col[3 * bb + k]) / A;
+                nn[k] = area[ba] * nrm[3 * ba + k] + area[bb] * nrm[3 * bb + k];
+            }
+            len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+            if (len > 0.0)
+                for (k = 0; k < 3; ++k) nrm[3 * ba + k] = nn[k] / len;
+        }
+        area[ba] = A;
+        live[bb] = 0.0;
+        for (i = 0; i < n; ++i)
+            if (label[i] == (double)bb) label[i] = (double)ba;
+        for (i = 0; i < n; ++i) {
+            if (live[i] == 0.0 || i == ba) continue;
+            if (i < ba) D[(size_t)i * nm + ba] = rad__vp_metric(R, C, col, nrm, kc, i, ba);
+            else D[(size_t)ba * nm + i] = rad__vp_metric(R, C, col, nrm, kc, ba, i);
+        }
+    }
+    /* slots in order of the surviving clusters */
+    for (i = 0, t = 0; i < n; ++i)
+        if (live[i] != 0.0) live[i] = (double)(++t); /* slot + 1 */
+    for (i = 0; i < n; ++i) b->slot[s0 + i] = (uint8_t)(live[(uint32_t)label[i]] - 1.0);
+    b->ncl[v] = (uint8_t)t;
+    return RAD_SUCCESS;
+}
+
+/* maps the form-factor stage's progress to [0.1, 1] */
+typedef struct rad__vp_progress {
+    int (*fn)(void *user, float fraction);
+    void *user;
+} rad__vp_progress;
+
+static int rad__vp_progress_fn(void *user, float fraction)
+{
+    const rad__vp_progress *p = (const rad__vp_progress *)user;
+    return p->fn(p->user, 0.1f + 0.9f * fraction);
+}
+
+static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_scene *S = b->S;
+    const rad_allocator *A = &vp->allocator;
+    uint64_t *cand = NULL, total = 0;
+    uint32_t ncand = 0, t, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
+    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL, *voxel_cand = NULL;
+    double *cand_area = NULL;
+    float *s_pos = NULL, *s_bary = NULL;
+    size_t bytes, q;
+    rad_result r = RAD_SUCCESS;
+    int k;
+
+    /* 1. candidate voxels from triangle bounds */
+    for (t = 0; t < S->triangle_count; ++t) {
+        const float *tv = S->positions + 9 * (size_t)t;
+        uint64_t n = 1;
+        for (k = 0; k < 3; ++k) {
+            float mn = tv[k], mx = tv[k];
+            int64_t i0, i1;
+            if (tv[3 + k] < mn) mn = tv[3 + k];
+            if (tv[6 + k] < mn) mn = tv[6 + k];
+            if (tv[3 + k] > mx) mx = tv[3 + k];
+            if (tv[6 + k] > mx) mx = tv[6 + k];
+            i0 = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+            i1 = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+            if (i0 < 0) i0 = 0;
+            if (i1 > (int64_t)vp->dims[k] - 1) i1 = (int64_t)vp->dims[k] - 1;
+            n *= (uint64_t)(i1 >= i0 ? i1 - i0 + 1 : 0);
+        }
+        total += n;
+        if (total > 0xFFFFFFF0u) {
+            rad__log(c, RAD_LOG_ERROR, "virtual patches: triangles overlap more than 2^32 voxels (use bigger voxels)");
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+    }
+    cand = (uint64_t *)rad__alloc_array(A, (size_t)total, sizeof(uint64_t));
+    if (!cand) return RAD_ERROR_OUT_OF_MEMORY;
+    for (t = 0, q = 0; t < S->triangle_count; ++t) {
+        const float *tv = S->positions + 9 * (size_t)t;
+        int64_t i0[3], i1[3], x, y, z;
+        for (k = 0; k < 3; ++k) {
+            float mn = tv[k], mx = tv[k];
+            if (tv[3 + k] < mn) mn = tv[3 + k];
+            if (tv[6 + k] < mn) mn = tv[6 + k];
+            if (tv[3 + k] > mx) mx = tv[3 + k];
+            if (tv[6 + k] > mx) mx = tv[6 + k];
+            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+            if (i0[k] < 0) i0[k] = 0;
+            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
+        }
+        for (z = i0[2]; z <= i1[2]; ++z)
+            for (y = i0[1]; y <= i1[1]; ++y)
+                for (x = i0[0]; x <= i1[0]; ++x)
+                    cand[q++] = (uint64_t)x + (uint64_t)vp->dims[0] * ((uint64_t)y + (uint64_t)vp->dims[1] * (uint64_t)z);
+    }
+    qsort(cand, (size_t)total, sizeof(uint64_t), rad__vp_cmp_u64);
+    for (q = 0; q < (size_t)total; ++q)
+        if (q == 0 || cand[q] != cand[q - 1]) cand[ncand++] = cand[q];
+    vp->candidate_voxels = ncand;
+    b->cand = cand;
+
+    /* exact surface area per candidate voxel and axis: each triangle clipped to the voxels its
+       bounds overlap, times the split weights of its normal */
+    cand_area = (double *)rad__alloc_array(A, ncand, 6 * sizeof(double));
+    if (!cand_area) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(cand_area, 0, sizeof(double) * 6u * ncand);
+    for (t = 0; t < S->triangle_count; ++t) {
+        const float *tv = S->positions + 9 * (size_t)t;
+        int64_t i0[3], i1[3], x, y, z;
+        float wt[6];
+        rad__vp_weights(b->o.weights, S->normals + 3 * (size_t)t, wt);
+        for (k = 0; k < 3; ++k) {
+            float mn = tv[k], mx = tv[k];
+            if (tv[3 + k] < mn) mn = tv[3 + k];
+            if (tv[6 + k] < mn) mn = tv[6 + k];
+            if (tv[3 + k] > mx) mx = tv[3 + k];
+            if (tv[6 + k] > mx) mx = tv[6 + k];
+            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+            if (i0[k] < 0) i0[k] = 0;
+            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
+        }
+        for (z = i0[2]; z <= i1[2]; ++z)
+            for (y = i0[1]; y <= i1[1]; ++y)
+                for (x = i0[0]; x <= i1[0]; ++x) {
+                    uint64_t key = (uint64_t)x + (uint64_t)vp->dims[0] * ((uint64_t)y + (uint64_t)vp->dims[1] * (uint64_t)z);
+                    double lo[3], hi[3], ar;
+                    uint32_t lo_i = 0, hi_i = ncand;
+                    int64_t cell[3];
+                    cell[0] = x; cell[1] = y; cell[2] = z;
+                    for (k = 0; k < 3; ++k) {
+                        lo[k] = (double)vp->origin[k] + (double)cell[k] * (double)vp->voxel_size[k];
+                        hi[k] = lo[k] + (double)vp->voxel_size[k];
+                    }
+                    /* a triangle inside one voxel needs no clipping */
+                    ar = (i0[0] == i1[0] && i0[1] == i1[1] && i0[2] == i1[2]) ? (double)S->areas[t] : rad__vp_clip_area(tv, lo, hi);
+                    if (!(ar > 0.0)) continue;
+                    while (lo_i < hi_i) {
+                        uint32_t mid = lo_i + (hi_i - lo_i) / 2;
+                        if (cand[mid] < key) lo_i = mid + 1;
+                        else hi_i = mid;
+                    }
+                    for (k = 0; k < 6; ++k) cand_area[6 * (size_t)lo_i + k] += ar * (double)wt[k];
+                }
+    }
+
+    /* 2. face rays, chunk by chunk; samples appended in voxel order */
+    chunk = RAD__VP_CHUNK_RAYS / (6u * P);
+    if (chunk < 1) chunk = 1;
+    if (chunk > ncand) chunk = ncand;
+    b->hits = (rad_hit *)rad__alloc_array(A, (size_t)chunk * 6u * P, sizeof(rad_hit));
+    b->rays = (rad_ray *)rad__alloc_array(A, (size_t)b->tasks * RAD__RAY_BATCH, sizeof(rad_ray));
+    tri_count = (uint32_t *)rad__alloc_array(A, S->triangle_count, sizeof(uint32_t));
+    cand_first = (uint32_t *)rad__alloc_array(A, (size_t)ncand + 1u, sizeof(uint32_t));
+    if (!b->hits || !b->rays || !tri_count || !cand_first) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(tri_count, 0, sizeof(uint32_t) * S->triangle_count);
+    for (begin = 0; begin < ncand && r == RAD_SUCCESS; begin += chunk) {
+        uint32_t cnt = ncand - begin < chunk ? ncand - begin : chunk, h;
+        rad__ctx cc = *c;
+        cc.progress = NULL; /* progress once per chunk, below */
+        b->chunk_begin = begin;
+        r = rad__for_rows(&cc, cnt, b->tasks < cnt ? b->tasks : cnt, rad__vp_face_row, b);
+        if (r != RAD_SUCCESS) break;
+        vp->face_rays += (uint64_t)cnt * 6u * P;
+        for (v = 0; v < cnt; ++v) {
+            cand_first[begin + v] = M;
+            for (h = 0; h < 6u * P; ++h) {
+                const rad_hit *hit = &b->hits[(size_t)v * 6u * P + h];
+                const float *tv;
+                float b0;
+                if (hit->triangle == RAD_NONE || hit->triangle >= S->triangle_count) continue;
+                if (M == 0xFFFFFFFEu) {
+                    rad__log(c, RAD_LOG_ERROR, "virtual patches: more than 2^32 - 2 samples (use fewer face points)");
+                    r = RAD_ERROR_SIZE_OVERFLOW;
+                    goto done;
+                }
+                if (!rad__vp_grow(b, &cap, M + 1u, &s_pos, &s_tri, &s_vox, &s_bary)) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+                tv = S->positions + 9 * (size_t)hit->triangle;
+                b0 = 1.0f - hit->b1 - hit->b2;
+                for (k = 0; k < 3; ++k) s_pos[3 * (size_t)M + k] = b0 * tv[k] + hit->b1 * tv[3 + k] + hit->b2 * tv[6 + k];
+                s_bary[2 * (size_t)M] = hit->b1;
+                s_bary[2 * (size_t)M + 1] = hit->b2;
+                s_tri[M] = hit->triangle;
+                s_vox[M] = begin + v;
+                tri_count[hit->triangle]++;
+                ++M;
+            }
+        }
+        if (c->progress && c->progress(c->progress_user, 0.1f * (float)(begin + cnt) / (float)ncand)) r = RAD_ERROR_CANCELLED;
+    }
+    if (r != RAD_SUCCESS) goto done;
+    cand_first[ncand] = M;
+    rad__free(A, b->hits);
+    b->hits = NULL;
+    if (M == 0) {
+        rad__log(c, RAD_LOG_ERROR, "virtual patches: no face ray hit the scene (%u candidate voxels)", ncand);
+        r = RAD_ERROR_EMPTY_SCENE;
+        goto done;
+    }
+
+    /* 3. non-empty voxels, samples and their split weights */
+    for (v = 0; v < ncand; ++v)
+        if (cand_first[v + 1] > cand_first[v]) vp->voxel_count++;
+    vp->sample_count = M;
+    vp->voxel_keys = (uint64_t *)rad__alloc_array(A, vp->voxel_count, sizeof(uint64_t));
+    vp->voxel_first = (uint32_t *)rad__alloc_array(A, (size_t)vp->voxel_count + 1u, sizeof(uint32_t));
+    vp->sample_first = (uint32_t *)rad__alloc_array(A, (size_t)vp->voxel_count + 1u, sizeof(uint32_t));
+    vp->voxel_patch = (uint32_t *)rad__alloc_array(A, vp->voxel_count, 6 * sizeof(uint32_t));
+    vp->sample_normals = (float *)rad__alloc_array(A, M, 3 * sizeof(float));
+    vp->sample_albedo = (float *)rad__alloc_array(A, M, 3 * sizeof(float));
+    vp->sample_areas = (float *)rad__alloc_array(A, M, sizeof(float));
+    vp->sample_weights = (float *)rad__alloc_array(A, M, 6 * sizeof(float));
+    b->sample_voxel = (uint32_t *)rad__alloc_array(A, M, sizeof(uint32_t));
+    voxel_cand = (uint32_t *)rad__alloc_array(A, vp->voxel_count, sizeof(uint32_t));
+    if (!vp->voxel_keys || !vp->voxel_first || !vp->sample_first || !vp->voxel_patch || !vp->sample_normals ||
+        !vp->sample_albedo || !vp->sample_areas || !vp->sample_weights || !b->sample_voxel || !voxel_cand) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (v = 0, i = 0; v < ncand; ++v) {
+        uint32_t s;
+        if (cand_first[v + 1] == cand_first[v]) continue;
+        vp->voxel_keys[i] = cand[v];
+        voxel_cand[i] = v;
+        vp->sample_first[i] = cand_first[v];
+        for (s = cand_first[v]; s < cand_first[v + 1]; ++s) b->sample_voxel[s] = i;
+        ++i;
+    }
+    vp->sample_first[vp->voxel_count] = M;
+    vp->sample_positions = s_pos;
+    vp->sample_triangles = s_tri;
+    s_pos = NULL;
+    s_tri = NULL;
+    for (i = 0; i < M; ++i) {
+        uint32_t tr = vp->sample_triangles[i];
+        memcpy(vp->sample_normals + 3 * (size_t)i, S->normals + 3 * (size_t)tr, 3 * sizeof(float));
+        rad_scene_albedo(S, tr, s_bary[2 * (size_t)i], s_bary[2 * (size_t)i + 1], vp->sample_albedo + 3 * (size_t)i);
+        for (k = 0; k < 3; ++k)
+            if (!(vp->sample_albedo[3 * (size_t)i + k] >= 0.0f && vp->sample_albedo[3 * (size_t)i + k] < 1.0f)) {
+                rad__log(c, RAD_LOG_ERROR, "virtual patches: the albedo of triangle %u is outside [0, 1)", tr);
+                r = RAD_ERROR_ALBEDO_RANGE;
+                goto done;
+            }
+        vp->sample_areas[i] = S->areas[tr] / (float)tri_count[tr];
+        rad__vp_weights(b->o.weights, vp->sample_normals + 3 * (size_t)i, vp->sample_weights + 6 * (size_t)i);
+    }
+
+    /* 4. patches: one per voxel and axis with samples; the weights of its samples are scaled
+       so that the patch area is the exact clipped area of the voxel's surface on that axis
+       (clustered: one per cluster, every sample scaled by its voxel's area correction) */
+    if (b->o.kind == RAD_VP_CLUSTERED) {
+        uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count, s;
+        rad__ctx cc = *c;
+        cc.progress = NULL;
+        b->vscale = (float *)rad__alloc_array(A, vp->voxel_count, sizeof(float));
+        b->eff = (float *)rad__alloc_array(A, M, sizeof(float));
+        b->slot = (uint8_t *)rad__alloc_array(A, M, 1);
+        b->ncl = (uint8_t *)rad__alloc_array(A, vp->voxel_count, 1);
+        b->kc = b->o.metric_columns < M ? b->o.metric_columns : M;
+        b->cols = (uint32_t *)rad__alloc_array(A, b->kc, sizeof(uint32_t));
+        b->nmax = 1;
+        for (v = 0; v < vp->voxel_count; ++v)
+            if (vp->sample_first[v + 1] - vp->sample_first[v] > b->nmax) b->nmax = vp->sample_first[v + 1] - vp->sample_first[v];
+        b->cper = 2 * (size_t)b->nmax * b->kc + (size_t)b->nmax * b->nmax + 9 * (size_t)b->nmax;
+        b->cscratch = (double *)rad__alloc_array(A, (size_t)T, b->cper * sizeof(double));
+        if (!b->vscale || !b->eff || !b->slot || !b->ncl || !b->cols || !b->cscratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+        for (v = 0; v < vp->voxel_count; ++v) {
+            double have = 0.0, exact = 0.0;
+            for (a = 0; a < 6; ++a) exact += cand_area[6 * (size_t)voxel_cand[v] + a];
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) have += (double)vp->sample_areas[s];
+            b->vscale[v] = have > 0.0 && exact > 0.0 ? (float)(exact / have) : 1.0f;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) b->eff[s] = vp->sample_areas[s] * b->vscale[v];
+        }
+        for (i = 0; i < b->kc; ++i) b->cols[i] = (uint32_t)(((uint64_t)2 * i + 1) * M / (2 * (uint64_t)b->kc));
+        r = rad__for_rows(&cc, vp->voxel_count, T, rad__vp_cluster_row, b);
+        if (r != RAD_SUCCESS) goto done;
+        for (v = 0; v < vp->voxel_count; ++v) {
+            vp->voxel_first[v] = N;
+            for (a = 0; a < 6; ++a) vp->voxel_patch[6 * (size_t)v + a] = a < b->ncl[v] ? N++ : RAD_NONE;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                for (a = 0; a < 6; ++a) vp->sample_weights[6 * (size_t)s + a] = 0.0f;
+                vp->sample_weights[6 * (size_t)s + b->slot[s]] = b->vscale[v];
+            }
+        }
+        rad__free(A, b->eff);
+        b->eff = NULL;
+    } else for (v = 0; v < vp->voxel_count; ++v) {
+        vp->voxel_first[v] = N;
+        for (a = 0; a < 6; ++a) {
+            uint32_t s;
+            double have = 0.0, exact = cand_area[6 * (size_t)voxel_cand[v] + a];
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s)
+                have += (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+            if (have > 0.0 && exact > 0.0) {
+                float scale = (float)(exact / have);
+                for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) vp->sample_weights[6 * (size_t)s + a] *= scale;
+            }
+            vp->voxel_patch[6 * (size_t)v + a] = have > 0.0 ? N++ : RAD_NONE;
+        }
+    }
+    rad__free(A, cand_area);
+    cand_area = NULL;
+    rad__free(A, voxel_cand);
+    voxel_cand = NULL;
+    b->eff = (float *)rad__alloc_array(A, M, sizeof(float));
+    if (!b->eff) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (i = 0; i < M; ++i) {
+        const float *w = vp->sample_weights + 6 * (size_t)i;
+        b->eff[i] = vp->sample_areas[i] * (w[0] + w[1] + w[2] + w[3] + w[4] + w[5]);
+    }
+    vp->voxel_first[vp->voxel_count] = N;
+    vp->count = N;
+    if (!rad__mul3(N, N, sizeof(float), &bytes)) {
+        rad__log(c, RAD_LOG_ERROR, "virtual patches: the %u x %u matrix does not fit in memory (use bigger voxels)", N, N);
+        r = RAD_ERROR_SIZE_OVERFLOW;
+        goto done;
+    }
+    vp->areas = (float *)rad__alloc_array(A, N, sizeof(float));
+    vp->albedo = (float *)rad__alloc_array(A, N, 3 * sizeof(float));
+    vp->normals = (float *)rad__alloc_array(A, N, 3 * sizeof(float));
+    vp->axis = (uint8_t *)rad__alloc_array(A, N, 1);
+    vp->voxel = (uint32_t *)rad__alloc_array(A, N, sizeof(uint32_t));
+    if (!vp->areas || !vp->albedo || !vp->normals || !vp->axis || !vp->voxel) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (v = 0; v < vp->voxel_count; ++v)
+        for (a = 0; a < 6; ++a) {
+            uint32_t p = vp->voxel_patch[6 * (size_t)v + a], s;
+            double area = 0.0, col[3] = { 0.0, 0.0, 0.0 };
+            if (p == RAD_NONE) continue;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                area += w;
+                for (k = 0; k < 3; ++k) col[k] += w * (double)vp->sample_albedo[3 * (size_t)s + k];
+            }
+            vp->areas[p] = (float)area;
+            for (k = 0; k < 3; ++k) {
+                vp->albedo[3 * (size_t)p + k] = (float)(col[k] / area);
+                vp->normals[3 * (size_t)p + k] = 0.0f;
+            }
+            if (b->o.kind == RAD_VP_CLUSTERED) {
+                double nn[3] = { 0.0, 0.0, 0.0 }, len;
+                for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                    double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                    for (k = 0; k < 3; ++k) nn[k] += w * (double)vp->sample_normals[3 * (size_t)s + k];
+                }
+                len = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+                for (k = 0; k < 3; ++k) vp->normals[3 * (size_t)p + k] = len > 0.0 ? (float)(nn[k] / len) : 0.0f;
+            } else {
+                vp->normals[3 * (size_t)p + (a >> 1)] = (a & 1u) ? -1.0f : 1.0f;
+            }
+            vp->axis[p] = (uint8_t)a;
+            vp->voxel[p] = v;
+        }
+
+    /* 5. form factors, one row voxel per task */
+    rad__free(A, s_bary);
+    s_bary = NULL;
+    rad__free(A, tri_count);
+    tri_count = NULL;
+    rad__free(A, cand);
+    cand = NULL;
+    b->cand = NULL;
+    rad__free(A, cand_first);
+    cand_first = NULL;
+    b->P = (float *)rad__alloc(A, bytes);
+    if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    vp->matrix.rows = vp->matrix.cols = N;
+    vp->matrix.storage = RAD_STORAGE_DENSE;
+    vp->matrix.dense = b->P; /* owned by vp from here on */
+    {
+        uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
+        rad__ctx cc = *c;
+        rad__vp_progress prog;
+        prog.fn = c->progress;
+        prog.user = c->progress_user;
+        if (c->progress) {
+            cc.progress = rad__vp_progress_fn;
+            cc.progress_user = &prog;
+        }
+        b->occ = (uint8_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, 1);
+        b->ray_i = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+        b->ray_j = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+        b->ray_g = (float *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(float));
+        b->rays_cast = (uint64_t *)rad__alloc_array(A, T, sizeof(uint64_t));
+        b->acc = (double *)rad__alloc_array(A, (size_t)T * 6u, (size_t)N * sizeof(double));
+        b->rowf = (float *)rad__alloc_array(A, N, sizeof(float));
+        if (b->o.visibility_rays > 0 && !b->o.skip_visibility)
+            b->pairs = (rad__vp_pair *)rad__alloc_array(A, (size_t)T * RAD__VP_PAIRS, sizeof(rad__vp_pair));
+        if (!b->occ || !b->ray_i || !b->ray_j || !b->ray_g || !b->rays_cast || !b->acc || !b->rowf ||
+            (b->o.visibility_rays > 0 && !b->o.skip_visibility && !b->pairs)) {
+            r = RAD_ERROR_OUT_OF_MEMORY;
+            goto done;
+        }
+        memset(b->rays_cast, 0, sizeof(uint64_t) * T);
+        /* progress of this stage maps to [0.1, 1] */
+        if (c->progress && c->progress(c->progress_user, 0.1f)) { r = RAD_ERROR_CANCELLED; goto done; }
+        r = rad__for_rows(&cc, vp->voxel_count, T, b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled : rad__vp_ff_row, b);
+        for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+        if (r == RAD_SUCCESS) {
+            cc.progress = NULL;
+            r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
+            if (r == RAD_SUCCESS && !b->o.keep_row_sums) r = rad__for_rows(&cc, N, T, rad__vp_rowsum_row, b);
+            else if (r == RAD_SUCCESS)
+                for (i = 0; i < N; ++i) b->rowf[i] = 1.0f;
+            if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
+        }
+        if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
+    }
+done:
+    rad__free(A, cand);
+    rad__free(A, cand_area);
+    rad__free(A, voxel_cand);
+    rad__free(A, cand_first);
+    rad__free(A, tri_count);
+    rad__free(A, s_pos);
+    rad__free(A, s_tri);
+    rad__free(A, s_vox);
+    rad__free(A, s_bary);
+    rad__free(A, b->hits);
+    rad__free(A, b->rays);
+    rad__free(A, b->occ);
+    rad__free(A, b->ray_i);
+    rad__free(A, b->ray_j);
+    rad__free(A, b->ray_g);
+    rad__free(A, b->rays_cast);
+    rad__free(A, b->acc);
+    rad__free(A, b->pairs);
+    rad__free(A, b->eff);
+    rad__free(A, b->rowf);
+    rad__free(A, b->vscale);
+    rad__free(A, b->cols);
+    rad__free(A, b->cscratch);
+    rad__free(A, b->slot);
+    rad__free(A, b->ncl);
+    rad__free(A, b->sample_voxel);
+    return r;
+}
+
+RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                 const rad_context *ctx, rad_virtual_patches **out)
+{
+    rad__ctx c;
+    rad__vp_build b;
+    rad_virtual_patches *vp;
+    rad_result r;
+    double cells = 1.0;
+    int k, given = 0;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!scene || !raycaster || !out || !raycaster->intersect) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: NULL scene, raycaster, intersect callback or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    memset(&b, 0, sizeof(b));
+    if (options) b.o = *options; else rad_vp_options_default(&b.o);
+    if (b.o.resolution == 0) b.o.resolution = 16;
+    if (b.o.face_points == 0) b.o.face_points = 16;
+    if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
+    if (b.o.max_clusters == 0) b.o.max_clusters = 6;
+    if (b.o.metric_columns == 0) b.o.metric_columns = 64;
+    if ((b.o.kind != RAD_VP_AXIS_ALIGNED && b.o.kind != RAD_VP_CLUSTERED) || b.o.max_clusters > 6 || b.o.metric_columns > 4096) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: bad kind, max_clusters (1..6) or metric_columns (<= 4096)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (k = 0; k < 3; ++k) {
+        if (!rad__finite(b.o.voxel_size[k]) || b.o.voxel_size[k] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size[%d] = %g is negative or not finite", k, (double)b.o.voxel_size[k]);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (b.o.voxel_size[k] > 0.0f) given++;
+    }
+    if ((given != 0 && given != 3) || b.o.face_points > 4096u || b.o.visibility_rays > RAD__RAY_BATCH || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
+        !rad__finite(b.o.ray_epsilon) || b.o.ray_epsilon < 0.0f || (!b.o.skip_visibility && !raycaster->occluded)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size must be all 0 or all > 0; face_points <= 4096; visibility_rays "
+                 "<= 1024; weights, ray_epsilon valid; an occluded callback unless skip_visibility");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(vp, 0, sizeof(*vp));
+    vp->allocator = c.allocator;
+    vp->scene = scene;
+    vp->weights = b.o.weights;
+    vp->kind = b.o.kind;
+    for (k = 0; k < 3; ++k) {
+        float ext = scene->bounds_max[k] - scene->bounds_min[k], h;
+        float longest = scene->bounds_max[0] - scene->bounds_min[0];
+        if (scene->bounds_max[1] - scene->bounds_min[1] > longest) longest = scene->bounds_max[1] - scene->bounds_min[1];
+        if (scene->bounds_max[2] - scene->bounds_min[2] > longest) longest = scene->bounds_max[2] - scene->bounds_min[2];
+        h = given ? b.o.voxel_size[k] : longest / (float)b.o.resolution;
+        if (!(h > 0.0f)) h = 1.0f;
+        vp->voxel_size[k] = h;
+        vp->origin[k] = scene->bounds_min[k] - RAD__VP_MARGIN * h;
+        cells = floor((double)(ext + 2.0f * RAD__VP_MARGIN * h) / (double)h) + 1.0;
+        if (cells > 4194304.0) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: %g voxels along axis %d (use bigger voxels)", cells, k);
+            rad_vp_destroy(vp);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        vp->dims[k] = (uint32_t)cells;
+    }
+    b.S = scene;
+    b.rc = raycaster;
+    b.vp = vp;
+    b.eps = b.o.ray_epsilon * scene->diagonal;
+    b.tasks = c.tasks;
+    r = rad__vp_build_run(&b, &c);
+    if (r != RAD_SUCCESS) {
+        rad_vp_destroy(vp);
+        return r;
+    }
+    *out = vp;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E)
+{
+    if (!system) return;
+    memset(system, 0, sizeof(*system));
+    if (!vp) return;
+    system->F = &vp->matrix;
+    system->albedo = vp->albedo;
+    system->areas = vp->areas;
+    system->E = E;
+    system->n = vp->count;
+}
+
+RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out)
+{
+    uint32_t v, a, s;
+    int k;
+    if (!vp || !sample_values || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    for (v = 0; v < vp->voxel_count; ++v)
+        for (a = 0; a < 6; ++a) {
+            uint32_t p = vp->voxel_patch[6 * (size_t)v + a];
+            double acc[3] = { 0.0, 0.0, 0.0 }, wsum = 0.0;
+            if (p == RAD_NONE) continue;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                if (vp->kind == RAD_VP_CLUSTERED) {
+                    double cosw = (double)rad__dot(vp->normals + 3 * (size_t)p, vp->sample_normals + 3 * (size_t)s);
+                    w = cosw > 0.0 ? cosw * (double)vp->sample_areas[s] : 0.0;
+                }
+                wsum += w;
+                for (k = 0; k < 3; ++k) acc[k] += w * (double)sample_values[3 * (size_t)s + k];
+            }
+            for (k = 0; k < 3; ++k) out[3 * (size_t)p + k] = wsum > 0.0 ? (float)(acc[k] / wsum) : 0.0f;
+        }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster, const rad_light *lights,
+                                  uint32_t light_count, const rad_direct_options *options, rad_source_mode mode,
+                                  float *out_E, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *v;
+    uint32_t i, M;
+    rad_result r = RAD_SUCCESS;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !out_E || (mode != RAD_SOURCE_DIRECT && mode != RAD_SOURCE_EMISSION)) return RAD_ERROR_INVALID_ARGUMENT;
+    M = vp->sample_count;
+    v = (float *)rad__alloc_array(&c.allocator, M, 3 * sizeof(float));
+    if (!v) return RAD_ERROR_OUT_OF_MEMORY;
+    if (mode == RAD_SOURCE_DIRECT) {
+        r = rad_direct_irradiance(vp->scene, raycaster, lights, light_count, options, vp->sample_positions,
+                                  vp->sample_normals, M, v, ctx);
+        if (r == RAD_SUCCESS)
+            for (i = 0; i < 3 * M; ++i) v[i] *= vp->sample_albedo[i];
+    } else {
+        const rad_scene *S = vp->scene;
+        for (i = 0; i < M; ++i) {
+            const float *L = S->materials_table[S->materials[vp->sample_triangles[i]]].emission;
+            for (k = 0; k < 3; ++k) v[3 * (size_t)i + k] = (float)RAD__PI * L[k];
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad_vp_from_samples(vp, v, out_E);
+    rad__free(&c.allocator, v);
+    if (r == RAD_SUCCESS) r = rad__check_output(&c, "virtual-patch sources", out_E, 3 * (size_t)vp->count);
+    return r;
+}
+
+/* index of the voxel with this key, or RAD_NONE */
+static uint32_t rad__vp_find(const rad_virtual_patches *vp, uint64_t key)
+{
+    uint32_t lo = 0, hi = vp->voxel_count;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (vp->voxel_keys[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < vp->voxel_count && vp->voxel_keys[lo] == key ? lo : RAD_NONE;
+}
+
+RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float *values, const float p[3],
+                                     const float n[3], float out[3])
+{
+    double g[3], acc[3] = { 0.0, 0.0, 0.0 }, tsum = 0.0, facc[3] = { 0.0, 0.0, 0.0 };
+    int64_t base[3];
+    float w[6];
+    uint32_t corner, used = 0;
+    int k;
+    if (!out) return 0;
+    out[0] = out[1] = out[2] = 0.0f;
+    if (!vp || !values || !p || !n || !rad__finite3(p) || !rad__finite3(n)) return 0;
+    rad__vp_weights(vp->weights, n, w);
+    for (k = 0; k < 3; ++k) {
+        double x = ((double)p[k] - (double)vp->origin[k]) / (double)vp->voxel_size[k] - 0.5;
+        if (x < -2.0) x = -2.0;
+        if (x > (double)vp->dims[k] + 1.0) x = (double)vp->dims[k] + 1.0;
+        base[k] = (int64_t)floor(x);
+        g[k] = x - (double)base[k];
+    }
+    for (corner = 0; corner < 8; ++corner) {
+        int64_t cell[3];
+        double t = 1.0, L[3] = { 0.0, 0.0, 0.0 }, ws = 0.0;
+        uint32_t v, a;
+        int inside = 1;
+        for (k = 0; k < 3; ++k) {
+            int bit = (int)((corner >> k) & 1u);
+            cell[k] = base[k] + bit;
+            t *= bit ? g[k] : 1.0 - g[k];
+            if (cell[k] < 0 || cell[k] >= (int64_t)vp->dims[k]) inside = 0;
+        }
+        if (!inside) continue;
+        v = rad__vp_find(vp, (uint64_t)cell[0] + (uint64_t)vp->dims[0] * ((uint64_t)cell[1] + (uint64_t)vp->dims[1] * (uint64_t)cell[2]));
+        if (v == RAD_NONE) continue;
+        for (a = 0; a < 6; ++a) {
+            uint32_t q = vp->voxel_patch[6 * (size_t)v + a];
+            float wa;
+            if (q == RAD_NONE) continue;
+            wa = vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)q, n) : w[a];
+            if (!(wa > 0.0f)) continue;
+            ws += (double)wa;
+            for (k = 0; k < 3; ++k) L[k] += (double)wa * (double)values[3 * (size_t)q + k];
+        }
+        if (!(ws > 0.0)) continue; /* nothing in this voxel faces n */
+        used++;
+        for (k = 0; k < 3; ++k) {
+            acc[k] += t * L[k] / ws;
+            facc[k] += L[k] / ws;
+        }
+        tsum += t;
+    }
+    if (!used) return 0;
+    for (k = 0; k < 3; ++k) out[k] = tsum > 0.0 ? (float)(acc[k] / tsum) : (float)(facc[k] / (double)used);
+    return used;
+}
+
+typedef struct rad__vp_gather_job {
+    const rad_virtual_patches *vp;
+    const float *values, *points, *normals;
+    float *out;
+    uint32_t count, tasks;
+} rad__vp_gather_job;
+
+static void rad__vp_gather_task(void *data, uint32_t task)
+{
+    rad__vp_gather_job *j = (rad__vp_gather_job *)data;
+    uint32_t i0 = (uint32_t)((uint64_t)j->count * task / j->tasks), i1 = (uint32_t)((uint64_t)j->count * (task + 1) / j->tasks), i;
+    for (i = i0; i < i1; ++i)
+        (void)rad_vp_gather_point(j->vp, j->values, j->points + 3 * (size_t)i, j->normals + 3 * (size_t)i, j->out + 3 * (size_t)i);
+}
+
+RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *values, const float *points,
+                                 const float *normals, uint32_t count, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__vp_gather_job j;
+    uint32_t i;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !values || (count && (!points || !normals || !out))) return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < count; ++i)
+        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather: point %u or its normal is not finite", i);
+            return RAD_ERROR_NON_FINITE;
+        }
+    if (count == 0) return RAD_SUCCESS;
+    j.vp = vp;
+    j.values = values;
+    j.points = points;
+    j.normals = normals;
+    j.out = out;
+    j.count = count;
+    j.tasks = c.tasks < count ? c.tasks : count;
+    c.parallel_for(c.parallel_user, j.tasks, rad__vp_gather_task, &j);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
+                                      float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *pts, *nrm;
+    size_t ps, ns;
+    uint32_t V, T, t, i;
+    rad_result r;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !values || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    V = mesh->vertex_count;
+    T = mesh->triangle_count;
+    if (!mesh->indices && (size_t)T * 3u > V) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    ps = mesh->position_stride ? mesh->position_stride : 3 * sizeof(float);
+    ns = mesh->normal_stride ? mesh->normal_stride : 3 * sizeof(float);
+    pts = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
+    if (!pts || !nrm) {
+        rad__free(&c.allocator, pts);
+        rad__free(&c.allocator, nrm);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < V; ++i) memcpy(pts + 3 * (size_t)i, (const char *)mesh->positions + ps * i, 3 * sizeof(float));
+    memset(nrm, 0, sizeof(float) * 3u * V);
+    if (mesh->normals) {
+        for (i = 0; i < V; ++i) memcpy(nrm + 3 * (size_t)i, (const char *)mesh->normals + ns * i, 3 * sizeof(float));
+    } else {
+        for (t = 0; t < T; ++t) {
+            uint32_t id[3], m;
+            float e1[3], e2[3], cr[3];
+            for (m = 0; m < 3; ++m) {
+                id[m] = mesh->indices ? mesh->indices[3 * (size_t)t + m] : 3u * t + m;
+                if (id[m] >= V) {
+                    rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_mesh: triangle %u has vertex index %u >= %u", t, id[m], V);
+                    rad__free(&c.allocator, pts);
+                    rad__free(&c.allocator, nrm);
+                    return RAD_ERROR_INDEX_OUT_OF_RANGE;
+                }
+            }
+            rad__sub(e1, pts + 3 * (size_t)id[1], pts + 3 * (size_t)id[0]);
+            rad__sub(e2, pts + 3 * (size_t)id[2], pts + 3 * (size_t)id[0]);
+            rad__cross(cr, e1, e2); /* twice the area times the unit normal */
+            for (m = 0; m < 3; ++m)
+                for (k = 0; k < 3; ++k) nrm[3 * (size_t)id[m] + k] += cr[k];
+        }
+    }
+    for (i = 0; i < V; ++i) rad__normalize(nrm + 3 * (size_t)i);
+    r = rad_vp_gather(vp, values, pts, nrm, V, out, ctx);
+    rad__free(&c.allocator, pts);
+    rad__free(&c.allocator, nrm);
+    return r;
 }
 
 #endif /* RADIOSITY_IMPLEMENTATION */

@@ -114,6 +114,13 @@ else
     fail gallery-small
 fi
 compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+# the virtual-patch example builds and, without the shared data, says it skipped
+if build vp-bunny $CC -std=c99 $WARN -O2 $OMP -I. examples/vp_bunny.c -o "$BUILD/vp_bunny" -lm &&
+   "$BUILD/vp_bunny" --data "$BUILD/no-such-data" >"$BUILD/vp_bunny.out" 2>&1 && grep -q skipped "$BUILD/vp_bunny.out"; then
+    pass vp-bunny-skip
+else
+    fail vp-bunny-skip
+fi
 if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -lm &&
    "$BUILD/walk" --grid 2 --m 256 --frames 2 --size 64x36 -o "$BUILD/walk-small" >"$BUILD/walk.out" 2>&1 &&
    [ -s "$BUILD/walk-small_001.png" ]; then

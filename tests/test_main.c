@@ -61,6 +61,7 @@ static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
 #include "test_multibounce.c"
 #include "test_temporal.c"
 #include "test_local.c"
+#include "test_vp.c"
 #include "test_regress.c"
 #include "test_robust.c"
 #include "test_api.c"
@@ -68,7 +69,7 @@ static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
 #include "test_shading.c"
 #include "test_glsl.c"
 
-static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_solve, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl };
+static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_solve, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl };
 
 int main(int argc, char **argv)
 {
