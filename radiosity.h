@@ -206,12 +206,12 @@
        float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
        step (the same random draws as the CPU), the alias-table build for streamed rows, and
        the local multi-bounce matrix's apply and add (rank-1 update, rank-2 when evicting) on
-       a matrix kept resident on the GPU;
+       a matrix kept resident on the GPU, and virtual-patch gathering at surface points;
        RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
        specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), a workgroup (gathers, applies) or
-       an invocation (temporal step, alias build, local pre-pass) per row, and row_offset / row_count / base in
+       an invocation (temporal step, alias build, local pre-pass, vp gather) per row, and row_offset / row_count / base in
        every kernel so a matrix larger than one storage-buffer
        range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
        sources: the .comp files in glsl/ of the repository (make glsl regenerates the header's copy);
@@ -1114,7 +1114,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
      dispatch row_count groups in x (at most maxComputeWorkGroupCount[0], 65535 guaranteed:
      chunk longer runs); the group's invocations read the row at consecutive addresses with a
      stride of the group size and sum in shared memory (12 bytes per invocation). The temporal
-     step and the alias build run ONE INVOCATION PER ROW: ceil(row_count / size) groups
+     step, the alias build and VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
      (LOCAL_VECTORS: per row or column, see its entry).
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
@@ -1216,7 +1216,20 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        has no kernel; hiding and showing members (rad_local_remove, re-adding a hidden member)
        touch no plane. Measured on lavapipe (tests/test_vulkan.c) after 46 adds, 6 of
        them evicting, into M = 48: at most 9.7e-7 relative from rad_local_add's planes (exact
-       and first-order), the float pre-pass against the CPU's double u, v and s. */
+       and first-order), the float pre-pass against the CPU's double u, v and s.
+   RAD_GLSL_VP_GATHER      virtual-patch gathering at surface points (vertices, G-buffer
+       texels), as rad_vp_gather: split-weight (or, clustered, N . n) normal weights in each
+       voxel of the 2x2x2 block, trilinear weights across the voxels, voxels missing or with no
+       patch facing n skipped (>>api_vp). Push: rad_glsl_vp_gather_push (the grid of the
+       rad_virtual_patches); flags RAD_GLSL_FLAG_COSINE (weights RAD_VP_WEIGHTS_COSINE),
+       _CLUSTERED. ONE INVOCATION PER POINT. 0: points (3 floats each)  1: unit normals
+       (3 each)  2: values per patch (3N: B, L or H)  3: voxel_keys (voxel_count uint64, as
+       uvec2)  4: voxel_patch (6 per voxel)  5: patch normals (3N; read only when CLUSTERED,
+       else bind any buffer)  6: out (3 per point). Chunks: bindings 0, 1 and 6 hold the
+       chunk's points from element base (bind the three at the same offset). The grid
+       coordinate is computed as a float pair (TwoSum / Dekker products: the CPU uses double),
+       because its float rounding, about 1e-7 dims absolute, is large against small trilinear
+       weights (measured: 3e-5 relative without it, 2.9e-7 with it, on lavapipe). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -1231,7 +1244,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_LOCAL_APPLY       =  8, /* glsl/local_apply.comp */
     RAD_GLSL_LOCAL_VECTORS     =  9, /* glsl/local_vectors.comp */
     RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
-    RAD_GLSL_COUNT = 11
+    RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
+    RAD_GLSL_COUNT = 12
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -1250,6 +1264,8 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_LOCAL_PASS_EVICT 1u   /* local vectors: the fused downdate's corrections (evicting adds) */
 #define RAD_GLSL_LOCAL_PASS_SCALARS 2u /* local vectors: s and the factors, 3 invocations */
 /* floats of the local-update work buffer for capacity m (u, v, c, r per channel, 12 scalars) */
+#define RAD_GLSL_FLAG_COSINE 1u       /* vp gather: RAD_VP_WEIGHTS_COSINE split weights */
+#define RAD_GLSL_FLAG_CLUSTERED 2u    /* vp gather: RAD_VP_CLUSTERED (w = N_a . n; binding 5 read) */
 #define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
@@ -1309,6 +1325,15 @@ typedef struct rad_glsl_local_update_push {
     uint32_t k;                    /* the new patch's slot */
     uint32_t ev;                   /* the slot evicted by this add (== k), or RAD_NONE */
 } rad_glsl_local_update_push;
+typedef struct rad_glsl_vp_gather_push {
+    float origin[3];               /* rad_virtual_patches.origin */
+    float voxel_size[3];           /* .voxel_size */
+    uint32_t dims[3];              /* .dims */
+    uint32_t voxel_count;          /* .voxel_count */
+    uint32_t row_offset, row_count; /* the points of this dispatch */
+    uint32_t base;                 /* element of bindings 0, 1, 6 holding point row_offset's x */
+    uint32_t flags;                /* RAD_GLSL_FLAG_COSINE, _CLUSTERED */
+} rad_glsl_vp_gather_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -6592,6 +6617,10 @@ typedef char rad__check_glsl_local_vectors_push[(sizeof(rad_glsl_local_vectors_p
 typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_push) == 28 &&
                                                 offsetof(rad_glsl_local_update_push, base) == 16 &&
                                                 offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
+typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
+                                             offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
+                                             offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
+                                             offsetof(rad_glsl_vp_gather_push, flags) == 52) ? 1 : -1];
 typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28 &&
                                          offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
                                          offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
@@ -7571,6 +7600,154 @@ static const char rad__glsl_10_0[] =
     "    for (uint c = 0u; c < 3u; ++c) update(c, at, i);\n"
     "}\n";
 static const char *const rad__glsl_pieces_10[] = { rad__glsl_10_0 };
+static const char rad__glsl_11_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_VP_GATHER: virtual-patch gathering at surface points, as\n"
+    "// rad_vp_gather / rad_vp_gather_point (SPEC \302\2476-\302\2477, T eq. 5.3, P eq. 9). For point i with unit\n"
+    "// normal n: in each voxel v of the 2x2x2 block around p (by voxel centres; the grid coordinate\n"
+    "// x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),\n"
+    "//   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0\n"
+    "// (axis-aligned: w_a the split weights of n, max(0, +-n_k)^2 or max(0, +-n_k) normalized to\n"
+    "// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = N_a . n); voxels outside the grid,\n"
+    "// empty or with no patch facing n are skipped, and\n"
+    "//   out_i = sum_v t_v L(v) / sum_v t_v       (t_v the trilinear weights; 0 when no voxel is used;\n"
+    "//   the plain mean of the used L(v) when their t_v sum to 0)\n"
+    "// ONE INVOCATION PER POINT: dispatch ceil(row_count / size) groups for the points\n"
+    "// row_offset .. row_offset + row_count - 1. Chunking: bindings 0, 1 and 6 may hold only this\n"
+    "// chunk's points, point i at elements base + 3 (i - row_offset) .. + 2 of each (bind the three at\n"
+    "// the same element offset). Voxel keys are the uint64 rad_virtual_patches.voxel_keys (ascending,\n"
+    "// ix + dims0 (iy + dims1 iz)), read as uvec2 (low word first) and found by binary search.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer Points { float P[]; };       // 3 per point\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Normals { float Nrm[]; };    // 3 per point, unit\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float X[]; };       // 3 N, per patch\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VoxelKeys { uvec2 keys[]; }; // voxel_count uint64\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VoxelPatch { uint vpatch[]; }; // 6 per voxel, or ~0u\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N (clustered only)\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };             // 3 per point\n"
+    "layout(push_constant) uniform Push {\n"
+    "    float origin_x, origin_y, origin_z;   // rad_virtual_patches.origin\n"
+    "    float size_x, size_y, size_z;         // .voxel_size\n"
+    "    uint dims_x, dims_y, dims_z;          // .dims\n"
+    "    uint voxel_count;                     // .voxel_count\n"
+    "    uint row_offset;                      // first point of this dispatch\n"
+    "    uint row_count;                       // points in this dispatch\n"
+    "    uint base;                            // element of bindings 0, 1, 6 holding point row_offset\n"
+    "    uint flags;                           // bit 0: cosine split weights; bit 1: clustered\n"
+    "} pc;\n"
+    "\n"
+    "uvec2 mul64(uint a, uvec2 b) { uint hi, lo; umulExtended(a, b.x, hi, lo); return uvec2(lo, hi + a * b.y); }\n"
+    "uvec2 add64(uvec2 a, uint b) { uint c; uint lo = uaddCarry(a.x, b, c); return uvec2(lo, a.y + c); }\n"
+    "bool less64(uvec2 a, uvec2 b) { return a.y < b.y || (a.y == b.y && a.x < b.x); }\n"
+    "\n"
+    "uint find_voxel(uvec2 key)\n"
+    "{\n"
+    "    uint lo = 0u, hi = pc.voxel_count;\n"
+    "    while (lo < hi) {\n"
+    "        uint mid = lo + (hi - lo) / 2u;\n"
+    "        if (less64(keys[mid], key)) lo = mid + 1u; else hi = mid;\n"
+    "    }\n"
+    "    return lo < pc.voxel_count && keys[lo] == key \? lo : 0xFFFFFFFFu;\n"
+    "}\n"
+    "\n"
+    "// a + b exactly, as the pair (sum, error) (Knuth's TwoSum)\n"
+    "vec2 two_sum(float a, float b)\n"
+    "{\n"
+    "    precise float s = a + b;\n"
+    "    precise float bb = s - a;\n"
+    "    precise float e = (a - (s - bb)) + (b - bb);\n"
+    "    return vec2(s, e);\n"
+    "}\n"
+    "// a * b exactly, as the pair (product, error) (Dekker, Veltkamp's split; no fma needed)\n"
+    "vec2 two_prod(float a, float b)\n"
+    "{\n"
+    "    precise float ca = 4097.0 * a, cb = 4097.0 * b;\n"
+    "    precise float ah = ca - (ca - a), bh = cb - (cb - b);\n"
+    "    precise float al = a - ah, bl = b - bh;\n"
+    "    precise float q = a * b;\n"
+    "    precise float e = ((ah * bh - q) + ah * bl + al * bh) + al * bl;\n"
+    "    return vec2(q, e);\n"
+    "}\n"
+    "// (p - o) / s - 1/2 as an unevaluated float pair (hi, lo), to about 1e-14 relative\n";
+static const char rad__glsl_11_1[] =
+    "vec2 grid_coordinate(float p, float o, float s)\n"
+    "{\n"
+    "    vec2 d = two_sum(p, -o);                      // p - o exactly\n"
+    "    precise float q = d.x / s;\n"
+    "    vec2 qs = two_prod(q, s);\n"
+    "    precise float r = ((d.x - qs.x) - qs.y) + d.y; // the remainder d - q s\n"
+    "    precise float ql = r / s;\n"
+    "    vec2 x = two_sum(q, -0.5);\n"
+    "    precise float lo = x.y + ql;\n"
+    "    return vec2(x.x, lo);\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint at = pc.base + 3u * r;\n"
+    "    vec3 p = vec3(P[at], P[at + 1u], P[at + 2u]), n = vec3(Nrm[at], Nrm[at + 1u], Nrm[at + 2u]);\n"
+    "    vec3 origin = vec3(pc.origin_x, pc.origin_y, pc.origin_z), size = vec3(pc.size_x, pc.size_y, pc.size_z);\n"
+    "    uvec3 dims = uvec3(pc.dims_x, pc.dims_y, pc.dims_z);\n"
+    "    bool clustered = (pc.flags & 2u) != 0u;\n"
+    "    // the split weights of n (+x, -x, +y, -y, +z, -z)\n"
+    "    vec3 wp = max(n, vec3(0.0)), wm = max(-n, vec3(0.0));\n"
+    "    if ((pc.flags & 1u) == 0u) { wp *= wp; wm *= wm; }\n"
+    "    float wsum = wp.x + wm.x + wp.y + wm.y + wp.z + wm.z;\n"
+    "    float w[6] = float[6](wp.x, wm.x, wp.y, wm.y, wp.z, wm.z);\n"
+    "    if (wsum > 0.0) for (int a = 0; a < 6; ++a) w[a] /= wsum;\n"
+    "    // the grid coordinate as a float pair (the CPU computes it in double: a float x would carry\n"
+    "    // an absolute error of about 1e-7 dims, large against the small trilinear weights)\n"
+    "    ivec3 b;\n"
+    "    vec3 g0, g1;\n"
+    "    for (int k = 0; k < 3; ++k) {\n"
+    "        vec2 x = grid_coordinate(p[k], origin[k], size[k]);\n"
+    "        float top = float(dims[k]) + 1.0;\n"
+    "        if (x.x < -2.0 || (x.x == -2.0 && x.y < 0.0)) x = vec2(-2.0, 0.0);\n"
+    "        if (x.x > top || (x.x == top && x.y > 0.0)) x = vec2(top, 0.0);\n"
+    "        float fb = floor(x.x);\n"
+    "        precise float f = x.x - fb;             // exact\n"
+    "        if (f + x.y < 0.0) fb -= 1.0; else if (f + x.y >= 1.0) fb += 1.0;\n"
+    "        f = x.x - fb;\n"
+    "        b[k] = int(fb);\n"
+    "        g1[k] = f + x.y;                        // the weight of the upper cell, g\n"
+    "        g0[k] = (1.0 - f) - x.y;                // 1 - g, from the pair: no cancellation near g = 1\n"
+    "    }\n"
+    "    precise vec3 acc = vec3(0.0), facc = vec3(0.0);\n"
+    "    precise float tsum = 0.0;\n"
+    "    uint used = 0u;\n"
+    "    for (uint corner = 0u; corner < 8u; ++corner) {\n"
+    "        ivec3 bit = ivec3(int(corner & 1u), int((corner >> 1) & 1u), int((corner >> 2) & 1u));\n"
+    "        ivec3 cell = b + bit;\n"
+    "        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(uvec3(cell), dims))) continue;\n"
+    "        vec3 tt = mix(g0, g1, vec3(bit));\n"
+    "        float t = tt.x * tt.y * tt.z;\n"
+    "        uvec2 key = add64(mul64(dims.x, add64(mul64(dims.y, uvec2(uint(cell.z), 0u)), uint(cell.y))), uint(cell.x));\n"
+    "        uint v = find_voxel(key);\n"
+    "        if (v == 0xFFFFFFFFu) continue;\n"
+    "        precise vec3 L = vec3(0.0);\n"
+    "        precise float ws = 0.0;\n"
+    "        for (uint a = 0u; a < 6u; ++a) {\n"
+    "            uint q = vpatch[6u * v + a];\n"
+    "            if (q == 0xFFFFFFFFu) continue;\n"
+    "            float wa = clustered \? dot(vec3(PN[3u * q], PN[3u * q + 1u], PN[3u * q + 2u]), n) : w[a];\n"
+    "            if (!(wa > 0.0)) continue;\n"
+    "            ws += wa;\n"
+    "            L += wa * vec3(X[3u * q], X[3u * q + 1u], X[3u * q + 2u]);\n"
+    "        }\n"
+    "        if (!(ws > 0.0)) continue; // nothing in this voxel faces n\n"
+    "        used++;\n"
+    "        acc += t * L / ws;\n"
+    "        facc += L / ws;\n"
+    "        tsum += t;\n"
+    "    }\n"
+    "    vec3 o = used == 0u \? vec3(0.0) : (tsum > 0.0 \? acc / tsum : facc / float(used));\n"
+    "    outv[at] = o.x;\n"
+    "    outv[at + 1u] = o.y;\n"
+    "    outv[at + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_11[] = { rad__glsl_11_0, rad__glsl_11_1 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
@@ -7582,7 +7759,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "lighting.glsl", rad__glsl_pieces_7, 3u, 9212u },
     { "local_apply.comp", rad__glsl_pieces_8, 1u, 3523u },
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6660u },
-    { "local_update.comp", rad__glsl_pieces_10, 1u, 3412u }
+    { "local_update.comp", rad__glsl_pieces_10, 1u, 3412u },
+    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7418u }
 };
 /* >>glsl end */
 

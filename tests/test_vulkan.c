@@ -1146,6 +1146,127 @@ static void test_local(void)
     free(F); free(areas); free(rho);
 }
 
+
+/* ---- virtual-patch gathering: normal weights, trilinear filter skipping empty voxels ---------- */
+
+/* a grid of 5 x 4 x 6 voxels, about 60% of them present, each axis patch present with
+   probability 0.7 (clustered: random unit normals): the gather's skipping is exercised at
+   every level (missing voxel, voxel without a patch facing n, outside the grid) */
+static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_size, uint32_t *used_hist)
+{
+    const uint32_t dims[3] = { 5, 4, 6 }, cells = 5 * 4 * 6, npts = 2000;
+    rad_virtual_patches vp;
+    uint64_t keys[5 * 4 * 6];
+    uint32_t vpatch[6 * 5 * 4 * 6], c, a, count = 0, i, cut[4], q;
+    float normals[3 * 6 * 5 * 4 * 6], *values = NULL, *pts = (float *)malloc(3 * (size_t)npts * 4);
+    float *nrm = (float *)malloc(3 * (size_t)npts * 4), *cpu = (float *)malloc(3 * (size_t)npts * 4);
+    vk_kernel k;
+    vk_buf bP, bN, bX, bK, bV, bPN, bO;
+    int ok = 1;
+    memset(&vp, 0, sizeof(vp));
+    vp.origin[0] = -1.0f; vp.origin[1] = 0.5f; vp.origin[2] = 2.0f;
+    vp.voxel_size[0] = 0.7f; vp.voxel_size[1] = 0.9f; vp.voxel_size[2] = 0.6f;
+    memcpy(vp.dims, dims, sizeof(dims));
+    for (c = 0; c < cells; ++c) {
+        if (frand() < 0.4f) continue;
+        keys[vp.voxel_count] = c;
+        for (a = 0; a < 6; ++a) {
+            uint32_t *slot = &vpatch[6 * vp.voxel_count + a];
+            *slot = RAD_NONE;
+            if (frand() < 0.3f) continue;
+            *slot = count;
+            if (kind == RAD_VP_CLUSTERED) {
+                float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l = sqrtf(x * x + y * y + z * z) + 1e-6f;
+                normals[3 * count] = x / l; normals[3 * count + 1] = y / l; normals[3 * count + 2] = z / l;
+            } else {
+                normals[3 * count] = normals[3 * count + 1] = normals[3 * count + 2] = 0.0f;
+                normals[3 * count + a / 2] = a % 2 ? -1.0f : 1.0f;
+            }
+            ++count;
+        }
+        vp.voxel_count++;
+    }
+    vp.count = count;
+    vp.voxel_keys = keys;
+    vp.voxel_patch = vpatch;
+    vp.normals = normals;
+    vp.kind = kind;
+    vp.weights = weights;
+    values = random_vector(3 * (size_t)count, 0.1f);
+    if (!values || !pts || !nrm || !cpu) { T_CHECK(0); goto done; }
+    for (i = 0; i < npts; ++i) {
+        float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l;
+        uint32_t d;
+        if (i % 7 == 0) { /* an axis normal: four split weights are zero */
+            float s = i % 2 ? 1.0f : -1.0f;
+            x = (i / 7) % 3 == 0 ? s : 0.0f;
+            y = (i / 7) % 3 == 1 ? s : 0.0f;
+            z = (i / 7) % 3 == 2 ? s : 0.0f;
+        }
+        l = sqrtf(x * x + y * y + z * z) + 1e-6f;
+        nrm[3 * i] = x / l; nrm[3 * i + 1] = y / l; nrm[3 * i + 2] = z / l;
+        for (d = 0; d < 3; ++d) /* from one voxel outside the grid to one beyond it; some far away */
+            pts[3 * i + d] = vp.origin[d] + vp.voxel_size[d] * ((float)(dims[d] + 2) * frand() - 1.0f) * (i % 97 == 5 ? 9.0f : 1.0f);
+    }
+    T_CHECK(rad_vp_gather(&vp, values, pts, nrm, npts, cpu, NULL) == RAD_SUCCESS);
+    for (i = 0; i < npts; ++i) {
+        float o[3];
+        uint32_t used = rad_vp_gather_point(&vp, values, pts + 3 * i, nrm + 3 * i, o);
+        used_hist[used > 8 ? 8 : used]++;
+    }
+    if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_VP_GATHER, 0, 7, (uint32_t)sizeof(rad_glsl_vp_gather_push), local_size)) { T_CHECK(0); goto done; }
+    ok &= vk_buffer(&g_vk, &bP, 3 * (VkDeviceSize)npts * 4, pts);
+    ok &= vk_buffer(&g_vk, &bN, 3 * (VkDeviceSize)npts * 4, nrm);
+    ok &= vk_buffer(&g_vk, &bX, 3 * (VkDeviceSize)count * 4, values);
+    ok &= vk_buffer(&g_vk, &bK, (VkDeviceSize)vp.voxel_count * 8, keys);
+    ok &= vk_buffer(&g_vk, &bV, 6 * (VkDeviceSize)vp.voxel_count * 4, vpatch);
+    ok &= vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, normals);
+    ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)npts * 4, NULL);
+    if (ok) memset(bO.map, 0xFF, 3 * (size_t)npts * 4); /* NaN: every point must be written */
+    chunks(npts, cut);
+    for (q = 0; q < 3 && ok; ++q) {
+        rad_glsl_vp_gather_push p;
+        vk_range r[7];
+        uint32_t b1, b2;
+        if (cut[q + 1] == cut[q]) continue;
+        r[0] = vk_chunk(&g_vk, &bP, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &p.base);
+        r[1] = vk_chunk(&g_vk, &bN, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b1);
+        r[6] = vk_chunk(&g_vk, &bO, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b2);
+        T_CHECK(b1 == p.base && b2 == p.base);
+        r[2] = vk_whole(&bX); r[3] = vk_whole(&bK); r[4] = vk_whole(&bV); r[5] = vk_whole(&bPN);
+        memcpy(p.origin, vp.origin, sizeof(p.origin));
+        memcpy(p.voxel_size, vp.voxel_size, sizeof(p.voxel_size));
+        memcpy(p.dims, vp.dims, sizeof(p.dims));
+        p.voxel_count = vp.voxel_count;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.flags = (weights == RAD_VP_WEIGHTS_COSINE ? RAD_GLSL_FLAG_COSINE : 0u) | (kind == RAD_VP_CLUSTERED ? RAD_GLSL_FLAG_CLUSTERED : 0u);
+        ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+    }
+    T_CHECK(ok);
+    if (ok) compare(kind == RAD_VP_CLUSTERED ? "vp gather (clustered)" : weights == RAD_VP_WEIGHTS_COSINE ? "vp gather (cosine)" : "vp gather",
+                    (const float *)bO.map, cpu, 3 * (size_t)npts, 1e-5);
+    vk_buffer_free(&g_vk, &bP); vk_buffer_free(&g_vk, &bN); vk_buffer_free(&g_vk, &bX); vk_buffer_free(&g_vk, &bK);
+    vk_buffer_free(&g_vk, &bV); vk_buffer_free(&g_vk, &bPN); vk_buffer_free(&g_vk, &bO);
+    vk_kernel_destroy(&g_vk, &k);
+done:
+    free(values); free(pts); free(nrm); free(cpu);
+}
+
+static void test_vp_gather(void)
+{
+    uint32_t hist[9], i;
+    g_rng = 12345u; /* the same grids whichever tests ran before */
+    memset(hist, 0, sizeof(hist));
+    vp_case(RAD_VP_AXIS_ALIGNED, RAD_VP_WEIGHTS_SQUARED, g_local_sizes[0], hist);
+    vp_case(RAD_VP_AXIS_ALIGNED, RAD_VP_WEIGHTS_COSINE, g_local_sizes[1], hist);
+    vp_case(RAD_VP_CLUSTERED, RAD_VP_WEIGHTS_SQUARED, g_local_sizes[0], hist);
+    printf("    points by voxels used (0..8):");
+    for (i = 0; i < 9; ++i) printf(" %u", hist[i]);
+    printf("\n");
+    T_CHECK(hist[0] > 0 && hist[7] + hist[8] > 0 && hist[2] + hist[3] + hist[4] > 0); /* skipping happened, and near-full blocks */
+}
+
 /* ---- the C mirrors of the push-constant blocks, against the compiled SPIR-V ------------------ */
 
 /* member names and byte offsets of the push-constant block of a SPIR-V module (from OpMemberName
@@ -1235,6 +1356,13 @@ static void test_push_mirrors(void)
     static const mirror_member lupd[] = { MM(rad_glsl_local_update_push, m), MM(rad_glsl_local_update_push, end),
         MM(rad_glsl_local_update_push, row_offset), MM(rad_glsl_local_update_push, row_count), MM(rad_glsl_local_update_push, base),
         MM(rad_glsl_local_update_push, k), MM(rad_glsl_local_update_push, ev), { NULL, 0 } };
+    static const mirror_member vpg[] = { { "origin_x", offsetof(rad_glsl_vp_gather_push, origin) },
+        { "origin_y", offsetof(rad_glsl_vp_gather_push, origin) + 4 }, { "origin_z", offsetof(rad_glsl_vp_gather_push, origin) + 8 },
+        { "size_x", offsetof(rad_glsl_vp_gather_push, voxel_size) }, { "size_y", offsetof(rad_glsl_vp_gather_push, voxel_size) + 4 },
+        { "size_z", offsetof(rad_glsl_vp_gather_push, voxel_size) + 8 }, { "dims_x", offsetof(rad_glsl_vp_gather_push, dims) },
+        { "dims_y", offsetof(rad_glsl_vp_gather_push, dims) + 4 }, { "dims_z", offsetof(rad_glsl_vp_gather_push, dims) + 8 },
+        MM(rad_glsl_vp_gather_push, voxel_count), MM(rad_glsl_vp_gather_push, row_offset), MM(rad_glsl_vp_gather_push, row_count),
+        MM(rad_glsl_vp_gather_push, base), MM(rad_glsl_vp_gather_push, flags), { NULL, 0 } };
     g_worst_what = "push-constant block, bytes";
     check_mirror(RAD_GLSL_GATHER_DENSE, dense, sizeof(rad_glsl_gather_dense_push));
     check_mirror(RAD_GLSL_GATHER_CSR, sparse, sizeof(rad_glsl_gather_csr_push));
@@ -1246,6 +1374,7 @@ static void test_push_mirrors(void)
     check_mirror(RAD_GLSL_LOCAL_APPLY, lapply, sizeof(rad_glsl_local_apply_push));
     check_mirror(RAD_GLSL_LOCAL_VECTORS, lvec, sizeof(rad_glsl_local_vectors_push));
     check_mirror(RAD_GLSL_LOCAL_UPDATE, lupd, sizeof(rad_glsl_local_update_push));
+    check_mirror(RAD_GLSL_VP_GATHER, vpg, sizeof(rad_glsl_vp_gather_push));
     /* every kernel (.comp; includes have no push block) has its mirror checked above */
     {
         uint32_t id;
@@ -1314,6 +1443,7 @@ static const vk_test g_tests[] = {
     { "vk_mb_apply_bc1_bc4_outliers_permuted", test_mb_blocks },
     { "vk_alias_build_streamed_rows_then_temporal", test_alias_build },
     { "vk_local_adds_evictions_apply_resident", test_local },
+    { "vk_vp_gather_trilinear_skipping", test_vp_gather },
     { NULL, NULL }
 };
 
