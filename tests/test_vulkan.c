@@ -1149,6 +1149,61 @@ static void test_local(void)
 
 /* ---- virtual-patch gathering: normal weights, trilinear filter skipping empty voxels ---------- */
 
+/* RAD_GLSL_VP_GATHER at 'npts' points (in three chunks) against rad_vp_gather */
+static void vp_run(const rad_virtual_patches *vp, const float *values, const float *pts, const float *nrm, uint32_t npts,
+                   uint32_t local_size, const char *what)
+{
+    const uint32_t count = vp->count;
+    const rad_vp_kind kind = vp->kind;
+    const rad_vp_weights weights = vp->weights;
+    float *cpu = (float *)malloc(3 * (size_t)npts * 4);
+    vk_kernel k;
+    vk_buf bP, bN, bX, bK, bV, bPN, bO;
+    uint32_t cut[4], q;
+    int ok = 1;
+    if (!cpu) { T_CHECK(0); return; }
+    T_CHECK(rad_vp_gather(vp, values, pts, nrm, npts, cpu, NULL) == RAD_SUCCESS);
+    if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_VP_GATHER, 0, 7, (uint32_t)sizeof(rad_glsl_vp_gather_push), local_size)) {
+        T_CHECK(0);
+        free(cpu);
+        return;
+    }
+    ok &= vk_buffer(&g_vk, &bP, 3 * (VkDeviceSize)npts * 4, pts);
+    ok &= vk_buffer(&g_vk, &bN, 3 * (VkDeviceSize)npts * 4, nrm);
+    ok &= vk_buffer(&g_vk, &bX, 3 * (VkDeviceSize)count * 4, values);
+    ok &= vk_buffer(&g_vk, &bK, (VkDeviceSize)vp->voxel_count * 8, vp->voxel_keys);
+    ok &= vk_buffer(&g_vk, &bV, 6 * (VkDeviceSize)vp->voxel_count * 4, vp->voxel_patch);
+    ok &= vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, vp->normals);
+    ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)npts * 4, NULL);
+    if (ok) memset(bO.map, 0xFF, 3 * (size_t)npts * 4); /* NaN: every point must be written */
+    chunks(npts, cut);
+    for (q = 0; q < 3 && ok; ++q) {
+        rad_glsl_vp_gather_push p;
+        vk_range r[7];
+        uint32_t b1, b2;
+        if (cut[q + 1] == cut[q]) continue;
+        r[0] = vk_chunk(&g_vk, &bP, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &p.base);
+        r[1] = vk_chunk(&g_vk, &bN, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b1);
+        r[6] = vk_chunk(&g_vk, &bO, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b2);
+        T_CHECK(b1 == p.base && b2 == p.base);
+        r[2] = vk_whole(&bX); r[3] = vk_whole(&bK); r[4] = vk_whole(&bV); r[5] = vk_whole(&bPN);
+        memcpy(p.origin, vp->origin, sizeof(p.origin));
+        memcpy(p.voxel_size, vp->voxel_size, sizeof(p.voxel_size));
+        memcpy(p.dims, vp->dims, sizeof(p.dims));
+        p.voxel_count = vp->voxel_count;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.flags = (weights == RAD_VP_WEIGHTS_COSINE ? RAD_GLSL_FLAG_COSINE : 0u) | (kind == RAD_VP_CLUSTERED ? RAD_GLSL_FLAG_CLUSTERED : 0u);
+        ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+    }
+    T_CHECK(ok);
+    if (ok) compare(what, (const float *)bO.map, cpu, 3 * (size_t)npts, 1e-5);
+    vk_buffer_free(&g_vk, &bP); vk_buffer_free(&g_vk, &bN); vk_buffer_free(&g_vk, &bX); vk_buffer_free(&g_vk, &bK);
+    vk_buffer_free(&g_vk, &bV); vk_buffer_free(&g_vk, &bPN); vk_buffer_free(&g_vk, &bO);
+    vk_kernel_destroy(&g_vk, &k);
+    free(cpu);
+}
+
 /* a grid of 5 x 4 x 6 voxels, about 60% of them present, each axis patch present with
    probability 0.7 (clustered: random unit normals): the gather's skipping is exercised at
    every level (missing voxel, voxel without a patch facing n, outside the grid) */
@@ -1157,12 +1212,9 @@ static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_siz
     const uint32_t dims[3] = { 5, 4, 6 }, cells = 5 * 4 * 6, npts = 2000;
     rad_virtual_patches vp;
     uint64_t keys[5 * 4 * 6];
-    uint32_t vpatch[6 * 5 * 4 * 6], c, a, count = 0, i, cut[4], q;
+    uint32_t vpatch[6 * 5 * 4 * 6], c, a, count = 0, i;
     float normals[3 * 6 * 5 * 4 * 6], *values = NULL, *pts = (float *)malloc(3 * (size_t)npts * 4);
-    float *nrm = (float *)malloc(3 * (size_t)npts * 4), *cpu = (float *)malloc(3 * (size_t)npts * 4);
-    vk_kernel k;
-    vk_buf bP, bN, bX, bK, bV, bPN, bO;
-    int ok = 1;
+    float *nrm = (float *)malloc(3 * (size_t)npts * 4);
     memset(&vp, 0, sizeof(vp));
     vp.origin[0] = -1.0f; vp.origin[1] = 0.5f; vp.origin[2] = 2.0f;
     vp.voxel_size[0] = 0.7f; vp.voxel_size[1] = 0.9f; vp.voxel_size[2] = 0.6f;
@@ -1193,7 +1245,7 @@ static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_siz
     vp.kind = kind;
     vp.weights = weights;
     values = random_vector(3 * (size_t)count, 0.1f);
-    if (!values || !pts || !nrm || !cpu) { T_CHECK(0); goto done; }
+    if (!values || !pts || !nrm) { T_CHECK(0); goto done; }
     for (i = 0; i < npts; ++i) {
         float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l;
         uint32_t d;
@@ -1208,49 +1260,95 @@ static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_siz
         for (d = 0; d < 3; ++d) /* from one voxel outside the grid to one beyond it; some far away */
             pts[3 * i + d] = vp.origin[d] + vp.voxel_size[d] * ((float)(dims[d] + 2) * frand() - 1.0f) * (i % 97 == 5 ? 9.0f : 1.0f);
     }
-    T_CHECK(rad_vp_gather(&vp, values, pts, nrm, npts, cpu, NULL) == RAD_SUCCESS);
     for (i = 0; i < npts; ++i) {
         float o[3];
         uint32_t used = rad_vp_gather_point(&vp, values, pts + 3 * i, nrm + 3 * i, o);
         used_hist[used > 8 ? 8 : used]++;
     }
-    if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_VP_GATHER, 0, 7, (uint32_t)sizeof(rad_glsl_vp_gather_push), local_size)) { T_CHECK(0); goto done; }
-    ok &= vk_buffer(&g_vk, &bP, 3 * (VkDeviceSize)npts * 4, pts);
-    ok &= vk_buffer(&g_vk, &bN, 3 * (VkDeviceSize)npts * 4, nrm);
-    ok &= vk_buffer(&g_vk, &bX, 3 * (VkDeviceSize)count * 4, values);
-    ok &= vk_buffer(&g_vk, &bK, (VkDeviceSize)vp.voxel_count * 8, keys);
-    ok &= vk_buffer(&g_vk, &bV, 6 * (VkDeviceSize)vp.voxel_count * 4, vpatch);
-    ok &= vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, normals);
-    ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)npts * 4, NULL);
-    if (ok) memset(bO.map, 0xFF, 3 * (size_t)npts * 4); /* NaN: every point must be written */
-    chunks(npts, cut);
-    for (q = 0; q < 3 && ok; ++q) {
-        rad_glsl_vp_gather_push p;
-        vk_range r[7];
-        uint32_t b1, b2;
-        if (cut[q + 1] == cut[q]) continue;
-        r[0] = vk_chunk(&g_vk, &bP, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &p.base);
-        r[1] = vk_chunk(&g_vk, &bN, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b1);
-        r[6] = vk_chunk(&g_vk, &bO, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b2);
-        T_CHECK(b1 == p.base && b2 == p.base);
-        r[2] = vk_whole(&bX); r[3] = vk_whole(&bK); r[4] = vk_whole(&bV); r[5] = vk_whole(&bPN);
-        memcpy(p.origin, vp.origin, sizeof(p.origin));
-        memcpy(p.voxel_size, vp.voxel_size, sizeof(p.voxel_size));
-        memcpy(p.dims, vp.dims, sizeof(p.dims));
-        p.voxel_count = vp.voxel_count;
-        p.row_offset = cut[q];
-        p.row_count = cut[q + 1] - cut[q];
-        p.flags = (weights == RAD_VP_WEIGHTS_COSINE ? RAD_GLSL_FLAG_COSINE : 0u) | (kind == RAD_VP_CLUSTERED ? RAD_GLSL_FLAG_CLUSTERED : 0u);
-        ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
-    }
-    T_CHECK(ok);
-    if (ok) compare(kind == RAD_VP_CLUSTERED ? "vp gather (clustered)" : weights == RAD_VP_WEIGHTS_COSINE ? "vp gather (cosine)" : "vp gather",
-                    (const float *)bO.map, cpu, 3 * (size_t)npts, 1e-5);
-    vk_buffer_free(&g_vk, &bP); vk_buffer_free(&g_vk, &bN); vk_buffer_free(&g_vk, &bX); vk_buffer_free(&g_vk, &bK);
-    vk_buffer_free(&g_vk, &bV); vk_buffer_free(&g_vk, &bPN); vk_buffer_free(&g_vk, &bO);
-    vk_kernel_destroy(&g_vk, &k);
+    vp_run(&vp, values, pts, nrm, npts, local_size, kind == RAD_VP_CLUSTERED ? "vp gather (clustered)"
+           : weights == RAD_VP_WEIGHTS_COSINE ? "vp gather (cosine)" : "vp gather");
 done:
-    free(values); free(pts); free(nrm); free(cpu);
+    free(values); free(pts); free(nrm);
+}
+
+
+/* a built set: three walls of a 4 x 2 x 3 room corner (floor, x = 0, z = 0) as 4 x 4 triangle
+   grids, rad_vp_create with 'kind'; points on the walls (with their normals) and inside the
+   room (random normals) */
+static void vp_built(rad_vp_kind kind, uint32_t local_size)
+{
+    static const float o[3][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } };
+    static const float U[3][3] = { { 0, 0, 3 }, { 0, 2, 0 }, { 4, 0, 0 } }, V[3][3] = { { 4, 0, 0 }, { 0, 0, 3 }, { 0, 2, 0 } };
+    static const float nrm_of[3][3] = { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, 1 } };
+    float pos[3][3 * 25];
+    uint32_t idx[3][6 * 16], q, i, j, d;
+    rad_mesh_desc meshes[3];
+    rad_material mat;
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options vo;
+    rad_virtual_patches *vp = NULL;
+    const uint32_t npts = 1000;
+    float *pts = (float *)malloc(3 * (size_t)npts * 4), *nrm = (float *)malloc(3 * (size_t)npts * 4), *values = NULL;
+    for (q = 0; q < 3; ++q) {
+        for (j = 0; j <= 4; ++j)
+            for (i = 0; i <= 4; ++i)
+                for (d = 0; d < 3; ++d) pos[q][3 * (j * 5 + i) + d] = o[q][d] + U[q][d] * (float)i / 4.0f + V[q][d] * (float)j / 4.0f;
+        for (j = 0; j < 4; ++j)
+            for (i = 0; i < 4; ++i) {
+                uint32_t a = j * 5 + i, *tri = &idx[q][6 * (j * 4 + i)];
+                tri[0] = a; tri[1] = a + 1; tri[2] = a + 6;
+                tri[3] = a; tri[4] = a + 6; tri[5] = a + 5;
+            }
+        memset(&meshes[q], 0, sizeof(meshes[q]));
+        meshes[q].positions = pos[q];
+        meshes[q].vertex_count = 25;
+        meshes[q].indices = idx[q];
+        meshes[q].triangle_count = 32;
+    }
+    memset(&mat, 0, sizeof(mat));
+    mat.albedo[0] = mat.albedo[1] = mat.albedo[2] = 0.5f;
+    memset(&desc, 0, sizeof(desc));
+    desc.meshes = meshes;
+    desc.mesh_count = 3;
+    desc.materials = &mat;
+    desc.material_count = 1;
+    if (!pts || !nrm) { T_CHECK(0); goto done; }
+    T_CHECK(rad_scene_create(&desc, NULL, &scene) == RAD_SUCCESS);
+    if (scene) T_CHECK(rad_bvh_create(scene, NULL, &bvh) == RAD_SUCCESS);
+    if (!bvh) goto done;
+    rad_bvh_raycaster(bvh, &rc);
+    rad_vp_options_default(&vo);
+    vo.resolution = 9;
+    vo.face_points = 4;
+    vo.skip_visibility = 1;
+    vo.kind = kind;
+    T_CHECK(rad_vp_create(scene, &rc, &vo, NULL, &vp) == RAD_SUCCESS);
+    if (!vp) goto done;
+    values = random_vector(3 * (size_t)vp->count, 0.0f);
+    if (!values) { T_CHECK(0); goto done; }
+    for (i = 0; i < npts; ++i) {
+        float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l = sqrtf(x * x + y * y + z * z) + 1e-6f;
+        if (i % 2 == 0) { /* on a wall */
+            q = (i / 2) % 3;
+            for (d = 0; d < 3; ++d) {
+                pts[3 * i + d] = U[q][d] * frand() + V[q][d] * frand();
+                nrm[3 * i + d] = nrm_of[q][d];
+            }
+        } else {
+            pts[3 * i] = 4.0f * frand(); pts[3 * i + 1] = 2.0f * frand(); pts[3 * i + 2] = 3.0f * frand();
+            nrm[3 * i] = x / l; nrm[3 * i + 1] = y / l; nrm[3 * i + 2] = z / l;
+        }
+    }
+    vp_run(vp, values, pts, nrm, npts, local_size, kind == RAD_VP_CLUSTERED ? "vp gather, built (clustered)" : "vp gather, built");
+    printf("    built: %u patches in %u voxels (%u x %u x %u grid)\n", vp->count, vp->voxel_count, vp->dims[0], vp->dims[1], vp->dims[2]);
+done:
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+    free(pts); free(nrm); free(values);
 }
 
 static void test_vp_gather(void)
@@ -1261,6 +1359,8 @@ static void test_vp_gather(void)
     vp_case(RAD_VP_AXIS_ALIGNED, RAD_VP_WEIGHTS_SQUARED, g_local_sizes[0], hist);
     vp_case(RAD_VP_AXIS_ALIGNED, RAD_VP_WEIGHTS_COSINE, g_local_sizes[1], hist);
     vp_case(RAD_VP_CLUSTERED, RAD_VP_WEIGHTS_SQUARED, g_local_sizes[0], hist);
+    vp_built(RAD_VP_AXIS_ALIGNED, g_local_sizes[1]);
+    vp_built(RAD_VP_CLUSTERED, g_local_sizes[0]);
     printf("    points by voxels used (0..8):");
     for (i = 0; i < 9; ++i) printf(" %u", hist[i]);
     printf("\n");
