@@ -211,9 +211,9 @@
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
        specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), a workgroup (gathers, applies) or
-       an invocation (temporal step, alias build, local pre-pass, vp gather) per row, and row_offset / row_count / base in
-       every kernel so a matrix larger than one storage-buffer
-       range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
+       an invocation (temporal step, alias build, local pre-pass, vp gather) per row, and
+       row_offset / row_count / base in every kernel so a matrix larger than one
+       storage-buffer range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
        sources: the .comp files in glsl/ of the repository (make glsl regenerates the header's copy);
        tests/test_vulkan.c runs every kernel against the CPU path; examples/vulkan_temporal.c
        is a complete program.
@@ -1110,11 +1110,12 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
    - Workgroup: layout(local_size_x_id = 0): specialization constant RAD_GLSL_SPEC_LOCAL_SIZE
      (id 0) sets the x size (default 1 when not specialized; 64 to 256 are good choices, any
      size up to maxComputeWorkGroupInvocations works). Nothing depends on the subgroup size.
-   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*, LOCAL_APPLY, LOCAL_UPDATE) run ONE WORKGROUP PER ROW:
-     dispatch row_count groups in x (at most maxComputeWorkGroupCount[0], 65535 guaranteed:
-     chunk longer runs); the group's invocations read the row at consecutive addresses with a
-     stride of the group size and sum in shared memory (12 bytes per invocation). The temporal
-     step, the alias build and VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
+   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*, LOCAL_APPLY, LOCAL_UPDATE) run
+     ONE WORKGROUP PER ROW: dispatch row_count groups in x (at most
+     maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
+     invocations read the row at consecutive addresses with a stride of the group size and sum
+     in shared memory (12 bytes per invocation). The temporal step, the alias build and
+     VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
      (LOCAL_VECTORS: per row or column, see its entry).
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
@@ -1212,11 +1213,12 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        break energy conservation: the CPU's RAD_ERROR_SINGULAR) UPDATE writes nothing; read s
        (work[12 m + c]) back to detect it. With RAD_LOCAL_EVICT_DROP an add into a full set is
        a plain add (ev = RAD_NONE) into the dropped member's slot k, with that member out of
-       the slot map: row and column k are overwritten as the drop would have zeroed them. The standalone rad_local_evict (a rank-1 downdate)
-       has no kernel; hiding and showing members (rad_local_remove, re-adding a hidden member)
-       touch no plane. Measured on lavapipe (tests/test_vulkan.c) after 46 adds, 6 of
-       them evicting, into M = 48: at most 9.7e-7 relative from rad_local_add's planes (exact
-       and first-order), the float pre-pass against the CPU's double u, v and s.
+       the slot map: row and column k are overwritten as the drop would have zeroed them.
+       The standalone rad_local_evict (a rank-1 downdate) has no kernel; hiding and showing
+       members (rad_local_remove, re-adding a hidden member) touch no plane. Measured on
+       lavapipe (tests/test_vulkan.c), T resident through 54 adds into M = 48 (the last 6 into
+       a full set: rank 2, or after a drop): at most 9.7e-7 relative from rad_local_add's
+       planes (exact and first-order), the float pre-pass against the CPU's double u, v, s.
    RAD_GLSL_VP_GATHER      virtual-patch gathering at surface points (vertices, G-buffer
        texels), as rad_vp_gather: split-weight (or, clustered, N . n) normal weights in each
        voxel of the 2x2x2 block, trilinear weights across the voxels, voxels missing or with no
