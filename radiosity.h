@@ -1214,6 +1214,9 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        (work[12 m + c]) back to detect it. With RAD_LOCAL_EVICT_DROP an add into a full set is
        a plain add (ev = RAD_NONE) into the dropped member's slot k, with that member out of
        the slot map: row and column k are overwritten as the drop would have zeroed them.
+       Each dispatch reads what the one before it wrote (pass 0's chunks accumulate v): in
+       one command buffer, put a compute-to-compute buffer memory barrier (shader write to
+       shader read) between consecutive dispatches, and before LOCAL_APPLY reads the planes.
        The standalone rad_local_evict (a rank-1 downdate) has no kernel; hiding and showing
        members (rad_local_remove, re-adding a hidden member) touch no plane. Measured on
        lavapipe (tests/test_vulkan.c), T resident through 54 adds into M = 48 (the last 6 into
