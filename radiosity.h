@@ -204,14 +204,16 @@
        it with glslang or shaderc and dispatch it on your own Vulkan device; radiosity.h never
        touches a GPU. Kernels: dense and CSR gather (one bounce), multi-bounce apply from
        float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
-       step (the same random draws as the CPU) and the alias-table build for streamed rows;
+       step (the same random draws as the CPU), the alias-table build for streamed rows, and
+       the local multi-bounce matrix's apply and add (rank-1 update, rank-2 when evicting) on
+       a matrix kept resident on the GPU, and virtual-patch gathering at surface points;
        RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
        specialization constant 0 (RAD_GLSL_SPEC_LOCAL_SIZE), a workgroup (gathers, applies) or
-       an invocation (temporal step, alias build) per row, and row_offset / row_count / base in
-       every kernel so a matrix larger than one storage-buffer
-       range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
+       an invocation (temporal step, alias build, local pre-pass, vp gather) per row, and
+       row_offset / row_count / base in every kernel so a matrix larger than one
+       storage-buffer range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
        sources: the .comp files in glsl/ of the repository (make glsl regenerates the header's copy);
        tests/test_vulkan.c runs every kernel against the CPU path; examples/vulkan_temporal.c
        is a complete program.
@@ -1108,11 +1110,13 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
    - Workgroup: layout(local_size_x_id = 0): specialization constant RAD_GLSL_SPEC_LOCAL_SIZE
      (id 0) sets the x size (default 1 when not specialized; 64 to 256 are good choices, any
      size up to maxComputeWorkGroupInvocations works). Nothing depends on the subgroup size.
-   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*) run ONE WORKGROUP PER ROW:
-     dispatch row_count groups in x (at most maxComputeWorkGroupCount[0], 65535 guaranteed:
-     chunk longer runs); the group's invocations read the row at consecutive addresses with a
-     stride of the group size and sum in shared memory (12 bytes per invocation). The temporal
-     step and the alias build run ONE INVOCATION PER ROW: ceil(row_count / size) groups.
+   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*, LOCAL_APPLY, LOCAL_UPDATE) run
+     ONE WORKGROUP PER ROW: dispatch row_count groups in x (at most
+     maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
+     invocations read the row at consecutive addresses with a stride of the group size and sum
+     in shared memory (12 bytes per invocation). The temporal step, the alias build and
+     VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
+     (LOCAL_VECTORS: per row or column, see its entry).
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
      checked at compile time).
@@ -1179,7 +1183,58 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        >>api_shading as GLSL functions named as in C (rad_shade ...), no #version line: put
        its text after yours (or resolve an #include to it). Its results agree with the C
        functions to 1e-5 relative (tests/test_shading_vulkan.c, through glsl/lighting_eval.comp;
-       the header's copy is checked equal to glsl/lighting.glsl). */
+       the header's copy is checked equal to glsl/lighting.glsl).
+   RAD_GLSL_LOCAL_APPLY    L_i = sum_{j in P_Lit} T_ij E_j (+ E_i) for i in P_Vis, as rad_local_apply,
+       on the planes of a rad_local (>>api_local; uploaded unchanged or kept resident on the
+       GPU). Push: rad_glsl_local_apply_push; flags RAD_GLSL_FLAG_TOTAL. ONE WORKGROUP PER
+       VISIBLE ENTRY. 0, 1, 2: the R, G, B planes (stride m = capacity; the rows slot_offset ..
+       slot_offset + slot_count - 1, row slot_offset at element base)  3: E (3n, world order)
+       4: lit map, slot_end uints: the world patch whose E lights column j, or RAD_NONE
+       (unlit or free slot)  5: slot of each visible entry  6: world patch of each visible entry
+       7: out (3n; the visible patches written). Chunks: an entry whose slot is outside the
+       bound rows is skipped, so each chunk's dispatch may take the whole visible list.
+   RAD_GLSL_LOCAL_VECTORS and RAD_GLSL_LOCAL_UPDATE  rad_local_add on T resident on the GPU:
+       the host keeps the slot bookkeeping (which slot, which member to evict) and streams only
+       the new patch's row and column over the slots, a_c[j] = rho_c[patch(j)] A_n F_nj / A_j and
+       b_c[j] = rho_c[n] F_nj (3 m floats each, channel-major, zero outside the members and at
+       the evicted slot), the list nz of the slots where F_nj != 0, and rho_n F_nn. VECTORS is
+       the small pre-pass: u = (I + T) a, v = b (I + T) (pass RAD_GLSL_LOCAL_PASS_GATHER, one
+       dispatch per row chunk, one invocation per row or column: max(row_count, end)
+       invocations), the corrections of the fused exact downdate when the add evicts slot ev
+       (pass _EVICT, end invocations) and s = 1 - ann - b.u with the factors of the exact or
+       first-order form (pass _SCALARS, 3 invocations), in float, into a work buffer of
+       RAD_GLSL_LOCAL_WORK_FLOATS(m) floats; UPDATE is the O(M^2) pass, ONE WORKGROUP PER ROW:
+       T += cuv u v - c r / g (rank 1, or rank 2 when evicting), the new row coef v and column
+       coef u, T_kk. Pushes: rad_glsl_local_vectors_push, rad_glsl_local_update_push; the
+       layout of the work buffer is in glsl/local_vectors.comp. VECTORS bindings: 0, 1, 2
+       planes (the chunk's rows at base; passes 1 and 2 read none: bind any range)  3: a
+       4: b  5: nz  6: work. UPDATE bindings: 0, 1, 2 planes (read-write, the chunk's rows)
+       3: work. A kernel cannot return an error: when s <= 1e-12 in some channel (rows that
+       break energy conservation: the CPU's RAD_ERROR_SINGULAR) UPDATE writes nothing; read s
+       (work[12 m + c]) back to detect it. With RAD_LOCAL_EVICT_DROP an add into a full set is
+       a plain add (ev = RAD_NONE) into the dropped member's slot k, with that member out of
+       the slot map: row and column k are overwritten as the drop would have zeroed them.
+       Each dispatch reads what the one before it wrote (pass 0's chunks accumulate v): in
+       one command buffer, put a compute-to-compute buffer memory barrier (shader write to
+       shader read) between consecutive dispatches, and before LOCAL_APPLY reads the planes.
+       The standalone rad_local_evict (a rank-1 downdate) has no kernel; hiding and showing
+       members (rad_local_remove, re-adding a hidden member) touch no plane. Measured on
+       lavapipe (tests/test_vulkan.c), T resident through 54 adds into M = 48 (the last 6 into
+       a full set: rank 2, or after a drop): at most 9.7e-7 relative from rad_local_add's
+       planes (exact and first-order), the float pre-pass against the CPU's double u, v, s.
+   RAD_GLSL_VP_GATHER      virtual-patch gathering at surface points (vertices, G-buffer
+       texels), as rad_vp_gather: split-weight (or, clustered, N . n) normal weights in each
+       voxel of the 2x2x2 block, trilinear weights across the voxels, voxels missing or with no
+       patch facing n skipped (>>api_vp). Push: rad_glsl_vp_gather_push (the grid of the
+       rad_virtual_patches); flags RAD_GLSL_FLAG_COSINE (weights RAD_VP_WEIGHTS_COSINE),
+       _CLUSTERED. ONE INVOCATION PER POINT. 0: points (3 floats each)  1: unit normals
+       (3 each)  2: values per patch (3N: B, L or H)  3: voxel_keys (voxel_count uint64, as
+       uvec2)  4: voxel_patch (6 per voxel)  5: patch normals (3N; read only when CLUSTERED,
+       else bind any buffer)  6: out (3 per point). Chunks: bindings 0, 1 and 6 hold the
+       chunk's points from element base (bind the three at the same offset). The grid
+       coordinate is computed as a float pair (TwoSum / Dekker products: the CPU uses double),
+       because its float rounding, about 1e-7 dims absolute, is large against small trilinear
+       weights (measured: 3e-5 relative without it, 2.9e-7 with it, on lavapipe). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -1191,7 +1246,11 @@ typedef enum rad_glsl_id {
     RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* glsl/mb_apply_blocks.comp */
     RAD_GLSL_ALIAS_BUILD       =  6, /* glsl/alias_build.comp */
     RAD_GLSL_LIGHTING          =  7, /* glsl/lighting.glsl */
-    RAD_GLSL_COUNT = 8
+    RAD_GLSL_LOCAL_APPLY       =  8, /* glsl/local_apply.comp */
+    RAD_GLSL_LOCAL_VECTORS     =  9, /* glsl/local_vectors.comp */
+    RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
+    RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
+    RAD_GLSL_COUNT = 12
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -1204,6 +1263,15 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_FLAG_BC1 4u          /* block apply: one BC1 image (else three BC4 images) */
 #define RAD_GLSL_FLAG_OUTLIERS 8u     /* block apply: the outlier arrays are bound */
 #define RAD_GLSL_FLAG_DENSE 1u        /* alias build: dense rows, no column array */
+#define RAD_GLSL_FLAG_FIRST_CHUNK 1u  /* local vectors, pass 0: the first row chunk (v = b + ...) */
+#define RAD_GLSL_FLAG_FIRST_ORDER 2u  /* local vectors, pass 2: RAD_LOCAL_FIRST_ORDER factors */
+#define RAD_GLSL_LOCAL_PASS_GATHER 0u  /* local vectors: u, c, v, r from T (row-chunked) */
+#define RAD_GLSL_LOCAL_PASS_EVICT 1u   /* local vectors: the fused downdate's corrections (evicting adds) */
+#define RAD_GLSL_LOCAL_PASS_SCALARS 2u /* local vectors: s and the factors, 3 invocations */
+/* floats of the local-update work buffer for capacity m (u, v, c, r per channel, 12 scalars) */
+#define RAD_GLSL_FLAG_COSINE 1u       /* vp gather: RAD_VP_WEIGHTS_COSINE split weights */
+#define RAD_GLSL_FLAG_CLUSTERED 2u    /* vp gather: RAD_VP_CLUSTERED (w = N_a . n; binding 5 read) */
+#define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -1241,6 +1309,36 @@ typedef struct rad_glsl_alias_build_push {
     uint32_t out_base;             /* low 32 bits of the bin at element 0 of bindings 3, 4, 5 */
     uint32_t flags;                /* RAD_GLSL_FLAG_DENSE */
 } rad_glsl_alias_build_push;
+typedef struct rad_glsl_local_apply_push {
+    uint32_t m, end;               /* rad_local.capacity (plane stride), rad_local.slot_end */
+    uint32_t row_offset, row_count; /* visible entries of this dispatch */
+    uint32_t slot_offset, slot_count; /* plane rows held by bindings 0..2 */
+    uint32_t base;                 /* element of bindings 0..2 holding plane row slot_offset */
+    uint32_t flags;                /* RAD_GLSL_FLAG_TOTAL */
+} rad_glsl_local_apply_push;
+typedef struct rad_glsl_local_vectors_push {
+    uint32_t m, end;               /* capacity; slots in use after the add */
+    uint32_t row_offset, row_count, base; /* pass 0: the plane rows bound */
+    uint32_t nnz;                  /* slots in the nz list */
+    uint32_t ev;                   /* the slot evicted by this add, or RAD_NONE */
+    uint32_t pass;                 /* RAD_GLSL_LOCAL_PASS_* */
+    uint32_t flags;                /* RAD_GLSL_FLAG_FIRST_CHUNK, _FIRST_ORDER */
+    float ann[3];                  /* rho_n F_nn per channel */
+} rad_glsl_local_vectors_push;
+typedef struct rad_glsl_local_update_push {
+    uint32_t m, end, row_offset, row_count, base;
+    uint32_t k;                    /* the new patch's slot */
+    uint32_t ev;                   /* the slot evicted by this add (== k), or RAD_NONE */
+} rad_glsl_local_update_push;
+typedef struct rad_glsl_vp_gather_push {
+    float origin[3];               /* rad_virtual_patches.origin */
+    float voxel_size[3];           /* .voxel_size */
+    uint32_t dims[3];              /* .dims */
+    uint32_t voxel_count;          /* .voxel_count */
+    uint32_t row_offset, row_count; /* the points of this dispatch */
+    uint32_t base;                 /* element of bindings 0, 1, 6 holding point row_offset's x */
+    uint32_t flags;                /* RAD_GLSL_FLAG_COSINE, _CLUSTERED */
+} rad_glsl_vp_gather_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -6514,6 +6612,20 @@ typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60
 typedef char rad__check_glsl_blocks_push[(sizeof(rad_glsl_mb_blocks_push) == 24 &&
                                           offsetof(rad_glsl_mb_blocks_push, tile) == 12 &&
                                           offsetof(rad_glsl_mb_blocks_push, flags) == 20) ? 1 : -1];
+typedef char rad__check_glsl_local_apply_push[(sizeof(rad_glsl_local_apply_push) == 32 &&
+                                               offsetof(rad_glsl_local_apply_push, slot_offset) == 16 &&
+                                               offsetof(rad_glsl_local_apply_push, flags) == 28) ? 1 : -1];
+typedef char rad__check_glsl_local_vectors_push[(sizeof(rad_glsl_local_vectors_push) == 48 &&
+                                                 offsetof(rad_glsl_local_vectors_push, nnz) == 20 &&
+                                                 offsetof(rad_glsl_local_vectors_push, flags) == 32 &&
+                                                 offsetof(rad_glsl_local_vectors_push, ann) == 36) ? 1 : -1];
+typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_push) == 28 &&
+                                                offsetof(rad_glsl_local_update_push, base) == 16 &&
+                                                offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
+typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
+                                             offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
+                                             offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
+                                             offsetof(rad_glsl_vp_gather_push, flags) == 52) ? 1 : -1];
 typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28 &&
                                          offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
                                          offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
@@ -7241,6 +7353,406 @@ static const char rad__glsl_7_2[] =
     "\n"
     "#endif\n";
 static const char *const rad__glsl_pieces_7[] = { rad__glsl_7_0, rad__glsl_7_1, rad__glsl_7_2 };
+static const char rad__glsl_8_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LOCAL_APPLY: the local multi-bounce apply of rad_local_apply\n"
+    "// (SPEC \302\2475, thesis fig. 4.2): for every visible entry r = row_offset .. row_offset + row_count - 1,\n"
+    "// with slot i = vis_slot[r] and world patch p = vis_patch[r],\n"
+    "//   out[p] = sum_{j < end, lit_patch[j] != NONE} T_c[i][j] * E[lit_patch[j]]   (+ E[p] when flags bit 0)\n"
+    "// for channels c = R, G, B. T is rad_local.planes: three M x M planes, row = receiving slot,\n"
+    "// stride m. ONE WORKGROUP PER VISIBLE ENTRY: dispatch row_count groups; the group strides over\n"
+    "// the columns j < end and sums in shared memory.\n"
+    "// Chunking: bindings 0..2 may hold only plane rows slot_offset .. slot_offset + slot_count - 1\n"
+    "// (row i at element base + (i - slot_offset) * m); an entry whose slot lies outside them is\n"
+    "// skipped, so one dispatch per chunk over the whole visible list (or over the part of a list\n"
+    "// sorted by slot that falls in the chunk) covers every row.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };        // 3 n, world order\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer LitPatch { uint lit_patch[]; }; // end: patch of slot j, or ~0u\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer VisSlot { uint vis_slot[]; };   // visible entries: slots\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer VisPatch { uint vis_patch[]; }; // visible entries: patches\n"
+    "layout(std430, set = 0, binding = 7) buffer Output { float outv[]; };               // 3 n, world order\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint m;            // M: rad_local.capacity, the plane stride\n"
+    "    uint end;          // rad_local.slot_end: columns j < end\n"
+    "    uint row_offset;   // first visible entry of this dispatch\n"
+    "    uint row_count;    // visible entries in this dispatch (= workgroups)\n"
+    "    uint slot_offset;  // first plane row held by bindings 0..2\n"
+    "    uint slot_count;   // plane rows held by bindings 0..2\n"
+    "    uint base;         // element of bindings 0..2 that holds plane row slot_offset, column 0\n"
+    "    uint flags;        // bit 0: add E (RAD_OUTPUT_TOTAL)\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;                    // the whole group: barriers stay uniform\n"
+    "    uint i = vis_slot[pc.row_offset + r];\n"
+    "    if (i < pc.slot_offset || i - pc.slot_offset >= pc.slot_count) return; // another chunk's row\n"
+    "    uint at = pc.base + (i - pc.slot_offset) * pc.m;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "        uint p = lit_patch[j];\n"
+    "        if (p == 0xFFFFFFFFu) continue;\n"
+    "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[3u * p], E[3u * p + 1u], E[3u * p + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    uint o = 3u * vis_patch[pc.row_offset + r];\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0 };
+static const char rad__glsl_9_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LOCAL_VECTORS: the small pre-pass of a local-matrix add\n"
+    "// (rad_local_add, SPEC \302\2475) computed from T resident on the GPU: the vectors u, v and the scalar\n"
+    "// s of the Sherman-Morrison update (fused with the exact downdate of slot ev when an add evicts),\n"
+    "// which RAD_GLSL_LOCAL_UPDATE then applies. T is rad_local.planes (three M x M planes, stride m,\n"
+    "// row = receiving slot). The host streams only the new patch's row and column over the slots:\n"
+    "//   a_c[j] = rho_c[patch(j)] * A_n F_nj / A_j (column by reciprocity), b_c[j] = rho_c[n] * F_nj\n"
+    "// for member slots j != ev (zero elsewhere; channel-major, a[c * m + j]), nz = the slots with a\n"
+    "// non-zero F_nj (any order), ann_c = rho_c[n] F_nn. Work buffer (binding 6), channel c at c * 4m:\n"
+    "//   u[j] at +j, v[j] at +m + j, c[j] = T[j][ev] at +2m + j, r[j] = T[ev][j] at +3m + j;\n"
+    "//   then 12 scalars at 12m: s[3], cuv[3] (rank-1 factor), coef[3] (new row/column factor), tnn[3].\n"
+    "// Passes (push 'pass'), run in this order, each one dispatch (or one per row chunk for pass 0):\n"
+    "//   0  GATHER, row-chunked: ONE INVOCATION PER ITEM, max(row_count, end) invocations.\n"
+    "//      Invocation x as row i = row_offset + x: u[i] = a[i] + sum_p T[i][nz_p] a[nz_p], c[i] = T[i][ev];\n"
+    "//      as column j = x < end: v[j] (=, flags bit 0 on the first chunk; else +=) b[j] +\n"
+    "//      sum over nz_p in the chunk of b[nz_p] T[nz_p][j]; r[j] = T[ev][j] when ev is in the chunk.\n"
+    "//   1  EVICT (only when ev != ~0u), end invocations, reads no plane: with g = 1 + r[ev],\n"
+    "//      u[i] -= c[i] (r.a) / g, v[i] -= (b.c) r[i] / g, u[ev] = v[ev] = 0.\n"
+    "//   2  SCALARS, 3 invocations (one per channel): s = 1 - ann - b.u, and the factors:\n"
+    "//      exact (flags bit 1 clear): cuv = coef = 1/s, tnn = 1/s - 1 (as (ann + b.u) / s); first order (bit 1 set,\n"
+    "//      RAD_LOCAL_FIRST_ORDER): d = ann + b.a, coef = 1 + d, cuv = (1 + d)^2, tnn = d.\n"
+    "// Float arithmetic (the CPU accumulates u, v, s in double): within 1e-5 relative of rad_local_add\n"
+    "// for the tested sets. A kernel cannot fail: s <= 1e-12 (rows that break energy conservation)\n"
+    "// makes RAD_GLSL_LOCAL_UPDATE leave T unchanged; read s back to detect it.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VecA { float a[]; };   // 3 m, channel-major\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VecB { float b[]; };   // 3 m, channel-major\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer NonZero { uint nz[]; }; // nnz slots\n"
+    "layout(std430, set = 0, binding = 6) buffer Work { float w[]; };            // 12 m + 12\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint m;            // M: rad_local.capacity, the plane stride\n"
+    "    uint end;          // slots in use after the add: max(new slot + 1, rad_local.slot_end)\n"
+    "    uint row_offset;   // pass 0: first plane row held by bindings 0..2\n"
+    "    uint row_count;    // pass 0: plane rows held by bindings 0..2 (row_offset + row_count <= end)\n"
+    "    uint base;         // pass 0: element of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint nnz;          // entries of nz\n"
+    "    uint ev;           // the slot evicted by this add, or 0xFFFFFFFF\n"
+    "    uint pass;         // 0, 1, 2 (see above)\n"
+    "    uint flags;        // bit 0: first chunk of pass 0 (v = b + ...); bit 1: first-order update\n"
+    "    float ann_r, ann_g, ann_b; // rho_n F_nn per channel\n"
+    "} pc;\n"
+    "\n"
+    "float plane(uint c, uint e) { return c == 0u \? R[e] : c == 1u \? G[e] : B[e]; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint x = gl_GlobalInvocationID.x, m = pc.m, c;\n"
+    "    bool evict = pc.ev != 0xFFFFFFFFu;\n"
+    "    if (pc.pass == 0u) {\n"
+    "        if (x < pc.row_count) { // row i of the chunk\n"
+    "            uint i = pc.row_offset + x, at = pc.base + x * m;\n"
+    "            for (c = 0u; c < 3u; ++c) {\n";
+static const char rad__glsl_9_1[] =
+    "                precise float acc = a[c * m + i];\n"
+    "                for (uint p = 0u; p < pc.nnz; ++p) acc += plane(c, at + nz[p]) * a[c * m + nz[p]];\n"
+    "                w[c * 4u * m + i] = acc;\n"
+    "                w[c * 4u * m + 2u * m + i] = (evict && i != pc.ev) \? plane(c, at + pc.ev) : 0.0;\n"
+    "            }\n"
+    "        }\n"
+    "        if (x < pc.end) { // column j\n"
+    "            uint j = x;\n"
+    "            bool ev_here = evict && pc.ev >= pc.row_offset && pc.ev - pc.row_offset < pc.row_count;\n"
+    "            for (c = 0u; c < 3u; ++c) {\n"
+    "                precise float acc = (pc.flags & 1u) != 0u \? b[c * m + j] : w[c * 4u * m + m + j];\n"
+    "                for (uint p = 0u; p < pc.nnz; ++p) {\n"
+    "                    uint r = nz[p];\n"
+    "                    if (r >= pc.row_offset && r - pc.row_offset < pc.row_count)\n"
+    "                        acc += b[c * m + r] * plane(c, pc.base + (r - pc.row_offset) * m + j);\n"
+    "                }\n"
+    "                w[c * 4u * m + m + j] = acc;\n"
+    "                if (ev_here) w[c * 4u * m + 3u * m + j] = plane(c, pc.base + (pc.ev - pc.row_offset) * m + j);\n"
+    "            }\n"
+    "        }\n"
+    "    } else if (pc.pass == 1u) {\n"
+    "        if (x >= pc.end || !evict) return;\n"
+    "        for (c = 0u; c < 3u; ++c) {\n"
+    "            uint o = c * 4u * m;\n"
+    "            float g = 1.0 + w[o + 3u * m + pc.ev];\n"
+    "            precise float ra = 0.0, bc = 0.0;  // r.a and b.c (a and b are zero at ev)\n"
+    "            for (uint p = 0u; p < pc.nnz; ++p) {\n"
+    "                uint j = nz[p];\n"
+    "                ra += w[o + 3u * m + j] * a[c * m + j];\n"
+    "                bc += b[c * m + j] * w[o + 2u * m + j];\n"
+    "            }\n"
+    "            if (x == pc.ev) {\n"
+    "                w[o + x] = 0.0;\n"
+    "                w[o + m + x] = 0.0;\n"
+    "            } else {\n"
+    "                w[o + x] -= w[o + 2u * m + x] * (ra / g);\n"
+    "                w[o + m + x] -= (bc / g) * w[o + 3u * m + x];\n"
+    "            }\n"
+    "        }\n"
+    "    } else if (pc.pass == 2u) {\n"
+    "        if (x >= 3u) return;\n"
+    "        c = x;\n"
+    "        precise float bu = 0.0, ba = 0.0;\n"
+    "        for (uint p = 0u; p < pc.nnz; ++p) {\n"
+    "            uint j = nz[p];\n"
+    "            bu += b[c * m + j] * w[c * 4u * m + j];\n"
+    "            ba += b[c * m + j] * a[c * m + j];\n"
+    "        }\n"
+    "        float ann = c == 0u \? pc.ann_r : c == 1u \? pc.ann_g : pc.ann_b;\n"
+    "        precise float q = ann + bu, s = 1.0 - q; // q: no cancellation\n"
+    "        uint o = 12u * m;\n"
+    "        w[o + c] = s;\n"
+    "        if ((pc.flags & 2u) == 0u) {\n"
+    "            w[o + 3u + c] = 1.0 / s;\n"
+    "            w[o + 6u + c] = 1.0 / s;\n"
+    "            w[o + 9u + c] = q / s;                 // 1/s - 1 without its cancellation\n"
+    "        } else {\n"
+    "            precise float d = ann + ba;\n"
+    "            w[o + 3u + c] = (1.0 + d) * (1.0 + d);\n"
+    "            w[o + 6u + c] = 1.0 + d;\n"
+    "            w[o + 9u + c] = d;\n"
+    "        }\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_9[] = { rad__glsl_9_0, rad__glsl_9_1 };
+static const char rad__glsl_10_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LOCAL_UPDATE: the O(M^2) pass of a local-matrix add\n"
+    "// (rad_local_add, SPEC \302\2475) on T resident on the GPU, after RAD_GLSL_LOCAL_VECTORS filled the work\n"
+    "// buffer (its comment has the layout: u, v, c, r per channel and the scalars s, cuv, coef, tnn).\n"
+    "// For plane rows i = row_offset .. row_offset + row_count - 1 (all < end), channels R, G, B:\n"
+    "//   i == k (the new patch's slot):  T[k][j] = coef v[j] (j != k), T[k][k] = tnn\n"
+    "//   else: T[i][j] += cuv u[i] v[j] - c[i] r[j] / g   (j < end, j != k; the second term only when\n"
+    "//         an add evicts slot ev = k, g = 1 + r[ev]: the exact downdate fused into a rank-2 pass)\n"
+    "//         T[i][k] = coef u[i]\n"
+    "// which is rad_local_add's update, new row and new column; with the factors of the first-order\n"
+    "// form when RAD_GLSL_LOCAL_VECTORS ran with it. Nothing is written when some channel has\n"
+    "// s <= 1e-12 (the CPU returns RAD_ERROR_SINGULAR and leaves T unchanged). Rows and columns >= end\n"
+    "// are not touched. ONE WORKGROUP PER ROW: dispatch row_count groups; the group strides over j.\n"
+    "// Chunking: bindings 0..2 may hold only this chunk's rows, row i at element base + (i - row_offset) * m.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Work { float w[]; }; // 12 m + 12, from LOCAL_VECTORS\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint m;            // M: rad_local.capacity, the plane stride\n"
+    "    uint end;          // slots in use after the add (as given to RAD_GLSL_LOCAL_VECTORS)\n"
+    "    uint row_offset;   // first plane row of this dispatch\n"
+    "    uint row_count;    // rows in this dispatch (= workgroups)\n"
+    "    uint base;         // element of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint k;            // the new patch's slot\n"
+    "    uint ev;           // the slot evicted by this add (then ev == k), or 0xFFFFFFFF\n"
+    "} pc;\n"
+    "\n"
+    "void update(uint c, uint at, uint i)\n"
+    "{\n"
+    "    uint m = pc.m, o = c * 4u * m, s = 12u * m, lid = gl_LocalInvocationID.x;\n"
+    "    float cuv = w[s + 3u + c], coef = w[s + 6u + c];\n"
+    "    if (i == pc.k) {\n"
+    "        for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "            precise float t = j == pc.k \? w[s + 9u + c] : coef * w[o + m + j];\n"
+    "            if (c == 0u) R[at + j] = t; else if (c == 1u) G[at + j] = t; else B[at + j] = t;\n"
+    "        }\n"
+    "        return;\n"
+    "    }\n"
+    "    precise float ui = cuv * w[o + i];\n"
+    "    precise float ci = pc.ev != 0xFFFFFFFFu \? -w[o + 2u * m + i] / (1.0 + w[o + 3u * m + pc.ev]) : 0.0;\n"
+    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "        precise float t;\n"
+    "        if (j == pc.k) t = coef * w[o + i];\n"
+    "        else {\n"
+    "            t = c == 0u \? R[at + j] : c == 1u \? G[at + j] : B[at + j];\n"
+    "            if (ui != 0.0 || ci != 0.0) t += ci * w[o + 3u * m + j] + ui * w[o + m + j];\n"
+    "        }\n"
+    "        if (c == 0u) R[at + j] = t; else if (c == 1u) G[at + j] = t; else B[at + j] = t;\n"
+    "    }\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint s = 12u * pc.m;\n"
+    "    for (uint c = 0u; c < 3u; ++c)\n"
+    "        if (!(w[s + c] > 1e-12)) return; // singular: T stays as it was\n"
+    "    uint at = pc.base + r * pc.m, i = pc.row_offset + r;\n"
+    "    for (uint c = 0u; c < 3u; ++c) update(c, at, i);\n"
+    "}\n";
+static const char *const rad__glsl_pieces_10[] = { rad__glsl_10_0 };
+static const char rad__glsl_11_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_VP_GATHER: virtual-patch gathering at surface points, as\n"
+    "// rad_vp_gather / rad_vp_gather_point (SPEC \302\2476-\302\2477, T eq. 5.3, P eq. 9). For point i with unit\n"
+    "// normal n: in each voxel v of the 2x2x2 block around p (by voxel centres; the grid coordinate\n"
+    "// x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),\n"
+    "//   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0\n"
+    "// (axis-aligned: w_a the split weights of n, max(0, +-n_k)^2 or max(0, +-n_k) normalized to\n"
+    "// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = N_a . n); voxels outside the grid,\n"
+    "// empty or with no patch facing n are skipped, and\n"
+    "//   out_i = sum_v t_v L(v) / sum_v t_v       (t_v the trilinear weights; 0 when no voxel is used;\n"
+    "//   the plain mean of the used L(v) when their t_v sum to 0)\n"
+    "// ONE INVOCATION PER POINT: dispatch ceil(row_count / size) groups for the points\n"
+    "// row_offset .. row_offset + row_count - 1. Chunking: bindings 0, 1 and 6 may hold only this\n"
+    "// chunk's points, point i at elements base + 3 (i - row_offset) .. + 2 of each (bind the three at\n"
+    "// the same element offset). Voxel keys are the uint64 rad_virtual_patches.voxel_keys (ascending,\n"
+    "// ix + dims0 (iy + dims1 iz)), read as uvec2 (low word first) and found by binary search.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer Points { float P[]; };       // 3 per point\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Normals { float Nrm[]; };    // 3 per point, unit\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float X[]; };       // 3 N, per patch\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VoxelKeys { uvec2 keys[]; }; // voxel_count uint64\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VoxelPatch { uint vpatch[]; }; // 6 per voxel, or ~0u\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N (clustered only)\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };             // 3 per point\n"
+    "layout(push_constant) uniform Push {\n"
+    "    float origin_x, origin_y, origin_z;   // rad_virtual_patches.origin\n"
+    "    float size_x, size_y, size_z;         // .voxel_size\n"
+    "    uint dims_x, dims_y, dims_z;          // .dims\n"
+    "    uint voxel_count;                     // .voxel_count\n"
+    "    uint row_offset;                      // first point of this dispatch\n"
+    "    uint row_count;                       // points in this dispatch\n"
+    "    uint base;                            // element of bindings 0, 1, 6 holding point row_offset\n"
+    "    uint flags;                           // bit 0: cosine split weights; bit 1: clustered\n"
+    "} pc;\n"
+    "\n"
+    "uvec2 mul64(uint a, uvec2 b) { uint hi, lo; umulExtended(a, b.x, hi, lo); return uvec2(lo, hi + a * b.y); }\n"
+    "uvec2 add64(uvec2 a, uint b) { uint c; uint lo = uaddCarry(a.x, b, c); return uvec2(lo, a.y + c); }\n"
+    "bool less64(uvec2 a, uvec2 b) { return a.y < b.y || (a.y == b.y && a.x < b.x); }\n"
+    "\n"
+    "uint find_voxel(uvec2 key)\n"
+    "{\n"
+    "    uint lo = 0u, hi = pc.voxel_count;\n"
+    "    while (lo < hi) {\n"
+    "        uint mid = lo + (hi - lo) / 2u;\n"
+    "        if (less64(keys[mid], key)) lo = mid + 1u; else hi = mid;\n"
+    "    }\n"
+    "    return lo < pc.voxel_count && keys[lo] == key \? lo : 0xFFFFFFFFu;\n"
+    "}\n"
+    "\n"
+    "// a + b exactly, as the pair (sum, error) (Knuth's TwoSum)\n"
+    "vec2 two_sum(float a, float b)\n"
+    "{\n"
+    "    precise float s = a + b;\n"
+    "    precise float bb = s - a;\n"
+    "    precise float e = (a - (s - bb)) + (b - bb);\n"
+    "    return vec2(s, e);\n"
+    "}\n"
+    "// a * b exactly, as the pair (product, error) (Dekker, Veltkamp's split; no fma needed)\n"
+    "vec2 two_prod(float a, float b)\n"
+    "{\n"
+    "    precise float ca = 4097.0 * a, cb = 4097.0 * b;\n"
+    "    precise float ah = ca - (ca - a), bh = cb - (cb - b);\n"
+    "    precise float al = a - ah, bl = b - bh;\n"
+    "    precise float q = a * b;\n"
+    "    precise float e = ((ah * bh - q) + ah * bl + al * bh) + al * bl;\n"
+    "    return vec2(q, e);\n"
+    "}\n"
+    "// (p - o) / s - 1/2 as an unevaluated float pair (hi, lo), to about 1e-14 relative\n";
+static const char rad__glsl_11_1[] =
+    "vec2 grid_coordinate(float p, float o, float s)\n"
+    "{\n"
+    "    vec2 d = two_sum(p, -o);                      // p - o exactly\n"
+    "    precise float q = d.x / s;\n"
+    "    vec2 qs = two_prod(q, s);\n"
+    "    precise float r = ((d.x - qs.x) - qs.y) + d.y; // the remainder d - q s\n"
+    "    precise float ql = r / s;\n"
+    "    vec2 x = two_sum(q, -0.5);\n"
+    "    precise float lo = x.y + ql;\n"
+    "    return vec2(x.x, lo);\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint at = pc.base + 3u * r;\n"
+    "    vec3 p = vec3(P[at], P[at + 1u], P[at + 2u]), n = vec3(Nrm[at], Nrm[at + 1u], Nrm[at + 2u]);\n"
+    "    vec3 origin = vec3(pc.origin_x, pc.origin_y, pc.origin_z), size = vec3(pc.size_x, pc.size_y, pc.size_z);\n"
+    "    uvec3 dims = uvec3(pc.dims_x, pc.dims_y, pc.dims_z);\n"
+    "    bool clustered = (pc.flags & 2u) != 0u;\n"
+    "    // the split weights of n (+x, -x, +y, -y, +z, -z)\n"
+    "    vec3 wp = max(n, vec3(0.0)), wm = max(-n, vec3(0.0));\n"
+    "    if ((pc.flags & 1u) == 0u) { wp *= wp; wm *= wm; }\n"
+    "    float wsum = wp.x + wm.x + wp.y + wm.y + wp.z + wm.z;\n"
+    "    float w[6] = float[6](wp.x, wm.x, wp.y, wm.y, wp.z, wm.z);\n"
+    "    if (wsum > 0.0) for (int a = 0; a < 6; ++a) w[a] /= wsum;\n"
+    "    // the grid coordinate as a float pair (the CPU computes it in double: a float x would carry\n"
+    "    // an absolute error of about 1e-7 dims, large against the small trilinear weights)\n"
+    "    ivec3 b;\n"
+    "    vec3 g0, g1;\n"
+    "    for (int k = 0; k < 3; ++k) {\n"
+    "        vec2 x = grid_coordinate(p[k], origin[k], size[k]);\n"
+    "        float top = float(dims[k]) + 1.0;\n"
+    "        if (x.x < -2.0 || (x.x == -2.0 && x.y < 0.0)) x = vec2(-2.0, 0.0);\n"
+    "        if (x.x > top || (x.x == top && x.y > 0.0)) x = vec2(top, 0.0);\n"
+    "        float fb = floor(x.x);\n"
+    "        precise float f = x.x - fb;             // exact\n"
+    "        if (f + x.y < 0.0) fb -= 1.0; else if (f + x.y >= 1.0) fb += 1.0;\n"
+    "        f = x.x - fb;\n"
+    "        b[k] = int(fb);\n"
+    "        g1[k] = f + x.y;                        // the weight of the upper cell, g\n"
+    "        g0[k] = (1.0 - f) - x.y;                // 1 - g, from the pair: no cancellation near g = 1\n"
+    "    }\n"
+    "    precise vec3 acc = vec3(0.0), facc = vec3(0.0);\n"
+    "    precise float tsum = 0.0;\n"
+    "    uint used = 0u;\n"
+    "    for (uint corner = 0u; corner < 8u; ++corner) {\n"
+    "        ivec3 bit = ivec3(int(corner & 1u), int((corner >> 1) & 1u), int((corner >> 2) & 1u));\n"
+    "        ivec3 cell = b + bit;\n"
+    "        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(uvec3(cell), dims))) continue;\n"
+    "        vec3 tt = mix(g0, g1, vec3(bit));\n"
+    "        float t = tt.x * tt.y * tt.z;\n"
+    "        uvec2 key = add64(mul64(dims.x, add64(mul64(dims.y, uvec2(uint(cell.z), 0u)), uint(cell.y))), uint(cell.x));\n"
+    "        uint v = find_voxel(key);\n"
+    "        if (v == 0xFFFFFFFFu) continue;\n"
+    "        precise vec3 L = vec3(0.0);\n"
+    "        precise float ws = 0.0;\n"
+    "        for (uint a = 0u; a < 6u; ++a) {\n"
+    "            uint q = vpatch[6u * v + a];\n"
+    "            if (q == 0xFFFFFFFFu) continue;\n"
+    "            float wa = clustered \? dot(vec3(PN[3u * q], PN[3u * q + 1u], PN[3u * q + 2u]), n) : w[a];\n"
+    "            if (!(wa > 0.0)) continue;\n"
+    "            ws += wa;\n"
+    "            L += wa * vec3(X[3u * q], X[3u * q + 1u], X[3u * q + 2u]);\n"
+    "        }\n"
+    "        if (!(ws > 0.0)) continue; // nothing in this voxel faces n\n"
+    "        used++;\n"
+    "        acc += t * L / ws;\n"
+    "        facc += L / ws;\n"
+    "        tsum += t;\n"
+    "    }\n"
+    "    vec3 o = used == 0u \? vec3(0.0) : (tsum > 0.0 \? acc / tsum : facc / float(used));\n"
+    "    outv[at] = o.x;\n"
+    "    outv[at + 1u] = o.y;\n"
+    "    outv[at + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_11[] = { rad__glsl_11_0, rad__glsl_11_1 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
@@ -7249,7 +7761,11 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
     { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
     { "alias_build.comp", rad__glsl_pieces_6, 2u, 4697u },
-    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9212u }
+    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9212u },
+    { "local_apply.comp", rad__glsl_pieces_8, 1u, 3523u },
+    { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6660u },
+    { "local_update.comp", rad__glsl_pieces_10, 1u, 3412u },
+    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7418u }
 };
 /* >>glsl end */
 

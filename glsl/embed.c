@@ -29,6 +29,10 @@ static const kernel kernels[] = {
     { "RAD_GLSL_MB_APPLY_BLOCKS", "glsl/mb_apply_blocks.comp" },
     { "RAD_GLSL_ALIAS_BUILD", "glsl/alias_build.comp" },
     { "RAD_GLSL_LIGHTING", "glsl/lighting.glsl" }, /* an include: every lighting model (>>shading) */
+    { "RAD_GLSL_LOCAL_APPLY", "glsl/local_apply.comp" },
+    { "RAD_GLSL_LOCAL_VECTORS", "glsl/local_vectors.comp" },
+    { "RAD_GLSL_LOCAL_UPDATE", "glsl/local_update.comp" },
+    { "RAD_GLSL_VP_GATHER", "glsl/vp_gather.comp" },
 };
 #define KERNELS (sizeof(kernels) / sizeof(kernels[0]))
 

@@ -829,6 +829,544 @@ done:
     free(F); free(c.off); free(c.col); free(c.val); free(cpu_bins); free(scratch); free(padded_off);
 }
 
+/* ---- local multi-bounce matrix: adds (rank-1, fused evict rank-2) and apply, T resident ------ */
+
+/* the GPU side of a rad_local: the three planes resident, and the per-add buffers */
+typedef struct gpu_local {
+    vk_kernel kv, ku, ka;
+    vk_buf planes[3], a, b, nz, work;
+    uint32_t m;
+} gpu_local;
+
+/* the row chunks of plane rows [0, end) for the kernels */
+static void local_chunk_ranges(const gpu_local *g, uint32_t r0, uint32_t r1, vk_range *r, uint32_t *base)
+{
+    uint32_t ch;
+    for (ch = 0; ch < 3; ++ch)
+        r[ch] = vk_chunk(&g_vk, &g->planes[ch], 4, (VkDeviceSize)r0 * g->m, (VkDeviceSize)(r1 - r0) * g->m, base);
+}
+
+/* what an engine streams for adding 'patch': the new row and column over the slots, from the
+   fetched row F[patch][.] and the slot map before the add (with the evicted member's slot ev
+   already out of it), as rad_local_add builds them; then the kernels on the resident planes */
+static int gpu_local_add(gpu_local *g, const float *F, uint32_t n, const float *areas, const float *rho,
+                         const uint32_t *slot_before, uint32_t patch, uint32_t k, uint32_t ev, uint32_t end, int first_order,
+                         const float *ann_override)
+{
+    float *a = (float *)g->a.map, *b = (float *)g->b.map;
+    uint32_t *nz = (uint32_t *)g->nz.map, nnz = 0, j, ch, cut[4], q, first = 1;
+    double an = areas[patch];
+    float ann[3] = { 0, 0, 0 };
+    int ok = 1;
+    memset(a, 0, 3 * (size_t)g->m * 4);
+    memset(b, 0, 3 * (size_t)g->m * 4);
+    for (j = 0; j < n; ++j) {
+        float f = F[(size_t)patch * n + j];
+        uint32_t sj = slot_before[j];
+        if (f == 0.0f) continue;
+        if (j == patch) {
+            for (ch = 0; ch < 3; ++ch) ann[ch] = (float)((double)rho[3 * patch + ch] * f);
+            continue;
+        }
+        if (sj == RAD_NONE || sj == ev) continue;
+        for (ch = 0; ch < 3; ++ch) {
+            a[ch * g->m + sj] = (float)((double)rho[3 * j + ch] * (an * f / (double)areas[j]));
+            b[ch * g->m + sj] = (float)((double)rho[3 * patch + ch] * f);
+        }
+        nz[nnz++] = sj;
+    }
+    if (ann_override) memcpy(ann, ann_override, sizeof(ann));
+    chunks(end, cut);
+    for (q = 0; q < 3 && ok; ++q) { /* pass 0, per row chunk */
+        rad_glsl_local_vectors_push p;
+        vk_range r[7];
+        if (cut[q + 1] == cut[q]) continue;
+        memset(&p, 0, sizeof(p));
+        local_chunk_ranges(g, cut[q], cut[q + 1], r, &p.base);
+        r[3] = vk_whole(&g->a); r[4] = vk_whole(&g->b); r[5] = vk_whole(&g->nz); r[6] = vk_whole(&g->work);
+        p.m = g->m;
+        p.end = end;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.nnz = nnz;
+        p.ev = ev;
+        p.pass = RAD_GLSL_LOCAL_PASS_GATHER;
+        p.flags = (first ? RAD_GLSL_FLAG_FIRST_CHUNK : 0u) | (first_order ? RAD_GLSL_FLAG_FIRST_ORDER : 0u);
+        memcpy(p.ann, ann, sizeof(ann));
+        first = 0;
+        ok &= vk_dispatch(&g_vk, &g->kv, r, &p, p.row_count > end ? p.row_count : end);
+    }
+    {
+        rad_glsl_local_vectors_push p;
+        vk_range r[7];
+        memset(&p, 0, sizeof(p));
+        local_chunk_ranges(g, 0, end, r, &p.base); /* passes 1 and 2 read no plane; any range */
+        r[3] = vk_whole(&g->a); r[4] = vk_whole(&g->b); r[5] = vk_whole(&g->nz); r[6] = vk_whole(&g->work);
+        p.m = g->m;
+        p.end = end;
+        p.nnz = nnz;
+        p.ev = ev;
+        p.flags = first_order ? RAD_GLSL_FLAG_FIRST_ORDER : 0u;
+        memcpy(p.ann, ann, sizeof(ann));
+        if (ev != RAD_NONE) {
+            p.pass = RAD_GLSL_LOCAL_PASS_EVICT;
+            ok &= vk_dispatch(&g_vk, &g->kv, r, &p, end);
+        }
+        p.pass = RAD_GLSL_LOCAL_PASS_SCALARS;
+        ok &= vk_dispatch(&g_vk, &g->kv, r, &p, 3);
+    }
+    for (q = 0; q < 3 && ok; ++q) { /* the update, per row chunk */
+        rad_glsl_local_update_push p;
+        vk_range r[4];
+        if (cut[q + 1] == cut[q]) continue;
+        local_chunk_ranges(g, cut[q], cut[q + 1], r, &p.base);
+        r[3] = vk_whole(&g->work);
+        p.m = g->m;
+        p.end = end;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.k = k;
+        p.ev = ev;
+        ok &= vk_dispatch(&g_vk, &g->ku, r, &p, p.row_count);
+    }
+    return ok;
+}
+
+static int gpu_local_init(gpu_local *g, uint32_t m, uint32_t local_size)
+{
+    int ok = 1, ch;
+    memset(g, 0, sizeof(*g));
+    g->m = m;
+    ok &= vk_kernel_create(&g_vk, &g->kv, RAD_GLSL_LOCAL_VECTORS, 0, 7, (uint32_t)sizeof(rad_glsl_local_vectors_push), local_size);
+    ok &= vk_kernel_create(&g_vk, &g->ku, RAD_GLSL_LOCAL_UPDATE, 0, 4, (uint32_t)sizeof(rad_glsl_local_update_push), local_size);
+    ok &= vk_kernel_create(&g_vk, &g->ka, RAD_GLSL_LOCAL_APPLY, 0, 8, (uint32_t)sizeof(rad_glsl_local_apply_push), local_size);
+    for (ch = 0; ch < 3; ++ch) {
+        ok &= vk_buffer(&g_vk, &g->planes[ch], (VkDeviceSize)m * m * 4, NULL);
+        if (ok) memset(g->planes[ch].map, 0, (size_t)m * m * 4); /* an empty set: T = 0 */
+    }
+    ok &= vk_buffer(&g_vk, &g->a, 3 * (VkDeviceSize)m * 4, NULL);
+    ok &= vk_buffer(&g_vk, &g->b, 3 * (VkDeviceSize)m * 4, NULL);
+    ok &= vk_buffer(&g_vk, &g->nz, (VkDeviceSize)m * 4, NULL);
+    ok &= vk_buffer(&g_vk, &g->work, RAD_GLSL_LOCAL_WORK_FLOATS(m) * 4, NULL);
+    return ok;
+}
+
+static void gpu_local_free(gpu_local *g)
+{
+    int ch;
+    for (ch = 0; ch < 3; ++ch) vk_buffer_free(&g_vk, &g->planes[ch]);
+    vk_buffer_free(&g_vk, &g->a); vk_buffer_free(&g_vk, &g->b); vk_buffer_free(&g_vk, &g->nz); vk_buffer_free(&g_vk, &g->work);
+    vk_kernel_destroy(&g_vk, &g->kv); vk_kernel_destroy(&g_vk, &g->ku); vk_kernel_destroy(&g_vk, &g->ka);
+}
+
+/* the resident planes against rad_local.planes */
+static int gpu_local_compare(const gpu_local *g, const rad_local *L, const char *what)
+{
+    size_t mm = (size_t)g->m * g->m;
+    float *gpu = (float *)malloc(3 * mm * sizeof(float));
+    int ch, r;
+    if (!gpu) return 0;
+    for (ch = 0; ch < 3; ++ch) memcpy(gpu + ch * mm, g->planes[ch].map, mm * 4);
+    r = compare(what, gpu, L->planes, 3 * mm, 1e-5);
+    free(gpu);
+    return r;
+}
+
+/* out = T E over the visible entries, the planes bound in three slot chunks */
+static int gpu_local_apply(gpu_local *g, const rad_local *L, const float *E, const uint32_t *visible, uint32_t nvis,
+                           const uint32_t *lit, uint32_t nlit, rad_output output, float *out)
+{
+    const uint32_t n = L->n, end = L->slot_end;
+    vk_buf bE, bLit, bSlot, bPatch, bOut;
+    uint32_t i, cut[4], q;
+    int ok = 1;
+    ok &= vk_buffer(&g_vk, &bE, 3 * (VkDeviceSize)n * 4, E);
+    ok &= vk_buffer(&g_vk, &bLit, (VkDeviceSize)end * 4 + 4, NULL);
+    ok &= vk_buffer(&g_vk, &bSlot, (VkDeviceSize)nvis * 4 + 4, NULL);
+    ok &= vk_buffer(&g_vk, &bPatch, (VkDeviceSize)nvis * 4 + 4, visible);
+    ok &= vk_buffer(&g_vk, &bOut, 3 * (VkDeviceSize)n * 4, NULL);
+    if (ok) {
+        uint32_t *lp = (uint32_t *)bLit.map, *vs = (uint32_t *)bSlot.map;
+        memset(lp, 0xFF, (size_t)end * 4);
+        for (i = 0; i < nlit; ++i) lp[L->patch_slot[lit[i]]] = lit[i];
+        for (i = 0; i < nvis; ++i) vs[i] = L->patch_slot[visible[i]];
+        memset(bOut.map, 0xFF, 3 * (size_t)n * 4); /* NaN: every visible entry must be written */
+    }
+    chunks(end, cut);
+    for (q = 0; q < 3 && ok; ++q) {
+        rad_glsl_local_apply_push p;
+        vk_range r[8];
+        if (cut[q + 1] == cut[q]) continue;
+        local_chunk_ranges(g, cut[q], cut[q + 1], r, &p.base);
+        r[3] = vk_whole(&bE); r[4] = vk_whole(&bLit); r[5] = vk_whole(&bSlot); r[6] = vk_whole(&bPatch); r[7] = vk_whole(&bOut);
+        p.m = g->m;
+        p.end = end;
+        p.row_offset = 0;
+        p.row_count = nvis; /* every entry, each chunk: the kernel skips rows it does not hold */
+        p.slot_offset = cut[q];
+        p.slot_count = cut[q + 1] - cut[q];
+        p.flags = output == RAD_OUTPUT_TOTAL ? RAD_GLSL_FLAG_TOTAL : 0u;
+        ok &= vk_dispatch(&g_vk, &g->ka, r, &p, nvis);
+    }
+    if (ok) memcpy(out, bOut.map, 3 * (size_t)n * 4);
+    vk_buffer_free(&g_vk, &bE); vk_buffer_free(&g_vk, &bLit); vk_buffer_free(&g_vk, &bSlot); vk_buffer_free(&g_vk, &bPatch);
+    vk_buffer_free(&g_vk, &bOut);
+    return ok;
+}
+
+/* a world with reciprocity (F_ij A_i = F_ji A_j), rows summing to at most 0.9, some F_ii > 0 */
+static void local_world(uint32_t n, float *F, float *areas, float *rho)
+{
+    uint32_t i, j;
+    double mx = 0.0;
+    for (i = 0; i < n; ++i) areas[i] = 1.0f + frand();
+    for (i = 0; i < 3 * n; ++i) rho[i] = 0.85f * frand();
+    for (i = 0; i < n; ++i)
+        for (j = i; j < n; ++j) {
+            float gij = (i == j ? frand() < 0.2f : frand() < 0.5f) ? frand() : 0.0f; /* G symmetric */
+            F[(size_t)i * n + j] = gij / areas[i];
+            F[(size_t)j * n + i] = gij / areas[j];
+        }
+    for (i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (j = 0; j < n; ++j) s += F[(size_t)i * n + j];
+        mx = s > mx ? s : mx;
+    }
+    for (i = 0; i < n * n; ++i) F[i] = (float)(F[i] * 0.9 / mx);
+}
+
+static void local_case(const float *F, uint32_t n, const float *areas, const float *rho, uint32_t m, uint32_t local_size,
+                       rad_local_update update, rad_local_eviction evict, uint32_t *evicting_adds)
+{
+    rad_matrix mat;
+    rad_row_source src;
+    rad_local_options o;
+    rad_local *L = NULL;
+    gpu_local g;
+    uint32_t *before = (uint32_t *)malloc((size_t)n * 4), *order = (uint32_t *)malloc((size_t)n * 4), i, step = 0;
+    uint32_t *vis = (uint32_t *)malloc((size_t)n * 4), *lit = (uint32_t *)malloc((size_t)n * 4), nvis = 0, nlit = 0;
+    float *E = random_vector(3 * (size_t)n, 0.3f), *cpu = (float *)calloc(3 * (size_t)n, 4), *gpu = (float *)malloc(3 * (size_t)n * 4);
+    int ok = 1, total;
+    const char *what = update != RAD_LOCAL_EXACT ? "local T after adds (first order)"
+                       : evict == RAD_LOCAL_EVICT_DROP ? "local T after adds (exact, evictions by drop)" : "local T after adds (exact)";
+    memset(&mat, 0, sizeof(mat));
+    mat.rows = mat.cols = n;
+    mat.storage = RAD_STORAGE_DENSE;
+    mat.dense = F;
+    if (!before || !order || !vis || !lit || !E || !cpu || !gpu || !gpu_local_init(&g, m, local_size)) { T_CHECK(0); goto done; }
+    rad_local_options_default(&o);
+    o.capacity = m;
+    o.update = update;
+    o.evict = evict;
+    T_CHECK(rad_row_source_matrix(&mat, areas, rho, &src) == RAD_SUCCESS);
+    T_CHECK(rad_local_create(&src, &o, NULL, &L) == RAD_SUCCESS);
+    if (!L) goto done;
+    for (i = 0; i < n; ++i) order[i] = (i * 37u + 11u) % n; /* n prime to 37: a permutation */
+    /* fill the set, hide 10 members, show one again, fill the free slots, then evict into adds */
+    for (i = 0; ok && i < m + 6; ++i) { /* m - 8 adds, 8 into the free slots, 6 evicting */
+        uint32_t patch = order[i], k, ev, end, had = L->slot_end;
+        int full;
+        if (i == m - 8) { /* hide 10 members (the 1st, 4th, ...), then show the 4th again */
+            uint32_t h;
+            for (h = 0; h < 10; ++h) T_CHECK(rad_local_remove(L, order[3 * h], NULL) == RAD_SUCCESS);
+            T_CHECK(rad_local_add(L, order[3], NULL) == RAD_SUCCESS); /* only shown: T unchanged */
+        }
+        memcpy(before, L->patch_slot, (size_t)n * 4);
+        full = L->count + L->hidden >= L->capacity;
+        {
+            rad_result r = rad_local_add(L, patch, NULL);
+            if (r != RAD_SUCCESS) { printf("    FAIL rad_local_add(%u): %s\n", patch, rad_result_string(r)); g_checks_failed++; break; }
+        }
+        k = L->patch_slot[patch];
+        /* the member evicted from slot k is out of the slot map; with the seed's drop the add is a
+           plain one into slot k (its old row and column are overwritten, as the drop zeroed them) */
+        ev = full && evict == RAD_LOCAL_EVICT_DOWNDATE ? k : RAD_NONE;
+        if (full) {
+            uint32_t p;
+            for (p = 0; p < n; ++p)
+                if (before[p] == k) before[p] = RAD_NONE;
+            ++*evicting_adds;
+        }
+        end = k + 1 > had ? k + 1 : had;
+        ok &= gpu_local_add(&g, F, n, areas, rho, before, patch, k, ev, end, update == RAD_LOCAL_FIRST_ORDER, NULL);
+        if (++step % 8 == 0 || full) ok &= gpu_local_compare(&g, L, what);
+    }
+    T_CHECK(ok && L->evictions > 0 && L->hidden > 0);
+    ok &= gpu_local_compare(&g, L, what);
+    /* apply: every visible member receives, every member (hidden ones too) with E != 0 lights */
+    for (i = 0; i < n; ++i) {
+        uint32_t p = order[i], s = L->patch_slot[p];
+        if (s == RAD_NONE) continue;
+        if (!L->slot_hidden[s]) vis[nvis++] = p;
+        if (i % 3 != 1 || L->slot_hidden[s]) lit[nlit++] = p;
+    }
+    for (total = 0; ok && total < 2; ++total) {
+        rad_output out = total ? RAD_OUTPUT_TOTAL : RAD_OUTPUT_INDIRECT;
+        float *gv = (float *)malloc(3 * (size_t)nvis * 4), *cv = (float *)malloc(3 * (size_t)nvis * 4);
+        T_CHECK(rad_local_apply(L, E, vis, nvis, lit, nlit, out, cpu, NULL) == RAD_SUCCESS);
+        T_CHECK(gpu_local_apply(&g, L, E, vis, nvis, lit, nlit, out, gpu));
+        if (gv && cv) {
+            for (i = 0; i < 3 * nvis; ++i) { gv[i] = gpu[3 * vis[i / 3] + i % 3]; cv[i] = cpu[3 * vis[i / 3] + i % 3]; }
+            compare(total ? "local apply total" : "local apply", gv, cv, 3 * (size_t)nvis, 1e-5);
+        } else T_CHECK(0);
+        free(gv); free(cv);
+    }
+    /* rows that break energy conservation (s <= 0): the update leaves T as it was */
+    if (ok && update == RAD_LOCAL_EXACT) {
+        const float bad[3] = { 1.5f, 0.0f, 0.0f };
+        uint32_t k = 0; /* an evicting add (the set is full): slot k of a hidden member */
+        while (k < m && !(L->slot_patch[k] != RAD_NONE && L->slot_hidden[k])) ++k;
+        for (i = 0; i < n && L->patch_slot[order[i]] != RAD_NONE; ++i) {}
+        if (k < m && i < n) {
+            memcpy(before, L->patch_slot, (size_t)n * 4);
+            T_CHECK(gpu_local_add(&g, F, n, areas, rho, before, order[i], k, k, L->slot_end, 0, bad));
+            T_CHECK(((const float *)g.work.map)[12 * m] < 0.0f);
+            gpu_local_compare(&g, L, "local T unchanged after a singular add");
+        } else T_CHECK(0);
+    }
+done:
+    rad_local_destroy(L);
+    gpu_local_free(&g);
+    free(before); free(order); free(vis); free(lit); free(E); free(cpu); free(gpu);
+}
+
+static void test_local(void)
+{
+    const uint32_t n = 151, m = 48;
+    float *F = (float *)malloc((size_t)n * n * 4), *areas = (float *)malloc(n * 4), *rho = (float *)malloc(3 * n * 4);
+    uint32_t evicting = 0;
+    if (!F || !areas || !rho) { T_CHECK(0); free(F); free(areas); free(rho); return; }
+    local_world(n, F, areas, rho);
+    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_EXACT, RAD_LOCAL_EVICT_DOWNDATE, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[1], RAD_LOCAL_EXACT, RAD_LOCAL_EVICT_DOWNDATE, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[0], RAD_LOCAL_FIRST_ORDER, RAD_LOCAL_EVICT_DOWNDATE, &evicting);
+    local_case(F, n, areas, rho, m, g_local_sizes[1], RAD_LOCAL_EXACT, RAD_LOCAL_EVICT_DROP, &evicting);
+    printf("    M = %u of n = %u, %u adds into a full set (rank 2 with the downdate, plain after a drop)\n", m, n, evicting);
+    T_CHECK(evicting >= 3);
+    free(F); free(areas); free(rho);
+}
+
+
+/* ---- virtual-patch gathering: normal weights, trilinear filter skipping empty voxels ---------- */
+
+/* RAD_GLSL_VP_GATHER at 'npts' points (in three chunks) against rad_vp_gather */
+static void vp_run(const rad_virtual_patches *vp, const float *values, const float *pts, const float *nrm, uint32_t npts,
+                   uint32_t local_size, const char *what)
+{
+    const uint32_t count = vp->count;
+    const rad_vp_kind kind = vp->kind;
+    const rad_vp_weights weights = vp->weights;
+    float *cpu = (float *)malloc(3 * (size_t)npts * 4);
+    vk_kernel k;
+    vk_buf bP, bN, bX, bK, bV, bPN, bO;
+    uint32_t cut[4], q;
+    int ok = 1;
+    if (!cpu) { T_CHECK(0); return; }
+    T_CHECK(rad_vp_gather(vp, values, pts, nrm, npts, cpu, NULL) == RAD_SUCCESS);
+    if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_VP_GATHER, 0, 7, (uint32_t)sizeof(rad_glsl_vp_gather_push), local_size)) {
+        T_CHECK(0);
+        free(cpu);
+        return;
+    }
+    ok &= vk_buffer(&g_vk, &bP, 3 * (VkDeviceSize)npts * 4, pts);
+    ok &= vk_buffer(&g_vk, &bN, 3 * (VkDeviceSize)npts * 4, nrm);
+    ok &= vk_buffer(&g_vk, &bX, 3 * (VkDeviceSize)count * 4, values);
+    ok &= vk_buffer(&g_vk, &bK, (VkDeviceSize)vp->voxel_count * 8, vp->voxel_keys);
+    ok &= vk_buffer(&g_vk, &bV, 6 * (VkDeviceSize)vp->voxel_count * 4, vp->voxel_patch);
+    ok &= vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, vp->normals);
+    ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)npts * 4, NULL);
+    if (ok) memset(bO.map, 0xFF, 3 * (size_t)npts * 4); /* NaN: every point must be written */
+    chunks(npts, cut);
+    for (q = 0; q < 3 && ok; ++q) {
+        rad_glsl_vp_gather_push p;
+        vk_range r[7];
+        uint32_t b1, b2;
+        if (cut[q + 1] == cut[q]) continue;
+        r[0] = vk_chunk(&g_vk, &bP, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &p.base);
+        r[1] = vk_chunk(&g_vk, &bN, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b1);
+        r[6] = vk_chunk(&g_vk, &bO, 4, 3 * (VkDeviceSize)cut[q], 3 * (VkDeviceSize)(cut[q + 1] - cut[q]), &b2);
+        T_CHECK(b1 == p.base && b2 == p.base);
+        r[2] = vk_whole(&bX); r[3] = vk_whole(&bK); r[4] = vk_whole(&bV); r[5] = vk_whole(&bPN);
+        memcpy(p.origin, vp->origin, sizeof(p.origin));
+        memcpy(p.voxel_size, vp->voxel_size, sizeof(p.voxel_size));
+        memcpy(p.dims, vp->dims, sizeof(p.dims));
+        p.voxel_count = vp->voxel_count;
+        p.row_offset = cut[q];
+        p.row_count = cut[q + 1] - cut[q];
+        p.flags = (weights == RAD_VP_WEIGHTS_COSINE ? RAD_GLSL_FLAG_COSINE : 0u) | (kind == RAD_VP_CLUSTERED ? RAD_GLSL_FLAG_CLUSTERED : 0u);
+        ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+    }
+    T_CHECK(ok);
+    if (ok) compare(what, (const float *)bO.map, cpu, 3 * (size_t)npts, 1e-5);
+    vk_buffer_free(&g_vk, &bP); vk_buffer_free(&g_vk, &bN); vk_buffer_free(&g_vk, &bX); vk_buffer_free(&g_vk, &bK);
+    vk_buffer_free(&g_vk, &bV); vk_buffer_free(&g_vk, &bPN); vk_buffer_free(&g_vk, &bO);
+    vk_kernel_destroy(&g_vk, &k);
+    free(cpu);
+}
+
+/* a grid of 5 x 4 x 6 voxels, about 60% of them present, each axis patch present with
+   probability 0.7 (clustered: random unit normals): the gather's skipping is exercised at
+   every level (missing voxel, voxel without a patch facing n, outside the grid) */
+static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_size, uint32_t *used_hist)
+{
+    const uint32_t dims[3] = { 5, 4, 6 }, cells = 5 * 4 * 6, npts = 2000;
+    rad_virtual_patches vp;
+    uint64_t keys[5 * 4 * 6];
+    uint32_t vpatch[6 * 5 * 4 * 6], c, a, count = 0, i;
+    float normals[3 * 6 * 5 * 4 * 6], *values = NULL, *pts = (float *)malloc(3 * (size_t)npts * 4);
+    float *nrm = (float *)malloc(3 * (size_t)npts * 4);
+    memset(&vp, 0, sizeof(vp));
+    vp.origin[0] = -1.0f; vp.origin[1] = 0.5f; vp.origin[2] = 2.0f;
+    vp.voxel_size[0] = 0.7f; vp.voxel_size[1] = 0.9f; vp.voxel_size[2] = 0.6f;
+    memcpy(vp.dims, dims, sizeof(dims));
+    for (c = 0; c < cells; ++c) {
+        if (frand() < 0.4f) continue;
+        keys[vp.voxel_count] = c;
+        for (a = 0; a < 6; ++a) {
+            uint32_t *slot = &vpatch[6 * vp.voxel_count + a];
+            *slot = RAD_NONE;
+            if (frand() < 0.3f) continue;
+            *slot = count;
+            if (kind == RAD_VP_CLUSTERED) {
+                float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l = sqrtf(x * x + y * y + z * z) + 1e-6f;
+                normals[3 * count] = x / l; normals[3 * count + 1] = y / l; normals[3 * count + 2] = z / l;
+            } else {
+                normals[3 * count] = normals[3 * count + 1] = normals[3 * count + 2] = 0.0f;
+                normals[3 * count + a / 2] = a % 2 ? -1.0f : 1.0f;
+            }
+            ++count;
+        }
+        vp.voxel_count++;
+    }
+    vp.count = count;
+    vp.voxel_keys = keys;
+    vp.voxel_patch = vpatch;
+    vp.normals = normals;
+    vp.kind = kind;
+    vp.weights = weights;
+    values = random_vector(3 * (size_t)count, 0.1f);
+    if (!values || !pts || !nrm) { T_CHECK(0); goto done; }
+    for (i = 0; i < npts; ++i) {
+        float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l;
+        uint32_t d;
+        if (i % 7 == 0) { /* an axis normal: four split weights are zero */
+            float s = i % 2 ? 1.0f : -1.0f;
+            x = (i / 7) % 3 == 0 ? s : 0.0f;
+            y = (i / 7) % 3 == 1 ? s : 0.0f;
+            z = (i / 7) % 3 == 2 ? s : 0.0f;
+        }
+        l = sqrtf(x * x + y * y + z * z) + 1e-6f;
+        nrm[3 * i] = x / l; nrm[3 * i + 1] = y / l; nrm[3 * i + 2] = z / l;
+        for (d = 0; d < 3; ++d) /* from one voxel outside the grid to one beyond it; some far away */
+            pts[3 * i + d] = vp.origin[d] + vp.voxel_size[d] * ((float)(dims[d] + 2) * frand() - 1.0f) * (i % 97 == 5 ? 9.0f : 1.0f);
+    }
+    for (i = 0; i < npts; ++i) {
+        float o[3];
+        uint32_t used = rad_vp_gather_point(&vp, values, pts + 3 * i, nrm + 3 * i, o);
+        used_hist[used > 8 ? 8 : used]++;
+    }
+    vp_run(&vp, values, pts, nrm, npts, local_size, kind == RAD_VP_CLUSTERED ? "vp gather (clustered)"
+           : weights == RAD_VP_WEIGHTS_COSINE ? "vp gather (cosine)" : "vp gather");
+done:
+    free(values); free(pts); free(nrm);
+}
+
+
+/* a built set: three walls of a 4 x 2 x 3 room corner (floor, x = 0, z = 0) as 4 x 4 triangle
+   grids, rad_vp_create with 'kind'; points on the walls (with their normals) and inside the
+   room (random normals) */
+static void vp_built(rad_vp_kind kind, uint32_t local_size)
+{
+    static const float o[3][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { 0, 0, 0 } };
+    static const float U[3][3] = { { 0, 0, 3 }, { 0, 2, 0 }, { 4, 0, 0 } }, V[3][3] = { { 4, 0, 0 }, { 0, 0, 3 }, { 0, 2, 0 } };
+    static const float nrm_of[3][3] = { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, 1 } };
+    float pos[3][3 * 25];
+    uint32_t idx[3][6 * 16], q, i, j, d;
+    rad_mesh_desc meshes[3];
+    rad_material mat;
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options vo;
+    rad_virtual_patches *vp = NULL;
+    const uint32_t npts = 1000;
+    float *pts = (float *)malloc(3 * (size_t)npts * 4), *nrm = (float *)malloc(3 * (size_t)npts * 4), *values = NULL;
+    for (q = 0; q < 3; ++q) {
+        for (j = 0; j <= 4; ++j)
+            for (i = 0; i <= 4; ++i)
+                for (d = 0; d < 3; ++d) pos[q][3 * (j * 5 + i) + d] = o[q][d] + U[q][d] * (float)i / 4.0f + V[q][d] * (float)j / 4.0f;
+        for (j = 0; j < 4; ++j)
+            for (i = 0; i < 4; ++i) {
+                uint32_t a = j * 5 + i, *tri = &idx[q][6 * (j * 4 + i)];
+                tri[0] = a; tri[1] = a + 1; tri[2] = a + 6;
+                tri[3] = a; tri[4] = a + 6; tri[5] = a + 5;
+            }
+        memset(&meshes[q], 0, sizeof(meshes[q]));
+        meshes[q].positions = pos[q];
+        meshes[q].vertex_count = 25;
+        meshes[q].indices = idx[q];
+        meshes[q].triangle_count = 32;
+    }
+    memset(&mat, 0, sizeof(mat));
+    mat.albedo[0] = mat.albedo[1] = mat.albedo[2] = 0.5f;
+    memset(&desc, 0, sizeof(desc));
+    desc.meshes = meshes;
+    desc.mesh_count = 3;
+    desc.materials = &mat;
+    desc.material_count = 1;
+    if (!pts || !nrm) { T_CHECK(0); goto done; }
+    T_CHECK(rad_scene_create(&desc, NULL, &scene) == RAD_SUCCESS);
+    if (scene) T_CHECK(rad_bvh_create(scene, NULL, &bvh) == RAD_SUCCESS);
+    if (!bvh) goto done;
+    rad_bvh_raycaster(bvh, &rc);
+    rad_vp_options_default(&vo);
+    vo.resolution = 9;
+    vo.face_points = 4;
+    vo.skip_visibility = 1;
+    vo.kind = kind;
+    T_CHECK(rad_vp_create(scene, &rc, &vo, NULL, &vp) == RAD_SUCCESS);
+    if (!vp) goto done;
+    values = random_vector(3 * (size_t)vp->count, 0.0f);
+    if (!values) { T_CHECK(0); goto done; }
+    for (i = 0; i < npts; ++i) {
+        float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l = sqrtf(x * x + y * y + z * z) + 1e-6f;
+        if (i % 2 == 0) { /* on a wall */
+            q = (i / 2) % 3;
+            for (d = 0; d < 3; ++d) {
+                pts[3 * i + d] = U[q][d] * frand() + V[q][d] * frand();
+                nrm[3 * i + d] = nrm_of[q][d];
+            }
+        } else {
+            pts[3 * i] = 4.0f * frand(); pts[3 * i + 1] = 2.0f * frand(); pts[3 * i + 2] = 3.0f * frand();
+            nrm[3 * i] = x / l; nrm[3 * i + 1] = y / l; nrm[3 * i + 2] = z / l;
+        }
+    }
+    vp_run(vp, values, pts, nrm, npts, local_size, kind == RAD_VP_CLUSTERED ? "vp gather, built (clustered)" : "vp gather, built");
+    printf("    built: %u patches in %u voxels (%u x %u x %u grid)\n", vp->count, vp->voxel_count, vp->dims[0], vp->dims[1], vp->dims[2]);
+done:
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+    free(pts); free(nrm); free(values);
+}
+
+static void test_vp_gather(void)
+{
+    uint32_t hist[9], i;
+    g_rng = 12345u; /* the same grids whichever tests ran before */
+    memset(hist, 0, sizeof(hist));
+    vp_case(RAD_VP_AXIS_ALIGNED, RAD_VP_WEIGHTS_SQUARED, g_local_sizes[0], hist);
+    vp_case(RAD_VP_AXIS_ALIGNED, RAD_VP_WEIGHTS_COSINE, g_local_sizes[1], hist);
+    vp_case(RAD_VP_CLUSTERED, RAD_VP_WEIGHTS_SQUARED, g_local_sizes[0], hist);
+    vp_built(RAD_VP_AXIS_ALIGNED, g_local_sizes[1]);
+    vp_built(RAD_VP_CLUSTERED, g_local_sizes[0]);
+    printf("    points by voxels used (0..8):");
+    for (i = 0; i < 9; ++i) printf(" %u", hist[i]);
+    printf("\n");
+    T_CHECK(hist[0] > 0 && hist[7] + hist[8] > 0 && hist[2] + hist[3] + hist[4] > 0); /* skipping happened, and near-full blocks */
+}
+
 /* ---- the C mirrors of the push-constant blocks, against the compiled SPIR-V ------------------ */
 
 /* member names and byte offsets of the push-constant block of a SPIR-V module (from OpMemberName
@@ -907,6 +1445,24 @@ static void test_push_mirrors(void)
     static const mirror_member alias[] = { MM(rad_glsl_alias_build_push, row_offset), MM(rad_glsl_alias_build_push, row_count),
         MM(rad_glsl_alias_build_push, cols), MM(rad_glsl_alias_build_push, words), MM(rad_glsl_alias_build_push, entry_base),
         MM(rad_glsl_alias_build_push, out_base), MM(rad_glsl_alias_build_push, flags), { NULL, 0 } };
+    static const mirror_member lapply[] = { MM(rad_glsl_local_apply_push, m), MM(rad_glsl_local_apply_push, end),
+        MM(rad_glsl_local_apply_push, row_offset), MM(rad_glsl_local_apply_push, row_count), MM(rad_glsl_local_apply_push, slot_offset),
+        MM(rad_glsl_local_apply_push, slot_count), MM(rad_glsl_local_apply_push, base), MM(rad_glsl_local_apply_push, flags), { NULL, 0 } };
+    static const mirror_member lvec[] = { MM(rad_glsl_local_vectors_push, m), MM(rad_glsl_local_vectors_push, end),
+        MM(rad_glsl_local_vectors_push, row_offset), MM(rad_glsl_local_vectors_push, row_count), MM(rad_glsl_local_vectors_push, base),
+        MM(rad_glsl_local_vectors_push, nnz), MM(rad_glsl_local_vectors_push, ev), MM(rad_glsl_local_vectors_push, pass),
+        MM(rad_glsl_local_vectors_push, flags), { "ann_r", offsetof(rad_glsl_local_vectors_push, ann) },
+        { "ann_g", offsetof(rad_glsl_local_vectors_push, ann) + 4 }, { "ann_b", offsetof(rad_glsl_local_vectors_push, ann) + 8 }, { NULL, 0 } };
+    static const mirror_member lupd[] = { MM(rad_glsl_local_update_push, m), MM(rad_glsl_local_update_push, end),
+        MM(rad_glsl_local_update_push, row_offset), MM(rad_glsl_local_update_push, row_count), MM(rad_glsl_local_update_push, base),
+        MM(rad_glsl_local_update_push, k), MM(rad_glsl_local_update_push, ev), { NULL, 0 } };
+    static const mirror_member vpg[] = { { "origin_x", offsetof(rad_glsl_vp_gather_push, origin) },
+        { "origin_y", offsetof(rad_glsl_vp_gather_push, origin) + 4 }, { "origin_z", offsetof(rad_glsl_vp_gather_push, origin) + 8 },
+        { "size_x", offsetof(rad_glsl_vp_gather_push, voxel_size) }, { "size_y", offsetof(rad_glsl_vp_gather_push, voxel_size) + 4 },
+        { "size_z", offsetof(rad_glsl_vp_gather_push, voxel_size) + 8 }, { "dims_x", offsetof(rad_glsl_vp_gather_push, dims) },
+        { "dims_y", offsetof(rad_glsl_vp_gather_push, dims) + 4 }, { "dims_z", offsetof(rad_glsl_vp_gather_push, dims) + 8 },
+        MM(rad_glsl_vp_gather_push, voxel_count), MM(rad_glsl_vp_gather_push, row_offset), MM(rad_glsl_vp_gather_push, row_count),
+        MM(rad_glsl_vp_gather_push, base), MM(rad_glsl_vp_gather_push, flags), { NULL, 0 } };
     g_worst_what = "push-constant block, bytes";
     check_mirror(RAD_GLSL_GATHER_DENSE, dense, sizeof(rad_glsl_gather_dense_push));
     check_mirror(RAD_GLSL_GATHER_CSR, sparse, sizeof(rad_glsl_gather_csr_push));
@@ -915,6 +1471,10 @@ static void test_push_mirrors(void)
     check_mirror(RAD_GLSL_TEMPORAL_STEP, temporal, sizeof(rad_glsl_temporal_push));
     check_mirror(RAD_GLSL_MB_APPLY_BLOCKS, blocks, sizeof(rad_glsl_mb_blocks_push));
     check_mirror(RAD_GLSL_ALIAS_BUILD, alias, sizeof(rad_glsl_alias_build_push));
+    check_mirror(RAD_GLSL_LOCAL_APPLY, lapply, sizeof(rad_glsl_local_apply_push));
+    check_mirror(RAD_GLSL_LOCAL_VECTORS, lvec, sizeof(rad_glsl_local_vectors_push));
+    check_mirror(RAD_GLSL_LOCAL_UPDATE, lupd, sizeof(rad_glsl_local_update_push));
+    check_mirror(RAD_GLSL_VP_GATHER, vpg, sizeof(rad_glsl_vp_gather_push));
     /* every kernel (.comp; includes have no push block) has its mirror checked above */
     {
         uint32_t id;
@@ -982,6 +1542,8 @@ static const vk_test g_tests[] = {
     { "vk_temporal_step", test_temporal },
     { "vk_mb_apply_bc1_bc4_outliers_permuted", test_mb_blocks },
     { "vk_alias_build_streamed_rows_then_temporal", test_alias_build },
+    { "vk_local_adds_evictions_apply_resident", test_local },
+    { "vk_vp_gather_trilinear_skipping", test_vp_gather },
     { NULL, NULL }
 };
 

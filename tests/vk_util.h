@@ -332,7 +332,8 @@ static int vk_kernel_create(vk_ctx *v, vk_kernel *k, rad_glsl_id id, uint32_t im
     if ((unsigned)id < 64u) vk_created[id]++;
     k->images = images;
     k->group_per_row = id == RAD_GLSL_GATHER_DENSE || id == RAD_GLSL_GATHER_CSR || id == RAD_GLSL_MB_APPLY_FLOAT ||
-                       id == RAD_GLSL_MB_APPLY_HALF || id == RAD_GLSL_MB_APPLY_BLOCKS;
+                       id == RAD_GLSL_MB_APPLY_HALF || id == RAD_GLSL_MB_APPLY_BLOCKS || id == RAD_GLSL_LOCAL_APPLY ||
+                       id == RAD_GLSL_LOCAL_UPDATE;
     k->bindings = bindings;
     k->push_size = push_size;
     k->local_size = local_size;
