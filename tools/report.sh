@@ -227,7 +227,7 @@ log "temporal against matrix-vector, N = $TSIZES (bench/temporal)"
 if [ -x "$TBENCH" ] && "$TBENCH" --sizes "$TSIZES" --append "$TAB_T" --csv "$OUT/data/temporal_error.csv" > "$OUT/data/temporal.log" 2>&1; then
     # rows "| N (target) | step10 | step64 | MV | ..."
     {
-        echo "N temporal_k=10 temporal_k=64 matrix-vector thesis_temporal_(RTX_3060) thesis_matrix-vector"
+        echo "N temporal_k=10 temporal_k=64 matrix-vector thesis_temporal_k=10 thesis_matrix-vector"
         awk -F'|' '/^\| [0-9]+ \([0-9]+\) \|/ {
             split($2, a, /[ ()]+/); n = a[2]; t = a[3]
             pt = pm = "-"

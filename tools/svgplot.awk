@@ -5,7 +5,8 @@
 #
 # DATA: whitespace-separated columns; the first line names them (the first column is x, each
 # further column one series; an underscore in a name is shown as a space). A value that is not a
-# number ('-', 'nan') leaves a gap. Log axes skip values <= 0. Ticks: decades (and 2, 5) on log
+# number ('-', 'nan') is skipped (the line joins the points on either side, so series measured at
+# different x can share one file). Log axes skip values <= 0. Ticks: decades (and 2, 5) on log
 # axes, 1/2/5 x 10^k steps on linear ones.
 
 function fmt(v,    a) {
@@ -32,7 +33,7 @@ NR == 1 { ncol = NF; for (i = 1; i <= NF; ++i) { name[i] = $i; gsub(/_/, " ", na
     for (i = 1; i <= ncol; ++i) val[nrow, i] = $i
 }
 END {
-    W = 640; H = 400; ML = 78; MR = 170; MT = 36; MB = 52; PW = W - ML - MR; PH = H - MT - MB
+    W = 700; H = 400; ML = 78; MR = 230; MT = 36; MB = 52; PW = W - ML - MR; PH = H - MT - MB
     split("#1f77b4 #d62728 #2ca02c #ff7f0e #9467bd #8c564b #e377c2 #17becf", colour, " ")
     xmin = ymin = 1e300; xmax = ymax = -1e300
     for (r = 1; r <= nrow; ++r) {
@@ -84,13 +85,20 @@ END {
         }
     }
     if (logx) {
+        nt = 0
         for (e = int(lx0 / log(10) - 1); log(10) * e <= lx1 + 1e-9; ++e)
             for (m = 1; m <= 5; m += (m == 1 ? 1 : 3)) {
                 v = m * exp(log(10) * e)
                 if (log(v) < lx0 - 1e-9 || log(v) > lx1 + 1e-9) continue
+                ++nt
                 x = tx(v)
                 printf("<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#ddd\"/>\n", x, MT, x, MT + PH)
                 printf("<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", x, MT + PH + 16, fmt(v))
+            }
+        if (nt < 2)
+            for (k = 0; k < 2; ++k) {
+                v = k ? xmax : xmin
+                printf("<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", tx(v), MT + PH + 16, fmt(v))
             }
     } else {
         for (v = lx0; v <= lx1 + sx * 1e-6; v += sx) {
@@ -110,7 +118,7 @@ END {
         pen = 0
         for (r = 1; r <= nrow; ++r) {
             x = val[r, 1]; y = val[r, i]
-            if (!isnum(x) || !isnum(y) || (logx && x + 0 <= 0) || (logy && y + 0 <= 0)) { pen = 0; continue }
+            if (!isnum(x) || !isnum(y) || (logx && x + 0 <= 0) || (logy && y + 0 <= 0)) continue
             path = path sprintf("%s%.1f %.1f ", pen ? "L" : "M", tx(x + 0), ty(y + 0))
             pen = 1
             if (markers) mk = mk sprintf("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3\" fill=\"%s\"/>\n", tx(x + 0), ty(y + 0), c)
