@@ -102,6 +102,13 @@ vp|virtual patches (SPEC §6)|0|--method vp|T-5: 200 000 triangles to 12 000 (or
 aavp|axis-aligned virtual patches (SPEC §7)|0|--method aavp|T table 3: temporal + AAVP 0.08 ms, SSIM 0.73 (RTXGI 0.17 ms, SSIM 0.66)
 '
 
+# Virtual-patch count against accuracy (T-5): `rad render SCENE VP_SWEEP B` for each budget B in
+# VP_BUDGETS, run once `rad render --help` lists the method named in VP_SWEEP (x axis: the
+# patches= of its timing line, else B). Set VP_SWEEP to the vp method's budget option, e.g.
+# VP_SWEEP='--method aavp --vp-max-patches'.
+VP_SWEEP=${RAD_REPORT_VP_SWEEP:-}
+case $MODE in quick) VP_BUDGETS="100 300" ;; medium) VP_BUDGETS="250 1000 4000" ;; *) VP_BUDGETS="500 2000 8000 12000" ;; esac
+
 [ -x "$RAD" ] || { echo "report.sh: $RAD not built (make tools)" >&2; exit 1; }
 mkdir -p "$OUT/img" "$OUT/plots" "$OUT/data"
 OUT=$(cd "$OUT" && pwd)
@@ -277,9 +284,46 @@ awk -v title="Compression error of F_mb (3 bounces), with and without reordering
     -v ylabel="MSE of the decoded matrix" -v logx=1 -v logy=1 -v markers=1 -f tools/svgplot.awk \
     "$OUT/data/compression.dat" > "$OUT/plots/compression.svg"
 
+# ---- virtual-patch count against accuracy ------------------------------------------------------
+VP_OK=0
+vp_method=${VP_SWEEP#--method }
+vp_method=${vp_method%% *}
+if [ -n "$VP_SWEEP" ] && printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$vp_method([ |]|$)"; then
+    echo "patches PSNR_cornell PSNR_bunny" > "$OUT/data/vp_psnr.dat"
+    echo "patches SSIM_cornell SSIM_bunny" > "$OUT/data/vp_ssim.dat"
+    : > "$TMP/vp.md"
+    for sc in cornell bunny; do
+        if [ $sc = cornell ]; then scene=cornell cam="" size=$SIZE; else scene=$TMP/bunny-box.obj size=$BUNNY_SIZE
+            cam="--camera $CORNELL_CAM --fov $CORNELL_FOV"; fi
+        [ -f "$TMP/$sc-reference.pfm" ] || continue
+        for b in $VP_BUDGETS; do
+            log "virtual patches: $sc, budget $b"
+            if "$RAD" render "$scene" $cam --size "$size" --aa "$AA" --pixel-light-samples "$PLS" --threads 1 $VP_SWEEP "$b" \
+                -o "$TMP/vp.pfm" > "$OUT/data/vp-$sc-$b.log" 2>&1 &&
+                read -r mse psnr ssim < <(compare "$TMP/vp.pfm" "$TMP/$sc-reference.pfm" "$TMP/vpd.png" "$TMP/vp.png"); then
+                np=$(grep -o 'patches=[0-9]*' "$OUT/data/vp-$sc-$b.log" | tail -1 | cut -d= -f2)
+                ms=$(grep -o 'step_ms_median=[0-9.e+-]*' "$OUT/data/vp-$sc-$b.log" | tail -1 | cut -d= -f2)
+                np=${np:-$b}
+                printf '| %s | %s | %s | %s | %s | %s | %s |\n' "$sc" "$b" "$np" "$mse" "$psnr" "$ssim" "${ms:--}" >> "$TMP/vp.md"
+                if [ $sc = cornell ]; then echo "$np $psnr -" >> "$OUT/data/vp_psnr.dat"; echo "$np $ssim -" >> "$OUT/data/vp_ssim.dat"
+                else echo "$np - $psnr" >> "$OUT/data/vp_psnr.dat"; echo "$np - $ssim" >> "$OUT/data/vp_ssim.dat"; fi
+            else
+                printf '| %s | %s | FAILED (data/vp-%s-%s.log) | - | - | - | - |\n' "$sc" "$b" "$sc" "$b" >> "$TMP/vp.md"
+            fi
+        done
+    done
+    for k in psnr ssim; do
+        awk -v title="Virtual patches: $(echo $k | tr a-z A-Z) against the patch count" -v xlabel="virtual patches" \
+            -v ylabel="$(echo $k | tr a-z A-Z) vs the reference" -v logx=1 -v markers=1 -f tools/svgplot.awk \
+            "$OUT/data/vp_$k.dat" > "$OUT/plots/vp_$k.svg"
+    done
+    VP_OK=1
+fi
+
 # ---- the headline: the thesis's figures against ours ------------------------------------------
 # m ID FIELD: a metric of a Cornell-box method (2 MSE, 3 PSNR, 4 SSIM, 5 ms), or "-"
 m() { awk -v id="$1" -v f="$2" '$1 == "cornell" && $2 == id { v = $(f + 1) } END { print (v == "" ? "-" : v) }' "$OUT/data/metrics.txt"; }
+ms() { awk -v v="$(m "$1" 5)" 'BEGIN { if (v == "-") print v; else printf "%.3g", v }'; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a + 0 > 0 && b + 0 > 0) printf "%.1fx", a / b; else print "-" }'; }
 {
     echo "| figure | thesis (SPEC §12) | ours, this run (Cornell box, $SIZE, $PATCHES-patch target) |"
@@ -291,7 +335,7 @@ ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a + 0 > 0 && b + 0 > 0) printf "%
         rat=$(awk -F'|' '/^\| [0-9]+ \([0-9]+\) \|/ { r = $0 } END { split(r, c, "|"); gsub(/ /, "", c[6]); print c[6] }' "$TAB_T")
         echo "| temporal step vs matrix-vector product (T table 1, largest N) | N = 10422: 0.08 vs 12.01 ms (150x), GPU | $big ($rat), one CPU thread |"
     fi
-    echo "| multi-bounce matrix vs 3 Jacobi bounces (T-3) | 3x faster | $(ratio "$(m classic3 5)" "$(m mbfloat3 5)") ($(m classic3 5) ms vs $(m mbfloat3 5) ms, float F_mb); SSIM $(m mbfloat3 4) vs classic 3 bounces $(m classic3 4) (thesis: 0.762 vs 0.743) |"
+    echo "| multi-bounce matrix vs 3 Jacobi bounces (T-3) | 3x faster | $(ratio "$(m classic3 5)" "$(m mbfloat3 5)") ($(ms classic3) ms for 3 bounces vs $(ms mbfloat3) ms for one float F_mb product; the 64-bounce row's product, the same work, took $(ms mbfloat) ms). F_mb is RGB (3 N^2 floats) while F is one N^2 matrix shared by the channels, so on a CPU one F_mb product reads as many bytes as 3 bounces. SSIM $(m mbfloat3 4) vs $(m classic3 4) for 3 classic bounces (thesis: 0.762 vs 0.743) |"
     echo "| compressed multi-bounce vs classic (T-3) | about 10x faster | BC1: $(ratio "$(m classic 5)" "$(m mbbc1 5)"), 3xBC4: $(ratio "$(m classic 5)" "$(m mbbc4 5)") against 64 classic bounces (CPU decode; the thesis decodes in GPU texture hardware) |"
     awk -F'|' -v nmax="$(echo $CSIZES | awk '{ print $NF }')" '
         { key = $1 "|" $2; if ($3 == "no-reorder") plain[key] = $4; else if ($4 + 0 > 0) { r[$2] = sprintf("%.1fx", plain[key] / $4); n = $1; mem[$2] = sprintf("%.1fx", ($7 / 3) / $6) } }
@@ -318,7 +362,7 @@ MD="$OUT/REPORT.md"
     echo "| quality | $MODE (\`bash tools/report.sh$([ $MODE = full ] || echo " --$MODE")\`; \`make report\` = full, \`make report-quick\` = quick, checked in CI) |"
     echo "| date | $(date -u '+%Y-%m-%d %H:%M UTC') |"
     echo "| machine | ${CPU:-unknown CPU}, $(nproc) logical CPUs, $(awk '/MemTotal/ { printf "%.0f GB", $2 / 1048576 }' /proc/meminfo) |"
-    echo "| load | shared machine: load average $LOAD_START at the start (other jobs ran at the same time, so times are noisy; medians are used) |"
+    echo "| load | shared machine: load average $LOAD_START at the start, $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null) at the end (other jobs ran at the same time, so times are noisy even as medians: the two float F_mb rows do the same work per frame, and their times show the spread) |"
     echo "| library | $("$RAD" version 2>/dev/null) |"
     echo "| run time | $T_ALL s for the whole report |"
     echo
@@ -368,11 +412,18 @@ MD="$OUT/REPORT.md"
     echo
     echo "## Virtual-patch count against accuracy (thesis T-5)"
     echo
-    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])vp([ |]|$)"; then
-        echo "The \`vp\` method is in this build; its sweep is not wired into this script yet."
+    if [ "$VP_OK" = 1 ]; then
+        echo "\`rad render SCENE $VP_SWEEP B\` for B in $VP_BUDGETS, against each scene's reference above."
+        echo
+        echo "| scene | budget | patches | MSE | PSNR (dB) | SSIM | per frame (ms) |"
+        echo "|---|---:|---:|---:|---:|---:|---:|"
+        cat "$TMP/vp.md"
+        echo
+        echo "![PSNR against the virtual-patch count](plots/vp_psnr.svg) ![SSIM against the virtual-patch count](plots/vp_ssim.svg)"
     else
-        echo "Not in this build: virtual patches (SPEC §6-7) are on another branch. When \`rad render --method vp\`"
-        echo "exists, its rows above fill in and this section sweeps its patch budget."
+        echo "Not in this build: virtual patches (SPEC §6-7) are on another branch (\`vp\`). When \`rad render\`"
+        echo "has the method, its rows above fill in, and setting VP_SWEEP in tools/report.sh to its patch-budget"
+        echo "option makes this section sweep the budget ($VP_BUDGETS) on both scenes, with PSNR and SSIM plots."
     fi
     echo
     echo "## Raw data"
