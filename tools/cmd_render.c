@@ -12,7 +12,12 @@
 
    Multibounce and temporal (render_with_method, render_method): the same pixels, with the
    patches' H from methods.c (L = F_mb E, or the temporal frames, H = L / rho) and the halo
-   correction from the bake's row sums of F. */
+   correction from the bake's row sums of F.
+
+   Every radiosity method prints one line for scripts (tools/report.sh) on stderr:
+   "rad render: timing: method=M patches=N frames=F [bounces=K ]step_ms_median=X step_ms_min=Y",
+   the method's own per-frame work: the classic solve (K Jacobi bounces), one F_mb E product
+   (median of 9), or one temporal step (median over the frames). */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
