@@ -6,6 +6,8 @@
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/
 #   make glsl    regenerates the GLSL sources embedded in radiosity.h from glsl/
+#   make report  the evaluation report (every method vs the path-traced reference, plots) into
+#                report/ (long: about 15 min); make report-quick: a small one into build/, checked
 #   make clean
 CC      ?= cc
 CXX     ?= c++
@@ -18,7 +20,7 @@ EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 RAD_DATA_DIR ?= ../shared/data
 
-.PHONY: all demo gallery walk test bench bench-quick tools fuzz clean glsl
+.PHONY: all demo gallery walk test bench bench-quick tools fuzz clean glsl report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk tools
 
@@ -90,6 +92,14 @@ tools: $(BUILD)/rad
 $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. tools/*.c -o $@ -lassimp -lm
 	cp $@ tools/rad
+
+# the evaluation report (tools/report.sh, issue #12): full quality into report/ (committed), or
+# quick into build/report-quick/ with every table cell and image checked (tests/run.sh runs it)
+report: $(BUILD)/rad $(BUILD)/temporal
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal
+
+report-quick: $(BUILD)/rad $(BUILD)/temporal
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --quick --out $(BUILD)/report-quick --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal
 
 # libFuzzer harnesses (clang with libclang-rt-14-dev): FUZZ_SECONDS per fuzzer
 FUZZ_SECONDS ?= 300

@@ -16,7 +16,8 @@
    --csv path); if gnuplot is on the PATH, also temporal_error.png.
 
    Build: cc -std=c99 -O3 -march=native -fopenmp -I. bench/temporal.c -o temporal -lm
-   Run:   temporal [--quick] [--append FILE.md] [--csv FILE.csv] */
+   Run:   temporal [--quick] [--sizes N,N,...] [--append FILE.md] [--csv FILE.csv]
+          (--sizes: up to four patch-count targets instead of the thesis's; tools/report.sh) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
@@ -113,7 +114,9 @@ static lag_result lag_run(const rad_alias_tables *t, const rad_patches *P, const
 
 int main(int argc, char **argv)
 {
-    static const uint32_t targets[4] = { 1736, 5485, 8786, 10422 };
+    static const uint32_t thesis_sizes[4] = { 1736, 5485, 8786, 10422 };
+    uint32_t targets[4] = { 1736, 5485, 8786, 10422 };
+    int custom = 0;
     static const double published_temporal[4] = { 0.02, 0.04, 0.06, 0.08 }, published_mv[4] = { 0.34, 2.94, 7.34, 12.01 };
     const char *csv_path = "temporal_error.csv";
     int quick = 0, a, s, sizes, threads = 1;
@@ -124,12 +127,25 @@ int main(int argc, char **argv)
         if (!strcmp(argv[a], "--quick")) quick = 1;
         else if (!strcmp(argv[a], "--append") && a + 1 < argc) g_md = fopen(argv[++a], "a");
         else if (!strcmp(argv[a], "--csv") && a + 1 < argc) csv_path = argv[++a];
-        else { fprintf(stderr, "usage: temporal [--quick] [--append FILE.md] [--csv FILE.csv]\n"); return 2; }
+        else if (!strcmp(argv[a], "--sizes") && a + 1 < argc) {
+            /* patch-count targets instead of the thesis's four (tools/report.sh --quick) */
+            const char *p = argv[++a];
+            char *end;
+            custom = 0;
+            while (*p && custom < 4) {
+                unsigned long v = strtoul(p, &end, 10);
+                if (end == p || v < 16 || v > 20000) break;
+                targets[custom++] = (uint32_t)v;
+                p = *end == ',' ? end + 1 : end;
+            }
+            if (custom == 0 || *p) { fprintf(stderr, "--sizes wants 1 to 4 patch counts in 16..20000, e.g. 300,600\n"); return 2; }
+        }
+        else { fprintf(stderr, "usage: temporal [--quick] [--sizes N,N,...] [--append FILE.md] [--csv FILE.csv]\n"); return 2; }
     }
 #ifdef _OPENMP
     threads = omp_get_max_threads();
 #endif
-    sizes = quick ? 2 : 4;
+    sizes = custom ? custom : quick ? 2 : 4;
     for (s = 0; s < sizes; ++s) {
         rad_scene_desc desc;
         rad_scene *scene = NULL;
@@ -240,10 +256,19 @@ int main(int argc, char **argv)
             rad_temporal_destroy(tm);
             tm = NULL;
         }
-        snprintf(rows_t1[s], sizeof(rows_t1[s]),
-                 "| %u (%u) | %.3f | %.3f | %.2f | %.0fx | %.0fx | %.2f%% | %.2f%% | %.2f vs %.2f (%.0fx) |\n", n, targets[s],
-                 tstep[0] * 1e3, tstep[1] * 1e3, tmv * 1e3, tmv / tstep[0], tmv / tstep[1], 100.0 * err[0], 100.0 * err[1],
-                 published_temporal[s], published_mv[s], published_mv[s] / published_temporal[s]);
+        {
+            int p, pub = -1;
+            char pubtext[64] = "-";
+            for (p = 0; p < 4; ++p)
+                if (targets[s] == thesis_sizes[p]) pub = p;
+            if (pub >= 0)
+                snprintf(pubtext, sizeof(pubtext), "%.2f vs %.2f (%.0fx)", published_temporal[pub], published_mv[pub],
+                         published_mv[pub] / published_temporal[pub]);
+            snprintf(rows_t1[s], sizeof(rows_t1[s]),
+                     "| %u (%u) | %.3f | %.3f | %.3f | %.1fx | %.1fx | %.2f%% | %.2f%% | %s |\n", n, targets[s],
+                     tstep[0] * 1e3, tstep[1] * 1e3, tmv * 1e3, tmv / tstep[0], tmv / tstep[1], 100.0 * err[0],
+                     100.0 * err[1], pubtext);
+        }
         fprintf(stderr, "%s", rows_t1[s]);
         /* lag: fixed w = 0.998 against adaptive */
         if (s == sizes - 1) {

@@ -199,6 +199,15 @@ if [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; 
             if [ "${RAD_TEST_REQUIRE_ALL:-0}" = 1 ]; then FAILED=$((FAILED + ns)); FAILED_NAMES="$FAILED_NAMES tool-tests(skipped)"
             else SKIPPED=$((SKIPPED + ns)); SKIPPED_NAMES="$SKIPPED_NAMES tool-tests"; fi
         fi
+        # the evaluation report at quick quality (make report-quick): every table cell filled,
+        # every image written (tools/report.sh --check)
+        if build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
+            RAD_DATA_DIR="${RAD_DATA_DIR:-../shared/data}" bash tools/report.sh --quick --out "$BUILD/report-quick" \
+                --rad "$BUILD/rad" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
+            pass "report-quick ($(tail -n 1 "$BUILD/report-quick.log" | sed 's/.*: \([0-9]* table rows, [0-9]* images\).*/\1/'))"
+        else
+            fail report-quick; tail -n 20 "$BUILD/report-quick.log" | sed 's/^/    /'
+        fi
     else
         fail tool-build
     fi

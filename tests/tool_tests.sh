@@ -357,5 +357,45 @@ bad "--mode bogus" "unknown --mode 'bogus'" bake cornell --method temporal --mod
 bad "--method bogus" "unknown method 'bogus'" render cornell --method bogus -o "$TMP/y.pfm"
 bad "bake --method pathtrace" "needs no bake" bake cornell --method pathtrace -o "$TMP/y.radb"
 
+# ---- what tools/report.sh relies on: the timing line and compare --png ------------------------
+for meth in classic multibounce temporal; do
+    if "$RAD" render cornell --method $meth --patches 100 --size 8x8 --aa 1 --pixel-light-samples 1 --threads 1 \
+        $([ $meth = temporal ] && echo "--frames 5") -o "$TMP/tm.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        grep -Eq "^rad render: timing: method=$meth patches=[0-9]+ frames=[0-9]+ .*step_ms_median=[0-9.]+ step_ms_min=[0-9.]+$" "$TMP/err.txt"; then
+        ok "render --method $meth prints its timing line"
+    else
+        fail "render --method $meth prints its timing line" "$(grep timing "$TMP/err.txt" | head -c 300)"
+    fi
+done
+if "$RAD" compare "$TMP/tm.pfm" "$TMP/tm.pfm" --png "$TMP/tm.png" --exposure 2 > "$TMP/cmp.txt" 2>&1 && [ -s "$TMP/tm.png" ] &&
+    "$RAD" compare "$TMP/tm.png" "$TMP/tm.png" > /dev/null 2>&1; then
+    ok "compare --png writes A as a readable PNG"
+else
+    fail "compare --png writes A as a readable PNG" "$(head -c 300 "$TMP/cmp.txt")"
+fi
+"$RAD" compare "$TMP/tm.pfm" "$TMP/tm.pfm" --png "$TMP/tm.jpg" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 2 ] && grep -q -- "--png wants a .png file" "$TMP/err.txt" && ok "compare --png rejects another extension" ||
+    fail "compare --png rejects another extension" "exit $rc"
+"$RAD" compare "$TMP/tm.pfm" "$TMP/tm.pfm" --png "$TMP/tm.png" --exposure -1 > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 2 ] && grep -q -- "--exposure wants a positive number" "$TMP/err.txt" && ok "compare rejects --exposure -1" ||
+    fail "compare rejects --exposure -1" "exit $rc"
+# the report's own check finds an empty cell and a missing image
+mkdir -p "$TMP/rep"
+printf '| a | b |\n|---|---|\n| 1 | 2 |\n' > "$TMP/rep/REPORT.md"
+if bash tools/report.sh --check "$TMP/rep" > /dev/null 2>&1; then
+    printf '| a | |\n' >> "$TMP/rep/REPORT.md"
+    if ! bash tools/report.sh --check "$TMP/rep" > /dev/null 2>&1; then
+        printf '| a | b |\n|---|---|\n| 1 | ![x](img/none.png) |\n' > "$TMP/rep/REPORT.md"
+        bash tools/report.sh --check "$TMP/rep" > /dev/null 2>&1 && fail "report --check finds a missing image" ||
+            ok "report --check passes a full table and finds an empty cell and a missing image"
+    else
+        fail "report --check finds an empty cell"
+    fi
+else
+    fail "report --check passes a full table"
+fi
+
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

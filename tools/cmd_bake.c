@@ -115,7 +115,7 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     rad_context ctx;
     rad_result r;
     uint32_t n, i;
-    double t0;
+    double t0, t1;
     memset(out, 0, sizeof *out);
     rad_tool_context(&ctx, NULL);
     rad_patch_options_default(&po);
@@ -173,6 +173,7 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     so.bounces = o->bounces;
     memset(&stats, 0, sizeof stats);
     rad_tool_context(&ctx, "solve");
+    t1 = rad_tool_seconds();
     switch (o->solver) {
     case RAD_TOOL_GAUSS_SEIDEL:
         r = rad_solve_gauss_seidel(&sys, &so, out->L, &stats, &ctx);
@@ -185,6 +186,7 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     case RAD_TOOL_DIRECT: r = rad_solve_direct(&sys, &so, out->L, &ctx); break;
     default: r = rad_solve_jacobi(&sys, &so, out->L, &stats, &ctx); break;
     }
+    out->solve_seconds = rad_tool_seconds() - t1;
     rad_tool_progress_end();
     if (r != RAD_SUCCESS) {
         rad_tool_classic_free(out);

@@ -1,6 +1,6 @@
 /* cmd_compare.c - rad compare: MSE, PSNR and SSIM between two images.
 
-   rad compare A B [--diff OUT.png|OUT.pfm] [--diff-scale X]
+   rad compare A B [--diff OUT.png|OUT.pfm] [--diff-scale X] [--png OUT.png [--exposure X]]
 
    A and B are PFM (linear) or PNG (8-bit sRGB, decoded to linear). The metrics are those of
    REFERENCE.md §6 on LINEAR values clamped to [0,1] (peak L = 1); SSIM per R, G, B channel,
@@ -13,18 +13,20 @@
 
 static void compare_usage(FILE *f)
 {
-    fprintf(f, "usage: rad compare A B [--diff OUT.png] [--diff-scale X]\n"
+    fprintf(f, "usage: rad compare A B [--diff OUT.png] [--diff-scale X] [--png OUT.png [--exposure X]]\n"
                "  A, B          .pfm (linear float) or .png (8-bit sRGB, decoded to linear)\n"
                "  --diff FILE   heat map of the per-pixel mean absolute difference (black: none)\n"
                "  --diff-scale X  the difference shown at the top of the colour scale (default: the largest)\n"
+               "  --png FILE    also write A as an 8-bit sRGB PNG (exposure --exposure X, default 1): one\n"
+               "                render gives both the .pfm the metrics need and a picture (tools/report.sh)\n"
                "  prints MSE, PSNR (peak 1) and SSIM (11x11 Gaussian window, sigma 1.5, per channel,\n"
                "  averaged), all on linear values clamped to [0,1]\n");
 }
 
 int rad_cmd_compare(int argc, char **argv)
 {
-    const char *pa = NULL, *pb = NULL, *diff = NULL;
-    float scale = 0.0f;
+    const char *pa = NULL, *pb = NULL, *diff = NULL, *png = NULL;
+    float scale = 0.0f, exposure = 1.0f;
     rad_image a = { 0, 0, NULL }, b = { 0, 0, NULL };
     char err[512];
     double mse, psnr, ssim;
@@ -34,6 +36,27 @@ int rad_cmd_compare(int argc, char **argv)
         if (!strcmp(s, "-h") || !strcmp(s, "--help")) {
             compare_usage(stdout);
             return 0;
+        } else if (!strcmp(s, "--png") || !strcmp(s, "--exposure")) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "rad compare: %s needs a value\n", s);
+                return 2;
+            }
+            if (!strcmp(s, "--png")) {
+                size_t l;
+                png = argv[++i];
+                l = strlen(png);
+                if (l < 4 || (strcmp(png + l - 4, ".png") && strcmp(png + l - 4, ".PNG"))) {
+                    fprintf(stderr, "rad compare: --png wants a .png file, got '%s'\n", png);
+                    return 2;
+                }
+            } else {
+                char *end;
+                exposure = strtof(argv[++i], &end);
+                if (*end || !(exposure > 0.0f) || !(exposure < 1e30f)) {
+                    fprintf(stderr, "rad compare: --exposure wants a positive number, got '%s'\n", argv[i]);
+                    return 2;
+                }
+            }
         } else if (!strcmp(s, "--diff") || !strcmp(s, "--diff-scale")) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "rad compare: %s needs a value\n", s);
@@ -118,6 +141,15 @@ int rad_cmd_compare(int argc, char **argv)
         }
         printf("diff: %s (mean |A-B| over RGB; white = %.6g)\n", diff, (double)scale);
         rad_image_free(&heat);
+    }
+    if (png) {
+        if (rad_image_write_png(png, &a, exposure) != 0) {
+            fprintf(stderr, "rad compare: cannot write '%s'\n", png);
+            rad_image_free(&a);
+            rad_image_free(&b);
+            return 1;
+        }
+        printf("png: %s (A, exposure %g)\n", png, (double)exposure);
     }
     rad_image_free(&a);
     rad_image_free(&b);

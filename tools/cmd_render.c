@@ -12,7 +12,12 @@
 
    Multibounce and temporal (render_with_method, render_method): the same pixels, with the
    patches' H from methods.c (L = F_mb E, or the temporal frames, H = L / rho) and the halo
-   correction from the bake's row sums of F. */
+   correction from the bake's row sums of F.
+
+   Every radiosity method prints one line for scripts (tools/report.sh) on stderr:
+   "rad render: timing: method=M patches=N frames=F [bounces=K ]step_ms_median=X step_ms_min=Y",
+   the method's own per-frame work: the classic solve (K Jacobi bounces), one F_mb E product
+   (median of 9), or one temporal step (median over the frames). */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
@@ -123,6 +128,12 @@ static int vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, f
     free(rs);
     free(S);
     return rc;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
 }
 
 typedef struct isect_job {
@@ -331,10 +342,13 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
     rad_tool_indirect *m = NULL;
     const rad_patches *P = &bake->patches;
     uint32_t frames = mo->method == RAD_TOOL_TEMPORAL ? mo->frames : 1u, f;
-    double t = 0.0, sum = 0.0, tmin = 1e300, tmax = 0.0;
+    /* multibounce: the product is repeated (same result each time) so its time is a median */
+    uint32_t reps = mo->method == RAD_TOOL_TEMPORAL ? frames : 9u;
+    double t = 0.0, sum = 0.0, tmin = 1e300, tmax = 0.0, *times;
     float *H, *Hv;
     int rc = 0;
     if (rad_tool_indirect_open(cmd, bake_name, bake, mo, &m)) return 1;
+    times = (double *)xmalloc(sizeof(double) * reps);
     H = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->count);
     Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
 #if defined(__unix__) || defined(__APPLE__)
@@ -342,6 +356,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
 #endif
     for (f = 1; f <= frames && rc == 0; ++f) {
         rc = rad_tool_indirect_step(m, H, &t);
+        times[f - 1] = t;
         sum += t;
         if (t < tmin) tmin = t;
         if (t > tmax) tmax = t;
@@ -363,7 +378,12 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
             rad_image_free(&frame);
         }
     }
+    for (f = frames + 1; f <= reps && rc == 0; ++f) rc = rad_tool_indirect_step(m, H, &times[f - 1]);
     if (rc == 0) {
+        qsort(times, reps, sizeof(double), cmp_double);
+        /* one line for scripts (tools/report.sh): the method's per-frame work alone */
+        fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=%u step_ms_median=%.6f step_ms_min=%.6f\n", cmd,
+                rad_tool_method_name(mo->method), P->count, reps, 1e3 * times[reps / 2], 1e3 * times[0]);
         if (mo->method == RAD_TOOL_TEMPORAL)
             fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
                     cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
@@ -382,6 +402,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
     }
     free(H);
     free(Hv);
+    free(times);
     rad_tool_indirect_close(m);
     return rc;
 }
@@ -611,6 +632,9 @@ int rad_cmd_render(int argc, char **argv)
             }
             P = sol.patches;
             H = sol.H;
+            fprintf(stderr, "rad %s: timing: method=classic patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+                            "step_ms_min=%.6f\n",
+                    cmd, P->count, o.bounces, 1e3 * sol.solve_seconds, 1e3 * sol.solve_seconds);
         }
         Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
         rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);

@@ -149,6 +149,7 @@ typedef struct rad_tool_classic {
     rad_patches *patches;
     rad_form_factors *ff;
     float *D, *E, *L, *B, *H;   /* 3N floats each */
+    double solve_seconds;       /* the solver call alone (the per-frame cost of the method) */
 } rad_tool_classic;
 /* prints progress and errors; returns 0 or 1 */
 int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
