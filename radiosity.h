@@ -7086,6 +7086,12 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #  define RAD__MB_F16C 1
 #endif
 
+#if defined(RAD__MB_FMA)
+#  define RAD__MB_MADD(a, b, c) _mm256_fmadd_ps(a, b, c)
+#else
+#  define RAD__MB_MADD(a, b, c) _mm256_add_ps(c, _mm256_mul_ps(a, b))
+#endif
+
 #define RAD__MB_MR 6u
 #define RAD__MB_NR 16u
 #define RAD__MB_KC 256u
@@ -7888,24 +7894,24 @@ RAD_API rad_result rad_multibounce_reorder(const rad_multibounce *src, uint32_t 
 
 /* ---- BC1 and BC4 blocks (REFERENCE §4) ---- */
 
-static void rad__bc1_color(uint32_t c, float *rgb)
-{
-    rgb[0] = (float)((c >> 11) & 31u) / 31.0f;
-    rgb[1] = (float)((c >> 5) & 63u) / 63.0f;
-    rgb[2] = (float)(c & 31u) / 31.0f;
-}
-
+/* The palettes are the specification's real-valued formulas rounded once: an integer
+   numerator over an integer denominator (e.g. (2 c0 + c1) / (3 * 31)), one correctly rounded
+   division. No intermediate rounding, so no compiler contraction can change a value, and the
+   AVX2 apply reproduces them to the bit. */
 static void rad__bc1_palette(uint32_t c0, uint32_t c1, float pal[4][3])
 {
+    static const uint32_t shift[3] = { 11u, 5u, 0u }, mask[3] = { 31u, 63u, 31u };
     int k;
-    rad__bc1_color(c0, pal[0]);
-    rad__bc1_color(c1, pal[1]);
     for (k = 0; k < 3; ++k) {
+        uint32_t a = (c0 >> shift[k]) & mask[k], b = (c1 >> shift[k]) & mask[k];
+        float d = (float)mask[k];
+        pal[0][k] = (float)a / d;
+        pal[1][k] = (float)b / d;
         if (c0 > c1) {
-            pal[2][k] = (2.0f * pal[0][k] + pal[1][k]) / 3.0f;
-            pal[3][k] = (pal[0][k] + 2.0f * pal[1][k]) / 3.0f;
+            pal[2][k] = (float)(2u * a + b) / (3.0f * d);
+            pal[3][k] = (float)(a + 2u * b) / (3.0f * d);
         } else {
-            pal[2][k] = (pal[0][k] + pal[1][k]) / 2.0f;
+            pal[2][k] = (float)(a + b) / (2.0f * d);
             pal[3][k] = 0.0f;
         }
     }
@@ -7913,13 +7919,13 @@ static void rad__bc1_palette(uint32_t c0, uint32_t c1, float pal[4][3])
 
 static void rad__bc4_palette(uint32_t r0, uint32_t r1, float pal[8])
 {
-    int k;
+    uint32_t k;
     pal[0] = (float)r0 / 255.0f;
     pal[1] = (float)r1 / 255.0f;
     if (r0 > r1) {
-        for (k = 2; k < 8; ++k) pal[k] = ((float)(8 - k) * pal[0] + (float)(k - 1) * pal[1]) / 7.0f;
+        for (k = 2; k < 8; ++k) pal[k] = (float)((8u - k) * r0 + (k - 1u) * r1) / (7.0f * 255.0f);
     } else {
-        for (k = 2; k < 6; ++k) pal[k] = ((float)(6 - k) * pal[0] + (float)(k - 1) * pal[1]) / 5.0f;
+        for (k = 2; k < 6; ++k) pal[k] = (float)((6u - k) * r0 + (k - 1u) * r1) / (5.0f * 255.0f);
         pal[6] = 0.0f;
         pal[7] = 1.0f;
     }
@@ -8438,7 +8444,33 @@ typedef struct rad__mb_bapply {
     float *out;
 } rad__mb_bapply;
 
-#if !defined(RAD__MB_AVX2)
+#if defined(RAD__MB_AVX2)
+/* x / d, correctly rounded, as the scalar decoder divides: with FMA, the reciprocal product
+   m = x r (r = 1/d) corrected once by the residual, m + (x - m d) r. For every quotient the
+   BC1 and BC4 palettes form (endpoints over 31, 63, 255; interpolants over 3, 5, 7; all
+   endpoint pairs) this equals the division: tests/test_multibounce.c checks all of them. */
+static inline __m256 rad__mb_div(__m256 x, __m256 d, __m256 r)
+{
+#if defined(RAD__MB_FMA)
+    __m256 m = _mm256_mul_ps(x, r);
+    return _mm256_fmadd_ps(_mm256_fnmadd_ps(m, d, x), r, m);
+#else
+    (void)r;
+    return _mm256_div_ps(x, d);
+#endif
+}
+
+static inline __m128 rad__mb_div4(__m128 x, __m128 d, __m128 r)
+{
+#if defined(RAD__MB_FMA)
+    __m128 m = _mm_mul_ps(x, r);
+    return _mm_fmadd_ps(_mm_fnmadd_ps(m, d, x), r, m);
+#else
+    (void)r;
+    return _mm_div_ps(x, d);
+#endif
+}
+#else
 static void rad__mb_block_palettes(const rad_multibounce_blocks *b, const uint8_t *blk, size_t nblocks, const float *scale,
                                    float pal[3][8])
 {
@@ -8475,11 +8507,37 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
         const __m256i s1a = _mm256_setr_epi32(0, 8, 16, 24, 2, 10, 18, 26), s1b = _mm256_setr_epi32(4, 12, 20, 28, 6, 14, 22, 30);
         const __m256i s4a = _mm256_setr_epi32(0, 12, 0, 12, 3, 15, 3, 15), s4b = _mm256_setr_epi32(6, 18, 6, 18, 9, 21, 9, 21);
         const float *srow = b->scales + 3 * (size_t)(b->tile ? (by * 4u / b->tile) * b->tiles_per_row : 0u);
-        const __m256 w0a = _mm256_setr_ps(1.0f, 0.0f, 6.0f / 7, 5.0f / 7, 4.0f / 7, 3.0f / 7, 2.0f / 7, 1.0f / 7);
-        const __m256 w1a = _mm256_setr_ps(0.0f, 1.0f, 1.0f / 7, 2.0f / 7, 3.0f / 7, 4.0f / 7, 5.0f / 7, 6.0f / 7);
-        const __m256 w0b = _mm256_setr_ps(1.0f, 0.0f, 4.0f / 5, 3.0f / 5, 2.0f / 5, 1.0f / 5, 0.0f, 0.0f);
-        const __m256 w1b = _mm256_setr_ps(0.0f, 1.0f, 1.0f / 5, 2.0f / 5, 3.0f / 5, 4.0f / 5, 0.0f, 0.0f);
-        const __m256 cb = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+        /* BC4 palette lane k = (W0[k] r0 + W1[k] r1 + C[k]) / D[k]: the decoder's integer
+           numerator over its denominator (lanes 0, 1: the endpoints over 255; 6-value mode
+           lanes 6, 7: the constants 0 and 1 over 1); index [0] the 6-value mode (r0 <= r1),
+           [1] the 8-value one */
+        __m256 bw0[2], bw1[2], bc[2], bd[2], br[2];
+        const __m256i sh_rg = _mm256_setr_epi32(11, 11, 11, 11, 5, 5, 5, 5), mask_rg = _mm256_setr_epi32(31, 31, 31, 31, 63, 63, 63, 63);
+        const __m128i mask_b = _mm_set1_epi32(31);
+        __m256 bc1a[2], bc1b[2], den_rg[2], rcp_rg[2];
+        __m128 den_b[2], rcp_b[2];
+        bc1a[0] = _mm256_setr_ps(1.0f, 1.0f, 1.0f, 0.0f, 1.0f, 1.0f, 1.0f, 0.0f);   /* 3-colour mode (c0 <= c1) */
+        bc1b[0] = _mm256_setr_ps(0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f);
+        den_rg[0] = _mm256_setr_ps(31.0f, 31.0f, 62.0f, 31.0f, 63.0f, 63.0f, 126.0f, 63.0f);
+        den_b[0] = _mm_setr_ps(31.0f, 31.0f, 62.0f, 31.0f);
+        bc1a[1] = _mm256_setr_ps(1.0f, 1.0f, 2.0f, 2.0f, 1.0f, 1.0f, 2.0f, 2.0f);   /* 4-colour mode */
+        bc1b[1] = _mm256_setr_ps(0.0f, 0.0f, 1.0f, 1.0f, 0.0f, 0.0f, 1.0f, 1.0f);
+        den_rg[1] = _mm256_setr_ps(31.0f, 31.0f, 93.0f, 93.0f, 63.0f, 63.0f, 189.0f, 189.0f);
+        den_b[1] = _mm_setr_ps(31.0f, 31.0f, 93.0f, 93.0f);
+        for (i = 0; i < 2; ++i) {
+            rcp_rg[i] = _mm256_div_ps(_mm256_set1_ps(1.0f), den_rg[i]);
+            rcp_b[i] = _mm_div_ps(_mm_set1_ps(1.0f), den_b[i]);
+        }
+        bw0[0] = _mm256_setr_ps(1.0f, 0.0f, 4.0f, 3.0f, 2.0f, 1.0f, 0.0f, 0.0f);     /* 6-value mode (r0 <= r1) */
+        bw1[0] = _mm256_setr_ps(0.0f, 1.0f, 1.0f, 2.0f, 3.0f, 4.0f, 0.0f, 0.0f);
+        bc[0] = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f);
+        bd[0] = _mm256_setr_ps(255.0f, 255.0f, 1275.0f, 1275.0f, 1275.0f, 1275.0f, 1.0f, 1.0f);
+        bw0[1] = _mm256_setr_ps(1.0f, 0.0f, 6.0f, 5.0f, 4.0f, 3.0f, 2.0f, 1.0f);     /* 8-value mode */
+        bw1[1] = _mm256_setr_ps(0.0f, 1.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f);
+        bc[1] = _mm256_setzero_ps();
+        bd[1] = _mm256_setr_ps(255.0f, 255.0f, 1785.0f, 1785.0f, 1785.0f, 1785.0f, 1785.0f, 1785.0f);
+        br[0] = _mm256_div_ps(_mm256_set1_ps(1.0f), bd[0]);
+        br[1] = _mm256_div_ps(_mm256_set1_ps(1.0f), bd[1]);
         for (bx = 0; bx < bpr; ++bx) {
             const uint8_t *blk = row + 8 * (size_t)bx;
             const float *scale = srow + 3 * (size_t)a->tile_col[bx];
@@ -8487,37 +8545,37 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
             const float *xe = a->xe + 16 * (size_t)bx;
             size_t xs = 16 * (size_t)bpr;
             if (b->format == RAD_BLOCK_BC1) {
-                /* palettes with reciprocal multiplies (the decoder divides; the difference is
-                   an ulp, far below the format's precision) */
+                /* the palette exactly as rad_bc1_decode_block computes it (integer numerator over
+                   integer denominator, one correctly rounded division: the same value to the
+                   bit), times the tile scale, one channel per 4 lanes: I = (a, b, a, b) the
+                   channel's endpoint codes, numerators I A + swap(I) B = (a, b, 2a + b, a + 2b)
+                   or (a, b, a + b, 0), over (d, d, 3d, 3d) or (d, d, 2d, d) with d = 31 or 63.
+                   R and G share a 256-bit vector, B a 128-bit one; the mode (c0 > c1) indexes
+                   the constants: the encoder mixes both modes (a branch would mispredict) */
                 uint32_t c0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, c1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
-                float e0[3], e1[3], m[3];
-                m[0] = scale[0] * (1.0f / 31.0f); m[1] = scale[1] * (1.0f / 63.0f); m[2] = scale[2] * (1.0f / 31.0f);
-                e0[0] = (float)(c0 >> 11) * m[0]; e0[1] = (float)((c0 >> 5) & 63u) * m[1]; e0[2] = (float)(c0 & 31u) * m[2];
-                e1[0] = (float)(c1 >> 11) * m[0]; e1[1] = (float)((c1 >> 5) & 63u) * m[1]; e1[2] = (float)(c1 & 31u) * m[2];
-                for (ch = 0; ch < 3; ++ch) {
-                    pal[ch][0] = e0[ch];
-                    pal[ch][1] = e1[ch];
-                    if (c0 > c1) {
-                        pal[ch][2] = (2.0f * e0[ch] + e1[ch]) * (1.0f / 3.0f);
-                        pal[ch][3] = (e0[ch] + 2.0f * e1[ch]) * (1.0f / 3.0f);
-                    } else {
-                        pal[ch][2] = (e0[ch] + e1[ch]) * 0.5f;
-                        pal[ch][3] = 0.0f;
-                    }
-                }
-            }
-            if (b->format == RAD_BLOCK_BC1) {
                 uint32_t w = (uint32_t)blk[4] | (uint32_t)blk[5] << 8 | (uint32_t)blk[6] << 16 | (uint32_t)blk[7] << 24;
+                uint32_t md = c0 > c1;
+                long long pair = (long long)((uint64_t)c1 << 32 | c0);
+                __m256 irg = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi64x(pair), sh_rg), mask_rg));
+                __m128 ib4 = _mm_cvtepi32_ps(_mm_and_si128(_mm_set1_epi64x(pair), mask_b));
+                __m256 prg = _mm256_mul_ps(rad__mb_div(_mm256_add_ps(_mm256_mul_ps(irg, bc1a[md]), _mm256_mul_ps(_mm256_permute_ps(irg, 0xB1), bc1b[md])),
+                                                       den_rg[md], rcp_rg[md]),
+                                           _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_set1_ps(scale[0])), _mm_set1_ps(scale[1]), 1));
+                __m128 pb = _mm_mul_ps(rad__mb_div4(_mm_add_ps(_mm_mul_ps(ib4, _mm256_castps256_ps128(bc1a[md])),
+                                                               _mm_mul_ps(_mm_permute_ps(ib4, 0xB1), _mm256_castps256_ps128(bc1b[md]))),
+                                                    den_b[md], rcp_b[md]),
+                                       _mm_set1_ps(scale[2]));
                 __m256i wv = _mm256_set1_epi32((int)w);
                 __m256i ia = _mm256_and_si256(_mm256_srlv_epi32(wv, s1a), three), ib = _mm256_and_si256(_mm256_srlv_epi32(wv, s1b), three);
-                __m256 p0 = _mm256_broadcast_ps((const __m128 *)pal[0]), p1 = _mm256_broadcast_ps((const __m128 *)pal[1]),
-                       p2 = _mm256_broadcast_ps((const __m128 *)pal[2]);
-                v0 = _mm256_add_ps(v0, _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar_ps(p0, ia), _mm256_loadu_ps(xe)),
-                                                     _mm256_mul_ps(_mm256_permutevar_ps(p0, ib), _mm256_loadu_ps(xe + 8))));
-                v1 = _mm256_add_ps(v1, _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar_ps(p1, ia), _mm256_loadu_ps(xe + xs)),
-                                                     _mm256_mul_ps(_mm256_permutevar_ps(p1, ib), _mm256_loadu_ps(xe + xs + 8))));
-                v2 = _mm256_add_ps(v2, _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar_ps(p2, ia), _mm256_loadu_ps(xe + 2 * xs)),
-                                                     _mm256_mul_ps(_mm256_permutevar_ps(p2, ib), _mm256_loadu_ps(xe + 2 * xs + 8))));
+                __m256 p0 = _mm256_permute2f128_ps(prg, prg, 0x00), p1 = _mm256_permute2f128_ps(prg, prg, 0x11);
+                __m256 pp2 = _mm256_insertf128_ps(_mm256_castps128_ps256(pb), pb, 1);
+                v0 = RAD__MB_MADD(_mm256_permutevar_ps(p0, ia), _mm256_loadu_ps(xe), v0);
+                v0 = RAD__MB_MADD(_mm256_permutevar_ps(p0, ib), _mm256_loadu_ps(xe + 8), v0);
+                v1 = RAD__MB_MADD(_mm256_permutevar_ps(p1, ia), _mm256_loadu_ps(xe + xs), v1);
+                v1 = RAD__MB_MADD(_mm256_permutevar_ps(p1, ib), _mm256_loadu_ps(xe + xs + 8), v1);
+                v2 = RAD__MB_MADD(_mm256_permutevar_ps(pp2, ia), _mm256_loadu_ps(xe + 2 * xs), v2);
+                v2 = RAD__MB_MADD(_mm256_permutevar_ps(pp2, ib), _mm256_loadu_ps(xe + 2 * xs + 8), v2);
+                (void)pal;
             } else {
                 __m256 *vv[3];
                 vv[0] = &v0; vv[1] = &v1; vv[2] = &v2;
@@ -8526,13 +8584,14 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
                     int lo = (int)((uint32_t)q[2] | (uint32_t)q[3] << 8 | (uint32_t)q[4] << 16);
                     int hi = (int)((uint32_t)q[5] | (uint32_t)q[6] << 8 | (uint32_t)q[7] << 16);
                     __m256i wv = _mm256_setr_epi32(lo, lo, hi, hi, lo, lo, hi, hi);
-                    float sc = scale[ch] * (1.0f / 255.0f);
-                    __m256 r0 = _mm256_set1_ps((float)q[0] * sc), r1 = _mm256_set1_ps((float)q[1] * sc), p;
-                    if (q[0] > q[1]) p = _mm256_add_ps(_mm256_mul_ps(r0, w0a), _mm256_mul_ps(r1, w1a));
-                    else p = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r0, w0b), _mm256_mul_ps(r1, w1b)), _mm256_mul_ps(cb, _mm256_set1_ps(scale[ch])));
+                    /* branch-free: the encoder mixes both modes */
+                    uint32_t m = q[0] > q[1];
+                    __m256 num = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(bw0[m], _mm256_set1_ps((float)q[0])),
+                                                             _mm256_mul_ps(bw1[m], _mm256_set1_ps((float)q[1]))), bc[m]);
+                    __m256 p = _mm256_mul_ps(rad__mb_div(num, bd[m], br[m]), _mm256_set1_ps(scale[ch]));
                     __m256i ia = _mm256_and_si256(_mm256_srlv_epi32(wv, s4a), seven), ib = _mm256_and_si256(_mm256_srlv_epi32(wv, s4b), seven);
-                    *vv[ch] = _mm256_add_ps(*vv[ch], _mm256_add_ps(_mm256_mul_ps(_mm256_permutevar8x32_ps(p, ia), _mm256_loadu_ps(xe + ch * xs)),
-                                                                   _mm256_mul_ps(_mm256_permutevar8x32_ps(p, ib), _mm256_loadu_ps(xe + ch * xs + 8))));
+                    *vv[ch] = RAD__MB_MADD(_mm256_permutevar8x32_ps(p, ia), _mm256_loadu_ps(xe + ch * xs), *vv[ch]);
+                    *vv[ch] = RAD__MB_MADD(_mm256_permutevar8x32_ps(p, ib), _mm256_loadu_ps(xe + ch * xs + 8), *vv[ch]);
                 }
             }
         }

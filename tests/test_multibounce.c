@@ -665,6 +665,82 @@ done:
     mb_world_free(&w);
 }
 
+/* Whatever decode path the build compiled (AVX2 palettes or the scalar one), the compressed
+   apply uses the decoder's values to the bit: with E = e_j (1 in every channel at patch j)
+   every output is one decoded entry times 1 plus exact zeros, so it must equal column j of
+   rad_multibounce_blocks_decode exactly (outliers included). */
+static void mb_decode_exact(void)
+{
+    mb_world w;
+    rad_multibounce *mb = NULL;
+    uint32_t n, f, fr, j, i, ch;
+    float *dec = NULL, *E = NULL, *out = NULL;
+    if (!mb_cornell(&w, rad_test_quick() ? 120u : 200u)) return;
+    n = w.patches->count;
+    CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, NULL, NULL, &mb));
+    dec = (float *)malloc(sizeof(float) * 3 * n * n);
+    E = (float *)calloc(3 * (size_t)n, sizeof(float));
+    out = (float *)malloc(sizeof(float) * 3 * n);
+    if (!mb || !dec || !E || !out) goto done;
+    for (f = 0; f < 2; ++f)
+        for (fr = 0; fr < 2; ++fr) {
+            rad_block_options o;
+            rad_multibounce_blocks *b = NULL;
+            uint64_t bad = 0;
+            rad_block_options_default(&o);
+            o.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+            o.outlier_fraction = fr ? 0.05f : 0.0f;
+            CHECK_OK(rad_multibounce_blocks_create(mb, &o, NULL, &b, NULL));
+            if (!b) continue;
+            CHECK_OK(rad_multibounce_blocks_decode(b, dec, NULL));
+            for (j = 0; j < n; j += 3) {
+                E[3 * j] = E[3 * j + 1] = E[3 * j + 2] = 1.0f;
+                CHECK_OK(rad_multibounce_blocks_apply(b, E, out, RAD_OUTPUT_INDIRECT, NULL));
+                E[3 * j] = E[3 * j + 1] = E[3 * j + 2] = 0.0f;
+                for (i = 0; i < n; ++i)
+                    for (ch = 0; ch < 3; ++ch)
+                        if (out[3 * (size_t)i + ch] != dec[ch * (size_t)n * n + (size_t)i * n + j]) ++bad;
+            }
+            CHECK(bad == 0);
+            if (bad) printf("    %s, outliers %u: %llu entries differ\n", f ? "BC4x3" : "BC1", fr, (unsigned long long)bad);
+            rad_multibounce_blocks_destroy(b);
+        }
+done:
+    rad_multibounce_destroy(mb);
+    free(dec);
+    free(E);
+    free(out);
+    mb_world_free(&w);
+}
+
+/* The AVX2 palettes divide by the FMA-corrected reciprocal product; it must equal IEEE
+   division for every quotient the BC1 and BC4 decoders form: integer numerators 0..1785 over
+   the denominators 31, 63, 255 (endpoints), 62, 93, 126, 189 (BC1 interpolants), 1275, 1785
+   (BC4 interpolants). */
+static void mb_simd_division(void)
+{
+#if defined(RAD__MB_AVX2)
+    static const float den[9] = { 31.0f, 63.0f, 255.0f, 62.0f, 93.0f, 126.0f, 189.0f, 1275.0f, 1785.0f };
+    uint32_t d, x, l, bad = 0, count = 0;
+    for (d = 0; d < 9; ++d)
+        for (x = 0; x <= 1785u; x += 8) {
+            float xs[8], got[8];
+            __m256 dv = _mm256_set1_ps(den[d]);
+            for (l = 0; l < 8; ++l) xs[l] = (float)(x + l);
+            _mm256_storeu_ps(got, rad__mb_div(_mm256_loadu_ps(xs), dv, _mm256_div_ps(_mm256_set1_ps(1.0f), dv)));
+            for (l = 0; l < 8; ++l) {
+                volatile float q = xs[l] / den[d];
+                bad += got[l] != q;
+                ++count;
+            }
+        }
+    printf("    %u quotients, %u differ\n", count, bad);
+    CHECK(bad == 0);
+#else
+    printf("    (no AVX2 decode path in this build)\n");
+#endif
+}
+
 static const rad_test_case tests_multibounce[] = {
     { "multibounce: binary16 conversion", mb_half },
     { "multibounce: F_mb E equals K Jacobi bounces (K = 1, 3, 8)", mb_jacobi },
@@ -676,6 +752,8 @@ static const rad_test_case tests_multibounce[] = {
     { "multibounce: half-precision apply", mb_half_apply },
     { "multibounce: compressed apply and its error", mb_compressed },
     { "multibounce: reordering methods on a scrambled patch order", mb_reorder_methods },
+    { "multibounce: compressed apply uses the decoder's values to the bit", mb_decode_exact },
+    { "multibounce: SIMD palette division equals IEEE division", mb_simd_division },
     { "multibounce: container sections, round trip, corruption", mb_container },
     { "multibounce: argument errors", mb_errors },
     { NULL, NULL }
