@@ -1432,8 +1432,12 @@ RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
 
 /* out = F~ E (or E + F~ E) with F~ the compressed matrix: E is permuted on input, blocks are
    decoded on the fly block row by block row (never the whole matrix), the outliers added
-   exactly and the result un-permuted on output. Parallel over block rows. Thread safety:
-   reentrant. Cost: O(N^2) decode work, bytes_total bytes read. SPEC §4. */
+   exactly and the result un-permuted on output. Every decoded entry equals the value of
+   rad_bc1_decode_block / rad_bc4_decode_block times its scale to the bit, on the scalar path
+   (RAD_NO_SIMD) and the AVX2 one (branch-free palettes, divisions by FMA-corrected
+   reciprocals) alike; only the order of the sums differs. Parallel over block rows. Thread
+   safety: reentrant. Cost: O(N^2) decode work (on the CPU about as many multiply-adds as a
+   dense float apply, plus the palettes: decode-bound), bytes_total bytes read. SPEC §4. */
 RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
                                                 rad_output output, const rad_context *ctx);
 /* The decoded matrix in the original order (3 N^2 floats: R, G, B planes) with outliers, for
@@ -1442,7 +1446,10 @@ RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *b
                                                  const rad_context *ctx);
 
 /* Single 4x4 blocks, texel (x, y) at index 4y + x. Decoders follow the specification's real
-   division (REFERENCE §4): BC1 writes 16 RGB triples (48 floats), BC4 16 values. The encoders
+   division (REFERENCE §4), rounded once: every palette value is an integer numerator over an
+   integer denominator (e.g. (2 c0 + c1) / 93 for a 5-bit BC1 channel), one correctly rounded
+   float division, so no compiler contraction changes it. BC1 writes 16 RGB triples (48
+   floats), BC4 16 values. The encoders
    clamp their input to [0,1] and choose the better of the two modes of the format by squared
    error against the exact decoder. Thread safety: pure functions. */
 RAD_API void rad_bc1_decode_block(const uint8_t block[8], float out_rgb[48]);
