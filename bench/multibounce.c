@@ -9,8 +9,7 @@
    L = F_mb E for the Cornell E (E = rad_sources(RAD_SOURCE_EMISSION)), max |dL| / max |L|;
    and the build times of F_mb and of each compression.
 
-   Build: cc -O3 -march=native -fopenmp -I. -Iwip bench/multibounce.c -lm
-          (until the multi-bounce code is merged into radiosity.h it is taken from wip/)
+   Build: cc -O3 -march=native -fopenmp -I. bench/multibounce.c -lm   (make build/multibounce)
    Run:   multibounce [--quick] [--append FILE.md]   (--quick: the 1.7k size only) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
@@ -35,7 +34,7 @@ static double rel_err(const float *a, const float *b, size_t n)
     return m > 0.0 ? d / m : d;
 }
 
-#define REPS 7
+#define REPS 31
 typedef struct run { const rad_system *sys; const rad_multibounce *mb; const rad_multibounce_blocks *b; uint32_t k; } run;
 
 /* best of REPS, milliseconds */
@@ -59,6 +58,80 @@ static double time_it(const run *r, const float *E, float *out)
         if (dt < best) best = dt;
     }
     return best;
+}
+
+/* K = 3 extras: the orderings on a scrambled patch order (F_mb conjugated by a fixed
+   pseudo-random permutation, as a mesh without spatial coherence would give), and the
+   outlier fraction against bytes and error with the default ordering */
+static int scrambled(const rad_multibounce *mb, double t_jac, size_t bytes_f)
+{
+    static const float fractions[4] = { 0.0f, 0.01f, 0.02f, 0.05f };
+    uint32_t n = mb->n, i, j, ch, f, ro, *p = (uint32_t *)malloc(sizeof(uint32_t) * n);
+    float *P = (float *)malloc(sizeof(float) * 3 * (size_t)n * n);
+    uint64_t st = 12345u;
+    rad_multibounce view;
+    if (!p || !P) return 1;
+    for (i = 0; i < n; ++i) p[i] = i;
+    for (i = n - 1; i > 0; --i) {
+        uint32_t t;
+        st = st * 6364136223846793005ull + 1442695040888963407ull;
+        j = (uint32_t)((st >> 33) % (i + 1u));
+        t = p[i]; p[i] = p[j]; p[j] = t;
+    }
+    for (ch = 0; ch < 3; ++ch)
+        for (i = 0; i < n; ++i)
+            for (j = 0; j < n; ++j) P[(size_t)ch * n * n + (size_t)i * n + j] = mb->planes[(size_t)ch * n * n + (size_t)p[i] * n + p[j]];
+    view = *mb;
+    view.planes = P;
+    view.storage = NULL;
+    emit("\nThe same K = 3 matrix with its patch order scrambled (a fixed pseudo-random permutation: a mesh whose patch\n");
+    emit("order has no spatial coherence), tile 64:\n\n| form | reorder | MSE | MSE ratio |\n|---|---|---|---|\n");
+    for (f = 0; f < 2; ++f) {
+        double plain = 0.0;
+        for (ro = 0; ro <= RAD_REORDER_GROUPS; ++ro) {
+            rad_block_options bo;
+            rad_block_report rep;
+            rad_multibounce_blocks *b = NULL;
+            if (ro == RAD_REORDER_GREEDY_2OPT) continue;
+            rad_block_options_default(&bo);
+            bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+            bo.reorder = (int)ro;
+            if (rad_multibounce_blocks_create(&view, &bo, NULL, &b, &rep)) return 1;
+            if (!ro) plain = rep.mse;
+            emit("| %s | %d | %.3g | %.2f |\n", f ? "3xBC4" : "BC1", (int)ro, rep.mse, plain / rep.mse);
+            rad_multibounce_blocks_destroy(b);
+        }
+    }
+    free(P);
+    free(p);
+    emit("\nOutlier fraction (K = 3, tile 64, reorder 3, the default): bytes per outlier = 4 (column) + 12 (exact RGB floats),\n");
+    emit("plus 8 (N + 1) bytes of row offsets.\n\n| form | outliers | bytes (MiB) | / float F | of which outliers | MSE | apply ms | vs 3 Jacobi |\n|---|---|---|---|---|---|---|---|\n");
+    for (f = 0; f < 2; ++f)
+        for (i = 0; i < 4; ++i) {
+            rad_block_options bo;
+            rad_block_report rep;
+            rad_multibounce_blocks *b = NULL;
+            run r;
+            float *E = (float *)malloc(sizeof(float) * 3 * n), *out = (float *)malloc(sizeof(float) * 3 * n);
+            double ta;
+            if (!E || !out) return 1;
+            for (j = 0; j < 3 * n; ++j) E[j] = (float)((j * 2654435761u) % 1000u) / 1000.0f;
+            rad_block_options_default(&bo);
+            bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+            bo.outlier_fraction = fractions[i];
+            if (rad_multibounce_blocks_create(mb, &bo, NULL, &b, &rep)) return 1;
+            memset(&r, 0, sizeof(r));
+            r.b = b;
+            ta = time_it(&r, E, out);
+            emit("| %s | %g%% | %.1f | %.3f | %.3f | %.3g | %.2f | %.2fx |\n", f ? "3xBC4" : "BC1", 100.0 * fractions[i],
+                 (double)rep.bytes_total / 1048576.0, (double)rep.bytes_total / (double)bytes_f, (double)rep.bytes_outliers / (double)bytes_f,
+                 rep.mse, ta, t_jac / ta);
+            rad_multibounce_blocks_destroy(b);
+            free(E);
+            free(out);
+        }
+    emit("\n");
+    return 0;
 }
 
 static int bench_size(uint32_t target)
@@ -125,37 +198,50 @@ static int bench_size(uint32_t target)
         t_half[ki] = time_it(&r, E, out);
         e_half[ki] = rel_err(out, ref, n3);
         if (ks[ki] != 1) {
+            static const char *const methods[4] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps" };
             if (ki == 1) {
-                emit("Compressed forms of F_mb (K = %u; outliers 5%%, scale per 64x64 tile). Bytes are what one apply reads\n", ks[ki]);
-                emit("(blocks + scales + permutations + outliers); MSE of the decoded matrix over 3 N^2 entries; L error = max |dL| / max |L| against K Jacobi bounces.\n\n");
-                emit("| K | form | reorder | build s | bytes (MiB) | / float F | MSE | MSE ratio (plain/reordered) | L error | apply ms | vs K Jacobi |\n");
-                emit("|---|---|---|---|---|---|---|---|---|---|---|\n");
+                emit("Compressed forms of F_mb (outliers 5%%). Bytes are what one apply reads (blocks + scales + permutations +\n");
+                emit("outliers); MSE of the decoded matrix over 3 N^2 entries; ratio = MSE without reordering / MSE (same form and tile);\n");
+                emit("L error = max |dL| / max |L| against K Jacobi bounces; apply and Jacobi times best of %d in this run.\n\n", REPS);
+                emit("| K | form | tile | reorder | build s | bytes (MiB) | / float F | MSE | MSE ratio | L error | apply ms | vs K Jacobi |\n");
+                emit("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
             }
             for (f = 0; f < 2; ++f) {
-                double mse_plain = 0.0;
-                for (ro = 0; ro < 2; ++ro) {
-                    rad_block_options bo;
-                    rad_block_report rep;
-                    rad_multibounce_blocks *b = NULL;
-                    double tb, ta, e;
-                    rad_block_options_default(&bo);
-                    bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
-                    bo.reorder = (int)ro;
-                    bo.reorder_samples = 0;
-                    t0 = now();
-                    if (rad_multibounce_blocks_create(mb, &bo, NULL, &b, &rep)) return 1;
-                    tb = now() - t0;
-                    memset(&r, 0, sizeof(r));
-                    r.b = b;
-                    ta = time_it(&r, E, out);
-                    e = rel_err(out, ref, n3);
-                    if (!ro) mse_plain = rep.mse;
-                    emit("| %u | %s | %s | %.2f | %.1f | %.3f | %.3g | %s%.2f%s | %.4f | %.2f | %.1fx |\n", ks[ki], f ? "3xBC4" : "BC1",
-                         ro ? "yes" : "no", tb, (double)rep.bytes_total / 1048576.0, (double)rep.bytes_total / (double)bytes_f, rep.mse,
-                         ro ? "" : "(", ro ? mse_plain / rep.mse : 1.0, ro ? "" : ")", e, ta, t_jac[ki] / ta);
-                    rad_multibounce_blocks_destroy(b);
+                uint32_t tl;
+                for (tl = 0; tl < (ki == 1 ? 2u : 1u); ++tl) {
+                    double mse_plain = 0.0;
+                    for (ro = 0; ro <= RAD_REORDER_GROUPS; ++ro) {
+                        rad_block_options bo;
+                        rad_block_report rep;
+                        rad_multibounce_blocks *b = NULL;
+                        double tb, ta, e;
+                        if (ki != 1 && (ro == RAD_REORDER_GREEDY_2OPT)) continue;
+                        rad_block_options_default(&bo);
+                        bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+                        bo.reorder = (int)ro;
+                        bo.reorder_samples = 0;
+                        bo.tile = tl ? 0u : 64u;
+                        t0 = now();
+                        if (rad_multibounce_blocks_create(mb, &bo, NULL, &b, &rep)) return 1;
+                        tb = now() - t0;
+                        memset(&r, 0, sizeof(r));
+                        r.b = b;
+                        ta = tl ? 0.0 : time_it(&r, E, out);
+                        e = rel_err(out, ref, n3);
+                        if (!ro) mse_plain = rep.mse;
+                        if (tl)
+                            emit("| %u | %s | matrix | %s | %.2f | %.1f | %.3f | %.3g | %.2f | - | - | - |\n", ks[ki], f ? "3xBC4" : "BC1",
+                                 methods[ro], tb, (double)rep.bytes_total / 1048576.0, (double)rep.bytes_total / (double)bytes_f,
+                                 rep.mse, mse_plain / rep.mse);
+                        else
+                            emit("| %u | %s | 64 | %s | %.2f | %.1f | %.3f | %.3g | %.2f | %.4f | %.2f | %.2fx |\n", ks[ki], f ? "3xBC4" : "BC1",
+                                 methods[ro], tb, (double)rep.bytes_total / 1048576.0, (double)rep.bytes_total / (double)bytes_f, rep.mse,
+                                 mse_plain / rep.mse, e, ta, t_jac[ki] / ta);
+                        rad_multibounce_blocks_destroy(b);
+                    }
                 }
             }
+            if (ki == 1 && scrambled(mb, t_jac[ki], bytes_f)) return 1;
         }
         rad_multibounce_destroy(mb);
         rad_multibounce_destroy(h);

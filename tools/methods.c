@@ -40,7 +40,7 @@ void rad_tool_method_options_default(rad_tool_method_options *mo)
     mo->bounces = 64;
     mo->format = RAD_TOOL_MB_BC4X3;
     mo->outliers = 0.05f;
-    mo->reorder = 1;
+    mo->reorder = RAD_REORDER_GROUPS;
     mo->tile = 64;
     mo->mode = RAD_TEMPORAL_FEEDBACK;
     mo->k = 10;
@@ -77,7 +77,7 @@ const char *rad_tool_method_help(int render)
                     "                     (as classic: the image of K equals classic --bounces K; default 64)\n"
                     "  --format F         multibounce: F_mb storage float, half, bc1 or bc4x3 (default)\n"
                     "  --outliers P       multibounce bc1/bc4x3: fraction of entries kept exactly (default 0.05)\n"
-                    "  --reorder, --no-reorder   multibounce bc1/bc4x3: greedy row/column reordering (default on)\n"
+                    "  --reorder, --no-reorder   multibounce bc1/bc4x3: row/column reordering (default on)\n"
                     "  --reorder-samples N   reordering distances on N coordinates (default 0: all)\n"
                     "  --tile T           multibounce bc1/bc4x3: scales per T x T texels, 0: per matrix (default 64)\n"
                     "  --mode M           temporal: feedback (default, converges to L_inf), single (one bounce)\n"
@@ -96,7 +96,7 @@ const char *rad_tool_method_help(int render)
                     "                     the renderer's gather; default 64)\n"
                     "  --format F         F_mb storage: float, half, bc1 or bc4x3 (default)\n"
                     "  --outliers P       bc1/bc4x3: fraction of the entries kept exactly (default 0.05)\n"
-                    "  --reorder, --no-reorder   bc1/bc4x3: greedy row/column reordering (default on)\n"
+                    "  --reorder, --no-reorder   bc1/bc4x3: row/column reordering (default on)\n"
                     "  --reorder-samples N   reordering distances on N coordinates (default 0: all)\n"
                     "  --tile T           bc1/bc4x3: scales per T x T texels (multiple of 4), 0: per matrix (default 64)\n"
                     "temporal (alias tables; k, w, adaptive and seed are the render's defaults):\n"
@@ -121,7 +121,7 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
     if (i == sizeof names / sizeof names[0]) return 0;
     if (i >= 13) { /* flags */
         if (i == 15) mo->adaptive = 1, mo->given |= RAD_TOOL_OPT_ADAPTIVE;
-        else mo->reorder = i == 13, mo->given |= RAD_TOOL_OPT_REORDER;
+        else mo->reorder = i == 13 ? RAD_REORDER_GROUPS : RAD_REORDER_NONE, mo->given |= RAD_TOOL_OPT_REORDER;
         return 1;
     }
     if (*a + 1 >= argc) {
