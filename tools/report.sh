@@ -177,7 +177,7 @@ run_scene() {
         args=${args//FRAMES/$FRAMES}
         local mname=${args#--method }
         mname=${mname%% *}
-        if ! printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$mname([ |]|$)"; then
+        if ! printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$mname([] |]|$)"; then
             printf '| %s | `%s` | not in this build | | | | | %s |\n' "$label" "$args" "$pub" | sed 's/| |/| - |/g; s/| |/| - |/g' >> "$md"
             continue
         fi
@@ -289,7 +289,7 @@ awk -v title="Compression error of F_mb (3 bounces), with and without reordering
 VP_OK=0
 vp_method=${VP_SWEEP#--method }
 vp_method=${vp_method%% *}
-if [ -n "$VP_SWEEP" ] && printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$vp_method([ |]|$)"; then
+if [ -n "$VP_SWEEP" ] && printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$vp_method([] |]|$)"; then
     echo "patches PSNR_cornell PSNR_bunny" > "$OUT/data/vp_psnr.dat"
     echo "patches SSIM_cornell SSIM_bunny" > "$OUT/data/vp_ssim.dat"
     : > "$TMP/vp.md"
@@ -342,9 +342,9 @@ ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a + 0 > 0 && b + 0 > 0) printf "%
         { key = $1 "|" $2; if ($3 == "no-reorder") plain[key] = $4; else if ($4 + 0 > 0) { r[$2] = sprintf("%.1fx", plain[key] / $4); n = $1; mem[$2] = sprintf("%.1fx", ($7 / 3) / $6) } }
         END { printf "| reordering cuts the compression MSE (T-3) | 5x | N = %s: BC1 %s, 3xBC4 %s |\n", n, r["bc1"], r["bc4x3"]
               printf "| compressed F_mb memory vs the plain float F (T-3) | 3x below | N = %s: BC1 %s, 3xBC4 %s below (blocks + scales + outliers + permutations) |\n", n, mem["bc1"], mem["bc4x3"] }' "$TMP/comp.md"
-    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])local([ |]|$)"; then :; else
+    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])local([] |]|$)"; then :; else
         echo "| local matrix update vs recomputation (T-4) | 6-15x | not in this build (branch \`local\`) |"; fi
-    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])aavp([ |]|$)"; then :; else
+    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])aavp([] |]|$)"; then :; else
         echo "| temporal + AAVP vs RTXGI (T table 3) | 0.08 ms, SSIM 0.73 vs 0.17 ms, SSIM 0.66 | not in this build (branch \`vp\`) |"; fi
 } > "$TMP/headline.md"
 
