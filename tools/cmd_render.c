@@ -14,10 +14,21 @@
    patches' H from methods.c (L = F_mb E, or the temporal frames, H = L / rho) and the halo
    correction from the bake's row sums of F.
 
+   Local (render_local_method, SPEC §5): the classic patches, F and E; a rad_local of capacity
+   --local-m M filled with the M patches nearest the camera (rad_local_nearest, one
+   rad_local_rebuild), L = T E over P_Vis x P_Lit (rad_local_visible, rad_local_lit), H = L / rho
+   and the classic render; patches outside the set or not visible get no indirect light.
+   Virtual patches (render_vp_method, SPEC §6-§7): rad_vp_create (vp: RAD_VP_CLUSTERED, aavp:
+   RAD_VP_AXIS_ALIGNED) at --vp-resolution or at the finest resolution within --vp-max-patches,
+   E = rad_vp_sources, Jacobi --bounces K (inf: Gauss-Seidel), H = F (E + L) per patch, and the
+   classic per-pixel render with H gathered at each sample's hit point (rad_vp_gather per batch).
+
    Every radiosity method prints one line for scripts (tools/report.sh) on stderr:
    "rad render: timing: method=M patches=N frames=F [bounces=K ]step_ms_median=X step_ms_min=Y",
    the method's own per-frame work: the classic solve (K Jacobi bounces), one F_mb E product
-   (median of 9), or one temporal step (median over the frames). */
+   (median of 9), one temporal step (median over the frames), one local apply L = T E (median
+   of 9; plus rebuild_ms), or the virtual patches' solve + H (plus build_ms, sources_ms,
+   gather_ms, render_ms, resolution, vp_mib and peak_rss_mib). */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
