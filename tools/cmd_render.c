@@ -14,16 +14,28 @@
    patches' H from methods.c (L = F_mb E, or the temporal frames, H = L / rho) and the halo
    correction from the bake's row sums of F.
 
+   Local (render_local_method, SPEC §5): the classic patches, F and E; a rad_local of capacity
+   --local-m M filled with the M patches nearest the camera (rad_local_nearest, one
+   rad_local_rebuild), L = T E over P_Vis x P_Lit (rad_local_visible, rad_local_lit), H = L / rho
+   and the classic render; patches outside the set or not visible get no indirect light.
+   Virtual patches (render_vp_method, SPEC §6-§7): rad_vp_create (vp: RAD_VP_CLUSTERED, aavp:
+   RAD_VP_AXIS_ALIGNED) at --vp-resolution or at the finest resolution within --vp-max-patches,
+   E = rad_vp_sources, Jacobi --bounces K (inf: Gauss-Seidel), H = F (E + L) per patch, and the
+   classic per-pixel render with H gathered at each sample's hit point (rad_vp_gather per batch).
+
    Every radiosity method prints one line for scripts (tools/report.sh) on stderr:
    "rad render: timing: method=M patches=N frames=F [bounces=K ]step_ms_median=X step_ms_min=Y",
    the method's own per-frame work: the classic solve (K Jacobi bounces), one F_mb E product
-   (median of 9), or one temporal step (median over the frames). */
+   (median of 9), one temporal step (median over the frames), one local apply L = T E (median
+   of 9; plus rebuild_ms), or the virtual patches' solve + H (plus build_ms, sources_ms,
+   gather_ms, render_ms, resolution, vp_mib and peak_rss_mib). */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #if defined(__unix__) || defined(__APPLE__)
+#include <sys/resource.h> /* getrusage: peak memory in the vp timing line */
 #include <sys/stat.h> /* mkdir for --sequence */
 #endif
 
@@ -42,10 +54,11 @@ static void *xmalloc(size_t size)
 static void render_usage(FILE *f)
 {
     fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|pathtrace] [options]\n"
+            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|pathtrace] [options]\n"
             "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
             "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
-            "                     indirect light L = F_mb E), temporal (alias-table frames) or pathtrace\n"
+            "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
+            "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches)\n"
             "  --bake FILE.radb   classic, multibounce, temporal: use a bake of that method made by\n"
             "                     'rad bake' from this scene instead of computing it here\n"
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
@@ -146,6 +159,10 @@ typedef struct isect_job {
 
 /* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
 static int render_shading = -1;
+/* --method vp|aavp: render_classic gathers H at each sample from these (P and Hv unused) */
+static const rad_virtual_patches *render_vp = NULL;
+static const float *render_vp_H = NULL;
+static double render_vp_gather_seconds = 0.0;
 
 static int render_classic(const rad_tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
                           int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
@@ -155,7 +172,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     size_t batch_cap, total = (size_t)width * height, done_px = 0;
     rad_ray *rays;
     rad_hit *hits;
-    float *points, *normals, *irr, *shade_v = NULL, *shade_a = NULL, *shaded = NULL;
+    float *points, *normals, *irr, *shade_v = NULL, *shade_a = NULL, *shaded = NULL, *gathered = NULL;
     uint32_t *valid;
     rad_direct_options dopt;
     rad_context quiet;
@@ -172,6 +189,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
+    if (render_vp) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     if (render_shading >= 0) {
         shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
         shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
@@ -235,6 +253,15 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
                 break;
             }
         }
+        if (gathered && nvalid > 0) {
+            double tg = rad_tool_seconds();
+            r = rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
+            render_vp_gather_seconds += rad_tool_seconds() - tg;
+            if (r != RAD_SUCCESS) {
+                result = rad_tool_fail("render", "rad_vp_gather", r);
+                break;
+            }
+        }
         if (shaded && nvalid > 0) {
             for (k = 0; k < nvalid; ++k) {
                 const rad_ray *ry = &rays[valid[k]];
@@ -253,14 +280,15 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
             const rad_hit *h = &hits[ray];
             const rad_material *m = &scene->materials_table[scene->materials[h->triangle]];
             float albedo[3], wts[3];
-            uint32_t p = rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
+            uint32_t p = gathered ? 0u : rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
             const uint32_t *vi;
             if (p == RAD_NONE) continue;
-            vi = P->patches[p].vertices;
+            vi = gathered ? NULL : P->patches[p].vertices;
             rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
             for (i = 0; i < 3; ++i) {
-                float hi = wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
-                           wts[2] * Hv[3 * (size_t)vi[2] + i];
+                float hi = gathered ? gathered[3 * k + i]
+                                    : wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
+                                          wts[2] * Hv[3 * (size_t)vi[2] + i];
                 img->rgb[3 * pixel + i] += (shaded ? shaded[3 * k + i] + albedo[i] / PI_F * hi
                                                    : albedo[i] / PI_F * (irr[3 * k + i] + hi)) + m->emission[i];
             }
@@ -283,6 +311,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     free(shade_v);
     free(shade_a);
     free(shaded);
+    free(gathered);
     return result;
 }
 
@@ -448,6 +477,246 @@ static int render_with_method(const char *cmd, const rad_tool_world *w, const ch
     return rc;
 }
 
+/* peak resident set of the process in MiB (0 where unknown) */
+static double peak_rss_mib(void)
+{
+#if defined(__unix__) || defined(__APPLE__)
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) == 0)
+#if defined(__APPLE__)
+        return (double)ru.ru_maxrss / 1048576.0;
+#else
+        return (double)ru.ru_maxrss / 1024.0;
+#endif
+#endif
+    return 0.0;
+}
+
+/* rad_vp_create at 'resolution' (progress labelled), or NULL with the error printed */
+static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+                                     uint32_t resolution)
+{
+    rad_vp_options vo;
+    rad_virtual_patches *vp = NULL;
+    rad_context ctx;
+    rad_result r;
+    rad_vp_options_default(&vo);
+    vo.resolution = resolution;
+    vo.face_points = mo->face_points;
+    if (mo->method == RAD_TOOL_VP) vo.kind = RAD_VP_CLUSTERED;
+    rad_tool_context(&ctx, "virtual patches");
+    r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &vp);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_vp_create", r);
+        return NULL;
+    }
+    fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches, %u voxels, %u samples\n", cmd,
+            rad_tool_method_name(mo->method), resolution, vp->count, vp->voxel_count, vp->sample_count);
+    return vp;
+}
+
+/* --method vp|aavp (SPEC §6-§7): virtual patches, E at their samples, the classic solve on
+   their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
+   classic per-pixel render with H gathered at each sample's hit point. */
+static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                            const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
+                            uint32_t aa, uint32_t light_samples, rad_image *img)
+{
+    rad_virtual_patches *vp = NULL;
+    rad_direct_options dopt;
+    rad_solve_options so;
+    rad_solve_stats stats;
+    rad_system sys;
+    rad_context ctx;
+    rad_result r;
+    float *E = NULL, *L = NULL, *B = NULL, *H = NULL;
+    uint32_t n, i, res = mo->vp_resolution, builds = 0;
+    double t0 = rad_tool_seconds(), t_build, t_E, t_solve;
+    int rc = 0;
+    if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
+        /* the patch count grows about as R^2 (surface voxels): predict, build, correct */
+        uint32_t best_res = 0, lo = 1, hi = 1025;
+        rad_virtual_patches *best = NULL;
+        res = 4;
+        while (builds < 6 && lo < hi) {
+            rad_virtual_patches *t = vp_build(cmd, w, mo, res);
+            uint32_t count, next;
+            ++builds;
+            if (!t) {
+                rad_vp_destroy(best);
+                return 1;
+            }
+            count = t->count;
+            if (count <= mo->vp_max_patches) {
+                rad_vp_destroy(best);
+                best = t, best_res = res, lo = res + 1;
+            } else {
+                rad_vp_destroy(t);
+                hi = res;
+            }
+            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(count ? count : 1)) * 0.97);
+            if (next < lo) next = lo;
+            if (next >= hi) next = hi - 1;
+            if (next < lo) break;
+            res = next;
+        }
+        if (!best) {
+            fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd,
+                    mo->vp_max_patches);
+            return 1;
+        }
+        vp = best, res = best_res;
+        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u (%u patches) after %u builds\n", cmd,
+                mo->vp_max_patches, res, vp->count, builds);
+    } else if (!(vp = vp_build(cmd, w, mo, res))) {
+        return 1;
+    }
+    t_build = rad_tool_seconds() - t0;
+    n = vp->count;
+    E = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    rad_direct_options_default(&dopt);
+    dopt.include_emitters = 1;
+    dopt.light_samples = o->light_samples;
+    rad_tool_context(&ctx, "direct light");
+    t0 = rad_tool_seconds();
+    r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
+    rad_tool_progress_end();
+    t_E = rad_tool_seconds() - t0;
+    if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "rad_vp_sources", r);
+    if (rc == 0) {
+        rad_vp_system(&sys, vp, E);
+        rad_solve_options_default(&so);
+        so.output = RAD_OUTPUT_INDIRECT;
+        so.bounces = mo->bounces;
+        memset(&stats, 0, sizeof stats);
+        rad_tool_context(&ctx, NULL);
+        t0 = rad_tool_seconds();
+        if (mo->bounces == RAD_MB_INFINITE) {
+            r = rad_solve_gauss_seidel(&sys, &so, L, &stats, &ctx);
+            if (r == RAD_ERROR_NOT_CONVERGED) {
+                fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge (residual %g after %u sweeps)\n", cmd,
+                        stats.residual, stats.iterations);
+                r = RAD_SUCCESS;
+            }
+        } else {
+            r = rad_solve_jacobi(&sys, &so, L, &stats, &ctx);
+        }
+        for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
+        if (r == RAD_SUCCESS) r = rad_matrix_multiply(&vp->matrix, B, H, &ctx);
+        t_solve = rad_tool_seconds() - t0;
+        if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "solve", r);
+    }
+    if (rc == 0) {
+        render_vp = vp, render_vp_H = H, render_vp_gather_seconds = 0.0;
+        t0 = rad_tool_seconds();
+        rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
+        render_vp = NULL, render_vp_H = NULL;
+        /* one line for scripts: step = the solve (K bounces + H = F B) as classic's */
+        if (rc == 0) {
+            fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=1 bounces=%s%.0u step_ms_median=%.6f "
+                            "step_ms_min=%.6f build_ms=%.1f sources_ms=%.1f gather_ms=%.1f render_ms=%.1f "
+                            "resolution=%u vp_mib=%.1f peak_rss_mib=%.1f\n",
+                    cmd, rad_tool_method_name(mo->method), n, mo->bounces == RAD_MB_INFINITE ? "inf" : "",
+                    mo->bounces == RAD_MB_INFINITE ? 0u : mo->bounces,
+                    1e3 * t_solve, 1e3 * t_solve, 1e3 * t_build, 1e3 * t_E, 1e3 * render_vp_gather_seconds,
+                    1e3 * (rad_tool_seconds() - t0), res, (double)rad_vp_memory(vp) / 1048576.0, peak_rss_mib());
+        }
+    }
+    free(E);
+    free(L);
+    free(B);
+    free(H);
+    rad_vp_destroy(vp);
+    return rc;
+}
+
+/* --method local (SPEC §5): the classic patches, F and E; a local matrix of capacity M over F's
+   rows filled with the M patches nearest the camera (rad_local_rebuild), L = T E over P_Vis x
+   P_Lit, H = L / rho (L = rho F (E + L) within the set), rendered as classic. */
+static int render_local_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *oc,
+                               const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
+                               uint32_t aa, uint32_t light_samples, rad_image *img)
+{
+    rad_tool_classic_options o = *oc;
+    rad_tool_classic sol;
+    rad_local_options lo;
+    rad_local *local = NULL;
+    rad_row_source src;
+    rad_context ctx;
+    rad_result r;
+    uint32_t n, m, i, c, nvis = 0, nlit = 0;
+    uint32_t *set = NULL, *vis = NULL, *lit = NULL;
+    float *areas = NULL, *albedo = NULL, *L = NULL, *H = NULL, *Hv = NULL;
+    double t0, t_rebuild = 0.0, times[9];
+    int rc = 0, k;
+    o.sources_only = 1;
+    if (rad_tool_classic_solve(cmd, w, &o, &sol)) return 1;
+    n = sol.patches->count;
+    m = mo->local_m < n ? mo->local_m : n;
+    if (mo->local_m > n && (mo->given & RAD_TOOL_OPT_LOCAL_M))
+        fprintf(stderr, "rad %s: --local-m %u is more than the %u patches: using %u\n", cmd, mo->local_m, n, n);
+    areas = (float *)xmalloc(sizeof(float) * n);
+    albedo = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    set = (uint32_t *)xmalloc(sizeof(uint32_t) * m);
+    vis = (uint32_t *)xmalloc(sizeof(uint32_t) * m);
+    lit = (uint32_t *)xmalloc(sizeof(uint32_t) * m);
+    for (i = 0; i < n; ++i) {
+        areas[i] = sol.patches->patches[i].area;
+        for (c = 0; c < 3; ++c) albedo[3 * i + c] = sol.patches->patches[i].albedo[c];
+    }
+    for (i = 0; i < 3 * n; ++i) L[i] = 0.0f;
+    rad_tool_context(&ctx, NULL);
+    rad_local_options_default(&lo);
+    lo.capacity = m;
+    r = rad_row_source_matrix(&sol.ff->matrix, areas, albedo, &src);
+    if (r == RAD_SUCCESS) r = rad_local_create(&src, &lo, &ctx, &local);
+    if (r == RAD_SUCCESS) r = rad_local_nearest(sol.patches, cam->position, m, set, &ctx);
+    if (r == RAD_SUCCESS) {
+        t0 = rad_tool_seconds();
+        r = rad_local_rebuild(local, set, m, &ctx);
+        t_rebuild = rad_tool_seconds() - t0;
+    }
+    if (r == RAD_SUCCESS)
+        r = rad_local_visible(sol.patches, &w->rc, cam, (float)width / (float)height, set, m, vis, &nvis, &ctx);
+    if (r == RAD_SUCCESS) r = rad_local_lit(sol.E, set, m, 0.0f, lit, &nlit);
+    for (k = 0; k < 9 && r == RAD_SUCCESS; ++k) {
+        t0 = rad_tool_seconds();
+        r = rad_local_apply(local, sol.E, vis, nvis, lit, nlit, RAD_OUTPUT_INDIRECT, L, &ctx);
+        times[k] = rad_tool_seconds() - t0;
+    }
+    if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "local matrix", r);
+    if (rc == 0) {
+        qsort(times, 9, sizeof(double), cmp_double);
+        fprintf(stderr, "rad %s: local matrix: M = %u of %u patches, |P_Vis| = %u, |P_Lit| = %u, %.1f MiB\n", cmd, m,
+                n, nvis, nlit, (double)rad_local_memory(local) / 1048576.0);
+        fprintf(stderr, "rad %s: timing: method=local patches=%u frames=9 step_ms_median=%.6f step_ms_min=%.6f "
+                        "rebuild_ms=%.3f local_m=%u visible=%u lit=%u\n",
+                cmd, n, 1e3 * times[4], 1e3 * times[0], 1e3 * t_rebuild, m, nvis, nlit);
+        /* H = L / rho: the irradiance from the secondary sources (0 where rho is 0) */
+        for (i = 0; i < 3 * n; ++i) H[i] = albedo[i] > 0.0f ? L[i] / albedo[i] : 0.0f;
+        Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)sol.patches->vertex_count);
+        rc = vertex_H(sol.patches, &sol.ff->matrix, H, Hv);
+        if (rc == 0) rc = render_classic(w, sol.patches, Hv, cam, width, height, aa, light_samples, img);
+    }
+    rad_local_destroy(local);
+    free(areas);
+    free(albedo);
+    free(L);
+    free(H);
+    free(Hv);
+    free(set);
+    free(vis);
+    free(lit);
+    rad_tool_classic_free(&sol);
+    return rc;
+}
+
 int rad_cmd_render(int argc, char **argv)
 {
     const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
@@ -528,6 +797,10 @@ int rad_cmd_render(int argc, char **argv)
         fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
+    if (mo.method >= RAD_TOOL_LOCAL && bake_path) {
+        fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd, method);
+        return 2;
+    }
     if (pathtrace && bake_path) {
         fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
@@ -551,7 +824,16 @@ int rad_cmd_render(int argc, char **argv)
         return 1;
     }
 
-    if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL) {
+    if (mo.method >= RAD_TOOL_LOCAL) {
+        rc = mo.method == RAD_TOOL_LOCAL
+                 ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
+                 : render_vp_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
+        if (rc) {
+            rad_image_free(&img);
+            rad_tool_close_world(&w);
+            return 1;
+        }
+    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL) {
         rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                 &img);
         if (rc) {

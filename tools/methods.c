@@ -47,6 +47,9 @@ void rad_tool_method_options_default(rad_tool_method_options *mo)
     mo->w = 0.998f;
     mo->frames = 64;
     mo->every = 1;
+    mo->vp_resolution = 16;
+    mo->face_points = 16;
+    mo->local_m = 1024;
 }
 
 const char *rad_tool_method_name(rad_tool_method method)
@@ -55,6 +58,9 @@ const char *rad_tool_method_name(rad_tool_method method)
     case RAD_TOOL_MULTIBOUNCE: return "multibounce";
     case RAD_TOOL_TEMPORAL: return "temporal";
     case RAD_TOOL_PATHTRACE: return "pathtrace";
+    case RAD_TOOL_LOCAL: return "local";
+    case RAD_TOOL_VP: return "vp";
+    case RAD_TOOL_AAVP: return "aavp";
     default: return "classic";
     }
 }
@@ -91,6 +97,18 @@ const char *rad_tool_method_help(int render)
                     "                     running mean of the frames: converges fast)\n"
                     "  --seed S           generator seed (default 0; also the path tracer's seed)\n"
                     "  --sequence DIR     also write DIR/frame_NNNNN.png every --every N frames (default 1)\n"
+                    "vp (clustered virtual patches, SPEC §6) and aavp (axis-aligned, SPEC §7); any mesh size, no\n"
+                    "per-triangle patches (--patches etc. are ignored); --bounces K|inf as classic (Jacobi; inf:\n"
+                    "Gauss-Seidel to 1e-6); indirect light gathered per pixel from the voxel grid:\n"
+                    "  --vp-resolution R  voxels along the longest axis of the scene (default 16)\n"
+                    "  --vp-max-patches B the finest resolution whose patch count is at most B (replaces\n"
+                    "                     --vp-resolution; found by building at predicted resolutions, <= 6 builds)\n"
+                    "  --face-points P    Hammersley points per voxel face (default 16)\n"
+                    "local (local multi-bounce matrix, SPEC §5; classic patches and F, T = (I - rho F_S)^-1 - I\n"
+                    "of the set S, the full solution within S; render only):\n"
+                    "  --local-m M        capacity: S = the M patches nearest the camera (default 1024, at most\n"
+                    "                     the patch count). L = T E over P_Vis x P_Lit: patches outside S (or not\n"
+                    "                     visible) get no indirect light and light outside S is not bounced\n"
                   : "multibounce:\n"
                     "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
                     "                     the renderer's gather; default 64)\n"
@@ -116,6 +134,28 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
                                         "--adaptive"};
     const char *opt = argv[*a], *v;
     size_t i;
+    {
+        static const char *const extra[] = {"--vp-resolution", "--vp-max-patches", "--face-points", "--local-m"};
+        for (i = 0; i < 4; ++i)
+            if (!strcmp(opt, extra[i])) break;
+        if (i < 4) {
+            uint32_t *dst = i == 0 ? &mo->vp_resolution : i == 1 ? &mo->vp_max_patches
+                          : i == 2 ? &mo->face_points : &mo->local_m;
+            uint32_t hi = i == 0 ? 1024u : i == 1 ? 1000000u : i == 2 ? 4096u : 1000000u;
+            if (*a + 1 >= argc) {
+                fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+                return 2;
+            }
+            v = argv[++*a];
+            if (rad_tool_parse_uint(cmd, opt, v, dst)) return 2;
+            if (*dst == 0 || *dst > hi) {
+                fprintf(stderr, "rad %s: %s must be in 1..%u, not %s\n", cmd, opt, hi, v);
+                return 2;
+            }
+            mo->given |= RAD_TOOL_OPT_VP_RESOLUTION << i;
+            return 1;
+        }
+    }
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (!strcmp(opt, names[i])) break;
     if (i == sizeof names / sizeof names[0]) return 0;
@@ -135,9 +175,12 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         else if (!strcmp(v, "multibounce")) mo->method = RAD_TOOL_MULTIBOUNCE;
         else if (!strcmp(v, "temporal")) mo->method = RAD_TOOL_TEMPORAL;
         else if (!strcmp(v, "pathtrace")) mo->method = RAD_TOOL_PATHTRACE;
+        else if (!strcmp(v, "local")) mo->method = RAD_TOOL_LOCAL;
+        else if (!strcmp(v, "vp")) mo->method = RAD_TOOL_VP;
+        else if (!strcmp(v, "aavp")) mo->method = RAD_TOOL_AAVP;
         else {
             fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal%s)\n", cmd, v,
-                    strcmp(cmd, "render") ? "" : " or pathtrace");
+                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp or aavp");
             return 2;
         }
         mo->given |= RAD_TOOL_OPT_METHOD;
@@ -246,7 +289,8 @@ static const char *given_name(uint32_t bits)
 {
     static const char *const names[] = {"--bounces", "--format", "--outliers", "--reorder/--no-reorder",
                                         "--reorder-samples", "--tile", "--mode", "--k", "--w", "--adaptive",
-                                        "--seed", "--frames", "--sequence", "--every", "--method"};
+                                        "--seed", "--frames", "--sequence", "--every", "--method",
+                                        "--vp-resolution", "--vp-max-patches", "--face-points", "--local-m"};
     uint32_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (bits & (1u << i)) return names[i];
@@ -259,6 +303,33 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
     const char *want = NULL;
     if (!render && (g & RAD_TOOL_OPT_RENDER_ONLY)) {
         fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & RAD_TOOL_OPT_RENDER_ONLY));
+        return 2;
+    }
+    if (!render && mo->method >= RAD_TOOL_LOCAL) {
+        fprintf(stderr, "rad %s: method '%s' is render-only (rad render --method %s builds it in memory: %s)\n", cmd,
+                rad_tool_method_name(mo->method), rad_tool_method_name(mo->method),
+                mo->method == RAD_TOOL_LOCAL ? "its matrix depends on the camera; a classic bake holds its F"
+                                             : "the container has no section for virtual patches yet");
+        return 2;
+    }
+    if (mo->method >= RAD_TOOL_LOCAL) {
+        uint32_t other = mo->method == RAD_TOOL_LOCAL ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES : RAD_TOOL_OPT_LOCAL_M;
+        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED | other);
+        if (bad) {
+            fprintf(stderr, "rad %s: %s is not an option of --method %s%s\n", cmd, given_name(bad),
+                    rad_tool_method_name(mo->method),
+                    mo->method == RAD_TOOL_LOCAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (T is the full solution in the set)" : "");
+            return 2;
+        }
+        if ((g & RAD_TOOL_OPT_VP_RESOLUTION) && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
+            fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
+            return 2;
+        }
+        return 0;
+    }
+    if (g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M)) {
+        fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd, given_name(g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M)),
+                (g & RAD_TOOL_OPT_VP) ? "vp or aavp" : "local", rad_tool_method_name(mo->method));
         return 2;
     }
     if (!render && mo->method == RAD_TOOL_PATHTRACE) {

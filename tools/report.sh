@@ -97,7 +97,7 @@ mbbc1|multi-bounce F_mb, BC1 + outliers, reordered|1|--method multibounce --form
 mbbc4|multi-bounce F_mb, 3xBC4 + outliers, reordered|1|--method multibounce --format bc4x3|T-3: memory 3x below the plain form-factor matrix
 temporal|temporal, k 10, w 0.998, after FRAMES frames|1|--method temporal --w 0.998 --frames FRAMES|T table 2 (temporal): MSE 0.06651, PSNR 23.54, SSIM 0.8323
 temporal_ad|temporal, k 10, adaptive w, after FRAMES frames|1|--method temporal --adaptive --frames FRAMES|none (beyond the thesis: SPEC §8 adaptive w)
-local|local matrix (SPEC §5)|0|--method local|T-4: update cost 6-15x below recomputation
+local|local matrix (SPEC §5), M = 1024 nearest the camera|1|--method local|T-4: update cost 6-15x below recomputation
 vp|virtual patches (SPEC §6)|0|--method vp|T-5: 200 000 triangles to 12 000 (or 2 000) patches
 aavp|axis-aligned virtual patches (SPEC §7)|0|--method aavp|T table 3: temporal + AAVP 0.08 ms, SSIM 0.73 (RTXGI 0.17 ms, SSIM 0.66)
 '
@@ -108,6 +108,7 @@ aavp|axis-aligned virtual patches (SPEC §7)|0|--method aavp|T table 3: temporal
 # VP_SWEEP='--method aavp --vp-max-patches'.
 VP_SWEEP=${RAD_REPORT_VP_SWEEP:-}
 case $MODE in quick) VP_BUDGETS="100 300" ;; medium) VP_BUDGETS="250 1000 4000" ;; *) VP_BUDGETS="500 2000 8000 12000" ;; esac
+VP_BUDGETS=${RAD_REPORT_VP_BUDGETS:-$VP_BUDGETS} # e.g. fewer for a shorter run (each budget builds 2-4 times)
 
 [ -x "$RAD" ] || { echo "report.sh: $RAD not built (make tools)" >&2; exit 1; }
 mkdir -p "$OUT/img" "$OUT/plots" "$OUT/data"
@@ -176,7 +177,7 @@ run_scene() {
         args=${args//FRAMES/$FRAMES}
         local mname=${args#--method }
         mname=${mname%% *}
-        if ! printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$mname([ |]|$)"; then
+        if ! printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$mname([] |]|$)"; then
             printf '| %s | `%s` | not in this build | | | | | %s |\n' "$label" "$args" "$pub" | sed 's/| |/| - |/g; s/| |/| - |/g' >> "$md"
             continue
         fi
@@ -288,7 +289,7 @@ awk -v title="Compression error of F_mb (3 bounces), with and without reordering
 VP_OK=0
 vp_method=${VP_SWEEP#--method }
 vp_method=${vp_method%% *}
-if [ -n "$VP_SWEEP" ] && printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$vp_method([ |]|$)"; then
+if [ -n "$VP_SWEEP" ] && printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$vp_method([] |]|$)"; then
     echo "patches PSNR_cornell PSNR_bunny" > "$OUT/data/vp_psnr.dat"
     echo "patches SSIM_cornell SSIM_bunny" > "$OUT/data/vp_ssim.dat"
     : > "$TMP/vp.md"
@@ -341,9 +342,9 @@ ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a + 0 > 0 && b + 0 > 0) printf "%
         { key = $1 "|" $2; if ($3 == "no-reorder") plain[key] = $4; else if ($4 + 0 > 0) { r[$2] = sprintf("%.1fx", plain[key] / $4); n = $1; mem[$2] = sprintf("%.1fx", ($7 / 3) / $6) } }
         END { printf "| reordering cuts the compression MSE (T-3) | 5x | N = %s: BC1 %s, 3xBC4 %s |\n", n, r["bc1"], r["bc4x3"]
               printf "| compressed F_mb memory vs the plain float F (T-3) | 3x below | N = %s: BC1 %s, 3xBC4 %s below (blocks + scales + outliers + permutations) |\n", n, mem["bc1"], mem["bc4x3"] }' "$TMP/comp.md"
-    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])local([ |]|$)"; then :; else
+    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])local([] |]|$)"; then :; else
         echo "| local matrix update vs recomputation (T-4) | 6-15x | not in this build (branch \`local\`) |"; fi
-    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])aavp([ |]|$)"; then :; else
+    if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])aavp([] |]|$)"; then :; else
         echo "| temporal + AAVP vs RTXGI (T table 3) | 0.08 ms, SSIM 0.73 vs 0.17 ms, SSIM 0.66 | not in this build (branch \`vp\`) |"; fi
 } > "$TMP/headline.md"
 

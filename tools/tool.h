@@ -180,7 +180,8 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
                           float *out_rgb);
 /* ---- the multi-bounce and temporal methods (methods.c) ------------------------------------ */
 typedef enum rad_tool_method {
-    RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3
+    RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
+    RAD_TOOL_LOCAL = 4, RAD_TOOL_VP = 5, RAD_TOOL_AAVP = 6 /* render only (cmd_render.c) */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
 typedef enum rad_tool_mb_format {
@@ -205,6 +206,10 @@ typedef struct rad_tool_method_options {
     uint32_t frames;          /* --frames N (render; default 64) */
     const char *sequence;     /* --sequence DIR (render) */
     uint32_t every;           /* --every N (render; default 1) */
+    uint32_t vp_resolution;   /* --vp-resolution R: voxels along the longest axis (default 16) */
+    uint32_t vp_max_patches;  /* --vp-max-patches B: the finest resolution with at most B patches (0: off) */
+    uint32_t face_points;     /* --face-points P: Hammersley points per voxel face (default 16) */
+    uint32_t local_m;         /* --local-m M: local matrix capacity (default 1024, at most the patches) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
 } rad_tool_method_options;
 enum {
@@ -212,8 +217,10 @@ enum {
     RAD_TOOL_OPT_REORDER = 1u << 3, RAD_TOOL_OPT_REORDER_SAMPLES = 1u << 4, RAD_TOOL_OPT_TILE = 1u << 5,
     RAD_TOOL_OPT_MODE = 1u << 6, RAD_TOOL_OPT_K = 1u << 7, RAD_TOOL_OPT_W = 1u << 8, RAD_TOOL_OPT_ADAPTIVE = 1u << 9,
     RAD_TOOL_OPT_SEED = 1u << 10, RAD_TOOL_OPT_FRAMES = 1u << 11, RAD_TOOL_OPT_SEQUENCE = 1u << 12,
-    RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14
+    RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14, RAD_TOOL_OPT_VP_RESOLUTION = 1u << 15,
+    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18
 };
+#define RAD_TOOL_OPT_VP (RAD_TOOL_OPT_VP_RESOLUTION | RAD_TOOL_OPT_VP_MAX_PATCHES | RAD_TOOL_OPT_FACE_POINTS)
 #define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
                                RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
 #define RAD_TOOL_OPT_TEMPORAL (RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_K | RAD_TOOL_OPT_W | RAD_TOOL_OPT_ADAPTIVE)
