@@ -247,7 +247,10 @@
        0.1.0  scene input and validation, patches, built-in BVH (4-wide, SSE), Embree
               backend, form factors (analytic, Monte Carlo, point-to-point; dense, sparse,
               row ranges), Jacobi, Gauss-Seidel, progressive refinement, LU; direct light;
-              built-in Cornell box; baked-data container.
+              built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
+              compression and reordering; temporal radiosity with alias tables; local
+              matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
+              models and microfacet BRDFs; embedded GLSL kernels for every run-time step.
        The full history is in CHANGELOG.md.
 */
 
