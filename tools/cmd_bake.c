@@ -17,16 +17,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void *xcalloc(size_t n, size_t size)
-{
-    void *p = calloc(n ? n : 1, size);
-    if (!p) {
-        fprintf(stderr, "rad: out of memory\n");
-        exit(1);
-    }
-    return p;
-}
-
 void rad_tool_classic_options_default(rad_tool_classic_options *o)
 {
     memset(o, 0, sizeof *o);
@@ -139,11 +129,11 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     fprintf(stderr, "rad %s: form factors %u x %u (%.1f MB) in %.2f s\n", cmd, n, n, 4.0 * n * (double)n / 1e6,
             rad_tool_seconds() - t0);
 
-    out->D = (float *)xcalloc(3 * (size_t)n, sizeof(float));
-    out->E = (float *)xcalloc(3 * (size_t)n, sizeof(float));
-    out->L = (float *)xcalloc(3 * (size_t)n, sizeof(float));
-    out->B = (float *)xcalloc(3 * (size_t)n, sizeof(float));
-    out->H = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    out->D = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    out->E = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    out->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    out->B = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    out->H = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     t0 = rad_tool_seconds();
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
@@ -226,7 +216,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
         return rad_tool_fail(cmd, "rad_container_open", r);
     }
     count = rad_container_section_count(ct);
-    secs = (rad_section *)xcalloc((size_t)count + 4, sizeof(rad_section));
+    secs = (rad_section *)rad_tool_calloc((size_t)count + 4, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
     memset(&info, 0, sizeof info);
     info.magic = 0x52414442u;
@@ -249,7 +239,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
         rad_tool_fail(cmd, "rad_container_size", r);
         goto done;
     }
-    dst = xcalloc(dst_size, 1);
+    dst = rad_tool_calloc(dst_size, 1);
     if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
         rad_tool_fail(cmd, "rad_container_write", r);
         goto done;

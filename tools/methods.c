@@ -21,16 +21,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void *xcalloc(size_t n, size_t size)
-{
-    void *p = calloc(n ? n : 1, size);
-    if (!p) {
-        fprintf(stderr, "rad: out of memory\n");
-        exit(1);
-    }
-    return p;
-}
-
 /* ---- options ------------------------------------------------------------------------------ */
 
 void rad_tool_method_options_default(rad_tool_method_options *mo)
@@ -427,9 +417,9 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     rad_tool_context(&ctx, NULL);
 
     /* row sums of F for the halo correction */
-    ones = (float *)xcalloc(3 * (size_t)n, sizeof(float));
-    rows3 = (float *)xcalloc(3 * (size_t)n, sizeof(float));
-    S = (float *)xcalloc(n, sizeof(float));
+    ones = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    rows3 = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    S = (float *)rad_tool_calloc(n, sizeof(float));
     for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
     if ((r = rad_matrix_multiply(&c.ff->matrix, ones, rows3, &ctx)) != RAD_SUCCESS) {
         what = "rad_matrix_multiply";
@@ -557,7 +547,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
         goto fail;
     }
     count = rad_container_section_count(ct);
-    secs = (rad_section *)xcalloc((size_t)count + 4 + 3 * 3 + RAD_MB_MAX_SECTIONS, sizeof(rad_section));
+    secs = (rad_section *)rad_tool_calloc((size_t)count + 4 + 3 * 3 + RAD_MB_MAX_SECTIONS, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
     memset(&info, 0, sizeof info);
     info.magic = 0x52414442u;
@@ -596,7 +586,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
         what = "rad_container_size";
         goto fail;
     }
-    dst = xcalloc(dst_size, 1);
+    dst = rad_tool_calloc(dst_size, 1);
     if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
         what = "rad_container_write";
         goto fail;
@@ -685,14 +675,14 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
                 bake_name, n);
         return 1;
     }
-    m = (rad_tool_indirect *)xcalloc(1, sizeof *m);
+    m = (rad_tool_indirect *)rad_tool_calloc(1, sizeof *m);
     m->cmd = cmd;
     m->method = mo->method;
     m->n = n;
     m->E = bake->E;
     m->albedo = bake->patches.albedo;
     m->S = (const float *)s->data;
-    m->L = (float *)xcalloc(3 * (size_t)n, sizeof(float));
+    m->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     rad_tool_context(&m->ctx, NULL);
     if (mo->method == RAD_TOOL_MULTIBOUNCE) {
         const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");

@@ -113,6 +113,16 @@ void rad_tool_set_threads(int threads)
 #endif
 }
 
+void *rad_tool_calloc(size_t n, size_t size)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p) {
+        fprintf(stderr, "rad: out of memory\n");
+        exit(1);
+    }
+    return p;
+}
+
 int rad_tool_fail(const char *cmd, const char *what, rad_result r)
 {
     rad_tool_progress_end();

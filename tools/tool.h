@@ -110,6 +110,8 @@ void rad_tool_context(rad_context *ctx, const char *label);
 void rad_tool_progress_end(void);
 /* "rad CMD: what failed: RAD_ERROR_...: ..." on stderr; returns 1 */
 int rad_tool_fail(const char *cmd, const char *what, rad_result r);
+/* calloc of n elements (at least one) that prints and exits on failure */
+void *rad_tool_calloc(size_t n, size_t size);
 /* option values: 0 on success, else prints "rad CMD: bad value ..." and returns 2 */
 int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out);
 int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
