@@ -10,10 +10,21 @@
    and the build times of F_mb and of each compression.
 
    Build: cc -O3 -march=native -fopenmp -I. bench/multibounce.c -lm   (make build/multibounce)
-   Run:   multibounce [--quick] [--append FILE.md]   (--quick: the 1.7k size only) */
+   Run:   multibounce [--quick] [--append FILE.md]   (--quick: the 1.7k size only)
+          multibounce --apply-only [--size TARGET] [--cache FILE] [--label TEXT] [--append FILE.md]
+            only the apply table: K Jacobi bounces (K = 3, 8) against the BC1 and 3xBC4 forms of
+            F_mb (default options: outliers 5%, reorder 3, tile 64), best of 31, with the share
+            of the outlier pass. --cache FILE keeps F, E, albedo and the four compressed
+            matrices between runs (built when FILE is missing: the O(N^3) steps run once), so
+            a second build of this program (e.g. -DRAD_BENCH_HEADER='"old.h"', an older
+            radiosity.h) times its apply on the same bytes. */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
+#ifdef RAD_BENCH_HEADER
+#include RAD_BENCH_HEADER
+#else
 #include "../radiosity.h"
+#endif
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -261,11 +272,187 @@ static int bench_size(uint32_t target)
     return 0;
 }
 
+/* ---- --apply-only: the apply table alone, with a cache of the O(N^3) results ---- */
+
+static const char *const g_apply_names[4] = { "bc1k3", "bc1k8", "bc4k3", "bc4k8" };
+
+static int apply_build(uint32_t target, const char *cache)
+{
+    rad_scene_desc desc;
+    rad_camera cam;
+    rad_scene *scene = NULL;
+    rad_patches *patches = NULL;
+    rad_bvh *bvh = NULL;
+    rad_form_factors *ff = NULL;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_raycaster rc;
+    rad_multibounce_blocks *bl[4] = { NULL, NULL, NULL, NULL };
+    rad_section sec[4 * RAD_MB_MAX_SECTIONS];
+    uint32_t n, cnt = 0, k, f, c;
+    size_t bytes;
+    void *buf;
+    FILE *fp;
+    double t0;
+    rad_cornell_box(&desc, &cam);
+    rad_patch_options_default(&po);
+    po.target_count = target;
+    rad_form_factor_options_default(&fo);
+    if (rad_scene_create(&desc, NULL, &scene) || rad_patches_create(scene, &po, NULL, &patches) || rad_bvh_create(scene, NULL, &bvh))
+        return 1;
+    rad_bvh_raycaster(bvh, &rc);
+    t0 = now();
+    if (rad_form_factors_dense(patches, &rc, &fo, NULL, &ff)) return 1;
+    n = patches->count;
+    fprintf(stderr, "N = %u: form factors %.1f s\n", n, now() - t0);
+    {
+        float *E = (float *)malloc(sizeof(float) * 3 * n);
+        if (!E) return 1;
+        rad_sources(patches, RAD_SOURCE_EMISSION, NULL, E);
+        fp = fopen(cache, "wb");
+        if (!fp) return 1;
+        fwrite(&n, sizeof(n), 1, fp);
+        fwrite(E, sizeof(float), 3 * (size_t)n, fp);
+        fwrite(patches->albedo, sizeof(float), 3 * (size_t)n, fp);
+        fwrite(ff->matrix.dense, sizeof(float), (size_t)n * n, fp);
+        free(E);
+    }
+    for (k = 0; k < 2; ++k) {
+        rad_multibounce_options o;
+        rad_multibounce *mb = NULL;
+        rad_multibounce_options_default(&o);
+        o.bounces = k ? 8u : 3u;
+        t0 = now();
+        if (rad_multibounce_create(&ff->matrix, patches->albedo, &o, NULL, &mb)) return 1;
+        fprintf(stderr, "F_mb K = %u: %.1f s\n", o.bounces, now() - t0);
+        for (f = 0; f < 2; ++f) {
+            rad_block_options bo;
+            rad_block_options_default(&bo);
+            bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+            t0 = now();
+            if (rad_multibounce_blocks_create(mb, &bo, NULL, &bl[2 * f + k], NULL)) return 1;
+            fprintf(stderr, "%s: %.1f s\n", g_apply_names[2 * f + k], now() - t0);
+            if (rad_multibounce_blocks_sections(bl[2 * f + k], g_apply_names[2 * f + k], sec + cnt, &c)) return 1;
+            cnt += c;
+        }
+        rad_multibounce_destroy(mb);
+    }
+    if (rad_container_size(sec, cnt, &bytes)) return 1;
+    buf = malloc(bytes);
+    if (!buf || rad_container_write(sec, cnt, buf, bytes)) return 1;
+    fwrite(&bytes, sizeof(bytes), 1, fp);
+    fwrite(buf, 1, bytes, fp);
+    fclose(fp);
+    free(buf);
+    for (k = 0; k < 4; ++k) rad_multibounce_blocks_destroy(bl[k]);
+    rad_form_factors_destroy(ff);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(patches);
+    rad_scene_destroy(scene);
+    return 0;
+}
+
+static int apply_only(uint32_t target, const char *cache, const char *label, int threads)
+{
+    FILE *fp;
+    uint32_t n, k, f;
+    float *E, *albedo, *Fd, *out, *ref;
+    size_t bytes, n3;
+    void *buf;
+    rad_container *ct = NULL;
+    rad_matrix F;
+    rad_system sys;
+    double t_jac[2];
+    char tmp[256];
+    if (!cache) {
+        snprintf(tmp, sizeof(tmp), "/tmp/rad_mb_apply_%u.bin", target);
+        cache = tmp;
+    }
+    fp = fopen(cache, "rb");
+    if (!fp) {
+        if (apply_build(target, cache)) { fprintf(stderr, "building the cache failed\n"); return 1; }
+        fp = fopen(cache, "rb");
+        if (!fp) return 1;
+    }
+    if (fread(&n, sizeof(n), 1, fp) != 1) return 1;
+    n3 = 3 * (size_t)n;
+    E = (float *)malloc(sizeof(float) * n3);
+    albedo = (float *)malloc(sizeof(float) * n3);
+    out = (float *)malloc(sizeof(float) * n3);
+    ref = (float *)malloc(sizeof(float) * n3);
+    Fd = (float *)malloc(sizeof(float) * (size_t)n * n);
+    if (!E || !albedo || !out || !ref || !Fd) return 1;
+    if (fread(E, sizeof(float), n3, fp) != n3 || fread(albedo, sizeof(float), n3, fp) != n3 ||
+        fread(Fd, sizeof(float), (size_t)n * n, fp) != (size_t)n * n || fread(&bytes, sizeof(bytes), 1, fp) != 1)
+        return 1;
+    buf = malloc(bytes);
+    if (!buf || fread(buf, 1, bytes, fp) != bytes) return 1;
+    fclose(fp);
+    if (rad_container_open(buf, bytes, NULL, &ct)) return 1;
+    memset(&F, 0, sizeof(F));
+    F.rows = F.cols = n;
+    F.storage = RAD_STORAGE_DENSE;
+    F.dense = Fd;
+    memset(&sys, 0, sizeof(sys));
+    sys.F = &F;
+    sys.albedo = albedo;
+    sys.E = E;
+    sys.n = n;
+    emit("\n%s, N = %u, %d thread%s (OMP_NUM_THREADS), best of %d; L error = max |dL| / max |L| against K Jacobi bounces:\n\n",
+         label ? label : "apply", n, threads, threads == 1 ? "" : "s", REPS);
+    emit("| form | K | bytes (MiB) | apply ms | of which outliers ms | K Jacobi ms | speed-up | L error |\n|---|---|---|---|---|---|---|---|\n");
+    for (k = 0; k < 2; ++k) {
+        run r;
+        memset(&r, 0, sizeof(r));
+        r.sys = &sys;
+        r.k = k ? 8u : 3u;
+        t_jac[k] = time_it(&r, E, out);
+    }
+    for (f = 0; f < 2; ++f)
+        for (k = 0; k < 2; ++k) {
+            rad_multibounce_blocks *b = NULL, nob;
+            rad_solve_options so;
+            run r;
+            double ta, to, e;
+            size_t blocks = (size_t)((n + 3) / 4) * ((n + 3) / 4) * 8 * (f ? 3 : 1), other;
+            if (rad_multibounce_blocks_load(ct, g_apply_names[2 * f + k], NULL, &b)) return 1;
+            rad_solve_options_default(&so);
+            so.bounces = k ? 8u : 3u;
+            rad_solve_jacobi(&sys, &so, ref, NULL, NULL);
+            memset(&r, 0, sizeof(r));
+            r.b = b;
+            ta = time_it(&r, E, out);
+            e = rel_err(out, ref, n3);
+            /* the same without the outliers: the difference is the outlier pass */
+            nob = *b;
+            nob.outlier_count = 0;
+            nob.outlier_offsets = NULL;
+            nob.outlier_columns = NULL;
+            nob.outlier_values = NULL;
+            r.b = &nob;
+            to = ta - time_it(&r, E, out);
+            other = (size_t)b->tiles_per_row * b->tiles_per_row * 12 + (b->row_perm ? 8 * (size_t)n : 0) +
+                    (b->outlier_count ? 8 * ((size_t)n + 1) + 16 * (size_t)b->outlier_count : 0);
+            emit("| %s | %u | %.1f | %.3f | %.3f | %.3f | %.2fx | %.1e |\n", f ? "3xBC4" : "BC1", so.bounces,
+                 (double)(blocks + other) / 1048576.0, ta, to, t_jac[k], t_jac[k] / ta, e);
+            rad_multibounce_blocks_destroy(b);
+        }
+    rad_container_close(ct);
+    free(buf); free(E); free(albedo); free(out); free(ref); free(Fd);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
-    int i, quick = 0, threads = 1;
+    int i, quick = 0, threads = 1, apply = 0;
+    uint32_t size = 1736;
+    const char *cache = NULL, *label = NULL;
     for (i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
+        else if (!strcmp(argv[i], "--apply-only")) apply = 1;
+        else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
+        else if (!strcmp(argv[i], "--label") && i + 1 < argc) label = argv[++i];
         else if (!strcmp(argv[i], "--append") && i + 1 < argc) {
             g_md = fopen(argv[++i], "a");
             if (!g_md) { fprintf(stderr, "cannot open %s\n", argv[i]); return 1; }
@@ -274,6 +461,11 @@ int main(int argc, char **argv)
 #ifdef _OPENMP
     threads = omp_get_max_threads();
 #endif
+    if (apply) {
+        int r = apply_only(size, cache, label, threads);
+        if (g_md) fclose(g_md);
+        return r;
+    }
     emit("\n## Multi-bounce matrix and block compression (SPEC §4)\n\nCPU, %d threads; Jacobi = rad_solve_jacobi (dense F, one pass per bounce).\n", threads);
     if (bench_size(1736)) return 1;
     if (!quick && bench_size(5485)) return 1;
