@@ -1532,13 +1532,18 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
 RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
 
 /* out = F~ E (or E + F~ E) with F~ the compressed matrix: E is permuted on input, blocks are
-   decoded on the fly block row by block row (never the whole matrix), the outliers added
-   exactly and the result un-permuted on output. Every decoded entry equals the value of
-   rad_bc1_decode_block / rad_bc4_decode_block times its scale to the bit, on the scalar path
+   used on the fly block row by block row (never the whole matrix), the outliers added
+   exactly and the result un-permuted on output. Every entry used equals the value of
+   rad_bc1_decode_block / rad_bc4_decode_block times its scale, on the scalar path
    (RAD_NO_SIMD) and the AVX2 one (branch-free palettes, divisions by FMA-corrected
-   reciprocals) alike; only the order of the sums differs. Parallel over block rows. Thread
-   safety: reentrant. Cost: O(N^2) decode work (on the CPU about as many multiply-adds as a
-   dense float apply, plus the palettes: decode-bound), bytes_total bytes read. SPEC §4. */
+   reciprocals) alike; only the order of the float sums differs. 3xBC4 decodes each texel;
+   BC1 is a lookup-table product: per block column and row byte (4 texels' indices) the sums
+   of E over the texels of each index, built once per apply (12 KiB per block column), then
+   per block row and channel one palette-times-table multiply-add per 4 texels. Parallel over
+   block rows (BC1: and over block columns for the tables). Thread safety: reentrant. Cost:
+   O(N^2) work (on the CPU about as many multiply-adds as a dense float apply, plus the
+   palettes: compute-bound, see BENCHMARKS.md), bytes_total bytes read; BC1 also writes and
+   reads 3072 N bytes of tables (scratch memory). SPEC §4. */
 RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
                                                 rad_output output, const rad_context *ctx);
 /* The decoded matrix in the original order (3 N^2 floats: R, G, B planes) with outliers, for
@@ -9193,7 +9198,8 @@ typedef struct rad__mb_bapply {
     const float *xp;     /* 3 * padded, SoA, permuted columns */
     const float *xe;     /* 3 * bpr * 16: x expanded for the two-column SIMD lanes (BC4) */
     float *y;            /* 3 * padded, SoA, permuted rows */
-    float *lut;          /* BC1: per block column 256 x 16 partial sums (see rad__mb_lut_task) */
+    float *lut;          /* BC1: the tables of block columns c0..c1-1, 256 x 12 partial sums each */
+    uint32_t c0, c1;     /* BC1: the column tile of this pass */
     const float *e4;     /* outliers: E in the original order, 4 floats (R, G, B, 0) per patch */
     uint32_t padded, tasks;
     const uint32_t *tile_col; /* per block column: its tile column */
@@ -9331,23 +9337,24 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    palette is): 12 multiply-adds for 12 texel-channels and no per-texel index shuffles. The
    tile scale multiplies a row's sum over the blocks of one scale tile once. The result
    equals decode-then-multiply up to the order of the float sums. Block columns are walked in
-   tiles of RAD__MB_LUT_TILE so that their tables (12 KiB each) stay in L2 while the task's
-   block rows pass over them. Measured (BENCHMARKS.md): about 10% faster than decoding each
+   tiles of RAD__MB_LUT_TILE: two parallel passes per tile, its tables (12 KiB per column),
+   then every block row over them while they are in cache (all tables first was 1.5x slower
+   at N = 5696: 17 MB of tables written and read back through DRAM, more than the 15 MB of
+   blocks; tables per task repeat the work in every task, 64 by default). Measured (BENCHMARKS.md): about 10% faster than decoding each
    texel at N = 1850; 16-float entries (one cache line each) and palettes from tables over
    the endpoint codes were both slower (L2 traffic). */
 #define RAD__MB_LUT_TILE 32u
 #define RAD__MB_LUT_ENTRY 12u
 #define RAD__MB_LUT_STRIDE 3072u /* floats per block column: 256 entries of 12 */
 
-static void rad__mb_lut_task(void *data, uint32_t t)
+/* the tables of block columns bx0..bx1-1 into lut (RAD__MB_LUT_STRIDE floats per column) */
+static void rad__mb_lut_build(const rad__mb_bapply *a, uint32_t bx0, uint32_t bx1, float *lut)
 {
-    const rad__mb_bapply *a = (const rad__mb_bapply *)data;
-    uint32_t bpr = a->b->blocks_per_row, bx0 = (uint32_t)((uint64_t)bpr * t / a->tasks), bx1 = (uint32_t)((uint64_t)bpr * (t + 1) / a->tasks);
     uint32_t bx, v, ch, j;
     for (bx = bx0; bx < bx1; ++bx) {
         /* lo[n]: texels 0 and 1 with the codes of nibble n; hi[n]: texels 2 and 3 */
         float lo[16][12], hi[16][12];
-        float *T = a->lut + RAD__MB_LUT_STRIDE * (size_t)bx;
+        float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - bx0);
         memset(lo, 0, sizeof(lo));
         memset(hi, 0, sizeof(hi));
         for (v = 0; v < 16; ++v)
@@ -9361,6 +9368,13 @@ static void rad__mb_lut_task(void *data, uint32_t t)
         for (v = 0; v < 256; ++v)
             for (j = 0; j < RAD__MB_LUT_ENTRY; ++j) T[RAD__MB_LUT_ENTRY * v + j] = lo[v & 15u][j] + hi[v >> 4][j];
     }
+}
+
+static void rad__mb_lut_task(void *data, uint32_t t)
+{
+    const rad__mb_bapply *a = (const rad__mb_bapply *)data;
+    uint32_t w = a->c1 - a->c0, bx0 = a->c0 + w * t / a->tasks, bx1 = a->c0 + w * (t + 1) / a->tasks;
+    rad__mb_lut_build(a, bx0, bx1, a->lut + RAD__MB_LUT_STRIDE * (size_t)(bx0 - a->c0));
 }
 
 static void rad__mb_bc1_task(void *data, uint32_t t)
@@ -9393,8 +9407,10 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
         rcp_b[s] = _mm_div_ps(_mm_set1_ps(1.0f), den_b[s]);
     }
 #endif
-    for (c0 = 0; c0 < bpr; c0 += RAD__MB_LUT_TILE) {
-        c1 = bpr - c0 < RAD__MB_LUT_TILE ? bpr : c0 + RAD__MB_LUT_TILE;
+    const float *lut = a->lut;
+    c0 = a->c0;
+    c1 = a->c1;
+    {
         for (by = by0; by < by1; ++by) {
             const uint8_t *row = b->blocks + 8 * (size_t)by * bpr;
             for (s = c0; s < c1; s = e) {
@@ -9409,7 +9425,7 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
                     __m256 h;
                     for (bx = s; bx < e; ++bx) {
                         const uint8_t *blk = row + 8 * (size_t)bx;
-                        const float *T = a->lut + RAD__MB_LUT_STRIDE * (size_t)bx;
+                        const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0);
                         uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
                         uint32_t md = k0 > k1;
                         long long pair = (long long)((uint64_t)k1 << 32 | k0);
@@ -9450,7 +9466,7 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
                     memset(acc, 0, sizeof(acc));
                     for (bx = s; bx < e; ++bx) {
                         const uint8_t *blk = row + 8 * (size_t)bx;
-                        const float *T = a->lut + RAD__MB_LUT_STRIDE * (size_t)bx;
+                        const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0);
                         uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
                         float p[4][3];
                         rad__bc1_palette(k0, k1, p);
@@ -9517,7 +9533,7 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     rad__mb_bapply a;
     float *scratch, *xe, *e4;
     uint32_t *tile_col, n, padded, bpr, bx, ch, h, l;
-    size_t i, lut = 0;
+    size_t i, lut = 0, tabs;
     int bc1;
     rad__ctx_init(&c, ctx);
     if (rad__mb_blocks_check(b) != RAD_SUCCESS || !E || !out || E == out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -9525,16 +9541,18 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     bpr = b->blocks_per_row;
     padded = 4u * bpr;
     bc1 = b->format == RAD_BLOCK_BC1;
-    /* xp, y (3 padded each), xe (BC4: 12 padded) or the tables (BC1: RAD__MB_LUT_STRIDE / 4
-       per texel column, 772 padded), e4 (4 n) */
-    if (!rad__mul3((size_t)padded, bc1 ? 6u + RAD__MB_LUT_STRIDE / 4u : 18u, sizeof(float), &i) || !rad__mul3((size_t)n, 4u, sizeof(float), &lut) ||
-        i > (size_t)-1 - lut)
+    /* xp, y (3 padded each), xe (BC4: 12 padded) or the tables (BC1: one column tile per
+       task), e4 (4 n) */
+    tabs = bc1 ? (size_t)RAD__MB_LUT_TILE * RAD__MB_LUT_STRIDE : 12 * (size_t)padded;
+    if (!rad__mul3((size_t)padded, 6u, sizeof(float), &i) || !rad__mul3((size_t)n, 4u, sizeof(float), &lut) ||
+        tabs > ((size_t)-1 - i - lut) / sizeof(float))
         return RAD_ERROR_SIZE_OVERFLOW;
+    i += tabs * sizeof(float);
     scratch = (float *)rad__alloc(&c.allocator, i + lut);
     if (!scratch) return RAD_ERROR_OUT_OF_MEMORY;
     rad__mb_gather(E, b->col_perm, n, padded, scratch);
     xe = scratch + 6 * (size_t)padded;
-    e4 = xe + (bc1 ? RAD__MB_LUT_STRIDE / 4u : 12u) * (size_t)padded;
+    e4 = xe + tabs;
     for (i = 0; i < n; ++i) {
         e4[4 * i] = E[3 * i];
         e4[4 * i + 1] = E[3 * i + 1];
@@ -9560,12 +9578,18 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     a.padded = padded;
     a.E = E;
     a.out = out;
-    a.tasks = c.tasks < bpr ? c.tasks : bpr;
     if (bc1) {
+        /* per column tile: its tables (parallel over columns), then all block rows over them */
         memset(a.y, 0, 3 * (size_t)padded * sizeof(float));
-        c.parallel_for(c.parallel_user, a.tasks, rad__mb_lut_task, &a);
-        c.parallel_for(c.parallel_user, a.tasks, rad__mb_bc1_task, &a);
+        for (a.c0 = 0; a.c0 < bpr; a.c0 = a.c1) {
+            a.c1 = bpr - a.c0 < RAD__MB_LUT_TILE ? bpr : a.c0 + RAD__MB_LUT_TILE;
+            a.tasks = c.tasks < a.c1 - a.c0 ? c.tasks : a.c1 - a.c0;
+            c.parallel_for(c.parallel_user, a.tasks, rad__mb_lut_task, &a);
+            a.tasks = c.tasks < bpr ? c.tasks : bpr;
+            c.parallel_for(c.parallel_user, a.tasks, rad__mb_bc1_task, &a);
+        }
     } else {
+        a.tasks = c.tasks < bpr ? c.tasks : bpr;
         c.parallel_for(c.parallel_user, a.tasks, rad__mb_bapply_task, &a);
     }
     rad__mb_scatter(a.y, padded, b->row_perm, n, out);
