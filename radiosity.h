@@ -9337,13 +9337,14 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    palette is): 12 multiply-adds for 12 texel-channels and no per-texel index shuffles. The
    tile scale multiplies a row's sum over the blocks of one scale tile once. The result
    equals decode-then-multiply up to the order of the float sums. Block columns are walked in
-   tiles of RAD__MB_LUT_TILE: two parallel passes per tile, its tables (12 KiB per column),
+   tiles of RAD__MB_LUT_TILE (768 KiB of tables: L2 is 1 MiB here; 64 was 5-10% faster than 32
+   at N = 5696, the same at 1850): two parallel passes per tile, its tables (12 KiB per column),
    then every block row over them while they are in cache (all tables first was 1.5x slower
    at N = 5696: 17 MB of tables written and read back through DRAM, more than the 15 MB of
    blocks; tables per task repeat the work in every task, 64 by default). Measured (BENCHMARKS.md): about 10% faster than decoding each
    texel at N = 1850; 16-float entries (one cache line each) and palettes from tables over
    the endpoint codes were both slower (L2 traffic). */
-#define RAD__MB_LUT_TILE 32u
+#define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_ENTRY 12u
 #define RAD__MB_LUT_STRIDE 3072u /* floats per block column: 256 entries of 12 */
 
