@@ -9199,7 +9199,7 @@ typedef struct rad__mb_bapply {
     const float *xe;     /* 3 * bpr * 16: x expanded for the two-column SIMD lanes (BC4) */
     float *y;            /* 3 * padded, SoA, permuted rows */
     float *lut;          /* BC1: the tables of block columns c0..c1-1, 256 x 12 partial sums each */
-    uint32_t c0, c1;     /* BC1: the column tile of this pass */
+    uint32_t c0, c1;     /* BC1: the block columns of this pass */
     const float *e4;     /* outliers: E in the original order, 4 floats (R, G, B, 0) per patch */
     uint32_t padded, tasks;
     const uint32_t *tile_col; /* per block column: its tile column */
@@ -9336,15 +9336,18 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    palette (the specification's exact values, unscaled, computed as rad__mb_bapply_task's BC4
    palette is): 12 multiply-adds for 12 texel-channels and no per-texel index shuffles. The
    tile scale multiplies a row's sum over the blocks of one scale tile once. The result
-   equals decode-then-multiply up to the order of the float sums. Block columns are walked in
-   tiles of RAD__MB_LUT_TILE (768 KiB of tables: L2 is 1 MiB here; 64 was 5-10% faster than 32
-   at N = 5696, the same at 1850): two parallel passes per tile, its tables (12 KiB per column),
-   then every block row over them while they are in cache (all tables first was 1.5x slower
-   at N = 5696: 17 MB of tables written and read back through DRAM, more than the 15 MB of
-   blocks; tables per task repeat the work in every task, 64 by default). Measured (BENCHMARKS.md): about 10% faster than decoding each
-   texel at N = 1850; 16-float entries (one cache line each) and palettes from tables over
-   the endpoint codes were both slower (L2 traffic). */
+   equals decode-then-multiply up to the order of the float sums. Block columns go in passes
+   of RAD__MB_LUT_PASS (2.25 MiB of tables, in L3): per pass two parallel loops, the pass's
+   tables (parallel over columns), then every block row over them, in tiles of
+   RAD__MB_LUT_TILE columns (768 KiB of tables: L2 is 1 MiB here) so that a tile's tables
+   stay in L2 while the task's block rows pass over them. Measured at N = 5696 (BENCHMARKS.md):
+   all tables first was 1.5x slower (17 MB of tables written and read back through DRAM, more
+   than the 15 MB of blocks); one pass per 64-column tile cost 15% with 2 threads at
+   N = 1850 (more fork-joins); tables per task repeat the work in every task (64 by
+   default); 16-float entries (one cache line each) and palettes looked up in tables over
+   the endpoint codes were both slower. */
 #define RAD__MB_LUT_TILE 64u
+#define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
 #define RAD__MB_LUT_STRIDE 3072u /* floats per block column: 256 entries of 12 */
 
@@ -9408,10 +9411,9 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
         rcp_b[s] = _mm_div_ps(_mm_set1_ps(1.0f), den_b[s]);
     }
 #endif
-    const float *lut = a->lut;
-    c0 = a->c0;
-    c1 = a->c1;
-    {
+    for (c0 = a->c0; c0 < a->c1; c0 = c1) {
+        const float *lut = a->lut + RAD__MB_LUT_STRIDE * (size_t)(c0 - a->c0);
+        c1 = a->c1 - c0 < RAD__MB_LUT_TILE ? a->c1 : c0 + RAD__MB_LUT_TILE;
         for (by = by0; by < by1; ++by) {
             const uint8_t *row = b->blocks + 8 * (size_t)by * bpr;
             for (s = c0; s < c1; s = e) {
@@ -9544,7 +9546,7 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     bc1 = b->format == RAD_BLOCK_BC1;
     /* xp, y (3 padded each), xe (BC4: 12 padded) or the tables (BC1: one column tile per
        task), e4 (4 n) */
-    tabs = bc1 ? (size_t)RAD__MB_LUT_TILE * RAD__MB_LUT_STRIDE : 12 * (size_t)padded;
+    tabs = bc1 ? (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE : 12 * (size_t)padded;
     if (!rad__mul3((size_t)padded, 6u, sizeof(float), &i) || !rad__mul3((size_t)n, 4u, sizeof(float), &lut) ||
         tabs > ((size_t)-1 - i - lut) / sizeof(float))
         return RAD_ERROR_SIZE_OVERFLOW;
@@ -9583,7 +9585,7 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
         /* per column tile: its tables (parallel over columns), then all block rows over them */
         memset(a.y, 0, 3 * (size_t)padded * sizeof(float));
         for (a.c0 = 0; a.c0 < bpr; a.c0 = a.c1) {
-            a.c1 = bpr - a.c0 < RAD__MB_LUT_TILE ? bpr : a.c0 + RAD__MB_LUT_TILE;
+            a.c1 = bpr - a.c0 < RAD__MB_LUT_PASS ? bpr : a.c0 + RAD__MB_LUT_PASS;
             a.tasks = c.tasks < a.c1 - a.c0 ? c.tasks : a.c1 - a.c0;
             c.parallel_for(c.parallel_user, a.tasks, rad__mb_lut_task, &a);
             a.tasks = c.tasks < bpr ? c.tasks : bpr;
