@@ -9200,6 +9200,8 @@ typedef struct rad__mb_bapply {
     float *y;            /* 3 * padded, SoA, permuted rows */
     float *lut;          /* BC1: the tables of block columns c0..c1-1, 256 x 12 partial sums each */
     uint32_t c0, c1;     /* BC1: the block columns of this pass */
+    float *y2;           /* BC1: per block row 12 sums (R, G, B x 4 rows), task t's rows shifted
+                            by 16 t floats so that no two tasks write one cache line */
     const float *e4;     /* outliers: E in the original order, 4 floats (R, G, B, 0) per patch */
     uint32_t padded, tasks;
     const uint32_t *tile_col; /* per block column: its tile column */
@@ -9418,7 +9420,7 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
             const uint8_t *row = b->blocks + 8 * (size_t)by * bpr;
             for (s = c0; s < c1; s = e) {
                 const float *scale = b->scales + 3 * (size_t)rad__mb_tile_index(b, s, by);
-                float *yo = a->y + 4 * (size_t)by;
+                float *yo = a->y2 + 16 * (size_t)t + 12 * (size_t)by;
                 e = (s / tb + 1u) * tb;
                 if (e > c1) e = c1;
 #if defined(RAD__MB_AVX2)
@@ -9454,10 +9456,8 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
                     h = _mm256_hadd_ps(_mm256_hadd_ps(r0, r1), _mm256_hadd_ps(r2, r3));
                     sum = _mm_hadd_ps(_mm_hadd_ps(q0, q1), _mm_hadd_ps(q2, q3));
                     _mm_storeu_ps(yo, _mm_add_ps(_mm_loadu_ps(yo), _mm_mul_ps(_mm256_castps256_ps128(h), _mm_set1_ps(scale[0]))));
-                    yo += a->padded;
-                    _mm_storeu_ps(yo, _mm_add_ps(_mm_loadu_ps(yo), _mm_mul_ps(_mm256_extractf128_ps(h, 1), _mm_set1_ps(scale[1]))));
-                    yo += a->padded;
-                    _mm_storeu_ps(yo, _mm_add_ps(_mm_loadu_ps(yo), _mm_mul_ps(sum, _mm_set1_ps(scale[2]))));
+                    _mm_storeu_ps(yo + 4, _mm_add_ps(_mm_loadu_ps(yo + 4), _mm_mul_ps(_mm256_extractf128_ps(h, 1), _mm_set1_ps(scale[1]))));
+                    _mm_storeu_ps(yo + 8, _mm_add_ps(_mm_loadu_ps(yo + 8), _mm_mul_ps(sum, _mm_set1_ps(scale[2]))));
                     (void)ch;
                     (void)y;
                 }
@@ -9480,7 +9480,7 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
                     }
                     for (ch = 0; ch < 3; ++ch)
                         for (y = 0; y < 4; ++y)
-                            yo[(size_t)ch * a->padded + y] +=
+                            yo[4 * ch + y] +=
                                 ((acc[y][4 * ch] + acc[y][4 * ch + 1]) + (acc[y][4 * ch + 2] + acc[y][4 * ch + 3])) * scale[ch];
                 }
 #endif
@@ -9546,7 +9546,9 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     bc1 = b->format == RAD_BLOCK_BC1;
     /* xp, y (3 padded each), xe (BC4: 12 padded) or the tables (BC1: one column tile per
        task), e4 (4 n) */
-    tabs = bc1 ? (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE : 12 * (size_t)padded;
+    a.tasks = c.tasks < bpr ? c.tasks : bpr;
+    tabs = bc1 ? (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE + 12 * (size_t)bpr + 16 * (size_t)a.tasks
+               : 12 * (size_t)padded;
     if (!rad__mul3((size_t)padded, 6u, sizeof(float), &i) || !rad__mul3((size_t)n, 4u, sizeof(float), &lut) ||
         tabs > ((size_t)-1 - i - lut) / sizeof(float))
         return RAD_ERROR_SIZE_OVERFLOW;
@@ -9582,15 +9584,21 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     a.E = E;
     a.out = out;
     if (bc1) {
-        /* per column tile: its tables (parallel over columns), then all block rows over them */
-        memset(a.y, 0, 3 * (size_t)padded * sizeof(float));
+        /* per pass: its tables (parallel over columns), then all block rows over them */
+        uint32_t t, tasks = a.tasks, by, y;
+        a.y2 = xe + (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE;
+        memset(a.y2, 0, (12 * (size_t)bpr + 16 * (size_t)tasks) * sizeof(float));
         for (a.c0 = 0; a.c0 < bpr; a.c0 = a.c1) {
             a.c1 = bpr - a.c0 < RAD__MB_LUT_PASS ? bpr : a.c0 + RAD__MB_LUT_PASS;
             a.tasks = c.tasks < a.c1 - a.c0 ? c.tasks : a.c1 - a.c0;
             c.parallel_for(c.parallel_user, a.tasks, rad__mb_lut_task, &a);
-            a.tasks = c.tasks < bpr ? c.tasks : bpr;
+            a.tasks = tasks;
             c.parallel_for(c.parallel_user, a.tasks, rad__mb_bc1_task, &a);
         }
+        for (t = 0; t < tasks; ++t)
+            for (by = (uint32_t)((uint64_t)bpr * t / tasks); by < (uint32_t)((uint64_t)bpr * (t + 1) / tasks); ++by)
+                for (ch = 0; ch < 3; ++ch)
+                    for (y = 0; y < 4; ++y) a.y[(size_t)ch * padded + 4 * by + y] = a.y2[16 * (size_t)t + 12 * (size_t)by + 4 * ch + y];
     } else {
         a.tasks = c.tasks < bpr ? c.tasks : bpr;
         c.parallel_for(c.parallel_user, a.tasks, rad__mb_bapply_task, &a);
