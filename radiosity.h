@@ -9202,7 +9202,6 @@ typedef struct rad__mb_bapply {
     uint32_t c0, c1;     /* BC1: the block columns of this pass */
     float *y2;           /* BC1: per block row 12 sums (R, G, B x 4 rows), task t's rows shifted
                             by 16 t floats so that no two tasks write one cache line */
-    const float *e4;     /* outliers: E in the original order, 4 floats (R, G, B, 0) per patch */
     uint32_t padded, tasks;
     const uint32_t *tile_col; /* per block column: its tile column */
     const float *E;      /* outliers: original order */
@@ -9335,19 +9334,19 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    M_k(byte) the sum of the block column's four E values whose index is k. So per apply, per
    block column, a table of M_0..M_3 for the 256 bytes (12 floats per byte: R M_0..M_3,
    G M_0..M_3, B M_0..M_3), and a block row costs one table entry per row times the block's
-   palette (the specification's exact values, unscaled, computed as rad__mb_bapply_task's BC4
-   palette is): 12 multiply-adds for 12 texel-channels and no per-texel index shuffles. The
-   tile scale multiplies a row's sum over the blocks of one scale tile once. The result
-   equals decode-then-multiply up to the order of the float sums. Block columns go in passes
-   of RAD__MB_LUT_PASS (2.25 MiB of tables, in L3): per pass two parallel loops, the pass's
-   tables (parallel over columns), then every block row over them, in tiles of
-   RAD__MB_LUT_TILE columns (768 KiB of tables: L2 is 1 MiB here) so that a tile's tables
-   stay in L2 while the task's block rows pass over them. Measured at N = 5696 (BENCHMARKS.md):
-   all tables first was 1.5x slower (17 MB of tables written and read back through DRAM, more
-   than the 15 MB of blocks); one pass per 64-column tile cost 15% with 2 threads at
-   N = 1850 (more fork-joins); tables per task repeat the work in every task (64 by
-   default); 16-float entries (one cache line each) and palettes looked up in tables over
-   the endpoint codes were both slower. */
+   palette (the specification's exact values, unscaled: integer numerator over integer
+   denominator, one correctly rounded division): 12 multiply-adds for 12 texel-channels and
+   no per-texel index shuffles. The tile scale multiplies a row's sum over the blocks of one
+   scale tile once. The result equals decode-then-multiply up to the order of the float sums.
+   Block columns go in passes of RAD__MB_LUT_PASS (2.25 MiB of tables, kept in L3): per pass
+   two parallel loops, the pass's tables (parallel over columns), then every block row over
+   them, in tiles of RAD__MB_LUT_TILE columns (768 KiB of tables; L2 is 1 MiB here) so that a
+   tile's tables stay in L2 while a task's block rows pass over them. Measured
+   (BENCHMARKS.md): 1.08x (N = 1850) and 1.13x (N = 5696) faster than decoding every texel
+   on one thread. Slower alternatives measured: all tables first (1.5x slower at N = 5696:
+   17 MB of tables written and read back through DRAM, more than the 15 MB of blocks), tables
+   per task (the work repeats in every task, 64 by default), 16-float entries (one cache line
+   each), palettes looked up in tables over the endpoint codes (L2 traffic). */
 #define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
@@ -9495,22 +9494,10 @@ static void rad__mb_outlier_task(void *data, uint32_t t)
     const rad_multibounce_blocks *b = a->b;
     uint32_t i0 = (uint32_t)((uint64_t)b->n * t / a->tasks), i1 = (uint32_t)((uint64_t)b->n * (t + 1) / a->tasks), i;
     for (i = i0; i < i1; ++i) {
-        uint64_t k = b->outlier_offsets[i], k1 = b->outlier_offsets[i + 1];
+        uint64_t k;
         float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-#if defined(RAD__MB_AVX2)
-        /* one 4-lane multiply-add per outlier: its RGB (and the next one's R, times the 0 of e4) */
-        uint64_t kv = k1 < b->outlier_count ? k1 : k1 - (k1 > k);
-        __m128 acc = _mm_setzero_ps();
-        float lanes[4];
-        for (; k < kv; ++k)
-            acc = RAD__MB_MADD4(_mm_loadu_ps(b->outlier_values + 3 * k), _mm_loadu_ps(a->e4 + 4 * (size_t)b->outlier_columns[k]), acc);
-        _mm_storeu_ps(lanes, acc);
-        s0 = lanes[0];
-        s1 = lanes[1];
-        s2 = lanes[2];
-#endif
-        for (; k < k1; ++k) {
-            const float *v = b->outlier_values + 3 * k, *e = a->e4 + 4 * (size_t)b->outlier_columns[k];
+        for (k = b->outlier_offsets[i]; k < b->outlier_offsets[i + 1]; ++k) {
+            const float *v = b->outlier_values + 3 * k, *e = a->E + 3 * (size_t)b->outlier_columns[k];
             s0 += v[0] * e[0];
             s1 += v[1] * e[1];
             s2 += v[2] * e[2];
@@ -9534,9 +9521,9 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
 {
     rad__ctx c;
     rad__mb_bapply a;
-    float *scratch, *xe, *e4;
+    float *scratch, *xe;
     uint32_t *tile_col, n, padded, bpr, bx, ch, h, l;
-    size_t i, lut = 0, tabs;
+    size_t i, tabs;
     int bc1;
     rad__ctx_init(&c, ctx);
     if (rad__mb_blocks_check(b) != RAD_SUCCESS || !E || !out || E == out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -9544,26 +9531,16 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     bpr = b->blocks_per_row;
     padded = 4u * bpr;
     bc1 = b->format == RAD_BLOCK_BC1;
-    /* xp, y (3 padded each), xe (BC4: 12 padded) or the tables (BC1: one column tile per
-       task), e4 (4 n) */
+    /* xp, y (3 padded each), then xe (BC4: 12 padded) or the tables of one pass and y2 (BC1) */
     a.tasks = c.tasks < bpr ? c.tasks : bpr;
     tabs = bc1 ? (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE + 12 * (size_t)bpr + 16 * (size_t)a.tasks
                : 12 * (size_t)padded;
-    if (!rad__mul3((size_t)padded, 6u, sizeof(float), &i) || !rad__mul3((size_t)n, 4u, sizeof(float), &lut) ||
-        tabs > ((size_t)-1 - i - lut) / sizeof(float))
+    if (!rad__mul3((size_t)padded, 6u, sizeof(float), &i) || tabs > ((size_t)-1 - i) / sizeof(float))
         return RAD_ERROR_SIZE_OVERFLOW;
-    i += tabs * sizeof(float);
-    scratch = (float *)rad__alloc(&c.allocator, i + lut);
+    scratch = (float *)rad__alloc(&c.allocator, i + tabs * sizeof(float));
     if (!scratch) return RAD_ERROR_OUT_OF_MEMORY;
     rad__mb_gather(E, b->col_perm, n, padded, scratch);
     xe = scratch + 6 * (size_t)padded;
-    e4 = xe + tabs;
-    for (i = 0; i < n; ++i) {
-        e4[4 * i] = E[3 * i];
-        e4[4 * i + 1] = E[3 * i + 1];
-        e4[4 * i + 2] = E[3 * i + 2];
-        e4[4 * i + 3] = 0.0f;
-    }
     if (!bc1)
         for (ch = 0; ch < 3; ++ch)
             for (bx = 0; bx < bpr; ++bx)
@@ -9578,7 +9555,6 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     a.xp = scratch;
     a.xe = xe;
     a.lut = xe;
-    a.e4 = e4;
     a.y = scratch + 3 * (size_t)padded;
     a.padded = padded;
     a.E = E;
