@@ -1476,9 +1476,11 @@ typedef struct rad_block_options {
                                   0 disables the step (default 0.05) */
     int reorder;               /* row and column reordering: RAD_REORDER_NONE (0),
                                   RAD_REORDER_GREEDY (1, thesis Listing 3.1),
-                                  RAD_REORDER_GREEDY_2OPT (2) or RAD_REORDER_GROUPS (3, the
-                                  default: 12-30% lower MSE than GREEDY on the Cornell F_mb
-                                  with 1-5% outliers, see BENCHMARKS.md) */
+                                  RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: 12-30%
+                                  lower MSE than GREEDY on the Cornell F_mb with 1-5%
+                                  outliers) or RAD_REORDER_MATCH (4, the default: a further
+                                  3% (BC1) / 6% (3xBC4) lower than GROUPS at N = 1850 for
+                                  the same build time; see BENCHMARKS.md) */
     uint32_t reorder_samples;  /* 0: L2 distances over all coordinates (the literal algorithm,
                                   through a Gram matrix); else over this many evenly spaced
                                   coordinates (faster, a little worse; default 0) */
@@ -1527,7 +1529,9 @@ RAD_API void rad_block_options_default(rad_block_options *options);
    (optional) says what each step did and the decoded-matrix error. Errors: INVALID_ARGUMENT,
    OUT_OF_MEMORY, SIZE_OVERFLOW, CANCELLED. Thread safety: reentrant. Cost: O(N^2 log N) for
    the outliers, O(N^3) for exact reordering (two Gram matrices) or O(N^2 samples), plus
-   O(N^2) per 2-opt / group-swap pass (at most 64 / 16 passes), O(N^2) encoding. SPEC §4. */
+   O(N^2) per 2-opt / group-swap pass (at most 64 passes each) or per matching round (a few),
+   O(N^2) encoding; 16 N^2 bytes of scratch while reordering. Deterministic: the same bytes
+   whatever the number of threads. SPEC §4. */
 RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
                                                  const rad_context *ctx, rad_multibounce_blocks **out,
                                                  rad_block_report *report);
@@ -7910,7 +7914,7 @@ RAD_API void rad_block_options_default(rad_block_options *o)
     memset(o, 0, sizeof(*o));
     o->format = RAD_BLOCK_BC4X3;
     o->outlier_fraction = 0.05f;
-    o->reorder = RAD_REORDER_GROUPS;
+    o->reorder = RAD_REORDER_MATCH;
     o->reorder_samples = 0;
     o->tile = 64;
 }

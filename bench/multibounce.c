@@ -10,7 +10,8 @@
    and the build times of F_mb and of each compression.
 
    Build: cc -O3 -march=native -fopenmp -I. bench/multibounce.c -lm   (make build/multibounce)
-   Run:   multibounce [--quick] [--append FILE.md]   (--quick: the 1.7k size only) */
+   Run:   multibounce [--quick] [--reorder-only] [--append FILE.md]   (--quick: the 1.7k size only;
+          --reorder-only: only the table of reordering methods, MSE and build time, no apply timings) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
@@ -88,7 +89,7 @@ static int scrambled(const rad_multibounce *mb, double t_jac, size_t bytes_f)
     emit("order has no spatial coherence), tile 64:\n\n| form | reorder | MSE | MSE ratio |\n|---|---|---|---|\n");
     for (f = 0; f < 2; ++f) {
         double plain = 0.0;
-        for (ro = 0; ro <= RAD_REORDER_GROUPS; ++ro) {
+        for (ro = 0; ro <= RAD_REORDER_MATCH; ++ro) {
             rad_block_options bo;
             rad_block_report rep;
             rad_multibounce_blocks *b = NULL;
@@ -198,7 +199,8 @@ static int bench_size(uint32_t target)
         t_half[ki] = time_it(&r, E, out);
         e_half[ki] = rel_err(out, ref, n3);
         if (ks[ki] != 1) {
-            static const char *const methods[4] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps" };
+            static const char *const methods[5] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+                                                           "matching + group swaps" };
             if (ki == 1) {
                 emit("Compressed forms of F_mb (outliers 5%%). Bytes are what one apply reads (blocks + scales + permutations +\n");
                 emit("outliers); MSE of the decoded matrix over 3 N^2 entries; ratio = MSE without reordering / MSE (same form and tile);\n");
@@ -210,7 +212,7 @@ static int bench_size(uint32_t target)
                 uint32_t tl;
                 for (tl = 0; tl < (ki == 1 ? 2u : 1u); ++tl) {
                     double mse_plain = 0.0;
-                    for (ro = 0; ro <= RAD_REORDER_GROUPS; ++ro) {
+                    for (ro = 0; ro <= RAD_REORDER_MATCH; ++ro) {
                         rad_block_options bo;
                         rad_block_report rep;
                         rad_multibounce_blocks *b = NULL;
@@ -261,11 +263,103 @@ static int bench_size(uint32_t target)
     return 0;
 }
 
+/* --reorder-only: the reordering methods alone (no apply timings), K = 3, tile 64, outliers
+   5%: decoded-matrix MSE, ratio to the unreordered MSE and build time of
+   rad_multibounce_blocks_create, on the patch order and on a scrambled one (a fixed
+   pseudo-random permutation). */
+static int reorder_only(uint32_t target)
+{
+    static const char *const names[RAD_REORDER_MATCH + 1] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+                                                               "matching + group swaps" };
+    rad_scene_desc desc;
+    rad_camera cam;
+    rad_scene *scene = NULL;
+    rad_patches *patches = NULL;
+    rad_bvh *bvh = NULL;
+    rad_form_factors *ff = NULL;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_raycaster rc;
+    rad_multibounce_options mo;
+    rad_multibounce *mb = NULL, view;
+    float *P;
+    uint32_t n, i, j, ch, *p, sc, f, ro;
+    uint64_t st = 12345u;
+    double t0;
+    rad_cornell_box(&desc, &cam);
+    rad_patch_options_default(&po);
+    po.target_count = target;
+    rad_form_factor_options_default(&fo);
+    if (rad_scene_create(&desc, NULL, &scene) || rad_patches_create(scene, &po, NULL, &patches) || rad_bvh_create(scene, NULL, &bvh))
+        return 1;
+    rad_bvh_raycaster(bvh, &rc);
+    if (rad_form_factors_dense(patches, &rc, &fo, NULL, &ff)) return 1;
+    rad_multibounce_options_default(&mo);
+    mo.bounces = 3;
+    t0 = now();
+    if (rad_multibounce_create(&ff->matrix, patches->albedo, &mo, NULL, &mb)) return 1;
+    n = mb->n;
+    emit("\n### Reordering methods, Cornell box, N = %u, K = 3 (F_mb built in %.2f s), outliers 5%%, tile 64\n\n", n, now() - t0);
+    emit("Build = rad_multibounce_blocks_create (outliers, reordering, scales, encoding), best of 3 on the Cornell order, one run\n");
+    emit("on the scrambled one; ratio = MSE without reordering / MSE.\n\n");
+    emit("| patch order | form | reorder | build s | MSE | MSE ratio |\n|---|---|---|---|---|---|\n");
+    p = (uint32_t *)malloc(sizeof(uint32_t) * n);
+    P = (float *)malloc(sizeof(float) * 3 * (size_t)n * n);
+    if (!p || !P) return 1;
+    for (i = 0; i < n; ++i) p[i] = i;
+    for (i = n - 1; i > 0; --i) {
+        uint32_t t;
+        st = st * 6364136223846793005ull + 1442695040888963407ull;
+        j = (uint32_t)((st >> 33) % (i + 1u));
+        t = p[i]; p[i] = p[j]; p[j] = t;
+    }
+    for (ch = 0; ch < 3; ++ch)
+        for (i = 0; i < n; ++i)
+            for (j = 0; j < n; ++j) P[(size_t)ch * n * n + (size_t)i * n + j] = mb->planes[(size_t)ch * n * n + (size_t)p[i] * n + p[j]];
+    view = *mb;
+    view.planes = P;
+    view.storage = NULL;
+    for (sc = 0; sc < 2; ++sc)
+        for (f = 0; f < 2; ++f) {
+            double plain = 0.0;
+            for (ro = 0; ro <= RAD_REORDER_MATCH; ++ro) {
+                rad_block_options bo;
+                rad_block_report rep;
+                rad_multibounce_blocks *b = NULL;
+                double tb = 1e30;
+                int rep_i;
+                rad_block_options_default(&bo);
+                bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+                bo.reorder = (int)ro;
+                for (rep_i = 0; rep_i < (sc ? 1 : 3); ++rep_i) { /* build time: best of 3 on the patch order */
+                    rad_multibounce_blocks_destroy(b);
+                    b = NULL;
+                    t0 = now();
+                    if (rad_multibounce_blocks_create(sc ? &view : mb, &bo, NULL, &b, &rep)) return 1;
+                    if (now() - t0 < tb) tb = now() - t0;
+                }
+                if (!ro) plain = rep.mse;
+                emit("| %s | %s | %s | %.2f | %.3g | %.2f |\n", sc ? "scrambled" : "Cornell", f ? "3xBC4" : "BC1", names[ro], tb, rep.mse,
+                     plain / rep.mse);
+                rad_multibounce_blocks_destroy(b);
+            }
+        }
+    free(P);
+    free(p);
+    rad_multibounce_destroy(mb);
+    rad_form_factors_destroy(ff);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(patches);
+    rad_scene_destroy(scene);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
-    int i, quick = 0, threads = 1;
+    int i, quick = 0, threads = 1, reorder = 0;
     for (i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
+        else if (!strcmp(argv[i], "--reorder-only")) reorder = 1;
         else if (!strcmp(argv[i], "--append") && i + 1 < argc) {
             g_md = fopen(argv[++i], "a");
             if (!g_md) { fprintf(stderr, "cannot open %s\n", argv[i]); return 1; }
@@ -274,6 +368,13 @@ int main(int argc, char **argv)
 #ifdef _OPENMP
     threads = omp_get_max_threads();
 #endif
+    if (reorder) {
+        emit("\n## Multi-bounce compression: reordering methods (SPEC §4)\n\nCPU, %d threads.\n", threads);
+        if (reorder_only(1736)) return 1;
+        if (!quick && reorder_only(5485)) return 1;
+        if (g_md) fclose(g_md);
+        return 0;
+    }
     emit("\n## Multi-bounce matrix and block compression (SPEC §4)\n\nCPU, %d threads; Jacobi = rad_solve_jacobi (dense F, one pass per bounce).\n", threads);
     if (bench_size(1736)) return 1;
     if (!quick && bench_size(5485)) return 1;
