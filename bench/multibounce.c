@@ -107,7 +107,7 @@ static int scrambled(const rad_multibounce *mb, double t_jac, size_t bytes_f)
     }
     free(P);
     free(p);
-    emit("\nOutlier fraction (K = 3, tile 64, reorder 3, the default): bytes per outlier = 4 (column) + 12 (exact RGB floats),\n");
+    emit("\nOutlier fraction (K = 3, tile 64, the default reorder: matching): bytes per outlier = 4 (column) + 12 (exact RGB floats),\n");
     emit("plus 8 (N + 1) bytes of row offsets.\n\n| form | outliers | bytes (MiB) | / float F | of which outliers | MSE | apply ms | vs 3 Jacobi |\n|---|---|---|---|---|---|---|---|\n");
     for (f = 0; f < 2; ++f)
         for (i = 0; i < 4; ++i) {
