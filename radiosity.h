@@ -1530,8 +1530,9 @@ RAD_API void rad_block_options_default(rad_block_options *options);
    OUT_OF_MEMORY, SIZE_OVERFLOW, CANCELLED. Thread safety: reentrant. Cost: O(N^2 log N) for
    the outliers, O(N^3) for exact reordering (two Gram matrices) or O(N^2 samples), plus
    O(N^2) per 2-opt / group-swap pass (at most 64 passes each) or per matching round (a few),
-   O(N^2) encoding; 16 N^2 bytes of scratch while reordering. Deterministic: the same bytes
-   whatever the number of threads. SPEC §4. */
+   O(N^2) encoding. Scratch at the peak about 40 N^2 bytes with exact distances (working
+   planes, the coordinates twice and a Gram matrix). Deterministic: the same bytes whatever
+   the number of threads. SPEC §4. */
 RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
                                                  const rad_context *ctx, rad_multibounce_blocks **out,
                                                  rad_block_report *report);
@@ -8726,7 +8727,8 @@ done:
 }
 
 /* Row and column orders of the RGB planes W (3 n^2 floats) by the greedy chain (method
-   RAD_REORDER_GREEDY) or the greedy chain refined by 2-opt (RAD_REORDER_GREEDY_2OPT),
+   RAD_REORDER_GREEDY), the chain refined by 2-opt (RAD_REORDER_GREEDY_2OPT), then by group
+   swaps (RAD_REORDER_GROUPS), or by matching and group swaps (RAD_REORDER_MATCH),
    distances over all 3n coordinates of a row/column (samples == 0) or over 'samples' evenly
    spaced ones. */
 static rad_result rad__mb_reorder_perms(const rad__ctx *c, const float *W, uint32_t n, uint32_t samples, int method,
