@@ -1466,6 +1466,8 @@ typedef enum rad_block_format {
 #define RAD_REORDER_GREEDY_2OPT 2 /* the greedy chain, then 2-opt reversals that shorten it */
 #define RAD_REORDER_GROUPS 3      /* 2-opt chain, then swaps between the groups of four rows
                                      (columns) that make each 4x4 block's rows more alike */
+#define RAD_REORDER_MATCH 4       /* groups of four by greedy matching (rows into pairs, pairs
+                                     into fours) on the same distance, then the group swaps */
 
 typedef struct rad_block_options {
     rad_block_format format;   /* default RAD_BLOCK_BC4X3 */
@@ -1474,9 +1476,11 @@ typedef struct rad_block_options {
                                   0 disables the step (default 0.05) */
     int reorder;               /* row and column reordering: RAD_REORDER_NONE (0),
                                   RAD_REORDER_GREEDY (1, thesis Listing 3.1),
-                                  RAD_REORDER_GREEDY_2OPT (2) or RAD_REORDER_GROUPS (3, the
-                                  default: 12-30% lower MSE than GREEDY on the Cornell F_mb
-                                  with 1-5% outliers, see BENCHMARKS.md) */
+                                  RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: 12-30%
+                                  lower MSE than GREEDY on the Cornell F_mb with 1-5%
+                                  outliers) or RAD_REORDER_MATCH (4, the default: a further
+                                  3% (BC1) / 6% (3xBC4) lower than GROUPS at N = 1850 for
+                                  the same build time; see BENCHMARKS.md) */
     uint32_t reorder_samples;  /* 0: L2 distances over all coordinates (the literal algorithm,
                                   through a Gram matrix); else over this many evenly spaced
                                   coordinates (faster, a little worse; default 0) */
@@ -1525,7 +1529,10 @@ RAD_API void rad_block_options_default(rad_block_options *options);
    (optional) says what each step did and the decoded-matrix error. Errors: INVALID_ARGUMENT,
    OUT_OF_MEMORY, SIZE_OVERFLOW, CANCELLED. Thread safety: reentrant. Cost: O(N^2 log N) for
    the outliers, O(N^3) for exact reordering (two Gram matrices) or O(N^2 samples), plus
-   O(N^2) per 2-opt / group-swap pass (at most 64 / 16 passes), O(N^2) encoding. SPEC §4. */
+   O(N^2) per 2-opt / group-swap pass (at most 64 passes each) or per matching round (a few),
+   O(N^2) encoding. Scratch at the peak about 40 N^2 bytes with exact distances (working
+   planes, the coordinates twice and a Gram matrix). Deterministic: the same bytes whatever
+   the number of threads. SPEC §4. */
 RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
                                                  const rad_context *ctx, rad_multibounce_blocks **out,
                                                  rad_block_report *report);
@@ -7915,7 +7922,7 @@ RAD_API void rad_block_options_default(rad_block_options *o)
     memset(o, 0, sizeof(*o));
     o->format = RAD_BLOCK_BC4X3;
     o->outlier_fraction = 0.05f;
-    o->reorder = RAD_REORDER_GROUPS;
+    o->reorder = RAD_REORDER_MATCH;
     o->reorder_samples = 0;
     o->tile = 64;
 }
@@ -8485,10 +8492,12 @@ static rad_result rad__mb_chain(const rad__ctx *c, const float *G, uint32_t n, u
    first improvement, until a pass finds nothing or after 'passes' passes. The greedy chain's
    late steps jump between far-apart leftovers; reversals remove those long edges. O(n^2) per
    pass plus O(n) per accepted move. */
-static rad_result rad__mb_two_opt(const rad__ctx *c, float *G, uint32_t n, uint32_t *order, uint32_t passes)
+/* The Gram matrix G (n x n) overwritten by the L2 distances |a - b|, symmetric to the bit
+   whatever the GEMM's rounding, zero on the diagonal. O(n^2). */
+static rad_result rad__mb_distances(const rad__ctx *c, float *G, uint32_t n)
 {
     float *diag = (float *)rad__alloc_array(&c->allocator, n, sizeof(float));
-    uint32_t i, j, pass;
+    uint32_t i, j;
     if (!diag) return RAD_ERROR_OUT_OF_MEMORY;
     for (i = 0; i < n; ++i) diag[i] = G[(size_t)i * n + i];
     for (i = 0; i < n; ++i)
@@ -8497,8 +8506,16 @@ static rad_result rad__mb_two_opt(const rad__ctx *c, float *G, uint32_t n, uint3
             G[(size_t)i * n + j] = i == j ? 0.0f : (d2 > 0.0f ? sqrtf(d2) : 0.0f);
         }
     rad__free(&c->allocator, diag);
-    for (i = 0; i < n; ++i) /* symmetric to the bit, whatever the GEMM's rounding */
+    for (i = 0; i < n; ++i)
         for (j = i + 1; j < n; ++j) G[(size_t)j * n + i] = G[(size_t)i * n + j];
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__mb_two_opt(const rad__ctx *c, float *G, uint32_t n, uint32_t *order, uint32_t passes)
+{
+    uint32_t i, j, pass;
+    rad_result r = rad__mb_distances(c, G, n);
+    if (r != RAD_SUCCESS) return r;
     for (pass = 0; pass < passes && n > 3; ++pass) {
         int improved = 0;
         /* i = n means "before the start": reversing a prefix order[0..j] */
@@ -8564,8 +8581,161 @@ static void rad__mb_group_swaps(const float *D, uint32_t n, uint32_t *order, uin
     }
 }
 
+/* ---- grouping by matching (RAD_REORDER_MATCH) ---- */
+
+typedef struct rad__mb_edge {
+    float w;
+    uint32_t a, b; /* a < b */
+} rad__mb_edge;
+
+static int rad__mb_edge_cmp(const void *x, const void *y)
+{
+    const rad__mb_edge *p = (const rad__mb_edge *)x, *q = (const rad__mb_edge *)y;
+    if (p->w != q->w) return p->w < q->w ? -1 : 1;
+    if (p->a != q->a) return p->a < q->a ? -1 : 1;
+    return p->b < q->b ? -1 : (p->b > q->b ? 1 : 0);
+}
+
+/* Cost of putting items i and j together: the sum of the squared distances (D: distances)
+   between the 'per' members of i and those of j. */
+static float rad__mb_match_cost(const float *D, uint32_t n, const uint32_t *members, uint32_t per, uint32_t i, uint32_t j)
+{
+    float s = 0.0f;
+    uint32_t a, b;
+    for (a = 0; a < per; ++a) {
+        const float *Da = D + (size_t)members[i * per + a] * n;
+        for (b = 0; b < per; ++b) {
+            float d = Da[members[j * per + b]];
+            s += d * d;
+        }
+    }
+    return s;
+}
+
+#define RAD__MB_MATCH_K 8u
+
+/* Greedy matching of m items (each 'per' members of the n rows): the edges from every free
+   item to its RAD__MB_MATCH_K cheapest free partners, cheapest first, each taken when both
+   ends are free; repeated on the items left free until fewer than two remain. partner[i] =
+   the item matched to i, or UINT32_MAX (at most one is left when m is odd). Deterministic
+   (ties by index). O(f^2 per^2) per round for f free items; rounds are few (each takes at
+   least the cheapest edge, usually almost all). */
+static rad_result rad__mb_match(const rad__ctx *c, const float *D, uint32_t n, const uint32_t *members, uint32_t per, uint32_t m,
+                                uint32_t *partner)
+{
+    uint32_t *freel = (uint32_t *)rad__alloc_array(&c->allocator, m, sizeof(uint32_t));
+    rad__mb_edge *e = (rad__mb_edge *)rad__alloc_array(&c->allocator, (size_t)m * RAD__MB_MATCH_K, sizeof(rad__mb_edge));
+    uint32_t i, nf;
+    if (!freel || !e) {
+        rad__free(&c->allocator, freel);
+        rad__free(&c->allocator, e);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < m; ++i) partner[i] = UINT32_MAX;
+    for (;;) {
+        size_t ne = 0, q;
+        uint32_t fi, fj;
+        nf = 0;
+        for (i = 0; i < m; ++i)
+            if (partner[i] == UINT32_MAX) freel[nf++] = i;
+        if (nf < 2) break;
+        for (fi = 0; fi < nf; ++fi) {
+            float bw[RAD__MB_MATCH_K];
+            uint32_t bj[RAD__MB_MATCH_K], cnt = 0, k;
+            for (fj = 0; fj < nf; ++fj) {
+                float w;
+                if (fj == fi) continue;
+                w = rad__mb_match_cost(D, n, members, per, freel[fi], freel[fj]);
+                if (cnt == RAD__MB_MATCH_K && !(w < bw[cnt - 1])) continue;
+                k = cnt < RAD__MB_MATCH_K ? cnt++ : cnt - 1;
+                while (k > 0 && w < bw[k - 1]) { bw[k] = bw[k - 1]; bj[k] = bj[k - 1]; --k; }
+                bw[k] = w;
+                bj[k] = freel[fj];
+            }
+            for (k = 0; k < cnt; ++k) {
+                e[ne].w = bw[k];
+                e[ne].a = freel[fi] < bj[k] ? freel[fi] : bj[k];
+                e[ne].b = freel[fi] < bj[k] ? bj[k] : freel[fi];
+                ++ne;
+            }
+        }
+        qsort(e, ne, sizeof(rad__mb_edge), rad__mb_edge_cmp);
+        for (q = 0; q < ne; ++q)
+            if (partner[e[q].a] == UINT32_MAX && partner[e[q].b] == UINT32_MAX) {
+                partner[e[q].a] = e[q].b;
+                partner[e[q].b] = e[q].a;
+            }
+    }
+    rad__free(&c->allocator, freel);
+    rad__free(&c->allocator, e);
+    return RAD_SUCCESS;
+}
+
+/* Groups of four by two rounds of matching on the squared distances (D: distances): rows
+   into pairs, then pairs into quadruples (cost: the four cross squared distances, so the sum
+   of a quadruple's six is what the two rounds minimise); the quadruples follow each other in
+   the order of a greedy chain over them (so that scale tiles hold alike rows), then the
+   members of an unmatched pair and an unmatched row. The greedy chain builds groups as runs
+   of a path, which strands rows; matching looks at every row's nearest partners at once.
+   O(n^2) per round plus O(n^2 / 16 * 16) for the chain. */
+static rad_result rad__mb_match_groups(const rad__ctx *c, const float *D, uint32_t n, uint32_t *order)
+{
+    uint32_t np = 0, nq = 0, i, k, at = 0, cur = 0;
+    uint32_t *partner = (uint32_t *)rad__alloc_array(&c->allocator, n, sizeof(uint32_t));
+    uint32_t *ident = (uint32_t *)rad__alloc_array(&c->allocator, n, sizeof(uint32_t));
+    uint32_t *pairs = (uint32_t *)rad__alloc_array(&c->allocator, n, sizeof(uint32_t));
+    uint32_t *quads = (uint32_t *)rad__alloc_array(&c->allocator, n, sizeof(uint32_t));
+    unsigned char *used = (unsigned char *)rad__alloc(&c->allocator, n);
+    rad_result r = RAD_ERROR_OUT_OF_MEMORY;
+    if (!partner || !ident || !pairs || !quads || !used) goto done;
+    for (i = 0; i < n; ++i) ident[i] = i;
+    r = rad__mb_match(c, D, n, ident, 1u, n, partner);
+    if (r != RAD_SUCCESS) goto done;
+    for (i = 0; i < n; ++i)
+        if (partner[i] != UINT32_MAX && i < partner[i]) { pairs[2 * np] = i; pairs[2 * np + 1] = partner[i]; ++np; }
+    r = rad__mb_match(c, D, n, pairs, 2u, np, partner);
+    if (r != RAD_SUCCESS) goto done;
+    for (i = 0; i < np; ++i)
+        if (partner[i] != UINT32_MAX && i < partner[i]) {
+            quads[4 * nq] = pairs[2 * i];
+            quads[4 * nq + 1] = pairs[2 * i + 1];
+            quads[4 * nq + 2] = pairs[2 * partner[i]];
+            quads[4 * nq + 3] = pairs[2 * partner[i] + 1];
+            ++nq;
+        }
+    /* greedy chain over the quadruples, from the first */
+    memset(used, 0, n);
+    for (k = 0; k < nq; ++k) {
+        uint32_t q, best_q = cur;
+        float best = FLT_MAX;
+        if (k > 0)
+            for (q = 0; q < nq; ++q) {
+                float w;
+                if (used[q]) continue;
+                w = rad__mb_match_cost(D, n, quads, 4u, cur, q);
+                if (w < best) { best = w; best_q = q; }
+            }
+        used[best_q] = 1;
+        cur = best_q;
+        for (i = 0; i < 4; ++i) order[at++] = quads[4 * cur + i];
+    }
+    memset(used, 0, n);
+    for (i = 0; i < at; ++i) used[order[i]] = 1;
+    for (i = 0; i < n; ++i)
+        if (!used[i]) order[at++] = i;
+    r = RAD_SUCCESS;
+done:
+    rad__free(&c->allocator, partner);
+    rad__free(&c->allocator, ident);
+    rad__free(&c->allocator, pairs);
+    rad__free(&c->allocator, quads);
+    rad__free(&c->allocator, used);
+    return r;
+}
+
 /* Row and column orders of the RGB planes W (3 n^2 floats) by the greedy chain (method
-   RAD_REORDER_GREEDY) or the greedy chain refined by 2-opt (RAD_REORDER_GREEDY_2OPT),
+   RAD_REORDER_GREEDY), the chain refined by 2-opt (RAD_REORDER_GREEDY_2OPT), then by group
+   swaps (RAD_REORDER_GROUPS), or by matching and group swaps (RAD_REORDER_MATCH),
    distances over all 3n coordinates of a row/column (samples == 0) or over 'samples' evenly
    spaced ones. */
 static rad_result rad__mb_reorder_perms(const rad__ctx *c, const float *W, uint32_t n, uint32_t samples, int method,
@@ -8592,6 +8762,12 @@ static rad_result rad__mb_reorder_perms(const rad__ctx *c, const float *W, uint3
             for (i = 0; i < n; ++i) XT[(size_t)i * samples + s] = X[(size_t)s * n + i];
         memset(G, 0, nn * sizeof(float));
         r = rad__mb_gemm(c, n, n, samples, XT, samples, X, n, G, n);
+        if (method == RAD_REORDER_MATCH) {
+            if (r == RAD_SUCCESS) r = rad__mb_distances(c, G, n);
+            if (r == RAD_SUCCESS) r = rad__mb_match_groups(c, G, n, pass == 0 ? col_perm : row_perm);
+            if (r == RAD_SUCCESS) rad__mb_group_swaps(G, n, pass == 0 ? col_perm : row_perm, 64u);
+            continue;
+        }
         if (r == RAD_SUCCESS) r = rad__mb_chain(c, G, n, pass == 0 ? col_perm : row_perm);
         if (r == RAD_SUCCESS && method >= RAD_REORDER_GREEDY_2OPT) r = rad__mb_two_opt(c, G, n, pass == 0 ? col_perm : row_perm, 64u);
         if (r == RAD_SUCCESS && method == RAD_REORDER_GROUPS) rad__mb_group_swaps(G, n, pass == 0 ? col_perm : row_perm, 64u);
@@ -9022,8 +9198,8 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     if (rad__mb_check(mb) != RAD_SUCCESS || mb->row_perm) return RAD_ERROR_INVALID_ARGUMENT;
     if (options) o = *options; else rad_block_options_default(&o);
     if ((o.format != RAD_BLOCK_BC1 && o.format != RAD_BLOCK_BC4X3) || !(o.outlier_fraction >= 0.0f && o.outlier_fraction < 1.0f) ||
-        (o.tile % 4u) != 0 || o.reorder < RAD_REORDER_NONE || o.reorder > RAD_REORDER_GROUPS) {
-        rad__log(&c, RAD_LOG_ERROR, "blocks: bad options (format %d, outlier fraction %g, tile %u: a multiple of 4, reorder %d: 0..3)",
+        (o.tile % 4u) != 0 || o.reorder < RAD_REORDER_NONE || o.reorder > RAD_REORDER_MATCH) {
+        rad__log(&c, RAD_LOG_ERROR, "blocks: bad options (format %d, outlier fraction %g, tile %u: a multiple of 4, reorder %d: 0..4)",
                  (int)o.format, (double)o.outlier_fraction, o.tile, o.reorder);
         return RAD_ERROR_INVALID_ARGUMENT;
     }

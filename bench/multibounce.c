@@ -10,10 +10,13 @@
    and the build times of F_mb and of each compression.
 
    Build: cc -O3 -march=native -fopenmp -I. bench/multibounce.c -lm   (make build/multibounce)
-   Run:   multibounce [--quick] [--append FILE.md]   (--quick: the 1.7k size only)
+   Run:   multibounce [--quick] [--reorder-only] [--append FILE.md]   (--quick: the 1.7k size only;
+          --reorder-only: only the table of reordering methods, MSE and build time, no apply timings;
+          --reorder-search: a slow local search on the real encoded error from the default ordering, N = 1850,
+          to see how far the methods are from it: about 10 minutes on one core)
           multibounce --apply-only [--size TARGET] [--cache FILE] [--label TEXT] [--append FILE.md]
             only the apply table: K Jacobi bounces (K = 3, 8) against the BC1 and 3xBC4 forms of
-            F_mb (default options: outliers 5%, reorder 3, tile 64), best of 31, with the share
+            F_mb (rad_block_options_default), best of 31, with the share
             of the outlier pass. --cache FILE keeps F, E, albedo and the four compressed
             matrices between runs (built when FILE is missing: the O(N^3) steps run once), so
             a second build of this program (e.g. -DRAD_BENCH_HEADER='"old.h"', an older
@@ -99,7 +102,7 @@ static int scrambled(const rad_multibounce *mb, double t_jac, size_t bytes_f)
     emit("order has no spatial coherence), tile 64:\n\n| form | reorder | MSE | MSE ratio |\n|---|---|---|---|\n");
     for (f = 0; f < 2; ++f) {
         double plain = 0.0;
-        for (ro = 0; ro <= RAD_REORDER_GROUPS; ++ro) {
+        for (ro = 0; ro <= RAD_REORDER_MATCH; ++ro) {
             rad_block_options bo;
             rad_block_report rep;
             rad_multibounce_blocks *b = NULL;
@@ -115,7 +118,7 @@ static int scrambled(const rad_multibounce *mb, double t_jac, size_t bytes_f)
     }
     free(P);
     free(p);
-    emit("\nOutlier fraction (K = 3, tile 64, reorder 3, the default): bytes per outlier = 4 (column) + 12 (exact RGB floats),\n");
+    emit("\nOutlier fraction (K = 3, tile 64, the default reorder: matching): bytes per outlier = 4 (column) + 12 (exact RGB floats),\n");
     emit("plus 8 (N + 1) bytes of row offsets.\n\n| form | outliers | bytes (MiB) | / float F | of which outliers | MSE | apply ms | vs 3 Jacobi |\n|---|---|---|---|---|---|---|---|\n");
     for (f = 0; f < 2; ++f)
         for (i = 0; i < 4; ++i) {
@@ -209,7 +212,8 @@ static int bench_size(uint32_t target)
         t_half[ki] = time_it(&r, E, out);
         e_half[ki] = rel_err(out, ref, n3);
         if (ks[ki] != 1) {
-            static const char *const methods[4] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps" };
+            static const char *const methods[5] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+                                                           "matching + group swaps" };
             if (ki == 1) {
                 emit("Compressed forms of F_mb (outliers 5%%). Bytes are what one apply reads (blocks + scales + permutations +\n");
                 emit("outliers); MSE of the decoded matrix over 3 N^2 entries; ratio = MSE without reordering / MSE (same form and tile);\n");
@@ -221,7 +225,7 @@ static int bench_size(uint32_t target)
                 uint32_t tl;
                 for (tl = 0; tl < (ki == 1 ? 2u : 1u); ++tl) {
                     double mse_plain = 0.0;
-                    for (ro = 0; ro <= RAD_REORDER_GROUPS; ++ro) {
+                    for (ro = 0; ro <= RAD_REORDER_MATCH; ++ro) {
                         rad_block_options bo;
                         rad_block_report rep;
                         rad_multibounce_blocks *b = NULL;
@@ -265,6 +269,288 @@ static int bench_size(uint32_t target)
         emit("| %u | %.2f | %.2f | %.2f | %.2fx | %.1e | %.2f | %.2fx | %.1e |\n", ks[ki], t_jac[ki], t_build[ki], t_float[ki],
              t_jac[ki] / t_float[ki], e_float[ki], t_half[ki], t_jac[ki] / t_half[ki], e_half[ki]);
     free(E); free(ref); free(out);
+    rad_form_factors_destroy(ff);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(patches);
+    rad_scene_destroy(scene);
+    return 0;
+}
+
+/* --reorder-only: the reordering methods alone (no apply timings), K = 3, tile 64, outliers
+   5%: decoded-matrix MSE, ratio to the unreordered MSE and build time of
+   rad_multibounce_blocks_create, on the patch order and on a scrambled one (a fixed
+   pseudo-random permutation). */
+static int reorder_only(uint32_t target)
+{
+    static const char *const names[RAD_REORDER_MATCH + 1] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+                                                               "matching + group swaps" };
+    rad_scene_desc desc;
+    rad_camera cam;
+    rad_scene *scene = NULL;
+    rad_patches *patches = NULL;
+    rad_bvh *bvh = NULL;
+    rad_form_factors *ff = NULL;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_raycaster rc;
+    rad_multibounce_options mo;
+    rad_multibounce *mb = NULL, view;
+    float *P;
+    uint32_t n, i, j, ch, *p, sc, f, ro;
+    uint64_t st = 12345u;
+    double t0;
+    rad_cornell_box(&desc, &cam);
+    rad_patch_options_default(&po);
+    po.target_count = target;
+    rad_form_factor_options_default(&fo);
+    if (rad_scene_create(&desc, NULL, &scene) || rad_patches_create(scene, &po, NULL, &patches) || rad_bvh_create(scene, NULL, &bvh))
+        return 1;
+    rad_bvh_raycaster(bvh, &rc);
+    if (rad_form_factors_dense(patches, &rc, &fo, NULL, &ff)) return 1;
+    rad_multibounce_options_default(&mo);
+    mo.bounces = 3;
+    t0 = now();
+    if (rad_multibounce_create(&ff->matrix, patches->albedo, &mo, NULL, &mb)) return 1;
+    n = mb->n;
+    emit("\n### Reordering methods, Cornell box, N = %u, K = 3 (F_mb built in %.2f s), outliers 5%%, tile 64\n\n", n, now() - t0);
+    emit("Build = rad_multibounce_blocks_create (outliers, reordering, scales, encoding), best of 3 on the Cornell order, one run\n");
+    emit("on the scrambled one; ratio = MSE without reordering / MSE.\n\n");
+    emit("| patch order | form | reorder | build s | MSE | MSE ratio |\n|---|---|---|---|---|---|\n");
+    p = (uint32_t *)malloc(sizeof(uint32_t) * n);
+    P = (float *)malloc(sizeof(float) * 3 * (size_t)n * n);
+    if (!p || !P) return 1;
+    for (i = 0; i < n; ++i) p[i] = i;
+    for (i = n - 1; i > 0; --i) {
+        uint32_t t;
+        st = st * 6364136223846793005ull + 1442695040888963407ull;
+        j = (uint32_t)((st >> 33) % (i + 1u));
+        t = p[i]; p[i] = p[j]; p[j] = t;
+    }
+    for (ch = 0; ch < 3; ++ch)
+        for (i = 0; i < n; ++i)
+            for (j = 0; j < n; ++j) P[(size_t)ch * n * n + (size_t)i * n + j] = mb->planes[(size_t)ch * n * n + (size_t)p[i] * n + p[j]];
+    view = *mb;
+    view.planes = P;
+    view.storage = NULL;
+    for (sc = 0; sc < 2; ++sc)
+        for (f = 0; f < 2; ++f) {
+            double plain = 0.0;
+            for (ro = 0; ro <= RAD_REORDER_MATCH + 1u; ++ro) { /* the last: matching on 256 sampled coordinates */
+                rad_block_options bo;
+                rad_block_report rep;
+                rad_multibounce_blocks *b = NULL;
+                double tb = 1e30;
+                int rep_i;
+                rad_block_options_default(&bo);
+                bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+                bo.reorder = ro > RAD_REORDER_MATCH ? RAD_REORDER_MATCH : (int)ro;
+                bo.reorder_samples = ro > RAD_REORDER_MATCH ? 256u : 0u;
+                for (rep_i = 0; rep_i < (sc ? 1 : 3); ++rep_i) { /* build time: best of 3 on the patch order */
+                    rad_multibounce_blocks_destroy(b);
+                    b = NULL;
+                    t0 = now();
+                    if (rad_multibounce_blocks_create(sc ? &view : mb, &bo, NULL, &b, &rep)) return 1;
+                    if (now() - t0 < tb) tb = now() - t0;
+                }
+                if (!ro) plain = rep.mse;
+                emit("| %s | %s | %s | %.2f | %.3g | %.2f |\n", sc ? "scrambled" : "Cornell", f ? "3xBC4" : "BC1",
+                     ro > RAD_REORDER_MATCH ? "matching, 256 sampled coordinates" : names[ro], tb, rep.mse, plain / rep.mse);
+                rad_multibounce_blocks_destroy(b);
+            }
+        }
+    free(P);
+    free(p);
+    rad_multibounce_destroy(mb);
+    rad_form_factors_destroy(ff);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(patches);
+    rad_scene_destroy(scene);
+    return 0;
+}
+
+/* --reorder-search: how far the reordering methods are from what a slow search on the real
+   error finds. From the default ordering (RAD_REORDER_MATCH), each row in turn is swapped
+   with each row up to 16 positions away in another group of four whenever re-encoding the
+   two block rows involved (tile scales held for the pass) lowers their real squared error;
+   then the same for columns; two rounds. Deterministic; minutes at N = 1850. Not a library
+   method: too slow for what it gains (see BENCHMARKS.md). */
+typedef struct rsearch {
+    uint32_t n, bpr, tpr;
+    int bc4;
+    float *Wp, *scales; /* permuted planes (outliers zeroed), 3 floats per 64-texel tile */
+} rsearch;
+
+/* real squared error of block row I with row slot 'slot' holding permuted row 'with' (slot 4: as is) */
+static double rs_row_err(const rsearch *s, uint32_t I, uint32_t slot, uint32_t with)
+{
+    size_t nn = (size_t)s->n * s->n;
+    double e = 0.0;
+    uint32_t J, t, ch;
+    for (J = 0; J < s->bpr; ++J) {
+        const float *sc = s->scales + 3 * (size_t)((I * 4u / 64u) * s->tpr + J * 4u / 64u);
+        float tex[48], dec[48], val[48];
+        uint8_t blk[8];
+        for (t = 0; t < 16; ++t) {
+            uint32_t y = I * 4u + t / 4u, x = J * 4u + t % 4u, src = t / 4u == slot ? with : y;
+            for (ch = 0; ch < 3; ++ch) {
+                float v = (y < s->n && x < s->n) ? s->Wp[ch * nn + (size_t)src * s->n + x] : 0.0f;
+                val[3 * t + ch] = v;
+                tex[3 * t + ch] = sc[ch] > 0.0f ? v / sc[ch] : 0.0f;
+            }
+        }
+        if (!s->bc4) {
+            rad_bc1_encode_block(tex, blk);
+            rad_bc1_decode_block(blk, dec);
+        } else
+            for (ch = 0; ch < 3; ++ch) {
+                float v[16], d[16];
+                for (t = 0; t < 16; ++t) v[t] = tex[3 * t + ch];
+                rad_bc4_encode_block(v, blk);
+                rad_bc4_decode_block(blk, d);
+                for (t = 0; t < 16; ++t) dec[3 * t + ch] = d[t];
+            }
+        for (t = 0; t < 16; ++t)
+            if (I * 4u + t / 4u < s->n && J * 4u + t % 4u < s->n)
+                for (ch = 0; ch < 3; ++ch) {
+                    double d = (double)(dec[3 * t + ch] * sc[ch] - val[3 * t + ch]);
+                    e += d * d;
+                }
+    }
+    return e;
+}
+
+/* Wp = W permuted by (rp, cp), and its tile scales */
+static void rs_setup(rsearch *s, const float *W, const uint32_t *rp, const uint32_t *cp)
+{
+    size_t nn = (size_t)s->n * s->n;
+    uint32_t ch, i, j;
+    memset(s->scales, 0, sizeof(float) * 3 * s->tpr * s->tpr);
+    for (ch = 0; ch < 3; ++ch)
+        for (i = 0; i < s->n; ++i)
+            for (j = 0; j < s->n; ++j) {
+                float v = W[ch * nn + (size_t)rp[i] * s->n + cp[j]];
+                float *sc = s->scales + 3 * (size_t)((i / 64u) * s->tpr + j / 64u) + ch;
+                s->Wp[ch * nn + (size_t)i * s->n + j] = v;
+                if (v > *sc) *sc = v;
+            }
+}
+
+/* one pass of row swaps (columns: call with the transposed planes and the orders exchanged); returns the swaps made */
+static uint32_t rs_pass(rsearch *s, const float *W, uint32_t *rp, const uint32_t *cp)
+{
+    uint32_t full = s->n & ~3u, pa, pb, I, made = 0;
+    size_t nn = (size_t)s->n * s->n;
+    double *re = (double *)malloc(sizeof(double) * s->bpr);
+    if (!re) return 0;
+    rs_setup(s, W, rp, cp);
+    for (I = 0; I < s->bpr; ++I) re[I] = rs_row_err(s, I, 4u, 0u);
+    for (pa = 0; pa < full; ++pa)
+        for (pb = pa > 16u ? pa - 16u : 0u; pb < full && pb <= pa + 16u; ++pb) {
+            uint32_t A = pa / 4u, B = pb / 4u, ch, j;
+            double ea, eb;
+            if (A == B) continue;
+            ea = rs_row_err(s, A, pa % 4u, pb);
+            if (ea - re[A] >= re[B]) continue; /* B cannot fall below zero */
+            eb = rs_row_err(s, B, pb % 4u, pa);
+            if (ea + eb < (re[A] + re[B]) * (1.0 - 1e-9)) {
+                uint32_t t = rp[pa];
+                rp[pa] = rp[pb];
+                rp[pb] = t;
+                for (ch = 0; ch < 3; ++ch)
+                    for (j = 0; j < s->n; ++j) {
+                        float *x = s->Wp + ch * nn + (size_t)pa * s->n + j, *y = s->Wp + ch * nn + (size_t)pb * s->n + j, q = *x;
+                        *x = *y;
+                        *y = q;
+                    }
+                re[A] = ea;
+                re[B] = eb;
+                ++made;
+            }
+        }
+    free(re);
+    return made;
+}
+
+static int reorder_search(uint32_t target)
+{
+    rad_scene_desc desc;
+    rad_camera cam;
+    rad_scene *scene = NULL;
+    rad_patches *patches = NULL;
+    rad_bvh *bvh = NULL;
+    rad_form_factors *ff = NULL;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_raycaster rc;
+    rad_multibounce_options mo;
+    rad_multibounce *mb = NULL;
+    uint32_t n, f;
+    size_t nn;
+    rad_cornell_box(&desc, &cam);
+    rad_patch_options_default(&po);
+    po.target_count = target;
+    rad_form_factor_options_default(&fo);
+    if (rad_scene_create(&desc, NULL, &scene) || rad_patches_create(scene, &po, NULL, &patches) || rad_bvh_create(scene, NULL, &bvh))
+        return 1;
+    rad_bvh_raycaster(bvh, &rc);
+    if (rad_form_factors_dense(patches, &rc, &fo, NULL, &ff)) return 1;
+    rad_multibounce_options_default(&mo);
+    if (rad_multibounce_create(&ff->matrix, patches->albedo, &mo, NULL, &mb)) return 1;
+    n = mb->n;
+    nn = (size_t)n * n;
+    emit("\n### Search on the real error, Cornell box, N = %u, K = 3, outliers 5%%, tile 64\n\n", n);
+    emit("| form | step | swaps (rows, columns) | seconds | MSE | MSE ratio |\n|---|---|---|---|---|---|\n");
+    for (f = 0; f < 2; ++f) {
+        rad_block_options bo;
+        rad_block_report rep0, rep;
+        rad_multibounce_blocks *b = NULL;
+        rsearch s, st;
+        float *W = (float *)malloc(sizeof(float) * 3 * nn), *WT = (float *)malloc(sizeof(float) * 3 * nn);
+        uint32_t *rp = (uint32_t *)malloc(sizeof(uint32_t) * n), *cp = (uint32_t *)malloc(sizeof(uint32_t) * n), i, j, ch, round;
+        uint64_t q;
+        if (!W || !WT || !rp || !cp) return 1;
+        rad_block_options_default(&bo);
+        bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
+        bo.reorder = RAD_REORDER_NONE;
+        if (rad_multibounce_blocks_create(mb, &bo, NULL, &b, &rep0)) return 1;
+        rad_multibounce_blocks_destroy(b);
+        bo.reorder = RAD_REORDER_MATCH;
+        if (rad_multibounce_blocks_create(mb, &bo, NULL, &b, &rep)) return 1;
+        emit("| %s | matching (the default) | - | - | %.4g | %.3f |\n", f ? "3xBC4" : "BC1", rep.mse, rep0.mse / rep.mse);
+        memcpy(W, mb->planes, sizeof(float) * 3 * nn);
+        for (i = 0; i < n; ++i)
+            for (q = b->outlier_offsets[i]; q < b->outlier_offsets[i + 1]; ++q)
+                for (ch = 0; ch < 3; ++ch) W[ch * nn + (size_t)i * n + b->outlier_columns[q]] = 0.0f;
+        for (ch = 0; ch < 3; ++ch)
+            for (i = 0; i < n; ++i)
+                for (j = 0; j < n; ++j) WT[ch * nn + (size_t)j * n + i] = W[ch * nn + (size_t)i * n + j];
+        memcpy(rp, b->row_perm, sizeof(uint32_t) * n);
+        memcpy(cp, b->col_perm, sizeof(uint32_t) * n);
+        rad_multibounce_blocks_destroy(b);
+        s.n = n;
+        s.bpr = (n + 3u) / 4u;
+        s.tpr = (n + 63u) / 64u;
+        s.bc4 = (int)f;
+        s.Wp = (float *)malloc(sizeof(float) * 3 * nn);
+        s.scales = (float *)malloc(sizeof(float) * 3 * s.tpr * s.tpr);
+        if (!s.Wp || !s.scales) return 1;
+        st = s;
+        for (round = 0; round < 2; ++round) {
+            double t0 = now(), sse = 0.0;
+            uint32_t a = rs_pass(&s, W, rp, cp), c = rs_pass(&st, WT, cp, rp), I;
+            rs_setup(&s, W, rp, cp);
+            for (I = 0; I < s.bpr; ++I) sse += rs_row_err(&s, I, 4u, 0u);
+            emit("| %s | + search round %u | %u, %u | %.0f | %.4g | %.3f |\n", f ? "3xBC4" : "BC1", round + 1u, a, c, now() - t0,
+                 sse / (3.0 * (double)nn), rep0.mse * 3.0 * (double)nn / sse);
+        }
+        free(s.Wp);
+        free(s.scales);
+        free(W);
+        free(WT);
+        free(rp);
+        free(cp);
+    }
+    rad_multibounce_destroy(mb);
     rad_form_factors_destroy(ff);
     rad_bvh_destroy(bvh);
     rad_patches_destroy(patches);
@@ -444,7 +730,7 @@ static int apply_only(uint32_t target, const char *cache, const char *label, int
 
 int main(int argc, char **argv)
 {
-    int i, quick = 0, threads = 1, apply = 0;
+    int i, quick = 0, threads = 1, reorder = 0, apply = 0;
     uint32_t size = 1736;
     const char *cache = NULL, *label = NULL;
     for (i = 1; i < argc; ++i) {
@@ -453,6 +739,8 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
         else if (!strcmp(argv[i], "--label") && i + 1 < argc) label = argv[++i];
+        else if (!strcmp(argv[i], "--reorder-only")) reorder = 1;
+        else if (!strcmp(argv[i], "--reorder-search")) reorder = 2;
         else if (!strcmp(argv[i], "--append") && i + 1 < argc) {
             g_md = fopen(argv[++i], "a");
             if (!g_md) { fprintf(stderr, "cannot open %s\n", argv[i]); return 1; }
@@ -465,6 +753,17 @@ int main(int argc, char **argv)
         int r = apply_only(size, cache, label, threads);
         if (g_md) fclose(g_md);
         return r;
+    }
+    if (reorder) {
+        emit("\n## Multi-bounce compression: reordering methods (SPEC §4)\n\nCPU, %d threads.\n", threads);
+        if (reorder == 2) {
+            if (reorder_search(1736)) return 1;
+        } else {
+            if (reorder_only(1736)) return 1;
+            if (!quick && reorder_only(5485)) return 1;
+        }
+        if (g_md) fclose(g_md);
+        return 0;
     }
     emit("\n## Multi-bounce matrix and block compression (SPEC §4)\n\nCPU, %d threads; Jacobi = rad_solve_jacobi (dense F, one pass per bounce).\n", threads);
     if (bench_size(1736)) return 1;

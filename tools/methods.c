@@ -30,7 +30,7 @@ void rad_tool_method_options_default(rad_tool_method_options *mo)
     mo->bounces = 64;
     mo->format = RAD_TOOL_MB_BC4X3;
     mo->outliers = 0.05f;
-    mo->reorder = RAD_REORDER_GROUPS;
+    mo->reorder = RAD_REORDER_MATCH;
     mo->tile = 64;
     mo->mode = RAD_TEMPORAL_FEEDBACK;
     mo->k = 10;
@@ -151,7 +151,7 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
     if (i == sizeof names / sizeof names[0]) return 0;
     if (i >= 13) { /* flags */
         if (i == 15) mo->adaptive = 1, mo->given |= RAD_TOOL_OPT_ADAPTIVE;
-        else mo->reorder = i == 13 ? RAD_REORDER_GROUPS : RAD_REORDER_NONE, mo->given |= RAD_TOOL_OPT_REORDER;
+        else mo->reorder = i == 13 ? RAD_REORDER_MATCH : RAD_REORDER_NONE, mo->given |= RAD_TOOL_OPT_REORDER;
         return 1;
     }
     if (*a + 1 >= argc) {
