@@ -11555,8 +11555,13 @@ typedef struct rad__tstep {
 
 #if defined(__GNUC__) || defined(__clang__)
 #  define RAD__PREFETCH(p) __builtin_prefetch(p)
+#  define RAD__HOT static inline __attribute__((always_inline)) /* the step's per-draw helpers */
+#elif defined(_MSC_VER)
+#  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static __forceinline
 #else
 #  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static inline
 #endif
 #ifndef RAD__TEMPORAL_AHEAD
 #  define RAD__TEMPORAL_AHEAD 64u /* draws whose bins are in flight ahead of the one resolved */
@@ -11573,6 +11578,7 @@ typedef struct rad__tpipe {
     const uint32_t *bins;  /* bins of row 'row' in table set 'set' */
     uint32_t nb, words, key, seedframe, k, sets;
     uint32_t row, set, s, end; /* the next draw to issue; row == end: none left */
+    uint32_t mix;              /* (set * k + s) * 0x9E3779B9u of that draw, kept by addition */
     const uint32_t *e[RAD__TEMPORAL_AHEAD]; /* issued draws: the bin ... */
     uint32_t u2[RAD__TEMPORAL_AHEAD];       /* ... and the threshold test's random word */
 } rad__tpipe;
@@ -11586,28 +11592,35 @@ static void rad__tpipe_row(rad__tpipe *p)
     p->bins = tb->bins + (size_t)first * p->words;
 }
 
-/* issues the next draw of the sequence into ring slot 'slot' */
-static void rad__tpipe_issue(rad__tpipe *p, uint32_t slot)
+/* the issuing side moves past the last draw of a row's table set (rare: out of the hot path) */
+static void rad__tpipe_next(rad__tpipe *p)
 {
-    uint32_t u1;
-    if (p->row >= p->end) return;
-    u1 = rad__pcg(p->key ^ ((p->set * p->k + p->s) * 0x9E3779B9u));
-    p->u2[slot] = rad__pcg(u1 ^ 0x68E31DA4u);
-    p->e[slot] = p->bins + (size_t)(((uint64_t)u1 * (uint64_t)p->nb) >> 32) * p->words;
-    RAD__PREFETCH(p->e[slot]);
-    if (++p->s < p->k) return;
     p->s = 0;
     if (++p->set == p->sets) {
         p->set = 0;
+        p->mix = 0;
         if (++p->row >= p->end) return;
         p->key = rad__pcg(p->seedframe ^ p->row);
     }
     rad__tpipe_row(p);
 }
 
+/* issues the next draw of the sequence into ring slot 'slot' */
+RAD__HOT void rad__tpipe_issue(rad__tpipe *p, uint32_t slot)
+{
+    uint32_t u1;
+    if (p->row >= p->end) return;
+    u1 = rad__pcg(p->key ^ p->mix);
+    p->mix += 0x9E3779B9u;
+    p->u2[slot] = rad__pcg(u1 ^ 0x68E31DA4u);
+    p->e[slot] = p->bins + (size_t)(((uint64_t)u1 * (uint64_t)p->nb) >> 32) * p->words;
+    RAD__PREFETCH(p->e[slot]);
+    if (++p->s == p->k) rad__tpipe_next(p);
+}
+
 /* resolves the draw in ring slot *q (issued AHEAD draws ago), issues the draw AHEAD after it
    into the freed slot, advances *q; returns the sampled RGB value (V_J, or env for J = N) */
-static const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words, const float *V, const float *env)
+RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words, const float *V, const float *env)
 {
     const uint32_t slot = *q, *e = p->e[slot], u2 = p->u2[slot];
     uint32_t col;
@@ -11691,6 +11704,7 @@ static void rad__temporal_task(void *data, uint32_t task)
     p.end = r1;
     p.set = 0;
     p.s = 0;
+    p.mix = 0;
     p.key = rad__pcg(p.seedframe ^ r0);
     rad__tpipe_row(&p);
     for (q = 0; q < RAD__TEMPORAL_AHEAD; ++q) rad__tpipe_issue(&p, q);
