@@ -2291,12 +2291,14 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
 #endif
 
 /* Linux: madvise(MADV_HUGEPAGE) on large alias tables (>>temporal). Strict ISO C (-std=c99)
-   hides the declaration in <sys/mman.h>; the function and the value 14 are Linux ABI. */
+   hides the declaration in <sys/mman.h>; the function and the value 14 (asm-generic, which
+   these architectures use) are Linux ABI. */
 #if defined(__linux__) && !defined(RAD_NO_HUGEPAGES)
 #  include <sys/mman.h>
 #  if defined(MADV_HUGEPAGE)
 #    define RAD__MADV_HUGEPAGE MADV_HUGEPAGE
-#  elif !defined(__cplusplus)
+#  elif !defined(__cplusplus) && (defined(__x86_64__) || defined(__i386__) || defined(__aarch64__) || defined(__arm__) || \
+                                  defined(__riscv) || defined(__powerpc64__))
 extern int madvise(void *addr, size_t length, int advice);
 #    define RAD__MADV_HUGEPAGE 14
 #  endif
