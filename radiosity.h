@@ -11622,7 +11622,7 @@ RAD__HOT void rad__tpipe_issue(rad__tpipe *p, uint32_t slot)
 
 /* resolves the draw in ring slot *q (issued AHEAD draws ago), issues the draw AHEAD after it
    into the freed slot, advances *q; returns the sampled RGB value (V_J, or env for J = N) */
-RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words, const float *V, const float *env)
+RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words, uint32_t n, const float *V, const float *env)
 {
     const uint32_t slot = *q, *e = p->e[slot], u2 = p->u2[slot];
     uint32_t col;
@@ -11630,7 +11630,7 @@ RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words
     *q = slot + 1u == RAD__TEMPORAL_AHEAD ? 0u : slot + 1u;
     if (words == 2u) col = u2 < e[0] ? (e[1] & 0xFFFFu) : (e[1] >> 16);
     else col = u2 < e[0] ? e[1] : e[2];
-    return col < p->t->n ? V + 3u * (size_t)col : env;
+    return col < n ? V + 3u * (size_t)col : env;
 }
 
 /* blend of row i: rho (SINGLE, FEEDBACK), the adaptive weight, B_next = w B + (1 - w) X */
@@ -11719,7 +11719,7 @@ static void rad__temporal_task(void *data, uint32_t task)
             const uint32_t words = (uint32_t)t->tables[0]->format;
             float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, scale;
             for (s = 0; s < k; ++s) {
-                const float *v = rad__tpipe_take(&p, &q, words, V, env);
+                const float *v = rad__tpipe_take(&p, &q, words, n, V, env);
                 a0 += v[0];
                 a1 += v[1];
                 a2 += v[2];
@@ -11732,7 +11732,7 @@ static void rad__temporal_task(void *data, uint32_t task)
             for (c = 0; c < 3u; ++c) {
                 const uint32_t words = (uint32_t)t->tables[c]->format;
                 float a = 0.0f;
-                for (s = 0; s < k; ++s) a += rad__tpipe_take(&p, &q, words, V, env)[c];
+                for (s = 0; s < k; ++s) a += rad__tpipe_take(&p, &q, words, n, V, env)[c];
                 X[c] = a * (t->tables[c]->totals[i] / (float)k);
             }
         }
