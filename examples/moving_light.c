@@ -21,13 +21,13 @@
         exitance (E + B + the emitter's own pi L_e) / pi, tone mapped (exposure, sRGB), to
         PREFIX_NNNN.png.
    A CSV PREFIX.csv gets frame, light position, the error, the step's and the exact solve's
-   milliseconds. With a moving light the blend weight w trades lag for noise: the light moves
+   milliseconds and the blend weight (with --adaptive the mean of the per-row weights). With a moving light the blend weight w trades lag for noise: the light moves
    360/frames degrees per frame and B follows with a delay of about 1/(1 - w) frames (and each
    further bounce of mode feedback one frame more), while the noise of one frame's estimate
    shrinks by sqrt((1 - w)/(1 + w)); hence the defaults k = 64, w = 0.8. --adaptive uses the
-   per-row weight of SPEC §8, made for lights that jump and then stay: under a light that
-   moves every frame its change test keeps restarting rows, and the error is larger than with
-   a fixed w (BENCHMARKS.md). The step's time includes the parallel_for's start and join
+   per-row weight of SPEC §8, made for lights that jump and then stay: a light that moves a
+   little every frame does not trip its change test, so the weights climb towards weight_max
+   and B lags far behind (BENCHMARKS.md). The step's time includes the parallel_for's start and join
    (OpenMP), which dominate at these sizes and on a busy machine.
 
    Build:  make moving-light   (cc -std=c99 -O2 -fopenmp -I. examples/moving_light.c -o build/moving_light -lm)
@@ -247,7 +247,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "moving_light: cannot write %s\n", path);
         return 1;
     }
-    fprintf(csv, "frame,light_x,light_y,light_z,relative_rms_error,step_ms,exact_ms\n");
+    fprintf(csv, "frame,light_x,light_y,light_z,relative_rms_error,step_ms,exact_ms,mean_w\n");
     printf("mode %s, k %u, %s %.4g, %u warm-up frames, %u frames; exact: %s\n", single ? "single" : "feedback", k,
            adaptive ? "adaptive, w max" : "w", (double)(adaptive ? to.weight_max : w), warmup, frames, single ? "rho o (F E)" : "Gauss-Seidel L_inf to 1e-6");
     printf("frame | light x y z | rel. RMS error | step ms | exact ms | file\n");
@@ -293,8 +293,17 @@ int main(int argc, char **argv)
         err_sum += err;
         step_sum += t_step;
         err_last = err;
-        fprintf(csv, "%u,%.6g,%.6g,%.6g,%.6f,%.4f,%.4f\n", g, (double)light.position[0], (double)light.position[1],
-                (double)light.position[2], err, 1e3 * t_step, 1e3 * t_exact);
+        {
+            /* the blend weight: fixed, or the mean of the adaptive per-row weights */
+            const float *wr = rad_temporal_weights(tm);
+            double wm = 0.0;
+            if (wr)
+                for (i = 0; i < n; ++i) wm += wr[i] / (double)n;
+            else
+                wm = w;
+            fprintf(csv, "%u,%.6g,%.6g,%.6g,%.6f,%.4f,%.4f,%.5f\n", g, (double)light.position[0], (double)light.position[1],
+                    (double)light.position[2], err, 1e3 * t_step, 1e3 * t_exact, wm);
+        }
 
         /* 5. the image */
         path[0] = '\0';
