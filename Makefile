@@ -2,6 +2,7 @@
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
 #   make gallery every lighting model on rows of spheres, to gallery.png
 #   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
+#   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/
@@ -20,7 +21,7 @@ EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 RAD_DATA_DIR ?= ../shared/data
 
-.PHONY: all demo gallery walk test bench bench-quick tools fuzz clean glsl report report-quick
+.PHONY: all demo gallery walk moving-light test bench bench-quick tools fuzz clean glsl report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk tools
 
@@ -44,6 +45,14 @@ gallery: $(BUILD)/gallery
 	./$(BUILD)/gallery -o gallery.png
 
 walk: $(BUILD)/walk
+
+# temporal radiosity under a moving point light: PNG frames + per-frame error CSV (examples/moving_light.c)
+$(BUILD)/moving_light: examples/moving_light.c examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/moving_light.c -o $@ -lm
+
+moving-light: $(BUILD)/moving_light
+	mkdir -p $(BUILD)/moving_light_frames
+	./$(BUILD)/moving_light -o $(BUILD)/moving_light_frames/frame
 
 test:
 	CC="$(CC)" CXX="$(CXX)" BUILD="$(BUILD)" bash tests/run.sh

@@ -99,6 +99,9 @@
                                                      (SSE2/AVX) is used only when the compiler
                                                      already enables it (-msse2 is the x86-64
                                                      default, -mavx / -march=native for AVX).
+       RAD_NO_HUGEPAGES           (undefined)        implementing file (Linux): alias tables of
+                                                     4 MiB or more are not 2 MiB aligned nor
+                                                     advised MADV_HUGEPAGE (see >>api_temporal)
        _OPENMP                    (set by -fopenmp)  implementing file: the default parallel_for
                                                      runs tasks on OpenMP threads
 
@@ -1906,6 +1909,12 @@ typedef struct rad_alias_tables {
    Errors: INVALID_ARGUMENT (non-square F, a negative or non-finite entry: the logger names
    it), SIZE_OVERFLOW, OUT_OF_MEMORY, CANCELLED. Cost: O(nnz), two passes over F.
    Memory: 8 (compact) or 12 (wide) bytes per non-zero entry + 1 bin per row, 12 bytes per row.
+   HUGE PAGES (Linux, unless RAD_NO_HUGEPAGES): a block of 4 MiB or more is allocated 2 MiB
+   larger through the context's allocator, placed 2 MiB aligned inside it and advised
+   madvise(MADV_HUGEPAGE) before it is written, so that transparent huge pages back it even
+   in the kernel's 'madvise' mode: every draw of the step is a random read into the tables,
+   and with 4 KiB pages most draws also miss the TLB (about 15% of the step's time at
+   N = 10832, BENCHMARKS.md). A hint only: where the kernel declines, nothing changes.
    Thread safety: reentrant. SPEC §8. */
 RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format format, const rad_context *ctx,
                                            rad_alias_tables **out);
@@ -2009,7 +2018,10 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
    including E) to out_indirect when it is not NULL; rad_temporal_indirect returns it too.
    Parallel over rows through ctx->parallel_for; the bits do not depend on the thread count
    or task split (each row's draws depend only on seed, frame, row and sample).
-   Errors: INVALID_ARGUMENT. Cost: O(N k) random reads into the tables and E.
+   Errors: INVALID_ARGUMENT. Cost: O(N k) random reads into the tables and E: the draws
+   are software-pipelined (each task hashes and prefetches the bins of the draws 64 ahead of
+   the one it resolves, across rows), so the cost per draw is the hashing, not the memory
+   latency (BENCHMARKS.md: about 5-6 ns per draw on one core with tables of 450 MB).
    Thread safety: one thread at a time per state. SPEC §8. */
 RAD_API rad_result rad_temporal_step(rad_temporal *temporal, const float *E, const float E0[3], float *out_indirect);
 
@@ -2288,6 +2300,20 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
 #if !defined(RAD_NO_SIMD) && defined(__AVX__)
 #  define RAD__AVX 1
 #  include <immintrin.h>
+#endif
+
+/* Linux: madvise(MADV_HUGEPAGE) on large alias tables (>>temporal). Strict ISO C (-std=c99)
+   hides the declaration in <sys/mman.h>; the function and the value 14 (asm-generic, which
+   these architectures use) are Linux ABI. */
+#if defined(__linux__) && !defined(RAD_NO_HUGEPAGES)
+#  include <sys/mman.h>
+#  if defined(MADV_HUGEPAGE)
+#    define RAD__MADV_HUGEPAGE MADV_HUGEPAGE
+#  elif !defined(__cplusplus) && (defined(__x86_64__) || defined(__i386__) || defined(__aarch64__) || defined(__arm__) || \
+                                  defined(__riscv) || defined(__powerpc64__))
+extern int madvise(void *addr, size_t length, int advice);
+#    define RAD__MADV_HUGEPAGE 14
+#  endif
 #endif
 
 #define RAD__PI 3.14159265358979323846
@@ -11415,6 +11441,29 @@ RAD_API size_t rad_alias_tables_memory(const rad_alias_tables *t)
     return (size_t)t->row_offsets[t->rows] * (size_t)t->format * 4u + ((size_t)t->rows + 1u) * 8u + (size_t)t->rows * 4u;
 }
 
+#define RAD__HUGE_PAGE ((size_t)2u << 20) /* x86-64 and AArch64 (4 KiB base pages) transparent huge page */
+
+/* 'size' bytes for a table block; *raw receives the pointer to free. On Linux, blocks of at
+   least two huge pages are placed 2 MiB aligned (over-allocating 2 MiB) and their whole huge
+   pages marked MADV_HUGEPAGE before first touch: a draw is a random read into hundreds of MB,
+   and with 4 KiB pages nearly every draw also misses the TLB (BENCHMARKS.md). The advice is a
+   hint; its failure (kernel without THP, memory not from mmap) changes nothing. */
+static unsigned char *rad__alias_alloc(const rad_allocator *a, size_t size, void **raw)
+{
+#ifdef RAD__MADV_HUGEPAGE
+    if (size >= 2u * RAD__HUGE_PAGE && size <= (size_t)-1 - RAD__HUGE_PAGE) {
+        unsigned char *p = (unsigned char *)rad__alloc(a, size + RAD__HUGE_PAGE);
+        *raw = p;
+        if (!p) return NULL;
+        p += (RAD__HUGE_PAGE - (size_t)((uintptr_t)p & (RAD__HUGE_PAGE - 1u))) & (RAD__HUGE_PAGE - 1u);
+        (void)madvise(p, size & ~(RAD__HUGE_PAGE - 1u), RAD__MADV_HUGEPAGE);
+        return p;
+    }
+#endif
+    *raw = rad__alloc(a, size);
+    return (unsigned char *)*raw;
+}
+
 typedef struct rad__alias_job {
     const rad_matrix *F;        /* or NULL: 'plane' */
     const float *plane;
@@ -11479,6 +11528,7 @@ static rad_result rad__alias_build(const rad_matrix *F, const float *plane, uint
     rad__alias_job job;
     rad_alias_tables *t;
     rad_result r;
+    unsigned char *base;
     size_t off_bytes, tot_bytes, bin_bytes, total, words, bins_off, tot_off;
     uint64_t sum = 0, maxrow;
     uint32_t i, tasks;
@@ -11536,7 +11586,7 @@ static rad_result rad__alias_build(const rad_matrix *F, const float *plane, uint
     if (!t) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_OUT_OF_MEMORY; }
     memset(t, 0, sizeof(*t));
     t->allocator = c.allocator;
-    t->storage = rad__alloc(&c.allocator, total);
+    base = rad__alias_alloc(&c.allocator, total, &t->storage);
     job.scratch_stride = (rad_alias_row_scratch_size((uint32_t)maxrow) + 7u) & ~(size_t)7u;
     job.scratch = (unsigned char *)rad__alloc_array(&c.allocator, tasks, job.scratch_stride);
     if (!t->storage || !job.scratch) {
@@ -11545,11 +11595,11 @@ static rad_result rad__alias_build(const rad_matrix *F, const float *plane, uint
         rad_alias_tables_destroy(t);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    memcpy(t->storage, job.offsets, off_bytes);
+    memcpy(base, job.offsets, off_bytes);
     rad__free(&c.allocator, job.offsets);
-    job.offsets = (uint64_t *)t->storage;
-    job.totals = (float *)((unsigned char *)t->storage + tot_off);
-    job.bins = (uint32_t *)(void *)((unsigned char *)t->storage + bins_off);
+    job.offsets = (uint64_t *)(void *)base;
+    job.totals = (float *)(void *)(base + tot_off);
+    job.bins = (uint32_t *)(void *)(base + bins_off);
     job.pass = 2;
     r = rad__for_rows(&c, n, tasks, rad__alias_job_row, &job);
     rad__free(&c.allocator, job.scratch);
@@ -11817,112 +11867,186 @@ typedef struct rad__tstep {
 
 #if defined(__GNUC__) || defined(__clang__)
 #  define RAD__PREFETCH(p) __builtin_prefetch(p)
+#  define RAD__HOT static inline __attribute__((always_inline)) /* the step's per-draw helpers */
+#elif defined(_MSC_VER)
+#  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static __forceinline
 #else
 #  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static inline
 #endif
-#define RAD__TEMPORAL_BATCH 16u /* draws whose bins are prefetched together */
+#ifndef RAD__TEMPORAL_AHEAD
+#  define RAD__TEMPORAL_AHEAD 64u /* draws whose bins are in flight ahead of the one resolved */
+#endif
 
-/* acc (RGB, or channel ch only when ch < 3) += sum over draws s of V_J */
-static void rad__temporal_row(const rad_temporal *t, const rad_alias_tables *tb, uint32_t key, uint32_t sample0,
-                              uint32_t i, const float *V, const float *env, uint32_t ch, float *acc)
+/* SOFTWARE PIPELINE of the step. A task's draws form one sequence (row by row, table set by
+   set, sample by sample: exactly the order of the sums in the doc block). The producer hashes
+   draw d + AHEAD, computes its bin address and prefetches it while the consumer resolves draw
+   d, so about AHEAD cache misses are in flight across row boundaries instead of at most one
+   row's k. Only the time at which a bin is fetched changes, never which bin or the order of
+   the float sums: the bits equal the plain loop's. */
+typedef struct rad__tpipe {
+    const rad_temporal *t;
+    const uint32_t *bins;  /* bins of row 'row' in table set 'set' */
+    uint32_t nb, words, key, seedframe, k, sets;
+    uint32_t row, set, s, end; /* the next draw to issue; row == end: none left */
+    uint32_t mix;              /* (set * k + s) * 0x9E3779B9u of that draw, kept by addition */
+    const uint32_t *e[RAD__TEMPORAL_AHEAD]; /* issued draws: the bin ... */
+    uint32_t u2[RAD__TEMPORAL_AHEAD];       /* ... and the threshold test's random word */
+} rad__tpipe;
+
+static void rad__tpipe_row(rad__tpipe *p)
 {
-    const uint32_t k = t->o.samples, words = (uint32_t)tb->format, n = t->n;
-    const uint64_t first = tb->row_offsets[i];
-    const uint32_t nb = (uint32_t)(tb->row_offsets[i + 1] - first);
-    const uint32_t *bins = tb->bins + (size_t)first * words;
-    uint32_t s0, s, u1[RAD__TEMPORAL_BATCH], u2[RAD__TEMPORAL_BATCH], cols[RAD__TEMPORAL_BATCH];
-    for (s0 = 0; s0 < k; s0 += RAD__TEMPORAL_BATCH) {
-        uint32_t m = k - s0 < RAD__TEMPORAL_BATCH ? k - s0 : RAD__TEMPORAL_BATCH;
-        for (s = 0; s < m; ++s) {
-            uint32_t a = rad__pcg(key ^ ((sample0 + s0 + s) * 0x9E3779B9u));
-            u1[s] = a;
-            u2[s] = rad__pcg(a ^ 0x68E31DA4u);
-            RAD__PREFETCH(bins + (size_t)(((uint64_t)a * nb) >> 32) * words);
-        }
-        for (s = 0; s < m; ++s) {
-            cols[s] = rad__alias_pick(bins, nb, words, u1[s], u2[s]);
-            if (cols[s] < n) RAD__PREFETCH(V + 3u * (size_t)cols[s]);
-        }
-        for (s = 0; s < m; ++s) {
-            const float *v = cols[s] < n ? V + 3u * (size_t)cols[s] : env;
-            if (ch < 3u) acc[ch] += v[ch];
-            else { acc[0] += v[0]; acc[1] += v[1]; acc[2] += v[2]; }
-        }
+    const rad_alias_tables *tb = p->t->tables[p->set];
+    const uint64_t first = tb->row_offsets[p->row];
+    p->nb = (uint32_t)(tb->row_offsets[p->row + 1u] - first);
+    p->words = (uint32_t)tb->format;
+    p->bins = tb->bins + (size_t)first * p->words;
+}
+
+/* the issuing side moves past the last draw of a row's table set (rare: out of the hot path) */
+static void rad__tpipe_next(rad__tpipe *p)
+{
+    p->s = 0;
+    if (++p->set == p->sets) {
+        p->set = 0;
+        p->mix = 0;
+        if (++p->row >= p->end) return;
+        p->key = rad__pcg(p->seedframe ^ p->row);
     }
+    rad__tpipe_row(p);
+}
+
+/* issues the next draw of the sequence into ring slot 'slot' */
+RAD__HOT void rad__tpipe_issue(rad__tpipe *p, uint32_t slot)
+{
+    uint32_t u1;
+    if (p->row >= p->end) return;
+    u1 = rad__pcg(p->key ^ p->mix);
+    p->mix += 0x9E3779B9u;
+    p->u2[slot] = rad__pcg(u1 ^ 0x68E31DA4u);
+    p->e[slot] = p->bins + (size_t)(((uint64_t)u1 * (uint64_t)p->nb) >> 32) * p->words;
+    RAD__PREFETCH(p->e[slot]);
+    if (++p->s == p->k) rad__tpipe_next(p);
+}
+
+/* resolves the draw in ring slot *q (issued AHEAD draws ago), issues the draw AHEAD after it
+   into the freed slot, advances *q; returns the sampled RGB value (V_J, or env for J = N) */
+RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words, uint32_t n, const float *V, const float *env)
+{
+    const uint32_t slot = *q, *e = p->e[slot], u2 = p->u2[slot];
+    uint32_t col;
+    rad__tpipe_issue(p, slot);
+    *q = slot + 1u == RAD__TEMPORAL_AHEAD ? 0u : slot + 1u;
+    if (words == 2u) col = u2 < e[0] ? (e[1] & 0xFFFFu) : (e[1] >> 16);
+    else col = u2 < e[0] ? e[1] : e[2];
+    return col < n ? V + 3u * (size_t)col : env;
+}
+
+/* blend of row i: rho (SINGLE, FEEDBACK), the adaptive weight, B_next = w B + (1 - w) X */
+static void rad__temporal_finish(rad_temporal *t, uint32_t i, float *X)
+{
+    float w, *Bn = t->B_next + 3u * (size_t)i;
+    const float *Bp = t->B + 3u * (size_t)i;
+    if (t->o.mode != RAD_TEMPORAL_MULTIBOUNCE) {
+        const float *rho = t->albedo + 3u * (size_t)i;
+        X[0] *= rho[0];
+        X[1] *= rho[1];
+        X[2] *= rho[2];
+    }
+    if (t->o.adaptive) {
+        float x = X[0] + X[1] + X[2], b = Bp[0] + Bp[1] + Bp[2], a, d, wss, sd, r, tgt = t->o.noise_target;
+        uint32_t c = t->count[i];
+        if (c > 0) {
+            /* change test against the current estimate, on x - b winsorized at 3 standard
+               deviations so single heavy-tailed samples cannot trigger it */
+            sd = (float)sqrt((double)t->var[i]);
+            d = x - b;
+            if (d > 3.0f * sd) d = 3.0f * sd;
+            if (d < -3.0f * sd) d = -3.0f * sd;
+            t->fast[i] += 0.25f * (d - t->fast[i]);
+            d = t->fast[i] < 0.0f ? -t->fast[i] : t->fast[i];
+            if (c >= 4u && d > t->o.change_sigma * 0.378f * sd && d > tgt * (b < 0.0f ? -b : b)) c = 0;
+        }
+        if (c == 0) {
+            t->mean[i] = x;
+            t->var[i] = 0.0f;
+            t->fast[i] = 0.0f;
+        } else {
+            a = 1.0f / (float)(c + 1u);
+            if (a < 1.0f / 64.0f) a = 1.0f / 64.0f;
+            t->mean[i] += a * (x - t->mean[i]);
+            t->var[i] += a * ((x - t->mean[i]) * (x - t->mean[i]) - t->var[i]);
+        }
+        if (t->var[i] > 0.0f) {
+            r = tgt * t->mean[i] * tgt * t->mean[i] / t->var[i];
+            wss = (1.0f - r) / (1.0f + r);
+            if (wss < 0.0f) wss = 0.0f;
+            if (wss > t->o.weight_max) wss = t->o.weight_max;
+        } else {
+            wss = 0.0f;
+        }
+        w = (float)c / (float)(c + 1u);
+        if (w > wss) w = wss;
+        t->count[i] = c + 1u < c ? c : c + 1u;
+        t->w[i] = w;
+    } else {
+        w = t->o.weight;
+    }
+    Bn[0] = w * Bp[0] + (1.0f - w) * X[0];
+    Bn[1] = w * Bp[1] + (1.0f - w) * X[1];
+    Bn[2] = w * Bp[2] + (1.0f - w) * X[2];
 }
 
 static void rad__temporal_task(void *data, uint32_t task)
 {
     const rad__tstep *st = (const rad__tstep *)data;
     rad_temporal *t = st->t;
-    const uint32_t n = t->n, k = t->o.samples;
+    const uint32_t n = t->n, k = t->o.samples, sets = t->table_count;
     const uint32_t r0 = (uint32_t)((uint64_t)n * task / st->tasks), r1 = (uint32_t)((uint64_t)n * (task + 1u) / st->tasks);
-    const uint32_t seedframe = rad__pcg(rad__pcg(t->o.seed) ^ t->frame);
-    uint32_t i, ch;
+    const float *V = st->V, *env = st->env;
+    rad__tpipe p;
+    uint32_t i, c, s, q;
+    if (r0 >= r1) return;
+    p.t = t;
+    p.k = k;
+    p.sets = sets;
+    p.seedframe = rad__pcg(rad__pcg(t->o.seed) ^ t->frame);
+    p.row = r0;
+    p.end = r1;
+    p.set = 0;
+    p.s = 0;
+    p.mix = 0;
+    p.key = rad__pcg(p.seedframe ^ r0);
+    rad__tpipe_row(&p);
+    for (q = 0; q < RAD__TEMPORAL_AHEAD; ++q) rad__tpipe_issue(&p, q);
+    q = 0;
     for (i = r0; i < r1; ++i) {
-        const uint32_t key = rad__pcg(seedframe ^ i);
-        float acc[3] = { 0.0f, 0.0f, 0.0f }, X[3], w, *Bn = t->B_next + 3u * (size_t)i;
-        const float *Bp = t->B + 3u * (size_t)i;
-        if (t->table_count == 1u) {
-            float scale = t->tables[0]->totals[i] / (float)k;
-            rad__temporal_row(t, t->tables[0], key, 0u, i, st->V, st->env, 3u, acc);
-            X[0] = acc[0] * scale;
-            X[1] = acc[1] * scale;
-            X[2] = acc[2] * scale;
+        float X[3];
+        /* the sums live in registers (an array indexed by the channel would go through memory
+           and chain every draw's add to the previous one's store) */
+        if (sets == 1u) {
+            const uint32_t words = (uint32_t)t->tables[0]->format;
+            float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f, scale;
+            for (s = 0; s < k; ++s) {
+                const float *v = rad__tpipe_take(&p, &q, words, n, V, env);
+                a0 += v[0];
+                a1 += v[1];
+                a2 += v[2];
+            }
+            scale = t->tables[0]->totals[i] / (float)k;
+            X[0] = a0 * scale;
+            X[1] = a1 * scale;
+            X[2] = a2 * scale;
         } else {
-            for (ch = 0; ch < 3u; ++ch) {
-                rad__temporal_row(t, t->tables[ch], key, ch * k, i, st->V, st->env, ch, acc);
-                X[ch] = acc[ch] * (t->tables[ch]->totals[i] / (float)k);
+            for (c = 0; c < 3u; ++c) {
+                const uint32_t words = (uint32_t)t->tables[c]->format;
+                float a = 0.0f;
+                for (s = 0; s < k; ++s) a += rad__tpipe_take(&p, &q, words, n, V, env)[c];
+                X[c] = a * (t->tables[c]->totals[i] / (float)k);
             }
         }
-        if (t->o.mode != RAD_TEMPORAL_MULTIBOUNCE) {
-            const float *rho = t->albedo + 3u * (size_t)i;
-            X[0] *= rho[0];
-            X[1] *= rho[1];
-            X[2] *= rho[2];
-        }
-        if (t->o.adaptive) {
-            float x = X[0] + X[1] + X[2], b = Bp[0] + Bp[1] + Bp[2], a, d, wss, sd, r, tgt = t->o.noise_target;
-            uint32_t c = t->count[i];
-            if (c > 0) {
-                /* change test against the current estimate, on x - b winsorized at 3 standard
-                   deviations so single heavy-tailed samples cannot trigger it */
-                sd = (float)sqrt((double)t->var[i]);
-                d = x - b;
-                if (d > 3.0f * sd) d = 3.0f * sd;
-                if (d < -3.0f * sd) d = -3.0f * sd;
-                t->fast[i] += 0.25f * (d - t->fast[i]);
-                d = t->fast[i] < 0.0f ? -t->fast[i] : t->fast[i];
-                if (c >= 4u && d > t->o.change_sigma * 0.378f * sd && d > tgt * (b < 0.0f ? -b : b)) c = 0;
-            }
-            if (c == 0) {
-                t->mean[i] = x;
-                t->var[i] = 0.0f;
-                t->fast[i] = 0.0f;
-            } else {
-                a = 1.0f / (float)(c + 1u);
-                if (a < 1.0f / 64.0f) a = 1.0f / 64.0f;
-                t->mean[i] += a * (x - t->mean[i]);
-                t->var[i] += a * ((x - t->mean[i]) * (x - t->mean[i]) - t->var[i]);
-            }
-            if (t->var[i] > 0.0f) {
-                r = tgt * t->mean[i] * tgt * t->mean[i] / t->var[i];
-                wss = (1.0f - r) / (1.0f + r);
-                if (wss < 0.0f) wss = 0.0f;
-                if (wss > t->o.weight_max) wss = t->o.weight_max;
-            } else {
-                wss = 0.0f;
-            }
-            w = (float)c / (float)(c + 1u);
-            if (w > wss) w = wss;
-            t->count[i] = c + 1u < c ? c : c + 1u;
-            t->w[i] = w;
-        } else {
-            w = t->o.weight;
-        }
-        Bn[0] = w * Bp[0] + (1.0f - w) * X[0];
-        Bn[1] = w * Bp[1] + (1.0f - w) * X[1];
-        Bn[2] = w * Bp[2] + (1.0f - w) * X[2];
+        rad__temporal_finish(t, i, X);
     }
 }
 

@@ -128,6 +128,16 @@ if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -
 else
     fail walk-small
 fi
+# temporal radiosity under a moving light: frames 0 and 3 written, different, 4 error rows
+if build moving-light $CC -std=c99 $WARN -O2 $OMP -I. examples/moving_light.c -o "$BUILD/moving_light" -lm &&
+   "$BUILD/moving_light" --patches 150 --frames 4 --every 3 --size 32x32 -o "$BUILD/moving-small" >"$BUILD/moving-light.out" 2>&1 &&
+   [ -s "$BUILD/moving-small_0000.png" ] && [ -s "$BUILD/moving-small_0003.png" ] && [ ! -e "$BUILD/moving-small_0001.png" ] &&
+   ! cmp -s "$BUILD/moving-small_0000.png" "$BUILD/moving-small_0003.png" &&
+   [ "$(awk -F, 'NR > 1 && $5 >= 0 && $5 < 10' "$BUILD/moving-small.csv" | cut -d, -f2-4 | sort -u | wc -l)" -eq 4 ]; then
+    pass moving-light-small
+else
+    fail moving-light-small
+fi
 # ---- GLSL: the header holds the current glsl/ sources --------------------------------------
 if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
    "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then

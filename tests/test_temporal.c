@@ -646,6 +646,156 @@ static void tp_container(void)
     tp_cornell_free(&c);
 }
 
+/* The step written out plainly from the doc block (rad_temporal_random + rad_alias_draw, the
+   float operations in the documented order, fixed weight) for 'frames' frames; B: 3N, starts
+   at 0. The library's software-pipelined step must give the same bits. */
+static void tp_plain_steps(const rad_alias_tables *const *tb, uint32_t sets, const float *albedo, const rad_temporal_options *o,
+                           const float *E, const float *E0, uint32_t frames, float *B)
+{
+    const uint32_t n = tb[0]->rows, k = o->samples;
+    float *V = (float *)malloc(sizeof(float) * 3 * n), *Bn = (float *)malloc(sizeof(float) * 3 * n);
+    uint32_t fr, i, c, s, u[2];
+    memset(B, 0, sizeof(float) * 3 * n);
+    for (fr = 0; fr < frames; ++fr) {
+        for (i = 0; i < 3 * n; ++i) V[i] = o->mode == RAD_TEMPORAL_FEEDBACK ? E[i] + B[i] : E[i];
+        for (i = 0; i < n; ++i) {
+            float acc[3] = { 0.0f, 0.0f, 0.0f }, X[3];
+            for (c = 0; c < sets; ++c) {
+                const uint64_t first = tb[c]->row_offsets[i];
+                const uint32_t nb = (uint32_t)(tb[c]->row_offsets[i + 1] - first);
+                for (s = 0; s < k; ++s) {
+                    uint32_t col, ch;
+                    rad_temporal_random(o->seed, fr, i, c * k + s, u);
+                    col = rad_alias_draw(tb[c]->bins + (size_t)first * (uint32_t)tb[c]->format, nb, tb[c]->format, u[0], u[1]);
+                    for (ch = 0; ch < 3; ++ch)
+                        if (sets == 1u || ch == c) acc[ch] += col < n ? V[3 * (size_t)col + ch] : (E0 ? E0[ch] : 0.0f);
+                }
+            }
+            for (c = 0; c < 3; ++c) {
+                X[c] = acc[c] * (tb[sets == 1u ? 0 : c]->totals[i] / (float)k);
+                if (o->mode != RAD_TEMPORAL_MULTIBOUNCE) X[c] *= albedo[3 * i + c];
+                Bn[3 * i + c] = o->weight * B[3 * i + c] + (1.0f - o->weight) * X[c];
+            }
+        }
+        memcpy(B, Bn, sizeof(float) * 3 * n);
+    }
+    free(V);
+    free(Bn);
+}
+
+/* The pipelined step (draws hashed and prefetched RAD__TEMPORAL_AHEAD ahead, across rows) equals
+   the plain loop bit for bit: k = 1 with one row per task (fewer draws than the look-ahead),
+   k = 10, k = 70 (more draws per row than the look-ahead) in feedback mode with wide bins,
+   three channel tables of mixed formats, several task splits. */
+static void tp_pipeline_bits(void)
+{
+    tp_cornell c;
+    rad_alias_tables *t = NULL, *tw = NULL, *tc[3] = { NULL, NULL, NULL };
+    rad_context ctx;
+    rad_temporal_options o;
+    float *ref, *out, *plane, E0[3] = { 0.2f, 0.4f, 0.1f };
+    uint32_t n, v, i;
+    static const uint32_t ks[4] = { 1, 10, 70, 10 }, tasks[4] = { 4096, 0, 7, 3 };
+    if (!tp_cornell_build(&c, rad_test_quick() ? 40 : 80, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    n = c.n;
+    ref = (float *)malloc(sizeof(float) * 3 * n);
+    out = (float *)malloc(sizeof(float) * 3 * n);
+    plane = (float *)malloc(sizeof(float) * n * n);
+    CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_COMPACT, NULL, &t));
+    CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_WIDE, NULL, &tw));
+    for (v = 0; v < 3; ++v) {
+        for (i = 0; i < n * n; ++i) plane[i] = (1.0f + 0.5f * (float)v) * c.ff->matrix.dense[i];
+        CHECK_OK(rad_alias_tables_create_dense(plane, n, v == 1 ? RAD_ALIAS_WIDE : RAD_ALIAS_COMPACT, NULL, &tc[v]));
+    }
+    for (v = 0; v < 4 && t && tw && tc[0] && tc[1] && tc[2]; ++v) {
+        const rad_alias_tables *const *tb = v == 3 ? (const rad_alias_tables *const *)tc : (const rad_alias_tables *const *)(v == 2 ? &tw : &t);
+        const uint32_t sets = v == 3 ? 3u : 1u;
+        rad_temporal *tm = NULL;
+        uint32_t fr;
+        rad_temporal_options_default(&o);
+        o.samples = ks[v];
+        o.seed = 1234u + v;
+        o.weight = 0.75f;
+        o.mode = v == 2 ? RAD_TEMPORAL_FEEDBACK : v == 3 ? RAD_TEMPORAL_MULTIBOUNCE : RAD_TEMPORAL_SINGLE;
+        memset(&ctx, 0, sizeof(ctx));
+        if (tasks[v]) { ctx.parallel_for = tp_reverse_for; ctx.task_count = tasks[v]; }
+        tp_plain_steps(tb, sets, c.P->albedo, &o, c.E, E0, 3, ref);
+        CHECK_OK(rad_temporal_create(tb, sets, c.P->albedo, &o, &ctx, &tm));
+        if (!tm) continue;
+        for (fr = 0; fr < 3; ++fr) CHECK_OK(rad_temporal_step(tm, c.E, E0, out));
+        CHECK(memcmp(ref, out, sizeof(float) * 3 * n) == 0);
+        rad_temporal_destroy(tm);
+    }
+    rad_alias_tables_destroy(t);
+    rad_alias_tables_destroy(tw);
+    for (v = 0; v < 3; ++v) rad_alias_tables_destroy(tc[v]);
+    free(ref); free(out); free(plane);
+    tp_cornell_free(&c);
+}
+
+/* counts the bytes a custom allocator hands out and takes back (huge-page path below) */
+typedef struct tp_counting { size_t live, calls; } tp_counting;
+static void *tp_count_alloc(void *user, size_t size)
+{
+    tp_counting *a = (tp_counting *)user;
+    size_t *p = (size_t *)malloc(size + 16u);
+    if (!p) return NULL;
+    p[0] = size;
+    a->live += size;
+    a->calls++;
+    return (unsigned char *)p + 16;
+}
+static void tp_count_free(void *user, void *ptr)
+{
+    tp_counting *a = (tp_counting *)user;
+    size_t *p = (size_t *)(void *)((unsigned char *)ptr - 16);
+    a->live -= p[0];
+    free(p);
+}
+
+/* Tables of more than two huge pages (about 4.4 MB): on Linux the block is 2 MiB aligned
+   (placed inside an over-allocation, the original pointer kept for free) and advised
+   MADV_HUGEPAGE. The bins equal the streamed-row builder's, draws work, and destroy gives back
+   every byte through a custom allocator (and frees correctly under ASan/valgrind). */
+static void tp_huge_tables(void)
+{
+    const uint32_t n = 740;
+    float *plane = (float *)malloc(sizeof(float) * n * n), total;
+    uint32_t *bins = (uint32_t *)malloc(sizeof(uint32_t) * 2 * (n + 1)), i, nb, state = 7u, bad = 0;
+    void *scratch = malloc(rad_alias_row_scratch_size(n));
+    rad_alias_tables *t = NULL;
+    rad_context ctx;
+    tp_counting counter = { 0, 0 };
+    for (i = 0; i < n * n; ++i) {
+        state = state * 1664525u + 1013904223u;
+        plane[i] = (float)(1u + (state >> 20)) * (0.9f / (4096.0f * (float)n)); /* rows sum to < 0.9 */
+    }
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.allocator.alloc = tp_count_alloc;
+    ctx.allocator.free = tp_count_free;
+    ctx.allocator.user = &counter;
+    CHECK_OK(rad_alias_tables_create_dense(plane, n, RAD_ALIAS_COMPACT, &ctx, &t));
+    if (t) {
+        CHECK(t->row_offsets[n] == (uint64_t)n * (n + 1u)); /* every entry plus the environment */
+        CHECK(rad_alias_tables_memory(t) > 4u * ((size_t)1 << 20));
+#ifdef RAD__MADV_HUGEPAGE
+        CHECK(((uintptr_t)t->row_offsets & (((uintptr_t)2 << 20) - 1u)) == 0);
+        CHECK((void *)t->row_offsets != t->storage);
+#endif
+        for (i = 0; i < n; i += 37) {
+            CHECK_OK(rad_alias_build_row(NULL, plane + (size_t)i * n, n, n, RAD_ALIAS_COMPACT, bins, &nb, &total, scratch));
+            if (nb != n + 1u || total != t->totals[i] ||
+                memcmp(bins, t->bins + (size_t)t->row_offsets[i] * 2u, sizeof(uint32_t) * 2u * nb) != 0)
+                ++bad;
+            CHECK(rad_alias_draw(t->bins + (size_t)t->row_offsets[i] * 2u, n + 1u, RAD_ALIAS_COMPACT, 0x12345678u, 0x9ABCDEF0u) <= n);
+        }
+        CHECK(bad == 0);
+    }
+    rad_alias_tables_destroy(t);
+    CHECK(counter.calls > 0 && counter.live == 0);
+    free(plane); free(bins); free(scratch);
+}
+
 static const rad_test_case tests_temporal[] = {
     { "temporal_random_vectors", tp_random_vectors },
     { "temporal_alias_chi_square", tp_alias_chi_square },
@@ -658,5 +808,7 @@ static const rad_test_case tests_temporal[] = {
     { "temporal_adaptive", tp_adaptive },
     { "temporal_errors", tp_errors },
     { "temporal_container", tp_container },
+    { "temporal_pipeline_bits", tp_pipeline_bits },
+    { "temporal_huge_tables", tp_huge_tables },
     { NULL, NULL }
 };
