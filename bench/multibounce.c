@@ -14,13 +14,14 @@
           --reorder-only: only the table of reordering methods, MSE and build time, no apply timings;
           --reorder-search: a slow local search on the real encoded error from the default ordering, N = 1850,
           to see how far the methods are from it: about 10 minutes on one core)
-          multibounce --apply-only [--size TARGET] [--cache FILE] [--label TEXT] [--append FILE.md]
+          multibounce --apply-only [--dense] [--size TARGET] [--cache FILE] [--label TEXT] [--append FILE.md]
             only the apply table: K Jacobi bounces (K = 3, 8) against the BC1 and 3xBC4 forms of
             F_mb (rad_block_options_default), best of 31, with the share
             of the outlier pass. --cache FILE keeps F, E, albedo and the four compressed
             matrices between runs (built when FILE is missing: the O(N^3) steps run once), so
             a second build of this program (e.g. -DRAD_BENCH_HEADER='"old.h"', an older
-            radiosity.h) times its apply on the same bytes. */
+            radiosity.h) times its apply on the same bytes. --dense adds the float and half
+            F_mb (K = 1, 3, 8, built from the cached F) against K Jacobi bounces. */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #ifdef RAD_BENCH_HEADER
@@ -638,7 +639,50 @@ static int apply_build(uint32_t target, const char *cache)
     return 0;
 }
 
-static int apply_only(uint32_t target, const char *cache, const char *label, int threads)
+/* --dense: float and half F_mb (K = 1, 3, 8) built from the cached F, against K Jacobi bounces */
+static int apply_dense(rad_system *sys, rad_matrix *F, const float *albedo, const float *E, float *out, float *ref, int threads)
+{
+    static const uint32_t ks[3] = { 1u, 3u, 8u };
+    uint32_t ki, n = sys->n;
+    size_t n3 = 3 * (size_t)n;
+    emit("\nDense F_mb, N = %u, %d thread%s, best of %d (float F_mb: %.1f MiB = 3x F; half: %.1f MiB); L error = max |dL| / max |L|:\n\n",
+         n, threads, threads == 1 ? "" : "s", REPS, 12.0 * n * n / 1048576.0, 6.0 * n * n / 1048576.0);
+    emit("| K | Jacobi ms | F_mb build s | float F_mb ms | speed-up | L error | half F_mb ms | speed-up | L error |\n");
+    emit("|---|---|---|---|---|---|---|---|---|\n");
+    for (ki = 0; ki < 3; ++ki) {
+        rad_multibounce_options o;
+        rad_multibounce *mb = NULL, *h = NULL;
+        rad_solve_options so;
+        run r;
+        double tj, tb, tf, th, ef, eh, t0;
+        memset(&r, 0, sizeof(r));
+        r.sys = sys;
+        r.k = ks[ki];
+        tj = time_it(&r, E, out);
+        rad_solve_options_default(&so);
+        so.bounces = ks[ki];
+        rad_solve_jacobi(sys, &so, ref, NULL, NULL);
+        rad_multibounce_options_default(&o);
+        o.bounces = ks[ki];
+        t0 = now();
+        if (rad_multibounce_create(F, albedo, &o, NULL, &mb)) return 1;
+        tb = now() - t0;
+        if (rad_multibounce_convert(mb, RAD_MB_HALF, NULL, &h)) return 1;
+        memset(&r, 0, sizeof(r));
+        r.mb = mb;
+        tf = time_it(&r, E, out);
+        ef = rel_err(out, ref, n3);
+        r.mb = h;
+        th = time_it(&r, E, out);
+        eh = rel_err(out, ref, n3);
+        emit("| %u | %.2f | %.1f | %.2f | %.2fx | %.1e | %.2f | %.2fx | %.1e |\n", ks[ki], tj, tb, tf, tj / tf, ef, th, tj / th, eh);
+        rad_multibounce_destroy(h);
+        rad_multibounce_destroy(mb);
+    }
+    return 0;
+}
+
+static int apply_only(uint32_t target, const char *cache, const char *label, int threads, int dense)
 {
     FILE *fp;
     uint32_t n, k, f;
@@ -723,6 +767,7 @@ static int apply_only(uint32_t target, const char *cache, const char *label, int
                  (double)(blocks + other) / 1048576.0, ta, to, t_jac[k], t_jac[k] / ta, e);
             rad_multibounce_blocks_destroy(b);
         }
+    if (dense && apply_dense(&sys, &F, albedo, E, out, ref, threads)) return 1;
     rad_container_close(ct);
     free(buf); free(E); free(albedo); free(out); free(ref); free(Fd);
     return 0;
@@ -730,12 +775,13 @@ static int apply_only(uint32_t target, const char *cache, const char *label, int
 
 int main(int argc, char **argv)
 {
-    int i, quick = 0, threads = 1, reorder = 0, apply = 0;
+    int i, quick = 0, threads = 1, reorder = 0, apply = 0, dense = 0;
     uint32_t size = 1736;
     const char *cache = NULL, *label = NULL;
     for (i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
         else if (!strcmp(argv[i], "--apply-only")) apply = 1;
+        else if (!strcmp(argv[i], "--dense")) dense = 1;
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--cache") && i + 1 < argc) cache = argv[++i];
         else if (!strcmp(argv[i], "--label") && i + 1 < argc) label = argv[++i];
@@ -750,7 +796,7 @@ int main(int argc, char **argv)
     threads = omp_get_max_threads();
 #endif
     if (apply) {
-        int r = apply_only(size, cache, label, threads);
+        int r = apply_only(size, cache, label, threads, dense);
         if (g_md) fclose(g_md);
         return r;
     }
