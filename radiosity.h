@@ -11875,8 +11875,20 @@ typedef struct rad__tstep {
 #  define RAD__PREFETCH(p) ((void)0)
 #  define RAD__HOT static inline
 #endif
+#if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
+#  define RAD__TEMPORAL_AVX2 1 /* hashes 8 draws at once (rad__tpipe_issue8) */
+#endif
+/* draws whose bins are in flight ahead of the one resolved. AVX2 issues cheaper, so more of
+   them overlap: 64 -> 128 took 4.9 to 4.2 ns per draw with 450 MB of tables (BENCHMARKS.md) */
 #ifndef RAD__TEMPORAL_AHEAD
-#  define RAD__TEMPORAL_AHEAD 64u /* draws whose bins are in flight ahead of the one resolved */
+#  if defined(RAD__TEMPORAL_AVX2)
+#    define RAD__TEMPORAL_AHEAD 128u
+#  else
+#    define RAD__TEMPORAL_AHEAD 64u
+#  endif
+#endif
+#if defined(RAD__TEMPORAL_AVX2) && (RAD__TEMPORAL_AHEAD % 8u) != 0
+#  undef RAD__TEMPORAL_AVX2 /* the ring is filled 8 slots at a time */
 #endif
 
 /* SOFTWARE PIPELINE of the step. A task's draws form one sequence (row by row, table set by
@@ -11930,8 +11942,7 @@ RAD__HOT void rad__tpipe_issue(rad__tpipe *p, uint32_t slot)
     if (++p->s == p->k) rad__tpipe_next(p);
 }
 
-#if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64)) && (RAD__TEMPORAL_AHEAD % 8u) == 0
-#  define RAD__TEMPORAL_AVX2 1
+#if defined(RAD__TEMPORAL_AVX2)
 /* rad__pcg on 8 lanes */
 RAD__HOT __m256i rad__pcg8(__m256i v)
 {
