@@ -11879,7 +11879,7 @@ typedef struct rad__tstep {
 #  define RAD__TEMPORAL_AVX2 1 /* hashes 8 draws at once (rad__tpipe_issue8) */
 #endif
 /* draws whose bins are in flight ahead of the one resolved. AVX2 issues cheaper, so more of
-   them overlap: 64 -> 128 took 4.9 to 4.2 ns per draw with 450 MB of tables (BENCHMARKS.md) */
+   them overlap: 64 -> 128 took 4.8-5.1 to 4.2-4.5 ns per draw with 450 MB of tables (BENCHMARKS.md) */
 #ifndef RAD__TEMPORAL_AHEAD
 #  if defined(RAD__TEMPORAL_AVX2)
 #    define RAD__TEMPORAL_AHEAD 128u
@@ -11946,7 +11946,8 @@ RAD__HOT void rad__tpipe_issue(rad__tpipe *p, uint32_t slot)
 /* rad__pcg on 8 lanes */
 RAD__HOT __m256i rad__pcg8(__m256i v)
 {
-    const __m256i s = _mm256_add_epi32(_mm256_mullo_epi32(v, _mm256_set1_epi32((int)747796405u)), _mm256_set1_epi32((int)2891336453u));
+    const __m256i s = _mm256_add_epi32(_mm256_mullo_epi32(v, _mm256_set1_epi32((int)747796405u)),
+                                       _mm256_set1_epi32((int)2891336453u));
     const __m256i sh = _mm256_add_epi32(_mm256_srli_epi32(s, 28), _mm256_set1_epi32(4));
     const __m256i t = _mm256_mullo_epi32(_mm256_xor_si256(_mm256_srlv_epi32(s, sh), s), _mm256_set1_epi32(277803737));
     return _mm256_xor_si256(_mm256_srli_epi32(t, 22), t);
@@ -12000,12 +12001,18 @@ RAD__HOT void rad__tpipe_issue8(rad__tpipe *p, uint32_t slot)
     /* addresses: bins + bin * words, as 64-bit integers */
     inb_lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(inb));
     inb_hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(inb, 1));
-    scale_lo = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(4u * words_a)), _mm256_set1_epi64x((long long)(4u * words_b)), inb_lo);
-    scale_hi = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(4u * words_a)), _mm256_set1_epi64x((long long)(4u * words_b)), inb_hi);
-    base_lo = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(uintptr_t)bins_a), _mm256_set1_epi64x((long long)(uintptr_t)bins_b), inb_lo);
-    base_hi = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(uintptr_t)bins_a), _mm256_set1_epi64x((long long)(uintptr_t)bins_b), inb_hi);
-    base_lo = _mm256_add_epi64(base_lo, _mm256_mul_epu32(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(idx)), scale_lo));
-    base_hi = _mm256_add_epi64(base_hi, _mm256_mul_epu32(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(idx, 1)), scale_hi));
+    scale_lo = _mm256_set1_epi64x((long long)(4u * words_a));
+    scale_hi = _mm256_set1_epi64x((long long)(4u * words_b));
+    scale_lo = _mm256_blendv_epi8(scale_lo, scale_hi, inb_lo);
+    scale_hi = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(4u * words_a)), scale_hi, inb_hi);
+    base_lo = _mm256_set1_epi64x((long long)(uintptr_t)bins_a);
+    base_hi = _mm256_set1_epi64x((long long)(uintptr_t)bins_b);
+    base_lo = _mm256_blendv_epi8(base_lo, base_hi, inb_lo);
+    base_hi = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(uintptr_t)bins_a), base_hi, inb_hi);
+    scale_lo = _mm256_mul_epu32(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(idx)), scale_lo);
+    scale_hi = _mm256_mul_epu32(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(idx, 1)), scale_hi);
+    base_lo = _mm256_add_epi64(base_lo, scale_lo);
+    base_hi = _mm256_add_epi64(base_hi, scale_hi);
     _mm256_storeu_si256((__m256i *)(void *)(p->e + slot), base_lo);
     _mm256_storeu_si256((__m256i *)(void *)(p->e + slot + 4u), base_hi);
     for (j = 0; j < 8u; ++j) RAD__PREFETCH(p->e[slot + j]);
