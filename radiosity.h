@@ -11875,8 +11875,20 @@ typedef struct rad__tstep {
 #  define RAD__PREFETCH(p) ((void)0)
 #  define RAD__HOT static inline
 #endif
+#if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
+#  define RAD__TEMPORAL_AVX2 1 /* hashes 8 draws at once (rad__tpipe_issue8) */
+#endif
+/* draws whose bins are in flight ahead of the one resolved. AVX2 issues cheaper, so more of
+   them overlap: 64 -> 128 took 4.8-5.1 to 4.2-4.5 ns per draw with 450 MB of tables (BENCHMARKS.md) */
 #ifndef RAD__TEMPORAL_AHEAD
-#  define RAD__TEMPORAL_AHEAD 64u /* draws whose bins are in flight ahead of the one resolved */
+#  if defined(RAD__TEMPORAL_AVX2)
+#    define RAD__TEMPORAL_AHEAD 128u
+#  else
+#    define RAD__TEMPORAL_AHEAD 64u
+#  endif
+#endif
+#if defined(RAD__TEMPORAL_AVX2) && (RAD__TEMPORAL_AHEAD % 8u) != 0
+#  undef RAD__TEMPORAL_AVX2 /* the ring is filled 8 slots at a time */
 #endif
 
 /* SOFTWARE PIPELINE of the step. A task's draws form one sequence (row by row, table set by
@@ -11930,16 +11942,100 @@ RAD__HOT void rad__tpipe_issue(rad__tpipe *p, uint32_t slot)
     if (++p->s == p->k) rad__tpipe_next(p);
 }
 
+#if defined(RAD__TEMPORAL_AVX2)
+/* rad__pcg on 8 lanes */
+RAD__HOT __m256i rad__pcg8(__m256i v)
+{
+    const __m256i s = _mm256_add_epi32(_mm256_mullo_epi32(v, _mm256_set1_epi32((int)747796405u)),
+                                       _mm256_set1_epi32((int)2891336453u));
+    const __m256i sh = _mm256_add_epi32(_mm256_srli_epi32(s, 28), _mm256_set1_epi32(4));
+    const __m256i t = _mm256_mullo_epi32(_mm256_xor_si256(_mm256_srlv_epi32(s, sh), s), _mm256_set1_epi32(277803737));
+    return _mm256_xor_si256(_mm256_srli_epi32(t, 22), t);
+}
+
+/* issues the next 8 draws of the sequence into ring slots slot .. slot + 7, the same words
+   and bins as 8 calls of rad__tpipe_issue: both hashes and the bin index on 8 lanes. With
+   k >= 8 the 8 draws cross at most one boundary (row or table set): lanes 0 .. m-1 belong to
+   the draw's current row and set (A), lanes m .. 7 to the next one (B). Lanes past the task's
+   last row repeat A's stream (valid bins of A's row: prefetched, never resolved). */
+RAD__HOT void rad__tpipe_issue8(rad__tpipe *p, uint32_t slot)
+{
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256i laneg = _mm256_mullo_epi32(lane, _mm256_set1_epi32((int)0x9E3779B9u));
+    uint32_t m = p->k - p->s, key_a, mix_a, nb_a, words_a, key_b, mix_b, nb_b, words_b, j;
+    const uint32_t *bins_a, *bins_b;
+    __m256i inb, vkey, vmix, vnb, u1, u2, even, odd, idx, inb_lo, inb_hi, base_lo, base_hi, scale_lo, scale_hi;
+    if (p->k < 8u || p->row >= p->end) {
+        for (j = 0; j < 8u; ++j) rad__tpipe_issue(p, slot + j);
+        return;
+    }
+    if (m > 8u) m = 8u;
+    key_a = key_b = p->key;
+    mix_a = mix_b = p->mix;
+    nb_a = nb_b = p->nb;
+    words_a = words_b = p->words;
+    bins_a = bins_b = p->bins;
+    p->mix += m * 0x9E3779B9u;
+    p->s += m;
+    if (p->s == p->k) rad__tpipe_next(p);
+    if (m < 8u && p->row < p->end) {
+        key_b = p->key;
+        mix_b = p->mix - m * 0x9E3779B9u; /* lane j >= m: p->mix + (j - m) * 0x9E3779B9u */
+        nb_b = p->nb;
+        words_b = p->words; /* the table sets may differ in format */
+        bins_b = p->bins;
+        p->mix += (8u - m) * 0x9E3779B9u;
+        p->s += 8u - m; /* < k: 8 - m < 8 <= k */
+    }
+    inb = _mm256_cmpgt_epi32(lane, _mm256_set1_epi32((int)m - 1));
+    vkey = _mm256_blendv_epi8(_mm256_set1_epi32((int)key_a), _mm256_set1_epi32((int)key_b), inb);
+    vmix = _mm256_blendv_epi8(_mm256_set1_epi32((int)mix_a), _mm256_set1_epi32((int)mix_b), inb);
+    vnb = _mm256_blendv_epi8(_mm256_set1_epi32((int)nb_a), _mm256_set1_epi32((int)nb_b), inb);
+    u1 = rad__pcg8(_mm256_xor_si256(vkey, _mm256_add_epi32(vmix, laneg)));
+    u2 = rad__pcg8(_mm256_xor_si256(u1, _mm256_set1_epi32(0x68E31DA4)));
+    _mm256_storeu_si256((__m256i *)(void *)(p->u2 + slot), u2);
+    /* bin = (u1 * nb) >> 32: even lanes' products shifted down, odd lanes' kept in place */
+    even = _mm256_srli_epi64(_mm256_mul_epu32(u1, vnb), 32);
+    odd = _mm256_mul_epu32(_mm256_srli_epi64(u1, 32), _mm256_srli_epi64(vnb, 32));
+    idx = _mm256_blend_epi32(even, odd, 0xAA);
+    /* addresses: bins + bin * words, as 64-bit integers */
+    inb_lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(inb));
+    inb_hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(inb, 1));
+    scale_lo = _mm256_set1_epi64x((long long)(4u * words_a));
+    scale_hi = _mm256_set1_epi64x((long long)(4u * words_b));
+    scale_lo = _mm256_blendv_epi8(scale_lo, scale_hi, inb_lo);
+    scale_hi = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(4u * words_a)), scale_hi, inb_hi);
+    base_lo = _mm256_set1_epi64x((long long)(uintptr_t)bins_a);
+    base_hi = _mm256_set1_epi64x((long long)(uintptr_t)bins_b);
+    base_lo = _mm256_blendv_epi8(base_lo, base_hi, inb_lo);
+    base_hi = _mm256_blendv_epi8(_mm256_set1_epi64x((long long)(uintptr_t)bins_a), base_hi, inb_hi);
+    scale_lo = _mm256_mul_epu32(_mm256_cvtepu32_epi64(_mm256_castsi256_si128(idx)), scale_lo);
+    scale_hi = _mm256_mul_epu32(_mm256_cvtepu32_epi64(_mm256_extracti128_si256(idx, 1)), scale_hi);
+    base_lo = _mm256_add_epi64(base_lo, scale_lo);
+    base_hi = _mm256_add_epi64(base_hi, scale_hi);
+    _mm256_storeu_si256((__m256i *)(void *)(p->e + slot), base_lo);
+    _mm256_storeu_si256((__m256i *)(void *)(p->e + slot + 4u), base_hi);
+    for (j = 0; j < 8u; ++j) RAD__PREFETCH(p->e[slot + j]);
+}
+#endif
+
 /* resolves the draw in ring slot *q (issued AHEAD draws ago), issues the draw AHEAD after it
-   into the freed slot, advances *q; returns the sampled RGB value (V_J, or env for J = N) */
+   into the freed slot (AVX2: the 8 draws after slots slot-7 .. slot once slot-7 .. slot are
+   resolved), advances *q; returns the sampled RGB value (V_J, or env for J = N) */
 RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words, uint32_t n, const float *V, const float *env)
 {
     const uint32_t slot = *q, *e = p->e[slot], u2 = p->u2[slot];
     uint32_t col;
+#if defined(RAD__TEMPORAL_AVX2)
+    if ((slot & 7u) == 7u) rad__tpipe_issue8(p, slot - 7u);
+#else
     rad__tpipe_issue(p, slot);
+#endif
     *q = slot + 1u == RAD__TEMPORAL_AHEAD ? 0u : slot + 1u;
-    if (words == 2u) col = u2 < e[0] ? (e[1] & 0xFFFFu) : (e[1] >> 16);
-    else col = u2 < e[0] ? e[1] : e[2];
+    /* written without a conditional: the test is a coin flip, and clang 14 made a branch of
+       '?:' here (mispredicted about half the time, ~2x slower than gcc's cmov) */
+    if (words == 2u) col = (e[1] >> (16u * (uint32_t)(u2 >= e[0]))) & 0xFFFFu;
+    else col = e[1u + (uint32_t)(u2 >= e[0])];
     return col < n ? V + 3u * (size_t)col : env;
 }
 
@@ -12019,7 +12115,11 @@ static void rad__temporal_task(void *data, uint32_t task)
     p.mix = 0;
     p.key = rad__pcg(p.seedframe ^ r0);
     rad__tpipe_row(&p);
+#if defined(RAD__TEMPORAL_AVX2)
+    for (q = 0; q < RAD__TEMPORAL_AHEAD; q += 8u) rad__tpipe_issue8(&p, q);
+#else
     for (q = 0; q < RAD__TEMPORAL_AHEAD; ++q) rad__tpipe_issue(&p, q);
+#endif
     q = 0;
     for (i = r0; i < r1; ++i) {
         float X[3];
