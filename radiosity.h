@@ -8430,8 +8430,10 @@ static void rad__mb_apply_task(void *data, uint32_t t)
     const rad__mb_apply *a = (const rad__mb_apply *)data;
     uint32_t n = a->mb->n, i0 = (uint32_t)((uint64_t)n * t / a->tasks), i1 = (uint32_t)((uint64_t)n * (t + 1) / a->tasks), i, ch;
     size_t nn = (size_t)n * n;
-    for (i = i0; i < i1; ++i)
-        for (ch = 0; ch < 3; ++ch) {
+    /* plane by plane: one sequential stream at a time (interleaving the three planes' rows
+       cost the half apply 1.45x at N = 5696, see BENCHMARKS.md); every y is the same dot */
+    for (ch = 0; ch < 3; ++ch)
+        for (i = i0; i < i1; ++i) {
             size_t at = ch * nn + (size_t)i * n;
             a->y[ch * (size_t)n + i] = a->mb->planes ? rad__mb_dot(a->mb->planes + at, a->x + ch * (size_t)n, n)
                                                      : rad__mb_dot_half(a->mb->half + at, a->x + ch * (size_t)n, n);
