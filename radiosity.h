@@ -2019,9 +2019,10 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
    Parallel over rows through ctx->parallel_for; the bits do not depend on the thread count
    or task split (each row's draws depend only on seed, frame, row and sample).
    Errors: INVALID_ARGUMENT. Cost: O(N k) random reads into the tables and E: the draws
-   are software-pipelined (each task hashes and prefetches the bins of the draws 64 ahead of
-   the one it resolves, across rows), so the cost per draw is the hashing, not the memory
-   latency (BENCHMARKS.md: about 5-6 ns per draw on one core with tables of 450 MB).
+   are software-pipelined (each task hashes and prefetches the bins of the draws 64 to 128
+   ahead of the one it resolves, across rows; with AVX2 and compact tables 8 rows side by
+   side, one per vector lane), so the misses overlap instead of waiting one by one
+   (BENCHMARKS.md: about 3.7 ns per draw on one core with tables of 450 MB).
    Thread safety: one thread at a time per state. SPEC §8. */
 RAD_API rad_result rad_temporal_step(rad_temporal *temporal, const float *E, const float E0[3], float *out_indirect);
 
@@ -12096,6 +12097,159 @@ static void rad__temporal_finish(rad_temporal *t, uint32_t i, float *X)
     Bn[2] = w * Bp[2] + (1.0f - w) * X[2];
 }
 
+#if defined(RAD__TEMPORAL_AVX2)
+/* VECTOR STEP (AVX2; every table set compact): eight rows side by side, one lane per row. A
+   vector draw is draw s of table set c for 8 consecutive rows; a task's vector draws run block
+   of 8 rows by block, set by set, sample by sample. The issuing side hashes vector draw
+   d + RAD__TVEC_AHEAD (both words and the bin on 8 lanes) and prefetches its 8 bins while
+   vector draw d is resolved with two 64-bit gathers (the bins) and one masked gather per
+   channel (V, or E_0 for the environment column). Each lane adds its own row's values in the
+   documented order, so the bits equal the plain loop's; the scalar work per draw is about a
+   third of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
+#ifndef RAD__TVEC_AHEAD
+#define RAD__TVEC_AHEAD 16u
+#endif /* vector draws in flight: 128 draws */
+
+typedef struct rad__tvec {
+    const rad_temporal *t;
+    uint32_t k, sets, end, seedframe;
+    uint32_t row, set, s;      /* the next vector draw to issue: rows row .. row + 7 */
+    const uint32_t *bins;      /* bins of table set 'set' */
+    __m256i key, nb;           /* per lane: the row's key and bin count in set 'set' */
+    __m256i first_lo, first_hi; /* per lane: the row's first bin (64-bit), lanes 0-3 and 4-7 */
+    uint64_t bin[RAD__TVEC_AHEAD * 8u]; /* issued vector draws: bin numbers in their set ... */
+    uint32_t u2[RAD__TVEC_AHEAD * 8u];  /* ... and the threshold test's random words */
+} rad__tvec;
+
+/* loads the lanes of block 'row' in table set 'set' (rows past the task's end repeat its last
+   row: their draws are issued and resolved, never finished) */
+static void rad__tvec_block(rad__tvec *p)
+{
+    const rad_alias_tables *tb = p->t->tables[p->set];
+    uint32_t key[8], nb[8], j;
+    uint64_t first[8];
+    for (j = 0; j < 8u; ++j) {
+        const uint32_t r = p->row + j < p->end ? p->row + j : p->end - 1u;
+        first[j] = tb->row_offsets[r];
+        nb[j] = (uint32_t)(tb->row_offsets[r + 1u] - first[j]);
+        key[j] = r;
+    }
+    p->bins = tb->bins;
+    p->key = rad__pcg8(_mm256_xor_si256(_mm256_set1_epi32((int)p->seedframe), _mm256_loadu_si256((const __m256i *)(const void *)key)));
+    p->nb = _mm256_loadu_si256((const __m256i *)(const void *)nb);
+    p->first_lo = _mm256_loadu_si256((const __m256i *)(const void *)first);
+    p->first_hi = _mm256_loadu_si256((const __m256i *)(const void *)(first + 4));
+}
+
+RAD__HOT void rad__tvec_issue(rad__tvec *p, uint32_t slot)
+{
+    uint64_t *b = p->bin + 8u * slot;
+    __m256i u1, even, odd, idx;
+    uint32_t j;
+    if (p->row >= p->end) return;
+    u1 = rad__pcg8(_mm256_xor_si256(p->key, _mm256_set1_epi32((int)((p->set * p->k + p->s) * 0x9E3779B9u))));
+    _mm256_storeu_si256((__m256i *)(void *)(p->u2 + 8u * slot), rad__pcg8(_mm256_xor_si256(u1, _mm256_set1_epi32(0x68E31DA4))));
+    /* bin = (u1 * nb) >> 32 on 8 lanes, then first + bin as 64-bit integers */
+    even = _mm256_srli_epi64(_mm256_mul_epu32(u1, p->nb), 32);
+    odd = _mm256_mul_epu32(_mm256_srli_epi64(u1, 32), _mm256_srli_epi64(p->nb, 32));
+    idx = _mm256_blend_epi32(even, odd, 0xAA);
+    _mm256_storeu_si256((__m256i *)(void *)b, _mm256_add_epi64(p->first_lo, _mm256_cvtepu32_epi64(_mm256_castsi256_si128(idx))));
+    _mm256_storeu_si256((__m256i *)(void *)(b + 4), _mm256_add_epi64(p->first_hi, _mm256_cvtepu32_epi64(_mm256_extracti128_si256(idx, 1))));
+    for (j = 0; j < 8u; ++j) RAD__PREFETCH(p->bins + 2u * (size_t)b[j]);
+    if (++p->s < p->k) return;
+    p->s = 0;
+    if (++p->set == p->sets) {
+        p->set = 0;
+        p->row += 8u;
+        if (p->row >= p->end) return;
+    }
+    rad__tvec_block(p);
+}
+
+/* compact bin b as one 64-bit integer: threshold (low half), column word (high half); x86 is
+   little-endian, and a view's bins may be only 4-byte aligned */
+RAD__HOT long long rad__bin64(const uint32_t *bins, uint64_t b)
+{
+    long long v;
+    memcpy(&v, bins + 2u * (size_t)b, sizeof(v));
+    return v;
+}
+
+static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r1)
+{
+    rad_temporal *t = st->t;
+    const uint32_t k = t->o.samples, sets = t->table_count;
+    const __m256i sign = _mm256_set1_epi32((int)0x80000000u), nvec = _mm256_set1_epi32((int)t->n);
+    const __m256i sixteen = _mm256_set1_epi32(16), low16 = _mm256_set1_epi32(0xFFFF);
+    const float kf = (float)k;
+    const __m256 env0 = _mm256_set1_ps(st->env[0]), env1 = _mm256_set1_ps(st->env[1]), env2 = _mm256_set1_ps(st->env[2]);
+    rad__tvec p;
+    uint32_t row, c, s, q = 0, j;
+    p.t = t;
+    p.k = k;
+    p.sets = sets;
+    p.end = r1;
+    p.seedframe = rad__pcg(rad__pcg(t->o.seed) ^ t->frame);
+    p.row = r0;
+    p.set = 0;
+    p.s = 0;
+    rad__tvec_block(&p);
+    for (j = 0; j < RAD__TVEC_AHEAD; ++j) rad__tvec_issue(&p, j);
+    for (row = r0; row < r1; row += 8u) {
+        float X[3][8], T[8];
+        for (c = 0; c < sets; ++c) {
+            const uint32_t *gb = t->tables[c]->bins;
+            __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, scale;
+            for (s = 0; s < k; ++s) {
+                /* the 8 bins, read before the slot is reused (scalar loads: two 64-bit gathers
+                   cost about 10% more per draw on the machine of BENCHMARKS.md) */
+                const uint64_t *bn = p.bin + 8u * q;
+                const __m256i u2 = _mm256_loadu_si256((const __m256i *)(const void *)(p.u2 + 8u * q));
+                const __m256i glo = _mm256_set_epi64x(rad__bin64(gb, bn[3]), rad__bin64(gb, bn[2]), rad__bin64(gb, bn[1]), rad__bin64(gb, bn[0]));
+                const __m256i ghi = _mm256_set_epi64x(rad__bin64(gb, bn[7]), rad__bin64(gb, bn[6]), rad__bin64(gb, bn[5]), rad__bin64(gb, bn[4]));
+                __m256i thr, cw, col, idx3;
+                __m256 valid;
+                rad__tvec_issue(&p, q);
+                q = q + 1u == RAD__TVEC_AHEAD ? 0u : q + 1u;
+                /* [t0 c0 t1 c1 | t2 c2 t3 c3], [t4 c4 ..] -> thresholds and column words in lane order */
+                thr = _mm256_castps_si256(_mm256_shuffle_ps(_mm256_castsi256_ps(glo), _mm256_castsi256_ps(ghi), 0x88));
+                cw = _mm256_castps_si256(_mm256_shuffle_ps(_mm256_castsi256_ps(glo), _mm256_castsi256_ps(ghi), 0xDD));
+                thr = _mm256_permute4x64_epi64(thr, 0xD8);
+                cw = _mm256_permute4x64_epi64(cw, 0xD8);
+                /* u2 < threshold (unsigned): the own column (low half), else the alias (high half) */
+                col = _mm256_cmpgt_epi32(_mm256_xor_si256(thr, sign), _mm256_xor_si256(u2, sign));
+                col = _mm256_and_si256(_mm256_srlv_epi32(cw, _mm256_andnot_si256(col, sixteen)), low16);
+                valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(nvec, col));
+                idx3 = _mm256_add_epi32(col, _mm256_add_epi32(col, col));
+                if (sets == 1u) {
+                    a0 = _mm256_add_ps(a0, _mm256_mask_i32gather_ps(env0, st->V, idx3, valid, 4));
+                    a1 = _mm256_add_ps(a1, _mm256_mask_i32gather_ps(env1, st->V + 1, idx3, valid, 4));
+                    a2 = _mm256_add_ps(a2, _mm256_mask_i32gather_ps(env2, st->V + 2, idx3, valid, 4));
+                } else {
+                    a0 = _mm256_add_ps(a0, _mm256_mask_i32gather_ps(_mm256_set1_ps(st->env[c]), st->V + c, idx3, valid, 4));
+                }
+            }
+            for (j = 0; j < 8u; ++j) T[j] = t->tables[c]->totals[row + j < r1 ? row + j : r1 - 1u];
+            scale = _mm256_div_ps(_mm256_loadu_ps(T), _mm256_set1_ps(kf)); /* T_i / k in float */
+            if (sets == 1u) {
+                _mm256_storeu_ps(X[0], _mm256_mul_ps(a0, scale));
+                _mm256_storeu_ps(X[1], _mm256_mul_ps(a1, scale));
+                _mm256_storeu_ps(X[2], _mm256_mul_ps(a2, scale));
+            } else {
+                _mm256_storeu_ps(X[c], _mm256_mul_ps(a0, scale));
+            }
+        }
+        for (j = 0; j < 8u && row + j < r1; ++j) {
+            float x[3];
+            x[0] = X[0][j];
+            x[1] = X[1][j];
+            x[2] = X[2][j];
+            rad__temporal_finish(t, row + j, x);
+        }
+    }
+}
+#endif
+
 static void rad__temporal_task(void *data, uint32_t task)
 {
     const rad__tstep *st = (const rad__tstep *)data;
@@ -12106,6 +12260,13 @@ static void rad__temporal_task(void *data, uint32_t task)
     rad__tpipe p;
     uint32_t i, c, s, q;
     if (r0 >= r1) return;
+#if defined(RAD__TEMPORAL_AVX2)
+    for (c = 0; c < sets && t->tables[c]->format == RAD_ALIAS_COMPACT; ++c) {}
+    if (c == sets) {
+        rad__temporal_task_vec(st, r0, r1);
+        return;
+    }
+#endif
     p.t = t;
     p.k = k;
     p.sets = sets;

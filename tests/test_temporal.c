@@ -686,16 +686,18 @@ static void tp_plain_steps(const rad_alias_tables *const *tb, uint32_t sets, con
 /* The pipelined step (draws hashed and prefetched RAD__TEMPORAL_AHEAD ahead, across rows) equals
    the plain loop bit for bit: k = 1 with one row per task (fewer draws than the look-ahead),
    k = 10, k = 70 (more draws per row than the look-ahead) in feedback mode with wide bins,
-   three channel tables of mixed formats, several task splits. */
+   three channel tables of mixed formats, three compact channel tables with k = 3, several task
+   splits (on x86-64 with AVX2, compact tables take the path that puts 8 rows side by side:
+   one row per task and splits of 7 leave partial blocks of rows). */
 static void tp_pipeline_bits(void)
 {
     tp_cornell c;
-    rad_alias_tables *t = NULL, *tw = NULL, *tc[3] = { NULL, NULL, NULL };
+    rad_alias_tables *t = NULL, *tw = NULL, *tc[3] = { NULL, NULL, NULL }, *tk[3] = { NULL, NULL, NULL };
     rad_context ctx;
     rad_temporal_options o;
     float *ref, *out, *plane, E0[3] = { 0.2f, 0.4f, 0.1f };
     uint32_t n, v, i;
-    static const uint32_t ks[4] = { 1, 10, 70, 10 }, tasks[4] = { 4096, 0, 7, 3 };
+    static const uint32_t ks[5] = { 1, 10, 70, 10, 3 }, tasks[5] = { 4096, 0, 7, 3, 7 };
     if (!tp_cornell_build(&c, rad_test_quick() ? 40 : 80, 0)) { CHECK(0); tp_cornell_free(&c); return; }
     n = c.n;
     ref = (float *)malloc(sizeof(float) * 3 * n);
@@ -706,17 +708,20 @@ static void tp_pipeline_bits(void)
     for (v = 0; v < 3; ++v) {
         for (i = 0; i < n * n; ++i) plane[i] = (1.0f + 0.5f * (float)v) * c.ff->matrix.dense[i];
         CHECK_OK(rad_alias_tables_create_dense(plane, n, v == 1 ? RAD_ALIAS_WIDE : RAD_ALIAS_COMPACT, NULL, &tc[v]));
+        CHECK_OK(rad_alias_tables_create_dense(plane, n, RAD_ALIAS_COMPACT, NULL, &tk[v]));
     }
-    for (v = 0; v < 4 && t && tw && tc[0] && tc[1] && tc[2]; ++v) {
-        const rad_alias_tables *const *tb = v == 3 ? (const rad_alias_tables *const *)tc : (const rad_alias_tables *const *)(v == 2 ? &tw : &t);
-        const uint32_t sets = v == 3 ? 3u : 1u;
+    for (v = 0; v < 5 && t && tw && tc[0] && tc[1] && tc[2] && tk[0] && tk[1] && tk[2]; ++v) {
+        const rad_alias_tables *const *tb = v == 4 ? (const rad_alias_tables *const *)tk
+                                          : v == 3 ? (const rad_alias_tables *const *)tc
+                                                   : (const rad_alias_tables *const *)(v == 2 ? &tw : &t);
+        const uint32_t sets = v >= 3 ? 3u : 1u;
         rad_temporal *tm = NULL;
         uint32_t fr;
         rad_temporal_options_default(&o);
         o.samples = ks[v];
         o.seed = 1234u + v;
         o.weight = 0.75f;
-        o.mode = v == 2 ? RAD_TEMPORAL_FEEDBACK : v == 3 ? RAD_TEMPORAL_MULTIBOUNCE : RAD_TEMPORAL_SINGLE;
+        o.mode = v == 2 ? RAD_TEMPORAL_FEEDBACK : v >= 3 ? RAD_TEMPORAL_MULTIBOUNCE : RAD_TEMPORAL_SINGLE;
         memset(&ctx, 0, sizeof(ctx));
         if (tasks[v]) { ctx.parallel_for = tp_reverse_for; ctx.task_count = tasks[v]; }
         tp_plain_steps(tb, sets, c.P->albedo, &o, c.E, E0, 3, ref);
@@ -728,7 +733,10 @@ static void tp_pipeline_bits(void)
     }
     rad_alias_tables_destroy(t);
     rad_alias_tables_destroy(tw);
-    for (v = 0; v < 3; ++v) rad_alias_tables_destroy(tc[v]);
+    for (v = 0; v < 3; ++v) {
+        rad_alias_tables_destroy(tc[v]);
+        rad_alias_tables_destroy(tk[v]);
+    }
     free(ref); free(out); free(plane);
     tp_cornell_free(&c);
 }
