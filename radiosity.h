@@ -9536,45 +9536,62 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
 
 /* BC1 as a lookup-table product. Row y of a 4x4 block is one byte of indices (2 bits per
    texel), and that row's share of out is sum_x pal[idx_x] E_x = sum_k pal[k] M_k(byte) with
-   M_k(byte) the sum of the block column's four E values whose index is k. So per apply, per
-   block column, a table of M_0..M_3 for the 256 bytes (12 floats per byte: R M_0..M_3,
-   G M_0..M_3, B M_0..M_3), and a block row costs one table entry per row times the block's
-   palette (the specification's exact values, unscaled: integer numerator over integer
-   denominator, one correctly rounded division): 12 multiply-adds for 12 texel-channels and
-   no per-texel index shuffles. The tile scale multiplies a row's sum over the blocks of one
-   scale tile once. The result equals decode-then-multiply up to the order of the float sums.
+   M_k(byte) the sum of the block column's four E values whose index is k. The palette is
+   linear in the endpoints (per channel, codes a and b over d = 31 or 63): 4-colour mode
+   (a, b, (2a + b)/3, (a + 2b)/3)/d, 3-colour mode (a, b, (a + b)/2, 0)/d, so
+       sum_k pal[k] M_k = (a/d) A + (b/d) B,  A = M_0 + (2 M_2 + M_3)/3, B = M_1 + (M_2 + 2 M_3)/3
+   (3-colour: A = M_0 + M_2/2, B = M_1 + M_2/2). Per apply, per block column, a table of A
+   and B for the 256 bytes in both modes (12 floats per byte: R G B of A and B in 3-colour
+   mode, then in 4-colour mode); a block row costs, per block, its endpoints as one vector
+   (a_R a_G a_B b_R b_G b_B)/d and one multiply-add per row with the entry of the row's byte
+   in the block's mode. No palette is formed: 6 multiply-adds for 12 texel-channels. The tile
+   scale multiplies a row's sum over the blocks of one scale tile once. The result equals
+   decode-then-multiply up to float rounding (the palette's thirds are folded into the table
+   instead of rounded per block; tests/test_multibounce.c allows 1e-5 of the magnitude).
    Block columns go in passes of RAD__MB_LUT_PASS (2.25 MiB of tables, kept in L3): per pass
    two parallel loops, the pass's tables (parallel over columns), then every block row over
    them, in tiles of RAD__MB_LUT_TILE columns (768 KiB of tables; L2 is 1 MiB here) so that a
    tile's tables stay in L2 while a task's block rows pass over them. Measured
-   (BENCHMARKS.md): 1.08x (N = 1850) and 1.13x (N = 5696) faster than decoding every texel
-   on one thread. Slower alternatives measured: all tables first (1.5x slower at N = 5696:
+   (BENCHMARKS.md). Slower alternatives measured: all tables first (1.5x slower at N = 5696:
    17 MB of tables written and read back through DRAM, more than the 15 MB of blocks), tables
    per task (the work repeats in every task, 64 by default), 16-float entries (one cache line
-   each), palettes looked up in tables over the endpoint codes (L2 traffic). */
+   each), palettes looked up in tables over the endpoint codes (L2 traffic), the exact
+   palette per block times sums by code (M_0..M_3; 1.6x slower: the palette was two thirds
+   of the instructions). */
 #define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
 #define RAD__MB_LUT_STRIDE 3072u /* floats per block column: 256 entries of 12 */
+#define RAD__MB_LUT_PAD 8u       /* zeros after a pass's tables: the 8-float load of the last entry's 4-colour half */
 
 /* the tables of block columns bx0..bx1-1 into lut (RAD__MB_LUT_STRIDE floats per column) */
 static void rad__mb_lut_build(const rad__mb_bapply *a, uint32_t bx0, uint32_t bx1, float *lut)
 {
-    uint32_t bx, v, ch, j;
+    /* weights of a texel with code k in A and B: 3-colour, then 4-colour mode */
+    static const float wa[2][4] = { { 1.0f, 0.0f, 0.5f, 0.0f }, { 1.0f, 0.0f, 2.0f / 3.0f, 1.0f / 3.0f } };
+    static const float wb[2][4] = { { 0.0f, 1.0f, 0.5f, 0.0f }, { 0.0f, 1.0f, 1.0f / 3.0f, 2.0f / 3.0f } };
+    uint32_t bx, v, ch, j, m, x;
     for (bx = bx0; bx < bx1; ++bx) {
         /* lo[n]: texels 0 and 1 with the codes of nibble n; hi[n]: texels 2 and 3 */
         float lo[16][12], hi[16][12];
         float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - bx0);
-        memset(lo, 0, sizeof(lo));
-        memset(hi, 0, sizeof(hi));
         for (v = 0; v < 16; ++v)
-            for (ch = 0; ch < 3; ++ch) {
-                const float *e = a->xp + (size_t)ch * a->padded + 4 * (size_t)bx;
-                lo[v][4 * ch + (v & 3u)] += e[0];
-                lo[v][4 * ch + (v >> 2)] += e[1];
-                hi[v][4 * ch + (v & 3u)] += e[2];
-                hi[v][4 * ch + (v >> 2)] += e[3];
-            }
+            for (m = 0; m < 2; ++m)
+                for (ch = 0; ch < 3; ++ch) {
+                    const float *e = a->xp + (size_t)ch * a->padded + 4 * (size_t)bx;
+                    float la = 0.0f, lb = 0.0f, ha = 0.0f, hb = 0.0f;
+                    for (x = 0; x < 2; ++x) {
+                        const uint32_t code = (v >> (2 * x)) & 3u;
+                        la += wa[m][code] * e[x];
+                        lb += wb[m][code] * e[x];
+                        ha += wa[m][code] * e[2 + x];
+                        hb += wb[m][code] * e[2 + x];
+                    }
+                    lo[v][6 * m + ch] = la;
+                    lo[v][6 * m + 3 + ch] = lb;
+                    hi[v][6 * m + ch] = ha;
+                    hi[v][6 * m + 3 + ch] = hb;
+                }
         for (v = 0; v < 256; ++v)
             for (j = 0; j < RAD__MB_LUT_ENTRY; ++j) T[RAD__MB_LUT_ENTRY * v + j] = lo[v & 15u][j] + hi[v >> 4][j];
     }
@@ -9594,28 +9611,11 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
     uint32_t bpr = b->blocks_per_row, by0 = (uint32_t)((uint64_t)bpr * t / a->tasks), by1 = (uint32_t)((uint64_t)bpr * (t + 1) / a->tasks);
     uint32_t tb = b->tile ? b->tile / 4u : bpr, c0, c1, by, bx, s, e, ch, y;
 #if defined(RAD__MB_AVX2)
-    /* the palette exactly as rad_bc1_decode_block computes it (integer numerator over integer
-       denominator, one correctly rounded division: the same value to the bit), one channel
-       per 4 lanes: I = (a, b, a, b) the channel's endpoint codes, numerators I A + swap(I) B =
-       (a, b, 2a + b, a + 2b) or (a, b, a + b, 0), over (d, d, 3d, 3d) or (d, d, 2d, d) with
-       d = 31 or 63. R and G share a 256-bit vector, B a 128-bit one; the mode (c0 > c1)
-       indexes the constants: the encoder mixes both modes (a branch would mispredict) */
-    const __m256i sh_rg = _mm256_setr_epi32(11, 11, 11, 11, 5, 5, 5, 5), mask_rg = _mm256_setr_epi32(31, 31, 31, 31, 63, 63, 63, 63);
-    const __m128i mask_b = _mm_set1_epi32(31);
-    __m256 bc1a[2], bc1b[2], den_rg[2], rcp_rg[2];
-    __m128 den_b[2], rcp_b[2];
-    bc1a[0] = _mm256_setr_ps(1.0f, 1.0f, 1.0f, 0.0f, 1.0f, 1.0f, 1.0f, 0.0f);   /* 3-colour mode (c0 <= c1) */
-    bc1b[0] = _mm256_setr_ps(0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f);
-    den_rg[0] = _mm256_setr_ps(31.0f, 31.0f, 62.0f, 31.0f, 63.0f, 63.0f, 126.0f, 63.0f);
-    den_b[0] = _mm_setr_ps(31.0f, 31.0f, 62.0f, 31.0f);
-    bc1a[1] = _mm256_setr_ps(1.0f, 1.0f, 2.0f, 2.0f, 1.0f, 1.0f, 2.0f, 2.0f);   /* 4-colour mode */
-    bc1b[1] = _mm256_setr_ps(0.0f, 0.0f, 1.0f, 1.0f, 0.0f, 0.0f, 1.0f, 1.0f);
-    den_rg[1] = _mm256_setr_ps(31.0f, 31.0f, 93.0f, 93.0f, 63.0f, 63.0f, 189.0f, 189.0f);
-    den_b[1] = _mm_setr_ps(31.0f, 31.0f, 93.0f, 93.0f);
-    for (s = 0; s < 2; ++s) {
-        rcp_rg[s] = _mm256_div_ps(_mm256_set1_ps(1.0f), den_rg[s]);
-        rcp_b[s] = _mm_div_ps(_mm_set1_ps(1.0f), den_b[s]);
-    }
+    /* endpoints (a_R a_G a_B b_R b_G b_B 0 0) / d from the word c0 | c1 << 16 on 8 lanes */
+    const __m256i ep_shift = _mm256_setr_epi32(11, 5, 0, 27, 21, 16, 0, 0);
+    const __m256i ep_mask = _mm256_setr_epi32(31, 63, 31, 31, 63, 31, 0, 0);
+    const __m256 ep_rcp = _mm256_setr_ps(1.0f / 31.0f, 1.0f / 63.0f, 1.0f / 31.0f, 1.0f / 31.0f, 1.0f / 63.0f, 1.0f / 31.0f, 0.0f, 0.0f);
+    const __m256i to_b = _mm256_setr_epi32(3, 4, 5, 6, 7, 7, 7, 7);
 #endif
     for (c0 = a->c0; c0 < a->c1; c0 = c1) {
         const float *lut = a->lut + RAD__MB_LUT_STRIDE * (size_t)(c0 - a->c0);
@@ -9630,62 +9630,59 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
 #if defined(RAD__MB_AVX2)
                 {
                     __m256 r0 = _mm256_setzero_ps(), r1 = _mm256_setzero_ps(), r2 = _mm256_setzero_ps(), r3 = _mm256_setzero_ps();
-                    __m128 q0 = _mm_setzero_ps(), q1 = _mm_setzero_ps(), q2 = _mm_setzero_ps(), q3 = _mm_setzero_ps(), sum;
-                    __m256 h;
+                    __m128 q0, q1, q2, q3;
                     for (bx = s; bx < e; ++bx) {
                         const uint8_t *blk = row + 8 * (size_t)bx;
-                        const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0);
-                        uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
-                        uint32_t md = k0 > k1;
-                        long long pair = (long long)((uint64_t)k1 << 32 | k0);
-                        __m256 irg = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi64x(pair), sh_rg), mask_rg));
-                        __m128 ib4 = _mm_cvtepi32_ps(_mm_and_si128(_mm_set1_epi64x(pair), mask_b));
-                        __m256 prg = rad__mb_div(_mm256_add_ps(_mm256_mul_ps(irg, bc1a[md]), _mm256_mul_ps(_mm256_permute_ps(irg, 0xB1), bc1b[md])),
-                                                 den_rg[md], rcp_rg[md]);
-                        __m128 pb = rad__mb_div4(_mm_add_ps(_mm_mul_ps(ib4, _mm256_castps256_ps128(bc1a[md])),
-                                                            _mm_mul_ps(_mm_permute_ps(ib4, 0xB1), _mm256_castps256_ps128(bc1b[md]))),
-                                                 den_b[md], rcp_b[md]);
-                        const float *m0 = T + RAD__MB_LUT_ENTRY * (size_t)blk[4], *m1 = T + RAD__MB_LUT_ENTRY * (size_t)blk[5];
-                        const float *m2 = T + RAD__MB_LUT_ENTRY * (size_t)blk[6], *m3 = T + RAD__MB_LUT_ENTRY * (size_t)blk[7];
-                        r0 = RAD__MB_MADD(prg, _mm256_loadu_ps(m0), r0);
-                        r1 = RAD__MB_MADD(prg, _mm256_loadu_ps(m1), r1);
-                        r2 = RAD__MB_MADD(prg, _mm256_loadu_ps(m2), r2);
-                        r3 = RAD__MB_MADD(prg, _mm256_loadu_ps(m3), r3);
-                        q0 = RAD__MB_MADD4(pb, _mm_loadu_ps(m0 + 8), q0);
-                        q1 = RAD__MB_MADD4(pb, _mm_loadu_ps(m1 + 8), q1);
-                        q2 = RAD__MB_MADD4(pb, _mm_loadu_ps(m2 + 8), q2);
-                        q3 = RAD__MB_MADD4(pb, _mm_loadu_ps(m3 + 8), q3);
+                        const uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
+                        /* the row's entry in the block's mode: 3-colour at +0, 4-colour (c0 > c1) at +6;
+                           by arithmetic, not a comparison, which gcc 12 made a branch (the encoder
+                           mixes both modes: mispredicted about half the time, 1.6x slower) */
+                        const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0) + 6u * ((k1 - k0) >> 31);
+                        const __m256 ep = _mm256_mul_ps(
+                            _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)(k0 | k1 << 16)), ep_shift), ep_mask)),
+                            ep_rcp);
+                        r0 = RAD__MB_MADD(ep, _mm256_loadu_ps(T + RAD__MB_LUT_ENTRY * (size_t)blk[4]), r0);
+                        r1 = RAD__MB_MADD(ep, _mm256_loadu_ps(T + RAD__MB_LUT_ENTRY * (size_t)blk[5]), r1);
+                        r2 = RAD__MB_MADD(ep, _mm256_loadu_ps(T + RAD__MB_LUT_ENTRY * (size_t)blk[6]), r2);
+                        r3 = RAD__MB_MADD(ep, _mm256_loadu_ps(T + RAD__MB_LUT_ENTRY * (size_t)blk[7]), r3);
                     }
-                    /* (R0 R1 R2 R3 | G0 G1 G2 G3) and (B0 B1 B2 B3): sums over k */
-                    h = _mm256_hadd_ps(_mm256_hadd_ps(r0, r1), _mm256_hadd_ps(r2, r3));
-                    sum = _mm_hadd_ps(_mm_hadd_ps(q0, q1), _mm_hadd_ps(q2, q3));
-                    _mm_storeu_ps(yo, _mm_add_ps(_mm_loadu_ps(yo), _mm_mul_ps(_mm256_castps256_ps128(h), _mm_set1_ps(scale[0]))));
-                    _mm_storeu_ps(yo + 4, _mm_add_ps(_mm_loadu_ps(yo + 4), _mm_mul_ps(_mm256_extractf128_ps(h, 1), _mm_set1_ps(scale[1]))));
-                    _mm_storeu_ps(yo + 8, _mm_add_ps(_mm_loadu_ps(yo + 8), _mm_mul_ps(sum, _mm_set1_ps(scale[2]))));
+                    /* lanes 0-2 (a/d) A and 3-5 (b/d) B: row y's RGB = their sum (lanes 6-7:
+                       zero endpoints times whatever followed the entry, never used) */
+                    q0 = _mm_add_ps(_mm256_castps256_ps128(r0), _mm256_castps256_ps128(_mm256_permutevar8x32_ps(r0, to_b)));
+                    q1 = _mm_add_ps(_mm256_castps256_ps128(r1), _mm256_castps256_ps128(_mm256_permutevar8x32_ps(r1, to_b)));
+                    q2 = _mm_add_ps(_mm256_castps256_ps128(r2), _mm256_castps256_ps128(_mm256_permutevar8x32_ps(r2, to_b)));
+                    q3 = _mm_add_ps(_mm256_castps256_ps128(r3), _mm256_castps256_ps128(_mm256_permutevar8x32_ps(r3, to_b)));
+                    _MM_TRANSPOSE4_PS(q0, q1, q2, q3); /* q0 = R of rows 0-3, q1 = G, q2 = B */
+                    _mm_storeu_ps(yo, _mm_add_ps(_mm_loadu_ps(yo), _mm_mul_ps(q0, _mm_set1_ps(scale[0]))));
+                    _mm_storeu_ps(yo + 4, _mm_add_ps(_mm_loadu_ps(yo + 4), _mm_mul_ps(q1, _mm_set1_ps(scale[1]))));
+                    _mm_storeu_ps(yo + 8, _mm_add_ps(_mm_loadu_ps(yo + 8), _mm_mul_ps(q2, _mm_set1_ps(scale[2]))));
                     (void)ch;
                     (void)y;
                 }
 #else
                 {
-                    /* acc[y][4 ch + k]: row y's sum of pal[ch][k] M_k */
-                    float acc[4][12];
+                    /* acc[y][j]: row y's sum of ep[j] times the entry's j-th value */
+                    float acc[4][6];
                     uint32_t j;
                     memset(acc, 0, sizeof(acc));
                     for (bx = s; bx < e; ++bx) {
                         const uint8_t *blk = row + 8 * (size_t)bx;
-                        const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0);
-                        uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
-                        float p[4][3];
-                        rad__bc1_palette(k0, k1, p);
+                        const uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
+                        const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0) + 6u * ((k1 - k0) >> 31);
+                        float ep[6];
+                        ep[0] = (float)((k0 >> 11) & 31u) * (1.0f / 31.0f);
+                        ep[1] = (float)((k0 >> 5) & 63u) * (1.0f / 63.0f);
+                        ep[2] = (float)(k0 & 31u) * (1.0f / 31.0f);
+                        ep[3] = (float)((k1 >> 11) & 31u) * (1.0f / 31.0f);
+                        ep[4] = (float)((k1 >> 5) & 63u) * (1.0f / 63.0f);
+                        ep[5] = (float)(k1 & 31u) * (1.0f / 31.0f);
                         for (y = 0; y < 4; ++y) {
                             const float *m = T + RAD__MB_LUT_ENTRY * (size_t)blk[4 + y];
-                            for (j = 0; j < 12; ++j) acc[y][j] += p[j & 3u][j >> 2] * m[j];
+                            for (j = 0; j < 6; ++j) acc[y][j] += ep[j] * m[j];
                         }
                     }
                     for (ch = 0; ch < 3; ++ch)
-                        for (y = 0; y < 4; ++y)
-                            yo[4 * ch + y] +=
-                                ((acc[y][4 * ch] + acc[y][4 * ch + 1]) + (acc[y][4 * ch + 2] + acc[y][4 * ch + 3])) * scale[ch];
+                        for (y = 0; y < 4; ++y) yo[4 * ch + y] += (acc[y][ch] + acc[y][3 + ch]) * scale[ch];
                 }
 #endif
             }
@@ -9738,7 +9735,7 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     bc1 = b->format == RAD_BLOCK_BC1;
     /* xp, y (3 padded each), then xe (BC4: 12 padded) or the tables of one pass and y2 (BC1) */
     a.tasks = c.tasks < bpr ? c.tasks : bpr;
-    tabs = bc1 ? (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE + 12 * (size_t)bpr + 16 * (size_t)a.tasks
+    tabs = bc1 ? (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE + RAD__MB_LUT_PAD + 12 * (size_t)bpr + 16 * (size_t)a.tasks
                : 12 * (size_t)padded;
     if (!rad__mul3((size_t)padded, 6u, sizeof(float), &i) || tabs > ((size_t)-1 - i) / sizeof(float))
         return RAD_ERROR_SIZE_OVERFLOW;
@@ -9767,8 +9764,8 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     if (bc1) {
         /* per pass: its tables (parallel over columns), then all block rows over them */
         uint32_t t, tasks = a.tasks, by, y;
-        a.y2 = xe + (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE;
-        memset(a.y2, 0, (12 * (size_t)bpr + 16 * (size_t)tasks) * sizeof(float));
+        a.y2 = xe + (size_t)(bpr < RAD__MB_LUT_PASS ? bpr : RAD__MB_LUT_PASS) * RAD__MB_LUT_STRIDE + RAD__MB_LUT_PAD;
+        memset(a.y2 - RAD__MB_LUT_PAD, 0, (RAD__MB_LUT_PAD + 12 * (size_t)bpr + 16 * (size_t)tasks) * sizeof(float));
         for (a.c0 = 0; a.c0 < bpr; a.c0 = a.c1) {
             a.c1 = bpr - a.c0 < RAD__MB_LUT_PASS ? bpr : a.c0 + RAD__MB_LUT_PASS;
             a.tasks = c.tasks < a.c1 - a.c0 ? c.tasks : a.c1 - a.c0;
