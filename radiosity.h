@@ -1543,16 +1543,17 @@ RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
 
 /* out = F~ E (or E + F~ E) with F~ the compressed matrix: E is permuted on input, blocks are
    used on the fly block row by block row (never the whole matrix), the outliers added
-   exactly and the result un-permuted on output. Every entry used equals the value of
-   rad_bc1_decode_block / rad_bc4_decode_block times its scale, on the scalar path
-   (RAD_NO_SIMD) and the AVX2 one (branch-free palettes, divisions by FMA-corrected
-   reciprocals) alike; only the order of the float sums differs. 3xBC4 decodes each texel;
-   BC1 is a lookup-table product: per block column and row byte (4 texels' indices) the sums
-   of E over the texels of each index, built once per apply (12 KiB per block column), then
-   per block row and channel one palette-times-table multiply-add per 4 texels. Parallel over
-   block rows (BC1: and over block columns for the tables). Thread safety: reentrant. Cost:
-   O(N^2) work (on the CPU about as many multiply-adds as a dense float apply, plus the
-   palettes: compute-bound, see BENCHMARKS.md), bytes_total bytes read; BC1 also writes and
+   exactly and the result un-permuted on output. 3xBC4: every entry used equals the value of
+   rad_bc4_decode_block times its scale, on the scalar path (RAD_NO_SIMD) and the AVX2 one
+   (branch-free palettes, divisions by FMA-corrected reciprocals) alike; only the order of
+   the float sums differs. BC1 is a lookup-table product that never forms the palette: per
+   block column and row byte (4 texels' indices) two endpoint weights per channel and mode
+   (the palette is linear in the endpoints), built once per apply (12 KiB per block column),
+   then per block and row one multiply-add of the endpoints with the row byte's entry; its
+   entries equal rad_bc1_decode_block's within a few float roundings (1e-6 relative, tested).
+   Parallel over block rows (BC1: and over block columns for the tables). Thread safety:
+   reentrant. Cost: O(N^2) work (on the CPU about as many multiply-adds as a dense float
+   apply: compute-bound, see BENCHMARKS.md), bytes_total bytes read; BC1 also writes and
    reads 3072 N bytes of tables (scratch memory). SPEC §4. */
 RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
                                                 rad_output output, const rad_context *ctx);
@@ -8861,8 +8862,8 @@ RAD_API rad_result rad_multibounce_reorder(const rad_multibounce *src, uint32_t 
 
 /* The palettes are the specification's real-valued formulas rounded once: an integer
    numerator over an integer denominator (e.g. (2 c0 + c1) / (3 * 31)), one correctly rounded
-   division. No intermediate rounding, so no compiler contraction can change a value, and the
-   AVX2 apply reproduces them to the bit. */
+   division. No intermediate rounding, so no compiler contraction can change a value (the
+   BC1 apply folds the palette into its tables instead: within 1e-6 of these values). */
 static void rad__bc1_palette(uint32_t c0, uint32_t c1, float pal[4][3])
 {
     static const uint32_t shift[3] = { 11u, 5u, 0u }, mask[3] = { 31u, 63u, 31u };
