@@ -9414,32 +9414,6 @@ typedef struct rad__mb_bapply {
     float *out;
 } rad__mb_bapply;
 
-/* The exact outliers of block row 'by' added to its sums s[4 ch + y] (y: the row in the
-   block, in permuted order; the outliers are stored by original row). Fused into the block
-   loops, which are compute-bound, so streaming the outliers (16 bytes each: at 5% of the
-   entries more bytes than the BC1 blocks) overlaps with them instead of taking a pass of
-   its own (BENCHMARKS.md). */
-static void rad__mb_row_outliers(const rad__mb_bapply *a, uint32_t by, float *s)
-{
-    const rad_multibounce_blocks *b = a->b;
-    uint32_t y;
-    if (!b->outlier_count) return;
-    for (y = 0; y < 4u && 4u * by + y < b->n; ++y) {
-        const uint32_t r = 4u * by + y, i = b->row_perm ? b->row_perm[r] : r;
-        uint64_t k;
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        for (k = b->outlier_offsets[i]; k < b->outlier_offsets[i + 1]; ++k) {
-            const float *v = b->outlier_values + 3 * k, *e = a->E + 3 * (size_t)b->outlier_columns[k];
-            s0 += v[0] * e[0];
-            s1 += v[1] * e[1];
-            s2 += v[2] * e[2];
-        }
-        s[y] += s0;
-        s[4 + y] += s1;
-        s[8 + y] += s2;
-    }
-}
-
 #if defined(RAD__MB_AVX2)
 /* x / d, correctly rounded, as the scalar decoder divides: with FMA, the reciprocal product
    m = x r (r = 1/d) corrected once by the residual, m + (x - m d) r. For every quotient the
@@ -9555,7 +9529,6 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
             }
         }
 #endif
-        rad__mb_row_outliers(a, by, &acc[0][0]);
         for (ch = 0; ch < 3; ++ch)
             for (y = 0; y < 4; ++y) a->y[(size_t)ch * a->padded + 4 * by + y] = acc[ch][y];
     }
@@ -9650,7 +9623,6 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
         c1 = a->c1 - c0 < RAD__MB_LUT_TILE ? a->c1 : c0 + RAD__MB_LUT_TILE;
         for (by = by0; by < by1; ++by) {
             const uint8_t *row = b->blocks + 8 * (size_t)by * bpr;
-            if (c0 == 0) rad__mb_row_outliers(a, by, a->y2 + 16 * (size_t)t + 12 * (size_t)by); /* once: the first tile of the first pass */
             for (s = c0; s < c1; s = e) {
                 const float *scale = b->scales + 3 * (size_t)rad__mb_tile_index(b, s, by);
                 float *yo = a->y2 + 16 * (size_t)t + 12 * (size_t)by;
@@ -9716,6 +9688,26 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
 #endif
             }
         }
+    }
+}
+
+static void rad__mb_outlier_task(void *data, uint32_t t)
+{
+    const rad__mb_bapply *a = (const rad__mb_bapply *)data;
+    const rad_multibounce_blocks *b = a->b;
+    uint32_t i0 = (uint32_t)((uint64_t)b->n * t / a->tasks), i1 = (uint32_t)((uint64_t)b->n * (t + 1) / a->tasks), i;
+    for (i = i0; i < i1; ++i) {
+        uint64_t k;
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        for (k = b->outlier_offsets[i]; k < b->outlier_offsets[i + 1]; ++k) {
+            const float *v = b->outlier_values + 3 * k, *e = a->E + 3 * (size_t)b->outlier_columns[k];
+            s0 += v[0] * e[0];
+            s1 += v[1] * e[1];
+            s2 += v[2] * e[2];
+        }
+        a->out[3 * (size_t)i] += s0;
+        a->out[3 * (size_t)i + 1] += s1;
+        a->out[3 * (size_t)i + 2] += s2;
     }
 }
 
@@ -9790,7 +9782,11 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
         a.tasks = c.tasks < bpr ? c.tasks : bpr;
         c.parallel_for(c.parallel_user, a.tasks, rad__mb_bapply_task, &a);
     }
-    rad__mb_scatter(a.y, padded, b->row_perm, n, out); /* the outliers are in (rad__mb_row_outliers) */
+    rad__mb_scatter(a.y, padded, b->row_perm, n, out);
+    if (b->outlier_count) {
+        a.tasks = c.tasks < n ? c.tasks : n;
+        c.parallel_for(c.parallel_user, a.tasks, rad__mb_outlier_task, &a);
+    }
     if (output == RAD_OUTPUT_TOTAL)
         for (i = 0; i < 3 * (size_t)n; ++i) out[i] += E[i];
     rad__free(&c.allocator, scratch);
