@@ -360,7 +360,7 @@ MD="$OUT/REPORT.md"
     echo
     echo "| setting | value |"
     echo "|---|---|"
-    echo "| quality | $MODE (\`bash tools/report.sh$([ $MODE = full ] || echo " --$MODE")\`; \`make report\` = full, \`make report-quick\` = quick, checked in CI) |"
+    echo "| quality | $MODE (\`bash tools/report.sh$([ $MODE = full ] || echo " --$MODE")\`$([ -n "${RAD_REPORT_VP_SWEEP:-}${RAD_REPORT_VP_BUDGETS:-}" ] && echo " with RAD_REPORT_VP_SWEEP='${RAD_REPORT_VP_SWEEP:-}' and RAD_REPORT_VP_BUDGETS='${RAD_REPORT_VP_BUDGETS:-}'"); \`make report\` = full, \`make report-quick\` = quick, checked in CI) |"
     echo "| date | $(date -u '+%Y-%m-%d %H:%M UTC') |"
     echo "| machine | ${CPU:-unknown CPU}, $(nproc) logical CPUs, $(awk '/MemTotal/ { printf "%.0f GB", $2 / 1048576 }' /proc/meminfo) |"
     echo "| load | shared machine: load average $LOAD_START at the start, $(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null) at the end (other jobs ran at the same time, so times are noisy even as medians: the two float F_mb rows do the same work per frame, and their times show the spread) |"
