@@ -92,6 +92,8 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 SAN="-g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
 RAD_TEST_QUICK=1 unit unit-asan-ubsan-O0 $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c
 RAD_TEST_QUICK=1 unit unit-asan-ubsan-O2-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
+# the SIMD paths of this machine (AVX2 temporal lanes, BC1/BC4 apply, BVH) under the sanitizers
+RAD_TEST_QUICK=1 unit unit-asan-ubsan-O1-native $CC -std=c99 $WARN -O1 -march=native $OMP $SAN -I. tests/test_main.c
 
 # ---- compile tests ------------------------------------------------------------------------
 echo "== compile tests"
