@@ -9552,13 +9552,14 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    Block columns go in passes of RAD__MB_LUT_PASS (2.25 MiB of tables, kept in L3): per pass
    two parallel loops, the pass's tables (parallel over columns), then every block row over
    them, in tiles of RAD__MB_LUT_TILE columns (768 KiB of tables; L2 is 1 MiB here) so that a
-   tile's tables stay in L2 while a task's block rows pass over them. Measured
-   (BENCHMARKS.md). Slower alternatives measured: all tables first (1.5x slower at N = 5696:
+   tile's tables stay in L2 while a task's block rows pass over them (BENCHMARKS.md: 1.2x
+   faster than the exact palette per block). Slower alternatives measured: all tables first (1.5x slower at N = 5696:
    17 MB of tables written and read back through DRAM, more than the 15 MB of blocks), tables
    per task (the work repeats in every task, 64 by default), 16-float entries (one cache line
    each), palettes looked up in tables over the endpoint codes (L2 traffic), the exact
-   palette per block times sums by code (M_0..M_3; 1.6x slower: the palette was two thirds
-   of the instructions). */
+   palette per block times sums by code (M_0..M_3: the palette was two thirds of the
+   instructions), nibble tables small enough for L1 (twice the loads: 2x slower), the
+   outliers added inside the block loop (their rows then come in permuted order). */
 #define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
@@ -9635,9 +9636,9 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
                     for (bx = s; bx < e; ++bx) {
                         const uint8_t *blk = row + 8 * (size_t)bx;
                         const uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
-                        /* the row's entry in the block's mode: 3-colour at +0, 4-colour (c0 > c1) at +6;
-                           by arithmetic, not a comparison, which gcc 12 made a branch (the encoder
-                           mixes both modes: mispredicted about half the time, 1.6x slower) */
+                        /* the row's entry in the block's mode: 3-colour at +0, 4-colour (c0 > c1)
+                           at +6; by arithmetic, not a comparison, which gcc 12 made a branch (the
+                           encoder mixes both modes: mispredicted about half the time, 1.2x slower) */
                         const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0) + 6u * ((k1 - k0) >> 31);
                         const __m256 ep = _mm256_mul_ps(
                             _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)(k0 | k1 << 16)), ep_shift), ep_mask)),
