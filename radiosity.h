@@ -9559,7 +9559,10 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    each), palettes looked up in tables over the endpoint codes (L2 traffic), the exact
    palette per block times sums by code (M_0..M_3: the palette was two thirds of the
    instructions), nibble tables small enough for L1 (twice the loads: 2x slower), the
-   outliers added inside the block loop (their rows then come in permuted order). */
+   outliers added inside the block loop (their rows then come in permuted order), a sweep
+   down two block columns at a time with their tables in L1 and the row sums in memory (2.8x
+   slower at N = 5696: consecutive block rows are a row of blocks apart, 11 KiB, so every
+   block is on another page). */
 #define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
