@@ -9553,16 +9553,16 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    two parallel loops, the pass's tables (parallel over columns), then every block row over
    them, in tiles of RAD__MB_LUT_TILE columns (768 KiB of tables; L2 is 1 MiB here) so that a
    tile's tables stay in L2 while a task's block rows pass over them (BENCHMARKS.md: 1.2x
-   faster than the exact palette per block). Slower alternatives measured: all tables first (1.5x slower at N = 5696:
-   17 MB of tables written and read back through DRAM, more than the 15 MB of blocks), tables
-   per task (the work repeats in every task, 64 by default), 16-float entries (one cache line
-   each), palettes looked up in tables over the endpoint codes (L2 traffic), the exact
-   palette per block times sums by code (M_0..M_3: the palette was two thirds of the
-   instructions), nibble tables small enough for L1 (twice the loads: 2x slower), the
-   outliers added inside the block loop (their rows then come in permuted order), a sweep
-   down two block columns at a time with their tables in L1 and the row sums in memory (2.8x
-   slower at N = 5696: consecutive block rows are a row of blocks apart, 11 KiB, so every
-   block is on another page). */
+   faster than the exact palette per block). Slower alternatives measured: all tables first
+   (1.5x slower at N = 5696: 17 MB of tables written and read back through DRAM, more than
+   the 15 MB of blocks), tables per task (the work repeats in every task, 64 by default),
+   16-float entries (one cache line each), palettes looked up in tables over the endpoint
+   codes (L2 traffic), the exact palette per block times sums by code (M_0..M_3: the palette
+   was two thirds of the instructions), nibble tables small enough for L1 (twice the loads:
+   2x slower), the outliers added inside the block loop (their rows then come in permuted
+   order), a sweep down two block columns at a time with their tables in L1 and the row sums
+   in memory (2.8x slower at N = 5696: consecutive block rows are a row of blocks apart,
+   11 KiB, so every block is on another page). */
 #define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
