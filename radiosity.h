@@ -11962,6 +11962,15 @@ RAD__HOT __m256i rad__pcg8(__m256i v)
     return _mm256_xor_si256(_mm256_srli_epi32(t, 22), t);
 }
 
+/* the draw's bin (u1 * nb) >> 32 on 8 lanes: even lanes' products shifted down, odd lanes'
+   kept in place */
+RAD__HOT __m256i rad__bin8(__m256i u1, __m256i nb)
+{
+    const __m256i even = _mm256_srli_epi64(_mm256_mul_epu32(u1, nb), 32);
+    const __m256i odd = _mm256_mul_epu32(_mm256_srli_epi64(u1, 32), _mm256_srli_epi64(nb, 32));
+    return _mm256_blend_epi32(even, odd, 0xAA);
+}
+
 /* issues the next 8 draws of the sequence into ring slots slot .. slot + 7, the same words
    and bins as 8 calls of rad__tpipe_issue: both hashes and the bin index on 8 lanes. With
    k >= 8 the 8 draws cross at most one boundary (row or table set): lanes 0 .. m-1 belong to
@@ -11973,7 +11982,7 @@ RAD__HOT void rad__tpipe_issue8(rad__tpipe *p, uint32_t slot)
     const __m256i laneg = _mm256_mullo_epi32(lane, _mm256_set1_epi32((int)0x9E3779B9u));
     uint32_t m = p->k - p->s, key_a, mix_a, nb_a, words_a, key_b, mix_b, nb_b, words_b, j;
     const uint32_t *bins_a, *bins_b;
-    __m256i inb, vkey, vmix, vnb, u1, u2, even, odd, idx, inb_lo, inb_hi, base_lo, base_hi, scale_lo, scale_hi;
+    __m256i inb, vkey, vmix, vnb, u1, u2, idx, inb_lo, inb_hi, base_lo, base_hi, scale_lo, scale_hi;
     if (p->k < 8u || p->row >= p->end) {
         for (j = 0; j < 8u; ++j) rad__tpipe_issue(p, slot + j);
         return;
@@ -12003,10 +12012,7 @@ RAD__HOT void rad__tpipe_issue8(rad__tpipe *p, uint32_t slot)
     u1 = rad__pcg8(_mm256_xor_si256(vkey, _mm256_add_epi32(vmix, laneg)));
     u2 = rad__pcg8(_mm256_xor_si256(u1, _mm256_set1_epi32(0x68E31DA4)));
     _mm256_storeu_si256((__m256i *)(void *)(p->u2 + slot), u2);
-    /* bin = (u1 * nb) >> 32: even lanes' products shifted down, odd lanes' kept in place */
-    even = _mm256_srli_epi64(_mm256_mul_epu32(u1, vnb), 32);
-    odd = _mm256_mul_epu32(_mm256_srli_epi64(u1, 32), _mm256_srli_epi64(vnb, 32));
-    idx = _mm256_blend_epi32(even, odd, 0xAA);
+    idx = rad__bin8(u1, vnb);
     /* addresses: bins + bin * words, as 64-bit integers */
     inb_lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(inb));
     inb_hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(inb, 1));
@@ -12108,13 +12114,13 @@ static void rad__temporal_finish(rad_temporal *t, uint32_t i, float *X)
    vector draw is draw s of table set c for 8 consecutive rows; a task's vector draws run block
    of 8 rows by block, set by set, sample by sample. The issuing side hashes vector draw
    d + RAD__TVEC_AHEAD (both words and the bin on 8 lanes) and prefetches its 8 bins while
-   vector draw d is resolved with two 64-bit gathers (the bins) and one masked gather per
+   vector draw d is resolved with 8 scalar 64-bit loads (the bins) and one masked gather per
    channel (V, or E_0 for the environment column). Each lane adds its own row's values in the
    documented order, so the bits equal the plain loop's; the scalar work per draw is about a
    third of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
 #ifndef RAD__TVEC_AHEAD
-#define RAD__TVEC_AHEAD 16u
-#endif /* vector draws in flight: 128 draws */
+#  define RAD__TVEC_AHEAD 16u /* vector draws in flight: 128 draws (12, 24, 32 measured slower) */
+#endif
 
 typedef struct rad__tvec {
     const rad_temporal *t;
@@ -12150,15 +12156,12 @@ static void rad__tvec_block(rad__tvec *p)
 RAD__HOT void rad__tvec_issue(rad__tvec *p, uint32_t slot)
 {
     uint64_t *b = p->bin + 8u * slot;
-    __m256i u1, even, odd, idx;
+    __m256i u1, idx;
     uint32_t j;
     if (p->row >= p->end) return;
     u1 = rad__pcg8(_mm256_xor_si256(p->key, _mm256_set1_epi32((int)((p->set * p->k + p->s) * 0x9E3779B9u))));
     _mm256_storeu_si256((__m256i *)(void *)(p->u2 + 8u * slot), rad__pcg8(_mm256_xor_si256(u1, _mm256_set1_epi32(0x68E31DA4))));
-    /* bin = (u1 * nb) >> 32 on 8 lanes, then first + bin as 64-bit integers */
-    even = _mm256_srli_epi64(_mm256_mul_epu32(u1, p->nb), 32);
-    odd = _mm256_mul_epu32(_mm256_srli_epi64(u1, 32), _mm256_srli_epi64(p->nb, 32));
-    idx = _mm256_blend_epi32(even, odd, 0xAA);
+    idx = rad__bin8(u1, p->nb); /* then first + bin as 64-bit integers */
     _mm256_storeu_si256((__m256i *)(void *)b, _mm256_add_epi64(p->first_lo, _mm256_cvtepu32_epi64(_mm256_castsi256_si128(idx))));
     _mm256_storeu_si256((__m256i *)(void *)(b + 4), _mm256_add_epi64(p->first_hi, _mm256_cvtepu32_epi64(_mm256_extracti128_si256(idx, 1))));
     for (j = 0; j < 8u; ++j) RAD__PREFETCH(p->bins + 2u * (size_t)b[j]);
@@ -12208,7 +12211,7 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
             __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, scale;
             for (s = 0; s < k; ++s) {
                 /* the 8 bins, read before the slot is reused (scalar loads: two 64-bit gathers
-                   cost about 10% more per draw on the machine of BENCHMARKS.md) */
+                   cost 10-20% more per draw on the machine of BENCHMARKS.md) */
                 const uint64_t *bn = p.bin + 8u * q;
                 const __m256i u2 = _mm256_loadu_si256((const __m256i *)(const void *)(p.u2 + 8u * q));
                 const __m256i glo = _mm256_set_epi64x(rad__bin64(gb, bn[3]), rad__bin64(gb, bn[2]), rad__bin64(gb, bn[1]), rad__bin64(gb, bn[0]));
