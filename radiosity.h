@@ -1641,9 +1641,9 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, c
      blocked Gauss-Jordan inverse (default) or the K = infinity multi-bounce build. */
 
 /* The sparse rows of the global form-factor matrix. fetch writes row 'row' of F (F_row,j for
-   every j with a non-zero entry: at most 'capacity' = n entries, any order, no repeats) into
-   out_columns / out_values and the entry count into *out_count, and returns RAD_SUCCESS or
-   an error the library passes on. It is called from the calling thread only (a streamed
+   every j with a non-zero entry: at most 'capacity' = n entries, any order, each column once;
+   rad_local refuses a repeat with CORRUPT) into out_columns / out_values and the entry count
+   into *out_count, and returns RAD_SUCCESS or an error the library passes on. It is called from the calling thread only (a streamed
    reader needs no lock). areas (n) and albedo (3n, each channel in [0,1)) are borrowed. */
 typedef rad_result (*rad_row_fetch_fn)(void *user, uint32_t row, uint32_t capacity, uint32_t *out_columns,
                                        float *out_values, uint32_t *out_count);
@@ -1675,7 +1675,8 @@ RAD_API rad_result rad_row_source_bake(const rad_bake *bake, rad_row_source *out
    offsets that end at the column and value counts); each fetch then reads one row's columns
    and values with two seeks and two reads, so the matrix is never in memory. The matrix
    sections' checksums are not verified (that would read them whole): every fetched row is
-   checked instead (columns < N by this reader; values finite and >= 0 by rad_local).
+   checked instead (strictly ascending columns < N, finite values >= 0; CORRUPT otherwise,
+   logged through the context given here).
    Errors: IO (the file cannot be opened or read), TRUNCATED, CORRUPT, VERSION, ALBEDO_RANGE,
    INVALID_ARGUMENT (no CSR matrix in the file), OUT_OF_MEMORY. Thread safety: one stream per
    thread (fetches move the file position). Seeks go through fseek, so where long is 32 bits
@@ -10139,6 +10140,7 @@ struct rad_row_stream {
     uint64_t col_at, val_at;   /* file offsets of the CSR columns and values */
     size_t bytes;
     rad_allocator allocator;
+    rad__ctx log;              /* the context given at open: fetch failures are logged through it */
 };
 
 RAD_API void rad_row_stream_close(rad_row_stream *s)
@@ -10173,8 +10175,16 @@ static rad_result rad__stream_fetch(void *user, uint32_t row, uint32_t capacity,
     if (count > 0 && (!rad__stream_read(s->f, s->col_at + 4u * b, out_columns, 4u * (size_t)count) ||
                       !rad__stream_read(s->f, s->val_at + 4u * b, out_values, 4u * (size_t)count)))
         return RAD_ERROR_IO;
+    /* the matrix sections are not checksummed here (that would read them whole): every row
+       is checked for what CSR promises instead, ascending columns below n and values >= 0 */
     for (k = 0; k < count; ++k)
-        if (out_columns[k] >= s->n) return RAD_ERROR_CORRUPT;
+        if (out_columns[k] >= s->n || (k > 0 && out_columns[k] <= out_columns[k - 1]) || !rad__finite(out_values[k]) ||
+            out_values[k] < 0.0f) {
+            rad__log(&s->log, RAD_LOG_ERROR, "row stream: row %u entry %u (column %u, value %g) breaks the CSR rules "
+                     "(ascending columns < %u, finite values >= 0): the file is corrupt", row, k, out_columns[k],
+                     (double)out_values[k], s->n);
+            return RAD_ERROR_CORRUPT;
+        }
     *out_count = count;
     return RAD_SUCCESS;
 }
@@ -10210,6 +10220,7 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
     if (!s) return RAD_ERROR_OUT_OF_MEMORY;
     memset(s, 0, sizeof(*s));
     s->allocator = c.allocator;
+    s->log = c;
     s->f = fopen(path, "rb");
     if (!s->f) {
         rad__log(&c, RAD_LOG_ERROR, "row stream: cannot open '%s'", path);
@@ -10349,6 +10360,7 @@ typedef struct rad__local_scratch {
     float *vf;               /* 3 M: v rounded to float for the update passes */
     double *cc;              /* 3 M: column of the slot evicted by a fused add */
     uint32_t *nz;            /* M: slots where the new row is non-zero */
+    uint8_t *seen;           /* n bits, all clear between fetches: repeated columns are rejected */
 } rad__local_scratch;
 
 typedef struct rad__local_storage {
@@ -10377,7 +10389,7 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     rad_local_options o;
     rad_local *L;
     rad__local_storage *st;
-    size_t sizes[13], total = 0, mm, off, part;
+    size_t sizes[14], total = 0, mm, off, part;
     unsigned char *mem;
     uint32_t i, M, k;
     rad__ctx_init(&c, ctx);
@@ -10425,8 +10437,9 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     sizes[10] = (size_t)M * sizeof(uint64_t);            /* hide_order */
     sizes[11] = (size_t)M * 3 * sizeof(float);           /* vf */
     sizes[12] = (size_t)M * 3 * sizeof(double);          /* cc */
+    sizes[13] = ((size_t)source->n + 7u) / 8u;           /* seen */
     total = sizeof(rad__local_storage);
-    for (k = 0; k < 13; ++k) {
+    for (k = 0; k < 14; ++k) {
         part = (sizes[k] + 63u) & ~(size_t)63u;
         if (part < sizes[k] || total + part < total) return RAD_ERROR_SIZE_OVERFLOW;
         total += part;
@@ -10455,7 +10468,9 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     st->slot_hidden = (uint8_t *)(mem + off); off += (sizes[9] + 63u) & ~(size_t)63u;
     st->hide_order = (uint64_t *)(mem + off); off += (sizes[10] + 63u) & ~(size_t)63u;
     st->s.vf = (float *)(mem + off); off += (sizes[11] + 63u) & ~(size_t)63u;
-    st->s.cc = (double *)(mem + off);
+    st->s.cc = (double *)(mem + off); off += (sizes[12] + 63u) & ~(size_t)63u;
+    st->s.seen = (uint8_t *)(mem + off);
+    memset(st->s.seen, 0, sizes[13]);
     memset(st->slot_hidden, 0, M);
     st->bytes = total + 64u + sizeof(rad_local);
     memset(st->planes, 0, mm);
@@ -10611,16 +10626,27 @@ static rad_result rad__local_fetch(const rad__ctx *c, rad_local *L, uint32_t pat
         return RAD_ERROR_SIZE_MISMATCH;
     }
     for (p = 0; p < k; ++p) {
-        if (s->row_columns[p] >= L->n) {
-            rad__log(c, RAD_LOG_ERROR, "local matrix: row %u has column %u >= n = %u", patch, s->row_columns[p], L->n);
-            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        uint32_t j = s->row_columns[p];
+        if (j >= L->n) {
+            rad__log(c, RAD_LOG_ERROR, "local matrix: row %u has column %u >= n = %u", patch, j, L->n);
+            r = RAD_ERROR_INDEX_OUT_OF_RANGE;
+            break;
         }
+        if (s->seen[j >> 3] & (1u << (j & 7u))) {
+            rad__log(c, RAD_LOG_ERROR, "local matrix: row %u repeats column %u (a row source returns each column once)", patch, j);
+            r = RAD_ERROR_CORRUPT;
+            break;
+        }
+        s->seen[j >> 3] |= (uint8_t)(1u << (j & 7u));
         if (!rad__finite(s->row_values[p]) || s->row_values[p] < 0.0f) {
-            rad__log(c, RAD_LOG_ERROR, "local matrix: F[%u][%u] = %g (must be finite and >= 0)", patch, s->row_columns[p],
-                     (double)s->row_values[p]);
-            return RAD_ERROR_NON_FINITE;
+            rad__log(c, RAD_LOG_ERROR, "local matrix: F[%u][%u] = %g (must be finite and >= 0)", patch, j, (double)s->row_values[p]);
+            r = RAD_ERROR_NON_FINITE;
+            ++p;
+            break;
         }
     }
+    while (p-- > 0) s->seen[s->row_columns[p] >> 3] = 0; /* clears every byte this row set */
+    if (r != RAD_SUCCESS) return r;
     *count = k;
     return RAD_SUCCESS;
 }

@@ -690,6 +690,123 @@ static void test_local_row_sources(void)
 }
 
 
+/* a row that names a column twice: from a user's source and from a streamed bake whose
+   column bytes were edited (the stream does not checksum the matrix sections). Before the
+   check a repeat of a member column overflowed the scratch of member slots. */
+typedef struct lc_rep { uint32_t n, repeat; } lc_rep;
+
+static rad_result lc_rep_fetch(void *user, uint32_t row, uint32_t capacity, uint32_t *cols, float *vals, uint32_t *count)
+{
+    lc_rep *t = (lc_rep *)user;
+    uint32_t j, k = 0;
+    for (j = 0; j < t->n && k < capacity; ++j) {
+        if (j == row) continue;
+        cols[k] = j;
+        vals[k++] = 0.1f;
+    }
+    if (t->repeat && row == 3 && k >= 2) cols[1] = cols[0]; /* column 0 twice */
+    *count = k;
+    return RAD_SUCCESS;
+}
+
+static void test_local_repeated_columns(void)
+{
+    float areas[6] = {1, 1, 1, 1, 1, 1}, albedo[18];
+    lc_rep rep = {6u, 1u};
+    rad_row_source src;
+    rad_local_options o;
+    rad_local *L = NULL;
+    uint32_t i;
+    for (i = 0; i < 18; ++i) albedo[i] = 0.5f;
+    memset(&src, 0, sizeof(src));
+    src.n = 6; src.areas = areas; src.albedo = albedo; src.fetch = lc_rep_fetch; src.user = &rep;
+    rad_local_options_default(&o);
+    o.capacity = 2;
+    CHECK_OK(rad_local_create(&src, &o, NULL, &L));
+    if (L) {
+        CHECK_OK(rad_local_add(L, 0, NULL));
+        CHECK_RESULT(rad_local_add(L, 3, NULL), RAD_ERROR_CORRUPT);
+        CHECK(L->count == 1 && L->patch_slot[3] == RAD_NONE);
+        /* the refused row left no marks behind: the same row without the repeat is taken */
+        rep.repeat = 0;
+        CHECK_OK(rad_local_add(L, 3, NULL));
+        CHECK(L->count == 2);
+    }
+    rad_local_destroy(L);
+#ifndef RAD_NO_STDIO
+    {
+        lc_world w;
+        rad_form_factors *sp = NULL;
+        rad_form_factor_options fo;
+        rad_raycaster rc;
+        void *buf = NULL;
+        size_t size = 0;
+        const char *path = "build/test_local_repeat.radb";
+        if (!lc_cornell(&w, 70u)) return;
+        rad_form_factor_options_default(&fo);
+        fo.samples = 2;
+        rad_bvh_raycaster(w.bvh, &rc);
+        CHECK_OK(rad_form_factors_sparse(w.patches, &rc, &fo, NULL, &sp));
+        if (sp) CHECK_OK(rad_save_memory(w.patches, &sp->matrix, NULL, NULL, NULL, &buf, &size));
+        if (buf) {
+            unsigned char *b = (unsigned char *)buf;
+            uint32_t n = rad__get32(b + 8), k, row = 5, e0 = (uint32_t)sp->matrix.row_offsets[row],
+                     e1 = (uint32_t)sp->matrix.row_offsets[row + 1];
+            uint64_t col_at = 0, val_at = 0;
+            int mode;
+            for (k = 0; k < n; ++k) {
+                const unsigned char *e = b + 64 + 64 * (size_t)k;
+                if (rad__get32(e) == RAD_SECTION_FF_COLUMNS) col_at = rad__get64(e + 16);
+                if (rad__get32(e) == RAD_SECTION_FF_VALUES) val_at = rad__get64(e + 16);
+            }
+            CHECK(col_at != 0 && val_at != 0 && e1 >= e0 + 2);
+            /* mode 0: row 5 names one member column twice; 1: columns out of order; 2: a NaN */
+            for (mode = 0; mode < 3 && col_at && val_at && e1 >= e0 + 2; ++mode) {
+                unsigned char *copy = (unsigned char *)malloc(size);
+                FILE *f;
+                rad_row_stream *st = NULL;
+                rad_row_source sf;
+                rad_local *Lf = NULL;
+                int wrote;
+                if (!copy) break;
+                memcpy(copy, buf, size);
+                if (mode == 0) for (k = e0; k < e1; ++k) memcpy(copy + col_at + 4 * (size_t)k, b + col_at + 4 * (size_t)e0, 4);
+                if (mode == 1) {
+                    memcpy(copy + col_at + 4 * (size_t)e0, b + col_at + 4 * (size_t)(e0 + 1), 4);
+                    memcpy(copy + col_at + 4 * (size_t)(e0 + 1), b + col_at + 4 * (size_t)e0, 4);
+                }
+                if (mode == 2) memset(copy + val_at + 4 * (size_t)e0, 0xFF, 4); /* a NaN bit pattern */
+                f = fopen(path, "wb");
+                if (!f) { path = "test_local_repeat.radb"; f = fopen(path, "wb"); }
+                wrote = f && fwrite(copy, 1, size, f) == size;
+                if (f) fclose(f);
+                free(copy);
+                CHECK(wrote);
+                CHECK_OK(rad_row_stream_open(path, NULL, &st));
+                if (st) {
+                    rad_row_stream_source(st, &sf);
+                    rad_local_options_default(&o);
+                    o.capacity = 2;
+                    CHECK_OK(rad_local_create(&sf, &o, NULL, &Lf));
+                    if (Lf) {
+                        uint32_t first = rad__get32(b + col_at + 4 * (size_t)e0);
+                        CHECK_OK(rad_local_add(Lf, first, NULL));
+                        CHECK_RESULT(rad_local_add(Lf, row, NULL), RAD_ERROR_CORRUPT);
+                        CHECK(Lf->count == 1);
+                    }
+                    rad_local_destroy(Lf);
+                    rad_row_stream_close(st);
+                }
+                remove(path);
+            }
+        }
+        rad_free_buffer(buf, NULL);
+        rad_form_factors_destroy(sp);
+        lc_world_free(&w);
+    }
+#endif
+}
+
 /* nearest-M against a brute-force count, P_Vis against per-pixel camera rays (every patch a
    pixel hits is visible; a patch behind the camera or facing away never is), P_Lit */
 static void test_local_sets(void)
@@ -926,6 +1043,7 @@ static const rad_test_case tests_local[] = {
     {"local_apply_subsets", test_local_apply_subsets},
     {"local_bad_input", test_local_bad_input},
     {"local_row_sources", test_local_row_sources},
+    {"local_repeated_columns", test_local_repeated_columns},
     {"local_sets", test_local_sets},
     {"local_alloc_failure", test_local_alloc_failure},
     {"local_null_arguments", test_local_null_arguments},
