@@ -154,6 +154,14 @@
        Every fallible function returns rad_result: RAD_SUCCESS (0) or a negative code;
        rad_result_string() names it. Detail ("triangle 12 of mesh 'floor' has zero area")
        goes to rad_context.log when set. There is no global error state.
+       Non-finite values, one rule for every solver and run-time product (rad_matrix_multiply,
+       the solvers, rad_multibounce_apply, rad_multibounce_blocks_apply, rad_local_apply,
+       rad_temporal_step): a NaN or Inf in the input vector is refused before any work, and
+       an output value that overflows float is reported; both return RAD_ERROR_NON_FINITE
+       with the index in the log, so a success never carries NaN or Inf. After an overflow
+       the output array holds unspecified values (a temporal state is left as before the
+       step). Each check is one pass over the vector, O(N) beside the product's O(N^2) or
+       O(N k).
 
    6. THREADING
        radiosity.h never starts a thread. Long calls split their work into tasks and run them
@@ -311,7 +319,8 @@ typedef enum rad_result {
     RAD_ERROR_IO = -17,                   /* a file could not be opened, read or written */
     RAD_ERROR_TRUNCATED = -18,            /* baked data ends before its sections do */
     RAD_ERROR_CORRUPT = -19,              /* bad magic, checksum, table or section layout */
-    RAD_ERROR_VERSION = -20               /* baked data of an unsupported container version */
+    RAD_ERROR_VERSION = -20,              /* baked data of an unsupported container version */
+    RAD_ERROR_SCALE_RANGE = -21           /* a scene larger or smaller than RAD_SCENE_MAX/MIN_SIZE */
 } rad_result;
 
 /* A static English name and description of a result ("RAD_ERROR_NON_FINITE: ..."). */
@@ -422,11 +431,17 @@ typedef struct rad_scene {
     rad_allocator allocator;       /* private: the allocator that made it */
 } rad_scene;
 
+/* The scene sizes (bounding-box diagonal, in the scene's units) the library supports: ray
+   tests, form factors and light stay accurate from one to the other (tested at both ends);
+   rad_scene_create refuses a scene outside with RAD_ERROR_SCALE_RANGE. */
+#define RAD_SCENE_MIN_SIZE 1e-15
+#define RAD_SCENE_MAX_SIZE 1e18
+
 /* Validates 'desc' and copies it into a new scene.
    Parameters: desc (borrowed for the call), ctx (optional), out (receives an owning pointer).
    Errors: INVALID_ARGUMENT, EMPTY_SCENE, INDEX_OUT_OF_RANGE, NON_FINITE, DEGENERATE_TRIANGLE,
-   ALBEDO_RANGE, NEGATIVE_EMISSION, MATERIAL_OUT_OF_RANGE, SIZE_OVERFLOW, OUT_OF_MEMORY; the
-   logger names the mesh and triangle. Thread safety: reentrant. Cost: O(triangles). SPEC §1. */
+   ALBEDO_RANGE, NEGATIVE_EMISSION, MATERIAL_OUT_OF_RANGE, SIZE_OVERFLOW, SCALE_RANGE,
+   OUT_OF_MEMORY; the logger names the mesh and triangle. Thread safety: reentrant. Cost: O(triangles). SPEC §1. */
 RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_context *ctx, rad_scene **out);
 RAD_API void rad_scene_destroy(rad_scene *scene);
 
@@ -589,7 +604,10 @@ RAD_API void rad_camera_ray(const rad_camera *camera, uint32_t width, uint32_t h
 
 typedef enum rad_storage { RAD_STORAGE_DENSE = 0, RAD_STORAGE_SPARSE = 1 } rad_storage;
 
-/* A non-owning view of a rows x cols matrix of floats: dense row-major, or CSR. */
+/* A non-owning view of a rows x cols matrix of floats: dense row-major, or CSR. Every
+   function that takes a CSR view checks its structure first (row_offsets[0] = 0, never
+   decreasing; columns ascending and < cols) and refuses a bad one with RAD_ERROR_CORRUPT;
+   row_offsets[rows] must be the length of columns and values, which no check can see. */
 typedef struct rad_matrix {
     uint32_t rows, cols;
     rad_storage storage;
@@ -673,7 +691,7 @@ typedef enum rad_output { RAD_OUTPUT_INDIRECT = 0, RAD_OUTPUT_TOTAL = 1 } rad_ou
 /* The linear system B = E + (rho o F) B. All pointers borrowed. */
 typedef struct rad_system {
     const rad_matrix *F;     /* N x N form factors */
-    const float *albedo;     /* 3N, each in [0,1) */
+    const float *albedo;     /* 3N, each in [0,1): the solvers refuse others (ALBEDO_RANGE) */
     const float *E;          /* 3N source (see UNITS AND CONVENTIONS) */
     const float *areas;      /* N, needed by progressive refinement only */
     uint32_t n;
@@ -2024,7 +2042,8 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
    including E) to out_indirect when it is not NULL; rad_temporal_indirect returns it too.
    Parallel over rows through ctx->parallel_for; the bits do not depend on the thread count
    or task split (each row's draws depend only on seed, frame, row and sample).
-   Errors: INVALID_ARGUMENT. Cost: O(N k) random reads into the tables and E: the draws
+   Errors: INVALID_ARGUMENT, NON_FINITE (E or E0 not finite, or B overflows float: the
+   step is then undone). Cost: O(N k) random reads into the tables and E: the draws
    are software-pipelined (each task hashes and prefetches the bins of the draws 64 to 128
    ahead of the one it resolves, across rows; with AVX2 and compact tables 8 rows side by
    side, one per vector lane), so the misses overlap instead of waiting one by one
@@ -2360,6 +2379,7 @@ RAD_API const char *rad_result_string(rad_result result)
     case RAD_ERROR_TRUNCATED: return "RAD_ERROR_TRUNCATED: the baked data is truncated";
     case RAD_ERROR_CORRUPT: return "RAD_ERROR_CORRUPT: the baked data is corrupted (checksum, table or layout)";
     case RAD_ERROR_VERSION: return "RAD_ERROR_VERSION: the baked data has an unsupported version";
+    case RAD_ERROR_SCALE_RANGE: return "RAD_ERROR_SCALE_RANGE: the scene is larger or smaller than the library supports";
     }
     return "RAD_ERROR_UNKNOWN: not a rad_result value";
 }
@@ -2474,8 +2494,21 @@ static void rad__log(const rad__ctx *c, rad_log_level level, const char *fmt, ..
 static int rad__finite(float x) { return x == x && x - x == 0.0f; }
 static int rad__finite3(const float *v) { return rad__finite(v[0]) && rad__finite(v[1]) && rad__finite(v[2]); }
 
-/* Outputs never carry NaN or Inf: a value that overflowed float (an emitter or light far too
-   strong for the scene's scale, a system that diverges) is reported instead. */
+/* Inputs and outputs never carry NaN or Inf (ERRORS in the top comment): a value that
+   overflowed float (an emitter or light far too strong for the scene's scale, a system that
+   diverges) is reported instead. */
+static rad_result rad__check_input(const rad__ctx *c, const char *what, const float *v, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(v[i])) {
+            rad__log(c, RAD_LOG_ERROR, "%s: input value %llu (patch %llu channel %u) is %g: inputs must be finite", what,
+                     (unsigned long long)i, (unsigned long long)(i / 3u), (unsigned)(i % 3u), (double)v[i]);
+            return RAD_ERROR_NON_FINITE;
+        }
+    return RAD_SUCCESS;
+}
+
 static rad_result rad__check_output(const rad__ctx *c, const char *what, const float *v, size_t n)
 {
     size_t i;
@@ -2894,14 +2927,19 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     }
     RAD_ASSERT(dst == n);
     {
-        float d[3];
-        rad__sub(d, s->bounds_max, s->bounds_min);
-        s->diagonal = rad__len(d);
-        if (!(s->diagonal > 0.0f) || !rad__finite(s->diagonal)) {
-            rad__log(&c, RAD_LOG_ERROR, "the scene's bounding box diagonal is %g (too large for float)", (double)s->diagonal);
-            rad_scene_destroy(s);
-            return RAD_ERROR_NON_FINITE;
+        double d2 = 0.0, diag;
+        for (k = 0; k < 3; ++k) {
+            double e = (double)s->bounds_max[k] - (double)s->bounds_min[k];
+            d2 += e * e;
         }
+        diag = sqrt(d2);
+        if (!(diag >= RAD_SCENE_MIN_SIZE && diag <= RAD_SCENE_MAX_SIZE)) {
+            rad__log(&c, RAD_LOG_ERROR, "the scene's bounding box diagonal is %g units: the library supports %g to %g (rescale "
+                     "the scene, e.g. to meters)", diag, RAD_SCENE_MIN_SIZE, RAD_SCENE_MAX_SIZE);
+            rad_scene_destroy(s);
+            return RAD_ERROR_SCALE_RANGE;
+        }
+        s->diagonal = (float)diag;
     }
     *out = s;
     return RAD_SUCCESS;
@@ -3667,7 +3705,7 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
 /* Watertight ray/triangle test, both faces. Returns 1 with t, b1, b2 on a hit in (tmin, tmax). */
 static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *t_out, float *b1, float *b2)
 {
-    float A[3], B[3], C[3], Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T;
+    float A[3], B[3], C[3], Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, inv_det, T;
     int k;
     for (k = 0; k < 3; ++k) { A[k] = v[k] - w->o[k]; B[k] = v[3 + k] - w->o[k]; C[k] = v[6 + k] - w->o[k]; }
     Ax = A[w->kx] - w->sx * A[w->kz]; Ay = A[w->ky] - w->sy * A[w->kz];
@@ -3685,11 +3723,18 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     det = U + V + W;
     if (det == 0.0f) return 0;
-    T = (U * (w->sz * A[w->kz]) + V * (w->sz * B[w->kz]) + W * (w->sz * C[w->kz])) / det;
+    /* barycentrics first, then T from them: U, V, W scale as length^2, so the paper's
+       (U z_A + V z_B + W z_C) / det (length^3) overflows float beyond about 1e12 and
+       underflows below 1e-13; this form holds from about 1e-18 to 1e18 */
+    inv_det = 1.0f / det;
+    U *= inv_det;
+    V *= inv_det;
+    W *= inv_det;
+    T = U * (w->sz * A[w->kz]) + V * (w->sz * B[w->kz]) + W * (w->sz * C[w->kz]);
     if (!(T > w->tmin && T < tmax)) return 0;
     *t_out = T;
-    *b1 = V / det;
-    *b2 = W / det;
+    *b1 = V;
+    *b2 = W;
     return 1;
 }
 
@@ -4675,12 +4720,35 @@ RAD_API void rad_system_init(rad_system *system, const rad_matrix *F, const rad_
     }
 }
 
-static rad_result rad__check_matrix(const rad_matrix *F)
+/* A matrix view before use. CSR structure is checked in full (offsets from 0, never
+   decreasing; columns ascending and < cols): a hand-built matrix cannot send a product out
+   of its arrays. O(rows + non-zeros), beside the O(non-zeros) of any use of it. */
+static rad_result rad__check_matrix(const rad_matrix *F, const rad__ctx *c)
 {
+    uint32_t i;
+    uint64_t p;
     if (!F) return RAD_ERROR_INVALID_ARGUMENT;
     if (F->storage == RAD_STORAGE_DENSE) return F->dense ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
-    if (F->storage == RAD_STORAGE_SPARSE) return (F->row_offsets && F->columns && F->values) ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
-    return RAD_ERROR_INVALID_ARGUMENT;
+    if (F->storage != RAD_STORAGE_SPARSE || !F->row_offsets || !F->columns || !F->values) return RAD_ERROR_INVALID_ARGUMENT;
+    if (F->rows > 0 && F->row_offsets[0] != 0) {
+        rad__log(c, RAD_LOG_ERROR, "CSR matrix: row_offsets[0] is %llu, must be 0", (unsigned long long)F->row_offsets[0]);
+        return RAD_ERROR_CORRUPT;
+    }
+    for (i = 0; i < F->rows; ++i) {
+        uint64_t b = F->row_offsets[i], e = F->row_offsets[i + 1];
+        if (e < b || e - b > F->cols) {
+            rad__log(c, RAD_LOG_ERROR, "CSR matrix: row %u spans offsets %llu to %llu (must not decrease nor exceed %u columns)", i,
+                     (unsigned long long)b, (unsigned long long)e, F->cols);
+            return RAD_ERROR_CORRUPT;
+        }
+        for (p = b; p < e; ++p)
+            if (F->columns[p] >= F->cols || (p > b && F->columns[p] <= F->columns[p - 1])) {
+                rad__log(c, RAD_LOG_ERROR, "CSR matrix: row %u has column %u at entry %llu (columns must ascend and be < %u)", i,
+                         F->columns[p], (unsigned long long)p, F->cols);
+                return RAD_ERROR_CORRUPT;
+            }
+    }
+    return RAD_SUCCESS;
 }
 
 /* options every solver shares: a known output kind, a finite non-negative tolerance */
@@ -4698,14 +4766,21 @@ static rad_result rad__check_solve_options(const rad_solve_options *o, const rad
 static rad_result rad__check_system(const rad_system *s, const rad__ctx *c)
 {
     rad_result r;
+    size_t i;
     if (!s || !s->albedo || !s->E) return RAD_ERROR_INVALID_ARGUMENT;
-    r = rad__check_matrix(s->F);
+    r = rad__check_matrix(s->F, c);
     if (r != RAD_SUCCESS) return r;
     if (s->F->rows != s->n || s->F->cols != s->n || s->n == 0) {
         rad__log(c, RAD_LOG_ERROR, "system: the matrix is %u x %u but n is %u", s->F->rows, s->F->cols, s->n);
         return s->n == 0 ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_SIZE_MISMATCH;
     }
-    return RAD_SUCCESS;
+    for (i = 0; i < 3 * (size_t)s->n; ++i)
+        if (!(s->albedo[i] >= 0.0f && s->albedo[i] < 1.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "system: albedo of patch %llu channel %u is %g (must be in [0,1): the system diverges)",
+                     (unsigned long long)(i / 3u), (unsigned)(i % 3u), (double)s->albedo[i]);
+            return RAD_ERROR_ALBEDO_RANGE;
+        }
+    return r;
 }
 
 /* dot products of one dense row with three vectors (structure of arrays) */
@@ -4877,17 +4952,18 @@ RAD_API rad_result rad_matrix_multiply(const rad_matrix *F, const float *x, floa
     float *soa = NULL;
     rad_result r;
     rad__ctx_init(&c, ctx);
-    r = rad__check_matrix(F);
+    r = rad__check_matrix(F, &c);
     if (r != RAD_SUCCESS) return r;
     if (!x || !out || x == out) return RAD_ERROR_INVALID_ARGUMENT;
     if (F->rows == 0) return RAD_SUCCESS;
+    if (rad__check_input(&c, "rad_matrix_multiply", x, 3 * (size_t)F->cols) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
     if (F->storage == RAD_STORAGE_DENSE) {
         soa = (float *)rad__alloc_array(&c.allocator, (size_t)F->cols * 3u, sizeof(float));
         if (!soa) return RAD_ERROR_OUT_OF_MEMORY;
     }
     rad__matvec(&c, F, x, out, soa);
     rad__free(&c.allocator, soa);
-    return RAD_SUCCESS;
+    return rad__check_output(&c, "rad_matrix_multiply", out, 3 * (size_t)F->rows);
 }
 
 static void rad__finish_output(const rad_system *s, rad_output output, float *B_total_or_L, int have_total)
@@ -6350,7 +6426,7 @@ RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, co
     *out_size = 0;
     if (!P || P->count == 0) return RAD_ERROR_INVALID_ARGUMENT;
     if (F) {
-        r = rad__check_matrix(F);
+        r = rad__check_matrix(F, &c);
         if (r != RAD_SUCCESS) return r;
         if (F->rows != P->count || F->cols != P->count) {
             rad__log(&c, RAD_LOG_ERROR, "save: the matrix is %u x %u but there are %u patches", F->rows, F->cols, P->count);
@@ -8240,7 +8316,8 @@ RAD_API rad_result rad_multibounce_create(const rad_matrix *F, const float *albe
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
-    r = rad__check_matrix(F);
+    r = rad__check_matrix(F, &c);
+    if (r == RAD_ERROR_CORRUPT) return r;
     if (r != RAD_SUCCESS || !albedo) return RAD_ERROR_INVALID_ARGUMENT;
     if (options) o = *options; else rad_multibounce_options_default(&o);
     if (o.bounces == 0 || (o.precision != RAD_MB_FLOAT && o.precision != RAD_MB_HALF) || !(o.tolerance >= 0.0)) {
@@ -8477,6 +8554,7 @@ RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float 
     rad__ctx_init(&c, ctx);
     if (rad__mb_check(mb) != RAD_SUCCESS || !E || !out || E == out) return RAD_ERROR_INVALID_ARGUMENT;
     n = mb->n;
+    if (rad__check_input(&c, "rad_multibounce_apply", E, 3 * (size_t)n) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
     x = (float *)rad__alloc_array(&c.allocator, (size_t)n, 6 * sizeof(float));
     if (!x) return RAD_ERROR_OUT_OF_MEMORY;
     rad__mb_gather(E, mb->col_perm, n, n, x);
@@ -8489,7 +8567,7 @@ RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float 
     if (output == RAD_OUTPUT_TOTAL)
         for (i = 0; i < 3 * (size_t)n; ++i) out[i] += E[i];
     rad__free(&c.allocator, x);
-    return RAD_SUCCESS;
+    return rad__check_output(&c, "rad_multibounce_apply", out, 3 * (size_t)n);
 }
 
 /* ---- greedy reordering (thesis Listing 3.1) ---- */
@@ -9740,6 +9818,7 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
     rad__ctx_init(&c, ctx);
     if (rad__mb_blocks_check(b) != RAD_SUCCESS || !E || !out || E == out) return RAD_ERROR_INVALID_ARGUMENT;
     n = b->n;
+    if (rad__check_input(&c, "rad_multibounce_blocks_apply", E, 3 * (size_t)n) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
     bpr = b->blocks_per_row;
     padded = 4u * bpr;
     bc1 = b->format == RAD_BLOCK_BC1;
@@ -9800,7 +9879,7 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
         for (i = 0; i < 3 * (size_t)n; ++i) out[i] += E[i];
     rad__free(&c.allocator, scratch);
     rad__free(&c.allocator, tile_col);
-    return RAD_SUCCESS;
+    return rad__check_output(&c, "rad_multibounce_blocks_apply", out, 3 * (size_t)n);
 }
 
 RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *b, float *out_planes, const rad_context *ctx)
@@ -11654,8 +11733,9 @@ RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format
                                            rad_alias_tables **out)
 {
     rad__ctx c;
-    rad_result r = rad__check_matrix(F);
+    rad_result r;
     rad__ctx_init(&c, ctx);
+    r = rad__check_matrix(F, &c);
     if (out) *out = NULL;
     if (r != RAD_SUCCESS) return r;
     if (F->rows != F->cols) {
@@ -12355,6 +12435,11 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
     size_t n3, j;
     if (!t || !E) return RAD_ERROR_INVALID_ARGUMENT;
     n3 = 3u * (size_t)t->n;
+    if (rad__check_input(&t->c, "rad_temporal_step", E, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
+    if (E0 && !rad__finite3(E0)) {
+        rad__log(&t->c, RAD_LOG_ERROR, "rad_temporal_step: E0 (%g %g %g) is not finite", (double)E0[0], (double)E0[1], (double)E0[2]);
+        return RAD_ERROR_NON_FINITE;
+    }
     st.t = t;
     st.env[0] = E0 ? E0[0] : 0.0f;
     st.env[1] = E0 ? E0[1] : 0.0f;
@@ -12369,6 +12454,11 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
     t->restart_all = 0;
     st.tasks = t->c.tasks < t->n ? t->c.tasks : t->n;
     t->c.parallel_for(t->c.parallel_user, st.tasks, rad__temporal_task, &st);
+    if (rad__check_output(&t->c, "rad_temporal_step", t->B_next, n3) != RAD_SUCCESS) {
+        /* the step is undone: B and the frame stay as they were; adaptive weights restart */
+        t->restart_all = 1;
+        return RAD_ERROR_NON_FINITE;
+    }
     tmp = t->B;
     t->B = t->B_next;
     t->B_next = tmp;

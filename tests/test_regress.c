@@ -115,9 +115,274 @@ static void rg_test_extreme_area_ratio(void)
     rad_scene_destroy(s);
 }
 
+/* review of the run-time products (issue 23): a NaN or Inf in E, or a product that overflows
+   float, returned success with NaN/Inf in the output from rad_matrix_multiply, the two
+   multi-bounce applies and the temporal step, while the solvers refused it. One rule now:
+   NON_FINITE, and the temporal state is left as it was. */
+static void rg_test_nonfinite_products(void)
+{
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_bvh *b = NULL;
+    rad_raycaster rc;
+    rad_form_factors *ff = NULL;
+    rad_form_factor_options fo;
+    rad_patch_options po;
+    rad_multibounce *mb = NULL;
+    rad_multibounce_options mo;
+    rad_multibounce_blocks *bl = NULL;
+    rad_block_options bo;
+    rad_alias_tables *at = NULL;
+    rad_temporal *tp = NULL;
+    rad_temporal_options to;
+    float *E = NULL, *out = NULL, *B0 = NULL;
+    uint32_t N, i, frame;
+    int c;
+    rad_cornell_box(&d, NULL);
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    rad_patch_options_default(&po);
+    po.target_count = 100;
+    if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &b));
+    if (!P || !b) goto done;
+    N = P->count;
+    rad_bvh_raycaster(b, &rc);
+    rad_form_factor_options_default(&fo);
+    fo.samples = 4;
+    CHECK_OK(rad_form_factors_dense(P, &rc, &fo, NULL, &ff));
+    if (!ff) goto done;
+    rad_multibounce_options_default(&mo);
+    mo.bounces = RAD_MB_INFINITE;
+    CHECK_OK(rad_multibounce_create(&ff->matrix, P->albedo, &mo, NULL, &mb));
+    rad_block_options_default(&bo);
+    if (mb) CHECK_OK(rad_multibounce_blocks_create(mb, &bo, NULL, &bl, NULL));
+    CHECK_OK(rad_alias_tables_create(&ff->matrix, RAD_ALIAS_AUTO, NULL, &at));
+    if (at) {
+        const rad_alias_tables *l[1];
+        l[0] = at;
+        rad_temporal_options_default(&to);
+        CHECK_OK(rad_temporal_create(l, 1, P->albedo, &to, NULL, &tp));
+    }
+    E = (float *)malloc(sizeof(float) * 3 * N);
+    out = (float *)malloc(sizeof(float) * 3 * N);
+    B0 = (float *)malloc(sizeof(float) * 3 * N);
+    if (!mb || !bl || !tp || !E || !out || !B0) goto done;
+    CHECK_OK(rad_sources(P, RAD_SOURCE_EMISSION, NULL, E));
+    CHECK_OK(rad_temporal_step(tp, E, NULL, NULL));
+    memcpy(B0, rad_temporal_indirect(tp), sizeof(float) * 3 * N);
+    frame = rad_temporal_frame(tp);
+    for (c = 0; c < 2; ++c) {
+        CHECK_OK(rad_sources(P, RAD_SOURCE_EMISSION, NULL, E));
+        E[3 * (N / 2) + 1] = c == 0 ? (float)(HUGE_VAL - HUGE_VAL) : (float)HUGE_VAL;
+        CHECK_RESULT(rad_matrix_multiply(&ff->matrix, E, out, NULL), RAD_ERROR_NON_FINITE);
+        CHECK_RESULT(rad_multibounce_apply(mb, E, out, RAD_OUTPUT_INDIRECT, NULL), RAD_ERROR_NON_FINITE);
+        CHECK_RESULT(rad_multibounce_blocks_apply(bl, E, out, RAD_OUTPUT_TOTAL, NULL), RAD_ERROR_NON_FINITE);
+        CHECK_RESULT(rad_temporal_step(tp, E, NULL, out), RAD_ERROR_NON_FINITE);
+    }
+    /* finite but huge: the products overflow float */
+    CHECK_OK(rad_sources(P, RAD_SOURCE_EMISSION, NULL, E));
+    for (i = 0; i < 3 * N; ++i) E[i] = 3e38f; /* F_mb's row sums are above 1.5 here */
+    CHECK_RESULT(rad_multibounce_apply(mb, E, out, RAD_OUTPUT_INDIRECT, NULL), RAD_ERROR_NON_FINITE);
+    CHECK_RESULT(rad_temporal_step(tp, E, NULL, out), RAD_ERROR_NON_FINITE);
+    {
+        float e0[3] = { 0.0f, 1.0f, 0.0f };
+        CHECK_OK(rad_sources(P, RAD_SOURCE_EMISSION, NULL, E));
+        e0[0] = (float)HUGE_VAL;
+        CHECK_RESULT(rad_temporal_step(tp, E, e0, out), RAD_ERROR_NON_FINITE);
+    }
+    CHECK(rad_temporal_frame(tp) == frame);
+    CHECK(memcmp(B0, rad_temporal_indirect(tp), sizeof(float) * 3 * N) == 0);
+    /* and a good step still works after the refusals */
+    CHECK_OK(rad_sources(P, RAD_SOURCE_EMISSION, NULL, E));
+    CHECK_OK(rad_temporal_step(tp, E, NULL, out));
+    for (i = 0; i < 3 * N; ++i) CHECK(rad__finite(out[i]));
+done:
+    free(E);
+    free(out);
+    free(B0);
+    rad_temporal_destroy(tp);
+    rad_alias_tables_destroy(at);
+    rad_multibounce_blocks_destroy(bl);
+    rad_multibounce_destroy(mb);
+    rad_form_factors_destroy(ff);
+    rad_bvh_destroy(b);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
+/* review: a hand-built CSR matrix with a column past the end or offsets that decrease read
+   out of its arrays in rad_matrix_multiply; a hand-made system with albedo 1.5 diverged (or
+   went negative in the direct solve) with success. */
+static void rg_test_hand_made_systems(void)
+{
+    static const uint64_t offs_bad_col[4] = { 0, 1, 2, 3 }, offs_down[4] = { 0, 2, 1, 3 }, offs_start[4] = { 1, 2, 3, 3 };
+    static const uint64_t offs_ok[4] = { 0, 2, 3, 4 }, offs_wide[4] = { 0, 4, 4, 4 };
+    static const uint32_t cols_bad[4] = { 1, 1000000, 0, 0 }, cols_ok[4] = { 1, 2, 0, 1 }, cols_desc[4] = { 2, 1, 0, 1 };
+    static const float vals[4] = { 0.25f, 0.25f, 0.5f, 0.5f };
+    float x[9] = { 1, 1, 1, 1, 1, 1, 1, 1, 1 }, y[9], albedo[9], E[9] = { 1, 1, 1, 0, 0, 0, 0, 0, 0 };
+    rad_matrix M;
+    rad_system sys;
+    rad_solve_options so;
+    rad_alias_tables *at = NULL;
+    uint32_t i;
+    memset(&M, 0, sizeof(M));
+    M.rows = M.cols = 3;
+    M.storage = RAD_STORAGE_SPARSE;
+    M.values = vals;
+    M.row_offsets = offs_bad_col; M.columns = cols_bad;
+    CHECK_RESULT(rad_matrix_multiply(&M, x, y, NULL), RAD_ERROR_CORRUPT);
+    CHECK_RESULT(rad_alias_tables_create(&M, RAD_ALIAS_AUTO, NULL, &at), RAD_ERROR_CORRUPT);
+    CHECK(at == NULL);
+    M.row_offsets = offs_down; M.columns = cols_ok;
+    CHECK_RESULT(rad_matrix_multiply(&M, x, y, NULL), RAD_ERROR_CORRUPT);
+    M.row_offsets = offs_start;
+    CHECK_RESULT(rad_matrix_multiply(&M, x, y, NULL), RAD_ERROR_CORRUPT);
+    M.row_offsets = offs_wide; /* four entries in one row of a 3-column matrix */
+    CHECK_RESULT(rad_matrix_multiply(&M, x, y, NULL), RAD_ERROR_CORRUPT);
+    M.row_offsets = offs_ok; M.columns = cols_desc;
+    CHECK_RESULT(rad_matrix_multiply(&M, x, y, NULL), RAD_ERROR_CORRUPT);
+    M.columns = cols_ok;
+    CHECK_OK(rad_matrix_multiply(&M, x, y, NULL));
+    CHECK_NEAR(y[0], 0.5, 1e-6);
+    CHECK_NEAR(y[3], 0.5, 1e-6);
+    CHECK_NEAR(y[6], 0.5, 1e-6);
+    /* the same matrix as a system: albedo 0.5 solves, 1.5 and -0.5 are refused by every solver */
+    memset(&sys, 0, sizeof(sys));
+    sys.F = &M;
+    sys.albedo = albedo;
+    sys.E = E;
+    sys.n = 3;
+    rad_solve_options_default(&so);
+    so.bounces = 4;
+    for (i = 0; i < 9; ++i) albedo[i] = 0.5f;
+    CHECK_OK(rad_solve_jacobi(&sys, &so, y, NULL, NULL));
+    albedo[4] = 1.5f;
+    CHECK_RESULT(rad_solve_jacobi(&sys, &so, y, NULL, NULL), RAD_ERROR_ALBEDO_RANGE);
+    CHECK_RESULT(rad_solve_gauss_seidel(&sys, &so, y, NULL, NULL), RAD_ERROR_ALBEDO_RANGE);
+    CHECK_RESULT(rad_solve_direct(&sys, &so, y, NULL), RAD_ERROR_ALBEDO_RANGE);
+    albedo[4] = -0.5f;
+    CHECK_RESULT(rad_solve_jacobi(&sys, &so, y, NULL, NULL), RAD_ERROR_ALBEDO_RANGE);
+    albedo[4] = (float)(HUGE_VAL - HUGE_VAL);
+    CHECK_RESULT(rad_solve_direct(&sys, &so, y, NULL), RAD_ERROR_ALBEDO_RANGE);
+    albedo[4] = 0.5f;
+    M.columns = cols_bad;
+    M.row_offsets = offs_bad_col;
+    CHECK_RESULT(rad_solve_jacobi(&sys, &so, y, NULL, NULL), RAD_ERROR_CORRUPT);
+}
+
+/* adversarial pass (issue 23): the BVH missed every ray of a Cornell box scaled 1e14 (the
+   watertight test's t was a length^3 product that overflowed float; below 1e-13 it
+   underflowed), so images came out black with success. Radiosity is scale-free: the mean
+   radiosity, the direct light and the camera hits must be those of the unit box at both
+   ends of the supported range, and a scene outside it is refused by name. */
+static int rg_scaled_cornell(double scale, double *mean_B, double *mean_direct, uint32_t *hits, rad_result *why)
+{
+    rad_scene_desc d;
+    rad_mesh_desc m[16];
+    float *pos[16];
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_bvh *b = NULL;
+    rad_raycaster rc;
+    rad_form_factors *ff = NULL;
+    rad_form_factor_options fo;
+    rad_patch_options po;
+    rad_direct_options dop;
+    rad_system sys;
+    rad_solve_options so;
+    rad_camera cam;
+    uint32_t i, k;
+    float *E = NULL, *B = NULL, *D = NULL;
+    int ok = 0;
+    rad_cornell_box(&d, &cam);
+    if (d.mesh_count > 16) return 0;
+    for (i = 0; i < d.mesh_count; ++i) {
+        m[i] = d.meshes[i];
+        pos[i] = (float *)malloc(sizeof(float) * 3 * m[i].vertex_count);
+        if (pos[i])
+            for (k = 0; k < 3 * m[i].vertex_count; ++k) pos[i][k] = (float)(m[i].positions[k] * scale);
+        m[i].positions = pos[i];
+    }
+    d.meshes = m;
+    *why = rad_scene_create(&d, NULL, &S);
+    if (*why != RAD_SUCCESS) goto out;
+    rad_patch_options_default(&po);
+    po.target_count = 80;
+    if (rad_patches_create(S, &po, NULL, &P) != RAD_SUCCESS || rad_bvh_create(S, NULL, &b) != RAD_SUCCESS) goto out;
+    rad_bvh_raycaster(b, &rc);
+    rad_form_factor_options_default(&fo);
+    fo.samples = 4;
+    if (rad_form_factors_dense(P, &rc, &fo, NULL, &ff) != RAD_SUCCESS) goto out;
+    E = (float *)calloc(3 * (size_t)P->count, sizeof(float));
+    B = (float *)calloc(3 * (size_t)P->count, sizeof(float));
+    D = (float *)calloc(3 * (size_t)P->count, sizeof(float));
+    if (!E || !B || !D || rad_sources(P, RAD_SOURCE_EMISSION, NULL, E) != RAD_SUCCESS) goto out;
+    rad_system_init(&sys, &ff->matrix, P, E);
+    rad_solve_options_default(&so);
+    so.bounces = 8;
+    rad_direct_options_default(&dop);
+    if (rad_solve_jacobi(&sys, &so, B, NULL, NULL) != RAD_SUCCESS ||
+        rad_direct_patches(P, &rc, NULL, 0, &dop, D, NULL) != RAD_SUCCESS)
+        goto out;
+    *mean_B = *mean_direct = 0.0;
+    for (i = 0; i < 3 * P->count; ++i) {
+        *mean_B += (double)B[i] * P->areas[i / 3] / (scale * scale);
+        *mean_direct += (double)D[i] * P->areas[i / 3] / (scale * scale);
+    }
+    for (k = 0; k < 3; ++k) {
+        cam.position[k] = (float)(cam.position[k] * scale);
+        cam.target[k] = (float)(cam.target[k] * scale);
+    }
+    *hits = 0;
+    for (i = 0; i < 256; ++i) {
+        rad_ray ray;
+        rad_hit h;
+        rad_camera_ray(&cam, 16, 16, (float)(i % 16) + 0.5f, (float)(i / 16) + 0.5f, &ray);
+        if (rc.intersect(rc.user, &ray, 1, &h) == RAD_SUCCESS && h.triangle != RAD_NONE) ++*hits;
+    }
+    ok = 1;
+out:
+    free(E);
+    free(B);
+    free(D);
+    rad_form_factors_destroy(ff);
+    rad_bvh_destroy(b);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+    for (i = 0; i < d.mesh_count; ++i) free(pos[i]);
+    return ok;
+}
+
+static void rg_test_scene_scale(void)
+{
+    /* the Cornell box's diagonal is about 0.96 units: 2e-15 and 1e18 sit just inside the range */
+    static const double scales[] = { 2e-15, 1e-9, 1e9, 1e14, 1e18 };
+    double B0 = 0.0, D0 = 0.0, Bs, Ds;
+    uint32_t h0 = 0, hs, i;
+    rad_result why = RAD_SUCCESS;
+    CHECK(rg_scaled_cornell(1.0, &B0, &D0, &h0, &why));
+    CHECK(h0 > 200);
+    for (i = 0; i < sizeof(scales) / sizeof(scales[0]); ++i) {
+        Bs = Ds = -1.0;
+        hs = 0;
+        CHECK(rg_scaled_cornell(scales[i], &Bs, &Ds, &hs, &why));
+        CHECK_REL(Bs, B0, 1e-5);
+        CHECK_REL(Ds, D0, 1e-5);
+        CHECK(hs == h0);
+    }
+    CHECK(!rg_scaled_cornell(2e18, &Bs, &Ds, &hs, &why));
+    CHECK_RESULT(why, RAD_ERROR_SCALE_RANGE);
+    CHECK(!rg_scaled_cornell(5e-16, &Bs, &Ds, &hs, &why));
+    CHECK_RESULT(why, RAD_ERROR_SCALE_RANGE);
+}
+
 static const rad_test_case tests_regress[] = {
     { "regress_point_light_overflow", rg_test_point_light_overflow },
     { "regress_emission_overflow", rg_test_emission_overflow },
     { "regress_extreme_area_ratio", rg_test_extreme_area_ratio },
+    { "regress_nonfinite_products", rg_test_nonfinite_products },
+    { "regress_hand_made_systems", rg_test_hand_made_systems },
+    { "regress_scene_scale", rg_test_scene_scale },
     { NULL, NULL }
 };
