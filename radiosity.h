@@ -630,7 +630,7 @@ typedef struct rad_form_factor_options {
                                patch's n x n sub-triangles (exact centroid, midpoint rule); the
                                visibility targets are rotated Hammersley points. Pairs closer
                                than twice their size get 16x the points. */
-    float ray_epsilon;      /* relative to the scene diagonal (0: 1e-5) */
+    float ray_epsilon;      /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     float drop_threshold;   /* sparse: entries below it are dropped (0 keeps non-zeros) */
     uint32_t seed;          /* decorrelates visibility sample points (any value) */
     int skip_visibility;    /* non-zero: V = 1 everywhere (unoccluded form factors) */
@@ -776,7 +776,7 @@ typedef struct rad_direct_options {
                                   of the patch's n x n sub-triangles */
     uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
     int include_emitters;      /* non-zero (default): emissive triangles are area lights */
-    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5) */
+    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
 } rad_direct_options;
 
@@ -785,9 +785,10 @@ RAD_API void rad_direct_options_default(rad_direct_options *options);
 /* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
    sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
    (analytic point-to-polygon irradiance pi L F times the fraction of 'light_samples'
-   unoccluded shadow rays). A point receives nothing from behind its normal. 'samples' is
-   unused here. Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles or a
-   negative min_distance), NON_FINITE (a non-finite light field or point, or irradiance that
+   unoccluded shadow rays). A point receives nothing from behind its normal; normals need not
+   be unit (they are normalized), a zero one is refused. 'samples' is unused here.
+   Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, a negative
+   min_distance, a zero normal or ray_epsilon outside (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that
    overflows float), NEGATIVE_EMISSION (a negative light colour), RAYCAST_FAILED. */
 RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
                                          const rad_light *lights, uint32_t light_count,
@@ -1109,7 +1110,10 @@ RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx);
 RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out);
 RAD_API void rad_bake_destroy(rad_bake *bake);
 #ifndef RAD_NO_STDIO
-/* The same, through a file (RAD_ERROR_IO when it cannot be written or read). */
+/* The same, through a file. Saving writes '<path>.partial' in the same folder and renames it
+   into place only when complete, so a failed save leaves the old file as it was (IO). Loading
+   reads the 64-byte header first and refuses a folder (IO), a file without the container
+   magic (CORRUPT) or one shorter than its header says (TRUNCATED) before reading the rest. */
 RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
                                  const float *B, const rad_context *ctx);
 RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out);
@@ -2172,7 +2176,7 @@ typedef struct rad_vp_options {
     uint32_t resolution;      /* default 16 */
     uint32_t face_points;     /* Hammersley points per voxel face (default 16, at most 4096) */
     rad_vp_weights weights;   /* default RAD_VP_WEIGHTS_SQUARED */
-    float ray_epsilon;        /* relative to the scene diagonal (0: 1e-5) */
+    float ray_epsilon;        /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     int skip_visibility;      /* non-zero: V = 1 between samples (unoccluded form factors) */
     uint32_t visibility_rays; /* shadow rays per pair of voxels (default 16, at most 1024); 0:
                                  one ray per pair of samples (SPEC §6 step 5 literally: cost
@@ -2344,6 +2348,8 @@ extern int madvise(void *addr, size_t length, int advice);
 
 #define RAD__PI 3.14159265358979323846
 #define RAD__MAX_SAMPLES 256u
+/* ray offsets above 1% of the scene's diagonal step over walls and change the answer */
+#define RAD__MAX_RAY_EPSILON 1e-2f
 #define RAD__RAY_BATCH 1024u
 
 /* compile-time checks: layouts shaders and files will rely on */
@@ -3705,7 +3711,7 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
 /* Watertight ray/triangle test, both faces. Returns 1 with t, b1, b2 on a hit in (tmin, tmax). */
 static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *t_out, float *b1, float *b2)
 {
-    float A[3], B[3], C[3], Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, inv_det, T;
+    float A[3], B[3], C[3], Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T;
     int k;
     for (k = 0; k < 3; ++k) { A[k] = v[k] - w->o[k]; B[k] = v[3 + k] - w->o[k]; C[k] = v[6 + k] - w->o[k]; }
     Ax = A[w->kx] - w->sx * A[w->kz]; Ay = A[w->ky] - w->sy * A[w->kz];
@@ -3723,18 +3729,14 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     det = U + V + W;
     if (det == 0.0f) return 0;
-    /* barycentrics first, then T from them: U, V, W scale as length^2, so the paper's
-       (U z_A + V z_B + W z_C) / det (length^3) overflows float beyond about 1e12 and
-       underflows below 1e-13; this form holds from about 1e-18 to 1e18 */
-    inv_det = 1.0f / det;
-    U *= inv_det;
-    V *= inv_det;
-    W *= inv_det;
-    T = U * (w->sz * A[w->kz]) + V * (w->sz * B[w->kz]) + W * (w->sz * C[w->kz]);
+    /* U, V, W scale as length^2, so the numerator of t (length^3) is formed in double: in
+       float it overflows beyond scenes of about 1e12 and underflows below 1e-13 */
+    T = (float)(((double)U * (double)(w->sz * A[w->kz]) + (double)V * (double)(w->sz * B[w->kz]) +
+                 (double)W * (double)(w->sz * C[w->kz])) / (double)det);
     if (!(T > w->tmin && T < tmax)) return 0;
     *t_out = T;
-    *b1 = V;
-    *b2 = W;
+    *b1 = V / det;
+    *b2 = W / det;
     return 1;
 }
 
@@ -4458,9 +4460,11 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
     if (f->o.samples > RAD__MAX_SAMPLES) f->o.samples = RAD__MAX_SAMPLES;
     f->o.samples = rad__lattice_side(f->o.samples) * rad__lattice_side(f->o.samples); /* a square */
     if (f->o.ray_epsilon == 0.0f) f->o.ray_epsilon = 1e-5f;
-    if (!rad__finite(f->o.ray_epsilon) || f->o.ray_epsilon < 0.0f || !rad__finite(f->o.drop_threshold) ||
+    if (!(f->o.ray_epsilon > 0.0f && f->o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || !rad__finite(f->o.drop_threshold) ||
         f->o.drop_threshold < 0.0f || (f->o.method != RAD_FF_ANALYTIC && f->o.method != RAD_FF_MONTE_CARLO)) {
-        rad__log(c, RAD_LOG_ERROR, "form factor options: bad method, ray_epsilon or drop_threshold");
+        rad__log(c, RAD_LOG_ERROR, "form factor options: method %d, ray_epsilon %g (must be in (0, %g]) or drop_threshold %g "
+                 "(finite, >= 0) is bad", (int)f->o.method, (double)f->o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON,
+                 (double)f->o.drop_threshold);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!f->o.skip_visibility && (!rc || !rc->occluded)) {
@@ -5576,7 +5580,11 @@ static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const ra
     if (d->o.light_samples == 0) d->o.light_samples = 16;
     if (d->o.light_samples > RAD__MAX_SAMPLES) d->o.light_samples = RAD__MAX_SAMPLES;
     if (d->o.ray_epsilon == 0.0f) d->o.ray_epsilon = 1e-5f;
-    if (!rad__finite(d->o.ray_epsilon) || d->o.ray_epsilon < 0.0f) return RAD_ERROR_INVALID_ARGUMENT;
+    if (!(d->o.ray_epsilon > 0.0f && d->o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(c, RAD_LOG_ERROR, "direct light options: ray_epsilon %g must be in (0, %g] (relative to the scene diagonal)",
+                 (double)d->o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     for (l = 0; l < light_count; ++l) {
         const rad_light *li = &lights[l];
         if (!rad__finite3(li->color) || !rad__finite3(li->position) || !rad__finite3(li->direction) ||
@@ -5612,6 +5620,7 @@ RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_rayca
     rad__direct d;
     rad_result r;
     uint32_t i;
+    float *unit;
     rad__ctx_init(&c, ctx);
     if (!points || !normals || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
     r = rad__direct_setup(&d, scene, raycaster, lights, light_count, options, &c);
@@ -5621,11 +5630,29 @@ RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_rayca
             rad__log(&c, RAD_LOG_ERROR, "point %u or its normal is not finite", i);
             return RAD_ERROR_NON_FINITE;
         }
+    /* the cosines need unit normals: the caller's are normalized into a copy */
+    unit = (float *)rad__alloc_array(&c.allocator, count ? (size_t)count : 1u, 3 * sizeof(float));
+    if (!unit) {
+        rad__log(&c, RAD_LOG_ERROR, "direct irradiance: out of memory for %u normals", count);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < count; ++i) {
+        const float *n = normals + 3 * (size_t)i;
+        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        int k;
+        if (!(len > 0.0) || len - len != 0.0) {
+            rad__log(&c, RAD_LOG_ERROR, "direct irradiance: the normal of point %u has length %g (must be non-zero)", i, len);
+            rad__free(&c.allocator, unit);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        for (k = 0; k < 3; ++k) unit[3 * (size_t)i + (size_t)k] = (float)((double)n[k] / len);
+    }
     d.points = points;
-    d.normals = normals;
+    d.normals = unit;
     d.count = count;
     d.out = out_irradiance;
     r = rad__direct_run(&d, &c, (count + RAD__DIRECT_GROUP - 1) / RAD__DIRECT_GROUP);
+    rad__free(&c.allocator, unit);
     return r == RAD_SUCCESS ? rad__check_output(&c, "direct irradiance", out_irradiance, 3 * (size_t)count) : r;
 }
 
@@ -6673,27 +6700,52 @@ RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_cont
 }
 
 #ifndef RAD_NO_STDIO
+/* Writes 'size' bytes to '<path>.partial' beside path and renames it over path only when
+   every byte is written and closed: a failed save leaves the old file (or none) in place. */
+static rad_result rad__write_file_atomic(const rad__ctx *c, const char *path, const void *data, size_t size)
+{
+    size_t len = strlen(path);
+    char *tmp = (char *)rad__alloc(&c->allocator, len + 9u);
+    FILE *f;
+    int ok;
+    if (!tmp) {
+        rad__log(c, RAD_LOG_ERROR, "saving '%s': out of memory for the temporary name", path);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".partial", 9u);
+    f = fopen(tmp, "wb");
+    if (!f) {
+        rad__log(c, RAD_LOG_ERROR, "cannot open '%s' for writing (the folder must exist and be writable)", tmp);
+        rad__free(&c->allocator, tmp);
+        return RAD_ERROR_IO;
+    }
+    ok = fwrite(data, 1, size, f) == size;
+    ok = (fclose(f) == 0) && ok;
+    if (ok && rename(tmp, path) != 0) {
+        /* where rename does not replace an existing file (Windows), replace it by hand */
+        ok = remove(path) == 0 && rename(tmp, path) == 0;
+    }
+    if (!ok) {
+        remove(tmp);
+        rad__log(c, RAD_LOG_ERROR, "cannot write '%s' (disk full or not writable): the old file, if any, is unchanged", path);
+    }
+    rad__free(&c->allocator, tmp);
+    return ok ? RAD_SUCCESS : RAD_ERROR_IO;
+}
+
 RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
                                  const float *B, const rad_context *ctx)
 {
     rad__ctx c;
     void *buf = NULL;
     size_t size = 0;
-    FILE *f;
     rad_result r;
     rad__ctx_init(&c, ctx);
     if (!path) return RAD_ERROR_INVALID_ARGUMENT;
     r = rad_save_memory(patches, F, E, B, ctx, &buf, &size);
     if (r != RAD_SUCCESS) return r;
-    f = fopen(path, "wb");
-    if (!f) {
-        rad__log(&c, RAD_LOG_ERROR, "cannot open '%s' for writing", path);
-        rad__free(&c.allocator, buf);
-        return RAD_ERROR_IO;
-    }
-    if (fwrite(buf, 1, size, f) != size) r = RAD_ERROR_IO;
-    if (fclose(f) != 0) r = RAD_ERROR_IO;
-    if (r != RAD_SUCCESS) rad__log(&c, RAD_LOG_ERROR, "cannot write '%s'", path);
+    r = rad__write_file_atomic(&c, path, buf, size);
     rad__free(&c.allocator, buf);
     return r;
 }
@@ -6704,6 +6756,8 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
     FILE *f;
     long len;
     void *buf;
+    unsigned char head[64];
+    size_t got;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
@@ -6713,14 +6767,39 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
         rad__log(&c, RAD_LOG_ERROR, "cannot open '%s'", path);
         return RAD_ERROR_IO;
     }
+    /* the header first: a folder, a file of another kind or a truncated bake is refused
+       before anything of its size is allocated or read */
+    got = fread(head, 1, sizeof(head), f);
+    if (got < sizeof(head)) {
+        int err = ferror(f);
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, err ? "cannot read '%s' (a folder, or not readable)" :
+                 "'%s' is shorter than a container header (64 bytes)", path);
+        return err ? RAD_ERROR_IO : RAD_ERROR_TRUNCATED;
+    }
+    if (memcmp(head, "RADB", 4) != 0) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "'%s' is not a radiosity.h container (no RADB magic)", path);
+        return RAD_ERROR_CORRUPT;
+    }
     if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
         fclose(f);
         rad__log(&c, RAD_LOG_ERROR, "cannot size '%s'", path);
         return RAD_ERROR_IO;
     }
-    buf = rad__alloc(&c.allocator, (size_t)len ? (size_t)len : 1u);
-    if (!buf) { fclose(f); return RAD_ERROR_OUT_OF_MEMORY; }
-    if (len > 0 && fread(buf, 1, (size_t)len, f) != (size_t)len) {
+    if (rad__get64(head + 24) > (uint64_t)len) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "'%s' has %ld bytes, its header says %llu: the file is truncated", path, len,
+                 (unsigned long long)rad__get64(head + 24));
+        return RAD_ERROR_TRUNCATED;
+    }
+    buf = rad__alloc(&c.allocator, (size_t)len);
+    if (!buf) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "loading '%s': out of memory for its %ld bytes", path, len);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (fread(buf, 1, (size_t)len, f) != (size_t)len) {
         fclose(f);
         rad__free(&c.allocator, buf);
         rad__log(&c, RAD_LOG_ERROR, "cannot read '%s'", path);
@@ -13516,9 +13595,10 @@ RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *ra
         if (b.o.voxel_size[k] > 0.0f) given++;
     }
     if ((given != 0 && given != 3) || b.o.face_points > 4096u || b.o.visibility_rays > RAD__RAY_BATCH || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
-        !rad__finite(b.o.ray_epsilon) || b.o.ray_epsilon < 0.0f || (!b.o.skip_visibility && !raycaster->occluded)) {
+        !(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || (!b.o.skip_visibility && !raycaster->occluded)) {
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size must be all 0 or all > 0; face_points <= 4096; visibility_rays "
-                 "<= 1024; weights, ray_epsilon valid; an occluded callback unless skip_visibility");
+                 "<= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility",
+                 (double)b.o.ray_epsilon);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));

@@ -310,7 +310,7 @@ static int rg_scaled_cornell(double scale, double *mean_B, double *mean_direct, 
     rad_patch_options_default(&po);
     po.target_count = 80;
     if (rad_patches_create(S, &po, NULL, &P) != RAD_SUCCESS || rad_bvh_create(S, NULL, &b) != RAD_SUCCESS) goto out;
-    rad_bvh_raycaster(b, &rc);
+    (rad_bvh_raycaster)(b, &rc); /* the built-in BVH even in the Embree suite: its range is what is promised */
     rad_form_factor_options_default(&fo);
     fo.samples = 4;
     if (rad_form_factors_dense(P, &rc, &fo, NULL, &ff) != RAD_SUCCESS) goto out;
@@ -347,7 +347,7 @@ out:
     free(B);
     free(D);
     rad_form_factors_destroy(ff);
-    rad_bvh_destroy(b);
+    (rad_bvh_destroy)(b);
     rad_patches_destroy(P);
     rad_scene_destroy(S);
     for (i = 0; i < d.mesh_count; ++i) free(pos[i]);
@@ -377,6 +377,149 @@ static void rg_test_scene_scale(void)
     CHECK_RESULT(why, RAD_ERROR_SCALE_RANGE);
 }
 
+#ifndef RAD_NO_STDIO
+/* adversarial pass (issue 23): rad_load_file on a folder asked for a 9.2e18-byte buffer
+   (OUT_OF_MEMORY), any file was read whole before its header was looked at, and a failed
+   save left a partial file where the old one was. */
+static void rg_test_file_io(void)
+{
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_bake *b = NULL;
+    void *buf = NULL;
+    size_t size = 0;
+    FILE *f;
+    const char *path = "build/test_regress_io.radb", *other = "build/test_regress_io.txt";
+    f = fopen(path, "wb");
+    if (!f) { path = "test_regress_io.radb"; other = "test_regress_io.txt"; } else fclose(f);
+    CHECK_RESULT(rad_load_file(".", NULL, &b), RAD_ERROR_IO);
+    CHECK(b == NULL);
+    f = fopen(other, "wb");
+    if (f) {
+        int i;
+        for (i = 0; i < 100; ++i) fputs("v 0 0 0 # not a bake\n", f);
+        fclose(f);
+    }
+    CHECK_RESULT(rad_load_file(other, NULL, &b), RAD_ERROR_CORRUPT);
+    f = fopen(other, "wb");
+    if (f) { fputs("RADB", f); fclose(f); }
+    CHECK_RESULT(rad_load_file(other, NULL, &b), RAD_ERROR_TRUNCATED);
+    remove(other);
+    rad_cornell_box(&d, NULL);
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    rad_patch_options_default(&po);
+    po.target_count = 40;
+    if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
+    if (P) {
+        CHECK_OK(rad_save_file(path, P, NULL, NULL, NULL, NULL));
+        CHECK_OK(rad_save_memory(P, NULL, NULL, NULL, NULL, &buf, &size));
+        /* the header says more bytes than the file holds: refused before reading it */
+        f = fopen(path, "rb+");
+        if (f && buf && size > 128) {
+            unsigned char *copy = (unsigned char *)malloc(size);
+            if (copy) {
+                memcpy(copy, buf, size);
+                fclose(f);
+                f = fopen(path, "wb");
+                if (f) { fwrite(copy, 1, size - 64, f); fclose(f); f = NULL; }
+                CHECK_RESULT(rad_load_file(path, NULL, &b), RAD_ERROR_TRUNCATED);
+                free(copy);
+            }
+        }
+        if (f) fclose(f);
+        /* a save over an existing file replaces it whole and leaves no temporary behind */
+        CHECK_OK(rad_save_file(path, P, NULL, NULL, NULL, NULL));
+        CHECK_OK(rad_load_file(path, NULL, &b));
+        CHECK(b && b->patches.count == P->count);
+        rad_bake_destroy(b);
+        b = NULL;
+        {
+            char tmp[128];
+            snprintf(tmp, sizeof(tmp), "%s.partial", path);
+            f = fopen(tmp, "rb");
+            CHECK(f == NULL);
+            if (f) fclose(f);
+        }
+        /* a save that cannot be written reports IO and leaves nothing */
+        CHECK_RESULT(rad_save_file("build/no-such-folder/x/out.radb", P, NULL, NULL, NULL, NULL), RAD_ERROR_IO);
+        f = fopen("build/no-such-folder/x/out.radb.partial", "rb");
+        CHECK(f == NULL);
+        if (f) fclose(f);
+    }
+    remove(path);
+    rad_free_buffer(buf, NULL);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+#endif
+
+/* adversarial pass (issue 23): ray_epsilon 0.3 or 1e30 was accepted (rays then start past
+   the walls: row sums above 1, energy from nowhere), and rad_direct_irradiance scaled its
+   answer by the length of the normal it was given (a zero normal gave 0 with success). */
+static void rg_test_epsilon_and_normals(void)
+{
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_bvh *b = NULL;
+    rad_raycaster rc;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_direct_options dop;
+    rad_vp_options vo;
+    rad_form_factors *ff = NULL;
+    rad_virtual_patches *vp = NULL;
+    rad_light l;
+    float p[3] = { 0.25f, 0.001f, 0.25f }, n1[3] = { 0.0f, 1.0f, 0.0f }, n2[3] = { 0.0f, 1e-30f, 0.0f };
+    float n3[3] = { 0.0f, 1e20f, 0.0f }, n0[3] = { 0.0f, 0.0f, 0.0f }, e1[3], e2[3], e3[3];
+    rad_cornell_box(&d, NULL);
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    rad_patch_options_default(&po);
+    po.target_count = 30;
+    if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &b));
+    if (!P || !b) goto done;
+    rad_bvh_raycaster(b, &rc);
+    rad_form_factor_options_default(&fo);
+    fo.ray_epsilon = 0.3f;
+    CHECK_RESULT(rad_form_factors_dense(P, &rc, &fo, NULL, &ff), RAD_ERROR_INVALID_ARGUMENT);
+    fo.ray_epsilon = 1e30f;
+    CHECK_RESULT(rad_form_factors_dense(P, &rc, &fo, NULL, &ff), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(ff == NULL);
+    fo.ray_epsilon = 1e-2f; /* the largest accepted */
+    fo.samples = 1;
+    CHECK_OK(rad_form_factors_dense(P, &rc, &fo, NULL, &ff));
+    rad_vp_options_default(&vo);
+    vo.resolution = 2;
+    vo.ray_epsilon = 0.5f;
+    CHECK_RESULT(rad_vp_create(S, &rc, &vo, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(vp == NULL);
+    memset(&l, 0, sizeof(l));
+    l.type = RAD_LIGHT_POINT;
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    l.position[0] = 0.25f;
+    l.position[1] = 0.4f;
+    l.position[2] = 0.25f;
+    rad_direct_options_default(&dop);
+    dop.ray_epsilon = 0.05f;
+    CHECK_RESULT(rad_direct_irradiance(S, &rc, &l, 1, &dop, p, n1, 1, e1, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    rad_direct_options_default(&dop);
+    CHECK_OK(rad_direct_irradiance(S, &rc, &l, 1, &dop, p, n1, 1, e1, NULL));
+    CHECK_OK(rad_direct_irradiance(S, &rc, &l, 1, &dop, p, n2, 1, e2, NULL));
+    CHECK_OK(rad_direct_irradiance(S, &rc, &l, 1, &dop, p, n3, 1, e3, NULL));
+    CHECK(e1[0] > 0.0f);
+    CHECK_REL(e2[0], e1[0], 1e-6);
+    CHECK_REL(e3[1], e1[1], 1e-6);
+    CHECK_RESULT(rad_direct_irradiance(S, &rc, &l, 1, &dop, p, n0, 1, e1, NULL), RAD_ERROR_INVALID_ARGUMENT);
+done:
+    rad_form_factors_destroy(ff);
+    rad_bvh_destroy(b);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
 static const rad_test_case tests_regress[] = {
     { "regress_point_light_overflow", rg_test_point_light_overflow },
     { "regress_emission_overflow", rg_test_emission_overflow },
@@ -384,5 +527,9 @@ static const rad_test_case tests_regress[] = {
     { "regress_nonfinite_products", rg_test_nonfinite_products },
     { "regress_hand_made_systems", rg_test_hand_made_systems },
     { "regress_scene_scale", rg_test_scene_scale },
+    { "regress_epsilon_and_normals", rg_test_epsilon_and_normals },
+#ifndef RAD_NO_STDIO
+    { "regress_file_io", rg_test_file_io },
+#endif
     { NULL, NULL }
 };

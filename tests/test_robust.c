@@ -133,7 +133,7 @@ static void rb_pipeline(const rad_scene *S, float max_edge_rel)
     E = (float *)malloc(sizeof(float) * n3);
     B = (float *)malloc(sizeof(float) * n3);
     pts = (float *)malloc(sizeof(float) * n3);
-    nrm = (float *)malloc(sizeof(float) * n3);
+    nrm = (float *)calloc(n3, sizeof(float));
     if (!bvh || !rows || !D || !Dp || !E || !B || !pts || !nrm) { CHECK(0); goto done; }
     /* form factors, both methods for dense; sparse and rows with the analytic one */
     for (k = 1; k >= 0; --k) {
@@ -232,7 +232,8 @@ static void rb_run(const char *name, const float *tris, uint32_t count, const ui
     r = rb_scene(tris, count, mats, m, 4, &S);
     if (r != RAD_SUCCESS) {
         printf("    %s: rad_scene_create: %s\n", name, rad_result_string(r));
-        CHECK(r == RAD_ERROR_DEGENERATE_TRIANGLE || r == RAD_ERROR_NON_FINITE || r == RAD_ERROR_EMPTY_SCENE);
+        CHECK(r == RAD_ERROR_DEGENERATE_TRIANGLE || r == RAD_ERROR_NON_FINITE || r == RAD_ERROR_EMPTY_SCENE ||
+              r == RAD_ERROR_SCALE_RANGE);
         CHECK(S == NULL);
         return;
     }
@@ -871,7 +872,7 @@ static int rb_compute(const rad_patches *P, const rad_raycaster *rc, const rad_c
     o->Dpt = (float *)malloc(sizeof(float) * n3);
     E = (float *)malloc(sizeof(float) * n3);
     pts = (float *)malloc(sizeof(float) * n3);
-    nrm = (float *)malloc(sizeof(float) * n3);
+    nrm = (float *)calloc(n3, sizeof(float));
     if (!o->D || !o->Dpt || !E || !pts || !nrm) goto done;
     if (rad_direct_patches(P, rc, &l, 1, &dop, o->D, ctx) != RAD_SUCCESS) goto done;
     for (i = 0; i < n; ++i)
