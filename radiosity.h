@@ -784,8 +784,9 @@ RAD_API void rad_direct_options_default(rad_direct_options *options);
 
 /* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
    sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
-   (analytic point-to-polygon irradiance pi L F times the fraction of 'light_samples'
-   unoccluded shadow rays). A point receives nothing from behind its normal; normals need not
+   (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
+   shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
+   gets the light of its visible part). A point receives nothing from behind its normal; normals need not
    be unit (they are normalized), a zero one is refused. 'samples' is unused here.
    Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, a negative
    min_distance, a zero normal or ray_epsilon outside (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that
@@ -5471,7 +5472,8 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
         }
     }
     if (d->o.include_emitters) {
-        double P[3], N[3];
+        double P[3], N[3], ks[RAD__MAX_SAMPLES], ksum;
+        float ys[3 * RAD__MAX_SAMPLES];
         for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
         for (l = 0; l < d->emitter_count; ++l) {
             uint32_t t = d->emitters[l], h;
@@ -5486,11 +5488,27 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
             h = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
             r1 = (float)(h & 0xFFFFu) / 65536.0f;
             r2 = (float)(h >> 16) / 65536.0f;
+            /* Each shadow ray carries its sample's share of the kernel cos cos / r^2 (zero
+               behind p's plane): the visible fraction is then weighted as the form factor
+               weights the emitter's points. Equal shares were exact only when visibility does
+               not depend on where the point lies (a large emitter seen through an opening got
+               a fraction of its light). Unoccluded, the shares sum to the analytic F. */
+            ksum = 0.0;
             for (s = 0; s < L; ++s) {
-                float u1, u2, y[3];
+                float u1, u2, *y = ys + 3 * s, dy[3], r2y;
+                double kern;
                 rad__hammersley(s, L, r1, r2, &u1, &u2);
                 rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
-                r = rad__direct_ray(d, task, nrays, p, n, y, tn, NULL, w, scale / (float)L, slot);
+                rad__sub(dy, y, p);
+                r2y = rad__dot(dy, dy);
+                kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
+                ks[s] = kern > 0.0 ? kern : 0.0;
+                ksum += ks[s];
+            }
+            for (s = 0; s < L; ++s) {
+                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)L;
+                if (!(share > 0.0f)) continue;
+                r = rad__direct_ray(d, task, nrays, p, n, ys + 3 * s, tn, NULL, w, scale * share, slot);
                 if (r != RAD_SUCCESS) return r;
             }
         }

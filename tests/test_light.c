@@ -486,6 +486,89 @@ done:
     rad_scene_destroy(scene);
 }
 
+/* An open box (10 x 5 x 10, walls facing in) under a 40 x 40 emitter 6 above the floor: the
+   floor's centre sees the emitter only through the opening, a 12 x 12 square of it (the
+   opening projected from the point onto the emitter's plane), so its irradiance is pi L F of
+   that square, in closed form. With equal shares per shadow ray the estimate was the whole
+   emitter's F times the fraction of rays that get through, a fifth of the answer here. */
+static void li_box_quad(float *pos, uint32_t *idx, uint32_t q, const float *c, const float *want)
+{
+    float e1[3], e2[3], n[3];
+    uint32_t k, b = 4 * q;
+    for (k = 0; k < 12; ++k) pos[12 * q + k] = c[k];
+    for (k = 0; k < 3; ++k) { e1[k] = c[3 + k] - c[k]; e2[k] = c[6 + k] - c[k]; }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    if (n[0] * want[0] + n[1] * want[1] + n[2] * want[2] > 0.0f) {
+        idx[6 * q] = b; idx[6 * q + 1] = b + 1; idx[6 * q + 2] = b + 2;
+        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 2; idx[6 * q + 5] = b + 3;
+    } else {
+        idx[6 * q] = b; idx[6 * q + 1] = b + 2; idx[6 * q + 2] = b + 1;
+        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 3; idx[6 * q + 5] = b + 2;
+    }
+}
+
+static void li_test_partly_hidden_emitter(void)
+{
+    static const float quads[6][12] = {
+        { 0, 0, 0, 0, 0, 10, 10, 0, 10, 10, 0, 0 },      /* floor */
+        { 0, 0, 0, 10, 0, 0, 10, 5, 0, 0, 5, 0 },        /* walls */
+        { 0, 0, 10, 10, 0, 10, 10, 5, 10, 0, 5, 10 },
+        { 0, 0, 0, 0, 0, 10, 0, 5, 10, 0, 5, 0 },
+        { 10, 0, 0, 10, 0, 10, 10, 5, 10, 10, 5, 0 },
+        { -15, 6, -15, 25, 6, -15, 25, 6, 25, -15, 6, 25 } /* the emitter */
+    };
+    static const float wants[6][3] = { { 0, 1, 0 }, { 0, 0, 1 }, { 0, 0, -1 }, { 1, 0, 0 }, { -1, 0, 0 }, { 0, -1, 0 } };
+    static const float visible[12] = { -1, 6, -1, 11, 6, -1, 11, 6, 11, -1, 6, 11 }; /* front faces down */
+    float pos[72], p[3] = { 5.0f, 1e-4f, 5.0f }, n[3] = { 0.0f, 1.0f, 0.0f }, p2[3] = { 2.0f, 1e-4f, 7.0f }, out[3];
+    uint32_t idx[36], mats[12], q;
+    rad_material m[2] = { { { 0.7f, 0.7f, 0.7f }, { 0.0f, 0.0f, 0.0f }, 0 }, { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0 } };
+    rad_mesh_desc mesh;
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_bvh *b = NULL;
+    rad_raycaster rc;
+    rad_direct_options o;
+    for (q = 0; q < 6; ++q) li_box_quad(pos, idx, q, quads[q], wants[q]);
+    for (q = 0; q < 12; ++q) mats[q] = q >= 10 ? 1u : 0u;
+    memset(&mesh, 0, sizeof(mesh));
+    mesh.positions = pos;
+    mesh.vertex_count = 24;
+    mesh.indices = idx;
+    mesh.triangle_count = 12;
+    mesh.material_ids = mats;
+    memset(&d, 0, sizeof(d));
+    d.meshes = &mesh;
+    d.mesh_count = 1;
+    d.materials = m;
+    d.material_count = 2;
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &b));
+    if (b) {
+        float ref, ref2, vis2[12];
+        rad_bvh_raycaster(b, &rc);
+        rad_direct_options_default(&o);
+        o.light_samples = 256;
+        CHECK_OK(rad_direct_irradiance(S, &rc, NULL, 0, &o, p, n, 1, out, NULL));
+        ref = (float)RAD__PI * rad_ff_point_polygon(p, n, visible, 4);
+        printf("    floor centre: %.5f, visible square %.5f (ratio %.4f)\n", (double)out[0], (double)ref, (double)(out[0] / ref));
+        CHECK_REL(out[0], ref, 0.03);
+        /* off centre: the opening projects to x in [-0.4, 12.4], z in [-1.6, 12.4] at y = 6 */
+        for (q = 0; q < 4; ++q) {
+            vis2[3 * q] = p2[0] + ((visible[3 * q] < 0.0f ? 0.0f : 10.0f) - p2[0]) * 1.2f;
+            vis2[3 * q + 1] = 6.0f;
+            vis2[3 * q + 2] = p2[2] + ((visible[3 * q + 2] < 0.0f ? 0.0f : 10.0f) - p2[2]) * 1.2f;
+        }
+        CHECK_OK(rad_direct_irradiance(S, &rc, NULL, 0, &o, p2, n, 1, out, NULL));
+        ref2 = (float)RAD__PI * rad_ff_point_polygon(p2, n, vis2, 4);
+        printf("    off centre: %.5f, visible rectangle %.5f (ratio %.4f)\n", (double)out[0], (double)ref2, (double)(out[0] / ref2));
+        CHECK_REL(out[0], ref2, 0.03);
+    }
+    rad_bvh_destroy(b);
+    rad_scene_destroy(S);
+}
+
 static const rad_test_case tests_light[] = {
     { "light_directional_point_spot", li_test_directional_point_spot },
     { "light_sky", li_test_sky },
@@ -493,5 +576,6 @@ static const rad_test_case tests_light[] = {
     { "light_direct_patches", li_test_direct_patches },
     { "light_direct_patches_own_triangle", li_test_direct_patches_own_triangle },
     { "light_no_double_counting", li_test_no_double_counting },
+    { "light_partly_hidden_emitter", li_test_partly_hidden_emitter },
     { NULL, NULL }
 };
