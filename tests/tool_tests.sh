@@ -400,6 +400,14 @@ bad "--mode bogus" "unknown --mode 'bogus'" bake cornell --method temporal --mod
 bad "--method bogus" "unknown method 'bogus'" render cornell --method bogus -o "$TMP/y.pfm"
 bad "bake --method pathtrace" "needs no bake" bake cornell --method pathtrace -o "$TMP/y.radb"
 
+# ---- reliability (issue 23): the tool's side ---------------------------------------------------
+# --threads is bounded: 100000 crashed inside libgomp
+for c in formfactors bake render trace; do
+    bad "$c --threads 100000" "--threads 100000 is too many (at most 1024" $c "$TMP/parallel.obj" --threads 100000 $([ $c = formfactors ] || echo -o "$TMP/y.pfm")
+done
+"$RAD" formfactors "$TMP/parallel.obj" --patches 8 --threads 1024 > /dev/null 2> "$TMP/err.txt" &&
+    ok "--threads 1024 (the limit) runs" || fail "--threads 1024 (the limit) runs" "$(head -c 200 "$TMP/err.txt")"
+
 # ---- what tools/report.sh relies on: the timing line and compare --png ------------------------
 for meth in classic multibounce temporal; do
     if "$RAD" render cornell --method $meth --patches 100 --size 8x8 --aa 1 --pixel-light-samples 1 --threads 1 \

@@ -296,7 +296,7 @@ static void bake_usage(FILE *f)
                "  --method M         classic (default), multibounce or temporal\n"
                "%s"
                "%s"
-               "  --threads N        worker threads (default: all)\n",
+               "  --threads N        worker threads (default: all cores; at most 1024)\n",
             rad_tool_classic_help(), rad_tool_method_help(0));
 }
 
@@ -327,7 +327,7 @@ int rad_cmd_bake(int argc, char **argv)
         }
         if (!strcmp(opt, "-o")) out_path = argv[++a];
         else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
+            if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad bake --help)\n", cmd, opt);
             return 2;

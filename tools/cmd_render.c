@@ -76,7 +76,7 @@ static void render_usage(FILE *f)
             "patch and classic solution options (ignored with --bake, which keeps its own):\n"
             "%s"
             "%s"
-            "  --threads N        worker threads (default: all)\n",
+            "  --threads N        worker threads (default: all cores; at most 1024)\n",
             rad_tool_classic_help(), rad_tool_method_help(1));
 }
 
@@ -777,7 +777,7 @@ int rad_cmd_render(int argc, char **argv)
         } else if (!strcmp(opt, "--shading")) {
             if (rad_tool_parse_shading(cmd, argv[++a], &render_shading)) return 2;
         } else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
+            if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad render --help)\n", cmd, opt);
             return 2;

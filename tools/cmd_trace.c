@@ -23,7 +23,7 @@ static void trace_usage(FILE *f)
                "  --seed S           random seed (default 0); same seed, same image on any thread count\n"
                "  --max-depth N      path length cap (default 64)\n"
                "  --rr-depth N       Russian roulette from this bounce on (default 16)\n"
-               "  --threads N        worker threads (default: all)\n"
+               "  --threads N        worker threads (default: all cores; at most 1024)\n"
                "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
                "  -o FILE            .pfm (linear float radiance) or .png (8-bit sRGB)\n");
 }
@@ -126,10 +126,9 @@ int rad_cmd_trace(int argc, char **argv)
             }
             opt.rr_depth = (int)v;
         } else if (!strcmp(a, "--threads")) {
-            if (parse_int(next, 0, 4096, &threads) != 0) {
-                fprintf(stderr, "rad trace: --threads wants an integer >= 0, got '%s'\n", next);
-                return 2;
-            }
+            uint32_t t = 0;
+            if (rad_tool_parse_threads("trace", a, next, &t)) return 2;
+            threads = (long)t;
         } else if (!strcmp(a, "--exposure")) {
             char *end;
             exposure = strtof(next, &end);

@@ -82,6 +82,12 @@ int rad_tool_progress(void *user, float fraction);
 void rad_tool_log(void *user, rad_log_level level, const char *message);
 /* --threads N (0: all): sets the OpenMP thread count when built with OpenMP */
 void rad_tool_set_threads(int threads);
+/* The most --threads accepts: libgomp crashes creating 100000 threads (issue 23), and more
+   threads than this helps no machine the tool runs on. */
+#define RAD_TOOL_MAX_THREADS 1024u
+/* --threads N: a whole number in 0..RAD_TOOL_MAX_THREADS; 0 on success, else prints
+   "rad CMD: ..." and returns 2 */
+int rad_tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out);
 /* parses "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ"; 0 on success */
 int rad_tool_parse_camera(const char *text, rad_camera *out);
 /* parses "WxH"; 0 on success */
