@@ -408,6 +408,71 @@ done
 "$RAD" formfactors "$TMP/parallel.obj" --patches 8 --threads 1024 > /dev/null 2> "$TMP/err.txt" &&
     ok "--threads 1024 (the limit) runs" || fail "--threads 1024 (the limit) runs" "$(head -c 200 "$TMP/err.txt")"
 
+# Outputs go to a temporary file in the same folder, renamed into place only on success: a
+# failed write leaves the old file as it was and no temporary behind; an output that is an
+# input (by device and inode: another name, a hard or symbolic link) is refused before any work.
+mkdir -p "$TMP/out"
+cp "$TMP/parallel.obj" "$TMP/out/scene.obj"
+cp "$TMP/parallel.obj" "$TMP/out/scene.orig"
+ln "$TMP/out/scene.obj" "$TMP/out/hard.obj" 2> /dev/null || cp "$TMP/out/scene.obj" "$TMP/out/hard.obj"
+ln -s scene.obj "$TMP/out/soft.obj"
+for o in scene.obj hard.obj soft.obj; do
+    "$RAD" bake "$TMP/out/scene.obj" --patches 8 -o "$TMP/out/$o" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "is the input" "$TMP/err.txt" && cmp -s "$TMP/out/scene.obj" "$TMP/out/scene.orig" &&
+        ok "bake -o $o (the input) is refused, the input unchanged" ||
+        fail "bake -o $o (the input) is refused, the input unchanged" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+"$RAD" render "$TMP/out/scene.obj" --patches 8 --size 8x8 -o "$TMP/out/soft.pfm" > /dev/null 2>&1 &&
+    cp "$TMP/out/soft.pfm" "$TMP/out/a.pfm" &&
+    "$RAD" compare "$TMP/out/a.pfm" "$TMP/out/soft.pfm" --diff "$TMP/out/a.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "is the input" "$TMP/err.txt" && ok "compare --diff onto an input is refused" ||
+    fail "compare --diff onto an input is refused" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+for c in "render cornell --size 8x8" "trace cornell --size 8x8 --spp 1" "bake cornell --patches 8"; do
+    ext=pfm; case $c in bake*) ext=radb ;; esac
+    "$RAD" $c -o "$TMP/no/such/dir/x.$ext" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "cannot write '.*': the folder '.*' does not exist" "$TMP/err.txt" &&
+        ok "${c%% *} -o under a missing folder: exit 1 with a message" ||
+        fail "${c%% *} -o under a missing folder: exit 1 with a message" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+if [ "$(id -u)" != 0 ]; then
+    mkdir -p "$TMP/ro" && echo old > "$TMP/ro/x.png" && chmod 555 "$TMP/ro"
+    "$RAD" render cornell --size 8x8 --patches 8 -o "$TMP/ro/x.png" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    chmod 755 "$TMP/ro"
+    [ $rc -eq 1 ] && grep -q "cannot write" "$TMP/err.txt" && [ "$(cat "$TMP/ro/x.png")" = old ] &&
+        ok "render into a read-only folder: exit 1, the old file intact" ||
+        fail "render into a read-only folder: exit 1, the old file intact" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+else
+    skip "render into a read-only folder" "running as root (permissions do not apply)"
+fi
+# a write that fails half way (a 1 KiB file size limit, the signal ignored so write() reports
+# EFBIG): PNG errors were ignored ("wrote x.png", exit 0, a truncated file), PFM and .radb
+# errors truncated the old file
+"$RAD" render cornell --patches 50 --size 64x64 --aa 1 -o "$TMP/out/c64.pfm" > /dev/null 2>&1
+for t in "png:render cornell --patches 50 --size 128x128 --aa 1" "pfm:render cornell --patches 50 --size 64x64 --aa 1" \
+    "radb:bake cornell --patches 50" "png:compare $TMP/out/c64.pfm $TMP/out/c64.pfm --png" \
+    "pfm:compare $TMP/out/c64.pfm $TMP/out/c64.pfm --diff"; do
+    ext=${t%%:*} c=${t#*:} o=-o
+    case $c in compare*) o= ;; esac
+    rm -rf "$TMP/fs" && mkdir -p "$TMP/fs" && echo old > "$TMP/fs/x.$ext"
+    (ulimit -f 1 && trap '' XFSZ && "$RAD" $c $o "$TMP/fs/x.$ext" > "$TMP/out.txt" 2> "$TMP/err.txt")
+    rc=$?
+    left=$(ls -A "$TMP/fs" | grep -v "^x.$ext\$" | tr '\n' ' ')
+    [ $rc -eq 1 ] && grep -q "error writing '.*x.$ext': File too large" "$TMP/err.txt" && [ "$(cat "$TMP/fs/x.$ext")" = old ] &&
+        [ -z "$left" ] && ! grep -q "^wrote" "$TMP/out.txt" &&
+        ok "${c%% *} .$ext write error: exit 1, the message, the old file intact, no temporary left" ||
+        fail "${c%% *} .$ext write error: exit 1, the message, the old file intact, no temporary left" \
+            "exit $rc, left '$left': $(head -c 200 "$TMP/err.txt")"
+done
+# and a write that succeeds replaces the old file, with the mode a new file gets
+echo old > "$TMP/fs/y.png"
+"$RAD" render cornell --patches 8 --size 8x8 --aa 1 -o "$TMP/fs/y.png" > /dev/null 2>&1 &&
+    [ "$(head -c 4 "$TMP/fs/y.png" | od -An -tx1 | tr -d ' \n')" = "89504e47" ] && [ -r "$TMP/fs/y.png" ] &&
+    [ -z "$(ls -A "$TMP/fs" | grep tmp)" ] && ok "render replaces an old output" || fail "render replaces an old output"
+
 # ---- what tools/report.sh relies on: the timing line and compare --png ------------------------
 for meth in classic multibounce temporal; do
     if "$RAD" render cornell --method $meth --patches 100 --size 8x8 --aa 1 --pixel-light-samples 1 --threads 1 \

@@ -89,6 +89,14 @@ int rad_cmd_compare(int argc, char **argv)
         compare_usage(stderr);
         return 2;
     }
+    {
+        const char *inputs[2];
+        inputs[0] = pa;
+        inputs[1] = pb;
+        if ((diff && rad_tool_check_output("compare", diff, inputs, 2)) ||
+            (png && rad_tool_check_output("compare", png, inputs, 2)))
+            return 1;
+    }
     if (rad_image_read(pa, &a, err, sizeof(err)) != 0) {
         fprintf(stderr, "rad compare: %s\n", err);
         return 1;
@@ -132,8 +140,15 @@ int rad_cmd_compare(int argc, char **argv)
             }
             scale = top > 0.0 ? (float)top : 1.0f;
         }
-        if (rad_image_diff_heatmap(&a, &b, scale, &heat) != 0 || rad_image_write(diff, &heat, 1.0f) != 0) {
-            fprintf(stderr, "rad compare: cannot write the difference image '%s'\n", diff);
+        if (rad_image_diff_heatmap(&a, &b, scale, &heat) != 0) {
+            fprintf(stderr, "rad compare: out of memory for the difference image '%s'\n", diff);
+            rad_image_free(&heat);
+            rad_image_free(&a);
+            rad_image_free(&b);
+            return 1;
+        }
+        if (rad_image_write(diff, &heat, 1.0f) != 0) {
+            fprintf(stderr, "rad compare: the difference image: %s\n", rad_tool_output_error());
             rad_image_free(&heat);
             rad_image_free(&a);
             rad_image_free(&b);
@@ -144,7 +159,7 @@ int rad_cmd_compare(int argc, char **argv)
     }
     if (png) {
         if (rad_image_write_png(png, &a, exposure) != 0) {
-            fprintf(stderr, "rad compare: cannot write '%s'\n", png);
+            fprintf(stderr, "rad compare: %s\n", rad_tool_output_error());
             rad_image_free(&a);
             rad_image_free(&b);
             return 1;

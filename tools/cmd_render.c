@@ -401,7 +401,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
             if (rc == 0) rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
             if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, &frame);
             if (rc == 0 && rad_image_write_png(path, &frame, exposure) != 0) {
-                fprintf(stderr, "rad %s: cannot write '%s' (does the directory exist?)\n", cmd, path);
+                fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
                 rc = 1;
             }
             rad_image_free(&frame);
@@ -425,7 +425,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         char path[4096];
         snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
         if (rad_image_write_png(path, img, exposure) != 0) {
-            fprintf(stderr, "rad %s: cannot write '%s' (does the directory exist?)\n", cmd, path);
+            fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
             rc = 1;
         }
     }
@@ -813,6 +813,12 @@ int rad_cmd_render(int argc, char **argv)
             return 2;
         }
     }
+    {
+        const char *inputs[2];
+        inputs[0] = scene_name;
+        inputs[1] = bake_path;
+        if (rad_tool_check_output(cmd, out_path, inputs, 2)) return 1;
+    }
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
     if (!have_cam) cam = w.file.camera;
@@ -932,7 +938,7 @@ int rad_cmd_render(int argc, char **argv)
         }
     }
     if (rad_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad %s: cannot write '%s'\n", cmd, out_path);
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
         rad_image_free(&img);
         rad_tool_close_world(&w);
         return 1;

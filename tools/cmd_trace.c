@@ -154,6 +154,7 @@ int rad_cmd_trace(int argc, char **argv)
             return 2;
         }
     }
+    if (rad_tool_check_output("trace", out_path, &scene_path, 1)) return 1;
     rad_tool_set_threads((int)threads);
 
     memset(&ts, 0, sizeof(ts));
@@ -211,7 +212,7 @@ int rad_cmd_trace(int argc, char **argv)
     fprintf(stderr, "rad trace: %.2f s (%.3g samples/s)\n", t1 - t0,
             (double)opt.width * (double)opt.height * (double)opt.spp / (t1 - t0 > 0.0 ? t1 - t0 : 1e-9));
     if (rad_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad trace: cannot write '%s'\n", out_path);
+        fprintf(stderr, "rad trace: %s\n", rad_tool_output_error());
         goto done;
     }
     fprintf(stderr, "rad trace: wrote %s\n", out_path);
