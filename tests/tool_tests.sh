@@ -473,6 +473,42 @@ echo old > "$TMP/fs/y.png"
     [ "$(head -c 4 "$TMP/fs/y.png" | od -An -tx1 | tr -d ' \n')" = "89504e47" ] && [ -r "$TMP/fs/y.png" ] &&
     [ -z "$(ls -A "$TMP/fs" | grep tmp)" ] && ok "render replaces an old output" || fail "render replaces an old output"
 
+# Import: vertices are welded relative to each mesh's size, not within assimp's absolute 1e-5:
+# a Cornell-like box (metres) scaled by 3e-5 kept its triangles but lost corners (floor to
+# ceiling 0.1135 instead of 0.1048 at 500 patches), at 1e-5 five triangles collapsed.
+cornell_obj() { # cornell_obj SCALE > FILE
+    awk -v s="$1" '
+    function v(x, y, z) { printf "v %.9g %.9g %.9g\n", x * s, y * s, z * s }
+    function quad(name, a, b, c, d, e, f, g, h, i, j, k, l) {
+        printf "o %s\n", name; v(a, b, c); v(d, e, f); v(g, h, i); v(j, k, l); n += 4
+        printf "f %d %d %d %d\n", n - 3, n - 2, n - 1, n }
+    BEGIN {
+        quad("floor", 0.5528, 0, 0, 0, 0, 0, 0, 0, 0.5592, 0.5496, 0, 0.5592)
+        quad("ceiling", 0.556, 0.5488, 0, 0.556, 0.5488, 0.5592, 0, 0.5488, 0.5592, 0, 0.5488, 0)
+        quad("back", 0.5496, 0, 0.5592, 0, 0, 0.5592, 0, 0.5488, 0.5592, 0.556, 0.5488, 0.5592)
+        quad("green", 0, 0, 0.5592, 0, 0, 0, 0, 0.5488, 0, 0, 0.5488, 0.5592)
+        quad("red", 0.5528, 0, 0, 0.5496, 0, 0.5592, 0.556, 0.5488, 0.5592, 0.556, 0.5488, 0)
+        quad("light", 0.343, 0.5487, 0.227, 0.343, 0.5487, 0.332, 0.213, 0.5487, 0.332, 0.213, 0.5487, 0.227)
+        quad("block", 0.13, 0.165, 0.065, 0.082, 0.165, 0.225, 0.24, 0.165, 0.272, 0.29, 0.165, 0.114)
+    }'
+}
+cornell_obj 1 > "$TMP/box1.obj"
+cornell_obj 3e-5 > "$TMP/box3e-5.obj"
+cornell_obj 1e-5 > "$TMP/box1e-5.obj"
+if "$RAD" formfactors "$TMP/box1.obj" --patches 500 > "$TMP/ff1.txt" 2> "$TMP/err1.txt" &&
+    "$RAD" formfactors "$TMP/box3e-5.obj" --patches 500 > "$TMP/ff3.txt" 2> "$TMP/err3.txt" &&
+    "$RAD" formfactors "$TMP/box1e-5.obj" --patches 500 > "$TMP/ff5.txt" 2> "$TMP/err5.txt"; then
+    f1=$(pair "$TMP/ff1.txt" floor ceiling) f3=$(pair "$TMP/ff3.txt" floor ceiling) f5=$(pair "$TMP/ff5.txt" floor ceiling)
+    close "$f3" "$f1" 1e-3 && ok "formfactors of the box scaled 3e-5 = unscaled ($f3, $f1)" ||
+        fail "formfactors of the box scaled 3e-5 = unscaled" "floor-ceiling $f3, unscaled $f1"
+    t1=$(grep -o '[0-9]* triangles' "$TMP/err1.txt") t5=$(grep -o '[0-9]* triangles' "$TMP/err5.txt")
+    [ -n "$t1" ] && [ "$t1" = "$t5" ] && ! grep -q "degenerate" "$TMP/err5.txt" && close "$f5" "$f1" 1e-3 &&
+        ok "the box scaled 1e-5 keeps all its triangles ($t5) and its form factors" ||
+        fail "the box scaled 1e-5 keeps all its triangles" "'$t5' vs '$t1', floor-ceiling $f5: $(grep degenerate "$TMP/err5.txt")"
+else
+    fail "formfactors of the scaled box" "$(head -c 300 "$TMP/err3.txt" "$TMP/err5.txt")"
+fi
+
 # ---- what tools/report.sh relies on: the timing line and compare --png ------------------------
 for meth in classic multibounce temporal; do
     if "$RAD" render cornell --method $meth --patches 100 --size 8x8 --aa 1 --pixel-light-samples 1 --threads 1 \

@@ -1,7 +1,8 @@
 /* import.c - scenes for the rad tool: the built-in Cornell box, or any file assimp reads
    (OBJ+MTL, glTF 2.0, FBX, PLY ...).
 
-   Geometry: assimp triangulates and joins identical vertices; the node graph is walked here
+   Geometry: assimp triangulates; vertices are welded here with a tolerance relative to each
+   mesh's size (weld_mesh; assimp's own weld is absolute and broke small scenes); the node graph is walked here
    (instead of aiProcess_PreTransformVertices, which merges meshes of the same material and so
    loses object names), every mesh's vertices are transformed by its node's accumulated
    matrix, and meshes are grouped by name (the mesh's own name, else its node's name) into one
@@ -309,6 +310,127 @@ static void convert_material(imp_storage *st, const struct aiScene *sc, const ch
     }
 }
 
+/* ---- vertex welding ------------------------------------------------------------------------ */
+
+/* assimp's aiProcess_JoinIdenticalVertices joins vertices closer than an absolute 1e-5: a
+   Cornell box scaled by 3e-5 lost corners (the floor-to-ceiling form factor moved by 8%) and
+   at 1e-5 whole triangles collapsed (issue 23). The tool welds here instead, within each assimp
+   mesh (like assimp), with a tolerance relative to that mesh's size: positions within
+   WELD_REL x its bounding-box diagonal, and uvs and normals within assimp's 1e-5 (they do not
+   scale with the scene), make one vertex. So the result does not depend on the scene's units. */
+#define WELD_REL 1e-6
+#define WELD_ATTR_EPS 1e-5
+
+typedef struct weld_table {
+    int64_t *cell;       /* 3 per kept vertex: its grid cell */
+    uint32_t *next;      /* the next kept vertex in the same cell (UINT32_MAX: none) */
+    uint32_t *slot;      /* hash table of cells: the first kept vertex of the cell (UINT32_MAX: empty) */
+    uint32_t mask;
+} weld_table;
+
+static uint32_t weld_hash(const int64_t c[3])
+{
+    uint64_t h = (uint64_t)c[0] * 0x9E3779B97F4A7C15ull ^ (uint64_t)c[1] * 0xC2B2AE3D27D4EB4Full ^
+                 (uint64_t)c[2] * 0x165667B19E3779F9ull;
+    return (uint32_t)(h ^ (h >> 29));
+}
+
+/* the slot of cell c: the one holding it, or the empty one where it goes */
+static uint32_t weld_find(const weld_table *t, const int64_t c[3])
+{
+    uint32_t i = weld_hash(c) & t->mask;
+    for (;;) {
+        uint32_t r = t->slot[i];
+        if (r == UINT32_MAX) return i;
+        if (t->cell[3 * (size_t)r] == c[0] && t->cell[3 * (size_t)r + 1] == c[1] && t->cell[3 * (size_t)r + 2] == c[2])
+            return i;
+        i = (i + 1) & t->mask;
+    }
+}
+
+static int weld_same(const struct aiMesh *m, uint32_t a, uint32_t b, double tol)
+{
+    const struct aiVector3D *p = m->mVertices;
+    double dx = (double)p[a].x - p[b].x, dy = (double)p[a].y - p[b].y, dz = (double)p[a].z - p[b].z;
+    if (!(dx * dx + dy * dy + dz * dz <= tol * tol)) return 0;
+    if (m->mTextureCoords[0]) {
+        const struct aiVector3D *t = m->mTextureCoords[0];
+        if (!(fabs((double)t[a].x - t[b].x) <= WELD_ATTR_EPS && fabs((double)t[a].y - t[b].y) <= WELD_ATTR_EPS)) return 0;
+    }
+    if (m->mNormals) {
+        const struct aiVector3D *n = m->mNormals;
+        dx = (double)n[a].x - n[b].x, dy = (double)n[a].y - n[b].y, dz = (double)n[a].z - n[b].z;
+        if (!(dx * dx + dy * dy + dz * dz <= WELD_ATTR_EPS * WELD_ATTR_EPS)) return 0;
+    }
+    return 1;
+}
+
+/* remap[v]: the kept vertex v becomes (kept vertices are numbered in order of first use);
+   returns how many are kept */
+static uint32_t weld_mesh(const struct aiMesh *m, uint32_t *remap, uint32_t *kept_of)
+{
+    uint32_t n = m->mNumVertices, v, kept = 0, cap = 16;
+    double bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0}, diag = 0.0, tol, cell;
+    int k, any = 0;
+    weld_table t;
+    for (v = 0; v < n; ++v) {
+        double q[3];
+        q[0] = m->mVertices[v].x, q[1] = m->mVertices[v].y, q[2] = m->mVertices[v].z;
+        if (!(fabs(q[0]) <= 3.4e38 && fabs(q[1]) <= 3.4e38 && fabs(q[2]) <= 3.4e38)) continue; /* NaN, inf */
+        for (k = 0; k < 3; ++k) {
+            if (!any || q[k] < bmin[k]) bmin[k] = q[k];
+            if (!any || q[k] > bmax[k]) bmax[k] = q[k];
+        }
+        any = 1;
+    }
+    for (k = 0; k < 3; ++k) diag += (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
+    diag = sqrt(diag);
+    tol = WELD_REL * diag;
+    cell = tol > 0.0 ? tol : 1.0; /* all at one point: exact matches only */
+    while (cap < 2 * (uint64_t)n && cap < 0x80000000u) cap *= 2;
+    t.cell = (int64_t *)xrealloc(NULL, sizeof(int64_t) * 3 * (n ? n : 1));
+    t.next = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * (n ? n : 1));
+    t.slot = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * cap);
+    t.mask = cap - 1;
+    memset(t.slot, 0xFF, sizeof(uint32_t) * cap);
+    for (v = 0; v < n; ++v) {
+        double q[3];
+        int64_t c[3], d[3];
+        int dx, dy, dz, found = 0;
+        uint32_t s;
+        q[0] = m->mVertices[v].x, q[1] = m->mVertices[v].y, q[2] = m->mVertices[v].z;
+        if (!(fabs(q[0]) <= 3.4e38 && fabs(q[1]) <= 3.4e38 && fabs(q[2]) <= 3.4e38)) {
+            kept_of[kept] = v; /* not welded: rad_scene_create names it */
+            remap[v] = kept++;
+            continue;
+        }
+        for (k = 0; k < 3; ++k) c[k] = (int64_t)floor((q[k] - bmin[k]) / cell);
+        for (dx = -1; dx <= 1 && !found; ++dx)
+            for (dy = -1; dy <= 1 && !found; ++dy)
+                for (dz = -1; dz <= 1 && !found; ++dz) {
+                    uint32_t r;
+                    d[0] = c[0] + dx, d[1] = c[1] + dy, d[2] = c[2] + dz;
+                    for (r = t.slot[weld_find(&t, d)]; r != UINT32_MAX; r = t.next[r])
+                        if (weld_same(m, kept_of[r], v, tol)) {
+                            remap[v] = r;
+                            found = 1;
+                            break;
+                        }
+                }
+        if (found) continue;
+        kept_of[kept] = v;
+        memcpy(t.cell + 3 * (size_t)kept, c, sizeof c);
+        s = weld_find(&t, c);
+        t.next[kept] = t.slot[s]; /* UINT32_MAX for a new cell */
+        t.slot[s] = kept;
+        remap[v] = kept++;
+    }
+    free(t.cell);
+    free(t.next);
+    free(t.slot);
+    return kept;
+}
+
 /* ---- geometry ---------------------------------------------------------------------------- */
 
 static void mat_mul(const struct aiMatrix4x4 *a, const struct aiMatrix4x4 *b, struct aiMatrix4x4 *o)
@@ -359,6 +481,7 @@ typedef struct walk_state {
     rad_tool_scene *out;
     int camera_done;
     unsigned unnamed;
+    uint32_t bad_indices;  /* faces with an index past the mesh's vertices (dropped) */
 } walk_state;
 
 static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiNode *node, const struct aiMatrix4x4 *m)
@@ -366,7 +489,7 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
     char fallback[32];
     const char *name = mesh->mName.length ? mesh->mName.data : node->mName.length ? node->mName.data : NULL;
     imp_group *g;
-    uint32_t base, f, v, tri = 0;
+    uint32_t base, f, v, k, kept, tri = 0, *remap, *kept_of;
     float det;
     if (!name) {
         snprintf(fallback, sizeof fallback, "mesh%u", ws->unnamed++);
@@ -375,25 +498,29 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
     if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return;
     g = group_for(ws->st, name);
     if ((uint64_t)g->vertex_count + mesh->mNumVertices > 0xFFFFFFF0u) return;
+    remap = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * (mesh->mNumVertices ? mesh->mNumVertices : 1));
+    kept_of = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * (mesh->mNumVertices ? mesh->mNumVertices : 1));
+    kept = weld_mesh(mesh, remap, kept_of);
     base = g->vertex_count;
-    if (g->vertex_count + mesh->mNumVertices > g->vertex_cap) {
-        while (g->vertex_count + mesh->mNumVertices > g->vertex_cap) g->vertex_cap = g->vertex_cap ? 2 * g->vertex_cap : 256;
+    if (g->vertex_count + kept > g->vertex_cap) {
+        while (g->vertex_count + kept > g->vertex_cap) g->vertex_cap = g->vertex_cap ? 2 * g->vertex_cap : 256;
         g->positions = (float *)xrealloc(g->positions, sizeof(float) * 3 * g->vertex_cap);
         g->uvs = (float *)xrealloc(g->uvs, sizeof(float) * 2 * g->vertex_cap);
     }
-    for (v = 0; v < mesh->mNumVertices; ++v) {
+    for (k = 0; k < kept; ++k) {
         float p[3];
+        v = kept_of[k];
         p[0] = mesh->mVertices[v].x, p[1] = mesh->mVertices[v].y, p[2] = mesh->mVertices[v].z;
-        xform_point(m, p, g->positions + 3 * (size_t)(base + v));
+        xform_point(m, p, g->positions + 3 * (size_t)(base + k));
         if (mesh->mTextureCoords[0]) {
-            g->uvs[2 * (size_t)(base + v)] = mesh->mTextureCoords[0][v].x;
-            g->uvs[2 * (size_t)(base + v) + 1] = mesh->mTextureCoords[0][v].y;
+            g->uvs[2 * (size_t)(base + k)] = mesh->mTextureCoords[0][v].x;
+            g->uvs[2 * (size_t)(base + k) + 1] = mesh->mTextureCoords[0][v].y;
         } else {
-            g->uvs[2 * (size_t)(base + v)] = g->uvs[2 * (size_t)(base + v) + 1] = 0.0f;
+            g->uvs[2 * (size_t)(base + k)] = g->uvs[2 * (size_t)(base + k) + 1] = 0.0f;
         }
     }
     if (mesh->mTextureCoords[0]) g->any_uv = 1;
-    g->vertex_count += mesh->mNumVertices;
+    g->vertex_count += kept;
     /* a mirroring transform flips the winding */
     det = m->a1 * (m->b2 * m->c3 - m->b3 * m->c2) - m->a2 * (m->b1 * m->c3 - m->b3 * m->c1) +
           m->a3 * (m->b1 * m->c2 - m->b2 * m->c1);
@@ -409,11 +536,18 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
         uint32_t *ix;
         if (face->mNumIndices != 3) continue;
         ix = g->indices + 3 * (size_t)g->triangle_count;
-        ix[0] = base + face->mIndices[0];
-        ix[1] = base + (det < 0 ? face->mIndices[2] : face->mIndices[1]);
-        ix[2] = base + (det < 0 ? face->mIndices[1] : face->mIndices[2]);
+        if (face->mIndices[0] >= mesh->mNumVertices || face->mIndices[1] >= mesh->mNumVertices ||
+            face->mIndices[2] >= mesh->mNumVertices) {
+            ++ws->bad_indices; /* assimp checks; counted should one slip through */
+            continue;
+        }
+        ix[0] = base + remap[face->mIndices[0]];
+        ix[1] = base + remap[det < 0 ? face->mIndices[2] : face->mIndices[1]];
+        ix[2] = base + remap[det < 0 ? face->mIndices[1] : face->mIndices[2]];
         g->material_ids[g->triangle_count++] = mesh->mMaterialIndex;
     }
+    free(remap);
+    free(kept_of);
 }
 
 static void walk(walk_state *ws, const struct aiNode *node, const struct aiMatrix4x4 *parent)
@@ -517,7 +651,7 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
         out->storage = st;
         return 0;
     }
-    sc = aiImportFile(path_or_name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    sc = aiImportFile(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
     if (!sc) {
         set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
         return 1;

@@ -328,7 +328,7 @@ int rad_cmd_formfactors(int argc, char **argv)
     }
     rad_form_factor_options_default(&fo);
     fo.samples = samples;
-    fprintf(stderr, "rad %s: %u patches\n", cmd, P->count);
+    fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w.scene->triangle_count, P->count);
     r = rad_form_factors_dense(P, &w.rc, &fo, &ctx, &ff);
     rad_tool_progress_end();
     if (r != RAD_SUCCESS) {
