@@ -509,6 +509,54 @@ else
     fail "formfactors of the scaled box" "$(head -c 300 "$TMP/err3.txt" "$TMP/err5.txt")"
 fi
 
+# Emission Ke that is negative, NaN, infinite (1e39 overflows a float) or above 1e30 became 0
+# without a word: now exit 1 naming the material and the value
+cat > "$TMP/ke.obj" <<'EOF'
+mtllib ke.mtl
+o a
+usemtl lamp
+v 0 0 0
+v 1 0 0
+v 1 1 0
+f 1 2 3
+o b
+v 0 0 1
+v 1 1 1
+v 1 0 1
+f 4 5 6
+EOF
+for ke in "1e31 1e31 1e31" "-1 0 0" "nan nan nan" "1e39 1 1"; do
+    printf 'newmtl lamp\nKd 0.5 0.5 0.5\nKe %s\n' "$ke" > "$TMP/ke.mtl"
+    "$RAD" formfactors "$TMP/ke.obj" --patches 4 > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "material .* 'lamp': emission .* is out of range" "$TMP/err.txt" &&
+        ok "Ke $ke is refused naming the material" || fail "Ke $ke is refused naming the material" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+printf 'newmtl lamp\nKd 0.5 0.5 0.5\nKe 17 12 4\n' > "$TMP/ke.mtl"
+"$RAD" formfactors "$TMP/ke.obj" --patches 4 > /dev/null 2> "$TMP/err.txt" && ok "Ke 17 12 4 is accepted" ||
+    fail "Ke 17 12 4 is accepted" "$(head -c 200 "$TMP/err.txt")"
+# a glTF whose second triangle has an index past its 4 vertices (0 1 2, 0 2 4): assimp drops
+# the face with a log warning only; the tool fails with the reason. The buffer: 4 float3
+# positions (the unit square in z = 0), then 6 uint32 indices.
+gltf() { # gltf BASE64 > FILE
+    printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "name": "n"}],
+ "meshes": [{"name": "m", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+ "buffers": [{"byteLength": 72, "uri": "data:application/octet-stream;base64,%s"}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+  {"bufferView": 1, "componentType": 5125, "count": 6, "type": "SCALAR"}]}\n' "$1"
+}
+B64=AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAEAAAACAAAAAAAAAAIAAAA
+gltf "${B64}DAAAA" > "$TMP/good.gltf"
+gltf "${B64}EAAAA" > "$TMP/oor.gltf"
+"$RAD" formfactors "$TMP/good.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt" && grep -q "2 triangles" "$TMP/err.txt" &&
+    ok "a glTF with an embedded buffer loads (2 triangles)" || fail "a glTF with an embedded buffer loads" "$(head -c 200 "$TMP/err.txt")"
+"$RAD" formfactors "$TMP/oor.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "oor.gltf' is broken: .*out-of-range indices" "$TMP/err.txt" &&
+    ok "a glTF with an out-of-range index fails with the reason" ||
+    fail "a glTF with an out-of-range index fails with the reason" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+
 # ---- what tools/report.sh relies on: the timing line and compare --png ------------------------
 for meth in classic multibounce temporal; do
     if "$RAD" render cornell --method $meth --patches 100 --size 8x8 --aa 1 --pixel-light-samples 1 --threads 1 \

@@ -241,8 +241,13 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
 
 /* ---- materials --------------------------------------------------------------------------- */
 
-static void convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
-                             rad_material *out, int *warned_clamp)
+/* The largest emission (radiance) accepted: what the tool's other inputs allow (1e30). */
+#define EMISSION_MAX 1e30f
+
+/* 0, or 1 with the reason in err (a negative, NaN, infinite or overflowing emission: it used
+   to become 0 without a word) */
+static int convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
+                            uint32_t index, rad_material *out, int *warned_clamp, char *err, size_t errlen)
 {
     struct aiColor4D c;
     struct aiString name, tpath;
@@ -258,14 +263,32 @@ static void convert_material(imp_storage *st, const struct aiScene *sc, const ch
     }
     if (!have_base && aiGetMaterialColor(m, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS)
         out->albedo[0] = c.r, out->albedo[1] = c.g, out->albedo[2] = c.b;
+    if (aiGetMaterialString(m, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS) name.length = 0, name.data[0] = 0;
     if (aiGetMaterialColor(m, AI_MATKEY_COLOR_EMISSIVE, &c) == aiReturn_SUCCESS)
         out->emission[0] = c.r, out->emission[1] = c.g, out->emission[2] = c.b;
-    if (aiGetMaterialFloatArray(m, AI_MATKEY_EMISSIVE_INTENSITY, &fv, &one) == aiReturn_SUCCESS && fv >= 0) strength = (float)fv;
-    for (k = 0; k < 3; ++k) {
-        out->emission[k] *= strength;
-        if (!(out->emission[k] >= 0.0f) || out->emission[k] > 1e30f) out->emission[k] = 0.0f;
+    if (aiGetMaterialFloatArray(m, AI_MATKEY_EMISSIVE_INTENSITY, &fv, &one) == aiReturn_SUCCESS) {
+        if (!(fv >= 0 && fv <= EMISSION_MAX)) {
+            if (err && errlen)
+                snprintf(err, errlen, "'%s': material %u '%s': emissive strength %g is out of range (want a finite value in [0, %g])",
+                         file, index, name.data, (double)fv, (double)EMISSION_MAX);
+            return 1;
+        }
+        strength = (float)fv;
     }
-    if (aiGetMaterialString(m, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS) name.length = 0, name.data[0] = 0;
+    for (k = 0; k < 3; ++k) {
+        float e = out->emission[k], es = e * strength;
+        /* e * strength: an overflow to inf is caught like an inf in the file */
+        if (!(e >= 0.0f && e <= EMISSION_MAX) || !(es >= 0.0f && es <= EMISSION_MAX)) {
+            if (err && errlen)
+                snprintf(err, errlen,
+                         "'%s': material %u '%s': emission (Ke, or emissive x strength) %g %g %g is out of range "
+                         "(want finite values in [0, %g])",
+                         file, index, name.data, (double)(out->emission[0] * strength), (double)(out->emission[1] * strength),
+                         (double)(out->emission[2] * strength), (double)EMISSION_MAX);
+            return 1;
+        }
+    }
+    for (k = 0; k < 3; ++k) out->emission[k] *= strength;
     /* texture: base colour (glTF) or diffuse (OBJ map_Kd ...) */
     if (aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
         aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) {
@@ -308,6 +331,57 @@ static void convert_material(imp_storage *st, const struct aiScene *sc, const ch
                 name.data, (double)ALBEDO_MAX);
         *warned_clamp = 1;
     }
+    return 0;
+}
+
+/* ---- assimp's log ------------------------------------------------------------------------- */
+
+/* assimp reports what it repaired or dropped only to its logger: a glTF with an out-of-range
+   index lost a triangle with exit 0 (issue 23). While a file is imported its warnings and
+   errors are shown (at most LOG_SHOWN), and one saying faces were dropped for out-of-range
+   indices fails the import with that reason. */
+#define LOG_SHOWN 10
+static struct {
+    unsigned shown, more;
+    char fatal[512];
+} g_log;
+
+static void assimp_log(const char *message, char *user)
+{
+    const char *text = message;
+    size_t n;
+    int warn = !strncmp(message, "Warn", 4), error = !strncmp(message, "Error", 5);
+    (void)user;
+    if (!warn && !error) return; /* Info, Debug */
+    if (strstr(message, ": ")) text = strstr(message, ": ") + 2; /* "Warn,  T0: text" */
+    n = strlen(text);
+    while (n && (text[n - 1] == '\n' || text[n - 1] == '\r')) --n;
+    if (!g_log.fatal[0] && (strstr(text, "out-of-range") || strstr(text, "out of range")) &&
+        (strstr(text, "dropped") || strstr(text, "ignored") || strstr(text, "skipp") || strstr(text, "remov"))) {
+        snprintf(g_log.fatal, sizeof g_log.fatal, "%.*s", (int)(n < 400 ? n : 400), text);
+        return;
+    }
+    if (g_log.shown < LOG_SHOWN) {
+        fprintf(stderr, "rad: warning: assimp: %.*s\n", (int)n, text);
+        ++g_log.shown;
+    } else {
+        ++g_log.more;
+    }
+}
+
+static const struct aiScene *import_logged(const char *path, unsigned flags)
+{
+    const struct aiScene *sc;
+    struct aiLogStream stream;
+    memset(&g_log, 0, sizeof g_log);
+    stream.callback = assimp_log;
+    stream.user = NULL;
+    aiEnableVerboseLogging(AI_FALSE);
+    aiAttachLogStream(&stream);
+    sc = aiImportFile(path, flags);
+    aiDetachAllLogStreams();
+    if (g_log.more) fprintf(stderr, "rad: warning: assimp: %u more warnings\n", g_log.more);
+    return sc;
 }
 
 /* ---- vertex welding ------------------------------------------------------------------------ */
@@ -651,9 +725,14 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
         out->storage = st;
         return 0;
     }
-    sc = aiImportFile(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
+    sc = import_logged(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
     if (!sc) {
         set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
+        return 1;
+    }
+    if (g_log.fatal[0]) {
+        set_err(err, errlen, "'%s' is broken: assimp: %s", path_or_name, g_log.fatal);
+        aiReleaseImport(sc);
         return 1;
     }
     if (!sc->mRootNode || sc->mNumMeshes == 0) {
@@ -672,8 +751,13 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
     for (i = 0; i < st->material_count; ++i) {
-        if (i < sc->mNumMaterials) convert_material(st, sc, path_or_name, sc->mMaterials[i], &st->materials[i], &warned);
-        else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
+        if (i < sc->mNumMaterials) {
+            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &warned, err, errlen)) {
+                aiReleaseImport(sc);
+                rad_tool_free_scene(out);
+                return 1;
+            }
+        } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
     }
     /* geometry, lights, camera */
     memset(&id, 0, sizeof id);
@@ -684,6 +768,13 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     ws.out = out;
     walk(&ws, sc->mRootNode, &id);
     aiReleaseImport(sc);
+    if (ws.bad_indices) {
+        char n[32];
+        snprintf(n, sizeof n, "%u", ws.bad_indices);
+        set_err(err, errlen, "'%s' is broken: %s faces have an index past their mesh's vertices", path_or_name, n);
+        rad_tool_free_scene(out);
+        return 1;
+    }
     st->meshes = (rad_mesh_desc *)xrealloc(NULL, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
     memset(st->meshes, 0, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
     for (i = 0; i < st->group_count; ++i) {
