@@ -557,6 +557,25 @@ rc=$?
     ok "a glTF with an out-of-range index fails with the reason" ||
     fail "a glTF with an out-of-range index fails with the reason" "exit $rc: $(head -c 200 "$TMP/err.txt")"
 
+# compare: NaN and infinite pixels were clamped away and compared as fine (exit 0)
+printf 'PF\n2 1\n-1.0\n' > "$TMP/finite.pfm"
+printf '\000\000\000\077%.0s' 1 2 3 4 5 6 >> "$TMP/finite.pfm"
+printf 'PF\n2 1\n-1.0\n' > "$TMP/nan.pfm"
+printf '\000\000\300\177\000\000\000\077\000\000\000\077\000\000\200\177\000\000\000\077\000\000\000\077' >> "$TMP/nan.pfm"
+"$RAD" compare "$TMP/finite.pfm" "$TMP/finite.pfm" > /dev/null 2> "$TMP/err.txt" && ok "compare of finite images exits 0" ||
+    fail "compare of finite images exits 0" "$(head -c 200 "$TMP/err.txt")"
+"$RAD" compare "$TMP/finite.pfm" "$TMP/nan.pfm" > "$TMP/out.txt" 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "B '.*nan.pfm' has 1 NaN and 1 infinite values" "$TMP/err.txt" && grep -q "^nonfinite B: 1 NaN, 1 inf" "$TMP/out.txt" &&
+    ok "compare reports NaN and infinite pixels and exits 1" || fail "compare reports NaN and infinite pixels and exits 1" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+# --size: an image beyond 2 GiB is refused with the bytes (32768x32768 allocated 12 GiB silently)
+for c in render trace; do
+    timeout 120 "$RAD" $c cornell --size 32768x32768 -o "$TMP/huge.pfm" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 2 ] && grep -q "needs 12884901888 bytes (12.0 GiB) for the image, more than the limit of 2147483648 bytes" "$TMP/err.txt" &&
+        ok "$c --size 32768x32768 is refused with the bytes" || fail "$c --size 32768x32768 is refused with the bytes" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+
 # ---- what tools/report.sh relies on: the timing line and compare --png ------------------------
 for meth in classic multibounce temporal; do
     if "$RAD" render cornell --method $meth --patches 100 --size 8x8 --aa 1 --pixel-light-samples 1 --threads 1 \

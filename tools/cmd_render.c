@@ -63,7 +63,7 @@ static void render_usage(FILE *f)
             "                     'rad bake' from this scene instead of computing it here\n"
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
             "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
-            "  --size WxH         image size (default 512x512)\n"
+            "  --size WxH         image size (default 512x512; at most 2 GiB of image: 12 bytes a pixel)\n"
             "  --aa N             radiosity methods: stratified samples per pixel, rounded down to a square (default 16)\n"
             "  --spp N            pathtrace: samples per pixel (default 64)\n"
             "  --seed S           pathtrace: random seed (default 0)\n"
@@ -762,6 +762,7 @@ int rad_cmd_render(int argc, char **argv)
                 fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, argv[a]);
                 return 2;
             }
+            if (rad_tool_check_size(cmd, width, height)) return 2;
         } else if (!strcmp(opt, "--aa")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
             if (aa == 0) { fprintf(stderr, "rad %s: --aa must be > 0\n", cmd); return 2; }

@@ -18,7 +18,7 @@ static void trace_usage(FILE *f)
                "  path-traced reference image (diffuse, next-event estimation + MIS); linear radiance\n"
                "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
                "  --fov DEG          vertical field of view (default: the scene's, else 45)\n"
-               "  --size WxH         image size (default 256x256)\n"
+               "  --size WxH         image size (default 256x256; at most 2 GiB of image: 12 bytes a pixel)\n"
                "  --spp N            samples per pixel (default 64)\n"
                "  --seed S           random seed (default 0); same seed, same image on any thread count\n"
                "  --max-depth N      path length cap (default 64)\n"
@@ -101,6 +101,7 @@ int rad_cmd_trace(int argc, char **argv)
                 fprintf(stderr, "rad trace: --size wants WxH, got '%s'\n", next);
                 return 2;
             }
+            if (rad_tool_check_size("trace", opt.width, opt.height)) return 2;
         } else if (!strcmp(a, "--spp")) {
             if (parse_int(next, 1, 1L << 24, &v) != 0) {
                 fprintf(stderr, "rad trace: --spp wants a positive integer, got '%s'\n", next);

@@ -381,6 +381,13 @@ int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errle
         return -1;
     }
     swap = (scale < 0.0) != rad__host_little_endian();
+    if ((double)w * (double)h * 3.0 * sizeof(float) > RAD_TOOL_MAX_IMAGE_BYTES) {
+        if (err)
+            snprintf(err, errlen, "%s: a %dx%d image needs %.0f bytes, more than the limit of %.0f", path, w, h,
+                     (double)w * (double)h * 3.0 * sizeof(float), RAD_TOOL_MAX_IMAGE_BYTES);
+        fclose(f);
+        return -1;
+    }
     if (rad_image_alloc(img, w, h) != 0) {
         if (err) snprintf(err, errlen, "%s: %dx%d image: out of memory", path, w, h);
         fclose(f);

@@ -221,6 +221,18 @@ int rad_tool_parse_size(const char *text, int *w, int *h)
     return 0;
 }
 
+int rad_tool_check_size(const char *cmd, int w, int h)
+{
+    double bytes = (double)w * (double)h * 3.0 * sizeof(float);
+    if (w <= 0 || h <= 0) return 2;
+    if (bytes > RAD_TOOL_MAX_IMAGE_BYTES) {
+        fprintf(stderr, "rad %s: --size %dx%d needs %.0f bytes (%.1f GiB) for the image, more than the limit of %.0f bytes (%.0f GiB)\n",
+                cmd, w, h, bytes, bytes / 1073741824.0, RAD_TOOL_MAX_IMAGE_BYTES, RAD_TOOL_MAX_IMAGE_BYTES / 1073741824.0);
+        return 2;
+    }
+    return 0;
+}
+
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w)
 {
     char err[1024];

@@ -118,6 +118,12 @@ int rad_tool_parse_threads(const char *cmd, const char *opt, const char *text, u
 int rad_tool_parse_camera(const char *text, rad_camera *out);
 /* parses "WxH"; 0 on success */
 int rad_tool_parse_size(const char *text, int *w, int *h);
+/* The most memory an image may take (linear RGB floats, 12 bytes a pixel): 2 GiB, e.g.
+   16384x8192. --size 32768x32768 allocated 12 GiB without a word (issue 23). */
+#define RAD_TOOL_MAX_IMAGE_BYTES 2147483648.0
+/* --size: 0 when the image fits RAD_TOOL_MAX_IMAGE_BYTES, else prints "rad CMD: ..." with the
+   bytes and returns 2 */
+int rad_tool_check_size(const char *cmd, int w, int h);
 
 /* ---- added by trace-metrics ------------------------------------------------------------ */
 /* Reads .png (8-bit sRGB through stb_image, decoded to linear) or else PFM; 0 on success. */
