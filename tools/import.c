@@ -118,7 +118,7 @@ static void *xrealloc(void *p, size_t size)
 {
     void *q = realloc(p, size ? size : 1);
     if (!q) {
-        fprintf(stderr, "rad: out of memory\n");
+        fprintf(stderr, "rad: out of memory importing the scene (%lu bytes)\n", (unsigned long)size);
         exit(1);
     }
     return q;

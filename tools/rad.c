@@ -118,7 +118,7 @@ void *rad_tool_calloc(size_t n, size_t size)
 {
     void *p = calloc(n ? n : 1, size);
     if (!p) {
-        fprintf(stderr, "rad: out of memory\n");
+        fprintf(stderr, "rad: out of memory (%lu x %lu bytes)\n", (unsigned long)n, (unsigned long)size);
         exit(1);
     }
     return p;
