@@ -467,11 +467,14 @@ for t in "png:render cornell --patches 50 --size 128x128 --aa 1" "pfm:render cor
         fail "${c%% *} .$ext write error: exit 1, the message, the old file intact, no temporary left" \
             "exit $rc, left '$left': $(head -c 200 "$TMP/err.txt")"
 done
-# and a write that succeeds replaces the old file, with the mode a new file gets
+# and a write that succeeds replaces the old file, keeping its mode
 echo old > "$TMP/fs/y.png"
+chmod 640 "$TMP/fs/y.png"
 "$RAD" render cornell --patches 8 --size 8x8 --aa 1 -o "$TMP/fs/y.png" > /dev/null 2>&1 &&
-    [ "$(head -c 4 "$TMP/fs/y.png" | od -An -tx1 | tr -d ' \n')" = "89504e47" ] && [ -r "$TMP/fs/y.png" ] &&
-    [ -z "$(ls -A "$TMP/fs" | grep tmp)" ] && ok "render replaces an old output" || fail "render replaces an old output"
+    [ "$(head -c 4 "$TMP/fs/y.png" | od -An -tx1 | tr -d ' \n')" = "89504e47" ] &&
+    { ! stat -c %a "$TMP/fs/y.png" > /dev/null 2>&1 || [ "$(stat -c %a "$TMP/fs/y.png")" = 640 ]; } &&
+    [ -z "$(ls -A "$TMP/fs" | grep tmp)" ] && ok "render replaces an old output, keeping its mode" ||
+    fail "render replaces an old output, keeping its mode" "mode $(stat -c %a "$TMP/fs/y.png" 2> /dev/null)"
 
 # Import: vertices are welded relative to each mesh's size, not within assimp's absolute 1e-5:
 # a Cornell-like box (metres) scaled by 3e-5 kept its triangles but lost corners (floor to

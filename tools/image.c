@@ -129,10 +129,15 @@ int rad_tool_output_open(rad_tool_output *o, const char *path)
             rad_tool_output_abort(o);
             return -1;
         }
-        /* mkstemp makes the file 0600: give it the mode a plain fopen would (0666 & ~umask) */
-        mask = umask(0);
-        umask(mask);
-        (void)fchmod(fd, (mode_t)(0666 & ~mask));
+        /* mkstemp makes the file 0600: give it the old file's mode, or the one a plain fopen
+           would (0666 & ~umask) */
+        if (stat(path, &st) == 0) {
+            (void)fchmod(fd, st.st_mode & 07777);
+        } else {
+            mask = umask(0);
+            umask(mask);
+            (void)fchmod(fd, (mode_t)(0666 & ~mask));
+        }
         o->f = fdopen(fd, "wb");
         if (!o->f) {
             int e = errno;
