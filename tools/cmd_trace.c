@@ -182,12 +182,12 @@ int rad_cmd_trace(int argc, char **argv)
     ctx.progress = rad_tool_progress;
     r = rad_scene_create(&ts.desc, &ctx, &scene);
     if (r != RAD_SUCCESS) {
-        fprintf(stderr, "rad trace: %s: %s\n", scene_path, rad_result_string(r));
+        fprintf(stderr, "rad trace: %s: rad_scene_create failed: %s\n", scene_path, rad_result_string(r));
         goto done;
     }
     r = rad_bvh_create(scene, &ctx, &bvh);
     if (r != RAD_SUCCESS) {
-        fprintf(stderr, "rad trace: BVH: %s\n", rad_result_string(r));
+        fprintf(stderr, "rad trace: building the BVH failed: %s\n", rad_result_string(r));
         goto done;
     }
     rad_bvh_raycaster(bvh, &rc);
@@ -207,7 +207,7 @@ int rad_cmd_trace(int argc, char **argv)
     r = (rad_result)rad_trace_image(scene, &rc, ts.lights, ts.light_count, &cam, &opt, &ctx, &img);
     t1 = trace_now();
     if (r != RAD_SUCCESS) {
-        fprintf(stderr, "rad trace: %s\n", rad_result_string(r));
+        fprintf(stderr, "rad trace: path tracing failed: %s\n", rad_result_string(r));
         goto done;
     }
     fprintf(stderr, "rad trace: %.2f s (%.3g samples/s)\n", t1 - t0,
