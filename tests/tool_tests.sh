@@ -400,6 +400,185 @@ bad "--mode bogus" "unknown --mode 'bogus'" bake cornell --method temporal --mod
 bad "--method bogus" "unknown method 'bogus'" render cornell --method bogus -o "$TMP/y.pfm"
 bad "bake --method pathtrace" "needs no bake" bake cornell --method pathtrace -o "$TMP/y.radb"
 
+# ---- reliability (issue 23): the tool's side ---------------------------------------------------
+# --threads is bounded: 100000 crashed inside libgomp
+for c in formfactors bake render trace; do
+    bad "$c --threads 100000" "--threads 100000 is too many (at most 1024" $c "$TMP/parallel.obj" --threads 100000 $([ $c = formfactors ] || echo -o "$TMP/y.pfm")
+done
+"$RAD" formfactors "$TMP/parallel.obj" --patches 8 --threads 1024 > /dev/null 2> "$TMP/err.txt" &&
+    ok "--threads 1024 (the limit) runs" || fail "--threads 1024 (the limit) runs" "$(head -c 200 "$TMP/err.txt")"
+
+# Outputs go to a temporary file in the same folder, renamed into place only on success: a
+# failed write leaves the old file as it was and no temporary behind; an output that is an
+# input (by device and inode: another name, a hard or symbolic link) is refused before any work.
+mkdir -p "$TMP/out"
+cp "$TMP/parallel.obj" "$TMP/out/scene.obj"
+cp "$TMP/parallel.obj" "$TMP/out/scene.orig"
+ln "$TMP/out/scene.obj" "$TMP/out/hard.obj" 2> /dev/null || cp "$TMP/out/scene.obj" "$TMP/out/hard.obj"
+ln -s scene.obj "$TMP/out/soft.obj"
+for o in scene.obj hard.obj soft.obj; do
+    "$RAD" bake "$TMP/out/scene.obj" --patches 8 -o "$TMP/out/$o" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "is the input" "$TMP/err.txt" && cmp -s "$TMP/out/scene.obj" "$TMP/out/scene.orig" &&
+        ok "bake -o $o (the input) is refused, the input unchanged" ||
+        fail "bake -o $o (the input) is refused, the input unchanged" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+"$RAD" render "$TMP/out/scene.obj" --patches 8 --size 8x8 -o "$TMP/out/soft.pfm" > /dev/null 2>&1 &&
+    cp "$TMP/out/soft.pfm" "$TMP/out/a.pfm" &&
+    "$RAD" compare "$TMP/out/a.pfm" "$TMP/out/soft.pfm" --diff "$TMP/out/a.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "is the input" "$TMP/err.txt" && ok "compare --diff onto an input is refused" ||
+    fail "compare --diff onto an input is refused" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+for c in "render cornell --size 8x8" "trace cornell --size 8x8 --spp 1" "bake cornell --patches 8"; do
+    ext=pfm; case $c in bake*) ext=radb ;; esac
+    "$RAD" $c -o "$TMP/no/such/dir/x.$ext" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "cannot write '.*': the folder '.*' does not exist" "$TMP/err.txt" &&
+        ok "${c%% *} -o under a missing folder: exit 1 with a message" ||
+        fail "${c%% *} -o under a missing folder: exit 1 with a message" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+if [ "$(id -u)" != 0 ]; then
+    mkdir -p "$TMP/ro" && echo old > "$TMP/ro/x.png" && chmod 555 "$TMP/ro"
+    "$RAD" render cornell --size 8x8 --patches 8 -o "$TMP/ro/x.png" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    chmod 755 "$TMP/ro"
+    [ $rc -eq 1 ] && grep -q "cannot write" "$TMP/err.txt" && [ "$(cat "$TMP/ro/x.png")" = old ] &&
+        ok "render into a read-only folder: exit 1, the old file intact" ||
+        fail "render into a read-only folder: exit 1, the old file intact" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+else
+    skip "render into a read-only folder" "running as root (permissions do not apply)"
+fi
+# a write that fails half way (a 1 KiB file size limit, the signal ignored so write() reports
+# EFBIG): PNG errors were ignored ("wrote x.png", exit 0, a truncated file), PFM and .radb
+# errors truncated the old file
+"$RAD" render cornell --patches 50 --size 64x64 --aa 1 -o "$TMP/out/c64.pfm" > /dev/null 2>&1
+for t in "png:render cornell --patches 50 --size 128x128 --aa 1" "pfm:render cornell --patches 50 --size 64x64 --aa 1" \
+    "radb:bake cornell --patches 50" "png:compare $TMP/out/c64.pfm $TMP/out/c64.pfm --png" \
+    "pfm:compare $TMP/out/c64.pfm $TMP/out/c64.pfm --diff"; do
+    ext=${t%%:*} c=${t#*:} o=-o
+    case $c in compare*) o= ;; esac
+    rm -rf "$TMP/fs" && mkdir -p "$TMP/fs" && echo old > "$TMP/fs/x.$ext"
+    (ulimit -f 1 && trap '' XFSZ && "$RAD" $c $o "$TMP/fs/x.$ext" > "$TMP/out.txt" 2> "$TMP/err.txt")
+    rc=$?
+    left=$(ls -A "$TMP/fs" | grep -v "^x.$ext\$" | tr '\n' ' ')
+    [ $rc -eq 1 ] && grep -q "error writing '.*x.$ext': File too large" "$TMP/err.txt" && [ "$(cat "$TMP/fs/x.$ext")" = old ] &&
+        [ -z "$left" ] && ! grep -q "^wrote" "$TMP/out.txt" &&
+        ok "${c%% *} .$ext write error: exit 1, the message, the old file intact, no temporary left" ||
+        fail "${c%% *} .$ext write error: exit 1, the message, the old file intact, no temporary left" \
+            "exit $rc, left '$left': $(head -c 200 "$TMP/err.txt")"
+done
+# and a write that succeeds replaces the old file, keeping its mode
+echo old > "$TMP/fs/y.png"
+chmod 640 "$TMP/fs/y.png"
+"$RAD" render cornell --patches 8 --size 8x8 --aa 1 -o "$TMP/fs/y.png" > /dev/null 2>&1 &&
+    [ "$(head -c 4 "$TMP/fs/y.png" | od -An -tx1 | tr -d ' \n')" = "89504e47" ] &&
+    { ! stat -c %a "$TMP/fs/y.png" > /dev/null 2>&1 || [ "$(stat -c %a "$TMP/fs/y.png")" = 640 ]; } &&
+    [ -z "$(ls -A "$TMP/fs" | grep tmp)" ] && ok "render replaces an old output, keeping its mode" ||
+    fail "render replaces an old output, keeping its mode" "mode $(stat -c %a "$TMP/fs/y.png" 2> /dev/null)"
+
+# Import: vertices are welded relative to each mesh's size, not within assimp's absolute 1e-5:
+# a Cornell-like box (metres) scaled by 3e-5 kept its triangles but lost corners (floor to
+# ceiling 0.1135 instead of 0.1048 at 500 patches), at 1e-5 five triangles collapsed.
+cornell_obj() { # cornell_obj SCALE > FILE
+    awk -v s="$1" '
+    function v(x, y, z) { printf "v %.9g %.9g %.9g\n", x * s, y * s, z * s }
+    function quad(name, a, b, c, d, e, f, g, h, i, j, k, l) {
+        printf "o %s\n", name; v(a, b, c); v(d, e, f); v(g, h, i); v(j, k, l); n += 4
+        printf "f %d %d %d %d\n", n - 3, n - 2, n - 1, n }
+    BEGIN {
+        quad("floor", 0.5528, 0, 0, 0, 0, 0, 0, 0, 0.5592, 0.5496, 0, 0.5592)
+        quad("ceiling", 0.556, 0.5488, 0, 0.556, 0.5488, 0.5592, 0, 0.5488, 0.5592, 0, 0.5488, 0)
+        quad("back", 0.5496, 0, 0.5592, 0, 0, 0.5592, 0, 0.5488, 0.5592, 0.556, 0.5488, 0.5592)
+        quad("green", 0, 0, 0.5592, 0, 0, 0, 0, 0.5488, 0, 0, 0.5488, 0.5592)
+        quad("red", 0.5528, 0, 0, 0.5496, 0, 0.5592, 0.556, 0.5488, 0.5592, 0.556, 0.5488, 0)
+        quad("light", 0.343, 0.5487, 0.227, 0.343, 0.5487, 0.332, 0.213, 0.5487, 0.332, 0.213, 0.5487, 0.227)
+        quad("block", 0.13, 0.165, 0.065, 0.082, 0.165, 0.225, 0.24, 0.165, 0.272, 0.29, 0.165, 0.114)
+    }'
+}
+cornell_obj 1 > "$TMP/box1.obj"
+cornell_obj 3e-5 > "$TMP/box3e-5.obj"
+cornell_obj 1e-5 > "$TMP/box1e-5.obj"
+if "$RAD" formfactors "$TMP/box1.obj" --patches 500 > "$TMP/ff1.txt" 2> "$TMP/err1.txt" &&
+    "$RAD" formfactors "$TMP/box3e-5.obj" --patches 500 > "$TMP/ff3.txt" 2> "$TMP/err3.txt" &&
+    "$RAD" formfactors "$TMP/box1e-5.obj" --patches 500 > "$TMP/ff5.txt" 2> "$TMP/err5.txt"; then
+    f1=$(pair "$TMP/ff1.txt" floor ceiling) f3=$(pair "$TMP/ff3.txt" floor ceiling) f5=$(pair "$TMP/ff5.txt" floor ceiling)
+    close "$f3" "$f1" 1e-3 && ok "formfactors of the box scaled 3e-5 = unscaled ($f3, $f1)" ||
+        fail "formfactors of the box scaled 3e-5 = unscaled" "floor-ceiling $f3, unscaled $f1"
+    t1=$(grep -o '[0-9]* triangles' "$TMP/err1.txt") t5=$(grep -o '[0-9]* triangles' "$TMP/err5.txt")
+    [ -n "$t1" ] && [ "$t1" = "$t5" ] && ! grep -q "degenerate" "$TMP/err5.txt" && close "$f5" "$f1" 1e-3 &&
+        ok "the box scaled 1e-5 keeps all its triangles ($t5) and its form factors" ||
+        fail "the box scaled 1e-5 keeps all its triangles" "'$t5' vs '$t1', floor-ceiling $f5: $(grep degenerate "$TMP/err5.txt")"
+else
+    fail "formfactors of the scaled box" "$(head -c 300 "$TMP/err3.txt" "$TMP/err5.txt")"
+fi
+
+# Emission Ke that is negative, NaN, infinite (1e39 overflows a float) or above 1e30 became 0
+# without a word: now exit 1 naming the material and the value
+cat > "$TMP/ke.obj" <<'EOF'
+mtllib ke.mtl
+o a
+usemtl lamp
+v 0 0 0
+v 1 0 0
+v 1 1 0
+f 1 2 3
+o b
+v 0 0 1
+v 1 1 1
+v 1 0 1
+f 4 5 6
+EOF
+for ke in "1e31 1e31 1e31" "-1 0 0" "nan nan nan" "1e39 1 1"; do
+    printf 'newmtl lamp\nKd 0.5 0.5 0.5\nKe %s\n' "$ke" > "$TMP/ke.mtl"
+    "$RAD" formfactors "$TMP/ke.obj" --patches 4 > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "material .* 'lamp': emission .* is out of range" "$TMP/err.txt" &&
+        ok "Ke $ke is refused naming the material" || fail "Ke $ke is refused naming the material" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+printf 'newmtl lamp\nKd 0.5 0.5 0.5\nKe 17 12 4\n' > "$TMP/ke.mtl"
+"$RAD" formfactors "$TMP/ke.obj" --patches 4 > /dev/null 2> "$TMP/err.txt" && ok "Ke 17 12 4 is accepted" ||
+    fail "Ke 17 12 4 is accepted" "$(head -c 200 "$TMP/err.txt")"
+# a glTF whose second triangle has an index past its 4 vertices (0 1 2, 0 2 4): assimp drops
+# the face with a log warning only; the tool fails with the reason. The buffer: 4 float3
+# positions (the unit square in z = 0), then 6 uint32 indices.
+gltf() { # gltf BASE64 > FILE
+    printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "name": "n"}],
+ "meshes": [{"name": "m", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+ "buffers": [{"byteLength": 72, "uri": "data:application/octet-stream;base64,%s"}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+  {"bufferView": 1, "componentType": 5125, "count": 6, "type": "SCALAR"}]}\n' "$1"
+}
+B64=AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAEAAAACAAAAAAAAAAIAAAA
+gltf "${B64}DAAAA" > "$TMP/good.gltf"
+gltf "${B64}EAAAA" > "$TMP/oor.gltf"
+"$RAD" formfactors "$TMP/good.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt" && grep -q "2 triangles" "$TMP/err.txt" &&
+    ok "a glTF with an embedded buffer loads (2 triangles)" || fail "a glTF with an embedded buffer loads" "$(head -c 200 "$TMP/err.txt")"
+"$RAD" formfactors "$TMP/oor.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "oor.gltf' is broken: .*out-of-range indices" "$TMP/err.txt" &&
+    ok "a glTF with an out-of-range index fails with the reason" ||
+    fail "a glTF with an out-of-range index fails with the reason" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+
+# compare: NaN and infinite pixels were clamped away and compared as fine (exit 0)
+printf 'PF\n2 1\n-1.0\n' > "$TMP/finite.pfm"
+printf '\000\000\000\077%.0s' 1 2 3 4 5 6 >> "$TMP/finite.pfm"
+printf 'PF\n2 1\n-1.0\n' > "$TMP/nan.pfm"
+printf '\000\000\300\177\000\000\000\077\000\000\000\077\000\000\200\177\000\000\000\077\000\000\000\077' >> "$TMP/nan.pfm"
+"$RAD" compare "$TMP/finite.pfm" "$TMP/finite.pfm" > /dev/null 2> "$TMP/err.txt" && ok "compare of finite images exits 0" ||
+    fail "compare of finite images exits 0" "$(head -c 200 "$TMP/err.txt")"
+"$RAD" compare "$TMP/finite.pfm" "$TMP/nan.pfm" > "$TMP/out.txt" 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "B '.*nan.pfm' has 1 NaN and 1 infinite values" "$TMP/err.txt" && grep -q "^nonfinite B: 1 NaN, 1 inf" "$TMP/out.txt" &&
+    ok "compare reports NaN and infinite pixels and exits 1" || fail "compare reports NaN and infinite pixels and exits 1" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+# --size: an image beyond 2 GiB is refused with the bytes (32768x32768 allocated 12 GiB silently)
+for c in render trace; do
+    timeout 120 "$RAD" $c cornell --size 32768x32768 -o "$TMP/huge.pfm" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 2 ] && grep -q "needs 12884901888 bytes (12.0 GiB) for the image, more than the limit of 2147483648 bytes" "$TMP/err.txt" &&
+        ok "$c --size 32768x32768 is refused with the bytes" || fail "$c --size 32768x32768 is refused with the bytes" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+done
+
 # ---- what tools/report.sh relies on: the timing line and compare --png ------------------------
 for meth in classic multibounce temporal; do
     if "$RAD" render cornell --method $meth --patches 100 --size 8x8 --aa 1 --pixel-light-samples 1 --threads 1 \

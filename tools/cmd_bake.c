@@ -206,7 +206,6 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     rad_tool_bake_info info;
     uint32_t count, i, k = 0, n = c->patches->count;
     rad_result r;
-    FILE *f;
     int rc = 1;
     rad_tool_context(&ctx, NULL);
     if ((r = rad_save_memory(c->patches, &c->ff->matrix, c->E, c->B, &ctx, &buf, &size)) != RAD_SUCCESS)
@@ -244,13 +243,8 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
         rad_tool_fail(cmd, "rad_container_write", r);
         goto done;
     }
-    f = fopen(path, "wb");
-    if (!f) {
-        fprintf(stderr, "rad %s: cannot write '%s'\n", cmd, path);
-        goto done;
-    }
-    if (fwrite(dst, 1, dst_size, f) != dst_size || fclose(f) != 0) {
-        fprintf(stderr, "rad %s: error writing '%s'\n", cmd, path);
+    if (rad_tool_write_file(path, dst, dst_size) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
         goto done;
     }
     printf("wrote %s: %u patches, %u sections, %lu bytes\n", path, n, k, (unsigned long)dst_size);
@@ -263,21 +257,11 @@ done:
     return rc;
 }
 
-/* the bytes to 'path'; 0 or 1 (message printed) */
+/* the bytes to 'path' (a temporary renamed into place); 0 or 1 (message printed) */
 static int write_bytes(const char *cmd, const char *path, const void *data, size_t size)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f) {
-        fprintf(stderr, "rad %s: cannot write '%s'\n", cmd, path);
-        return 1;
-    }
-    if (fwrite(data, 1, size, f) != size) {
-        fclose(f);
-        fprintf(stderr, "rad %s: error writing '%s'\n", cmd, path);
-        return 1;
-    }
-    if (fclose(f) != 0) {
-        fprintf(stderr, "rad %s: error writing '%s'\n", cmd, path);
+    if (rad_tool_write_file(path, data, size) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
         return 1;
     }
     return 0;
@@ -296,7 +280,7 @@ static void bake_usage(FILE *f)
                "  --method M         classic (default), multibounce or temporal\n"
                "%s"
                "%s"
-               "  --threads N        worker threads (default: all)\n",
+               "  --threads N        worker threads (default: all cores; at most 1024)\n",
             rad_tool_classic_help(), rad_tool_method_help(0));
 }
 
@@ -327,7 +311,7 @@ int rad_cmd_bake(int argc, char **argv)
         }
         if (!strcmp(opt, "-o")) out_path = argv[++a];
         else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
+            if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad bake --help)\n", cmd, opt);
             return 2;
@@ -340,6 +324,7 @@ int rad_cmd_bake(int argc, char **argv)
         return 2;
     }
     if (rad_tool_method_check(cmd, 0, &mo, &o)) return 2;
+    if (rad_tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
     if (mo.method != RAD_TOOL_CLASSIC) {

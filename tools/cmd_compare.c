@@ -4,12 +4,42 @@
 
    A and B are PFM (linear) or PNG (8-bit sRGB, decoded to linear). The metrics are those of
    REFERENCE.md §6 on LINEAR values clamped to [0,1] (peak L = 1); SSIM per R, G, B channel,
-   averaged. Exit status: 0 compared, 1 unreadable images or different sizes, 2 usage. */
+   averaged. Exit status: 0 compared, 1 unreadable images, different sizes or an image with
+   NaN or infinite values (the metrics clamp them away, so they are counted and reported:
+   an all-NaN render compared as equal to a black one), 2 usage. */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* how many values of img are NaN / infinite; the first such pixel in *first (-1: none) */
+static void count_nonfinite(const rad_image *img, size_t *nan, size_t *inf, long *first)
+{
+    size_t k, n = (size_t)img->width * (size_t)img->height * 3u;
+    *nan = *inf = 0;
+    *first = -1;
+    for (k = 0; k < n; ++k) {
+        float v = img->rgb[k];
+        if (v != v) ++*nan;
+        else if (v - v != 0.0f) ++*inf;
+        else continue;
+        if (*first < 0) *first = (long)(k / 3u);
+    }
+}
+
+/* prints one line when img has NaN or infinite values; returns 1 then */
+static int report_nonfinite(const char *name, const char *path, const rad_image *img)
+{
+    size_t nan, inf;
+    long first;
+    count_nonfinite(img, &nan, &inf, &first);
+    if (!nan && !inf) return 0;
+    fprintf(stderr, "rad compare: %s '%s' has %lu NaN and %lu infinite values (first at pixel x=%ld, y=%ld): the metrics below clamp them and mean nothing\n",
+            name, path, (unsigned long)nan, (unsigned long)inf, first % img->width, first / img->width);
+    printf("nonfinite %s: %lu NaN, %lu inf\n", name, (unsigned long)nan, (unsigned long)inf);
+    return 1;
+}
 
 static void compare_usage(FILE *f)
 {
@@ -20,7 +50,9 @@ static void compare_usage(FILE *f)
                "  --png FILE    also write A as an 8-bit sRGB PNG (exposure --exposure X, default 1): one\n"
                "                render gives both the .pfm the metrics need and a picture (tools/report.sh)\n"
                "  prints MSE, PSNR (peak 1) and SSIM (11x11 Gaussian window, sigma 1.5, per channel,\n"
-               "  averaged), all on linear values clamped to [0,1]\n");
+               "  averaged), all on linear values clamped to [0,1]\n"
+               "  exit 1 when an image holds NaN or infinite values (counted on stderr and in a\n"
+               "  'nonfinite' line), or the images cannot be read or differ in size\n");
 }
 
 int rad_cmd_compare(int argc, char **argv)
@@ -30,7 +62,7 @@ int rad_cmd_compare(int argc, char **argv)
     rad_image a = { 0, 0, NULL }, b = { 0, 0, NULL };
     char err[512];
     double mse, psnr, ssim;
-    int i;
+    int i, bad;
     for (i = 0; i < argc; ++i) {
         const char *s = argv[i];
         if (!strcmp(s, "-h") || !strcmp(s, "--help")) {
@@ -89,6 +121,14 @@ int rad_cmd_compare(int argc, char **argv)
         compare_usage(stderr);
         return 2;
     }
+    {
+        const char *inputs[2];
+        inputs[0] = pa;
+        inputs[1] = pb;
+        if ((diff && rad_tool_check_output("compare", diff, inputs, 2)) ||
+            (png && rad_tool_check_output("compare", png, inputs, 2)))
+            return 1;
+    }
     if (rad_image_read(pa, &a, err, sizeof(err)) != 0) {
         fprintf(stderr, "rad compare: %s\n", err);
         return 1;
@@ -105,6 +145,8 @@ int rad_cmd_compare(int argc, char **argv)
         rad_image_free(&b);
         return 1;
     }
+    bad = report_nonfinite("A", pa, &a);
+    bad |= report_nonfinite("B", pb, &b);
     mse = rad_image_mse(&a, &b);
     psnr = rad_image_psnr(&a, &b);
     ssim = rad_image_ssim(&a, &b);
@@ -132,8 +174,15 @@ int rad_cmd_compare(int argc, char **argv)
             }
             scale = top > 0.0 ? (float)top : 1.0f;
         }
-        if (rad_image_diff_heatmap(&a, &b, scale, &heat) != 0 || rad_image_write(diff, &heat, 1.0f) != 0) {
-            fprintf(stderr, "rad compare: cannot write the difference image '%s'\n", diff);
+        if (rad_image_diff_heatmap(&a, &b, scale, &heat) != 0) {
+            fprintf(stderr, "rad compare: out of memory for the difference image '%s'\n", diff);
+            rad_image_free(&heat);
+            rad_image_free(&a);
+            rad_image_free(&b);
+            return 1;
+        }
+        if (rad_image_write(diff, &heat, 1.0f) != 0) {
+            fprintf(stderr, "rad compare: the difference image: %s\n", rad_tool_output_error());
             rad_image_free(&heat);
             rad_image_free(&a);
             rad_image_free(&b);
@@ -144,7 +193,7 @@ int rad_cmd_compare(int argc, char **argv)
     }
     if (png) {
         if (rad_image_write_png(png, &a, exposure) != 0) {
-            fprintf(stderr, "rad compare: cannot write '%s'\n", png);
+            fprintf(stderr, "rad compare: %s\n", rad_tool_output_error());
             rad_image_free(&a);
             rad_image_free(&b);
             return 1;
@@ -153,5 +202,5 @@ int rad_cmd_compare(int argc, char **argv)
     }
     rad_image_free(&a);
     rad_image_free(&b);
-    return 0;
+    return bad ? 1 : 0;
 }

@@ -122,7 +122,12 @@ int rad_cmd_info(int argc, char **argv)
     int a;
     for (a = 0; a < argc; ++a) {
         if (!strcmp(argv[a], "--help") || !strcmp(argv[a], "-h")) { info_usage(stdout); return 0; }
-        if (!strcmp(argv[a], "--threads") && a + 1 < argc) { ++a; continue; }
+        if (!strcmp(argv[a], "--threads") && a + 1 < argc) {
+            uint32_t t;
+            if (rad_tool_parse_threads(cmd, argv[a], argv[a + 1], &t)) return 2;
+            ++a;
+            continue;
+        }
         if (argv[a][0] == '-' && argv[a][1]) { fprintf(stderr, "rad %s: unknown option '%s'\n", cmd, argv[a]); return 2; }
         if (path) { fprintf(stderr, "rad %s: more than one file given\n", cmd); return 2; }
         path = argv[a];

@@ -63,7 +63,7 @@ static void render_usage(FILE *f)
             "                     'rad bake' from this scene instead of computing it here\n"
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
             "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
-            "  --size WxH         image size (default 512x512)\n"
+            "  --size WxH         image size (default 512x512; at most 2 GiB of image: 12 bytes a pixel)\n"
             "  --aa N             radiosity methods: stratified samples per pixel, rounded down to a square (default 16)\n"
             "  --spp N            pathtrace: samples per pixel (default 64)\n"
             "  --seed S           pathtrace: random seed (default 0)\n"
@@ -76,7 +76,7 @@ static void render_usage(FILE *f)
             "patch and classic solution options (ignored with --bake, which keeps its own):\n"
             "%s"
             "%s"
-            "  --threads N        worker threads (default: all)\n",
+            "  --threads N        worker threads (default: all cores; at most 1024)\n",
             rad_tool_classic_help(), rad_tool_method_help(1));
 }
 
@@ -401,7 +401,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
             if (rc == 0) rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
             if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, &frame);
             if (rc == 0 && rad_image_write_png(path, &frame, exposure) != 0) {
-                fprintf(stderr, "rad %s: cannot write '%s' (does the directory exist?)\n", cmd, path);
+                fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
                 rc = 1;
             }
             rad_image_free(&frame);
@@ -425,7 +425,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         char path[4096];
         snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
         if (rad_image_write_png(path, img, exposure) != 0) {
-            fprintf(stderr, "rad %s: cannot write '%s' (does the directory exist?)\n", cmd, path);
+            fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
             rc = 1;
         }
     }
@@ -762,6 +762,7 @@ int rad_cmd_render(int argc, char **argv)
                 fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, argv[a]);
                 return 2;
             }
+            if (rad_tool_check_size(cmd, width, height)) return 2;
         } else if (!strcmp(opt, "--aa")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
             if (aa == 0) { fprintf(stderr, "rad %s: --aa must be > 0\n", cmd); return 2; }
@@ -777,7 +778,7 @@ int rad_cmd_render(int argc, char **argv)
         } else if (!strcmp(opt, "--shading")) {
             if (rad_tool_parse_shading(cmd, argv[++a], &render_shading)) return 2;
         } else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &threads)) return 2;
+            if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad render --help)\n", cmd, opt);
             return 2;
@@ -812,6 +813,12 @@ int rad_cmd_render(int argc, char **argv)
             fprintf(stderr, "rad %s: output '%s' must end in .png or .pfm\n", cmd, out_path);
             return 2;
         }
+    }
+    {
+        const char *inputs[2];
+        inputs[0] = scene_name;
+        inputs[1] = bake_path;
+        if (rad_tool_check_output(cmd, out_path, inputs, 2)) return 1;
     }
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
@@ -932,7 +939,7 @@ int rad_cmd_render(int argc, char **argv)
         }
     }
     if (rad_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad %s: cannot write '%s'\n", cmd, out_path);
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
         rad_image_free(&img);
         rad_tool_close_world(&w);
         return 1;

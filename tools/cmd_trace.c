@@ -18,12 +18,12 @@ static void trace_usage(FILE *f)
                "  path-traced reference image (diffuse, next-event estimation + MIS); linear radiance\n"
                "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
                "  --fov DEG          vertical field of view (default: the scene's, else 45)\n"
-               "  --size WxH         image size (default 256x256)\n"
+               "  --size WxH         image size (default 256x256; at most 2 GiB of image: 12 bytes a pixel)\n"
                "  --spp N            samples per pixel (default 64)\n"
                "  --seed S           random seed (default 0); same seed, same image on any thread count\n"
                "  --max-depth N      path length cap (default 64)\n"
                "  --rr-depth N       Russian roulette from this bounce on (default 16)\n"
-               "  --threads N        worker threads (default: all)\n"
+               "  --threads N        worker threads (default: all cores; at most 1024)\n"
                "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
                "  -o FILE            .pfm (linear float radiance) or .png (8-bit sRGB)\n");
 }
@@ -101,6 +101,7 @@ int rad_cmd_trace(int argc, char **argv)
                 fprintf(stderr, "rad trace: --size wants WxH, got '%s'\n", next);
                 return 2;
             }
+            if (rad_tool_check_size("trace", opt.width, opt.height)) return 2;
         } else if (!strcmp(a, "--spp")) {
             if (parse_int(next, 1, 1L << 24, &v) != 0) {
                 fprintf(stderr, "rad trace: --spp wants a positive integer, got '%s'\n", next);
@@ -126,10 +127,9 @@ int rad_cmd_trace(int argc, char **argv)
             }
             opt.rr_depth = (int)v;
         } else if (!strcmp(a, "--threads")) {
-            if (parse_int(next, 0, 4096, &threads) != 0) {
-                fprintf(stderr, "rad trace: --threads wants an integer >= 0, got '%s'\n", next);
-                return 2;
-            }
+            uint32_t t = 0;
+            if (rad_tool_parse_threads("trace", a, next, &t)) return 2;
+            threads = (long)t;
         } else if (!strcmp(a, "--exposure")) {
             char *end;
             exposure = strtof(next, &end);
@@ -155,6 +155,7 @@ int rad_cmd_trace(int argc, char **argv)
             return 2;
         }
     }
+    if (rad_tool_check_output("trace", out_path, &scene_path, 1)) return 1;
     rad_tool_set_threads((int)threads);
 
     memset(&ts, 0, sizeof(ts));
@@ -181,12 +182,12 @@ int rad_cmd_trace(int argc, char **argv)
     ctx.progress = rad_tool_progress;
     r = rad_scene_create(&ts.desc, &ctx, &scene);
     if (r != RAD_SUCCESS) {
-        fprintf(stderr, "rad trace: %s: %s\n", scene_path, rad_result_string(r));
+        fprintf(stderr, "rad trace: %s: rad_scene_create failed: %s\n", scene_path, rad_result_string(r));
         goto done;
     }
     r = rad_bvh_create(scene, &ctx, &bvh);
     if (r != RAD_SUCCESS) {
-        fprintf(stderr, "rad trace: BVH: %s\n", rad_result_string(r));
+        fprintf(stderr, "rad trace: building the BVH failed: %s\n", rad_result_string(r));
         goto done;
     }
     rad_bvh_raycaster(bvh, &rc);
@@ -206,13 +207,13 @@ int rad_cmd_trace(int argc, char **argv)
     r = (rad_result)rad_trace_image(scene, &rc, ts.lights, ts.light_count, &cam, &opt, &ctx, &img);
     t1 = trace_now();
     if (r != RAD_SUCCESS) {
-        fprintf(stderr, "rad trace: %s\n", rad_result_string(r));
+        fprintf(stderr, "rad trace: path tracing failed: %s\n", rad_result_string(r));
         goto done;
     }
     fprintf(stderr, "rad trace: %.2f s (%.3g samples/s)\n", t1 - t0,
             (double)opt.width * (double)opt.height * (double)opt.spp / (t1 - t0 > 0.0 ? t1 - t0 : 1e-9));
     if (rad_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad trace: cannot write '%s'\n", out_path);
+        fprintf(stderr, "rad trace: %s\n", rad_tool_output_error());
         goto done;
     }
     fprintf(stderr, "rad trace: wrote %s\n", out_path);

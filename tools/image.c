@@ -4,13 +4,28 @@
    PFM (Portable Float Map): a text header "PF\n<width> <height>\n<scale>\n" followed by
    width*height*3 binary floats, little-endian when scale < 0 (what we write: -1.0), rows stored
    BOTTOM row first. rad_image keeps the top row first, so rows are flipped on the way in and
-   out. "Pf" (greyscale) files are read too and replicated to RGB. */
+   out. "Pf" (greyscale) files are read too and replicated to RGB.
+
+   Every file the tool writes goes through rad_tool_output_open/commit below: the bytes go to a
+   temporary file in the destination's folder, which is renamed onto the destination only when
+   every write, the flush and the close succeeded, so a failed write leaves the old file as it
+   was (issue 23). */
+#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 200809L /* mkstemp, fchmod, fsync */
+#endif
 #include "tool.h"
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
 #include <ctype.h>
+
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/stat.h>
+#include <unistd.h>
+#define RAD_TOOL_POSIX 1
+#endif
 
 #if defined(__GNUC__)
 #pragma GCC diagnostic push
@@ -33,6 +48,211 @@
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
+
+/* ---- safe output ---------------------------------------------------------------------- */
+
+static char g_output_error[1024];
+
+const char *rad_tool_output_error(void)
+{
+    return g_output_error[0] ? g_output_error : "unknown error";
+}
+
+static void output_error(const char *path, const char *what, int errnum)
+{
+    if (errnum) snprintf(g_output_error, sizeof g_output_error, "%s '%s': %s", what, path, strerror(errnum));
+    else snprintf(g_output_error, sizeof g_output_error, "%s '%s'", what, path);
+}
+
+/* the folder part of path ("." when none) into buf */
+static void output_folder(const char *path, char *buf, size_t cap)
+{
+    const char *slash = strrchr(path, '/');
+    size_t n;
+    if (!slash) {
+        snprintf(buf, cap, ".");
+        return;
+    }
+    n = (size_t)(slash - path);
+    if (n == 0) n = 1; /* "/x" */
+    if (n >= cap) n = cap - 1;
+    memcpy(buf, path, n);
+    buf[n] = '\0';
+}
+
+int rad_tool_output_open(rad_tool_output *o, const char *path)
+{
+    size_t n;
+    memset(o, 0, sizeof *o);
+    g_output_error[0] = '\0';
+    if (!path || !*path) {
+        output_error("", "no output file given:", 0);
+        return -1;
+    }
+    n = strlen(path);
+    if (path[n - 1] == '/') {
+        output_error(path, "cannot write", EISDIR);
+        return -1;
+    }
+    o->path = (char *)malloc(n + 1);
+    o->tmp = (char *)malloc(n + 32);
+    if (!o->path || !o->tmp) {
+        free(o->path), free(o->tmp);
+        memset(o, 0, sizeof *o);
+        output_error(path, "cannot write", ENOMEM);
+        return -1;
+    }
+    memcpy(o->path, path, n + 1);
+#ifdef RAD_TOOL_POSIX
+    {
+        /* "DIR/.NAME.tmpXXXXXX": same folder, so the rename cannot cross file systems */
+        const char *slash = strrchr(path, '/');
+        size_t dl = slash ? (size_t)(slash - path + 1) : 0;
+        int fd;
+        mode_t mask;
+        struct stat st;
+        if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+            output_error(path, "cannot write", EISDIR);
+            rad_tool_output_abort(o);
+            return -1;
+        }
+        memcpy(o->tmp, path, dl);
+        snprintf(o->tmp + dl, n + 32 - dl, ".%s.tmpXXXXXX", path + dl);
+        fd = mkstemp(o->tmp);
+        if (fd < 0) {
+            char folder[4096];
+            int e = errno;
+            output_folder(path, folder, sizeof folder);
+            snprintf(g_output_error, sizeof g_output_error, "cannot write '%.400s': cannot create a file in '%.400s': %s", path,
+                     folder, strerror(e));
+            o->tmp[0] = '\0';
+            rad_tool_output_abort(o);
+            return -1;
+        }
+        /* mkstemp makes the file 0600: give it the old file's mode, or the one a plain fopen
+           would (0666 & ~umask) */
+        if (stat(path, &st) == 0) {
+            (void)fchmod(fd, st.st_mode & 07777);
+        } else {
+            mask = umask(0);
+            umask(mask);
+            (void)fchmod(fd, (mode_t)(0666 & ~mask));
+        }
+        o->f = fdopen(fd, "wb");
+        if (!o->f) {
+            int e = errno;
+            close(fd);
+            output_error(path, "cannot write", e);
+            rad_tool_output_abort(o);
+            return -1;
+        }
+    }
+#else
+    snprintf(o->tmp, n + 32, "%s.tmp", path);
+    o->f = fopen(o->tmp, "wb");
+    if (!o->f) {
+        output_error(o->tmp, "cannot create", errno);
+        o->tmp[0] = '\0';
+        rad_tool_output_abort(o);
+        return -1;
+    }
+#endif
+    return 0;
+}
+
+void rad_tool_output_abort(rad_tool_output *o)
+{
+    if (o->f) fclose(o->f);
+    if (o->tmp && o->tmp[0]) remove(o->tmp);
+    free(o->tmp);
+    free(o->path);
+    memset(o, 0, sizeof *o);
+}
+
+int rad_tool_output_commit(rad_tool_output *o, int ok)
+{
+    int e = 0;
+    if (!o->f) {
+        rad_tool_output_abort(o);
+        return -1;
+    }
+    if (!ok || ferror(o->f)) {
+        if (!g_output_error[0]) output_error(o->path, "error writing", EIO);
+        rad_tool_output_abort(o);
+        return -1;
+    }
+    if (fflush(o->f) != 0) e = errno ? errno : EIO;
+#ifdef RAD_TOOL_POSIX
+    if (!e && fsync(fileno(o->f)) != 0 && errno != EINVAL && errno != EROFS) e = errno; /* the bytes are on disk before the rename */
+#endif
+    if (fclose(o->f) != 0 && !e) e = errno ? errno : EIO;
+    o->f = NULL;
+    if (e) {
+        output_error(o->path, "error writing", e);
+        rad_tool_output_abort(o);
+        return -1;
+    }
+#ifndef RAD_TOOL_POSIX
+    remove(o->path); /* rename does not replace a file on every system */
+#endif
+    if (rename(o->tmp, o->path) != 0) {
+        output_error(o->path, "cannot replace", errno);
+        rad_tool_output_abort(o);
+        return -1;
+    }
+    o->tmp[0] = '\0'; /* it is the destination now */
+    rad_tool_output_abort(o);
+    return 0;
+}
+
+int rad_tool_write_file(const char *path, const void *data, size_t size)
+{
+    rad_tool_output o;
+    int ok;
+    if (rad_tool_output_open(&o, path) != 0) return -1;
+    ok = fwrite(data, 1, size, o.f) == size;
+    if (!ok) output_error(path, "error writing", errno ? errno : EIO);
+    return rad_tool_output_commit(&o, ok);
+}
+
+int rad_tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count)
+{
+#ifdef RAD_TOOL_POSIX
+    struct stat so, si;
+    char folder[4096];
+    int i;
+    if (!path || !*path) return 0;
+    if (stat(path, &so) == 0) {
+        if (S_ISDIR(so.st_mode)) {
+            fprintf(stderr, "rad %s: the output '%s' is a directory\n", cmd, path);
+            return 1;
+        }
+        for (i = 0; i < input_count; ++i)
+            if (inputs[i] && stat(inputs[i], &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino) {
+                fprintf(stderr, "rad %s: the output '%s' is the input '%s': refusing to overwrite it\n", cmd, path,
+                        inputs[i]);
+                return 1;
+            }
+    }
+    output_folder(path, folder, sizeof folder);
+    if (stat(folder, &si) != 0 || !S_ISDIR(si.st_mode)) {
+        fprintf(stderr, "rad %s: cannot write '%s': the folder '%s' does not exist\n", cmd, path, folder);
+        return 1;
+    }
+    if (access(folder, W_OK | X_OK) != 0) {
+        fprintf(stderr, "rad %s: cannot write '%s': folder '%s': %s\n", cmd, path, folder, strerror(errno));
+        return 1;
+    }
+#else
+    int i;
+    for (i = 0; i < input_count; ++i)
+        if (inputs[i] && path && !strcmp(inputs[i], path)) {
+            fprintf(stderr, "rad %s: the output '%s' is the input: refusing to overwrite it\n", cmd, path);
+            return 1;
+        }
+#endif
+    return 0;
+}
 
 int rad_image_alloc(rad_image *img, int width, int height)
 {
@@ -78,14 +298,17 @@ static void rad__swap4(unsigned char *p)
 
 int rad_image_write_pfm(const char *path, const rad_image *img)
 {
-    FILE *f;
+    rad_tool_output o;
     int y, ok = 1;
     size_t row = 0;
     unsigned char *buf = NULL;
-    if (!path || !img || !img->rgb || img->width <= 0 || img->height <= 0) return -1;
-    f = fopen(path, "wb");
-    if (!f) return -1;
-    if (fprintf(f, "PF\n%d %d\n-1.0\n", img->width, img->height) < 0) ok = 0;
+    g_output_error[0] = '\0';
+    if (!path || !img || !img->rgb || img->width <= 0 || img->height <= 0) {
+        output_error(path ? path : "", "no image to write to", 0);
+        return -1;
+    }
+    if (rad_tool_output_open(&o, path) != 0) return -1;
+    if (fprintf(o.f, "PF\n%d %d\n-1.0\n", img->width, img->height) < 0) ok = 0;
     row = (size_t)img->width * 3u * sizeof(float);
     if (ok && !rad__host_little_endian()) {
         buf = (unsigned char *)malloc(row);
@@ -97,14 +320,14 @@ int rad_image_write_pfm(const char *path, const rad_image *img)
             size_t k;
             memcpy(buf, src, row);
             for (k = 0; k < row; k += 4) rad__swap4(buf + k);
-            if (fwrite(buf, 1, row, f) != row) ok = 0;
-        } else if (fwrite(src, 1, row, f) != row) {
+            if (fwrite(buf, 1, row, o.f) != row) ok = 0;
+        } else if (fwrite(src, 1, row, o.f) != row) {
             ok = 0;
         }
     }
+    if (!ok) output_error(path, "error writing", errno ? errno : EIO);
     free(buf);
-    if (fclose(f) != 0) ok = 0;
-    return ok ? 0 : -1;
+    return rad_tool_output_commit(&o, ok);
 }
 
 /* reads one whitespace-separated header token (skipping '#' comments); 0 on success */
@@ -163,6 +386,13 @@ int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errle
         return -1;
     }
     swap = (scale < 0.0) != rad__host_little_endian();
+    if ((double)w * (double)h * 3.0 * sizeof(float) > RAD_TOOL_MAX_IMAGE_BYTES) {
+        if (err)
+            snprintf(err, errlen, "%s: a %dx%d image needs %.0f bytes, more than the limit of %.0f", path, w, h,
+                     (double)w * (double)h * 3.0 * sizeof(float), RAD_TOOL_MAX_IMAGE_BYTES);
+        fclose(f);
+        return -1;
+    }
     if (rad_image_alloc(img, w, h) != 0) {
         if (err) snprintf(err, errlen, "%s: %dx%d image: out of memory", path, w, h);
         fclose(f);
@@ -222,19 +452,58 @@ unsigned char rad_image_srgb8(float linear)
     return (unsigned char)(rad__srgb_encode((double)linear) * 255.0 + 0.5);
 }
 
+/* stb_image_write's sink: every chunk to the temporary file, failures remembered */
+typedef struct png_sink {
+    FILE *f;
+    int ok;
+    int errnum;
+} png_sink;
+
+static void png_sink_write(void *user, void *data, int size)
+{
+    png_sink *s = (png_sink *)user;
+    if (!s->ok || size <= 0) return;
+    if (fwrite(data, 1, (size_t)size, s->f) != (size_t)size) {
+        s->ok = 0;
+        s->errnum = errno ? errno : EIO;
+    }
+}
+
 int rad_image_write_png(const char *path, const rad_image *img, float exposure)
 {
     unsigned char *px;
     size_t i, n;
-    int ok;
-    if (!path || !img || !img->rgb || img->width <= 0 || img->height <= 0) return -1;
+    rad_tool_output o;
+    png_sink sink;
+    g_output_error[0] = '\0';
+    if (!path || !img || !img->rgb || img->width <= 0 || img->height <= 0) {
+        output_error(path ? path : "", "no image to write to", 0);
+        return -1;
+    }
     n = (size_t)img->width * (size_t)img->height * 3u;
     px = (unsigned char *)malloc(n);
-    if (!px) return -1;
+    if (!px) {
+        output_error(path, "cannot write", ENOMEM);
+        return -1;
+    }
     for (i = 0; i < n; ++i) px[i] = rad_image_srgb8(img->rgb[i] * exposure);
-    ok = stbi_write_png(path, img->width, img->height, 3, px, img->width * 3);
+    if (rad_tool_output_open(&o, path) != 0) {
+        free(px);
+        return -1;
+    }
+    /* stbi_write_png ignores fwrite's result (a full disk gave "wrote x.png", exit 0 and a
+       truncated file): encode through the callback, which checks every write */
+    sink.f = o.f;
+    sink.ok = 1;
+    sink.errnum = 0;
+    if (!stbi_write_png_to_func(png_sink_write, &sink, img->width, img->height, 3, px, img->width * 3)) {
+        if (sink.ok) output_error(path, "cannot encode the PNG", ENOMEM);
+        sink.ok = 0;
+    } else if (!sink.ok) {
+        output_error(path, "error writing", sink.errnum);
+    }
     free(px);
-    return ok ? 0 : -1;
+    return rad_tool_output_commit(&o, sink.ok);
 }
 
 int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen)
@@ -274,10 +543,12 @@ static int rad__has_ext(const char *path, const char *ext)
 
 int rad_image_write(const char *path, const rad_image *img, float exposure)
 {
+    g_output_error[0] = '\0';
     if (!path) return -1;
     /* PFM holds the radiance itself: exposure applies to the 8-bit PNG only */
     if (rad__has_ext(path, ".pfm")) return rad_image_write_pfm(path, img);
     if (rad__has_ext(path, ".png")) return rad_image_write_png(path, img, exposure);
+    output_error(path, "cannot write (want a .png or .pfm name)", 0);
     return -1;
 }
 

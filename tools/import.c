@@ -1,7 +1,8 @@
 /* import.c - scenes for the rad tool: the built-in Cornell box, or any file assimp reads
    (OBJ+MTL, glTF 2.0, FBX, PLY ...).
 
-   Geometry: assimp triangulates and joins identical vertices; the node graph is walked here
+   Geometry: assimp triangulates; vertices are welded here with a tolerance relative to each
+   mesh's size (weld_mesh; assimp's own weld is absolute and broke small scenes); the node graph is walked here
    (instead of aiProcess_PreTransformVertices, which merges meshes of the same material and so
    loses object names), every mesh's vertices are transformed by its node's accumulated
    matrix, and meshes are grouped by name (the mesh's own name, else its node's name) into one
@@ -117,7 +118,7 @@ static void *xrealloc(void *p, size_t size)
 {
     void *q = realloc(p, size ? size : 1);
     if (!q) {
-        fprintf(stderr, "rad: out of memory\n");
+        fprintf(stderr, "rad: out of memory importing the scene (%lu bytes)\n", (unsigned long)size);
         exit(1);
     }
     return q;
@@ -240,8 +241,13 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
 
 /* ---- materials --------------------------------------------------------------------------- */
 
-static void convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
-                             rad_material *out, int *warned_clamp)
+/* The largest emission (radiance) accepted: what the tool's other inputs allow (1e30). */
+#define EMISSION_MAX 1e30f
+
+/* 0, or 1 with the reason in err (a negative, NaN, infinite or overflowing emission: it used
+   to become 0 without a word) */
+static int convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
+                            uint32_t index, rad_material *out, int *warned_clamp, char *err, size_t errlen)
 {
     struct aiColor4D c;
     struct aiString name, tpath;
@@ -257,14 +263,32 @@ static void convert_material(imp_storage *st, const struct aiScene *sc, const ch
     }
     if (!have_base && aiGetMaterialColor(m, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS)
         out->albedo[0] = c.r, out->albedo[1] = c.g, out->albedo[2] = c.b;
+    if (aiGetMaterialString(m, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS) name.length = 0, name.data[0] = 0;
     if (aiGetMaterialColor(m, AI_MATKEY_COLOR_EMISSIVE, &c) == aiReturn_SUCCESS)
         out->emission[0] = c.r, out->emission[1] = c.g, out->emission[2] = c.b;
-    if (aiGetMaterialFloatArray(m, AI_MATKEY_EMISSIVE_INTENSITY, &fv, &one) == aiReturn_SUCCESS && fv >= 0) strength = (float)fv;
-    for (k = 0; k < 3; ++k) {
-        out->emission[k] *= strength;
-        if (!(out->emission[k] >= 0.0f) || out->emission[k] > 1e30f) out->emission[k] = 0.0f;
+    if (aiGetMaterialFloatArray(m, AI_MATKEY_EMISSIVE_INTENSITY, &fv, &one) == aiReturn_SUCCESS) {
+        if (!(fv >= 0 && fv <= EMISSION_MAX)) {
+            if (err && errlen)
+                snprintf(err, errlen, "'%s': material %u '%s': emissive strength %g is out of range (want a finite value in [0, %g])",
+                         file, index, name.data, (double)fv, (double)EMISSION_MAX);
+            return 1;
+        }
+        strength = (float)fv;
     }
-    if (aiGetMaterialString(m, AI_MATKEY_NAME, &name) != aiReturn_SUCCESS) name.length = 0, name.data[0] = 0;
+    for (k = 0; k < 3; ++k) {
+        float e = out->emission[k], es = e * strength;
+        /* e * strength: an overflow to inf is caught like an inf in the file */
+        if (!(e >= 0.0f && e <= EMISSION_MAX) || !(es >= 0.0f && es <= EMISSION_MAX)) {
+            if (err && errlen)
+                snprintf(err, errlen,
+                         "'%s': material %u '%s': emission (Ke, or emissive x strength) %g %g %g is out of range "
+                         "(want finite values in [0, %g])",
+                         file, index, name.data, (double)(out->emission[0] * strength), (double)(out->emission[1] * strength),
+                         (double)(out->emission[2] * strength), (double)EMISSION_MAX);
+            return 1;
+        }
+    }
+    for (k = 0; k < 3; ++k) out->emission[k] *= strength;
     /* texture: base colour (glTF) or diffuse (OBJ map_Kd ...) */
     if (aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
         aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) {
@@ -307,6 +331,178 @@ static void convert_material(imp_storage *st, const struct aiScene *sc, const ch
                 name.data, (double)ALBEDO_MAX);
         *warned_clamp = 1;
     }
+    return 0;
+}
+
+/* ---- assimp's log ------------------------------------------------------------------------- */
+
+/* assimp reports what it repaired or dropped only to its logger: a glTF with an out-of-range
+   index lost a triangle with exit 0 (issue 23). While a file is imported its warnings and
+   errors are shown (at most LOG_SHOWN), and one saying faces were dropped for out-of-range
+   indices fails the import with that reason. */
+#define LOG_SHOWN 10
+static struct {
+    unsigned shown, more;
+    char fatal[512];
+} g_log;
+
+static void assimp_log(const char *message, char *user)
+{
+    const char *text = message;
+    size_t n;
+    int warn = !strncmp(message, "Warn", 4), error = !strncmp(message, "Error", 5);
+    (void)user;
+    if (!warn && !error) return; /* Info, Debug */
+    if (strstr(message, ": ")) text = strstr(message, ": ") + 2; /* "Warn,  T0: text" */
+    n = strlen(text);
+    while (n && (text[n - 1] == '\n' || text[n - 1] == '\r')) --n;
+    if (!g_log.fatal[0] && (strstr(text, "out-of-range") || strstr(text, "out of range")) &&
+        (strstr(text, "dropped") || strstr(text, "ignored") || strstr(text, "skipp") || strstr(text, "remov"))) {
+        snprintf(g_log.fatal, sizeof g_log.fatal, "%.*s", (int)(n < 400 ? n : 400), text);
+        return;
+    }
+    if (g_log.shown < LOG_SHOWN) {
+        fprintf(stderr, "rad: warning: assimp: %.*s\n", (int)n, text);
+        ++g_log.shown;
+    } else {
+        ++g_log.more;
+    }
+}
+
+static const struct aiScene *import_logged(const char *path, unsigned flags)
+{
+    const struct aiScene *sc;
+    struct aiLogStream stream;
+    memset(&g_log, 0, sizeof g_log);
+    stream.callback = assimp_log;
+    stream.user = NULL;
+    aiEnableVerboseLogging(AI_FALSE);
+    aiAttachLogStream(&stream);
+    sc = aiImportFile(path, flags);
+    aiDetachAllLogStreams();
+    if (g_log.more) fprintf(stderr, "rad: warning: assimp: %u more warnings\n", g_log.more);
+    return sc;
+}
+
+/* ---- vertex welding ------------------------------------------------------------------------ */
+
+/* assimp's aiProcess_JoinIdenticalVertices joins vertices closer than an absolute 1e-5: a
+   Cornell box scaled by 3e-5 lost corners (the floor-to-ceiling form factor moved by 8%) and
+   at 1e-5 whole triangles collapsed (issue 23). The tool welds here instead, within each assimp
+   mesh (like assimp), with a tolerance relative to that mesh's size: positions within
+   WELD_REL x its bounding-box diagonal, and uvs and normals within assimp's 1e-5 (they do not
+   scale with the scene), make one vertex. So the result does not depend on the scene's units. */
+#define WELD_REL 1e-6
+#define WELD_ATTR_EPS 1e-5
+
+typedef struct weld_table {
+    int64_t *cell;       /* 3 per kept vertex: its grid cell */
+    uint32_t *next;      /* the next kept vertex in the same cell (UINT32_MAX: none) */
+    uint32_t *slot;      /* hash table of cells: the first kept vertex of the cell (UINT32_MAX: empty) */
+    uint32_t mask;
+} weld_table;
+
+static uint32_t weld_hash(const int64_t c[3])
+{
+    uint64_t h = (uint64_t)c[0] * 0x9E3779B97F4A7C15ull ^ (uint64_t)c[1] * 0xC2B2AE3D27D4EB4Full ^
+                 (uint64_t)c[2] * 0x165667B19E3779F9ull;
+    return (uint32_t)(h ^ (h >> 29));
+}
+
+/* the slot of cell c: the one holding it, or the empty one where it goes */
+static uint32_t weld_find(const weld_table *t, const int64_t c[3])
+{
+    uint32_t i = weld_hash(c) & t->mask;
+    for (;;) {
+        uint32_t r = t->slot[i];
+        if (r == UINT32_MAX) return i;
+        if (t->cell[3 * (size_t)r] == c[0] && t->cell[3 * (size_t)r + 1] == c[1] && t->cell[3 * (size_t)r + 2] == c[2])
+            return i;
+        i = (i + 1) & t->mask;
+    }
+}
+
+static int weld_same(const struct aiMesh *m, uint32_t a, uint32_t b, double tol)
+{
+    const struct aiVector3D *p = m->mVertices;
+    double dx = (double)p[a].x - p[b].x, dy = (double)p[a].y - p[b].y, dz = (double)p[a].z - p[b].z;
+    if (!(dx * dx + dy * dy + dz * dz <= tol * tol)) return 0;
+    if (m->mTextureCoords[0]) {
+        const struct aiVector3D *t = m->mTextureCoords[0];
+        if (!(fabs((double)t[a].x - t[b].x) <= WELD_ATTR_EPS && fabs((double)t[a].y - t[b].y) <= WELD_ATTR_EPS)) return 0;
+    }
+    if (m->mNormals) {
+        const struct aiVector3D *n = m->mNormals;
+        dx = (double)n[a].x - n[b].x, dy = (double)n[a].y - n[b].y, dz = (double)n[a].z - n[b].z;
+        if (!(dx * dx + dy * dy + dz * dz <= WELD_ATTR_EPS * WELD_ATTR_EPS)) return 0;
+    }
+    return 1;
+}
+
+/* remap[v]: the kept vertex v becomes (kept vertices are numbered in order of first use);
+   returns how many are kept */
+static uint32_t weld_mesh(const struct aiMesh *m, uint32_t *remap, uint32_t *kept_of)
+{
+    uint32_t n = m->mNumVertices, v, kept = 0, cap = 16;
+    double bmin[3] = {0, 0, 0}, bmax[3] = {0, 0, 0}, diag = 0.0, tol, cell;
+    int k, any = 0;
+    weld_table t;
+    for (v = 0; v < n; ++v) {
+        double q[3];
+        q[0] = m->mVertices[v].x, q[1] = m->mVertices[v].y, q[2] = m->mVertices[v].z;
+        if (!(fabs(q[0]) <= 3.4e38 && fabs(q[1]) <= 3.4e38 && fabs(q[2]) <= 3.4e38)) continue; /* NaN, inf */
+        for (k = 0; k < 3; ++k) {
+            if (!any || q[k] < bmin[k]) bmin[k] = q[k];
+            if (!any || q[k] > bmax[k]) bmax[k] = q[k];
+        }
+        any = 1;
+    }
+    for (k = 0; k < 3; ++k) diag += (bmax[k] - bmin[k]) * (bmax[k] - bmin[k]);
+    diag = sqrt(diag);
+    tol = WELD_REL * diag;
+    cell = tol > 0.0 ? tol : 1.0; /* all at one point: exact matches only */
+    while (cap < 2 * (uint64_t)n && cap < 0x80000000u) cap *= 2;
+    t.cell = (int64_t *)xrealloc(NULL, sizeof(int64_t) * 3 * (n ? n : 1));
+    t.next = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * (n ? n : 1));
+    t.slot = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * cap);
+    t.mask = cap - 1;
+    memset(t.slot, 0xFF, sizeof(uint32_t) * cap);
+    for (v = 0; v < n; ++v) {
+        double q[3];
+        int64_t c[3], d[3];
+        int dx, dy, dz, found = 0;
+        uint32_t s;
+        q[0] = m->mVertices[v].x, q[1] = m->mVertices[v].y, q[2] = m->mVertices[v].z;
+        if (!(fabs(q[0]) <= 3.4e38 && fabs(q[1]) <= 3.4e38 && fabs(q[2]) <= 3.4e38)) {
+            kept_of[kept] = v; /* not welded: rad_scene_create names it */
+            remap[v] = kept++;
+            continue;
+        }
+        for (k = 0; k < 3; ++k) c[k] = (int64_t)floor((q[k] - bmin[k]) / cell);
+        for (dx = -1; dx <= 1 && !found; ++dx)
+            for (dy = -1; dy <= 1 && !found; ++dy)
+                for (dz = -1; dz <= 1 && !found; ++dz) {
+                    uint32_t r;
+                    d[0] = c[0] + dx, d[1] = c[1] + dy, d[2] = c[2] + dz;
+                    for (r = t.slot[weld_find(&t, d)]; r != UINT32_MAX; r = t.next[r])
+                        if (weld_same(m, kept_of[r], v, tol)) {
+                            remap[v] = r;
+                            found = 1;
+                            break;
+                        }
+                }
+        if (found) continue;
+        kept_of[kept] = v;
+        memcpy(t.cell + 3 * (size_t)kept, c, sizeof c);
+        s = weld_find(&t, c);
+        t.next[kept] = t.slot[s]; /* UINT32_MAX for a new cell */
+        t.slot[s] = kept;
+        remap[v] = kept++;
+    }
+    free(t.cell);
+    free(t.next);
+    free(t.slot);
+    return kept;
 }
 
 /* ---- geometry ---------------------------------------------------------------------------- */
@@ -359,6 +555,7 @@ typedef struct walk_state {
     rad_tool_scene *out;
     int camera_done;
     unsigned unnamed;
+    uint32_t bad_indices;  /* faces with an index past the mesh's vertices (dropped) */
 } walk_state;
 
 static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiNode *node, const struct aiMatrix4x4 *m)
@@ -366,7 +563,7 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
     char fallback[32];
     const char *name = mesh->mName.length ? mesh->mName.data : node->mName.length ? node->mName.data : NULL;
     imp_group *g;
-    uint32_t base, f, v, tri = 0;
+    uint32_t base, f, v, k, kept, tri = 0, *remap, *kept_of;
     float det;
     if (!name) {
         snprintf(fallback, sizeof fallback, "mesh%u", ws->unnamed++);
@@ -375,25 +572,29 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
     if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return;
     g = group_for(ws->st, name);
     if ((uint64_t)g->vertex_count + mesh->mNumVertices > 0xFFFFFFF0u) return;
+    remap = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * (mesh->mNumVertices ? mesh->mNumVertices : 1));
+    kept_of = (uint32_t *)xrealloc(NULL, sizeof(uint32_t) * (mesh->mNumVertices ? mesh->mNumVertices : 1));
+    kept = weld_mesh(mesh, remap, kept_of);
     base = g->vertex_count;
-    if (g->vertex_count + mesh->mNumVertices > g->vertex_cap) {
-        while (g->vertex_count + mesh->mNumVertices > g->vertex_cap) g->vertex_cap = g->vertex_cap ? 2 * g->vertex_cap : 256;
+    if (g->vertex_count + kept > g->vertex_cap) {
+        while (g->vertex_count + kept > g->vertex_cap) g->vertex_cap = g->vertex_cap ? 2 * g->vertex_cap : 256;
         g->positions = (float *)xrealloc(g->positions, sizeof(float) * 3 * g->vertex_cap);
         g->uvs = (float *)xrealloc(g->uvs, sizeof(float) * 2 * g->vertex_cap);
     }
-    for (v = 0; v < mesh->mNumVertices; ++v) {
+    for (k = 0; k < kept; ++k) {
         float p[3];
+        v = kept_of[k];
         p[0] = mesh->mVertices[v].x, p[1] = mesh->mVertices[v].y, p[2] = mesh->mVertices[v].z;
-        xform_point(m, p, g->positions + 3 * (size_t)(base + v));
+        xform_point(m, p, g->positions + 3 * (size_t)(base + k));
         if (mesh->mTextureCoords[0]) {
-            g->uvs[2 * (size_t)(base + v)] = mesh->mTextureCoords[0][v].x;
-            g->uvs[2 * (size_t)(base + v) + 1] = mesh->mTextureCoords[0][v].y;
+            g->uvs[2 * (size_t)(base + k)] = mesh->mTextureCoords[0][v].x;
+            g->uvs[2 * (size_t)(base + k) + 1] = mesh->mTextureCoords[0][v].y;
         } else {
-            g->uvs[2 * (size_t)(base + v)] = g->uvs[2 * (size_t)(base + v) + 1] = 0.0f;
+            g->uvs[2 * (size_t)(base + k)] = g->uvs[2 * (size_t)(base + k) + 1] = 0.0f;
         }
     }
     if (mesh->mTextureCoords[0]) g->any_uv = 1;
-    g->vertex_count += mesh->mNumVertices;
+    g->vertex_count += kept;
     /* a mirroring transform flips the winding */
     det = m->a1 * (m->b2 * m->c3 - m->b3 * m->c2) - m->a2 * (m->b1 * m->c3 - m->b3 * m->c1) +
           m->a3 * (m->b1 * m->c2 - m->b2 * m->c1);
@@ -409,11 +610,18 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
         uint32_t *ix;
         if (face->mNumIndices != 3) continue;
         ix = g->indices + 3 * (size_t)g->triangle_count;
-        ix[0] = base + face->mIndices[0];
-        ix[1] = base + (det < 0 ? face->mIndices[2] : face->mIndices[1]);
-        ix[2] = base + (det < 0 ? face->mIndices[1] : face->mIndices[2]);
+        if (face->mIndices[0] >= mesh->mNumVertices || face->mIndices[1] >= mesh->mNumVertices ||
+            face->mIndices[2] >= mesh->mNumVertices) {
+            ++ws->bad_indices; /* assimp checks; counted should one slip through */
+            continue;
+        }
+        ix[0] = base + remap[face->mIndices[0]];
+        ix[1] = base + remap[det < 0 ? face->mIndices[2] : face->mIndices[1]];
+        ix[2] = base + remap[det < 0 ? face->mIndices[1] : face->mIndices[2]];
         g->material_ids[g->triangle_count++] = mesh->mMaterialIndex;
     }
+    free(remap);
+    free(kept_of);
 }
 
 static void walk(walk_state *ws, const struct aiNode *node, const struct aiMatrix4x4 *parent)
@@ -517,9 +725,14 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
         out->storage = st;
         return 0;
     }
-    sc = aiImportFile(path_or_name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    sc = import_logged(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
     if (!sc) {
         set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
+        return 1;
+    }
+    if (g_log.fatal[0]) {
+        set_err(err, errlen, "'%s' is broken: assimp: %s", path_or_name, g_log.fatal);
+        aiReleaseImport(sc);
         return 1;
     }
     if (!sc->mRootNode || sc->mNumMeshes == 0) {
@@ -538,8 +751,13 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
     for (i = 0; i < st->material_count; ++i) {
-        if (i < sc->mNumMaterials) convert_material(st, sc, path_or_name, sc->mMaterials[i], &st->materials[i], &warned);
-        else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
+        if (i < sc->mNumMaterials) {
+            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &warned, err, errlen)) {
+                aiReleaseImport(sc);
+                rad_tool_free_scene(out);
+                return 1;
+            }
+        } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
     }
     /* geometry, lights, camera */
     memset(&id, 0, sizeof id);
@@ -550,6 +768,13 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     ws.out = out;
     walk(&ws, sc->mRootNode, &id);
     aiReleaseImport(sc);
+    if (ws.bad_indices) {
+        char n[32];
+        snprintf(n, sizeof n, "%u", ws.bad_indices);
+        set_err(err, errlen, "'%s' is broken: %s faces have an index past their mesh's vertices", path_or_name, n);
+        rad_tool_free_scene(out);
+        return 1;
+    }
     st->meshes = (rad_mesh_desc *)xrealloc(NULL, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
     memset(st->meshes, 0, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
     for (i = 0; i < st->group_count; ++i) {

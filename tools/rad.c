@@ -107,6 +107,7 @@ void rad_tool_context(rad_context *ctx, const char *label)
 void rad_tool_set_threads(int threads)
 {
 #ifdef _OPENMP
+    if (threads > (int)RAD_TOOL_MAX_THREADS) threads = (int)RAD_TOOL_MAX_THREADS; /* the parsers refuse more */
     if (threads > 0) omp_set_num_threads(threads);
 #else
     (void)threads;
@@ -117,7 +118,7 @@ void *rad_tool_calloc(size_t n, size_t size)
 {
     void *p = calloc(n ? n : 1, size);
     if (!p) {
-        fprintf(stderr, "rad: out of memory\n");
+        fprintf(stderr, "rad: out of memory (%lu x %lu bytes)\n", (unsigned long)n, (unsigned long)size);
         exit(1);
     }
     return p;
@@ -142,6 +143,19 @@ int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint
 bad:
     fprintf(stderr, "rad %s: bad value '%s' for %s (want a whole number >= 0)\n", cmd, text ? text : "", opt);
     return 2;
+}
+
+int rad_tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out)
+{
+    uint32_t v = 0;
+    if (rad_tool_parse_uint(cmd, opt, text, &v)) return 2;
+    if (v > RAD_TOOL_MAX_THREADS) {
+        fprintf(stderr, "rad %s: %s %s is too many (at most %u; 0 means all cores)\n", cmd, opt, text,
+                RAD_TOOL_MAX_THREADS);
+        return 2;
+    }
+    *out = v;
+    return 0;
 }
 
 int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out)
@@ -207,6 +221,18 @@ int rad_tool_parse_size(const char *text, int *w, int *h)
     return 0;
 }
 
+int rad_tool_check_size(const char *cmd, int w, int h)
+{
+    double bytes = (double)w * (double)h * 3.0 * sizeof(float);
+    if (w <= 0 || h <= 0) return 2;
+    if (bytes > RAD_TOOL_MAX_IMAGE_BYTES) {
+        fprintf(stderr, "rad %s: --size %dx%d needs %.0f bytes (%.1f GiB) for the image, more than the limit of %.0f bytes (%.0f GiB)\n",
+                cmd, w, h, bytes, bytes / 1073741824.0, RAD_TOOL_MAX_IMAGE_BYTES, RAD_TOOL_MAX_IMAGE_BYTES / 1073741824.0);
+        return 2;
+    }
+    return 0;
+}
+
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w)
 {
     char err[1024];
@@ -256,7 +282,8 @@ static void usage(FILE *f)
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
                "  info FILE.radb           list what a bake holds and check it\n"
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
-               "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all).\n");
+               "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
+               "at most 1024).\n");
 }
 
 static void formfactors_usage(FILE *f)
@@ -267,7 +294,7 @@ static void formfactors_usage(FILE *f)
                "  --patches N   target patch count (default 2000)\n"
                "  --max-edge L  longest patch edge (default: no limit)\n"
                "  --samples S   points per patch pair (default 16, up to 256)\n"
-               "  --threads N   worker threads (default: all)\n");
+               "  --threads N   worker threads (default: all cores; at most 1024)\n");
 }
 
 /* ---- formfactors ----------------------------------------------------------------------- */
@@ -293,7 +320,7 @@ int rad_cmd_formfactors(int argc, char **argv)
         if (need && a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
         if (!strcmp(o, "--patches")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
         else if (!strcmp(o, "--samples")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
-        else if (!strcmp(o, "--threads")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &threads)) return 2; }
+        else if (!strcmp(o, "--threads")) { if (rad_tool_parse_threads(cmd, o, argv[++a], &threads)) return 2; }
         else if (!strcmp(o, "--max-edge")) { if (rad_tool_parse_float(cmd, o, argv[++a], &max_edge)) return 2; }
         else if (o[0] == '-' && o[1]) { fprintf(stderr, "rad %s: unknown option '%s'\n", cmd, o); return 2; }
         else if (!scene_name) scene_name = o;
@@ -313,7 +340,7 @@ int rad_cmd_formfactors(int argc, char **argv)
     }
     rad_form_factor_options_default(&fo);
     fo.samples = samples;
-    fprintf(stderr, "rad %s: %u patches\n", cmd, P->count);
+    fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w.scene->triangle_count, P->count);
     r = rad_form_factors_dense(P, &w.rc, &fo, &ctx, &ff);
     rad_tool_progress_end();
     if (r != RAD_SUCCESS) {

@@ -5,6 +5,7 @@
 #define RAD_TOOL_H
 #include "../radiosity.h"
 #include <stddef.h>
+#include <stdio.h>
 
 /* ---- scenes (import.c) ---------------------------------------------------------------- */
 
@@ -44,6 +45,31 @@ int rad_image_write_png(const char *path, const rad_image *img, float exposure);
 /* writes .pfm or .png by the path's extension */
 int rad_image_write(const char *path, const rad_image *img, float exposure);
 
+/* ---- output files (image.c): every file the tool writes ------------------------------- */
+/* A temporary file in the destination's folder, renamed onto it by rad_tool_output_commit
+   only when everything was written: a failure leaves the old file (if any) untouched and no
+   temporary behind. The image writers and the bake writers all use it. */
+typedef struct rad_tool_output {
+    FILE *f;        /* write here */
+    char *path;     /* the destination */
+    char *tmp;      /* the temporary */
+} rad_tool_output;
+/* 0, or -1 with the reason in rad_tool_output_error() */
+int rad_tool_output_open(rad_tool_output *o, const char *path);
+/* ok: 1 when every write succeeded. Flushes, syncs, closes and renames; on any failure
+   removes the temporary and returns -1 (reason in rad_tool_output_error()). */
+int rad_tool_output_commit(rad_tool_output *o, int ok);
+void rad_tool_output_abort(rad_tool_output *o); /* closes and removes the temporary */
+/* size bytes to path through the above; 0 or -1 */
+int rad_tool_write_file(const char *path, const void *data, size_t size);
+/* why the last output (or image write) failed, e.g. "cannot write 'x.png': cannot create a
+   file in 'dir': Permission denied" */
+const char *rad_tool_output_error(void);
+/* Before the work: refuses an output that is one of the inputs (the same file by st_dev and
+   st_ino, so another name or a link for it counts), is a directory, or whose folder is
+   missing or not writable. 0 when fine, else prints "rad CMD: ..." and returns 1. */
+int rad_tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count);
+
 /* ---- metrics (metrics.c): REFERENCE.md §6 on values clamped to [0,1] ----------------- */
 double rad_image_mse(const rad_image *a, const rad_image *b);
 double rad_image_psnr(const rad_image *a, const rad_image *b);  /* L = 1; +inf for equal images */
@@ -82,10 +108,22 @@ int rad_tool_progress(void *user, float fraction);
 void rad_tool_log(void *user, rad_log_level level, const char *message);
 /* --threads N (0: all): sets the OpenMP thread count when built with OpenMP */
 void rad_tool_set_threads(int threads);
+/* The most --threads accepts: libgomp crashes creating 100000 threads (issue 23), and more
+   threads than this helps no machine the tool runs on. */
+#define RAD_TOOL_MAX_THREADS 1024u
+/* --threads N: a whole number in 0..RAD_TOOL_MAX_THREADS; 0 on success, else prints
+   "rad CMD: ..." and returns 2 */
+int rad_tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out);
 /* parses "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ"; 0 on success */
 int rad_tool_parse_camera(const char *text, rad_camera *out);
 /* parses "WxH"; 0 on success */
 int rad_tool_parse_size(const char *text, int *w, int *h);
+/* The most memory an image may take (linear RGB floats, 12 bytes a pixel): 2 GiB, e.g.
+   16384x8192. --size 32768x32768 allocated 12 GiB without a word (issue 23). */
+#define RAD_TOOL_MAX_IMAGE_BYTES 2147483648.0
+/* --size: 0 when the image fits RAD_TOOL_MAX_IMAGE_BYTES, else prints "rad CMD: ..." with the
+   bytes and returns 2 */
+int rad_tool_check_size(const char *cmd, int w, int h);
 
 /* ---- added by trace-metrics ------------------------------------------------------------ */
 /* Reads .png (8-bit sRGB through stb_image, decoded to linear) or else PFM; 0 on success. */
