@@ -18,6 +18,7 @@ static const char *type_name(uint32_t type)
     case RAD_SECTION_FF_COLUMNS: return "FF_COLUMNS";
     case RAD_SECTION_FF_VALUES: return "FF_VALUES";
     case RAD_SECTION_VECTOR: return "VECTOR";
+    case RAD_SECTION_SIGNATURE: return "SIGNATURE";
     case RAD_SECTION_MB_INFO: return "MB_INFO";
     case RAD_SECTION_MB_FLOAT: return "MB_FLOAT";
     case RAD_SECTION_MB_HALF: return "MB_HALF";
