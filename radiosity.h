@@ -1041,7 +1041,8 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
    later step NaN, infinite or slow, so each loader (rad_load_memory, rad_multibounce_load,
    rad_multibounce_blocks_load, rad_alias_tables_view) checks the values it hands out, once,
    in O(size of the section): every float is finite (else RAD_ERROR_NON_FINITE) and of
-   magnitude at most RAD_BAKE_VALUE_MAX, and the quantities that are non-negative by
+   magnitude at most RAD_BAKE_VALUE_MAX (patch areas excepted: they grow with the square of
+   the scene's scale), patch emission is >= 0 (RAD_ERROR_NEGATIVE_EMISSION), and the quantities that are non-negative by
    definition (form factors, F_mb entries, block scales, outliers, alias totals) are >= 0
    (else RAD_ERROR_CORRUPT); the logger names the section, the entry and the value. */
 #define RAD_CONTAINER_VERSION 1u
@@ -6445,6 +6446,42 @@ static rad_result rad__check_values(const rad__ctx *c, const char *what, const f
     return RAD_SUCCESS; /* not reached */
 }
 
+static int rad__all_finite(const float *v, uint64_t n)
+{
+    uint64_t i;
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(v[i])) return 0;
+    return 1;
+}
+
+/* the float fields of a patch record: finite (NON_FINITE), of magnitude <= RAD_BAKE_VALUE_MAX
+   (CORRUPT) except the area (it grows with the square of the scene's scale, and rad_system
+   only divides areas by areas), emission >= 0 (NEGATIVE_EMISSION) */
+static rad_result rad__check_patch_values(const rad__ctx *c, const rad_patch *p, uint32_t i)
+{
+    float f[13];
+    uint32_t k;
+    memcpy(f, p->centroid, 3 * sizeof(float));
+    memcpy(f + 3, p->normal, 3 * sizeof(float));
+    f[6] = p->area;
+    memcpy(f + 7, p->albedo, 3 * sizeof(float));
+    memcpy(f + 10, p->emission, 3 * sizeof(float));
+    for (k = 0; k < 13; ++k)
+        if (!rad__all_finite(f + k, 1) || (k != 6 && (f[k] > RAD_BAKE_VALUE_MAX || f[k] < -RAD_BAKE_VALUE_MAX))) {
+            const int finite = rad__finite(f[k]);
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has %s %g (%s)", i,
+                     k < 3 ? "centroid" : k < 6 ? "normal" : k == 6 ? "area" : k < 10 ? "albedo" : "emission", (double)f[k],
+                     finite ? "beyond RAD_BAKE_VALUE_MAX = 1e30" : "not finite");
+            return finite ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE;
+        }
+    for (k = 10; k < 13; ++k)
+        if (f[k] < 0.0f) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has emission %g", i, (double)f[k]);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+    return RAD_SUCCESS;
+}
+
 /* ---- scene hashes and the signature ---- */
 
 RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash)
@@ -6578,6 +6615,8 @@ RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, co
                 : rad__check_values(&c, "sparse form factors (FF_VALUES)", F->values, F->row_offsets[F->rows], 1);
         if (r != RAD_SUCCESS) return r;
     }
+    for (t = 0; t < P->count; ++t)
+        if ((r = rad__check_patch_values(&c, &P->patches[t], t)) != RAD_SUCCESS) return r;
     if (E && (r = rad__check_values(&c, "vector 'E'", E, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
     if (B && (r = rad__check_values(&c, "vector 'B'", B, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
     memset(&sig, 0, sizeof(sig));
@@ -6644,14 +6683,6 @@ static rad_result rad__bake_section(const rad__ctx *c, const rad_container *ct, 
     return RAD_SUCCESS;
 }
 
-static int rad__all_finite(const float *v, uint64_t n)
-{
-    uint64_t i;
-    for (i = 0; i < n; ++i)
-        if (!rad__finite(v[i])) return 0;
-    return 1;
-}
-
 static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
 {
     const rad_section *sp, *sv, *st, *sd, *so, *sc, *sx, *se, *sb;
@@ -6673,10 +6704,7 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
     b->patches.vertex_count = (uint32_t)sv->count;
     b->patches.vertices = (float *)(uintptr_t)sv->data;
     b->patches.triangle_count = (uint32_t)T;
-    if (!rad__all_finite(b->patches.vertices, sv->count * 3u)) {
-        rad__log(c, RAD_LOG_ERROR, "baked data: a patch vertex is not finite");
-        return RAD_ERROR_NON_FINITE;
-    }
+    if ((r = rad__check_values(c, "patch vertices (PATCH_VERTICES)", b->patches.vertices, sv->count * 3u, 0)) != RAD_SUCCESS) return r;
     b->patches.first_patch = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
     b->patches.subdivision = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
     b->patches.areas = (float *)rad__alloc_array(&b->allocator, N, sizeof(float));
@@ -6704,11 +6732,7 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
             rad__log(c, RAD_LOG_ERROR, "baked data: patch %u lies on triangle %u of %llu", i, p->triangle, (unsigned long long)T);
             return RAD_ERROR_INDEX_OUT_OF_RANGE;
         }
-        if (!rad__finite3(p->centroid) || !rad__finite3(p->normal) || !rad__finite(p->area) || !rad__finite3(p->emission) ||
-            !rad__finite3(p->albedo)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has a non-finite field", i);
-            return RAD_ERROR_NON_FINITE;
-        }
+        if ((r = rad__check_patch_values(c, p, i)) != RAD_SUCCESS) return r;
         if (!(p->area > 0.0f)) {
             rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has area %g", i, (double)p->area);
             return RAD_ERROR_DEGENERATE_TRIANGLE;

@@ -442,6 +442,25 @@ static void ct_test_bad_values(void)
         ct_expect_value(buf, size, RAD_SECTION_VECTOR, "H", 7, RAD_BAKE_VALUE_MAX, RAD_SUCCESS, "", "");
         ct_expect_value(buf, size, RAD_SECTION_VECTOR, "E", 1, -3e38f, RAD_ERROR_CORRUPT, "vector 'E'", "-3e+38");
         ct_expect_value(buf, size, RAD_SECTION_VECTOR, "B", 2, qnan, RAD_ERROR_NON_FINITE, "vector 'B'", "nan");
+        ct_expect_value(buf, size, RAD_SECTION_PATCH_VERTICES, "vertices", 4, 3e38f, RAD_ERROR_CORRUPT, "PATCH_VERTICES", "3e+38");
+        {
+            /* patch 2's area and emission (rad_patch: area at byte 24, emission at 40) */
+            static const float bad[3] = { (float)INFINITY, -1.0f, 3e38f };
+            static const size_t at[3] = { 2 * sizeof(rad_patch) + 24, 2 * sizeof(rad_patch) + 40, 2 * sizeof(rad_patch) + 44 };
+            static const rad_result want[3] = { RAD_ERROR_NON_FINITE, RAD_ERROR_NEGATIVE_EMISSION, RAD_ERROR_CORRUPT };
+            int q;
+            for (q = 0; q < 3; ++q) {
+                unsigned char *copy = ct_poke(buf, size, RAD_SECTION_PATCHES, "patches", at[q], &bad[q], 4);
+                CHECK(copy != NULL);
+                if (!copy) continue;
+                ct_log_context(&ctx);
+                CHECK_RESULT(rad_load_memory(copy, size, &ctx, &b), want[q]);
+                CHECK(strstr(ct_log_last, "patch 2 ") != NULL && strstr(ct_log_last, q ? "emission" : "area") != NULL);
+                rad_bake_destroy(b);
+                b = NULL;
+                free(copy);
+            }
+        }
         free(buf);
     }
     /* a vector of the application's with the wrong length */
