@@ -183,6 +183,12 @@ int rad_cmd_info(int argc, char **argv)
         }
         printf("%s\n", any ? "" : " none");
     }
+    if (bake->signature)
+        printf("signature: geometry %016llx, materials %016llx, options %016llx\n",
+               (unsigned long long)bake->signature->geometry, (unsigned long long)bake->signature->materials,
+               (unsigned long long)bake->signature->options);
+    else
+        printf("signature: none (a bake of another scene with the same triangle count cannot be told apart)\n");
     {
         const rad_section *s = rad_container_find(ct, RAD_TOOL_SECTION_OPTIONS, "rad.options");
         if (s && s->elem_size == sizeof(rad_tool_bake_info) && s->count == 1) {
