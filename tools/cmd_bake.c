@@ -10,7 +10,8 @@
    H = F B = F (E + L) is the irradiance from the secondary sources that the renderer adds to
    its per-pixel direct light. The bake holds the patches, F, E and B (rad_save_memory), plus
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
-   were made with, so `rad render --bake` can check that the file fits the scene.
+   were made with, so `rad render --bake` can check that the file fits the scene (with the
+   library's signature section, which also holds the hash of rad.options: rad_tool_sign_options).
    --method multibounce and temporal bake through methods.c (rad_tool_method_bake). */
 #include "tool.h"
 #include <stdio.h>

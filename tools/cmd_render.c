@@ -338,10 +338,6 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
     if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info) : 0u, &ctx)) != RAD_SUCCESS) {
         fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)\n", cmd, bake_path, rad_result_string(r));
         rc = 1;
-    } else if (bake->patches.triangle_count != w->scene->triangle_count) {
-        fprintf(stderr, "rad %s: bake '%s' was made from a scene of %u triangles, this one has %u\n", cmd, bake_path,
-                bake->patches.triangle_count, w->scene->triangle_count);
-        rc = 1;
     } else if (info) {
         /* the same patch options on this scene must give the same patches */
         rad_patch_options po;

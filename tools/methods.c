@@ -688,7 +688,7 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
                 return 1;
             }
     }
-    if (mo->method == RAD_TOOL_TEMPORAL && (mi.k == 0 || mi.k > RAD_TEMPORAL_MAX_SAMPLES)) {
+    if (mo->method == RAD_TOOL_TEMPORAL && !(mo->given & RAD_TOOL_OPT_K) && (mi.k == 0 || mi.k > RAD_TEMPORAL_MAX_SAMPLES)) {
         fprintf(stderr, "rad %s: bake '%s': section rad.method has k = %u draws per row (1 to %u, as --k)\n", cmd, bake_name,
                 mi.k, RAD_TEMPORAL_MAX_SAMPLES);
         return 1;
