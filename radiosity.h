@@ -206,8 +206,15 @@
        byte order refuses it (RAD_ERROR_VERSION). Every size, offset, checksum and index is
        checked before use: a truncated file gives RAD_ERROR_TRUNCATED, a damaged one
        RAD_ERROR_CORRUPT, another version RAD_ERROR_VERSION, an index out of range
-       RAD_ERROR_INDEX_OUT_OF_RANGE; nothing is read outside the given bytes. Applications add
-       their own sections (types >= RAD_SECTION_USER) through rad_container_write.
+       RAD_ERROR_INDEX_OUT_OF_RANGE; nothing is read outside the given bytes. Behind a valid
+       checksum every value a loader hands out is checked once, at load: NaN or infinity gives
+       RAD_ERROR_NON_FINITE, a negative form factor, F_mb entry, scale or alias total, or a
+       magnitude beyond RAD_BAKE_VALUE_MAX (1e30), RAD_ERROR_CORRUPT. A signature section
+       records hashes of the scene's geometry and materials (rad_scene_hash) and of the
+       application's options; rad_bake_matches_scene refuses a bake of another scene
+       (RAD_ERROR_SCENE_MISMATCH, naming what differs). New section types never change the
+       container version: a bake without a signature still loads. Applications add their own
+       sections (types >= RAD_SECTION_USER) through rad_container_write.
 
   10. GLSL
        The GPU paths are GLSL 4.50 compute kernels embedded as text (SPEC §10): get one with
@@ -318,9 +325,11 @@ typedef enum rad_result {
     RAD_ERROR_SIZE_MISMATCH = -16,        /* arrays or matrices of incompatible sizes */
     RAD_ERROR_IO = -17,                   /* a file could not be opened, read or written */
     RAD_ERROR_TRUNCATED = -18,            /* baked data ends before its sections do */
-    RAD_ERROR_CORRUPT = -19,              /* bad magic, checksum, table or section layout */
+    RAD_ERROR_CORRUPT = -19,              /* bad magic, checksum, table or section layout, or a
+                                             stored value outside its range */
     RAD_ERROR_VERSION = -20,              /* baked data of an unsupported container version */
-    RAD_ERROR_SCALE_RANGE = -21           /* a scene larger or smaller than RAD_SCENE_MAX/MIN_SIZE */
+    RAD_ERROR_SCENE_MISMATCH = -21,       /* baked data made from another scene or other options */
+    RAD_ERROR_SCALE_RANGE = -22           /* a scene larger or smaller than RAD_SCENE_MAX/MIN_SIZE */
 } rad_result;
 
 /* A static English name and description of a result ("RAD_ERROR_NON_FINITE: ..."). */
@@ -1042,8 +1051,26 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
    flags, CRC-32 of the table, CRC-32 of the header), a table of 64-byte section entries (type, element size, element count,
    offset, byte size, CRC-32 of the data, a 24-byte name), and the section data, each section
    starting on a 64-byte boundary so the file can be memory-mapped and read in place.
-   Loading validates every size, offset, checksum and index before anything is used. */
+   Loading validates every size, offset, checksum and index before anything is used.
+   VERSIONING: RAD_CONTAINER_VERSION changes only when the header or the table entry layout
+   changes (a reader refuses another version with RAD_ERROR_VERSION). New section types are
+   added without a version change: readers look sections up by type and name and skip the
+   ones they do not know, so a file without a newer section (RAD_SECTION_SIGNATURE, added
+   in 0.1.0) still loads, and an older reader loads a newer file.
+   VALUES: behind a valid checksum a section may still hold values that would make every
+   later step NaN, infinite or slow, so each loader (rad_load_memory, rad_multibounce_load,
+   rad_multibounce_blocks_load, rad_alias_tables_view) checks the values it hands out, once,
+   in O(size of the section): every float is finite (else RAD_ERROR_NON_FINITE) and of
+   magnitude at most RAD_BAKE_VALUE_MAX (patch areas excepted: they grow with the square of
+   the scene's scale), patch emission is >= 0 (RAD_ERROR_NEGATIVE_EMISSION), and the quantities that are non-negative by
+   definition (form factors, F_mb entries, block scales, outliers, alias totals) are >= 0
+   (else RAD_ERROR_CORRUPT); the logger names the section, the entry and the value. */
 #define RAD_CONTAINER_VERSION 1u
+/* The largest magnitude a loader accepts in a float section: 1e30, so that a sum of up to
+   3e8 such values (more than any row holds) stays finite. Nothing physical comes near (form
+   factors are <= 1, F_mb entries <= 1 / (1 - max albedo) <= 2^24); rad_save_memory refuses
+   larger values in what it writes, so whatever it writes loads. */
+#define RAD_BAKE_VALUE_MAX 1e30f
 
 typedef enum rad_section_type {
     RAD_SECTION_PATCHES = 1,         /* rad_patch records */
@@ -1054,6 +1081,7 @@ typedef enum rad_section_type {
     RAD_SECTION_FF_COLUMNS = 6,      /* CSR: uint32 */
     RAD_SECTION_FF_VALUES = 7,       /* CSR: floats */
     RAD_SECTION_VECTOR = 8,          /* a named RGB vector, 3N floats ("E", "B", "L", "H", ...) */
+    RAD_SECTION_SIGNATURE = 9,       /* one rad_bake_signature ("signature"): what it was made from */
     RAD_SECTION_USER = 0x10000       /* types from here up are the application's own */
 } rad_section_type;
 
@@ -1084,6 +1112,34 @@ RAD_API const rad_section *rad_container_section(const rad_container *container,
 /* The first section of 'type' whose name equals 'name' (any name when name is NULL), or NULL. */
 RAD_API const rad_section *rad_container_find(const rad_container *container, uint32_t type, const char *name);
 
+/* What a bake was made from (section RAD_SECTION_SIGNATURE, one 32-byte element), so that a
+   bake of another scene with the same triangle and patch counts is refused instead of
+   rendering silently wrong (rad_bake_matches_scene). A field of 0 was not recorded. */
+typedef struct rad_bake_signature {
+    uint64_t geometry;       /* rad_scene_hash: the triangles' positions */
+    uint64_t materials;      /* rad_scene_hash: each triangle's albedo, emission, texture id, uvs */
+    uint64_t options;        /* the application's hash of the options it baked with (rad_hash64) */
+    uint64_t reserved;       /* 0; readers ignore it */
+} rad_bake_signature;
+
+/* FNV-1a, 64 bits, over 'size' bytes, continuing from 'hash' (RAD_HASH64_INIT to start):
+   for each byte, hash = (hash ^ byte) * 0x100000001B3. rad_hash64("a", 1, RAD_HASH64_INIT)
+   is 0xAF63DC4C8601EC8C. Pure, O(size). */
+#define RAD_HASH64_INIT 0xCBF29CE484222325ull
+RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash);
+/* The two hashes of a signature, stable across platforms, byte orders and builds (only the
+   scene's input values enter, as the little-endian bytes of their IEEE bit patterns, never
+   values the library derives from them):
+     geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats;
+     materials = rad_hash64 of triangle_count, then per triangle its material's albedo[3],
+                 emission[3] (floats) and texture (uint32), then 1 and the 6 uv floats per
+                 triangle when the scene has uvs, else 0.
+   Indices are covered (positions are per triangle), and the geometric normals and areas follow
+   from the positions; shading normals are not kept by rad_scene, and a texture's contents
+   (the albedo_lookup callback) cannot be hashed, only its id. Either output may be NULL.
+   Errors: INVALID_ARGUMENT. Cost: O(triangles), no allocation. Thread safety: pure. */
+RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials);
+
 /* A loaded bake: patches (usable with rad_patches_locate, rad_patches_vertex_values and
    rad_system_init; patches.scene is NULL, set it before calling functions that need the
    scene), the form-factor matrix (rows == 0 when the bake has none) and the named vectors.
@@ -1094,6 +1150,7 @@ typedef struct rad_bake {
     rad_matrix F;
     const float *E;          /* "E" vector or NULL */
     const float *B;          /* "B" vector (the solution as saved) or NULL */
+    const rad_bake_signature *signature; /* NULL when the bake has none (saved without a scene) */
     rad_container *container;
     void *owned;             /* private: bytes read from a file */
     rad_allocator allocator; /* private */
@@ -1101,15 +1158,31 @@ typedef struct rad_bake {
 
 /* Saves patches (required), a matrix (optional: NULL) and the vectors E and B (optional:
    NULL; 3 * patches->count floats) into a new buffer *out of *out_size bytes, allocated with
-   ctx's allocator (free it with rad_free_buffer). */
+   ctx's allocator (free it with rad_free_buffer). When patches->scene is set, a signature
+   section records its rad_scene_hash (options 0: an application that wants its options
+   checked too rewrites that section with its own hash in 'options'). Values that a loader
+   would refuse (see VALUES above) are refused here: NON_FINITE, CORRUPT. */
 RAD_API rad_result rad_save_memory(const rad_patches *patches, const rad_matrix *F, const float *E, const float *B,
                                    const rad_context *ctx, void **out, size_t *out_size);
 RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx);
 /* Opens a saved bake in place (data borrowed, must outlive the bake) and checks every index:
    patch vertices < vertex count, patch triangles < triangle count, CSR offsets monotone and
-   columns < N, vector and matrix sizes equal to the patch count. */
+   columns < N, vector and matrix sizes equal to the patch count; and every value (VALUES
+   above): the form factors and every RAD_SECTION_VECTOR section (E, B and the application's
+   "H", "L", ...: each must hold 3N floats). A signature section, when present, must be one
+   32-byte element. Errors: the container's, NON_FINITE, CORRUPT, INDEX_OUT_OF_RANGE,
+   SIZE_MISMATCH, ALBEDO_RANGE, DEGENERATE_TRIANGLE, OUT_OF_MEMORY. */
 RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out);
 RAD_API void rad_bake_destroy(rad_bake *bake);
+/* RAD_SUCCESS when 'bake' was made from 'scene': the same triangle count and, when the bake
+   has a signature, the same geometry and materials hashes (rad_scene_hash), and the same
+   options hash when both 'options' and the bake's are non-zero. Otherwise
+   RAD_ERROR_SCENE_MISMATCH, and the logger says what differs (geometry, materials, options)
+   with both hashes. A bake without a signature (saved without a scene) is checked by its
+   triangle count only, with a warning through the logger. Errors: INVALID_ARGUMENT,
+   SCENE_MISMATCH. Cost: O(triangles). */
+RAD_API rad_result rad_bake_matches_scene(const rad_bake *bake, const rad_scene *scene, uint64_t options,
+                                          const rad_context *ctx);
 #ifndef RAD_NO_STDIO
 /* The same, through a file. Saving writes '<path>.partial' in the same folder and renames it
    into place only when complete, so a failed save leaves the old file as it was (IO). Loading
@@ -1612,9 +1685,12 @@ RAD_API rad_result rad_multibounce_blocks_sections(const rad_multibounce_blocks 
 /* Opens the object called 'name' from an open container as a view: its arrays point into the
    container's bytes (which must outlive it); destroy it with the usual destroy call. Every
    size is checked against N, permutations must be bijections of [0, N), outlier offsets
-   monotone and columns < N, scales and values finite. Errors: CORRUPT (a missing or malformed
-   section, a bad permutation), INDEX_OUT_OF_RANGE (an outlier column >= N), OUT_OF_MEMORY,
-   INVALID_ARGUMENT. Cost: O(N^2 / 4 + outliers) to validate. */
+   monotone and columns < N; every value (F_mb entries, float or half, scales, outliers)
+   finite, >= 0 and at most RAD_BAKE_VALUE_MAX (>>api_container VALUES). Errors: CORRUPT (a
+   missing or malformed section, a bad permutation, a negative or too large value),
+   NON_FINITE (NaN or infinity; the logger names the section, entry and value),
+   INDEX_OUT_OF_RANGE (an outlier column >= N), OUT_OF_MEMORY, INVALID_ARGUMENT. Cost: O(N^2)
+   for the float and half planes, O(N^2 / 16 + outliers) for blocks, once. */
 RAD_API rad_result rad_multibounce_load(const rad_container *container, const char *name, const rad_context *ctx,
                                         rad_multibounce **out);
 RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, const char *name,
@@ -1980,10 +2056,12 @@ RAD_API uint32_t rad_alias_draw(const uint32_t *bins, uint32_t n, rad_alias_form
    (up to 23 characters; the three sections share it). Data borrowed from the tables. */
 RAD_API void rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section out[3]);
 
-/* A non-owning view of tables stored in a container under 'name', validated (offsets
-   monotone, bin counts >= 1, columns and aliases <= cols, totals finite and > 0). *out
+/* A non-owning view of tables stored in a container under 'name', validated once (offsets
+   monotone, bin counts in [1, N + 1], columns and aliases <= cols, totals > 0 and at most
+   RAD_BAKE_VALUE_MAX; the thresholds are probabilities in [0, 1] by their encoding). *out
    points into the container, which must outlive it; do not destroy a view.
-   Errors: INVALID_ARGUMENT (missing sections), CORRUPT (the logger says why). */
+   Errors: INVALID_ARGUMENT (missing sections), NON_FINITE (a NaN or infinite total),
+   CORRUPT (anything else; the logger says which row and value). Cost: O(rows + bins). */
 RAD_API rad_result rad_alias_tables_view(const rad_container *container, const char *name, const rad_context *ctx,
                                          rad_alias_tables *out);
 
@@ -1993,9 +2071,13 @@ typedef enum rad_temporal_mode {
     RAD_TEMPORAL_MULTIBOUNCE = 2 /* G = a channel of F_mb (albedo already inside): no rho */
 } rad_temporal_mode;
 
+/* The most draws per row and frame rad_temporal_create accepts: the step costs k N draws, and
+   beyond a few hundred the exact product (rad_matrix_multiply, N per row) is cheaper. */
+#define RAD_TEMPORAL_MAX_SAMPLES 65536u
+
 typedef struct rad_temporal_options {
     rad_temporal_mode mode;
-    uint32_t samples;      /* k draws per row and frame (default 10; >= 1) */
+    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES) */
     float weight;          /* fixed w in [0, 1) (default 0.998; 0 keeps no history) */
     uint32_t seed;         /* generator seed */
     int adaptive;          /* non-zero: per-row w from the estimator's variance (see below) */
@@ -2386,6 +2468,7 @@ RAD_API const char *rad_result_string(rad_result result)
     case RAD_ERROR_TRUNCATED: return "RAD_ERROR_TRUNCATED: the baked data is truncated";
     case RAD_ERROR_CORRUPT: return "RAD_ERROR_CORRUPT: the baked data is corrupted (checksum, table or layout)";
     case RAD_ERROR_VERSION: return "RAD_ERROR_VERSION: the baked data has an unsupported version";
+    case RAD_ERROR_SCENE_MISMATCH: return "RAD_ERROR_SCENE_MISMATCH: the baked data was made from another scene or other options";
     case RAD_ERROR_SCALE_RANGE: return "RAD_ERROR_SCALE_RANGE: the scene is larger or smaller than the library supports";
     }
     return "RAD_ERROR_UNKNOWN: not a rad_result value";
@@ -6224,6 +6307,7 @@ typedef char rad__check_shading_gpu_size[(sizeof(rad_shading_gpu) == 96) ? 1 : -
 /* ======================================================================================== */
 
 typedef char rad__check_patch_size[(sizeof(rad_patch) == 68) ? 1 : -1];
+typedef char rad__check_signature_size[(sizeof(rad_bake_signature) == 32) ? 1 : -1];
 
 #define RAD__HEADER_BYTES 64u
 #define RAD__ENTRY_BYTES 64u
@@ -6449,6 +6533,175 @@ static void rad__section(rad_section *s, uint32_t type, uint32_t elem_size, uint
     }
 }
 
+/* The value rule of every loader (>>api_container VALUES): n floats, each finite (else
+   NON_FINITE) and of magnitude <= RAD_BAKE_VALUE_MAX, and >= 0 when 'nonneg' (-0 passes)
+   (else CORRUPT). One branch-free pass on the bit patterns (NaN and infinity have larger
+   magnitude bits than any finite bound), then the first bad entry is found again for the
+   message, which names 'what', the entry and its value. */
+static rad_result rad__check_values(const rad__ctx *c, const char *what, const float *v, uint64_t n, int nonneg)
+{
+    const float vmax = RAD_BAKE_VALUE_MAX;
+    uint32_t maxbits, sign = nonneg ? 0x80000000u : 0u, bad = 0;
+    uint64_t i, j;
+    memcpy(&maxbits, &vmax, 4);
+    for (i = 0; i < n && !bad; i += 4096) {
+        uint64_t e = n - i < 4096 ? n : i + 4096;
+        for (j = i; j < e; ++j) {
+            uint32_t b;
+            memcpy(&b, v + j, 4);
+            bad |= (uint32_t)((b & 0x7FFFFFFFu) > maxbits) | (uint32_t)((b & sign) != 0 && b != sign);
+        }
+    }
+    if (!bad) return RAD_SUCCESS;
+    for (i = 0; i < n; ++i) {
+        const float x = v[i];
+        if (!rad__finite(x)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (not finite)", what, (unsigned long long)i, (double)x);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (x > vmax || x < -vmax || (nonneg && x < 0.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (%s)", what, (unsigned long long)i, (double)x,
+                     nonneg && x < 0.0f ? "negative" : "beyond RAD_BAKE_VALUE_MAX = 1e30");
+            return RAD_ERROR_CORRUPT;
+        }
+    }
+    return RAD_SUCCESS; /* not reached */
+}
+
+static int rad__all_finite(const float *v, uint64_t n)
+{
+    uint64_t i;
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(v[i])) return 0;
+    return 1;
+}
+
+/* the float fields of a patch record: finite (NON_FINITE), of magnitude <= RAD_BAKE_VALUE_MAX
+   (CORRUPT) except the area (it grows with the square of the scene's scale, and rad_system
+   only divides areas by areas), emission >= 0 (NEGATIVE_EMISSION) */
+static rad_result rad__check_patch_values(const rad__ctx *c, const rad_patch *p, uint32_t i)
+{
+    float f[13];
+    uint32_t k;
+    memcpy(f, p->centroid, 3 * sizeof(float));
+    memcpy(f + 3, p->normal, 3 * sizeof(float));
+    f[6] = p->area;
+    memcpy(f + 7, p->albedo, 3 * sizeof(float));
+    memcpy(f + 10, p->emission, 3 * sizeof(float));
+    for (k = 0; k < 13; ++k)
+        if (!rad__all_finite(f + k, 1) || (k != 6 && (f[k] > RAD_BAKE_VALUE_MAX || f[k] < -RAD_BAKE_VALUE_MAX))) {
+            const int finite = rad__finite(f[k]);
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has %s %g (%s)", i,
+                     k < 3 ? "centroid" : k < 6 ? "normal" : k == 6 ? "area" : k < 10 ? "albedo" : "emission", (double)f[k],
+                     finite ? "beyond RAD_BAKE_VALUE_MAX = 1e30" : "not finite");
+            return finite ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE;
+        }
+    for (k = 10; k < 13; ++k)
+        if (f[k] < 0.0f) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has emission %g", i, (double)f[k]);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+    return RAD_SUCCESS;
+}
+
+/* ---- scene hashes and the signature ---- */
+
+RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    size_t i;
+    if (!p) return hash;
+    for (i = 0; i < size; ++i) hash = (hash ^ p[i]) * 0x100000001B3ull;
+    return hash;
+}
+
+/* hash of n uint32 words (or float bit patterns) as little-endian bytes */
+static uint64_t rad__hash_words(uint64_t h, const void *words, size_t n)
+{
+    const unsigned char *p = (const unsigned char *)words;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        uint32_t w;
+        unsigned char b[4];
+        memcpy(&w, p + 4 * i, 4);
+        rad__put32(b, w);
+        h = rad_hash64(b, 4, h);
+    }
+    return h;
+}
+
+RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials)
+{
+    uint64_t g = RAD_HASH64_INIT, m = RAD_HASH64_INIT;
+    uint32_t t, flag;
+    if (out_geometry) *out_geometry = 0;
+    if (out_materials) *out_materials = 0;
+    if (!scene || !scene->positions || !scene->materials || !scene->materials_table) return RAD_ERROR_INVALID_ARGUMENT;
+    g = rad__hash_words(g, &scene->triangle_count, 1);
+    g = rad__hash_words(g, scene->positions, 9u * (size_t)scene->triangle_count);
+    m = rad__hash_words(m, &scene->triangle_count, 1);
+    for (t = 0; t < scene->triangle_count; ++t) {
+        const uint32_t mi = scene->materials[t];
+        if (mi >= scene->material_count) return RAD_ERROR_INVALID_ARGUMENT;
+        m = rad__hash_words(m, scene->materials_table[mi].albedo, 3);
+        m = rad__hash_words(m, scene->materials_table[mi].emission, 3);
+        m = rad__hash_words(m, &scene->materials_table[mi].texture, 1);
+    }
+    flag = scene->uvs ? 1u : 0u;
+    m = rad__hash_words(m, &flag, 1);
+    if (scene->uvs) m = rad__hash_words(m, scene->uvs, 6u * (size_t)scene->triangle_count);
+    if (out_geometry) *out_geometry = g;
+    if (out_materials) *out_materials = m;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_bake_matches_scene(const rad_bake *bake, const rad_scene *scene, uint64_t options, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_bake_signature *s;
+    uint64_t g = 0, m = 0;
+    int dg, dm, dopt;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!bake || !scene) return RAD_ERROR_INVALID_ARGUMENT;
+    if (bake->patches.triangle_count != scene->triangle_count) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data was made from another scene: the geometry differs (%u triangles in the bake, %u in the scene)",
+                 bake->patches.triangle_count, scene->triangle_count);
+        return RAD_ERROR_SCENE_MISMATCH;
+    }
+    s = bake->signature;
+    if (!s) {
+        rad__log(&c, RAD_LOG_WARNING, "baked data has no signature (saved without its scene, or by an older version): only its triangle count (%u) was compared",
+                 scene->triangle_count);
+        return RAD_SUCCESS;
+    }
+    if ((r = rad_scene_hash(scene, &g, &m)) != RAD_SUCCESS) return r;
+    dg = s->geometry != 0 && s->geometry != g;
+    dm = s->materials != 0 && s->materials != m;
+    dopt = options != 0 && s->options != 0 && s->options != options;
+    if (!dg && !dm && !dopt) return RAD_SUCCESS;
+    {
+        const char *part[3];
+        char list[64];
+        int np = 0, i;
+        if (dg) part[np++] = "geometry";
+        if (dm) part[np++] = "materials";
+        if (dopt) part[np++] = "options";
+        list[0] = '\0';
+        for (i = 0; i < np; ++i) {
+            if (i > 0) strcat(list, i == np - 1 ? " and " : ", ");
+            strcat(list, part[i]);
+        }
+        rad__log(&c, RAD_LOG_ERROR,
+                 "baked data was made from another scene or with other options: the %s differ%s (bake / scene hashes: geometry "
+                 "%016llx / %016llx, materials %016llx / %016llx, options %016llx / %016llx)",
+                 list, np == 1 && !dm && !dopt ? "s" : "", (unsigned long long)s->geometry, (unsigned long long)g,
+                 (unsigned long long)s->materials, (unsigned long long)m, (unsigned long long)s->options,
+                 (unsigned long long)options);
+    }
+    return RAD_ERROR_SCENE_MISMATCH;
+}
+
 RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx)
 {
     rad__ctx c;
@@ -6460,7 +6713,8 @@ RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, co
                                    const rad_context *ctx, void **out, size_t *out_size)
 {
     rad__ctx c;
-    rad_section s[8];
+    rad_section s[9];
+    rad_bake_signature sig;
     uint32_t n = 0, t, *tri = NULL;
     size_t bytes;
     void *buf;
@@ -6477,7 +6731,18 @@ RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, co
             rad__log(&c, RAD_LOG_ERROR, "save: the matrix is %u x %u but there are %u patches", F->rows, F->cols, P->count);
             return RAD_ERROR_SIZE_MISMATCH;
         }
+        /* what the loader would refuse is not written */
+        r = F->storage == RAD_STORAGE_DENSE
+                ? rad__check_values(&c, "dense form factors (FF_DENSE)", F->dense, (uint64_t)F->rows * F->cols, 1)
+                : rad__check_values(&c, "sparse form factors (FF_VALUES)", F->values, F->row_offsets[F->rows], 1);
+        if (r != RAD_SUCCESS) return r;
     }
+    for (t = 0; t < P->count; ++t)
+        if ((r = rad__check_patch_values(&c, &P->patches[t], t)) != RAD_SUCCESS) return r;
+    if (E && (r = rad__check_values(&c, "vector 'E'", E, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
+    if (B && (r = rad__check_values(&c, "vector 'B'", B, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
+    memset(&sig, 0, sizeof(sig));
+    if (P->scene && (r = rad_scene_hash(P->scene, &sig.geometry, &sig.materials)) != RAD_SUCCESS) return r;
     tri = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->triangle_count * 2u, sizeof(uint32_t));
     if (!tri) return RAD_ERROR_OUT_OF_MEMORY;
     for (t = 0; t < P->triangle_count; ++t) { tri[2 * (size_t)t] = P->first_patch[t]; tri[2 * (size_t)t + 1] = P->subdivision[t]; }
@@ -6494,6 +6759,7 @@ RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, co
     }
     if (E) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, E, "E");
     if (B) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, B, "B");
+    if (P->scene) rad__section(&s[n++], RAD_SECTION_SIGNATURE, (uint32_t)sizeof(sig), 1, &sig, "signature");
     r = rad_container_size(s, n, &bytes);
     if (r != RAD_SUCCESS) { rad__free(&c.allocator, tri); return r; }
     buf = rad__alloc(&c.allocator, bytes);
@@ -6539,14 +6805,6 @@ static rad_result rad__bake_section(const rad__ctx *c, const rad_container *ct, 
     return RAD_SUCCESS;
 }
 
-static int rad__all_finite(const float *v, uint64_t n)
-{
-    uint64_t i;
-    for (i = 0; i < n; ++i)
-        if (!rad__finite(v[i])) return 0;
-    return 1;
-}
-
 static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
 {
     const rad_section *sp, *sv, *st, *sd, *so, *sc, *sx, *se, *sb;
@@ -6568,10 +6826,7 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
     b->patches.vertex_count = (uint32_t)sv->count;
     b->patches.vertices = (float *)(uintptr_t)sv->data;
     b->patches.triangle_count = (uint32_t)T;
-    if (!rad__all_finite(b->patches.vertices, sv->count * 3u)) {
-        rad__log(c, RAD_LOG_ERROR, "baked data: a patch vertex is not finite");
-        return RAD_ERROR_NON_FINITE;
-    }
+    if ((r = rad__check_values(c, "patch vertices (PATCH_VERTICES)", b->patches.vertices, sv->count * 3u, 0)) != RAD_SUCCESS) return r;
     b->patches.first_patch = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
     b->patches.subdivision = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
     b->patches.areas = (float *)rad__alloc_array(&b->allocator, N, sizeof(float));
@@ -6599,11 +6854,7 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
             rad__log(c, RAD_LOG_ERROR, "baked data: patch %u lies on triangle %u of %llu", i, p->triangle, (unsigned long long)T);
             return RAD_ERROR_INDEX_OUT_OF_RANGE;
         }
-        if (!rad__finite3(p->centroid) || !rad__finite3(p->normal) || !rad__finite(p->area) || !rad__finite3(p->emission) ||
-            !rad__finite3(p->albedo)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has a non-finite field", i);
-            return RAD_ERROR_NON_FINITE;
-        }
+        if ((r = rad__check_patch_values(c, p, i)) != RAD_SUCCESS) return r;
         if (!(p->area > 0.0f)) {
             rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has area %g", i, (double)p->area);
             return RAD_ERROR_DEGENERATE_TRIANGLE;
@@ -6626,10 +6877,8 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
             rad__log(c, RAD_LOG_ERROR, "baked data: dense matrix of %llu entries for %u patches", (unsigned long long)sd->count, N);
             return RAD_ERROR_SIZE_MISMATCH;
         }
-        if (!rad__all_finite((const float *)sd->data, sd->count)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: the dense matrix holds a non-finite value");
-            return RAD_ERROR_NON_FINITE;
-        }
+        if ((r = rad__check_values(c, "dense form factors (FF_DENSE)", (const float *)sd->data, sd->count, 1)) != RAD_SUCCESS)
+            return r;
         b->F.rows = b->F.cols = N;
         b->F.storage = RAD_STORAGE_DENSE;
         b->F.dense = (const float *)sd->data;
@@ -6664,29 +6913,38 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
                 }
             }
         }
-        if (!rad__all_finite((const float *)sx->data, sx->count)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: the sparse matrix holds a non-finite value");
-            return RAD_ERROR_NON_FINITE;
-        }
+        if ((r = rad__check_values(c, "sparse form factors (FF_VALUES)", (const float *)sx->data, sx->count, 1)) != RAD_SUCCESS)
+            return r;
         b->F.rows = b->F.cols = N;
         b->F.storage = RAD_STORAGE_SPARSE;
         b->F.row_offsets = off;
         b->F.columns = col;
         b->F.values = (const float *)sx->data;
     }
+    /* every vector, not only E and B: the application's ("H", "L", ...) are read in place too */
+    for (k = 0; k < rad_container_section_count(b->container); ++k) {
+        const rad_section *s = rad_container_section(b->container, k);
+        char what[48];
+        if (s->type != RAD_SECTION_VECTOR) continue;
+        if (s->elem_size != 12u || s->count != N) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: vector '%s' has %llu elements of %u bytes, expected %u RGB triples", s->name,
+                     (unsigned long long)s->count, s->elem_size, N);
+            return RAD_ERROR_SIZE_MISMATCH;
+        }
+        snprintf(what, sizeof(what), "vector '%s'", s->name);
+        if ((r = rad__check_values(c, what, (const float *)s->data, s->count * 3u, 0)) != RAD_SUCCESS) return r;
+    }
     if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "E", 12, 0, &se)) != RAD_SUCCESS) return r;
     if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "B", 12, 0, &sb)) != RAD_SUCCESS) return r;
-    if ((se && se->count != N) || (sb && sb->count != N)) {
-        rad__log(c, RAD_LOG_ERROR, "baked data: a vector's length differs from the %u patches", N);
-        return RAD_ERROR_SIZE_MISMATCH;
-    }
-    if ((se && !rad__all_finite((const float *)se->data, se->count * 3u)) ||
-        (sb && !rad__all_finite((const float *)sb->data, sb->count * 3u))) {
-        rad__log(c, RAD_LOG_ERROR, "baked data: a vector holds a non-finite value");
-        return RAD_ERROR_NON_FINITE;
-    }
     b->E = se ? (const float *)se->data : NULL;
     b->B = sb ? (const float *)sb->data : NULL;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_SIGNATURE, NULL, (uint32_t)sizeof(rad_bake_signature), 0, &se)) != RAD_SUCCESS)
+        return r;
+    if (se && se->count != 1u) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: the signature section holds %llu records, expected 1", (unsigned long long)se->count);
+        return RAD_ERROR_CORRUPT;
+    }
+    b->signature = se ? (const rad_bake_signature *)se->data : NULL;
     return RAD_SUCCESS;
 }
 
@@ -10134,6 +10392,24 @@ static rad_result rad__mb_load_perms(const rad__ctx *c, const rad_container *ct,
     return r;
 }
 
+/* rad__check_values for binary16 F_mb planes: every value finite and >= 0 (any finite half is
+   below RAD_BAKE_VALUE_MAX) */
+static rad_result rad__check_halves(const rad__ctx *c, const char *name, const uint16_t *h, uint64_t n)
+{
+    uint64_t i;
+    uint32_t bad = 0;
+    for (i = 0; i < n; ++i) bad |= (uint32_t)((h[i] & 0x7FFFu) >= 0x7C00u) | (uint32_t)(h[i] > 0x8000u);
+    if (!bad) return RAD_SUCCESS;
+    for (i = 0; i < n; ++i)
+        if ((h[i] & 0x7FFFu) >= 0x7C00u || h[i] > 0x8000u) {
+            const int nonfinite = (h[i] & 0x7FFFu) >= 0x7C00u;
+            rad__log(c, RAD_LOG_ERROR, "baked data: multibounce '%s' half planes (MB_HALF): entry %llu is %g (%s)", name ? name : "",
+                     (unsigned long long)i, (double)rad_half_to_float(h[i]), nonfinite ? "not finite" : "negative");
+            return nonfinite ? RAD_ERROR_NON_FINITE : RAD_ERROR_CORRUPT;
+        }
+    return RAD_SUCCESS;
+}
+
 RAD_API rad_result rad_multibounce_load(const rad_container *ct, const char *name, const rad_context *ctx, rad_multibounce **out)
 {
     rad__ctx c;
@@ -10155,6 +10431,14 @@ RAD_API rad_result rad_multibounce_load(const rad_container *ct, const char *nam
     total = 3u * (uint64_t)info[2] * info[2];
     if (total / 3u / info[2] != info[2] || total > (uint64_t)((size_t)-1) / 4u) return RAD_ERROR_SIZE_OVERFLOW;
     r = rad__mb_section(&c, ct, info[1] ? RAD_SECTION_MB_HALF : RAD_SECTION_MB_FLOAT, name, info[1] ? 2u : 4u, total, &data);
+    if (r != RAD_SUCCESS) return r;
+    if (info[1]) {
+        r = rad__check_halves(&c, name, (const uint16_t *)data, total);
+    } else {
+        char what[64];
+        snprintf(what, sizeof(what), "multibounce '%s' float planes (MB_FLOAT)", name ? name : "");
+        r = rad__check_values(&c, what, (const float *)data, total, 1);
+    }
     if (r != RAD_SUCCESS) return r;
     mb = (rad_multibounce *)rad__alloc(&c.allocator, sizeof(*mb));
     if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
@@ -10212,9 +10496,10 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *ct, const ch
     if (r == RAD_SUCCESS) {
         r = rad__mb_section(&c, ct, RAD_SECTION_MB_SCALES, name, 3 * sizeof(float), (uint64_t)tpr * tpr, &p);
         b->scales = (const float *)p;
-        if (r == RAD_SUCCESS && !rad__all_finite(b->scales, 3u * (uint64_t)tpr * tpr)) {
-            rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': a scale is not finite", name ? name : "");
-            r = RAD_ERROR_CORRUPT;
+        if (r == RAD_SUCCESS) {
+            char what[64];
+            snprintf(what, sizeof(what), "multibounce '%s' block scales (MB_SCALES)", name ? name : "");
+            r = rad__check_values(&c, what, b->scales, 3u * (uint64_t)tpr * tpr, 1);
         }
     }
     if (r == RAD_SUCCESS) r = rad__mb_load_perms(&c, ct, name, n, (info[6] & 1u) != 0, &b->row_perm, &b->col_perm);
@@ -10244,9 +10529,10 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *ct, const ch
                          (unsigned long long)i, b->outlier_columns[i], n);
                 r = RAD_ERROR_INDEX_OUT_OF_RANGE;
             }
-        if (r == RAD_SUCCESS && !rad__all_finite(b->outlier_values, 3u * b->outlier_count)) {
-            rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': an outlier value is not finite", name ? name : "");
-            r = RAD_ERROR_CORRUPT;
+        if (r == RAD_SUCCESS) {
+            char what[64];
+            snprintf(what, sizeof(what), "multibounce '%s' outliers (MB_OUTLIER_VALUES)", name ? name : "");
+            r = rad__check_values(&c, what, b->outlier_values, 3u * b->outlier_count, 1);
         }
     }
     if (r != RAD_SUCCESS) { rad_multibounce_blocks_destroy(b); return r; }
@@ -11901,9 +12187,11 @@ RAD_API rad_result rad_alias_tables_view(const rad_container *ct, const char *na
                 rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u has a bad bin range", i);
                 return RAD_ERROR_CORRUPT;
             }
-            if (!rad__finite(tot[i]) || !(tot[i] > 0.0f)) {
-                rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u has total %g", i, (double)tot[i]);
-                return RAD_ERROR_CORRUPT;
+            if (!rad__finite(tot[i]) || !(tot[i] > 0.0f) || tot[i] > RAD_BAKE_VALUE_MAX) {
+                rad__log(&c, RAD_LOG_ERROR, "baked data: alias tables '%s' totals (TEMPORAL_TOTALS): row %u has total %g (%s)",
+                         name ? name : "", i, (double)tot[i],
+                         !rad__finite(tot[i]) ? "not finite" : tot[i] > 0.0f ? "beyond RAD_BAKE_VALUE_MAX = 1e30" : "not > 0");
+                return rad__finite(tot[i]) ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE;
             }
         }
         for (b = 0, nb = sb->count; b < nb; ++b) {
@@ -12023,7 +12311,7 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
         rad__log(&c, RAD_LOG_ERROR, "temporal: modes SINGLE and FEEDBACK need the albedo");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (o.samples == 0 || o.samples > 0x01000000u || !(o.weight >= 0.0f && o.weight < 1.0f) ||
+    if (o.samples == 0 || o.samples > RAD_TEMPORAL_MAX_SAMPLES || !(o.weight >= 0.0f && o.weight < 1.0f) ||
         (o.adaptive && (!(o.noise_target > 0.0f) || !(o.weight_max >= 0.0f && o.weight_max < 1.0f) ||
                         !(o.change_sigma > 0.0f) || !rad__finite(o.noise_target) || !rad__finite(o.change_sigma)))) {
         rad__log(&c, RAD_LOG_ERROR, "temporal: bad options (samples %u, weight %g, target %g, weight_max %g, sigma %g)", o.samples,

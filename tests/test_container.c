@@ -317,11 +317,356 @@ static void ct_test_alloc_failure(void)
     ct_teardown(&f);
 }
 
+/* ---- values behind valid checksums, and the scene signature ------------------------------ */
+
+/* the last message of the library's logger, to check that it names the section, entry and value */
+static char ct_log_last[512];
+static int ct_log_warnings;
+static void ct_log(void *user, rad_log_level level, const char *message)
+{
+    (void)user;
+    if (level == RAD_LOG_WARNING) ct_log_warnings++;
+    snprintf(ct_log_last, sizeof(ct_log_last), "%s", message);
+}
+
+static void ct_log_context(rad_context *ctx)
+{
+    memset(ctx, 0, sizeof(*ctx));
+    ctx->log = ct_log;
+    ct_log_last[0] = '\0';
+    ct_log_warnings = 0;
+}
+
+/* a malloc'd copy of the container 'buf' with 'bytes' written at byte 'at' of its section of
+   'type' called 'name', every checksum fixed (NULL when there is no such section) */
+static unsigned char *ct_poke(const void *buf, size_t size, uint32_t type, const char *name, size_t at, const void *bytes,
+                              size_t n)
+{
+    unsigned char *copy = (unsigned char *)malloc(size);
+    uint32_t i, count;
+    if (!copy) return NULL;
+    memcpy(copy, buf, size);
+    count = rad__get32(copy + 8);
+    for (i = 0; i < count; ++i) {
+        unsigned char *e = copy + 64 + 64 * (size_t)i;
+        if (rad__get32(e) == type && strncmp((const char *)e + 40, name, 24) == 0 && at + n <= rad__get64(e + 24)) {
+            memcpy(copy + rad__get64(e + 16) + at, bytes, n);
+            ct_fix_section_crc(copy, i);
+            return copy;
+        }
+    }
+    free(copy);
+    return NULL;
+}
+
+/* float 'index' of section (type, name) set to 'value': rad_load_memory gives 'expected' and
+   a message that contains 'what', "entry <index>" and 'shown' (the value as %g prints it) */
+static void ct_expect_value(const void *buf, size_t size, uint32_t type, const char *name, uint64_t index, float value,
+                            rad_result expected, const char *what, const char *shown)
+{
+    rad_context ctx;
+    rad_bake *b = NULL;
+    char entry[40];
+    unsigned char *copy = ct_poke(buf, size, type, name, (size_t)index * 4u, &value, 4);
+    CHECK(copy != NULL);
+    if (!copy) return;
+    ct_log_context(&ctx);
+    CHECK_RESULT(rad_load_memory(copy, size, &ctx, &b), expected);
+    CHECK(b == NULL || expected == RAD_SUCCESS);
+    if (expected != RAD_SUCCESS) {
+        snprintf(entry, sizeof(entry), "entry %llu ", (unsigned long long)index);
+        if (!strstr(ct_log_last, what) || !strstr(ct_log_last, entry) || !strstr(ct_log_last, shown)) {
+            printf("    message '%s' lacks '%s', '%s' or '%s'\n", ct_log_last, what, entry, shown);
+            CHECK(0);
+        }
+    }
+    rad_bake_destroy(b);
+    free(copy);
+}
+
+/* rad_save_memory's bake plus the application's vector "H" (as rad bake writes it) */
+static void *ct_save_with_h(const ct_fixture *f, const rad_matrix *F, uint32_t h_count, size_t *out_size)
+{
+    void *buf = NULL, *dst = NULL;
+    size_t size = 0;
+    rad_container *ct = NULL;
+    rad_section s[16];
+    uint32_t k = 0, i;
+    *out_size = 0;
+    if (rad_save_memory(f->P, F, f->E, f->B, NULL, &buf, &size) != RAD_SUCCESS) return NULL;
+    if (rad_container_open(buf, size, NULL, &ct) == RAD_SUCCESS && rad_container_section_count(ct) < 15) {
+        for (i = 0; i < rad_container_section_count(ct); ++i) s[k++] = *rad_container_section(ct, i);
+        memset(&s[k], 0, sizeof(s[k]));
+        s[k].type = RAD_SECTION_VECTOR;
+        s[k].elem_size = 12;
+        s[k].count = h_count;
+        s[k].data = f->B;
+        strcpy(s[k++].name, "H");
+        if (rad_container_size(s, k, out_size) == RAD_SUCCESS && (dst = malloc(*out_size)) != NULL &&
+            rad_container_write(s, k, dst, *out_size) != RAD_SUCCESS) {
+            free(dst);
+            dst = NULL;
+        }
+    }
+    rad_container_close(ct);
+    rad_free_buffer(buf, NULL);
+    return dst;
+}
+
+/* Bakes with valid checksums but NaN, 3e38 or negative values (issue 23): every loader value
+   is checked once at load (NON_FINITE for NaN/Inf, CORRUPT for a finite value out of range),
+   the message names the section, the entry and the value; rad_save_memory refuses to write
+   what would not load. */
+static void ct_test_bad_values(void)
+{
+    ct_fixture f;
+    void *buf;
+    size_t size = 0;
+    rad_bake *b = NULL;
+    rad_context ctx;
+    const float qnan = (float)NAN;
+    if (!ct_setup(&f)) { CHECK(0); ct_teardown(&f); return; }
+    buf = ct_save_with_h(&f, &f.dense->matrix, f.P->count, &size);
+    CHECK(buf != NULL);
+    if (buf) {
+        CHECK_OK(rad_load_memory(buf, size, NULL, &b));
+        rad_bake_destroy(b);
+        b = NULL;
+        ct_expect_value(buf, size, RAD_SECTION_FF_DENSE, "F", 5, qnan, RAD_ERROR_NON_FINITE, "FF_DENSE", "nan");
+        ct_expect_value(buf, size, RAD_SECTION_FF_DENSE, "F", 5, 3e38f, RAD_ERROR_CORRUPT, "FF_DENSE", "3e+38");
+        ct_expect_value(buf, size, RAD_SECTION_FF_DENSE, "F", 5, -0.25f, RAD_ERROR_CORRUPT, "FF_DENSE", "negative");
+        ct_expect_value(buf, size, RAD_SECTION_FF_DENSE, "F", 5, -0.0f, RAD_SUCCESS, "", "");
+        ct_expect_value(buf, size, RAD_SECTION_VECTOR, "H", 7, qnan, RAD_ERROR_NON_FINITE, "vector 'H'", "nan");
+        ct_expect_value(buf, size, RAD_SECTION_VECTOR, "H", 7, (float)INFINITY, RAD_ERROR_NON_FINITE, "vector 'H'", "inf");
+        ct_expect_value(buf, size, RAD_SECTION_VECTOR, "H", 7, 3e38f, RAD_ERROR_CORRUPT, "vector 'H'", "3e+38");
+        ct_expect_value(buf, size, RAD_SECTION_VECTOR, "H", 7, RAD_BAKE_VALUE_MAX, RAD_SUCCESS, "", "");
+        ct_expect_value(buf, size, RAD_SECTION_VECTOR, "E", 1, -3e38f, RAD_ERROR_CORRUPT, "vector 'E'", "-3e+38");
+        ct_expect_value(buf, size, RAD_SECTION_VECTOR, "B", 2, qnan, RAD_ERROR_NON_FINITE, "vector 'B'", "nan");
+        ct_expect_value(buf, size, RAD_SECTION_PATCH_VERTICES, "vertices", 4, 3e38f, RAD_ERROR_CORRUPT, "PATCH_VERTICES", "3e+38");
+        {
+            /* patch 2's area and emission (rad_patch: area at byte 24, emission at 40) */
+            static const float bad[3] = { (float)INFINITY, -1.0f, 3e38f };
+            static const size_t at[3] = { 2 * sizeof(rad_patch) + 24, 2 * sizeof(rad_patch) + 40, 2 * sizeof(rad_patch) + 44 };
+            static const rad_result want[3] = { RAD_ERROR_NON_FINITE, RAD_ERROR_NEGATIVE_EMISSION, RAD_ERROR_CORRUPT };
+            int q;
+            for (q = 0; q < 3; ++q) {
+                unsigned char *copy = ct_poke(buf, size, RAD_SECTION_PATCHES, "patches", at[q], &bad[q], 4);
+                CHECK(copy != NULL);
+                if (!copy) continue;
+                ct_log_context(&ctx);
+                CHECK_RESULT(rad_load_memory(copy, size, &ctx, &b), want[q]);
+                CHECK(strstr(ct_log_last, "patch 2 ") != NULL && strstr(ct_log_last, q ? "emission" : "area") != NULL);
+                rad_bake_destroy(b);
+                b = NULL;
+                free(copy);
+            }
+        }
+        free(buf);
+    }
+    /* a vector of the application's with the wrong length */
+    buf = ct_save_with_h(&f, &f.dense->matrix, f.P->count - 1, &size);
+    CHECK(buf != NULL);
+    if (buf) {
+        ct_log_context(&ctx);
+        CHECK_RESULT(rad_load_memory(buf, size, &ctx, &b), RAD_ERROR_SIZE_MISMATCH);
+        CHECK(strstr(ct_log_last, "vector 'H'") != NULL);
+        free(buf);
+    }
+    /* the CSR values */
+    buf = ct_save_with_h(&f, &f.sparse->matrix, f.P->count, &size);
+    CHECK(buf != NULL);
+    if (buf) {
+        ct_expect_value(buf, size, RAD_SECTION_FF_VALUES, "F", 3, 3e38f, RAD_ERROR_CORRUPT, "FF_VALUES", "3e+38");
+        ct_expect_value(buf, size, RAD_SECTION_FF_VALUES, "F", 3, -1.0f, RAD_ERROR_CORRUPT, "FF_VALUES", "negative");
+        ct_expect_value(buf, size, RAD_SECTION_FF_VALUES, "F", 3, qnan, RAD_ERROR_NON_FINITE, "FF_VALUES", "nan");
+        free(buf);
+    }
+    /* what would not load is not written */
+    {
+        const uint32_t n3 = 3 * f.P->count;
+        float *E = (float *)malloc(sizeof(float) * n3), *D = (float *)malloc(sizeof(float) * f.P->count * f.P->count);
+        rad_matrix m = f.dense->matrix;
+        void *out = NULL;
+        size_t out_size = 0;
+        if (E && D) {
+            memcpy(E, f.E, sizeof(float) * n3);
+            E[4] = 3e38f;
+            CHECK_RESULT(rad_save_memory(f.P, NULL, E, NULL, NULL, &out, &out_size), RAD_ERROR_CORRUPT);
+            E[4] = qnan;
+            CHECK_RESULT(rad_save_memory(f.P, NULL, NULL, E, NULL, &out, &out_size), RAD_ERROR_NON_FINITE);
+            CHECK(out == NULL && out_size == 0);
+            memcpy(D, f.dense->matrix.dense, sizeof(float) * f.P->count * f.P->count);
+            D[9] = -0.5f;
+            m.dense = D;
+            CHECK_RESULT(rad_save_memory(f.P, &m, NULL, NULL, NULL, &out, &out_size), RAD_ERROR_CORRUPT);
+        }
+        free(E);
+        free(D);
+    }
+    ct_teardown(&f);
+}
+
+/* the FNV-1a of the doc block, written out here from its text */
+static uint64_t ct_fnv_words(uint64_t h, const void *words, size_t n)
+{
+    const unsigned char *p = (const unsigned char *)words;
+    size_t i, k;
+    for (i = 0; i < n; ++i) {
+        uint32_t w;
+        memcpy(&w, p + 4 * i, 4);
+        for (k = 0; k < 4; ++k) h = (h ^ ((w >> (8 * k)) & 0xFFu)) * 0x100000001B3ull;
+    }
+    return h;
+}
+
+/* A scene of the same triangle count with one vertex moved, or one albedo changed, is refused
+   with the reason; the same scene is accepted; a bake saved without a scene loads and is
+   checked by its triangle count only (with a warning); the options hash is compared when both
+   sides have one (issue 23). */
+static void ct_test_signature(void)
+{
+    ct_fixture f;
+    rad_scene_desc d;
+    rad_mesh_desc meshes[16];
+    rad_material mats[16];
+    rad_scene *moved = NULL, *recoloured = NULL;
+    rad_context ctx;
+    void *buf = NULL;
+    size_t size = 0;
+    rad_bake *b = NULL;
+    uint64_t g = 0, m = 0, want;
+    float *pos = NULL;
+    const float *orig;
+    uint32_t t;
+    CHECK(rad_hash64("", 0, RAD_HASH64_INIT) == 0xCBF29CE484222325ull);
+    CHECK(rad_hash64("a", 1, RAD_HASH64_INIT) == 0xAF63DC4C8601EC8Cull);
+    CHECK(rad_hash64("foobar", 6, RAD_HASH64_INIT) == 0x85944171F73967E8ull);
+    if (!ct_setup(&f)) { CHECK(0); ct_teardown(&f); return; }
+    /* the hashes are the documented ones */
+    CHECK_OK(rad_scene_hash(f.scene, &g, &m));
+    want = ct_fnv_words(RAD_HASH64_INIT, &f.scene->triangle_count, 1);
+    want = ct_fnv_words(want, f.scene->positions, 9u * (size_t)f.scene->triangle_count);
+    CHECK(g == want && g != 0);
+    want = ct_fnv_words(RAD_HASH64_INIT, &f.scene->triangle_count, 1);
+    for (t = 0; t < f.scene->triangle_count; ++t) {
+        const rad_material *mt = &f.scene->materials_table[f.scene->materials[t]];
+        want = ct_fnv_words(want, mt->albedo, 3);
+        want = ct_fnv_words(want, mt->emission, 3);
+        want = ct_fnv_words(want, &mt->texture, 1);
+    }
+    {
+        const uint32_t no_uvs = 0;
+        CHECK(f.scene->uvs == NULL);
+        want = ct_fnv_words(want, &no_uvs, 1);
+    }
+    CHECK(m == want && m != g);
+    {
+        uint64_t g2 = 1, m2 = 1;
+        CHECK_RESULT(rad_scene_hash(NULL, &g2, &m2), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(g2 == 0 && m2 == 0);
+    }
+
+    /* the same counts, one vertex moved / one albedo changed */
+    rad_cornell_box(&d, NULL);
+    CHECK(d.mesh_count <= 16 && d.material_count <= 16);
+    memcpy(meshes, d.meshes, sizeof(rad_mesh_desc) * d.mesh_count);
+    memcpy(mats, d.materials, sizeof(rad_material) * d.material_count);
+    pos = (float *)malloc(sizeof(float) * 3 * meshes[0].vertex_count);
+    CHECK(meshes[0].position_stride == 0 || meshes[0].position_stride == 3 * sizeof(float));
+    orig = meshes[0].positions;
+    memcpy(pos, orig, sizeof(float) * 3 * meshes[0].vertex_count);
+    pos[1] += 0.01f;
+    meshes[0].positions = pos;
+    d.meshes = meshes;
+    CHECK_OK(rad_scene_create(&d, NULL, &moved));
+    meshes[0].positions = orig; /* back to the original geometry */
+    mats[0].albedo[1] *= 0.5f;
+    d.materials = mats;
+    CHECK_OK(rad_scene_create(&d, NULL, &recoloured));
+
+    CHECK_OK(rad_save_memory(f.P, &f.dense->matrix, f.E, f.B, NULL, &buf, &size));
+    CHECK_OK(rad_load_memory(buf, size, NULL, &b));
+    if (b && moved && recoloured) {
+        CHECK(b->signature != NULL);
+        if (b->signature) {
+            CHECK(b->signature->geometry == g && b->signature->materials == m && b->signature->options == 0);
+        }
+        CHECK(moved->triangle_count == f.scene->triangle_count);
+        ct_log_context(&ctx);
+        CHECK_OK(rad_bake_matches_scene(b, f.scene, 0, &ctx));
+        CHECK_OK(rad_bake_matches_scene(b, f.scene, 1234, &ctx)); /* the bake has no options hash */
+        CHECK(ct_log_last[0] == '\0');
+        CHECK_RESULT(rad_bake_matches_scene(b, moved, 0, &ctx), RAD_ERROR_SCENE_MISMATCH);
+        CHECK(strstr(ct_log_last, "the geometry differs") != NULL && strstr(ct_log_last, "materials") != NULL);
+        CHECK_RESULT(rad_bake_matches_scene(b, recoloured, 0, &ctx), RAD_ERROR_SCENE_MISMATCH);
+        CHECK(strstr(ct_log_last, "the materials differ") != NULL && strstr(ct_log_last, "geometry differs") == NULL);
+        CHECK_RESULT(rad_bake_matches_scene(NULL, f.scene, 0, &ctx), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_bake_matches_scene(b, NULL, 0, &ctx), RAD_ERROR_INVALID_ARGUMENT);
+    }
+    rad_bake_destroy(b);
+    b = NULL;
+    /* an options hash written into the signature (as rad bake does): compared when both have one */
+    {
+        rad_bake_signature sig;
+        unsigned char *copy;
+        memset(&sig, 0, sizeof(sig));
+        sig.geometry = g;
+        sig.materials = m;
+        sig.options = 1234;
+        copy = ct_poke(buf, size, RAD_SECTION_SIGNATURE, "signature", 0, &sig, sizeof(sig));
+        CHECK(copy != NULL);
+        if (copy) {
+            CHECK_OK(rad_load_memory(copy, size, NULL, &b));
+            ct_log_context(&ctx);
+            if (b) {
+                CHECK_OK(rad_bake_matches_scene(b, f.scene, 1234, &ctx));
+                CHECK_OK(rad_bake_matches_scene(b, f.scene, 0, &ctx));
+                CHECK_RESULT(rad_bake_matches_scene(b, f.scene, 4321, &ctx), RAD_ERROR_SCENE_MISMATCH);
+                CHECK(strstr(ct_log_last, "the options differ") != NULL);
+                if (moved) {
+                    CHECK_RESULT(rad_bake_matches_scene(b, moved, 4321, &ctx), RAD_ERROR_SCENE_MISMATCH);
+                    CHECK(strstr(ct_log_last, "the geometry and options differ") != NULL);
+                }
+            }
+            rad_bake_destroy(b);
+            b = NULL;
+            free(copy);
+        }
+    }
+    rad_free_buffer(buf, NULL);
+    buf = NULL;
+    /* a bake saved without its scene (as before the signature existed) */
+    {
+        rad_patches P = *f.P;
+        P.scene = NULL;
+        CHECK_OK(rad_save_memory(&P, NULL, f.E, NULL, NULL, &buf, &size));
+        CHECK_OK(rad_load_memory(buf, size, NULL, &b));
+        if (b) {
+            CHECK(b->signature == NULL && rad_container_find(b->container, RAD_SECTION_SIGNATURE, NULL) == NULL);
+            ct_log_context(&ctx);
+            CHECK_OK(rad_bake_matches_scene(b, moved ? moved : f.scene, 0, &ctx));
+            CHECK(ct_log_warnings == 1 && strstr(ct_log_last, "no signature") != NULL);
+            b->patches.triangle_count--; /* another triangle count is refused even so */
+            CHECK_RESULT(rad_bake_matches_scene(b, f.scene, 0, &ctx), RAD_ERROR_SCENE_MISMATCH);
+            CHECK(strstr(ct_log_last, "geometry differs") != NULL);
+            b->patches.triangle_count++;
+        }
+        rad_bake_destroy(b);
+        rad_free_buffer(buf, NULL);
+    }
+    rad_scene_destroy(moved);
+    rad_scene_destroy(recoloured);
+    free(pos);
+    ct_teardown(&f);
+}
+
 static const rad_test_case tests_container[] = {
     { "container_round_trip", ct_test_round_trip },
     { "container_corruption", ct_test_corruption },
     { "container_save_mismatch", ct_test_save_mismatch },
     { "container_user_sections", ct_test_user_sections },
     { "container_alloc_failure", ct_test_alloc_failure },
+    { "container_bad_values", ct_test_bad_values },
+    { "container_signature", ct_test_signature },
     { NULL, NULL }
 };

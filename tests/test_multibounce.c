@@ -950,6 +950,87 @@ static void mb_reorder_match(void)
     }
 }
 
+/* one poked copy of a multi-bounce container (ct_poke: checksums fixed) opened and loaded:
+   'expected', and a message naming 'what' */
+static void mb_expect_load(const void *buf, size_t size, uint32_t type, const char *name, size_t at, const void *bytes,
+                           size_t n, rad_result expected, const char *what)
+{
+    unsigned char *copy = ct_poke(buf, size, type, name, at, bytes, n);
+    rad_container *ct = NULL;
+    rad_multibounce *mb = NULL;
+    rad_multibounce_blocks *b = NULL;
+    rad_context ctx;
+    CHECK(copy != NULL);
+    if (!copy) return;
+    CHECK_OK(rad_container_open(copy, size, NULL, &ct));
+    ct_log_context(&ctx);
+    if (type == RAD_SECTION_MB_SCALES || type == RAD_SECTION_MB_OUTLIER_VALUES) {
+        CHECK_RESULT(rad_multibounce_blocks_load(ct, name, &ctx, &b), expected);
+        CHECK((b != NULL) == (expected == RAD_SUCCESS));
+    } else {
+        CHECK_RESULT(rad_multibounce_load(ct, name, &ctx, &mb), expected);
+        CHECK((mb != NULL) == (expected == RAD_SUCCESS));
+    }
+    if (expected != RAD_SUCCESS && (!strstr(ct_log_last, what) || !strstr(ct_log_last, "entry"))) {
+        printf("    message '%s' lacks '%s'\n", ct_log_last, what);
+        CHECK(0);
+    }
+    rad_multibounce_destroy(mb);
+    rad_multibounce_blocks_destroy(b);
+    rad_container_close(ct);
+    free(copy);
+}
+
+/* F_mb planes (float and half), block scales and outliers with valid checksums but NaN, 3e38
+   or negative values are refused at load (issue 23: they rendered NaN with exit 0) */
+static void mb_bad_values(void)
+{
+    mb_world w;
+    rad_multibounce *mb = NULL, *h = NULL;
+    rad_multibounce_blocks *b = NULL;
+    rad_block_options o;
+    rad_section s[3 * RAD_MB_MAX_SECTIONS];
+    uint32_t k1 = 0, k2 = 0, k3 = 0;
+    size_t bytes = 0;
+    void *buf = NULL;
+    const float qnan = (float)NAN, huge = 3e38f, neg = -1.0f, fine = 0.5f;
+    const uint16_t hnan = 0x7E00u, hinf = 0x7C00u, hneg = 0xBC00u, hzero = 0x8000u;
+    if (!mb_cornell(&w, 60u)) return;
+    CHECK_OK(rad_multibounce_create(&w.ff->matrix, w.patches->albedo, NULL, NULL, &mb));
+    CHECK_OK(rad_multibounce_convert(mb, RAD_MB_HALF, NULL, &h));
+    rad_block_options_default(&o);
+    o.tile = 16;
+    CHECK_OK(rad_multibounce_blocks_create(mb, &o, NULL, &b, NULL));
+    if (!mb || !h || !b) goto done;
+    CHECK(b->outlier_count > 2);
+    CHECK_OK(rad_multibounce_sections(mb, "f", s, &k1));
+    CHECK_OK(rad_multibounce_sections(h, "h", s + k1, &k2));
+    CHECK_OK(rad_multibounce_blocks_sections(b, "b", s + k1 + k2, &k3));
+    CHECK_OK(rad_container_size(s, k1 + k2 + k3, &bytes));
+    buf = malloc(bytes);
+    if (!buf) goto done;
+    CHECK_OK(rad_container_write(s, k1 + k2 + k3, buf, bytes));
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_FLOAT, "f", 40, &fine, 4, RAD_SUCCESS, "");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_FLOAT, "f", 40, &qnan, 4, RAD_ERROR_NON_FINITE, "MB_FLOAT");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_FLOAT, "f", 40, &huge, 4, RAD_ERROR_CORRUPT, "3e+38");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_FLOAT, "f", 40, &neg, 4, RAD_ERROR_CORRUPT, "negative");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_HALF, "h", 20, &hzero, 2, RAD_SUCCESS, "");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_HALF, "h", 20, &hnan, 2, RAD_ERROR_NON_FINITE, "MB_HALF");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_HALF, "h", 20, &hinf, 2, RAD_ERROR_NON_FINITE, "inf");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_HALF, "h", 20, &hneg, 2, RAD_ERROR_CORRUPT, "negative");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_SCALES, "b", 4, &fine, 4, RAD_SUCCESS, "");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_SCALES, "b", 4, &huge, 4, RAD_ERROR_CORRUPT, "MB_SCALES");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_SCALES, "b", 4, &qnan, 4, RAD_ERROR_NON_FINITE, "MB_SCALES");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_OUTLIER_VALUES, "b", 8, &huge, 4, RAD_ERROR_CORRUPT, "MB_OUTLIER_VALUES");
+    mb_expect_load(buf, bytes, RAD_SECTION_MB_OUTLIER_VALUES, "b", 8, &neg, 4, RAD_ERROR_CORRUPT, "negative");
+done:
+    free(buf);
+    rad_multibounce_blocks_destroy(b);
+    rad_multibounce_destroy(h);
+    rad_multibounce_destroy(mb);
+    mb_world_free(&w);
+}
+
 static const rad_test_case tests_multibounce[] = {
     { "multibounce: binary16 conversion", mb_half },
     { "multibounce: F_mb E equals K Jacobi bounces (K = 1, 3, 8)", mb_jacobi },
@@ -966,6 +1047,7 @@ static const rad_test_case tests_multibounce[] = {
     { "multibounce: SIMD palette division equals IEEE division", mb_simd_division },
     { "multibounce: compressed apply equals decode-then-multiply (hand-built blocks)", mb_apply_vs_decode },
     { "multibounce: container sections, round trip, corruption", mb_container },
+    { "multibounce: NaN, 3e38 and negative values refused at load", mb_bad_values },
     { "multibounce: argument errors", mb_errors },
     { NULL, NULL }
 };

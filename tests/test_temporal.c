@@ -804,6 +804,58 @@ static void tp_huge_tables(void)
     free(plane); free(bins); free(scratch);
 }
 
+/* Alias totals with a valid checksum but NaN or 3e38 are refused at load, and the draw count k
+   is bounded (issue 23: a bake with k = 16M took 10 s per frame at 206 patches) */
+static void tp_bad_values(void)
+{
+    tp_cornell c;
+    rad_alias_tables *t = NULL, v;
+    rad_section sec[3];
+    rad_container *ct = NULL;
+    rad_context ctx;
+    rad_temporal_options o;
+    rad_temporal *tm = NULL;
+    void *buf = NULL;
+    size_t size = 0;
+    int q;
+    if (!tp_cornell_build(&c, 60, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
+    if (t) {
+        rad_alias_tables_sections(t, "F", sec);
+        CHECK_OK(rad_container_size(sec, 3, &size));
+        buf = malloc(size);
+        CHECK_OK(rad_container_write(sec, 3, buf, size));
+        for (q = 0; q < 3; ++q) {
+            const float value = q == 0 ? 3e38f : q == 1 ? (float)NAN : -2.0f;
+            unsigned char *copy = ct_poke(buf, size, RAD_SECTION_TEMPORAL_TOTALS, "F", 3 * 4, &value, 4);
+            CHECK(copy != NULL);
+            if (!copy) continue;
+            CHECK_OK(rad_container_open(copy, size, NULL, &ct));
+            ct_log_context(&ctx);
+            CHECK_RESULT(rad_alias_tables_view(ct, "F", &ctx, &v), q == 1 ? RAD_ERROR_NON_FINITE : RAD_ERROR_CORRUPT);
+            CHECK(strstr(ct_log_last, "TEMPORAL_TOTALS") != NULL && strstr(ct_log_last, "row 3") != NULL);
+            rad_container_close(ct);
+            ct = NULL;
+            free(copy);
+        }
+        /* k: 1 to RAD_TEMPORAL_MAX_SAMPLES */
+        rad_temporal_options_default(&o);
+        o.mode = RAD_TEMPORAL_FEEDBACK;
+        o.samples = RAD_TEMPORAL_MAX_SAMPLES;
+        CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm));
+        rad_temporal_destroy(tm);
+        tm = NULL;
+        o.samples = RAD_TEMPORAL_MAX_SAMPLES + 1u;
+        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
+        o.samples = 16777216u;
+        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(tm == NULL);
+    }
+    free(buf);
+    rad_alias_tables_destroy(t);
+    tp_cornell_free(&c);
+}
+
 static const rad_test_case tests_temporal[] = {
     { "temporal_random_vectors", tp_random_vectors },
     { "temporal_alias_chi_square", tp_alias_chi_square },
@@ -816,6 +868,7 @@ static const rad_test_case tests_temporal[] = {
     { "temporal_adaptive", tp_adaptive },
     { "temporal_errors", tp_errors },
     { "temporal_container", tp_container },
+    { "temporal_bad_values", tp_bad_values },
     { "temporal_pipeline_bits", tp_pipeline_bits },
     { "temporal_huge_tables", tp_huge_tables },
     { NULL, NULL }

@@ -148,6 +148,19 @@ if "$RAD" bake cornell --patches 500 -o "$TMP/x.radb" > /dev/null 2> "$TMP/err.t
 else
     fail "bake cornell" "$(head -c 300 "$TMP/err.txt")"
 fi
+# a bake of another scene with the same triangle and patch counts (the parallel squares' bake for
+# the perpendicular ones): the bake's signature (rad_bake_matches_scene) refuses it, naming what differs
+if "$RAD" bake "$TMP/parallel.obj" --patches 16 -o "$TMP/par.radb" > /dev/null 2> "$TMP/err.txt"; then
+    "$RAD" render "$TMP/parallel.obj" --bake "$TMP/par.radb" --size 8x8 -o "$TMP/par.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        ok "render --bake accepts its own scene's bake" || fail "render --bake accepts its own scene's bake" "$(head -c 300 "$TMP/err.txt")"
+    "$RAD" render "$TMP/perpendicular.obj" --bake "$TMP/par.radb" --size 8x8 -o "$TMP/perp.pfm" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q "the geometry differs" "$TMP/err.txt" && grep -q "does not fit this scene" "$TMP/err.txt" &&
+        ok "render --bake refuses another scene's bake of the same triangle count" ||
+        fail "render --bake refuses another scene's bake of the same triangle count" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+else
+    fail "bake parallel squares" "$(head -c 300 "$TMP/err.txt")"
+fi
 
 # ---- render -----------------------------------------------------------------------------
 if "$RAD" render cornell --method classic --size 64x64 --aa 4 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"; then

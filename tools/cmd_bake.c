@@ -10,7 +10,8 @@
    H = F B = F (E + L) is the irradiance from the secondary sources that the renderer adds to
    its per-pixel direct light. The bake holds the patches, F, E and B (rad_save_memory), plus
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
-   were made with, so `rad render --bake` can check that the file fits the scene.
+   were made with, so `rad render --bake` can check that the file fits the scene (with the
+   library's signature section, which also holds the hash of rad.options: rad_tool_sign_options).
    --method multibounce and temporal bake through methods.c (rad_tool_method_bake). */
 #include "tool.h"
 #include <stdio.h>
@@ -194,6 +195,22 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     return 0;
 }
 
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info)
+{
+    return rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
+}
+
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig)
+{
+    uint32_t i;
+    for (i = 0; i < count; ++i)
+        if (secs[i].type == RAD_SECTION_SIGNATURE && secs[i].elem_size == sizeof *sig && secs[i].count == 1) {
+            memcpy(sig, secs[i].data, sizeof *sig);
+            sig->options = rad_tool_options_hash(info);
+            secs[i].data = sig;
+        }
+}
+
 /* rad_save_memory's container plus our sections, written to 'path' */
 static int save_bake(const char *cmd, const char *path, const rad_tool_world *w, const rad_tool_classic_options *o,
                      const rad_tool_classic *c)
@@ -204,6 +221,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     rad_container *ct = NULL;
     rad_section *secs;
     rad_tool_bake_info info;
+    rad_bake_signature sig;
     uint32_t count, i, k = 0, n = c->patches->count;
     rad_result r;
     int rc = 1;
@@ -226,6 +244,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     info.bounces = o->bounces;
     info.light_samples = o->light_samples;
     info.triangle_count = w->scene->triangle_count;
+    rad_tool_sign_options(secs, k, &info, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->L;
     strcpy(secs[k++].name, "L");
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->H;

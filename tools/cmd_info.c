@@ -18,6 +18,7 @@ static const char *type_name(uint32_t type)
     case RAD_SECTION_FF_COLUMNS: return "FF_COLUMNS";
     case RAD_SECTION_FF_VALUES: return "FF_VALUES";
     case RAD_SECTION_VECTOR: return "VECTOR";
+    case RAD_SECTION_SIGNATURE: return "SIGNATURE";
     case RAD_SECTION_MB_INFO: return "MB_INFO";
     case RAD_SECTION_MB_FLOAT: return "MB_FLOAT";
     case RAD_SECTION_MB_HALF: return "MB_HALF";
@@ -187,6 +188,12 @@ int rad_cmd_info(int argc, char **argv)
         }
         printf("%s\n", any ? "" : " none");
     }
+    if (bake->signature)
+        printf("signature: geometry %016llx, materials %016llx, options %016llx\n",
+               (unsigned long long)bake->signature->geometry, (unsigned long long)bake->signature->materials,
+               (unsigned long long)bake->signature->options);
+    else
+        printf("signature: none (a bake of another scene with the same triangle count cannot be told apart)\n");
     {
         const rad_section *s = rad_container_find(ct, RAD_TOOL_SECTION_OPTIONS, "rad.options");
         if (s && s->elem_size == sizeof(rad_tool_bake_info) && s->count == 1) {

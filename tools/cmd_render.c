@@ -325,8 +325,9 @@ static const rad_tool_bake_info *bake_info(const rad_bake *bake)
     return info->magic == 0x52414442u ? info : NULL;
 }
 
-/* 0 when a loaded bake was made from this scene (its triangle count, and the patch count its
-   options give on this scene); else 1 with a message */
+/* 0 when a loaded bake was made from this scene (rad_bake_matches_scene: its triangle count,
+   geometry and materials, and its options section is the one it was baked with; then the
+   patch count its options give on this scene); else 1 with a message */
 static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bake *bake, const rad_tool_world *w)
 {
     const rad_tool_bake_info *info = bake_info(bake);
@@ -334,9 +335,8 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
     rad_result r;
     int rc = 0;
     rad_tool_context(&ctx, NULL);
-    if (bake->patches.triangle_count != w->scene->triangle_count) {
-        fprintf(stderr, "rad %s: bake '%s' was made from a scene of %u triangles, this one has %u\n", cmd, bake_path,
-                bake->patches.triangle_count, w->scene->triangle_count);
+    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info) : 0u, &ctx)) != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)\n", cmd, bake_path, rad_result_string(r));
         rc = 1;
     } else if (info) {
         /* the same patch options on this scene must give the same patches */

@@ -398,6 +398,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     rad_alias_tables *tables[3] = {NULL, NULL, NULL};
     rad_block_report report;
     rad_tool_bake_info info;
+    rad_bake_signature sig;
     rad_tool_method_info mi;
     rad_container *ct = NULL;
     rad_section *secs = NULL;
@@ -558,6 +559,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     info.bounces = mo->bounces;
     info.light_samples = o->light_samples;
     info.triangle_count = w->scene->triangle_count;
+    rad_tool_sign_options(secs, k, &info, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c.D;
     strcpy(secs[k++].name, "D");
     secs[k].type = RAD_TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;
@@ -673,6 +675,22 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
     if (!s || s->elem_size != 4 || s->count != n) {
         fprintf(stderr, "rad %s: bake '%s' holds no row sums of F for its %u patches (section rad.rowsums)\n", cmd,
                 bake_name, n);
+        return 1;
+    }
+    /* the values this file hands out are checked once here, as the library's loaders check theirs */
+    {
+        const float *S = (const float *)s->data;
+        uint32_t i;
+        for (i = 0; i < n; ++i)
+            if (!(S[i] >= 0.0f && S[i] <= RAD_BAKE_VALUE_MAX)) {
+                fprintf(stderr, "rad %s: bake '%s': section rad.rowsums, entry %u is %g (not in [0, 1e30])\n", cmd, bake_name,
+                        i, (double)S[i]);
+                return 1;
+            }
+    }
+    if (mo->method == RAD_TOOL_TEMPORAL && !(mo->given & RAD_TOOL_OPT_K) && (mi.k == 0 || mi.k > RAD_TEMPORAL_MAX_SAMPLES)) {
+        fprintf(stderr, "rad %s: bake '%s': section rad.method has k = %u draws per row (1 to %u, as --k)\n", cmd, bake_name,
+                mi.k, RAD_TEMPORAL_MAX_SAMPLES);
         return 1;
     }
     m = (rad_tool_indirect *)rad_tool_calloc(1, sizeof *m);

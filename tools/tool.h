@@ -208,6 +208,12 @@ typedef struct rad_tool_bake_info {
     uint32_t triangle_count; /* of the scene baked */
 } rad_tool_bake_info;
 #define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u)
+/* The hash of a rad.options record, kept in the bake's signature (rad_bake_signature.options)
+   so that a bake's options section is known to be the one it was made with. */
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info);
+/* Points the signature section among secs[0..count) (written by rad_save_memory with the scene's
+   hashes) at *sig, a copy with the options hash of 'info' added. */
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig);
 
 /* ---- lighting models for the direct term (shading.c) ------------------------------------ */
 /* "none" (-1) or a rad_shading_model name; 0 on success, else prints and returns 2 */
