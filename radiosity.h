@@ -2657,7 +2657,10 @@ static rad_result rad__for_rows(const rad__ctx *c, uint32_t count, uint32_t task
     rad_result r = RAD_SUCCESS;
     if (count == 0) return RAD_SUCCESS;
     job.results = (rad_result *)rad__alloc_array(&c->allocator, tasks, sizeof(rad_result));
-    if (!job.results) return RAD_ERROR_OUT_OF_MEMORY;
+    if (!job.results) {
+        rad__log(c, RAD_LOG_ERROR, "out of memory for %u task results", tasks);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
     job.fn = fn;
     job.data = data;
     job.tasks = tasks;
@@ -2672,8 +2675,16 @@ static rad_result rad__for_rows(const rad__ctx *c, uint32_t count, uint32_t task
         c->parallel_for(c->parallel_user, tasks, rad__rows_task, &job);
         for (t = 0; t < tasks; ++t)
             if (job.results[t] != RAD_SUCCESS) { r = job.results[t]; break; }
-        if (r == RAD_SUCCESS && c->progress && c->progress(c->progress_user, (float)(b + 1) / (float)batches))
+        /* tasks cannot log (they may run on other threads): their failure is reported here */
+        if (r == RAD_ERROR_RAYCAST_FAILED)
+            rad__log(c, RAD_LOG_ERROR, "a ray query callback (occluded or intersect) returned an error while rows %u to %u of %u "
+                     "ran: the call stops", job.begin, job.end - 1u, count);
+        else if (r != RAD_SUCCESS)
+            rad__log(c, RAD_LOG_ERROR, "rows %u to %u of %u: %s", job.begin, job.end - 1u, count, rad_result_string(r));
+        if (r == RAD_SUCCESS && c->progress && c->progress(c->progress_user, (float)(b + 1) / (float)batches)) {
             r = RAD_ERROR_CANCELLED;
+            rad__log(c, RAD_LOG_INFO, "cancelled by the progress callback after %u of %u rows", job.end, count);
+        }
     }
     rad__free(&c->allocator, job.results);
     return r;
@@ -4389,7 +4400,8 @@ static rad_result rad__ff_flush(rad__ff *f, uint32_t task, uint32_t count)
 static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t slot, uint32_t task, uint32_t *nrays)
 {
     const rad_patch *pl = &f->P->patches[lo], *ph = &f->P->patches[hi];
-    float vl[9], vh[9], r1, r2, d[3], rl = 0.0f, rh = 0.0f, scale = 1.0f, xs[3];
+    float vl[9], vh[9], r1, r2, d[3], rl = 0.0f, rh = 0.0f, scale = 1.0f, xs[3], xy[6 * RAD__MAX_SAMPLES];
+    double wk[RAD__MAX_SAMPLES], total = 0.0, ksum = 0.0;
     uint32_t S = f->o.samples, s, h, m, nside = 1;
     double *acc = f->acc + (size_t)task * f->P->count, PN[3];
     int k, near;
@@ -4421,6 +4433,12 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
     } else {
         near = 0;
     }
+    /* Analytic method: the pair's value is sum_s F(x_s) V_s. One ray per point to a uniform
+       point y_s of the source measures the visible share of its area, not of its form factor,
+       so a large or long source half hidden behind an edge lost (or gained) light. Each ray
+       carries instead its share k_s / sum k of the pair's total W = sum_s F(x_s), with k the
+       kernel cos cos / r^2 of its two points (a ratio estimator, exact when nothing occludes:
+       the shares sum to W). The Monte Carlo method's weights are its kernel already. */
     for (s = 0; s < S; ++s) {
         const float *x = xs;
         float y[3], u1, u2, w, dxy[3];
@@ -4429,18 +4447,36 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
         } else {
             x = f->pts + ((size_t)lo * S + s) * 3u;
         }
+        wk[s] = 0.0;
         rad__sub(dxy, x, vh);
         if (!(rad__dot(dxy, ph->normal) > 0.0f)) continue; /* x is behind the receiver */
         rad__hammersley(s, S, r1, r2, &u1, &u2);
         rad__triangle_point(vh, vh + 3, vh + 6, u1, u2, y);
+        memcpy(xy + 6 * s, x, 3 * sizeof(float));
+        memcpy(xy + 6 * s + 3, y, 3 * sizeof(float));
         if (f->o.method == RAD_FF_ANALYTIC) {
-            double P[3];
+            double P[3], kern;
+            float r2y;
             for (k = 0; k < 3; ++k) P[k] = x[k];
-            w = (float)fabs(rad__ff_point_tri(P, PN, vh));
+            w = (float)fabs(rad__ff_point_tri(P, PN, vh)) * scale;
+            if (!(w > 0.0f)) continue;
+            total += (double)w;
+            rad__sub(dxy, y, x);
+            r2y = rad__dot(dxy, dxy);
+            kern = r2y > 0.0f ? (double)rad__dot(dxy, pl->normal) * -(double)rad__dot(dxy, ph->normal) / ((double)r2y * (double)r2y)
+                              : 0.0;
+            wk[s] = kern > 0.0 ? kern : 0.0;
+            ksum += wk[s];
         } else {
-            w = rad_ff_point_point(x, pl->normal, y, ph->normal, ph->area);
+            w = rad_ff_point_point(x, pl->normal, y, ph->normal, ph->area) * scale;
+            wk[s] = w > 0.0f ? (double)w : 0.0;
         }
-        w *= scale;
+    }
+    for (s = 0; s < S; ++s) {
+        const float *x = xy + 6 * s, *y = xy + 6 * s + 3;
+        float w;
+        if (f->o.method == RAD_FF_ANALYTIC) w = ksum > 0.0 ? (float)(total * wk[s] / ksum) : 0.0f;
+        else w = (float)wk[s];
         if (!(w > 0.0f)) continue;
         if (f->o.skip_visibility) {
             acc[slot] += (double)w;

@@ -1107,7 +1107,77 @@ static void ff_test_bvh_watertight(void)
 /* the test table                                                                           */
 /* ---------------------------------------------------------------------------------------- */
 
+/* A small patch under a large source square (10 x 10 at height 1) with an occluder (1 x 1 at
+   height 0.5) straight between them: the occluder hides the 2 x 2 middle of the source, where
+   the kernel peaks. The visible form factor is F(10 x 10) - F(2 x 2) at the patch, in closed
+   form. A visibility ray aimed at a uniform point of the source saw the 4% of its area that
+   is hidden instead of the third of its form factor. */
+static void ff_test_partly_hidden_source(void)
+{
+    static const float rec[12] = { -0.01f, 0, -0.01f, -0.01f, 0, 0.01f, 0.01f, 0, 0.01f, 0.01f, 0, -0.01f };
+    static const float occ[12] = { -0.5f, 0.5f, -0.5f, 0.5f, 0.5f, -0.5f, 0.5f, 0.5f, 0.5f, -0.5f, 0.5f, 0.5f };
+    static const float src[12] = { -5, 1, -5, 5, 1, -5, 5, 1, 5, -5, 1, 5 };
+    static const float big[12] = { -5, 1, -5, 5, 1, -5, 5, 1, 5, -5, 1, 5 }, mid[12] = { -1, 1, -1, 1, 1, -1, 1, 1, 1, -1, 1, 1 };
+    static const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
+    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0 };
+    rad_mesh_desc mesh[3];
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_bvh *b = NULL;
+    rad_raycaster rc;
+    rad_form_factor_options fo;
+    float *rows = NULL, p0[3] = { 0, 0, 0 }, n0[3] = { 0, 1, 0 };
+    uint32_t i, r = RAD_NONE, N;
+    double F = 0.0, exact;
+    memset(mesh, 0, sizeof(mesh));
+    mesh[0].positions = rec;
+    mesh[1].positions = occ;
+    mesh[2].positions = src;
+    for (i = 0; i < 3; ++i) {
+        mesh[i].vertex_count = 4;
+        mesh[i].indices = idx;
+        mesh[i].triangle_count = 2;
+    }
+    memset(&d, 0, sizeof(d));
+    d.meshes = mesh;
+    d.mesh_count = 3;
+    d.materials = &m;
+    d.material_count = 1;
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    rad_patch_options_default(&po);
+    po.target_count = 6; /* one patch per triangle */
+    if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &b));
+    if (!P || !b) goto done;
+    N = P->count;
+    rad_bvh_raycaster(b, &rc);
+    rad_form_factor_options_default(&fo);
+    fo.samples = 64;
+    rows = (float *)malloc(sizeof(float) * N * N);
+    if (!rows) goto done;
+    CHECK_OK(rad_form_factor_rows(P, &rc, &fo, 0, N, rows, NULL));
+    for (i = 0; i < N; ++i)
+        if (S->meshes[P->patches[i].triangle] == 0 && r == RAD_NONE) r = i;
+    CHECK(r != RAD_NONE);
+    if (r == RAD_NONE) goto done;
+    for (i = 0; i < N; ++i)
+        if (S->meshes[P->patches[i].triangle] == 2) F += rows[(size_t)r * N + i];
+    exact = (double)rad_ff_point_polygon(p0, n0, big, 4) - (double)rad_ff_point_polygon(p0, n0, mid, 4);
+    /* the polygons' fronts face down, towards the patch; counter-clockwise from below */
+    printf("    F(patch -> source) %.4f, visible part in closed form %.4f (unoccluded %.4f)\n", F, exact,
+           (double)rad_ff_point_polygon(p0, n0, big, 4));
+    CHECK_REL(F, exact, 0.05);
+done:
+    free(rows);
+    rad_bvh_destroy(b);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
 static const rad_test_case tests_formfactor[] = {
+    {"formfactor_partly_hidden_source", ff_test_partly_hidden_source},
     { "formfactor_point_polygon_square", ff_test_point_polygon_square },
     { "formfactor_point_polygon_disk", ff_test_point_polygon_disk },
     { "formfactor_point_polygon_clip", ff_test_point_polygon_clip },
