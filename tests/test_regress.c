@@ -520,6 +520,57 @@ done:
     rad_scene_destroy(S);
 }
 
+/* adversarial pass (issue 23): a raycaster callback's failure came back as RAYCAST_FAILED
+   with nothing in the log, so a user could not tell which call or why. */
+static int rg_log_lines;
+static char rg_log_last[512];
+static void rg_log(void *user, rad_log_level level, const char *message)
+{
+    (void)user;
+    (void)level;
+    rg_log_lines++;
+    snprintf(rg_log_last, sizeof(rg_log_last), "%s", message);
+}
+static rad_result rg_failing_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
+{
+    (void)user; (void)rays; (void)count; (void)out;
+    return RAD_ERROR_IO;
+}
+
+static void rg_test_raycaster_failure_logged(void)
+{
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_raycaster rc;
+    rad_form_factors *ff = NULL;
+    rad_context ctx;
+    float *D = NULL;
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.log = rg_log;
+    rad_cornell_box(&d, NULL);
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    rad_patch_options_default(&po);
+    po.target_count = 30;
+    if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
+    if (!P) goto done;
+    memset(&rc, 0, sizeof(rc));
+    rc.occluded = rg_failing_occluded;
+    rg_log_lines = 0;
+    CHECK_RESULT(rad_form_factors_dense(P, &rc, NULL, &ctx, &ff), RAD_ERROR_RAYCAST_FAILED);
+    CHECK(rg_log_lines >= 1 && strstr(rg_log_last, "ray query callback") != NULL);
+    D = (float *)malloc(sizeof(float) * 3 * P->count);
+    rg_log_lines = 0;
+    if (D) CHECK_RESULT(rad_direct_patches(P, &rc, NULL, 0, NULL, D, &ctx), RAD_ERROR_RAYCAST_FAILED);
+    CHECK(rg_log_lines >= 1 && strstr(rg_log_last, "ray query callback") != NULL);
+done:
+    free(D);
+    rad_form_factors_destroy(ff);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
 static const rad_test_case tests_regress[] = {
     { "regress_point_light_overflow", rg_test_point_light_overflow },
     { "regress_emission_overflow", rg_test_emission_overflow },
@@ -528,6 +579,7 @@ static const rad_test_case tests_regress[] = {
     { "regress_hand_made_systems", rg_test_hand_made_systems },
     { "regress_scene_scale", rg_test_scene_scale },
     { "regress_epsilon_and_normals", rg_test_epsilon_and_normals },
+    { "regress_raycaster_failure_logged", rg_test_raycaster_failure_logged },
 #ifndef RAD_NO_STDIO
     { "regress_file_io", rg_test_file_io },
 #endif
