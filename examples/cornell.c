@@ -21,9 +21,16 @@
                          [--spp N] [--light-samples N] [--bounces N]                        */
 
 #if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
-#  define _POSIX_C_SOURCE 199309L /* clock_gettime */
+#  define _POSIX_C_SOURCE 200112L /* clock_gettime; isatty and fileno */
 #endif
 
+#if defined(__unix__) || defined(__APPLE__)
+#include <stdio.h>
+#include <unistd.h>
+#define CORNELL_ISATTY(f) isatty(fileno(f))
+#else
+#define CORNELL_ISATTY(f) 1
+#endif
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
 #include "png_write.h"
@@ -79,12 +86,24 @@ typedef struct progress_state {
     int last;
 } progress_state;
 
+/* On a terminal one line updated in place; in a file or pipe a line per 25% */
+static int progress_on_tty(void)
+{
+    static int tty = -1;
+    if (tty < 0) tty = CORNELL_ISATTY(stderr) ? 1 : 0;
+    return tty;
+}
+
 static int on_progress(void *user, float fraction)
 {
     progress_state *s = (progress_state *)user;
     int pct = (int)(fraction * 100.0f + 0.5f);
     if (pct != s->last) {
-        fprintf(stderr, "\r  %-14s %3d%%", s->label, pct);
+        if (progress_on_tty()) {
+            fprintf(stderr, "\r  %-14s %3d%%", s->label, pct);
+        } else if (pct / 25 != (s->last < 0 ? -1 : s->last / 25)) {
+            fprintf(stderr, "  %-14s %3d%%\n", s->label, pct);
+        }
         fflush(stderr);
         s->last = pct;
     }
@@ -99,7 +118,7 @@ static void progress_begin(progress_state *s, const char *label)
 
 static void progress_end(progress_state *s)
 {
-    if (s->last >= 0) {
+    if (s->last >= 0 && progress_on_tty()) {
         fprintf(stderr, "\r%40s\r", "");
         fflush(stderr);
     }
@@ -476,11 +495,11 @@ int main(int argc, char **argv)
                 samples_clipped += (uint64_t)clipped;
             }
         }
-        fprintf(stderr, "\r  %-14s %3d%%", "render", (int)(100.0 * y1 / height + 0.5));
+        if (progress_on_tty()) fprintf(stderr, "\r  %-14s %3d%%", "render", (int)(100.0 * y1 / height + 0.5));
         fflush(stderr);
     }
     t_render = now_seconds() - t0;
-    fprintf(stderr, "\r%40s\r", "");
+    if (progress_on_tty()) fprintf(stderr, "\r%40s\r", "");
     for (i = 0; i < 3 * width * height; ++i) image[i] = srgb8(accum[i] / (float)spp);
     if (png_write_rgb8(out_path, width, height, image, (size_t)3 * width) != 0) {
         fprintf(stderr, "cornell: cannot write %s\n", out_path);

@@ -632,5 +632,14 @@ else
     fail "report --check passes a full table"
 fi
 
+# ---- a new user's first runs: what the tool says ------------------------------------------
+"$RAD" help 2>&1 | grep -q 'local|vp|aavp' && ok "help lists every render method" || fail "help lists every render method"
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n' > "$TMP/nolight.obj"
+"$RAD" render "$TMP/nolight.obj" -o "$TMP/nolight.png" --size 16x16 --patches 1 > /dev/null 2> "$TMP/err.txt"
+grep -q "no emitters and no lights" "$TMP/err.txt" && ok "render warns about a scene without light" ||
+    fail "render warns about a scene without light" "$(head -c 300 "$TMP/err.txt")"
+grep -q "below the 2 triangles" "$TMP/err.txt" && ok "render says --patches below the triangle count" ||
+    fail "render says --patches below the triangle count" "$(head -c 300 "$TMP/err.txt")"
+
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

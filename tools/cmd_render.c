@@ -822,6 +822,19 @@ int rad_cmd_render(int argc, char **argv)
     }
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    {
+        uint32_t t, emitters = 0;
+        for (t = 0; t < w.scene->triangle_count; ++t) {
+            const float *Le = w.scene->materials_table[w.scene->materials[t]].emission;
+            if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) ++emitters;
+        }
+        if (!emitters && !w.file.light_count)
+            fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
+        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL) && !pathtrace && !bake_path &&
+            o.patches < w.scene->triangle_count)
+            fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
+                    cmd, o.patches, w.scene->triangle_count);
+    }
     if (!have_cam) cam = w.file.camera;
     else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
     if (fov > 0.0f) cam.fov_y_degrees = fov;
