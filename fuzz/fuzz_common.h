@@ -47,15 +47,15 @@ static inline int fuzz_bounded(const float *v, size_t n, float bound)
     return 1;
 }
 
-/* Accepted inputs whose values were not tame enough for fuzz_bounded (NaN, Inf or huge
-   values that the loaders let through): counted, and the count printed when the process
-   exits, so a run's log says how often it met them. */
+/* Loaded objects (one per load: several per input and pass) whose values were not tame
+   enough for fuzz_bounded (NaN, Inf or huge values that the loaders let through): counted,
+   and the count printed when the process exits, so a run's log says how often it met them. */
 static unsigned long fuzz_untamed_count;
 static const char *fuzz_untamed_what = "";
 static void fuzz_untamed_report(void)
 {
     if (fuzz_untamed_count)
-        fprintf(stderr, "fuzz: %lu accepted inputs held %s (not checked for finite outputs)\n", fuzz_untamed_count,
+        fprintf(stderr, "fuzz: %lu loaded objects held %s (not checked for finite outputs)\n", fuzz_untamed_count,
                 fuzz_untamed_what);
 }
 static inline void fuzz_untamed(const char *what)
