@@ -123,7 +123,7 @@ fuzz: | $(BUILD)
 	./$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus
 	failed=""; for f in $(FUZZ_HARNESSES); do \
 	    if $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm && \
-	       ./$(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/fuzz/$$f- $(BUILD)/fuzz/corpus/$$f; \
+	       TMPDIR=$(BUILD)/fuzz ./$(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/fuzz/$$f- $(BUILD)/fuzz/corpus/$$f; \
 	    then :; else failed="$$failed $$f"; fi; \
 	done; \
 	if [ -n "$$failed" ]; then echo "fuzz: failed:$$failed"; exit 1; fi

@@ -255,7 +255,8 @@ if have clang && have clang++; then
     if printf 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n){(void)d;(void)n;return 0;}' |
         clang -fsanitize=fuzzer -x c - -o /dev/null 2>/dev/null; then
         echo "== fuzz smoke"
-        # one harness per loader; the builds (about 45 s each) run two at a time
+        # one harness per loader; the builds (about 45 s each) run two at a time; TMPDIR: where
+        # fuzz_stream writes its input file (left behind when it crashes)
         FUZZERS="container scene stream multibounce temporal"
         for f in $FUZZERS; do mkdir -p "$BUILD/fuzz/$f"; done
         if build make-corpus $CC -std=c99 -O2 -I. fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
@@ -270,8 +271,8 @@ if have clang && have clang++; then
             wait
             for f in $FUZZERS; do
                 if [ -x "$BUILD/fuzz_$f" ] &&
-                   { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
-                   "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
+                   { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || TMPDIR="$BUILD" "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
+                   TMPDIR="$BUILD" "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
                        "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
                     pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
                 else
