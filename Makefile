@@ -110,17 +110,23 @@ report: $(BUILD)/rad $(BUILD)/temporal
 report-quick: $(BUILD)/rad $(BUILD)/temporal
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --quick --out $(BUILD)/report-quick --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal
 
-# libFuzzer harnesses (clang with libclang-rt-14-dev): FUZZ_SECONDS per fuzzer
+# libFuzzer harnesses (clang with libclang-rt-14-dev), one per loader: FUZZ_SECONDS per
+# fuzzer, every harness run even when one fails (the target fails at the end); the corpora
+# grow in $(BUILD)/fuzz/corpus/<harness>, crash inputs land in $(BUILD)/fuzz/<harness>-crash-*.
+# One harness: make fuzz FUZZ_HARNESSES=stream
 FUZZ_SECONDS ?= 300
 FUZZ_CC ?= clang
+FUZZ_HARNESSES ?= container scene stream multibounce temporal
 fuzz: | $(BUILD)
-	mkdir -p $(BUILD)/fuzz/corpus_container $(BUILD)/fuzz/corpus_scene
+	mkdir -p $(addprefix $(BUILD)/fuzz/corpus/,container scene stream multibounce temporal)
 	$(CC) -std=c99 -O2 -I. fuzz/make_corpus.c -o $(BUILD)/fuzz/make_corpus -lm
-	./$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus_container $(BUILD)/fuzz/corpus_scene
-	for f in container scene; do \
-	    $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm || exit 1; \
-	    ./$(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 $(BUILD)/fuzz/corpus_$$f || exit 1; \
-	done
+	./$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus
+	failed=""; for f in $(FUZZ_HARNESSES); do \
+	    if $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm && \
+	       TMPDIR=$(BUILD)/fuzz ./$(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/fuzz/$$f- $(BUILD)/fuzz/corpus/$$f; \
+	    then :; else failed="$$failed $$f"; fi; \
+	done; \
+	if [ -n "$$failed" ]; then echo "fuzz: failed:$$failed"; exit 1; fi
 
 clean:
 	rm -rf $(BUILD) cornell.png gallery.png tools/rad

@@ -8,26 +8,9 @@
    Build: clang -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_container.c */
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
-#include <stdlib.h>
-#include <string.h>
+#include "fuzz_common.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-
-/* recomputes the checksums of whatever sections the table describes, when they are in range */
-static void fix_checksums(unsigned char *p, size_t size)
-{
-    uint32_t count, i;
-    if (size < 64) return;
-    count = rad__get32(p + 8);
-    if (count > 4096 || 64 + 64 * (size_t)count > size) return;
-    for (i = 0; i < count; ++i) {
-        unsigned char *e = p + 64 + 64 * (size_t)i;
-        uint64_t off = rad__get64(e + 16), bytes = rad__get64(e + 24);
-        if (off <= size && bytes <= size - off) rad__put32(e + 32, rad__crc32(p + off, (size_t)bytes));
-    }
-    rad__put32(p + 36, rad__crc32(p + 64, 64 * (size_t)count));
-    rad__put32(p + 60, rad__crc32(p, 60));
-}
 
 static void exercise(void *buf, size_t size);
 
@@ -38,7 +21,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size) memcpy(buf, data, size);
     exercise(buf, size);
     if (size) memcpy(buf, data, size);
-    fix_checksums((unsigned char *)buf, size);
+    fuzz_fix_checksums((unsigned char *)buf, size);
     exercise(buf, size);
     free(buf);
     return 0;

@@ -1,7 +1,17 @@
-/* make_corpus.c - writes the fuzzers' seed corpora: valid bakes of the Cornell box (dense and
-   sparse, with and without vectors) and scene inputs describing a quad, a box and the Cornell
-   box's first meshes in fuzz_scene.c's byte format.
-   Usage: make_corpus CONTAINER_DIR SCENE_DIR */
+/* make_corpus.c - writes the fuzzers' seed corpora into DIR/<harness>/ (the folders must
+   exist):
+   - container: valid bakes of the Cornell box (dense and sparse, with and without vectors);
+   - scene: scene inputs describing a quad and the Cornell box's first meshes in
+     fuzz_scene.c's byte format;
+   - stream: CSR bakes (what rad_row_stream_open reads), at two sizes;
+   - multibounce: F_mb of a small Cornell box as saved by rad_multibounce_sections and
+     rad_multibounce_blocks_sections: float, half with permutations, 3xBC4 with scale tiles,
+     permutations and outliers, BC1 with one scale and none, BC1 with all of them, and one
+     container holding several objects;
+   - temporal: alias tables as saved by rad_alias_tables_sections: compact tables of the
+     sparse F, wide tables of the dense F, and the three per-channel tables of F_mb
+     (Fmb.r, Fmb.g, Fmb.b) in one container.
+   Usage: make_corpus DIR */
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include <stdio.h>
@@ -17,6 +27,108 @@ static void write_file(const char *dir, const char *name, const void *data, size
     if (!f) { fprintf(stderr, "cannot write %s\n", path); exit(1); }
     fwrite(data, 1, size, f);
     fclose(f);
+}
+
+static void write_sections(const char *dir, const char *name, const rad_section *s, uint32_t count)
+{
+    size_t size;
+    void *buf;
+    if (rad_container_size(s, count, &size) != RAD_SUCCESS || !(buf = malloc(size)) ||
+        rad_container_write(s, count, buf, size) != RAD_SUCCESS) {
+        fprintf(stderr, "cannot build %s/%s\n", dir, name);
+        exit(1);
+    }
+    write_file(dir, name, buf, size);
+    free(buf);
+}
+
+static void need(rad_result r, const char *what)
+{
+    if (r != RAD_SUCCESS) { fprintf(stderr, "make_corpus: %s: %s\n", what, rad_result_string(r)); exit(1); }
+}
+
+/* the multi-bounce and alias-table seeds, from a smaller Cornell box (fast inputs) */
+static void write_method_seeds(const char *root, const rad_scene *s, const rad_raycaster *rc)
+{
+    char mdir[1024], tdir[1024];
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_patches *P = NULL;
+    rad_form_factors *dense = NULL, *sparse = NULL;
+    rad_multibounce *mb = NULL, *half = NULL, *perm = NULL;
+    rad_multibounce_blocks *bc4 = NULL, *bc1 = NULL, *bc1p = NULL;
+    rad_block_options bo;
+    rad_alias_tables *compact = NULL, *wide = NULL, *ch[3] = { NULL, NULL, NULL };
+    rad_section sec[4 * RAD_MB_MAX_SECTIONS];
+    uint32_t k, total, c;
+    static const char *const chname[3] = { "Fmb.r", "Fmb.g", "Fmb.b" };
+    snprintf(mdir, sizeof(mdir), "%s/multibounce", root);
+    snprintf(tdir, sizeof(tdir), "%s/temporal", root);
+    rad_patch_options_default(&po);
+    po.target_count = 12;
+    need(rad_patches_create(s, &po, NULL, &P), "patches");
+    rad_form_factor_options_default(&fo);
+    fo.samples = 1;
+    need(rad_form_factors_dense(P, rc, &fo, NULL, &dense), "dense form factors");
+    fo.drop_threshold = 1e-3f;
+    need(rad_form_factors_sparse(P, rc, &fo, NULL, &sparse), "sparse form factors");
+    need(rad_multibounce_create(&dense->matrix, P->albedo, NULL, NULL, &mb), "F_mb");
+    need(rad_multibounce_reorder(mb, 0, NULL, &perm), "reorder");
+    need(rad_multibounce_convert(perm, RAD_MB_HALF, NULL, &half), "half");
+    rad_block_options_default(&bo);
+    bo.tile = 8;
+    need(rad_multibounce_blocks_create(mb, &bo, NULL, &bc4, NULL), "3xBC4");
+    bo.format = RAD_BLOCK_BC1;
+    bo.tile = 0;
+    bo.outlier_fraction = 0.0f;
+    bo.reorder = RAD_REORDER_NONE;
+    need(rad_multibounce_blocks_create(mb, &bo, NULL, &bc1, NULL), "BC1");
+    bo.tile = 4;
+    bo.outlier_fraction = 0.1f;
+    bo.reorder = RAD_REORDER_GREEDY;
+    need(rad_multibounce_blocks_create(mb, &bo, NULL, &bc1p, NULL), "BC1 with outliers");
+    need(rad_multibounce_sections(mb, "Fmb", sec, &k), "sections");
+    write_sections(mdir, "float.radb", sec, k);
+    need(rad_multibounce_sections(half, "Fmb", sec, &k), "sections");
+    write_sections(mdir, "half_perm.radb", sec, k);
+    need(rad_multibounce_blocks_sections(bc4, "Fmb", sec, &k), "sections");
+    write_sections(mdir, "bc4_tiles_perm_outliers.radb", sec, k);
+    need(rad_multibounce_blocks_sections(bc1, "Fmb", sec, &k), "sections");
+    write_sections(mdir, "bc1_plain.radb", sec, k);
+    need(rad_multibounce_blocks_sections(bc1p, "Fmb", sec, &k), "sections");
+    write_sections(mdir, "bc1_tiles_perm_outliers.radb", sec, k);
+    total = 0;
+    need(rad_multibounce_sections(mb, "Fmb", sec, &k), "sections");
+    total += k;
+    need(rad_multibounce_sections(half, "Fmb-half", sec + total, &k), "sections");
+    total += k;
+    need(rad_multibounce_blocks_sections(bc1, "Fmb-bc1", sec + total, &k), "sections");
+    total += k;
+    write_sections(mdir, "several.radb", sec, total);
+    /* alias tables */
+    need(rad_alias_tables_create(&sparse->matrix, RAD_ALIAS_AUTO, NULL, &compact), "compact alias tables");
+    need(rad_alias_tables_create(&dense->matrix, RAD_ALIAS_WIDE, NULL, &wide), "wide alias tables");
+    for (c = 0; c < 3; ++c)
+        need(rad_alias_tables_create_dense(mb->planes + (size_t)c * mb->n * mb->n, mb->n, RAD_ALIAS_AUTO, NULL, &ch[c]),
+             "per-channel alias tables");
+    rad_alias_tables_sections(compact, "F", sec);
+    write_sections(tdir, "compact.radb", sec, 3);
+    rad_alias_tables_sections(wide, "F", sec);
+    write_sections(tdir, "wide.radb", sec, 3);
+    for (c = 0; c < 3; ++c) rad_alias_tables_sections(ch[c], chname[c], sec + 3 * c);
+    write_sections(tdir, "fmb_channels.radb", sec, 9);
+    for (c = 0; c < 3; ++c) rad_alias_tables_destroy(ch[c]);
+    rad_alias_tables_destroy(compact);
+    rad_alias_tables_destroy(wide);
+    rad_multibounce_blocks_destroy(bc1p);
+    rad_multibounce_blocks_destroy(bc1);
+    rad_multibounce_blocks_destroy(bc4);
+    rad_multibounce_destroy(half);
+    rad_multibounce_destroy(perm);
+    rad_multibounce_destroy(mb);
+    rad_form_factors_destroy(dense);
+    rad_form_factors_destroy(sparse);
+    rad_patches_destroy(P);
 }
 
 static void put_f(unsigned char **p, float v) { memcpy(*p, &v, 4); *p += 4; }
@@ -35,7 +147,10 @@ int main(int argc, char **argv)
     void *buf;
     size_t size;
     uint32_t i;
-    if (argc < 3) { fprintf(stderr, "usage: make_corpus CONTAINER_DIR SCENE_DIR\n"); return 2; }
+    char dir[5][1024];
+    static const char *const sub[5] = { "container", "scene", "stream", "multibounce", "temporal" };
+    if (argc != 2) { fprintf(stderr, "usage: make_corpus DIR (with DIR/container, scene, stream, multibounce, temporal)\n"); return 2; }
+    for (i = 0; i < 5; ++i) snprintf(dir[i], sizeof(dir[i]), "%s/%s", argv[1], sub[i]);
     rad_cornell_box(&d, NULL);
     if (rad_scene_create(&d, NULL, &s) != RAD_SUCCESS) return 1;
     rad_patch_options_default(&po);
@@ -50,9 +165,13 @@ int main(int argc, char **argv)
     rad_form_factors_sparse(P, &rc, &fo, NULL, &sparse);
     E = (float *)malloc(sizeof(float) * 3 * P->count);
     rad_sources(P, RAD_SOURCE_EMISSION, NULL, E);
-    if (rad_save_memory(P, &dense->matrix, E, E, NULL, &buf, &size) == RAD_SUCCESS) { write_file(argv[1], "dense.radb", buf, size); rad_free_buffer(buf, NULL); }
-    if (rad_save_memory(P, &sparse->matrix, E, NULL, NULL, &buf, &size) == RAD_SUCCESS) { write_file(argv[1], "sparse.radb", buf, size); rad_free_buffer(buf, NULL); }
-    if (rad_save_memory(P, NULL, NULL, NULL, NULL, &buf, &size) == RAD_SUCCESS) { write_file(argv[1], "patches.radb", buf, size); rad_free_buffer(buf, NULL); }
+    if (rad_save_memory(P, &dense->matrix, E, E, NULL, &buf, &size) == RAD_SUCCESS) { write_file(dir[0], "dense.radb", buf, size); rad_free_buffer(buf, NULL); }
+    if (rad_save_memory(P, &sparse->matrix, E, NULL, NULL, &buf, &size) == RAD_SUCCESS) {
+        write_file(dir[0], "sparse.radb", buf, size);
+        write_file(dir[2], "sparse.radb", buf, size);
+        rad_free_buffer(buf, NULL);
+    }
+    if (rad_save_memory(P, NULL, NULL, NULL, NULL, &buf, &size) == RAD_SUCCESS) { write_file(dir[0], "patches.radb", buf, size); rad_free_buffer(buf, NULL); }
     /* scene seeds: header (meshes-1, materials, target, flags), materials, then per mesh
        (vertex count, triangle count, use ids), positions, indices, ids, material */
     {
@@ -67,7 +186,7 @@ int main(int argc, char **argv)
         *p++ = 0; *p++ = 1;
         *p++ = 0;
         put_f(&p, 0.5f); put_f(&p, 0.5f); put_f(&p, 1.0f);
-        write_file(argv[2], "quad.bin", seed, (size_t)(p - seed));
+        write_file(dir[1], "quad.bin", seed, (size_t)(p - seed));
         /* the Cornell box's floor, back wall and light as three meshes */
         p = seed;
         *p++ = 2; *p++ = 2; *p++ = 60; *p++ = 1;
@@ -83,8 +202,23 @@ int main(int argc, char **argv)
             *p++ = (unsigned char)(i == 2 ? 1 : 0);
         }
         put_f(&p, 0.3f); put_f(&p, 0.5f); put_f(&p, 0.3f);
-        write_file(argv[2], "cornell3.bin", seed, (size_t)(p - seed));
+        write_file(dir[1], "cornell3.bin", seed, (size_t)(p - seed));
     }
+    /* a smaller CSR bake for the stream (fewer entries per row: faster inputs) */
+    {
+        rad_patches *Q = NULL;
+        rad_form_factors *q = NULL;
+        po.target_count = 12;
+        fo.drop_threshold = 1e-2f;
+        if (rad_patches_create(s, &po, NULL, &Q) == RAD_SUCCESS && rad_form_factors_sparse(Q, &rc, &fo, NULL, &q) == RAD_SUCCESS &&
+            rad_save_memory(Q, &q->matrix, NULL, NULL, NULL, &buf, &size) == RAD_SUCCESS) {
+            write_file(dir[2], "sparse_small.radb", buf, size);
+            rad_free_buffer(buf, NULL);
+        }
+        rad_form_factors_destroy(q);
+        rad_patches_destroy(Q);
+    }
+    write_method_seeds(argv[1], s, &rc);
     free(E);
     rad_form_factors_destroy(dense);
     rad_form_factors_destroy(sparse);

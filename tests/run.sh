@@ -255,16 +255,28 @@ if have clang && have clang++; then
     if printf 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n){(void)d;(void)n;return 0;}' |
         clang -fsanitize=fuzzer -x c - -o /dev/null 2>/dev/null; then
         echo "== fuzz smoke"
-        mkdir -p "$BUILD/fuzz/container" "$BUILD/fuzz/scene"
+        # one harness per loader; the builds (about 45 s each) run two at a time; TMPDIR: where
+        # fuzz_stream writes its input file (left behind when it crashes)
+        FUZZERS="container scene stream multibounce temporal"
+        for f in $FUZZERS; do mkdir -p "$BUILD/fuzz/$f"; done
         if build make-corpus $CC -std=c99 -O2 -I. fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
-           "$BUILD/make_corpus" "$BUILD/fuzz/container" "$BUILD/fuzz/scene"; then
-            for f in container scene; do
-                if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
-                   { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f-crashes.log" 2>&1; } &&
-                   "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
+           "$BUILD/make_corpus" "$BUILD/fuzz"; then
+            running=0
+            for f in $FUZZERS; do
+                rm -f "$BUILD/fuzz_$f"
+                build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &
+                running=$((running + 1))
+                if [ "$running" -ge 2 ]; then wait -n; running=$((running - 1)); fi
+            done
+            wait
+            for f in $FUZZERS; do
+                if [ -x "$BUILD/fuzz_$f" ] &&
+                   { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || TMPDIR="$BUILD" "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
+                   TMPDIR="$BUILD" "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
+                       "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
                     pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
                 else
-                    tail -20 "$BUILD/fuzz-$f.log" | sed 's/^/    /'
+                    tail -20 "$BUILD/fuzz-$f.log" 2>/dev/null | sed 's/^/    /'
                     fail "fuzz-$f"
                 fi
             done
