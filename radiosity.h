@@ -13108,8 +13108,10 @@ static rad_result rad__vp_ff_row(void *data, uint32_t u, uint32_t task)
             if (!(cj > 0.0f)) continue;
             d2 = rad__dot(d, d);
             fl = (ei > ej ? ei : ej) / (float)RAD__PI;
-            /* cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2 */
-            g = vp->sample_areas[i] * vp->sample_areas[j] * (ci / d2) * (cj / (d2 > fl ? d2 : fl)) / (float)RAD__PI;
+            /* cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2; each factor s (c / d^2)
+               is a length, so no product leaves float's range (s_i s_j alone overflowed in
+               scenes of 1e12 and underflowed below 1e-9) */
+            g = (vp->sample_areas[i] * (ci / d2)) * (vp->sample_areas[j] * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI;
             if (!(g > 0.0f)) continue;
             if (b->o.skip_visibility) {
                 rad__vp_pair_add(b, acc, u, i, j, (double)g);
@@ -13196,7 +13198,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
                 if (!(cj > 0.0f)) continue;
                 d2 = rad__dot(d, d);
                 fl = (ei > ej ? ei : ej) / (float)RAD__PI;
-                g = si * sj * (ci / d2) * (cj / (d2 > fl ? d2 : fl)) / (float)RAD__PI;
+                g = (si * (ci / d2)) * (sj * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI; /* as above */
                 if (!(g > 0.0f)) continue;
                 for (c = 0; c < 6; ++c) t6[c] += (double)g * (double)wj[c];
                 if (b->o.skip_visibility) continue;

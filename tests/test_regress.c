@@ -571,6 +571,79 @@ done:
     rad_scene_destroy(S);
 }
 
+/* adversarial pass (issue 23): virtual patches failed at scale 1e12 (NaN form factors,
+   reported as if the lights were too strong) and lost half the light at 1e-12 without a word:
+   the pair kernel multiplied two sample areas (length^4) in float. */
+static double rg_vp_mean(double scale, rad_result *why)
+{
+    rad_scene_desc d;
+    rad_mesh_desc m[16];
+    float *pos[16];
+    rad_scene *S = NULL;
+    rad_bvh *b = NULL;
+    rad_raycaster rc;
+    rad_vp_options vo;
+    rad_virtual_patches *vp = NULL;
+    rad_system sys;
+    rad_solve_options so;
+    uint32_t i, k;
+    float *E = NULL, *B = NULL;
+    double mean = -1.0;
+    rad_cornell_box(&d, NULL);
+    if (d.mesh_count > 16) return -1.0;
+    for (i = 0; i < d.mesh_count; ++i) {
+        m[i] = d.meshes[i];
+        pos[i] = (float *)malloc(sizeof(float) * 3 * m[i].vertex_count);
+        if (pos[i])
+            for (k = 0; k < 3 * m[i].vertex_count; ++k) pos[i][k] = (float)(m[i].positions[k] * scale);
+        m[i].positions = pos[i];
+    }
+    d.meshes = m;
+    *why = rad_scene_create(&d, NULL, &S);
+    if (*why == RAD_SUCCESS) *why = rad_bvh_create(S, NULL, &b);
+    if (*why != RAD_SUCCESS) goto out;
+    (rad_bvh_raycaster)(b, &rc);
+    rad_vp_options_default(&vo);
+    vo.resolution = 4;
+    *why = rad_vp_create(S, &rc, &vo, NULL, &vp);
+    if (*why != RAD_SUCCESS) goto out;
+    E = (float *)calloc(3 * (size_t)vp->count, sizeof(float));
+    B = (float *)calloc(3 * (size_t)vp->count, sizeof(float));
+    if (!E || !B) goto out;
+    *why = rad_vp_sources(vp, &rc, NULL, 0, NULL, RAD_SOURCE_DIRECT, E, NULL);
+    if (*why != RAD_SUCCESS) goto out;
+    rad_vp_system(&sys, vp, E);
+    rad_solve_options_default(&so);
+    so.bounces = 8;
+    so.output = RAD_OUTPUT_TOTAL;
+    *why = rad_solve_jacobi(&sys, &so, B, NULL, NULL);
+    if (*why != RAD_SUCCESS) goto out;
+    mean = 0.0;
+    for (i = 0; i < 3 * vp->count; ++i) mean += (double)B[i] * sys.areas[i / 3] / (scale * scale);
+out:
+    free(E);
+    free(B);
+    rad_vp_destroy(vp);
+    (rad_bvh_destroy)(b);
+    rad_scene_destroy(S);
+    for (i = 0; i < d.mesh_count; ++i) free(pos[i]);
+    return mean;
+}
+
+static void rg_test_vp_scale(void)
+{
+    rad_result why = RAD_SUCCESS;
+    double m0 = rg_vp_mean(1.0, &why), m;
+    CHECK_OK(why);
+    CHECK(m0 > 0.0);
+    m = rg_vp_mean(1e-12, &why);
+    CHECK_OK(why);
+    CHECK_REL(m, m0, 1e-4);
+    m = rg_vp_mean(1e12, &why);
+    CHECK_OK(why);
+    CHECK_REL(m, m0, 1e-4);
+}
+
 static const rad_test_case tests_regress[] = {
     { "regress_point_light_overflow", rg_test_point_light_overflow },
     { "regress_emission_overflow", rg_test_emission_overflow },
@@ -578,6 +651,7 @@ static const rad_test_case tests_regress[] = {
     { "regress_nonfinite_products", rg_test_nonfinite_products },
     { "regress_hand_made_systems", rg_test_hand_made_systems },
     { "regress_scene_scale", rg_test_scene_scale },
+    { "regress_vp_scale", rg_test_vp_scale },
     { "regress_epsilon_and_normals", rg_test_epsilon_and_normals },
     { "regress_raycaster_failure_logged", rg_test_raycaster_failure_logged },
 #ifndef RAD_NO_STDIO
