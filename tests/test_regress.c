@@ -276,11 +276,38 @@ static void rg_test_hand_made_systems(void)
    underflowed), so images came out black with success. Radiosity is scale-free: the mean
    radiosity, the direct light and the camera hits must be those of the unit box at both
    ends of the supported range, and a scene outside it is refused by name. */
-static int rg_scaled_cornell(double scale, double *mean_B, double *mean_direct, uint32_t *hits, rad_result *why)
+/* The built-in Cornell box scaled by 'scale' (and its camera, when cam is not NULL): the
+   scene copies the positions, so the scaled copies live only for the call. */
+static rad_result rg_cornell_scaled(double scale, rad_camera *cam, rad_scene **out)
 {
     rad_scene_desc d;
     rad_mesh_desc m[16];
     float *pos[16];
+    uint32_t i, k;
+    rad_result r;
+    rad_camera c;
+    rad_cornell_box(&d, &c);
+    if (d.mesh_count > 16) return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < d.mesh_count; ++i) {
+        m[i] = d.meshes[i];
+        pos[i] = (float *)malloc(sizeof(float) * 3 * m[i].vertex_count);
+        if (pos[i])
+            for (k = 0; k < 3 * m[i].vertex_count; ++k) pos[i][k] = (float)(m[i].positions[k] * scale);
+        m[i].positions = pos[i];
+    }
+    d.meshes = m;
+    r = rad_scene_create(&d, NULL, out);
+    for (i = 0; i < d.mesh_count; ++i) free(pos[i]);
+    for (k = 0; k < 3; ++k) {
+        c.position[k] = (float)(c.position[k] * scale);
+        c.target[k] = (float)(c.target[k] * scale);
+    }
+    if (cam) *cam = c;
+    return r;
+}
+
+static int rg_scaled_cornell(double scale, double *mean_B, double *mean_direct, uint32_t *hits, rad_result *why)
+{
     rad_scene *S = NULL;
     rad_patches *P = NULL;
     rad_bvh *b = NULL;
@@ -292,20 +319,10 @@ static int rg_scaled_cornell(double scale, double *mean_B, double *mean_direct, 
     rad_system sys;
     rad_solve_options so;
     rad_camera cam;
-    uint32_t i, k;
+    uint32_t i;
     float *E = NULL, *B = NULL, *D = NULL;
     int ok = 0;
-    rad_cornell_box(&d, &cam);
-    if (d.mesh_count > 16) return 0;
-    for (i = 0; i < d.mesh_count; ++i) {
-        m[i] = d.meshes[i];
-        pos[i] = (float *)malloc(sizeof(float) * 3 * m[i].vertex_count);
-        if (pos[i])
-            for (k = 0; k < 3 * m[i].vertex_count; ++k) pos[i][k] = (float)(m[i].positions[k] * scale);
-        m[i].positions = pos[i];
-    }
-    d.meshes = m;
-    *why = rad_scene_create(&d, NULL, &S);
+    *why = rg_cornell_scaled(scale, &cam, &S);
     if (*why != RAD_SUCCESS) goto out;
     rad_patch_options_default(&po);
     po.target_count = 80;
@@ -330,10 +347,6 @@ static int rg_scaled_cornell(double scale, double *mean_B, double *mean_direct, 
         *mean_B += (double)B[i] * P->areas[i / 3] / (scale * scale);
         *mean_direct += (double)D[i] * P->areas[i / 3] / (scale * scale);
     }
-    for (k = 0; k < 3; ++k) {
-        cam.position[k] = (float)(cam.position[k] * scale);
-        cam.target[k] = (float)(cam.target[k] * scale);
-    }
     *hits = 0;
     for (i = 0; i < 256; ++i) {
         rad_ray ray;
@@ -350,7 +363,6 @@ out:
     (rad_bvh_destroy)(b);
     rad_patches_destroy(P);
     rad_scene_destroy(S);
-    for (i = 0; i < d.mesh_count; ++i) free(pos[i]);
     return ok;
 }
 
@@ -576,9 +588,6 @@ done:
    the pair kernel multiplied two sample areas (length^4) in float. */
 static double rg_vp_mean(double scale, rad_result *why)
 {
-    rad_scene_desc d;
-    rad_mesh_desc m[16];
-    float *pos[16];
     rad_scene *S = NULL;
     rad_bvh *b = NULL;
     rad_raycaster rc;
@@ -586,20 +595,10 @@ static double rg_vp_mean(double scale, rad_result *why)
     rad_virtual_patches *vp = NULL;
     rad_system sys;
     rad_solve_options so;
-    uint32_t i, k;
+    uint32_t i;
     float *E = NULL, *B = NULL;
     double mean = -1.0;
-    rad_cornell_box(&d, NULL);
-    if (d.mesh_count > 16) return -1.0;
-    for (i = 0; i < d.mesh_count; ++i) {
-        m[i] = d.meshes[i];
-        pos[i] = (float *)malloc(sizeof(float) * 3 * m[i].vertex_count);
-        if (pos[i])
-            for (k = 0; k < 3 * m[i].vertex_count; ++k) pos[i][k] = (float)(m[i].positions[k] * scale);
-        m[i].positions = pos[i];
-    }
-    d.meshes = m;
-    *why = rad_scene_create(&d, NULL, &S);
+    *why = rg_cornell_scaled(scale, NULL, &S);
     if (*why == RAD_SUCCESS) *why = rad_bvh_create(S, NULL, &b);
     if (*why != RAD_SUCCESS) goto out;
     (rad_bvh_raycaster)(b, &rc);
@@ -626,7 +625,6 @@ out:
     rad_vp_destroy(vp);
     (rad_bvh_destroy)(b);
     rad_scene_destroy(S);
-    for (i = 0; i < d.mesh_count; ++i) free(pos[i]);
     return mean;
 }
 
