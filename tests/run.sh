@@ -1,13 +1,19 @@
 #!/usr/bin/env bash
 # Runs every test suite and ends with one line "N passed, N failed[, N skipped]".
 # A suite whose tool is missing is skipped (and named); with RAD_TEST_REQUIRE_ALL=1 a skipped
-# suite counts as failed. Optional packages are installed when we can (root with apt-get).
+# suite counts as failed. Optional packages are installed first when we can (root with apt-get).
+# Independent suites run side by side, RAD_TEST_JOBS at a time (default: the number of CPUs);
+# each writes its own log and its own scratch folder, and the logs are printed in order at the end.
 set -u
 cd "$(dirname "$0")/.."
 CC=${CC:-cc}
 CXX=${CXX:-c++}
 BUILD=${BUILD:-build}/tests
-mkdir -p "$BUILD"
+case "$BUILD" in /*) ;; *) BUILD="$PWD/$BUILD" ;; esac
+STAGES="$BUILD/stages"
+rm -rf "$STAGES" "$BUILD/tmp"
+mkdir -p "$BUILD" "$STAGES" "$BUILD/tmp"
+JOBS=${RAD_TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
 WARN="-Wall -Wextra -Wpedantic -Wshadow -Werror"
 PASSED=0; FAILED=0; SKIPPED=0
 SKIPPED_NAMES=""; FAILED_NAMES=""
@@ -36,13 +42,17 @@ build() {
     echo "  build of $name failed:"; sed 's/^/    /' "$BUILD/$name.log" | head -40
     return 1
 }
-# a unit-test binary: adds its own "N passed, N failed" counts
+# a unit-test binary: adds its own "N passed, N failed" counts. RAD_TEST_SHARD=i/n in the
+# environment runs every n-th test from the i-th (test_main.c).
 unit() {
     local name=$1; shift
     local out="$BUILD/$name.out"
     echo "== $name"
-    if ! build "$name" "$@" -o "$BUILD/$name" -lm; then fail "$name (build)"; return; fi
-    "$BUILD/$name" >"$out" 2>&1
+    if [ -z "${UNIT_PREBUILT:-}" ]; then
+        if ! build "$name" "$@" -o "$BUILD/$name" -lm; then fail "$name (build)"; return; fi
+        UNIT_BIN="$BUILD/$name"
+    fi
+    ${UNIT_WRAP:-} "$UNIT_BIN" >"$out" 2>&1
     local rc=$?
     local line p f
     line=$(grep -E '^[0-9]+ passed, [0-9]+ failed' "$out" | tail -n 1)
@@ -53,7 +63,7 @@ unit() {
     p=$(echo "$line" | sed -E 's/^([0-9]+) passed.*/\1/')
     f=$(echo "$line" | sed -E 's/^[0-9]+ passed, ([0-9]+) failed.*/\1/')
     PASSED=$((PASSED + p)); FAILED=$((FAILED + f))
-    grep -E 'FAIL|error' "$out" | head -40 | sed 's/^/    /'
+    grep -E 'FAIL|error|==[0-9]+==' "$out" | head -40 | sed 's/^/    /'
     if [ "$rc" != 0 ] && [ "$f" = 0 ]; then fail "$name (exit $rc)"; fi
     [ "$f" = 0 ] || FAILED_NAMES="$FAILED_NAMES $name"
     echo "   $line"
@@ -64,98 +74,144 @@ compile_run() {
     if build "$name" "$@" && "$BUILD/$name" >"$BUILD/$name.out" 2>&1; then pass "$name"; else fail "$name"; fi
 }
 
+# ---- the scheduler -------------------------------------------------------------------------
+# stage NAME FUNCTION: runs FUNCTION in the background with fresh counters, its output in
+# $STAGES/NAME.log and its counts in $STAGES/NAME.count; at most $JOBS at once.
+STAGE_ORDER=""
+stage() {
+    local name=$1 fn=$2
+    STAGE_ORDER="$STAGE_ORDER $name"
+    while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n; done
+    (
+        PASSED=0; FAILED=0; SKIPPED=0; SKIPPED_NAMES=""; FAILED_NAMES=""
+        export RAD_TEST_TMPDIR="$BUILD/tmp/$name" TMPDIR="$BUILD/tmp/$name"
+        mkdir -p "$RAD_TEST_TMPDIR"
+        start=$(date +%s)
+        "$fn" >"$STAGES/$name.log" 2>&1
+        secs=$(( $(date +%s) - start ))
+        printf '%s %s %s %s\n%s\n%s\n' "$PASSED" "$FAILED" "$SKIPPED" "$secs" "$FAILED_NAMES" "$SKIPPED_NAMES" >"$STAGES/$name.count"
+        echo "  [$(date +%H:%M:%S)] $name: $PASSED passed, $FAILED failed, $SKIPPED skipped ($secs s)"
+    ) &
+}
+
+# ---- what this machine has (installs first: apt-get must not run beside the suites) --------
 OMP=""
 printf 'int main(void){return 0;}' | $CC -fopenmp -x c - -o /dev/null 2>/dev/null && OMP="-fopenmp"
-
-# ---- unit tests with the default compiler -------------------------------------------------
-unit unit-O2 $CC -std=c99 $WARN -O2 -I. tests/test_main.c
-if [ -n "$OMP" ]; then
-    unit unit-O2-openmp $CC -std=c99 $WARN -O2 $OMP -I. tests/test_main.c
-else
-    skip unit-O2-openmp "$CC has no OpenMP"
-fi
-unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c
-unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c
-unit unit-native $CC -std=c99 $WARN -O2 -march=native $OMP -I. tests/test_main.c
-
-# ---- Embree backend (optional: installed when we can) -------------------------------------
-[ -f /usr/include/embree3/rtcore.h ] || try_install libembree-dev
-if [ -f /usr/include/embree3/rtcore.h ]; then
-    unit unit-embree $CC -std=c99 $WARN -O2 $OMP -DRAD_EMBREE -DRAD_TEST_EMBREE -I. tests/test_main.c -lembree3
-else
-    skip unit-embree "Embree 3 is not installed (package libembree-dev)"
-fi
-
-# ---- sanitizers ---------------------------------------------------------------------------
-export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
-export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-SAN="-g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
-RAD_TEST_QUICK=1 unit unit-asan-ubsan-O0 $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c
-RAD_TEST_QUICK=1 unit unit-asan-ubsan-O2-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
-# the SIMD paths of this machine (AVX2 temporal lanes, BC1/BC4 apply, BVH) under the sanitizers
-RAD_TEST_QUICK=1 unit unit-asan-ubsan-O1-native $CC -std=c99 $WARN -O1 -march=native $OMP $SAN -I. tests/test_main.c
-
-# ---- compile tests ------------------------------------------------------------------------
-echo "== compile tests"
-compile_run compile-c99 $CC -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-c99" -lm
-compile_run compile-cpp11 $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-cpp11" -lm
-compile_run compile-static $CC -std=c99 $WARN -Wno-unused-function -I. tests/static_build.c -o "$BUILD/compile-static" -lm
-compile_run compile-custom-alloc $CC -std=c99 $WARN -I. tests/custom_alloc.c -o "$BUILD/compile-custom-alloc" -lm
-if build demo $CC -std=c99 $WARN -O2 $OMP -I. examples/cornell.c -o "$BUILD/cornell" -lm &&
-   "$BUILD/cornell" --patches 300 --size 96x96 -o "$BUILD/cornell-small.png" >"$BUILD/demo.out" 2>&1 &&
-   [ -s "$BUILD/cornell-small.png" ]; then
-    pass demo-small
-else
-    fail demo-small
-fi
-if build gallery $CC -std=c99 $WARN -O2 -I. examples/gallery.c -o "$BUILD/gallery" -lm &&
-   "$BUILD/gallery" --size 12 -o "$BUILD/gallery-small.png" >"$BUILD/gallery.out" 2>&1 &&
-   [ -s "$BUILD/gallery-small.png" ]; then
-    pass gallery-small
-else
-    fail gallery-small
-fi
-compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
-# the virtual-patch example builds and, without the shared data, says it skipped
-if build vp-bunny $CC -std=c99 $WARN -O2 $OMP -I. examples/vp_bunny.c -o "$BUILD/vp_bunny" -lm &&
-   "$BUILD/vp_bunny" --data "$BUILD/no-such-data" >"$BUILD/vp_bunny.out" 2>&1 && grep -q skipped "$BUILD/vp_bunny.out"; then
-    pass vp-bunny-skip
-else
-    fail vp-bunny-skip
-fi
-if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -lm &&
-   "$BUILD/walk" --grid 2 --m 256 --frames 2 --size 64x36 -o "$BUILD/walk-small" >"$BUILD/walk.out" 2>&1 &&
-   [ -s "$BUILD/walk-small_001.png" ]; then
-    pass walk-small
-else
-    fail walk-small
-fi
-# temporal radiosity under a moving light: frames 0 and 3 written, different, 4 error rows
-if build moving-light $CC -std=c99 $WARN -O2 $OMP -I. examples/moving_light.c -o "$BUILD/moving_light" -lm &&
-   "$BUILD/moving_light" --patches 150 --frames 4 --every 3 --size 32x32 -o "$BUILD/moving-small" >"$BUILD/moving-light.out" 2>&1 &&
-   [ -s "$BUILD/moving-small_0000.png" ] && [ -s "$BUILD/moving-small_0003.png" ] && [ ! -e "$BUILD/moving-small_0001.png" ] &&
-   ! cmp -s "$BUILD/moving-small_0000.png" "$BUILD/moving-small_0003.png" &&
-   [ "$(awk -F, 'NR > 1 && $5 >= 0 && $5 < 10' "$BUILD/moving-small.csv" | cut -d, -f2-4 | sort -u | wc -l)" -eq 4 ]; then
-    pass moving-light-small
-else
-    fail moving-light-small
-fi
-# ---- GLSL: the header holds the current glsl/ sources --------------------------------------
-if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
-   "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
-    pass glsl-embed-current
-else
-    cat "$BUILD/glsl-embed.out" 2>/dev/null | sed "s/^/    /"
-    fail glsl-embed-current
-fi
-# ---- Vulkan: every GLSL kernel against the CPU path (lavapipe is enough; installed when we can)
 vk_ready() { [ -f /usr/include/vulkan/vulkan.h ] && have glslangValidator && ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1; }
+[ -f /usr/include/embree3/rtcore.h ] || try_install libembree-dev
 vk_ready || try_install mesa-vulkan-drivers libvulkan-dev glslang-tools
 # the Khronos validation layer: test_vulkan turns it on when installed and fails on its messages
 [ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ] || try_install vulkan-validationlayers
-if vk_ready; then
+have spirv-val || try_install spirv-tools
+{ [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
+have clang || try_install clang libclang-rt-14-dev
+have valgrind || try_install valgrind
+HAVE_ASAN_CLANG=0; HAVE_FUZZER=0
+if have clang; then
+    printf 'int main(void){return 0;}' | clang -fsanitize=address,undefined -x c - -o /dev/null 2>/dev/null && HAVE_ASAN_CLANG=1
+    printf 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n){(void)d;(void)n;return 0;}' |
+        clang -fsanitize=fuzzer -x c - -o /dev/null 2>/dev/null && HAVE_FUZZER=1
+fi
+
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+SAN="-g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
+
+# ---- the suites -----------------------------------------------------------------------------
+s_unit_O2() { unit unit-O2 $CC -std=c99 $WARN -O2 -I. tests/test_main.c; }
+s_unit_openmp() {
+    if [ -n "$OMP" ]; then unit unit-O2-openmp $CC -std=c99 $WARN -O2 $OMP -I. tests/test_main.c
+    else skip unit-O2-openmp "$CC has no OpenMP"; fi
+}
+s_unit_scalar() { unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c; }
+s_unit_avx() { unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c; }
+s_unit_native() { unit unit-native $CC -std=c99 $WARN -O2 -march=native $OMP -I. tests/test_main.c; }
+s_unit_embree() {
+    if [ -f /usr/include/embree3/rtcore.h ]; then
+        unit unit-embree $CC -std=c99 $WARN -O2 $OMP -DRAD_EMBREE -DRAD_TEST_EMBREE -I. tests/test_main.c -lembree3
+    else
+        skip unit-embree "Embree 3 is not installed (package libembree-dev)"
+    fi
+}
+# sanitizers at the quick sizes
+s_asan_O0() { RAD_TEST_QUICK=1 unit unit-asan-ubsan-O0 $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c; }
+s_asan_O2_scalar() { RAD_TEST_QUICK=1 unit unit-asan-ubsan-O2-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD $SAN -I. tests/test_main.c; }
+# the SIMD paths of this machine (AVX2 temporal lanes, BC1/BC4 apply, BVH) under the sanitizers
+s_asan_O1_native() { RAD_TEST_QUICK=1 unit unit-asan-ubsan-O1-native $CC -std=c99 $WARN -O1 -march=native $OMP $SAN -I. tests/test_main.c; }
+
+s_compile() {
+    compile_run compile-c99 $CC -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-c99" -lm
+    compile_run compile-cpp11 $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-cpp11" -lm
+    compile_run compile-static $CC -std=c99 $WARN -Wno-unused-function -I. tests/static_build.c -o "$BUILD/compile-static" -lm
+    compile_run compile-custom-alloc $CC -std=c99 $WARN -I. tests/custom_alloc.c -o "$BUILD/compile-custom-alloc" -lm
+    if build link-a $CC -std=c99 $WARN -I. -c tests/link_a.c -o "$BUILD/link_a.o" &&
+       build link-b $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. -c tests/link_b.cpp -o "$BUILD/link_b.o" &&
+       build link-main $CC -std=c99 $WARN -I. -c tests/link_main.c -o "$BUILD/link_main.o" &&
+       build link-exe $CXX "$BUILD/link_a.o" "$BUILD/link_b.o" "$BUILD/link_main.o" -o "$BUILD/link-c-cpp" -lm &&
+       "$BUILD/link-c-cpp" >"$BUILD/link-c-cpp.out" 2>&1; then
+        pass link-c-and-cpp
+    else
+        fail link-c-and-cpp
+    fi
+    # ---- GLSL: the header holds the current glsl/ sources
+    if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
+       "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
+        pass glsl-embed-current
+    else
+        sed "s/^/    /" "$BUILD/glsl-embed.out" 2>/dev/null
+        fail glsl-embed-current
+    fi
+}
+
+s_examples() {
+    if build demo $CC -std=c99 $WARN -O2 $OMP -I. examples/cornell.c -o "$BUILD/cornell" -lm &&
+       "$BUILD/cornell" --patches 300 --size 96x96 -o "$BUILD/cornell-small.png" >"$BUILD/demo.out" 2>&1 &&
+       [ -s "$BUILD/cornell-small.png" ]; then
+        pass demo-small
+    else
+        fail demo-small
+    fi
+    if build gallery $CC -std=c99 $WARN -O2 -I. examples/gallery.c -o "$BUILD/gallery" -lm &&
+       "$BUILD/gallery" --size 12 -o "$BUILD/gallery-small.png" >"$BUILD/gallery.out" 2>&1 &&
+       [ -s "$BUILD/gallery-small.png" ]; then
+        pass gallery-small
+    else
+        fail gallery-small
+    fi
+    compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+    # the virtual-patch example builds and, without the external meshes, says it skipped
+    if build vp-bunny $CC -std=c99 $WARN -O2 $OMP -I. examples/vp_bunny.c -o "$BUILD/vp_bunny" -lm &&
+       "$BUILD/vp_bunny" --data "$BUILD/no-such-data" >"$BUILD/vp_bunny.out" 2>&1 && grep -q skipped "$BUILD/vp_bunny.out"; then
+        pass vp-bunny-skip
+    else
+        fail vp-bunny-skip
+    fi
+    if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -lm &&
+       "$BUILD/walk" --grid 2 --m 256 --frames 2 --size 64x36 -o "$BUILD/walk-small" >"$BUILD/walk.out" 2>&1 &&
+       [ -s "$BUILD/walk-small_001.png" ]; then
+        pass walk-small
+    else
+        fail walk-small
+    fi
+    # temporal radiosity under a moving light: frames 0 and 3 written, different, 4 error rows
+    if build moving-light $CC -std=c99 $WARN -O2 $OMP -I. examples/moving_light.c -o "$BUILD/moving_light" -lm &&
+       "$BUILD/moving_light" --patches 150 --frames 4 --every 3 --size 32x32 -o "$BUILD/moving-small" >"$BUILD/moving-light.out" 2>&1 &&
+       [ -s "$BUILD/moving-small_0000.png" ] && [ -s "$BUILD/moving-small_0003.png" ] && [ ! -e "$BUILD/moving-small_0001.png" ] &&
+       ! cmp -s "$BUILD/moving-small_0000.png" "$BUILD/moving-small_0003.png" &&
+       [ "$(awk -F, 'NR > 1 && $5 >= 0 && $5 < 10' "$BUILD/moving-small.csv" | cut -d, -f2-4 | sort -u | wc -l)" -eq 4 ]; then
+        pass moving-light-small
+    else
+        fail moving-light-small
+    fi
+}
+
+# ---- Vulkan: every GLSL kernel against the CPU path (lavapipe is enough)
+s_vulkan() {
+    if ! vk_ready; then
+        skip vulkan "no Vulkan headers, Vulkan driver or glslangValidator (packages mesa-vulkan-drivers libvulkan-dev glslang-tools)"
+        return
+    fi
     echo "== GLSL sources compile on their own"
-    have spirv-val || try_install spirv-tools
     for f in glsl/*.comp; do
         spv="$BUILD/$(basename "$f").spv"
         if glslangValidator -V --target-env vulkan1.1 "$f" -o "$spv" >"$BUILD/glslang.log" 2>&1 &&
@@ -174,12 +230,7 @@ if vk_ready; then
         tail -n 20 "$BUILD/vulkan-example.out" 2>/dev/null | sed 's/^/    /'
         fail vulkan-example
     fi
-else
-    skip vulkan "no Vulkan headers, Vulkan driver or glslangValidator (packages mesa-vulkan-drivers libvulkan-dev glslang-tools)"
-fi
-# ---- GLSL lighting models against C on a Vulkan device (lavapipe is enough) ----------------
-{ have glslangValidator && [ -f /usr/include/vulkan/vulkan.h ]; } || try_install glslang-tools libvulkan-dev mesa-vulkan-drivers
-if have glslangValidator && [ -f /usr/include/vulkan/vulkan.h ]; then
+    # the GLSL lighting models against C on the same device
     if build shading-vulkan $CC -std=c99 $WARN -O2 -I. tests/test_shading_vulkan.c -o "$BUILD/shading-vulkan" -lvulkan -lm; then
         "$BUILD/shading-vulkan" . >"$BUILD/shading-vulkan.out" 2>&1
         rc=$?
@@ -190,121 +241,158 @@ if have glslangValidator && [ -f /usr/include/vulkan/vulkan.h ]; then
     else
         fail "shading-vulkan (build)"
     fi
-else
-    skip shading-vulkan "glslangValidator or the Vulkan headers are missing (packages glslang-tools libvulkan-dev mesa-vulkan-drivers)"
-fi
-# ---- the rad tool (needs assimp and stb: installed when we can) --------------------------
-{ [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
-if [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; then
-    if build tool-rad $CC -std=c99 $WARN -O2 $OMP -I. tools/*.c -o "$BUILD/rad" -lassimp -lm; then
-        pass tool-build
-        echo "== tool tests"
-        out=$(RAD_DATA_DIR="${RAD_DATA_DIR:-../shared/data}" bash tests/tool_tests.sh "$BUILD/rad" 2>&1)
-        echo "$out" | grep -E '^(ok|FAIL|SKIP)' | sed 's/^/  /'
-        PASSED=$((PASSED + $(echo "$out" | grep -c '^ok')))
-        nf=$(echo "$out" | grep -c '^FAIL')
-        FAILED=$((FAILED + nf))
-        [ "$nf" = 0 ] || FAILED_NAMES="$FAILED_NAMES tool-tests"
-        echo "$out" | grep -E '^skip' | while read -r line; do echo "  $line"; done
-        ns=$(echo "$out" | grep -c '^skip')
-        if [ "$ns" -gt 0 ]; then
-            if [ "${RAD_TEST_REQUIRE_ALL:-0}" = 1 ]; then FAILED=$((FAILED + ns)); FAILED_NAMES="$FAILED_NAMES tool-tests(skipped)"
-            else SKIPPED=$((SKIPPED + ns)); SKIPPED_NAMES="$SKIPPED_NAMES tool-tests"; fi
-        fi
-        # the evaluation report at quick quality (make report-quick): every table cell filled,
-        # every image written (tools/report.sh --check)
-        if build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
-            RAD_DATA_DIR="${RAD_DATA_DIR:-../shared/data}" bash tools/report.sh --quick --out "$BUILD/report-quick" \
-                --rad "$BUILD/rad" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
-            pass "report-quick ($(tail -n 1 "$BUILD/report-quick.log" | sed 's/.*: \([0-9]* table rows, [0-9]* images\).*/\1/'))"
-        else
-            fail report-quick; tail -n 20 "$BUILD/report-quick.log" | sed 's/^/    /'
-        fi
-    else
-        fail tool-build
-    fi
-    if [ -f tests/test_tool.c ]; then
-        unit test-tool $CC -std=c99 $WARN -O2 $OMP -I. tests/test_tool.c tools/image.c tools/metrics.c tools/trace.c
-    fi
-else
-    skip tool-suites "assimp or stb is not installed (packages libassimp-dev libstb-dev)"
-fi
-if build link-a $CC -std=c99 $WARN -I. -c tests/link_a.c -o "$BUILD/link_a.o" &&
-   build link-b $CXX -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. -c tests/link_b.cpp -o "$BUILD/link_b.o" &&
-   build link-main $CC -std=c99 $WARN -I. -c tests/link_main.c -o "$BUILD/link_main.o" &&
-   build link-exe $CXX "$BUILD/link_a.o" "$BUILD/link_b.o" "$BUILD/link_main.o" -o "$BUILD/link-c-cpp" -lm &&
-   "$BUILD/link-c-cpp" >"$BUILD/link-c-cpp.out" 2>&1; then
-    pass link-c-and-cpp
-else
-    fail link-c-and-cpp
-fi
+}
 
-# ---- clang (optional: installed when we can) ---------------------------------------------
-have clang || try_install clang libclang-rt-14-dev
-if have clang && have clang++; then
+# ---- the rad tool (needs assimp and stb)
+have_tool_deps() { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; }
+s_tool() {
+    if ! have_tool_deps; then
+        skip tool-suites "assimp or stb is not installed (packages libassimp-dev libstb-dev)"
+        return
+    fi
+    if ! build tool-rad $CC -std=c99 $WARN -O2 $OMP -I. tools/*.c -o "$BUILD/rad" -lassimp -lm; then
+        fail tool-build; return
+    fi
+    pass tool-build
+    echo "== tool tests"
+    local out nf ns
+    out=$(RAD_DATA_DIR="${RAD_DATA_DIR:-../shared/data}" bash tests/tool_tests.sh "$BUILD/rad" 2>&1)
+    echo "$out" | grep -E '^(ok|FAIL|SKIP)' | sed 's/^/  /'
+    PASSED=$((PASSED + $(echo "$out" | grep -c '^ok')))
+    nf=$(echo "$out" | grep -c '^FAIL')
+    FAILED=$((FAILED + nf))
+    [ "$nf" = 0 ] || FAILED_NAMES="$FAILED_NAMES tool-tests"
+    echo "$out" | grep -E '^skip' | while read -r line; do echo "  $line"; done
+    ns=$(echo "$out" | grep -c '^skip')
+    if [ "$ns" -gt 0 ]; then
+        if [ "${RAD_TEST_REQUIRE_ALL:-0}" = 1 ]; then FAILED=$((FAILED + ns)); FAILED_NAMES="$FAILED_NAMES tool-tests(skipped)"
+        else SKIPPED=$((SKIPPED + ns)); SKIPPED_NAMES="$SKIPPED_NAMES tool-tests"; fi
+    fi
+}
+# the evaluation report at quick quality (make report-quick): every table cell filled, every
+# image written (tools/report.sh --check); its own build of the tool so it can run beside s_tool
+s_report() {
+    have_tool_deps || return 0
+    if build report-rad $CC -std=c99 $WARN -O2 $OMP -I. tools/*.c -o "$BUILD/rad-report" -lassimp -lm &&
+       build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
+       RAD_DATA_DIR="${RAD_DATA_DIR:-../shared/data}" bash tools/report.sh --quick --out "$BUILD/report-quick" \
+           --rad "$BUILD/rad-report" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
+        pass "report-quick ($(tail -n 1 "$BUILD/report-quick.log" | sed 's/.*: \([0-9]* table rows, [0-9]* images\).*/\1/'))"
+    else
+        fail report-quick; tail -n 20 "$BUILD/report-quick.log" | sed 's/^/    /'
+    fi
+}
+s_test_tool() {
+    have_tool_deps || return 0
+    unit test-tool $CC -std=c99 $WARN -O2 $OMP -I. tests/test_tool.c tools/image.c tools/metrics.c tools/trace.c
+}
+
+# ---- clang
+s_clang() {
+    if ! { have clang && have clang++; }; then skip clang-suites "clang is not installed (package clang)"; return; fi
     unit unit-clang-O2 clang -std=c99 $WARN -O2 -I. tests/test_main.c
     compile_run compile-clang-c99 clang -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-clang-c99" -lm
     compile_run compile-clang-cpp11 clang++ -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-clang-cpp11" -lm
-    if printf 'int main(void){return 0;}' | clang -fsanitize=address,undefined -x c - -o /dev/null 2>/dev/null; then
+}
+s_clang_asan_O2() {
+    have clang || return 0
+    if [ "$HAVE_ASAN_CLANG" = 1 ]; then
         RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan-O2 clang -std=c99 $WARN -O2 $SAN -I. tests/test_main.c
-        RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan-O0-scalar clang -std=c99 $WARN -O0 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
     else
         skip unit-clang-asan-ubsan "clang's sanitizer runtime is missing (package libclang-rt-14-dev)"
     fi
-    # libFuzzer smoke runs (the long runs are `make fuzz`, recorded in FUZZING.md)
-    if printf 'int LLVMFuzzerTestOneInput(const unsigned char *d, unsigned long n){(void)d;(void)n;return 0;}' |
-        clang -fsanitize=fuzzer -x c - -o /dev/null 2>/dev/null; then
-        echo "== fuzz smoke"
-        # one harness per loader; the builds (about 45 s each) run two at a time; TMPDIR: where
-        # fuzz_stream writes its input file (left behind when it crashes)
-        FUZZERS="container scene stream multibounce temporal"
-        for f in $FUZZERS; do mkdir -p "$BUILD/fuzz/$f"; done
-        if build make-corpus $CC -std=c99 -O2 -I. fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
-           "$BUILD/make_corpus" "$BUILD/fuzz"; then
-            running=0
-            for f in $FUZZERS; do
-                rm -f "$BUILD/fuzz_$f"
-                build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &
-                running=$((running + 1))
-                if [ "$running" -ge 2 ]; then wait -n; running=$((running - 1)); fi
-            done
-            wait
-            for f in $FUZZERS; do
-                if [ -x "$BUILD/fuzz_$f" ] &&
-                   { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || TMPDIR="$BUILD" "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
-                   TMPDIR="$BUILD" "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
-                       "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
-                    pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
-                else
-                    tail -20 "$BUILD/fuzz-$f.log" 2>/dev/null | sed 's/^/    /'
-                    fail "fuzz-$f"
-                fi
-            done
+}
+s_clang_asan_O0() {
+    [ "$HAVE_ASAN_CLANG" = 1 ] || return 0
+    RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan-O0-scalar clang -std=c99 $WARN -O0 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
+}
+# libFuzzer smoke runs (the long runs are `make fuzz`, recorded in FUZZING.md); TMPDIR: where
+# fuzz_stream writes its input file (left behind when it crashes)
+FUZZERS="container scene stream multibounce temporal"
+s_fuzz() {
+    have clang || return 0
+    if [ "$HAVE_FUZZER" != 1 ]; then skip fuzz-smoke "clang has no libFuzzer runtime (package libclang-rt-14-dev)"; return; fi
+    echo "== fuzz smoke"
+    local f
+    for f in $FUZZERS; do mkdir -p "$BUILD/fuzz/$f"; done
+    if ! { build make-corpus $CC -std=c99 -O2 -I. fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
+           "$BUILD/make_corpus" "$BUILD/fuzz"; }; then
+        fail fuzz-corpus; return
+    fi
+    for f in $FUZZERS; do
+        rm -f "$BUILD/fuzz_$f"
+        if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
+           { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
+           "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
+               "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
+            pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
         else
-            fail fuzz-corpus
+            tail -20 "$BUILD/fuzz-$f.log" 2>/dev/null | sed 's/^/    /'
+            fail "fuzz-$f"
         fi
-    else
-        skip fuzz-smoke "clang has no libFuzzer runtime (package libclang-rt-14-dev)"
-    fi
-else
-    skip clang-suites "clang is not installed (package clang)"
-fi
+    done
+}
 
-# ---- valgrind memcheck (optional: installed when we can) ---------------------------------
-have valgrind || try_install valgrind
-if have valgrind; then
-    echo "== valgrind memcheck"
-    if build unit-valgrind $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-valgrind" -lm &&
-       RAD_TEST_QUICK=1 valgrind --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible \
-           --quiet "$BUILD/unit-valgrind" >"$BUILD/valgrind.out" 2>&1; then
-        pass "valgrind-memcheck ($(tail -n 1 "$BUILD/valgrind.out"))"
-    else
-        grep -E '==[0-9]+==' "$BUILD/valgrind.out" | head -30 | sed 's/^/    /'
-        fail valgrind-memcheck
+# ---- valgrind memcheck: one build, the quick suite split in two halves that run side by side
+VALGRIND_SHARDS=2
+s_valgrind_build() {
+    if ! have valgrind; then skip valgrind-memcheck "valgrind is not installed (package valgrind)"; return; fi
+    build unit-valgrind $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-valgrind" -lm ||
+        fail "valgrind-memcheck (build)"
+}
+s_valgrind_shard() {
+    local i=$1
+    [ -x "$BUILD/unit-valgrind" ] || return 0
+    RAD_TEST_QUICK=1 RAD_TEST_SHARD="$i/$VALGRIND_SHARDS" UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-valgrind" \
+        UNIT_WRAP="valgrind --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --quiet" \
+        unit "valgrind-memcheck-$((i + 1))of$VALGRIND_SHARDS"
+}
+s_valgrind_0() { s_valgrind_shard 0; }
+s_valgrind_1() { s_valgrind_shard 1; }
+
+# ---- run: the longest first, so the last to finish are short ----------------------------
+echo "running the suites, $JOBS at a time (logs in $STAGES)"
+s_valgrind_build >"$STAGES/valgrind-build.log" 2>&1
+printf '%s %s %s 0\n%s\n%s\n' "$PASSED" "$FAILED" "$SKIPPED" "$FAILED_NAMES" "$SKIPPED_NAMES" >"$STAGES/valgrind-build.count"
+STAGE_ORDER="valgrind-build"
+PASSED=0; FAILED=0; SKIPPED=0; SKIPPED_NAMES=""; FAILED_NAMES=""
+stage valgrind-1 s_valgrind_0
+stage valgrind-2 s_valgrind_1
+stage asan-O0 s_asan_O0
+stage clang-asan-O0 s_clang_asan_O0
+stage tool s_tool
+stage report s_report
+stage asan-O1-native s_asan_O1_native
+stage asan-O2-scalar s_asan_O2_scalar
+stage clang-asan-O2 s_clang_asan_O2
+stage fuzz s_fuzz
+stage vulkan s_vulkan
+stage unit-O2 s_unit_O2
+stage unit-openmp s_unit_openmp
+stage unit-scalar s_unit_scalar
+stage unit-avx s_unit_avx
+stage unit-native s_unit_native
+stage unit-embree s_unit_embree
+stage clang s_clang
+stage examples s_examples
+stage compile s_compile
+stage test-tool s_test_tool
+wait
+
+echo
+for name in $STAGE_ORDER; do
+    c="$STAGES/$name.count"
+    if [ ! -f "$c" ]; then
+        echo "== [$name] printed no counts"; cat "$STAGES/$name.log" 2>/dev/null
+        FAILED=$((FAILED + 1)); FAILED_NAMES="$FAILED_NAMES $name(stage)"; continue
     fi
-else
-    skip valgrind-memcheck "valgrind is not installed (package valgrind)"
-fi
+    read -r p f s secs <"$c"
+    echo "==== [$name: $secs s]"
+    cat "$STAGES/$name.log"
+    PASSED=$((PASSED + p)); FAILED=$((FAILED + f)); SKIPPED=$((SKIPPED + s))
+    FAILED_NAMES="$FAILED_NAMES$(sed -n 2p "$c")"
+    SKIPPED_NAMES="$SKIPPED_NAMES$(sed -n 3p "$c")"
+done
 
 echo
 [ -z "$SKIPPED_NAMES" ] || echo "skipped suites:$SKIPPED_NAMES"

@@ -61,4 +61,19 @@ static int rad_test_quick(void)
     return q && q[0] == '1';
 }
 
+/* A scratch file path: in $RAD_TEST_TMPDIR (tests/run.sh gives each suite its own, so suites
+   run side by side without sharing files), else $TMPDIR, else /tmp. Four buffers in turn, so a
+   test can hold a few paths at once. */
+static const char *rad_test_path(const char *name)
+{
+    static char buf[4][512];
+    static int next;
+    const char *dir = getenv("RAD_TEST_TMPDIR");
+    char *out = buf[next++ & 3];
+    if (!dir || !dir[0]) dir = getenv("TMPDIR");
+    if (!dir || !dir[0]) dir = "/tmp";
+    snprintf(out, sizeof(buf[0]), "%s/rad_test_%s", dir, name);
+    return out;
+}
+
 #endif

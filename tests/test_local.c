@@ -645,14 +645,13 @@ static void test_local_row_sources(void)
 #ifndef RAD_NO_STDIO
     /* the same rows streamed from a file: same planes; a damaged file is refused */
     if (Ls && buf) {
-        const char *path = "build/test_local_stream.radb";
+        const char *path = rad_test_path("local_stream.radb");
         FILE *f = fopen(path, "wb");
         rad_row_stream *st = NULL;
         rad_row_source sf;
         rad_local *Lf = NULL;
         int wrote = f && fwrite(buf, 1, size, f) == size;
         if (f) fclose(f);
-        if (!wrote) { path = "test_local_stream.radb"; f = fopen(path, "wb"); wrote = f && fwrite(buf, 1, size, f) == size; if (f) fclose(f); }
         CHECK(wrote);
         CHECK_OK(rad_row_stream_open(path, NULL, &st));
         if (st) {
@@ -741,7 +740,7 @@ static void test_local_repeated_columns(void)
         rad_raycaster rc;
         void *buf = NULL;
         size_t size = 0;
-        const char *path = "build/test_local_repeat.radb";
+        const char *path = rad_test_path("local_repeat.radb");
         if (!lc_cornell(&w, 70u)) return;
         rad_form_factor_options_default(&fo);
         fo.samples = 2;
@@ -777,7 +776,6 @@ static void test_local_repeated_columns(void)
                 }
                 if (mode == 2) memset(copy + val_at + 4 * (size_t)e0, 0xFF, 4); /* a NaN bit pattern */
                 f = fopen(path, "wb");
-                if (!f) { path = "test_local_repeat.radb"; f = fopen(path, "wb"); }
                 wrote = f && fwrite(copy, 1, size, f) == size;
                 if (f) fclose(f);
                 free(copy);

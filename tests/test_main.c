@@ -1,5 +1,7 @@
 /* test_main.c - the unit tests: one translation unit holding the implementation and every
-   test file. Usage: test_main [NAME-SUBSTRING]. Prints "N passed, N failed" last. */
+   test file. Usage: test_main [NAME-SUBSTRING]. Prints "N passed, N failed" last.
+   Environment: RAD_TEST_QUICK=1 smaller sizes; RAD_TEST_SHARD=i/n every n-th test from the
+   i-th; RAD_TEST_TIMES=1 CPU seconds per test; RAD_TEST_TMPDIR where scratch files go. */
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include "test.h"
@@ -74,7 +76,14 @@ static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formf
 int main(int argc, char **argv)
 {
     int passed = 0, failed = 0;
+    int times = getenv("RAD_TEST_TIMES") != NULL; /* CPU seconds per test, to keep the suite short */
     size_t t;
+    unsigned shard = 0, shards = 1, index = 0; /* RAD_TEST_SHARD=i/n: every n-th test from the i-th */
+    const char *sh = getenv("RAD_TEST_SHARD");
+    if (sh && (sscanf(sh, "%u/%u", &shard, &shards) != 2 || shards == 0 || shard >= shards)) {
+        printf("RAD_TEST_SHARD='%s' is not i/n with i < n\n", sh);
+        return 2;
+    }
     (void)&rad_test_quick; /* helpers some builds do not call */
     (void)&rad__bvh_destroy_real;
 #ifdef RAD_TEST_EMBREE
@@ -85,10 +94,14 @@ int main(int argc, char **argv)
         const rad_test_case *c;
         for (c = rad_test_tables[t]; c->name; ++c) {
             if (argc > 1 && !strstr(c->name, argv[1])) continue;
+            if (index++ % shards != shard) continue;
+            clock_t t0;
             rad_test_failures = 0;
             printf("%s\n", c->name);
             fflush(stdout);
+            t0 = clock();
             c->fn();
+            if (times) printf("  time %s %.2f s\n", c->name, (double)(clock() - t0) / CLOCKS_PER_SEC);
             if (rad_test_failures) { printf("  FAILED %s (%d checks)\n", c->name, rad_test_failures); failed++; }
             else passed++;
         }

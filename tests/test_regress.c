@@ -403,9 +403,7 @@ static void rg_test_file_io(void)
     void *buf = NULL;
     size_t size = 0;
     FILE *f;
-    const char *path = "build/test_regress_io.radb", *other = "build/test_regress_io.txt";
-    f = fopen(path, "wb");
-    if (!f) { path = "test_regress_io.radb"; other = "test_regress_io.txt"; } else fclose(f);
+    const char *path = rad_test_path("regress_io.radb"), *other = rad_test_path("regress_io.txt");
     CHECK_RESULT(rad_load_file(".", NULL, &b), RAD_ERROR_IO);
     CHECK(b == NULL);
     f = fopen(other, "wb");
@@ -455,8 +453,8 @@ static void rg_test_file_io(void)
             if (f) fclose(f);
         }
         /* a save that cannot be written reports IO and leaves nothing */
-        CHECK_RESULT(rad_save_file("build/no-such-folder/x/out.radb", P, NULL, NULL, NULL, NULL), RAD_ERROR_IO);
-        f = fopen("build/no-such-folder/x/out.radb.partial", "rb");
+        CHECK_RESULT(rad_save_file(rad_test_path("no-such-folder/x/out.radb"), P, NULL, NULL, NULL, NULL), RAD_ERROR_IO);
+        f = fopen(rad_test_path("no-such-folder/x/out.radb.partial"), "rb");
         CHECK(f == NULL);
         if (f) fclose(f);
     }
