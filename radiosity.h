@@ -825,6 +825,46 @@ typedef enum rad_source_mode {
 RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
                                float *out_E);
 
+/* ---- final gather: one traced bounce in front of a radiosity solution ----
+   A proxy (patches or virtual patches) holds radiosity as an average over each patch, so a
+   point that sees more of the lit scene than its patch's average (open floors, the faces a
+   camera sees) gets too little indirect light, and a coarse proxy blurs it. The final gather
+   traces that one bounce instead: from each point, 'rays' cosine-distributed rays (stratified,
+   rotated per point); at each front-facing hit the reflected light is rho(hit) (D(hit) + H(hit))
+   with D the direct irradiance there (rad_direct_irradiance with the lights and emitters) and
+   H the indirect irradiance the solution gives there (the caller's lookup: rad_vp_gather of
+   H = F B for virtual patches, the per-vertex irradiance of patches), so
+       out(p) = (1 / rays) sum_k rho_k (D_k + H_k)          (indirect irradiance at p)
+   Misses and back faces give 0 (the sky and the emitters are direct light at p, counted by
+   rad_direct_irradiance there). The proxy's error then enters only through H at the hits,
+   one bounce further away. Cost per point: 'rays' closest-hit rays, 'rays' direct-light
+   evaluations (light_samples shadow rays per area light each) and 'rays' lookups. */
+typedef struct rad_final_gather_options {
+    uint32_t rays;           /* per point (0: 64; at most 4096) */
+    uint32_t light_samples;  /* shadow rays per hit and area light or sky (0: 4) */
+    float ray_epsilon;       /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;           /* decorrelates runs; same seed, same bits on any thread count */
+} rad_final_gather_options;
+
+/* H at 'count' hit points: hits[i] (triangle, barycentrics), points 3 floats, unit geometric
+   normals 3 floats; writes 3 floats per point of indirect irradiance into out. Called from
+   the thread that called rad_final_gather, with up to 65536 points at a time. */
+typedef rad_result (*rad_gather_lookup_fn)(void *user, const rad_hit *hits, const float *points, const float *normals,
+                                           uint32_t count, float *out_irradiance);
+
+RAD_API void rad_final_gather_options_default(rad_final_gather_options *options);
+
+/* Indirect irradiance (3 floats per point) at 'count' points with normals (normalized here;
+   a zero one is refused), as above. lookup may be NULL (H = 0: exactly the first bounce of
+   the lights). Errors: INVALID_ARGUMENT (NULL input, rays above 4096, a zero normal, bad
+   light or ray_epsilon), NON_FINITE (a point, normal or result), RAYCAST_FAILED, CANCELLED,
+   OUT_OF_MEMORY, or what lookup returned. Thread safety: reentrant; the ray work runs through
+   ctx->parallel_for. */
+RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
+                                    uint32_t light_count, const rad_final_gather_options *options,
+                                    rad_gather_lookup_fn lookup, void *lookup_user, const float *points,
+                                    const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx);
+
 
 /* ======================================================================================== */
 /* >>api_shading: lighting models and BRDFs                                                 */
@@ -5832,6 +5872,222 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
         return RAD_SUCCESS;
     }
     return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+/* ---- final gather ---- */
+
+#define RAD__FG_CHUNK 65536u /* hit points per lookup call */
+
+typedef struct rad__fg {
+    const rad_scene *S;
+    const rad_raycaster *rc;
+    const float *points, *normals; /* the chunk's points (unit normals) */
+    uint32_t rays, seed, first;    /* first: index of the chunk's first point */
+    float eps;
+    rad_ray *ray_buf;              /* per task RAD__RAY_BATCH */
+    rad_hit *hits;                 /* the chunk's hits, rays per point */
+    float *hit_p, *hit_n;          /* 3 per hit; hit_n zero: no contribution */
+} rad__fg;
+
+static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__fg *g = (rad__fg *)data;
+    const float *p = g->points + 3 * (size_t)row, *n = g->normals + 3 * (size_t)row;
+    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    float t1[3], t2[3];
+    uint32_t seed = rad__hash(g->seed ^ rad__hash(g->first + row + 0x68E31DA4u)), k0, k;
+    float rot = (float)(seed >> 8) * (1.0f / 16777216.0f);
+    int c;
+    /* a tangent frame around n */
+    if (fabsf(n[0]) > 0.5f) { t1[0] = n[1]; t1[1] = -n[0]; t1[2] = 0.0f; }
+    else { t1[0] = 0.0f; t1[1] = n[2]; t1[2] = -n[1]; }
+    rad__normalize(t1);
+    t2[0] = n[1] * t1[2] - n[2] * t1[1];
+    t2[1] = n[2] * t1[0] - n[0] * t1[2];
+    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    for (k0 = 0; k0 < g->rays; k0 += RAD__RAY_BATCH) {
+        uint32_t m = g->rays - k0 < RAD__RAY_BATCH ? g->rays - k0 : RAD__RAY_BATCH;
+        rad_hit *h = g->hits + (size_t)row * g->rays + k0;
+        for (k = 0; k < m; ++k) {
+            /* cosine-weighted: radius sqrt(u1) on the disk, lifted; u1 stratified, u2 the
+               radical inverse, both rotated per point */
+            float u1 = ((float)(k0 + k) + 0.5f) / (float)g->rays, u2 = rad__radical_inverse(k0 + k) + rot, r, phi, x, y, z;
+            if (u2 >= 1.0f) u2 -= 1.0f;
+            r = sqrtf(u1);
+            phi = 2.0f * (float)RAD__PI * u2;
+            x = r * cosf(phi);
+            y = r * sinf(phi);
+            z = sqrtf(1.0f - u1 > 0.0f ? 1.0f - u1 : 0.0f);
+            for (c = 0; c < 3; ++c) {
+                rays[k].origin[c] = p[c] + n[c] * g->eps;
+                rays[k].dir[c] = x * t1[c] + y * t2[c] + z * n[c];
+            }
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = FLT_MAX;
+        }
+        if (g->rc->intersect(g->rc->user, rays, m, h) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        for (k = 0; k < m; ++k) {
+            size_t at = 3 * ((size_t)row * g->rays + k0 + k);
+            uint32_t t = h[k].triangle;
+            const float *v, *nt;
+            if (t == RAD_NONE || t >= g->S->triangle_count) {
+                h[k].triangle = RAD_NONE;
+                g->hit_p[at] = g->hit_p[at + 1] = g->hit_p[at + 2] = 0.0f;
+                g->hit_n[at] = g->hit_n[at + 1] = g->hit_n[at + 2] = 0.0f;
+                continue;
+            }
+            v = g->S->positions + 9 * (size_t)t;
+            nt = g->S->normals + 3 * (size_t)t;
+            for (c = 0; c < 3; ++c) {
+                g->hit_p[at + (size_t)c] = v[c] + h[k].b1 * (v[3 + c] - v[c]) + h[k].b2 * (v[6 + c] - v[c]);
+                g->hit_n[at + (size_t)c] = nt[c];
+            }
+            if (!(rad__dot(nt, rays[k].dir) < 0.0f)) { /* a back face: one-sided, black */
+                h[k].triangle = RAD_NONE;
+                g->hit_n[at] = g->hit_n[at + 1] = g->hit_n[at + 2] = 0.0f;
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_final_gather_options_default(rad_final_gather_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->rays = 64;
+    o->light_samples = 4;
+    o->ray_epsilon = 1e-5f;
+}
+
+RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
+                                    uint32_t light_count, const rad_final_gather_options *options,
+                                    rad_gather_lookup_fn lookup, void *lookup_user, const float *points,
+                                    const float *normals, uint32_t count, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__fg g;
+    rad_final_gather_options o;
+    rad_direct_options dopt;
+    rad_context quiet;
+    float *unit = NULL, *D = NULL, *H = NULL, *albedo = NULL;
+    uint32_t per, first, i, T, *owner = NULL;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!scene || !raycaster || !raycaster->intersect || !raycaster->occluded || !points || !normals || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "final gather: NULL scene, raycaster (with intersect and occluded), points, normals or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else rad_final_gather_options_default(&o);
+    if (o.rays == 0) o.rays = 64;
+    if (o.light_samples == 0) o.light_samples = 4;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (o.rays > 4096 || !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "final gather: rays %u (at most 4096) or ray_epsilon %g (in (0, %g]) out of range", o.rays,
+                 (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (count == 0) return RAD_SUCCESS;
+    memset(&g, 0, sizeof(g));
+    g.S = scene;
+    g.rc = raycaster;
+    g.rays = o.rays;
+    g.seed = o.seed;
+    g.eps = o.ray_epsilon * scene->diagonal;
+    rad_direct_options_default(&dopt);
+    dopt.light_samples = o.light_samples;
+    dopt.ray_epsilon = o.ray_epsilon;
+    dopt.seed = rad__hash(o.seed + 0x5BD1E995u);
+    /* the direct-light calls inside run without progress: this call's progress counts points */
+    if (ctx) quiet = *ctx;
+    else memset(&quiet, 0, sizeof(quiet));
+    quiet.progress = NULL;
+    per = RAD__FG_CHUNK / o.rays;
+    if (per == 0) per = 1;
+    T = c.tasks < per ? c.tasks : per;
+    unit = (float *)rad__alloc_array(&c.allocator, per, 3 * sizeof(float));
+    g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    g.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, sizeof(rad_hit));
+    g.hit_p = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    g.hit_n = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    D = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    H = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    albedo = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    owner = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, sizeof(uint32_t)); /* each hit's point */
+    if (!unit || !g.ray_buf || !g.hits || !g.hit_p || !g.hit_n || !D || !H || !albedo || !owner) {
+        rad__log(&c, RAD_LOG_ERROR, "final gather: out of memory for %u points of %u rays", per, o.rays);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (first = 0; first < count && r == RAD_SUCCESS; first += per) {
+        uint32_t m = count - first < per ? count - first : per, nh = 0, k;
+        size_t hits = (size_t)m * o.rays, j;
+        for (i = 0; i < m && r == RAD_SUCCESS; ++i) {
+            const float *p = points + 3 * (size_t)(first + i), *n = normals + 3 * (size_t)(first + i);
+            double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+            if (!rad__finite3(p) || !rad__finite3(n)) {
+                rad__log(&c, RAD_LOG_ERROR, "final gather: point %u or its normal is not finite", first + i);
+                r = RAD_ERROR_NON_FINITE;
+            } else if (!(len > 0.0) || len - len != 0.0) {
+                rad__log(&c, RAD_LOG_ERROR, "final gather: the normal of point %u has length %g (must be non-zero)", first + i, len);
+                r = RAD_ERROR_INVALID_ARGUMENT;
+            } else {
+                for (k = 0; k < 3; ++k) unit[3 * (size_t)i + k] = (float)((double)n[k] / len);
+            }
+        }
+        if (r != RAD_SUCCESS) break;
+        g.points = points + 3 * (size_t)first;
+        g.normals = unit;
+        g.first = first;
+        r = rad__for_rows(&c, m, T, rad__fg_row, &g);
+        if (r != RAD_SUCCESS) break;
+        /* the front-facing hits, packed to the front of the hit arrays */
+        for (j = 0; j < hits; ++j) {
+            if (g.hits[j].triangle == RAD_NONE) continue;
+            if (j != nh) {
+                g.hits[nh] = g.hits[j];
+                memcpy(g.hit_p + 3 * (size_t)nh, g.hit_p + 3 * j, 3 * sizeof(float));
+                memcpy(g.hit_n + 3 * (size_t)nh, g.hit_n + 3 * j, 3 * sizeof(float));
+            }
+            owner[nh++] = (uint32_t)(j / o.rays);
+        }
+        if (nh > 0) {
+            r = rad_direct_irradiance(scene, raycaster, lights, light_count, &dopt, g.hit_p, g.hit_n, nh, D, &quiet);
+            if (r != RAD_SUCCESS) {
+                rad__log(&c, RAD_LOG_ERROR, "final gather: direct light at the hits failed: %s", rad_result_string(r));
+                break;
+            }
+            if (lookup) {
+                r = lookup(lookup_user, g.hits, g.hit_p, g.hit_n, nh, H);
+                if (r != RAD_SUCCESS) {
+                    rad__log(&c, RAD_LOG_ERROR, "final gather: the lookup callback returned %s", rad_result_string(r));
+                    break;
+                }
+            } else {
+                memset(H, 0, sizeof(float) * 3 * (size_t)nh);
+            }
+            for (j = 0; j < nh; ++j) rad_scene_albedo(scene, g.hits[j].triangle, g.hits[j].b1, g.hits[j].b2, albedo + 3 * j);
+        }
+        for (i = 0; i < m; ++i) out[3 * (size_t)(first + i)] = out[3 * (size_t)(first + i) + 1] = out[3 * (size_t)(first + i) + 2] = 0.0f;
+        for (j = 0; j < nh; ++j) {
+            uint32_t pt = first + owner[j];
+            for (k = 0; k < 3; ++k)
+                out[3 * (size_t)pt + k] += albedo[3 * j + k] * (D[3 * j + k] + H[3 * j + k]) / (float)o.rays;
+        }
+        if (c.progress && c.progress(c.progress_user, (float)((double)(first + m) / (double)count))) {
+            rad__log(&c, RAD_LOG_INFO, "final gather: cancelled by the progress callback after %u of %u points", first + m, count);
+            r = RAD_ERROR_CANCELLED;
+        }
+    }
+    rad__free(&c.allocator, unit);
+    rad__free(&c.allocator, g.ray_buf);
+    rad__free(&c.allocator, g.hits);
+    rad__free(&c.allocator, g.hit_p);
+    rad__free(&c.allocator, g.hit_n);
+    rad__free(&c.allocator, D);
+    rad__free(&c.allocator, H);
+    rad__free(&c.allocator, albedo);
+    rad__free(&c.allocator, owner);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "final gather", out, 3 * (size_t)count) : r;
 }
 
 /* ======================================================================================== */

@@ -569,6 +569,129 @@ static void li_test_partly_hidden_emitter(void)
     rad_scene_destroy(S);
 }
 
+/* the lookup of li_test_final_gather: a constant H, or an error */
+static rad_result li_fg_const(void *user, const rad_hit *hits, const float *points, const float *normals, uint32_t count,
+                              float *out)
+{
+    const float *h = (const float *)user;
+    uint32_t i;
+    (void)hits; (void)points; (void)normals;
+    if (!h) return RAD_ERROR_RAYCAST_FAILED;
+    for (i = 0; i < 3 * count; ++i) out[i] = h[i % 3];
+    return RAD_SUCCESS;
+}
+
+static void li_fg_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+    uint32_t i;
+    (void)user;
+    for (i = count; i-- > 0;) fn(data, i);
+}
+
+/* rad_final_gather: the first bounce off a sunlit floor against the analytic point-to-polygon
+   form factor; a closed furnace (every wall emits L = 1, albedo 0.5) where the exact
+   H = pi rho / (1 - rho) = pi must come back; bits independent of the task order; errors. */
+static void li_test_final_gather(void)
+{
+    static const float quads[6][12] = {
+        { 0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0 },      /* floor */
+        { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 },      /* walls */
+        { 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1 },
+        { 0, 0, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0 },
+        { 1, 0, 0, 1, 0, 1, 1, 1, 1, 1, 1, 0 },
+        { 0, 1, 0, 1, 1, 0, 1, 1, 1, 0, 1, 1 }       /* the lid (furnace only) */
+    };
+    static const float wants[6][3] = { { 0, 1, 0 }, { 0, 0, 1 }, { 0, 0, -1 }, { 1, 0, 0 }, { -1, 0, 0 }, { 0, -1, 0 } };
+    const float heights[3] = { 0.1f, 0.5f, 0.9f };
+    float pos[72], pts[9], nrm[9], out[9], out2[9], floor_d[3], fp[3] = { 0.5f, 0.0f, 0.5f }, up[3] = { 0, 1, 0 }, H[3];
+    uint32_t idx[36], q, i, furnace;
+    rad_material grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0 }, glow = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 1.0f, 1.0f }, 0 };
+    rad_light sun;
+    rad_final_gather_options fo;
+    rad_context ctx;
+    for (q = 0; q < 6; ++q) li_box_quad(pos, idx, q, quads[q], wants[q]);
+    for (i = 0; i < 3; ++i) { /* on the wall x = 0, facing +x */
+        pts[3 * i] = 0.0f; pts[3 * i + 1] = heights[i]; pts[3 * i + 2] = 0.5f;
+        nrm[3 * i] = 1.0f; nrm[3 * i + 1] = 0.0f; nrm[3 * i + 2] = 0.0f;
+    }
+    li_light_init(&sun, RAD_LIGHT_DIRECTIONAL, 1.0f, 1.0f, 1.0f);
+    sun.direction[1] = -1.0f; /* straight down: the walls get nothing directly */
+    rad_final_gather_options_default(&fo);
+    fo.rays = 4096;
+    for (furnace = 0; furnace < 2; ++furnace) {
+        rad_mesh_desc mesh;
+        rad_scene_desc d;
+        rad_scene *S = NULL;
+        rad_bvh *b = NULL;
+        rad_raycaster rc;
+        memset(&mesh, 0, sizeof(mesh));
+        mesh.positions = pos;
+        mesh.vertex_count = furnace ? 24 : 20;
+        mesh.indices = idx;
+        mesh.triangle_count = furnace ? 12 : 10;
+        memset(&d, 0, sizeof(d));
+        d.meshes = &mesh;
+        d.mesh_count = 1;
+        d.materials = furnace ? &glow : &grey;
+        d.material_count = 1;
+        CHECK_OK(rad_scene_create(&d, NULL, &S));
+        if (S) CHECK_OK(rad_bvh_create(S, NULL, &b));
+        if (!b) { rad_scene_destroy(S); continue; }
+        rad_bvh_raycaster(b, &rc);
+        if (!furnace) {
+            rad_direct_options dopt;
+            rad_direct_options_default(&dopt);
+            CHECK_OK(rad_direct_irradiance(S, &rc, &sun, 1, &dopt, fp, up, 1, floor_d, NULL));
+            CHECK_REL(floor_d[0], 1.0f, 1e-5);
+            CHECK_OK(rad_final_gather(S, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 3, out, NULL));
+            for (i = 0; i < 3; ++i) {
+                float want = 0.5f * floor_d[0] * rad_ff_point_polygon(pts + 3 * i, nrm + 3 * i, quads[0], 4);
+                printf("    wall at height %.1f: final gather %.5f, rho D F(point, floor) %.5f\n", (double)heights[i],
+                       (double)out[3 * i], (double)want);
+                CHECK_REL(out[3 * i], want, 0.01);
+                CHECK(out[3 * i] == out[3 * i + 2]); /* grey: the channels agree */
+            }
+            /* the same bits with tasks in reverse order on one thread */
+            memset(&ctx, 0, sizeof(ctx));
+            ctx.parallel_for = li_fg_reverse_for;
+            ctx.task_count = 3;
+            CHECK_OK(rad_final_gather(S, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 3, out2, &ctx));
+            CHECK(memcmp(out, out2, sizeof(out)) == 0);
+            fo.seed = 7u; /* control: another seed, other bits */
+            CHECK_OK(rad_final_gather(S, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 3, out2, NULL));
+            CHECK(memcmp(out, out2, sizeof(out)) != 0);
+            fo.seed = 0u;
+            /* errors */
+            CHECK_RESULT(rad_final_gather(NULL, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 3, out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+            fo.rays = 5000;
+            CHECK_RESULT(rad_final_gather(S, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 3, out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+            fo.rays = 16;
+            nrm[0] = 0.0f;
+            CHECK_RESULT(rad_final_gather(S, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 1, out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+            nrm[0] = 1.0f;
+            pts[1] = (float)NAN;
+            CHECK_RESULT(rad_final_gather(S, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 1, out, NULL), RAD_ERROR_NON_FINITE);
+            pts[1] = heights[0];
+            CHECK_RESULT(rad_final_gather(S, &rc, &sun, 1, &fo, li_fg_const, NULL, pts, nrm, 1, out, NULL), RAD_ERROR_RAYCAST_FAILED);
+            fo.rays = 4096;
+        } else {
+            /* every ray hits a wall lit by the other five: D = pi; with the exact H = pi the
+               gather returns pi, without a lookup rho D = pi / 2 */
+            H[0] = H[1] = H[2] = (float)LI_PI;
+            fo.rays = 256;
+            CHECK_OK(rad_final_gather(S, &rc, NULL, 0, &fo, li_fg_const, H, pts, nrm, 3, out, NULL));
+            CHECK_OK(rad_final_gather(S, &rc, NULL, 0, &fo, NULL, NULL, pts, nrm, 3, out2, NULL));
+            for (i = 0; i < 9; ++i) {
+                CHECK_REL(out[i], LI_PI, 1e-4);
+                CHECK_REL(out2[i], 0.5 * LI_PI, 1e-4);
+            }
+            fo.rays = 4096;
+        }
+        rad_bvh_destroy(b);
+        rad_scene_destroy(S);
+    }
+}
+
 static const rad_test_case tests_light[] = {
     { "light_directional_point_spot", li_test_directional_point_spot },
     { "light_sky", li_test_sky },
@@ -577,5 +700,6 @@ static const rad_test_case tests_light[] = {
     { "light_direct_patches_own_triangle", li_test_direct_patches_own_triangle },
     { "light_no_double_counting", li_test_no_double_counting },
     { "light_partly_hidden_emitter", li_test_partly_hidden_emitter },
+    { "light_final_gather", li_test_final_gather },
     { NULL, NULL }
 };

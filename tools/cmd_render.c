@@ -69,6 +69,9 @@ static void render_usage(FILE *f)
             "  --seed S           pathtrace: random seed (default 0)\n"
             "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
             "  --pixel-light-samples N   radiosity methods: shadow rays per pixel sample and light (default 16)\n"
+            "  --final-gather N   classic, vp, aavp: trace the first bounce from each pixel sample with N\n"
+            "                     rays (direct light at the hits, the solution's irradiance there): the\n"
+            "                     indirect light of points a patch average misrepresents; default 0 (off)\n"
             "  --shading MODEL    radiosity methods: lighting model for the analytic lights' direct term: none\n"
             "                     (default: Lambert through the irradiance), lambert, half-lambert, banded,\n"
             "                     phong, blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says\n"
@@ -163,6 +166,38 @@ static int render_shading = -1;
 static const rad_virtual_patches *render_vp = NULL;
 static const float *render_vp_H = NULL;
 static double render_vp_gather_seconds = 0.0;
+/* --final-gather N: rays per pixel sample for one traced bounce (0: off; rad_final_gather) */
+static uint32_t render_final_gather = 0;
+
+typedef struct fg_lookup {
+    const rad_patches *P; /* classic: per-vertex H of the patches */
+    const float *Hv;
+} fg_lookup;
+
+/* H at the final gather's hits: the virtual patches' gather, or the patches' per-vertex H */
+static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *points, const float *normals, uint32_t count,
+                               float *out)
+{
+    const fg_lookup *l = (const fg_lookup *)user;
+    uint32_t k;
+    int i;
+    if (render_vp) {
+        rad_context quiet;
+        rad_tool_context(&quiet, NULL);
+        return rad_vp_gather(render_vp, render_vp_H, points, normals, count, out, &quiet);
+    }
+    for (k = 0; k < count; ++k) {
+        float wts[3];
+        uint32_t p = rad_patches_locate(l->P, hits[k].triangle, hits[k].b1, hits[k].b2, wts);
+        const uint32_t *vi;
+        if (p == RAD_NONE) { out[3 * k] = out[3 * k + 1] = out[3 * k + 2] = 0.0f; continue; }
+        vi = l->P->patches[p].vertices;
+        for (i = 0; i < 3; ++i)
+            out[3 * k + i] = wts[0] * l->Hv[3 * (size_t)vi[0] + i] + wts[1] * l->Hv[3 * (size_t)vi[1] + i] +
+                             wts[2] * l->Hv[3 * (size_t)vi[2] + i];
+    }
+    return RAD_SUCCESS;
+}
 
 static int render_classic(const rad_tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
                           int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
@@ -189,7 +224,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
-    if (render_vp) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    if (render_vp || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     if (render_shading >= 0) {
         shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
         shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
@@ -253,7 +288,23 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
                 break;
             }
         }
-        if (gathered && nvalid > 0) {
+        if (render_final_gather && nvalid > 0) {
+            rad_final_gather_options fo;
+            fg_lookup lk;
+            double tg = rad_tool_seconds();
+            rad_final_gather_options_default(&fo);
+            fo.rays = render_final_gather;
+            fo.seed = (uint32_t)y0 * 0x9E3779B9u;
+            lk.P = P;
+            lk.Hv = Hv;
+            r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, &lk, points, normals,
+                                 nvalid, gathered, &quiet);
+            render_vp_gather_seconds += rad_tool_seconds() - tg;
+            if (r != RAD_SUCCESS) {
+                result = rad_tool_fail("render", "rad_final_gather", r);
+                break;
+            }
+        } else if (gathered && nvalid > 0) {
             double tg = rad_tool_seconds();
             r = rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
             render_vp_gather_seconds += rad_tool_seconds() - tg;
@@ -772,6 +823,9 @@ int rad_cmd_render(int argc, char **argv)
         } else if (!strcmp(opt, "--pixel-light-samples")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
             if (pixel_light_samples == 0) { fprintf(stderr, "rad %s: %s must be > 0\n", cmd, opt); return 2; }
+        } else if (!strcmp(opt, "--final-gather")) {
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], &render_final_gather)) return 2;
+            if (render_final_gather > 4096) { fprintf(stderr, "rad %s: %s is at most 4096\n", cmd, opt); return 2; }
         } else if (!strcmp(opt, "--exposure")) {
             if (rad_tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
             if (!(exposure > 0.0f)) { fprintf(stderr, "rad %s: --exposure must be > 0\n", cmd); return 2; }
