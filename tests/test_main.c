@@ -1,7 +1,7 @@
 /* test_main.c - the unit tests: one translation unit holding the implementation and every
    test file. Usage: test_main [NAME-SUBSTRING]. Prints "N passed, N failed" last.
    Environment: RAD_TEST_QUICK=1 smaller sizes; RAD_TEST_SHARD=i/n every n-th test from the
-   i-th; RAD_TEST_TIMES=1 CPU seconds per test; RAD_TEST_TMPDIR where scratch files go. */
+   i-th; RAD_TEST_SKIP=a,b leaves out the tests of those names; RAD_TEST_TIMES=1 CPU seconds per test; RAD_TEST_TMPDIR where scratch files go. */
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
 #include "test.h"
@@ -73,13 +73,28 @@ static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
 
 static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_solve, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl };
 
+/* 1 when 'name' is one of the comma-separated names in 'list' */
+static int rad_test_listed(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    const char *p = list;
+    while (*p) {
+        const char *e = strchr(p, ',');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (len == n && strncmp(p, name, n) == 0) return 1;
+        if (!e) break;
+        p = e + 1;
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     int passed = 0, failed = 0;
     int times = getenv("RAD_TEST_TIMES") != NULL; /* CPU seconds per test, to keep the suite short */
     size_t t;
     unsigned shard = 0, shards = 1, index = 0; /* RAD_TEST_SHARD=i/n: every n-th test from the i-th */
-    const char *sh = getenv("RAD_TEST_SHARD");
+    const char *sh = getenv("RAD_TEST_SHARD"), *skip = getenv("RAD_TEST_SKIP");
     if (sh && (sscanf(sh, "%u/%u", &shard, &shards) != 2 || shards == 0 || shard >= shards)) {
         printf("RAD_TEST_SHARD='%s' is not i/n with i < n\n", sh);
         return 2;
@@ -94,6 +109,7 @@ int main(int argc, char **argv)
         const rad_test_case *c;
         for (c = rad_test_tables[t]; c->name; ++c) {
             if (argc > 1 && !strstr(c->name, argv[1])) continue;
+            if (skip && rad_test_listed(skip, c->name)) continue;
             if (index++ % shards != shard) continue;
             clock_t t0;
             rad_test_failures = 0;
