@@ -213,7 +213,7 @@ static int bench_size(uint32_t target)
         t_half[ki] = time_it(&r, E, out);
         e_half[ki] = rel_err(out, ref, n3);
         if (ks[ki] != 1) {
-            static const char *const methods[5] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+            static const char *const methods[5] = { "none", "greedy chain", "greedy + 2-opt", "2-opt + group swaps",
                                                            "matching + group swaps" };
             if (ki == 1) {
                 emit("Compressed forms of F_mb (outliers 5%%). Bytes are what one apply reads (blocks + scales + permutations +\n");
@@ -283,7 +283,7 @@ static int bench_size(uint32_t target)
    pseudo-random permutation). */
 static int reorder_only(uint32_t target)
 {
-    static const char *const names[RAD_REORDER_MATCH + 1] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+    static const char *const names[RAD_REORDER_MATCH + 1] = { "none", "greedy chain", "greedy + 2-opt", "2-opt + group swaps",
                                                                "matching + group swaps" };
     rad_scene_desc desc;
     rad_camera cam;
