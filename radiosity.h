@@ -217,7 +217,7 @@
        sections (types >= RAD_SECTION_USER) through rad_container_write.
 
   10. GLSL
-       The GPU paths are GLSL 4.50 compute kernels embedded as text (SPEC §10): get one with
+       The GPU paths are GLSL 4.50 compute kernels embedded as text (>>api_glsl): get one with
        rad_glsl_source(RAD_GLSL_TEMPORAL_STEP, buf, size, &len) (or rad_glsl_pieces), compile
        it with glslang or shaderc and dispatch it on your own Vulkan device; radiosity.h never
        touches a GPU. Kernels: dense and CSR gather (one bounce), multi-bounce apply from
@@ -248,7 +248,8 @@
          sub-triangle lattice (the midpoint rule: no bias toward any corner) and the receiver
          side analytically; pairs closer than twice their size get 16x the points, because the
          integrand is nearly singular along a shared edge. Measured against the closed forms
-         of REFERENCE.md at default quality: relative errors below 1e-4.
+         of Howell's catalogue (docs/references.md) at default quality: relative errors
+         below 1e-4.
        - The BVH's box test widens every slab by 1 + 2 gamma_3 (Ize 2013) and its triangle
          test is watertight (Woop, Benthin, Wald 2013), so rays through shared edges and
          vertices are never lost.
@@ -450,7 +451,7 @@ typedef struct rad_scene {
    Parameters: desc (borrowed for the call), ctx (optional), out (receives an owning pointer).
    Errors: INVALID_ARGUMENT, EMPTY_SCENE, INDEX_OUT_OF_RANGE, NON_FINITE, DEGENERATE_TRIANGLE,
    ALBEDO_RANGE, NEGATIVE_EMISSION, MATERIAL_OUT_OF_RANGE, SIZE_OVERFLOW, SCALE_RANGE,
-   OUT_OF_MEMORY; the logger names the mesh and triangle. Thread safety: reentrant. Cost: O(triangles). SPEC §1. */
+   OUT_OF_MEMORY; the logger names the mesh and triangle. Thread safety: reentrant. Cost: O(triangles). */
 RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_context *ctx, rad_scene **out);
 RAD_API void rad_scene_destroy(rad_scene *scene);
 
@@ -467,7 +468,7 @@ typedef struct rad_camera {
 } rad_camera;
 
 /* The built-in Cornell box: the original Cornell geometry in metres (the same scene as
-   shared/data/cornell.obj: 16 quads, 32 triangles) with the common RGB materials
+   the cornell.obj of docs/data.md: 16 quads, 32 triangles) with the common RGB materials
    (white 0.725 0.71 0.68, red 0.63 0.065 0.05, green 0.14 0.45 0.091, light albedo 0.78 and
    radiance 17 12 4, one-sided, facing down, 0.1 mm below the ceiling) and its camera
    (0.278 0.273 -0.8 looking along +z, vertical fov 39.3077). Meshes: floor, ceiling, back,
@@ -520,7 +521,7 @@ RAD_API void rad_patch_options_default(rad_patch_options *options);
 /* Cuts the scene into patches. scene is borrowed and must outlive the result.
    Errors: INVALID_ARGUMENT (negative or non-finite option), SIZE_OVERFLOW (more than 2^32-2
    patches), ALBEDO_RANGE (texture callback out of range), OUT_OF_MEMORY.
-   Thread safety: reentrant. Cost: O(patches). SPEC §1. */
+   Thread safety: reentrant. Cost: O(patches). */
 RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_options *options,
                                       const rad_context *ctx, rad_patches **out);
 RAD_API void rad_patches_destroy(rad_patches *patches);
@@ -661,7 +662,7 @@ RAD_API void rad_form_factor_options_default(rad_form_factor_options *options);
    from the sample points of the smaller patch (the lower index on a tie); the other entry
    follows by reciprocity, so A_i F_ij = A_j F_ji holds exactly, no area ratio can overflow,
    and any split of the rows gives the same bits as the full matrix. raycaster may be NULL only with skip_visibility. Thread safety: reentrant; uses
-   ctx->parallel_for. Cost: O((row_end-row_begin) N samples). SPEC §2. */
+   ctx->parallel_for. Cost: O((row_end-row_begin) N samples). docs/methods/formfactor-analytic.md. */
 RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_raycaster *raycaster,
                                         const rad_form_factor_options *options, uint32_t row_begin,
                                         uint32_t row_end, float *out_rows, const rad_context *ctx);
@@ -683,10 +684,10 @@ RAD_API void rad_form_factors_destroy(rad_form_factors *ff);
 /* Point to polygon, unoccluded, analytic (Lambert's contour integral): the form factor from a
    differential area at p with unit normal n to the convex or simple polygon 'vertices'
    (count points, 3 floats each, counter-clockwise seen from its front). The polygon is clipped
-   to p's upper half-space; returns 0 when p is behind the polygon's plane. SPEC §2. */
+   to p's upper half-space; returns 0 when p is behind the polygon's plane. docs/methods/formfactor-analytic.md. */
 RAD_API float rad_ff_point_polygon(const float p[3], const float n[3], const float *vertices, uint32_t count);
 
-/* Point to point (SPEC §2, T eq. 5.1) without visibility:
+/* Point to point, the kernel of Monte Carlo form factors and virtual patches, without visibility:
    s_j cos(r, n_i) cos(-r, n_j) / (pi max(|r|^2, s_j / pi)), 0 when either cosine is <= 0. */
 RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const float pj[3], const float nj[3],
                                  float sj);
@@ -733,7 +734,7 @@ RAD_API void rad_system_init(rad_system *system, const rad_matrix *F, const rad_
    out must not alias x. Cost: one pass over F. */
 RAD_API rad_result rad_matrix_multiply(const rad_matrix *F, const float *x, float *out, const rad_context *ctx);
 
-/* Jacobi bounces: B^0 = E, B^k = (rho o F) B^(k-1); out = L_K or E + L_K. O(K N^2). SPEC §3. */
+/* Jacobi bounces: B^0 = E, B^k = (rho o F) B^(k-1); out = L_K or E + L_K. O(K N^2). docs/methods/classic.md. */
 RAD_API rad_result rad_solve_jacobi(const rad_system *system, const rad_solve_options *options, float *out,
                                     rad_solve_stats *stats, const rad_context *ctx);
 /* Gauss-Seidel sweeps in patch order until the residual is below tolerance. Serial.
@@ -765,7 +766,7 @@ typedef enum rad_light_type {
 
 typedef enum rad_falloff {
     RAD_FALLOFF_QUADRATIC = 0, /* I / d^2 (physical) */
-    RAD_FALLOFF_LINEAR = 1     /* I / d (the seed's LINEAR_FALOFF option; not physical) */
+    RAD_FALLOFF_LINEAR = 1     /* I / d (the linear falloff of Korobeinikov 2022; not physical) */
 } rad_falloff;
 
 typedef struct rad_light {
@@ -870,7 +871,8 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
 /* >>api_shading: lighting models and BRDFs                                                 */
 /* ======================================================================================== */
 
-/* Local lighting models for the direct term and the final shading (SPEC §9, B-2.1, B-2.2).
+/* Local lighting models for the direct term and the final shading (docs/methods/shading.md; the set of
+   models of Korobeinikov 2022, docs/references.md).
    Radiosity gives the indirect light of diffuse surfaces; these functions give the response
    of a surface to one light direction, the same in C and in glsl/lighting.glsl.
 
@@ -881,7 +883,7 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
         I / d^2 for a point light). rad_shading_brdf() returns it.
      R  the response: L_o = R * E. For every model that has a BRDF, R = f * max(n.l, 0).
         rad_shading_eval() returns it; this is what a shader adds per light.
-   The models of B-2.1 that the thesis states as an "intensity" (a cosine-like number in
+   The models usually stated as an "intensity" (a cosine-like number in
    [0,1]) are scaled by albedo / pi so that a white model of intensity cos(theta) is exactly
    Lambert: R = albedo / pi * intensity. For banded, f = R / (n.l). Half-Lambert (wrap)
    lights points with n.l < 0, so it has no BRDF: rad_shading_brdf() refuses it.
@@ -890,8 +892,8 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
    normalized forms with kd + ks <= 1; Oren-Nayar nearly (the qualitative model: at albedo 1
    its directional albedo reaches 1.0105 at grazing view for sigma = 0.25, and stays <= 1 for
    sigma >= 0.5: 0.83 at sigma 1); the microfacet model with the Shirley diffuse term or none (with
-   Shirley at albedo 1 the sum reaches 1.0015 at grazing view). The thesis's Lambert diffuse
-   term (1 - F(n,l)) albedo / pi (eq. 27, the default because it is the thesis's) is neither
+   Shirley at albedo 1 the sum reaches 1.0015 at grazing view). The Lambert diffuse
+   term (1 - F(n,l)) albedo / pi (the default, as in Korobeinikov 2022) is neither
    reciprocal nor energy-conserving with the specular term (measured 1.07 at albedo 1).
    Minnaert is reciprocal, energy-conserving only for k >= 1. Banded and half-Lambert are
    neither. Every model returns 0 (f and R) when n.v <= 0: surfaces are one-sided. */
@@ -914,25 +916,25 @@ typedef enum rad_shading_model {
                                      A = 1 - 0.5 s^2 / (s^2 + 0.33), B = 0.45 s^2 / (s^2 + 0.09),
                                      a = max(theta_l, theta_v), b = min (Oren, Nayar 1994,
                                      qualitative model); computed as (l.v - n.l n.v) / max(n.l, n.v) */
-    RAD_SHADING_MICROFACET = 7,   /* f = F(h,l) G2(l,v,h) D(h) / (4 |n.l| |n.v|) + f_diffuse (B eq. 17) */
+    RAD_SHADING_MICROFACET = 7,   /* f = F(h,l) G2(l,v,h) D(h) / (4 |n.l| |n.v|) + f_diffuse (Cook & Torrance 1982) */
     RAD_SHADING_MODEL_COUNT = 8
 } rad_shading_model;
 
 typedef enum rad_ndf {
-    RAD_NDF_BECKMANN = 0,         /* B eq. 18 / 24; Lambda: the rational approximation (21) */
-    RAD_NDF_GGX = 1               /* B eq. 22 / 26; Lambda: eq. 23 (exact) */
+    RAD_NDF_BECKMANN = 0,         /* Beckmann; Lambda: the rational approximation of Walter et al. 2007 */
+    RAD_NDF_GGX = 1               /* Walter et al. 2007; Lambda: exact */
 } rad_ndf;
 
 typedef enum rad_masking {
-    RAD_MASKING_SEPARABLE = 0,         /* G2 = G1(v, h) G1(l, h)                (B eq. 13) */
-    RAD_MASKING_HEIGHT_CORRELATED = 1  /* G2 = chi(h.v) chi(h.l) / (1 + L(v) + L(l)) (eq. 14) */
+    RAD_MASKING_SEPARABLE = 0,         /* G2 = G1(v, h) G1(l, h)                (Heitz 2014) */
+    RAD_MASKING_HEIGHT_CORRELATED = 1  /* G2 = chi(h.v) chi(h.l) / (1 + L(v) + L(l)) (Heitz 2014) */
 } rad_masking;
 
 typedef enum rad_diffuse_term {
     RAD_DIFFUSE_NONE = 0,         /* specular only */
-    RAD_DIFFUSE_LAMBERT = 1,      /* (1 - F(n,l)) albedo / pi, F the Schlick term below (eq. 27) */
+    RAD_DIFFUSE_LAMBERT = 1,      /* (1 - F(n,l)) albedo / pi, F the Schlick term below (Korobeinikov 2022) */
     RAD_DIFFUSE_SHIRLEY = 2       /* (1 - F0) 21 albedo / (20 pi) (1 - (1 - n.l)^5) (1 - (1 - n.v)^5)
-                                     (Shirley et al. 1997, eq. 28) */
+                                     (Shirley et al. 1997) */
 } rad_diffuse_term;
 
 /* Ranges are checked by rad_shading_validate (and so by the two entries). Albedos, kd, ks,
@@ -969,8 +971,8 @@ typedef struct rad_microfacet_params {
     float alpha_x, alpha_y;       /* roughness along t and b, each in [1e-3, 1]; equal values
                                      make the model isotropic (t and b then unused); default 0.3 */
     float f0[3];                  /* Fresnel reflectance at normal incidence; default 0.04 */
-    float f90[3];                 /* ... at grazing incidence (eq. 16); default 1 */
-    float fresnel_exponent;       /* 1/p of eq. 16, in [1, 10]; 5 is Schlick's eq. 15; default 5 */
+    float f90[3];                 /* ... at grazing incidence (generalized Schlick); default 1 */
+    float fresnel_exponent;       /* 1/p of the generalized form, in [1, 10]; 5 is Schlick's; default 5 */
     float albedo[3];              /* rho of the diffuse term; default 0.5 */
 } rad_microfacet_params;
 
@@ -1009,7 +1011,7 @@ RAD_API rad_result rad_shading_model_from_name(const char *name, rad_shading_mod
    names it), NON_FINITE (a NaN or Inf parameter). Thread-safe, O(1). */
 RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context *ctx);
 
-/* The two evaluation entries (see CONVENTION above; SPEC §9).
+/* The two evaluation entries (see CONVENTION above; docs/methods/shading.md).
    l, v, n: non-zero finite 3-vectors, normalized here. t, b: the tangent frame, used only
    by an anisotropic microfacet model (alpha_x != alpha_y); there t is required, made
    orthogonal to n here, and b may be NULL (then b = n x t) or is made orthogonal to n and t.
@@ -1025,35 +1027,35 @@ RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], cons
 RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
                                     const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
 
-/* Terms of the microfacet model, to compose your own (B-2.2.6 to 2.2.10). Plain float math:
+/* Terms of the microfacet model, to compose your own (docs/methods/shading.md). Plain float math:
    the caller guarantees valid inputs (cosines in [-1, 1], roughness in (0, 1]); nothing is
    checked. All thread-safe and O(1). 'nm' is n.m, 'tm' t.m, 'bm' b.m for the microfacet
    normal m (usually h). */
-RAD_API float rad_ndf_beckmann(float nm, float alpha);                                   /* eq. 18 */
-RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y); /* eq. 24 */
-RAD_API float rad_ndf_ggx(float nm, float alpha);                                        /* eq. 22 */
-RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y);      /* eq. 26 */
-/* The Smith variable a = n.s / sqrt(alpha_x^2 (t.s)^2 + alpha_y^2 (b.s)^2) (eq. 25; with
-   alpha_x = alpha_y = alpha it is eq. 19, since (t.s)^2 + (b.s)^2 = 1 - (n.s)^2). Returns
+RAD_API float rad_ndf_beckmann(float nm, float alpha);                                   /* Beckmann */
+RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y); /* Beckmann, anisotropic */
+RAD_API float rad_ndf_ggx(float nm, float alpha);                                        /* GGX */
+RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y);      /* GGX, anisotropic */
+/* The Smith variable a = n.s / sqrt(alpha_x^2 (t.s)^2 + alpha_y^2 (b.s)^2) (Heitz 2014; with
+   alpha_x = alpha_y = alpha it is n.s / (alpha sqrt(1 - (n.s)^2)), since (t.s)^2 + (b.s)^2 = 1 - (n.s)^2). Returns
    +inf for s = n (no masking); requires n.s > 0. */
 RAD_API float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y);
-/* Lambda(a) for a > 0: GGX (eq. 23); Beckmann's rational approximation (eq. 21; 0 for
-   a >= 1.6); Beckmann's exact form (eq. 20, with erf; C only, the reference for the
+/* Lambda(a) for a > 0: GGX (exact); Beckmann's rational approximation (Walter et al. 2007; 0 for
+   a >= 1.6); Beckmann's exact form (with erf; C only, the reference for the
    approximation). Each returns 0 for a = +inf. */
 RAD_API float rad_lambda_ggx(float a);
 RAD_API float rad_lambda_beckmann(float a);
 RAD_API float rad_lambda_beckmann_exact(float a);
-/* G1 = chi+(m.s) / (1 + Lambda(s)) (eq. 11). */
+/* G1 = chi+(m.s) / (1 + Lambda(s)) (Heitz 2014). */
 RAD_API float rad_smith_g1(float ms, float lambda_s);
-/* G2 separable G1(v) G1(l) (eq. 13) and height-correlated (eq. 14). */
+/* G2 separable G1(v) G1(l) and height-correlated 1 / (1 + Lambda(v) + Lambda(l)) (Heitz 2014). */
 RAD_API float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l);
 RAD_API float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l);
-/* Schlick's Fresnel F0 + (1 - F0)(1 - max(c, 0))^5 (eq. 15) and its generalized form
-   F0 + (F90 - F0)(1 - max(c, 0))^exponent (eq. 16, exponent = 1/p). One channel. */
+/* Schlick's Fresnel F0 + (1 - F0)(1 - max(c, 0))^5 (Schlick 1994) and its generalized form
+   F0 + (F90 - F0)(1 - max(c, 0))^exponent (Real-Time Rendering; exponent = 1/p). One channel. */
 RAD_API float rad_fresnel_schlick(float f0, float c);
 RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c);
-/* Diffuse terms, one channel: Lambert (1 - F) albedo / pi (eq. 27, F = F(n,l)), Shirley
-   et al. (1 - F0) 21 albedo / (20 pi) (1 - (1 - nl+)^5)(1 - (1 - nv+)^5) (eq. 28). */
+/* Diffuse terms, one channel: Lambert (1 - F) albedo / pi (F = F(n,l)), Shirley
+   et al. (1 - F0) 21 albedo / (20 pi) (1 - (1 - nl+)^5)(1 - (1 - nv+)^5). */
 RAD_API float rad_diffuse_lambert(float albedo, float F);
 RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv);
 
@@ -1086,7 +1088,7 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
 /* >>api_container: baked data                                                              */
 /* ======================================================================================== */
 
-/* One versioned binary container for everything a bake produces (SPEC §11). Layout, all
+/* One versioned binary container for everything a bake produces (docs/methods/container.md). Layout, all
    little-endian: a 64-byte header ("RADB", version, section count, table offset, file size,
    flags, CRC-32 of the table, CRC-32 of the header), a table of 64-byte section entries (type, element size, element count,
    offset, byte size, CRC-32 of the data, a 24-byte name), and the section data, each section
@@ -1237,7 +1239,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
 /* >>api_glsl: GLSL compute kernels                                                         */
 /* ======================================================================================== */
 
-/* SPEC §10. The compute kernels, as GLSL 4.50 source text the application compiles (with
+/* The compute kernels, as GLSL 4.50 source text the application compiles (with
    glslang or shaderc) and dispatches on its own Vulkan 1.1+ device (Vulkan GLSL: push
    constants and specialization constants): radiosity.h never touches a GPU. The canonical
    sources are the files glsl/<name> of the repository; the copy in the >>glsl section is
@@ -1312,7 +1314,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        with row_offset + row_count <= N); the outlier arrays are bound whole (indexed by
        original row), which limits them to one storage range (N of about 14 000 at 5%), and
        the image to maxImageDimension2D texels (16384 on lavapipe).
-   RAD_GLSL_ALIAS_BUILD    alias tables of streamed rows (P-4.3), the bins of
+   RAD_GLSL_ALIAS_BUILD    alias tables of streamed rows (docs/methods/temporal.md), the bins of
        rad_alias_build_row (Vose in double: needs the shaderFloat64 feature; bit-identical where
        double arithmetic is IEEE, as on lavapipe). Push: rad_glsl_alias_build_push; flags
        RAD_GLSL_FLAG_DENSE (rows of cols values, no column array). 0: input row offsets
@@ -1494,21 +1496,21 @@ RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
    *out_length (optional) receives the length without the NUL, on success and when dst is too
    small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
    INVALID_ARGUMENT (unknown id; dst NULL with out_length NULL or dst_size > 0), SIZE_MISMATCH
-   (dst_size <= length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). SPEC §10. */
+   (dst_size <= length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). */
 RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
 
 /* ======================================================================================== */
 /* >>api_multibounce: multi-bounce matrix and its compression                               */
 /* ======================================================================================== */
 
-/* SPEC §4 (thesis ch. 3). The albedo and K bounces folded into one RGB matrix,
+/* docs/methods/multibounce.md (Shcherbakov 2025, ch. 3). The albedo and K bounces folded into one RGB matrix,
        F_mb = sum_{k=1..K} (rho o F)^k        (K = inf: (I - rho o F)^-1 - I)
    so that L_K = F_mb E costs one matrix-vector product whatever K is. Limits: the albedo is
    baked in (changing a material means rebuilding) and K is fixed at build time.
    Storage: three N x N planes (R, G, B), row-major, float or IEEE binary16. Optional row and
    column permutations: plane entry (i', j') is F_mb[row_perm[i']][col_perm[j']].
    Compression (rad_multibounce_blocks_*): outliers kept exactly in a sparse list, greedy
-   row/column reordering (thesis Listing 3.1, optionally refined: rad_block_options.reorder), scaling into [0,1] per matrix or per tile, and
+   row/column reordering (the greedy chain of Shcherbakov 2025, optionally refined: rad_block_options.reorder), scaling into [0,1] per matrix or per tile, and
    GPU block encoding, bit-exact with the Khronos Data Format specification: BC1 (one RGB
    texture) or three BC4 planes. Texel (x, y) of the matrix image is entry (row y, column x) of
    the permuted matrix; 4x4 blocks, block (bx, by) at byte 8 * (ceil(N/4) * by + bx); the image
@@ -1565,7 +1567,7 @@ RAD_API void rad_multibounce_options_default(rad_multibounce_options *options);
    build's SIMD, not on the number of threads). Progress is reported after each product.
    Errors: INVALID_ARGUMENT, SIZE_MISMATCH, ALBEDO_RANGE, SIZE_OVERFLOW, OUT_OF_MEMORY,
    NOT_CONVERGED (K = inf), CANCELLED. Thread safety: reentrant. Cost: O(N^3 log K) time per
-   channel, 16 N^2 bytes of scratch plus the 12 N^2 (6 N^2 half) bytes of the result. SPEC §4. */
+   channel, 16 N^2 bytes of scratch plus the 12 N^2 (6 N^2 half) bytes of the result. docs/methods/multibounce.md. */
 RAD_API rad_result rad_multibounce_create(const rad_matrix *F, const float *albedo,
                                           const rad_multibounce_options *options, const rad_context *ctx,
                                           rad_multibounce **out);
@@ -1573,7 +1575,7 @@ RAD_API rad_result rad_multibounce_create(const rad_matrix *F, const float *albe
    is exact), keeping its permutations. Cost: O(N^2). */
 RAD_API rad_result rad_multibounce_convert(const rad_multibounce *src, rad_mb_precision precision,
                                            const rad_context *ctx, rad_multibounce **out);
-/* A copy of 'src' with rows and columns reordered greedily (thesis Listing 3.1, see
+/* A copy of 'src' with rows and columns reordered greedily (docs/methods/compression.md, see
    rad_block_options.reorder_samples; always RAD_REORDER_GREEDY); only for an unpermuted src. Cost: O(N^3) exact,
    O(N^2 samples) sampled. */
 RAD_API rad_result rad_multibounce_reorder(const rad_multibounce *src, uint32_t samples, const rad_context *ctx,
@@ -1584,7 +1586,7 @@ RAD_API void rad_multibounce_destroy(rad_multibounce *mb);
    interleaved RGB floats in the original patch order (permutations are applied inside). One
    pass over the three planes, parallel over rows; half planes are widened on the fly (F16C
    when the build has it). out must not alias E. Thread safety: reentrant (mb is read only).
-   Cost: O(N^2), 12 N^2 (6 N^2) bytes read. SPEC §4. */
+   Cost: O(N^2), 12 N^2 (6 N^2) bytes read. docs/methods/multibounce.md. */
 RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float *E, float *out, rad_output output,
                                          const rad_context *ctx);
 
@@ -1601,7 +1603,7 @@ typedef enum rad_block_format {
 } rad_block_format;
 
 #define RAD_REORDER_NONE 0        /* rad_block_options.reorder: keep the patch order */
-#define RAD_REORDER_GREEDY 1      /* greedy nearest-neighbour chain (thesis Listing 3.1) */
+#define RAD_REORDER_GREEDY 1      /* greedy nearest-neighbour chain (Shcherbakov 2025) */
 #define RAD_REORDER_GREEDY_2OPT 2 /* the greedy chain, then 2-opt reversals that shorten it */
 #define RAD_REORDER_GROUPS 3      /* 2-opt chain, then swaps between the groups of four rows
                                      (columns) that make each 4x4 block's rows more alike */
@@ -1614,7 +1616,7 @@ typedef struct rad_block_options {
                                   channel) go exactly into the sparse list, zeros left in place;
                                   0 disables the step (default 0.05) */
     int reorder;               /* row and column reordering: RAD_REORDER_NONE (0),
-                                  RAD_REORDER_GREEDY (1, thesis Listing 3.1),
+                                  RAD_REORDER_GREEDY (1, Shcherbakov 2025),
                                   RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: 12-30%
                                   lower MSE than GREEDY on the Cornell F_mb with 1-5%
                                   outliers) or RAD_REORDER_MATCH (4, the default: a further
@@ -1671,7 +1673,7 @@ RAD_API void rad_block_options_default(rad_block_options *options);
    O(N^2) per 2-opt / group-swap pass (at most 64 passes each) or per matching round (a few),
    O(N^2) encoding. Scratch at the peak about 40 N^2 bytes with exact distances (working
    planes, the coordinates twice and a Gram matrix). Deterministic: the same bytes whatever
-   the number of threads. SPEC §4. */
+   the number of threads. docs/methods/compression.md. */
 RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
                                                  const rad_context *ctx, rad_multibounce_blocks **out,
                                                  rad_block_report *report);
@@ -1690,7 +1692,7 @@ RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
    Parallel over block rows (BC1: and over block columns for the tables). Thread safety:
    reentrant. Cost: O(N^2) work (on the CPU about as many multiply-adds as a dense float
    apply: compute-bound, see BENCHMARKS.md), bytes_total bytes read; BC1 also writes and
-   reads 3072 N bytes of tables (scratch memory). SPEC §4. */
+   reads 3072 N bytes of tables (scratch memory). docs/methods/compression.md. */
 RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
                                                 rad_output output, const rad_context *ctx);
 /* The decoded matrix in the original order (3 N^2 floats: R, G, B planes) with outliers, for
@@ -1699,7 +1701,7 @@ RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *b
                                                  const rad_context *ctx);
 
 /* Single 4x4 blocks, texel (x, y) at index 4y + x. Decoders follow the specification's real
-   division (REFERENCE §4), rounded once: every palette value is an integer numerator over an
+   division (Khronos Data Format specification), rounded once: every palette value is an integer numerator over an
    integer denominator (e.g. (2 c0 + c1) / 93 for a 5-bit BC1 channel), one correctly rounded
    float division, so no compiler contraction changes it. BC1 writes 16 RGB triples (48
    floats), BC4 16 values. The encoders
@@ -1740,7 +1742,7 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, c
 /* >>api_local: local multi-bounce matrix for large scenes                                  */
 /* ======================================================================================== */
 
-/* SPEC §5 (thesis ch. 4). An open world does not fit an N x N matrix, so only a set S of at
+/* docs/methods/local.md (Shcherbakov 2025, ch. 4). An open world does not fit an N x N matrix, so only a set S of at
    most M patches (the ones nearest the camera, or any set the caller chooses) carries the
    multi-bounce transport
        T = sum_{k>=1} A^k = (I - A)^-1 - I,      A = rho o F restricted to S   (per channel)
@@ -1753,21 +1755,21 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, c
      in double (u and v only over the slots where the new row is non-zero); T is stored and
      updated in float (one vectorised pass). Cost O(M^2) per patch. Measured drift against a
      direct inverse: 7e-7 relative after 260 adds (tests), 4e-6 after 4096 (bench/local.c).
-   - The thesis's update (RAD_LOCAL_FIRST_ORDER) in this library's convention (the receiving
+   - The update of Shcherbakov 2025 (RAD_LOCAL_FIRST_ORDER) in this library's convention (the receiving
      row carries the albedo): d = b . a (the "double reflection": light leaving n, reflected
      once by S, back on n); the row and column are scaled by (1 + d) instead of 1/s, and the
      old matrix gets the product of the two: T_Sn = (1+d) u, T_nS = (1+d) v,
      T_SS += (1+d)^2 u v, T_nn = d. It ignores the return paths through T and the higher
      powers of d; the tests measure how far it lands from the exact form.
-   - Removing a patch takes it out of the displayed set but not out of the system (SPEC §5:
-     "the patch still exists in the world, it is just not drawn"): it becomes a hidden member,
+   - Removing a patch takes it out of the displayed set but not out of the system (it stays
+     in the world and only stops being drawn): it becomes a hidden member,
      skipped by rad_local_apply's default row and column sets, and the light paths through it
      stay in T exactly. Its slot is reused when an add finds the set full: the hidden member
      hidden longest ago is then evicted. Eviction (also callable directly) is, by default, the
      exact Sherman-Morrison downdate, T_ij -= T_ik T_kj / (1 + T_kk) for slot k, so T is at all
      times exactly (I - A)^-1 - I over the members, visible and hidden: bounded by the
      physical limit, row sums below rho_max / (1 - rho_max). Adding a hidden patch again only
-     shows it (O(1)). RAD_LOCAL_EVICT_DROP is the seed's literal removal: the row and column
+     shows it (O(1)). RAD_LOCAL_EVICT_DROP is the literal removal of Shcherbakov 2025: the row and column
      are dropped and the paths through the patch stay in T; but if that patch re-enters, its
      new row and column count those paths a second time, and a camera moving back and forth
      makes T grow without bound (measured in tests/test_local.c: on the 260-patch Cornell box
@@ -1775,7 +1777,7 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, c
      An add into a full set fuses the downdate of the evicted member with its own update:
      with c = T[:, e], r = T[e, :], g = 1 + T_ee, u = a + T a - c (r.a) / g,
      v = b + b T - (b.c) r / g, and one rank-2 pass T += -c r / g + u v / s.
-   - Apply: L_i = sum_{j in P_Lit} T_ij E_j for i in P_Vis (thesis fig. 4.2).
+   - Apply: L_i = sum_{j in P_Lit} T_ij E_j for i in P_Vis (Shcherbakov 2025, ch. 4).
    - Rebuild (the comparison for the update cost): T of a whole set from scratch, by a
      blocked Gauss-Jordan inverse (default) or the K = infinity multi-bounce build. */
 
@@ -1831,12 +1833,12 @@ RAD_API void rad_row_stream_close(rad_row_stream *stream);
 
 typedef enum rad_local_update {
     RAD_LOCAL_EXACT = 0,       /* Sherman-Morrison: T is (I - A)^-1 - I of the set (default) */
-    RAD_LOCAL_FIRST_ORDER = 1  /* the thesis's formulas (see above) */
+    RAD_LOCAL_FIRST_ORDER = 1  /* Shcherbakov 2025's formulas (see above) */
 } rad_local_update;
 
 typedef enum rad_local_eviction {
     RAD_LOCAL_EVICT_DOWNDATE = 0, /* exact downdate: paths through the evicted patch leave T (default) */
-    RAD_LOCAL_EVICT_DROP = 1      /* the seed's form: drop the row and column, keep the paths (see above) */
+    RAD_LOCAL_EVICT_DROP = 1      /* Shcherbakov 2025's form: drop the row and column, keep the paths (see above) */
 } rad_local_eviction;
 
 typedef enum rad_local_rebuild_method {
@@ -1896,14 +1898,14 @@ RAD_API void rad_local_destroy(rad_local *local);
    NON_FINITE (a fetched value is not finite or negative), SINGULAR (s <= 0: the rows
    break energy conservation). On error the set is unchanged, except that a hidden member
    may have been evicted to make room (only before a SINGULAR). Thread safety: not on the same
-   object; uses ctx->parallel_for. Cost: O(slot_end^2) per channel. SPEC §5. */
+   object; uses ctx->parallel_for. Cost: O(slot_end^2) per channel. docs/methods/local.md. */
 RAD_API rad_result rad_local_add(rad_local *local, uint32_t patch, const rad_context *ctx);
 /* Removes 'patch' from the displayed set: it becomes a hidden member and the transport
    through it is kept (see the section comment). Errors: INDEX_OUT_OF_RANGE,
    INVALID_ARGUMENT (not a visible member). Cost: O(1). */
 RAD_API rad_result rad_local_remove(rad_local *local, uint32_t patch, const rad_context *ctx);
 /* Takes member 'patch' (visible or hidden) out of the system and frees its slot: the exact
-   downdate (RAD_LOCAL_EVICT_DOWNDATE) or the seed's drop (RAD_LOCAL_EVICT_DROP). Errors:
+   downdate (RAD_LOCAL_EVICT_DOWNDATE) or the drop of Shcherbakov 2025 (RAD_LOCAL_EVICT_DROP). Errors:
    INDEX_OUT_OF_RANGE, INVALID_ARGUMENT (not a member). Thread safety: not on the same object;
    uses ctx->parallel_for. Cost: O(slot_end^2) per channel (downdate), O(slot_end) (drop). */
 RAD_API rad_result rad_local_evict(rad_local *local, uint32_t patch, const rad_context *ctx);
@@ -1924,7 +1926,7 @@ RAD_API rad_result rad_local_rebuild(rad_local *local, const uint32_t *patches, 
    are members (hidden ones allowed: a lit patch behind the camera still lights the scene);
    NULL means every visible member. Errors: INVALID_ARGUMENT, INDEX_OUT_OF_RANGE (a
    patch >= n or not in the set), NON_FINITE (E not finite or the result overflows). Thread
-   safety: reentrant (local is read only). Cost: O(|visible| slot_end). SPEC §5. */
+   safety: reentrant (local is read only). Cost: O(|visible| slot_end). docs/methods/local.md. */
 RAD_API rad_result rad_local_apply(const rad_local *local, const float *E, const uint32_t *visible,
                                    uint32_t visible_count, const uint32_t *lit, uint32_t lit_count,
                                    rad_output output, float *out, const rad_context *ctx);
@@ -1936,7 +1938,7 @@ RAD_API size_t rad_local_memory(const rad_local *local);
 /* The 'count' patches whose centroids are nearest 'position' (count <= patches->count),
    nearest first, ties by index, into out_patches. Works on a loaded bake's patches.
    Errors: INVALID_ARGUMENT, NON_FINITE (position), OUT_OF_MEMORY. Thread safety: reentrant.
-   Cost: O(n log n), 8n bytes of scratch. SPEC §5 (thesis fig. 4.1). */
+   Cost: O(n log n), 8n bytes of scratch. docs/methods/local.md. */
 RAD_API rad_result rad_local_nearest(const rad_patches *patches, const float position[3], uint32_t count,
                                      uint32_t *out_patches, const rad_context *ctx);
 /* P_Vis: the candidates that 'camera' (aspect = width / height) can see. A patch is visible
@@ -1963,7 +1965,8 @@ RAD_API rad_result rad_local_lit(const float *E, const uint32_t *candidates, uin
 /* >>api_temporal: temporal radiosity                                                       */
 /* ======================================================================================== */
 
-/* Temporal radiosity (SPEC §8; thesis T-6, preprint P-3.2 and P-4) spreads the O(N^2) gather
+/* Temporal radiosity (docs/methods/temporal.md; Shcherbakov 2025, ch. 6; Shcherbakov et al.
+   2023, sec. 3.2 and 4) spreads the O(N^2) gather
    L = G E over frames at O(N k) per frame: each row G_i of a non-negative matrix (a row of F,
    or one channel of the multi-bounce matrix F_mb) is read as a probability distribution over
    its non-zero entries plus the ENVIRONMENT ENTRY G_i0 = max(0, 1 - S_i) (S_i = the row sum,
@@ -1976,7 +1979,7 @@ RAD_API rad_result rad_local_lit(const float *E, const uint32_t *candidates, uin
    ALIAS TABLES. One table per row over the row's entries with value > 0, in ascending column
    order, followed by the environment entry when G_i0 > 0; a row always has at least one bin
    (an all-zero row has only the environment entry, T_i = 1). Built by Vose's O(n) method,
-   robust variant (REFERENCE §3): q_b = n w_b / W with W accumulated in double; worklists
+   robust variant (Vose 1991): q_b = n w_b / W with W accumulated in double; worklists
    Small (q < 1) and Large (q >= 1) kept as stacks in ascending bin order; while both are
    non-empty pop l from Small and g from Large, prob[l] = q_l, alias[l] = g,
    q_g = (q_g + q_l) - 1, push g on Small if q_g < 1 else on Large; bins left in either list
@@ -2056,7 +2059,7 @@ typedef struct rad_alias_tables {
    in the kernel's 'madvise' mode: every draw of the step is a random read into the tables,
    and with 4 KiB pages most draws also miss the TLB (about 15% of the step's time at
    N = 10832, BENCHMARKS.md). A hint only: where the kernel declines, nothing changes.
-   Thread safety: reentrant. SPEC §8. */
+   Thread safety: reentrant. docs/methods/temporal.md. */
 RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format format, const rad_context *ctx,
                                            rad_alias_tables **out);
 
@@ -2071,7 +2074,7 @@ RAD_API void rad_alias_tables_destroy(rad_alias_tables *tables);
 /* Bytes the tables' bins, offsets and totals take. */
 RAD_API size_t rad_alias_tables_memory(const rad_alias_tables *tables);
 
-/* STREAMED ROWS (P-4.3): the table of one row built at run time into caller memory.
+/* STREAMED ROWS (Shcherbakov et al. 2023, sec. 4): the table of one row built at run time into caller memory.
    columns: ascending column indices (< cols) of the 'count' values, or NULL when 'values' is
    a dense row of count == cols entries. Entries <= 0 are skipped, exactly as the whole-matrix
    builders do, so the bins are bit-identical to theirs. out_bins: room for count + 1 bins of
@@ -2107,7 +2110,7 @@ RAD_API rad_result rad_alias_tables_view(const rad_container *container, const c
 
 typedef enum rad_temporal_mode {
     RAD_TEMPORAL_SINGLE = 0,     /* G = F, X_i times rho_i: one bounce of E (L_1) */
-    RAD_TEMPORAL_FEEDBACK = 1,   /* G = F, samples E + B^prev: converges to L_inf (T-6.4, P-4.2) */
+    RAD_TEMPORAL_FEEDBACK = 1,   /* G = F, samples E + B^prev: converges to L_inf (docs/methods/temporal.md) */
     RAD_TEMPORAL_MULTIBOUNCE = 2 /* G = a channel of F_mb (albedo already inside): no rho */
 } rad_temporal_mode;
 
@@ -2126,7 +2129,7 @@ typedef struct rad_temporal_options {
     float change_sigma;    /* adaptive: change test threshold in standard deviations (default 5) */
 } rad_temporal_options;
 
-/* ADAPTIVE WEIGHT (the preprint's open problem P-6). Per row, on the scalar x = sum of the
+/* ADAPTIVE WEIGHT (the open problem stated by Shcherbakov et al. 2023). Per row, on the scalar x = sum of the
    channels of X_i, with c_i = frames since the row's (re)start:
      a = max(1/(c_i + 1), 1/64); m_i += a (x - m_i); v_i += a ((x - m_i)^2 - v_i)   (in float)
      steady weight: r = (target m_i)^2 / v_i; w_ss = (1 - r) / (1 + r) clamped to
@@ -2151,7 +2154,7 @@ typedef struct rad_temporal rad_temporal;
    MULTIBOUNCE mode: one per channel) borrowed tables, which must outlive the state; all of
    the same size N x N. albedo: 3N floats, borrowed, required for SINGLE and FEEDBACK, unused
    (may be NULL) for MULTIBOUNCE. B starts at 0. Errors: INVALID_ARGUMENT, SIZE_MISMATCH,
-   OUT_OF_MEMORY. Thread safety: reentrant. Memory: O(N). SPEC §8. */
+   OUT_OF_MEMORY. Thread safety: reentrant. Memory: O(N). docs/methods/temporal.md. */
 RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, uint32_t table_count, const float *albedo,
                                        const rad_temporal_options *options, const rad_context *ctx,
                                        rad_temporal **out);
@@ -2175,7 +2178,7 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
    ahead of the one it resolves, across rows; with AVX2 and compact tables 8 rows side by
    side, one per vector lane), so the misses overlap instead of waiting one by one
    (BENCHMARKS.md: about 3.7 ns per draw on one core with tables of 450 MB).
-   Thread safety: one thread at a time per state. SPEC §8. */
+   Thread safety: one thread at a time per state. docs/methods/temporal.md. */
 RAD_API rad_result rad_temporal_step(rad_temporal *temporal, const float *E, const float E0[3], float *out_indirect);
 
 /* The current indirect light (3N floats, owned by the state, valid until the next step). */
@@ -2189,9 +2192,10 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
 /* >>api_vp: virtual patches for high-polygon scenes                                        */
 /* ======================================================================================== */
 
-/* Virtual patches (SPEC §6-§7; thesis T-5, preprint P-3.1): a radiosity proxy with no geometry,
+/* Virtual patches (docs/methods/virtual-patches.md, docs/methods/aavp.md; Shcherbakov 2025,
+   ch. 5; Shcherbakov et al. 2023, sec. 3.1): a radiosity proxy with no geometry,
    built automatically from any mesh, so that a scene of 10^5-10^7 triangles is solved with
-   about 10^4 unknowns. Axis-aligned (the default, the preprint's recommended variant) or
+   about 10^4 unknowns. Axis-aligned (the default, the variant Shcherbakov et al. 2023 recommend) or
    general (clustered, below).
    BUILD (rad_vp_create):
      1. The scene bounds, widened by 0.4827 voxel on each side (walls on the bounds then lie
@@ -2217,13 +2221,13 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
         of that voxel and axis, and sample_weights holds the corrected weights.
      5. Form factors, never stored per sample: with the symmetric point-to-point kernel
             G_ij = s_i s_j cos_i cos_j / (pi max(|r|^2, max(e_i, e_j) / pi)) V(p_i, p_j)
-        (SPEC §2's kernel times s_i; the near-point clamp uses the larger of the two samples'
+        (rad_ff_point_point's kernel times s_i; the near-point clamp uses the larger of the two samples'
         areas after the area correction above, e_i = s_i sum_a w_ia, so it is symmetric and
         a pair of coincident samples transfers at most the smaller area), the exchanged
         energy P_ab = sum_i sum_j w_ia w_jb G_ij is accumulated in double, one row voxel at a
         time, over the pairs i < j (visibility: see VISIBILITY; rays always go from the lower
         sample index to the higher), mirrored
-        (P_ba = P_ab) and divided: F_ab = P_ab / A_a. This is SPEC §7's merge (row
+        (P_ba = P_ab) and divided: F_ab = P_ab / A_a. This is the axis merge of docs/methods/aavp.md (row
         F_a,j = sum_i w_ia s_i F_ij / A_a, column F_j,a = sum_i w_ia F_ji) applied to both
         indices, so A_a F_ab = A_b F_ba holds to float rounding.
      6. Row sums above 1 (the point kernel next to a tiny patch overshoots: rows up to 1.68
@@ -2259,33 +2263,33 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    row-major rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
    brings any per-patch value (B, L, the irradiance H = F (E + L)) back to surface points with
    normal weights and trilinear filtering that skips voxels without a patch facing the normal.
-   GENERAL VIRTUAL PATCHES (kind RAD_VP_CLUSTERED, SPEC §6 step 7). Per voxel every sample
+   GENERAL VIRTUAL PATCHES (kind RAD_VP_CLUSTERED, docs/methods/virtual-patches.md). Per voxel every sample
    starts as a cluster (area e_i = s_i times the voxel's area correction: exact clipped area /
    sum of s_i; colour, normal, form-factor row and column); the pair with the smallest
        M(a,b) = (1 + |c_a - c_b|) (2 - n_a . n_b) (1 + sqrt(sum_k (F_ak - F_bk)^2 + (F_ka - F_kb)^2))
    is merged (row: area-weighted mean, column: sum, colour: area-weighted mean, normal: the
-   normalized area-weighted mean, area: sum; T eq. 5.2) until max_clusters remain. DEPARTURE:
+   normalized area-weighted mean, area: sum; Shcherbakov 2025, ch. 5) until max_clusters remain. DEPARTURE:
    the metric's rows and columns are the unoccluded point-to-point form factors to
    'metric_columns' samples spread over the scene (every M / metric_columns-th sample), not all
    M: the full rows would cost M^2 per voxel pass. Each sample then belongs to one patch
    (weight = the area correction), and the form factors are built by step 5 unchanged, so the
-   merged rows and columns are exactly T eq. 5.2 applied to the whole sample matrix, with
+   merged rows and columns are exactly these merge rules applied to the whole sample matrix, with
    visibility. E uses w_ij = max(0, N_j . n_i) over the voxel's samples (rad_vp_from_samples)
-   and gathering w_j = max(0, N_j . n), both normalized (SPEC §6).
+   and gathering w_j = max(0, N_j . n), both normalized.
    LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
    sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
    patch facing its normal gets 0. */
 
 typedef enum rad_vp_weights {
-    RAD_VP_WEIGHTS_SQUARED = 0, /* w_a = max(0, n . e_a)^2: sums to exactly 1 (SPEC §7 default) */
-    RAD_VP_WEIGHTS_COSINE = 1   /* the seed's max(0, n . e_a), divided by their sum (1 to sqrt 3) */
+    RAD_VP_WEIGHTS_SQUARED = 0, /* w_a = max(0, n . e_a)^2: sums to exactly 1 (the default) */
+    RAD_VP_WEIGHTS_COSINE = 1   /* the cosines max(0, n . e_a) of Shcherbakov 2025, divided by their sum (1 to sqrt 3) */
 } rad_vp_weights;
 
 /* Which proxy rad_vp_create builds. */
 typedef enum rad_vp_kind {
-    RAD_VP_AXIS_ALIGNED = 0,    /* at most six patches per voxel, one per axis direction (SPEC §7) */
+    RAD_VP_AXIS_ALIGNED = 0,    /* at most six patches per voxel, one per axis direction */
     RAD_VP_CLUSTERED = 1        /* general virtual patches: per voxel, greedy clustering of the
-                                   samples into at most max_clusters patches (SPEC §6 step 7) */
+                                   samples into at most max_clusters patches */
 } rad_vp_kind;
 
 /* The six axis directions, in patch order inside a voxel. */
@@ -2302,7 +2306,7 @@ typedef struct rad_vp_options {
     float ray_epsilon;        /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     int skip_visibility;      /* non-zero: V = 1 between samples (unoccluded form factors) */
     uint32_t visibility_rays; /* shadow rays per pair of voxels (default 16, at most 1024); 0:
-                                 one ray per pair of samples (SPEC §6 step 5 literally: cost
+                                 one ray per pair of samples (the literal form: cost
                                  M^2 / 2 rays). See VISIBILITY in the section comment. */
     int keep_row_sums;        /* non-zero: skip step 6 (rows may then sum to more than 1) */
     rad_vp_kind kind;         /* default RAD_VP_AXIS_ALIGNED */
@@ -2361,7 +2365,7 @@ RAD_API void rad_vp_options_default(rad_vp_options *options);
    use bigger voxels), EMPTY_SCENE (no face ray hit anything), RAYCAST_FAILED, CANCELLED,
    OUT_OF_MEMORY. The logger says which. Thread safety: reentrant; uses ctx->parallel_for and
    reports progress (face rays 10%, form factors 90%). Deterministic: the same bits whatever
-   the thread count. Cost and memory: see the section comment. SPEC §6-§7. */
+   the thread count. Cost and memory: see the section comment. docs/methods/virtual-patches.md. */
 RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
                                  const rad_context *ctx, rad_virtual_patches **out);
 RAD_API void rad_vp_destroy(rad_virtual_patches *vp);
@@ -2372,7 +2376,7 @@ RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
    the source E (3N floats, borrowed). */
 RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E);
 
-/* Per-patch values from per-sample values (SPEC §6 primary light, normalized):
+/* Per-patch values from per-sample values (the primary light, normalized):
    out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel (axis-aligned), or
    out_j = sum_i w_ij s_i v_i / sum_i w_ij s_i with w_ij = max(0, N_j . n_i) (clustered). sample_values: 3M floats
    (for instance rho_i D_i from the engine's own shadow maps); out: 3N floats.
@@ -2384,12 +2388,12 @@ RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const floa
    sample i (rad_direct_irradiance with the lights; the emitters' own emission is kept out);
    RAD_SOURCE_EMISSION: v_i = pi L_i of the sample's material (lights unused, raycaster may be
    NULL). Errors: those of rad_direct_irradiance, OUT_OF_MEMORY. Cost: O(M) direct-light
-   evaluations. SPEC §6 (T-5.8). */
+   evaluations. docs/methods/virtual-patches.md. */
 RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
                                   const rad_light *lights, uint32_t light_count, const rad_direct_options *options,
                                   rad_source_mode mode, float *out_E, const rad_context *ctx);
 
-/* Gathering at one surface point p with unit normal n (SPEC §6-§7, T eq. 5.3, P eq. 9): in each
+/* Gathering at one surface point p with unit normal n (docs/methods/virtual-patches.md): in each
    voxel of the 2x2x2 block around p (by voxel centres), L(v) = sum_a w_a(n) x_a / sum_a w_a(n)
    over v's patches (w_a the split weights of rad_vp_weights; clustered: w_j = max(0, N_j . n));
    voxels missing or with no patch
@@ -3106,7 +3110,7 @@ RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b
     }
 }
 
-/* ---- the built-in Cornell box (original Cornell data in metres, as shared/data/cornell.obj) ---- */
+/* ---- the built-in Cornell box (original Cornell data in metres, as the cornell.obj of docs/data.md) ---- */
 
 static const float rad__cornell_positions[] = {
     /* floor */ 0.5528f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.5592f, 0.5496f, 0.0f, 0.5592f,
@@ -6322,7 +6326,7 @@ RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, 
     return RAD_SUCCESS;
 }
 
-/* ---- terms (B-2.2.6 to 2.2.10) ---- */
+/* ---- terms of the microfacet model ---- */
 
 RAD_API float rad_ndf_beckmann(float nm, float alpha)
 {
@@ -7823,7 +7827,7 @@ static const char *const rad__glsl_pieces_5[] = { rad__glsl_5_0, rad__glsl_5_1 }
 static const char rad__glsl_6_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_ALIAS_BUILD: alias tables of streamed rows built on the GPU\n"
-    "// (SPEC section 8, P-4.3), the same bins as rad_alias_build_row (Vose's robust variant in double, the\n"
+    "// (docs/methods/temporal.md), the same bins as rad_alias_build_row (Vose's robust variant in double, the\n"
     "// order of operations of the >>api_temporal doc block; bit-identical where double arithmetic is\n"
     "// IEEE, as on lavapipe), one invocation per row.\n"
     "// Input rows in CSR form: row i's entries are k = in_off[i] .. in_off[i+1]-1 (uint64, global), at\n"
@@ -7895,9 +7899,9 @@ static const char rad__glsl_6_0[] =
     "    }\n"
     "    W += env > 0.0 \? env : 0.0;\n"
     "    // Vose, robust variant: Small grows up from stack[0], Large down from stack[n-1]\n"
-    "    uint small_top = 0u, large_bottom = n;\n"
-    "    for (uint b = 0u; b < n; ++b) {\n";
+    "    uint small_top = 0u, large_bottom = n;\n";
 static const char rad__glsl_6_1[] =
+    "    for (uint b = 0u; b < n; ++b) {\n"
     "        precise double qb = double(n) * q[b0 + b] / W;\n"
     "        q[b0 + b] = qb;\n"
     "        if (qb < 1.0) stack[b0 + small_top++] = b;\n"
@@ -7917,7 +7921,7 @@ static const char rad__glsl_6_1[] =
     "}\n";
 static const char *const rad__glsl_pieces_6[] = { rad__glsl_6_0, rad__glsl_6_1 };
 static const char rad__glsl_7_0[] =
-    "// lighting.glsl - the lighting models and BRDF terms of radiosity.h (SPEC \302\2479, >>shading),\n"
+    "// lighting.glsl - the lighting models and BRDF terms of radiosity.h (docs/methods/shading.md, >>shading),\n"
     "// GLSL 450. An include: no #version; it defines only functions and one struct, all named\n"
     "// as their C counterparts (rad_ndf_ggx ...). The arithmetic is written in the same order as\n"
     "// the C code so the results agree to float rounding (tests/test_shading_vulkan.c checks\n"
@@ -7961,7 +7965,7 @@ static const char rad__glsl_7_0[] =
     "    ivec4 mode;\n"
     "};\n"
     "\n"
-    "// B eq. 18\n"
+    "// Beckmann NDF\n"
     "float rad_ndf_beckmann(float nm, float alpha)\n"
     "{\n"
     "    float a2 = alpha * alpha, c2 = nm * nm;\n"
@@ -7969,7 +7973,7 @@ static const char rad__glsl_7_0[] =
     "    return exp((c2 - 1.0) / (a2 * c2)) / (RAD_PI * a2 * c2 * c2);\n"
     "}\n"
     "\n"
-    "// B eq. 24\n"
+    "// Beckmann NDF, anisotropic\n"
     "float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
     "{\n"
     "    float c2 = nm * nm;\n"
@@ -7978,7 +7982,7 @@ static const char rad__glsl_7_0[] =
     "    return exp(-e) / (RAD_PI * alpha_x * alpha_y * c2 * c2);\n"
     "}\n"
     "\n"
-    "// B eq. 22\n"
+    "// GGX NDF (Walter et al. 2007)\n"
     "float rad_ndf_ggx(float nm, float alpha)\n"
     "{\n"
     "    float a2 = alpha * alpha;\n"
@@ -7987,7 +7991,7 @@ static const char rad__glsl_7_0[] =
     "    return a2 / (RAD_PI * d * d);\n"
     "}\n"
     "\n"
-    "// B eq. 26\n"
+    "// GGX NDF, anisotropic\n"
     "float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
     "{\n"
     "    if (!(nm > 0.0)) return 0.0;\n"
@@ -7995,7 +7999,7 @@ static const char rad__glsl_7_0[] =
     "    return 1.0 / (RAD_PI * alpha_x * alpha_y * d * d);\n"
     "}\n"
     "\n"
-    "// B eq. 25 (eq. 19 when alpha_x = alpha_y): the Smith variable a; the largest float for\n"
+    "// the Smith variable a (anisotropic; the isotropic form when alpha_x = alpha_y); the largest float for\n"
     "// s = n (C returns +inf there; both give Lambda = 0)\n"
     "float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)\n"
     "{\n"
@@ -8004,36 +8008,36 @@ static const char rad__glsl_7_0[] =
     "    return ns / sqrt(d2);\n"
     "}\n"
     "\n"
-    "// B eq. 23, for a > 0\n"
-    "// (Beckmann's exact Lambda, eq. 20, needs erf, which GLSL lacks: it is C only.)\n"
+    "// Lambda of GGX (exact), for a > 0\n"
+    "// (Beckmann's exact Lambda needs erf, which GLSL lacks: it is C only.)\n"
     "float rad_lambda_ggx(float a)\n"
     "{\n"
     "    return 0.5 * (-1.0 + sqrt(1.0 + 1.0 / (a * a)));\n"
     "}\n"
     "\n"
-    "// B eq. 21 (Beckmann, rational approximation)\n"
+    "// Lambda of Beckmann, rational approximation (Walter et al. 2007)\n"
     "float rad_lambda_beckmann(float a)\n"
     "{\n"
     "    if (!(a < 1.6)) return 0.0;\n"
     "    return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);\n"
     "}\n"
     "\n"
-    "// B eq. 11\n"
+    "// Smith G1 (Heitz 2014)\n"
     "float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0 \? 1.0 / (1.0 + lambda_s) : 0.0; }\n"
     "\n"
-    "// B eq. 13 and 14\n"
+    "// Smith G2, separable and height-correlated (Heitz 2014)\n"
     "float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)\n"
     "{\n"
     "    return (mv > 0.0 && ml > 0.0) \? 1.0 / ((1.0 + lambda_v) * (1.0 + lambda_l)) : 0.0;\n"
     "}\n"
-    "\n"
+    "\n";
+static const char rad__glsl_7_1[] =
     "float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)\n"
     "{\n"
     "    return (mv > 0.0 && ml > 0.0) \? 1.0 / (1.0 + lambda_v + lambda_l) : 0.0;\n"
     "}\n"
     "\n"
-    "// B eq. 15 and 16 (one channel)\n";
-static const char rad__glsl_7_1[] =
+    "// Schlick's Fresnel and its generalized F90 form (one channel)\n"
     "float rad_fresnel_schlick(float f0, float c)\n"
     "{\n"
     "    float x = 1.0 - (c > 0.0 \? c : 0.0), x2 = x * x;\n"
@@ -8045,7 +8049,7 @@ static const char rad__glsl_7_1[] =
     "    return f0 + (f90 - f0) * pow(1.0 - (c > 0.0 \? c : 0.0), exponent);\n"
     "}\n"
     "\n"
-    "// B eq. 27 and 28 (one channel)\n"
+    "// diffuse terms: Lambert (1 - F) and Shirley et al. 1997 (one channel)\n"
     "float rad_diffuse_lambert(float albedo, float F) { return (1.0 - F) * albedo * RAD_INV_PI; }\n"
     "\n"
     "float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)\n"
@@ -8110,12 +8114,12 @@ static const char rad__glsl_7_1[] =
     "                if (len > 0.0) {\n"
     "                    h /= len;\n"
     "                    float nh = dot(n, h), lh = dot(l, h), vh = dot(v, h), D;\n"
-    "                    if (iso) {\n"
+    "                    if (iso) {\n";
+static const char rad__glsl_7_2[] =
     "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);\n"
     "                    } else {\n"
     "                        float th = dot(t, h), bh = dot(b, h);\n"
-    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)\n";
-static const char rad__glsl_7_2[] =
+    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)\n"
     "                                               : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);\n"
     "                    }\n"
     "                    float lv = rad_shading_lambda(ndf, iso, nv, iso \? 0.0 : dot(t, v), iso \? 0.0 : dot(b, v), ax, ay);\n"
@@ -8144,7 +8148,7 @@ static const char *const rad__glsl_pieces_7[] = { rad__glsl_7_0, rad__glsl_7_1, 
 static const char rad__glsl_8_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_LOCAL_APPLY: the local multi-bounce apply of rad_local_apply\n"
-    "// (SPEC \302\2475, thesis fig. 4.2): for every visible entry r = row_offset .. row_offset + row_count - 1,\n"
+    "// (docs/methods/local.md): for every visible entry r = row_offset .. row_offset + row_count - 1,\n"
     "// with slot i = vis_slot[r] and world patch p = vis_patch[r],\n"
     "//   out[p] = sum_{j < end, lit_patch[j] != NONE} T_c[i][j] * E[lit_patch[j]]   (+ E[p] when flags bit 0)\n"
     "// for channels c = R, G, B. T is rad_local.planes: three M x M planes, row = receiving slot,\n"
@@ -8209,7 +8213,7 @@ static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0 };
 static const char rad__glsl_9_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_LOCAL_VECTORS: the small pre-pass of a local-matrix add\n"
-    "// (rad_local_add, SPEC \302\2475) computed from T resident on the GPU: the vectors u, v and the scalar\n"
+    "// (rad_local_add, docs/methods/local.md) computed from T resident on the GPU: the vectors u, v and the scalar\n"
     "// s of the Sherman-Morrison update (fused with the exact downdate of slot ev when an add evicts),\n"
     "// which RAD_GLSL_LOCAL_UPDATE then applies. T is rad_local.planes (three M x M planes, stride m,\n"
     "// row = receiving slot). The host streams only the new patch's row and column over the slots:\n"
@@ -8331,7 +8335,7 @@ static const char *const rad__glsl_pieces_9[] = { rad__glsl_9_0, rad__glsl_9_1 }
 static const char rad__glsl_10_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_LOCAL_UPDATE: the O(M^2) pass of a local-matrix add\n"
-    "// (rad_local_add, SPEC \302\2475) on T resident on the GPU, after RAD_GLSL_LOCAL_VECTORS filled the work\n"
+    "// (rad_local_add, docs/methods/local.md) on T resident on the GPU, after RAD_GLSL_LOCAL_VECTORS filled the work\n"
     "// buffer (its comment has the layout: u, v, c, r per channel and the scalars s, cuv, coef, tnn).\n"
     "// For plane rows i = row_offset .. row_offset + row_count - 1 (all < end), channels R, G, B:\n"
     "//   i == k (the new patch's slot):  T[k][j] = coef v[j] (j != k), T[k][k] = tnn\n"
@@ -8396,7 +8400,7 @@ static const char *const rad__glsl_pieces_10[] = { rad__glsl_10_0 };
 static const char rad__glsl_11_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_VP_GATHER: virtual-patch gathering at surface points, as\n"
-    "// rad_vp_gather / rad_vp_gather_point (SPEC \302\2476-\302\2477, T eq. 5.3, P eq. 9). For point i with unit\n"
+    "// rad_vp_gather / rad_vp_gather_point (docs/methods/virtual-patches.md). For point i with unit\n"
     "// normal n: in each voxel v of the 2x2x2 block around p (by voxel centres; the grid coordinate\n"
     "// x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),\n"
     "//   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0\n"
@@ -8548,12 +8552,12 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
     { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
-    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4697u },
-    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9212u },
-    { "local_apply.comp", rad__glsl_pieces_8, 1u, 3523u },
-    { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6660u },
-    { "local_update.comp", rad__glsl_pieces_10, 1u, 3412u },
-    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7418u }
+    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4700u },
+    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9441u },
+    { "local_apply.comp", rad__glsl_pieces_8, 1u, 3519u },
+    { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
+    { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
+    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u }
 };
 /* >>glsl end */
 
@@ -9217,7 +9221,7 @@ RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float 
     return rad__check_output(&c, "rad_multibounce_apply", out, 3 * (size_t)n);
 }
 
-/* ---- greedy reordering (thesis Listing 3.1) ---- */
+/* ---- greedy reordering (Shcherbakov 2025, ch. 3) ---- */
 
 /* Greedy chain over the n items whose Gram matrix is G (n x n): order[0] = 0, then each next
    item is the unplaced one nearest (L2, |a|^2 + |b|^2 - 2 a.b) to the last placed. O(n^2). */
@@ -9588,7 +9592,7 @@ RAD_API rad_result rad_multibounce_reorder(const rad_multibounce *src, uint32_t 
     return RAD_SUCCESS;
 }
 
-/* ---- BC1 and BC4 blocks (REFERENCE §4) ---- */
+/* ---- BC1 and BC4 blocks (Khronos Data Format specification) ---- */
 
 /* The palettes are the specification's real-valued formulas rounded once: an integer
    numerator over an integer denominator (e.g. (2 c0 + c1) / (3 * 31)), one correctly rounded
@@ -11453,7 +11457,7 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
         /* full: evict the member hidden longest ago. The exact downdate is fused with this
            add (one rank-2 pass instead of two rank-1 passes): with c = T[:, e], r = T[e, :],
            g = 1 + T_ee, the add's vectors over the downdated T are u = a + T a - c (r.a) / g
-           and v = b + b T - (b.c) r / g, and T += -c r / g + u v / s. The seed's drop is
+           and v = b + b T - (b.c) r / g, and T += -c r / g + u v / s. The drop (RAD_LOCAL_EVICT_DROP) is
            cheap and done first. */
         uint32_t oldest = RAD_NONE;
         for (i = 0; i < L->slot_end; ++i)
@@ -13675,7 +13679,7 @@ static double rad__vp_metric(const double *R, const double *C, const double *col
     return (1.0 + sqrt(dc)) * (2.0 - dn) * (1.0 + sqrt(df));
 }
 
-/* greedy clustering of voxel v's samples into at most max_clusters (SPEC §6 step 7) */
+/* greedy clustering of voxel v's samples into at most max_clusters (>>api_vp) */
 static rad_result rad__vp_cluster_row(void *data, uint32_t v, uint32_t task)
 {
     rad__vp_build *b = (rad__vp_build *)data;
@@ -13715,7 +13719,7 @@ static rad_result rad__vp_cluster_row(void *data, uint32_t v, uint32_t task)
             for (j = i + 1; j < n; ++j)
                 if (live[j] != 0.0 && (best < 0.0 || D[(size_t)i * nm + j] < best)) { best = D[(size_t)i * nm + j]; ba = i; bb = j; }
         }
-        /* merge bb into ba (T eq. 5.2) */
+        /* merge bb into ba (the merge rules of >>api_vp) */
         A = area[ba] + area[bb];
         for (t = 0; t < kc; ++t) {
             R[(size_t)ba * kc + t] = (area[ba] * R[(size_t)ba * kc + t] + area[bb] * R[(size_t)bb * kc + t]) / A;

@@ -1,4 +1,4 @@
-/* local.c - the local multi-bounce matrix (SPEC §5, thesis ch. 4) on the generated
+/* local.c - the local multi-bounce matrix (docs/methods/local.md) on the generated
    rooms-and-corridors scene (examples/rooms.h).
 
    1. The large scene: 8 x 8 rooms with corridors (about 72 000 patches; --quick: 4 x 4),
@@ -15,7 +15,7 @@
    4. Error against the full solution on a scene small enough to solve (2 x 2 rooms, coarse
       patches): a 30-frame camera walk with M = N / 3, L = T E over P_Vis x P_Lit against
       the full-world L_inf restricted to P_Vis (relative L2, mean over frames), for the exact
-      update, the thesis's first-order update and a rebuild of the set each frame.
+      update, the first-order update (RAD_LOCAL_FIRST_ORDER) and a rebuild of the set each frame.
    5. Memory: the local matrix, the row buffers, and the global matrix it replaces.
 
    Everything runs on one thread (a serial parallel_for in the context), so update and
@@ -394,7 +394,7 @@ static void bench_error(void)
          frames, M * 4 / 5, M);
     emit("| matrix | (a) vs full L_inf | (b) vs full transport of P_Lit |\n|---|---|---|\n");
     emit("| exact update (Sherman-Morrison, hidden members kept) | %.4f | %.4f |\n", err[0], errs[0]);
-    emit("| thesis first-order update | %.4f | %.4f |\n", err[1], errs[1]);
+    emit("| first-order update (Shcherbakov 2025) | %.4f | %.4f |\n", err[1], errs[1]);
     emit("| rebuilt each frame from the visible set only | %.4f | %.4f |\n", err[2], errs[2]);
     emit("\nFirst-order against exact on the same frames: %.4f (relative L2, normalised as (b)).\n", gap);
     rad_local_destroy(L[0]);
@@ -421,7 +421,7 @@ int main(int argc, char **argv)
     memset(&g_ctx, 0, sizeof(g_ctx));
     g_ctx.parallel_for = serial_for;
     g_ctx.task_count = 1;
-    emit("\n## Local multi-bounce matrix for large scenes (SPEC §5)\n\nCPU, 1 thread%s.\n", quick ? " (--quick)" : "");
+    emit("\n## Local multi-bounce matrix for large scenes\n\nCPU, 1 thread%s.\n", quick ? " (--quick)" : "");
     bench_large(grid, M);
     bench_error();
     emit("\n(bench/local.c: %.0f s in all)\n", now() - t0);

@@ -1,4 +1,4 @@
-/* multibounce.c - the multi-bounce matrix (SPEC §4) against K Jacobi bounces, and its block
+/* multibounce.c - the multi-bounce matrix (docs/methods/multibounce.md) against K Jacobi bounces, and its block
    compression, on the built-in Cornell box.
 
    For each size (about 1.7k and 5.5k patches, rad_patch_options.target_count) the program
@@ -213,7 +213,7 @@ static int bench_size(uint32_t target)
         t_half[ki] = time_it(&r, E, out);
         e_half[ki] = rel_err(out, ref, n3);
         if (ks[ki] != 1) {
-            static const char *const methods[5] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+            static const char *const methods[5] = { "none", "greedy chain", "greedy + 2-opt", "2-opt + group swaps",
                                                            "matching + group swaps" };
             if (ki == 1) {
                 emit("Compressed forms of F_mb (outliers 5%%). Bytes are what one apply reads (blocks + scales + permutations +\n");
@@ -283,7 +283,7 @@ static int bench_size(uint32_t target)
    pseudo-random permutation). */
 static int reorder_only(uint32_t target)
 {
-    static const char *const names[RAD_REORDER_MATCH + 1] = { "none", "greedy (Listing 3.1)", "greedy + 2-opt", "2-opt + group swaps",
+    static const char *const names[RAD_REORDER_MATCH + 1] = { "none", "greedy chain", "greedy + 2-opt", "2-opt + group swaps",
                                                                "matching + group swaps" };
     rad_scene_desc desc;
     rad_camera cam;
@@ -801,7 +801,7 @@ int main(int argc, char **argv)
         return r;
     }
     if (reorder) {
-        emit("\n## Multi-bounce compression: reordering methods (SPEC §4)\n\nCPU, %d threads.\n", threads);
+        emit("\n## Multi-bounce compression: reordering methods\n\nCPU, %d threads.\n", threads);
         if (reorder == 2) {
             if (reorder_search(1736)) return 1;
         } else {
@@ -811,7 +811,7 @@ int main(int argc, char **argv)
         if (g_md) fclose(g_md);
         return 0;
     }
-    emit("\n## Multi-bounce matrix and block compression (SPEC §4)\n\nCPU, %d threads; Jacobi = rad_solve_jacobi (dense F, one pass per bounce).\n", threads);
+    emit("\n## Multi-bounce matrix and block compression\n\nCPU, %d threads; Jacobi = rad_solve_jacobi (dense F, one pass per bounce).\n", threads);
     if (bench_size(1736)) return 1;
     if (!quick && bench_size(5485)) return 1;
     if (g_md) fclose(g_md);

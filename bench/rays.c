@@ -8,13 +8,14 @@
    (best of 3) and memory are reported for each backend.
 
    Scenes: the built-in Cornell box cut into about 4000 patches, and the Stanford bunny
-   (shared/data/stanford-bunny.obj, 69 451 triangles, found through RAD_DATA_DIR or
-   ../shared/data) standing on the Cornell box floor; the bunny scene is skipped with a message
-   when the file is absent. The OBJ reading here is a bench-only reader of the plain "v x y z" /
+   (stanford-bunny.obj, 69 451 triangles, a public model that is not part of the repository:
+   see docs/data.md) standing on the Cornell box floor, read from the folder given by
+   --data DIR, else $RAD_DATA_DIR; the bunny scene is skipped with a message when no folder is
+   given or the file is absent. The OBJ reading here is a bench-only reader of the plain "v x y z" /
    "f a b c" lines these data files use, not a general importer.
 
    Build: cc -O3 -march=native -fopenmp [-DRAD_EMBREE ... -lembree3] bench/rays.c
-   Run:   rays [--append FILE.md]    (prints the tables, and appends them to FILE.md) */
+   Run:   rays [--data DIR] [--append FILE.md]    (prints the tables, and appends them to FILE.md) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
@@ -221,6 +222,7 @@ int main(int argc, char **argv)
     int a;
     for (a = 1; a < argc; ++a)
         if (!strcmp(argv[a], "--append") && a + 1 < argc) g_md = fopen(argv[++a], "a");
+        else if (!strcmp(argv[a], "--data") && a + 1 < argc) dir = argv[++a];
     emit("\n## c) Ray queries: built-in BVH against Embree\n\n");
     emit("Occlusion rays recorded from form-factor rows (rad_form_factor_rows, default options) and replayed "
          "through each backend in chunks of 1024; intersection replays the same rays as closest-hit queries "
@@ -228,8 +230,11 @@ int main(int argc, char **argv)
     rad_cornell_box(&desc, NULL);
     if (rad_scene_create(&desc, NULL, &cornell) != RAD_SUCCESS) return 1;
     run_scene("Cornell box", cornell, 4000, 48);
-    snprintf(path, sizeof(path), "%s/stanford-bunny.obj", dir ? dir : "../shared/data");
-    if (load_obj(path, &bpos, &bnv, &bidx, &bnt)) {
+    snprintf(path, sizeof(path), "%s/stanford-bunny.obj", dir ? dir : "");
+    if (!dir || !dir[0]) {
+        emit("\n### Stanford bunny in the Cornell box: skipped (no data folder: pass --data DIR or set RAD_DATA_DIR; "
+             "see docs/data.md)\n");
+    } else if (load_obj(path, &bpos, &bnv, &bidx, &bnt)) {
         /* the bunny, scaled to 0.25 m tall, standing in the middle of the Cornell floor */
         rad_mesh_desc *meshes = (rad_mesh_desc *)calloc(desc.mesh_count + 1, sizeof(rad_mesh_desc));
         rad_scene_desc d2 = desc;
@@ -268,7 +273,7 @@ int main(int argc, char **argv)
         free(bpos);
         free(bidx);
     } else {
-        emit("\n### Stanford bunny in the Cornell box: skipped (%s not found; set RAD_DATA_DIR)\n", path);
+        emit("\n### Stanford bunny in the Cornell box: skipped (%s not found; see docs/data.md)\n", path);
     }
     rad_scene_destroy(cornell);
     if (g_md) fclose(g_md);

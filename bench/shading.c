@@ -1,4 +1,4 @@
-/* shading.c - cost of one lighting-model evaluation in C (SPEC §9, >>shading).
+/* shading.c - cost of one lighting-model evaluation in C (docs/methods/shading.md, >>shading).
 
    For each model (and the microfacet variants), 2^18 random unit configurations (l, v in the
    upper hemisphere of n, a tangent frame) are evaluated in a loop, on one thread:
@@ -64,7 +64,7 @@ int main(int argc, char **argv)
             fclose(f);
         }
         if (tm) strftime(date, sizeof(date), "%Y-%m-%d %H:%M UTC", tm);
-        emit("\n## Lighting models (SPEC §9): cost of one evaluation in C\n\n");
+        emit("\n## Lighting models: cost of one evaluation in C\n\n");
         emit("Measured %s on %s (%s), compiled `-std=c99 -O3 -march=native`.\n\n", date, cpu,
 #ifdef __VERSION__
              "gcc/clang " __VERSION__

@@ -1,5 +1,5 @@
-/* temporal.c - temporal radiosity (SPEC §8) against the dense gather, side by side with the
-   thesis's Table 1 (RTX 3060), plus the lag and noise of the adaptive blend weight.
+/* temporal.c - temporal radiosity (docs/methods/temporal.md) against the dense gather, side by side
+   with Table 1 of Shcherbakov 2025 (RTX 3060; docs/references.md), plus the lag and noise of the adaptive blend weight.
 
    For the Cornell box cut into about 1736, 5485, 8786 and 10422 patches (actual N reported;
    --quick: the two smaller sizes only): dense form factors, alias tables (compact format),
@@ -17,7 +17,7 @@
 
    Build: cc -std=c99 -O3 -march=native -fopenmp -I. bench/temporal.c -o temporal -lm
    Run:   temporal [--quick] [--sizes N,N,...] [--append FILE.md] [--csv FILE.csv]
-          (--sizes: up to four patch-count targets instead of the thesis's; tools/report.sh) */
+          (--sizes: up to four patch-count targets instead of the published four; tools/report.sh) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
@@ -161,7 +161,7 @@ static lag_result lag_run(const rad_alias_tables *t, const rad_patches *P, const
 
 int main(int argc, char **argv)
 {
-    static const uint32_t thesis_sizes[4] = { 1736, 5485, 8786, 10422 };
+    static const uint32_t published_sizes[4] = { 1736, 5485, 8786, 10422 };
     uint32_t targets[4] = { 1736, 5485, 8786, 10422 };
     int custom = 0;
     static const double published_temporal[4] = { 0.02, 0.04, 0.06, 0.08 }, published_mv[4] = { 0.34, 2.94, 7.34, 12.01 };
@@ -175,7 +175,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--append") && a + 1 < argc) g_md = fopen(argv[++a], "a");
         else if (!strcmp(argv[a], "--csv") && a + 1 < argc) csv_path = argv[++a];
         else if (!strcmp(argv[a], "--sizes") && a + 1 < argc) {
-            /* patch-count targets instead of the thesis's four (tools/report.sh --quick) */
+            /* patch-count targets instead of the published four (tools/report.sh --quick) */
             const char *p = argv[++a];
             char *end;
             custom = 0;
@@ -328,7 +328,7 @@ int main(int argc, char **argv)
             int p, pub = -1;
             char pubtext[64] = "-";
             for (p = 0; p < 4; ++p)
-                if (targets[s] == thesis_sizes[p]) pub = p;
+                if (targets[s] == published_sizes[p]) pub = p;
             if (pub >= 0)
                 snprintf(pubtext, sizeof(pubtext), "%.2f vs %.2f (%.0fx)", published_temporal[pub], published_mv[pub],
                          published_mv[pub] / published_temporal[pub]);
@@ -357,11 +357,11 @@ int main(int argc, char **argv)
         rad_patches_destroy(P);
         rad_scene_destroy(scene);
     }
-    emit("\n## Temporal radiosity (SPEC §8): alias-table sampling against the dense gather\n\n");
+    emit("\n## Temporal radiosity: alias-table sampling against the dense gather\n\n");
     emit("CPU, timings on 1 thread (bake and lag runs on %d OpenMP threads). Cornell box, E = rho * direct light of the ceiling emitter; single bounce. "
          "Step = rad_temporal_step (compact alias tables, w = 0.998), MV = one dense RGB rad_matrix_multiply; "
          "times are medians (ms). Error = relative RMS against rho o (F E) after 3000 warm-up frames (mean of 100 frames). "
-         "Published: thesis Table 1, RTX 3060, k = 10.\n\n", threads);
+         "Published: Shcherbakov 2025, Table 1, RTX 3060, k = 10.\n\n", threads);
     emit("| N (target) | step k=10 ms | step k=64 ms | MV ms | ratio k=10 | ratio k=64 | error k=10 | error k=64 | published step vs MV ms (ratio) |\n");
     emit("|---|---|---|---|---|---|---|---|---|\n");
     for (s = 0; s < sizes; ++s) emit("%s", rows_t1[s]);

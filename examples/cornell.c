@@ -1,7 +1,8 @@
 /* cornell.c - render the Cornell box with radiosity.h: direct light per pixel, indirect light
    from radiosity.
 
-   This example shows the way an engine uses radiosity.h (SPEC §0, way (b)): the built-in
+   This example shows the way an engine uses radiosity.h (direct light as the source,
+   docs/methods/direct-light.md): the built-in
    Cornell box is cut into a few thousand patches, the dense form-factor matrix F is computed
    with the built-in BVH, the direct irradiance D of every patch from the area light is the
    source E = rho * D (the light's own emission is NOT put into the system, so nothing is
@@ -331,7 +332,7 @@ int main(int argc, char **argv)
     progress_begin(&ps, "direct light");
     t0 = now_seconds();
     check(rad_direct_patches(patches, &rc, NULL, 0, &dopt, D, &ctx), "rad_direct_patches");
-    /* E = rho * D: direct light is the source, the light's emission stays out (SPEC §0 (b)) */
+    /* E = rho * D: direct light is the source, the light's emission stays out (RAD_SOURCE_DIRECT) */
     check(rad_sources(patches, RAD_SOURCE_DIRECT, D, E), "rad_sources");
     t_direct = now_seconds() - t0;
     progress_end(&ps);

@@ -1,5 +1,5 @@
-/* gallery.c - every lighting model of radiosity.h (>>shading, SPEC §9) on rows of spheres,
-   like figure 2.3.8 of the bachelor thesis (B-2.1, B-2.2).
+/* gallery.c - every lighting model of radiosity.h (>>shading, docs/methods/shading.md) on rows
+   of spheres, like the model comparison figure of Korobeinikov 2022 (docs/references.md).
 
    One PNG, one row per model, seven spheres per row sweeping the model's main parameter:
      1 Lambert                 albedo 0.2 .. 0.8

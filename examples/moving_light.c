@@ -1,4 +1,4 @@
-/* moving_light.c - temporal radiosity (SPEC §8) under a moving light: a point light circles
+/* moving_light.c - temporal radiosity (docs/methods/temporal.md) under a moving light: a point light circles
    inside the Cornell box and every frame costs O(N k) draws from alias tables instead of an
    O(N^2) gather; written as a numbered PNG sequence with the per-frame error against the exact
    solution.
@@ -25,7 +25,7 @@
    360/frames degrees per frame and B follows with a delay of about 1/(1 - w) frames (and each
    further bounce of mode feedback one frame more), while the noise of one frame's estimate
    shrinks by sqrt((1 - w)/(1 + w)); hence the defaults k = 64, w = 0.8. --adaptive uses the
-   per-row weight of SPEC §8, made for lights that jump and then stay: a light that moves a
+   per-row weight of rad_temporal_options.adaptive, made for lights that jump and then stay: a light that moves a
    little every frame does not trip its change test, so the weights climb towards weight_max
    and B lags far behind (BENCHMARKS.md). The step's time includes the parallel_for's start and join
    (OpenMP), which dominate at these sizes and on a busy machine.

@@ -1,4 +1,4 @@
-/* rooms.h - a generated large scene for the local multi-bounce matrix (SPEC §5): rows of
+/* rooms.h - a generated large scene for the local multi-bounce matrix (docs/methods/local.md): rows of
    rooms along corridors, and a form-factor row source that computes rows on demand.
    Used by examples/walk.c and bench/local.c. Public domain or MIT.
 

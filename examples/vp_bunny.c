@@ -1,7 +1,8 @@
-/* vp_bunny.c - virtual patches (SPEC §6-§7) on real high-polygon meshes: the Stanford bunny
+/* vp_bunny.c - virtual patches (docs/methods/aavp.md) on real high-polygon meshes: the Stanford bunny
    (69 451 triangles) in the Cornell box, and with --ogre the bunny and the ogre (193 459
-   triangles together) side by side in it. The meshes come from ../shared/data (or
-   $RAD_DATA_DIR, or --data DIR); when they are missing the program says so and exits 0.
+   triangles together) side by side in it. The meshes are public models that are not part of
+   the repository (docs/data.md): the program reads them from the folder given by --data DIR,
+   else $RAD_DATA_DIR; with no folder, or when a mesh is missing, it says it skipped and exits 0.
 
    What it does, timing every stage and tracking the peak bytes allocated through the library
    (a counting rad_context allocator):
@@ -375,7 +376,6 @@ int main(int argc, char **argv)
     uint32_t total_tris = 0;
 
     setvbuf(stdout, NULL, _IOLBF, 0);
-    if (!data) data = "../shared/data";
     for (a = 1; a < argc; ++a) {
         const char *s = argv[a];
         if (!strcmp(s, "--data") && a + 1 < argc) data = argv[++a];
@@ -396,16 +396,21 @@ int main(int argc, char **argv)
     if (W == 0 || Hh == 0 || spp == 0 || resolution == 0) usage();
 
     /* 1. meshes and scene */
+    if (!data || !data[0]) {
+        printf("vp_bunny: skipped: no data folder (pass --data DIR or set RAD_DATA_DIR to a folder holding the meshes "
+               "of docs/data.md)\n");
+        return 0;
+    }
     t0 = now();
     snprintf(path, sizeof(path), "%s/stanford-bunny.obj", data);
     if (!load_obj(path, &bunny)) {
-        printf("vp_bunny: skipped: %s not found or unreadable (set RAD_DATA_DIR or --data to the shared data folder)\n", path);
+        printf("vp_bunny: skipped: %s not found or unreadable (see docs/data.md; set RAD_DATA_DIR or --data)\n", path);
         return 0;
     }
     if (ogre) {
         snprintf(path, sizeof(path), "%s/ogre.obj", data);
         if (!load_obj(path, &ogre_mesh)) {
-            printf("vp_bunny: skipped: %s not found or unreadable (set RAD_DATA_DIR or --data)\n", path);
+            printf("vp_bunny: skipped: %s not found or unreadable (see docs/data.md; set RAD_DATA_DIR or --data)\n", path);
             return 0;
         }
         fit(&bunny, 0.22f, 0.16f, 0.30f);

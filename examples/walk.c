@@ -1,5 +1,5 @@
 /* walk.c - a camera walk through a large generated scene with the local multi-bounce matrix
-   (SPEC §5, thesis ch. 4): only the M patches nearest the camera carry multi-bounce
+   (docs/methods/local.md): only the M patches nearest the camera carry multi-bounce
    transport, updated as the camera moves, and the global form factors are read one row at
    a time, so the 69 000-patch scene never needs its N x N matrix (about 18 GiB as floats).
 
@@ -14,7 +14,7 @@
      4. the frame is drawn with one camera ray per pixel: the hit patch shows B / pi (patches
         outside P_Vis show only their own emission: the far lamps glow over black walls,
         which carry no light in this frame) and written as a PNG.
-   The source is emission (SPEC §0 way (a)): the lamps are the only E, so every wall shows
+   The source is emission (RAD_SOURCE_EMISSION, docs/methods/direct-light.md): the lamps are the only E, so every wall shows
    light that reached it through the local matrix. Timings of each step go to stdout.
 
    Build:  cc -std=c99 -O2 -fopenmp -I. examples/walk.c -o build/walk -lm

@@ -1,6 +1,6 @@
 #version 450
 // radiosity.h kernel RAD_GLSL_ALIAS_BUILD: alias tables of streamed rows built on the GPU
-// (SPEC section 8, P-4.3), the same bins as rad_alias_build_row (Vose's robust variant in double, the
+// (docs/methods/temporal.md), the same bins as rad_alias_build_row (Vose's robust variant in double, the
 // order of operations of the >>api_temporal doc block; bit-identical where double arithmetic is
 // IEEE, as on lavapipe), one invocation per row.
 // Input rows in CSR form: row i's entries are k = in_off[i] .. in_off[i+1]-1 (uint64, global), at

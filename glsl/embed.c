@@ -1,4 +1,4 @@
-/* glsl/embed.c - writes the canonical GLSL sources of glsl/ into radiosity.h (SPEC §10, STYLE §10).
+/* glsl/embed.c - writes the canonical GLSL sources of glsl/ into radiosity.h (the >>api_glsl section).
 
        embed [--check] [HEADER]      (HEADER defaults to radiosity.h; run from the repository root)
 

@@ -1,4 +1,4 @@
-// lighting.glsl - the lighting models and BRDF terms of radiosity.h (SPEC §9, >>shading),
+// lighting.glsl - the lighting models and BRDF terms of radiosity.h (docs/methods/shading.md, >>shading),
 // GLSL 450. An include: no #version; it defines only functions and one struct, all named
 // as their C counterparts (rad_ndf_ggx ...). The arithmetic is written in the same order as
 // the C code so the results agree to float rounding (tests/test_shading_vulkan.c checks
@@ -42,7 +42,7 @@ struct RadShadingParams {
     ivec4 mode;
 };
 
-// B eq. 18
+// Beckmann NDF
 float rad_ndf_beckmann(float nm, float alpha)
 {
     float a2 = alpha * alpha, c2 = nm * nm;
@@ -50,7 +50,7 @@ float rad_ndf_beckmann(float nm, float alpha)
     return exp((c2 - 1.0) / (a2 * c2)) / (RAD_PI * a2 * c2 * c2);
 }
 
-// B eq. 24
+// Beckmann NDF, anisotropic
 float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
 {
     float c2 = nm * nm;
@@ -59,7 +59,7 @@ float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float 
     return exp(-e) / (RAD_PI * alpha_x * alpha_y * c2 * c2);
 }
 
-// B eq. 22
+// GGX NDF (Walter et al. 2007)
 float rad_ndf_ggx(float nm, float alpha)
 {
     float a2 = alpha * alpha;
@@ -68,7 +68,7 @@ float rad_ndf_ggx(float nm, float alpha)
     return a2 / (RAD_PI * d * d);
 }
 
-// B eq. 26
+// GGX NDF, anisotropic
 float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
 {
     if (!(nm > 0.0)) return 0.0;
@@ -76,7 +76,7 @@ float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha
     return 1.0 / (RAD_PI * alpha_x * alpha_y * d * d);
 }
 
-// B eq. 25 (eq. 19 when alpha_x = alpha_y): the Smith variable a; the largest float for
+// the Smith variable a (anisotropic; the isotropic form when alpha_x = alpha_y); the largest float for
 // s = n (C returns +inf there; both give Lambda = 0)
 float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)
 {
@@ -85,24 +85,24 @@ float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)
     return ns / sqrt(d2);
 }
 
-// B eq. 23, for a > 0
-// (Beckmann's exact Lambda, eq. 20, needs erf, which GLSL lacks: it is C only.)
+// Lambda of GGX (exact), for a > 0
+// (Beckmann's exact Lambda needs erf, which GLSL lacks: it is C only.)
 float rad_lambda_ggx(float a)
 {
     return 0.5 * (-1.0 + sqrt(1.0 + 1.0 / (a * a)));
 }
 
-// B eq. 21 (Beckmann, rational approximation)
+// Lambda of Beckmann, rational approximation (Walter et al. 2007)
 float rad_lambda_beckmann(float a)
 {
     if (!(a < 1.6)) return 0.0;
     return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);
 }
 
-// B eq. 11
+// Smith G1 (Heitz 2014)
 float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0 ? 1.0 / (1.0 + lambda_s) : 0.0; }
 
-// B eq. 13 and 14
+// Smith G2, separable and height-correlated (Heitz 2014)
 float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)
 {
     return (mv > 0.0 && ml > 0.0) ? 1.0 / ((1.0 + lambda_v) * (1.0 + lambda_l)) : 0.0;
@@ -113,7 +113,7 @@ float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float l
     return (mv > 0.0 && ml > 0.0) ? 1.0 / (1.0 + lambda_v + lambda_l) : 0.0;
 }
 
-// B eq. 15 and 16 (one channel)
+// Schlick's Fresnel and its generalized F90 form (one channel)
 float rad_fresnel_schlick(float f0, float c)
 {
     float x = 1.0 - (c > 0.0 ? c : 0.0), x2 = x * x;
@@ -125,7 +125,7 @@ float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)
     return f0 + (f90 - f0) * pow(1.0 - (c > 0.0 ? c : 0.0), exponent);
 }
 
-// B eq. 27 and 28 (one channel)
+// diffuse terms: Lambert (1 - F) and Shirley et al. 1997 (one channel)
 float rad_diffuse_lambert(float albedo, float F) { return (1.0 - F) * albedo * RAD_INV_PI; }
 
 float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)

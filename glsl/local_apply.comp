@@ -1,6 +1,6 @@
 #version 450
 // radiosity.h kernel RAD_GLSL_LOCAL_APPLY: the local multi-bounce apply of rad_local_apply
-// (SPEC §5, thesis fig. 4.2): for every visible entry r = row_offset .. row_offset + row_count - 1,
+// (docs/methods/local.md): for every visible entry r = row_offset .. row_offset + row_count - 1,
 // with slot i = vis_slot[r] and world patch p = vis_patch[r],
 //   out[p] = sum_{j < end, lit_patch[j] != NONE} T_c[i][j] * E[lit_patch[j]]   (+ E[p] when flags bit 0)
 // for channels c = R, G, B. T is rad_local.planes: three M x M planes, row = receiving slot,

@@ -1,6 +1,6 @@
 #version 450
 // radiosity.h kernel RAD_GLSL_LOCAL_UPDATE: the O(M^2) pass of a local-matrix add
-// (rad_local_add, SPEC §5) on T resident on the GPU, after RAD_GLSL_LOCAL_VECTORS filled the work
+// (rad_local_add, docs/methods/local.md) on T resident on the GPU, after RAD_GLSL_LOCAL_VECTORS filled the work
 // buffer (its comment has the layout: u, v, c, r per channel and the scalars s, cuv, coef, tnn).
 // For plane rows i = row_offset .. row_offset + row_count - 1 (all < end), channels R, G, B:
 //   i == k (the new patch's slot):  T[k][j] = coef v[j] (j != k), T[k][k] = tnn

@@ -1,6 +1,6 @@
 #version 450
 // radiosity.h kernel RAD_GLSL_LOCAL_VECTORS: the small pre-pass of a local-matrix add
-// (rad_local_add, SPEC §5) computed from T resident on the GPU: the vectors u, v and the scalar
+// (rad_local_add, docs/methods/local.md) computed from T resident on the GPU: the vectors u, v and the scalar
 // s of the Sherman-Morrison update (fused with the exact downdate of slot ev when an add evicts),
 // which RAD_GLSL_LOCAL_UPDATE then applies. T is rad_local.planes (three M x M planes, stride m,
 // row = receiving slot). The host streams only the new patch's row and column over the slots:

@@ -1,6 +1,6 @@
 #version 450
 // radiosity.h kernel RAD_GLSL_VP_GATHER: virtual-patch gathering at surface points, as
-// rad_vp_gather / rad_vp_gather_point (SPEC §6-§7, T eq. 5.3, P eq. 9). For point i with unit
+// rad_vp_gather / rad_vp_gather_point (docs/methods/virtual-patches.md). For point i with unit
 // normal n: in each voxel v of the 2x2x2 block around p (by voxel centres; the grid coordinate
 // x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),
 //   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0

@@ -1,4 +1,5 @@
-/* test_formfactor.c - form factors (SPEC §2) against the closed forms of REFERENCE.md §1, the
+/* test_formfactor.c - form factors (docs/methods/formfactor-analytic.md) against the closed forms of
+   Howell's catalogue (C-11, C-14, C-41; docs/references.md), the
    enclosure properties, the row/sparse/dense storage, determinism, and the built-in BVH
    against a brute-force ray caster. Included by test_main.c after the implementation: every
    name is static and prefixed ff_. */
@@ -223,7 +224,7 @@ static void ff_test_point_polygon_disk(void)
     /* the 256-gon and the disk of equal area differ by O((pi/256)^2 / 12 ~ 1e-5) in radius
        moments; 1e-4 relative covers the shape difference, the float vertices and the return */
     CHECK_REL(got, expect, 1e-4);
-    CHECK_NEAR(got, 0.5, 2e-4); /* the disk itself, REFERENCE.md table */
+    CHECK_NEAR(got, 0.5, 2e-4); /* the disk itself: r^2 / (r^2 + h^2) = 1/2 at r = h */
 
     /* off-axis: disk of radius 0.5 centred at (0.7, 0.2, 0); point at (0,0,1)... use an
        offset a = |(0.7, 0.2)| in the formula */

@@ -1,4 +1,4 @@
-/* test_glsl.c - the embedded GLSL sources and their access functions (SPEC §10). The kernels
+/* test_glsl.c - the embedded GLSL sources and their access functions (>>api_glsl). The kernels
    themselves are compiled and run against the CPU paths by tests/test_vulkan.c. */
 
 static void test_glsl_sources(void)

@@ -1,5 +1,5 @@
-/* test_local.c - the local multi-bounce matrix (SPEC §5): adding patches one by one against
-   (I - A)^-1 - I by Gauss-Jordan in double computed here, the thesis's first-order update
+/* test_local.c - the local multi-bounce matrix (docs/methods/local.md): adding patches one by one against
+   (I - A)^-1 - I by Gauss-Jordan in double computed here, the first-order update
    against the exact one, removal keeping the transport through the removed patch, a long
    add/remove walk bounded by the physical limit and between the rebuilt and the full-world
    transport, apply over P_Vis x P_Lit, the CSR and baked-container row sources, and bad
@@ -152,8 +152,8 @@ static int lc_source(const lc_world *w, rad_row_source *src)
 
 /* ---------------------------------------------------------------------------------------- */
 
-/* Adding every patch one by one from empty reproduces (I - A)^-1 - I (SPEC §5); the thesis's
-   first-order update lands measurably further away. */
+/* Adding every patch one by one from empty reproduces (I - A)^-1 - I; the first-order
+   update (RAD_LOCAL_FIRST_ORDER) lands measurably further away. */
 static void test_local_add_exact_and_first_order(void)
 {
     lc_world w;
@@ -195,7 +195,7 @@ static void test_local_add_exact_and_first_order(void)
         e_fo = lc_error(&w, fo, ids, w.n);
         e_rb = lc_error(&w, rb, ids, w.n);
         e_rn = lc_error(&w, rn, ids, w.n);
-        printf("    N = %u: exact add %.3g, first-order (thesis) %.3g, rebuild: blocked inverse %.3g, Neumann %.3g "
+        printf("    N = %u: exact add %.3g, first-order %.3g, rebuild: blocked inverse %.3g, Neumann %.3g "
                "(max |T - T_ref| / max T_ref)\n", w.n, e_ex, e_fo, e_rb, e_rn);
         CHECK(e_ex < 1e-4);
         CHECK(e_rb < 1e-4);
@@ -213,7 +213,7 @@ static void test_local_add_exact_and_first_order(void)
 }
 
 /* Removing hides a patch and keeps T exactly; evicting it by the downdate gives the inverse
-   without it; the seed's drop keeps the block of the inverse with it (the paths through it). */
+   without it; the drop (RAD_LOCAL_EVICT_DROP) keeps the block of the inverse with it (the paths through it). */
 static void test_local_remove_and_evict(void)
 {
     lc_world w;
@@ -432,7 +432,7 @@ out:
 }
 
 /* A camera going back and forth between two ends of the box. With the exact downdate the
-   row sums stay under the bound for every round trip; the seed's drop counts the paths of
+   row sums stay under the bound for every round trip; the drop (RAD_LOCAL_EVICT_DROP) counts the paths of
    each patch that re-enters once more and passes the bound (then s <= 0: SINGULAR). */
 static void test_local_back_and_forth(void)
 {

@@ -1,6 +1,7 @@
-/* test_multibounce.c - the multi-bounce matrix and its compression (SPEC §4): F_mb E against K
+/* test_multibounce.c - the multi-bounce matrix and its compression (docs/methods/multibounce.md,
+   docs/methods/compression.md): F_mb E against K
    Jacobi bounces and the direct solve, binary16, hand-built BC1/BC4 blocks against the
-   decode rules of REFERENCE §4, encoder error bounds, permutations, the compressed apply, and
+   decode rules of the Khronos Data Format specification, encoder error bounds, permutations, the compressed apply, and
    the container sections. Included by test_main.c after the implementation: every name is
    static and prefixed mb_. */
 
@@ -651,7 +652,7 @@ static void mb_reorder_methods(void)
     CHECK(mse[RAD_REORDER_MATCH] * 2.0 <= mse[RAD_REORDER_NONE]);
     CHECK(mse[RAD_REORDER_MATCH] <= 1.1 * mse[RAD_REORDER_GREEDY]);
     /* on the patch order: matching gives a lower real encoded MSE than the greedy chain
-       (Listing 3.1) in both formats (measured: 378 patches 25% / 28% lower for BC1 / 3xBC4,
+       (RAD_REORDER_GREEDY) in both formats (measured: 378 patches 25% / 28% lower for BC1 / 3xBC4,
        206 patches 17% / 14%); RAD_TEST_QUICK: 3xBC4 only */
     for (ch = rad_test_quick() ? 1u : 0u; ch < 2; ++ch) {
         double m2[2];

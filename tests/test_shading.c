@@ -1,4 +1,4 @@
-/* test_shading.c - lighting models and BRDFs (SPEC §9): NDF normalization, the weak white
+/* test_shading.c - lighting models and BRDFs (docs/methods/shading.md): NDF normalization, the weak white
    furnace for Smith G1, reciprocity, energy, Beckmann's rational Lambda against the exact
    erf form, hand-computed values, API errors. Integrals are midpoint sums in closed-form
    changes of variables; each tolerance below is the quadrature error measured at the
@@ -73,11 +73,11 @@ static void sh_test_g1_furnace(void)
                 }
 }
 
-/* Beckmann: the rational approximation of Lambda (B eq. 21) against the exact erf form
-   (eq. 20). The bound is the 0.35 % relative error on G1 = 1/(1 + Lambda) quoted for Walter
-   et al. 2007's rational G1 (quoted from memory: the paper itself is not in this repository's
-   sources); measured here: 0.313 % at a = 1.336, on a grid of a in (0, 6]. (Lambda itself
-   differs by up to 0.76 as a -> 0, where both forms go to infinity: G1 is the fair measure.) */
+/* Beckmann: the rational approximation of Lambda against the exact erf form. The bound is
+   the 0.35 % relative error on G1 = 1/(1 + Lambda) quoted for Walter et al. 2007's rational
+   G1 (docs/references.md; quoted from memory, not checked against the paper); measured here:
+   0.313 % at a = 1.336, on a grid of a in (0, 6]. (Lambda itself differs by up to 0.76 as
+   a -> 0, where both forms go to infinity: G1 is the fair measure.) */
 static void sh_test_beckmann_lambda(void)
 {
     double worst = 0.0;
@@ -94,7 +94,7 @@ static void sh_test_beckmann_lambda(void)
     CHECK_REL(rad_lambda_beckmann_exact(1.0f), 0.5 * (0.8427007929497149 - 1.0) + exp(-1.0) / (2.0 * sqrt(SH_PI)), 1e-6);
     CHECK_NEAR(rad_lambda_beckmann(1.6f), 0.0, 0.0);
     CHECK_NEAR(rad_lambda_beckmann_exact(HUGE_VALF), 0.0, 0.0);
-    /* GGX eq. 23 at a = 1: (sqrt(2) - 1) / 2 */
+    /* GGX Lambda at a = 1: (sqrt(2) - 1) / 2 */
     CHECK_REL(rad_lambda_ggx(1.0f), (sqrt(2.0) - 1.0) / 2.0, 1e-6);
     CHECK_NEAR(rad_lambda_ggx(HUGE_VALF), 0.0, 0.0);
 }
@@ -205,7 +205,7 @@ static void sh_test_energy(void)
         double a = sh_albedo(&s, v, n);
         CHECK(a > 1.0 && a < 1.015);
     }
-    /* the test can tell: the thesis's Lambert diffuse term (1 - F(n,l)) rho / pi (eq. 27) is
+    /* the test can tell: the default Lambert diffuse term (1 - F(n,l)) rho / pi (Korobeinikov 2022) is
        not energy-conserving with the specular term at albedo 1 (measured 1.072) */
     rad_shading_default(&s, RAD_SHADING_MICROFACET);
     for (k = 0; k < 3; ++k) s.microfacet.albedo[k] = 1.0f;

@@ -1,4 +1,4 @@
-/* test_temporal.c - temporal radiosity (SPEC §8): the generator's published vectors, alias
+/* test_temporal.c - temporal radiosity (docs/methods/temporal.md): the generator's published vectors, alias
    tables (exact implied probabilities, chi-square of draws, streamed rows, container round
    trip), the step's expectation against the exact gather, convergence to rho o (F E) and to
    L_inf with feedback, rows with sums above 1, the environment entry, determinism across
@@ -188,7 +188,7 @@ static void tp_alias_tables_exact(void)
     tp_cornell_free(&c);
 }
 
-/* Streamed rows (P-4.3): every row rebuilt alone from the dense row and from the CSR row gives
+/* Streamed rows (rad_alias_build_row): every row rebuilt alone from the dense row and from the CSR row gives
    the same bins and T_i as the pre-built tables (bit for bit); CSR-built tables equal dense-built. */
 static void tp_streamed_rows(void)
 {

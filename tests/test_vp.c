@@ -1,4 +1,4 @@
-/* test_vp.c - axis-aligned virtual patches (SPEC §6-§7): reciprocity of the merged patches, the
+/* test_vp.c - axis-aligned virtual patches (docs/methods/aavp.md): reciprocity of the merged patches, the
    furnace in a closed box, agreement with classic radiosity on an axis-aligned box, continuity
    of the gathered lighting across voxels, peak memory through a counting allocator, and the
    argument checks. Included by test_main.c after the implementation: every name is static

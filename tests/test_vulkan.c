@@ -1,6 +1,6 @@
 /* test_vulkan.c - every GLSL kernel of radiosity.h compiled (from the header's embedded source,
    by glslangValidator) and run on a Vulkan device (any: Mesa's lavapipe in CI), compared with
-   the CPU path on the same inputs (SPEC §10). Each kernel runs in row chunks bound at offsets
+   the CPU path on the same inputs (>>api_glsl). Each kernel runs in row chunks bound at offsets
    (the chunked processing of matrices larger than one storage-buffer range) and with two
    workgroup sizes (specialization constant 0).
 
@@ -492,7 +492,7 @@ static void test_mb_blocks(void)
             uint32_t j, ch;
             if (!gpu_blocks_init(&g, b, g_local_sizes[ls])) { T_CHECK(0); gpu_blocks_free(&g); continue; }
             /* the decode itself: E = unit vector j gives column j of the decoded matrix; each
-               entry within 2/255 of its tile scale of the CPU decoder (REFERENCE §4) */
+               entry within 2/255 of its tile scale of the CPU decoder (rad_bc1/bc4_decode_block) */
             for (j = 0; j < n; j += 3) {
                 double worst = 0.0;
                 for (i = 0; i < 3 * (size_t)n; ++i) unit[i] = 0.0f;
@@ -1078,7 +1078,7 @@ static void local_case(const float *F, uint32_t n, const float *areas, const flo
             if (r != RAD_SUCCESS) { printf("    FAIL rad_local_add(%u): %s\n", patch, rad_result_string(r)); g_checks_failed++; break; }
         }
         k = L->patch_slot[patch];
-        /* the member evicted from slot k is out of the slot map; with the seed's drop the add is a
+        /* the member evicted from slot k is out of the slot map; with RAD_LOCAL_EVICT_DROP the add is a
            plain one into slot k (its old row and column are overwritten, as the drop zeroed them) */
         ev = full && evict == RAD_LOCAL_EVICT_DOWNDATE ? k : RAD_NONE;
         if (full) {
