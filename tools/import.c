@@ -67,6 +67,7 @@ typedef struct imp_storage {
     imp_group *groups;
     uint32_t group_count, group_cap;
     rad_material *materials;
+    char **material_names;
     uint32_t material_count;
     imp_texture *textures;
     uint32_t texture_count;
@@ -144,6 +145,8 @@ static void free_storage(imp_storage *st)
         free(st->groups[i].material_ids);
     }
     for (i = 0; i < st->texture_count; ++i) free(st->textures[i].rgb);
+    for (i = 0; st->material_names && i < st->material_count; ++i) free(st->material_names[i]);
+    free(st->material_names);
     free(st->groups);
     free(st->meshes);
     free(st->materials);
@@ -719,8 +722,10 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     if (!strcmp(path_or_name, "cornell")) {
         st = (imp_storage *)calloc(1, sizeof *st);
         if (!st) return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
+        static const char *const cornell_names[4] = {"white", "red", "green", "light"};
         st->builtin = 1;
         rad_cornell_box(&out->desc, &out->camera);
+        if (out->desc.material_count == 4) out->material_names = cornell_names;
         out->has_camera = 1;
         out->storage = st;
         return 0;
@@ -750,6 +755,14 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     st->material_count = sc->mNumMaterials ? sc->mNumMaterials : 1;
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
+    st->material_names = (char **)xrealloc(NULL, sizeof(char *) * st->material_count);
+    for (i = 0; i < st->material_count; ++i) {
+        struct aiString mname;
+        if (i >= sc->mNumMaterials || aiGetMaterialString(sc->mMaterials[i], AI_MATKEY_NAME, &mname) != aiReturn_SUCCESS)
+            mname.length = 0, mname.data[0] = 0;
+        st->material_names[i] = xstrdup(mname.data);
+    }
+    out->material_names = (const char *const *)st->material_names;
     for (i = 0; i < st->material_count; ++i) {
         if (i < sc->mNumMaterials) {
             if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &warned, err, errlen)) {

@@ -8,6 +8,7 @@
        rad trace SCENE -o OUT  the reference path tracer
        rad compare A B         image metrics
        rad info FILE.radb      what a bake holds
+       rad export SCENE -o OUT.obj     the scene as OBJ + MTL
 
    This file holds the implementation of radiosity.h, the dispatcher, the shared helpers of
    tool.h and the formfactors command. Exit codes: 0 ok, 1 failure, 2 usage error. */
@@ -282,6 +283,7 @@ static void usage(FILE *f)
                "  trace SCENE -o OUT       the reference path tracer\n"
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
                "  info FILE.radb           list what a bake holds and check it\n"
+               "  export SCENE -o OUT.obj  write the scene as OBJ + MTL (Kd albedo, Ke emission)\n"
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
                "at most 1024).\n");
@@ -382,7 +384,8 @@ int main(int argc, char **argv)
         const char *name;
         int (*fn)(int, char **);
     } cmds[] = {{"formfactors", rad_cmd_formfactors}, {"bake", rad_cmd_bake},       {"render", rad_cmd_render},
-                {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info}};
+                {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info},
+                {"export", rad_cmd_export}};
     size_t i;
     if (argc < 2) {
         usage(stderr);

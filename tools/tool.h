@@ -17,6 +17,7 @@ typedef struct rad_tool_scene {
     int has_camera;          /* 1 when the camera came from the file or the built-in scene */
     rad_light *lights;       /* analytic lights found in the file (may be none) */
     uint32_t light_count;
+    const char *const *material_names; /* desc.material_count names ("" when unnamed), or NULL */
     void *storage;           /* private */
 } rad_tool_scene;
 
@@ -101,6 +102,7 @@ int rad_cmd_render(int argc, char **argv);
 int rad_cmd_trace(int argc, char **argv);
 int rad_cmd_compare(int argc, char **argv);
 int rad_cmd_info(int argc, char **argv);
+int rad_cmd_export(int argc, char **argv);
 
 /* ---- shared helpers (rad.c) ------------------------------------------------------------- */
 /* progress to stderr: a bar when stderr is a terminal, a plain percentage line otherwise */
