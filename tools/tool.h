@@ -248,10 +248,10 @@ typedef struct rad_tool_method_options {
     uint32_t tile;            /* --tile T: scales per T x T texels, 0: per matrix (default 64) */
     rad_temporal_mode mode;   /* --mode feedback|single|multibounce (default feedback) */
     uint32_t k;               /* --k K: draws per row and frame (default 10) */
-    float w;                  /* --w W: fixed blend weight (default 0.998) */
-    int adaptive;             /* --adaptive: per-row weight */
+    float w;                  /* --w W: a fixed blend weight (0.998 when --w is not given; unused then) */
+    int adaptive;             /* --adaptive: per-row weight (the default; --w W turns it off) */
     uint32_t seed;            /* --seed S (default 0) */
-    uint32_t frames;          /* --frames N (render; default 64) */
+    uint32_t frames;          /* --frames N (render; default 1024) */
     const char *sequence;     /* --sequence DIR (render) */
     uint32_t every;           /* --every N (render; default 1) */
     uint32_t vp_resolution;   /* --vp-resolution R: voxels along the longest axis (default 16) */
