@@ -414,6 +414,20 @@ if [ -s "$TMP/ref.pfm" ]; then
     else
         fail "local with M = 60 renders" "$(head -c 300 "$TMP/err.txt")"
     fi
+    # the default --local-m covers a small scene whole: at 1054 patches (one form-factor sample
+    # per pair to keep it quick) the old fixed M = 1024 left the 30 farthest without indirect
+    # light (40 dB against classic); now M = every patch, the full solution
+    LM="--patches 1000 --samples 1 --size 24x24 --aa 1 --pixel-light-samples 4"
+    if "$RAD" render cornell $LM -o "$TMP/lmc.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell $LM --method local -o "$TMP/lmd.pfm" > /dev/null 2> "$TMP/err.txt"; then
+        lm=$(grep -o 'timing: method=local patches=[0-9]* .*local_m=[0-9]*' "$TMP/err.txt" | sed 's/.*patches=\([0-9]*\) .*local_m=\([0-9]*\)/\1 \2/')
+        p=$(psnr_of "$TMP/lmc.pfm" "$TMP/lmd.pfm")
+        [ -n "$lm" ] && [ "${lm% *}" = "${lm#* }" ] && at_least "$p" 45 &&
+            ok "local's default M covers all ${lm% *} patches (PSNR $p dB against classic >= 45)" ||
+            fail "local's default M covers all the patches" "patches and M '$lm', PSNR '$p' dB"
+    else
+        fail "local's default M covers all the patches" "$(head -c 300 "$TMP/err.txt")"
+    fi
     for vm in aavp vp; do
         if "$RAD" render cornell $M --method $vm --vp-resolution 4 -o "$TMP/$vm.pfm" > /dev/null 2> "$TMP/err.txt" &&
             grep -q "timing: method=$vm patches=[0-9]* .*step_ms_median=" "$TMP/err.txt"; then

@@ -15,7 +15,8 @@
    correction from the bake's row sums of F.
 
    Local (render_local_method, SPEC §5): the classic patches, F and E; a rad_local of capacity
-   --local-m M filled with the M patches nearest the camera (rad_local_nearest, one
+   --local-m M (default: every patch, up to RAD_TOOL_LOCAL_M_AUTO_MAX) filled with the M patches
+   nearest the camera (rad_local_nearest, one
    rad_local_rebuild), L = T E over P_Vis x P_Lit (rad_local_visible, rad_local_lit), H = L / rho
    and the classic render; patches outside the set or not visible get no indirect light.
    Virtual patches (render_vp_method, SPEC §6-§7): rad_vp_create (vp: RAD_VP_CLUSTERED, aavp:
@@ -656,9 +657,17 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
     o.sources_only = 1;
     if (rad_tool_classic_solve(cmd, w, &o, &sol)) return 1;
     n = sol.patches->count;
-    m = mo->local_m < n ? mo->local_m : n;
-    if (mo->local_m > n && (mo->given & RAD_TOOL_OPT_LOCAL_M))
-        fprintf(stderr, "rad %s: --local-m %u is more than the %u patches: using %u\n", cmd, mo->local_m, n, n);
+    if (mo->local_m == 0) { /* the default: the whole scene when it is small enough */
+        m = n < RAD_TOOL_LOCAL_M_AUTO_MAX ? n : RAD_TOOL_LOCAL_M_AUTO_MAX;
+        if (m < n)
+            fprintf(stderr, "rad %s: warning: the default --local-m covers %u of the %u patches (the nearest to the "
+                            "camera; the others get no indirect light): give --local-m %u for all of them\n",
+                    cmd, m, n, n);
+    } else {
+        m = mo->local_m < n ? mo->local_m : n;
+        if (mo->local_m > n)
+            fprintf(stderr, "rad %s: --local-m %u is more than the %u patches: using %u\n", cmd, mo->local_m, n, n);
+    }
     areas = (float *)xmalloc(sizeof(float) * n);
     albedo = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);

@@ -48,7 +48,7 @@ void rad_tool_method_options_default(rad_tool_method_options *mo)
     mo->every = 1;
     mo->vp_resolution = 16;
     mo->face_points = 16;
-    mo->local_m = 1024;
+    mo->local_m = 0; /* every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX (cmd_render.c) */
 }
 
 const char *rad_tool_method_name(rad_tool_method method)
@@ -106,8 +106,9 @@ const char *rad_tool_method_help(int render)
                     "  --face-points P    Hammersley points per voxel face (default 16)\n"
                     "local (local multi-bounce matrix, SPEC §5; classic patches and F, T = (I - rho F_S)^-1 - I\n"
                     "of the set S, the full solution within S; render only):\n"
-                    "  --local-m M        capacity: S = the M patches nearest the camera (default 1024, at most\n"
-                    "                     the patch count). L = T E over P_Vis x P_Lit: patches outside S (or not\n"
+                    "  --local-m M        capacity: S = the M patches nearest the camera (default: every patch,\n"
+                    "                     up to 4096: T takes 12 M^2 bytes, 192 MiB at 4096, and its rebuild\n"
+                    "                     6 M^3 flops). L = T E over P_Vis x P_Lit: patches outside S (or not\n"
                     "                     visible) get no indirect light and light outside S is not bounced\n"
                   : "multibounce:\n"
                     "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"

@@ -97,7 +97,7 @@ mbbc1|multi-bounce F_mb, BC1 + outliers, reordered|1|--method multibounce --form
 mbbc4|multi-bounce F_mb, 3xBC4 + outliers, reordered|1|--method multibounce --format bc4x3|T-3: memory 3x below the plain form-factor matrix
 temporal|temporal, k 10, w 0.998, after FRAMES frames|1|--method temporal --w 0.998 --frames FRAMES|T table 2 (temporal): MSE 0.06651, PSNR 23.54, SSIM 0.8323
 temporal_ad|temporal, k 10, adaptive w, after FRAMES frames|1|--method temporal --adaptive --frames FRAMES|none (beyond the thesis: SPEC §8 adaptive w)
-local|local matrix (SPEC §5), M = 1024 nearest the camera|1|--method local|T-4: update cost 6-15x below recomputation
+local|local matrix (SPEC §5), M = 1024 nearest the camera|1|--method local --local-m 1024|T-4: update cost 6-15x below recomputation
 vp|virtual patches (SPEC §6)|0|--method vp|T-5: 200 000 triangles to 12 000 (or 2 000) patches
 aavp|axis-aligned virtual patches (SPEC §7)|0|--method aavp|T table 3: temporal + AAVP 0.08 ms, SSIM 0.73 (RTXGI 0.17 ms, SSIM 0.66)
 '
