@@ -23,6 +23,11 @@ skip_data() { echo "skip-data $1: $2"; }
 close() { awk -v v="$1" -v e="$2" -v r="$3" 'BEGIN { d = v - e; if (d < 0) d = -d; exit !(v != "" && d <= r * (e < 0 ? -e : e)) }'; }
 # value of "FROM TO VALUE" for a pair
 pair() { awk -v a="$2" -v b="$3" '$1 == a && $2 == b { print $3 }' "$1"; }
+# PSNR and SSIM of two images (rad compare)
+psnr_of() { "$RAD" compare "$1" "$2" 2> /dev/null | awk '/^PSNR/ { print $2 }'; }
+ssim_of() { "$RAD" compare "$1" "$2" 2> /dev/null | awk '/^SSIM/ { print $2 }'; }
+# at_least VALUE MIN: inf counts as large
+at_least() { [ "$1" = "inf" ] || awk -v v="$1" -v m="$2" 'BEGIN { exit !(v != "" && v + 0 >= m) }'; }
 
 # ---- the program ----------------------------------------------------------------------
 "$RAD" help > "$TMP/help.txt" 2>&1 && grep -q formfactors "$TMP/help.txt" && ok "help exits 0" || fail "help exits 0"
@@ -250,6 +255,83 @@ else
     fail "render pathtrace writes a PFM" "$(head -c 300 "$TMP/err.txt")"
 fi
 
+# A scene without a camera is looked at from where its surfaces face the viewer: an open-front
+# box (McGuire's CornellBox-Original has this form, its front at +z) rendered black from the
+# old default, a camera at -z behind the back wall that sees only back faces
+cat > "$TMP/openbox.mtl" <<'EOF'
+newmtl white
+Kd 0.7 0.7 0.7
+newmtl lamp
+Kd 0.7 0.7 0.7
+Ke 10 10 10
+EOF
+cat > "$TMP/openbox.obj" <<'EOF'
+mtllib openbox.mtl
+usemtl white
+o floor
+v -1 0 -1
+v -1 0 1
+v 1 0 1
+v 1 0 -1
+f 1 2 3 4
+o ceiling
+v -1 2 -1
+v 1 2 -1
+v 1 2 1
+v -1 2 1
+f 5 6 7 8
+o back
+v -1 0 -1
+v 1 0 -1
+v 1 2 -1
+v -1 2 -1
+f 9 10 11 12
+o left
+v -1 0 -1
+v -1 2 -1
+v -1 2 1
+v -1 0 1
+f 13 14 15 16
+o right
+v 1 0 -1
+v 1 0 1
+v 1 2 1
+v 1 2 -1
+f 17 18 19 20
+o light
+usemtl lamp
+v -0.25 1.98 -0.25
+v 0.25 1.98 -0.25
+v 0.25 1.98 0.25
+v -0.25 1.98 0.25
+f 21 22 23 24
+EOF
+printf 'PF\n16 16\n-1.0\n' > "$TMP/black16.pfm" && head -c 3072 /dev/zero >> "$TMP/black16.pfm"
+for c in render trace; do
+    if "$RAD" $c "$TMP/openbox.obj" --size 16x16 $([ $c = render ] && echo "--patches 50 --aa 1" || echo "--spp 4") \
+        -o "$TMP/openbox.pfm" > /dev/null 2> "$TMP/err.txt"; then
+        p=$(psnr_of "$TMP/black16.pfm" "$TMP/openbox.pfm")
+        grep -q "no camera: bounds (-1, 0, -1) to (1, 2, 1); chose --camera .* looking along -z" "$TMP/err.txt" &&
+            [ -n "$p" ] && [ "$p" != inf ] && awk -v p="$p" 'BEGIN { exit !(p + 0 < 40) }' &&
+            ok "$c: an open box without a camera is seen through its open side, not black (PSNR $p dB against black)" ||
+            fail "$c: an open box without a camera is seen through its open side, not black" \
+                "PSNR '$p' against black: $(grep 'no camera' "$TMP/err.txt" | head -c 300)"
+    else
+        fail "$c: an open box without a camera is seen through its open side" "$(head -c 300 "$TMP/err.txt")"
+    fi
+done
+# closed by a front wall, no outside view sees front faces: the camera goes inside
+{ cat "$TMP/openbox.obj"; printf 'usemtl white\no front\nv -1 0 1\nv -1 2 1\nv 1 2 1\nv 1 0 1\nf 25 26 27 28\n'; } > "$TMP/closedbox.obj"
+if "$RAD" render "$TMP/closedbox.obj" --size 16x16 --patches 50 --aa 1 -o "$TMP/closedbox.pfm" > /dev/null 2> "$TMP/err.txt"; then
+    p=$(psnr_of "$TMP/black16.pfm" "$TMP/closedbox.pfm")
+    grep -q "no camera: bounds .*; chose --camera .* (inside the bounds" "$TMP/err.txt" && [ -n "$p" ] && [ "$p" != inf ] &&
+        awk -v p="$p" 'BEGIN { exit !(p + 0 < 40) }' &&
+        ok "render: a closed room without a camera is seen from inside (PSNR $p dB against black)" ||
+        fail "render: a closed room without a camera is seen from inside" "PSNR '$p': $(grep 'no camera' "$TMP/err.txt" | head -c 300)"
+else
+    fail "render: a closed room without a camera is seen from inside" "$(head -c 300 "$TMP/err.txt")"
+fi
+
 # --shading: the built-in box has only an area light, which stays Lambertian whatever the
 # model, so a microfacet render equals the default one up to float rounding
 if "$RAD" render cornell --patches 300 --size 32x32 --aa 1 -o "$TMP/sh-none.pfm" > /dev/null 2> "$TMP/err.txt" &&
@@ -270,10 +352,6 @@ fi
 # `--bounces K` means the same in all methods (the patch solution L_K; the image gathers once
 # more), so multibounce with float storage must reproduce classic to float rounding, compressed
 # storage to its compression error, and temporal approaches it as frames are averaged.
-psnr_of() { "$RAD" compare "$1" "$2" 2> /dev/null | awk '/^PSNR/ { print $2 }'; }
-ssim_of() { "$RAD" compare "$1" "$2" 2> /dev/null | awk '/^SSIM/ { print $2 }'; }
-# at_least VALUE MIN: inf counts as large
-at_least() { [ "$1" = "inf" ] || awk -v v="$1" -v m="$2" 'BEGIN { exit !(v != "" && v + 0 >= m) }'; }
 M="--patches 300 --size 32x32 --aa 4"
 # psnr_check NAME A B MIN_DB: ok when PSNR(A, B) >= MIN_DB
 psnr_check() {

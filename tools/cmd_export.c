@@ -9,8 +9,8 @@
    with one 'newmtl' per material: Kd = albedo, Ke = emitted radiance (the importer reads Ke
    as radiance, so the round trip keeps the light). Numbers are printed with 9 significant
    digits, which a float reads back exactly. What OBJ cannot hold is reported on stderr and
-   left out: the camera (written as a comment, with the --camera/--fov options that restore
-   it), analytic lights, and albedo textures (the material's colour factor is written).
+   left out: the scene's camera (written as a comment, with the --camera/--fov options that
+   restore it), analytic lights, and albedo textures (the material's colour factor is written).
    Both files go through rad_tool_output_* (a temporary renamed into place), and neither may
    be the scene or one of the MTL files it names. */
 #include "tool.h"
@@ -151,11 +151,12 @@ int rad_cmd_export(int argc, char **argv)
     }
 
     fprintf(obj.f, "# written by rad export from '%s'\n", scene_name);
-    fprintf(obj.f, "# camera: --camera %.9g,%.9g,%.9g:%.9g,%.9g,%.9g:%.9g,%.9g,%.9g --fov %.9g%s\n",
-            (double)ts.camera.position[0], (double)ts.camera.position[1], (double)ts.camera.position[2],
-            (double)ts.camera.target[0], (double)ts.camera.target[1], (double)ts.camera.target[2], (double)ts.camera.up[0],
-            (double)ts.camera.up[1], (double)ts.camera.up[2], (double)ts.camera.fov_y_degrees,
-            ts.has_camera ? "" : " (the scene has none: a framing of its bounds)");
+    if (ts.has_camera) /* else render and trace choose one from the geometry, as for the source */
+        fprintf(obj.f, "# camera: --camera %.9g,%.9g,%.9g:%.9g,%.9g,%.9g:%.9g,%.9g,%.9g --fov %.9g\n",
+                (double)ts.camera.position[0], (double)ts.camera.position[1], (double)ts.camera.position[2],
+                (double)ts.camera.target[0], (double)ts.camera.target[1], (double)ts.camera.target[2],
+                (double)ts.camera.up[0], (double)ts.camera.up[1], (double)ts.camera.up[2],
+                (double)ts.camera.fov_y_degrees);
     fprintf(obj.f, "mtllib %s\n", mtl_base);
     for (m = 0; m < d->mesh_count; ++m) {
         const rad_mesh_desc *md = &d->meshes[m];

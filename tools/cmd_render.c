@@ -844,8 +844,10 @@ int rad_cmd_render(int argc, char **argv)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                     cmd, o.patches, w.scene->triangle_count);
     }
-    if (!have_cam) cam = w.file.camera;
-    else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
+    if (!have_cam) {
+        if (w.file.has_camera) cam = w.file.camera;
+        else rad_tool_choose_camera(cmd, w.scene, &w.rc, width, height, &cam);
+    } else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
     if (fov > 0.0f) cam.fov_y_degrees = fov;
     if (rad_image_alloc(&img, width, height) != 0) {
         fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);

@@ -13,7 +13,8 @@
    the lights, camera and names that came with it. */
 typedef struct rad_tool_scene {
     rad_scene_desc desc;
-    rad_camera camera;       /* the file's first camera, or a default framing of the bounds */
+    rad_camera camera;       /* the file's first camera, or a framing of the bounds from -z (render
+                                and trace choose their own then: rad_tool_choose_camera) */
     int has_camera;          /* 1 when the camera came from the file or the built-in scene */
     rad_light *lights;       /* analytic lights found in the file (may be none) */
     uint32_t light_count;
@@ -167,6 +168,14 @@ typedef struct rad_tool_world {
 /* loads, validates and builds the BVH; prints the error and returns 1 on failure, else 0 */
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w);
 void rad_tool_close_world(rad_tool_world *w);
+/* A camera for a scene that has none (rad_tool_scene.has_camera 0): of the views from outside
+   the bounds along +z, -z, +x, -x, -y, +y (the bounding sphere in view) and from inside them,
+   the first outside one whose sample rays hit mostly front faces (fov 39.3 degrees), else the
+   inside one that sees most front faces (fov 75, from near the bounds' side behind it); a
+   camera behind a box's back wall sees only back faces, which render black.
+   Prints the bounds and the camera chosen, as --camera and --fov options, to stderr. */
+void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
+                            rad_camera *cam);
 
 /* ---- the classic method: patches, F, direct light, solve (cmd_bake.c) --------------------- */
 typedef enum rad_tool_solver { RAD_TOOL_JACOBI = 0, RAD_TOOL_GAUSS_SEIDEL = 1, RAD_TOOL_DIRECT = 2 } rad_tool_solver;
