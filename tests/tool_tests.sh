@@ -726,6 +726,14 @@ printf '\000\000\300\177\000\000\000\077\000\000\000\077\000\000\200\177\000\000
 rc=$?
 [ $rc -eq 1 ] && grep -q "B '.*nan.pfm' has 1 NaN and 1 infinite values" "$TMP/err.txt" && grep -q "^nonfinite B: 1 NaN, 1 inf" "$TMP/out.txt" &&
     ok "compare reports NaN and infinite pixels and exits 1" || fail "compare reports NaN and infinite pixels and exits 1" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+# compare --exposure E scales both images before the metrics clamp them: 3.5 against 3.0 is
+# white against white (inf dB) unscaled, 0.875 against 0.75 (MSE 0.015625, 18.06 dB) at 0.25
+printf 'PF\n4 4\n-1.0\n' > "$TMP/bright35.pfm" && printf '\000\000\140\100%.0s' $(seq 48) >> "$TMP/bright35.pfm"
+printf 'PF\n4 4\n-1.0\n' > "$TMP/bright30.pfm" && printf '\000\000\100\100%.0s' $(seq 48) >> "$TMP/bright30.pfm"
+p1=$(psnr_of "$TMP/bright35.pfm" "$TMP/bright30.pfm")
+p=$("$RAD" compare "$TMP/bright35.pfm" "$TMP/bright30.pfm" --exposure 0.25 2> /dev/null | awk '/^PSNR/ { print $2 }')
+[ "$p1" = inf ] && close "$p" 18.0618 1e-3 && ok "compare --exposure 0.25 scales before the clamp ($p dB; unscaled $p1)" ||
+    fail "compare --exposure 0.25 scales before the clamp" "PSNR '$p' (want 18.06), unscaled '$p1'"
 # --size: an image beyond 2 GiB is refused with the bytes (32768x32768 allocated 12 GiB silently)
 for c in render trace; do
     timeout 120 "$RAD" $c cornell --size 32768x32768 -o "$TMP/huge.pfm" > /dev/null 2> "$TMP/err.txt"
@@ -750,6 +758,11 @@ if "$RAD" compare "$TMP/tm.pfm" "$TMP/tm.pfm" --png "$TMP/tm.png" --exposure 2 >
 else
     fail "compare --png writes A as a readable PNG" "$(head -c 300 "$TMP/cmp.txt")"
 fi
+# --png-exposure: the picture's exposure alone (tools/report.sh: metrics on linear values)
+"$RAD" compare "$TMP/tm.pfm" "$TMP/tm.pfm" --png "$TMP/tm2.png" --png-exposure 2 > "$TMP/cmp.txt" 2>&1 &&
+    cmp -s "$TMP/tm.png" "$TMP/tm2.png" && grep -q "^values: linear, clamped" "$TMP/cmp.txt" &&
+    ok "compare --png-exposure 2 writes the PNG of --exposure 2 and leaves the metrics linear" ||
+    fail "compare --png-exposure 2 writes the PNG of --exposure 2 and leaves the metrics linear" "$(head -c 300 "$TMP/cmp.txt")"
 "$RAD" compare "$TMP/tm.pfm" "$TMP/tm.pfm" --png "$TMP/tm.jpg" > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 2 ] && grep -q -- "--png wants a .png file" "$TMP/err.txt" && ok "compare --png rejects another extension" ||

@@ -124,7 +124,7 @@ elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
 
 # metrics of $1 (pfm) against $2 (pfm) -> "MSE PSNR SSIM"; writes the PNG and the heat map
 compare() {
-    "$RAD" compare "$1" "$2" --diff "$3" --diff-scale $DIFF_SCALE --png "$4" --exposure $EXPOSURE > "$TMP/cmp.txt" 2>&1 ||
+    "$RAD" compare "$1" "$2" --diff "$3" --diff-scale $DIFF_SCALE --png "$4" --png-exposure $EXPOSURE > "$TMP/cmp.txt" 2>&1 ||
         return 1
     awk '/^MSE:/ { m = $2 } /^PSNR:/ { p = $2 } /^SSIM:/ { s = $2 } END { printf "%.3g %.2f %.4f\n", m, p, s }' "$TMP/cmp.txt"
 }
