@@ -709,6 +709,16 @@ gltf "${B64}DAAAA" > "$TMP/good.gltf"
 gltf "${B64}EAAAA" > "$TMP/oor.gltf"
 "$RAD" formfactors "$TMP/good.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt" && grep -q "2 triangles" "$TMP/err.txt" &&
     ok "a glTF with an embedded buffer loads (2 triangles)" || fail "a glTF with an embedded buffer loads" "$(head -c 200 "$TMP/err.txt")"
+# assimp adds a default material (base colour 1, clamped to 0.999) to every glTF: unused, it
+# drew "albedo clamped" for a file whose own material is fine; used, the warning stays
+sed 's/"indices": 1}/"indices": 1, "material": 0}/; s/"scene": 0,/"scene": 0, "materials": [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}],/' \
+    "$TMP/good.gltf" > "$TMP/grey.gltf"
+"$RAD" formfactors "$TMP/grey.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt" && grep -q "2 triangles" "$TMP/err.txt" &&
+    ! grep -q "albedo clamped" "$TMP/err.txt" && ok "no warning about assimp's unused default material" ||
+    fail "no warning about assimp's unused default material" "$(head -c 200 "$TMP/err.txt")"
+"$RAD" formfactors "$TMP/good.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt"
+grep -q "albedo clamped" "$TMP/err.txt" && ok "the default material warns when a triangle uses it" ||
+    fail "the default material warns when a triangle uses it" "$(head -c 200 "$TMP/err.txt")"
 "$RAD" formfactors "$TMP/oor.gltf" --patches 4 > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 1 ] && grep -q "oor.gltf' is broken: .*out-of-range indices" "$TMP/err.txt" &&

@@ -248,9 +248,10 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
 #define EMISSION_MAX 1e30f
 
 /* 0, or 1 with the reason in err (a negative, NaN, infinite or overflowing emission: it used
-   to become 0 without a word) */
+   to become 0 without a word). *clamped: set to 1 when the albedo was clamped into
+   [0, ALBEDO_MAX] (the warning waits until it is known which materials are used). */
 static int convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
-                            uint32_t index, rad_material *out, int *warned_clamp, char *err, size_t errlen)
+                            uint32_t index, rad_material *out, unsigned char *clamped_out, char *err, size_t errlen)
 {
     struct aiColor4D c;
     struct aiString name, tpath;
@@ -329,11 +330,7 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
         if (!(out->albedo[k] >= 0.0f)) out->albedo[k] = 0.0f, clamped = 1;
         if (out->albedo[k] > ALBEDO_MAX) out->albedo[k] = ALBEDO_MAX, clamped = 1;
     }
-    if (clamped && !*warned_clamp) {
-        fprintf(stderr, "rad: warning: material '%s': albedo clamped into [0, %g] (radiosity needs albedo < 1)\n",
-                name.data, (double)ALBEDO_MAX);
-        *warned_clamp = 1;
-    }
+    *clamped_out = (unsigned char)clamped;
     return 0;
 }
 
@@ -712,7 +709,7 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     walk_state ws;
     struct aiMatrix4x4 id;
     uint32_t i, k, tris = 0;
-    int warned = 0;
+    unsigned char *clamped = NULL;
     float bmin[3] = {1e30f, 1e30f, 1e30f}, bmax[3] = {-1e30f, -1e30f, -1e30f};
     memset(out, 0, sizeof *out);
     if (!path_or_name || !*path_or_name) {
@@ -756,6 +753,8 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
     st->material_names = (char **)xrealloc(NULL, sizeof(char *) * st->material_count);
+    clamped = (unsigned char *)xrealloc(NULL, st->material_count);
+    memset(clamped, 0, st->material_count);
     for (i = 0; i < st->material_count; ++i) {
         struct aiString mname;
         if (i >= sc->mNumMaterials || aiGetMaterialString(sc->mMaterials[i], AI_MATKEY_NAME, &mname) != aiReturn_SUCCESS)
@@ -765,7 +764,8 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     out->material_names = (const char *const *)st->material_names;
     for (i = 0; i < st->material_count; ++i) {
         if (i < sc->mNumMaterials) {
-            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &warned, err, errlen)) {
+            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &clamped[i], err, errlen)) {
+                free(clamped);
                 aiReleaseImport(sc);
                 rad_tool_free_scene(out);
                 return 1;
@@ -781,6 +781,28 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     ws.out = out;
     walk(&ws, sc->mRootNode, &id);
     aiReleaseImport(sc);
+    /* One warning for the first clamped material, except assimp's default material when no
+       triangle uses it: assimp adds one to every glTF (base colour 1, always clamped) and a
+       "DefaultMaterial" to every OBJ, and warned about it where the file's own materials
+       were fine. */
+    {
+        unsigned char *used = (unsigned char *)xrealloc(NULL, st->material_count);
+        uint32_t g, t;
+        memset(used, 0, st->material_count);
+        for (g = 0; g < st->group_count; ++g)
+            for (t = 0; t < st->groups[g].triangle_count; ++t)
+                if (st->groups[g].material_ids[t] < st->material_count) used[st->groups[g].material_ids[t]] = 1;
+        for (i = 0; i < st->material_count; ++i) {
+            const char *mn = st->material_names[i];
+            if (!clamped[i] || (!used[i] && (!mn[0] || !strcmp(mn, AI_DEFAULT_MATERIAL_NAME)))) continue;
+            fprintf(stderr, "rad: warning: material %u '%s'%s: albedo clamped into [0, %g] (radiosity needs albedo < 1)\n", i,
+                    mn, !mn[0] || !strcmp(mn, AI_DEFAULT_MATERIAL_NAME) ? " (assimp's default material)" : "",
+                    (double)ALBEDO_MAX);
+            break;
+        }
+        free(used);
+        free(clamped);
+    }
     if (ws.bad_indices) {
         char n[32];
         snprintf(n, sizeof n, "%u", ws.bad_indices);
