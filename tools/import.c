@@ -33,6 +33,7 @@
 #include <assimp/scene.h>
 #include <assimp/postprocess.h>
 #include <assimp/material.h>
+#include <assimp/version.h>
 #define STB_IMAGE_STATIC /* private copy: image.c has its own */
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
@@ -384,6 +385,66 @@ static const struct aiScene *import_logged(const char *path, unsigned flags)
     return sc;
 }
 
+/* ---- glTF extensions the file requires ------------------------------------------------------- */
+
+/* A glTF file lists in "extensionsRequired" the extensions a reader must implement to load it
+   (EXT_meshopt_compression, KHR_draco_mesh_compression: compressed geometry). When assimp
+   fails on such a file its message names a symptom ("buffer ... missing the uri"), so the
+   list is read here from the JSON (the .gltf text, or a .glb's first chunk) and named in the
+   error. Writes "A, B" into out and returns how many; 0 when the file is not glTF or lists
+   none. */
+#define GLTF_JSON_MAX (64u << 20)
+static unsigned gltf_required_extensions(const char *path, char *out, size_t cap)
+{
+    FILE *f;
+    char *json = NULL, *p;
+    unsigned char head[20];
+    size_t n = 0, len = strlen(path), used = 0;
+    unsigned count = 0;
+    int glb;
+    if (cap) out[0] = '\0';
+    if (!((len > 5 && (!strcmp(path + len - 5, ".gltf") || !strcmp(path + len - 5, ".GLTF"))) ||
+          (len > 4 && (!strcmp(path + len - 4, ".glb") || !strcmp(path + len - 4, ".GLB")))))
+        return 0;
+    if (!(f = fopen(path, "rb"))) return 0;
+    glb = fread(head, 1, 20, f) == 20 && !memcmp(head, "glTF", 4);
+    if (glb) {
+        /* 12-byte header, then the first chunk: its length, its type "JSON", its bytes */
+        uint32_t clen = (uint32_t)head[12] | (uint32_t)head[13] << 8 | (uint32_t)head[14] << 16 | (uint32_t)head[15] << 24;
+        if (memcmp(head + 16, "JSON", 4) || clen > GLTF_JSON_MAX) { fclose(f); return 0; }
+        json = (char *)xrealloc(NULL, (size_t)clen + 1);
+        n = fread(json, 1, clen, f);
+    } else {
+        rewind(f);
+        json = (char *)xrealloc(NULL, (size_t)GLTF_JSON_MAX + 1);
+        n = fread(json, 1, GLTF_JSON_MAX, f);
+    }
+    fclose(f);
+    json[n] = '\0';
+    /* "extensionsRequired" : [ "A" , "B" ] */
+    for (p = strstr(json, "\"extensionsRequired\""); p && !count; p = strstr(p + 1, "\"extensionsRequired\"")) {
+        char *q = p + 20;
+        while (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n') ++q;
+        if (*q++ != ':') continue;
+        while (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n') ++q;
+        if (*q++ != '[') continue;
+        for (;;) {
+            char *e;
+            while (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n' || *q == ',') ++q;
+            if (*q != '"') break;
+            e = strchr(q + 1, '"');
+            if (!e) break;
+            if (used + (size_t)(e - q) + 3 < cap) {
+                used += (size_t)snprintf(out + used, cap - used, "%s%.*s", count ? ", " : "", (int)(e - q - 1), q + 1);
+                ++count;
+            }
+            q = e + 1;
+        }
+    }
+    free(json);
+    return count;
+}
+
 /* ---- vertex welding ------------------------------------------------------------------------ */
 
 /* assimp's aiProcess_JoinIdenticalVertices joins vertices closer than an absolute 1e-5: a
@@ -729,7 +790,15 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     }
     sc = import_logged(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
     if (!sc) {
-        set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
+        char exts[512];
+        unsigned ne = gltf_required_extensions(path_or_name, exts, sizeof exts);
+        if (ne && err && errlen)
+            snprintf(err, errlen,
+                     "cannot import '%s': %s; the file requires the glTF extension%s %s (its extensionsRequired), "
+                     "which this importer (assimp %u.%u.%u) could not read",
+                     path_or_name, aiGetErrorString(), ne > 1 ? "s" : "", exts, aiGetVersionMajor(), aiGetVersionMinor(),
+                     aiGetVersionPatch());
+        else set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
         return 1;
     }
     if (g_log.fatal[0]) {
