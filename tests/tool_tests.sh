@@ -41,7 +41,7 @@ rc=$?
 rc=$?
 [ $rc -eq 1 ] && [ -s "$TMP/err.txt" ] && ok "missing scene file exits 1 with a message" || fail "missing scene file exits 1 with a message" "exit $rc"
 
-# ---- form factors on generated scenes (REFERENCE.md §1) --------------------------------
+# ---- form factors on generated scenes (closed forms: Howell's catalogue, docs/references.md)
 # two parallel opposed unit squares at gap 1, facing each other (C-11)
 cat > "$TMP/parallel.obj" <<'EOF'
 o a
@@ -347,7 +347,7 @@ fi
 [ $rc = 2 ] && ok "render --shading rejects an unknown model" || fail "render --shading rejects an unknown model" "exit $rc"
 "$RAD" render cornell -o "$TMP/x.png" --method pathtrace --shading phong > /dev/null 2>&1; rc=$?
 [ $rc = 2 ] && ok "render --shading is refused with pathtrace" || fail "render --shading is refused with pathtrace" "exit $rc"
-# ---- multibounce and temporal (SPEC §4, §8) ------------------------------------------------
+# ---- multibounce and temporal ------------------------------------------------------------
 # Small runs (~330 patches, 32x32 images) against the classic method with the same patches.
 # `--bounces K` means the same in all methods (the patch solution L_K; the image gathers once
 # more), so multibounce with float storage must reproduce classic to float rounding, compressed
@@ -474,7 +474,7 @@ if "$RAD" render cornell $M -o "$TMP/ref.pfm" > /dev/null 2> "$TMP/err.txt" &&
 else
     fail "classic references for multibounce and temporal" "$(head -c 300 "$TMP/err.txt")"
 fi
-# ---- local matrix (SPEC §5) and virtual patches (SPEC §6, §7) --------------------------------
+# ---- local matrix and virtual patches -----------------------------------------------------
 # local with M = every patch holds T = (I - rho F)^-1 - I of the whole scene: the full solution
 # on the patches the camera sees (measured 52 dB against classic 64 bounces at 32x32; the
 # patches outside P_Vis get no H and darken the shared vertices a little), a small M leaves

@@ -1,7 +1,8 @@
-/* methods.c - the multi-bounce (SPEC §4) and temporal (SPEC §8) methods of `rad bake` and
-   `rad render`: their options, their bakes and the per-patch indirect light they give.
+/* methods.c - the multi-bounce and temporal methods of `rad bake` and `rad render` (from
+   Shcherbakov 2025, ch. 3 and 6, and Shcherbakov et al. 2023, listed in docs/references.md):
+   their options, their bakes and the per-patch indirect light they give.
 
-   Both follow the classic method's way (b) of SPEC §0: the source is E = rho D (the patches'
+   Both take the direct light as the source, as the classic method does: E = rho D (the patches'
    direct light) and the renderer adds per pixel rho/pi (D + H), H being the irradiance from
    the secondary sources. The classic method computes H = F (E + L_K) with F; these bakes hold
    no F, so H comes from the indirect radiosity itself: L_{K+1} = rho o F (E + L_K), hence
@@ -97,14 +98,14 @@ const char *rad_tool_method_help(int render)
                     "                     1 - W^N of the solution after N frames: W 0.998 needs ~2300 for 99%)\n"
                     "  --seed S           generator seed (default 0; also the path tracer's seed)\n"
                     "  --sequence DIR     also write DIR/frame_NNNNN.png every --every N frames (default 1)\n"
-                    "vp (clustered virtual patches, SPEC §6) and aavp (axis-aligned, SPEC §7); any mesh size, no\n"
+                    "vp (clustered virtual patches) and aavp (axis-aligned virtual patches); any mesh size, no\n"
                     "per-triangle patches (--patches etc. are ignored); --bounces K|inf as classic (Jacobi; inf:\n"
                     "Gauss-Seidel to 1e-6); indirect light gathered per pixel from the voxel grid:\n"
                     "  --vp-resolution R  voxels along the longest axis of the scene (default 16)\n"
                     "  --vp-max-patches B the finest resolution whose patch count is at most B (replaces\n"
                     "                     --vp-resolution; found by building at predicted resolutions, <= 6 builds)\n"
                     "  --face-points P    Hammersley points per voxel face (default 16)\n"
-                    "local (local multi-bounce matrix, SPEC §5; classic patches and F, T = (I - rho F_S)^-1 - I\n"
+                    "local (local multi-bounce matrix; classic patches and F, T = (I - rho F_S)^-1 - I\n"
                     "of the set S, the full solution within S; render only):\n"
                     "  --local-m M        capacity: S = the M patches nearest the camera (default: every patch,\n"
                     "                     up to 4096: T takes 12 M^2 bytes, 192 MiB at 4096, and its rebuild\n"

@@ -72,7 +72,7 @@ const char *rad_tool_output_error(void);
    missing or not writable. 0 when fine, else prints "rad CMD: ..." and returns 1. */
 int rad_tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count);
 
-/* ---- metrics (metrics.c): REFERENCE.md §6 on values clamped to [0,1] ----------------- */
+/* ---- metrics (metrics.c): MSE, PSNR, SSIM on values clamped to [0,1] ------------------- */
 double rad_image_mse(const rad_image *a, const rad_image *b);
 double rad_image_psnr(const rad_image *a, const rad_image *b);  /* L = 1; +inf for equal images */
 double rad_image_ssim(const rad_image *a, const rad_image *b);  /* per channel, averaged */
