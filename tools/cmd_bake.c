@@ -4,7 +4,7 @@
             [--bounces K] [--patches N] [--max-edge L] [--samples S] [--light-samples N]
             [method options, see methods.c] [--threads N]
 
-   Way (b) of SPEC §0: the direct irradiance D of every patch (emissive triangles and the
+   Direct light as the source: the direct irradiance D of every patch (emissive triangles and the
    file's analytic lights, with shadow rays) gives the source E = rho D; the emitters' own
    emission stays out of the system. The solver gives the indirect light L, B = E + L, and
    H = F B = F (E + L) is the irradiance from the secondary sources that the renderer adds to
@@ -146,7 +146,7 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
         rad_tool_classic_free(out);
         return rad_tool_fail(cmd, "rad_direct_patches", r);
     }
-    /* E = rho D: direct light is the source, emission stays out of the system (SPEC §0 (b)) */
+    /* E = rho D: direct light is the source, emission stays out of the system (the renderer adds D per pixel) */
     if ((r = rad_sources(out->patches, RAD_SOURCE_DIRECT, out->D, out->E)) != RAD_SUCCESS) {
         rad_tool_classic_free(out);
         return rad_tool_fail(cmd, "rad_sources", r);
@@ -291,9 +291,9 @@ static void bake_usage(FILE *f)
     fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal] [options]\n"
                "Computes patches, form factors and the patches' direct light E = rho D, then by method:\n"
                "  classic      the indirect solution L; saves patches, F, E, B = E + L (and L, H = F B, D)\n"
-               "  multibounce  F_mb = sum_k (rho o F)^k (SPEC 4), stored as float, half or compressed\n"
+               "  multibounce  F_mb = sum_k (rho o F)^k, stored as float, half or compressed\n"
                "               (BC1, 3xBC4); saves patches, E, D, F's row sums and F_mb (no F)\n"
-               "  temporal     alias tables over the rows of F (or of F_mb's channels) (SPEC 8); saves\n"
+               "  temporal     alias tables over the rows of F (or of F_mb's channels); saves\n"
                "               patches, E, D, F's row sums and the tables (no F)\n"
                "  -o FILE            output file (required)\n"
                "  --method M         classic (default), multibounce or temporal\n"

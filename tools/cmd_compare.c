@@ -1,10 +1,14 @@
 /* cmd_compare.c - rad compare: MSE, PSNR and SSIM between two images.
 
-   rad compare A B [--diff OUT.png|OUT.pfm] [--diff-scale X] [--png OUT.png [--exposure X]]
+   rad compare A B [--exposure E] [--diff OUT.png|OUT.pfm] [--diff-scale X] [--png OUT.png]
+                   [--png-exposure X]
 
-   A and B are PFM (linear) or PNG (8-bit sRGB, decoded to linear). The metrics are those of
-   REFERENCE.md §6 on LINEAR values clamped to [0,1] (peak L = 1); SSIM per R, G, B channel,
-   averaged. Exit status: 0 compared, 1 unreadable images, different sizes or an image with
+   A and B are PFM (linear) or PNG (8-bit sRGB, decoded to linear). The metrics (MSE, PSNR with
+   peak L = 1, SSIM per R, G, B channel, averaged: metrics.c) are computed on LINEAR values
+   times --exposure E (default 1), clamped to [0,1]: a scene whose radiance reaches 3.5 clamps
+   to white wherever it is bright and scored 14 dB for every method; --exposure 0.25 brings it
+   into range. E scales the --diff heat map and the --png picture too (--png-exposure X sets
+   the picture's alone). Exit status: 0 compared, 1 unreadable images, different sizes or an image with
    NaN or infinite values (the metrics clamp them away, so they are counted and reported:
    an all-NaN render compared as equal to a black one), 2 usage. */
 #include "tool.h"
@@ -43,14 +47,17 @@ static int report_nonfinite(const char *name, const char *path, const rad_image 
 
 static void compare_usage(FILE *f)
 {
-    fprintf(f, "usage: rad compare A B [--diff OUT.png] [--diff-scale X] [--png OUT.png [--exposure X]]\n"
+    fprintf(f, "usage: rad compare A B [--exposure E] [--diff OUT.png] [--diff-scale X] [--png OUT.png [--png-exposure X]]\n"
                "  A, B          .pfm (linear float) or .png (8-bit sRGB, decoded to linear)\n"
+               "  --exposure E  multiply both images by E before the metrics clamp them to [0,1]\n"
+               "                (default 1; for radiance above 1, e.g. E = 1 / the brightest value)\n"
                "  --diff FILE   heat map of the per-pixel mean absolute difference (black: none)\n"
                "  --diff-scale X  the difference shown at the top of the colour scale (default: the largest)\n"
-               "  --png FILE    also write A as an 8-bit sRGB PNG (exposure --exposure X, default 1): one\n"
-               "                render gives both the .pfm the metrics need and a picture (tools/report.sh)\n"
+               "  --png FILE    also write A as an 8-bit sRGB PNG (times E): one render gives both the\n"
+               "                .pfm the metrics need and a picture (tools/report.sh)\n"
+               "  --png-exposure X  the PNG's exposure alone (default E), the metrics keep E\n"
                "  prints MSE, PSNR (peak 1) and SSIM (11x11 Gaussian window, sigma 1.5, per channel,\n"
-               "  averaged), all on linear values clamped to [0,1]\n"
+               "  averaged), all on linear values times E, clamped to [0,1]\n"
                "  exit 1 when an image holds NaN or infinite values (counted on stderr and in a\n"
                "  'nonfinite' line), or the images cannot be read or differ in size\n");
 }
@@ -58,7 +65,7 @@ static void compare_usage(FILE *f)
 int rad_cmd_compare(int argc, char **argv)
 {
     const char *pa = NULL, *pb = NULL, *diff = NULL, *png = NULL;
-    float scale = 0.0f, exposure = 1.0f;
+    float scale = 0.0f, exposure = 1.0f, png_exposure = 0.0f; /* 0: the same as exposure */
     rad_image a = { 0, 0, NULL }, b = { 0, 0, NULL };
     char err[512];
     double mse, psnr, ssim;
@@ -68,7 +75,7 @@ int rad_cmd_compare(int argc, char **argv)
         if (!strcmp(s, "-h") || !strcmp(s, "--help")) {
             compare_usage(stdout);
             return 0;
-        } else if (!strcmp(s, "--png") || !strcmp(s, "--exposure")) {
+        } else if (!strcmp(s, "--png") || !strcmp(s, "--exposure") || !strcmp(s, "--png-exposure")) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "rad compare: %s needs a value\n", s);
                 return 2;
@@ -83,11 +90,13 @@ int rad_cmd_compare(int argc, char **argv)
                 }
             } else {
                 char *end;
-                exposure = strtof(argv[++i], &end);
-                if (*end || !(exposure > 0.0f) || !(exposure < 1e30f)) {
-                    fprintf(stderr, "rad compare: --exposure wants a positive number, got '%s'\n", argv[i]);
+                float v = strtof(argv[++i], &end);
+                if (*end || !(v > 0.0f) || !(v < 1e30f)) {
+                    fprintf(stderr, "rad compare: %s wants a positive number, got '%s'\n", s, argv[i]);
                     return 2;
                 }
+                if (!strcmp(s, "--exposure")) exposure = v;
+                else png_exposure = v;
             }
         } else if (!strcmp(s, "--diff") || !strcmp(s, "--diff-scale")) {
             if (i + 1 >= argc) {
@@ -147,11 +156,18 @@ int rad_cmd_compare(int argc, char **argv)
     }
     bad = report_nonfinite("A", pa, &a);
     bad |= report_nonfinite("B", pb, &b);
+    if (exposure != 1.0f) {
+        size_t k, n = (size_t)a.width * (size_t)a.height * 3u;
+        for (k = 0; k < n; ++k) a.rgb[k] *= exposure, b.rgb[k] *= exposure;
+    }
     mse = rad_image_mse(&a, &b);
     psnr = rad_image_psnr(&a, &b);
     ssim = rad_image_ssim(&a, &b);
     printf("A: %s\nB: %s\nsize: %dx%d\n", pa, pb, a.width, a.height);
-    printf("values: linear, clamped to [0,1] (PNG decoded from sRGB); peak L = 1\n");
+    if (exposure != 1.0f)
+        printf("values: linear times --exposure %g, clamped to [0,1] (PNG decoded from sRGB); peak L = 1\n", (double)exposure);
+    else
+        printf("values: linear, clamped to [0,1] (PNG decoded from sRGB); peak L = 1\n");
     printf("MSE:  %.9g\n", mse);
     if (isinf(psnr)) printf("PSNR: inf dB (identical after clamping)\n");
     else printf("PSNR: %.4f dB\n", psnr);
@@ -192,13 +208,14 @@ int rad_cmd_compare(int argc, char **argv)
         rad_image_free(&heat);
     }
     if (png) {
-        if (rad_image_write_png(png, &a, exposure) != 0) {
+        /* a holds A times exposure already */
+        if (rad_image_write_png(png, &a, png_exposure > 0.0f ? png_exposure / exposure : 1.0f) != 0) {
             fprintf(stderr, "rad compare: %s\n", rad_tool_output_error());
             rad_image_free(&a);
             rad_image_free(&b);
             return 1;
         }
-        printf("png: %s (A, exposure %g)\n", png, (double)exposure);
+        printf("png: %s (A, exposure %g)\n", png, (double)(png_exposure > 0.0f ? png_exposure : exposure));
     }
     rad_image_free(&a);
     rad_image_free(&b);

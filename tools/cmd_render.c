@@ -1,7 +1,7 @@
 /* cmd_render.c - `rad render`: an image of a scene by the classic radiosity method (per-pixel
    direct light + indirect light from the patches) or by path tracing.
 
-   Classic (SPEC §0 way (b), as examples/cornell.c): a camera ray per sample finds the surface;
+   Classic (direct light as the source, as examples/cornell.c): a camera ray per sample finds the surface;
    the direct irradiance D is computed at that point with shadow rays (rad_direct_irradiance:
    the emissive triangles analytically times the unoccluded fraction, plus the file's analytic
    lights); H = F (E + L) = F B, the irradiance from the secondary sources, is smoothed to the
@@ -14,11 +14,12 @@
    patches' H from methods.c (L = F_mb E, or the temporal frames, H = L / rho) and the halo
    correction from the bake's row sums of F.
 
-   Local (render_local_method, SPEC §5): the classic patches, F and E; a rad_local of capacity
-   --local-m M filled with the M patches nearest the camera (rad_local_nearest, one
+   Local (render_local_method; Shcherbakov 2025, ch. 4, in docs/references.md): the classic patches, F and E; a rad_local of capacity
+   --local-m M (default: every patch, up to RAD_TOOL_LOCAL_M_AUTO_MAX) filled with the M patches
+   nearest the camera (rad_local_nearest, one
    rad_local_rebuild), L = T E over P_Vis x P_Lit (rad_local_visible, rad_local_lit), H = L / rho
    and the classic render; patches outside the set or not visible get no indirect light.
-   Virtual patches (render_vp_method, SPEC §6-§7): rad_vp_create (vp: RAD_VP_CLUSTERED, aavp:
+   Virtual patches (render_vp_method; Shcherbakov 2025, ch. 5): rad_vp_create (vp: RAD_VP_CLUSTERED, aavp:
    RAD_VP_AXIS_ALIGNED) at --vp-resolution or at the finest resolution within --vp-max-patches,
    E = rad_vp_sources, Jacobi --bounces K (inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point (rad_vp_gather per batch).
@@ -567,7 +568,7 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
     return vp;
 }
 
-/* --method vp|aavp (SPEC §6-§7): virtual patches, E at their samples, the classic solve on
+/* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
 static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
@@ -685,7 +686,7 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     return rc;
 }
 
-/* --method local (SPEC §5): the classic patches, F and E; a local matrix of capacity M over F's
+/* --method local: the classic patches, F and E; a local matrix of capacity M over F's
    rows filled with the M patches nearest the camera (rad_local_rebuild), L = T E over P_Vis x
    P_Lit, H = L / rho (L = rho F (E + L) within the set), rendered as classic. */
 static int render_local_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *oc,
@@ -707,9 +708,17 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
     o.sources_only = 1;
     if (rad_tool_classic_solve(cmd, w, &o, &sol)) return 1;
     n = sol.patches->count;
-    m = mo->local_m < n ? mo->local_m : n;
-    if (mo->local_m > n && (mo->given & RAD_TOOL_OPT_LOCAL_M))
-        fprintf(stderr, "rad %s: --local-m %u is more than the %u patches: using %u\n", cmd, mo->local_m, n, n);
+    if (mo->local_m == 0) { /* the default: the whole scene when it is small enough */
+        m = n < RAD_TOOL_LOCAL_M_AUTO_MAX ? n : RAD_TOOL_LOCAL_M_AUTO_MAX;
+        if (m < n)
+            fprintf(stderr, "rad %s: warning: the default --local-m covers %u of the %u patches (the nearest to the "
+                            "camera; the others get no indirect light): give --local-m %u for all of them\n",
+                    cmd, m, n, n);
+    } else {
+        m = mo->local_m < n ? mo->local_m : n;
+        if (mo->local_m > n)
+            fprintf(stderr, "rad %s: --local-m %u is more than the %u patches: using %u\n", cmd, mo->local_m, n, n);
+    }
     areas = (float *)xmalloc(sizeof(float) * n);
     albedo = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
@@ -889,8 +898,10 @@ int rad_cmd_render(int argc, char **argv)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                     cmd, o.patches, w.scene->triangle_count);
     }
-    if (!have_cam) cam = w.file.camera;
-    else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
+    if (!have_cam) {
+        if (w.file.has_camera) cam = w.file.camera;
+        else rad_tool_choose_camera(cmd, w.scene, &w.rc, width, height, &cam);
+    } else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
     if (fov > 0.0f) cam.fov_y_degrees = fov;
     if (rad_image_alloc(&img, width, height) != 0) {
         fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);

@@ -191,6 +191,10 @@ int rad_cmd_trace(int argc, char **argv)
         goto done;
     }
     rad_bvh_raycaster(bvh, &rc);
+    if (!camera_text && !ts.has_camera) {
+        rad_tool_choose_camera("trace", scene, &rc, opt.width, opt.height, &cam);
+        if (fov > 0.0f) cam.fov_y_degrees = fov;
+    }
     {
         uint32_t t, emitters = 0;
         for (t = 0; t < scene->triangle_count; ++t) {

@@ -33,6 +33,7 @@
 #include <assimp/scene.h>
 #include <assimp/postprocess.h>
 #include <assimp/material.h>
+#include <assimp/version.h>
 #define STB_IMAGE_STATIC /* private copy: image.c has its own */
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
@@ -67,6 +68,7 @@ typedef struct imp_storage {
     imp_group *groups;
     uint32_t group_count, group_cap;
     rad_material *materials;
+    char **material_names;
     uint32_t material_count;
     imp_texture *textures;
     uint32_t texture_count;
@@ -144,6 +146,8 @@ static void free_storage(imp_storage *st)
         free(st->groups[i].material_ids);
     }
     for (i = 0; i < st->texture_count; ++i) free(st->textures[i].rgb);
+    for (i = 0; st->material_names && i < st->material_count; ++i) free(st->material_names[i]);
+    free(st->material_names);
     free(st->groups);
     free(st->meshes);
     free(st->materials);
@@ -245,9 +249,10 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
 #define EMISSION_MAX 1e30f
 
 /* 0, or 1 with the reason in err (a negative, NaN, infinite or overflowing emission: it used
-   to become 0 without a word) */
+   to become 0 without a word). *clamped: set to 1 when the albedo was clamped into
+   [0, ALBEDO_MAX] (the warning waits until it is known which materials are used). */
 static int convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
-                            uint32_t index, rad_material *out, int *warned_clamp, char *err, size_t errlen)
+                            uint32_t index, rad_material *out, unsigned char *clamped_out, char *err, size_t errlen)
 {
     struct aiColor4D c;
     struct aiString name, tpath;
@@ -326,11 +331,7 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
         if (!(out->albedo[k] >= 0.0f)) out->albedo[k] = 0.0f, clamped = 1;
         if (out->albedo[k] > ALBEDO_MAX) out->albedo[k] = ALBEDO_MAX, clamped = 1;
     }
-    if (clamped && !*warned_clamp) {
-        fprintf(stderr, "rad: warning: material '%s': albedo clamped into [0, %g] (radiosity needs albedo < 1)\n",
-                name.data, (double)ALBEDO_MAX);
-        *warned_clamp = 1;
-    }
+    *clamped_out = (unsigned char)clamped;
     return 0;
 }
 
@@ -382,6 +383,66 @@ static const struct aiScene *import_logged(const char *path, unsigned flags)
     aiDetachAllLogStreams();
     if (g_log.more) fprintf(stderr, "rad: warning: assimp: %u more warnings\n", g_log.more);
     return sc;
+}
+
+/* ---- glTF extensions the file requires ------------------------------------------------------- */
+
+/* A glTF file lists in "extensionsRequired" the extensions a reader must implement to load it
+   (EXT_meshopt_compression, KHR_draco_mesh_compression: compressed geometry). When assimp
+   fails on such a file its message names a symptom ("buffer ... missing the uri"), so the
+   list is read here from the JSON (the .gltf text, or a .glb's first chunk) and named in the
+   error. Writes "A, B" into out and returns how many; 0 when the file is not glTF or lists
+   none. */
+#define GLTF_JSON_MAX (64u << 20)
+static unsigned gltf_required_extensions(const char *path, char *out, size_t cap)
+{
+    FILE *f;
+    char *json = NULL, *p;
+    unsigned char head[20];
+    size_t n = 0, len = strlen(path), used = 0;
+    unsigned count = 0;
+    int glb;
+    if (cap) out[0] = '\0';
+    if (!((len > 5 && (!strcmp(path + len - 5, ".gltf") || !strcmp(path + len - 5, ".GLTF"))) ||
+          (len > 4 && (!strcmp(path + len - 4, ".glb") || !strcmp(path + len - 4, ".GLB")))))
+        return 0;
+    if (!(f = fopen(path, "rb"))) return 0;
+    glb = fread(head, 1, 20, f) == 20 && !memcmp(head, "glTF", 4);
+    if (glb) {
+        /* 12-byte header, then the first chunk: its length, its type "JSON", its bytes */
+        uint32_t clen = (uint32_t)head[12] | (uint32_t)head[13] << 8 | (uint32_t)head[14] << 16 | (uint32_t)head[15] << 24;
+        if (memcmp(head + 16, "JSON", 4) || clen > GLTF_JSON_MAX) { fclose(f); return 0; }
+        json = (char *)xrealloc(NULL, (size_t)clen + 1);
+        n = fread(json, 1, clen, f);
+    } else {
+        rewind(f);
+        json = (char *)xrealloc(NULL, (size_t)GLTF_JSON_MAX + 1);
+        n = fread(json, 1, GLTF_JSON_MAX, f);
+    }
+    fclose(f);
+    json[n] = '\0';
+    /* "extensionsRequired" : [ "A" , "B" ] */
+    for (p = strstr(json, "\"extensionsRequired\""); p && !count; p = strstr(p + 1, "\"extensionsRequired\"")) {
+        char *q = p + 20;
+        while (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n') ++q;
+        if (*q++ != ':') continue;
+        while (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n') ++q;
+        if (*q++ != '[') continue;
+        for (;;) {
+            char *e;
+            while (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n' || *q == ',') ++q;
+            if (*q != '"') break;
+            e = strchr(q + 1, '"');
+            if (!e) break;
+            if (used + (size_t)(e - q) + 3 < cap) {
+                used += (size_t)snprintf(out + used, cap - used, "%s%.*s", count ? ", " : "", (int)(e - q - 1), q + 1);
+                ++count;
+            }
+            q = e + 1;
+        }
+    }
+    free(json);
+    return count;
 }
 
 /* ---- vertex welding ------------------------------------------------------------------------ */
@@ -709,7 +770,7 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     walk_state ws;
     struct aiMatrix4x4 id;
     uint32_t i, k, tris = 0;
-    int warned = 0;
+    unsigned char *clamped = NULL;
     float bmin[3] = {1e30f, 1e30f, 1e30f}, bmax[3] = {-1e30f, -1e30f, -1e30f};
     memset(out, 0, sizeof *out);
     if (!path_or_name || !*path_or_name) {
@@ -719,15 +780,25 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     if (!strcmp(path_or_name, "cornell")) {
         st = (imp_storage *)calloc(1, sizeof *st);
         if (!st) return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
+        static const char *const cornell_names[4] = {"white", "red", "green", "light"};
         st->builtin = 1;
         rad_cornell_box(&out->desc, &out->camera);
+        if (out->desc.material_count == 4) out->material_names = cornell_names;
         out->has_camera = 1;
         out->storage = st;
         return 0;
     }
     sc = import_logged(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
     if (!sc) {
-        set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
+        char exts[512];
+        unsigned ne = gltf_required_extensions(path_or_name, exts, sizeof exts);
+        if (ne && err && errlen)
+            snprintf(err, errlen,
+                     "cannot import '%s': %s; the file requires the glTF extension%s %s (its extensionsRequired), "
+                     "which this importer (assimp %u.%u.%u) could not read",
+                     path_or_name, aiGetErrorString(), ne > 1 ? "s" : "", exts, aiGetVersionMajor(), aiGetVersionMinor(),
+                     aiGetVersionPatch());
+        else set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
         return 1;
     }
     if (g_log.fatal[0]) {
@@ -750,9 +821,20 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     st->material_count = sc->mNumMaterials ? sc->mNumMaterials : 1;
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
+    st->material_names = (char **)xrealloc(NULL, sizeof(char *) * st->material_count);
+    clamped = (unsigned char *)xrealloc(NULL, st->material_count);
+    memset(clamped, 0, st->material_count);
+    for (i = 0; i < st->material_count; ++i) {
+        struct aiString mname;
+        if (i >= sc->mNumMaterials || aiGetMaterialString(sc->mMaterials[i], AI_MATKEY_NAME, &mname) != aiReturn_SUCCESS)
+            mname.length = 0, mname.data[0] = 0;
+        st->material_names[i] = xstrdup(mname.data);
+    }
+    out->material_names = (const char *const *)st->material_names;
     for (i = 0; i < st->material_count; ++i) {
         if (i < sc->mNumMaterials) {
-            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &warned, err, errlen)) {
+            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &clamped[i], err, errlen)) {
+                free(clamped);
                 aiReleaseImport(sc);
                 rad_tool_free_scene(out);
                 return 1;
@@ -768,6 +850,28 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     ws.out = out;
     walk(&ws, sc->mRootNode, &id);
     aiReleaseImport(sc);
+    /* One warning for the first clamped material, except assimp's default material when no
+       triangle uses it: assimp adds one to every glTF (base colour 1, always clamped) and a
+       "DefaultMaterial" to every OBJ, and warned about it where the file's own materials
+       were fine. */
+    {
+        unsigned char *used = (unsigned char *)xrealloc(NULL, st->material_count);
+        uint32_t g, t;
+        memset(used, 0, st->material_count);
+        for (g = 0; g < st->group_count; ++g)
+            for (t = 0; t < st->groups[g].triangle_count; ++t)
+                if (st->groups[g].material_ids[t] < st->material_count) used[st->groups[g].material_ids[t]] = 1;
+        for (i = 0; i < st->material_count; ++i) {
+            const char *mn = st->material_names[i];
+            if (!clamped[i] || (!used[i] && (!mn[0] || !strcmp(mn, AI_DEFAULT_MATERIAL_NAME)))) continue;
+            fprintf(stderr, "rad: warning: material %u '%s'%s: albedo clamped into [0, %g] (radiosity needs albedo < 1)\n", i,
+                    mn, !mn[0] || !strcmp(mn, AI_DEFAULT_MATERIAL_NAME) ? " (assimp's default material)" : "",
+                    (double)ALBEDO_MAX);
+            break;
+        }
+        free(used);
+        free(clamped);
+    }
     if (ws.bad_indices) {
         char n[32];
         snprintf(n, sizeof n, "%u", ws.bad_indices);

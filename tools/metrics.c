@@ -1,4 +1,4 @@
-/* metrics.c - image metrics of REFERENCE.md §6, on LINEAR values clamped to [0,1] (L = 1).
+/* metrics.c - image metrics (MSE, PSNR, SSIM) on LINEAR values clamped to [0,1] (L = 1).
 
    MSE   mean of (a - b)^2 over every pixel and channel.
    PSNR  10 log10(1 / MSE); +inf for equal images.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # tools/report.sh - the evaluation report (issue #12): every radiosity method of the `rad` tool
 # against the path-traced reference (`rad trace`), with MSE / PSNR / SSIM, per-frame times and
-# the thesis's published figures (SPEC §12) side by side, difference heat maps, and plots
+# the published figures of Shcherbakov 2025 (docs/references.md; "T" below) side by side, difference heat maps, and plots
 # (per-frame time against N, temporal error against frame, compression error with and without
 # reordering). Writes OUT/REPORT.md, OUT/img/*.png, OUT/plots/*.svg, OUT/data/* (raw logs).
 #
@@ -10,8 +10,9 @@
 #
 # `make report` runs the full quality into report/ (committed); `make report-quick` a reduced
 # one into build/report-quick/ and then --check (tests/run.sh counts it as a test).
-# Scenes: the built-in Cornell box, and the Stanford bunny in the box (RAD_DATA_DIR, default
-# ../shared/data; the section says so and is skipped when the file is absent).
+# Scenes: the built-in Cornell box, and the Stanford bunny in the box (the box from `rad export
+# cornell`, the bunny from RAD_DATA_DIR/stanford-bunny.obj: no default; the section says so and is
+# skipped when the file is absent).
 #
 # Adding a method: one line in METHODS below (id|label|needs dense F|rad render arguments|
 # published figure). A row whose --method the built `rad render --help` does not list is kept
@@ -24,7 +25,7 @@ OUT=
 RAD=build/rad
 TBENCH=build/temporal
 CHECK_ONLY=
-DATA=${RAD_DATA_DIR:-../shared/data}
+DATA=${RAD_DATA_DIR:-} # optional: the folder holding stanford-bunny.obj
 while [ $# -gt 0 ]; do
     case "$1" in
     --quick) MODE=quick ;;
@@ -87,22 +88,22 @@ DIFF_SCALE=0.1   # the heat maps share one scale: white = mean |ours - reference
 CORNELL_CAM="0.278,0.273,-0.8:0.278,0.273,0:0,1,0"
 CORNELL_FOV=39.3077
 
-#    id|label|dense|rad render arguments|published (thesis) figure
+#    id|label|dense|rad render arguments|published figure (T: Shcherbakov 2025)
 METHODS='
 classic|classic Jacobi, 64 bounces|1|--method classic --bounces 64|T table 2 (radiosity): MSE 0.06658, PSNR 23.53, SSIM 0.8354
-classic3|classic Jacobi, 3 bounces|1|--method classic --bounces 3|T-3: SSIM 0.743 (classic, 3 bounces)
-mbfloat|multi-bounce F_mb, float, 64 bounces|1|--method multibounce --format float|T-3: one product per frame for any bounce count
-mbfloat3|multi-bounce F_mb, float, 3 bounces|1|--method multibounce --format float --bounces 3|T-3: 3x faster than 3 classic bounces; SSIM 0.762
-mbbc1|multi-bounce F_mb, BC1 + outliers, reordered|1|--method multibounce --format bc1|T-3: about 10x faster than classic with compression
-mbbc4|multi-bounce F_mb, 3xBC4 + outliers, reordered|1|--method multibounce --format bc4x3|T-3: memory 3x below the plain form-factor matrix
+classic3|classic Jacobi, 3 bounces|1|--method classic --bounces 3|T ch. 3: SSIM 0.743 (classic, 3 bounces)
+mbfloat|multi-bounce F_mb, float, 64 bounces|1|--method multibounce --format float|T ch. 3: one product per frame for any bounce count
+mbfloat3|multi-bounce F_mb, float, 3 bounces|1|--method multibounce --format float --bounces 3|T ch. 3: 3x faster than 3 classic bounces; SSIM 0.762
+mbbc1|multi-bounce F_mb, BC1 + outliers, reordered|1|--method multibounce --format bc1|T ch. 3: about 10x faster than classic with compression
+mbbc4|multi-bounce F_mb, 3xBC4 + outliers, reordered|1|--method multibounce --format bc4x3|T ch. 3: memory 3x below the plain form-factor matrix
 temporal|temporal, k 10, w 0.998, after FRAMES frames|1|--method temporal --w 0.998 --frames FRAMES|T table 2 (temporal): MSE 0.06651, PSNR 23.54, SSIM 0.8323
-temporal_ad|temporal, k 10, adaptive w, after FRAMES frames|1|--method temporal --adaptive --frames FRAMES|none (beyond the thesis: SPEC §8 adaptive w)
-local|local matrix (SPEC §5), M = 1024 nearest the camera|1|--method local|T-4: update cost 6-15x below recomputation
-vp|virtual patches (SPEC §6)|0|--method vp|T-5: 200 000 triangles to 12 000 (or 2 000) patches
-aavp|axis-aligned virtual patches (SPEC §7)|0|--method aavp|T table 3: temporal + AAVP 0.08 ms, SSIM 0.73 (RTXGI 0.17 ms, SSIM 0.66)
+temporal_ad|temporal, k 10, adaptive w, after FRAMES frames|1|--method temporal --adaptive --frames FRAMES|none (beyond T: the adaptive w answers its open problem)
+local|local matrix, M = 1024 nearest the camera|1|--method local --local-m 1024|T ch. 4: update cost 6-15x below recomputation
+vp|virtual patches|0|--method vp|T ch. 5: 200 000 triangles to 12 000 (or 2 000) patches
+aavp|axis-aligned virtual patches|0|--method aavp|T table 3: temporal + AAVP 0.08 ms, SSIM 0.73 (RTXGI 0.17 ms, SSIM 0.66)
 '
 
-# Virtual-patch count against accuracy (T-5): `rad render SCENE VP_SWEEP B` for each budget B in
+# Virtual-patch count against accuracy (T ch. 5): `rad render SCENE VP_SWEEP B` for each budget B in
 # VP_BUDGETS, run once `rad render --help` lists the method named in VP_SWEEP (x axis: the
 # patches= of its timing line, else B). Set VP_SWEEP to the vp method's budget option, e.g.
 # VP_SWEEP='--method aavp --vp-max-patches'.
@@ -124,25 +125,26 @@ elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
 
 # metrics of $1 (pfm) against $2 (pfm) -> "MSE PSNR SSIM"; writes the PNG and the heat map
 compare() {
-    "$RAD" compare "$1" "$2" --diff "$3" --diff-scale $DIFF_SCALE --png "$4" --exposure $EXPOSURE > "$TMP/cmp.txt" 2>&1 ||
+    "$RAD" compare "$1" "$2" --diff "$3" --diff-scale $DIFF_SCALE --png "$4" --png-exposure $EXPOSURE > "$TMP/cmp.txt" 2>&1 ||
         return 1
     awk '/^MSE:/ { m = $2 } /^PSNR:/ { p = $2 } /^SSIM:/ { s = $2 } END { printf "%.3g %.2f %.4f\n", m, p, s }' "$TMP/cmp.txt"
 }
 
-# the bunny in the box: cornell.obj without its two blocks, plus the bunny scaled to 0.25 m and
-# standing in the middle of the floor (as bench/rays.c places it)
+# the bunny in the box: the built-in box (`rad export cornell`: its white material is m0_white)
+# without its two blocks, plus the bunny scaled to 0.25 m and standing in the middle of the floor
+# (as bench/rays.c places it)
 make_bunny_scene() {
     local dir=$1
-    [ -f "$DATA/stanford-bunny.obj" ] && [ -f "$DATA/cornell.obj" ] && [ -f "$DATA/cornell.mtl" ] || return 1
-    cp "$DATA/cornell.mtl" "$dir/cornell.mtl"
-    awk -v base="$(awk '/^v /{n++} END{print n+0}' "$DATA/cornell.obj")" '
+    [ -n "$DATA" ] && [ -f "$DATA/stanford-bunny.obj" ] || return 1
+    "$RAD" export cornell -o "$dir/box.obj" > /dev/null || return 1
+    awk -v base="$(awk '/^v /{n++} END{print n+0}' "$dir/box.obj")" '
         FNR == 1 { file++ }
         file == 1 { if ($1 == "o") skip = ($2 ~ /block/); if (!($1 == "f" && skip)) print; next }
         file == 2 && $1 == "v" { nv++; for (k = 2; k <= 4; ++k) { if (nv == 1 || $k < lo[k]) lo[k] = $k; if (nv == 1 || $k > hi[k]) hi[k] = $k } next }
-        file == 3 && FNR == 1 { s = 0.25 / (hi[3] - lo[3]); print "o bunny"; print "usemtl white" }
+        file == 3 && FNR == 1 { s = 0.25 / (hi[3] - lo[3]); print "o bunny"; print "usemtl m0_white" }
         file == 3 && $1 == "v" { printf "v %.6f %.6f %.6f\n", ($2 - 0.5 * (lo[2] + hi[2])) * s + 0.28, ($3 - lo[3]) * s + 0.0005, ($4 - 0.5 * (lo[4] + hi[4])) * s + 0.30; next }
         file == 3 && $1 == "f" { printf "f"; for (k = 2; k <= NF; ++k) { split($k, p, "/"); printf " %d", p[1] + base } printf "\n" }
-    ' "$DATA/cornell.obj" "$DATA/stanford-bunny.obj" "$DATA/stanford-bunny.obj" > "$dir/bunny-box.obj"
+    ' "$dir/box.obj" "$DATA/stanford-bunny.obj" "$DATA/stanford-bunny.obj" > "$dir/bunny-box.obj"
 }
 
 # one scene: the reference, then every method; appends its section to $TMP/scenes.md
@@ -165,8 +167,8 @@ run_scene() {
         printf '\n## %s\n\n' "$title"
         printf 'Reference: `rad trace %s %s--size %s --spp %s` (%s s, all threads). Methods: `rad render %s %s--size %s --aa %s --pixel-light-samples %s --patches %s --threads 1` plus the arguments below. ' \
             "$shown" "${cam:+$cam }" "$size" "$spp" "$t_ref" "$shown" "${cam:+$cam }" "$size" "$AA" "$PLS" "$PATCHES"
-        printf 'Per-frame time: the method'"'"'s own run-time work per frame as `rad render` reports it (its timing line), on one thread (this 2-core machine is shared; with two threads a small parallel step waits for the scheduler and its time is a multiple of 4 ms): classic = the K Jacobi bounces (K matrix-vector products), multi-bounce = one product `F_mb E` (median of 9), temporal = one `rad_temporal_step` (median over the frames), local = one apply `L = T E` over P_Vis x P_Lit (median of 9; the rebuild of T is rebuild_ms in the log), vp and aavp = the solve on the virtual patches'"'"' matrix (K Jacobi bounces + H = F B; the build, the sources and the per-pixel gather are build_ms, sources_ms and gather_ms in the log). "vs classic" = the classic 64-bounce time / this time. Published values: the thesis (T), RTX 3060, its own scene and reference.\n\n'
-        printf '| method | `rad render` arguments | MSE | PSNR (dB) | SSIM | per frame (ms) | vs classic | published (SPEC §12) |\n'
+        printf 'Per-frame time: the method'"'"'s own run-time work per frame as `rad render` reports it (its timing line), on one thread (this 2-core machine is shared; with two threads a small parallel step waits for the scheduler and its time is a multiple of 4 ms): classic = the K Jacobi bounces (K matrix-vector products), multi-bounce = one product `F_mb E` (median of 9), temporal = one `rad_temporal_step` (median over the frames), local = one apply `L = T E` over P_Vis x P_Lit (median of 9; the rebuild of T is rebuild_ms in the log), vp and aavp = the solve on the virtual patches'"'"' matrix (K Jacobi bounces + H = F B; the build, the sources and the per-pixel gather are build_ms, sources_ms and gather_ms in the log). "vs classic" = the classic 64-bounce time / this time. Published values: T = Shcherbakov 2025 (docs/references.md), RTX 3060, its own scene and reference.\n\n'
+        printf '| method | `rad render` arguments | MSE | PSNR (dB) | SSIM | per frame (ms) | vs classic | published (T) |\n'
         printf '|---|---|---:|---:|---:|---:|---:|---|\n'
     } > "$md"
     printf '| method | image | difference to the reference (white = %s) |\n|---|---|---|\n' "$DIFF_SCALE" > "$imgs"
@@ -213,19 +215,19 @@ run_scene() {
 
 : > "$OUT/data/metrics.txt"
 : > "$TMP/scenes.md"
-run_scene cornell "Cornell box (built-in, REFERENCE §8)" cornell "$SIZE" "$SPP" 32
+run_scene cornell "Cornell box (built-in, the original Cornell data in metres)" cornell "$SIZE" "$SPP" 32
 if make_bunny_scene "$TMP"; then
     tris=$(grep -c '^f ' "$TMP/bunny-box.obj")
     cp "$TMP/bunny-box.obj" "$TMP/bunny-box.obj.keep" 2> /dev/null
     run_scene bunny "Stanford bunny in the Cornell box" "$TMP/bunny-box.obj" "$BUNNY_SIZE" "$BUNNY_SPP" "$((tris + 0))"
     {
-        printf '\nThe bunny scene is `%s/cornell.obj` without its two blocks plus `stanford-bunny.obj` scaled to 0.25 m and standing in the middle of the floor (written by this script). ' "$DATA"
+        printf '\nThe bunny scene is the built-in Cornell box (`rad export cornell`) without its two blocks plus `%s/stanford-bunny.obj` scaled to 0.25 m and standing in the middle of the floor (written by this script). ' "$DATA"
         printf 'The `rad` tool makes at least one patch per triangle and stores F densely: with %s triangles that is a %s GB matrix (this machine: %s GB of memory) and about %s patch pairs of form factors, which at the measured ~1 Mpairs/s (BENCHMARKS.md a) is hours, so the dense methods (classic, multi-bounce, temporal) were not run on it. The virtual patches are the method meant for it (the local method of rad fetches its rows from the classic dense F, so it is not run here either).\n' \
             "$tris" "$(awk -v t="$tris" 'BEGIN { printf "%.1f", 4 * t * t / 1e9 }')" \
             "$(awk '/MemTotal/ { printf "%.0f", $2 / 1048576 }' /proc/meminfo)" "$(awk -v t="$tris" 'BEGIN { printf "%.1e", t * t / 2 }')"
     } >> "$TMP/scenes.md"
 else
-    printf '\n## Stanford bunny in the Cornell box\n\nSkipped: `%s/stanford-bunny.obj` (and `cornell.obj`, `cornell.mtl`) not found; set RAD_DATA_DIR to the directory that holds them.\n' "$DATA" >> "$TMP/scenes.md"
+    printf '\n## Stanford bunny in the Cornell box\n\nSkipped: %s; set RAD_DATA_DIR to the directory that holds `stanford-bunny.obj`.\n' "$([ -n "$DATA" ] && echo "\`$DATA/stanford-bunny.obj\` not found" || echo "RAD_DATA_DIR is not set")" >> "$TMP/scenes.md"
 fi
 
 # ---- plot 1 and 2: temporal against the matrix-vector product (bench/temporal) -------------
@@ -235,7 +237,7 @@ log "temporal against matrix-vector, N = $TSIZES (bench/temporal)"
 if [ -x "$TBENCH" ] && "$TBENCH" --sizes "$TSIZES" --append "$TAB_T" --csv "$OUT/data/temporal_error.csv" > "$OUT/data/temporal.log" 2>&1; then
     # rows "| N (target) | step10 | step64 | MV | ..."
     {
-        echo "N temporal_k=10 temporal_k=64 matrix-vector thesis_temporal_k=10 thesis_matrix-vector"
+        echo "N temporal_k=10 temporal_k=64 matrix-vector published_temporal_k=10 published_matrix-vector"
         awk -F'|' '/^\| [0-9]+ \([0-9]+\) \|/ {
             split($2, a, /[ ()]+/); n = a[2]; t = a[3]
             pt = pm = "-"
@@ -321,13 +323,13 @@ if [ -n "$VP_SWEEP" ] && printf '%s\n' "$HELP" | grep -Eq "(^|[ |])$vp_method([]
     VP_OK=1
 fi
 
-# ---- the headline: the thesis's figures against ours ------------------------------------------
+# ---- the headline: the published figures against ours ------------------------------------------
 # m ID FIELD: a metric of a Cornell-box method (2 MSE, 3 PSNR, 4 SSIM, 5 ms), or "-"
 m() { awk -v id="$1" -v f="$2" '$1 == "cornell" && $2 == id { v = $(f + 1) } END { print (v == "" ? "-" : v) }' "$OUT/data/metrics.txt"; }
 ms() { awk -v v="$(m "$1" 5)" 'BEGIN { if (v == "-") print v; else printf "%.3g", v }'; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a + 0 > 0 && b + 0 > 0) printf "%.1fx", a / b; else print "-" }'; }
 {
-    echo "| figure | thesis (SPEC §12) | ours, this run (Cornell box, $SIZE, $PATCHES-patch target) |"
+    echo "| figure | published (T: Shcherbakov 2025) | ours, this run (Cornell box, $SIZE, $PATCHES-patch target) |"
     echo "|---|---|---|"
     echo "| radiosity vs path-traced reference (T table 2) | MSE 0.06658, PSNR 23.53, SSIM 0.8354 | classic 64 bounces: MSE $(m classic 2), PSNR $(m classic 3), SSIM $(m classic 4) |"
     echo "| temporal vs path-traced reference (T table 2) | MSE 0.06651, PSNR 23.54, SSIM 0.8323 | temporal, w 0.998, $FRAMES frames: MSE $(m temporal 2), PSNR $(m temporal 3), SSIM $(m temporal 4); adaptive w: PSNR $(m temporal_ad 3), SSIM $(m temporal_ad 4) |"
@@ -336,14 +338,14 @@ ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a + 0 > 0 && b + 0 > 0) printf "%
         rat=$(awk -F'|' '/^\| [0-9]+ \([0-9]+\) \|/ { r = $0 } END { split(r, c, "|"); gsub(/ /, "", c[6]); print c[6] }' "$TAB_T")
         echo "| temporal step vs matrix-vector product (T table 1, largest N) | N = 10422: 0.08 vs 12.01 ms (150x), GPU | $big ($rat), one CPU thread |"
     fi
-    echo "| multi-bounce matrix vs 3 Jacobi bounces (T-3) | 3x faster | $(ratio "$(m classic3 5)" "$(m mbfloat3 5)") ($(ms classic3) ms for 3 bounces vs $(ms mbfloat3) ms for one float F_mb product; the 64-bounce row's product, the same work, took $(ms mbfloat) ms). F_mb is RGB (3 N^2 floats) while F is one N^2 matrix shared by the channels, so on a CPU one F_mb product reads as many bytes as 3 bounces. SSIM $(m mbfloat3 4) vs $(m classic3 4) for 3 classic bounces (thesis: 0.762 vs 0.743) |"
-    echo "| compressed multi-bounce vs classic (T-3) | about 10x faster | BC1: $(ratio "$(m classic 5)" "$(m mbbc1 5)"), 3xBC4: $(ratio "$(m classic 5)" "$(m mbbc4 5)") against 64 classic bounces (CPU decode; the thesis decodes in GPU texture hardware) |"
+    echo "| multi-bounce matrix vs 3 Jacobi bounces (T ch. 3) | 3x faster | $(ratio "$(m classic3 5)" "$(m mbfloat3 5)") ($(ms classic3) ms for 3 bounces vs $(ms mbfloat3) ms for one float F_mb product; the 64-bounce row's product, the same work, took $(ms mbfloat) ms). F_mb is RGB (3 N^2 floats) while F is one N^2 matrix shared by the channels, so on a CPU one F_mb product reads as many bytes as 3 bounces. SSIM $(m mbfloat3 4) vs $(m classic3 4) for 3 classic bounces (T: 0.762 vs 0.743) |"
+    echo "| compressed multi-bounce vs classic (T ch. 3) | about 10x faster | BC1: $(ratio "$(m classic 5)" "$(m mbbc1 5)"), 3xBC4: $(ratio "$(m classic 5)" "$(m mbbc4 5)") against 64 classic bounces (CPU decode; T decodes in GPU texture hardware) |"
     awk -F'|' -v nmax="$(echo $CSIZES | awk '{ print $NF }')" '
         { key = $1 "|" $2; if ($3 == "no-reorder") plain[key] = $4; else if ($4 + 0 > 0) { r[$2] = sprintf("%.1fx", plain[key] / $4); n = $1; mem[$2] = sprintf("%.1fx", ($7 / 3) / $6) } }
-        END { printf "| reordering cuts the compression MSE (T-3) | 5x | N = %s: BC1 %s, 3xBC4 %s |\n", n, r["bc1"], r["bc4x3"]
-              printf "| compressed F_mb memory vs the plain float F (T-3) | 3x below | N = %s: BC1 %s, 3xBC4 %s below (blocks + scales + outliers + permutations) |\n", n, mem["bc1"], mem["bc4x3"] }' "$TMP/comp.md"
+        END { printf "| reordering cuts the compression MSE (T ch. 3) | 5x | N = %s: BC1 %s, 3xBC4 %s |\n", n, r["bc1"], r["bc4x3"]
+              printf "| compressed F_mb memory vs the plain float F (T ch. 3) | 3x below | N = %s: BC1 %s, 3xBC4 %s below (blocks + scales + outliers + permutations) |\n", n, mem["bc1"], mem["bc4x3"] }' "$TMP/comp.md"
     if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])local([] |]|$)"; then :; else
-        echo "| local matrix update vs recomputation (T-4) | 6-15x | not in this build (branch \`local\`) |"; fi
+        echo "| local matrix update vs recomputation (T ch. 4) | 6-15x | not in this build (branch \`local\`) |"; fi
     if printf '%s\n' "$HELP" | grep -Eq "(^|[ |])aavp([] |]|$)"; then :; else
         echo "| temporal + AAVP vs RTXGI (T table 3) | 0.08 ms, SSIM 0.73 vs 0.17 ms, SSIM 0.66 | not in this build (branch \`vp\`) |"; fi
 } > "$TMP/headline.md"
@@ -356,7 +358,7 @@ MD="$OUT/REPORT.md"
     echo "# radiosity.h evaluation report"
     echo
     echo "Every method of the \`rad\` tool against a path-traced reference, side by side with the figures the"
-    echo "thesis publishes (SPEC §12), all measured in one run of \`tools/report.sh\` (issue #12)."
+    echo "Shcherbakov 2025 publishes (T; docs/references.md lists it), all measured in one run of \`tools/report.sh\` (issue #12)."
     echo
     echo "| setting | value |"
     echo "|---|---|"
@@ -367,10 +369,10 @@ MD="$OUT/REPORT.md"
     echo "| library | $("$RAD" version 2>/dev/null) |"
     echo "| run time | $T_ALL s for the whole report |"
     echo
-    echo "Metrics (REFERENCE §6): MSE, PSNR (peak 1) and SSIM (11x11 Gaussian, sigma 1.5, per channel R, G, B,"
+    echo "Metrics: MSE, PSNR (peak 1) and SSIM (Wang et al. 2004: 11x11 Gaussian, sigma 1.5, per channel R, G, B,"
     echo "averaged) on linear radiance clamped to [0,1], computed by \`rad compare\` from the PFM images. The"
     echo "PNGs below are sRGB at exposure $EXPOSURE; the heat maps show the per-pixel mean |ours - reference| over"
-    echo "RGB on one shared scale (white = $DIFF_SCALE). The thesis's numbers come from its own scenes, reference"
+    echo "RGB on one shared scale (white = $DIFF_SCALE). T's numbers come from its own scenes, reference"
     echo "and GPU (RTX 3060), so they are context, not a like-for-like target: this report runs on a CPU."
     echo
     echo "## Side by side"
@@ -378,13 +380,13 @@ MD="$OUT/REPORT.md"
     cat "$TMP/headline.md"
     cat "$TMP/scenes.md"
     echo
-    echo "## Temporal radiosity against the matrix-vector product (thesis Table 1)"
+    echo "## Temporal radiosity against the matrix-vector product (T table 1)"
     echo
     if [ "$T_OK" = 1 ]; then
         echo "\`build/temporal --sizes $TSIZES\` (bench/temporal.c; the same code as \`make bench\`): Cornell box, single"
-        echo "bounce, one thread. Times are medians in ms; the thesis column is its RTX 3060 measurement."
+        echo "bounce, one thread. Times are medians in ms; the published column is T's RTX 3060 measurement."
         echo
-        awk '/^\| N \(target\)/ { on = 1 } on && /^\|/ { print } on && !/^\|/ && NR > 1 { if (printed) exit } on && /^\|/ { printed = 1 }' "$TAB_T" | sed 's/| - |/| none (not a thesis size) |/'
+        awk '/^\| N \(target\)/ { on = 1 } on && /^\|/ { print } on && !/^\|/ && NR > 1 { if (printed) exit } on && /^\|/ { printed = 1 }' "$TAB_T" | sed 's/| - |/| none (not a size T measured) |/'
         echo
         echo "![per-frame time against N](plots/time_vs_n.svg)"
         echo
@@ -397,11 +399,11 @@ MD="$OUT/REPORT.md"
         echo "FAILED: \`$TBENCH\` did not run (see data/temporal.log; \`make build/temporal\`)."
     fi
     echo
-    echo "## Compression of the multi-bounce matrix: reordering (thesis T-3)"
+    echo "## Compression of the multi-bounce matrix: reordering (T ch. 3)"
     echo
     echo "\`rad bake cornell --patches N --method multibounce --bounces 3 --format F [--reorder|--no-reorder]\`"
     echo "(outliers 5 %, scales per 64x64 tile). MSE of the decoded F_mb over all entries; relative = RMS error /"
-    echo "RMS entry. The thesis reports reordering cutting the compression MSE 5x."
+    echo "RMS entry. T reports reordering cutting the compression MSE 5x."
     echo
     echo "| N | format | reordering | MSE | relative RMS (%) | bytes | float F_mb bytes | MSE ratio plain / reordered |"
     echo "|---:|---|---|---:|---:|---:|---:|---:|"
@@ -411,7 +413,7 @@ MD="$OUT/REPORT.md"
     echo
     echo "![compression error with and without reordering](plots/compression.svg)"
     echo
-    echo "## Virtual-patch count against accuracy (thesis T-5)"
+    echo "## Virtual-patch count against accuracy (T ch. 5)"
     echo
     if [ "$VP_OK" = 1 ]; then
         echo "\`rad render SCENE $VP_SWEEP B\` for B in $VP_BUDGETS, against each scene's reference above."
@@ -422,7 +424,7 @@ MD="$OUT/REPORT.md"
         echo
         echo "![PSNR against the virtual-patch count](plots/vp_psnr.svg) ![SSIM against the virtual-patch count](plots/vp_ssim.svg)"
     else
-        echo "Not in this build: virtual patches (SPEC §6-7) are on another branch (\`vp\`). When \`rad render\`"
+        echo "Not in this build: virtual patches are on another branch (\`vp\`). When \`rad render\`"
         echo "has the method, its rows above fill in, and setting VP_SWEEP in tools/report.sh to its patch-budget"
         echo "option makes this section sweep the budget ($VP_BUDGETS) on both scenes, with PSNR and SSIM plots."
     fi

@@ -1,5 +1,5 @@
 /* shading.c - 'rad render --shading MODEL': the lighting models of radiosity.h (>>shading,
-   SPEC §9) applied to the direct term of the classic render.
+   from Korobeinikov 2022 in docs/references.md) applied to the direct term of the classic render.
 
    How a model combines with the radiosity solution. Radiosity computes diffuse transport
    only, so the indirect irradiance H (and the solution itself) stays Lambertian with the

@@ -1,0 +1,208 @@
+/* cmd_export.c - rad export: any scene the tool loads (the built-in 'cornell' or a file assimp
+   reads) written as Wavefront OBJ + MTL, so that what the tool sees can be opened elsewhere
+   and read back (the tool checks compare the built-in box with its exported OBJ).
+
+   rad export SCENE -o OUT.obj
+
+   What is written: one 'o NAME' per mesh (its vertices, then its triangles, a 'usemtl' line
+   wherever the material changes), and OUT.mtl beside it (named by a relative 'mtllib' line)
+   with one 'newmtl' per material: Kd = albedo, Ke = emitted radiance (the importer reads Ke
+   as radiance, so the round trip keeps the light). Numbers are printed with 9 significant
+   digits, which a float reads back exactly. What OBJ cannot hold is reported on stderr and
+   left out: the scene's camera (written as a comment, with the --camera/--fov options that
+   restore it), analytic lights, and albedo textures (the material's colour factor is written).
+   Both files go through rad_tool_output_* (a temporary renamed into place), and neither may
+   be the scene or one of the MTL files it names. */
+#include "tool.h"
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void export_usage(FILE *f)
+{
+    fprintf(f, "usage: rad export SCENE -o OUT.obj\n"
+               "  writes SCENE ('cornell' or any file rad reads) as OUT.obj and OUT.mtl beside it:\n"
+               "  one 'o' per mesh, one 'usemtl' per run of a material, Kd = albedo, Ke = emitted\n"
+               "  radiance. The camera goes into a comment (with the --camera and --fov that restore\n"
+               "  it); analytic lights and albedo textures are left out with a warning.\n");
+}
+
+/* a name usable after 'o', 'usemtl' and 'newmtl': no whitespace or control characters */
+static void clean_name(const char *name, char *buf, size_t cap)
+{
+    size_t i = 0;
+    if (name)
+        for (; name[i] && i + 1 < cap; ++i) {
+            unsigned char c = (unsigned char)name[i];
+            buf[i] = (isspace(c) || iscntrl(c) || c == '#') ? '_' : (char)c;
+        }
+    buf[i] = '\0';
+}
+
+/* the MTL files an OBJ names (mtllib lines), resolved against the OBJ's folder; returns the count */
+#define EXPORT_MAX_MTLLIB 16
+static int obj_mtllibs(const char *obj, char names[][1024], int cap)
+{
+    FILE *f;
+    char line[2048];
+    int count = 0;
+    size_t n = strlen(obj);
+    const char *slash = strrchr(obj, '/');
+    size_t dir = slash ? (size_t)(slash - obj + 1) : 0;
+    if (n < 4 || (strcmp(obj + n - 4, ".obj") && strcmp(obj + n - 4, ".OBJ"))) return 0;
+    if (!(f = fopen(obj, "r"))) return 0;
+    while (count < cap && fgets(line, sizeof line, f)) {
+        char *p = line, *e;
+        while (*p == ' ' || *p == '\t') ++p;
+        if (strncmp(p, "mtllib", 6) || !(p[6] == ' ' || p[6] == '\t')) continue;
+        p += 6;
+        while (*p == ' ' || *p == '\t') ++p;
+        for (e = p + strlen(p); e > p && isspace((unsigned char)e[-1]); --e) {
+        }
+        *e = '\0';
+        if (!*p) continue;
+        if (*p == '/') snprintf(names[count], 1024, "%s", p);
+        else snprintf(names[count], 1024, "%.*s%s", (int)dir, obj, p);
+        ++count;
+    }
+    fclose(f);
+    return count;
+}
+
+static void write_rgb(FILE *f, const char *key, const float *v)
+{
+    fprintf(f, "%s %.9g %.9g %.9g\n", key, (double)v[0], (double)v[1], (double)v[2]);
+}
+
+int rad_cmd_export(int argc, char **argv)
+{
+    const char *cmd = "export", *scene_name = NULL, *out_path = NULL;
+    char err[1024], mtl_path[4096], mtllibs[EXPORT_MAX_MTLLIB][1024], name[256];
+    const char *inputs[EXPORT_MAX_MTLLIB + 1];
+    const char *mtl_base;
+    rad_tool_scene ts;
+    rad_tool_output obj, mtl;
+    const rad_scene_desc *d;
+    uint32_t m, t, k, textured = 0, written_tris = 0;
+    uint64_t base = 1; /* OBJ indices count from 1 over the whole file */
+    int a, nlib, i, ok;
+    size_t l;
+    for (a = 0; a < argc; ++a) {
+        const char *o = argv[a];
+        if (!strcmp(o, "--help") || !strcmp(o, "-h")) { export_usage(stdout); return 0; }
+        if (!strcmp(o, "-o")) {
+            if (a + 1 >= argc) { fprintf(stderr, "rad %s: -o needs a value\n", cmd); return 2; }
+            out_path = argv[++a];
+        } else if (o[0] == '-' && o[1]) {
+            fprintf(stderr, "rad %s: unknown option '%s'\n", cmd, o);
+            export_usage(stderr);
+            return 2;
+        } else if (!scene_name) scene_name = o;
+        else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
+    }
+    if (!scene_name || !out_path) {
+        fprintf(stderr, "rad %s: %s\n", cmd, !scene_name ? "no scene given" : "no output file given (-o OUT.obj)");
+        export_usage(stderr);
+        return 2;
+    }
+    l = strlen(out_path);
+    if (l < 5 || (strcmp(out_path + l - 4, ".obj") && strcmp(out_path + l - 4, ".OBJ")) || out_path[l - 5] == '/') {
+        fprintf(stderr, "rad %s: -o wants a .obj file, got '%s'\n", cmd, out_path);
+        return 2;
+    }
+    if (l - 4 + 5 > sizeof mtl_path) { fprintf(stderr, "rad %s: output path too long\n", cmd); return 2; }
+    memcpy(mtl_path, out_path, l - 4);
+    memcpy(mtl_path + l - 4, out_path[l - 3] == 'O' ? ".MTL" : ".mtl", 5);
+    mtl_base = strrchr(mtl_path, '/') ? strrchr(mtl_path, '/') + 1 : mtl_path;
+    /* neither output may be the scene or an MTL file it names */
+    nlib = strcmp(scene_name, "cornell") ? obj_mtllibs(scene_name, mtllibs, EXPORT_MAX_MTLLIB) : 0;
+    inputs[0] = scene_name;
+    for (i = 0; i < nlib; ++i) inputs[1 + i] = mtllibs[i];
+    if (rad_tool_check_output(cmd, out_path, inputs, 1 + nlib) || rad_tool_check_output(cmd, mtl_path, inputs, 1 + nlib))
+        return 1;
+
+    if (rad_tool_load_scene(scene_name, &ts, err, sizeof err) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, err);
+        return 1;
+    }
+    d = &ts.desc;
+    if (rad_tool_output_open(&mtl, mtl_path) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+        rad_tool_free_scene(&ts);
+        return 1;
+    }
+    if (rad_tool_output_open(&obj, out_path) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+        rad_tool_output_abort(&mtl);
+        rad_tool_free_scene(&ts);
+        return 1;
+    }
+
+    /* materials: "m<index>" keeps the names unique whatever the file called them */
+    fprintf(mtl.f, "# written by rad export from '%s': Kd = albedo, Ke = emitted radiance (W m^-2 sr^-1)\n", scene_name);
+    for (m = 0; m < d->material_count; ++m) {
+        const rad_material *mat = &d->materials[m];
+        clean_name(ts.material_names ? ts.material_names[m] : NULL, name, sizeof name);
+        fprintf(mtl.f, "newmtl m%u%s%s\n", m, name[0] ? "_" : "", name);
+        write_rgb(mtl.f, "Kd", mat->albedo);
+        write_rgb(mtl.f, "Ke", mat->emission);
+        if (mat->texture) ++textured;
+    }
+
+    fprintf(obj.f, "# written by rad export from '%s'\n", scene_name);
+    if (ts.has_camera) /* else render and trace choose one from the geometry, as for the source */
+        fprintf(obj.f, "# camera: --camera %.9g,%.9g,%.9g:%.9g,%.9g,%.9g:%.9g,%.9g,%.9g --fov %.9g\n",
+                (double)ts.camera.position[0], (double)ts.camera.position[1], (double)ts.camera.position[2],
+                (double)ts.camera.target[0], (double)ts.camera.target[1], (double)ts.camera.target[2],
+                (double)ts.camera.up[0], (double)ts.camera.up[1], (double)ts.camera.up[2],
+                (double)ts.camera.fov_y_degrees);
+    fprintf(obj.f, "mtllib %s\n", mtl_base);
+    for (m = 0; m < d->mesh_count; ++m) {
+        const rad_mesh_desc *md = &d->meshes[m];
+        size_t stride = md->position_stride ? md->position_stride : 3 * sizeof(float);
+        uint32_t last = RAD_NONE;
+        clean_name(md->name, name, sizeof name);
+        if (name[0]) fprintf(obj.f, "o %s\n", name);
+        else fprintf(obj.f, "o mesh%u\n", m);
+        for (k = 0; k < md->vertex_count; ++k) {
+            const float *p = (const float *)(const void *)((const char *)md->positions + (size_t)k * stride);
+            fprintf(obj.f, "v %.9g %.9g %.9g\n", (double)p[0], (double)p[1], (double)p[2]);
+        }
+        for (t = 0; t < md->triangle_count; ++t) {
+            uint32_t mat = md->material_ids ? md->material_ids[t] : md->material, v[3];
+            for (k = 0; k < 3; ++k) v[k] = md->indices ? md->indices[3 * (size_t)t + k] : 3 * t + k;
+            if (v[0] >= md->vertex_count || v[1] >= md->vertex_count || v[2] >= md->vertex_count) continue;
+            if (mat != last && mat < d->material_count) {
+                clean_name(ts.material_names ? ts.material_names[mat] : NULL, name, sizeof name);
+                fprintf(obj.f, "usemtl m%u%s%s\n", mat, name[0] ? "_" : "", name);
+                last = mat;
+            }
+            fprintf(obj.f, "f %llu %llu %llu\n", (unsigned long long)(base + v[0]), (unsigned long long)(base + v[1]),
+                    (unsigned long long)(base + v[2]));
+            ++written_tris;
+        }
+        base += md->vertex_count;
+    }
+    ok = !ferror(obj.f) && !ferror(mtl.f);
+    if (rad_tool_output_commit(&mtl, ok) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+        rad_tool_output_abort(&obj);
+        rad_tool_free_scene(&ts);
+        return 1;
+    }
+    if (rad_tool_output_commit(&obj, ok) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+        rad_tool_free_scene(&ts);
+        return 1;
+    }
+    if (ts.light_count)
+        fprintf(stderr, "rad %s: warning: %u analytic lights left out (OBJ has no lights)\n", cmd, ts.light_count);
+    if (textured)
+        fprintf(stderr, "rad %s: warning: %u textured materials written with their colour factor only (textures left out)\n",
+                cmd, textured);
+    printf("wrote %s and %s (%u meshes, %u triangles, %u materials)\n", out_path, mtl_path, d->mesh_count, written_tris,
+           d->material_count);
+    rad_tool_free_scene(&ts);
+    return 0;
+}
