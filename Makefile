@@ -19,7 +19,9 @@ OPENMP  := $(shell printf 'int main(void){return 0;}' | $(CC) -fopenmp -x c - -o
 # Embree 3 for the ray benchmark, when installed (package libembree-dev)
 EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
-RAD_DATA_DIR ?= ../shared/data
+# a folder holding the public meshes of docs/data.md, for the benchmarks and the report that
+# use them (empty: they say what they skipped)
+RAD_DATA_DIR ?=
 
 .PHONY: all demo gallery walk moving-light test bench bench-quick tools fuzz clean glsl report report-quick
 

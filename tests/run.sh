@@ -256,14 +256,16 @@ s_tool() {
     pass tool-build
     echo "== tool tests"
     local out nf ns
-    out=$(RAD_DATA_DIR="${RAD_DATA_DIR:-../shared/data}" bash tests/tool_tests.sh "$BUILD/rad" 2>&1)
+    out=$(bash tests/tool_tests.sh "$BUILD/rad" 2>&1)
     echo "$out" | grep -E '^(ok|FAIL|SKIP)' | sed 's/^/  /'
     PASSED=$((PASSED + $(echo "$out" | grep -c '^ok')))
     nf=$(echo "$out" | grep -c '^FAIL')
     FAILED=$((FAILED + nf))
     [ "$nf" = 0 ] || FAILED_NAMES="$FAILED_NAMES tool-tests"
+    # skip-data: a check of meshes from RAD_DATA_DIR, which the repository does not hold (never
+    # a failure); skip: a missing tool (a failure under RAD_TEST_REQUIRE_ALL=1)
     echo "$out" | grep -E '^skip' | while read -r line; do echo "  $line"; done
-    ns=$(echo "$out" | grep -c '^skip')
+    ns=$(echo "$out" | grep -c '^skip ')
     if [ "$ns" -gt 0 ]; then
         if [ "${RAD_TEST_REQUIRE_ALL:-0}" = 1 ]; then FAILED=$((FAILED + ns)); FAILED_NAMES="$FAILED_NAMES tool-tests(skipped)"
         else SKIPPED=$((SKIPPED + ns)); SKIPPED_NAMES="$SKIPPED_NAMES tool-tests"; fi
@@ -275,7 +277,7 @@ s_report() {
     have_tool_deps || return 0
     if build report-rad $CC -std=c99 $WARN -O2 $OMP -I. tools/*.c -o "$BUILD/rad-report" -lassimp -lm &&
        build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
-       RAD_DATA_DIR="${RAD_DATA_DIR:-../shared/data}" bash tools/report.sh --quick --out "$BUILD/report-quick" \
+       bash tools/report.sh --quick --out "$BUILD/report-quick" \
            --rad "$BUILD/rad-report" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
         pass "report-quick ($(tail -n 1 "$BUILD/report-quick.log" | sed 's/.*: \([0-9]* table rows, [0-9]* images\).*/\1/'))"
     else
