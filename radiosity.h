@@ -4664,20 +4664,57 @@ static int rad__hc_draw(const rad__ff *f, const double (*q)[3], uint32_t rows, u
     iy0 = fy0 > 0.0 ? (uint32_t)fy0 : 0u;
     iy1 = fy1 < (double)(rows - 1u) ? (uint32_t)fy1 : rows - 1u;
     for (iy = iy0; iy <= iy1; ++iy) {
-        double y = ctr[y0 + iy];
-        for (ix = ix0; ix <= ix1; ++ix) {
+        double y = ctr[y0 + iy], lo = (double)ix0, hi = (double)ix1, slo = lo, shi = hi;
+        int tall[4], tslow[4], nall = 0, nslow = 0, out = 0;
+        /* The row's span. An edge parallel to the row (e0 = 0) has one value along it: it keeps
+           or drops the whole row. Where another edge crosses the row gives the span, one cell
+           wider each way; the cells more than a cell inside every crossing are inside those
+           edges whatever the rounding (the crossing is good to far less than a cell, the edge
+           function there far larger than its rounding). The edge functions decide every other
+           cell, and the nearly horizontal edges (|e0| <= 1e-6 |e1|: an imprecise crossing)
+           every cell. Each edge is evaluated at one place only, so a centre on an edge shared
+           by two triangles still goes to exactly one. */
+        for (v = 0; v < ne && !out; ++v) {
+            const double *e = edge[v];
+            double cross;
+            if (e[0] == 0.0) {
+                double val = e[1] * y + e[2];
+                if (!(val > 0.0 || (val == 0.0 && e[1] > 0.0))) out = 1;
+                continue;
+            }
+            tall[nall++] = v;
+            if (!(fabs(e[0]) > 1e-6 * fabs(e[1]))) { tslow[nslow++] = v; continue; }
+            /* the crossing in cell units, clamped to the face and a few cells beyond (which
+               changes no bound) and rounded down by truncating a positive number: floor()
+               is a library call on plain x86-64 */
+            cross = -(e[1] * y + e[2]) / e[0] * half + half - 0.5;
+            cross = cross > -4.0 ? (cross < (double)res + 4.0 ? cross : (double)res + 4.0) : -4.0;
+            cross = (double)(long)(cross + 8.0) - 8.0;
+            if (e[0] > 0.0) {
+                if (cross - 1.0 > lo) lo = cross - 1.0;
+                if (cross + 2.0 > slo) slo = cross + 2.0;
+            } else {
+                if (cross + 2.0 < hi) hi = cross + 2.0;
+                if (cross - 1.0 < shi) shi = cross - 1.0;
+            }
+        }
+        if (out || !(lo <= hi)) continue;
+        for (ix = (uint32_t)lo; ix <= (uint32_t)hi; ++ix) {
             double x = ctr[ix];
             size_t cell = (size_t)iy * res + ix;
+            const int *list = (double)ix < slo || (double)ix > shi ? tall : tslow;
+            int count = list == tall ? nall : nslow, t;
             float inv;
-            for (v = 0; v < ne; ++v) {
-                double e = edge[v][0] * x + edge[v][1] * y + edge[v][2];
-                if (e > 0.0) continue;
+            for (t = 0; t < count; ++t) {
+                const double *e = edge[list[t]];
+                double val = e[0] * x + e[1] * y + e[2];
+                if (val > 0.0) continue;
                 /* on the edge: the polygon whose edge function has (e0, e1) > 0 in lexical order
                    takes the centre; its neighbour across the edge has the negated function */
-                if (e == 0.0 && (edge[v][0] > 0.0 || (edge[v][0] == 0.0 && edge[v][1] > 0.0))) continue;
+                if (val == 0.0 && (e[0] > 0.0 || (e[0] == 0.0 && e[1] > 0.0))) continue;
                 break;
             }
-            if (v < ne) continue;
+            if (t < count) continue;
             drawn = 1;
             if (acc) { *acc += dff[cell]; continue; }
             inv = (float)(w[0] * x + w[1] * y + w[2]);
@@ -4699,7 +4736,7 @@ static rad_result rad__hc_row(rad__ff *f, uint32_t i, uint32_t task)
     float *row = f->out + (size_t)(i - f->row_begin) * f->out_stride;
     double *acc = f->acc + (size_t)task * N, c[3], n[3], u[3], v[3], sg, a, b;
     const int skip = f->o.skip_visibility != 0;
-    uint32_t j, m;
+    uint32_t j, m, face;
     size_t cell;
     int k;
     for (k = 0; k < 3; ++k) { c[k] = pi->centroid[k]; n[k] = pi->normal[k]; }
@@ -4717,7 +4754,7 @@ static rad_result rad__hc_row(rad__ff *f, uint32_t i, uint32_t task)
     for (j = 0; j < N; ++j) {
         const rad_patch *pj = &P->patches[j];
         double L[3][3], q[3][3], front = 0.0;
-        uint32_t value, face;
+        uint32_t value;
         int drawn = 0;
         if (j == i) continue;
         /* the corners in the hemicube's frame (u, v, n) */
@@ -4751,11 +4788,15 @@ static rad_result rad__hc_row(rad__ff *f, uint32_t i, uint32_t task)
         }
         if (drawn) f->pairs[task]++;
     }
-    if (!skip)
-        for (cell = 0; cell < cells; ++cell) {
-            uint32_t it = item[cell];
-            if (it < N) acc[it] += cell < top ? f->hc_dtop[cell] : f->hc_dside[(cell - top) % side];
+    if (!skip) {
+        for (cell = 0; cell < top; ++cell)
+            if (item[cell] < N) acc[item[cell]] += f->hc_dtop[cell];
+        for (face = 1; face < 5; ++face) {
+            const uint32_t *it = item + top + (size_t)(face - 1u) * side;
+            for (cell = 0; cell < side; ++cell)
+                if (it[cell] < N) acc[it[cell]] += f->hc_dside[cell];
         }
+    }
     for (j = 0; j < N; ++j) row[j] = (float)acc[j];
     row[i] = 0.0f;
     return RAD_SUCCESS;

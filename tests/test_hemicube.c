@@ -383,6 +383,7 @@ static void hc_test_cornell_analytic(void)
     if (!ff_world_make(&d, 0.0f, rad_test_quick() ? 150 : 400, &w)) return;
     N = w.patches->count;
     rad_form_factor_options_default(&oa);
+    if (rad_test_quick()) oa.samples = 4; /* a quarter of the rays under the sanitizers and valgrind */
     hc_options(&oh, rad_test_quick() ? 64 : 128);
     CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &oa, NULL, &fa));
     CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &oh, NULL, &fh)); /* a raycaster given is unused */
@@ -421,7 +422,7 @@ static void hc_test_cornell_analytic(void)
        nothing, where the analytic method's points on the patch see part; and neighbours
        meeting at a corner get the centroid's value, not the area mean. These shrink with
        the patches (at N 2188: worst group 0.021, indirect 0.022). */
-    if (rad_test_quick()) { /* N 242, res 64: measured 0.11, 0.21, 0.057 */
+    if (rad_test_quick()) { /* N 242, res 64, analytic with 4 samples: measured 0.11, 0.21, 0.059 */
         CHECK(l1 < 0.15);
         CHECK(worst_group < 0.3);
         CHECK(bdiff / bsum < 0.08);
