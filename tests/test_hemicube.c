@@ -63,21 +63,30 @@ static int hc_point_world(const float *c, float size, const ff_quad *q, float ma
     return ff_world_make(&d, max_edge, 0, w);
 }
 
-/* Row 0 (the emitter) of the hemicube matrix summed over the patches of mesh 1 (the receiver). */
-static double hc_row0_to_mesh1(const ff_world *w, uint32_t res, double *out_dF_sum)
+/* Row 0 (the emitter) of the hemicube matrix summed over the patches of mesh 1 (the receiver),
+   with the depth test or without visibility (skip). */
+static double hc_row0_to_mesh1(const ff_world *w, uint32_t res, int skip)
 {
     rad_form_factor_options o;
     uint32_t N = w->patches->count, j;
     float *row = (float *)malloc(sizeof(float) * N);
     double sum = 0.0;
     hc_options(&o, res);
+    o.skip_visibility = skip;
     if (!row) return -1.0;
     CHECK_OK(rad_form_factor_rows(w->patches, NULL, &o, 0, 1, row, NULL));
     for (j = 0; j < N; ++j)
         if (w->scene->meshes[w->patches->patches[j].triangle] == 1) sum += row[j];
-    if (out_dF_sum) *out_dF_sum = sum;
     free(row);
     return sum;
+}
+
+/* the delta form factor of top-face cell (ix, iy) at resolution res */
+static double hc_top_delta(uint32_t res, uint32_t ix, uint32_t iy)
+{
+    double x = ((double)(2u * ix + 1u) - (double)res) / (double)res, y = ((double)(2u * iy + 1u) - (double)res) / (double)res;
+    double h = 2.0 / (double)res, r2 = x * x + y * y + 1.0;
+    return h * h / (FF_PI * r2 * r2);
 }
 
 /* ---------------------------------------------------------------------------------------- */
@@ -111,7 +120,18 @@ static void hc_test_convergence(void)
     if (!hc_point_world(c_par, 1.0f / 64.0f, &par, 0.0f, &wp, tp)) return;
     if (!hc_point_world(c_perp, 1.0f / 64.0f, &perp, 0.0f, &wq, tq)) { ff_world_free(&wp); return; }
     for (r = 0; r < 3; ++r) {
-        double fp = hc_row0_to_mesh1(&wp, res[r], NULL), fq = hc_row0_to_mesh1(&wq, res[r], NULL);
+        double fp = hc_row0_to_mesh1(&wp, res[r], 0), fq = hc_row0_to_mesh1(&wq, res[r], 0), cells = 0.0;
+        uint32_t ix, iy;
+        /* The receiver's diagonal (its two triangles' shared edge) runs through the cell centres
+           x = y of the top face: each centre on it goes to exactly one triangle, so F is the sum
+           of the deltas of the cells inside the square (|x|, |y| < 0.5; no centre is on its
+           outline), with the depth test or without, and nothing is counted twice. */
+        for (iy = 0; iy < res[r]; ++iy)
+            for (ix = 0; ix < res[r]; ++ix)
+                if (fabs(2.0 * ix + 1.0 - res[r]) < 0.5 * res[r] && fabs(2.0 * iy + 1.0 - res[r]) < 0.5 * res[r])
+                    cells += hc_top_delta(res[r], ix, iy);
+        CHECK_REL(fp, cells, 1e-6);
+        CHECK_REL(hc_row0_to_mesh1(&wp, res[r], 1), cells, 1e-6);
         err_par[r] = fabs(fp - exact_par) / exact_par;
         err_perp[r] = fabs(fq - exact_perp) / exact_perp;
         printf("    res %4u: parallel F %.7f (exact %.7f, relative error %.2e), perpendicular F %.7f (exact %.7f, %.2e)\n",
@@ -187,7 +207,7 @@ static void hc_test_clipping(void)
     /* the edges fall between cell centres: the error is O(1 / res), of alternating sign
        (measured 5.1e-3 at 64, 1.3e-3 at 256, 3.2e-4 at 1024) */
     exact = hc_point_parallel(3.0, 3.0, 1.0);
-    F = hc_row0_to_mesh1(&w, 256, NULL);
+    F = hc_row0_to_mesh1(&w, 256, 0);
     printf("    ceiling across the near planes: F %.6f, exact %.6f, relative error %.2e\n", F, exact, fabs(F - exact) / exact);
     CHECK_REL(F, exact, 3e-3);
     ff_world_free(&w);
@@ -196,7 +216,7 @@ static void hc_test_clipping(void)
     if (!hc_point_world(c0, 1.0f / 64.0f, &low, 0.0f, &w, t)) return;
     /* measured 1.0e-2 at 128, 2.5e-3 at 256, 6.3e-4 at 1024 */
     exact = hc_point_perpendicular(0.5, 0.5, 0.3);
-    F = hc_row0_to_mesh1(&w, 256, NULL);
+    F = hc_row0_to_mesh1(&w, 256, 0);
     printf("    wall crossing the base plane: F %.6f, exact %.6f, relative error %.2e\n", F, exact, fabs(F - exact) / exact);
     CHECK_REL(F, exact, 4e-3);
     ff_world_free(&w);
@@ -443,14 +463,6 @@ done:
 /* ---------------------------------------------------------------------------------------- */
 /* 5. aliasing: a small distant patch gets whole cells or nothing                           */
 /* ---------------------------------------------------------------------------------------- */
-
-/* the delta form factor of top-face cell (ix, iy) at resolution res */
-static double hc_top_delta(uint32_t res, uint32_t ix, uint32_t iy)
-{
-    double x = ((double)(2u * ix + 1u) - (double)res) / (double)res, y = ((double)(2u * iy + 1u) - (double)res) / (double)res;
-    double h = 2.0 / (double)res, r2 = x * x + y * y + 1.0;
-    return h * h / (FF_PI * r2 * r2);
-}
 
 static void hc_test_aliasing(void)
 {
