@@ -687,9 +687,10 @@ RAD_API void rad_form_factor_options_default(rad_form_factor_options *options);
    same bits). ALIASING: a patch covering few cells as seen from i gets a whole number of cells'
    delta form factors, 0 when it falls between centres; pick res so that the smallest patch
    covers several cells from its neighbours. rays_cast stays 0; pairs_evaluated counts the
-   ordered pairs (i, j) with j drawn into i's hemicube. Cost per row: O(N + 3 res^2) plus the
-   cells each patch covers; scratch 24 res^2 bytes per task (fewer tasks when that would pass
-   256 MiB; the results do not depend on the task count). */
+   ordered pairs (i, j) with j covering some cell centre of i's hemicube (before the depth
+   test). Cost per row: O(N + 3 res^2) plus the cells each patch covers; scratch 24 res^2
+   bytes per task (fewer tasks when that would pass 256 MiB; the results do not depend on the
+   task count). */
 
 /* The row range [row_begin, row_end) of the N x N form-factor matrix, dense, into out_rows
    ((row_end - row_begin) * N floats, row-major). Each unordered pair {i, j} is computed once,
