@@ -4927,14 +4927,15 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
                  (double)f->o.drop_threshold);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (f->o.method == RAD_FF_HEMICUBE &&
-        (f->o.hemicube_resolution < RAD__HC_MIN_RES || f->o.hemicube_resolution > RAD__HC_MAX_RES || (f->o.hemicube_resolution & 1u))) {
+    if (f->o.method == RAD_FF_HEMICUBE && (f->o.hemicube_resolution < RAD__HC_MIN_RES ||
+                                           f->o.hemicube_resolution > RAD__HC_MAX_RES || (f->o.hemicube_resolution & 1u))) {
         rad__log(c, RAD_LOG_ERROR, "form factor options: hemicube_resolution %u must be even and in [%u, %u] (0: %u)",
                  f->o.hemicube_resolution, RAD__HC_MIN_RES, RAD__HC_MAX_RES, RAD__HC_DEFAULT_RES);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!f->o.skip_visibility && f->o.method != RAD_FF_HEMICUBE && (!rc || !rc->occluded)) {
-        rad__log(c, RAD_LOG_ERROR, "form factors need a raycaster with occluded() unless skip_visibility is set or the method is RAD_FF_HEMICUBE");
+        rad__log(c, RAD_LOG_ERROR,
+                 "form factors need a raycaster with occluded() unless skip_visibility is set or the method is RAD_FF_HEMICUBE");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!P->scene) {
