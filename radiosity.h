@@ -630,7 +630,9 @@ typedef struct rad_matrix {
 typedef enum rad_ff_method {
     RAD_FF_ANALYTIC = 0,   /* analytic inner integral (point to polygon) at 'samples' points on
                               the emitting patch, visibility from one ray per point (default) */
-    RAD_FF_MONTE_CARLO = 1 /* 'samples' point pairs on both patches, kernel and one ray each */
+    RAD_FF_MONTE_CARLO = 1,/* 'samples' point pairs on both patches, kernel and one ray each */
+    RAD_FF_HEMICUBE = 2    /* Cohen and Greenberg's hemicube at each patch's centroid, with an
+                              item buffer for visibility (HEMICUBE below; no raycaster) */
 } rad_ff_method;
 
 typedef struct rad_form_factor_options {
@@ -640,35 +642,72 @@ typedef struct rad_form_factor_options {
                                patch's n x n sub-triangles (exact centroid, midpoint rule); the
                                visibility targets are rotated Hammersley points. Pairs closer
                                than twice their size get 16x the points. */
-    float ray_epsilon;      /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    float ray_epsilon;      /* relative to the scene diagonal (0: 1e-5; at most 1e-2); the
+                               hemicube's near-plane distance */
     float drop_threshold;   /* sparse: entries below it are dropped (0 keeps non-zeros) */
     uint32_t seed;          /* decorrelates visibility sample points (any value) */
     int skip_visibility;    /* non-zero: V = 1 everywhere (unoccluded form factors) */
+    uint32_t hemicube_resolution; /* RAD_FF_HEMICUBE: cells across the top face (0: 128); even,
+                               4 to 2048, else INVALID_ARGUMENT. Other methods ignore it. */
 } rad_form_factor_options;
 
 /* An owning form-factor matrix; 'matrix' views its storage. */
 typedef struct rad_form_factors {
     rad_matrix matrix;
     uint64_t rays_cast;        /* visibility rays the build cast */
-    uint64_t pairs_evaluated;  /* unordered patch pairs whose value was computed */
+    uint64_t pairs_evaluated;  /* unordered patch pairs whose value was computed (the
+                                  hemicube: ordered pairs drawn, see HEMICUBE) */
     rad_allocator allocator;   /* private */
     void *storage;             /* private */
 } rad_form_factors;
 
+/* Defaults: RAD_FF_ANALYTIC, samples 16, ray_epsilon 1e-5, hemicube_resolution 128, the rest 0. */
 RAD_API void rad_form_factor_options_default(rad_form_factor_options *options);
+
+/* HEMICUBE (RAD_FF_HEMICUBE; Cohen and Greenberg 1985). Row i is what a hemicube at patch i's
+   centroid, oriented by its normal, sees: the point-to-area form factors from the centroid,
+   the classic method's assumption (accurate when a patch is small against its distance to
+   the others; a patch next to i gets the centroid's value, not the area average). The
+   hemicube has a top face of res x res cells at unit distance along the normal and four side
+   faces of res x res/2 cells (res = hemicube_resolution; its side axes are the branchless
+   orthonormal basis of the normal, Duff et al. 2017). Every other patch is drawn into each
+   face it reaches: projected, clipped against the near plane at ray_epsilon times the scene
+   diagonal (nearer geometry is cut away; a patch whose plane passes closer than that to the
+   centroid is edge-on and skipped), and point-sampled at the cell centres with a depth test
+   (an item buffer: each cell holds the nearest patch covering its centre; a centre on an edge
+   shared by two patches goes to exactly one of them). Patch i itself and everything behind
+   its plane are skipped. F_ij is the sum over the cells that j holds of the closed-form delta
+   form factors (the midpoint rule: top cell dA / (pi (x^2 + y^2 + 1)^2), side cell
+   z dA / (pi (y^2 + z^2 + 1)^2) in the face's coordinates), whose total over the hemicube
+   differs from 1 by O(1/res^2). Every patch occludes, seen from either side, but one seen from
+   behind receives nothing (its cells count for no column).
+   Consequences: visibility is the item buffer, so the raycaster is not used (may be NULL);
+   samples and seed are ignored; skip_visibility counts the cells of every front-facing patch
+   with no depth test. Each row is computed on its own: A_i F_ij = A_j F_ji holds only up to
+   the discretisation, and the dense call computes all N rows (rows, dense and sparse give the
+   same bits). ALIASING: a patch covering few cells as seen from i gets a whole number of cells'
+   delta form factors, 0 when it falls between centres; pick res so that the smallest patch
+   covers several cells from its neighbours. rays_cast stays 0; pairs_evaluated counts the
+   ordered pairs (i, j) with j covering some cell centre of i's hemicube (before the depth
+   test). Cost per row: O(N + 3 res^2) plus the cells each patch covers; scratch 24 res^2
+   bytes per task (fewer tasks when that would pass 256 MiB; the results do not depend on the
+   task count). */
 
 /* The row range [row_begin, row_end) of the N x N form-factor matrix, dense, into out_rows
    ((row_end - row_begin) * N floats, row-major). Each unordered pair {i, j} is computed once,
    from the sample points of the smaller patch (the lower index on a tie); the other entry
    follows by reciprocity, so A_i F_ij = A_j F_ji holds exactly, no area ratio can overflow,
-   and any split of the rows gives the same bits as the full matrix. raycaster may be NULL only with skip_visibility. Thread safety: reentrant; uses
+   and any split of the rows gives the same bits as the full matrix (RAD_FF_HEMICUBE computes
+   each row on its own instead: HEMICUBE above). raycaster may be NULL only with
+   skip_visibility or RAD_FF_HEMICUBE. Thread safety: reentrant; uses
    ctx->parallel_for. Cost: O((row_end-row_begin) N samples). docs/methods/formfactor-analytic.md. */
 RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_raycaster *raycaster,
                                         const rad_form_factor_options *options, uint32_t row_begin,
                                         uint32_t row_end, float *out_rows, const rad_context *ctx);
 
 /* The dense N x N matrix (N = patches->count; SIZE_OVERFLOW when N*N*4 bytes does not fit).
-   Computes each unordered pair once: half the work of N rows. Same values as the rows call. */
+   Computes each unordered pair once: half the work of N rows (the hemicube: N rows). Same
+   values as the rows call. */
 RAD_API rad_result rad_form_factors_dense(const rad_patches *patches, const rad_raycaster *raycaster,
                                           const rad_form_factor_options *options, const rad_context *ctx,
                                           rad_form_factors **out);
@@ -4271,6 +4310,15 @@ RAD_API void rad_camera_ray(const rad_camera *cam, uint32_t width, uint32_t heig
 /* >>formfactor: form factors                                                               */
 /* ======================================================================================== */
 
+#define RAD__HC_DEFAULT_RES 128u
+#define RAD__HC_MIN_RES 4u
+#define RAD__HC_MAX_RES 2048u
+/* scratch of all the tasks' hemicubes together: fewer tasks above it (the results do not
+   depend on the task count) */
+#define RAD__HC_SCRATCH_BYTES ((size_t)256 << 20)
+#define RAD__HC_NONE 0xFFFFFFFFu  /* a cell that sees nothing */
+#define RAD__HC_BACK 0xFFFFFFFEu  /* a cell that sees a patch from behind: counts for no column */
+
 /* Contour integral over one convex polygon q (points relative to the receiver point, in its
    upper half-space), against unit normal n, in double. Signed by the winding. */
 static double rad__contour(const double (*q)[3], int count, const double *n)
@@ -4376,6 +4424,7 @@ RAD_API void rad_form_factor_options_default(rad_form_factor_options *o)
     o->method = RAD_FF_ANALYTIC;
     o->samples = 16;
     o->ray_epsilon = 1e-5f;
+    o->hemicube_resolution = RAD__HC_DEFAULT_RES;
 }
 
 /* shared state of one form-factor computation */
@@ -4398,6 +4447,14 @@ typedef struct rad__ff {
     size_t out_stride;
     int dense_mode;               /* 1: compute j > i and mirror into a full N x N 'out' */
     uint32_t tasks;
+    /* RAD_FF_HEMICUBE (the pair fields above stay NULL) */
+    uint32_t hc_res;
+    double hc_near;               /* absolute near-plane distance */
+    double *hc_centre;            /* res cell centres across a face, -1 .. 1 (a side face's
+                                     heights are the upper half, 0 .. 1) */
+    double *hc_dtop, *hc_dside;   /* delta form factors: res x res, res x res/2, row-major */
+    uint32_t *hc_item;            /* per task 3 res^2 cells: the top face, then the 4 sides */
+    float *hc_depth;              /* per task, the same cells: 1 / depth of the nearest item */
 } rad__ff;
 
 static void rad__ff_patch_corners(const rad__ff *f, uint32_t i, float *v)
@@ -4559,6 +4616,237 @@ static int rad__ff_from_i(const rad__ff *f, uint32_t i, uint32_t j)
     return ai < aj || (ai == aj && i < j);
 }
 
+/* ---- the hemicube (Cohen and Greenberg 1985; HEMICUBE in >>api_formfactor) ---- */
+
+/* The coefficients e of the edge function e0 x + e1 y + e2 of the projected edge p -> r times
+   'sign' (positive on the left of the edge when sign is 1). They are computed from the two
+   endpoints in a fixed order (smaller x, then smaller y, first) and negated when the edge
+   runs the other way, so two polygons that share the edge get exactly opposite values at
+   every point, whatever the compiler contracts into fused multiply-adds: a cell centre on the
+   edge goes to exactly one of them (the tie rule of rad__hc_draw). */
+static void rad__hc_edge(const double *p, const double *r, double sign, double *e)
+{
+    int swap = r[0] < p[0] || (r[0] == p[0] && r[1] < p[1]);
+    const double *lo = swap ? r : p, *hi = swap ? p : r;
+    double s = swap ? -sign : sign;
+    e[0] = s * (lo[1] - hi[1]);
+    e[1] = s * (hi[0] - lo[0]);
+    e[2] = s * (lo[0] * hi[1] - lo[1] * hi[0]);
+}
+
+/* Draws triangle q (three points in one face's frame, relative to the hemicube's centre: a and
+   b across the face, d along its axis) into that face: 'rows' rows of res cells whose centres
+   are x = centre[ix], y = centre[y0 + iy] (y0 = 0 for the top face, res/2 for a side face,
+   whose b / d runs from 0 to 1 only), its item, depth and delta form factor arrays starting
+   at item, depth, dff. With acc (no visibility) adds the delta form factor of every covered
+   cell to *acc; else keeps in each cell the nearest item so far (depth holds 1 / distance along
+   the face's axis, 0 for none). Returns 1 when the triangle covered some cell centre. */
+static int rad__hc_draw(const rad__ff *f, const double (*q)[3], uint32_t rows, uint32_t y0, uint32_t *item, float *depth,
+                        const double *dff, uint32_t value, double *acc)
+{
+    const uint32_t res = f->hc_res;
+    const double znear = f->hc_near, *ctr = f->hc_centre, half = 0.5 * (double)res, blo = y0 ? 0.0 : -1.0;
+    double poly[4][3], xy[4][2], edge[4][3], e1[3], e2[3], m[3], w[3], k, len, area = 0.0;
+    double xmin, xmax, ymin, ymax, fx0, fx1, fy0, fy1;
+    uint32_t ix0, ix1, iy0, iy1, ix, iy;
+    int n = 0, ne = 0, v, kk, drawn = 0;
+    /* outside the face's frustum: every point beyond the near plane or one of the four sides */
+    if (q[0][2] < znear && q[1][2] < znear && q[2][2] < znear) return 0;
+    if (q[0][0] > q[0][2] && q[1][0] > q[1][2] && q[2][0] > q[2][2]) return 0;
+    if (q[0][0] < -q[0][2] && q[1][0] < -q[1][2] && q[2][0] < -q[2][2]) return 0;
+    if (q[0][1] > q[0][2] && q[1][1] > q[1][2] && q[2][1] > q[2][2]) return 0;
+    if (q[0][1] < blo * q[0][2] && q[1][1] < blo * q[1][2] && q[2][1] < blo * q[2][2]) return 0;
+    /* the triangle's plane m . x = k; 1 / distance along the axis at (x, y) is w . (x, y, 1). A
+       plane passing within the near distance of the centre is seen edge-on: nothing to draw */
+    for (kk = 0; kk < 3; ++kk) { e1[kk] = q[1][kk] - q[0][kk]; e2[kk] = q[2][kk] - q[0][kk]; }
+    m[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    m[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    m[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    len = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    k = m[0] * q[0][0] + m[1] * q[0][1] + m[2] * q[0][2];
+    if (!(fabs(k) > znear * len)) return 0;
+    for (kk = 0; kk < 3; ++kk) w[kk] = m[kk] / k;
+    /* clip against d >= znear; a new point is interpolated from the inside end of its edge, so a
+       clipped edge shared by two triangles gives both the same point */
+    for (v = 0; v < 3; ++v) {
+        const double *p = q[v], *r = q[(v + 1) % 3];
+        int pin = p[2] >= znear, rin = r[2] >= znear;
+        if (pin) { for (kk = 0; kk < 3; ++kk) poly[n][kk] = p[kk]; ++n; }
+        if (pin != rin) {
+            const double *in = pin ? p : r, *out = pin ? r : p;
+            double t = (in[2] - znear) / (in[2] - out[2]);
+            for (kk = 0; kk < 2; ++kk) poly[n][kk] = in[kk] + t * (out[kk] - in[kk]);
+            poly[n][2] = znear;
+            ++n;
+        }
+    }
+    if (n < 3) return 0;
+    for (v = 0; v < n; ++v) { xy[v][0] = poly[v][0] / poly[v][2]; xy[v][1] = poly[v][1] / poly[v][2]; }
+    xmin = xmax = xy[0][0];
+    ymin = ymax = xy[0][1];
+    for (v = 0; v < n; ++v) {
+        const double *p = xy[v], *r = xy[(v + 1) % n];
+        area += p[0] * r[1] - r[0] * p[1];
+        if (p[0] < xmin) xmin = p[0];
+        if (p[0] > xmax) xmax = p[0];
+        if (p[1] < ymin) ymin = p[1];
+        if (p[1] > ymax) ymax = p[1];
+    }
+    if (!(area != 0.0)) return 0;
+    for (v = 0; v < n; ++v) {
+        rad__hc_edge(xy[v], xy[(v + 1) % n], area > 0.0 ? 1.0 : -1.0, edge[ne]);
+        if (edge[ne][0] != 0.0 || edge[ne][1] != 0.0) ++ne; /* a zero-length edge bounds nothing */
+    }
+    /* the cells whose centres the bounding box may hold, one cell wider each way (the edge
+       functions decide) */
+    fx0 = floor(xmin * half + half - 0.5);
+    fx1 = ceil(xmax * half + half - 0.5);
+    fy0 = floor(ymin * half + half - 0.5 - (double)y0);
+    fy1 = ceil(ymax * half + half - 0.5 - (double)y0);
+    if (!(fx1 >= 0.0 && fx0 <= (double)(res - 1u) && fy1 >= 0.0 && fy0 <= (double)(rows - 1u))) return 0;
+    ix0 = fx0 > 0.0 ? (uint32_t)fx0 : 0u;
+    ix1 = fx1 < (double)(res - 1u) ? (uint32_t)fx1 : res - 1u;
+    iy0 = fy0 > 0.0 ? (uint32_t)fy0 : 0u;
+    iy1 = fy1 < (double)(rows - 1u) ? (uint32_t)fy1 : rows - 1u;
+    for (iy = iy0; iy <= iy1; ++iy) {
+        double y = ctr[y0 + iy], lo = (double)ix0, hi = (double)ix1, slo = lo, shi = hi;
+        int tall[4], tslow[4], nall = 0, nslow = 0, out = 0;
+        /* The row's span. An edge parallel to the row (e0 = 0) has one value along it: it keeps
+           or drops the whole row. Where another edge crosses the row gives the span, one cell
+           wider each way; the cells more than a cell inside every crossing are inside those
+           edges whatever the rounding (the crossing is good to far less than a cell, the edge
+           function there far larger than its rounding). The edge functions decide every other
+           cell, and the nearly horizontal edges (|e0| <= 1e-6 |e1|: an imprecise crossing)
+           every cell. Each edge is evaluated at one place only, so a centre on an edge shared
+           by two triangles still goes to exactly one. */
+        for (v = 0; v < ne && !out; ++v) {
+            const double *e = edge[v];
+            double cross;
+            if (e[0] == 0.0) {
+                double val = e[1] * y + e[2];
+                if (!(val > 0.0 || (val == 0.0 && e[1] > 0.0))) out = 1;
+                continue;
+            }
+            tall[nall++] = v;
+            if (!(fabs(e[0]) > 1e-6 * fabs(e[1]))) { tslow[nslow++] = v; continue; }
+            /* the crossing in cell units, clamped to the face and a few cells beyond (which
+               changes no bound) and rounded down by truncating a positive number: floor()
+               is a library call on plain x86-64 */
+            cross = -(e[1] * y + e[2]) / e[0] * half + half - 0.5;
+            cross = cross > -4.0 ? (cross < (double)res + 4.0 ? cross : (double)res + 4.0) : -4.0;
+            cross = (double)(long)(cross + 8.0) - 8.0;
+            if (e[0] > 0.0) {
+                if (cross - 1.0 > lo) lo = cross - 1.0;
+                if (cross + 2.0 > slo) slo = cross + 2.0;
+            } else {
+                if (cross + 2.0 < hi) hi = cross + 2.0;
+                if (cross - 1.0 < shi) shi = cross - 1.0;
+            }
+        }
+        if (out || !(lo <= hi)) continue;
+        for (ix = (uint32_t)lo; ix <= (uint32_t)hi; ++ix) {
+            double x = ctr[ix];
+            size_t cell = (size_t)iy * res + ix;
+            const int *list = (double)ix < slo || (double)ix > shi ? tall : tslow;
+            int count = list == tall ? nall : nslow, t;
+            float inv;
+            for (t = 0; t < count; ++t) {
+                const double *e = edge[list[t]];
+                double val = e[0] * x + e[1] * y + e[2];
+                if (val > 0.0) continue;
+                /* on the edge: the polygon whose edge function has (e0, e1) > 0 in lexical order
+                   takes the centre; its neighbour across the edge has the negated function */
+                if (val == 0.0 && (e[0] > 0.0 || (e[0] == 0.0 && e[1] > 0.0))) continue;
+                break;
+            }
+            if (t < count) continue;
+            drawn = 1;
+            if (acc) { *acc += dff[cell]; continue; }
+            inv = (float)(w[0] * x + w[1] * y + w[2]);
+            if (inv > depth[cell]) { depth[cell] = inv; item[cell] = value; }
+        }
+    }
+    return drawn;
+}
+
+/* Row i by the hemicube at patch i's centroid. */
+static rad_result rad__hc_row(rad__ff *f, uint32_t i, uint32_t task)
+{
+    const rad_patches *P = f->P;
+    const rad_patch *pi = &P->patches[i];
+    const uint32_t N = P->count, res = f->hc_res, half = res / 2u;
+    const size_t top = (size_t)res * res, side = (size_t)res * half, cells = top + 4u * side;
+    uint32_t *item = f->hc_item + (size_t)task * cells;
+    float *depth = f->hc_depth + (size_t)task * cells;
+    float *row = f->out + (size_t)(i - f->row_begin) * f->out_stride;
+    double *acc = f->acc + (size_t)task * N, c[3], n[3], u[3], v[3], sg, a, b;
+    const int skip = f->o.skip_visibility != 0;
+    uint32_t j, m, face;
+    size_t cell;
+    int k;
+    for (k = 0; k < 3; ++k) { c[k] = pi->centroid[k]; n[k] = pi->normal[k]; }
+    /* the side axes: the branchless orthonormal basis of n (Duff et al. 2017) */
+    sg = n[2] >= 0.0 ? 1.0 : -1.0;
+    a = -1.0 / (sg + n[2]);
+    b = n[0] * n[1] * a;
+    u[0] = 1.0 + sg * n[0] * n[0] * a; u[1] = sg * b; u[2] = -sg * n[0];
+    v[0] = b; v[1] = sg + n[1] * n[1] * a; v[2] = -n[1];
+    memset(acc, 0, sizeof(double) * N);
+    if (!skip) {
+        memset(item, 0xFF, sizeof(uint32_t) * cells); /* RAD__HC_NONE */
+        memset(depth, 0, sizeof(float) * cells);
+    }
+    for (j = 0; j < N; ++j) {
+        const rad_patch *pj = &P->patches[j];
+        double L[3][3], q[3][3], front = 0.0;
+        uint32_t value;
+        int drawn = 0;
+        if (j == i) continue;
+        /* the corners in the hemicube's frame (u, v, n) */
+        for (m = 0; m < 3; ++m) {
+            const float *x = P->vertices + 3 * (size_t)pj->vertices[m];
+            double d[3];
+            for (k = 0; k < 3; ++k) d[k] = (double)x[k] - c[k];
+            L[m][0] = d[0] * u[0] + d[1] * u[1] + d[2] * u[2];
+            L[m][1] = d[0] * v[0] + d[1] * v[1] + d[2] * v[2];
+            L[m][2] = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
+            if (m == 0) front = -(d[0] * pj->normal[0] + d[1] * pj->normal[1] + d[2] * pj->normal[2]);
+        }
+        if (L[0][2] <= 0.0 && L[1][2] <= 0.0 && L[2][2] <= 0.0) continue; /* behind i's plane, or in it */
+        if (skip && !(front > 0.0)) continue;
+        value = front > 0.0 ? j : RAD__HC_BACK; /* seen from behind: occludes, receives nothing */
+        for (face = 0; face < 5; ++face) {
+            size_t off = face == 0 ? 0 : top + (size_t)(face - 1u) * side;
+            for (m = 0; m < 3; ++m) {
+                const double *l = L[m];
+                double *o = q[m];
+                switch (face) {
+                case 0: o[0] = l[0]; o[1] = l[1]; o[2] = l[2]; break;  /* top: (u, v) across, n along */
+                case 1: o[0] = l[1]; o[1] = l[2]; o[2] = l[0]; break;  /* +u: (v, n) across */
+                case 2: o[0] = l[1]; o[1] = l[2]; o[2] = -l[0]; break; /* -u */
+                case 3: o[0] = l[0]; o[1] = l[2]; o[2] = l[1]; break;  /* +v: (u, n) across */
+                default: o[0] = l[0]; o[1] = l[2]; o[2] = -l[1]; break; /* -v */
+                }
+            }
+            drawn |= rad__hc_draw(f, (const double(*)[3])q, face ? half : res, face ? half : 0u, item + off, depth + off,
+                                  face ? f->hc_dside : f->hc_dtop, value, skip ? acc + j : NULL);
+        }
+        if (drawn) f->pairs[task]++;
+    }
+    if (!skip) {
+        for (cell = 0; cell < top; ++cell)
+            if (item[cell] < N) acc[item[cell]] += f->hc_dtop[cell];
+        for (face = 1; face < 5; ++face) {
+            const uint32_t *it = item + top + (size_t)(face - 1u) * side;
+            for (cell = 0; cell < side; ++cell)
+                if (it[cell] < N) acc[it[cell]] += f->hc_dside[cell];
+        }
+    }
+    for (j = 0; j < N; ++j) row[j] = (float)acc[j];
+    row[i] = 0.0f;
+    return RAD_SUCCESS;
+}
+
 static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
 {
     rad__ff *f = (rad__ff *)data;
@@ -4566,6 +4854,7 @@ static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
     double *acc = f->acc + (size_t)task * N;
     float inv_s = 1.0f / (float)f->o.samples;
     rad_result r;
+    if (f->o.method == RAD_FF_HEMICUBE) return rad__hc_row(f, i, task);
     /* dense mode: only j > i, each pair written both ways; rows mode: every j. Either way a
        pair is computed from the same side with the same points, so the bits agree. */
     for (j = f->dense_mode ? i + 1 : 0; j < N; ++j) {
@@ -4610,7 +4899,56 @@ static void rad__ff_release(rad__ff *f, const rad_allocator *a)
     rad__free(a, f->acc);
     rad__free(a, f->rays_cast);
     rad__free(a, f->pairs);
+    rad__free(a, f->hc_centre);
+    rad__free(a, f->hc_dtop);
+    rad__free(a, f->hc_dside);
+    rad__free(a, f->hc_item);
+    rad__free(a, f->hc_depth);
     memset(f, 0, sizeof(*f));
+}
+
+/* The hemicube's tables and per-task scratch (rad__ff_setup has checked the options). */
+static rad_result rad__hc_setup(rad__ff *f, const rad__ctx *c)
+{
+    const uint32_t res = f->o.hemicube_resolution, half = res / 2u, N = f->P->count;
+    const size_t cells = 3u * (size_t)res * res, per_task = cells * (sizeof(uint32_t) + sizeof(float));
+    const double h = 2.0 / (double)res, da = h * h;
+    uint32_t ix, iy, T = f->tasks;
+    if (per_task >= RAD__HC_SCRATCH_BYTES) T = 1;
+    else if (T > RAD__HC_SCRATCH_BYTES / per_task) T = (uint32_t)(RAD__HC_SCRATCH_BYTES / per_task);
+    f->tasks = T;
+    f->hc_res = res;
+    f->hc_near = (double)f->eps;
+    f->hc_centre = (double *)rad__alloc_array(&c->allocator, res, sizeof(double));
+    f->hc_dtop = (double *)rad__alloc_array(&c->allocator, (size_t)res * res, sizeof(double));
+    f->hc_dside = (double *)rad__alloc_array(&c->allocator, (size_t)res * half, sizeof(double));
+    f->hc_item = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * cells, sizeof(uint32_t));
+    f->hc_depth = (float *)rad__alloc_array(&c->allocator, (size_t)T * cells, sizeof(float));
+    f->acc = (double *)rad__alloc_array(&c->allocator, (size_t)T * N, sizeof(double));
+    f->rays_cast = (uint64_t *)rad__alloc_array(&c->allocator, T, sizeof(uint64_t));
+    f->pairs = (uint64_t *)rad__alloc_array(&c->allocator, T, sizeof(uint64_t));
+    if (!f->hc_centre || !f->hc_dtop || !f->hc_dside || !f->hc_item || !f->hc_depth || !f->acc || !f->rays_cast || !f->pairs) {
+        rad__log(c, RAD_LOG_ERROR, "out of memory for the scratch of %u hemicubes of resolution %u (%u patches)", T, res, N);
+        rad__ff_release(f, &c->allocator);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(f->rays_cast, 0, sizeof(uint64_t) * T);
+    memset(f->pairs, 0, sizeof(uint64_t) * T);
+    /* cell centres -1 + (ix + 1/2) h; the delta form factors of the midpoint rule: a top cell
+       at (x, y, 1) subtends dA / (pi r^4), a side cell at (1, x, y) y dA / (pi r^4), with
+       r^2 = x^2 + y^2 + 1 */
+    for (ix = 0; ix < res; ++ix) f->hc_centre[ix] = ((double)(2u * ix + 1u) - (double)res) / (double)res;
+    for (iy = 0; iy < res; ++iy)
+        for (ix = 0; ix < res; ++ix) {
+            double x = f->hc_centre[ix], y = f->hc_centre[iy], r2 = x * x + y * y + 1.0;
+            f->hc_dtop[(size_t)iy * res + ix] = da / (RAD__PI * r2 * r2);
+        }
+    for (iy = 0; iy < half; ++iy)
+        for (ix = 0; ix < res; ++ix) {
+            double x = f->hc_centre[ix], y = f->hc_centre[half + iy], r2 = x * x + y * y + 1.0;
+            f->hc_dside[(size_t)iy * res + ix] = y * da / (RAD__PI * r2 * r2);
+        }
+    return RAD_SUCCESS;
 }
 
 static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_raycaster *rc, const rad_form_factor_options *o,
@@ -4624,15 +4962,24 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
     if (f->o.samples > RAD__MAX_SAMPLES) f->o.samples = RAD__MAX_SAMPLES;
     f->o.samples = rad__lattice_side(f->o.samples) * rad__lattice_side(f->o.samples); /* a square */
     if (f->o.ray_epsilon == 0.0f) f->o.ray_epsilon = 1e-5f;
+    if (f->o.hemicube_resolution == 0) f->o.hemicube_resolution = RAD__HC_DEFAULT_RES;
     if (!(f->o.ray_epsilon > 0.0f && f->o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || !rad__finite(f->o.drop_threshold) ||
-        f->o.drop_threshold < 0.0f || (f->o.method != RAD_FF_ANALYTIC && f->o.method != RAD_FF_MONTE_CARLO)) {
+        f->o.drop_threshold < 0.0f ||
+        (f->o.method != RAD_FF_ANALYTIC && f->o.method != RAD_FF_MONTE_CARLO && f->o.method != RAD_FF_HEMICUBE)) {
         rad__log(c, RAD_LOG_ERROR, "form factor options: method %d, ray_epsilon %g (must be in (0, %g]) or drop_threshold %g "
                  "(finite, >= 0) is bad", (int)f->o.method, (double)f->o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON,
                  (double)f->o.drop_threshold);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (!f->o.skip_visibility && (!rc || !rc->occluded)) {
-        rad__log(c, RAD_LOG_ERROR, "form factors need a raycaster with occluded() unless skip_visibility is set");
+    if (f->o.method == RAD_FF_HEMICUBE && (f->o.hemicube_resolution < RAD__HC_MIN_RES ||
+                                           f->o.hemicube_resolution > RAD__HC_MAX_RES || (f->o.hemicube_resolution & 1u))) {
+        rad__log(c, RAD_LOG_ERROR, "form factor options: hemicube_resolution %u must be even and in [%u, %u] (0: %u)",
+                 f->o.hemicube_resolution, RAD__HC_MIN_RES, RAD__HC_MAX_RES, RAD__HC_DEFAULT_RES);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!f->o.skip_visibility && f->o.method != RAD_FF_HEMICUBE && (!rc || !rc->occluded)) {
+        rad__log(c, RAD_LOG_ERROR,
+                 "form factors need a raycaster with occluded() unless skip_visibility is set or the method is RAD_FF_HEMICUBE");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!P->scene) {
@@ -4646,6 +4993,7 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
     if (T > P->count) T = P->count;
     if (T == 0) T = 1;
     f->tasks = T;
+    if (f->o.method == RAD_FF_HEMICUBE) return rad__hc_setup(f, c);
     f->pts = (float *)rad__alloc_array(&c->allocator, (size_t)P->count * f->o.samples, 3 * sizeof(float));
     f->rays = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
     f->occ = (uint8_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 1);
@@ -4750,9 +5098,13 @@ RAD_API rad_result rad_form_factors_dense(const rad_patches *patches, const rad_
     r = rad__ff_setup(&f, patches, raycaster, options, &c);
     if (r != RAD_SUCCESS) { rad_form_factors_destroy(ff); return r; }
     f.out = (float *)ff->storage;
-    f.dense_mode = 1;
-    /* the last row has no j > i: write its diagonal here */
-    f.out[(size_t)N * N - 1] = 0.0f;
+    if (f.o.method == RAD_FF_HEMICUBE) {
+        f.out_stride = N; /* every row on its own, as the rows call */
+    } else {
+        f.dense_mode = 1;
+        /* the last row has no j > i: write its diagonal here */
+        f.out[(size_t)N * N - 1] = 0.0f;
+    }
     r = rad__for_rows(&c, N, f.tasks, rad__ff_row, &f);
     rad__ff_totals(&f, &ff->rays_cast, &ff->pairs_evaluated);
     rad__ff_release(&f, &c.allocator);
