@@ -66,6 +66,17 @@ if "$RAD" formfactors "$TMP/parallel.obj" > "$TMP/par.txt" 2> "$TMP/err.txt"; th
 else
     fail "formfactors C-11 parallel squares" "$(head -c 300 "$TMP/err.txt")"
 fi
+# the same pair by the two other form-factor methods
+for m in montecarlo hemicube; do
+    if "$RAD" formfactors "$TMP/parallel.obj" --ff $m --patches 200 > "$TMP/par-$m.txt" 2> "$TMP/err.txt"; then
+        v=$(pair "$TMP/par-$m.txt" a b)
+        close "$v" 0.19982489569838746 5e-3 && ok "formfactors --ff $m C-11 ($v)" || fail "formfactors --ff $m C-11" "got '$v'"
+    else
+        fail "formfactors --ff $m C-11" "$(head -c 300 "$TMP/err.txt")"
+    fi
+done
+"$RAD" formfactors "$TMP/parallel.obj" --ff hemicube --hemicube-res 5 > /dev/null 2> "$TMP/err.txt"
+[ $? -eq 1 ] && grep -q "hemicube_resolution" "$TMP/err.txt" && ok "formfactors --hemicube-res 5 refused" || fail "formfactors --hemicube-res 5 refused"
 
 # perpendicular unit squares sharing an edge, both facing into the quarter space (C-14)
 cat > "$TMP/perpendicular.obj" <<'EOF'

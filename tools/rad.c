@@ -380,12 +380,17 @@ static void usage(FILE *f)
 
 static void formfactors_usage(FILE *f)
 {
-    fprintf(f, "usage: rad formfactors SCENE [--patches N] [--max-edge L] [--samples S] [--threads N]\n"
+    fprintf(f, "usage: rad formfactors SCENE [--patches N] [--max-edge L] [--samples S] [--ff M] [--hemicube-res R]\n"
+               "                        [--threads N]\n"
                "Prints one line 'FROM TO VALUE' per ordered pair of named objects: the area-weighted\n"
                "group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i.\n"
                "  --patches N   target patch count (default 2000)\n"
                "  --max-edge L  longest patch edge (default: no limit)\n"
-               "  --samples S   points per patch pair (default 16, up to 256)\n"
+               "  --samples S   points per patch pair (default 16, up to 256; analytic and montecarlo)\n"
+               "  --ff M        analytic (default: the point-to-polygon integral at S points of the other\n"
+               "                patch, one visibility ray each), montecarlo (S point pairs) or hemicube\n"
+               "                (a hemicube at each patch centroid with an item buffer; no rays)\n"
+               "  --hemicube-res R  cells across the hemicube's top face (default 128; even, 4 to 2048)\n"
                "  --threads N   worker threads (default: all cores; at most 1024)\n");
 }
 
@@ -394,7 +399,8 @@ static void formfactors_usage(FILE *f)
 int rad_cmd_formfactors(int argc, char **argv)
 {
     const char *scene_name = NULL, *cmd = "formfactors";
-    uint32_t patches_target = 2000, samples = 16, threads = 0, G, H, i, j, gc;
+    uint32_t patches_target = 2000, samples = 16, threads = 0, G, H, i, j, gc, hemicube_res = 0;
+    rad_ff_method ff_method = RAD_FF_ANALYTIC;
     float max_edge = 0.0f;
     rad_tool_world w;
     rad_patches *P = NULL;
@@ -407,13 +413,22 @@ int rad_cmd_formfactors(int argc, char **argv)
     int a;
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
-        int need = !strcmp(o, "--patches") || !strcmp(o, "--samples") || !strcmp(o, "--threads") || !strcmp(o, "--max-edge");
+        int need = !strcmp(o, "--patches") || !strcmp(o, "--samples") || !strcmp(o, "--threads") || !strcmp(o, "--max-edge") ||
+                   !strcmp(o, "--ff") || !strcmp(o, "--hemicube-res");
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) { formfactors_usage(stdout); return 0; }
         if (need && a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
         if (!strcmp(o, "--patches")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
         else if (!strcmp(o, "--samples")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
         else if (!strcmp(o, "--threads")) { if (rad_tool_parse_threads(cmd, o, argv[++a], &threads)) return 2; }
         else if (!strcmp(o, "--max-edge")) { if (rad_tool_parse_float(cmd, o, argv[++a], &max_edge)) return 2; }
+        else if (!strcmp(o, "--hemicube-res")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &hemicube_res)) return 2; }
+        else if (!strcmp(o, "--ff")) {
+            const char *m = argv[++a];
+            if (!strcmp(m, "analytic")) ff_method = RAD_FF_ANALYTIC;
+            else if (!strcmp(m, "montecarlo") || !strcmp(m, "monte-carlo")) ff_method = RAD_FF_MONTE_CARLO;
+            else if (!strcmp(m, "hemicube")) ff_method = RAD_FF_HEMICUBE;
+            else { fprintf(stderr, "rad %s: unknown --ff '%s' (analytic, montecarlo or hemicube)\n", cmd, m); return 2; }
+        }
         else if (o[0] == '-' && o[1]) { fprintf(stderr, "rad %s: unknown option '%s'\n", cmd, o); return 2; }
         else if (!scene_name) scene_name = o;
         else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
@@ -432,6 +447,8 @@ int rad_cmd_formfactors(int argc, char **argv)
     }
     rad_form_factor_options_default(&fo);
     fo.samples = samples;
+    fo.method = ff_method;
+    if (hemicube_res) fo.hemicube_resolution = hemicube_res;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w.scene->triangle_count, P->count);
     r = rad_form_factors_dense(P, &w.rc, &fo, &ctx, &ff);
     rad_tool_progress_end();
