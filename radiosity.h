@@ -3895,14 +3895,28 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
     Ax = A[w->kx] - w->sx * A[w->kz]; Ay = A[w->ky] - w->sy * A[w->kz];
     Bx = B[w->kx] - w->sx * B[w->kz]; By = B[w->ky] - w->sy * B[w->kz];
     Cx = C[w->kx] - w->sx * C[w->kz]; Cy = C[w->ky] - w->sy * C[w->kz];
-    U = Cx * By - Cy * Bx;
-    V = Ax * Cy - Ay * Cx;
-    W = Bx * Ay - By * Ax;
-    if (U == 0.0f || V == 0.0f || W == 0.0f) {
-        /* on an edge in float: redo the 2D edge tests in double so shared edges are never missed */
-        U = (float)((double)Cx * (double)By - (double)Cy * (double)Bx);
-        V = (float)((double)Ax * (double)Cy - (double)Ay * (double)Cx);
-        W = (float)((double)Bx * (double)Ay - (double)By * (double)Ax);
+    /* Each product its own statement: a compiler may fuse a * b - c * d into one FMA, which
+       breaks the antisymmetry of a shared edge's test between its two triangles by up to one
+       rounding, and rays slip between them. Standard C fuses only within an expression, but
+       gcc with -std=gnu* (and any compiler with -ffp-contract=fast) fuses across statements,
+       so with FMA hardware any result within rounding of 0 is redone too. The redo is in
+       double, where a product of two floats is exact. */
+    {
+        float cb = Cx * By, cy = Cy * Bx, ac = Ax * Cy, ay = Ay * Cx, ba = Bx * Ay, bb = By * Ax;
+        U = cb - cy;
+        V = ac - ay;
+        W = ba - bb;
+#if defined(__FMA__)
+        if (fabsf(U) <= 1.2e-7f * (fabsf(cb) + fabsf(cy)) || fabsf(V) <= 1.2e-7f * (fabsf(ac) + fabsf(ay)) ||
+            fabsf(W) <= 1.2e-7f * (fabsf(ba) + fabsf(bb)))
+#else
+        if (U == 0.0f || V == 0.0f || W == 0.0f)
+#endif
+        {
+            U = (float)((double)Cx * (double)By - (double)Cy * (double)Bx);
+            V = (float)((double)Ax * (double)Cy - (double)Ay * (double)Cx);
+            W = (float)((double)Bx * (double)Ay - (double)By * (double)Ax);
+        }
     }
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     det = U + V + W;
