@@ -5933,6 +5933,30 @@ static rad_result rad__direct_ray(rad__direct *d, uint32_t task, uint32_t *nrays
     return RAD_SUCCESS;
 }
 
+/* Two unit tangents completing the unit normal n to a frame. */
+static void rad__tangent_frame(const float *n, float *t1, float *t2)
+{
+    float a[3] = { 1.0f, 0.0f, 0.0f };
+    if (fabs((double)n[0]) > 0.5) { a[0] = 0.0f; a[1] = 1.0f; }
+    rad__cross(t1, n, a);
+    rad__normalize(t1);
+    rad__cross(t2, n, t1);
+}
+
+/* Direction s of n cosine-distributed ones around n (frame t1, t2): Hammersley point s of n,
+   rotated by the two 16-bit halves of h, lifted from the disk. */
+static void rad__cosine_dir(const float *n, const float *t1, const float *t2, uint32_t s, uint32_t count, uint32_t h,
+                            float *dir)
+{
+    float u1, u2, rr, ph;
+    int k;
+    rad__hammersley(s, count, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
+    rr = (float)sqrt((double)u1);
+    ph = (float)(2.0 * RAD__PI) * u2;
+    for (k = 0; k < 3; ++k)
+        dir[k] = t1[k] * rr * (float)cos((double)ph) + t2[k] * rr * (float)sin((double)ph) + n[k] * (float)sqrt((double)(1.0f - u1));
+}
+
 /* all lights at one point into slot, each contribution times 'scale' */
 static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
                                     uint32_t slot, float scale, uint32_t seed)
@@ -5979,22 +6003,12 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
             if (r != RAD_SUCCESS) return r;
         } else if (li->type == RAD_LIGHT_SKY) {
             /* cosine-weighted directions: unoccluded fraction of the hemisphere times E_0 */
-            float t1[3], t2[3], a[3] = { 1.0f, 0.0f, 0.0f }, r1, r2;
+            float t1[3], t2[3];
             uint32_t h = rad__hash(seed ^ 0x5bd1e995u ^ l);
-            if (fabs((double)n[0]) > 0.5) { a[0] = 0.0f; a[1] = 1.0f; }
-            rad__cross(t1, n, a);
-            rad__normalize(t1);
-            rad__cross(t2, n, t1);
-            r1 = (float)(h & 0xFFFFu) / 65536.0f;
-            r2 = (float)(h >> 16) / 65536.0f;
+            rad__tangent_frame(n, t1, t2);
             for (s = 0; s < L; ++s) {
-                float u1, u2, rr, ph, dir[3];
-                rad__hammersley(s, L, r1, r2, &u1, &u2);
-                rr = (float)sqrt((double)u1);
-                ph = (float)(2.0 * RAD__PI) * u2;
-                for (k = 0; k < 3; ++k)
-                    dir[k] = t1[k] * rr * (float)cos((double)ph) + t2[k] * rr * (float)sin((double)ph) +
-                             n[k] * (float)sqrt((double)(1.0f - u1));
+                float dir[3];
+                rad__cosine_dir(n, t1, t2, s, L, h, dir);
                 r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, li->color, scale / (float)L, slot);
                 if (r != RAD_SUCCESS) return r;
             }
@@ -6159,6 +6173,30 @@ static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const ra
     return RAD_SUCCESS;
 }
 
+/* Points first .. first + count - 1 and their normals: finite (else NON_FINITE) and non-zero
+   (else INVALID_ARGUMENT), each logged with 'what'; the unit normals into unit (3 per point). */
+static rad_result rad__unit_normals(const rad__ctx *c, const char *what, const float *points, const float *normals,
+                                    uint32_t first, uint32_t count, float *unit)
+{
+    uint32_t i;
+    for (i = first; i < first + count; ++i)
+        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
+            rad__log(c, RAD_LOG_ERROR, "%s: point %u or its normal is not finite", what, i);
+            return RAD_ERROR_NON_FINITE;
+        }
+    for (i = 0; i < count; ++i) {
+        const float *n = normals + 3 * (size_t)(first + i);
+        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        int k;
+        if (!(len > 0.0) || len - len != 0.0) {
+            rad__log(c, RAD_LOG_ERROR, "%s: the normal of point %u has length %g (must be non-zero)", what, first + i, len);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        for (k = 0; k < 3; ++k) unit[3 * (size_t)i + (size_t)k] = (float)((double)n[k] / len);
+    }
+    return RAD_SUCCESS;
+}
+
 RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
                                          uint32_t light_count, const rad_direct_options *options, const float *points,
                                          const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx)
@@ -6166,33 +6204,21 @@ RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_rayca
     rad__ctx c;
     rad__direct d;
     rad_result r;
-    uint32_t i;
     float *unit;
     rad__ctx_init(&c, ctx);
     if (!points || !normals || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
     r = rad__direct_setup(&d, scene, raycaster, lights, light_count, options, &c);
     if (r != RAD_SUCCESS) return r;
-    for (i = 0; i < count; ++i)
-        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
-            rad__log(&c, RAD_LOG_ERROR, "point %u or its normal is not finite", i);
-            return RAD_ERROR_NON_FINITE;
-        }
     /* the cosines need unit normals: the caller's are normalized into a copy */
     unit = (float *)rad__alloc_array(&c.allocator, count ? (size_t)count : 1u, 3 * sizeof(float));
     if (!unit) {
         rad__log(&c, RAD_LOG_ERROR, "direct irradiance: out of memory for %u normals", count);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    for (i = 0; i < count; ++i) {
-        const float *n = normals + 3 * (size_t)i;
-        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-        int k;
-        if (!(len > 0.0) || len - len != 0.0) {
-            rad__log(&c, RAD_LOG_ERROR, "direct irradiance: the normal of point %u has length %g (must be non-zero)", i, len);
-            rad__free(&c.allocator, unit);
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-        for (k = 0; k < 3; ++k) unit[3 * (size_t)i + (size_t)k] = (float)((double)n[k] / len);
+    r = rad__unit_normals(&c, "direct irradiance", points, normals, 0, count, unit);
+    if (r != RAD_SUCCESS) {
+        rad__free(&c.allocator, unit);
+        return r;
     }
     d.points = points;
     d.normals = unit;
@@ -6256,7 +6282,7 @@ typedef struct rad__fg {
     float eps;
     rad_ray *ray_buf;              /* per task RAD__RAY_BATCH */
     rad_hit *hits;                 /* the chunk's hits, rays per point */
-    float *hit_p, *hit_n;          /* 3 per hit; hit_n zero: no contribution */
+    float *hit_p, *hit_n;          /* 3 per hit (kept where hits[].triangle is not RAD_NONE) */
 } rad__fg;
 
 static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
@@ -6266,32 +6292,14 @@ static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
     rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
     float t1[3], t2[3];
     uint32_t seed = rad__hash(g->seed ^ rad__hash(g->first + row + 0x68E31DA4u)), k0, k;
-    float rot = (float)(seed >> 8) * (1.0f / 16777216.0f);
     int c;
-    /* a tangent frame around n */
-    if (fabsf(n[0]) > 0.5f) { t1[0] = n[1]; t1[1] = -n[0]; t1[2] = 0.0f; }
-    else { t1[0] = 0.0f; t1[1] = n[2]; t1[2] = -n[1]; }
-    rad__normalize(t1);
-    t2[0] = n[1] * t1[2] - n[2] * t1[1];
-    t2[1] = n[2] * t1[0] - n[0] * t1[2];
-    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    rad__tangent_frame(n, t1, t2);
     for (k0 = 0; k0 < g->rays; k0 += RAD__RAY_BATCH) {
         uint32_t m = g->rays - k0 < RAD__RAY_BATCH ? g->rays - k0 : RAD__RAY_BATCH;
         rad_hit *h = g->hits + (size_t)row * g->rays + k0;
         for (k = 0; k < m; ++k) {
-            /* cosine-weighted: radius sqrt(u1) on the disk, lifted; u1 stratified, u2 the
-               radical inverse, both rotated per point */
-            float u1 = ((float)(k0 + k) + 0.5f) / (float)g->rays, u2 = rad__radical_inverse(k0 + k) + rot, r, phi, x, y, z;
-            if (u2 >= 1.0f) u2 -= 1.0f;
-            r = sqrtf(u1);
-            phi = 2.0f * (float)RAD__PI * u2;
-            x = r * cosf(phi);
-            y = r * sinf(phi);
-            z = sqrtf(1.0f - u1 > 0.0f ? 1.0f - u1 : 0.0f);
-            for (c = 0; c < 3; ++c) {
-                rays[k].origin[c] = p[c] + n[c] * g->eps;
-                rays[k].dir[c] = x * t1[c] + y * t2[c] + z * n[c];
-            }
+            rad__cosine_dir(n, t1, t2, k0 + k, g->rays, seed, rays[k].dir);
+            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c] + n[c] * g->eps;
             rays[k].tmin = 0.0f;
             rays[k].tmax = FLT_MAX;
         }
@@ -6300,10 +6308,8 @@ static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
             size_t at = 3 * ((size_t)row * g->rays + k0 + k);
             uint32_t t = h[k].triangle;
             const float *v, *nt;
-            if (t == RAD_NONE || t >= g->S->triangle_count) {
+            if (t == RAD_NONE || t >= g->S->triangle_count) { /* a miss: packed out below */
                 h[k].triangle = RAD_NONE;
-                g->hit_p[at] = g->hit_p[at + 1] = g->hit_p[at + 2] = 0.0f;
-                g->hit_n[at] = g->hit_n[at + 1] = g->hit_n[at + 2] = 0.0f;
                 continue;
             }
             v = g->S->positions + 9 * (size_t)t;
@@ -6312,10 +6318,7 @@ static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
                 g->hit_p[at + (size_t)c] = v[c] + h[k].b1 * (v[3 + c] - v[c]) + h[k].b2 * (v[6 + c] - v[c]);
                 g->hit_n[at + (size_t)c] = nt[c];
             }
-            if (!(rad__dot(nt, rays[k].dir) < 0.0f)) { /* a back face: one-sided, black */
-                h[k].triangle = RAD_NONE;
-                g->hit_n[at] = g->hit_n[at + 1] = g->hit_n[at + 2] = 0.0f;
-            }
+            if (!(rad__dot(nt, rays[k].dir) < 0.0f)) h[k].triangle = RAD_NONE; /* a back face: one-sided, black */
         }
     }
     return RAD_SUCCESS;
@@ -6391,19 +6394,7 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
     for (first = 0; first < count && r == RAD_SUCCESS; first += per) {
         uint32_t m = count - first < per ? count - first : per, nh = 0, k;
         size_t hits = (size_t)m * o.rays, j;
-        for (i = 0; i < m && r == RAD_SUCCESS; ++i) {
-            const float *p = points + 3 * (size_t)(first + i), *n = normals + 3 * (size_t)(first + i);
-            double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-            if (!rad__finite3(p) || !rad__finite3(n)) {
-                rad__log(&c, RAD_LOG_ERROR, "final gather: point %u or its normal is not finite", first + i);
-                r = RAD_ERROR_NON_FINITE;
-            } else if (!(len > 0.0) || len - len != 0.0) {
-                rad__log(&c, RAD_LOG_ERROR, "final gather: the normal of point %u has length %g (must be non-zero)", first + i, len);
-                r = RAD_ERROR_INVALID_ARGUMENT;
-            } else {
-                for (k = 0; k < 3; ++k) unit[3 * (size_t)i + k] = (float)((double)n[k] / len);
-            }
-        }
+        r = rad__unit_normals(&c, "final gather", points, normals, first, m, unit);
         if (r != RAD_SUCCESS) break;
         g.points = points + 3 * (size_t)first;
         g.normals = unit;
