@@ -538,6 +538,33 @@ RAD_API uint32_t rad_patches_locate(const rad_patches *patches, uint32_t triangl
 RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const float *patch_values,
                                              uint32_t channels, float *out_vertex_values);
 
+/* Per-vertex irradiance without dark halos. A patch partly covered by other geometry (under a
+   block, under a one-sided light a hair below the ceiling) has a small H only because part of
+   its area sees nothing; a plain vertex average smears that into the visible surface around the
+   contact. So the value at vertex v is (mean radiosity seen) x (how much is seen):
+       H_v = [sum_i A_i H_i / sum_i A_i S_i] * S_v,
+   the sums over the patches sharing v, S_v the area-weighted mean of S over those patches that
+   are not partly covered (S_i >= 3/4 of the largest S at v). S (one float per patch) is the
+   row sum of F (sum_j F_ij, how much of its hemisphere a patch sees: rad_matrix_multiply by
+   ones); NULL gives rad_patches_vertex_values. H: 3 floats per patch; out: 3 per patch vertex.
+   Errors: INVALID_ARGUMENT, NON_FINITE (H or S not finite, S < 0), OUT_OF_MEMORY. O(patches). */
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx);
+
+/* Values at the vertices of one of the scene's own meshes, for an engine that draws that mesh:
+   'mesh' is the index the mesh had in rad_scene_desc.meshes and 'desc' the same description
+   (its vertex count and indices). vertex_values: 3 floats per patch vertex (from
+   rad_patches_vertex_values or rad_patches_vertex_irradiance). Each triangle corner takes the
+   value interpolated at that corner of its patch; a vertex shared by several triangles gets
+   the area-weighted mean over them (so a crease averages its sides, as the mesh's own smooth
+   normals do), and a vertex no triangle uses (or only skipped degenerate ones) gets 0.
+   out: 3 * desc->vertex_count floats. Errors: INVALID_ARGUMENT (mesh >= the scene's mesh count,
+   a NULL pointer), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
+   of that mesh beyond desc->triangle_count: another description), OUT_OF_MEMORY.
+   O(triangles of the scene). */
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx);
+
 /* ======================================================================================== */
 /* >>api_rays: ray queries and the built-in BVH                                             */
 /* ======================================================================================== */
@@ -3566,6 +3593,130 @@ RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const f
             out_vertex_values[(size_t)v * channels + k] = src[channels] > 0.0 ? (float)(src[k] / src[channels]) : 0.0f;
     }
     rad__free(&a, acc);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *S_v, *S_max, *S_area;
+    uint32_t n, nv, i, k;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !H || !out_vertex_H) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: patches, H and out_vertex_H are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    n = patches->count;
+    nv = patches->vertex_count;
+    for (i = 0; i < 3 * n; ++i)
+        if (!rad__finite(H[i])) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: H of patch %u is not finite", i / 3);
+            return RAD_ERROR_NON_FINITE;
+        }
+    if (!S) return rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(S[i]) || S[i] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: row sum S of patch %u is %g (finite, >= 0 expected)",
+                     i, (double)S[i]);
+            return RAD_ERROR_NON_FINITE;
+        }
+    S_v = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)nv, sizeof(float));
+    if (!S_v) return RAD_ERROR_OUT_OF_MEMORY;
+    S_max = S_v + nv;
+    S_area = S_max + nv;
+    /* the bracket: vertex means of H and of S, both area-weighted over the patches at v */
+    r = rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(patches, S, 1, S_v);
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] > S_max[v]) S_max[v] = S[i];
+            }
+        for (i = 0; i < nv; ++i) {
+            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= scale;
+            S_v[i] = 0.0f;
+        }
+        /* S_v: how much the uncovered patches at v see */
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] >= 0.75f * S_max[v]) {
+                    S_v[v] += patches->patches[i].area * S[i];
+                    S_area[v] += patches->patches[i].area;
+                }
+            }
+        for (i = 0; i < nv; ++i) {
+            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= s_v;
+        }
+    }
+    rad__free(&c.allocator, S_v);
+    return r;
+}
+
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_scene *S;
+    double *acc;
+    uint32_t t, k, m, V;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !patches->scene || !vertex_values || !desc || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: patches, vertex_values, desc and out are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    S = patches->scene;
+    if (mesh >= S->mesh_count) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: mesh %u, but the scene has %u meshes", mesh, S->mesh_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    V = desc->vertex_count;
+    acc = (double *)rad__alloc_array(&c.allocator, 4 * (size_t)V + 1u, sizeof(double));
+    if (!acc) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(acc, 0, (4 * (size_t)V + 1u) * sizeof(double));
+    for (t = 0; t < S->triangle_count; ++t) {
+        uint32_t j = S->source_triangles[t], id[3];
+        static const float corner[3][2] = { { 0.0f, 0.0f }, { 1.0f, 0.0f }, { 0.0f, 1.0f } };
+        if (S->meshes[t] != mesh) continue;
+        if (j >= desc->triangle_count) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: the scene's mesh %u has triangle %u, desc has %u triangles",
+                     mesh, j, desc->triangle_count);
+            rad__free(&c.allocator, acc);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+        for (k = 0; k < 3; ++k) {
+            id[k] = desc->indices ? desc->indices[3 * (size_t)j + k] : 3 * j + k;
+            if (id[k] >= V) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: triangle %u has vertex index %u >= %u", j, id[k], V);
+                rad__free(&c.allocator, acc);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        }
+        for (k = 0; k < 3; ++k) {
+            float w[3];
+            uint32_t p = rad_patches_locate(patches, t, corner[k][0], corner[k][1], w);
+            double *dst = acc + 4 * (size_t)id[k];
+            if (p == RAD_NONE) continue;
+            for (m = 0; m < 3; ++m) {
+                const float *src = vertex_values + 3 * (size_t)patches->patches[p].vertices[m];
+                dst[0] += (double)S->areas[t] * w[m] * src[0];
+                dst[1] += (double)S->areas[t] * w[m] * src[1];
+                dst[2] += (double)S->areas[t] * w[m] * src[2];
+            }
+            dst[3] += S->areas[t];
+        }
+    }
+    for (k = 0; k < V; ++k) {
+        const double *src = acc + 4 * (size_t)k;
+        for (m = 0; m < 3; ++m) out[3 * (size_t)k + m] = src[3] > 0.0 ? (float)(src[m] / src[3]) : 0.0f;
+    }
+    rad__free(&c.allocator, acc);
     return RAD_SUCCESS;
 }
 
