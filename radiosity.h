@@ -781,7 +781,7 @@ typedef int (*rad_residual_fn)(void *user, uint32_t iteration, double residual);
 
 typedef struct rad_solve_options {
     rad_output output;         /* RAD_OUTPUT_INDIRECT (default) or RAD_OUTPUT_TOTAL */
-    uint32_t bounces;          /* Jacobi: K (0 returns 0 indirect / E total) */
+    uint32_t bounces;          /* Jacobi: K (default 8; 0 returns 0 indirect / E total) */
     double tolerance;          /* Gauss-Seidel, shooting: relative (0: 1e-6) */
     uint32_t max_iterations;   /* GS sweeps (0: 1000), shooting steps (0: 100 N) */
     rad_residual_fn on_residual;
@@ -852,7 +852,9 @@ typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
     uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
-    int include_emitters;      /* non-zero (default): emissive triangles are area lights */
+    int include_emitters;      /* non-zero (default): emissive triangles are area lights;
+                                  0 leaves them out (a zeroed struct has no emitters: start
+                                  from rad_direct_options_default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
 } rad_direct_options;
@@ -1605,7 +1607,8 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
 
 typedef struct rad_multibounce_options {
-    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3) */
+    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3; 0 is INVALID_ARGUMENT:
+                                  start from rad_multibounce_options_default) */
     rad_mb_precision precision;/* storage of the result (default RAD_MB_FLOAT) */
     double tolerance;          /* K = inf: Neumann doubling stops once max row sum of
                                   (rho o F)^m <= tolerance (0: 1e-8) */
@@ -1679,8 +1682,10 @@ typedef enum rad_block_format {
 #define RAD_REORDER_MATCH 4       /* groups of four by greedy matching (rows into pairs, pairs
                                      into fours) on the same distance, then the group swaps */
 
+/* Start from rad_block_options_default: here zero is a setting, not the default (a zeroed
+   struct asks for BC1, no outliers, no reordering and one scale per channel). */
 typedef struct rad_block_options {
-    rad_block_format format;   /* default RAD_BLOCK_BC4X3 */
+    rad_block_format format;   /* default RAD_BLOCK_BC4X3 (0 is RAD_BLOCK_BC1) */
     float outlier_fraction;    /* the largest fraction p of the N^2 entries (by their largest
                                   channel) go exactly into the sparse list, zeros left in place;
                                   0 disables the step (default 0.05) */
@@ -1917,7 +1922,8 @@ typedef enum rad_local_rebuild_method {
 } rad_local_rebuild_method;
 
 typedef struct rad_local_options {
-    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default 1024) */
+    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default
+                                  1024; 0 is INVALID_ARGUMENT: start from rad_local_options_default) */
     rad_local_update update;   /* default RAD_LOCAL_EXACT */
     rad_local_eviction evict;  /* default RAD_LOCAL_EVICT_DOWNDATE */
     rad_local_rebuild_method rebuild; /* default RAD_LOCAL_REBUILD_INVERSE */
@@ -2189,7 +2195,8 @@ typedef enum rad_temporal_mode {
 
 typedef struct rad_temporal_options {
     rad_temporal_mode mode;
-    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES) */
+    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES,
+                              0 is INVALID_ARGUMENT: start from rad_temporal_options_default) */
     float weight;          /* fixed w in [0, 1) (default 0.998; 0 keeps no history) */
     uint32_t seed;         /* generator seed */
     int adaptive;          /* non-zero: per-row w from the estimator's variance (see below) */
