@@ -5671,6 +5671,21 @@ static void rad__finish_output(const rad_system *s, rad_output output, float *B_
         for (i = 0; i < n3; ++i) B_total_or_L[i] += s->E[i];
 }
 
+/* What every solver checks first: the system (logged once), the output and the options
+   (NULL: the defaults, copied to *o). */
+static rad_result rad__solve_begin(const rad_system *s, const rad_solve_options *options, const float *out,
+                                   const char *name, const rad__ctx *c, rad_solve_options *o)
+{
+    rad_result r = rad__check_system(s, c);
+    if (r != RAD_SUCCESS) return r;
+    if (!out) {
+        rad__log(c, RAD_LOG_ERROR, "%s: out is NULL", name);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) *o = *options; else rad_solve_options_default(o);
+    return rad__check_solve_options(o, c);
+}
+
 RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options *options, float *out, rad_solve_stats *stats,
                                     const rad_context *ctx)
 {
@@ -5681,11 +5696,8 @@ RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options
     uint32_t k;
     rad_result r;
     rad__ctx_init(&c, ctx);
-    r = rad__check_system(s, &c);
+    r = rad__solve_begin(s, options, out, "rad_solve_jacobi", &c, &o);
     if (r != RAD_SUCCESS) return r;
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     n3 = 3 * (size_t)s->n;
     cur = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
     tmp = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
@@ -5753,12 +5765,9 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
     {
-        rad_result checked = rad__check_system(s, &c); /* logs once */
-        if (checked != RAD_SUCCESS) return checked;
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_gauss_seidel", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
     }
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_it = o.max_iterations ? o.max_iterations : 1000;
     n3 = 3 * (size_t)s->n;
@@ -5807,15 +5816,13 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
     {
-        rad_result checked = rad__check_system(s, &c); /* logs once */
-        if (checked != RAD_SUCCESS) return checked;
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_progressive", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
     }
-    if (!out || !s->areas) {
+    if (!s->areas) {
         rad__log(&c, RAD_LOG_ERROR, "progressive refinement needs system->areas");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_steps = o.max_iterations ? o.max_iterations : (s->n > 42949672u ? 0xFFFFFFFFu : 100u * s->n);
     n3 = 3 * (size_t)s->n;
@@ -5919,12 +5926,9 @@ RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options
     int factored = -1;
     rad__ctx_init(&c, ctx);
     {
-        rad_result checked = rad__check_system(s, &c); /* logs once */
-        if (checked != RAD_SUCCESS) return checked;
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_direct", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
     }
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     n = s->n;
     if (!rad__mul3(n, n, sizeof(double), &bytes)) return RAD_ERROR_SIZE_OVERFLOW;
     M = (double *)rad__alloc(&c.allocator, bytes);
