@@ -204,6 +204,20 @@ s_examples() {
     else
         fail moving-light-small
     fi
+    # the teaching examples, at small sizes: each prints its table
+    compile_run learn_formfactors $CC -std=c99 $WARN -O2 -I. examples/learn_formfactors.c -o "$BUILD/learn_formfactors" -lm
+    if build learn_solvers $CC -std=c99 $WARN -O2 $OMP -I. examples/learn_solvers.c -o "$BUILD/learn_solvers" -lm &&
+       "$BUILD/learn_solvers" --patches 100 --iterations 4 >"$BUILD/learn_solvers.out" 2>&1; then
+        pass learn_solvers
+    else
+        fail learn_solvers
+    fi
+    if build learn_stochastic $CC -std=c99 $WARN -O2 $OMP -I. examples/learn_stochastic.c -o "$BUILD/learn_stochastic" -lm &&
+       "$BUILD/learn_stochastic" --patches 60 --max-rays 4000 >"$BUILD/learn_stochastic.out" 2>&1; then
+        pass learn_stochastic
+    else
+        fail learn_stochastic
+    fi
 }
 
 # ---- Vulkan: every GLSL kernel against the CPU path (lavapipe is enough)
