@@ -6125,14 +6125,18 @@ static rad_result rad__stoch_jacobi(rad__stoch *s, double p0)
     int stop = 0;
     for (i = 0; i < n3; ++i) s->B[i] = s->cur[i] = (double)s->E[i];
     for (it = 0; it < s->o.iterations && !stop; ++it) {
-        double pk = 0.0;
+        double pk = 0.0, frac;
         for (i = 0; i < s->n; ++i) pk += (double)s->P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
         if (pk < s->o.tolerance * p0) break;
         r = rad__stoch_shoot(s, s->cur, rad__stoch_count(s->o.rays, pk, p0),
                              rad__hash(s->o.seed ^ rad__hash(it + 0x9E3779B9u)), s->acc);
         if (r != RAD_SUCCESS) return r;
         for (i = 0; i < n3; ++i) { s->cur[i] = s->acc[i]; s->B[i] += s->acc[i]; }
-        stop = rad__stoch_report(s, s->B, (double)(it + 1) / (double)(s->o.iterations + s->o.regular_iterations));
+        /* progress: iterations done, or the unshot power's way down to the tolerance (log scale) */
+        frac = (double)(it + 1) / (double)s->o.iterations;
+        if (s->o.tolerance < 1.0 && log(p0 / pk) / -log(s->o.tolerance) > frac) frac = log(p0 / pk) / -log(s->o.tolerance);
+        frac *= (double)s->o.iterations / (double)(s->o.iterations + s->o.regular_iterations);
+        stop = rad__stoch_report(s, s->B, frac < 1.0 ? frac : 1.0);
     }
     unshot = 0.0;
     for (i = 0; i < s->n; ++i) unshot += (double)s->P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);

@@ -468,7 +468,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         if (mo->method == RAD_TOOL_TEMPORAL)
             fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
                     cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
-        else
+        else if (mo->method == RAD_TOOL_MULTIBOUNCE)
             fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
         rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
     }
@@ -893,7 +893,8 @@ int rad_cmd_render(int argc, char **argv)
         }
         if (!emitters && !w.file.light_count)
             fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL) && !pathtrace && !bake_path &&
+        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC) &&
+            !pathtrace && !bake_path &&
             o.patches < w.scene->triangle_count)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                     cmd, o.patches, w.scene->triangle_count);
@@ -918,7 +919,7 @@ int rad_cmd_render(int argc, char **argv)
             rad_tool_close_world(&w);
             return 1;
         }
-    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL) {
+    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_STOCHASTIC) {
         rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                 &img);
         if (rc) {
