@@ -269,7 +269,8 @@
               built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
               compression and reordering; temporal radiosity with alias tables; local
               matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
-              models and microfacet BRDFs; embedded GLSL kernels for every run-time step.
+              models and microfacet BRDFs; embedded GLSL kernels for every run-time step;
+              hemicube form factors; stochastic radiosity (stochastic Jacobi, random walks).
        The full history is in CHANGELOG.md.
 */
 
