@@ -378,4 +378,5 @@ static const rad_test_case tests_stochastic[] = {
     { "stochastic_furnace", st_test_furnace },
     { "stochastic_threads", st_test_threads },
     { "stochastic_errors", st_test_errors },
+    { NULL, NULL }
 };
