@@ -353,9 +353,11 @@ s_fuzz() {
 
 # ---- valgrind memcheck: one build, the quick suite split in two halves that run side by side.
 # Left out: tests that repeat the same computations in other orders or at other scales (they
-# are a third of its time; every build above runs them, five under the sanitizers)
+# are a third of its time; every build above runs them, five under the sanitizers), and the
+# stochastic statistics (16 seeds of the same solve; the furnace and thread tests keep both
+# estimators under valgrind)
 VALGRIND_SHARDS=2
-VALGRIND_SKIP=formfactor_determinism,robust_determinism,solve_jacobi_deterministic,solve_cornell_agree,robust_scale_invariance,robust_nearly_parallel,formfactor_c41_disks
+VALGRIND_SKIP=formfactor_determinism,robust_determinism,solve_jacobi_deterministic,solve_cornell_agree,robust_scale_invariance,robust_nearly_parallel,formfactor_c41_disks,stochastic_mean_jacobi,stochastic_mean_walk,stochastic_variance_jacobi,stochastic_variance_walk
 s_valgrind_build() {
     if ! have valgrind; then skip valgrind-memcheck "valgrind is not installed (package valgrind)"; return; fi
     build unit-valgrind $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-valgrind" -lm ||
