@@ -878,7 +878,8 @@ RAD_API void rad_stochastic_options_default(rad_stochastic_options *options);
    patches' scene). E: 3N floats, each finite and >= 0 (E is a source of light: a negative
    value has no power to draw rays by). out: 3N floats, L or B as options->output says.
    options may be NULL (the defaults). stats may be NULL.
-   Errors: INVALID_ARGUMENT (NULL patches, raycaster, intersect, E or out; an unknown method or
+   Errors: INVALID_ARGUMENT (NULL patches, raycaster, intersect, E or out; patches without their
+   scene (the patches of a loaded bake: set patches.scene first); an unknown method or
    output; ray_epsilon outside (0, 1e-2]; a negative or non-finite tolerance; regular
    iterations with the walk), NON_FINITE (a NaN or Inf in E, or a result that overflows float),
    NEGATIVE_EMISSION (a negative E), ALBEDO_RANGE (a patch albedo outside [0,1)),
