@@ -370,6 +370,45 @@ static void st_test_errors(void)
     st_box_free(&b);
 }
 
+/* allocation failure at every allocation (the counting allocator of test_scene.c): success or
+   OUT_OF_MEMORY, the failure reported, nothing leaked or overrun; both estimators */
+static void st_test_alloc_failure(void)
+{
+    st_box b;
+    rad_stochastic_options o;
+    rad_context ctx;
+    sc_alloc_state st;
+    float *B = NULL;
+    long n, total;
+    uint32_t m;
+    if (!st_box_build(&b, NULL, 0.5f, 1)) { CHECK(0); st_box_free(&b); return; }
+    B = (float *)malloc(3 * sizeof(float) * b.P->count);
+    if (!B) { CHECK(0); st_box_free(&b); return; }
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.allocator.alloc = sc_alloc_fn;
+    ctx.allocator.free = sc_free_fn;
+    ctx.allocator.user = &st;
+    for (m = 0; m < 2; ++m) {
+        rad_stochastic_options_default(&o);
+        o.method = m ? RAD_STOCHASTIC_WALK : RAD_STOCHASTIC_JACOBI;
+        o.rays = 300;
+        o.iterations = m ? 1u : 3u;
+        for (n = 0, total = 1; n <= total; ++n) {
+            rad_result r;
+            memset(&st, 0, sizeof(st));
+            st.fail_at = n;
+            r = rad_solve_stochastic(b.P, &b.rc, b.E, &o, B, NULL, &ctx);
+            CHECK(r == RAD_SUCCESS || r == RAD_ERROR_OUT_OF_MEMORY);
+            if (n > 0 && n <= st.calls) CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
+            CHECK(st.allocs == st.frees && st.live_bytes == 0 && st.corrupt == 0);
+            if (n == 0) total = st.calls;
+        }
+        CHECK(total >= 10);
+    }
+    free(B);
+    st_box_free(&b);
+}
+
 static const rad_test_case tests_stochastic[] = {
     { "stochastic_mean_jacobi", st_test_mean_jacobi },
     { "stochastic_mean_walk", st_test_mean_walk },
@@ -378,5 +417,6 @@ static const rad_test_case tests_stochastic[] = {
     { "stochastic_furnace", st_test_furnace },
     { "stochastic_threads", st_test_threads },
     { "stochastic_errors", st_test_errors },
+    { "stochastic_alloc_failure", st_test_alloc_failure },
     { NULL, NULL }
 };
