@@ -496,6 +496,9 @@ if "$RAD" render cornell $M -o "$TMP/ref.pfm" > /dev/null 2> "$TMP/err.txt" &&
             grep -q "method: stochastic, --sr-estimator walk" "$TMP/info.txt" && ! grep -q "FF_DENSE" "$TMP/info.txt" &&
             ok "info shows a stochastic bake" || fail "info shows a stochastic bake" "$(head -c 600 "$TMP/info.txt")"
         psnr_check "stochastic walk ~ classic" "$TMP/ref.pfm" "$TMP/sr.pfm" 45
+        "$RAD" render cornell --method stochastic --bake "$TMP/sr.radb" --sr-rays 5 $M -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt" &&
+            grep -q "fixes .*--sr-\*" "$TMP/err.txt" && ok "stochastic render --bake warns that the bake fixes --sr-rays" ||
+            fail "stochastic render --bake warns that the bake fixes --sr-rays" "$(head -c 300 "$TMP/err.txt")"
     else
         fail "stochastic bakes and renders" "$(head -c 300 "$TMP/err.txt")"
     fi

@@ -502,9 +502,10 @@ static int render_with_method(const char *cmd, const rad_tool_world *w, const ch
     int rc;
     rad_tool_context(&ctx, NULL);
     if (bake_path) {
-        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE))
-            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile "
-                            "and --mode; those given here are ignored\n",
+        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_SR |
+                         (mo->method == RAD_TOOL_STOCHASTIC ? RAD_TOOL_OPT_SEED : 0u)))
+            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile, "
+                            "--mode, --sr-* (and the stochastic solve's --seed); those given here are ignored\n",
                     cmd, bake_path);
         if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
             fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
