@@ -361,6 +361,9 @@ static void st_test_errors(void)
     memset(&ctx, 0, sizeof(ctx));
     ctx.progress = st_cancel;
     CHECK_RESULT(rad_solve_stochastic(b.P, &b.rc, b.E, &o, B, NULL, &ctx), RAD_ERROR_CANCELLED);
+    /* options NULL: the defaults (Jacobi, 64 rays per patch in the first iteration) */
+    CHECK_OK(rad_solve_stochastic(b.P, &b.rc, b.E, NULL, B, &st, NULL));
+    CHECK(st.rays_cast >= 64u * b.P->count && st.iterations > 5 && st.unshot < 1e-4);
     /* no source: no light, no rays */
     for (i = 0; i < 3 * b.P->count; ++i) b.E[i] = 0.0f;
     o.output = RAD_OUTPUT_TOTAL;
