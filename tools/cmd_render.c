@@ -436,7 +436,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         if (mo->method == RAD_TOOL_TEMPORAL)
             fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
                     cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
-        else
+        else if (mo->method == RAD_TOOL_MULTIBOUNCE)
             fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
         rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
     }
@@ -470,9 +470,10 @@ static int render_with_method(const char *cmd, const rad_tool_world *w, const ch
     int rc;
     rad_tool_context(&ctx, NULL);
     if (bake_path) {
-        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE))
-            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile "
-                            "and --mode; those given here are ignored\n",
+        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_SR |
+                         (mo->method == RAD_TOOL_STOCHASTIC ? RAD_TOOL_OPT_SEED : 0u)))
+            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile, "
+                            "--mode, --sr-* (and the stochastic solve's --seed); those given here are ignored\n",
                     cmd, bake_path);
         if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
             fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
@@ -861,7 +862,8 @@ int rad_cmd_render(int argc, char **argv)
         }
         if (!emitters && !w.file.light_count)
             fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL) && !pathtrace && !bake_path &&
+        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC) &&
+            !pathtrace && !bake_path &&
             o.patches < w.scene->triangle_count)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                     cmd, o.patches, w.scene->triangle_count);
@@ -886,7 +888,7 @@ int rad_cmd_render(int argc, char **argv)
             rad_tool_close_world(&w);
             return 1;
         }
-    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL) {
+    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_STOCHASTIC) {
         rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                 &img);
         if (rc) {
