@@ -5988,10 +5988,11 @@ typedef struct rad__hr_elem {
     uint32_t tri, parent, child, depth;
 } rad__hr_elem;
 
-/* receiver r gathers from source s: F with visibility, Fu unoccluded */
+/* receiver r gathers from source s: F with visibility, Fu unoccluded, Fd the spread (largest
+   minus smallest) of the unoccluded point-to-triangle values over r's points */
 typedef struct rad__hr_link {
     uint32_t r, s;
-    float F, Fu;
+    float F, Fu, Fd;
 } rad__hr_link;
 
 struct rad_hierarchical {
@@ -6325,6 +6326,12 @@ static rad_result rad__hr_flush(rad__hr_eval *ev, uint32_t task, uint32_t n)
     return RAD_SUCCESS;
 }
 
+/* Link l's F: the mean over the receiver's K lattice points x_k of the analytic point-to-
+   triangle value f_k, times visibility. One ray per point, to a Hammersley point y_k of the
+   source; as in the analytic form-factor method each ray carries the share kern_k / sum kern
+   of the link's total sum f, kern the cos cos / r^2 of its two end points, so that a wall half
+   hidden near its base loses the share of light its near (strong) part carries, not its share
+   of area. */
 static void rad__hr_eval_task(void *data, uint32_t task)
 {
     rad__hr_eval *ev = (rad__hr_eval *)data;
@@ -6337,46 +6344,63 @@ static void rad__hr_eval_task(void *data, uint32_t task)
         const rad__hr_elem *er = &h->el[lk->r], *es = &h->el[lk->s];
         uint32_t hs = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s)));
         float r1 = (float)(hs & 0xFFFFu) / 65536.0f, r2 = (float)(hs >> 16) / 65536.0f;
-        double N[3], fu = 0.0;
+        float xs[3 * RAD__HR_MAX_RAYS], ys[3 * RAD__HR_MAX_RAYS];
+        double N[3], fu = 0.0, fmin = 1e30, fmax = 0.0, kern[RAD__HR_MAX_RAYS], f[RAD__HR_MAX_RAYS], ksum = 0.0;
         int k;
         for (k = 0; k < 3; ++k) N[k] = er->n[k];
-        lk->F = lk->Fu = 0.0f;
+        lk->F = lk->Fu = lk->Fd = 0.0f;
         for (s = 0; s < K; ++s) {
-            float x[3], d[3], y[3], u1, u2, f;
+            float *x = xs + 3 * s, *y = ys + 3 * s, d[3], u1, u2;
             double X[3];
+            f[s] = kern[s] = 0.0;
             rad__lattice_point(er->v, er->v + 3, er->v + 6, h->nside, s, x);
             rad__sub(d, x, es->v);
-            if (!(rad__dot(d, es->n) > 0.0f)) continue; /* the point is behind the source */
-            for (k = 0; k < 3; ++k) X[k] = x[k];
-            f = (float)(fabs(rad__ff_point_tri(X, N, es->v)) / (double)K);
-            ev->kernels[task]++;
-            if (!(f > 0.0f)) continue;
-            fu += (double)f;
-            if (h->o.skip_visibility) {
-                lk->F += f;
+            if (!(rad__dot(d, es->n) > 0.0f)) { /* the point is behind the source */
+                fmin = 0.0;
                 continue;
             }
+            for (k = 0; k < 3; ++k) X[k] = x[k];
+            f[s] = fabs(rad__ff_point_tri(X, N, es->v)) / (double)K;
+            ev->kernels[task]++;
+            if (f[s] < fmin) fmin = f[s];
+            if (f[s] > fmax) fmax = f[s];
+            fu += f[s];
             rad__hammersley(s, K, r1, r2, &u1, &u2);
             rad__triangle_point(es->v, es->v + 3, es->v + 6, u1, u2, y);
+            rad__sub(d, y, x);
             {
-                rad_ray *ray = ev->rays + base + nrays;
-                float len;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = x[k] + er->n[k] * h->ray_eps;
-                    ray->dir[k] = (y[k] + es->n[k] * h->ray_eps) - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
-                ev->w[base + nrays] = f;
-                ev->idx[base + nrays] = l;
-                if (++nrays == RAD__RAY_BATCH) {
-                    r = rad__hr_flush(ev, task, nrays);
-                    nrays = 0;
-                }
+                double r2d = (double)rad__dot(d, d), cx = (double)rad__dot(d, er->n), cy = -(double)rad__dot(d, es->n);
+                kern[s] = f[s] > 0.0 && r2d > 0.0 && cx > 0.0 && cy > 0.0 ? cx * cy / (r2d * r2d) : 0.0;
+                ksum += kern[s];
             }
         }
         lk->Fu = (float)fu;
+        lk->Fd = fmax > fmin ? (float)((fmax - fmin) * (double)K) : 0.0f;
+        if (h->o.skip_visibility) {
+            lk->F = lk->Fu;
+            continue;
+        }
+        for (s = 0; s < K && r == RAD_SUCCESS; ++s) {
+            /* no usable kernel (every end point grazing): each ray carries its point's f */
+            double w = ksum > 0.0 ? fu * kern[s] / ksum : f[s];
+            rad_ray *ray;
+            float len;
+            if (!(w > 0.0)) continue;
+            ray = ev->rays + base + nrays;
+            for (k = 0; k < 3; ++k) {
+                ray->origin[k] = xs[3 * s + (uint32_t)k] + er->n[k] * h->ray_eps;
+                ray->dir[k] = (ys[3 * s + (uint32_t)k] + es->n[k] * h->ray_eps) - ray->origin[k];
+            }
+            len = rad__len(ray->dir);
+            ray->tmin = 0.0f;
+            ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+            ev->w[base + nrays] = (float)w;
+            ev->idx[base + nrays] = l;
+            if (++nrays == RAD__RAY_BATCH) {
+                r = rad__hr_flush(ev, task, nrays);
+                nrays = 0;
+            }
+        }
     }
     if (r == RAD_SUCCESS) r = rad__hr_flush(ev, task, nrays);
     ev->results[task] = r;
@@ -6455,21 +6479,29 @@ static rad_result rad__hr_push(rad_hierarchical *h, rad__hr_list *L, uint32_t r,
     }
     L->a[L->n].r = r;
     L->a[L->n].s = s;
-    L->a[L->n].F = L->a[L->n].Fu = 0.0f;
+    L->a[L->n].F = L->a[L->n].Fu = L->a[L->n].Fd = 0.0f;
     L->n++;
     return RAD_SUCCESS;
 }
 
-/* The oracle: 1 when link l carries more than eps_abs and one of its elements can split
-   (*split gets it); BF refinement with the unoccluded F where some ray got through. */
+/* The oracle: 1 when link l should be refined (*split gets the element to split). BF
+   refinement: the power A_r F_rs max_c(B_s) the link carries (F unoccluded where some ray got
+   through, 0 where none did) above eps_abs splits the larger element that can split; and the
+   link's own error, A_r max_c(B_s) times the spread of F_rs over r's points, above eps_abs
+   splits the receiver (so that no leaf gathers over a link whose F differs much across it). */
 static int rad__hr_oracle(const rad_hierarchical *h, const rad__hr_link *l, uint32_t *split)
 {
     const rad__hr_elem *er = &h->el[l->r], *es = &h->el[l->s];
     float bs = es->B[0] > es->B[1] ? es->B[0] : es->B[1];
     int can_r = er->area * 0.25f >= h->min_area, can_s = es->area * 0.25f >= h->min_area;
+    double pw;
     if (es->B[2] > bs) bs = es->B[2];
-    if (!(l->F > 0.0f) || !((double)er->area * (double)l->Fu * (double)bs > h->eps_abs)) return 0;
-    if (!can_r && !can_s) return 0;
+    pw = (double)er->area * (double)bs;
+    if (can_r && pw * (double)l->Fd > h->eps_abs) {
+        *split = l->r;
+        return 1;
+    }
+    if (!(pw * (double)l->Fu > h->eps_abs) || (!can_r && !can_s)) return 0;
     *split = (can_s && (es->area >= er->area || !can_r)) ? l->s : l->r;
     return 1;
 }
