@@ -238,7 +238,7 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
 /* ---- the multi-bounce and temporal methods (methods.c) ------------------------------------ */
 typedef enum rad_tool_method {
     RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
-    RAD_TOOL_LOCAL = 4, RAD_TOOL_VP = 5, RAD_TOOL_AAVP = 6 /* render only (cmd_render.c) */
+    RAD_TOOL_LOCAL = 4, RAD_TOOL_VP = 5, RAD_TOOL_AAVP = 6, RAD_TOOL_HIERARCHICAL = 7 /* render only (cmd_render.c) */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
 typedef enum rad_tool_mb_format {
@@ -268,6 +268,9 @@ typedef struct rad_tool_method_options {
     uint32_t face_points;     /* --face-points P: Hammersley points per voxel face (default 16) */
     uint32_t local_m;         /* --local-m M: local matrix capacity, at most the patches (0, the
                                  default: every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX) */
+    float hr_eps;             /* --hr-eps E: hierarchical BF refinement tolerance (0: the library's 1e-3) */
+    float hr_min_area;        /* --hr-min-area A: smallest element, scene units^2 (0: total area / 10000) */
+    uint32_t hr_rays;         /* --hr-rays R: points and visibility rays per link, a square (0: 4) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
 } rad_tool_method_options;
 enum {
@@ -276,8 +279,10 @@ enum {
     RAD_TOOL_OPT_MODE = 1u << 6, RAD_TOOL_OPT_K = 1u << 7, RAD_TOOL_OPT_W = 1u << 8, RAD_TOOL_OPT_ADAPTIVE = 1u << 9,
     RAD_TOOL_OPT_SEED = 1u << 10, RAD_TOOL_OPT_FRAMES = 1u << 11, RAD_TOOL_OPT_SEQUENCE = 1u << 12,
     RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14, RAD_TOOL_OPT_VP_RESOLUTION = 1u << 15,
-    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18
+    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18,
+    RAD_TOOL_OPT_HR_EPS = 1u << 19, RAD_TOOL_OPT_HR_MIN_AREA = 1u << 20, RAD_TOOL_OPT_HR_RAYS = 1u << 21
 };
+#define RAD_TOOL_OPT_HR (RAD_TOOL_OPT_HR_EPS | RAD_TOOL_OPT_HR_MIN_AREA | RAD_TOOL_OPT_HR_RAYS)
 #define RAD_TOOL_OPT_VP (RAD_TOOL_OPT_VP_RESOLUTION | RAD_TOOL_OPT_VP_MAX_PATCHES | RAD_TOOL_OPT_FACE_POINTS)
 #define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
                                RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
@@ -298,6 +303,12 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
 int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o);
 const char *rad_tool_method_help(int render);
 const char *rad_tool_method_name(rad_tool_method method);
+/* --method hierarchical: rad_hierarchical_create and solve over the world with E = rho D at
+   the elements' centroids (D: rad_direct_irradiance with light_samples shadow rays, emitters
+   included, as the classic patches' D) and mo's --hr-* options; prints the counts and the
+   form-factor work. 0 (*out owned by the caller) or 1 (message printed). */
+int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+                                uint32_t light_samples, rad_hierarchical **out);
 
 /* The user sections the two methods add: what was built, and the row sums S_i of F (the
    halo correction of the per-vertex H needs them and these bakes hold no F). */
