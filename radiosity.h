@@ -814,7 +814,8 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
    elements' radiosity, the classic H = F B; the renderer's indirect term is rho / pi H).
    Without clustering, step 1 joins every pair of scene triangles, O(T^2) links: meant for
    scenes of up to a few thousand triangles (more than RAD_HIERARCHICAL_MAX_ROOT_PAIRS ordered
-   pairs is refused with SIZE_OVERFLOW). Reentrant; one object is not used by two threads at once. */
+   pairs is refused with SIZE_OVERFLOW). Reentrant; the solve uses ctx->parallel_for for the
+   links' form factors; after it the accessors and lookups only read (any threads at once). */
 
 #define RAD_HIERARCHICAL_MAX_ROOT_PAIRS 50000000ull
 
@@ -891,8 +892,8 @@ RAD_API rad_result rad_hierarchical_leaves(const rad_hierarchical *h, uint32_t f
                                            uint32_t *out_triangles, float *out_B, float *out_H);
 /* Links [first, first + count) of the solution: the receiver's and the source's centroids
    (6 floats each), the form factor F_rs with visibility, and the receiver's and source's
-   depths in their quadtrees (0: a scene triangle). Any output may be NULL. Errors as
-   rad_hierarchical_leaves. */
+   depths in their quadtrees (2 per link; 0: a scene triangle). Any output may be NULL.
+   Errors as rad_hierarchical_leaves. */
 RAD_API rad_result rad_hierarchical_links(const rad_hierarchical *h, uint64_t first, uint32_t count, float *out_points,
                                           float *out_form_factors, uint32_t *out_depths);
 /* The value at 'count' points given as scene triangle and barycentrics (b1, b2, 2 floats per

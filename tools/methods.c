@@ -114,7 +114,7 @@ const char *rad_tool_method_help(int render)
                     "                     visible) get no indirect light and light outside S is not bounced\n"
                     "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement, solved\n"
                     "to convergence; --patches etc. and --bounces are not used; render only):\n"
-                    "  --hr-eps E         refinement tolerance, a fraction of the source power (default 1e-3)\n"
+                    "  --hr-eps E         refinement tolerance, a fraction of the source power (default 1e-5)\n"
                     "  --hr-min-area A    smallest element area, scene units^2 (default: total area / 10000)\n"
                     "  --hr-rays R        points and visibility rays per link: 1, 4, 9 ... 64 (default 4)\n"
                   : "multibounce:\n"
@@ -885,7 +885,9 @@ int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const 
     double t0 = rad_tool_seconds();
     *out = NULL;
     rad_hierarchical_options_default(&ho);
-    if (mo->hr_eps > 0.0f) ho.tolerance = mo->hr_eps;
+    /* finer than the library's teaching default: a still image as close to the path tracer as
+       classic's at a small part of its rays (BENCHMARKS.md, hierarchical radiosity) */
+    ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
     ho.min_area = mo->hr_min_area;
     if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
     sd.w = w;

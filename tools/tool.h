@@ -268,7 +268,7 @@ typedef struct rad_tool_method_options {
     uint32_t face_points;     /* --face-points P: Hammersley points per voxel face (default 16) */
     uint32_t local_m;         /* --local-m M: local matrix capacity, at most the patches (0, the
                                  default: every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX) */
-    float hr_eps;             /* --hr-eps E: hierarchical BF refinement tolerance (0: the library's 1e-3) */
+    float hr_eps;             /* --hr-eps E: hierarchical BF refinement tolerance (0: 1e-5) */
     float hr_min_area;        /* --hr-min-area A: smallest element, scene units^2 (0: total area / 10000) */
     uint32_t hr_rays;         /* --hr-rays R: points and visibility rays per link, a square (0: 4) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
