@@ -6189,7 +6189,10 @@ static rad_result rad__hr_split(rad_hierarchical *h, uint32_t i, const rad__ctx 
     int m, j;
     rad_result r;
     if (h->el[i].child != RAD_NONE) return RAD_SUCCESS;
-    if (h->nel > 0xFFFFFFF0u - 4u) return RAD_ERROR_SIZE_OVERFLOW;
+    if (h->nel > 0xFFFFFFF0u - 4u) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: more than 2^32 elements");
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
     if (h->nel + 4u > h->cap_el) {
         uint32_t cap = h->cap_el > 0x7FFFFFF0u ? 0xFFFFFFF0u : 2u * h->cap_el;
         size_t old_bytes, new_bytes;
