@@ -799,12 +799,14 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
    quadtree of elements: an element is split on demand into 4 by its edge midpoints. Light
    travels over links: link r <- s says that element r gathers from element s with the form
    factor F_rs (r's points, the analytic point-to-triangle kernel of rad_ff_point_polygon to
-   s, times the share of rays from those points to s that nothing blocks). The solve:
+   s, times the kernel-weighted share of rays from those points to s that nothing blocks):
      1. one link r <- s for every ordered pair of scene triangles that face each other;
-     2. BF refinement: a link whose power A_r F_rs max_c(B_s) (F_rs unoccluded; 0 when every
-        ray was blocked) exceeds tolerance * P, P = sum over triangles of A max_c(E), is
-        replaced by 4 links to the children of its larger element (split on demand), down to
-        elements of min_area; the new links are refined in turn;
+     2. BF refinement: a link whose power A_r F_rs max_c(B_s) (F_rs unoccluded) exceeds
+        tolerance * P, P = sum over triangles of A max_c(E), is replaced by 4 links to the
+        children of its larger element (split on demand), and one whose error A_r max_c(B_s)
+        times the spread of the kernel over r's points exceeds it by 4 links from r's
+        children; elements are split while their children keep min_area; the new links are
+        refined in turn;
      3. gather and push-pull (Jacobi): G_r = sum over r's links of F_rs B_s; pushed down
         (an element receives what its ancestors gathered), B = E + rho G at the leaves,
         pulled up as area-weighted means; repeated until B changes by less than 1e-6 of
