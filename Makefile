@@ -34,6 +34,10 @@ $(BUILD):
 $(BUILD)/cornell: examples/cornell.c examples/png_write.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/cornell.c -o $@ -lm
 
+# hierarchical radiosity's links drawn over the Cornell box (examples/learn_hierarchical.c)
+$(BUILD)/learn_hierarchical: examples/learn_hierarchical.c examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) -I. examples/learn_hierarchical.c -o $@ -lm
+
 # virtual patches on the bunny in the Cornell box (needs $(RAD_DATA_DIR); --ogre for 193k triangles)
 $(BUILD)/vp_bunny: examples/vp_bunny.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/vp_bunny.c -o $@ -lm

@@ -921,6 +921,127 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
                                         rad_stochastic_stats *stats, const rad_context *ctx);
 
 /* ======================================================================================== */
+/* >>api_hierarchical: hierarchical radiosity                                               */
+/* ======================================================================================== */
+
+/* Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991, "A Rapid Hierarchical
+   Radiosity Algorithm"; docs/methods/hierarchical.md). Each scene triangle is the root of a
+   quadtree of elements: an element is split on demand into 4 by its edge midpoints. Light
+   travels over links: link r <- s says that element r gathers from element s with the form
+   factor F_rs (r's points, the analytic point-to-triangle kernel of rad_ff_point_polygon to
+   s, times the kernel-weighted share of rays from those points to s that nothing blocks):
+     1. one link r <- s for every ordered pair of scene triangles that face each other;
+     2. BF refinement: a link whose power A_r F_rs max_c(B_s) (F_rs unoccluded) exceeds
+        tolerance * P, P = sum over triangles of A max_c(E), is replaced by 4 links to the
+        children of its larger element (split on demand), and one whose error A_r max_c(B_s)
+        times the spread of the kernel over r's points exceeds it by 4 links from r's
+        children; elements are split while their children keep min_area; the new links are
+        refined in turn;
+     3. gather and push-pull (Jacobi): G_r = sum over r's links of F_rs B_s; pushed down
+        (an element receives what its ancestors gathered), B = E + rho G at the leaves,
+        pulled up as area-weighted means; repeated until B changes by less than 1e-6 of
+        max B;
+     4. steps 2 and 3 again with the new B, until no link is refined or max_iterations rounds.
+   The result: per leaf, B (radiosity, W m^-2) and H = G (the irradiance from the other
+   elements' radiosity, the classic H = F B; the renderer's indirect term is rho / pi H).
+   Without clustering, step 1 joins every pair of scene triangles, O(T^2) links: meant for
+   scenes of up to a few thousand triangles (more than RAD_HIERARCHICAL_MAX_ROOT_PAIRS ordered
+   pairs is refused with SIZE_OVERFLOW). Reentrant; the solve uses ctx->parallel_for for the
+   links' form factors; after it the accessors and lookups only read (any threads at once). */
+
+#define RAD_HIERARCHICAL_MAX_ROOT_PAIRS 50000000ull
+
+/* The source term of elements: out_E (3 per point) for 'count' element centroids 'points'
+   with unit normals, the scene triangles they lie on and their albedos (3 per point).
+   E.g. albedo times the direct irradiance (rad_direct_irradiance) for RAD_SOURCE_DIRECT.
+   Returns RAD_SUCCESS or an error the solve passes on. Called on the solving thread. */
+typedef rad_result (*rad_hierarchical_source_fn)(void *user, const float *points, const float *normals,
+                                                 const uint32_t *triangles, const float *albedos, uint32_t count,
+                                                 float *out_E);
+
+typedef struct rad_hierarchical_options {
+    double tolerance;          /* BF refinement threshold, a fraction of P (0: 1e-3); > 0, < 1 */
+    float min_area;            /* elements are split only into children of at least this area,
+                                  scene units^2 (0: the total area / 10000); total area /
+                                  min_area at most 2^28, else INVALID_ARGUMENT */
+    uint32_t visibility_rays;  /* points per link on the receiver, each with the analytic
+                                  kernel and one visibility ray (0: 4); a square 1..64 */
+    uint32_t max_iterations;   /* refine-and-solve rounds (0: 16) */
+    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;             /* decorrelates the rays' end points on the sources (any value) */
+    int skip_visibility;       /* non-zero: V = 1, no rays (the raycaster may be NULL) */
+    rad_hierarchical_source_fn source; /* NULL: E = pi * the material's emitted radiance */
+    void *source_user;
+} rad_hierarchical_options;
+
+typedef struct rad_hierarchical_stats {
+    uint32_t elements;         /* every element (quadtree node) made */
+    uint32_t leaves;
+    uint64_t links;            /* links of the final solution */
+    uint64_t links_evaluated;  /* links whose form factor was computed (refined ones too) */
+    uint64_t kernel_evaluations; /* point-to-triangle kernels evaluated (the form-factor work) */
+    uint64_t rays_cast;        /* visibility rays */
+    uint32_t rounds;           /* refine-and-solve rounds done */
+    uint32_t sweeps;           /* gather and push-pull sweeps, all rounds */
+    double residual;           /* last sweep's largest change of B / max B */
+} rad_hierarchical_stats;
+
+/* what rad_hierarchical_lookup returns */
+typedef enum rad_hierarchical_value {
+    RAD_HIERARCHICAL_RADIOSITY = 0, /* B = E + rho H */
+    RAD_HIERARCHICAL_GATHERED = 1   /* H, the irradiance from the other elements */
+} rad_hierarchical_value;
+
+typedef struct rad_hierarchical rad_hierarchical;
+
+/* Defaults: tolerance 1e-3, min_area 0 (total / 10000), visibility_rays 4, max_iterations 16,
+   ray_epsilon 1e-5, the rest 0. */
+RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *options);
+
+/* Checks the options and makes the roots (one element per scene triangle, its albedo at the
+   centroid). scene and raycaster are borrowed and must outlive the object; raycaster may be
+   NULL with skip_visibility. Errors: INVALID_ARGUMENT (NULL, a bad option: the logger names
+   it), SIZE_OVERFLOW (too many triangle pairs), ALBEDO_RANGE, OUT_OF_MEMORY. O(T). */
+RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                           const rad_hierarchical_options *options, const rad_context *ctx,
+                                           rad_hierarchical **out);
+/* Runs the solve (steps 1 to 4 above). Can be called once. ctx: logging, progress (after each
+   round; cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
+   twice), RAYCAST_FAILED, NON_FINITE (a source value or the result), NEGATIVE_EMISSION (the
+   source gave E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000),
+   CANCELLED, OUT_OF_MEMORY. After an error the object can only be destroyed.
+   Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep. */
+RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx);
+RAD_API void rad_hierarchical_destroy(rad_hierarchical *h);
+
+/* Counts and work of the solve (zeros before it). */
+RAD_API void rad_hierarchical_get_stats(const rad_hierarchical *h, rad_hierarchical_stats *out);
+/* Leaves [first, first + count) of the solved object, in a fixed order (by scene triangle,
+   then depth first): corners (9 floats each, counter-clockwise), scene triangle, B and H
+   (3 floats each). Any output may be NULL. Errors: INVALID_ARGUMENT (not solved, NULL h),
+   INDEX_OUT_OF_RANGE (past the last leaf). */
+RAD_API rad_result rad_hierarchical_leaves(const rad_hierarchical *h, uint32_t first, uint32_t count, float *out_corners,
+                                           uint32_t *out_triangles, float *out_B, float *out_H);
+/* Links [first, first + count) of the solution: the receiver's and the source's centroids
+   (6 floats each), the form factor F_rs with visibility, and the receiver's and source's
+   depths in their quadtrees (2 per link; 0: a scene triangle). Any output may be NULL.
+   Errors as rad_hierarchical_leaves. */
+RAD_API rad_result rad_hierarchical_links(const rad_hierarchical *h, uint64_t first, uint32_t count, float *out_points,
+                                          float *out_form_factors, uint32_t *out_depths);
+/* The value at 'count' points given as scene triangle and barycentrics (b1, b2, 2 floats per
+   point) into out (3 floats per point). smooth 0: the value of the leaf holding the point.
+   smooth 1: interpolated from the leaf's corners; a corner holds the area-weighted mean of
+   the leaves around it that lie in the same plane (the seams of rad_patches_vertex_values),
+   and for H the halo fix of the classic renderer: the mean is divided by the leaves' mean
+   row sum S (the form factors an element gathers over, ancestors' links included) and
+   multiplied by the mean S of the leaves whose S is at least 0.75 of the corner's largest,
+   so a floor corner under a block does not darken its uncovered neighbours. Errors:
+   INVALID_ARGUMENT (not solved, NULL pointer, bad value), INDEX_OUT_OF_RANGE (a triangle). */
+RAD_API rad_result rad_hierarchical_lookup(const rad_hierarchical *h, rad_hierarchical_value value, int smooth,
+                                           const uint32_t *triangles, const float *barycentrics, uint32_t count,
+                                           float *out);
+
+/* ======================================================================================== */
 /* >>api_light: lights and the source term                                                  */
 /* ======================================================================================== */
 
@@ -6533,6 +6654,923 @@ done:
     rad__free(&c.allocator, s.w.rays);
     rad__free(&c.allocator, s.w.hits);
     return r;
+}
+
+/* ======================================================================================== */
+/* >>hierarchical: hierarchical radiosity (quadtrees, links, BF refinement, push-pull)      */
+/* ======================================================================================== */
+
+#define RAD__HR_DEFAULT_TOLERANCE 1e-3
+#define RAD__HR_DEFAULT_RAYS 4u
+#define RAD__HR_MAX_RAYS 64u
+#define RAD__HR_DEFAULT_ROUNDS 16u
+#define RAD__HR_MAX_SWEEPS 1000u
+#define RAD__HR_SWEEP_TOLERANCE 1e-6
+#define RAD__HR_SOURCE_BATCH 4096u
+
+/* One quadtree node. Children are 4 consecutive elements, made after their parent, so index
+   order is a top-down order and its reverse a bottom-up one. */
+typedef struct rad__hr_elem {
+    float v[9];          /* corners, counter-clockwise */
+    float b[6];          /* the corners' barycentrics (b1, b2) in the scene triangle */
+    float n[3];
+    float area;
+    float rho[3], E[3], B[3];
+    double G[3], Gt[3];  /* gathered over own links; Gt with the ancestors' (pushed down) */
+    double S, St;        /* the same for the form factors alone (the row sum) */
+    uint32_t tri, parent, child, depth;
+} rad__hr_elem;
+
+/* receiver r gathers from source s: F with visibility, Fu unoccluded, Fd the spread (largest
+   minus smallest) of the unoccluded point-to-triangle values over r's points */
+typedef struct rad__hr_link {
+    uint32_t r, s;
+    float F, Fu, Fd;
+} rad__hr_link;
+
+struct rad_hierarchical {
+    const rad_scene *scene;
+    rad_raycaster rc;
+    rad_hierarchical_options o;
+    uint32_t nside;
+    float min_area, ray_eps;
+    double eps_abs;
+    rad__hr_elem *el;
+    uint32_t nel, cap_el;
+    rad__hr_link *links;
+    size_t nlinks;
+    uint32_t *leaf, *leaf_of, *leaf_vert, nleaf, nvert;
+    float *vert_B, *vert_H;
+    rad_hierarchical_stats st;
+    int state;           /* 0 created, 1 solved, -1 a solve failed */
+    rad_allocator allocator;
+};
+
+RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->tolerance = RAD__HR_DEFAULT_TOLERANCE;
+    o->visibility_rays = RAD__HR_DEFAULT_RAYS;
+    o->max_iterations = RAD__HR_DEFAULT_ROUNDS;
+    o->ray_epsilon = 1e-5f;
+}
+
+RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
+{
+    rad_allocator a;
+    if (!h) return;
+    a = h->allocator;
+    rad__free(&a, h->el);
+    rad__free(&a, h->links);
+    rad__free(&a, h->leaf);
+    rad__free(&a, h->leaf_of);
+    rad__free(&a, h->leaf_vert);
+    rad__free(&a, h->vert_B);
+    rad__free(&a, h->vert_H);
+    rad__free(&a, h);
+}
+
+static void rad__hr_normal_area(rad__hr_elem *e)
+{
+    float a[3], b[3], n[3], l;
+    rad__sub(a, e->v + 3, e->v);
+    rad__sub(b, e->v + 6, e->v);
+    rad__cross(n, a, b);
+    l = rad__len(n);
+    e->area = 0.5f * l;
+    if (l > 0.0f) { n[0] /= l; n[1] /= l; n[2] /= l; }
+    memcpy(e->n, n, sizeof(n));
+}
+
+static void rad__hr_centroid(const rad__hr_elem *e, float *c)
+{
+    int k;
+    for (k = 0; k < 3; ++k) c[k] = (e->v[k] + e->v[3 + k] + e->v[6 + k]) / 3.0f;
+}
+
+/* the element's albedo at its centroid; ALBEDO_RANGE when a texture callback leaves [0,1) */
+static rad_result rad__hr_albedo(const rad_hierarchical *h, rad__hr_elem *e, const rad__ctx *c)
+{
+    int k;
+    rad_scene_albedo(h->scene, e->tri, (e->b[0] + e->b[2] + e->b[4]) / 3.0f, (e->b[1] + e->b[3] + e->b[5]) / 3.0f, e->rho);
+    for (k = 0; k < 3; ++k)
+        if (!(e->rho[k] >= 0.0f && e->rho[k] < 1.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical: albedo %g of triangle %u (channel %d) is outside [0,1)",
+                     (double)e->rho[k], e->tri, k);
+            return RAD_ERROR_ALBEDO_RANGE;
+        }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                           const rad_hierarchical_options *options, const rad_context *ctx,
+                                           rad_hierarchical **out)
+{
+    rad__ctx c;
+    rad_hierarchical *h;
+    rad_hierarchical_options o;
+    uint32_t t, T;
+    double total = 0.0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!scene || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: scene and out must not be NULL");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options;
+    else rad_hierarchical_options_default(&o);
+    if (o.tolerance == 0.0) o.tolerance = RAD__HR_DEFAULT_TOLERANCE;
+    if (o.visibility_rays == 0) o.visibility_rays = RAD__HR_DEFAULT_RAYS;
+    if (o.max_iterations == 0) o.max_iterations = RAD__HR_DEFAULT_ROUNDS;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (!(o.tolerance > 0.0 && o.tolerance < 1.0)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: tolerance %g must be in (0, 1)", o.tolerance);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(o.min_area >= 0.0f) || !rad__finite(o.min_area)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: min_area %g must be finite and >= 0", (double)o.min_area);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    {
+        uint32_t n = rad__lattice_side(o.visibility_rays);
+        if (o.visibility_rays > RAD__HR_MAX_RAYS || n * n != o.visibility_rays) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: visibility_rays %u must be a square from 1 to %u",
+                     o.visibility_rays, RAD__HR_MAX_RAYS);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    if (!(o.ray_epsilon > 0.0f && o.ray_epsilon <= 1e-2f)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: ray_epsilon %g must be in (0, 1e-2]", (double)o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!raycaster && !o.skip_visibility) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: a raycaster is needed unless skip_visibility is set");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (raycaster && !o.skip_visibility && !raycaster->occluded) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: the raycaster has no occluded function");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    T = scene->triangle_count;
+    if (T == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: the scene has no triangles");
+        return RAD_ERROR_EMPTY_SCENE;
+    }
+    if ((double)T * (double)(T - 1u) > (double)RAD_HIERARCHICAL_MAX_ROOT_PAIRS) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: %u triangles give %.0f ordered pairs, more than the %llu "
+                 "first links allowed (no clustering: see >>api_hierarchical)", T, (double)T * (double)(T - 1u),
+                 (unsigned long long)RAD_HIERARCHICAL_MAX_ROOT_PAIRS);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    for (t = 0; t < T; ++t) total += (double)scene->areas[t];
+    if (o.min_area == 0.0f) o.min_area = (float)(total / 10000.0);
+    if (!(total / (double)o.min_area <= 268435456.0)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: min_area %g is too small: the total area %g over it "
+                 "passes 2^28 elements", (double)o.min_area, total);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    h = (rad_hierarchical *)rad__alloc(&c.allocator, sizeof(*h));
+    if (!h) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(h, 0, sizeof(*h));
+    h->allocator = c.allocator;
+    h->scene = scene;
+    if (raycaster) h->rc = *raycaster;
+    h->o = o;
+    h->nside = rad__lattice_side(o.visibility_rays);
+    h->min_area = o.min_area;
+    h->ray_eps = o.ray_epsilon * scene->diagonal;
+    h->cap_el = T < 1024u ? 1024u : T;
+    h->el = (rad__hr_elem *)rad__alloc_array(&h->allocator, h->cap_el, sizeof(rad__hr_elem));
+    if (!h->el) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: out of memory for %u elements", T);
+        rad_hierarchical_destroy(h);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (t = 0; t < T; ++t) {
+        rad__hr_elem *e = &h->el[t];
+        memset(e, 0, sizeof(*e));
+        memcpy(e->v, scene->positions + 9 * (size_t)t, 9 * sizeof(float));
+        e->b[2] = 1.0f; /* corner 1: (1, 0) */
+        e->b[5] = 1.0f; /* corner 2: (0, 1) */
+        e->area = scene->areas[t];
+        memcpy(e->n, scene->normals + 3 * (size_t)t, 3 * sizeof(float));
+        e->tri = t;
+        e->parent = e->child = RAD_NONE;
+        if ((r = rad__hr_albedo(h, e, &c)) != RAD_SUCCESS) {
+            rad_hierarchical_destroy(h);
+            return r;
+        }
+    }
+    h->nel = T;
+    *out = h;
+    return RAD_SUCCESS;
+}
+
+/* Splits element i into 4 (once). Returns OUT_OF_MEMORY or SIZE_OVERFLOW; element pointers
+   taken before the call are stale after it. */
+static rad_result rad__hr_split(rad_hierarchical *h, uint32_t i, const rad__ctx *c)
+{
+    static const int corner[4][3] = { { 0, 3, 5 }, { 3, 1, 4 }, { 5, 4, 2 }, { 3, 4, 5 } };
+    float p[18], q[12];
+    uint32_t k, first;
+    int m, j;
+    rad_result r;
+    if (h->el[i].child != RAD_NONE) return RAD_SUCCESS;
+    if (h->nel > 0xFFFFFFF0u - 4u) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: more than 2^32 elements");
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    if (h->nel + 4u > h->cap_el) {
+        uint32_t cap = h->cap_el > 0x7FFFFFF0u ? 0xFFFFFFF0u : 2u * h->cap_el;
+        size_t old_bytes, new_bytes;
+        rad__hr_elem *grown;
+        if (!rad__mul(h->cap_el, sizeof(rad__hr_elem), &old_bytes) || !rad__mul(cap, sizeof(rad__hr_elem), &new_bytes))
+            return RAD_ERROR_SIZE_OVERFLOW;
+        grown = (rad__hr_elem *)rad__realloc(&h->allocator, h->el, old_bytes, new_bytes);
+        if (!grown) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for %u elements", cap);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        h->el = grown;
+        h->cap_el = cap;
+    }
+    /* points 0..2 the corners, 3..5 the midpoints of edges 01, 12, 20; the same expression
+       on both sides of a shared edge gives the same bits (corners weld in lookups) */
+    for (m = 0; m < 3; ++m) {
+        int a = m, b = (m + 1) % 3;
+        for (j = 0; j < 3; ++j) {
+            p[3 * m + j] = h->el[i].v[3 * a + j];
+            p[9 + 3 * m + j] = 0.5f * (h->el[i].v[3 * a + j] + h->el[i].v[3 * b + j]);
+        }
+        for (j = 0; j < 2; ++j) {
+            q[2 * m + j] = h->el[i].b[2 * a + j];
+            q[6 + 2 * m + j] = 0.5f * (h->el[i].b[2 * a + j] + h->el[i].b[2 * b + j]);
+        }
+    }
+    first = h->nel;
+    for (k = 0; k < 4; ++k) {
+        rad__hr_elem *e = &h->el[first + k];
+        const rad__hr_elem *pa = &h->el[i];
+        memset(e, 0, sizeof(*e));
+        for (m = 0; m < 3; ++m) {
+            memcpy(e->v + 3 * m, p + 3 * corner[k][m], 3 * sizeof(float));
+            memcpy(e->b + 2 * m, q + 2 * corner[k][m], 2 * sizeof(float));
+        }
+        rad__hr_normal_area(e);
+        memcpy(e->n, pa->n, sizeof(e->n)); /* the plane's normal, not a rounded one */
+        e->tri = pa->tri;
+        e->parent = i;
+        e->child = RAD_NONE;
+        e->depth = pa->depth + 1u;
+        memcpy(e->B, pa->B, sizeof(e->B)); /* until the next sweep */
+        if ((r = rad__hr_albedo(h, e, c)) != RAD_SUCCESS) return r;
+    }
+    h->el[i].child = first;
+    h->nel += 4u;
+    return RAD_SUCCESS;
+}
+
+/* E of elements [first, nel): the material's pi L, or the source callback in batches */
+static rad_result rad__hr_sources(rad_hierarchical *h, uint32_t first, const rad__ctx *c)
+{
+    uint32_t i, k;
+    float *buf;
+    uint32_t *tris;
+    rad_result r = RAD_SUCCESS;
+    if (first >= h->nel) return RAD_SUCCESS;
+    if (!h->o.source) {
+        for (i = first; i < h->nel; ++i) {
+            const rad_material *m = &h->scene->materials_table[h->scene->materials[h->el[i].tri]];
+            for (k = 0; k < 3; ++k) h->el[i].E[k] = (float)RAD__PI * m->emission[k];
+        }
+        return RAD_SUCCESS;
+    }
+    buf = (float *)rad__alloc_array(&h->allocator, (size_t)RAD__HR_SOURCE_BATCH * 12u, sizeof(float));
+    tris = (uint32_t *)rad__alloc_array(&h->allocator, RAD__HR_SOURCE_BATCH, sizeof(uint32_t));
+    if (!buf || !tris) {
+        rad__free(&h->allocator, buf);
+        rad__free(&h->allocator, tris);
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the source batch");
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = first; i < h->nel && r == RAD_SUCCESS; i += RAD__HR_SOURCE_BATCH) {
+        uint32_t n = h->nel - i < RAD__HR_SOURCE_BATCH ? h->nel - i : RAD__HR_SOURCE_BATCH;
+        float *pts = buf, *nrm = buf + 3 * RAD__HR_SOURCE_BATCH, *alb = buf + 6 * RAD__HR_SOURCE_BATCH;
+        float *E = buf + 9 * RAD__HR_SOURCE_BATCH;
+        for (k = 0; k < n; ++k) {
+            const rad__hr_elem *e = &h->el[i + k];
+            rad__hr_centroid(e, pts + 3 * k);
+            memcpy(nrm + 3 * k, e->n, 3 * sizeof(float));
+            memcpy(alb + 3 * k, e->rho, 3 * sizeof(float));
+            tris[k] = e->tri;
+        }
+        r = h->o.source(h->o.source_user, pts, nrm, tris, alb, n, E);
+        if (r != RAD_SUCCESS) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the source callback returned %s", rad_result_string(r));
+            break;
+        }
+        for (k = 0; k < 3 * n; ++k) {
+            if (!rad__finite(E[k])) {
+                rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the source gave %g for element %u", (double)E[k], i + k / 3u);
+                r = RAD_ERROR_NON_FINITE;
+                break;
+            }
+            if (E[k] < 0.0f) {
+                rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the source gave E = %g < 0 for element %u", (double)E[k],
+                         i + k / 3u);
+                r = RAD_ERROR_NEGATIVE_EMISSION;
+                break;
+            }
+        }
+        if (r == RAD_SUCCESS)
+            for (k = 0; k < n; ++k) memcpy(h->el[i + k].E, E + 3 * k, 3 * sizeof(float));
+    }
+    rad__free(&h->allocator, buf);
+    rad__free(&h->allocator, tris);
+    return r;
+}
+
+/* ---- link evaluation: kernels at the receiver's points, rays to the source, in tasks ---- */
+
+typedef struct rad__hr_eval {
+    rad_hierarchical *h;
+    rad__hr_link *links;
+    size_t count;
+    uint32_t tasks;
+    rad_ray *rays;
+    uint8_t *occ;
+    float *w;
+    size_t *idx;
+    uint64_t *kernels, *rays_cast;
+    rad_result *results;
+} rad__hr_eval;
+
+static rad_result rad__hr_flush(rad__hr_eval *ev, uint32_t task, uint32_t n)
+{
+    size_t base = (size_t)task * RAD__RAY_BATCH;
+    uint32_t k;
+    if (n == 0) return RAD_SUCCESS;
+    if (ev->h->rc.occluded(ev->h->rc.user, ev->rays + base, n, ev->occ + base) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    ev->rays_cast[task] += n;
+    for (k = 0; k < n; ++k)
+        if (!ev->occ[base + k]) ev->links[ev->idx[base + k]].F += ev->w[base + k];
+    return RAD_SUCCESS;
+}
+
+/* Link l's F: the mean over the receiver's K lattice points x_k of the analytic point-to-
+   triangle value f_k, times visibility. One ray per point, to a Hammersley point y_k of the
+   source; as in the analytic form-factor method each ray carries the share kern_k / sum kern
+   of the link's total sum f, kern the cos cos / r^2 of its two end points, so that a wall half
+   hidden near its base loses the share of light its near (strong) part carries, not its share
+   of area. */
+static void rad__hr_eval_task(void *data, uint32_t task)
+{
+    rad__hr_eval *ev = (rad__hr_eval *)data;
+    rad_hierarchical *h = ev->h;
+    size_t b = ev->count * task / ev->tasks, e = ev->count * (task + 1u) / ev->tasks, l, base = (size_t)task * RAD__RAY_BATCH;
+    uint32_t K = h->nside * h->nside, nrays = 0, s;
+    rad_result r = RAD_SUCCESS;
+    for (l = b; l < e && r == RAD_SUCCESS; ++l) {
+        rad__hr_link *lk = &ev->links[l];
+        const rad__hr_elem *er = &h->el[lk->r], *es = &h->el[lk->s];
+        uint32_t hs = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s)));
+        float r1 = (float)(hs & 0xFFFFu) / 65536.0f, r2 = (float)(hs >> 16) / 65536.0f;
+        float xs[3 * RAD__HR_MAX_RAYS], ys[3 * RAD__HR_MAX_RAYS];
+        double N[3], fu = 0.0, fmin = 1e30, fmax = 0.0, kern[RAD__HR_MAX_RAYS], f[RAD__HR_MAX_RAYS], ksum = 0.0;
+        int k;
+        for (k = 0; k < 3; ++k) N[k] = er->n[k];
+        lk->F = lk->Fu = lk->Fd = 0.0f;
+        for (s = 0; s < K; ++s) {
+            float *x = xs + 3 * s, *y = ys + 3 * s, d[3], u1, u2;
+            double X[3];
+            f[s] = kern[s] = 0.0;
+            rad__lattice_point(er->v, er->v + 3, er->v + 6, h->nside, s, x);
+            rad__sub(d, x, es->v);
+            if (!(rad__dot(d, es->n) > 0.0f)) { /* the point is behind the source */
+                fmin = 0.0;
+                continue;
+            }
+            for (k = 0; k < 3; ++k) X[k] = x[k];
+            f[s] = fabs(rad__ff_point_tri(X, N, es->v)) / (double)K;
+            ev->kernels[task]++;
+            if (f[s] < fmin) fmin = f[s];
+            if (f[s] > fmax) fmax = f[s];
+            fu += f[s];
+            rad__hammersley(s, K, r1, r2, &u1, &u2);
+            rad__triangle_point(es->v, es->v + 3, es->v + 6, u1, u2, y);
+            rad__sub(d, y, x);
+            {
+                double r2d = (double)rad__dot(d, d), cx = (double)rad__dot(d, er->n), cy = -(double)rad__dot(d, es->n);
+                kern[s] = f[s] > 0.0 && r2d > 0.0 && cx > 0.0 && cy > 0.0 ? cx * cy / (r2d * r2d) : 0.0;
+                ksum += kern[s];
+            }
+        }
+        lk->Fu = (float)fu;
+        lk->Fd = fmax > fmin ? (float)((fmax - fmin) * (double)K) : 0.0f;
+        if (h->o.skip_visibility) {
+            lk->F = lk->Fu;
+            continue;
+        }
+        for (s = 0; s < K && r == RAD_SUCCESS; ++s) {
+            /* no usable kernel (every end point grazing): each ray carries its point's f */
+            double w = ksum > 0.0 ? fu * kern[s] / ksum : f[s];
+            rad_ray *ray;
+            float len;
+            if (!(w > 0.0)) continue;
+            ray = ev->rays + base + nrays;
+            for (k = 0; k < 3; ++k) {
+                ray->origin[k] = xs[3 * s + (uint32_t)k] + er->n[k] * h->ray_eps;
+                ray->dir[k] = (ys[3 * s + (uint32_t)k] + es->n[k] * h->ray_eps) - ray->origin[k];
+            }
+            len = rad__len(ray->dir);
+            ray->tmin = 0.0f;
+            ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+            ev->w[base + nrays] = (float)w;
+            ev->idx[base + nrays] = l;
+            if (++nrays == RAD__RAY_BATCH) {
+                r = rad__hr_flush(ev, task, nrays);
+                nrays = 0;
+            }
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad__hr_flush(ev, task, nrays);
+    ev->results[task] = r;
+}
+
+static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, size_t count, const rad__ctx *c)
+{
+    rad__hr_eval ev;
+    size_t tasks = (count + 255u) / 256u;
+    uint32_t t;
+    rad_result r = RAD_SUCCESS;
+    if (count == 0) return RAD_SUCCESS;
+    if (tasks > c->tasks) tasks = c->tasks;
+    memset(&ev, 0, sizeof(ev));
+    ev.h = h;
+    ev.links = links;
+    ev.count = count;
+    ev.tasks = (uint32_t)tasks;
+    ev.rays = (rad_ray *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(rad_ray));
+    ev.occ = (uint8_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, 1);
+    ev.w = (float *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(float));
+    ev.idx = (size_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(size_t));
+    ev.kernels = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
+    ev.rays_cast = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
+    ev.results = (rad_result *)rad__alloc_array(&h->allocator, tasks, sizeof(rad_result));
+    if (!ev.rays || !ev.occ || !ev.w || !ev.idx || !ev.kernels || !ev.rays_cast || !ev.results) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the link evaluation scratch");
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        for (t = 0; t < ev.tasks; ++t) {
+            ev.kernels[t] = ev.rays_cast[t] = 0;
+            ev.results[t] = RAD_SUCCESS;
+        }
+        c->parallel_for(c->parallel_user, ev.tasks, rad__hr_eval_task, &ev);
+        for (t = 0; t < ev.tasks; ++t) {
+            h->st.kernel_evaluations += ev.kernels[t];
+            h->st.rays_cast += ev.rays_cast[t];
+            if (ev.results[t] != RAD_SUCCESS && r == RAD_SUCCESS) r = ev.results[t];
+        }
+        h->st.links_evaluated += count;
+        if (r != RAD_SUCCESS) rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the raycaster failed");
+    }
+    rad__free(&h->allocator, ev.rays);
+    rad__free(&h->allocator, ev.occ);
+    rad__free(&h->allocator, ev.w);
+    rad__free(&h->allocator, ev.idx);
+    rad__free(&h->allocator, ev.kernels);
+    rad__free(&h->allocator, ev.rays_cast);
+    rad__free(&h->allocator, ev.results);
+    return r;
+}
+
+/* a growable array of links */
+typedef struct rad__hr_list {
+    rad__hr_link *a;
+    size_t n, cap;
+} rad__hr_list;
+
+static rad_result rad__hr_push(rad_hierarchical *h, rad__hr_list *L, uint32_t r, uint32_t s, const rad__ctx *c)
+{
+    if (!rad__ff_facing(h->el[r].v, h->el[r].n, h->el[s].v, h->el[s].n)) return RAD_SUCCESS;
+    if (L->n == L->cap) {
+        size_t cap = L->cap ? 2u * L->cap : 1024u, old_bytes, new_bytes;
+        rad__hr_link *g;
+        if (!rad__mul(L->cap, sizeof(rad__hr_link), &old_bytes) || !rad__mul(cap, sizeof(rad__hr_link), &new_bytes)) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: too many links");
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        g = (rad__hr_link *)rad__realloc(&h->allocator, L->a, old_bytes, new_bytes);
+        if (!g) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for %llu links", (unsigned long long)cap);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        L->a = g;
+        L->cap = cap;
+    }
+    L->a[L->n].r = r;
+    L->a[L->n].s = s;
+    L->a[L->n].F = L->a[L->n].Fu = L->a[L->n].Fd = 0.0f;
+    L->n++;
+    return RAD_SUCCESS;
+}
+
+/* The oracle: 1 when link l should be refined (*split gets the element to split). BF
+   refinement: the power A_r F_rs max_c(B_s) the link carries (F unoccluded where some ray got
+   through, 0 where none did) above eps_abs splits the larger element that can split; and the
+   link's own error, A_r max_c(B_s) times the spread of F_rs over r's points, above eps_abs
+   splits the receiver (so that no leaf gathers over a link whose F differs much across it). */
+static int rad__hr_oracle(const rad_hierarchical *h, const rad__hr_link *l, uint32_t *split)
+{
+    const rad__hr_elem *er = &h->el[l->r], *es = &h->el[l->s];
+    float bs = es->B[0] > es->B[1] ? es->B[0] : es->B[1];
+    int can_r = er->area * 0.25f >= h->min_area, can_s = es->area * 0.25f >= h->min_area;
+    double pw;
+    if (es->B[2] > bs) bs = es->B[2];
+    pw = (double)er->area * (double)bs;
+    if (can_r && pw * (double)l->Fd > h->eps_abs) {
+        *split = l->r;
+        return 1;
+    }
+    if (!(pw * (double)l->Fu > h->eps_abs) || (!can_r && !can_s)) return 0;
+    *split = (can_s && (es->area >= er->area || !can_r)) ? l->s : l->r;
+    return 1;
+}
+
+/* One refinement pass over the links, level by level. *changed: any link refined. */
+static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__ctx *c)
+{
+    rad__hr_list keep, cand, next;
+    size_t i;
+    rad_result r = RAD_SUCCESS;
+    *changed = 0;
+    memset(&keep, 0, sizeof(keep));
+    memset(&next, 0, sizeof(next));
+    cand.a = h->links;
+    cand.n = cand.cap = h->nlinks;
+    h->links = NULL;
+    h->nlinks = 0;
+    while (cand.n > 0 && r == RAD_SUCCESS) {
+        next.n = 0;
+        for (i = 0; i < cand.n && r == RAD_SUCCESS; ++i) {
+            rad__hr_link l = cand.a[i];
+            uint32_t e, k;
+            if (!rad__hr_oracle(h, &l, &e)) {
+                if (keep.n == keep.cap) {
+                    /* rad__hr_push checks facing, which a kept link passed already */
+                    r = rad__hr_push(h, &keep, l.r, l.s, c);
+                    if (r == RAD_SUCCESS) keep.a[keep.n - 1u] = l;
+                } else {
+                    keep.a[keep.n++] = l;
+                }
+                continue;
+            }
+            *changed = 1;
+            if ((r = rad__hr_split(h, e, c)) != RAD_SUCCESS) break;
+            for (k = 0; k < 4u && r == RAD_SUCCESS; ++k) {
+                uint32_t ch = h->el[e].child + k;
+                r = e == l.s ? rad__hr_push(h, &next, l.r, ch, c) : rad__hr_push(h, &next, ch, l.s, c);
+            }
+        }
+        if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, next.a, next.n, c);
+        {
+            rad__hr_list tmp = cand;
+            cand = next;
+            next = tmp;
+        }
+    }
+    rad__free(&h->allocator, cand.a);
+    rad__free(&h->allocator, next.a);
+    h->links = keep.a;
+    h->nlinks = keep.n;
+    return r;
+}
+
+/* One gather and push-pull sweep; returns the largest change of a leaf's B over max B */
+static double rad__hr_sweep(rad_hierarchical *h)
+{
+    uint32_t i, k;
+    size_t l;
+    double change = 0.0, bmax = 0.0;
+    for (i = 0; i < h->nel; ++i) {
+        rad__hr_elem *e = &h->el[i];
+        e->G[0] = e->G[1] = e->G[2] = 0.0;
+        e->S = 0.0;
+    }
+    for (l = 0; l < h->nlinks; ++l) {
+        const rad__hr_link *lk = &h->links[l];
+        rad__hr_elem *er = &h->el[lk->r];
+        const float *B = h->el[lk->s].B;
+        for (k = 0; k < 3; ++k) er->G[k] += (double)lk->F * (double)B[k];
+        er->S += (double)lk->F;
+    }
+    for (i = 0; i < h->nel; ++i) { /* push: parents come first */
+        rad__hr_elem *e = &h->el[i];
+        const rad__hr_elem *p = e->parent != RAD_NONE ? &h->el[e->parent] : NULL;
+        for (k = 0; k < 3; ++k) e->Gt[k] = e->G[k] + (p ? p->Gt[k] : 0.0);
+        e->St = e->S + (p ? p->St : 0.0);
+    }
+    for (i = h->nel; i-- > 0;) { /* pull: children come first */
+        rad__hr_elem *e = &h->el[i];
+        if (e->child == RAD_NONE) {
+            for (k = 0; k < 3; ++k) {
+                float b = (float)((double)e->E[k] + (double)e->rho[k] * e->Gt[k]);
+                double d = fabs((double)b - (double)e->B[k]);
+                if (d > change) change = d;
+                if ((double)b > bmax) bmax = (double)b;
+                e->B[k] = b;
+            }
+        } else {
+            const rad__hr_elem *ch = &h->el[e->child];
+            double a = 0.0, s[3] = { 0.0, 0.0, 0.0 };
+            uint32_t m;
+            for (m = 0; m < 4; ++m) {
+                a += (double)ch[m].area;
+                for (k = 0; k < 3; ++k) s[k] += (double)ch[m].area * (double)ch[m].B[k];
+            }
+            for (k = 0; k < 3; ++k) e->B[k] = a > 0.0 ? (float)(s[k] / a) : 0.0f;
+        }
+    }
+    return bmax > 0.0 ? change / bmax : 0.0;
+}
+
+/* leaves in order, per-leaf corner vertices welded by position and plane, vertex values */
+static rad_result rad__hr_finish(rad_hierarchical *h, const rad__ctx *c)
+{
+    uint32_t i, k, T = h->scene->triangle_count, top, nl = 0, cap, mask, nv = 0;
+    uint32_t *stack = NULL, *table = NULL;
+    double *acc = NULL;
+    rad_result r = RAD_SUCCESS;
+    for (i = 0; i < h->nel; ++i)
+        if (h->el[i].child == RAD_NONE) ++nl;
+    if (nl > 0x3FFFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    for (cap = 16u; cap < 6u * nl; cap *= 2u) {
+    }
+    mask = cap - 1u;
+    h->leaf = (uint32_t *)rad__alloc_array(&h->allocator, nl, sizeof(uint32_t));
+    h->leaf_of = (uint32_t *)rad__alloc_array(&h->allocator, h->nel, sizeof(uint32_t));
+    h->leaf_vert = (uint32_t *)rad__alloc_array(&h->allocator, 3u * (size_t)nl, sizeof(uint32_t));
+    stack = (uint32_t *)rad__alloc_array(&h->allocator, h->nel, sizeof(uint32_t));
+    table = (uint32_t *)rad__alloc_array(&h->allocator, cap, sizeof(uint32_t));
+    /* per vertex: position and normal (6), area, A B (3), A H (3), A S, S max, halo A S, halo A */
+    acc = (double *)rad__alloc_array(&h->allocator, 3u * (size_t)nl, 19u * sizeof(double));
+    if (!h->leaf || !h->leaf_of || !h->leaf_vert || !stack || !table || !acc) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the %u leaves' lookup", nl);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    h->nleaf = 0;
+    for (i = 0; i < T; ++i) { /* depth first per scene triangle */
+        stack[0] = i;
+        top = 1;
+        while (top > 0) {
+            uint32_t e = stack[--top];
+            h->leaf_of[e] = RAD_NONE;
+            if (h->el[e].child == RAD_NONE) {
+                h->leaf_of[e] = h->nleaf;
+                h->leaf[h->nleaf++] = e;
+            } else {
+                for (k = 4; k-- > 0;) stack[top++] = h->el[e].child + k;
+            }
+        }
+    }
+    for (i = 0; i < cap; ++i) table[i] = RAD_NONE;
+    for (i = 0; i < h->nleaf; ++i) {
+        const rad__hr_elem *e = &h->el[h->leaf[i]];
+        for (k = 0; k < 3; ++k) {
+            const float *p = e->v + 3 * k;
+            uint32_t bits[3], hv, slot, v;
+            int m;
+            memcpy(bits, p, sizeof(bits));
+            for (m = 0; m < 3; ++m)
+                if (p[m] == 0.0f) bits[m] = 0; /* -0 and 0 weld */
+            hv = rad__hash(bits[0] ^ rad__hash(bits[1] ^ rad__hash(bits[2])));
+            for (slot = hv & mask;; slot = (slot + 1u) & mask) {
+                double *a;
+                v = table[slot];
+                if (v == RAD_NONE) {
+                    v = table[slot] = nv++;
+                    a = acc + 19u * (size_t)v;
+                    memset(a, 0, 19u * sizeof(double));
+                    for (m = 0; m < 3; ++m) { a[m] = p[m]; a[3 + m] = e->n[m]; }
+                    break;
+                }
+                a = acc + 19u * (size_t)v;
+                if (a[0] == p[0] && a[1] == p[1] && a[2] == p[2] &&
+                    a[3] * e->n[0] + a[4] * e->n[1] + a[5] * e->n[2] > 0.999)
+                    break;
+            }
+            h->leaf_vert[3 * i + k] = v;
+            {
+                double *a = acc + 19u * (size_t)v, A = (double)e->area;
+                a[6] += A;
+                for (m = 0; m < 3; ++m) {
+                    a[7 + m] += A * (double)e->B[m];
+                    a[10 + m] += A * e->Gt[m];
+                }
+                a[13] += A * e->St;
+                if (e->St > a[14]) a[14] = e->St;
+            }
+        }
+    }
+    for (i = 0; i < h->nleaf; ++i) { /* the halo fix: the leaves that see most of what the corner's best one sees */
+        const rad__hr_elem *e = &h->el[h->leaf[i]];
+        for (k = 0; k < 3; ++k) {
+            double *a = acc + 19u * (size_t)h->leaf_vert[3 * i + k];
+            if (e->St >= 0.75 * a[14]) {
+                a[15] += (double)e->area * e->St;
+                a[16] += (double)e->area;
+            }
+        }
+    }
+    h->nvert = nv;
+    h->vert_B = (float *)rad__alloc_array(&h->allocator, 3u * (size_t)(nv ? nv : 1u), sizeof(float));
+    h->vert_H = (float *)rad__alloc_array(&h->allocator, 3u * (size_t)(nv ? nv : 1u), sizeof(float));
+    if (!h->vert_B || !h->vert_H) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for %u lookup vertices", nv);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < nv; ++i) {
+        const double *a = acc + 19u * (size_t)i;
+        double scale = a[13] > 0.0 && a[16] > 0.0 ? (a[15] / a[16]) / a[13] : 0.0;
+        for (k = 0; k < 3; ++k) {
+            h->vert_B[3 * i + k] = a[6] > 0.0 ? (float)(a[7 + k] / a[6]) : 0.0f;
+            h->vert_H[3 * i + k] = (float)(a[10 + k] * scale);
+        }
+    }
+done:
+    rad__free(&h->allocator, stack);
+    rad__free(&h->allocator, table);
+    rad__free(&h->allocator, acc);
+    return r;
+}
+
+RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__hr_list L;
+    uint32_t i, j, T, round;
+    double P = 0.0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!h) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: h is NULL");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (h->state != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: already %s", h->state > 0 ? "solved" : "failed");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    h->state = -1;
+    T = h->scene->triangle_count;
+    if ((r = rad__hr_sources(h, 0, &c)) != RAD_SUCCESS) return r;
+    for (i = 0; i < T; ++i) {
+        rad__hr_elem *e = &h->el[i];
+        float m = e->E[0] > e->E[1] ? e->E[0] : e->E[1];
+        if (e->E[2] > m) m = e->E[2];
+        P += (double)e->area * (double)m;
+        memcpy(e->B, e->E, sizeof(e->B));
+    }
+    h->eps_abs = h->o.tolerance * P;
+    memset(&L, 0, sizeof(L));
+    for (i = 0; i < T && r == RAD_SUCCESS; ++i)
+        for (j = 0; j < T && r == RAD_SUCCESS; ++j)
+            if (i != j) r = rad__hr_push(h, &L, i, j, &c);
+    h->links = L.a;
+    h->nlinks = L.n;
+    if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, h->links, h->nlinks, &c);
+    for (round = 0; round < h->o.max_iterations && r == RAD_SUCCESS; ++round) {
+        int changed = 0;
+        uint32_t first = h->nel, s;
+        double res = 0.0;
+        r = rad__hr_refine(h, &changed, &c);
+        if (r == RAD_SUCCESS) r = rad__hr_sources(h, first, &c);
+        if (r != RAD_SUCCESS) break;
+        for (s = 0; s < RAD__HR_MAX_SWEEPS; ++s) {
+            res = rad__hr_sweep(h);
+            h->st.sweeps++;
+            if (res < RAD__HR_SWEEP_TOLERANCE) break;
+        }
+        h->st.residual = res;
+        h->st.rounds = round + 1u;
+        if (s == RAD__HR_MAX_SWEEPS) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: round %u: %u sweeps left a change of %g of max B", round,
+                     RAD__HR_MAX_SWEEPS, res);
+            r = RAD_ERROR_NOT_CONVERGED;
+            break;
+        }
+        if (c.progress && c.progress(c.progress_user, (float)(round + 1u) / (float)h->o.max_iterations)) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: cancelled after round %u", round);
+            r = RAD_ERROR_CANCELLED;
+            break;
+        }
+        if (!changed) break;
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < h->nel && r == RAD_SUCCESS; ++i) r = rad__check_output(&c, "rad_hierarchical_solve", h->el[i].B, 3);
+    }
+    if (r == RAD_SUCCESS) r = rad__hr_finish(h, &c);
+    if (r != RAD_SUCCESS) return r;
+    h->st.elements = h->nel;
+    h->st.leaves = h->nleaf;
+    h->st.links = h->nlinks;
+    h->state = 1;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_hierarchical_get_stats(const rad_hierarchical *h, rad_hierarchical_stats *out)
+{
+    if (!out) return;
+    memset(out, 0, sizeof(*out));
+    if (h) *out = h->st;
+}
+
+RAD_API rad_result rad_hierarchical_leaves(const rad_hierarchical *h, uint32_t first, uint32_t count, float *out_corners,
+                                           uint32_t *out_triangles, float *out_B, float *out_H)
+{
+    uint32_t i, k;
+    if (!h || h->state != 1) return RAD_ERROR_INVALID_ARGUMENT;
+    if (first > h->nleaf || count > h->nleaf - first) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    for (i = 0; i < count; ++i) {
+        const rad__hr_elem *e = &h->el[h->leaf[first + i]];
+        if (out_corners) memcpy(out_corners + 9 * (size_t)i, e->v, 9 * sizeof(float));
+        if (out_triangles) out_triangles[i] = e->tri;
+        for (k = 0; k < 3; ++k) {
+            if (out_B) out_B[3 * (size_t)i + k] = e->B[k];
+            if (out_H) out_H[3 * (size_t)i + k] = (float)e->Gt[k];
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_hierarchical_links(const rad_hierarchical *h, uint64_t first, uint32_t count, float *out_points,
+                                          float *out_form_factors, uint32_t *out_depths)
+{
+    uint32_t i;
+    if (!h || h->state != 1) return RAD_ERROR_INVALID_ARGUMENT;
+    if (first > (uint64_t)h->nlinks || (uint64_t)count > (uint64_t)h->nlinks - first) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    for (i = 0; i < count; ++i) {
+        const rad__hr_link *l = &h->links[(size_t)first + i];
+        if (out_points) {
+            rad__hr_centroid(&h->el[l->r], out_points + 6 * (size_t)i);
+            rad__hr_centroid(&h->el[l->s], out_points + 6 * (size_t)i + 3);
+        }
+        if (out_form_factors) out_form_factors[i] = l->F;
+        if (out_depths) {
+            out_depths[2 * (size_t)i] = h->el[l->r].depth;
+            out_depths[2 * (size_t)i + 1] = h->el[l->s].depth;
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_hierarchical_lookup(const rad_hierarchical *h, rad_hierarchical_value value, int smooth,
+                                           const uint32_t *triangles, const float *barycentrics, uint32_t count,
+                                           float *out)
+{
+    uint32_t i, k;
+    if (!h || h->state != 1 || !triangles || !barycentrics || !out ||
+        (value != RAD_HIERARCHICAL_RADIOSITY && value != RAD_HIERARCHICAL_GATHERED))
+        return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < count; ++i) {
+        uint32_t t = triangles[i], e;
+        float l1 = barycentrics[2 * (size_t)i], l2 = barycentrics[2 * (size_t)i + 1];
+        const float *vals;
+        if (t >= h->scene->triangle_count) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        if (!rad__finite(l1) || !rad__finite(l2)) return RAD_ERROR_INVALID_ARGUMENT;
+        /* clamp into the triangle, then descend: (l1, l2) become the child's own */
+        if (l1 < 0.0f) l1 = 0.0f;
+        if (l2 < 0.0f) l2 = 0.0f;
+        if (l1 + l2 > 1.0f) { float s = l1 + l2; l1 /= s; l2 /= s; }
+        for (e = t; h->el[e].child != RAD_NONE;) {
+            uint32_t ch = h->el[e].child;
+            if (l1 >= 0.5f) { e = ch + 1u; l1 = 2.0f * l1 - 1.0f; l2 = 2.0f * l2; }
+            else if (l2 >= 0.5f) { e = ch + 2u; l1 = 2.0f * l1; l2 = 2.0f * l2 - 1.0f; }
+            else if (l1 + l2 <= 0.5f) { e = ch; l1 = 2.0f * l1; l2 = 2.0f * l2; }
+            else { float m2 = 1.0f - 2.0f * l1; e = ch + 3u; l1 = 2.0f * l2 - m2; l2 = m2; }
+        }
+        if (!smooth) {
+            const rad__hr_elem *el = &h->el[e];
+            for (k = 0; k < 3; ++k) out[3 * (size_t)i + k] = value == RAD_HIERARCHICAL_RADIOSITY ? el->B[k] : (float)el->Gt[k];
+            continue;
+        }
+        {
+            const uint32_t *vv = h->leaf_vert + 3 * (size_t)h->leaf_of[e];
+            float w0 = 1.0f - l1 - l2;
+            vals = value == RAD_HIERARCHICAL_RADIOSITY ? h->vert_B : h->vert_H;
+            if (w0 < 0.0f) w0 = 0.0f;
+            for (k = 0; k < 3; ++k)
+                out[3 * (size_t)i + k] = w0 * vals[3 * (size_t)vv[0] + k] + l1 * vals[3 * (size_t)vv[1] + k] +
+                                         l2 * vals[3 * (size_t)vv[2] + k];
+        }
+    }
+    return RAD_SUCCESS;
 }
 
 /* ======================================================================================== */

@@ -179,6 +179,14 @@ s_examples() {
     else
         fail gallery-small
     fi
+    # hierarchical radiosity's links as an image
+    if build learn-hierarchical $CC -std=c99 $WARN -O2 -I. examples/learn_hierarchical.c -o "$BUILD/learn_hierarchical" -lm &&
+       "$BUILD/learn_hierarchical" --eps 1e-2 --size 64 -o "$BUILD/learn-hierarchical.png" >"$BUILD/learn-hierarchical.out" 2>&1 &&
+       [ -s "$BUILD/learn-hierarchical.png" ] && grep -q 'links' "$BUILD/learn-hierarchical.out"; then
+        pass learn-hierarchical
+    else
+        fail learn-hierarchical
+    fi
     compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
     compile_run engine_bake $CC -std=c99 $WARN -O2 -I. examples/engine_bake.c -o "$BUILD/engine_bake" -lm
     # the virtual-patch example builds and, without the external meshes, says it skipped

@@ -557,6 +557,13 @@ if [ -s "$TMP/ref.pfm" ]; then
             fail "$vm renders the Cornell box" "$(head -c 300 "$TMP/err.txt")"
         fi
     done
+    # hierarchical: its timing line with the form-factor work, close to classic on 300 patches
+    if "$RAD" render cornell $M --method hierarchical --hr-eps 3e-3 -o "$TMP/hr.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        grep -q "timing: method=hierarchical patches=[0-9]* .*links=[0-9]* kernels=[0-9]* rays=[0-9]*" "$TMP/err.txt"; then
+        psnr_check "hierarchical renders the Cornell box close to classic" "$TMP/ref.pfm" "$TMP/hr.pfm" 30
+    else
+        fail "hierarchical renders the Cornell box" "$(head -c 300 "$TMP/err.txt")"
+    fi
     if "$RAD" render cornell $M --method aavp --vp-max-patches 300 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"; then
         np=$(grep -o 'timing: method=aavp patches=[0-9]*' "$TMP/err.txt" | cut -d= -f3)
         [ -n "$np" ] && [ "$np" -le 300 ] && [ "$np" -gt 100 ] && ok "aavp --vp-max-patches 300 gives $np patches (100 < n <= 300)" ||
@@ -587,6 +594,13 @@ bad "--sr-estimator foo" "unknown --sr-estimator 'foo'" bake cornell --method st
 bad "--sr-rays 0" "--sr-rays must be in 1.." render cornell --method stochastic --sr-rays 0 -o "$TMP/y.pfm"
 bad "--bounces with stochastic" "--bounces is for --method multibounce, not stochastic" render cornell --method stochastic --bounces 3 -o "$TMP/y.pfm"
 bad "--sr-iterations with vp" "--sr-iterations is not an option of --method vp" render cornell --method vp --sr-iterations 3 -o "$TMP/y.pfm"
+bad "bake --method hierarchical" "method 'hierarchical' is render-only" bake cornell --method hierarchical -o "$TMP/y.radb"
+bad "--hr-eps 2" "--hr-eps must be in (0, 1)" render cornell --method hierarchical --hr-eps 2 -o "$TMP/y.pfm"
+bad "--hr-rays 5" "--hr-rays must be a square" render cornell --method hierarchical --hr-rays 5 -o "$TMP/y.pfm"
+bad "--hr-min-area -1" "--hr-min-area must be a positive area" render cornell --method hierarchical --hr-min-area -1 -o "$TMP/y.pfm"
+bad "--hr-eps with classic" "--hr-eps is for --method hierarchical, not classic" render cornell --hr-eps 1e-3 -o "$TMP/y.pfm"
+bad "--bounces with hierarchical" "--bounces is not an option of --method hierarchical" render cornell --method hierarchical --bounces 3 -o "$TMP/y.pfm"
+bad "--vp-resolution with hierarchical" "--vp-resolution is not an option of --method hierarchical" render cornell --method hierarchical --vp-resolution 4 -o "$TMP/y.pfm"
 bad "--format bc5" "unknown --format 'bc5'" bake cornell --method multibounce --format bc5 -o "$TMP/y.radb"
 bad "--format with classic" "--format is for --method multibounce, not classic" bake cornell --format half -o "$TMP/y.radb"
 bad "--outliers with half" "--outliers is for the compressed formats" bake cornell --method multibounce --format half --outliers 0.1 -o "$TMP/y.radb"

@@ -55,11 +55,12 @@ static void *xmalloc(size_t size)
 static void render_usage(FILE *f)
 {
     fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|pathtrace] [options]\n"
+            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace] [options]\n"
             "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
             "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
             "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
-            "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches)\n"
+            "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
+            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991)\n"
             "  --bake FILE.radb   classic, multibounce, temporal: use a bake of that method made by\n"
             "                     'rad bake' from this scene instead of computing it here\n"
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
@@ -135,6 +136,9 @@ static int render_shading = -1;
 static const rad_virtual_patches *render_vp = NULL;
 static const float *render_vp_H = NULL;
 static double render_vp_gather_seconds = 0.0;
+/* --method hierarchical: render_classic looks H up at each sample's hit (smooth, halo-fixed) */
+static const rad_hierarchical *render_hr = NULL;
+static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out);
 /* --final-gather N: rays per pixel sample for one traced bounce (0: off; rad_final_gather) */
 static uint32_t render_final_gather = 0;
 
@@ -155,6 +159,7 @@ static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *poi
         rad_tool_context(&quiet, NULL);
         return rad_vp_gather(render_vp, render_vp_H, points, normals, count, out, &quiet);
     }
+    if (render_hr) return hr_lookup(hits, NULL, count, out);
     for (k = 0; k < count; ++k) {
         float wts[3];
         uint32_t p = rad_patches_locate(l->P, hits[k].triangle, hits[k].b1, hits[k].b2, wts);
@@ -166,6 +171,24 @@ static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *poi
                              wts[2] * l->Hv[3 * (size_t)vi[2] + i];
     }
     return RAD_SUCCESS;
+}
+
+/* H of the hierarchical solution at hits[valid[k]] (valid NULL: hits[k]), k < count */
+static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out)
+{
+    uint32_t *tris = (uint32_t *)xmalloc(sizeof(uint32_t) * (count ? count : 1u)), k;
+    float *bary = (float *)xmalloc(sizeof(float) * 2 * (count ? count : 1u));
+    rad_result r;
+    for (k = 0; k < count; ++k) {
+        const rad_hit *h = &hits[valid ? valid[k] : k];
+        tris[k] = h->triangle;
+        bary[2 * k] = h->b1;
+        bary[2 * k + 1] = h->b2;
+    }
+    r = rad_hierarchical_lookup(render_hr, RAD_HIERARCHICAL_GATHERED, 1, tris, bary, count, out);
+    free(tris);
+    free(bary);
+    return r;
 }
 
 static int render_classic(const rad_tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
@@ -193,7 +216,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
-    if (render_vp || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    if (render_vp || render_hr || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     if (render_shading >= 0) {
         shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
         shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
@@ -275,7 +298,8 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
             }
         } else if (gathered && nvalid > 0) {
             double tg = rad_tool_seconds();
-            r = rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
+            r = render_hr ? hr_lookup(hits, valid, nvalid, gathered)
+                          : rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
             render_vp_gather_seconds += rad_tool_seconds() - tg;
             if (r != RAD_SUCCESS) {
                 result = rad_tool_fail("render", "rad_vp_gather", r);
@@ -655,6 +679,32 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     return rc;
 }
 
+/* --method hierarchical: the solution (rad_tool_hierarchical_build), then the classic render
+   with H looked up at each sample */
+static int render_hr_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                            const rad_tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
+                            uint32_t light_samples, rad_image *img)
+{
+    rad_hierarchical *h = NULL;
+    rad_hierarchical_stats st;
+    double t0 = rad_tool_seconds(), t_solve;
+    int rc;
+    if (rad_tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) return 1;
+    t_solve = rad_tool_seconds() - t0;
+    rad_hierarchical_get_stats(h, &st);
+    render_hr = h;
+    t0 = rad_tool_seconds();
+    rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
+    render_hr = NULL;
+    if (rc == 0)
+        fprintf(stderr, "rad %s: timing: method=hierarchical patches=%u frames=1 step_ms_median=%.6f step_ms_min=%.6f "
+                        "links=%llu kernels=%llu rays=%llu render_ms=%.1f\n",
+                cmd, st.leaves, 1e3 * t_solve, 1e3 * t_solve, (unsigned long long)st.links,
+                (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, 1e3 * (rad_tool_seconds() - t0));
+    rad_hierarchical_destroy(h);
+    return rc;
+}
+
 /* --method local: the classic patches, F and E; a local matrix of capacity M over F's
    rows filled with the M patches nearest the camera (rad_local_rebuild), L = T E over P_Vis x
    P_Lit, H = L / rho (L = rho F (E + L) within the set), rendered as classic. */
@@ -880,8 +930,9 @@ int rad_cmd_render(int argc, char **argv)
     }
 
     if (mo.method >= RAD_TOOL_LOCAL) {
-        rc = mo.method == RAD_TOOL_LOCAL
-                 ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
+        rc = mo.method == RAD_TOOL_LOCAL ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
+             : mo.method == RAD_TOOL_HIERARCHICAL
+                 ? render_hr_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
                  : render_vp_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
         if (rc) {
             rad_image_free(&img);

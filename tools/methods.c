@@ -62,6 +62,7 @@ const char *rad_tool_method_name(rad_tool_method method)
     case RAD_TOOL_LOCAL: return "local";
     case RAD_TOOL_VP: return "vp";
     case RAD_TOOL_AAVP: return "aavp";
+    case RAD_TOOL_HIERARCHICAL: return "hierarchical";
     default: return "classic";
     }
 }
@@ -124,6 +125,11 @@ const char *rad_tool_method_help(int render)
                     "                     up to 4096: T takes 12 M^2 bytes, 192 MiB at 4096, and its rebuild\n"
                     "                     6 M^3 flops). L = T E over P_Vis x P_Lit: patches outside S (or not\n"
                     "                     visible) get no indirect light and light outside S is not bounced\n"
+                    "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement, solved\n"
+                    "to convergence; --patches etc. and --bounces are not used; render only):\n"
+                    "  --hr-eps E         refinement tolerance, a fraction of the source power (default 1e-5)\n"
+                    "  --hr-min-area A    smallest element area, scene units^2 (default: total area / 10000)\n"
+                    "  --hr-rays R        points and visibility rays per link: 1, 4, 9 ... 64 (default 4)\n"
                     "%s"
                   : "multibounce:\n"
                     "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
@@ -177,6 +183,38 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         mo->given |= RAD_TOOL_OPT_SR_RAYS << which;
         return 1;
     }
+    if (!strcmp(opt, "--hr-eps") || !strcmp(opt, "--hr-min-area") || !strcmp(opt, "--hr-rays")) {
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+            return 2;
+        }
+        v = argv[++*a];
+        if (opt[5] == 'r') {
+            uint32_t n = 1;
+            if (rad_tool_parse_uint(cmd, opt, v, &mo->hr_rays)) return 2;
+            while (n * n < mo->hr_rays) ++n;
+            if (mo->hr_rays == 0 || mo->hr_rays > 64 || n * n != mo->hr_rays) {
+                fprintf(stderr, "rad %s: --hr-rays must be a square from 1 to 64 (1, 4, 9 ...), not %s\n", cmd, v);
+                return 2;
+            }
+            mo->given |= RAD_TOOL_OPT_HR_RAYS;
+        } else if (opt[5] == 'e') {
+            if (rad_tool_parse_float(cmd, opt, v, &mo->hr_eps)) return 2;
+            if (!(mo->hr_eps > 0.0f && mo->hr_eps < 1.0f)) {
+                fprintf(stderr, "rad %s: --hr-eps must be in (0, 1) (e.g. 1e-3), not %s\n", cmd, v);
+                return 2;
+            }
+            mo->given |= RAD_TOOL_OPT_HR_EPS;
+        } else {
+            if (rad_tool_parse_float(cmd, opt, v, &mo->hr_min_area)) return 2;
+            if (!(mo->hr_min_area > 0.0f) || mo->hr_min_area > 1e30f) {
+                fprintf(stderr, "rad %s: --hr-min-area must be a positive area, not %s\n", cmd, v);
+                return 2;
+            }
+            mo->given |= RAD_TOOL_OPT_HR_MIN_AREA;
+        }
+        return 1;
+    }
     {
         static const char *const extra[] = {"--vp-resolution", "--vp-max-patches", "--face-points", "--local-m"};
         for (i = 0; i < 4; ++i)
@@ -222,9 +260,10 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         else if (!strcmp(v, "vp")) mo->method = RAD_TOOL_VP;
         else if (!strcmp(v, "aavp")) mo->method = RAD_TOOL_AAVP;
         else if (!strcmp(v, "stochastic")) mo->method = RAD_TOOL_STOCHASTIC;
+        else if (!strcmp(v, "hierarchical")) mo->method = RAD_TOOL_HIERARCHICAL;
         else {
             fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal, stochastic%s)\n", cmd, v,
-                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp or aavp");
+                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp, aavp or hierarchical");
             return 2;
         }
         mo->given |= RAD_TOOL_OPT_METHOD;
@@ -335,7 +374,8 @@ static const char *given_name(uint32_t bits)
                                         "--reorder-samples", "--tile", "--mode", "--k", "--w", "--adaptive",
                                         "--seed", "--frames", "--sequence", "--every", "--method",
                                         "--vp-resolution", "--vp-max-patches", "--face-points", "--local-m",
-                                        "--sr-rays", "--sr-iterations", "--sr-estimator"};
+                                        "--sr-rays", "--sr-iterations", "--sr-estimator",
+                                        "--hr-eps", "--hr-min-area", "--hr-rays"};
     uint32_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (bits & (1u << i)) return names[i];
@@ -353,18 +393,23 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
     if (!render && mo->method >= RAD_TOOL_LOCAL) {
         fprintf(stderr, "rad %s: method '%s' is render-only (rad render --method %s builds it in memory: %s)\n", cmd,
                 rad_tool_method_name(mo->method), rad_tool_method_name(mo->method),
-                mo->method == RAD_TOOL_LOCAL ? "its matrix depends on the camera; a classic bake holds its F"
-                                             : "the container has no section for virtual patches yet");
+                mo->method == RAD_TOOL_LOCAL          ? "its matrix depends on the camera; a classic bake holds its F"
+                : mo->method == RAD_TOOL_HIERARCHICAL ? "the container has no section for quadtrees and links yet"
+                                                      : "the container has no section for virtual patches yet");
         return 2;
     }
     if (mo->method >= RAD_TOOL_LOCAL) {
-        uint32_t other = mo->method == RAD_TOOL_LOCAL ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES : RAD_TOOL_OPT_LOCAL_M;
+        uint32_t other = mo->method == RAD_TOOL_LOCAL          ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_HR
+                         : mo->method == RAD_TOOL_HIERARCHICAL ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_LOCAL_M
+                                                               : RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR;
         bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED |
                    RAD_TOOL_OPT_SR | other);
         if (bad) {
             fprintf(stderr, "rad %s: %s is not an option of --method %s%s\n", cmd, given_name(bad),
                     rad_tool_method_name(mo->method),
-                    mo->method == RAD_TOOL_LOCAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (T is the full solution in the set)" : "");
+                    mo->method == RAD_TOOL_LOCAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (T is the full solution in the set)"
+                    : mo->method == RAD_TOOL_HIERARCHICAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (it solves to convergence)"
+                                                                                          : "");
             return 2;
         }
         if ((g & RAD_TOOL_OPT_VP_RESOLUTION) && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
@@ -373,9 +418,11 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
         }
         return 0;
     }
-    if (g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M)) {
-        fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd, given_name(g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M)),
-                (g & RAD_TOOL_OPT_VP) ? "vp or aavp" : "local", rad_tool_method_name(mo->method));
+    if (g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR)) {
+        fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd,
+                given_name(g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR)),
+                (g & RAD_TOOL_OPT_VP) ? "vp or aavp" : (g & RAD_TOOL_OPT_LOCAL_M) ? "local" : "hierarchical",
+                rad_tool_method_name(mo->method));
         return 2;
     }
     if ((g & RAD_TOOL_OPT_SR) && mo->method != RAD_TOOL_STOCHASTIC) {
@@ -969,5 +1016,71 @@ int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds)
         return rad_tool_fail(m->cmd, m->temporal ? "rad_temporal_step" : "multi-bounce apply", r);
     /* H = L_{K+1} / rho (see the top of this file) */
     for (i = 0; i < 3 * m->n; ++i) H[i] = m->albedo[i] > 0.0f ? L[i] / m->albedo[i] : 0.0f;
+    return 0;
+}
+
+/* ---- hierarchical (render only) ------------------------------------------------------------ */
+
+typedef struct hr_source_data {
+    const rad_tool_world *w;
+    rad_direct_options dopt;
+} hr_source_data;
+
+/* E = rho D at the elements' centroids (RAD_SOURCE_DIRECT, as the classic patches) */
+static rad_result hr_source(void *user, const float *points, const float *normals, const uint32_t *triangles,
+                            const float *albedos, uint32_t count, float *out_E)
+{
+    const hr_source_data *d = (const hr_source_data *)user;
+    rad_context quiet;
+    rad_result r;
+    uint32_t i;
+    (void)triangles;
+    rad_tool_context(&quiet, NULL);
+    r = rad_direct_irradiance(d->w->scene, &d->w->rc, d->w->file.lights, d->w->file.light_count, &d->dopt, points,
+                              normals, count, out_E, &quiet);
+    if (r == RAD_SUCCESS)
+        for (i = 0; i < 3 * count; ++i) out_E[i] *= albedos[i];
+    return r;
+}
+
+int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+                                uint32_t light_samples, rad_hierarchical **out)
+{
+    rad_hierarchical_options ho;
+    rad_hierarchical_stats st;
+    hr_source_data sd;
+    rad_context ctx;
+    rad_result r;
+    double t0 = rad_tool_seconds();
+    *out = NULL;
+    rad_hierarchical_options_default(&ho);
+    /* finer than the library's teaching default: a still image as close to the path tracer as
+       classic's at a small part of its rays (BENCHMARKS.md, hierarchical radiosity) */
+    ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
+    ho.min_area = mo->hr_min_area;
+    if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
+    sd.w = w;
+    rad_direct_options_default(&sd.dopt);
+    sd.dopt.include_emitters = 1;
+    sd.dopt.light_samples = light_samples;
+    ho.source = hr_source;
+    ho.source_user = &sd;
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_hierarchical_create(w->scene, &w->rc, &ho, &ctx, out)) != RAD_SUCCESS)
+        return rad_tool_fail(cmd, "rad_hierarchical_create", r);
+    rad_tool_context(&ctx, "hierarchical");
+    r = rad_hierarchical_solve(*out, &ctx);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_hierarchical_destroy(*out);
+        *out = NULL;
+        return rad_tool_fail(cmd, "rad_hierarchical_solve", r);
+    }
+    rad_hierarchical_get_stats(*out, &st);
+    fprintf(stderr, "rad %s: hierarchical: %u triangles, %u elements, %u leaves, %llu links, %llu kernel evaluations, "
+                    "%llu rays, %u rounds, %u sweeps in %.2f s\n",
+            cmd, w->scene->triangle_count, st.elements, st.leaves, (unsigned long long)st.links,
+            (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, st.rounds, st.sweeps,
+            rad_tool_seconds() - t0);
     return 0;
 }

@@ -367,7 +367,7 @@ static void usage(FILE *f)
                "  formfactors SCENE        group form factors between the scene's named objects\n"
                "  bake SCENE -o FILE.radb  compute and save a solution: --method classic|multibounce|temporal\n"
                "  render SCENE -o OUT      render an image (.png or .pfm):\n"
-               "                           --method classic|multibounce|temporal|local|vp|aavp|pathtrace\n"
+               "                           --method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace\n"
                "                           [--bake FILE.radb]\n"
                "  trace SCENE -o OUT       the reference path tracer\n"
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"

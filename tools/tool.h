@@ -240,7 +240,7 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
 typedef enum rad_tool_method {
     RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
     RAD_TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
-    RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7 /* render only (cmd_render.c) */
+    RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7, RAD_TOOL_HIERARCHICAL = 8 /* render only (cmd_render.c) */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
 typedef enum rad_tool_mb_format {
@@ -273,6 +273,9 @@ typedef struct rad_tool_method_options {
     uint32_t sr_rays;         /* --sr-rays N: stochastic rays of the first iteration / walks (0: the library's 64 per patch) */
     uint32_t sr_iterations;   /* --sr-iterations N: Jacobi shooting iterations at most / walk batches (0: the library's) */
     uint32_t sr_estimator;    /* --sr-estimator jacobi|walk: a rad_stochastic_method (default jacobi) */
+    float hr_eps;             /* --hr-eps E: hierarchical BF refinement tolerance (0: 1e-5) */
+    float hr_min_area;        /* --hr-min-area A: smallest element, scene units^2 (0: total area / 10000) */
+    uint32_t hr_rays;         /* --hr-rays R: points and visibility rays per link, a square (0: 4) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
 } rad_tool_method_options;
 enum {
@@ -282,9 +285,11 @@ enum {
     RAD_TOOL_OPT_SEED = 1u << 10, RAD_TOOL_OPT_FRAMES = 1u << 11, RAD_TOOL_OPT_SEQUENCE = 1u << 12,
     RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14, RAD_TOOL_OPT_VP_RESOLUTION = 1u << 15,
     RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18,
-    RAD_TOOL_OPT_SR_RAYS = 1u << 19, RAD_TOOL_OPT_SR_ITERATIONS = 1u << 20, RAD_TOOL_OPT_SR_ESTIMATOR = 1u << 21
+    RAD_TOOL_OPT_SR_RAYS = 1u << 19, RAD_TOOL_OPT_SR_ITERATIONS = 1u << 20, RAD_TOOL_OPT_SR_ESTIMATOR = 1u << 21,
+    RAD_TOOL_OPT_HR_EPS = 1u << 22, RAD_TOOL_OPT_HR_MIN_AREA = 1u << 23, RAD_TOOL_OPT_HR_RAYS = 1u << 24
 };
 #define RAD_TOOL_OPT_SR (RAD_TOOL_OPT_SR_RAYS | RAD_TOOL_OPT_SR_ITERATIONS | RAD_TOOL_OPT_SR_ESTIMATOR)
+#define RAD_TOOL_OPT_HR (RAD_TOOL_OPT_HR_EPS | RAD_TOOL_OPT_HR_MIN_AREA | RAD_TOOL_OPT_HR_RAYS)
 #define RAD_TOOL_OPT_VP (RAD_TOOL_OPT_VP_RESOLUTION | RAD_TOOL_OPT_VP_MAX_PATCHES | RAD_TOOL_OPT_FACE_POINTS)
 #define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
                                RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
@@ -305,6 +310,12 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
 int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o);
 const char *rad_tool_method_help(int render);
 const char *rad_tool_method_name(rad_tool_method method);
+/* --method hierarchical: rad_hierarchical_create and solve over the world with E = rho D at
+   the elements' centroids (D: rad_direct_irradiance with light_samples shadow rays, emitters
+   included, as the classic patches' D) and mo's --hr-* options; prints the counts and the
+   form-factor work. 0 (*out owned by the caller) or 1 (message printed). */
+int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+                                uint32_t light_samples, rad_hierarchical **out);
 
 /* The user sections the methods add: what was built, and the row sums S_i of F (the halo
    correction of the per-vertex H needs them and these bakes hold no F). --method stochastic
