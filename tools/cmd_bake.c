@@ -195,18 +195,24 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     return 0;
 }
 
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info)
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w)
 {
-    return rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
+    uint64_t h = rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
+    /* the command line's lights, so that a bake lit by --sun is not rendered under another sun;
+       none leaves the hash of bakes made before those options unchanged */
+    if (w && w->file.light_count > w->file_light_count)
+        h = rad_tool_lights_hash(w->file.lights + w->file_light_count, w->file.light_count - w->file_light_count, h);
+    return h;
 }
 
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig)
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+                           rad_bake_signature *sig)
 {
     uint32_t i;
     for (i = 0; i < count; ++i)
         if (secs[i].type == RAD_SECTION_SIGNATURE && secs[i].elem_size == sizeof *sig && secs[i].count == 1) {
             memcpy(sig, secs[i].data, sizeof *sig);
-            sig->options = rad_tool_options_hash(info);
+            sig->options = rad_tool_options_hash(info, w);
             secs[i].data = sig;
         }
 }
@@ -244,7 +250,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     info.bounces = o->bounces;
     info.light_samples = o->light_samples;
     info.triangle_count = w->scene->triangle_count;
-    rad_tool_sign_options(secs, k, &info, &sig);
+    rad_tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->L;
     strcpy(secs[k++].name, "L");
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->H;
@@ -299,11 +305,12 @@ static void bake_usage(FILE *f)
                "  --method M         classic (default), multibounce or temporal\n"
                "%s"
                "%s"
+               "%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(0));
+            rad_tool_classic_help(), rad_tool_method_help(0), rad_tool_light_help());
 }
 
-int rad_cmd_bake(int argc, char **argv)
+static int bake_main(int argc, char **argv, rad_tool_lights *lights)
 {
     const char *cmd = "bake", *scene_name = NULL, *out_path = NULL;
     rad_tool_classic_options o;
@@ -322,6 +329,9 @@ int rad_cmd_bake(int argc, char **argv)
         if (rc == 2) return 2;
         if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        rc = rad_tool_light_option(cmd, argc, argv, &a, lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads")) && a + 1 >= argc) {
@@ -345,7 +355,7 @@ int rad_cmd_bake(int argc, char **argv)
     if (rad_tool_method_check(cmd, 0, &mo, &o)) return 2;
     if (rad_tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
     rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
     if (mo.method != RAD_TOOL_CLASSIC) {
         void *buf = NULL;
         size_t size = 0;
@@ -365,5 +375,15 @@ int rad_cmd_bake(int argc, char **argv)
     rad_tool_classic_free(&c);
     rad_tool_close_world(&w);
     if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    return rc;
+}
+
+int rad_cmd_bake(int argc, char **argv)
+{
+    rad_tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = bake_main(argc, argv, &lights);
+    rad_tool_lights_free(&lights);
     return rc;
 }

@@ -80,8 +80,9 @@ static void render_usage(FILE *f)
             "patch and classic solution options (ignored with --bake, which keeps its own):\n"
             "%s"
             "%s"
+            "%s"
             "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(1));
+            rad_tool_classic_help(), rad_tool_method_help(1), rad_tool_light_help());
 }
 
 /* Per-vertex H, with the halo fix of examples/cornell.c step 7: a patch partly covered (under
@@ -213,6 +214,8 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     rad_direct_options dopt;
     rad_context quiet;
     int y0, rows_per_batch, result = 0;
+    float sky[3] = {0.0f, 0.0f, 0.0f};
+    uint32_t k, i;
     for (strata = 1; (strata + 1) * (strata + 1) <= aa; ++strata) {
     }
     spp = strata * strata;
@@ -235,10 +238,14 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     dopt.include_emitters = 1;
     dopt.light_samples = light_samples;
     rad_tool_context(&quiet, NULL);
+    /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
+    for (k = 0; k < w->file.light_count; ++k)
+        if (w->file.lights[k].type == RAD_LIGHT_SKY)
+            for (i = 0; i < 3; ++i) sky[i] += w->file.lights[k].color[i] / PI_F;
 
     for (y0 = 0; y0 < height && result == 0; y0 += rows_per_batch) {
         int y1 = y0 + rows_per_batch < height ? y0 + rows_per_batch : height, chunk, nchunks;
-        uint32_t count = 0, nvalid = 0, k, i;
+        uint32_t count = 0, nvalid = 0;
         int x, y;
         uint32_t s;
         rad_result r;
@@ -268,7 +275,12 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
         for (k = 0; k < count; ++k) {
             uint32_t t = hits[k].triangle;
             const float *v, *nt;
-            if (t == RAD_NONE) continue;
+            if (t == RAD_NONE || t >= scene->triangle_count) {
+                size_t pixel = (size_t)y0 * width + k / spp;
+                for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
+                hits[k].triangle = RAD_NONE;
+                continue;
+            }
             nt = scene->normals + 3 * (size_t)t;
             if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] >= 0.0f) {
                 hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
@@ -387,8 +399,17 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
     rad_result r;
     int rc = 0;
     rad_tool_context(&ctx, NULL);
-    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info) : 0u, &ctx)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)\n", cmd, bake_path, rad_result_string(r));
+    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info, w) : 0u, &ctx)) != RAD_SUCCESS) {
+        /* the same options without this command line's lights: then only the lights differ */
+        rad_tool_world bare = *w;
+        bare.file_light_count = w->file.light_count;
+        if (info && rad_bake_matches_scene(bake, w->scene, rad_tool_options_hash(info, &bare), NULL) == RAD_SUCCESS)
+            fprintf(stderr, "rad %s: bake '%s' was made with other lights than this command line's --sun, --sky, "
+                            "--point and --spot: give the bake's light options, or render without --bake\n",
+                    cmd, bake_path);
+        else
+            fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)%s\n", cmd, bake_path, rad_result_string(r),
+                    info ? "; the options hash covers --sun, --sky, --point and --spot: give the bake's own" : "");
         rc = 1;
     } else if (info) {
         /* the same patch options on this scene must give the same patches */
@@ -777,7 +798,7 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
     return rc;
 }
 
-int rad_cmd_render(int argc, char **argv)
+static int render_main(int argc, char **argv, rad_tool_lights *lights)
 {
     const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
     rad_tool_classic_options o;
@@ -800,6 +821,9 @@ int rad_cmd_render(int argc, char **argv)
         if (rc == 2) return 2;
         if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        rc = rad_tool_light_option(cmd, argc, argv, &a, lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if (opt[0] == '-' && opt[1] && a + 1 >= argc) {
@@ -884,7 +908,7 @@ int rad_cmd_render(int argc, char **argv)
         if (rad_tool_check_output(cmd, out_path, inputs, 2)) return 1;
     }
     rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
     {
         uint32_t t, emitters = 0;
         for (t = 0; t < w.scene->triangle_count; ++t) {
@@ -1026,4 +1050,14 @@ int rad_cmd_render(int argc, char **argv)
     rad_image_free(&img);
     rad_tool_close_world(&w);
     return 0;
+}
+
+int rad_cmd_render(int argc, char **argv)
+{
+    rad_tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = render_main(argc, argv, &lights);
+    rad_tool_lights_free(&lights);
+    return rc;
 }

@@ -236,6 +236,12 @@ int rad_tool_check_size(const char *cmd, int w, int h)
 
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w)
 {
+    return rad_tool_open_world_lit(cmd, path_or_name, NULL, w);
+}
+
+int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
+                            rad_tool_world *w)
+{
     char err[1024];
     rad_context ctx;
     rad_result r;
@@ -244,9 +250,14 @@ int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_worl
         fprintf(stderr, "rad %s: %s\n", cmd, err);
         return 1;
     }
+    w->file_light_count = w->file.light_count;
+    if (rad_tool_add_lights(cmd, &w->file, lights, &w->lights_storage)) {
+        rad_tool_free_scene(&w->file);
+        return 1;
+    }
     rad_tool_context(&ctx, NULL);
     if ((r = rad_scene_create(&w->file.desc, &ctx, &w->scene)) != RAD_SUCCESS) {
-        rad_tool_free_scene(&w->file);
+        rad_tool_close_world(w);
         return rad_tool_fail(cmd, "rad_scene_create", r);
     }
     if (w->scene->skipped_triangles)
@@ -264,6 +275,7 @@ void rad_tool_close_world(rad_tool_world *w)
     rad_bvh_destroy(w->bvh);
     rad_scene_destroy(w->scene);
     rad_tool_free_scene(&w->file);
+    rad_tool_lights_release(w->lights_storage);
     memset(w, 0, sizeof *w);
 }
 

@@ -158,15 +158,45 @@ int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint
 int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
 double rad_tool_seconds(void);
 
+/* ---- lights from the command line (lights.c) ------------------------------------------- */
+/* --area P:U:V:RGB: an emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB */
+typedef struct rad_tool_area_light {
+    float p[3], u[3], v[3], radiance[3];
+} rad_tool_area_light;
+/* What --sun, --sky, --point, --spot and --area gave (units: lights.c and rad_tool_light_help) */
+typedef struct rad_tool_lights {
+    rad_light *lights;              /* the analytic ones, in the library's units */
+    uint32_t count;
+    rad_tool_area_light *areas;
+    uint32_t area_count;
+} rad_tool_lights;
+/* argv[*a] is one of the light options: parses it (and its value, advancing *a) and returns 1;
+   0 when it is not one; 2 on a bad value (message naming the option printed) */
+int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_tool_lights *L);
+const char *rad_tool_light_help(void);
+void rad_tool_lights_free(rad_tool_lights *L);
+/* Appends L to a loaded scene: the analytic lights to f->lights, the area lights to f->desc
+   (meshes "area_light_K", emissive materials); *storage keeps the new arrays (free with
+   rad_tool_lights_release after the scene is destroyed). Prints what was added. 0 or 1. */
+int rad_tool_add_lights(const char *cmd, rad_tool_scene *f, const rad_tool_lights *L, void **storage);
+void rad_tool_lights_release(void *storage);
+/* rad_hash64 of the lights' fields, continuing from h */
+uint64_t rad_tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h);
+
 /* A scene ready for ray queries: the loaded file, the validated scene and its BVH. */
 typedef struct rad_tool_world {
-    rad_tool_scene file;
+    rad_tool_scene file;      /* file.lights: the file's lights, then those of the command line */
     rad_scene *scene;
     rad_bvh *bvh;
     rad_raycaster rc;
+    uint32_t file_light_count; /* lights of the file itself (the rest came from the command line) */
+    void *lights_storage;      /* private (rad_tool_add_lights) */
 } rad_tool_world;
 /* loads, validates and builds the BVH; prints the error and returns 1 on failure, else 0 */
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w);
+/* the same with the command line's lights added (lights may be NULL) */
+int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
+                            rad_tool_world *w);
 void rad_tool_close_world(rad_tool_world *w);
 /* A camera for a scene that has none (rad_tool_scene.has_camera 0): of the views from outside
    the bounds along +z, -z, +x, -x, -y, +y (the bounding sphere in view) and from inside them,
@@ -219,12 +249,15 @@ typedef struct rad_tool_bake_info {
     uint32_t triangle_count; /* of the scene baked */
 } rad_tool_bake_info;
 #define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u)
-/* The hash of a rad.options record, kept in the bake's signature (rad_bake_signature.options)
-   so that a bake's options section is known to be the one it was made with. */
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info);
+/* The hash of a rad.options record and of the lights given on the command line (w's lights
+   past file_light_count; none: the hash of the record alone, as before those options), kept
+   in the bake's signature (rad_bake_signature.options) so that a bake's options section and
+   lights are known to be the ones it was made with. */
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w);
 /* Points the signature section among secs[0..count) (written by rad_save_memory with the scene's
-   hashes) at *sig, a copy with the options hash of 'info' added. */
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig);
+   hashes) at *sig, a copy with the options hash of 'info' and w's lights added. */
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+                           rad_bake_signature *sig);
 
 /* ---- lighting models for the direct term (shading.c) ------------------------------------ */
 /* "none" (-1) or a rad_shading_model name; 0 on success, else prints and returns 2 */
