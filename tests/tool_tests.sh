@@ -890,6 +890,39 @@ bad "--area without area" "bad --area .*U and V span no area" render cornell --a
 bad "--point 1,2,x:1" "bad --point '1,2,x:1'" render cornell --point 1,2,x:1 -o "$TMP/y.pfm"
 bad "--sun with no value" "--sun needs a value" render cornell -o "$TMP/y.pfm" --sun
 
+# ---- the dense build's budget (tools/budget.c) ---------------------------------------------
+# a 40 x 40 grid of quads (3200 triangles): F needs at least 3200^2 x 4 bytes = 39 MiB, so a
+# 16 MiB limit refuses it before the patches are made, naming the virtual-patch methods
+awk 'BEGIN { n = 40; for (j = 0; j <= n; ++j) for (i = 0; i <= n; ++i) printf "v %d 0 %d\n", i, j;
+             for (j = 0; j < n; ++j) for (i = 0; i < n; ++i) { a = j * (n + 1) + i + 1; printf "f %d %d %d %d\n", a, a + n + 1, a + n + 2, a + 1 } }' > "$TMP/grid.obj"
+while IFS='|' read -r sub method want; do
+    case $sub in render) out="-o $TMP/g.pfm --size 8x8" ;; bake) out="-o $TMP/g.radb" ;; *) out= ;; esac
+    /usr/bin/env time -f %e -o "$TMP/time.txt" "$RAD" $sub "$TMP/grid.obj" $method --max-memory 16M $out > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q -- "$want a dense 3200 x 3200 form-factor matrix (at least one patch per triangle" "$TMP/err.txt" &&
+        grep -q "only 16 MiB may be used (--max-memory)" "$TMP/err.txt" && grep -q -- "--method aavp or --method vp" "$TMP/err.txt" &&
+        tail -n 1 "$TMP/time.txt" | awk '{ exit !($1 < 10) }' &&
+        ok "$sub $method --max-memory 16M refuses a 3200-triangle dense build at once ($(tail -n 1 "$TMP/time.txt") s)" ||
+        fail "$sub $method --max-memory 16M refuses a 3200-triangle dense build" "exit $rc: $(head -c 400 "$TMP/err.txt")"
+done <<'EOF2'
+render|--method classic|--method classic needs
+render|--method temporal|--method temporal needs
+bake|--method multibounce|--method multibounce needs
+formfactors|--ff analytic|the form factors need
+EOF2
+# the exact patch count is checked too: 32 triangles, --patches 3000 (about 3000 patches, 34 MiB)
+"$RAD" render cornell --patches 3000 --max-memory 16M --size 8x8 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "needs a dense [0-9]* x [0-9]* form-factor matrix ([0-9]* patches)" "$TMP/err.txt" &&
+    ok "render --patches 3000 --max-memory 16M is refused once the patches are counted" ||
+    fail "render --patches 3000 --max-memory 16M is refused once the patches are counted" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+"$RAD" render cornell --patches 50 --max-memory 16M --size 8x8 --aa 1 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" formfactors "$TMP/grid.obj" --patches 1 --max-memory 16M --force > /dev/null 2>> "$TMP/err.txt" &&
+    ok "a build within --max-memory runs, and --force runs one beyond it" ||
+    fail "a build within --max-memory runs, and --force runs one beyond it" "$(head -c 300 "$TMP/err.txt")"
+bad "--max-memory 12Q" "bad value '12Q' for --max-memory" render cornell --max-memory 12Q -o "$TMP/y.pfm"
+bad "--max-memory -1" "bad value '-1' for --max-memory" bake cornell --max-memory -1 -o "$TMP/y.radb"
+
 # ---- a new user's first runs: what the tool says ------------------------------------------
 "$RAD" help 2>&1 | grep -q 'local|vp|aavp' && ok "help lists every render method" || fail "help lists every render method"
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n' > "$TMP/nolight.obj"

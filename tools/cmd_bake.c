@@ -36,14 +36,22 @@ const char *rad_tool_classic_help(void)
            "  --patches N        target patch count (default 2000)\n"
            "  --max-edge L       longest patch edge (default: no limit)\n"
            "  --samples S        form-factor points per patch pair (default 16, up to 256)\n"
-           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n";
+           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n"
+           "  --max-memory SIZE  refuse a dense N x N build estimated above SIZE (e.g. 8G; default: the\n"
+           "                     MemAvailable of /proc/meminfo); builds estimated over an hour are refused too\n"
+           "  --force            build it whatever the estimate\n";
 }
 
 int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o)
 {
     const char *opt = argv[*a];
-    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples"};
+    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples",
+                                        "--max-memory"};
     size_t i;
+    if (!strcmp(opt, "--force")) {
+        o->force = 1;
+        return 1;
+    }
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (!strcmp(opt, names[i])) break;
     if (i == sizeof names / sizeof names[0]) return 0;
@@ -75,6 +83,7 @@ int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_
         if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
         if (o->samples == 0) { fprintf(stderr, "rad %s: --samples must be > 0\n", cmd); return 2; }
         return 1;
+    case 6: return rad_tool_parse_bytes(cmd, opt, argv[*a], &o->max_memory) ? 2 : 1;
     default:
         if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
         if (o->light_samples == 0) { fprintf(stderr, "rad %s: --light-samples must be > 0\n", cmd); return 2; }
@@ -113,10 +122,16 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     po.target_count = o->patches;
     po.max_edge = o->max_edge;
     t0 = rad_tool_seconds();
+    /* at least one patch per triangle: a scene too big for F is refused before any work */
+    if (rad_tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
     if ((r = rad_patches_create(w->scene, &po, &ctx, &out->patches)) != RAD_SUCCESS)
         return rad_tool_fail(cmd, "rad_patches_create", r);
     n = out->patches->count;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w->scene->triangle_count, n);
+    if (rad_tool_dense_check(cmd, o, n, 0)) {
+        rad_tool_classic_free(out);
+        return 1;
+    }
 
     rad_form_factor_options_default(&fo);
     fo.samples = o->samples;
@@ -353,6 +368,7 @@ static int bake_main(int argc, char **argv, rad_tool_lights *lights)
         return 2;
     }
     if (rad_tool_method_check(cmd, 0, &mo, &o)) return 2;
+    rad_tool_dense_plan(&o, &mo, 1);
     if (rad_tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;

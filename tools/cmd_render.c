@@ -878,6 +878,7 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         return 2;
     }
     if (rad_tool_method_check(cmd, 1, &mo, &o)) return 2;
+    rad_tool_dense_plan(&o, &mo, 0);
     method = rad_tool_method_name(mo.method);
     seed = mo.seed;
     pathtrace = mo.method == RAD_TOOL_PATHTRACE;

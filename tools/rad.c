@@ -393,7 +393,7 @@ static void usage(FILE *f)
 static void formfactors_usage(FILE *f)
 {
     fprintf(f, "usage: rad formfactors SCENE [--patches N] [--max-edge L] [--samples S] [--ff M] [--hemicube-res R]\n"
-               "                        [--threads N]\n"
+               "                        [--max-memory SIZE] [--force] [--threads N]\n"
                "Prints one line 'FROM TO VALUE' per ordered pair of named objects: the area-weighted\n"
                "group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i.\n"
                "  --patches N   target patch count (default 2000)\n"
@@ -403,6 +403,7 @@ static void formfactors_usage(FILE *f)
                "                patch, one visibility ray each), montecarlo (S point pairs) or hemicube\n"
                "                (a hemicube at each patch centroid with an item buffer; no rays)\n"
                "  --hemicube-res R  cells across the hemicube's top face (default 128; even, 4 to 2048)\n"
+               "  --max-memory SIZE, --force   the dense build's limit (rad render --help)\n"
                "  --threads N   worker threads (default: all cores; at most 1024)\n");
 }
 
@@ -423,11 +424,19 @@ int rad_cmd_formfactors(int argc, char **argv)
     rad_result r;
     double *num, *den;
     int a;
+    rad_tool_classic_options budget;
+    rad_tool_classic_options_default(&budget);
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
         int need = !strcmp(o, "--patches") || !strcmp(o, "--samples") || !strcmp(o, "--threads") || !strcmp(o, "--max-edge") ||
                    !strcmp(o, "--ff") || !strcmp(o, "--hemicube-res");
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) { formfactors_usage(stdout); return 0; }
+        if (!strcmp(o, "--force")) { budget.force = 1; continue; }
+        if (!strcmp(o, "--max-memory")) {
+            if (a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
+            if (rad_tool_parse_bytes(cmd, o, argv[++a], &budget.max_memory)) return 2;
+            continue;
+        }
         if (need && a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
         if (!strcmp(o, "--patches")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
         else if (!strcmp(o, "--samples")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
@@ -448,7 +457,12 @@ int rad_cmd_formfactors(int argc, char **argv)
     if (!scene_name) { fprintf(stderr, "rad %s: no scene given\n", cmd); formfactors_usage(stderr); return 2; }
     if (samples == 0 || max_edge < 0.0f) { fprintf(stderr, "rad %s: --samples must be > 0, --max-edge >= 0\n", cmd); return 2; }
     rad_tool_set_threads((int)threads);
+    budget.samples = samples;
     if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_dense_check(cmd, &budget, w.scene->triangle_count, 1)) {
+        rad_tool_close_world(&w);
+        return 1;
+    }
     rad_tool_context(&ctx, "form factors");
     rad_patch_options_default(&po);
     po.target_count = patches_target;
@@ -462,6 +476,11 @@ int rad_cmd_formfactors(int argc, char **argv)
     fo.method = ff_method;
     if (hemicube_res) fo.hemicube_resolution = hemicube_res;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w.scene->triangle_count, P->count);
+    if (rad_tool_dense_check(cmd, &budget, P->count, 0)) {
+        rad_patches_destroy(P);
+        rad_tool_close_world(&w);
+        return 1;
+    }
     r = rad_form_factors_dense(P, &w.rc, &fo, &ctx, &ff);
     rad_tool_progress_end();
     if (r != RAD_SUCCESS) {

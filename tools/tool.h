@@ -217,12 +217,35 @@ typedef struct rad_tool_classic_options {
     uint32_t bounces;        /* --bounces K (Jacobi; default 64) */
     uint32_t light_samples;  /* --light-samples N: shadow rays per point (default 16) */
     int sources_only;        /* 1: rad_tool_classic_solve stops after E (L, B, H stay NULL) */
+    /* the dense build's budget (budget.c): checked by rad_tool_classic_solve before the patches
+       (N at least the triangle count) and after them */
+    double max_memory;       /* --max-memory SIZE in bytes (0: MemAvailable) */
+    int force;               /* --force: build whatever the estimate */
+    double dense_bytes_per_n2; /* bytes per N^2 entry the run holds at its peak (0: 4, F alone) */
+    double dense_cubic;      /* flops / N^3 beyond the form factors (LU, multibounce) */
+    uint32_t dense_local_m;  /* local: capacity M of the 12 M^2 bytes of T (0: none) */
+    const char *dense_method; /* the method named in the refusal (NULL: classic) */
 } rad_tool_classic_options;
 void rad_tool_classic_options_default(rad_tool_classic_options *o);
 /* argv[*a] is one of the options above: parses it (and its value, advancing *a) and returns
    1; returns 0 when it is not one of them, 2 on a bad value (message printed) */
 int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o);
 const char *rad_tool_classic_help(void);
+
+/* ---- the dense build's budget (budget.c) ------------------------------------------------ */
+/* A dense build estimated to take longer than this is refused (without --force). */
+#define RAD_TOOL_DENSE_MAX_SECONDS 3600.0
+/* --max-memory SIZE: bytes with an optional K, M, G or T (powers of 1024); 0 or 2 (printed) */
+int rad_tool_parse_bytes(const char *cmd, const char *opt, const char *text, double *out);
+/* MemAvailable of /proc/meminfo in bytes; 0 where unknown (then only --max-memory limits) */
+double rad_tool_mem_available(void);
+struct rad_tool_method_options;
+/* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice). */
+void rad_tool_dense_plan(rad_tool_classic_options *o, const struct rad_tool_method_options *mo, int bake);
+/* Before a dense build of n patches (lower_bound: n is the triangle count, the patches not made
+   yet): 0 when the estimate fits the memory limit and RAD_TOOL_DENSE_MAX_SECONDS (or
+   o->force); else prints the estimate, the limit and the virtual-patch methods, returns 1. */
+int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uint32_t n, int lower_bound);
 
 /* Patches, dense F, direct irradiance D of the patches (emitters and analytic lights),
    E = rho D (RAD_SOURCE_DIRECT), the indirect solution L, B = E + L and H = F B. */
