@@ -529,6 +529,18 @@ if [ -s "$TMP/ref.pfm" ]; then
         np=$(grep -o 'timing: method=aavp patches=[0-9]*' "$TMP/err.txt" | cut -d= -f3)
         [ -n "$np" ] && [ "$np" -le 300 ] && [ "$np" -gt 100 ] && ok "aavp --vp-max-patches 300 gives $np patches (100 < n <= 300)" ||
             fail "aavp --vp-max-patches 300" "patches '$np'"
+        # the budget is met by counting (rad_vp_count) and one build, at the finest resolution
+        # within it: one step finer has more patches
+        r=$(grep -o 'resolution [0-9]* from [0-9]* counts' "$TMP/err.txt" | cut -d' ' -f2)
+        nb=$(grep -c 'aavp virtual patches at resolution' "$TMP/err.txt")
+        if [ -n "$r" ] && [ "$nb" = 1 ] &&
+            "$RAD" render cornell --size 8x8 --aa 1 --method aavp --vp-resolution $((r + 1)) -o "$TMP/x1.pfm" > /dev/null 2> "$TMP/err.txt"; then
+            n1=$(grep -o 'timing: method=aavp patches=[0-9]*' "$TMP/err.txt" | cut -d= -f3)
+            [ -n "$n1" ] && [ "$n1" -gt 300 ] && ok "aavp --vp-max-patches 300: one build, at the finest resolution ($r; $((r + 1)) gives $n1)" ||
+                fail "aavp --vp-max-patches 300 picks the finest resolution" "resolution $r, $((r + 1)) gives '$n1'"
+        else
+            fail "aavp --vp-max-patches 300: one build" "resolution '$r', $nb builds"
+        fi
     else
         fail "aavp --vp-max-patches 300 renders" "$(head -c 300 "$TMP/err.txt")"
     fi

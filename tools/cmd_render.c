@@ -589,6 +589,24 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
     return vp;
 }
 
+/* the patch count rad_vp_create would give at 'resolution' (rad_vp_count); 0 or 1 (printed) */
+static int vp_count(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo, uint32_t resolution,
+                    uint32_t *count)
+{
+    rad_vp_options vo;
+    rad_vp_counts cnt;
+    rad_context ctx;
+    rad_result r;
+    rad_vp_options_default(&vo);
+    vo.resolution = resolution;
+    vo.face_points = mo->face_points;
+    if (mo->method == RAD_TOOL_VP) vo.kind = RAD_VP_CLUSTERED;
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_vp_count", r);
+    *count = cnt.patches;
+    return 0;
+}
+
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
@@ -604,44 +622,37 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     rad_context ctx;
     rad_result r;
     float *E = NULL, *L = NULL, *B = NULL, *H = NULL;
-    uint32_t n, i, res = mo->vp_resolution, builds = 0;
+    uint32_t n, i, res = mo->vp_resolution;
     double t0 = rad_tool_seconds(), t_build, t_E, t_solve;
     int rc = 0;
     if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
-        /* the patch count grows about as R^2 (surface voxels): predict, build, correct */
-        uint32_t best_res = 0, lo = 1, hi = 1025;
-        rad_virtual_patches *best = NULL;
-        res = 4;
-        while (builds < 6 && lo < hi) {
-            rad_virtual_patches *t = vp_build(cmd, w, mo, res);
-            uint32_t count, next;
-            ++builds;
-            if (!t) {
-                rad_vp_destroy(best);
-                return 1;
-            }
-            count = t->count;
-            if (count <= mo->vp_max_patches) {
-                rad_vp_destroy(best);
-                best = t, best_res = res, lo = res + 1;
-            } else {
-                rad_vp_destroy(t);
-                hi = res;
-            }
-            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(count ? count : 1)) * 0.97);
-            if (next < lo) next = lo;
+        /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build
+           up to the patches, without the form factors that take nearly all of its time), then
+           one build. The count grows about as R^2 (surface voxels): predict from the nearest
+           count, count, narrow the bracket [lo, hi) to adjacent resolutions. */
+        uint32_t lo = 0, hi = 4097, counts = 0, c = 0;
+        double tc = rad_tool_seconds();
+        res = mo->vp_resolution ? mo->vp_resolution : 16;
+        while (counts < 24 && hi - lo > 1) {
+            uint32_t next;
+            if (vp_count(cmd, w, mo, res, &c)) return 1;
+            ++counts;
+            if (c <= mo->vp_max_patches) lo = res;
+            else hi = res;
+            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(c ? c : 1)));
+            if (next <= lo) next = lo + 1;
             if (next >= hi) next = hi - 1;
-            if (next < lo) break;
             res = next;
         }
-        if (!best) {
+        if (lo == 0) {
             fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd,
                     mo->vp_max_patches);
             return 1;
         }
-        vp = best, res = best_res;
-        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u (%u patches) after %u builds\n", cmd,
-                mo->vp_max_patches, res, vp->count, builds);
+        res = lo;
+        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd,
+                mo->vp_max_patches, res, counts, rad_tool_seconds() - tc);
+        if (!(vp = vp_build(cmd, w, mo, res))) return 1;
     } else if (!(vp = vp_build(cmd, w, mo, res))) {
         return 1;
     }
