@@ -6,6 +6,7 @@
        rad render SCENE -o OUT.png|OUT.pfm     an image (classic, multibounce or temporal
                                        radiosity, or path tracing)
        rad trace SCENE -o OUT  the reference path tracer
+       (render, trace, bake: --sun, --sky, --point, --spot, --area add lights: lights.c)
        rad compare A B         image metrics
        rad info FILE.radb      what a bake holds
        rad export SCENE -o OUT.obj     the scene as OBJ + MTL
@@ -387,7 +388,10 @@ static void usage(FILE *f)
                "  export SCENE -o OUT.obj  write the scene as OBJ + MTL (Kd albedo, Ke emission)\n"
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
-               "at most 1024).\n");
+               "at most 1024). render, trace and bake add lights to the file's own: --sun DIR:RGB,\n"
+               "--sky RGB, --point POS:RGB, --spot POS:DIR:ANGLES:RGB, --area P:U:V:RGB (units: rad render\n"
+               "--help). Dense methods (classic, multibounce, temporal, local) refuse a build estimated\n"
+               "beyond the free memory (--max-memory SIZE) or an hour; --force runs it anyway.\n");
 }
 
 static void formfactors_usage(FILE *f)
