@@ -249,7 +249,8 @@
          side analytically; pairs closer than twice their size get 16x the points, because the
          integrand is nearly singular along a shared edge. Measured against the closed forms
          of Howell's catalogue (docs/references.md) at default quality: relative errors
-         below 1e-4.
+         below 1e-4 with patches a tenth of the shapes' size, a few 1e-4 at a quarter (the
+         tests hold every case to 1e-3).
        - The BVH's box test widens every slab by 1 + 2 gamma_3 (Ize 2013) and its triangle
          test is watertight (Woop, Benthin, Wald 2013), so rays through shared edges and
          vertices are never lost.
@@ -537,6 +538,33 @@ RAD_API uint32_t rad_patches_locate(const rad_patches *patches, uint32_t triangl
 RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const float *patch_values,
                                              uint32_t channels, float *out_vertex_values);
 
+/* Per-vertex irradiance without dark halos. A patch partly covered by other geometry (under a
+   block, under a one-sided light a hair below the ceiling) has a small H only because part of
+   its area sees nothing; a plain vertex average smears that into the visible surface around the
+   contact. So the value at vertex v is (mean radiosity seen) x (how much is seen):
+       H_v = [sum_i A_i H_i / sum_i A_i S_i] * S_v,
+   the sums over the patches sharing v, S_v the area-weighted mean of S over those patches that
+   are not partly covered (S_i >= 3/4 of the largest S at v). S (one float per patch) is the
+   row sum of F (sum_j F_ij, how much of its hemisphere a patch sees: rad_matrix_multiply by
+   ones); NULL gives rad_patches_vertex_values. H: 3 floats per patch; out: 3 per patch vertex.
+   Errors: INVALID_ARGUMENT, NON_FINITE (H or S not finite, S < 0), OUT_OF_MEMORY. O(patches). */
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx);
+
+/* Values at the vertices of one of the scene's own meshes, for an engine that draws that mesh:
+   'mesh' is the index the mesh had in rad_scene_desc.meshes and 'desc' the same description
+   (its vertex count and indices). vertex_values: 3 floats per patch vertex (from
+   rad_patches_vertex_values or rad_patches_vertex_irradiance). Each triangle corner takes the
+   value interpolated at that corner of its patch; a vertex shared by several triangles gets
+   the area-weighted mean over them (so a crease averages its sides, as the mesh's own smooth
+   normals do), and a vertex no triangle uses (or only skipped degenerate ones) gets 0.
+   out: 3 * desc->vertex_count floats. Errors: INVALID_ARGUMENT (mesh >= the scene's mesh count,
+   a NULL pointer), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
+   of that mesh beyond desc->triangle_count: another description), OUT_OF_MEMORY.
+   O(triangles of the scene). */
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx);
+
 /* ======================================================================================== */
 /* >>api_rays: ray queries and the built-in BVH                                             */
 /* ======================================================================================== */
@@ -753,7 +781,7 @@ typedef int (*rad_residual_fn)(void *user, uint32_t iteration, double residual);
 
 typedef struct rad_solve_options {
     rad_output output;         /* RAD_OUTPUT_INDIRECT (default) or RAD_OUTPUT_TOTAL */
-    uint32_t bounces;          /* Jacobi: K (0 returns 0 indirect / E total) */
+    uint32_t bounces;          /* Jacobi: K (default 8; 0 returns 0 indirect / E total) */
     double tolerance;          /* Gauss-Seidel, shooting: relative (0: 1e-6) */
     uint32_t max_iterations;   /* GS sweeps (0: 1000), shooting steps (0: 100 N) */
     rad_residual_fn on_residual;
@@ -824,7 +852,9 @@ typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
     uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
-    int include_emitters;      /* non-zero (default): emissive triangles are area lights */
+    int include_emitters;      /* non-zero (default): emissive triangles are area lights;
+                                  0 leaves them out (a zeroed struct has no emitters: start
+                                  from rad_direct_options_default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
 } rad_direct_options;
@@ -861,7 +891,9 @@ typedef enum rad_source_mode {
 
 /* Builds E (3N floats) from the patches one of the two ways of UNITS AND CONVENTIONS.
    direct_irradiance (3N) is required for RAD_SOURCE_DIRECT and must be NULL for
-   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT). */
+   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT).
+   A NaN or Inf in it is NON_FINITE, a negative value INVALID_ARGUMENT; out_E is written only on
+   success. */
 RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
                                float *out_E);
 
@@ -1575,7 +1607,8 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
 
 typedef struct rad_multibounce_options {
-    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3) */
+    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3; 0 is INVALID_ARGUMENT:
+                                  start from rad_multibounce_options_default) */
     rad_mb_precision precision;/* storage of the result (default RAD_MB_FLOAT) */
     double tolerance;          /* K = inf: Neumann doubling stops once max row sum of
                                   (rho o F)^m <= tolerance (0: 1e-8) */
@@ -1649,8 +1682,10 @@ typedef enum rad_block_format {
 #define RAD_REORDER_MATCH 4       /* groups of four by greedy matching (rows into pairs, pairs
                                      into fours) on the same distance, then the group swaps */
 
+/* Start from rad_block_options_default: here zero is a setting, not the default (a zeroed
+   struct asks for BC1, no outliers, no reordering and one scale per channel). */
 typedef struct rad_block_options {
-    rad_block_format format;   /* default RAD_BLOCK_BC4X3 */
+    rad_block_format format;   /* default RAD_BLOCK_BC4X3 (0 is RAD_BLOCK_BC1) */
     float outlier_fraction;    /* the largest fraction p of the N^2 entries (by their largest
                                   channel) go exactly into the sparse list, zeros left in place;
                                   0 disables the step (default 0.05) */
@@ -1887,7 +1922,8 @@ typedef enum rad_local_rebuild_method {
 } rad_local_rebuild_method;
 
 typedef struct rad_local_options {
-    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default 1024) */
+    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default
+                                  1024; 0 is INVALID_ARGUMENT: start from rad_local_options_default) */
     rad_local_update update;   /* default RAD_LOCAL_EXACT */
     rad_local_eviction evict;  /* default RAD_LOCAL_EVICT_DOWNDATE */
     rad_local_rebuild_method rebuild; /* default RAD_LOCAL_REBUILD_INVERSE */
@@ -2159,7 +2195,8 @@ typedef enum rad_temporal_mode {
 
 typedef struct rad_temporal_options {
     rad_temporal_mode mode;
-    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES) */
+    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES,
+                              0 is INVALID_ARGUMENT: start from rad_temporal_options_default) */
     float weight;          /* fixed w in [0, 1) (default 0.998; 0 keeps no history) */
     uint32_t seed;         /* generator seed */
     int adaptive;          /* non-zero: per-row w from the estimator's variance (see below) */
@@ -3580,6 +3617,130 @@ RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const f
             out_vertex_values[(size_t)v * channels + k] = src[channels] > 0.0 ? (float)(src[k] / src[channels]) : 0.0f;
     }
     rad__free(&a, acc);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *S_v, *S_max, *S_area;
+    uint32_t n, nv, i, k;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !H || !out_vertex_H) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: patches, H and out_vertex_H are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    n = patches->count;
+    nv = patches->vertex_count;
+    for (i = 0; i < 3 * n; ++i)
+        if (!rad__finite(H[i])) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: H of patch %u is not finite", i / 3);
+            return RAD_ERROR_NON_FINITE;
+        }
+    if (!S) return rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(S[i]) || S[i] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: row sum S of patch %u is %g (finite, >= 0 expected)",
+                     i, (double)S[i]);
+            return RAD_ERROR_NON_FINITE;
+        }
+    S_v = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)nv, sizeof(float));
+    if (!S_v) return RAD_ERROR_OUT_OF_MEMORY;
+    S_max = S_v + nv;
+    S_area = S_max + nv;
+    /* the bracket: vertex means of H and of S, both area-weighted over the patches at v */
+    r = rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(patches, S, 1, S_v);
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] > S_max[v]) S_max[v] = S[i];
+            }
+        for (i = 0; i < nv; ++i) {
+            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= scale;
+            S_v[i] = 0.0f;
+        }
+        /* S_v: how much the uncovered patches at v see */
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] >= 0.75f * S_max[v]) {
+                    S_v[v] += patches->patches[i].area * S[i];
+                    S_area[v] += patches->patches[i].area;
+                }
+            }
+        for (i = 0; i < nv; ++i) {
+            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= s_v;
+        }
+    }
+    rad__free(&c.allocator, S_v);
+    return r;
+}
+
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_scene *S;
+    double *acc;
+    uint32_t t, k, m, V;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !patches->scene || !vertex_values || !desc || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: patches, vertex_values, desc and out are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    S = patches->scene;
+    if (mesh >= S->mesh_count) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: mesh %u, but the scene has %u meshes", mesh, S->mesh_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    V = desc->vertex_count;
+    acc = (double *)rad__alloc_array(&c.allocator, 4 * (size_t)V + 1u, sizeof(double));
+    if (!acc) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(acc, 0, (4 * (size_t)V + 1u) * sizeof(double));
+    for (t = 0; t < S->triangle_count; ++t) {
+        uint32_t j = S->source_triangles[t], id[3];
+        static const float corner[3][2] = { { 0.0f, 0.0f }, { 1.0f, 0.0f }, { 0.0f, 1.0f } };
+        if (S->meshes[t] != mesh) continue;
+        if (j >= desc->triangle_count) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: the scene's mesh %u has triangle %u, desc has %u triangles",
+                     mesh, j, desc->triangle_count);
+            rad__free(&c.allocator, acc);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+        for (k = 0; k < 3; ++k) {
+            id[k] = desc->indices ? desc->indices[3 * (size_t)j + k] : 3 * j + k;
+            if (id[k] >= V) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: triangle %u has vertex index %u >= %u", j, id[k], V);
+                rad__free(&c.allocator, acc);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        }
+        for (k = 0; k < 3; ++k) {
+            float w[3];
+            uint32_t p = rad_patches_locate(patches, t, corner[k][0], corner[k][1], w);
+            double *dst = acc + 4 * (size_t)id[k];
+            if (p == RAD_NONE) continue;
+            for (m = 0; m < 3; ++m) {
+                const float *src = vertex_values + 3 * (size_t)patches->patches[p].vertices[m];
+                dst[0] += (double)S->areas[t] * w[m] * src[0];
+                dst[1] += (double)S->areas[t] * w[m] * src[1];
+                dst[2] += (double)S->areas[t] * w[m] * src[2];
+            }
+            dst[3] += S->areas[t];
+        }
+    }
+    for (k = 0; k < V; ++k) {
+        const double *src = acc + 4 * (size_t)k;
+        for (m = 0; m < 3; ++m) out[3 * (size_t)k + m] = src[3] > 0.0 ? (float)(src[m] / src[3]) : 0.0f;
+    }
+    rad__free(&c.allocator, acc);
     return RAD_SUCCESS;
 }
 
@@ -5527,6 +5688,21 @@ static void rad__finish_output(const rad_system *s, rad_output output, float *B_
         for (i = 0; i < n3; ++i) B_total_or_L[i] += s->E[i];
 }
 
+/* What every solver checks first: the system (logged once), the output and the options
+   (NULL: the defaults, copied to *o). */
+static rad_result rad__solve_begin(const rad_system *s, const rad_solve_options *options, const float *out,
+                                   const char *name, const rad__ctx *c, rad_solve_options *o)
+{
+    rad_result r = rad__check_system(s, c);
+    if (r != RAD_SUCCESS) return r;
+    if (!out) {
+        rad__log(c, RAD_LOG_ERROR, "%s: out is NULL", name);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) *o = *options; else rad_solve_options_default(o);
+    return rad__check_solve_options(o, c);
+}
+
 RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options *options, float *out, rad_solve_stats *stats,
                                     const rad_context *ctx)
 {
@@ -5537,11 +5713,8 @@ RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options
     uint32_t k;
     rad_result r;
     rad__ctx_init(&c, ctx);
-    r = rad__check_system(s, &c);
+    r = rad__solve_begin(s, options, out, "rad_solve_jacobi", &c, &o);
     if (r != RAD_SUCCESS) return r;
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     n3 = 3 * (size_t)s->n;
     cur = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
     tmp = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
@@ -5608,10 +5781,10 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
     double maxE = 0.0, residual = 0.0, tol;
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_gauss_seidel", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_it = o.max_iterations ? o.max_iterations : 1000;
     n3 = 3 * (size_t)s->n;
@@ -5659,13 +5832,14 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
     double initial = 0.0, residual = 1.0, tol;
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out || !s->areas) {
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_progressive", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
+    if (!s->areas) {
         rad__log(&c, RAD_LOG_ERROR, "progressive refinement needs system->areas");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_steps = o.max_iterations ? o.max_iterations : (s->n > 42949672u ? 0xFFFFFFFFu : 100u * s->n);
     n3 = 3 * (size_t)s->n;
@@ -5768,10 +5942,10 @@ RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options
     rad_result r = RAD_SUCCESS;
     int factored = -1;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_direct", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
     n = s->n;
     if (!rad__mul3(n, n, sizeof(double), &bytes)) return RAD_ERROR_SIZE_OVERFLOW;
     M = (double *)rad__alloc(&c.allocator, bytes);
@@ -6280,7 +6454,9 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
     if (mode == RAD_SOURCE_DIRECT) {
         if (!direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
         for (i = 0; i < 3 * patches->count; ++i)
-            if (!rad__finite(direct_irradiance[i]) || direct_irradiance[i] < 0.0f) return RAD_ERROR_NON_FINITE;
+            if (!rad__finite(direct_irradiance[i])) return RAD_ERROR_NON_FINITE;
+        for (i = 0; i < 3 * patches->count; ++i)
+            if (direct_irradiance[i] < 0.0f) return RAD_ERROR_INVALID_ARGUMENT; /* finite but no irradiance */
         for (i = 0; i < 3 * patches->count; ++i) out_E[i] = patches->albedo[i] * direct_irradiance[i];
         return RAD_SUCCESS;
     }

@@ -180,6 +180,7 @@ s_examples() {
         fail gallery-small
     fi
     compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+    compile_run engine_bake $CC -std=c99 $WARN -O2 -I. examples/engine_bake.c -o "$BUILD/engine_bake" -lm
     # the virtual-patch example builds and, without the external meshes, says it skipped
     if build vp-bunny $CC -std=c99 $WARN -O2 $OMP -I. examples/vp_bunny.c -o "$BUILD/vp_bunny" -lm &&
        "$BUILD/vp_bunny" --data "$BUILD/no-such-data" >"$BUILD/vp_bunny.out" 2>&1 && grep -q skipped "$BUILD/vp_bunny.out"; then

@@ -85,46 +85,14 @@ static void render_usage(FILE *f)
             rad_tool_classic_help(), rad_tool_method_help(1), rad_tool_light_help());
 }
 
-/* Per-vertex H, with the halo fix of examples/cornell.c step 7: a patch partly covered (under
-   the light, under a block) has a small H only because part of it sees nothing; H is
-   interpolated as (mean radiosity seen) x (how much is seen, from uncovered patches).
+/* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
    S: the row sums of F (how much of its hemisphere each patch sees). */
 static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv)
 {
-    uint32_t n = P->count, nv = P->vertex_count, i, k;
-    float *S_v = (float *)xmalloc(sizeof(float) * nv);
-    float *S_max = (float *)xmalloc(sizeof(float) * nv), *S_area = (float *)xmalloc(sizeof(float) * nv);
+    rad_context ctx;
     rad_result r;
-    r = rad_patches_vertex_values(P, H, 3, Hv);
-    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(P, S, 1, S_v);
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[i].vertices[k];
-                if (S[i] > S_max[v]) S_max[v] = S[i];
-            }
-        for (i = 0; i < nv; ++i) {
-            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
-            Hv[3 * i] *= scale, Hv[3 * i + 1] *= scale, Hv[3 * i + 2] *= scale;
-            S_v[i] = 0.0f;
-        }
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[i].vertices[k];
-                if (S[i] >= 0.75f * S_max[v]) {
-                    S_v[v] += P->patches[i].area * S[i];
-                    S_area[v] += P->patches[i].area;
-                }
-            }
-        for (i = 0; i < nv; ++i) {
-            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
-            Hv[3 * i] *= s_v, Hv[3 * i + 1] *= s_v, Hv[3 * i + 2] *= s_v;
-        }
-    }
-    free(S_v);
-    free(S_max);
-    free(S_area);
+    rad_tool_context(&ctx, NULL);
+    r = rad_patches_vertex_irradiance(P, H, S, Hv, &ctx);
     return r == RAD_SUCCESS ? 0 : rad_tool_fail("render", "per-vertex H", r);
 }
 
