@@ -2668,6 +2668,23 @@ RAD_API void rad_vp_options_default(rad_vp_options *options);
 RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
                                  const rad_context *ctx, rad_virtual_patches **out);
 RAD_API void rad_vp_destroy(rad_virtual_patches *vp);
+
+/* What rad_vp_create would build with the same arguments, counted without building it: steps
+   1 to 4 of BUILD (candidate voxels, face rays, samples, patches; the clustering for
+   RAD_VP_CLUSTERED) run exactly as there, so 'patches' is the count rad_vp_create gives, and
+   the form factors (step 5: the N x N matrix, the M^2 kernel sums and the shadow rays between
+   samples, nearly all of a build's time) are skipped. Use it to choose the resolution for a
+   patch budget before building (rad render --vp-max-patches). Errors: those of rad_vp_create
+   except the matrix's SIZE_OVERFLOW. Cost: 6 face_points rays per candidate voxel and O(M). */
+typedef struct rad_vp_counts {
+    uint32_t patches;           /* N */
+    uint32_t samples;           /* M */
+    uint32_t voxels;            /* non-empty voxels */
+    uint32_t candidate_voxels;  /* voxels overlapped by triangle bounds */
+    uint64_t face_rays;
+} rad_vp_counts;
+RAD_API rad_result rad_vp_count(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                const rad_context *ctx, rad_vp_counts *out);
 /* Bytes the object holds (matrix, patches, voxels, samples). */
 RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
 
@@ -15351,6 +15368,7 @@ typedef struct rad__vp_build {
     struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
     uint64_t *rays_cast;         /* per task */
     float *P;                    /* N x N */
+    int count_only;              /* rad_vp_count: stop once the patches are counted (step 4) */
 } rad__vp_build;
 
 static void rad__vp_cell(const rad_virtual_patches *vp, uint64_t key, uint32_t *c)
@@ -16127,6 +16145,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     }
     vp->voxel_first[vp->voxel_count] = N;
     vp->count = N;
+    if (b->count_only) goto done;
     if (!rad__mul3(N, N, sizeof(float), &bytes)) {
         rad__log(c, RAD_LOG_ERROR, "virtual patches: the %u x %u matrix does not fit in memory (use bigger voxels)", N, N);
         r = RAD_ERROR_SIZE_OVERFLOW;
@@ -16252,8 +16271,8 @@ done:
     return r;
 }
 
-RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
-                                 const rad_context *ctx, rad_virtual_patches **out)
+static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                  const rad_context *ctx, rad_virtual_patches **out, int count_only)
 {
     rad__ctx c;
     rad__vp_build b;
@@ -16321,12 +16340,38 @@ RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *ra
     b.vp = vp;
     b.eps = b.o.ray_epsilon * scene->diagonal;
     b.tasks = c.tasks;
+    b.count_only = count_only;
     r = rad__vp_build_run(&b, &c);
     if (r != RAD_SUCCESS) {
         rad_vp_destroy(vp);
         return r;
     }
     *out = vp;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                 const rad_context *ctx, rad_virtual_patches **out)
+{
+    return rad__vp_create(scene, raycaster, options, ctx, out, 0);
+}
+
+RAD_API rad_result rad_vp_count(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                const rad_context *ctx, rad_vp_counts *out)
+{
+    rad_virtual_patches *vp = NULL;
+    rad_result r;
+    if (out) memset(out, 0, sizeof(*out));
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    /* the build itself up to the patches, so the counts are those rad_vp_create gives */
+    r = rad__vp_create(scene, raycaster, options, ctx, &vp, 1);
+    if (r != RAD_SUCCESS) return r;
+    out->patches = vp->count;
+    out->samples = vp->sample_count;
+    out->voxels = vp->voxel_count;
+    out->candidate_voxels = vp->candidate_voxels;
+    out->face_rays = vp->face_rays;
+    rad_vp_destroy(vp);
     return RAD_SUCCESS;
 }
 

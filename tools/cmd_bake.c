@@ -36,14 +36,22 @@ const char *rad_tool_classic_help(void)
            "  --patches N        target patch count (default 2000)\n"
            "  --max-edge L       longest patch edge (default: no limit)\n"
            "  --samples S        form-factor points per patch pair (default 16, up to 256)\n"
-           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n";
+           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n"
+           "  --max-memory SIZE  refuse a dense N x N build estimated above SIZE (e.g. 8G; default: the\n"
+           "                     MemAvailable of /proc/meminfo); builds estimated over an hour are refused too\n"
+           "  --force            build it whatever the estimate\n";
 }
 
 int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o)
 {
     const char *opt = argv[*a];
-    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples"};
+    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples",
+                                        "--max-memory"};
     size_t i;
+    if (!strcmp(opt, "--force")) {
+        o->force = 1;
+        return 1;
+    }
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (!strcmp(opt, names[i])) break;
     if (i == sizeof names / sizeof names[0]) return 0;
@@ -75,6 +83,7 @@ int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_
         if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
         if (o->samples == 0) { fprintf(stderr, "rad %s: --samples must be > 0\n", cmd); return 2; }
         return 1;
+    case 6: return rad_tool_parse_bytes(cmd, opt, argv[*a], &o->max_memory) ? 2 : 1;
     default:
         if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
         if (o->light_samples == 0) { fprintf(stderr, "rad %s: --light-samples must be > 0\n", cmd); return 2; }
@@ -113,10 +122,16 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     po.target_count = o->patches;
     po.max_edge = o->max_edge;
     t0 = rad_tool_seconds();
+    /* at least one patch per triangle: a scene too big for F is refused before any work */
+    if (rad_tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
     if ((r = rad_patches_create(w->scene, &po, &ctx, &out->patches)) != RAD_SUCCESS)
         return rad_tool_fail(cmd, "rad_patches_create", r);
     n = out->patches->count;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w->scene->triangle_count, n);
+    if (rad_tool_dense_check(cmd, o, n, 0)) {
+        rad_tool_classic_free(out);
+        return 1;
+    }
 
     if (!(o->sources_only && o->no_form_factors)) {
         rad_form_factor_options_default(&fo);
@@ -197,18 +212,24 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     return 0;
 }
 
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info)
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w)
 {
-    return rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
+    uint64_t h = rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
+    /* the command line's lights, so that a bake lit by --sun is not rendered under another sun;
+       none leaves the hash of bakes made before those options unchanged */
+    if (w && w->file.light_count > w->file_light_count)
+        h = rad_tool_lights_hash(w->file.lights + w->file_light_count, w->file.light_count - w->file_light_count, h);
+    return h;
 }
 
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig)
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+                           rad_bake_signature *sig)
 {
     uint32_t i;
     for (i = 0; i < count; ++i)
         if (secs[i].type == RAD_SECTION_SIGNATURE && secs[i].elem_size == sizeof *sig && secs[i].count == 1) {
             memcpy(sig, secs[i].data, sizeof *sig);
-            sig->options = rad_tool_options_hash(info);
+            sig->options = rad_tool_options_hash(info, w);
             secs[i].data = sig;
         }
 }
@@ -246,7 +267,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     info.bounces = o->bounces;
     info.light_samples = o->light_samples;
     info.triangle_count = w->scene->triangle_count;
-    rad_tool_sign_options(secs, k, &info, &sig);
+    rad_tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->L;
     strcpy(secs[k++].name, "L");
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->H;
@@ -303,11 +324,12 @@ static void bake_usage(FILE *f)
                "  --method M         classic (default), multibounce, temporal or stochastic\n"
                "%s"
                "%s"
+               "%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(0));
+            rad_tool_classic_help(), rad_tool_method_help(0), rad_tool_light_help());
 }
 
-int rad_cmd_bake(int argc, char **argv)
+static int bake_main(int argc, char **argv, rad_tool_lights *lights)
 {
     const char *cmd = "bake", *scene_name = NULL, *out_path = NULL;
     rad_tool_classic_options o;
@@ -326,6 +348,9 @@ int rad_cmd_bake(int argc, char **argv)
         if (rc == 2) return 2;
         if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        rc = rad_tool_light_option(cmd, argc, argv, &a, lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads")) && a + 1 >= argc) {
@@ -347,9 +372,10 @@ int rad_cmd_bake(int argc, char **argv)
         return 2;
     }
     if (rad_tool_method_check(cmd, 0, &mo, &o)) return 2;
+    rad_tool_dense_plan(&o, &mo, 1);
     if (rad_tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
     rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
     if (mo.method != RAD_TOOL_CLASSIC) {
         void *buf = NULL;
         size_t size = 0;
@@ -369,5 +395,15 @@ int rad_cmd_bake(int argc, char **argv)
     rad_tool_classic_free(&c);
     rad_tool_close_world(&w);
     if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    return rc;
+}
+
+int rad_cmd_bake(int argc, char **argv)
+{
+    rad_tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = bake_main(argc, argv, &lights);
+    rad_tool_lights_free(&lights);
     return rc;
 }

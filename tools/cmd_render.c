@@ -81,8 +81,9 @@ static void render_usage(FILE *f)
             "patch and classic solution options (ignored with --bake, which keeps its own):\n"
             "%s"
             "%s"
+            "%s"
             "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(1));
+            rad_tool_classic_help(), rad_tool_method_help(1), rad_tool_light_help());
 }
 
 /* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
@@ -204,6 +205,8 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     rad_direct_options dopt;
     rad_context quiet;
     int y0, rows_per_batch, result = 0;
+    float sky[3] = {0.0f, 0.0f, 0.0f};
+    uint32_t k, i;
     for (strata = 1; (strata + 1) * (strata + 1) <= aa; ++strata) {
     }
     spp = strata * strata;
@@ -226,10 +229,14 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     dopt.include_emitters = 1;
     dopt.light_samples = light_samples;
     rad_tool_context(&quiet, NULL);
+    /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
+    for (k = 0; k < w->file.light_count; ++k)
+        if (w->file.lights[k].type == RAD_LIGHT_SKY)
+            for (i = 0; i < 3; ++i) sky[i] += w->file.lights[k].color[i] / PI_F;
 
     for (y0 = 0; y0 < height && result == 0; y0 += rows_per_batch) {
         int y1 = y0 + rows_per_batch < height ? y0 + rows_per_batch : height, chunk, nchunks;
-        uint32_t count = 0, nvalid = 0, k, i;
+        uint32_t count = 0, nvalid = 0;
         int x, y;
         uint32_t s;
         rad_result r;
@@ -259,7 +266,12 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
         for (k = 0; k < count; ++k) {
             uint32_t t = hits[k].triangle;
             const float *v, *nt;
-            if (t == RAD_NONE) continue;
+            if (t == RAD_NONE || t >= scene->triangle_count) {
+                size_t pixel = (size_t)y0 * width + k / spp;
+                for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
+                hits[k].triangle = RAD_NONE;
+                continue;
+            }
             nt = scene->normals + 3 * (size_t)t;
             if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] >= 0.0f) {
                 hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
@@ -379,8 +391,17 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
     rad_result r;
     int rc = 0;
     rad_tool_context(&ctx, NULL);
-    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info) : 0u, &ctx)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)\n", cmd, bake_path, rad_result_string(r));
+    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info, w) : 0u, &ctx)) != RAD_SUCCESS) {
+        /* the same options without this command line's lights: then only the lights differ */
+        rad_tool_world bare = *w;
+        bare.file_light_count = w->file.light_count;
+        if (info && rad_bake_matches_scene(bake, w->scene, rad_tool_options_hash(info, &bare), NULL) == RAD_SUCCESS)
+            fprintf(stderr, "rad %s: bake '%s' was made with other lights than this command line's --sun, --sky, "
+                            "--point and --spot: give the bake's light options, or render without --bake\n",
+                    cmd, bake_path);
+        else
+            fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)%s\n", cmd, bake_path, rad_result_string(r),
+                    info ? "; the options hash covers --sun, --sky, --point and --spot: give the bake's own" : "");
         rc = 1;
     } else if (info) {
         /* the same patch options on this scene must give the same patches */
@@ -561,6 +582,24 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
     return vp;
 }
 
+/* the patch count rad_vp_create would give at 'resolution' (rad_vp_count); 0 or 1 (printed) */
+static int vp_count(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo, uint32_t resolution,
+                    uint32_t *count)
+{
+    rad_vp_options vo;
+    rad_vp_counts cnt;
+    rad_context ctx;
+    rad_result r;
+    rad_vp_options_default(&vo);
+    vo.resolution = resolution;
+    vo.face_points = mo->face_points;
+    if (mo->method == RAD_TOOL_VP) vo.kind = RAD_VP_CLUSTERED;
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_vp_count", r);
+    *count = cnt.patches;
+    return 0;
+}
+
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
@@ -576,44 +615,37 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     rad_context ctx;
     rad_result r;
     float *E = NULL, *L = NULL, *B = NULL, *H = NULL;
-    uint32_t n, i, res = mo->vp_resolution, builds = 0;
+    uint32_t n, i, res = mo->vp_resolution;
     double t0 = rad_tool_seconds(), t_build, t_E, t_solve;
     int rc = 0;
     if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
-        /* the patch count grows about as R^2 (surface voxels): predict, build, correct */
-        uint32_t best_res = 0, lo = 1, hi = 1025;
-        rad_virtual_patches *best = NULL;
-        res = 4;
-        while (builds < 6 && lo < hi) {
-            rad_virtual_patches *t = vp_build(cmd, w, mo, res);
-            uint32_t count, next;
-            ++builds;
-            if (!t) {
-                rad_vp_destroy(best);
-                return 1;
-            }
-            count = t->count;
-            if (count <= mo->vp_max_patches) {
-                rad_vp_destroy(best);
-                best = t, best_res = res, lo = res + 1;
-            } else {
-                rad_vp_destroy(t);
-                hi = res;
-            }
-            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(count ? count : 1)) * 0.97);
-            if (next < lo) next = lo;
+        /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build
+           up to the patches, without the form factors that take nearly all of its time), then
+           one build. The count grows about as R^2 (surface voxels): predict from the nearest
+           count, count, narrow the bracket [lo, hi) to adjacent resolutions. */
+        uint32_t lo = 0, hi = 4097, counts = 0, c = 0;
+        double tc = rad_tool_seconds();
+        res = mo->vp_resolution ? mo->vp_resolution : 16;
+        while (counts < 24 && hi - lo > 1) {
+            uint32_t next;
+            if (vp_count(cmd, w, mo, res, &c)) return 1;
+            ++counts;
+            if (c <= mo->vp_max_patches) lo = res;
+            else hi = res;
+            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(c ? c : 1)));
+            if (next <= lo) next = lo + 1;
             if (next >= hi) next = hi - 1;
-            if (next < lo) break;
             res = next;
         }
-        if (!best) {
+        if (lo == 0) {
             fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd,
                     mo->vp_max_patches);
             return 1;
         }
-        vp = best, res = best_res;
-        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u (%u patches) after %u builds\n", cmd,
-                mo->vp_max_patches, res, vp->count, builds);
+        res = lo;
+        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd,
+                mo->vp_max_patches, res, counts, rad_tool_seconds() - tc);
+        if (!(vp = vp_build(cmd, w, mo, res))) return 1;
     } else if (!(vp = vp_build(cmd, w, mo, res))) {
         return 1;
     }
@@ -796,7 +828,7 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
     return rc;
 }
 
-int rad_cmd_render(int argc, char **argv)
+static int render_main(int argc, char **argv, rad_tool_lights *lights)
 {
     const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
     rad_tool_classic_options o;
@@ -819,6 +851,9 @@ int rad_cmd_render(int argc, char **argv)
         if (rc == 2) return 2;
         if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        rc = rad_tool_light_option(cmd, argc, argv, &a, lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if (opt[0] == '-' && opt[1] && a + 1 >= argc) {
@@ -873,6 +908,7 @@ int rad_cmd_render(int argc, char **argv)
         return 2;
     }
     if (rad_tool_method_check(cmd, 1, &mo, &o)) return 2;
+    rad_tool_dense_plan(&o, &mo, 0);
     method = rad_tool_method_name(mo.method);
     seed = mo.seed;
     pathtrace = mo.method == RAD_TOOL_PATHTRACE;
@@ -903,7 +939,7 @@ int rad_cmd_render(int argc, char **argv)
         if (rad_tool_check_output(cmd, out_path, inputs, 2)) return 1;
     }
     rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
     {
         uint32_t t, emitters = 0;
         for (t = 0; t < w.scene->triangle_count; ++t) {
@@ -1047,4 +1083,14 @@ int rad_cmd_render(int argc, char **argv)
     rad_image_free(&img);
     rad_tool_close_world(&w);
     return 0;
+}
+
+int rad_cmd_render(int argc, char **argv)
+{
+    rad_tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = render_main(argc, argv, &lights);
+    rad_tool_lights_free(&lights);
+    return rc;
 }

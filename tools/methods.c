@@ -757,7 +757,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     info.bounces = mo->bounces;
     info.light_samples = o->light_samples;
     info.triangle_count = w->scene->triangle_count;
-    rad_tool_sign_options(secs, k, &info, &sig);
+    rad_tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c.D;
     strcpy(secs[k++].name, "D");
     secs[k].type = RAD_TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;

@@ -158,15 +158,45 @@ int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint
 int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
 double rad_tool_seconds(void);
 
+/* ---- lights from the command line (lights.c) ------------------------------------------- */
+/* --area P:U:V:RGB: an emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB */
+typedef struct rad_tool_area_light {
+    float p[3], u[3], v[3], radiance[3];
+} rad_tool_area_light;
+/* What --sun, --sky, --point, --spot and --area gave (units: lights.c and rad_tool_light_help) */
+typedef struct rad_tool_lights {
+    rad_light *lights;              /* the analytic ones, in the library's units */
+    uint32_t count;
+    rad_tool_area_light *areas;
+    uint32_t area_count;
+} rad_tool_lights;
+/* argv[*a] is one of the light options: parses it (and its value, advancing *a) and returns 1;
+   0 when it is not one; 2 on a bad value (message naming the option printed) */
+int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_tool_lights *L);
+const char *rad_tool_light_help(void);
+void rad_tool_lights_free(rad_tool_lights *L);
+/* Appends L to a loaded scene: the analytic lights to f->lights, the area lights to f->desc
+   (meshes "area_light_K", emissive materials); *storage keeps the new arrays (free with
+   rad_tool_lights_release after the scene is destroyed). Prints what was added. 0 or 1. */
+int rad_tool_add_lights(const char *cmd, rad_tool_scene *f, const rad_tool_lights *L, void **storage);
+void rad_tool_lights_release(void *storage);
+/* rad_hash64 of the lights' fields, continuing from h */
+uint64_t rad_tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h);
+
 /* A scene ready for ray queries: the loaded file, the validated scene and its BVH. */
 typedef struct rad_tool_world {
-    rad_tool_scene file;
+    rad_tool_scene file;      /* file.lights: the file's lights, then those of the command line */
     rad_scene *scene;
     rad_bvh *bvh;
     rad_raycaster rc;
+    uint32_t file_light_count; /* lights of the file itself (the rest came from the command line) */
+    void *lights_storage;      /* private (rad_tool_add_lights) */
 } rad_tool_world;
 /* loads, validates and builds the BVH; prints the error and returns 1 on failure, else 0 */
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w);
+/* the same with the command line's lights added (lights may be NULL) */
+int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
+                            rad_tool_world *w);
 void rad_tool_close_world(rad_tool_world *w);
 /* A camera for a scene that has none (rad_tool_scene.has_camera 0): of the views from outside
    the bounds along +z, -z, +x, -x, -y, +y (the bounding sphere in view) and from inside them,
@@ -188,12 +218,35 @@ typedef struct rad_tool_classic_options {
     uint32_t light_samples;  /* --light-samples N: shadow rays per point (default 16) */
     int sources_only;        /* 1: rad_tool_classic_solve stops after E (L, B, H stay NULL) */
     int no_form_factors;     /* with sources_only: F is not built (ff stays NULL; --method stochastic) */
+    /* the dense build's budget (budget.c): checked by rad_tool_classic_solve before the patches
+       (N at least the triangle count) and after them */
+    double max_memory;       /* --max-memory SIZE in bytes (0: MemAvailable) */
+    int force;               /* --force: build whatever the estimate */
+    double dense_bytes_per_n2; /* bytes per N^2 entry the run holds at its peak (0: 4, F alone) */
+    double dense_cubic;      /* flops / N^3 beyond the form factors (LU, multibounce) */
+    uint32_t dense_local_m;  /* local: capacity M of the 12 M^2 bytes of T (0: none) */
+    const char *dense_method; /* the method named in the refusal (NULL: classic) */
 } rad_tool_classic_options;
 void rad_tool_classic_options_default(rad_tool_classic_options *o);
 /* argv[*a] is one of the options above: parses it (and its value, advancing *a) and returns
    1; returns 0 when it is not one of them, 2 on a bad value (message printed) */
 int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o);
 const char *rad_tool_classic_help(void);
+
+/* ---- the dense build's budget (budget.c) ------------------------------------------------ */
+/* A dense build estimated to take longer than this is refused (without --force). */
+#define RAD_TOOL_DENSE_MAX_SECONDS 3600.0
+/* --max-memory SIZE: bytes with an optional K, M, G or T (powers of 1024); 0 or 2 (printed) */
+int rad_tool_parse_bytes(const char *cmd, const char *opt, const char *text, double *out);
+/* MemAvailable of /proc/meminfo in bytes; 0 where unknown (then only --max-memory limits) */
+double rad_tool_mem_available(void);
+struct rad_tool_method_options;
+/* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice). */
+void rad_tool_dense_plan(rad_tool_classic_options *o, const struct rad_tool_method_options *mo, int bake);
+/* Before a dense build of n patches (lower_bound: n is the triangle count, the patches not made
+   yet): 0 when the estimate fits the memory limit and RAD_TOOL_DENSE_MAX_SECONDS (or
+   o->force); else prints the estimate, the limit and the virtual-patch methods, returns 1. */
+int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uint32_t n, int lower_bound);
 
 /* Patches, dense F, direct irradiance D of the patches (emitters and analytic lights),
    E = rho D (RAD_SOURCE_DIRECT), the indirect solution L, B = E + L and H = F B. */
@@ -220,12 +273,15 @@ typedef struct rad_tool_bake_info {
     uint32_t triangle_count; /* of the scene baked */
 } rad_tool_bake_info;
 #define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u)
-/* The hash of a rad.options record, kept in the bake's signature (rad_bake_signature.options)
-   so that a bake's options section is known to be the one it was made with. */
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info);
+/* The hash of a rad.options record and of the lights given on the command line (w's lights
+   past file_light_count; none: the hash of the record alone, as before those options), kept
+   in the bake's signature (rad_bake_signature.options) so that a bake's options section and
+   lights are known to be the ones it was made with. */
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w);
 /* Points the signature section among secs[0..count) (written by rad_save_memory with the scene's
-   hashes) at *sig, a copy with the options hash of 'info' added. */
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig);
+   hashes) at *sig, a copy with the options hash of 'info' and w's lights added. */
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+                           rad_bake_signature *sig);
 
 /* ---- lighting models for the direct term (shading.c) ------------------------------------ */
 /* "none" (-1) or a rad_shading_model name; 0 on success, else prints and returns 2 */
