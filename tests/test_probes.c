@@ -432,6 +432,83 @@ static void pb_test_sampling_update(void)
     pb_cornell_free(&f);
 }
 
+/* RAD_PROBES_DIRECT with analytic lights over a floor: the odd part E(n) - E(-n) of a point
+   light, a sun and a sky matches rad_direct_irradiance (deltas lie exactly in bands 0-2's odd
+   part; the sky is sampled both ways) */
+static void pb_test_lights(void)
+{
+    static const float floor_pos[12] = { 0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0 };
+    static const uint32_t floor_idx[6] = { 0, 1, 2, 0, 2, 3 };
+    static const float ns[4][3] = { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, 1 }, { 0.48f, 0.6f, -0.64f } };
+    float p[3] = { 0.5f, 0.5f, 0.5f }, *B = NULL;
+    rad_mesh_desc m;
+    rad_material mat;
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_probes *pr = NULL;
+    rad_probe_options o;
+    rad_direct_options dopt;
+    rad_light li[3];
+    int k, c, l;
+    memset(&m, 0, sizeof(m));
+    memset(&mat, 0, sizeof(mat));
+    memset(&d, 0, sizeof(d));
+    memset(li, 0, sizeof(li));
+    m.positions = floor_pos;
+    m.vertex_count = 4;
+    m.indices = floor_idx;
+    m.triangle_count = 2;
+    mat.albedo[0] = mat.albedo[1] = mat.albedo[2] = 0.5f;
+    d.meshes = &m;
+    d.mesh_count = 1;
+    d.materials = &mat;
+    d.material_count = 1;
+    li[0].type = RAD_LIGHT_POINT;
+    li[0].color[0] = 2.0f; li[0].color[1] = 1.0f; li[0].color[2] = 0.5f;
+    li[0].position[0] = 0.7f; li[0].position[1] = 1.5f; li[0].position[2] = 0.4f;
+    li[1].type = RAD_LIGHT_DIRECTIONAL;
+    li[1].color[0] = li[1].color[1] = li[1].color[2] = 0.5f;
+    li[1].direction[0] = -1.0f; li[1].direction[1] = -0.5f;
+    li[2].type = RAD_LIGHT_SKY;
+    li[2].color[0] = li[2].color[1] = li[2].color[2] = 1.0f;
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    if (S) CHECK_OK(rad_patches_create(S, NULL, NULL, &P));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
+    if (!P || !bvh) goto done;
+    rad_bvh_raycaster(bvh, &rc);
+    B = (float *)calloc(3 * (size_t)P->count, sizeof(float));
+    rad_probe_options_default(&o);
+    o.flags = RAD_PROBES_DIRECT;
+    o.rays = 4096;
+    rad_direct_options_default(&dopt);
+    dopt.light_samples = 4096;
+    for (l = 0; l < 3; ++l) {
+        pr = NULL;
+        CHECK_OK(rad_probes_create(P, &rc, &li[l], 1, p, 1, &o, B, NULL, &pr));
+        if (!pr) continue;
+        for (k = 0; k < 4; ++k) {
+            float n[2][3], e[2][3], r[2][3];
+            int j;
+            for (c = 0; c < 3; ++c) { n[0][c] = ns[k][c]; n[1][c] = -ns[k][c]; }
+            for (j = 0; j < 2; ++j) {
+                rad_sh9_irradiance(rad_probes_coefficients(pr), n[j], e[j]);
+                CHECK_OK(rad_direct_irradiance(S, &rc, &li[l], 1, &dopt, p, n[j], 1, r[j], NULL));
+            }
+            for (c = 0; c < 3; ++c) CHECK_NEAR(e[0][c] - e[1][c], r[0][c] - r[1][c], 1e-4 + 0.01 * (r[0][c] + r[1][c]));
+            if (k == 0) CHECK(r[0][1] - r[1][1] > 0.1f); /* every light reaches the top more than the bottom */
+        }
+        rad_probes_destroy(pr);
+    }
+done:
+    free(B);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
 static void pb_test_bad_options(void)
 {
     pb_cornell f;
@@ -528,6 +605,7 @@ static const rad_test_case tests_probes[] = {
     { "probes_inside_geometry", pb_test_inside },
     { "probes_constant_room", pb_test_constant_room },
     { "probes_sampling_update", pb_test_sampling_update },
+    { "probes_lights", pb_test_lights },
     { "probes_bad_options", pb_test_bad_options },
     { "probes_alloc", pb_test_alloc },
     { NULL, NULL }
