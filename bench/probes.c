@@ -32,8 +32,8 @@ static float *B;
 
 static void reference(const float *p, const float *n, int direct, uint32_t rays, float out[3])
 {
-    rad_ray *rr = (rad_ray *)malloc(sizeof(rad_ray) * rays);
-    rad_hit *hh = (rad_hit *)malloc(sizeof(rad_hit) * rays);
+    rad_ray *rr = (rad_ray *)calloc(rays, sizeof(rad_ray));
+    rad_hit *hh = (rad_hit *)calloc(rays, sizeof(rad_hit));
     float t1[3], t2[3], a[3] = {1, 0, 0}, D[3] = {0, 0, 0};
     double acc[3] = {0, 0, 0}, l;
     uint32_t k, m = (uint32_t)sqrt((double)rays);

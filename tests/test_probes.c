@@ -135,8 +135,8 @@ static void pb_cornell_free(pb_cornell *f)
 static void pb_reference(const pb_cornell *f, const float *p, const float *n, uint32_t rays, int direct, float out[3])
 {
     rad_direct_options dopt;
-    rad_ray *rr = (rad_ray *)malloc(sizeof(rad_ray) * rays);
-    rad_hit *hh = (rad_hit *)malloc(sizeof(rad_hit) * rays);
+    rad_ray *rr = (rad_ray *)calloc(rays, sizeof(rad_ray));
+    rad_hit *hh = (rad_hit *)calloc(rays, sizeof(rad_hit));
     float t1[3], t2[3], a[3] = { 1, 0, 0 }, D[3];
     double acc[3] = { 0, 0, 0 };
     uint32_t k;
