@@ -2530,7 +2530,8 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
    behind the surface counts little, one straight behind it not at all), disabled probes are
    skipped, and the weights are renormalized. When no weight is left (every neighbour
    disabled) the nearest enabled probe is used. The result is clamped at 0 (an L2 sum can dip
-   below zero behind a strong light). It is continuous in p and n. */
+   below zero behind a strong light). It is continuous in p and n. rad_probes_sample_visible
+   also skips the probes a shadow ray from p does not reach (a wall between p and a probe). */
 
 typedef enum rad_probe_flags {
     RAD_PROBES_DIRECT = 1      /* add the direct light D_i (THE GATHER above) */
@@ -2593,6 +2594,14 @@ RAD_API rad_result rad_probes_update(rad_probes *probes, const float *B, const r
    normal), NON_FINITE (p or n). out is 0 when every probe is disabled. Thread-safe, O(1) on a
    grid, O(probes) with user positions. */
 RAD_API rad_result rad_probes_sample(const rad_probes *probes, const float p[3], const float n[3], float out_rgb[3]);
+
+/* The same with visibility: a probe that a shadow ray from p (offset along n) does not reach
+   is skipped as if disabled, so light does not leak through a wall between p and a probe.
+   raycaster is borrowed for the call. Errors: those of rad_probes_sample, INVALID_ARGUMENT (a
+   NULL raycaster), RAYCAST_FAILED. Thread-safe when the raycaster is. Cost: up to 8 shadow
+   rays on a grid, one per enabled probe with user positions. */
+RAD_API rad_result rad_probes_sample_visible(const rad_probes *probes, const rad_raycaster *raycaster, const float p[3],
+                                             const float n[3], float out_rgb[3]);
 
 /* Accessors. positions: 3 floats per probe (moved probes at their new place); states: one
    rad_probe_state per probe; coefficients: 27 floats per probe (layout above). */
@@ -15060,6 +15069,7 @@ struct rad_probes {
     int grid;
     uint32_t dims[3];
     float origin[3], spacing, h2;
+    float eps;                 /* ray offset (ray_epsilon x the scene diagonal) */
     rad_allocator allocator;
 };
 
@@ -15552,6 +15562,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     pr->allocator = c.allocator;
     pr->patch_count = N;
     pr->h2 = 1e-6f * S->diagonal * S->diagonal;
+    pr->eps = b.o.ray_epsilon * S->diagonal;
     if (positions) {
         for (i = 0; i < count; ++i)
             if (!rad__finite3(positions + 3 * (size_t)i)) {
@@ -15685,12 +15696,33 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     return RAD_SUCCESS;
 }
 
-RAD_API rad_result rad_probes_sample(const rad_probes *pr, const float p[3], const float n[3], float out_rgb[3])
+/* 1 when a shadow ray from p (offset along the unit normal un) reaches q, or when there is no
+   raycaster; 0 when occluded; -1 when the raycaster failed */
+static int rad__probe_visible(const rad_probes *pr, const rad_raycaster *rc, const float *p, const float *un, const float *q)
+{
+    rad_ray ray;
+    uint8_t occ = 0;
+    float len;
+    int k;
+    if (!rc) return 1;
+    for (k = 0; k < 3; ++k) {
+        ray.origin[k] = p[k] + un[k] * pr->eps;
+        ray.dir[k] = q[k] - ray.origin[k];
+    }
+    len = rad__len(ray.dir);
+    ray.tmin = 0.0f;
+    ray.tmax = len > 2.0f * pr->eps ? 1.0f - pr->eps / len : 0.5f;
+    if (rc->occluded(rc->user, &ray, 1, &occ) != RAD_SUCCESS) return -1;
+    return occ ? 0 : 1;
+}
+
+static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *rc, const float p[3], const float n[3],
+                                     float out_rgb[3])
 {
     float un[3], e[3], acc[3] = { 0.0f, 0.0f, 0.0f };
     double wsum = 0.0;
     uint32_t i;
-    int k;
+    int k, vis;
     if (!pr || !p || !n || !out_rgb) return RAD_ERROR_INVALID_ARGUMENT;
     out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
     if (!rad__finite3(p) || !rad__finite3(n)) return RAD_ERROR_NON_FINITE;
@@ -15720,6 +15752,9 @@ RAD_API rad_result rad_probes_sample(const rad_probes *pr, const float p[3], con
                     cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
                     w *= 0.25f * (1.0f + cs) * (1.0f + cs);
                     if (!(w > 0.0f)) continue;
+                    vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
+                    if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
+                    if (!vis) continue;
                     rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
                     for (k = 0; k < 3; ++k) acc[k] += w * e[k];
                     wsum += w;
@@ -15733,6 +15768,9 @@ RAD_API rad_result rad_probes_sample(const rad_probes *pr, const float p[3], con
             cs = len2 > 0.0f ? rad__dot(d, un) / (float)sqrt((double)len2) : 1.0f;
             w = 0.25f * (1.0f + cs) * (1.0f + cs) / (len2 + pr->h2);
             if (!(w > 0.0f)) continue;
+            vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
+            if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
+            if (!vis) continue;
             rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
             for (k = 0; k < 3; ++k) acc[k] += w * e[k];
             wsum += w;
@@ -15758,6 +15796,18 @@ RAD_API rad_result rad_probes_sample(const rad_probes *pr, const float p[3], con
         out_rgb[k] = v > 0.0f ? v : 0.0f;
     }
     return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_probes_sample(const rad_probes *pr, const float p[3], const float n[3], float out_rgb[3])
+{
+    return rad__probes_sample(pr, NULL, p, n, out_rgb);
+}
+
+RAD_API rad_result rad_probes_sample_visible(const rad_probes *pr, const rad_raycaster *raycaster, const float p[3],
+                                             const float n[3], float out_rgb[3])
+{
+    if (!raycaster || !raycaster->occluded) return RAD_ERROR_INVALID_ARGUMENT;
+    return rad__probes_sample(pr, raycaster, p, n, out_rgb);
 }
 
 RAD_API uint32_t rad_probes_count(const rad_probes *pr) { return pr ? pr->count : 0u; }

@@ -403,6 +403,14 @@ static void pb_test_sampling_update(void)
     pr = NULL;
     CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &two[0][0], 2, &o, f.B, NULL, &pr));
     if (pr) {
+        /* above the blocks nothing is occluded: with and without visibility agree */
+        float p[3] = { 0.3f, 0.45f, 0.3f }, n[3] = { 0.2f, 0.9f, 0.1f }, e[3], v[3];
+        int c;
+        CHECK_OK(rad_probes_sample(pr, p, n, e));
+        CHECK_OK(rad_probes_sample_visible(pr, &f.rc, p, n, v));
+        for (c = 0; c < 3; ++c) CHECK(e[c] == v[c] && e[c] > 0.0f);
+    }
+    if (pr) {
         float mid[3] = { 0.275f, 0.4f, 0.28f }, toA[3] = { -1, 0, 0 }, toB[3] = { 1, 0, 0 }, e[3], a[3];
         int c;
         CHECK(rad_probes_states(pr)[0] == RAD_PROBE_VALID && rad_probes_states(pr)[1] == RAD_PROBE_VALID);
@@ -417,6 +425,27 @@ static void pb_test_sampling_update(void)
         rad_sh9_irradiance(rad_probes_coefficients(pr), toB, a);
         for (c = 0; c < 3; ++c) CHECK_NEAR(e[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-3 * a[1]);
     }
+    rad_probes_destroy(pr);
+    pr = NULL;
+    {
+        /* a probe behind the tall block: sample_visible drops it, sample mixes it in */
+        static const float ab[2][3] = { { 0.15f, 0.2f, 0.35f }, { 0.52f, 0.2f, 0.35f } };
+        float p[3] = { 0.2f, 0.2f, 0.35f }, up[3] = { 0, 1, 0 }, e[3], v[3], a[3];
+        int c;
+        CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &ab[0][0], 2, &o, f.B, NULL, &pr));
+        if (pr) {
+            CHECK(rad_probes_states(pr)[0] == RAD_PROBE_VALID && rad_probes_states(pr)[1] == RAD_PROBE_VALID);
+            CHECK_OK(rad_probes_sample(pr, p, up, e));
+            CHECK_OK(rad_probes_sample_visible(pr, &f.rc, p, up, v));
+            rad_sh9_irradiance(rad_probes_coefficients(pr), up, a);
+            for (c = 0; c < 3; ++c) CHECK_REL(v[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-5);
+            CHECK(fabsf(e[0] - v[0]) > 1e-3f * v[0]);
+            CHECK_RESULT(rad_probes_sample_visible(pr, NULL, p, up, v), RAD_ERROR_INVALID_ARGUMENT);
+        }
+        rad_probes_destroy(pr);
+        pr = NULL;
+    }
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &two[0][0], 2, &o, f.B, NULL, &pr));
     /* update with another solution = a fresh build with it, bit for bit */
     B2 = (float *)malloc(sizeof(float) * 3 * f.P->count);
     for (i = 0; i < 3 * f.P->count; ++i) B2[i] = f.B[i] * (0.5f + 0.001f * (float)(i % 997));
