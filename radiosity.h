@@ -224,7 +224,8 @@
        float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
        step (the same random draws as the CPU), the alias-table build for streamed rows, and
        the local multi-bounce matrix's apply and add (rank-1 update, rank-2 when evicting) on
-       a matrix kept resident on the GPU, and virtual-patch gathering at surface points;
+       a matrix kept resident on the GPU, virtual-patch gathering at surface points, and the
+       irradiance-probe update;
        RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
@@ -269,7 +270,8 @@
               built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
               compression and reordering; temporal radiosity with alias tables; local
               matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
-              models and microfacet BRDFs; embedded GLSL kernels for every run-time step.
+              models and microfacet BRDFs; irradiance probes (SH L2); embedded GLSL kernels
+              for every run-time step.
        The full history is in CHANGELOG.md.
 */
 
@@ -9110,7 +9112,10 @@ static const char rad__glsl_12_0[] =
     "    uint w0 = 9u * first[p].x - pc.weight_base;\n"
     "    uint count = first[p + 1u].x - first[p].x;\n"
     "    precise vec3 acc[9];\n"
-    "    for (uint i = 0u; i < 9u; ++i) acc[i] = vec3(direct[27u * p + 3u * i], direct[27u * p + 3u * i + 1u], direct[27u * p + 3u * i + 2u]);\n"
+    "    for (uint i = 0u; i < 9u; ++i) {\n"
+    "        uint d = 27u * p + 3u * i;\n"
+    "        acc[i] = vec3(direct[d], direct[d + 1u], direct[d + 2u]);\n"
+    "    }\n"
     "    for (uint e = 0u; e < count; ++e) {\n"
     "        uint j = patch_index[k0 + e];\n"
     "        vec3 b = vec3(B[3u * j], B[3u * j + 1u], B[3u * j + 2u]);\n"
@@ -9136,7 +9141,7 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
-    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2610u }
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u }
 };
 /* >>glsl end */
 
@@ -15526,7 +15531,8 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon,
+                 (double)RAD__MAX_RAY_EPSILON);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!rad__finite(b.o.spacing) || b.o.spacing < 0.0f || !rad__finite(b.o.max_move) || !rad__finite(b.o.clearance) ||
@@ -15667,7 +15673,8 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         for (q = 0; q < m && r == RAD_SUCCESS; ++q) {
             pr->first[first + q] = pr->entries;
             r = rad__probes_pack(pr, b.dense + 9 * (size_t)N * q, N, &cap);
-            if (r != RAD_SUCCESS) rad__log(&c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
+            if (r != RAD_SUCCESS)
+                rad__log(&c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
         }
         if (r == RAD_SUCCESS && c.progress && c.progress(c.progress_user, (float)((double)(first + m) / (double)pr->count))) {
             rad__log(&c, RAD_LOG_INFO, "probes: cancelled by the progress callback after %u of %u probes", first + m, pr->count);

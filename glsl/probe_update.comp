@@ -31,7 +31,10 @@ void main()
     uint w0 = 9u * first[p].x - pc.weight_base;
     uint count = first[p + 1u].x - first[p].x;
     precise vec3 acc[9];
-    for (uint i = 0u; i < 9u; ++i) acc[i] = vec3(direct[27u * p + 3u * i], direct[27u * p + 3u * i + 1u], direct[27u * p + 3u * i + 2u]);
+    for (uint i = 0u; i < 9u; ++i) {
+        uint d = 27u * p + 3u * i;
+        acc[i] = vec3(direct[d], direct[d + 1u], direct[d + 2u]);
+    }
     for (uint e = 0u; e < count; ++e) {
         uint j = patch_index[k0 + e];
         vec3 b = vec3(B[3u * j], B[3u * j + 1u], B[3u * j + 2u]);
