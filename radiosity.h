@@ -15552,7 +15552,10 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     /* the lights pass the checks of the direct-light code */
     if (b.o.flags & RAD_PROBES_DIRECT) {
         r = rad__direct_setup(&dv, S, raycaster, lights, light_count, NULL, &c);
-        if (r != RAD_SUCCESS) return r;
+        if (r != RAD_SUCCESS) {
+            rad__log(&c, RAD_LOG_ERROR, "probes: the %u lights were refused (%s)", light_count, rad_result_string(r));
+            return r;
+        }
     }
     if (B) {
         r = rad__check_input(&c, "probes", B, 3 * (size_t)N);

@@ -573,6 +573,7 @@ static void pb_test_bad_options(void)
     li.type = RAD_LIGHT_POINT;
     li.color[0] = -1.0f;
     CHECK_RESULT(rad_probes_create(f.P, &f.rc, &li, 1, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_NEGATIVE_EMISSION);
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 1, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
     rad_probe_options_default(&o);
     f.B[7] = NAN;
     CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, f.B, NULL, &pr), RAD_ERROR_NON_FINITE);
