@@ -104,6 +104,7 @@ int rad_cmd_trace(int argc, char **argv);
 int rad_cmd_compare(int argc, char **argv);
 int rad_cmd_info(int argc, char **argv);
 int rad_cmd_export(int argc, char **argv);
+int rad_cmd_probes(int argc, char **argv);
 
 /* ---- shared helpers (rad.c) ------------------------------------------------------------- */
 /* progress to stderr: a bar when stderr is a terminal, a plain percentage line otherwise */
