@@ -2298,8 +2298,21 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    with a similar patch count: 0.984 and 0.979).
    COST: O(M^2) kernel evaluations and up to M^2/2 shadow rays for M samples; M grows with the
    number of non-empty voxels times 6 face_points (times the hit rate).
-   USE: rad_vp_system makes a rad_system for every classic solver (the matrix is dense
-   row-major rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
+   SPARSE ROWS (storage = RAD_STORAGE_SPARSE): after step 6 the matrix is kept as CSR with the
+   entries F_ab <= drop_threshold left out (exact zeros always: pairs of voxels that see each
+   other not at all), and the dense build matrix is freed, so the object holds O(nnz), not
+   N^2: 8 bytes per kept entry (column and value) and 8 per row. The build itself still
+   holds the N x N float matrix while it runs (the peak of MEMORY above, plus 8 bytes per kept
+   entry during the copy). Dropping entries lowers the row sums by the dropped mass (the
+   environment entry of temporal radiosity picks it up as unreached light); reciprocity holds
+   for every pair where both entries are kept. Every run-time method takes vp->matrix as it
+   is (CSR or dense): rad_solve_*, rad_matrix_multiply, rad_multibounce_create,
+   rad_alias_tables_create (temporal radiosity), rad_row_source_matrix with vp->areas and
+   vp->albedo (the local matrix, rad_alias_build_row on rows fetched one at a time), and
+   rad_vp_sections / rad_vp_load (>>api_vp, container) with rad_row_stream_open, which
+   streams the rows of a saved set from its file.
+   USE: rad_vp_system makes a rad_system for every classic solver (the matrix is a dense
+   row-major or CSR rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
    brings any per-patch value (B, L, the irradiance H = F (E + L)) back to surface points with
    normal weights and trilinear filtering that skips voxels without a patch facing the normal.
    GENERAL VIRTUAL PATCHES (kind RAD_VP_CLUSTERED, docs/methods/virtual-patches.md). Per voxel every sample
@@ -2352,6 +2365,10 @@ typedef struct rad_vp_options {
     uint32_t max_clusters;    /* RAD_VP_CLUSTERED: Q, patches per voxel at most (1..6, default 6) */
     uint32_t metric_columns;  /* RAD_VP_CLUSTERED: samples used as the columns k of the metric's
                                  form-factor term (default 64, at most 4096) */
+    rad_storage storage;      /* of vp->matrix: RAD_STORAGE_DENSE (default) or RAD_STORAGE_SPARSE
+                                 (CSR, see SPARSE ROWS in the section comment) */
+    float drop_threshold;     /* RAD_STORAGE_SPARSE: entries F_ab <= it are dropped (0 keeps every
+                                 non-zero; >= 0, finite) */
 } rad_vp_options;
 
 /* Axis-aligned virtual patches with their form factors. Read-only after creation.
@@ -13565,6 +13582,9 @@ RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
     rad__free(&a, vp->axis);
     rad__free(&a, vp->voxel);
     rad__free(&a, (void *)vp->matrix.dense);
+    rad__free(&a, (void *)vp->matrix.row_offsets);
+    rad__free(&a, (void *)vp->matrix.columns);
+    rad__free(&a, (void *)vp->matrix.values);
     rad__free(&a, vp->voxel_keys);
     rad__free(&a, vp->voxel_first);
     rad__free(&a, vp->voxel_patch);
@@ -13580,12 +13600,15 @@ RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
 
 RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp)
 {
-    size_t n, m, v;
+    size_t n, m, v, f;
     if (!vp) return 0;
     n = vp->count;
     m = vp->sample_count;
     v = vp->voxel_count;
-    return sizeof(*vp) + n * n * sizeof(float) + n * (8 * sizeof(float) + 1 + sizeof(uint32_t)) +
+    f = vp->matrix.storage == RAD_STORAGE_SPARSE && vp->matrix.row_offsets
+            ? (size_t)vp->matrix.row_offsets[n] * (sizeof(uint32_t) + sizeof(float)) + (n + 1) * sizeof(uint64_t)
+            : n * n * sizeof(float);
+    return sizeof(*vp) + f + n * (8 * sizeof(float) + 1 + sizeof(uint32_t)) +
            v * (sizeof(uint64_t) + 8 * sizeof(uint32_t)) + 2 * sizeof(uint32_t) +
            m * (16 * sizeof(float) + sizeof(uint32_t));
 }
@@ -13943,6 +13966,42 @@ static rad_result rad__vp_divide_row(void *data, uint32_t p, uint32_t task)
     double inv = 1.0 / (double)b->vp->areas[p];
     (void)task;
     for (c = 0; c < N; ++c) row[c] = (float)((double)row[c] * (double)(cp < b->rowf[c] ? cp : b->rowf[c]) * inv);
+    return RAD_SUCCESS;
+}
+
+/* SPARSE ROWS: the finished dense matrix to CSR (entries > threshold), then the dense freed */
+static rad_result rad__vp_to_csr(rad_virtual_patches *vp, float threshold, const rad_allocator *A)
+{
+    uint32_t N = vp->count, p, c;
+    const float *D = vp->matrix.dense;
+    uint64_t *off = (uint64_t *)rad__alloc_array(A, (size_t)N + 1u, sizeof(uint64_t)), k = 0;
+    uint32_t *col;
+    float *val;
+    if (!off) return RAD_ERROR_OUT_OF_MEMORY;
+    for (p = 0; p < N; ++p) {
+        off[p] = k;
+        for (c = 0; c < N; ++c) k += D[(size_t)p * N + c] > threshold && D[(size_t)p * N + c] > 0.0f;
+    }
+    off[N] = k;
+    col = (uint32_t *)rad__alloc_array(A, k ? (size_t)k : 1u, sizeof(uint32_t));
+    val = (float *)rad__alloc_array(A, k ? (size_t)k : 1u, sizeof(float));
+    if (!col || !val) {
+        rad__free(A, off);
+        rad__free(A, col);
+        rad__free(A, val);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (p = 0, k = 0; p < N; ++p)
+        for (c = 0; c < N; ++c) {
+            float x = D[(size_t)p * N + c];
+            if (x > threshold && x > 0.0f) col[k] = c, val[k++] = x;
+        }
+    rad__free(A, (void *)vp->matrix.dense);
+    vp->matrix.dense = NULL;
+    vp->matrix.storage = RAD_STORAGE_SPARSE;
+    vp->matrix.row_offsets = off;
+    vp->matrix.columns = col;
+    vp->matrix.values = val;
     return RAD_SUCCESS;
 }
 
@@ -14491,6 +14550,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
             if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
         }
         if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
+        if (r == RAD_SUCCESS && b->o.storage == RAD_STORAGE_SPARSE) r = rad__vp_to_csr(vp, b->o.drop_threshold, A);
     }
 done:
     rad__free(A, cand);
@@ -14556,9 +14616,12 @@ RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *ra
         if (b.o.voxel_size[k] > 0.0f) given++;
     }
     if ((given != 0 && given != 3) || b.o.face_points > 4096u || b.o.visibility_rays > RAD__RAY_BATCH || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
-        !(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || (!b.o.skip_visibility && !raycaster->occluded)) {
+        !(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || (!b.o.skip_visibility && !raycaster->occluded) ||
+        (b.o.storage != RAD_STORAGE_DENSE && b.o.storage != RAD_STORAGE_SPARSE) || !rad__finite(b.o.drop_threshold) ||
+        b.o.drop_threshold < 0.0f) {
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size must be all 0 or all > 0; face_points <= 4096; visibility_rays "
-                 "<= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility",
+                 "<= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility; "
+                 "storage dense or sparse; drop_threshold finite and >= 0",
                  (double)b.o.ray_epsilon);
         return RAD_ERROR_INVALID_ARGUMENT;
     }

@@ -268,8 +268,13 @@ typedef struct rad_tool_method_options {
     uint32_t face_points;     /* --face-points P: Hammersley points per voxel face (default 16) */
     uint32_t local_m;         /* --local-m M: local matrix capacity, at most the patches (0, the
                                  default: every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX) */
+    uint32_t proxy;           /* --proxy patches|aavp|vp (rad_tool_proxy; render, with multibounce,
+                                 temporal and local: the method runs over virtual patches) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
 } rad_tool_method_options;
+/* --proxy: what multibounce, temporal and local run over (default: classic patches) */
+typedef enum rad_tool_proxy { RAD_TOOL_PROXY_PATCHES = 0, RAD_TOOL_PROXY_AAVP = 1, RAD_TOOL_PROXY_VP = 2 } rad_tool_proxy;
+#define RAD_TOOL_OPT_PROXY (1u << 28)
 enum {
     RAD_TOOL_OPT_BOUNCES = 1u << 0, RAD_TOOL_OPT_FORMAT = 1u << 1, RAD_TOOL_OPT_OUTLIERS = 1u << 2,
     RAD_TOOL_OPT_REORDER = 1u << 3, RAD_TOOL_OPT_REORDER_SAMPLES = 1u << 4, RAD_TOOL_OPT_TILE = 1u << 5,
