@@ -525,6 +525,21 @@ if [ -s "$TMP/ref.pfm" ]; then
             fail "$vm renders the Cornell box" "$(head -c 300 "$TMP/err.txt")"
         fi
     done
+    # --proxy: the run-time methods over the same virtual patches give the aavp image (the
+    # full solution: multibounce inf and local over every patch exactly, temporal to its noise)
+    if "$RAD" render cornell $M --method aavp --vp-resolution 4 --bounces inf -o "$TMP/pref.pfm" > /dev/null 2> "$TMP/err.txt"; then
+        for pm in "multibounce --bounces inf:60" "local:60" "temporal:40"; do
+            pa=${pm%:*}
+            if "$RAD" render cornell $M --method $pa --proxy aavp --vp-resolution 4 -o "$TMP/px.pfm" > /dev/null 2> "$TMP/err.txt" &&
+                grep -q "timing: method=${pa%% *} proxy=aavp" "$TMP/err.txt" && grep -q "sparse rows: " "$TMP/err.txt"; then
+                psnr_check "--method ${pm%:*} --proxy aavp gives the aavp solve" "$TMP/pref.pfm" "$TMP/px.pfm" "${pm#*:}"
+            else
+                fail "--method ${pm%:*} --proxy aavp renders" "$(head -c 300 "$TMP/err.txt")"
+            fi
+        done
+    else
+        fail "aavp --bounces inf renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
     if "$RAD" render cornell $M --method aavp --vp-max-patches 300 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"; then
         np=$(grep -o 'timing: method=aavp patches=[0-9]*' "$TMP/err.txt" | cut -d= -f3)
         [ -n "$np" ] && [ "$np" -le 300 ] && [ "$np" -gt 100 ] && ok "aavp --vp-max-patches 300 gives $np patches (100 < n <= 300)" ||
@@ -547,6 +562,10 @@ bad "--vp-resolution with classic" "--vp-resolution is for --method vp or aavp, 
 bad "--bounces with local" "--bounces is not an option of --method local" render cornell --method local --bounces 3 -o "$TMP/y.pfm"
 bad "--vp-resolution with --vp-max-patches" "exclude each other" render cornell --method aavp --vp-resolution 4 --vp-max-patches 9 -o "$TMP/y.pfm"
 bad "--vp-max-patches x" "--vp-max-patches" render cornell --method aavp --vp-max-patches x -o "$TMP/y.pfm"
+bad "--proxy x" "unknown --proxy 'x'" render cornell --method temporal --proxy x -o "$TMP/y.pfm"
+bad "--proxy with classic" "--proxy aavp is for --method multibounce, temporal or local" render cornell --proxy aavp -o "$TMP/y.pfm"
+bad "--proxy with --format" "--format is not an option of --proxy vp" render cornell --method multibounce --proxy vp --format half -o "$TMP/y.pfm"
+bad "--proxy in bake" "--proxy is an option of rad render" bake cornell --method temporal --proxy aavp -o "$TMP/y.radb"
 bad "--face-points 5000" "--face-points must be in 1..4096" render cornell --method vp --face-points 5000 -o "$TMP/y.pfm"
 bad "bake --method aavp" "method 'aavp' is render-only" bake cornell --method aavp -o "$TMP/y.radb"
 bad "bake --method local" "method 'local' is render-only" bake cornell --method local -o "$TMP/y.radb"
