@@ -2,6 +2,7 @@
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
 #   make gallery every lighting model on rows of spheres, to gallery.png
 #   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
+#   make build/realtime  examples/realtime.c: per-frame light, E, temporal step and gather over AAVP
 #   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
@@ -25,7 +26,7 @@ RAD_DATA_DIR ?=
 
 .PHONY: all demo gallery walk moving-light test bench bench-quick tools fuzz clean glsl report report-quick
 
-all: $(BUILD)/cornell $(BUILD)/walk tools
+all: $(BUILD)/cornell $(BUILD)/walk $(BUILD)/realtime tools
 
 $(BUILD):
 	mkdir -p $(BUILD)
@@ -36,6 +37,10 @@ $(BUILD)/cornell: examples/cornell.c examples/png_write.h radiosity.h | $(BUILD)
 # virtual patches on the bunny in the Cornell box (needs $(RAD_DATA_DIR); --ogre for 193k triangles)
 $(BUILD)/vp_bunny: examples/vp_bunny.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/vp_bunny.c -o $@ -lm
+
+# the per-frame engine loop over virtual patches (a mesh as argument, else the Cornell box)
+$(BUILD)/realtime: examples/realtime.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/realtime.c -o $@ -lm
 
 demo: $(BUILD)/cornell
 	./$(BUILD)/cornell -o cornell.png
