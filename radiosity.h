@@ -1856,7 +1856,9 @@ RAD_API rad_result rad_row_source_bake(const rad_bake *bake, rad_row_source *out
    and values with two seeks and two reads, so the matrix is never in memory. The matrix
    sections' checksums are not verified (that would read them whole): every fetched row is
    checked instead (strictly ascending columns < N, finite values >= 0; CORRUPT otherwise,
-   logged through the context given here).
+   logged through the context given here). A file of virtual patches (rad_vp_sections) works
+   the same way: its RAD_SECTION_VP_AREAS and _ALBEDO stand for the patches (checked: areas
+   finite and > 0, albedos in [0, 1)).
    Errors: IO (the file cannot be opened or read), TRUNCATED, CORRUPT, VERSION, ALBEDO_RANGE,
    INVALID_ARGUMENT (no CSR matrix in the file), OUT_OF_MEMORY. Thread safety: one stream per
    thread (fetches move the file position). Seeks go through fseek, so where long is 32 bits
@@ -2409,6 +2411,7 @@ typedef struct rad_virtual_patches {
     rad_vp_kind kind;
     rad_vp_weights weights;
     rad_allocator allocator;    /* private */
+    uint32_t info_record[16];   /* private: the RAD_SECTION_VP_INFO record (rad_vp_sections) */
 } rad_virtual_patches;
 
 RAD_API void rad_vp_options_default(rad_vp_options *options);
@@ -2471,6 +2474,52 @@ RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *val
    gets 0). Errors: INVALID_ARGUMENT, INDEX_OUT_OF_RANGE, NON_FINITE, OUT_OF_MEMORY. */
 RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
                                       float *out, const rad_context *ctx);
+
+/* CONTAINER (docs/methods/container.md): a whole set, so that an application bakes it once and
+   loads it at start-up (rad bake --method aavp|vp). rad_vp_sections lists the set as sections
+   named 'name' (up to 23 characters; every section shares it; data borrowed from vp):
+   RAD_SECTION_VP_INFO (16 uint32: kind, weights, N, voxel_count, M, dims[3], the bit patterns
+   of origin[3] and voxel_size[3], candidate_voxels, 0), the per-patch, per-voxel and
+   per-sample arrays of rad_virtual_patches (types RAD_SECTION_VP_AREAS .. _SAMPLE_TRIANGLES,
+   one each, in the struct's layout), and the matrix as RAD_SECTION_FF_DENSE or the three
+   RAD_SECTION_FF_ROW_OFFSETS / _COLUMNS / _VALUES sections (CSR), so that
+   rad_row_stream_open streams the rows of a saved set from its file as it does a classic
+   bake's (it takes the areas and albedos from these sections when the file has no patches).
+   *out_count receives how many were written (at most RAD_VP_MAX_SECTIONS). Errors:
+   INVALID_ARGUMENT. */
+#define RAD_SECTION_VP_INFO 40u
+#define RAD_SECTION_VP_AREAS 41u            /* N floats */
+#define RAD_SECTION_VP_ALBEDO 42u           /* 3 N floats */
+#define RAD_SECTION_VP_NORMALS 43u          /* 3 N floats */
+#define RAD_SECTION_VP_AXIS 44u             /* N uint8 */
+#define RAD_SECTION_VP_VOXEL 45u            /* N uint32 */
+#define RAD_SECTION_VP_VOXEL_KEYS 46u       /* voxel_count uint64 */
+#define RAD_SECTION_VP_VOXEL_FIRST 47u      /* voxel_count + 1 uint32 */
+#define RAD_SECTION_VP_VOXEL_PATCH 48u      /* 6 uint32 per voxel */
+#define RAD_SECTION_VP_SAMPLE_FIRST 49u     /* voxel_count + 1 uint32 */
+#define RAD_SECTION_VP_SAMPLE_POSITIONS 50u /* 3 M floats */
+#define RAD_SECTION_VP_SAMPLE_NORMALS 51u   /* 3 M floats */
+#define RAD_SECTION_VP_SAMPLE_ALBEDO 52u    /* 3 M floats */
+#define RAD_SECTION_VP_SAMPLE_AREAS 53u     /* M floats */
+#define RAD_SECTION_VP_SAMPLE_WEIGHTS 54u   /* 6 M floats */
+#define RAD_SECTION_VP_SAMPLE_TRIANGLES 55u /* M uint32 */
+#define RAD_VP_MAX_SECTIONS 19u
+RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count);
+
+/* A set read back from the sections named 'name' of a container: an owning copy (the
+   container may be closed after), destroyed with rad_vp_destroy, holding the same bits
+   (face_rays and pair_rays, not saved, are 0). scene: the scene the set was built from
+   (borrowed, must outlive the set; NULL allowed, but then rad_vp_sources refuses the set);
+   with a scene every sample triangle must be below its triangle count. Every index and value
+   is checked once (VALUES of >>api_container, and: kind and weights known, the voxel keys
+   ascending inside the grid, voxel_first and sample_first monotone from 0 to N and M, each
+   patch in the voxel whose range holds it, voxel_patch entries RAD_NONE or a patch of that
+   voxel, axis < 6, areas > 0, albedos in [0, 1), a square N x N matrix with CSR rows ascending
+   and values >= 0). Errors: INVALID_ARGUMENT (NULL, or no VP_INFO section of that name),
+   CORRUPT (a missing or inconsistent section: the logger names it), NON_FINITE,
+   INDEX_OUT_OF_RANGE (a sample triangle beyond the scene), OUT_OF_MEMORY. Cost: O(size). */
+RAD_API rad_result rad_vp_load(const rad_container *container, const char *name, const rad_scene *scene,
+                               const rad_context *ctx, rad_virtual_patches **out);
 
 #ifdef __cplusplus
 }
@@ -11340,8 +11389,8 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
     rad__ctx c;
     rad_row_stream *s;
     unsigned char head[RAD__HEADER_BYTES], *table = NULL, *buf = NULL;
-    uint64_t file_size, actual, off[4] = {0, 0, 0, 0}, cnt[4] = {0, 0, 0, 0};
-    uint32_t count, i, crc[4] = {0, 0, 0, 0}, found = 0;
+    uint64_t file_size, actual, off[6] = {0, 0, 0, 0, 0, 0}, cnt[6] = {0, 0, 0, 0, 0, 0};
+    uint32_t count, i, crc[6] = {0, 0, 0, 0, 0, 0}, found = 0, vps = 0;
     long end;
     rad_result r = RAD_SUCCESS;
     rad__ctx_init(&c, ctx);
@@ -11405,6 +11454,8 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
         uint32_t type = rad__get32(e), esz = rad__get32(e + 4), want, slot;
         uint64_t n = rad__get64(e + 8), at = rad__get64(e + 16), bytes = rad__get64(e + 24);
         if (type == RAD_SECTION_PATCHES) { slot = 0; want = (uint32_t)sizeof(rad_patch); }
+        else if (type == RAD_SECTION_VP_AREAS) { slot = 4; want = 4u; }
+        else if (type == RAD_SECTION_VP_ALBEDO) { slot = 5; want = 12u; }
         else if (type == RAD_SECTION_FF_ROW_OFFSETS) { slot = 1; want = 8u; }
         else if (type == RAD_SECTION_FF_COLUMNS) { slot = 2; want = 4u; }
         else if (type == RAD_SECTION_FF_VALUES) { slot = 3; want = 4u; }
@@ -11420,9 +11471,15 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
         crc[slot] = rad__get32(e + 32);
         found |= 1u << slot;
     }
-    if (found != 15u || cnt[0] == 0 || cnt[0] > 0xFFFFFFFEu || cnt[1] != cnt[0] + 1 || cnt[2] != cnt[3]) {
+    /* a saved virtual-patch set (rad_vp_sections): its areas and albedos stand for the patches */
+    if (!(found & 1u) && (found & 48u) == 48u && cnt[4] == cnt[5]) {
+        vps = 1;
+        off[0] = off[4], cnt[0] = cnt[4], crc[0] = crc[4];
+        found |= 1u;
+    }
+    if ((found & 15u) != 15u || cnt[0] == 0 || cnt[0] > 0xFFFFFFFEu || cnt[1] != cnt[0] + 1 || cnt[2] != cnt[3]) {
         rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' holds no patches with a CSR form-factor matrix of matching size", path);
-        r = found != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
+        r = (found & 15u) != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
         goto fail;
     }
     s->n = (uint32_t)cnt[0];
@@ -11431,25 +11488,45 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
     s->areas = (float *)rad__alloc_array(&c.allocator, s->n, sizeof(float));
     s->albedo = (float *)rad__alloc_array(&c.allocator, s->n, 3 * sizeof(float));
     s->offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)s->n + 1u, sizeof(uint64_t));
-    buf = (unsigned char *)rad__alloc_array(&c.allocator, s->n, sizeof(rad_patch));
+    buf = (unsigned char *)rad__alloc_array(&c.allocator, s->n, vps ? 12u : sizeof(rad_patch));
     if (!s->areas || !s->albedo || !s->offsets || !buf) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
     s->bytes = sizeof(*s) + (size_t)s->n * 16u + ((size_t)s->n + 1u) * 8u;
-    if (!rad__stream_read(s->f, off[0], buf, (size_t)s->n * sizeof(rad_patch)) ||
+    if (!rad__stream_read(s->f, off[0], vps ? (void *)s->areas : (void *)buf, (size_t)s->n * (vps ? 4u : sizeof(rad_patch))) ||
+        (vps && !rad__stream_read(s->f, off[5], buf, (size_t)s->n * 12u)) ||
         !rad__stream_read(s->f, off[1], s->offsets, ((size_t)s->n + 1u) * 8u)) {
         r = RAD_ERROR_IO;
         goto fail;
     }
-    if (rad__crc32(buf, (size_t)s->n * sizeof(rad_patch)) != crc[0] || rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != crc[1]) {
+    if ((vps ? rad__crc32((const unsigned char *)s->areas, (size_t)s->n * 4u) != crc[0] ||
+                   rad__crc32(buf, (size_t)s->n * 12u) != crc[5]
+             : rad__crc32(buf, (size_t)s->n * sizeof(rad_patch)) != crc[0]) ||
+        rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != crc[1]) {
         rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': checksum mismatch in the patches or the row offsets", path);
         r = RAD_ERROR_CORRUPT;
         goto fail;
     }
     for (i = 0; i < s->n; ++i) {
-        rad_patch p;
         uint32_t k;
-        memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
-        s->areas[i] = p.area;
-        for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
+        if (vps) {
+            memcpy(s->albedo + 3 * (size_t)i, buf + 12u * (size_t)i, 12);
+        } else {
+            rad_patch p;
+            memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
+            s->areas[i] = p.area;
+            for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
+        }
+        for (k = 0; vps && k < 3; ++k) /* the patches' loader checked a classic bake's */
+            if (!(s->albedo[3 * (size_t)i + k] >= 0.0f && s->albedo[3 * (size_t)i + k] < 1.0f)) {
+                rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has albedo %g (must be in [0, 1))", path, i,
+                         (double)s->albedo[3 * (size_t)i + k]);
+                r = RAD_ERROR_ALBEDO_RANGE;
+                goto fail;
+            }
+        if (vps && (!(s->areas[i] > 0.0f) || !rad__finite(s->areas[i]))) {
+            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has area %g", path, i, (double)s->areas[i]);
+            r = RAD_ERROR_CORRUPT;
+            goto fail;
+        }
         if (s->offsets[i + 1] < s->offsets[i]) {
             rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets decrease at row %u", path, i);
             r = RAD_ERROR_CORRUPT;
@@ -14659,6 +14736,18 @@ RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *ra
         rad_vp_destroy(vp);
         return r;
     }
+    /* the container record (rad_vp_sections): kind, weights, counts, grid */
+    vp->info_record[0] = (uint32_t)vp->kind;
+    vp->info_record[1] = (uint32_t)vp->weights;
+    vp->info_record[2] = vp->count;
+    vp->info_record[3] = vp->voxel_count;
+    vp->info_record[4] = vp->sample_count;
+    for (k = 0; k < 3; ++k) {
+        vp->info_record[5 + k] = vp->dims[k];
+        memcpy(&vp->info_record[8 + k], &vp->origin[k], 4);
+        memcpy(&vp->info_record[11 + k], &vp->voxel_size[k], 4);
+    }
+    vp->info_record[14] = vp->candidate_voxels;
     *out = vp;
     return RAD_SUCCESS;
 }
@@ -14710,6 +14799,10 @@ RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_rayca
     int k;
     rad__ctx_init(&c, ctx);
     if (!vp || !out_E || (mode != RAD_SOURCE_DIRECT && mode != RAD_SOURCE_EMISSION)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (!vp->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_sources: the set has no scene (rad_vp_load with scene NULL)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     M = vp->sample_count;
     v = (float *)rad__alloc_array(&c.allocator, M, 3 * sizeof(float));
     if (!v) return RAD_ERROR_OUT_OF_MEMORY;
@@ -14890,6 +14983,210 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
     rad__free(&c.allocator, pts);
     rad__free(&c.allocator, nrm);
     return r;
+}
+
+/* ---- container ---- */
+
+RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count)
+{
+    uint32_t N, V, M, k = 0;
+    if (out_count) *out_count = 0;
+    if (!vp || !out || !out_count || !vp->matrix.rows) return RAD_ERROR_INVALID_ARGUMENT;
+    N = vp->count, V = vp->voxel_count, M = vp->sample_count;
+    rad__section(&out[k++], RAD_SECTION_VP_INFO, 4, 16, vp->info_record, name);
+    rad__section(&out[k++], RAD_SECTION_VP_AREAS, 4, N, vp->areas, name);
+    rad__section(&out[k++], RAD_SECTION_VP_ALBEDO, 12, N, vp->albedo, name);
+    rad__section(&out[k++], RAD_SECTION_VP_NORMALS, 12, N, vp->normals, name);
+    rad__section(&out[k++], RAD_SECTION_VP_AXIS, 1, N, vp->axis, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL, 4, N, vp->voxel, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_KEYS, 8, V, vp->voxel_keys, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, vp->voxel_first, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_PATCH, 24, V, vp->voxel_patch, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, vp->sample_first, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, vp->sample_positions, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, vp->sample_normals, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, vp->sample_albedo, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_AREAS, 4, M, vp->sample_areas, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, vp->sample_weights, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, vp->sample_triangles, name);
+    if (vp->matrix.storage == RAD_STORAGE_SPARSE) {
+        uint64_t nnz = vp->matrix.row_offsets[N];
+        rad__section(&out[k++], RAD_SECTION_FF_ROW_OFFSETS, 8, (uint64_t)N + 1u, vp->matrix.row_offsets, name);
+        rad__section(&out[k++], RAD_SECTION_FF_COLUMNS, 4, nnz, vp->matrix.columns, name);
+        rad__section(&out[k++], RAD_SECTION_FF_VALUES, 4, nnz, vp->matrix.values, name);
+    } else {
+        rad__section(&out[k++], RAD_SECTION_FF_DENSE, 4, (uint64_t)N * N, vp->matrix.dense, name);
+    }
+    *out_count = k;
+    return RAD_SUCCESS;
+}
+
+/* one section of the set: present, of 'elem' bytes per element and 'count' elements; copied
+   into a new array of the set's allocator */
+static rad_result rad__vp_take(const rad__ctx *c, const rad_container *ct, const char *name, uint32_t type, uint32_t elem,
+                               uint64_t count, void **dst)
+{
+    const rad_section *sec = rad_container_find(ct, type, name);
+    *dst = NULL;
+    if (!sec || sec->elem_size != elem || sec->count != count) {
+        rad__log(c, RAD_LOG_ERROR, "rad_vp_load: section type %u of '%s' is %s (want %llu elements of %u bytes)", type,
+                 name ? name : "", sec ? "of the wrong size" : "missing", (unsigned long long)count, elem);
+        return RAD_ERROR_CORRUPT;
+    }
+    *dst = rad__alloc_array(&c->allocator, count ? (size_t)count : 1u, elem);
+    if (!*dst) return RAD_ERROR_OUT_OF_MEMORY;
+    if (count) memcpy(*dst, sec->data, (size_t)count * elem);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_bad(const rad__ctx *c, const char *what, uint64_t at)
+{
+    rad__log(c, RAD_LOG_ERROR, "rad_vp_load: %s (entry %llu)", what, (unsigned long long)at);
+    return RAD_ERROR_CORRUPT;
+}
+
+/* the checks of rad_vp_load after every array is copied */
+static rad_result rad__vp_validate(const rad__ctx *c, const rad_virtual_patches *vp)
+{
+    uint32_t N = vp->count, V = vp->voxel_count, M = vp->sample_count, i, a;
+    double cells = (double)vp->dims[0] * (double)vp->dims[1] * (double)vp->dims[2];
+    rad_result r;
+    if ((r = rad__check_values(c, "virtual patches: albedo", vp->albedo, 3 * (uint64_t)N, 1)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: normals", vp->normals, 3 * (uint64_t)N, 0)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample positions", vp->sample_positions, 3 * (uint64_t)M, 0)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample normals", vp->sample_normals, 3 * (uint64_t)M, 0)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample albedo", vp->sample_albedo, 3 * (uint64_t)M, 1)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample areas", vp->sample_areas, M, 1)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample weights", vp->sample_weights, 6 * (uint64_t)M, 1)) != RAD_SUCCESS)
+        return r;
+    for (i = 0; i < N; ++i) {
+        if (!rad__finite(vp->areas[i]) || !(vp->areas[i] > 0.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "rad_vp_load: patch %u has area %g (must be finite and > 0)", i, (double)vp->areas[i]);
+            return rad__finite(vp->areas[i]) ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE;
+        }
+        for (a = 0; a < 3; ++a)
+            if (!(vp->albedo[3 * (size_t)i + a] < 1.0f)) return rad__vp_bad(c, "a patch albedo is not below 1", i);
+        if (vp->axis[i] > 5) return rad__vp_bad(c, "a patch axis is beyond 5", i);
+        if (vp->voxel[i] >= V || i < vp->voxel_first[vp->voxel[i]] || i >= vp->voxel_first[vp->voxel[i] + 1])
+            return rad__vp_bad(c, "a patch lies outside its voxel's patch range", i);
+    }
+    if (vp->voxel_first[0] != 0 || vp->voxel_first[V] != N || vp->sample_first[0] != 0 || vp->sample_first[V] != M)
+        return rad__vp_bad(c, "voxel_first or sample_first does not run from 0 to the patch or sample count", 0);
+    for (i = 0; i < V; ++i) {
+        if (vp->voxel_first[i + 1] < vp->voxel_first[i] || vp->sample_first[i + 1] < vp->sample_first[i])
+            return rad__vp_bad(c, "voxel_first or sample_first decreases", i);
+        if ((double)vp->voxel_keys[i] >= cells || (i > 0 && vp->voxel_keys[i] <= vp->voxel_keys[i - 1]))
+            return rad__vp_bad(c, "the voxel keys are not ascending inside the grid", i);
+        for (a = 0; a < 6; ++a) {
+            uint32_t p = vp->voxel_patch[6 * (size_t)i + a];
+            if (p != RAD_NONE && (p >= N || vp->voxel[p] != i)) return rad__vp_bad(c, "voxel_patch names a patch of another voxel", i);
+        }
+    }
+    for (i = 0; i < 3; ++i)
+        if (!rad__finite(vp->origin[i]) || !rad__finite(vp->voxel_size[i]) || !(vp->voxel_size[i] > 0.0f) || vp->dims[i] == 0)
+            return rad__vp_bad(c, "the grid (origin, voxel size, dims) is not finite and positive", i);
+    if (vp->scene)
+        for (i = 0; i < M; ++i)
+            if (vp->sample_triangles[i] >= vp->scene->triangle_count) {
+                rad__log(c, RAD_LOG_ERROR, "rad_vp_load: sample %u lies on triangle %u, the scene has %u", i,
+                         vp->sample_triangles[i], vp->scene->triangle_count);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+    if (vp->matrix.storage == RAD_STORAGE_SPARSE) {
+        if ((r = rad__check_matrix(&vp->matrix, c)) != RAD_SUCCESS) return r;
+        return rad__check_values(c, "virtual patches: form factors", vp->matrix.values, vp->matrix.row_offsets[N], 1);
+    }
+    return rad__check_values(c, "virtual patches: form factors", vp->matrix.dense, (uint64_t)N * N, 1);
+}
+
+RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const rad_scene *scene, const rad_context *ctx,
+                               rad_virtual_patches **out)
+{
+    rad__ctx c;
+    rad_virtual_patches *vp;
+    const rad_section *si;
+    uint32_t info[16], N, V, M, k;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!ct || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    si = rad_container_find(ct, RAD_SECTION_VP_INFO, name);
+    if (!si) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_load: the container holds no virtual patches named '%s'", name ? name : "");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (si->elem_size != 4 || si->count != 16) return rad__vp_bad(&c, "the VP_INFO section is not 16 uint32", 0);
+    memcpy(info, si->data, sizeof info);
+    N = info[2], V = info[3], M = info[4];
+    if (info[0] > 1u || info[1] > 1u || N == 0 || V == 0 || M == 0 || N > 6u * (uint64_t)V || info[15] != 0)
+        return rad__vp_bad(&c, "VP_INFO: unknown kind or weights, or counts out of range", 0);
+    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(vp, 0, sizeof(*vp));
+    vp->allocator = c.allocator;
+    vp->scene = scene;
+    vp->kind = (rad_vp_kind)info[0];
+    vp->weights = (rad_vp_weights)info[1];
+    vp->count = N, vp->voxel_count = V, vp->sample_count = M;
+    for (k = 0; k < 3; ++k) {
+        vp->dims[k] = info[5 + k];
+        memcpy(&vp->origin[k], &info[8 + k], 4);
+        memcpy(&vp->voxel_size[k], &info[11 + k], 4);
+    }
+    vp->candidate_voxels = info[14];
+    memcpy(vp->info_record, info, sizeof info);
+#define RAD__VP_TAKE(type, elem, count, field)                                                          \
+    if (r == RAD_SUCCESS) {                                                                            \
+        void *p_;                                                                                      \
+        r = rad__vp_take(&c, ct, name, type, elem, count, &p_);                                        \
+        vp->field = p_;                                                                                \
+    }
+    RAD__VP_TAKE(RAD_SECTION_VP_AREAS, 4, N, areas)
+    RAD__VP_TAKE(RAD_SECTION_VP_ALBEDO, 12, N, albedo)
+    RAD__VP_TAKE(RAD_SECTION_VP_NORMALS, 12, N, normals)
+    RAD__VP_TAKE(RAD_SECTION_VP_AXIS, 1, N, axis)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL, 4, N, voxel)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles)
+#undef RAD__VP_TAKE
+    vp->matrix.rows = vp->matrix.cols = N;
+    if (r == RAD_SUCCESS && rad_container_find(ct, RAD_SECTION_FF_ROW_OFFSETS, name)) {
+        void *po = NULL, *pc = NULL, *pv = NULL;
+        vp->matrix.storage = RAD_STORAGE_SPARSE;
+        r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_ROW_OFFSETS, 8, (uint64_t)N + 1u, &po);
+        vp->matrix.row_offsets = (const uint64_t *)po;
+        if (r == RAD_SUCCESS) {
+            const rad_section *sc = rad_container_find(ct, RAD_SECTION_FF_COLUMNS, name);
+            uint64_t nnz = vp->matrix.row_offsets[N];
+            if (!sc || sc->count != nnz) r = rad__vp_bad(&c, "the CSR columns do not match the row offsets", nnz);
+            if (r == RAD_SUCCESS) r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_COLUMNS, 4, nnz, &pc);
+            vp->matrix.columns = (const uint32_t *)pc;
+            if (r == RAD_SUCCESS) r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_VALUES, 4, nnz, &pv);
+            vp->matrix.values = (const float *)pv;
+        }
+    } else if (r == RAD_SUCCESS) {
+        void *pd = NULL;
+        vp->matrix.storage = RAD_STORAGE_DENSE;
+        size_t bytes;
+        if (!rad__mul3(N, N, sizeof(float), &bytes)) r = RAD_ERROR_SIZE_OVERFLOW;
+        else r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_DENSE, 4, (uint64_t)N * N, &pd);
+        vp->matrix.dense = (const float *)pd;
+    }
+    if (r == RAD_SUCCESS) r = rad__vp_validate(&c, vp);
+    if (r != RAD_SUCCESS) {
+        rad_vp_destroy(vp);
+        return r;
+    }
+    *out = vp;
+    return RAD_SUCCESS;
 }
 
 #endif /* RADIOSITY_IMPLEMENTATION */
