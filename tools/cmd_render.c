@@ -695,9 +695,84 @@ done:
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
-static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                            const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
-                            uint32_t aa, uint32_t light_samples, rad_image *img)
+/* --bake FILE with --method aavp|vp or --proxy: the set saved by rad bake --method aavp|vp
+   (rad_vp_load, checked against the scene's signature and the kind asked for) and its E into
+   *E_out; NULL with the error printed */
+static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, const rad_tool_world *w, int clustered,
+                                         float **E_out)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned char *buf = NULL;
+    long size = -1;
+    rad_container *ct = NULL;
+    rad_virtual_patches *vp = NULL;
+    const rad_section *se, *sg;
+    rad_context ctx;
+    rad_result r;
+    uint64_t geometry = 0, materials = 0;
+    *E_out = NULL;
+    if (f && fseek(f, 0, SEEK_END) == 0) size = ftell(f);
+    if (size > 0 && fseek(f, 0, SEEK_SET) == 0) {
+        buf = (unsigned char *)xmalloc((size_t)size);
+        if (fread(buf, 1, (size_t)size, f) != (size_t)size) size = -1;
+    }
+    if (f) fclose(f);
+    if (size <= 0) {
+        fprintf(stderr, "rad %s: cannot read bake '%s'\n", cmd, path);
+        free(buf);
+        return NULL;
+    }
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_container_open(buf, (size_t)size, &ctx, &ct)) != RAD_SUCCESS ||
+        (r = rad_vp_load(ct, "vp", w->scene, &ctx, &vp)) != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bake '%s' holds no virtual patches (bake them with --method aavp|vp): %s\n", cmd, path,
+                rad_result_string(r));
+        goto fail;
+    }
+    sg = rad_container_find(ct, RAD_SECTION_SIGNATURE, NULL);
+    if ((r = rad_scene_hash(w->scene, &geometry, &materials)) != RAD_SUCCESS || !sg || sg->elem_size != sizeof(rad_bake_signature) ||
+        memcmp(sg->data, &geometry, 8) || memcmp((const unsigned char *)sg->data + 8, &materials, 8)) {
+        fprintf(stderr, "rad %s: bake '%s' was not made from this scene (its signature differs)\n", cmd, path);
+        goto fail;
+    }
+    if ((vp->kind == RAD_VP_CLUSTERED) != (clustered != 0)) {
+        fprintf(stderr, "rad %s: bake '%s' holds %s virtual patches, not %s\n", cmd, path,
+                vp->kind == RAD_VP_CLUSTERED ? "vp" : "aavp", clustered ? "vp" : "aavp");
+        goto fail;
+    }
+    se = rad_container_find(ct, RAD_SECTION_VECTOR, "E");
+    if (!se || se->elem_size != 12 || se->count != vp->count) {
+        fprintf(stderr, "rad %s: bake '%s' holds no source vector E for its %u patches\n", cmd, path, vp->count);
+        goto fail;
+    }
+    *E_out = (float *)xmalloc(sizeof(float) * 3 * (size_t)vp->count);
+    memcpy(*E_out, se->data, sizeof(float) * 3 * (size_t)vp->count);
+    {
+        uint32_t i;
+        for (i = 0; i < 3 * vp->count; ++i)
+            if (!((*E_out)[i] >= 0.0f && (*E_out)[i] <= RAD_BAKE_VALUE_MAX)) {
+                fprintf(stderr, "rad %s: bake '%s': E entry %u is %g (not in [0, 1e30])\n", cmd, path, i, (double)(*E_out)[i]);
+                free(*E_out);
+                *E_out = NULL;
+                goto fail;
+            }
+    }
+    rad_container_close(ct);
+    free(buf);
+    fprintf(stderr, "rad %s: loaded %u virtual patches (%llu non-zeros) from '%s'\n", cmd, vp->count,
+            vp->matrix.storage == RAD_STORAGE_SPARSE ? (unsigned long long)vp->matrix.row_offsets[vp->count]
+                                                     : (unsigned long long)vp->count * vp->count, path);
+    return vp;
+fail:
+    rad_vp_destroy(vp);
+    rad_container_close(ct);
+    free(buf);
+    return NULL;
+}
+
+static int render_vp_method(const char *cmd, const rad_tool_world *w, const char *bake_path,
+                            const rad_tool_classic_options *o, const rad_tool_method_options *mo, const rad_camera *cam,
+                            int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
 {
     rad_virtual_patches *vp = NULL;
     rad_direct_options dopt;
@@ -710,7 +785,14 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     uint32_t n, i, res = mo->vp_resolution, builds = 0;
     double t0 = rad_tool_seconds(), t_build, t_E, t_solve, t_step = 0.0;
     int rc = 0;
-    if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
+    if (bake_path) {
+        if (mo->given & RAD_TOOL_OPT_VP) {
+            fprintf(stderr, "rad %s: --vp-resolution, --vp-max-patches and --face-points are the bake's with --bake\n", cmd);
+            return 1;
+        }
+        if (!(vp = vp_load_bake(cmd, bake_path, w, mo->method == RAD_TOOL_VP || mo->proxy == RAD_TOOL_PROXY_VP, &E)))
+            return 1;
+    } else if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
         /* the patch count grows about as R^2 (surface voxels): predict, build, correct */
         uint32_t best_res = 0, lo = 1, hi = 1025;
         rad_virtual_patches *best = NULL;
@@ -750,7 +832,7 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     }
     t_build = rad_tool_seconds() - t0;
     n = vp->count;
-    E = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    if (!E) E = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
@@ -759,7 +841,8 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     dopt.light_samples = o->light_samples;
     rad_tool_context(&ctx, "direct light");
     t0 = rad_tool_seconds();
-    r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
+    r = bake_path ? RAD_SUCCESS /* the bake's E */
+                  : rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
     rad_tool_progress_end();
     t_E = rad_tool_seconds() - t0;
     if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "rad_vp_sources", r);
@@ -992,7 +1075,7 @@ int rad_cmd_render(int argc, char **argv)
         fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
-    if ((mo.method >= RAD_TOOL_LOCAL || mo.proxy) && bake_path) {
+    if (mo.method == RAD_TOOL_LOCAL && !mo.proxy && bake_path) {
         fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd, method);
         return 2;
     }
@@ -1043,7 +1126,7 @@ int rad_cmd_render(int argc, char **argv)
     if (mo.method >= RAD_TOOL_LOCAL || mo.proxy) {
         rc = mo.method == RAD_TOOL_LOCAL && !mo.proxy
                  ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
-                 : render_vp_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
+                 : render_vp_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
         if (rc) {
             rad_image_free(&img);
             rad_tool_close_world(&w);

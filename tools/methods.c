@@ -367,11 +367,13 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
         fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & RAD_TOOL_OPT_RENDER_ONLY));
         return 2;
     }
-    if (!render && mo->method >= RAD_TOOL_LOCAL) {
-        fprintf(stderr, "rad %s: method '%s' is render-only (rad render --method %s builds it in memory: %s)\n", cmd,
-                rad_tool_method_name(mo->method), rad_tool_method_name(mo->method),
-                mo->method == RAD_TOOL_LOCAL ? "its matrix depends on the camera; a classic bake holds its F"
-                                             : "the container has no section for virtual patches yet");
+    if (!render && mo->method == RAD_TOOL_LOCAL) {
+        fprintf(stderr, "rad %s: method 'local' is render-only (rad render --method local builds it in memory: "
+                "its matrix depends on the camera; a classic bake holds its F)\n", cmd);
+        return 2;
+    }
+    if (!render && mo->method >= RAD_TOOL_VP && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
+        fprintf(stderr, "rad %s: --vp-max-patches is an option of rad render (bake with --vp-resolution)\n", cmd);
         return 2;
     }
     if (mo->method >= RAD_TOOL_LOCAL) {
