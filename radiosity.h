@@ -15135,27 +15135,27 @@ RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const 
     }
     vp->candidate_voxels = info[14];
     memcpy(vp->info_record, info, sizeof info);
-#define RAD__VP_TAKE(type, elem, count, field)                                                          \
+#define RAD__VP_TAKE(type, elem, count, field, ctype)                                                   \
     if (r == RAD_SUCCESS) {                                                                            \
         void *p_;                                                                                      \
         r = rad__vp_take(&c, ct, name, type, elem, count, &p_);                                        \
-        vp->field = p_;                                                                                \
+        vp->field = (ctype *)p_;                                                                       \
     }
-    RAD__VP_TAKE(RAD_SECTION_VP_AREAS, 4, N, areas)
-    RAD__VP_TAKE(RAD_SECTION_VP_ALBEDO, 12, N, albedo)
-    RAD__VP_TAKE(RAD_SECTION_VP_NORMALS, 12, N, normals)
-    RAD__VP_TAKE(RAD_SECTION_VP_AXIS, 1, N, axis)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL, 4, N, voxel)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles)
+    RAD__VP_TAKE(RAD_SECTION_VP_AREAS, 4, N, areas, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_ALBEDO, 12, N, albedo, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_NORMALS, 12, N, normals, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_AXIS, 1, N, axis, uint8_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL, 4, N, voxel, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys, uint64_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles, uint32_t)
 #undef RAD__VP_TAKE
     vp->matrix.rows = vp->matrix.cols = N;
     if (r == RAD_SUCCESS && rad_container_find(ct, RAD_SECTION_FF_ROW_OFFSETS, name)) {
