@@ -2110,6 +2110,19 @@ RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format
 RAD_API rad_result rad_alias_tables_create_dense(const float *plane, uint32_t n, rad_alias_format format,
                                                  const rad_context *ctx, rad_alias_tables **out);
 
+/* Tables for every row of a rad_row_source (>>api_local): rows fetched one at a time, from
+   memory or streamed from a file (rad_row_stream_open, also over a saved virtual-patch set), so
+   the matrix is never held whole: memory is the tables' O(nnz) plus one row. Each row is read
+   twice (a pass that counts the bins, then the build); a row whose columns do not ascend is
+   sorted first, so the bins equal those of rad_alias_tables_create on the same matrix, bit for
+   bit. Fetches run on the calling thread (a stream needs no lock), the builds too.
+   Errors: INVALID_ARGUMENT (NULL, a source without fetch, N = 0, compact with N > 65535, a
+   negative or non-finite entry, a column >= N or twice in a row: the logger names it), the
+   fetch's own errors, SIZE_OVERFLOW, OUT_OF_MEMORY, CANCELLED (progress). Cost: O(nnz log)
+   plus two reads of every row. docs/methods/temporal.md. */
+RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *source, rad_alias_format format,
+                                                const rad_context *ctx, rad_alias_tables **out);
+
 RAD_API void rad_alias_tables_destroy(rad_alias_tables *tables);
 
 /* Bytes the tables' bins, offsets and totals take. */
@@ -12881,6 +12894,143 @@ RAD_API rad_result rad_alias_tables_create_dense(const float *plane, uint32_t n,
     if (out) *out = NULL;
     if (!plane) return RAD_ERROR_INVALID_ARGUMENT;
     return rad__alias_build(NULL, plane, n, format, ctx, out);
+}
+
+/* sorts a fetched row by column (shell sort on the pairs; fetched rows are short and mostly
+   ascending already) and refuses a column that repeats */
+static int rad__alias_sort_row(uint32_t *cols, float *vals, uint32_t count)
+{
+    static const uint32_t gaps[] = { 1750u, 701u, 301u, 132u, 57u, 23u, 10u, 4u, 1u };
+    uint32_t g, i, k;
+    for (i = 1; i < count && cols[i - 1] < cols[i]; ++i) {}
+    if (i >= count) return 1;
+    for (g = 0; g < sizeof(gaps) / sizeof(gaps[0]); ++g) {
+        uint32_t h = gaps[g];
+        for (i = h; i < count; ++i) {
+            uint32_t c = cols[i];
+            float v = vals[i];
+            for (k = i; k >= h && cols[k - h] > c; k -= h) cols[k] = cols[k - h], vals[k] = vals[k - h];
+            cols[k] = c, vals[k] = v;
+        }
+    }
+    for (i = 1; i < count; ++i)
+        if (cols[i] == cols[i - 1]) return 0;
+    return 1;
+}
+
+RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *src, rad_alias_format format, const rad_context *ctx,
+                                                rad_alias_tables **out)
+{
+    rad__ctx c;
+    rad_alias_tables *t = NULL;
+    rad_result r = RAD_SUCCESS;
+    uint64_t *off = NULL, sum = 0;
+    uint32_t *cols = NULL, n, i, count, nb, pass;
+    float *vals = NULL;
+    void *scratch = NULL;
+    unsigned char *base = NULL;
+    size_t off_bytes, tot_bytes, bin_bytes, tot_off, bins_off, total;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!src || !out || !src->fetch || src->n == 0 || src->n == 0xFFFFFFFFu) return RAD_ERROR_INVALID_ARGUMENT;
+    n = src->n;
+    format = rad__alias_resolve(format, n);
+    if ((format != RAD_ALIAS_COMPACT && format != RAD_ALIAS_WIDE) || (format == RAD_ALIAS_COMPACT && n > 65535u)) {
+        rad__log(&c, RAD_LOG_ERROR, "alias tables: bad format for N = %u (compact needs N <= 65535)", n);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    off = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)n + 1u, sizeof(uint64_t));
+    cols = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    vals = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
+    scratch = rad__alloc(&c.allocator, rad_alias_row_scratch_size(n));
+    if (!off || !cols || !vals || !scratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    off[0] = 0;
+    for (pass = 1; pass <= 2 && r == RAD_SUCCESS; ++pass) {
+        if (pass == 2) {
+            /* one block as rad_alias_tables_create's: offsets | totals | bins */
+            if (!rad__mul((size_t)n + 1u, sizeof(uint64_t), &off_bytes) || !rad__mul((size_t)n, sizeof(float), &tot_bytes) ||
+                sum > (uint64_t)((size_t)-1) || !rad__mul3((size_t)sum, (size_t)format, sizeof(uint32_t), &bin_bytes)) {
+                r = RAD_ERROR_SIZE_OVERFLOW;
+                break;
+            }
+            tot_off = off_bytes;
+            bins_off = tot_off + ((tot_bytes + 7u) & ~(size_t)7u);
+            total = bins_off + bin_bytes;
+            if (total < bin_bytes) { r = RAD_ERROR_SIZE_OVERFLOW; break; }
+            t = (rad_alias_tables *)rad__alloc(&c.allocator, sizeof(rad_alias_tables));
+            if (!t) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
+            memset(t, 0, sizeof(*t));
+            t->allocator = c.allocator;
+            base = rad__alias_alloc(&c.allocator, total, &t->storage);
+            if (!base) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
+            memcpy(base, off, off_bytes);
+            t->row_offsets = (const uint64_t *)(void *)base;
+            t->totals = (const float *)(void *)(base + tot_off);
+            t->bins = (const uint32_t *)(void *)(base + bins_off);
+            sum = 0;
+        }
+        for (i = 0; i < n; ++i) {
+            count = 0;
+            if ((r = src->fetch(src->user, i, n, cols, vals, &count)) != RAD_SUCCESS) {
+                rad__log(&c, RAD_LOG_ERROR, "alias tables: fetching row %u failed: %s", i, rad_result_string(r));
+                break;
+            }
+            if (count > n || !rad__alias_sort_row(cols, vals, count)) {
+                rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u has %u entries or a column twice (N = %u)", i, count, n);
+                r = RAD_ERROR_INVALID_ARGUMENT;
+                break;
+            }
+            if (pass == 1) {
+                double W = 0.0;
+                uint32_t k;
+                nb = 0;
+                for (k = 0; k < count; ++k) {
+                    if (!rad__finite(vals[k]) || vals[k] < 0.0f || cols[k] >= n) {
+                        rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u entry %u (column %u) is %g: entries must be finite, "
+                                 ">= 0, column < %u", i, k, cols[k], (double)vals[k], n);
+                        r = RAD_ERROR_INVALID_ARGUMENT;
+                        break;
+                    }
+                    if (vals[k] > 0.0f) { ++nb; W += (double)vals[k]; }
+                }
+                if (r != RAD_SUCCESS) break;
+                if (1.0 - W > 0.0) ++nb;
+                sum += nb;
+                off[i + 1] = sum;
+            } else {
+                float tot;
+                r = rad__alias_row(cols, vals, count, n, format, (uint32_t *)(void *)(base + bins_off) + (size_t)off[i] * (uint32_t)format,
+                                   &nb, &tot, scratch, &c, i);
+                if (r != RAD_SUCCESS) break;
+                if (nb != off[i + 1] - off[i]) {
+                    rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u changed between its two reads", i);
+                    r = RAD_ERROR_CORRUPT;
+                    break;
+                }
+                ((float *)(void *)(base + tot_off))[i] = tot;
+                sum += count;
+            }
+            if (c.progress && (i & 255u) == 255u &&
+                c.progress(c.progress_user, 0.5f * (float)(pass - 1) + 0.5f * (float)(i + 1) / (float)n)) {
+                r = RAD_ERROR_CANCELLED;
+                break;
+            }
+        }
+    }
+    if (r == RAD_SUCCESS) {
+        t->rows = t->cols = n;
+        t->format = format;
+        t->source_entries = sum;
+        *out = t;
+        t = NULL;
+    }
+done:
+    rad_alias_tables_destroy(t);
+    rad__free(&c.allocator, off);
+    rad__free(&c.allocator, cols);
+    rad__free(&c.allocator, vals);
+    rad__free(&c.allocator, scratch);
+    return r;
 }
 
 RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section out[3])

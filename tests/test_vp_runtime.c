@@ -289,9 +289,27 @@ out:
     rad_scene_destroy(scene);
 }
 
+/* a row source that returns the rows of another one in descending column order */
+static const rad_row_source *vpr_reverse_src;
+static rad_result vpr_fetch_reversed(void *user, uint32_t row, uint32_t capacity, uint32_t *cols, float *vals, uint32_t *count)
+{
+    rad_result r = vpr_reverse_src->fetch(vpr_reverse_src->user, row, capacity, cols, vals, count);
+    uint32_t i;
+    (void)user;
+    for (i = 0; r == RAD_SUCCESS && i < *count / 2; ++i) {
+        uint32_t c = cols[i];
+        float v = vals[i];
+        cols[i] = cols[*count - 1 - i], vals[i] = vals[*count - 1 - i];
+        cols[*count - 1 - i] = c, vals[*count - 1 - i] = v;
+    }
+    return r;
+}
+
 /* rows streamed from a saved set's file, one alias table built per fetched row, give the bins
-   and totals of the tables of the in-memory CSR matrix, bit for bit; the local matrix over the
-   streamed rows equals the one over the in-memory rows */
+   and totals of the tables of the in-memory CSR matrix, bit for bit, and so do the whole
+   tables of rad_alias_tables_create_rows (also from rows returned out of order) and the
+   temporal steps on them; the local matrix over the streamed rows equals the one over the
+   in-memory rows */
 static void vpr_test_streamed_rows(void)
 {
     static vp_scene s;
@@ -338,6 +356,46 @@ static void vpr_test_streamed_rows(void)
             ++bad;
     }
     CHECK(bad == 0);
+    /* the whole tables from the stream (and from a source that returns rows backwards), and
+       temporal steps on them: the same bits as from the in-memory matrix */
+    {
+        rad_alias_tables *ts = NULL, *tr = NULL;
+        rad_row_source rev = src;
+        vpr_reverse_src = &src;
+        rev.fetch = vpr_fetch_reversed;
+        rev.user = NULL;
+        CHECK_OK(rad_alias_tables_create_rows(&src, RAD_ALIAS_AUTO, NULL, &ts));
+        CHECK_OK(rad_alias_tables_create_rows(&rev, RAD_ALIAS_AUTO, NULL, &tr));
+        if (ts && tr) {
+            uint64_t nbins = at->row_offsets[N];
+            CHECK(ts->format == at->format && ts->source_entries == at->source_entries);
+            CHECK(!memcmp(ts->row_offsets, at->row_offsets, 8 * (size_t)(N + 1)) && !memcmp(ts->totals, at->totals, 4 * (size_t)N) &&
+                  !memcmp(ts->bins, at->bins, 4 * (size_t)words * nbins));
+            CHECK(!memcmp(tr->row_offsets, at->row_offsets, 8 * (size_t)(N + 1)) && !memcmp(tr->bins, at->bins, 4 * (size_t)words * nbins));
+            {
+                const rad_alias_tables *t1[1], *t2[1];
+                rad_temporal *p1 = NULL, *p2 = NULL;
+                rad_temporal_options to;
+                float *E = (float *)calloc(3 * (size_t)N, sizeof(float));
+                uint32_t fr;
+                t1[0] = at, t2[0] = ts;
+                rad_temporal_options_default(&to);
+                CHECK_OK(rad_temporal_create(t1, 1, vp->albedo, &to, NULL, &p1));
+                CHECK_OK(rad_temporal_create(t2, 1, vp->albedo, &to, NULL, &p2));
+                for (i = 0; E && i < 3 * N; i += 7) E[i] = 1.0f + (float)(i % 5);
+                for (fr = 0; E && p1 && p2 && fr < 4; ++fr) {
+                    CHECK_OK(rad_temporal_step(p1, E, NULL, NULL));
+                    CHECK_OK(rad_temporal_step(p2, E, NULL, NULL));
+                }
+                if (E && p1 && p2) CHECK(!memcmp(rad_temporal_indirect(p1), rad_temporal_indirect(p2), 12 * (size_t)N));
+                rad_temporal_destroy(p1);
+                rad_temporal_destroy(p2);
+                free(E);
+            }
+        }
+        rad_alias_tables_destroy(ts);
+        rad_alias_tables_destroy(tr);
+    }
     /* the local matrix over 32 patches: streamed and in-memory rows, the same T */
     CHECK_OK(rad_row_source_matrix(&vp->matrix, vp->areas, vp->albedo, &mem));
     rad_local_options_default(&lo);
