@@ -2316,9 +2316,13 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    SPARSE ROWS (storage = RAD_STORAGE_SPARSE): after step 6 the matrix is kept as CSR with the
    entries F_ab <= drop_threshold left out (exact zeros always: pairs of voxels that see each
    other not at all), and the dense build matrix is freed, so the object holds O(nnz), not
-   N^2: 8 bytes per kept entry (column and value) and 8 per row. The build itself still
-   holds the N x N float matrix while it runs (the peak of MEMORY above, plus 8 bytes per kept
-   entry during the copy). Dropping entries lowers the row sums by the dropped mass (the
+   N^2: 8 bytes per kept entry (column and value) and 8 per row. The build never holds the
+   N x N matrix either: step 5 runs over chunks of row voxels whose float rows fit
+   RAD_VP_ROW_CHUNK_BYTES (32 MiB unless defined otherwise before the implementation; at least
+   one voxel's rows), keeps each chunk's non-zeros (the upper parts, columns from the row
+   voxel on) as CSR, then mirrors them into full rows and applies step 6 and the threshold on
+   the non-zeros: peak about that chunk plus 12 bytes per non-zero (upper parts and full rows
+   together) besides the rest of MEMORY above. The values are the dense build's, bit for bit. Dropping entries lowers the row sums by the dropped mass (the
    environment entry of temporal radiosity picks it up as unreached light); reciprocity holds
    for every pair where both entries are kept. Every run-time method takes vp->matrix as it
    is (CSR or dense): rad_solve_*, rad_matrix_multiply, rad_multibounce_create,
@@ -13753,6 +13757,13 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
 /* >>vp: virtual patches (voxels, face-ray samples, axis-aligned patches, gathering)       */
 /* ======================================================================================== */
 
+/* SPARSE ROWS: the most bytes of float rows the build holds at once (one voxel's rows when
+   that is more). Define it before the implementation to change the peak memory; no result
+   depends on it. */
+#ifndef RAD_VP_ROW_CHUNK_BYTES
+#define RAD_VP_ROW_CHUNK_BYTES (32u << 20)
+#endif
+
 #define RAD__VP_MARGIN 0.4827f           /* voxels of padding around the scene bounds */
 #define RAD__VP_CHUNK_RAYS (1u << 21)     /* face-ray hits kept at once */
 #define RAD__VP_PAIRS 16384u              /* pair records per task for sampled visibility */
@@ -13870,7 +13881,8 @@ typedef struct rad__vp_build {
     uint8_t *slot, *ncl;         /* per sample: cluster slot; per voxel: cluster count */
     struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
     uint64_t *rays_cast;         /* per task */
-    float *P;                    /* N x N */
+    float *P;                    /* N x N, or (sparse rows) the rows of a chunk of voxels */
+    uint32_t voxel_base, p_base; /* sparse rows: the chunk's first voxel and first patch */
 } rad__vp_build;
 
 static void rad__vp_cell(const rad_virtual_patches *vp, uint64_t key, uint32_t *c)
@@ -14010,7 +14022,7 @@ static rad_result rad__vp_ff_row(void *data, uint32_t u, uint32_t task)
     for (a = 0; a < 6; ++a) {
         uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
         if (p == RAD_NONE) continue;
-        for (c = pf; c < N; ++c) b->P[(size_t)p * N + c] = (float)acc[(size_t)a * N + c];
+        for (c = pf; c < N; ++c) b->P[(size_t)(p - b->p_base) * N + c] = (float)acc[(size_t)a * N + c];
     }
     return RAD_SUCCESS;
 }
@@ -14155,7 +14167,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
     for (a = 0; a < 6; ++a) {
         uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
         if (p == RAD_NONE) continue;
-        for (c = pf; c < N; ++c) b->P[(size_t)p * N + c] = (float)acc[(size_t)a * N + c];
+        for (c = pf; c < N; ++c) b->P[(size_t)(p - b->p_base) * N + c] = (float)acc[(size_t)a * N + c];
     }
     return RAD_SUCCESS;
 }
@@ -14196,35 +14208,165 @@ static rad_result rad__vp_divide_row(void *data, uint32_t p, uint32_t task)
     return RAD_SUCCESS;
 }
 
-/* SPARSE ROWS: the finished dense matrix to CSR (entries > threshold), then the dense freed */
-static rad_result rad__vp_to_csr(rad_virtual_patches *vp, float threshold, const rad_allocator *A)
+/* SPARSE ROWS: row voxel voxel_base + row of the current chunk */
+static rad_result rad__vp_ff_chunk(void *data, uint32_t row, uint32_t task)
 {
-    uint32_t N = vp->count, p, c;
-    const float *D = vp->matrix.dense;
-    uint64_t *off = (uint64_t *)rad__alloc_array(A, (size_t)N + 1u, sizeof(uint64_t)), k = 0;
-    uint32_t *col;
-    float *val;
-    if (!off) return RAD_ERROR_OUT_OF_MEMORY;
-    for (p = 0; p < N; ++p) {
-        off[p] = k;
-        for (c = 0; c < N; ++c) k += D[(size_t)p * N + c] > threshold && D[(size_t)p * N + c] > 0.0f;
+    rad__vp_build *b = (rad__vp_build *)data;
+    return b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled(data, b->voxel_base + row, task)
+                                    : rad__vp_ff_row(data, b->voxel_base + row, task);
+}
+
+/* grows a CSR pair of arrays (columns, values) to hold 'need' entries */
+static int rad__vp_grow_csr(const rad_allocator *A, uint32_t **col, float **val, uint64_t *cap, uint64_t need)
+{
+    uint64_t nc = *cap ? *cap : 4096u;
+    uint32_t *c2;
+    float *v2;
+    if (need <= *cap) return 1;
+    while (nc < need) nc *= 2u;
+    if (nc > (uint64_t)((size_t)-1 / 4u)) return 0;
+    c2 = (uint32_t *)rad__alloc_array(A, (size_t)nc, sizeof(uint32_t));
+    v2 = (float *)rad__alloc_array(A, (size_t)nc, sizeof(float));
+    if (!c2 || !v2) {
+        rad__free(A, c2);
+        rad__free(A, v2);
+        return 0;
     }
-    off[N] = k;
-    col = (uint32_t *)rad__alloc_array(A, k ? (size_t)k : 1u, sizeof(uint32_t));
-    val = (float *)rad__alloc_array(A, k ? (size_t)k : 1u, sizeof(float));
-    if (!col || !val) {
+    if (*cap) {
+        memcpy(c2, *col, (size_t)*cap * sizeof(uint32_t));
+        memcpy(v2, *val, (size_t)*cap * sizeof(float));
+    }
+    rad__free(A, *col);
+    rad__free(A, *val);
+    *col = c2, *val = v2, *cap = nc;
+    return 1;
+}
+
+/* SPARSE ROWS: step 5 over chunks of row voxels whose rows fit 'budget' bytes of b->P, each
+   chunk's upper parts (columns from the row voxel's first patch on) kept as CSR; then the
+   mirror, step 6 and the drop threshold on the CSR rows. The entries and their arithmetic are
+   those of the dense path, so the kept values are the same bits. */
+static rad_result rad__vp_sparse_rows(rad__vp_build *b, const rad__ctx *c, uint32_t T, size_t budget)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_allocator *A = &vp->allocator;
+    uint32_t N = vp->count, V = vp->voxel_count, v0, v1, p, *ucol = NULL, *col = NULL, *lcnt = NULL;
+    uint64_t *uoff = NULL, *off = NULL, *pos = NULL, ucap = 0, k = 0, e, kept = 0;
+    float *uval = NULL, *val = NULL;
+    rad__ctx quiet = *c;
+    rad_result r = RAD_SUCCESS;
+    quiet.progress = NULL;
+    uoff = (uint64_t *)rad__alloc_array(A, (size_t)N + 1u, sizeof(uint64_t));
+    if (!uoff) return RAD_ERROR_OUT_OF_MEMORY;
+    for (v0 = 0; v0 < V && r == RAD_SUCCESS; v0 = v1) {
+        for (v1 = v0 + 1; v1 < V && (size_t)(vp->voxel_first[v1 + 1] - vp->voxel_first[v0]) * N * sizeof(float) <= budget; ++v1) {}
+        b->voxel_base = v0;
+        b->p_base = vp->voxel_first[v0];
+        r = rad__for_rows(&quiet, v1 - v0, T, rad__vp_ff_chunk, b);
+        for (p = vp->voxel_first[v0]; p < vp->voxel_first[v1] && r == RAD_SUCCESS; ++p) {
+            const float *row = b->P + (size_t)(p - b->p_base) * N;
+            uint32_t cc;
+            uoff[p] = k;
+            for (cc = vp->voxel_first[vp->voxel[p]]; cc < N; ++cc)
+                if (row[cc] != 0.0f) {
+                    if (k == ucap && !rad__vp_grow_csr(A, &ucol, &uval, &ucap, k + 1)) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
+                    ucol[k] = cc, uval[k++] = row[cc];
+                }
+        }
+        if (r == RAD_SUCCESS && c->progress && c->progress(c->progress_user, 0.1f + 0.9f * (float)v1 / (float)V))
+            r = RAD_ERROR_CANCELLED;
+    }
+    uoff[N] = k;
+    rad__free(A, b->P);
+    b->P = NULL;
+    /* the mirror: row p's columns below its voxel are the upper entries (r, p) of earlier voxels */
+    if (r == RAD_SUCCESS) {
+        lcnt = (uint32_t *)rad__alloc_array(A, N, sizeof(uint32_t));
+        off = (uint64_t *)rad__alloc_array(A, (size_t)N + 1u, sizeof(uint64_t));
+        pos = (uint64_t *)rad__alloc_array(A, N, sizeof(uint64_t));
+        if (!lcnt || !off || !pos) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        uint64_t total = 0;
+        memset(lcnt, 0, sizeof(uint32_t) * N);
+        for (p = 0; p < N; ++p)
+            for (e = uoff[p]; e < uoff[p + 1]; ++e)
+                if (ucol[e] >= vp->voxel_first[vp->voxel[p] + 1]) lcnt[ucol[e]]++;
+        for (p = 0; p < N; ++p) {
+            off[p] = total;
+            pos[p] = total;
+            total += lcnt[p] + (uoff[p + 1] - uoff[p]);
+        }
+        off[N] = total;
+        col = (uint32_t *)rad__alloc_array(A, total ? (size_t)total : 1u, sizeof(uint32_t));
+        val = (float *)rad__alloc_array(A, total ? (size_t)total : 1u, sizeof(float));
+        if (!col || !val) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        for (p = 0; p < N; ++p)
+            for (e = uoff[p]; e < uoff[p + 1]; ++e)
+                if (ucol[e] >= vp->voxel_first[vp->voxel[p] + 1]) {
+                    uint64_t at = pos[ucol[e]]++;
+                    col[at] = p, val[at] = uval[e];
+                }
+        for (p = 0; p < N; ++p) {
+            memcpy(col + pos[p], ucol + uoff[p], sizeof(uint32_t) * (size_t)(uoff[p + 1] - uoff[p]));
+            memcpy(val + pos[p], uval + uoff[p], sizeof(float) * (size_t)(uoff[p + 1] - uoff[p]));
+        }
+        /* step 6 as rad__vp_rowsum_row and rad__vp_divide_row, on the non-zeros */
+        for (p = 0; p < N; ++p) {
+            double sum = 0.0;
+            for (e = off[p]; e < off[p + 1]; ++e) sum += (double)val[e];
+            sum /= (double)vp->areas[p];
+            b->rowf[p] = b->o.keep_row_sums ? 1.0f : sum > 1.0 ? (float)(1.0 / sum) : 1.0f;
+        }
+        for (p = 0; p < N; ++p) {
+            float cp = b->rowf[p];
+            double inv = 1.0 / (double)vp->areas[p];
+            for (e = off[p]; e < off[p + 1]; ++e)
+                val[e] = (float)((double)val[e] * (double)(cp < b->rowf[col[e]] ? cp : b->rowf[col[e]]) * inv);
+        }
+        r = rad__check_output(c, "virtual-patch form factors", val, (size_t)off[N]);
+    }
+    /* the drop threshold, in place; then arrays of the kept size */
+    if (r == RAD_SUCCESS) {
+        uint64_t begin = 0;
+        for (p = 0; p < N; ++p) {
+            uint64_t end = off[p + 1];
+            off[p] = kept;
+            for (e = begin; e < end; ++e)
+                if (val[e] > b->o.drop_threshold && val[e] > 0.0f) col[kept] = col[e], val[kept++] = val[e];
+            begin = end;
+        }
+        off[N] = kept;
+        {
+            uint32_t *c2 = (uint32_t *)rad__alloc_array(A, kept ? (size_t)kept : 1u, sizeof(uint32_t));
+            float *v2 = (float *)rad__alloc_array(A, kept ? (size_t)kept : 1u, sizeof(float));
+            if (!c2 || !v2) {
+                rad__free(A, c2);
+                rad__free(A, v2);
+                r = RAD_ERROR_OUT_OF_MEMORY;
+            } else {
+                memcpy(c2, col, sizeof(uint32_t) * (size_t)kept);
+                memcpy(v2, val, sizeof(float) * (size_t)kept);
+                rad__free(A, col);
+                rad__free(A, val);
+                col = c2, val = v2;
+            }
+        }
+    }
+    rad__free(A, uoff);
+    rad__free(A, ucol);
+    rad__free(A, uval);
+    rad__free(A, lcnt);
+    rad__free(A, pos);
+    if (r != RAD_SUCCESS) {
         rad__free(A, off);
         rad__free(A, col);
         rad__free(A, val);
-        return RAD_ERROR_OUT_OF_MEMORY;
+        return r;
     }
-    for (p = 0, k = 0; p < N; ++p)
-        for (c = 0; c < N; ++c) {
-            float x = D[(size_t)p * N + c];
-            if (x > threshold && x > 0.0f) col[k] = c, val[k++] = x;
-        }
-    rad__free(A, (void *)vp->matrix.dense);
-    vp->matrix.dense = NULL;
+    vp->matrix.rows = vp->matrix.cols = N;
     vp->matrix.storage = RAD_STORAGE_SPARSE;
     vp->matrix.row_offsets = off;
     vp->matrix.columns = col;
@@ -14734,13 +14876,25 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     b->cand = NULL;
     rad__free(A, cand_first);
     cand_first = NULL;
-    b->P = (float *)rad__alloc(A, bytes);
-    if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    vp->matrix.rows = vp->matrix.cols = N;
-    vp->matrix.storage = RAD_STORAGE_DENSE;
-    vp->matrix.dense = b->P; /* owned by vp from here on */
     {
         uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
+        /* sparse rows: the rows of a chunk of row voxels at a time (at least one voxel's six,
+           else at most RAD_VP_ROW_CHUNK_BYTES), never N x N */
+        size_t budget = (size_t)RAD_VP_ROW_CHUNK_BYTES;
+        if (b->o.storage == RAD_STORAGE_SPARSE) {
+            uint32_t most = 0;
+            for (v = 0; v < vp->voxel_count; ++v)
+                if (vp->voxel_first[v + 1] - vp->voxel_first[v] > most) most = vp->voxel_first[v + 1] - vp->voxel_first[v];
+            if (budget < (size_t)most * N * sizeof(float)) budget = (size_t)most * N * sizeof(float);
+            if (budget < bytes) bytes = budget;
+        }
+        b->P = (float *)rad__alloc(A, bytes);
+        if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+        if (b->o.storage != RAD_STORAGE_SPARSE) {
+            vp->matrix.rows = vp->matrix.cols = N;
+            vp->matrix.storage = RAD_STORAGE_DENSE;
+            vp->matrix.dense = b->P; /* owned by vp from here on */
+        }
         rad__ctx cc = *c;
         rad__vp_progress prog;
         prog.fn = c->progress;
@@ -14766,6 +14920,11 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         memset(b->rays_cast, 0, sizeof(uint64_t) * T);
         /* progress of this stage maps to [0.1, 1] */
         if (c->progress && c->progress(c->progress_user, 0.1f)) { r = RAD_ERROR_CANCELLED; goto done; }
+        if (b->o.storage == RAD_STORAGE_SPARSE) {
+            r = rad__vp_sparse_rows(b, c, T, budget);
+            for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+            goto done;
+        }
         r = rad__for_rows(&cc, vp->voxel_count, T, b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled : rad__vp_ff_row, b);
         for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
         if (r == RAD_SUCCESS) {
@@ -14777,9 +14936,9 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
             if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
         }
         if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
-        if (r == RAD_SUCCESS && b->o.storage == RAD_STORAGE_SPARSE) r = rad__vp_to_csr(vp, b->o.drop_threshold, A);
     }
 done:
+    if (b->o.storage == RAD_STORAGE_SPARSE) rad__free(A, b->P); /* the chunk buffer (NULL once used) */
     rad__free(A, cand);
     rad__free(A, cand_area);
     rad__free(A, voxel_cand);

@@ -3,6 +3,8 @@
    Environment: RAD_TEST_QUICK=1 smaller sizes; RAD_TEST_SHARD=i/n every n-th test from the
    i-th; RAD_TEST_SKIP=a,b leaves out the tests of those names; RAD_TEST_TIMES=1 CPU seconds per test; RAD_TEST_TMPDIR where scratch files go. */
 #define RADIOSITY_IMPLEMENTATION
+/* small chunks, so the sparse virtual-patch build's chunking is exercised (vp_sparse_rows) */
+#define RAD_VP_ROW_CHUNK_BYTES 65536u
 #include "../radiosity.h"
 #include "test.h"
 
