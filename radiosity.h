@@ -2299,7 +2299,8 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    v. When a voxel pair has at most that many pairs, every pair gets its ray and V_uv is the
    kernel-weighted mean. V_uv is shared by both directions, so reciprocity is unchanged. The
    pair list of one voxel pair is thinned systematically beyond 16384 entries.
-   MEMORY (peak, through ctx's allocator): the N x N float matrix, about 100 bytes per sample,
+   MEMORY (peak, through ctx's allocator): the N x N float matrix (sparse rows: see SPARSE
+   ROWS), about 100 bytes per sample,
    T x (6 N doubles + 1024 rays + 16384 12-byte pair records) of task scratch (T = the
    context's task count, at most the voxel count), 4 bytes per triangle, 16 bytes per
    triangle-voxel overlap and 64 per candidate voxel, the face-ray hits of a chunk of
