@@ -2,6 +2,7 @@
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
 #   make gallery every lighting model on rows of spheres, to gallery.png
 #   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
+#   make learn   builds the teaching examples examples/learn_*.c into build/
 #   make build/realtime  examples/realtime.c: per-frame light, E, temporal step and gather over AAVP
 #   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
@@ -24,7 +25,7 @@ EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
 
-.PHONY: all demo gallery walk moving-light test bench bench-quick tools fuzz clean glsl report report-quick
+.PHONY: all demo gallery walk learn moving-light test bench bench-quick tools fuzz clean glsl report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk $(BUILD)/realtime tools
 
@@ -52,6 +53,12 @@ gallery: $(BUILD)/gallery
 	./$(BUILD)/gallery -o gallery.png
 
 walk: $(BUILD)/walk
+
+# the teaching examples (examples/learn_*.c): each prints a small table
+LEARN = $(BUILD)/learn_formfactors $(BUILD)/learn_solvers $(BUILD)/learn_stochastic
+learn: $(LEARN)
+$(BUILD)/learn_%: examples/learn_%.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. $< -o $@ -lm
 
 # temporal radiosity under a moving point light: PNG frames + per-frame error CSV (examples/moving_light.c)
 $(BUILD)/moving_light: examples/moving_light.c examples/png_write.h radiosity.h | $(BUILD)

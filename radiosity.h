@@ -249,7 +249,8 @@
          side analytically; pairs closer than twice their size get 16x the points, because the
          integrand is nearly singular along a shared edge. Measured against the closed forms
          of Howell's catalogue (docs/references.md) at default quality: relative errors
-         below 1e-4.
+         below 1e-4 with patches a tenth of the shapes' size, a few 1e-4 at a quarter (the
+         tests hold every case to 1e-3).
        - The BVH's box test widens every slab by 1 + 2 gamma_3 (Ize 2013) and its triangle
          test is watertight (Woop, Benthin, Wald 2013), so rays through shared edges and
          vertices are never lost.
@@ -269,7 +270,8 @@
               built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
               compression and reordering; temporal radiosity with alias tables; local
               matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
-              models and microfacet BRDFs; embedded GLSL kernels for every run-time step.
+              models and microfacet BRDFs; embedded GLSL kernels for every run-time step;
+              hemicube form factors; stochastic radiosity (stochastic Jacobi, random walks).
        The full history is in CHANGELOG.md.
 */
 
@@ -537,6 +539,33 @@ RAD_API uint32_t rad_patches_locate(const rad_patches *patches, uint32_t triangl
 RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const float *patch_values,
                                              uint32_t channels, float *out_vertex_values);
 
+/* Per-vertex irradiance without dark halos. A patch partly covered by other geometry (under a
+   block, under a one-sided light a hair below the ceiling) has a small H only because part of
+   its area sees nothing; a plain vertex average smears that into the visible surface around the
+   contact. So the value at vertex v is (mean radiosity seen) x (how much is seen):
+       H_v = [sum_i A_i H_i / sum_i A_i S_i] * S_v,
+   the sums over the patches sharing v, S_v the area-weighted mean of S over those patches that
+   are not partly covered (S_i >= 3/4 of the largest S at v). S (one float per patch) is the
+   row sum of F (sum_j F_ij, how much of its hemisphere a patch sees: rad_matrix_multiply by
+   ones); NULL gives rad_patches_vertex_values. H: 3 floats per patch; out: 3 per patch vertex.
+   Errors: INVALID_ARGUMENT, NON_FINITE (H or S not finite, S < 0), OUT_OF_MEMORY. O(patches). */
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx);
+
+/* Values at the vertices of one of the scene's own meshes, for an engine that draws that mesh:
+   'mesh' is the index the mesh had in rad_scene_desc.meshes and 'desc' the same description
+   (its vertex count and indices). vertex_values: 3 floats per patch vertex (from
+   rad_patches_vertex_values or rad_patches_vertex_irradiance). Each triangle corner takes the
+   value interpolated at that corner of its patch; a vertex shared by several triangles gets
+   the area-weighted mean over them (so a crease averages its sides, as the mesh's own smooth
+   normals do), and a vertex no triangle uses (or only skipped degenerate ones) gets 0.
+   out: 3 * desc->vertex_count floats. Errors: INVALID_ARGUMENT (mesh >= the scene's mesh count,
+   a NULL pointer), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
+   of that mesh beyond desc->triangle_count: another description), OUT_OF_MEMORY.
+   O(triangles of the scene). */
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx);
+
 /* ======================================================================================== */
 /* >>api_rays: ray queries and the built-in BVH                                             */
 /* ======================================================================================== */
@@ -753,7 +782,7 @@ typedef int (*rad_residual_fn)(void *user, uint32_t iteration, double residual);
 
 typedef struct rad_solve_options {
     rad_output output;         /* RAD_OUTPUT_INDIRECT (default) or RAD_OUTPUT_TOTAL */
-    uint32_t bounces;          /* Jacobi: K (0 returns 0 indirect / E total) */
+    uint32_t bounces;          /* Jacobi: K (default 8; 0 returns 0 indirect / E total) */
     double tolerance;          /* Gauss-Seidel, shooting: relative (0: 1e-6) */
     uint32_t max_iterations;   /* GS sweeps (0: 1000), shooting steps (0: 100 N) */
     rad_residual_fn on_residual;
@@ -791,6 +820,107 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
                                     const rad_context *ctx);
 
 /* ======================================================================================== */
+/* >>api_stochastic: stochastic (Monte Carlo) radiosity                                     */
+/* ======================================================================================== */
+
+/* Stochastic radiosity (docs/methods/stochastic.md) solves the same patch system as the
+   classic solvers, B = E + rho o (F B), without ever building F: form factors are sampled by
+   rays. A ray leaves a uniform point of patch i in a cosine-distributed direction; the patch j
+   it hits first (front face) is then drawn with probability exactly F_ij, so the power a ray
+   carries, dropped on j and reflected there (times rho_j / A_j), is an unbiased estimate of
+   one step of the power equation A_j B_j = A_j E_j + rho_j sum_i F_ij A_i B_i. A miss or a back
+   face absorbs the ray (F_ij is 0 for a patch facing away, as in the classic matrix).
+
+   RAD_STOCHASTIC_JACOBI: stochastic Jacobi iteration (Neumann et al. 1994; Bekaert's thesis).
+     Shooting (incremental) iterations: the unshot radiosity dB (first E) is shot with rays
+     drawn in proportion to each patch's unshot power A_i (dB_r + dB_g + dB_b) (systematic
+     sampling: patch i gets floor or ceil of its share), each ray carrying an equal share of
+     the total; what the rays deposit is the next dB, added to B. Iteration k casts
+     ceil(rays * P_k / P_0) rays (P_k the unshot power), so every unit of power is shot with
+     the same density of rays; the shooting stops when P_k < tolerance * P_0 or after
+     'iterations'. Then 'regular_iterations' regular iterations B' = E + rho o F~ B shoot the
+     whole power of the current B (rays * P(B) / P_0 rays each) and the result is the mean of
+     their B': more rays on a solution that no longer changes in expectation.
+   RAD_STOCHASTIC_WALK: shooting random walks with the collision estimator (Sbert's random
+     walk radiosity). 'rays' walks start on patches drawn in proportion to their power A_i E_i
+     (systematic sampling), each carrying an equal share; at every patch j a walk hits it
+     scores rho_j times its power into B_j (divided by A_j), then continues from a uniform
+     point of j with probability max_c rho_j,c (Russian roulette; the surviving power is
+     divided by that probability, so no channel grows), else ends. 'iterations' batches of
+     'rays' walks are averaged. A walk ends after 65536 collisions at the most.
+
+   Both estimators are unbiased for the exact patch system (with exact form factors and
+   visibility): the mean over seeds converges to the classic direct solve up to its form-factor
+   error, and the variance falls as 1 / rays (tests/test_stochastic.c checks both). The noise
+   is per patch: a patch of area A receives about rays * A / A_total of the hits, so small
+   patches are noisy; Bekaert's thesis discusses the variance.
+
+   DETERMINISM. Every ray's random numbers are a hash (the integer hash of >>core) of the seed,
+   the iteration and the ray's (or walk's and bounce's) index, and deposits are summed in ray
+   order in double precision: the same seed gives the same bits on any number of threads and
+   any task order. Rays are traced in waves of at most 2^20 through raycaster->intersect
+   (batches of 1024 per task). */
+
+typedef enum rad_stochastic_method {
+    RAD_STOCHASTIC_JACOBI = 0, /* stochastic Jacobi iteration, shooting then regular (default) */
+    RAD_STOCHASTIC_WALK = 1    /* shooting random walks, collision estimator */
+} rad_stochastic_method;
+
+/* Called after every iteration (Jacobi: shooting and regular; walk: batch) with the number of
+   iterations done, the rays cast so far and the current estimate of B = E + L (3N floats, the
+   running mean in the regular phase and for walks). Return non-zero to stop: the solver then
+   returns RAD_SUCCESS with that estimate. */
+typedef int (*rad_stochastic_fn)(void *user, uint32_t iteration, uint64_t rays_cast, const float *B);
+
+typedef struct rad_stochastic_options {
+    rad_stochastic_method method; /* RAD_STOCHASTIC_JACOBI (default) or RAD_STOCHASTIC_WALK */
+    rad_output output;            /* RAD_OUTPUT_INDIRECT (default): L = B - E; or RAD_OUTPUT_TOTAL */
+    uint32_t rays;                /* Jacobi: rays of the first shooting iteration (later ones in
+                                     proportion to their power); walk: walks per batch.
+                                     0: 64 per patch, at least 4096, at most 2^26 */
+    uint32_t iterations;          /* Jacobi: shooting iterations at most (0: 256); walk: batches
+                                     averaged (0: 1) */
+    uint32_t regular_iterations;  /* Jacobi: regular iterations after the shooting, averaged
+                                     (0: none); walk: must be 0 */
+    double tolerance;             /* Jacobi: the shooting stops when the unshot power is below
+                                     tolerance times the source power (0: 1e-4); walk: unused */
+    float ray_epsilon;            /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;                /* any value; same seed, same bits */
+    rad_stochastic_fn on_iteration; /* optional */
+    void *iteration_user;
+} rad_stochastic_options;
+
+typedef struct rad_stochastic_stats {
+    uint32_t iterations;          /* Jacobi: shooting + regular iterations done; walk: batches */
+    uint64_t rays_cast;           /* closest-hit rays traced (walk: one per collision or miss) */
+    double unshot;                /* Jacobi: unshot power / source power when the shooting
+                                     stopped (the truncation left out); walk: 0 */
+} rad_stochastic_stats;
+
+/* Defaults: RAD_STOCHASTIC_JACOBI, RAD_OUTPUT_INDIRECT, every count 0 (its documented default),
+   tolerance 1e-4, ray_epsilon 1e-5, seed 0, no callback. */
+RAD_API void rad_stochastic_options_default(rad_stochastic_options *options);
+
+/* Solves B = E + rho o (F B) on 'patches' (albedo from patches->albedo) by one of the two
+   estimators above, tracing rays through 'raycaster' (its intersect callback; built on the
+   patches' scene). E: 3N floats, each finite and >= 0 (E is a source of light: a negative
+   value has no power to draw rays by). out: 3N floats, L or B as options->output says.
+   options may be NULL (the defaults). stats may be NULL.
+   Errors: INVALID_ARGUMENT (NULL patches, raycaster, intersect, E or out; patches without their
+   scene (the patches of a loaded bake: set patches.scene first); an unknown method or
+   output; ray_epsilon outside (0, 1e-2]; a negative or non-finite tolerance; regular
+   iterations with the walk), NON_FINITE (a NaN or Inf in E, or a result that overflows float),
+   NEGATIVE_EMISSION (a negative E), ALBEDO_RANGE (a patch albedo outside [0,1)),
+   RAYCAST_FAILED, CANCELLED (ctx->progress, called after each iteration), OUT_OF_MEMORY.
+   Thread safety: reentrant; rays run through ctx->parallel_for.
+   Cost: Jacobi about rays / (1 - rho_mean) rays for the shooting (plus rays * P(B)/P(E) per
+   regular iteration); walk about iterations * rays / (1 - rho_mean); memory O(N) plus 28
+   bytes per ray of a wave and 48 KiB per task. docs/methods/stochastic.md. */
+RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_raycaster *raycaster, const float *E,
+                                        const rad_stochastic_options *options, float *out,
+                                        rad_stochastic_stats *stats, const rad_context *ctx);
+
+/* ======================================================================================== */
 /* >>api_light: lights and the source term                                                  */
 /* ======================================================================================== */
 
@@ -824,7 +954,9 @@ typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
     uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
-    int include_emitters;      /* non-zero (default): emissive triangles are area lights */
+    int include_emitters;      /* non-zero (default): emissive triangles are area lights;
+                                  0 leaves them out (a zeroed struct has no emitters: start
+                                  from rad_direct_options_default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
 } rad_direct_options;
@@ -861,7 +993,9 @@ typedef enum rad_source_mode {
 
 /* Builds E (3N floats) from the patches one of the two ways of UNITS AND CONVENTIONS.
    direct_irradiance (3N) is required for RAD_SOURCE_DIRECT and must be NULL for
-   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT). */
+   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT).
+   A NaN or Inf in it is NON_FINITE, a negative value INVALID_ARGUMENT; out_E is written only on
+   success. */
 RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
                                float *out_E);
 
@@ -1575,7 +1709,8 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
 
 typedef struct rad_multibounce_options {
-    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3) */
+    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3; 0 is INVALID_ARGUMENT:
+                                  start from rad_multibounce_options_default) */
     rad_mb_precision precision;/* storage of the result (default RAD_MB_FLOAT) */
     double tolerance;          /* K = inf: Neumann doubling stops once max row sum of
                                   (rho o F)^m <= tolerance (0: 1e-8) */
@@ -1649,8 +1784,10 @@ typedef enum rad_block_format {
 #define RAD_REORDER_MATCH 4       /* groups of four by greedy matching (rows into pairs, pairs
                                      into fours) on the same distance, then the group swaps */
 
+/* Start from rad_block_options_default: here zero is a setting, not the default (a zeroed
+   struct asks for BC1, no outliers, no reordering and one scale per channel). */
 typedef struct rad_block_options {
-    rad_block_format format;   /* default RAD_BLOCK_BC4X3 */
+    rad_block_format format;   /* default RAD_BLOCK_BC4X3 (0 is RAD_BLOCK_BC1) */
     float outlier_fraction;    /* the largest fraction p of the N^2 entries (by their largest
                                   channel) go exactly into the sparse list, zeros left in place;
                                   0 disables the step (default 0.05) */
@@ -1889,7 +2026,8 @@ typedef enum rad_local_rebuild_method {
 } rad_local_rebuild_method;
 
 typedef struct rad_local_options {
-    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default 1024) */
+    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default
+                                  1024; 0 is INVALID_ARGUMENT: start from rad_local_options_default) */
     rad_local_update update;   /* default RAD_LOCAL_EXACT */
     rad_local_eviction evict;  /* default RAD_LOCAL_EVICT_DOWNDATE */
     rad_local_rebuild_method rebuild; /* default RAD_LOCAL_REBUILD_INVERSE */
@@ -2174,7 +2312,8 @@ typedef enum rad_temporal_mode {
 
 typedef struct rad_temporal_options {
     rad_temporal_mode mode;
-    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES) */
+    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES,
+                              0 is INVALID_ARGUMENT: start from rad_temporal_options_default) */
     float weight;          /* fixed w in [0, 1) (default 0.998; 0 keeps no history) */
     uint32_t seed;         /* generator seed */
     int adaptive;          /* non-zero: per-row w from the estimator's variance (see below) */
@@ -3647,6 +3786,130 @@ RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const f
             out_vertex_values[(size_t)v * channels + k] = src[channels] > 0.0 ? (float)(src[k] / src[channels]) : 0.0f;
     }
     rad__free(&a, acc);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *S_v, *S_max, *S_area;
+    uint32_t n, nv, i, k;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !H || !out_vertex_H) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: patches, H and out_vertex_H are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    n = patches->count;
+    nv = patches->vertex_count;
+    for (i = 0; i < 3 * n; ++i)
+        if (!rad__finite(H[i])) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: H of patch %u is not finite", i / 3);
+            return RAD_ERROR_NON_FINITE;
+        }
+    if (!S) return rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(S[i]) || S[i] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: row sum S of patch %u is %g (finite, >= 0 expected)",
+                     i, (double)S[i]);
+            return RAD_ERROR_NON_FINITE;
+        }
+    S_v = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)nv, sizeof(float));
+    if (!S_v) return RAD_ERROR_OUT_OF_MEMORY;
+    S_max = S_v + nv;
+    S_area = S_max + nv;
+    /* the bracket: vertex means of H and of S, both area-weighted over the patches at v */
+    r = rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(patches, S, 1, S_v);
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] > S_max[v]) S_max[v] = S[i];
+            }
+        for (i = 0; i < nv; ++i) {
+            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= scale;
+            S_v[i] = 0.0f;
+        }
+        /* S_v: how much the uncovered patches at v see */
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] >= 0.75f * S_max[v]) {
+                    S_v[v] += patches->patches[i].area * S[i];
+                    S_area[v] += patches->patches[i].area;
+                }
+            }
+        for (i = 0; i < nv; ++i) {
+            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= s_v;
+        }
+    }
+    rad__free(&c.allocator, S_v);
+    return r;
+}
+
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_scene *S;
+    double *acc;
+    uint32_t t, k, m, V;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !patches->scene || !vertex_values || !desc || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: patches, vertex_values, desc and out are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    S = patches->scene;
+    if (mesh >= S->mesh_count) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: mesh %u, but the scene has %u meshes", mesh, S->mesh_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    V = desc->vertex_count;
+    acc = (double *)rad__alloc_array(&c.allocator, 4 * (size_t)V + 1u, sizeof(double));
+    if (!acc) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(acc, 0, (4 * (size_t)V + 1u) * sizeof(double));
+    for (t = 0; t < S->triangle_count; ++t) {
+        uint32_t j = S->source_triangles[t], id[3];
+        static const float corner[3][2] = { { 0.0f, 0.0f }, { 1.0f, 0.0f }, { 0.0f, 1.0f } };
+        if (S->meshes[t] != mesh) continue;
+        if (j >= desc->triangle_count) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: the scene's mesh %u has triangle %u, desc has %u triangles",
+                     mesh, j, desc->triangle_count);
+            rad__free(&c.allocator, acc);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+        for (k = 0; k < 3; ++k) {
+            id[k] = desc->indices ? desc->indices[3 * (size_t)j + k] : 3 * j + k;
+            if (id[k] >= V) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: triangle %u has vertex index %u >= %u", j, id[k], V);
+                rad__free(&c.allocator, acc);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        }
+        for (k = 0; k < 3; ++k) {
+            float w[3];
+            uint32_t p = rad_patches_locate(patches, t, corner[k][0], corner[k][1], w);
+            double *dst = acc + 4 * (size_t)id[k];
+            if (p == RAD_NONE) continue;
+            for (m = 0; m < 3; ++m) {
+                const float *src = vertex_values + 3 * (size_t)patches->patches[p].vertices[m];
+                dst[0] += (double)S->areas[t] * w[m] * src[0];
+                dst[1] += (double)S->areas[t] * w[m] * src[1];
+                dst[2] += (double)S->areas[t] * w[m] * src[2];
+            }
+            dst[3] += S->areas[t];
+        }
+    }
+    for (k = 0; k < V; ++k) {
+        const double *src = acc + 4 * (size_t)k;
+        for (m = 0; m < 3; ++m) out[3 * (size_t)k + m] = src[3] > 0.0 ? (float)(src[m] / src[3]) : 0.0f;
+    }
+    rad__free(&c.allocator, acc);
     return RAD_SUCCESS;
 }
 
@@ -5594,6 +5857,21 @@ static void rad__finish_output(const rad_system *s, rad_output output, float *B_
         for (i = 0; i < n3; ++i) B_total_or_L[i] += s->E[i];
 }
 
+/* What every solver checks first: the system (logged once), the output and the options
+   (NULL: the defaults, copied to *o). */
+static rad_result rad__solve_begin(const rad_system *s, const rad_solve_options *options, const float *out,
+                                   const char *name, const rad__ctx *c, rad_solve_options *o)
+{
+    rad_result r = rad__check_system(s, c);
+    if (r != RAD_SUCCESS) return r;
+    if (!out) {
+        rad__log(c, RAD_LOG_ERROR, "%s: out is NULL", name);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) *o = *options; else rad_solve_options_default(o);
+    return rad__check_solve_options(o, c);
+}
+
 RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options *options, float *out, rad_solve_stats *stats,
                                     const rad_context *ctx)
 {
@@ -5604,11 +5882,8 @@ RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options
     uint32_t k;
     rad_result r;
     rad__ctx_init(&c, ctx);
-    r = rad__check_system(s, &c);
+    r = rad__solve_begin(s, options, out, "rad_solve_jacobi", &c, &o);
     if (r != RAD_SUCCESS) return r;
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     n3 = 3 * (size_t)s->n;
     cur = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
     tmp = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
@@ -5675,10 +5950,10 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
     double maxE = 0.0, residual = 0.0, tol;
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_gauss_seidel", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_it = o.max_iterations ? o.max_iterations : 1000;
     n3 = 3 * (size_t)s->n;
@@ -5726,13 +6001,14 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
     double initial = 0.0, residual = 1.0, tol;
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out || !s->areas) {
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_progressive", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
+    if (!s->areas) {
         rad__log(&c, RAD_LOG_ERROR, "progressive refinement needs system->areas");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_steps = o.max_iterations ? o.max_iterations : (s->n > 42949672u ? 0xFFFFFFFFu : 100u * s->n);
     n3 = 3 * (size_t)s->n;
@@ -5835,10 +6111,10 @@ RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options
     rad_result r = RAD_SUCCESS;
     int factored = -1;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_direct", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
     n = s->n;
     if (!rad__mul3(n, n, sizeof(double), &bytes)) return RAD_ERROR_SIZE_OVERFLOW;
     M = (double *)rad__alloc(&c.allocator, bytes);
@@ -5926,6 +6202,420 @@ done:
     rad__free(&c.allocator, M);
     rad__free(&c.allocator, b);
     rad__free(&c.allocator, piv);
+    return r;
+}
+
+/* ======================================================================================== */
+/* >>stochastic: stochastic (Monte Carlo) radiosity                                         */
+/* ======================================================================================== */
+
+RAD_API void rad_stochastic_options_default(rad_stochastic_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->method = RAD_STOCHASTIC_JACOBI;
+    o->output = RAD_OUTPUT_INDIRECT;
+    o->tolerance = 1e-4;
+    o->ray_epsilon = 1e-5f;
+}
+
+#define RAD__SR_WAVE (1u << 20)   /* rays traced per wave: bounds the per-ray arrays */
+#define RAD__SR_MAX_DEPTH 65536u  /* collisions of one walk at the most */
+
+/* A wave of rays: ray r leaves a uniform point of patch src[r] in a cosine-distributed
+   direction drawn from key[r]; dst[r] receives the patch hit on its front, or RAD_NONE. */
+typedef struct rad__sr {
+    const rad_patches *P;
+    const rad_raycaster *rc;
+    float eps;
+    uint32_t count;
+    const uint32_t *src, *key;
+    uint32_t *dst;
+    rad_ray *rays;   /* RAD__RAY_BATCH per task */
+    rad_hit *hits;   /* RAD__RAY_BATCH per task */
+} rad__sr;
+
+static void rad__tangent_frame(const float *n, float *t1, float *t2); /* >>light */
+
+/* uniform in (0, 1) from the top 24 bits of a hash */
+static float rad__sr_unit(uint32_t h) { return ((float)(h >> 8) + 0.5f) * (1.0f / 16777216.0f); }
+
+static rad_result rad__sr_chunk(void *data, uint32_t chunk, uint32_t task)
+{
+    rad__sr *w = (rad__sr *)data;
+    const rad_patches *P = w->P;
+    rad_ray *rays = w->rays + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = w->hits + (size_t)task * RAD__RAY_BATCH;
+    uint32_t r0 = chunk * RAD__RAY_BATCH, m = w->count - r0 < RAD__RAY_BATCH ? w->count - r0 : RAD__RAY_BATCH, k;
+    int c;
+    for (k = 0; k < m; ++k) {
+        const rad_patch *p = &P->patches[w->src[r0 + k]];
+        uint32_t key = w->key[r0 + k];
+        float t1[3], t2[3], x[3], u1, u2, rr, ph, z;
+        const float *v0 = P->vertices + 3 * (size_t)p->vertices[0], *v1 = P->vertices + 3 * (size_t)p->vertices[1],
+                    *v2 = P->vertices + 3 * (size_t)p->vertices[2];
+        rad__triangle_point(v0, v1, v2, rad__sr_unit(rad__hash(key ^ 0x2C1B3C6Du)), rad__sr_unit(rad__hash(key ^ 0x297A2D39u)), x);
+        u1 = rad__sr_unit(rad__hash(key ^ 0x6B43A9B5u));
+        u2 = rad__sr_unit(rad__hash(key ^ 0x1B873593u));
+        rr = (float)sqrt((double)u1);
+        ph = (float)(2.0 * RAD__PI) * u2;
+        z = (float)sqrt((double)(1.0f - u1));
+        rad__tangent_frame(p->normal, t1, t2);
+        for (c = 0; c < 3; ++c) {
+            rays[k].origin[c] = x[c] + p->normal[c] * w->eps;
+            rays[k].dir[c] = t1[c] * rr * (float)cos((double)ph) + t2[c] * rr * (float)sin((double)ph) + p->normal[c] * z;
+        }
+        rays[k].tmin = 0.0f;
+        rays[k].tmax = FLT_MAX;
+    }
+    if (w->rc->intersect(w->rc->user, rays, m, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < m; ++k) {
+        uint32_t t = hits[k].triangle, j = RAD_NONE;
+        /* a back face absorbs the ray: patches are one-sided, F_ij = 0 for a patch facing away */
+        if (t != RAD_NONE && t < P->scene->triangle_count && rad__dot(P->scene->normals + 3 * (size_t)t, rays[k].dir) < 0.0f)
+            j = rad_patches_locate(P, t, hits[k].b1, hits[k].b2, NULL);
+        w->dst[r0 + k] = j;
+    }
+    return RAD_SUCCESS;
+}
+
+/* traces w->count rays (parallel over chunks of RAD__RAY_BATCH; no progress inside a wave) */
+static rad_result rad__sr_trace(const rad__ctx *c, rad__sr *w, uint32_t tasks)
+{
+    rad__ctx quiet = *c;
+    quiet.progress = NULL;
+    return rad__for_rows(&quiet, (w->count + RAD__RAY_BATCH - 1u) / RAD__RAY_BATCH, tasks, rad__sr_chunk, w);
+}
+
+/* Systematic sampling: ray k of n goes to the patch whose cumulative weight interval holds
+   (k + u) / n of the total (cum: the running sums of the weights, total > 0). Writes src for
+   rays [k0, k0 + m) and returns the patch cursor. A patch of weight 0 is never drawn. */
+static uint32_t rad__sr_sources(const double *cum, uint32_t np, uint64_t n, double u, uint64_t k0, uint32_t m,
+                                uint32_t cursor, uint32_t *src)
+{
+    uint32_t k, last = np - 1u;
+    double total = cum[np - 1u];
+    while (last > 0 && cum[last - 1u] == total) --last; /* the last patch of weight > 0 */
+    for (k = 0; k < m; ++k) {
+        double x = ((double)(k0 + k) + u) / (double)n * total;
+        while (cursor < last && cum[cursor] <= x) ++cursor;
+        src[k] = cursor;
+    }
+    return cursor;
+}
+
+typedef struct rad__stoch {
+    rad__ctx *c;
+    const rad_patches *P;
+    const float *E;
+    rad_stochastic_options o;
+    uint32_t n, tasks;
+    double *cum, *acc, *cur, *B, *mean;
+    uint32_t *src, *key, *dst, *walk;
+    float *power, *est;            /* power: 3 per walk; est: the estimate for the callback */
+    rad__sr w;
+    uint64_t rays_cast;
+    double unshot;
+    uint32_t iteration;
+} rad__stoch;
+
+/* current estimate into s->est; calls the callback and progress. 1: stop, 2: cancelled */
+static int rad__stoch_report(rad__stoch *s, const double *B, double fraction)
+{
+    size_t i;
+    ++s->iteration;
+    if (s->o.on_iteration) {
+        for (i = 0; i < 3 * (size_t)s->n; ++i) s->est[i] = (float)B[i];
+        if (s->o.on_iteration(s->o.iteration_user, s->iteration, s->rays_cast, s->est)) return 1;
+    }
+    if (s->c->progress && s->c->progress(s->c->progress_user, (float)fraction)) return 2;
+    return 0;
+}
+
+/* One Jacobi step: shoots the radiosity x (3N, >= 0) with 'rays' rays drawn by power
+   A_i (x_r + x_g + x_b), and writes what they deposit (times rho / A) into out (3N). */
+static rad_result rad__stoch_shoot(rad__stoch *s, const double *x, uint64_t rays, uint32_t stream, double *out)
+{
+    const rad_patches *P = s->P;
+    uint32_t i, cursor = 0;
+    uint64_t k0;
+    double total = 0.0, u, share;
+    rad_result r = RAD_SUCCESS;
+    for (i = 0; i < s->n; ++i) {
+        total += (double)P->areas[i] * (x[3 * (size_t)i] + x[3 * (size_t)i + 1] + x[3 * (size_t)i + 2]);
+        s->cum[i] = total;
+    }
+    memset(out, 0, 3 * (size_t)s->n * sizeof(double));
+    if (!(total > 0.0) || rays == 0) return RAD_SUCCESS;
+    u = (double)rad__sr_unit(rad__hash(stream ^ 0x3C6EF372u));
+    share = total / (double)rays;
+    for (k0 = 0; k0 < rays && r == RAD_SUCCESS; k0 += RAD__SR_WAVE) {
+        uint32_t m = rays - k0 < RAD__SR_WAVE ? (uint32_t)(rays - k0) : RAD__SR_WAVE, k;
+        cursor = rad__sr_sources(s->cum, s->n, rays, u, k0, m, cursor, s->src);
+        for (k = 0; k < m; ++k) s->key[k] = rad__hash(stream ^ rad__hash((uint32_t)(k0 + k) ^ (uint32_t)((k0 + k) >> 32) * 0x85EBCA6Bu));
+        s->w.count = m;
+        r = rad__sr_trace(s->c, &s->w, s->tasks);
+        s->rays_cast += m;
+        /* deposits in ray order: the sum does not depend on how the wave was split */
+        for (k = 0; k < m && r == RAD_SUCCESS; ++k) {
+            uint32_t a = s->src[k], j = s->dst[k];
+            const double *xa = x + 3 * (size_t)a;
+            double sum = xa[0] + xa[1] + xa[2], f;
+            int ch;
+            if (j == RAD_NONE) continue;
+            f = share / (sum * (double)P->areas[j]);
+            for (ch = 0; ch < 3; ++ch) out[3 * (size_t)j + ch] += (double)P->albedo[3 * (size_t)j + ch] * xa[ch] * f;
+        }
+    }
+    return r;
+}
+
+static uint64_t rad__stoch_count(uint32_t rays, double power, double p0)
+{
+    double want = ceil((double)rays * power / p0);
+    return want < 1.0 ? 1u : want > 1e15 ? (uint64_t)1e15 : (uint64_t)want;
+}
+
+static rad_result rad__stoch_jacobi(rad__stoch *s, double p0)
+{
+    size_t n3 = 3 * (size_t)s->n, i;
+    uint32_t it, reg = 0;
+    double unshot;
+    rad_result r = RAD_SUCCESS;
+    int stop = 0;
+    for (i = 0; i < n3; ++i) s->B[i] = s->cur[i] = (double)s->E[i];
+    for (it = 0; it < s->o.iterations && !stop; ++it) {
+        double pk = 0.0, frac;
+        for (i = 0; i < s->n; ++i) pk += (double)s->P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
+        if (pk < s->o.tolerance * p0) break;
+        r = rad__stoch_shoot(s, s->cur, rad__stoch_count(s->o.rays, pk, p0),
+                             rad__hash(s->o.seed ^ rad__hash(it + 0x9E3779B9u)), s->acc);
+        if (r != RAD_SUCCESS) return r;
+        for (i = 0; i < n3; ++i) { s->cur[i] = s->acc[i]; s->B[i] += s->acc[i]; }
+        /* progress: iterations done, or the unshot power's way down to the tolerance (log scale) */
+        frac = (double)(it + 1) / (double)s->o.iterations;
+        if (s->o.tolerance < 1.0 && log(p0 / pk) / -log(s->o.tolerance) > frac) frac = log(p0 / pk) / -log(s->o.tolerance);
+        frac *= (double)s->o.iterations / (double)(s->o.iterations + s->o.regular_iterations);
+        stop = rad__stoch_report(s, s->B, frac < 1.0 ? frac : 1.0);
+    }
+    unshot = 0.0;
+    for (i = 0; i < s->n; ++i) unshot += (double)s->P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
+    s->unshot = unshot / p0;
+    if (stop == 2) return RAD_ERROR_CANCELLED;
+    if (stop || s->o.regular_iterations == 0) return RAD_SUCCESS;
+    /* regular iterations B' = E + rho o F~ B, averaged */
+    for (i = 0; i < n3; ++i) s->mean[i] = 0.0;
+    for (reg = 0; reg < s->o.regular_iterations; ++reg) {
+        double pb = 0.0;
+        for (i = 0; i < s->n; ++i) pb += (double)s->P->areas[i] * (s->B[3 * i] + s->B[3 * i + 1] + s->B[3 * i + 2]);
+        r = rad__stoch_shoot(s, s->B, rad__stoch_count(s->o.rays, pb, p0),
+                             rad__hash(s->o.seed ^ rad__hash(reg + 0x7F4A7C15u) ^ 0xA5A5A5A5u), s->acc);
+        if (r != RAD_SUCCESS) return r;
+        for (i = 0; i < n3; ++i) {
+            s->B[i] = (double)s->E[i] + s->acc[i];
+            s->mean[i] += (s->B[i] - s->mean[i]) / (double)(reg + 1u);
+        }
+        stop = rad__stoch_report(s, s->mean, (double)(it + reg + 1) / (double)(s->o.iterations + s->o.regular_iterations));
+        if (stop) break;
+    }
+    memcpy(s->B, s->mean, n3 * sizeof(double));
+    return stop == 2 ? RAD_ERROR_CANCELLED : RAD_SUCCESS;
+}
+
+static rad_result rad__stoch_walk(rad__stoch *s, double p0)
+{
+    const rad_patches *P = s->P;
+    size_t n3 = 3 * (size_t)s->n, i;
+    uint32_t it;
+    rad_result r = RAD_SUCCESS;
+    int stop = 0;
+    (void)p0;
+    for (i = 0; i < s->n; ++i) {
+        s->cur[3 * i] = s->E[3 * i]; s->cur[3 * i + 1] = s->E[3 * i + 1]; s->cur[3 * i + 2] = s->E[3 * i + 2];
+    }
+    for (i = 0; i < n3; ++i) s->mean[i] = 0.0;
+    for (it = 0; it < s->o.iterations && !stop; ++it) {
+        uint32_t stream = rad__hash(s->o.seed ^ rad__hash(it + 0x61C88647u) ^ 0x5A5A5A5Au), cursor = 0;
+        double total = 0.0, u = (double)rad__sr_unit(rad__hash(stream ^ 0x3C6EF372u)), share;
+        uint64_t k0;
+        for (i = 0; i < s->n; ++i) {
+            total += (double)P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
+            s->cum[i] = total;
+        }
+        share = total / (double)s->o.rays;
+        memset(s->acc, 0, n3 * sizeof(double));
+        for (k0 = 0; k0 < s->o.rays && r == RAD_SUCCESS; k0 += RAD__SR_WAVE) {
+            uint32_t m = s->o.rays - k0 < RAD__SR_WAVE ? (uint32_t)(s->o.rays - k0) : RAD__SR_WAVE, k, active = m, depth;
+            cursor = rad__sr_sources(s->cum, s->n, s->o.rays, u, k0, m, cursor, s->src);
+            for (k = 0; k < m; ++k) {
+                const float *e = s->E + 3 * (size_t)s->src[k];
+                double sum = (double)e[0] + (double)e[1] + (double)e[2];
+                int ch;
+                s->walk[k] = rad__hash(stream ^ rad__hash((uint32_t)(k0 + k)));
+                for (ch = 0; ch < 3; ++ch) s->power[3 * (size_t)k + ch] = (float)(share * (double)e[ch] / sum);
+            }
+            for (depth = 0; active > 0 && depth < RAD__SR_MAX_DEPTH && r == RAD_SUCCESS; ++depth) {
+                uint32_t kept = 0;
+                for (k = 0; k < active; ++k) s->key[k] = rad__hash(s->walk[k] + depth * 0x9E3779B9u);
+                s->w.count = active;
+                r = rad__sr_trace(s->c, &s->w, s->tasks);
+                s->rays_cast += active;
+                if (r != RAD_SUCCESS) break;
+                /* score, roulette and compact in walk order */
+                for (k = 0; k < active; ++k) {
+                    uint32_t j = s->dst[k];
+                    const float *rho;
+                    float pw[3], q;
+                    int ch;
+                    if (j == RAD_NONE) continue;
+                    rho = P->albedo + 3 * (size_t)j;
+                    for (ch = 0; ch < 3; ++ch) {
+                        pw[ch] = rho[ch] * s->power[3 * (size_t)k + ch];
+                        s->acc[3 * (size_t)j + ch] += (double)pw[ch] / (double)P->areas[j];
+                    }
+                    q = rho[0] > rho[1] ? rho[0] : rho[1];
+                    if (rho[2] > q) q = rho[2];
+                    if (!(rad__sr_unit(rad__hash(s->key[k] ^ 0x5F356495u)) < q)) continue;
+                    s->src[kept] = j;
+                    s->walk[kept] = s->walk[k];
+                    for (ch = 0; ch < 3; ++ch) s->power[3 * (size_t)kept + ch] = pw[ch] / q;
+                    ++kept;
+                }
+                active = kept;
+            }
+        }
+        if (r != RAD_SUCCESS) return r;
+        for (i = 0; i < n3; ++i) {
+            s->mean[i] += (s->acc[i] - s->mean[i]) / (double)(it + 1u);
+            s->B[i] = (double)s->E[i] + s->mean[i];
+        }
+        stop = rad__stoch_report(s, s->B, (double)(it + 1) / (double)s->o.iterations);
+    }
+    return stop == 2 ? RAD_ERROR_CANCELLED : RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_raycaster *raycaster, const float *E,
+                                        const rad_stochastic_options *options, float *out,
+                                        rad_stochastic_stats *stats, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__stoch s;
+    size_t n3, i, wave;
+    double p0 = 0.0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (stats) memset(stats, 0, sizeof(*stats));
+    if (!patches || !raycaster || !raycaster->intersect || !E || !out || patches->count == 0 || !patches->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: patches, a raycaster with intersect, E and out are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    memset(&s, 0, sizeof(s));
+    if (options) s.o = *options; else rad_stochastic_options_default(&s.o);
+    if ((s.o.method != RAD_STOCHASTIC_JACOBI && s.o.method != RAD_STOCHASTIC_WALK) ||
+        (s.o.output != RAD_OUTPUT_INDIRECT && s.o.output != RAD_OUTPUT_TOTAL)) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: method %d or output %d unknown (RAD_STOCHASTIC_JACOBI or _WALK; "
+                 "RAD_OUTPUT_INDIRECT or _TOTAL)", (int)s.o.method, (int)s.o.output);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(s.o.tolerance >= 0.0) || s.o.tolerance - s.o.tolerance != 0.0) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: tolerance %g must be finite and >= 0", s.o.tolerance);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s.o.ray_epsilon == 0.0f) s.o.ray_epsilon = 1e-5f;
+    if (!(s.o.ray_epsilon > 0.0f && s.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: ray_epsilon %g outside (0, 1e-2]", (double)s.o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s.o.method == RAD_STOCHASTIC_WALK && s.o.regular_iterations != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: regular_iterations (%u) are for RAD_STOCHASTIC_JACOBI; the walk "
+                 "averages 'iterations' batches", s.o.regular_iterations);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s.o.rays == 0) {
+        uint64_t d = 64u * (uint64_t)patches->count;
+        s.o.rays = d < 4096u ? 4096u : d > (1u << 26) ? (1u << 26) : (uint32_t)d;
+    }
+    if (s.o.iterations == 0) s.o.iterations = s.o.method == RAD_STOCHASTIC_JACOBI ? 256u : 1u;
+    if (s.o.tolerance == 0.0) s.o.tolerance = 1e-4;
+    n3 = 3 * (size_t)patches->count;
+    if (rad__check_input(&c, "stochastic radiosity (E)", E, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
+    for (i = 0; i < n3; ++i) {
+        if (E[i] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: E of patch %llu channel %u is %g (must be >= 0: a source "
+                     "shoots power)", (unsigned long long)(i / 3u), (unsigned)(i % 3u), (double)E[i]);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+        if (!(patches->albedo[i] >= 0.0f && patches->albedo[i] < 1.0f)) {
+            rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: albedo of patch %llu channel %u is %g (must be in [0,1))",
+                     (unsigned long long)(i / 3u), (unsigned)(i % 3u), (double)patches->albedo[i]);
+            return RAD_ERROR_ALBEDO_RANGE;
+        }
+        p0 += (double)patches->areas[i / 3u] * (double)E[i];
+    }
+    s.c = &c;
+    s.P = patches;
+    s.E = E;
+    s.n = patches->count;
+    s.tasks = c.tasks;
+    /* a shooting iteration casts at most 'rays' (the unshot power only falls); a regular one more */
+    wave = s.o.rays < RAD__SR_WAVE && !(s.o.method == RAD_STOCHASTIC_JACOBI && s.o.regular_iterations) ? s.o.rays
+                                                                                                        : RAD__SR_WAVE;
+    s.cum = (double *)rad__alloc_array(&c.allocator, s.n, sizeof(double));
+    s.acc = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.cur = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.B = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.mean = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.est = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
+    s.src = (uint32_t *)rad__alloc_array(&c.allocator, wave, sizeof(uint32_t));
+    s.key = (uint32_t *)rad__alloc_array(&c.allocator, wave, sizeof(uint32_t));
+    s.dst = (uint32_t *)rad__alloc_array(&c.allocator, wave, sizeof(uint32_t));
+    s.walk = (uint32_t *)rad__alloc_array(&c.allocator, s.o.method == RAD_STOCHASTIC_WALK ? wave : 1u, sizeof(uint32_t));
+    s.power = (float *)rad__alloc_array(&c.allocator, s.o.method == RAD_STOCHASTIC_WALK ? wave : 1u, 3 * sizeof(float));
+    s.w.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)s.tasks * RAD__RAY_BATCH, sizeof(rad_ray));
+    s.w.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)s.tasks * RAD__RAY_BATCH, sizeof(rad_hit));
+    if (!s.cum || !s.acc || !s.cur || !s.B || !s.mean || !s.est || !s.src || !s.key || !s.dst || !s.walk || !s.power ||
+        !s.w.rays || !s.w.hits) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: out of memory for %u patches and waves of %llu rays", s.n,
+                 (unsigned long long)wave);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    s.w.P = patches;
+    s.w.rc = raycaster;
+    s.w.eps = s.o.ray_epsilon * patches->scene->diagonal;
+    s.w.src = s.src;
+    s.w.key = s.key;
+    s.w.dst = s.dst;
+    if (!(p0 > 0.0)) { /* no source: no light, nothing to shoot */
+        for (i = 0; i < n3; ++i) s.B[i] = (double)E[i];
+    } else {
+        r = s.o.method == RAD_STOCHASTIC_JACOBI ? rad__stoch_jacobi(&s, p0) : rad__stoch_walk(&s, p0);
+    }
+    if (stats) {
+        stats->iterations = s.iteration;
+        stats->rays_cast = s.rays_cast;
+        stats->unshot = s.unshot;
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < n3; ++i) out[i] = (float)(s.o.output == RAD_OUTPUT_TOTAL ? s.B[i] : s.B[i] - (double)E[i]);
+        r = rad__check_output(&c, "stochastic radiosity", out, n3);
+    } else if (r == RAD_ERROR_CANCELLED) {
+        rad__log(&c, RAD_LOG_INFO, "stochastic radiosity: cancelled by the progress callback after %u iterations", s.iteration);
+    }
+done:
+    rad__free(&c.allocator, s.cum);
+    rad__free(&c.allocator, s.acc);
+    rad__free(&c.allocator, s.cur);
+    rad__free(&c.allocator, s.B);
+    rad__free(&c.allocator, s.mean);
+    rad__free(&c.allocator, s.est);
+    rad__free(&c.allocator, s.src);
+    rad__free(&c.allocator, s.key);
+    rad__free(&c.allocator, s.dst);
+    rad__free(&c.allocator, s.walk);
+    rad__free(&c.allocator, s.power);
+    rad__free(&c.allocator, s.w.rays);
+    rad__free(&c.allocator, s.w.hits);
     return r;
 }
 
@@ -6347,7 +7037,9 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
     if (mode == RAD_SOURCE_DIRECT) {
         if (!direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
         for (i = 0; i < 3 * patches->count; ++i)
-            if (!rad__finite(direct_irradiance[i]) || direct_irradiance[i] < 0.0f) return RAD_ERROR_NON_FINITE;
+            if (!rad__finite(direct_irradiance[i])) return RAD_ERROR_NON_FINITE;
+        for (i = 0; i < 3 * patches->count; ++i)
+            if (direct_irradiance[i] < 0.0f) return RAD_ERROR_INVALID_ARGUMENT; /* finite but no irradiance */
         for (i = 0; i < 3 * patches->count; ++i) out_E[i] = patches->albedo[i] * direct_irradiance[i];
         return RAD_SUCCESS;
     }

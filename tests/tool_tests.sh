@@ -482,6 +482,38 @@ if "$RAD" render cornell $M -o "$TMP/ref.pfm" > /dev/null 2> "$TMP/err.txt" &&
         [ $rc -eq 1 ] && grep -q "holds no multibounce data" "$TMP/err.txt" &&
             ok "multibounce render rejects a classic bake" || fail "multibounce render rejects a classic bake" "exit $rc"
     fi
+    # stochastic: no F; the patch solution is noisy, so the image approaches classic (the same
+    # patches) as the rays grow (measured 55 dB at the default 64 rays per patch, 59 dB at 100000)
+    if "$RAD" bake cornell --patches 300 --method stochastic --sr-estimator walk -o "$TMP/sr.radb" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell --method stochastic --bake "$TMP/sr.radb" $M -o "$TMP/sr.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        ok "stochastic bakes and renders"
+        ! grep -q "form factors" "$TMP/err.txt" && ok "stochastic builds no form factors" ||
+            fail "stochastic builds no form factors" "$(head -c 300 "$TMP/err.txt")"
+        "$RAD" render cornell --method stochastic --sr-estimator walk $M -o "$TMP/sr_mem.pfm" > /dev/null 2>&1
+        cmp -s "$TMP/sr.pfm" "$TMP/sr_mem.pfm" && ok "stochastic render --bake equals the in-memory bake" ||
+            fail "stochastic render --bake equals the in-memory bake"
+        "$RAD" info "$TMP/sr.radb" > "$TMP/info.txt" 2>&1 &&
+            grep -q "method: stochastic, --sr-estimator walk" "$TMP/info.txt" && ! grep -q "FF_DENSE" "$TMP/info.txt" &&
+            ok "info shows a stochastic bake" || fail "info shows a stochastic bake" "$(head -c 600 "$TMP/info.txt")"
+        psnr_check "stochastic walk ~ classic" "$TMP/ref.pfm" "$TMP/sr.pfm" 45
+        "$RAD" render cornell --method stochastic --bake "$TMP/sr.radb" --sr-rays 5 $M -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt" &&
+            grep -q "fixes .*--sr-\*" "$TMP/err.txt" && ok "stochastic render --bake warns that the bake fixes --sr-rays" ||
+            fail "stochastic render --bake warns that the bake fixes --sr-rays" "$(head -c 300 "$TMP/err.txt")"
+    else
+        fail "stochastic bakes and renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
+    if "$RAD" render cornell $M --method stochastic --threads 1 -o "$TMP/sr1.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell $M --method stochastic --threads 2 -o "$TMP/sr2.pfm" > /dev/null 2>> "$TMP/err.txt" &&
+        "$RAD" render cornell $M --method stochastic --sr-rays 100000 -o "$TMP/srbig.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        cmp -s "$TMP/sr1.pfm" "$TMP/sr2.pfm" && ok "stochastic: same image on 1 and 2 threads" ||
+            fail "stochastic: same image on 1 and 2 threads"
+        p1=$(psnr_of "$TMP/ref.pfm" "$TMP/sr1.pfm") p2=$(psnr_of "$TMP/ref.pfm" "$TMP/srbig.pfm")
+        at_least "$p1" 45 && awk -v a="$p1" -v b="$p2" 'BEGIN { exit !(a != "" && b - a >= 1.5) }' &&
+            ok "stochastic Jacobi approaches classic with more rays (PSNR $p1 dB, $p2 dB at --sr-rays 100000)" ||
+            fail "stochastic Jacobi approaches classic with more rays" "PSNR $p1 dB, $p2 dB at --sr-rays 100000"
+    else
+        fail "stochastic renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
 else
     fail "classic references for multibounce and temporal" "$(head -c 300 "$TMP/err.txt")"
 fi
@@ -587,6 +619,11 @@ rc=$?
 [ $rc -eq 1 ] && grep -q "holds aavp virtual patches, not vp" "$TMP/err.txt" && ok "refuses an aavp bake for --method vp" ||
     fail "refuses an aavp bake for --method vp" "exit $rc: $(head -c 200 "$TMP/err.txt")"
 bad "bake --method local" "method 'local' is render-only" bake cornell --method local -o "$TMP/y.radb"
+bad "--sr-rays with classic" "--sr-rays is for --method stochastic, not classic" render cornell --sr-rays 100 -o "$TMP/y.pfm"
+bad "--sr-estimator foo" "unknown --sr-estimator 'foo'" bake cornell --method stochastic --sr-estimator foo -o "$TMP/y.radb"
+bad "--sr-rays 0" "--sr-rays must be in 1.." render cornell --method stochastic --sr-rays 0 -o "$TMP/y.pfm"
+bad "--bounces with stochastic" "--bounces is for --method multibounce, not stochastic" render cornell --method stochastic --bounces 3 -o "$TMP/y.pfm"
+bad "--sr-iterations with vp" "--sr-iterations is not an option of --method vp" render cornell --method vp --sr-iterations 3 -o "$TMP/y.pfm"
 bad "--format bc5" "unknown --format 'bc5'" bake cornell --method multibounce --format bc5 -o "$TMP/y.radb"
 bad "--format with classic" "--format is for --method multibounce, not classic" bake cornell --format half -o "$TMP/y.radb"
 bad "--outliers with half" "--outliers is for the compressed formats" bake cornell --method multibounce --format half --outliers 0.1 -o "$TMP/y.radb"

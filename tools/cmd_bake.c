@@ -1,6 +1,6 @@
 /* cmd_bake.c - the classic radiosity solution (shared with rad render) and `rad bake`.
 
-   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|aavp|vp] [--solver jacobi|gauss-seidel|direct]
+   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|aavp|vp] [--solver jacobi|gauss-seidel|direct]
             [--bounces K] [--patches N] [--max-edge L] [--samples S] [--light-samples N]
             [method options, see methods.c] [--threads N]
 
@@ -12,8 +12,8 @@
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
    were made with, so `rad render --bake` can check that the file fits the scene (with the
    library's signature section, which also holds the hash of rad.options: rad_tool_sign_options).
-   --method multibounce and temporal bake through methods.c (rad_tool_method_bake); aavp and vp
-   save the virtual patches with sparse rows (bake_vp). */
+   --method multibounce, temporal and stochastic bake through methods.c (rad_tool_method_bake); aavp
+   and vp save the virtual patches with sparse rows (bake_vp). */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -119,17 +119,19 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     n = out->patches->count;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w->scene->triangle_count, n);
 
-    rad_form_factor_options_default(&fo);
-    fo.samples = o->samples;
-    rad_tool_context(&ctx, "form factors");
-    r = rad_form_factors_dense(out->patches, &w->rc, &fo, &ctx, &out->ff);
-    rad_tool_progress_end();
-    if (r != RAD_SUCCESS) {
-        rad_tool_classic_free(out);
-        return rad_tool_fail(cmd, "rad_form_factors_dense", r);
+    if (!(o->sources_only && o->no_form_factors)) {
+        rad_form_factor_options_default(&fo);
+        fo.samples = o->samples;
+        rad_tool_context(&ctx, "form factors");
+        r = rad_form_factors_dense(out->patches, &w->rc, &fo, &ctx, &out->ff);
+        rad_tool_progress_end();
+        if (r != RAD_SUCCESS) {
+            rad_tool_classic_free(out);
+            return rad_tool_fail(cmd, "rad_form_factors_dense", r);
+        }
+        fprintf(stderr, "rad %s: form factors %u x %u (%.1f MB) in %.2f s\n", cmd, n, n, 4.0 * n * (double)n / 1e6,
+                rad_tool_seconds() - t0);
     }
-    fprintf(stderr, "rad %s: form factors %u x %u (%.1f MB) in %.2f s\n", cmd, n, n, 4.0 * n * (double)n / 1e6,
-            rad_tool_seconds() - t0);
 
     out->D = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     out->E = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
@@ -379,17 +381,19 @@ done:
 
 static void bake_usage(FILE *f)
 {
-    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal] [options]\n"
+    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|aavp|vp] [options]\n"
                "Computes patches, form factors and the patches' direct light E = rho D, then by method:\n"
                "  classic      the indirect solution L; saves patches, F, E, B = E + L (and L, H = F B, D)\n"
                "  multibounce  F_mb = sum_k (rho o F)^k, stored as float, half or compressed\n"
                "               (BC1, 3xBC4); saves patches, E, D, F's row sums and F_mb (no F)\n"
                "  temporal     alias tables over the rows of F (or of F_mb's channels); saves\n"
                "               patches, E, D, F's row sums and the tables (no F)\n"
+               "  stochastic   no F: L by stochastic Jacobi or random walks over rays; saves patches, E, D,\n"
+               "               row sums estimated by rays and L\n"
                "  aavp, vp     virtual patches (--vp-resolution, --face-points) with sparse rows and\n"
                "               their E; rad render --method aavp|vp or --proxy aavp|vp --bake loads them\n"
                "  -o FILE            output file (required)\n"
-               "  --method M         classic (default), multibounce, temporal, aavp or vp\n"
+               "  --method M         classic (default), multibounce, temporal, stochastic, aavp or vp\n"
                "%s"
                "%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",

@@ -84,46 +84,14 @@ static void render_usage(FILE *f)
             rad_tool_classic_help(), rad_tool_method_help(1));
 }
 
-/* Per-vertex H, with the halo fix of examples/cornell.c step 7: a patch partly covered (under
-   the light, under a block) has a small H only because part of it sees nothing; H is
-   interpolated as (mean radiosity seen) x (how much is seen, from uncovered patches).
+/* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
    S: the row sums of F (how much of its hemisphere each patch sees). */
 static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv)
 {
-    uint32_t n = P->count, nv = P->vertex_count, i, k;
-    float *S_v = (float *)xmalloc(sizeof(float) * nv);
-    float *S_max = (float *)xmalloc(sizeof(float) * nv), *S_area = (float *)xmalloc(sizeof(float) * nv);
+    rad_context ctx;
     rad_result r;
-    r = rad_patches_vertex_values(P, H, 3, Hv);
-    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(P, S, 1, S_v);
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[i].vertices[k];
-                if (S[i] > S_max[v]) S_max[v] = S[i];
-            }
-        for (i = 0; i < nv; ++i) {
-            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
-            Hv[3 * i] *= scale, Hv[3 * i + 1] *= scale, Hv[3 * i + 2] *= scale;
-            S_v[i] = 0.0f;
-        }
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[i].vertices[k];
-                if (S[i] >= 0.75f * S_max[v]) {
-                    S_v[v] += P->patches[i].area * S[i];
-                    S_area[v] += P->patches[i].area;
-                }
-            }
-        for (i = 0; i < nv; ++i) {
-            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
-            Hv[3 * i] *= s_v, Hv[3 * i + 1] *= s_v, Hv[3 * i + 2] *= s_v;
-        }
-    }
-    free(S_v);
-    free(S_max);
-    free(S_area);
+    rad_tool_context(&ctx, NULL);
+    r = rad_patches_vertex_irradiance(P, H, S, Hv, &ctx);
     return r == RAD_SUCCESS ? 0 : rad_tool_fail("render", "per-vertex H", r);
 }
 
@@ -468,7 +436,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         if (mo->method == RAD_TOOL_TEMPORAL)
             fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
                     cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
-        else
+        else if (mo->method == RAD_TOOL_MULTIBOUNCE)
             fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
         rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
     }
@@ -502,9 +470,10 @@ static int render_with_method(const char *cmd, const rad_tool_world *w, const ch
     int rc;
     rad_tool_context(&ctx, NULL);
     if (bake_path) {
-        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE))
-            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile "
-                            "and --mode; those given here are ignored\n",
+        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_SR |
+                         (mo->method == RAD_TOOL_STOCHASTIC ? RAD_TOOL_OPT_SEED : 0u)))
+            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile, "
+                            "--mode, --sr-* (and the stochastic solve's --seed); those given here are ignored\n",
                     cmd, bake_path);
         if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
             fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
@@ -1107,7 +1076,8 @@ int rad_cmd_render(int argc, char **argv)
         }
         if (!emitters && !w.file.light_count)
             fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL) && !mo.proxy && !pathtrace && !bake_path &&
+        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC) &&
+            !mo.proxy && !pathtrace && !bake_path &&
             o.patches < w.scene->triangle_count)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                     cmd, o.patches, w.scene->triangle_count);
@@ -1132,7 +1102,7 @@ int rad_cmd_render(int argc, char **argv)
             rad_tool_close_world(&w);
             return 1;
         }
-    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL) {
+    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_STOCHASTIC) {
         rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                 &img);
         if (rc) {

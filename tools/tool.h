@@ -187,6 +187,7 @@ typedef struct rad_tool_classic_options {
     uint32_t bounces;        /* --bounces K (Jacobi; default 64) */
     uint32_t light_samples;  /* --light-samples N: shadow rays per point (default 16) */
     int sources_only;        /* 1: rad_tool_classic_solve stops after E (L, B, H stay NULL) */
+    int no_form_factors;     /* with sources_only: F is not built (ff stays NULL; --method stochastic) */
 } rad_tool_classic_options;
 void rad_tool_classic_options_default(rad_tool_classic_options *o);
 /* argv[*a] is one of the options above: parses it (and its value, advancing *a) and returns
@@ -238,7 +239,8 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
 /* ---- the multi-bounce and temporal methods (methods.c) ------------------------------------ */
 typedef enum rad_tool_method {
     RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
-    RAD_TOOL_LOCAL = 4, RAD_TOOL_VP = 5, RAD_TOOL_AAVP = 6 /* render only (cmd_render.c) */
+    RAD_TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
+    RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7 /* render only (cmd_render.c); vp, aavp also bake_vp (cmd_bake.c) */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
 typedef enum rad_tool_mb_format {
@@ -268,6 +270,9 @@ typedef struct rad_tool_method_options {
     uint32_t face_points;     /* --face-points P: Hammersley points per voxel face (default 16) */
     uint32_t local_m;         /* --local-m M: local matrix capacity, at most the patches (0, the
                                  default: every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX) */
+    uint32_t sr_rays;         /* --sr-rays N: stochastic rays of the first iteration / walks (0: the library's 64 per patch) */
+    uint32_t sr_iterations;   /* --sr-iterations N: Jacobi shooting iterations at most / walk batches (0: the library's) */
+    uint32_t sr_estimator;    /* --sr-estimator jacobi|walk: a rad_stochastic_method (default jacobi) */
     uint32_t proxy;           /* --proxy patches|aavp|vp (rad_tool_proxy; render, with multibounce,
                                  temporal and local: the method runs over virtual patches) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
@@ -281,8 +286,10 @@ enum {
     RAD_TOOL_OPT_MODE = 1u << 6, RAD_TOOL_OPT_K = 1u << 7, RAD_TOOL_OPT_W = 1u << 8, RAD_TOOL_OPT_ADAPTIVE = 1u << 9,
     RAD_TOOL_OPT_SEED = 1u << 10, RAD_TOOL_OPT_FRAMES = 1u << 11, RAD_TOOL_OPT_SEQUENCE = 1u << 12,
     RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14, RAD_TOOL_OPT_VP_RESOLUTION = 1u << 15,
-    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18
+    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18,
+    RAD_TOOL_OPT_SR_RAYS = 1u << 19, RAD_TOOL_OPT_SR_ITERATIONS = 1u << 20, RAD_TOOL_OPT_SR_ESTIMATOR = 1u << 21
 };
+#define RAD_TOOL_OPT_SR (RAD_TOOL_OPT_SR_RAYS | RAD_TOOL_OPT_SR_ITERATIONS | RAD_TOOL_OPT_SR_ESTIMATOR)
 #define RAD_TOOL_OPT_VP (RAD_TOOL_OPT_VP_RESOLUTION | RAD_TOOL_OPT_VP_MAX_PATCHES | RAD_TOOL_OPT_FACE_POINTS)
 #define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
                                RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
@@ -304,8 +311,12 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
 const char *rad_tool_method_help(int render);
 const char *rad_tool_method_name(rad_tool_method method);
 
-/* The user sections the two methods add: what was built, and the row sums S_i of F (the
-   halo correction of the per-vertex H needs them and these bakes hold no F). */
+/* The user sections the methods add: what was built, and the row sums S_i of F (the halo
+   correction of the per-vertex H needs them and these bakes hold no F). --method stochastic
+   keeps its options in the same record: rays in k, iterations in bounces, the estimator in
+   mode, the seed in seed, the solve's seconds in build_seconds and its rays cast in
+   bytes_lo/bytes_hi; its bake holds the solution L as the vector "L" and row sums estimated
+   by rays (it builds no F). */
 typedef struct rad_tool_method_info {
     uint32_t magic;           /* 0x5241444D */
     uint32_t method;          /* RAD_TOOL_MULTIBOUNCE or RAD_TOOL_TEMPORAL */
