@@ -3,6 +3,7 @@
 #   make gallery every lighting model on rows of spheres, to gallery.png
 #   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
 #   make learn   builds the teaching examples examples/learn_*.c into build/
+#   make build/realtime  examples/realtime.c: per-frame light, E, temporal step and gather over AAVP
 #   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
@@ -26,7 +27,7 @@ RAD_DATA_DIR ?=
 
 .PHONY: all demo gallery walk learn moving-light test bench bench-quick tools fuzz clean glsl report report-quick
 
-all: $(BUILD)/cornell $(BUILD)/walk tools
+all: $(BUILD)/cornell $(BUILD)/walk $(BUILD)/realtime tools
 
 $(BUILD):
 	mkdir -p $(BUILD)
@@ -41,6 +42,10 @@ $(BUILD)/learn_hierarchical: examples/learn_hierarchical.c examples/png_write.h 
 # virtual patches on the bunny in the Cornell box (needs $(RAD_DATA_DIR); --ogre for 193k triangles)
 $(BUILD)/vp_bunny: examples/vp_bunny.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/vp_bunny.c -o $@ -lm
+
+# the per-frame engine loop over virtual patches (a mesh as argument, else the Cornell box)
+$(BUILD)/realtime: examples/realtime.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/realtime.c -o $@ -lm
 
 demo: $(BUILD)/cornell
 	./$(BUILD)/cornell -o cornell.png

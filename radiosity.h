@@ -2130,7 +2130,9 @@ RAD_API rad_result rad_row_source_bake(const rad_bake *bake, rad_row_source *out
    and values with two seeks and two reads, so the matrix is never in memory. The matrix
    sections' checksums are not verified (that would read them whole): every fetched row is
    checked instead (strictly ascending columns < N, finite values >= 0; CORRUPT otherwise,
-   logged through the context given here).
+   logged through the context given here). A file of virtual patches (rad_vp_sections) works
+   the same way: its RAD_SECTION_VP_AREAS and _ALBEDO stand for the patches (checked: areas
+   finite and > 0, albedos in [0, 1)).
    Errors: IO (the file cannot be opened or read), TRUNCATED, CORRUPT, VERSION, ALBEDO_RANGE,
    INVALID_ARGUMENT (no CSR matrix in the file), OUT_OF_MEMORY. Thread safety: one stream per
    thread (fetches move the file position). Seeks go through fseek, so where long is 32 bits
@@ -2383,6 +2385,19 @@ RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format
 RAD_API rad_result rad_alias_tables_create_dense(const float *plane, uint32_t n, rad_alias_format format,
                                                  const rad_context *ctx, rad_alias_tables **out);
 
+/* Tables for every row of a rad_row_source (>>api_local): rows fetched one at a time, from
+   memory or streamed from a file (rad_row_stream_open, also over a saved virtual-patch set), so
+   the matrix is never held whole: memory is the tables' O(nnz) plus one row. Each row is read
+   twice (a pass that counts the bins, then the build); a row whose columns do not ascend is
+   sorted first, so the bins equal those of rad_alias_tables_create on the same matrix, bit for
+   bit. Fetches run on the calling thread (a stream needs no lock), the builds too.
+   Errors: INVALID_ARGUMENT (NULL, a source without fetch, N = 0, compact with N > 65535, a
+   negative or non-finite entry, a column >= N or twice in a row: the logger names it), the
+   fetch's own errors, SIZE_OVERFLOW, OUT_OF_MEMORY, CANCELLED (progress). Cost: O(nnz log)
+   plus two reads of every row. docs/methods/temporal.md. */
+RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *source, rad_alias_format format,
+                                                const rad_context *ctx, rad_alias_tables **out);
+
 RAD_API void rad_alias_tables_destroy(rad_alias_tables *tables);
 
 /* Bytes the tables' bins, offsets and totals take. */
@@ -2560,7 +2575,8 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    v. When a voxel pair has at most that many pairs, every pair gets its ray and V_uv is the
    kernel-weighted mean. V_uv is shared by both directions, so reciprocity is unchanged. The
    pair list of one voxel pair is thinned systematically beyond 16384 entries.
-   MEMORY (peak, through ctx's allocator): the N x N float matrix, about 100 bytes per sample,
+   MEMORY (peak, through ctx's allocator): the N x N float matrix (sparse rows: see SPARSE
+   ROWS), about 100 bytes per sample,
    T x (6 N doubles + 1024 rays + 16384 12-byte pair records) of task scratch (T = the
    context's task count, at most the voxel count), 4 bytes per triangle, 16 bytes per
    triangle-voxel overlap and 64 per candidate voxel, the face-ray hits of a chunk of
@@ -2574,8 +2590,25 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    with a similar patch count: 0.984 and 0.979).
    COST: O(M^2) kernel evaluations and up to M^2/2 shadow rays for M samples; M grows with the
    number of non-empty voxels times 6 face_points (times the hit rate).
-   USE: rad_vp_system makes a rad_system for every classic solver (the matrix is dense
-   row-major rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
+   SPARSE ROWS (storage = RAD_STORAGE_SPARSE): after step 6 the matrix is kept as CSR with the
+   entries F_ab <= drop_threshold left out (exact zeros always: pairs of voxels that see each
+   other not at all), and the dense build matrix is freed, so the object holds O(nnz), not
+   N^2: 8 bytes per kept entry (column and value) and 8 per row. The build never holds the
+   N x N matrix either: step 5 runs over chunks of row voxels whose float rows fit
+   RAD_VP_ROW_CHUNK_BYTES (32 MiB unless defined otherwise before the implementation; at least
+   one voxel's rows), keeps each chunk's non-zeros (the upper parts, columns from the row
+   voxel on) as CSR, then mirrors them into full rows and applies step 6 and the threshold on
+   the non-zeros: peak about that chunk plus 12 bytes per non-zero (upper parts and full rows
+   together) besides the rest of MEMORY above. The values are the dense build's, bit for bit. Dropping entries lowers the row sums by the dropped mass (the
+   environment entry of temporal radiosity picks it up as unreached light); reciprocity holds
+   for every pair where both entries are kept. Every run-time method takes vp->matrix as it
+   is (CSR or dense): rad_solve_*, rad_matrix_multiply, rad_multibounce_create,
+   rad_alias_tables_create (temporal radiosity), rad_row_source_matrix with vp->areas and
+   vp->albedo (the local matrix, rad_alias_build_row on rows fetched one at a time), and
+   rad_vp_sections / rad_vp_load (>>api_vp, container) with rad_row_stream_open, which
+   streams the rows of a saved set from its file.
+   USE: rad_vp_system makes a rad_system for every classic solver (the matrix is a dense
+   row-major or CSR rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
    brings any per-patch value (B, L, the irradiance H = F (E + L)) back to surface points with
    normal weights and trilinear filtering that skips voxels without a patch facing the normal.
    GENERAL VIRTUAL PATCHES (kind RAD_VP_CLUSTERED, docs/methods/virtual-patches.md). Per voxel every sample
@@ -2628,6 +2661,10 @@ typedef struct rad_vp_options {
     uint32_t max_clusters;    /* RAD_VP_CLUSTERED: Q, patches per voxel at most (1..6, default 6) */
     uint32_t metric_columns;  /* RAD_VP_CLUSTERED: samples used as the columns k of the metric's
                                  form-factor term (default 64, at most 4096) */
+    rad_storage storage;      /* of vp->matrix: RAD_STORAGE_DENSE (default) or RAD_STORAGE_SPARSE
+                                 (CSR, see SPARSE ROWS in the section comment) */
+    float drop_threshold;     /* RAD_STORAGE_SPARSE: entries F_ab <= it are dropped (0 keeps every
+                                 non-zero; >= 0, finite) */
 } rad_vp_options;
 
 /* Axis-aligned virtual patches with their form factors. Read-only after creation.
@@ -2668,6 +2705,7 @@ typedef struct rad_virtual_patches {
     rad_vp_kind kind;
     rad_vp_weights weights;
     rad_allocator allocator;    /* private */
+    uint32_t info_record[16];   /* private: the RAD_SECTION_VP_INFO record (rad_vp_sections) */
 } rad_virtual_patches;
 
 RAD_API void rad_vp_options_default(rad_vp_options *options);
@@ -2747,6 +2785,52 @@ RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *val
    gets 0). Errors: INVALID_ARGUMENT, INDEX_OUT_OF_RANGE, NON_FINITE, OUT_OF_MEMORY. */
 RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
                                       float *out, const rad_context *ctx);
+
+/* CONTAINER (docs/methods/container.md): a whole set, so that an application bakes it once and
+   loads it at start-up (rad bake --method aavp|vp). rad_vp_sections lists the set as sections
+   named 'name' (up to 23 characters; every section shares it; data borrowed from vp):
+   RAD_SECTION_VP_INFO (16 uint32: kind, weights, N, voxel_count, M, dims[3], the bit patterns
+   of origin[3] and voxel_size[3], candidate_voxels, 0), the per-patch, per-voxel and
+   per-sample arrays of rad_virtual_patches (types RAD_SECTION_VP_AREAS .. _SAMPLE_TRIANGLES,
+   one each, in the struct's layout), and the matrix as RAD_SECTION_FF_DENSE or the three
+   RAD_SECTION_FF_ROW_OFFSETS / _COLUMNS / _VALUES sections (CSR), so that
+   rad_row_stream_open streams the rows of a saved set from its file as it does a classic
+   bake's (it takes the areas and albedos from these sections when the file has no patches).
+   *out_count receives how many were written (at most RAD_VP_MAX_SECTIONS). Errors:
+   INVALID_ARGUMENT. */
+#define RAD_SECTION_VP_INFO 40u
+#define RAD_SECTION_VP_AREAS 41u            /* N floats */
+#define RAD_SECTION_VP_ALBEDO 42u           /* 3 N floats */
+#define RAD_SECTION_VP_NORMALS 43u          /* 3 N floats */
+#define RAD_SECTION_VP_AXIS 44u             /* N uint8 */
+#define RAD_SECTION_VP_VOXEL 45u            /* N uint32 */
+#define RAD_SECTION_VP_VOXEL_KEYS 46u       /* voxel_count uint64 */
+#define RAD_SECTION_VP_VOXEL_FIRST 47u      /* voxel_count + 1 uint32 */
+#define RAD_SECTION_VP_VOXEL_PATCH 48u      /* 6 uint32 per voxel */
+#define RAD_SECTION_VP_SAMPLE_FIRST 49u     /* voxel_count + 1 uint32 */
+#define RAD_SECTION_VP_SAMPLE_POSITIONS 50u /* 3 M floats */
+#define RAD_SECTION_VP_SAMPLE_NORMALS 51u   /* 3 M floats */
+#define RAD_SECTION_VP_SAMPLE_ALBEDO 52u    /* 3 M floats */
+#define RAD_SECTION_VP_SAMPLE_AREAS 53u     /* M floats */
+#define RAD_SECTION_VP_SAMPLE_WEIGHTS 54u   /* 6 M floats */
+#define RAD_SECTION_VP_SAMPLE_TRIANGLES 55u /* M uint32 */
+#define RAD_VP_MAX_SECTIONS 19u
+RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count);
+
+/* A set read back from the sections named 'name' of a container: an owning copy (the
+   container may be closed after), destroyed with rad_vp_destroy, holding the same bits
+   (face_rays and pair_rays, not saved, are 0). scene: the scene the set was built from
+   (borrowed, must outlive the set; NULL allowed, but then rad_vp_sources refuses the set);
+   with a scene every sample triangle must be below its triangle count. Every index and value
+   is checked once (VALUES of >>api_container, and: kind and weights known, the voxel keys
+   ascending inside the grid, voxel_first and sample_first monotone from 0 to N and M, each
+   patch in the voxel whose range holds it, voxel_patch entries RAD_NONE or a patch of that
+   voxel, axis < 6, areas > 0, albedos in [0, 1), a square N x N matrix with CSR rows ascending
+   and values >= 0). Errors: INVALID_ARGUMENT (NULL, or no VP_INFO section of that name),
+   CORRUPT (a missing or inconsistent section: the logger names it), NON_FINITE,
+   INDEX_OUT_OF_RANGE (a sample triangle beyond the scene), OUT_OF_MEMORY. Cost: O(size). */
+RAD_API rad_result rad_vp_load(const rad_container *container, const char *name, const rad_scene *scene,
+                               const rad_context *ctx, rad_virtual_patches **out);
 
 /* ======================================================================================== */
 /* >>api_probes: irradiance probes (SH L2) from a patch solution                            */
@@ -13297,8 +13381,8 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
     rad__ctx c;
     rad_row_stream *s;
     unsigned char head[RAD__HEADER_BYTES], *table = NULL, *buf = NULL;
-    uint64_t file_size, actual, off[4] = {0, 0, 0, 0}, cnt[4] = {0, 0, 0, 0};
-    uint32_t count, i, crc[4] = {0, 0, 0, 0}, found = 0;
+    uint64_t file_size, actual, off[6] = {0, 0, 0, 0, 0, 0}, cnt[6] = {0, 0, 0, 0, 0, 0};
+    uint32_t count, i, crc[6] = {0, 0, 0, 0, 0, 0}, found = 0, vps = 0;
     long end;
     rad_result r = RAD_SUCCESS;
     rad__ctx_init(&c, ctx);
@@ -13362,6 +13446,8 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
         uint32_t type = rad__get32(e), esz = rad__get32(e + 4), want, slot;
         uint64_t n = rad__get64(e + 8), at = rad__get64(e + 16), bytes = rad__get64(e + 24);
         if (type == RAD_SECTION_PATCHES) { slot = 0; want = (uint32_t)sizeof(rad_patch); }
+        else if (type == RAD_SECTION_VP_AREAS) { slot = 4; want = 4u; }
+        else if (type == RAD_SECTION_VP_ALBEDO) { slot = 5; want = 12u; }
         else if (type == RAD_SECTION_FF_ROW_OFFSETS) { slot = 1; want = 8u; }
         else if (type == RAD_SECTION_FF_COLUMNS) { slot = 2; want = 4u; }
         else if (type == RAD_SECTION_FF_VALUES) { slot = 3; want = 4u; }
@@ -13377,9 +13463,15 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
         crc[slot] = rad__get32(e + 32);
         found |= 1u << slot;
     }
-    if (found != 15u || cnt[0] == 0 || cnt[0] > 0xFFFFFFFEu || cnt[1] != cnt[0] + 1 || cnt[2] != cnt[3]) {
+    /* a saved virtual-patch set (rad_vp_sections): its areas and albedos stand for the patches */
+    if (!(found & 1u) && (found & 48u) == 48u && cnt[4] == cnt[5]) {
+        vps = 1;
+        off[0] = off[4], cnt[0] = cnt[4], crc[0] = crc[4];
+        found |= 1u;
+    }
+    if ((found & 15u) != 15u || cnt[0] == 0 || cnt[0] > 0xFFFFFFFEu || cnt[1] != cnt[0] + 1 || cnt[2] != cnt[3]) {
         rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' holds no patches with a CSR form-factor matrix of matching size", path);
-        r = found != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
+        r = (found & 15u) != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
         goto fail;
     }
     s->n = (uint32_t)cnt[0];
@@ -13388,25 +13480,45 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
     s->areas = (float *)rad__alloc_array(&c.allocator, s->n, sizeof(float));
     s->albedo = (float *)rad__alloc_array(&c.allocator, s->n, 3 * sizeof(float));
     s->offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)s->n + 1u, sizeof(uint64_t));
-    buf = (unsigned char *)rad__alloc_array(&c.allocator, s->n, sizeof(rad_patch));
+    buf = (unsigned char *)rad__alloc_array(&c.allocator, s->n, vps ? 12u : sizeof(rad_patch));
     if (!s->areas || !s->albedo || !s->offsets || !buf) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
     s->bytes = sizeof(*s) + (size_t)s->n * 16u + ((size_t)s->n + 1u) * 8u;
-    if (!rad__stream_read(s->f, off[0], buf, (size_t)s->n * sizeof(rad_patch)) ||
+    if (!rad__stream_read(s->f, off[0], vps ? (void *)s->areas : (void *)buf, (size_t)s->n * (vps ? 4u : sizeof(rad_patch))) ||
+        (vps && !rad__stream_read(s->f, off[5], buf, (size_t)s->n * 12u)) ||
         !rad__stream_read(s->f, off[1], s->offsets, ((size_t)s->n + 1u) * 8u)) {
         r = RAD_ERROR_IO;
         goto fail;
     }
-    if (rad__crc32(buf, (size_t)s->n * sizeof(rad_patch)) != crc[0] || rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != crc[1]) {
+    if ((vps ? rad__crc32((const unsigned char *)s->areas, (size_t)s->n * 4u) != crc[0] ||
+                   rad__crc32(buf, (size_t)s->n * 12u) != crc[5]
+             : rad__crc32(buf, (size_t)s->n * sizeof(rad_patch)) != crc[0]) ||
+        rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != crc[1]) {
         rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': checksum mismatch in the patches or the row offsets", path);
         r = RAD_ERROR_CORRUPT;
         goto fail;
     }
     for (i = 0; i < s->n; ++i) {
-        rad_patch p;
         uint32_t k;
-        memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
-        s->areas[i] = p.area;
-        for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
+        if (vps) {
+            memcpy(s->albedo + 3 * (size_t)i, buf + 12u * (size_t)i, 12);
+        } else {
+            rad_patch p;
+            memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
+            s->areas[i] = p.area;
+            for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
+        }
+        for (k = 0; vps && k < 3; ++k) /* the patches' loader checked a classic bake's */
+            if (!(s->albedo[3 * (size_t)i + k] >= 0.0f && s->albedo[3 * (size_t)i + k] < 1.0f)) {
+                rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has albedo %g (must be in [0, 1))", path, i,
+                         (double)s->albedo[3 * (size_t)i + k]);
+                r = RAD_ERROR_ALBEDO_RANGE;
+                goto fail;
+            }
+        if (vps && (!(s->areas[i] > 0.0f) || !rad__finite(s->areas[i]))) {
+            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has area %g", path, i, (double)s->areas[i]);
+            r = RAD_ERROR_CORRUPT;
+            goto fail;
+        }
         if (s->offsets[i + 1] < s->offsets[i]) {
             rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets decrease at row %u", path, i);
             r = RAD_ERROR_CORRUPT;
@@ -14763,6 +14875,143 @@ RAD_API rad_result rad_alias_tables_create_dense(const float *plane, uint32_t n,
     return rad__alias_build(NULL, plane, n, format, ctx, out);
 }
 
+/* sorts a fetched row by column (shell sort on the pairs; fetched rows are short and mostly
+   ascending already) and refuses a column that repeats */
+static int rad__alias_sort_row(uint32_t *cols, float *vals, uint32_t count)
+{
+    static const uint32_t gaps[] = { 1750u, 701u, 301u, 132u, 57u, 23u, 10u, 4u, 1u };
+    uint32_t g, i, k;
+    for (i = 1; i < count && cols[i - 1] < cols[i]; ++i) {}
+    if (i >= count) return 1;
+    for (g = 0; g < sizeof(gaps) / sizeof(gaps[0]); ++g) {
+        uint32_t h = gaps[g];
+        for (i = h; i < count; ++i) {
+            uint32_t c = cols[i];
+            float v = vals[i];
+            for (k = i; k >= h && cols[k - h] > c; k -= h) cols[k] = cols[k - h], vals[k] = vals[k - h];
+            cols[k] = c, vals[k] = v;
+        }
+    }
+    for (i = 1; i < count; ++i)
+        if (cols[i] == cols[i - 1]) return 0;
+    return 1;
+}
+
+RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *src, rad_alias_format format, const rad_context *ctx,
+                                                rad_alias_tables **out)
+{
+    rad__ctx c;
+    rad_alias_tables *t = NULL;
+    rad_result r = RAD_SUCCESS;
+    uint64_t *off = NULL, sum = 0;
+    uint32_t *cols = NULL, n, i, count, nb, pass;
+    float *vals = NULL;
+    void *scratch = NULL;
+    unsigned char *base = NULL;
+    size_t off_bytes, tot_bytes, bin_bytes, tot_off, bins_off, total;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!src || !out || !src->fetch || src->n == 0 || src->n == 0xFFFFFFFFu) return RAD_ERROR_INVALID_ARGUMENT;
+    n = src->n;
+    format = rad__alias_resolve(format, n);
+    if ((format != RAD_ALIAS_COMPACT && format != RAD_ALIAS_WIDE) || (format == RAD_ALIAS_COMPACT && n > 65535u)) {
+        rad__log(&c, RAD_LOG_ERROR, "alias tables: bad format for N = %u (compact needs N <= 65535)", n);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    off = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)n + 1u, sizeof(uint64_t));
+    cols = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    vals = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
+    scratch = rad__alloc(&c.allocator, rad_alias_row_scratch_size(n));
+    if (!off || !cols || !vals || !scratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    off[0] = 0;
+    for (pass = 1; pass <= 2 && r == RAD_SUCCESS; ++pass) {
+        if (pass == 2) {
+            /* one block as rad_alias_tables_create's: offsets | totals | bins */
+            if (!rad__mul((size_t)n + 1u, sizeof(uint64_t), &off_bytes) || !rad__mul((size_t)n, sizeof(float), &tot_bytes) ||
+                sum > (uint64_t)((size_t)-1) || !rad__mul3((size_t)sum, (size_t)format, sizeof(uint32_t), &bin_bytes)) {
+                r = RAD_ERROR_SIZE_OVERFLOW;
+                break;
+            }
+            tot_off = off_bytes;
+            bins_off = tot_off + ((tot_bytes + 7u) & ~(size_t)7u);
+            total = bins_off + bin_bytes;
+            if (total < bin_bytes) { r = RAD_ERROR_SIZE_OVERFLOW; break; }
+            t = (rad_alias_tables *)rad__alloc(&c.allocator, sizeof(rad_alias_tables));
+            if (!t) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
+            memset(t, 0, sizeof(*t));
+            t->allocator = c.allocator;
+            base = rad__alias_alloc(&c.allocator, total, &t->storage);
+            if (!base) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
+            memcpy(base, off, off_bytes);
+            t->row_offsets = (const uint64_t *)(void *)base;
+            t->totals = (const float *)(void *)(base + tot_off);
+            t->bins = (const uint32_t *)(void *)(base + bins_off);
+            sum = 0;
+        }
+        for (i = 0; i < n; ++i) {
+            count = 0;
+            if ((r = src->fetch(src->user, i, n, cols, vals, &count)) != RAD_SUCCESS) {
+                rad__log(&c, RAD_LOG_ERROR, "alias tables: fetching row %u failed: %s", i, rad_result_string(r));
+                break;
+            }
+            if (count > n || !rad__alias_sort_row(cols, vals, count)) {
+                rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u has %u entries or a column twice (N = %u)", i, count, n);
+                r = RAD_ERROR_INVALID_ARGUMENT;
+                break;
+            }
+            if (pass == 1) {
+                double W = 0.0;
+                uint32_t k;
+                nb = 0;
+                for (k = 0; k < count; ++k) {
+                    if (!rad__finite(vals[k]) || vals[k] < 0.0f || cols[k] >= n) {
+                        rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u entry %u (column %u) is %g: entries must be finite, "
+                                 ">= 0, column < %u", i, k, cols[k], (double)vals[k], n);
+                        r = RAD_ERROR_INVALID_ARGUMENT;
+                        break;
+                    }
+                    if (vals[k] > 0.0f) { ++nb; W += (double)vals[k]; }
+                }
+                if (r != RAD_SUCCESS) break;
+                if (1.0 - W > 0.0) ++nb;
+                sum += nb;
+                off[i + 1] = sum;
+            } else {
+                float tot;
+                r = rad__alias_row(cols, vals, count, n, format, (uint32_t *)(void *)(base + bins_off) + (size_t)off[i] * (uint32_t)format,
+                                   &nb, &tot, scratch, &c, i);
+                if (r != RAD_SUCCESS) break;
+                if (nb != off[i + 1] - off[i]) {
+                    rad__log(&c, RAD_LOG_ERROR, "alias tables: row %u changed between its two reads", i);
+                    r = RAD_ERROR_CORRUPT;
+                    break;
+                }
+                ((float *)(void *)(base + tot_off))[i] = tot;
+                sum += count;
+            }
+            if (c.progress && (i & 255u) == 255u &&
+                c.progress(c.progress_user, 0.5f * (float)(pass - 1) + 0.5f * (float)(i + 1) / (float)n)) {
+                r = RAD_ERROR_CANCELLED;
+                break;
+            }
+        }
+    }
+    if (r == RAD_SUCCESS) {
+        t->rows = t->cols = n;
+        t->format = format;
+        t->source_entries = sum;
+        *out = t;
+        t = NULL;
+    }
+done:
+    rad_alias_tables_destroy(t);
+    rad__free(&c.allocator, off);
+    rad__free(&c.allocator, cols);
+    rad__free(&c.allocator, vals);
+    rad__free(&c.allocator, scratch);
+    return r;
+}
+
 RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section out[3])
 {
     if (!out) return;
@@ -15483,6 +15732,13 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
 /* >>vp: virtual patches (voxels, face-ray samples, axis-aligned patches, gathering)       */
 /* ======================================================================================== */
 
+/* SPARSE ROWS: the most bytes of float rows the build holds at once (one voxel's rows when
+   that is more). Define it before the implementation to change the peak memory; no result
+   depends on it. */
+#ifndef RAD_VP_ROW_CHUNK_BYTES
+#define RAD_VP_ROW_CHUNK_BYTES (32u << 20)
+#endif
+
 #define RAD__VP_MARGIN 0.4827f           /* voxels of padding around the scene bounds */
 #define RAD__VP_CHUNK_RAYS (1u << 21)     /* face-ray hits kept at once */
 #define RAD__VP_PAIRS 16384u              /* pair records per task for sampled visibility */
@@ -15539,6 +15795,9 @@ RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
     rad__free(&a, vp->axis);
     rad__free(&a, vp->voxel);
     rad__free(&a, (void *)vp->matrix.dense);
+    rad__free(&a, (void *)vp->matrix.row_offsets);
+    rad__free(&a, (void *)vp->matrix.columns);
+    rad__free(&a, (void *)vp->matrix.values);
     rad__free(&a, vp->voxel_keys);
     rad__free(&a, vp->voxel_first);
     rad__free(&a, vp->voxel_patch);
@@ -15554,12 +15813,15 @@ RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
 
 RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp)
 {
-    size_t n, m, v;
+    size_t n, m, v, f;
     if (!vp) return 0;
     n = vp->count;
     m = vp->sample_count;
     v = vp->voxel_count;
-    return sizeof(*vp) + n * n * sizeof(float) + n * (8 * sizeof(float) + 1 + sizeof(uint32_t)) +
+    f = vp->matrix.storage == RAD_STORAGE_SPARSE && vp->matrix.row_offsets
+            ? (size_t)vp->matrix.row_offsets[n] * (sizeof(uint32_t) + sizeof(float)) + (n + 1) * sizeof(uint64_t)
+            : n * n * sizeof(float);
+    return sizeof(*vp) + f + n * (8 * sizeof(float) + 1 + sizeof(uint32_t)) +
            v * (sizeof(uint64_t) + 8 * sizeof(uint32_t)) + 2 * sizeof(uint32_t) +
            m * (16 * sizeof(float) + sizeof(uint32_t));
 }
@@ -15594,7 +15856,8 @@ typedef struct rad__vp_build {
     uint8_t *slot, *ncl;         /* per sample: cluster slot; per voxel: cluster count */
     struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
     uint64_t *rays_cast;         /* per task */
-    float *P;                    /* N x N */
+    float *P;                    /* N x N, or (sparse rows) the rows of a chunk of voxels */
+    uint32_t voxel_base, p_base; /* sparse rows: the chunk's first voxel and first patch */
     int count_only;              /* rad_vp_count: stop once the patches are counted (step 4) */
 } rad__vp_build;
 
@@ -15735,7 +15998,7 @@ static rad_result rad__vp_ff_row(void *data, uint32_t u, uint32_t task)
     for (a = 0; a < 6; ++a) {
         uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
         if (p == RAD_NONE) continue;
-        for (c = pf; c < N; ++c) b->P[(size_t)p * N + c] = (float)acc[(size_t)a * N + c];
+        for (c = pf; c < N; ++c) b->P[(size_t)(p - b->p_base) * N + c] = (float)acc[(size_t)a * N + c];
     }
     return RAD_SUCCESS;
 }
@@ -15880,7 +16143,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
     for (a = 0; a < 6; ++a) {
         uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
         if (p == RAD_NONE) continue;
-        for (c = pf; c < N; ++c) b->P[(size_t)p * N + c] = (float)acc[(size_t)a * N + c];
+        for (c = pf; c < N; ++c) b->P[(size_t)(p - b->p_base) * N + c] = (float)acc[(size_t)a * N + c];
     }
     return RAD_SUCCESS;
 }
@@ -15918,6 +16181,172 @@ static rad_result rad__vp_divide_row(void *data, uint32_t p, uint32_t task)
     double inv = 1.0 / (double)b->vp->areas[p];
     (void)task;
     for (c = 0; c < N; ++c) row[c] = (float)((double)row[c] * (double)(cp < b->rowf[c] ? cp : b->rowf[c]) * inv);
+    return RAD_SUCCESS;
+}
+
+/* SPARSE ROWS: row voxel voxel_base + row of the current chunk */
+static rad_result rad__vp_ff_chunk(void *data, uint32_t row, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    return b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled(data, b->voxel_base + row, task)
+                                    : rad__vp_ff_row(data, b->voxel_base + row, task);
+}
+
+/* grows a CSR pair of arrays (columns, values) to hold 'need' entries */
+static int rad__vp_grow_csr(const rad_allocator *A, uint32_t **col, float **val, uint64_t *cap, uint64_t need)
+{
+    uint64_t nc = *cap ? *cap : 4096u;
+    uint32_t *c2;
+    float *v2;
+    if (need <= *cap) return 1;
+    while (nc < need) nc *= 2u;
+    if (nc > (uint64_t)((size_t)-1 / 4u)) return 0;
+    c2 = (uint32_t *)rad__alloc_array(A, (size_t)nc, sizeof(uint32_t));
+    v2 = (float *)rad__alloc_array(A, (size_t)nc, sizeof(float));
+    if (!c2 || !v2) {
+        rad__free(A, c2);
+        rad__free(A, v2);
+        return 0;
+    }
+    if (*cap) {
+        memcpy(c2, *col, (size_t)*cap * sizeof(uint32_t));
+        memcpy(v2, *val, (size_t)*cap * sizeof(float));
+    }
+    rad__free(A, *col);
+    rad__free(A, *val);
+    *col = c2, *val = v2, *cap = nc;
+    return 1;
+}
+
+/* SPARSE ROWS: step 5 over chunks of row voxels whose rows fit 'budget' bytes of b->P, each
+   chunk's upper parts (columns from the row voxel's first patch on) kept as CSR; then the
+   mirror, step 6 and the drop threshold on the CSR rows. The entries and their arithmetic are
+   those of the dense path, so the kept values are the same bits. */
+static rad_result rad__vp_sparse_rows(rad__vp_build *b, const rad__ctx *c, uint32_t T, size_t budget)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_allocator *A = &vp->allocator;
+    uint32_t N = vp->count, V = vp->voxel_count, v0, v1, p, *ucol = NULL, *col = NULL, *lcnt = NULL;
+    uint64_t *uoff = NULL, *off = NULL, *pos = NULL, ucap = 0, k = 0, e, kept = 0;
+    float *uval = NULL, *val = NULL;
+    rad__ctx quiet = *c;
+    rad_result r = RAD_SUCCESS;
+    quiet.progress = NULL;
+    uoff = (uint64_t *)rad__alloc_array(A, (size_t)N + 1u, sizeof(uint64_t));
+    if (!uoff) return RAD_ERROR_OUT_OF_MEMORY;
+    for (v0 = 0; v0 < V && r == RAD_SUCCESS; v0 = v1) {
+        for (v1 = v0 + 1; v1 < V && (size_t)(vp->voxel_first[v1 + 1] - vp->voxel_first[v0]) * N * sizeof(float) <= budget; ++v1) {}
+        b->voxel_base = v0;
+        b->p_base = vp->voxel_first[v0];
+        r = rad__for_rows(&quiet, v1 - v0, T, rad__vp_ff_chunk, b);
+        for (p = vp->voxel_first[v0]; p < vp->voxel_first[v1] && r == RAD_SUCCESS; ++p) {
+            const float *row = b->P + (size_t)(p - b->p_base) * N;
+            uint32_t cc;
+            uoff[p] = k;
+            for (cc = vp->voxel_first[vp->voxel[p]]; cc < N; ++cc)
+                if (row[cc] != 0.0f) {
+                    if (k == ucap && !rad__vp_grow_csr(A, &ucol, &uval, &ucap, k + 1)) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
+                    ucol[k] = cc, uval[k++] = row[cc];
+                }
+        }
+        if (r == RAD_SUCCESS && c->progress && c->progress(c->progress_user, 0.1f + 0.9f * (float)v1 / (float)V))
+            r = RAD_ERROR_CANCELLED;
+    }
+    uoff[N] = k;
+    rad__free(A, b->P);
+    b->P = NULL;
+    /* the mirror: row p's columns below its voxel are the upper entries (r, p) of earlier voxels */
+    if (r == RAD_SUCCESS) {
+        lcnt = (uint32_t *)rad__alloc_array(A, N, sizeof(uint32_t));
+        off = (uint64_t *)rad__alloc_array(A, (size_t)N + 1u, sizeof(uint64_t));
+        pos = (uint64_t *)rad__alloc_array(A, N, sizeof(uint64_t));
+        if (!lcnt || !off || !pos) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        uint64_t total = 0;
+        memset(lcnt, 0, sizeof(uint32_t) * N);
+        for (p = 0; p < N; ++p)
+            for (e = uoff[p]; e < uoff[p + 1]; ++e)
+                if (ucol[e] >= vp->voxel_first[vp->voxel[p] + 1]) lcnt[ucol[e]]++;
+        for (p = 0; p < N; ++p) {
+            off[p] = total;
+            pos[p] = total;
+            total += lcnt[p] + (uoff[p + 1] - uoff[p]);
+        }
+        off[N] = total;
+        col = (uint32_t *)rad__alloc_array(A, total ? (size_t)total : 1u, sizeof(uint32_t));
+        val = (float *)rad__alloc_array(A, total ? (size_t)total : 1u, sizeof(float));
+        if (!col || !val) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        for (p = 0; p < N; ++p)
+            for (e = uoff[p]; e < uoff[p + 1]; ++e)
+                if (ucol[e] >= vp->voxel_first[vp->voxel[p] + 1]) {
+                    uint64_t at = pos[ucol[e]]++;
+                    col[at] = p, val[at] = uval[e];
+                }
+        for (p = 0; p < N; ++p) {
+            memcpy(col + pos[p], ucol + uoff[p], sizeof(uint32_t) * (size_t)(uoff[p + 1] - uoff[p]));
+            memcpy(val + pos[p], uval + uoff[p], sizeof(float) * (size_t)(uoff[p + 1] - uoff[p]));
+        }
+        /* step 6 as rad__vp_rowsum_row and rad__vp_divide_row, on the non-zeros */
+        for (p = 0; p < N; ++p) {
+            double sum = 0.0;
+            for (e = off[p]; e < off[p + 1]; ++e) sum += (double)val[e];
+            sum /= (double)vp->areas[p];
+            b->rowf[p] = b->o.keep_row_sums ? 1.0f : sum > 1.0 ? (float)(1.0 / sum) : 1.0f;
+        }
+        for (p = 0; p < N; ++p) {
+            float cp = b->rowf[p];
+            double inv = 1.0 / (double)vp->areas[p];
+            for (e = off[p]; e < off[p + 1]; ++e)
+                val[e] = (float)((double)val[e] * (double)(cp < b->rowf[col[e]] ? cp : b->rowf[col[e]]) * inv);
+        }
+        r = rad__check_output(c, "virtual-patch form factors", val, (size_t)off[N]);
+    }
+    /* the drop threshold, in place; then arrays of the kept size */
+    if (r == RAD_SUCCESS) {
+        uint64_t begin = 0;
+        for (p = 0; p < N; ++p) {
+            uint64_t end = off[p + 1];
+            off[p] = kept;
+            for (e = begin; e < end; ++e)
+                if (val[e] > b->o.drop_threshold && val[e] > 0.0f) col[kept] = col[e], val[kept++] = val[e];
+            begin = end;
+        }
+        off[N] = kept;
+        {
+            uint32_t *c2 = (uint32_t *)rad__alloc_array(A, kept ? (size_t)kept : 1u, sizeof(uint32_t));
+            float *v2 = (float *)rad__alloc_array(A, kept ? (size_t)kept : 1u, sizeof(float));
+            if (!c2 || !v2) {
+                rad__free(A, c2);
+                rad__free(A, v2);
+                r = RAD_ERROR_OUT_OF_MEMORY;
+            } else {
+                memcpy(c2, col, sizeof(uint32_t) * (size_t)kept);
+                memcpy(v2, val, sizeof(float) * (size_t)kept);
+                rad__free(A, col);
+                rad__free(A, val);
+                col = c2, val = v2;
+            }
+        }
+    }
+    rad__free(A, uoff);
+    rad__free(A, ucol);
+    rad__free(A, uval);
+    rad__free(A, lcnt);
+    rad__free(A, pos);
+    if (r != RAD_SUCCESS) {
+        rad__free(A, off);
+        rad__free(A, col);
+        rad__free(A, val);
+        return r;
+    }
+    vp->matrix.rows = vp->matrix.cols = N;
+    vp->matrix.storage = RAD_STORAGE_SPARSE;
+    vp->matrix.row_offsets = off;
+    vp->matrix.columns = col;
+    vp->matrix.values = val;
     return RAD_SUCCESS;
 }
 
@@ -16424,13 +16853,25 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     b->cand = NULL;
     rad__free(A, cand_first);
     cand_first = NULL;
-    b->P = (float *)rad__alloc(A, bytes);
-    if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    vp->matrix.rows = vp->matrix.cols = N;
-    vp->matrix.storage = RAD_STORAGE_DENSE;
-    vp->matrix.dense = b->P; /* owned by vp from here on */
     {
         uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
+        /* sparse rows: the rows of a chunk of row voxels at a time (at least one voxel's six,
+           else at most RAD_VP_ROW_CHUNK_BYTES), never N x N */
+        size_t budget = (size_t)RAD_VP_ROW_CHUNK_BYTES;
+        if (b->o.storage == RAD_STORAGE_SPARSE) {
+            uint32_t most = 0;
+            for (v = 0; v < vp->voxel_count; ++v)
+                if (vp->voxel_first[v + 1] - vp->voxel_first[v] > most) most = vp->voxel_first[v + 1] - vp->voxel_first[v];
+            if (budget < (size_t)most * N * sizeof(float)) budget = (size_t)most * N * sizeof(float);
+            if (budget < bytes) bytes = budget;
+        }
+        b->P = (float *)rad__alloc(A, bytes);
+        if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+        if (b->o.storage != RAD_STORAGE_SPARSE) {
+            vp->matrix.rows = vp->matrix.cols = N;
+            vp->matrix.storage = RAD_STORAGE_DENSE;
+            vp->matrix.dense = b->P; /* owned by vp from here on */
+        }
         rad__ctx cc = *c;
         rad__vp_progress prog;
         prog.fn = c->progress;
@@ -16456,6 +16897,11 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         memset(b->rays_cast, 0, sizeof(uint64_t) * T);
         /* progress of this stage maps to [0.1, 1] */
         if (c->progress && c->progress(c->progress_user, 0.1f)) { r = RAD_ERROR_CANCELLED; goto done; }
+        if (b->o.storage == RAD_STORAGE_SPARSE) {
+            r = rad__vp_sparse_rows(b, c, T, budget);
+            for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+            goto done;
+        }
         r = rad__for_rows(&cc, vp->voxel_count, T, b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled : rad__vp_ff_row, b);
         for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
         if (r == RAD_SUCCESS) {
@@ -16469,6 +16915,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
     }
 done:
+    if (b->o.storage == RAD_STORAGE_SPARSE) rad__free(A, b->P); /* the chunk buffer (NULL once used) */
     rad__free(A, cand);
     rad__free(A, cand_area);
     rad__free(A, voxel_cand);
@@ -16532,9 +16979,12 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
         if (b.o.voxel_size[k] > 0.0f) given++;
     }
     if ((given != 0 && given != 3) || b.o.face_points > 4096u || b.o.visibility_rays > RAD__RAY_BATCH || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
-        !(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || (!b.o.skip_visibility && !raycaster->occluded)) {
+        !(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || (!b.o.skip_visibility && !raycaster->occluded) ||
+        (b.o.storage != RAD_STORAGE_DENSE && b.o.storage != RAD_STORAGE_SPARSE) || !rad__finite(b.o.drop_threshold) ||
+        b.o.drop_threshold < 0.0f) {
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size must be all 0 or all > 0; face_points <= 4096; visibility_rays "
-                 "<= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility",
+                 "<= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility; "
+                 "storage dense or sparse; drop_threshold finite and >= 0",
                  (double)b.o.ray_epsilon);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
@@ -16573,6 +17023,18 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
         rad_vp_destroy(vp);
         return r;
     }
+    /* the container record (rad_vp_sections): kind, weights, counts, grid */
+    vp->info_record[0] = (uint32_t)vp->kind;
+    vp->info_record[1] = (uint32_t)vp->weights;
+    vp->info_record[2] = vp->count;
+    vp->info_record[3] = vp->voxel_count;
+    vp->info_record[4] = vp->sample_count;
+    for (k = 0; k < 3; ++k) {
+        vp->info_record[5 + k] = vp->dims[k];
+        memcpy(&vp->info_record[8 + k], &vp->origin[k], 4);
+        memcpy(&vp->info_record[11 + k], &vp->voxel_size[k], 4);
+    }
+    vp->info_record[14] = vp->candidate_voxels;
     *out = vp;
     return RAD_SUCCESS;
 }
@@ -16649,6 +17111,10 @@ RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_rayca
     int k;
     rad__ctx_init(&c, ctx);
     if (!vp || !out_E || (mode != RAD_SOURCE_DIRECT && mode != RAD_SOURCE_EMISSION)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (!vp->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_sources: the set has no scene (rad_vp_load with scene NULL)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     M = vp->sample_count;
     v = (float *)rad__alloc_array(&c.allocator, M, 3 * sizeof(float));
     if (!v) return RAD_ERROR_OUT_OF_MEMORY;
@@ -16829,6 +17295,210 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
     rad__free(&c.allocator, pts);
     rad__free(&c.allocator, nrm);
     return r;
+}
+
+/* ---- container ---- */
+
+RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count)
+{
+    uint32_t N, V, M, k = 0;
+    if (out_count) *out_count = 0;
+    if (!vp || !out || !out_count || !vp->matrix.rows) return RAD_ERROR_INVALID_ARGUMENT;
+    N = vp->count, V = vp->voxel_count, M = vp->sample_count;
+    rad__section(&out[k++], RAD_SECTION_VP_INFO, 4, 16, vp->info_record, name);
+    rad__section(&out[k++], RAD_SECTION_VP_AREAS, 4, N, vp->areas, name);
+    rad__section(&out[k++], RAD_SECTION_VP_ALBEDO, 12, N, vp->albedo, name);
+    rad__section(&out[k++], RAD_SECTION_VP_NORMALS, 12, N, vp->normals, name);
+    rad__section(&out[k++], RAD_SECTION_VP_AXIS, 1, N, vp->axis, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL, 4, N, vp->voxel, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_KEYS, 8, V, vp->voxel_keys, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, vp->voxel_first, name);
+    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_PATCH, 24, V, vp->voxel_patch, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, vp->sample_first, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, vp->sample_positions, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, vp->sample_normals, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, vp->sample_albedo, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_AREAS, 4, M, vp->sample_areas, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, vp->sample_weights, name);
+    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, vp->sample_triangles, name);
+    if (vp->matrix.storage == RAD_STORAGE_SPARSE) {
+        uint64_t nnz = vp->matrix.row_offsets[N];
+        rad__section(&out[k++], RAD_SECTION_FF_ROW_OFFSETS, 8, (uint64_t)N + 1u, vp->matrix.row_offsets, name);
+        rad__section(&out[k++], RAD_SECTION_FF_COLUMNS, 4, nnz, vp->matrix.columns, name);
+        rad__section(&out[k++], RAD_SECTION_FF_VALUES, 4, nnz, vp->matrix.values, name);
+    } else {
+        rad__section(&out[k++], RAD_SECTION_FF_DENSE, 4, (uint64_t)N * N, vp->matrix.dense, name);
+    }
+    *out_count = k;
+    return RAD_SUCCESS;
+}
+
+/* one section of the set: present, of 'elem' bytes per element and 'count' elements; copied
+   into a new array of the set's allocator */
+static rad_result rad__vp_take(const rad__ctx *c, const rad_container *ct, const char *name, uint32_t type, uint32_t elem,
+                               uint64_t count, void **dst)
+{
+    const rad_section *sec = rad_container_find(ct, type, name);
+    *dst = NULL;
+    if (!sec || sec->elem_size != elem || sec->count != count) {
+        rad__log(c, RAD_LOG_ERROR, "rad_vp_load: section type %u of '%s' is %s (want %llu elements of %u bytes)", type,
+                 name ? name : "", sec ? "of the wrong size" : "missing", (unsigned long long)count, elem);
+        return RAD_ERROR_CORRUPT;
+    }
+    *dst = rad__alloc_array(&c->allocator, count ? (size_t)count : 1u, elem);
+    if (!*dst) return RAD_ERROR_OUT_OF_MEMORY;
+    if (count) memcpy(*dst, sec->data, (size_t)count * elem);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_bad(const rad__ctx *c, const char *what, uint64_t at)
+{
+    rad__log(c, RAD_LOG_ERROR, "rad_vp_load: %s (entry %llu)", what, (unsigned long long)at);
+    return RAD_ERROR_CORRUPT;
+}
+
+/* the checks of rad_vp_load after every array is copied */
+static rad_result rad__vp_validate(const rad__ctx *c, const rad_virtual_patches *vp)
+{
+    uint32_t N = vp->count, V = vp->voxel_count, M = vp->sample_count, i, a;
+    double cells = (double)vp->dims[0] * (double)vp->dims[1] * (double)vp->dims[2];
+    rad_result r;
+    if ((r = rad__check_values(c, "virtual patches: albedo", vp->albedo, 3 * (uint64_t)N, 1)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: normals", vp->normals, 3 * (uint64_t)N, 0)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample positions", vp->sample_positions, 3 * (uint64_t)M, 0)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample normals", vp->sample_normals, 3 * (uint64_t)M, 0)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample albedo", vp->sample_albedo, 3 * (uint64_t)M, 1)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample areas", vp->sample_areas, M, 1)) != RAD_SUCCESS ||
+        (r = rad__check_values(c, "virtual patches: sample weights", vp->sample_weights, 6 * (uint64_t)M, 1)) != RAD_SUCCESS)
+        return r;
+    for (i = 0; i < N; ++i) {
+        if (!rad__finite(vp->areas[i]) || !(vp->areas[i] > 0.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "rad_vp_load: patch %u has area %g (must be finite and > 0)", i, (double)vp->areas[i]);
+            return rad__finite(vp->areas[i]) ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE;
+        }
+        for (a = 0; a < 3; ++a)
+            if (!(vp->albedo[3 * (size_t)i + a] < 1.0f)) return rad__vp_bad(c, "a patch albedo is not below 1", i);
+        if (vp->axis[i] > 5) return rad__vp_bad(c, "a patch axis is beyond 5", i);
+        if (vp->voxel[i] >= V || i < vp->voxel_first[vp->voxel[i]] || i >= vp->voxel_first[vp->voxel[i] + 1])
+            return rad__vp_bad(c, "a patch lies outside its voxel's patch range", i);
+    }
+    if (vp->voxel_first[0] != 0 || vp->voxel_first[V] != N || vp->sample_first[0] != 0 || vp->sample_first[V] != M)
+        return rad__vp_bad(c, "voxel_first or sample_first does not run from 0 to the patch or sample count", 0);
+    for (i = 0; i < V; ++i) {
+        if (vp->voxel_first[i + 1] < vp->voxel_first[i] || vp->sample_first[i + 1] < vp->sample_first[i])
+            return rad__vp_bad(c, "voxel_first or sample_first decreases", i);
+        if ((double)vp->voxel_keys[i] >= cells || (i > 0 && vp->voxel_keys[i] <= vp->voxel_keys[i - 1]))
+            return rad__vp_bad(c, "the voxel keys are not ascending inside the grid", i);
+        for (a = 0; a < 6; ++a) {
+            uint32_t p = vp->voxel_patch[6 * (size_t)i + a];
+            if (p != RAD_NONE && (p >= N || vp->voxel[p] != i)) return rad__vp_bad(c, "voxel_patch names a patch of another voxel", i);
+        }
+    }
+    for (i = 0; i < 3; ++i)
+        if (!rad__finite(vp->origin[i]) || !rad__finite(vp->voxel_size[i]) || !(vp->voxel_size[i] > 0.0f) || vp->dims[i] == 0)
+            return rad__vp_bad(c, "the grid (origin, voxel size, dims) is not finite and positive", i);
+    if (vp->scene)
+        for (i = 0; i < M; ++i)
+            if (vp->sample_triangles[i] >= vp->scene->triangle_count) {
+                rad__log(c, RAD_LOG_ERROR, "rad_vp_load: sample %u lies on triangle %u, the scene has %u", i,
+                         vp->sample_triangles[i], vp->scene->triangle_count);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+    if (vp->matrix.storage == RAD_STORAGE_SPARSE) {
+        if ((r = rad__check_matrix(&vp->matrix, c)) != RAD_SUCCESS) return r;
+        return rad__check_values(c, "virtual patches: form factors", vp->matrix.values, vp->matrix.row_offsets[N], 1);
+    }
+    return rad__check_values(c, "virtual patches: form factors", vp->matrix.dense, (uint64_t)N * N, 1);
+}
+
+RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const rad_scene *scene, const rad_context *ctx,
+                               rad_virtual_patches **out)
+{
+    rad__ctx c;
+    rad_virtual_patches *vp;
+    const rad_section *si;
+    uint32_t info[16], N, V, M, k;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!ct || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    si = rad_container_find(ct, RAD_SECTION_VP_INFO, name);
+    if (!si) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_load: the container holds no virtual patches named '%s'", name ? name : "");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (si->elem_size != 4 || si->count != 16) return rad__vp_bad(&c, "the VP_INFO section is not 16 uint32", 0);
+    memcpy(info, si->data, sizeof info);
+    N = info[2], V = info[3], M = info[4];
+    if (info[0] > 1u || info[1] > 1u || N == 0 || V == 0 || M == 0 || N > 6u * (uint64_t)V || info[15] != 0)
+        return rad__vp_bad(&c, "VP_INFO: unknown kind or weights, or counts out of range", 0);
+    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(vp, 0, sizeof(*vp));
+    vp->allocator = c.allocator;
+    vp->scene = scene;
+    vp->kind = (rad_vp_kind)info[0];
+    vp->weights = (rad_vp_weights)info[1];
+    vp->count = N, vp->voxel_count = V, vp->sample_count = M;
+    for (k = 0; k < 3; ++k) {
+        vp->dims[k] = info[5 + k];
+        memcpy(&vp->origin[k], &info[8 + k], 4);
+        memcpy(&vp->voxel_size[k], &info[11 + k], 4);
+    }
+    vp->candidate_voxels = info[14];
+    memcpy(vp->info_record, info, sizeof info);
+#define RAD__VP_TAKE(type, elem, count, field, ctype)                                                   \
+    if (r == RAD_SUCCESS) {                                                                            \
+        void *p_;                                                                                      \
+        r = rad__vp_take(&c, ct, name, type, elem, count, &p_);                                        \
+        vp->field = (ctype *)p_;                                                                       \
+    }
+    RAD__VP_TAKE(RAD_SECTION_VP_AREAS, 4, N, areas, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_ALBEDO, 12, N, albedo, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_NORMALS, 12, N, normals, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_AXIS, 1, N, axis, uint8_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL, 4, N, voxel, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys, uint64_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first, uint32_t)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights, float)
+    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles, uint32_t)
+#undef RAD__VP_TAKE
+    vp->matrix.rows = vp->matrix.cols = N;
+    if (r == RAD_SUCCESS && rad_container_find(ct, RAD_SECTION_FF_ROW_OFFSETS, name)) {
+        void *po = NULL, *pc = NULL, *pv = NULL;
+        vp->matrix.storage = RAD_STORAGE_SPARSE;
+        r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_ROW_OFFSETS, 8, (uint64_t)N + 1u, &po);
+        vp->matrix.row_offsets = (const uint64_t *)po;
+        if (r == RAD_SUCCESS) {
+            const rad_section *sc = rad_container_find(ct, RAD_SECTION_FF_COLUMNS, name);
+            uint64_t nnz = vp->matrix.row_offsets[N];
+            if (!sc || sc->count != nnz) r = rad__vp_bad(&c, "the CSR columns do not match the row offsets", nnz);
+            if (r == RAD_SUCCESS) r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_COLUMNS, 4, nnz, &pc);
+            vp->matrix.columns = (const uint32_t *)pc;
+            if (r == RAD_SUCCESS) r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_VALUES, 4, nnz, &pv);
+            vp->matrix.values = (const float *)pv;
+        }
+    } else if (r == RAD_SUCCESS) {
+        void *pd = NULL;
+        vp->matrix.storage = RAD_STORAGE_DENSE;
+        size_t bytes;
+        if (!rad__mul3(N, N, sizeof(float), &bytes)) r = RAD_ERROR_SIZE_OVERFLOW;
+        else r = rad__vp_take(&c, ct, name, RAD_SECTION_FF_DENSE, 4, (uint64_t)N * N, &pd);
+        vp->matrix.dense = (const float *)pd;
+    }
+    if (r == RAD_SUCCESS) r = rad__vp_validate(&c, vp);
+    if (r != RAD_SUCCESS) {
+        rad_vp_destroy(vp);
+        return r;
+    }
+    *out = vp;
+    return RAD_SUCCESS;
 }
 
 /* ======================================================================================== */

@@ -196,6 +196,16 @@ s_examples() {
     else
         fail vp-bunny-skip
     fi
+    # the engine loop over virtual patches: every stage timed, and the light reaches the vertices
+    if build realtime $CC -std=c99 $WARN -O2 $OMP -I. examples/realtime.c -o "$BUILD/realtime" -lm &&
+       "$BUILD/realtime" --patches 200 --frames 12 >"$BUILD/realtime.out" 2>&1 &&
+       grep -q "mean per frame over 12 frames: E update" "$BUILD/realtime.out" &&
+       awk '$1 == 11 { exit !($5 > 0) }' "$BUILD/realtime.out"; then
+        pass realtime-small
+    else
+        sed "s/^/    /" "$BUILD/realtime.out" 2>/dev/null | tail -5
+        fail realtime-small
+    fi
     if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -lm &&
        "$BUILD/walk" --grid 2 --m 256 --frames 2 --size 64x36 -o "$BUILD/walk-small" >"$BUILD/walk.out" 2>&1 &&
        [ -s "$BUILD/walk-small_001.png" ]; then

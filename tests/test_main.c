@@ -3,6 +3,8 @@
    Environment: RAD_TEST_QUICK=1 smaller sizes; RAD_TEST_SHARD=i/n every n-th test from the
    i-th; RAD_TEST_SKIP=a,b leaves out the tests of those names; RAD_TEST_TIMES=1 CPU seconds per test; RAD_TEST_TMPDIR where scratch files go. */
 #define RADIOSITY_IMPLEMENTATION
+/* small chunks, so the sparse virtual-patch build's chunking is exercised (vp_sparse_rows) */
+#define RAD_VP_ROW_CHUNK_BYTES 65536u
 #include "../radiosity.h"
 #include "test.h"
 
@@ -67,6 +69,7 @@ static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
 #include "test_temporal.c"
 #include "test_local.c"
 #include "test_vp.c"
+#include "test_vp_runtime.c"
 #include "test_regress.c"
 #include "test_robust.c"
 #include "test_api.c"
@@ -75,7 +78,7 @@ static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
 #include "test_glsl.c"
 #include "test_probes.c"
 
-static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_hemicube, tests_hierarchical, tests_solve, tests_stochastic, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl, tests_probes };
+static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_hemicube, tests_hierarchical, tests_solve, tests_stochastic, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_vp_runtime, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl, tests_probes };
 
 /* 1 when 'name' is one of the comma-separated names in 'list' */
 static int rad_test_listed(const char *list, const char *name)

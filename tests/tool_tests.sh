@@ -564,6 +564,21 @@ if [ -s "$TMP/ref.pfm" ]; then
     else
         fail "hierarchical renders the Cornell box" "$(head -c 300 "$TMP/err.txt")"
     fi
+    # --proxy: the run-time methods over the same virtual patches give the aavp image (the
+    # full solution: multibounce inf and local over every patch exactly, temporal to its noise)
+    if "$RAD" render cornell $M --method aavp --vp-resolution 4 --bounces inf -o "$TMP/pref.pfm" > /dev/null 2> "$TMP/err.txt"; then
+        for pm in "multibounce --bounces inf:60" "local:60" "temporal:40"; do
+            pa=${pm%:*}
+            if "$RAD" render cornell $M --method $pa --proxy aavp --vp-resolution 4 -o "$TMP/px.pfm" > /dev/null 2> "$TMP/err.txt" &&
+                grep -q "timing: method=${pa%% *} proxy=aavp" "$TMP/err.txt" && grep -q "sparse rows: " "$TMP/err.txt"; then
+                psnr_check "--method ${pm%:*} --proxy aavp gives the aavp solve" "$TMP/pref.pfm" "$TMP/px.pfm" "${pm#*:}"
+            else
+                fail "--method ${pm%:*} --proxy aavp renders" "$(head -c 300 "$TMP/err.txt")"
+            fi
+        done
+    else
+        fail "aavp --bounces inf renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
     if "$RAD" render cornell $M --method aavp --vp-max-patches 300 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"; then
         np=$(grep -o 'timing: method=aavp patches=[0-9]*' "$TMP/err.txt" | cut -d= -f3)
         [ -n "$np" ] && [ "$np" -le 300 ] && [ "$np" -gt 100 ] && ok "aavp --vp-max-patches 300 gives $np patches (100 < n <= 300)" ||
@@ -598,8 +613,34 @@ bad "--vp-resolution with classic" "--vp-resolution is for --method vp or aavp, 
 bad "--bounces with local" "--bounces is not an option of --method local" render cornell --method local --bounces 3 -o "$TMP/y.pfm"
 bad "--vp-resolution with --vp-max-patches" "exclude each other" render cornell --method aavp --vp-resolution 4 --vp-max-patches 9 -o "$TMP/y.pfm"
 bad "--vp-max-patches x" "--vp-max-patches" render cornell --method aavp --vp-max-patches x -o "$TMP/y.pfm"
+bad "--proxy x" "unknown --proxy 'x'" render cornell --method temporal --proxy x -o "$TMP/y.pfm"
+bad "--proxy with classic" "--proxy aavp is for --method multibounce, temporal or local" render cornell --proxy aavp -o "$TMP/y.pfm"
+bad "--proxy with --format" "--format is not an option of --proxy vp" render cornell --method multibounce --proxy vp --format half -o "$TMP/y.pfm"
+bad "--proxy in bake" "--proxy is an option of rad render" bake cornell --method temporal --proxy aavp -o "$TMP/y.radb"
 bad "--face-points 5000" "--face-points must be in 1..4096" render cornell --method vp --face-points 5000 -o "$TMP/y.pfm"
-bad "bake --method aavp" "method 'aavp' is render-only" bake cornell --method aavp -o "$TMP/y.radb"
+bad "bake --method aavp --vp-max-patches" "--vp-max-patches is an option of rad render" bake cornell --method aavp --vp-max-patches 99 -o "$TMP/y.radb"
+# virtual patches baked (sparse rows) and rendered from the bake: the image of building them here
+if "$RAD" bake cornell --method aavp --vp-resolution 4 -o "$TMP/vp.radb" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" render cornell --size 24x24 --aa 1 --method aavp --vp-resolution 4 -o "$TMP/vp0.pfm" > /dev/null 2>> "$TMP/err.txt" &&
+    "$RAD" render cornell --size 24x24 --aa 1 --method aavp --bake "$TMP/vp.radb" -o "$TMP/vp1.pfm" > /dev/null 2>> "$TMP/err.txt" &&
+    "$RAD" render cornell --size 24x24 --aa 1 --method local --proxy aavp --bake "$TMP/vp.radb" -o "$TMP/vp2.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+    p1=$(psnr_of "$TMP/vp0.pfm" "$TMP/vp1.pfm")
+    p2=$(psnr_of "$TMP/vp0.pfm" "$TMP/vp2.pfm")
+    at_least "$p1" 100 && at_least "$p2" 50 && ok "bake --method aavp renders as built (PSNR $p1 dB; local --proxy $p2 dB)" ||
+        fail "bake --method aavp renders as built" "PSNR '$p1' and '$p2' dB"
+    "$RAD" info "$TMP/vp.radb" 2>/dev/null | grep -q "VP_SAMPLE_WEIGHTS" && ok "rad info names the virtual-patch sections" ||
+        fail "rad info names the virtual-patch sections" "$("$RAD" info "$TMP/vp.radb" 2>&1 | head -c 300)"
+else
+    fail "bake --method aavp and render it" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" render cornell --method vp --bake "$TMP/vp.radb" -o "$TMP/y.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "holds aavp virtual patches, not vp" "$TMP/err.txt" && ok "refuses an aavp bake for --method vp" ||
+    fail "refuses an aavp bake for --method vp" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+"$RAD" render cornell --size 8x8 --aa 1 --method aavp --sun 0,-1,0:1 --bake "$TMP/vp.radb" -o "$TMP/y.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "made with other lights or options" "$TMP/err.txt" && ok "refuses an aavp bake under another --sun" ||
+    fail "refuses an aavp bake under another --sun" "exit $rc: $(head -c 200 "$TMP/err.txt")"
 bad "bake --method local" "method 'local' is render-only" bake cornell --method local -o "$TMP/y.radb"
 bad "--sr-rays with classic" "--sr-rays is for --method stochastic, not classic" render cornell --sr-rays 100 -o "$TMP/y.pfm"
 bad "--sr-estimator foo" "unknown --sr-estimator 'foo'" bake cornell --method stochastic --sr-estimator foo -o "$TMP/y.radb"

@@ -159,7 +159,8 @@ int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uin
     if (time_over) fprintf(stderr, "%s more than the %.0f minutes the tool starts a dense build for",
                            mem_over ? ", and" : ";", RAD_TOOL_DENSE_MAX_SECONDS / 60.0);
     fprintf(stderr, ".\nrad %s: use %s--method aavp or --method vp (virtual patches: a few thousand patches whatever the "
-                    "triangle count; --vp-max-patches B sets how many), or give --force to build it anyway%s\n",
+                    "triangle count; --vp-max-patches B sets how many; --proxy aavp runs multibounce, temporal or local over them), "
+                    "or give --force to build it anyway%s\n",
             cmd, o->dense_method ? "" : "rad render ", mem_over ? " (or --max-memory SIZE for another limit)" : "");
     return 1;
 }

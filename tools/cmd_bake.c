@@ -1,6 +1,6 @@
 /* cmd_bake.c - the classic radiosity solution (shared with rad render) and `rad bake`.
 
-   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic] [--solver jacobi|gauss-seidel|direct]
+   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|aavp|vp] [--solver jacobi|gauss-seidel|direct]
             [--bounces K] [--patches N] [--max-edge L] [--samples S] [--light-samples N]
             [method options, see methods.c] [--threads N]
 
@@ -12,7 +12,8 @@
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
    were made with, so `rad render --bake` can check that the file fits the scene (with the
    library's signature section, which also holds the hash of rad.options: rad_tool_sign_options).
-   --method multibounce, temporal and stochastic bake through methods.c (rad_tool_method_bake). */
+   --method multibounce, temporal and stochastic bake through methods.c (rad_tool_method_bake); aavp
+   and vp save the virtual patches with sparse rows (bake_vp). */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -309,9 +310,99 @@ static int write_bytes(const char *cmd, const char *path, const void *data, size
     return 0;
 }
 
+/* --method aavp|vp: the virtual patches with sparse rows (rad_vp_sections, named "vp"), their
+   source E = rho D at the samples (vector "E"), the scene's signature with the hash of the
+   options (resolution, face points, light samples in rad.options) and rad.options itself.
+   rad render --method aavp|vp (or --proxy) --bake FILE loads it instead of building. */
+static int bake_vp(const char *cmd, const char *path, const rad_tool_world *w, const rad_tool_classic_options *o,
+                   const rad_tool_method_options *mo)
+{
+    rad_vp_options vo;
+    rad_virtual_patches *vp = NULL;
+    rad_direct_options dopt;
+    rad_section secs[RAD_VP_MAX_SECTIONS + 3];
+    rad_tool_bake_info info;
+    rad_bake_signature sig;
+    rad_context ctx;
+    rad_result r;
+    float *E = NULL;
+    void *dst = NULL;
+    size_t dst_size = 0;
+    uint32_t k = 0;
+    int rc = 1;
+    rad_vp_options_default(&vo);
+    vo.resolution = mo->vp_resolution;
+    vo.face_points = mo->face_points;
+    vo.kind = mo->method == RAD_TOOL_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    vo.storage = RAD_STORAGE_SPARSE;
+    rad_tool_context(&ctx, "virtual patches");
+    r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &vp);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_vp_create", r);
+    E = (float *)rad_tool_calloc(3 * (size_t)vp->count, sizeof(float));
+    rad_direct_options_default(&dopt);
+    dopt.include_emitters = 1;
+    dopt.light_samples = o->light_samples;
+    rad_tool_context(&ctx, "direct light");
+    r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
+    rad_tool_progress_end();
+    rad_tool_context(&ctx, NULL);
+    if (r != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_vp_sources", r);
+        goto done;
+    }
+    if ((r = rad_vp_sections(vp, "vp", secs, &k)) != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_vp_sections", r);
+        goto done;
+    }
+    memset(&info, 0, sizeof info);
+    info.magic = 0x52414442u;
+    info.patches = vp->count;
+    info.samples = mo->face_points;
+    info.solver = (uint32_t)mo->method;
+    info.bounces = mo->vp_resolution;
+    info.light_samples = o->light_samples;
+    info.triangle_count = w->scene->triangle_count;
+    memset(&sig, 0, sizeof sig);
+    if ((r = rad_scene_hash(w->scene, &sig.geometry, &sig.materials)) != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_scene_hash", r);
+        goto done;
+    }
+    sig.options = rad_tool_options_hash(&info, w);
+    memset(&secs[k], 0, 3 * sizeof secs[0]);
+    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = vp->count, secs[k].data = E;
+    strcpy(secs[k++].name, "E");
+    secs[k].type = RAD_SECTION_SIGNATURE, secs[k].elem_size = sizeof sig, secs[k].count = 1, secs[k].data = &sig;
+    strcpy(secs[k++].name, "signature");
+    secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
+    strcpy(secs[k++].name, "rad.options");
+    if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_container_size", r);
+        goto done;
+    }
+    dst = rad_tool_calloc(dst_size, 1);
+    if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_container_write", r);
+        goto done;
+    }
+    if (rad_tool_write_file(path, dst, dst_size) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+        goto done;
+    }
+    printf("wrote %s: %s, %u virtual patches at resolution %u, %llu non-zeros, %lu bytes\n", path,
+           rad_tool_method_name(mo->method), vp->count, mo->vp_resolution,
+           (unsigned long long)vp->matrix.row_offsets[vp->count], (unsigned long)dst_size);
+    rc = 0;
+done:
+    free(dst);
+    free(E);
+    rad_vp_destroy(vp);
+    return rc;
+}
+
 static void bake_usage(FILE *f)
 {
-    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic] [options]\n"
+    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|aavp|vp] [options]\n"
                "Computes patches, form factors and the patches' direct light E = rho D, then by method:\n"
                "  classic      the indirect solution L; saves patches, F, E, B = E + L (and L, H = F B, D)\n"
                "  multibounce  F_mb = sum_k (rho o F)^k, stored as float, half or compressed\n"
@@ -320,8 +411,10 @@ static void bake_usage(FILE *f)
                "               patches, E, D, F's row sums and the tables (no F)\n"
                "  stochastic   no F: L by stochastic Jacobi or random walks over rays; saves patches, E, D,\n"
                "               row sums estimated by rays and L\n"
+               "  aavp, vp     virtual patches (--vp-resolution, --face-points) with sparse rows and\n"
+               "               their E; rad render --method aavp|vp or --proxy aavp|vp --bake loads them\n"
                "  -o FILE            output file (required)\n"
-               "  --method M         classic (default), multibounce, temporal or stochastic\n"
+               "  --method M         classic (default), multibounce, temporal, stochastic, aavp or vp\n"
                "%s"
                "%s"
                "%s"
@@ -376,6 +469,12 @@ static int bake_main(int argc, char **argv, rad_tool_lights *lights)
     if (rad_tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
+    if (mo.method == RAD_TOOL_VP || mo.method == RAD_TOOL_AAVP) {
+        rc = bake_vp(cmd, out_path, &w, &o, &mo);
+        rad_tool_close_world(&w);
+        if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+        return rc;
+    }
     if (mo.method != RAD_TOOL_CLASSIC) {
         void *buf = NULL;
         size_t size = 0;

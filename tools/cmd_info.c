@@ -36,7 +36,15 @@ static const char *type_name(uint32_t type)
     case RAD_TOOL_SECTION_OPTIONS: return "USER(rad options)";
     case RAD_TOOL_SECTION_METHOD: return "USER(rad method)";
     case RAD_TOOL_SECTION_ROWSUMS: return "USER(row sums)";
-    default: return type >= RAD_SECTION_USER ? "USER" : "UNKNOWN";
+    default:
+        if (type >= RAD_SECTION_VP_INFO && type <= RAD_SECTION_VP_SAMPLE_TRIANGLES) {
+            static const char *const vp[] = {"VP_INFO", "VP_AREAS", "VP_ALBEDO", "VP_NORMALS", "VP_AXIS", "VP_VOXEL",
+                                             "VP_VOXEL_KEYS", "VP_VOXEL_FIRST", "VP_VOXEL_PATCH", "VP_SAMPLE_FIRST",
+                                             "VP_SAMPLE_POSITIONS", "VP_SAMPLE_NORMALS", "VP_SAMPLE_ALBEDO",
+                                             "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES"};
+            return vp[type - RAD_SECTION_VP_INFO];
+        }
+        return type >= RAD_SECTION_USER ? "USER" : "UNKNOWN";
     }
 }
 

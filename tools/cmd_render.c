@@ -569,7 +569,9 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
     rad_vp_options_default(&vo);
     vo.resolution = resolution;
     vo.face_points = mo->face_points;
-    if (mo->method == RAD_TOOL_VP) vo.kind = RAD_VP_CLUSTERED;
+    if (mo->method == RAD_TOOL_VP || mo->proxy == RAD_TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
+    /* the run-time methods over a proxy take its rows as CSR: O(non-zeros) once built */
+    if (mo->proxy) vo.storage = RAD_STORAGE_SPARSE;
     rad_tool_context(&ctx, "virtual patches");
     r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &vp);
     rad_tool_progress_end();
@@ -578,7 +580,12 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
         return NULL;
     }
     fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches, %u voxels, %u samples\n", cmd,
-            rad_tool_method_name(mo->method), resolution, vp->count, vp->voxel_count, vp->sample_count);
+            vo.kind == RAD_VP_CLUSTERED ? "vp" : "aavp", resolution, vp->count, vp->voxel_count, vp->sample_count);
+    if (vp->matrix.storage == RAD_STORAGE_SPARSE)
+        fprintf(stderr, "rad %s: sparse rows: %llu non-zeros (%.1f%% of N^2), %.1f MiB\n", cmd,
+                (unsigned long long)vp->matrix.row_offsets[vp->count],
+                100.0 * (double)vp->matrix.row_offsets[vp->count] / ((double)vp->count * (double)vp->count),
+                (double)rad_vp_memory(vp) / 1048576.0);
     return vp;
 }
 
@@ -593,19 +600,228 @@ static int vp_count(const char *cmd, const rad_tool_world *w, const rad_tool_met
     rad_vp_options_default(&vo);
     vo.resolution = resolution;
     vo.face_points = mo->face_points;
-    if (mo->method == RAD_TOOL_VP) vo.kind = RAD_VP_CLUSTERED;
+    if (mo->method == RAD_TOOL_VP || mo->proxy == RAD_TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
     rad_tool_context(&ctx, NULL);
     if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_vp_count", r);
     *count = cnt.patches;
     return 0;
 }
 
+/* --proxy aavp|vp: the indirect radiosity L of the virtual patches by --method multibounce
+   (F_mb of K bounces, float: L_K as Jacobi), temporal (alias tables over the CSR rows, or over
+   F_mb's channels in --mode multibounce; --frames steps) or local (T of the M patches nearest
+   the camera, by voxel centre; L = T E over the set, 0 outside). *step_seconds: the median
+   temporal step, else the whole computation. */
+typedef struct proxy_near { double d2; uint32_t patch; } proxy_near;
+static int cmp_near(const void *a, const void *b)
+{
+    const proxy_near *x = (const proxy_near *)a, *y = (const proxy_near *)b;
+    return x->d2 < y->d2 ? -1 : x->d2 > y->d2 ? 1 : (x->patch > y->patch) - (x->patch < y->patch);
+}
+
+static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const float *E,
+                          const rad_tool_method_options *mo, const rad_camera *cam, float *L, double *step_seconds)
+{
+    rad_multibounce *mb = NULL;
+    rad_alias_tables *tables[3] = {NULL, NULL, NULL};
+    rad_temporal *tp = NULL;
+    rad_local *local = NULL;
+    uint32_t *order = NULL, n = vp->count, i;
+    double *steps = NULL, t0 = rad_tool_seconds();
+    const char *what = NULL;
+    rad_context ctx;
+    rad_result r = RAD_SUCCESS;
+    rad_tool_context(&ctx, NULL);
+    memset(L, 0, sizeof(float) * 3 * (size_t)n);
+    if (mo->method == RAD_TOOL_MULTIBOUNCE || (mo->method == RAD_TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
+        rad_multibounce_options mbo;
+        rad_multibounce_options_default(&mbo);
+        mbo.bounces = mo->bounces;
+        rad_tool_context(&ctx, "multi-bounce matrix");
+        r = rad_multibounce_create(&vp->matrix, vp->albedo, &mbo, &ctx, &mb);
+        rad_tool_progress_end();
+        rad_tool_context(&ctx, NULL);
+        if (r != RAD_SUCCESS) { what = "rad_multibounce_create"; goto done; }
+        if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+            if ((r = rad_multibounce_apply(mb, E, L, RAD_OUTPUT_INDIRECT, &ctx)) != RAD_SUCCESS) what = "rad_multibounce_apply";
+            *step_seconds = rad_tool_seconds() - t0;
+            goto done;
+        }
+    }
+    if (mo->method == RAD_TOOL_TEMPORAL) {
+        const rad_alias_tables *tp3[3];
+        rad_temporal_options to;
+        uint32_t count = mb ? 3u : 1u, f;
+        for (i = 0; i < count && r == RAD_SUCCESS; ++i) {
+            r = mb ? rad_alias_tables_create_dense(mb->planes + (size_t)i * n * n, n, RAD_ALIAS_AUTO, &ctx, &tables[i])
+                   : rad_alias_tables_create(&vp->matrix, RAD_ALIAS_AUTO, &ctx, &tables[i]);
+            tp3[i] = tables[i];
+        }
+        if (r != RAD_SUCCESS) { what = "alias tables"; goto done; }
+        rad_temporal_options_default(&to);
+        to.mode = mo->mode;
+        to.samples = mo->k;
+        to.adaptive = mo->adaptive && !(mo->given & RAD_TOOL_OPT_W);
+        to.weight = mo->w;
+        to.seed = mo->seed;
+        if ((r = rad_temporal_create(tp3, count, vp->albedo, &to, &ctx, &tp)) != RAD_SUCCESS) { what = "rad_temporal_create"; goto done; }
+        steps = (double *)xmalloc(sizeof(double) * mo->frames);
+        for (f = 0; f < mo->frames; ++f) {
+            double ts = rad_tool_seconds();
+            if ((r = rad_temporal_step(tp, E, NULL, NULL)) != RAD_SUCCESS) { what = "rad_temporal_step"; goto done; }
+            steps[f] = rad_tool_seconds() - ts;
+        }
+        memcpy(L, rad_temporal_indirect(tp), sizeof(float) * 3 * (size_t)n);
+        qsort(steps, mo->frames, sizeof(double), cmp_double);
+        *step_seconds = steps[mo->frames / 2];
+        fprintf(stderr, "rad %s: temporal over %u virtual patches: %u frames, k %u, tables %.1f MiB, step %.3f ms (median)\n",
+                cmd, n, mo->frames, mo->k, (double)(rad_alias_tables_memory(tables[0]) * count) / 1048576.0,
+                1e3 * *step_seconds);
+    } else if (mo->method == RAD_TOOL_LOCAL) {
+        rad_row_source src;
+        rad_local_options lo;
+        uint32_t m = mo->local_m ? mo->local_m : (n < RAD_TOOL_LOCAL_M_AUTO_MAX ? n : RAD_TOOL_LOCAL_M_AUTO_MAX);
+        proxy_near *d2 = (proxy_near *)xmalloc(sizeof(proxy_near) * (size_t)n);
+        if (m > n) m = n;
+        order = (uint32_t *)xmalloc(sizeof(uint32_t) * (size_t)n);
+        for (i = 0; i < n; ++i) {
+            uint32_t c[3], k;
+            uint64_t key = vp->voxel_keys[vp->voxel[i]];
+            double q = 0.0;
+            c[0] = (uint32_t)(key % vp->dims[0]);
+            c[1] = (uint32_t)((key / vp->dims[0]) % vp->dims[1]);
+            c[2] = (uint32_t)(key / vp->dims[0] / vp->dims[1]);
+            for (k = 0; k < 3; ++k) {
+                double x = (double)vp->origin[k] + ((double)c[k] + 0.5) * (double)vp->voxel_size[k] - (double)cam->position[k];
+                q += x * x;
+            }
+            d2[i].d2 = q;
+            d2[i].patch = i;
+        }
+        qsort(d2, n, sizeof *d2, cmp_near);
+        for (i = 0; i < n; ++i) order[i] = d2[i].patch;
+        free(d2);
+        rad_local_options_default(&lo);
+        lo.capacity = m;
+        if ((r = rad_row_source_matrix(&vp->matrix, vp->areas, vp->albedo, &src)) != RAD_SUCCESS) { what = "rad_row_source_matrix"; goto done; }
+        if ((r = rad_local_create(&src, &lo, &ctx, &local)) != RAD_SUCCESS) { what = "rad_local_create"; goto done; }
+        rad_tool_context(&ctx, "local matrix");
+        r = rad_local_rebuild(local, order, m, &ctx);
+        rad_tool_progress_end();
+        rad_tool_context(&ctx, NULL);
+        if (r != RAD_SUCCESS) { what = "rad_local_rebuild"; goto done; }
+        if ((r = rad_local_apply(local, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, L, &ctx)) != RAD_SUCCESS) { what = "rad_local_apply"; goto done; }
+        *step_seconds = rad_tool_seconds() - t0;
+        fprintf(stderr, "rad %s: local matrix over %u of %u virtual patches (nearest the camera)\n", cmd, m, n);
+    }
+done:
+    free(steps);
+    free(order);
+    rad_local_destroy(local);
+    rad_temporal_destroy(tp);
+    for (i = 0; i < 3; ++i) rad_alias_tables_destroy(tables[i]);
+    rad_multibounce_destroy(mb);
+    return what ? rad_tool_fail(cmd, what, r) : 0;
+}
+
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
-static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                            const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
-                            uint32_t aa, uint32_t light_samples, rad_image *img)
+/* --bake FILE with --method aavp|vp or --proxy: the set saved by rad bake --method aavp|vp
+   (rad_vp_load, checked against the scene's signature and the kind asked for) and its E into
+   *E_out; NULL with the error printed */
+static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, const rad_tool_world *w, int clustered,
+                                         float **E_out)
+{
+    FILE *f = fopen(path, "rb");
+    unsigned char *buf = NULL;
+    long size = -1;
+    rad_container *ct = NULL;
+    rad_virtual_patches *vp = NULL;
+    const rad_section *se, *sg;
+    rad_context ctx;
+    rad_result r;
+    uint64_t geometry = 0, materials = 0;
+    *E_out = NULL;
+    if (f && fseek(f, 0, SEEK_END) == 0) size = ftell(f);
+    if (size > 0 && fseek(f, 0, SEEK_SET) == 0) {
+        buf = (unsigned char *)xmalloc((size_t)size);
+        if (fread(buf, 1, (size_t)size, f) != (size_t)size) size = -1;
+    }
+    if (f) fclose(f);
+    if (size <= 0) {
+        fprintf(stderr, "rad %s: cannot read bake '%s'\n", cmd, path);
+        free(buf);
+        return NULL;
+    }
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_container_open(buf, (size_t)size, &ctx, &ct)) != RAD_SUCCESS ||
+        (r = rad_vp_load(ct, "vp", w->scene, &ctx, &vp)) != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bake '%s' holds no virtual patches (bake them with --method aavp|vp): %s\n", cmd, path,
+                rad_result_string(r));
+        goto fail;
+    }
+    sg = rad_container_find(ct, RAD_SECTION_SIGNATURE, NULL);
+    if ((r = rad_scene_hash(w->scene, &geometry, &materials)) != RAD_SUCCESS || !sg || sg->elem_size != sizeof(rad_bake_signature) ||
+        memcmp(sg->data, &geometry, 8) || memcmp((const unsigned char *)sg->data + 8, &materials, 8)) {
+        fprintf(stderr, "rad %s: bake '%s' was not made from this scene (its signature differs)\n", cmd, path);
+        goto fail;
+    }
+    {
+        /* the options record and the command line's lights (a bake lit by --sun holds that sun's E) */
+        const rad_section *so = rad_container_find(ct, RAD_TOOL_SECTION_OPTIONS, "rad.options");
+        rad_tool_bake_info info;
+        uint64_t want;
+        if (!so || so->elem_size != sizeof info || so->count != 1) {
+            fprintf(stderr, "rad %s: bake '%s' holds no rad.options record\n", cmd, path);
+            goto fail;
+        }
+        memcpy(&info, so->data, sizeof info);
+        want = rad_tool_options_hash(&info, w);
+        if (memcmp((const unsigned char *)sg->data + 16, &want, 8)) {
+            fprintf(stderr, "rad %s: bake '%s' was made with other lights or options (the --sun, --sky, --point, --spot "
+                            "of the bake must be given again)\n", cmd, path);
+            goto fail;
+        }
+    }
+    if ((vp->kind == RAD_VP_CLUSTERED) != (clustered != 0)) {
+        fprintf(stderr, "rad %s: bake '%s' holds %s virtual patches, not %s\n", cmd, path,
+                vp->kind == RAD_VP_CLUSTERED ? "vp" : "aavp", clustered ? "vp" : "aavp");
+        goto fail;
+    }
+    se = rad_container_find(ct, RAD_SECTION_VECTOR, "E");
+    if (!se || se->elem_size != 12 || se->count != vp->count) {
+        fprintf(stderr, "rad %s: bake '%s' holds no source vector E for its %u patches\n", cmd, path, vp->count);
+        goto fail;
+    }
+    *E_out = (float *)xmalloc(sizeof(float) * 3 * (size_t)vp->count);
+    memcpy(*E_out, se->data, sizeof(float) * 3 * (size_t)vp->count);
+    {
+        uint32_t i;
+        for (i = 0; i < 3 * vp->count; ++i)
+            if (!((*E_out)[i] >= 0.0f && (*E_out)[i] <= RAD_BAKE_VALUE_MAX)) {
+                fprintf(stderr, "rad %s: bake '%s': E entry %u is %g (not in [0, 1e30])\n", cmd, path, i, (double)(*E_out)[i]);
+                free(*E_out);
+                *E_out = NULL;
+                goto fail;
+            }
+    }
+    rad_container_close(ct);
+    free(buf);
+    fprintf(stderr, "rad %s: loaded %u virtual patches (%llu non-zeros) from '%s'\n", cmd, vp->count,
+            vp->matrix.storage == RAD_STORAGE_SPARSE ? (unsigned long long)vp->matrix.row_offsets[vp->count]
+                                                     : (unsigned long long)vp->count * vp->count, path);
+    return vp;
+fail:
+    rad_vp_destroy(vp);
+    rad_container_close(ct);
+    free(buf);
+    return NULL;
+}
+
+static int render_vp_method(const char *cmd, const rad_tool_world *w, const char *bake_path,
+                            const rad_tool_classic_options *o, const rad_tool_method_options *mo, const rad_camera *cam,
+                            int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
 {
     rad_virtual_patches *vp = NULL;
     rad_direct_options dopt;
@@ -616,9 +832,16 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     rad_result r;
     float *E = NULL, *L = NULL, *B = NULL, *H = NULL;
     uint32_t n, i, res = mo->vp_resolution;
-    double t0 = rad_tool_seconds(), t_build, t_E, t_solve;
+    double t0 = rad_tool_seconds(), t_build, t_E, t_solve, t_step = 0.0;
     int rc = 0;
-    if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
+    if (bake_path) {
+        if (mo->given & RAD_TOOL_OPT_VP) {
+            fprintf(stderr, "rad %s: --vp-resolution, --vp-max-patches and --face-points are the bake's with --bake\n", cmd);
+            return 1;
+        }
+        if (!(vp = vp_load_bake(cmd, bake_path, w, mo->method == RAD_TOOL_VP || mo->proxy == RAD_TOOL_PROXY_VP, &E)))
+            return 1;
+    } else if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
         /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build
            up to the patches, without the form factors that take nearly all of its time), then
            one build. The count grows about as R^2 (surface voxels): predict from the nearest
@@ -651,7 +874,7 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     }
     t_build = rad_tool_seconds() - t0;
     n = vp->count;
-    E = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    if (!E) E = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
@@ -660,7 +883,8 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     dopt.light_samples = o->light_samples;
     rad_tool_context(&ctx, "direct light");
     t0 = rad_tool_seconds();
-    r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
+    r = bake_path ? RAD_SUCCESS /* the bake's E */
+                  : rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
     rad_tool_progress_end();
     t_E = rad_tool_seconds() - t0;
     if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "rad_vp_sources", r);
@@ -672,7 +896,10 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
         memset(&stats, 0, sizeof stats);
         rad_tool_context(&ctx, NULL);
         t0 = rad_tool_seconds();
-        if (mo->bounces == RAD_MB_INFINITE) {
+        if (mo->proxy) {
+            r = RAD_SUCCESS;
+            if (proxy_indirect(cmd, vp, E, mo, cam, L, &t_step)) rc = 1;
+        } else if (mo->bounces == RAD_MB_INFINITE) {
             r = rad_solve_gauss_seidel(&sys, &so, L, &stats, &ctx);
             if (r == RAD_ERROR_NOT_CONVERGED) {
                 fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge (residual %g after %u sweeps)\n", cmd,
@@ -683,8 +910,9 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
             r = rad_solve_jacobi(&sys, &so, L, &stats, &ctx);
         }
         for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
-        if (r == RAD_SUCCESS) r = rad_matrix_multiply(&vp->matrix, B, H, &ctx);
+        if (r == RAD_SUCCESS && rc == 0) r = rad_matrix_multiply(&vp->matrix, B, H, &ctx);
         t_solve = rad_tool_seconds() - t0;
+        if (!mo->proxy) t_step = t_solve;
         if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "solve", r);
     }
     if (rc == 0) {
@@ -694,12 +922,15 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
         render_vp = NULL, render_vp_H = NULL;
         /* one line for scripts: step = the solve (K bounces + H = F B) as classic's */
         if (rc == 0) {
-            fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=1 bounces=%s%.0u step_ms_median=%.6f "
+            fprintf(stderr, "rad %s: timing: method=%s%s patches=%u frames=%u bounces=%s%.0u step_ms_median=%.6f "
                             "step_ms_min=%.6f build_ms=%.1f sources_ms=%.1f gather_ms=%.1f render_ms=%.1f "
                             "resolution=%u vp_mib=%.1f peak_rss_mib=%.1f\n",
-                    cmd, rad_tool_method_name(mo->method), n, mo->bounces == RAD_MB_INFINITE ? "inf" : "",
+                    cmd, rad_tool_method_name(mo->method),
+                    mo->proxy == RAD_TOOL_PROXY_VP ? " proxy=vp" : mo->proxy ? " proxy=aavp" : "", n,
+                    mo->proxy && mo->method == RAD_TOOL_TEMPORAL ? mo->frames : 1u,
+                    mo->bounces == RAD_MB_INFINITE ? "inf" : "",
                     mo->bounces == RAD_MB_INFINITE ? 0u : mo->bounces,
-                    1e3 * t_solve, 1e3 * t_solve, 1e3 * t_build, 1e3 * t_E, 1e3 * render_vp_gather_seconds,
+                    1e3 * t_step, 1e3 * t_step, 1e3 * t_build, 1e3 * t_E, 1e3 * render_vp_gather_seconds,
                     1e3 * (rad_tool_seconds() - t0), res, (double)rad_vp_memory(vp) / 1048576.0, peak_rss_mib());
         }
     }
@@ -916,7 +1147,7 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
-    if (mo.method >= RAD_TOOL_LOCAL && bake_path) {
+    if (mo.method == RAD_TOOL_LOCAL && !mo.proxy && bake_path) {
         fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd, method);
         return 2;
     }
@@ -949,7 +1180,7 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         if (!emitters && !w.file.light_count)
             fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
         if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC) &&
-            !pathtrace && !bake_path &&
+            !mo.proxy && !pathtrace && !bake_path &&
             o.patches < w.scene->triangle_count)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                     cmd, o.patches, w.scene->triangle_count);
@@ -965,11 +1196,12 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         return 1;
     }
 
-    if (mo.method >= RAD_TOOL_LOCAL) {
-        rc = mo.method == RAD_TOOL_LOCAL ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
+    if (mo.method >= RAD_TOOL_LOCAL || mo.proxy) {
+        rc = mo.method == RAD_TOOL_LOCAL && !mo.proxy
+                 ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
              : mo.method == RAD_TOOL_HIERARCHICAL
                  ? render_hr_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
-                 : render_vp_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
+                 : render_vp_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
         if (rc) {
             rad_image_free(&img);
             rad_tool_close_world(&w);

@@ -119,6 +119,9 @@ const char *rad_tool_method_help(int render)
                     "  --vp-max-patches B the finest resolution whose patch count is at most B (replaces\n"
                     "                     --vp-resolution; found by building at predicted resolutions, <= 6 builds)\n"
                     "  --face-points P    Hammersley points per voxel face (default 16)\n"
+                    "  --proxy P          multibounce, temporal, local: run over patches (default), aavp or vp\n"
+                    "                     (virtual patches with sparse rows, built with --vp-resolution etc.;\n"
+                    "                     E at their samples, the indirect light gathered per pixel as --method aavp)\n"
                     "local (local multi-bounce matrix; classic patches and F, T = (I - rho F_S)^-1 - I\n"
                     "of the set S, the full solution within S; render only):\n"
                     "  --local-m M        capacity: S = the M patches nearest the camera (default: every patch,\n"
@@ -148,6 +151,57 @@ const char *rad_tool_method_help(int render)
                     "  --seed S           generator seed (default 0)\n"
                     "%s", stochastic_help);
     return buf;
+}
+
+/* --proxy patches|aavp|vp: 1 taken, 2 bad value, 0 not this option */
+static int proxy_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo)
+{
+    const char *v;
+    if (strcmp(argv[*a], "--proxy")) return 0;
+    if (*a + 1 >= argc) {
+        fprintf(stderr, "rad %s: --proxy needs a value (patches, aavp or vp)\n", cmd);
+        return 2;
+    }
+    v = argv[++*a];
+    if (!strcmp(v, "patches")) mo->proxy = RAD_TOOL_PROXY_PATCHES;
+    else if (!strcmp(v, "aavp")) mo->proxy = RAD_TOOL_PROXY_AAVP;
+    else if (!strcmp(v, "vp")) mo->proxy = RAD_TOOL_PROXY_VP;
+    else {
+        fprintf(stderr, "rad %s: unknown --proxy '%s' (patches, aavp or vp)\n", cmd, v);
+        return 2;
+    }
+    mo->given |= RAD_TOOL_OPT_PROXY;
+    return 1;
+}
+
+static const char *given_name(uint32_t bits);
+
+/* --proxy aavp|vp: render only, with multibounce, temporal or local; the proxy's F_mb is
+   float and its frames are not written one by one, so the options for those are refused */
+static int proxy_check(const char *cmd, int render, const rad_tool_method_options *mo)
+{
+    uint32_t bad;
+    if (!mo->proxy) return 0;
+    if (!render) {
+        fprintf(stderr, "rad %s: --proxy is an option of rad render (bake virtual patches with --method aavp|vp)\n", cmd);
+        return 2;
+    }
+    if (mo->method != RAD_TOOL_MULTIBOUNCE && mo->method != RAD_TOOL_TEMPORAL && mo->method != RAD_TOOL_LOCAL) {
+        fprintf(stderr, "rad %s: --proxy %s is for --method multibounce, temporal or local, not %s\n", cmd,
+                mo->proxy == RAD_TOOL_PROXY_VP ? "vp" : "aavp", rad_tool_method_name(mo->method));
+        return 2;
+    }
+    bad = mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY);
+    if (bad) {
+        fprintf(stderr, "rad %s: %s is not an option of --proxy %s (its F_mb is float; one image, no sequence)\n", cmd,
+                given_name(bad), mo->proxy == RAD_TOOL_PROXY_VP ? "vp" : "aavp");
+        return 2;
+    }
+    if ((mo->given & RAD_TOOL_OPT_VP_RESOLUTION) && (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
+        fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
+        return 2;
+    }
+    return 0;
 }
 
 int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo)
@@ -214,6 +268,10 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
             mo->given |= RAD_TOOL_OPT_HR_MIN_AREA;
         }
         return 1;
+    }
+    {
+        int pr = proxy_option(cmd, argc, argv, a, mo);
+        if (pr) return pr;
     }
     {
         static const char *const extra[] = {"--vp-resolution", "--vp-max-patches", "--face-points", "--local-m"};
@@ -384,18 +442,23 @@ static const char *given_name(uint32_t bits)
 
 int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o)
 {
-    uint32_t g = mo->given, bad = 0;
+    /* with --proxy the virtual patches' options belong to the proxy */
+    uint32_t g = mo->given & ~(mo->proxy ? RAD_TOOL_OPT_VP : 0u), bad = 0;
     const char *want = NULL;
+    if (proxy_check(cmd, render, mo)) return 2;
     if (!render && (g & RAD_TOOL_OPT_RENDER_ONLY)) {
         fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & RAD_TOOL_OPT_RENDER_ONLY));
         return 2;
     }
-    if (!render && mo->method >= RAD_TOOL_LOCAL) {
+    if (!render && (mo->method == RAD_TOOL_LOCAL || mo->method == RAD_TOOL_HIERARCHICAL)) {
         fprintf(stderr, "rad %s: method '%s' is render-only (rad render --method %s builds it in memory: %s)\n", cmd,
                 rad_tool_method_name(mo->method), rad_tool_method_name(mo->method),
-                mo->method == RAD_TOOL_LOCAL          ? "its matrix depends on the camera; a classic bake holds its F"
-                : mo->method == RAD_TOOL_HIERARCHICAL ? "the container has no section for quadtrees and links yet"
-                                                      : "the container has no section for virtual patches yet");
+                mo->method == RAD_TOOL_LOCAL ? "its matrix depends on the camera; a classic bake holds its F"
+                                             : "the container has no section for quadtrees and links yet");
+        return 2;
+    }
+    if (!render && (mo->method == RAD_TOOL_VP || mo->method == RAD_TOOL_AAVP) && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
+        fprintf(stderr, "rad %s: --vp-max-patches is an option of rad render (bake with --vp-resolution)\n", cmd);
         return 2;
     }
     if (mo->method >= RAD_TOOL_LOCAL) {

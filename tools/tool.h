@@ -297,7 +297,8 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
 typedef enum rad_tool_method {
     RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
     RAD_TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
-    RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7, RAD_TOOL_HIERARCHICAL = 8 /* render only (cmd_render.c) */
+    RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7, /* render only (cmd_render.c); vp, aavp also bake_vp (cmd_bake.c) */
+    RAD_TOOL_HIERARCHICAL = 8 /* render only (cmd_render.c) */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
 typedef enum rad_tool_mb_format {
@@ -333,8 +334,13 @@ typedef struct rad_tool_method_options {
     float hr_eps;             /* --hr-eps E: hierarchical BF refinement tolerance (0: 1e-5) */
     float hr_min_area;        /* --hr-min-area A: smallest element, scene units^2 (0: total area / 10000) */
     uint32_t hr_rays;         /* --hr-rays R: points and visibility rays per link, a square (0: 4) */
+    uint32_t proxy;           /* --proxy patches|aavp|vp (rad_tool_proxy; render, with multibounce,
+                                 temporal and local: the method runs over virtual patches) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
 } rad_tool_method_options;
+/* --proxy: what multibounce, temporal and local run over (default: classic patches) */
+typedef enum rad_tool_proxy { RAD_TOOL_PROXY_PATCHES = 0, RAD_TOOL_PROXY_AAVP = 1, RAD_TOOL_PROXY_VP = 2 } rad_tool_proxy;
+#define RAD_TOOL_OPT_PROXY (1u << 28)
 enum {
     RAD_TOOL_OPT_BOUNCES = 1u << 0, RAD_TOOL_OPT_FORMAT = 1u << 1, RAD_TOOL_OPT_OUTLIERS = 1u << 2,
     RAD_TOOL_OPT_REORDER = 1u << 3, RAD_TOOL_OPT_REORDER_SAMPLES = 1u << 4, RAD_TOOL_OPT_TILE = 1u << 5,
