@@ -705,6 +705,28 @@ RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_ra
                                         const rad_form_factor_options *options, uint32_t row_begin,
                                         uint32_t row_end, float *out_rows, const rad_context *ctx);
 
+/* The upper-triangle pairs of the row range: every pair {i, j} with row_begin <= i < row_end
+   and i < j < N, each computed once (no pair outside the range), so that disjoint row ranges
+   covering [0, N) together compute each unordered pair exactly once, as the dense call does:
+   a bake split over processes or machines does the work of one dense call, not twice it.
+   Output, packed row after row (row i holds N - 1 - i entries, j = i+1 .. N-1):
+   out_upper gets F_ij and out_lower F_ji, both rad_form_factor_pair_count(N, row_begin,
+   row_end) floats. Each value has the same bits as in rad_form_factors_dense and
+   rad_form_factor_rows (the same points, the same side, the same reciprocity product), so
+   the full matrix assembled from the pieces equals the dense one bit for bit. The diagonal is
+   0 and not stored. out_pairs_evaluated (may be NULL) gets the pairs whose value was computed
+   (the facing ones, as rad_form_factors.pairs_evaluated). RAD_FF_HEMICUBE computes each row on
+   its own (no reciprocity): INVALID_ARGUMENT, use the rows call. Errors: INVALID_ARGUMENT,
+   OUT_OF_MEMORY, RAYCAST_FAILED, CANCELLED. Thread safety: reentrant; uses ctx->parallel_for.
+   Cost: O(pair count x samples). */
+RAD_API rad_result rad_form_factor_pairs(const rad_patches *patches, const rad_raycaster *raycaster,
+                                         const rad_form_factor_options *options, uint32_t row_begin,
+                                         uint32_t row_end, float *out_upper, float *out_lower,
+                                         uint64_t *out_pairs_evaluated, const rad_context *ctx);
+/* The pairs {i, j}, row_begin <= i < row_end, i < j < n: sum of (n - 1 - i); 0 when the range
+   is empty or not within [0, n]. Pure. */
+RAD_API uint64_t rad_form_factor_pair_count(uint32_t n, uint32_t row_begin, uint32_t row_end);
+
 /* The dense N x N matrix (N = patches->count; SIZE_OVERFLOW when N*N*4 bytes does not fit).
    Computes each unordered pair once: half the work of N rows (the hemicube: N rows). Same
    values as the rows call. */
@@ -4459,7 +4481,9 @@ typedef struct rad__ff {
     float *out;
     uint32_t row_begin;           /* rows call: matrix row of out's first row */
     size_t out_stride;
-    int dense_mode;               /* 1: compute j > i and mirror into a full N x N 'out' */
+    int dense_mode;               /* 1: compute j > i and mirror into a full N x N 'out';
+                                     2 (pairs call): j > i into packed 'out' and 'out_lower' */
+    float *out_lower;             /* pairs call: F_ji, packed like 'out' */
     uint32_t tasks;
     /* RAD_FF_HEMICUBE (the pair fields above stay NULL) */
     uint32_t hc_res;
@@ -4879,16 +4903,30 @@ static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
     r = rad__ff_flush(f, task, nrays);
     if (r != RAD_SUCCESS) return r;
     if (f->dense_mode) {
-        float *row = f->out + (size_t)i * N;
-        row[i] = 0.0f;
-        for (j = i + 1; j < N; ++j) {
+        /* F_ij and F_ji of each pair j > i: in place in the full matrix, or packed (pairs call:
+           entry k of row i is j = i + 1 + k) */
+        float *up, *lo;
+        size_t up_at, lo_at, lo_stride;
+        if (f->dense_mode == 1) {
+            up = lo = f->out;
+            f->out[(size_t)i * N + i] = 0.0f;
+            up_at = (size_t)i * N + i + 1u;
+            lo_at = (size_t)(i + 1u) * N + i;
+            lo_stride = N;
+        } else {
+            up = f->out;
+            lo = f->out_lower;
+            up_at = lo_at = (size_t)rad_form_factor_pair_count(N, f->row_begin, i);
+            lo_stride = 1;
+        }
+        for (j = i + 1; j < N; ++j, ++up_at, lo_at += lo_stride) {
             float v = (float)acc[j] * inv_s;
             if (rad__ff_from_i(f, i, j)) {
-                row[j] = v;
-                f->out[(size_t)j * N + i] = v * (f->P->areas[i] / f->P->areas[j]);
+                up[up_at] = v;
+                lo[lo_at] = v * (f->P->areas[i] / f->P->areas[j]);
             } else {
-                f->out[(size_t)j * N + i] = v;
-                row[j] = v * (f->P->areas[j] / f->P->areas[i]);
+                lo[lo_at] = v;
+                up[up_at] = v * (f->P->areas[j] / f->P->areas[i]);
             }
         }
     } else {
@@ -5064,6 +5102,47 @@ RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_ra
     f.row_begin = row_begin;
     f.out_stride = patches->count;
     r = rad__for_rows(&c, row_end - row_begin, f.tasks, rad__ff_row_offset, &f);
+    rad__ff_release(&f, &c.allocator);
+    return r;
+}
+
+RAD_API uint64_t rad_form_factor_pair_count(uint32_t n, uint32_t row_begin, uint32_t row_end)
+{
+    /* pairs of the rows before i: i (n - 1) - i (i - 1) / 2 */
+    uint64_t b = row_begin, e = row_end, m = n ? (uint64_t)n - 1u : 0u;
+    if (row_begin >= row_end || row_end > n) return 0;
+    return (e * m - e * (e - 1u) / 2u) - (b * m - (b ? b * (b - 1u) / 2u : 0u));
+}
+
+RAD_API rad_result rad_form_factor_pairs(const rad_patches *patches, const rad_raycaster *raycaster,
+                                         const rad_form_factor_options *options, uint32_t row_begin, uint32_t row_end,
+                                         float *out_upper, float *out_lower, uint64_t *out_pairs_evaluated,
+                                         const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ff f;
+    rad_result r;
+    uint64_t rays = 0, pairs = 0;
+    rad__ctx_init(&c, ctx);
+    if (out_pairs_evaluated) *out_pairs_evaluated = 0;
+    if (!patches || row_begin > row_end || row_end > patches->count) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options && options->method == RAD_FF_HEMICUBE) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_form_factor_pairs: the hemicube computes each row on its own (no reciprocity); "
+                 "use rad_form_factor_rows");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (rad_form_factor_pair_count(patches->count, row_begin, row_end) == 0) return RAD_SUCCESS;
+    if (!out_upper || !out_lower) return RAD_ERROR_INVALID_ARGUMENT;
+    if (row_end - row_begin < c.tasks) c.tasks = row_end - row_begin;
+    r = rad__ff_setup(&f, patches, raycaster, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    f.out = out_upper;
+    f.out_lower = out_lower;
+    f.row_begin = row_begin;
+    f.dense_mode = 2;
+    r = rad__for_rows(&c, row_end - row_begin, f.tasks, rad__ff_row_offset, &f);
+    rad__ff_totals(&f, &rays, &pairs);
+    if (out_pairs_evaluated) *out_pairs_evaluated = pairs;
     rad__ff_release(&f, &c.allocator);
     return r;
 }
