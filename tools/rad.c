@@ -3,6 +3,7 @@
        rad help | rad CMD --help
        rad formfactors SCENE   group form factors between the scene's named objects
        rad bake SCENE -o FILE.radb     a solution, saved (classic, multibounce or temporal)
+       rad merge PART... -o FILE.radb  the parts of a sharded bake (bake --shard I/N) joined
        rad render SCENE -o OUT.png|OUT.pfm     an image (classic, multibounce or temporal
                                        radiosity, or path tracing)
        rad trace SCENE -o OUT  the reference path tracer
@@ -366,6 +367,8 @@ static void usage(FILE *f)
                "  version                  the library version\n"
                "  formfactors SCENE        group form factors between the scene's named objects\n"
                "  bake SCENE -o FILE.radb  compute and save a solution: --method classic|multibounce|temporal\n"
+               "                           --shard I/N or --rows A:B: one part of it (docs/distributed.md)\n"
+               "  merge PART... -o FILE    join the parts of a sharded bake into the bake itself\n"
                "  render SCENE -o OUT      render an image (.png or .pfm):\n"
                "                           --method classic|multibounce|temporal|local|vp|aavp|pathtrace\n"
                "                           [--bake FILE.radb]\n"
@@ -484,6 +487,8 @@ int rad_cmd_formfactors(int argc, char **argv)
 
 /* ---- dispatch -------------------------------------------------------------------------- */
 
+/* tools/mpi/rad_mpi.c links these sources with a main of its own */
+#ifndef RAD_TOOL_NO_MAIN
 int main(int argc, char **argv)
 {
     static const struct {
@@ -491,7 +496,7 @@ int main(int argc, char **argv)
         int (*fn)(int, char **);
     } cmds[] = {{"formfactors", rad_cmd_formfactors}, {"bake", rad_cmd_bake},       {"render", rad_cmd_render},
                 {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info},
-                {"export", rad_cmd_export}};
+                {"export", rad_cmd_export},           {"merge", rad_cmd_merge}};
     size_t i;
     if (argc < 2) {
         usage(stderr);
@@ -516,3 +521,4 @@ int main(int argc, char **argv)
     fprintf(stderr, "rad: unknown command '%s' (try 'rad help')\n", argv[1]);
     return 2;
 }
+#endif
