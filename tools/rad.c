@@ -359,6 +359,7 @@ void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_r
 
 /* ---- help ------------------------------------------------------------------------------ */
 
+#ifndef RAD_TOOL_NO_MAIN
 static void usage(FILE *f)
 {
     fprintf(f, "usage: rad COMMAND [options]        (rad COMMAND --help for its options)\n"
@@ -380,6 +381,7 @@ static void usage(FILE *f)
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
                "at most 1024).\n");
 }
+#endif
 
 static void formfactors_usage(FILE *f)
 {
