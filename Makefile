@@ -98,7 +98,7 @@ bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal
 	./$(BUILD)/local --quick --append $(BUILD)/BENCHMARKS-quick.md
 
 # the MPI driver of the distributed bake (docs/distributed.md), when OpenMPI is installed
-# (Debian libopenmpi-dev openmpi-bin): the tool's sources with tools/mpi/rad_mpi.c's main
+# (Debian libopenmpi-dev openmpi-bin): the tool's sources but main.c, with tools/mpi/rad_mpi.c's main
 MPICC   ?= mpicc
 HAVE_MPICC := $(shell command -v $(MPICC) 2>/dev/null)
 tools: $(BUILD)/rad $(if $(HAVE_MPICC),$(BUILD)/rad-mpi)
@@ -106,7 +106,7 @@ tools: $(BUILD)/rad $(if $(HAVE_MPICC),$(BUILD)/rad-mpi)
 rad-mpi: $(BUILD)/rad-mpi
 
 $(BUILD)/rad-mpi: tools/mpi/rad_mpi.c $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
-	$(MPICC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -DRAD_TOOL_NO_MAIN -I. tools/*.c tools/mpi/rad_mpi.c -o $@ -lassimp -lm
+	$(MPICC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. $(filter-out tools/main.c,$(wildcard tools/*.c)) tools/mpi/rad_mpi.c -o $@ -lassimp -lm
 	cp $@ tools/rad-mpi
 
 # the tool needs assimp (scene import) and stb (images): Debian libassimp-dev libstb-dev

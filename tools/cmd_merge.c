@@ -368,7 +368,7 @@ static int range_cmp(const void *a, const void *b)
 /* every row in exactly one part; else prints what is given twice or missing */
 static int check_cover(const char *cmd, const rad_tool_part *parts, const part_view *v, uint32_t count)
 {
-    uint32_t N = v[0].sh->patches, n = v[0].sh->shard_count, p, k, total = 0, at = 0, missing = 0;
+    uint32_t N = v[0].sh->patches, n = v[0].sh->shard_count, p, k, total = 0, at = 0, missing = 0, first = 0;
     range_ref *rr;
     int all_shards = 1;
     for (p = 0; p < count; ++p) {
@@ -395,16 +395,17 @@ static int check_cover(const char *cmd, const rad_tool_part *parts, const part_v
         }
         for (k = 0; k < n; ++k)
             if (!seen[k]) {
-                if (!missing) fprintf(stderr, "rad %s: shard", cmd);
-                fprintf(stderr, "%s %u", missing ? "," : "", k);
+                if (!missing) fprintf(stderr, "rad %s: shard", cmd), first = k;
+                if (missing < 16) fprintf(stderr, "%s %u", missing ? "," : "", k);
+                else if (missing == 16) fprintf(stderr, ", ...");
                 ++missing;
             }
         free(seen);
-        if (missing) {
-            fprintf(stderr, " of %u %s missing (%u of %u parts given): bake %s with --shard I/%u\n", n,
-                    missing > 1 ? "are" : "is", count, n, missing > 1 ? "them" : "it", n);
-            return 1;
-        }
+        if (missing == 1)
+            fprintf(stderr, " of %u is missing (%u of %u parts given): bake it with --shard %u/%u\n", n, count, n, first, n);
+        else if (missing)
+            fprintf(stderr, " of %u are missing (%u of %u parts given): bake each with --shard I/%u\n", n, count, n, n);
+        if (missing) return 1;
     }
     rr = (range_ref *)rad_tool_calloc(total, sizeof(range_ref));
     for (p = 0, k = 0; p < count; ++p) {

@@ -359,7 +359,6 @@ void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_r
 
 /* ---- help ------------------------------------------------------------------------------ */
 
-#ifndef RAD_TOOL_NO_MAIN
 static void usage(FILE *f)
 {
     fprintf(f, "usage: rad COMMAND [options]        (rad COMMAND --help for its options)\n"
@@ -381,7 +380,6 @@ static void usage(FILE *f)
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
                "at most 1024).\n");
 }
-#endif
 
 static void formfactors_usage(FILE *f)
 {
@@ -489,9 +487,8 @@ int rad_cmd_formfactors(int argc, char **argv)
 
 /* ---- dispatch -------------------------------------------------------------------------- */
 
-/* tools/mpi/rad_mpi.c links these sources with a main of its own */
-#ifndef RAD_TOOL_NO_MAIN
-int main(int argc, char **argv)
+/* main.c calls it; tools/mpi/rad_mpi.c links the other sources with a main of its own */
+int rad_tool_main(int argc, char **argv)
 {
     static const struct {
         const char *name;
@@ -523,4 +520,3 @@ int main(int argc, char **argv)
     fprintf(stderr, "rad: unknown command '%s' (try 'rad help')\n", argv[1]);
     return 2;
 }
-#endif

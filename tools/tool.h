@@ -105,6 +105,9 @@ int rad_cmd_compare(int argc, char **argv);
 int rad_cmd_info(int argc, char **argv);
 int rad_cmd_export(int argc, char **argv);
 
+/* the rad program (rad.c): dispatches argv[1] to a subcommand; the exit code (main.c) */
+int rad_tool_main(int argc, char **argv);
+
 /* ---- shared helpers (rad.c) ------------------------------------------------------------- */
 /* progress to stderr: a bar when stderr is a terminal, a plain percentage line otherwise */
 int rad_tool_progress(void *user, float fraction);

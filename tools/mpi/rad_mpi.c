@@ -8,8 +8,8 @@
    the parts and merges them (rad_tool_merge: the same checks as rad merge). A rank that fails
    prints its message, prefixed with its rank, and the whole run exits 1 with nothing written:
    only rank 0 writes, through a temporary renamed into place after the merge succeeded. Built
-   with mpicc from the rad tool's sources (rad.c without its main: RAD_TOOL_NO_MAIN); the
-   library knows nothing of MPI. Threads per rank: --threads N, else OMP_NUM_THREADS, else the
+   with mpicc from the rad tool's sources but tools/main.c (make rad-mpi); the library knows
+   nothing of MPI. Threads per rank: --threads N, else OMP_NUM_THREADS, else the
    cores this rank may use divided by the ranks on its node. */
 #include "../tool.h"
 #include <mpi.h>
