@@ -18,9 +18,11 @@
    its order, so the output equals the single bake byte for byte (a part's run record, the
    seconds, stays in the part). docs/distributed.md. */
 #include "tool.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ---- the shard split ------------------------------------------------------------------- */
 
@@ -97,6 +99,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     uint64_t pairs = 0, at = 0;
     float *up = NULL, *lo = NULL;
     double t0;
+    clock_t c0;
     int rc = 1;
     *out = NULL;
     *out_size = 0;
@@ -113,7 +116,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
         nr = rad_tool_shard_ranges(N, spec->index, spec->count, ranges);
     }
     for (k = 0; k < nr; ++k) pairs += rad_form_factor_pair_count(N, ranges[2 * k], ranges[2 * k + 1]);
-    if ((double)pairs * 4.0 > (double)((size_t)-1) / 4.0) {
+    if (pairs > (uint64_t)((size_t)-1 / sizeof(float))) {
         fprintf(stderr, "rad %s: %llu pairs do not fit in memory addresses\n", cmd, (unsigned long long)pairs);
         goto done;
     }
@@ -131,6 +134,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     rad_form_factor_options_default(&fo);
     fo.samples = o->samples;
     t0 = rad_tool_seconds();
+    c0 = clock();
     rad_tool_context(&ctx, "form factors");
     for (k = 0; k < nr; ++k) {
         uint64_t ev = 0;
@@ -146,9 +150,10 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     sh.seconds = rad_tool_seconds() - t0;
     if (spec->rows) fprintf(stderr, "rad %s: rows %u:%u", cmd, ranges[0], ranges[1]);
     else fprintf(stderr, "rad %s: shard %u/%u (%u row ranges)", cmd, spec->index, spec->count, nr);
-    fprintf(stderr, ": %llu of %llu pairs (%.1f%%) in %.2f s\n", (unsigned long long)pairs,
+    fprintf(stderr, ": %llu of %llu pairs (%.1f%%), %llu evaluated, in %.2f s (%.2f s CPU)\n", (unsigned long long)pairs,
             (unsigned long long)rad_form_factor_pair_count(N, 0, N),
-            100.0 * (double)pairs / (double)(rad_form_factor_pair_count(N, 0, N) + (N < 2)), sh.seconds);
+            100.0 * (double)pairs / (double)(rad_form_factor_pair_count(N, 0, N) + (N < 2)),
+            (unsigned long long)sh.pairs_evaluated, sh.seconds, (double)(clock() - c0) / CLOCKS_PER_SEC);
 
     /* patches, vertices, triangles, E and the signature, then ours */
     rad_tool_context(&ctx, NULL);
@@ -448,8 +453,6 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
     rad_tool_classic_options o;
     rad_matrix F;
     rad_section secs[11];
-    rad_context ctx;
-    rad_bake *check = NULL;
     rad_result r;
     float *full = NULL;
     void *dst = NULL;
@@ -484,8 +487,15 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
             uint32_t i, j;
             for (i = v[p].ranges[2 * k]; i < v[p].ranges[2 * k + 1]; ++i)
                 for (j = i + 1; j < N; ++j, ++at) {
-                    full[(size_t)i * N + j] = v[p].up[at];
-                    full[(size_t)j * N + i] = v[p].lo[at];
+                    float a = v[p].up[at], b = v[p].lo[at];
+                    /* what rad_load_memory would refuse is not written (NaN fails too) */
+                    if (!(a >= 0.0f && a <= RAD_BAKE_VALUE_MAX && b >= 0.0f && b <= RAD_BAKE_VALUE_MAX)) {
+                        fprintf(stderr, "rad %s: %s: the form factors of patches %u and %u are %g and %g (finite, >= 0 "
+                                        "expected)\n", cmd, parts[p].name, i, j, (double)a, (double)b);
+                        goto done;
+                    }
+                    full[(size_t)i * N + j] = a;
+                    full[(size_t)j * N + i] = b;
                 }
         }
         evaluated += v[p].sh->pairs_evaluated;
@@ -539,13 +549,15 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
         rad_tool_fail(cmd, "rad_container_write", r);
         goto done;
     }
-    /* what is written loads (every value checked) */
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_load_memory(dst, dst_size, &ctx, &check)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_load_memory of the merged bake", r);
-        goto done;
-    }
-    rad_bake_destroy(check);
+    /* the solution's vectors are checked as rad_save_memory checks them (F was, above; the
+       rest was loaded from the parts): what is written loads, without a second pass over F */
+    for (k = 0; k < 3 * N; ++k)
+        if (!(fabsf(c.B[k]) <= RAD_BAKE_VALUE_MAX && fabsf(c.L[k]) <= RAD_BAKE_VALUE_MAX &&
+              fabsf(c.H[k]) <= RAD_BAKE_VALUE_MAX)) {
+            fprintf(stderr, "rad %s: the solution of patch %u is not finite (B %g, L %g, H %g)\n", cmd, k / 3,
+                    (double)c.B[k], (double)c.L[k], (double)c.H[k]);
+            goto done;
+        }
     if (rad_tool_write_file(out_path, dst, dst_size) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
         goto done;
