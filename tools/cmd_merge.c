@@ -62,13 +62,15 @@ bad:
     return 2;
 }
 
-/* Shard I of n: the rows cut into K = min(N, 8 n) chunks dealt out in a snake (0 1 .. n-1,
+/* Shard I of n: the rows cut into K = min(N, 64 n) chunks dealt out in a snake (0 1 .. n-1,
    n-1 .. 1 0, ...), so each shard gets chunks from the top of the triangle, where a row has
-   many pairs j > i, and from the bottom, where it has few, and from every part of the scene.
+   many pairs j > i, and from the bottom, where it has few, and from every part of the scene:
+   the cost of a pair varies with where it is (near pairs take 16x the points, rays cross
+   different geometry), and 64 chunks a shard average that out where 8 did not.
    Adjacent chunks of one shard are joined. */
 uint32_t rad_tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ranges)
 {
-    uint32_t K = N < 8u * n ? N : 8u * n, q, count = 0;
+    uint32_t K = N < RAD_TOOL_SHARD_CHUNKS * n ? N : RAD_TOOL_SHARD_CHUNKS * n, q, count = 0;
     for (q = 0; q < K; ++q) {
         uint32_t round = q / n, pos = q % n, shard = (round & 1u) ? n - 1u - pos : pos;
         uint32_t b = (uint32_t)((uint64_t)q * N / K), e = (uint32_t)((uint64_t)(q + 1u) * N / K);
@@ -95,7 +97,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     rad_section *secs = NULL;
     void *base = NULL, *dst = NULL;
     size_t base_size = 0, dst_size = 0;
-    uint32_t ranges[2 * 8 * 2 + 2], nr, N, k, i, count;
+    uint32_t ranges[2 * RAD_TOOL_SHARD_CHUNKS], nr, N, k, i, count;
     uint64_t pairs = 0, at = 0;
     float *up = NULL, *lo = NULL;
     double t0;

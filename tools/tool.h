@@ -360,11 +360,13 @@ typedef struct rad_tool_shard_spec {
     uint32_t row_begin, row_end;  /* --rows: rows A to B-1 */
 } rad_tool_shard_spec;
 #define RAD_TOOL_MAX_SHARDS 65536u
+/* chunks of rows per shard (the snake of rad_tool_shard_ranges) */
+#define RAD_TOOL_SHARD_CHUNKS 64u
 /* "I/N" and "A:B" into s; 0, or 2 with a message */
 int rad_tool_parse_shard(const char *cmd, const char *text, rad_tool_shard_spec *s);
 int rad_tool_parse_rows(const char *cmd, const char *text, rad_tool_shard_spec *s);
 /* The rows of shard I of n over N rows as ranges [ranges[2k], ranges[2k+1]), ascending; returns
-   their count (at most 8; 0 when n > N leaves the shard nothing). Shards of one n cover the
+   their count (at most RAD_TOOL_SHARD_CHUNKS; 0 when n > N leaves the shard nothing). Shards of one n cover the
    rows exactly once, with nearly equal pair counts (rad_form_factor_pair_count). */
 uint32_t rad_tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ranges);
 
