@@ -508,6 +508,9 @@ static void api_ff_bad_options(api_fx *f)
         api_fill(f->buf, f->buf_len);
         CHECK_RESULT(rad_form_factor_rows(f->P, &f->rc, &o[i], 0, 2, f->buf, NULL), RAD_ERROR_INVALID_ARGUMENT);
         CHECK(api_untouched(f->buf, f->buf_len));
+        api_fill(f->buf2, f->buf_len);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, &o[i], 0, 2, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(api_untouched(f->buf, f->buf_len) && api_untouched(f->buf2, f->buf_len));
         ff = API_SENTINEL(rad_form_factors);
         CHECK_RESULT(rad_form_factors_dense(f->P, &f->rc, &o[i], NULL, &ff), RAD_ERROR_INVALID_ARGUMENT);
         CHECK(ff == NULL);
@@ -544,6 +547,24 @@ static void api_ff_args(api_fx *f)
     CHECK_OK(rad_form_factor_rows(f->P, &f->rc, NULL, 3, 3, f->buf, NULL)); /* an empty range writes nothing */
     CHECK_OK(rad_form_factor_rows(f->P, &f->rc, NULL, N, N, f->buf, NULL));
     CHECK(api_untouched(f->buf, f->buf_len));
+    /* pairs: the same refusals, nothing written; an empty range (the last row has no j > i) is fine */
+    {
+        uint64_t ev = 7;
+        api_fill(f->buf2, f->buf_len);
+        CHECK_RESULT(rad_form_factor_pairs(NULL, &f->rc, NULL, 0, 1, f->buf, f->buf2, &ev, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(ev == 0);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, 0, 1, NULL, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, 0, 1, f->buf, NULL, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, 2, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, 0, N + 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, 0xFFFFFFFFu, 0xFFFFFFFFu, f->buf, f->buf2, NULL, NULL),
+                     RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, NULL, NULL, 0, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &half, NULL, 0, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_OK(rad_form_factor_pairs(f->P, &f->rc, NULL, N - 1, N, NULL, NULL, &ev, NULL));
+        CHECK(ev == 0);
+        CHECK(api_untouched(f->buf, f->buf_len) && api_untouched(f->buf2, f->buf_len));
+    }
     o.skip_visibility = 1; /* the raycaster may be NULL then */
     CHECK_OK(rad_form_factor_rows(f->P, NULL, &o, 0, 1, f->buf, NULL));
     o.samples = 0xFFFFFFFFu; /* capped */
