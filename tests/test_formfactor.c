@@ -746,16 +746,24 @@ static void ff_test_pairs(void)
     cuts[4] = N;
     memset(full, 0xAB, sizeof(float) * (size_t)N * N);
     for (i = 0; i < N; ++i) full[(size_t)i * N + i] = 0.0f;
-    for (k = 0; k < 4; ++k) {
-        uint64_t n = rad_form_factor_pair_count(N, cuts[k], cuts[k + 1]), at = 0;
+    /* two calls: ranges 0 and 2 (not adjacent, with an empty one between), then 1 and 3 */
+    for (k = 0; k < 2; ++k) {
+        uint32_t r[6], c, nr = 0;
+        uint64_t n = 0, at = 0;
+        for (c = (uint32_t)k; c < 4; c += 2) {
+            r[2 * nr] = cuts[c], r[2 * nr + 1] = cuts[c + 1], ++nr;
+            n += rad_form_factor_pair_count(N, cuts[c], cuts[c + 1]);
+            if (c == 0) r[2 * nr] = r[2 * nr + 1] = cuts[1], ++nr; /* an empty range */
+        }
         total += n;
-        CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts[k], cuts[k + 1], up, lo, &pairs, NULL));
+        CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, r, nr, up, lo, &pairs, NULL));
         pairs_sum += pairs;
-        for (i = cuts[k]; i < cuts[k + 1]; ++i)
-            for (j = i + 1; j < N; ++j, ++at) {
-                full[(size_t)i * N + j] = up[at];
-                full[(size_t)j * N + i] = lo[at];
-            }
+        for (c = 0; c < nr; ++c)
+            for (i = r[2 * c]; i < r[2 * c + 1]; ++i)
+                for (j = i + 1; j < N; ++j, ++at) {
+                    full[(size_t)i * N + j] = up[at];
+                    full[(size_t)j * N + i] = lo[at];
+                }
         CHECK(at == n);
     }
     CHECK(total == (uint64_t)N * (N - 1u) / 2u);
@@ -763,12 +771,19 @@ static void ff_test_pairs(void)
     CHECK(pairs_sum == ff->pairs_evaluated && pairs_sum > 0);
     printf("    %u patches: %llu pairs evaluated in 4 ranges, %llu by the dense call\n", N, (unsigned long long)pairs_sum,
            (unsigned long long)ff->pairs_evaluated);
-    /* empty range, bad range, the hemicube (no reciprocity) */
-    CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, N - 1, N, NULL, NULL, NULL, NULL));
-    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, 2, N + 1, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
-    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, 0, 2, NULL, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    /* no pairs, bad ranges (beyond N, overlapping, out of order), the hemicube (no reciprocity) */
+    cuts[0] = N - 1, cuts[1] = N;
+    CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 1, NULL, NULL, NULL, NULL));
+    CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, NULL, 0, NULL, NULL, NULL, NULL));
+    cuts[0] = 2, cuts[1] = N + 1;
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 1, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    cuts[0] = 0, cuts[1] = 4, cuts[2] = 3, cuts[3] = 5;
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 2, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    cuts[0] = 4, cuts[1] = 5, cuts[2] = 0, cuts[3] = 2;
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 2, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts + 2, 1, NULL, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
     fo.method = RAD_FF_HEMICUBE;
-    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, 0, 2, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts + 2, 1, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
 done:
     free(full);
     free(up);

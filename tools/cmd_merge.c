@@ -98,7 +98,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     void *base = NULL, *dst = NULL;
     size_t base_size = 0, dst_size = 0;
     uint32_t ranges[2 * RAD_TOOL_SHARD_CHUNKS], nr, N, k, i, count;
-    uint64_t pairs = 0, at = 0;
+    uint64_t pairs = 0;
     float *up = NULL, *lo = NULL;
     double t0;
     clock_t c0;
@@ -138,17 +138,13 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     t0 = rad_tool_seconds();
     c0 = clock();
     rad_tool_context(&ctx, "form factors");
-    for (k = 0; k < nr; ++k) {
-        uint64_t ev = 0;
-        r = rad_form_factor_pairs(c.patches, &w->rc, &fo, ranges[2 * k], ranges[2 * k + 1], up + at, lo + at, &ev, &ctx);
-        if (r != RAD_SUCCESS) {
-            rad_tool_fail(cmd, "rad_form_factor_pairs", r);
-            goto done;
-        }
-        sh.pairs_evaluated += ev;
-        at += rad_form_factor_pair_count(N, ranges[2 * k], ranges[2 * k + 1]);
-    }
+    /* one call for all the ranges: the threads share every row of the part */
+    r = rad_form_factor_pairs(c.patches, &w->rc, &fo, ranges, nr, up, lo, &sh.pairs_evaluated, &ctx);
     rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_tool_fail(cmd, "rad_form_factor_pairs", r);
+        goto done;
+    }
     sh.seconds = rad_tool_seconds() - t0;
     if (spec->rows) fprintf(stderr, "rad %s: rows %u:%u", cmd, ranges[0], ranges[1]);
     else fprintf(stderr, "rad %s: shard %u/%u (%u row ranges)", cmd, spec->index, spec->count, nr);

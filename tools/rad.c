@@ -96,11 +96,18 @@ void rad_tool_log(void *user, rad_log_level level, const char *message)
             message);
 }
 
+static int g_progress_on = 1;
+
+void rad_tool_show_progress(int on)
+{
+    g_progress_on = on;
+}
+
 void rad_tool_context(rad_context *ctx, const char *label)
 {
     memset(ctx, 0, sizeof *ctx);
     ctx->log = rad_tool_log;
-    if (label) {
+    if (label && g_progress_on) {
         ctx->progress = rad_tool_progress;
         ctx->progress_user = (void *)(size_t)label;
     }

@@ -150,6 +150,8 @@ void rad_trace_options_default(rad_trace_options *options);
 /* A context whose log goes to stderr and whose progress is drawn with 'label' (NULL: no
    progress). */
 void rad_tool_context(rad_context *ctx, const char *label);
+/* 0: contexts made from now on draw no progress (rad-mpi's ranks other than 0) */
+void rad_tool_show_progress(int on);
 /* ends a progress line that did not reach 100% */
 void rad_tool_progress_end(void);
 /* "rad CMD: what failed: RAD_ERROR_...: ..." on stderr; returns 1 */

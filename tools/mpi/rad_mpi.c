@@ -85,6 +85,7 @@ int main(int argc, char **argv)
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
     t0 = MPI_Wtime();
     sprintf(cmd, "mpi bake [rank %d/%d]", rank, ranks);
+    rad_tool_show_progress(rank == 0); /* one progress line, not one per rank */
     /* the command line: rank 0 says what is wrong with it, once */
     if (rank == 0) {
         if (argc < 2 || strcmp(argv[1], "bake")) {
