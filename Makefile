@@ -2,6 +2,7 @@
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
 #   make gallery every lighting model on rows of spheres, to gallery.png
 #   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
+#   make learn   builds the teaching examples examples/learn_*.c into build/
 #   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
@@ -23,7 +24,7 @@ EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
 
-.PHONY: all demo gallery walk moving-light test bench bench-quick tools rad-mpi fuzz clean glsl report report-quick
+.PHONY: all demo gallery walk learn moving-light test bench bench-quick tools rad-mpi fuzz clean glsl report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk tools
 
@@ -32,6 +33,10 @@ $(BUILD):
 
 $(BUILD)/cornell: examples/cornell.c examples/png_write.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/cornell.c -o $@ -lm
+
+# hierarchical radiosity's links drawn over the Cornell box (examples/learn_hierarchical.c)
+$(BUILD)/learn_hierarchical: examples/learn_hierarchical.c examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) -I. examples/learn_hierarchical.c -o $@ -lm
 
 # virtual patches on the bunny in the Cornell box (needs $(RAD_DATA_DIR); --ogre for 193k triangles)
 $(BUILD)/vp_bunny: examples/vp_bunny.c radiosity.h | $(BUILD)
@@ -47,6 +52,12 @@ gallery: $(BUILD)/gallery
 	./$(BUILD)/gallery -o gallery.png
 
 walk: $(BUILD)/walk
+
+# the teaching examples (examples/learn_*.c): each prints a small table
+LEARN = $(BUILD)/learn_formfactors $(BUILD)/learn_solvers $(BUILD)/learn_stochastic
+learn: $(LEARN)
+$(BUILD)/learn_%: examples/learn_%.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. $< -o $@ -lm
 
 # temporal radiosity under a moving point light: PNG frames + per-frame error CSV (examples/moving_light.c)
 $(BUILD)/moving_light: examples/moving_light.c examples/png_write.h radiosity.h | $(BUILD)

@@ -249,7 +249,8 @@
          side analytically; pairs closer than twice their size get 16x the points, because the
          integrand is nearly singular along a shared edge. Measured against the closed forms
          of Howell's catalogue (docs/references.md) at default quality: relative errors
-         below 1e-4.
+         below 1e-4 with patches a tenth of the shapes' size, a few 1e-4 at a quarter (the
+         tests hold every case to 1e-3).
        - The BVH's box test widens every slab by 1 + 2 gamma_3 (Ize 2013) and its triangle
          test is watertight (Woop, Benthin, Wald 2013), so rays through shared edges and
          vertices are never lost.
@@ -269,7 +270,8 @@
               built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
               compression and reordering; temporal radiosity with alias tables; local
               matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
-              models and microfacet BRDFs; embedded GLSL kernels for every run-time step.
+              models and microfacet BRDFs; embedded GLSL kernels for every run-time step;
+              hemicube form factors; stochastic radiosity (stochastic Jacobi, random walks).
        The full history is in CHANGELOG.md.
 */
 
@@ -537,6 +539,33 @@ RAD_API uint32_t rad_patches_locate(const rad_patches *patches, uint32_t triangl
 RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const float *patch_values,
                                              uint32_t channels, float *out_vertex_values);
 
+/* Per-vertex irradiance without dark halos. A patch partly covered by other geometry (under a
+   block, under a one-sided light a hair below the ceiling) has a small H only because part of
+   its area sees nothing; a plain vertex average smears that into the visible surface around the
+   contact. So the value at vertex v is (mean radiosity seen) x (how much is seen):
+       H_v = [sum_i A_i H_i / sum_i A_i S_i] * S_v,
+   the sums over the patches sharing v, S_v the area-weighted mean of S over those patches that
+   are not partly covered (S_i >= 3/4 of the largest S at v). S (one float per patch) is the
+   row sum of F (sum_j F_ij, how much of its hemisphere a patch sees: rad_matrix_multiply by
+   ones); NULL gives rad_patches_vertex_values. H: 3 floats per patch; out: 3 per patch vertex.
+   Errors: INVALID_ARGUMENT, NON_FINITE (H or S not finite, S < 0), OUT_OF_MEMORY. O(patches). */
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx);
+
+/* Values at the vertices of one of the scene's own meshes, for an engine that draws that mesh:
+   'mesh' is the index the mesh had in rad_scene_desc.meshes and 'desc' the same description
+   (its vertex count and indices). vertex_values: 3 floats per patch vertex (from
+   rad_patches_vertex_values or rad_patches_vertex_irradiance). Each triangle corner takes the
+   value interpolated at that corner of its patch; a vertex shared by several triangles gets
+   the area-weighted mean over them (so a crease averages its sides, as the mesh's own smooth
+   normals do), and a vertex no triangle uses (or only skipped degenerate ones) gets 0.
+   out: 3 * desc->vertex_count floats. Errors: INVALID_ARGUMENT (mesh >= the scene's mesh count,
+   a NULL pointer), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
+   of that mesh beyond desc->triangle_count: another description), OUT_OF_MEMORY.
+   O(triangles of the scene). */
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx);
+
 /* ======================================================================================== */
 /* >>api_rays: ray queries and the built-in BVH                                             */
 /* ======================================================================================== */
@@ -778,7 +807,7 @@ typedef int (*rad_residual_fn)(void *user, uint32_t iteration, double residual);
 
 typedef struct rad_solve_options {
     rad_output output;         /* RAD_OUTPUT_INDIRECT (default) or RAD_OUTPUT_TOTAL */
-    uint32_t bounces;          /* Jacobi: K (0 returns 0 indirect / E total) */
+    uint32_t bounces;          /* Jacobi: K (default 8; 0 returns 0 indirect / E total) */
     double tolerance;          /* Gauss-Seidel, shooting: relative (0: 1e-6) */
     uint32_t max_iterations;   /* GS sweeps (0: 1000), shooting steps (0: 100 N) */
     rad_residual_fn on_residual;
@@ -816,6 +845,228 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
                                     const rad_context *ctx);
 
 /* ======================================================================================== */
+/* >>api_stochastic: stochastic (Monte Carlo) radiosity                                     */
+/* ======================================================================================== */
+
+/* Stochastic radiosity (docs/methods/stochastic.md) solves the same patch system as the
+   classic solvers, B = E + rho o (F B), without ever building F: form factors are sampled by
+   rays. A ray leaves a uniform point of patch i in a cosine-distributed direction; the patch j
+   it hits first (front face) is then drawn with probability exactly F_ij, so the power a ray
+   carries, dropped on j and reflected there (times rho_j / A_j), is an unbiased estimate of
+   one step of the power equation A_j B_j = A_j E_j + rho_j sum_i F_ij A_i B_i. A miss or a back
+   face absorbs the ray (F_ij is 0 for a patch facing away, as in the classic matrix).
+
+   RAD_STOCHASTIC_JACOBI: stochastic Jacobi iteration (Neumann et al. 1994; Bekaert's thesis).
+     Shooting (incremental) iterations: the unshot radiosity dB (first E) is shot with rays
+     drawn in proportion to each patch's unshot power A_i (dB_r + dB_g + dB_b) (systematic
+     sampling: patch i gets floor or ceil of its share), each ray carrying an equal share of
+     the total; what the rays deposit is the next dB, added to B. Iteration k casts
+     ceil(rays * P_k / P_0) rays (P_k the unshot power), so every unit of power is shot with
+     the same density of rays; the shooting stops when P_k < tolerance * P_0 or after
+     'iterations'. Then 'regular_iterations' regular iterations B' = E + rho o F~ B shoot the
+     whole power of the current B (rays * P(B) / P_0 rays each) and the result is the mean of
+     their B': more rays on a solution that no longer changes in expectation.
+   RAD_STOCHASTIC_WALK: shooting random walks with the collision estimator (Sbert's random
+     walk radiosity). 'rays' walks start on patches drawn in proportion to their power A_i E_i
+     (systematic sampling), each carrying an equal share; at every patch j a walk hits it
+     scores rho_j times its power into B_j (divided by A_j), then continues from a uniform
+     point of j with probability max_c rho_j,c (Russian roulette; the surviving power is
+     divided by that probability, so no channel grows), else ends. 'iterations' batches of
+     'rays' walks are averaged. A walk ends after 65536 collisions at the most.
+
+   Both estimators are unbiased for the exact patch system (with exact form factors and
+   visibility): the mean over seeds converges to the classic direct solve up to its form-factor
+   error, and the variance falls as 1 / rays (tests/test_stochastic.c checks both). The noise
+   is per patch: a patch of area A receives about rays * A / A_total of the hits, so small
+   patches are noisy; Bekaert's thesis discusses the variance.
+
+   DETERMINISM. Every ray's random numbers are a hash (the integer hash of >>core) of the seed,
+   the iteration and the ray's (or walk's and bounce's) index, and deposits are summed in ray
+   order in double precision: the same seed gives the same bits on any number of threads and
+   any task order. Rays are traced in waves of at most 2^20 through raycaster->intersect
+   (batches of 1024 per task). */
+
+typedef enum rad_stochastic_method {
+    RAD_STOCHASTIC_JACOBI = 0, /* stochastic Jacobi iteration, shooting then regular (default) */
+    RAD_STOCHASTIC_WALK = 1    /* shooting random walks, collision estimator */
+} rad_stochastic_method;
+
+/* Called after every iteration (Jacobi: shooting and regular; walk: batch) with the number of
+   iterations done, the rays cast so far and the current estimate of B = E + L (3N floats, the
+   running mean in the regular phase and for walks). Return non-zero to stop: the solver then
+   returns RAD_SUCCESS with that estimate. */
+typedef int (*rad_stochastic_fn)(void *user, uint32_t iteration, uint64_t rays_cast, const float *B);
+
+typedef struct rad_stochastic_options {
+    rad_stochastic_method method; /* RAD_STOCHASTIC_JACOBI (default) or RAD_STOCHASTIC_WALK */
+    rad_output output;            /* RAD_OUTPUT_INDIRECT (default): L = B - E; or RAD_OUTPUT_TOTAL */
+    uint32_t rays;                /* Jacobi: rays of the first shooting iteration (later ones in
+                                     proportion to their power); walk: walks per batch.
+                                     0: 64 per patch, at least 4096, at most 2^26 */
+    uint32_t iterations;          /* Jacobi: shooting iterations at most (0: 256); walk: batches
+                                     averaged (0: 1) */
+    uint32_t regular_iterations;  /* Jacobi: regular iterations after the shooting, averaged
+                                     (0: none); walk: must be 0 */
+    double tolerance;             /* Jacobi: the shooting stops when the unshot power is below
+                                     tolerance times the source power (0: 1e-4); walk: unused */
+    float ray_epsilon;            /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;                /* any value; same seed, same bits */
+    rad_stochastic_fn on_iteration; /* optional */
+    void *iteration_user;
+} rad_stochastic_options;
+
+typedef struct rad_stochastic_stats {
+    uint32_t iterations;          /* Jacobi: shooting + regular iterations done; walk: batches */
+    uint64_t rays_cast;           /* closest-hit rays traced (walk: one per collision or miss) */
+    double unshot;                /* Jacobi: unshot power / source power when the shooting
+                                     stopped (the truncation left out); walk: 0 */
+} rad_stochastic_stats;
+
+/* Defaults: RAD_STOCHASTIC_JACOBI, RAD_OUTPUT_INDIRECT, every count 0 (its documented default),
+   tolerance 1e-4, ray_epsilon 1e-5, seed 0, no callback. */
+RAD_API void rad_stochastic_options_default(rad_stochastic_options *options);
+
+/* Solves B = E + rho o (F B) on 'patches' (albedo from patches->albedo) by one of the two
+   estimators above, tracing rays through 'raycaster' (its intersect callback; built on the
+   patches' scene). E: 3N floats, each finite and >= 0 (E is a source of light: a negative
+   value has no power to draw rays by). out: 3N floats, L or B as options->output says.
+   options may be NULL (the defaults). stats may be NULL.
+   Errors: INVALID_ARGUMENT (NULL patches, raycaster, intersect, E or out; patches without their
+   scene (the patches of a loaded bake: set patches.scene first); an unknown method or
+   output; ray_epsilon outside (0, 1e-2]; a negative or non-finite tolerance; regular
+   iterations with the walk), NON_FINITE (a NaN or Inf in E, or a result that overflows float),
+   NEGATIVE_EMISSION (a negative E), ALBEDO_RANGE (a patch albedo outside [0,1)),
+   RAYCAST_FAILED, CANCELLED (ctx->progress, called after each iteration), OUT_OF_MEMORY.
+   Thread safety: reentrant; rays run through ctx->parallel_for.
+   Cost: Jacobi about rays / (1 - rho_mean) rays for the shooting (plus rays * P(B)/P(E) per
+   regular iteration); walk about iterations * rays / (1 - rho_mean); memory O(N) plus 28
+   bytes per ray of a wave and 48 KiB per task. docs/methods/stochastic.md. */
+RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_raycaster *raycaster, const float *E,
+                                        const rad_stochastic_options *options, float *out,
+                                        rad_stochastic_stats *stats, const rad_context *ctx);
+
+/* ======================================================================================== */
+/* >>api_hierarchical: hierarchical radiosity                                               */
+/* ======================================================================================== */
+
+/* Hierarchical radiosity (Hanrahan, Salzman and Aupperle 1991, "A Rapid Hierarchical
+   Radiosity Algorithm"; docs/methods/hierarchical.md). Each scene triangle is the root of a
+   quadtree of elements: an element is split on demand into 4 by its edge midpoints. Light
+   travels over links: link r <- s says that element r gathers from element s with the form
+   factor F_rs (r's points, the analytic point-to-triangle kernel of rad_ff_point_polygon to
+   s, times the kernel-weighted share of rays from those points to s that nothing blocks):
+     1. one link r <- s for every ordered pair of scene triangles that face each other;
+     2. BF refinement: a link whose power A_r F_rs max_c(B_s) (F_rs unoccluded) exceeds
+        tolerance * P, P = sum over triangles of A max_c(E), is replaced by 4 links to the
+        children of its larger element (split on demand), and one whose error A_r max_c(B_s)
+        times the spread of the kernel over r's points exceeds it by 4 links from r's
+        children; elements are split while their children keep min_area; the new links are
+        refined in turn;
+     3. gather and push-pull (Jacobi): G_r = sum over r's links of F_rs B_s; pushed down
+        (an element receives what its ancestors gathered), B = E + rho G at the leaves,
+        pulled up as area-weighted means; repeated until B changes by less than 1e-6 of
+        max B;
+     4. steps 2 and 3 again with the new B, until no link is refined or max_iterations rounds.
+   The result: per leaf, B (radiosity, W m^-2) and H = G (the irradiance from the other
+   elements' radiosity, the classic H = F B; the renderer's indirect term is rho / pi H).
+   Without clustering, step 1 joins every pair of scene triangles, O(T^2) links: meant for
+   scenes of up to a few thousand triangles (more than RAD_HIERARCHICAL_MAX_ROOT_PAIRS ordered
+   pairs is refused with SIZE_OVERFLOW). Reentrant; the solve uses ctx->parallel_for for the
+   links' form factors; after it the accessors and lookups only read (any threads at once). */
+
+#define RAD_HIERARCHICAL_MAX_ROOT_PAIRS 50000000ull
+
+/* The source term of elements: out_E (3 per point) for 'count' element centroids 'points'
+   with unit normals, the scene triangles they lie on and their albedos (3 per point).
+   E.g. albedo times the direct irradiance (rad_direct_irradiance) for RAD_SOURCE_DIRECT.
+   Returns RAD_SUCCESS or an error the solve passes on. Called on the solving thread. */
+typedef rad_result (*rad_hierarchical_source_fn)(void *user, const float *points, const float *normals,
+                                                 const uint32_t *triangles, const float *albedos, uint32_t count,
+                                                 float *out_E);
+
+typedef struct rad_hierarchical_options {
+    double tolerance;          /* BF refinement threshold, a fraction of P (0: 1e-3); > 0, < 1 */
+    float min_area;            /* elements are split only into children of at least this area,
+                                  scene units^2 (0: the total area / 10000); total area /
+                                  min_area at most 2^28, else INVALID_ARGUMENT */
+    uint32_t visibility_rays;  /* points per link on the receiver, each with the analytic
+                                  kernel and one visibility ray (0: 4); a square 1..64 */
+    uint32_t max_iterations;   /* refine-and-solve rounds (0: 16) */
+    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;             /* decorrelates the rays' end points on the sources (any value) */
+    int skip_visibility;       /* non-zero: V = 1, no rays (the raycaster may be NULL) */
+    rad_hierarchical_source_fn source; /* NULL: E = pi * the material's emitted radiance */
+    void *source_user;
+} rad_hierarchical_options;
+
+typedef struct rad_hierarchical_stats {
+    uint32_t elements;         /* every element (quadtree node) made */
+    uint32_t leaves;
+    uint64_t links;            /* links of the final solution */
+    uint64_t links_evaluated;  /* links whose form factor was computed (refined ones too) */
+    uint64_t kernel_evaluations; /* point-to-triangle kernels evaluated (the form-factor work) */
+    uint64_t rays_cast;        /* visibility rays */
+    uint32_t rounds;           /* refine-and-solve rounds done */
+    uint32_t sweeps;           /* gather and push-pull sweeps, all rounds */
+    double residual;           /* last sweep's largest change of B / max B */
+} rad_hierarchical_stats;
+
+/* what rad_hierarchical_lookup returns */
+typedef enum rad_hierarchical_value {
+    RAD_HIERARCHICAL_RADIOSITY = 0, /* B = E + rho H */
+    RAD_HIERARCHICAL_GATHERED = 1   /* H, the irradiance from the other elements */
+} rad_hierarchical_value;
+
+typedef struct rad_hierarchical rad_hierarchical;
+
+/* Defaults: tolerance 1e-3, min_area 0 (total / 10000), visibility_rays 4, max_iterations 16,
+   ray_epsilon 1e-5, the rest 0. */
+RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *options);
+
+/* Checks the options and makes the roots (one element per scene triangle, its albedo at the
+   centroid). scene and raycaster are borrowed and must outlive the object; raycaster may be
+   NULL with skip_visibility. Errors: INVALID_ARGUMENT (NULL, a bad option: the logger names
+   it), SIZE_OVERFLOW (too many triangle pairs), ALBEDO_RANGE, OUT_OF_MEMORY. O(T). */
+RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                           const rad_hierarchical_options *options, const rad_context *ctx,
+                                           rad_hierarchical **out);
+/* Runs the solve (steps 1 to 4 above). Can be called once. ctx: logging, progress (after each
+   round; cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
+   twice), RAYCAST_FAILED, NON_FINITE (a source value or the result), NEGATIVE_EMISSION (the
+   source gave E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000),
+   CANCELLED, OUT_OF_MEMORY. After an error the object can only be destroyed.
+   Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep. */
+RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx);
+RAD_API void rad_hierarchical_destroy(rad_hierarchical *h);
+
+/* Counts and work of the solve (zeros before it). */
+RAD_API void rad_hierarchical_get_stats(const rad_hierarchical *h, rad_hierarchical_stats *out);
+/* Leaves [first, first + count) of the solved object, in a fixed order (by scene triangle,
+   then depth first): corners (9 floats each, counter-clockwise), scene triangle, B and H
+   (3 floats each). Any output may be NULL. Errors: INVALID_ARGUMENT (not solved, NULL h),
+   INDEX_OUT_OF_RANGE (past the last leaf). */
+RAD_API rad_result rad_hierarchical_leaves(const rad_hierarchical *h, uint32_t first, uint32_t count, float *out_corners,
+                                           uint32_t *out_triangles, float *out_B, float *out_H);
+/* Links [first, first + count) of the solution: the receiver's and the source's centroids
+   (6 floats each), the form factor F_rs with visibility, and the receiver's and source's
+   depths in their quadtrees (2 per link; 0: a scene triangle). Any output may be NULL.
+   Errors as rad_hierarchical_leaves. */
+RAD_API rad_result rad_hierarchical_links(const rad_hierarchical *h, uint64_t first, uint32_t count, float *out_points,
+                                          float *out_form_factors, uint32_t *out_depths);
+/* The value at 'count' points given as scene triangle and barycentrics (b1, b2, 2 floats per
+   point) into out (3 floats per point). smooth 0: the value of the leaf holding the point.
+   smooth 1: interpolated from the leaf's corners; a corner holds the area-weighted mean of
+   the leaves around it that lie in the same plane (the seams of rad_patches_vertex_values),
+   and for H the halo fix of the classic renderer: the mean is divided by the leaves' mean
+   row sum S (the form factors an element gathers over, ancestors' links included) and
+   multiplied by the mean S of the leaves whose S is at least 0.75 of the corner's largest,
+   so a floor corner under a block does not darken its uncovered neighbours. Errors:
+   INVALID_ARGUMENT (not solved, NULL pointer, bad value), INDEX_OUT_OF_RANGE (a triangle). */
+RAD_API rad_result rad_hierarchical_lookup(const rad_hierarchical *h, rad_hierarchical_value value, int smooth,
+                                           const uint32_t *triangles, const float *barycentrics, uint32_t count,
+                                           float *out);
+
+/* ======================================================================================== */
 /* >>api_light: lights and the source term                                                  */
 /* ======================================================================================== */
 
@@ -849,7 +1100,9 @@ typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
     uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
-    int include_emitters;      /* non-zero (default): emissive triangles are area lights */
+    int include_emitters;      /* non-zero (default): emissive triangles are area lights;
+                                  0 leaves them out (a zeroed struct has no emitters: start
+                                  from rad_direct_options_default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
 } rad_direct_options;
@@ -886,7 +1139,9 @@ typedef enum rad_source_mode {
 
 /* Builds E (3N floats) from the patches one of the two ways of UNITS AND CONVENTIONS.
    direct_irradiance (3N) is required for RAD_SOURCE_DIRECT and must be NULL for
-   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT). */
+   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT).
+   A NaN or Inf in it is NON_FINITE, a negative value INVALID_ARGUMENT; out_E is written only on
+   success. */
 RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
                                float *out_E);
 
@@ -1600,7 +1855,8 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
 
 typedef struct rad_multibounce_options {
-    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3) */
+    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3; 0 is INVALID_ARGUMENT:
+                                  start from rad_multibounce_options_default) */
     rad_mb_precision precision;/* storage of the result (default RAD_MB_FLOAT) */
     double tolerance;          /* K = inf: Neumann doubling stops once max row sum of
                                   (rho o F)^m <= tolerance (0: 1e-8) */
@@ -1674,8 +1930,10 @@ typedef enum rad_block_format {
 #define RAD_REORDER_MATCH 4       /* groups of four by greedy matching (rows into pairs, pairs
                                      into fours) on the same distance, then the group swaps */
 
+/* Start from rad_block_options_default: here zero is a setting, not the default (a zeroed
+   struct asks for BC1, no outliers, no reordering and one scale per channel). */
 typedef struct rad_block_options {
-    rad_block_format format;   /* default RAD_BLOCK_BC4X3 */
+    rad_block_format format;   /* default RAD_BLOCK_BC4X3 (0 is RAD_BLOCK_BC1) */
     float outlier_fraction;    /* the largest fraction p of the N^2 entries (by their largest
                                   channel) go exactly into the sparse list, zeros left in place;
                                   0 disables the step (default 0.05) */
@@ -1912,7 +2170,8 @@ typedef enum rad_local_rebuild_method {
 } rad_local_rebuild_method;
 
 typedef struct rad_local_options {
-    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default 1024) */
+    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default
+                                  1024; 0 is INVALID_ARGUMENT: start from rad_local_options_default) */
     rad_local_update update;   /* default RAD_LOCAL_EXACT */
     rad_local_eviction evict;  /* default RAD_LOCAL_EVICT_DOWNDATE */
     rad_local_rebuild_method rebuild; /* default RAD_LOCAL_REBUILD_INVERSE */
@@ -2184,7 +2443,8 @@ typedef enum rad_temporal_mode {
 
 typedef struct rad_temporal_options {
     rad_temporal_mode mode;
-    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES) */
+    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES,
+                              0 is INVALID_ARGUMENT: start from rad_temporal_options_default) */
     float weight;          /* fixed w in [0, 1) (default 0.998; 0 keeps no history) */
     uint32_t seed;         /* generator seed */
     int adaptive;          /* non-zero: per-row w from the estimator's variance (see below) */
@@ -2433,6 +2693,23 @@ RAD_API void rad_vp_options_default(rad_vp_options *options);
 RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
                                  const rad_context *ctx, rad_virtual_patches **out);
 RAD_API void rad_vp_destroy(rad_virtual_patches *vp);
+
+/* What rad_vp_create would build with the same arguments, counted without building it: steps
+   1 to 4 of BUILD (candidate voxels, face rays, samples, patches; the clustering for
+   RAD_VP_CLUSTERED) run exactly as there, so 'patches' is the count rad_vp_create gives, and
+   the form factors (step 5: the N x N matrix, the M^2 kernel sums and the shadow rays between
+   samples, nearly all of a build's time) are skipped. Use it to choose the resolution for a
+   patch budget before building (rad render --vp-max-patches). Errors: those of rad_vp_create
+   except the matrix's SIZE_OVERFLOW. Cost: 6 face_points rays per candidate voxel and O(M). */
+typedef struct rad_vp_counts {
+    uint32_t patches;           /* N */
+    uint32_t samples;           /* M */
+    uint32_t voxels;            /* non-empty voxels */
+    uint32_t candidate_voxels;  /* voxels overlapped by triangle bounds */
+    uint64_t face_rays;
+} rad_vp_counts;
+RAD_API rad_result rad_vp_count(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                const rad_context *ctx, rad_vp_counts *out);
 /* Bytes the object holds (matrix, patches, voxels, samples). */
 RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
 
@@ -3588,6 +3865,130 @@ RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const f
             out_vertex_values[(size_t)v * channels + k] = src[channels] > 0.0 ? (float)(src[k] / src[channels]) : 0.0f;
     }
     rad__free(&a, acc);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
+                                                 float *out_vertex_H, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *S_v, *S_max, *S_area;
+    uint32_t n, nv, i, k;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !H || !out_vertex_H) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: patches, H and out_vertex_H are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    n = patches->count;
+    nv = patches->vertex_count;
+    for (i = 0; i < 3 * n; ++i)
+        if (!rad__finite(H[i])) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: H of patch %u is not finite", i / 3);
+            return RAD_ERROR_NON_FINITE;
+        }
+    if (!S) return rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(S[i]) || S[i] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: row sum S of patch %u is %g (finite, >= 0 expected)",
+                     i, (double)S[i]);
+            return RAD_ERROR_NON_FINITE;
+        }
+    S_v = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)nv, sizeof(float));
+    if (!S_v) return RAD_ERROR_OUT_OF_MEMORY;
+    S_max = S_v + nv;
+    S_area = S_max + nv;
+    /* the bracket: vertex means of H and of S, both area-weighted over the patches at v */
+    r = rad_patches_vertex_values(patches, H, 3, out_vertex_H);
+    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(patches, S, 1, S_v);
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] > S_max[v]) S_max[v] = S[i];
+            }
+        for (i = 0; i < nv; ++i) {
+            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= scale;
+            S_v[i] = 0.0f;
+        }
+        /* S_v: how much the uncovered patches at v see */
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = patches->patches[i].vertices[k];
+                if (S[i] >= 0.75f * S_max[v]) {
+                    S_v[v] += patches->patches[i].area * S[i];
+                    S_area[v] += patches->patches[i].area;
+                }
+            }
+        for (i = 0; i < nv; ++i) {
+            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
+            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= s_v;
+        }
+    }
+    rad__free(&c.allocator, S_v);
+    return r;
+}
+
+RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
+                                           const rad_mesh_desc *desc, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_scene *S;
+    double *acc;
+    uint32_t t, k, m, V;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !patches->scene || !vertex_values || !desc || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: patches, vertex_values, desc and out are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    S = patches->scene;
+    if (mesh >= S->mesh_count) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: mesh %u, but the scene has %u meshes", mesh, S->mesh_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    V = desc->vertex_count;
+    acc = (double *)rad__alloc_array(&c.allocator, 4 * (size_t)V + 1u, sizeof(double));
+    if (!acc) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(acc, 0, (4 * (size_t)V + 1u) * sizeof(double));
+    for (t = 0; t < S->triangle_count; ++t) {
+        uint32_t j = S->source_triangles[t], id[3];
+        static const float corner[3][2] = { { 0.0f, 0.0f }, { 1.0f, 0.0f }, { 0.0f, 1.0f } };
+        if (S->meshes[t] != mesh) continue;
+        if (j >= desc->triangle_count) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: the scene's mesh %u has triangle %u, desc has %u triangles",
+                     mesh, j, desc->triangle_count);
+            rad__free(&c.allocator, acc);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+        for (k = 0; k < 3; ++k) {
+            id[k] = desc->indices ? desc->indices[3 * (size_t)j + k] : 3 * j + k;
+            if (id[k] >= V) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: triangle %u has vertex index %u >= %u", j, id[k], V);
+                rad__free(&c.allocator, acc);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        }
+        for (k = 0; k < 3; ++k) {
+            float w[3];
+            uint32_t p = rad_patches_locate(patches, t, corner[k][0], corner[k][1], w);
+            double *dst = acc + 4 * (size_t)id[k];
+            if (p == RAD_NONE) continue;
+            for (m = 0; m < 3; ++m) {
+                const float *src = vertex_values + 3 * (size_t)patches->patches[p].vertices[m];
+                dst[0] += (double)S->areas[t] * w[m] * src[0];
+                dst[1] += (double)S->areas[t] * w[m] * src[1];
+                dst[2] += (double)S->areas[t] * w[m] * src[2];
+            }
+            dst[3] += S->areas[t];
+        }
+    }
+    for (k = 0; k < V; ++k) {
+        const double *src = acc + 4 * (size_t)k;
+        for (m = 0; m < 3; ++m) out[3 * (size_t)k + m] = src[3] > 0.0 ? (float)(src[m] / src[3]) : 0.0f;
+    }
+    rad__free(&c.allocator, acc);
     return RAD_SUCCESS;
 }
 
@@ -5640,6 +6041,21 @@ static void rad__finish_output(const rad_system *s, rad_output output, float *B_
         for (i = 0; i < n3; ++i) B_total_or_L[i] += s->E[i];
 }
 
+/* What every solver checks first: the system (logged once), the output and the options
+   (NULL: the defaults, copied to *o). */
+static rad_result rad__solve_begin(const rad_system *s, const rad_solve_options *options, const float *out,
+                                   const char *name, const rad__ctx *c, rad_solve_options *o)
+{
+    rad_result r = rad__check_system(s, c);
+    if (r != RAD_SUCCESS) return r;
+    if (!out) {
+        rad__log(c, RAD_LOG_ERROR, "%s: out is NULL", name);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) *o = *options; else rad_solve_options_default(o);
+    return rad__check_solve_options(o, c);
+}
+
 RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options *options, float *out, rad_solve_stats *stats,
                                     const rad_context *ctx)
 {
@@ -5650,11 +6066,8 @@ RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options
     uint32_t k;
     rad_result r;
     rad__ctx_init(&c, ctx);
-    r = rad__check_system(s, &c);
+    r = rad__solve_begin(s, options, out, "rad_solve_jacobi", &c, &o);
     if (r != RAD_SUCCESS) return r;
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     n3 = 3 * (size_t)s->n;
     cur = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
     tmp = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
@@ -5721,10 +6134,10 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
     double maxE = 0.0, residual = 0.0, tol;
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_gauss_seidel", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_it = o.max_iterations ? o.max_iterations : 1000;
     n3 = 3 * (size_t)s->n;
@@ -5772,13 +6185,14 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
     double initial = 0.0, residual = 1.0, tol;
     rad_result r = RAD_ERROR_NOT_CONVERGED;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out || !s->areas) {
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_progressive", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
+    if (!s->areas) {
         rad__log(&c, RAD_LOG_ERROR, "progressive refinement needs system->areas");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
     max_steps = o.max_iterations ? o.max_iterations : (s->n > 42949672u ? 0xFFFFFFFFu : 100u * s->n);
     n3 = 3 * (size_t)s->n;
@@ -5881,10 +6295,10 @@ RAD_API rad_result rad_solve_direct(const rad_system *s, const rad_solve_options
     rad_result r = RAD_SUCCESS;
     int factored = -1;
     rad__ctx_init(&c, ctx);
-    if (rad__check_system(s, &c) != RAD_SUCCESS) return rad__check_system(s, &c);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_solve_options_default(&o);
-    if (rad__check_solve_options(&o, &c) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
+    {
+        rad_result begun = rad__solve_begin(s, options, out, "rad_solve_direct", &c, &o);
+        if (begun != RAD_SUCCESS) return begun;
+    }
     n = s->n;
     if (!rad__mul3(n, n, sizeof(double), &bytes)) return RAD_ERROR_SIZE_OVERFLOW;
     M = (double *)rad__alloc(&c.allocator, bytes);
@@ -5973,6 +6387,1337 @@ done:
     rad__free(&c.allocator, b);
     rad__free(&c.allocator, piv);
     return r;
+}
+
+/* ======================================================================================== */
+/* >>stochastic: stochastic (Monte Carlo) radiosity                                         */
+/* ======================================================================================== */
+
+RAD_API void rad_stochastic_options_default(rad_stochastic_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->method = RAD_STOCHASTIC_JACOBI;
+    o->output = RAD_OUTPUT_INDIRECT;
+    o->tolerance = 1e-4;
+    o->ray_epsilon = 1e-5f;
+}
+
+#define RAD__SR_WAVE (1u << 20)   /* rays traced per wave: bounds the per-ray arrays */
+#define RAD__SR_MAX_DEPTH 65536u  /* collisions of one walk at the most */
+
+/* A wave of rays: ray r leaves a uniform point of patch src[r] in a cosine-distributed
+   direction drawn from key[r]; dst[r] receives the patch hit on its front, or RAD_NONE. */
+typedef struct rad__sr {
+    const rad_patches *P;
+    const rad_raycaster *rc;
+    float eps;
+    uint32_t count;
+    const uint32_t *src, *key;
+    uint32_t *dst;
+    rad_ray *rays;   /* RAD__RAY_BATCH per task */
+    rad_hit *hits;   /* RAD__RAY_BATCH per task */
+} rad__sr;
+
+static void rad__tangent_frame(const float *n, float *t1, float *t2); /* >>light */
+
+/* uniform in (0, 1) from the top 24 bits of a hash */
+static float rad__sr_unit(uint32_t h) { return ((float)(h >> 8) + 0.5f) * (1.0f / 16777216.0f); }
+
+static rad_result rad__sr_chunk(void *data, uint32_t chunk, uint32_t task)
+{
+    rad__sr *w = (rad__sr *)data;
+    const rad_patches *P = w->P;
+    rad_ray *rays = w->rays + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = w->hits + (size_t)task * RAD__RAY_BATCH;
+    uint32_t r0 = chunk * RAD__RAY_BATCH, m = w->count - r0 < RAD__RAY_BATCH ? w->count - r0 : RAD__RAY_BATCH, k;
+    int c;
+    for (k = 0; k < m; ++k) {
+        const rad_patch *p = &P->patches[w->src[r0 + k]];
+        uint32_t key = w->key[r0 + k];
+        float t1[3], t2[3], x[3], u1, u2, rr, ph, z;
+        const float *v0 = P->vertices + 3 * (size_t)p->vertices[0], *v1 = P->vertices + 3 * (size_t)p->vertices[1],
+                    *v2 = P->vertices + 3 * (size_t)p->vertices[2];
+        rad__triangle_point(v0, v1, v2, rad__sr_unit(rad__hash(key ^ 0x2C1B3C6Du)), rad__sr_unit(rad__hash(key ^ 0x297A2D39u)), x);
+        u1 = rad__sr_unit(rad__hash(key ^ 0x6B43A9B5u));
+        u2 = rad__sr_unit(rad__hash(key ^ 0x1B873593u));
+        rr = (float)sqrt((double)u1);
+        ph = (float)(2.0 * RAD__PI) * u2;
+        z = (float)sqrt((double)(1.0f - u1));
+        rad__tangent_frame(p->normal, t1, t2);
+        for (c = 0; c < 3; ++c) {
+            rays[k].origin[c] = x[c] + p->normal[c] * w->eps;
+            rays[k].dir[c] = t1[c] * rr * (float)cos((double)ph) + t2[c] * rr * (float)sin((double)ph) + p->normal[c] * z;
+        }
+        rays[k].tmin = 0.0f;
+        rays[k].tmax = FLT_MAX;
+    }
+    if (w->rc->intersect(w->rc->user, rays, m, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < m; ++k) {
+        uint32_t t = hits[k].triangle, j = RAD_NONE;
+        /* a back face absorbs the ray: patches are one-sided, F_ij = 0 for a patch facing away */
+        if (t != RAD_NONE && t < P->scene->triangle_count && rad__dot(P->scene->normals + 3 * (size_t)t, rays[k].dir) < 0.0f)
+            j = rad_patches_locate(P, t, hits[k].b1, hits[k].b2, NULL);
+        w->dst[r0 + k] = j;
+    }
+    return RAD_SUCCESS;
+}
+
+/* traces w->count rays (parallel over chunks of RAD__RAY_BATCH; no progress inside a wave) */
+static rad_result rad__sr_trace(const rad__ctx *c, rad__sr *w, uint32_t tasks)
+{
+    rad__ctx quiet = *c;
+    quiet.progress = NULL;
+    return rad__for_rows(&quiet, (w->count + RAD__RAY_BATCH - 1u) / RAD__RAY_BATCH, tasks, rad__sr_chunk, w);
+}
+
+/* Systematic sampling: ray k of n goes to the patch whose cumulative weight interval holds
+   (k + u) / n of the total (cum: the running sums of the weights, total > 0). Writes src for
+   rays [k0, k0 + m) and returns the patch cursor. A patch of weight 0 is never drawn. */
+static uint32_t rad__sr_sources(const double *cum, uint32_t np, uint64_t n, double u, uint64_t k0, uint32_t m,
+                                uint32_t cursor, uint32_t *src)
+{
+    uint32_t k, last = np - 1u;
+    double total = cum[np - 1u];
+    while (last > 0 && cum[last - 1u] == total) --last; /* the last patch of weight > 0 */
+    for (k = 0; k < m; ++k) {
+        double x = ((double)(k0 + k) + u) / (double)n * total;
+        while (cursor < last && cum[cursor] <= x) ++cursor;
+        src[k] = cursor;
+    }
+    return cursor;
+}
+
+typedef struct rad__stoch {
+    rad__ctx *c;
+    const rad_patches *P;
+    const float *E;
+    rad_stochastic_options o;
+    uint32_t n, tasks;
+    double *cum, *acc, *cur, *B, *mean;
+    uint32_t *src, *key, *dst, *walk;
+    float *power, *est;            /* power: 3 per walk; est: the estimate for the callback */
+    rad__sr w;
+    uint64_t rays_cast;
+    double unshot;
+    uint32_t iteration;
+} rad__stoch;
+
+/* current estimate into s->est; calls the callback and progress. 1: stop, 2: cancelled */
+static int rad__stoch_report(rad__stoch *s, const double *B, double fraction)
+{
+    size_t i;
+    ++s->iteration;
+    if (s->o.on_iteration) {
+        for (i = 0; i < 3 * (size_t)s->n; ++i) s->est[i] = (float)B[i];
+        if (s->o.on_iteration(s->o.iteration_user, s->iteration, s->rays_cast, s->est)) return 1;
+    }
+    if (s->c->progress && s->c->progress(s->c->progress_user, (float)fraction)) return 2;
+    return 0;
+}
+
+/* One Jacobi step: shoots the radiosity x (3N, >= 0) with 'rays' rays drawn by power
+   A_i (x_r + x_g + x_b), and writes what they deposit (times rho / A) into out (3N). */
+static rad_result rad__stoch_shoot(rad__stoch *s, const double *x, uint64_t rays, uint32_t stream, double *out)
+{
+    const rad_patches *P = s->P;
+    uint32_t i, cursor = 0;
+    uint64_t k0;
+    double total = 0.0, u, share;
+    rad_result r = RAD_SUCCESS;
+    for (i = 0; i < s->n; ++i) {
+        total += (double)P->areas[i] * (x[3 * (size_t)i] + x[3 * (size_t)i + 1] + x[3 * (size_t)i + 2]);
+        s->cum[i] = total;
+    }
+    memset(out, 0, 3 * (size_t)s->n * sizeof(double));
+    if (!(total > 0.0) || rays == 0) return RAD_SUCCESS;
+    u = (double)rad__sr_unit(rad__hash(stream ^ 0x3C6EF372u));
+    share = total / (double)rays;
+    for (k0 = 0; k0 < rays && r == RAD_SUCCESS; k0 += RAD__SR_WAVE) {
+        uint32_t m = rays - k0 < RAD__SR_WAVE ? (uint32_t)(rays - k0) : RAD__SR_WAVE, k;
+        cursor = rad__sr_sources(s->cum, s->n, rays, u, k0, m, cursor, s->src);
+        for (k = 0; k < m; ++k) s->key[k] = rad__hash(stream ^ rad__hash((uint32_t)(k0 + k) ^ (uint32_t)((k0 + k) >> 32) * 0x85EBCA6Bu));
+        s->w.count = m;
+        r = rad__sr_trace(s->c, &s->w, s->tasks);
+        s->rays_cast += m;
+        /* deposits in ray order: the sum does not depend on how the wave was split */
+        for (k = 0; k < m && r == RAD_SUCCESS; ++k) {
+            uint32_t a = s->src[k], j = s->dst[k];
+            const double *xa = x + 3 * (size_t)a;
+            double sum = xa[0] + xa[1] + xa[2], f;
+            int ch;
+            if (j == RAD_NONE) continue;
+            f = share / (sum * (double)P->areas[j]);
+            for (ch = 0; ch < 3; ++ch) out[3 * (size_t)j + ch] += (double)P->albedo[3 * (size_t)j + ch] * xa[ch] * f;
+        }
+    }
+    return r;
+}
+
+static uint64_t rad__stoch_count(uint32_t rays, double power, double p0)
+{
+    double want = ceil((double)rays * power / p0);
+    return want < 1.0 ? 1u : want > 1e15 ? (uint64_t)1e15 : (uint64_t)want;
+}
+
+static rad_result rad__stoch_jacobi(rad__stoch *s, double p0)
+{
+    size_t n3 = 3 * (size_t)s->n, i;
+    uint32_t it, reg = 0;
+    double unshot;
+    rad_result r = RAD_SUCCESS;
+    int stop = 0;
+    for (i = 0; i < n3; ++i) s->B[i] = s->cur[i] = (double)s->E[i];
+    for (it = 0; it < s->o.iterations && !stop; ++it) {
+        double pk = 0.0, frac;
+        for (i = 0; i < s->n; ++i) pk += (double)s->P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
+        if (pk < s->o.tolerance * p0) break;
+        r = rad__stoch_shoot(s, s->cur, rad__stoch_count(s->o.rays, pk, p0),
+                             rad__hash(s->o.seed ^ rad__hash(it + 0x9E3779B9u)), s->acc);
+        if (r != RAD_SUCCESS) return r;
+        for (i = 0; i < n3; ++i) { s->cur[i] = s->acc[i]; s->B[i] += s->acc[i]; }
+        /* progress: iterations done, or the unshot power's way down to the tolerance (log scale) */
+        frac = (double)(it + 1) / (double)s->o.iterations;
+        if (s->o.tolerance < 1.0 && log(p0 / pk) / -log(s->o.tolerance) > frac) frac = log(p0 / pk) / -log(s->o.tolerance);
+        frac *= (double)s->o.iterations / (double)(s->o.iterations + s->o.regular_iterations);
+        stop = rad__stoch_report(s, s->B, frac < 1.0 ? frac : 1.0);
+    }
+    unshot = 0.0;
+    for (i = 0; i < s->n; ++i) unshot += (double)s->P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
+    s->unshot = unshot / p0;
+    if (stop == 2) return RAD_ERROR_CANCELLED;
+    if (stop || s->o.regular_iterations == 0) return RAD_SUCCESS;
+    /* regular iterations B' = E + rho o F~ B, averaged */
+    for (i = 0; i < n3; ++i) s->mean[i] = 0.0;
+    for (reg = 0; reg < s->o.regular_iterations; ++reg) {
+        double pb = 0.0;
+        for (i = 0; i < s->n; ++i) pb += (double)s->P->areas[i] * (s->B[3 * i] + s->B[3 * i + 1] + s->B[3 * i + 2]);
+        r = rad__stoch_shoot(s, s->B, rad__stoch_count(s->o.rays, pb, p0),
+                             rad__hash(s->o.seed ^ rad__hash(reg + 0x7F4A7C15u) ^ 0xA5A5A5A5u), s->acc);
+        if (r != RAD_SUCCESS) return r;
+        for (i = 0; i < n3; ++i) {
+            s->B[i] = (double)s->E[i] + s->acc[i];
+            s->mean[i] += (s->B[i] - s->mean[i]) / (double)(reg + 1u);
+        }
+        stop = rad__stoch_report(s, s->mean, (double)(it + reg + 1) / (double)(s->o.iterations + s->o.regular_iterations));
+        if (stop) break;
+    }
+    memcpy(s->B, s->mean, n3 * sizeof(double));
+    return stop == 2 ? RAD_ERROR_CANCELLED : RAD_SUCCESS;
+}
+
+static rad_result rad__stoch_walk(rad__stoch *s, double p0)
+{
+    const rad_patches *P = s->P;
+    size_t n3 = 3 * (size_t)s->n, i;
+    uint32_t it;
+    rad_result r = RAD_SUCCESS;
+    int stop = 0;
+    (void)p0;
+    for (i = 0; i < s->n; ++i) {
+        s->cur[3 * i] = s->E[3 * i]; s->cur[3 * i + 1] = s->E[3 * i + 1]; s->cur[3 * i + 2] = s->E[3 * i + 2];
+    }
+    for (i = 0; i < n3; ++i) s->mean[i] = 0.0;
+    for (it = 0; it < s->o.iterations && !stop; ++it) {
+        uint32_t stream = rad__hash(s->o.seed ^ rad__hash(it + 0x61C88647u) ^ 0x5A5A5A5Au), cursor = 0;
+        double total = 0.0, u = (double)rad__sr_unit(rad__hash(stream ^ 0x3C6EF372u)), share;
+        uint64_t k0;
+        for (i = 0; i < s->n; ++i) {
+            total += (double)P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
+            s->cum[i] = total;
+        }
+        share = total / (double)s->o.rays;
+        memset(s->acc, 0, n3 * sizeof(double));
+        for (k0 = 0; k0 < s->o.rays && r == RAD_SUCCESS; k0 += RAD__SR_WAVE) {
+            uint32_t m = s->o.rays - k0 < RAD__SR_WAVE ? (uint32_t)(s->o.rays - k0) : RAD__SR_WAVE, k, active = m, depth;
+            cursor = rad__sr_sources(s->cum, s->n, s->o.rays, u, k0, m, cursor, s->src);
+            for (k = 0; k < m; ++k) {
+                const float *e = s->E + 3 * (size_t)s->src[k];
+                double sum = (double)e[0] + (double)e[1] + (double)e[2];
+                int ch;
+                s->walk[k] = rad__hash(stream ^ rad__hash((uint32_t)(k0 + k)));
+                for (ch = 0; ch < 3; ++ch) s->power[3 * (size_t)k + ch] = (float)(share * (double)e[ch] / sum);
+            }
+            for (depth = 0; active > 0 && depth < RAD__SR_MAX_DEPTH && r == RAD_SUCCESS; ++depth) {
+                uint32_t kept = 0;
+                for (k = 0; k < active; ++k) s->key[k] = rad__hash(s->walk[k] + depth * 0x9E3779B9u);
+                s->w.count = active;
+                r = rad__sr_trace(s->c, &s->w, s->tasks);
+                s->rays_cast += active;
+                if (r != RAD_SUCCESS) break;
+                /* score, roulette and compact in walk order */
+                for (k = 0; k < active; ++k) {
+                    uint32_t j = s->dst[k];
+                    const float *rho;
+                    float pw[3], q;
+                    int ch;
+                    if (j == RAD_NONE) continue;
+                    rho = P->albedo + 3 * (size_t)j;
+                    for (ch = 0; ch < 3; ++ch) {
+                        pw[ch] = rho[ch] * s->power[3 * (size_t)k + ch];
+                        s->acc[3 * (size_t)j + ch] += (double)pw[ch] / (double)P->areas[j];
+                    }
+                    q = rho[0] > rho[1] ? rho[0] : rho[1];
+                    if (rho[2] > q) q = rho[2];
+                    if (!(rad__sr_unit(rad__hash(s->key[k] ^ 0x5F356495u)) < q)) continue;
+                    s->src[kept] = j;
+                    s->walk[kept] = s->walk[k];
+                    for (ch = 0; ch < 3; ++ch) s->power[3 * (size_t)kept + ch] = pw[ch] / q;
+                    ++kept;
+                }
+                active = kept;
+            }
+        }
+        if (r != RAD_SUCCESS) return r;
+        for (i = 0; i < n3; ++i) {
+            s->mean[i] += (s->acc[i] - s->mean[i]) / (double)(it + 1u);
+            s->B[i] = (double)s->E[i] + s->mean[i];
+        }
+        stop = rad__stoch_report(s, s->B, (double)(it + 1) / (double)s->o.iterations);
+    }
+    return stop == 2 ? RAD_ERROR_CANCELLED : RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_raycaster *raycaster, const float *E,
+                                        const rad_stochastic_options *options, float *out,
+                                        rad_stochastic_stats *stats, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__stoch s;
+    size_t n3, i, wave;
+    double p0 = 0.0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (stats) memset(stats, 0, sizeof(*stats));
+    if (!patches || !raycaster || !raycaster->intersect || !E || !out || patches->count == 0 || !patches->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: patches, a raycaster with intersect, E and out are required");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    memset(&s, 0, sizeof(s));
+    if (options) s.o = *options; else rad_stochastic_options_default(&s.o);
+    if ((s.o.method != RAD_STOCHASTIC_JACOBI && s.o.method != RAD_STOCHASTIC_WALK) ||
+        (s.o.output != RAD_OUTPUT_INDIRECT && s.o.output != RAD_OUTPUT_TOTAL)) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: method %d or output %d unknown (RAD_STOCHASTIC_JACOBI or _WALK; "
+                 "RAD_OUTPUT_INDIRECT or _TOTAL)", (int)s.o.method, (int)s.o.output);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(s.o.tolerance >= 0.0) || s.o.tolerance - s.o.tolerance != 0.0) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: tolerance %g must be finite and >= 0", s.o.tolerance);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s.o.ray_epsilon == 0.0f) s.o.ray_epsilon = 1e-5f;
+    if (!(s.o.ray_epsilon > 0.0f && s.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: ray_epsilon %g outside (0, 1e-2]", (double)s.o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s.o.method == RAD_STOCHASTIC_WALK && s.o.regular_iterations != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: regular_iterations (%u) are for RAD_STOCHASTIC_JACOBI; the walk "
+                 "averages 'iterations' batches", s.o.regular_iterations);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s.o.rays == 0) {
+        uint64_t d = 64u * (uint64_t)patches->count;
+        s.o.rays = d < 4096u ? 4096u : d > (1u << 26) ? (1u << 26) : (uint32_t)d;
+    }
+    if (s.o.iterations == 0) s.o.iterations = s.o.method == RAD_STOCHASTIC_JACOBI ? 256u : 1u;
+    if (s.o.tolerance == 0.0) s.o.tolerance = 1e-4;
+    n3 = 3 * (size_t)patches->count;
+    if (rad__check_input(&c, "stochastic radiosity (E)", E, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
+    for (i = 0; i < n3; ++i) {
+        if (E[i] < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: E of patch %llu channel %u is %g (must be >= 0: a source "
+                     "shoots power)", (unsigned long long)(i / 3u), (unsigned)(i % 3u), (double)E[i]);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+        if (!(patches->albedo[i] >= 0.0f && patches->albedo[i] < 1.0f)) {
+            rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: albedo of patch %llu channel %u is %g (must be in [0,1))",
+                     (unsigned long long)(i / 3u), (unsigned)(i % 3u), (double)patches->albedo[i]);
+            return RAD_ERROR_ALBEDO_RANGE;
+        }
+        p0 += (double)patches->areas[i / 3u] * (double)E[i];
+    }
+    s.c = &c;
+    s.P = patches;
+    s.E = E;
+    s.n = patches->count;
+    s.tasks = c.tasks;
+    /* a shooting iteration casts at most 'rays' (the unshot power only falls); a regular one more */
+    wave = s.o.rays < RAD__SR_WAVE && !(s.o.method == RAD_STOCHASTIC_JACOBI && s.o.regular_iterations) ? s.o.rays
+                                                                                                        : RAD__SR_WAVE;
+    s.cum = (double *)rad__alloc_array(&c.allocator, s.n, sizeof(double));
+    s.acc = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.cur = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.B = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.mean = (double *)rad__alloc_array(&c.allocator, n3, sizeof(double));
+    s.est = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
+    s.src = (uint32_t *)rad__alloc_array(&c.allocator, wave, sizeof(uint32_t));
+    s.key = (uint32_t *)rad__alloc_array(&c.allocator, wave, sizeof(uint32_t));
+    s.dst = (uint32_t *)rad__alloc_array(&c.allocator, wave, sizeof(uint32_t));
+    s.walk = (uint32_t *)rad__alloc_array(&c.allocator, s.o.method == RAD_STOCHASTIC_WALK ? wave : 1u, sizeof(uint32_t));
+    s.power = (float *)rad__alloc_array(&c.allocator, s.o.method == RAD_STOCHASTIC_WALK ? wave : 1u, 3 * sizeof(float));
+    s.w.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)s.tasks * RAD__RAY_BATCH, sizeof(rad_ray));
+    s.w.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)s.tasks * RAD__RAY_BATCH, sizeof(rad_hit));
+    if (!s.cum || !s.acc || !s.cur || !s.B || !s.mean || !s.est || !s.src || !s.key || !s.dst || !s.walk || !s.power ||
+        !s.w.rays || !s.w.hits) {
+        rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: out of memory for %u patches and waves of %llu rays", s.n,
+                 (unsigned long long)wave);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    s.w.P = patches;
+    s.w.rc = raycaster;
+    s.w.eps = s.o.ray_epsilon * patches->scene->diagonal;
+    s.w.src = s.src;
+    s.w.key = s.key;
+    s.w.dst = s.dst;
+    if (!(p0 > 0.0)) { /* no source: no light, nothing to shoot */
+        for (i = 0; i < n3; ++i) s.B[i] = (double)E[i];
+    } else {
+        r = s.o.method == RAD_STOCHASTIC_JACOBI ? rad__stoch_jacobi(&s, p0) : rad__stoch_walk(&s, p0);
+    }
+    if (stats) {
+        stats->iterations = s.iteration;
+        stats->rays_cast = s.rays_cast;
+        stats->unshot = s.unshot;
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < n3; ++i) out[i] = (float)(s.o.output == RAD_OUTPUT_TOTAL ? s.B[i] : s.B[i] - (double)E[i]);
+        r = rad__check_output(&c, "stochastic radiosity", out, n3);
+    } else if (r == RAD_ERROR_CANCELLED) {
+        rad__log(&c, RAD_LOG_INFO, "stochastic radiosity: cancelled by the progress callback after %u iterations", s.iteration);
+    }
+done:
+    rad__free(&c.allocator, s.cum);
+    rad__free(&c.allocator, s.acc);
+    rad__free(&c.allocator, s.cur);
+    rad__free(&c.allocator, s.B);
+    rad__free(&c.allocator, s.mean);
+    rad__free(&c.allocator, s.est);
+    rad__free(&c.allocator, s.src);
+    rad__free(&c.allocator, s.key);
+    rad__free(&c.allocator, s.dst);
+    rad__free(&c.allocator, s.walk);
+    rad__free(&c.allocator, s.power);
+    rad__free(&c.allocator, s.w.rays);
+    rad__free(&c.allocator, s.w.hits);
+    return r;
+}
+
+/* ======================================================================================== */
+/* >>hierarchical: hierarchical radiosity (quadtrees, links, BF refinement, push-pull)      */
+/* ======================================================================================== */
+
+#define RAD__HR_DEFAULT_TOLERANCE 1e-3
+#define RAD__HR_DEFAULT_RAYS 4u
+#define RAD__HR_MAX_RAYS 64u
+#define RAD__HR_DEFAULT_ROUNDS 16u
+#define RAD__HR_MAX_SWEEPS 1000u
+#define RAD__HR_SWEEP_TOLERANCE 1e-6
+#define RAD__HR_SOURCE_BATCH 4096u
+
+/* One quadtree node. Children are 4 consecutive elements, made after their parent, so index
+   order is a top-down order and its reverse a bottom-up one. */
+typedef struct rad__hr_elem {
+    float v[9];          /* corners, counter-clockwise */
+    float b[6];          /* the corners' barycentrics (b1, b2) in the scene triangle */
+    float n[3];
+    float area;
+    float rho[3], E[3], B[3];
+    double G[3], Gt[3];  /* gathered over own links; Gt with the ancestors' (pushed down) */
+    double S, St;        /* the same for the form factors alone (the row sum) */
+    uint32_t tri, parent, child, depth;
+} rad__hr_elem;
+
+/* receiver r gathers from source s: F with visibility, Fu unoccluded, Fd the spread (largest
+   minus smallest) of the unoccluded point-to-triangle values over r's points */
+typedef struct rad__hr_link {
+    uint32_t r, s;
+    float F, Fu, Fd;
+} rad__hr_link;
+
+struct rad_hierarchical {
+    const rad_scene *scene;
+    rad_raycaster rc;
+    rad_hierarchical_options o;
+    uint32_t nside;
+    float min_area, ray_eps;
+    double eps_abs;
+    rad__hr_elem *el;
+    uint32_t nel, cap_el;
+    rad__hr_link *links;
+    size_t nlinks;
+    uint32_t *leaf, *leaf_of, *leaf_vert, nleaf, nvert;
+    float *vert_B, *vert_H;
+    rad_hierarchical_stats st;
+    int state;           /* 0 created, 1 solved, -1 a solve failed */
+    rad_allocator allocator;
+};
+
+RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->tolerance = RAD__HR_DEFAULT_TOLERANCE;
+    o->visibility_rays = RAD__HR_DEFAULT_RAYS;
+    o->max_iterations = RAD__HR_DEFAULT_ROUNDS;
+    o->ray_epsilon = 1e-5f;
+}
+
+RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
+{
+    rad_allocator a;
+    if (!h) return;
+    a = h->allocator;
+    rad__free(&a, h->el);
+    rad__free(&a, h->links);
+    rad__free(&a, h->leaf);
+    rad__free(&a, h->leaf_of);
+    rad__free(&a, h->leaf_vert);
+    rad__free(&a, h->vert_B);
+    rad__free(&a, h->vert_H);
+    rad__free(&a, h);
+}
+
+static void rad__hr_normal_area(rad__hr_elem *e)
+{
+    float a[3], b[3], n[3], l;
+    rad__sub(a, e->v + 3, e->v);
+    rad__sub(b, e->v + 6, e->v);
+    rad__cross(n, a, b);
+    l = rad__len(n);
+    e->area = 0.5f * l;
+    if (l > 0.0f) { n[0] /= l; n[1] /= l; n[2] /= l; }
+    memcpy(e->n, n, sizeof(n));
+}
+
+static void rad__hr_centroid(const rad__hr_elem *e, float *c)
+{
+    int k;
+    for (k = 0; k < 3; ++k) c[k] = (e->v[k] + e->v[3 + k] + e->v[6 + k]) / 3.0f;
+}
+
+/* the element's albedo at its centroid; ALBEDO_RANGE when a texture callback leaves [0,1) */
+static rad_result rad__hr_albedo(const rad_hierarchical *h, rad__hr_elem *e, const rad__ctx *c)
+{
+    int k;
+    rad_scene_albedo(h->scene, e->tri, (e->b[0] + e->b[2] + e->b[4]) / 3.0f, (e->b[1] + e->b[3] + e->b[5]) / 3.0f, e->rho);
+    for (k = 0; k < 3; ++k)
+        if (!(e->rho[k] >= 0.0f && e->rho[k] < 1.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical: albedo %g of triangle %u (channel %d) is outside [0,1)",
+                     (double)e->rho[k], e->tri, k);
+            return RAD_ERROR_ALBEDO_RANGE;
+        }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                           const rad_hierarchical_options *options, const rad_context *ctx,
+                                           rad_hierarchical **out)
+{
+    rad__ctx c;
+    rad_hierarchical *h;
+    rad_hierarchical_options o;
+    uint32_t t, T;
+    double total = 0.0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!scene || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: scene and out must not be NULL");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options;
+    else rad_hierarchical_options_default(&o);
+    if (o.tolerance == 0.0) o.tolerance = RAD__HR_DEFAULT_TOLERANCE;
+    if (o.visibility_rays == 0) o.visibility_rays = RAD__HR_DEFAULT_RAYS;
+    if (o.max_iterations == 0) o.max_iterations = RAD__HR_DEFAULT_ROUNDS;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (!(o.tolerance > 0.0 && o.tolerance < 1.0)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: tolerance %g must be in (0, 1)", o.tolerance);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(o.min_area >= 0.0f) || !rad__finite(o.min_area)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: min_area %g must be finite and >= 0", (double)o.min_area);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    {
+        uint32_t n = rad__lattice_side(o.visibility_rays);
+        if (o.visibility_rays > RAD__HR_MAX_RAYS || n * n != o.visibility_rays) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: visibility_rays %u must be a square from 1 to %u",
+                     o.visibility_rays, RAD__HR_MAX_RAYS);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    if (!(o.ray_epsilon > 0.0f && o.ray_epsilon <= 1e-2f)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: ray_epsilon %g must be in (0, 1e-2]", (double)o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!raycaster && !o.skip_visibility) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: a raycaster is needed unless skip_visibility is set");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (raycaster && !o.skip_visibility && !raycaster->occluded) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: the raycaster has no occluded function");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    T = scene->triangle_count;
+    if (T == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: the scene has no triangles");
+        return RAD_ERROR_EMPTY_SCENE;
+    }
+    if ((double)T * (double)(T - 1u) > (double)RAD_HIERARCHICAL_MAX_ROOT_PAIRS) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: %u triangles give %.0f ordered pairs, more than the %llu "
+                 "first links allowed (no clustering: see >>api_hierarchical)", T, (double)T * (double)(T - 1u),
+                 (unsigned long long)RAD_HIERARCHICAL_MAX_ROOT_PAIRS);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    for (t = 0; t < T; ++t) total += (double)scene->areas[t];
+    if (o.min_area == 0.0f) o.min_area = (float)(total / 10000.0);
+    if (!(total / (double)o.min_area <= 268435456.0)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: min_area %g is too small: the total area %g over it "
+                 "passes 2^28 elements", (double)o.min_area, total);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    h = (rad_hierarchical *)rad__alloc(&c.allocator, sizeof(*h));
+    if (!h) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(h, 0, sizeof(*h));
+    h->allocator = c.allocator;
+    h->scene = scene;
+    if (raycaster) h->rc = *raycaster;
+    h->o = o;
+    h->nside = rad__lattice_side(o.visibility_rays);
+    h->min_area = o.min_area;
+    h->ray_eps = o.ray_epsilon * scene->diagonal;
+    h->cap_el = T < 1024u ? 1024u : T;
+    h->el = (rad__hr_elem *)rad__alloc_array(&h->allocator, h->cap_el, sizeof(rad__hr_elem));
+    if (!h->el) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: out of memory for %u elements", T);
+        rad_hierarchical_destroy(h);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (t = 0; t < T; ++t) {
+        rad__hr_elem *e = &h->el[t];
+        memset(e, 0, sizeof(*e));
+        memcpy(e->v, scene->positions + 9 * (size_t)t, 9 * sizeof(float));
+        e->b[2] = 1.0f; /* corner 1: (1, 0) */
+        e->b[5] = 1.0f; /* corner 2: (0, 1) */
+        e->area = scene->areas[t];
+        memcpy(e->n, scene->normals + 3 * (size_t)t, 3 * sizeof(float));
+        e->tri = t;
+        e->parent = e->child = RAD_NONE;
+        if ((r = rad__hr_albedo(h, e, &c)) != RAD_SUCCESS) {
+            rad_hierarchical_destroy(h);
+            return r;
+        }
+    }
+    h->nel = T;
+    *out = h;
+    return RAD_SUCCESS;
+}
+
+/* Splits element i into 4 (once). Returns OUT_OF_MEMORY or SIZE_OVERFLOW; element pointers
+   taken before the call are stale after it. */
+static rad_result rad__hr_split(rad_hierarchical *h, uint32_t i, const rad__ctx *c)
+{
+    static const int corner[4][3] = { { 0, 3, 5 }, { 3, 1, 4 }, { 5, 4, 2 }, { 3, 4, 5 } };
+    float p[18], q[12];
+    uint32_t k, first;
+    int m, j;
+    rad_result r;
+    if (h->el[i].child != RAD_NONE) return RAD_SUCCESS;
+    if (h->nel > 0xFFFFFFF0u - 4u) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: more than 2^32 elements");
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    if (h->nel + 4u > h->cap_el) {
+        uint32_t cap = h->cap_el > 0x7FFFFFF0u ? 0xFFFFFFF0u : 2u * h->cap_el;
+        size_t old_bytes, new_bytes;
+        rad__hr_elem *grown;
+        if (!rad__mul(h->cap_el, sizeof(rad__hr_elem), &old_bytes) || !rad__mul(cap, sizeof(rad__hr_elem), &new_bytes))
+            return RAD_ERROR_SIZE_OVERFLOW;
+        grown = (rad__hr_elem *)rad__realloc(&h->allocator, h->el, old_bytes, new_bytes);
+        if (!grown) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for %u elements", cap);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        h->el = grown;
+        h->cap_el = cap;
+    }
+    /* points 0..2 the corners, 3..5 the midpoints of edges 01, 12, 20; the same expression
+       on both sides of a shared edge gives the same bits (corners weld in lookups) */
+    for (m = 0; m < 3; ++m) {
+        int a = m, b = (m + 1) % 3;
+        for (j = 0; j < 3; ++j) {
+            p[3 * m + j] = h->el[i].v[3 * a + j];
+            p[9 + 3 * m + j] = 0.5f * (h->el[i].v[3 * a + j] + h->el[i].v[3 * b + j]);
+        }
+        for (j = 0; j < 2; ++j) {
+            q[2 * m + j] = h->el[i].b[2 * a + j];
+            q[6 + 2 * m + j] = 0.5f * (h->el[i].b[2 * a + j] + h->el[i].b[2 * b + j]);
+        }
+    }
+    first = h->nel;
+    for (k = 0; k < 4; ++k) {
+        rad__hr_elem *e = &h->el[first + k];
+        const rad__hr_elem *pa = &h->el[i];
+        memset(e, 0, sizeof(*e));
+        for (m = 0; m < 3; ++m) {
+            memcpy(e->v + 3 * m, p + 3 * corner[k][m], 3 * sizeof(float));
+            memcpy(e->b + 2 * m, q + 2 * corner[k][m], 2 * sizeof(float));
+        }
+        rad__hr_normal_area(e);
+        memcpy(e->n, pa->n, sizeof(e->n)); /* the plane's normal, not a rounded one */
+        e->tri = pa->tri;
+        e->parent = i;
+        e->child = RAD_NONE;
+        e->depth = pa->depth + 1u;
+        memcpy(e->B, pa->B, sizeof(e->B)); /* until the next sweep */
+        if ((r = rad__hr_albedo(h, e, c)) != RAD_SUCCESS) return r;
+    }
+    h->el[i].child = first;
+    h->nel += 4u;
+    return RAD_SUCCESS;
+}
+
+/* E of elements [first, nel): the material's pi L, or the source callback in batches */
+static rad_result rad__hr_sources(rad_hierarchical *h, uint32_t first, const rad__ctx *c)
+{
+    uint32_t i, k;
+    float *buf;
+    uint32_t *tris;
+    rad_result r = RAD_SUCCESS;
+    if (first >= h->nel) return RAD_SUCCESS;
+    if (!h->o.source) {
+        for (i = first; i < h->nel; ++i) {
+            const rad_material *m = &h->scene->materials_table[h->scene->materials[h->el[i].tri]];
+            for (k = 0; k < 3; ++k) h->el[i].E[k] = (float)RAD__PI * m->emission[k];
+        }
+        return RAD_SUCCESS;
+    }
+    buf = (float *)rad__alloc_array(&h->allocator, (size_t)RAD__HR_SOURCE_BATCH * 12u, sizeof(float));
+    tris = (uint32_t *)rad__alloc_array(&h->allocator, RAD__HR_SOURCE_BATCH, sizeof(uint32_t));
+    if (!buf || !tris) {
+        rad__free(&h->allocator, buf);
+        rad__free(&h->allocator, tris);
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the source batch");
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = first; i < h->nel && r == RAD_SUCCESS; i += RAD__HR_SOURCE_BATCH) {
+        uint32_t n = h->nel - i < RAD__HR_SOURCE_BATCH ? h->nel - i : RAD__HR_SOURCE_BATCH;
+        float *pts = buf, *nrm = buf + 3 * RAD__HR_SOURCE_BATCH, *alb = buf + 6 * RAD__HR_SOURCE_BATCH;
+        float *E = buf + 9 * RAD__HR_SOURCE_BATCH;
+        for (k = 0; k < n; ++k) {
+            const rad__hr_elem *e = &h->el[i + k];
+            rad__hr_centroid(e, pts + 3 * k);
+            memcpy(nrm + 3 * k, e->n, 3 * sizeof(float));
+            memcpy(alb + 3 * k, e->rho, 3 * sizeof(float));
+            tris[k] = e->tri;
+        }
+        r = h->o.source(h->o.source_user, pts, nrm, tris, alb, n, E);
+        if (r != RAD_SUCCESS) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the source callback returned %s", rad_result_string(r));
+            break;
+        }
+        for (k = 0; k < 3 * n; ++k) {
+            if (!rad__finite(E[k])) {
+                rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the source gave %g for element %u", (double)E[k], i + k / 3u);
+                r = RAD_ERROR_NON_FINITE;
+                break;
+            }
+            if (E[k] < 0.0f) {
+                rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the source gave E = %g < 0 for element %u", (double)E[k],
+                         i + k / 3u);
+                r = RAD_ERROR_NEGATIVE_EMISSION;
+                break;
+            }
+        }
+        if (r == RAD_SUCCESS)
+            for (k = 0; k < n; ++k) memcpy(h->el[i + k].E, E + 3 * k, 3 * sizeof(float));
+    }
+    rad__free(&h->allocator, buf);
+    rad__free(&h->allocator, tris);
+    return r;
+}
+
+/* ---- link evaluation: kernels at the receiver's points, rays to the source, in tasks ---- */
+
+typedef struct rad__hr_eval {
+    rad_hierarchical *h;
+    rad__hr_link *links;
+    size_t count;
+    uint32_t tasks;
+    rad_ray *rays;
+    uint8_t *occ;
+    float *w;
+    size_t *idx;
+    uint64_t *kernels, *rays_cast;
+    rad_result *results;
+} rad__hr_eval;
+
+static rad_result rad__hr_flush(rad__hr_eval *ev, uint32_t task, uint32_t n)
+{
+    size_t base = (size_t)task * RAD__RAY_BATCH;
+    uint32_t k;
+    if (n == 0) return RAD_SUCCESS;
+    if (ev->h->rc.occluded(ev->h->rc.user, ev->rays + base, n, ev->occ + base) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    ev->rays_cast[task] += n;
+    for (k = 0; k < n; ++k)
+        if (!ev->occ[base + k]) ev->links[ev->idx[base + k]].F += ev->w[base + k];
+    return RAD_SUCCESS;
+}
+
+/* Link l's F: the mean over the receiver's K lattice points x_k of the analytic point-to-
+   triangle value f_k, times visibility. One ray per point, to a Hammersley point y_k of the
+   source; as in the analytic form-factor method each ray carries the share kern_k / sum kern
+   of the link's total sum f, kern the cos cos / r^2 of its two end points, so that a wall half
+   hidden near its base loses the share of light its near (strong) part carries, not its share
+   of area. */
+static void rad__hr_eval_task(void *data, uint32_t task)
+{
+    rad__hr_eval *ev = (rad__hr_eval *)data;
+    rad_hierarchical *h = ev->h;
+    size_t b = ev->count * task / ev->tasks, e = ev->count * (task + 1u) / ev->tasks, l, base = (size_t)task * RAD__RAY_BATCH;
+    uint32_t K = h->nside * h->nside, nrays = 0, s;
+    rad_result r = RAD_SUCCESS;
+    for (l = b; l < e && r == RAD_SUCCESS; ++l) {
+        rad__hr_link *lk = &ev->links[l];
+        const rad__hr_elem *er = &h->el[lk->r], *es = &h->el[lk->s];
+        uint32_t hs = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s)));
+        float r1 = (float)(hs & 0xFFFFu) / 65536.0f, r2 = (float)(hs >> 16) / 65536.0f;
+        float xs[3 * RAD__HR_MAX_RAYS], ys[3 * RAD__HR_MAX_RAYS];
+        double N[3], fu = 0.0, fmin = 1e30, fmax = 0.0, kern[RAD__HR_MAX_RAYS], f[RAD__HR_MAX_RAYS], ksum = 0.0;
+        int k;
+        for (k = 0; k < 3; ++k) N[k] = er->n[k];
+        lk->F = lk->Fu = lk->Fd = 0.0f;
+        for (s = 0; s < K; ++s) {
+            float *x = xs + 3 * s, *y = ys + 3 * s, d[3], u1, u2;
+            double X[3];
+            f[s] = kern[s] = 0.0;
+            rad__lattice_point(er->v, er->v + 3, er->v + 6, h->nside, s, x);
+            rad__sub(d, x, es->v);
+            if (!(rad__dot(d, es->n) > 0.0f)) { /* the point is behind the source */
+                fmin = 0.0;
+                continue;
+            }
+            for (k = 0; k < 3; ++k) X[k] = x[k];
+            f[s] = fabs(rad__ff_point_tri(X, N, es->v)) / (double)K;
+            ev->kernels[task]++;
+            if (f[s] < fmin) fmin = f[s];
+            if (f[s] > fmax) fmax = f[s];
+            fu += f[s];
+            rad__hammersley(s, K, r1, r2, &u1, &u2);
+            rad__triangle_point(es->v, es->v + 3, es->v + 6, u1, u2, y);
+            rad__sub(d, y, x);
+            {
+                double r2d = (double)rad__dot(d, d), cx = (double)rad__dot(d, er->n), cy = -(double)rad__dot(d, es->n);
+                kern[s] = f[s] > 0.0 && r2d > 0.0 && cx > 0.0 && cy > 0.0 ? cx * cy / (r2d * r2d) : 0.0;
+                ksum += kern[s];
+            }
+        }
+        lk->Fu = (float)fu;
+        lk->Fd = fmax > fmin ? (float)((fmax - fmin) * (double)K) : 0.0f;
+        if (h->o.skip_visibility) {
+            lk->F = lk->Fu;
+            continue;
+        }
+        for (s = 0; s < K && r == RAD_SUCCESS; ++s) {
+            /* no usable kernel (every end point grazing): each ray carries its point's f */
+            double w = ksum > 0.0 ? fu * kern[s] / ksum : f[s];
+            rad_ray *ray;
+            float len;
+            if (!(w > 0.0)) continue;
+            ray = ev->rays + base + nrays;
+            for (k = 0; k < 3; ++k) {
+                ray->origin[k] = xs[3 * s + (uint32_t)k] + er->n[k] * h->ray_eps;
+                ray->dir[k] = (ys[3 * s + (uint32_t)k] + es->n[k] * h->ray_eps) - ray->origin[k];
+            }
+            len = rad__len(ray->dir);
+            ray->tmin = 0.0f;
+            ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+            ev->w[base + nrays] = (float)w;
+            ev->idx[base + nrays] = l;
+            if (++nrays == RAD__RAY_BATCH) {
+                r = rad__hr_flush(ev, task, nrays);
+                nrays = 0;
+            }
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad__hr_flush(ev, task, nrays);
+    ev->results[task] = r;
+}
+
+static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, size_t count, const rad__ctx *c)
+{
+    rad__hr_eval ev;
+    size_t tasks = (count + 255u) / 256u;
+    uint32_t t;
+    rad_result r = RAD_SUCCESS;
+    if (count == 0) return RAD_SUCCESS;
+    if (tasks > c->tasks) tasks = c->tasks;
+    memset(&ev, 0, sizeof(ev));
+    ev.h = h;
+    ev.links = links;
+    ev.count = count;
+    ev.tasks = (uint32_t)tasks;
+    ev.rays = (rad_ray *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(rad_ray));
+    ev.occ = (uint8_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, 1);
+    ev.w = (float *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(float));
+    ev.idx = (size_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(size_t));
+    ev.kernels = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
+    ev.rays_cast = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
+    ev.results = (rad_result *)rad__alloc_array(&h->allocator, tasks, sizeof(rad_result));
+    if (!ev.rays || !ev.occ || !ev.w || !ev.idx || !ev.kernels || !ev.rays_cast || !ev.results) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the link evaluation scratch");
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        for (t = 0; t < ev.tasks; ++t) {
+            ev.kernels[t] = ev.rays_cast[t] = 0;
+            ev.results[t] = RAD_SUCCESS;
+        }
+        c->parallel_for(c->parallel_user, ev.tasks, rad__hr_eval_task, &ev);
+        for (t = 0; t < ev.tasks; ++t) {
+            h->st.kernel_evaluations += ev.kernels[t];
+            h->st.rays_cast += ev.rays_cast[t];
+            if (ev.results[t] != RAD_SUCCESS && r == RAD_SUCCESS) r = ev.results[t];
+        }
+        h->st.links_evaluated += count;
+        if (r != RAD_SUCCESS) rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the raycaster failed");
+    }
+    rad__free(&h->allocator, ev.rays);
+    rad__free(&h->allocator, ev.occ);
+    rad__free(&h->allocator, ev.w);
+    rad__free(&h->allocator, ev.idx);
+    rad__free(&h->allocator, ev.kernels);
+    rad__free(&h->allocator, ev.rays_cast);
+    rad__free(&h->allocator, ev.results);
+    return r;
+}
+
+/* a growable array of links */
+typedef struct rad__hr_list {
+    rad__hr_link *a;
+    size_t n, cap;
+} rad__hr_list;
+
+static rad_result rad__hr_push(rad_hierarchical *h, rad__hr_list *L, uint32_t r, uint32_t s, const rad__ctx *c)
+{
+    if (!rad__ff_facing(h->el[r].v, h->el[r].n, h->el[s].v, h->el[s].n)) return RAD_SUCCESS;
+    if (L->n == L->cap) {
+        size_t cap = L->cap ? 2u * L->cap : 1024u, old_bytes, new_bytes;
+        rad__hr_link *g;
+        if (!rad__mul(L->cap, sizeof(rad__hr_link), &old_bytes) || !rad__mul(cap, sizeof(rad__hr_link), &new_bytes)) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: too many links");
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        g = (rad__hr_link *)rad__realloc(&h->allocator, L->a, old_bytes, new_bytes);
+        if (!g) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for %llu links", (unsigned long long)cap);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        L->a = g;
+        L->cap = cap;
+    }
+    L->a[L->n].r = r;
+    L->a[L->n].s = s;
+    L->a[L->n].F = L->a[L->n].Fu = L->a[L->n].Fd = 0.0f;
+    L->n++;
+    return RAD_SUCCESS;
+}
+
+/* The oracle: 1 when link l should be refined (*split gets the element to split). BF
+   refinement: the power A_r F_rs max_c(B_s) the link carries (F unoccluded where some ray got
+   through, 0 where none did) above eps_abs splits the larger element that can split; and the
+   link's own error, A_r max_c(B_s) times the spread of F_rs over r's points, above eps_abs
+   splits the receiver (so that no leaf gathers over a link whose F differs much across it). */
+static int rad__hr_oracle(const rad_hierarchical *h, const rad__hr_link *l, uint32_t *split)
+{
+    const rad__hr_elem *er = &h->el[l->r], *es = &h->el[l->s];
+    float bs = es->B[0] > es->B[1] ? es->B[0] : es->B[1];
+    int can_r = er->area * 0.25f >= h->min_area, can_s = es->area * 0.25f >= h->min_area;
+    double pw;
+    if (es->B[2] > bs) bs = es->B[2];
+    pw = (double)er->area * (double)bs;
+    if (can_r && pw * (double)l->Fd > h->eps_abs) {
+        *split = l->r;
+        return 1;
+    }
+    if (!(pw * (double)l->Fu > h->eps_abs) || (!can_r && !can_s)) return 0;
+    *split = (can_s && (es->area >= er->area || !can_r)) ? l->s : l->r;
+    return 1;
+}
+
+/* One refinement pass over the links, level by level. *changed: any link refined. */
+static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__ctx *c)
+{
+    rad__hr_list keep, cand, next;
+    size_t i;
+    rad_result r = RAD_SUCCESS;
+    *changed = 0;
+    memset(&keep, 0, sizeof(keep));
+    memset(&next, 0, sizeof(next));
+    cand.a = h->links;
+    cand.n = cand.cap = h->nlinks;
+    h->links = NULL;
+    h->nlinks = 0;
+    while (cand.n > 0 && r == RAD_SUCCESS) {
+        next.n = 0;
+        for (i = 0; i < cand.n && r == RAD_SUCCESS; ++i) {
+            rad__hr_link l = cand.a[i];
+            uint32_t e, k;
+            if (!rad__hr_oracle(h, &l, &e)) {
+                if (keep.n == keep.cap) {
+                    /* rad__hr_push checks facing, which a kept link passed already */
+                    r = rad__hr_push(h, &keep, l.r, l.s, c);
+                    if (r == RAD_SUCCESS) keep.a[keep.n - 1u] = l;
+                } else {
+                    keep.a[keep.n++] = l;
+                }
+                continue;
+            }
+            *changed = 1;
+            if ((r = rad__hr_split(h, e, c)) != RAD_SUCCESS) break;
+            for (k = 0; k < 4u && r == RAD_SUCCESS; ++k) {
+                uint32_t ch = h->el[e].child + k;
+                r = e == l.s ? rad__hr_push(h, &next, l.r, ch, c) : rad__hr_push(h, &next, ch, l.s, c);
+            }
+        }
+        if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, next.a, next.n, c);
+        {
+            rad__hr_list tmp = cand;
+            cand = next;
+            next = tmp;
+        }
+    }
+    rad__free(&h->allocator, cand.a);
+    rad__free(&h->allocator, next.a);
+    h->links = keep.a;
+    h->nlinks = keep.n;
+    return r;
+}
+
+/* One gather and push-pull sweep; returns the largest change of a leaf's B over max B */
+static double rad__hr_sweep(rad_hierarchical *h)
+{
+    uint32_t i, k;
+    size_t l;
+    double change = 0.0, bmax = 0.0;
+    for (i = 0; i < h->nel; ++i) {
+        rad__hr_elem *e = &h->el[i];
+        e->G[0] = e->G[1] = e->G[2] = 0.0;
+        e->S = 0.0;
+    }
+    for (l = 0; l < h->nlinks; ++l) {
+        const rad__hr_link *lk = &h->links[l];
+        rad__hr_elem *er = &h->el[lk->r];
+        const float *B = h->el[lk->s].B;
+        for (k = 0; k < 3; ++k) er->G[k] += (double)lk->F * (double)B[k];
+        er->S += (double)lk->F;
+    }
+    for (i = 0; i < h->nel; ++i) { /* push: parents come first */
+        rad__hr_elem *e = &h->el[i];
+        const rad__hr_elem *p = e->parent != RAD_NONE ? &h->el[e->parent] : NULL;
+        for (k = 0; k < 3; ++k) e->Gt[k] = e->G[k] + (p ? p->Gt[k] : 0.0);
+        e->St = e->S + (p ? p->St : 0.0);
+    }
+    for (i = h->nel; i-- > 0;) { /* pull: children come first */
+        rad__hr_elem *e = &h->el[i];
+        if (e->child == RAD_NONE) {
+            for (k = 0; k < 3; ++k) {
+                float b = (float)((double)e->E[k] + (double)e->rho[k] * e->Gt[k]);
+                double d = fabs((double)b - (double)e->B[k]);
+                if (d > change) change = d;
+                if ((double)b > bmax) bmax = (double)b;
+                e->B[k] = b;
+            }
+        } else {
+            const rad__hr_elem *ch = &h->el[e->child];
+            double a = 0.0, s[3] = { 0.0, 0.0, 0.0 };
+            uint32_t m;
+            for (m = 0; m < 4; ++m) {
+                a += (double)ch[m].area;
+                for (k = 0; k < 3; ++k) s[k] += (double)ch[m].area * (double)ch[m].B[k];
+            }
+            for (k = 0; k < 3; ++k) e->B[k] = a > 0.0 ? (float)(s[k] / a) : 0.0f;
+        }
+    }
+    return bmax > 0.0 ? change / bmax : 0.0;
+}
+
+/* leaves in order, per-leaf corner vertices welded by position and plane, vertex values */
+static rad_result rad__hr_finish(rad_hierarchical *h, const rad__ctx *c)
+{
+    uint32_t i, k, T = h->scene->triangle_count, top, nl = 0, cap, mask, nv = 0;
+    uint32_t *stack = NULL, *table = NULL;
+    double *acc = NULL;
+    rad_result r = RAD_SUCCESS;
+    for (i = 0; i < h->nel; ++i)
+        if (h->el[i].child == RAD_NONE) ++nl;
+    if (nl > 0x3FFFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    for (cap = 16u; cap < 6u * nl; cap *= 2u) {
+    }
+    mask = cap - 1u;
+    h->leaf = (uint32_t *)rad__alloc_array(&h->allocator, nl, sizeof(uint32_t));
+    h->leaf_of = (uint32_t *)rad__alloc_array(&h->allocator, h->nel, sizeof(uint32_t));
+    h->leaf_vert = (uint32_t *)rad__alloc_array(&h->allocator, 3u * (size_t)nl, sizeof(uint32_t));
+    stack = (uint32_t *)rad__alloc_array(&h->allocator, h->nel, sizeof(uint32_t));
+    table = (uint32_t *)rad__alloc_array(&h->allocator, cap, sizeof(uint32_t));
+    /* per vertex: position and normal (6), area, A B (3), A H (3), A S, S max, halo A S, halo A */
+    acc = (double *)rad__alloc_array(&h->allocator, 3u * (size_t)nl, 19u * sizeof(double));
+    if (!h->leaf || !h->leaf_of || !h->leaf_vert || !stack || !table || !acc) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the %u leaves' lookup", nl);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    h->nleaf = 0;
+    for (i = 0; i < T; ++i) { /* depth first per scene triangle */
+        stack[0] = i;
+        top = 1;
+        while (top > 0) {
+            uint32_t e = stack[--top];
+            h->leaf_of[e] = RAD_NONE;
+            if (h->el[e].child == RAD_NONE) {
+                h->leaf_of[e] = h->nleaf;
+                h->leaf[h->nleaf++] = e;
+            } else {
+                for (k = 4; k-- > 0;) stack[top++] = h->el[e].child + k;
+            }
+        }
+    }
+    for (i = 0; i < cap; ++i) table[i] = RAD_NONE;
+    for (i = 0; i < h->nleaf; ++i) {
+        const rad__hr_elem *e = &h->el[h->leaf[i]];
+        for (k = 0; k < 3; ++k) {
+            const float *p = e->v + 3 * k;
+            uint32_t bits[3], hv, slot, v;
+            int m;
+            memcpy(bits, p, sizeof(bits));
+            for (m = 0; m < 3; ++m)
+                if (p[m] == 0.0f) bits[m] = 0; /* -0 and 0 weld */
+            hv = rad__hash(bits[0] ^ rad__hash(bits[1] ^ rad__hash(bits[2])));
+            for (slot = hv & mask;; slot = (slot + 1u) & mask) {
+                double *a;
+                v = table[slot];
+                if (v == RAD_NONE) {
+                    v = table[slot] = nv++;
+                    a = acc + 19u * (size_t)v;
+                    memset(a, 0, 19u * sizeof(double));
+                    for (m = 0; m < 3; ++m) { a[m] = p[m]; a[3 + m] = e->n[m]; }
+                    break;
+                }
+                a = acc + 19u * (size_t)v;
+                if (a[0] == p[0] && a[1] == p[1] && a[2] == p[2] &&
+                    a[3] * e->n[0] + a[4] * e->n[1] + a[5] * e->n[2] > 0.999)
+                    break;
+            }
+            h->leaf_vert[3 * i + k] = v;
+            {
+                double *a = acc + 19u * (size_t)v, A = (double)e->area;
+                a[6] += A;
+                for (m = 0; m < 3; ++m) {
+                    a[7 + m] += A * (double)e->B[m];
+                    a[10 + m] += A * e->Gt[m];
+                }
+                a[13] += A * e->St;
+                if (e->St > a[14]) a[14] = e->St;
+            }
+        }
+    }
+    for (i = 0; i < h->nleaf; ++i) { /* the halo fix: the leaves that see most of what the corner's best one sees */
+        const rad__hr_elem *e = &h->el[h->leaf[i]];
+        for (k = 0; k < 3; ++k) {
+            double *a = acc + 19u * (size_t)h->leaf_vert[3 * i + k];
+            if (e->St >= 0.75 * a[14]) {
+                a[15] += (double)e->area * e->St;
+                a[16] += (double)e->area;
+            }
+        }
+    }
+    h->nvert = nv;
+    h->vert_B = (float *)rad__alloc_array(&h->allocator, 3u * (size_t)(nv ? nv : 1u), sizeof(float));
+    h->vert_H = (float *)rad__alloc_array(&h->allocator, 3u * (size_t)(nv ? nv : 1u), sizeof(float));
+    if (!h->vert_B || !h->vert_H) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for %u lookup vertices", nv);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < nv; ++i) {
+        const double *a = acc + 19u * (size_t)i;
+        double scale = a[13] > 0.0 && a[16] > 0.0 ? (a[15] / a[16]) / a[13] : 0.0;
+        for (k = 0; k < 3; ++k) {
+            h->vert_B[3 * i + k] = a[6] > 0.0 ? (float)(a[7 + k] / a[6]) : 0.0f;
+            h->vert_H[3 * i + k] = (float)(a[10 + k] * scale);
+        }
+    }
+done:
+    rad__free(&h->allocator, stack);
+    rad__free(&h->allocator, table);
+    rad__free(&h->allocator, acc);
+    return r;
+}
+
+RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__hr_list L;
+    uint32_t i, j, T, round;
+    double P = 0.0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!h) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: h is NULL");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (h->state != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: already %s", h->state > 0 ? "solved" : "failed");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    h->state = -1;
+    T = h->scene->triangle_count;
+    if ((r = rad__hr_sources(h, 0, &c)) != RAD_SUCCESS) return r;
+    for (i = 0; i < T; ++i) {
+        rad__hr_elem *e = &h->el[i];
+        float m = e->E[0] > e->E[1] ? e->E[0] : e->E[1];
+        if (e->E[2] > m) m = e->E[2];
+        P += (double)e->area * (double)m;
+        memcpy(e->B, e->E, sizeof(e->B));
+    }
+    h->eps_abs = h->o.tolerance * P;
+    memset(&L, 0, sizeof(L));
+    for (i = 0; i < T && r == RAD_SUCCESS; ++i)
+        for (j = 0; j < T && r == RAD_SUCCESS; ++j)
+            if (i != j) r = rad__hr_push(h, &L, i, j, &c);
+    h->links = L.a;
+    h->nlinks = L.n;
+    if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, h->links, h->nlinks, &c);
+    for (round = 0; round < h->o.max_iterations && r == RAD_SUCCESS; ++round) {
+        int changed = 0;
+        uint32_t first = h->nel, s;
+        double res = 0.0;
+        r = rad__hr_refine(h, &changed, &c);
+        if (r == RAD_SUCCESS) r = rad__hr_sources(h, first, &c);
+        if (r != RAD_SUCCESS) break;
+        for (s = 0; s < RAD__HR_MAX_SWEEPS; ++s) {
+            res = rad__hr_sweep(h);
+            h->st.sweeps++;
+            if (res < RAD__HR_SWEEP_TOLERANCE) break;
+        }
+        h->st.residual = res;
+        h->st.rounds = round + 1u;
+        if (s == RAD__HR_MAX_SWEEPS) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: round %u: %u sweeps left a change of %g of max B", round,
+                     RAD__HR_MAX_SWEEPS, res);
+            r = RAD_ERROR_NOT_CONVERGED;
+            break;
+        }
+        if (c.progress && c.progress(c.progress_user, (float)(round + 1u) / (float)h->o.max_iterations)) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: cancelled after round %u", round);
+            r = RAD_ERROR_CANCELLED;
+            break;
+        }
+        if (!changed) break;
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < h->nel && r == RAD_SUCCESS; ++i) r = rad__check_output(&c, "rad_hierarchical_solve", h->el[i].B, 3);
+    }
+    if (r == RAD_SUCCESS) r = rad__hr_finish(h, &c);
+    if (r != RAD_SUCCESS) return r;
+    h->st.elements = h->nel;
+    h->st.leaves = h->nleaf;
+    h->st.links = h->nlinks;
+    h->state = 1;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_hierarchical_get_stats(const rad_hierarchical *h, rad_hierarchical_stats *out)
+{
+    if (!out) return;
+    memset(out, 0, sizeof(*out));
+    if (h) *out = h->st;
+}
+
+RAD_API rad_result rad_hierarchical_leaves(const rad_hierarchical *h, uint32_t first, uint32_t count, float *out_corners,
+                                           uint32_t *out_triangles, float *out_B, float *out_H)
+{
+    uint32_t i, k;
+    if (!h || h->state != 1) return RAD_ERROR_INVALID_ARGUMENT;
+    if (first > h->nleaf || count > h->nleaf - first) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    for (i = 0; i < count; ++i) {
+        const rad__hr_elem *e = &h->el[h->leaf[first + i]];
+        if (out_corners) memcpy(out_corners + 9 * (size_t)i, e->v, 9 * sizeof(float));
+        if (out_triangles) out_triangles[i] = e->tri;
+        for (k = 0; k < 3; ++k) {
+            if (out_B) out_B[3 * (size_t)i + k] = e->B[k];
+            if (out_H) out_H[3 * (size_t)i + k] = (float)e->Gt[k];
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_hierarchical_links(const rad_hierarchical *h, uint64_t first, uint32_t count, float *out_points,
+                                          float *out_form_factors, uint32_t *out_depths)
+{
+    uint32_t i;
+    if (!h || h->state != 1) return RAD_ERROR_INVALID_ARGUMENT;
+    if (first > (uint64_t)h->nlinks || (uint64_t)count > (uint64_t)h->nlinks - first) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    for (i = 0; i < count; ++i) {
+        const rad__hr_link *l = &h->links[(size_t)first + i];
+        if (out_points) {
+            rad__hr_centroid(&h->el[l->r], out_points + 6 * (size_t)i);
+            rad__hr_centroid(&h->el[l->s], out_points + 6 * (size_t)i + 3);
+        }
+        if (out_form_factors) out_form_factors[i] = l->F;
+        if (out_depths) {
+            out_depths[2 * (size_t)i] = h->el[l->r].depth;
+            out_depths[2 * (size_t)i + 1] = h->el[l->s].depth;
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_hierarchical_lookup(const rad_hierarchical *h, rad_hierarchical_value value, int smooth,
+                                           const uint32_t *triangles, const float *barycentrics, uint32_t count,
+                                           float *out)
+{
+    uint32_t i, k;
+    if (!h || h->state != 1 || !triangles || !barycentrics || !out ||
+        (value != RAD_HIERARCHICAL_RADIOSITY && value != RAD_HIERARCHICAL_GATHERED))
+        return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < count; ++i) {
+        uint32_t t = triangles[i], e;
+        float l1 = barycentrics[2 * (size_t)i], l2 = barycentrics[2 * (size_t)i + 1];
+        const float *vals;
+        if (t >= h->scene->triangle_count) return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        if (!rad__finite(l1) || !rad__finite(l2)) return RAD_ERROR_INVALID_ARGUMENT;
+        /* clamp into the triangle, then descend: (l1, l2) become the child's own */
+        if (l1 < 0.0f) l1 = 0.0f;
+        if (l2 < 0.0f) l2 = 0.0f;
+        if (l1 + l2 > 1.0f) { float s = l1 + l2; l1 /= s; l2 /= s; }
+        for (e = t; h->el[e].child != RAD_NONE;) {
+            uint32_t ch = h->el[e].child;
+            if (l1 >= 0.5f) { e = ch + 1u; l1 = 2.0f * l1 - 1.0f; l2 = 2.0f * l2; }
+            else if (l2 >= 0.5f) { e = ch + 2u; l1 = 2.0f * l1; l2 = 2.0f * l2 - 1.0f; }
+            else if (l1 + l2 <= 0.5f) { e = ch; l1 = 2.0f * l1; l2 = 2.0f * l2; }
+            else { float m2 = 1.0f - 2.0f * l1; e = ch + 3u; l1 = 2.0f * l2 - m2; l2 = m2; }
+        }
+        if (!smooth) {
+            const rad__hr_elem *el = &h->el[e];
+            for (k = 0; k < 3; ++k) out[3 * (size_t)i + k] = value == RAD_HIERARCHICAL_RADIOSITY ? el->B[k] : (float)el->Gt[k];
+            continue;
+        }
+        {
+            const uint32_t *vv = h->leaf_vert + 3 * (size_t)h->leaf_of[e];
+            float w0 = 1.0f - l1 - l2;
+            vals = value == RAD_HIERARCHICAL_RADIOSITY ? h->vert_B : h->vert_H;
+            if (w0 < 0.0f) w0 = 0.0f;
+            for (k = 0; k < 3; ++k)
+                out[3 * (size_t)i + k] = w0 * vals[3 * (size_t)vv[0] + k] + l1 * vals[3 * (size_t)vv[1] + k] +
+                                         l2 * vals[3 * (size_t)vv[2] + k];
+        }
+    }
+    return RAD_SUCCESS;
 }
 
 /* ======================================================================================== */
@@ -6393,7 +8138,9 @@ RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode,
     if (mode == RAD_SOURCE_DIRECT) {
         if (!direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
         for (i = 0; i < 3 * patches->count; ++i)
-            if (!rad__finite(direct_irradiance[i]) || direct_irradiance[i] < 0.0f) return RAD_ERROR_NON_FINITE;
+            if (!rad__finite(direct_irradiance[i])) return RAD_ERROR_NON_FINITE;
+        for (i = 0; i < 3 * patches->count; ++i)
+            if (direct_irradiance[i] < 0.0f) return RAD_ERROR_INVALID_ARGUMENT; /* finite but no irradiance */
         for (i = 0; i < 3 * patches->count; ++i) out_E[i] = patches->albedo[i] * direct_irradiance[i];
         return RAD_SUCCESS;
     }
@@ -13751,6 +15498,7 @@ typedef struct rad__vp_build {
     struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
     uint64_t *rays_cast;         /* per task */
     float *P;                    /* N x N */
+    int count_only;              /* rad_vp_count: stop once the patches are counted (step 4) */
 } rad__vp_build;
 
 static void rad__vp_cell(const rad_virtual_patches *vp, uint64_t key, uint32_t *c)
@@ -14527,6 +16275,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     }
     vp->voxel_first[vp->voxel_count] = N;
     vp->count = N;
+    if (b->count_only) goto done;
     if (!rad__mul3(N, N, sizeof(float), &bytes)) {
         rad__log(c, RAD_LOG_ERROR, "virtual patches: the %u x %u matrix does not fit in memory (use bigger voxels)", N, N);
         r = RAD_ERROR_SIZE_OVERFLOW;
@@ -14652,8 +16401,8 @@ done:
     return r;
 }
 
-RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
-                                 const rad_context *ctx, rad_virtual_patches **out)
+static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                  const rad_context *ctx, rad_virtual_patches **out, int count_only)
 {
     rad__ctx c;
     rad__vp_build b;
@@ -14721,12 +16470,38 @@ RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *ra
     b.vp = vp;
     b.eps = b.o.ray_epsilon * scene->diagonal;
     b.tasks = c.tasks;
+    b.count_only = count_only;
     r = rad__vp_build_run(&b, &c);
     if (r != RAD_SUCCESS) {
         rad_vp_destroy(vp);
         return r;
     }
     *out = vp;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_create(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                 const rad_context *ctx, rad_virtual_patches **out)
+{
+    return rad__vp_create(scene, raycaster, options, ctx, out, 0);
+}
+
+RAD_API rad_result rad_vp_count(const rad_scene *scene, const rad_raycaster *raycaster, const rad_vp_options *options,
+                                const rad_context *ctx, rad_vp_counts *out)
+{
+    rad_virtual_patches *vp = NULL;
+    rad_result r;
+    if (out) memset(out, 0, sizeof(*out));
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    /* the build itself up to the patches, so the counts are those rad_vp_create gives */
+    r = rad__vp_create(scene, raycaster, options, ctx, &vp, 1);
+    if (r != RAD_SUCCESS) return r;
+    out->patches = vp->count;
+    out->samples = vp->sample_count;
+    out->voxels = vp->voxel_count;
+    out->candidate_voxels = vp->candidate_voxels;
+    out->face_rays = vp->face_rays;
+    rad_vp_destroy(vp);
     return RAD_SUCCESS;
 }
 

@@ -212,7 +212,7 @@ int main(int argc, char **argv)
     rad_system sys;
     rad_context ctx, quiet;
     progress_state ps;
-    float *D, *E, *L, *EL, *H, *Hv, *S, *S_v, *S_max, *S_area;
+    float *D, *E, *L, *EL, *H, *Hv, *S;
     uint32_t blind = 0;
     unsigned char *image;
     uint32_t n, i, k, strata, rows_per_batch, y0;
@@ -353,20 +353,12 @@ int main(int argc, char **argv)
     report("solve", t_solve, "Jacobi, %u bounces of indirect light L", sstats.iterations);
 
     /* 7. H = F (E + L): irradiance from the secondary sources, then smoothed to the vertices.
-       Plain vertex averages of H darken the visible surface next to anything that covers part
-       of a patch: the ceiling patches under the light (one-sided, 0.1 mm below the ceiling,
-       so they see nothing behind it) and the floor patches under the blocks. Such a patch
-       has a small H only because a part of its area sees nothing; the averaging would smear
-       that into a dark halo around the light and the block bases. So H is interpolated as
-       (mean radiosity seen) x (how much is seen): with S = F 1 the row sums,
-           H_v = [sum A_i H_i / sum A_i S_i] * S_v,
-       the bracket from two rad_patches_vertex_values calls (on H and on S), S_v the mean of S
-       over the patches at the vertex that are not partly covered (S_i >= 3/4 of the largest). */
+       Plain vertex averages of H would darken the visible surface next to anything that covers
+       part of a patch (the ceiling patches under the one-sided light, the floor under the
+       blocks): rad_patches_vertex_irradiance takes the row sums S = F 1 (how much each patch
+       sees) to interpolate H as (mean radiosity seen) x (how much is seen). */
     t0 = now_seconds();
     S = (float *)xmalloc(sizeof(float) * n);
-    S_v = (float *)xmalloc(sizeof(float) * (size_t)patches->vertex_count);
-    S_max = (float *)xmalloc(sizeof(float) * (size_t)patches->vertex_count);
-    S_area = (float *)xmalloc(sizeof(float) * (size_t)patches->vertex_count);
     for (i = 0; i < 3 * n; ++i) EL[i] = 1.0f;
     check(rad_matrix_multiply(&ff->matrix, EL, H, &quiet), "rad_matrix_multiply (row sums)");
     for (i = 0; i < n; ++i) {
@@ -375,35 +367,7 @@ int main(int argc, char **argv)
     }
     for (i = 0; i < 3 * n; ++i) EL[i] = E[i] + L[i];
     check(rad_matrix_multiply(&ff->matrix, EL, H, &quiet), "rad_matrix_multiply");
-    check(rad_patches_vertex_values(patches, H, 3, Hv), "rad_patches_vertex_values");
-    check(rad_patches_vertex_values(patches, S, 1, S_v), "rad_patches_vertex_values");
-    for (i = 0; i < patches->vertex_count; ++i) S_max[i] = S_area[i] = 0.0f;
-    for (i = 0; i < n; ++i)
-        for (k = 0; k < 3; ++k) {
-            uint32_t v = patches->patches[i].vertices[k];
-            if (S[i] > S_max[v]) S_max[v] = S[i];
-        }
-    for (i = 0; i < patches->vertex_count; ++i) {
-        float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f; /* S_v: area-weighted mean of S */
-        Hv[3 * i] *= scale;
-        Hv[3 * i + 1] *= scale;
-        Hv[3 * i + 2] *= scale;
-        S_v[i] = 0.0f;
-    }
-    for (i = 0; i < n; ++i)
-        for (k = 0; k < 3; ++k) {
-            uint32_t v = patches->patches[i].vertices[k];
-            if (S[i] >= 0.75f * S_max[v]) {
-                S_v[v] += patches->patches[i].area * S[i];
-                S_area[v] += patches->patches[i].area;
-            }
-        }
-    for (i = 0; i < patches->vertex_count; ++i) {
-        float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
-        Hv[3 * i] *= s_v;
-        Hv[3 * i + 1] *= s_v;
-        Hv[3 * i + 2] *= s_v;
-    }
+    check(rad_patches_vertex_irradiance(patches, H, S, Hv, &ctx), "rad_patches_vertex_irradiance");
     t_gather = now_seconds() - t0;
     report("gather", t_gather, "H = F (E + L), per-vertex values (%u patches see nothing)", blind);
 
@@ -528,9 +492,6 @@ int main(int argc, char **argv)
     free(H);
     free(Hv);
     free(S);
-    free(S_v);
-    free(S_max);
-    free(S_area);
     rad_form_factors_destroy(ff);
     rad_bvh_destroy(bvh);
     rad_patches_destroy(patches);

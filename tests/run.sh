@@ -180,7 +180,16 @@ s_examples() {
     else
         fail gallery-small
     fi
+    # hierarchical radiosity's links as an image
+    if build learn-hierarchical $CC -std=c99 $WARN -O2 -I. examples/learn_hierarchical.c -o "$BUILD/learn_hierarchical" -lm &&
+       "$BUILD/learn_hierarchical" --eps 1e-2 --size 64 -o "$BUILD/learn-hierarchical.png" >"$BUILD/learn-hierarchical.out" 2>&1 &&
+       [ -s "$BUILD/learn-hierarchical.png" ] && grep -q 'links' "$BUILD/learn-hierarchical.out"; then
+        pass learn-hierarchical
+    else
+        fail learn-hierarchical
+    fi
     compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
+    compile_run engine_bake $CC -std=c99 $WARN -O2 -I. examples/engine_bake.c -o "$BUILD/engine_bake" -lm
     # the virtual-patch example builds and, without the external meshes, says it skipped
     if build vp-bunny $CC -std=c99 $WARN -O2 $OMP -I. examples/vp_bunny.c -o "$BUILD/vp_bunny" -lm &&
        "$BUILD/vp_bunny" --data "$BUILD/no-such-data" >"$BUILD/vp_bunny.out" 2>&1 && grep -q skipped "$BUILD/vp_bunny.out"; then
@@ -204,6 +213,20 @@ s_examples() {
         pass moving-light-small
     else
         fail moving-light-small
+    fi
+    # the teaching examples, at small sizes: each prints its table
+    compile_run learn_formfactors $CC -std=c99 $WARN -O2 -I. examples/learn_formfactors.c -o "$BUILD/learn_formfactors" -lm
+    if build learn_solvers $CC -std=c99 $WARN -O2 $OMP -I. examples/learn_solvers.c -o "$BUILD/learn_solvers" -lm &&
+       "$BUILD/learn_solvers" --patches 100 --iterations 4 >"$BUILD/learn_solvers.out" 2>&1; then
+        pass learn_solvers
+    else
+        fail learn_solvers
+    fi
+    if build learn_stochastic $CC -std=c99 $WARN -O2 $OMP -I. examples/learn_stochastic.c -o "$BUILD/learn_stochastic" -lm &&
+       "$BUILD/learn_stochastic" --patches 60 --max-rays 4000 >"$BUILD/learn_stochastic.out" 2>&1; then
+        pass learn_stochastic
+    else
+        fail learn_stochastic
     fi
 }
 
@@ -372,9 +395,11 @@ s_fuzz() {
 
 # ---- valgrind memcheck: one build, the quick suite split in two halves that run side by side.
 # Left out: tests that repeat the same computations in other orders or at other scales (they
-# are a third of its time; every build above runs them, five under the sanitizers)
+# are a third of its time; every build above runs them, five under the sanitizers), and the
+# stochastic statistics (16 seeds of the same solve; the furnace and thread tests keep both
+# estimators under valgrind)
 VALGRIND_SHARDS=2
-VALGRIND_SKIP=formfactor_determinism,robust_determinism,solve_jacobi_deterministic,solve_cornell_agree,robust_scale_invariance,robust_nearly_parallel,formfactor_c41_disks
+VALGRIND_SKIP=formfactor_determinism,robust_determinism,solve_jacobi_deterministic,solve_cornell_agree,robust_scale_invariance,robust_nearly_parallel,formfactor_c41_disks,stochastic_mean_jacobi,stochastic_mean_walk,stochastic_variance_jacobi,stochastic_variance_walk
 s_valgrind_build() {
     if ! have valgrind; then skip valgrind-memcheck "valgrind is not installed (package valgrind)"; return; fi
     build unit-valgrind $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-valgrind" -lm ||

@@ -844,8 +844,8 @@ static void api_sources_args(api_fx *f)
     /* a bad value late in D: the error, and out_E untouched (outputs are written only on success) */
     D[n3 - 1] = (float)NAN;
     CHECK_RESULT(rad_sources(f->P, RAD_SOURCE_DIRECT, D, f->buf), RAD_ERROR_NON_FINITE);
-    D[n3 - 1] = -1.0f;
-    CHECK_RESULT(rad_sources(f->P, RAD_SOURCE_DIRECT, D, f->buf), RAD_ERROR_NON_FINITE);
+    D[n3 - 1] = -1.0f; /* finite: a bad argument, not an overflow */
+    CHECK_RESULT(rad_sources(f->P, RAD_SOURCE_DIRECT, D, f->buf), RAD_ERROR_INVALID_ARGUMENT);
     D[n3 - 1] = (float)INFINITY;
     CHECK_RESULT(rad_sources(f->P, RAD_SOURCE_DIRECT, D, f->buf), RAD_ERROR_NON_FINITE);
     if (!api_untouched(f->buf, n3)) printf("    rad_sources(RAD_SOURCE_DIRECT) wrote out_E before failing\n");

@@ -698,6 +698,133 @@ static void sc_test_vertex_values(void)
     rad_scene_destroy(scene);
 }
 
+/* rad_patches_vertex_irradiance: on a floor whose patches with x < 0.3 see only 30% of their
+   hemisphere (S = 0.3) and the others all of it (S = 1), each seeing radiosity 2 (H = 2 S), a
+   vertex touching any uncovered patch gets 2 x 1 = 2 exactly, one inside the covered part
+   2 x 0.3; the plain vertex average gives less than 2 on the border (the halo). */
+static void sc_test_vertex_irradiance(void)
+{
+    static const float c[3] = { 0, 0, 0 }, ux[3] = { 1, 0, 0 }, uz[3] = { 0, 0, 1 };
+    float pos[12];
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0 };
+    rad_mesh_desc mesh;
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    float *H, *S, *hv, *plain, *smax;
+    uint32_t i, k, border = 0, halo = 0;
+    sc_quad(pos, c, uz, ux);
+    memset(&mesh, 0, sizeof(mesh));
+    mesh.positions = pos; mesh.vertex_count = 4; mesh.indices = sc_quad_idx; mesh.triangle_count = 2;
+    memset(&desc, 0, sizeof(desc));
+    desc.meshes = &mesh; desc.mesh_count = 1; desc.materials = &mat; desc.material_count = 1;
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    if (!scene) return;
+    rad_patch_options_default(&po);
+    po.max_edge = 0.1f;
+    CHECK_OK(rad_patches_create(scene, &po, NULL, &P));
+    if (!P) { rad_scene_destroy(scene); return; }
+    H = (float *)malloc(sizeof(float) * 3 * P->count);
+    S = (float *)malloc(sizeof(float) * P->count);
+    hv = (float *)malloc(sizeof(float) * 3 * P->vertex_count);
+    plain = (float *)malloc(sizeof(float) * 3 * P->vertex_count);
+    smax = (float *)calloc(P->vertex_count, sizeof(float));
+    if (H && S && hv && plain && smax) {
+        for (i = 0; i < P->count; ++i) {
+            S[i] = P->patches[i].centroid[0] < 0.3f ? 0.3f : 1.0f;
+            for (k = 0; k < 3; ++k) H[3 * i + k] = 2.0f * S[i] * (float)(k + 1);
+            for (k = 0; k < 3; ++k)
+                if (S[i] > smax[P->patches[i].vertices[k]]) smax[P->patches[i].vertices[k]] = S[i];
+        }
+        CHECK_OK(rad_patches_vertex_irradiance(P, H, S, hv, NULL));
+        CHECK_OK(rad_patches_vertex_values(P, H, 3, plain));
+        for (i = 0; i < P->vertex_count; ++i) {
+            for (k = 0; k < 3; ++k) CHECK_REL(hv[3 * i + k], 2.0 * smax[i] * (k + 1), 1e-5);
+            if (smax[i] == 1.0f && plain[3 * i] < 1.99f) halo++;
+            border += smax[i] == 1.0f;
+        }
+        CHECK(halo > 0 && halo < border); /* the plain average does darken the border */
+        /* no row sums: the plain average */
+        CHECK_OK(rad_patches_vertex_irradiance(P, H, NULL, hv, NULL));
+        CHECK(memcmp(hv, plain, sizeof(float) * 3 * P->vertex_count) == 0);
+        CHECK_RESULT(rad_patches_vertex_irradiance(NULL, H, S, hv, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_patches_vertex_irradiance(P, NULL, S, hv, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_patches_vertex_irradiance(P, H, S, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        S[P->count - 1] = -0.5f;
+        CHECK_RESULT(rad_patches_vertex_irradiance(P, H, S, hv, NULL), RAD_ERROR_NON_FINITE);
+        S[P->count - 1] = 1.0f;
+        H[1] = (float)NAN;
+        CHECK_RESULT(rad_patches_vertex_irradiance(P, H, S, hv, NULL), RAD_ERROR_NON_FINITE);
+    }
+    free(H); free(S); free(hv); free(plain); free(smax);
+    rad_patches_destroy(P);
+    rad_scene_destroy(scene);
+}
+
+/* rad_patches_gather_mesh: a field linear in position, given at the patch vertices, comes back
+   at the Cornell box meshes' own vertices (shared corners, indexed meshes) to float rounding,
+   and wrong descriptions are refused. */
+static void sc_test_gather_mesh(void)
+{
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_mesh_desc bad;
+    uint32_t *idx = NULL;
+    float *vv = NULL, *out = NULL;
+    uint32_t i, m, k;
+    double worst = 0.0;
+    rad_cornell_box(&desc, NULL);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    if (!scene) return;
+    rad_patch_options_default(&po);
+    po.max_edge = 0.12f;
+    CHECK_OK(rad_patches_create(scene, &po, NULL, &P));
+    if (!P) { rad_scene_destroy(scene); return; }
+    vv = (float *)malloc(sizeof(float) * 3 * P->vertex_count);
+    out = (float *)malloc(sizeof(float) * 3 * 64);
+    if (!vv || !out) goto done;
+    for (i = 0; i < P->vertex_count; ++i)
+        for (k = 0; k < 3; ++k) vv[3 * i + k] = 1.0f + P->vertices[3 * i] + 2.0f * P->vertices[3 * i + 1] + (float)k * P->vertices[3 * i + 2];
+    for (m = 0; m < desc.mesh_count; ++m) {
+        const rad_mesh_desc *md = &desc.meshes[m];
+        if (md->vertex_count > 64) { CHECK(0 && "mesh too large for the test"); continue; }
+        CHECK_OK(rad_patches_gather_mesh(P, vv, m, md, out, NULL));
+        for (i = 0; i < md->vertex_count; ++i) {
+            const float *q = (const float *)((const char *)md->positions + i * (md->position_stride ? md->position_stride : 12));
+            for (k = 0; k < 3; ++k) {
+                double want = 1.0 + q[0] + 2.0 * q[1] + (double)k * q[2], d = fabs(out[3 * i + k] - want);
+                if (d > worst) worst = d;
+            }
+        }
+    }
+    printf("    largest error at the meshes' vertices %.3g\n", worst);
+    CHECK(worst < 1e-5);
+    CHECK_RESULT(rad_patches_gather_mesh(P, vv, desc.mesh_count, &desc.meshes[0], out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_patches_gather_mesh(P, NULL, 0, &desc.meshes[0], out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_patches_gather_mesh(P, vv, 0, NULL, out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    /* a description with fewer triangles or an index past its vertices: another mesh */
+    bad = desc.meshes[0];
+    bad.triangle_count = 1;
+    CHECK_RESULT(rad_patches_gather_mesh(P, vv, 0, &bad, out, NULL), RAD_ERROR_INDEX_OUT_OF_RANGE);
+    bad = desc.meshes[0];
+    idx = (uint32_t *)malloc(sizeof(uint32_t) * 3 * bad.triangle_count);
+    if (idx) {
+        for (i = 0; i < 3 * bad.triangle_count; ++i) idx[i] = bad.indices ? bad.indices[i] : i;
+        idx[3 * bad.triangle_count - 1] = bad.vertex_count;
+        bad.indices = idx;
+        CHECK_RESULT(rad_patches_gather_mesh(P, vv, 0, &bad, out, NULL), RAD_ERROR_INDEX_OUT_OF_RANGE);
+    }
+done:
+    free(idx);
+    free(vv);
+    free(out);
+    rad_patches_destroy(P);
+    rad_scene_destroy(scene);
+}
+
 /* ---- context hooks ------------------------------------------------------------------------ */
 
 /* The whole pipeline on the Cornell box (one patch per triangle) with ctx. Returns the first
@@ -1010,6 +1137,8 @@ static const rad_test_case tests_scene[] = {
     { "scene_patch_locate", sc_test_patch_locate },
     { "scene_patch_welding", sc_test_patch_welding },
     { "scene_vertex_values", sc_test_vertex_values },
+    { "scene_vertex_irradiance", sc_test_vertex_irradiance },
+    { "scene_gather_mesh", sc_test_gather_mesh },
     { "scene_allocator_counting", sc_test_allocator_counting },
     { "scene_allocator_failures", sc_test_allocator_failures },
     { "scene_progress_cancel", sc_test_progress_cancel },

@@ -876,7 +876,78 @@ out:
     rad_scene_destroy(scene);
 }
 
+/* ---- counting without building -------------------------------------------------------------- */
+
+/* rad_vp_count runs the build up to the patches: its counts are those of rad_vp_create at every
+   resolution and for both kinds, and it needs far less memory (no N x N matrix) */
+static void vp_test_count(void)
+{
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options o;
+    rad_vp_counts cnt;
+    uint32_t res, kind, last = 0;
+    rad_cornell_box(&desc, NULL);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    for (kind = 0; kind < 2; ++kind)
+        for (res = 2; res <= (rad_test_quick() ? 6u : 10u); res += 2) {
+            rad_virtual_patches *vp = NULL;
+            rad_vp_options_default(&o);
+            o.resolution = res;
+            o.face_points = 4;
+            if (kind) { o.kind = RAD_VP_CLUSTERED; o.max_clusters = 3; }
+            CHECK_OK(rad_vp_count(scene, &rc, &o, NULL, &cnt));
+            CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+            if (!vp) continue;
+            CHECK(cnt.patches == vp->count);
+            CHECK(cnt.samples == vp->sample_count);
+            CHECK(cnt.voxels == vp->voxel_count);
+            CHECK(cnt.candidate_voxels == vp->candidate_voxels);
+            CHECK(cnt.face_rays == vp->face_rays);
+            if (!kind) CHECK(cnt.patches > last); /* finer voxels, more patches on the box */
+            if (!kind) last = cnt.patches;
+            rad_vp_destroy(vp);
+        }
+    /* bad arguments are refused as rad_vp_create refuses them */
+    CHECK(rad_vp_count(scene, &rc, &o, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(rad_vp_count(NULL, &rc, &o, NULL, &cnt) == RAD_ERROR_INVALID_ARGUMENT && cnt.patches == 0);
+    o.face_points = 5000;
+    CHECK(rad_vp_count(scene, &rc, &o, NULL, &cnt) == RAD_ERROR_INVALID_ARGUMENT);
+    /* a count needs none of the build's N x N matrix */
+    {
+        vp_peak_state st;
+        long long count_peak;
+        rad_context ctx;
+        rad_virtual_patches *vp = NULL;
+        memset(&st, 0, sizeof st);
+        memset(&ctx, 0, sizeof ctx);
+        ctx.allocator.alloc = vp_peak_alloc;
+        ctx.allocator.free = vp_peak_free;
+        ctx.allocator.user = &st;
+        rad_vp_options_default(&o);
+        o.resolution = rad_test_quick() ? 8 : 12;
+        o.face_points = 4;
+        CHECK_OK(rad_vp_count(scene, &rc, &o, &ctx, &cnt));
+        CHECK(st.live == 0);
+        count_peak = st.peak;
+        st.peak = 0;
+        CHECK_OK(rad_vp_create(scene, &rc, &o, &ctx, &vp));
+        if (vp) CHECK(cnt.patches == vp->count);
+        /* the build holds the count's arrays plus the matrix and its scratch */
+        CHECK(count_peak + (long long)cnt.patches * cnt.patches * 4 <= st.peak);
+        rad_vp_destroy(vp);
+        CHECK(st.live == 0);
+    }
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 static const rad_test_case tests_vp[] = {
+    { "vp_count", vp_test_count },
     { "vp_reciprocity", vp_test_reciprocity },
     { "vp_furnace", vp_test_furnace },
     { "vp_memory", vp_test_memory },

@@ -482,6 +482,38 @@ if "$RAD" render cornell $M -o "$TMP/ref.pfm" > /dev/null 2> "$TMP/err.txt" &&
         [ $rc -eq 1 ] && grep -q "holds no multibounce data" "$TMP/err.txt" &&
             ok "multibounce render rejects a classic bake" || fail "multibounce render rejects a classic bake" "exit $rc"
     fi
+    # stochastic: no F; the patch solution is noisy, so the image approaches classic (the same
+    # patches) as the rays grow (measured 55 dB at the default 64 rays per patch, 59 dB at 100000)
+    if "$RAD" bake cornell --patches 300 --method stochastic --sr-estimator walk -o "$TMP/sr.radb" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell --method stochastic --bake "$TMP/sr.radb" $M -o "$TMP/sr.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        ok "stochastic bakes and renders"
+        ! grep -q "form factors" "$TMP/err.txt" && ok "stochastic builds no form factors" ||
+            fail "stochastic builds no form factors" "$(head -c 300 "$TMP/err.txt")"
+        "$RAD" render cornell --method stochastic --sr-estimator walk $M -o "$TMP/sr_mem.pfm" > /dev/null 2>&1
+        cmp -s "$TMP/sr.pfm" "$TMP/sr_mem.pfm" && ok "stochastic render --bake equals the in-memory bake" ||
+            fail "stochastic render --bake equals the in-memory bake"
+        "$RAD" info "$TMP/sr.radb" > "$TMP/info.txt" 2>&1 &&
+            grep -q "method: stochastic, --sr-estimator walk" "$TMP/info.txt" && ! grep -q "FF_DENSE" "$TMP/info.txt" &&
+            ok "info shows a stochastic bake" || fail "info shows a stochastic bake" "$(head -c 600 "$TMP/info.txt")"
+        psnr_check "stochastic walk ~ classic" "$TMP/ref.pfm" "$TMP/sr.pfm" 45
+        "$RAD" render cornell --method stochastic --bake "$TMP/sr.radb" --sr-rays 5 $M -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt" &&
+            grep -q "fixes .*--sr-\*" "$TMP/err.txt" && ok "stochastic render --bake warns that the bake fixes --sr-rays" ||
+            fail "stochastic render --bake warns that the bake fixes --sr-rays" "$(head -c 300 "$TMP/err.txt")"
+    else
+        fail "stochastic bakes and renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
+    if "$RAD" render cornell $M --method stochastic --threads 1 -o "$TMP/sr1.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell $M --method stochastic --threads 2 -o "$TMP/sr2.pfm" > /dev/null 2>> "$TMP/err.txt" &&
+        "$RAD" render cornell $M --method stochastic --sr-rays 100000 -o "$TMP/srbig.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        cmp -s "$TMP/sr1.pfm" "$TMP/sr2.pfm" && ok "stochastic: same image on 1 and 2 threads" ||
+            fail "stochastic: same image on 1 and 2 threads"
+        p1=$(psnr_of "$TMP/ref.pfm" "$TMP/sr1.pfm") p2=$(psnr_of "$TMP/ref.pfm" "$TMP/srbig.pfm")
+        at_least "$p1" 45 && awk -v a="$p1" -v b="$p2" 'BEGIN { exit !(a != "" && b - a >= 1.5) }' &&
+            ok "stochastic Jacobi approaches classic with more rays (PSNR $p1 dB, $p2 dB at --sr-rays 100000)" ||
+            fail "stochastic Jacobi approaches classic with more rays" "PSNR $p1 dB, $p2 dB at --sr-rays 100000"
+    else
+        fail "stochastic renders" "$(head -c 300 "$TMP/err.txt")"
+    fi
 else
     fail "classic references for multibounce and temporal" "$(head -c 300 "$TMP/err.txt")"
 fi
@@ -525,10 +557,29 @@ if [ -s "$TMP/ref.pfm" ]; then
             fail "$vm renders the Cornell box" "$(head -c 300 "$TMP/err.txt")"
         fi
     done
+    # hierarchical: its timing line with the form-factor work, close to classic on 300 patches
+    if "$RAD" render cornell $M --method hierarchical --hr-eps 3e-3 -o "$TMP/hr.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        grep -q "timing: method=hierarchical patches=[0-9]* .*links=[0-9]* kernels=[0-9]* rays=[0-9]*" "$TMP/err.txt"; then
+        psnr_check "hierarchical renders the Cornell box close to classic" "$TMP/ref.pfm" "$TMP/hr.pfm" 30
+    else
+        fail "hierarchical renders the Cornell box" "$(head -c 300 "$TMP/err.txt")"
+    fi
     if "$RAD" render cornell $M --method aavp --vp-max-patches 300 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"; then
         np=$(grep -o 'timing: method=aavp patches=[0-9]*' "$TMP/err.txt" | cut -d= -f3)
         [ -n "$np" ] && [ "$np" -le 300 ] && [ "$np" -gt 100 ] && ok "aavp --vp-max-patches 300 gives $np patches (100 < n <= 300)" ||
             fail "aavp --vp-max-patches 300" "patches '$np'"
+        # the budget is met by counting (rad_vp_count) and one build, at the finest resolution
+        # within it: one step finer has more patches
+        r=$(grep -o 'resolution [0-9]* from [0-9]* counts' "$TMP/err.txt" | cut -d' ' -f2)
+        nb=$(grep -c 'aavp virtual patches at resolution' "$TMP/err.txt")
+        if [ -n "$r" ] && [ "$nb" = 1 ] &&
+            "$RAD" render cornell --size 8x8 --aa 1 --method aavp --vp-resolution $((r + 1)) -o "$TMP/x1.pfm" > /dev/null 2> "$TMP/err.txt"; then
+            n1=$(grep -o 'timing: method=aavp patches=[0-9]*' "$TMP/err.txt" | cut -d= -f3)
+            [ -n "$n1" ] && [ "$n1" -gt 300 ] && ok "aavp --vp-max-patches 300: one build, at the finest resolution ($r; $((r + 1)) gives $n1)" ||
+                fail "aavp --vp-max-patches 300 picks the finest resolution" "resolution $r, $((r + 1)) gives '$n1'"
+        else
+            fail "aavp --vp-max-patches 300: one build" "resolution '$r', $nb builds"
+        fi
     else
         fail "aavp --vp-max-patches 300 renders" "$(head -c 300 "$TMP/err.txt")"
     fi
@@ -550,6 +601,18 @@ bad "--vp-max-patches x" "--vp-max-patches" render cornell --method aavp --vp-ma
 bad "--face-points 5000" "--face-points must be in 1..4096" render cornell --method vp --face-points 5000 -o "$TMP/y.pfm"
 bad "bake --method aavp" "method 'aavp' is render-only" bake cornell --method aavp -o "$TMP/y.radb"
 bad "bake --method local" "method 'local' is render-only" bake cornell --method local -o "$TMP/y.radb"
+bad "--sr-rays with classic" "--sr-rays is for --method stochastic, not classic" render cornell --sr-rays 100 -o "$TMP/y.pfm"
+bad "--sr-estimator foo" "unknown --sr-estimator 'foo'" bake cornell --method stochastic --sr-estimator foo -o "$TMP/y.radb"
+bad "--sr-rays 0" "--sr-rays must be in 1.." render cornell --method stochastic --sr-rays 0 -o "$TMP/y.pfm"
+bad "--bounces with stochastic" "--bounces is for --method multibounce, not stochastic" render cornell --method stochastic --bounces 3 -o "$TMP/y.pfm"
+bad "--sr-iterations with vp" "--sr-iterations is not an option of --method vp" render cornell --method vp --sr-iterations 3 -o "$TMP/y.pfm"
+bad "bake --method hierarchical" "method 'hierarchical' is render-only" bake cornell --method hierarchical -o "$TMP/y.radb"
+bad "--hr-eps 2" "--hr-eps must be in (0, 1)" render cornell --method hierarchical --hr-eps 2 -o "$TMP/y.pfm"
+bad "--hr-rays 5" "--hr-rays must be a square" render cornell --method hierarchical --hr-rays 5 -o "$TMP/y.pfm"
+bad "--hr-min-area -1" "--hr-min-area must be a positive area" render cornell --method hierarchical --hr-min-area -1 -o "$TMP/y.pfm"
+bad "--hr-eps with classic" "--hr-eps is for --method hierarchical, not classic" render cornell --hr-eps 1e-3 -o "$TMP/y.pfm"
+bad "--bounces with hierarchical" "--bounces is not an option of --method hierarchical" render cornell --method hierarchical --bounces 3 -o "$TMP/y.pfm"
+bad "--vp-resolution with hierarchical" "--vp-resolution is not an option of --method hierarchical" render cornell --method hierarchical --vp-resolution 4 -o "$TMP/y.pfm"
 bad "--format bc5" "unknown --format 'bc5'" bake cornell --method multibounce --format bc5 -o "$TMP/y.radb"
 bad "--format with classic" "--format is for --method multibounce, not classic" bake cornell --format half -o "$TMP/y.radb"
 bad "--outliers with half" "--outliers is for the compressed formats" bake cornell --method multibounce --format half --outliers 0.1 -o "$TMP/y.radb"
@@ -826,6 +889,102 @@ if bash tools/report.sh --check "$TMP/rep" > /dev/null 2>&1; then
 else
     fail "report --check passes a full table"
 fi
+
+# ---- lights from the command line (tools/lights.c) -----------------------------------------
+# mean linear radiance of a PFM (little-endian floats after the three header lines)
+pfm_mean() {
+    local hdr
+    hdr=$(head -n 3 "$1" | wc -c)
+    tail -c +$((hdr + 1)) "$1" | od -An -v -f | awk '{ for (i = 1; i <= NF; ++i) { s += $i; n++ } } END { if (n) printf "%.6g\n", s / n }'
+}
+# The built-in box exported without its emitter: lit only by each light option in turn, rad
+# render (classic, 300 patches) and rad trace agree on the mean radiance within 5% (measured:
+# 1.5% or better for sun, sky and area, 1.4% point, 3.2% spot: the patches' indirect light of a
+# small bright spot is a little low at 300 patches). --fov 25 keeps the frame inside the box.
+"$RAD" export cornell -o "$TMP/dark.obj" > /dev/null 2>&1
+sed 's/^Ke .*/Ke 0 0 0/' "$TMP/dark.mtl" > "$TMP/dark.tmp" && mv "$TMP/dark.tmp" "$TMP/dark.mtl"
+while read -r name light; do
+    if "$RAD" render "$TMP/dark.obj" $light --fov 25 --size 24x24 --patches 300 --aa 64 -o "$TMP/l-r.pfm" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" trace "$TMP/dark.obj" $light --fov 25 --size 24x24 --spp 256 -o "$TMP/l-t.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        mr=$(pfm_mean "$TMP/l-r.pfm")
+        mt=$(pfm_mean "$TMP/l-t.pfm")
+        awk -v t="$mt" 'BEGIN { exit !(t + 0 > 0.01) }' && close "$mr" "$mt" 0.05 &&
+            grep -q "lights from the command line: .*1 $name" "$TMP/err.txt" &&
+            ok "$light: render and trace agree (mean radiance $mr and $mt)" ||
+            fail "$light: render and trace agree" "mean radiance $mr and $mt; $(grep 'command line' "$TMP/err.txt" | head -c 200)"
+    else
+        fail "$light: render and trace agree" "$(head -c 300 "$TMP/err.txt")"
+    fi
+done <<'EOF2'
+sun --sun 0.2,-0.5,1:2
+sky --sky 1
+point --point 0.278,0.45,0.28:0.5
+spot --spot 0.278,0.54,0.28:0,-1,0:20,35:1
+area --area 0.2,0.35,0.05:0.15,0,0:0,0.12,0:10
+EOF2
+# the sky is the radiance a ray that leaves the scene sees: rad render shows it like rad trace
+if "$RAD" render "$TMP/dark.obj" --sky 0.5,0.25,1 --size 16x16 --patches 50 --aa 1 --camera 0,0,-1:0,0,-2:0,1,0 \
+    -o "$TMP/sky.pfm" > /dev/null 2> "$TMP/err.txt"; then
+    v=$(pfm_mean "$TMP/sky.pfm")
+    close "$v" 0.583333 1e-4 && ok "render: a camera looking away from the scene sees the --sky radiance ($v)" ||
+        fail "render: a camera looking away from the scene sees the --sky radiance" "mean $v, want 0.583333"
+else
+    fail "render: a camera looking away from the scene sees the --sky radiance" "$(head -c 300 "$TMP/err.txt")"
+fi
+# a bake keeps its command-line lights: rendered with the same ones it fits, with others it is
+# refused by name
+if "$RAD" bake "$TMP/dark.obj" --patches 100 --sun 0.2,-0.5,1:2 -o "$TMP/sun.radb" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" render "$TMP/dark.obj" --bake "$TMP/sun.radb" --sun 0.2,-0.5,1:2 --size 8x8 --aa 1 -o "$TMP/sun.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+    "$RAD" render "$TMP/dark.obj" --bake "$TMP/sun.radb" --sun 0.2,-0.5,1:3 --size 8x8 --aa 1 -o "$TMP/sun2.pfm" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q -- "--sun" "$TMP/err.txt" && ok "render --bake refuses other command-line lights than the bake's" ||
+        fail "render --bake refuses other command-line lights than the bake's" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+else
+    fail "bake and render --bake with --sun" "$(head -c 300 "$TMP/err.txt")"
+fi
+# malformed light options: exit 2 with a message naming the option
+bad "--sun 0,0,0:1" "bad --sun '0,0,0:1': DIR is zero" render cornell --sun 0,0,0:1 -o "$TMP/y.pfm"
+bad "--sun without RGB" "bad --sun '0,-1,0': wrong number" trace cornell --sun 0,-1,0 -o "$TMP/y.pfm"
+bad "--sky -1" "bad --sky '-1': the RGB" bake cornell --sky -1 -o "$TMP/y.radb"
+bad "--point 1,2:3" "bad --point '1,2:3': POS" render cornell --point 1,2:3 -o "$TMP/y.pfm"
+bad "--spot 40,30" "bad --spot .*INNER < OUTER" render cornell --spot 0,1,0:0,-1,0:40,30:1 -o "$TMP/y.pfm"
+bad "--spot angle 0" "bad --spot .*OUTER must be in (0, 180\]" trace cornell --spot 0,1,0:0,-1,0:0:1 -o "$TMP/y.pfm"
+bad "--area without area" "bad --area .*U and V span no area" render cornell --area 0,0,0:1,0,0:2,0,0:1 -o "$TMP/y.pfm"
+bad "--point 1,2,x:1" "bad --point '1,2,x:1'" render cornell --point 1,2,x:1 -o "$TMP/y.pfm"
+bad "--sun with no value" "--sun needs a value" render cornell -o "$TMP/y.pfm" --sun
+
+# ---- the dense build's budget (tools/budget.c) ---------------------------------------------
+# a 40 x 40 grid of quads (3200 triangles): F needs at least 3200^2 x 4 bytes = 39 MiB, so a
+# 16 MiB limit refuses it before the patches are made, naming the virtual-patch methods
+awk 'BEGIN { n = 40; for (j = 0; j <= n; ++j) for (i = 0; i <= n; ++i) printf "v %d 0 %d\n", i, j;
+             for (j = 0; j < n; ++j) for (i = 0; i < n; ++i) { a = j * (n + 1) + i + 1; printf "f %d %d %d %d\n", a, a + n + 1, a + n + 2, a + 1 } }' > "$TMP/grid.obj"
+while IFS='|' read -r sub method want; do
+    case $sub in render) out="-o $TMP/g.pfm --size 8x8" ;; bake) out="-o $TMP/g.radb" ;; *) out= ;; esac
+    /usr/bin/env time -f %e -o "$TMP/time.txt" "$RAD" $sub "$TMP/grid.obj" $method --max-memory 16M $out > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q -- "$want a dense 3200 x 3200 form-factor matrix (at least one patch per triangle" "$TMP/err.txt" &&
+        grep -q "only 16 MiB may be used (--max-memory)" "$TMP/err.txt" && grep -q -- "--method aavp or --method vp" "$TMP/err.txt" &&
+        tail -n 1 "$TMP/time.txt" | awk '{ exit !($1 < 10) }' &&
+        ok "$sub $method --max-memory 16M refuses a 3200-triangle dense build at once ($(tail -n 1 "$TMP/time.txt") s)" ||
+        fail "$sub $method --max-memory 16M refuses a 3200-triangle dense build" "exit $rc: $(head -c 400 "$TMP/err.txt")"
+done <<'EOF2'
+render|--method classic|--method classic needs
+render|--method temporal|--method temporal needs
+bake|--method multibounce|--method multibounce needs
+formfactors|--ff analytic|the form factors need
+EOF2
+# the exact patch count is checked too: 32 triangles, --patches 3000 (about 3000 patches, 34 MiB)
+"$RAD" render cornell --patches 3000 --max-memory 16M --size 8x8 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "needs a dense [0-9]* x [0-9]* form-factor matrix ([0-9]* patches)" "$TMP/err.txt" &&
+    ok "render --patches 3000 --max-memory 16M is refused once the patches are counted" ||
+    fail "render --patches 3000 --max-memory 16M is refused once the patches are counted" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+"$RAD" render cornell --patches 50 --max-memory 16M --size 8x8 --aa 1 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" formfactors "$TMP/grid.obj" --patches 1 --max-memory 16M --force > /dev/null 2>> "$TMP/err.txt" &&
+    ok "a build within --max-memory runs, and --force runs one beyond it" ||
+    fail "a build within --max-memory runs, and --force runs one beyond it" "$(head -c 300 "$TMP/err.txt")"
+bad "--max-memory 12Q" "bad value '12Q' for --max-memory" render cornell --max-memory 12Q -o "$TMP/y.pfm"
+bad "--max-memory -1" "bad value '-1' for --max-memory" bake cornell --max-memory -1 -o "$TMP/y.radb"
 
 # ---- a new user's first runs: what the tool says ------------------------------------------
 "$RAD" help 2>&1 | grep -q 'local|vp|aavp' && ok "help lists every render method" || fail "help lists every render method"

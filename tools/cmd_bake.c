@@ -1,6 +1,6 @@
 /* cmd_bake.c - the classic radiosity solution (shared with rad render) and `rad bake`.
 
-   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal] [--solver jacobi|gauss-seidel|direct]
+   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic] [--solver jacobi|gauss-seidel|direct]
             [--bounces K] [--patches N] [--max-edge L] [--samples S] [--light-samples N]
             [method options, see methods.c] [--threads N]
 
@@ -12,7 +12,7 @@
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
    were made with, so `rad render --bake` can check that the file fits the scene (with the
    library's signature section, which also holds the hash of rad.options: rad_tool_sign_options).
-   --method multibounce and temporal bake through methods.c (rad_tool_method_bake). */
+   --method multibounce, temporal and stochastic bake through methods.c (rad_tool_method_bake). */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,14 +37,22 @@ const char *rad_tool_classic_help(void)
            "  --patches N        target patch count (default 2000)\n"
            "  --max-edge L       longest patch edge (default: no limit)\n"
            "  --samples S        form-factor points per patch pair (default 16, up to 256)\n"
-           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n";
+           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n"
+           "  --max-memory SIZE  refuse a dense N x N build estimated above SIZE (e.g. 8G; default: the\n"
+           "                     MemAvailable of /proc/meminfo); builds estimated over an hour are refused too\n"
+           "  --force            build it whatever the estimate\n";
 }
 
 int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o)
 {
     const char *opt = argv[*a];
-    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples"};
+    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples",
+                                        "--max-memory"};
     size_t i;
+    if (!strcmp(opt, "--force")) {
+        o->force = 1;
+        return 1;
+    }
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (!strcmp(opt, names[i])) break;
     if (i == sizeof names / sizeof names[0]) return 0;
@@ -76,6 +84,7 @@ int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_
         if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
         if (o->samples == 0) { fprintf(stderr, "rad %s: --samples must be > 0\n", cmd); return 2; }
         return 1;
+    case 6: return rad_tool_parse_bytes(cmd, opt, argv[*a], &o->max_memory) ? 2 : 1;
     default:
         if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
         if (o->light_samples == 0) { fprintf(stderr, "rad %s: --light-samples must be > 0\n", cmd); return 2; }
@@ -109,10 +118,16 @@ int rad_tool_classic_sources(const char *cmd, const rad_tool_world *w, const rad
     rad_patch_options_default(&po);
     po.target_count = o->patches;
     po.max_edge = o->max_edge;
+    /* at least one patch per triangle: a scene too big for F is refused before any work */
+    if (rad_tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
     if ((r = rad_patches_create(w->scene, &po, &ctx, &out->patches)) != RAD_SUCCESS)
         return rad_tool_fail(cmd, "rad_patches_create", r);
     n = out->patches->count;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w->scene->triangle_count, n);
+    if (rad_tool_dense_check(cmd, o, n, 0)) {
+        rad_tool_classic_free(out);
+        return 1;
+    }
     out->D = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     out->E = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     rad_direct_options_default(&dopt);
@@ -188,6 +203,7 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     double t0;
     clock_t c0;
     if (rad_tool_classic_sources(cmd, w, o, out)) return 1;
+    if (o->sources_only && o->no_form_factors) return 0;
     n = out->patches->count;
     t0 = rad_tool_seconds();
     c0 = clock();
@@ -225,18 +241,24 @@ void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, 
     info->triangle_count = w->scene->triangle_count;
 }
 
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info)
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w)
 {
-    return rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
+    uint64_t h = rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
+    /* the command line's lights, so that a bake lit by --sun is not rendered under another sun;
+       none leaves the hash of bakes made before those options unchanged */
+    if (w && w->file.light_count > w->file_light_count)
+        h = rad_tool_lights_hash(w->file.lights + w->file_light_count, w->file.light_count - w->file_light_count, h);
+    return h;
 }
 
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig)
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+                           rad_bake_signature *sig)
 {
     uint32_t i;
     for (i = 0; i < count; ++i)
         if (secs[i].type == RAD_SECTION_SIGNATURE && secs[i].elem_size == sizeof *sig && secs[i].count == 1) {
             memcpy(sig, secs[i].data, sizeof *sig);
-            sig->options = rad_tool_options_hash(info);
+            sig->options = rad_tool_options_hash(info, w);
             secs[i].data = sig;
         }
 }
@@ -267,7 +289,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     secs = (rad_section *)rad_tool_calloc((size_t)count + 4, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
     rad_tool_bake_info_fill(&info, w, o);
-    rad_tool_sign_options(secs, k, &info, &sig);
+    rad_tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->L;
     strcpy(secs[k++].name, "L");
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->H;
@@ -311,22 +333,25 @@ static int write_bytes(const char *cmd, const char *path, const void *data, size
 
 static void bake_usage(FILE *f)
 {
-    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal] [options]\n"
+    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic] [options]\n"
                "Computes patches, form factors and the patches' direct light E = rho D, then by method:\n"
                "  classic      the indirect solution L; saves patches, F, E, B = E + L (and L, H = F B, D)\n"
                "  multibounce  F_mb = sum_k (rho o F)^k, stored as float, half or compressed\n"
                "               (BC1, 3xBC4); saves patches, E, D, F's row sums and F_mb (no F)\n"
                "  temporal     alias tables over the rows of F (or of F_mb's channels); saves\n"
                "               patches, E, D, F's row sums and the tables (no F)\n"
+               "  stochastic   no F: L by stochastic Jacobi or random walks over rays; saves patches, E, D,\n"
+               "               row sums estimated by rays and L\n"
                "  -o FILE            output file (required)\n"
-               "  --method M         classic (default), multibounce or temporal\n"
+               "  --method M         classic (default), multibounce, temporal or stochastic\n"
+               "%s"
                "%s"
                "%s"
                "  --shard I/N        classic: bake part I of N (0 <= I < N) into FILE; rad merge joins the\n"
                "                     N parts into the bake itself (docs/distributed.md)\n"
                "  --rows A:B         classic: bake the part holding rows A to B-1 (instead of --shard)\n"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(0));
+            rad_tool_classic_help(), rad_tool_method_help(0), rad_tool_light_help());
 }
 
 int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_args *args)
@@ -342,6 +367,9 @@ int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_ar
         if (rc == 2) return 2;
         if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &args->o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        rc = rad_tool_light_option(cmd, argc, argv, &a, &args->lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--shard") || !strcmp(opt, "--rows")) &&
@@ -378,43 +406,50 @@ int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_ar
         return 2;
     }
     if (rad_tool_method_check(cmd, 0, &args->mo, &args->o)) return 2;
+    rad_tool_dense_plan(&args->o, &args->mo, 1);
     return -1;
 }
 
-int rad_cmd_bake(int argc, char **argv)
+static int bake_main(const char *cmd, rad_tool_bake_args *args)
 {
-    const char *cmd = "bake";
-    rad_tool_bake_args args;
     rad_tool_world w;
     rad_tool_classic c;
     double t0 = rad_tool_seconds();
-    int rc = rad_tool_bake_parse(cmd, argc, argv, &args);
-    if (rc >= 0) return rc;
-    if (rad_tool_check_output(cmd, args.out, &args.scene, 1)) return 1;
-    rad_tool_set_threads((int)args.threads);
-    if (rad_tool_open_world(cmd, args.scene, &w)) return 1;
-    if (args.mo.method != RAD_TOOL_CLASSIC || args.shard.rows || args.shard.count) {
+    int rc;
+    if (rad_tool_check_output(cmd, args->out, &args->scene, 1)) return 1;
+    rad_tool_set_threads((int)args->threads);
+    if (rad_tool_open_world_lit(cmd, args->scene, &args->lights, &w)) return 1;
+    if (args->mo.method != RAD_TOOL_CLASSIC || args->shard.rows || args->shard.count) {
         void *buf = NULL;
         size_t size = 0;
-        if (args.mo.method != RAD_TOOL_CLASSIC) rc = rad_tool_method_bake(cmd, &w, &args.o, &args.mo, &buf, &size);
-        else rc = rad_tool_bake_part(cmd, &w, &args.o, &args.shard, &buf, &size);
-        if (rc == 0) rc = write_bytes(cmd, args.out, buf, size);
+        if (args->mo.method != RAD_TOOL_CLASSIC) rc = rad_tool_method_bake(cmd, &w, &args->o, &args->mo, &buf, &size);
+        else rc = rad_tool_bake_part(cmd, &w, &args->o, &args->shard, &buf, &size);
+        if (rc == 0) rc = write_bytes(cmd, args->out, buf, size);
         if (rc == 0)
-            printf("wrote %s: %s, %lu bytes\n", args.out,
-                   args.mo.method != RAD_TOOL_CLASSIC ? rad_tool_method_name(args.mo.method) : "a part of a classic bake",
+            printf("wrote %s: %s, %lu bytes\n", args->out,
+                   args->mo.method != RAD_TOOL_CLASSIC ? rad_tool_method_name(args->mo.method) : "a part of a classic bake",
                    (unsigned long)size);
         free(buf);
         rad_tool_close_world(&w);
         if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
         return rc;
     }
-    if (rad_tool_classic_solve(cmd, &w, &args.o, &c)) {
+    if (rad_tool_classic_solve(cmd, &w, &args->o, &c)) {
         rad_tool_close_world(&w);
         return 1;
     }
-    rc = save_bake(cmd, args.out, &w, &args.o, &c);
+    rc = save_bake(cmd, args->out, &w, &args->o, &c);
     rad_tool_classic_free(&c);
     rad_tool_close_world(&w);
     if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    return rc;
+}
+
+int rad_cmd_bake(int argc, char **argv)
+{
+    rad_tool_bake_args args;
+    int rc = rad_tool_bake_parse("bake", argc, argv, &args);
+    if (rc < 0) rc = bake_main("bake", &args);
+    rad_tool_lights_free(&args.lights);
     return rc;
 }

@@ -51,11 +51,24 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
     uint32_t i;
     if (!s || s->elem_size != sizeof mi || s->count != 1) return 0;
     memcpy(&mi, s->data, sizeof mi);
-    if (mi.magic != RAD_TOOL_METHOD_MAGIC || (mi.method != RAD_TOOL_MULTIBOUNCE && mi.method != RAD_TOOL_TEMPORAL)) {
+    if (mi.magic != RAD_TOOL_METHOD_MAGIC ||
+        (mi.method != RAD_TOOL_MULTIBOUNCE && mi.method != RAD_TOOL_TEMPORAL && mi.method != RAD_TOOL_STOCHASTIC)) {
         fprintf(stderr, "rad info: the rad.method section is damaged\n");
         return 1;
     }
     bytes = (uint64_t)mi.bytes_lo | ((uint64_t)mi.bytes_hi << 32);
+    if (mi.method == RAD_TOOL_STOCHASTIC) { /* the record's fields as methods.c fills them for this method */
+        const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
+        printf("method: stochastic, --sr-estimator %s, --sr-rays %u, --sr-iterations %u, --seed %u\n"
+               "  solution 'L': %s, %llu rays, solved in %.2f s\n",
+               mi.mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", mi.k, mi.bounces, mi.seed,
+               ls && ls->elem_size == 12 ? "present" : "MISSING", (unsigned long long)bytes, (double)mi.build_seconds);
+        if (!ls || ls->elem_size != 12) {
+            fprintf(stderr, "rad info: the stochastic bake holds no vector L\n");
+            return 1;
+        }
+        return 0;
+    }
     if (mi.method == RAD_TOOL_MULTIBOUNCE) {
         static const char *const fmt[] = {"float", "half", "bc1", "bc4x3"};
         rad_multibounce *mb = NULL;

@@ -167,7 +167,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     secs = (rad_section *)rad_tool_calloc((size_t)count + 6, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[i] = *rad_container_section(ct, i);
     rad_tool_bake_info_fill(&info, w, o);
-    rad_tool_sign_options(secs, count, &info, &sig);
+    rad_tool_sign_options(secs, count, &info, w, &sig);
     k = count;
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = N, secs[k].data = c.D;
     strcpy(secs[k++].name, "D");
@@ -261,10 +261,6 @@ static int open_part(const char *cmd, const rad_tool_part *p, part_view *v)
     }
     v->info = (const rad_tool_bake_info *)s->data;
     v->sig = v->bake->signature;
-    if (v->sig->options != rad_tool_options_hash(v->info)) {
-        fprintf(stderr, "rad %s: %s: its rad.options record is not the one its signature was made with\n", cmd, p->name);
-        return 1;
-    }
     for (k = 0; k < 5; ++k) {
         v->keep[k] = rad_container_find(ct, keep_types[k], k >= 3 ? keep_names[k] : NULL);
         if (!v->keep[k]) {
@@ -322,7 +318,7 @@ static int same_bake(const char *cmd, const rad_tool_part *pa, const part_view *
                 (unsigned long long)(a->sig->geometry != b->sig->geometry ? b->sig->geometry : b->sig->materials));
         return 1;
     }
-    if (memcmp(x, y, sizeof *x)) {
+    if (memcmp(x, y, sizeof *x) || a->sig->options != b->sig->options) {
         char what[160];
         if (x->patches != y->patches) sprintf(what, "--patches %u vs %u", x->patches, y->patches);
         else if (x->max_edge != y->max_edge) sprintf(what, "--max-edge %g vs %g", (double)x->max_edge, (double)y->max_edge);
@@ -331,7 +327,7 @@ static int same_bake(const char *cmd, const rad_tool_part *pa, const part_view *
         else if (x->bounces != y->bounces) sprintf(what, "--bounces %u vs %u", x->bounces, y->bounces);
         else if (x->light_samples != y->light_samples)
             sprintf(what, "--light-samples %u vs %u", x->light_samples, y->light_samples);
-        else sprintf(what, "the rad.options records");
+        else sprintf(what, "the lights given on the command line, or the rad.options records");
         fprintf(stderr, "rad %s: %s and %s were baked with different options (%s)\n", cmd, pa->name, pb->name, what);
         return 1;
     }

@@ -55,11 +55,12 @@ static void *xmalloc(size_t size)
 static void render_usage(FILE *f)
 {
     fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|pathtrace] [options]\n"
+            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace] [options]\n"
             "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
             "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
             "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
-            "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches)\n"
+            "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
+            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991)\n"
             "  --bake FILE.radb   classic, multibounce, temporal: use a bake of that method made by\n"
             "                     'rad bake' from this scene instead of computing it here\n"
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
@@ -80,50 +81,19 @@ static void render_usage(FILE *f)
             "patch and classic solution options (ignored with --bake, which keeps its own):\n"
             "%s"
             "%s"
+            "%s"
             "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(1));
+            rad_tool_classic_help(), rad_tool_method_help(1), rad_tool_light_help());
 }
 
-/* Per-vertex H, with the halo fix of examples/cornell.c step 7: a patch partly covered (under
-   the light, under a block) has a small H only because part of it sees nothing; H is
-   interpolated as (mean radiosity seen) x (how much is seen, from uncovered patches).
+/* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
    S: the row sums of F (how much of its hemisphere each patch sees). */
 static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv)
 {
-    uint32_t n = P->count, nv = P->vertex_count, i, k;
-    float *S_v = (float *)xmalloc(sizeof(float) * nv);
-    float *S_max = (float *)xmalloc(sizeof(float) * nv), *S_area = (float *)xmalloc(sizeof(float) * nv);
+    rad_context ctx;
     rad_result r;
-    r = rad_patches_vertex_values(P, H, 3, Hv);
-    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(P, S, 1, S_v);
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[i].vertices[k];
-                if (S[i] > S_max[v]) S_max[v] = S[i];
-            }
-        for (i = 0; i < nv; ++i) {
-            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
-            Hv[3 * i] *= scale, Hv[3 * i + 1] *= scale, Hv[3 * i + 2] *= scale;
-            S_v[i] = 0.0f;
-        }
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[i].vertices[k];
-                if (S[i] >= 0.75f * S_max[v]) {
-                    S_v[v] += P->patches[i].area * S[i];
-                    S_area[v] += P->patches[i].area;
-                }
-            }
-        for (i = 0; i < nv; ++i) {
-            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
-            Hv[3 * i] *= s_v, Hv[3 * i + 1] *= s_v, Hv[3 * i + 2] *= s_v;
-        }
-    }
-    free(S_v);
-    free(S_max);
-    free(S_area);
+    rad_tool_context(&ctx, NULL);
+    r = rad_patches_vertex_irradiance(P, H, S, Hv, &ctx);
     return r == RAD_SUCCESS ? 0 : rad_tool_fail("render", "per-vertex H", r);
 }
 
@@ -167,6 +137,9 @@ static int render_shading = -1;
 static const rad_virtual_patches *render_vp = NULL;
 static const float *render_vp_H = NULL;
 static double render_vp_gather_seconds = 0.0;
+/* --method hierarchical: render_classic looks H up at each sample's hit (smooth, halo-fixed) */
+static const rad_hierarchical *render_hr = NULL;
+static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out);
 /* --final-gather N: rays per pixel sample for one traced bounce (0: off; rad_final_gather) */
 static uint32_t render_final_gather = 0;
 
@@ -187,6 +160,7 @@ static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *poi
         rad_tool_context(&quiet, NULL);
         return rad_vp_gather(render_vp, render_vp_H, points, normals, count, out, &quiet);
     }
+    if (render_hr) return hr_lookup(hits, NULL, count, out);
     for (k = 0; k < count; ++k) {
         float wts[3];
         uint32_t p = rad_patches_locate(l->P, hits[k].triangle, hits[k].b1, hits[k].b2, wts);
@@ -198,6 +172,24 @@ static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *poi
                              wts[2] * l->Hv[3 * (size_t)vi[2] + i];
     }
     return RAD_SUCCESS;
+}
+
+/* H of the hierarchical solution at hits[valid[k]] (valid NULL: hits[k]), k < count */
+static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out)
+{
+    uint32_t *tris = (uint32_t *)xmalloc(sizeof(uint32_t) * (count ? count : 1u)), k;
+    float *bary = (float *)xmalloc(sizeof(float) * 2 * (count ? count : 1u));
+    rad_result r;
+    for (k = 0; k < count; ++k) {
+        const rad_hit *h = &hits[valid ? valid[k] : k];
+        tris[k] = h->triangle;
+        bary[2 * k] = h->b1;
+        bary[2 * k + 1] = h->b2;
+    }
+    r = rad_hierarchical_lookup(render_hr, RAD_HIERARCHICAL_GATHERED, 1, tris, bary, count, out);
+    free(tris);
+    free(bary);
+    return r;
 }
 
 static int render_classic(const rad_tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
@@ -213,6 +205,8 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     rad_direct_options dopt;
     rad_context quiet;
     int y0, rows_per_batch, result = 0;
+    float sky[3] = {0.0f, 0.0f, 0.0f};
+    uint32_t k, i;
     for (strata = 1; (strata + 1) * (strata + 1) <= aa; ++strata) {
     }
     spp = strata * strata;
@@ -225,7 +219,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
-    if (render_vp || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    if (render_vp || render_hr || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     if (render_shading >= 0) {
         shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
         shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
@@ -235,10 +229,14 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     dopt.include_emitters = 1;
     dopt.light_samples = light_samples;
     rad_tool_context(&quiet, NULL);
+    /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
+    for (k = 0; k < w->file.light_count; ++k)
+        if (w->file.lights[k].type == RAD_LIGHT_SKY)
+            for (i = 0; i < 3; ++i) sky[i] += w->file.lights[k].color[i] / PI_F;
 
     for (y0 = 0; y0 < height && result == 0; y0 += rows_per_batch) {
         int y1 = y0 + rows_per_batch < height ? y0 + rows_per_batch : height, chunk, nchunks;
-        uint32_t count = 0, nvalid = 0, k, i;
+        uint32_t count = 0, nvalid = 0;
         int x, y;
         uint32_t s;
         rad_result r;
@@ -268,7 +266,12 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
         for (k = 0; k < count; ++k) {
             uint32_t t = hits[k].triangle;
             const float *v, *nt;
-            if (t == RAD_NONE) continue;
+            if (t == RAD_NONE || t >= scene->triangle_count) {
+                size_t pixel = (size_t)y0 * width + k / spp;
+                for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
+                hits[k].triangle = RAD_NONE;
+                continue;
+            }
             nt = scene->normals + 3 * (size_t)t;
             if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] >= 0.0f) {
                 hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
@@ -307,7 +310,8 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
             }
         } else if (gathered && nvalid > 0) {
             double tg = rad_tool_seconds();
-            r = rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
+            r = render_hr ? hr_lookup(hits, valid, nvalid, gathered)
+                          : rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
             render_vp_gather_seconds += rad_tool_seconds() - tg;
             if (r != RAD_SUCCESS) {
                 result = rad_tool_fail("render", "rad_vp_gather", r);
@@ -387,8 +391,17 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
     rad_result r;
     int rc = 0;
     rad_tool_context(&ctx, NULL);
-    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info) : 0u, &ctx)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)\n", cmd, bake_path, rad_result_string(r));
+    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info, w) : 0u, &ctx)) != RAD_SUCCESS) {
+        /* the same options without this command line's lights: then only the lights differ */
+        rad_tool_world bare = *w;
+        bare.file_light_count = w->file.light_count;
+        if (info && rad_bake_matches_scene(bake, w->scene, rad_tool_options_hash(info, &bare), NULL) == RAD_SUCCESS)
+            fprintf(stderr, "rad %s: bake '%s' was made with other lights than this command line's --sun, --sky, "
+                            "--point and --spot: give the bake's light options, or render without --bake\n",
+                    cmd, bake_path);
+        else
+            fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)%s\n", cmd, bake_path, rad_result_string(r),
+                    info ? "; the options hash covers --sun, --sky, --point and --spot: give the bake's own" : "");
         rc = 1;
     } else if (info) {
         /* the same patch options on this scene must give the same patches */
@@ -468,7 +481,7 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
         if (mo->method == RAD_TOOL_TEMPORAL)
             fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
                     cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
-        else
+        else if (mo->method == RAD_TOOL_MULTIBOUNCE)
             fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
         rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
     }
@@ -502,9 +515,10 @@ static int render_with_method(const char *cmd, const rad_tool_world *w, const ch
     int rc;
     rad_tool_context(&ctx, NULL);
     if (bake_path) {
-        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE))
-            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile "
-                            "and --mode; those given here are ignored\n",
+        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_SR |
+                         (mo->method == RAD_TOOL_STOCHASTIC ? RAD_TOOL_OPT_SEED : 0u)))
+            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile, "
+                            "--mode, --sr-* (and the stochastic solve's --seed); those given here are ignored\n",
                     cmd, bake_path);
         if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
             fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
@@ -568,6 +582,24 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
     return vp;
 }
 
+/* the patch count rad_vp_create would give at 'resolution' (rad_vp_count); 0 or 1 (printed) */
+static int vp_count(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo, uint32_t resolution,
+                    uint32_t *count)
+{
+    rad_vp_options vo;
+    rad_vp_counts cnt;
+    rad_context ctx;
+    rad_result r;
+    rad_vp_options_default(&vo);
+    vo.resolution = resolution;
+    vo.face_points = mo->face_points;
+    if (mo->method == RAD_TOOL_VP) vo.kind = RAD_VP_CLUSTERED;
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_vp_count", r);
+    *count = cnt.patches;
+    return 0;
+}
+
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
@@ -583,44 +615,37 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     rad_context ctx;
     rad_result r;
     float *E = NULL, *L = NULL, *B = NULL, *H = NULL;
-    uint32_t n, i, res = mo->vp_resolution, builds = 0;
+    uint32_t n, i, res = mo->vp_resolution;
     double t0 = rad_tool_seconds(), t_build, t_E, t_solve;
     int rc = 0;
     if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
-        /* the patch count grows about as R^2 (surface voxels): predict, build, correct */
-        uint32_t best_res = 0, lo = 1, hi = 1025;
-        rad_virtual_patches *best = NULL;
-        res = 4;
-        while (builds < 6 && lo < hi) {
-            rad_virtual_patches *t = vp_build(cmd, w, mo, res);
-            uint32_t count, next;
-            ++builds;
-            if (!t) {
-                rad_vp_destroy(best);
-                return 1;
-            }
-            count = t->count;
-            if (count <= mo->vp_max_patches) {
-                rad_vp_destroy(best);
-                best = t, best_res = res, lo = res + 1;
-            } else {
-                rad_vp_destroy(t);
-                hi = res;
-            }
-            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(count ? count : 1)) * 0.97);
-            if (next < lo) next = lo;
+        /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build
+           up to the patches, without the form factors that take nearly all of its time), then
+           one build. The count grows about as R^2 (surface voxels): predict from the nearest
+           count, count, narrow the bracket [lo, hi) to adjacent resolutions. */
+        uint32_t lo = 0, hi = 4097, counts = 0, c = 0;
+        double tc = rad_tool_seconds();
+        res = mo->vp_resolution ? mo->vp_resolution : 16;
+        while (counts < 24 && hi - lo > 1) {
+            uint32_t next;
+            if (vp_count(cmd, w, mo, res, &c)) return 1;
+            ++counts;
+            if (c <= mo->vp_max_patches) lo = res;
+            else hi = res;
+            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(c ? c : 1)));
+            if (next <= lo) next = lo + 1;
             if (next >= hi) next = hi - 1;
-            if (next < lo) break;
             res = next;
         }
-        if (!best) {
+        if (lo == 0) {
             fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd,
                     mo->vp_max_patches);
             return 1;
         }
-        vp = best, res = best_res;
-        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u (%u patches) after %u builds\n", cmd,
-                mo->vp_max_patches, res, vp->count, builds);
+        res = lo;
+        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd,
+                mo->vp_max_patches, res, counts, rad_tool_seconds() - tc);
+        if (!(vp = vp_build(cmd, w, mo, res))) return 1;
     } else if (!(vp = vp_build(cmd, w, mo, res))) {
         return 1;
     }
@@ -683,6 +708,32 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const rad_
     free(B);
     free(H);
     rad_vp_destroy(vp);
+    return rc;
+}
+
+/* --method hierarchical: the solution (rad_tool_hierarchical_build), then the classic render
+   with H looked up at each sample */
+static int render_hr_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                            const rad_tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
+                            uint32_t light_samples, rad_image *img)
+{
+    rad_hierarchical *h = NULL;
+    rad_hierarchical_stats st;
+    double t0 = rad_tool_seconds(), t_solve;
+    int rc;
+    if (rad_tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) return 1;
+    t_solve = rad_tool_seconds() - t0;
+    rad_hierarchical_get_stats(h, &st);
+    render_hr = h;
+    t0 = rad_tool_seconds();
+    rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
+    render_hr = NULL;
+    if (rc == 0)
+        fprintf(stderr, "rad %s: timing: method=hierarchical patches=%u frames=1 step_ms_median=%.6f step_ms_min=%.6f "
+                        "links=%llu kernels=%llu rays=%llu render_ms=%.1f\n",
+                cmd, st.leaves, 1e3 * t_solve, 1e3 * t_solve, (unsigned long long)st.links,
+                (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, 1e3 * (rad_tool_seconds() - t0));
+    rad_hierarchical_destroy(h);
     return rc;
 }
 
@@ -777,7 +828,7 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
     return rc;
 }
 
-int rad_cmd_render(int argc, char **argv)
+static int render_main(int argc, char **argv, rad_tool_lights *lights)
 {
     const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
     rad_tool_classic_options o;
@@ -800,6 +851,9 @@ int rad_cmd_render(int argc, char **argv)
         if (rc == 2) return 2;
         if (rc == 1) continue;
         rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        rc = rad_tool_light_option(cmd, argc, argv, &a, lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if (opt[0] == '-' && opt[1] && a + 1 >= argc) {
@@ -854,6 +908,7 @@ int rad_cmd_render(int argc, char **argv)
         return 2;
     }
     if (rad_tool_method_check(cmd, 1, &mo, &o)) return 2;
+    rad_tool_dense_plan(&o, &mo, 0);
     method = rad_tool_method_name(mo.method);
     seed = mo.seed;
     pathtrace = mo.method == RAD_TOOL_PATHTRACE;
@@ -884,7 +939,7 @@ int rad_cmd_render(int argc, char **argv)
         if (rad_tool_check_output(cmd, out_path, inputs, 2)) return 1;
     }
     rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
     {
         uint32_t t, emitters = 0;
         for (t = 0; t < w.scene->triangle_count; ++t) {
@@ -893,7 +948,8 @@ int rad_cmd_render(int argc, char **argv)
         }
         if (!emitters && !w.file.light_count)
             fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL) && !pathtrace && !bake_path &&
+        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC) &&
+            !pathtrace && !bake_path &&
             o.patches < w.scene->triangle_count)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                     cmd, o.patches, w.scene->triangle_count);
@@ -910,15 +966,16 @@ int rad_cmd_render(int argc, char **argv)
     }
 
     if (mo.method >= RAD_TOOL_LOCAL) {
-        rc = mo.method == RAD_TOOL_LOCAL
-                 ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
+        rc = mo.method == RAD_TOOL_LOCAL ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
+             : mo.method == RAD_TOOL_HIERARCHICAL
+                 ? render_hr_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
                  : render_vp_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
         if (rc) {
             rad_image_free(&img);
             rad_tool_close_world(&w);
             return 1;
         }
-    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL) {
+    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_STOCHASTIC) {
         rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                 &img);
         if (rc) {
@@ -1026,4 +1083,14 @@ int rad_cmd_render(int argc, char **argv)
     rad_image_free(&img);
     rad_tool_close_world(&w);
     return 0;
+}
+
+int rad_cmd_render(int argc, char **argv)
+{
+    rad_tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = render_main(argc, argv, &lights);
+    rad_tool_lights_free(&lights);
+    return rc;
 }

@@ -2,7 +2,9 @@
 
    rad trace SCENE [--camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ] [--fov DEG] [--size WxH] [--spp N]
                    [--seed S] [--max-depth N] [--rr-depth N] [--threads N] [--exposure X]
-                   -o OUT.pfm|OUT.png */
+                   [--sun DIR:RGB] [--sky RGB] [--point POS:RGB] [--spot POS:DIR:ANGLES:RGB]
+                   [--area P:U:V:RGB] -o OUT.pfm|OUT.png
+   The lights options (lights.c) add to the file's lights exactly as in rad render. */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,7 +27,8 @@ static void trace_usage(FILE *f)
                "  --rr-depth N       Russian roulette from this bounce on (default 16)\n"
                "  --threads N        worker threads (default: all cores; at most 1024)\n"
                "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
-               "  -o FILE            .pfm (linear float radiance) or .png (8-bit sRGB)\n");
+               "  -o FILE            .pfm (linear float radiance) or .png (8-bit sRGB)\n"
+               "%s", rad_tool_light_help());
 }
 
 static double trace_now(void)
@@ -48,7 +51,7 @@ static int parse_int(const char *s, long lo, long hi, long *out)
     return 0;
 }
 
-int rad_cmd_trace(int argc, char **argv)
+static int trace_main(int argc, char **argv, rad_tool_lights *lights)
 {
     const char *scene_path = NULL, *out_path = NULL, *camera_text = NULL;
     rad_trace_options opt;
@@ -65,6 +68,8 @@ int rad_cmd_trace(int argc, char **argv)
     rad_image img = { 0, 0, NULL };
     rad_result r;
     double t0, t1;
+    void *light_storage = NULL;
+    int lr;
 
     rad_trace_options_default(&opt);
     for (i = 0; i < argc; ++i) {
@@ -72,7 +77,11 @@ int rad_cmd_trace(int argc, char **argv)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             trace_usage(stdout);
             return 0;
-        } else if (a[0] != '-' || !a[1]) {
+        }
+        lr = rad_tool_light_option("trace", argc, argv, &i, lights);
+        if (lr == 2) return 2;
+        if (lr == 1) continue;
+        if (a[0] != '-' || !a[1]) {
             if (scene_path) {
                 fprintf(stderr, "rad trace: more than one scene ('%s' and '%s')\n", scene_path, a);
                 return 2;
@@ -163,11 +172,16 @@ int rad_cmd_trace(int argc, char **argv)
         fprintf(stderr, "rad trace: %s\n", err);
         return 1;
     }
+    if (rad_tool_add_lights("trace", &ts, lights, &light_storage)) {
+        rad_tool_free_scene(&ts);
+        return 1;
+    }
     if (camera_text) {
         memset(&cam, 0, sizeof(cam));
         if (rad_tool_parse_camera(camera_text, &cam) != 0) {
             fprintf(stderr, "rad trace: --camera wants PX,PY,PZ:TX,TY,TZ:UX,UY,UZ, got '%s'\n", camera_text);
             rad_tool_free_scene(&ts);
+            rad_tool_lights_release(light_storage);
             return 2;
         }
         cam.fov_y_degrees = fov > 0.0f ? fov : (ts.has_camera ? ts.camera.fov_y_degrees : 45.0f);
@@ -227,5 +241,16 @@ done:
     rad_bvh_destroy(bvh);
     rad_scene_destroy(scene);
     rad_tool_free_scene(&ts);
+    rad_tool_lights_release(light_storage);
     return code;
+}
+
+int rad_cmd_trace(int argc, char **argv)
+{
+    rad_tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = trace_main(argc, argv, &lights);
+    rad_tool_lights_free(&lights);
+    return rc;
 }

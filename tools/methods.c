@@ -58,9 +58,11 @@ const char *rad_tool_method_name(rad_tool_method method)
     case RAD_TOOL_MULTIBOUNCE: return "multibounce";
     case RAD_TOOL_TEMPORAL: return "temporal";
     case RAD_TOOL_PATHTRACE: return "pathtrace";
+    case RAD_TOOL_STOCHASTIC: return "stochastic";
     case RAD_TOOL_LOCAL: return "local";
     case RAD_TOOL_VP: return "vp";
     case RAD_TOOL_AAVP: return "aavp";
+    case RAD_TOOL_HIERARCHICAL: return "hierarchical";
     default: return "classic";
     }
 }
@@ -76,9 +78,21 @@ static const char *mode_name(uint32_t m)
     return m == RAD_TEMPORAL_SINGLE ? "single" : m == RAD_TEMPORAL_MULTIBOUNCE ? "multibounce" : "feedback";
 }
 
+static const char stochastic_help[] =
+    "stochastic (stochastic radiosity: the classic patches and E, no F; rays sample it, so the\n"
+    "solution is noisy and the noise falls as 1/sqrt(rays); docs/methods/stochastic.md):\n"
+    "  --sr-estimator E   jacobi (default: stochastic Jacobi, shooting) or walk (random walks,\n"
+    "                     collision estimator)\n"
+    "  --sr-rays N        rays of the first Jacobi iteration, later ones in proportion to their\n"
+    "                     power; walks per batch (default 64 per patch)\n"
+    "  --sr-iterations N  Jacobi: shooting iterations at most (default 256; they stop when the\n"
+    "                     unshot power is below 1e-4 of the source); walk: batches averaged (default 1)\n"
+    "  --seed S           generator seed (default 0; same seed, same image on any thread count)\n";
+
 const char *rad_tool_method_help(int render)
 {
-    return render ? "multibounce and temporal (without --bake: baked here first; with --bake the bake's own):\n"
+    static char buf[8192];
+    snprintf(buf, sizeof buf, render ? "multibounce and temporal (without --bake: baked here first; with --bake the bake's own):\n"
                     "  --bounces K|inf    multibounce, temporal --mode multibounce: bounces of the patch solution\n"
                     "                     (as classic: the image of K equals classic --bounces K; default 64)\n"
                     "  --format F         multibounce: F_mb storage float, half, bc1 or bc4x3 (default)\n"
@@ -95,7 +109,7 @@ const char *rad_tool_method_help(int render)
                     "  --adaptive         per-patch blend weight from the estimator's variance (the default: B is\n"
                     "                     the running mean of the frames at first, so it converges fast)\n"
                     "  --w W              a fixed blend weight in [0, 1) instead (B starts at 0 and reaches\n"
-                    "                     1 - W^N of the solution after N frames: W 0.998 needs ~2300 for 99%)\n"
+                    "                     1 - W^N of the solution after N frames: W 0.998 needs ~2300 for 99%%)\n"
                     "  --seed S           generator seed (default 0; also the path tracer's seed)\n"
                     "  --sequence DIR     also write DIR/frame_NNNNN.png every --every N frames (default 1)\n"
                     "vp (clustered virtual patches) and aavp (axis-aligned virtual patches); any mesh size, no\n"
@@ -111,6 +125,12 @@ const char *rad_tool_method_help(int render)
                     "                     up to 4096: T takes 12 M^2 bytes, 192 MiB at 4096, and its rebuild\n"
                     "                     6 M^3 flops). L = T E over P_Vis x P_Lit: patches outside S (or not\n"
                     "                     visible) get no indirect light and light outside S is not bounced\n"
+                    "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement, solved\n"
+                    "to convergence; --patches etc. and --bounces are not used; render only):\n"
+                    "  --hr-eps E         refinement tolerance, a fraction of the source power (default 1e-5)\n"
+                    "  --hr-min-area A    smallest element area, scene units^2 (default: total area / 10000)\n"
+                    "  --hr-rays R        points and visibility rays per link: 1, 4, 9 ... 64 (default 4)\n"
+                    "%s"
                   : "multibounce:\n"
                     "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
                     "                     the renderer's gather; default 64)\n"
@@ -125,7 +145,9 @@ const char *rad_tool_method_help(int render)
                     "  --k K              draws per patch and frame (default 10)\n"
                     "  --adaptive         per-patch blend weight from the estimator's variance (default)\n"
                     "  --w W              a fixed blend weight in [0, 1) instead of the adaptive one\n"
-                    "  --seed S           generator seed (default 0)\n";
+                    "  --seed S           generator seed (default 0)\n"
+                    "%s", stochastic_help);
+    return buf;
 }
 
 int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo)
@@ -136,6 +158,63 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
                                         "--adaptive"};
     const char *opt = argv[*a], *v;
     size_t i;
+    if (!strcmp(opt, "--sr-rays") || !strcmp(opt, "--sr-iterations") || !strcmp(opt, "--sr-estimator")) {
+        int which = opt[5] == 'r' ? 0 : opt[5] == 'i' ? 1 : 2;
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+            return 2;
+        }
+        v = argv[++*a];
+        if (which == 2) {
+            if (!strcmp(v, "jacobi")) mo->sr_estimator = RAD_STOCHASTIC_JACOBI;
+            else if (!strcmp(v, "walk")) mo->sr_estimator = RAD_STOCHASTIC_WALK;
+            else {
+                fprintf(stderr, "rad %s: unknown --sr-estimator '%s' (jacobi or walk)\n", cmd, v);
+                return 2;
+            }
+        } else {
+            uint32_t *dst = which ? &mo->sr_iterations : &mo->sr_rays, hi = which ? 1000000u : (1u << 26);
+            if (rad_tool_parse_uint(cmd, opt, v, dst)) return 2;
+            if (*dst == 0 || *dst > hi) {
+                fprintf(stderr, "rad %s: %s must be in 1..%u, not %s\n", cmd, opt, hi, v);
+                return 2;
+            }
+        }
+        mo->given |= RAD_TOOL_OPT_SR_RAYS << which;
+        return 1;
+    }
+    if (!strcmp(opt, "--hr-eps") || !strcmp(opt, "--hr-min-area") || !strcmp(opt, "--hr-rays")) {
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+            return 2;
+        }
+        v = argv[++*a];
+        if (opt[5] == 'r') {
+            uint32_t n = 1;
+            if (rad_tool_parse_uint(cmd, opt, v, &mo->hr_rays)) return 2;
+            while (n * n < mo->hr_rays) ++n;
+            if (mo->hr_rays == 0 || mo->hr_rays > 64 || n * n != mo->hr_rays) {
+                fprintf(stderr, "rad %s: --hr-rays must be a square from 1 to 64 (1, 4, 9 ...), not %s\n", cmd, v);
+                return 2;
+            }
+            mo->given |= RAD_TOOL_OPT_HR_RAYS;
+        } else if (opt[5] == 'e') {
+            if (rad_tool_parse_float(cmd, opt, v, &mo->hr_eps)) return 2;
+            if (!(mo->hr_eps > 0.0f && mo->hr_eps < 1.0f)) {
+                fprintf(stderr, "rad %s: --hr-eps must be in (0, 1) (e.g. 1e-3), not %s\n", cmd, v);
+                return 2;
+            }
+            mo->given |= RAD_TOOL_OPT_HR_EPS;
+        } else {
+            if (rad_tool_parse_float(cmd, opt, v, &mo->hr_min_area)) return 2;
+            if (!(mo->hr_min_area > 0.0f) || mo->hr_min_area > 1e30f) {
+                fprintf(stderr, "rad %s: --hr-min-area must be a positive area, not %s\n", cmd, v);
+                return 2;
+            }
+            mo->given |= RAD_TOOL_OPT_HR_MIN_AREA;
+        }
+        return 1;
+    }
     {
         static const char *const extra[] = {"--vp-resolution", "--vp-max-patches", "--face-points", "--local-m"};
         for (i = 0; i < 4; ++i)
@@ -180,9 +259,11 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         else if (!strcmp(v, "local")) mo->method = RAD_TOOL_LOCAL;
         else if (!strcmp(v, "vp")) mo->method = RAD_TOOL_VP;
         else if (!strcmp(v, "aavp")) mo->method = RAD_TOOL_AAVP;
+        else if (!strcmp(v, "stochastic")) mo->method = RAD_TOOL_STOCHASTIC;
+        else if (!strcmp(v, "hierarchical")) mo->method = RAD_TOOL_HIERARCHICAL;
         else {
-            fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal%s)\n", cmd, v,
-                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp or aavp");
+            fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal, stochastic%s)\n", cmd, v,
+                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp, aavp or hierarchical");
             return 2;
         }
         mo->given |= RAD_TOOL_OPT_METHOD;
@@ -292,7 +373,9 @@ static const char *given_name(uint32_t bits)
     static const char *const names[] = {"--bounces", "--format", "--outliers", "--reorder/--no-reorder",
                                         "--reorder-samples", "--tile", "--mode", "--k", "--w", "--adaptive",
                                         "--seed", "--frames", "--sequence", "--every", "--method",
-                                        "--vp-resolution", "--vp-max-patches", "--face-points", "--local-m"};
+                                        "--vp-resolution", "--vp-max-patches", "--face-points", "--local-m",
+                                        "--sr-rays", "--sr-iterations", "--sr-estimator",
+                                        "--hr-eps", "--hr-min-area", "--hr-rays"};
     uint32_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (bits & (1u << i)) return names[i];
@@ -310,17 +393,23 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
     if (!render && mo->method >= RAD_TOOL_LOCAL) {
         fprintf(stderr, "rad %s: method '%s' is render-only (rad render --method %s builds it in memory: %s)\n", cmd,
                 rad_tool_method_name(mo->method), rad_tool_method_name(mo->method),
-                mo->method == RAD_TOOL_LOCAL ? "its matrix depends on the camera; a classic bake holds its F"
-                                             : "the container has no section for virtual patches yet");
+                mo->method == RAD_TOOL_LOCAL          ? "its matrix depends on the camera; a classic bake holds its F"
+                : mo->method == RAD_TOOL_HIERARCHICAL ? "the container has no section for quadtrees and links yet"
+                                                      : "the container has no section for virtual patches yet");
         return 2;
     }
     if (mo->method >= RAD_TOOL_LOCAL) {
-        uint32_t other = mo->method == RAD_TOOL_LOCAL ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES : RAD_TOOL_OPT_LOCAL_M;
-        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED | other);
+        uint32_t other = mo->method == RAD_TOOL_LOCAL          ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_HR
+                         : mo->method == RAD_TOOL_HIERARCHICAL ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_LOCAL_M
+                                                               : RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR;
+        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED |
+                   RAD_TOOL_OPT_SR | other);
         if (bad) {
             fprintf(stderr, "rad %s: %s is not an option of --method %s%s\n", cmd, given_name(bad),
                     rad_tool_method_name(mo->method),
-                    mo->method == RAD_TOOL_LOCAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (T is the full solution in the set)" : "");
+                    mo->method == RAD_TOOL_LOCAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (T is the full solution in the set)"
+                    : mo->method == RAD_TOOL_HIERARCHICAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (it solves to convergence)"
+                                                                                          : "");
             return 2;
         }
         if ((g & RAD_TOOL_OPT_VP_RESOLUTION) && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
@@ -329,9 +418,16 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
         }
         return 0;
     }
-    if (g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M)) {
-        fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd, given_name(g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M)),
-                (g & RAD_TOOL_OPT_VP) ? "vp or aavp" : "local", rad_tool_method_name(mo->method));
+    if (g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR)) {
+        fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd,
+                given_name(g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR)),
+                (g & RAD_TOOL_OPT_VP) ? "vp or aavp" : (g & RAD_TOOL_OPT_LOCAL_M) ? "local" : "hierarchical",
+                rad_tool_method_name(mo->method));
+        return 2;
+    }
+    if ((g & RAD_TOOL_OPT_SR) && mo->method != RAD_TOOL_STOCHASTIC) {
+        fprintf(stderr, "rad %s: %s is for --method stochastic, not %s\n", cmd, given_name(g & RAD_TOOL_OPT_SR),
+                rad_tool_method_name(mo->method));
         return 2;
     }
     if (!render && mo->method == RAD_TOOL_PATHTRACE) {
@@ -356,6 +452,10 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
     case RAD_TOOL_MULTIBOUNCE:
         bad = g & (RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED);
         want = "temporal";
+        break;
+    case RAD_TOOL_STOCHASTIC:
+        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY);
+        want = (bad & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES)) ? "multibounce" : "temporal";
         break;
     default:
         bad = g & RAD_TOOL_OPT_MB_BUILD;
@@ -394,6 +494,57 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
 
 /* ---- bake ---------------------------------------------------------------------------------- */
 
+/* --method stochastic builds no F, so the row sums S_i = sum_j F_ij (the part of patch i's
+   hemisphere that sees a patch's front) are estimated by rays: 64 per patch from stratified
+   points in cosine-distributed directions, the fraction that lands on a front face. */
+#define SR_ROWSUM_RAYS 64u
+static rad_result stochastic_rowsums(const rad_tool_world *w, const rad_patches *P, float *S)
+{
+    rad_ray rays[SR_ROWSUM_RAYS];
+    rad_hit hits[SR_ROWSUM_RAYS];
+    const float eps = 1e-5f * w->scene->diagonal;
+    uint32_t i, k;
+    for (i = 0; i < P->count; ++i) {
+        const rad_patch *p = &P->patches[i];
+        const float *v0 = P->vertices + 3 * (size_t)p->vertices[0], *v1 = P->vertices + 3 * (size_t)p->vertices[1],
+                    *v2 = P->vertices + 3 * (size_t)p->vertices[2], *n = p->normal;
+        float t1[3], t2[3], a[3] = {1.0f, 0.0f, 0.0f}, len;
+        uint32_t seen = 0;
+        if (fabsf(n[0]) > 0.5f) a[0] = 0.0f, a[1] = 1.0f;
+        t1[0] = n[1] * a[2] - n[2] * a[1], t1[1] = n[2] * a[0] - n[0] * a[2], t1[2] = n[0] * a[1] - n[1] * a[0];
+        len = sqrtf(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+        t1[0] /= len, t1[1] /= len, t1[2] /= len;
+        t2[0] = n[1] * t1[2] - n[2] * t1[1], t2[1] = n[2] * t1[0] - n[0] * t1[2], t2[2] = n[0] * t1[1] - n[1] * t1[0];
+        for (k = 0; k < SR_ROWSUM_RAYS; ++k) {
+            /* point: 8 x 8 strata of the unit square folded onto the triangle; direction:
+               another 8 x 8 stratification, the two paired by a fixed shuffle */
+            float u1 = ((float)(k % 8u) + 0.5f) / 8.0f, u2 = ((float)(k / 8u) + 0.5f) / 8.0f;
+            uint32_t q = (k * 37u + 11u) % SR_ROWSUM_RAYS;
+            float d1 = ((float)(q % 8u) + 0.5f) / 8.0f, d2 = ((float)(q / 8u) + 0.5f) / 8.0f;
+            float rr = sqrtf(d1), ph = 6.28318530718f * d2, z = sqrtf(1.0f - d1), b1, b2;
+            int c;
+            if (u1 + u2 > 1.0f) u1 = 1.0f - u1, u2 = 1.0f - u2;
+            b1 = u1, b2 = u2;
+            for (c = 0; c < 3; ++c) {
+                rays[k].origin[c] = v0[c] + b1 * (v1[c] - v0[c]) + b2 * (v2[c] - v0[c]) + n[c] * eps;
+                rays[k].dir[c] = t1[c] * rr * cosf(ph) + t2[c] * rr * sinf(ph) + n[c] * z;
+            }
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = 3.0e38f;
+        }
+        if (w->rc.intersect(w->rc.user, rays, SR_ROWSUM_RAYS, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        for (k = 0; k < SR_ROWSUM_RAYS; ++k) {
+            uint32_t t = hits[k].triangle;
+            if (t < w->scene->triangle_count) {
+                const float *tn = w->scene->normals + 3 * (size_t)t;
+                if (tn[0] * rays[k].dir[0] + tn[1] * rays[k].dir[1] + tn[2] * rays[k].dir[2] < 0.0f) ++seen;
+            }
+        }
+        S[i] = (float)seen / (float)SR_ROWSUM_RAYS;
+    }
+    return RAD_SUCCESS;
+}
+
 static uint32_t mb_bounces(uint32_t bounces)
 {
     return bounces == RAD_MB_INFINITE ? RAD_MB_INFINITE : bounces + 1u;
@@ -418,7 +569,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     void *base = NULL, *dst = NULL;
     size_t base_size = 0, dst_size = 0, bytes = 0;
     uint32_t n, i, k = 0, count;
-    float *ones = NULL, *rows3 = NULL, *S = NULL;
+    float *ones = NULL, *rows3 = NULL, *S = NULL, *L = NULL;
     double t0;
     const char *what = NULL;
     int rc = 1;
@@ -426,6 +577,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     *out = NULL;
     *out_size = 0;
     so.sources_only = 1;
+    so.no_form_factors = mo->method == RAD_TOOL_STOCHASTIC;
     if (rad_tool_classic_solve(cmd, w, &so, &c)) return 1;
     n = c.patches->count;
     rad_tool_context(&ctx, NULL);
@@ -434,12 +586,19 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     ones = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     rows3 = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     S = (float *)rad_tool_calloc(n, sizeof(float));
-    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
-    if ((r = rad_matrix_multiply(&c.ff->matrix, ones, rows3, &ctx)) != RAD_SUCCESS) {
-        what = "rad_matrix_multiply";
-        goto fail;
+    if (mo->method == RAD_TOOL_STOCHASTIC) {
+        if ((r = stochastic_rowsums(w, c.patches, S)) != RAD_SUCCESS) {
+            what = "row sums by rays";
+            goto fail;
+        }
+    } else {
+        for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
+        if ((r = rad_matrix_multiply(&c.ff->matrix, ones, rows3, &ctx)) != RAD_SUCCESS) {
+            what = "rad_matrix_multiply";
+            goto fail;
+        }
+        for (i = 0; i < n; ++i) S[i] = rows3[3 * i];
     }
-    for (i = 0; i < n; ++i) S[i] = rows3[3 * i];
 
     memset(&mi, 0, sizeof mi);
     mi.magic = RAD_TOOL_METHOD_MAGIC;
@@ -455,6 +614,11 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     mi.w = mo->w;
     mi.adaptive = (uint32_t)mo->adaptive;
     mi.seed = mo->seed;
+    if (mo->method == RAD_TOOL_STOCHASTIC) {
+        mi.k = mo->sr_rays;
+        mi.bounces = mo->sr_iterations;
+        mi.mode = mo->sr_estimator;
+    }
 
     t0 = rad_tool_seconds();
     if (mo->method == RAD_TOOL_MULTIBOUNCE ||
@@ -518,6 +682,27 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
             bytes = (size_t)3 * n * n * (mo->format == RAD_TOOL_MB_HALF ? 2u : 4u);
             fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", cmd, format_name(mo->format), (unsigned long)bytes);
         }
+    } else if (mo->method == RAD_TOOL_STOCHASTIC) {
+        rad_stochastic_options sto;
+        rad_stochastic_stats st;
+        rad_stochastic_options_default(&sto);
+        sto.method = (rad_stochastic_method)mo->sr_estimator;
+        sto.rays = mo->sr_rays;
+        sto.iterations = mo->sr_iterations;
+        sto.seed = mo->seed;
+        L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+        rad_tool_context(&ctx, "stochastic radiosity");
+        r = rad_solve_stochastic(c.patches, &w->rc, c.E, &sto, L, &st, &ctx);
+        rad_tool_progress_end();
+        rad_tool_context(&ctx, NULL);
+        if (r != RAD_SUCCESS) {
+            what = "rad_solve_stochastic";
+            goto fail;
+        }
+        bytes = (size_t)st.rays_cast; /* the record's byte count holds the rays cast here */
+        fprintf(stderr, "rad %s: stochastic radiosity (%s) in %.2f s: %u iterations, %llu rays, unshot %.2g\n", cmd,
+                sto.method == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", rad_tool_seconds() - t0, st.iterations,
+                (unsigned long long)st.rays_cast, st.unshot);
     } else {
         rad_tool_context(&ctx, "alias tables");
         if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
@@ -572,7 +757,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     info.bounces = mo->bounces;
     info.light_samples = o->light_samples;
     info.triangle_count = w->scene->triangle_count;
-    rad_tool_sign_options(secs, k, &info, &sig);
+    rad_tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c.D;
     strcpy(secs[k++].name, "D");
     secs[k].type = RAD_TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;
@@ -590,6 +775,9 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
             goto fail;
         }
         k += added;
+    } else if (mo->method == RAD_TOOL_STOCHASTIC) {
+        secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = L;
+        strcpy(secs[k++].name, "L");
     } else if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
         static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
         for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(tables[i], names[i], secs + k);
@@ -622,6 +810,7 @@ fail:
     free(ones);
     free(rows3);
     free(S);
+    free(L);
     rad_tool_classic_free(&c);
     return rc;
 }
@@ -638,6 +827,8 @@ struct rad_tool_indirect {
     rad_alias_tables tables[3];
     rad_temporal *temporal;
     float *L;
+    const float *Ls;        /* stochastic: the bake's solution L */
+    double solve_seconds;   /* stochastic: the solve's time, the method's per-frame work */
     rad_context ctx;
 };
 
@@ -715,7 +906,27 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
     m->S = (const float *)s->data;
     m->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     rad_tool_context(&m->ctx, NULL);
-    if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+    if (mo->method == RAD_TOOL_STOCHASTIC) {
+        const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
+        uint32_t i;
+        if (!ls || ls->elem_size != 12 || ls->count != n) {
+            fprintf(stderr, "rad %s: bake '%s' holds no solution L for its %u patches (vector section L)\n", cmd, bake_name, n);
+            rad_tool_indirect_close(m);
+            return 1;
+        }
+        m->Ls = (const float *)ls->data;
+        for (i = 0; i < 3 * n; ++i)
+            if (!(m->Ls[i] >= 0.0f && m->Ls[i] <= RAD_BAKE_VALUE_MAX)) {
+                fprintf(stderr, "rad %s: bake '%s': vector L, value %u is %g (not in [0, 1e30])\n", cmd, bake_name, i,
+                        (double)m->Ls[i]);
+                rad_tool_indirect_close(m);
+                return 1;
+            }
+        m->solve_seconds = mi.build_seconds;
+        fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
+                mi.mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
+                (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo), (double)mi.build_seconds);
+    } else if (mo->method == RAD_TOOL_MULTIBOUNCE) {
         const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
         uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;
         if (kind > 3) {
@@ -789,6 +1000,11 @@ int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds)
     uint32_t i;
     double t0 = rad_tool_seconds();
     const float *L = m->L;
+    if (m->Ls) { /* solved at bake time: its time is the solve's */
+        for (i = 0; i < 3 * m->n; ++i) H[i] = m->albedo[i] > 0.0f ? m->Ls[i] / m->albedo[i] : 0.0f;
+        *seconds = m->solve_seconds;
+        return 0;
+    }
     if (m->blocks) r = rad_multibounce_blocks_apply(m->blocks, m->E, m->L, RAD_OUTPUT_INDIRECT, &m->ctx);
     else if (m->mb) r = rad_multibounce_apply(m->mb, m->E, m->L, RAD_OUTPUT_INDIRECT, &m->ctx);
     else {
@@ -800,5 +1016,71 @@ int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds)
         return rad_tool_fail(m->cmd, m->temporal ? "rad_temporal_step" : "multi-bounce apply", r);
     /* H = L_{K+1} / rho (see the top of this file) */
     for (i = 0; i < 3 * m->n; ++i) H[i] = m->albedo[i] > 0.0f ? L[i] / m->albedo[i] : 0.0f;
+    return 0;
+}
+
+/* ---- hierarchical (render only) ------------------------------------------------------------ */
+
+typedef struct hr_source_data {
+    const rad_tool_world *w;
+    rad_direct_options dopt;
+} hr_source_data;
+
+/* E = rho D at the elements' centroids (RAD_SOURCE_DIRECT, as the classic patches) */
+static rad_result hr_source(void *user, const float *points, const float *normals, const uint32_t *triangles,
+                            const float *albedos, uint32_t count, float *out_E)
+{
+    const hr_source_data *d = (const hr_source_data *)user;
+    rad_context quiet;
+    rad_result r;
+    uint32_t i;
+    (void)triangles;
+    rad_tool_context(&quiet, NULL);
+    r = rad_direct_irradiance(d->w->scene, &d->w->rc, d->w->file.lights, d->w->file.light_count, &d->dopt, points,
+                              normals, count, out_E, &quiet);
+    if (r == RAD_SUCCESS)
+        for (i = 0; i < 3 * count; ++i) out_E[i] *= albedos[i];
+    return r;
+}
+
+int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+                                uint32_t light_samples, rad_hierarchical **out)
+{
+    rad_hierarchical_options ho;
+    rad_hierarchical_stats st;
+    hr_source_data sd;
+    rad_context ctx;
+    rad_result r;
+    double t0 = rad_tool_seconds();
+    *out = NULL;
+    rad_hierarchical_options_default(&ho);
+    /* finer than the library's teaching default: a still image as close to the path tracer as
+       classic's at a small part of its rays (BENCHMARKS.md, hierarchical radiosity) */
+    ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
+    ho.min_area = mo->hr_min_area;
+    if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
+    sd.w = w;
+    rad_direct_options_default(&sd.dopt);
+    sd.dopt.include_emitters = 1;
+    sd.dopt.light_samples = light_samples;
+    ho.source = hr_source;
+    ho.source_user = &sd;
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_hierarchical_create(w->scene, &w->rc, &ho, &ctx, out)) != RAD_SUCCESS)
+        return rad_tool_fail(cmd, "rad_hierarchical_create", r);
+    rad_tool_context(&ctx, "hierarchical");
+    r = rad_hierarchical_solve(*out, &ctx);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) {
+        rad_hierarchical_destroy(*out);
+        *out = NULL;
+        return rad_tool_fail(cmd, "rad_hierarchical_solve", r);
+    }
+    rad_hierarchical_get_stats(*out, &st);
+    fprintf(stderr, "rad %s: hierarchical: %u triangles, %u elements, %u leaves, %llu links, %llu kernel evaluations, "
+                    "%llu rays, %u rounds, %u sweeps in %.2f s\n",
+            cmd, w->scene->triangle_count, st.elements, st.leaves, (unsigned long long)st.links,
+            (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, st.rounds, st.sweeps,
+            rad_tool_seconds() - t0);
     return 0;
 }

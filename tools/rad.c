@@ -7,6 +7,7 @@
        rad render SCENE -o OUT.png|OUT.pfm     an image (classic, multibounce or temporal
                                        radiosity, or path tracing)
        rad trace SCENE -o OUT  the reference path tracer
+       (render, trace, bake: --sun, --sky, --point, --spot, --area add lights: lights.c)
        rad compare A B         image metrics
        rad info FILE.radb      what a bake holds
        rad export SCENE -o OUT.obj     the scene as OBJ + MTL
@@ -244,6 +245,12 @@ int rad_tool_check_size(const char *cmd, int w, int h)
 
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w)
 {
+    return rad_tool_open_world_lit(cmd, path_or_name, NULL, w);
+}
+
+int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
+                            rad_tool_world *w)
+{
     char err[1024];
     rad_context ctx;
     rad_result r;
@@ -252,9 +259,14 @@ int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_worl
         fprintf(stderr, "rad %s: %s\n", cmd, err);
         return 1;
     }
+    w->file_light_count = w->file.light_count;
+    if (rad_tool_add_lights(cmd, &w->file, lights, &w->lights_storage)) {
+        rad_tool_free_scene(&w->file);
+        return 1;
+    }
     rad_tool_context(&ctx, NULL);
     if ((r = rad_scene_create(&w->file.desc, &ctx, &w->scene)) != RAD_SUCCESS) {
-        rad_tool_free_scene(&w->file);
+        rad_tool_close_world(w);
         return rad_tool_fail(cmd, "rad_scene_create", r);
     }
     if (w->scene->skipped_triangles)
@@ -272,6 +284,7 @@ void rad_tool_close_world(rad_tool_world *w)
     rad_bvh_destroy(w->bvh);
     rad_scene_destroy(w->scene);
     rad_tool_free_scene(&w->file);
+    rad_tool_lights_release(w->lights_storage);
     memset(w, 0, sizeof *w);
 }
 
@@ -377,7 +390,7 @@ static void usage(FILE *f)
                "                           --shard I/N or --rows A:B: one part of it (docs/distributed.md)\n"
                "  merge PART... -o FILE    join the parts of a sharded bake into the bake itself\n"
                "  render SCENE -o OUT      render an image (.png or .pfm):\n"
-               "                           --method classic|multibounce|temporal|local|vp|aavp|pathtrace\n"
+               "                           --method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace\n"
                "                           [--bake FILE.radb]\n"
                "  trace SCENE -o OUT       the reference path tracer\n"
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
@@ -385,13 +398,16 @@ static void usage(FILE *f)
                "  export SCENE -o OUT.obj  write the scene as OBJ + MTL (Kd albedo, Ke emission)\n"
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
-               "at most 1024).\n");
+               "at most 1024). render, trace and bake add lights to the file's own: --sun DIR:RGB,\n"
+               "--sky RGB, --point POS:RGB, --spot POS:DIR:ANGLES:RGB, --area P:U:V:RGB (units: rad render\n"
+               "--help). Dense methods (classic, multibounce, temporal, local) refuse a build estimated\n"
+               "beyond the free memory (--max-memory SIZE) or an hour; --force runs it anyway.\n");
 }
 
 static void formfactors_usage(FILE *f)
 {
     fprintf(f, "usage: rad formfactors SCENE [--patches N] [--max-edge L] [--samples S] [--ff M] [--hemicube-res R]\n"
-               "                        [--threads N]\n"
+               "                        [--max-memory SIZE] [--force] [--threads N]\n"
                "Prints one line 'FROM TO VALUE' per ordered pair of named objects: the area-weighted\n"
                "group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i.\n"
                "  --patches N   target patch count (default 2000)\n"
@@ -401,6 +417,7 @@ static void formfactors_usage(FILE *f)
                "                patch, one visibility ray each), montecarlo (S point pairs) or hemicube\n"
                "                (a hemicube at each patch centroid with an item buffer; no rays)\n"
                "  --hemicube-res R  cells across the hemicube's top face (default 128; even, 4 to 2048)\n"
+               "  --max-memory SIZE, --force   the dense build's limit (rad render --help)\n"
                "  --threads N   worker threads (default: all cores; at most 1024)\n");
 }
 
@@ -421,11 +438,19 @@ int rad_cmd_formfactors(int argc, char **argv)
     rad_result r;
     double *num, *den;
     int a;
+    rad_tool_classic_options budget;
+    rad_tool_classic_options_default(&budget);
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
         int need = !strcmp(o, "--patches") || !strcmp(o, "--samples") || !strcmp(o, "--threads") || !strcmp(o, "--max-edge") ||
                    !strcmp(o, "--ff") || !strcmp(o, "--hemicube-res");
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) { formfactors_usage(stdout); return 0; }
+        if (!strcmp(o, "--force")) { budget.force = 1; continue; }
+        if (!strcmp(o, "--max-memory")) {
+            if (a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
+            if (rad_tool_parse_bytes(cmd, o, argv[++a], &budget.max_memory)) return 2;
+            continue;
+        }
         if (need && a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
         if (!strcmp(o, "--patches")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
         else if (!strcmp(o, "--samples")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
@@ -446,7 +471,12 @@ int rad_cmd_formfactors(int argc, char **argv)
     if (!scene_name) { fprintf(stderr, "rad %s: no scene given\n", cmd); formfactors_usage(stderr); return 2; }
     if (samples == 0 || max_edge < 0.0f) { fprintf(stderr, "rad %s: --samples must be > 0, --max-edge >= 0\n", cmd); return 2; }
     rad_tool_set_threads((int)threads);
+    budget.samples = samples;
     if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
+    if (rad_tool_dense_check(cmd, &budget, w.scene->triangle_count, 1)) {
+        rad_tool_close_world(&w);
+        return 1;
+    }
     rad_tool_context(&ctx, "form factors");
     rad_patch_options_default(&po);
     po.target_count = patches_target;
@@ -460,6 +490,11 @@ int rad_cmd_formfactors(int argc, char **argv)
     fo.method = ff_method;
     if (hemicube_res) fo.hemicube_resolution = hemicube_res;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w.scene->triangle_count, P->count);
+    if (rad_tool_dense_check(cmd, &budget, P->count, 0)) {
+        rad_patches_destroy(P);
+        rad_tool_close_world(&w);
+        return 1;
+    }
     r = rad_form_factors_dense(P, &w.rc, &fo, &ctx, &ff);
     rad_tool_progress_end();
     if (r != RAD_SUCCESS) {

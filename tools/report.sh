@@ -109,7 +109,7 @@ aavp|axis-aligned virtual patches|0|--method aavp|T table 3: temporal + AAVP 0.0
 # VP_SWEEP='--method aavp --vp-max-patches'.
 VP_SWEEP=${RAD_REPORT_VP_SWEEP:-}
 case $MODE in quick) VP_BUDGETS="100 300" ;; medium) VP_BUDGETS="250 1000 4000" ;; *) VP_BUDGETS="500 2000 8000 12000" ;; esac
-VP_BUDGETS=${RAD_REPORT_VP_BUDGETS:-$VP_BUDGETS} # e.g. fewer for a shorter run (each budget builds 2-4 times)
+VP_BUDGETS=${RAD_REPORT_VP_BUDGETS:-$VP_BUDGETS} # e.g. fewer for a shorter run (each budget counts patches, then builds once)
 
 [ -x "$RAD" ] || { echo "report.sh: $RAD not built (make tools)" >&2; exit 1; }
 mkdir -p "$OUT/img" "$OUT/plots" "$OUT/data"

@@ -163,15 +163,45 @@ int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint
 int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
 double rad_tool_seconds(void);
 
+/* ---- lights from the command line (lights.c) ------------------------------------------- */
+/* --area P:U:V:RGB: an emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB */
+typedef struct rad_tool_area_light {
+    float p[3], u[3], v[3], radiance[3];
+} rad_tool_area_light;
+/* What --sun, --sky, --point, --spot and --area gave (units: lights.c and rad_tool_light_help) */
+typedef struct rad_tool_lights {
+    rad_light *lights;              /* the analytic ones, in the library's units */
+    uint32_t count;
+    rad_tool_area_light *areas;
+    uint32_t area_count;
+} rad_tool_lights;
+/* argv[*a] is one of the light options: parses it (and its value, advancing *a) and returns 1;
+   0 when it is not one; 2 on a bad value (message naming the option printed) */
+int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_tool_lights *L);
+const char *rad_tool_light_help(void);
+void rad_tool_lights_free(rad_tool_lights *L);
+/* Appends L to a loaded scene: the analytic lights to f->lights, the area lights to f->desc
+   (meshes "area_light_K", emissive materials); *storage keeps the new arrays (free with
+   rad_tool_lights_release after the scene is destroyed). Prints what was added. 0 or 1. */
+int rad_tool_add_lights(const char *cmd, rad_tool_scene *f, const rad_tool_lights *L, void **storage);
+void rad_tool_lights_release(void *storage);
+/* rad_hash64 of the lights' fields, continuing from h */
+uint64_t rad_tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h);
+
 /* A scene ready for ray queries: the loaded file, the validated scene and its BVH. */
 typedef struct rad_tool_world {
-    rad_tool_scene file;
+    rad_tool_scene file;      /* file.lights: the file's lights, then those of the command line */
     rad_scene *scene;
     rad_bvh *bvh;
     rad_raycaster rc;
+    uint32_t file_light_count; /* lights of the file itself (the rest came from the command line) */
+    void *lights_storage;      /* private (rad_tool_add_lights) */
 } rad_tool_world;
 /* loads, validates and builds the BVH; prints the error and returns 1 on failure, else 0 */
 int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w);
+/* the same with the command line's lights added (lights may be NULL) */
+int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
+                            rad_tool_world *w);
 void rad_tool_close_world(rad_tool_world *w);
 /* A camera for a scene that has none (rad_tool_scene.has_camera 0): of the views from outside
    the bounds along +z, -z, +x, -x, -y, +y (the bounding sphere in view) and from inside them,
@@ -192,12 +222,36 @@ typedef struct rad_tool_classic_options {
     uint32_t bounces;        /* --bounces K (Jacobi; default 64) */
     uint32_t light_samples;  /* --light-samples N: shadow rays per point (default 16) */
     int sources_only;        /* 1: rad_tool_classic_solve stops after E (L, B, H stay NULL) */
+    int no_form_factors;     /* with sources_only: F is not built (ff stays NULL; --method stochastic) */
+    /* the dense build's budget (budget.c): checked by rad_tool_classic_solve before the patches
+       (N at least the triangle count) and after them */
+    double max_memory;       /* --max-memory SIZE in bytes (0: MemAvailable) */
+    int force;               /* --force: build whatever the estimate */
+    double dense_bytes_per_n2; /* bytes per N^2 entry the run holds at its peak (0: 4, F alone) */
+    double dense_cubic;      /* flops / N^3 beyond the form factors (LU, multibounce) */
+    uint32_t dense_local_m;  /* local: capacity M of the 12 M^2 bytes of T (0: none) */
+    const char *dense_method; /* the method named in the refusal (NULL: classic) */
 } rad_tool_classic_options;
 void rad_tool_classic_options_default(rad_tool_classic_options *o);
 /* argv[*a] is one of the options above: parses it (and its value, advancing *a) and returns
    1; returns 0 when it is not one of them, 2 on a bad value (message printed) */
 int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o);
 const char *rad_tool_classic_help(void);
+
+/* ---- the dense build's budget (budget.c) ------------------------------------------------ */
+/* A dense build estimated to take longer than this is refused (without --force). */
+#define RAD_TOOL_DENSE_MAX_SECONDS 3600.0
+/* --max-memory SIZE: bytes with an optional K, M, G or T (powers of 1024); 0 or 2 (printed) */
+int rad_tool_parse_bytes(const char *cmd, const char *opt, const char *text, double *out);
+/* MemAvailable of /proc/meminfo in bytes; 0 where unknown (then only --max-memory limits) */
+double rad_tool_mem_available(void);
+struct rad_tool_method_options;
+/* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice). */
+void rad_tool_dense_plan(rad_tool_classic_options *o, const struct rad_tool_method_options *mo, int bake);
+/* Before a dense build of n patches (lower_bound: n is the triangle count, the patches not made
+   yet): 0 when the estimate fits the memory limit and RAD_TOOL_DENSE_MAX_SECONDS (or
+   o->force); else prints the estimate, the limit and the virtual-patch methods, returns 1. */
+int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uint32_t n, int lower_bound);
 
 /* Patches, dense F, direct irradiance D of the patches (emitters and analytic lights),
    E = rho D (RAD_SOURCE_DIRECT), the indirect solution L, B = E + L and H = F B. */
@@ -233,12 +287,15 @@ typedef struct rad_tool_bake_info {
 #define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u)
 /* the rad.options record of a bake of w with o */
 void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, const rad_tool_classic_options *o);
-/* The hash of a rad.options record, kept in the bake's signature (rad_bake_signature.options)
-   so that a bake's options section is known to be the one it was made with. */
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info);
+/* The hash of a rad.options record and of the lights given on the command line (w's lights
+   past file_light_count; none: the hash of the record alone, as before those options), kept
+   in the bake's signature (rad_bake_signature.options) so that a bake's options section and
+   lights are known to be the ones it was made with. */
+uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w);
 /* Points the signature section among secs[0..count) (written by rad_save_memory with the scene's
-   hashes) at *sig, a copy with the options hash of 'info' added. */
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, rad_bake_signature *sig);
+   hashes) at *sig, a copy with the options hash of 'info' and w's lights added. */
+void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+                           rad_bake_signature *sig);
 
 /* ---- lighting models for the direct term (shading.c) ------------------------------------ */
 /* "none" (-1) or a rad_shading_model name; 0 on success, else prints and returns 2 */
@@ -252,7 +309,8 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
 /* ---- the multi-bounce and temporal methods (methods.c) ------------------------------------ */
 typedef enum rad_tool_method {
     RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
-    RAD_TOOL_LOCAL = 4, RAD_TOOL_VP = 5, RAD_TOOL_AAVP = 6 /* render only (cmd_render.c) */
+    RAD_TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
+    RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7, RAD_TOOL_HIERARCHICAL = 8 /* render only (cmd_render.c) */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
 typedef enum rad_tool_mb_format {
@@ -282,6 +340,12 @@ typedef struct rad_tool_method_options {
     uint32_t face_points;     /* --face-points P: Hammersley points per voxel face (default 16) */
     uint32_t local_m;         /* --local-m M: local matrix capacity, at most the patches (0, the
                                  default: every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX) */
+    uint32_t sr_rays;         /* --sr-rays N: stochastic rays of the first iteration / walks (0: the library's 64 per patch) */
+    uint32_t sr_iterations;   /* --sr-iterations N: Jacobi shooting iterations at most / walk batches (0: the library's) */
+    uint32_t sr_estimator;    /* --sr-estimator jacobi|walk: a rad_stochastic_method (default jacobi) */
+    float hr_eps;             /* --hr-eps E: hierarchical BF refinement tolerance (0: 1e-5) */
+    float hr_min_area;        /* --hr-min-area A: smallest element, scene units^2 (0: total area / 10000) */
+    uint32_t hr_rays;         /* --hr-rays R: points and visibility rays per link, a square (0: 4) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
 } rad_tool_method_options;
 enum {
@@ -290,8 +354,12 @@ enum {
     RAD_TOOL_OPT_MODE = 1u << 6, RAD_TOOL_OPT_K = 1u << 7, RAD_TOOL_OPT_W = 1u << 8, RAD_TOOL_OPT_ADAPTIVE = 1u << 9,
     RAD_TOOL_OPT_SEED = 1u << 10, RAD_TOOL_OPT_FRAMES = 1u << 11, RAD_TOOL_OPT_SEQUENCE = 1u << 12,
     RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14, RAD_TOOL_OPT_VP_RESOLUTION = 1u << 15,
-    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18
+    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18,
+    RAD_TOOL_OPT_SR_RAYS = 1u << 19, RAD_TOOL_OPT_SR_ITERATIONS = 1u << 20, RAD_TOOL_OPT_SR_ESTIMATOR = 1u << 21,
+    RAD_TOOL_OPT_HR_EPS = 1u << 22, RAD_TOOL_OPT_HR_MIN_AREA = 1u << 23, RAD_TOOL_OPT_HR_RAYS = 1u << 24
 };
+#define RAD_TOOL_OPT_SR (RAD_TOOL_OPT_SR_RAYS | RAD_TOOL_OPT_SR_ITERATIONS | RAD_TOOL_OPT_SR_ESTIMATOR)
+#define RAD_TOOL_OPT_HR (RAD_TOOL_OPT_HR_EPS | RAD_TOOL_OPT_HR_MIN_AREA | RAD_TOOL_OPT_HR_RAYS)
 #define RAD_TOOL_OPT_VP (RAD_TOOL_OPT_VP_RESOLUTION | RAD_TOOL_OPT_VP_MAX_PATCHES | RAD_TOOL_OPT_FACE_POINTS)
 #define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
                                RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
@@ -312,9 +380,19 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
 int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o);
 const char *rad_tool_method_help(int render);
 const char *rad_tool_method_name(rad_tool_method method);
+/* --method hierarchical: rad_hierarchical_create and solve over the world with E = rho D at
+   the elements' centroids (D: rad_direct_irradiance with light_samples shadow rays, emitters
+   included, as the classic patches' D) and mo's --hr-* options; prints the counts and the
+   form-factor work. 0 (*out owned by the caller) or 1 (message printed). */
+int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+                                uint32_t light_samples, rad_hierarchical **out);
 
-/* The user sections the two methods add: what was built, and the row sums S_i of F (the
-   halo correction of the per-vertex H needs them and these bakes hold no F). */
+/* The user sections the methods add: what was built, and the row sums S_i of F (the halo
+   correction of the per-vertex H needs them and these bakes hold no F). --method stochastic
+   keeps its options in the same record: rays in k, iterations in bounces, the estimator in
+   mode, the seed in seed, the solve's seconds in build_seconds and its rays cast in
+   bytes_lo/bytes_hi; its bake holds the solution L as the vector "L" and row sums estimated
+   by rays (it builds no F). */
 typedef struct rad_tool_method_info {
     uint32_t magic;           /* 0x5241444D */
     uint32_t method;          /* RAD_TOOL_MULTIBOUNCE or RAD_TOOL_TEMPORAL */
@@ -411,8 +489,10 @@ typedef struct rad_tool_bake_args {
     rad_tool_method_options mo;
     uint32_t threads;
     rad_tool_shard_spec shard;
+    rad_tool_lights lights;       /* --sun, --sky, ...: free with rad_tool_lights_free */
 } rad_tool_bake_args;
-/* -1: go on and bake; else the exit code (--help: 0 after printing it; 2: bad usage, printed) */
+/* -1: go on and bake; else the exit code (--help: 0 after printing it; 2: bad usage, printed).
+   args->lights is to be freed (rad_tool_lights_free) whatever it returns. */
 int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_args *args);
 
 #endif

@@ -108,6 +108,7 @@ int main(int argc, char **argv)
     }
     MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (rc >= 0) {
+        if (rank == 0 && argc >= 2 && !strcmp(argv[1], "bake")) rad_tool_lights_free(&args.lights);
         MPI_Finalize();
         return rc;
     }
@@ -118,12 +119,13 @@ int main(int argc, char **argv)
         spec.index = (uint32_t)rank;
         spec.count = (uint32_t)ranks;
         choose_threads(args.threads);
-        if (rad_tool_open_world(cmd, args.scene, &w)) fail = 1;
+        if (rad_tool_open_world_lit(cmd, args.scene, &args.lights, &w)) fail = 1;
         else {
             fail = rad_tool_bake_part(cmd, &w, &args.o, &spec, &part, &part_size) != 0;
             rad_tool_close_world(&w);
         }
     }
+    rad_tool_lights_free(&args.lights);
     MPI_Allreduce(&fail, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     if (any) {
         if (rank == 0) fprintf(stderr, "rad mpi bake: a rank failed (its message is above): nothing written\n");

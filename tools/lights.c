@@ -1,0 +1,318 @@
+/* lights.c - lights given on the command line (--sun, --sky, --point, --spot, --area), added to
+   the scene file's own lights by every command that lights a scene (render, trace, bake).
+
+   One option per light, repeatable; numbers separated by commas, parts by colons; an RGB is
+   three numbers or one (grey). Units follow the library's rad_light (>>api_light) except the
+   sky, which is given as the radiance one sees in it:
+     --sun DIR:RGB              directional light travelling along DIR (0,-1,0: straight down);
+                                RGB = irradiance in W/m^2 on a surface facing it
+     --sky RGB                  constant sky of radiance RGB (W m^-2 sr^-1) in every direction
+                                not blocked by the scene; an unoccluded surface receives pi RGB
+                                (the library's exitance E_0 = pi RGB)
+     --point POS:RGB            point light; RGB = intensity in W/sr (irradiance I / d^2 at
+                                distance d, quadratic falloff)
+     --spot POS:DIR:ANGLES:RGB  spot light at POS aimed along DIR; ANGLES = OUTER or
+                                INNER,OUTER half-angles in degrees (full intensity inside
+                                INNER, smoothstep to 0 at OUTER; one angle: a hard edge);
+                                RGB = intensity in W/sr on the axis
+     --area P:U:V:RGB           emissive parallelogram P, P+U, P+U+V, P+V (two triangles of a
+                                mesh "area_light_K", albedo 0), emitting radiance RGB
+                                (W m^-2 sr^-1) from the side U x V points to: an area light
+                                exactly like an emissive triangle of the file
+   The analytic lights are appended to rad_tool_scene.lights; the area lights are appended to
+   the scene description before rad_scene_create (rad_tool_open_world_lit), so every method,
+   the path tracer and the bake see the same lights. */
+#include "tool.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LIGHTS_DEG 0.017453292519943295
+
+const char *rad_tool_light_help(void)
+{
+    return "lights added to the scene's own (repeatable; RGB is R,G,B or one grey value):\n"
+           "  --sun DIR:RGB      directional light travelling along DIR (0,-1,0: down); RGB = irradiance\n"
+           "                     in W/m^2 on a surface facing it\n"
+           "  --sky RGB          uniform sky of radiance RGB (W/m^2/sr): an unoccluded surface gets pi RGB\n"
+           "  --point POS:RGB    point light; RGB = intensity in W/sr (irradiance I/d^2)\n"
+           "  --spot POS:DIR:ANGLES:RGB  spot light aimed along DIR; ANGLES = OUTER or INNER,OUTER\n"
+           "                     half-angles in degrees (smooth edge from INNER to OUTER); RGB = intensity W/sr\n"
+           "  --area P:U:V:RGB   emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB (W/m^2/sr),\n"
+           "                     emitting towards U x V (an area light like an emissive triangle)\n";
+}
+
+/* 'count' comma-separated finite numbers filling the whole of [s, s + len); 0 on success */
+static int parse_numbers(const char *s, size_t len, float *out, int count)
+{
+    char buf[256], *p, *end;
+    int i;
+    if (len == 0 || len >= sizeof buf) return 1;
+    memcpy(buf, s, len);
+    buf[len] = 0;
+    p = buf;
+    for (i = 0; i < count; ++i) {
+        double v;
+        if (i > 0) {
+            if (*p != ',') return 1;
+            ++p;
+        }
+        if (!*p || *p == ',' || *p == ' ') return 1;
+        v = strtod(p, &end);
+        if (end == p || !(v == v) || fabs(v) > 1e30) return 1;
+        out[i] = (float)v;
+        p = end;
+    }
+    return *p != 0;
+}
+
+/* an RGB: three numbers or one grey value, each >= 0 */
+static int parse_rgb(const char *s, size_t len, float *rgb)
+{
+    if (parse_numbers(s, len, rgb, 3) != 0) {
+        if (parse_numbers(s, len, rgb, 1) != 0) return 1;
+        rgb[1] = rgb[2] = rgb[0];
+    }
+    return !(rgb[0] >= 0.0f && rgb[1] >= 0.0f && rgb[2] >= 0.0f);
+}
+
+static float len3(const float *v) { return sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+/* splits text at ':' into at most 'max' parts; the number of parts */
+static int split_parts(const char *text, const char **part, size_t *plen, int max)
+{
+    int n = 0;
+    const char *p = text;
+    for (;;) {
+        const char *c = strchr(p, ':');
+        if (n == max) return max + 1;
+        part[n] = p;
+        plen[n] = c ? (size_t)(c - p) : strlen(p);
+        ++n;
+        if (!c) return n;
+        p = c + 1;
+    }
+}
+
+void rad_tool_lights_free(rad_tool_lights *L)
+{
+    if (!L) return;
+    free(L->lights);
+    free(L->areas);
+    memset(L, 0, sizeof *L);
+}
+
+int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_tool_lights *L)
+{
+    static const char *const names[] = {"--sun", "--sky", "--point", "--spot", "--area"};
+    static const char *const forms[] = {"DIR:RGB, e.g. 0.3,-1,0.2:5", "RGB, e.g. 0.4,0.5,0.8", "POS:RGB, e.g. 0,1.5,0:10",
+                                        "POS:DIR:ANGLES:RGB, e.g. 0,1.9,0:0,-1,0:20,30:10",
+                                        "P:U:V:RGB, e.g. -0.2,1.9,-0.2:0.4,0,0:0,0,0.4:15"};
+    static const int nparts[] = {2, 1, 2, 4, 4};
+    const char *opt = argv[*a], *text, *part[5], *why = NULL;
+    size_t plen[5];
+    int i, n;
+    rad_light li;
+    rad_tool_area_light al;
+    for (i = 0; i < 5; ++i)
+        if (!strcmp(opt, names[i])) break;
+    if (i == 5) return 0;
+    if (*a + 1 >= argc) {
+        fprintf(stderr, "rad %s: %s needs a value (%s)\n", cmd, opt, forms[i]);
+        return 2;
+    }
+    text = argv[++*a];
+    memset(&li, 0, sizeof li);
+    memset(&al, 0, sizeof al);
+    li.falloff = RAD_FALLOFF_QUADRATIC;
+    n = split_parts(text, part, plen, 4);
+    if (n != nparts[i]) {
+        why = "wrong number of ':'-separated parts";
+    } else if (parse_rgb(part[n - 1], plen[n - 1], i == 4 ? al.radiance : li.color)) {
+        why = "the RGB is not one or three numbers >= 0";
+    } else switch (i) {
+    case 0:
+        li.type = RAD_LIGHT_DIRECTIONAL;
+        if (parse_numbers(part[0], plen[0], li.direction, 3)) why = "DIR is not three numbers";
+        else if (!(len3(li.direction) > 0.0f)) why = "DIR is zero";
+        break;
+    case 1:
+        li.type = RAD_LIGHT_SKY;
+        for (n = 0; n < 3; ++n) li.color[n] *= 3.14159265358979323846f; /* radiance to exitance E_0 */
+        break;
+    case 2:
+        li.type = RAD_LIGHT_POINT;
+        if (parse_numbers(part[0], plen[0], li.position, 3)) why = "POS is not three numbers";
+        break;
+    case 3: {
+        float ang[2];
+        li.type = RAD_LIGHT_SPOT;
+        if (parse_numbers(part[0], plen[0], li.position, 3)) why = "POS is not three numbers";
+        else if (parse_numbers(part[1], plen[1], li.direction, 3)) why = "DIR is not three numbers";
+        else if (!(len3(li.direction) > 0.0f)) why = "DIR is zero";
+        else if (parse_numbers(part[2], plen[2], ang, 2) == 0) {
+            if (!(ang[0] >= 0.0f && ang[1] > ang[0] && ang[1] <= 180.0f)) why = "ANGLES must be 0 <= INNER < OUTER <= 180 degrees";
+            li.inner_angle = (float)(ang[0] * LIGHTS_DEG), li.outer_angle = (float)(ang[1] * LIGHTS_DEG);
+        } else if (parse_numbers(part[2], plen[2], ang, 1) == 0) {
+            if (!(ang[0] > 0.0f && ang[0] <= 180.0f)) why = "ANGLES: OUTER must be in (0, 180] degrees";
+            li.inner_angle = li.outer_angle = (float)(ang[0] * LIGHTS_DEG);
+        } else why = "ANGLES is not OUTER or INNER,OUTER in degrees";
+        break;
+    }
+    default: {
+        float c[3];
+        if (parse_numbers(part[0], plen[0], al.p, 3) || parse_numbers(part[1], plen[1], al.u, 3) ||
+            parse_numbers(part[2], plen[2], al.v, 3)) {
+            why = "P, U and V must be three numbers each";
+            break;
+        }
+        c[0] = al.u[1] * al.v[2] - al.u[2] * al.v[1];
+        c[1] = al.u[2] * al.v[0] - al.u[0] * al.v[2];
+        c[2] = al.u[0] * al.v[1] - al.u[1] * al.v[0];
+        if (!(len3(c) > 0.0f)) why = "U and V span no area";
+        break;
+    }
+    }
+    if (why) {
+        fprintf(stderr, "rad %s: bad %s '%s': %s (want %s)\n", cmd, opt, text, why, forms[i]);
+        return 2;
+    }
+    if (i == 4) {
+        rad_tool_area_light *g = (rad_tool_area_light *)realloc(L->areas, sizeof *g * (L->area_count + 1u));
+        if (!g) { fprintf(stderr, "rad %s: out of memory\n", cmd); return 2; }
+        L->areas = g;
+        L->areas[L->area_count++] = al;
+    } else {
+        rad_light *g = (rad_light *)realloc(L->lights, sizeof *g * (L->count + 1u));
+        if (!g) { fprintf(stderr, "rad %s: out of memory\n", cmd); return 2; }
+        L->lights = g;
+        L->lights[L->count++] = li;
+    }
+    return 1;
+}
+
+/* the scene description with the area lights appended (meshes, materials, names) */
+typedef struct lights_storage {
+    rad_mesh_desc *meshes;
+    rad_material *materials;
+    const char **material_names;
+    float *positions;   /* 12 per area light */
+    char *names;        /* 32 per area light: mesh names, then material names */
+} lights_storage;
+
+static void storage_free(lights_storage *s)
+{
+    if (!s) return;
+    free(s->meshes);
+    free(s->materials);
+    free((void *)s->material_names);
+    free(s->positions);
+    free(s->names);
+    free(s);
+}
+
+void rad_tool_lights_release(void *storage) { storage_free((lights_storage *)storage); }
+
+/* appends the area lights to f->desc; the arrays are kept in *out (NULL when none) */
+static int add_areas(rad_tool_scene *f, const rad_tool_lights *L, lights_storage **out)
+{
+    lights_storage *s;
+    uint32_t nm = f->desc.mesh_count, nmat = f->desc.material_count, i, k;
+    static const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
+    *out = NULL;
+    if (!L || !L->area_count) return 0;
+    s = (lights_storage *)calloc(1, sizeof *s);
+    if (!s) return 1;
+    s->meshes = (rad_mesh_desc *)calloc((size_t)nm + L->area_count, sizeof *s->meshes);
+    s->materials = (rad_material *)calloc((size_t)nmat + L->area_count, sizeof *s->materials);
+    s->material_names = (const char **)calloc((size_t)nmat + L->area_count, sizeof(char *));
+    s->positions = (float *)calloc((size_t)L->area_count * 12u, sizeof(float));
+    s->names = (char *)calloc((size_t)L->area_count * 2u, 32);
+    if (!s->meshes || !s->materials || !s->material_names || !s->positions || !s->names) {
+        storage_free(s);
+        return 1;
+    }
+    if (nm) memcpy(s->meshes, f->desc.meshes, sizeof *s->meshes * nm);
+    if (nmat) memcpy(s->materials, f->desc.materials, sizeof *s->materials * nmat);
+    for (i = 0; i < nmat; ++i) s->material_names[i] = f->material_names ? f->material_names[i] : "";
+    for (i = 0; i < L->area_count; ++i) {
+        const rad_tool_area_light *al = &L->areas[i];
+        float *p = s->positions + 12 * (size_t)i;
+        char *mesh_name = s->names + 64 * (size_t)i, *mat_name = mesh_name + 32;
+        rad_mesh_desc *md = &s->meshes[nm + i];
+        rad_material *mt = &s->materials[nmat + i];
+        for (k = 0; k < 3; ++k) {
+            p[k] = al->p[k];
+            p[3 + k] = al->p[k] + al->u[k];
+            p[6 + k] = al->p[k] + al->u[k] + al->v[k];
+            p[9 + k] = al->p[k] + al->v[k];
+            mt->emission[k] = al->radiance[k];
+        }
+        snprintf(mesh_name, 32, "area_light_%u", i + 1u);
+        snprintf(mat_name, 32, "area_light_%u", i + 1u);
+        md->name = mesh_name;
+        md->positions = p;
+        md->vertex_count = 4;
+        md->indices = quad;
+        md->triangle_count = 2;
+        md->material = nmat + i;
+        s->material_names[nmat + i] = mat_name;
+    }
+    f->desc.meshes = s->meshes;
+    f->desc.mesh_count = nm + L->area_count;
+    f->desc.materials = s->materials;
+    f->desc.material_count = nmat + L->area_count;
+    f->material_names = s->material_names;
+    *out = s;
+    return 0;
+}
+
+int rad_tool_add_lights(const char *cmd, rad_tool_scene *f, const rad_tool_lights *L, void **storage)
+{
+    lights_storage *s = NULL;
+    uint32_t i, counts[4] = {0, 0, 0, 0};
+    *storage = NULL;
+    if (!L || (!L->count && !L->area_count)) return 0;
+    if (add_areas(f, L, &s)) {
+        fprintf(stderr, "rad %s: out of memory for the area lights\n", cmd);
+        return 1;
+    }
+    if (L->count) {
+        rad_light *g = (rad_light *)realloc(f->lights, sizeof *g * ((size_t)f->light_count + L->count));
+        if (!g) {
+            storage_free(s);
+            fprintf(stderr, "rad %s: out of memory for the lights\n", cmd);
+            return 1;
+        }
+        memcpy(g + f->light_count, L->lights, sizeof *g * L->count);
+        f->lights = g;
+        f->light_count += L->count;
+    }
+    for (i = 0; i < L->count; ++i)
+        if ((int)L->lights[i].type >= 0 && (int)L->lights[i].type < 4) counts[L->lights[i].type]++;
+    fprintf(stderr, "rad %s: lights from the command line: %u sun, %u sky, %u point, %u spot, %u area\n", cmd,
+            counts[RAD_LIGHT_DIRECTIONAL], counts[RAD_LIGHT_SKY], counts[RAD_LIGHT_POINT], counts[RAD_LIGHT_SPOT],
+            L->area_count);
+    *storage = s;
+    return 0;
+}
+
+uint64_t rad_tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h)
+{
+    uint32_t i;
+    /* field by field: the structs are memset, but the hash should not depend on that */
+    for (i = 0; i < count; ++i) {
+        const rad_light *l = &lights[i];
+        uint32_t t = (uint32_t)l->type, f = (uint32_t)l->falloff;
+        h = rad_hash64(&t, sizeof t, h);
+        h = rad_hash64(l->color, sizeof l->color, h);
+        h = rad_hash64(l->position, sizeof l->position, h);
+        h = rad_hash64(l->direction, sizeof l->direction, h);
+        h = rad_hash64(&f, sizeof f, h);
+        h = rad_hash64(&l->min_distance, sizeof(float), h);
+        h = rad_hash64(&l->inner_angle, sizeof(float), h);
+        h = rad_hash64(&l->outer_angle, sizeof(float), h);
+    }
+    return h;
+}
