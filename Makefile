@@ -88,10 +88,13 @@ $(BUILD)/local: bench/local.c examples/rooms.h radiosity.h | $(BUILD)
 $(BUILD)/walk: examples/walk.c examples/rooms.h examples/png_write.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/walk.c -o $@ -lm
 
+$(BUILD)/probes: bench/probes.c bench/bench_common.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O2 $(OPENMP) -I. bench/probes.c -o $@ -lm
+
 $(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local
+bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
 	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
@@ -99,14 +102,16 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/temporal --append BENCHMARKS.md
 	./$(BUILD)/shading --append BENCHMARKS.md
 	./$(BUILD)/local --append BENCHMARKS.md
+	./$(BUILD)/probes --append BENCHMARKS.md
 
-bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local
+bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/multibounce --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/temporal --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/shading --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/local --quick --append $(BUILD)/BENCHMARKS-quick.md
+	./$(BUILD)/probes --quick --append $(BUILD)/BENCHMARKS-quick.md
 
 # the MPI driver of the distributed bake (docs/distributed.md), when OpenMPI is installed
 # (Debian libopenmpi-dev openmpi-bin): the tool's sources but main.c, with tools/mpi/rad_mpi.c's main

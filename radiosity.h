@@ -224,7 +224,8 @@
        float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
        step (the same random draws as the CPU), the alias-table build for streamed rows, and
        the local multi-bounce matrix's apply and add (rank-1 update, rank-2 when evicting) on
-       a matrix kept resident on the GPU, and virtual-patch gathering at surface points;
+       a matrix kept resident on the GPU, virtual-patch gathering at surface points, and the
+       irradiance-probe update;
        RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
@@ -270,8 +271,9 @@
               built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
               compression and reordering; temporal radiosity with alias tables; local
               matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
-              models and microfacet BRDFs; embedded GLSL kernels for every run-time step;
-              hemicube form factors; stochastic radiosity (stochastic Jacobi, random walks).
+              models and microfacet BRDFs; irradiance probes (SH L2); embedded GLSL kernels
+              for every run-time step; hemicube form factors; stochastic radiosity
+              (stochastic Jacobi, random walks); hierarchical radiosity.
        The full history is in CHANGELOG.md.
 */
 
@@ -1697,7 +1699,15 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        chunk's points from element base (bind the three at the same offset). The grid
        coordinate is computed as a float pair (TwoSum / Dekker products: the CPU uses double),
        because its float rounding, about 1e-7 dims absolute, is large against small trilinear
-       weights (measured: 3e-5 relative without it, 2.9e-7 with it, on lavapipe). */
+       weights (measured: 3e-5 relative without it, 2.9e-7 with it, on lavapipe).
+   RAD_GLSL_PROBE_UPDATE   irradiance probes from a new patch solution, as rad_probes_update
+       (>>api_probes): E_i = D_i + sum_e W_e,i B_patch(e), 27 coefficients per probe.
+       Push: rad_glsl_probe_update_push. ONE INVOCATION PER PROBE. The arrays of
+       rad_probes_weights uploaded unchanged: 0: first (probe count + 1 uint64)  1: patch index
+       per entry (entry k at element k - entry_base)  2: weights (9 per entry, entry k's at
+       element 9 k - weight_base)  3: direct (27 per probe)  4: B (3N)  5: out coefficients
+       (27 per probe; the chunk's probes written). Matches the CPU to 1e-5 (measured 6.8e-6 on
+       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -1713,7 +1723,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_LOCAL_VECTORS     =  9, /* glsl/local_vectors.comp */
     RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
     RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
-    RAD_GLSL_COUNT = 12
+    RAD_GLSL_PROBE_UPDATE      = 12, /* glsl/probe_update.comp */
+    RAD_GLSL_COUNT = 13
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -1802,6 +1813,11 @@ typedef struct rad_glsl_vp_gather_push {
     uint32_t base;                 /* element of bindings 0, 1, 6 holding point row_offset's x */
     uint32_t flags;                /* RAD_GLSL_FLAG_COSINE, _CLUSTERED */
 } rad_glsl_vp_gather_push;
+typedef struct rad_glsl_probe_update_push {
+    uint32_t row_offset, row_count; /* the probes of this dispatch */
+    uint32_t entry_base;           /* low 32 bits of the entry at element 0 of binding 1 */
+    uint32_t weight_base;          /* low 32 bits of the float (9 x entry) at element 0 of binding 2 */
+} rad_glsl_probe_update_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -2756,6 +2772,164 @@ RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *val
    gets 0). Errors: INVALID_ARGUMENT, INDEX_OUT_OF_RANGE, NON_FINITE, OUT_OF_MEMORY. */
 RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
                                       float *out, const rad_context *ctx);
+
+/* ======================================================================================== */
+/* >>api_probes: irradiance probes (SH L2) from a patch solution                            */
+/* ======================================================================================== */
+
+/* Irradiance probes (docs/methods/probes.md) light what has no patches of its own: dynamic
+   objects, particles, a character walking through a baked room. A probe at point p stores the
+   irradiance E(n) arriving at p for every normal n, as 9 spherical-harmonic coefficients per
+   colour (L2: bands 0, 1, 2).
+
+   SH BASIS. Real, orthonormal over the unit sphere (integral of Y_i Y_j over the sphere is
+   1 when i = j, else 0), in world axes, index i = l (l + 1) + m, for a unit direction
+   (x, y, z):
+       Y0 = 0.282095                       (1/2) sqrt(1/pi)
+       Y1 = 0.488603 y   Y2 = 0.488603 z   Y3 = 0.488603 x          sqrt(3/(4 pi))
+       Y4 = 1.092548 x y   Y5 = 1.092548 y z   Y7 = 1.092548 x z    (1/2) sqrt(15/pi)
+       Y6 = 0.315392 (3 z^2 - 1)                                    (1/4) sqrt(5/pi)
+       Y8 = 0.546274 (x^2 - y^2)                                    (1/4) sqrt(15/pi)
+   (the order and signs of Sloan's "Stupid Spherical Harmonics Tricks" and of most engines.)
+
+   WHAT IS STORED. The radiance L(w) arriving at p is projected, L_i = integral L(w) Y_i(w) dw,
+   and convolved with the clamped cosine (Ramamoorthi and Hanrahan 2001, "An Efficient
+   Representation for Irradiance Environment Maps"): E_i = A_l L_i with
+       A_0 = pi,  A_1 = 2 pi / 3,  A_2 = pi / 4.
+   The stored coefficients are E_i (W m^-2, irradiance, already convolved), so the irradiance
+   at a surface of unit normal n is the plain sum
+       E(n) = sum_{i=0..8} E_i Y_i(n)                      (rad_sh9_irradiance)
+   and a Lambertian surface of albedo rho there shows radiance rho E(n) / pi. Constant and
+   linear radiance are reproduced exactly; the band-limit error for other lighting is a few
+   percent (the paper's bound: 9% at worst, 3% on average over normals). Layout: 27 floats per
+   probe, coefficient-major with RGB interleaved: E_i of channel c at [27 probe + 3 i + c].
+   An engine that wants radiance coefficients divides E_i by A_l.
+
+   THE GATHER. Per probe and patch j whose front faces p, the patch is cut into the lattice of
+   'patch_samples' points y (16x as many when p is within 4 patch sizes); each sample that a
+   shadow ray from p reaches adds the solid angle dw = (A_j / S) cos_j / max(|y - p|^2,
+   A_j / (S pi)) in the direction w = (y - p) / |y - p|. The patch's radiance is B_j / pi, so
+       E_i(p) = D_i(p) + sum_j W_ij B_j,   W_ij = (A_l / pi) sum_{visible s} dw_s Y_i(w_s).
+   The W_ij are kept (9 floats and a patch index for each patch a probe sees), so
+   rad_probes_update turns a new solution (a temporal frame, a light moved) into coefficients
+   in O(entries) with no ray. D_i is the direct light, fixed at creation: zero, or with
+   RAD_PROBES_DIRECT the emissive triangles (their radiance L_e, sampled as the patches with
+   'light_samples' points each), the directional, point and spot lights (a delta of the light's
+   irradiance at p in its direction, one shadow ray) and the sky (radiance E_0 / pi over the
+   validity rays that escape). Use RAD_PROBES_DIRECT with a solution that does not hold the
+   emitters' own light (RAD_SOURCE_DIRECT, or RAD_OUTPUT_INDIRECT), never with
+   RAD_SOURCE_EMISSION and RAD_OUTPUT_TOTAL (that counts the emitters twice).
+
+   PROBES INSIDE GEOMETRY. 'rays' rays in a spherical Fibonacci set leave every probe; when
+   more than 'backface_fraction' of them hit a back face (the one-sided patches face away:
+   the probe is inside a solid, behind a wall or outside a closed room), the probe is moved
+   through the nearest back face it saw, to 'clearance' past it, if that is within
+   'max_move' and the probe passes the test there (state RAD_PROBE_MOVED); otherwise it is
+   disabled (RAD_PROBE_DISABLED: its coefficients are 0 and sampling skips it).
+
+   SAMPLING. rad_probes_sample(p, n): on a grid, the 8 probes of p's cell (p clamped into the
+   grid) with trilinear weights; with user positions, every probe with the weight
+   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. Each weight is multiplied by
+   ((1 + cos) / 2)^2, cos the cosine between n and the direction from p to the probe (a probe
+   behind the surface counts little, one straight behind it not at all), disabled probes are
+   skipped, and the weights are renormalized. When no weight is left (every neighbour
+   disabled) the nearest enabled probe is used. The result is clamped at 0 (an L2 sum can dip
+   below zero behind a strong light). It is continuous in p and n. rad_probes_sample_visible
+   also skips the probes a shadow ray from p does not reach (a wall between p and a probe). */
+
+typedef enum rad_probe_flags {
+    RAD_PROBES_DIRECT = 1      /* add the direct light D_i (THE GATHER above) */
+} rad_probe_flags;
+
+typedef enum rad_probe_state {
+    RAD_PROBE_DISABLED = 0,    /* inside geometry and not movable: coefficients 0 */
+    RAD_PROBE_VALID = 1,
+    RAD_PROBE_MOVED = 2        /* was inside geometry, moved out (positions hold the new place) */
+} rad_probe_state;
+
+typedef struct rad_probe_options {
+    float spacing;             /* grid spacing in scene units when no positions are given
+                                  (0: the largest extent of the scene bounds / 8) */
+    uint32_t rays;             /* validity rays per probe (0: 256; at most 65536) */
+    uint32_t patch_samples;    /* sample points per patch (0: 4), rounded to a square n*n */
+    uint32_t light_samples;    /* sample points per emissive triangle with RAD_PROBES_DIRECT
+                                  (0: 64), rounded to a square */
+    float backface_fraction;   /* share of back-face hits that marks a probe inside geometry
+                                  (0: 0.25; at most 1) */
+    float max_move;            /* farthest a probe is moved out of geometry, scene units (0: half
+                                  the spacing, or 5% of the scene diagonal with user positions;
+                                  negative: never move, disable) */
+    float clearance;           /* how far past the back face a moved probe lands, scene units
+                                  (0: a fifth of the max_move default) */
+    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t flags;            /* rad_probe_flags */
+} rad_probe_options;
+
+typedef struct rad_probes rad_probes;
+
+RAD_API void rad_probe_options_default(rad_probe_options *options);
+
+/* Places probes (a grid over the scene bounds when positions is NULL, else the 'count' points
+   of positions, 3 floats each, copied), tests and moves those inside geometry, gathers their
+   weights from the patches (THE GATHER above) and, when B is not NULL, fills their
+   coefficients from the 3N radiosities B (else they are 0 until rad_probes_update).
+   patches (and their scene) and raycaster are borrowed for the call; lights (light_count,
+   used only with RAD_PROBES_DIRECT) too.
+   Errors: INVALID_ARGUMENT (NULL patches or raycaster, count 0 with positions, a negative or
+   non-finite spacing, rays above 65536, backface_fraction outside [0, 1], a bad light or
+   ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
+   probes: a larger spacing), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY; the log names which.
+   Thread safety: reentrant; the rays run through ctx->parallel_for. Cost: probes x (rays +
+   patches x patch_samples) rays; memory 40 bytes per (probe, visible patch). */
+RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_raycaster *raycaster,
+                                     const rad_light *lights, uint32_t light_count, const float *positions,
+                                     uint32_t count, const rad_probe_options *options, const float *B,
+                                     const rad_context *ctx, rad_probes **out);
+RAD_API void rad_probes_destroy(rad_probes *probes);
+
+/* New coefficients from a new solution B (3N floats, N the patch count at creation):
+   E_i = D_i + sum_j W_ij B_j per probe. Bit-identical to a fresh rad_probes_create with the
+   same B. Errors: INVALID_ARGUMENT (NULL), NON_FINITE (a B value, or a coefficient that
+   overflows). Cost: O(entries) (rad_probes_entry_count), parallel over probes, no ray. */
+RAD_API rad_result rad_probes_update(rad_probes *probes, const float *B, const rad_context *ctx);
+
+/* Irradiance (3 floats, W m^-2) at point p for a surface of normal n (need not be unit),
+   interpolated from the probes (SAMPLING above). Errors: INVALID_ARGUMENT (NULL, a zero
+   normal), NON_FINITE (p or n). out is 0 when every probe is disabled. Thread-safe, O(1) on a
+   grid, O(probes) with user positions. */
+RAD_API rad_result rad_probes_sample(const rad_probes *probes, const float p[3], const float n[3], float out_rgb[3]);
+
+/* The same with visibility: a probe that a shadow ray from p (offset along n) does not reach
+   is skipped as if disabled, so light does not leak through a wall between p and a probe.
+   raycaster is borrowed for the call. Errors: those of rad_probes_sample, INVALID_ARGUMENT (a
+   NULL raycaster), RAYCAST_FAILED. Thread-safe when the raycaster is. Cost: up to 8 shadow
+   rays on a grid, one per enabled probe with user positions. */
+RAD_API rad_result rad_probes_sample_visible(const rad_probes *probes, const rad_raycaster *raycaster, const float p[3],
+                                             const float n[3], float out_rgb[3]);
+
+/* Accessors. positions: 3 floats per probe (moved probes at their new place); states: one
+   rad_probe_state per probe; coefficients: 27 floats per probe (layout above). */
+RAD_API uint32_t rad_probes_count(const rad_probes *probes);
+RAD_API const float *rad_probes_positions(const rad_probes *probes);
+RAD_API const uint8_t *rad_probes_states(const rad_probes *probes);
+RAD_API const float *rad_probes_coefficients(const rad_probes *probes);
+/* The grid: returns 1 and writes its size (probes per axis; probe (x, y, z) is number
+   x + dims[0] (y + dims[1] z)), the first probe's original position and the spacing; returns
+   0 for user positions. Any output may be NULL. */
+RAD_API int rad_probes_grid(const rad_probes *probes, uint32_t dims[3], float origin[3], float *spacing);
+/* Stored (probe, patch) weight entries: the cost of one update. */
+RAD_API size_t rad_probes_entry_count(const rad_probes *probes);
+/* The arrays of an update, for running it elsewhere (RAD_GLSL_PROBE_UPDATE uploads them
+   unchanged): first (count + 1 offsets: the entries of probe i are first[i] .. first[i+1] - 1),
+   patch (the patch index of each entry), weights (9 floats per entry: W_ij) and direct (27
+   floats per probe: D_i). Owned by the probes; any output may be NULL. */
+RAD_API void rad_probes_weights(const rad_probes *probes, const uint64_t **first, const uint32_t **patch,
+                                const float **weights, const float **direct);
+
+/* The 9 basis values Y_0..Y_8 at direction d (normalized here; 0 for a zero d). */
+RAD_API void rad_sh9_basis(const float d[3], float out[9]);
+/* E(n) = sum_i E_i Y_i(n) per channel from 27 coefficients (layout above), not clamped. */
+RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], float out_rgb[3]);
 
 #ifdef __cplusplus
 }
@@ -9648,6 +9822,8 @@ typedef char rad__check_glsl_local_vectors_push[(sizeof(rad_glsl_local_vectors_p
 typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_push) == 28 &&
                                                 offsetof(rad_glsl_local_update_push, base) == 16 &&
                                                 offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
+typedef char rad__check_glsl_probe_update_push[(sizeof(rad_glsl_probe_update_push) == 16 &&
+                                               offsetof(rad_glsl_probe_update_push, weight_base) == 12) ? 1 : -1];
 typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
                                              offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
                                              offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
@@ -10779,6 +10955,56 @@ static const char rad__glsl_11_1[] =
     "    outv[at + 2u] = o.z;\n"
     "}\n";
 static const char *const rad__glsl_pieces_11[] = { rad__glsl_11_0, rad__glsl_11_1 };
+static const char rad__glsl_12_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_PROBE_UPDATE: irradiance probes from a new patch solution, as\n"
+    "// rad_probes_update (docs/methods/probes.md):\n"
+    "//   E_i(probe) = D_i(probe) + sum over the probe's entries e of W_e,i B_patch(e)\n"
+    "// 27 coefficients per probe (coefficient-major, RGB interleaved: [27 p + 3 i + c]) for probes\n"
+    "// p = row_offset .. row_offset + row_count - 1, ONE INVOCATION PER PROBE. Binding 0 holds all\n"
+    "// probe count + 1 entry offsets as uint64 (two uint words each, low word first: rad_probes_weights'\n"
+    "// first array uploaded unchanged). Chunking: bindings 1 and 2 may hold only this chunk's entries:\n"
+    "// entry k is element k - entry_base of binding 1 and elements 9 k - weight_base .. + 8 of binding 2\n"
+    "// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer First { uvec2 first[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Patch { uint patch_index[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Weights { float weights[]; };   // 9 per entry\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Direct { float direct[]; };     // 27 per probe\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Radiosity { float B[]; };       // 3 N\n"
+    "layout(std430, set = 0, binding = 5) buffer Output { float coefficients[]; };        // 27 per probe\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first probe of this dispatch\n"
+    "    uint row_count;   // probes in this dispatch\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of binding 1\n"
+    "    uint weight_base; // low 32 bits of the float index (9 k) at element 0 of binding 2\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint p = pc.row_offset + r;\n"
+    "    uint k0 = first[p].x - pc.entry_base;             // wraps correctly: only the difference matters\n"
+    "    uint w0 = 9u * first[p].x - pc.weight_base;\n"
+    "    uint count = first[p + 1u].x - first[p].x;\n"
+    "    precise vec3 acc[9];\n"
+    "    for (uint i = 0u; i < 9u; ++i) {\n"
+    "        uint d = 27u * p + 3u * i;\n"
+    "        acc[i] = vec3(direct[d], direct[d + 1u], direct[d + 2u]);\n"
+    "    }\n"
+    "    for (uint e = 0u; e < count; ++e) {\n"
+    "        uint j = patch_index[k0 + e];\n"
+    "        vec3 b = vec3(B[3u * j], B[3u * j + 1u], B[3u * j + 2u]);\n"
+    "        for (uint i = 0u; i < 9u; ++i) acc[i] += weights[w0 + 9u * e + i] * b;\n"
+    "    }\n"
+    "    for (uint i = 0u; i < 9u; ++i) {\n"
+    "        coefficients[27u * p + 3u * i] = acc[i].x;\n"
+    "        coefficients[27u * p + 3u * i + 1u] = acc[i].y;\n"
+    "        coefficients[27u * p + 3u * i + 2u] = acc[i].z;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_12[] = { rad__glsl_12_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
@@ -10791,7 +11017,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_apply.comp", rad__glsl_pieces_8, 1u, 3519u },
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
-    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u }
+    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u }
 };
 /* >>glsl end */
 
@@ -16732,6 +16959,797 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
     rad__free(&c.allocator, pts);
     rad__free(&c.allocator, nrm);
     return r;
+}
+
+/* ======================================================================================== */
+/* >>probes: irradiance probes (SH L2) from a patch solution                                */
+/* ======================================================================================== */
+
+struct rad_probes {
+    uint32_t count;
+    uint32_t patch_count;      /* N at creation: the size rad_probes_update expects */
+    float *positions;          /* 3 per probe */
+    uint8_t *states;
+    float *coefficients;       /* 27 per probe */
+    float *direct;             /* 27 per probe: D_i */
+    uint64_t *first;           /* count + 1: entries of probe i are [first[i], first[i+1]) */
+    uint32_t *patch;           /* per entry */
+    float *weights;            /* 9 per entry */
+    size_t entries;
+    int grid;
+    uint32_t dims[3];
+    float origin[3], spacing, h2;
+    float eps;                 /* ray offset (ray_epsilon x the scene diagonal) */
+    rad_allocator allocator;
+};
+
+/* the cosine-convolution factors A_l of the 9 coefficients (Ramamoorthi and Hanrahan 2001) */
+static const float rad__sh_A[9] = { 3.14159265f, 2.09439510f, 2.09439510f, 2.09439510f, 0.78539816f,
+                                    0.78539816f, 0.78539816f, 0.78539816f, 0.78539816f };
+
+/* basis values at a unit direction */
+static void rad__sh9(const float *d, float *y)
+{
+    float x = d[0], yy = d[1], z = d[2];
+    y[0] = 0.282094792f;
+    y[1] = 0.488602512f * yy;
+    y[2] = 0.488602512f * z;
+    y[3] = 0.488602512f * x;
+    y[4] = 1.092548431f * x * yy;
+    y[5] = 1.092548431f * yy * z;
+    y[6] = 0.315391565f * (3.0f * z * z - 1.0f);
+    y[7] = 1.092548431f * x * z;
+    y[8] = 0.546274215f * (x * x - yy * yy);
+}
+
+RAD_API void rad_sh9_basis(const float d[3], float out[9])
+{
+    float u[3];
+    int k;
+    if (!d || !out) return;
+    u[0] = d[0]; u[1] = d[1]; u[2] = d[2];
+    if (!(rad__dot(u, u) > 0.0f)) {
+        for (k = 0; k < 9; ++k) out[k] = 0.0f;
+        return;
+    }
+    rad__normalize(u);
+    rad__sh9(u, out);
+}
+
+RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], float out_rgb[3])
+{
+    float y[9];
+    int i, c;
+    if (!coefficients || !n || !out_rgb) return;
+    rad_sh9_basis(n, y);
+    for (c = 0; c < 3; ++c) {
+        double s = 0.0;
+        for (i = 0; i < 9; ++i) s += (double)coefficients[3 * i + c] * y[i];
+        out_rgb[c] = (float)s;
+    }
+}
+
+RAD_API void rad_probe_options_default(rad_probe_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->rays = 256;
+    o->patch_samples = 4;
+    o->light_samples = 64;
+    o->backface_fraction = 0.25f;
+    o->ray_epsilon = 1e-5f;
+}
+
+/* direction k of n in a spherical Fibonacci set: equal areas, deterministic */
+static void rad__fibonacci_dir(uint32_t k, uint32_t n, float *d)
+{
+    double z = 1.0 - (2.0 * k + 1.0) / (double)n, r = sqrt(1.0 - z * z), ph = (double)k * 2.39996322972865332;
+    d[0] = (float)(r * cos(ph));
+    d[1] = (float)(r * sin(ph));
+    d[2] = (float)z;
+}
+
+typedef struct rad__pb {
+    const rad_patches *P;
+    const rad_scene *S;
+    const rad_raycaster *rc;
+    const rad_light *lights;
+    uint32_t light_count;
+    rad_probe_options o;
+    float eps, max_move, clearance;
+    float *pos;                /* 3 per probe */
+    uint8_t *states;
+    uint32_t *emitters, emitter_count;
+    /* per task scratch */
+    rad_ray *rays;             /* RAD__RAY_BATCH per task */
+    rad_hit *hits;
+    uint8_t *occ;
+    uint32_t *target;          /* patch index, or RAD_NONE for the direct light */
+    float *w;                  /* 9 per queued ray */
+    float *col;                /* 3 per queued ray (direct light colour) */
+    /* chunk */
+    uint32_t first;            /* the chunk's first probe */
+    float *dense;              /* 9 N per probe of the chunk */
+    float *direct;             /* 27 per probe (all probes) */
+} rad__pb;
+
+/* Traces the validity rays at p: the number that hit a back face, and the nearest such hit
+   (distance and direction). */
+static rad_result rad__pb_test(rad__pb *b, uint32_t task, const float *p, uint32_t *back, float *tnear, float *dnear)
+{
+    rad_ray *rays = b->rays + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = b->hits + (size_t)task * RAD__RAY_BATCH;
+    uint32_t k0, k, R = b->o.rays;
+    int c;
+    *back = 0;
+    *tnear = FLT_MAX;
+    for (k0 = 0; k0 < R; k0 += RAD__RAY_BATCH) {
+        uint32_t m = R - k0 < RAD__RAY_BATCH ? R - k0 : RAD__RAY_BATCH;
+        for (k = 0; k < m; ++k) {
+            rad__fibonacci_dir(k0 + k, R, rays[k].dir);
+            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c];
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = FLT_MAX;
+        }
+        if (b->rc->intersect(b->rc->user, rays, m, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        for (k = 0; k < m; ++k) {
+            uint32_t t = hits[k].triangle;
+            if (t == RAD_NONE || t >= b->S->triangle_count) continue;
+            if (rad__dot(b->S->normals + 3 * (size_t)t, rays[k].dir) > 0.0f) {
+                ++*back;
+                if (hits[k].t < *tnear) {
+                    *tnear = hits[k].t;
+                    for (c = 0; c < 3; ++c) dnear[c] = rays[k].dir[c];
+                }
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+/* validity and moving out, one probe */
+static rad_result rad__pb_place(void *data, uint32_t i, uint32_t task)
+{
+    rad__pb *b = (rad__pb *)data;
+    float *p = b->pos + 3 * (size_t)i, t, d[3], q[3], t2, d2[3];
+    uint32_t back, back2;
+    float limit = b->o.backface_fraction * (float)b->o.rays;
+    rad_result r = rad__pb_test(b, task, p, &back, &t, d);
+    int c;
+    if (r != RAD_SUCCESS) return r;
+    if ((float)back <= limit) { b->states[i] = RAD_PROBE_VALID; return RAD_SUCCESS; }
+    b->states[i] = RAD_PROBE_DISABLED;
+    if (!(b->max_move > 0.0f) || !(t + b->clearance <= b->max_move)) return RAD_SUCCESS;
+    for (c = 0; c < 3; ++c) q[c] = p[c] + d[c] * (t + b->clearance);
+    r = rad__pb_test(b, task, q, &back2, &t2, d2);
+    if (r != RAD_SUCCESS) return r;
+    if ((float)back2 <= limit) {
+        for (c = 0; c < 3; ++c) p[c] = q[c];
+        b->states[i] = RAD_PROBE_MOVED;
+    }
+    return RAD_SUCCESS;
+}
+
+/* shadow-tests the queued rays of a task and adds the weights of the unoccluded ones */
+static rad_result rad__pb_flush(rad__pb *b, uint32_t task, uint32_t row, uint32_t count)
+{
+    size_t base = (size_t)task * RAD__RAY_BATCH;
+    float *dense = b->dense + (size_t)(row - b->first) * 9u * b->P->count, *direct = b->direct + 27 * (size_t)row;
+    uint32_t k;
+    int i, c;
+    if (count == 0) return RAD_SUCCESS;
+    if (b->rc->occluded(b->rc->user, b->rays + base, count, b->occ + base) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k) {
+        const float *w = b->w + 9 * (base + k);
+        uint32_t j = b->target[base + k];
+        if (b->occ[base + k]) continue;
+        if (j != RAD_NONE)
+            for (i = 0; i < 9; ++i) dense[9 * (size_t)j + (size_t)i] += w[i];
+        else
+            for (i = 0; i < 9; ++i)
+                for (c = 0; c < 3; ++c) direct[3 * i + c] += w[i] * b->col[3 * (base + k) + (size_t)c];
+    }
+    return RAD_SUCCESS;
+}
+
+/* queues a ray from p towards y (to y offset by eps along ny; to infinity along y when ny is
+   NULL) carrying the basis values at its direction times 'scale' */
+static rad_result rad__pb_queue(rad__pb *b, uint32_t task, uint32_t row, uint32_t *nq, const float *p, const float *y,
+                                const float *ny, float scale, uint32_t target, const float *col)
+{
+    size_t at = (size_t)task * RAD__RAY_BATCH + *nq;
+    rad_ray *ray = b->rays + at;
+    float dir[3], Y[9], len;
+    int c, i;
+    for (c = 0; c < 3; ++c) ray->origin[c] = p[c];
+    if (ny) {
+        for (c = 0; c < 3; ++c) ray->dir[c] = y[c] + ny[c] * b->eps - p[c];
+        len = rad__len(ray->dir);
+        ray->tmin = 0.0f;
+        ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+    } else {
+        for (c = 0; c < 3; ++c) ray->dir[c] = y[c];
+        ray->tmin = 0.0f;
+        ray->tmax = FLT_MAX;
+    }
+    for (c = 0; c < 3; ++c) dir[c] = ray->dir[c];
+    rad__normalize(dir);
+    rad__sh9(dir, Y);
+    for (i = 0; i < 9; ++i) b->w[9 * at + (size_t)i] = scale * rad__sh_A[i] * Y[i];
+    b->target[at] = target;
+    if (col)
+        for (c = 0; c < 3; ++c) b->col[3 * at + (size_t)c] = col[c];
+    if (++*nq == RAD__RAY_BATCH) {
+        rad_result r = rad__pb_flush(b, task, row, *nq);
+        *nq = 0;
+        return r;
+    }
+    return RAD_SUCCESS;
+}
+
+/* The lattice points of triangle v seen from p: each queued with its solid angle times
+   'scale' (1/pi for a patch of radiosity B, the radiance for an emitter). Patches closer
+   than 4 sizes get a 4x finer lattice: the kernel varies fast there. */
+static rad_result rad__pb_triangle(rad__pb *b, uint32_t task, uint32_t row, uint32_t *nq, const float *p, const float *v,
+                                   const float *n, float area, uint32_t samples, float scale, uint32_t target,
+                                   const float *col)
+{
+    float cen[3], d[3];
+    uint32_t side = rad__lattice_side(samples), S, s;
+    int c;
+    rad_result r;
+    for (c = 0; c < 3; ++c) cen[c] = (v[c] + v[3 + c] + v[6 + c]) / 3.0f;
+    rad__sub(d, p, cen);
+    if (rad__dot(d, d) < 16.0f * area) side *= 4u;
+    S = side * side;
+    for (s = 0; s < S; ++s) {
+        float y[3], dy[3], r2, cj, dw, floor2 = area / ((float)S * (float)RAD__PI);
+        rad__lattice_point(v, v + 3, v + 6, side, s, y);
+        rad__sub(dy, y, p);
+        r2 = rad__dot(dy, dy);
+        if (!(r2 > 0.0f)) continue;
+        cj = -rad__dot(dy, n) / (float)sqrt((double)r2);
+        if (!(cj > 0.0f)) continue;
+        dw = (area / (float)S) * cj / (r2 > floor2 ? r2 : floor2);
+        r = rad__pb_queue(b, task, row, nq, p, y, n, dw * scale, target, col);
+        if (r != RAD_SUCCESS) return r;
+    }
+    return RAD_SUCCESS;
+}
+
+/* the gather of one probe: patch weights into its dense row, direct light into direct */
+static rad_result rad__pb_gather(void *data, uint32_t row, uint32_t task)
+{
+    rad__pb *b = (rad__pb *)data;
+    const rad_patches *P = b->P;
+    const float *p = b->pos + 3 * (size_t)row;
+    uint32_t nq = 0, j, l, k;
+    rad_result r = RAD_SUCCESS;
+    int c;
+    if (b->states[row] == RAD_PROBE_DISABLED) return RAD_SUCCESS;
+    for (j = 0; j < P->count && r == RAD_SUCCESS; ++j) {
+        const rad_patch *pt = &P->patches[j];
+        float v[9], d[3];
+        int m;
+        rad__sub(d, p, pt->centroid);
+        if (!(rad__dot(d, pt->normal) > 0.0f)) continue; /* p does not see the patch's front */
+        for (m = 0; m < 3; ++m)
+            for (c = 0; c < 3; ++c) v[3 * m + c] = P->vertices[3 * (size_t)pt->vertices[m] + (size_t)c];
+        r = rad__pb_triangle(b, task, row, &nq, p, v, pt->normal, pt->area, b->o.patch_samples, (float)(1.0 / RAD__PI), j, NULL);
+    }
+    if (r == RAD_SUCCESS && (b->o.flags & RAD_PROBES_DIRECT)) {
+        for (l = 0; l < b->emitter_count && r == RAD_SUCCESS; ++l) {
+            uint32_t t = b->emitters[l];
+            const float *tv = b->S->positions + 9 * (size_t)t, *tn = b->S->normals + 3 * (size_t)t;
+            float d[3];
+            rad__sub(d, p, tv);
+            if (!(rad__dot(d, tn) > 0.0f)) continue;
+            r = rad__pb_triangle(b, task, row, &nq, p, tv, tn, b->S->areas[t], b->o.light_samples, 1.0f, RAD_NONE,
+                                 b->S->materials_table[b->S->materials[t]].emission);
+        }
+        for (l = 0; l < b->light_count && r == RAD_SUCCESS; ++l) {
+            const rad_light *li = &b->lights[l];
+            float v[3], col[3];
+            if (li->type == RAD_LIGHT_DIRECTIONAL) {
+                for (c = 0; c < 3; ++c) v[c] = -li->direction[c];
+                rad__normalize(v);
+                r = rad__pb_queue(b, task, row, &nq, p, v, NULL, 1.0f, RAD_NONE, li->color);
+            } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
+                float dist, dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * b->S->diagonal;
+                rad__sub(v, li->position, p);
+                dist = rad__len(v);
+                if (!(dist > 0.0f)) continue;
+                dc = dist > md ? dist : md;
+                atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
+                if (li->type == RAD_LIGHT_SPOT) {
+                    float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
+                    memcpy(axis, li->direction, sizeof(axis));
+                    rad__normalize(axis);
+                    ca = -rad__dot(v, axis) / dist;
+                    if (ci > co) {
+                        t = (ca - co) / (ci - co);
+                        t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+                        atten *= t * t * (3.0f - 2.0f * t);
+                    } else if (!(ca >= co)) {
+                        atten = 0.0f;
+                    }
+                    if (!(atten > 0.0f)) continue;
+                }
+                for (c = 0; c < 3; ++c) col[c] = li->color[c] * atten;
+                /* to the light's point: the ray ends just short of it (ny = 0 keeps it there) */
+                {
+                    const float zero[3] = { 0.0f, 0.0f, 0.0f };
+                    r = rad__pb_queue(b, task, row, &nq, p, li->position, zero, 1.0f, RAD_NONE, col);
+                }
+            } else if (li->type == RAD_LIGHT_SKY) {
+                /* radiance E_0 / pi over the escaping directions, 4 pi / rays steradians each */
+                float w = (float)(4.0 / (double)b->o.rays);
+                for (k = 0; k < b->o.rays && r == RAD_SUCCESS; ++k) {
+                    rad__fibonacci_dir(k, b->o.rays, v);
+                    r = rad__pb_queue(b, task, row, &nq, p, v, NULL, w, RAD_NONE, li->color);
+                }
+            }
+        }
+    }
+    if (r == RAD_SUCCESS) r = rad__pb_flush(b, task, row, nq);
+    return r;
+}
+
+/* rows of rad__for_rows count from 0: the chunk's probes start at b->first */
+static rad_result rad__pb_gather_chunk(void *data, uint32_t row, uint32_t task)
+{
+    return rad__pb_gather(data, ((rad__pb *)data)->first + row, task);
+}
+
+typedef struct rad__pu {
+    rad_probes *pr;
+    const float *B;
+} rad__pu;
+
+static void rad__probes_update_one(rad_probes *pr, const float *B, uint32_t i)
+{
+    double acc[27];
+    size_t e;
+    int k, c;
+    for (k = 0; k < 27; ++k) acc[k] = pr->direct[27 * (size_t)i + (size_t)k];
+    for (e = (size_t)pr->first[i]; e < (size_t)pr->first[i + 1]; ++e) {
+        const float *w = pr->weights + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
+        for (k = 0; k < 9; ++k)
+            for (c = 0; c < 3; ++c) acc[3 * k + c] += (double)w[k] * b[c];
+    }
+    for (k = 0; k < 27; ++k) pr->coefficients[27 * (size_t)i + (size_t)k] = (float)acc[k];
+}
+
+static rad_result rad__probes_update_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__pu *u = (rad__pu *)data;
+    (void)task;
+    rad__probes_update_one(u->pr, u->B, row);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_probes_update(rad_probes *probes, const float *B, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__pu u;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!probes || !B) {
+        rad__log(&c, RAD_LOG_ERROR, "probes update: NULL probes or B");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    r = rad__check_input(&c, "probes update", B, 3 * (size_t)probes->patch_count);
+    if (r != RAD_SUCCESS) return r;
+    u.pr = probes;
+    u.B = B;
+    c.progress = NULL; /* O(entries): too short to report */
+    r = rad__for_rows(&c, probes->count, c.tasks < probes->count ? c.tasks : probes->count, rad__probes_update_row, &u);
+    if (r != RAD_SUCCESS) return r;
+    return rad__check_output(&c, "probes update", probes->coefficients, 27 * (size_t)probes->count);
+}
+
+RAD_API void rad_probes_destroy(rad_probes *pr)
+{
+    rad_allocator a;
+    if (!pr) return;
+    a = pr->allocator;
+    rad__free(&a, pr->positions);
+    rad__free(&a, pr->states);
+    rad__free(&a, pr->coefficients);
+    rad__free(&a, pr->direct);
+    rad__free(&a, pr->first);
+    rad__free(&a, pr->patch);
+    rad__free(&a, pr->weights);
+    rad__free(&a, pr);
+}
+
+/* appends the non-zero rows of a probe's dense weights to the entry arrays */
+static rad_result rad__probes_pack(rad_probes *pr, const float *dense, uint32_t N, size_t *cap)
+{
+    uint32_t j;
+    int k;
+    for (j = 0; j < N; ++j) {
+        const float *w = dense + 9 * (size_t)j;
+        int any = 0;
+        for (k = 0; k < 9; ++k) any |= w[k] != 0.0f;
+        if (!any) continue;
+        if (pr->entries == *cap) {
+            size_t nc = *cap ? 2 * *cap : 1024, b9, b1;
+            void *np, *nw;
+            if (!rad__mul(nc, 9 * sizeof(float), &b9) || !rad__mul(nc, sizeof(uint32_t), &b1)) return RAD_ERROR_SIZE_OVERFLOW;
+            np = rad__realloc(&pr->allocator, pr->patch, *cap * sizeof(uint32_t), b1);
+            if (!np) return RAD_ERROR_OUT_OF_MEMORY;
+            pr->patch = (uint32_t *)np;
+            nw = rad__realloc(&pr->allocator, pr->weights, *cap * 9 * sizeof(float), b9);
+            if (!nw) return RAD_ERROR_OUT_OF_MEMORY;
+            pr->weights = (float *)nw;
+            *cap = nc;
+        }
+        pr->patch[pr->entries] = j;
+        memcpy(pr->weights + 9 * pr->entries, w, 9 * sizeof(float));
+        ++pr->entries;
+    }
+    return RAD_SUCCESS;
+}
+
+#define RAD__PROBES_MAX_GRID (1u << 24)
+#define RAD__PROBES_CHUNK_FLOATS (1u << 22) /* dense scratch per chunk of probes (16 MiB) */
+
+RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_raycaster *raycaster, const rad_light *lights,
+                                     uint32_t light_count, const float *positions, uint32_t count,
+                                     const rad_probe_options *options, const float *B, const rad_context *ctx,
+                                     rad_probes **out)
+{
+    rad__ctx c;
+    rad__pb b;
+    rad__direct dv;
+    rad_probes *pr = NULL;
+    const rad_scene *S;
+    rad_result r = RAD_SUCCESS;
+    uint32_t i, T, N, per, first;
+    size_t cap = 0;
+    float ext[3], spacing = 0.0f;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!patches || !patches->scene || !raycaster || !raycaster->intersect || !raycaster->occluded || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: NULL patches, raycaster (with intersect and occluded) or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    S = patches->scene;
+    N = patches->count;
+    memset(&b, 0, sizeof(b));
+    if (options) b.o = *options; else rad_probe_options_default(&b.o);
+    if (b.o.rays == 0) b.o.rays = 256;
+    if (b.o.patch_samples == 0) b.o.patch_samples = 4;
+    if (b.o.light_samples == 0) b.o.light_samples = 64;
+    if (b.o.backface_fraction == 0.0f) b.o.backface_fraction = 0.25f;
+    if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
+    if (b.o.patch_samples > RAD__MAX_SAMPLES) b.o.patch_samples = RAD__MAX_SAMPLES;
+    if (b.o.light_samples > RAD__MAX_SAMPLES) b.o.light_samples = RAD__MAX_SAMPLES;
+    if (b.o.rays > 65536u) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: rays %u above 65536", b.o.rays);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(b.o.backface_fraction >= 0.0f && b.o.backface_fraction <= 1.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)b.o.backface_fraction);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon,
+                 (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!rad__finite(b.o.spacing) || b.o.spacing < 0.0f || !rad__finite(b.o.max_move) || !rad__finite(b.o.clearance) ||
+        b.o.clearance < 0.0f) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: spacing %g and clearance %g must be finite and >= 0, max_move %g finite",
+                 (double)b.o.spacing, (double)b.o.clearance, (double)b.o.max_move);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (b.o.flags & ~(uint32_t)RAD_PROBES_DIRECT) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: unknown flags 0x%x", b.o.flags);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (positions && count == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: positions given with count 0");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    /* the lights pass the checks of the direct-light code */
+    if (b.o.flags & RAD_PROBES_DIRECT) {
+        r = rad__direct_setup(&dv, S, raycaster, lights, light_count, NULL, &c);
+        if (r != RAD_SUCCESS) {
+            rad__log(&c, RAD_LOG_ERROR, "probes: the %u lights were refused (%s)", light_count, rad_result_string(r));
+            return r;
+        }
+    }
+    if (B) {
+        r = rad__check_input(&c, "probes", B, 3 * (size_t)N);
+        if (r != RAD_SUCCESS) return r;
+    }
+    for (k = 0; k < 3; ++k) ext[k] = S->bounds_max[k] - S->bounds_min[k];
+    pr = (rad_probes *)rad__alloc(&c.allocator, sizeof(rad_probes));
+    if (!pr) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(pr, 0, sizeof(*pr));
+    pr->allocator = c.allocator;
+    pr->patch_count = N;
+    pr->h2 = 1e-6f * S->diagonal * S->diagonal;
+    pr->eps = b.o.ray_epsilon * S->diagonal;
+    if (positions) {
+        for (i = 0; i < count; ++i)
+            if (!rad__finite3(positions + 3 * (size_t)i)) {
+                rad__log(&c, RAD_LOG_ERROR, "probes: position %u is not finite", i);
+                rad_probes_destroy(pr);
+                return RAD_ERROR_NON_FINITE;
+            }
+        pr->count = count;
+    } else {
+        double total = 1.0;
+        float big = ext[0] > ext[1] ? (ext[0] > ext[2] ? ext[0] : ext[2]) : (ext[1] > ext[2] ? ext[1] : ext[2]);
+        spacing = b.o.spacing > 0.0f ? b.o.spacing : big / 8.0f;
+        for (k = 0; k < 3; ++k) {
+            double d = ceil((double)ext[k] / (double)spacing);
+            if (d < 1.0) d = 1.0;
+            total *= d;
+            pr->dims[k] = total <= (double)RAD__PROBES_MAX_GRID ? (uint32_t)d : 0u;
+        }
+        if (total > (double)RAD__PROBES_MAX_GRID) {
+            rad__log(&c, RAD_LOG_ERROR, "probes: spacing %g gives %.0f probes over the bounds (at most %u): use a larger spacing",
+                     (double)spacing, total, RAD__PROBES_MAX_GRID);
+            rad_probes_destroy(pr);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        pr->grid = 1;
+        pr->spacing = spacing;
+        for (k = 0; k < 3; ++k)
+            pr->origin[k] = 0.5f * (S->bounds_min[k] + S->bounds_max[k]) - 0.5f * (float)(pr->dims[k] - 1u) * spacing;
+        pr->count = pr->dims[0] * pr->dims[1] * pr->dims[2];
+    }
+    pr->positions = (float *)rad__alloc_array(&c.allocator, pr->count, 3 * sizeof(float));
+    pr->states = (uint8_t *)rad__alloc_array(&c.allocator, pr->count, 1);
+    pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
+    pr->direct = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
+    pr->first = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)pr->count + 1u, sizeof(uint64_t));
+    if (!pr->positions || !pr->states || !pr->coefficients || !pr->direct || !pr->first) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for %u probes", pr->count);
+        rad_probes_destroy(pr);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (positions) {
+        memcpy(pr->positions, positions, sizeof(float) * 3 * (size_t)count);
+    } else {
+        uint32_t x, y, z;
+        for (z = 0; z < pr->dims[2]; ++z)
+            for (y = 0; y < pr->dims[1]; ++y)
+                for (x = 0; x < pr->dims[0]; ++x) {
+                    float *q = pr->positions + 3 * ((size_t)x + (size_t)pr->dims[0] * ((size_t)y + (size_t)pr->dims[1] * z));
+                    q[0] = pr->origin[0] + (float)x * spacing;
+                    q[1] = pr->origin[1] + (float)y * spacing;
+                    q[2] = pr->origin[2] + (float)z * spacing;
+                }
+    }
+    memset(pr->direct, 0, sizeof(float) * 27 * (size_t)pr->count);
+    {
+        float move_default = pr->grid ? 0.5f * spacing : 0.05f * S->diagonal;
+        b.max_move = b.o.max_move == 0.0f ? move_default : b.o.max_move;
+        b.clearance = b.o.clearance > 0.0f ? b.o.clearance : 0.2f * move_default;
+    }
+    b.P = patches;
+    b.S = S;
+    b.rc = raycaster;
+    b.lights = lights;
+    b.light_count = (b.o.flags & RAD_PROBES_DIRECT) ? light_count : 0u;
+    b.eps = b.o.ray_epsilon * S->diagonal;
+    b.pos = pr->positions;
+    b.states = pr->states;
+    b.direct = pr->direct;
+    per = N ? (uint32_t)(RAD__PROBES_CHUNK_FLOATS / (9u * (size_t)N)) : pr->count;
+    if (per == 0) per = 1;
+    if (per > pr->count) per = pr->count;
+    T = c.tasks < pr->count ? c.tasks : pr->count;
+    b.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    b.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
+    b.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    b.target = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    b.w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 9 * sizeof(float));
+    b.col = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
+    b.emitters = (uint32_t *)rad__alloc_array(&c.allocator, S->triangle_count, sizeof(uint32_t));
+    b.dense = (float *)rad__alloc_array(&c.allocator, (size_t)per * 9u, N ? (size_t)N * sizeof(float) : 1u);
+    if (!b.rays || !b.hits || !b.occ || !b.target || !b.w || !b.col || !b.emitters || !b.dense) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for the ray buffers of %u tasks", T);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < S->triangle_count; ++i) {
+            const float *e = S->materials_table[S->materials[i]].emission;
+            if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) b.emitters[b.emitter_count++] = i;
+        }
+        r = rad__for_rows(&c, pr->count, T, rad__pb_place, &b);
+    }
+    for (first = 0; first < pr->count && r == RAD_SUCCESS; first += per) {
+        uint32_t m = pr->count - first < per ? pr->count - first : per, q;
+        memset(b.dense, 0, sizeof(float) * 9 * (size_t)N * m);
+        b.first = first;
+        {
+            rad__ctx cc = c;
+            uint32_t tt = T < m ? T : m;
+            cc.progress = NULL;
+            r = rad__for_rows(&cc, m, tt, rad__pb_gather_chunk, &b);
+        }
+        for (q = 0; q < m && r == RAD_SUCCESS; ++q) {
+            pr->first[first + q] = pr->entries;
+            r = rad__probes_pack(pr, b.dense + 9 * (size_t)N * q, N, &cap);
+            if (r != RAD_SUCCESS)
+                rad__log(&c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
+        }
+        if (r == RAD_SUCCESS && c.progress && c.progress(c.progress_user, (float)((double)(first + m) / (double)pr->count))) {
+            rad__log(&c, RAD_LOG_INFO, "probes: cancelled by the progress callback after %u of %u probes", first + m, pr->count);
+            r = RAD_ERROR_CANCELLED;
+        }
+    }
+    pr->first[pr->count] = pr->entries;
+    rad__free(&c.allocator, b.rays);
+    rad__free(&c.allocator, b.hits);
+    rad__free(&c.allocator, b.occ);
+    rad__free(&c.allocator, b.target);
+    rad__free(&c.allocator, b.w);
+    rad__free(&c.allocator, b.col);
+    rad__free(&c.allocator, b.emitters);
+    rad__free(&c.allocator, b.dense);
+    if (r == RAD_SUCCESS) r = rad__check_output(&c, "probes (direct light)", pr->direct, 27 * (size_t)pr->count);
+    if (r == RAD_SUCCESS) {
+        if (B) r = rad_probes_update(pr, B, ctx);
+        else memset(pr->coefficients, 0, sizeof(float) * 27 * (size_t)pr->count);
+    }
+    if (r != RAD_SUCCESS) {
+        rad_probes_destroy(pr);
+        return r;
+    }
+    *out = pr;
+    return RAD_SUCCESS;
+}
+
+/* 1 when a shadow ray from p (offset along the unit normal un) reaches q, or when there is no
+   raycaster; 0 when occluded; -1 when the raycaster failed */
+static int rad__probe_visible(const rad_probes *pr, const rad_raycaster *rc, const float *p, const float *un, const float *q)
+{
+    rad_ray ray;
+    uint8_t occ = 0;
+    float len;
+    int k;
+    if (!rc) return 1;
+    for (k = 0; k < 3; ++k) {
+        ray.origin[k] = p[k] + un[k] * pr->eps;
+        ray.dir[k] = q[k] - ray.origin[k];
+    }
+    len = rad__len(ray.dir);
+    ray.tmin = 0.0f;
+    ray.tmax = len > 2.0f * pr->eps ? 1.0f - pr->eps / len : 0.5f;
+    if (rc->occluded(rc->user, &ray, 1, &occ) != RAD_SUCCESS) return -1;
+    return occ ? 0 : 1;
+}
+
+static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *rc, const float p[3], const float n[3],
+                                     float out_rgb[3])
+{
+    float un[3], e[3], acc[3] = { 0.0f, 0.0f, 0.0f };
+    double wsum = 0.0;
+    uint32_t i;
+    int k, vis;
+    if (!pr || !p || !n || !out_rgb) return RAD_ERROR_INVALID_ARGUMENT;
+    out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
+    if (!rad__finite3(p) || !rad__finite3(n)) return RAD_ERROR_NON_FINITE;
+    un[0] = n[0]; un[1] = n[1]; un[2] = n[2];
+    if (!(rad__dot(un, un) > 0.0f)) return RAD_ERROR_INVALID_ARGUMENT;
+    rad__normalize(un);
+    if (pr->grid) {
+        uint32_t i0[3], x, y, z;
+        float f[3];
+        for (k = 0; k < 3; ++k) {
+            float u = (p[k] - pr->origin[k]) / pr->spacing, top = (float)(pr->dims[k] - 1u);
+            u = u < 0.0f ? 0.0f : (u > top ? top : u);
+            i0[k] = (uint32_t)u;
+            if (i0[k] + 1u >= pr->dims[k]) i0[k] = pr->dims[k] >= 2u ? pr->dims[k] - 2u : 0u;
+            f[k] = pr->dims[k] >= 2u ? u - (float)i0[k] : 0.0f;
+        }
+        for (z = 0; z < 2; ++z)
+            for (y = 0; y < 2; ++y)
+                for (x = 0; x < 2; ++x) {
+                    uint32_t ix = i0[0] + x, iy = i0[1] + y, iz = i0[2] + z;
+                    float w = (x ? f[0] : 1.0f - f[0]) * (y ? f[1] : 1.0f - f[1]) * (z ? f[2] : 1.0f - f[2]), d[3], len, cs;
+                    if (ix >= pr->dims[0] || iy >= pr->dims[1] || iz >= pr->dims[2] || !(w > 0.0f)) continue;
+                    i = ix + pr->dims[0] * (iy + pr->dims[1] * iz);
+                    if (pr->states[i] == RAD_PROBE_DISABLED) continue;
+                    rad__sub(d, pr->positions + 3 * (size_t)i, p);
+                    len = rad__len(d);
+                    cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
+                    w *= 0.25f * (1.0f + cs) * (1.0f + cs);
+                    if (!(w > 0.0f)) continue;
+                    vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
+                    if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
+                    if (!vis) continue;
+                    rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
+                    for (k = 0; k < 3; ++k) acc[k] += w * e[k];
+                    wsum += w;
+                }
+    } else {
+        for (i = 0; i < pr->count; ++i) {
+            float d[3], len2, cs, w;
+            if (pr->states[i] == RAD_PROBE_DISABLED) continue;
+            rad__sub(d, pr->positions + 3 * (size_t)i, p);
+            len2 = rad__dot(d, d);
+            cs = len2 > 0.0f ? rad__dot(d, un) / (float)sqrt((double)len2) : 1.0f;
+            w = 0.25f * (1.0f + cs) * (1.0f + cs) / (len2 + pr->h2);
+            if (!(w > 0.0f)) continue;
+            vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
+            if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
+            if (!vis) continue;
+            rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
+            for (k = 0; k < 3; ++k) acc[k] += w * e[k];
+            wsum += w;
+        }
+    }
+    if (!(wsum > 0.0)) {
+        /* every neighbour disabled or straight behind: the nearest enabled probe */
+        float best = FLT_MAX;
+        uint32_t bi = RAD_NONE;
+        for (i = 0; i < pr->count; ++i) {
+            float d[3], len2;
+            if (pr->states[i] == RAD_PROBE_DISABLED) continue;
+            rad__sub(d, pr->positions + 3 * (size_t)i, p);
+            len2 = rad__dot(d, d);
+            if (len2 < best) { best = len2; bi = i; }
+        }
+        if (bi == RAD_NONE) return RAD_SUCCESS;
+        rad_sh9_irradiance(pr->coefficients + 27 * (size_t)bi, un, acc);
+        wsum = 1.0;
+    }
+    for (k = 0; k < 3; ++k) {
+        float v = (float)((double)acc[k] / wsum);
+        out_rgb[k] = v > 0.0f ? v : 0.0f;
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_probes_sample(const rad_probes *pr, const float p[3], const float n[3], float out_rgb[3])
+{
+    return rad__probes_sample(pr, NULL, p, n, out_rgb);
+}
+
+RAD_API rad_result rad_probes_sample_visible(const rad_probes *pr, const rad_raycaster *raycaster, const float p[3],
+                                             const float n[3], float out_rgb[3])
+{
+    if (!raycaster || !raycaster->occluded) return RAD_ERROR_INVALID_ARGUMENT;
+    return rad__probes_sample(pr, raycaster, p, n, out_rgb);
+}
+
+RAD_API uint32_t rad_probes_count(const rad_probes *pr) { return pr ? pr->count : 0u; }
+RAD_API const float *rad_probes_positions(const rad_probes *pr) { return pr ? pr->positions : NULL; }
+RAD_API const uint8_t *rad_probes_states(const rad_probes *pr) { return pr ? pr->states : NULL; }
+RAD_API const float *rad_probes_coefficients(const rad_probes *pr) { return pr ? pr->coefficients : NULL; }
+RAD_API size_t rad_probes_entry_count(const rad_probes *pr) { return pr ? pr->entries : 0u; }
+
+RAD_API void rad_probes_weights(const rad_probes *pr, const uint64_t **first, const uint32_t **patch, const float **weights,
+                                const float **direct)
+{
+    if (first) *first = pr ? pr->first : NULL;
+    if (patch) *patch = pr ? pr->patch : NULL;
+    if (weights) *weights = pr ? pr->weights : NULL;
+    if (direct) *direct = pr ? pr->direct : NULL;
+}
+
+RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin[3], float *spacing)
+{
+    int k;
+    if (!pr || !pr->grid) return 0;
+    for (k = 0; k < 3; ++k) {
+        if (dims) dims[k] = pr->dims[k];
+        if (origin) origin[k] = pr->origin[k];
+    }
+    if (spacing) *spacing = pr->spacing;
+    return 1;
 }
 
 #endif /* RADIOSITY_IMPLEMENTATION */

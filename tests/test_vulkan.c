@@ -1367,6 +1367,92 @@ static void test_vp_gather(void)
     T_CHECK(hist[0] > 0 && hist[7] + hist[8] > 0 && hist[2] + hist[3] + hist[4] > 0); /* skipping happened, and near-full blocks */
 }
 
+/* ---- irradiance probes: the update from a new patch solution --------------------------------- */
+
+/* RAD_GLSL_PROBE_UPDATE against rad_probes_update: Cornell-box probes (grid, direct light on),
+   a random solution B, the probes in three chunks whose entry ranges are bound at offsets */
+static void test_probe_update(void)
+{
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_probe_options o;
+    rad_probes *pr = NULL;
+    float *B = NULL;
+    const uint64_t *first;
+    const uint32_t *patch;
+    const float *weights, *direct;
+    uint32_t n, i, q, cut[4], s;
+    size_t entries;
+    g_worst_what = "relative error of the coefficients";
+    rad_cornell_box(&d, NULL);
+    rad_patch_options_default(&po);
+    po.target_count = 150;
+    if (rad_scene_create(&d, NULL, &S) != RAD_SUCCESS || rad_patches_create(S, &po, NULL, &P) != RAD_SUCCESS ||
+        rad_bvh_create(S, NULL, &bvh) != RAD_SUCCESS) { T_CHECK(0); goto done; }
+    rad_bvh_raycaster(bvh, &rc);
+    rad_probe_options_default(&o);
+    o.spacing = 0.12f;
+    o.rays = 64;
+    o.flags = RAD_PROBES_DIRECT;
+    if (rad_probes_create(P, &rc, NULL, 0, NULL, 0, &o, NULL, NULL, &pr) != RAD_SUCCESS) { T_CHECK(0); goto done; }
+    B = (float *)malloc(3 * (size_t)P->count * 4);
+    if (!B) { T_CHECK(0); goto done; }
+    for (i = 0; i < 3 * P->count; ++i) B[i] = 2.0f * frand();
+    T_CHECK(rad_probes_update(pr, B, NULL) == RAD_SUCCESS);
+    n = rad_probes_count(pr);
+    entries = rad_probes_entry_count(pr);
+    rad_probes_weights(pr, &first, &patch, &weights, &direct);
+    printf("    %u probes, %lu entries\n", n, (unsigned long)entries);
+    chunks(n, cut);
+    for (s = 0; s < 2; ++s) {
+        vk_kernel k;
+        vk_buf bF, bP, bW, bD, bB, bO;
+        int ok = 1;
+        if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_PROBE_UPDATE, 0, 6, (uint32_t)sizeof(rad_glsl_probe_update_push), g_local_sizes[s])) {
+            T_CHECK(0);
+            break;
+        }
+        ok &= vk_buffer(&g_vk, &bF, ((VkDeviceSize)n + 1) * 8, first);
+        ok &= vk_buffer(&g_vk, &bP, (VkDeviceSize)entries * 4, patch);
+        ok &= vk_buffer(&g_vk, &bW, 9 * (VkDeviceSize)entries * 4, weights);
+        ok &= vk_buffer(&g_vk, &bD, 27 * (VkDeviceSize)n * 4, direct);
+        ok &= vk_buffer(&g_vk, &bB, 3 * (VkDeviceSize)P->count * 4, B);
+        ok &= vk_buffer(&g_vk, &bO, 27 * (VkDeviceSize)n * 4, NULL);
+        if (ok) memset(bO.map, 0xFF, 27 * (size_t)n * 4); /* NaN: every probe must be written */
+        for (q = 0; q < 3 && ok; ++q) {
+            rad_glsl_probe_update_push p;
+            vk_range r[6];
+            uint32_t wb;
+            VkDeviceSize k0 = first[cut[q]], k1 = first[cut[q + 1]];
+            if (cut[q + 1] == cut[q]) continue;
+            r[0] = vk_whole(&bF);
+            r[1] = vk_chunk(&g_vk, &bP, 4, k0, k1 - k0, &p.entry_base);
+            r[2] = vk_chunk(&g_vk, &bW, 4, 9 * k0, 9 * (k1 - k0), &wb);
+            r[3] = vk_whole(&bD); r[4] = vk_whole(&bB); r[5] = vk_whole(&bO);
+            p.entry_base = (uint32_t)k0 - p.entry_base;
+            p.weight_base = (uint32_t)(9 * k0) - wb;
+            p.row_offset = cut[q];
+            p.row_count = cut[q + 1] - cut[q];
+            ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+        }
+        T_CHECK(ok);
+        if (ok) compare("probe update", (const float *)bO.map, rad_probes_coefficients(pr), 27 * (size_t)n, 1e-5);
+        vk_buffer_free(&g_vk, &bF); vk_buffer_free(&g_vk, &bP); vk_buffer_free(&g_vk, &bW);
+        vk_buffer_free(&g_vk, &bD); vk_buffer_free(&g_vk, &bB); vk_buffer_free(&g_vk, &bO);
+        vk_kernel_destroy(&g_vk, &k);
+    }
+done:
+    free(B);
+    rad_probes_destroy(pr);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
 /* ---- the C mirrors of the push-constant blocks, against the compiled SPIR-V ------------------ */
 
 /* member names and byte offsets of the push-constant block of a SPIR-V module (from OpMemberName
@@ -1463,6 +1549,8 @@ static void test_push_mirrors(void)
         { "dims_y", offsetof(rad_glsl_vp_gather_push, dims) + 4 }, { "dims_z", offsetof(rad_glsl_vp_gather_push, dims) + 8 },
         MM(rad_glsl_vp_gather_push, voxel_count), MM(rad_glsl_vp_gather_push, row_offset), MM(rad_glsl_vp_gather_push, row_count),
         MM(rad_glsl_vp_gather_push, base), MM(rad_glsl_vp_gather_push, flags), { NULL, 0 } };
+    static const mirror_member probe[] = { MM(rad_glsl_probe_update_push, row_offset), MM(rad_glsl_probe_update_push, row_count),
+        MM(rad_glsl_probe_update_push, entry_base), MM(rad_glsl_probe_update_push, weight_base), { NULL, 0 } };
     g_worst_what = "push-constant block, bytes";
     check_mirror(RAD_GLSL_GATHER_DENSE, dense, sizeof(rad_glsl_gather_dense_push));
     check_mirror(RAD_GLSL_GATHER_CSR, sparse, sizeof(rad_glsl_gather_csr_push));
@@ -1475,6 +1563,7 @@ static void test_push_mirrors(void)
     check_mirror(RAD_GLSL_LOCAL_VECTORS, lvec, sizeof(rad_glsl_local_vectors_push));
     check_mirror(RAD_GLSL_LOCAL_UPDATE, lupd, sizeof(rad_glsl_local_update_push));
     check_mirror(RAD_GLSL_VP_GATHER, vpg, sizeof(rad_glsl_vp_gather_push));
+    check_mirror(RAD_GLSL_PROBE_UPDATE, probe, sizeof(rad_glsl_probe_update_push));
     /* every kernel (.comp; includes have no push block) has its mirror checked above */
     {
         uint32_t id;
@@ -1544,6 +1633,7 @@ static const vk_test g_tests[] = {
     { "vk_alias_build_streamed_rows_then_temporal", test_alias_build },
     { "vk_local_adds_evictions_apply_resident", test_local },
     { "vk_vp_gather_trilinear_skipping", test_vp_gather },
+    { "vk_probe_update", test_probe_update },
     { NULL, NULL }
 };
 

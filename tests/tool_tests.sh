@@ -985,6 +985,49 @@ rc=$?
     fail "a build within --max-memory runs, and --force runs one beyond it" "$(head -c 300 "$TMP/err.txt")"
 bad "--max-memory 12Q" "bad value '12Q' for --max-memory" render cornell --max-memory 12Q -o "$TMP/y.pfm"
 bad "--max-memory -1" "bad value '-1' for --max-memory" bake cornell --max-memory -1 -o "$TMP/y.radb"
+# ---- rad probes: SH L2 irradiance probes on a grid (docs/methods/probes.md) ---------------
+# E(n) = sum_i E_i Y_i(n) at the probe of the top layer nearest the light: the light above gives
+# far more irradiance facing up than down; the indirect-only file holds less than the total;
+# disabled probes hold zeros; the binary file has its documented size
+sh_up_down() { # FILE.json -> "E(+y) E(-y)" (red) of the valid probe with the largest y nearest x = z = 0.278
+    awk '/"p": \[/ { gsub(/[\[\],"{}:]/, " "); n = split($0, t, " ");
+        x = t[2]; y = t[3]; z = t[4]; st = t[6]; e0 = t[8]; e1 = t[11]; e6 = t[26]; e8 = t[32];
+        if (st != "valid") next;
+        d = (x - 0.278) ^ 2 + (z - 0.278) ^ 2;
+        if (y > by + 1e-6 || (y > by - 1e-6 && d < bd)) { by = y; bd = d;
+            up = 0.282095 * e0 + 0.488603 * e1 - 0.315392 * e6 - 0.546274 * e8;
+            dn = 0.282095 * e0 - 0.488603 * e1 - 0.315392 * e6 - 0.546274 * e8 } }
+        END { printf "%g %g\n", up, dn }' by=-1e30 "$1"
+}
+if "$RAD" probes cornell --patches 200 --spacing 0.14 -o "$TMP/probes.json" > "$TMP/probes.txt" 2> "$TMP/err.txt" &&
+    "$RAD" probes cornell --patches 200 --spacing 0.14 --indirect -o "$TMP/probes_ind.json" > /dev/null 2>> "$TMP/err.txt" &&
+    "$RAD" probes cornell --patches 200 --spacing 0.14 -o "$TMP/probes.bin" > /dev/null 2>> "$TMP/err.txt"; then
+    count=$(awk '/"count"/ { gsub(/[^0-9]/, ""); print }' "$TMP/probes.json")
+    lines=$(grep -c '"p": \[' "$TMP/probes.json")
+    zeros=$(grep '"state": "disabled"' "$TMP/probes.json" | grep -vc '\[[^]]*[1-9][^]]*\]\]' )
+    disabled=$(grep -c '"state": "disabled"' "$TMP/probes.json")
+    read -r up dn <<< "$(sh_up_down "$TMP/probes.json")"
+    read -r iup idn <<< "$(sh_up_down "$TMP/probes_ind.json")"
+    size=$(wc -c < "$TMP/probes.bin" | tr -d ' ')
+    if [ "$count" = 64 ] && [ "$lines" = 64 ] && [ "$zeros" = "$disabled" ] && [ "$size" = $((48 + 64 * 124)) ] &&
+        [ "$(head -c 8 "$TMP/probes.bin")" = RADPROBE ] &&
+        awk -v u="$up" -v d="$dn" -v iu="$iup" 'BEGIN { exit !(u > 4 * d && d > 0 && iu > 0 && iu < 0.5 * u) }'; then
+        ok "probes cornell: 4x4x4 grid in JSON and binary, E(up) $up >> E(down) $dn, indirect $iup < total"
+    else
+        fail "probes cornell" "count '$count' lines '$lines' zeros '$zeros'/'$disabled' size '$size' up '$up' down '$dn' indirect '$iup'"
+    fi
+else
+    fail "probes cornell" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" probes cornell --spacing 0 -o "$TMP/p0.json" > /dev/null 2>&1
+rc1=$?
+"$RAD" probes cornell -o "$TMP/p0.txt" > /dev/null 2>&1
+rc2=$?
+"$RAD" probes cornell --patches 50 --spacing 0.0001 -o "$TMP/p0.json" > /dev/null 2> "$TMP/err.txt"
+rc3=$?
+[ $rc1 -eq 2 ] && [ $rc2 -eq 2 ] && [ $rc3 -eq 1 ] && [ ! -e "$TMP/p0.json" ] && grep -q "larger spacing" "$TMP/err.txt" &&
+    ok "probes refuses --spacing 0, a .txt output and a grid too fine (no file left)" ||
+    fail "probes refuses bad options" "exits $rc1 $rc2 $rc3: $(head -c 200 "$TMP/err.txt")"
 
 # ---- a new user's first runs: what the tool says ------------------------------------------
 "$RAD" help 2>&1 | grep -q 'local|vp|aavp' && ok "help lists every render method" || fail "help lists every render method"

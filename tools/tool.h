@@ -104,6 +104,7 @@ int rad_cmd_trace(int argc, char **argv);
 int rad_cmd_compare(int argc, char **argv);
 int rad_cmd_info(int argc, char **argv);
 int rad_cmd_export(int argc, char **argv);
+int rad_cmd_probes(int argc, char **argv);
 
 /* the rad program (rad.c): dispatches argv[1] to a subcommand; the exit code (main.c) */
 int rad_tool_main(int argc, char **argv);

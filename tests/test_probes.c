@@ -1,0 +1,642 @@
+/* test_probes.c - irradiance probes (SH L2): the basis and convolution against closed forms,
+   probe irradiance in the Cornell box against the direct light of rad_direct_irradiance plus
+   a Monte Carlo gather of the same patch solution, probes inside geometry, sampling, update,
+   options, allocation failures. Everything static and prefixed pb_. */
+
+#define PB_PI 3.14159265358979323846
+
+/* Projects radiance f over the sphere with the public basis (midpoint rule in z and phi: the
+   area element is dz dphi) and returns the 9 projections. */
+static void pb_project(double (*f)(const float *w), double L[9])
+{
+    int iz, ip, k, NZ = 400, NP = 400;
+    for (k = 0; k < 9; ++k) L[k] = 0.0;
+    for (iz = 0; iz < NZ; ++iz)
+        for (ip = 0; ip < NP; ++ip) {
+            double z = -1.0 + (iz + 0.5) * 2.0 / NZ, ph = (ip + 0.5) * 2.0 * PB_PI / NP, r = sqrt(1.0 - z * z);
+            float w[3], y[9];
+            double v;
+            w[0] = (float)(r * cos(ph)); w[1] = (float)(r * sin(ph)); w[2] = (float)z;
+            v = f(w);
+            rad_sh9_basis(w, y);
+            for (k = 0; k < 9; ++k) L[k] += v * y[k] * (2.0 / NZ) * (2.0 * PB_PI / NP);
+        }
+}
+
+static double pb_const(const float *w) { (void)w; return 1.0; }
+static double pb_linear(const float *w) { return 0.3 * w[0] - 0.5 * w[1] + 0.7 * w[2]; }
+static double pb_quad(const float *w) { return (double)w[2] * w[2]; }
+static double pb_lobe(const float *w) { return w[2] > 0.0f ? (double)w[2] : 0.0; }
+
+/* irradiance from projections: E_i = A_l L_i into the 27-float layout (grey) */
+static void pb_convolve(const double L[9], float co[27])
+{
+    static const double A[9] = { PB_PI, 2 * PB_PI / 3, 2 * PB_PI / 3, 2 * PB_PI / 3, PB_PI / 4, PB_PI / 4, PB_PI / 4, PB_PI / 4, PB_PI / 4 };
+    int i, c;
+    for (i = 0; i < 9; ++i)
+        for (c = 0; c < 3; ++c) co[3 * i + c] = (float)(A[i] * L[i]);
+}
+
+static void pb_test_sh_projection(void)
+{
+    static const float ns[5][3] = { { 0, 0, 1 }, { 1, 0, 0 }, { 0, -1, 0 }, { 0.6f, 0.0f, 0.8f }, { -0.48f, 0.6f, -0.64f } };
+    double L[9];
+    float co[27], e[3], y[9], d[3] = { 0.0f, 0.0f, 2.0f };
+    int i, k;
+    /* orthonormal basis: the lobe max(0, z) has L_00 = sqrt(pi)/2, L_10 = sqrt(pi/3), L_20 = sqrt(5 pi)/8 */
+    pb_project(pb_lobe, L);
+    CHECK_NEAR(L[0], sqrt(PB_PI) / 2.0, 1e-4);
+    CHECK_NEAR(L[2], sqrt(PB_PI / 3.0), 1e-4);
+    CHECK_NEAR(L[6], sqrt(5.0 * PB_PI) / 8.0, 1e-4);
+    for (k = 0; k < 9; ++k)
+        if (k != 0 && k != 2 && k != 6) CHECK_NEAR(L[k], 0.0, 1e-4);
+    rad_sh9_basis(d, y); /* normalizes */
+    CHECK_NEAR(y[2], 0.488603, 1e-5);
+    CHECK_NEAR(y[6], 0.630783, 1e-5);
+    for (i = 0; i < 5; ++i) {
+        const float *n = ns[i];
+        /* constant radiance 1: E = pi for every normal */
+        pb_project(pb_const, L);
+        pb_convolve(L, co);
+        rad_sh9_irradiance(co, n, e);
+        CHECK_NEAR(e[0], PB_PI, 1e-4);
+        CHECK_NEAR(e[2], PB_PI, 1e-4);
+        /* linear radiance a.w: E(n) = (2 pi / 3) a.n */
+        pb_project(pb_linear, L);
+        pb_convolve(L, co);
+        rad_sh9_irradiance(co, n, e);
+        CHECK_NEAR(e[1], 2.0 * PB_PI / 3.0 * (0.3 * n[0] - 0.5 * n[1] + 0.7 * n[2]), 1e-4);
+        /* quadratic radiance z^2 is exact too: E(n) = pi/4 + (pi/4) n_z^2 (pi/2 at the pole, pi/4 at the equator) */
+        pb_project(pb_quad, L);
+        pb_convolve(L, co);
+        rad_sh9_irradiance(co, n, e);
+        CHECK_NEAR(e[0], PB_PI / 4.0 + PB_PI / 4.0 * n[2] * n[2], 1e-4);
+    }
+}
+
+/* The Cornell box with ~pc patches, its BVH, and B = E + L solved with the direct light as the
+   source (emitters out of the system), so probes add the direct light themselves. */
+typedef struct pb_cornell {
+    rad_scene *S;
+    rad_patches *P;
+    rad_bvh *bvh;
+    rad_raycaster rc;
+    float *B;
+} pb_cornell;
+
+static int pb_cornell_init(pb_cornell *f, uint32_t pc)
+{
+    rad_scene_desc d;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL;
+    rad_solve_options so;
+    rad_system sys;
+    float *D, *E;
+    int ok = 0;
+    memset(f, 0, sizeof(*f));
+    rad_cornell_box(&d, NULL);
+    if (rad_scene_create(&d, NULL, &f->S) != RAD_SUCCESS) return 0;
+    rad_patch_options_default(&po);
+    po.target_count = pc;
+    if (rad_patches_create(f->S, &po, NULL, &f->P) != RAD_SUCCESS) return 0;
+    if (rad_bvh_create(f->S, NULL, &f->bvh) != RAD_SUCCESS) return 0;
+    rad_bvh_raycaster(f->bvh, &f->rc);
+    rad_form_factor_options_default(&fo);
+    if (rad_form_factors_dense(f->P, &f->rc, &fo, NULL, &ff) != RAD_SUCCESS) return 0;
+    D = (float *)malloc(sizeof(float) * 3 * f->P->count);
+    E = (float *)malloc(sizeof(float) * 3 * f->P->count);
+    f->B = (float *)malloc(sizeof(float) * 3 * f->P->count);
+    if (D && E && f->B && rad_direct_patches(f->P, &f->rc, NULL, 0, NULL, D, NULL) == RAD_SUCCESS &&
+        rad_sources(f->P, RAD_SOURCE_DIRECT, D, E) == RAD_SUCCESS) {
+        rad_system_init(&sys, &ff->matrix, f->P, E);
+        rad_solve_options_default(&so);
+        so.output = RAD_OUTPUT_TOTAL;
+        so.bounces = 24;
+        ok = rad_solve_jacobi(&sys, &so, f->B, NULL, NULL) == RAD_SUCCESS;
+    }
+    free(D);
+    free(E);
+    rad_form_factors_destroy(ff);
+    return ok;
+}
+
+static void pb_cornell_free(pb_cornell *f)
+{
+    free(f->B);
+    rad_bvh_destroy(f->bvh);
+    rad_patches_destroy(f->P);
+    rad_scene_destroy(f->S);
+}
+
+/* The independent value: direct irradiance (rad_direct_irradiance: analytic emitter, shadow
+   rays) plus the indirect part by Monte Carlo, 'rays' cosine-distributed rays from p, each
+   front-facing hit bringing its patch's B (E = mean of B over the cosine-weighted rays). */
+static void pb_reference(const pb_cornell *f, const float *p, const float *n, uint32_t rays, int direct, float out[3])
+{
+    rad_direct_options dopt;
+    rad_ray *rr = (rad_ray *)calloc(rays, sizeof(rad_ray));
+    rad_hit *hh = (rad_hit *)calloc(rays, sizeof(rad_hit));
+    float t1[3], t2[3], a[3] = { 1, 0, 0 }, D[3];
+    double acc[3] = { 0, 0, 0 };
+    uint32_t k;
+    int c;
+    if (!rr || !hh) { free(rr); free(hh); CHECK(0); return; }
+    if (fabs(n[0]) > 0.5) { a[0] = 0; a[1] = 1; }
+    t1[0] = n[1] * a[2] - n[2] * a[1]; t1[1] = n[2] * a[0] - n[0] * a[2]; t1[2] = n[0] * a[1] - n[1] * a[0];
+    { double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]); for (c = 0; c < 3; ++c) t1[c] = (float)(t1[c] / l); }
+    t2[0] = n[1] * t1[2] - n[2] * t1[1]; t2[1] = n[2] * t1[0] - n[0] * t1[2]; t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    for (k = 0; k < rays; ++k) {
+        /* a stratified (rays = m*m) cosine-weighted set, jittered by a fixed LCG */
+        uint32_t m = (uint32_t)sqrt((double)rays), ia = k % m, ib = k / m;
+        double u1 = (ia + 0.5 + 0.4 * sin(7.1 * k)) / m, u2 = (ib + 0.5 + 0.4 * cos(3.3 * k)) / m, r = sqrt(u1), ph = 2 * PB_PI * u2;
+        for (c = 0; c < 3; ++c) {
+            rr[k].origin[c] = p[c];
+            rr[k].dir[c] = (float)(t1[c] * r * cos(ph) + t2[c] * r * sin(ph) + n[c] * sqrt(1.0 - u1));
+        }
+        rr[k].tmin = 0.0f;
+        rr[k].tmax = 1e30f;
+    }
+    CHECK_OK(f->rc.intersect(f->rc.user, rr, rays, hh));
+    for (k = 0; k < rays; ++k) {
+        uint32_t t = hh[k].triangle, j;
+        float w[3];
+        if (t == RAD_NONE) continue;
+        if (f->S->normals[3 * t] * rr[k].dir[0] + f->S->normals[3 * t + 1] * rr[k].dir[1] + f->S->normals[3 * t + 2] * rr[k].dir[2] >= 0.0f) continue;
+        j = rad_patches_locate(f->P, t, hh[k].b1, hh[k].b2, w);
+        for (c = 0; c < 3; ++c) acc[c] += f->B[3 * j + c];
+    }
+    rad_direct_options_default(&dopt);
+    dopt.light_samples = 64;
+    D[0] = D[1] = D[2] = 0.0f;
+    if (direct) CHECK_OK(rad_direct_irradiance(f->S, &f->rc, NULL, 0, &dopt, p, n, 1, D, NULL));
+    for (c = 0; c < 3; ++c) out[c] = (float)(acc[c] / rays) + D[c];
+    free(rr);
+    free(hh);
+}
+
+static void pb_test_cornell_reference(void)
+{
+    /* points in the open air of the box (x 0..0.556, y 0..0.549, z 0..0.559), away from the blocks */
+    static const float pts[4][3] = { { 0.278f, 0.40f, 0.28f }, { 0.10f, 0.25f, 0.10f }, { 0.45f, 0.45f, 0.45f }, { 0.40f, 0.10f, 0.05f } };
+    static const float ns[4][3] = { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, 1 }, { 0.577350f, -0.577350f, 0.577350f } };
+    pb_cornell f;
+    rad_probe_options o;
+    rad_probes *pd = NULL, *pi = NULL;
+    uint32_t i, k, within = 0, total = 0;
+    if (!pb_cornell_init(&f, rad_test_quick() ? 200 : 400)) { CHECK(0); pb_cornell_free(&f); return; }
+    rad_probe_options_default(&o);
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &pts[0][0], 4, &o, f.B, NULL, &pi)); /* the indirect light */
+    o.flags = RAD_PROBES_DIRECT;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &pts[0][0], 4, &o, f.B, NULL, &pd)); /* plus the direct light */
+    if (!pd || !pi) { rad_probes_destroy(pd); rad_probes_destroy(pi); pb_cornell_free(&f); return; }
+    for (i = 0; i < 4; ++i) {
+        float ep[8][3], rp[8][3], hp[8][3], gp[8][3], top[3] = { 0, 0, 0 };
+        int c;
+        CHECK(rad_probes_states(pd)[i] == RAD_PROBE_VALID);
+        for (k = 0; k < 8; ++k) {
+            float n[3];
+            for (c = 0; c < 3; ++c) n[c] = k < 4 ? ns[k][c] : -ns[k - 4][c];
+            rad_sh9_irradiance(rad_probes_coefficients(pd) + 27 * i, n, ep[k]);
+            rad_sh9_irradiance(rad_probes_coefficients(pi) + 27 * i, n, hp[k]);
+            pb_reference(&f, pts[i], n, 4096, 1, rp[k]);
+            pb_reference(&f, pts[i], n, 4096, 0, gp[k]);
+            for (c = 0; c < 3; ++c) if (rp[k][c] > top[c]) top[c] = rp[k][c];
+        }
+        for (k = 0; k < 8; ++k)
+            for (c = 0; c < 3; ++c) {
+                if (k < 4) {
+                    /* the odd part E(n) - E(-n) = integral of L (w.n) lies in band 1: exact, up to the
+                       gather's and the reference's sampling */
+                    CHECK_NEAR(ep[k][c] - ep[k + 4][c], rp[k][c] - rp[k + 4][c], 0.03 * (rp[k][c] + rp[k + 4][c]));
+                }
+                /* the band limit: a small bright source leaves up to a tenth of its irradiance on normals
+                   across or away from it */
+                CHECK_NEAR(ep[k][c], rp[k][c], 0.1 * top[c]);
+                /* indirect light alone (what engines add to per-pixel direct light) is smooth: 5% */
+                ++total;
+                within += fabs(hp[k][c] - gp[k][c]) <= 0.05 * gp[k][c];
+                if (getenv("PB_DEBUG"))
+                    printf("p%u n%u c%d total %g ref %g  indirect %g ref %g\n", i, k, c, ep[k][c], rp[k][c], hp[k][c], gp[k][c]);
+            }
+    }
+    printf("    indirect within 5%% of the reference: %u of %u\n", within, total);
+    CHECK(within >= total * 9 / 10);
+    rad_probes_destroy(pd);
+    rad_probes_destroy(pi);
+    pb_cornell_free(&f);
+}
+
+/* a probe inside the tall block, one outside the box, one in the air; moved, disabled, kept */
+static void pb_test_inside(void)
+{
+    static const float pts[3][3] = { { 0.37f, 0.15f, 0.35f }, { 0.278f, -0.05f, 0.28f }, { 0.278f, 0.40f, 0.28f } };
+    pb_cornell f;
+    rad_probe_options o;
+    rad_probes *pr = NULL;
+    const uint8_t *st;
+    if (!pb_cornell_init(&f, 100)) { CHECK(0); pb_cornell_free(&f); return; }
+    rad_probe_options_default(&o);
+    o.max_move = 0.2f;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &pts[0][0], 3, &o, f.B, NULL, &pr));
+    if (pr) {
+        const float *q = rad_probes_positions(pr);
+        st = rad_probes_states(pr);
+        CHECK(st[0] == RAD_PROBE_MOVED);   /* inside the tall block: moved through its nearest face */
+        CHECK(st[1] == RAD_PROBE_MOVED);   /* under the floor: moved up through it */
+        CHECK(st[2] == RAD_PROBE_VALID);
+        CHECK(q[0] != pts[0][0] || q[1] != pts[0][1] || q[2] != pts[0][2]);
+        CHECK(memcmp(q + 6, pts[2], sizeof(float) * 3) == 0);
+        {
+            /* the moved probe is in the air: a probe created there again is valid */
+            rad_probes *p2 = NULL;
+            CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, q, 1, &o, NULL, NULL, &p2));
+            if (p2) CHECK(rad_probes_states(p2)[0] == RAD_PROBE_VALID);
+            rad_probes_destroy(p2);
+        }
+    }
+    rad_probes_destroy(pr);
+    /* max_move below the distance to the nearest face, or negative (never move): disabled, 0 */
+    o.max_move = 0.03f;
+    pr = NULL;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &pts[0][0], 3, &o, f.B, NULL, &pr));
+    if (pr) {
+        int c;
+        CHECK(rad_probes_states(pr)[0] == RAD_PROBE_DISABLED);
+        CHECK(rad_probes_states(pr)[1] == RAD_PROBE_DISABLED);
+        CHECK(rad_probes_states(pr)[2] == RAD_PROBE_VALID);
+        for (c = 0; c < 54; ++c) CHECK(rad_probes_coefficients(pr)[c] == 0.0f);
+        CHECK(rad_probes_coefficients(pr)[54] > 0.0f);
+    }
+    rad_probes_destroy(pr);
+    o.max_move = -1.0f;
+    pr = NULL;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &pts[0][0], 1, &o, f.B, NULL, &pr));
+    if (pr) CHECK(rad_probes_states(pr)[0] == RAD_PROBE_DISABLED);
+    rad_probes_destroy(pr);
+    pb_cornell_free(&f);
+}
+
+/* A closed cube [0,1]^3 of six inward quads (grey), cut into patches. */
+static const float pb_cube_pos[24 * 3] = {
+    0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 1,   0, 1, 0, 0, 1, 1, 1, 1, 1, 1, 1, 0, /* floor (+y), ceiling (-y) */
+    0, 0, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0,   1, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, /* x = 0 (+x), x = 1 (-x) */
+    0, 0, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0,   0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1  /* z = 0 (+z), z = 1 (-z) */
+};
+static const uint32_t pb_cube_idx[36] = { 0, 2, 1, 0, 3, 2, 4, 6, 5, 4, 7, 6, 8, 10, 9, 8, 11, 10,
+                                          12, 14, 13, 12, 15, 14, 16, 18, 17, 16, 19, 18, 20, 22, 21, 20, 23, 22 };
+
+static void pb_test_constant_room(void)
+{
+    static const float ns[4][3] = { { 0, 1, 0 }, { 0, 0, -1 }, { 1, 0, 0 }, { 0.48f, -0.6f, 0.64f } };
+    static const float pts[3][3] = { { 0.5f, 0.5f, 0.5f }, { 0.2f, 0.7f, 0.35f }, { 0.9f, 0.1f, 0.8f } };
+    rad_mesh_desc m;
+    rad_material mat;
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_probes *pr = NULL;
+    rad_probe_options o;
+    float *B = NULL;
+    uint32_t i, k;
+    memset(&m, 0, sizeof(m));
+    memset(&mat, 0, sizeof(mat));
+    memset(&d, 0, sizeof(d));
+    m.positions = pb_cube_pos;
+    m.vertex_count = 24;
+    m.indices = pb_cube_idx;
+    m.triangle_count = 12;
+    mat.albedo[0] = mat.albedo[1] = mat.albedo[2] = 0.5f;
+    d.meshes = &m;
+    d.mesh_count = 1;
+    d.materials = &mat;
+    d.material_count = 1;
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    rad_patch_options_default(&po);
+    po.target_count = 200;
+    if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
+    if (!P || !bvh) goto done;
+    rad_bvh_raycaster(bvh, &rc);
+    for (i = 0; i < P->count; ++i) CHECK(P->patches[i].normal[0] + P->patches[i].normal[1] + P->patches[i].normal[2] > 0.5f ||
+                                         P->patches[i].normal[0] + P->patches[i].normal[1] + P->patches[i].normal[2] < -0.5f);
+    B = (float *)malloc(sizeof(float) * 3 * P->count);
+    for (i = 0; i < 3 * P->count; ++i) B[i] = 2.0f;
+    rad_probe_options_default(&o);
+    CHECK_OK(rad_probes_create(P, &rc, NULL, 0, &pts[0][0], 3, &o, B, NULL, &pr));
+    if (pr)
+        for (i = 0; i < 3; ++i) {
+            CHECK(rad_probes_states(pr)[i] == RAD_PROBE_VALID);
+            for (k = 0; k < 4; ++k) {
+                float e[3];
+                rad_sh9_irradiance(rad_probes_coefficients(pr) + 27 * i, ns[k], e);
+                CHECK_REL(e[1], 2.0, 0.01);
+            }
+        }
+    rad_probes_destroy(pr);
+    pr = NULL;
+    /* the grid: spacing 0.3 over the unit cube is 4 x 4 x 4 probes, centred */
+    o.spacing = 0.3f;
+    CHECK_OK(rad_probes_create(P, &rc, NULL, 0, NULL, 0, &o, B, NULL, &pr));
+    if (pr) {
+        uint32_t dims[3] = { 0, 0, 0 };
+        float sp = 0.0f, org[3] = { 0, 0, 0 };
+        CHECK(rad_probes_grid(pr, dims, org, &sp) == 1);
+        CHECK(dims[0] == 4 && dims[1] == 4 && dims[2] == 4 && sp == 0.3f);
+        CHECK_NEAR(org[0], 0.05, 1e-6);
+        CHECK(rad_probes_count(pr) == 64);
+        for (i = 0; i < 64; ++i) CHECK(rad_probes_states(pr)[i] == RAD_PROBE_VALID);
+    }
+done:
+    rad_probes_destroy(pr);
+    free(B);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
+/* sampling: continuous along a line through the grid; a normal facing one of two probes takes
+   that probe's value; update from a new solution = a fresh build with it */
+static void pb_test_sampling_update(void)
+{
+    static const float two[2][3] = { { 0.15f, 0.4f, 0.28f }, { 0.40f, 0.4f, 0.28f } };
+    pb_cornell f;
+    rad_probe_options o;
+    rad_probes *pr = NULL, *p2 = NULL;
+    float *B2;
+    uint32_t i;
+    if (!pb_cornell_init(&f, 100)) { CHECK(0); pb_cornell_free(&f); return; }
+    rad_probe_options_default(&o);
+    o.flags = RAD_PROBES_DIRECT;
+    o.spacing = 0.12f;
+    o.rays = 64;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, NULL, &pr));
+    if (pr) {
+        /* a jump J at step i makes that step's difference about J while its neighbours keep the slope;
+           trilinear weights only bend the curve at cell borders (slopes change, nothing jumps) */
+        float e[401][3], n[3] = { 0.3f, 0.9f, -0.2f }, maxv = 0.0f;
+        uint32_t jumps = 0;
+        for (i = 0; i <= 400; ++i) {
+            float p[3];
+            int c;
+            p[0] = 0.05f + 0.45f * (float)i / 400.0f;
+            p[1] = 0.45f;
+            p[2] = 0.05f + 0.4f * (float)i / 400.0f;
+            CHECK_OK(rad_probes_sample(pr, p, n, e[i]));
+            for (c = 0; c < 3; ++c)
+                if (e[i][c] > maxv) maxv = e[i][c];
+        }
+        for (i = 2; i < 400; ++i) {
+            int c;
+            for (c = 0; c < 3; ++c) {
+                float d0 = fabsf(e[i - 1][c] - e[i - 2][c]), d1 = fabsf(e[i][c] - e[i - 1][c]), d2 = fabsf(e[i + 1][c] - e[i][c]);
+                if (d1 > 2.0f * (d0 > d2 ? d0 : d2) + 1e-4f * maxv) ++jumps;
+            }
+        }
+        CHECK(maxv > 1.0f);
+        CHECK(jumps == 0);
+    }
+    rad_probes_destroy(pr);
+    pr = NULL;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &two[0][0], 2, &o, f.B, NULL, &pr));
+    if (pr) {
+        /* above the blocks nothing is occluded: with and without visibility agree */
+        float p[3] = { 0.3f, 0.45f, 0.3f }, n[3] = { 0.2f, 0.9f, 0.1f }, e[3], v[3];
+        int c;
+        CHECK_OK(rad_probes_sample(pr, p, n, e));
+        CHECK_OK(rad_probes_sample_visible(pr, &f.rc, p, n, v));
+        for (c = 0; c < 3; ++c) CHECK(e[c] == v[c] && e[c] > 0.0f);
+    }
+    if (pr) {
+        float mid[3] = { 0.275f, 0.4f, 0.28f }, toA[3] = { -1, 0, 0 }, toB[3] = { 1, 0, 0 }, e[3], a[3];
+        int c;
+        CHECK(rad_probes_states(pr)[0] == RAD_PROBE_VALID && rad_probes_states(pr)[1] == RAD_PROBE_VALID);
+        CHECK_OK(rad_probes_sample(pr, mid, toA, e));
+        rad_sh9_irradiance(rad_probes_coefficients(pr), toA, a);
+        for (c = 0; c < 3; ++c) CHECK_REL(e[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-5); /* clamped at 0 */
+        CHECK_OK(rad_probes_sample(pr, mid, toB, e));
+        rad_sh9_irradiance(rad_probes_coefficients(pr) + 27, toB, a);
+        for (c = 0; c < 3; ++c) CHECK_REL(e[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-5);
+        /* at a probe, with a normal across the line, that probe dominates */
+        CHECK_OK(rad_probes_sample(pr, two[0], toB, e));
+        rad_sh9_irradiance(rad_probes_coefficients(pr), toB, a);
+        for (c = 0; c < 3; ++c) CHECK_NEAR(e[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-3 * a[1]);
+    }
+    rad_probes_destroy(pr);
+    pr = NULL;
+    {
+        /* a probe behind the tall block: sample_visible drops it, sample mixes it in */
+        static const float ab[2][3] = { { 0.15f, 0.2f, 0.35f }, { 0.52f, 0.2f, 0.35f } };
+        float p[3] = { 0.2f, 0.2f, 0.35f }, up[3] = { 0, 1, 0 }, e[3], v[3], a[3];
+        int c;
+        CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &ab[0][0], 2, &o, f.B, NULL, &pr));
+        if (pr) {
+            CHECK(rad_probes_states(pr)[0] == RAD_PROBE_VALID && rad_probes_states(pr)[1] == RAD_PROBE_VALID);
+            CHECK_OK(rad_probes_sample(pr, p, up, e));
+            CHECK_OK(rad_probes_sample_visible(pr, &f.rc, p, up, v));
+            rad_sh9_irradiance(rad_probes_coefficients(pr), up, a);
+            for (c = 0; c < 3; ++c) CHECK_REL(v[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-5);
+            CHECK(fabsf(e[0] - v[0]) > 1e-3f * v[0]);
+            CHECK_RESULT(rad_probes_sample_visible(pr, NULL, p, up, v), RAD_ERROR_INVALID_ARGUMENT);
+        }
+        rad_probes_destroy(pr);
+        pr = NULL;
+    }
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &two[0][0], 2, &o, f.B, NULL, &pr));
+    /* update with another solution = a fresh build with it, bit for bit */
+    B2 = (float *)malloc(sizeof(float) * 3 * f.P->count);
+    for (i = 0; i < 3 * f.P->count; ++i) B2[i] = f.B[i] * (0.5f + 0.001f * (float)(i % 997));
+    if (pr) {
+        CHECK_OK(rad_probes_update(pr, B2, NULL));
+        CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, &two[0][0], 2, &o, B2, NULL, &p2));
+        if (p2) CHECK(memcmp(rad_probes_coefficients(pr), rad_probes_coefficients(p2), sizeof(float) * 54) == 0);
+        CHECK(rad_probes_entry_count(pr) > 0 && rad_probes_entry_count(pr) <= 2 * f.P->count);
+    }
+    rad_probes_destroy(p2);
+    rad_probes_destroy(pr);
+    free(B2);
+    pb_cornell_free(&f);
+}
+
+/* RAD_PROBES_DIRECT with analytic lights over a floor: the odd part E(n) - E(-n) of a point
+   light, a sun and a sky matches rad_direct_irradiance (deltas lie exactly in bands 0-2's odd
+   part; the sky is sampled both ways) */
+static void pb_test_lights(void)
+{
+    static const float floor_pos[12] = { 0, 0, 0, 0, 0, 1, 1, 0, 1, 1, 0, 0 };
+    static const uint32_t floor_idx[6] = { 0, 1, 2, 0, 2, 3 };
+    static const float ns[4][3] = { { 0, 1, 0 }, { 1, 0, 0 }, { 0, 0, 1 }, { 0.48f, 0.6f, -0.64f } };
+    float p[3] = { 0.5f, 0.5f, 0.5f }, *B = NULL;
+    rad_mesh_desc m;
+    rad_material mat;
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_probes *pr = NULL;
+    rad_probe_options o;
+    rad_direct_options dopt;
+    rad_light li[3];
+    int k, c, l;
+    memset(&m, 0, sizeof(m));
+    memset(&mat, 0, sizeof(mat));
+    memset(&d, 0, sizeof(d));
+    memset(li, 0, sizeof(li));
+    m.positions = floor_pos;
+    m.vertex_count = 4;
+    m.indices = floor_idx;
+    m.triangle_count = 2;
+    mat.albedo[0] = mat.albedo[1] = mat.albedo[2] = 0.5f;
+    d.meshes = &m;
+    d.mesh_count = 1;
+    d.materials = &mat;
+    d.material_count = 1;
+    li[0].type = RAD_LIGHT_POINT;
+    li[0].color[0] = 2.0f; li[0].color[1] = 1.0f; li[0].color[2] = 0.5f;
+    li[0].position[0] = 0.7f; li[0].position[1] = 1.5f; li[0].position[2] = 0.4f;
+    li[1].type = RAD_LIGHT_DIRECTIONAL;
+    li[1].color[0] = li[1].color[1] = li[1].color[2] = 0.5f;
+    li[1].direction[0] = -1.0f; li[1].direction[1] = -0.5f;
+    li[2].type = RAD_LIGHT_SKY;
+    li[2].color[0] = li[2].color[1] = li[2].color[2] = 1.0f;
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    if (S) CHECK_OK(rad_patches_create(S, NULL, NULL, &P));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
+    if (!P || !bvh) goto done;
+    rad_bvh_raycaster(bvh, &rc);
+    B = (float *)calloc(3 * (size_t)P->count, sizeof(float));
+    rad_probe_options_default(&o);
+    o.flags = RAD_PROBES_DIRECT;
+    o.rays = 4096;
+    rad_direct_options_default(&dopt);
+    dopt.light_samples = 4096;
+    for (l = 0; l < 3; ++l) {
+        pr = NULL;
+        CHECK_OK(rad_probes_create(P, &rc, &li[l], 1, p, 1, &o, B, NULL, &pr));
+        if (!pr) continue;
+        for (k = 0; k < 4; ++k) {
+            float n[2][3], e[2][3], r[2][3];
+            int j;
+            for (c = 0; c < 3; ++c) { n[0][c] = ns[k][c]; n[1][c] = -ns[k][c]; }
+            for (j = 0; j < 2; ++j) {
+                rad_sh9_irradiance(rad_probes_coefficients(pr), n[j], e[j]);
+                CHECK_OK(rad_direct_irradiance(S, &rc, &li[l], 1, &dopt, p, n[j], 1, r[j], NULL));
+            }
+            for (c = 0; c < 3; ++c) CHECK_NEAR(e[0][c] - e[1][c], r[0][c] - r[1][c], 1e-4 + 0.01 * (r[0][c] + r[1][c]));
+            if (k == 0) CHECK(r[0][1] - r[1][1] > 0.1f); /* every light reaches the top more than the bottom */
+        }
+        rad_probes_destroy(pr);
+    }
+done:
+    free(B);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
+static void pb_test_bad_options(void)
+{
+    pb_cornell f;
+    rad_probe_options o;
+    rad_probes *pr = (rad_probes *)&o;
+    float p[3] = { 0.278f, 0.3f, 0.28f }, bad[3] = { 0.0f, NAN, 0.0f }, e[3], zero[3] = { 0, 0, 0 };
+    rad_light li;
+    if (!pb_cornell_init(&f, 50)) { CHECK(0); pb_cornell_free(&f); return; }
+    rad_probe_options_default(&o);
+    CHECK_RESULT(rad_probes_create(NULL, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(pr == NULL);
+    CHECK_RESULT(rad_probes_create(f.P, NULL, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 0, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, bad, 1, &o, NULL, NULL, &pr), RAD_ERROR_NON_FINITE);
+    o.rays = 70000;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    rad_probe_options_default(&o);
+    o.backface_fraction = 1.5f;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    rad_probe_options_default(&o);
+    o.spacing = -1.0f;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    o.spacing = 1e-5f;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, NULL, NULL, &pr), RAD_ERROR_SIZE_OVERFLOW);
+    rad_probe_options_default(&o);
+    o.ray_epsilon = 0.5f;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    rad_probe_options_default(&o);
+    o.flags = 8;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    o.flags = RAD_PROBES_DIRECT;
+    memset(&li, 0, sizeof(li));
+    li.type = RAD_LIGHT_POINT;
+    li.color[0] = -1.0f;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, &li, 1, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_NEGATIVE_EMISSION);
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 1, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    rad_probe_options_default(&o);
+    f.B[7] = NAN;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, f.B, NULL, &pr), RAD_ERROR_NON_FINITE);
+    CHECK(pr == NULL);
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr));
+    if (pr) {
+        CHECK_RESULT(rad_probes_update(pr, f.B, NULL), RAD_ERROR_NON_FINITE);
+        CHECK_RESULT(rad_probes_update(pr, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_probes_sample(pr, p, zero, e), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_probes_sample(pr, bad, p, e), RAD_ERROR_NON_FINITE);
+        CHECK_RESULT(rad_probes_sample(NULL, p, p, e), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(rad_probes_grid(pr, NULL, NULL, NULL) == 0);
+    }
+    rad_probes_destroy(pr);
+    rad_probes_destroy(NULL);
+    CHECK(rad_probes_count(NULL) == 0);
+    pb_cornell_free(&f);
+}
+
+/* every allocation of a create and an update failing in turn: OUT_OF_MEMORY, nothing leaked */
+static void pb_test_alloc(void)
+{
+    pb_cornell f;
+    rad_probe_options o;
+    sc_alloc_state st;
+    rad_context ctx;
+    long n, total = 1;
+    if (!pb_cornell_init(&f, 50)) { CHECK(0); pb_cornell_free(&f); return; }
+    rad_probe_options_default(&o);
+    o.spacing = 0.2f;
+    o.rays = 32;
+    o.flags = RAD_PROBES_DIRECT;
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.allocator.alloc = sc_alloc_fn;
+    ctx.allocator.free = sc_free_fn;
+    ctx.allocator.user = &st;
+    ctx.task_count = 4;
+    for (n = 0; n <= total; ++n) {
+        rad_probes *pr = NULL;
+        rad_result r;
+        memset(&st, 0, sizeof(st));
+        st.fail_at = n;
+        r = rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, &ctx, &pr);
+        if (r != RAD_SUCCESS) CHECK(pr == NULL);
+        if (r == RAD_SUCCESS) r = rad_probes_update(pr, f.B, &ctx);
+        CHECK(r == RAD_SUCCESS || r == RAD_ERROR_OUT_OF_MEMORY);
+        if (n > 0 && n <= st.calls) CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
+        rad_probes_destroy(pr);
+        CHECK(st.allocs == st.frees && st.live_bytes == 0 && st.corrupt == 0);
+        if (n == 0) total = st.calls;
+    }
+    CHECK(total >= 10);
+    pb_cornell_free(&f);
+}
+
+static const rad_test_case tests_probes[] = {
+    { "probes_sh_projection", pb_test_sh_projection },
+    { "probes_cornell_reference", pb_test_cornell_reference },
+    { "probes_inside_geometry", pb_test_inside },
+    { "probes_constant_room", pb_test_constant_room },
+    { "probes_sampling_update", pb_test_sampling_update },
+    { "probes_lights", pb_test_lights },
+    { "probes_bad_options", pb_test_bad_options },
+    { "probes_alloc", pb_test_alloc },
+    { NULL, NULL }
+};
