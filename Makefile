@@ -7,7 +7,7 @@
 #   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
 #   make bench   writes BENCHMARKS.md (long: minutes)
-#   make tools   builds the command-line tools in tools/
+#   make tools   builds the command-line tools in tools/ (and tools/rad-mpi when mpicc is installed)
 #   make glsl    regenerates the GLSL sources embedded in radiosity.h from glsl/
 #   make report  the evaluation report (every method vs the path-traced reference, plots) into
 #                report/ (long: about 15 min); make report-quick: a small one into build/, checked
@@ -25,7 +25,7 @@ EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
 
-.PHONY: all demo gallery walk learn moving-light test bench bench-quick tools fuzz clean glsl report report-quick
+.PHONY: all demo gallery walk learn moving-light test bench bench-quick tools rad-mpi fuzz clean glsl report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk $(BUILD)/realtime tools
 
@@ -118,7 +118,17 @@ bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal
 	./$(BUILD)/local --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/probes --quick --append $(BUILD)/BENCHMARKS-quick.md
 
-tools: $(BUILD)/rad
+# the MPI driver of the distributed bake (docs/distributed.md), when OpenMPI is installed
+# (Debian libopenmpi-dev openmpi-bin): the tool's sources but main.c, with tools/mpi/rad_mpi.c's main
+MPICC   ?= mpicc
+HAVE_MPICC := $(shell command -v $(MPICC) 2>/dev/null)
+tools: $(BUILD)/rad $(if $(HAVE_MPICC),$(BUILD)/rad-mpi)
+
+rad-mpi: $(BUILD)/rad-mpi
+
+$(BUILD)/rad-mpi: tools/mpi/rad_mpi.c $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
+	$(MPICC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. $(filter-out tools/main.c,$(wildcard tools/*.c)) tools/mpi/rad_mpi.c -o $@ -lassimp -lm
+	cp $@ tools/rad-mpi
 
 # the tool needs assimp (scene import) and stb (images): Debian libassimp-dev libstb-dev
 $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
@@ -152,7 +162,7 @@ fuzz: | $(BUILD)
 	if [ -n "$$failed" ]; then echo "fuzz: failed:$$failed"; exit 1; fi
 
 clean:
-	rm -rf $(BUILD) cornell.png gallery.png tools/rad
+	rm -rf $(BUILD) cornell.png gallery.png tools/rad tools/rad-mpi
 
 # the GLSL kernels: glsl/*.comp are the canonical sources, embedded into radiosity.h
 $(BUILD)/glsl_embed: glsl/embed.c | $(BUILD)

@@ -736,6 +736,31 @@ RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_ra
                                         const rad_form_factor_options *options, uint32_t row_begin,
                                         uint32_t row_end, float *out_rows, const rad_context *ctx);
 
+/* The upper-triangle pairs of some rows: every pair {i, j} with i in one of the row ranges
+   [ranges[2k], ranges[2k+1]) (k < range_count; ascending and disjoint, empty ones allowed)
+   and i < j < N, each computed once (no pair outside them), so that disjoint ranges covering
+   [0, N) together compute each unordered pair exactly once, as the dense call does: a bake
+   split over processes or machines does the work of one dense call, not twice it. One call
+   takes all of a part's ranges, so its threads share all of its rows. Output, packed range
+   after range and row after row (row i holds N - 1 - i entries, j = i+1 .. N-1): out_upper
+   gets F_ij and out_lower F_ji, each the sum of rad_form_factor_pair_count over the ranges
+   floats. Each value has the same bits as in rad_form_factors_dense and rad_form_factor_rows
+   (the same points, the same side, the same reciprocity product), so the full matrix
+   assembled from the pieces equals the dense one bit for bit. The diagonal is 0 and not
+   stored. out_pairs_evaluated (may be NULL) gets the pairs whose value was computed (the
+   facing ones, as rad_form_factors.pairs_evaluated). RAD_FF_HEMICUBE computes each row on its
+   own (no reciprocity): INVALID_ARGUMENT, use the rows call. Errors: INVALID_ARGUMENT (also
+   ranges out of [0, N], reversed, overlapping or out of order), OUT_OF_MEMORY,
+   RAYCAST_FAILED, CANCELLED. Thread safety: reentrant; uses ctx->parallel_for.
+   Cost: O(pair count x samples). */
+RAD_API rad_result rad_form_factor_pairs(const rad_patches *patches, const rad_raycaster *raycaster,
+                                         const rad_form_factor_options *options, const uint32_t *ranges,
+                                         uint32_t range_count, float *out_upper, float *out_lower,
+                                         uint64_t *out_pairs_evaluated, const rad_context *ctx);
+/* The pairs {i, j}, row_begin <= i < row_end, i < j < n: sum of (n - 1 - i); 0 when the range
+   is empty or not within [0, n]. Pure. */
+RAD_API uint64_t rad_form_factor_pair_count(uint32_t n, uint32_t row_begin, uint32_t row_end);
+
 /* The dense N x N matrix (N = patches->count; SIZE_OVERFLOW when N*N*4 bytes does not fit).
    Computes each unordered pair once: half the work of N rows (the hemicube: N rows). Same
    values as the rows call. */
@@ -5118,7 +5143,12 @@ typedef struct rad__ff {
     float *out;
     uint32_t row_begin;           /* rows call: matrix row of out's first row */
     size_t out_stride;
-    int dense_mode;               /* 1: compute j > i and mirror into a full N x N 'out' */
+    int dense_mode;               /* 1: compute j > i and mirror into a full N x N 'out';
+                                     2 (pairs call): j > i into packed 'out' and 'out_lower' */
+    float *out_lower;             /* pairs call: F_ji, packed like 'out' */
+    const uint32_t *pr_ranges;    /* pairs call: the row ranges, their count, the cumulative */
+    uint32_t pr_count;            /* rows and pairs before each (count + 1 each) and the packed */
+    uint64_t *pr_rows, *pr_pairs, *pr_at; /* offset of each task's current row */
     uint32_t tasks;
     /* RAD_FF_HEMICUBE (the pair fields above stay NULL) */
     uint32_t hc_res;
@@ -5538,16 +5568,30 @@ static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
     r = rad__ff_flush(f, task, nrays);
     if (r != RAD_SUCCESS) return r;
     if (f->dense_mode) {
-        float *row = f->out + (size_t)i * N;
-        row[i] = 0.0f;
-        for (j = i + 1; j < N; ++j) {
+        /* F_ij and F_ji of each pair j > i: in place in the full matrix, or packed (pairs call:
+           entry k of row i is j = i + 1 + k) */
+        float *up, *lo;
+        size_t up_at, lo_at, lo_stride;
+        if (f->dense_mode == 1) {
+            up = lo = f->out;
+            f->out[(size_t)i * N + i] = 0.0f;
+            up_at = (size_t)i * N + i + 1u;
+            lo_at = (size_t)(i + 1u) * N + i;
+            lo_stride = N;
+        } else {
+            up = f->out;
+            lo = f->out_lower;
+            up_at = lo_at = (size_t)f->pr_at[task];
+            lo_stride = 1;
+        }
+        for (j = i + 1; j < N; ++j, ++up_at, lo_at += lo_stride) {
             float v = (float)acc[j] * inv_s;
             if (rad__ff_from_i(f, i, j)) {
-                row[j] = v;
-                f->out[(size_t)j * N + i] = v * (f->P->areas[i] / f->P->areas[j]);
+                up[up_at] = v;
+                lo[lo_at] = v * (f->P->areas[i] / f->P->areas[j]);
             } else {
-                f->out[(size_t)j * N + i] = v;
-                row[j] = v * (f->P->areas[j] / f->P->areas[i]);
+                lo[lo_at] = v;
+                up[up_at] = v * (f->P->areas[j] / f->P->areas[i]);
             }
         }
     } else {
@@ -5723,6 +5767,92 @@ RAD_API rad_result rad_form_factor_rows(const rad_patches *patches, const rad_ra
     f.row_begin = row_begin;
     f.out_stride = patches->count;
     r = rad__for_rows(&c, row_end - row_begin, f.tasks, rad__ff_row_offset, &f);
+    rad__ff_release(&f, &c.allocator);
+    return r;
+}
+
+RAD_API uint64_t rad_form_factor_pair_count(uint32_t n, uint32_t row_begin, uint32_t row_end)
+{
+    /* pairs of the rows before i: i (n - 1) - i (i - 1) / 2 */
+    uint64_t b = row_begin, e = row_end, m = n ? (uint64_t)n - 1u : 0u;
+    if (row_begin >= row_end || row_end > n) return 0;
+    return (e * m - e * (e - 1u) / 2u) - (b * m - (b ? b * (b - 1u) / 2u : 0u));
+}
+
+/* pairs call: task row t is row i of range k, with pr_rows[k] <= t < pr_rows[k + 1]; its
+   packed entries start at pr_pairs[k] plus the pairs of the range's rows before i */
+static rad_result rad__ff_pairs_task(void *data, uint32_t t, uint32_t task)
+{
+    rad__ff *f = (rad__ff *)data;
+    uint32_t lo = 0, hi = f->pr_count, i;
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (f->pr_rows[mid] <= t) lo = mid;
+        else hi = mid;
+    }
+    i = f->pr_ranges[2 * lo] + (uint32_t)(t - f->pr_rows[lo]);
+    f->pr_at[task] = f->pr_pairs[lo] + rad_form_factor_pair_count(f->P->count, f->pr_ranges[2 * lo], i);
+    return rad__ff_row(data, i, task);
+}
+
+RAD_API rad_result rad_form_factor_pairs(const rad_patches *patches, const rad_raycaster *raycaster,
+                                         const rad_form_factor_options *options, const uint32_t *ranges,
+                                         uint32_t range_count, float *out_upper, float *out_lower,
+                                         uint64_t *out_pairs_evaluated, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ff f;
+    rad_result r;
+    uint64_t rays = 0, pairs = 0, rows = 0, *cum;
+    uint32_t k, N;
+    rad__ctx_init(&c, ctx);
+    if (out_pairs_evaluated) *out_pairs_evaluated = 0;
+    if (!patches || (range_count && !ranges)) return RAD_ERROR_INVALID_ARGUMENT;
+    N = patches->count;
+    for (k = 0; k < range_count; ++k) {
+        uint32_t b = ranges[2 * k], e = ranges[2 * k + 1];
+        if (b > e || e > N || (k && b < ranges[2 * k - 1])) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_form_factor_pairs: range %u is [%u, %u): reversed, beyond the %u patches or "
+                     "before the range ahead of it", k, b, e, N);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        rows += e - b;
+        pairs += rad_form_factor_pair_count(N, b, e);
+    }
+    if (options && options->method == RAD_FF_HEMICUBE) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_form_factor_pairs: the hemicube computes each row on its own (no reciprocity); "
+                 "use rad_form_factor_rows");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (pairs == 0) return RAD_SUCCESS;
+    if (!out_upper || !out_lower) return RAD_ERROR_INVALID_ARGUMENT;
+    if (rows < c.tasks) c.tasks = (uint32_t)rows;
+    r = rad__ff_setup(&f, patches, raycaster, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    /* cumulative rows and pairs of the ranges, then one packed offset per task */
+    cum = (uint64_t *)rad__alloc_array(&c.allocator, 2 * (size_t)range_count + 2 + f.tasks, sizeof(uint64_t));
+    if (!cum) {
+        rad__ff_release(&f, &c.allocator);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    f.pr_rows = cum;
+    f.pr_pairs = cum + range_count + 1;
+    f.pr_at = cum + 2 * (size_t)range_count + 2;
+    f.pr_rows[0] = f.pr_pairs[0] = 0;
+    for (k = 0; k < range_count; ++k) {
+        f.pr_rows[k + 1] = f.pr_rows[k] + (ranges[2 * k + 1] - ranges[2 * k]);
+        f.pr_pairs[k + 1] = f.pr_pairs[k] + rad_form_factor_pair_count(N, ranges[2 * k], ranges[2 * k + 1]);
+    }
+    f.pr_ranges = ranges;
+    f.pr_count = range_count;
+    f.out = out_upper;
+    f.out_lower = out_lower;
+    f.dense_mode = 2;
+    r = rad__for_rows(&c, (uint32_t)rows, f.tasks, rad__ff_pairs_task, &f);
+    pairs = 0;
+    rad__ff_totals(&f, &rays, &pairs);
+    if (out_pairs_evaluated) *out_pairs_evaluated = pairs;
+    rad__free(&c.allocator, cum);
     rad__ff_release(&f, &c.allocator);
     return r;
 }

@@ -106,6 +106,7 @@ have spirv-val || try_install spirv-tools
 { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
 have clang || try_install clang libclang-rt-14-dev
 have valgrind || try_install valgrind
+{ have mpicc && have mpirun; } || try_install libopenmpi-dev openmpi-bin
 HAVE_ASAN_CLANG=0; HAVE_FUZZER=0
 if have clang; then
     printf 'int main(void){return 0;}' | clang -fsanitize=address,undefined -x c - -o /dev/null 2>/dev/null && HAVE_ASAN_CLANG=1
@@ -318,6 +319,38 @@ s_report() {
         fail report-quick; tail -n 20 "$BUILD/report-quick.log" | sed 's/^/    /'
     fi
 }
+# the distributed bake (tests/dist_tests.sh): shards, merge and, with OpenMPI, tools/rad-mpi.
+# The tool's objects are compiled once and linked twice: rad with main.c, rad-mpi with its own.
+s_dist() {
+    have_tool_deps || return 0
+    local o="$BUILD/dist-obj" f mpi="" out nf ns
+    mkdir -p "$o"
+    for f in tools/*.c; do
+        build "dist-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP -I. -c "$f" -o "$o/$(basename "$f" .c).o" ||
+            { fail "dist (build $f)"; return; }
+    done
+    if ! build dist-rad $CC $OMP "$o"/*.o -o "$BUILD/rad-dist" -lassimp -lm ||
+       ! build dist-part-edit $CC -std=c99 $WARN -O2 -I. tests/dist_part_edit.c -o "$BUILD/dist_part_edit" -lm; then
+        fail "dist (build)"; return
+    fi
+    if have mpicc && have mpirun; then
+        if build rad-mpi mpicc -std=c99 $WARN -O2 $OMP -I. tools/mpi/rad_mpi.c $(ls "$o"/*.o | grep -v '/main\.o$') \
+               -o "$BUILD/rad-mpi" -lassimp -lm; then
+            mpi="$BUILD/rad-mpi"
+        else
+            fail "rad-mpi (build)"
+        fi
+    fi
+    echo "== distributed bake"
+    out=$(bash tests/dist_tests.sh "$BUILD/rad-dist" "$BUILD/dist_part_edit" "$mpi" 2>&1)
+    echo "$out" | grep -E '^(ok|FAIL)' | sed 's/^/  /'
+    PASSED=$((PASSED + $(echo "$out" | grep -c '^ok')))
+    nf=$(echo "$out" | grep -c '^FAIL')
+    FAILED=$((FAILED + nf))
+    [ "$nf" = 0 ] || FAILED_NAMES="$FAILED_NAMES dist-tests"
+    ns=$(echo "$out" | grep -c '^skip ')
+    [ "$ns" = 0 ] || skip dist-mpi "$(echo "$out" | grep -m1 '^skip ' | sed 's/^skip [^:]*: //')"
+}
 s_test_tool() {
     have_tool_deps || return 0
     unit test-tool $CC -std=c99 $WARN -O2 $OMP -I. tests/test_tool.c tools/image.c tools/metrics.c tools/trace.c
@@ -404,6 +437,7 @@ stage asan-O0 s_asan_O0
 stage clang-asan-O1 s_clang_asan_O1
 stage tool s_tool
 stage report s_report
+stage dist s_dist
 stage asan-O1-native s_asan_O1_native
 stage asan-O2-scalar s_asan_O2_scalar
 stage clang-asan-O2 s_clang_asan_O2

@@ -491,6 +491,7 @@ static void api_ff_kernels(api_fx *f)
 /* bad form-factor options: each must give INVALID_ARGUMENT from every entry point */
 static void api_ff_bad_options(api_fx *f)
 {
+    static const uint32_t two_rows[2] = {0, 2};
     rad_form_factor_options o[8];
     uint32_t i, count = 0;
     rad_form_factors *ff;
@@ -508,6 +509,10 @@ static void api_ff_bad_options(api_fx *f)
         api_fill(f->buf, f->buf_len);
         CHECK_RESULT(rad_form_factor_rows(f->P, &f->rc, &o[i], 0, 2, f->buf, NULL), RAD_ERROR_INVALID_ARGUMENT);
         CHECK(api_untouched(f->buf, f->buf_len));
+        api_fill(f->buf2, f->buf_len);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, &o[i], two_rows, 1, f->buf, f->buf2, NULL, NULL),
+                     RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(api_untouched(f->buf, f->buf_len) && api_untouched(f->buf2, f->buf_len));
         ff = API_SENTINEL(rad_form_factors);
         CHECK_RESULT(rad_form_factors_dense(f->P, &f->rc, &o[i], NULL, &ff), RAD_ERROR_INVALID_ARGUMENT);
         CHECK(ff == NULL);
@@ -544,6 +549,32 @@ static void api_ff_args(api_fx *f)
     CHECK_OK(rad_form_factor_rows(f->P, &f->rc, NULL, 3, 3, f->buf, NULL)); /* an empty range writes nothing */
     CHECK_OK(rad_form_factor_rows(f->P, &f->rc, NULL, N, N, f->buf, NULL));
     CHECK(api_untouched(f->buf, f->buf_len));
+    /* pairs: the same refusals, nothing written; no pairs at all (the last row has no j > i) is fine */
+    {
+        uint64_t ev = 7;
+        uint32_t r[4];
+        api_fill(f->buf2, f->buf_len);
+        r[0] = 0, r[1] = 1;
+        CHECK_RESULT(rad_form_factor_pairs(NULL, &f->rc, NULL, r, 1, f->buf, f->buf2, &ev, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(ev == 0);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, NULL, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, r, 1, NULL, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, r, 1, f->buf, NULL, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, NULL, NULL, r, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &half, NULL, r, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        r[0] = 2, r[1] = 1;
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, r, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        r[0] = 0, r[1] = N + 1;
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, r, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        r[0] = r[1] = 0xFFFFFFFFu;
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, r, 1, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        r[0] = 0, r[1] = 2, r[2] = 1, r[3] = 3; /* overlapping */
+        CHECK_RESULT(rad_form_factor_pairs(f->P, &f->rc, NULL, r, 2, f->buf, f->buf2, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        r[0] = N - 1, r[1] = N;
+        CHECK_OK(rad_form_factor_pairs(f->P, &f->rc, NULL, r, 1, NULL, NULL, &ev, NULL));
+        CHECK(ev == 0);
+        CHECK(api_untouched(f->buf, f->buf_len) && api_untouched(f->buf2, f->buf_len));
+    }
     o.skip_visibility = 1; /* the raycaster may be NULL then */
     CHECK_OK(rad_form_factor_rows(f->P, NULL, &o, 0, 1, f->buf, NULL));
     o.samples = 0xFFFFFFFFu; /* capped */

@@ -712,6 +712,86 @@ done:
     ff_world_free(&w);
 }
 
+/* rad_form_factor_pairs: disjoint row ranges of the upper triangle, reassembled, give the
+   dense matrix bit for bit and evaluate exactly the dense call's pairs (each once) */
+static void ff_test_pairs(void)
+{
+    ff_quad q[6];
+    rad_mesh_desc meshes[6];
+    ff_world w;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL;
+    float *full = NULL, *up = NULL, *lo = NULL;
+    uint32_t N, i, j, cuts[5];
+    uint64_t total = 0, pairs_sum = 0, pairs;
+    int k;
+    if (!ff_cube_world(q, meshes, &w)) return;
+    N = w.patches->count;
+    rad_form_factor_options_default(&fo);
+    CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &ff));
+    full = (float *)malloc(sizeof(float) * (size_t)N * N);
+    up = (float *)malloc(sizeof(float) * (size_t)N * N);
+    lo = (float *)malloc(sizeof(float) * (size_t)N * N);
+    CHECK(full && up && lo && N > 8);
+    if (!ff || !full || !up || !lo || N <= 8) goto done;
+    /* the counts: N (N - 1) / 2 in all, additive over ranges, 0 when empty or out of range */
+    CHECK(rad_form_factor_pair_count(N, 0, N) == (uint64_t)N * (N - 1u) / 2u);
+    CHECK(rad_form_factor_pair_count(N, 3, 3) == 0 && rad_form_factor_pair_count(N, 0, N + 1) == 0);
+    CHECK(rad_form_factor_pair_count(N, N - 1, N) == 0 && rad_form_factor_pair_count(N, 0, 1) == N - 1u);
+    CHECK(rad_form_factor_pair_count(4000000000u, 0, 4000000000u) == 4000000000ull * 3999999999ull / 2u);
+    cuts[0] = 0;
+    cuts[1] = 1;
+    cuts[2] = N / 3;
+    cuts[3] = N / 3 + N / 4;
+    cuts[4] = N;
+    memset(full, 0xAB, sizeof(float) * (size_t)N * N);
+    for (i = 0; i < N; ++i) full[(size_t)i * N + i] = 0.0f;
+    /* two calls: ranges 0 and 2 (not adjacent, with an empty one between), then 1 and 3 */
+    for (k = 0; k < 2; ++k) {
+        uint32_t r[6], c, nr = 0;
+        uint64_t n = 0, at = 0;
+        for (c = (uint32_t)k; c < 4; c += 2) {
+            r[2 * nr] = cuts[c], r[2 * nr + 1] = cuts[c + 1], ++nr;
+            n += rad_form_factor_pair_count(N, cuts[c], cuts[c + 1]);
+            if (c == 0) r[2 * nr] = r[2 * nr + 1] = cuts[1], ++nr; /* an empty range */
+        }
+        total += n;
+        CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, r, nr, up, lo, &pairs, NULL));
+        pairs_sum += pairs;
+        for (c = 0; c < nr; ++c)
+            for (i = r[2 * c]; i < r[2 * c + 1]; ++i)
+                for (j = i + 1; j < N; ++j, ++at) {
+                    full[(size_t)i * N + j] = up[at];
+                    full[(size_t)j * N + i] = lo[at];
+                }
+        CHECK(at == n);
+    }
+    CHECK(total == (uint64_t)N * (N - 1u) / 2u);
+    CHECK(memcmp(full, ff->matrix.dense, sizeof(float) * (size_t)N * N) == 0);
+    CHECK(pairs_sum == ff->pairs_evaluated && pairs_sum > 0);
+    printf("    %u patches: %llu pairs evaluated in 4 ranges, %llu by the dense call\n", N, (unsigned long long)pairs_sum,
+           (unsigned long long)ff->pairs_evaluated);
+    /* no pairs, bad ranges (beyond N, overlapping, out of order), the hemicube (no reciprocity) */
+    cuts[0] = N - 1, cuts[1] = N;
+    CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 1, NULL, NULL, NULL, NULL));
+    CHECK_OK(rad_form_factor_pairs(w.patches, &w.rc, &fo, NULL, 0, NULL, NULL, NULL, NULL));
+    cuts[0] = 2, cuts[1] = N + 1;
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 1, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    cuts[0] = 0, cuts[1] = 4, cuts[2] = 3, cuts[3] = 5;
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 2, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    cuts[0] = 4, cuts[1] = 5, cuts[2] = 0, cuts[3] = 2;
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts, 2, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts + 2, 1, NULL, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+    fo.method = RAD_FF_HEMICUBE;
+    CHECK(rad_form_factor_pairs(w.patches, &w.rc, &fo, cuts + 2, 1, up, lo, NULL, NULL) == RAD_ERROR_INVALID_ARGUMENT);
+done:
+    free(full);
+    free(up);
+    free(lo);
+    rad_form_factors_destroy(ff);
+    ff_world_free(&w);
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* 6. determinism                                                                           */
 /* ---------------------------------------------------------------------------------------- */
@@ -1189,6 +1269,7 @@ static const rad_test_case tests_formfactor[] = {
     { "formfactor_monte_carlo", ff_test_monte_carlo },
     { "formfactor_enclosure_cube", ff_test_enclosure_cube },
     { "formfactor_rows_sparse", ff_test_rows_sparse },
+    { "formfactor_pairs", ff_test_pairs },
     { "formfactor_determinism", ff_test_determinism },
     { "formfactor_cornell", ff_test_cornell },
     { "formfactor_bvh_brute_force", ff_test_bvh_brute_force },

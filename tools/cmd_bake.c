@@ -18,6 +18,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 void rad_tool_classic_options_default(rad_tool_classic_options *o)
 {
@@ -104,25 +105,20 @@ void rad_tool_classic_free(rad_tool_classic *c)
     memset(c, 0, sizeof *c);
 }
 
-int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                           rad_tool_classic *out)
+int rad_tool_classic_sources(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                             rad_tool_classic *out)
 {
     rad_patch_options po;
-    rad_form_factor_options fo;
     rad_direct_options dopt;
-    rad_solve_options so;
-    rad_solve_stats stats;
-    rad_system sys;
     rad_context ctx;
     rad_result r;
-    uint32_t n, i;
-    double t0, t1;
+    uint32_t n;
+    double t0 = rad_tool_seconds();
     memset(out, 0, sizeof *out);
     rad_tool_context(&ctx, NULL);
     rad_patch_options_default(&po);
     po.target_count = o->patches;
     po.max_edge = o->max_edge;
-    t0 = rad_tool_seconds();
     /* at least one patch per triangle: a scene too big for F is refused before any work */
     if (rad_tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
     if ((r = rad_patches_create(w->scene, &po, &ctx, &out->patches)) != RAD_SUCCESS)
@@ -133,27 +129,8 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
         rad_tool_classic_free(out);
         return 1;
     }
-
-    if (!(o->sources_only && o->no_form_factors)) {
-        rad_form_factor_options_default(&fo);
-        fo.samples = o->samples;
-        rad_tool_context(&ctx, "form factors");
-        r = rad_form_factors_dense(out->patches, &w->rc, &fo, &ctx, &out->ff);
-        rad_tool_progress_end();
-        if (r != RAD_SUCCESS) {
-            rad_tool_classic_free(out);
-            return rad_tool_fail(cmd, "rad_form_factors_dense", r);
-        }
-        fprintf(stderr, "rad %s: form factors %u x %u (%.1f MB) in %.2f s\n", cmd, n, n, 4.0 * n * (double)n / 1e6,
-                rad_tool_seconds() - t0);
-    }
-
     out->D = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     out->E = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    out->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    out->B = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    out->H = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    t0 = rad_tool_seconds();
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
     dopt.light_samples = o->light_samples;
@@ -169,14 +146,24 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
         rad_tool_classic_free(out);
         return rad_tool_fail(cmd, "rad_sources", r);
     }
-    if (o->sources_only) {
-        free(out->L), free(out->B), free(out->H);
-        out->L = out->B = out->H = NULL;
-        fprintf(stderr, "rad %s: direct light in %.2f s\n", cmd, rad_tool_seconds() - t0);
-        return 0;
-    }
+    fprintf(stderr, "rad %s: direct light in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    return 0;
+}
 
-    rad_system_init(&sys, &out->ff->matrix, out->patches, out->E);
+int rad_tool_classic_indirect(const char *cmd, const rad_tool_classic_options *o, const rad_matrix *F,
+                              rad_tool_classic *c)
+{
+    rad_solve_options so;
+    rad_solve_stats stats;
+    rad_system sys;
+    rad_context ctx;
+    rad_result r;
+    uint32_t n = c->patches->count, i;
+    double t1;
+    c->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    c->B = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    c->H = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    rad_system_init(&sys, F, c->patches, c->E);
     rad_solve_options_default(&so);
     so.output = RAD_OUTPUT_INDIRECT;
     so.bounces = o->bounces;
@@ -185,32 +172,74 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     t1 = rad_tool_seconds();
     switch (o->solver) {
     case RAD_TOOL_GAUSS_SEIDEL:
-        r = rad_solve_gauss_seidel(&sys, &so, out->L, &stats, &ctx);
+        r = rad_solve_gauss_seidel(&sys, &so, c->L, &stats, &ctx);
         if (r == RAD_ERROR_NOT_CONVERGED) {
             fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge (residual %g after %u sweeps)\n", cmd,
                     stats.residual, stats.iterations);
             r = RAD_SUCCESS;
         }
         break;
-    case RAD_TOOL_DIRECT: r = rad_solve_direct(&sys, &so, out->L, &ctx); break;
-    default: r = rad_solve_jacobi(&sys, &so, out->L, &stats, &ctx); break;
+    case RAD_TOOL_DIRECT: r = rad_solve_direct(&sys, &so, c->L, &ctx); break;
+    default: r = rad_solve_jacobi(&sys, &so, c->L, &stats, &ctx); break;
     }
-    out->solve_seconds = rad_tool_seconds() - t1;
+    c->solve_seconds = rad_tool_seconds() - t1;
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) return rad_tool_fail(cmd, "solve", r);
+    for (i = 0; i < 3 * n; ++i) c->B[i] = c->E[i] + c->L[i];
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_matrix_multiply(F, c->B, c->H, &ctx)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_matrix_multiply", r);
+    fprintf(stderr, "rad %s: %s solve in %.2f s\n", cmd,
+            o->solver == RAD_TOOL_GAUSS_SEIDEL ? "Gauss-Seidel" : o->solver == RAD_TOOL_DIRECT ? "direct (LU)" : "Jacobi",
+            c->solve_seconds);
+    return 0;
+}
+
+int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                           rad_tool_classic *out)
+{
+    rad_form_factor_options fo;
+    rad_context ctx;
+    rad_result r;
+    uint32_t n;
+    double t0;
+    clock_t c0;
+    if (rad_tool_classic_sources(cmd, w, o, out)) return 1;
+    if (o->sources_only && o->no_form_factors) return 0;
+    n = out->patches->count;
+    t0 = rad_tool_seconds();
+    c0 = clock();
+    rad_form_factor_options_default(&fo);
+    fo.samples = o->samples;
+    rad_tool_context(&ctx, "form factors");
+    r = rad_form_factors_dense(out->patches, &w->rc, &fo, &ctx, &out->ff);
     rad_tool_progress_end();
     if (r != RAD_SUCCESS) {
         rad_tool_classic_free(out);
-        return rad_tool_fail(cmd, "solve", r);
+        return rad_tool_fail(cmd, "rad_form_factors_dense", r);
     }
-    for (i = 0; i < 3 * n; ++i) out->B[i] = out->E[i] + out->L[i];
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_matrix_multiply(&out->ff->matrix, out->B, out->H, &ctx)) != RAD_SUCCESS) {
+    /* the CPU time too: the work of a sharded bake is compared with it (docs/distributed.md) */
+    fprintf(stderr, "rad %s: form factors %u x %u (%.1f MB), %llu pairs evaluated, in %.2f s (%.2f s CPU)\n", cmd, n, n,
+            4.0 * n * (double)n / 1e6, (unsigned long long)out->ff->pairs_evaluated, rad_tool_seconds() - t0,
+            (double)(clock() - c0) / CLOCKS_PER_SEC);
+    if (o->sources_only) return 0;
+    if (rad_tool_classic_indirect(cmd, o, &out->ff->matrix, out)) {
         rad_tool_classic_free(out);
-        return rad_tool_fail(cmd, "rad_matrix_multiply", r);
+        return 1;
     }
-    fprintf(stderr, "rad %s: direct light and %s solve in %.2f s\n", cmd,
-            o->solver == RAD_TOOL_GAUSS_SEIDEL ? "Gauss-Seidel" : o->solver == RAD_TOOL_DIRECT ? "direct (LU)" : "Jacobi",
-            rad_tool_seconds() - t0);
     return 0;
+}
+
+void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, const rad_tool_classic_options *o)
+{
+    memset(info, 0, sizeof *info);
+    info->magic = 0x52414442u;
+    info->patches = o->patches;
+    info->max_edge = o->max_edge;
+    info->samples = o->samples;
+    info->solver = (uint32_t)o->solver;
+    info->bounces = o->bounces;
+    info->light_samples = o->light_samples;
+    info->triangle_count = w->scene->triangle_count;
 }
 
 uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w)
@@ -235,7 +264,8 @@ void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bak
         }
 }
 
-/* rad_save_memory's container plus our sections, written to 'path' */
+/* rad_save_memory's container plus our sections, written to 'path'. rad merge (cmd_merge.c)
+   writes the same sections in the same order from a sharded bake's parts: change both. */
 static int save_bake(const char *cmd, const char *path, const rad_tool_world *w, const rad_tool_classic_options *o,
                      const rad_tool_classic *c)
 {
@@ -259,15 +289,7 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     count = rad_container_section_count(ct);
     secs = (rad_section *)rad_tool_calloc((size_t)count + 4, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
-    memset(&info, 0, sizeof info);
-    info.magic = 0x52414442u;
-    info.patches = o->patches;
-    info.max_edge = o->max_edge;
-    info.samples = o->samples;
-    info.solver = (uint32_t)o->solver;
-    info.bounces = o->bounces;
-    info.light_samples = o->light_samples;
-    info.triangle_count = w->scene->triangle_count;
+    rad_tool_bake_info_fill(&info, w, o);
     rad_tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->L;
     strcpy(secs[k++].name, "L");
@@ -418,79 +440,104 @@ static void bake_usage(FILE *f)
                "%s"
                "%s"
                "%s"
+               "  --shard I/N        classic: bake part I of N (0 <= I < N) into FILE; rad merge joins the\n"
+               "                     N parts into the bake itself (docs/distributed.md)\n"
+               "  --rows A:B         classic: bake the part holding rows A to B-1 (instead of --shard)\n"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
             rad_tool_classic_help(), rad_tool_method_help(0), rad_tool_light_help());
 }
 
-static int bake_main(int argc, char **argv, rad_tool_lights *lights)
+int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_args *args)
 {
-    const char *cmd = "bake", *scene_name = NULL, *out_path = NULL;
-    rad_tool_classic_options o;
-    rad_tool_method_options mo;
-    rad_tool_world w;
-    rad_tool_classic c;
-    uint32_t threads = 0;
-    double t0 = rad_tool_seconds();
     int a, rc;
-    rad_tool_classic_options_default(&o);
-    rad_tool_method_options_default(&mo);
+    memset(args, 0, sizeof *args);
+    rad_tool_classic_options_default(&args->o);
+    rad_tool_method_options_default(&args->mo);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { bake_usage(stdout); return 0; }
-        rc = rad_tool_method_option(cmd, argc, argv, &a, &mo);
+        rc = rad_tool_method_option(cmd, argc, argv, &a, &args->mo);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        rc = rad_tool_classic_option(cmd, argc, argv, &a, &args->o);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        rc = rad_tool_light_option(cmd, argc, argv, &a, lights);
+        rc = rad_tool_light_option(cmd, argc, argv, &a, &args->lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads")) && a + 1 >= argc) {
+        if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--shard") || !strcmp(opt, "--rows")) &&
+            a + 1 >= argc) {
             fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
             return 2;
         }
-        if (!strcmp(opt, "-o")) out_path = argv[++a];
+        if (!strcmp(opt, "-o")) args->out = argv[++a];
         else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
+            if (rad_tool_parse_threads(cmd, opt, argv[++a], &args->threads)) return 2;
+        } else if (!strcmp(opt, "--shard")) {
+            if (rad_tool_parse_shard(cmd, argv[++a], &args->shard)) return 2;
+        } else if (!strcmp(opt, "--rows")) {
+            if (rad_tool_parse_rows(cmd, argv[++a], &args->shard)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad bake --help)\n", cmd, opt);
             return 2;
-        } else if (!scene_name) scene_name = opt;
+        } else if (!args->scene) args->scene = opt;
         else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
     }
-    if (!scene_name || !out_path) {
-        fprintf(stderr, "rad %s: %s\n", cmd, !scene_name ? "no scene given" : "no output file given (-o FILE.radb)");
+    if (!args->scene || !args->out) {
+        fprintf(stderr, "rad %s: %s\n", cmd, !args->scene ? "no scene given" : "no output file given (-o FILE.radb)");
         bake_usage(stderr);
         return 2;
     }
-    if (rad_tool_method_check(cmd, 0, &mo, &o)) return 2;
-    rad_tool_dense_plan(&o, &mo, 1);
-    if (rad_tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
-    rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
-    if (mo.method == RAD_TOOL_VP || mo.method == RAD_TOOL_AAVP) {
-        rc = bake_vp(cmd, out_path, &w, &o, &mo);
+    if (args->shard.rows && args->shard.count) {
+        fprintf(stderr, "rad %s: --shard and --rows both choose the part: give one\n", cmd);
+        return 2;
+    }
+    if ((args->shard.rows || args->shard.count) && args->mo.method != RAD_TOOL_CLASSIC) {
+        fprintf(stderr, "rad %s: --shard and --rows split the classic bake's form factors; --method %s builds on the "
+                        "whole matrix (merge a classic bake, or bake it on one machine)\n",
+                cmd, rad_tool_method_name(args->mo.method));
+        return 2;
+    }
+    if (rad_tool_method_check(cmd, 0, &args->mo, &args->o)) return 2;
+    rad_tool_dense_plan(&args->o, &args->mo, 1);
+    return -1;
+}
+
+static int bake_main(const char *cmd, rad_tool_bake_args *args)
+{
+    rad_tool_world w;
+    rad_tool_classic c;
+    double t0 = rad_tool_seconds();
+    int rc;
+    if (rad_tool_check_output(cmd, args->out, &args->scene, 1)) return 1;
+    rad_tool_set_threads((int)args->threads);
+    if (rad_tool_open_world_lit(cmd, args->scene, &args->lights, &w)) return 1;
+    if (args->mo.method == RAD_TOOL_VP || args->mo.method == RAD_TOOL_AAVP) {
+        rc = bake_vp(cmd, args->out, &w, &args->o, &args->mo);
         rad_tool_close_world(&w);
         if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
         return rc;
     }
-    if (mo.method != RAD_TOOL_CLASSIC) {
+    if (args->mo.method != RAD_TOOL_CLASSIC || args->shard.rows || args->shard.count) {
         void *buf = NULL;
         size_t size = 0;
-        rc = rad_tool_method_bake(cmd, &w, &o, &mo, &buf, &size);
-        if (rc == 0) rc = write_bytes(cmd, out_path, buf, size);
-        if (rc == 0) printf("wrote %s: %s, %lu bytes\n", out_path, rad_tool_method_name(mo.method), (unsigned long)size);
+        if (args->mo.method != RAD_TOOL_CLASSIC) rc = rad_tool_method_bake(cmd, &w, &args->o, &args->mo, &buf, &size);
+        else rc = rad_tool_bake_part(cmd, &w, &args->o, &args->shard, &buf, &size);
+        if (rc == 0) rc = write_bytes(cmd, args->out, buf, size);
+        if (rc == 0)
+            printf("wrote %s: %s, %lu bytes\n", args->out,
+                   args->mo.method != RAD_TOOL_CLASSIC ? rad_tool_method_name(args->mo.method) : "a part of a classic bake",
+                   (unsigned long)size);
         free(buf);
         rad_tool_close_world(&w);
         if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
         return rc;
     }
-    if (rad_tool_classic_solve(cmd, &w, &o, &c)) {
+    if (rad_tool_classic_solve(cmd, &w, &args->o, &c)) {
         rad_tool_close_world(&w);
         return 1;
     }
-    rc = save_bake(cmd, out_path, &w, &o, &c);
+    rc = save_bake(cmd, args->out, &w, &args->o, &c);
     rad_tool_classic_free(&c);
     rad_tool_close_world(&w);
     if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
@@ -499,10 +546,9 @@ static int bake_main(int argc, char **argv, rad_tool_lights *lights)
 
 int rad_cmd_bake(int argc, char **argv)
 {
-    rad_tool_lights lights;
-    int rc;
-    memset(&lights, 0, sizeof lights);
-    rc = bake_main(argc, argv, &lights);
-    rad_tool_lights_free(&lights);
+    rad_tool_bake_args args;
+    int rc = rad_tool_bake_parse("bake", argc, argv, &args);
+    if (rc < 0) rc = bake_main("bake", &args);
+    rad_tool_lights_free(&args.lights);
     return rc;
 }

@@ -3,6 +3,7 @@
        rad help | rad CMD --help
        rad formfactors SCENE   group form factors between the scene's named objects
        rad bake SCENE -o FILE.radb     a solution, saved (classic, multibounce or temporal)
+       rad merge PART... -o FILE.radb  the parts of a sharded bake (bake --shard I/N) joined
        rad render SCENE -o OUT.png|OUT.pfm     an image (classic, multibounce or temporal
                                        radiosity, or path tracing)
        rad trace SCENE -o OUT  the reference path tracer
@@ -97,11 +98,18 @@ void rad_tool_log(void *user, rad_log_level level, const char *message)
             message);
 }
 
+static int g_progress_on = 1;
+
+void rad_tool_show_progress(int on)
+{
+    g_progress_on = on;
+}
+
 void rad_tool_context(rad_context *ctx, const char *label)
 {
     memset(ctx, 0, sizeof *ctx);
     ctx->log = rad_tool_log;
-    if (label) {
+    if (label && g_progress_on) {
         ctx->progress = rad_tool_progress;
         ctx->progress_user = (void *)(size_t)label;
     }
@@ -380,6 +388,8 @@ static void usage(FILE *f)
                "  version                  the library version\n"
                "  formfactors SCENE        group form factors between the scene's named objects\n"
                "  bake SCENE -o FILE.radb  compute and save a solution: --method classic|multibounce|temporal\n"
+               "                           --shard I/N or --rows A:B: one part of it (docs/distributed.md)\n"
+               "  merge PART... -o FILE    join the parts of a sharded bake into the bake itself\n"
                "  render SCENE -o OUT      render an image (.png or .pfm):\n"
                "                           --method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace\n"
                "                           [--bake FILE.radb]\n"
@@ -521,14 +531,15 @@ int rad_cmd_formfactors(int argc, char **argv)
 
 /* ---- dispatch -------------------------------------------------------------------------- */
 
-int main(int argc, char **argv)
+/* main.c calls it; tools/mpi/rad_mpi.c links the other sources with a main of its own */
+int rad_tool_main(int argc, char **argv)
 {
     static const struct {
         const char *name;
         int (*fn)(int, char **);
     } cmds[] = {{"formfactors", rad_cmd_formfactors}, {"bake", rad_cmd_bake},       {"render", rad_cmd_render},
                 {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info},
-                {"export", rad_cmd_export},           {"probes", rad_cmd_probes}};
+                {"export", rad_cmd_export},           {"probes", rad_cmd_probes},   {"merge", rad_cmd_merge}};
     size_t i;
     if (argc < 2) {
         usage(stderr);

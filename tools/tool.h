@@ -106,6 +106,9 @@ int rad_cmd_info(int argc, char **argv);
 int rad_cmd_export(int argc, char **argv);
 int rad_cmd_probes(int argc, char **argv);
 
+/* the rad program (rad.c): dispatches argv[1] to a subcommand; the exit code (main.c) */
+int rad_tool_main(int argc, char **argv);
+
 /* ---- shared helpers (rad.c) ------------------------------------------------------------- */
 /* progress to stderr: a bar when stderr is a terminal, a plain percentage line otherwise */
 int rad_tool_progress(void *user, float fraction);
@@ -148,6 +151,8 @@ void rad_trace_options_default(rad_trace_options *options);
 /* A context whose log goes to stderr and whose progress is drawn with 'label' (NULL: no
    progress). */
 void rad_tool_context(rad_context *ctx, const char *label);
+/* 0: contexts made from now on draw no progress (rad-mpi's ranks other than 0) */
+void rad_tool_show_progress(int on);
 /* ends a progress line that did not reach 100% */
 void rad_tool_progress_end(void);
 /* "rad CMD: what failed: RAD_ERROR_...: ..." on stderr; returns 1 */
@@ -258,6 +263,13 @@ typedef struct rad_tool_classic {
     double solve_seconds;       /* the solver call alone (the per-frame cost of the method) */
 } rad_tool_classic;
 /* prints progress and errors; returns 0 or 1 */
+/* Its steps, for the distributed bake (cmd_merge.c): the patches, D and E only (ff, L, B, H
+   stay NULL); then, given c->patches, c->E and F, the solve of o->solver into c->L, c->B and
+   c->H (allocated here; rad_tool_classic_free or free() them). 0 or 1 (message printed). */
+int rad_tool_classic_sources(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                             rad_tool_classic *out);
+int rad_tool_classic_indirect(const char *cmd, const rad_tool_classic_options *o, const rad_matrix *F,
+                              rad_tool_classic *c);
 int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
                            rad_tool_classic *out);
 void rad_tool_classic_free(rad_tool_classic *c);
@@ -274,6 +286,8 @@ typedef struct rad_tool_bake_info {
     uint32_t triangle_count; /* of the scene baked */
 } rad_tool_bake_info;
 #define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u)
+/* the rad.options record of a bake of w with o */
+void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, const rad_tool_classic_options *o);
 /* The hash of a rad.options record and of the lights given on the command line (w's lights
    past file_light_count; none: the hash of the record alone, as before those options), kept
    in the bake's signature (rad_bake_signature.options) so that a bake's options section and
@@ -424,5 +438,68 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
 int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds);
 const float *rad_tool_indirect_rowsums(const rad_tool_indirect *m);
 void rad_tool_indirect_close(rad_tool_indirect *m);
+
+/* ---- the distributed bake: parts and merge (cmd_merge.c; docs/distributed.md) ----------- */
+/* rad bake --shard I/N or --rows A:B */
+typedef struct rad_tool_shard_spec {
+    uint32_t index, count;        /* --shard I/N (count 0: not given) */
+    int rows;                     /* 1: --rows A:B given */
+    uint32_t row_begin, row_end;  /* --rows: rows A to B-1 */
+} rad_tool_shard_spec;
+#define RAD_TOOL_MAX_SHARDS 65536u
+/* chunks of rows per shard (the snake of rad_tool_shard_ranges) */
+#define RAD_TOOL_SHARD_CHUNKS 64u
+/* "I/N" and "A:B" into s; 0, or 2 with a message */
+int rad_tool_parse_shard(const char *cmd, const char *text, rad_tool_shard_spec *s);
+int rad_tool_parse_rows(const char *cmd, const char *text, rad_tool_shard_spec *s);
+/* The rows of shard I of n over N rows as ranges [ranges[2k], ranges[2k+1]), ascending; returns
+   their count (at most RAD_TOOL_SHARD_CHUNKS; 0 when n > N leaves the shard nothing). Shards of one n cover the
+   rows exactly once, with nearly equal pair counts (rad_form_factor_pair_count). */
+uint32_t rad_tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ranges);
+
+/* The record a part holds (RAD_TOOL_SECTION_SHARD, "rad.shard"), beside its row ranges
+   ("rad.rows": uint32 pairs) and its pairs ("F.upper", "F.lower": rad_form_factor_pairs). */
+typedef struct rad_tool_shard_info {
+    uint32_t magic;           /* RAD_TOOL_SHARD_MAGIC */
+    uint32_t format;          /* 1 */
+    char library[16];         /* RAD_VERSION_STRING of the build that baked it */
+    uint32_t patches;         /* N */
+    uint32_t shard, shard_count; /* --shard I/N; shard_count 0: --rows */
+    uint32_t range_count;
+    uint64_t pairs;           /* pairs {i, j}, j > i, of its rows */
+    uint64_t pairs_evaluated; /* of those, the facing ones computed */
+    double seconds;           /* the form factors of this part (a record of the run) */
+} rad_tool_shard_info;
+#define RAD_TOOL_SHARD_MAGIC 0x52414453u
+#define RAD_TOOL_SECTION_SHARD (RAD_SECTION_USER + 0x20u)
+#define RAD_TOOL_SECTION_ROWS (RAD_SECTION_USER + 0x21u)
+#define RAD_TOOL_SECTION_PAIRS (RAD_SECTION_USER + 0x22u)
+
+/* A classic bake's part as container bytes (malloc'd, free with free()). 0 or 1 (printed). */
+int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
+                       const rad_tool_shard_spec *spec, void **out, size_t *out_size);
+/* A part in memory, named for messages (a file name, "rank 2") */
+typedef struct rad_tool_part {
+    const char *name;
+    const void *data;
+    size_t size;
+} rad_tool_part;
+/* Checks the parts, joins them, solves, writes out_path (a temporary renamed into place, so a
+   failure leaves nothing). 0, 1 (message printed naming the part and the reason) or 2. */
+int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, const char *out_path);
+int rad_cmd_merge(int argc, char **argv);
+
+/* rad bake's command line (cmd_bake.c), shared with tools/mpi/rad_mpi.c */
+typedef struct rad_tool_bake_args {
+    const char *scene, *out;
+    rad_tool_classic_options o;
+    rad_tool_method_options mo;
+    uint32_t threads;
+    rad_tool_shard_spec shard;
+    rad_tool_lights lights;       /* --sun, --sky, ...: free with rad_tool_lights_free */
+} rad_tool_bake_args;
+/* -1: go on and bake; else the exit code (--help: 0 after printing it; 2: bad usage, printed).
+   args->lights is to be freed (rad_tool_lights_free) whatever it returns. */
+int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_args *args);
 
 #endif
