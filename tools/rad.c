@@ -9,6 +9,7 @@
        rad compare A B         image metrics
        rad info FILE.radb      what a bake holds
        rad export SCENE -o OUT.obj     the scene as OBJ + MTL
+       rad lightmap SCENE -o OUT.pfm|OUT.png   a lightmap over the second uv set (cmd_lightmap.c)
 
    This file holds the implementation of radiosity.h, the dispatcher, the shared helpers of
    tool.h and the formfactors command. Exit codes: 0 ok, 1 failure, 2 usage error. */
@@ -373,6 +374,8 @@ static void usage(FILE *f)
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
                "  info FILE.radb           list what a bake holds and check it\n"
                "  export SCENE -o OUT.obj  write the scene as OBJ + MTL (Kd albedo, Ke emission)\n"
+               "  lightmap SCENE -o OUT    bake a lightmap (.pfm or .png) over the second uv set, or an\n"
+               "                           automatic unwrap; --sh for L1 spherical harmonics\n"
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
                "at most 1024).\n");
@@ -491,7 +494,7 @@ int main(int argc, char **argv)
         int (*fn)(int, char **);
     } cmds[] = {{"formfactors", rad_cmd_formfactors}, {"bake", rad_cmd_bake},       {"render", rad_cmd_render},
                 {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info},
-                {"export", rad_cmd_export}};
+                {"export", rad_cmd_export},           {"lightmap", rad_cmd_lightmap}};
     size_t i;
     if (argc < 2) {
         usage(stderr);

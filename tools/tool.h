@@ -340,4 +340,11 @@ int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds);
 const float *rad_tool_indirect_rowsums(const rad_tool_indirect *m);
 void rad_tool_indirect_close(rad_tool_indirect *m);
 
+/* ---- lightmaps (cmd_lightmap.c, unwrap.c) ------------------------------------------------ */
+int rad_cmd_lightmap(int argc, char **argv);
+/* A simple automatic lightmap unwrap (unwrap.c: charts of connected triangles within 30
+   degrees, planar projection, shelf packing with 2-texel gutters): 6 floats per scene triangle
+   into out_uvs, the chart count into out_charts (may be NULL). 0, or 1 with a message printed. */
+int rad_tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts);
+
 #endif
