@@ -1,6 +1,7 @@
 # radiosity.h - build, demo, tests and benchmarks.
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
 #   make gallery every lighting model on rows of spheres, to gallery.png
+#   make lightmap  a lightmap of the Cornell box beside the box shaded by it, to lightmap.png
 #   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
 #   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
@@ -23,7 +24,7 @@ EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
 
-.PHONY: all demo gallery walk moving-light test bench bench-quick tools fuzz clean glsl report report-quick
+.PHONY: all demo gallery lightmap walk moving-light test bench bench-quick tools fuzz clean glsl report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk tools
 
@@ -39,6 +40,13 @@ $(BUILD)/vp_bunny: examples/vp_bunny.c radiosity.h | $(BUILD)
 
 demo: $(BUILD)/cornell
 	./$(BUILD)/cornell -o cornell.png
+
+# a lightmap of the Cornell box beside the box shaded by it (examples/lightmap.c)
+$(BUILD)/lightmap: examples/lightmap.c examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/lightmap.c -o $@ -lm
+
+lightmap: $(BUILD)/lightmap
+	./$(BUILD)/lightmap -o lightmap.png
 
 $(BUILD)/gallery: examples/gallery.c examples/png_write.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) -I. examples/gallery.c -o $@ -lm
@@ -131,7 +139,7 @@ fuzz: | $(BUILD)
 	if [ -n "$$failed" ]; then echo "fuzz: failed:$$failed"; exit 1; fi
 
 clean:
-	rm -rf $(BUILD) cornell.png gallery.png tools/rad
+	rm -rf $(BUILD) cornell.png gallery.png lightmap.png tools/rad
 
 # the GLSL kernels: glsl/*.comp are the canonical sources, embedded into radiosity.h
 $(BUILD)/glsl_embed: glsl/embed.c | $(BUILD)
