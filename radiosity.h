@@ -1081,6 +1081,43 @@ RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lightmap, uint32_t ch
                                        uint32_t iterations, rad_lightmap_seam_stats *out_stats,
                                        const rad_context *ctx);
 
+/* RUN TIME (rad_lightmap_weights_create, rad_lightmap_refresh): a lightmap refreshed from a
+   new patch solution (a temporal frame, a moved light's re-solve) in O(texels x few) without
+   a new gather. Each valid texel gets a sparse row of texel-from-patch weights: at each valid
+   sample the patch containing it (rad_patches_locate) and its three vertex weights, each
+   vertex standing for the area-weighted mean of the patches that share it (as
+   rad_patches_vertex_values), averaged over the texel's valid samples; so the row
+   interpolates the patches' irradiance H = F B smoothly (a few to a few dozen entries). The
+   row is then scaled by the texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked)
+   from the gathered lightmap and the patch irradiance of the same solution (1 when either is
+   NULL or the row gives 0; at most 16), which keeps the gather's sub-patch detail (contact
+   shadows, gradients inside a patch). A refresh with H_baked gives back the bake's luminance
+   exactly; with another solution it is exact where the light's shape across each patch and
+   its neighbours does not change, and off by the change elsewhere (the test measures it). */
+typedef struct rad_lightmap_weights {
+    uint32_t texels;            /* width * height of the lightmap */
+    uint32_t patch_count;       /* N of the patches */
+    uint64_t *row_offsets;      /* texels + 1; a texel without a valid sample has an empty row */
+    uint32_t *columns;          /* patch indices */
+    float *values;              /* weights (detail factor included) */
+    rad_allocator allocator;    /* private */
+} rad_lightmap_weights;
+
+/* Builds the rows above. baked_texels (3 per texel, an RGB irradiance gather of the solution,
+   before dilation) and baked_patch_irradiance (3N: H = F B of the same solution) are optional
+   together (both or neither). Errors: INVALID_ARGUMENT (NULL lightmap or patches, patches of
+   another scene, one of the two baked inputs without the other), OUT_OF_MEMORY. O(samples). */
+RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lightmap, const rad_patches *patches,
+                                               const float *baked_texels, const float *baked_patch_irradiance,
+                                               const rad_context *ctx, rad_lightmap_weights **out);
+RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *weights);
+
+/* out[t] = sum_p W_tp H_p (3 floats per texel) for every texel with a row; texels without one
+   are left as they are (the gutters keep their dilated values). patch_irradiance: 3N floats.
+   Parallel over texels through ctx->parallel_for. Errors: INVALID_ARGUMENT. */
+RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, const float *patch_irradiance, float *out,
+                                        const rad_context *ctx);
+
 /* Bilinear lookup of a lightmap (channels floats per texel) at (u, v), clamped to the edge
    texels, with the texel convention above. out: channels floats. */
 RAD_API void rad_lightmap_sample(const rad_lightmap *lightmap, uint32_t channels, const float *values, float u, float v,
@@ -7449,6 +7486,196 @@ RAD_API void rad_lightmap_sample(const rad_lightmap *lm, uint32_t channels, cons
         for (k = 0; k < 4; ++k) s += w[k] * values[(size_t)idx[k] * channels + ch];
         out[ch] = s;
     }
+}
+
+RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
+{
+    rad_allocator a;
+    if (!w) return;
+    a = w->allocator;
+    rad__free(&a, w->row_offsets);
+    rad__free(&a, w->columns);
+    rad__free(&a, w->values);
+    rad__free(&a, w);
+}
+
+/* barycentrics (b1, b2) of point x in triangle v (9 floats), least squares in its plane */
+static void rad__lm_bary3(const float *v, const float *x, float *b1, float *b2)
+{
+    double e1[3], e2[3], d[3], d00 = 0.0, d01 = 0.0, d11 = 0.0, d20 = 0.0, d21 = 0.0, den, u, w;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)v[3 + k] - v[k];
+        e2[k] = (double)v[6 + k] - v[k];
+        d[k] = (double)x[k] - v[k];
+        d00 += e1[k] * e1[k]; d01 += e1[k] * e2[k]; d11 += e2[k] * e2[k];
+        d20 += d[k] * e1[k]; d21 += d[k] * e2[k];
+    }
+    den = d00 * d11 - d01 * d01;
+    u = den > 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
+    w = den > 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
+    if (u < 0.0) u = 0.0;
+    if (w < 0.0) w = 0.0;
+    if (u + w > 1.0) { double s = u + w; u /= s; w /= s; }
+    *b1 = (float)u;
+    *b2 = (float)w;
+}
+
+#define RAD__LM_ROW_MAX 256u /* entries one texel's row may gather before merging stops adding */
+
+RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad_patches *P, const float *baked_texels,
+                                               const float *baked_H, const rad_context *ctx, rad_lightmap_weights **out)
+{
+    rad__ctx c;
+    rad_lightmap_weights *W = NULL;
+    uint32_t *vfirst = NULL, *vpatch = NULL, *fill = NULL, i, texels, col[RAD__LM_ROW_MAX];
+    double *varea = NULL, val[RAD__LM_ROW_MAX];
+    uint64_t total = 0, cap = 0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!lm || !P || P->scene != lm->scene || (!baked_texels) != (!baked_H)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: NULL lightmap or patches, patches of another scene, or only one of "
+                 "baked_texels and baked_patch_irradiance");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    texels = lm->width * lm->height;
+    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    if (!W) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(W, 0, sizeof(*W));
+    W->allocator = c.allocator;
+    W->texels = texels;
+    W->patch_count = P->count;
+    /* the patches around each vertex, and their total area */
+    vfirst = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    fill = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    vpatch = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
+    varea = (double *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(double));
+    W->row_offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)texels + 1, sizeof(uint64_t));
+    if (!vfirst || !fill || !vpatch || !varea || !W->row_offsets) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(fill, 0, sizeof(uint32_t) * ((size_t)P->vertex_count + 1));
+    memset(varea, 0, sizeof(double) * ((size_t)P->vertex_count + 1));
+    for (i = 0; i < P->count; ++i) {
+        int k;
+        for (k = 0; k < 3; ++k) { fill[P->patches[i].vertices[k]]++; varea[P->patches[i].vertices[k]] += P->patches[i].area; }
+    }
+    vfirst[0] = 0;
+    for (i = 0; i < P->vertex_count; ++i) { vfirst[i + 1] = vfirst[i] + fill[i]; fill[i] = 0; }
+    for (i = 0; i < P->count; ++i) {
+        int k;
+        for (k = 0; k < 3; ++k) { uint32_t v = P->patches[i].vertices[k]; vpatch[vfirst[v] + fill[v]++] = i; }
+    }
+    /* rows, texel by texel, appended to growing arrays */
+    for (i = 0; i < texels; ++i) {
+        uint32_t s, n = 0, nv = 0, e;
+        W->row_offsets[i] = total;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+            uint32_t t = lm->sample_triangles[s], p, k;
+            float b1, b2, vw[3];
+            if (!lm->sample_valid[s]) continue;
+            ++nv;
+            rad__lm_bary3(lm->scene->positions + 9 * (size_t)t, lm->sample_positions + 3 * (size_t)s, &b1, &b2);
+            p = rad_patches_locate(P, t, b1, b2, vw);
+            if (p == RAD_NONE) continue;
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = P->patches[p].vertices[k], j;
+                if (!(varea[v] > 0.0) || !(vw[k] != 0.0f)) continue;
+                for (j = vfirst[v]; j < vfirst[v + 1]; ++j) {
+                    uint32_t q = vpatch[j], m;
+                    double wq = (double)vw[k] * P->patches[q].area / varea[v];
+                    for (m = 0; m < n && col[m] != q; ++m) {}
+                    if (m == n) {
+                        if (n == RAD__LM_ROW_MAX) continue; /* never with welded triangle meshes: a vertex has few patches */
+                        col[n] = q;
+                        val[n++] = 0.0;
+                    }
+                    val[m] += wq;
+                }
+            }
+        }
+        if (nv == 0 || n == 0) continue;
+        for (e = 0; e < n; ++e) val[e] /= nv;
+        if (baked_texels) {
+            double num = 0.0, den = 0.0, cf = 1.0;
+            int k;
+            for (k = 0; k < 3; ++k) num += baked_texels[3 * (size_t)i + k];
+            for (e = 0; e < n; ++e)
+                for (k = 0; k < 3; ++k) den += val[e] * baked_H[3 * (size_t)col[e] + k];
+            if (den > 0.0 && num >= 0.0) cf = num / den < 16.0 ? num / den : 16.0;
+            for (e = 0; e < n; ++e) val[e] *= cf;
+        }
+        if (total + n > cap) {
+            uint64_t nc = cap ? 2 * cap : 4096;
+            uint32_t *ncol;
+            float *nval;
+            while (nc < total + n) nc *= 2;
+            ncol = (uint32_t *)rad__realloc(&c.allocator, W->columns, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
+            if (!ncol) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+            W->columns = ncol;
+            nval = (float *)rad__realloc(&c.allocator, W->values, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
+            if (!nval) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+            W->values = nval;
+            cap = nc;
+        }
+        for (e = 0; e < n; ++e) { W->columns[total + e] = col[e]; W->values[total + e] = (float)val[e]; }
+        total += n;
+    }
+    W->row_offsets[texels] = total;
+done:
+    rad__free(&c.allocator, vfirst);
+    rad__free(&c.allocator, fill);
+    rad__free(&c.allocator, vpatch);
+    rad__free(&c.allocator, varea);
+    if (r != RAD_SUCCESS) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
+        rad_lightmap_weights_destroy(W);
+        return r;
+    }
+    *out = W;
+    return RAD_SUCCESS;
+}
+
+typedef struct rad__lm_refresh {
+    const rad_lightmap_weights *W;
+    const float *H;
+    float *out;
+} rad__lm_refresh;
+
+static rad_result rad__lm_refresh_row(void *data, uint32_t t, uint32_t task)
+{
+    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
+    const rad_lightmap_weights *W = f->W;
+    uint64_t a = W->row_offsets[t], b = W->row_offsets[t + 1], e;
+    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+    (void)task;
+    if (a == b) return RAD_SUCCESS;
+    for (e = a; e < b; ++e) {
+        const float *h = f->H + 3 * (size_t)W->columns[e], w = W->values[e];
+        s0 += w * h[0];
+        s1 += w * h[1];
+        s2 += w * h[2];
+    }
+    f->out[3 * (size_t)t] = s0;
+    f->out[3 * (size_t)t + 1] = s1;
+    f->out[3 * (size_t)t + 2] = s2;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const float *H, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__lm_refresh f;
+    rad__ctx_init(&c, ctx);
+    if (!W || !H || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    f.W = W;
+    f.H = H;
+    f.out = out;
+    c.progress = NULL; /* a per-frame call: one batch, no progress */
+    return rad__for_rows(&c, W->texels, c.tasks < W->texels ? c.tasks : (W->texels ? W->texels : 1u), rad__lm_refresh_row, &f);
 }
 
 /* one edge of a lightmapped triangle, its end points in canonical (lexicographic) order */
