@@ -7640,26 +7640,30 @@ typedef struct rad__lm_refresh {
     const rad_lightmap_weights *W;
     const float *H;
     float *out;
+    uint32_t tasks;
 } rad__lm_refresh;
 
-static rad_result rad__lm_refresh_row(void *data, uint32_t t, uint32_t task)
+/* one contiguous block of texels per task: the rows are short, so a cyclic split would make
+   the tasks write the same cache lines of out */
+static void rad__lm_refresh_task(void *data, uint32_t task)
 {
     const rad__lm_refresh *f = (const rad__lm_refresh *)data;
     const rad_lightmap_weights *W = f->W;
-    uint64_t a = W->row_offsets[t], b = W->row_offsets[t + 1], e;
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-    (void)task;
-    if (a == b) return RAD_SUCCESS;
-    for (e = a; e < b; ++e) {
-        const float *h = f->H + 3 * (size_t)W->columns[e], w = W->values[e];
-        s0 += w * h[0];
-        s1 += w * h[1];
-        s2 += w * h[2];
+    uint32_t t = (uint32_t)((uint64_t)W->texels * task / f->tasks), end = (uint32_t)((uint64_t)W->texels * (task + 1) / f->tasks);
+    for (; t < end; ++t) {
+        uint64_t a = W->row_offsets[t], b = W->row_offsets[t + 1], e;
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        if (a == b) continue;
+        for (e = a; e < b; ++e) {
+            const float *h = f->H + 3 * (size_t)W->columns[e], w = W->values[e];
+            s0 += w * h[0];
+            s1 += w * h[1];
+            s2 += w * h[2];
+        }
+        f->out[3 * (size_t)t] = s0;
+        f->out[3 * (size_t)t + 1] = s1;
+        f->out[3 * (size_t)t + 2] = s2;
     }
-    f->out[3 * (size_t)t] = s0;
-    f->out[3 * (size_t)t + 1] = s1;
-    f->out[3 * (size_t)t + 2] = s2;
-    return RAD_SUCCESS;
 }
 
 RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const float *H, float *out, const rad_context *ctx)
@@ -7674,8 +7678,9 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
     f.W = W;
     f.H = H;
     f.out = out;
-    c.progress = NULL; /* a per-frame call: one batch, no progress */
-    return rad__for_rows(&c, W->texels, c.tasks < W->texels ? c.tasks : (W->texels ? W->texels : 1u), rad__lm_refresh_row, &f);
+    f.tasks = c.tasks < W->texels ? c.tasks : (W->texels ? W->texels : 1u);
+    c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_task, &f);
+    return RAD_SUCCESS;
 }
 
 /* one edge of a lightmapped triangle, its end points in canonical (lexicographic) order */
