@@ -1,7 +1,8 @@
 /* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
 
    rad lightmap SCENE -o OUT.pfm|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
-                [--visibility-rays N] [--unwrap] [classic options] [--threads N] [--exposure X]
+                [--visibility-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
+                [classic options] [--threads N] [--exposure X]
 
    The classic solution (cmd_bake.c: patches, F, direct light as the source, B = E + L) is
    gathered into the texels of the lightmap uv set (>>api_lightmap): every mesh's second uv set
@@ -10,7 +11,10 @@
    lights and emitters per texel + the irradiance from the secondary sources; --sh: the L1
    spherical harmonics of the indirect radiance only (engines add direct light per pixel),
    four PFM files OUT.L00.pfm, OUT.L1m1.pfm, OUT.L10.pfm, OUT.L11.pfm (PNG cannot hold the
-   negative coefficients). Then dilation into the gutters and seam stitching. */
+   negative coefficients). Then dilation into the gutters and seam stitching. --render draws
+   the scene's camera view (or the one rad trace would choose) shaded from the lightmap alone:
+   radiance = emission + albedo x bilinear lightmap irradiance / pi, N x N samples a pixel, to
+   compare with `rad trace` (rad compare). */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,6 +31,9 @@ static void lightmap_usage(FILE *f)
                "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
                "  --visibility-rays N   shadow rays per sample point and patch (default 2, at most 64)\n"
                "  --unwrap              unwrap even when the file has a second uv set\n"
+               "  --render VIEW         also render the camera view shaded from the lightmap (.png or .pfm;\n"
+               "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
+               "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 2)\n"
                "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
                "                        the radiance of a white surface)\n"
                "  --threads N           worker threads (default: all cores)\n"
@@ -44,6 +51,52 @@ static char *lightmap_tagged(const char *path, const char *tag)
     return out;
 }
 
+/* the view shaded from an RGB irradiance lightmap: one closest hit per sample, the lightmap
+   read at the hit's lightmap uv; back faces and misses are black (one-sided like rad trace) */
+static int lightmap_render(const rad_tool_world *w, const rad_lightmap *lm, const float *values, int width, int height,
+                           int aa, const char *path, float exposure)
+{
+    rad_camera cam = w->file.camera;
+    rad_image img;
+    int x, y, sx, sy, bad;
+    if (!w->file.has_camera) rad_tool_choose_camera("lightmap", w->scene, &w->rc, width, height, &cam);
+    if (!(cam.fov_y_degrees > 0.0f)) cam.fov_y_degrees = 45.0f;
+    if (rad_image_alloc(&img, width, height)) { fprintf(stderr, "rad lightmap: out of memory for the view\n"); return 1; }
+    for (y = 0; y < height; ++y)
+        for (x = 0; x < width; ++x) {
+            float acc[3] = {0.0f, 0.0f, 0.0f};
+            for (sy = 0; sy < aa; ++sy)
+                for (sx = 0; sx < aa; ++sx) {
+                    rad_ray ray;
+                    rad_hit hit;
+                    const float *t, *n;
+                    float u, v, e[3], rho[3];
+                    int k;
+                    rad_camera_ray(&cam, (uint32_t)width, (uint32_t)height, x + (sx + 0.5f) / aa, y + (sy + 0.5f) / aa, &ray);
+                    if (w->rc.intersect(w->rc.user, &ray, 1, &hit) != RAD_SUCCESS || hit.triangle == RAD_NONE) continue;
+                    n = w->scene->normals + 3 * (size_t)hit.triangle;
+                    if (n[0] * ray.dir[0] + n[1] * ray.dir[1] + n[2] * ray.dir[2] >= 0.0f) continue;
+                    {
+                        const rad_material *m = &w->scene->materials_table[w->scene->materials[hit.triangle]];
+                        for (k = 0; k < 3; ++k) acc[k] += m->emission[k];
+                    }
+                    if (!w->scene->lightmapped[hit.triangle]) continue;
+                    t = w->scene->lightmap_uvs + 6 * (size_t)hit.triangle;
+                    u = t[0] + hit.b1 * (t[2] - t[0]) + hit.b2 * (t[4] - t[0]);
+                    v = t[1] + hit.b1 * (t[3] - t[1]) + hit.b2 * (t[5] - t[1]);
+                    rad_lightmap_sample(lm, 3, values, u, v, e);
+                    rad_scene_albedo(w->scene, hit.triangle, hit.b1, hit.b2, rho);
+                    for (k = 0; k < 3; ++k) acc[k] += rho[k] * e[k] / 3.14159265f;
+                }
+            for (sx = 0; sx < 3; ++sx) img.rgb[3 * ((size_t)y * width + x) + sx] = acc[sx] / (float)(aa * aa);
+        }
+    bad = rad_image_write(path, &img, exposure * 3.14159265f);
+    rad_image_free(&img);
+    if (bad) { fprintf(stderr, "rad lightmap: %s\n", rad_tool_output_error()); return 1; }
+    fprintf(stderr, "rad lightmap: wrote the view %s\n", path);
+    return 0;
+}
+
 static int lightmap_is_png(const char *path)
 {
     size_t n = strlen(path);
@@ -52,7 +105,9 @@ static int lightmap_is_png(const char *path)
 
 int rad_cmd_lightmap(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out_path = NULL;
+    const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
+    int rw = 256, rh = 256;
+    uint32_t aa = 2;
     rad_tool_classic_options co;
     rad_tool_classic cl;
     rad_tool_world w, w2;
@@ -87,7 +142,16 @@ int rad_cmd_lightmap(int argc, char **argv)
             return 2;
         }
         if (!strcmp(o, "-o")) out_path = argv[++a];
-        else if (!strcmp(o, "--size")) {
+        else if (!strcmp(o, "--render")) render_path = argv[++a];
+        else if (!strcmp(o, "--render-size")) {
+            if (rad_tool_parse_size(argv[++a], &rw, &rh) || rad_tool_check_size("lightmap", rw, rh)) {
+                fprintf(stderr, "rad lightmap: bad --render-size '%s'\n", argv[a]);
+                return 2;
+            }
+        } else if (!strcmp(o, "--aa")) {
+            if (rad_tool_parse_uint("lightmap", o, argv[++a], &aa)) return 2;
+            if (aa == 0 || aa > 16) { fprintf(stderr, "rad lightmap: --aa must be 1 to 16\n"); return 2; }
+        } else if (!strcmp(o, "--size")) {
             const char *v = argv[++a];
             if (strchr(v, 'x')) {
                 if (rad_tool_parse_size(v, &width, &height)) { fprintf(stderr, "rad lightmap: bad --size '%s'\n", v); return 2; }
@@ -128,11 +192,16 @@ int rad_cmd_lightmap(int argc, char **argv)
         fprintf(stderr, "rad lightmap: --sh writes PFM files (PNG cannot hold negative coefficients): use -o NAME.pfm\n");
         return 2;
     }
+    if (sh && render_path) {
+        fprintf(stderr, "rad lightmap: --render shades from the RGB lightmap: leave out --sh\n");
+        return 2;
+    }
     if (rad_tool_check_size("lightmap", width, height)) return 2;
     {
         const char *inputs[1];
         inputs[0] = scene_path;
         if (rad_tool_check_output("lightmap", out_path, inputs, 1)) return 1;
+        if (render_path && rad_tool_check_output("lightmap", render_path, inputs, 1)) return 1;
     }
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world("lightmap", scene_path, &w)) return 1;
@@ -223,6 +292,7 @@ int rad_cmd_lightmap(int argc, char **argv)
             free(path);
         }
     }
+    if (render_path && lightmap_render(&w2, lm, values, rw, rh, (int)aa, render_path, exposure)) goto done;
     code = 0;
 done:
     free(values);
