@@ -855,6 +855,17 @@ if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 16 --patches 60 --texel-
 else
     fail "lightmap --sh writes four PFM layers" "$(head -c 300 "$TMP/err.txt")"
 fi
+# --render: the view shaded from the lightmap resembles the path tracer's (both at low quality)
+if "$RAD" lightmap cornell -o "$TMP/lmr.pfm" --size 64 --patches 150 --texel-samples 1 --visibility-rays 1 \
+        --render "$TMP/lmview.png" --render-size 48x48 --aa 1 > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" trace cornell -o "$TMP/lmtrace.png" --size 48x48 --spp 16 > /dev/null 2>&1; then
+    s=$(ssim_of "$TMP/lmview.png" "$TMP/lmtrace.png")
+    at_least "$s" 0.7 && ok "lightmap --render resembles rad trace (SSIM $s)" || fail "lightmap --render resembles rad trace" "SSIM $s"
+else
+    fail "lightmap --render" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" lightmap cornell -o "$TMP/x.pfm" --sh --render "$TMP/x.png" > /dev/null 2>&1
+[ $? -eq 2 ] && ok "lightmap --render refuses --sh" || fail "lightmap --render refuses --sh"
 # a glTF quad with TEXCOORD_0 and TEXCOORD_1: the tool bakes over the file's second uv set
 printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "name": "n"}],
  "meshes": [{"name": "m", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 1}, "indices": 2}]}],
