@@ -79,6 +79,10 @@ $(BUILD)/temporal: bench/temporal.c radiosity.h | $(BUILD)
 $(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
 
+# lightmap timings and noise (BENCHMARKS.md "Lightmaps")
+$(BUILD)/bench_lightmap: bench/lightmap.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap.c -o $@ -lm
+
 $(BUILD)/local: bench/local.c examples/rooms.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/local.c -o $@ -lm
 
