@@ -21,7 +21,7 @@
 static rad_scene *cornell_atlas(uint32_t N, rad_bvh **bvh)
 {
     static rad_mesh_desc meshes[16];
-    static float luv[16][16];
+    static float luv[16][2 * 20]; /* the blocks have 5 quads of 4 vertices */
     rad_scene_desc desc;
     rad_scene *S = NULL;
     uint32_t m, q, i, cell = 0, cells = 6;

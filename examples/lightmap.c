@@ -22,7 +22,7 @@ int main(int argc, char **argv)
     rad_scene_desc desc;
     rad_camera cam;
     rad_mesh_desc meshes[16];
-    float luv[16][2 * 8];        /* the Cornell meshes have at most 2 quads of 4 vertices */
+    float luv[16][2 * 20];       /* the Cornell meshes have at most 5 quads of 4 vertices */
     rad_scene *scene = NULL;
     rad_bvh *bvh = NULL;
     rad_raycaster rc;
@@ -52,6 +52,7 @@ int main(int argc, char **argv)
     rad_cornell_box(&desc, &cam);
     memcpy(meshes, desc.meshes, sizeof(rad_mesh_desc) * desc.mesh_count);
     for (m = 0; m < desc.mesh_count; ++m) {
+        if (meshes[m].vertex_count > 20) return 1; /* luv holds 5 quads a mesh */
         for (q = 0; q < meshes[m].vertex_count / 4; ++q, ++cell) {
             static const float cu[4] = { 0, 1, 1, 0 }, cv[4] = { 0, 0, 1, 1 };
             float x0 = (float)(cell % cells) / cells, y0 = (float)(cell / cells) / cells, g = 1.0f / N, s = 1.0f / cells - 2.0f * g;
