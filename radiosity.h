@@ -1021,7 +1021,9 @@ typedef enum rad_lightmap_encoding {
 
 typedef struct rad_lightmap_gather_options {
     rad_lightmap_encoding encoding;
-    uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64) */
+    uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64); with 1
+                                   the share is of the visible area, not of the form factor
+                                   (reads a few % low next to contacts) */
     float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
 } rad_lightmap_gather_options;
