@@ -1,6 +1,7 @@
 # radiosity.h - build, demo, tests and benchmarks.
 #   make demo    renders the built-in Cornell box to cornell.png (needs only a C compiler)
 #   make gallery every lighting model on rows of spheres, to gallery.png
+#   make lightmap  a lightmap of the Cornell box beside the box shaded by it, to lightmap.png
 #   make walk    builds examples/walk.c (a camera walk through a 69k-patch scene, local matrix)
 #   make learn   builds the teaching examples examples/learn_*.c into build/
 #   make build/realtime  examples/realtime.c: per-frame light, E, temporal step and gather over AAVP
@@ -25,7 +26,7 @@ EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
 
-.PHONY: all demo gallery walk learn moving-light test bench bench-quick tools rad-mpi fuzz clean glsl report report-quick
+.PHONY: all demo gallery lightmap walk learn moving-light test bench bench-quick tools rad-mpi fuzz clean glsl report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk $(BUILD)/realtime tools
 
@@ -49,6 +50,13 @@ $(BUILD)/realtime: examples/realtime.c radiosity.h | $(BUILD)
 
 demo: $(BUILD)/cornell
 	./$(BUILD)/cornell -o cornell.png
+
+# a lightmap of the Cornell box beside the box shaded by it (examples/lightmap.c)
+$(BUILD)/lightmap: examples/lightmap.c examples/png_write.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/lightmap.c -o $@ -lm
+
+lightmap: $(BUILD)/lightmap
+	./$(BUILD)/lightmap -o lightmap.png
 
 $(BUILD)/gallery: examples/gallery.c examples/png_write.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) -I. examples/gallery.c -o $@ -lm
@@ -86,6 +94,10 @@ $(BUILD)/temporal: bench/temporal.c radiosity.h | $(BUILD)
 
 $(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
+
+# lightmap timings and noise (BENCHMARKS.md "Lightmaps")
+$(BUILD)/bench_lightmap: bench/lightmap.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap.c -o $@ -lm
 
 $(BUILD)/local: bench/local.c examples/rooms.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/local.c -o $@ -lm
@@ -162,7 +174,7 @@ fuzz: | $(BUILD)
 	if [ -n "$$failed" ]; then echo "fuzz: failed:$$failed"; exit 1; fi
 
 clean:
-	rm -rf $(BUILD) cornell.png gallery.png tools/rad tools/rad-mpi
+	rm -rf $(BUILD) cornell.png gallery.png lightmap.png tools/rad tools/rad-mpi
 
 # the GLSL kernels: glsl/*.comp are the canonical sources, embedded into radiosity.h
 $(BUILD)/glsl_embed: glsl/embed.c | $(BUILD)

@@ -403,6 +403,10 @@ typedef struct rad_mesh_desc {
     uint32_t triangle_count;
     const uint32_t *material_ids;  /* one per triangle; NULL: every triangle uses 'material' */
     uint32_t material;
+    const float *lightmap_uvs;     /* optional second u v set, the lightmap atlas (>>api_lightmap),
+                                      each in [0, 1] (u right, v down: row 0 of the atlas at v = 0);
+                                      NULL: the mesh is not lightmapped (old code unchanged) */
+    size_t lightmap_uv_stride;     /* 0: 2 * sizeof(float) */
 } rad_mesh_desc;
 
 typedef enum rad_scene_flags {
@@ -429,6 +433,8 @@ typedef struct rad_scene {
     float *positions;
     float *normals;
     float *uvs;                    /* 6 per triangle, or NULL when no mesh had uvs */
+    float *lightmap_uvs;           /* 6 per triangle, or NULL when no mesh had lightmap_uvs */
+    uint8_t *lightmapped;          /* per triangle: 1 when its mesh gave lightmap_uvs (NULL with them) */
     float *areas;
     uint32_t *materials;
     uint32_t *meshes;
@@ -1187,6 +1193,219 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
                                     rad_gather_lookup_fn lookup, void *lookup_user, const float *points,
                                     const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx);
 
+
+/* ======================================================================================== */
+/* >>api_lightmap: lightmaps over a second UV set                                           */
+/* ======================================================================================== */
+
+/* Lightmaps (docs/methods/lightmap.md): the light of a solved patch set baked into a W x H
+   texture over the meshes' lightmap_uvs (rad_mesh_desc), the form engines consume for static
+   geometry. Steps: rad_lightmap_create (texels: rasterize, sample points, validity),
+   rad_lightmap_gather (+ rad_lightmap_direct), then rad_lightmap_dilate and rad_lightmap_stitch.
+   TEXELS. Texel (x, y) covers u in [x/W, (x+1)/W] and v in [y/H, (y+1)/H]; its centre is at
+   ((x + 1/2)/W, (y + 1/2)/H); values are stored row by row from y = 0. Coverage is
+   conservative: a texel belongs to every lightmapped triangle whose uv triangle overlaps its
+   square (a separating-axis test), however little, so bilinear filtering inside any triangle
+   reads only texels that were baked for it. Each texel has an n x n grid of sub-points
+   (samples, rounded to a square); every sub-point inside a triangle's uv triangle becomes a
+   SAMPLE on that triangle (world position by barycentric interpolation, the triangle's
+   geometric normal). A covered texel without any inside sub-point gets one sample: the point
+   of the nearest overlapping triangle closest (in uv) to the texel centre. Every sample then
+   moves 4 ray epsilons towards its triangle's centroid (at most half the way), so one on a
+   triangle's border is not on the plane of the wall that meets it there.
+   VALIDITY. From each sample, validity_rays cosine-distributed rays; one that hits a back
+   face means the sample lies inside or behind geometry (the floor under a wall standing on
+   it, the ceiling behind a one-sided lamp). A sample is invalid when more than
+   backface_limit of its rays hit back faces; a texel is valid when any of its samples is.
+   Invalid samples take no part in the gather, so a texel at a wall-floor contact is lit only
+   from the side of the wall its valid samples are on: no light leaks under a wall at least a
+   texel thick (a thinner one puts both sides into the same texel: use more texels).
+   Cost: O(texels samples) rasterization, validity_rays rays per sample. */
+
+typedef struct rad_lightmap_options {
+    uint32_t width, height;     /* texels (0: 256 each; at most 16384, and width * height * samples
+                                   at most 2^28) */
+    uint32_t samples;           /* sub-points per texel, rounded to a square n x n (0: 4; at most 16) */
+    uint32_t validity_rays;     /* rays per sample for the inside-geometry test (0: 16; at most
+                                   1024) */
+    float backface_limit;       /* a sample is invalid when more than this fraction of its
+                                   validity rays hit back faces (0: 0.1; in (0, 1]; 1 turns the
+                                   test off) */
+    float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;              /* rotates the validity rays */
+} rad_lightmap_options;
+
+/* Texel flags */
+#define RAD_TEXEL_COVERED 1u    /* some lightmapped triangle overlaps the texel */
+#define RAD_TEXEL_VALID 2u      /* ... and some of its samples passed the validity test */
+
+/* The texels of one atlas. Read-only after creation. Texel i = x + width * y. */
+typedef struct rad_lightmap {
+    uint32_t width, height;
+    uint8_t *flags;             /* width * height: RAD_TEXEL_* bits */
+    float *positions;           /* 3 per texel: mean of the valid samples (of all, when none is
+                                   valid; 0 when uncovered) */
+    float *normals;             /* 3 per texel: their normalized mean normal (0 when uncovered) */
+    uint32_t *sample_first;     /* width * height + 1: the samples of texel i are
+                                   [sample_first[i], sample_first[i + 1]) */
+    uint32_t sample_count;
+    float *sample_positions;    /* 3 per sample */
+    float *sample_normals;      /* 3 per sample: the unit geometric normal of its triangle */
+    uint32_t *sample_triangles; /* per sample: the scene triangle */
+    uint8_t *sample_valid;      /* per sample: 1 valid, 0 inside or behind geometry */
+    uint32_t covered_texels, valid_texels, invalid_samples;
+    uint64_t rays_cast;         /* validity rays */
+    const rad_scene *scene;     /* borrowed: must outlive this object */
+    rad_allocator allocator;    /* private */
+} rad_lightmap;
+
+RAD_API void rad_lightmap_options_default(rad_lightmap_options *options);
+
+/* Builds the texels of the scene's lightmapped triangles (those of meshes with lightmap_uvs;
+   uvs outside [0, 1] are clipped to the atlas). raycaster: its intersect() casts the validity
+   rays (borrowed for the call). Errors: INVALID_ARGUMENT (NULL input, a scene without
+   lightmap_uvs, an option out of range), SIZE_OVERFLOW, RAYCAST_FAILED, CANCELLED,
+   OUT_OF_MEMORY; the logger says which. Thread safety: reentrant; the validity rays run
+   through ctx->parallel_for; deterministic whatever the thread count. */
+RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                       const rad_lightmap_options *options, const rad_context *ctx,
+                                       rad_lightmap **out);
+RAD_API void rad_lightmap_destroy(rad_lightmap *lightmap);
+
+/* GATHER. At each valid sample p (unit normal n) the irradiance from the secondary sources
+   (patch radiosities B_j, exitance W m^-2, Lambertian: radiance B_j / pi) is
+       H(p) = sum_j B_j F(p, j) V(p, j)
+   with F(p, j) the analytic point-to-polygon form factor of patch j clipped to p's upper
+   half-space (rad_ff_point_polygon) and V(p, j) its visible share: visibility_rays shadow rays
+   to stratified points y_k of patch j, each weighted by its kernel cos cos / r^2 (the ratio
+   estimator of the form-factor code). A texel holds the mean over its valid samples; texels
+   without one hold 0 (fill them with rad_lightmap_dilate).
+   RGB IRRADIANCE (RAD_LIGHTMAP_IRRADIANCE): 3 floats per texel, H in W m^-2. A Lambertian
+   surface of albedo rho shows radiance rho H / pi.
+   L1 SPHERICAL HARMONICS (RAD_LIGHTMAP_SH_L1): 12 floats per texel, coefficient-major
+   (L_0,0 rgb, L_1,-1 rgb, L_1,0 rgb, L_1,1 rgb) of the incident RADIANCE over the upper
+   hemisphere,  L_lm = integral L(w) Y_lm(w) dw,  in the real SH basis of Godot and Unity
+   (world axes, no normalization beyond the basis):
+       Y_0,0 = 0.282095   Y_1,-1 = 0.488603 y   Y_1,0 = 0.488603 z   Y_1,1 = 0.488603 x
+   Each patch contributes exactly (B_j / pi) V(p, j) times the integrals of Y over the solid
+   angle it subtends, in closed form: Y_0,0 times its solid angle, and 0.488603 times its
+   vector irradiance (1/2) sum_edges theta_e g_e (Arvo's contour integral, g_e the unit normal
+   of the plane through p and edge e, theta_e the angle the edge subtends). Reconstruction of
+   the irradiance at a normal m (Ramamoorthi and Hanrahan's convolution, A_0 = pi, A_1 = 2 pi / 3):
+       E(m) = pi 0.282095 L_0,0 + (2 pi / 3) 0.488603 (L_1,-1 m_y + L_1,0 m_z + L_1,1 m_x)
+   i.e. E(m) / pi = 0.282095 L_0,0 + 0.325735 (L_1,-1 m_y + L_1,0 m_z + L_1,1 m_x), the
+   weights Godot's directional lightmaps and Unity's SphericalHarmonicsL2 (first four terms)
+   evaluate. At m = n it gives back H within the L1 approximation (exact for uniform light). */
+typedef enum rad_lightmap_encoding {
+    RAD_LIGHTMAP_IRRADIANCE = 0, /* 3 floats per texel */
+    RAD_LIGHTMAP_SH_L1 = 1       /* 12 floats per texel */
+} rad_lightmap_encoding;
+
+typedef struct rad_lightmap_gather_options {
+    rad_lightmap_encoding encoding;
+    uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64); with 1
+                                   the share is of the visible area, not of the form factor
+                                   (reads a few % low next to contacts) */
+    float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;
+} rad_lightmap_gather_options;
+
+RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *options);
+/* Floats per texel of an encoding (3 or 12; 0 for an unknown one). */
+RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding);
+
+/* The gather above from any solved classic patch set: patch_radiosity 3N floats (B = E + L of
+   rad_solve_* with RAD_OUTPUT_TOTAL; with RAD_SOURCE_DIRECT the lightmap then holds the
+   indirect irradiance and the direct light is added per texel by rad_lightmap_direct or per
+   pixel by the engine; with RAD_SOURCE_EMISSION B holds the emitters and the lightmap the
+   total). patches must be of lightmap->scene. Patches with B = 0 and those behind a sample
+   cost nothing. out: width * height * channels floats. Errors: INVALID_ARGUMENT, NON_FINITE
+   (a B or result), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY. Cost: O(valid samples x patches)
+   form factors and up to visibility_rays shadow rays per pair. Reentrant; parallel. */
+RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lightmap, const rad_patches *patches,
+                                       const float *patch_radiosity, const rad_raycaster *raycaster,
+                                       const rad_lightmap_gather_options *options, float *out,
+                                       const rad_context *ctx);
+
+/* Direct irradiance (rad_direct_irradiance with these lights and options) averaged over each
+   texel's valid samples, ADDED to out (3 floats per texel: an RGB irradiance lightmap);
+   texels without a valid sample are left as they are. Errors: those of
+   rad_direct_irradiance, OUT_OF_MEMORY. */
+RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lightmap, const rad_raycaster *raycaster,
+                                       const rad_light *lights, uint32_t light_count,
+                                       const rad_direct_options *options, float *out, const rad_context *ctx);
+
+/* DILATION. Every texel without RAD_TEXEL_VALID gets the mean of its 8 neighbours that have a
+   value (valid, or filled by an earlier pass), pass after pass: 'passes' passes (0: until
+   every texel reachable is filled), so the gutters between charts and invalid texels hold
+   their neighbours' light and bilinear filtering at a chart border reads no black.
+   values: width * height * channels floats, in place. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
+RAD_API rad_result rad_lightmap_dilate(const rad_lightmap *lightmap, uint32_t channels, float *values,
+                                       uint32_t passes, const rad_context *ctx);
+
+/* SEAMS. A seam is a triangle edge whose two lightmapped triangles share both end points in
+   space (the same floats) but not in the atlas, and whose normals differ by less than 30
+   degrees (across a sharper crease irradiance differs by right). Each seam gets sample pairs
+   along the edge, at most half a texel apart on either side; bilinear lookups of the two
+   sides should agree there. rad_lightmap_stitch moves the texels least, in the least-squares
+   sense, so that they do: the projection of the values onto {A x = 0} (A: one row per sample
+   pair, its bilinear weights on one side minus those of the other), by 'iterations' sweeps
+   of Kaczmarz's row projections (0: 64) from the baked values, each channel on its own.
+   values: in place (run it after rad_lightmap_dilate: gutter texels take part). out_stats
+   (optional): the seam count and the largest jump before and after. Errors:
+   INVALID_ARGUMENT, OUT_OF_MEMORY. Cost: O(seam samples x iterations). */
+typedef struct rad_lightmap_seam_stats {
+    uint32_t seams;             /* seam edges found */
+    uint32_t sample_pairs;      /* rows of A */
+    float max_jump_before;      /* largest |bilinear(a) - bilinear(b)| over the sample pairs and channels */
+    float max_jump_after;
+} rad_lightmap_seam_stats;
+
+RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lightmap, uint32_t channels, float *values,
+                                       uint32_t iterations, rad_lightmap_seam_stats *out_stats,
+                                       const rad_context *ctx);
+
+/* RUN TIME (rad_lightmap_weights_create, rad_lightmap_refresh): a lightmap refreshed from a
+   new patch solution (a temporal frame, a moved light's re-solve) in O(texels x few) without
+   a new gather. Each valid texel gets a sparse row of texel-from-patch weights: at each valid
+   sample the patch containing it (rad_patches_locate) and its three vertex weights, each
+   vertex standing for the area-weighted mean of the patches that share it (as
+   rad_patches_vertex_values), averaged over the texel's valid samples; so the row
+   interpolates the patches' irradiance H = F B smoothly (a few to a few dozen entries). The
+   row is then scaled by the texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked)
+   from the gathered lightmap and the patch irradiance of the same solution (1 when either is
+   NULL or the row gives 0; at most 16), which keeps the gather's sub-patch detail (contact
+   shadows, gradients inside a patch). A refresh with H_baked gives back the bake's luminance
+   exactly; with another solution it is exact where the light's shape across each patch and
+   its neighbours does not change, and off by the change elsewhere (the test measures it). */
+typedef struct rad_lightmap_weights {
+    uint32_t texels;            /* width * height of the lightmap */
+    uint32_t patch_count;       /* N of the patches */
+    uint64_t *row_offsets;      /* texels + 1; a texel without a valid sample has an empty row */
+    uint32_t *columns;          /* patch indices */
+    float *values;              /* weights (detail factor included) */
+    rad_allocator allocator;    /* private */
+} rad_lightmap_weights;
+
+/* Builds the rows above. baked_texels (3 per texel, an RGB irradiance gather of the solution,
+   before dilation) and baked_patch_irradiance (3N: H = F B of the same solution) are optional
+   together (both or neither). Errors: INVALID_ARGUMENT (NULL lightmap or patches, patches of
+   another scene, one of the two baked inputs without the other), OUT_OF_MEMORY. O(samples). */
+RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lightmap, const rad_patches *patches,
+                                               const float *baked_texels, const float *baked_patch_irradiance,
+                                               const rad_context *ctx, rad_lightmap_weights **out);
+RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *weights);
+
+/* out[t] = sum_p W_tp H_p (3 floats per texel) for every texel with a row; texels without one
+   are left as they are (the gutters keep their dilated values). patch_irradiance: 3N floats.
+   Parallel over texels through ctx->parallel_for. Errors: INVALID_ARGUMENT. */
+RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, const float *patch_irradiance, float *out,
+                                        const rad_context *ctx);
+
+/* Bilinear lookup of a lightmap (channels floats per texel) at (u, v), clamped to the edge
+   texels, with the texel convention above. out: channels floats. */
+RAD_API void rad_lightmap_sample(const rad_lightmap *lightmap, uint32_t channels, const float *values, float u, float v,
+                                 float *out);
 
 /* ======================================================================================== */
 /* >>api_shading: lighting models and BRDFs                                                 */
@@ -3449,6 +3668,8 @@ RAD_API void rad_scene_destroy(rad_scene *scene)
     rad__free(&a, scene->positions);
     rad__free(&a, scene->normals);
     rad__free(&a, scene->uvs);
+    rad__free(&a, scene->lightmap_uvs);
+    rad__free(&a, scene->lightmapped);
     rad__free(&a, scene->areas);
     rad__free(&a, scene->materials);
     rad__free(&a, scene->meshes);
@@ -3496,6 +3717,7 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
     size_t ps = m->position_stride ? m->position_stride : 3 * sizeof(float);
     size_t ns = m->normal_stride ? m->normal_stride : 3 * sizeof(float);
     size_t us = m->uv_stride ? m->uv_stride : 2 * sizeof(float);
+    size_t ls = m->lightmap_uv_stride ? m->lightmap_uv_stride : 2 * sizeof(float);
     uint32_t v, t;
     int k;
     *kept = 0;
@@ -3504,7 +3726,8 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
         rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': positions is NULL", mi, rad__mesh_name(m));
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (ps < 3 * sizeof(float) || (m->normals && ns < 3 * sizeof(float)) || (m->uvs && us < 2 * sizeof(float))) {
+    if (ps < 3 * sizeof(float) || (m->normals && ns < 3 * sizeof(float)) || (m->uvs && us < 2 * sizeof(float)) ||
+        (m->lightmap_uvs && ls < 2 * sizeof(float))) {
         rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': a stride is smaller than its element", mi, rad__mesh_name(m));
         return RAD_ERROR_INVALID_ARGUMENT;
     }
@@ -3528,6 +3751,13 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
             const float *uv = rad__strided(m->uvs, us, v);
             if (!rad__finite(uv[0]) || !rad__finite(uv[1])) {
                 rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': vertex %u has a non-finite uv", mi, rad__mesh_name(m), v);
+                return RAD_ERROR_NON_FINITE;
+            }
+        }
+        if (m->lightmap_uvs) {
+            const float *uv = rad__strided(m->lightmap_uvs, ls, v);
+            if (!rad__finite(uv[0]) || !rad__finite(uv[1])) {
+                rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': vertex %u has a non-finite lightmap uv", mi, rad__mesh_name(m), v);
                 return RAD_ERROR_NON_FINITE;
             }
         }
@@ -3573,7 +3803,7 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     rad_result r;
     uint64_t total = 0, input = 0;
     uint32_t mi, t, n, dst;
-    int k, any_uv = 0;
+    int k, any_uv = 0, any_lm = 0;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
@@ -3591,6 +3821,7 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
         total += kept;
         input += desc->meshes[mi].triangle_count;
         if (desc->meshes[mi].uvs) any_uv = 1;
+        if (desc->meshes[mi].lightmap_uvs) any_lm = 1;
     }
     if (total == 0) {
         rad__log(&c, RAD_LOG_ERROR, "the scene has no triangles (%llu given, %llu degenerate)", (unsigned long long)input,
@@ -3620,8 +3851,12 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     s->materials_table = (rad_material *)rad__alloc_array(&c.allocator, desc->material_count, sizeof(rad_material));
     s->mesh_names = (char **)rad__alloc_array(&c.allocator, desc->mesh_count, sizeof(char *));
     if (any_uv) s->uvs = (float *)rad__alloc_array(&c.allocator, (size_t)n * 6u, sizeof(float));
+    if (any_lm) {
+        s->lightmap_uvs = (float *)rad__alloc_array(&c.allocator, (size_t)n * 6u, sizeof(float));
+        s->lightmapped = (uint8_t *)rad__alloc_array(&c.allocator, n, 1);
+    }
     if (!s->positions || !s->normals || !s->areas || !s->materials || !s->meshes || !s->source_triangles ||
-        !s->materials_table || !s->mesh_names || (any_uv && !s->uvs)) {
+        !s->materials_table || !s->mesh_names || (any_uv && !s->uvs) || (any_lm && (!s->lightmap_uvs || !s->lightmapped))) {
         rad_scene_destroy(s);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -3641,6 +3876,7 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
         const rad_mesh_desc *m = &desc->meshes[mi];
         size_t ps = m->position_stride ? m->position_stride : 3 * sizeof(float);
         size_t us = m->uv_stride ? m->uv_stride : 2 * sizeof(float);
+        size_t ls = m->lightmap_uv_stride ? m->lightmap_uv_stride : 2 * sizeof(float);
         for (t = 0; t < m->triangle_count; ++t) {
             double cr[3], cl;
             float tri[9], *P;
@@ -3656,6 +3892,14 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
                     s->uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
                     s->uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
                 }
+            if (s->lightmap_uvs) {
+                s->lightmapped[dst] = m->lightmap_uvs ? 1u : 0u;
+                for (v = 0; v < 3; ++v) {
+                    const float *uv = m->lightmap_uvs ? rad__strided(m->lightmap_uvs, ls, rad__mesh_index(m, t, v)) : NULL;
+                    s->lightmap_uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
+                    s->lightmap_uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
+                }
+            }
             for (k = 0; k < 3; ++k) s->normals[3 * (size_t)dst + (size_t)k] = (float)(cr[k] / cl);
             s->areas[dst] = (float)(0.5 * cl);
             s->materials[dst] = m->material_ids ? m->material_ids[t] : m->material;
@@ -3746,7 +3990,7 @@ static const rad_material rad__cornell_materials[4] = {
 
 #define RAD__CORNELL_MESH(name, first_vertex, quads, mat)                                                      \
     { name, rad__cornell_positions + 3 * (first_vertex), 0, 4 * (quads), NULL, 0, NULL, 0, rad__cornell_quad_indices, \
-      2 * (quads), NULL, mat }
+      2 * (quads), NULL, mat, NULL, 0 }
 
 static const rad_mesh_desc rad__cornell_meshes[8] = {
     RAD__CORNELL_MESH("floor", 0, 1, 0),      RAD__CORNELL_MESH("ceiling", 4, 1, 0),
@@ -8584,6 +8828,1156 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
     rad__free(&c.allocator, albedo);
     rad__free(&c.allocator, owner);
     return r == RAD_SUCCESS ? rad__check_output(&c, "final gather", out, 3 * (size_t)count) : r;
+}
+
+/* ======================================================================================== */
+/* >>lightmap: lightmaps over a second UV set                                               */
+/* ======================================================================================== */
+
+#define RAD__LM_MAX_SIDE 16384u
+#define RAD__LM_MAX_SUB 16u
+#define RAD__LM_MAX_SLOTS ((uint64_t)1 << 28)
+#define RAD__LM_GROUP 64u          /* samples per validity row */
+#define RAD__LM_SH_Y0 0.282094792f /* 1 / (2 sqrt(pi)) */
+#define RAD__LM_SH_Y1 0.488602512f /* sqrt(3) / (2 sqrt(pi)) */
+
+RAD_API void rad_lightmap_options_default(rad_lightmap_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->width = o->height = 256;
+    o->samples = 4;
+    o->validity_rays = 16;
+    o->backface_limit = 0.1f;
+    o->ray_epsilon = 1e-5f;
+}
+
+RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->encoding = RAD_LIGHTMAP_IRRADIANCE;
+    o->visibility_rays = 4;
+    o->ray_epsilon = 1e-5f;
+}
+
+RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding)
+{
+    return encoding == RAD_LIGHTMAP_IRRADIANCE ? 3u : encoding == RAD_LIGHTMAP_SH_L1 ? 12u : 0u;
+}
+
+RAD_API void rad_lightmap_destroy(rad_lightmap *lm)
+{
+    rad_allocator a;
+    if (!lm) return;
+    a = lm->allocator;
+    rad__free(&a, lm->flags);
+    rad__free(&a, lm->positions);
+    rad__free(&a, lm->normals);
+    rad__free(&a, lm->sample_first);
+    rad__free(&a, lm->sample_positions);
+    rad__free(&a, lm->sample_normals);
+    rad__free(&a, lm->sample_triangles);
+    rad__free(&a, lm->sample_valid);
+    rad__free(&a, lm);
+}
+
+/* 1 when the uv triangle t (texel units, 6 doubles) and the box [x0,x1] x [y0,y1] overlap
+   with positive area (separating axes: the box's two and the triangle's three edge normals);
+   touching along a line does not count, so an edge on a texel border leaves the next texel out */
+static int rad__lm_overlap(const double *t, double x0, double y0, double x1, double y1)
+{
+    double mn, mx;
+    int e, k;
+    mn = mx = t[0];
+    for (k = 1; k < 3; ++k) { if (t[2 * k] < mn) mn = t[2 * k]; if (t[2 * k] > mx) mx = t[2 * k]; }
+    if (mx <= x0 || mn >= x1) return 0;
+    mn = mx = t[1];
+    for (k = 1; k < 3; ++k) { if (t[2 * k + 1] < mn) mn = t[2 * k + 1]; if (t[2 * k + 1] > mx) mx = t[2 * k + 1]; }
+    if (mx <= y0 || mn >= y1) return 0;
+    for (e = 0; e < 3; ++e) {
+        const double *a = t + 2 * e, *b = t + 2 * ((e + 1) % 3), *c = t + 2 * ((e + 2) % 3);
+        double nx = -(b[1] - a[1]), ny = b[0] - a[0], ta = nx * a[0] + ny * a[1], tc = nx * c[0] + ny * c[1];
+        double bx[4], lo, hi;
+        bx[0] = nx * x0 + ny * y0; bx[1] = nx * x1 + ny * y0; bx[2] = nx * x0 + ny * y1; bx[3] = nx * x1 + ny * y1;
+        lo = hi = bx[0];
+        for (k = 1; k < 4; ++k) { if (bx[k] < lo) lo = bx[k]; if (bx[k] > hi) hi = bx[k]; }
+        /* the triangle projects to [min(ta, tc), max(ta, tc)] (a and b project alike) */
+        if ((ta <= tc && (hi <= ta || lo >= tc)) || (ta > tc && (hi <= tc || lo >= ta))) return 0;
+    }
+    return 1;
+}
+
+/* barycentrics (b1, b2) of q in the uv triangle t; returns 0 for a degenerate triangle */
+static int rad__lm_bary(const double *t, double qx, double qy, double *b1, double *b2)
+{
+    double e1x = t[2] - t[0], e1y = t[3] - t[1], e2x = t[4] - t[0], e2y = t[5] - t[1];
+    double d = e1x * e2y - e1y * e2x, px = qx - t[0], py = qy - t[1];
+    if (!(fabs(d) > 1e-300)) return 0;
+    *b1 = (px * e2y - py * e2x) / d;
+    *b2 = (e1x * py - e1y * px) / d;
+    return 1;
+}
+
+/* the point of uv triangle t closest to q: barycentrics and squared distance */
+static double rad__lm_closest(const double *t, double qx, double qy, double *b1, double *b2)
+{
+    double best = DBL_MAX, x, y;
+    int e;
+    if (rad__lm_bary(t, qx, qy, b1, b2) && *b1 >= 0.0 && *b2 >= 0.0 && *b1 + *b2 <= 1.0) return 0.0;
+    for (e = 0; e < 3; ++e) {
+        const double *a = t + 2 * e, *b = t + 2 * ((e + 1) % 3);
+        double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy, s = 0.0, d2;
+        if (l2 > 0.0) s = ((qx - a[0]) * dx + (qy - a[1]) * dy) / l2;
+        if (s < 0.0) s = 0.0;
+        if (s > 1.0) s = 1.0;
+        x = a[0] + s * dx;
+        y = a[1] + s * dy;
+        d2 = (x - qx) * (x - qx) + (y - qy) * (y - qy);
+        if (d2 < best) {
+            /* barycentrics of the edge point: vertex e weight 1 - s, vertex e + 1 weight s */
+            double w[3] = { 0.0, 0.0, 0.0 };
+            best = d2;
+            w[e] = 1.0 - s;
+            w[(e + 1) % 3] = s;
+            *b1 = w[1];
+            *b2 = w[2];
+        }
+    }
+    return best;
+}
+
+typedef struct rad__lm_valid {
+    rad_lightmap *lm;
+    const rad_raycaster *rc;
+    uint32_t rays;
+    uint32_t limit;               /* back-face hits allowed */
+    uint32_t seed;
+    float eps;
+    rad_ray *ray_buf;             /* per task 'rays' */
+    rad_hit *hit_buf;
+    uint64_t *rays_cast;          /* per task */
+} rad__lm_valid;
+
+static rad_result rad__lm_valid_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__lm_valid *v = (rad__lm_valid *)data;
+    rad_lightmap *lm = v->lm;
+    rad_ray *rays = v->ray_buf + (size_t)task * v->rays;
+    rad_hit *hits = v->hit_buf + (size_t)task * v->rays;
+    uint32_t s, end = (row + 1u) * RAD__LM_GROUP, k;
+    int c;
+    if (end > lm->sample_count) end = lm->sample_count;
+    for (s = row * RAD__LM_GROUP; s < end; ++s) {
+        const float *p = lm->sample_positions + 3 * (size_t)s, *n = lm->sample_normals + 3 * (size_t)s;
+        float t1[3], t2[3];
+        uint32_t h = rad__hash(v->seed ^ rad__hash(s + 0x2545F491u)), back = 0;
+        rad__tangent_frame(n, t1, t2);
+        for (k = 0; k < v->rays; ++k) {
+            rad__cosine_dir(n, t1, t2, k, v->rays, h, rays[k].dir);
+            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c] + n[c] * v->eps;
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = FLT_MAX;
+        }
+        if (v->rc->intersect(v->rc->user, rays, v->rays, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        v->rays_cast[task] += v->rays;
+        for (k = 0; k < v->rays; ++k) {
+            uint32_t t = hits[k].triangle;
+            if (t != RAD_NONE && t < lm->scene->triangle_count && rad__dot(lm->scene->normals + 3 * (size_t)t, rays[k].dir) > 0.0f)
+                ++back;
+        }
+        lm->sample_valid[s] = back > v->limit ? 0u : 1u;
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                       const rad_lightmap_options *options, const rad_context *ctx, rad_lightmap **out)
+{
+    rad__ctx c;
+    rad_lightmap_options o;
+    rad_lightmap *lm = NULL;
+    uint32_t W, H, n, S, t, x, y, i, total = 0;
+    size_t texels, slots;
+    uint32_t *slot_tri = NULL, *fb_tri = NULL;
+    float *slot_b = NULL, *fb_b = NULL, *fb_d = NULL;
+    rad__lm_valid v;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!scene || !raycaster || !raycaster->intersect) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: NULL scene or raycaster (with intersect)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!scene->lightmap_uvs || !scene->lightmapped) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: no mesh of the scene has lightmap_uvs");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else rad_lightmap_options_default(&o);
+    if (o.width == 0) o.width = 256;
+    if (o.height == 0) o.height = 256;
+    if (o.samples == 0) o.samples = 4;
+    if (o.validity_rays == 0) o.validity_rays = 16;
+    if (o.backface_limit == 0.0f) o.backface_limit = 0.1f;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (o.width > RAD__LM_MAX_SIDE || o.height > RAD__LM_MAX_SIDE || o.samples > RAD__LM_MAX_SUB ||
+        o.validity_rays > 1024u || !(o.backface_limit > 0.0f && o.backface_limit <= 1.0f) ||
+        !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: an option is out of range (size %ux%u, at most %u; samples %u, at most %u; "
+                 "validity_rays %u, at most 1024; backface_limit %g in (0, 1]; ray_epsilon %g in (0, %g])", o.width, o.height,
+                 RAD__LM_MAX_SIDE, o.samples, RAD__LM_MAX_SUB, o.validity_rays, (double)o.backface_limit,
+                 (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    W = o.width;
+    H = o.height;
+    n = rad__lattice_side(o.samples);
+    if (n * n > RAD__LM_MAX_SUB) n = 4;
+    S = n * n;
+    texels = (size_t)W * H;
+    if ((uint64_t)texels * S > RAD__LM_MAX_SLOTS) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: %ux%u texels of %u samples pass the limit of 2^28 sample slots", W, H, S);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    slots = texels * S;
+    lm = (rad_lightmap *)rad__alloc(&c.allocator, sizeof(rad_lightmap));
+    if (!lm) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(lm, 0, sizeof(*lm));
+    lm->allocator = c.allocator;
+    lm->width = W;
+    lm->height = H;
+    lm->scene = scene;
+    lm->flags = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
+    lm->positions = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
+    lm->normals = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
+    lm->sample_first = (uint32_t *)rad__alloc_array(&c.allocator, texels + 1, sizeof(uint32_t));
+    slot_tri = (uint32_t *)rad__alloc_array(&c.allocator, slots, sizeof(uint32_t));
+    slot_b = (float *)rad__alloc_array(&c.allocator, slots, 2 * sizeof(float));
+    fb_tri = (uint32_t *)rad__alloc_array(&c.allocator, texels, sizeof(uint32_t));
+    fb_b = (float *)rad__alloc_array(&c.allocator, texels, 2 * sizeof(float));
+    fb_d = (float *)rad__alloc_array(&c.allocator, texels, sizeof(float));
+    if (!lm->flags || !lm->positions || !lm->normals || !lm->sample_first || !slot_tri || !slot_b || !fb_tri || !fb_b || !fb_d) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %ux%u texels", W, H);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    memset(lm->flags, 0, texels);
+    memset(lm->positions, 0, texels * 3 * sizeof(float));
+    memset(lm->normals, 0, texels * 3 * sizeof(float));
+    for (i = 0; i < slots; ++i) slot_tri[i] = RAD_NONE;
+    for (i = 0; i < texels; ++i) { fb_tri[i] = RAD_NONE; fb_d[i] = FLT_MAX; }
+    /* rasterize: serial, each triangle over the texels of its uv bounds */
+    for (t = 0; t < scene->triangle_count; ++t) {
+        double tu[6], mnx, mny, mxx, mxy;
+        int64_t x0, x1, y0, y1;
+        int k;
+        if (!scene->lightmapped[t]) continue;
+        for (k = 0; k < 3; ++k) {
+            tu[2 * k] = (double)scene->lightmap_uvs[6 * (size_t)t + 2 * (size_t)k] * W;
+            tu[2 * k + 1] = (double)scene->lightmap_uvs[6 * (size_t)t + 2 * (size_t)k + 1] * H;
+        }
+        {
+            double b1, b2;
+            if (!rad__lm_bary(tu, tu[0], tu[1], &b1, &b2)) continue; /* zero uv area: nothing to bake */
+        }
+        mnx = mxx = tu[0];
+        mny = mxy = tu[1];
+        for (k = 1; k < 3; ++k) {
+            if (tu[2 * k] < mnx) mnx = tu[2 * k];
+            if (tu[2 * k] > mxx) mxx = tu[2 * k];
+            if (tu[2 * k + 1] < mny) mny = tu[2 * k + 1];
+            if (tu[2 * k + 1] > mxy) mxy = tu[2 * k + 1];
+        }
+        if (mxx <= 0.0 || mxy <= 0.0 || mnx >= (double)W || mny >= (double)H) continue;
+        x0 = (int64_t)floor(mnx); x1 = (int64_t)floor(mxx);
+        y0 = (int64_t)floor(mny); y1 = (int64_t)floor(mxy);
+        if (x0 < 0) x0 = 0;
+        if (y0 < 0) y0 = 0;
+        if (x1 > (int64_t)W - 1) x1 = (int64_t)W - 1;
+        if (y1 > (int64_t)H - 1) y1 = (int64_t)H - 1;
+        for (y = (uint32_t)y0; y <= (uint32_t)y1; ++y)
+            for (x = (uint32_t)x0; x <= (uint32_t)x1; ++x) {
+                size_t ti = (size_t)y * W + x;
+                uint32_t a, b, got = 0;
+                double b1, b2, d2;
+                if (!rad__lm_overlap(tu, (double)x, (double)y, (double)x + 1.0, (double)y + 1.0)) continue;
+                lm->flags[ti] |= RAD_TEXEL_COVERED;
+                for (b = 0; b < n; ++b)
+                    for (a = 0; a < n; ++a) {
+                        size_t si = ti * S + (size_t)b * n + a;
+                        if (!rad__lm_bary(tu, x + (a + 0.5) / n, y + (b + 0.5) / n, &b1, &b2)) continue;
+                        if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0) continue;
+                        got = 1;
+                        if (slot_tri[si] != RAD_NONE) continue; /* the first triangle keeps a shared sub-point */
+                        slot_tri[si] = t;
+                        slot_b[2 * si] = (float)b1;
+                        slot_b[2 * si + 1] = (float)b2;
+                    }
+                if (got) continue;
+                d2 = rad__lm_closest(tu, x + 0.5, y + 0.5, &b1, &b2);
+                if (d2 < (double)fb_d[ti]) {
+                    fb_d[ti] = (float)d2;
+                    fb_tri[ti] = t;
+                    fb_b[2 * ti] = (float)b1;
+                    fb_b[2 * ti + 1] = (float)b2;
+                }
+            }
+    }
+    /* the samples, texel by texel */
+    for (i = 0; i < texels; ++i) {
+        uint32_t m = 0, s;
+        lm->sample_first[i] = total;
+        if (!(lm->flags[i] & RAD_TEXEL_COVERED)) continue;
+        for (s = 0; s < S; ++s) if (slot_tri[(size_t)i * S + s] != RAD_NONE) ++m;
+        if (m == 0 && fb_tri[i] != RAD_NONE) m = 1;
+        if ((uint64_t)total + m >= (uint64_t)RAD_NONE) { r = RAD_ERROR_SIZE_OVERFLOW; goto done; }
+        total += m;
+    }
+    lm->sample_first[texels] = total;
+    lm->sample_count = total;
+    lm->sample_positions = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
+    lm->sample_normals = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
+    lm->sample_triangles = (uint32_t *)rad__alloc_array(&c.allocator, total ? total : 1u, sizeof(uint32_t));
+    lm->sample_valid = (uint8_t *)rad__alloc_array(&c.allocator, total ? total : 1u, 1);
+    if (!lm->sample_positions || !lm->sample_normals || !lm->sample_triangles || !lm->sample_valid) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %u samples", total);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < texels; ++i) {
+        uint32_t at = lm->sample_first[i], s, m = lm->sample_first[i + 1] - at, j = 0;
+        for (s = 0; s < S && j < m; ++s) {
+            size_t si = (size_t)i * S + s;
+            uint32_t tt = slot_tri[si];
+            float b1, b2;
+            const float *P;
+            int k;
+            if (tt == RAD_NONE && !(s == S - 1 && j == 0)) continue;
+            if (tt == RAD_NONE) { /* no sub-point inside: the fallback point */
+                tt = fb_tri[i];
+                b1 = fb_b[2 * (size_t)i];
+                b2 = fb_b[2 * (size_t)i + 1];
+            } else {
+                b1 = slot_b[2 * si];
+                b2 = slot_b[2 * si + 1];
+            }
+            P = scene->positions + 9 * (size_t)tt;
+            {
+                /* a point on the triangle's border (a fallback point, a sub-point on an edge)
+                   lies on the plane of the wall that meets it there, where its validity rays
+                   would start behind that wall: it moves towards the centroid by a few ray
+                   epsilons (at most half the way) */
+                float *X = lm->sample_positions + 3 * (size_t)(at + j), dc[3], len, step;
+                for (k = 0; k < 3; ++k) {
+                    X[k] = P[k] + b1 * (P[3 + k] - P[k]) + b2 * (P[6 + k] - P[k]);
+                    dc[k] = (P[k] + P[3 + k] + P[6 + k]) / 3.0f - X[k];
+                    lm->sample_normals[3 * (size_t)(at + j) + k] = scene->normals[3 * (size_t)tt + k];
+                }
+                len = rad__len(dc);
+                step = 4.0f * o.ray_epsilon * scene->diagonal;
+                if (len > 0.0f) {
+                    if (step > 0.5f * len) step = 0.5f * len;
+                    for (k = 0; k < 3; ++k) X[k] += dc[k] * (step / len);
+                }
+            }
+            lm->sample_triangles[at + j] = tt;
+            ++j;
+        }
+    }
+    /* validity */
+    memset(&v, 0, sizeof(v));
+    v.lm = lm;
+    v.rc = raycaster;
+    v.rays = o.validity_rays;
+    v.limit = (uint32_t)floor((double)o.backface_limit * o.validity_rays + 1e-9);
+    v.seed = o.seed;
+    v.eps = o.ray_epsilon * scene->diagonal;
+    if (total > 0) {
+        uint32_t rows = (total + RAD__LM_GROUP - 1) / RAD__LM_GROUP, T = c.tasks < rows ? c.tasks : rows;
+        v.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_ray));
+        v.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_hit));
+        v.rays_cast = (uint64_t *)rad__alloc_array(&c.allocator, T, sizeof(uint64_t));
+        if (!v.ray_buf || !v.hit_buf || !v.rays_cast) {
+            r = RAD_ERROR_OUT_OF_MEMORY;
+        } else {
+            memset(v.rays_cast, 0, sizeof(uint64_t) * T);
+            r = rad__for_rows(&c, rows, T, rad__lm_valid_row, &v);
+            for (i = 0; i < T; ++i) lm->rays_cast += v.rays_cast[i];
+        }
+        rad__free(&c.allocator, v.ray_buf);
+        rad__free(&c.allocator, v.hit_buf);
+        rad__free(&c.allocator, v.rays_cast);
+        if (r != RAD_SUCCESS) goto done;
+    }
+    /* texel position and normal */
+    for (i = 0; i < texels; ++i) {
+        uint32_t s, a = lm->sample_first[i], b = lm->sample_first[i + 1], any = 0;
+        float cnt = 0.0f, *P = lm->positions + 3 * (size_t)i, *N = lm->normals + 3 * (size_t)i;
+        int k;
+        if (a == b) continue;
+        ++lm->covered_texels;
+        for (s = a; s < b; ++s) {
+            if (lm->sample_valid[s]) any = 1;
+            else ++lm->invalid_samples;
+        }
+        if (any) { lm->flags[i] |= RAD_TEXEL_VALID; ++lm->valid_texels; }
+        for (s = a; s < b; ++s) {
+            if (any && !lm->sample_valid[s]) continue;
+            for (k = 0; k < 3; ++k) {
+                P[k] += lm->sample_positions[3 * (size_t)s + k];
+                N[k] += lm->sample_normals[3 * (size_t)s + k];
+            }
+            cnt += 1.0f;
+        }
+        for (k = 0; k < 3; ++k) P[k] /= cnt;
+        if (rad__len(N) > 0.0f) rad__normalize(N);
+        else memcpy(N, lm->sample_normals + 3 * (size_t)a, 3 * sizeof(float));
+    }
+done:
+    rad__free(&c.allocator, slot_tri);
+    rad__free(&c.allocator, slot_b);
+    rad__free(&c.allocator, fb_tri);
+    rad__free(&c.allocator, fb_b);
+    rad__free(&c.allocator, fb_d);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_SIZE_OVERFLOW) rad__log(&c, RAD_LOG_ERROR, "lightmap: more than 2^32 - 2 samples");
+        rad_lightmap_destroy(lm);
+        return r;
+    }
+    *out = lm;
+    return RAD_SUCCESS;
+}
+
+/* The projections of the radiance of a Lambertian polygon (triangle v, 9 floats) seen from p
+   (unit normal n), clipped to p's upper half-space: out[0] its solid angle, out[1..3] its
+   vector irradiance integral w dw (so n . out[1..3] = pi F). Returns 0 when nothing is left. */
+static int rad__lm_polygon(const double *p, const double *n, const float *v, double *out)
+{
+    double q[3][3], d[3], poly[4][3], r[4][3], vec[3] = { 0.0, 0.0, 0.0 }, omega = 0.0, dn;
+    int i, k, m = 0;
+    for (i = 0; i < 3; ++i) {
+        for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
+        d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
+    }
+    for (i = 0; i < 3; ++i) {
+        int j = (i + 1) % 3;
+        if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) poly[m][k] = q[i][k]; ++m; }
+        if ((d[i] > 0.0 && d[j] < 0.0) || (d[i] < 0.0 && d[j] > 0.0)) {
+            double s = d[i] / (d[i] - d[j]);
+            for (k = 0; k < 3; ++k) poly[m][k] = q[i][k] + s * (q[j][k] - q[i][k]);
+            ++m;
+        }
+    }
+    if (m < 3) return 0;
+    for (i = 0; i < m; ++i) {
+        double l = sqrt(poly[i][0] * poly[i][0] + poly[i][1] * poly[i][1] + poly[i][2] * poly[i][2]);
+        if (!(l > 0.0)) return 0; /* p on the polygon's boundary */
+        for (k = 0; k < 3; ++k) r[i][k] = poly[i][k] / l;
+    }
+    for (i = 0; i < m; ++i) {
+        const double *a = r[i], *b = r[(i + 1) % m];
+        double cr[3], cl, dot;
+        cr[0] = a[1] * b[2] - a[2] * b[1];
+        cr[1] = a[2] * b[0] - a[0] * b[2];
+        cr[2] = a[0] * b[1] - a[1] * b[0];
+        cl = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+        if (!(cl > 1e-300)) continue;
+        dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        for (k = 0; k < 3; ++k) vec[k] += 0.5 * atan2(cl, dot) * cr[k] / cl;
+    }
+    /* solid angle: a fan of spherical triangles (Van Oosterom and Strackee) */
+    for (i = 1; i + 1 < m; ++i) {
+        const double *a = r[0], *b = r[i], *cc = r[i + 1];
+        double trip = a[0] * (b[1] * cc[2] - b[2] * cc[1]) + a[1] * (b[2] * cc[0] - b[0] * cc[2]) + a[2] * (b[0] * cc[1] - b[1] * cc[0]);
+        double den = 1.0 + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) + (b[0] * cc[0] + b[1] * cc[1] + b[2] * cc[2]) +
+                     (cc[0] * a[0] + cc[1] * a[1] + cc[2] * a[2]);
+        omega += 2.0 * atan2(trip, den);
+    }
+    /* the winding decides the signs; the polygon lies above p's plane, so n . vec >= 0 */
+    dn = vec[0] * n[0] + vec[1] * n[1] + vec[2] * n[2];
+    if (dn < 0.0) { for (k = 0; k < 3; ++k) vec[k] = -vec[k]; dn = -dn; }
+    if (!(dn > 0.0)) return 0;
+    out[0] = fabs(omega);
+    for (k = 0; k < 3; ++k) out[1 + k] = vec[k];
+    return 1;
+}
+
+typedef struct rad__lm_gather {
+    const rad_lightmap *lm;
+    const rad_patches *P;
+    const float *B;
+    const rad_raycaster *rc;
+    uint32_t ch, vis, seed;
+    float eps;
+    uint8_t *lit;                 /* per patch: B != 0 */
+    rad_ray *ray_buf;             /* per task RAD__RAY_BATCH */
+    uint8_t *occ_buf;
+    float *ray_c;                 /* per task RAD__RAY_BATCH x ch: each ray's contribution */
+    float *out;
+} rad__lm_gather;
+
+static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count, double *acc)
+{
+    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    uint8_t *occ = g->occ_buf + (size_t)task * RAD__RAY_BATCH;
+    const float *w = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
+    uint32_t k, ch;
+    if (count == 0) return RAD_SUCCESS;
+    if (g->rc->occluded(g->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k)
+        if (!occ[k])
+            for (ch = 0; ch < g->ch; ++ch) acc[ch] += (double)w[(size_t)k * g->ch + ch];
+    return RAD_SUCCESS;
+}
+
+/* one texel: the mean over its valid samples of the patches' light */
+static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
+{
+    rad__lm_gather *g = (rad__lm_gather *)data;
+    const rad_lightmap *lm = g->lm;
+    const rad_patches *P = g->P;
+    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    float *rc = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
+    double acc[12], sum[12];
+    uint32_t s, j, ch, nval = 0, nr = 0;
+    float *out = g->out + (size_t)texel * g->ch;
+    int k;
+    for (ch = 0; ch < g->ch; ++ch) sum[ch] = 0.0;
+    for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) {
+        const float *pf = lm->sample_positions + 3 * (size_t)s, *nf = lm->sample_normals + 3 * (size_t)s;
+        double p[3], n[3];
+        uint32_t h;
+        rad_result r;
+        if (!lm->sample_valid[s]) continue;
+        ++nval;
+        for (k = 0; k < 3; ++k) { p[k] = pf[k]; n[k] = nf[k]; }
+        for (ch = 0; ch < g->ch; ++ch) acc[ch] = 0.0;
+        h = rad__hash(g->seed ^ rad__hash(s * 0x9E3779B9u + 0x3C6EF372u));
+        for (j = 0; j < P->count; ++j) {
+            const rad_patch *pj = &P->patches[j];
+            float tri[9], y[3], d[3], r1, r2, u1, u2;
+            double proj[4], kw[64], ksum = 0.0, full[12], Lr[3];
+            uint32_t m, q;
+            if (!g->lit[j] || pj->triangle == lm->sample_triangles[s]) continue;
+            for (m = 0; m < 3; ++m)
+                for (k = 0; k < 3; ++k) tri[3 * m + k] = P->vertices[3 * (size_t)pj->vertices[m] + (size_t)k];
+            rad__sub(d, pf, tri);
+            if (!(rad__dot(d, pj->normal) > 0.0f)) continue; /* p behind the patch */
+            if (!rad__lm_polygon(p, n, tri, proj)) continue;
+            for (k = 0; k < 3; ++k) Lr[k] = (double)g->B[3 * (size_t)j + k] / RAD__PI;
+            /* the patch's unoccluded contribution in the encoding */
+            if (g->ch == 3) {
+                double ndv = n[0] * proj[1] + n[1] * proj[2] + n[2] * proj[3];
+                for (k = 0; k < 3; ++k) full[k] = Lr[k] * ndv;
+            } else {
+                for (k = 0; k < 3; ++k) {
+                    full[k] = Lr[k] * RAD__LM_SH_Y0 * proj[0];
+                    full[3 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[2];
+                    full[6 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[3];
+                    full[9 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[1];
+                }
+            }
+            /* visibility: rays to stratified points of the patch, each carrying its kernel's
+               share of the contribution */
+            r1 = (float)((h ^ rad__hash(j)) & 0xFFFFu) / 65536.0f;
+            r2 = (float)((h ^ rad__hash(j)) >> 16) / 65536.0f;
+            for (q = 0; q < g->vis; ++q) {
+                float dd[3], l2, cp, cq;
+                rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
+                rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
+                rad__sub(dd, y, pf);
+                l2 = rad__dot(dd, dd);
+                cp = rad__dot(dd, nf);
+                cq = -rad__dot(dd, pj->normal);
+                kw[q] = (l2 > 0.0f && cp > 0.0f && cq > 0.0f) ? (double)cp * cq / ((double)l2 * l2) : 0.0;
+                ksum += kw[q];
+            }
+            if (!(ksum > 0.0)) continue;
+            for (q = 0; q < g->vis; ++q) {
+                rad_ray *ray;
+                float len;
+                if (!(kw[q] > 0.0)) continue;
+                rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
+                rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
+                ray = rays + nr;
+                for (k = 0; k < 3; ++k) {
+                    ray->origin[k] = pf[k] + nf[k] * g->eps;
+                    ray->dir[k] = (y[k] + pj->normal[k] * g->eps) - ray->origin[k];
+                }
+                len = rad__len(ray->dir);
+                ray->tmin = 0.0f;
+                ray->tmax = len > 2.0f * g->eps ? 1.0f - g->eps / len : 0.5f;
+                for (ch = 0; ch < g->ch; ++ch) rc[(size_t)nr * g->ch + ch] = (float)(full[ch] * kw[q] / ksum);
+                if (++nr == RAD__RAY_BATCH) {
+                    r = rad__lm_flush(g, task, nr, acc);
+                    nr = 0;
+                    if (r != RAD_SUCCESS) return r;
+                }
+            }
+        }
+        r = rad__lm_flush(g, task, nr, acc);
+        nr = 0;
+        if (r != RAD_SUCCESS) return r;
+        for (ch = 0; ch < g->ch; ++ch) sum[ch] += acc[ch];
+    }
+    for (ch = 0; ch < g->ch; ++ch) out[ch] = nval ? (float)(sum[ch] / nval) : 0.0f;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches *patches, const float *B,
+                                       const rad_raycaster *raycaster, const rad_lightmap_gather_options *options, float *out,
+                                       const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__lm_gather g;
+    rad_lightmap_gather_options o;
+    uint32_t T, i, texels;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !patches || !B || !raycaster || !raycaster->occluded || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: NULL lightmap, patches, radiosity, raycaster (with occluded) or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (patches->scene != lm->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the patches were made from another scene than the lightmap");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else rad_lightmap_gather_options_default(&o);
+    if (o.visibility_rays == 0) o.visibility_rays = 4;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (rad_lightmap_channels(o.encoding) == 0 || o.visibility_rays > 64u ||
+        !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: encoding %d, visibility_rays %u (at most 64) or ray_epsilon %g out of range",
+                 (int)o.encoding, o.visibility_rays, (double)o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    r = rad__check_input(&c, "lightmap gather: patch radiosity", B, 3 * (size_t)patches->count);
+    if (r != RAD_SUCCESS) return r;
+    memset(&g, 0, sizeof(g));
+    g.lm = lm;
+    g.P = patches;
+    g.B = B;
+    g.rc = raycaster;
+    g.ch = rad_lightmap_channels(o.encoding);
+    g.vis = o.visibility_rays;
+    g.seed = o.seed;
+    g.eps = o.ray_epsilon * lm->scene->diagonal;
+    g.out = out;
+    texels = lm->width * lm->height;
+    T = c.tasks < texels ? c.tasks : texels;
+    g.lit = (uint8_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, 1);
+    g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    g.occ_buf = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    g.ray_c = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, g.ch * sizeof(float));
+    if (!g.lit || !g.ray_buf || !g.occ_buf || !g.ray_c) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: out of memory for %u tasks", T);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        for (i = 0; i < patches->count; ++i)
+            g.lit[i] = (B[3 * (size_t)i] != 0.0f || B[3 * (size_t)i + 1] != 0.0f || B[3 * (size_t)i + 2] != 0.0f) ? 1u : 0u;
+        r = rad__for_rows(&c, texels, T, rad__lm_gather_row, &g);
+    }
+    rad__free(&c.allocator, g.lit);
+    rad__free(&c.allocator, g.ray_buf);
+    rad__free(&c.allocator, g.occ_buf);
+    rad__free(&c.allocator, g.ray_c);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather", out, (size_t)texels * g.ch) : r;
+}
+
+RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lm, const rad_raycaster *raycaster, const rad_light *lights,
+                                       uint32_t light_count, const rad_direct_options *options, float *out,
+                                       const rad_context *ctx)
+{
+    rad__ctx c;
+    float *pts, *nrm, *D;
+    uint32_t *owner, i, s, m = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap direct: NULL lightmap or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    pts = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    D = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    owner = (uint32_t *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, sizeof(uint32_t));
+    if (!pts || !nrm || !D || !owner) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap direct: out of memory for %u samples", lm->sample_count);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < lm->width * lm->height; ++i)
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+            if (!lm->sample_valid[s]) continue;
+            memcpy(pts + 3 * (size_t)m, lm->sample_positions + 3 * (size_t)s, 3 * sizeof(float));
+            memcpy(nrm + 3 * (size_t)m, lm->sample_normals + 3 * (size_t)s, 3 * sizeof(float));
+            owner[m++] = i;
+        }
+    r = m ? rad_direct_irradiance(lm->scene, raycaster, lights, light_count, options, pts, nrm, m, D, ctx) : RAD_SUCCESS;
+    if (r == RAD_SUCCESS) {
+        uint32_t a = 0, b;
+        while (a < m) {
+            uint32_t texel = owner[a], k;
+            double sum[3] = { 0.0, 0.0, 0.0 };
+            for (b = a; b < m && owner[b] == texel; ++b)
+                for (k = 0; k < 3; ++k) sum[k] += D[3 * (size_t)b + k];
+            for (k = 0; k < 3; ++k) out[3 * (size_t)texel + k] += (float)(sum[k] / (double)(b - a));
+            a = b;
+        }
+    }
+done:
+    rad__free(&c.allocator, pts);
+    rad__free(&c.allocator, nrm);
+    rad__free(&c.allocator, D);
+    rad__free(&c.allocator, owner);
+    return r;
+}
+
+RAD_API rad_result rad_lightmap_dilate(const rad_lightmap *lm, uint32_t channels, float *values, uint32_t passes,
+                                       const rad_context *ctx)
+{
+    rad__ctx c;
+    uint8_t *have, *next;
+    uint32_t W, H, pass, x, y, ch;
+    size_t texels, i;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !values || channels == 0 || channels > 64u) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap dilate: NULL lightmap or values, or channels %u not in 1..64", channels);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    W = lm->width;
+    H = lm->height;
+    texels = (size_t)W * H;
+    have = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
+    next = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
+    if (!have || !next) {
+        rad__free(&c.allocator, have);
+        rad__free(&c.allocator, next);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < texels; ++i) have[i] = (lm->flags[i] & RAD_TEXEL_VALID) ? 1u : 0u;
+    for (pass = 0; passes == 0 || pass < passes; ++pass) {
+        int changed = 0;
+        memcpy(next, have, texels);
+        for (y = 0; y < H; ++y)
+            for (x = 0; x < W; ++x) {
+                size_t ti = (size_t)y * W + x;
+                float acc[64];
+                int dx, dy, cnt = 0;
+                if (have[ti]) continue;
+                for (ch = 0; ch < channels; ++ch) acc[ch] = 0.0f;
+                for (dy = -1; dy <= 1; ++dy)
+                    for (dx = -1; dx <= 1; ++dx) {
+                        int64_t nx = (int64_t)x + dx, ny = (int64_t)y + dy;
+                        size_t ni;
+                        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= (int64_t)W || ny >= (int64_t)H) continue;
+                        ni = (size_t)ny * W + (size_t)nx;
+                        if (!have[ni]) continue;
+                        for (ch = 0; ch < channels; ++ch) acc[ch] += values[ni * channels + ch];
+                        ++cnt;
+                    }
+                if (!cnt) continue;
+                for (ch = 0; ch < channels; ++ch) values[ti * channels + ch] = acc[ch] / (float)cnt;
+                next[ti] = 1;
+                changed = 1;
+            }
+        memcpy(have, next, texels);
+        if (!changed) break;
+    }
+    rad__free(&c.allocator, have);
+    rad__free(&c.allocator, next);
+    return RAD_SUCCESS;
+}
+
+/* bilinear taps of (u, v): texel indices and weights, clamped to the edge texels */
+static void rad__lm_taps(const rad_lightmap *lm, float u, float v, uint32_t *idx, float *w)
+{
+    double x = (double)u * lm->width - 0.5, y = (double)v * lm->height - 0.5, fx, fy;
+    int64_t x0, y0, x1, y1;
+    if (!(x > 0.0)) x = 0.0;
+    if (!(y > 0.0)) y = 0.0;
+    if (x > (double)lm->width - 1.0) x = (double)lm->width - 1.0;
+    if (y > (double)lm->height - 1.0) y = (double)lm->height - 1.0;
+    x0 = (int64_t)floor(x);
+    y0 = (int64_t)floor(y);
+    fx = x - (double)x0;
+    fy = y - (double)y0;
+    x1 = x0 + 1 < (int64_t)lm->width ? x0 + 1 : x0;
+    y1 = y0 + 1 < (int64_t)lm->height ? y0 + 1 : y0;
+    idx[0] = (uint32_t)(y0 * lm->width + x0); w[0] = (float)((1.0 - fx) * (1.0 - fy));
+    idx[1] = (uint32_t)(y0 * lm->width + x1); w[1] = (float)(fx * (1.0 - fy));
+    idx[2] = (uint32_t)(y1 * lm->width + x0); w[2] = (float)((1.0 - fx) * fy);
+    idx[3] = (uint32_t)(y1 * lm->width + x1); w[3] = (float)(fx * fy);
+}
+
+RAD_API void rad_lightmap_sample(const rad_lightmap *lm, uint32_t channels, const float *values, float u, float v, float *out)
+{
+    uint32_t idx[4], ch;
+    float w[4];
+    int k;
+    if (!lm || !values || !out) return;
+    rad__lm_taps(lm, u, v, idx, w);
+    for (ch = 0; ch < channels; ++ch) {
+        float s = 0.0f;
+        for (k = 0; k < 4; ++k) s += w[k] * values[(size_t)idx[k] * channels + ch];
+        out[ch] = s;
+    }
+}
+
+RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
+{
+    rad_allocator a;
+    if (!w) return;
+    a = w->allocator;
+    rad__free(&a, w->row_offsets);
+    rad__free(&a, w->columns);
+    rad__free(&a, w->values);
+    rad__free(&a, w);
+}
+
+/* barycentrics (b1, b2) of point x in triangle v (9 floats), least squares in its plane */
+static void rad__lm_bary3(const float *v, const float *x, float *b1, float *b2)
+{
+    double e1[3], e2[3], d[3], d00 = 0.0, d01 = 0.0, d11 = 0.0, d20 = 0.0, d21 = 0.0, den, u, w;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)v[3 + k] - v[k];
+        e2[k] = (double)v[6 + k] - v[k];
+        d[k] = (double)x[k] - v[k];
+        d00 += e1[k] * e1[k]; d01 += e1[k] * e2[k]; d11 += e2[k] * e2[k];
+        d20 += d[k] * e1[k]; d21 += d[k] * e2[k];
+    }
+    den = d00 * d11 - d01 * d01;
+    u = den > 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
+    w = den > 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
+    if (u < 0.0) u = 0.0;
+    if (w < 0.0) w = 0.0;
+    if (u + w > 1.0) { double s = u + w; u /= s; w /= s; }
+    *b1 = (float)u;
+    *b2 = (float)w;
+}
+
+#define RAD__LM_ROW_MAX 256u /* entries one texel's row may gather before merging stops adding */
+
+RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad_patches *P, const float *baked_texels,
+                                               const float *baked_H, const rad_context *ctx, rad_lightmap_weights **out)
+{
+    rad__ctx c;
+    rad_lightmap_weights *W = NULL;
+    uint32_t *vfirst = NULL, *vpatch = NULL, *fill = NULL, i, texels, col[RAD__LM_ROW_MAX];
+    double *varea = NULL, val[RAD__LM_ROW_MAX];
+    uint64_t total = 0, cap = 0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!lm || !P || P->scene != lm->scene || (!baked_texels) != (!baked_H)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: NULL lightmap or patches, patches of another scene, or only one of "
+                 "baked_texels and baked_patch_irradiance");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    texels = lm->width * lm->height;
+    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    if (!W) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(W, 0, sizeof(*W));
+    W->allocator = c.allocator;
+    W->texels = texels;
+    W->patch_count = P->count;
+    /* the patches around each vertex, and their total area */
+    vfirst = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    fill = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    vpatch = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
+    varea = (double *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(double));
+    W->row_offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)texels + 1, sizeof(uint64_t));
+    if (!vfirst || !fill || !vpatch || !varea || !W->row_offsets) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(fill, 0, sizeof(uint32_t) * ((size_t)P->vertex_count + 1));
+    memset(varea, 0, sizeof(double) * ((size_t)P->vertex_count + 1));
+    for (i = 0; i < P->count; ++i) {
+        int k;
+        for (k = 0; k < 3; ++k) { fill[P->patches[i].vertices[k]]++; varea[P->patches[i].vertices[k]] += P->patches[i].area; }
+    }
+    vfirst[0] = 0;
+    for (i = 0; i < P->vertex_count; ++i) { vfirst[i + 1] = vfirst[i] + fill[i]; fill[i] = 0; }
+    for (i = 0; i < P->count; ++i) {
+        int k;
+        for (k = 0; k < 3; ++k) { uint32_t v = P->patches[i].vertices[k]; vpatch[vfirst[v] + fill[v]++] = i; }
+    }
+    /* rows, texel by texel, appended to growing arrays */
+    for (i = 0; i < texels; ++i) {
+        uint32_t s, n = 0, nv = 0, e;
+        W->row_offsets[i] = total;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+            uint32_t t = lm->sample_triangles[s], p, k;
+            float b1, b2, vw[3];
+            if (!lm->sample_valid[s]) continue;
+            ++nv;
+            rad__lm_bary3(lm->scene->positions + 9 * (size_t)t, lm->sample_positions + 3 * (size_t)s, &b1, &b2);
+            p = rad_patches_locate(P, t, b1, b2, vw);
+            if (p == RAD_NONE) continue;
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = P->patches[p].vertices[k], j;
+                if (!(varea[v] > 0.0) || !(vw[k] != 0.0f)) continue;
+                for (j = vfirst[v]; j < vfirst[v + 1]; ++j) {
+                    uint32_t q = vpatch[j], m;
+                    double wq = (double)vw[k] * P->patches[q].area / varea[v];
+                    for (m = 0; m < n && col[m] != q; ++m) {}
+                    if (m == n) {
+                        if (n == RAD__LM_ROW_MAX) continue; /* never with welded triangle meshes: a vertex has few patches */
+                        col[n] = q;
+                        val[n++] = 0.0;
+                    }
+                    val[m] += wq;
+                }
+            }
+        }
+        if (nv == 0 || n == 0) continue;
+        for (e = 0; e < n; ++e) val[e] /= nv;
+        if (baked_texels) {
+            double num = 0.0, den = 0.0, cf = 1.0;
+            int k;
+            for (k = 0; k < 3; ++k) num += baked_texels[3 * (size_t)i + k];
+            for (e = 0; e < n; ++e)
+                for (k = 0; k < 3; ++k) den += val[e] * baked_H[3 * (size_t)col[e] + k];
+            if (den > 0.0 && num >= 0.0) cf = num / den < 16.0 ? num / den : 16.0;
+            for (e = 0; e < n; ++e) val[e] *= cf;
+        }
+        if (total + n > cap) {
+            uint64_t nc = cap ? 2 * cap : 4096;
+            uint32_t *ncol;
+            float *nval;
+            while (nc < total + n) nc *= 2;
+            ncol = (uint32_t *)rad__realloc(&c.allocator, W->columns, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
+            if (!ncol) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+            W->columns = ncol;
+            nval = (float *)rad__realloc(&c.allocator, W->values, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
+            if (!nval) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+            W->values = nval;
+            cap = nc;
+        }
+        for (e = 0; e < n; ++e) { W->columns[total + e] = col[e]; W->values[total + e] = (float)val[e]; }
+        total += n;
+    }
+    W->row_offsets[texels] = total;
+done:
+    rad__free(&c.allocator, vfirst);
+    rad__free(&c.allocator, fill);
+    rad__free(&c.allocator, vpatch);
+    rad__free(&c.allocator, varea);
+    if (r != RAD_SUCCESS) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
+        rad_lightmap_weights_destroy(W);
+        return r;
+    }
+    *out = W;
+    return RAD_SUCCESS;
+}
+
+typedef struct rad__lm_refresh {
+    const rad_lightmap_weights *W;
+    const float *H;
+    float *out;
+    uint32_t tasks;
+} rad__lm_refresh;
+
+/* one contiguous block of texels per task: the rows are short, so a cyclic split would make
+   the tasks write the same cache lines of out */
+static void rad__lm_refresh_task(void *data, uint32_t task)
+{
+    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
+    const rad_lightmap_weights *W = f->W;
+    uint32_t t = (uint32_t)((uint64_t)W->texels * task / f->tasks), end = (uint32_t)((uint64_t)W->texels * (task + 1) / f->tasks);
+    for (; t < end; ++t) {
+        uint64_t a = W->row_offsets[t], b = W->row_offsets[t + 1], e;
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        if (a == b) continue;
+        for (e = a; e < b; ++e) {
+            const float *h = f->H + 3 * (size_t)W->columns[e], w = W->values[e];
+            s0 += w * h[0];
+            s1 += w * h[1];
+            s2 += w * h[2];
+        }
+        f->out[3 * (size_t)t] = s0;
+        f->out[3 * (size_t)t + 1] = s1;
+        f->out[3 * (size_t)t + 2] = s2;
+    }
+}
+
+RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const float *H, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__lm_refresh f;
+    rad__ctx_init(&c, ctx);
+    if (!W || !H || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    f.W = W;
+    f.H = H;
+    f.out = out;
+    f.tasks = c.tasks < W->texels ? c.tasks : (W->texels ? W->texels : 1u);
+    c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_task, &f);
+    return RAD_SUCCESS;
+}
+
+/* one edge of a lightmapped triangle, its end points in canonical (lexicographic) order */
+typedef struct rad__lm_edge {
+    float a[3], b[3];
+    float ua[2], ub[2];
+    uint32_t tri;
+} rad__lm_edge;
+
+static int rad__lm_pcmp(const float *a, const float *b)
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        if (a[k] < b[k]) return -1;
+        if (a[k] > b[k]) return 1;
+    }
+    return 0;
+}
+
+static int rad__lm_edge_cmp(const void *x, const void *y)
+{
+    const rad__lm_edge *e = (const rad__lm_edge *)x, *f = (const rad__lm_edge *)y;
+    int r = rad__lm_pcmp(e->a, f->a);
+    if (r) return r;
+    r = rad__lm_pcmp(e->b, f->b);
+    if (r) return r;
+    return e->tri < f->tri ? -1 : e->tri > f->tri ? 1 : 0;
+}
+
+/* one row of A: up to 8 (texel, weight) taps, duplicates merged */
+typedef struct rad__lm_row {
+    uint32_t idx[8];
+    float w[8];
+    uint32_t n;
+    float norm;                   /* sum of w^2 */
+} rad__lm_row;
+
+static void rad__lm_row_add(rad__lm_row *row, uint32_t idx, float w)
+{
+    uint32_t k;
+    for (k = 0; k < row->n; ++k)
+        if (row->idx[k] == idx) { row->w[k] += w; return; }
+    row->idx[row->n] = idx;
+    row->w[row->n++] = w;
+}
+
+static float rad__lm_rows_jump(const rad__lm_row *rows, size_t count, uint32_t channels, const float *x)
+{
+    float worst = 0.0f;
+    size_t r;
+    uint32_t ch, k;
+    for (r = 0; r < count; ++r)
+        for (ch = 0; ch < channels; ++ch) {
+            float d = 0.0f;
+            for (k = 0; k < rows[r].n; ++k) d += rows[r].w[k] * x[(size_t)rows[r].idx[k] * channels + ch];
+            if (fabs((double)d) > worst) worst = (float)fabs((double)d);
+        }
+    return worst;
+}
+
+RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lm, uint32_t channels, float *values, uint32_t iterations,
+                                       rad_lightmap_seam_stats *stats, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_scene *S;
+    rad__lm_edge *edges = NULL;
+    rad__lm_row *rows = NULL;
+    size_t ne = 0, nrows = 0, cap = 0, i, j;
+    uint32_t t, seams = 0, it, ch;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (stats) memset(stats, 0, sizeof(*stats));
+    if (!lm || !values || channels == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap stitch: NULL lightmap or values, or zero channels");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (iterations == 0) iterations = 64;
+    S = lm->scene;
+    edges = (rad__lm_edge *)rad__alloc_array(&c.allocator, (size_t)S->triangle_count * 3u, sizeof(rad__lm_edge));
+    if (!edges) return RAD_ERROR_OUT_OF_MEMORY;
+    for (t = 0; t < S->triangle_count; ++t) {
+        int e;
+        if (!S->lightmapped[t]) continue;
+        for (e = 0; e < 3; ++e) {
+            rad__lm_edge *E = &edges[ne++];
+            const float *pa = S->positions + 9 * (size_t)t + 3 * e, *pb = S->positions + 9 * (size_t)t + 3 * ((e + 1) % 3);
+            const float *ua = S->lightmap_uvs + 6 * (size_t)t + 2 * e, *ub = S->lightmap_uvs + 6 * (size_t)t + 2 * ((e + 1) % 3);
+            if (rad__lm_pcmp(pa, pb) > 0) { const float *tmp = pa; pa = pb; pb = tmp; tmp = ua; ua = ub; ub = tmp; }
+            memcpy(E->a, pa, sizeof(E->a));
+            memcpy(E->b, pb, sizeof(E->b));
+            memcpy(E->ua, ua, sizeof(E->ua));
+            memcpy(E->ub, ub, sizeof(E->ub));
+            E->tri = t;
+        }
+    }
+    qsort(edges, ne, sizeof(rad__lm_edge), rad__lm_edge_cmp);
+    for (i = 0; i + 1 < ne; ++i) {
+        const rad__lm_edge *A = &edges[i], *Bv = &edges[i + 1];
+        double la, lb, tol = 1e-3 / (double)(lm->width > lm->height ? lm->width : lm->height);
+        uint32_t m, q;
+        if (rad__lm_pcmp(A->a, Bv->a) || rad__lm_pcmp(A->b, Bv->b) || A->tri == Bv->tri) continue;
+        if (rad__dot(S->normals + 3 * (size_t)A->tri, S->normals + 3 * (size_t)Bv->tri) < 0.8660254f) continue;
+        if (fabs((double)A->ua[0] - Bv->ua[0]) <= tol && fabs((double)A->ua[1] - Bv->ua[1]) <= tol &&
+            fabs((double)A->ub[0] - Bv->ub[0]) <= tol && fabs((double)A->ub[1] - Bv->ub[1]) <= tol)
+            continue; /* the same edge in the atlas: not a seam */
+        ++seams;
+        la = sqrt(pow(((double)A->ub[0] - A->ua[0]) * lm->width, 2) + pow(((double)A->ub[1] - A->ua[1]) * lm->height, 2));
+        lb = sqrt(pow(((double)Bv->ub[0] - Bv->ua[0]) * lm->width, 2) + pow(((double)Bv->ub[1] - Bv->ua[1]) * lm->height, 2));
+        if (lb > la) la = lb;
+        m = (uint32_t)ceil(2.0 * (la < 1e6 ? la : 1e6)) + 1u;
+        if (m < 2) m = 2;
+        for (q = 0; q <= m; ++q) {
+            float s = (float)q / (float)m, uvA[2], uvB[2], w[4];
+            uint32_t idx[4], k;
+            rad__lm_row *row;
+            if (nrows == cap) {
+                size_t nc = cap ? 2 * cap : 1024;
+                rad__lm_row *nr = (rad__lm_row *)rad__realloc(&c.allocator, rows, cap * sizeof(rad__lm_row), nc * sizeof(rad__lm_row));
+                if (!nr) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+                rows = nr;
+                cap = nc;
+            }
+            row = &rows[nrows];
+            row->n = 0;
+            for (k = 0; k < 2; ++k) {
+                uvA[k] = A->ua[k] + s * (A->ub[k] - A->ua[k]);
+                uvB[k] = Bv->ua[k] + s * (Bv->ub[k] - Bv->ua[k]);
+            }
+            rad__lm_taps(lm, uvA[0], uvA[1], idx, w);
+            for (k = 0; k < 4; ++k) if (w[k] != 0.0f) rad__lm_row_add(row, idx[k], w[k]);
+            rad__lm_taps(lm, uvB[0], uvB[1], idx, w);
+            for (k = 0; k < 4; ++k) if (w[k] != 0.0f) rad__lm_row_add(row, idx[k], -w[k]);
+            row->norm = 0.0f;
+            for (k = 0; k < row->n; ++k) row->norm += row->w[k] * row->w[k];
+            if (row->norm > 1e-12f) ++nrows;
+        }
+    }
+    if (stats) {
+        stats->seams = seams;
+        stats->sample_pairs = (uint32_t)(nrows < 0xFFFFFFFFu ? nrows : 0xFFFFFFFFu);
+        stats->max_jump_before = rad__lm_rows_jump(rows, nrows, channels, values);
+    }
+    /* Kaczmarz: each row's residual projected out in turn; from the baked values it converges
+       to their nearest (least-squares) point on the consistent set */
+    for (it = 0; it < iterations; ++it)
+        for (ch = 0; ch < channels; ++ch)
+            for (j = 0; j < nrows; ++j) {
+                const rad__lm_row *row = &rows[j];
+                float d = 0.0f;
+                uint32_t k;
+                for (k = 0; k < row->n; ++k) d += row->w[k] * values[(size_t)row->idx[k] * channels + ch];
+                d /= row->norm;
+                for (k = 0; k < row->n; ++k) values[(size_t)row->idx[k] * channels + ch] -= d * row->w[k];
+            }
+    if (stats) stats->max_jump_after = rad__lm_rows_jump(rows, nrows, channels, values);
+done:
+    rad__free(&c.allocator, edges);
+    rad__free(&c.allocator, rows);
+    if (r != RAD_SUCCESS) rad__log(&c, RAD_LOG_ERROR, "lightmap stitch: out of memory for %lu seam samples", (unsigned long)nrows);
+    return r;
 }
 
 /* ======================================================================================== */

@@ -190,6 +190,13 @@ s_examples() {
     fi
     compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
     compile_run engine_bake $CC -std=c99 $WARN -O2 -I. examples/engine_bake.c -o "$BUILD/engine_bake" -lm
+    if build lightmap-example $CC -std=c99 $WARN -O2 $OMP -I. examples/lightmap.c -o "$BUILD/lightmap" -lm &&
+       "$BUILD/lightmap" --size 32 --patches 100 -o "$BUILD/lightmap-small.png" >"$BUILD/lightmap.out" 2>&1 &&
+       [ -s "$BUILD/lightmap-small.png" ] && grep -q "valid" "$BUILD/lightmap.out"; then
+        pass lightmap-small
+    else
+        fail lightmap-small
+    fi
     # the virtual-patch example builds and, without the external meshes, says it skipped
     if build vp-bunny $CC -std=c99 $WARN -O2 $OMP -I. examples/vp_bunny.c -o "$BUILD/vp_bunny" -lm &&
        "$BUILD/vp_bunny" --data "$BUILD/no-such-data" >"$BUILD/vp_bunny.out" 2>&1 && grep -q skipped "$BUILD/vp_bunny.out"; then

@@ -77,8 +77,9 @@ static void rad_test_embree_bvh_destroy(rad_bvh *bvh)
 #include "test_shading.c"
 #include "test_glsl.c"
 #include "test_probes.c"
+#include "test_lightmap.c"
 
-static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_hemicube, tests_hierarchical, tests_solve, tests_stochastic, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_vp_runtime, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl, tests_probes };
+static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_hemicube, tests_hierarchical, tests_solve, tests_stochastic, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_vp_runtime, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl, tests_probes, tests_lightmap };
 
 /* 1 when 'name' is one of the comma-separated names in 'list' */
 static int rad_test_listed(const char *list, const char *name)

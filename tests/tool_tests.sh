@@ -1079,5 +1079,51 @@ grep -q "no emitters and no lights" "$TMP/err.txt" && ok "render warns about a s
 grep -q "below the 2 triangles" "$TMP/err.txt" && ok "render says --patches below the triangle count" ||
     fail "render says --patches below the triangle count" "$(head -c 300 "$TMP/err.txt")"
 
+# ---- rad lightmap ---------------------------------------------------------------------------
+# the Cornell box has no second uv set: the tool unwraps it, bakes and writes a PFM whose
+# texels hold light (and the gutters, dilated, no black)
+if "$RAD" lightmap cornell -o "$TMP/lm.pfm" --size 32 --patches 100 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt"; then
+    grep -q "unwrapped 32 triangles into" "$TMP/err.txt" && ok "lightmap unwraps a scene without a second uv set" ||
+        fail "lightmap unwraps a scene without a second uv set" "$(head -c 300 "$TMP/err.txt")"
+    "$RAD" compare "$TMP/lm.pfm" "$TMP/lm.pfm" > /dev/null 2>&1 && ok "lightmap writes a readable PFM" || fail "lightmap writes a readable PFM"
+else
+    fail "lightmap of the Cornell box" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" lightmap cornell -o "$TMP/lm.png" --sh > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 2 ] && grep -q "PNG cannot hold negative" "$TMP/err.txt" && ok "lightmap --sh refuses a PNG" || fail "lightmap --sh refuses a PNG" "exit $rc"
+if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 16 --patches 60 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" &&
+    [ -s "$TMP/sh.L00.pfm" ] && [ -s "$TMP/sh.L1m1.pfm" ] && [ -s "$TMP/sh.L10.pfm" ] && [ -s "$TMP/sh.L11.pfm" ]; then
+    ok "lightmap --sh writes four PFM layers"
+else
+    fail "lightmap --sh writes four PFM layers" "$(head -c 300 "$TMP/err.txt")"
+fi
+# --render: the view shaded from the lightmap resembles the path tracer's (both at low quality)
+if "$RAD" lightmap cornell -o "$TMP/lmr.pfm" --size 64 --patches 150 --texel-samples 1 --visibility-rays 1 \
+        --render "$TMP/lmview.png" --render-size 48x48 --aa 1 > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" trace cornell -o "$TMP/lmtrace.png" --size 48x48 --spp 16 > /dev/null 2>&1; then
+    s=$(ssim_of "$TMP/lmview.png" "$TMP/lmtrace.png")
+    at_least "$s" 0.7 && ok "lightmap --render resembles rad trace (SSIM $s)" || fail "lightmap --render resembles rad trace" "SSIM $s"
+else
+    fail "lightmap --render" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" lightmap cornell -o "$TMP/x.pfm" --sh --render "$TMP/x.png" > /dev/null 2>&1
+[ $? -eq 2 ] && ok "lightmap --render refuses --sh" || fail "lightmap --render refuses --sh"
+# a glTF quad with TEXCOORD_0 and TEXCOORD_1: the tool bakes over the file's second uv set
+printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0, "name": "n"}],
+ "meshes": [{"name": "m", "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 1}, "indices": 2}]}],
+ "buffers": [{"byteLength": 104, "uri": "data:application/octet-stream;base64,%s"}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+  {"buffer": 0, "byteOffset": 80, "byteLength": 24}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+  {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+  {"bufferView": 2, "componentType": 5125, "count": 6, "type": "SCALAR"}]}\n' \
+    AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAIA/AAAAAAAAgD8AAIA/AAAAAAAAgD8AAAAAAQAAAAIAAAAAAAAAAgAAAAMAAAA= \
+    > "$TMP/uv2.gltf"
+"$RAD" lightmap "$TMP/uv2.gltf" -o "$TMP/uv2.pfm" --size 8 --patches 2 > /dev/null 2> "$TMP/err.txt" &&
+    grep -q "using the file's second uv set" "$TMP/err.txt" && grep -q "64 covered" "$TMP/err.txt" &&
+    ok "lightmap uses a glTF's TEXCOORD_1 (the quad covers all 64 texels)" ||
+    fail "lightmap uses a glTF's TEXCOORD_1" "$(head -c 400 "$TMP/err.txt")"
+
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

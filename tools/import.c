@@ -56,11 +56,14 @@ typedef struct imp_group {
     char *name;
     float *positions;     /* 3 per vertex */
     float *uvs;           /* 2 per vertex, or NULL */
+    float *uvs2;          /* the second uv set (the lightmap's: glTF TEXCOORD_1), 2 per vertex */
     uint32_t *indices;
     uint32_t *material_ids;
     uint32_t vertex_count, vertex_cap;
     uint32_t triangle_count, triangle_cap;
     int any_uv;
+    int all_uv2;          /* 1 while every mesh added has a second uv set */
+    int meshes_added;
 } imp_group;
 
 typedef struct imp_storage {
@@ -142,6 +145,7 @@ static void free_storage(imp_storage *st)
         free(st->groups[i].name);
         free(st->groups[i].positions);
         free(st->groups[i].uvs);
+        free(st->groups[i].uvs2);
         free(st->groups[i].indices);
         free(st->groups[i].material_ids);
     }
@@ -492,6 +496,10 @@ static int weld_same(const struct aiMesh *m, uint32_t a, uint32_t b, double tol)
         const struct aiVector3D *t = m->mTextureCoords[0];
         if (!(fabs((double)t[a].x - t[b].x) <= WELD_ATTR_EPS && fabs((double)t[a].y - t[b].y) <= WELD_ATTR_EPS)) return 0;
     }
+    if (m->mTextureCoords[1]) { /* the lightmap's uv set: a vertex on a chart seam stays two */
+        const struct aiVector3D *t = m->mTextureCoords[1];
+        if (!(fabs((double)t[a].x - t[b].x) <= WELD_ATTR_EPS && fabs((double)t[a].y - t[b].y) <= WELD_ATTR_EPS)) return 0;
+    }
     if (m->mNormals) {
         const struct aiVector3D *n = m->mNormals;
         dx = (double)n[a].x - n[b].x, dy = (double)n[a].y - n[b].y, dz = (double)n[a].z - n[b].z;
@@ -641,6 +649,7 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
         while (g->vertex_count + kept > g->vertex_cap) g->vertex_cap = g->vertex_cap ? 2 * g->vertex_cap : 256;
         g->positions = (float *)xrealloc(g->positions, sizeof(float) * 3 * g->vertex_cap);
         g->uvs = (float *)xrealloc(g->uvs, sizeof(float) * 2 * g->vertex_cap);
+        g->uvs2 = (float *)xrealloc(g->uvs2, sizeof(float) * 2 * g->vertex_cap);
     }
     for (k = 0; k < kept; ++k) {
         float p[3];
@@ -653,8 +662,13 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
         } else {
             g->uvs[2 * (size_t)(base + k)] = g->uvs[2 * (size_t)(base + k) + 1] = 0.0f;
         }
+        /* assimp's texture v runs up (OpenGL); the lightmap's v runs down like glTF's */
+        g->uvs2[2 * (size_t)(base + k)] = mesh->mTextureCoords[1] ? mesh->mTextureCoords[1][v].x : 0.0f;
+        g->uvs2[2 * (size_t)(base + k) + 1] = mesh->mTextureCoords[1] ? 1.0f - mesh->mTextureCoords[1][v].y : 0.0f;
     }
     if (mesh->mTextureCoords[0]) g->any_uv = 1;
+    g->all_uv2 = (g->meshes_added == 0 || g->all_uv2) && mesh->mTextureCoords[1] != NULL;
+    g->meshes_added++;
     g->vertex_count += kept;
     /* a mirroring transform flips the winding */
     det = m->a1 * (m->b2 * m->c3 - m->b3 * m->c2) - m->a2 * (m->b1 * m->c3 - m->b3 * m->c1) +
@@ -891,6 +905,7 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
         md->indices = g->indices;
         md->triangle_count = g->triangle_count;
         md->material_ids = g->material_ids;
+        if (g->all_uv2) md->lightmap_uvs = g->uvs2;
         for (t = 0; t < g->triangle_count; ++t)
             if (st->materials[g->material_ids[t]].texture) {
                 md->uvs = g->uvs; /* zeros when the file had none */

@@ -12,6 +12,7 @@
        rad info FILE.radb      what a bake holds
        rad export SCENE -o OUT.obj     the scene as OBJ + MTL
        rad probes SCENE -o OUT.json|OUT.bin    irradiance probes (SH L2) on a grid
+       rad lightmap SCENE -o OUT.pfm|OUT.png   a lightmap over the second uv set (cmd_lightmap.c)
 
    This file holds the implementation of radiosity.h, the dispatcher, the shared helpers of
    tool.h and the formfactors command. Exit codes: 0 ok, 1 failure, 2 usage error. */
@@ -398,6 +399,8 @@ static void usage(FILE *f)
                "  info FILE.radb           list what a bake holds and check it\n"
                "  export SCENE -o OUT.obj  write the scene as OBJ + MTL (Kd albedo, Ke emission)\n"
                "  probes SCENE -o OUT      irradiance probes (SH L2) on a grid: OUT.json or OUT.bin\n"
+               "  lightmap SCENE -o OUT    bake a lightmap (.pfm or .png) over the second uv set, or an\n"
+               "                           automatic unwrap; --sh for L1 spherical harmonics\n"
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
                "at most 1024). render, trace and bake add lights to the file's own: --sun DIR:RGB,\n"
@@ -539,7 +542,8 @@ int rad_tool_main(int argc, char **argv)
         int (*fn)(int, char **);
     } cmds[] = {{"formfactors", rad_cmd_formfactors}, {"bake", rad_cmd_bake},       {"render", rad_cmd_render},
                 {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info},
-                {"export", rad_cmd_export},           {"probes", rad_cmd_probes},   {"merge", rad_cmd_merge}};
+                {"export", rad_cmd_export},           {"probes", rad_cmd_probes},   {"merge", rad_cmd_merge},
+                {"lightmap", rad_cmd_lightmap}};
     size_t i;
     if (argc < 2) {
         usage(stderr);

@@ -501,5 +501,11 @@ typedef struct rad_tool_bake_args {
 /* -1: go on and bake; else the exit code (--help: 0 after printing it; 2: bad usage, printed).
    args->lights is to be freed (rad_tool_lights_free) whatever it returns. */
 int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_args *args);
+/* ---- lightmaps (cmd_lightmap.c, unwrap.c) ------------------------------------------------ */
+int rad_cmd_lightmap(int argc, char **argv);
+/* A simple automatic lightmap unwrap (unwrap.c: charts of connected triangles within 30
+   degrees, planar projection, shelf packing with 2-texel gutters): 6 floats per scene triangle
+   into out_uvs, the chart count into out_charts (may be NULL). 0, or 1 with a message printed. */
+int rad_tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts);
 
 #endif

@@ -1,0 +1,308 @@
+/* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
+
+   rad lightmap SCENE -o OUT.pfm|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
+                [--visibility-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
+                [classic options] [--threads N] [--exposure X]
+
+   The classic solution (cmd_bake.c: patches, F, direct light as the source, B = E + L) is
+   gathered into the texels of the lightmap uv set (>>api_lightmap): every mesh's second uv set
+   (glTF TEXCOORD_1, assimp's second channel), or, when some mesh has none (or --unwrap), the
+   simple automatic unwrap of unwrap.c. RGB: irradiance (W m^-2) = the direct light of the
+   lights and emitters per texel + the irradiance from the secondary sources; --sh: the L1
+   spherical harmonics of the indirect radiance only (engines add direct light per pixel),
+   four PFM files OUT.L00.pfm, OUT.L1m1.pfm, OUT.L10.pfm, OUT.L11.pfm (PNG cannot hold the
+   negative coefficients). Then dilation into the gutters and seam stitching. --render draws
+   the scene's camera view (or the one rad trace would choose) shaded from the lightmap alone:
+   radiance = emission + albedo x bilinear lightmap irradiance / pi, N x N samples a pixel, to
+   compare with `rad trace` (rad compare). */
+#include "tool.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void lightmap_usage(FILE *f)
+{
+    fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.png [options]\n"
+               "  bakes the classic radiosity solution into a lightmap over the second uv set\n"
+               "  (glTF TEXCOORD_1); meshes without one are unwrapped automatically (simple charts)\n"
+               "  --size N|WxH          atlas texels (default 256)\n"
+               "  --sh                  L1 spherical harmonics of the indirect light (4 PFM files\n"
+               "                        OUT.L00.pfm OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)\n"
+               "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
+               "  --visibility-rays N   shadow rays per sample point and patch (default 2, at most 64)\n"
+               "  --unwrap              unwrap even when the file has a second uv set\n"
+               "  --render VIEW         also render the camera view shaded from the lightmap (.png or .pfm;\n"
+               "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
+               "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 2)\n"
+               "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
+               "                        the radiance of a white surface)\n"
+               "  --threads N           worker threads (default: all cores)\n"
+               "%s", rad_tool_classic_help());
+}
+
+/* a path with 'tag' inserted before the extension: a.pfm -> a.L00.pfm */
+static char *lightmap_tagged(const char *path, const char *tag)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    size_t stem = (dot && (!slash || dot > slash)) ? (size_t)(dot - path) : strlen(path);
+    char *out = (char *)rad_tool_calloc(strlen(path) + strlen(tag) + 3, 1);
+    memcpy(out, path, stem);
+    sprintf(out + stem, ".%s%s", tag, path + stem);
+    return out;
+}
+
+/* the view shaded from an RGB irradiance lightmap: one closest hit per sample, the lightmap
+   read at the hit's lightmap uv; back faces and misses are black (one-sided like rad trace) */
+static int lightmap_render(const rad_tool_world *w, const rad_lightmap *lm, const float *values, int width, int height,
+                           int aa, const char *path, float exposure)
+{
+    rad_camera cam = w->file.camera;
+    rad_image img;
+    int x, y, sx, sy, bad;
+    if (!w->file.has_camera) rad_tool_choose_camera("lightmap", w->scene, &w->rc, width, height, &cam);
+    if (!(cam.fov_y_degrees > 0.0f)) cam.fov_y_degrees = 45.0f;
+    if (rad_image_alloc(&img, width, height)) { fprintf(stderr, "rad lightmap: out of memory for the view\n"); return 1; }
+    for (y = 0; y < height; ++y)
+        for (x = 0; x < width; ++x) {
+            float acc[3] = {0.0f, 0.0f, 0.0f};
+            for (sy = 0; sy < aa; ++sy)
+                for (sx = 0; sx < aa; ++sx) {
+                    rad_ray ray;
+                    rad_hit hit;
+                    const float *t, *n;
+                    float u, v, e[3], rho[3];
+                    int k;
+                    rad_camera_ray(&cam, (uint32_t)width, (uint32_t)height, x + (sx + 0.5f) / aa, y + (sy + 0.5f) / aa, &ray);
+                    if (w->rc.intersect(w->rc.user, &ray, 1, &hit) != RAD_SUCCESS || hit.triangle == RAD_NONE) continue;
+                    n = w->scene->normals + 3 * (size_t)hit.triangle;
+                    if (n[0] * ray.dir[0] + n[1] * ray.dir[1] + n[2] * ray.dir[2] >= 0.0f) continue;
+                    {
+                        const rad_material *m = &w->scene->materials_table[w->scene->materials[hit.triangle]];
+                        for (k = 0; k < 3; ++k) acc[k] += m->emission[k];
+                    }
+                    if (!w->scene->lightmapped[hit.triangle]) continue;
+                    t = w->scene->lightmap_uvs + 6 * (size_t)hit.triangle;
+                    u = t[0] + hit.b1 * (t[2] - t[0]) + hit.b2 * (t[4] - t[0]);
+                    v = t[1] + hit.b1 * (t[3] - t[1]) + hit.b2 * (t[5] - t[1]);
+                    rad_lightmap_sample(lm, 3, values, u, v, e);
+                    rad_scene_albedo(w->scene, hit.triangle, hit.b1, hit.b2, rho);
+                    for (k = 0; k < 3; ++k) acc[k] += rho[k] * e[k] / 3.14159265f;
+                }
+            for (sx = 0; sx < 3; ++sx) img.rgb[3 * ((size_t)y * width + x) + sx] = acc[sx] / (float)(aa * aa);
+        }
+    bad = rad_image_write(path, &img, exposure * 3.14159265f);
+    rad_image_free(&img);
+    if (bad) { fprintf(stderr, "rad lightmap: %s\n", rad_tool_output_error()); return 1; }
+    fprintf(stderr, "rad lightmap: wrote the view %s\n", path);
+    return 0;
+}
+
+static int lightmap_is_png(const char *path)
+{
+    size_t n = strlen(path);
+    return n >= 4 && (!strcmp(path + n - 4, ".png") || !strcmp(path + n - 4, ".PNG"));
+}
+
+int rad_cmd_lightmap(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
+    int rw = 256, rh = 256;
+    uint32_t aa = 2;
+    rad_tool_classic_options co;
+    rad_tool_classic cl;
+    rad_tool_world w, w2;
+    rad_lightmap_options lo;
+    rad_lightmap_gather_options go;
+    rad_lightmap_seam_stats st;
+    rad_lightmap *lm = NULL;
+    rad_context ctx;
+    rad_result r;
+    int width = 256, height = 256, sh = 0, force_unwrap = 0, a, code = 1, own_scene = 0;
+    uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch;
+    float exposure = 0.31830988f, *values = NULL, *uvs = NULL;
+    double t0;
+    rad_mesh_desc mesh;
+    rad_scene_desc desc;
+    rad_tool_classic_options_default(&co);
+    for (a = 0; a < argc; ++a) {
+        const char *o = argv[a];
+        int k;
+        if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
+            lightmap_usage(stdout);
+            return 0;
+        }
+        if ((k = rad_tool_classic_option("lightmap", argc, argv, &a, &co)) != 0) {
+            if (k == 2) return 2;
+            continue;
+        }
+        if (!strcmp(o, "--sh")) { sh = 1; continue; }
+        if (!strcmp(o, "--unwrap")) { force_unwrap = 1; continue; }
+        if (o[0] == '-' && strcmp(o, "-") != 0 && a + 1 >= argc) {
+            fprintf(stderr, "rad lightmap: %s needs a value (or is unknown; try rad lightmap --help)\n", o);
+            return 2;
+        }
+        if (!strcmp(o, "-o")) out_path = argv[++a];
+        else if (!strcmp(o, "--render")) render_path = argv[++a];
+        else if (!strcmp(o, "--render-size")) {
+            if (rad_tool_parse_size(argv[++a], &rw, &rh) || rad_tool_check_size("lightmap", rw, rh)) {
+                fprintf(stderr, "rad lightmap: bad --render-size '%s'\n", argv[a]);
+                return 2;
+            }
+        } else if (!strcmp(o, "--aa")) {
+            if (rad_tool_parse_uint("lightmap", o, argv[++a], &aa)) return 2;
+            if (aa == 0 || aa > 16) { fprintf(stderr, "rad lightmap: --aa must be 1 to 16\n"); return 2; }
+        } else if (!strcmp(o, "--size")) {
+            const char *v = argv[++a];
+            if (strchr(v, 'x')) {
+                if (rad_tool_parse_size(v, &width, &height)) { fprintf(stderr, "rad lightmap: bad --size '%s'\n", v); return 2; }
+            } else {
+                uint32_t n;
+                if (rad_tool_parse_uint("lightmap", o, v, &n)) return 2;
+                width = height = (int)(n > 16384u ? 16385u : n);
+            }
+            if (width < 4 || height < 4 || width > 16384 || height > 16384) {
+                fprintf(stderr, "rad lightmap: --size must be 4 to 16384 texels a side\n");
+                return 2;
+            }
+        } else if (!strcmp(o, "--texel-samples")) {
+            if (rad_tool_parse_uint("lightmap", o, argv[++a], &texel_samples)) return 2;
+            if (texel_samples == 0 || texel_samples > 16) { fprintf(stderr, "rad lightmap: --texel-samples must be 1 to 16\n"); return 2; }
+        } else if (!strcmp(o, "--visibility-rays")) {
+            if (rad_tool_parse_uint("lightmap", o, argv[++a], &vis)) return 2;
+            if (vis == 0 || vis > 64) { fprintf(stderr, "rad lightmap: --visibility-rays must be 1 to 64\n"); return 2; }
+        } else if (!strcmp(o, "--exposure")) {
+            if (rad_tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
+        } else if (!strcmp(o, "--threads")) {
+            if (rad_tool_parse_threads("lightmap", o, argv[++a], &threads)) return 2;
+        } else if (o[0] == '-' && o[1]) {
+            fprintf(stderr, "rad lightmap: unknown option '%s' (try rad lightmap --help)\n", o);
+            return 2;
+        } else if (!scene_path) {
+            scene_path = o;
+        } else {
+            fprintf(stderr, "rad lightmap: more than one scene ('%s', '%s')\n", scene_path, o);
+            return 2;
+        }
+    }
+    if (!scene_path || !out_path) {
+        lightmap_usage(stderr);
+        return 2;
+    }
+    if (sh && lightmap_is_png(out_path)) {
+        fprintf(stderr, "rad lightmap: --sh writes PFM files (PNG cannot hold negative coefficients): use -o NAME.pfm\n");
+        return 2;
+    }
+    if (sh && render_path) {
+        fprintf(stderr, "rad lightmap: --render shades from the RGB lightmap: leave out --sh\n");
+        return 2;
+    }
+    if (rad_tool_check_size("lightmap", width, height)) return 2;
+    {
+        const char *inputs[1];
+        inputs[0] = scene_path;
+        if (rad_tool_check_output("lightmap", out_path, inputs, 1)) return 1;
+        if (render_path && rad_tool_check_output("lightmap", render_path, inputs, 1)) return 1;
+    }
+    rad_tool_set_threads((int)threads);
+    if (rad_tool_open_world("lightmap", scene_path, &w)) return 1;
+    w2 = w;
+    memset(&cl, 0, sizeof cl);
+    /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
+    if (force_unwrap || !w.scene->lightmap_uvs || memchr(w.scene->lightmapped, 0, w.scene->triangle_count)) {
+        if (!force_unwrap && w.scene->lightmap_uvs)
+            fprintf(stderr, "rad lightmap: some meshes have no second uv set: unwrapping the whole scene\n");
+        uvs = (float *)rad_tool_calloc(6 * (size_t)w.scene->triangle_count, sizeof(float));
+        if (rad_tool_unwrap(w.scene, (uint32_t)width, (uint32_t)height, uvs, NULL)) goto done;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.name = "unwrapped";
+        mesh.positions = w.scene->positions;
+        mesh.vertex_count = 3 * w.scene->triangle_count;
+        mesh.uvs = w.scene->uvs;
+        mesh.triangle_count = w.scene->triangle_count;
+        mesh.material_ids = w.scene->materials;
+        mesh.lightmap_uvs = uvs;
+        desc = w.file.desc;
+        desc.meshes = &mesh;
+        desc.mesh_count = 1;
+        w2.scene = NULL;
+        w2.bvh = NULL;
+        own_scene = 1;
+        rad_tool_context(&ctx, NULL);
+        if ((r = rad_scene_create(&desc, &ctx, &w2.scene)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_scene_create", r); goto done; }
+        if ((r = rad_bvh_create(w2.scene, &ctx, &w2.bvh)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_bvh_create", r); goto done; }
+        rad_bvh_raycaster(w2.bvh, &w2.rc);
+    } else {
+        fprintf(stderr, "rad lightmap: using the file's second uv set\n");
+    }
+    if (rad_tool_classic_solve("lightmap", &w2, &co, &cl)) goto done;
+    /* the gather wants the total radiosity of the secondary sources: B = E + L */
+    t0 = rad_tool_seconds();
+    rad_lightmap_options_default(&lo);
+    lo.width = (uint32_t)width;
+    lo.height = (uint32_t)height;
+    lo.samples = texel_samples;
+    rad_tool_context(&ctx, "lightmap texels");
+    r = rad_lightmap_create(w2.scene, &w2.rc, &lo, &ctx, &lm);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_create", r); goto done; }
+    fprintf(stderr, "rad lightmap: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", lm->width,
+            lm->height, lm->covered_texels, lm->valid_texels, lm->invalid_samples, lm->sample_count);
+    rad_lightmap_gather_options_default(&go);
+    go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
+    go.visibility_rays = vis;
+    ch = rad_lightmap_channels(go.encoding);
+    values = (float *)rad_tool_calloc((size_t)width * height * ch, sizeof(float));
+    rad_tool_context(&ctx, "lightmap gather");
+    r = rad_lightmap_gather(lm, cl.patches, cl.B, &w2.rc, &go, values, &ctx);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_gather", r); goto done; }
+    if (!sh) {
+        rad_direct_options dopt;
+        rad_direct_options_default(&dopt);
+        dopt.include_emitters = 1;
+        dopt.light_samples = co.light_samples;
+        rad_tool_context(&ctx, "lightmap direct");
+        r = rad_lightmap_direct(lm, &w2.rc, w2.file.lights, w2.file.light_count, &dopt, values, &ctx);
+        rad_tool_progress_end();
+        if (r != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_direct", r); goto done; }
+    }
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_lightmap_dilate(lm, ch, values, 0, &ctx)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_dilate", r); goto done; }
+    if ((r = rad_lightmap_stitch(lm, ch, values, 0, &st, &ctx)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_stitch", r); goto done; }
+    fprintf(stderr, "rad lightmap: baked in %.2f s; %u seams, largest jump %.4g before stitching, %.4g after\n",
+            rad_tool_seconds() - t0, st.seams, (double)st.max_jump_before, (double)st.max_jump_after);
+    {
+        rad_image img;
+        uint32_t layers = sh ? 4u : 1u, l;
+        static const char *const tags[4] = {"L00", "L1m1", "L10", "L11"};
+        for (l = 0; l < layers; ++l) {
+            char *path = sh ? lightmap_tagged(out_path, tags[l]) : NULL;
+            const char *dst = path ? path : out_path;
+            int bad;
+            if (rad_image_alloc(&img, width, height)) { free(path); fprintf(stderr, "rad lightmap: out of memory\n"); goto done; }
+            for (i = 0; i < (uint32_t)(width * height); ++i) memcpy(img.rgb + 3 * (size_t)i, values + (size_t)i * ch + 3 * l, 3 * sizeof(float));
+            bad = rad_image_write(dst, &img, exposure);
+            rad_image_free(&img);
+            if (bad) {
+                fprintf(stderr, "rad lightmap: %s\n", rad_tool_output_error());
+                free(path);
+                goto done;
+            }
+            fprintf(stderr, "rad lightmap: wrote %s\n", dst);
+            free(path);
+        }
+    }
+    if (render_path && lightmap_render(&w2, lm, values, rw, rh, (int)aa, render_path, exposure)) goto done;
+    code = 0;
+done:
+    free(values);
+    rad_lightmap_destroy(lm);
+    rad_tool_classic_free(&cl);
+    if (own_scene) {
+        rad_bvh_destroy(w2.bvh);
+        rad_scene_destroy(w2.scene);
+    }
+    free(uvs);
+    rad_tool_close_world(&w);
+    return code;
+}
