@@ -594,9 +594,13 @@ typedef struct rad_raycaster {
 
 typedef struct rad_bvh rad_bvh;
 
-/* Builds the BVH (binned SAH, 4 triangles per leaf at most) over the scene's triangles.
-   scene is borrowed only for the call (the BVH copies the triangles).
-   Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. Cost: O(T log T). */
+/* Builds the BVH over the scene's triangles: binned SAH down to leaves of at most 4 triangles
+   (stored side by side and tested together with SIMD), collapsed to 8-wide nodes when the
+   implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD). The
+   subtrees below the top levels are built in parallel through ctx->parallel_for; the tree does
+   not depend on the thread count. scene is borrowed only for the call (the BVH copies the
+   triangles). Errors: INVALID_ARGUMENT, OUT_OF_MEMORY, SIZE_OVERFLOW (2^29 triangles or more).
+   Cost: O(T log T). */
 RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out);
 RAD_API void rad_bvh_destroy(rad_bvh *bvh);
 /* Fills a raycaster table that queries 'bvh' (which must outlive its use). */
@@ -3738,24 +3742,31 @@ typedef struct rad__bvh_node {
     uint32_t count;   /* triangles in a leaf, 0 for an inner node */
 } rad__bvh_node;
 
-/* The traversal structure: 4-wide nodes collapsed from the binary SAH tree, so one SIMD slab
-   test checks four child boxes. Empty slots have child RAD_NONE. */
-typedef struct rad__bvh4 {
-    float lo[3][4], hi[3][4]; /* per axis, per child */
-    uint32_t child[4];        /* RAD__BVH4_LEAF | leaf block for a leaf, else node index */
-    uint32_t count[4];        /* triangles of a leaf child (1 to 4) */
-} rad__bvh4;
+/* The traversal structure: RAD__BVH_W-wide nodes collapsed from the binary SAH tree, so one
+   SIMD slab test checks all child boxes: 8 wide with AVX (one 256-bit test), else 4 wide (SSE,
+   or the scalar loop under RAD_NO_SIMD). Empty slots have child RAD_NONE. */
+#if defined(RAD__AVX)
+#  define RAD__BVH_W 8
+#else
+#  define RAD__BVH_W 4
+#endif
+typedef struct rad__bvhw {
+    float lo[3][RAD__BVH_W], hi[3][RAD__BVH_W]; /* per axis, per child */
+    uint32_t child[RAD__BVH_W]; /* RAD__BVH4_LEAF | leaf block for a leaf, else node index */
+    uint32_t count[RAD__BVH_W]; /* triangles of a leaf child (1 to 4) */
+} rad__bvhw;
 #define RAD__BVH4_LEAF 0x80000000u
 
 /* A leaf's triangles (at most four) side by side, so one SIMD pass tests them all: lane j of
-   v[c][a] is coordinate a of vertex c of triangle j. Unused lanes are zero and never tested. */
+   v[c][a] is coordinate a of vertex c of triangle j. Unused lanes are zero (id RAD_NONE) and
+   never tested. */
 typedef struct rad__tri4 {
     float v[3][3][4];
     uint32_t id[4];           /* scene triangle of each lane */
 } rad__tri4;
 
 struct rad_bvh {
-    rad__bvh4 *nodes;
+    rad__bvhw *nodes;
     uint32_t node_count;
     rad__tri4 *leaves;
     uint32_t leaf_count;
@@ -3763,9 +3774,7 @@ struct rad_bvh {
     rad_allocator allocator;
 };
 
-#ifndef RAD__BVH_BINS
 #define RAD__BVH_BINS 16
-#endif
 #define RAD__BVH_LEAF 4
 #define RAD__BVH_STACK 128
 #define RAD__BVH_SAH_DEPTH 64
@@ -3805,7 +3814,7 @@ RAD_API void rad_bvh_destroy(rad_bvh *bvh)
 RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
 {
     if (!bvh) return 0;
-    return sizeof(*bvh) + (size_t)bvh->node_count * sizeof(rad__bvh4) + (size_t)bvh->leaf_count * sizeof(rad__tri4);
+    return sizeof(*bvh) + (size_t)bvh->node_count * sizeof(rad__bvhw) + (size_t)bvh->leaf_count * sizeof(rad__tri4);
 }
 
 /* A triangle reference of the build: its bounds and scene triangle. The build sorts these in
@@ -3833,7 +3842,7 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
     rad__aabb nb, cb, bins[3][RAD__BVH_BINS];
     uint32_t cnt[3][RAD__BVH_BINS];
     double scale[3];
-    float best_cost = FLT_MAX, leaf_cost;
+    float best_cost = FLT_MAX;
     int axis, use[3];
     rad__aabb_empty(&nb);
     rad__aabb_empty(&cb);
@@ -3846,8 +3855,9 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
     }
     memcpy(node->bmin, nb.lo, sizeof(nb.lo));
     memcpy(node->bmax, nb.hi, sizeof(nb.hi));
-    if (count <= 1) return 0;
-    leaf_cost = (float)count * rad__aabb_area(&nb);
+    /* a leaf's triangles are tested together in one SIMD pass (rad__wray_tri4), about the cost
+       of testing one: any range that fits in a leaf is one */
+    if (count <= RAD__BVH_LEAF) return 0;
     /* past RAD__BVH_SAH_DEPTH levels, ranges are split in half: the depth stays below
        RAD__BVH_SAH_DEPTH + 32, so traversal stacks of RAD__BVH_STACK entries never overflow */
     for (axis = 0; axis < 3; ++axis) {
@@ -3891,10 +3901,7 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
         }
     }
     /* SAH with a traversal step costing one triangle test: stop when splitting does not pay */
-#ifdef RAD__EXP_FULL
-    if (count <= RAD__BVH_LEAF) return 0;
-#endif
-    if (count <= RAD__BVH_LEAF && (best_axis == 3 || best_cost + rad__aabb_area(&nb) >= leaf_cost)) return 0;
+    /* (ranges of at most RAD__BVH_LEAF triangles returned as leaves above) */
     if (best_axis == 3) {
         mid = first + count / 2; /* all centroids equal, or too deep: split the range */
     } else {
@@ -3959,9 +3966,10 @@ static void rad__bvh_task(void *data, uint32_t i)
     j->task_leaves[i] = rad__bvh_build_sub(j->tree, j->refs, ni, j->task_depth[i], 2u * j->tree[ni].first);
 }
 
-/* Collapses the binary tree 'bin' into 4-wide nodes: each 4-wide node opens the largest inner
-   child of its binary node until it has four children. 'stack' has room for 4 entries per leaf. */
-static rad_result rad__bvh4_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t root, uint32_t *stack,
+/* Collapses the binary tree 'bin' into RAD__BVH_W-wide nodes: each wide node opens the largest
+   inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
+   entries per leaf. */
+static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t root, uint32_t *stack,
                                      const float *positions, const uint32_t *order)
 {
     uint32_t sp = 0;
@@ -3969,28 +3977,28 @@ static rad_result rad__bvh4_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
     stack[sp++] = root; /* binary node */
     stack[sp++] = 0; /* its 4-wide node */
     while (sp > 0) {
-        uint32_t n4 = stack[--sp], bi = stack[--sp], slots[4], ns = 0, k;
-        rad__bvh4 *node = &b->nodes[n4];
+        uint32_t n4 = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns = 0, k;
+        rad__bvhw *node = &b->nodes[n4];
         if (bin[bi].count) {
             slots[ns++] = bi; /* a leaf root (tiny scenes) */
         } else {
             slots[ns++] = bin[bi].first;
             slots[ns++] = bin[bi].first + 1;
-            while (ns < 4) {
+            while (ns < RAD__BVH_W) {
                 float best = -1.0f;
-                uint32_t bk = 4;
+                uint32_t bk = RAD__BVH_W;
                 for (k = 0; k < ns; ++k) {
                     const rad__bvh_node *q = &bin[slots[k]];
                     float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
                     float area = dx * dy + dy * dz + dz * dx;
                     if (q->count == 0 && area > best) { best = area; bk = k; }
                 }
-                if (bk == 4) break;
+                if (bk == RAD__BVH_W) break;
                 slots[ns++] = bin[slots[bk]].first + 1;
                 slots[bk] = bin[slots[bk]].first;
             }
         }
-        for (k = 0; k < 4; ++k) {
+        for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
                 for (a = 0; a < 3; ++a) { node->lo[a][k] = 0.0f; node->hi[a][k] = 0.0f; }
@@ -4003,6 +4011,7 @@ static rad_result rad__bvh4_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
                 rad__tri4 *q = &b->leaves[b->leaf_count];
                 uint32_t j, c;
                 memset(q, 0, sizeof(*q));
+                for (j = 0; j < 4; ++j) q->id[j] = RAD_NONE;
                 for (j = 0; j < bin[slots[k]].count; ++j) {
                     const float *v = positions + 9 * (size_t)order[bin[slots[k]].first + j];
                     for (c = 0; c < 3; ++c)
@@ -4121,9 +4130,9 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     for (i = 0; i < n; ++i) order[i] = refs[i].id;
     /* a binary tree of L leaves has L - 1 inner nodes, and each 4-wide node opens at least one
        of them (or is the root leaf of a one-leaf tree) */
-    b->nodes = (rad__bvh4 *)rad__alloc_array(&c.allocator, leaves, sizeof(rad__bvh4));
+    b->nodes = (rad__bvhw *)rad__alloc_array(&c.allocator, leaves, sizeof(rad__bvhw));
     b->leaves = (rad__tri4 *)rad__alloc_array(&c.allocator, leaves, sizeof(rad__tri4));
-    r = (b->nodes && b->leaves) ? rad__bvh4_collapse(b, tree, root, stack, scene->positions, order) : RAD_ERROR_OUT_OF_MEMORY;
+    r = (b->nodes && b->leaves) ? rad__bvhw_collapse(b, tree, root, stack, scene->positions, order) : RAD_ERROR_OUT_OF_MEMORY;
     rad__free(&c.allocator, refs);
     rad__free(&c.allocator, stack);
     rad__free(&c.allocator, task_node);
@@ -4211,14 +4220,26 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
 }
 #endif
 
-/* Slab test of a ray against the four child boxes of a node: bit k of the result is set when
+/* Slab test of a ray against the child boxes of a node: bit k of the result is set when
    child k is hit within [tmin, tmax]; tnear[k] receives its entry distance. Zero direction
-   components were replaced by +-1e-30 in inv (no NaN from 0 * inf). */
-static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
+   components were replaced by +-1e-30 in inv (no NaN from 0 * inf). Each slab's far distance
+   is widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
+   through shared vertices on box faces). */
+static int rad__bvhw_boxes(const rad__bvhw *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
 {
-#if defined(RAD__SSE2)
-    /* each slab's far distance is widened by 1 + 2 gamma_3 (Ize 2013), so rounding never
-       culls a box the ray touches (rays through shared vertices on box faces) */
+#if defined(RAD__AVX)
+    __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm256_set1_ps(1.0000004f);
+    int a;
+    for (a = 0; a < 3; ++a) {
+        __m256 oa = _mm256_set1_ps(o[a]), ia = _mm256_set1_ps(inv[a]);
+        __m256 x = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->lo[a]), oa), ia);
+        __m256 y = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->hi[a]), oa), ia);
+        t0 = _mm256_max_ps(t0, _mm256_min_ps(x, y));
+        t1 = _mm256_min_ps(t1, _mm256_mul_ps(_mm256_max_ps(x, y), widen));
+    }
+    _mm256_storeu_ps(tnear, t0);
+    return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+#elif defined(RAD__SSE2)
     __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm_set1_ps(1.0000004f);
     int a;
     for (a = 0; a < 3; ++a) {
@@ -4232,7 +4253,7 @@ static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv,
     return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
 #else
     int k, a, mask = 0;
-    for (k = 0; k < 4; ++k) {
+    for (k = 0; k < RAD__BVH_W; ++k) {
         float t0 = tmin, t1 = tmax * 1.0000004f + 1e-30f;
         for (a = 0; a < 3; ++a) {
             float x = (n->lo[a][k] - o[a]) * inv[a], y = (n->hi[a][k] - o[a]) * inv[a];
@@ -4244,6 +4265,18 @@ static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv,
         if (t0 <= t1) mask |= 1 << k;
     }
     return mask;
+#endif
+}
+
+/* index of the lowest set bit of a nonzero mask */
+static uint32_t rad__low_bit(uint32_t m)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return (uint32_t)__builtin_ctz(m);
+#else
+    uint32_t k = 0;
+    while (!(m & 1u)) { m >>= 1; ++k; }
+    return k;
 #endif
 }
 
@@ -4345,11 +4378,10 @@ static int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count
 
 static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_hit *hit)
 {
-    /* the lowest set bit of a 4-bit mask */
-    static const unsigned char low_bit[16] = { 0, 0, 1, 0, 2, 0, 1, 0, 3, 0, 1, 0, 2, 0, 1, 0 };
     rad__wray w;
-    uint32_t stack[3 * RAD__BVH_STACK], sp = 0;
-    float stack_t[3 * RAD__BVH_STACK], tmax = ray->tmax, inv[3];
+    /* a node pushes at most RAD__BVH_W - 1 children more than it pops, once per level */
+    uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0;
+    float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = ray->tmax, inv[3];
     int found = 0, a;
     if (!(ray->tmax > ray->tmin)) return 0;
     rad__wray_init(&w, ray);
@@ -4361,18 +4393,18 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
     stack[sp] = 0;
     stack_t[sp++] = ray->tmin;
     while (sp > 0) {
-        const rad__bvh4 *n;
-        float tn[4];
-        uint32_t order[4], no = 0, k, ni;
+        const rad__bvhw *n;
+        float tn[RAD__BVH_W];
+        uint32_t order[RAD__BVH_W], no = 0, k, ni;
         int mask;
         --sp;
         if (stack_t[sp] > tmax) continue; /* entered beyond the closest hit found since */
         ni = stack[sp];
         n = &bvh->nodes[ni];
-        mask = rad__bvh4_boxes(n, w.o, inv, ray->tmin, tmax, tn);
+        mask = rad__bvhw_boxes(n, w.o, inv, ray->tmin, tmax, tn);
         while (mask) {
             uint32_t ch;
-            k = low_bit[mask];
+            k = rad__low_bit((uint32_t)mask);
             mask &= mask - 1;
             ch = n->child[k];
             if (ch == RAD_NONE) continue;
@@ -4392,9 +4424,6 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
                 order[no++] = k;
             }
         }
-#ifdef RAD__EXP_NOSORT
-        if (any) { while (no > 0) { --no; stack[sp] = n->child[order[no]]; stack_t[sp++] = tn[order[no]]; } continue; }
-#endif
         /* push inner children far to near, so the nearest is visited first */
         if (no == 1) {
             stack[sp] = n->child[order[0]];

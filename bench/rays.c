@@ -1,21 +1,26 @@
-/* rays.c - ray-query throughput of the built-in BVH against Embree on the rays a form-factor
-   bake really casts.
+/* rays.c - ray-query throughput of the built-in BVH against Embree on the rays a bake and a
+   path tracer really cast.
 
-   For each scene the program records the occlusion rays of a sample of form-factor rows
-   (rad_form_factor_rows through a recording raycaster), then replays the same rays through
-   each backend on 1 and 2 threads (chunks of 1024 rays, OpenMP), best of 3. Intersection
-   throughput replays the same rays as closest-hit queries with tmax = infinity. BVH build time
-   (best of 3) and memory are reported for each backend.
+   For each scene four ray sets: the occlusion rays of a sample of form-factor rows (recorded
+   through a recording raycaster; replayed as closest-hit queries with tmax = infinity too),
+   512x512 camera rays, cosine-distributed bounce rays from the camera hits, and shadow
+   segments from the bounce hits to a point light. Each set runs through both backends on 1
+   and 2 threads (chunks of 1024 rays, OpenMP), the backends alternating, best of 5; one thread
+   is timed by its own CPU time, two by wall time. Answers are compared ray for ray. Build time
+   (best of 5, alternating) and memory are reported for each backend.
 
-   Scenes: the built-in Cornell box cut into about 4000 patches, and the Stanford bunny
-   (stanford-bunny.obj, 69 451 triangles, a public model that is not part of the repository:
-   see docs/data.md) standing on the Cornell box floor, read from the folder given by
-   --data DIR, else $RAD_DATA_DIR; the bunny scene is skipped with a message when no folder is
-   given or the file is absent. The OBJ reading here is a bench-only reader of the plain "v x y z" /
-   "f a b c" lines these data files use, not a general importer.
+   Scenes: the built-in Cornell box cut into about 4000 patches, the Stanford bunny
+   (stanford-bunny.obj, 69 451 triangles) standing on the Cornell box floor, and the Dabrovic
+   Sponza atrium (sponza.obj, 66 454 triangles): public models that are not part of the
+   repository (see docs/data.md), read from the folder given by --data DIR, else
+   $RAD_DATA_DIR; a scene is skipped with a message when no folder is given or its file is
+   absent. The OBJ reading here is a bench-only reader of the "v x y z" and "f" lines these
+   data files use (indices a, a/b or a/b/c; polygons fanned), not a general importer.
 
    Build: cc -O3 -march=native -fopenmp [-DRAD_EMBREE ... -lembree3] bench/rays.c
-   Run:   rays [--data DIR] [--append FILE.md] [--only NAME] [--sets N]    (prints the tables, and appends them to FILE.md) */
+   Run:   rays [--data DIR] [--append FILE.md] [--only NAME] [--sets N]
+          (prints the tables and appends them to FILE.md; --only: the scenes whose name
+          contains NAME; --sets N: the first N ray sets) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
