@@ -3789,9 +3789,11 @@ static void rad__aabb_empty(rad__aabb *b)
 static void rad__aabb_grow(rad__aabb *b, const float *lo, const float *hi)
 {
     int k;
+    /* selects rather than conditional stores: they compile to min/max without branches,
+       which the build's binning loop mispredicted (a NaN keeps the old bound either way) */
     for (k = 0; k < 3; ++k) {
-        if (lo[k] < b->lo[k]) b->lo[k] = lo[k];
-        if (hi[k] > b->hi[k]) b->hi[k] = hi[k];
+        b->lo[k] = lo[k] < b->lo[k] ? lo[k] : b->lo[k];
+        b->hi[k] = hi[k] > b->hi[k] ? hi[k] : b->hi[k];
     }
 }
 static float rad__aabb_area(const rad__aabb *b)
