@@ -603,9 +603,13 @@ typedef struct rad_raycaster {
 
 typedef struct rad_bvh rad_bvh;
 
-/* Builds the BVH (binned SAH, 4 triangles per leaf at most) over the scene's triangles.
-   scene is borrowed only for the call (the BVH copies the triangles).
-   Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. Cost: O(T log T). */
+/* Builds the BVH over the scene's triangles: binned SAH down to leaves of at most 4 triangles
+   (stored side by side and tested together with SIMD), collapsed to 8-wide nodes when the
+   implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD). The
+   subtrees below the top levels are built in parallel through ctx->parallel_for; the tree does
+   not depend on the thread count. scene is borrowed only for the call (the BVH copies the
+   triangles). Errors: INVALID_ARGUMENT, OUT_OF_MEMORY, SIZE_OVERFLOW (2^29 triangles or more).
+   Cost: O(T log T). */
 RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out);
 RAD_API void rad_bvh_destroy(rad_bvh *bvh);
 /* Fills a raycaster table that queries 'bvh' (which must outlive its use). */
@@ -4505,20 +4509,34 @@ typedef struct rad__bvh_node {
     uint32_t count;   /* triangles in a leaf, 0 for an inner node */
 } rad__bvh_node;
 
-/* The traversal structure: 4-wide nodes collapsed from the binary SAH tree, so one SIMD slab
-   test checks four child boxes. Empty slots have child RAD_NONE. */
-typedef struct rad__bvh4 {
-    float lo[3][4], hi[3][4]; /* per axis, per child */
-    uint32_t child[4];        /* RAD__BVH4_LEAF | first triangle for a leaf, else node index */
-    uint32_t count[4];        /* triangles of a leaf child */
-} rad__bvh4;
+/* The traversal structure: RAD__BVH_W-wide nodes collapsed from the binary SAH tree, so one
+   SIMD slab test checks all child boxes: 8 wide with AVX (one 256-bit test), else 4 wide (SSE,
+   or the scalar loop under RAD_NO_SIMD). Empty slots have child RAD_NONE. */
+#if defined(RAD__AVX)
+#  define RAD__BVH_W 8
+#else
+#  define RAD__BVH_W 4
+#endif
+typedef struct rad__bvhw {
+    float lo[3][RAD__BVH_W], hi[3][RAD__BVH_W]; /* per axis, per child */
+    uint32_t child[RAD__BVH_W]; /* RAD__BVH4_LEAF | leaf block for a leaf, else node index */
+    uint32_t count[RAD__BVH_W]; /* triangles of a leaf child (1 to 4) */
+} rad__bvhw;
 #define RAD__BVH4_LEAF 0x80000000u
 
+/* A leaf's triangles (at most four) side by side, so one SIMD pass tests them all: lane j of
+   v[c][a] is coordinate a of vertex c of triangle j. Unused lanes are zero (id RAD_NONE) and
+   never tested. */
+typedef struct rad__tri4 {
+    float v[3][3][4];
+    uint32_t id[4];           /* scene triangle of each lane */
+} rad__tri4;
+
 struct rad_bvh {
-    rad__bvh4 *nodes;
+    rad__bvhw *nodes;
     uint32_t node_count;
-    float *tris;        /* 9 floats per triangle, in leaf order */
-    uint32_t *ids;      /* scene triangle of each */
+    rad__tri4 *leaves;
+    uint32_t leaf_count;
     uint32_t tri_count;
     rad_allocator allocator;
 };
@@ -4538,9 +4556,11 @@ static void rad__aabb_empty(rad__aabb *b)
 static void rad__aabb_grow(rad__aabb *b, const float *lo, const float *hi)
 {
     int k;
+    /* selects rather than conditional stores: they compile to min/max without branches,
+       which the build's binning loop mispredicted (a NaN keeps the old bound either way) */
     for (k = 0; k < 3; ++k) {
-        if (lo[k] < b->lo[k]) b->lo[k] = lo[k];
-        if (hi[k] > b->hi[k]) b->hi[k] = hi[k];
+        b->lo[k] = lo[k] < b->lo[k] ? lo[k] : b->lo[k];
+        b->hi[k] = hi[k] > b->hi[k] ? hi[k] : b->hi[k];
     }
 }
 static float rad__aabb_area(const rad__aabb *b)
@@ -4556,60 +4576,198 @@ RAD_API void rad_bvh_destroy(rad_bvh *bvh)
     if (!bvh) return;
     a = bvh->allocator;
     rad__free(&a, bvh->nodes);
-    rad__free(&a, bvh->tris);
-    rad__free(&a, bvh->ids);
+    rad__free(&a, bvh->leaves);
     rad__free(&a, bvh);
 }
 
 RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
 {
     if (!bvh) return 0;
-    return sizeof(*bvh) + (size_t)bvh->node_count * sizeof(rad__bvh4) +
-           (size_t)bvh->tri_count * (9 * sizeof(float) + sizeof(uint32_t));
+    return sizeof(*bvh) + (size_t)bvh->node_count * sizeof(rad__bvhw) + (size_t)bvh->leaf_count * sizeof(rad__tri4);
 }
 
-/* bin of a centroid, in double so coordinates near +-FLT_MAX cannot overflow, and never
-   converting a NaN or out-of-range value to int */
-static int rad__bvh_bin(const float *cen, uint32_t t, int axis, const rad__aabb *cb, double scale)
+/* A triangle reference of the build: its bounds and scene triangle. The build sorts these in
+   place, so every pass over a node's range reads memory in order. */
+typedef struct rad__bref { float lo[3], hi[3]; uint32_t id; } rad__bref;
+
+/* bin of a centroid coordinate, in double so coordinates near +-FLT_MAX cannot overflow, and
+   never converting a NaN or out-of-range value to int */
+static int rad__bvh_bin(float cen, float lo, double scale)
 {
-    double x = ((double)cen[3 * (size_t)t + (size_t)axis] - (double)cb->lo[axis]) * scale;
+    double x = ((double)cen - (double)lo) * scale;
     if (!(x > 0.0)) return 0;
     if (!(x < (double)RAD__BVH_BINS)) return RAD__BVH_BINS - 1;
     return (int)x;
 }
 
-/* Collapses the binary tree 'bin' into 4-wide nodes: each 4-wide node opens the largest inner
-   child of its binary node until it has four children. 'stack' has room for 2 * bin_count. */
-static rad_result rad__bvh4_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t bin_count, uint32_t *stack)
+/* the centroid coordinate of a reference (lo + hi may overflow) */
+#define RAD__BREF_CEN(r, a) (0.5f * (r)->lo[a] + 0.5f * (r)->hi[a])
+
+/* Binned SAH split of binary node 'node' over refs[first, first + count): stores its bounds and
+   returns the split position (refs partitioned around it), or 0 when it stays a leaf. */
+static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t depth)
+{
+    uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, i;
+    rad__aabb nb, cb, bins[3][RAD__BVH_BINS];
+    uint32_t cnt[3][RAD__BVH_BINS];
+    double scale[3];
+    float best_cost = FLT_MAX;
+    int axis, use[3];
+    rad__aabb_empty(&nb);
+    rad__aabb_empty(&cb);
+    for (i = first; i < first + count; ++i) {
+        const rad__bref *r = &refs[i];
+        float c[3];
+        c[0] = RAD__BREF_CEN(r, 0); c[1] = RAD__BREF_CEN(r, 1); c[2] = RAD__BREF_CEN(r, 2);
+        rad__aabb_grow(&nb, r->lo, r->hi);
+        rad__aabb_grow(&cb, c, c);
+    }
+    memcpy(node->bmin, nb.lo, sizeof(nb.lo));
+    memcpy(node->bmax, nb.hi, sizeof(nb.hi));
+    /* a leaf's triangles are tested together in one SIMD pass (rad__wray_tri4), about the cost
+       of testing one: any range that fits in a leaf is one */
+    if (count <= RAD__BVH_LEAF) return 0;
+    /* past RAD__BVH_SAH_DEPTH levels, ranges are split in half: the depth stays below
+       RAD__BVH_SAH_DEPTH + 32, so traversal stacks of RAD__BVH_STACK entries never overflow */
+    for (axis = 0; axis < 3; ++axis) {
+        double extent = (double)cb.hi[axis] - (double)cb.lo[axis];
+        uint32_t bi;
+        use[axis] = depth < RAD__BVH_SAH_DEPTH && extent > 0.0;
+        scale[axis] = use[axis] ? (double)RAD__BVH_BINS / extent : 0.0;
+        for (bi = 0; bi < RAD__BVH_BINS; ++bi) { rad__aabb_empty(&bins[axis][bi]); cnt[axis][bi] = 0; }
+    }
+    if (use[0] || use[1] || use[2]) {
+        /* one pass bins all three axes */
+        for (i = first; i < first + count; ++i) {
+            const rad__bref *r = &refs[i];
+            for (axis = 0; axis < 3; ++axis) {
+                int bin = rad__bvh_bin(RAD__BREF_CEN(r, axis), cb.lo[axis], scale[axis]);
+                cnt[axis][bin]++;
+                rad__aabb_grow(&bins[axis][bin], r->lo, r->hi);
+            }
+        }
+    }
+    for (axis = 0; axis < 3; ++axis) {
+        rad__aabb left, right;
+        uint32_t right_count[RAD__BVH_BINS], lc = 0, rc = 0, bi;
+        float right_area[RAD__BVH_BINS];
+        if (!use[axis]) continue;
+        rad__aabb_empty(&right);
+        for (bi = RAD__BVH_BINS - 1; bi > 0; --bi) {
+            rad__aabb_grow(&right, bins[axis][bi].lo, bins[axis][bi].hi);
+            rc += cnt[axis][bi];
+            right_area[bi] = rad__aabb_area(&right);
+            right_count[bi] = rc;
+        }
+        rad__aabb_empty(&left);
+        for (bi = 0; bi + 1 < RAD__BVH_BINS; ++bi) {
+            float cost;
+            rad__aabb_grow(&left, bins[axis][bi].lo, bins[axis][bi].hi);
+            lc += cnt[axis][bi];
+            if (lc == 0 || right_count[bi + 1] == 0) continue;
+            cost = (float)lc * rad__aabb_area(&left) + (float)right_count[bi + 1] * right_area[bi + 1];
+            if (cost < best_cost) { best_cost = cost; best_axis = (uint32_t)axis; best_split = bi + 1; }
+        }
+    }
+    /* SAH with a traversal step costing one triangle test: stop when splitting does not pay */
+    /* (ranges of at most RAD__BVH_LEAF triangles returned as leaves above) */
+    if (best_axis == 3) {
+        mid = first + count / 2; /* all centroids equal, or too deep: split the range */
+    } else {
+        uint32_t lo = first, hi = first + count;
+        while (lo < hi) {
+            if ((uint32_t)rad__bvh_bin(RAD__BREF_CEN(&refs[lo], best_axis), cb.lo[best_axis], scale[best_axis]) < best_split) {
+                ++lo;
+            } else {
+                rad__bref t = refs[lo];
+                --hi;
+                refs[lo] = refs[hi];
+                refs[hi] = t;
+            }
+        }
+        mid = lo;
+        if (mid == first || mid == first + count) mid = first + count / 2;
+    }
+    return mid;
+}
+
+/* Builds the subtree under binary node 'root' (at 'depth'), its nodes numbered from 'next' on
+   in pairs. Returns its leaf count. */
+static uint32_t rad__bvh_build_sub(rad__bvh_node *tree, rad__bref *refs, uint32_t root, uint32_t depth0, uint32_t next)
+{
+    uint32_t stack[4 * (RAD__BVH_SAH_DEPTH + 40)], sp = 0, leaves = 0;
+    stack[sp++] = root;
+    stack[sp++] = depth0;
+    while (sp > 0) {
+        uint32_t depth = stack[--sp], ni = stack[--sp], mid, k2, first, count;
+        mid = rad__bvh_split(&tree[ni], refs, depth);
+        if (!mid) { ++leaves; continue; }
+        first = tree[ni].first;
+        count = tree[ni].count;
+        k2 = next;
+        next += 2;
+        tree[k2].first = first;
+        tree[k2].count = mid - first;
+        tree[k2 + 1].first = mid;
+        tree[k2 + 1].count = first + count - mid;
+        tree[ni].first = k2;
+        tree[ni].count = 0;
+        stack[sp++] = k2 + 1;
+        stack[sp++] = depth + 1;
+        stack[sp++] = k2;
+        stack[sp++] = depth + 1;
+    }
+    return leaves;
+}
+
+typedef struct rad__bvh_job {
+    rad__bvh_node *tree;
+    rad__bref *refs;
+    uint32_t *task_node, *task_depth, *task_leaves;
+} rad__bvh_job;
+
+static void rad__bvh_task(void *data, uint32_t i)
+{
+    rad__bvh_job *j = (rad__bvh_job *)data;
+    uint32_t ni = j->task_node[i];
+    /* a subtree over refs[first, first + count) has fewer than 2 count nodes below its root:
+       numbering them from 2 first keeps every subtree in its own part of the array */
+    j->task_leaves[i] = rad__bvh_build_sub(j->tree, j->refs, ni, j->task_depth[i], 2u * j->tree[ni].first);
+}
+
+/* Collapses the binary tree 'bin' into RAD__BVH_W-wide nodes: each wide node opens the largest
+   inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
+   entries per leaf. */
+static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t root, uint32_t *stack,
+                                     const float *positions, const uint32_t *order)
 {
     uint32_t sp = 0;
-    (void)bin_count;
     b->node_count = 1;
-    stack[sp++] = 0; /* binary node */
+    stack[sp++] = root; /* binary node */
     stack[sp++] = 0; /* its 4-wide node */
     while (sp > 0) {
-        uint32_t n4 = stack[--sp], bi = stack[--sp], slots[4], ns = 0, k;
-        rad__bvh4 *node = &b->nodes[n4];
+        uint32_t n4 = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns = 0, k;
+        rad__bvhw *node = &b->nodes[n4];
         if (bin[bi].count) {
             slots[ns++] = bi; /* a leaf root (tiny scenes) */
         } else {
             slots[ns++] = bin[bi].first;
             slots[ns++] = bin[bi].first + 1;
-            while (ns < 4) {
+            while (ns < RAD__BVH_W) {
                 float best = -1.0f;
-                uint32_t bk = 4;
+                uint32_t bk = RAD__BVH_W;
                 for (k = 0; k < ns; ++k) {
                     const rad__bvh_node *q = &bin[slots[k]];
                     float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
                     float area = dx * dy + dy * dz + dz * dx;
                     if (q->count == 0 && area > best) { best = area; bk = k; }
                 }
-                if (bk == 4) break;
+                if (bk == RAD__BVH_W) break;
                 slots[ns++] = bin[slots[bk]].first + 1;
                 slots[bk] = bin[slots[bk]].first;
             }
         }
-        for (k = 0; k < 4; ++k) {
+        for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
                 for (a = 0; a < 3; ++a) { node->lo[a][k] = 0.0f; node->hi[a][k] = 0.0f; }
@@ -4619,7 +4777,17 @@ static rad_result rad__bvh4_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
             }
             for (a = 0; a < 3; ++a) { node->lo[a][k] = bin[slots[k]].bmin[a]; node->hi[a][k] = bin[slots[k]].bmax[a]; }
             if (bin[slots[k]].count) {
-                node->child[k] = RAD__BVH4_LEAF | bin[slots[k]].first;
+                rad__tri4 *q = &b->leaves[b->leaf_count];
+                uint32_t j, c;
+                memset(q, 0, sizeof(*q));
+                for (j = 0; j < 4; ++j) q->id[j] = RAD_NONE;
+                for (j = 0; j < bin[slots[k]].count; ++j) {
+                    const float *v = positions + 9 * (size_t)order[bin[slots[k]].first + j];
+                    for (c = 0; c < 3; ++c)
+                        for (a = 0; a < 3; ++a) q->v[c][a][j] = v[3 * c + (uint32_t)a];
+                    q->id[j] = order[bin[slots[k]].first + j];
+                }
+                node->child[k] = RAD__BVH4_LEAF | b->leaf_count++;
                 node->count[k] = bin[slots[k]].count;
             } else {
                 uint32_t m = b->node_count++;
@@ -4639,17 +4807,17 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__ctx c;
     rad_bvh *b;
     rad__bvh_node *tree = NULL;
-    uint32_t n, i, sp = 0, tree_count;
-    float *tlo = NULL, *thi = NULL, *cen = NULL;
-    uint32_t *order = NULL, *stack = NULL;
+    rad__bref *refs = NULL;
+    uint32_t n, i, sp = 0, top, tasks = 0, leaves = 0, threshold, root;
+    uint32_t *stack = NULL, *task_node = NULL, *task_depth = NULL, *task_leaves = NULL, *order = NULL;
     rad_result r;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!scene || scene->triangle_count == 0) return RAD_ERROR_INVALID_ARGUMENT;
     n = scene->triangle_count;
-    if (n >= RAD__BVH4_LEAF) {
-        rad__log(&c, RAD_LOG_ERROR, "the built-in BVH holds at most %u triangles", RAD__BVH4_LEAF - 1u);
+    if (n >= RAD__BVH4_LEAF / 4u) {
+        rad__log(&c, RAD_LOG_ERROR, "the built-in BVH holds at most %u triangles", RAD__BVH4_LEAF / 4u - 1u);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
     b = (rad_bvh *)rad__alloc(&c.allocator, sizeof(rad_bvh));
@@ -4657,21 +4825,20 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     memset(b, 0, sizeof(*b));
     b->allocator = c.allocator;
     b->tri_count = n;
-    tree = (rad__bvh_node *)rad__alloc_array(&c.allocator, 2u * (size_t)n, sizeof(rad__bvh_node));
-    b->nodes = (rad__bvh4 *)rad__alloc_array(&c.allocator, 2u * (size_t)n, sizeof(rad__bvh4));
-    b->tris = (float *)rad__alloc_array(&c.allocator, (size_t)n * 9u, sizeof(float));
-    b->ids = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
-    tlo = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
-    thi = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
-    cen = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
-    order = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    /* subtrees number their nodes below 2 n (rad__bvh_task), the top levels from 2 n on */
+    tree = (rad__bvh_node *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 2u, sizeof(rad__bvh_node));
+    refs = (rad__bref *)rad__alloc_array(&c.allocator, n, sizeof(rad__bref));
     stack = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 4u, sizeof(uint32_t));
-    if (!tree || !b->nodes || !b->tris || !b->ids || !tlo || !thi || !cen || !order || !stack) {
-        rad__free(&c.allocator, tlo); rad__free(&c.allocator, thi); rad__free(&c.allocator, cen);
-        rad__free(&c.allocator, order); rad__free(&c.allocator, stack); rad__free(&c.allocator, tree);
+    task_node = (uint32_t *)rad__alloc_array(&c.allocator, 3u * (size_t)n, sizeof(uint32_t));
+    order = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+    if (!tree || !refs || !stack || !task_node || !order) {
+        rad__free(&c.allocator, refs); rad__free(&c.allocator, stack); rad__free(&c.allocator, tree);
+        rad__free(&c.allocator, task_node); rad__free(&c.allocator, order);
         rad_bvh_destroy(b);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
+    task_depth = task_node + n;
+    task_leaves = task_node + 2u * (size_t)n;
     for (i = 0; i < n; ++i) {
         const float *v = scene->positions + 9 * (size_t)i;
         int k;
@@ -4681,105 +4848,64 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
             if (v[6 + k] < lo) lo = v[6 + k];
             if (v[3 + k] > hi) hi = v[3 + k];
             if (v[6 + k] > hi) hi = v[6 + k];
-            tlo[3 * (size_t)i + (size_t)k] = lo;
-            thi[3 * (size_t)i + (size_t)k] = hi;
-            cen[3 * (size_t)i + (size_t)k] = 0.5f * lo + 0.5f * hi; /* lo + hi may overflow */
+            refs[i].lo[k] = lo;
+            refs[i].hi[k] = hi;
         }
-        order[i] = i;
+        refs[i].id = i;
     }
-    tree_count = 1;
-    tree[0].first = 0;
-    tree[0].count = n;
-    stack[sp++] = 0; /* node */
-    stack[sp++] = 0; /* depth */
+    /* the top levels one node at a time, down to subtrees small enough to balance the threads;
+       those are then built in parallel (the tree does not depend on the thread count) */
+    threshold = n / 64u > 1024u ? n / 64u : 1024u;
+    root = top = 2u * n;
+    tree[root].first = 0;
+    tree[root].count = n;
+    top++;
+    stack[sp++] = root;
+    stack[sp++] = 0;
     while (sp > 0) {
-        uint32_t depth = stack[--sp], ni = stack[--sp];
-        rad__bvh_node *node = &tree[ni];
-        uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, k2;
-        rad__aabb nb, cb;
-        float best_cost = FLT_MAX, leaf_cost;
-        int axis;
-        rad__aabb_empty(&nb);
-        rad__aabb_empty(&cb);
-        for (i = first; i < first + count; ++i) {
-            rad__aabb_grow(&nb, tlo + 3 * (size_t)order[i], thi + 3 * (size_t)order[i]);
-            rad__aabb_grow(&cb, cen + 3 * (size_t)order[i], cen + 3 * (size_t)order[i]);
+        uint32_t depth = stack[--sp], ni = stack[--sp], mid, first, count;
+        if (tree[ni].count <= threshold) {
+            task_node[tasks] = ni;
+            task_depth[tasks++] = depth;
+            continue;
         }
-        memcpy(node->bmin, nb.lo, sizeof(nb.lo));
-        memcpy(node->bmax, nb.hi, sizeof(nb.hi));
-        if (count <= 1) continue;
-        leaf_cost = (float)count * rad__aabb_area(&nb);
-        /* past RAD__BVH_SAH_DEPTH levels, ranges are split in half: the depth stays below
-           RAD__BVH_SAH_DEPTH + 32, so traversal stacks of RAD__BVH_STACK entries never overflow */
-        for (axis = 0; axis < 3 && depth < RAD__BVH_SAH_DEPTH; ++axis) {
-            rad__aabb bins[RAD__BVH_BINS], left, right;
-            uint32_t cnt[RAD__BVH_BINS], right_count[RAD__BVH_BINS], lc = 0, rc = 0, bi;
-            double extent = (double)cb.hi[axis] - (double)cb.lo[axis], scale;
-            float right_area[RAD__BVH_BINS];
-            if (!(extent > 0.0)) continue;
-            scale = (double)RAD__BVH_BINS / extent;
-            for (bi = 0; bi < RAD__BVH_BINS; ++bi) { rad__aabb_empty(&bins[bi]); cnt[bi] = 0; }
-            for (i = first; i < first + count; ++i) {
-                int bin = rad__bvh_bin(cen, order[i], axis, &cb, scale);
-                cnt[bin]++;
-                rad__aabb_grow(&bins[bin], tlo + 3 * (size_t)order[i], thi + 3 * (size_t)order[i]);
-            }
-            rad__aabb_empty(&right);
-            for (bi = RAD__BVH_BINS - 1; bi > 0; --bi) {
-                rad__aabb_grow(&right, bins[bi].lo, bins[bi].hi);
-                rc += cnt[bi];
-                right_area[bi] = rad__aabb_area(&right);
-                right_count[bi] = rc;
-            }
-            rad__aabb_empty(&left);
-            for (bi = 0; bi + 1 < RAD__BVH_BINS; ++bi) {
-                float cost;
-                rad__aabb_grow(&left, bins[bi].lo, bins[bi].hi);
-                lc += cnt[bi];
-                if (lc == 0 || right_count[bi + 1] == 0) continue;
-                cost = (float)lc * rad__aabb_area(&left) + (float)right_count[bi + 1] * right_area[bi + 1];
-                if (cost < best_cost) { best_cost = cost; best_axis = (uint32_t)axis; best_split = bi + 1; }
-            }
-        }
-        /* SAH with a traversal step costing one triangle test: stop when splitting does not pay */
-        if (count <= RAD__BVH_LEAF && (best_axis == 3 || best_cost + rad__aabb_area(&nb) >= leaf_cost)) continue;
-        if (best_axis == 3) {
-            mid = first + count / 2; /* all centroids equal, or too deep: split the range */
-        } else {
-            double scale = (double)RAD__BVH_BINS / ((double)cb.hi[best_axis] - (double)cb.lo[best_axis]);
-            uint32_t lo = first, hi = first + count;
-            while (lo < hi) {
-                uint32_t t = order[lo];
-                if ((uint32_t)rad__bvh_bin(cen, t, (int)best_axis, &cb, scale) < best_split) ++lo;
-                else { --hi; order[lo] = order[hi]; order[hi] = t; }
-            }
-            mid = lo;
-            if (mid == first || mid == first + count) mid = first + count / 2;
-        }
-        k2 = tree_count;
-        tree_count += 2;
-        tree[k2].first = first;
-        tree[k2].count = mid - first;
-        tree[k2 + 1].first = mid;
-        tree[k2 + 1].count = first + count - mid;
-        node = &tree[ni];
-        node->first = k2;
-        node->count = 0;
-        stack[sp++] = k2 + 1;
+        mid = rad__bvh_split(&tree[ni], refs, depth);
+        if (!mid) { ++leaves; continue; }
+        first = tree[ni].first;
+        count = tree[ni].count;
+        tree[top].first = first;
+        tree[top].count = mid - first;
+        tree[top + 1].first = mid;
+        tree[top + 1].count = first + count - mid;
+        tree[ni].first = top;
+        tree[ni].count = 0;
+        stack[sp++] = top + 1;
         stack[sp++] = depth + 1;
-        stack[sp++] = k2;
+        stack[sp++] = top;
         stack[sp++] = depth + 1;
+        top += 2;
     }
-    for (i = 0; i < n; ++i) {
-        memcpy(b->tris + 9 * (size_t)i, scene->positions + 9 * (size_t)order[i], 9 * sizeof(float));
-        b->ids[i] = order[i];
+    if (tasks > 0) {
+        rad__bvh_job job;
+        job.tree = tree;
+        job.refs = refs;
+        job.task_node = task_node;
+        job.task_depth = task_depth;
+        job.task_leaves = task_leaves;
+        if (tasks == 1) rad__bvh_task(&job, 0);
+        else c.parallel_for(c.parallel_user, tasks, rad__bvh_task, &job);
+        for (i = 0; i < tasks; ++i) leaves += task_leaves[i];
     }
-    r = rad__bvh4_collapse(b, tree, tree_count, stack);
-    rad__free(&c.allocator, tlo);
-    rad__free(&c.allocator, thi);
-    rad__free(&c.allocator, cen);
-    rad__free(&c.allocator, order);
+    for (i = 0; i < n; ++i) order[i] = refs[i].id;
+    /* a binary tree of L leaves has L - 1 inner nodes, and each 4-wide node opens at least one
+       of them (or is the root leaf of a one-leaf tree) */
+    b->nodes = (rad__bvhw *)rad__alloc_array(&c.allocator, leaves, sizeof(rad__bvhw));
+    b->leaves = (rad__tri4 *)rad__alloc_array(&c.allocator, leaves, sizeof(rad__tri4));
+    r = (b->nodes && b->leaves) ? rad__bvhw_collapse(b, tree, root, stack, scene->positions, order) : RAD_ERROR_OUT_OF_MEMORY;
+    rad__free(&c.allocator, refs);
     rad__free(&c.allocator, stack);
+    rad__free(&c.allocator, task_node);
+    rad__free(&c.allocator, order);
     rad__free(&c.allocator, tree);
     if (r != RAD_SUCCESS) { rad_bvh_destroy(b); return r; }
     *out = b;
@@ -4814,7 +4940,9 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
     w->tmax = r->tmax;
 }
 
-/* Watertight ray/triangle test, both faces. Returns 1 with t, b1, b2 on a hit in (tmin, tmax). */
+#if !defined(RAD__SSE2)
+/* Watertight ray/triangle test, both faces. Returns 1 with t, b1, b2 on a hit in (tmin, tmax).
+   rad__wray_tri4 performs the same operations on four triangles at once with SIMD. */
 static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *t_out, float *b1, float *b2)
 {
     float A[3], B[3], C[3], Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T;
@@ -4859,15 +4987,28 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
     *b2 = W / det;
     return 1;
 }
+#endif
 
-/* Slab test of a ray against the four child boxes of a node: bit k of the result is set when
+/* Slab test of a ray against the child boxes of a node: bit k of the result is set when
    child k is hit within [tmin, tmax]; tnear[k] receives its entry distance. Zero direction
-   components were replaced by +-1e-30 in inv (no NaN from 0 * inf). */
-static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
+   components were replaced by +-1e-30 in inv (no NaN from 0 * inf). Each slab's far distance
+   is widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
+   through shared vertices on box faces). */
+static int rad__bvhw_boxes(const rad__bvhw *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
 {
-#if defined(RAD__SSE2)
-    /* each slab's far distance is widened by 1 + 2 gamma_3 (Ize 2013), so rounding never
-       culls a box the ray touches (rays through shared vertices on box faces) */
+#if defined(RAD__AVX)
+    __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm256_set1_ps(1.0000004f);
+    int a;
+    for (a = 0; a < 3; ++a) {
+        __m256 oa = _mm256_set1_ps(o[a]), ia = _mm256_set1_ps(inv[a]);
+        __m256 x = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->lo[a]), oa), ia);
+        __m256 y = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->hi[a]), oa), ia);
+        t0 = _mm256_max_ps(t0, _mm256_min_ps(x, y));
+        t1 = _mm256_min_ps(t1, _mm256_mul_ps(_mm256_max_ps(x, y), widen));
+    }
+    _mm256_storeu_ps(tnear, t0);
+    return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+#elif defined(RAD__SSE2)
     __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm_set1_ps(1.0000004f);
     int a;
     for (a = 0; a < 3; ++a) {
@@ -4881,7 +5022,7 @@ static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv,
     return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
 #else
     int k, a, mask = 0;
-    for (k = 0; k < 4; ++k) {
+    for (k = 0; k < RAD__BVH_W; ++k) {
         float t0 = tmin, t1 = tmax * 1.0000004f + 1e-30f;
         for (a = 0; a < 3; ++a) {
             float x = (n->lo[a][k] - o[a]) * inv[a], y = (n->hi[a][k] - o[a]) * inv[a];
@@ -4896,11 +5037,120 @@ static int rad__bvh4_boxes(const rad__bvh4 *n, const float *o, const float *inv,
 #endif
 }
 
+/* index of the lowest set bit of a nonzero mask */
+static uint32_t rad__low_bit(uint32_t m)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    return (uint32_t)__builtin_ctz(m);
+#else
+    uint32_t k = 0;
+    while (!(m & 1u)) { m >>= 1; ++k; }
+    return k;
+#endif
+}
+
+/* The triangles of leaf q (count of them) against the ray, in lane order, as rad__wray_tri
+   would test them one by one: returns the last lane that hit (each hit lowers *tmax, so it is
+   the closest, the first of equal ones), or -1. With 'any' it returns at the first hit. */
+static int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count, int any, float *tmax, float *t_out,
+                          float *b1, float *b2)
+{
+#if defined(RAD__SSE2)
+    /* the vertex transform and the edge functions of rad__wray_tri, four triangles per
+       instruction; each lane performs the same operations as the scalar test, so a vertex or
+       an edge shared by two triangles gets the same values in every lane (watertight) */
+    __m128 sx = _mm_set1_ps(w->sx), sy = _mm_set1_ps(w->sy), zero = _mm_setzero_ps();
+    __m128 ox = _mm_set1_ps(w->o[w->kx]), oy = _mm_set1_ps(w->o[w->ky]), oz = _mm_set1_ps(w->o[w->kz]);
+    __m128 Az = _mm_sub_ps(_mm_loadu_ps(q->v[0][w->kz]), oz), Bz = _mm_sub_ps(_mm_loadu_ps(q->v[1][w->kz]), oz),
+           Cz = _mm_sub_ps(_mm_loadu_ps(q->v[2][w->kz]), oz);
+    __m128 Ax = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(q->v[0][w->kx]), ox), _mm_mul_ps(sx, Az));
+    __m128 Ay = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(q->v[0][w->ky]), oy), _mm_mul_ps(sy, Az));
+    __m128 Bx = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(q->v[1][w->kx]), ox), _mm_mul_ps(sx, Bz));
+    __m128 By = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(q->v[1][w->ky]), oy), _mm_mul_ps(sy, Bz));
+    __m128 Cx = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(q->v[2][w->kx]), ox), _mm_mul_ps(sx, Cz));
+    __m128 Cy = _mm_sub_ps(_mm_sub_ps(_mm_loadu_ps(q->v[2][w->ky]), oy), _mm_mul_ps(sy, Cz));
+    __m128 cb = _mm_mul_ps(Cx, By), cy = _mm_mul_ps(Cy, Bx), ac = _mm_mul_ps(Ax, Cy), ay = _mm_mul_ps(Ay, Cx);
+    __m128 ba = _mm_mul_ps(Bx, Ay), bb = _mm_mul_ps(By, Ax);
+    __m128 U = _mm_sub_ps(cb, cy), V = _mm_sub_ps(ac, ay), W = _mm_sub_ps(ba, bb), redo;
+    float u[4], v[4], ww[4], az[4], bz[4], cz[4];
+    int lanes = (1 << count) - 1, hit_mask, redo_mask, found = -1, j;
+#if defined(__FMA__)
+    {
+        /* as in rad__wray_tri: the compiler may fuse these products into FMAs, so any result
+           within rounding of zero is redone in double */
+        __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff)), eps = _mm_set1_ps(1.2e-7f);
+        redo = _mm_or_ps(_mm_or_ps(_mm_cmple_ps(_mm_and_ps(U, abs_mask),
+                                                _mm_mul_ps(eps, _mm_add_ps(_mm_and_ps(cb, abs_mask), _mm_and_ps(cy, abs_mask)))),
+                                   _mm_cmple_ps(_mm_and_ps(V, abs_mask),
+                                                _mm_mul_ps(eps, _mm_add_ps(_mm_and_ps(ac, abs_mask), _mm_and_ps(ay, abs_mask))))),
+                         _mm_cmple_ps(_mm_and_ps(W, abs_mask),
+                                      _mm_mul_ps(eps, _mm_add_ps(_mm_and_ps(ba, abs_mask), _mm_and_ps(bb, abs_mask)))));
+    }
+#else
+    redo = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(U, zero), _mm_cmpeq_ps(V, zero)), _mm_cmpeq_ps(W, zero));
+#endif
+    redo_mask = _mm_movemask_ps(redo) & lanes;
+    /* a lane is out when its edge functions have both signs (a NaN makes every compare false) */
+    hit_mask = ~_mm_movemask_ps(_mm_and_ps(_mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero)),
+                                           _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero)))) &
+               lanes;
+    if (!(hit_mask | redo_mask)) return -1;
+    _mm_storeu_ps(u, U); _mm_storeu_ps(v, V); _mm_storeu_ps(ww, W);
+    _mm_storeu_ps(az, Az); _mm_storeu_ps(bz, Bz); _mm_storeu_ps(cz, Cz);
+    if (redo_mask) {
+        float xa[4], ya[4], xb[4], yb[4], xc[4], yc[4];
+        _mm_storeu_ps(xa, Ax); _mm_storeu_ps(ya, Ay); _mm_storeu_ps(xb, Bx);
+        _mm_storeu_ps(yb, By); _mm_storeu_ps(xc, Cx); _mm_storeu_ps(yc, Cy);
+        for (j = 0; j < 4; ++j) {
+            if (!(redo_mask & (1 << j))) continue;
+            u[j] = (float)((double)xc[j] * (double)yb[j] - (double)yc[j] * (double)xb[j]);
+            v[j] = (float)((double)xa[j] * (double)yc[j] - (double)ya[j] * (double)xc[j]);
+            ww[j] = (float)((double)xb[j] * (double)ya[j] - (double)yb[j] * (double)xa[j]);
+            if ((u[j] < 0.0f || v[j] < 0.0f || ww[j] < 0.0f) && (u[j] > 0.0f || v[j] > 0.0f || ww[j] > 0.0f))
+                hit_mask &= ~(1 << j);
+            else
+                hit_mask |= 1 << j;
+        }
+    }
+    for (j = 0; j < 4; ++j) {
+        float det, T;
+        if (!(hit_mask & (1 << j))) continue;
+        det = u[j] + v[j] + ww[j];
+        if (det == 0.0f) continue;
+        T = (float)(((double)u[j] * (double)(w->sz * az[j]) + (double)v[j] * (double)(w->sz * bz[j]) +
+                     (double)ww[j] * (double)(w->sz * cz[j])) / (double)det);
+        if (!(T > w->tmin && T < *tmax)) continue;
+        *tmax = *t_out = T;
+        *b1 = v[j] / det;
+        *b2 = ww[j] / det;
+        found = j;
+        if (any) break;
+    }
+    return found;
+#else
+    float tri[9], t, c1, c2;
+    int found = -1;
+    uint32_t j, c, a;
+    for (j = 0; j < count; ++j) {
+        for (c = 0; c < 3; ++c)
+            for (a = 0; a < 3; ++a) tri[3 * c + a] = q->v[c][a][j];
+        if (!rad__wray_tri(w, tri, *tmax, &t, &c1, &c2)) continue;
+        *tmax = *t_out = t;
+        *b1 = c1;
+        *b2 = c2;
+        found = (int)j;
+        if (any) break;
+    }
+    return found;
+#endif
+}
+
 static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_hit *hit)
 {
     rad__wray w;
-    uint32_t stack[3 * RAD__BVH_STACK], sp = 0;
-    float stack_t[3 * RAD__BVH_STACK], tmax = ray->tmax, inv[3];
+    /* a node pushes at most RAD__BVH_W - 1 children more than it pops, once per level */
+    uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0;
+    float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = ray->tmax, inv[3];
     int found = 0, a;
     if (!(ray->tmax > ray->tmin)) return 0;
     rad__wray_init(&w, ray);
@@ -4912,37 +5162,43 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
     stack[sp] = 0;
     stack_t[sp++] = ray->tmin;
     while (sp > 0) {
-        const rad__bvh4 *n;
-        float tn[4];
-        uint32_t order[4], no = 0, k, ni;
+        const rad__bvhw *n;
+        float tn[RAD__BVH_W];
+        uint32_t order[RAD__BVH_W], no = 0, k, ni;
         int mask;
         --sp;
         if (stack_t[sp] > tmax) continue; /* entered beyond the closest hit found since */
         ni = stack[sp];
         n = &bvh->nodes[ni];
-        mask = rad__bvh4_boxes(n, w.o, inv, ray->tmin, tmax, tn);
-        for (k = 0; k < 4; ++k) {
-            uint32_t ch = n->child[k];
-            if (!(mask & (1 << k)) || ch == RAD_NONE) continue;
+        mask = rad__bvhw_boxes(n, w.o, inv, ray->tmin, tmax, tn);
+        while (mask) {
+            uint32_t ch;
+            k = rad__low_bit((uint32_t)mask);
+            mask &= mask - 1;
+            ch = n->child[k];
+            if (ch == RAD_NONE) continue;
             if (ch & RAD__BVH4_LEAF) {
-                uint32_t i, first = ch & ~RAD__BVH4_LEAF;
-                for (i = first; i < first + n->count[k]; ++i) {
-                    float t, b1, b2;
-                    if (rad__wray_tri(&w, bvh->tris + 9 * (size_t)i, tmax, &t, &b1, &b2)) {
-                        found = 1;
-                        if (any) return 1;
-                        tmax = t;
-                        hit->t = t;
-                        hit->triangle = bvh->ids[i];
-                        hit->b1 = b1;
-                        hit->b2 = b2;
-                    }
+                const rad__tri4 *q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
+                float t = 0.0f, b1 = 0.0f, b2 = 0.0f;
+                int j = rad__wray_tri4(&w, q, n->count[k], any, &tmax, &t, &b1, &b2);
+                if (j >= 0) {
+                    found = 1;
+                    if (any) return 1;
+                    hit->t = t;
+                    hit->triangle = q->id[j];
+                    hit->b1 = b1;
+                    hit->b2 = b2;
                 }
             } else {
                 order[no++] = k;
             }
         }
         /* push inner children far to near, so the nearest is visited first */
+        if (no == 1) {
+            stack[sp] = n->child[order[0]];
+            stack_t[sp++] = tn[order[0]];
+            continue;
+        }
         while (no > 0) {
             uint32_t far = 0, q;
             for (q = 1; q < no; ++q)

@@ -30,7 +30,14 @@ static void rad_test_embree_raycaster(const rad_bvh *bvh, rad_raycaster *out)
     }
     pos = (float *)malloc(sizeof(float) * 9 * bvh->tri_count);
     if (!pos || slot == RAD_TEST_EMBREE_MAX) { free(pos); printf("    FAIL embree map full\n"); rad_test_failures++; return; }
-    for (i = 0; i < bvh->tri_count; ++i) memcpy(pos + 9 * (size_t)bvh->ids[i], bvh->tris + 9 * (size_t)i, 9 * sizeof(float));
+    for (i = 0; i < bvh->leaf_count; ++i) { /* the BVH's own copy of the triangles, lane by lane */
+        const rad__tri4 *q = &bvh->leaves[i];
+        uint32_t j, c, a;
+        for (j = 0; j < 4; ++j)
+            if (q->id[j] != RAD_NONE)
+                for (c = 0; c < 3; ++c)
+                    for (a = 0; a < 3; ++a) pos[9 * (size_t)q->id[j] + 3 * c + a] = q->v[c][a][j];
+    }
     memset(&fake, 0, sizeof(fake));
     fake.positions = pos;
     fake.triangle_count = bvh->tri_count;
