@@ -16688,7 +16688,7 @@ RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *src, rad_a
     float *vals = NULL;
     void *scratch = NULL;
     unsigned char *base = NULL;
-    size_t off_bytes, tot_bytes, bin_bytes, tot_off, bins_off, total;
+    size_t off_bytes = 0, tot_bytes = 0, bin_bytes = 0, tot_off = 0, bins_off = 0, total = 0; /* set in pass 2 */
     rad__ctx_init(&c, ctx);
     if (out) *out = NULL;
     if (!src || !out || !src->fetch || src->n == 0 || src->n == 0xFFFFFFFFu) return RAD_ERROR_INVALID_ARGUMENT;
