@@ -628,7 +628,9 @@ if "$RAD" bake cornell --method aavp --vp-resolution 4 -o "$TMP/vp.radb" > /dev/
     p2=$(psnr_of "$TMP/vp0.pfm" "$TMP/vp2.pfm")
     at_least "$p1" 100 && at_least "$p2" 50 && ok "bake --method aavp renders as built (PSNR $p1 dB; local --proxy $p2 dB)" ||
         fail "bake --method aavp renders as built" "PSNR '$p1' and '$p2' dB"
-    "$RAD" info "$TMP/vp.radb" 2>/dev/null | grep -q "VP_SAMPLE_WEIGHTS" && ok "rad info names the virtual-patch sections" ||
+    "$RAD" info "$TMP/vp.radb" > "$TMP/info.txt" 2>&1 && grep -q "VP_SAMPLE_WEIGHTS" "$TMP/info.txt" &&
+        grep -q "virtual patches 'vp': axis-aligned (aavp), [0-9]* patches" "$TMP/info.txt" && ! grep -q "not a valid bake" "$TMP/info.txt" &&
+        ok "rad info names the virtual-patch sections" ||
         fail "rad info names the virtual-patch sections" "$("$RAD" info "$TMP/vp.radb" 2>&1 | head -c 300)"
 else
     fail "bake --method aavp and render it" "$(head -c 300 "$TMP/err.txt")"

@@ -184,6 +184,21 @@ int rad_cmd_info(int argc, char **argv)
         printf("  %-3u %-20s %-14s %9u %12llu %14llu  OK\n", i, type_name(s->type), s->name[0] ? s->name : "-",
                s->elem_size, (unsigned long long)s->count, (unsigned long long)s->count * s->elem_size);
     }
+    {
+        /* a virtual-patch bake (rad bake --method aavp|vp): its info record, no classic patches */
+        const rad_section *vi = rad_container_find(ct, RAD_SECTION_VP_INFO, NULL), *rows;
+        if (vi && vi->elem_size == 4 && vi->count == 16 && !rad_container_find(ct, RAD_SECTION_PATCHES, NULL)) {
+            uint32_t rec[16];
+            memcpy(rec, vi->data, sizeof rec);
+            rows = rad_container_find(ct, RAD_SECTION_FF_ROW_OFFSETS, vi->name);
+            printf("virtual patches '%s': %s, %u patches in %u voxels (grid %u x %u x %u), %u samples, form factors %s\n",
+                   vi->name, rec[0] == (uint32_t)RAD_VP_CLUSTERED ? "clustered (vp)" : "axis-aligned (aavp)", rec[2],
+                   rec[3], rec[5], rec[6], rec[7], rec[4], rows ? "sparse (CSR)" : "dense");
+            rad_container_close(ct);
+            free(data);
+            return 0;
+        }
+    }
     if ((r = rad_load_memory(data, (size_t)len, &ctx, &bake)) != RAD_SUCCESS) {
         fprintf(stderr, "rad %s: '%s' holds sections but not a valid bake: %s\n", cmd, path, rad_result_string(r));
         rad_container_close(ct);
