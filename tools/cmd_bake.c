@@ -266,11 +266,27 @@ void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bak
 
 /* rad_save_memory's container plus our sections, written to 'path'. rad merge (cmd_merge.c)
    writes the same sections in the same order from a sharded bake's parts: change both. */
+/* The sections as a container written to path (a temporary renamed into place); its size in
+   *out_size. 0, or 1 with the message printed. */
+static int write_sections(const char *cmd, const char *path, const rad_section *secs, uint32_t k, size_t *out_size)
+{
+    void *dst;
+    rad_result r;
+    int rc = 1;
+    if ((r = rad_container_size(secs, k, out_size)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_container_size", r);
+    dst = rad_tool_calloc(*out_size, 1);
+    if ((r = rad_container_write(secs, k, dst, *out_size)) != RAD_SUCCESS) rad_tool_fail(cmd, "rad_container_write", r);
+    else if (rad_tool_write_file(path, dst, *out_size) != 0) fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+    else rc = 0;
+    free(dst);
+    return rc;
+}
+
 static int save_bake(const char *cmd, const char *path, const rad_tool_world *w, const rad_tool_classic_options *o,
                      const rad_tool_classic *c)
 {
     rad_context ctx;
-    void *buf = NULL, *dst = NULL;
+    void *buf = NULL;
     size_t size = 0, dst_size = 0;
     rad_container *ct = NULL;
     rad_section *secs;
@@ -299,23 +315,10 @@ static int save_bake(const char *cmd, const char *path, const rad_tool_world *w,
     strcpy(secs[k++].name, "D");
     secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
-    if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_size", r);
-        goto done;
-    }
-    dst = rad_tool_calloc(dst_size, 1);
-    if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_write", r);
-        goto done;
-    }
-    if (rad_tool_write_file(path, dst, dst_size) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
-        goto done;
-    }
+    if (write_sections(cmd, path, secs, k, &dst_size)) goto done;
     printf("wrote %s: %u patches, %u sections, %lu bytes\n", path, n, k, (unsigned long)dst_size);
     rc = 0;
 done:
-    free(dst);
     free(secs);
     rad_container_close(ct);
     rad_free_buffer(buf, &ctx);
@@ -348,7 +351,6 @@ static int bake_vp(const char *cmd, const char *path, const rad_tool_world *w, c
     rad_context ctx;
     rad_result r;
     float *E = NULL;
-    void *dst = NULL;
     size_t dst_size = 0;
     uint32_t k = 0;
     int rc = 1;
@@ -398,25 +400,12 @@ static int bake_vp(const char *cmd, const char *path, const rad_tool_world *w, c
     strcpy(secs[k++].name, "signature");
     secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
-    if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_size", r);
-        goto done;
-    }
-    dst = rad_tool_calloc(dst_size, 1);
-    if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_write", r);
-        goto done;
-    }
-    if (rad_tool_write_file(path, dst, dst_size) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
-        goto done;
-    }
+    if (write_sections(cmd, path, secs, k, &dst_size)) goto done;
     printf("wrote %s: %s, %u virtual patches at resolution %u, %llu non-zeros, %lu bytes\n", path,
            rad_tool_method_name(mo->method), vp->count, mo->vp_resolution,
            (unsigned long long)vp->matrix.row_offsets[vp->count], (unsigned long)dst_size);
     rc = 0;
 done:
-    free(dst);
     free(E);
     rad_vp_destroy(vp);
     return rc;
