@@ -965,6 +965,14 @@ point --point 0.278,0.45,0.28:0.5
 spot --spot 0.278,0.54,0.28:0,-1,0:20,35:1
 area --area 0.2,0.35,0.05:0.15,0,0:0,0.12,0:10
 EOF2
+# rad compare's mean line is the energy check: it equals the independent mean of each PFM above
+line=$("$RAD" compare "$TMP/l-r.pfm" "$TMP/l-t.pfm" 2> /dev/null | grep '^mean:')
+ca=$(echo "$line" | awk '{ print $2 }'); cb=$(echo "$line" | awk '{ print $3 }')
+cr=$(echo "$line" | sed -n 's/.*A \/ B = //p')
+mr=$(pfm_mean "$TMP/l-r.pfm"); mt=$(pfm_mean "$TMP/l-t.pfm")
+close "$ca" "$mr" 1e-4 && close "$cb" "$mt" 1e-4 && [ -n "$cr" ] && close "$cr" "$(awk -v a="$mr" -v b="$mt" 'BEGIN { print a / b }')" 1e-4 &&
+    ok "compare prints each image's mean radiance and their ratio ($line)" ||
+    fail "compare prints each image's mean radiance and their ratio" "'$line' against $mr $mt"
 # the sky is the radiance a ray that leaves the scene sees: rad render shows it like rad trace
 if "$RAD" render "$TMP/dark.obj" --sky 0.5,0.25,1 --size 16x16 --patches 50 --aa 1 --camera 0,0,-1:0,0,-2:0,1,0 \
     -o "$TMP/sky.pfm" > /dev/null 2> "$TMP/err.txt"; then
