@@ -115,15 +115,17 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
 	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
+	bash bench/methods.sh $(BUILD)/rad BENCHMARKS.md
 	./$(BUILD)/multibounce --append BENCHMARKS.md
 	./$(BUILD)/temporal --append BENCHMARKS.md
 	./$(BUILD)/shading --append BENCHMARKS.md
 	./$(BUILD)/local --append BENCHMARKS.md
 	./$(BUILD)/probes --append BENCHMARKS.md
 
-bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
+bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
+	bash bench/methods.sh $(BUILD)/rad $(BUILD)/BENCHMARKS-quick.md --quick
 	./$(BUILD)/multibounce --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/temporal --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/shading --quick --append $(BUILD)/BENCHMARKS-quick.md
