@@ -2178,11 +2178,9 @@ typedef struct rad_block_options {
                                   0 disables the step (default 0.05) */
     int reorder;               /* row and column reordering: RAD_REORDER_NONE (0),
                                   RAD_REORDER_GREEDY (1, Shcherbakov 2025),
-                                  RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: 12-30%
-                                  lower MSE than GREEDY on the Cornell F_mb with 1-5%
-                                  outliers) or RAD_REORDER_MATCH (4, the default: a further
-                                  3% (BC1) / 6% (3xBC4) lower than GROUPS at N = 1850 for
-                                  the same build time; see BENCHMARKS.md) */
+                                  RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: lower
+                                  MSE than GREEDY) or RAD_REORDER_MATCH (4, the default: lower
+                                  still for the same build time; docs/methods/compression.md) */
     uint32_t reorder_samples;  /* 0: L2 distances over all coordinates (the literal algorithm,
                                   through a Gram matrix); else over this many evenly spaced
                                   coordinates (faster, a little worse; default 0) */
@@ -2252,7 +2250,7 @@ RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
    entries equal rad_bc1_decode_block's within a few float roundings (1e-6 relative, tested).
    Parallel over block rows (BC1: and over block columns for the tables). Thread safety:
    reentrant. Cost: O(N^2) work (on the CPU about as many multiply-adds as a dense float
-   apply: compute-bound, see BENCHMARKS.md), bytes_total bytes read; BC1 also writes and
+   apply: compute-bound), bytes_total bytes read; BC1 also writes and
    reads 3072 N bytes of tables (scratch memory). docs/methods/compression.md. */
 RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
                                                 rad_output output, const rad_context *ctx);
@@ -2621,8 +2619,7 @@ typedef struct rad_alias_tables {
    larger through the context's allocator, placed 2 MiB aligned inside it and advised
    madvise(MADV_HUGEPAGE) before it is written, so that transparent huge pages back it even
    in the kernel's 'madvise' mode: every draw of the step is a random read into the tables,
-   and with 4 KiB pages most draws also miss the TLB (about 15% of the step's time at
-   N = 10832, BENCHMARKS.md). A hint only: where the kernel declines, nothing changes.
+   and with 4 KiB pages most draws also miss the TLB. A hint only: where the kernel declines, nothing changes.
    Thread safety: reentrant. docs/methods/temporal.md. */
 RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format format, const rad_context *ctx,
                                            rad_alias_tables **out);
@@ -2754,8 +2751,7 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
    step is then undone). Cost: O(N k) random reads into the tables and E: the draws
    are software-pipelined (each task hashes and prefetches the bins of the draws 64 to 128
    ahead of the one it resolves, across rows; with AVX2 and compact tables 8 rows side by
-   side, one per vector lane), so the misses overlap instead of waiting one by one
-   (BENCHMARKS.md: about 3.7 ns per draw on one core with tables of 450 MB).
+   side, one per vector lane), so the misses overlap instead of waiting one by one.
    Thread safety: one thread at a time per state. docs/methods/temporal.md. */
 RAD_API rad_result rad_temporal_step(rad_temporal *temporal, const float *E, const float E0[3], float *out_indirect);
 
@@ -2814,8 +2810,8 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
         F_ab = P_ab min(c_a, c_b) / A_a, so every row sums to at most 1 and every solver
         converges. In a closed box this lowers the mean row sum by about 1% (keep_row_sums
         turns it off).
-   VISIBILITY. One shadow ray per sample pair costs M^2 / 2 rays (a bunny in the Cornell box
-   at 47 000 samples: 7.8e8 rays, 157 s on 2 cores), so by default the kernel is summed over
+   VISIBILITY. One shadow ray per sample pair costs M^2 / 2 rays (hundreds of millions for a
+   real mesh), so by default the kernel is summed over
    every sample pair but visibility is estimated per pair of voxels (u, v): 'visibility_rays'
    sample pairs are drawn with probability proportional to their kernel G_ij (stratified on
    the cumulative sum, offsets from a hash of u and v, so the result is deterministic), one
@@ -2831,11 +2827,6 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    candidate voxels (at most 2^21 hits, 32 MiB), and for clustering T x 8 (2 n kc + n^2 + 9 n)
    bytes (n: the most samples in one voxel, at most 6 face_points; kc: metric_columns).
    Nothing is O(samples^2).
-   MEASURED (examples/vp_bunny.c, 2 shared cores, BENCHMARKS.md): the bunny in the Cornell box
-   (69 463 triangles) at 24 voxels: 107 342 samples, 6 196 patches, 20 s, 212 MiB peak; the
-   bunny and the ogre (193 471 triangles) at 30 voxels: 168 602 samples, 9 638 patches, 103 s,
-   479 MiB; image SSIM against the path tracer 0.989 (classic radiosity on decimated copies
-   with a similar patch count: 0.984 and 0.979).
    COST: O(M^2) kernel evaluations and up to M^2/2 shadow rays for M samples; M grows with the
    number of non-empty voxels times 6 face_points (times the hit rate).
    SPARSE ROWS (storage = RAD_STORAGE_SPARSE): after step 6 the matrix is kept as CSR with the
@@ -13360,8 +13351,8 @@ static void rad__mb_apply_task(void *data, uint32_t t)
     const rad__mb_apply *a = (const rad__mb_apply *)data;
     uint32_t n = a->mb->n, i0 = (uint32_t)((uint64_t)n * t / a->tasks), i1 = (uint32_t)((uint64_t)n * (t + 1) / a->tasks), i, ch;
     size_t nn = (size_t)n * n;
-    /* plane by plane: one sequential stream at a time (interleaving the three planes' rows
-       cost the half apply 1.45x at N = 5696, see BENCHMARKS.md); every y is the same dot */
+    /* plane by plane: one sequential stream at a time (interleaved planes' rows compete for
+       the prefetchers); every y is the same dot */
     for (ch = 0; ch < 3; ++ch)
         for (i = i0; i < i1; ++i) {
             size_t at = ch * nn + (size_t)i * n;
@@ -14481,17 +14472,8 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    Block columns go in passes of RAD__MB_LUT_PASS (2.25 MiB of tables, kept in L3): per pass
    two parallel loops, the pass's tables (parallel over columns), then every block row over
    them, in tiles of RAD__MB_LUT_TILE columns (768 KiB of tables; L2 is 1 MiB here) so that a
-   tile's tables stay in L2 while a task's block rows pass over them (BENCHMARKS.md: 1.2x
-   faster than the exact palette per block). Slower alternatives measured: all tables first
-   (1.5x slower at N = 5696: 17 MB of tables written and read back through DRAM, more than
-   the 15 MB of blocks), tables per task (the work repeats in every task, 64 by default),
-   16-float entries (one cache line each), palettes looked up in tables over the endpoint
-   codes (L2 traffic), the exact palette per block times sums by code (M_0..M_3: the palette
-   was two thirds of the instructions), nibble tables small enough for L1 (twice the loads:
-   2x slower), the outliers added inside the block loop (their rows then come in permuted
-   order), a sweep down two block columns at a time with their tables in L1 and the row sums
-   in memory (2.8x slower at N = 5696: consecutive block rows are a row of blocks apart,
-   11 KiB, so every block is on another page). */
+   tile's tables stay in L2 while a task's block rows pass over them. The alternatives that
+   were measured slower are listed in docs/performance-notes.md. */
 #define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
@@ -14569,8 +14551,8 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
                         const uint8_t *blk = row + 8 * (size_t)bx;
                         const uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
                         /* the row's entry in the block's mode: 3-colour at +0, 4-colour (c0 > c1)
-                           at +6; by arithmetic, not a comparison, which gcc 12 made a branch (the
-                           encoder mixes both modes: mispredicted about half the time, 1.2x slower) */
+                           at +6; by arithmetic, not a comparison, which compilers make a branch
+                           that the encoder's mix of both modes mispredicts */
                         const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0) + 6u * ((k1 - k0) >> 31);
                         const __m256 ep = _mm256_mul_ps(
                             _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)(k0 | k1 << 16)), ep_shift), ep_mask)),
@@ -16462,7 +16444,7 @@ RAD_API size_t rad_alias_tables_memory(const rad_alias_tables *t)
 /* 'size' bytes for a table block; *raw receives the pointer to free. On Linux, blocks of at
    least two huge pages are placed 2 MiB aligned (over-allocating 2 MiB) and their whole huge
    pages marked MADV_HUGEPAGE before first touch: a draw is a random read into hundreds of MB,
-   and with 4 KiB pages nearly every draw also misses the TLB (BENCHMARKS.md). The advice is a
+   and with 4 KiB pages nearly every draw also misses the TLB. The advice is a
    hint; its failure (kernel without THP, memory not from mmap) changes nothing. */
 static unsigned char *rad__alias_alloc(const rad_allocator *a, size_t size, void **raw)
 {
@@ -17034,8 +17016,8 @@ typedef struct rad__tstep {
 #if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
 #  define RAD__TEMPORAL_AVX2 1 /* hashes 8 draws at once (rad__tpipe_issue8) */
 #endif
-/* draws whose bins are in flight ahead of the one resolved. AVX2 issues cheaper, so more of
-   them overlap: 64 -> 128 took 4.8-5.1 to 4.2-4.5 ns per draw with 450 MB of tables (BENCHMARKS.md) */
+/* draws whose bins are in flight ahead of the one resolved; AVX2 issues cheaper, so more of
+   them can overlap */
 #ifndef RAD__TEMPORAL_AHEAD
 #  if defined(RAD__TEMPORAL_AVX2)
 #    define RAD__TEMPORAL_AHEAD 128u
@@ -17194,8 +17176,8 @@ RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words
     rad__tpipe_issue(p, slot);
 #endif
     *q = slot + 1u == RAD__TEMPORAL_AHEAD ? 0u : slot + 1u;
-    /* written without a conditional: the test is a coin flip, and clang 14 made a branch of
-       '?:' here (mispredicted about half the time, ~2x slower than gcc's cmov) */
+    /* written without a conditional: the test is a coin flip, and a branch would mispredict
+       half the time */
     if (words == 2u) col = (e[1] >> (16u * (uint32_t)(u2 >= e[0]))) & 0xFFFFu;
     else col = e[1u + (uint32_t)(u2 >= e[0])];
     return col < n ? V + 3u * (size_t)col : env;
@@ -17266,7 +17248,7 @@ static void rad__temporal_finish(rad_temporal *t, uint32_t i, float *X)
    documented order, so the bits equal the plain loop's; the scalar work per draw is about a
    third of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
 #ifndef RAD__TVEC_AHEAD
-#  define RAD__TVEC_AHEAD 16u /* vector draws in flight: 128 draws (12, 24, 32 measured slower) */
+#  define RAD__TVEC_AHEAD 16u /* vector draws in flight: 128 draws, the measured best */
 #endif
 
 typedef struct rad__tvec {
@@ -17357,8 +17339,8 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
             const uint32_t *gb = t->tables[c]->bins;
             __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, scale;
             for (s = 0; s < k; ++s) {
-                /* the 8 bins, read before the slot is reused (scalar loads: two 64-bit gathers
-                   cost 10-20% more per draw on the machine of BENCHMARKS.md) */
+                /* the 8 bins, read before the slot is reused (scalar loads: 64-bit gathers were
+                   slower) */
                 const uint64_t *bn = p.bin + 8u * q;
                 const __m256i u2 = _mm256_loadu_si256((const __m256i *)(const void *)(p.u2 + 8u * q));
                 const __m256i glo = _mm256_set_epi64x(rad__bin64(gb, bn[3]), rad__bin64(gb, bn[2]), rad__bin64(gb, bn[1]), rad__bin64(gb, bn[0]));

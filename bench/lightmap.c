@@ -1,4 +1,4 @@
-/* lightmap.c - lightmap timings and noise (docs/methods/lightmap.md; BENCHMARKS.md
+/* lightmap.c - lightmap timings and noise (docs/methods/lightmap.md; docs/performance-notes.md
    "Lightmaps"): the Cornell box with one atlas cell per quad (as examples/lightmap.c).
    Usage: lightmap [--size N] [--patches N] [--refresh-size N] [--refresh-patches N]
    Prints: texel build, the gather with 1 and 4 visibility rays and the texel-to-texel

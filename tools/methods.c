@@ -1118,7 +1118,7 @@ int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const 
     *out = NULL;
     rad_hierarchical_options_default(&ho);
     /* finer than the library's teaching default: a still image as close to the path tracer as
-       classic's at a small part of its rays (BENCHMARKS.md, hierarchical radiosity) */
+       classic's at a small part of its rays (docs/performance-notes.md, hierarchical radiosity) */
     ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
     ho.min_area = mo->hr_min_area;
     if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
