@@ -55,7 +55,7 @@ static void *xmalloc(size_t size)
 static void render_usage(FILE *f)
 {
     fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace] [options]\n"
+            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|stochastic|vp|aavp|hierarchical|pathtrace] [options]\n"
             "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
             "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
             "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"

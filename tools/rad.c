@@ -2,7 +2,7 @@
 
        rad help | rad CMD --help
        rad formfactors SCENE   group form factors between the scene's named objects
-       rad bake SCENE -o FILE.radb     a solution, saved (classic, multibounce or temporal)
+       rad bake SCENE -o FILE.radb     a solution, saved (classic, multibounce, temporal, stochastic, vp, aavp)
        rad merge PART... -o FILE.radb  the parts of a sharded bake (bake --shard I/N) joined
        rad render SCENE -o OUT.png|OUT.pfm     an image (classic, multibounce or temporal
                                        radiosity, or path tracing)
@@ -388,11 +388,12 @@ static void usage(FILE *f)
                "  help                     this text\n"
                "  version                  the library version\n"
                "  formfactors SCENE        group form factors between the scene's named objects\n"
-               "  bake SCENE -o FILE.radb  compute and save a solution: --method classic|multibounce|temporal\n"
+               "  bake SCENE -o FILE.radb  compute and save a solution: --method classic|multibounce|temporal|\n"
+               "                           stochastic|vp|aavp\n"
                "                           --shard I/N or --rows A:B: one part of it (docs/distributed.md)\n"
                "  merge PART... -o FILE    join the parts of a sharded bake into the bake itself\n"
                "  render SCENE -o OUT      render an image (.png or .pfm):\n"
-               "                           --method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace\n"
+               "                           --method classic|multibounce|temporal|local|stochastic|vp|aavp|hierarchical|pathtrace\n"
                "                           [--bake FILE.radb]\n"
                "  trace SCENE -o OUT       the reference path tracer\n"
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
