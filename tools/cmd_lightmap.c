@@ -4,7 +4,7 @@
                 [--visibility-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
                 [classic options] [--threads N] [--exposure X]
 
-   The classic solution (cmd_bake.c: patches, F, direct light as the source, B = E + L) is
+   The classic solution (classic.c: patches, F, direct light as the source, B = E + L) is
    gathered into the texels of the lightmap uv set (>>api_lightmap): every mesh's second uv set
    (glTF TEXCOORD_1, assimp's second channel), or, when some mesh has none (or --unwrap), the
    simple automatic unwrap of unwrap.c. RGB: irradiance (W m^-2) = the direct light of the

@@ -1,6 +1,6 @@
 /* tool.h - what the rad tool's source files share. Each subcommand lives in its own file and
    is dispatched from rad.c; every file includes radiosity.h without the implementation, which
-   rad.c holds. */
+   common.c holds. */
 #ifndef RAD_TOOL_H
 #define RAD_TOOL_H
 #include "../radiosity.h"
@@ -44,8 +44,14 @@ int rad_image_write_pfm(const char *path, const rad_image *img);         /* 0 on
 int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errlen);
 /* sRGB-encoded 8-bit PNG of exposure * linear value, clamped */
 int rad_image_write_png(const char *path, const rad_image *img, float exposure);
-/* writes .pfm or .png by the path's extension */
+/* writes .pfm or .png by the path's extension: .pfm ignores 'exposure' (PFM keeps the
+   radiance); .png applies it */
 int rad_image_write(const char *path, const rad_image *img, float exposure);
+/* Reads .png (8-bit sRGB through stb_image, decoded to linear) or else PFM; 0 on success. */
+int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen);
+int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen);
+/* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
+unsigned char rad_image_srgb8(float linear);
 
 /* ---- output files (image.c): every file the tool writes ------------------------------- */
 /* A temporary file in the destination's folder, renamed onto it by rad_tool_output_commit
@@ -94,6 +100,11 @@ typedef struct rad_trace_options {
 int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
                     const rad_camera *camera, const rad_trace_options *options, const rad_context *ctx,
                     rad_image *out);
+/* Fills options with the defaults (256x256, 64 spp, seed 0, max_depth 64, rr_depth 16).
+   rad_trace_image: 'out' must be zero-initialised or a live image (reallocated when its size
+   differs); returns 0 or a rad_result error (INVALID_ARGUMENT, OUT_OF_MEMORY,
+   RAYCAST_FAILED, CANCELLED by ctx->progress). Surfaces are one-sided like the patches. */
+void rad_trace_options_default(rad_trace_options *options);
 
 /* ---- subcommands: int cmd(int argc, char **argv) with argv[0] the subcommand's first
    argument; return the process exit code (0 ok, 1 failure, 2 usage error) ------------- */
@@ -109,7 +120,7 @@ int rad_cmd_probes(int argc, char **argv);
 /* the rad program (rad.c): dispatches argv[1] to a subcommand; the exit code (main.c) */
 int rad_tool_main(int argc, char **argv);
 
-/* ---- shared helpers (rad.c) ------------------------------------------------------------- */
+/* ---- shared helpers (common.c) ----------------------------------------------------------- */
 /* progress to stderr: a bar when stderr is a terminal, a plain percentage line otherwise */
 int rad_tool_progress(void *user, float fraction);
 void rad_tool_log(void *user, rad_log_level level, const char *message);
@@ -132,22 +143,8 @@ int rad_tool_parse_size(const char *text, int *w, int *h);
    bytes and returns 2 */
 int rad_tool_check_size(const char *cmd, int w, int h);
 
-/* ---- added by trace-metrics ------------------------------------------------------------ */
-/* Reads .png (8-bit sRGB through stb_image, decoded to linear) or else PFM; 0 on success. */
-int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen);
-int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen);
-/* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
-unsigned char rad_image_srgb8(float linear);
-/* rad_image_write: .pfm ignores 'exposure' (PFM keeps the radiance); .png applies it. */
-/* Fills options with the defaults (256x256, 64 spp, seed 0, max_depth 64, rr_depth 16).
-   rad_trace_image: 'out' must be zero-initialised or a live image (reallocated when its size
-   differs); returns 0 or a rad_result error (INVALID_ARGUMENT, OUT_OF_MEMORY,
-   RAYCAST_FAILED, CANCELLED by ctx->progress). Surfaces are one-sided like the patches. */
-void rad_trace_options_default(rad_trace_options *options);
 
-
-/* added by tool-core */
-/* ---- more shared helpers (rad.c) -------------------------------------------------------- */
+/* ---- more shared helpers (common.c) ------------------------------------------------------ */
 /* A context whose log goes to stderr and whose progress is drawn with 'label' (NULL: no
    progress). */
 void rad_tool_context(rad_context *ctx, const char *label);
@@ -213,7 +210,7 @@ void rad_tool_close_world(rad_tool_world *w);
 void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
                             rad_camera *cam);
 
-/* ---- the classic method: patches, F, direct light, solve (cmd_bake.c) --------------------- */
+/* ---- the classic method: patches, F, direct light, solve (classic.c) ---------------------- */
 typedef enum rad_tool_solver { RAD_TOOL_JACOBI = 0, RAD_TOOL_GAUSS_SEIDEL = 1, RAD_TOOL_DIRECT = 2 } rad_tool_solver;
 typedef struct rad_tool_classic_options {
     uint32_t patches;        /* --patches N: target patch count (default 2000) */
