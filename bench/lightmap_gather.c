@@ -1,7 +1,7 @@
 /* lightmap_gather.c - the lightmap final gather: the hemisphere gather against the exact one
    (docs/methods/lightmap.md; docs/performance-notes.md "Lightmap bake").
    Usage: lightmap_gather [--size N] [--patches N] [--rays N,N,...] [--data DIR]
-                          [--bunny-size N] [--bunny-exact-size N] [--bunny-exact-texels N] [--exact 0|1]
+                          [--bunny-size N] [--bunny-exact-size N] [--bunny-exact-texels N] [--exact 0|1] [--exact-vis N]
    Cornell box (one atlas cell per quad, emission as the source, Gauss-Seidel B = E + L):
    the exact gather and the hemisphere gather with each ray count on an N x N atlas; per valid
    texel the relative difference of the luminance (mean, 95th percentile, max) and the times.
@@ -10,7 +10,12 @@
    triangle or smaller, the stochastic Jacobi solution, B = E + L), the same comparison on a
    small atlas (--bunny-exact-size, one sample a texel, only --bunny-exact-texels of its valid
    texels: the exact gather visits ~70 000 patches per sample), then the full bake (texels + hemisphere gather + dilate + stitch) on
-   --bunny-size texels, timed. */
+   --bunny-size texels, timed (wall and process CPU time: on a shared machine the CPU time
+   over the core count is the run's cost on idle cores). LMG_DEBUG=1 in the environment prints
+   the texels whose two gathers differ by more than 30%. */
+#if defined(__unix__) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 199309L
+#endif
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
 #include "tools/tool.h"
@@ -18,6 +23,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__unix__) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 199309L
+#endif
+#include <time.h>
 #ifdef _OPENMP
 #include <omp.h>
 #define NOW() omp_get_wtime()
@@ -25,6 +34,19 @@
 #include <time.h>
 #define NOW() ((double)clock() / CLOCKS_PER_SEC)
 #endif
+
+/* CPU time of the process, all threads: on a shared machine the wall time of a parallel run
+   mostly measures the other jobs; CPU / cores is what the run costs on idle cores */
+static double cpu_now(void)
+{
+#if defined(CLOCK_PROCESS_CPUTIME_ID)
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#else
+    return (double)clock() / CLOCKS_PER_SEC;
+#endif
+}
 
 static rad_scene *cornell_atlas(uint32_t N)
 {
@@ -180,6 +202,8 @@ static void solve_classic(const rad_patches *P, const rad_raycaster *rc, float *
     rad_form_factors_destroy(ff); free(E);
 }
 
+static uint32_t exact_vis = 4;
+
 static void run_compare(const char *name, const rad_lightmap *lm, const rad_patches *P, const float *B, const rad_raycaster *rc,
                         const uint32_t *rays, uint32_t nrays, int exact)
 {
@@ -189,9 +213,11 @@ static void run_compare(const char *name, const rad_lightmap *lm, const rad_patc
     double t, tx = 0.0, mean, p95, mx, rms;
     rad_lightmap_gather_options_default(&go);
     if (exact) {
+        go.visibility_rays = exact_vis;
         t = NOW(); if (rad_lightmap_gather(lm, P, B, rc, &go, X, NULL) != RAD_SUCCESS) exit(1); tx = NOW() - t;
-        printf("| %s, %ux%u, %u patches, %u valid texels | exact, 4 visibility rays | %.2f s | | | | |\n", name, lm->width,
-               lm->height, P->count, lm->valid_texels, tx);
+        printf("| %s, %ux%u, %u patches, %u valid texels | exact, %u visibility rays | %.2f s | | | | |\n", name, lm->width,
+               lm->height, P->count, lm->valid_texels, exact_vis, tx);
+        go.visibility_rays = 4;
     }
     for (k = 0; k < nrays; ++k) {
         go.method = RAD_LIGHTMAP_GATHER_HEMISPHERE;
@@ -223,6 +249,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--bunny-size")) BN = (uint32_t)atoi(argv[a + 1]);
         else if (!strcmp(argv[a], "--bunny-exact-size")) BX = (uint32_t)atoi(argv[a + 1]);
         else if (!strcmp(argv[a], "--bunny-exact-texels")) BT = (uint32_t)atoi(argv[a + 1]);
+        else if (!strcmp(argv[a], "--exact-vis")) exact_vis = (uint32_t)atoi(argv[a + 1]);
         else if (!strcmp(argv[a], "--exact")) exact = atoi(argv[a + 1]);
         else if (!strcmp(argv[a], "--data")) dir = argv[a + 1];
         else if (!strcmp(argv[a], "--rays")) {
@@ -250,7 +277,7 @@ int main(int argc, char **argv)
         float *uvs;
         rad_stochastic_options sto;
         rad_stochastic_stats sst;
-        double t, t0;
+        double t, t0, c0, cb = 0.0, cg = 0.0, cd = 0.0;
         float *E, *H;
         rad_lightmap_gather_options go;
         rad_lightmap_seam_stats st;
@@ -273,12 +300,14 @@ int main(int argc, char **argv)
             if (rad_solve_stochastic(P, &rc, E, &sto, B, &sst, NULL) != RAD_SUCCESS) return 1;
             printf("| bunny box, %u triangles, %u patches | stochastic Jacobi | %.2f s | %llu rays | | | |\n", U->triangle_count, P->count,
                    NOW() - t, (unsigned long long)sst.rays_cast);
+            fflush(stdout);
             rad_lightmap_options_default(&lo); lo.width = lo.height = size;
             if (a == 0) lo.samples = 1;
-            t0 = NOW();
+            t0 = NOW(); c0 = cpu_now();
             if (rad_lightmap_create(U, &rc, &lo, NULL, &lm) != RAD_SUCCESS) return 1;
-            t = NOW() - t0;
-            printf("| | texels (rasterize, validity) | %.2f s | %u samples, %u valid texels | | | |\n", t, lm->sample_count, lm->valid_texels);
+            t = NOW() - t0; cb = cpu_now() - c0;
+            printf("| | texels (rasterize, validity) | %.2f s (CPU %.2f s) | %u samples, %u valid texels | | | |\n", t, cb, lm->sample_count, lm->valid_texels);
+            fflush(stdout);
             if (a == 0) {
                 /* the exact gather on every texel would visit all patches from each: keep
                    every k-th valid texel (a shallow copy with its own flags and validity) */
@@ -304,14 +333,19 @@ int main(int argc, char **argv)
                 go.method = RAD_LIGHTMAP_GATHER_HEMISPHERE;
                 for (i = 0; i < nrays; ++i) {
                     go.hemisphere_rays = rays[i];
-                    t = NOW();
+                    t = NOW(); c0 = cpu_now();
                     if (rad_lightmap_gather(lm, P, B, &rc, &go, H, NULL) != RAD_SUCCESS) return 1;
-                    printf("| | hemisphere gather, %u rays a texel | %.2f s | | | | |\n", rays[i], NOW() - t);
+                    cg = cpu_now() - c0;
+                    printf("| | hemisphere gather, %u rays a texel | %.2f s (CPU %.2f s) | | | | |\n", rays[i], NOW() - t, cg);
+                    fflush(stdout);
                 }
-                t = NOW();
+                t = NOW(); c0 = cpu_now();
                 rad_lightmap_dilate(lm, 3, H, 0, NULL);
                 rad_lightmap_stitch(lm, 3, H, 0, &st, NULL);
-                printf("| | dilate + stitch | %.2f s | %u seams | | | |\n", NOW() - t, st.seams);
+                cd = cpu_now() - c0;
+                printf("| | dilate + stitch | %.2f s (CPU %.2f s) | %u seams | | | |\n", NOW() - t, cd, st.seams);
+                printf("| | bake (texels + last gather + dilate + stitch) | CPU %.2f s: %.1f s on 2 idle cores | | | | |\n", cb + cg + cd,
+                       (cb + cg + cd) / 2.0);
                 free(H);
             }
             rad_lightmap_destroy(lm); rad_patches_destroy(P); rad_bvh_destroy(bvh); rad_scene_destroy(U);
