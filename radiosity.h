@@ -3161,9 +3161,10 @@ RAD_API rad_result rad_vp_load(const rad_container *container, const char *name,
 
    SAMPLING. rad_probes_sample(p, n): on a grid, the 8 probes of p's cell (p clamped into the
    grid) with trilinear weights; with user positions, every probe with the weight
-   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. Each weight is multiplied by
-   ((1 + cos) / 2)^2, cos the cosine between n and the direction from p to the probe (a probe
-   behind the surface counts little, one straight behind it not at all), disabled probes are
+   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. With RAD_PROBE_WEIGHT_NORMAL (the
+   default) each weight is multiplied by ((1 + cos) / 2)^2, cos the cosine between n and the
+   direction from p to the probe (a probe behind the surface counts little, one straight
+   behind it not at all; RAD_PROBE_WEIGHT_PLAIN leaves this out), disabled probes are
    skipped, and the weights are renormalized. When no weight is left (every neighbour
    disabled) the nearest enabled probe is used. The result is clamped at 0 (an L2 sum can dip
    below zero behind a strong light). It is continuous in p and n. rad_probes_sample_visible
@@ -3178,6 +3179,16 @@ typedef enum rad_probe_state {
     RAD_PROBE_VALID = 1,
     RAD_PROBE_MOVED = 2        /* was inside geometry, moved out (positions hold the new place) */
 } rad_probe_state;
+
+/* The weights of SAMPLING. NORMAL (the default): each probe's weight times ((1 + cos) / 2)^2,
+   so that a probe behind a surface counts little (a probe on the far side of a wall). PLAIN:
+   the trilinear (or inverse-distance) weights alone: for points in open air (a dynamic object
+   in a room), where the normal factor only biases the mix towards the probes the normal
+   faces; there rad_probes_sample_visible keeps probes behind a wall out by shadow rays. */
+typedef enum rad_probe_weighting {
+    RAD_PROBE_WEIGHT_NORMAL = 0,
+    RAD_PROBE_WEIGHT_PLAIN = 1
+} rad_probe_weighting;
 
 typedef struct rad_probe_options {
     float spacing;             /* grid spacing in scene units when no positions are given
@@ -3195,6 +3206,7 @@ typedef struct rad_probe_options {
                                   (0: a fifth of the max_move default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t flags;            /* rad_probe_flags */
+    rad_probe_weighting weighting; /* how rad_probes_sample weighs the probes (0: by normal) */
 } rad_probe_options;
 
 typedef struct rad_probes rad_probes;
@@ -3208,8 +3220,8 @@ RAD_API void rad_probe_options_default(rad_probe_options *options);
    patches (and their scene) and raycaster are borrowed for the call; lights (light_count,
    used only with RAD_PROBES_DIRECT) too.
    Errors: INVALID_ARGUMENT (NULL patches or raycaster, count 0 with positions, a negative or
-   non-finite spacing, rays above 65536, backface_fraction outside [0, 1], a bad light or
-   ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
+   non-finite spacing, rays above 65536, backface_fraction outside [0, 1], an unknown
+   weighting, a bad light or ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
    probes: a larger spacing), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY; the log names which.
    Thread safety: reentrant; the rays run through ctx->parallel_for. Cost: probes x (rays +
    patches x patch_samples) rays; memory 40 bytes per (probe, visible patch). */
@@ -19443,6 +19455,7 @@ struct rad_probes {
     float *weights;            /* 9 per entry */
     size_t entries;
     int grid;
+    int plain;                 /* RAD_PROBE_WEIGHT_PLAIN: no normal factor in sampling */
     uint32_t dims[3];
     float origin[3], spacing, h2;
     float eps;                 /* ray offset (ray_epsilon x the scene diagonal) */
@@ -19901,6 +19914,10 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         rad__log(&c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)b.o.backface_fraction);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (b.o.weighting != RAD_PROBE_WEIGHT_NORMAL && b.o.weighting != RAD_PROBE_WEIGHT_PLAIN) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)b.o.weighting);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (!(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon,
                  (double)RAD__MAX_RAY_EPSILON);
@@ -19973,6 +19990,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
             pr->origin[k] = 0.5f * (S->bounds_min[k] + S->bounds_max[k]) - 0.5f * (float)(pr->dims[k] - 1u) * spacing;
         pr->count = pr->dims[0] * pr->dims[1] * pr->dims[2];
     }
+    pr->plain = b.o.weighting == RAD_PROBE_WEIGHT_PLAIN;
     pr->positions = (float *)rad__alloc_array(&c.allocator, pr->count, 3 * sizeof(float));
     pr->states = (uint8_t *)rad__alloc_array(&c.allocator, pr->count, 1);
     pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
@@ -20131,7 +20149,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
                     rad__sub(d, pr->positions + 3 * (size_t)i, p);
                     len = rad__len(d);
                     cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
-                    w *= 0.25f * (1.0f + cs) * (1.0f + cs);
+                    if (!pr->plain) w *= 0.25f * (1.0f + cs) * (1.0f + cs);
                     if (!(w > 0.0f)) continue;
                     vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
                     if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
@@ -20147,7 +20165,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             rad__sub(d, pr->positions + 3 * (size_t)i, p);
             len2 = rad__dot(d, d);
             cs = len2 > 0.0f ? rad__dot(d, un) / (float)sqrt((double)len2) : 1.0f;
-            w = 0.25f * (1.0f + cs) * (1.0f + cs) / (len2 + pr->h2);
+            w = (pr->plain ? 1.0f : 0.25f * (1.0f + cs) * (1.0f + cs)) / (len2 + pr->h2);
             if (!(w > 0.0f)) continue;
             vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
             if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
