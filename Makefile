@@ -95,6 +95,10 @@ $(BUILD)/temporal: bench/temporal.c radiosity.h | $(BUILD)
 $(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
 
+# the lightmap gather: hemisphere against exact, and the 1024^2 bunny-box bake (needs $(RAD_DATA_DIR))
+$(BUILD)/bench_lightmap_gather: bench/lightmap_gather.c tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap_gather.c tools/unwrap.c -o $@ -lm
+
 # lightmap timings and noise (BENCHMARKS.md "Lightmaps")
 $(BUILD)/bench_lightmap: bench/lightmap.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap.c -o $@ -lm

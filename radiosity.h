@@ -1305,6 +1305,25 @@ typedef enum rad_lightmap_encoding {
     RAD_LIGHTMAP_SH_L1 = 1       /* 12 floats per texel */
 } rad_lightmap_encoding;
 
+/* HEMISPHERE GATHER (RAD_LIGHTMAP_GATHER_HEMISPHERE), for scenes with many patches, where the
+   exact gather's O(samples x patches) is too slow. The patches split in two by radiosity:
+   the BRIGHT ones (luminance above exact_ratio times the area-weighted mean luminance of the
+   lit patches, i.e. the lamps and what they light most) are gathered exactly as above; the
+   light of all the others comes from hemisphere_rays closest-hit rays per texel, shared among
+   its valid samples (each sample a Hammersley set of ceil(hemisphere_rays / valid samples)
+   directions, rotated by a hash of the sample: deterministic, stratified). A ray that hits
+   the front of a patch that is not bright brings its radiosity B_j; one that misses, hits a
+   back face or a bright patch brings 0 (the bright ones are counted exactly). Irradiance:
+   cosine-distributed directions, H = mean B_j (the radiance B_j / pi over the cosine pdf);
+   SH: uniform directions over the hemisphere, L_lm = 2 pi mean (B_j / pi) Y_lm(w). This
+   estimates the same sum as the exact gather (constant B_j per patch), unbiased, with a
+   noise that falls with the rays (docs/methods/lightmap.md measures it). Cost: O(samples x
+   bright patches) form factors plus hemisphere_rays rays per texel, whatever the patch count. */
+typedef enum rad_lightmap_gather_method {
+    RAD_LIGHTMAP_GATHER_EXACT = 0,     /* every lit patch by its analytic form factor (default) */
+    RAD_LIGHTMAP_GATHER_HEMISPHERE = 1 /* bright patches exactly, the rest by hemisphere rays */
+} rad_lightmap_gather_method;
+
 typedef struct rad_lightmap_gather_options {
     rad_lightmap_encoding encoding;
     uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64); with 1
@@ -1312,6 +1331,10 @@ typedef struct rad_lightmap_gather_options {
                                    (reads a few % low next to contacts) */
     float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
+    rad_lightmap_gather_method method; /* RAD_LIGHTMAP_GATHER_EXACT (0) or _HEMISPHERE */
+    uint32_t hemisphere_rays;   /* hemisphere: rays per texel (0: 256; at most 65536) */
+    float exact_ratio;          /* hemisphere: a patch is bright above this times the mean
+                                   luminance (0: 16; > 0; FLT_MAX: none is bright) */
 } rad_lightmap_gather_options;
 
 RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *options);
@@ -1325,7 +1348,9 @@ RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding);
    total). patches must be of lightmap->scene. Patches with B = 0 and those behind a sample
    cost nothing. out: width * height * channels floats. Errors: INVALID_ARGUMENT, NON_FINITE
    (a B or result), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY. Cost: O(valid samples x patches)
-   form factors and up to visibility_rays shadow rays per pair. Reentrant; parallel. */
+   form factors and up to visibility_rays shadow rays per pair (the hemisphere method: see
+   above). The raycaster needs occluded(), and intersect() for the hemisphere method.
+   Reentrant; parallel; deterministic whatever the thread count. */
 RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lightmap, const rad_patches *patches,
                                        const float *patch_radiosity, const rad_raycaster *raycaster,
                                        const rad_lightmap_gather_options *options, float *out,
@@ -3127,9 +3152,10 @@ RAD_API rad_result rad_vp_load(const rad_container *container, const char *name,
 
    SAMPLING. rad_probes_sample(p, n): on a grid, the 8 probes of p's cell (p clamped into the
    grid) with trilinear weights; with user positions, every probe with the weight
-   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. Each weight is multiplied by
-   ((1 + cos) / 2)^2, cos the cosine between n and the direction from p to the probe (a probe
-   behind the surface counts little, one straight behind it not at all), disabled probes are
+   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. With RAD_PROBE_WEIGHT_NORMAL (the
+   default) each weight is multiplied by ((1 + cos) / 2)^2, cos the cosine between n and the
+   direction from p to the probe (a probe behind the surface counts little, one straight
+   behind it not at all; RAD_PROBE_WEIGHT_PLAIN leaves this out), disabled probes are
    skipped, and the weights are renormalized. When no weight is left (every neighbour
    disabled) the nearest enabled probe is used. The result is clamped at 0 (an L2 sum can dip
    below zero behind a strong light). It is continuous in p and n. rad_probes_sample_visible
@@ -3144,6 +3170,16 @@ typedef enum rad_probe_state {
     RAD_PROBE_VALID = 1,
     RAD_PROBE_MOVED = 2        /* was inside geometry, moved out (positions hold the new place) */
 } rad_probe_state;
+
+/* The weights of SAMPLING. NORMAL (the default): each probe's weight times ((1 + cos) / 2)^2,
+   so that a probe behind a surface counts little (a probe on the far side of a wall). PLAIN:
+   the trilinear (or inverse-distance) weights alone: for points in open air (a dynamic object
+   in a room), where the normal factor only biases the mix towards the probes the normal
+   faces; there rad_probes_sample_visible keeps probes behind a wall out by shadow rays. */
+typedef enum rad_probe_weighting {
+    RAD_PROBE_WEIGHT_NORMAL = 0,
+    RAD_PROBE_WEIGHT_PLAIN = 1
+} rad_probe_weighting;
 
 typedef struct rad_probe_options {
     float spacing;             /* grid spacing in scene units when no positions are given
@@ -3161,6 +3197,7 @@ typedef struct rad_probe_options {
                                   (0: a fifth of the max_move default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t flags;            /* rad_probe_flags */
+    rad_probe_weighting weighting; /* how rad_probes_sample weighs the probes (0: by normal) */
 } rad_probe_options;
 
 typedef struct rad_probes rad_probes;
@@ -3174,8 +3211,8 @@ RAD_API void rad_probe_options_default(rad_probe_options *options);
    patches (and their scene) and raycaster are borrowed for the call; lights (light_count,
    used only with RAD_PROBES_DIRECT) too.
    Errors: INVALID_ARGUMENT (NULL patches or raycaster, count 0 with positions, a negative or
-   non-finite spacing, rays above 65536, backface_fraction outside [0, 1], a bad light or
-   ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
+   non-finite spacing, rays above 65536, backface_fraction outside [0, 1], an unknown
+   weighting, a bad light or ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
    probes: a larger spacing), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY; the log names which.
    Thread safety: reentrant; the rays run through ctx->parallel_for. Cost: probes x (rays +
    patches x patch_samples) rays; memory 40 bytes per (probe, visible patch). */
@@ -9106,6 +9143,9 @@ RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *o)
     o->encoding = RAD_LIGHTMAP_IRRADIANCE;
     o->visibility_rays = 4;
     o->ray_epsilon = 1e-5f;
+    o->method = RAD_LIGHTMAP_GATHER_EXACT;
+    o->hemisphere_rays = 256;
+    o->exact_ratio = 16.0f;
 }
 
 RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding)
@@ -9555,12 +9595,16 @@ typedef struct rad__lm_gather {
     const rad_patches *P;
     const float *B;
     const rad_raycaster *rc;
-    uint32_t ch, vis, seed;
+    uint32_t ch, vis, seed, hemi;
     float eps;
-    uint8_t *lit;                 /* per patch: B != 0 */
+    uint32_t *list;               /* the patches gathered exactly: every lit one, or the bright ones */
+    uint32_t list_count;
+    uint8_t *skip;                /* hemisphere: per patch, 1 when a hit on it brings nothing */
     rad_ray *ray_buf;             /* per task RAD__RAY_BATCH */
     uint8_t *occ_buf;
     float *ray_c;                 /* per task RAD__RAY_BATCH x ch: each ray's contribution */
+    rad_hit *hit_buf;             /* hemisphere: per task RAD__RAY_BATCH */
+    float *hit_w;                 /* hemisphere: per task RAD__RAY_BATCH x 4 (weight, SH direction) */
     float *out;
 } rad__lm_gather;
 
@@ -9578,6 +9622,40 @@ static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count
     return RAD_SUCCESS;
 }
 
+/* hemisphere rays: each hit on the front of a patch that is not counted exactly brings its B */
+static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t count, double *sum)
+{
+    const rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = g->hit_buf + (size_t)task * RAD__RAY_BATCH;
+    const float *hw = g->hit_w + (size_t)task * RAD__RAY_BATCH * 4;
+    const rad_scene *S = g->lm->scene;
+    uint32_t k, j;
+    int c;
+    if (count == 0) return RAD_SUCCESS;
+    if (g->rc->intersect(g->rc->user, rays, count, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k) {
+        const rad_hit *h = hits + k;
+        const float *w = hw + 4 * (size_t)k;
+        float wt[3];
+        if (h->triangle == RAD_NONE || h->triangle >= S->triangle_count) continue;
+        if (!(rad__dot(S->normals + 3 * (size_t)h->triangle, rays[k].dir) < 0.0f)) continue; /* back face */
+        j = rad_patches_locate(g->P, h->triangle, h->b1, h->b2, wt);
+        if (j == RAD_NONE || g->skip[j]) continue;
+        for (c = 0; c < 3; ++c) {
+            double b = (double)g->B[3 * (size_t)j + (size_t)c] * w[0];
+            if (g->ch == 3) {
+                sum[c] += b;
+            } else {
+                sum[c] += b * RAD__LM_SH_Y0;
+                sum[3 + c] += b * RAD__LM_SH_Y1 * w[2];
+                sum[6 + c] += b * RAD__LM_SH_Y1 * w[3];
+                sum[9 + c] += b * RAD__LM_SH_Y1 * w[1];
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
 /* one texel: the mean over its valid samples of the patches' light */
 static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
 {
@@ -9586,27 +9664,34 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
     const rad_patches *P = g->P;
     rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
     float *rc = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
+    float *hw = g->hit_w ? g->hit_w + (size_t)task * RAD__RAY_BATCH * 4 : NULL;
     double acc[12], sum[12];
-    uint32_t s, j, ch, nval = 0, nr = 0;
+    uint32_t s, li, ch, nval = 0, nr = 0, nh = 0, per = 0;
     float *out = g->out + (size_t)texel * g->ch;
     int k;
+    rad_result r;
     for (ch = 0; ch < g->ch; ++ch) sum[ch] = 0.0;
+    if (g->hemi) {
+        for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) nval += lm->sample_valid[s] ? 1u : 0u;
+        per = nval ? (g->hemi + nval - 1) / nval : 0u;
+        nval = 0;
+    }
     for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) {
         const float *pf = lm->sample_positions + 3 * (size_t)s, *nf = lm->sample_normals + 3 * (size_t)s;
         double p[3], n[3];
         uint32_t h;
-        rad_result r;
         if (!lm->sample_valid[s]) continue;
         ++nval;
         for (k = 0; k < 3; ++k) { p[k] = pf[k]; n[k] = nf[k]; }
         for (ch = 0; ch < g->ch; ++ch) acc[ch] = 0.0;
         h = rad__hash(g->seed ^ rad__hash(s * 0x9E3779B9u + 0x3C6EF372u));
-        for (j = 0; j < P->count; ++j) {
+        for (li = 0; li < g->list_count; ++li) {
+            uint32_t j = g->list[li];
             const rad_patch *pj = &P->patches[j];
             float tri[9], y[3], d[3], r1, r2, u1, u2;
             double proj[4], kw[64], ksum = 0.0, full[12], Lr[3];
             uint32_t m, q;
-            if (!g->lit[j] || pj->triangle == lm->sample_triangles[s]) continue;
+            if (pj->triangle == lm->sample_triangles[s]) continue;
             for (m = 0; m < 3; ++m)
                 for (k = 0; k < 3; ++k) tri[3 * m + k] = P->vertices[3 * (size_t)pj->vertices[m] + (size_t)k];
             rad__sub(d, pf, tri);
@@ -9667,6 +9752,41 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
         nr = 0;
         if (r != RAD_SUCCESS) return r;
         for (ch = 0; ch < g->ch; ++ch) sum[ch] += acc[ch];
+        if (per) {
+            /* this sample's share of the texel's hemisphere rays (the exact rays above are
+               flushed, so the buffer is the hemisphere rays' alone) */
+            float t1[3], t2[3], u1, u2, w = g->ch == 3 ? 1.0f / (float)per : 2.0f / (float)per;
+            uint32_t q, hr = rad__hash(h ^ 0x85EBCA6Bu);
+            rad__tangent_frame(nf, t1, t2);
+            for (q = 0; q < per; ++q) {
+                rad_ray *ray = rays + nh;
+                float *wq = hw + 4 * (size_t)nh;
+                if (g->ch == 3) {
+                    rad__cosine_dir(nf, t1, t2, q, per, hr, ray->dir);
+                } else {
+                    /* uniform over the hemisphere: cos theta = u1 */
+                    float st, ph;
+                    rad__hammersley(q, per, (float)(hr & 0xFFFFu) / 65536.0f, (float)(hr >> 16) / 65536.0f, &u1, &u2);
+                    st = (float)sqrt((double)(1.0f - u1 * u1));
+                    ph = (float)(2.0 * RAD__PI) * u2;
+                    for (k = 0; k < 3; ++k)
+                        ray->dir[k] = t1[k] * st * (float)cos((double)ph) + t2[k] * st * (float)sin((double)ph) + nf[k] * u1;
+                }
+                for (k = 0; k < 3; ++k) ray->origin[k] = pf[k] + nf[k] * g->eps;
+                ray->tmin = 0.0f;
+                ray->tmax = FLT_MAX;
+                wq[0] = w;
+                for (k = 0; k < 3; ++k) wq[1 + k] = ray->dir[k];
+                if (++nh == RAD__RAY_BATCH) {
+                    r = rad__lm_flush_hits(g, task, nh, sum);
+                    nh = 0;
+                    if (r != RAD_SUCCESS) return r;
+                }
+            }
+            r = rad__lm_flush_hits(g, task, nh, sum);
+            nh = 0;
+            if (r != RAD_SUCCESS) return r;
+        }
     }
     for (ch = 0; ch < g->ch; ++ch) out[ch] = nval ? (float)(sum[ch] / nval) : 0.0f;
     return RAD_SUCCESS;
@@ -9681,6 +9801,7 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
     rad_lightmap_gather_options o;
     uint32_t T, i, texels;
     rad_result r;
+    int hemi;
     rad__ctx_init(&c, ctx);
     if (!lm || !patches || !B || !raycaster || !raycaster->occluded || !out) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: NULL lightmap, patches, radiosity, raycaster (with occluded) or output");
@@ -9693,10 +9814,23 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
     if (options) o = *options; else rad_lightmap_gather_options_default(&o);
     if (o.visibility_rays == 0) o.visibility_rays = 4;
     if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (o.hemisphere_rays == 0) o.hemisphere_rays = 256;
+    if (o.exact_ratio == 0.0f) o.exact_ratio = 16.0f;
     if (rad_lightmap_channels(o.encoding) == 0 || o.visibility_rays > 64u ||
         !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: encoding %d, visibility_rays %u (at most 64) or ray_epsilon %g out of range",
                  (int)o.encoding, o.visibility_rays, (double)o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((o.method != RAD_LIGHTMAP_GATHER_EXACT && o.method != RAD_LIGHTMAP_GATHER_HEMISPHERE) || o.hemisphere_rays > 65536u ||
+        !(o.exact_ratio > 0.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: method %d, hemisphere_rays %u (at most 65536) or exact_ratio %g out of range",
+                 (int)o.method, o.hemisphere_rays, (double)o.exact_ratio);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    hemi = o.method == RAD_LIGHTMAP_GATHER_HEMISPHERE;
+    if (hemi && !raycaster->intersect) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the hemisphere method needs the raycaster's intersect()");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     r = rad__check_input(&c, "lightmap gather: patch radiosity", B, 3 * (size_t)patches->count);
@@ -9709,26 +9843,50 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
     g.ch = rad_lightmap_channels(o.encoding);
     g.vis = o.visibility_rays;
     g.seed = o.seed;
+    g.hemi = hemi ? o.hemisphere_rays : 0u;
     g.eps = o.ray_epsilon * lm->scene->diagonal;
     g.out = out;
     texels = lm->width * lm->height;
     T = c.tasks < texels ? c.tasks : texels;
-    g.lit = (uint8_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, 1);
+    g.list = (uint32_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, sizeof(uint32_t));
+    g.skip = (uint8_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, 1);
     g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
     g.occ_buf = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
     g.ray_c = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, g.ch * sizeof(float));
-    if (!g.lit || !g.ray_buf || !g.occ_buf || !g.ray_c) {
+    if (hemi) {
+        g.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
+        g.hit_w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 4 * sizeof(float));
+    }
+    if (!g.list || !g.skip || !g.ray_buf || !g.occ_buf || !g.ray_c || (hemi && (!g.hit_buf || !g.hit_w))) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: out of memory for %u tasks", T);
         r = RAD_ERROR_OUT_OF_MEMORY;
     } else {
-        for (i = 0; i < patches->count; ++i)
-            g.lit[i] = (B[3 * (size_t)i] != 0.0f || B[3 * (size_t)i + 1] != 0.0f || B[3 * (size_t)i + 2] != 0.0f) ? 1u : 0u;
+        double lum_area = 0.0, area = 0.0, limit = 0.0;
+        for (i = 0; i < patches->count; ++i) {
+            const float *b = B + 3 * (size_t)i;
+            double lum = 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2];
+            if (b[0] == 0.0f && b[1] == 0.0f && b[2] == 0.0f) continue;
+            lum_area += lum * patches->patches[i].area;
+            area += patches->patches[i].area;
+        }
+        if (area > 0.0) limit = (double)o.exact_ratio * lum_area / area;
+        for (i = 0; i < patches->count; ++i) {
+            const float *b = B + 3 * (size_t)i;
+            int lit = b[0] != 0.0f || b[1] != 0.0f || b[2] != 0.0f;
+            /* the hemisphere method counts only the bright patches exactly */
+            int exact = lit && (!hemi || 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2] > limit);
+            g.skip[i] = (uint8_t)(exact || !lit);
+            if (exact) g.list[g.list_count++] = i;
+        }
         r = rad__for_rows(&c, texels, T, rad__lm_gather_row, &g);
     }
-    rad__free(&c.allocator, g.lit);
+    rad__free(&c.allocator, g.list);
+    rad__free(&c.allocator, g.skip);
     rad__free(&c.allocator, g.ray_buf);
     rad__free(&c.allocator, g.occ_buf);
     rad__free(&c.allocator, g.ray_c);
+    rad__free(&c.allocator, g.hit_buf);
+    rad__free(&c.allocator, g.hit_w);
     return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather", out, (size_t)texels * g.ch) : r;
 }
 
@@ -19279,6 +19437,7 @@ struct rad_probes {
     float *weights;            /* 9 per entry */
     size_t entries;
     int grid;
+    int plain;                 /* RAD_PROBE_WEIGHT_PLAIN: no normal factor in sampling */
     uint32_t dims[3];
     float origin[3], spacing, h2;
     float eps;                 /* ray offset (ray_epsilon x the scene diagonal) */
@@ -19737,6 +19896,10 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         rad__log(&c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)b.o.backface_fraction);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (b.o.weighting != RAD_PROBE_WEIGHT_NORMAL && b.o.weighting != RAD_PROBE_WEIGHT_PLAIN) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)b.o.weighting);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (!(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon,
                  (double)RAD__MAX_RAY_EPSILON);
@@ -19809,6 +19972,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
             pr->origin[k] = 0.5f * (S->bounds_min[k] + S->bounds_max[k]) - 0.5f * (float)(pr->dims[k] - 1u) * spacing;
         pr->count = pr->dims[0] * pr->dims[1] * pr->dims[2];
     }
+    pr->plain = b.o.weighting == RAD_PROBE_WEIGHT_PLAIN;
     pr->positions = (float *)rad__alloc_array(&c.allocator, pr->count, 3 * sizeof(float));
     pr->states = (uint8_t *)rad__alloc_array(&c.allocator, pr->count, 1);
     pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
@@ -19967,7 +20131,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
                     rad__sub(d, pr->positions + 3 * (size_t)i, p);
                     len = rad__len(d);
                     cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
-                    w *= 0.25f * (1.0f + cs) * (1.0f + cs);
+                    if (!pr->plain) w *= 0.25f * (1.0f + cs) * (1.0f + cs);
                     if (!(w > 0.0f)) continue;
                     vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
                     if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
@@ -19983,7 +20147,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             rad__sub(d, pr->positions + 3 * (size_t)i, p);
             len2 = rad__dot(d, d);
             cs = len2 > 0.0f ? rad__dot(d, un) / (float)sqrt((double)len2) : 1.0f;
-            w = 0.25f * (1.0f + cs) * (1.0f + cs) / (len2 + pr->h2);
+            w = (pr->plain ? 1.0f : 0.25f * (1.0f + cs) * (1.0f + cs)) / (len2 + pr->h2);
             if (!(w > 0.0f)) continue;
             vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
             if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;

@@ -1113,6 +1113,18 @@ if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 16 --patches 60 --texel-
 else
     fail "lightmap --sh writes four PFM layers" "$(head -c 300 "$TMP/err.txt")"
 fi
+# the hemisphere gather estimates the exact gather's sum by rays: the two lightmaps agree
+if "$RAD" lightmap cornell -o "$TMP/lmx.pfm" --size 32 --patches 100 --texel-samples 1 --visibility-rays 4 --gather exact > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" lightmap cornell -o "$TMP/lmh.pfm" --size 32 --patches 100 --texel-samples 1 --gather hemisphere > /dev/null 2>> "$TMP/err.txt"; then
+    p=$(psnr_of "$TMP/lmx.pfm" "$TMP/lmh.pfm")
+    at_least "$p" 38 && ok "lightmap --gather hemisphere matches --gather exact (PSNR $p dB)" ||
+        fail "lightmap --gather hemisphere matches --gather exact" "PSNR $p"
+else
+    fail "lightmap --gather" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" lightmap cornell -o "$TMP/lmx.pfm" --gather sideways > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 2 ] && grep -q "exact or hemisphere" "$TMP/err.txt" && ok "lightmap refuses an unknown --gather" || fail "lightmap refuses an unknown --gather" "exit $rc"
 # --render: the view shaded from the lightmap resembles the path tracer's (both at low quality)
 if "$RAD" lightmap cornell -o "$TMP/lmr.pfm" --size 64 --patches 150 --texel-samples 1 --visibility-rays 1 \
         --render "$TMP/lmview.png" --render-size 48x48 --aa 1 > /dev/null 2> "$TMP/err.txt" &&

@@ -1,7 +1,7 @@
 /* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
 
    rad lightmap SCENE -o OUT.pfm|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
-                [--visibility-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
+                [--visibility-rays N] [--gather exact|hemisphere] [--hemisphere-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
                 [classic options] [--threads N] [--exposure X]
 
    The classic solution (classic.c: patches, F, direct light as the source, B = E + L) is
@@ -30,6 +30,11 @@ static void lightmap_usage(FILE *f)
                "                        OUT.L00.pfm OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)\n"
                "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
                "  --visibility-rays N   shadow rays per sample point and patch (default 2, at most 64)\n"
+               "  --gather M            exact (every patch's form factor from every sample) or hemisphere\n"
+               "                        (the brightest patches exactly, the rest by rays; its cost does not\n"
+               "                        grow with the patches); default: hemisphere when samples x patches\n"
+               "                        exceeds 2e7\n"
+               "  --hemisphere-rays N   rays per texel of the hemisphere gather (default 256, at most 65536)\n"
                "  --unwrap              unwrap even when the file has a second uv set\n"
                "  --render VIEW         also render the camera view shaded from the lightmap (.png or .pfm;\n"
                "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
@@ -118,7 +123,8 @@ int rad_cmd_lightmap(int argc, char **argv)
     rad_context ctx;
     rad_result r;
     int width = 256, height = 256, sh = 0, force_unwrap = 0, a, code = 1, own_scene = 0;
-    uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch;
+    uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
+    int gather = -1; /* -1: by the work, else a rad_lightmap_gather_method */
     float exposure = 0.31830988f, *values = NULL, *uvs = NULL;
     double t0;
     rad_mesh_desc mesh;
@@ -170,6 +176,14 @@ int rad_cmd_lightmap(int argc, char **argv)
         } else if (!strcmp(o, "--visibility-rays")) {
             if (rad_tool_parse_uint("lightmap", o, argv[++a], &vis)) return 2;
             if (vis == 0 || vis > 64) { fprintf(stderr, "rad lightmap: --visibility-rays must be 1 to 64\n"); return 2; }
+        } else if (!strcmp(o, "--gather")) {
+            const char *v = argv[++a];
+            if (v && !strcmp(v, "exact")) gather = RAD_LIGHTMAP_GATHER_EXACT;
+            else if (v && !strcmp(v, "hemisphere")) gather = RAD_LIGHTMAP_GATHER_HEMISPHERE;
+            else { fprintf(stderr, "rad lightmap: --gather must be exact or hemisphere\n"); return 2; }
+        } else if (!strcmp(o, "--hemisphere-rays")) {
+            if (rad_tool_parse_uint("lightmap", o, argv[++a], &hemi_rays)) return 2;
+            if (hemi_rays == 0 || hemi_rays > 65536) { fprintf(stderr, "rad lightmap: --hemisphere-rays must be 1 to 65536\n"); return 2; }
         } else if (!strcmp(o, "--exposure")) {
             if (rad_tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
         } else if (!strcmp(o, "--threads")) {
@@ -250,6 +264,12 @@ int rad_cmd_lightmap(int argc, char **argv)
     rad_lightmap_gather_options_default(&go);
     go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
     go.visibility_rays = vis;
+    go.hemisphere_rays = hemi_rays;
+    /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
+    if (gather < 0) gather = (double)lm->sample_count * cl.patches->count > 2e7 ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
+    go.method = (rad_lightmap_gather_method)gather;
+    if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
+        fprintf(stderr, "rad lightmap: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", hemi_rays);
     ch = rad_lightmap_channels(go.encoding);
     values = (float *)rad_tool_calloc((size_t)width * height * ch, sizeof(float));
     rad_tool_context(&ctx, "lightmap gather");
