@@ -1949,7 +1949,19 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        per entry (entry k at element k - entry_base)  2: weights (9 per entry, entry k's at
        element 9 k - weight_base)  3: direct (27 per probe)  4: B (3N)  5: out coefficients
        (27 per probe; the chunk's probes written). Matches the CPU to 1e-5 (measured 6.8e-6 on
-       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c). */
+       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c).
+   RAD_GLSL_LIGHTMAP_REFRESH  a lightmap from a new patch irradiance H, as rad_lightmap_refresh
+       (>>api_lightmap), on the arrays of rad_lightmap_weights uploaded unchanged, in TWO
+       PASSES (push member pass): RAD_GLSL_LIGHTMAP_PASS_VERTICES, one invocation per patch
+       vertex, V = the vertex values of H; then RAD_GLSL_LIGHTMAP_PASS_TEXELS, one invocation
+       per row, the texels from V (a compute-to-compute barrier between the two: pass 1 reads
+       binding 4). Push: rad_glsl_lightmap_refresh_push. 0: vertex_first (vertex_count + 1)
+       1: vertex_patches  2: vertex_weights (entry k of both at element k - entry_base in pass
+       0)  3: H (3N)  4: V, scratch of 3 floats per vertex  5: row_texels  6: row_first
+       (row_count + 1)  7: entry_vertices  8: entry_weights (entry e at element e - entry_base
+       in pass 1)  9: the lightmap (3 per texel; only texels with a row written). A pass reads
+       none of the other's bindings among 0..3 and 5..9: bind any buffer there. Matches the
+       CPU to 1e-5 (tests/test_vulkan.c). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -1966,7 +1978,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
     RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
     RAD_GLSL_PROBE_UPDATE      = 12, /* glsl/probe_update.comp */
-    RAD_GLSL_COUNT = 13
+    RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* glsl/lightmap_refresh.comp */
+    RAD_GLSL_COUNT = 14
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -1988,6 +2001,8 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_FLAG_COSINE 1u       /* vp gather: RAD_VP_WEIGHTS_COSINE split weights */
 #define RAD_GLSL_FLAG_CLUSTERED 2u    /* vp gather: RAD_VP_CLUSTERED (w = N_a . n; binding 5 read) */
 #define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
+#define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
+#define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -2060,6 +2075,11 @@ typedef struct rad_glsl_probe_update_push {
     uint32_t entry_base;           /* low 32 bits of the entry at element 0 of binding 1 */
     uint32_t weight_base;          /* low 32 bits of the float (9 x entry) at element 0 of binding 2 */
 } rad_glsl_probe_update_push;
+typedef struct rad_glsl_lightmap_refresh_push {
+    uint32_t pass;                 /* RAD_GLSL_LIGHTMAP_PASS_VERTICES or _TEXELS */
+    uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
+    uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
+} rad_glsl_lightmap_refresh_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -11667,6 +11687,8 @@ typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_pus
                                                 offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
 typedef char rad__check_glsl_probe_update_push[(sizeof(rad_glsl_probe_update_push) == 16 &&
                                                offsetof(rad_glsl_probe_update_push, weight_base) == 12) ? 1 : -1];
+typedef char rad__check_glsl_lightmap_refresh_push[(sizeof(rad_glsl_lightmap_refresh_push) == 16 &&
+                                                   offsetof(rad_glsl_lightmap_refresh_push, entry_base) == 12) ? 1 : -1];
 typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
                                              offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
                                              offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
@@ -12848,6 +12870,66 @@ static const char rad__glsl_12_0[] =
     "    }\n"
     "}\n";
 static const char *const rad__glsl_pieces_12[] = { rad__glsl_12_0 };
+static const char rad__glsl_13_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LIGHTMAP_REFRESH: a lightmap refreshed from a new patch\n"
+    "// irradiance H, as rad_lightmap_refresh (docs/methods/lightmap.md), in its two stages:\n"
+    "//   pass 0 (RAD_GLSL_LIGHTMAP_PASS_VERTICES), one invocation per patch vertex v:\n"
+    "//     V[v] = sum over k in [vertex_first[v], vertex_first[v + 1]) of vertex_weights[k] H[vertex_patches[k]]\n"
+    "//   pass 1 (RAD_GLSL_LIGHTMAP_PASS_TEXELS), one invocation per row r (a texel with a row):\n"
+    "//     out[row_texels[r]] = sum over e in [row_first[r], row_first[r + 1]) of entry_weights[e] V[entry_vertices[e]]\n"
+    "// rows (vertices or texel rows) row_offset .. row_offset + row_count - 1. RGB vectors are\n"
+    "// interleaved (3 floats each). Pass 1 reads what pass 0 wrote into binding 4: put a\n"
+    "// compute-to-compute barrier between them. Texels without a row are not written.\n"
+    "// Chunking: the entry arrays of the pass (bindings 1 and 2, or 7 and 8) may hold only this\n"
+    "// chunk's entries: entry k is element k - entry_base. The offsets (0, 6), vectors (3, 4) and\n"
+    "// out (9) are bound whole. A pass reads none of the other pass's bindings (bind any buffer).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer VertexFirst { uint vertex_first[]; };   // vertices + 1\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer VertexPatches { uint vertex_patches[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer VertexWeights { float vertex_weights[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Irradiance { float H[]; };              // 3 N\n"
+    "layout(std430, set = 0, binding = 4) buffer VertexValues { float V[]; };                      // 3 per vertex\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowTexels { uint row_texels[]; };\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer RowFirst { uint row_first[]; };         // rows + 1\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer EntryVertices { uint entry_vertices[]; };\n"
+    "layout(std430, set = 0, binding = 8) readonly buffer EntryWeights { float entry_weights[]; };\n"
+    "layout(std430, set = 0, binding = 9) buffer Output { float lightmap[]; };                    // 3 per texel\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint pass;        // 0: vertices, 1: texel rows\n"
+    "    uint row_offset;  // first vertex or row of this dispatch\n"
+    "    uint row_count;   // vertices or rows in this dispatch\n"
+    "    uint entry_base;  // the entry index at element 0 of the pass's entry bindings\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint i = gl_GlobalInvocationID.x;\n"
+    "    if (i >= pc.row_count) return;\n"
+    "    uint r = pc.row_offset + i;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    if (pc.pass == 0u) {\n"
+    "        uint a = vertex_first[r] - pc.entry_base, b = vertex_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint k = a; k < b; ++k) {\n"
+    "            uint j = 3u * vertex_patches[k];\n"
+    "            acc += vertex_weights[k] * vec3(H[j], H[j + 1u], H[j + 2u]);\n"
+    "        }\n"
+    "        V[3u * r] = acc.x;\n"
+    "        V[3u * r + 1u] = acc.y;\n"
+    "        V[3u * r + 2u] = acc.z;\n"
+    "    } else {\n"
+    "        uint a = row_first[r] - pc.entry_base, b = row_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint e = a; e < b; ++e) {\n"
+    "            uint j = 3u * entry_vertices[e];\n"
+    "            acc += entry_weights[e] * vec3(V[j], V[j + 1u], V[j + 2u]);\n"
+    "        }\n"
+    "        uint t = 3u * row_texels[r];\n"
+    "        lightmap[t] = acc.x;\n"
+    "        lightmap[t + 1u] = acc.y;\n"
+    "        lightmap[t + 2u] = acc.z;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
@@ -12861,7 +12943,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
-    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u }
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u },
+    { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
 };
 /* >>glsl end */
 
