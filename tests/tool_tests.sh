@@ -1091,6 +1091,25 @@ if "$RAD" lightmap cornell -o "$TMP/lm.pfm" --size 32 --patches 100 --texel-samp
 else
     fail "lightmap of the Cornell box" "$(head -c 300 "$TMP/err.txt")"
 fi
+# OpenEXR (tinyexr): the same bake written as .exr reads back (through tinyexr) equal to the
+# PFM, value for value; a rad built without tinyexr refuses .exr with a message naming the package
+"$RAD" lightmap cornell -o "$TMP/lm.exr" --size 32 --patches 100 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt"
+rc=$?
+if [ $rc -eq 2 ] && grep -q "without OpenEXR support (install libtinyexr-dev" "$TMP/err.txt"; then
+    ok "lightmap -o .exr without tinyexr: a clear error"
+elif [ $rc -eq 0 ] && [ -s "$TMP/lm.pfm" ]; then
+    d=$("$RAD" compare "$TMP/lm.exr" "$TMP/lm.pfm" 2> /dev/null | awk '/^max \|A-B\|/ { print $3 }')
+    [ "$d" = 0 ] && ok "lightmap -o .exr reads back equal to the PFM" || fail "lightmap -o .exr reads back equal to the PFM" "max |A-B| '$d'"
+    if "$RAD" render cornell --patches 60 --size 24x24 -o "$TMP/r.exr" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell --patches 60 --size 24x24 -o "$TMP/r.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        d=$("$RAD" compare "$TMP/r.exr" "$TMP/r.pfm" 2> /dev/null | awk '/^max \|A-B\|/ { print $3 }')
+        [ "$d" = 0 ] && ok "render -o .exr reads back equal to the PFM" || fail "render -o .exr reads back equal to the PFM" "max |A-B| '$d'"
+    else
+        fail "render -o .exr" "$(head -c 300 "$TMP/err.txt")"
+    fi
+else
+    fail "lightmap -o .exr" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+fi
 "$RAD" lightmap cornell -o "$TMP/lm.png" --sh > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 2 ] && grep -q "PNG cannot hold negative" "$TMP/err.txt" && ok "lightmap --sh refuses a PNG" || fail "lightmap --sh refuses a PNG" "exit $rc"

@@ -1,6 +1,6 @@
 /* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
 
-   rad lightmap SCENE -o OUT.pfm|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
+   rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
                 [--visibility-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
                 [classic options] [--threads N] [--exposure X]
 
@@ -10,8 +10,8 @@
    simple automatic unwrap of unwrap.c. RGB: irradiance (W m^-2) = the direct light of the
    lights and emitters per texel + the irradiance from the secondary sources; --sh: the L1
    spherical harmonics of the indirect radiance only (engines add direct light per pixel),
-   four PFM files OUT.L00.pfm, OUT.L1m1.pfm, OUT.L10.pfm, OUT.L11.pfm (PNG cannot hold the
-   negative coefficients). Then dilation into the gutters and seam stitching. --render draws
+   four files OUT.L00.pfm, OUT.L1m1.pfm, OUT.L10.pfm, OUT.L11.pfm (or .exr; PNG cannot hold the
+   negative coefficients). .exr is 32-bit float OpenEXR (image.c, tinyexr). Then dilation into the gutters and seam stitching. --render draws
    the scene's camera view (or the one rad trace would choose) shaded from the lightmap alone:
    radiance = emission + albedo x bilinear lightmap irradiance / pi, N x N samples a pixel, to
    compare with `rad trace` (rad compare). */
@@ -22,16 +22,16 @@
 
 static void lightmap_usage(FILE *f)
 {
-    fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.png [options]\n"
+    fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [options]\n"
                "  bakes the classic radiosity solution into a lightmap over the second uv set\n"
                "  (glTF TEXCOORD_1); meshes without one are unwrapped automatically (simple charts)\n"
                "  --size N|WxH          atlas texels (default 256)\n"
-               "  --sh                  L1 spherical harmonics of the indirect light (4 PFM files\n"
+               "  --sh                  L1 spherical harmonics of the indirect light (4 PFM or EXR files\n"
                "                        OUT.L00.pfm OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)\n"
                "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
                "  --visibility-rays N   shadow rays per sample point and patch (default 2, at most 64)\n"
                "  --unwrap              unwrap even when the file has a second uv set\n"
-               "  --render VIEW         also render the camera view shaded from the lightmap (.png or .pfm;\n"
+               "  --render VIEW         also render the camera view shaded from the lightmap (.png, .pfm, .exr;\n"
                "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
                "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 2)\n"
                "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
@@ -189,7 +189,7 @@ int rad_cmd_lightmap(int argc, char **argv)
         return 2;
     }
     if (sh && lightmap_is_png(out_path)) {
-        fprintf(stderr, "rad lightmap: --sh writes PFM files (PNG cannot hold negative coefficients): use -o NAME.pfm\n");
+        fprintf(stderr, "rad lightmap: --sh writes PFM or EXR files (PNG cannot hold negative coefficients): use -o NAME.pfm or NAME.exr\n");
         return 2;
     }
     if (sh && render_path) {
@@ -197,6 +197,7 @@ int rad_cmd_lightmap(int argc, char **argv)
         return 2;
     }
     if (rad_tool_check_size("lightmap", width, height)) return 2;
+    if (rad_image_check_format("lightmap", out_path) || (render_path && rad_image_check_format("lightmap", render_path))) return 2;
     {
         const char *inputs[1];
         inputs[0] = scene_path;

@@ -55,8 +55,9 @@ static void *xmalloc(size_t size)
 static void render_usage(FILE *f)
 {
     fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace] [options]\n"
-            "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
+            "usage: rad render SCENE -o OUT.png|OUT.pfm|OUT.exr [--method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace] [options]\n"
+            "  -o FILE            output image: .pfm or .exr (linear radiance; .exr needs libtinyexr-dev at build) or .png\n"
+            "                     (sRGB, exposure applied)\n"
             "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
             "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
             "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
@@ -1155,14 +1156,7 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
     }
-    {
-        size_t l = strlen(out_path);
-        if (l < 4 || (strcmp(out_path + l - 4, ".png") && strcmp(out_path + l - 4, ".pfm") &&
-                      strcmp(out_path + l - 4, ".PNG") && strcmp(out_path + l - 4, ".PFM"))) {
-            fprintf(stderr, "rad %s: output '%s' must end in .png or .pfm\n", cmd, out_path);
-            return 2;
-        }
-    }
+    if (rad_image_check_format(cmd, out_path)) return 2;
     {
         const char *inputs[2];
         inputs[0] = scene_name;

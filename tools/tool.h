@@ -44,7 +44,14 @@ int rad_image_write_pfm(const char *path, const rad_image *img);         /* 0 on
 int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errlen);
 /* sRGB-encoded 8-bit PNG of exposure * linear value, clamped */
 int rad_image_write_png(const char *path, const rad_image *img, float exposure);
-/* writes .pfm or .png by the path's extension */
+/* OpenEXR, 32-bit float RGB (tinyexr; without -DRAD_TOOL_EXR both fail with a message naming
+   the package libtinyexr-dev) */
+int rad_image_write_exr(const char *path, const rad_image *img);         /* 0 on success */
+int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errlen);
+/* 0 when 'path' names an image format this build writes (.pfm, .png, .exr with tinyexr);
+   else prints why ("rad CMD: ...") and returns 2 */
+int rad_image_check_format(const char *cmd, const char *path);
+/* writes .pfm, .png or .exr by the path's extension */
 int rad_image_write(const char *path, const rad_image *img, float exposure);
 
 /* ---- output files (image.c): every file the tool writes ------------------------------- */
@@ -133,7 +140,7 @@ int rad_tool_parse_size(const char *text, int *w, int *h);
 int rad_tool_check_size(const char *cmd, int w, int h);
 
 /* ---- added by trace-metrics ------------------------------------------------------------ */
-/* Reads .png (8-bit sRGB through stb_image, decoded to linear) or else PFM; 0 on success. */
+/* Reads .png (8-bit sRGB through stb_image, decoded to linear), .exr (tinyexr) or else PFM; 0 on success. */
 int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen);
 int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen);
 /* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
