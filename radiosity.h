@@ -1400,26 +1400,43 @@ RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lightmap, uint32_t ch
    sample the patch containing it (rad_patches_locate) and its three vertex weights, each
    vertex standing for the area-weighted mean of the patches that share it (as
    rad_patches_vertex_values), averaged over the texel's valid samples; so the row
-   interpolates the patches' irradiance H = F B smoothly (a few to a few dozen entries). The
-   row is then scaled by the texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked)
-   from the gathered lightmap and the patch irradiance of the same solution (1 when either is
-   NULL or the row gives 0; at most 16), which keeps the gather's sub-patch detail (contact
-   shadows, gradients inside a patch). A refresh with H_baked gives back the bake's luminance
-   exactly; with another solution it is exact where the light's shape across each patch and
-   its neighbours does not change, and off by the change elsewhere (the test measures it). */
+   interpolates the patches' irradiance H = F B smoothly. The row is then scaled by the
+   texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked) from the gathered
+   lightmap and the patch irradiance of the same solution (1 when either is NULL or the row
+   gives 0; at most 16), which keeps the gather's sub-patch detail (contact shadows, gradients
+   inside a patch). A refresh with H_baked gives back the bake's luminance exactly; with
+   another solution it is exact where the light's shape across each patch and its neighbours
+   does not change, and off by the change elsewhere (the test measures it).
+   LAYOUT. The rows are stored FACTORED, in two sparse stages, because the patches around a
+   vertex are shared by every texel near it: stage 1 makes a value per patch vertex,
+       V_v = sum_k vertex_weights[k] H[vertex_patches[k]],  k in [vertex_first[v], vertex_first[v + 1])
+   (the area shares: they sum to 1 around a vertex), stage 2 a value per texel with a row,
+       out[row_texels[r]] = sum_e entry_weights[e] V[entry_vertices[e]],  e in [row_first[r], row_first[r + 1])
+   (the mean barycentric weights times the detail factor: about 3 entries a texel, against
+   about 10 patches in the expanded row). The texel-from-patch row of the text above is the
+   product of the two (W_tp = sum_e entry_weights[e] vertex_weights[k] over the pairs with
+   vertex_patches[k] = p); the refresh gives it up to float rounding (1e-6 relative). The
+   rows run in increasing texel order, so the stage-2 writes stream through the lightmap. */
 typedef struct rad_lightmap_weights {
     uint32_t texels;            /* width * height of the lightmap */
     uint32_t patch_count;       /* N of the patches */
-    uint64_t *row_offsets;      /* texels + 1; a texel without a valid sample has an empty row */
-    uint32_t *columns;          /* patch indices */
-    float *values;              /* weights (detail factor included) */
+    uint32_t vertex_count;      /* the patches' vertex_count */
+    uint32_t row_count;         /* texels with a row (a valid sample in a located patch) */
+    uint32_t *vertex_first;     /* vertex_count + 1 */
+    uint32_t *vertex_patches;   /* 3N: patch indices */
+    float *vertex_weights;      /* 3N: area shares */
+    uint32_t *row_texels;       /* row_count: the texel of each row, increasing */
+    uint32_t *row_first;        /* row_count + 1 */
+    uint32_t *entry_vertices;   /* row_first[row_count]: vertex indices */
+    float *entry_weights;       /* row_first[row_count]: weights (detail factor included) */
     rad_allocator allocator;    /* private */
 } rad_lightmap_weights;
 
 /* Builds the rows above. baked_texels (3 per texel, an RGB irradiance gather of the solution,
    before dilation) and baked_patch_irradiance (3N: H = F B of the same solution) are optional
    together (both or neither). Errors: INVALID_ARGUMENT (NULL lightmap or patches, patches of
-   another scene, one of the two baked inputs without the other), OUT_OF_MEMORY. O(samples). */
+   another scene, one of the two baked inputs without the other), SIZE_OVERFLOW (2^32 entries
+   or more), OUT_OF_MEMORY. O(samples). */
 RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lightmap, const rad_patches *patches,
                                                const float *baked_texels, const float *baked_patch_irradiance,
                                                const rad_context *ctx, rad_lightmap_weights **out);
@@ -1427,7 +1444,9 @@ RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *weights);
 
 /* out[t] = sum_p W_tp H_p (3 floats per texel) for every texel with a row; texels without one
    are left as they are (the gutters keep their dilated values). patch_irradiance: 3N floats.
-   Parallel over texels through ctx->parallel_for. Errors: INVALID_ARGUMENT. */
+   Two passes through ctx->parallel_for (vertices, then rows in contiguous blocks), with a
+   scratch of 3 floats per vertex from the context's allocator. Deterministic whatever the
+   thread count. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
 RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, const float *patch_irradiance, float *out,
                                         const rad_context *ctx);
 
@@ -1955,7 +1974,19 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        per entry (entry k at element k - entry_base)  2: weights (9 per entry, entry k's at
        element 9 k - weight_base)  3: direct (27 per probe)  4: B (3N)  5: out coefficients
        (27 per probe; the chunk's probes written). Matches the CPU to 1e-5 (measured 6.8e-6 on
-       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c). */
+       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c).
+   RAD_GLSL_LIGHTMAP_REFRESH  a lightmap from a new patch irradiance H, as rad_lightmap_refresh
+       (>>api_lightmap), on the arrays of rad_lightmap_weights uploaded unchanged, in TWO
+       PASSES (push member pass): RAD_GLSL_LIGHTMAP_PASS_VERTICES, one invocation per patch
+       vertex, V = the vertex values of H; then RAD_GLSL_LIGHTMAP_PASS_TEXELS, one invocation
+       per row, the texels from V (a compute-to-compute barrier between the two: pass 1 reads
+       binding 4). Push: rad_glsl_lightmap_refresh_push. 0: vertex_first (vertex_count + 1)
+       1: vertex_patches  2: vertex_weights (entry k of both at element k - entry_base in pass
+       0)  3: H (3N)  4: V, scratch of 3 floats per vertex  5: row_texels  6: row_first
+       (row_count + 1)  7: entry_vertices  8: entry_weights (entry e at element e - entry_base
+       in pass 1)  9: the lightmap (3 per texel; only texels with a row written). A pass reads
+       none of the other's bindings among 0..3 and 5..9: bind any buffer there. Matches the
+       CPU to 1e-5 (tests/test_vulkan.c). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -1972,7 +2003,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
     RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
     RAD_GLSL_PROBE_UPDATE      = 12, /* glsl/probe_update.comp */
-    RAD_GLSL_COUNT = 13
+    RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* glsl/lightmap_refresh.comp */
+    RAD_GLSL_COUNT = 14
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -1994,6 +2026,8 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_FLAG_COSINE 1u       /* vp gather: RAD_VP_WEIGHTS_COSINE split weights */
 #define RAD_GLSL_FLAG_CLUSTERED 2u    /* vp gather: RAD_VP_CLUSTERED (w = N_a . n; binding 5 read) */
 #define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
+#define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
+#define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -2066,6 +2100,11 @@ typedef struct rad_glsl_probe_update_push {
     uint32_t entry_base;           /* low 32 bits of the entry at element 0 of binding 1 */
     uint32_t weight_base;          /* low 32 bits of the float (9 x entry) at element 0 of binding 2 */
 } rad_glsl_probe_update_push;
+typedef struct rad_glsl_lightmap_refresh_push {
+    uint32_t pass;                 /* RAD_GLSL_LIGHTMAP_PASS_VERTICES or _TEXELS */
+    uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
+    uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
+} rad_glsl_lightmap_refresh_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -10035,9 +10074,13 @@ RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
     rad_allocator a;
     if (!w) return;
     a = w->allocator;
-    rad__free(&a, w->row_offsets);
-    rad__free(&a, w->columns);
-    rad__free(&a, w->values);
+    rad__free(&a, w->vertex_first);
+    rad__free(&a, w->vertex_patches);
+    rad__free(&a, w->vertex_weights);
+    rad__free(&a, w->row_texels);
+    rad__free(&a, w->row_first);
+    rad__free(&a, w->entry_vertices);
+    rad__free(&a, w->entry_weights);
     rad__free(&a, w);
 }
 
@@ -10063,15 +10106,17 @@ static void rad__lm_bary3(const float *v, const float *x, float *b1, float *b2)
     *b2 = (float)w;
 }
 
-#define RAD__LM_ROW_MAX 256u /* entries one texel's row may gather before merging stops adding */
+/* distinct vertices one texel's row may gather before merging stops adding (a texel spans a
+   few patches: never reached with welded meshes) */
+#define RAD__LM_ROW_MAX 128u
 
 RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad_patches *P, const float *baked_texels,
                                                const float *baked_H, const rad_context *ctx, rad_lightmap_weights **out)
 {
     rad__ctx c;
     rad_lightmap_weights *W = NULL;
-    uint32_t *vfirst = NULL, *vpatch = NULL, *fill = NULL, i, texels, col[RAD__LM_ROW_MAX];
-    double *varea = NULL, val[RAD__LM_ROW_MAX];
+    uint32_t *fill = NULL, i, texels, rows = 0, col[RAD__LM_ROW_MAX];
+    double *varea = NULL, *vbaked = NULL, val[RAD__LM_ROW_MAX];
     uint64_t total = 0, cap = 0;
     rad_result r = RAD_SUCCESS;
     rad__ctx_init(&c, ctx);
@@ -10082,36 +10127,63 @@ RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad
                  "baked_texels and baked_patch_irradiance");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if ((uint64_t)P->count * 3u >= 0xFFFFFFFFu) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: %u patches give 2^32 vertex entries or more", P->count);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
     texels = lm->width * lm->height;
+    for (i = 0; i < texels; ++i) { /* the rows to come: texels with a valid sample */
+        uint32_t s;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1] && !lm->sample_valid[s]; ++s) {}
+        rows += s < lm->sample_first[i + 1];
+    }
     W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
     if (!W) return RAD_ERROR_OUT_OF_MEMORY;
     memset(W, 0, sizeof(*W));
     W->allocator = c.allocator;
     W->texels = texels;
     W->patch_count = P->count;
-    /* the patches around each vertex, and their total area */
-    vfirst = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    W->vertex_count = P->vertex_count;
+    /* stage 1: the patches around each vertex and their area shares */
+    W->vertex_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    W->vertex_patches = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
+    W->vertex_weights = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(float));
     fill = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
-    vpatch = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
     varea = (double *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(double));
-    W->row_offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)texels + 1, sizeof(uint64_t));
-    if (!vfirst || !fill || !vpatch || !varea || !W->row_offsets) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    W->row_texels = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    W->row_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    rows = 0;
+    if (baked_H) vbaked = (double *)rad__alloc_array(&c.allocator, 3 * (size_t)P->vertex_count + 1, sizeof(double));
+    if (!W->vertex_first || !W->vertex_patches || !W->vertex_weights || !fill || !varea || !W->row_texels || !W->row_first ||
+        (baked_H && !vbaked)) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
     memset(fill, 0, sizeof(uint32_t) * ((size_t)P->vertex_count + 1));
     memset(varea, 0, sizeof(double) * ((size_t)P->vertex_count + 1));
     for (i = 0; i < P->count; ++i) {
         int k;
         for (k = 0; k < 3; ++k) { fill[P->patches[i].vertices[k]]++; varea[P->patches[i].vertices[k]] += P->patches[i].area; }
     }
-    vfirst[0] = 0;
-    for (i = 0; i < P->vertex_count; ++i) { vfirst[i + 1] = vfirst[i] + fill[i]; fill[i] = 0; }
+    W->vertex_first[0] = 0;
+    for (i = 0; i < P->vertex_count; ++i) { W->vertex_first[i + 1] = W->vertex_first[i] + fill[i]; fill[i] = 0; }
     for (i = 0; i < P->count; ++i) {
         int k;
-        for (k = 0; k < 3; ++k) { uint32_t v = P->patches[i].vertices[k]; vpatch[vfirst[v] + fill[v]++] = i; }
+        for (k = 0; k < 3; ++k) {
+            uint32_t v = P->patches[i].vertices[k], e = W->vertex_first[v] + fill[v]++;
+            W->vertex_patches[e] = i;
+            W->vertex_weights[e] = varea[v] > 0.0 ? (float)(P->patches[i].area / varea[v]) : 0.0f;
+        }
     }
-    /* rows, texel by texel, appended to growing arrays */
+    if (vbaked) /* the baked solution's vertex values, for the detail factors */
+        for (i = 0; i < P->vertex_count; ++i) {
+            uint32_t e;
+            int k;
+            for (k = 0; k < 3; ++k) vbaked[3 * (size_t)i + k] = 0.0;
+            for (e = W->vertex_first[i]; e < W->vertex_first[i + 1]; ++e)
+                for (k = 0; k < 3; ++k)
+                    vbaked[3 * (size_t)i + k] += (double)W->vertex_weights[e] * baked_H[3 * (size_t)W->vertex_patches[e] + k];
+        }
+    /* stage 2: rows, texel by texel, appended to growing arrays */
     for (i = 0; i < texels; ++i) {
         uint32_t s, n = 0, nv = 0, e;
-        W->row_offsets[i] = total;
         for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
             uint32_t t = lm->sample_triangles[s], p, k;
             float b1, b2, vw[3];
@@ -10121,56 +10193,64 @@ RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad
             p = rad_patches_locate(P, t, b1, b2, vw);
             if (p == RAD_NONE) continue;
             for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[p].vertices[k], j;
+                uint32_t v = P->patches[p].vertices[k], m;
                 if (!(varea[v] > 0.0) || !(vw[k] != 0.0f)) continue;
-                for (j = vfirst[v]; j < vfirst[v + 1]; ++j) {
-                    uint32_t q = vpatch[j], m;
-                    double wq = (double)vw[k] * P->patches[q].area / varea[v];
-                    for (m = 0; m < n && col[m] != q; ++m) {}
-                    if (m == n) {
-                        if (n == RAD__LM_ROW_MAX) continue; /* never with welded triangle meshes: a vertex has few patches */
-                        col[n] = q;
-                        val[n++] = 0.0;
-                    }
-                    val[m] += wq;
+                for (m = 0; m < n && col[m] != v; ++m) {}
+                if (m == n) {
+                    if (n == RAD__LM_ROW_MAX) continue;
+                    col[n] = v;
+                    val[n++] = 0.0;
                 }
+                val[m] += vw[k];
             }
         }
         if (nv == 0 || n == 0) continue;
         for (e = 0; e < n; ++e) val[e] /= nv;
-        if (baked_texels) {
+        if (vbaked) {
             double num = 0.0, den = 0.0, cf = 1.0;
             int k;
             for (k = 0; k < 3; ++k) num += baked_texels[3 * (size_t)i + k];
             for (e = 0; e < n; ++e)
-                for (k = 0; k < 3; ++k) den += val[e] * baked_H[3 * (size_t)col[e] + k];
+                for (k = 0; k < 3; ++k) den += val[e] * vbaked[3 * (size_t)col[e] + k];
             if (den > 0.0 && num >= 0.0) cf = num / den < 16.0 ? num / den : 16.0;
             for (e = 0; e < n; ++e) val[e] *= cf;
+        }
+        if (total + n >= 0xFFFFFFFFu) {
+            rad__log(&c, RAD_LOG_ERROR, "lightmap weights: 2^32 entries or more");
+            r = RAD_ERROR_SIZE_OVERFLOW;
+            goto done;
         }
         if (total + n > cap) {
             uint64_t nc = cap ? 2 * cap : 4096;
             uint32_t *ncol;
             float *nval;
             while (nc < total + n) nc *= 2;
-            ncol = (uint32_t *)rad__realloc(&c.allocator, W->columns, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
+            ncol = (uint32_t *)rad__realloc(&c.allocator, W->entry_vertices, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
             if (!ncol) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-            W->columns = ncol;
-            nval = (float *)rad__realloc(&c.allocator, W->values, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
+            W->entry_vertices = ncol;
+            nval = (float *)rad__realloc(&c.allocator, W->entry_weights, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
             if (!nval) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-            W->values = nval;
+            W->entry_weights = nval;
             cap = nc;
         }
-        for (e = 0; e < n; ++e) { W->columns[total + e] = col[e]; W->values[total + e] = (float)val[e]; }
+        W->row_texels[rows] = i;
+        W->row_first[rows++] = (uint32_t)total;
+        for (e = 0; e < n; ++e) { W->entry_vertices[total + e] = col[e]; W->entry_weights[total + e] = (float)val[e]; }
         total += n;
     }
-    W->row_offsets[texels] = total;
+    W->row_first[rows] = (uint32_t)total;
+    W->row_count = rows;
+    if (!W->entry_vertices) { /* no row at all: keep the arrays non-NULL */
+        W->entry_vertices = (uint32_t *)rad__alloc(&c.allocator, sizeof(uint32_t));
+        W->entry_weights = (float *)rad__alloc(&c.allocator, sizeof(float));
+        if (!W->entry_vertices || !W->entry_weights) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
 done:
-    rad__free(&c.allocator, vfirst);
     rad__free(&c.allocator, fill);
-    rad__free(&c.allocator, vpatch);
     rad__free(&c.allocator, varea);
+    rad__free(&c.allocator, vbaked);
     if (r != RAD_SUCCESS) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
+        if (r == RAD_ERROR_OUT_OF_MEMORY) rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
         rad_lightmap_weights_destroy(W);
         return r;
     }
@@ -10178,33 +10258,60 @@ done:
     return RAD_SUCCESS;
 }
 
+#define RAD__LM_REFRESH_GRAIN 65536u /* entries (and rows) a refresh task takes at least */
+
 typedef struct rad__lm_refresh {
     const rad_lightmap_weights *W;
     const float *H;
+    float *V;                   /* 3 per vertex: stage 1's output */
     float *out;
     uint32_t tasks;
 } rad__lm_refresh;
 
-/* one contiguous block of texels per task: the rows are short, so a cyclic split would make
-   the tasks write the same cache lines of out */
-static void rad__lm_refresh_task(void *data, uint32_t task)
+static void rad__lm_refresh_vertices(void *data, uint32_t task)
 {
     const rad__lm_refresh *f = (const rad__lm_refresh *)data;
     const rad_lightmap_weights *W = f->W;
-    uint32_t t = (uint32_t)((uint64_t)W->texels * task / f->tasks), end = (uint32_t)((uint64_t)W->texels * (task + 1) / f->tasks);
-    for (; t < end; ++t) {
-        uint64_t a = W->row_offsets[t], b = W->row_offsets[t + 1], e;
+    uint32_t v = (uint32_t)((uint64_t)W->vertex_count * task / f->tasks);
+    uint32_t end = (uint32_t)((uint64_t)W->vertex_count * (task + 1) / f->tasks);
+    for (; v < end; ++v) {
+        uint32_t e;
         float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        if (a == b) continue;
-        for (e = a; e < b; ++e) {
-            const float *h = f->H + 3 * (size_t)W->columns[e], w = W->values[e];
+        for (e = W->vertex_first[v]; e < W->vertex_first[v + 1]; ++e) {
+            const float *h = f->H + 3 * (size_t)W->vertex_patches[e], w = W->vertex_weights[e];
             s0 += w * h[0];
             s1 += w * h[1];
             s2 += w * h[2];
         }
-        f->out[3 * (size_t)t] = s0;
-        f->out[3 * (size_t)t + 1] = s1;
-        f->out[3 * (size_t)t + 2] = s2;
+        f->V[3 * (size_t)v] = s0;
+        f->V[3 * (size_t)v + 1] = s1;
+        f->V[3 * (size_t)v + 2] = s2;
+    }
+}
+
+/* one contiguous block of rows per task: the rows are short, so a cyclic split would make
+   the tasks write the same cache lines of out */
+static void rad__lm_refresh_rows(void *data, uint32_t task)
+{
+    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
+    const rad_lightmap_weights *W = f->W;
+    const uint32_t *first = W->row_first, *ev = W->entry_vertices;
+    const float *ew = W->entry_weights, *V = f->V;
+    uint32_t r = (uint32_t)((uint64_t)W->row_count * task / f->tasks);
+    uint32_t end = (uint32_t)((uint64_t)W->row_count * (task + 1) / f->tasks);
+    for (; r < end; ++r) {
+        uint32_t e = first[r], b = first[r + 1];
+        float *o = f->out + 3 * (size_t)W->row_texels[r];
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        for (; e < b; ++e) {
+            const float *x = V + 3 * (size_t)ev[e], w = ew[e];
+            s0 += w * x[0];
+            s1 += w * x[1];
+            s2 += w * x[2];
+        }
+        o[0] = s0;
+        o[1] = s1;
+        o[2] = s2;
     }
 }
 
@@ -10212,6 +10319,7 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
 {
     rad__ctx c;
     rad__lm_refresh f;
+    uint64_t most;
     rad__ctx_init(&c, ctx);
     if (!W || !H || !out) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
@@ -10220,8 +10328,29 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
     f.W = W;
     f.H = H;
     f.out = out;
-    f.tasks = c.tasks < W->texels ? c.tasks : (W->texels ? W->texels : 1u);
-    c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_task, &f);
+    f.V = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)W->vertex_count + 1, sizeof(float));
+    if (!f.V) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: out of memory (%u vertex values)", W->vertex_count);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    /* stage 1 is small (3 entries a patch): in the calling thread unless the patches are
+       many, as a parallel region's start and join can cost more than it on busy cores */
+    most = W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN;
+    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
+    if (f.tasks < 2) {
+        f.tasks = 1;
+        rad__lm_refresh_vertices(&f, 0);
+    } else {
+        c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_vertices, &f);
+    }
+    /* stage 2: a task per block of at least RAD__LM_REFRESH_GRAIN entries */
+    most = (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u;
+    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
+    if (f.tasks < 2) {
+        f.tasks = 1;
+        rad__lm_refresh_rows(&f, 0);
+    } else c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_rows, &f);
+    rad__free(&c.allocator, f.V);
     return RAD_SUCCESS;
 }
 
@@ -11707,6 +11836,8 @@ typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_pus
                                                 offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
 typedef char rad__check_glsl_probe_update_push[(sizeof(rad_glsl_probe_update_push) == 16 &&
                                                offsetof(rad_glsl_probe_update_push, weight_base) == 12) ? 1 : -1];
+typedef char rad__check_glsl_lightmap_refresh_push[(sizeof(rad_glsl_lightmap_refresh_push) == 16 &&
+                                                   offsetof(rad_glsl_lightmap_refresh_push, entry_base) == 12) ? 1 : -1];
 typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
                                              offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
                                              offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
@@ -12888,6 +13019,66 @@ static const char rad__glsl_12_0[] =
     "    }\n"
     "}\n";
 static const char *const rad__glsl_pieces_12[] = { rad__glsl_12_0 };
+static const char rad__glsl_13_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LIGHTMAP_REFRESH: a lightmap refreshed from a new patch\n"
+    "// irradiance H, as rad_lightmap_refresh (docs/methods/lightmap.md), in its two stages:\n"
+    "//   pass 0 (RAD_GLSL_LIGHTMAP_PASS_VERTICES), one invocation per patch vertex v:\n"
+    "//     V[v] = sum over k in [vertex_first[v], vertex_first[v + 1]) of vertex_weights[k] H[vertex_patches[k]]\n"
+    "//   pass 1 (RAD_GLSL_LIGHTMAP_PASS_TEXELS), one invocation per row r (a texel with a row):\n"
+    "//     out[row_texels[r]] = sum over e in [row_first[r], row_first[r + 1]) of entry_weights[e] V[entry_vertices[e]]\n"
+    "// rows (vertices or texel rows) row_offset .. row_offset + row_count - 1. RGB vectors are\n"
+    "// interleaved (3 floats each). Pass 1 reads what pass 0 wrote into binding 4: put a\n"
+    "// compute-to-compute barrier between them. Texels without a row are not written.\n"
+    "// Chunking: the entry arrays of the pass (bindings 1 and 2, or 7 and 8) may hold only this\n"
+    "// chunk's entries: entry k is element k - entry_base. The offsets (0, 6), vectors (3, 4) and\n"
+    "// out (9) are bound whole. A pass reads none of the other pass's bindings (bind any buffer).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer VertexFirst { uint vertex_first[]; };   // vertices + 1\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer VertexPatches { uint vertex_patches[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer VertexWeights { float vertex_weights[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Irradiance { float H[]; };              // 3 N\n"
+    "layout(std430, set = 0, binding = 4) buffer VertexValues { float V[]; };                      // 3 per vertex\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowTexels { uint row_texels[]; };\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer RowFirst { uint row_first[]; };         // rows + 1\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer EntryVertices { uint entry_vertices[]; };\n"
+    "layout(std430, set = 0, binding = 8) readonly buffer EntryWeights { float entry_weights[]; };\n"
+    "layout(std430, set = 0, binding = 9) buffer Output { float lightmap[]; };                    // 3 per texel\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint pass;        // 0: vertices, 1: texel rows\n"
+    "    uint row_offset;  // first vertex or row of this dispatch\n"
+    "    uint row_count;   // vertices or rows in this dispatch\n"
+    "    uint entry_base;  // the entry index at element 0 of the pass's entry bindings\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint i = gl_GlobalInvocationID.x;\n"
+    "    if (i >= pc.row_count) return;\n"
+    "    uint r = pc.row_offset + i;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    if (pc.pass == 0u) {\n"
+    "        uint a = vertex_first[r] - pc.entry_base, b = vertex_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint k = a; k < b; ++k) {\n"
+    "            uint j = 3u * vertex_patches[k];\n"
+    "            acc += vertex_weights[k] * vec3(H[j], H[j + 1u], H[j + 2u]);\n"
+    "        }\n"
+    "        V[3u * r] = acc.x;\n"
+    "        V[3u * r + 1u] = acc.y;\n"
+    "        V[3u * r + 2u] = acc.z;\n"
+    "    } else {\n"
+    "        uint a = row_first[r] - pc.entry_base, b = row_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint e = a; e < b; ++e) {\n"
+    "            uint j = 3u * entry_vertices[e];\n"
+    "            acc += entry_weights[e] * vec3(V[j], V[j + 1u], V[j + 2u]);\n"
+    "        }\n"
+    "        uint t = 3u * row_texels[r];\n"
+    "        lightmap[t] = acc.x;\n"
+    "        lightmap[t + 1u] = acc.y;\n"
+    "        lightmap[t + 2u] = acc.z;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
@@ -12901,7 +13092,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
-    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u }
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u },
+    { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
 };
 /* >>glsl end */
 

@@ -538,8 +538,8 @@ static void lm_test_cornell(void)
         CHECK_RESULT(rad_lightmap_weights_create(lm, P, H, NULL, NULL, &wt), RAD_ERROR_INVALID_ARGUMENT);
         CHECK_OK(rad_lightmap_weights_create(lm, P, H, Hp, NULL, &wt));
         if (wt && R && R2 && E2 && B2 && Hp2 && Hp3 && G2) {
-            entries = wt->row_offsets[wt->texels];
-            CHECK(entries <= 40u * (uint64_t)lm->valid_texels); /* a few dozen patches per texel at most */
+            entries = wt->row_first[wt->row_count];
+            CHECK(entries <= 12u * (uint64_t)lm->valid_texels); /* a few vertices per texel */
             CHECK_OK(rad_lightmap_refresh(wt, Hp, R, NULL));
             for (i = 0; i < 3 * P->count; ++i) Hp3[i] = 2.0f * Hp[i];
             CHECK_OK(rad_lightmap_refresh(wt, Hp3, R2, NULL));
@@ -563,6 +563,57 @@ static void lm_test_cornell(void)
         }
         rad_lightmap_weights_destroy(wt);
         free(R); free(R2); free(E2); free(B2); free(Hp2); free(Hp3); free(G2);
+    }
+    /* the factored rows without detail factors against the public interpolation: each valid
+       sample's value is rad_patches_vertex_values interpolated with rad_patches_locate's
+       weights (barycentrics from the triangle's corners here), a texel the mean of its
+       samples */
+    {
+        rad_lightmap_weights *w0 = NULL;
+        float *R = (float *)calloc(3 * (size_t)o.width * o.height, sizeof(float));
+        float *Vv = (float *)malloc(sizeof(float) * 3 * (P->vertex_count + 1));
+        double worst_rel = 0.0;
+        uint32_t compared = 0;
+        CHECK_OK(rad_lightmap_weights_create(lm, P, NULL, NULL, NULL, &w0));
+        if (w0 && R && Vv) {
+            CHECK(w0->row_count == lm->valid_texels);
+            CHECK_OK(rad_patches_vertex_values(P, Hp, 3, Vv));
+            CHECK_OK(rad_lightmap_refresh(w0, Hp, R, NULL));
+            for (i = 0; i < o.width * o.height; ++i) {
+                double ref[3] = { 0.0, 0.0, 0.0 };
+                uint32_t s, nv = 0, k;
+                if (!(lm->flags[i] & RAD_TEXEL_VALID)) continue;
+                for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+                    const float *v = S->positions + 9 * (size_t)lm->sample_triangles[s], *x = lm->sample_positions + 3 * (size_t)s;
+                    double e1[3], e2[3], d[3], a00 = 0, a01 = 0, a11 = 0, b0 = 0, b1 = 0, det;
+                    float wv[3];
+                    uint32_t p;
+                    if (!lm->sample_valid[s]) continue;
+                    for (k = 0; k < 3; ++k) {
+                        e1[k] = v[3 + k] - v[k]; e2[k] = v[6 + k] - v[k]; d[k] = x[k] - v[k];
+                        a00 += e1[k] * e1[k]; a01 += e1[k] * e2[k]; a11 += e2[k] * e2[k]; b0 += d[k] * e1[k]; b1 += d[k] * e2[k];
+                    }
+                    det = a00 * a11 - a01 * a01;
+                    p = rad_patches_locate(P, lm->sample_triangles[s], (float)((a11 * b0 - a01 * b1) / det),
+                                           (float)((a00 * b1 - a01 * b0) / det), wv);
+                    ++nv;
+                    for (k = 0; k < 3; ++k) {
+                        uint32_t vx = P->patches[p].vertices[k], ch;
+                        for (ch = 0; ch < 3; ++ch) ref[ch] += (double)wv[k] * Vv[3 * (size_t)vx + ch];
+                    }
+                }
+                for (k = 0; k < 3; ++k) {
+                    double rel = fabs(R[3 * i + k] - ref[k] / nv) / (ref[k] / nv + 1e-6);
+                    if (rel > worst_rel) worst_rel = rel;
+                }
+                ++compared;
+            }
+            CHECK(compared == lm->valid_texels);
+            CHECK(worst_rel < 1e-4); /* float rounding, and barycentrics clamped at triangle borders */
+            if (getenv("RAD_TEST_VERBOSE")) printf("    factored refresh against interpolated vertex values: %.2e relative\n", worst_rel);
+        }
+        rad_lightmap_weights_destroy(w0);
+        free(R); free(Vv);
     }
     /* direct light adds rad_direct_irradiance's mean */
     CHECK_OK(rad_lightmap_direct(lm, &rc, NULL, 0, NULL, Hd, NULL));

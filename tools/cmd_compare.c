@@ -189,6 +189,16 @@ int rad_cmd_compare(int argc, char **argv)
         if (mb > 0.0) printf("; A / B = %.6f", ma / mb);
         printf("\n");
     }
+    {
+        /* the unclamped difference: exact format round trips (PFM against EXR) read 0 here */
+        size_t k, n = (size_t)a.width * (size_t)a.height * 3u;
+        double top = 0.0;
+        for (k = 0; k < n; ++k) {
+            double d = fabs((double)a.rgb[k] - (double)b.rgb[k]);
+            if (d > top || d != d) top = d;
+        }
+        printf("max |A-B|: %.9g (linear, before clamping)\n", top);
+    }
     if (diff) {
         rad_image heat = { 0, 0, NULL };
         if (!(scale > 0.0f)) {
