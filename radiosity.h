@@ -2879,10 +2879,16 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    every sample pair but visibility is estimated per pair of voxels (u, v): 'visibility_rays'
    sample pairs are drawn with probability proportional to their kernel G_ij (stratified on
    the cumulative sum, offsets from a hash of u and v, so the result is deterministic), one
-   shadow ray each, and the fraction unoccluded, V_uv, scales every P_ab with a in u and b in
-   v. When a voxel pair has at most that many pairs, every pair gets its ray and V_uv is the
-   kernel-weighted mean. V_uv is shared by both directions, so reciprocity is unchanged. The
-   pair list of one voxel pair is thinned systematically beyond 16384 entries.
+   shadow ray each, and per axis pair (a, c) the unoccluded fraction of the drawn pairs
+   weighted by w_ia w_jc, V_uv(a, c), scales P_ab for the patch a of u and c of v (an axis pair
+   that no drawn pair weighs takes the voxel pair's plain unoccluded fraction). When a voxel
+   pair has at most that many pairs, every pair gets its ray and V_uv(a, c) is the mean
+   weighted by G_ij w_ia w_jc, so the blocks are the literal sums. One V_uv shared by every
+   axis pair (the earlier form) is biased wherever axes of a voxel see another voxel
+   differently (a lit floor beside a hidden wall), and more rays do not reduce that bias
+   (docs/performance-notes.md, "Light lost on real geometry"). V_uv(a, c)
+   serves both directions, so reciprocity is unchanged. The pair list of one voxel pair is
+   thinned systematically beyond 16384 entries.
    MEMORY (peak, through ctx's allocator): the N x N float matrix (sparse rows: see SPARSE
    ROWS), about 100 bytes per sample,
    T x (6 N doubles + 1024 rays + 16384 12-byte pair records) of task scratch (T = the
@@ -18235,22 +18241,48 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
                 ray->tmin = 0.0f;
                 ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
                 b->ray_g[at + s] = 1.0f;
+                b->ray_i[at + s] = list[q].i;
+                b->ray_j[at + s] = list[q].j;
             }
             nr = K;
         }
         if (b->rc->occluded(b->rc->user, b->rays + at, nr, b->occ + at) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
         b->rays_cast[task] += nr;
-        vis = 0.0;
-        if (n <= K) {
-            for (s = 0; s < n; ++s)
-                if (!b->occ[at + s]) vis += (double)list[s].g;
-            vis /= total;
-        } else {
-            for (s = 0; s < K; ++s)
-                if (!b->occ[at + s]) vis += 1.0;
-            vis /= (double)K;
+        /* visibility per axis pair (a, c): the rays' pairs weighted by w_ia w_jc (and by G_ij
+           when every pair has its ray; drawn pairs already carry G through their
+           probability), so that axes of one voxel that see the other voxel differently (a lit
+           floor and a hidden wall) keep their own share; an axis pair no ray weighed takes the
+           voxel pair's mean */
+        {
+            double seen_w[36], all_w[36], vis_w = 0.0, all_t = 0.0;
+            uint32_t e;
+            memset(seen_w, 0, sizeof(seen_w));
+            memset(all_w, 0, sizeof(all_w));
+            for (s = 0; s < nr; ++s) {
+                const rad__vp_pair *q = n <= K ? &list[s] : NULL;
+                uint32_t qi, qj, c2;
+                double gs;
+                const float *wi, *wj;
+                if (q) qi = q->i, qj = q->j, gs = (double)q->g;
+                else qi = b->ray_i[at + s], qj = b->ray_j[at + s], gs = 1.0;
+                wi = vp->sample_weights + 6 * (size_t)qi;
+                wj = vp->sample_weights + 6 * (size_t)qj;
+                all_t += gs;
+                if (!b->occ[at + s]) vis_w += gs;
+                for (a = 0; a < 6; ++a) {
+                    if (!(wi[a] > 0.0f)) continue;
+                    for (c2 = 0; c2 < 6; ++c2) {
+                        double x = gs * (double)wi[a] * (double)wj[c2];
+                        if (!(wj[c2] > 0.0f)) continue;
+                        all_w[6 * a + c2] += x;
+                        if (!b->occ[at + s]) seen_w[6 * a + c2] += x;
+                    }
+                }
+            }
+            vis = all_t > 0.0 ? vis_w / all_t : 0.0;
+            for (e = 0; e < 36; ++e) p0[e] *= all_w[e] > 0.0 ? seen_w[e] / all_w[e] : vis;
         }
-        if (vis > 0.0) rad__vp_add_block(b, acc, u, v, p0, vis);
+        rad__vp_add_block(b, acc, u, v, p0, 1.0);
     }
     for (a = 0; a < 6; ++a) {
         uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
@@ -18638,38 +18670,44 @@ static int rad__vp_progress_fn(void *user, float fraction)
     return p->fn(p->user, 0.1f + 0.9f * fraction);
 }
 
-static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+/* the voxels (clamped to the grid) that triangle t's bounding box overlaps: [i0, i1] per axis;
+   returns how many (0: none) */
+static uint64_t rad__vp_tri_cells(const rad_virtual_patches *vp, const float *tv, int64_t *i0, int64_t *i1)
+{
+    uint64_t n = 1;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        float mn = tv[k], mx = tv[k];
+        if (tv[3 + k] < mn) mn = tv[3 + k];
+        if (tv[6 + k] < mn) mn = tv[6 + k];
+        if (tv[3 + k] > mx) mx = tv[3 + k];
+        if (tv[6 + k] > mx) mx = tv[6 + k];
+        i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+        i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+        if (i0[k] < 0) i0[k] = 0;
+        if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
+        n *= (uint64_t)(i1[k] >= i0[k] ? i1[k] - i0[k] + 1 : 0);
+    }
+    return n;
+}
+
+/* BUILD step 1: the sorted distinct candidate voxels (keys) that triangle bounds overlap, and
+   per candidate and axis the exact surface area there (each triangle clipped to the voxels its
+   bounds overlap, times the split weights of its normal; the area correction of step 4) */
+static rad_result rad__vp_candidates(rad__vp_build *b, const rad__ctx *c, uint64_t **out_cand, uint32_t *out_count,
+                                     double **out_area)
 {
     rad_virtual_patches *vp = b->vp;
     const rad_scene *S = b->S;
     const rad_allocator *A = &vp->allocator;
-    uint64_t *cand = NULL, total = 0;
-    uint32_t ncand = 0, t, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
-    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL, *voxel_cand = NULL;
-    double *cand_area = NULL;
-    float *s_pos = NULL, *s_bary = NULL;
-    size_t bytes, q;
-    rad_result r = RAD_SUCCESS;
+    uint64_t *cand, total = 0;
+    double *cand_area;
+    uint32_t ncand = 0, t;
+    size_t q;
+    int64_t i0[3], i1[3], x, y, z;
     int k;
-
-    /* 1. candidate voxels from triangle bounds */
     for (t = 0; t < S->triangle_count; ++t) {
-        const float *tv = S->positions + 9 * (size_t)t;
-        uint64_t n = 1;
-        for (k = 0; k < 3; ++k) {
-            float mn = tv[k], mx = tv[k];
-            int64_t i0, i1;
-            if (tv[3 + k] < mn) mn = tv[3 + k];
-            if (tv[6 + k] < mn) mn = tv[6 + k];
-            if (tv[3 + k] > mx) mx = tv[3 + k];
-            if (tv[6 + k] > mx) mx = tv[6 + k];
-            i0 = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
-            i1 = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
-            if (i0 < 0) i0 = 0;
-            if (i1 > (int64_t)vp->dims[k] - 1) i1 = (int64_t)vp->dims[k] - 1;
-            n *= (uint64_t)(i1 >= i0 ? i1 - i0 + 1 : 0);
-        }
-        total += n;
+        total += rad__vp_tri_cells(vp, S->positions + 9 * (size_t)t, i0, i1);
         if (total > 0xFFFFFFF0u) {
             rad__log(c, RAD_LOG_ERROR, "virtual patches: triangles overlap more than 2^32 voxels (use bigger voxels)");
             return RAD_ERROR_SIZE_OVERFLOW;
@@ -18678,19 +18716,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     cand = (uint64_t *)rad__alloc_array(A, (size_t)total, sizeof(uint64_t));
     if (!cand) return RAD_ERROR_OUT_OF_MEMORY;
     for (t = 0, q = 0; t < S->triangle_count; ++t) {
-        const float *tv = S->positions + 9 * (size_t)t;
-        int64_t i0[3], i1[3], x, y, z;
-        for (k = 0; k < 3; ++k) {
-            float mn = tv[k], mx = tv[k];
-            if (tv[3 + k] < mn) mn = tv[3 + k];
-            if (tv[6 + k] < mn) mn = tv[6 + k];
-            if (tv[3 + k] > mx) mx = tv[3 + k];
-            if (tv[6 + k] > mx) mx = tv[6 + k];
-            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
-            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
-            if (i0[k] < 0) i0[k] = 0;
-            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
-        }
+        (void)rad__vp_tri_cells(vp, S->positions + 9 * (size_t)t, i0, i1);
         for (z = i0[2]; z <= i1[2]; ++z)
             for (y = i0[1]; y <= i1[1]; ++y)
                 for (x = i0[0]; x <= i1[0]; ++x)
@@ -18699,30 +18725,17 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     qsort(cand, (size_t)total, sizeof(uint64_t), rad__vp_cmp_u64);
     for (q = 0; q < (size_t)total; ++q)
         if (q == 0 || cand[q] != cand[q - 1]) cand[ncand++] = cand[q];
-    vp->candidate_voxels = ncand;
-    b->cand = cand;
-
-    /* exact surface area per candidate voxel and axis: each triangle clipped to the voxels its
-       bounds overlap, times the split weights of its normal */
     cand_area = (double *)rad__alloc_array(A, ncand, 6 * sizeof(double));
-    if (!cand_area) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    if (!cand_area) {
+        rad__free(A, cand);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
     memset(cand_area, 0, sizeof(double) * 6u * ncand);
     for (t = 0; t < S->triangle_count; ++t) {
         const float *tv = S->positions + 9 * (size_t)t;
-        int64_t i0[3], i1[3], x, y, z;
         float wt[6];
+        int one = rad__vp_tri_cells(vp, tv, i0, i1) == 1u;
         rad__vp_weights(b->o.weights, S->normals + 3 * (size_t)t, wt);
-        for (k = 0; k < 3; ++k) {
-            float mn = tv[k], mx = tv[k];
-            if (tv[3 + k] < mn) mn = tv[3 + k];
-            if (tv[6 + k] < mn) mn = tv[6 + k];
-            if (tv[3 + k] > mx) mx = tv[3 + k];
-            if (tv[6 + k] > mx) mx = tv[6 + k];
-            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
-            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
-            if (i0[k] < 0) i0[k] = 0;
-            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
-        }
         for (z = i0[2]; z <= i1[2]; ++z)
             for (y = i0[1]; y <= i1[1]; ++y)
                 for (x = i0[0]; x <= i1[0]; ++x) {
@@ -18736,7 +18749,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
                         hi[k] = lo[k] + (double)vp->voxel_size[k];
                     }
                     /* a triangle inside one voxel needs no clipping */
-                    ar = (i0[0] == i1[0] && i0[1] == i1[1] && i0[2] == i1[2]) ? (double)S->areas[t] : rad__vp_clip_area(tv, lo, hi);
+                    ar = one ? (double)S->areas[t] : rad__vp_clip_area(tv, lo, hi);
                     if (!(ar > 0.0)) continue;
                     while (lo_i < hi_i) {
                         uint32_t mid = lo_i + (hi_i - lo_i) / 2;
@@ -18746,6 +18759,100 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
                     for (k = 0; k < 6; ++k) cand_area[6 * (size_t)lo_i + k] += ar * (double)wt[k];
                 }
     }
+    *out_cand = cand;
+    *out_count = ncand;
+    *out_area = cand_area;
+    return RAD_SUCCESS;
+}
+
+/* BUILD steps 5 and 6: the form factors into vp->matrix (dense: 'bytes' of N x N floats; sparse
+   rows: chunks of row voxels), with the task scratch in b (freed by the caller) */
+static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size_t bytes)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_allocator *A = &vp->allocator;
+    uint32_t N = vp->count, v, i;
+    rad_result r;
+    uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
+    /* sparse rows: the rows of a chunk of row voxels at a time (at least one voxel's six,
+       else at most RAD_VP_ROW_CHUNK_BYTES), never N x N */
+    size_t budget = (size_t)RAD_VP_ROW_CHUNK_BYTES;
+    if (b->o.storage == RAD_STORAGE_SPARSE) {
+        uint32_t most = 0;
+        for (v = 0; v < vp->voxel_count; ++v)
+            if (vp->voxel_first[v + 1] - vp->voxel_first[v] > most) most = vp->voxel_first[v + 1] - vp->voxel_first[v];
+        if (budget < (size_t)most * N * sizeof(float)) budget = (size_t)most * N * sizeof(float);
+        if (budget < bytes) bytes = budget;
+    }
+    b->P = (float *)rad__alloc(A, bytes);
+    if (!b->P) return RAD_ERROR_OUT_OF_MEMORY;
+    if (b->o.storage != RAD_STORAGE_SPARSE) {
+        vp->matrix.rows = vp->matrix.cols = N;
+        vp->matrix.storage = RAD_STORAGE_DENSE;
+        vp->matrix.dense = b->P; /* owned by vp from here on */
+    }
+    rad__ctx cc = *c;
+    rad__vp_progress prog;
+    prog.fn = c->progress;
+    prog.user = c->progress_user;
+    if (c->progress) {
+        cc.progress = rad__vp_progress_fn;
+        cc.progress_user = &prog;
+    }
+    b->occ = (uint8_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, 1);
+    b->ray_i = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    b->ray_j = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    b->ray_g = (float *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(float));
+    b->rays_cast = (uint64_t *)rad__alloc_array(A, T, sizeof(uint64_t));
+    b->acc = (double *)rad__alloc_array(A, (size_t)T * 6u, (size_t)N * sizeof(double));
+    b->rowf = (float *)rad__alloc_array(A, N, sizeof(float));
+    if (b->o.visibility_rays > 0 && !b->o.skip_visibility)
+        b->pairs = (rad__vp_pair *)rad__alloc_array(A, (size_t)T * RAD__VP_PAIRS, sizeof(rad__vp_pair));
+    if (!b->occ || !b->ray_i || !b->ray_j || !b->ray_g || !b->rays_cast || !b->acc || !b->rowf ||
+        (b->o.visibility_rays > 0 && !b->o.skip_visibility && !b->pairs)) {
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(b->rays_cast, 0, sizeof(uint64_t) * T);
+    /* progress of this stage maps to [0.1, 1] */
+    if (c->progress && c->progress(c->progress_user, 0.1f)) return RAD_ERROR_CANCELLED;
+    if (b->o.storage == RAD_STORAGE_SPARSE) {
+        r = rad__vp_sparse_rows(b, c, T, budget);
+        for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+        return r;
+    }
+    r = rad__for_rows(&cc, vp->voxel_count, T, b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled : rad__vp_ff_row, b);
+    for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+    if (r == RAD_SUCCESS) {
+        cc.progress = NULL;
+        r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
+        if (r == RAD_SUCCESS && !b->o.keep_row_sums) r = rad__for_rows(&cc, N, T, rad__vp_rowsum_row, b);
+        else if (r == RAD_SUCCESS)
+            for (i = 0; i < N; ++i) b->rowf[i] = 1.0f;
+        if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
+    }
+    if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
+    return r;
+}
+
+static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_scene *S = b->S;
+    const rad_allocator *A = &vp->allocator;
+    uint64_t *cand = NULL;
+    uint32_t ncand = 0, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
+    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL, *voxel_cand = NULL;
+    double *cand_area = NULL;
+    float *s_pos = NULL, *s_bary = NULL;
+    size_t bytes;
+    rad_result r = RAD_SUCCESS;
+    int k;
+
+    /* 1. candidate voxels and their exact areas */
+    r = rad__vp_candidates(b, c, &cand, &ncand, &cand_area);
+    if (r != RAD_SUCCESS) return r;
+    vp->candidate_voxels = ncand;
+    b->cand = cand;
 
     /* 2. face rays, chunk by chunk; samples appended in voxel order */
     chunk = RAD__VP_CHUNK_RAYS / (6u * P);
@@ -18965,67 +19072,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     b->cand = NULL;
     rad__free(A, cand_first);
     cand_first = NULL;
-    {
-        uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
-        /* sparse rows: the rows of a chunk of row voxels at a time (at least one voxel's six,
-           else at most RAD_VP_ROW_CHUNK_BYTES), never N x N */
-        size_t budget = (size_t)RAD_VP_ROW_CHUNK_BYTES;
-        if (b->o.storage == RAD_STORAGE_SPARSE) {
-            uint32_t most = 0;
-            for (v = 0; v < vp->voxel_count; ++v)
-                if (vp->voxel_first[v + 1] - vp->voxel_first[v] > most) most = vp->voxel_first[v + 1] - vp->voxel_first[v];
-            if (budget < (size_t)most * N * sizeof(float)) budget = (size_t)most * N * sizeof(float);
-            if (budget < bytes) bytes = budget;
-        }
-        b->P = (float *)rad__alloc(A, bytes);
-        if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-        if (b->o.storage != RAD_STORAGE_SPARSE) {
-            vp->matrix.rows = vp->matrix.cols = N;
-            vp->matrix.storage = RAD_STORAGE_DENSE;
-            vp->matrix.dense = b->P; /* owned by vp from here on */
-        }
-        rad__ctx cc = *c;
-        rad__vp_progress prog;
-        prog.fn = c->progress;
-        prog.user = c->progress_user;
-        if (c->progress) {
-            cc.progress = rad__vp_progress_fn;
-            cc.progress_user = &prog;
-        }
-        b->occ = (uint8_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, 1);
-        b->ray_i = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-        b->ray_j = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-        b->ray_g = (float *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(float));
-        b->rays_cast = (uint64_t *)rad__alloc_array(A, T, sizeof(uint64_t));
-        b->acc = (double *)rad__alloc_array(A, (size_t)T * 6u, (size_t)N * sizeof(double));
-        b->rowf = (float *)rad__alloc_array(A, N, sizeof(float));
-        if (b->o.visibility_rays > 0 && !b->o.skip_visibility)
-            b->pairs = (rad__vp_pair *)rad__alloc_array(A, (size_t)T * RAD__VP_PAIRS, sizeof(rad__vp_pair));
-        if (!b->occ || !b->ray_i || !b->ray_j || !b->ray_g || !b->rays_cast || !b->acc || !b->rowf ||
-            (b->o.visibility_rays > 0 && !b->o.skip_visibility && !b->pairs)) {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-            goto done;
-        }
-        memset(b->rays_cast, 0, sizeof(uint64_t) * T);
-        /* progress of this stage maps to [0.1, 1] */
-        if (c->progress && c->progress(c->progress_user, 0.1f)) { r = RAD_ERROR_CANCELLED; goto done; }
-        if (b->o.storage == RAD_STORAGE_SPARSE) {
-            r = rad__vp_sparse_rows(b, c, T, budget);
-            for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
-            goto done;
-        }
-        r = rad__for_rows(&cc, vp->voxel_count, T, b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled : rad__vp_ff_row, b);
-        for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
-        if (r == RAD_SUCCESS) {
-            cc.progress = NULL;
-            r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
-            if (r == RAD_SUCCESS && !b->o.keep_row_sums) r = rad__for_rows(&cc, N, T, rad__vp_rowsum_row, b);
-            else if (r == RAD_SUCCESS)
-                for (i = 0; i < N; ++i) b->rowf[i] = 1.0f;
-            if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
-        }
-        if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
-    }
+    r = rad__vp_form_factors(b, c, bytes);
 done:
     if (b->o.storage == RAD_STORAGE_SPARSE) rad__free(A, b->P); /* the chunk buffer (NULL once used) */
     rad__free(A, cand);
