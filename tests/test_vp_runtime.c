@@ -5,6 +5,8 @@
    the in-memory matrix bit for bit; a saved set loads back with the same bits and renders the
    same, and damaged sections are refused. Included by test_main.c after test_vp.c (it uses
    its scene and allocator helpers); every name is static and prefixed vpr_. */
+#include "fixtures.h"
+
 
 /* a corridor 8 x 1 x 1 (faces in) lit from its ceiling: far pairs exchange little, so a drop
    threshold leaves few entries per row */
@@ -437,3 +439,5 @@ static const rad_test_case tests_vp_runtime[] = {
     { "vp_streamed_rows", vpr_test_streamed_rows },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_vp_runtime)
