@@ -2,9 +2,9 @@
    convergence to the point-to-area closed forms as the resolution grows, clipping against the
    near plane and the base plane, enclosures whose rows sum to 1, agreement with the analytic
    method on the Cornell box, the aliasing of small patches (shown, not hidden), storage and
-   determinism, bad options and allocation failures. Included by test_main.c after
-   test_formfactor.c and test_scene.c, whose helpers it uses (ff_quad, ff_world, ff_group,
-   ff_c11, ff_c14, ff_cube_world, fx_reverse_for, sc_alloc_*); its own names are prefixed hc_. */
+   determinism, bad options and allocation failures. Uses the fixtures' quads, worlds and closed
+   forms (ff_*), fx_reverse_for and the counting allocator (sc_alloc_*); its own names are
+   prefixed hc_. */
 #include "fixtures.h"
 
 

@@ -3,8 +3,8 @@
    O(nnz) bytes; temporal radiosity over the CSR rows converges to the direct solve of the same
    patches; alias tables built row by row from rows streamed out of a saved set equal those of
    the in-memory matrix bit for bit; a saved set loads back with the same bits and renders the
-   same, and damaged sections are refused. Included by test_main.c after test_vp.c (it uses
-   its scene and allocator helpers); every name is static and prefixed vpr_. */
+   same, and damaged sections are refused. Uses the fixtures' boxes and peak allocator (vp_*);
+   every name is static and prefixed vpr_. */
 #include "fixtures.h"
 
 
