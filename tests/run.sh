@@ -138,8 +138,8 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 SAN="-g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
 
 # ---- the suites -----------------------------------------------------------------------------
-# The full sizes run in the two gcc -O2 builds (one thread, and OpenMP); the other code paths
-# (scalar, AVX, native, Embree, clang) run every test at the quick sizes, as the sanitizers do.
+# The full sizes run in the gcc -O2 build; the other code paths (OpenMP, scalar, AVX, native,
+# Embree, clang) run every test at the quick sizes, as the sanitizers do.
 # unit-O2 runs the binary built for valgrind (the same flags with -g), built once by s_unit_build.
 s_unit_build() {
     build unit-O2-g $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-O2-g" -lm || fail "unit-O2 (build)"
@@ -149,7 +149,7 @@ s_unit_O2() {
     UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" unit unit-O2
 }
 s_unit_openmp() {
-    if [ -n "$OMP" ]; then unit unit-O2-openmp $CC -std=c99 $WARN -O2 $OMP -I. tests/test_main.c
+    if [ -n "$OMP" ]; then RAD_TEST_QUICK=1 unit unit-O2-openmp $CC -std=c99 $WARN -O2 $OMP -I. tests/test_main.c
     else skip unit-O2-openmp "$CC has no OpenMP"; fi
 }
 s_unit_scalar() { RAD_TEST_QUICK=1 unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c; }
@@ -508,9 +508,9 @@ stage asan-O2-scalar s_asan_O2_scalar
 stage clang-asan-O2 s_clang_asan_O2
 stage fuzz s_fuzz
 stage vulkan s_vulkan
-stage unit-openmp s_unit_openmp
 stage unit-O2 s_unit_O2
 stage examples s_examples
+stage unit-openmp s_unit_openmp
 stage clang s_clang
 stage unit-scalar s_unit_scalar
 stage unit-avx s_unit_avx
