@@ -3,7 +3,8 @@
    the unit-embree suite, and the scene builders, allocators and worlds that several test files
    build their cases from. The functions are static inline so that a file built on its own
    compiles warning-free while leaving most of them unused. Names keep the prefix of the file
-   they came from (sc_, ff_, vp_) or fx_ for those written here. */
+   they came from (sc_, ff_, vp_, ct_, so_), so the tests that call them read as before; fx_
+   names are the ones written here. */
 #ifndef RAD_TEST_FIXTURES_H
 #define RAD_TEST_FIXTURES_H
 #define RADIOSITY_IMPLEMENTATION
@@ -18,6 +19,7 @@
 #define FF_PI 3.14159265358979323846
 #endif
 
+/* the library's own rad_bvh_destroy, defined before the Embree stand-in below redefines the name */
 static inline void rad__bvh_destroy_real(rad_bvh *bvh) { rad_bvh_destroy(bvh); }
 
 #ifdef RAD_TEST_EMBREE
