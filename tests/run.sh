@@ -142,6 +142,7 @@ SAN="-g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recov
 # Embree, clang) run every test at the quick sizes, as the sanitizers do.
 # unit-O2 runs the binary built for valgrind (the same flags with -g), built once by s_unit_build.
 s_unit_build() {
+    rm -f "$BUILD/unit-O2-g" # the suites below run it when it exists: never one from an older run
     build unit-O2-g $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-O2-g" -lm || fail "unit-O2 (build)"
 }
 s_unit_O2() {
@@ -347,6 +348,7 @@ s_tool_build() {
         return
     fi
     local f
+    rm -rf "$BUILD/rad" "$TOOL_OBJ" # the suites below run rad when it exists: never one from an older run
     mkdir -p "$TOOL_OBJ"
     for f in tools/*.c; do
         build "tool-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP -I. -c "$f" -o "$TOOL_OBJ/$(basename "$f" .c).o" ||
