@@ -94,7 +94,8 @@ stage() {
         start=$(date +%s)
         "$fn" >"$STAGES/$name.log" 2>&1
         secs=$(( $(date +%s) - start ))
-        cpu=$(cpu_seconds)
+        times >"$STAGES/$name.times" # here, not in $(...): a subshell would count its own children
+        cpu=$(cpu_seconds <"$STAGES/$name.times")
         printf '%s %s %s %s %s\n%s\n%s\n' "$PASSED" "$FAILED" "$SKIPPED" "$secs" "$cpu" "$FAILED_NAMES" "$SKIPPED_NAMES" >"$STAGES/$name.count"
         echo "  [$(date +%H:%M:%S)] $name: $PASSED passed, $FAILED failed, $SKIPPED skipped ($secs s, CPU $cpu s)"
     ) &
@@ -108,9 +109,9 @@ wanted() {
     esac
     return 0
 }
-# user + system seconds of the finished children of this (sub)shell: the second line of `times`
+# user + system seconds of the finished children, from the second line of `times` on stdin
 cpu_seconds() {
-    times | sed -n 2p | awk '{ t = 0; for (i = 1; i <= 2; ++i) { split($i, a, /[ms]/); t += a[1] * 60 + a[2] } printf "%.0f", t }'
+    sed -n 2p | awk '{ t = 0; for (i = 1; i <= 2; ++i) { split($i, a, /[ms]/); t += a[1] * 60 + a[2] } printf "%.0f", t }'
 }
 
 # ---- what this machine has (installs first: apt-get must not run beside the suites) --------
@@ -202,7 +203,7 @@ s_compile() {
     fi
 }
 
-# The examples and the fuzz harnesses call only the API: each is compiled with
+# The examples call only the API: each is compiled with
 # RADIOSITY_IMPLEMENTATION_INCLUDED predefined (so its own #define RADIOSITY_IMPLEMENTATION brings
 # in the declarations only) and linked with one object that holds the implementation, compiled
 # once with the same flags, as a program of several files would be, instead of once per program.
@@ -451,14 +452,9 @@ s_fuzz() {
            "$BUILD/make_corpus" "$BUILD/fuzz"; }; then
         fail fuzz-corpus; return
     fi
-    # the implementation once, instrumented for coverage, linked into each harness (impl_object)
-    if ! impl_object impl-fuzz clang -std=c99 -g -O1 -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all; then
-        fail "fuzz (build of the implementation)"; return
-    fi
     for f in $FUZZERS; do
         rm -f "$BUILD/fuzz_$f"
-        if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -DRADIOSITY_IMPLEMENTATION_INCLUDED \
-               -I. "fuzz/fuzz_$f.c" "$BUILD/impl-fuzz.o" -o "$BUILD/fuzz_$f" -lm &&
+        if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
            { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
            "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
                "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
