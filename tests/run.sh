@@ -355,7 +355,7 @@ s_tool_build() {
         build "tool-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP -I. -c "$f" -o "$TOOL_OBJ/$(basename "$f" .c).o" ||
             { fail "tool-build ($f)"; return; }
     done
-    if build tool-rad $CC $OMP "$TOOL_OBJ"/*.o -o "$BUILD/rad" -lassimp -lm; then pass tool-build; else fail tool-build; fi
+    if build tool-link $CC $OMP "$TOOL_OBJ"/*.o -o "$BUILD/rad" -lassimp -lm; then pass tool-build; else fail tool-build; fi
 }
 s_tool() {
     [ -x "$BUILD/rad" ] || return 0
