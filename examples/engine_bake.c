@@ -8,6 +8,7 @@
 #include "radiosity.h"
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 static int ok(rad_result r, const char *what)
 {

@@ -18,6 +18,7 @@
 #include "radiosity.h"
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 
 static const float quads[2][12] = {
     { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 },  /* z = 0, front (counter-clockwise) facing +z */

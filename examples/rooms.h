@@ -24,6 +24,7 @@
    and rad_row_source_bake) is the production path, far too slow for N = 50k on this machine. */
 #ifndef ROOMS_H_INCLUDED
 #define ROOMS_H_INCLUDED
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "../radiosity.h"

@@ -3,7 +3,10 @@
 # A suite whose tool is missing is skipped (and named); with RAD_TEST_REQUIRE_ALL=1 a skipped
 # suite counts as failed. Optional packages are installed first when we can (root with apt-get).
 # Independent suites run side by side, RAD_TEST_JOBS at a time (default: the number of CPUs);
-# each writes its own log and its own scratch folder, and the logs are printed in order at the end.
+# RAD_TEST_STAGES="examples compile" runs only the suites of those names (see the end);
+# each writes its own log and its own scratch folder, and the logs are printed in order at the end
+# with each suite's wall and CPU seconds. The unit binary that valgrind runs and the rad tool are
+# built once, first, and shared by the suites that run them.
 set -u
 cd "$(dirname "$0")/.."
 CC=${CC:-cc}
@@ -78,8 +81,10 @@ compile_run() {
 # stage NAME FUNCTION: runs FUNCTION in the background with fresh counters, its output in
 # $STAGES/NAME.log and its counts in $STAGES/NAME.count; at most $JOBS at once.
 STAGE_ORDER=""
+# RAD_TEST_STAGES="a b": only the suites of those names (and the builds they run)
 stage() {
     local name=$1 fn=$2
+    wanted "$name" || return 0
     STAGE_ORDER="$STAGE_ORDER $name"
     while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n; done
     (
@@ -89,9 +94,24 @@ stage() {
         start=$(date +%s)
         "$fn" >"$STAGES/$name.log" 2>&1
         secs=$(( $(date +%s) - start ))
-        printf '%s %s %s %s\n%s\n%s\n' "$PASSED" "$FAILED" "$SKIPPED" "$secs" "$FAILED_NAMES" "$SKIPPED_NAMES" >"$STAGES/$name.count"
-        echo "  [$(date +%H:%M:%S)] $name: $PASSED passed, $FAILED failed, $SKIPPED skipped ($secs s)"
+        times >"$STAGES/$name.times" # here, not in $(...): a subshell would count its own children
+        cpu=$(cpu_seconds <"$STAGES/$name.times")
+        printf '%s %s %s %s %s\n%s\n%s\n' "$PASSED" "$FAILED" "$SKIPPED" "$secs" "$cpu" "$FAILED_NAMES" "$SKIPPED_NAMES" >"$STAGES/$name.count"
+        echo "  [$(date +%H:%M:%S)] $name: $PASSED passed, $FAILED failed, $SKIPPED skipped ($secs s, CPU $cpu s)"
     ) &
+}
+wanted() {
+    local w=" ${RAD_TEST_STAGES:-$1} "
+    case "$1" in
+        build-unit) [ -n "${w##* unit-O2 *}" ] && [ -n "${w##* valgrind-1 *}" ] && [ -n "${w##* valgrind-2 *}" ] && [ -n "${w##* build-unit *}" ] && return 1 ;;
+        build-tool) [ -n "${w##* tool *}" ] && [ -n "${w##* report *}" ] && [ -n "${w##* dist *}" ] && [ -n "${w##* build-tool *}" ] && return 1 ;;
+        *) [ -n "${w##* $1 *}" ] && return 1 ;;
+    esac
+    return 0
+}
+# user + system seconds of the finished children, from the second line of `times` on stdin
+cpu_seconds() {
+    sed -n 2p | awk '{ t = 0; for (i = 1; i <= 2; ++i) { split($i, a, /[ms]/); t += a[1] * 60 + a[2] } printf "%.0f", t }'
 }
 
 # ---- what this machine has (installs first: apt-get must not run beside the suites) --------
@@ -120,18 +140,28 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 SAN="-g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
 
 # ---- the suites -----------------------------------------------------------------------------
-s_unit_O2() { unit unit-O2 $CC -std=c99 $WARN -O2 -I. tests/test_main.c; }
+# The full sizes run in the gcc -O2 build; the other code paths (OpenMP, scalar, AVX, native,
+# Embree, clang) run every test at the quick sizes, as the sanitizers do.
+# unit-O2 runs the binary built for valgrind (the same flags with -g), built once by s_unit_build.
+s_unit_build() {
+    rm -f "$BUILD/unit-O2-g" # the suites below run it when it exists: never one from an older run
+    build unit-O2-g $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-O2-g" -lm || fail "unit-O2 (build)"
+}
+s_unit_O2() {
+    [ -x "$BUILD/unit-O2-g" ] || return 0
+    UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" unit unit-O2
+}
 s_unit_openmp() {
-    if [ -n "$OMP" ]; then unit unit-O2-openmp $CC -std=c99 $WARN -O2 $OMP -I. tests/test_main.c
+    if [ -n "$OMP" ]; then RAD_TEST_QUICK=1 unit unit-O2-openmp $CC -std=c99 $WARN -O2 $OMP -I. tests/test_main.c
     else skip unit-O2-openmp "$CC has no OpenMP"; fi
 }
-s_unit_scalar() { unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c; }
-s_unit_avx() { unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c; }
+s_unit_scalar() { RAD_TEST_QUICK=1 unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c; }
+s_unit_avx() { RAD_TEST_QUICK=1 unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c; }
 # gnu99: contraction into FMA on, as in a default gcc build (the watertight test must hold)
-s_unit_native() { unit unit-native $CC -std=gnu99 $WARN -O2 -march=native $OMP -I. tests/test_main.c; }
+s_unit_native() { RAD_TEST_QUICK=1 unit unit-native $CC -std=gnu99 $WARN -O2 -march=native $OMP -I. tests/test_main.c; }
 s_unit_embree() {
     if [ -f /usr/include/embree3/rtcore.h ]; then
-        unit unit-embree $CC -std=c99 $WARN -O2 $OMP -DRAD_EMBREE -DRAD_TEST_EMBREE -I. tests/test_main.c -lembree3
+        RAD_TEST_QUICK=1 unit unit-embree $CC -std=c99 $WARN -O2 $OMP -DRAD_EMBREE -DRAD_TEST_EMBREE -I. tests/test_main.c -lembree3
     else
         skip unit-embree "Embree 3 is not installed (package libembree-dev)"
     fi
@@ -156,6 +186,14 @@ s_compile() {
     else
         fail link-c-and-cpp
     fi
+    # each unit-test file also builds on its own (fixtures.h, RAD_TEST_MAIN; test_tool.c is one
+    # already): no file may use another's helpers (a syntax check; the unit builds compile them)
+    local t alone=1
+    for t in tests/test_*.c; do
+        case "$t" in tests/test_main.c | tests/test_tool.c | tests/test_vulkan.c | tests/test_shading_vulkan.c) continue ;; esac
+        build "alone-$(basename "$t" .c)" $CC -std=c99 $WARN $OMP -fsyntax-only -I. "$t" || alone=0
+    done
+    if [ $alone = 1 ]; then pass test-files-alone; else fail test-files-alone; fi
     # ---- GLSL: the header holds the current glsl/ sources
     if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
        "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
@@ -166,15 +204,30 @@ s_compile() {
     fi
 }
 
+# The examples call only the API: each is compiled with
+# RADIOSITY_IMPLEMENTATION_INCLUDED predefined (so its own #define RADIOSITY_IMPLEMENTATION brings
+# in the declarations only) and linked with one object that holds the implementation, compiled
+# once with the same flags, as a program of several files would be, instead of once per program.
+# The serial object is built without OpenMP, for the examples that need only a C compiler.
+impl_object() { # NAME, then the compiler and its flags
+    local name=$1; shift
+    printf '#define RADIOSITY_IMPLEMENTATION\n#include "radiosity.h"\n' >"$BUILD/$name.c"
+    build "$name" "$@" -I. -c "$BUILD/$name.c" -o "$BUILD/$name.o"
+}
 s_examples() {
-    if build demo $CC -std=c99 $WARN -O2 $OMP -I. examples/cornell.c -o "$BUILD/cornell" -lm &&
+    local EX="$CC -std=c99 $WARN -O2 -DRADIOSITY_IMPLEMENTATION_INCLUDED -I."
+    local IMPL_OMP="$OMP $BUILD/impl-examples.o" IMPL_SERIAL="$BUILD/impl-examples-serial.o"
+    if ! impl_object impl-examples $CC -std=c99 $WARN -O2 $OMP || ! impl_object impl-examples-serial $CC -std=c99 $WARN -O2; then
+        fail "examples (build of the implementation)"; return
+    fi
+    if build demo $EX examples/cornell.c $IMPL_OMP -o "$BUILD/cornell" -lm &&
        "$BUILD/cornell" --patches 300 --size 96x96 -o "$BUILD/cornell-small.png" >"$BUILD/demo.out" 2>&1 &&
        [ -s "$BUILD/cornell-small.png" ]; then
         pass demo-small
     else
         fail demo-small
     fi
-    if build gallery $CC -std=c99 $WARN -O2 -I. examples/gallery.c -o "$BUILD/gallery" -lm &&
+    if build gallery $EX examples/gallery.c $IMPL_SERIAL -o "$BUILD/gallery" -lm &&
        "$BUILD/gallery" --size 12 -o "$BUILD/gallery-small.png" >"$BUILD/gallery.out" 2>&1 &&
        [ -s "$BUILD/gallery-small.png" ]; then
         pass gallery-small
@@ -182,16 +235,16 @@ s_examples() {
         fail gallery-small
     fi
     # hierarchical radiosity's links as an image
-    if build learn-hierarchical $CC -std=c99 $WARN -O2 -I. examples/learn_hierarchical.c -o "$BUILD/learn_hierarchical" -lm &&
+    if build learn-hierarchical $EX examples/learn_hierarchical.c $IMPL_SERIAL -o "$BUILD/learn_hierarchical" -lm &&
        "$BUILD/learn_hierarchical" --eps 1e-2 --size 64 -o "$BUILD/learn-hierarchical.png" >"$BUILD/learn-hierarchical.out" 2>&1 &&
        [ -s "$BUILD/learn-hierarchical.png" ] && grep -q 'links' "$BUILD/learn-hierarchical.out"; then
         pass learn-hierarchical
     else
         fail learn-hierarchical
     fi
-    compile_run quickstart $CC -std=c99 $WARN -O2 -I. examples/quickstart.c -o "$BUILD/quickstart" -lm
-    compile_run engine_bake $CC -std=c99 $WARN -O2 -I. examples/engine_bake.c -o "$BUILD/engine_bake" -lm
-    if build lightmap-example $CC -std=c99 $WARN -O2 $OMP -I. examples/lightmap.c -o "$BUILD/lightmap" -lm &&
+    compile_run quickstart $EX examples/quickstart.c $IMPL_SERIAL -o "$BUILD/quickstart" -lm
+    compile_run engine_bake $EX examples/engine_bake.c $IMPL_SERIAL -o "$BUILD/engine_bake" -lm
+    if build lightmap-example $EX examples/lightmap.c $IMPL_OMP -o "$BUILD/lightmap" -lm &&
        "$BUILD/lightmap" --size 32 --patches 100 -o "$BUILD/lightmap-small.png" >"$BUILD/lightmap.out" 2>&1 &&
        [ -s "$BUILD/lightmap-small.png" ] && grep -q "valid" "$BUILD/lightmap.out"; then
         pass lightmap-small
@@ -199,14 +252,14 @@ s_examples() {
         fail lightmap-small
     fi
     # the virtual-patch example builds and, without the external meshes, says it skipped
-    if build vp-bunny $CC -std=c99 $WARN -O2 $OMP -I. examples/vp_bunny.c -o "$BUILD/vp_bunny" -lm &&
+    if build vp-bunny $EX examples/vp_bunny.c $IMPL_OMP -o "$BUILD/vp_bunny" -lm &&
        "$BUILD/vp_bunny" --data "$BUILD/no-such-data" >"$BUILD/vp_bunny.out" 2>&1 && grep -q skipped "$BUILD/vp_bunny.out"; then
         pass vp-bunny-skip
     else
         fail vp-bunny-skip
     fi
     # the engine loop over virtual patches: every stage timed, and the light reaches the vertices
-    if build realtime $CC -std=c99 $WARN -O2 $OMP -I. examples/realtime.c -o "$BUILD/realtime" -lm &&
+    if build realtime $EX examples/realtime.c $IMPL_OMP -o "$BUILD/realtime" -lm &&
        "$BUILD/realtime" --patches 200 --frames 12 >"$BUILD/realtime.out" 2>&1 &&
        grep -q "mean per frame over 12 frames: E update" "$BUILD/realtime.out" &&
        awk '$1 == 11 { exit !($5 > 0) }' "$BUILD/realtime.out"; then
@@ -215,7 +268,7 @@ s_examples() {
         sed "s/^/    /" "$BUILD/realtime.out" 2>/dev/null | tail -5
         fail realtime-small
     fi
-    if build walk $CC -std=c99 $WARN -O2 $OMP -I. examples/walk.c -o "$BUILD/walk" -lm &&
+    if build walk $EX examples/walk.c $IMPL_OMP -o "$BUILD/walk" -lm &&
        "$BUILD/walk" --grid 2 --m 256 --frames 2 --size 64x36 -o "$BUILD/walk-small" >"$BUILD/walk.out" 2>&1 &&
        [ -s "$BUILD/walk-small_001.png" ]; then
         pass walk-small
@@ -223,7 +276,7 @@ s_examples() {
         fail walk-small
     fi
     # temporal radiosity under a moving light: frames 0 and 3 written, different, 4 error rows
-    if build moving-light $CC -std=c99 $WARN -O2 $OMP -I. examples/moving_light.c -o "$BUILD/moving_light" -lm &&
+    if build moving-light $EX examples/moving_light.c $IMPL_OMP -o "$BUILD/moving_light" -lm &&
        "$BUILD/moving_light" --patches 150 --frames 4 --every 3 --size 32x32 -o "$BUILD/moving-small" >"$BUILD/moving-light.out" 2>&1 &&
        [ -s "$BUILD/moving-small_0000.png" ] && [ -s "$BUILD/moving-small_0003.png" ] && [ ! -e "$BUILD/moving-small_0001.png" ] &&
        ! cmp -s "$BUILD/moving-small_0000.png" "$BUILD/moving-small_0003.png" &&
@@ -233,14 +286,14 @@ s_examples() {
         fail moving-light-small
     fi
     # the teaching examples, at small sizes: each prints its table
-    compile_run learn_formfactors $CC -std=c99 $WARN -O2 -I. examples/learn_formfactors.c -o "$BUILD/learn_formfactors" -lm
-    if build learn_solvers $CC -std=c99 $WARN -O2 $OMP -I. examples/learn_solvers.c -o "$BUILD/learn_solvers" -lm &&
+    compile_run learn_formfactors $EX examples/learn_formfactors.c $IMPL_SERIAL -o "$BUILD/learn_formfactors" -lm
+    if build learn_solvers $EX examples/learn_solvers.c $IMPL_OMP -o "$BUILD/learn_solvers" -lm &&
        "$BUILD/learn_solvers" --patches 100 --iterations 4 >"$BUILD/learn_solvers.out" 2>&1; then
         pass learn_solvers
     else
         fail learn_solvers
     fi
-    if build learn_stochastic $CC -std=c99 $WARN -O2 $OMP -I. examples/learn_stochastic.c -o "$BUILD/learn_stochastic" -lm &&
+    if build learn_stochastic $EX examples/learn_stochastic.c $IMPL_OMP -o "$BUILD/learn_stochastic" -lm &&
        "$BUILD/learn_stochastic" --patches 60 --max-rays 4000 >"$BUILD/learn_stochastic.out" 2>&1; then
         pass learn_stochastic
     else
@@ -290,15 +343,25 @@ s_vulkan() {
 TOOL_EXR=""; TOOL_EXR_LIB=""
 [ -f /usr/include/tinyexr.h ] && { TOOL_EXR="-DRAD_TOOL_EXR"; TOOL_EXR_LIB="-ltinyexr"; }
 have_tool_deps() { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; }
-s_tool() {
+# The tool's objects, compiled once: rad links them with main.c, rad-mpi with its own main; the
+# tool, report and distributed suites all run this rad.
+TOOL_OBJ="$BUILD/tool-obj"
+s_tool_build() {
     if ! have_tool_deps; then
         skip tool-suites "assimp or stb is not installed (packages libassimp-dev libstb-dev)"
         return
     fi
-    if ! build tool-rad $CC -std=c99 $WARN -O2 $OMP $TOOL_EXR -I. tools/*.c -o "$BUILD/rad" -lassimp $TOOL_EXR_LIB -lm; then
-        fail tool-build; return
-    fi
-    pass tool-build
+    local f
+    rm -rf "$BUILD/rad" "$TOOL_OBJ" # the suites below run rad when it exists: never one from an older run
+    mkdir -p "$TOOL_OBJ"
+    for f in tools/*.c; do
+        build "tool-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP -I. $TOOL_EXR -c "$f" -o "$TOOL_OBJ/$(basename "$f" .c).o" ||
+            { fail "tool-build ($f)"; return; }
+    done
+    if build tool-link $CC $OMP "$TOOL_OBJ"/*.o -o "$BUILD/rad" -lassimp $TOOL_EXR_LIB -lm; then pass tool-build; else fail tool-build; fi
+}
+s_tool() {
+    [ -x "$BUILD/rad" ] || return 0
     echo "== tool tests"
     local out nf ns
     out=$(bash tests/tool_tests.sh "$BUILD/rad" 2>&1)
@@ -317,34 +380,27 @@ s_tool() {
     fi
 }
 # the evaluation report at quick quality (make report-quick): every table cell filled, every
-# image written (tools/report.sh --check); its own build of the tool so it can run beside s_tool
+# image written (tools/report.sh --check)
 s_report() {
-    have_tool_deps || return 0
-    if build report-rad $CC -std=c99 $WARN -O2 $OMP $TOOL_EXR -I. tools/*.c -o "$BUILD/rad-report" -lassimp $TOOL_EXR_LIB -lm &&
-       build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
+    [ -x "$BUILD/rad" ] || return 0
+    if build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
        bash tools/report.sh --quick --out "$BUILD/report-quick" \
-           --rad "$BUILD/rad-report" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
+           --rad "$BUILD/rad" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
         pass "report-quick ($(tail -n 1 "$BUILD/report-quick.log" | sed 's/.*: \([0-9]* table rows, [0-9]* images\).*/\1/'))"
     else
         fail report-quick; tail -n 20 "$BUILD/report-quick.log" | sed 's/^/    /'
     fi
 }
-# the distributed bake (tests/dist_tests.sh): shards, merge and, with OpenMPI, tools/rad-mpi.
-# The tool's objects are compiled once and linked twice: rad with main.c, rad-mpi with its own.
+# the distributed bake (tests/dist_tests.sh): shards, merge and, with OpenMPI, tools/rad-mpi
+# (the tool's objects linked with its own main)
 s_dist() {
-    have_tool_deps || return 0
-    local o="$BUILD/dist-obj" f mpi="" out nf ns
-    mkdir -p "$o"
-    for f in tools/*.c; do
-        build "dist-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP $TOOL_EXR -I. -c "$f" -o "$o/$(basename "$f" .c).o" ||
-            { fail "dist (build $f)"; return; }
-    done
-    if ! build dist-rad $CC $OMP "$o"/*.o -o "$BUILD/rad-dist" -lassimp $TOOL_EXR_LIB -lm ||
-       ! build dist-part-edit $CC -std=c99 $WARN -O2 -I. tests/dist_part_edit.c -o "$BUILD/dist_part_edit" -lm; then
+    [ -x "$BUILD/rad" ] || return 0
+    local mpi="" out nf ns
+    if ! build dist-part-edit $CC -std=c99 $WARN -O2 -I. tests/dist_part_edit.c -o "$BUILD/dist_part_edit" -lm; then
         fail "dist (build)"; return
     fi
     if have mpicc && have mpirun; then
-        if build rad-mpi mpicc -std=c99 $WARN -O2 $OMP -I. tools/mpi/rad_mpi.c $(ls "$o"/*.o | grep -v '/main\.o$') \
+        if build rad-mpi mpicc -std=c99 $WARN -O2 $OMP -I. tools/mpi/rad_mpi.c $(ls "$TOOL_OBJ"/*.o | grep -v '/main\.o$') \
                -o "$BUILD/rad-mpi" -lassimp $TOOL_EXR_LIB -lm; then
             mpi="$BUILD/rad-mpi"
         else
@@ -352,7 +408,7 @@ s_dist() {
         fi
     fi
     echo "== distributed bake"
-    out=$(bash tests/dist_tests.sh "$BUILD/rad-dist" "$BUILD/dist_part_edit" "$mpi" 2>&1)
+    out=$(bash tests/dist_tests.sh "$BUILD/rad" "$BUILD/dist_part_edit" "$mpi" 2>&1)
     echo "$out" | grep -E '^(ok|FAIL)' | sed 's/^/  /'
     PASSED=$((PASSED + $(echo "$out" | grep -c '^ok')))
     nf=$(echo "$out" | grep -c '^FAIL')
@@ -369,7 +425,7 @@ s_test_tool() {
 # ---- clang
 s_clang() {
     if ! { have clang && have clang++; }; then skip clang-suites "clang is not installed (package clang)"; return; fi
-    unit unit-clang-O2 clang -std=c99 $WARN -O2 -I. tests/test_main.c
+    RAD_TEST_QUICK=1 unit unit-clang-O2 clang -std=c99 $WARN -O2 -I. tests/test_main.c
     compile_run compile-clang-c99 clang -std=c99 $WARN -I. tests/compile_c99.c -o "$BUILD/compile-clang-c99" -lm
     compile_run compile-clang-cpp11 clang++ -std=c++11 -Wall -Wextra -Wpedantic -Werror -I. tests/compile_cpp.cpp -o "$BUILD/compile-clang-cpp11" -lm
 }
@@ -417,18 +473,17 @@ s_fuzz() {
 # Left out: tests that repeat the same computations in other orders or at other scales (they
 # are a third of its time; every build above runs them, five under the sanitizers), and the
 # stochastic statistics (16 seeds of the same solve; the furnace and thread tests keep both
-# estimators under valgrind)
+# estimators under valgrind); also the larger repeats of code the other tests cover: the
+# hierarchical solve at ever smaller tolerances, the lightmap on the whole Cornell box, the box
+# at six scales, the reorderings again on a scrambled patch order
 VALGRIND_SHARDS=2
 VALGRIND_SKIP=formfactor_determinism,robust_determinism,solve_jacobi_deterministic,solve_cornell_agree,robust_scale_invariance,robust_nearly_parallel,formfactor_c41_disks,stochastic_mean_jacobi,stochastic_mean_walk,stochastic_variance_jacobi,stochastic_variance_walk
-s_valgrind_build() {
-    if ! have valgrind; then skip valgrind-memcheck "valgrind is not installed (package valgrind)"; return; fi
-    build unit-valgrind $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-valgrind" -lm ||
-        fail "valgrind-memcheck (build)"
-}
+VALGRIND_SKIP="$VALGRIND_SKIP,hierarchical_converges,lightmap_cornell,regress_scene_scale,multibounce: reordering methods on a scrambled patch order"
 s_valgrind_shard() {
     local i=$1
-    [ -x "$BUILD/unit-valgrind" ] || return 0
-    RAD_TEST_QUICK=1 RAD_TEST_SHARD="$i/$VALGRIND_SHARDS" RAD_TEST_SKIP="$VALGRIND_SKIP" UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-valgrind" \
+    if ! have valgrind; then [ "$i" != 0 ] || skip valgrind-memcheck "valgrind is not installed (package valgrind)"; return; fi
+    [ -x "$BUILD/unit-O2-g" ] || return 0
+    RAD_TEST_QUICK=1 RAD_TEST_SHARD="$i/$VALGRIND_SHARDS" RAD_TEST_SKIP="$VALGRIND_SKIP" UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" \
         UNIT_WRAP="valgrind --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --quiet" \
         unit "valgrind-memcheck-$((i + 1))of$VALGRIND_SHARDS"
 }
@@ -437,10 +492,11 @@ s_valgrind_1() { s_valgrind_shard 1; }
 
 # ---- run: the longest first, so the last to finish are short ----------------------------
 echo "running the suites, $JOBS at a time (logs in $STAGES)"
-s_valgrind_build >"$STAGES/valgrind-build.log" 2>&1
-printf '%s %s %s 0\n%s\n%s\n' "$PASSED" "$FAILED" "$SKIPPED" "$FAILED_NAMES" "$SKIPPED_NAMES" >"$STAGES/valgrind-build.count"
-STAGE_ORDER="valgrind-build"
-PASSED=0; FAILED=0; SKIPPED=0; SKIPPED_NAMES=""; FAILED_NAMES=""
+RUN_START=$(date +%s)
+# first the shared builds, side by side; the suites that run them start when both are done
+stage build-unit s_unit_build
+stage build-tool s_tool_build
+wait
 stage valgrind-1 s_valgrind_0
 stage valgrind-2 s_valgrind_1
 stage asan-O0 s_asan_O0
@@ -454,33 +510,36 @@ stage clang-asan-O2 s_clang_asan_O2
 stage fuzz s_fuzz
 stage vulkan s_vulkan
 stage unit-O2 s_unit_O2
+stage examples s_examples
 stage unit-openmp s_unit_openmp
+stage clang s_clang
 stage unit-scalar s_unit_scalar
 stage unit-avx s_unit_avx
 stage unit-native s_unit_native
 stage unit-embree s_unit_embree
-stage clang s_clang
-stage examples s_examples
 stage compile s_compile
 stage test-tool s_test_tool
 wait
+RUN_SECS=$(( $(date +%s) - RUN_START ))
 
 echo
+CPU_TOTAL=0
 for name in $STAGE_ORDER; do
     c="$STAGES/$name.count"
     if [ ! -f "$c" ]; then
         echo "== [$name] printed no counts"; cat "$STAGES/$name.log" 2>/dev/null
         FAILED=$((FAILED + 1)); FAILED_NAMES="$FAILED_NAMES $name(stage)"; continue
     fi
-    read -r p f s secs <"$c"
-    echo "==== [$name: $secs s]"
+    read -r p f s secs cpu <"$c"
+    echo "==== [$name: $secs s, CPU $cpu s]"
     cat "$STAGES/$name.log"
-    PASSED=$((PASSED + p)); FAILED=$((FAILED + f)); SKIPPED=$((SKIPPED + s))
+    PASSED=$((PASSED + p)); FAILED=$((FAILED + f)); SKIPPED=$((SKIPPED + s)); CPU_TOTAL=$((CPU_TOTAL + cpu))
     FAILED_NAMES="$FAILED_NAMES$(sed -n 2p "$c")"
     SKIPPED_NAMES="$SKIPPED_NAMES$(sed -n 3p "$c")"
 done
 
 echo
+echo "suites: $RUN_SECS s wall, $CPU_TOTAL s CPU, $JOBS at a time"
 [ -z "$SKIPPED_NAMES" ] || echo "skipped suites:$SKIPPED_NAMES"
 [ -z "$FAILED_NAMES" ] || echo "failed:$FAILED_NAMES"
 if [ "$SKIPPED" -gt 0 ]; then

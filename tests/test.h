@@ -1,12 +1,18 @@
-/* test.h - the tiny harness shared by the unit-test files (included once, by test_main.c).
+/* test.h - the tiny harness shared by the unit-test files (through fixtures.h).
    A test is a function void f(void); CHECK* record failures and keep going; each test file
-   ends with a table of its tests. */
+   ends with a table of its tests and RAD_TEST_MAIN(table), which is the file's main when it
+   is built on its own and nothing inside test_main.c (which defines RAD_TEST_ALL and runs
+   every table). Usage of either binary: [NAME-SUBSTRING]; prints "N passed, N failed" last.
+   Environment: RAD_TEST_QUICK=1 smaller sizes; RAD_TEST_SHARD=i/n every n-th test from the
+   i-th; RAD_TEST_SKIP=a,b leaves out the tests of those names; RAD_TEST_TIMES=1 CPU seconds
+   per test; RAD_TEST_TMPDIR where scratch files go. */
 #ifndef RAD_TEST_H
 #define RAD_TEST_H
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
+#include <time.h>
 
 typedef struct rad_test_case { const char *name; void (*fn)(void); } rad_test_case;
 
@@ -75,5 +81,67 @@ static const char *rad_test_path(const char *name)
     snprintf(out, sizeof(buf[0]), "%s/rad_test_%s", dir, name);
     return out;
 }
+
+/* 1 when 'name' is one of the comma-separated names in 'list' */
+static int rad_test_listed(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    const char *p = list;
+    while (*p) {
+        const char *e = strchr(p, ',');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (len == n && strncmp(p, name, n) == 0) return 1;
+        if (!e) break;
+        p = e + 1;
+    }
+    return 0;
+}
+
+/* Runs the tests of 'count' tables (filtered by argv[1] and the environment above); returns
+   the exit status. */
+static int rad_test_run(const rad_test_case *const *tables, size_t count, int argc, char **argv)
+{
+    int passed = 0, failed = 0;
+    int times = getenv("RAD_TEST_TIMES") != NULL; /* CPU seconds per test, to keep the suite short */
+    size_t t;
+    unsigned shard = 0, shards = 1, index = 0; /* RAD_TEST_SHARD=i/n: every n-th test from the i-th */
+    const char *sh = getenv("RAD_TEST_SHARD"), *skip = getenv("RAD_TEST_SKIP");
+    if (sh && (sscanf(sh, "%u/%u", &shard, &shards) != 2 || shards == 0 || shard >= shards)) {
+        printf("RAD_TEST_SHARD='%s' is not i/n with i < n\n", sh);
+        return 2;
+    }
+    (void)&rad_test_quick; /* helpers some builds do not call */
+    (void)&rad_test_path;
+    for (t = 0; t < count; ++t) {
+        const rad_test_case *c;
+        for (c = tables[t]; c->name; ++c) {
+            clock_t t0;
+            if (argc > 1 && !strstr(c->name, argv[1])) continue;
+            if (skip && rad_test_listed(skip, c->name)) continue;
+            if (index++ % shards != shard) continue;
+            rad_test_failures = 0;
+            printf("%s\n", c->name);
+            fflush(stdout);
+            t0 = clock();
+            c->fn();
+            if (times) printf("  time %s %.2f s\n", c->name, (double)(clock() - t0) / CLOCKS_PER_SEC);
+            if (rad_test_failures) { printf("  FAILED %s (%d checks)\n", c->name, rad_test_failures); failed++; }
+            else passed++;
+        }
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
+
+#ifdef RAD_TEST_ALL
+#define RAD_TEST_MAIN(table)
+#else
+#define RAD_TEST_MAIN(table)                                                                         \
+    int main(int argc, char **argv)                                                                  \
+    {                                                                                                \
+        static const rad_test_case *const tables_[] = { table };                                     \
+        return rad_test_run(tables_, 1, argc, argv);                                                 \
+    }
+#endif
 
 #endif

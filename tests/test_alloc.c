@@ -3,6 +3,8 @@
    tables and the temporal state with two steps. Every call returns success or
    RAD_ERROR_OUT_OF_MEMORY, nothing leaks and no block is overrun (the counting allocator of
    test_scene.c with its canaries). */
+#include "fixtures.h"
+
 
 static void al_test_methods(void)
 {
@@ -98,3 +100,5 @@ static const rad_test_case tests_alloc[] = {
     { "alloc_failure_methods", al_test_methods },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_alloc)

@@ -4,6 +4,8 @@
    returning void / float / uint32 / pointers must not crash on NULL and return their neutral
    value. Organised as tables of small named cases; a failing case prints its name.
    Everything static and prefixed api_. */
+#include "fixtures.h"
+
 
 /* A call that once crashed (a NULL dereference in the library, since fixed) is made through
    API_CRASHER so it stands out in the source. */
@@ -34,20 +36,13 @@ typedef struct api_fx {
 static api_fx api_f;
 
 /* the fixture is built serially: the OpenMP default pays a parallel region per LU column */
-static void api_serial_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = 0; i < count; ++i) fn(data, i);
-}
-
 static int api_fx_build(api_fx *f)
 {
     rad_form_factor_options fo;
     rad_solve_options so;
     rad_context serial;
     memset(&serial, 0, sizeof(serial));
-    serial.parallel_for = api_serial_for;
+    serial.parallel_for = fx_serial_for;
     memset(f, 0, sizeof(*f));
     rad_cornell_box(&f->desc, NULL);
     if (rad_scene_create(&f->desc, NULL, &f->scene) != RAD_SUCCESS) return 0;
@@ -1096,3 +1091,5 @@ static const rad_test_case tests_api[] = {
     { "api_hooks", api_test_hooks },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_api)

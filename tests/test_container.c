@@ -1,6 +1,8 @@
 /* test_container.c - baked data: round trips (dense, sparse, vectors), and every corruption
    class rejected with its own error: truncation at every section, flipped bytes anywhere,
    another version, an out-of-range index behind a valid checksum, unaligned input. */
+#include "fixtures.h"
+
 
 typedef struct ct_fixture {
     rad_scene *scene;
@@ -110,15 +112,6 @@ static void ct_test_round_trip(void)
     }
 #endif
     ct_teardown(&f);
-}
-
-/* rewrites the CRC of section i (after the test modified its data) */
-static void ct_fix_section_crc(unsigned char *buf, uint32_t i)
-{
-    unsigned char *e = buf + 64 + 64 * (size_t)i;
-    rad__put32(e + 32, rad__crc32(buf + rad__get64(e + 16), (size_t)rad__get64(e + 24)));
-    rad__put32(buf + 36, rad__crc32(buf + 64, 64 * (size_t)rad__get32(buf + 8)));
-    rad__put32(buf + 60, rad__crc32(buf, 60));
 }
 
 static void ct_test_corruption(void)
@@ -317,46 +310,6 @@ static void ct_test_alloc_failure(void)
 }
 
 /* ---- values behind valid checksums, and the scene signature ------------------------------ */
-
-/* the last message of the library's logger, to check that it names the section, entry and value */
-static char ct_log_last[512];
-static int ct_log_warnings;
-static void ct_log(void *user, rad_log_level level, const char *message)
-{
-    (void)user;
-    if (level == RAD_LOG_WARNING) ct_log_warnings++;
-    snprintf(ct_log_last, sizeof(ct_log_last), "%s", message);
-}
-
-static void ct_log_context(rad_context *ctx)
-{
-    memset(ctx, 0, sizeof(*ctx));
-    ctx->log = ct_log;
-    ct_log_last[0] = '\0';
-    ct_log_warnings = 0;
-}
-
-/* a malloc'd copy of the container 'buf' with 'bytes' written at byte 'at' of its section of
-   'type' called 'name', every checksum fixed (NULL when there is no such section) */
-static unsigned char *ct_poke(const void *buf, size_t size, uint32_t type, const char *name, size_t at, const void *bytes,
-                              size_t n)
-{
-    unsigned char *copy = (unsigned char *)malloc(size);
-    uint32_t i, count;
-    if (!copy) return NULL;
-    memcpy(copy, buf, size);
-    count = rad__get32(copy + 8);
-    for (i = 0; i < count; ++i) {
-        unsigned char *e = copy + 64 + 64 * (size_t)i;
-        if (rad__get32(e) == type && strncmp((const char *)e + 40, name, 24) == 0 && at + n <= rad__get64(e + 24)) {
-            memcpy(copy + rad__get64(e + 16) + at, bytes, n);
-            ct_fix_section_crc(copy, i);
-            return copy;
-        }
-    }
-    free(copy);
-    return NULL;
-}
 
 /* float 'index' of section (type, name) set to 'value': rad_load_memory gives 'expected' and
    a message that contains 'what', "entry <index>" and 'shown' (the value as %g prints it) */
@@ -669,3 +622,5 @@ static const rad_test_case tests_container[] = {
     { "container_signature", ct_test_signature },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_container)

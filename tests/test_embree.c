@@ -1,5 +1,7 @@
 /* test_embree.c - the Embree backend: unavailable without RAD_EMBREE; with it, the same hits as
    the built-in BVH, the same form factors, a wrapped user RTCScene, errors to the logger. */
+#include "fixtures.h"
+
 
 static void em_test_availability(void)
 {
@@ -168,3 +170,5 @@ static const rad_test_case tests_embree[] = {
 #endif
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_embree)

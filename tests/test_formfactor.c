@@ -3,6 +3,8 @@
    enclosure properties, the row/sparse/dense storage, determinism, and the built-in BVH
    against a brute-force ray caster. Included by test_main.c after the implementation: every
    name is static and prefixed ff_. */
+#include "fixtures.h"
+
 
 #ifndef FF_PI
 #define FF_PI 3.14159265358979323846
@@ -11,127 +13,6 @@
 /* ---------------------------------------------------------------------------------------- */
 /* helpers                                                                                  */
 /* ---------------------------------------------------------------------------------------- */
-
-/* A planar quad o, o+u, o+u+v, o+v: counter-clockwise seen from the side u x v points to, so
-   that side is its front. Two triangles (0 1 2) (0 2 3). */
-typedef struct ff_quad {
-    float pos[12];
-} ff_quad;
-
-static const uint32_t ff_quad_indices[6] = { 0, 1, 2, 0, 2, 3 };
-
-static void ff_quad_set(ff_quad *q, float ox, float oy, float oz, float ux, float uy, float uz, float vx, float vy,
-                        float vz)
-{
-    float o[3], u[3], v[3];
-    int k;
-    o[0] = ox; o[1] = oy; o[2] = oz;
-    u[0] = ux; u[1] = uy; u[2] = uz;
-    v[0] = vx; v[1] = vy; v[2] = vz;
-    for (k = 0; k < 3; ++k) {
-        q->pos[k] = o[k];
-        q->pos[3 + k] = o[k] + u[k];
-        q->pos[6 + k] = o[k] + u[k] + v[k];
-        q->pos[9 + k] = o[k] + v[k];
-    }
-}
-
-static void ff_mesh_quad(rad_mesh_desc *m, const ff_quad *q)
-{
-    memset(m, 0, sizeof(*m));
-    m->positions = q->pos;
-    m->vertex_count = 4;
-    m->indices = ff_quad_indices;
-    m->triangle_count = 2;
-    m->material = 0;
-}
-
-/* A scene, its patches, its BVH and a raycaster over it. */
-typedef struct ff_world {
-    rad_scene *scene;
-    rad_patches *patches;
-    rad_bvh *bvh;
-    rad_raycaster rc;
-} ff_world;
-
-static void ff_world_free(ff_world *w)
-{
-    rad_bvh_destroy(w->bvh);
-    rad_patches_destroy(w->patches);
-    rad_scene_destroy(w->scene);
-    memset(w, 0, sizeof(*w));
-}
-
-/* Builds scene + patches (max_edge and/or target_count) + BVH. Returns 1 on success. */
-static int ff_world_make(const rad_scene_desc *desc, float max_edge, uint32_t target_count, ff_world *w)
-{
-    rad_patch_options popt;
-    rad_result r;
-    memset(w, 0, sizeof(*w));
-    r = rad_scene_create(desc, NULL, &w->scene);
-    CHECK_OK(r);
-    if (r != RAD_SUCCESS) return 0;
-    rad_patch_options_default(&popt);
-    popt.max_edge = max_edge;
-    popt.target_count = target_count;
-    r = rad_patches_create(w->scene, &popt, NULL, &w->patches);
-    CHECK_OK(r);
-    if (r != RAD_SUCCESS) { ff_world_free(w); return 0; }
-    r = rad_bvh_create(w->scene, NULL, &w->bvh);
-    CHECK_OK(r);
-    if (r != RAD_SUCCESS) { ff_world_free(w); return 0; }
-    rad_bvh_raycaster(w->bvh, &w->rc);
-    return 1;
-}
-
-static const rad_material ff_grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0 };
-
-static void ff_desc(rad_scene_desc *d, const rad_mesh_desc *meshes, uint32_t count)
-{
-    memset(d, 0, sizeof(*d));
-    d->meshes = meshes;
-    d->mesh_count = count;
-    d->materials = &ff_grey;
-    d->material_count = 1;
-}
-
-/* Area-weighted group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i,
-   groups by the scene mesh of each patch's triangle. */
-static double ff_group(const rad_patches *P, const float *F, uint32_t g, uint32_t h, double *area_g)
-{
-    const rad_scene *s = P->scene;
-    double num = 0.0, den = 0.0;
-    uint32_t i, j, N = P->count;
-    for (i = 0; i < N; ++i) {
-        double row = 0.0;
-        if (s->meshes[P->patches[i].triangle] != g) continue;
-        for (j = 0; j < N; ++j)
-            if (s->meshes[P->patches[j].triangle] == h) row += (double)F[(size_t)i * N + j];
-        num += (double)P->patches[i].area * row;
-        den += (double)P->patches[i].area;
-    }
-    if (area_g) *area_g = den;
-    return den > 0.0 ? num / den : 0.0;
-}
-
-/* Howell C-11: identical parallel opposed rectangles a x b at gap c */
-static double ff_c11(double a, double b, double c)
-{
-    double X = a / c, Y = b / c;
-    return 2.0 / (FF_PI * X * Y) *
-           (log(sqrt((1 + X * X) * (1 + Y * Y) / (1 + X * X + Y * Y))) + X * sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)) +
-            Y * sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) - X * atan(X) - Y * atan(Y));
-}
-
-/* Howell C-14: A1 = l x w, A2 = l x h, common edge l; F_12 */
-static double ff_c14(double l, double w, double h)
-{
-    double H = h / l, W = w / l, H2 = H * H, W2 = W * W, S = sqrt(H2 + W2);
-    double t1 = (1 + W2) * (1 + H2) / (1 + W2 + H2);
-    double t2 = pow(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2)), W2);
-    double t3 = pow(H2 * (1 + W2 + H2) / ((1 + H2) * (W2 + H2)), H2);
-    return 1.0 / (FF_PI * W) * (W * atan(1 / W) + H * atan(1 / H) - S * atan(1 / S) + 0.25 * log(t1 * t2 * t3));
-}
 
 /* Howell C-41: coaxial parallel disks r1 (emitter), r2, gap h */
 static double ff_c41(double r1, double r2, double h)
@@ -532,29 +413,6 @@ static void ff_test_monte_carlo(void)
 /* 4. enclosure: the closed unit cube                                                       */
 /* ---------------------------------------------------------------------------------------- */
 
-/* The 6 faces of [0,1]^3, fronts facing inwards. Face order: z=0, z=1, x=0, x=1, y=0, y=1
-   (so faces 2f and 2f+1 are parallel). */
-static void ff_cube_quads(ff_quad *q)
-{
-    ff_quad_set(&q[0], 0, 0, 0, 1, 0, 0, 0, 1, 0); /* +z */
-    ff_quad_set(&q[1], 0, 0, 1, 0, 1, 0, 1, 0, 0); /* -z */
-    ff_quad_set(&q[2], 0, 0, 0, 0, 1, 0, 0, 0, 1); /* +x */
-    ff_quad_set(&q[3], 1, 0, 0, 0, 0, 1, 0, 1, 0); /* -x */
-    ff_quad_set(&q[4], 0, 0, 0, 0, 0, 1, 1, 0, 0); /* +y */
-    ff_quad_set(&q[5], 0, 1, 0, 1, 0, 0, 0, 0, 1); /* -y */
-}
-
-static int ff_cube_world(ff_quad *q, rad_mesh_desc *meshes, ff_world *w)
-{
-    rad_scene_desc d;
-    int f;
-    ff_cube_quads(q);
-    for (f = 0; f < 6; ++f) ff_mesh_quad(&meshes[f], &q[f]);
-    ff_desc(&d, meshes, 6);
-    /* max_edge 0.25: each face triangle (legs 1) is cut 6 x 6; 432 patches */
-    return ff_world_make(&d, rad_test_quick() ? 0.5f : 0.25f, 0, w);
-}
-
 static void ff_test_enclosure_cube(void)
 {
     ff_quad q[6];
@@ -797,13 +655,6 @@ done:
 /* ---------------------------------------------------------------------------------------- */
 
 /* a parallel_for that runs the tasks serially in reverse order */
-static void ff_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i = count;
-    (void)user;
-    while (i-- > 0) fn(data, i);
-}
-
 static void ff_test_determinism(void)
 {
     rad_scene_desc d;
@@ -817,7 +668,7 @@ static void ff_test_determinism(void)
     N = w.patches->count;
     rad_form_factor_options_default(&fo);
     memset(&ctx, 0, sizeof(ctx));
-    ctx.parallel_for = ff_reverse_for;
+    ctx.parallel_for = fx_reverse_for;
     ctx.task_count = 7; /* a different split from the default 64 tasks */
     CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &a));
     CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &b));
@@ -1276,3 +1127,5 @@ static const rad_test_case tests_formfactor[] = {
     { "formfactor_bvh_watertight", ff_test_bvh_watertight },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_formfactor)

@@ -1,5 +1,7 @@
 /* test_glsl.c - the embedded GLSL sources and their access functions (>>api_glsl). The kernels
    themselves are compiled and run against the CPU paths by tests/test_vulkan.c. */
+#include "fixtures.h"
+
 
 static void test_glsl_sources(void)
 {
@@ -51,3 +53,5 @@ static const rad_test_case tests_glsl[] = {
     { "glsl_sources", test_glsl_sources },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_glsl)

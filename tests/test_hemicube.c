@@ -2,9 +2,11 @@
    convergence to the point-to-area closed forms as the resolution grows, clipping against the
    near plane and the base plane, enclosures whose rows sum to 1, agreement with the analytic
    method on the Cornell box, the aliasing of small patches (shown, not hidden), storage and
-   determinism, bad options and allocation failures. Included by test_main.c after
-   test_formfactor.c and test_scene.c, whose helpers it uses (ff_quad, ff_world, ff_group,
-   ff_c11, ff_c14, ff_cube_world, ff_reverse_for, sc_alloc_*); its own names are prefixed hc_. */
+   determinism, bad options and allocation failures. Uses the fixtures' quads, worlds and closed
+   forms (ff_*), fx_reverse_for and the counting allocator (sc_alloc_*); its own names are
+   prefixed hc_. */
+#include "fixtures.h"
+
 
 /* ---------------------------------------------------------------------------------------- */
 /* helpers                                                                                  */
@@ -541,7 +543,7 @@ static void hc_test_storage(void)
     CHECK_OK(rad_form_factors_dense(w.patches, NULL, &o, NULL, &a));
     CHECK_OK(rad_form_factors_dense(w.patches, NULL, &o, NULL, &b));
     memset(&ctx, 0, sizeof(ctx));
-    ctx.parallel_for = ff_reverse_for;
+    ctx.parallel_for = fx_reverse_for;
     ctx.task_count = 7;
     CHECK_OK(rad_form_factors_dense(w.patches, NULL, &o, &ctx, &cx));
     CHECK_OK(rad_form_factors_sparse(w.patches, NULL, &o, NULL, &sp));
@@ -732,3 +734,5 @@ static const rad_test_case tests_hemicube[] = {
     { "hemicube_alloc_failure", hc_test_alloc_failure },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_hemicube)

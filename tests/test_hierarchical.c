@@ -2,8 +2,10 @@
    Aupperle 1991): a closed furnace against its closed form B = E / (1 - rho), convergence to
    the classic solution on fine patches as the tolerance shrinks, links growing about linearly
    in the elements, the source callback, the smooth lookup, bad options and allocation
-   failures. Included by test_main.c after test_formfactor.c and test_scene.c, whose helpers it
-   uses (ff_quad, ff_cube_quads, ff_mesh_quad, sc_alloc_*, sc_log_*); its names are prefixed hr_. */
+   failures. Uses the fixtures' quads (ff_quad, ff_cube_quads, ff_mesh_quad), the counting
+   allocator and the log sink (sc_alloc_*, sc_log_*); its names are prefixed hr_. */
+#include "fixtures.h"
+
 
 typedef struct hr_world {
     rad_scene *scene;
@@ -458,3 +460,5 @@ static const rad_test_case tests_hierarchical[] = {
     { "hierarchical_alloc", hr_test_alloc },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_hierarchical)

@@ -1,5 +1,7 @@
 /* test_light.c - lights, direct irradiance, the source term, no double counting.
    Everything static and prefixed li_. */
+#include "fixtures.h"
+
 
 #define LI_PI 3.14159265358979323846
 
@@ -581,13 +583,6 @@ static rad_result li_fg_const(void *user, const rad_hit *hits, const float *poin
     return RAD_SUCCESS;
 }
 
-static void li_fg_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = count; i-- > 0;) fn(data, i);
-}
-
 /* rad_final_gather: the first bounce off a sunlit floor against the analytic point-to-polygon
    form factor; a closed furnace (every wall emits L = 1, albedo 0.5) where the exact
    H = pi rho / (1 - rho) = pi must come back; bits independent of the task order; errors. */
@@ -653,7 +648,7 @@ static void li_test_final_gather(void)
             }
             /* the same bits with tasks in reverse order on one thread */
             memset(&ctx, 0, sizeof(ctx));
-            ctx.parallel_for = li_fg_reverse_for;
+            ctx.parallel_for = fx_reverse_for;
             ctx.task_count = 3;
             CHECK_OK(rad_final_gather(S, &rc, &sun, 1, &fo, NULL, NULL, pts, nrm, 3, out2, &ctx));
             CHECK(memcmp(out, out2, sizeof(out)) == 0);
@@ -703,3 +698,5 @@ static const rad_test_case tests_light[] = {
     { "light_final_gather", li_test_final_gather },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_light)

@@ -1,6 +1,8 @@
 /* test_lightmap.c - lightmaps (>>lightmap): texel coverage, validity (no leak under a wall),
    the gather against closed forms and the patch solution, SH L1 projection, dilation and seam
    stitching. Included by test_main.c. */
+#include "fixtures.h"
+
 
 #define LM_PI 3.14159265358979323846
 
@@ -864,3 +866,5 @@ static const rad_test_case tests_lightmap[] = {
     { "lightmap_hemisphere", lm_test_hemisphere },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_lightmap)

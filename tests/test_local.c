@@ -5,55 +5,19 @@
    transport, apply over P_Vis x P_Lit, the CSR and baked-container row sources, and bad
    input. Included by test_main.c after the implementation: every name is static and
    prefixed lc_. */
+#include "fixtures.h"
 
-typedef struct lc_world {
-    rad_scene *scene;
-    rad_patches *patches;
-    rad_bvh *bvh;
-    rad_form_factors *ff;
-    float *E;
-    uint32_t n;
-} lc_world;
 
-static void lc_world_free(lc_world *w)
-{
-    free(w->E);
-    rad_form_factors_destroy(w->ff);
-    rad_bvh_destroy(w->bvh);
-    rad_patches_destroy(w->patches);
-    rad_scene_destroy(w->scene);
-    memset(w, 0, sizeof(*w));
-}
+/* the shared Cornell world (fixtures.h) */
+typedef fx_world lc_world;
 
 /* Cornell box of about 'target' patches with dense form factors; E = emission plus a little
    everywhere (so every column matters). */
 static int lc_cornell(lc_world *w, uint32_t target)
 {
-    rad_scene_desc desc;
-    rad_camera cam;
-    rad_patch_options po;
-    rad_form_factor_options fo;
-    rad_raycaster rc;
     uint32_t i;
-    memset(w, 0, sizeof(*w));
-    rad_cornell_box(&desc, &cam);
-    rad_patch_options_default(&po);
-    po.target_count = target;
-    rad_form_factor_options_default(&fo);
-    fo.samples = 4;
-    if (rad_scene_create(&desc, NULL, &w->scene) != RAD_SUCCESS || rad_patches_create(w->scene, &po, NULL, &w->patches) != RAD_SUCCESS ||
-        rad_bvh_create(w->scene, NULL, &w->bvh) != RAD_SUCCESS) {
+    if (!fx_cornell(w, target, 4, 0)) {
         CHECK(!"cornell setup");
-        lc_world_free(w);
-        return 0;
-    }
-    rad_bvh_raycaster(w->bvh, &rc);
-    w->n = w->patches->count;
-    w->E = (float *)malloc(sizeof(float) * 3 * w->n);
-    if (!w->E || rad_form_factors_dense(w->patches, &rc, &fo, NULL, &w->ff) != RAD_SUCCESS ||
-        rad_sources(w->patches, RAD_SOURCE_EMISSION, NULL, w->E) != RAD_SUCCESS) {
-        CHECK(!"cornell form factors");
-        lc_world_free(w);
         return 0;
     }
     for (i = 0; i < 3 * w->n; ++i) w->E[i] += 0.05f * (float)(i % 7);
@@ -63,13 +27,6 @@ static int lc_cornell(lc_world *w, uint32_t target)
 static uint32_t lc_target(void) { return rad_test_quick() ? 90u : 200u; }
 
 /* a parallel_for that runs the tasks in reverse order on the calling thread */
-static void lc_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = count; i > 0; --i) fn(data, i - 1);
-}
-
 /* T = (I - A)^-1 - I on the set 'ids' (m patches), A_ij = rho_i F_ij, channel ch, by
    Gauss-Jordan with partial pivoting in double: out m*m. Returns 0 on a zero pivot. */
 static int lc_reference(const lc_world *w, const uint32_t *ids, uint32_t m, uint32_t ch, double *out)
@@ -165,7 +122,7 @@ static void test_local_add_exact_and_first_order(void)
     double e_ex, e_fo, e_rb, e_rn;
     if (!lc_cornell(&w, lc_target())) return;
     ids = (uint32_t *)malloc(sizeof(uint32_t) * w.n);
-    if (!ids || !lc_source(&w, &src)) { free(ids); lc_world_free(&w); return; }
+    if (!ids || !lc_source(&w, &src)) { free(ids); fx_world_free(&w); return; }
     lc_shuffle(ids, w.n, 11u);
     rad_local_options_default(&o);
     o.capacity = w.n;
@@ -178,7 +135,7 @@ static void test_local_add_exact_and_first_order(void)
     o.update = RAD_LOCAL_FIRST_ORDER;
     CHECK_OK(rad_local_create(&src, &o, NULL, &fo));
     memset(&ctx, 0, sizeof(ctx));
-    ctx.parallel_for = lc_reverse_for;
+    ctx.parallel_for = fx_reverse_for;
     ctx.task_count = 5;
     if (ex && fo && rb && tk && rn) {
         for (i = 0; i < w.n; ++i) {
@@ -209,7 +166,7 @@ static void test_local_add_exact_and_first_order(void)
     rad_local_destroy(tk);
     rad_local_destroy(rn);
     free(ids);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 /* Removing hides a patch and keeps T exactly; evicting it by the downdate gives the inverse
@@ -291,7 +248,7 @@ out:
     rad_local_destroy(L);
     rad_local_destroy(D);
     free(ids); free(with); free(without); free(before); free(out);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 /* the 'count' patches nearest (px, py, pz), by selection with ties by index, into want */
@@ -428,7 +385,7 @@ out:
     rad_local_destroy(L);
     rad_local_destroy(R);
     free(ids); free(want); free(members); free(inset); free(full); free(Lw); free(Lr);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 /* A camera going back and forth between two ends of the box. With the exact downdate the
@@ -481,7 +438,7 @@ out:
     rad_local_destroy(L);
     free(want);
     free(inset);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 /* apply over P_Vis x P_Lit against the planes summed here; TOTAL adds E; untouched rows */
@@ -494,7 +451,7 @@ static void test_local_apply_subsets(void)
     uint32_t vis[10], lit[20], i, j, ch, nv = 0, nl = 0, *ids = NULL;
     float *out = NULL, *tot = NULL;
     if (!lc_cornell(&w, 60u)) return;
-    if (w.n < 64) { CHECK(w.n >= 64); lc_world_free(&w); return; }
+    if (w.n < 64) { CHECK(w.n >= 64); fx_world_free(&w); return; }
     out = (float *)malloc(sizeof(float) * 3 * w.n);
     tot = (float *)malloc(sizeof(float) * 3 * w.n);
     ids = (uint32_t *)malloc(sizeof(uint32_t) * w.n);
@@ -533,7 +490,7 @@ out:
     free(out);
     free(tot);
     free(ids);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 /* a two-patch world with a configurable row for bad-input tests */
@@ -615,7 +572,7 @@ static void test_local_row_sources(void)
     fo.samples = 4;
     rad_bvh_raycaster(w.bvh, &rc);
     CHECK_OK(rad_form_factors_sparse(w.patches, &rc, &fo, NULL, &sp));
-    if (!sp) { lc_world_free(&w); return; }
+    if (!sp) { fx_world_free(&w); return; }
     CHECK_OK(rad_save_memory(w.patches, &sp->matrix, w.E, NULL, NULL, &buf, &size));
     if (buf) CHECK_OK(rad_load_memory(buf, size, NULL, &bake));
     CHECK(lc_source(&w, &sd));
@@ -685,7 +642,7 @@ static void test_local_row_sources(void)
     rad_bake_destroy(bake);
     rad_free_buffer(buf, NULL);
     rad_form_factors_destroy(sp);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 
@@ -800,7 +757,7 @@ static void test_local_repeated_columns(void)
         }
         rad_free_buffer(buf, NULL);
         rad_form_factors_destroy(sp);
-        lc_world_free(&w);
+        fx_world_free(&w);
     }
 #endif
 }
@@ -889,7 +846,7 @@ static void test_local_sets(void)
     CHECK_RESULT(rad_local_lit(w.E, all, w.n, -1.0f, lit, &nl), RAD_ERROR_INVALID_ARGUMENT);
 out:
     free(near); free(all); free(vis); free(lit); free(seen);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 
@@ -912,7 +869,7 @@ static void test_local_alloc_failure(void)
     rad_cornell_box(&desc, &cam);
     rad_bvh_raycaster(w.bvh, &rc);
     out = (float *)malloc(sizeof(float) * 3 * w.n);
-    if (!out || w.n < 40 || !lc_source(&w, &src)) { free(out); lc_world_free(&w); return; }
+    if (!out || w.n < 40 || !lc_source(&w, &src)) { free(out); fx_world_free(&w); return; }
     for (i = 0; i < 40; ++i) ids[i] = i;
     memset(&ctx, 0, sizeof(ctx));
     ctx.allocator.alloc = sc_alloc_fn;
@@ -960,7 +917,7 @@ static void test_local_alloc_failure(void)
     }
     CHECK(total >= 10);
     free(out);
-    lc_world_free(&w);
+    fx_world_free(&w);
 }
 
 
@@ -1046,3 +1003,5 @@ static const rad_test_case tests_local[] = {
     {"local_alloc_failure", test_local_alloc_failure},
     {"local_null_arguments", test_local_null_arguments},
     {NULL, NULL}};
+
+RAD_TEST_MAIN(tests_local)

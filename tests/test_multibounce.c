@@ -4,58 +4,23 @@
    decode rules of the Khronos Data Format specification, encoder error bounds, permutations, the compressed apply, and
    the container sections. Included by test_main.c after the implementation: every name is
    static and prefixed mb_. */
+#include "fixtures.h"
+
 
 /* ---------------------------------------------------------------------------------------- */
 /* helpers                                                                                  */
 /* ---------------------------------------------------------------------------------------- */
 
-typedef struct mb_world {
-    rad_scene *scene;
-    rad_patches *patches;
-    rad_bvh *bvh;
-    rad_form_factors *ff;
-    float *E;
-} mb_world;
-
-static void mb_world_free(mb_world *w)
-{
-    free(w->E);
-    rad_form_factors_destroy(w->ff);
-    rad_bvh_destroy(w->bvh);
-    rad_patches_destroy(w->patches);
-    rad_scene_destroy(w->scene);
-    memset(w, 0, sizeof(*w));
-}
+/* the shared Cornell world (fixtures.h) */
+typedef fx_world mb_world;
 
 /* The built-in Cornell box cut into about 'target' patches, dense form factors through the
    BVH, E = emission. Returns 0 on failure (and records it). */
 static int mb_cornell(mb_world *w, uint32_t target)
 {
-    rad_scene_desc desc;
-    rad_camera cam;
-    rad_patch_options po;
-    rad_form_factor_options fo;
-    rad_raycaster rc;
-    memset(w, 0, sizeof(*w));
-    rad_cornell_box(&desc, &cam);
-    rad_patch_options_default(&po);
-    po.target_count = target;
-    rad_form_factor_options_default(&fo);
-    if (rad_scene_create(&desc, NULL, &w->scene) != RAD_SUCCESS || rad_patches_create(w->scene, &po, NULL, &w->patches) != RAD_SUCCESS ||
-        rad_bvh_create(w->scene, NULL, &w->bvh) != RAD_SUCCESS) {
-        CHECK(!"cornell setup");
-        mb_world_free(w);
-        return 0;
-    }
-    rad_bvh_raycaster(w->bvh, &rc);
-    w->E = (float *)malloc(sizeof(float) * 3 * w->patches->count);
-    if (!w->E || rad_form_factors_dense(w->patches, &rc, &fo, NULL, &w->ff) != RAD_SUCCESS ||
-        rad_sources(w->patches, RAD_SOURCE_EMISSION, NULL, w->E) != RAD_SUCCESS) {
-        CHECK(!"cornell form factors");
-        mb_world_free(w);
-        return 0;
-    }
-    return 1;
+    if (fx_cornell(w, target, 0, 0)) return 1;
+    CHECK(!"cornell setup");
+    return 0;
 }
 
 static uint32_t mb_target(void) { return rad_test_quick() ? 120u : 300u; }
@@ -149,7 +114,7 @@ static void mb_jacobi(void)
         free(ref);
         free(got);
     }
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 static void mb_infinite(void)
@@ -184,7 +149,7 @@ static void mb_infinite(void)
     CHECK(mb == NULL);
     free(ref);
     free(got);
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 static void mb_bc1_decode(void)
@@ -354,7 +319,7 @@ static void mb_permutations(void)
         rad_multibounce_destroy(p);
         free(x);
         free(y);
-        mb_world_free(&w);
+        fx_world_free(&w);
     }
 }
 
@@ -385,7 +350,7 @@ static void mb_half_apply(void)
     rad_multibounce_destroy(back);
     free(x);
     free(y);
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 static void mb_compressed(void)
@@ -450,7 +415,7 @@ done:
     free(got);
     free(dec);
     free(viadec);
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 static void mb_container(void)
@@ -546,7 +511,7 @@ done:
     rad_multibounce_blocks_destroy(b);
     free(x);
     free(y);
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 static void mb_errors(void)
@@ -686,7 +651,7 @@ done:
     free(p);
     free(P);
     free(dec);
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 /* Whatever decode path the build compiled (AVX2 or scalar), the compressed apply uses the
@@ -740,7 +705,7 @@ done:
     free(dec);
     free(E);
     free(out);
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 /* The AVX2 palettes divide by the FMA-corrected reciprocal product; it must equal IEEE
@@ -1029,7 +994,7 @@ done:
     rad_multibounce_blocks_destroy(b);
     rad_multibounce_destroy(h);
     rad_multibounce_destroy(mb);
-    mb_world_free(&w);
+    fx_world_free(&w);
 }
 
 static const rad_test_case tests_multibounce[] = {
@@ -1052,3 +1017,5 @@ static const rad_test_case tests_multibounce[] = {
     { "multibounce: argument errors", mb_errors },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_multibounce)

@@ -2,6 +2,8 @@
    probe irradiance in the Cornell box against the direct light of rad_direct_irradiance plus
    a Monte Carlo gather of the same patch solution, probes inside geometry, sampling, update,
    options, allocation failures. Everything static and prefixed pb_. */
+#include "fixtures.h"
+
 
 #define PB_PI 3.14159265358979323846
 
@@ -703,3 +705,5 @@ static const rad_test_case tests_probes[] = {
     { "probes_alloc", pb_test_alloc },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_probes)

@@ -1,6 +1,8 @@
 /* test_regress.c - regressions found by fuzzing and review, one test each, with where they
    came from. The fuzzers' crash inputs live in fuzz/crashes and are replayed by the fuzz
    smoke suite. */
+#include "fixtures.h"
+
 
 /* fuzz_scene, fuzz/crashes/scene-nonfinite-1: a point light 1e-20 from a surface gave
    irradiance 1/d^2 = inf (here a 1e-15 quad with the light 1e-21 above it). Outputs must never carry Inf: the call reports NON_FINITE. */
@@ -655,3 +657,5 @@ static const rad_test_case tests_regress[] = {
 #endif
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_regress)

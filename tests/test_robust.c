@@ -4,6 +4,8 @@
    scenes, one triangle) never puts a NaN or Inf into any output; the BVH on degenerate-ish
    inputs; bit-identical results run to run and across thread counts, task counts and task
    orders (THREADING). Everything static and prefixed rb_. */
+#include "fixtures.h"
+
 #include <pthread.h>
 
 /* ---- helpers -------------------------------------------------------------------------------- */
@@ -26,8 +28,6 @@ static size_t rb_nonfinite(const float *p, size_t n)
 
 static const char *rb_case = "";
 
-static void rb_serial_for(void *user, uint32_t count, rad_task_fn fn, void *data);
-
 /* the NaN scans and the scale test run serially: their subject is numerics, and with many
    tiny calls the OpenMP default spends more time starting regions than working (determinism
    covers the default context) */
@@ -35,7 +35,7 @@ static const rad_context *rb_serial_ctx(void)
 {
     static rad_context c;
     memset(&c, 0, sizeof(c));
-    c.parallel_for = rb_serial_for;
+    c.parallel_for = fx_serial_for;
     return &c;
 }
 
@@ -770,20 +770,6 @@ static void rb_pthreads_for(void *user, uint32_t count, rad_task_fn fn, void *da
     pthread_mutex_destroy(&p.lock);
 }
 
-static void rb_serial_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = 0; i < count; ++i) fn(data, i);
-}
-
-static void rb_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = count; i-- > 0;) fn(data, i);
-}
-
 /* every output of one run, for bitwise comparison */
 typedef struct rb_outputs {
     float *dense, *dense_mc, *sparse_vals, *rows, *D, *Dpt, *solve[4], *mv, *vv;
@@ -977,15 +963,15 @@ static void rb_test_determinism(void)
     if (!S || !P || !bvh) goto done;
     rad_bvh_raycaster(bvh, &rc);
     memset(ctx, 0, sizeof(ctx));
-    ctx[1].parallel_for = rb_serial_for;
-    ctx[2].parallel_for = rb_reverse_for;
+    ctx[1].parallel_for = fx_serial_for;
+    ctx[2].parallel_for = fx_reverse_for;
     ctx[3].parallel_for = rb_pthreads_for;
     ctx[4].parallel_for = rb_pthreads_for;
     ctx[4].task_count = 7;
     ctx[5].task_count = 1;
     ctx[6].task_count = 7;
     ctx[7].task_count = 64;
-    ctx[7].parallel_for = rb_reverse_for;
+    ctx[7].parallel_for = fx_reverse_for;
     ok = rb_compute(P, &rc, NULL, &ref);
     CHECK(ok);
     if (!ok) { rb_outputs_free(&ref); goto done; }
@@ -1017,3 +1003,5 @@ static const rad_test_case tests_robust[] = {
     { "robust_determinism", rb_test_determinism },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_robust)

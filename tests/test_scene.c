@@ -1,101 +1,9 @@
 /* test_scene.c - scene input and validation, patches, context hooks, the built-in Cornell box.
    Included by test_main.c after the implementation: everything is static and prefixed sc_. */
+#include "fixtures.h"
+
 
 /* ---- helpers ---------------------------------------------------------------------------- */
-
-typedef struct sc_log_state {
-    int count;
-    char last[512];
-} sc_log_state;
-
-static void sc_log_fn(void *user, rad_log_level level, const char *message)
-{
-    sc_log_state *s = (sc_log_state *)user;
-    (void)level;
-    s->count++;
-    strncpy(s->last, message, sizeof(s->last) - 1);
-    s->last[sizeof(s->last) - 1] = '\0';
-}
-
-/* A counting allocator: a 16-byte header holds the size so live bytes can be tracked, and a
-   64-byte canary after each block catches writes past the end (counted in 'corrupt' on free)
-   without corrupting the heap. fail_at > 0 makes the fail_at-th allocation (1-based) fail. */
-#define SC_CANARY 64
-typedef struct sc_alloc_state {
-    long calls, allocs, frees, failed, corrupt;
-    long long live_bytes;
-    long fail_at;
-} sc_alloc_state;
-
-static void *sc_alloc_fn(void *user, size_t size)
-{
-    sc_alloc_state *s = (sc_alloc_state *)user;
-    unsigned char *p;
-    long n;
-#ifdef _OPENMP
-#pragma omp critical(sc_alloc_lock)
-#endif
-    {
-        n = ++s->calls;
-    }
-    if (s->fail_at > 0 && n == s->fail_at) {
-#ifdef _OPENMP
-#pragma omp critical(sc_alloc_lock)
-#endif
-        {
-            s->failed++;
-        }
-        return NULL;
-    }
-    p = (unsigned char *)malloc(size + 16 + SC_CANARY);
-    if (!p) return NULL;
-    memcpy(p, &size, sizeof(size));
-    memset(p + 16 + size, 0xA5, SC_CANARY);
-#ifdef _OPENMP
-#pragma omp critical(sc_alloc_lock)
-#endif
-    {
-        s->allocs++;
-        s->live_bytes += (long long)size;
-    }
-    return p + 16;
-}
-
-static void sc_free_fn(void *user, void *ptr)
-{
-    sc_alloc_state *s = (sc_alloc_state *)user;
-    unsigned char *p;
-    size_t size, i;
-    int bad = 0;
-    if (!ptr) return;
-    p = (unsigned char *)ptr - 16;
-    memcpy(&size, p, sizeof(size));
-    for (i = 0; i < SC_CANARY; ++i) bad |= p[16 + size + i] != 0xA5;
-#ifdef _OPENMP
-#pragma omp critical(sc_alloc_lock)
-#endif
-    {
-        s->frees++;
-        s->corrupt += bad;
-        s->live_bytes -= (long long)size;
-    }
-    free(p);
-}
-
-static void sc_serial_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = 0; i < count; ++i) fn(data, i);
-}
-
-static void sc_ctx_alloc(rad_context *ctx, sc_alloc_state *st)
-{
-    memset(ctx, 0, sizeof(*ctx));
-    ctx->allocator.alloc = sc_alloc_fn;
-    ctx->allocator.free = sc_free_fn;
-    ctx->allocator.user = st;
-}
 
 /* 4 vertices of a quad: corner c, edges u and v (normal u x v), into pos[12] */
 static void sc_quad(float *pos, const float *c, const float *u, const float *v)
@@ -940,7 +848,7 @@ static void sc_test_allocator_failures(void)
     int bad = 0, oom_seen = 0;
     memset(&st, 0, sizeof(st));
     sc_ctx_alloc(&ctx, &st);
-    ctx.parallel_for = sc_serial_for; /* deterministic allocation order */
+    ctx.parallel_for = fx_serial_for; /* deterministic allocation order */
     ctx.task_count = 4;
     CHECK_OK(sc_pipeline(&ctx, &bad));
     total = st.allocs;
@@ -1145,3 +1053,5 @@ static const rad_test_case tests_scene[] = {
     { "scene_cornell", sc_test_cornell },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_scene)

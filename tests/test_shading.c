@@ -4,6 +4,8 @@
    changes of variables; each tolerance below is the quadrature error measured at the
    coarse (RAD_TEST_QUICK) grid with a margin, far below the errors the tests look for
    (a missing 1/pi, a wrong Lambda, a lobe normalized for the wrong exponent). */
+#include "fixtures.h"
+
 
 #define SH_PI 3.14159265358979323846
 
@@ -415,3 +417,5 @@ static const rad_test_case tests_shading[] = {
     { "shading_errors", sh_test_errors },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_shading)

@@ -1,5 +1,7 @@
 /* test_solve.c - the classic solvers: furnace tests, agreement on the Cornell box, matrix
    multiply, residual callbacks, error codes, determinism. Everything static and prefixed so_. */
+#include "fixtures.h"
+
 
 /* A closed unit cube: 6 inward-facing faces, 2 triangles each, material per face from 'albedo'. */
 typedef struct so_cube {
@@ -13,8 +15,6 @@ typedef struct so_cube {
     double row_dev; /* max |row sum - 1| */
 } so_cube;
 
-static const uint32_t so_quad_idx[6] = { 0, 1, 2, 0, 2, 3 };
-
 static int so_cube_build(so_cube *c, const float albedo[3], float max_edge)
 {
     int f, k;
@@ -23,21 +23,11 @@ static int so_cube_build(so_cube *c, const float albedo[3], float max_edge)
     uint32_t i, j;
     memset(c, 0, sizeof(*c));
     for (k = 0; k < 3; ++k) c->mat.albedo[k] = albedo[k];
+    fx_cube_faces(c->pos);
     for (f = 0; f < 6; ++f) {
-        int a = f / 2, s = (f % 2) ? -1 : 1; /* inward normal s * e_a: on the face at coord (s > 0 ? 0 : 1) */
-        float cen[3] = { 0.5f, 0.5f, 0.5f }, u[3] = { 0, 0, 0 }, v[3] = { 0, 0, 0 }, *p = c->pos + 12 * f;
-        cen[a] = s > 0 ? 0.0f : 1.0f;
-        if (s > 0) { u[(a + 1) % 3] = 1.0f; v[(a + 2) % 3] = 1.0f; }
-        else { v[(a + 1) % 3] = 1.0f; u[(a + 2) % 3] = 1.0f; }
-        for (k = 0; k < 3; ++k) {
-            p[k] = cen[k] - 0.5f * u[k] - 0.5f * v[k];
-            p[3 + k] = cen[k] + 0.5f * u[k] - 0.5f * v[k];
-            p[6 + k] = cen[k] + 0.5f * u[k] + 0.5f * v[k];
-            p[9 + k] = cen[k] - 0.5f * u[k] + 0.5f * v[k];
-        }
-        c->meshes[f].positions = p;
+        c->meshes[f].positions = c->pos + 12 * f;
         c->meshes[f].vertex_count = 4;
-        c->meshes[f].indices = so_quad_idx;
+        c->meshes[f].indices = ff_quad_indices;
         c->meshes[f].triangle_count = 2;
     }
     c->desc.meshes = c->meshes;
@@ -83,14 +73,6 @@ static double so_max_diff(const float *a, const float *b, uint32_t n)
         double d = fabs((double)a[i] - (double)b[i]);
         if (!(d <= m)) m = d == d ? d : 1e30; /* NaN counts as a huge difference */
     }
-    return m;
-}
-
-static double so_max_abs(const float *a, uint32_t n)
-{
-    double m = 0.0;
-    size_t i;
-    for (i = 0; i < 3 * (size_t)n; ++i) if (fabs((double)a[i]) > m) m = fabs((double)a[i]);
     return m;
 }
 
@@ -181,46 +163,10 @@ static void so_test_furnace_rgb(void)
 
 /* ---- the Cornell box: all solvers agree ---------------------------------------------------- */
 
-typedef struct so_cornell {
-    rad_scene *scene;
-    rad_patches *P;
-    rad_bvh *bvh;
-    rad_form_factors *ff, *ffs;
-    float *E;
-} so_cornell;
+/* the shared Cornell world (fixtures.h): E = emission, ffs the sparse form factors */
+typedef fx_world so_cornell;
 
-static int so_cornell_build(so_cornell *c, uint32_t target, int sparse)
-{
-    rad_scene_desc desc;
-    rad_patch_options po;
-    rad_form_factor_options fo;
-    rad_raycaster rc;
-    memset(c, 0, sizeof(*c));
-    rad_cornell_box(&desc, NULL);
-    if (rad_scene_create(&desc, NULL, &c->scene) != RAD_SUCCESS) return 0;
-    rad_patch_options_default(&po);
-    po.target_count = target;
-    if (rad_patches_create(c->scene, &po, NULL, &c->P) != RAD_SUCCESS) return 0;
-    if (rad_bvh_create(c->scene, NULL, &c->bvh) != RAD_SUCCESS) return 0;
-    rad_bvh_raycaster(c->bvh, &rc);
-    rad_form_factor_options_default(&fo);
-    if (rad_form_factors_dense(c->P, &rc, &fo, NULL, &c->ff) != RAD_SUCCESS) return 0;
-    if (sparse && rad_form_factors_sparse(c->P, &rc, &fo, NULL, &c->ffs) != RAD_SUCCESS) return 0;
-    c->E = (float *)malloc(sizeof(float) * 3 * c->P->count);
-    if (!c->E) return 0;
-    if (rad_sources(c->P, RAD_SOURCE_EMISSION, NULL, c->E) != RAD_SUCCESS) return 0;
-    return 1;
-}
-
-static void so_cornell_free(so_cornell *c)
-{
-    free(c->E);
-    rad_form_factors_destroy(c->ff);
-    rad_form_factors_destroy(c->ffs);
-    rad_bvh_destroy(c->bvh);
-    rad_patches_destroy(c->P);
-    rad_scene_destroy(c->scene);
-}
+static int so_cornell_build(so_cornell *c, uint32_t target, int sparse) { return fx_cornell(c, target, 0, sparse); }
 
 /* the four solvers with output 'mode' into out[4][3n]: direct, GS, progressive, Jacobi(100) */
 static void so_all_solvers(const rad_system *sys, rad_output mode, float **out)
@@ -246,8 +192,8 @@ static void so_test_cornell_agree(void)
     uint32_t n, s, mode;
     int ok = so_cornell_build(&c, rad_test_quick() ? 150 : 400, 1);
     CHECK(ok);
-    if (!ok) { so_cornell_free(&c); return; }
-    n = c.P->count;
+    if (!ok) { fx_world_free(&c); return; }
+    n = c.patches->count;
     printf("    %u patches, dense %u x %u, sparse %llu non-zeros\n", n, n, n,
            (unsigned long long)c.ffs->matrix.row_offsets[n]);
     for (s = 0; s < 4; ++s) {
@@ -256,9 +202,9 @@ static void so_test_cornell_agree(void)
     }
     for (mode = 0; mode < 2; ++mode) {
         double ref, worst = 0.0;
-        rad_system_init(&sys, &c.ff->matrix, c.P, c.E);
+        rad_system_init(&sys, &c.ff->matrix, c.patches, c.E);
         so_all_solvers(&sys, (rad_output)mode, out);
-        rad_system_init(&sys, &c.ffs->matrix, c.P, c.E);
+        rad_system_init(&sys, &c.ffs->matrix, c.patches, c.E);
         so_all_solvers(&sys, (rad_output)mode, outs);
         /* the scale is max |B_total| for both outputs: L = B - E has the same absolute errors */
         if (mode == 1) ref = so_max_abs(out[0], n);
@@ -285,7 +231,7 @@ static void so_test_cornell_agree(void)
     {
         rad_solve_options so;
         uint32_t i;
-        rad_system_init(&sys, &c.ff->matrix, c.P, c.E);
+        rad_system_init(&sys, &c.ff->matrix, c.patches, c.E);
         rad_solve_options_default(&so);
         so.output = RAD_OUTPUT_TOTAL;
         CHECK_OK(rad_solve_direct(&sys, &so, out[0], NULL));
@@ -294,7 +240,7 @@ static void so_test_cornell_agree(void)
         for (i = 0; i < 3 * n; ++i) CHECK_NEAR(out[0][i], out[1][i] + c.E[i], 1e-5 * (1.0 + fabs(out[0][i])));
     }
     for (s = 0; s < 4; ++s) { free(out[s]); free(outs[s]); }
-    so_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* ---- matrix multiply ---------------------------------------------------------------------- */
@@ -393,10 +339,10 @@ static void so_test_residual_and_errors(void)
     uint32_t n, i, solver;
     int ok = so_cornell_build(&c, rad_test_quick() ? 80 : 200, 0);
     CHECK(ok);
-    if (!ok) { so_cornell_free(&c); return; }
-    n = c.P->count;
+    if (!ok) { fx_world_free(&c); return; }
+    n = c.patches->count;
     B = (float *)malloc(sizeof(float) * 3 * n);
-    rad_system_init(&sys, &c.ff->matrix, c.P, c.E);
+    rad_system_init(&sys, &c.ff->matrix, c.patches, c.E);
     for (solver = 0; solver < 2; ++solver) {
         rad_result r;
         /* run to convergence: iterations increase, the residual drops */
@@ -463,7 +409,7 @@ static void so_test_residual_and_errors(void)
     CHECK_RESULT(rad_solve_jacobi(&sys, &so, NULL, &st, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_solve_direct(NULL, &so, B, NULL), RAD_ERROR_INVALID_ARGUMENT);
     free(B);
-    so_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 static void so_test_singular(void)
@@ -513,13 +459,6 @@ static void so_test_singular(void)
 
 /* ---- determinism --------------------------------------------------------------------------------- */
 
-static void so_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = count; i-- > 0;) fn(data, i);
-}
-
 static void so_test_jacobi_deterministic(void)
 {
     so_cornell c;
@@ -530,21 +469,21 @@ static void so_test_jacobi_deterministic(void)
     uint32_t n;
     int ok = so_cornell_build(&c, rad_test_quick() ? 100 : 300, 1);
     CHECK(ok);
-    if (!ok) { so_cornell_free(&c); return; }
-    n = c.P->count;
+    if (!ok) { fx_world_free(&c); return; }
+    n = c.patches->count;
     B1 = (float *)malloc(sizeof(float) * 3 * n);
     B2 = (float *)malloc(sizeof(float) * 3 * n);
     memset(&rev, 0, sizeof(rev));
-    rev.parallel_for = so_reverse_for;
+    rev.parallel_for = fx_reverse_for;
     rev.task_count = 7;
     rad_solve_options_default(&so);
     so.bounces = 12;
     so.output = RAD_OUTPUT_TOTAL;
-    rad_system_init(&sys, &c.ff->matrix, c.P, c.E);
+    rad_system_init(&sys, &c.ff->matrix, c.patches, c.E);
     CHECK_OK(rad_solve_jacobi(&sys, &so, B1, NULL, NULL));
     CHECK_OK(rad_solve_jacobi(&sys, &so, B2, NULL, &rev));
     CHECK(memcmp(B1, B2, sizeof(float) * 3 * n) == 0);
-    rad_system_init(&sys, &c.ffs->matrix, c.P, c.E);
+    rad_system_init(&sys, &c.ffs->matrix, c.patches, c.E);
     CHECK_OK(rad_solve_jacobi(&sys, &so, B1, NULL, NULL));
     CHECK_OK(rad_solve_jacobi(&sys, &so, B2, NULL, &rev));
     CHECK(memcmp(B1, B2, sizeof(float) * 3 * n) == 0);
@@ -554,7 +493,7 @@ static void so_test_jacobi_deterministic(void)
     CHECK(memcmp(B1, B2, sizeof(float) * 3 * n) == 0);
     free(B1);
     free(B2);
-    so_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 static const rad_test_case tests_solve[] = {
@@ -567,3 +506,5 @@ static const rad_test_case tests_solve[] = {
     { "solve_jacobi_deterministic", so_test_jacobi_deterministic },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_solve)

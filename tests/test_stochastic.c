@@ -1,6 +1,7 @@
 /* test_stochastic.c - stochastic radiosity (rad_solve_stochastic): the mean over seeds against
    the direct solve, the variance against the ray count, the closed furnace, determinism across
    thread counts, and bad input. Everything static and prefixed st_. */
+#include "fixtures.h"
 
 /* A closed unit cube seen from inside, one material per face (so the light changes colour from
    face to face); no occluders, so the analytic form factors (relative error below 1e-4) are
@@ -18,8 +19,6 @@ typedef struct st_box {
     float *E;
 } st_box;
 
-static const uint32_t st_quad_idx[6] = { 0, 1, 2, 0, 2, 3 };
-
 /* albedo: 6 RGB triples (NULL: a palette of six); emit: E on the patches of face 2 (the floor,
    y = 0) only, else E = 1 everywhere */
 static int st_box_build(st_box *b, const float *albedo, float max_edge, int floor_source)
@@ -31,22 +30,12 @@ static int st_box_build(st_box *b, const float *albedo, float max_edge, int floo
     int f, k;
     memset(b, 0, sizeof(*b));
     if (!albedo) albedo = palette;
+    fx_cube_faces(b->pos);
     for (f = 0; f < 6; ++f) {
-        int a = f / 2, s = (f % 2) ? -1 : 1;
-        float cen[3] = { 0.5f, 0.5f, 0.5f }, u[3] = { 0, 0, 0 }, v[3] = { 0, 0, 0 }, *p = b->pos + 12 * f;
-        cen[a] = s > 0 ? 0.0f : 1.0f;
-        if (s > 0) { u[(a + 1) % 3] = 1.0f; v[(a + 2) % 3] = 1.0f; }
-        else { v[(a + 1) % 3] = 1.0f; u[(a + 2) % 3] = 1.0f; }
-        for (k = 0; k < 3; ++k) {
-            p[k] = cen[k] - 0.5f * u[k] - 0.5f * v[k];
-            p[3 + k] = cen[k] + 0.5f * u[k] - 0.5f * v[k];
-            p[6 + k] = cen[k] + 0.5f * u[k] + 0.5f * v[k];
-            p[9 + k] = cen[k] - 0.5f * u[k] + 0.5f * v[k];
-            b->mat[f].albedo[k] = albedo[3 * f + k];
-        }
-        b->meshes[f].positions = p;
+        for (k = 0; k < 3; ++k) b->mat[f].albedo[k] = albedo[3 * f + k];
+        b->meshes[f].positions = b->pos + 12 * f;
         b->meshes[f].vertex_count = 4;
-        b->meshes[f].indices = st_quad_idx;
+        b->meshes[f].indices = ff_quad_indices;
         b->meshes[f].triangle_count = 2;
         b->meshes[f].material = (uint32_t)f;
     }
@@ -250,13 +239,6 @@ static void st_test_furnace(void)
 }
 
 /* tasks in reverse order on the calling thread: another schedule than the default */
-static void st_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = count; i-- > 0;) fn(data, i);
-}
-
 static int st_calls;
 static int st_stop_after_two(void *user, uint32_t iteration, uint64_t rays, const float *B)
 {
@@ -285,7 +267,7 @@ static void st_test_threads(void)
     memset(&c2, 0, sizeof(c2));
     c1.task_count = 1;
     c2.task_count = 13;
-    c2.parallel_for = st_reverse_for;
+    c2.parallel_for = fx_reverse_for;
     for (m = 0; m < 2; ++m) {
         rad_stochastic_options_default(&o);
         o.method = m ? RAD_STOCHASTIC_WALK : RAD_STOCHASTIC_JACOBI;
@@ -423,3 +405,5 @@ static const rad_test_case tests_stochastic[] = {
     { "stochastic_alloc_failure", st_test_alloc_failure },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_stochastic)

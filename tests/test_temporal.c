@@ -3,39 +3,18 @@
    trip), the step's expectation against the exact gather, convergence to rho o (F E) and to
    L_inf with feedback, rows with sums above 1, the environment entry, determinism across
    thread counts, the adaptive weight, error codes. Everything static and prefixed tp_. */
+#include "fixtures.h"
 
-typedef struct tp_cornell {
-    rad_scene *scene;
-    rad_patches *P;
-    rad_bvh *bvh;
-    rad_form_factors *ff, *ffs;
-    float *E;
-    uint32_t n;
-} tp_cornell;
+
+/* the shared Cornell world (fixtures.h) */
+typedef fx_world tp_cornell;
 
 /* Cornell box near 'target' patches, dense F and (optionally) sparse F; E: a positive
    pseudo-random source with a few bright patches and some zeros (heavy-tailed on purpose). */
 static int tp_cornell_build(tp_cornell *c, uint32_t target, int sparse)
 {
-    rad_scene_desc desc;
-    rad_patch_options po;
-    rad_form_factor_options fo;
-    rad_raycaster rc;
     uint32_t i, state = 12345u;
-    memset(c, 0, sizeof(*c));
-    rad_cornell_box(&desc, NULL);
-    if (rad_scene_create(&desc, NULL, &c->scene) != RAD_SUCCESS) return 0;
-    rad_patch_options_default(&po);
-    po.target_count = target;
-    if (rad_patches_create(c->scene, &po, NULL, &c->P) != RAD_SUCCESS) return 0;
-    if (rad_bvh_create(c->scene, NULL, &c->bvh) != RAD_SUCCESS) return 0;
-    rad_bvh_raycaster(c->bvh, &rc);
-    rad_form_factor_options_default(&fo);
-    if (rad_form_factors_dense(c->P, &rc, &fo, NULL, &c->ff) != RAD_SUCCESS) return 0;
-    if (sparse && rad_form_factors_sparse(c->P, &rc, &fo, NULL, &c->ffs) != RAD_SUCCESS) return 0;
-    c->n = c->P->count;
-    c->E = (float *)malloc(sizeof(float) * 3 * c->n);
-    if (!c->E) return 0;
+    if (!fx_cornell(c, target, 0, sparse)) return 0;
     for (i = 0; i < 3 * c->n; ++i) {
         state = state * 1664525u + 1013904223u;
         c->E[i] = (float)(state >> 8) / 16777216.0f;
@@ -43,16 +22,6 @@ static int tp_cornell_build(tp_cornell *c, uint32_t target, int sparse)
         if (i % 23 == 5) c->E[i] = 0.0f;
     }
     return 1;
-}
-
-static void tp_cornell_free(tp_cornell *c)
-{
-    free(c->E);
-    rad_form_factors_destroy(c->ff);
-    rad_form_factors_destroy(c->ffs);
-    rad_bvh_destroy(c->bvh);
-    rad_patches_destroy(c->P);
-    rad_scene_destroy(c->scene);
 }
 
 /* relative RMS of a against b over 3n floats: sqrt(sum (a-b)^2 / sum b^2) */
@@ -151,7 +120,7 @@ static void tp_alias_tables_exact(void)
     float *plane;
     double *p, worst = 0.0, worst2 = 0.0;
     uint32_t i, j, n;
-    if (!tp_cornell_build(&c, 120, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 120, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     plane = (float *)malloc(sizeof(float) * n * n);
     p = (double *)malloc(sizeof(double) * (n + 1));
@@ -185,7 +154,7 @@ static void tp_alias_tables_exact(void)
     rad_alias_tables_destroy(t2);
     free(plane);
     free(p);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* Streamed rows (rad_alias_build_row): every row rebuilt alone from the dense row and from the CSR row gives
@@ -199,7 +168,7 @@ static void tp_streamed_rows(void)
     void *scratch;
     float total;
     int same = 1;
-    if (!tp_cornell_build(&c, 100, 1)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 100, 1)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     bins = (uint32_t *)malloc(sizeof(uint32_t) * 3 * (n + 1));
     scratch = malloc(rad_alias_row_scratch_size(n));
@@ -229,7 +198,7 @@ static void tp_streamed_rows(void)
     rad_alias_tables_destroy(ts);
     free(bins);
     free(scratch);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* The step's expectation: M independent single steps (w = 0, each frame new draws) average
@@ -243,7 +212,7 @@ static void tp_expectation(void)
     float *FE, *ref, *out, E0[3] = { 0.3f, 0.5f, 0.7f };
     double *sum, *sum2;
     uint32_t i, j, n, fr, M = rad_test_quick() ? 500u : 2000u, bad = 0;
-    if (!tp_cornell_build(&c, 100, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 100, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     FE = (float *)malloc(sizeof(float) * 3 * n);
     ref = (float *)malloc(sizeof(float) * 3 * n);
@@ -254,13 +223,13 @@ static void tp_expectation(void)
     for (i = 0; i < n; ++i) {
         double S = 0.0;
         for (j = 0; j < n; ++j) S += c.ff->matrix.dense[(size_t)i * n + j];
-        for (j = 0; j < 3; ++j) ref[3 * i + j] = c.P->albedo[3 * i + j] * (FE[3 * i + j] + (S < 1.0 ? (float)(1.0 - S) : 0.0f) * E0[j]);
+        for (j = 0; j < 3; ++j) ref[3 * i + j] = c.patches->albedo[3 * i + j] * (FE[3 * i + j] + (S < 1.0 ? (float)(1.0 - S) : 0.0f) * E0[j]);
     }
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
     rad_temporal_options_default(&o);
     o.weight = 0.0f;
     o.samples = 10;
-    CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm));
+    CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.patches->albedo, &o, NULL, &tm));
     if (tm) {
         for (fr = 0; fr < M; ++fr) {
             CHECK_OK(rad_temporal_step(tm, c.E, E0, out));
@@ -278,7 +247,7 @@ static void tp_expectation(void)
     rad_temporal_destroy(tm);
     rad_alias_tables_destroy(t);
     free(FE); free(ref); free(out); free(sum); free(sum2);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* Constant E: single bounce converges to rho o (F E); feedback to L_inf of rad_solve_direct
@@ -295,7 +264,7 @@ static void tp_converge(void)
     rad_solve_options so;
     float *ref, *out, *avg;
     uint32_t i, n, fr, mode;
-    if (!tp_cornell_build(&c, 100, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 100, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     ref = (float *)malloc(sizeof(float) * 3 * n);
     out = (float *)malloc(sizeof(float) * 3 * n);
@@ -306,9 +275,9 @@ static void tp_converge(void)
         uint32_t warm = mode == 0 ? 1500u : 3000u;
         if (mode == 0) {
             CHECK_OK(rad_matrix_multiply(&c.ff->matrix, c.E, ref, NULL));
-            for (i = 0; i < 3 * n; ++i) ref[i] *= c.P->albedo[i];
+            for (i = 0; i < 3 * n; ++i) ref[i] *= c.patches->albedo[i];
         } else {
-            rad_system_init(&sys, &c.ff->matrix, c.P, c.E);
+            rad_system_init(&sys, &c.ff->matrix, c.patches, c.E);
             rad_solve_options_default(&so);
             so.output = RAD_OUTPUT_INDIRECT;
             CHECK_OK(rad_solve_direct(&sys, &so, ref, NULL));
@@ -317,7 +286,7 @@ static void tp_converge(void)
         o.mode = mode == 0 ? RAD_TEMPORAL_SINGLE : RAD_TEMPORAL_FEEDBACK;
         o.samples = 64;
         o.weight = 0.995f;
-        CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm));
+        CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.patches->albedo, &o, NULL, &tm));
         if (!tm) break;
         for (fr = 0; fr < warm; ++fr) CHECK_OK(rad_temporal_step(tm, c.E, NULL, out));
         e1 = tp_rel_rms(out, ref, n);
@@ -339,7 +308,7 @@ static void tp_converge(void)
     }
     rad_alias_tables_destroy(t);
     free(ref); free(out); free(avg);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* A multi-bounce-like input: one plane per channel (2F, 1.5F, F: rows above 1) in
@@ -352,7 +321,7 @@ static void tp_multibounce_channels(void)
     rad_temporal_options o;
     float *plane, *ref, *out, *avg, scale[3] = { 2.0f, 1.5f, 1.0f };
     uint32_t i, j, k, n, fr, M = 1500;
-    if (!tp_cornell_build(&c, 80, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 80, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     plane = (float *)malloc(sizeof(float) * n * n);
     ref = (float *)calloc(3 * n, sizeof(float));
@@ -383,22 +352,15 @@ static void tp_multibounce_channels(void)
         o.mode = RAD_TEMPORAL_SINGLE;
         rad_temporal_destroy(tm);
         tm = NULL;
-        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)t, 3, c.P->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)t, 3, c.patches->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
     }
     rad_temporal_destroy(tm);
     for (k = 0; k < 3; ++k) rad_alias_tables_destroy(t[k]);
     free(plane); free(ref); free(out); free(avg);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* a parallel_for that runs tasks in reverse order (and checks nothing runs twice) */
-static void tp_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
-{
-    uint32_t i;
-    (void)user;
-    for (i = count; i-- > 0;) fn(data, i);
-}
-
 /* Same seed, same bits: serial vs reversed custom parallel_for with 1, 7 and 64 tasks, and
    the OpenMP default; a different seed differs. Also adaptive mode. */
 static void tp_determinism(void)
@@ -410,13 +372,13 @@ static void tp_determinism(void)
     float *ref, *out;
     uint32_t n, fr, v, ad;
     static const uint32_t tasks[4] = { 0, 1, 7, 64 };
-    if (!tp_cornell_build(&c, 80, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 80, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     ref = (float *)malloc(sizeof(float) * 3 * n);
     out = (float *)malloc(sizeof(float) * 3 * n);
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
     memset(&ctx, 0, sizeof(ctx));
-    ctx.parallel_for = tp_reverse_for;
+    ctx.parallel_for = fx_reverse_for;
     ctx.task_count = 7;
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, &ctx, &t7));
     if (t && t7) CHECK(memcmp(t->bins, t7->bins, (size_t)t->row_offsets[n] * t->format * 4) == 0);
@@ -429,9 +391,9 @@ static void tp_determinism(void)
         for (v = 0; v < 5; ++v) {
             rad_temporal *tm = NULL;
             memset(&ctx, 0, sizeof(ctx));
-            if (v > 0 && v < 4) { ctx.parallel_for = tp_reverse_for; ctx.task_count = tasks[v]; }
+            if (v > 0 && v < 4) { ctx.parallel_for = fx_reverse_for; ctx.task_count = tasks[v]; }
             if (v == 4) o.seed = 100;
-            CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, &ctx, &tm));
+            CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.patches->albedo, &o, &ctx, &tm));
             if (!tm) continue;
             for (fr = 0; fr < 20; ++fr) CHECK_OK(rad_temporal_step(tm, c.E, NULL, out));
             if (v == 0) memcpy(ref, out, sizeof(float) * 3 * n);
@@ -449,7 +411,7 @@ static void tp_determinism(void)
     rad_alias_tables_destroy(t);
     rad_alias_tables_destroy(t7);
     free(ref); free(out);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* frames after a jump of E (E -> 2.5 E at frame 'jump') until the projection of B - L_a onto
@@ -466,12 +428,12 @@ static void tp_lag_run(tp_cornell *c, const rad_alias_tables *t, int adaptive, f
     *noise = 1.0;
     for (i = 0; i < 3 * n; ++i) E2[i] = 2.5f * c->E[i];
     rad_matrix_multiply(&c->ff->matrix, c->E, La, NULL);
-    for (i = 0; i < 3 * n; ++i) { La[i] *= c->P->albedo[i]; Lb[i] = 2.5f * La[i]; }
+    for (i = 0; i < 3 * n; ++i) { La[i] *= c->patches->albedo[i]; Lb[i] = 2.5f * La[i]; }
     rad_temporal_options_default(&o);
     o.samples = 10;
     o.adaptive = adaptive;
     o.noise_target = target;
-    if (rad_temporal_create(&t, 1, c->P->albedo, &o, NULL, &tm) != RAD_SUCCESS) { CHECK(0); goto done; }
+    if (rad_temporal_create(&t, 1, c->patches->albedo, &o, NULL, &tm) != RAD_SUCCESS) { CHECK(0); goto done; }
     for (fr = 0; fr < jump + 3000; ++fr) {
         rad_temporal_step(tm, fr < jump ? c->E : E2, NULL, out);
         if (fr >= jump - 200 && fr < jump) acc += tp_rel_rms(out, La, n) / 200.0;
@@ -497,7 +459,7 @@ static void tp_adaptive(void)
     uint32_t lag_f, lag_a;
     double noise_f, noise_a;
     if (rad_test_quick()) { printf("    (skipped in quick mode)\n"); return; }
-    if (!tp_cornell_build(&c, 100, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 100, 0)) { CHECK(0); fx_world_free(&c); return; }
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
     if (t) {
         tp_lag_run(&c, t, 0, 0.0f, &lag_f, &noise_f);
@@ -508,7 +470,7 @@ static void tp_adaptive(void)
         CHECK(noise_a <= noise_f * 1.05);
     }
     rad_alias_tables_destroy(t);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 static int tp_log_count;
@@ -608,7 +570,7 @@ static void tp_container(void)
     void *buf = NULL;
     size_t size = 0;
     uint32_t n;
-    if (!tp_cornell_build(&c, 60, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 60, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     memset(&ctx, 0, sizeof(ctx));
     ctx.log = tp_log;
@@ -643,7 +605,7 @@ static void tp_container(void)
     }
     free(buf);
     rad_alias_tables_destroy(t);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* The step written out plainly from the doc block (rad_temporal_random + rad_alias_draw, the
@@ -698,7 +660,7 @@ static void tp_pipeline_bits(void)
     float *ref, *out, *plane, E0[3] = { 0.2f, 0.4f, 0.1f };
     uint32_t n, v, i;
     static const uint32_t ks[5] = { 1, 10, 70, 10, 3 }, tasks[5] = { 4096, 0, 7, 3, 7 };
-    if (!tp_cornell_build(&c, rad_test_quick() ? 40 : 80, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, rad_test_quick() ? 40 : 80, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     ref = (float *)malloc(sizeof(float) * 3 * n);
     out = (float *)malloc(sizeof(float) * 3 * n);
@@ -723,9 +685,9 @@ static void tp_pipeline_bits(void)
         o.weight = 0.75f;
         o.mode = v == 2 ? RAD_TEMPORAL_FEEDBACK : v >= 3 ? RAD_TEMPORAL_MULTIBOUNCE : RAD_TEMPORAL_SINGLE;
         memset(&ctx, 0, sizeof(ctx));
-        if (tasks[v]) { ctx.parallel_for = tp_reverse_for; ctx.task_count = tasks[v]; }
-        tp_plain_steps(tb, sets, c.P->albedo, &o, c.E, E0, 3, ref);
-        CHECK_OK(rad_temporal_create(tb, sets, c.P->albedo, &o, &ctx, &tm));
+        if (tasks[v]) { ctx.parallel_for = fx_reverse_for; ctx.task_count = tasks[v]; }
+        tp_plain_steps(tb, sets, c.patches->albedo, &o, c.E, E0, 3, ref);
+        CHECK_OK(rad_temporal_create(tb, sets, c.patches->albedo, &o, &ctx, &tm));
         if (!tm) continue;
         for (fr = 0; fr < 3; ++fr) CHECK_OK(rad_temporal_step(tm, c.E, E0, out));
         CHECK(memcmp(ref, out, sizeof(float) * 3 * n) == 0);
@@ -738,7 +700,7 @@ static void tp_pipeline_bits(void)
         rad_alias_tables_destroy(tk[v]);
     }
     free(ref); free(out); free(plane);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 /* counts the bytes a custom allocator hands out and takes back (huge-page path below) */
@@ -818,7 +780,7 @@ static void tp_bad_values(void)
     void *buf = NULL;
     size_t size = 0;
     int q;
-    if (!tp_cornell_build(&c, 60, 0)) { CHECK(0); tp_cornell_free(&c); return; }
+    if (!tp_cornell_build(&c, 60, 0)) { CHECK(0); fx_world_free(&c); return; }
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
     if (t) {
         rad_alias_tables_sections(t, "F", sec);
@@ -842,18 +804,18 @@ static void tp_bad_values(void)
         rad_temporal_options_default(&o);
         o.mode = RAD_TEMPORAL_FEEDBACK;
         o.samples = RAD_TEMPORAL_MAX_SAMPLES;
-        CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm));
+        CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.patches->albedo, &o, NULL, &tm));
         rad_temporal_destroy(tm);
         tm = NULL;
         o.samples = RAD_TEMPORAL_MAX_SAMPLES + 1u;
-        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.patches->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
         o.samples = 16777216u;
-        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.P->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.patches->albedo, &o, NULL, &tm), RAD_ERROR_INVALID_ARGUMENT);
         CHECK(tm == NULL);
     }
     free(buf);
     rad_alias_tables_destroy(t);
-    tp_cornell_free(&c);
+    fx_world_free(&c);
 }
 
 static const rad_test_case tests_temporal[] = {
@@ -873,3 +835,5 @@ static const rad_test_case tests_temporal[] = {
     { "temporal_huge_tables", tp_huge_tables },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_temporal)

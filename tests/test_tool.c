@@ -3,12 +3,10 @@
    cc -std=c99 -O2 -fopenmp -I. tests/test_tool.c tools/image.c tools/metrics.c tools/trace.c \
       -o build/test_tool -lm
 
-   Prints one line per test and ends with "N passed, N failed"; exits non-zero on failure.
-   Temporary files go to $TMPDIR (default /tmp). */
-#define RADIOSITY_IMPLEMENTATION
-#include "../radiosity.h"
+   Prints one line per test and ends with "N passed, N failed"; exits non-zero on failure
+   (test.h: the arguments and environment). Temporary files go to $TMPDIR (default /tmp). */
+#include "fixtures.h"
 #include "../tools/tool.h"
-#include "test.h"
 #include <stdint.h>
 #ifdef _OPENMP
 #include <omp.h>
@@ -693,25 +691,7 @@ static const rad_test_case tests[] = {
     { "trace: point light NEE", test_trace_point_light },
     { "trace: agrees with the radiosity solution", test_trace_vs_radiosity },
     { "trace: deterministic across threads and schedules", test_trace_determinism },
+    { NULL, NULL }
 };
 
-int main(void)
-{
-    (void)&rad_test_path; /* test.h's scratch paths: this file has its own tmp_path */
-    size_t i, n = sizeof(tests) / sizeof(tests[0]);
-    int passed = 0, failed = 0;
-    for (i = 0; i < n; ++i) {
-        rad_test_failures = 0;
-        tests[i].fn();
-        if (rad_test_failures == 0) {
-            printf("ok   %s\n", tests[i].name);
-            passed++;
-        } else {
-            printf("FAIL %s\n", tests[i].name);
-            failed++;
-        }
-        fflush(stdout);
-    }
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed ? 1 : 0;
-}
+RAD_TEST_MAIN(tests)

@@ -3,117 +3,13 @@
    of the gathered lighting across voxels, peak memory through a counting allocator, and the
    argument checks. Included by test_main.c after the implementation: every name is static
    and prefixed vp_. */
+#include "fixtures.h"
+
 
 /* ---- helpers ------------------------------------------------------------------------------ */
 
-/* A peak-tracking allocator: a 16-byte header keeps each block's size. */
-typedef struct vp_peak_state {
-    long long live, peak;
-} vp_peak_state;
-
-static void *vp_peak_alloc(void *user, size_t size)
-{
-    vp_peak_state *s = (vp_peak_state *)user;
-    unsigned char *p = (unsigned char *)malloc(size + 16);
-    if (!p) return NULL;
-    memcpy(p, &size, sizeof(size));
-#ifdef _OPENMP
-#pragma omp critical(vp_peak_lock)
-#endif
-    {
-        s->live += (long long)size;
-        if (s->live > s->peak) s->peak = s->live;
-    }
-    return p + 16;
-}
-
-static void vp_peak_free(void *user, void *ptr)
-{
-    vp_peak_state *s = (vp_peak_state *)user;
-    unsigned char *p;
-    size_t size;
-    if (!ptr) return;
-    p = (unsigned char *)ptr - 16;
-    memcpy(&size, p, sizeof(size));
-#ifdef _OPENMP
-#pragma omp critical(vp_peak_lock)
-#endif
-    {
-        s->live -= (long long)size;
-    }
-    free(p);
-}
-
-/* Up to 8 axis-aligned quads, each cut into an n x n grid of triangle pairs. */
-#define VP_MAX_QUADS 10
 /* the thin-wall leak of vp_partition: the most the dark room may get, as a multiple of classic */
 #define VP_PARTITION_LEAK 1.7
-typedef struct vp_scene {
-    float pos[VP_MAX_QUADS][3 * 41 * 41];
-    uint32_t idx[VP_MAX_QUADS][6 * 40 * 40];
-    rad_mesh_desc meshes[VP_MAX_QUADS];
-    rad_material materials[2];
-    uint32_t count;
-} vp_scene;
-
-/* quad o, o+u, o+u+v, o+v, front on the side u x v points to, material m, n x n cells */
-static void vp_add_quad(vp_scene *s, const float *o, const float *u, const float *v, uint32_t m, uint32_t n)
-{
-    uint32_t q = s->count++, i, j, k;
-    rad_mesh_desc *d = &s->meshes[q];
-    for (j = 0; j <= n; ++j)
-        for (i = 0; i <= n; ++i)
-            for (k = 0; k < 3; ++k)
-                s->pos[q][3 * (j * (n + 1) + i) + k] = o[k] + u[k] * (float)i / (float)n + v[k] * (float)j / (float)n;
-    for (j = 0; j < n; ++j)
-        for (i = 0; i < n; ++i) {
-            uint32_t a = j * (n + 1) + i, *t = &s->idx[q][6 * (j * n + i)];
-            t[0] = a; t[1] = a + 1; t[2] = a + n + 2;
-            t[3] = a; t[4] = a + n + 2; t[5] = a + n + 1;
-        }
-    memset(d, 0, sizeof(*d));
-    d->positions = s->pos[q];
-    d->vertex_count = (n + 1) * (n + 1);
-    d->indices = s->idx[q];
-    d->triangle_count = 2 * n * n;
-    d->material = m;
-}
-
-/* The inside of the box [0,sx] x [0,sy] x [0,sz], faces pointing in; material 0 everywhere,
-   or material 1 on the ceiling (y = sy) when ceiling_light. */
-static void vp_box(vp_scene *s, float sx, float sy, float sz, uint32_t n, int ceiling_light)
-{
-    float o0[3] = { 0, 0, 0 }, X[3], Y[3], Z[3], oX[3], oY[3], oZ[3];
-    memset(s, 0, sizeof(*s));
-    X[0] = sx; X[1] = 0; X[2] = 0;
-    Y[0] = 0; Y[1] = sy; Y[2] = 0;
-    Z[0] = 0; Z[1] = 0; Z[2] = sz;
-    oX[0] = sx; oX[1] = 0; oX[2] = 0;
-    oY[0] = 0; oY[1] = sy; oY[2] = 0;
-    oZ[0] = 0; oZ[1] = 0; oZ[2] = sz;
-    vp_add_quad(s, o0, Z, X, 0, n);                      /* floor y = 0, normal +y */
-    vp_add_quad(s, oY, X, Z, ceiling_light ? 1u : 0u, n); /* ceiling y = sy, normal -y */
-    vp_add_quad(s, o0, Y, Z, 0, n);                      /* x = 0, normal +x */
-    vp_add_quad(s, oX, Z, Y, 0, n);                      /* x = sx, normal -x */
-    vp_add_quad(s, o0, X, Y, 0, n);                      /* z = 0, normal +z */
-    vp_add_quad(s, oZ, Y, X, 0, n);                      /* z = sz, normal -z */
-}
-
-static void vp_desc(vp_scene *s, rad_scene_desc *d, float rho, float emission)
-{
-    int k;
-    for (k = 0; k < 3; ++k) {
-        s->materials[0].albedo[k] = rho;
-        s->materials[0].emission[k] = emission;
-        s->materials[1].albedo[k] = rho;
-        s->materials[1].emission[k] = 0.0f;
-    }
-    memset(d, 0, sizeof(*d));
-    d->meshes = s->meshes;
-    d->mesh_count = s->count;
-    d->materials = s->materials;
-    d->material_count = 2;
-}
 
 /* ---- reciprocity --------------------------------------------------------------------------- */
 
@@ -1134,3 +1030,5 @@ static const rad_test_case tests_vp[] = {
     { "vp_solvers", vp_test_solvers },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_vp)

@@ -3,8 +3,10 @@
    O(nnz) bytes; temporal radiosity over the CSR rows converges to the direct solve of the same
    patches; alias tables built row by row from rows streamed out of a saved set equal those of
    the in-memory matrix bit for bit; a saved set loads back with the same bits and renders the
-   same, and damaged sections are refused. Included by test_main.c after test_vp.c (it uses
-   its scene and allocator helpers); every name is static and prefixed vpr_. */
+   same, and damaged sections are refused. Uses the fixtures' boxes and peak allocator (vp_*);
+   every name is static and prefixed vpr_. */
+#include "fixtures.h"
+
 
 /* a corridor 8 x 1 x 1 (faces in) lit from its ceiling: far pairs exchange little, so a drop
    threshold leaves few entries per row */
@@ -437,3 +439,5 @@ static const rad_test_case tests_vp_runtime[] = {
     { "vp_streamed_rows", vpr_test_streamed_rows },
     { NULL, NULL }
 };
+
+RAD_TEST_MAIN(tests_vp_runtime)

@@ -1,0 +1,585 @@
+/* fixtures.h - what the unit-test files share: the implementation (each test file is one
+   translation unit, alone or inside test_main.c), the harness (test.h), the Embree stand-in of
+   the unit-embree suite, and the scene builders, allocators and worlds that several test files
+   build their cases from. The functions are static inline so that a file built on its own
+   compiles warning-free while leaving most of them unused. Names keep the prefix of the file
+   they came from (sc_, ff_, vp_, ct_, so_), so the tests that call them read as before; fx_
+   names are the ones written here. */
+#ifndef RAD_TEST_FIXTURES_H
+#define RAD_TEST_FIXTURES_H
+#define RADIOSITY_IMPLEMENTATION
+/* small chunks, so the sparse virtual-patch build's chunking is exercised (vp_sparse_rows) */
+#ifndef RAD_VP_ROW_CHUNK_BYTES
+#define RAD_VP_ROW_CHUNK_BYTES 65536u
+#endif
+#include "../radiosity.h"
+#include "test.h"
+
+#ifndef FF_PI
+#define FF_PI 3.14159265358979323846
+#endif
+
+/* the library's own rad_bvh_destroy, defined before the Embree stand-in below redefines the name */
+static inline void rad__bvh_destroy_real(rad_bvh *bvh) { rad_bvh_destroy(bvh); }
+
+#ifdef RAD_TEST_EMBREE
+/* The Embree suite: every raycaster the tests take from a BVH is an Embree raycaster over the
+   same triangles, so the whole suite checks the Embree backend against the same expectations. */
+#define RAD_TEST_EMBREE_MAX 256
+static struct { const rad_bvh *bvh; rad_embree *embree; } rad_test_embree_map[RAD_TEST_EMBREE_MAX];
+
+static inline void rad_test_embree_raycaster(const rad_bvh *bvh, rad_raycaster *out)
+{
+    rad_scene fake;
+    float *pos;
+    uint32_t i, slot = RAD_TEST_EMBREE_MAX;
+    rad_embree *e = NULL;
+    rad_bvh_raycaster(bvh, out); /* a fallback that keeps tests running if Embree fails */
+    if (!bvh) return;
+    for (i = 0; i < RAD_TEST_EMBREE_MAX; ++i) {
+        if (rad_test_embree_map[i].bvh == bvh) { rad_embree_raycaster(rad_test_embree_map[i].embree, out); return; }
+        if (!rad_test_embree_map[i].bvh && slot == RAD_TEST_EMBREE_MAX) slot = i;
+    }
+    pos = (float *)malloc(sizeof(float) * 9 * bvh->tri_count);
+    if (!pos || slot == RAD_TEST_EMBREE_MAX) { free(pos); printf("    FAIL embree map full\n"); rad_test_failures++; return; }
+    for (i = 0; i < bvh->leaf_count; ++i) { /* the BVH's own copy of the triangles, lane by lane */
+        const rad__tri4 *q = &bvh->leaves[i];
+        uint32_t j, c, a;
+        for (j = 0; j < 4; ++j)
+            if (q->id[j] != RAD_NONE)
+                for (c = 0; c < 3; ++c)
+                    for (a = 0; a < 3; ++a) pos[9 * (size_t)q->id[j] + 3 * c + a] = q->v[c][a][j];
+    }
+    memset(&fake, 0, sizeof(fake));
+    fake.positions = pos;
+    fake.triangle_count = bvh->tri_count;
+    if (rad_embree_create(&fake, NULL, &e) != RAD_SUCCESS) { printf("    FAIL rad_embree_create\n"); rad_test_failures++; free(pos); return; }
+    free(pos);
+    rad_test_embree_map[slot].bvh = bvh;
+    rad_test_embree_map[slot].embree = e;
+    rad_embree_raycaster(e, out);
+}
+
+static inline void rad_test_embree_bvh_destroy(rad_bvh *bvh)
+{
+    uint32_t i;
+    for (i = 0; i < RAD_TEST_EMBREE_MAX; ++i)
+        if (bvh && rad_test_embree_map[i].bvh == bvh) {
+            rad_embree_destroy(rad_test_embree_map[i].embree);
+            rad_test_embree_map[i].bvh = NULL;
+            rad_test_embree_map[i].embree = NULL;
+        }
+    rad_bvh_destroy(bvh);
+}
+#define rad_bvh_raycaster(bvh, out) rad_test_embree_raycaster(bvh, out)
+#define rad_bvh_destroy(bvh) rad_test_embree_bvh_destroy(bvh)
+#endif
+
+/* ---- schedules: parallel_for hooks that run the tasks serially, forwards or backwards -------- */
+
+static inline void fx_serial_for(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+    uint32_t i;
+    (void)user;
+    for (i = 0; i < count; ++i) fn(data, i);
+}
+
+static inline void fx_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+    uint32_t i;
+    (void)user;
+    for (i = count; i-- > 0;) fn(data, i);
+}
+
+/* ---- a log sink and a counting allocator (sc_) ---------------------------------------------- */
+
+typedef struct sc_log_state {
+    int count;
+    char last[512];
+} sc_log_state;
+
+static inline void sc_log_fn(void *user, rad_log_level level, const char *message)
+{
+    sc_log_state *s = (sc_log_state *)user;
+    (void)level;
+    s->count++;
+    strncpy(s->last, message, sizeof(s->last) - 1);
+    s->last[sizeof(s->last) - 1] = '\0';
+}
+
+/* A counting allocator: a 16-byte header holds the size so live bytes can be tracked, and a
+   64-byte canary after each block catches writes past the end (counted in 'corrupt' on free)
+   without corrupting the heap. fail_at > 0 makes the fail_at-th allocation (1-based) fail. */
+#define SC_CANARY 64
+typedef struct sc_alloc_state {
+    long calls, allocs, frees, failed, corrupt;
+    long long live_bytes;
+    long fail_at;
+} sc_alloc_state;
+
+static inline void *sc_alloc_fn(void *user, size_t size)
+{
+    sc_alloc_state *s = (sc_alloc_state *)user;
+    unsigned char *p;
+    long n;
+#ifdef _OPENMP
+#pragma omp critical(sc_alloc_lock)
+#endif
+    {
+        n = ++s->calls;
+    }
+    if (s->fail_at > 0 && n == s->fail_at) {
+#ifdef _OPENMP
+#pragma omp critical(sc_alloc_lock)
+#endif
+        {
+            s->failed++;
+        }
+        return NULL;
+    }
+    p = (unsigned char *)malloc(size + 16 + SC_CANARY);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof(size));
+    memset(p + 16 + size, 0xA5, SC_CANARY);
+#ifdef _OPENMP
+#pragma omp critical(sc_alloc_lock)
+#endif
+    {
+        s->allocs++;
+        s->live_bytes += (long long)size;
+    }
+    return p + 16;
+}
+
+static inline void sc_free_fn(void *user, void *ptr)
+{
+    sc_alloc_state *s = (sc_alloc_state *)user;
+    unsigned char *p;
+    size_t size, i;
+    int bad = 0;
+    if (!ptr) return;
+    p = (unsigned char *)ptr - 16;
+    memcpy(&size, p, sizeof(size));
+    for (i = 0; i < SC_CANARY; ++i) bad |= p[16 + size + i] != 0xA5;
+#ifdef _OPENMP
+#pragma omp critical(sc_alloc_lock)
+#endif
+    {
+        s->frees++;
+        s->corrupt += bad;
+        s->live_bytes -= (long long)size;
+    }
+    free(p);
+}
+
+static inline void sc_ctx_alloc(rad_context *ctx, sc_alloc_state *st)
+{
+    memset(ctx, 0, sizeof(*ctx));
+    ctx->allocator.alloc = sc_alloc_fn;
+    ctx->allocator.free = sc_free_fn;
+    ctx->allocator.user = st;
+}
+
+
+/* ---- quads, small worlds and Howell's closed forms (ff_) ----------------------------------- */
+
+/* A planar quad o, o+u, o+u+v, o+v: counter-clockwise seen from the side u x v points to, so
+   that side is its front. Two triangles (0 1 2) (0 2 3). */
+typedef struct ff_quad {
+    float pos[12];
+} ff_quad;
+
+static const uint32_t ff_quad_indices[6] = { 0, 1, 2, 0, 2, 3 };
+
+static inline void ff_quad_set(ff_quad *q, float ox, float oy, float oz, float ux, float uy, float uz, float vx, float vy,
+                        float vz)
+{
+    float o[3], u[3], v[3];
+    int k;
+    o[0] = ox; o[1] = oy; o[2] = oz;
+    u[0] = ux; u[1] = uy; u[2] = uz;
+    v[0] = vx; v[1] = vy; v[2] = vz;
+    for (k = 0; k < 3; ++k) {
+        q->pos[k] = o[k];
+        q->pos[3 + k] = o[k] + u[k];
+        q->pos[6 + k] = o[k] + u[k] + v[k];
+        q->pos[9 + k] = o[k] + v[k];
+    }
+}
+
+static inline void ff_mesh_quad(rad_mesh_desc *m, const ff_quad *q)
+{
+    memset(m, 0, sizeof(*m));
+    m->positions = q->pos;
+    m->vertex_count = 4;
+    m->indices = ff_quad_indices;
+    m->triangle_count = 2;
+    m->material = 0;
+}
+
+/* A scene, its patches, its BVH and a raycaster over it. */
+typedef struct ff_world {
+    rad_scene *scene;
+    rad_patches *patches;
+    rad_bvh *bvh;
+    rad_raycaster rc;
+} ff_world;
+
+static inline void ff_world_free(ff_world *w)
+{
+    rad_bvh_destroy(w->bvh);
+    rad_patches_destroy(w->patches);
+    rad_scene_destroy(w->scene);
+    memset(w, 0, sizeof(*w));
+}
+
+/* Builds scene + patches (max_edge and/or target_count) + BVH. Returns 1 on success. */
+static inline int ff_world_make(const rad_scene_desc *desc, float max_edge, uint32_t target_count, ff_world *w)
+{
+    rad_patch_options popt;
+    rad_result r;
+    memset(w, 0, sizeof(*w));
+    r = rad_scene_create(desc, NULL, &w->scene);
+    CHECK_OK(r);
+    if (r != RAD_SUCCESS) return 0;
+    rad_patch_options_default(&popt);
+    popt.max_edge = max_edge;
+    popt.target_count = target_count;
+    r = rad_patches_create(w->scene, &popt, NULL, &w->patches);
+    CHECK_OK(r);
+    if (r != RAD_SUCCESS) { ff_world_free(w); return 0; }
+    r = rad_bvh_create(w->scene, NULL, &w->bvh);
+    CHECK_OK(r);
+    if (r != RAD_SUCCESS) { ff_world_free(w); return 0; }
+    rad_bvh_raycaster(w->bvh, &w->rc);
+    return 1;
+}
+
+static const rad_material ff_grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0 };
+
+static inline void ff_desc(rad_scene_desc *d, const rad_mesh_desc *meshes, uint32_t count)
+{
+    memset(d, 0, sizeof(*d));
+    d->meshes = meshes;
+    d->mesh_count = count;
+    d->materials = &ff_grey;
+    d->material_count = 1;
+}
+
+
+/* Area-weighted group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i,
+   groups by the scene mesh of each patch's triangle. */
+static inline double ff_group(const rad_patches *P, const float *F, uint32_t g, uint32_t h, double *area_g)
+{
+    const rad_scene *s = P->scene;
+    double num = 0.0, den = 0.0;
+    uint32_t i, j, N = P->count;
+    for (i = 0; i < N; ++i) {
+        double row = 0.0;
+        if (s->meshes[P->patches[i].triangle] != g) continue;
+        for (j = 0; j < N; ++j)
+            if (s->meshes[P->patches[j].triangle] == h) row += (double)F[(size_t)i * N + j];
+        num += (double)P->patches[i].area * row;
+        den += (double)P->patches[i].area;
+    }
+    if (area_g) *area_g = den;
+    return den > 0.0 ? num / den : 0.0;
+}
+
+
+/* Howell C-11: identical parallel opposed rectangles a x b at gap c */
+static inline double ff_c11(double a, double b, double c)
+{
+    double X = a / c, Y = b / c;
+    return 2.0 / (FF_PI * X * Y) *
+           (log(sqrt((1 + X * X) * (1 + Y * Y) / (1 + X * X + Y * Y))) + X * sqrt(1 + Y * Y) * atan(X / sqrt(1 + Y * Y)) +
+            Y * sqrt(1 + X * X) * atan(Y / sqrt(1 + X * X)) - X * atan(X) - Y * atan(Y));
+}
+
+/* Howell C-14: A1 = l x w, A2 = l x h, common edge l; F_12 */
+static inline double ff_c14(double l, double w, double h)
+{
+    double H = h / l, W = w / l, H2 = H * H, W2 = W * W, S = sqrt(H2 + W2);
+    double t1 = (1 + W2) * (1 + H2) / (1 + W2 + H2);
+    double t2 = pow(W2 * (1 + W2 + H2) / ((1 + W2) * (W2 + H2)), W2);
+    double t3 = pow(H2 * (1 + W2 + H2) / ((1 + H2) * (W2 + H2)), H2);
+    return 1.0 / (FF_PI * W) * (W * atan(1 / W) + H * atan(1 / H) - S * atan(1 / S) + 0.25 * log(t1 * t2 * t3));
+}
+
+
+/* The six faces of the unit cube [0,1]^3 as quads (four corners each, at pos[12 f]), fronts
+   facing inwards: face f lies on axis f / 2 at 0 (f even) or 1 (f odd); two triangles each
+   with ff_quad_indices. */
+static inline void fx_cube_faces(float *pos)
+{
+    int f, k;
+    for (f = 0; f < 6; ++f) {
+        int a = f / 2, s = (f % 2) ? -1 : 1; /* inward normal s * e_a: on the face at coord (s > 0 ? 0 : 1) */
+        float cen[3] = { 0.5f, 0.5f, 0.5f }, u[3] = { 0, 0, 0 }, v[3] = { 0, 0, 0 }, *p = pos + 12 * f;
+        cen[a] = s > 0 ? 0.0f : 1.0f;
+        if (s > 0) { u[(a + 1) % 3] = 1.0f; v[(a + 2) % 3] = 1.0f; }
+        else { v[(a + 1) % 3] = 1.0f; u[(a + 2) % 3] = 1.0f; }
+        for (k = 0; k < 3; ++k) {
+            p[k] = cen[k] - 0.5f * u[k] - 0.5f * v[k];
+            p[3 + k] = cen[k] + 0.5f * u[k] - 0.5f * v[k];
+            p[6 + k] = cen[k] + 0.5f * u[k] + 0.5f * v[k];
+            p[9 + k] = cen[k] - 0.5f * u[k] + 0.5f * v[k];
+        }
+    }
+}
+
+/* The 6 faces of [0,1]^3, fronts facing inwards. Face order: z=0, z=1, x=0, x=1, y=0, y=1
+   (so faces 2f and 2f+1 are parallel). */
+static inline void ff_cube_quads(ff_quad *q)
+{
+    ff_quad_set(&q[0], 0, 0, 0, 1, 0, 0, 0, 1, 0); /* +z */
+    ff_quad_set(&q[1], 0, 0, 1, 0, 1, 0, 1, 0, 0); /* -z */
+    ff_quad_set(&q[2], 0, 0, 0, 0, 1, 0, 0, 0, 1); /* +x */
+    ff_quad_set(&q[3], 1, 0, 0, 0, 0, 1, 0, 1, 0); /* -x */
+    ff_quad_set(&q[4], 0, 0, 0, 0, 0, 1, 1, 0, 0); /* +y */
+    ff_quad_set(&q[5], 0, 1, 0, 1, 0, 0, 0, 0, 1); /* -y */
+}
+
+static inline int ff_cube_world(ff_quad *q, rad_mesh_desc *meshes, ff_world *w)
+{
+    rad_scene_desc d;
+    int f;
+    ff_cube_quads(q);
+    for (f = 0; f < 6; ++f) ff_mesh_quad(&meshes[f], &q[f]);
+    ff_desc(&d, meshes, 6);
+    /* max_edge 0.25: each face triangle (legs 1) is cut 6 x 6; 432 patches */
+    return ff_world_make(&d, rad_test_quick() ? 0.5f : 0.25f, 0, w);
+}
+
+
+/* ---- a peak-tracking allocator and boxes of gridded quads (vp_) ---------------------------- */
+
+/* A peak-tracking allocator: a 16-byte header keeps each block's size. */
+typedef struct vp_peak_state {
+    long long live, peak;
+} vp_peak_state;
+
+static inline void *vp_peak_alloc(void *user, size_t size)
+{
+    vp_peak_state *s = (vp_peak_state *)user;
+    unsigned char *p = (unsigned char *)malloc(size + 16);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof(size));
+#ifdef _OPENMP
+#pragma omp critical(vp_peak_lock)
+#endif
+    {
+        s->live += (long long)size;
+        if (s->live > s->peak) s->peak = s->live;
+    }
+    return p + 16;
+}
+
+static inline void vp_peak_free(void *user, void *ptr)
+{
+    vp_peak_state *s = (vp_peak_state *)user;
+    unsigned char *p;
+    size_t size;
+    if (!ptr) return;
+    p = (unsigned char *)ptr - 16;
+    memcpy(&size, p, sizeof(size));
+#ifdef _OPENMP
+#pragma omp critical(vp_peak_lock)
+#endif
+    {
+        s->live -= (long long)size;
+    }
+    free(p);
+}
+
+/* Up to 10 axis-aligned quads, each cut into an n x n grid of triangle pairs. */
+#define VP_MAX_QUADS 10
+typedef struct vp_scene {
+    float pos[VP_MAX_QUADS][3 * 41 * 41];
+    uint32_t idx[VP_MAX_QUADS][6 * 40 * 40];
+    rad_mesh_desc meshes[VP_MAX_QUADS];
+    rad_material materials[2];
+    uint32_t count;
+} vp_scene;
+
+/* quad o, o+u, o+u+v, o+v, front on the side u x v points to, material m, n x n cells */
+static inline void vp_add_quad(vp_scene *s, const float *o, const float *u, const float *v, uint32_t m, uint32_t n)
+{
+    uint32_t q = s->count++, i, j, k;
+    rad_mesh_desc *d = &s->meshes[q];
+    for (j = 0; j <= n; ++j)
+        for (i = 0; i <= n; ++i)
+            for (k = 0; k < 3; ++k)
+                s->pos[q][3 * (j * (n + 1) + i) + k] = o[k] + u[k] * (float)i / (float)n + v[k] * (float)j / (float)n;
+    for (j = 0; j < n; ++j)
+        for (i = 0; i < n; ++i) {
+            uint32_t a = j * (n + 1) + i, *t = &s->idx[q][6 * (j * n + i)];
+            t[0] = a; t[1] = a + 1; t[2] = a + n + 2;
+            t[3] = a; t[4] = a + n + 2; t[5] = a + n + 1;
+        }
+    memset(d, 0, sizeof(*d));
+    d->positions = s->pos[q];
+    d->vertex_count = (n + 1) * (n + 1);
+    d->indices = s->idx[q];
+    d->triangle_count = 2 * n * n;
+    d->material = m;
+}
+
+/* The inside of the box [0,sx] x [0,sy] x [0,sz], faces pointing in; material 0 everywhere,
+   or material 1 on the ceiling (y = sy) when ceiling_light. */
+static inline void vp_box(vp_scene *s, float sx, float sy, float sz, uint32_t n, int ceiling_light)
+{
+    float o0[3] = { 0, 0, 0 }, X[3], Y[3], Z[3], oX[3], oY[3], oZ[3];
+    memset(s, 0, sizeof(*s));
+    X[0] = sx; X[1] = 0; X[2] = 0;
+    Y[0] = 0; Y[1] = sy; Y[2] = 0;
+    Z[0] = 0; Z[1] = 0; Z[2] = sz;
+    oX[0] = sx; oX[1] = 0; oX[2] = 0;
+    oY[0] = 0; oY[1] = sy; oY[2] = 0;
+    oZ[0] = 0; oZ[1] = 0; oZ[2] = sz;
+    vp_add_quad(s, o0, Z, X, 0, n);                      /* floor y = 0, normal +y */
+    vp_add_quad(s, oY, X, Z, ceiling_light ? 1u : 0u, n); /* ceiling y = sy, normal -y */
+    vp_add_quad(s, o0, Y, Z, 0, n);                      /* x = 0, normal +x */
+    vp_add_quad(s, oX, Z, Y, 0, n);                      /* x = sx, normal -x */
+    vp_add_quad(s, o0, X, Y, 0, n);                      /* z = 0, normal +z */
+    vp_add_quad(s, oZ, Y, X, 0, n);                      /* z = sz, normal -z */
+}
+
+static inline void vp_desc(vp_scene *s, rad_scene_desc *d, float rho, float emission)
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        s->materials[0].albedo[k] = rho;
+        s->materials[0].emission[k] = emission;
+        s->materials[1].albedo[k] = rho;
+        s->materials[1].emission[k] = 0.0f;
+    }
+    memset(d, 0, sizeof(*d));
+    d->meshes = s->meshes;
+    d->mesh_count = s->count;
+    d->materials = s->materials;
+    d->material_count = 2;
+}
+
+
+/* ---- damaged containers and the logger that reads their refusals (ct_) -------------------- */
+
+/* rewrites the CRC of section i (after the test modified its data) */
+static inline void ct_fix_section_crc(unsigned char *buf, uint32_t i)
+{
+    unsigned char *e = buf + 64 + 64 * (size_t)i;
+    rad__put32(e + 32, rad__crc32(buf + rad__get64(e + 16), (size_t)rad__get64(e + 24)));
+    rad__put32(buf + 36, rad__crc32(buf + 64, 64 * (size_t)rad__get32(buf + 8)));
+    rad__put32(buf + 60, rad__crc32(buf, 60));
+}
+
+
+/* the last message of the library's logger, to check that it names the section, entry and value */
+static char ct_log_last[512];
+static int ct_log_warnings;
+static inline void ct_log(void *user, rad_log_level level, const char *message)
+{
+    (void)user;
+    if (level == RAD_LOG_WARNING) ct_log_warnings++;
+    snprintf(ct_log_last, sizeof(ct_log_last), "%s", message);
+}
+
+static inline void ct_log_context(rad_context *ctx)
+{
+    memset(ctx, 0, sizeof(*ctx));
+    ctx->log = ct_log;
+    ct_log_last[0] = '\0';
+    ct_log_warnings = 0;
+}
+
+/* a malloc'd copy of the container 'buf' with 'bytes' written at byte 'at' of its section of
+   'type' called 'name', every checksum fixed (NULL when there is no such section) */
+static inline unsigned char *ct_poke(const void *buf, size_t size, uint32_t type, const char *name, size_t at, const void *bytes,
+                              size_t n)
+{
+    unsigned char *copy = (unsigned char *)malloc(size);
+    uint32_t i, count;
+    if (!copy) return NULL;
+    memcpy(copy, buf, size);
+    count = rad__get32(copy + 8);
+    for (i = 0; i < count; ++i) {
+        unsigned char *e = copy + 64 + 64 * (size_t)i;
+        if (rad__get32(e) == type && strncmp((const char *)e + 40, name, 24) == 0 && at + n <= rad__get64(e + 24)) {
+            memcpy(copy + rad__get64(e + 16) + at, bytes, n);
+            ct_fix_section_crc(copy, i);
+            return copy;
+        }
+    }
+    free(copy);
+    return NULL;
+}
+
+
+/* ---- small numeric helpers ----------------------------------------------------------------- */
+
+/* max |a| over 3n values */
+static inline double so_max_abs(const float *a, uint32_t n)
+{
+    double m = 0.0;
+    size_t i;
+    for (i = 0; i < 3 * (size_t)n; ++i) if (fabs((double)a[i]) > m) m = fabs((double)a[i]);
+    return m;
+}
+
+
+/* ---- the built-in Cornell box with its patches, BVH and form factors (fx_) ----------------- */
+
+/* A scene with its BVH, patches, dense (and optionally sparse) form factors and E = emission. */
+typedef struct fx_world {
+    rad_scene *scene;
+    rad_bvh *bvh;
+    rad_raycaster rc;
+    rad_patches *patches;
+    rad_form_factors *ff, *ffs;
+    float *E;
+    uint32_t n; /* patches->count */
+} fx_world;
+
+static inline void fx_world_free(fx_world *w)
+{
+    free(w->E);
+    rad_form_factors_destroy(w->ff);
+    rad_form_factors_destroy(w->ffs);
+    rad_bvh_destroy(w->bvh);
+    rad_patches_destroy(w->patches);
+    rad_scene_destroy(w->scene);
+    memset(w, 0, sizeof(*w));
+}
+
+/* The built-in Cornell box cut into about 'target' patches, form factors through the BVH with
+   'samples' per pair (0: the default) and a sparse copy when 'sparse'. Returns 0 on failure,
+   with w freed; the callers record the failure. */
+static inline int fx_cornell(fx_world *w, uint32_t target, uint32_t samples, int sparse)
+{
+    rad_scene_desc desc;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    memset(w, 0, sizeof(*w));
+    rad_cornell_box(&desc, NULL);
+    rad_patch_options_default(&po);
+    po.target_count = target;
+    rad_form_factor_options_default(&fo);
+    if (samples) fo.samples = samples;
+    if (rad_scene_create(&desc, NULL, &w->scene) != RAD_SUCCESS || rad_patches_create(w->scene, &po, NULL, &w->patches) != RAD_SUCCESS ||
+        rad_bvh_create(w->scene, NULL, &w->bvh) != RAD_SUCCESS) {
+        fx_world_free(w);
+        return 0;
+    }
+    rad_bvh_raycaster(w->bvh, &w->rc);
+    w->n = w->patches->count;
+    w->E = (float *)malloc(sizeof(float) * 3 * w->n);
+    if (!w->E || rad_form_factors_dense(w->patches, &w->rc, &fo, NULL, &w->ff) != RAD_SUCCESS ||
+        (sparse && rad_form_factors_sparse(w->patches, &w->rc, &fo, NULL, &w->ffs) != RAD_SUCCESS) ||
+        rad_sources(w->patches, RAD_SOURCE_EMISSION, NULL, w->E) != RAD_SUCCESS) {
+        fx_world_free(w);
+        return 0;
+    }
+    return 1;
+}
+
+#endif
