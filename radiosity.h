@@ -4760,6 +4760,53 @@ static void rad__bvh_task(void *data, uint32_t i)
     j->task_leaves[i] = rad__bvh_build_sub(j->tree, j->refs, ni, j->task_depth[i], 2u * j->tree[ni].first);
 }
 
+/* The children of the wide node over binary node 'bi': opens the largest inner child until
+   there are RAD__BVH_W (or only leaves). Returns their count. */
+static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, uint32_t bi, uint32_t *slots)
+{
+    uint32_t ns = 0, k;
+    if (bin[bi].count) {
+        slots[ns++] = bi; /* a leaf root (tiny scenes) */
+    } else {
+        slots[ns++] = bin[bi].first;
+        slots[ns++] = bin[bi].first + 1;
+        while (ns < RAD__BVH_W) {
+            float best = -1.0f;
+            uint32_t bk = RAD__BVH_W;
+            for (k = 0; k < ns; ++k) {
+                const rad__bvh_node *q = &bin[slots[k]];
+                float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
+                float area = dx * dy + dy * dz + dz * dx;
+                if (q->count == 0 && area > best) { best = area; bk = k; }
+            }
+            if (bk == RAD__BVH_W) break;
+            slots[ns++] = bin[slots[bk]].first + 1;
+            slots[bk] = bin[slots[bk]].first;
+        }
+    }
+    return ns;
+}
+
+/* Wide nodes and leaves the collapse of the binary tree under 'root' makes ('stack' as there). */
+static void rad__bvhw_count(const rad__bvh_node *bin, uint32_t root, uint32_t *stack, uint32_t *nodes, uint32_t *leaves)
+{
+    uint32_t sp = 0;
+    *nodes = 1;
+    *leaves = 0;
+    stack[sp++] = root;
+    while (sp > 0) {
+        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(bin, stack[--sp], slots), k;
+        for (k = 0; k < ns; ++k) {
+            if (bin[slots[k]].count) {
+                ++*leaves;
+            } else {
+                ++*nodes;
+                stack[sp++] = slots[k];
+            }
+        }
+    }
+}
+
 /* Collapses the binary tree 'bin' into RAD__BVH_W-wide nodes: each wide node opens the largest
    inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
    entries per leaf. */
@@ -4773,25 +4820,7 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
     while (sp > 0) {
         uint32_t n4 = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns = 0, k;
         rad__bvhw *node = &b->nodes[n4];
-        if (bin[bi].count) {
-            slots[ns++] = bi; /* a leaf root (tiny scenes) */
-        } else {
-            slots[ns++] = bin[bi].first;
-            slots[ns++] = bin[bi].first + 1;
-            while (ns < RAD__BVH_W) {
-                float best = -1.0f;
-                uint32_t bk = RAD__BVH_W;
-                for (k = 0; k < ns; ++k) {
-                    const rad__bvh_node *q = &bin[slots[k]];
-                    float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
-                    float area = dx * dy + dy * dz + dz * dx;
-                    if (q->count == 0 && area > best) { best = area; bk = k; }
-                }
-                if (bk == RAD__BVH_W) break;
-                slots[ns++] = bin[slots[bk]].first + 1;
-                slots[bk] = bin[slots[bk]].first;
-            }
-        }
+        ns = rad__bvhw_slots(bin, bi, slots);
         for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
@@ -4881,20 +4910,20 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
     return leaves;
 }
 
-/* The nodes and leaves for a tree of 'leaves' leaves (at most that many wide nodes too), in one
-   block whose nodes start on a 64-byte boundary: a 256-byte node then spans four cache lines,
-   not five, and the traversal's time goes mostly to loading nodes and leaves. */
-static rad_result rad__bvh_block(rad__ctx *c, rad_bvh *b, uint32_t leaves)
+/* The room for 'nodes' wide nodes and 'leaves' leaves, in one block whose nodes start on a
+   64-byte boundary: a 256-byte node then spans four cache lines, not five, and the
+   traversal's time goes mostly to loading nodes and leaves. */
+static rad_result rad__bvh_block(rad__ctx *c, rad_bvh *b, uint32_t nodes, uint32_t leaves)
 {
     size_t nodes_bytes, leaves_bytes;
-    if (!rad__mul(leaves, sizeof(rad__bvhw), &nodes_bytes) || !rad__mul(leaves, sizeof(rad__tri4), &leaves_bytes) ||
+    if (!rad__mul(nodes, sizeof(rad__bvhw), &nodes_bytes) || !rad__mul(leaves, sizeof(rad__tri4), &leaves_bytes) ||
         nodes_bytes + leaves_bytes < nodes_bytes || nodes_bytes + leaves_bytes > (size_t)-1 - 64u)
         return RAD_ERROR_OUT_OF_MEMORY;
     b->block_bytes = nodes_bytes + leaves_bytes + 64u;
     b->block = rad__alloc(&c->allocator, b->block_bytes);
     if (!b->block) return RAD_ERROR_OUT_OF_MEMORY;
     b->nodes = (rad__bvhw *)(void *)((char *)b->block + ((64u - (uintptr_t)b->block % 64u) % 64u));
-    b->leaves = (rad__tri4 *)(void *)(b->nodes + leaves);
+    b->leaves = (rad__tri4 *)(void *)(b->nodes + nodes);
     return RAD_SUCCESS;
 }
 
@@ -4904,7 +4933,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad_bvh *b;
     rad__bvh_node *tree = NULL;
     rad__bref *refs = NULL;
-    uint32_t n, i, leaves;
+    uint32_t n, i, leaves, nodes;
     uint32_t *stack = NULL, *task = NULL, *order = NULL;
     rad_result r;
     rad__ctx_init(&c, ctx);
@@ -4935,11 +4964,11 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         rad_bvh_destroy(b);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    leaves = rad__bvh_build_binary(&c, tree, refs, n, stack, task);
+    (void)rad__bvh_build_binary(&c, tree, refs, n, stack, task);
     for (i = 0; i < n; ++i) order[i] = refs[i].id;
-    /* Stage 3, the wide nodes and leaves: a binary tree of L leaves has L - 1 inner nodes,
-       and each wide node opens at least one of them (or is the root leaf of a one-leaf tree) */
-    r = rad__bvh_block(&c, b, leaves);
+    /* Stage 3, the wide nodes and leaves, counted first so the block holds just them */
+    rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
+    r = rad__bvh_block(&c, b, nodes, leaves);
     if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, order);
     rad__free(&c.allocator, refs);
     rad__free(&c.allocator, stack);
