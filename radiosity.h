@@ -3057,6 +3057,11 @@ typedef struct rad_vp_gather_table {
    Cost: two passes of rad_vp_gather_point's look-ups, in parallel through ctx. */
 RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, const float *points, const float *normals,
                                               uint32_t count, const rad_context *ctx, rad_vp_gather_table **out);
+/* The table of a mesh's vertices with the normals rad_vp_gather_mesh uses (its own, or the
+   area-weighted mean of its triangles' normals). Errors: those of rad_vp_gather_mesh and
+   rad_vp_gather_table_create. */
+RAD_API rad_result rad_vp_gather_table_mesh(const rad_virtual_patches *vp, const rad_mesh_desc *mesh, const rad_context *ctx,
+                                            rad_vp_gather_table **out);
 /* out (3 * count floats) = the table times values (3N floats, per patch: B, L or H), in
    parallel through ctx->parallel_for. Errors: INVALID_ARGUMENT (NULL). Cost: O(entries). */
 RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, const float *values, float *out,
@@ -3070,9 +3075,11 @@ RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table);
    with U_l the unshadowed irradiance of directional, point or spot light l (the exact formula
    of rad_direct_irradiance, evaluated for EVERY sample EVERY update: O(M) arithmetic, no
    rays) and V_il in {0, 1} its CACHED visibility. Each update re-tests the visibility of the
-   samples i with i mod P = (update + l) mod P, P = ceil(M / rays_per_frame), that face the
+   samples i with (i + l) mod P = update mod P, P = ceil(M / rays_per_frame), that face the
    light (one shadow ray each, the ray of rad_direct_irradiance), so a light's shadows are
    at most P updates old and its intensity, falloff, cosine and cone are never old. A light
+   whose position (directional: direction) has stayed the same for P updates has had every
+   sample tested since it moved, so it casts no rays (a sun, a light at rest). A light
    slot seen for the first time, or whose type changed, and every slot after
    rad_vp_lights_refresh, is tested for all its samples in that update. Sky lights: the
    unoccluded fraction of each sample's hemisphere (light_samples cosine rays, as
@@ -19134,27 +19141,26 @@ RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *val
     return RAD_SUCCESS;
 }
 
-RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
-                                      float *out, const rad_context *ctx)
+/* a mesh's vertex positions and unit normals (its own, or the area-weighted mean of its
+   triangles' normals) as packed arrays through c's allocator; rad_vp_gather_mesh's input */
+static rad_result rad__vp_mesh_points(const rad__ctx *c, const char *what, const rad_mesh_desc *mesh, float **out_pts,
+                                      float **out_nrm)
 {
-    rad__ctx c;
     float *pts, *nrm;
     size_t ps, ns;
     uint32_t V, T, t, i;
-    rad_result r;
     int k;
-    rad__ctx_init(&c, ctx);
-    if (!vp || !values || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    *out_pts = *out_nrm = NULL;
     V = mesh->vertex_count;
     T = mesh->triangle_count;
     if (!mesh->indices && (size_t)T * 3u > V) return RAD_ERROR_INDEX_OUT_OF_RANGE;
     ps = mesh->position_stride ? mesh->position_stride : 3 * sizeof(float);
     ns = mesh->normal_stride ? mesh->normal_stride : 3 * sizeof(float);
-    pts = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
-    nrm = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
+    pts = (float *)rad__alloc_array(&c->allocator, V ? V : 1u, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c->allocator, V ? V : 1u, 3 * sizeof(float));
     if (!pts || !nrm) {
-        rad__free(&c.allocator, pts);
-        rad__free(&c.allocator, nrm);
+        rad__free(&c->allocator, pts);
+        rad__free(&c->allocator, nrm);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     for (i = 0; i < V; ++i) memcpy(pts + 3 * (size_t)i, (const char *)mesh->positions + ps * i, 3 * sizeof(float));
@@ -19168,9 +19174,9 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
             for (m = 0; m < 3; ++m) {
                 id[m] = mesh->indices ? mesh->indices[3 * (size_t)t + m] : 3u * t + m;
                 if (id[m] >= V) {
-                    rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_mesh: triangle %u has vertex index %u >= %u", t, id[m], V);
-                    rad__free(&c.allocator, pts);
-                    rad__free(&c.allocator, nrm);
+                    rad__log(c, RAD_LOG_ERROR, "%s: triangle %u has vertex index %u >= %u", what, t, id[m], V);
+                    rad__free(&c->allocator, pts);
+                    rad__free(&c->allocator, nrm);
                     return RAD_ERROR_INDEX_OUT_OF_RANGE;
                 }
             }
@@ -19182,7 +19188,20 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
         }
     }
     for (i = 0; i < V; ++i) rad__normalize(nrm + 3 * (size_t)i);
-    r = rad_vp_gather(vp, values, pts, nrm, V, out, ctx);
+    *out_pts = pts, *out_nrm = nrm;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
+                                      float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *pts, *nrm;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !values || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__vp_mesh_points(&c, "rad_vp_gather_mesh", mesh, &pts, &nrm)) != RAD_SUCCESS) return r;
+    r = rad_vp_gather(vp, values, pts, nrm, mesh->vertex_count, out, ctx);
     rad__free(&c.allocator, pts);
     rad__free(&c.allocator, nrm);
     return r;
@@ -19351,6 +19370,22 @@ RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, con
     return RAD_SUCCESS;
 }
 
+RAD_API rad_result rad_vp_gather_table_mesh(const rad_virtual_patches *vp, const rad_mesh_desc *mesh, const rad_context *ctx,
+                                            rad_vp_gather_table **out)
+{
+    rad__ctx c;
+    float *pts, *nrm;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!vp || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__vp_mesh_points(&c, "rad_vp_gather_table_mesh", mesh, &pts, &nrm)) != RAD_SUCCESS) return r;
+    r = rad_vp_gather_table_create(vp, pts, nrm, mesh->vertex_count, ctx, out);
+    rad__free(&c.allocator, pts);
+    rad__free(&c.allocator, nrm);
+    return r;
+}
+
 RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, const float *values, float *out,
                                              const rad_context *ctx)
 {
@@ -19384,6 +19419,8 @@ struct rad_vp_lights {
     uint8_t *vis[RAD_VP_LIGHTS_MAX];  /* M per slot: cached visibility */
     int type[RAD_VP_LIGHTS_MAX];      /* the slot's light type at the last update, -1: none */
     uint8_t full[RAD_VP_LIGHTS_MAX];  /* re-test every sample at the next update */
+    float key[RAD_VP_LIGHTS_MAX][3];  /* what the slot's shadows depend on: position or direction */
+    uint32_t settled[RAD_VP_LIGHTS_MAX]; /* updates since the key changed (P: every sample tested since) */
     uint32_t period, update;          /* P; updates done */
     uint64_t rays;                    /* of the last update */
 };
@@ -19481,7 +19518,7 @@ typedef struct rad__vp_lights_job {
     rad_vp_lights *s;
     const rad_light *lights;
     uint32_t light_count, phase;
-    uint8_t full[RAD_VP_LIGHTS_MAX];
+    uint8_t full[RAD_VP_LIGHTS_MAX], skip[RAD_VP_LIGHTS_MAX];
     float eps, diagonal;
     rad_ray *rays;           /* RAD__RAY_BATCH per task */
     uint8_t *occ;            /* RAD__RAY_BATCH per task */
@@ -19518,7 +19555,7 @@ static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
         for (l = 0; l < j->light_count; ++l) {
             const rad_light *li = &j->lights[l];
             float w[3], v[3];
-            if (li->type == RAD_LIGHT_SKY) continue;
+            if (li->type == RAD_LIGHT_SKY || j->skip[l]) continue;
             if (!j->full[l] && (i % P + l % P) % P != j->phase) continue;
             if (!rad__light_unshadowed(li, j->diagonal, p, n, w, v)) continue;
             rad__shadow_ray(j->rays + at + nr, p, n, li->type == RAD_LIGHT_DIRECTIONAL ? NULL : li->position, NULL,
@@ -19559,7 +19596,7 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     rad__direct d;
     rad__vp_lights_job j;
     rad_result r;
-    uint32_t M, l, rows, T, t, has_sky = 0;
+    uint32_t M, l, rows, T, t, has_sky = 0, settled[RAD_VP_LIGHTS_MAX];
     rad__ctx_init(&c, ctx);
     if (!s || !out_E || (light_count && !lights)) return RAD_ERROR_INVALID_ARGUMENT;
     if (light_count > RAD_VP_LIGHTS_MAX) {
@@ -19574,12 +19611,19 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     j.phase = s->update % s->period;
     for (l = 0; l < light_count; ++l) {
         if (lights[l].type == RAD_LIGHT_SKY) { has_sky = 1; continue; }
+        const float *key = lights[l].type == RAD_LIGHT_DIRECTIONAL ? lights[l].direction : lights[l].position;
         j.full[l] = s->full[l] || s->type[l] != (int)lights[l].type;
         if (!s->vis[l]) {
             s->vis[l] = (uint8_t *)rad__alloc_array(&s->allocator, M ? (size_t)M : 1u, 1);
             if (!s->vis[l]) return RAD_ERROR_OUT_OF_MEMORY;
             j.full[l] = 1;
         }
+        /* a light whose position (direction) has not changed for a whole round of P updates
+           has every sample's visibility tested already: no rays (a sun, a light at rest) */
+        if (j.full[l]) settled[l] = s->period;
+        else if (memcmp(key, s->key[l], sizeof s->key[l])) settled[l] = 0;
+        else settled[l] = s->settled[l] < s->period ? s->settled[l] + 1u : s->period;
+        j.skip[l] = !j.full[l] && settled[l] >= s->period;
     }
     if (has_sky && !s->sky) {
         /* the sky's visibility depends on the geometry only: traced once, with a unit sky */
@@ -19624,6 +19668,11 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
             /* a slot not lit this update forgets its cache: it may come back as another light */
             s->type[l] = l < light_count && lights[l].type != RAD_LIGHT_SKY ? (int)lights[l].type : -1;
             s->full[l] = 0;
+            if (s->type[l] >= 0) {
+                memcpy(s->key[l], lights[l].type == RAD_LIGHT_DIRECTIONAL ? lights[l].direction : lights[l].position,
+                       sizeof s->key[l]);
+                s->settled[l] = settled[l];
+            }
         }
         ++s->update;
         r = rad_vp_from_samples(s->vp, s->v, out_E);

@@ -532,7 +532,8 @@ out:
 }
 
 /* a bounded budget: P = 5 updates per round; a moved light casts at most the budget per slot,
-   its E is stale in the shadows for fewer than P updates, then equals the exact E bit for bit;
+   its E is stale in the shadows for fewer than P updates, then equals the exact E bit for bit
+   and lights at rest cast no more rays;
    temporal radiosity fed by it converges to the direct solve of the new light (within 1%) */
 static void vpr_test_dynamic_lights_converge(void)
 {
@@ -581,6 +582,11 @@ static void vpr_test_dynamic_lights_converge(void)
             CHECK(diff > 0); /* the shadows of the old position are still in it */
         }
     }
+    for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
+    CHECK(bad == 0);
+    /* lights at rest for a whole round: no rays, the same E */
+    CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
+    CHECK(rad_vp_lights_rays(dl) == 0);
     for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
     CHECK(bad == 0);
     /* the whole loop: temporal radiosity over the updated E reaches the new solution */
