@@ -729,8 +729,9 @@ done:
    every light stays): per frame E at the samples (rad_vp_lights: the falloff exact, the shadows
    re-tested for --light-rays samples per frame, all by default), one temporal step, and with
    --sequence every --every-th frame rendered (H = F (E + L) gathered per pixel, the direct light
-   per pixel from the moved light). The light ends where the last frame puts it, so the final
-   image (rendered by the caller from E and L) is that frame. Stage times: their medians. */
+   per pixel from the moved light), and the last. The light ends where the last frame puts it,
+   so the final image (rendered by the caller from E and L) is that frame. Stage times: their
+   medians. */
 static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const rad_virtual_patches *vp, float *E,
                                  const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
                                  uint32_t aa, uint32_t light_samples, uint32_t patch_light_samples, float exposure,
@@ -803,7 +804,7 @@ static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const
         t0 = rad_tool_seconds();
         if ((r = rad_temporal_step(tp, E, NULL, L)) != RAD_SUCCESS) { what = "rad_temporal_step"; goto done; }
         ts[f - 1] = rad_tool_seconds() - t0;
-        if (mo->sequence && f % mo->every == 0 && f != frames) { /* the last one: the caller's image */
+        if (mo->sequence && (f % mo->every == 0 || f == frames)) { /* the last one too, as render_method */
             char path[4096];
             rad_image frame;
             memset(&frame, 0, sizeof frame);
