@@ -3077,9 +3077,10 @@ RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table);
    rays) and V_il in {0, 1} its CACHED visibility. Each update re-tests the visibility of the
    samples i with (i + l) mod P = update mod P, P = ceil(M / rays_per_frame), that face the
    light (one shadow ray each, the ray of rad_direct_irradiance), so a light's shadows are
-   at most P updates old and its intensity, falloff, cosine and cone are never old. A light
-   whose position (directional: direction) has stayed the same for P updates has had every
-   sample tested since it moved, so it casts no rays (a sun, a light at rest). A light
+   at most P updates old and its intensity, falloff, cosine and cone are never old (a sample
+   a light has never reached counts as unshadowed until its turn). A light whose position,
+   direction and cone have stayed the same for P updates has had every sample it lights
+   tested since they changed, so it casts no rays (a sun, a light at rest). A light
    slot seen for the first time, or whose type changed, and every slot after
    rad_vp_lights_refresh, is tested for all its samples in that update. Sky lights: the
    unoccluded fraction of each sample's hemisphere (light_samples cosine rays, as
@@ -19419,7 +19420,7 @@ struct rad_vp_lights {
     uint8_t *vis[RAD_VP_LIGHTS_MAX];  /* M per slot: cached visibility */
     int type[RAD_VP_LIGHTS_MAX];      /* the slot's light type at the last update, -1: none */
     uint8_t full[RAD_VP_LIGHTS_MAX];  /* re-test every sample at the next update */
-    float key[RAD_VP_LIGHTS_MAX][3];  /* what the slot's shadows depend on: position or direction */
+    float key[RAD_VP_LIGHTS_MAX][8];  /* what decides the slot's rays: position, direction, cone */
     uint32_t settled[RAD_VP_LIGHTS_MAX]; /* updates since the key changed (P: every sample tested since) */
     uint32_t period, update;          /* P; updates done */
     uint64_t rays;                    /* of the last update */
@@ -19512,6 +19513,15 @@ RAD_API rad_result rad_vp_lights_create(const rad_virtual_patches *vp, const rad
     }
     *out = s;
     return RAD_SUCCESS;
+}
+
+/* what decides which samples a light's rays go to and where: position, direction, cone */
+static void rad__vp_light_key(const rad_light *li, float key[8])
+{
+    memcpy(key, li->position, 3 * sizeof(float));
+    memcpy(key + 3, li->direction, 3 * sizeof(float));
+    key[6] = li->type == RAD_LIGHT_SPOT ? li->inner_angle : 0.0f;
+    key[7] = li->type == RAD_LIGHT_SPOT ? li->outer_angle : 0.0f;
 }
 
 typedef struct rad__vp_lights_job {
@@ -19611,17 +19621,20 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     j.phase = s->update % s->period;
     for (l = 0; l < light_count; ++l) {
         if (lights[l].type == RAD_LIGHT_SKY) { has_sky = 1; continue; }
-        const float *key = lights[l].type == RAD_LIGHT_DIRECTIONAL ? lights[l].direction : lights[l].position;
+        float key[8];
+        rad__vp_light_key(&lights[l], key);
         j.full[l] = s->full[l] || s->type[l] != (int)lights[l].type;
         if (!s->vis[l]) {
             s->vis[l] = (uint8_t *)rad__alloc_array(&s->allocator, M ? (size_t)M : 1u, 1);
             if (!s->vis[l]) return RAD_ERROR_OUT_OF_MEMORY;
+            memset(s->vis[l], 1, M); /* a sample the light never reached counts as lit until tested */
             j.full[l] = 1;
         }
-        /* a light whose position (direction) has not changed for a whole round of P updates
-           has every sample's visibility tested already: no rays (a sun, a light at rest) */
+        /* a light whose position, direction and cone have not changed for a whole round of P
+           updates has every lit sample's visibility tested already: no rays (a sun, a light
+           at rest) */
         if (j.full[l]) settled[l] = s->period;
-        else if (memcmp(key, s->key[l], sizeof s->key[l])) settled[l] = 0;
+        else if (memcmp(key, s->key[l], sizeof key)) settled[l] = 0;
         else settled[l] = s->settled[l] < s->period ? s->settled[l] + 1u : s->period;
         j.skip[l] = !j.full[l] && settled[l] >= s->period;
     }
@@ -19669,8 +19682,7 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
             s->type[l] = l < light_count && lights[l].type != RAD_LIGHT_SKY ? (int)lights[l].type : -1;
             s->full[l] = 0;
             if (s->type[l] >= 0) {
-                memcpy(s->key[l], lights[l].type == RAD_LIGHT_DIRECTIONAL ? lights[l].direction : lights[l].position,
-                       sizeof s->key[l]);
+                rad__vp_light_key(&lights[l], s->key[l]);
                 s->settled[l] = settled[l];
             }
         }

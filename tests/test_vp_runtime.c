@@ -589,6 +589,12 @@ static void vpr_test_dynamic_lights_converge(void)
     CHECK(rad_vp_lights_rays(dl) == 0);
     for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
     CHECK(bad == 0);
+    /* the spot turns where it stands: the samples its cone now reaches are tested within a round */
+    lights[1].direction[0] = 0.8f;
+    CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
+    for (f = 0; f < P; ++f) CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
+    for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
+    CHECK(bad == 0);
     /* the whole loop: temporal radiosity over the updated E reaches the new solution */
     rad_vp_system(&sys, vp, Ex);
     rad_solve_options_default(&so);
