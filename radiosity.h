@@ -19400,7 +19400,8 @@ RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, c
     j.values = values, j.out = out, j.count = table->count, j.pass = 2;
     /* one task per 4096 points at least: below that the threads cost more than the work */
     j.tasks = c.tasks < (table->count + 4095u) / 4096u ? c.tasks : (table->count + 4095u) / 4096u;
-    c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
+    if (j.tasks <= 1) rad__vp_table_task(&j, 0); /* a small mesh: no thread wake-up at all */
+    else c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
     return RAD_SUCCESS;
 }
 
