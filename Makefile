@@ -115,10 +115,14 @@ $(BUILD)/walk: examples/walk.c examples/rooms.h examples/png_write.h radiosity.h
 $(BUILD)/probes: bench/probes.c bench/bench_common.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O2 $(OPENMP) -I. bench/probes.c -o $@ -lm
 
+# the real-time loop over AAVP on real meshes (bench/realtime.sh; needs $(RAD_DATA_DIR))
+$(BUILD)/bench_realtime: bench/realtime.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/realtime.c -o $@ -lm
+
 $(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
+bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
 	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
@@ -128,8 +132,9 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/shading --append BENCHMARKS.md
 	./$(BUILD)/local --append BENCHMARKS.md
 	./$(BUILD)/probes --append BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/realtime.sh $(BUILD) BENCHMARKS.md
 
-bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
+bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
 	bash bench/methods.sh $(BUILD)/rad $(BUILD)/BENCHMARKS-quick.md --quick
@@ -138,6 +143,7 @@ bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BU
 	./$(BUILD)/shading --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/local --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/probes --quick --append $(BUILD)/BENCHMARKS-quick.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/realtime.sh --quick $(BUILD) $(BUILD)/BENCHMARKS-quick.md
 
 # the MPI driver of the distributed bake (docs/distributed.md), when OpenMPI is installed
 # (Debian libopenmpi-dev openmpi-bin): the tool's sources but main.c, with tools/mpi/rad_mpi.c's main

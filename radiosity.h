@@ -3095,6 +3095,98 @@ RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *val
 RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
                                       float *out, const rad_context *ctx);
 
+/* GATHER TABLE: rad_vp_gather at points that do not move (a static mesh's vertices) as a
+   sparse matrix, built once: row i holds the patches a and weights g_ia with
+   out_i = sum_a g_ia x_a, g_ia = t_v w_a(n_i) / (sum_b w_b(n_i) * sum_u t_u) for the patches a
+   of voxel v in the 2x2x2 block of rad_vp_gather_point (the same voxels, patches and weights:
+   the result equals rad_vp_gather's to float rounding). Per frame the gather is then one pass
+   over the table (8 bytes per entry, at most 48 entries per point, about 10 on a real mesh)
+   instead of eight voxel look-ups per point: the per-vertex gather of the dynamic-light loop
+   (examples/realtime.c). docs/methods/aavp.md. */
+typedef struct rad_vp_gather_table {
+    uint32_t count;          /* points */
+    uint32_t patches;        /* N of the set it was built for: values hold 3N floats */
+    uint32_t *offsets;       /* count + 1: row i is [offsets[i], offsets[i + 1]) */
+    uint32_t *patch;         /* offsets[count] patch indices */
+    float *weight;           /* offsets[count] weights g_ia */
+    rad_allocator allocator; /* private */
+} rad_vp_gather_table;
+
+/* The table of 'count' points (3 floats each) with unit normals (as rad_vp_gather; a point
+   whose block holds no patch facing its normal gets an empty row: 0, as there). Errors: INVALID_ARGUMENT,
+   NON_FINITE (a point or normal), SIZE_OVERFLOW (more than 2^32 - 1 entries), OUT_OF_MEMORY.
+   Cost: two passes of rad_vp_gather_point's look-ups, in parallel through ctx. */
+RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, const float *points, const float *normals,
+                                              uint32_t count, const rad_context *ctx, rad_vp_gather_table **out);
+/* The table of a mesh's vertices with the normals rad_vp_gather_mesh uses (its own, or the
+   area-weighted mean of its triangles' normals). Errors: those of rad_vp_gather_mesh and
+   rad_vp_gather_table_create. */
+RAD_API rad_result rad_vp_gather_table_mesh(const rad_virtual_patches *vp, const rad_mesh_desc *mesh, const rad_context *ctx,
+                                            rad_vp_gather_table **out);
+/* out (3 * count floats) = the table times values (3N floats, per patch: B, L or H), in
+   parallel through ctx->parallel_for. Errors: INVALID_ARGUMENT (NULL). Cost: O(entries). */
+RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, const float *values, float *out,
+                                             const rad_context *ctx);
+RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table);
+
+/* DYNAMIC LIGHTS (docs/methods/aavp.md "Dynamic lights"): E of the virtual patches (as
+   rad_vp_sources with RAD_SOURCE_DIRECT) for lights that move every frame, at a bounded
+   number of shadow rays. The direct irradiance at sample i is
+       D_i = sum_l U_l(p_i, n_i) V_il + D_static,i
+   with U_l the unshadowed irradiance of directional, point or spot light l (the exact formula
+   of rad_direct_irradiance, evaluated for EVERY sample EVERY update: O(M) arithmetic, no
+   rays) and V_il in {0, 1} its CACHED visibility. Each update re-tests the visibility of the
+   samples i with (i + l) mod P = update mod P, P = ceil(M / rays_per_frame), that face the
+   light (one shadow ray each, the ray of rad_direct_irradiance), so a light's shadows are
+   at most P updates old and its intensity, falloff, cosine and cone are never old (a sample
+   a light has never reached counts as unshadowed until its turn). A light whose position,
+   direction and cone have stayed the same for P updates has had every sample it lights
+   tested since they changed, so it casts no rays (a sun, a light at rest). A light
+   slot seen for the first time, or whose type changed, and every slot after
+   rad_vp_lights_refresh, is tested for all its samples in that update. Sky lights: the
+   unoccluded fraction of each sample's hemisphere (light_samples cosine rays, as
+   rad_direct_irradiance) depends on the geometry only, so it is traced once, at the first
+   update with a sky, and each update scales it by the sky's colour. Emissive triangles
+   (include_emitters): static, traced once at create. Then v_i = rho_i D_i and
+   E = rad_vp_from_samples(v). With rays_per_frame 0 (P = 1) every update re-tests every
+   sample: E then equals rad_vp_sources with the same lights and options, bit for bit when
+   there are only directional, point and spot lights (emitters: to float rounding; a sky: the
+   same estimator, with other ray directions unless it is lights[0]).
+   Memory: 12 bytes per sample (unit normals) + 12 (v) + 1 per sample and light slot
+   (+ 4 with a sky, + 12 with emitters). The scene must be static (the visibility cache
+   assumes it). */
+#define RAD_VP_LIGHTS_MAX 64u /* light slots (lights per update) at most */
+typedef struct rad_vp_lights_options {
+    uint32_t rays_per_frame;   /* shadow rays per light slot and update at most (0: every sample
+                                  every update, exact) */
+    rad_direct_options direct; /* ray_epsilon, light_samples (sky and emitters), include_emitters,
+                                  seed; rad_vp_lights_options_default: rad_direct_options_default
+                                  with include_emitters 0 */
+} rad_vp_lights_options;
+typedef struct rad_vp_lights rad_vp_lights;
+
+RAD_API void rad_vp_lights_options_default(rad_vp_lights_options *options);
+/* vp (with its scene) and raycaster are borrowed and must outlive the state. Errors:
+   INVALID_ARGUMENT (NULL, a set without a scene, bad ray_epsilon), NON_FINITE (a sample normal),
+   OUT_OF_MEMORY, and those of rad_direct_irradiance (the emitters' static part). */
+RAD_API rad_result rad_vp_lights_create(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
+                                        const rad_vp_lights_options *options, const rad_context *ctx,
+                                        rad_vp_lights **out);
+/* One update: the lights of this frame (slot l = lights[l]; light_count <= RAD_VP_LIGHTS_MAX)
+   into out_E (3N floats). Errors: INVALID_ARGUMENT (a bad light, as rad_direct_irradiance, or
+   too many), NON_FINITE, NEGATIVE_EMISSION, RAYCAST_FAILED, OUT_OF_MEMORY; after an error
+   every slot is re-tested in full at the next update. Cost: O(M lights)
+   arithmetic, at most rays_per_frame shadow rays per light (M at a slot's first update),
+   O(M) for E; parallel through ctx. Thread safety: one thread at a time per state. */
+RAD_API rad_result rad_vp_lights_update(rad_vp_lights *state, const rad_light *lights, uint32_t light_count,
+                                        float *out_E, const rad_context *ctx);
+/* The next update re-tests every sample of every slot (a light that jumped far: its shadows
+   are then right at once, at the cost of one full update). */
+RAD_API void rad_vp_lights_refresh(rad_vp_lights *state);
+/* Shadow rays the last update cast. */
+RAD_API uint64_t rad_vp_lights_rays(const rad_vp_lights *state);
+RAD_API void rad_vp_lights_destroy(rad_vp_lights *state);
+
 /* CONTAINER (docs/methods/container.md): a whole set, so that an application bakes it once and
    loads it at start-up (rad bake --method aavp|vp). rad_vp_sections lists the set as sections
    named 'name' (up to 23 characters; every section shares it; data borrowed from vp):
@@ -8676,6 +8768,71 @@ static rad_result rad__direct_flush(rad__direct *d, uint32_t task, uint32_t coun
     return RAD_SUCCESS;
 }
 
+/* the shadow ray from p (offset eps along n) to 'to' (a point, offset along to_n when given)
+   or along 'dir' to infinity */
+static void rad__shadow_ray(rad_ray *ray, const float *p, const float *n, const float *to, const float *to_n,
+                            const float *dir, float eps)
+{
+    int k;
+    for (k = 0; k < 3; ++k) ray->origin[k] = p[k] + n[k] * eps;
+    if (to) {
+        float len;
+        for (k = 0; k < 3; ++k) ray->dir[k] = to[k] + (to_n ? to_n[k] * eps : 0.0f) - ray->origin[k];
+        len = rad__len(ray->dir);
+        ray->tmin = 0.0f;
+        ray->tmax = len > 2.0f * eps ? 1.0f - eps / len : 0.5f;
+    } else {
+        for (k = 0; k < 3; ++k) ray->dir[k] = dir[k];
+        ray->tmin = 0.0f;
+        ray->tmax = FLT_MAX;
+    }
+}
+
+/* The unshadowed irradiance w (RGB) of one directional, point or spot light at p (unit
+   normal n): 1 with w and, for a directional light, the unit direction towards it in v
+   (point and spot: the shadow ray goes to li->position); 0 when the light gives nothing
+   there (behind the normal, outside the cone). The one formula of rad_direct_irradiance
+   and rad_vp_lights_update, so that both give the same bits. */
+static int rad__light_unshadowed(const rad_light *li, float diagonal, const float *p, const float *n, float *w, float *v)
+{
+    float dist, cosn;
+    int k;
+    if (li->type == RAD_LIGHT_DIRECTIONAL) {
+        for (k = 0; k < 3; ++k) v[k] = -li->direction[k];
+        rad__normalize(v);
+        cosn = rad__dot(v, n);
+        if (!(cosn > 0.0f)) return 0;
+        for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn;
+        return 1;
+    } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
+        float dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * diagonal;
+        rad__sub(v, li->position, p);
+        dist = rad__len(v);
+        if (!(dist > 0.0f)) return 0;
+        cosn = rad__dot(v, n) / dist;
+        if (!(cosn > 0.0f)) return 0;
+        dc = dist > md ? dist : md;
+        atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
+        if (li->type == RAD_LIGHT_SPOT) {
+            float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
+            memcpy(axis, li->direction, sizeof(axis));
+            rad__normalize(axis);
+            ca = -rad__dot(v, axis) / dist;
+            if (ci > co) {
+                t = (ca - co) / (ci - co);
+                t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+                atten *= t * t * (3.0f - 2.0f * t);
+            } else if (!(ca >= co)) {
+                atten = 0.0f;
+            }
+            if (!(atten > 0.0f)) return 0;
+        }
+        for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn * atten;
+        return 1;
+    }
+    return 0;
+}
+
 /* queues a shadow ray from p (offset along n) to 'to' (a point, offset along to_n when given)
    or along 'dir' to infinity, carrying weight w (scaled by 'scale') into slot */
 static rad_result rad__direct_ray(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
@@ -8683,20 +8840,8 @@ static rad_result rad__direct_ray(rad__direct *d, uint32_t task, uint32_t *nrays
                                   uint32_t slot)
 {
     size_t at = (size_t)task * RAD__RAY_BATCH + *nrays;
-    rad_ray *ray = d->rays + at;
     int k;
-    for (k = 0; k < 3; ++k) ray->origin[k] = p[k] + n[k] * d->eps;
-    if (to) {
-        float len;
-        for (k = 0; k < 3; ++k) ray->dir[k] = to[k] + (to_n ? to_n[k] * d->eps : 0.0f) - ray->origin[k];
-        len = rad__len(ray->dir);
-        ray->tmin = 0.0f;
-        ray->tmax = len > 2.0f * d->eps ? 1.0f - d->eps / len : 0.5f;
-    } else {
-        for (k = 0; k < 3; ++k) ray->dir[k] = dir[k];
-        ray->tmin = 0.0f;
-        ray->tmax = FLT_MAX;
-    }
+    rad__shadow_ray(d->rays + at, p, n, to, to_n, dir, d->eps);
     for (k = 0; k < 3; ++k) d->ray_w[3 * at + (size_t)k] = w[k] * scale;
     d->ray_slot[at] = slot;
     if (++*nrays == RAD__RAY_BATCH) {
@@ -8740,39 +8885,13 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
     int k;
     for (l = 0; l < d->light_count; ++l) {
         const rad_light *li = &d->lights[l];
-        float v[3], w[3], dist, cosn;
+        float v[3], w[3];
         if (li->type == RAD_LIGHT_DIRECTIONAL) {
-            for (k = 0; k < 3; ++k) v[k] = -li->direction[k];
-            rad__normalize(v);
-            cosn = rad__dot(v, n);
-            if (!(cosn > 0.0f)) continue;
-            for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn;
+            if (!rad__light_unshadowed(li, d->S->diagonal, p, n, w, v)) continue;
             r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, v, w, scale, slot);
             if (r != RAD_SUCCESS) return r;
         } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
-            float dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * d->S->diagonal;
-            rad__sub(v, li->position, p);
-            dist = rad__len(v);
-            if (!(dist > 0.0f)) continue;
-            cosn = rad__dot(v, n) / dist;
-            if (!(cosn > 0.0f)) continue;
-            dc = dist > md ? dist : md;
-            atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
-            if (li->type == RAD_LIGHT_SPOT) {
-                float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
-                memcpy(axis, li->direction, sizeof(axis));
-                rad__normalize(axis);
-                ca = -rad__dot(v, axis) / dist;
-                if (ci > co) {
-                    t = (ca - co) / (ci - co);
-                    t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-                    atten *= t * t * (3.0f - 2.0f * t);
-                } else if (!(ca >= co)) {
-                    atten = 0.0f;
-                }
-                if (!(atten > 0.0f)) continue;
-            }
-            for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn * atten;
+            if (!rad__light_unshadowed(li, d->S->diagonal, p, n, w, v)) continue;
             r = rad__direct_ray(d, task, nrays, p, n, li->position, NULL, NULL, w, scale, slot);
             if (r != RAD_SUCCESS) return r;
         } else if (li->type == RAD_LIGHT_SKY) {
@@ -19470,27 +19589,26 @@ RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *val
     return RAD_SUCCESS;
 }
 
-RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
-                                      float *out, const rad_context *ctx)
+/* a mesh's vertex positions and unit normals (its own, or the area-weighted mean of its
+   triangles' normals) as packed arrays through c's allocator; rad_vp_gather_mesh's input */
+static rad_result rad__vp_mesh_points(const rad__ctx *c, const char *what, const rad_mesh_desc *mesh, float **out_pts,
+                                      float **out_nrm)
 {
-    rad__ctx c;
     float *pts, *nrm;
     size_t ps, ns;
     uint32_t V, T, t, i;
-    rad_result r;
     int k;
-    rad__ctx_init(&c, ctx);
-    if (!vp || !values || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    *out_pts = *out_nrm = NULL;
     V = mesh->vertex_count;
     T = mesh->triangle_count;
     if (!mesh->indices && (size_t)T * 3u > V) return RAD_ERROR_INDEX_OUT_OF_RANGE;
     ps = mesh->position_stride ? mesh->position_stride : 3 * sizeof(float);
     ns = mesh->normal_stride ? mesh->normal_stride : 3 * sizeof(float);
-    pts = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
-    nrm = (float *)rad__alloc_array(&c.allocator, V, 3 * sizeof(float));
+    pts = (float *)rad__alloc_array(&c->allocator, V ? V : 1u, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c->allocator, V ? V : 1u, 3 * sizeof(float));
     if (!pts || !nrm) {
-        rad__free(&c.allocator, pts);
-        rad__free(&c.allocator, nrm);
+        rad__free(&c->allocator, pts);
+        rad__free(&c->allocator, nrm);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     for (i = 0; i < V; ++i) memcpy(pts + 3 * (size_t)i, (const char *)mesh->positions + ps * i, 3 * sizeof(float));
@@ -19504,9 +19622,9 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
             for (m = 0; m < 3; ++m) {
                 id[m] = mesh->indices ? mesh->indices[3 * (size_t)t + m] : 3u * t + m;
                 if (id[m] >= V) {
-                    rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_mesh: triangle %u has vertex index %u >= %u", t, id[m], V);
-                    rad__free(&c.allocator, pts);
-                    rad__free(&c.allocator, nrm);
+                    rad__log(c, RAD_LOG_ERROR, "%s: triangle %u has vertex index %u >= %u", what, t, id[m], V);
+                    rad__free(&c->allocator, pts);
+                    rad__free(&c->allocator, nrm);
                     return RAD_ERROR_INDEX_OUT_OF_RANGE;
                 }
             }
@@ -19518,9 +19636,515 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
         }
     }
     for (i = 0; i < V; ++i) rad__normalize(nrm + 3 * (size_t)i);
-    r = rad_vp_gather(vp, values, pts, nrm, V, out, ctx);
+    *out_pts = pts, *out_nrm = nrm;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float *values, const rad_mesh_desc *mesh,
+                                      float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    float *pts, *nrm;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!vp || !values || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__vp_mesh_points(&c, "rad_vp_gather_mesh", mesh, &pts, &nrm)) != RAD_SUCCESS) return r;
+    r = rad_vp_gather(vp, values, pts, nrm, mesh->vertex_count, out, ctx);
     rad__free(&c.allocator, pts);
     rad__free(&c.allocator, nrm);
+    return r;
+}
+
+/* ---- gather tables ---- */
+
+/* The weights of rad_vp_gather_point at (p, n): writes up to 48 (patch, weight) pairs and
+   returns their count (0: the point gets 0) */
+static uint32_t rad__vp_gather_weights(const rad_virtual_patches *vp, const float p[3], const float n[3], uint32_t *idx,
+                                       float *wout)
+{
+    double g[3], tsum = 0.0, raw[48], tv[8], wsv[8];
+    uint32_t start[9], corner, used = 0, cnt = 0, u, e;
+    int64_t base[3];
+    float w[6];
+    int k;
+    if (!rad__finite3(p) || !rad__finite3(n)) return 0;
+    rad__vp_weights(vp->weights, n, w);
+    for (k = 0; k < 3; ++k) {
+        double x = ((double)p[k] - (double)vp->origin[k]) / (double)vp->voxel_size[k] - 0.5;
+        if (x < -2.0) x = -2.0;
+        if (x > (double)vp->dims[k] + 1.0) x = (double)vp->dims[k] + 1.0;
+        base[k] = (int64_t)floor(x);
+        g[k] = x - (double)base[k];
+    }
+    for (corner = 0; corner < 8; ++corner) {
+        int64_t cell[3];
+        double t = 1.0, ws = 0.0;
+        uint32_t v, a, first = cnt;
+        int inside = 1;
+        for (k = 0; k < 3; ++k) {
+            int bit = (int)((corner >> k) & 1u);
+            cell[k] = base[k] + bit;
+            t *= bit ? g[k] : 1.0 - g[k];
+            if (cell[k] < 0 || cell[k] >= (int64_t)vp->dims[k]) inside = 0;
+        }
+        if (!inside) continue;
+        v = rad__vp_find(vp, (uint64_t)cell[0] + (uint64_t)vp->dims[0] * ((uint64_t)cell[1] + (uint64_t)vp->dims[1] * (uint64_t)cell[2]));
+        if (v == RAD_NONE) continue;
+        for (a = 0; a < 6; ++a) {
+            uint32_t q = vp->voxel_patch[6 * (size_t)v + a];
+            float wa;
+            if (q == RAD_NONE) continue;
+            wa = vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)q, n) : w[a];
+            if (!(wa > 0.0f)) continue;
+            ws += (double)wa;
+            idx[cnt] = q;
+            raw[cnt++] = (double)wa;
+        }
+        if (!(ws > 0.0)) { cnt = first; continue; } /* nothing in this voxel faces n */
+        start[used] = first;
+        tv[used] = t;
+        wsv[used++] = ws;
+        tsum += t;
+    }
+    start[used] = cnt;
+    for (u = 0; u < used; ++u) {
+        double f = tsum > 0.0 ? tv[u] / (wsv[u] * tsum) : 1.0 / (wsv[u] * (double)used);
+        for (e = start[u]; e < start[u + 1]; ++e) wout[e] = (float)(raw[e] * f);
+    }
+    return cnt;
+}
+
+typedef struct rad__vp_table_job {
+    const rad_virtual_patches *vp;
+    const float *points, *normals, *values;
+    rad_vp_gather_table *t;
+    float *out;
+    uint32_t count, tasks, pass;
+} rad__vp_table_job;
+
+static void rad__vp_table_task(void *data, uint32_t task)
+{
+    rad__vp_table_job *j = (rad__vp_table_job *)data;
+    uint32_t i0 = (uint32_t)((uint64_t)j->count * task / j->tasks), i1 = (uint32_t)((uint64_t)j->count * (task + 1) / j->tasks), i;
+    uint32_t idx[48];
+    float w[48];
+    for (i = i0; i < i1; ++i) {
+        if (j->pass == 0) { /* counts */
+            j->t->offsets[i + 1] = rad__vp_gather_weights(j->vp, j->points + 3 * (size_t)i, j->normals + 3 * (size_t)i, idx, w);
+        } else if (j->pass == 1) { /* entries */
+            uint32_t n = rad__vp_gather_weights(j->vp, j->points + 3 * (size_t)i, j->normals + 3 * (size_t)i, idx, w);
+            memcpy(j->t->patch + j->t->offsets[i], idx, sizeof(uint32_t) * n);
+            memcpy(j->t->weight + j->t->offsets[i], w, sizeof(float) * n);
+        } else { /* apply */
+            const rad_vp_gather_table *t = j->t;
+            const float *x = j->values;
+            float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f;
+            uint32_t e;
+            for (e = t->offsets[i]; e < t->offsets[i + 1]; ++e) {
+                const float *q = x + 3 * (size_t)t->patch[e], g = t->weight[e];
+                a0 += g * q[0], a1 += g * q[1], a2 += g * q[2];
+            }
+            j->out[3 * (size_t)i] = a0, j->out[3 * (size_t)i + 1] = a1, j->out[3 * (size_t)i + 2] = a2;
+        }
+    }
+}
+
+RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table)
+{
+    rad_allocator a;
+    if (!table) return;
+    a = table->allocator;
+    rad__free(&a, table->offsets);
+    rad__free(&a, table->patch);
+    rad__free(&a, table->weight);
+    rad__free(&a, table);
+}
+
+RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, const float *points, const float *normals,
+                                              uint32_t count, const rad_context *ctx, rad_vp_gather_table **out)
+{
+    rad__ctx c;
+    rad__vp_table_job j;
+    rad_vp_gather_table *t;
+    uint64_t total = 0;
+    uint32_t i;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!vp || !out || (count && (!points || !normals))) return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < count; ++i)
+        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_table_create: point %u or its normal is not finite", i);
+            return RAD_ERROR_NON_FINITE;
+        }
+    t = (rad_vp_gather_table *)rad__alloc(&c.allocator, sizeof(*t));
+    if (!t) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(t, 0, sizeof(*t));
+    t->allocator = c.allocator;
+    t->count = count;
+    t->patches = vp->count;
+    t->offsets = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)count + 1u, sizeof(uint32_t));
+    if (!t->offsets) {
+        rad_vp_gather_table_destroy(t);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    t->offsets[0] = 0;
+    j.vp = vp, j.points = points, j.normals = normals, j.values = NULL, j.t = t, j.out = NULL, j.count = count;
+    j.tasks = c.tasks < count ? c.tasks : count;
+    if (count) {
+        j.pass = 0;
+        c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
+    }
+    for (i = 0; i < count; ++i) {
+        total += t->offsets[i + 1];
+        if (total > 0xFFFFFFFFull) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_table_create: more than 2^32 - 1 entries for %u points", count);
+            rad_vp_gather_table_destroy(t);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        t->offsets[i + 1] = (uint32_t)total;
+    }
+    t->patch = (uint32_t *)rad__alloc_array(&c.allocator, total ? (size_t)total : 1u, sizeof(uint32_t));
+    t->weight = (float *)rad__alloc_array(&c.allocator, total ? (size_t)total : 1u, sizeof(float));
+    if (!t->patch || !t->weight) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_table_create: out of memory for %llu entries", (unsigned long long)total);
+        rad_vp_gather_table_destroy(t);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (count) {
+        j.pass = 1;
+        c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
+    }
+    *out = t;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_gather_table_mesh(const rad_virtual_patches *vp, const rad_mesh_desc *mesh, const rad_context *ctx,
+                                            rad_vp_gather_table **out)
+{
+    rad__ctx c;
+    float *pts, *nrm;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!vp || !mesh || !out || !mesh->positions) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__vp_mesh_points(&c, "rad_vp_gather_table_mesh", mesh, &pts, &nrm)) != RAD_SUCCESS) return r;
+    r = rad_vp_gather_table_create(vp, pts, nrm, mesh->vertex_count, ctx, out);
+    rad__free(&c.allocator, pts);
+    rad__free(&c.allocator, nrm);
+    return r;
+}
+
+RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, const float *values, float *out,
+                                             const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__vp_table_job j;
+    rad__ctx_init(&c, ctx);
+    if (!table || !values || (table->count && !out)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (table->count == 0) return RAD_SUCCESS;
+    memset(&j, 0, sizeof j);
+    j.t = (rad_vp_gather_table *)(uintptr_t)table; /* read only in the apply pass */
+    j.values = values, j.out = out, j.count = table->count, j.pass = 2;
+    /* one task per 4096 points at least: below that the threads cost more than the work */
+    j.tasks = c.tasks < (table->count + 4095u) / 4096u ? c.tasks : (table->count + 4095u) / 4096u;
+    if (j.tasks <= 1) rad__vp_table_task(&j, 0); /* a small mesh: no thread wake-up at all */
+    else c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
+    return RAD_SUCCESS;
+}
+
+/* ---- dynamic lights ---- */
+
+#define RAD__VP_LIGHTS_CHUNK 256u /* samples per task row */
+
+struct rad_vp_lights {
+    const rad_virtual_patches *vp;
+    const rad_raycaster *rc;
+    rad_vp_lights_options o;
+    rad_allocator allocator;
+    float *normals;                   /* 3M unit sample normals */
+    float *v;                         /* 3M: rho_i D_i of the last update */
+    float *emit;                      /* 3M: the emitters' D (include_emitters), else NULL */
+    float *sky;                       /* M: unoccluded hemisphere fraction, once a sky was seen */
+    uint8_t *vis[RAD_VP_LIGHTS_MAX];  /* M per slot: cached visibility */
+    int type[RAD_VP_LIGHTS_MAX];      /* the slot's light type at the last update, -1: none */
+    uint8_t full[RAD_VP_LIGHTS_MAX];  /* re-test every sample at the next update */
+    float key[RAD_VP_LIGHTS_MAX][8];  /* what decides the slot's rays: position, direction, cone */
+    uint32_t settled[RAD_VP_LIGHTS_MAX]; /* updates since the key changed (P: every sample tested since) */
+    uint32_t period, update;          /* P; updates done */
+    uint64_t rays;                    /* of the last update */
+};
+
+RAD_API void rad_vp_lights_options_default(rad_vp_lights_options *options)
+{
+    if (!options) return;
+    memset(options, 0, sizeof(*options));
+    rad_direct_options_default(&options->direct);
+    options->direct.include_emitters = 0;
+}
+
+RAD_API void rad_vp_lights_destroy(rad_vp_lights *s)
+{
+    rad_allocator a;
+    uint32_t l;
+    if (!s) return;
+    a = s->allocator;
+    for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) rad__free(&a, s->vis[l]);
+    rad__free(&a, s->normals);
+    rad__free(&a, s->v);
+    rad__free(&a, s->emit);
+    rad__free(&a, s->sky);
+    rad__free(&a, s);
+}
+
+RAD_API void rad_vp_lights_refresh(rad_vp_lights *s)
+{
+    uint32_t l;
+    if (!s) return;
+    for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) s->full[l] = 1;
+}
+
+RAD_API uint64_t rad_vp_lights_rays(const rad_vp_lights *s) { return s ? s->rays : 0u; }
+
+RAD_API rad_result rad_vp_lights_create(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
+                                        const rad_vp_lights_options *options, const rad_context *ctx,
+                                        rad_vp_lights **out)
+{
+    rad__ctx c;
+    rad__direct d;
+    rad_vp_lights *s;
+    rad_result r;
+    uint32_t M, l;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!vp || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    if (!vp->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_lights_create: the set has no scene (rad_vp_load with scene NULL)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    s = (rad_vp_lights *)rad__alloc(&c.allocator, sizeof(*s));
+    if (!s) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(s, 0, sizeof(*s));
+    s->allocator = c.allocator;
+    s->vp = vp;
+    s->rc = raycaster;
+    if (options) s->o = *options;
+    else rad_vp_lights_options_default(&s->o);
+    for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) s->type[l] = -1, s->full[l] = 1;
+    /* the options and raycaster, checked as rad_direct_irradiance checks them */
+    if ((r = rad__direct_setup(&d, vp->scene, raycaster, NULL, 0, &s->o.direct, &c)) != RAD_SUCCESS) {
+        rad_vp_lights_destroy(s);
+        return r;
+    }
+    M = vp->sample_count;
+    s->period = s->o.rays_per_frame == 0 || s->o.rays_per_frame >= M ? 1u
+                                                                      : (uint32_t)(((uint64_t)M + s->o.rays_per_frame - 1u) / s->o.rays_per_frame);
+    s->normals = (float *)rad__alloc_array(&c.allocator, M ? (size_t)M : 1u, 3 * sizeof(float));
+    s->v = (float *)rad__alloc_array(&c.allocator, M ? (size_t)M : 1u, 3 * sizeof(float));
+    if (!s->normals || !s->v) {
+        rad_vp_lights_destroy(s);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    /* the unit normals rad_direct_irradiance would make of the same samples: the same bits */
+    if ((r = rad__unit_normals(&c, "rad_vp_lights_create", vp->sample_positions, vp->sample_normals, 0, M, s->normals)) != RAD_SUCCESS) {
+        rad_vp_lights_destroy(s);
+        return r;
+    }
+    if (s->o.direct.include_emitters) {
+        s->emit = (float *)rad__alloc_array(&c.allocator, M ? (size_t)M : 1u, 3 * sizeof(float));
+        if (!s->emit) r = RAD_ERROR_OUT_OF_MEMORY;
+        else r = rad_direct_irradiance(vp->scene, raycaster, NULL, 0, &s->o.direct, vp->sample_positions, vp->sample_normals, M,
+                                       s->emit, ctx);
+        if (r != RAD_SUCCESS) {
+            rad_vp_lights_destroy(s);
+            return r;
+        }
+    }
+    *out = s;
+    return RAD_SUCCESS;
+}
+
+/* what decides which samples a light's rays go to and where: position, direction, cone */
+static void rad__vp_light_key(const rad_light *li, float key[8])
+{
+    memcpy(key, li->position, 3 * sizeof(float));
+    memcpy(key + 3, li->direction, 3 * sizeof(float));
+    key[6] = li->type == RAD_LIGHT_SPOT ? li->inner_angle : 0.0f;
+    key[7] = li->type == RAD_LIGHT_SPOT ? li->outer_angle : 0.0f;
+}
+
+typedef struct rad__vp_lights_job {
+    rad_vp_lights *s;
+    const rad_light *lights;
+    uint32_t light_count, phase;
+    uint8_t full[RAD_VP_LIGHTS_MAX], skip[RAD_VP_LIGHTS_MAX];
+    float eps, diagonal;
+    rad_ray *rays;           /* RAD__RAY_BATCH per task */
+    uint8_t *occ;            /* RAD__RAY_BATCH per task */
+    uint32_t *ray_sample;    /* RAD__RAY_BATCH per task */
+    uint8_t *ray_light;      /* RAD__RAY_BATCH per task */
+    uint64_t *task_rays;     /* per task */
+} rad__vp_lights_job;
+
+static rad_result rad__vp_lights_flush(rad__vp_lights_job *j, uint32_t task, uint32_t n)
+{
+    size_t at = (size_t)task * RAD__RAY_BATCH;
+    const rad_raycaster *rc = j->s->rc;
+    uint32_t k;
+    if (n == 0) return RAD_SUCCESS;
+    if (rc->occluded(rc->user, j->rays + at, n, j->occ + at) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < n; ++k) j->s->vis[j->ray_light[at + k]][j->ray_sample[at + k]] = j->occ[at + k] ? 0u : 1u;
+    j->task_rays[task] += n;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__vp_lights_job *j = (rad__vp_lights_job *)data;
+    rad_vp_lights *s = j->s;
+    const rad_virtual_patches *vp = s->vp;
+    uint32_t i0 = row * RAD__VP_LIGHTS_CHUNK, i1 = i0 + RAD__VP_LIGHTS_CHUNK, i, l, nr = 0, P = s->period;
+    size_t at = (size_t)task * RAD__RAY_BATCH;
+    rad_result r;
+    int k;
+    if (i1 > vp->sample_count) i1 = vp->sample_count;
+    /* 1. the shadow rays of this update: the samples whose turn it is, facing the light */
+    for (i = i0; i < i1; ++i) {
+        const float *p = vp->sample_positions + 3 * (size_t)i, *n = s->normals + 3 * (size_t)i;
+        for (l = 0; l < j->light_count; ++l) {
+            const rad_light *li = &j->lights[l];
+            float w[3], v[3];
+            if (li->type == RAD_LIGHT_SKY || j->skip[l]) continue;
+            if (!j->full[l] && (i % P + l % P) % P != j->phase) continue;
+            if (!rad__light_unshadowed(li, j->diagonal, p, n, w, v)) continue;
+            rad__shadow_ray(j->rays + at + nr, p, n, li->type == RAD_LIGHT_DIRECTIONAL ? NULL : li->position, NULL,
+                            li->type == RAD_LIGHT_DIRECTIONAL ? v : NULL, j->eps);
+            j->ray_sample[at + nr] = i;
+            j->ray_light[at + nr] = (uint8_t)l;
+            if (++nr == RAD__RAY_BATCH) {
+                if ((r = rad__vp_lights_flush(j, task, nr)) != RAD_SUCCESS) return r;
+                nr = 0;
+            }
+        }
+    }
+    if ((r = rad__vp_lights_flush(j, task, nr)) != RAD_SUCCESS) return r;
+    /* 2. D_i in light order in double, as rad_direct_irradiance sums its rays */
+    for (i = i0; i < i1; ++i) {
+        const float *p = vp->sample_positions + 3 * (size_t)i, *n = s->normals + 3 * (size_t)i;
+        double acc[3] = { 0.0, 0.0, 0.0 };
+        for (l = 0; l < j->light_count; ++l) {
+            const rad_light *li = &j->lights[l];
+            float w[3], v[3];
+            if (li->type == RAD_LIGHT_SKY) {
+                for (k = 0; k < 3; ++k) acc[k] += (double)(li->color[k] * s->sky[i]);
+            } else if (s->vis[l][i] && rad__light_unshadowed(li, j->diagonal, p, n, w, v)) {
+                for (k = 0; k < 3; ++k) acc[k] += (double)w[k];
+            }
+        }
+        if (s->emit)
+            for (k = 0; k < 3; ++k) acc[k] += (double)s->emit[3 * (size_t)i + k];
+        for (k = 0; k < 3; ++k) s->v[3 * (size_t)i + k] = (float)acc[k] * vp->sample_albedo[3 * (size_t)i + k];
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *lights, uint32_t light_count, float *out_E,
+                                        const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__direct d;
+    rad__vp_lights_job j;
+    rad_result r;
+    uint32_t M, l, rows, T, t, has_sky = 0, settled[RAD_VP_LIGHTS_MAX];
+    rad__ctx_init(&c, ctx);
+    if (!s || !out_E || (light_count && !lights)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (light_count > RAD_VP_LIGHTS_MAX) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_vp_lights_update: %u lights (at most %u)", light_count, RAD_VP_LIGHTS_MAX);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    /* every light checked as rad_direct_irradiance checks it */
+    if ((r = rad__direct_setup(&d, s->vp->scene, s->rc, lights, light_count, &s->o.direct, &c)) != RAD_SUCCESS) return r;
+    M = s->vp->sample_count;
+    memset(&j, 0, sizeof j);
+    j.s = s, j.lights = lights, j.light_count = light_count, j.eps = d.eps, j.diagonal = s->vp->scene->diagonal;
+    j.phase = s->update % s->period;
+    for (l = 0; l < light_count; ++l) {
+        if (lights[l].type == RAD_LIGHT_SKY) { has_sky = 1; continue; }
+        float key[8];
+        rad__vp_light_key(&lights[l], key);
+        j.full[l] = s->full[l] || s->type[l] != (int)lights[l].type;
+        if (!s->vis[l]) {
+            s->vis[l] = (uint8_t *)rad__alloc_array(&s->allocator, M ? (size_t)M : 1u, 1);
+            if (!s->vis[l]) return RAD_ERROR_OUT_OF_MEMORY;
+            memset(s->vis[l], 1, M); /* a sample the light never reached counts as lit until tested */
+            j.full[l] = 1;
+        }
+        /* a light whose position, direction and cone have not changed for a whole round of P
+           updates has every lit sample's visibility tested already: no rays (a sun, a light
+           at rest) */
+        if (j.full[l]) settled[l] = s->period;
+        else if (memcmp(key, s->key[l], sizeof key)) settled[l] = 0;
+        else settled[l] = s->settled[l] < s->period ? s->settled[l] + 1u : s->period;
+        j.skip[l] = !j.full[l] && settled[l] >= s->period;
+    }
+    if (has_sky && !s->sky) {
+        /* the sky's visibility depends on the geometry only: traced once, with a unit sky */
+        rad_light unit;
+        float *tmp = (float *)rad__alloc_array(&c.allocator, M ? (size_t)M : 1u, 3 * sizeof(float));
+        memset(&unit, 0, sizeof unit);
+        unit.type = RAD_LIGHT_SKY;
+        unit.color[0] = unit.color[1] = unit.color[2] = 1.0f;
+        s->sky = (float *)rad__alloc_array(&s->allocator, M ? (size_t)M : 1u, sizeof(float));
+        if (!tmp || !s->sky) r = RAD_ERROR_OUT_OF_MEMORY;
+        else {
+            rad_direct_options o = s->o.direct;
+            o.include_emitters = 0;
+            r = rad_direct_irradiance(s->vp->scene, s->rc, &unit, 1, &o, s->vp->sample_positions, s->vp->sample_normals, M, tmp, ctx);
+        }
+        if (r == RAD_SUCCESS)
+            for (l = 0; l < M; ++l) s->sky[l] = tmp[3 * (size_t)l];
+        rad__free(&c.allocator, tmp);
+        if (r != RAD_SUCCESS) {
+            rad__free(&s->allocator, s->sky);
+            s->sky = NULL;
+            return r;
+        }
+    }
+    rows = (M + RAD__VP_LIGHTS_CHUNK - 1) / RAD__VP_LIGHTS_CHUNK;
+    T = c.tasks < rows ? c.tasks : rows;
+    if (T == 0) T = 1;
+    j.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    j.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    j.ray_sample = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    j.ray_light = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    j.task_rays = (uint64_t *)rad__alloc_array(&c.allocator, T, sizeof(uint64_t));
+    if (!j.rays || !j.occ || !j.ray_sample || !j.ray_light || !j.task_rays) r = RAD_ERROR_OUT_OF_MEMORY;
+    else {
+        memset(j.task_rays, 0, sizeof(uint64_t) * T);
+        r = rad__for_rows(&c, rows, T, rad__vp_lights_row, &j);
+    }
+    if (r == RAD_SUCCESS) {
+        s->rays = 0;
+        for (t = 0; t < T; ++t) s->rays += j.task_rays[t];
+        for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) {
+            /* a slot not lit this update forgets its cache: it may come back as another light */
+            s->type[l] = l < light_count && lights[l].type != RAD_LIGHT_SKY ? (int)lights[l].type : -1;
+            s->full[l] = 0;
+            if (s->type[l] >= 0) {
+                rad__vp_light_key(&lights[l], s->key[l]);
+                s->settled[l] = settled[l];
+            }
+        }
+        ++s->update;
+        r = rad_vp_from_samples(s->vp, s->v, out_E);
+        if (r == RAD_SUCCESS) r = rad__check_output(&c, "rad_vp_lights_update", out_E, 3 * (size_t)s->vp->count);
+    } else {
+        rad_vp_lights_refresh(s);
+    }
+    rad__free(&c.allocator, j.rays);
+    rad__free(&c.allocator, j.occ);
+    rad__free(&c.allocator, j.ray_sample);
+    rad__free(&c.allocator, j.ray_light);
+    rad__free(&c.allocator, j.task_rays);
     return r;
 }
 

@@ -1,12 +1,15 @@
 /* realtime.c - the loop an engine runs with radiosity.h on a scene of any size (docs/methods/
    aavp.md, temporal.md): load a mesh, build axis-aligned virtual patches with sparse rows, bake
-   the rows into alias tables, then per frame move a point light, update E at the patches'
-   samples, take one temporal step (all bounces by feedback) and gather the radiosity at every
-   vertex, printing each stage's milliseconds. No mesh: the built-in Cornell box (lit by the
-   moving light only). MESH.obj: positions and faces (one stone material, albedo 0.7 0.68 0.63).
+   the rows into alias tables and the vertices into gather tables, then per frame move a point
+   light, update E at the patches' samples (rad_vp_lights: the light's falloff exact every frame,
+   its shadows re-tested for --rays samples per frame, round-robin), take one temporal step (all
+   bounces by feedback) and gather the radiosity at every vertex, printing each stage's
+   milliseconds. No mesh: the built-in Cornell box (lit by the moving light only). MESH.obj:
+   positions and faces (one stone material, albedo 0.7 0.68 0.63), also lit by a fixed sun.
    --patches N: the resolution is predicted from a coarse first build (default 2000).
+   --rays R: shadow rays per light and frame (default 0: every sample, exact every frame).
    Build:  cc -std=c99 -O2 -fopenmp -I. examples/realtime.c -o build/realtime -lm
-   Run:    build/realtime [MESH.obj] [--patches N] [--frames F] [--k K] */
+   Run:    build/realtime [MESH.obj] [--patches N] [--frames F] [--k K] [--rays R] */
 #if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
 #  define _POSIX_C_SOURCE 199309L /* clock_gettime */
 #endif
@@ -77,29 +80,6 @@ static int load_obj(const char *path, float **pos, uint32_t *nv, uint32_t **idx,
     return *nv > 0 && *nt > 0;
 }
 
-/* area-weighted vertex normals of one mesh (a vertex no triangle uses gets +y), once: an
-   engine keeps its own; then rad_vp_gather needs no work per frame beyond the gather */
-static float *vertex_normals(const rad_mesh_desc *d)
-{
-    float *n = (float *)calloc(3 * (size_t)d->vertex_count, sizeof(float));
-    uint32_t t, i, k;
-    if (!n) return NULL;
-    for (t = 0; t < d->triangle_count; ++t) {
-        const uint32_t *v = d->indices + 3 * (size_t)t;
-        const float *a = d->positions + 3 * (size_t)v[0], *b = d->positions + 3 * (size_t)v[1], *c = d->positions + 3 * (size_t)v[2];
-        float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        float x[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-        for (i = 0; i < 3; ++i)
-            for (k = 0; k < 3; ++k) n[3 * (size_t)v[i] + k] += x[k];
-    }
-    for (i = 0; i < d->vertex_count; ++i) {
-        float *q = n + 3 * (size_t)i, l = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-        if (l > 0.0f) q[0] /= l, q[1] /= l, q[2] /= l;
-        else q[0] = 0.0f, q[1] = 1.0f, q[2] = 0.0f;
-    }
-    return n;
-}
-
 static int cmp_double(const void *a, const void *b)
 {
     return (*(const double *)a > *(const double *)b) - (*(const double *)a < *(const double *)b);
@@ -108,8 +88,8 @@ static int cmp_double(const void *a, const void *b)
 int main(int argc, char **argv)
 {
     const char *path = NULL;
-    uint32_t want = 2000, frames = 60, k = 10, nv = 0, nt = 0, f, i, m, total_vertices = 0;
-    float *pos = NULL, *E, *B, **vertex_out, **vertex_n, centre[3], radius;
+    uint32_t want = 2000, frames = 60, k = 10, rays = 0, nv = 0, nt = 0, f, i, m, total_vertices = 0, light_count = 1;
+    float *pos = NULL, *E, *B, **vertex_out, centre[3], radius;
     uint32_t *idx = NULL;
     rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0};
     rad_mesh_desc mesh;
@@ -124,16 +104,19 @@ int main(int argc, char **argv)
     const rad_alias_tables *tp[1];
     rad_temporal_options to;
     rad_temporal *temporal = NULL;
-    rad_direct_options dopt;
-    rad_light light;
+    rad_vp_lights_options lo;
+    rad_vp_lights *dyn = NULL;
+    rad_vp_gather_table **gt;
+    rad_light light[2];
     double t, t_build, t_bake, sum[3] = {0.0, 0.0, 0.0}, *times;
 
     for (i = 1; i < (uint32_t)argc; ++i) {
         if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--patches")) want = (uint32_t)atoi(argv[++i]);
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--frames")) frames = (uint32_t)atoi(argv[++i]);
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--k")) k = (uint32_t)atoi(argv[++i]);
+        else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--rays")) rays = (uint32_t)atoi(argv[++i]);
         else if (argv[i][0] != '-' && !path) path = argv[i];
-        else return fprintf(stderr, "usage: realtime [MESH.obj] [--patches N] [--frames F] [--k K]\n"), 2;
+        else return fprintf(stderr, "usage: realtime [MESH.obj] [--patches N] [--frames F] [--k K] [--rays R]\n"), 2;
     }
     if (want < 8 || frames < 1 || k < 1 || k > RAD_TEMPORAL_MAX_SAMPLES)
         return fprintf(stderr, "realtime: --patches >= 8, --frames >= 1, --k in 1..%u\n", RAD_TEMPORAL_MAX_SAMPLES), 2;
@@ -189,39 +172,49 @@ int main(int argc, char **argv)
     E = (float *)malloc(sizeof(float) * 3 * vp->count);
     B = (float *)malloc(sizeof(float) * 3 * vp->count);
     vertex_out = (float **)malloc(sizeof(float *) * desc.mesh_count);
-    vertex_n = (float **)malloc(sizeof(float *) * desc.mesh_count);
+    gt = (rad_vp_gather_table **)calloc(desc.mesh_count, sizeof(rad_vp_gather_table *));
     times = (double *)malloc(sizeof(double) * 3 * frames);
-    if (!E || !B || !vertex_out || !vertex_n || !times) return 1;
-    for (m = 0; m < desc.mesh_count; ++m)
-        if (!(vertex_out[m] = (float *)malloc(sizeof(float) * 3 * (desc.meshes[m].vertex_count + 1))) ||
-            !(vertex_n[m] = vertex_normals(&desc.meshes[m])))
-            return 1;
+    if (!E || !B || !vertex_out || !gt || !times) return 1;
+    /* the gather tables: the voxels and weights of every vertex, found once (the mesh is static) */
+    t = now_ms();
+    for (m = 0; m < desc.mesh_count; ++m) {
+        if (!(vertex_out[m] = (float *)malloc(sizeof(float) * 3 * (desc.meshes[m].vertex_count + 1)))) return 1;
+        /* area-weighted vertex normals when the mesh has none (an engine passes its own) */
+        check(rad_vp_gather_table_mesh(vp, &desc.meshes[m], NULL, &gt[m]), "rad_vp_gather_table_mesh");
+    }
+    printf("gather tables: %u vertices in %.1f ms\n", total_vertices, now_ms() - t);
     for (i = 0; i < 3; ++i) centre[i] = 0.5f * (scene->bounds_min[i] + scene->bounds_max[i]);
     radius = 0.25f * fminf(scene->bounds_max[0] - scene->bounds_min[0], scene->bounds_max[2] - scene->bounds_min[2]);
-    memset(&light, 0, sizeof light);
-    light.type = RAD_LIGHT_POINT;
-    light.falloff = RAD_FALLOFF_QUADRATIC;
-    light.color[0] = light.color[1] = light.color[2] = 0.25f * scene->diagonal * scene->diagonal;
-    rad_direct_options_default(&dopt);
-    dopt.include_emitters = 0;
+    memset(light, 0, sizeof light);
+    light[0].type = RAD_LIGHT_POINT;
+    light[0].falloff = RAD_FALLOFF_QUADRATIC;
+    light[0].color[0] = light[0].color[1] = light[0].color[2] = 0.25f * scene->diagonal * scene->diagonal;
+    if (path) { /* a sun that stays: its shadows are tested once, then kept */
+        light[1].type = RAD_LIGHT_DIRECTIONAL;
+        light[1].direction[0] = 0.3f, light[1].direction[1] = -1.0f, light[1].direction[2] = 0.2f;
+        light[1].color[0] = light[1].color[1] = light[1].color[2] = 3.0f;
+        light_count = 2;
+    }
+    rad_vp_lights_options_default(&lo);
+    lo.rays_per_frame = rays;
+    check(rad_vp_lights_create(vp, &rc, &lo, NULL, &dyn), "rad_vp_lights_create");
 
     /* 4. the frames */
     printf("frame     E ms  step ms  gather ms  mean B\n");
     for (f = 0; f < frames; ++f) {
         double t0, t1, t2, t3, mean = 0.0;
         float a = 6.2831853f * (float)f / (float)frames;
-        light.position[0] = centre[0] + radius * cosf(a);
-        light.position[1] = centre[1];
-        light.position[2] = centre[2] + radius * sinf(a);
+        light[0].position[0] = centre[0] + radius * cosf(a);
+        light[0].position[1] = centre[1];
+        light[0].position[2] = centre[2] + radius * sinf(a);
         t0 = now_ms();
-        check(rad_vp_sources(vp, &rc, &light, 1, &dopt, RAD_SOURCE_DIRECT, E, NULL), "rad_vp_sources");
+        check(rad_vp_lights_update(dyn, light, light_count, E, NULL), "rad_vp_lights_update");
         t1 = now_ms();
         check(rad_temporal_step(temporal, E, NULL, B), "rad_temporal_step");
         t2 = now_ms();
         for (i = 0; i < 3 * vp->count; ++i) B[i] += E[i]; /* the step gives the indirect part */
         for (m = 0; m < desc.mesh_count; ++m)
-            check(rad_vp_gather(vp, B, desc.meshes[m].positions, vertex_n[m], desc.meshes[m].vertex_count, vertex_out[m],
-                                NULL), "rad_vp_gather");
+            check(rad_vp_gather_table_apply(gt[m], B, vertex_out[m], NULL), "rad_vp_gather_table_apply");
         t3 = now_ms();
         for (i = 0; i < desc.meshes[0].vertex_count; ++i) mean += vertex_out[0][3 * i + 1];
         sum[0] += t1 - t0, sum[1] += t2 - t1, sum[2] += t3 - t2;
@@ -238,8 +231,9 @@ int main(int argc, char **argv)
            times[frames / 2], times[frames + frames / 2], times[2 * frames + frames / 2],
            times[frames / 2] + times[frames + frames / 2] + times[2 * frames + frames / 2]);
 
-    for (m = 0; m < desc.mesh_count; ++m) free(vertex_out[m]), free(vertex_n[m]);
-    free(vertex_out), free(vertex_n), free(times), free(E), free(B), free(pos), free(idx);
+    for (m = 0; m < desc.mesh_count; ++m) free(vertex_out[m]), rad_vp_gather_table_destroy(gt[m]);
+    free(vertex_out), free(gt), free(times), free(E), free(B), free(pos), free(idx);
+    rad_vp_lights_destroy(dyn);
     rad_temporal_destroy(temporal);
     rad_alias_tables_destroy(tables);
     rad_vp_destroy(vp);

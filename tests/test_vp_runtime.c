@@ -432,11 +432,264 @@ out:
     rad_scene_destroy(scene);
 }
 
+/* ---- dynamic lights and gather tables (DYNAMIC LIGHTS and GATHER TABLE in >>api_vp) ---- */
+
+/* the Cornell box (its blocks cast shadows) as AAVP with sparse rows; light 0 a point light at
+   x, light 1 a spot looking down, light 2 a sun through the (closed) box: all shadowed */
+static rad_result vpr_dyn_setup(rad_scene **scene, rad_bvh **bvh, rad_raycaster *rc, rad_virtual_patches **vp)
+{
+    rad_scene_desc desc;
+    rad_vp_options o;
+    rad_result r;
+    rad_cornell_box(&desc, NULL);
+    if ((r = rad_scene_create(&desc, NULL, scene)) != RAD_SUCCESS) return r;
+    if ((r = rad_bvh_create(*scene, NULL, bvh)) != RAD_SUCCESS) return r;
+    rad_bvh_raycaster(*bvh, rc);
+    rad_vp_options_default(&o);
+    o.resolution = 6;
+    o.face_points = 4;
+    o.storage = RAD_STORAGE_SPARSE;
+    return rad_vp_create(*scene, rc, &o, NULL, vp);
+}
+
+static void vpr_dyn_lights(rad_light *l, const rad_scene *scene, float x)
+{
+    float c[3], ext[3];
+    int k;
+    for (k = 0; k < 3; ++k) c[k] = 0.5f * (scene->bounds_min[k] + scene->bounds_max[k]), ext[k] = scene->bounds_max[k] - scene->bounds_min[k];
+    memset(l, 0, 3 * sizeof(*l));
+    l[0].type = RAD_LIGHT_POINT;
+    l[0].position[0] = c[0] + x * ext[0], l[0].position[1] = c[1] + 0.3f * ext[1], l[0].position[2] = c[2];
+    l[0].color[0] = l[0].color[1] = l[0].color[2] = 0.2f * ext[1] * ext[1];
+    l[1].type = RAD_LIGHT_SPOT;
+    l[1].position[0] = c[0] - x * ext[0], l[1].position[1] = c[1] + 0.4f * ext[1], l[1].position[2] = c[2];
+    l[1].direction[1] = -1.0f;
+    l[1].inner_angle = 0.3f, l[1].outer_angle = 0.6f;
+    l[1].color[0] = 0.1f * ext[1] * ext[1], l[1].color[1] = l[1].color[2] = 0.05f * ext[1] * ext[1];
+    l[2].type = RAD_LIGHT_DIRECTIONAL;
+    l[2].direction[0] = 0.3f, l[2].direction[1] = -1.0f, l[2].direction[2] = 0.2f;
+    l[2].color[0] = l[2].color[1] = l[2].color[2] = 2.0f;
+}
+
+/* with every sample re-tested each update, rad_vp_lights_update gives rad_vp_sources' E bit for
+   bit (point, spot, sun) at two light positions, and to float rounding with the emitters;
+   a bad light is refused */
+static void vpr_test_dynamic_lights_exact(void)
+{
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_virtual_patches *vp = NULL;
+    rad_vp_lights *dl = NULL, *de = NULL;
+    rad_vp_lights_options lo;
+    rad_direct_options dopt;
+    rad_light lights[3];
+    rad_context quiet;
+    float *E = NULL, *Ex = NULL;
+    uint32_t N, i, pass, bad = 0;
+    double worst = 0.0;
+    CHECK_OK(vpr_dyn_setup(&scene, &bvh, &rc, &vp));
+    if (!vp) goto out;
+    N = vp->count;
+    E = (float *)malloc(sizeof(float) * 3 * N);
+    Ex = (float *)malloc(sizeof(float) * 3 * N);
+    if (!E || !Ex) goto out;
+    rad_vp_lights_options_default(&lo);
+    CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &dl));
+    lo.direct.include_emitters = 1;
+    lo.direct.light_samples = 4;
+    CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &de));
+    if (!dl || !de) goto out;
+    for (pass = 0; pass < 2; ++pass) {
+        vpr_dyn_lights(lights, scene, pass ? -0.3f : 0.25f);
+        rad_direct_options_default(&dopt);
+        dopt.include_emitters = 0;
+        CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
+        CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
+        CHECK(rad_vp_lights_rays(dl) > 0 && rad_vp_lights_rays(dl) <= 3u * vp->sample_count);
+        for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
+        dopt.include_emitters = 1;
+        dopt.light_samples = 4;
+        CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
+        CHECK_OK(rad_vp_lights_update(de, lights, 3, E, NULL));
+        for (i = 0; i < 3 * N; ++i) {
+            double d = fabs((double)E[i] - (double)Ex[i]) / ((double)Ex[i] + 1e-3);
+            if (d > worst) worst = d;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(worst < 1e-5);
+    memset(&quiet, 0, sizeof quiet);
+    quiet.log = vpr_quiet;
+    lights[0].color[0] = -1.0f;
+    CHECK(rad_vp_lights_update(dl, lights, 3, E, &quiet) == RAD_ERROR_NEGATIVE_EMISSION);
+    CHECK(rad_vp_lights_update(dl, lights, RAD_VP_LIGHTS_MAX + 1, E, &quiet) == RAD_ERROR_INVALID_ARGUMENT);
+out:
+    free(E); free(Ex);
+    rad_vp_lights_destroy(dl);
+    rad_vp_lights_destroy(de);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
+/* a bounded budget: P = 5 updates per round; a moved light casts at most the budget per slot,
+   its E is stale in the shadows for fewer than P updates, then equals the exact E bit for bit
+   and lights at rest cast no more rays;
+   temporal radiosity fed by it converges to the direct solve of the new light (within 1%) */
+static void vpr_test_dynamic_lights_converge(void)
+{
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_virtual_patches *vp = NULL;
+    rad_vp_lights *dl = NULL;
+    rad_vp_lights_options lo;
+    rad_direct_options dopt;
+    rad_light lights[3];
+    rad_alias_tables *at = NULL;
+    const rad_alias_tables *tabs[1];
+    rad_temporal *tp = NULL;
+    rad_temporal_options to;
+    rad_solve_options so;
+    rad_system sys;
+    float *E = NULL, *Ex = NULL, *Ld = NULL, *L = NULL;
+    uint32_t N, i, f, P = 5, budget, bad = 0, frames = 300;
+    double pd = 0.0, pt = 0.0;
+    CHECK_OK(vpr_dyn_setup(&scene, &bvh, &rc, &vp));
+    if (!vp) goto out;
+    N = vp->count;
+    E = (float *)malloc(sizeof(float) * 3 * N);
+    Ex = (float *)malloc(sizeof(float) * 3 * N);
+    Ld = (float *)malloc(sizeof(float) * 3 * N);
+    L = (float *)malloc(sizeof(float) * 3 * N);
+    if (!E || !Ex || !Ld || !L) goto out;
+    budget = (vp->sample_count + P - 1) / P;
+    rad_vp_lights_options_default(&lo);
+    lo.rays_per_frame = budget;
+    CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &dl));
+    if (!dl) goto out;
+    vpr_dyn_lights(lights, scene, 0.25f);
+    CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL)); /* the first: every sample */
+    vpr_dyn_lights(lights, scene, -0.3f);
+    rad_direct_options_default(&dopt);
+    dopt.include_emitters = 0;
+    CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
+    for (f = 0; f < P; ++f) {
+        CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
+        CHECK(rad_vp_lights_rays(dl) <= 3u * budget);
+        if (f == 0) {
+            uint32_t diff = 0;
+            for (i = 0; i < 3 * N; ++i) diff += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
+            CHECK(diff > 0); /* the shadows of the old position are still in it */
+        }
+    }
+    for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
+    CHECK(bad == 0);
+    /* lights at rest for a whole round: no rays, the same E */
+    CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
+    CHECK(rad_vp_lights_rays(dl) == 0);
+    for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
+    CHECK(bad == 0);
+    /* the spot turns where it stands: the samples its cone now reaches are tested within a round */
+    lights[1].direction[0] = 0.8f;
+    CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
+    for (f = 0; f < P; ++f) CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
+    for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
+    CHECK(bad == 0);
+    /* the whole loop: temporal radiosity over the updated E reaches the new solution */
+    rad_vp_system(&sys, vp, Ex);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    CHECK_OK(rad_solve_direct(&sys, &so, Ld, NULL));
+    CHECK_OK(rad_alias_tables_create(&vp->matrix, RAD_ALIAS_AUTO, NULL, &at));
+    if (!at) goto out;
+    tabs[0] = at;
+    rad_temporal_options_default(&to);
+    to.mode = RAD_TEMPORAL_FEEDBACK;
+    to.weight = 0.9f;
+    to.samples = 16;
+    CHECK_OK(rad_temporal_create(tabs, 1, vp->albedo, &to, NULL, &tp));
+    for (f = 0; tp && f < frames; ++f) {
+        CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
+        CHECK_OK(rad_temporal_step(tp, E, NULL, L));
+        if (f >= frames - 100)
+            for (i = 0; i < 3 * N; ++i) pt += vp->areas[i / 3] * (double)L[i] / 100.0;
+    }
+    for (i = 0; i < 3 * N; ++i) pd += vp->areas[i / 3] * (double)Ld[i];
+    CHECK(pd > 0.0);
+    CHECK_REL(pt, pd, 0.01);
+out:
+    free(E); free(Ex); free(Ld); free(L);
+    rad_temporal_destroy(tp);
+    rad_alias_tables_destroy(at);
+    rad_vp_lights_destroy(dl);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
+/* a gather table at the scene's triangle centroids (and points off the grid) gives rad_vp_gather's
+   values to float rounding */
+static void vpr_test_gather_table(void)
+{
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_virtual_patches *vp = NULL;
+    rad_vp_gather_table *gt = NULL;
+    float *x = NULL, *pts = NULL, *nrm = NULL, *a = NULL, *b = NULL;
+    uint32_t N, T, i, k, nonzero = 0;
+    double worst = 0.0;
+    CHECK_OK(vpr_dyn_setup(&scene, &bvh, &rc, &vp));
+    if (!vp) goto out;
+    N = vp->count;
+    T = scene->triangle_count + 2;
+    x = (float *)malloc(sizeof(float) * 3 * N);
+    pts = (float *)malloc(sizeof(float) * 3 * T);
+    nrm = (float *)malloc(sizeof(float) * 3 * T);
+    a = (float *)malloc(sizeof(float) * 3 * T);
+    b = (float *)malloc(sizeof(float) * 3 * T);
+    if (!x || !pts || !nrm || !a || !b) goto out;
+    for (i = 0; i < 3 * N; ++i) x[i] = (float)((i * 2654435761u) % 1000u) / 1000.0f;
+    for (i = 0; i + 2 < T; ++i)
+        for (k = 0; k < 3; ++k) {
+            const float *v = scene->positions + 9 * (size_t)i;
+            pts[3 * i + k] = (v[k] + v[3 + k] + v[6 + k]) / 3.0f;
+            nrm[3 * i + k] = scene->normals[3 * (size_t)i + k];
+        }
+    for (k = 0; k < 3; ++k) { /* outside the grid, and a point whose normal faces nothing there */
+        pts[3 * (T - 2) + k] = 1e3f, nrm[3 * (T - 2) + k] = k == 1 ? 1.0f : 0.0f;
+        pts[3 * (T - 1) + k] = scene->bounds_min[k], nrm[3 * (T - 1) + k] = k == 0 ? -1.0f : 0.0f;
+    }
+    CHECK_OK(rad_vp_gather_table_create(vp, pts, nrm, T, NULL, &gt));
+    if (!gt) goto out;
+    CHECK(gt->count == T && gt->patches == N && gt->offsets[T - 1] == gt->offsets[T - 2]);
+    CHECK_OK(rad_vp_gather_table_apply(gt, x, a, NULL));
+    CHECK_OK(rad_vp_gather(vp, x, pts, nrm, T, b, NULL));
+    for (i = 0; i < 3 * T; ++i) {
+        double d = fabs((double)a[i] - (double)b[i]);
+        if (d > worst) worst = d;
+        nonzero += b[i] > 0.0f;
+    }
+    CHECK(nonzero > 3 * (T - 2) / 2);
+    CHECK(worst < 1e-5);
+out:
+    free(x); free(pts); free(nrm); free(a); free(b);
+    rad_vp_gather_table_destroy(gt);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 static const rad_test_case tests_vp_runtime[] = {
     { "vp_sparse_rows", vpr_test_sparse_rows },
     { "vp_temporal_converges", vpr_test_temporal_converges },
     { "vp_container", vpr_test_container },
     { "vp_streamed_rows", vpr_test_streamed_rows },
+    { "vp_dynamic_lights_exact", vpr_test_dynamic_lights_exact },
+    { "vp_dynamic_lights_converge", vpr_test_dynamic_lights_converge },
+    { "vp_gather_table", vpr_test_gather_table },
     { NULL, NULL }
 };
 

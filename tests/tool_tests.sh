@@ -619,6 +619,20 @@ bad "--proxy with --format" "--format is not an option of --proxy vp" render cor
 bad "--proxy in bake" "--proxy is an option of rad render" bake cornell --method temporal --proxy aavp -o "$TMP/y.radb"
 bad "--face-points 5000" "--face-points must be in 1..4096" render cornell --method vp --face-points 5000 -o "$TMP/y.pfm"
 bad "bake --method aavp --vp-max-patches" "--vp-max-patches is an option of rad render" bake cornell --method aavp --vp-max-patches 99 -o "$TMP/y.radb"
+bad "--light-path x" "--light-path must be line:" render cornell --method temporal --proxy aavp --point 0.3,0.3,0.3:1 --light-path x -o "$TMP/y.pfm"
+bad "--light-path with classic" "--light-path is for --method temporal --proxy" render cornell --point 0.3,0.3,0.3:1 --light-path circle:0,0,0:1 -o "$TMP/y.pfm"
+bad "--light-rays without --light-path" "--light-rays needs --light-path" render cornell --method temporal --proxy aavp --light-rays 9 -o "$TMP/y.pfm"
+# a moving light (rad_vp_lights per frame): the frames are written; a path of length 0 gives
+# the image of the light at rest (the same E to float rounding, the same draws)
+LP="--size 24x24 --aa 1 --method temporal --proxy aavp --vp-resolution 4 --frames 40 --w 0.8 --point 0.28,0.4,0.28:0.05"
+if "$RAD" render cornell $LP --light-path line:0.1,0.4,0.2:0.45,0.4,0.3 --light-rays 50 --sequence "$TMP/seq" --every 20 -o "$TMP/lp.pfm" > /dev/null 2> "$TMP/err.txt" &&
+    [ -s "$TMP/seq/frame_00020.png" ] && [ -s "$TMP/seq/frame_00040.png" ] && grep -q "with a moving light: E update" "$TMP/err.txt" &&
+    "$RAD" render cornell $LP --light-path line:0.28,0.4,0.28:0.28,0.4,0.28 -o "$TMP/lp0.pfm" > /dev/null 2>> "$TMP/err.txt" &&
+    "$RAD" render cornell $LP -o "$TMP/lp1.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+    psnr_check "--light-path of length 0 gives the still temporal image" "$TMP/lp1.pfm" "$TMP/lp0.pfm" 50
+else
+    fail "--light-path renders a moving light" "$(head -c 300 "$TMP/err.txt")"
+fi
 # virtual patches baked (sparse rows) and rendered from the bake: the image of building them here
 if "$RAD" bake cornell --method aavp --vp-resolution 4 -o "$TMP/vp.radb" > /dev/null 2> "$TMP/err.txt" &&
     "$RAD" render cornell --size 24x24 --aa 1 --method aavp --vp-resolution 4 -o "$TMP/vp0.pfm" > /dev/null 2>> "$TMP/err.txt" &&

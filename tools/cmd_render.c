@@ -741,6 +741,128 @@ done:
     return what ? rad_tool_fail(cmd, what, r) : 0;
 }
 
+/* --method temporal --proxy aavp|vp with --light-path or --sequence: the frames of a light
+   that moves (the last --point or --spot of the command line, along the path; without a path
+   every light stays): per frame E at the samples (rad_vp_lights: the falloff exact, the shadows
+   re-tested for --light-rays samples per frame, all by default), one temporal step, and with
+   --sequence every --every-th frame rendered (H = F (E + L) gathered per pixel, the direct light
+   per pixel from the moved light), and the last. The light ends where the last frame puts it,
+   so the final image (rendered by the caller from E and L) is that frame. Stage times: their
+   medians. */
+static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const rad_virtual_patches *vp, float *E,
+                                 const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
+                                 uint32_t aa, uint32_t light_samples, uint32_t patch_light_samples, float exposure,
+                                 float *L, double *step_seconds)
+{
+    rad_alias_tables *tables = NULL;
+    const rad_alias_tables *tp1[1];
+    rad_temporal *tp = NULL;
+    rad_temporal_options to;
+    rad_vp_lights *dyn = NULL;
+    rad_vp_lights_options lo;
+    rad_light *moving = NULL;
+    rad_context ctx;
+    rad_result r = RAD_SUCCESS;
+    const char *what = NULL;
+    uint32_t n = vp->count, f, i, frames = mo->frames;
+    double *te = (double *)xmalloc(sizeof(double) * frames), *ts = (double *)xmalloc(sizeof(double) * frames);
+    float *B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n), *H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    uint64_t rays = 0;
+    int rc = 0;
+    rad_tool_context(&ctx, NULL);
+    if (mo->light_path) {
+        for (i = w->file.light_count; i > w->file_light_count; --i)
+            if (w->file.lights[i - 1].type == RAD_LIGHT_POINT || w->file.lights[i - 1].type == RAD_LIGHT_SPOT) {
+                moving = &w->file.lights[i - 1]; /* the world's own array: the per-pixel light moves with it */
+                break;
+            }
+        if (!moving) {
+            fprintf(stderr, "rad %s: --light-path moves the last --point or --spot light: give one\n", cmd);
+            rc = 1;
+            goto done;
+        }
+    }
+    if ((r = rad_alias_tables_create(&vp->matrix, RAD_ALIAS_AUTO, &ctx, &tables)) != RAD_SUCCESS) { what = "rad_alias_tables_create"; goto done; }
+    tp1[0] = tables;
+    rad_temporal_options_default(&to);
+    to.mode = mo->mode;
+    to.samples = mo->k;
+    to.adaptive = mo->adaptive && !(mo->given & RAD_TOOL_OPT_W);
+    to.weight = mo->w;
+    to.seed = mo->seed;
+    if ((r = rad_temporal_create(tp1, 1, vp->albedo, &to, &ctx, &tp)) != RAD_SUCCESS) { what = "rad_temporal_create"; goto done; }
+    rad_vp_lights_options_default(&lo);
+    lo.rays_per_frame = mo->light_rays;
+    lo.direct.include_emitters = 1;
+    lo.direct.light_samples = patch_light_samples; /* as rad_vp_sources got them for the still image */
+#if defined(__unix__) || defined(__APPLE__)
+    if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
+#endif
+    if ((r = rad_vp_lights_create(vp, &w->rc, &lo, &ctx, &dyn)) != RAD_SUCCESS) { what = "rad_vp_lights_create"; goto done; }
+    for (f = 1; f <= frames; ++f) {
+        double t0;
+        if (moving) {
+            const float *q = mo->path;
+            float u = frames > 1 ? (float)(f - 1) / (float)(frames - 1) : 1.0f;
+            int k;
+            if (mo->light_path == 1) {
+                for (k = 0; k < 3; ++k) moving->position[k] = q[k] + u * (q[3 + k] - q[k]);
+            } else {
+                float a = 6.2831853f * (float)(f - 1) / (float)frames;
+                moving->position[0] = q[0] + q[3] * cosf(a);
+                moving->position[1] = q[1];
+                moving->position[2] = q[2] + q[3] * sinf(a);
+            }
+        }
+        t0 = rad_tool_seconds();
+        if ((r = rad_vp_lights_update(dyn, w->file.lights, w->file.light_count, E, &ctx)) != RAD_SUCCESS) { what = "rad_vp_lights_update"; goto done; }
+        te[f - 1] = rad_tool_seconds() - t0;
+        rays += rad_vp_lights_rays(dyn);
+        t0 = rad_tool_seconds();
+        if ((r = rad_temporal_step(tp, E, NULL, L)) != RAD_SUCCESS) { what = "rad_temporal_step"; goto done; }
+        ts[f - 1] = rad_tool_seconds() - t0;
+        if (mo->sequence && (f % mo->every == 0 || f == frames)) { /* the last one too, as render_method */
+            char path[4096];
+            rad_image frame;
+            memset(&frame, 0, sizeof frame);
+            for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
+            if ((r = rad_matrix_multiply(&vp->matrix, B, H, &ctx)) != RAD_SUCCESS) { what = "rad_matrix_multiply"; goto done; }
+            snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, f);
+            if (rad_image_alloc(&frame, width, height) != 0) {
+                fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
+                rc = 1;
+                goto done;
+            }
+            render_vp = vp, render_vp_H = H;
+            rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, &frame);
+            render_vp = NULL, render_vp_H = NULL;
+            if (rc == 0 && rad_image_write_png(path, &frame, exposure) != 0) {
+                fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+                rc = 1;
+            }
+            rad_image_free(&frame);
+            if (rc) goto done;
+        }
+    }
+    qsort(te, frames, sizeof(double), cmp_double);
+    qsort(ts, frames, sizeof(double), cmp_double);
+    *step_seconds = ts[frames / 2];
+    fprintf(stderr, "rad %s: temporal over %u virtual patches, %u frames%s: E update %.3f ms (median; %.0f shadow rays per "
+                    "frame), temporal step %.3f ms (median)\n",
+            cmd, n, frames, moving ? " with a moving light" : "", 1e3 * te[frames / 2], (double)rays / frames,
+            1e3 * ts[frames / 2]);
+done:
+    free(te);
+    free(ts);
+    free(B);
+    free(H);
+    rad_vp_lights_destroy(dyn);
+    rad_temporal_destroy(tp);
+    rad_alias_tables_destroy(tables);
+    if (what) return rad_tool_fail(cmd, what, r);
+    return rc;
+}
+
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
@@ -838,7 +960,7 @@ fail:
 
 static int render_vp_method(const char *cmd, const rad_tool_world *w, const char *bake_path,
                             const rad_tool_classic_options *o, const rad_tool_method_options *mo, const rad_camera *cam,
-                            int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
+                            int width, int height, uint32_t aa, uint32_t light_samples, float exposure, rad_image *img)
 {
     rad_virtual_patches *vp = NULL;
     rad_direct_options dopt;
@@ -913,7 +1035,11 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const char
         memset(&stats, 0, sizeof stats);
         rad_tool_context(&ctx, NULL);
         t0 = rad_tool_seconds();
-        if (mo->proxy) {
+        if (mo->proxy && mo->method == RAD_TOOL_TEMPORAL && (mo->light_path || mo->sequence)) {
+            r = RAD_SUCCESS;
+            if (proxy_temporal_frames(cmd, w, vp, E, mo, cam, width, height, aa, light_samples, o->light_samples, exposure,
+                                      L, &t_step)) rc = 1;
+        } else if (mo->proxy) {
             r = RAD_SUCCESS;
             if (proxy_indirect(cmd, vp, E, mo, cam, L, &t_step)) rc = 1;
         } else if (mo->bounces == RAD_MB_INFINITE) {
@@ -1248,7 +1374,8 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
                  ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
              : mo.method == RAD_TOOL_HIERARCHICAL
                  ? render_hr_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
-                 : render_vp_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img);
+                 : render_vp_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
+                                    &img);
         if (rc) {
             rad_image_free(&img);
             rad_tool_close_world(&w);

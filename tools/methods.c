@@ -90,6 +90,16 @@ static const char stochastic_help[] =
     "                     unshot power is below 1e-4 of the source); walk: batches averaged (default 1)\n"
     "  --seed S           generator seed (default 0; same seed, same image on any thread count)\n";
 
+static const char light_path_help[] =
+    "  --light-path P     temporal --proxy aavp|vp: the last --point or --spot light moves, one step\n"
+    "                     per frame: line:X0,Y0,Z0:X1,Y1,Z1 (from the first point at frame 1 to\n"
+    "                     the second at the last) or circle:CX,CY,CZ:R (a horizontal circle, one\n"
+    "                     turn over the frames); E at the samples is updated every frame\n"
+    "                     (rad_vp_lights) and --sequence shows the light moving\n"
+    "  --light-rays N     with --light-path: shadow rays per light and frame, the samples re-tested\n"
+    "                     in turn (default 0: every sample every frame; shadows at most\n"
+    "                     samples / N frames old, the light's falloff exact every frame)\n";
+
 const char *rad_tool_method_help(int render)
 {
     static char buf[8192];
@@ -123,6 +133,7 @@ const char *rad_tool_method_help(int render)
                     "  --proxy P          multibounce, temporal, local: run over patches (default), aavp or vp\n"
                     "                     (virtual patches with sparse rows, built with --vp-resolution etc.;\n"
                     "                     E at their samples, the indirect light gathered per pixel as --method aavp)\n"
+                    "%s"
                     "local (local multi-bounce matrix; classic patches and F, T = (I - rho F_S)^-1 - I\n"
                     "of the set S, the full solution within S; render only):\n"
                     "  --local-m M        capacity: S = the M patches nearest the camera (default: every patch,\n"
@@ -140,7 +151,7 @@ const char *rad_tool_method_help(int render)
                     "  --lightmap-size N  atlas texels a side (default 256); --texel-samples N (default 4),\n"
                     "                     --visibility-rays N (default 2) as rad lightmap\n"
                     "%s"
-                  : "multibounce:\n"
+                  : "%.0smultibounce:\n"
                     "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
                     "                     the renderer's gather; default 64)\n"
                     "  --format F         F_mb storage: float, half, bc1 or bc4x3 (default)\n"
@@ -155,7 +166,7 @@ const char *rad_tool_method_help(int render)
                     "  --adaptive         per-patch blend weight from the estimator's variance (default)\n"
                     "  --w W              a fixed blend weight in [0, 1) instead of the adaptive one\n"
                     "  --seed S           generator seed (default 0)\n"
-                    "%s", stochastic_help);
+                    "%s", light_path_help, stochastic_help);
     return buf;
 }
 
@@ -197,7 +208,8 @@ static int proxy_check(const char *cmd, int render, const rad_tool_method_option
                 mo->proxy == RAD_TOOL_PROXY_VP ? "vp" : "aavp", rad_tool_method_name(mo->method));
         return 2;
     }
-    bad = mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY);
+    bad = mo->given & (RAD_TOOL_OPT_MB_BUILD |
+                       (mo->method == RAD_TOOL_TEMPORAL ? 0u : RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY));
     if (bad) {
         fprintf(stderr, "rad %s: %s is not an option of --proxy %s (its F_mb is float; one image, no sequence)\n", cmd,
                 given_name(bad), mo->proxy == RAD_TOOL_PROXY_VP ? "vp" : "aavp");
@@ -241,6 +253,36 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
             }
         }
         mo->given |= RAD_TOOL_OPT_SR_RAYS << which;
+        return 1;
+    }
+    if (!strcmp(opt, "--light-path") || !strcmp(opt, "--light-rays")) {
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
+            return 2;
+        }
+        v = argv[++*a];
+        if (opt[8] == 'r') {
+            if (rad_tool_parse_uint(cmd, opt, v, &mo->light_rays)) return 2;
+            mo->given |= RAD_TOOL_OPT_LIGHT_RAYS;
+            return 1;
+        }
+        {
+            float *q = mo->path;
+            char tail;
+            int ok = 0;
+            memset(mo->path, 0, sizeof mo->path);
+            if (!strncmp(v, "line:", 5))
+                ok = sscanf(v + 5, "%f,%f,%f:%f,%f,%f%c", q, q + 1, q + 2, q + 3, q + 4, q + 5, &tail) == 6, mo->light_path = 1;
+            else if (!strncmp(v, "circle:", 7))
+                ok = sscanf(v + 7, "%f,%f,%f:%f%c", q, q + 1, q + 2, q + 3, &tail) == 4 && q[3] > 0.0f, mo->light_path = 2;
+            for (i = 0; ok && i < 6; ++i) ok = q[i] - q[i] == 0.0f; /* finite */
+            if (!ok) {
+                fprintf(stderr, "rad %s: --light-path must be line:X0,Y0,Z0:X1,Y1,Z1 or circle:CX,CY,CZ:R (R > 0), not '%s'\n",
+                        cmd, v);
+                return 2;
+            }
+        }
+        mo->given |= RAD_TOOL_OPT_LIGHT_PATH;
         return 1;
     }
     if (!strcmp(opt, "--hr-eps") || !strcmp(opt, "--hr-min-area") || !strcmp(opt, "--hr-rays")) {
@@ -440,7 +482,7 @@ static const char *given_name(uint32_t bits)
                                         "--seed", "--frames", "--sequence", "--every", "--method",
                                         "--vp-resolution", "--vp-max-patches", "--face-points", "--local-m",
                                         "--sr-rays", "--sr-iterations", "--sr-estimator",
-                                        "--hr-eps", "--hr-min-area", "--hr-rays"};
+                                        "--hr-eps", "--hr-min-area", "--hr-rays", "--light-path", "--light-rays"};
     uint32_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (bits & (1u << i)) return names[i];
@@ -453,6 +495,16 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
     uint32_t g = mo->given & ~(mo->proxy ? RAD_TOOL_OPT_VP : 0u), bad = 0;
     const char *want = NULL;
     if (proxy_check(cmd, render, mo)) return 2;
+    if ((mo->given & (RAD_TOOL_OPT_LIGHT_PATH | RAD_TOOL_OPT_LIGHT_RAYS)) && render &&
+        (mo->method != RAD_TOOL_TEMPORAL || !mo->proxy)) {
+        fprintf(stderr, "rad %s: %s is for --method temporal --proxy aavp|vp\n", cmd,
+                given_name(mo->given & (RAD_TOOL_OPT_LIGHT_PATH | RAD_TOOL_OPT_LIGHT_RAYS)));
+        return 2;
+    }
+    if ((mo->given & RAD_TOOL_OPT_LIGHT_RAYS) && !(mo->given & RAD_TOOL_OPT_LIGHT_PATH)) {
+        fprintf(stderr, "rad %s: --light-rays needs --light-path\n", cmd);
+        return 2;
+    }
     if (!render && (g & RAD_TOOL_OPT_RENDER_ONLY)) {
         fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & RAD_TOOL_OPT_RENDER_ONLY));
         return 2;

@@ -353,6 +353,9 @@ typedef struct rad_tool_method_options {
     float hr_eps;             /* --hr-eps E: hierarchical BF refinement tolerance (0: 1e-5) */
     float hr_min_area;        /* --hr-min-area A: smallest element, scene units^2 (0: total area / 10000) */
     uint32_t hr_rays;         /* --hr-rays R: points and visibility rays per link, a square (0: 4) */
+    uint32_t light_path;      /* --light-path: 0 none, 1 line, 2 circle (render, temporal over a proxy) */
+    float path[6];            /* line: P0 (0..2), P1 (3..5); circle: centre (0..2), radius (3) */
+    uint32_t light_rays;      /* --light-rays N: shadow rays per moving light and frame (0: every sample) */
     uint32_t proxy;           /* --proxy patches|aavp|vp (rad_tool_proxy; render, with multibounce,
                                  temporal and local: the method runs over virtual patches) */
     uint32_t given;           /* RAD_TOOL_OPT_* bits */
@@ -368,7 +371,8 @@ enum {
     RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14, RAD_TOOL_OPT_VP_RESOLUTION = 1u << 15,
     RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18,
     RAD_TOOL_OPT_SR_RAYS = 1u << 19, RAD_TOOL_OPT_SR_ITERATIONS = 1u << 20, RAD_TOOL_OPT_SR_ESTIMATOR = 1u << 21,
-    RAD_TOOL_OPT_HR_EPS = 1u << 22, RAD_TOOL_OPT_HR_MIN_AREA = 1u << 23, RAD_TOOL_OPT_HR_RAYS = 1u << 24
+    RAD_TOOL_OPT_HR_EPS = 1u << 22, RAD_TOOL_OPT_HR_MIN_AREA = 1u << 23, RAD_TOOL_OPT_HR_RAYS = 1u << 24,
+    RAD_TOOL_OPT_LIGHT_PATH = 1u << 25, RAD_TOOL_OPT_LIGHT_RAYS = 1u << 26
 };
 #define RAD_TOOL_OPT_SR (RAD_TOOL_OPT_SR_RAYS | RAD_TOOL_OPT_SR_ITERATIONS | RAD_TOOL_OPT_SR_ESTIMATOR)
 #define RAD_TOOL_OPT_HR (RAD_TOOL_OPT_HR_EPS | RAD_TOOL_OPT_HR_MIN_AREA | RAD_TOOL_OPT_HR_RAYS)
@@ -376,7 +380,8 @@ enum {
 #define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
                                RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
 #define RAD_TOOL_OPT_TEMPORAL (RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_K | RAD_TOOL_OPT_W | RAD_TOOL_OPT_ADAPTIVE)
-#define RAD_TOOL_OPT_RENDER_ONLY (RAD_TOOL_OPT_FRAMES | RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY)
+#define RAD_TOOL_OPT_RENDER_ONLY (RAD_TOOL_OPT_FRAMES | RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY | \
+                                  RAD_TOOL_OPT_LIGHT_PATH | RAD_TOOL_OPT_LIGHT_RAYS)
 
 /* The default --local-m covers every patch of a scene up to this many (the set is then the
    whole scene and local gives the classic solution): T takes 12 M^2 bytes (192 MiB here) and
