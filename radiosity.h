@@ -1078,7 +1078,9 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
    twice), RAYCAST_FAILED, NON_FINITE (a source value or the result), NEGATIVE_EMISSION (the
    source gave E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000),
    CANCELLED, OUT_OF_MEMORY. After an error the object can only be destroyed.
-   Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep. */
+   Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep; with
+   clustering also O(members of the source) projections per cluster link evaluated and, per
+   sweep, per triangle the links into the clusters above it. */
 RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx);
 RAD_API void rad_hierarchical_destroy(rad_hierarchical *h);
 

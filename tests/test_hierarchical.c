@@ -2,7 +2,8 @@
    Aupperle 1991): a closed furnace against its closed form B = E / (1 - rho), convergence to
    the classic solution on fine patches as the tolerance shrinks, links growing about linearly
    in the elements, the source callback, the smooth lookup, bad options and allocation
-   failures. Included by test_main.c after test_formfactor.c and test_scene.c, whose helpers it
+   failures; clustering (Smits, Arvo and Greenberg 1994): on against off, a furnace holding a
+   finely cut sphere, links against triangles. Included by test_main.c after test_formfactor.c and test_scene.c, whose helpers it
    uses (ff_quad, ff_cube_quads, ff_mesh_quad, sc_alloc_*, sc_log_*); its names are prefixed hr_. */
 
 typedef struct hr_world {
@@ -373,6 +374,7 @@ static void hr_test_bad_options(void)
     HR_BAD(visibility_rays, 81u, RAD_ERROR_INVALID_ARGUMENT, "visibility_rays");
     HR_BAD(ray_epsilon, 0.5f, RAD_ERROR_INVALID_ARGUMENT, "ray_epsilon");
     HR_BAD(ray_epsilon, -1e-5f, RAD_ERROR_INVALID_ARGUMENT, "ray_epsilon");
+    HR_BAD(clustering, (rad_hierarchical_clustering)7, RAD_ERROR_INVALID_ARGUMENT, "clustering");
 #undef HR_BAD
     rad_hierarchical_options_default(&o);
     CHECK_RESULT(rad_hierarchical_create(w.scene, NULL, &o, &ctx, &h), RAD_ERROR_INVALID_ARGUMENT);
@@ -411,8 +413,9 @@ static void hr_test_bad_options(void)
     hr_world_free(&w);
 }
 
-/* 6. Allocation failure at every allocation of create and solve: success or OUT_OF_MEMORY,
-   nothing leaks, no block overrun (the counting allocator of test_scene.c). */
+/* 6. Allocation failure at every allocation of create and solve, without and with clusters:
+   success or OUT_OF_MEMORY, nothing leaks, no block overrun (the counting allocator of
+   test_scene.c). */
 static void hr_test_alloc(void)
 {
     rad_scene_desc d;
@@ -421,32 +424,36 @@ static void hr_test_alloc(void)
     sc_alloc_state st;
     rad_context ctx;
     long n, total = 1;
+    int pass;
     rad_cornell_box(&d, NULL);
     if (!hr_world_make(&d, &w)) return;
     rad_hierarchical_options_default(&o);
     o.tolerance = 1e-2;
     sc_ctx_alloc(&ctx, &st);
-    for (n = 0; n <= total; ++n) {
-        rad_hierarchical *h = NULL;
-        rad_result r;
-        memset(&st, 0, sizeof(st));
-        st.fail_at = n;
-        r = rad_hierarchical_create(w.scene, &w.rc, &o, &ctx, &h);
-        if (r == RAD_SUCCESS) r = rad_hierarchical_solve(h, &ctx);
-        if (r != RAD_SUCCESS && r != RAD_ERROR_OUT_OF_MEMORY) {
-            printf("    fail_at %ld: %s\n", n, rad_result_string(r));
-            CHECK(0);
+    for (pass = 0; pass < 2; ++pass, total = 1) {
+        o.clustering = pass ? RAD_HIERARCHICAL_CLUSTER_ON : RAD_HIERARCHICAL_CLUSTER_AUTO; /* AUTO: off on 32 triangles */
+        for (n = 0; n <= total; ++n) {
+            rad_hierarchical *h = NULL;
+            rad_result r;
+            memset(&st, 0, sizeof(st));
+            st.fail_at = n;
+            r = rad_hierarchical_create(w.scene, &w.rc, &o, &ctx, &h);
+            if (r == RAD_SUCCESS) r = rad_hierarchical_solve(h, &ctx);
+            if (r != RAD_SUCCESS && r != RAD_ERROR_OUT_OF_MEMORY) {
+                printf("    fail_at %ld: %s\n", n, rad_result_string(r));
+                CHECK(0);
+            }
+            if (n > 0 && n <= st.calls) CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
+            rad_hierarchical_destroy(h);
+            if (st.allocs != st.frees || st.live_bytes != 0 || st.corrupt != 0) {
+                printf("    fail_at %ld: %ld allocs, %ld frees, %lld live bytes, %ld overruns\n", n, st.allocs, st.frees,
+                       st.live_bytes, st.corrupt);
+                CHECK(0);
+            }
+            if (n == 0) total = st.calls;
         }
-        if (n > 0 && n <= st.calls) CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
-        rad_hierarchical_destroy(h);
-        if (st.allocs != st.frees || st.live_bytes != 0 || st.corrupt != 0) {
-            printf("    fail_at %ld: %ld allocs, %ld frees, %lld live bytes, %ld overruns\n", n, st.allocs, st.frees,
-                   st.live_bytes, st.corrupt);
-            CHECK(0);
-        }
-        if (n == 0) total = st.calls;
+        CHECK(total >= 10);
     }
-    CHECK(total >= 10);
     hr_world_free(&w);
 }
 
@@ -666,10 +673,26 @@ static void hr_test_cluster_furnace(void)
         rad_scene_destroy(cube);
         return;
     }
-    if (!rad_test_quick()) { /* 20000 + 768 triangles: 4.3e8 pairs */
+    { /* without clustering: refused above 5e7 pairs (8960 triangles: 8e7), with a log line */
+        hr_mesh big;
+        rad_scene *bs = NULL;
+        rad_context ctx;
+        sc_log_state log;
+        memset(&ctx, 0, sizeof(ctx));
+        memset(&log, 0, sizeof(log));
+        ctx.log = sc_log_fn;
+        ctx.log_user = &log;
         rad_hierarchical_options_default(&o);
         o.clustering = RAD_HIERARCHICAL_CLUSTER_OFF;
-        CHECK_RESULT(rad_hierarchical_create(w.scene, &w.rc, &o, NULL, &h), RAD_ERROR_SIZE_OVERFLOW);
+        o.skip_visibility = 1;
+        if (hr_mesh_make(&big, cube, 8, sphere, 32, 0) && rad_scene_create(&big.desc, NULL, &bs) == RAD_SUCCESS) {
+            CHECK_RESULT(rad_hierarchical_create(bs, NULL, &o, &ctx, &h), RAD_ERROR_SIZE_OVERFLOW);
+            CHECK(h == NULL && strstr(log.last, "without clustering") != NULL);
+        } else {
+            CHECK(0);
+        }
+        rad_scene_destroy(bs);
+        hr_mesh_free(&big);
     }
     h = hr_solve_c(&w, 1e-3, RAD_HIERARCHICAL_CLUSTER_AUTO, &st);
     if (h) {
