@@ -22,6 +22,9 @@ OPENMP  := $(shell printf 'int main(void){return 0;}' | $(CC) -fopenmp -x c - -o
 # Embree 3 for the ray benchmark, when installed (package libembree-dev)
 EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
+# OpenEXR output of the tool (.exr) through tinyexr, when installed (package libtinyexr-dev)
+TOOL_EXR := $(shell test -f /usr/include/tinyexr.h && echo -DRAD_TOOL_EXR)
+TOOL_EXR_LIB := $(if $(TOOL_EXR),-ltinyexr,)
 # a folder holding the public meshes of docs/data.md, for the benchmarks and the report that
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
@@ -95,6 +98,10 @@ $(BUILD)/temporal: bench/temporal.c radiosity.h | $(BUILD)
 $(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
 
+# the lightmap gather: hemisphere against exact, and the 1024^2 bunny-box bake (needs $(RAD_DATA_DIR))
+$(BUILD)/bench_lightmap_gather: bench/lightmap_gather.c tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap_gather.c tools/unwrap.c -o $@ -lm
+
 # lightmap timings and noise (BENCHMARKS.md "Lightmaps")
 $(BUILD)/bench_lightmap: bench/lightmap.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap.c -o $@ -lm
@@ -115,15 +122,17 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
 	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
+	bash bench/methods.sh $(BUILD)/rad BENCHMARKS.md
 	./$(BUILD)/multibounce --append BENCHMARKS.md
 	./$(BUILD)/temporal --append BENCHMARKS.md
 	./$(BUILD)/shading --append BENCHMARKS.md
 	./$(BUILD)/local --append BENCHMARKS.md
 	./$(BUILD)/probes --append BENCHMARKS.md
 
-bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
+bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
+	bash bench/methods.sh $(BUILD)/rad $(BUILD)/BENCHMARKS-quick.md --quick
 	./$(BUILD)/multibounce --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/temporal --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/shading --quick --append $(BUILD)/BENCHMARKS-quick.md
@@ -139,12 +148,13 @@ tools: $(BUILD)/rad $(if $(HAVE_MPICC),$(BUILD)/rad-mpi)
 rad-mpi: $(BUILD)/rad-mpi
 
 $(BUILD)/rad-mpi: tools/mpi/rad_mpi.c $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
-	$(MPICC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. $(filter-out tools/main.c,$(wildcard tools/*.c)) tools/mpi/rad_mpi.c -o $@ -lassimp -lm
+	$(MPICC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(TOOL_EXR) -I. $(filter-out tools/main.c,$(wildcard tools/*.c)) tools/mpi/rad_mpi.c -o $@ -lassimp $(TOOL_EXR_LIB) -lm
 	cp $@ tools/rad-mpi
 
-# the tool needs assimp (scene import) and stb (images): Debian libassimp-dev libstb-dev
+# the tool needs assimp (scene import) and stb (images): Debian libassimp-dev libstb-dev;
+# tinyexr (libtinyexr-dev) is optional: without it .exr outputs fail with a message
 $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. tools/*.c -o $@ -lassimp -lm
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(TOOL_EXR) -I. tools/*.c -o $@ -lassimp $(TOOL_EXR_LIB) -lm
 	cp $@ tools/rad
 
 # the evaluation report (tools/report.sh, issue #12): full quality into report/ (committed), or

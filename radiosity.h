@@ -1340,6 +1340,25 @@ typedef enum rad_lightmap_encoding {
     RAD_LIGHTMAP_SH_L1 = 1       /* 12 floats per texel */
 } rad_lightmap_encoding;
 
+/* HEMISPHERE GATHER (RAD_LIGHTMAP_GATHER_HEMISPHERE), for scenes with many patches, where the
+   exact gather's O(samples x patches) is too slow. The patches split in two by radiosity:
+   the BRIGHT ones (luminance above exact_ratio times the area-weighted mean luminance of the
+   lit patches, i.e. the lamps and what they light most) are gathered exactly as above; the
+   light of all the others comes from hemisphere_rays closest-hit rays per texel, shared among
+   its valid samples (each sample a Hammersley set of ceil(hemisphere_rays / valid samples)
+   directions, rotated by a hash of the sample: deterministic, stratified). A ray that hits
+   the front of a patch that is not bright brings its radiosity B_j; one that misses, hits a
+   back face or a bright patch brings 0 (the bright ones are counted exactly). Irradiance:
+   cosine-distributed directions, H = mean B_j (the radiance B_j / pi over the cosine pdf);
+   SH: uniform directions over the hemisphere, L_lm = 2 pi mean (B_j / pi) Y_lm(w). This
+   estimates the same sum as the exact gather (constant B_j per patch), unbiased, with a
+   noise that falls with the rays (docs/methods/lightmap.md measures it). Cost: O(samples x
+   bright patches) form factors plus hemisphere_rays rays per texel, whatever the patch count. */
+typedef enum rad_lightmap_gather_method {
+    RAD_LIGHTMAP_GATHER_EXACT = 0,     /* every lit patch by its analytic form factor (default) */
+    RAD_LIGHTMAP_GATHER_HEMISPHERE = 1 /* bright patches exactly, the rest by hemisphere rays */
+} rad_lightmap_gather_method;
+
 typedef struct rad_lightmap_gather_options {
     rad_lightmap_encoding encoding;
     uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64); with 1
@@ -1347,6 +1366,10 @@ typedef struct rad_lightmap_gather_options {
                                    (reads a few % low next to contacts) */
     float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
+    rad_lightmap_gather_method method; /* RAD_LIGHTMAP_GATHER_EXACT (0) or _HEMISPHERE */
+    uint32_t hemisphere_rays;   /* hemisphere: rays per texel (0: 256; at most 65536) */
+    float exact_ratio;          /* hemisphere: a patch is bright above this times the mean
+                                   luminance (0: 16; > 0; FLT_MAX: none is bright) */
 } rad_lightmap_gather_options;
 
 RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *options);
@@ -1360,7 +1383,9 @@ RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding);
    total). patches must be of lightmap->scene. Patches with B = 0 and those behind a sample
    cost nothing. out: width * height * channels floats. Errors: INVALID_ARGUMENT, NON_FINITE
    (a B or result), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY. Cost: O(valid samples x patches)
-   form factors and up to visibility_rays shadow rays per pair. Reentrant; parallel. */
+   form factors and up to visibility_rays shadow rays per pair (the hemisphere method: see
+   above). The raycaster needs occluded(), and intersect() for the hemisphere method.
+   Reentrant; parallel; deterministic whatever the thread count. */
 RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lightmap, const rad_patches *patches,
                                        const float *patch_radiosity, const rad_raycaster *raycaster,
                                        const rad_lightmap_gather_options *options, float *out,
@@ -1410,26 +1435,43 @@ RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lightmap, uint32_t ch
    sample the patch containing it (rad_patches_locate) and its three vertex weights, each
    vertex standing for the area-weighted mean of the patches that share it (as
    rad_patches_vertex_values), averaged over the texel's valid samples; so the row
-   interpolates the patches' irradiance H = F B smoothly (a few to a few dozen entries). The
-   row is then scaled by the texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked)
-   from the gathered lightmap and the patch irradiance of the same solution (1 when either is
-   NULL or the row gives 0; at most 16), which keeps the gather's sub-patch detail (contact
-   shadows, gradients inside a patch). A refresh with H_baked gives back the bake's luminance
-   exactly; with another solution it is exact where the light's shape across each patch and
-   its neighbours does not change, and off by the change elsewhere (the test measures it). */
+   interpolates the patches' irradiance H = F B smoothly. The row is then scaled by the
+   texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked) from the gathered
+   lightmap and the patch irradiance of the same solution (1 when either is NULL or the row
+   gives 0; at most 16), which keeps the gather's sub-patch detail (contact shadows, gradients
+   inside a patch). A refresh with H_baked gives back the bake's luminance exactly; with
+   another solution it is exact where the light's shape across each patch and its neighbours
+   does not change, and off by the change elsewhere (the test measures it).
+   LAYOUT. The rows are stored FACTORED, in two sparse stages, because the patches around a
+   vertex are shared by every texel near it: stage 1 makes a value per patch vertex,
+       V_v = sum_k vertex_weights[k] H[vertex_patches[k]],  k in [vertex_first[v], vertex_first[v + 1])
+   (the area shares: they sum to 1 around a vertex), stage 2 a value per texel with a row,
+       out[row_texels[r]] = sum_e entry_weights[e] V[entry_vertices[e]],  e in [row_first[r], row_first[r + 1])
+   (the mean barycentric weights times the detail factor: about 3 entries a texel, against
+   about 10 patches in the expanded row). The texel-from-patch row of the text above is the
+   product of the two (W_tp = sum_e entry_weights[e] vertex_weights[k] over the pairs with
+   vertex_patches[k] = p); the refresh gives it up to float rounding (1e-6 relative). The
+   rows run in increasing texel order, so the stage-2 writes stream through the lightmap. */
 typedef struct rad_lightmap_weights {
     uint32_t texels;            /* width * height of the lightmap */
     uint32_t patch_count;       /* N of the patches */
-    uint64_t *row_offsets;      /* texels + 1; a texel without a valid sample has an empty row */
-    uint32_t *columns;          /* patch indices */
-    float *values;              /* weights (detail factor included) */
+    uint32_t vertex_count;      /* the patches' vertex_count */
+    uint32_t row_count;         /* texels with a row (a valid sample in a located patch) */
+    uint32_t *vertex_first;     /* vertex_count + 1 */
+    uint32_t *vertex_patches;   /* 3N: patch indices */
+    float *vertex_weights;      /* 3N: area shares */
+    uint32_t *row_texels;       /* row_count: the texel of each row, increasing */
+    uint32_t *row_first;        /* row_count + 1 */
+    uint32_t *entry_vertices;   /* row_first[row_count]: vertex indices */
+    float *entry_weights;       /* row_first[row_count]: weights (detail factor included) */
     rad_allocator allocator;    /* private */
 } rad_lightmap_weights;
 
 /* Builds the rows above. baked_texels (3 per texel, an RGB irradiance gather of the solution,
    before dilation) and baked_patch_irradiance (3N: H = F B of the same solution) are optional
    together (both or neither). Errors: INVALID_ARGUMENT (NULL lightmap or patches, patches of
-   another scene, one of the two baked inputs without the other), OUT_OF_MEMORY. O(samples). */
+   another scene, one of the two baked inputs without the other), SIZE_OVERFLOW (2^32 entries
+   or more), OUT_OF_MEMORY. O(samples). */
 RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lightmap, const rad_patches *patches,
                                                const float *baked_texels, const float *baked_patch_irradiance,
                                                const rad_context *ctx, rad_lightmap_weights **out);
@@ -1437,7 +1479,9 @@ RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *weights);
 
 /* out[t] = sum_p W_tp H_p (3 floats per texel) for every texel with a row; texels without one
    are left as they are (the gutters keep their dilated values). patch_irradiance: 3N floats.
-   Parallel over texels through ctx->parallel_for. Errors: INVALID_ARGUMENT. */
+   Two passes through ctx->parallel_for (vertices, then rows in contiguous blocks), with a
+   scratch of 3 floats per vertex from the context's allocator. Deterministic whatever the
+   thread count. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
 RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, const float *patch_irradiance, float *out,
                                         const rad_context *ctx);
 
@@ -1965,7 +2009,19 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        per entry (entry k at element k - entry_base)  2: weights (9 per entry, entry k's at
        element 9 k - weight_base)  3: direct (27 per probe)  4: B (3N)  5: out coefficients
        (27 per probe; the chunk's probes written). Matches the CPU to 1e-5 (measured 6.8e-6 on
-       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c). */
+       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c).
+   RAD_GLSL_LIGHTMAP_REFRESH  a lightmap from a new patch irradiance H, as rad_lightmap_refresh
+       (>>api_lightmap), on the arrays of rad_lightmap_weights uploaded unchanged, in TWO
+       PASSES (push member pass): RAD_GLSL_LIGHTMAP_PASS_VERTICES, one invocation per patch
+       vertex, V = the vertex values of H; then RAD_GLSL_LIGHTMAP_PASS_TEXELS, one invocation
+       per row, the texels from V (a compute-to-compute barrier between the two: pass 1 reads
+       binding 4). Push: rad_glsl_lightmap_refresh_push. 0: vertex_first (vertex_count + 1)
+       1: vertex_patches  2: vertex_weights (entry k of both at element k - entry_base in pass
+       0)  3: H (3N)  4: V, scratch of 3 floats per vertex  5: row_texels  6: row_first
+       (row_count + 1)  7: entry_vertices  8: entry_weights (entry e at element e - entry_base
+       in pass 1)  9: the lightmap (3 per texel; only texels with a row written). A pass reads
+       none of the other's bindings among 0..3 and 5..9: bind any buffer there. Matches the
+       CPU to 1e-5 (tests/test_vulkan.c). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -1982,7 +2038,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
     RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
     RAD_GLSL_PROBE_UPDATE      = 12, /* glsl/probe_update.comp */
-    RAD_GLSL_COUNT = 13
+    RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* glsl/lightmap_refresh.comp */
+    RAD_GLSL_COUNT = 14
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -2004,6 +2061,8 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_FLAG_COSINE 1u       /* vp gather: RAD_VP_WEIGHTS_COSINE split weights */
 #define RAD_GLSL_FLAG_CLUSTERED 2u    /* vp gather: RAD_VP_CLUSTERED (w = N_a . n; binding 5 read) */
 #define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
+#define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
+#define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -2076,6 +2135,11 @@ typedef struct rad_glsl_probe_update_push {
     uint32_t entry_base;           /* low 32 bits of the entry at element 0 of binding 1 */
     uint32_t weight_base;          /* low 32 bits of the float (9 x entry) at element 0 of binding 2 */
 } rad_glsl_probe_update_push;
+typedef struct rad_glsl_lightmap_refresh_push {
+    uint32_t pass;                 /* RAD_GLSL_LIGHTMAP_PASS_VERTICES or _TEXELS */
+    uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
+    uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
+} rad_glsl_lightmap_refresh_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -2213,11 +2277,9 @@ typedef struct rad_block_options {
                                   0 disables the step (default 0.05) */
     int reorder;               /* row and column reordering: RAD_REORDER_NONE (0),
                                   RAD_REORDER_GREEDY (1, Shcherbakov 2025),
-                                  RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: 12-30%
-                                  lower MSE than GREEDY on the Cornell F_mb with 1-5%
-                                  outliers) or RAD_REORDER_MATCH (4, the default: a further
-                                  3% (BC1) / 6% (3xBC4) lower than GROUPS at N = 1850 for
-                                  the same build time; see BENCHMARKS.md) */
+                                  RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: lower
+                                  MSE than GREEDY) or RAD_REORDER_MATCH (4, the default: lower
+                                  still for the same build time; docs/methods/compression.md) */
     uint32_t reorder_samples;  /* 0: L2 distances over all coordinates (the literal algorithm,
                                   through a Gram matrix); else over this many evenly spaced
                                   coordinates (faster, a little worse; default 0) */
@@ -2287,7 +2349,7 @@ RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
    entries equal rad_bc1_decode_block's within a few float roundings (1e-6 relative, tested).
    Parallel over block rows (BC1: and over block columns for the tables). Thread safety:
    reentrant. Cost: O(N^2) work (on the CPU about as many multiply-adds as a dense float
-   apply: compute-bound, see BENCHMARKS.md), bytes_total bytes read; BC1 also writes and
+   apply: compute-bound), bytes_total bytes read; BC1 also writes and
    reads 3072 N bytes of tables (scratch memory). docs/methods/compression.md. */
 RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
                                                 rad_output output, const rad_context *ctx);
@@ -2656,8 +2718,7 @@ typedef struct rad_alias_tables {
    larger through the context's allocator, placed 2 MiB aligned inside it and advised
    madvise(MADV_HUGEPAGE) before it is written, so that transparent huge pages back it even
    in the kernel's 'madvise' mode: every draw of the step is a random read into the tables,
-   and with 4 KiB pages most draws also miss the TLB (about 15% of the step's time at
-   N = 10832, BENCHMARKS.md). A hint only: where the kernel declines, nothing changes.
+   and with 4 KiB pages most draws also miss the TLB. A hint only: where the kernel declines, nothing changes.
    Thread safety: reentrant. docs/methods/temporal.md. */
 RAD_API rad_result rad_alias_tables_create(const rad_matrix *F, rad_alias_format format, const rad_context *ctx,
                                            rad_alias_tables **out);
@@ -2789,8 +2850,7 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
    step is then undone). Cost: O(N k) random reads into the tables and E: the draws
    are software-pipelined (each task hashes and prefetches the bins of the draws 64 to 128
    ahead of the one it resolves, across rows; with AVX2 and compact tables 8 rows side by
-   side, one per vector lane), so the misses overlap instead of waiting one by one
-   (BENCHMARKS.md: about 3.7 ns per draw on one core with tables of 450 MB).
+   side, one per vector lane), so the misses overlap instead of waiting one by one.
    Thread safety: one thread at a time per state. docs/methods/temporal.md. */
 RAD_API rad_result rad_temporal_step(rad_temporal *temporal, const float *E, const float E0[3], float *out_indirect);
 
@@ -2849,15 +2909,21 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
         F_ab = P_ab min(c_a, c_b) / A_a, so every row sums to at most 1 and every solver
         converges. In a closed box this lowers the mean row sum by about 1% (keep_row_sums
         turns it off).
-   VISIBILITY. One shadow ray per sample pair costs M^2 / 2 rays (a bunny in the Cornell box
-   at 47 000 samples: 7.8e8 rays, 157 s on 2 cores), so by default the kernel is summed over
+   VISIBILITY. One shadow ray per sample pair costs M^2 / 2 rays (hundreds of millions for a
+   real mesh), so by default the kernel is summed over
    every sample pair but visibility is estimated per pair of voxels (u, v): 'visibility_rays'
    sample pairs are drawn with probability proportional to their kernel G_ij (stratified on
    the cumulative sum, offsets from a hash of u and v, so the result is deterministic), one
-   shadow ray each, and the fraction unoccluded, V_uv, scales every P_ab with a in u and b in
-   v. When a voxel pair has at most that many pairs, every pair gets its ray and V_uv is the
-   kernel-weighted mean. V_uv is shared by both directions, so reciprocity is unchanged. The
-   pair list of one voxel pair is thinned systematically beyond 16384 entries.
+   shadow ray each, and per axis pair (a, c) the unoccluded fraction of the drawn pairs
+   weighted by w_ia w_jc, V_uv(a, c), scales P_ab for the patch a of u and c of v (an axis pair
+   that no drawn pair weighs takes the voxel pair's plain unoccluded fraction). When a voxel
+   pair has at most that many pairs, every pair gets its ray and V_uv(a, c) is the mean
+   weighted by G_ij w_ia w_jc, so the blocks are the literal sums. One V_uv shared by every
+   axis pair (the earlier form) is biased wherever axes of a voxel see another voxel
+   differently (a lit floor beside a hidden wall), and more rays do not reduce that bias
+   (docs/performance-notes.md, "Light lost on real geometry"). V_uv(a, c)
+   serves both directions, so reciprocity is unchanged. The pair list of one voxel pair is
+   thinned systematically beyond 16384 entries.
    MEMORY (peak, through ctx's allocator): the N x N float matrix (sparse rows: see SPARSE
    ROWS), about 100 bytes per sample,
    T x (6 N doubles + 1024 rays + 16384 12-byte pair records) of task scratch (T = the
@@ -2866,11 +2932,6 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    candidate voxels (at most 2^21 hits, 32 MiB), and for clustering T x 8 (2 n kc + n^2 + 9 n)
    bytes (n: the most samples in one voxel, at most 6 face_points; kc: metric_columns).
    Nothing is O(samples^2).
-   MEASURED (examples/vp_bunny.c, 2 shared cores, BENCHMARKS.md): the bunny in the Cornell box
-   (69 463 triangles) at 24 voxels: 107 342 samples, 6 196 patches, 20 s, 212 MiB peak; the
-   bunny and the ogre (193 471 triangles) at 30 voxels: 168 602 samples, 9 638 patches, 103 s,
-   479 MiB; image SSIM against the path tracer 0.989 (classic radiosity on decimated copies
-   with a similar patch count: 0.984 and 0.979).
    COST: O(M^2) kernel evaluations and up to M^2/2 shadow rays for M samples; M grows with the
    number of non-empty voxels times 6 face_points (times the hit rate).
    SPARSE ROWS (storage = RAD_STORAGE_SPARSE): after step 6 the matrix is kept as CSR with the
@@ -3171,9 +3232,10 @@ RAD_API rad_result rad_vp_load(const rad_container *container, const char *name,
 
    SAMPLING. rad_probes_sample(p, n): on a grid, the 8 probes of p's cell (p clamped into the
    grid) with trilinear weights; with user positions, every probe with the weight
-   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. Each weight is multiplied by
-   ((1 + cos) / 2)^2, cos the cosine between n and the direction from p to the probe (a probe
-   behind the surface counts little, one straight behind it not at all), disabled probes are
+   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. With RAD_PROBE_WEIGHT_NORMAL (the
+   default) each weight is multiplied by ((1 + cos) / 2)^2, cos the cosine between n and the
+   direction from p to the probe (a probe behind the surface counts little, one straight
+   behind it not at all; RAD_PROBE_WEIGHT_PLAIN leaves this out), disabled probes are
    skipped, and the weights are renormalized. When no weight is left (every neighbour
    disabled) the nearest enabled probe is used. The result is clamped at 0 (an L2 sum can dip
    below zero behind a strong light). It is continuous in p and n. rad_probes_sample_visible
@@ -3188,6 +3250,16 @@ typedef enum rad_probe_state {
     RAD_PROBE_VALID = 1,
     RAD_PROBE_MOVED = 2        /* was inside geometry, moved out (positions hold the new place) */
 } rad_probe_state;
+
+/* The weights of SAMPLING. NORMAL (the default): each probe's weight times ((1 + cos) / 2)^2,
+   so that a probe behind a surface counts little (a probe on the far side of a wall). PLAIN:
+   the trilinear (or inverse-distance) weights alone: for points in open air (a dynamic object
+   in a room), where the normal factor only biases the mix towards the probes the normal
+   faces; there rad_probes_sample_visible keeps probes behind a wall out by shadow rays. */
+typedef enum rad_probe_weighting {
+    RAD_PROBE_WEIGHT_NORMAL = 0,
+    RAD_PROBE_WEIGHT_PLAIN = 1
+} rad_probe_weighting;
 
 typedef struct rad_probe_options {
     float spacing;             /* grid spacing in scene units when no positions are given
@@ -3205,6 +3277,7 @@ typedef struct rad_probe_options {
                                   (0: a fifth of the max_move default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t flags;            /* rad_probe_flags */
+    rad_probe_weighting weighting; /* how rad_probes_sample weighs the probes (0: by normal) */
 } rad_probe_options;
 
 typedef struct rad_probes rad_probes;
@@ -3218,8 +3291,8 @@ RAD_API void rad_probe_options_default(rad_probe_options *options);
    patches (and their scene) and raycaster are borrowed for the call; lights (light_count,
    used only with RAD_PROBES_DIRECT) too.
    Errors: INVALID_ARGUMENT (NULL patches or raycaster, count 0 with positions, a negative or
-   non-finite spacing, rays above 65536, backface_fraction outside [0, 1], a bad light or
-   ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
+   non-finite spacing, rays above 65536, backface_fraction outside [0, 1], an unknown
+   weighting, a bad light or ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
    probes: a larger spacing), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY; the log names which.
    Thread safety: reentrant; the rays run through ctx->parallel_for. Cost: probes x (rays +
    patches x patch_samples) rays; memory 40 bytes per (probe, visible patch). */
@@ -9697,6 +9770,9 @@ RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *o)
     o->encoding = RAD_LIGHTMAP_IRRADIANCE;
     o->visibility_rays = 4;
     o->ray_epsilon = 1e-5f;
+    o->method = RAD_LIGHTMAP_GATHER_EXACT;
+    o->hemisphere_rays = 256;
+    o->exact_ratio = 16.0f;
 }
 
 RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding)
@@ -10146,12 +10222,16 @@ typedef struct rad__lm_gather {
     const rad_patches *P;
     const float *B;
     const rad_raycaster *rc;
-    uint32_t ch, vis, seed;
+    uint32_t ch, vis, seed, hemi;
     float eps;
-    uint8_t *lit;                 /* per patch: B != 0 */
+    uint32_t *list;               /* the patches gathered exactly: every lit one, or the bright ones */
+    uint32_t list_count;
+    uint8_t *skip;                /* hemisphere: per patch, 1 when a hit on it brings nothing */
     rad_ray *ray_buf;             /* per task RAD__RAY_BATCH */
     uint8_t *occ_buf;
     float *ray_c;                 /* per task RAD__RAY_BATCH x ch: each ray's contribution */
+    rad_hit *hit_buf;             /* hemisphere: per task RAD__RAY_BATCH */
+    float *hit_w;                 /* hemisphere: per task RAD__RAY_BATCH x 4 (weight, SH direction) */
     float *out;
 } rad__lm_gather;
 
@@ -10169,6 +10249,40 @@ static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count
     return RAD_SUCCESS;
 }
 
+/* hemisphere rays: each hit on the front of a patch that is not counted exactly brings its B */
+static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t count, double *sum)
+{
+    const rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = g->hit_buf + (size_t)task * RAD__RAY_BATCH;
+    const float *hw = g->hit_w + (size_t)task * RAD__RAY_BATCH * 4;
+    const rad_scene *S = g->lm->scene;
+    uint32_t k, j;
+    int c;
+    if (count == 0) return RAD_SUCCESS;
+    if (g->rc->intersect(g->rc->user, rays, count, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k) {
+        const rad_hit *h = hits + k;
+        const float *w = hw + 4 * (size_t)k;
+        float wt[3];
+        if (h->triangle == RAD_NONE || h->triangle >= S->triangle_count) continue;
+        if (!(rad__dot(S->normals + 3 * (size_t)h->triangle, rays[k].dir) < 0.0f)) continue; /* back face */
+        j = rad_patches_locate(g->P, h->triangle, h->b1, h->b2, wt);
+        if (j == RAD_NONE || g->skip[j]) continue;
+        for (c = 0; c < 3; ++c) {
+            double b = (double)g->B[3 * (size_t)j + (size_t)c] * w[0];
+            if (g->ch == 3) {
+                sum[c] += b;
+            } else {
+                sum[c] += b * RAD__LM_SH_Y0;
+                sum[3 + c] += b * RAD__LM_SH_Y1 * w[2];
+                sum[6 + c] += b * RAD__LM_SH_Y1 * w[3];
+                sum[9 + c] += b * RAD__LM_SH_Y1 * w[1];
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
 /* one texel: the mean over its valid samples of the patches' light */
 static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
 {
@@ -10177,27 +10291,34 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
     const rad_patches *P = g->P;
     rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
     float *rc = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
+    float *hw = g->hit_w ? g->hit_w + (size_t)task * RAD__RAY_BATCH * 4 : NULL;
     double acc[12], sum[12];
-    uint32_t s, j, ch, nval = 0, nr = 0;
+    uint32_t s, li, ch, nval = 0, nr = 0, nh = 0, per = 0;
     float *out = g->out + (size_t)texel * g->ch;
     int k;
+    rad_result r;
     for (ch = 0; ch < g->ch; ++ch) sum[ch] = 0.0;
+    if (g->hemi) {
+        for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) nval += lm->sample_valid[s] ? 1u : 0u;
+        per = nval ? (g->hemi + nval - 1) / nval : 0u;
+        nval = 0;
+    }
     for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) {
         const float *pf = lm->sample_positions + 3 * (size_t)s, *nf = lm->sample_normals + 3 * (size_t)s;
         double p[3], n[3];
         uint32_t h;
-        rad_result r;
         if (!lm->sample_valid[s]) continue;
         ++nval;
         for (k = 0; k < 3; ++k) { p[k] = pf[k]; n[k] = nf[k]; }
         for (ch = 0; ch < g->ch; ++ch) acc[ch] = 0.0;
         h = rad__hash(g->seed ^ rad__hash(s * 0x9E3779B9u + 0x3C6EF372u));
-        for (j = 0; j < P->count; ++j) {
+        for (li = 0; li < g->list_count; ++li) {
+            uint32_t j = g->list[li];
             const rad_patch *pj = &P->patches[j];
             float tri[9], y[3], d[3], r1, r2, u1, u2;
             double proj[4], kw[64], ksum = 0.0, full[12], Lr[3];
             uint32_t m, q;
-            if (!g->lit[j] || pj->triangle == lm->sample_triangles[s]) continue;
+            if (pj->triangle == lm->sample_triangles[s]) continue;
             for (m = 0; m < 3; ++m)
                 for (k = 0; k < 3; ++k) tri[3 * m + k] = P->vertices[3 * (size_t)pj->vertices[m] + (size_t)k];
             rad__sub(d, pf, tri);
@@ -10258,6 +10379,41 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
         nr = 0;
         if (r != RAD_SUCCESS) return r;
         for (ch = 0; ch < g->ch; ++ch) sum[ch] += acc[ch];
+        if (per) {
+            /* this sample's share of the texel's hemisphere rays (the exact rays above are
+               flushed, so the buffer is the hemisphere rays' alone) */
+            float t1[3], t2[3], u1, u2, w = g->ch == 3 ? 1.0f / (float)per : 2.0f / (float)per;
+            uint32_t q, hr = rad__hash(h ^ 0x85EBCA6Bu);
+            rad__tangent_frame(nf, t1, t2);
+            for (q = 0; q < per; ++q) {
+                rad_ray *ray = rays + nh;
+                float *wq = hw + 4 * (size_t)nh;
+                if (g->ch == 3) {
+                    rad__cosine_dir(nf, t1, t2, q, per, hr, ray->dir);
+                } else {
+                    /* uniform over the hemisphere: cos theta = u1 */
+                    float st, ph;
+                    rad__hammersley(q, per, (float)(hr & 0xFFFFu) / 65536.0f, (float)(hr >> 16) / 65536.0f, &u1, &u2);
+                    st = (float)sqrt((double)(1.0f - u1 * u1));
+                    ph = (float)(2.0 * RAD__PI) * u2;
+                    for (k = 0; k < 3; ++k)
+                        ray->dir[k] = t1[k] * st * (float)cos((double)ph) + t2[k] * st * (float)sin((double)ph) + nf[k] * u1;
+                }
+                for (k = 0; k < 3; ++k) ray->origin[k] = pf[k] + nf[k] * g->eps;
+                ray->tmin = 0.0f;
+                ray->tmax = FLT_MAX;
+                wq[0] = w;
+                for (k = 0; k < 3; ++k) wq[1 + k] = ray->dir[k];
+                if (++nh == RAD__RAY_BATCH) {
+                    r = rad__lm_flush_hits(g, task, nh, sum);
+                    nh = 0;
+                    if (r != RAD_SUCCESS) return r;
+                }
+            }
+            r = rad__lm_flush_hits(g, task, nh, sum);
+            nh = 0;
+            if (r != RAD_SUCCESS) return r;
+        }
     }
     for (ch = 0; ch < g->ch; ++ch) out[ch] = nval ? (float)(sum[ch] / nval) : 0.0f;
     return RAD_SUCCESS;
@@ -10272,6 +10428,7 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
     rad_lightmap_gather_options o;
     uint32_t T, i, texels;
     rad_result r;
+    int hemi;
     rad__ctx_init(&c, ctx);
     if (!lm || !patches || !B || !raycaster || !raycaster->occluded || !out) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: NULL lightmap, patches, radiosity, raycaster (with occluded) or output");
@@ -10284,10 +10441,23 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
     if (options) o = *options; else rad_lightmap_gather_options_default(&o);
     if (o.visibility_rays == 0) o.visibility_rays = 4;
     if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (o.hemisphere_rays == 0) o.hemisphere_rays = 256;
+    if (o.exact_ratio == 0.0f) o.exact_ratio = 16.0f;
     if (rad_lightmap_channels(o.encoding) == 0 || o.visibility_rays > 64u ||
         !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: encoding %d, visibility_rays %u (at most 64) or ray_epsilon %g out of range",
                  (int)o.encoding, o.visibility_rays, (double)o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((o.method != RAD_LIGHTMAP_GATHER_EXACT && o.method != RAD_LIGHTMAP_GATHER_HEMISPHERE) || o.hemisphere_rays > 65536u ||
+        !(o.exact_ratio > 0.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: method %d, hemisphere_rays %u (at most 65536) or exact_ratio %g out of range",
+                 (int)o.method, o.hemisphere_rays, (double)o.exact_ratio);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    hemi = o.method == RAD_LIGHTMAP_GATHER_HEMISPHERE;
+    if (hemi && !raycaster->intersect) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the hemisphere method needs the raycaster's intersect()");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     r = rad__check_input(&c, "lightmap gather: patch radiosity", B, 3 * (size_t)patches->count);
@@ -10300,26 +10470,50 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
     g.ch = rad_lightmap_channels(o.encoding);
     g.vis = o.visibility_rays;
     g.seed = o.seed;
+    g.hemi = hemi ? o.hemisphere_rays : 0u;
     g.eps = o.ray_epsilon * lm->scene->diagonal;
     g.out = out;
     texels = lm->width * lm->height;
     T = c.tasks < texels ? c.tasks : texels;
-    g.lit = (uint8_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, 1);
+    g.list = (uint32_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, sizeof(uint32_t));
+    g.skip = (uint8_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, 1);
     g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
     g.occ_buf = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
     g.ray_c = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, g.ch * sizeof(float));
-    if (!g.lit || !g.ray_buf || !g.occ_buf || !g.ray_c) {
+    if (hemi) {
+        g.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
+        g.hit_w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 4 * sizeof(float));
+    }
+    if (!g.list || !g.skip || !g.ray_buf || !g.occ_buf || !g.ray_c || (hemi && (!g.hit_buf || !g.hit_w))) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: out of memory for %u tasks", T);
         r = RAD_ERROR_OUT_OF_MEMORY;
     } else {
-        for (i = 0; i < patches->count; ++i)
-            g.lit[i] = (B[3 * (size_t)i] != 0.0f || B[3 * (size_t)i + 1] != 0.0f || B[3 * (size_t)i + 2] != 0.0f) ? 1u : 0u;
+        double lum_area = 0.0, area = 0.0, limit = 0.0;
+        for (i = 0; i < patches->count; ++i) {
+            const float *b = B + 3 * (size_t)i;
+            double lum = 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2];
+            if (b[0] == 0.0f && b[1] == 0.0f && b[2] == 0.0f) continue;
+            lum_area += lum * patches->patches[i].area;
+            area += patches->patches[i].area;
+        }
+        if (area > 0.0) limit = (double)o.exact_ratio * lum_area / area;
+        for (i = 0; i < patches->count; ++i) {
+            const float *b = B + 3 * (size_t)i;
+            int lit = b[0] != 0.0f || b[1] != 0.0f || b[2] != 0.0f;
+            /* the hemisphere method counts only the bright patches exactly */
+            int exact = lit && (!hemi || 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2] > limit);
+            g.skip[i] = (uint8_t)(exact || !lit);
+            if (exact) g.list[g.list_count++] = i;
+        }
         r = rad__for_rows(&c, texels, T, rad__lm_gather_row, &g);
     }
-    rad__free(&c.allocator, g.lit);
+    rad__free(&c.allocator, g.list);
+    rad__free(&c.allocator, g.skip);
     rad__free(&c.allocator, g.ray_buf);
     rad__free(&c.allocator, g.occ_buf);
     rad__free(&c.allocator, g.ray_c);
+    rad__free(&c.allocator, g.hit_buf);
+    rad__free(&c.allocator, g.hit_w);
     return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather", out, (size_t)texels * g.ch) : r;
 }
 
@@ -10468,9 +10662,13 @@ RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
     rad_allocator a;
     if (!w) return;
     a = w->allocator;
-    rad__free(&a, w->row_offsets);
-    rad__free(&a, w->columns);
-    rad__free(&a, w->values);
+    rad__free(&a, w->vertex_first);
+    rad__free(&a, w->vertex_patches);
+    rad__free(&a, w->vertex_weights);
+    rad__free(&a, w->row_texels);
+    rad__free(&a, w->row_first);
+    rad__free(&a, w->entry_vertices);
+    rad__free(&a, w->entry_weights);
     rad__free(&a, w);
 }
 
@@ -10496,15 +10694,17 @@ static void rad__lm_bary3(const float *v, const float *x, float *b1, float *b2)
     *b2 = (float)w;
 }
 
-#define RAD__LM_ROW_MAX 256u /* entries one texel's row may gather before merging stops adding */
+/* distinct vertices one texel's row may gather before merging stops adding (a texel spans a
+   few patches: never reached with welded meshes) */
+#define RAD__LM_ROW_MAX 128u
 
 RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad_patches *P, const float *baked_texels,
                                                const float *baked_H, const rad_context *ctx, rad_lightmap_weights **out)
 {
     rad__ctx c;
     rad_lightmap_weights *W = NULL;
-    uint32_t *vfirst = NULL, *vpatch = NULL, *fill = NULL, i, texels, col[RAD__LM_ROW_MAX];
-    double *varea = NULL, val[RAD__LM_ROW_MAX];
+    uint32_t *fill = NULL, i, texels, rows = 0, col[RAD__LM_ROW_MAX];
+    double *varea = NULL, *vbaked = NULL, val[RAD__LM_ROW_MAX];
     uint64_t total = 0, cap = 0;
     rad_result r = RAD_SUCCESS;
     rad__ctx_init(&c, ctx);
@@ -10515,36 +10715,63 @@ RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad
                  "baked_texels and baked_patch_irradiance");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if ((uint64_t)P->count * 3u >= 0xFFFFFFFFu) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: %u patches give 2^32 vertex entries or more", P->count);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
     texels = lm->width * lm->height;
+    for (i = 0; i < texels; ++i) { /* the rows to come: texels with a valid sample */
+        uint32_t s;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1] && !lm->sample_valid[s]; ++s) {}
+        rows += s < lm->sample_first[i + 1];
+    }
     W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
     if (!W) return RAD_ERROR_OUT_OF_MEMORY;
     memset(W, 0, sizeof(*W));
     W->allocator = c.allocator;
     W->texels = texels;
     W->patch_count = P->count;
-    /* the patches around each vertex, and their total area */
-    vfirst = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    W->vertex_count = P->vertex_count;
+    /* stage 1: the patches around each vertex and their area shares */
+    W->vertex_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    W->vertex_patches = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
+    W->vertex_weights = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(float));
     fill = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
-    vpatch = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
     varea = (double *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(double));
-    W->row_offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)texels + 1, sizeof(uint64_t));
-    if (!vfirst || !fill || !vpatch || !varea || !W->row_offsets) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    W->row_texels = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    W->row_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    rows = 0;
+    if (baked_H) vbaked = (double *)rad__alloc_array(&c.allocator, 3 * (size_t)P->vertex_count + 1, sizeof(double));
+    if (!W->vertex_first || !W->vertex_patches || !W->vertex_weights || !fill || !varea || !W->row_texels || !W->row_first ||
+        (baked_H && !vbaked)) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
     memset(fill, 0, sizeof(uint32_t) * ((size_t)P->vertex_count + 1));
     memset(varea, 0, sizeof(double) * ((size_t)P->vertex_count + 1));
     for (i = 0; i < P->count; ++i) {
         int k;
         for (k = 0; k < 3; ++k) { fill[P->patches[i].vertices[k]]++; varea[P->patches[i].vertices[k]] += P->patches[i].area; }
     }
-    vfirst[0] = 0;
-    for (i = 0; i < P->vertex_count; ++i) { vfirst[i + 1] = vfirst[i] + fill[i]; fill[i] = 0; }
+    W->vertex_first[0] = 0;
+    for (i = 0; i < P->vertex_count; ++i) { W->vertex_first[i + 1] = W->vertex_first[i] + fill[i]; fill[i] = 0; }
     for (i = 0; i < P->count; ++i) {
         int k;
-        for (k = 0; k < 3; ++k) { uint32_t v = P->patches[i].vertices[k]; vpatch[vfirst[v] + fill[v]++] = i; }
+        for (k = 0; k < 3; ++k) {
+            uint32_t v = P->patches[i].vertices[k], e = W->vertex_first[v] + fill[v]++;
+            W->vertex_patches[e] = i;
+            W->vertex_weights[e] = varea[v] > 0.0 ? (float)(P->patches[i].area / varea[v]) : 0.0f;
+        }
     }
-    /* rows, texel by texel, appended to growing arrays */
+    if (vbaked) /* the baked solution's vertex values, for the detail factors */
+        for (i = 0; i < P->vertex_count; ++i) {
+            uint32_t e;
+            int k;
+            for (k = 0; k < 3; ++k) vbaked[3 * (size_t)i + k] = 0.0;
+            for (e = W->vertex_first[i]; e < W->vertex_first[i + 1]; ++e)
+                for (k = 0; k < 3; ++k)
+                    vbaked[3 * (size_t)i + k] += (double)W->vertex_weights[e] * baked_H[3 * (size_t)W->vertex_patches[e] + k];
+        }
+    /* stage 2: rows, texel by texel, appended to growing arrays */
     for (i = 0; i < texels; ++i) {
         uint32_t s, n = 0, nv = 0, e;
-        W->row_offsets[i] = total;
         for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
             uint32_t t = lm->sample_triangles[s], p, k;
             float b1, b2, vw[3];
@@ -10554,56 +10781,64 @@ RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad
             p = rad_patches_locate(P, t, b1, b2, vw);
             if (p == RAD_NONE) continue;
             for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[p].vertices[k], j;
+                uint32_t v = P->patches[p].vertices[k], m;
                 if (!(varea[v] > 0.0) || !(vw[k] != 0.0f)) continue;
-                for (j = vfirst[v]; j < vfirst[v + 1]; ++j) {
-                    uint32_t q = vpatch[j], m;
-                    double wq = (double)vw[k] * P->patches[q].area / varea[v];
-                    for (m = 0; m < n && col[m] != q; ++m) {}
-                    if (m == n) {
-                        if (n == RAD__LM_ROW_MAX) continue; /* never with welded triangle meshes: a vertex has few patches */
-                        col[n] = q;
-                        val[n++] = 0.0;
-                    }
-                    val[m] += wq;
+                for (m = 0; m < n && col[m] != v; ++m) {}
+                if (m == n) {
+                    if (n == RAD__LM_ROW_MAX) continue;
+                    col[n] = v;
+                    val[n++] = 0.0;
                 }
+                val[m] += vw[k];
             }
         }
         if (nv == 0 || n == 0) continue;
         for (e = 0; e < n; ++e) val[e] /= nv;
-        if (baked_texels) {
+        if (vbaked) {
             double num = 0.0, den = 0.0, cf = 1.0;
             int k;
             for (k = 0; k < 3; ++k) num += baked_texels[3 * (size_t)i + k];
             for (e = 0; e < n; ++e)
-                for (k = 0; k < 3; ++k) den += val[e] * baked_H[3 * (size_t)col[e] + k];
+                for (k = 0; k < 3; ++k) den += val[e] * vbaked[3 * (size_t)col[e] + k];
             if (den > 0.0 && num >= 0.0) cf = num / den < 16.0 ? num / den : 16.0;
             for (e = 0; e < n; ++e) val[e] *= cf;
+        }
+        if (total + n >= 0xFFFFFFFFu) {
+            rad__log(&c, RAD_LOG_ERROR, "lightmap weights: 2^32 entries or more");
+            r = RAD_ERROR_SIZE_OVERFLOW;
+            goto done;
         }
         if (total + n > cap) {
             uint64_t nc = cap ? 2 * cap : 4096;
             uint32_t *ncol;
             float *nval;
             while (nc < total + n) nc *= 2;
-            ncol = (uint32_t *)rad__realloc(&c.allocator, W->columns, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
+            ncol = (uint32_t *)rad__realloc(&c.allocator, W->entry_vertices, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
             if (!ncol) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-            W->columns = ncol;
-            nval = (float *)rad__realloc(&c.allocator, W->values, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
+            W->entry_vertices = ncol;
+            nval = (float *)rad__realloc(&c.allocator, W->entry_weights, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
             if (!nval) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-            W->values = nval;
+            W->entry_weights = nval;
             cap = nc;
         }
-        for (e = 0; e < n; ++e) { W->columns[total + e] = col[e]; W->values[total + e] = (float)val[e]; }
+        W->row_texels[rows] = i;
+        W->row_first[rows++] = (uint32_t)total;
+        for (e = 0; e < n; ++e) { W->entry_vertices[total + e] = col[e]; W->entry_weights[total + e] = (float)val[e]; }
         total += n;
     }
-    W->row_offsets[texels] = total;
+    W->row_first[rows] = (uint32_t)total;
+    W->row_count = rows;
+    if (!W->entry_vertices) { /* no row at all: keep the arrays non-NULL */
+        W->entry_vertices = (uint32_t *)rad__alloc(&c.allocator, sizeof(uint32_t));
+        W->entry_weights = (float *)rad__alloc(&c.allocator, sizeof(float));
+        if (!W->entry_vertices || !W->entry_weights) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
 done:
-    rad__free(&c.allocator, vfirst);
     rad__free(&c.allocator, fill);
-    rad__free(&c.allocator, vpatch);
     rad__free(&c.allocator, varea);
+    rad__free(&c.allocator, vbaked);
     if (r != RAD_SUCCESS) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
+        if (r == RAD_ERROR_OUT_OF_MEMORY) rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
         rad_lightmap_weights_destroy(W);
         return r;
     }
@@ -10611,33 +10846,60 @@ done:
     return RAD_SUCCESS;
 }
 
+#define RAD__LM_REFRESH_GRAIN 65536u /* entries (and rows) a refresh task takes at least */
+
 typedef struct rad__lm_refresh {
     const rad_lightmap_weights *W;
     const float *H;
+    float *V;                   /* 3 per vertex: stage 1's output */
     float *out;
     uint32_t tasks;
 } rad__lm_refresh;
 
-/* one contiguous block of texels per task: the rows are short, so a cyclic split would make
-   the tasks write the same cache lines of out */
-static void rad__lm_refresh_task(void *data, uint32_t task)
+static void rad__lm_refresh_vertices(void *data, uint32_t task)
 {
     const rad__lm_refresh *f = (const rad__lm_refresh *)data;
     const rad_lightmap_weights *W = f->W;
-    uint32_t t = (uint32_t)((uint64_t)W->texels * task / f->tasks), end = (uint32_t)((uint64_t)W->texels * (task + 1) / f->tasks);
-    for (; t < end; ++t) {
-        uint64_t a = W->row_offsets[t], b = W->row_offsets[t + 1], e;
+    uint32_t v = (uint32_t)((uint64_t)W->vertex_count * task / f->tasks);
+    uint32_t end = (uint32_t)((uint64_t)W->vertex_count * (task + 1) / f->tasks);
+    for (; v < end; ++v) {
+        uint32_t e;
         float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        if (a == b) continue;
-        for (e = a; e < b; ++e) {
-            const float *h = f->H + 3 * (size_t)W->columns[e], w = W->values[e];
+        for (e = W->vertex_first[v]; e < W->vertex_first[v + 1]; ++e) {
+            const float *h = f->H + 3 * (size_t)W->vertex_patches[e], w = W->vertex_weights[e];
             s0 += w * h[0];
             s1 += w * h[1];
             s2 += w * h[2];
         }
-        f->out[3 * (size_t)t] = s0;
-        f->out[3 * (size_t)t + 1] = s1;
-        f->out[3 * (size_t)t + 2] = s2;
+        f->V[3 * (size_t)v] = s0;
+        f->V[3 * (size_t)v + 1] = s1;
+        f->V[3 * (size_t)v + 2] = s2;
+    }
+}
+
+/* one contiguous block of rows per task: the rows are short, so a cyclic split would make
+   the tasks write the same cache lines of out */
+static void rad__lm_refresh_rows(void *data, uint32_t task)
+{
+    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
+    const rad_lightmap_weights *W = f->W;
+    const uint32_t *first = W->row_first, *ev = W->entry_vertices;
+    const float *ew = W->entry_weights, *V = f->V;
+    uint32_t r = (uint32_t)((uint64_t)W->row_count * task / f->tasks);
+    uint32_t end = (uint32_t)((uint64_t)W->row_count * (task + 1) / f->tasks);
+    for (; r < end; ++r) {
+        uint32_t e = first[r], b = first[r + 1];
+        float *o = f->out + 3 * (size_t)W->row_texels[r];
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        for (; e < b; ++e) {
+            const float *x = V + 3 * (size_t)ev[e], w = ew[e];
+            s0 += w * x[0];
+            s1 += w * x[1];
+            s2 += w * x[2];
+        }
+        o[0] = s0;
+        o[1] = s1;
+        o[2] = s2;
     }
 }
 
@@ -10645,6 +10907,7 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
 {
     rad__ctx c;
     rad__lm_refresh f;
+    uint64_t most;
     rad__ctx_init(&c, ctx);
     if (!W || !H || !out) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
@@ -10653,8 +10916,29 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
     f.W = W;
     f.H = H;
     f.out = out;
-    f.tasks = c.tasks < W->texels ? c.tasks : (W->texels ? W->texels : 1u);
-    c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_task, &f);
+    f.V = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)W->vertex_count + 1, sizeof(float));
+    if (!f.V) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: out of memory (%u vertex values)", W->vertex_count);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    /* stage 1 is small (3 entries a patch): in the calling thread unless the patches are
+       many, as a parallel region's start and join can cost more than it on busy cores */
+    most = W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN;
+    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
+    if (f.tasks < 2) {
+        f.tasks = 1;
+        rad__lm_refresh_vertices(&f, 0);
+    } else {
+        c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_vertices, &f);
+    }
+    /* stage 2: a task per block of at least RAD__LM_REFRESH_GRAIN entries */
+    most = (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u;
+    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
+    if (f.tasks < 2) {
+        f.tasks = 1;
+        rad__lm_refresh_rows(&f, 0);
+    } else c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_rows, &f);
+    rad__free(&c.allocator, f.V);
     return RAD_SUCCESS;
 }
 
@@ -12140,6 +12424,8 @@ typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_pus
                                                 offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
 typedef char rad__check_glsl_probe_update_push[(sizeof(rad_glsl_probe_update_push) == 16 &&
                                                offsetof(rad_glsl_probe_update_push, weight_base) == 12) ? 1 : -1];
+typedef char rad__check_glsl_lightmap_refresh_push[(sizeof(rad_glsl_lightmap_refresh_push) == 16 &&
+                                                   offsetof(rad_glsl_lightmap_refresh_push, entry_base) == 12) ? 1 : -1];
 typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
                                              offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
                                              offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
@@ -13321,6 +13607,66 @@ static const char rad__glsl_12_0[] =
     "    }\n"
     "}\n";
 static const char *const rad__glsl_pieces_12[] = { rad__glsl_12_0 };
+static const char rad__glsl_13_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LIGHTMAP_REFRESH: a lightmap refreshed from a new patch\n"
+    "// irradiance H, as rad_lightmap_refresh (docs/methods/lightmap.md), in its two stages:\n"
+    "//   pass 0 (RAD_GLSL_LIGHTMAP_PASS_VERTICES), one invocation per patch vertex v:\n"
+    "//     V[v] = sum over k in [vertex_first[v], vertex_first[v + 1]) of vertex_weights[k] H[vertex_patches[k]]\n"
+    "//   pass 1 (RAD_GLSL_LIGHTMAP_PASS_TEXELS), one invocation per row r (a texel with a row):\n"
+    "//     out[row_texels[r]] = sum over e in [row_first[r], row_first[r + 1]) of entry_weights[e] V[entry_vertices[e]]\n"
+    "// rows (vertices or texel rows) row_offset .. row_offset + row_count - 1. RGB vectors are\n"
+    "// interleaved (3 floats each). Pass 1 reads what pass 0 wrote into binding 4: put a\n"
+    "// compute-to-compute barrier between them. Texels without a row are not written.\n"
+    "// Chunking: the entry arrays of the pass (bindings 1 and 2, or 7 and 8) may hold only this\n"
+    "// chunk's entries: entry k is element k - entry_base. The offsets (0, 6), vectors (3, 4) and\n"
+    "// out (9) are bound whole. A pass reads none of the other pass's bindings (bind any buffer).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer VertexFirst { uint vertex_first[]; };   // vertices + 1\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer VertexPatches { uint vertex_patches[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer VertexWeights { float vertex_weights[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Irradiance { float H[]; };              // 3 N\n"
+    "layout(std430, set = 0, binding = 4) buffer VertexValues { float V[]; };                      // 3 per vertex\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowTexels { uint row_texels[]; };\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer RowFirst { uint row_first[]; };         // rows + 1\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer EntryVertices { uint entry_vertices[]; };\n"
+    "layout(std430, set = 0, binding = 8) readonly buffer EntryWeights { float entry_weights[]; };\n"
+    "layout(std430, set = 0, binding = 9) buffer Output { float lightmap[]; };                    // 3 per texel\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint pass;        // 0: vertices, 1: texel rows\n"
+    "    uint row_offset;  // first vertex or row of this dispatch\n"
+    "    uint row_count;   // vertices or rows in this dispatch\n"
+    "    uint entry_base;  // the entry index at element 0 of the pass's entry bindings\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint i = gl_GlobalInvocationID.x;\n"
+    "    if (i >= pc.row_count) return;\n"
+    "    uint r = pc.row_offset + i;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    if (pc.pass == 0u) {\n"
+    "        uint a = vertex_first[r] - pc.entry_base, b = vertex_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint k = a; k < b; ++k) {\n"
+    "            uint j = 3u * vertex_patches[k];\n"
+    "            acc += vertex_weights[k] * vec3(H[j], H[j + 1u], H[j + 2u]);\n"
+    "        }\n"
+    "        V[3u * r] = acc.x;\n"
+    "        V[3u * r + 1u] = acc.y;\n"
+    "        V[3u * r + 2u] = acc.z;\n"
+    "    } else {\n"
+    "        uint a = row_first[r] - pc.entry_base, b = row_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint e = a; e < b; ++e) {\n"
+    "            uint j = 3u * entry_vertices[e];\n"
+    "            acc += entry_weights[e] * vec3(V[j], V[j + 1u], V[j + 2u]);\n"
+    "        }\n"
+    "        uint t = 3u * row_texels[r];\n"
+    "        lightmap[t] = acc.x;\n"
+    "        lightmap[t + 1u] = acc.y;\n"
+    "        lightmap[t + 2u] = acc.z;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
@@ -13334,7 +13680,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
-    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u }
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u },
+    { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
 };
 /* >>glsl end */
 
@@ -13942,8 +14289,8 @@ static void rad__mb_apply_task(void *data, uint32_t t)
     const rad__mb_apply *a = (const rad__mb_apply *)data;
     uint32_t n = a->mb->n, i0 = (uint32_t)((uint64_t)n * t / a->tasks), i1 = (uint32_t)((uint64_t)n * (t + 1) / a->tasks), i, ch;
     size_t nn = (size_t)n * n;
-    /* plane by plane: one sequential stream at a time (interleaving the three planes' rows
-       cost the half apply 1.45x at N = 5696, see BENCHMARKS.md); every y is the same dot */
+    /* plane by plane: one sequential stream at a time (interleaved planes' rows compete for
+       the prefetchers); every y is the same dot */
     for (ch = 0; ch < 3; ++ch)
         for (i = i0; i < i1; ++i) {
             size_t at = ch * nn + (size_t)i * n;
@@ -15063,17 +15410,8 @@ static void rad__mb_bapply_task(void *data, uint32_t t)
    Block columns go in passes of RAD__MB_LUT_PASS (2.25 MiB of tables, kept in L3): per pass
    two parallel loops, the pass's tables (parallel over columns), then every block row over
    them, in tiles of RAD__MB_LUT_TILE columns (768 KiB of tables; L2 is 1 MiB here) so that a
-   tile's tables stay in L2 while a task's block rows pass over them (BENCHMARKS.md: 1.2x
-   faster than the exact palette per block). Slower alternatives measured: all tables first
-   (1.5x slower at N = 5696: 17 MB of tables written and read back through DRAM, more than
-   the 15 MB of blocks), tables per task (the work repeats in every task, 64 by default),
-   16-float entries (one cache line each), palettes looked up in tables over the endpoint
-   codes (L2 traffic), the exact palette per block times sums by code (M_0..M_3: the palette
-   was two thirds of the instructions), nibble tables small enough for L1 (twice the loads:
-   2x slower), the outliers added inside the block loop (their rows then come in permuted
-   order), a sweep down two block columns at a time with their tables in L1 and the row sums
-   in memory (2.8x slower at N = 5696: consecutive block rows are a row of blocks apart,
-   11 KiB, so every block is on another page). */
+   tile's tables stay in L2 while a task's block rows pass over them. The alternatives that
+   were measured slower are listed in docs/performance-notes.md. */
 #define RAD__MB_LUT_TILE 64u
 #define RAD__MB_LUT_PASS 192u
 #define RAD__MB_LUT_ENTRY 12u
@@ -15151,8 +15489,8 @@ static void rad__mb_bc1_task(void *data, uint32_t t)
                         const uint8_t *blk = row + 8 * (size_t)bx;
                         const uint32_t k0 = (uint32_t)blk[0] | (uint32_t)blk[1] << 8, k1 = (uint32_t)blk[2] | (uint32_t)blk[3] << 8;
                         /* the row's entry in the block's mode: 3-colour at +0, 4-colour (c0 > c1)
-                           at +6; by arithmetic, not a comparison, which gcc 12 made a branch (the
-                           encoder mixes both modes: mispredicted about half the time, 1.2x slower) */
+                           at +6; by arithmetic, not a comparison, which compilers make a branch
+                           that the encoder's mix of both modes mispredicts */
                         const float *T = lut + RAD__MB_LUT_STRIDE * (size_t)(bx - c0) + 6u * ((k1 - k0) >> 31);
                         const __m256 ep = _mm256_mul_ps(
                             _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)(k0 | k1 << 16)), ep_shift), ep_mask)),
@@ -17044,7 +17382,7 @@ RAD_API size_t rad_alias_tables_memory(const rad_alias_tables *t)
 /* 'size' bytes for a table block; *raw receives the pointer to free. On Linux, blocks of at
    least two huge pages are placed 2 MiB aligned (over-allocating 2 MiB) and their whole huge
    pages marked MADV_HUGEPAGE before first touch: a draw is a random read into hundreds of MB,
-   and with 4 KiB pages nearly every draw also misses the TLB (BENCHMARKS.md). The advice is a
+   and with 4 KiB pages nearly every draw also misses the TLB. The advice is a
    hint; its failure (kernel without THP, memory not from mmap) changes nothing. */
 static unsigned char *rad__alias_alloc(const rad_allocator *a, size_t size, void **raw)
 {
@@ -17616,8 +17954,8 @@ typedef struct rad__tstep {
 #if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
 #  define RAD__TEMPORAL_AVX2 1 /* hashes 8 draws at once (rad__tpipe_issue8) */
 #endif
-/* draws whose bins are in flight ahead of the one resolved. AVX2 issues cheaper, so more of
-   them overlap: 64 -> 128 took 4.8-5.1 to 4.2-4.5 ns per draw with 450 MB of tables (BENCHMARKS.md) */
+/* draws whose bins are in flight ahead of the one resolved; AVX2 issues cheaper, so more of
+   them can overlap */
 #ifndef RAD__TEMPORAL_AHEAD
 #  if defined(RAD__TEMPORAL_AVX2)
 #    define RAD__TEMPORAL_AHEAD 128u
@@ -17776,8 +18114,8 @@ RAD__HOT const float *rad__tpipe_take(rad__tpipe *p, uint32_t *q, uint32_t words
     rad__tpipe_issue(p, slot);
 #endif
     *q = slot + 1u == RAD__TEMPORAL_AHEAD ? 0u : slot + 1u;
-    /* written without a conditional: the test is a coin flip, and clang 14 made a branch of
-       '?:' here (mispredicted about half the time, ~2x slower than gcc's cmov) */
+    /* written without a conditional: the test is a coin flip, and a branch would mispredict
+       half the time */
     if (words == 2u) col = (e[1] >> (16u * (uint32_t)(u2 >= e[0]))) & 0xFFFFu;
     else col = e[1u + (uint32_t)(u2 >= e[0])];
     return col < n ? V + 3u * (size_t)col : env;
@@ -17848,7 +18186,7 @@ static void rad__temporal_finish(rad_temporal *t, uint32_t i, float *X)
    documented order, so the bits equal the plain loop's; the scalar work per draw is about a
    third of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
 #ifndef RAD__TVEC_AHEAD
-#  define RAD__TVEC_AHEAD 16u /* vector draws in flight: 128 draws (12, 24, 32 measured slower) */
+#  define RAD__TVEC_AHEAD 16u /* vector draws in flight: 128 draws, the measured best */
 #endif
 
 typedef struct rad__tvec {
@@ -17939,8 +18277,8 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
             const uint32_t *gb = t->tables[c]->bins;
             __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, scale;
             for (s = 0; s < k; ++s) {
-                /* the 8 bins, read before the slot is reused (scalar loads: two 64-bit gathers
-                   cost 10-20% more per draw on the machine of BENCHMARKS.md) */
+                /* the 8 bins, read before the slot is reused (scalar loads: 64-bit gathers were
+                   slower) */
                 const uint64_t *bn = p.bin + 8u * q;
                 const __m256i u2 = _mm256_loadu_si256((const __m256i *)(const void *)(p.u2 + 8u * q));
                 const __m256i glo = _mm256_set_epi64x(rad__bin64(gb, bn[3]), rad__bin64(gb, bn[2]), rad__bin64(gb, bn[1]), rad__bin64(gb, bn[0]));
@@ -18485,22 +18823,48 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
                 ray->tmin = 0.0f;
                 ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
                 b->ray_g[at + s] = 1.0f;
+                b->ray_i[at + s] = list[q].i;
+                b->ray_j[at + s] = list[q].j;
             }
             nr = K;
         }
         if (b->rc->occluded(b->rc->user, b->rays + at, nr, b->occ + at) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
         b->rays_cast[task] += nr;
-        vis = 0.0;
-        if (n <= K) {
-            for (s = 0; s < n; ++s)
-                if (!b->occ[at + s]) vis += (double)list[s].g;
-            vis /= total;
-        } else {
-            for (s = 0; s < K; ++s)
-                if (!b->occ[at + s]) vis += 1.0;
-            vis /= (double)K;
+        /* visibility per axis pair (a, c): the rays' pairs weighted by w_ia w_jc (and by G_ij
+           when every pair has its ray; drawn pairs already carry G through their
+           probability), so that axes of one voxel that see the other voxel differently (a lit
+           floor and a hidden wall) keep their own share; an axis pair no ray weighed takes the
+           voxel pair's mean */
+        {
+            double seen_w[36], all_w[36], vis_w = 0.0, all_t = 0.0;
+            uint32_t e;
+            memset(seen_w, 0, sizeof(seen_w));
+            memset(all_w, 0, sizeof(all_w));
+            for (s = 0; s < nr; ++s) {
+                const rad__vp_pair *q = n <= K ? &list[s] : NULL;
+                uint32_t qi, qj, c2;
+                double gs;
+                const float *wi, *wj;
+                if (q) qi = q->i, qj = q->j, gs = (double)q->g;
+                else qi = b->ray_i[at + s], qj = b->ray_j[at + s], gs = 1.0;
+                wi = vp->sample_weights + 6 * (size_t)qi;
+                wj = vp->sample_weights + 6 * (size_t)qj;
+                all_t += gs;
+                if (!b->occ[at + s]) vis_w += gs;
+                for (a = 0; a < 6; ++a) {
+                    if (!(wi[a] > 0.0f)) continue;
+                    for (c2 = 0; c2 < 6; ++c2) {
+                        double x = gs * (double)wi[a] * (double)wj[c2];
+                        if (!(wj[c2] > 0.0f)) continue;
+                        all_w[6 * a + c2] += x;
+                        if (!b->occ[at + s]) seen_w[6 * a + c2] += x;
+                    }
+                }
+            }
+            vis = all_t > 0.0 ? vis_w / all_t : 0.0;
+            for (e = 0; e < 36; ++e) p0[e] *= all_w[e] > 0.0 ? seen_w[e] / all_w[e] : vis;
         }
-        if (vis > 0.0) rad__vp_add_block(b, acc, u, v, p0, vis);
+        rad__vp_add_block(b, acc, u, v, p0, 1.0);
     }
     for (a = 0; a < 6; ++a) {
         uint32_t p = vp->voxel_patch[6 * (size_t)u + a], c;
@@ -18888,38 +19252,44 @@ static int rad__vp_progress_fn(void *user, float fraction)
     return p->fn(p->user, 0.1f + 0.9f * fraction);
 }
 
-static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+/* the voxels (clamped to the grid) that triangle t's bounding box overlaps: [i0, i1] per axis;
+   returns how many (0: none) */
+static uint64_t rad__vp_tri_cells(const rad_virtual_patches *vp, const float *tv, int64_t *i0, int64_t *i1)
+{
+    uint64_t n = 1;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        float mn = tv[k], mx = tv[k];
+        if (tv[3 + k] < mn) mn = tv[3 + k];
+        if (tv[6 + k] < mn) mn = tv[6 + k];
+        if (tv[3 + k] > mx) mx = tv[3 + k];
+        if (tv[6 + k] > mx) mx = tv[6 + k];
+        i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
+        i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
+        if (i0[k] < 0) i0[k] = 0;
+        if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
+        n *= (uint64_t)(i1[k] >= i0[k] ? i1[k] - i0[k] + 1 : 0);
+    }
+    return n;
+}
+
+/* BUILD step 1: the sorted distinct candidate voxels (keys) that triangle bounds overlap, and
+   per candidate and axis the exact surface area there (each triangle clipped to the voxels its
+   bounds overlap, times the split weights of its normal; the area correction of step 4) */
+static rad_result rad__vp_candidates(rad__vp_build *b, const rad__ctx *c, uint64_t **out_cand, uint32_t *out_count,
+                                     double **out_area)
 {
     rad_virtual_patches *vp = b->vp;
     const rad_scene *S = b->S;
     const rad_allocator *A = &vp->allocator;
-    uint64_t *cand = NULL, total = 0;
-    uint32_t ncand = 0, t, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
-    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL, *voxel_cand = NULL;
-    double *cand_area = NULL;
-    float *s_pos = NULL, *s_bary = NULL;
-    size_t bytes, q;
-    rad_result r = RAD_SUCCESS;
+    uint64_t *cand, total = 0;
+    double *cand_area;
+    uint32_t ncand = 0, t;
+    size_t q;
+    int64_t i0[3], i1[3], x, y, z;
     int k;
-
-    /* 1. candidate voxels from triangle bounds */
     for (t = 0; t < S->triangle_count; ++t) {
-        const float *tv = S->positions + 9 * (size_t)t;
-        uint64_t n = 1;
-        for (k = 0; k < 3; ++k) {
-            float mn = tv[k], mx = tv[k];
-            int64_t i0, i1;
-            if (tv[3 + k] < mn) mn = tv[3 + k];
-            if (tv[6 + k] < mn) mn = tv[6 + k];
-            if (tv[3 + k] > mx) mx = tv[3 + k];
-            if (tv[6 + k] > mx) mx = tv[6 + k];
-            i0 = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
-            i1 = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
-            if (i0 < 0) i0 = 0;
-            if (i1 > (int64_t)vp->dims[k] - 1) i1 = (int64_t)vp->dims[k] - 1;
-            n *= (uint64_t)(i1 >= i0 ? i1 - i0 + 1 : 0);
-        }
-        total += n;
+        total += rad__vp_tri_cells(vp, S->positions + 9 * (size_t)t, i0, i1);
         if (total > 0xFFFFFFF0u) {
             rad__log(c, RAD_LOG_ERROR, "virtual patches: triangles overlap more than 2^32 voxels (use bigger voxels)");
             return RAD_ERROR_SIZE_OVERFLOW;
@@ -18928,19 +19298,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     cand = (uint64_t *)rad__alloc_array(A, (size_t)total, sizeof(uint64_t));
     if (!cand) return RAD_ERROR_OUT_OF_MEMORY;
     for (t = 0, q = 0; t < S->triangle_count; ++t) {
-        const float *tv = S->positions + 9 * (size_t)t;
-        int64_t i0[3], i1[3], x, y, z;
-        for (k = 0; k < 3; ++k) {
-            float mn = tv[k], mx = tv[k];
-            if (tv[3 + k] < mn) mn = tv[3 + k];
-            if (tv[6 + k] < mn) mn = tv[6 + k];
-            if (tv[3 + k] > mx) mx = tv[3 + k];
-            if (tv[6 + k] > mx) mx = tv[6 + k];
-            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
-            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
-            if (i0[k] < 0) i0[k] = 0;
-            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
-        }
+        (void)rad__vp_tri_cells(vp, S->positions + 9 * (size_t)t, i0, i1);
         for (z = i0[2]; z <= i1[2]; ++z)
             for (y = i0[1]; y <= i1[1]; ++y)
                 for (x = i0[0]; x <= i1[0]; ++x)
@@ -18949,30 +19307,17 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     qsort(cand, (size_t)total, sizeof(uint64_t), rad__vp_cmp_u64);
     for (q = 0; q < (size_t)total; ++q)
         if (q == 0 || cand[q] != cand[q - 1]) cand[ncand++] = cand[q];
-    vp->candidate_voxels = ncand;
-    b->cand = cand;
-
-    /* exact surface area per candidate voxel and axis: each triangle clipped to the voxels its
-       bounds overlap, times the split weights of its normal */
     cand_area = (double *)rad__alloc_array(A, ncand, 6 * sizeof(double));
-    if (!cand_area) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    if (!cand_area) {
+        rad__free(A, cand);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
     memset(cand_area, 0, sizeof(double) * 6u * ncand);
     for (t = 0; t < S->triangle_count; ++t) {
         const float *tv = S->positions + 9 * (size_t)t;
-        int64_t i0[3], i1[3], x, y, z;
         float wt[6];
+        int one = rad__vp_tri_cells(vp, tv, i0, i1) == 1u;
         rad__vp_weights(b->o.weights, S->normals + 3 * (size_t)t, wt);
-        for (k = 0; k < 3; ++k) {
-            float mn = tv[k], mx = tv[k];
-            if (tv[3 + k] < mn) mn = tv[3 + k];
-            if (tv[6 + k] < mn) mn = tv[6 + k];
-            if (tv[3 + k] > mx) mx = tv[3 + k];
-            if (tv[6 + k] > mx) mx = tv[6 + k];
-            i0[k] = (int64_t)floor((double)(mn - vp->origin[k]) / (double)vp->voxel_size[k]);
-            i1[k] = (int64_t)floor((double)(mx - vp->origin[k]) / (double)vp->voxel_size[k]);
-            if (i0[k] < 0) i0[k] = 0;
-            if (i1[k] > (int64_t)vp->dims[k] - 1) i1[k] = (int64_t)vp->dims[k] - 1;
-        }
         for (z = i0[2]; z <= i1[2]; ++z)
             for (y = i0[1]; y <= i1[1]; ++y)
                 for (x = i0[0]; x <= i1[0]; ++x) {
@@ -18986,7 +19331,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
                         hi[k] = lo[k] + (double)vp->voxel_size[k];
                     }
                     /* a triangle inside one voxel needs no clipping */
-                    ar = (i0[0] == i1[0] && i0[1] == i1[1] && i0[2] == i1[2]) ? (double)S->areas[t] : rad__vp_clip_area(tv, lo, hi);
+                    ar = one ? (double)S->areas[t] : rad__vp_clip_area(tv, lo, hi);
                     if (!(ar > 0.0)) continue;
                     while (lo_i < hi_i) {
                         uint32_t mid = lo_i + (hi_i - lo_i) / 2;
@@ -18996,6 +19341,100 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
                     for (k = 0; k < 6; ++k) cand_area[6 * (size_t)lo_i + k] += ar * (double)wt[k];
                 }
     }
+    *out_cand = cand;
+    *out_count = ncand;
+    *out_area = cand_area;
+    return RAD_SUCCESS;
+}
+
+/* BUILD steps 5 and 6: the form factors into vp->matrix (dense: 'bytes' of N x N floats; sparse
+   rows: chunks of row voxels), with the task scratch in b (freed by the caller) */
+static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size_t bytes)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_allocator *A = &vp->allocator;
+    uint32_t N = vp->count, v, i;
+    rad_result r;
+    uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
+    /* sparse rows: the rows of a chunk of row voxels at a time (at least one voxel's six,
+       else at most RAD_VP_ROW_CHUNK_BYTES), never N x N */
+    size_t budget = (size_t)RAD_VP_ROW_CHUNK_BYTES;
+    if (b->o.storage == RAD_STORAGE_SPARSE) {
+        uint32_t most = 0;
+        for (v = 0; v < vp->voxel_count; ++v)
+            if (vp->voxel_first[v + 1] - vp->voxel_first[v] > most) most = vp->voxel_first[v + 1] - vp->voxel_first[v];
+        if (budget < (size_t)most * N * sizeof(float)) budget = (size_t)most * N * sizeof(float);
+        if (budget < bytes) bytes = budget;
+    }
+    b->P = (float *)rad__alloc(A, bytes);
+    if (!b->P) return RAD_ERROR_OUT_OF_MEMORY;
+    if (b->o.storage != RAD_STORAGE_SPARSE) {
+        vp->matrix.rows = vp->matrix.cols = N;
+        vp->matrix.storage = RAD_STORAGE_DENSE;
+        vp->matrix.dense = b->P; /* owned by vp from here on */
+    }
+    rad__ctx cc = *c;
+    rad__vp_progress prog;
+    prog.fn = c->progress;
+    prog.user = c->progress_user;
+    if (c->progress) {
+        cc.progress = rad__vp_progress_fn;
+        cc.progress_user = &prog;
+    }
+    b->occ = (uint8_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, 1);
+    b->ray_i = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    b->ray_j = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    b->ray_g = (float *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(float));
+    b->rays_cast = (uint64_t *)rad__alloc_array(A, T, sizeof(uint64_t));
+    b->acc = (double *)rad__alloc_array(A, (size_t)T * 6u, (size_t)N * sizeof(double));
+    b->rowf = (float *)rad__alloc_array(A, N, sizeof(float));
+    if (b->o.visibility_rays > 0 && !b->o.skip_visibility)
+        b->pairs = (rad__vp_pair *)rad__alloc_array(A, (size_t)T * RAD__VP_PAIRS, sizeof(rad__vp_pair));
+    if (!b->occ || !b->ray_i || !b->ray_j || !b->ray_g || !b->rays_cast || !b->acc || !b->rowf ||
+        (b->o.visibility_rays > 0 && !b->o.skip_visibility && !b->pairs)) {
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(b->rays_cast, 0, sizeof(uint64_t) * T);
+    /* progress of this stage maps to [0.1, 1] */
+    if (c->progress && c->progress(c->progress_user, 0.1f)) return RAD_ERROR_CANCELLED;
+    if (b->o.storage == RAD_STORAGE_SPARSE) {
+        r = rad__vp_sparse_rows(b, c, T, budget);
+        for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+        return r;
+    }
+    r = rad__for_rows(&cc, vp->voxel_count, T, b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled : rad__vp_ff_row, b);
+    for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
+    if (r == RAD_SUCCESS) {
+        cc.progress = NULL;
+        r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
+        if (r == RAD_SUCCESS && !b->o.keep_row_sums) r = rad__for_rows(&cc, N, T, rad__vp_rowsum_row, b);
+        else if (r == RAD_SUCCESS)
+            for (i = 0; i < N; ++i) b->rowf[i] = 1.0f;
+        if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
+    }
+    if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
+    return r;
+}
+
+static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_scene *S = b->S;
+    const rad_allocator *A = &vp->allocator;
+    uint64_t *cand = NULL;
+    uint32_t ncand = 0, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
+    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL, *voxel_cand = NULL;
+    double *cand_area = NULL;
+    float *s_pos = NULL, *s_bary = NULL;
+    size_t bytes;
+    rad_result r = RAD_SUCCESS;
+    int k;
+
+    /* 1. candidate voxels and their exact areas */
+    r = rad__vp_candidates(b, c, &cand, &ncand, &cand_area);
+    if (r != RAD_SUCCESS) return r;
+    vp->candidate_voxels = ncand;
+    b->cand = cand;
 
     /* 2. face rays, chunk by chunk; samples appended in voxel order */
     chunk = RAD__VP_CHUNK_RAYS / (6u * P);
@@ -19215,67 +19654,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     b->cand = NULL;
     rad__free(A, cand_first);
     cand_first = NULL;
-    {
-        uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count;
-        /* sparse rows: the rows of a chunk of row voxels at a time (at least one voxel's six,
-           else at most RAD_VP_ROW_CHUNK_BYTES), never N x N */
-        size_t budget = (size_t)RAD_VP_ROW_CHUNK_BYTES;
-        if (b->o.storage == RAD_STORAGE_SPARSE) {
-            uint32_t most = 0;
-            for (v = 0; v < vp->voxel_count; ++v)
-                if (vp->voxel_first[v + 1] - vp->voxel_first[v] > most) most = vp->voxel_first[v + 1] - vp->voxel_first[v];
-            if (budget < (size_t)most * N * sizeof(float)) budget = (size_t)most * N * sizeof(float);
-            if (budget < bytes) bytes = budget;
-        }
-        b->P = (float *)rad__alloc(A, bytes);
-        if (!b->P) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-        if (b->o.storage != RAD_STORAGE_SPARSE) {
-            vp->matrix.rows = vp->matrix.cols = N;
-            vp->matrix.storage = RAD_STORAGE_DENSE;
-            vp->matrix.dense = b->P; /* owned by vp from here on */
-        }
-        rad__ctx cc = *c;
-        rad__vp_progress prog;
-        prog.fn = c->progress;
-        prog.user = c->progress_user;
-        if (c->progress) {
-            cc.progress = rad__vp_progress_fn;
-            cc.progress_user = &prog;
-        }
-        b->occ = (uint8_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, 1);
-        b->ray_i = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-        b->ray_j = (uint32_t *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-        b->ray_g = (float *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(float));
-        b->rays_cast = (uint64_t *)rad__alloc_array(A, T, sizeof(uint64_t));
-        b->acc = (double *)rad__alloc_array(A, (size_t)T * 6u, (size_t)N * sizeof(double));
-        b->rowf = (float *)rad__alloc_array(A, N, sizeof(float));
-        if (b->o.visibility_rays > 0 && !b->o.skip_visibility)
-            b->pairs = (rad__vp_pair *)rad__alloc_array(A, (size_t)T * RAD__VP_PAIRS, sizeof(rad__vp_pair));
-        if (!b->occ || !b->ray_i || !b->ray_j || !b->ray_g || !b->rays_cast || !b->acc || !b->rowf ||
-            (b->o.visibility_rays > 0 && !b->o.skip_visibility && !b->pairs)) {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-            goto done;
-        }
-        memset(b->rays_cast, 0, sizeof(uint64_t) * T);
-        /* progress of this stage maps to [0.1, 1] */
-        if (c->progress && c->progress(c->progress_user, 0.1f)) { r = RAD_ERROR_CANCELLED; goto done; }
-        if (b->o.storage == RAD_STORAGE_SPARSE) {
-            r = rad__vp_sparse_rows(b, c, T, budget);
-            for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
-            goto done;
-        }
-        r = rad__for_rows(&cc, vp->voxel_count, T, b->o.visibility_rays > 0 ? rad__vp_ff_row_sampled : rad__vp_ff_row, b);
-        for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
-        if (r == RAD_SUCCESS) {
-            cc.progress = NULL;
-            r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
-            if (r == RAD_SUCCESS && !b->o.keep_row_sums) r = rad__for_rows(&cc, N, T, rad__vp_rowsum_row, b);
-            else if (r == RAD_SUCCESS)
-                for (i = 0; i < N; ++i) b->rowf[i] = 1.0f;
-            if (r == RAD_SUCCESS) r = rad__for_rows(&cc, N, T, rad__vp_divide_row, b);
-        }
-        if (r == RAD_SUCCESS) r = rad__check_output(c, "virtual-patch form factors", vp->matrix.dense, (size_t)N * N);
-    }
+    r = rad__vp_form_factors(b, c, bytes);
 done:
     if (b->o.storage == RAD_STORAGE_SPARSE) rad__free(A, b->P); /* the chunk buffer (NULL once used) */
     rad__free(A, cand);
@@ -19879,6 +20258,7 @@ struct rad_probes {
     float *weights;            /* 9 per entry */
     size_t entries;
     int grid;
+    int plain;                 /* RAD_PROBE_WEIGHT_PLAIN: no normal factor in sampling */
     uint32_t dims[3];
     float origin[3], spacing, h2;
     float eps;                 /* ray offset (ray_epsilon x the scene diagonal) */
@@ -20337,6 +20717,10 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         rad__log(&c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)b.o.backface_fraction);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (b.o.weighting != RAD_PROBE_WEIGHT_NORMAL && b.o.weighting != RAD_PROBE_WEIGHT_PLAIN) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)b.o.weighting);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (!(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon,
                  (double)RAD__MAX_RAY_EPSILON);
@@ -20409,6 +20793,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
             pr->origin[k] = 0.5f * (S->bounds_min[k] + S->bounds_max[k]) - 0.5f * (float)(pr->dims[k] - 1u) * spacing;
         pr->count = pr->dims[0] * pr->dims[1] * pr->dims[2];
     }
+    pr->plain = b.o.weighting == RAD_PROBE_WEIGHT_PLAIN;
     pr->positions = (float *)rad__alloc_array(&c.allocator, pr->count, 3 * sizeof(float));
     pr->states = (uint8_t *)rad__alloc_array(&c.allocator, pr->count, 1);
     pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
@@ -20567,7 +20952,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
                     rad__sub(d, pr->positions + 3 * (size_t)i, p);
                     len = rad__len(d);
                     cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
-                    w *= 0.25f * (1.0f + cs) * (1.0f + cs);
+                    if (!pr->plain) w *= 0.25f * (1.0f + cs) * (1.0f + cs);
                     if (!(w > 0.0f)) continue;
                     vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
                     if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
@@ -20583,7 +20968,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             rad__sub(d, pr->positions + 3 * (size_t)i, p);
             len2 = rad__dot(d, d);
             cs = len2 > 0.0f ? rad__dot(d, un) / (float)sqrt((double)len2) : 1.0f;
-            w = 0.25f * (1.0f + cs) * (1.0f + cs) / (len2 + pr->h2);
+            w = (pr->plain ? 1.0f : 0.25f * (1.0f + cs) * (1.0f + cs)) / (len2 + pr->h2);
             if (!(w > 0.0f)) continue;
             vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
             if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;

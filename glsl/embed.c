@@ -34,6 +34,7 @@ static const kernel kernels[] = {
     { "RAD_GLSL_LOCAL_UPDATE", "glsl/local_update.comp" },
     { "RAD_GLSL_VP_GATHER", "glsl/vp_gather.comp" },
     { "RAD_GLSL_PROBE_UPDATE", "glsl/probe_update.comp" },
+    { "RAD_GLSL_LIGHTMAP_REFRESH", "glsl/lightmap_refresh.comp" },
 };
 #define KERNELS (sizeof(kernels) / sizeof(kernels[0]))
 

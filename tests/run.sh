@@ -104,6 +104,7 @@ vk_ready || try_install mesa-vulkan-drivers libvulkan-dev glslang-tools
 [ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ] || try_install vulkan-validationlayers
 have spirv-val || try_install spirv-tools
 { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
+[ -f /usr/include/tinyexr.h ] || try_install libtinyexr-dev
 have clang || try_install clang libclang-rt-14-dev
 have valgrind || try_install valgrind
 { have mpicc && have mpirun; } || try_install libopenmpi-dev openmpi-bin
@@ -285,14 +286,16 @@ s_vulkan() {
     fi
 }
 
-# ---- the rad tool (needs assimp and stb)
+# ---- the rad tool (needs assimp and stb; OpenEXR output with tinyexr when installed)
+TOOL_EXR=""; TOOL_EXR_LIB=""
+[ -f /usr/include/tinyexr.h ] && { TOOL_EXR="-DRAD_TOOL_EXR"; TOOL_EXR_LIB="-ltinyexr"; }
 have_tool_deps() { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; }
 s_tool() {
     if ! have_tool_deps; then
         skip tool-suites "assimp or stb is not installed (packages libassimp-dev libstb-dev)"
         return
     fi
-    if ! build tool-rad $CC -std=c99 $WARN -O2 $OMP -I. tools/*.c -o "$BUILD/rad" -lassimp -lm; then
+    if ! build tool-rad $CC -std=c99 $WARN -O2 $OMP $TOOL_EXR -I. tools/*.c -o "$BUILD/rad" -lassimp $TOOL_EXR_LIB -lm; then
         fail tool-build; return
     fi
     pass tool-build
@@ -317,7 +320,7 @@ s_tool() {
 # image written (tools/report.sh --check); its own build of the tool so it can run beside s_tool
 s_report() {
     have_tool_deps || return 0
-    if build report-rad $CC -std=c99 $WARN -O2 $OMP -I. tools/*.c -o "$BUILD/rad-report" -lassimp -lm &&
+    if build report-rad $CC -std=c99 $WARN -O2 $OMP $TOOL_EXR -I. tools/*.c -o "$BUILD/rad-report" -lassimp $TOOL_EXR_LIB -lm &&
        build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
        bash tools/report.sh --quick --out "$BUILD/report-quick" \
            --rad "$BUILD/rad-report" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
@@ -333,16 +336,16 @@ s_dist() {
     local o="$BUILD/dist-obj" f mpi="" out nf ns
     mkdir -p "$o"
     for f in tools/*.c; do
-        build "dist-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP -I. -c "$f" -o "$o/$(basename "$f" .c).o" ||
+        build "dist-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP $TOOL_EXR -I. -c "$f" -o "$o/$(basename "$f" .c).o" ||
             { fail "dist (build $f)"; return; }
     done
-    if ! build dist-rad $CC $OMP "$o"/*.o -o "$BUILD/rad-dist" -lassimp -lm ||
+    if ! build dist-rad $CC $OMP "$o"/*.o -o "$BUILD/rad-dist" -lassimp $TOOL_EXR_LIB -lm ||
        ! build dist-part-edit $CC -std=c99 $WARN -O2 -I. tests/dist_part_edit.c -o "$BUILD/dist_part_edit" -lm; then
         fail "dist (build)"; return
     fi
     if have mpicc && have mpirun; then
         if build rad-mpi mpicc -std=c99 $WARN -O2 $OMP -I. tools/mpi/rad_mpi.c $(ls "$o"/*.o | grep -v '/main\.o$') \
-               -o "$BUILD/rad-mpi" -lassimp -lm; then
+               -o "$BUILD/rad-mpi" -lassimp $TOOL_EXR_LIB -lm; then
             mpi="$BUILD/rad-mpi"
         else
             fail "rad-mpi (build)"

@@ -563,6 +563,9 @@ static void pb_test_bad_options(void)
     o.spacing = 1e-5f;
     CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, NULL, NULL, &pr), RAD_ERROR_SIZE_OVERFLOW);
     rad_probe_options_default(&o);
+    o.weighting = (rad_probe_weighting)2;
+    CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
+    rad_probe_options_default(&o);
     o.ray_epsilon = 0.5f;
     CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
     rad_probe_options_default(&o);
@@ -629,6 +632,65 @@ static void pb_test_alloc(void)
     pb_cornell_free(&f);
 }
 
+/* Sampling in open air: points on a sphere in the middle of the Cornell box, the grid read
+   with the default normal weighting and with RAD_PROBE_WEIGHT_PLAIN, against the independent
+   indirect irradiance at each point. The normal factor leans every point towards the probes
+   its normal faces, away from the point itself: plain trilinear weights are closer there,
+   and reproduce a probe's own value at its position for any normal */
+static void pb_test_plain_weighting(void)
+{
+    static const float centre[3] = { 0.15f, 0.35f, 0.15f };
+    pb_cornell f;
+    rad_probe_options o;
+    rad_probes *pn = NULL, *pp = NULL;
+    double en = 0.0, ep = 0.0;
+    int i, c, K = rad_test_quick() ? 12 : 24;
+    if (!pb_cornell_init(&f, 100)) { CHECK(0); pb_cornell_free(&f); return; }
+    rad_probe_options_default(&o);
+    o.spacing = 0.1f;
+    o.rays = 64;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, NULL, &pn));
+    o.weighting = RAD_PROBE_WEIGHT_PLAIN;
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, NULL, &pp));
+    if (pn && pp) {
+        for (i = 0; i < K; ++i) {
+            float n[3], p[3], r[3], a[3], b[3];
+            double z = 1.0 - (2.0 * i + 1.0) / K, rr = sqrt(1.0 - z * z), ph = i * 2.39996322972865332;
+            n[0] = (float)(rr * cos(ph)); n[1] = (float)(rr * sin(ph)); n[2] = (float)z;
+            for (c = 0; c < 3; ++c) p[c] = centre[c] + 0.05f * n[c];
+            pb_reference(&f, p, n, 4096, 0, r);
+            CHECK_OK(rad_probes_sample(pn, p, n, a));
+            CHECK_OK(rad_probes_sample(pp, p, n, b));
+            for (c = 0; c < 3; ++c) {
+                en += fabs(a[c] - r[c]) / r[c];
+                ep += fabs(b[c] - r[c]) / r[c];
+            }
+        }
+        en /= 3 * K;
+        ep /= 3 * K;
+        if (rad_test_failures || getenv("RAD_TEST_VERBOSE"))
+            printf("    open air: mean relative error %.4f with the normal factor, %.4f plain\n", en, ep);
+        CHECK(ep < en);
+        CHECK(ep < 0.05);
+        {
+            /* at a valid probe, any normal: that probe's own irradiance */
+            uint32_t dims[3], id;
+            float org[3], sp, q[3], m[3] = { -0.6f, 0.0f, 0.8f }, e[3], a[3];
+            CHECK(rad_probes_grid(pp, dims, org, &sp) == 1);
+            id = 2 + dims[0] * (2 + dims[1] * 2);
+            for (c = 0; c < 3; ++c) q[c] = rad_probes_positions(pp)[3 * id + c];
+            if (rad_probes_states(pp)[id] == RAD_PROBE_VALID) {
+                CHECK_OK(rad_probes_sample(pp, q, m, e));
+                rad_sh9_irradiance(rad_probes_coefficients(pp) + 27 * id, m, a);
+                for (c = 0; c < 3; ++c) CHECK_REL(e[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-5);
+            }
+        }
+    }
+    rad_probes_destroy(pn);
+    rad_probes_destroy(pp);
+    pb_cornell_free(&f);
+}
+
 static const rad_test_case tests_probes[] = {
     { "probes_sh_projection", pb_test_sh_projection },
     { "probes_cornell_reference", pb_test_cornell_reference },
@@ -636,6 +698,7 @@ static const rad_test_case tests_probes[] = {
     { "probes_constant_room", pb_test_constant_room },
     { "probes_sampling_update", pb_test_sampling_update },
     { "probes_lights", pb_test_lights },
+    { "probes_plain_weighting", pb_test_plain_weighting },
     { "probes_bad_options", pb_test_bad_options },
     { "probes_alloc", pb_test_alloc },
     { NULL, NULL }

@@ -45,7 +45,9 @@ static void vp_peak_free(void *user, void *ptr)
 }
 
 /* Up to 8 axis-aligned quads, each cut into an n x n grid of triangle pairs. */
-#define VP_MAX_QUADS 8
+#define VP_MAX_QUADS 10
+/* the thin-wall leak of vp_partition: the most the dark room may get, as a multiple of classic */
+#define VP_PARTITION_LEAK 1.7
 typedef struct vp_scene {
     float pos[VP_MAX_QUADS][3 * 41 * 41];
     uint32_t idx[VP_MAX_QUADS][6 * 40 * 40];
@@ -598,6 +600,177 @@ static void vp_test_sampled_visibility(void)
     rad_scene_destroy(scene);
 }
 
+/* ---- a thin partition inside a voxel ------------------------------------------------------- */
+
+/* The room [0,4] x [0,2] x [0,2] split at x = 2 by a wall 0.02 thick whose two faces (one per
+   room) lie inside one column of voxels, with a doorway below y = 0.6; a point light in the
+   left room, so the right room gets only light through the doorway. Axes of one voxel then
+   see a voxel across the room very differently (the partition's lit face, its dark back, the
+   floor under the doorway) and the voxels that straddle the wall carry light across it
+   (docs/performance-notes.md, "Light lost on real geometry"). */
+static void vp_partition_scene(vp_scene *s)
+{
+    float o1[3] = { 1.99f, 0.6f, 0.0f }, o2[3] = { 2.01f, 0.6f, 0.0f }, Y[3] = { 0.0f, 1.4f, 0.0f }, Z[3] = { 0.0f, 0.0f, 2.0f };
+    vp_box(s, 4.0f, 2.0f, 2.0f, 8, 0);
+    vp_add_quad(s, o1, Z, Y, 0, 4); /* normal -x: the left room's face */
+    vp_add_quad(s, o2, Y, Z, 0, 4); /* normal +x: the right room's face */
+}
+
+/* visibility per axis pair against one ray per sample pair (visibility_rays 0, the literal
+   sum), by the relative RMS difference of the blocks P = A F: with a ray for every pair
+   (visibility_rays above any voxel pair's count) the two are the same sums, which one V_uv
+   shared by all axis pairs of two voxels missed whatever the ray count (a bias); with 32 rays
+   per voxel pair the bound is one the shared V_uv failed (docs/performance-notes.md) */
+static void vp_test_axis_visibility(void)
+{
+    static vp_scene s;
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options o;
+    rad_virtual_patches *ve = NULL;
+    uint32_t K[2] = { 1024, 32 }, t;
+    double tol[2] = { 1e-5, 0.045 };
+    vp_partition_scene(&s);
+    vp_desc(&s, &desc, 0.6f, 0.0f);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    rad_vp_options_default(&o);
+    o.resolution = 6;
+    o.face_points = 4;
+    o.visibility_rays = 0;
+    CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &ve));
+    for (t = 0; t < 2 && ve; ++t) {
+        rad_virtual_patches *vs = NULL;
+        o.visibility_rays = K[t];
+        CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vs));
+        if (vs && ve->count == vs->count) {
+            uint32_t N = vs->count, a, b;
+            double num = 0.0, den = 0.0;
+            for (a = 0; a < N; ++a)
+                for (b = 0; b < N; ++b) {
+                    double x = (double)vs->areas[a] * vs->matrix.dense[(size_t)a * N + b];
+                    double y = (double)ve->areas[a] * ve->matrix.dense[(size_t)a * N + b];
+                    num += (x - y) * (x - y);
+                    den += y * y;
+                }
+            printf("    %u patches, %u rays per voxel pair: %llu rays (literal %llu), relative RMS difference of A F %.4f\n", N,
+                   K[t], (unsigned long long)vs->pair_rays, (unsigned long long)ve->pair_rays, sqrt(num / den));
+            CHECK(sqrt(num / den) < tol[t]);
+        } else CHECK(0);
+        rad_vp_destroy(vs);
+    }
+    rad_vp_destroy(ve);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
+/* the light that reaches the dark room through the doorway: AAVP against classic radiosity
+   with visibility on ~600 patches (both the indirect light L, gathered at the classic patches) */
+static void vp_test_partition(void)
+{
+    static vp_scene s;
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_vp_options o;
+    rad_virtual_patches *vp = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL;
+    rad_direct_options dopt;
+    rad_light light;
+    rad_system sys;
+    rad_solve_options so;
+    float *Ec = NULL, *Lc = NULL, *Dc = NULL, *Ev = NULL, *Lv = NULL, *pts = NULL, *nrm = NULL, *g = NULL;
+    double dark_c = 0.0, dark_v = 0.0, lit_c = 0.0, lit_v = 0.0, dark_p = 0.0;
+    uint32_t i, n;
+    int k;
+    vp_partition_scene(&s);
+    vp_desc(&s, &desc, 0.7f, 0.0f);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    memset(&light, 0, sizeof(light));
+    light.type = RAD_LIGHT_POINT;
+    light.color[0] = light.color[1] = light.color[2] = 1.0f;
+    light.position[0] = 1.0f; light.position[1] = 1.6f; light.position[2] = 1.0f;
+    rad_direct_options_default(&dopt);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    so.bounces = 40;
+    rad_patch_options_default(&po);
+    po.target_count = rad_test_quick() ? 400 : 900;
+    CHECK_OK(rad_patches_create(scene, &po, NULL, &P));
+    rad_form_factor_options_default(&fo);
+    fo.samples = 4;
+    CHECK_OK(rad_form_factors_dense(P, &rc, &fo, NULL, &ff));
+    if (!P || !ff) goto out;
+    n = P->count;
+    Ec = (float *)malloc(sizeof(float) * 3 * n);
+    Lc = (float *)malloc(sizeof(float) * 3 * n);
+    Dc = (float *)malloc(sizeof(float) * 3 * n);
+    pts = (float *)malloc(sizeof(float) * 3 * n);
+    nrm = (float *)malloc(sizeof(float) * 3 * n);
+    g = (float *)malloc(sizeof(float) * 3 * n);
+    if (!Ec || !Lc || !Dc || !pts || !nrm || !g) goto out;
+    CHECK_OK(rad_direct_patches(P, &rc, &light, 1, &dopt, Dc, NULL));
+    CHECK_OK(rad_sources(P, RAD_SOURCE_DIRECT, Dc, Ec));
+    rad_system_init(&sys, &ff->matrix, P, Ec);
+    CHECK_OK(rad_solve_jacobi(&sys, &so, Lc, NULL, NULL));
+    rad_vp_options_default(&o);
+    o.resolution = 6;
+    o.face_points = 16;
+    CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+    if (!vp) goto out;
+    Ev = (float *)malloc(sizeof(float) * 3 * vp->count);
+    Lv = (float *)malloc(sizeof(float) * 3 * vp->count);
+    if (!Ev || !Lv) goto out;
+    CHECK_OK(rad_vp_sources(vp, &rc, &light, 1, &dopt, RAD_SOURCE_DIRECT, Ev, NULL));
+    rad_vp_system(&sys, vp, Ev);
+    CHECK_OK(rad_solve_jacobi(&sys, &so, Lv, NULL, NULL));
+    for (i = 0; i < n; ++i)
+        for (k = 0; k < 3; ++k) {
+            pts[3 * i + k] = P->patches[i].centroid[k];
+            nrm[3 * i + k] = P->patches[i].normal[k];
+        }
+    CHECK_OK(rad_vp_gather(vp, Lv, pts, nrm, n, g, NULL));
+    for (i = 0; i < n; ++i) {
+        int dark = P->patches[i].centroid[0] > 2.0f;
+        *(dark ? &dark_c : &lit_c) += P->patches[i].area * (double)Lc[3 * i];
+        *(dark ? &dark_v : &lit_v) += P->patches[i].area * (double)g[3 * i];
+    }
+    /* the same split on the patches themselves, each patch's power shared by its samples'
+       weights (what the proxy holds, before any gathering) */
+    for (i = 0; i < vp->count; ++i) {
+        uint32_t v = vp->voxel[i], a = vp->axis[i], q;
+        double dark = 0.0, all = 0.0;
+        for (q = vp->sample_first[v]; q < vp->sample_first[v + 1]; ++q) {
+            double w = (double)vp->sample_weights[6 * (size_t)q + a] * vp->sample_areas[q];
+            all += w;
+            if (vp->sample_positions[3 * (size_t)q] > 2.0f) dark += w;
+        }
+        if (all > 0.0) dark_p += vp->areas[i] * (double)Lv[3 * i] * dark / all;
+    }
+    printf("    classic %u patches, AAVP %u: indirect power lit room %.5f vs %.5f (%.3f), dark room %.5f vs %.5f (%.3f; "
+           "on the patches %.3f)\n", n, vp->count, lit_v, lit_c, lit_v / lit_c, dark_v, dark_c, dark_v / dark_c, dark_p / dark_c);
+    /* the totals agree; the dark room's excess is the light that voxels straddling the wall
+       carry across it (a known leak, measured in docs/performance-notes.md) */
+    CHECK_REL(lit_v + dark_v, lit_c + dark_c, 0.1);
+    CHECK(dark_v > dark_c * 0.9 && dark_v < dark_c * VP_PARTITION_LEAK);
+out:
+    free(Ec); free(Lc); free(Dc); free(Ev); free(Lv); free(pts); free(nrm); free(g);
+    rad_form_factors_destroy(ff);
+    rad_patches_destroy(P);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 /* ---- argument checks ----------------------------------------------------------------------- */
 
 static void vp_test_arguments(void)
@@ -953,6 +1126,8 @@ static const rad_test_case tests_vp[] = {
     { "vp_memory", vp_test_memory },
     { "vp_sampled_visibility", vp_test_sampled_visibility },
     { "vp_classic", vp_test_classic },
+    { "vp_axis_visibility", vp_test_axis_visibility },
+    { "vp_partition", vp_test_partition },
     { "vp_continuity", vp_test_continuity },
     { "vp_arguments", vp_test_arguments },
     { "vp_robustness", vp_test_robustness },

@@ -1453,6 +1453,128 @@ done:
     rad_scene_destroy(S);
 }
 
+/* ---- lightmaps: the refresh from a new patch irradiance ---------------------------------------- */
+
+/* RAD_GLSL_LIGHTMAP_REFRESH against rad_lightmap_refresh: the Cornell box with one atlas cell per
+   quad (as bench/lightmap.c), weights with detail factors from a first refresh, a random patch
+   irradiance; both passes in three chunks whose entry ranges are bound at offsets */
+static void test_lightmap_refresh(void)
+{
+    static rad_mesh_desc meshes[16];
+    static float luv[16][2 * 20];
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_lightmap_options lo;
+    rad_lightmap *lm = NULL;
+    rad_lightmap_weights *w0 = NULL, *w = NULL;
+    float *H = NULL, *base = NULL, *cpu = NULL;
+    uint32_t i, m, q, cell = 0, cut[4], s, texels;
+    const uint32_t size = 64, cells = 6;
+    g_worst_what = "relative error of the texels";
+    rad_cornell_box(&d, NULL);
+    memcpy(meshes, d.meshes, sizeof(rad_mesh_desc) * d.mesh_count);
+    for (m = 0; m < d.mesh_count; ++m) {
+        for (q = 0; q < meshes[m].vertex_count / 4; ++q, ++cell) {
+            static const float cu[4] = { 0, 1, 1, 0 }, cv[4] = { 0, 0, 1, 1 };
+            float x0 = (float)(cell % cells) / cells, y0 = (float)(cell / cells) / cells, g = 1.0f / size, e = 1.0f / cells - 2.0f * g;
+            for (i = 0; i < 4; ++i) { luv[m][8 * q + 2 * i] = x0 + g + e * cu[i]; luv[m][8 * q + 2 * i + 1] = y0 + g + e * cv[i]; }
+        }
+        meshes[m].lightmap_uvs = luv[m];
+    }
+    d.meshes = meshes;
+    rad_patch_options_default(&po);
+    po.target_count = 150;
+    if (rad_scene_create(&d, NULL, &S) != RAD_SUCCESS || rad_patches_create(S, &po, NULL, &P) != RAD_SUCCESS ||
+        rad_bvh_create(S, NULL, &bvh) != RAD_SUCCESS) { T_CHECK(0); goto done; }
+    rad_bvh_raycaster(bvh, &rc);
+    rad_lightmap_options_default(&lo);
+    lo.width = lo.height = size;
+    lo.validity_rays = 4;
+    if (rad_lightmap_create(S, &rc, &lo, NULL, &lm) != RAD_SUCCESS) { T_CHECK(0); goto done; }
+    texels = size * size;
+    H = (float *)malloc(3 * (size_t)P->count * 4);
+    base = (float *)calloc(3 * (size_t)texels, 4);
+    cpu = (float *)calloc(3 * (size_t)texels, 4);
+    if (!H || !base || !cpu) { T_CHECK(0); goto done; }
+    /* detail factors that differ from 1: a "bake" from a first irradiance, then a second one */
+    for (i = 0; i < 3 * P->count; ++i) H[i] = 0.2f + frand();
+    if (rad_lightmap_weights_create(lm, P, NULL, NULL, NULL, &w0) != RAD_SUCCESS ||
+        rad_lightmap_refresh(w0, H, base, NULL) != RAD_SUCCESS) { T_CHECK(0); goto done; }
+    for (i = 0; i < 3 * texels; ++i) base[i] *= 0.5f + frand();
+    if (rad_lightmap_weights_create(lm, P, base, H, NULL, &w) != RAD_SUCCESS) { T_CHECK(0); goto done; }
+    for (i = 0; i < 3 * P->count; ++i) H[i] = 2.0f * frand();
+    for (i = 0; i < 3 * texels; ++i) cpu[i] = -1.0f; /* texels without a row keep this */
+    T_CHECK(rad_lightmap_refresh(w, H, cpu, NULL) == RAD_SUCCESS);
+    printf("    %u vertices (%u entries), %u rows (%u entries)\n", w->vertex_count, w->vertex_first[w->vertex_count], w->row_count,
+           w->row_first[w->row_count]);
+    for (s = 0; s < 2; ++s) {
+        vk_kernel k;
+        vk_buf bVF, bVP, bVW, bH, bV, bRT, bRF, bEV, bEW, bO;
+        int ok = 1, pass;
+        if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_LIGHTMAP_REFRESH, 0, 10, (uint32_t)sizeof(rad_glsl_lightmap_refresh_push), g_local_sizes[s])) {
+            T_CHECK(0);
+            break;
+        }
+        ok &= vk_buffer(&g_vk, &bVF, ((VkDeviceSize)w->vertex_count + 1) * 4, w->vertex_first);
+        ok &= vk_buffer(&g_vk, &bVP, (VkDeviceSize)w->vertex_first[w->vertex_count] * 4 + 4, w->vertex_patches);
+        ok &= vk_buffer(&g_vk, &bVW, (VkDeviceSize)w->vertex_first[w->vertex_count] * 4 + 4, w->vertex_weights);
+        ok &= vk_buffer(&g_vk, &bH, 3 * (VkDeviceSize)P->count * 4, H);
+        ok &= vk_buffer(&g_vk, &bV, 3 * (VkDeviceSize)w->vertex_count * 4 + 4, NULL);
+        ok &= vk_buffer(&g_vk, &bRT, (VkDeviceSize)w->row_count * 4 + 4, w->row_texels);
+        ok &= vk_buffer(&g_vk, &bRF, ((VkDeviceSize)w->row_count + 1) * 4, w->row_first);
+        ok &= vk_buffer(&g_vk, &bEV, (VkDeviceSize)w->row_first[w->row_count] * 4 + 4, w->entry_vertices);
+        ok &= vk_buffer(&g_vk, &bEW, (VkDeviceSize)w->row_first[w->row_count] * 4 + 4, w->entry_weights);
+        ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)texels * 4, NULL);
+        if (ok) for (i = 0; i < 3 * texels; ++i) ((float *)bO.map)[i] = -1.0f;
+        for (pass = 0; pass < 2 && ok; ++pass) {
+            uint32_t n = pass == 0 ? w->vertex_count : w->row_count;
+            const uint32_t *first = pass == 0 ? w->vertex_first : w->row_first;
+            chunks(n, cut);
+            for (q = 0; q < 3 && ok; ++q) {
+                rad_glsl_lightmap_refresh_push p;
+                vk_range r[10];
+                uint32_t unused;
+                VkDeviceSize k0 = first[cut[q]], k1 = first[cut[q + 1]];
+                if (cut[q + 1] == cut[q]) continue;
+                r[0] = vk_whole(&bVF); r[3] = vk_whole(&bH); r[4] = vk_whole(&bV); r[5] = vk_whole(&bRT); r[6] = vk_whole(&bRF);
+                r[9] = vk_whole(&bO);
+                if (pass == 0) {
+                    r[1] = vk_chunk(&g_vk, &bVP, 4, k0, k1 - k0, &p.entry_base);
+                    r[2] = vk_chunk(&g_vk, &bVW, 4, k0, k1 - k0, &unused);
+                    r[7] = vk_whole(&bEV); r[8] = vk_whole(&bEW);
+                } else {
+                    r[7] = vk_chunk(&g_vk, &bEV, 4, k0, k1 - k0, &p.entry_base);
+                    r[8] = vk_chunk(&g_vk, &bEW, 4, k0, k1 - k0, &unused);
+                    r[1] = vk_whole(&bVP); r[2] = vk_whole(&bVW);
+                }
+                p.entry_base = (uint32_t)k0 - p.entry_base;
+                p.pass = pass == 0 ? RAD_GLSL_LIGHTMAP_PASS_VERTICES : RAD_GLSL_LIGHTMAP_PASS_TEXELS;
+                p.row_offset = cut[q];
+                p.row_count = cut[q + 1] - cut[q];
+                ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
+            }
+        }
+        T_CHECK(ok);
+        if (ok) compare("lightmap refresh", (const float *)bO.map, cpu, 3 * (size_t)texels, 1e-5);
+        vk_buffer_free(&g_vk, &bVF); vk_buffer_free(&g_vk, &bVP); vk_buffer_free(&g_vk, &bVW); vk_buffer_free(&g_vk, &bH);
+        vk_buffer_free(&g_vk, &bV); vk_buffer_free(&g_vk, &bRT); vk_buffer_free(&g_vk, &bRF); vk_buffer_free(&g_vk, &bEV);
+        vk_buffer_free(&g_vk, &bEW); vk_buffer_free(&g_vk, &bO);
+        vk_kernel_destroy(&g_vk, &k);
+    }
+done:
+    free(H); free(base); free(cpu);
+    rad_lightmap_weights_destroy(w0);
+    rad_lightmap_weights_destroy(w);
+    rad_lightmap_destroy(lm);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
 /* ---- the C mirrors of the push-constant blocks, against the compiled SPIR-V ------------------ */
 
 /* member names and byte offsets of the push-constant block of a SPIR-V module (from OpMemberName
@@ -1551,6 +1673,8 @@ static void test_push_mirrors(void)
         MM(rad_glsl_vp_gather_push, base), MM(rad_glsl_vp_gather_push, flags), { NULL, 0 } };
     static const mirror_member probe[] = { MM(rad_glsl_probe_update_push, row_offset), MM(rad_glsl_probe_update_push, row_count),
         MM(rad_glsl_probe_update_push, entry_base), MM(rad_glsl_probe_update_push, weight_base), { NULL, 0 } };
+    static const mirror_member lmr[] = { MM(rad_glsl_lightmap_refresh_push, pass), MM(rad_glsl_lightmap_refresh_push, row_offset),
+        MM(rad_glsl_lightmap_refresh_push, row_count), MM(rad_glsl_lightmap_refresh_push, entry_base), { NULL, 0 } };
     g_worst_what = "push-constant block, bytes";
     check_mirror(RAD_GLSL_GATHER_DENSE, dense, sizeof(rad_glsl_gather_dense_push));
     check_mirror(RAD_GLSL_GATHER_CSR, sparse, sizeof(rad_glsl_gather_csr_push));
@@ -1564,6 +1688,7 @@ static void test_push_mirrors(void)
     check_mirror(RAD_GLSL_LOCAL_UPDATE, lupd, sizeof(rad_glsl_local_update_push));
     check_mirror(RAD_GLSL_VP_GATHER, vpg, sizeof(rad_glsl_vp_gather_push));
     check_mirror(RAD_GLSL_PROBE_UPDATE, probe, sizeof(rad_glsl_probe_update_push));
+    check_mirror(RAD_GLSL_LIGHTMAP_REFRESH, lmr, sizeof(rad_glsl_lightmap_refresh_push));
     /* every kernel (.comp; includes have no push block) has its mirror checked above */
     {
         uint32_t id;
@@ -1634,6 +1759,7 @@ static const vk_test g_tests[] = {
     { "vk_local_adds_evictions_apply_resident", test_local },
     { "vk_vp_gather_trilinear_skipping", test_vp_gather },
     { "vk_probe_update", test_probe_update },
+    { "vk_lightmap_refresh", test_lightmap_refresh },
     { NULL, NULL }
 };
 

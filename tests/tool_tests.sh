@@ -977,6 +977,14 @@ point --point 0.278,0.45,0.28:0.5
 spot --spot 0.278,0.54,0.28:0,-1,0:20,35:1
 area --area 0.2,0.35,0.05:0.15,0,0:0,0.12,0:10
 EOF2
+# rad compare's mean line is the energy check: it equals the independent mean of each PFM above
+line=$("$RAD" compare "$TMP/l-r.pfm" "$TMP/l-t.pfm" 2> /dev/null | grep '^mean:')
+ca=$(echo "$line" | awk '{ print $2 }'); cb=$(echo "$line" | awk '{ print $3 }')
+cr=$(echo "$line" | sed -n 's/.*A \/ B = //p')
+mr=$(pfm_mean "$TMP/l-r.pfm"); mt=$(pfm_mean "$TMP/l-t.pfm")
+close "$ca" "$mr" 1e-4 && close "$cb" "$mt" 1e-4 && [ -n "$cr" ] && close "$cr" "$(awk -v a="$mr" -v b="$mt" 'BEGIN { print a / b }')" 1e-4 &&
+    ok "compare prints each image's mean radiance and their ratio ($line)" ||
+    fail "compare prints each image's mean radiance and their ratio" "'$line' against $mr $mt"
 # the sky is the radiance a ray that leaves the scene sees: rad render shows it like rad trace
 if "$RAD" render "$TMP/dark.obj" --sky 0.5,0.25,1 --size 16x16 --patches 50 --aa 1 --camera 0,0,-1:0,0,-2:0,1,0 \
     -o "$TMP/sky.pfm" > /dev/null 2> "$TMP/err.txt"; then
@@ -1085,7 +1093,12 @@ rc3=$?
     fail "probes refuses bad options" "exits $rc1 $rc2 $rc3: $(head -c 200 "$TMP/err.txt")"
 
 # ---- a new user's first runs: what the tool says ------------------------------------------
-"$RAD" help 2>&1 | grep -q 'local|vp|aavp' && ok "help lists every render method" || fail "help lists every render method"
+# every method the render command parses is named by rad help (the list from render --help's usage line)
+missing=""
+for m in $("$RAD" render --help 2>&1 | head -n 1 | sed -n 's/.*--method \([a-z|]*\).*/\1/p' | tr '|' ' ') stochastic hierarchical; do
+    "$RAD" help 2>&1 | grep -q "[ |]$m[|]\|[|]$m\$" || missing="$missing $m"
+done
+[ -z "$missing" ] && ok "help lists every render method" || fail "help lists every render method" "missing:$missing"
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n' > "$TMP/nolight.obj"
 "$RAD" render "$TMP/nolight.obj" -o "$TMP/nolight.png" --size 16x16 --patches 1 > /dev/null 2> "$TMP/err.txt"
 grep -q "no emitters and no lights" "$TMP/err.txt" && ok "render warns about a scene without light" ||
@@ -1103,6 +1116,25 @@ if "$RAD" lightmap cornell -o "$TMP/lm.pfm" --size 32 --patches 100 --texel-samp
 else
     fail "lightmap of the Cornell box" "$(head -c 300 "$TMP/err.txt")"
 fi
+# OpenEXR (tinyexr): the same bake written as .exr reads back (through tinyexr) equal to the
+# PFM, value for value; a rad built without tinyexr refuses .exr with a message naming the package
+"$RAD" lightmap cornell -o "$TMP/lm.exr" --size 32 --patches 100 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt"
+rc=$?
+if [ $rc -eq 2 ] && grep -q "without OpenEXR support (install libtinyexr-dev" "$TMP/err.txt"; then
+    ok "lightmap -o .exr without tinyexr: a clear error"
+elif [ $rc -eq 0 ] && [ -s "$TMP/lm.pfm" ]; then
+    d=$("$RAD" compare "$TMP/lm.exr" "$TMP/lm.pfm" 2> /dev/null | awk '/^max \|A-B\|/ { print $3 }')
+    [ "$d" = 0 ] && ok "lightmap -o .exr reads back equal to the PFM" || fail "lightmap -o .exr reads back equal to the PFM" "max |A-B| '$d'"
+    if "$RAD" render cornell --patches 60 --size 24x24 -o "$TMP/r.exr" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell --patches 60 --size 24x24 -o "$TMP/r.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        d=$("$RAD" compare "$TMP/r.exr" "$TMP/r.pfm" 2> /dev/null | awk '/^max \|A-B\|/ { print $3 }')
+        [ "$d" = 0 ] && ok "render -o .exr reads back equal to the PFM" || fail "render -o .exr reads back equal to the PFM" "max |A-B| '$d'"
+    else
+        fail "render -o .exr" "$(head -c 300 "$TMP/err.txt")"
+    fi
+else
+    fail "lightmap -o .exr" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+fi
 "$RAD" lightmap cornell -o "$TMP/lm.png" --sh > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 2 ] && grep -q "PNG cannot hold negative" "$TMP/err.txt" && ok "lightmap --sh refuses a PNG" || fail "lightmap --sh refuses a PNG" "exit $rc"
@@ -1112,6 +1144,18 @@ if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 16 --patches 60 --texel-
 else
     fail "lightmap --sh writes four PFM layers" "$(head -c 300 "$TMP/err.txt")"
 fi
+# the hemisphere gather estimates the exact gather's sum by rays: the two lightmaps agree
+if "$RAD" lightmap cornell -o "$TMP/lmx.pfm" --size 32 --patches 100 --texel-samples 1 --visibility-rays 4 --gather exact > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" lightmap cornell -o "$TMP/lmh.pfm" --size 32 --patches 100 --texel-samples 1 --gather hemisphere > /dev/null 2>> "$TMP/err.txt"; then
+    p=$(psnr_of "$TMP/lmx.pfm" "$TMP/lmh.pfm")
+    at_least "$p" 38 && ok "lightmap --gather hemisphere matches --gather exact (PSNR $p dB)" ||
+        fail "lightmap --gather hemisphere matches --gather exact" "PSNR $p"
+else
+    fail "lightmap --gather" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" lightmap cornell -o "$TMP/lmx.pfm" --gather sideways > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 2 ] && grep -q "exact or hemisphere" "$TMP/err.txt" && ok "lightmap refuses an unknown --gather" || fail "lightmap refuses an unknown --gather" "exit $rc"
 # --render: the view shaded from the lightmap resembles the path tracer's (both at low quality)
 if "$RAD" lightmap cornell -o "$TMP/lmr.pfm" --size 64 --patches 150 --texel-samples 1 --visibility-rays 1 \
         --render "$TMP/lmview.png" --render-size 48x48 --aa 1 > /dev/null 2> "$TMP/err.txt" &&
@@ -1121,6 +1165,26 @@ if "$RAD" lightmap cornell -o "$TMP/lmr.pfm" --size 64 --patches 150 --texel-sam
 else
     fail "lightmap --render" "$(head -c 300 "$TMP/err.txt")"
 fi
+# rad render --method lightmap: direct light per pixel, the indirect light from a baked lightmap;
+# against rad trace about as close as classic at the same patch count (low quality here), and
+# the method is render-only and listed by rad help
+if "$RAD" render cornell --method lightmap --patches 150 --lightmap-size 64 --texel-samples 1 --visibility-rays 1 \
+        --size 48x48 --aa 4 -o "$TMP/lmm.png" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" render cornell --patches 150 --size 48x48 --aa 4 -o "$TMP/lmc.png" > /dev/null 2>> "$TMP/err.txt" &&
+    [ -s "$TMP/lmtrace.png" ]; then
+    sl=$(ssim_of "$TMP/lmm.png" "$TMP/lmtrace.png") sc=$(ssim_of "$TMP/lmc.png" "$TMP/lmtrace.png")
+    awk -v l="$sl" -v c="$sc" 'BEGIN { exit !(l != "" && c != "" && l + 0 > c - 0.03 && l + 0 > 0.7) }' &&
+        ok "render --method lightmap resembles rad trace as classic does (SSIM $sl, classic $sc)" ||
+        fail "render --method lightmap resembles rad trace as classic does" "SSIM $sl, classic $sc"
+else
+    fail "render --method lightmap" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" bake cornell --method lightmap -o "$TMP/x.radb" > /dev/null 2> "$TMP/err.txt"
+[ $? -eq 2 ] && grep -q "render-only" "$TMP/err.txt" && ok "bake refuses --method lightmap (render-only)" ||
+    fail "bake refuses --method lightmap" "$(head -c 200 "$TMP/err.txt")"
+"$RAD" render cornell --lightmap-size 64 -o "$TMP/x.png" > /dev/null 2>&1
+[ $? -eq 2 ] && ok "render refuses --lightmap-size without --method lightmap" || fail "render refuses --lightmap-size without --method lightmap"
+"$RAD" help 2>&1 | grep -q "hierarchical|lightmap|pathtrace" && ok "rad help lists --method lightmap" || fail "rad help lists --method lightmap"
 "$RAD" lightmap cornell -o "$TMP/x.pfm" --sh --render "$TMP/x.png" > /dev/null 2>&1
 [ $? -eq 2 ] && ok "lightmap --render refuses --sh" || fail "lightmap --render refuses --sh"
 # a glTF quad with TEXCOORD_0 and TEXCOORD_1: the tool bakes over the file's second uv set

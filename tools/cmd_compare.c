@@ -33,6 +33,15 @@ static void count_nonfinite(const rad_image *img, size_t *nan, size_t *inf, long
 }
 
 /* prints one line when img has NaN or infinite values; returns 1 then */
+static double mean_radiance(const rad_image *img)
+{
+    size_t k, n = (size_t)img->width * (size_t)img->height * 3u, m = 0;
+    double sum = 0.0;
+    for (k = 0; k < n; ++k)
+        if (isfinite(img->rgb[k])) sum += img->rgb[k], ++m;
+    return m ? sum / (double)m : 0.0;
+}
+
 static int report_nonfinite(const char *name, const char *path, const rad_image *img)
 {
     size_t nan, inf;
@@ -57,7 +66,8 @@ static void compare_usage(FILE *f)
                "                .pfm the metrics need and a picture (tools/report.sh)\n"
                "  --png-exposure X  the PNG's exposure alone (default E), the metrics keep E\n"
                "  prints MSE, PSNR (peak 1) and SSIM (11x11 Gaussian window, sigma 1.5, per channel,\n"
-               "  averaged), all on linear values times E, clamped to [0,1]\n"
+               "  averaged), all on linear values times E, clamped to [0,1]; and the mean linear\n"
+               "  radiance of each (unclamped) with their ratio, the energy check against a reference\n"
                "  exit 1 when an image holds NaN or infinite values (counted on stderr and in a\n"
                "  'nonfinite' line), or the images cannot be read or differ in size\n");
 }
@@ -172,6 +182,23 @@ int rad_cmd_compare(int argc, char **argv)
     if (isinf(psnr)) printf("PSNR: inf dB (identical after clamping)\n");
     else printf("PSNR: %.4f dB\n", psnr);
     printf("SSIM: %.8f (11x11 Gaussian window, sigma 1.5, per channel R G B, averaged)\n", ssim);
+    {
+        /* the light each image holds, before any clamp: the energy check against a path tracer */
+        double ma = mean_radiance(&a), mb = mean_radiance(&b);
+        printf("mean: %.9g %.9g (linear radiance over RGB, finite values, unclamped)", ma, mb);
+        if (mb > 0.0) printf("; A / B = %.6f", ma / mb);
+        printf("\n");
+    }
+    {
+        /* the unclamped difference: exact format round trips (PFM against EXR) read 0 here */
+        size_t k, n = (size_t)a.width * (size_t)a.height * 3u;
+        double top = 0.0;
+        for (k = 0; k < n; ++k) {
+            double d = fabs((double)a.rgb[k] - (double)b.rgb[k]);
+            if (d > top || d != d) top = d;
+        }
+        printf("max |A-B|: %.9g (linear, before clamping)\n", top);
+    }
     if (diff) {
         rad_image heat = { 0, 0, NULL };
         if (!(scale > 0.0f)) {

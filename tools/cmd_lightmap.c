@@ -1,17 +1,17 @@
 /* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
 
-   rad lightmap SCENE -o OUT.pfm|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
-                [--visibility-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
+   rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
+                [--visibility-rays N] [--gather exact|hemisphere] [--hemisphere-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
                 [classic options] [--threads N] [--exposure X]
 
-   The classic solution (cmd_bake.c: patches, F, direct light as the source, B = E + L) is
+   The classic solution (classic.c: patches, F, direct light as the source, B = E + L) is
    gathered into the texels of the lightmap uv set (>>api_lightmap): every mesh's second uv set
    (glTF TEXCOORD_1, assimp's second channel), or, when some mesh has none (or --unwrap), the
    simple automatic unwrap of unwrap.c. RGB: irradiance (W m^-2) = the direct light of the
    lights and emitters per texel + the irradiance from the secondary sources; --sh: the L1
    spherical harmonics of the indirect radiance only (engines add direct light per pixel),
-   four PFM files OUT.L00.pfm, OUT.L1m1.pfm, OUT.L10.pfm, OUT.L11.pfm (PNG cannot hold the
-   negative coefficients). Then dilation into the gutters and seam stitching. --render draws
+   four files OUT.L00.pfm, OUT.L1m1.pfm, OUT.L10.pfm, OUT.L11.pfm (or .exr; PNG cannot hold the
+   negative coefficients). .exr is 32-bit float OpenEXR (image.c, tinyexr). Then dilation into the gutters and seam stitching. --render draws
    the scene's camera view (or the one rad trace would choose) shaded from the lightmap alone:
    radiance = emission + albedo x bilinear lightmap irradiance / pi, N x N samples a pixel, to
    compare with `rad trace` (rad compare). */
@@ -22,18 +22,24 @@
 
 static void lightmap_usage(FILE *f)
 {
-    fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.png [options]\n"
+    fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [options]\n"
                "  bakes the classic radiosity solution into a lightmap over the second uv set\n"
                "  (glTF TEXCOORD_1); meshes without one are unwrapped automatically (simple charts)\n"
                "  --size N|WxH          atlas texels (default 256)\n"
-               "  --sh                  L1 spherical harmonics of the indirect light (4 PFM files\n"
+               "  --sh                  L1 spherical harmonics of the indirect light (4 PFM or EXR files\n"
                "                        OUT.L00.pfm OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)\n"
                "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
                "  --visibility-rays N   shadow rays per sample point and patch (default 2, at most 64)\n"
+               "  --gather M            exact (every patch's form factor from every sample) or hemisphere\n"
+               "                        (the brightest patches exactly, the rest by rays; its cost does not\n"
+               "                        grow with the patches); default: hemisphere when samples x patches\n"
+               "                        exceeds 2e7\n"
+               "  --hemisphere-rays N   rays per texel of the hemisphere gather (default 256, at most 65536)\n"
                "  --unwrap              unwrap even when the file has a second uv set\n"
-               "  --render VIEW         also render the camera view shaded from the lightmap (.png or .pfm;\n"
+               "  --render VIEW         also render the camera view shaded from the lightmap (.png, .pfm, .exr;\n"
                "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
-               "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 2)\n"
+               "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 4, as\n"
+               "                        rad render's 16 samples)\n"
                "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
                "                        the radiance of a white surface)\n"
                "  --threads N           worker threads (default: all cores)\n"
@@ -103,26 +109,131 @@ static int lightmap_is_png(const char *path)
     return n >= 4 && (!strcmp(path + n - 4, ".png") || !strcmp(path + n - 4, ".PNG"));
 }
 
+void rad_tool_lightmap_bake_free(rad_tool_lightmap_baked *b)
+{
+    free(b->values);
+    rad_lightmap_destroy(b->lm);
+    rad_tool_classic_free(&b->cl);
+    if (b->own_scene) {
+        rad_bvh_destroy(b->w.bvh);
+        rad_scene_destroy(b->w.scene);
+    }
+    free(b->uvs);
+    memset(b, 0, sizeof *b);
+}
+
+int rad_tool_lightmap_bake(const char *cmd, const rad_tool_world *world, const rad_tool_classic_options *co, int width,
+                           int height, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
+                           int force_unwrap, int direct, rad_tool_lightmap_baked *out)
+{
+    rad_tool_world w2 = *world;
+    rad_lightmap_options lo;
+    rad_lightmap_gather_options go;
+    rad_lightmap_seam_stats st;
+    rad_context ctx;
+    rad_result r;
+    uint32_t ch;
+    double t0;
+    rad_mesh_desc mesh;
+    rad_scene_desc desc;
+    const rad_tool_world *w = world;
+    memset(out, 0, sizeof *out);
+    /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
+    if (force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
+        if (!force_unwrap && w->scene->lightmap_uvs)
+            fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
+        out->uvs = (float *)rad_tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
+        if (rad_tool_unwrap(w->scene, (uint32_t)width, (uint32_t)height, out->uvs, NULL)) goto fail;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.name = "unwrapped";
+        mesh.positions = w->scene->positions;
+        mesh.vertex_count = 3 * w->scene->triangle_count;
+        mesh.uvs = w->scene->uvs;
+        mesh.triangle_count = w->scene->triangle_count;
+        mesh.material_ids = w->scene->materials;
+        mesh.lightmap_uvs = out->uvs;
+        desc = w->file.desc;
+        desc.meshes = &mesh;
+        desc.mesh_count = 1;
+        w2.scene = NULL;
+        w2.bvh = NULL;
+        out->own_scene = 1;
+        out->w = w2;
+        rad_tool_context(&ctx, NULL);
+        if ((r = rad_scene_create(&desc, &ctx, &out->w.scene)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_scene_create", r); goto fail; }
+        if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_bvh_create", r); goto fail; }
+        rad_bvh_raycaster(out->w.bvh, &out->w.rc);
+    } else {
+        out->w = w2;
+        fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
+    }
+    w = &out->w;
+    if (rad_tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
+    /* the gather wants the total radiosity of the secondary sources: B = E + L */
+    t0 = rad_tool_seconds();
+    rad_lightmap_options_default(&lo);
+    lo.width = (uint32_t)width;
+    lo.height = (uint32_t)height;
+    lo.samples = texel_samples;
+    rad_tool_context(&ctx, "lightmap texels");
+    r = rad_lightmap_create(w->scene, &w->rc, &lo, &ctx, &out->lm);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_create", r); goto fail; }
+    fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
+            out->lm->width, out->lm->height, out->lm->covered_texels, out->lm->valid_texels, out->lm->invalid_samples,
+            out->lm->sample_count);
+    rad_lightmap_gather_options_default(&go);
+    go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
+    go.visibility_rays = vis;
+    go.hemisphere_rays = hemi_rays;
+    /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
+    if (gather < 0)
+        gather = (double)out->lm->sample_count * out->cl.patches->count > 2e7 ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
+    go.method = (rad_lightmap_gather_method)gather;
+    if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
+        fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, hemi_rays);
+    ch = rad_lightmap_channels(go.encoding);
+    out->values = (float *)rad_tool_calloc((size_t)width * height * ch, sizeof(float));
+    rad_tool_context(&ctx, "lightmap gather");
+    r = rad_lightmap_gather(out->lm, out->cl.patches, out->cl.B, &w->rc, &go, out->values, &ctx);
+    rad_tool_progress_end();
+    if (r != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
+    if (direct && !sh) {
+        rad_direct_options dopt;
+        rad_direct_options_default(&dopt);
+        dopt.include_emitters = 1;
+        dopt.light_samples = co->light_samples;
+        rad_tool_context(&ctx, "lightmap direct");
+        r = rad_lightmap_direct(out->lm, &w->rc, w->file.lights, w->file.light_count, &dopt, out->values, &ctx);
+        rad_tool_progress_end();
+        if (r != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_direct", r); goto fail; }
+    }
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_lightmap_dilate(out->lm, ch, out->values, 0, &ctx)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_dilate", r); goto fail; }
+    if ((r = rad_lightmap_stitch(out->lm, ch, out->values, 0, &st, &ctx)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_stitch", r); goto fail; }
+    fprintf(stderr, "rad %s: lightmap baked in %.2f s; %u seams, largest jump %.4g before stitching, %.4g after\n", cmd,
+            rad_tool_seconds() - t0, st.seams, (double)st.max_jump_before, (double)st.max_jump_after);
+    return 0;
+fail:
+    rad_tool_lightmap_bake_free(out);
+    return 1;
+}
+
 int rad_cmd_lightmap(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
     int rw = 256, rh = 256;
     uint32_t aa = 2;
     rad_tool_classic_options co;
-    rad_tool_classic cl;
-    rad_tool_world w, w2;
-    rad_lightmap_options lo;
-    rad_lightmap_gather_options go;
-    rad_lightmap_seam_stats st;
-    rad_lightmap *lm = NULL;
-    rad_context ctx;
-    rad_result r;
-    int width = 256, height = 256, sh = 0, force_unwrap = 0, a, code = 1, own_scene = 0;
-    uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch;
-    float exposure = 0.31830988f, *values = NULL, *uvs = NULL;
-    double t0;
-    rad_mesh_desc mesh;
-    rad_scene_desc desc;
+    rad_tool_world w;
+    rad_tool_lightmap_baked bk;
+    const rad_lightmap *lm = NULL;
+    int width = 256, height = 256, sh = 0, force_unwrap = 0, a, code = 1;
+    uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
+    int gather = -1; /* -1: by the work, else a rad_lightmap_gather_method */
+    const float *values = NULL;
+    float exposure = 0.31830988f;
+    memset(&bk, 0, sizeof bk);
     rad_tool_classic_options_default(&co);
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
@@ -170,6 +281,14 @@ int rad_cmd_lightmap(int argc, char **argv)
         } else if (!strcmp(o, "--visibility-rays")) {
             if (rad_tool_parse_uint("lightmap", o, argv[++a], &vis)) return 2;
             if (vis == 0 || vis > 64) { fprintf(stderr, "rad lightmap: --visibility-rays must be 1 to 64\n"); return 2; }
+        } else if (!strcmp(o, "--gather")) {
+            const char *v = argv[++a];
+            if (v && !strcmp(v, "exact")) gather = RAD_LIGHTMAP_GATHER_EXACT;
+            else if (v && !strcmp(v, "hemisphere")) gather = RAD_LIGHTMAP_GATHER_HEMISPHERE;
+            else { fprintf(stderr, "rad lightmap: --gather must be exact or hemisphere\n"); return 2; }
+        } else if (!strcmp(o, "--hemisphere-rays")) {
+            if (rad_tool_parse_uint("lightmap", o, argv[++a], &hemi_rays)) return 2;
+            if (hemi_rays == 0 || hemi_rays > 65536) { fprintf(stderr, "rad lightmap: --hemisphere-rays must be 1 to 65536\n"); return 2; }
         } else if (!strcmp(o, "--exposure")) {
             if (rad_tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
         } else if (!strcmp(o, "--threads")) {
@@ -189,7 +308,7 @@ int rad_cmd_lightmap(int argc, char **argv)
         return 2;
     }
     if (sh && lightmap_is_png(out_path)) {
-        fprintf(stderr, "rad lightmap: --sh writes PFM files (PNG cannot hold negative coefficients): use -o NAME.pfm\n");
+        fprintf(stderr, "rad lightmap: --sh writes PFM or EXR files (PNG cannot hold negative coefficients): use -o NAME.pfm or NAME.exr\n");
         return 2;
     }
     if (sh && render_path) {
@@ -197,6 +316,7 @@ int rad_cmd_lightmap(int argc, char **argv)
         return 2;
     }
     if (rad_tool_check_size("lightmap", width, height)) return 2;
+    if (rad_image_check_format("lightmap", out_path) || (render_path && rad_image_check_format("lightmap", render_path))) return 2;
     {
         const char *inputs[1];
         inputs[0] = scene_path;
@@ -205,72 +325,10 @@ int rad_cmd_lightmap(int argc, char **argv)
     }
     rad_tool_set_threads((int)threads);
     if (rad_tool_open_world("lightmap", scene_path, &w)) return 1;
-    w2 = w;
-    memset(&cl, 0, sizeof cl);
-    /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
-    if (force_unwrap || !w.scene->lightmap_uvs || memchr(w.scene->lightmapped, 0, w.scene->triangle_count)) {
-        if (!force_unwrap && w.scene->lightmap_uvs)
-            fprintf(stderr, "rad lightmap: some meshes have no second uv set: unwrapping the whole scene\n");
-        uvs = (float *)rad_tool_calloc(6 * (size_t)w.scene->triangle_count, sizeof(float));
-        if (rad_tool_unwrap(w.scene, (uint32_t)width, (uint32_t)height, uvs, NULL)) goto done;
-        memset(&mesh, 0, sizeof mesh);
-        mesh.name = "unwrapped";
-        mesh.positions = w.scene->positions;
-        mesh.vertex_count = 3 * w.scene->triangle_count;
-        mesh.uvs = w.scene->uvs;
-        mesh.triangle_count = w.scene->triangle_count;
-        mesh.material_ids = w.scene->materials;
-        mesh.lightmap_uvs = uvs;
-        desc = w.file.desc;
-        desc.meshes = &mesh;
-        desc.mesh_count = 1;
-        w2.scene = NULL;
-        w2.bvh = NULL;
-        own_scene = 1;
-        rad_tool_context(&ctx, NULL);
-        if ((r = rad_scene_create(&desc, &ctx, &w2.scene)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_scene_create", r); goto done; }
-        if ((r = rad_bvh_create(w2.scene, &ctx, &w2.bvh)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_bvh_create", r); goto done; }
-        rad_bvh_raycaster(w2.bvh, &w2.rc);
-    } else {
-        fprintf(stderr, "rad lightmap: using the file's second uv set\n");
-    }
-    if (rad_tool_classic_solve("lightmap", &w2, &co, &cl)) goto done;
-    /* the gather wants the total radiosity of the secondary sources: B = E + L */
-    t0 = rad_tool_seconds();
-    rad_lightmap_options_default(&lo);
-    lo.width = (uint32_t)width;
-    lo.height = (uint32_t)height;
-    lo.samples = texel_samples;
-    rad_tool_context(&ctx, "lightmap texels");
-    r = rad_lightmap_create(w2.scene, &w2.rc, &lo, &ctx, &lm);
-    rad_tool_progress_end();
-    if (r != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_create", r); goto done; }
-    fprintf(stderr, "rad lightmap: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", lm->width,
-            lm->height, lm->covered_texels, lm->valid_texels, lm->invalid_samples, lm->sample_count);
-    rad_lightmap_gather_options_default(&go);
-    go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
-    go.visibility_rays = vis;
-    ch = rad_lightmap_channels(go.encoding);
-    values = (float *)rad_tool_calloc((size_t)width * height * ch, sizeof(float));
-    rad_tool_context(&ctx, "lightmap gather");
-    r = rad_lightmap_gather(lm, cl.patches, cl.B, &w2.rc, &go, values, &ctx);
-    rad_tool_progress_end();
-    if (r != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_gather", r); goto done; }
-    if (!sh) {
-        rad_direct_options dopt;
-        rad_direct_options_default(&dopt);
-        dopt.include_emitters = 1;
-        dopt.light_samples = co.light_samples;
-        rad_tool_context(&ctx, "lightmap direct");
-        r = rad_lightmap_direct(lm, &w2.rc, w2.file.lights, w2.file.light_count, &dopt, values, &ctx);
-        rad_tool_progress_end();
-        if (r != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_direct", r); goto done; }
-    }
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_lightmap_dilate(lm, ch, values, 0, &ctx)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_dilate", r); goto done; }
-    if ((r = rad_lightmap_stitch(lm, ch, values, 0, &st, &ctx)) != RAD_SUCCESS) { rad_tool_fail("lightmap", "rad_lightmap_stitch", r); goto done; }
-    fprintf(stderr, "rad lightmap: baked in %.2f s; %u seams, largest jump %.4g before stitching, %.4g after\n",
-            rad_tool_seconds() - t0, st.seams, (double)st.max_jump_before, (double)st.max_jump_after);
+    if (rad_tool_lightmap_bake("lightmap", &w, &co, width, height, texel_samples, vis, gather, hemi_rays, sh, force_unwrap, !sh, &bk)) goto done;
+    lm = bk.lm;
+    values = bk.values;
+    ch = sh ? 12u : 3u;
     {
         rad_image img;
         uint32_t layers = sh ? 4u : 1u, l;
@@ -292,17 +350,10 @@ int rad_cmd_lightmap(int argc, char **argv)
             free(path);
         }
     }
-    if (render_path && lightmap_render(&w2, lm, values, rw, rh, (int)aa, render_path, exposure)) goto done;
+    if (render_path && lightmap_render(&bk.w, lm, values, rw, rh, (int)aa, render_path, exposure)) goto done;
     code = 0;
 done:
-    free(values);
-    rad_lightmap_destroy(lm);
-    rad_tool_classic_free(&cl);
-    if (own_scene) {
-        rad_bvh_destroy(w2.bvh);
-        rad_scene_destroy(w2.scene);
-    }
-    free(uvs);
+    rad_tool_lightmap_bake_free(&bk);
     rad_tool_close_world(&w);
     return code;
 }

@@ -55,12 +55,14 @@ static void *xmalloc(size_t size)
 static void render_usage(FILE *f)
 {
     fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm [--method classic|multibounce|temporal|local|vp|aavp|hierarchical|pathtrace] [options]\n"
-            "  -o FILE            output image: .pfm (linear radiance) or .png (sRGB, exposure applied)\n"
+            "usage: rad render SCENE -o OUT.png|OUT.pfm|OUT.exr [--method classic|multibounce|temporal|local|stochastic|vp|aavp|hierarchical|lightmap|pathtrace] [options]\n"
+            "  -o FILE            output image: .pfm or .exr (linear radiance; .exr needs libtinyexr-dev at build) or .png\n"
+            "                     (sRGB, exposure applied)\n"
             "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
             "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
             "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
-            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991)\n"
+            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991), lightmap (classic\n"
+            "                     baked into a lightmap, the indirect light looked up per pixel)\n"
             "  --bake FILE.radb   classic, multibounce, temporal, stochastic, hierarchical: use a bake of\n"
             "                     that method made by\n"
             "                     'rad bake' from this scene instead of computing it here\n"
@@ -141,6 +143,11 @@ static double render_vp_gather_seconds = 0.0;
 /* --method hierarchical: render_classic looks H up at each sample's hit (smooth, halo-fixed) */
 static const rad_hierarchical *render_hr = NULL;
 static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out);
+/* --method lightmap: render_classic reads H at each sample's lightmap uv from this RGB
+   irradiance lightmap (bilinear; P and Hv unused) */
+static const rad_lightmap *render_lm = NULL;
+static const float *render_lm_values = NULL;
+static uint32_t render_lm_size = 256, render_lm_samples = 4, render_lm_vis = 2;
 /* --final-gather N: rays per pixel sample for one traced bounce (0: off; rad_final_gather) */
 static uint32_t render_final_gather = 0;
 
@@ -220,7 +227,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
-    if (render_vp || render_hr || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    if (render_vp || render_hr || render_lm || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     if (render_shading >= 0) {
         shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
         shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
@@ -309,6 +316,16 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
                 result = rad_tool_fail("render", "rad_final_gather", r);
                 break;
             }
+        } else if (render_lm && nvalid > 0) {
+            double tg = rad_tool_seconds();
+            for (k = 0; k < nvalid; ++k) {
+                const rad_hit *h = &hits[valid[k]];
+                const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
+                float u = t[0] + h->b1 * (t[2] - t[0]) + h->b2 * (t[4] - t[0]);
+                float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
+                rad_lightmap_sample(render_lm, 3, render_lm_values, u, v, gathered + 3 * k);
+            }
+            render_vp_gather_seconds += rad_tool_seconds() - tg;
         } else if (gathered && nvalid > 0) {
             double tg = rad_tool_seconds();
             r = render_hr ? hr_lookup(hits, valid, nvalid, gathered)
@@ -1071,6 +1088,7 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
     rad_context ctx;
     int width = 512, height = 512, a, rc, have_cam = 0, pathtrace;
     uint32_t aa = 16, spp = 64, seed = 0, threads = 0, pixel_light_samples = 16;
+    int lightmap_opts = 0;
     float fov = 0.0f, exposure = 1.0f;
     double t0 = rad_tool_seconds();
     rad_tool_classic_options_default(&o);
@@ -1118,6 +1136,12 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         } else if (!strcmp(opt, "--pixel-light-samples")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
             if (pixel_light_samples == 0) { fprintf(stderr, "rad %s: %s must be > 0\n", cmd, opt); return 2; }
+        } else if (!strcmp(opt, "--lightmap-size") || !strcmp(opt, "--texel-samples") || !strcmp(opt, "--visibility-rays")) {
+            uint32_t *dst = opt[2] == 'l' ? &render_lm_size : opt[2] == 't' ? &render_lm_samples : &render_lm_vis;
+            uint32_t lo = opt[2] == 'l' ? 4u : 1u, hi = opt[2] == 'l' ? 16384u : opt[2] == 't' ? 16u : 64u;
+            if (rad_tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
+            if (*dst < lo || *dst > hi) { fprintf(stderr, "rad %s: %s must be %u to %u\n", cmd, opt, lo, hi); return 2; }
+            lightmap_opts = 1;
         } else if (!strcmp(opt, "--final-gather")) {
             if (rad_tool_parse_uint(cmd, opt, argv[++a], &render_final_gather)) return 2;
             if (render_final_gather > 4096) { fprintf(stderr, "rad %s: %s is at most 4096\n", cmd, opt); return 2; }
@@ -1140,6 +1164,15 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         return 2;
     }
     if (rad_tool_method_check(cmd, 1, &mo, &o)) return 2;
+    if (lightmap_opts && mo.method != RAD_TOOL_LIGHTMAP) {
+        fprintf(stderr, "rad %s: --lightmap-size, --texel-samples and --visibility-rays are for --method lightmap\n", cmd);
+        return 2;
+    }
+    if (mo.method == RAD_TOOL_LIGHTMAP && (bake_path || render_final_gather)) {
+        fprintf(stderr, "rad %s: --method lightmap bakes its own lightmap: %s is not used\n", cmd,
+                bake_path ? "--bake" : "--final-gather");
+        return 2;
+    }
     rad_tool_dense_plan(&o, &mo, 0);
     method = rad_tool_method_name(mo.method);
     seed = mo.seed;
@@ -1156,14 +1189,7 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
     }
-    {
-        size_t l = strlen(out_path);
-        if (l < 4 || (strcmp(out_path + l - 4, ".png") && strcmp(out_path + l - 4, ".pfm") &&
-                      strcmp(out_path + l - 4, ".PNG") && strcmp(out_path + l - 4, ".PFM"))) {
-            fprintf(stderr, "rad %s: output '%s' must end in .png or .pfm\n", cmd, out_path);
-            return 2;
-        }
-    }
+    if (rad_image_check_format(cmd, out_path)) return 2;
     {
         const char *inputs[2];
         inputs[0] = scene_name;
@@ -1180,7 +1206,8 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         }
         if (!emitters && !w.file.light_count)
             fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC) &&
+        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC ||
+             mo.method == RAD_TOOL_LIGHTMAP) &&
             !mo.proxy && !pathtrace && !bake_path &&
             o.patches < w.scene->triangle_count)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
@@ -1197,7 +1224,27 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         return 1;
     }
 
-    if ((mo.method >= RAD_TOOL_LOCAL && !(mo.method == RAD_TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
+    if (mo.method == RAD_TOOL_LIGHTMAP) {
+        rad_tool_lightmap_baked bk;
+        int lsz = (int)render_lm_size;
+        rc = rad_tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0, &bk);
+        if (rc == 0) {
+            fprintf(stderr, "rad %s: timing: method=lightmap patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+                            "step_ms_min=%.6f\n",
+                    cmd, bk.cl.patches->count, o.bounces, 1e3 * bk.cl.solve_seconds, 1e3 * bk.cl.solve_seconds);
+            render_lm = bk.lm;
+            render_lm_values = bk.values;
+            rc = render_classic(&bk.w, bk.cl.patches, NULL, &cam, width, height, aa, pixel_light_samples, &img);
+            render_lm = NULL;
+            render_lm_values = NULL;
+            rad_tool_lightmap_bake_free(&bk);
+        }
+        if (rc) {
+            rad_image_free(&img);
+            rad_tool_close_world(&w);
+            return 1;
+        }
+    } else if ((mo.method >= RAD_TOOL_LOCAL && !(mo.method == RAD_TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
         rc = mo.method == RAD_TOOL_LOCAL && !mo.proxy
                  ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
              : mo.method == RAD_TOOL_HIERARCHICAL

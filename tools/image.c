@@ -6,6 +6,12 @@
    BOTTOM row first. rad_image keeps the top row first, so rows are flipped on the way in and
    out. "Pf" (greyscale) files are read too and replicated to RGB.
 
+   OpenEXR (.exr): through tinyexr (Debian libtinyexr-dev) when the tool is built with
+   -DRAD_TOOL_EXR (the Makefile and tests/run.sh do when /usr/include/tinyexr.h exists): three
+   32-bit float channels B, G, R (the alphabetical order EXR files keep), ZIP compression,
+   the top row first as in rad_image; reading takes the R, G, B of any EXR tinyexr loads.
+   Without it, .exr paths fail with a message naming the package.
+
    Every file the tool writes goes through rad_tool_output_open/commit below: the bytes go to a
    temporary file in the destination's folder, which is renamed onto the destination only when
    every write, the flush and the close succeeded, so a failed write leaves the old file as it
@@ -541,6 +547,118 @@ static int rad__has_ext(const char *path, const char *ext)
     return 1;
 }
 
+#ifdef RAD_TOOL_EXR
+#include <tinyexr.h>
+
+int rad_image_write_exr(const char *path, const rad_image *img)
+{
+    EXRHeader hd;
+    EXRImage im;
+    EXRChannelInfo ch[3];
+    int types[3], req[3], c, ok;
+    float *planes[3] = { NULL, NULL, NULL };
+    unsigned char *mem = NULL;
+    const char *err = NULL;
+    size_t n, k, size;
+    rad_tool_output o;
+    g_output_error[0] = '\0';
+    if (!path || !img || !img->rgb || img->width <= 0 || img->height <= 0) {
+        output_error(path ? path : "", "no image to write to", 0);
+        return -1;
+    }
+    n = (size_t)img->width * (size_t)img->height;
+    for (c = 0; c < 3; ++c) {
+        planes[c] = (float *)malloc(n * sizeof(float));
+        if (!planes[c]) {
+            while (c-- > 0) free(planes[c]);
+            output_error(path, "out of memory for", ENOMEM);
+            return -1;
+        }
+    }
+    for (k = 0; k < n; ++k) { /* B, G, R planes */
+        planes[0][k] = img->rgb[3 * k + 2];
+        planes[1][k] = img->rgb[3 * k + 1];
+        planes[2][k] = img->rgb[3 * k];
+    }
+    InitEXRHeader(&hd);
+    InitEXRImage(&im);
+    memset(ch, 0, sizeof(ch));
+    ch[0].name[0] = 'B';
+    ch[1].name[0] = 'G';
+    ch[2].name[0] = 'R';
+    for (c = 0; c < 3; ++c) types[c] = req[c] = TINYEXR_PIXELTYPE_FLOAT;
+    hd.num_channels = 3;
+    hd.channels = ch;
+    hd.pixel_types = types;
+    hd.requested_pixel_types = req;
+    hd.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
+    im.num_channels = 3;
+    im.width = img->width;
+    im.height = img->height;
+    im.images = (unsigned char **)planes;
+    size = SaveEXRImageToMemory(&im, &hd, &mem, &err);
+    for (c = 0; c < 3; ++c) free(planes[c]);
+    if (size == 0 || !mem) {
+        snprintf(g_output_error, sizeof(g_output_error), "cannot encode the EXR '%s': %s", path, err ? err : "tinyexr failed");
+        if (err) FreeEXRErrorMessage(err);
+        free(mem);
+        return -1;
+    }
+    if (rad_tool_output_open(&o, path) != 0) { free(mem); return -1; }
+    ok = fwrite(mem, 1, size, o.f) == size;
+    if (!ok) output_error(path, "error writing", errno ? errno : EIO);
+    free(mem);
+    return rad_tool_output_commit(&o, ok);
+}
+
+int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errlen)
+{
+    float *rgba = NULL;
+    int w = 0, h = 0;
+    const char *msg = NULL;
+    size_t k, n;
+    if (err && errlen) err[0] = '\0';
+    if (!path || !img) return -1;
+    img->width = img->height = 0;
+    img->rgb = NULL;
+    if (LoadEXR(&rgba, &w, &h, path, &msg) != TINYEXR_SUCCESS) {
+        if (err) snprintf(err, errlen, "%s: cannot read EXR (%s)", path, msg ? msg : "tinyexr failed");
+        if (msg) FreeEXRErrorMessage(msg);
+        free(rgba);
+        return -1;
+    }
+    if (rad_image_alloc(img, w, h) != 0) {
+        if (err) snprintf(err, errlen, "%s: out of memory", path);
+        free(rgba);
+        return -1;
+    }
+    n = (size_t)w * (size_t)h;
+    for (k = 0; k < n; ++k) {
+        img->rgb[3 * k] = rgba[4 * k];
+        img->rgb[3 * k + 1] = rgba[4 * k + 1];
+        img->rgb[3 * k + 2] = rgba[4 * k + 2];
+    }
+    free(rgba);
+    return 0;
+}
+#else
+int rad_image_write_exr(const char *path, const rad_image *img)
+{
+    (void)img;
+    output_error(path ? path : "", "cannot write OpenEXR (this rad was built without tinyexr: install libtinyexr-dev "
+                 "and rebuild) to", 0);
+    return -1;
+}
+
+int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errlen)
+{
+    if (img) { img->width = img->height = 0; img->rgb = NULL; }
+    if (err) snprintf(err, errlen, "%s: cannot read OpenEXR: this rad was built without tinyexr (install libtinyexr-dev and rebuild)",
+                      path ? path : "");
+    return -1;
+}
+#endif
+
 int rad_image_write(const char *path, const rad_image *img, float exposure)
 {
     g_output_error[0] = '\0';
@@ -548,12 +666,30 @@ int rad_image_write(const char *path, const rad_image *img, float exposure)
     /* PFM holds the radiance itself: exposure applies to the 8-bit PNG only */
     if (rad__has_ext(path, ".pfm")) return rad_image_write_pfm(path, img);
     if (rad__has_ext(path, ".png")) return rad_image_write_png(path, img, exposure);
-    output_error(path, "cannot write (want a .png or .pfm name)", 0);
+    if (rad__has_ext(path, ".exr")) return rad_image_write_exr(path, img);
+    output_error(path, "cannot write (want a .png, .pfm or .exr name)", 0);
     return -1;
+}
+
+int rad_image_check_format(const char *cmd, const char *path)
+{
+    if (!path || !(rad__has_ext(path, ".pfm") || rad__has_ext(path, ".png") || rad__has_ext(path, ".exr"))) {
+        fprintf(stderr, "rad %s: output '%s' must end in .png, .pfm or .exr\n", cmd, path ? path : "");
+        return 2;
+    }
+#ifndef RAD_TOOL_EXR
+    if (rad__has_ext(path, ".exr")) {
+        fprintf(stderr, "rad %s: cannot write '%s': this rad was built without OpenEXR support (install libtinyexr-dev "
+                "and rebuild; the Makefile detects it)\n", cmd, path);
+        return 2;
+    }
+#endif
+    return 0;
 }
 
 int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen)
 {
     if (path && rad__has_ext(path, ".png")) return rad_image_read_png(path, img, err, errlen);
+    if (path && rad__has_ext(path, ".exr")) return rad_image_read_exr(path, img, err, errlen);
     return rad_image_read_pfm(path, img, err, errlen);
 }

@@ -63,6 +63,7 @@ const char *rad_tool_method_name(rad_tool_method method)
     case RAD_TOOL_VP: return "vp";
     case RAD_TOOL_AAVP: return "aavp";
     case RAD_TOOL_HIERARCHICAL: return "hierarchical";
+    case RAD_TOOL_LIGHTMAP: return "lightmap";
     default: return "classic";
     }
 }
@@ -133,6 +134,11 @@ const char *rad_tool_method_help(int render)
                     "  --hr-eps E         refinement tolerance, a fraction of the source power (default 1e-5)\n"
                     "  --hr-min-area A    smallest element area, scene units^2 (default: total area / 10000)\n"
                     "  --hr-rays R        points and visibility rays per link: 1, 4, 9 ... 64 (default 4)\n"
+                    "lightmap (the classic solution baked into a lightmap over the second uv set, else the\n"
+                    "automatic unwrap, as rad lightmap; direct light per pixel, the indirect light a bilinear\n"
+                    "lookup of the lightmap; render only):\n"
+                    "  --lightmap-size N  atlas texels a side (default 256); --texel-samples N (default 4),\n"
+                    "                     --visibility-rays N (default 2) as rad lightmap\n"
                     "%s"
                   : "multibounce:\n"
                     "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
@@ -319,9 +325,10 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         else if (!strcmp(v, "aavp")) mo->method = RAD_TOOL_AAVP;
         else if (!strcmp(v, "stochastic")) mo->method = RAD_TOOL_STOCHASTIC;
         else if (!strcmp(v, "hierarchical")) mo->method = RAD_TOOL_HIERARCHICAL;
+        else if (!strcmp(v, "lightmap")) mo->method = RAD_TOOL_LIGHTMAP;
         else {
             fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal, stochastic%s)\n", cmd, v,
-                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp, aavp or hierarchical");
+                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp, aavp, hierarchical or lightmap");
             return 2;
         }
         mo->given |= RAD_TOOL_OPT_METHOD;
@@ -450,6 +457,10 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
         fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & RAD_TOOL_OPT_RENDER_ONLY));
         return 2;
     }
+    if (!render && mo->method == RAD_TOOL_LIGHTMAP) {
+        fprintf(stderr, "rad %s: method 'lightmap' is render-only (rad lightmap writes the lightmap itself)\n", cmd);
+        return 2;
+    }
     if (!render && mo->method == RAD_TOOL_LOCAL) {
         fprintf(stderr, "rad %s: method 'local' is render-only (rad render --method local builds it in memory: its "
                         "matrix depends on the camera; a classic bake holds its F)\n", cmd);
@@ -462,6 +473,7 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
     if (mo->method >= RAD_TOOL_LOCAL) {
         uint32_t other = mo->method == RAD_TOOL_LOCAL          ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_HR
                          : mo->method == RAD_TOOL_HIERARCHICAL ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_LOCAL_M
+                         : mo->method == RAD_TOOL_LIGHTMAP     ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR
                                                                : RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR;
         bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED |
                    RAD_TOOL_OPT_SR | other);
@@ -1176,7 +1188,7 @@ int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const 
     *out = NULL;
     rad_hierarchical_options_default(&ho);
     /* finer than the library's teaching default: a still image as close to the path tracer as
-       classic's at a small part of its rays (BENCHMARKS.md, hierarchical radiosity) */
+       classic's at a small part of its rays (docs/performance-notes.md, hierarchical radiosity) */
     ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
     ho.min_area = mo->hr_min_area;
     if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;

@@ -1,6 +1,6 @@
 /* tool.h - what the rad tool's source files share. Each subcommand lives in its own file and
    is dispatched from rad.c; every file includes radiosity.h without the implementation, which
-   rad.c holds. */
+   common.c holds. */
 #ifndef RAD_TOOL_H
 #define RAD_TOOL_H
 #include "../radiosity.h"
@@ -44,8 +44,21 @@ int rad_image_write_pfm(const char *path, const rad_image *img);         /* 0 on
 int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errlen);
 /* sRGB-encoded 8-bit PNG of exposure * linear value, clamped */
 int rad_image_write_png(const char *path, const rad_image *img, float exposure);
-/* writes .pfm or .png by the path's extension */
+/* OpenEXR, 32-bit float RGB (tinyexr; without -DRAD_TOOL_EXR both fail with a message naming
+   the package libtinyexr-dev) */
+int rad_image_write_exr(const char *path, const rad_image *img);         /* 0 on success */
+int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errlen);
+/* 0 when 'path' names an image format this build writes (.pfm, .png, .exr with tinyexr);
+   else prints why ("rad CMD: ...") and returns 2 */
+int rad_image_check_format(const char *cmd, const char *path);
+/* writes .pfm, .png or .exr by the path's extension: .pfm and .exr ignore 'exposure' (they
+   keep the radiance); .png applies it */
 int rad_image_write(const char *path, const rad_image *img, float exposure);
+/* Reads .png (8-bit sRGB through stb_image, decoded to linear), .exr (tinyexr) or else PFM; 0 on success. */
+int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen);
+int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen);
+/* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
+unsigned char rad_image_srgb8(float linear);
 
 /* ---- output files (image.c): every file the tool writes ------------------------------- */
 /* A temporary file in the destination's folder, renamed onto it by rad_tool_output_commit
@@ -94,6 +107,11 @@ typedef struct rad_trace_options {
 int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
                     const rad_camera *camera, const rad_trace_options *options, const rad_context *ctx,
                     rad_image *out);
+/* Fills options with the defaults (256x256, 64 spp, seed 0, max_depth 64, rr_depth 16).
+   rad_trace_image: 'out' must be zero-initialised or a live image (reallocated when its size
+   differs); returns 0 or a rad_result error (INVALID_ARGUMENT, OUT_OF_MEMORY,
+   RAYCAST_FAILED, CANCELLED by ctx->progress). Surfaces are one-sided like the patches. */
+void rad_trace_options_default(rad_trace_options *options);
 
 /* ---- subcommands: int cmd(int argc, char **argv) with argv[0] the subcommand's first
    argument; return the process exit code (0 ok, 1 failure, 2 usage error) ------------- */
@@ -109,7 +127,7 @@ int rad_cmd_probes(int argc, char **argv);
 /* the rad program (rad.c): dispatches argv[1] to a subcommand; the exit code (main.c) */
 int rad_tool_main(int argc, char **argv);
 
-/* ---- shared helpers (rad.c) ------------------------------------------------------------- */
+/* ---- shared helpers (common.c) ----------------------------------------------------------- */
 /* progress to stderr: a bar when stderr is a terminal, a plain percentage line otherwise */
 int rad_tool_progress(void *user, float fraction);
 void rad_tool_log(void *user, rad_log_level level, const char *message);
@@ -132,22 +150,8 @@ int rad_tool_parse_size(const char *text, int *w, int *h);
    bytes and returns 2 */
 int rad_tool_check_size(const char *cmd, int w, int h);
 
-/* ---- added by trace-metrics ------------------------------------------------------------ */
-/* Reads .png (8-bit sRGB through stb_image, decoded to linear) or else PFM; 0 on success. */
-int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen);
-int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen);
-/* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
-unsigned char rad_image_srgb8(float linear);
-/* rad_image_write: .pfm ignores 'exposure' (PFM keeps the radiance); .png applies it. */
-/* Fills options with the defaults (256x256, 64 spp, seed 0, max_depth 64, rr_depth 16).
-   rad_trace_image: 'out' must be zero-initialised or a live image (reallocated when its size
-   differs); returns 0 or a rad_result error (INVALID_ARGUMENT, OUT_OF_MEMORY,
-   RAYCAST_FAILED, CANCELLED by ctx->progress). Surfaces are one-sided like the patches. */
-void rad_trace_options_default(rad_trace_options *options);
 
-
-/* added by tool-core */
-/* ---- more shared helpers (rad.c) -------------------------------------------------------- */
+/* ---- more shared helpers (common.c) ------------------------------------------------------ */
 /* A context whose log goes to stderr and whose progress is drawn with 'label' (NULL: no
    progress). */
 void rad_tool_context(rad_context *ctx, const char *label);
@@ -213,7 +217,7 @@ void rad_tool_close_world(rad_tool_world *w);
 void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
                             rad_camera *cam);
 
-/* ---- the classic method: patches, F, direct light, solve (cmd_bake.c) --------------------- */
+/* ---- the classic method: patches, F, direct light, solve (classic.c) ---------------------- */
 typedef enum rad_tool_solver { RAD_TOOL_JACOBI = 0, RAD_TOOL_GAUSS_SEIDEL = 1, RAD_TOOL_DIRECT = 2 } rad_tool_solver;
 typedef struct rad_tool_classic_options {
     uint32_t patches;        /* --patches N: target patch count (default 2000) */
@@ -312,7 +316,8 @@ typedef enum rad_tool_method {
     RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
     RAD_TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
     RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7, /* render only (cmd_render.c); vp, aavp also bake_vp (cmd_bake.c) */
-    RAD_TOOL_HIERARCHICAL = 8 /* cmd_render.c; baked as rho H on patches (rad_tool_method_bake) */
+    RAD_TOOL_HIERARCHICAL = 8, /* cmd_render.c; baked as rho H on patches (rad_tool_method_bake) */
+    RAD_TOOL_LIGHTMAP = 9      /* render only (cmd_render.c): a lightmap bake shades the indirect light */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
 typedef enum rad_tool_mb_format {
@@ -506,6 +511,26 @@ int rad_cmd_lightmap(int argc, char **argv);
 /* A simple automatic lightmap unwrap (unwrap.c: charts of connected triangles within 30
    degrees, planar projection, shelf packing with 2-texel gutters): 6 floats per scene triangle
    into out_uvs, the chart count into out_charts (may be NULL). 0, or 1 with a message printed. */
+/* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
+typedef struct rad_tool_lightmap_baked {
+    rad_tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
+    rad_tool_classic cl;     /* the classic solution gathered (patches of w.scene) */
+    rad_lightmap *lm;
+    float *values;           /* width * height * (3 or 12) floats, dilated and stitched */
+    float *uvs;              /* the unwrap's lightmap uvs, or NULL */
+    int own_scene;           /* w.scene and w.bvh are ours */
+} rad_tool_lightmap_baked;
+/* Solves the classic method over the lightmapped world (the file's second uv set, else the
+   unwrap) and bakes: texels, gather of B (sh: L1 SH, else RGB irradiance), with direct != 0
+   and RGB the direct light of the lights and emitters added per texel, dilation, stitching.
+   gather: a rad_lightmap_gather_method, or -1 to choose by the work (the hemisphere gather with
+   hemisphere_rays rays a texel past 2e7 sample-patch pairs). 0, or 1 after printing why (out
+   freed). Free with rad_tool_lightmap_bake_free. */
+int rad_tool_lightmap_bake(const char *cmd, const rad_tool_world *world, const rad_tool_classic_options *co, int width,
+                           int height, uint32_t texel_samples, uint32_t visibility_rays, int gather,
+                           uint32_t hemisphere_rays, int sh, int force_unwrap,
+                           int direct, rad_tool_lightmap_baked *out);
+void rad_tool_lightmap_bake_free(rad_tool_lightmap_baked *b);
 int rad_tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts);
 
 #endif

@@ -1,0 +1,365 @@
+/* common.c - the implementation of radiosity.h for the rad tool, and the helpers every command
+   shares (tool.h): progress and logging, contexts and threads, number and camera parsing, the
+   scene ("world") with its ray backend and lights, and the default camera. */
+#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 199309L /* clock_gettime, isatty */
+#endif
+#define RADIOSITY_IMPLEMENTATION
+#include "tool.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#if defined(__unix__) || defined(__APPLE__)
+#include <unistd.h>
+#define RAD_TOOL_ISATTY(fd) isatty(fd)
+#else
+#define RAD_TOOL_ISATTY(fd) 0
+#endif
+
+/* ---- shared helpers ------------------------------------------------------------------- */
+
+static struct {
+    const void *label;
+    int last;     /* last percentage shown, -1: none */
+    int open;     /* a bar line is open on a terminal */
+} g_progress = {NULL, -1, 0};
+
+void rad_tool_progress_end(void)
+{
+    if (g_progress.open) fprintf(stderr, "\n");
+    g_progress.open = 0;
+    g_progress.last = -1;
+    g_progress.label = NULL;
+}
+
+int rad_tool_progress(void *user, float fraction)
+{
+    const char *label = user ? (const char *)user : "working";
+    int pct;
+    if (!(fraction >= 0.0f)) fraction = 0.0f;
+    if (fraction > 1.0f) fraction = 1.0f;
+    pct = (int)(fraction * 100.0f);
+    if (g_progress.label != user || pct < g_progress.last) {
+        rad_tool_progress_end();
+        g_progress.label = user;
+    }
+    if (pct == g_progress.last) return 0;
+    if (RAD_TOOL_ISATTY(2)) {
+        char bar[31];
+        int i, fill = pct * 30 / 100;
+        for (i = 0; i < 30; ++i) bar[i] = i < fill ? '#' : '.';
+        bar[30] = 0;
+        fprintf(stderr, "\r  %-14s [%s] %3d%%", label, bar, pct);
+        g_progress.open = 1;
+        if (pct >= 100) {
+            fprintf(stderr, "\n");
+            g_progress.open = 0;
+        }
+        fflush(stderr);
+        g_progress.last = pct;
+    } else {
+        /* a plain line every 10% */
+        if (g_progress.last < 0 || pct / 10 != g_progress.last / 10) {
+            fprintf(stderr, "  %s %d%%\n", label, pct / 10 * 10);
+            g_progress.last = pct / 10 * 10;
+        }
+    }
+    if (pct >= 100) g_progress.last = 100;
+    return 0;
+}
+
+void rad_tool_log(void *user, rad_log_level level, const char *message)
+{
+    (void)user;
+    if (g_progress.open) {
+        fprintf(stderr, "\n");
+        g_progress.open = 0;
+    }
+    fprintf(stderr, "rad: %s: %s\n", level == RAD_LOG_ERROR ? "error" : level == RAD_LOG_WARNING ? "warning" : "info",
+            message);
+}
+
+static int g_progress_on = 1;
+
+void rad_tool_show_progress(int on)
+{
+    g_progress_on = on;
+}
+
+void rad_tool_context(rad_context *ctx, const char *label)
+{
+    memset(ctx, 0, sizeof *ctx);
+    ctx->log = rad_tool_log;
+    if (label && g_progress_on) {
+        ctx->progress = rad_tool_progress;
+        ctx->progress_user = (void *)(size_t)label;
+    }
+}
+
+void rad_tool_set_threads(int threads)
+{
+#ifdef _OPENMP
+    if (threads > (int)RAD_TOOL_MAX_THREADS) threads = (int)RAD_TOOL_MAX_THREADS; /* the parsers refuse more */
+    if (threads > 0) omp_set_num_threads(threads);
+#else
+    (void)threads;
+#endif
+}
+
+void *rad_tool_calloc(size_t n, size_t size)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p) {
+        fprintf(stderr, "rad: out of memory (%lu x %lu bytes)\n", (unsigned long)n, (unsigned long)size);
+        exit(1);
+    }
+    return p;
+}
+
+int rad_tool_fail(const char *cmd, const char *what, rad_result r)
+{
+    rad_tool_progress_end();
+    fprintf(stderr, "rad %s: %s failed: %s\n", cmd, what, rad_result_string(r));
+    return 1;
+}
+
+int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out)
+{
+    char *end;
+    unsigned long v;
+    if (!text || !*text || *text == '-') goto bad;
+    v = strtoul(text, &end, 10);
+    if (*end != '\0' || v > 0xFFFFFFFFul) goto bad;
+    *out = (uint32_t)v;
+    return 0;
+bad:
+    fprintf(stderr, "rad %s: bad value '%s' for %s (want a whole number >= 0)\n", cmd, text ? text : "", opt);
+    return 2;
+}
+
+int rad_tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out)
+{
+    uint32_t v = 0;
+    if (rad_tool_parse_uint(cmd, opt, text, &v)) return 2;
+    if (v > RAD_TOOL_MAX_THREADS) {
+        fprintf(stderr, "rad %s: %s %s is too many (at most %u; 0 means all cores)\n", cmd, opt, text,
+                RAD_TOOL_MAX_THREADS);
+        return 2;
+    }
+    *out = v;
+    return 0;
+}
+
+int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out)
+{
+    char *end;
+    float v;
+    if (!text || !*text) goto bad;
+    v = strtof(text, &end);
+    if (*end != '\0' || !(v == v) || fabsf(v) > 1e30f) goto bad;
+    *out = v;
+    return 0;
+bad:
+    fprintf(stderr, "rad %s: bad value '%s' for %s (want a number)\n", cmd, text ? text : "", opt);
+    return 2;
+}
+
+double rad_tool_seconds(void)
+{
+#if defined(_OPENMP)
+    return omp_get_wtime();
+#elif defined(CLOCK_MONOTONIC)
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+#else
+    return (double)clock() / (double)CLOCKS_PER_SEC;
+#endif
+}
+
+int rad_tool_parse_camera(const char *text, rad_camera *out)
+{
+    float v[9];
+    char extra;
+    if (!text) return 1;
+    if (sscanf(text, "%f,%f,%f:%f,%f,%f:%f,%f,%f%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8],
+               &extra) != 9)
+        return 1;
+    {
+        int i;
+        float d2 = 0.0f, u2 = 0.0f;
+        for (i = 0; i < 9; ++i)
+            if (!(v[i] == v[i]) || fabsf(v[i]) > 1e30f) return 1;
+        for (i = 0; i < 3; ++i) {
+            d2 += (v[3 + i] - v[i]) * (v[3 + i] - v[i]);
+            u2 += v[6 + i] * v[6 + i];
+        }
+        if (!(d2 > 0.0f) || !(u2 > 0.0f)) return 1;
+    }
+    memcpy(out->position, v, 3 * sizeof(float));
+    memcpy(out->target, v + 3, 3 * sizeof(float));
+    memcpy(out->up, v + 6, 3 * sizeof(float));
+    return 0;
+}
+
+int rad_tool_parse_size(const char *text, int *w, int *h)
+{
+    unsigned long a, b;
+    char extra;
+    if (!text || sscanf(text, "%lux%lu%c", &a, &b, &extra) != 2) return 1;
+    if (a == 0 || b == 0 || a > 32768 || b > 32768) return 1;
+    *w = (int)a;
+    *h = (int)b;
+    return 0;
+}
+
+int rad_tool_check_size(const char *cmd, int w, int h)
+{
+    double bytes = (double)w * (double)h * 3.0 * sizeof(float);
+    if (w <= 0 || h <= 0) return 2;
+    if (bytes > RAD_TOOL_MAX_IMAGE_BYTES) {
+        fprintf(stderr, "rad %s: --size %dx%d needs %.0f bytes (%.1f GiB) for the image, more than the limit of %.0f bytes (%.0f GiB)\n",
+                cmd, w, h, bytes, bytes / 1073741824.0, RAD_TOOL_MAX_IMAGE_BYTES, RAD_TOOL_MAX_IMAGE_BYTES / 1073741824.0);
+        return 2;
+    }
+    return 0;
+}
+
+int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w)
+{
+    return rad_tool_open_world_lit(cmd, path_or_name, NULL, w);
+}
+
+int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
+                            rad_tool_world *w)
+{
+    char err[1024];
+    rad_context ctx;
+    rad_result r;
+    memset(w, 0, sizeof *w);
+    if (rad_tool_load_scene(path_or_name, &w->file, err, sizeof err) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, err);
+        return 1;
+    }
+    w->file_light_count = w->file.light_count;
+    if (rad_tool_add_lights(cmd, &w->file, lights, &w->lights_storage)) {
+        rad_tool_free_scene(&w->file);
+        return 1;
+    }
+    rad_tool_context(&ctx, NULL);
+    if ((r = rad_scene_create(&w->file.desc, &ctx, &w->scene)) != RAD_SUCCESS) {
+        rad_tool_close_world(w);
+        return rad_tool_fail(cmd, "rad_scene_create", r);
+    }
+    if (w->scene->skipped_triangles)
+        fprintf(stderr, "rad: warning: %u degenerate triangles skipped\n", w->scene->skipped_triangles);
+    if ((r = rad_bvh_create(w->scene, &ctx, &w->bvh)) != RAD_SUCCESS) {
+        rad_tool_close_world(w);
+        return rad_tool_fail(cmd, "rad_bvh_create", r);
+    }
+    rad_bvh_raycaster(w->bvh, &w->rc);
+    return 0;
+}
+
+void rad_tool_close_world(rad_tool_world *w)
+{
+    rad_bvh_destroy(w->bvh);
+    rad_scene_destroy(w->scene);
+    rad_tool_free_scene(&w->file);
+    rad_tool_lights_release(w->lights_storage);
+    memset(w, 0, sizeof *w);
+}
+
+/* ---- a camera for a scene that has none ------------------------------------------------ */
+
+/* How much of a candidate view sees the front of surfaces: a grid of camera rays, counting the
+   hits on front faces and on back faces (the patches are one-sided: a back face renders black). */
+static void camera_score(const rad_scene *scene, const rad_raycaster *rc, const rad_camera *cam, int width, int height,
+                         uint32_t *front, uint32_t *back)
+{
+    enum { GRID = 24 };
+    rad_ray rays[GRID * GRID];
+    rad_hit hits[GRID * GRID];
+    uint32_t n = 0, k;
+    int x, y;
+    *front = *back = 0;
+    for (y = 0; y < GRID; ++y)
+        for (x = 0; x < GRID; ++x)
+            rad_camera_ray(cam, (uint32_t)width, (uint32_t)height, ((float)x + 0.5f) * (float)width / GRID,
+                           ((float)y + 0.5f) * (float)height / GRID, &rays[n++]);
+    if (rc->intersect(rc->user, rays, n, hits) != RAD_SUCCESS) return;
+    for (k = 0; k < n; ++k) {
+        const float *nt;
+        if (hits[k].triangle == RAD_NONE || hits[k].triangle >= scene->triangle_count) continue;
+        nt = scene->normals + 3 * (size_t)hits[k].triangle;
+        if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] < 0.0f) ++*front;
+        else ++*back;
+    }
+}
+
+void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
+                            rad_camera *cam)
+{
+    /* view directions in order of preference: along +z first (the Cornell box's camera and
+       the old default), then the other horizontal ones, then from above and from below */
+    static const float dirs[6][3] = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 1, 0}};
+    static const char *const names[6] = {"+z", "-z", "+x", "-x", "-y (from above)", "+y (from below)"};
+    const float *lo = scene->bounds_min, *hi = scene->bounds_max;
+    float c[3], ext[3], r = 0.0f, d, fov = 39.3077f;
+    rad_camera cand[12];
+    uint32_t front[12], back[12], best_front = 0;
+    int i, k, pick = -1;
+    for (k = 0; k < 3; ++k) {
+        c[k] = 0.5f * (lo[k] + hi[k]);
+        ext[k] = hi[k] - lo[k];
+        r += ext[k] * ext[k];
+    }
+    r = 0.5f * sqrtf(r);
+    if (!(r > 0.0f)) r = 1.0f;
+    d = r / sinf(0.5f * fov / 57.29577951f);
+    for (i = 0; i < 12; ++i) {
+        const float *v = dirs[i % 6];
+        rad_camera *q = &cand[i];
+        for (k = 0; k < 3; ++k) {
+            /* 0-5: outside, the bounding sphere in view; 6-11: inside, near the side of the
+               bounds behind the camera, looking across */
+            float back_off = i < 6 ? d : 0.45f * ext[k];
+            q->position[k] = c[k] - v[k] * back_off;
+            q->target[k] = q->position[k] + v[k];
+        }
+        q->up[0] = 0.0f, q->up[1] = v[1] != 0.0f ? 0.0f : 1.0f, q->up[2] = v[1] != 0.0f ? 1.0f : 0.0f;
+        q->fov_y_degrees = i < 6 ? fov : 75.0f; /* inside: wide, to see the room around the far wall */
+        camera_score(scene, rc, q, width, height, &front[i], &back[i]);
+    }
+    /* a view qualifies when nine in ten of its hits are front faces; outside views come first
+       (the first qualifying one seeing at least half as much as the best of them), then the
+       inside ones (the one seeing most) */
+    for (i = 0; i < 6; ++i)
+        if (front[i] > 0 && 10u * front[i] >= 9u * (front[i] + back[i]) && front[i] > best_front) best_front = front[i];
+    for (i = 0; i < 6 && pick < 0 && best_front; ++i)
+        if (front[i] > 0 && 10u * front[i] >= 9u * (front[i] + back[i]) && 2u * front[i] >= best_front) pick = i;
+    for (i = 6; i < 12 && pick < 0; ++i)
+        if (front[i] > 0 && 10u * front[i] >= 9u * (front[i] + back[i]) &&
+            (pick < 0 || front[i] > front[pick]))
+            pick = i;
+    if (pick < 0) { /* nothing clean: the view with the most front faces over back faces */
+        long best = 0;
+        for (i = 0; i < 12; ++i)
+            if ((long)front[i] - (long)back[i] > best) best = (long)front[i] - (long)back[i], pick = i;
+        if (pick < 0) pick = 0;
+    }
+    *cam = cand[pick];
+    fprintf(stderr,
+            "rad %s: the scene has no camera: bounds (%g, %g, %g) to (%g, %g, %g); chose --camera %g,%g,%g:%g,%g,%g:%g,%g,%g "
+            "--fov %g (%s the bounds, looking along %s: %u of %u sample rays see a front face, %u a back face)\n",
+            cmd, (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0], (double)hi[1], (double)hi[2],
+            (double)cam->position[0], (double)cam->position[1], (double)cam->position[2], (double)cam->target[0],
+            (double)cam->target[1], (double)cam->target[2], (double)cam->up[0], (double)cam->up[1], (double)cam->up[2],
+            (double)cam->fov_y_degrees, pick < 6 ? "outside" : "inside", names[pick % 6], front[pick], 24u * 24u,
+            back[pick]);
+}
