@@ -983,10 +983,35 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    elements' radiosity, the classic H = F B; the renderer's indirect term is rho / pi H).
    Without clustering, step 1 joins every pair of scene triangles, O(T^2) links: meant for
    scenes of up to a few thousand triangles (more than RAD_HIERARCHICAL_MAX_ROOT_PAIRS ordered
-   pairs is refused with SIZE_OVERFLOW). Reentrant; the solve uses ctx->parallel_for for the
-   links' form factors; after it the accessors and lookups only read (any threads at once). */
+   pairs is refused with SIZE_OVERFLOW).
+   Clustering (Smits, Arvo and Greenberg 1994, "A Clustering Algorithm for Radiosity in Complex
+   Environments") makes step 1 O(1): the scene triangles are the leaves of a binary tree of
+   volume clusters (median splits of their centroids along the longest axis; a cluster keeps
+   its bounding sphere, total area and the area-weighted mean of its members' B), and step 1
+   is the one link root cluster <- root cluster. A link with a cluster on either side, its
+   ends' bounding spheres a gap g apart, is refined (the end with the larger sphere split:
+   a cluster into its two children, an element as above) while the spheres overlap or its
+   bound on the power it carries, max_c(B) of the source's members times A_r
+   min(1, A_s / (pi g^2)), exceeds tolerance * P; links reaching two elements go on as in
+   step 2. Such a link's F: the source's projected area toward the receiver, the sum over its
+   member triangles of A_j max(0, n_j . w) (w from centre to centre, d apart), over pi d^2,
+   times the weighted share of visibility rays between area-sampled member points that nothing
+   blocks. An element receiver takes its own cosine; a cluster receiver hands the irradiance
+   straight to its member triangles, each by its own cosine to the source (so a cluster lit
+   from one side lights only the triangles facing that side), before the push. Reentrant; the
+   solve uses ctx->parallel_for for the links' form factors and the clusters' gather; after it
+   the accessors and lookups only read (any threads at once). */
 
 #define RAD_HIERARCHICAL_MAX_ROOT_PAIRS 50000000ull
+/* RAD_HIERARCHICAL_CLUSTER_AUTO clusters scenes with more ordered triangle pairs than this */
+#define RAD_HIERARCHICAL_AUTO_CLUSTER_PAIRS 1000000ull
+
+/* whether the links start at one root cluster or at all pairs of scene triangles */
+typedef enum rad_hierarchical_clustering {
+    RAD_HIERARCHICAL_CLUSTER_AUTO = 0, /* clusters above RAD_HIERARCHICAL_AUTO_CLUSTER_PAIRS pairs */
+    RAD_HIERARCHICAL_CLUSTER_OFF = 1,  /* all pairs (refused above RAD_HIERARCHICAL_MAX_ROOT_PAIRS) */
+    RAD_HIERARCHICAL_CLUSTER_ON = 2
+} rad_hierarchical_clustering;
 
 /* The source term of elements: out_E (3 per point) for 'count' element centroids 'points'
    with unit normals, the scene triangles they lie on and their albedos (3 per point).
@@ -1009,6 +1034,7 @@ typedef struct rad_hierarchical_options {
     int skip_visibility;       /* non-zero: V = 1, no rays (the raycaster may be NULL) */
     rad_hierarchical_source_fn source; /* NULL: E = pi * the material's emitted radiance */
     void *source_user;
+    rad_hierarchical_clustering clustering; /* 0: AUTO */
 } rad_hierarchical_options;
 
 typedef struct rad_hierarchical_stats {
@@ -1021,6 +1047,9 @@ typedef struct rad_hierarchical_stats {
     uint32_t rounds;           /* refine-and-solve rounds done */
     uint32_t sweeps;           /* gather and push-pull sweeps, all rounds */
     double residual;           /* last sweep's largest change of B / max B */
+    uint32_t clusters;         /* volume clusters built (0 without clustering) */
+    uint64_t cluster_links;    /* links of the final solution with a cluster at either end */
+    uint64_t projections;      /* member triangles projected for cluster links' F */
 } rad_hierarchical_stats;
 
 /* what rad_hierarchical_lookup returns */
@@ -1032,13 +1061,15 @@ typedef enum rad_hierarchical_value {
 typedef struct rad_hierarchical rad_hierarchical;
 
 /* Defaults: tolerance 1e-3, min_area 0 (total / 10000), visibility_rays 4, max_iterations 16,
-   ray_epsilon 1e-5, the rest 0. */
+   ray_epsilon 1e-5, clustering AUTO, the rest 0. */
 RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *options);
 
 /* Checks the options and makes the roots (one element per scene triangle, its albedo at the
    centroid). scene and raycaster are borrowed and must outlive the object; raycaster may be
-   NULL with skip_visibility. Errors: INVALID_ARGUMENT (NULL, a bad option: the logger names
-   it), SIZE_OVERFLOW (too many triangle pairs), ALBEDO_RANGE, OUT_OF_MEMORY. O(T). */
+   NULL with skip_visibility. With clustering, builds the cluster tree. Errors:
+   INVALID_ARGUMENT (NULL, a bad option: the logger names it), SIZE_OVERFLOW (too many
+   triangle pairs without clustering, or 2^31 triangles), ALBEDO_RANGE, OUT_OF_MEMORY.
+   O(T) (O(T log T) with clustering). */
 RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_raycaster *raycaster,
                                            const rad_hierarchical_options *options, const rad_context *ctx,
                                            rad_hierarchical **out);
@@ -1047,7 +1078,9 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
    twice), RAYCAST_FAILED, NON_FINITE (a source value or the result), NEGATIVE_EMISSION (the
    source gave E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000),
    CANCELLED, OUT_OF_MEMORY. After an error the object can only be destroyed.
-   Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep. */
+   Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep; with
+   clustering also O(members of the source) projections per cluster link evaluated and, per
+   sweep, per triangle the links into the clusters above it. */
 RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx);
 RAD_API void rad_hierarchical_destroy(rad_hierarchical *h);
 
@@ -1060,8 +1093,10 @@ RAD_API void rad_hierarchical_get_stats(const rad_hierarchical *h, rad_hierarchi
 RAD_API rad_result rad_hierarchical_leaves(const rad_hierarchical *h, uint32_t first, uint32_t count, float *out_corners,
                                            uint32_t *out_triangles, float *out_B, float *out_H);
 /* Links [first, first + count) of the solution: the receiver's and the source's centroids
-   (6 floats each), the form factor F_rs with visibility, and the receiver's and source's
-   depths in their quadtrees (2 per link; 0: a scene triangle). Any output may be NULL.
+   (6 floats each; a cluster's: its bounding sphere's centre), the form factor F_rs with
+   visibility (a cluster receiver's: before each member's cosine), and the receiver's and
+   source's depths in their quadtrees (2 per link; 0: a scene triangle; RAD_NONE: a cluster).
+   Any output may be NULL.
    Errors as rad_hierarchical_leaves. */
 RAD_API rad_result rad_hierarchical_links(const rad_hierarchical *h, uint64_t first, uint32_t count, float *out_points,
                                           float *out_form_factors, uint32_t *out_depths);
@@ -7826,6 +7861,24 @@ typedef struct rad__hr_link {
     float F, Fu, Fd;
 } rad__hr_link;
 
+/* A volume cluster: members perm[lo, hi) (the scene triangles under it); children are node
+   ids, a node id being an element index or RAD__HR_CL | a cluster index. Children come after
+   their parent, so reverse index order is a bottom-up one. */
+#define RAD__HR_CL 0x80000000u
+typedef struct rad__hr_cluster {
+    float c[3], radius, area;
+    float m2[6];         /* the members' second moments about c (rad__hr_tri_m2) */
+    float B[3], bmax;    /* area-weighted mean B of the members, and their largest channel */
+    uint32_t child[2], lo, hi, parent;
+} rad__hr_cluster;
+
+/* a link into a cluster, by receiver (the gather's per-member pass): F and the unit direction
+   u from the receiver's centre to the source's */
+typedef struct rad__hr_in {
+    float u[3], F;
+    uint32_t s;
+} rad__hr_in;
+
 struct rad_hierarchical {
     const rad_scene *scene;
     rad_raycaster rc;
@@ -7839,6 +7892,11 @@ struct rad_hierarchical {
     size_t nlinks;
     uint32_t *leaf, *leaf_of, *leaf_vert, nleaf, nvert;
     float *vert_B, *vert_H;
+    rad__hr_cluster *cl;     /* NULL without clustering */
+    uint32_t ncl, *perm, *tri_parent;
+    double *cum_area;        /* cum_area[i]: the area of perm[0, i) */
+    rad__hr_in *in;          /* links into clusters, grouped by receiver: in_first[c] .. in_first[c + 1] */
+    uint32_t *in_first;
     rad_hierarchical_stats st;
     int state;           /* 0 created, 1 solved, -1 a solve failed */
     rad_allocator allocator;
@@ -7866,6 +7924,12 @@ RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
     rad__free(&a, h->leaf_vert);
     rad__free(&a, h->vert_B);
     rad__free(&a, h->vert_H);
+    rad__free(&a, h->cl);
+    rad__free(&a, h->perm);
+    rad__free(&a, h->tri_parent);
+    rad__free(&a, h->cum_area);
+    rad__free(&a, h->in);
+    rad__free(&a, h->in_first);
     rad__free(&a, h);
 }
 
@@ -7887,6 +7951,147 @@ static void rad__hr_centroid(const rad__hr_elem *e, float *c)
     for (k = 0; k < 3; ++k) c[k] = (e->v[k] + e->v[3 + k] + e->v[6 + k]) / 3.0f;
 }
 
+/* Adds A times the second moments of triangle v about c (the mean over it of (x - c)(x - c)^T:
+   xx yy zz xy xz yz) to m: (g - c)(g - c)^T plus the spread about its centroid g,
+   sum over corners of (v_i - g)(v_i - g)^T / 12. */
+static void rad__hr_tri_m2(const float *v, const float *c, double A, double *m)
+{
+    static const int ia[6] = { 0, 1, 2, 0, 0, 1 }, ib[6] = { 0, 1, 2, 1, 2, 2 };
+    float g[3], d[3], e[3];
+    int k, q;
+    for (k = 0; k < 3; ++k) g[k] = (v[k] + v[3 + k] + v[6 + k]) / 3.0f;
+    rad__sub(d, g, c);
+    for (q = 0; q < 6; ++q) m[q] += A * (double)d[ia[q]] * (double)d[ib[q]];
+    for (k = 0; k < 3; ++k) {
+        rad__sub(e, v + 3 * k, g);
+        for (q = 0; q < 6; ++q) m[q] += A * (double)e[ia[q]] * (double)e[ib[q]] / 12.0;
+    }
+}
+
+static int rad__hr_is_cl(uint32_t id) { return (id & RAD__HR_CL) != 0u; }
+
+/* what links need of node id (an element or RAD__HR_CL | cluster): centre, bounding radius,
+   area, mean B and its largest channel; any output may be NULL */
+static void rad__hr_node(const rad_hierarchical *h, uint32_t id, float *c, float *radius, float *area, const float **B,
+                         float *bmax)
+{
+    const float *b;
+    if (rad__hr_is_cl(id)) {
+        const rad__hr_cluster *cl = &h->cl[id & ~RAD__HR_CL];
+        if (c) memcpy(c, cl->c, 3 * sizeof(float));
+        if (radius) *radius = cl->radius;
+        if (area) *area = cl->area;
+        if (B) *B = cl->B;
+        if (bmax) *bmax = cl->bmax;
+        return;
+    }
+    {
+        const rad__hr_elem *e = &h->el[id];
+        float cc[3];
+        rad__hr_centroid(e, cc);
+        if (c) memcpy(c, cc, sizeof(cc));
+        if (radius) {
+            float r2 = 0.0f, d[3], q;
+            int m;
+            for (m = 0; m < 3; ++m) {
+                rad__sub(d, e->v + 3 * m, cc);
+                q = rad__dot(d, d);
+                if (q > r2) r2 = q;
+            }
+            *radius = (float)sqrt((double)r2);
+        }
+        if (area) *area = e->area;
+        b = e->B;
+        if (B) *B = b;
+        if (bmax) *bmax = b[0] > b[1] ? (b[0] > b[2] ? b[0] : b[2]) : (b[1] > b[2] ? b[1] : b[2]);
+    }
+}
+
+/* the clusters' B and bmax from their children's, bottom up (children have larger indices) */
+static void rad__hr_cluster_pull(rad_hierarchical *h)
+{
+    uint32_t i, m, k;
+    for (i = h->ncl; i-- > 0;) {
+        rad__hr_cluster *cl = &h->cl[i];
+        double a = 0.0, s[3] = { 0.0, 0.0, 0.0 };
+        float bm = 0.0f;
+        for (m = 0; m < 2; ++m) {
+            const float *B;
+            float A, x;
+            rad__hr_node(h, cl->child[m], NULL, NULL, &A, &B, &x);
+            a += (double)A;
+            for (k = 0; k < 3; ++k) s[k] += (double)A * (double)B[k];
+            if (x > bm) bm = x;
+        }
+        for (k = 0; k < 3; ++k) cl->B[k] = a > 0.0 ? (float)(s[k] / a) : 0.0f;
+        cl->bmax = bm;
+    }
+}
+
+/* the spread of node id's area about its centre across unit direction w: the mean of
+   |x - c|^2 - ((x - c) . w)^2 over its area (second moments of rad__hr_tri_m2) */
+static double rad__hr_lateral(const rad_hierarchical *h, uint32_t id, const float *w)
+{
+    double m[6] = { 0, 0, 0, 0, 0, 0 }, along;
+    if (rad__hr_is_cl(id)) {
+        int q;
+        for (q = 0; q < 6; ++q) m[q] = (double)h->cl[id & ~RAD__HR_CL].m2[q];
+    } else {
+        float c[3];
+        rad__hr_centroid(&h->el[id], c);
+        rad__hr_tri_m2(h->el[id].v, c, 1.0, m);
+    }
+    along = m[0] * w[0] * w[0] + m[1] * w[1] * w[1] + m[2] * w[2] * w[2] +
+            2.0 * (m[3] * w[0] * w[1] + m[4] * w[0] * w[2] + m[5] * w[1] * w[2]);
+    along = m[0] + m[1] + m[2] - along;
+    return along > 0.0 ? along : 0.0;
+}
+
+/* the projected area of node id toward unit w: sum of A max(0, n . w) over its triangles */
+static double rad__hr_projected(const rad_hierarchical *h, uint32_t id, const float *w, uint64_t *count)
+{
+    double p = 0.0;
+    if (rad__hr_is_cl(id)) {
+        const rad__hr_cluster *cl = &h->cl[id & ~RAD__HR_CL];
+        uint32_t j;
+        for (j = cl->lo; j < cl->hi; ++j) {
+            uint32_t t = h->perm[j];
+            float c = rad__dot(h->scene->normals + 3 * (size_t)t, w);
+            if (c > 0.0f) p += (double)h->scene->areas[t] * (double)c;
+        }
+        *count += cl->hi - cl->lo;
+    } else {
+        float c = rad__dot(h->el[id].n, w);
+        if (c > 0.0f) p = (double)h->el[id].area * (double)c;
+        *count += 1u;
+    }
+    return p;
+}
+
+/* a point p of node id and its normal n: on the element, or on a member triangle picked by
+   area (u0) ; (u1, u2) place it on the triangle */
+static void rad__hr_node_point(const rad_hierarchical *h, uint32_t id, float u0, float u1, float u2, float *p, float *n)
+{
+    const float *v, *nv;
+    if (rad__hr_is_cl(id)) {
+        const rad__hr_cluster *cl = &h->cl[id & ~RAD__HR_CL];
+        double target = h->cum_area[cl->lo] + (double)u0 * (h->cum_area[cl->hi] - h->cum_area[cl->lo]);
+        uint32_t lo = cl->lo, hi = cl->hi - 1u; /* the last j in [lo, hi] with cum_area[j] <= target */
+        while (lo < hi) {
+            uint32_t mid = lo + (hi - lo + 1u) / 2u;
+            if (h->cum_area[mid] <= target) lo = mid;
+            else hi = mid - 1u;
+        }
+        v = h->scene->positions + 9 * (size_t)h->perm[lo];
+        nv = h->scene->normals + 3 * (size_t)h->perm[lo];
+    } else {
+        v = h->el[id].v;
+        nv = h->el[id].n;
+    }
+    rad__triangle_point(v, v + 3, v + 6, u1, u2, p);
+    memcpy(n, nv, 3 * sizeof(float));
+}
+
 /* the element's albedo at its centroid; ALBEDO_RANGE when a texture callback leaves [0,1) */
 static rad_result rad__hr_albedo(const rad_hierarchical *h, rad__hr_elem *e, const rad__ctx *c)
 {
@@ -7899,6 +8104,130 @@ static rad_result rad__hr_albedo(const rad_hierarchical *h, rad__hr_elem *e, con
             return RAD_ERROR_ALBEDO_RANGE;
         }
     return RAD_SUCCESS;
+}
+
+/* Reorders perm[lo, hi) so that perm[k] has the k-th smallest key (quickselect). */
+static void rad__hr_select(uint32_t *perm, const float *key, uint32_t lo, uint32_t hi, uint32_t k)
+{
+    while (hi - lo > 1u) {
+        float pivot = key[perm[lo + (hi - lo) / 2u]];
+        uint32_t i = lo, j = hi - 1u, t;
+        for (;;) { /* Hoare partition: [lo, j] <= pivot <= [j + 1, hi) */
+            while (key[perm[i]] < pivot) ++i;
+            while (key[perm[j]] > pivot) --j;
+            if (i >= j) break;
+            t = perm[i]; perm[i] = perm[j]; perm[j] = t;
+            ++i;
+            --j;
+        }
+        if (i == j) { /* perm[j] holds the pivot, in its final place */
+            if (k == j) return;
+            if (k < j) hi = j;
+            else lo = j + 1u;
+        } else if (k <= j) {
+            hi = j + 1u;
+        } else {
+            lo = j + 1u;
+        }
+    }
+}
+
+/* The cluster tree over the scene triangles (>>api_hierarchical): T - 1 clusters, built top
+   down by median splits along the longest axis of the members' centroids. */
+static rad_result rad__hr_build_clusters(rad_hierarchical *h, const rad__ctx *c)
+{
+    const rad_scene *S = h->scene;
+    uint32_t T = S->triangle_count, i, k, top = 0;
+    float *key = NULL;
+    uint32_t *stack = NULL; /* (lo, hi, parent, slot) per pending range */
+    rad_result r = RAD_SUCCESS;
+    h->cl = (rad__hr_cluster *)rad__alloc_array(&h->allocator, T - 1u, sizeof(rad__hr_cluster));
+    h->perm = (uint32_t *)rad__alloc_array(&h->allocator, T, sizeof(uint32_t));
+    h->tri_parent = (uint32_t *)rad__alloc_array(&h->allocator, T, sizeof(uint32_t));
+    h->cum_area = (double *)rad__alloc_array(&h->allocator, (size_t)T + 1u, sizeof(double));
+    key = (float *)rad__alloc_array(&h->allocator, T, 4u * sizeof(float));
+    stack = (uint32_t *)rad__alloc_array(&h->allocator, 2u * (size_t)T, 4u * sizeof(uint32_t));
+    if (!h->cl || !h->perm || !h->tri_parent || !h->cum_area || !key || !stack) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_create: out of memory for the clusters of %u triangles", T);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < T; ++i) {
+        const float *v = S->positions + 9 * (size_t)i;
+        h->perm[i] = i;
+        for (k = 0; k < 3; ++k) key[(size_t)k * T + i] = (v[k] + v[3 + k] + v[6 + k]) / 3.0f;
+    }
+    h->ncl = 0;
+    stack[0] = 0; stack[1] = T; stack[2] = RAD_NONE; stack[3] = 0;
+    top = 1;
+    while (top > 0) {
+        uint32_t lo, hi, parent, slot, id, axis = 0, mid;
+        float lo3[3] = { FLT_MAX, FLT_MAX, FLT_MAX }, hi3[3] = { -FLT_MAX, -FLT_MAX, -FLT_MAX }, ext = -1.0f;
+        --top;
+        lo = stack[4 * top]; hi = stack[4 * top + 1]; parent = stack[4 * top + 2]; slot = stack[4 * top + 3];
+        if (hi - lo == 1u) {
+            id = h->perm[lo];
+            h->tri_parent[id] = parent;
+        } else {
+            rad__hr_cluster *cl = &h->cl[h->ncl];
+            id = RAD__HR_CL | h->ncl++;
+            memset(cl, 0, sizeof(*cl));
+            cl->lo = lo;
+            cl->hi = hi;
+            cl->parent = parent;
+            for (i = lo; i < hi; ++i)
+                for (k = 0; k < 3; ++k) {
+                    float x = key[(size_t)k * T + h->perm[i]];
+                    if (x < lo3[k]) lo3[k] = x;
+                    if (x > hi3[k]) hi3[k] = x;
+                }
+            for (k = 0; k < 3; ++k)
+                if (hi3[k] - lo3[k] > ext) { ext = hi3[k] - lo3[k]; axis = k; }
+            mid = lo + (hi - lo) / 2u;
+            rad__hr_select(h->perm, key + (size_t)axis * T, lo, hi, mid);
+            /* the right half is pushed first so the left is built first: children get
+               increasing indices in depth-first order, after their parent */
+            stack[4 * top] = mid; stack[4 * top + 1] = hi; stack[4 * top + 2] = id & ~RAD__HR_CL; stack[4 * top + 3] = 1;
+            ++top;
+            stack[4 * top] = lo; stack[4 * top + 1] = mid; stack[4 * top + 2] = id & ~RAD__HR_CL; stack[4 * top + 3] = 0;
+            ++top;
+        }
+        if (parent != RAD_NONE) h->cl[parent].child[slot] = id;
+    }
+    /* bounding spheres (centred on the box of the members' corners), areas, cumulative areas */
+    h->cum_area[0] = 0.0;
+    for (i = 0; i < T; ++i) h->cum_area[i + 1u] = h->cum_area[i] + (double)S->areas[h->perm[i]];
+    for (i = 0; i < h->ncl; ++i) {
+        rad__hr_cluster *cl = &h->cl[i];
+        float lo3[3] = { FLT_MAX, FLT_MAX, FLT_MAX }, hi3[3] = { -FLT_MAX, -FLT_MAX, -FLT_MAX }, r2 = 0.0f;
+        uint32_t j, m;
+        for (j = cl->lo; j < cl->hi; ++j)
+            for (m = 0; m < 9; ++m) {
+                float x = S->positions[9 * (size_t)h->perm[j] + m];
+                if (x < lo3[m % 3u]) lo3[m % 3u] = x;
+                if (x > hi3[m % 3u]) hi3[m % 3u] = x;
+            }
+        for (k = 0; k < 3; ++k) cl->c[k] = 0.5f * (lo3[k] + hi3[k]);
+        for (j = cl->lo; j < cl->hi; ++j)
+            for (m = 0; m < 3; ++m) {
+                float d[3], q;
+                rad__sub(d, S->positions + 9 * (size_t)h->perm[j] + 3 * m, cl->c);
+                q = rad__dot(d, d);
+                if (q > r2) r2 = q;
+            }
+        cl->radius = (float)sqrt((double)r2) * (1.0f + 1e-6f);
+        cl->area = (float)(h->cum_area[cl->hi] - h->cum_area[cl->lo]);
+        {
+            double m2[6] = { 0, 0, 0, 0, 0, 0 };
+            for (j = cl->lo; j < cl->hi; ++j)
+                rad__hr_tri_m2(S->positions + 9 * (size_t)h->perm[j], cl->c, (double)S->areas[h->perm[j]], m2);
+            for (m = 0; m < 6; ++m) cl->m2[m] = cl->area > 0.0f ? (float)(m2[m] / (double)cl->area) : 0.0f;
+        }
+    }
+done:
+    rad__free(&h->allocator, key);
+    rad__free(&h->allocator, stack);
+    return r;
 }
 
 RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_raycaster *raycaster,
@@ -7956,9 +8285,21 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
         rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: the scene has no triangles");
         return RAD_ERROR_EMPTY_SCENE;
     }
-    if ((double)T * (double)(T - 1u) > (double)RAD_HIERARCHICAL_MAX_ROOT_PAIRS) {
+    if ((unsigned)o.clustering > (unsigned)RAD_HIERARCHICAL_CLUSTER_ON) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: clustering %d is not AUTO, OFF or ON", (int)o.clustering);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (T >= RAD__HR_CL) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: %u triangles, at most 2^31 - 1", T);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    if (o.clustering == RAD_HIERARCHICAL_CLUSTER_AUTO)
+        o.clustering = (double)T * (double)(T - 1u) > (double)RAD_HIERARCHICAL_AUTO_CLUSTER_PAIRS ? RAD_HIERARCHICAL_CLUSTER_ON
+                                                                                                  : RAD_HIERARCHICAL_CLUSTER_OFF;
+    if (T < 2u) o.clustering = RAD_HIERARCHICAL_CLUSTER_OFF; /* nothing to cluster */
+    if (o.clustering == RAD_HIERARCHICAL_CLUSTER_OFF && (double)T * (double)(T - 1u) > (double)RAD_HIERARCHICAL_MAX_ROOT_PAIRS) {
         rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: %u triangles give %.0f ordered pairs, more than the %llu "
-                 "first links allowed (no clustering: see >>api_hierarchical)", T, (double)T * (double)(T - 1u),
+                 "first links allowed without clustering (set clustering to AUTO or ON)", T, (double)T * (double)(T - 1u),
                  (unsigned long long)RAD_HIERARCHICAL_MAX_ROOT_PAIRS);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
@@ -8005,6 +8346,10 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
         }
     }
     h->nel = T;
+    if (o.clustering == RAD_HIERARCHICAL_CLUSTER_ON && (r = rad__hr_build_clusters(h, &c)) != RAD_SUCCESS) {
+        rad_hierarchical_destroy(h);
+        return r;
+    }
     *out = h;
     return RAD_SUCCESS;
 }
@@ -8019,12 +8364,12 @@ static rad_result rad__hr_split(rad_hierarchical *h, uint32_t i, const rad__ctx 
     int m, j;
     rad_result r;
     if (h->el[i].child != RAD_NONE) return RAD_SUCCESS;
-    if (h->nel > 0xFFFFFFF0u - 4u) {
-        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: more than 2^32 elements");
+    if (h->nel > RAD__HR_CL - 8u) { /* element ids stay below the cluster bit */
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: more than 2^31 elements");
         return RAD_ERROR_SIZE_OVERFLOW;
     }
     if (h->nel + 4u > h->cap_el) {
-        uint32_t cap = h->cap_el > 0x7FFFFFF0u ? 0xFFFFFFF0u : 2u * h->cap_el;
+        uint32_t cap = h->cap_el > 0x3FFFFFF8u ? RAD__HR_CL : 2u * h->cap_el;
         size_t old_bytes, new_bytes;
         rad__hr_elem *grown;
         if (!rad__mul(h->cap_el, sizeof(rad__hr_elem), &old_bytes) || !rad__mul(cap, sizeof(rad__hr_elem), &new_bytes))
@@ -8144,7 +8489,7 @@ typedef struct rad__hr_eval {
     uint8_t *occ;
     float *w;
     size_t *idx;
-    uint64_t *kernels, *rays_cast;
+    uint64_t *kernels, *rays_cast, *proj;
     rad_result *results;
 } rad__hr_eval;
 
@@ -8157,6 +8502,86 @@ static rad_result rad__hr_flush(rad__hr_eval *ev, uint32_t task, uint32_t n)
     ev->rays_cast[task] += n;
     for (k = 0; k < n; ++k)
         if (!ev->occ[base + k]) ev->links[ev->idx[base + k]].F += ev->w[base + k];
+    return RAD_SUCCESS;
+}
+
+/* A link with a cluster at an end (>>api_hierarchical): F from the source's projected area
+   toward the receiver over pi d^2 (times the receiver element's cosine), and K rays between
+   points drawn on both ends by area, each weighted by its two member cosines to the centre
+   line; the link's F is the weighted share that arrives. Ends whose spheres overlap get F 0:
+   the oracle refines them whatever F says. Queues rays on the task's batch. */
+static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l, uint32_t *nrays)
+{
+    rad_hierarchical *h = ev->h;
+    rad__hr_link *lk = &ev->links[l];
+    size_t base = (size_t)task * RAD__RAY_BATCH;
+    uint32_t K = h->nside * h->nside, a, got = 0, k;
+    float cr[3], cs[3], rr, rs, w[3], d, fu, wt[RAD__HR_MAX_RAYS], xs[3 * RAD__HR_MAX_RAYS], ys[3 * RAD__HR_MAX_RAYS];
+    float nx[3 * RAD__HR_MAX_RAYS], ny[3 * RAD__HR_MAX_RAYS];
+    double wsum = 0.0;
+    lk->F = lk->Fu = lk->Fd = 0.0f;
+    rad__hr_node(h, lk->r, cr, &rr, NULL, NULL, NULL);
+    rad__hr_node(h, lk->s, cs, &rs, NULL, NULL, NULL);
+    rad__sub(w, cr, cs);
+    d = rad__len(w);
+    if (!(d > rr + rs)) return RAD_SUCCESS;
+    for (k = 0; k < 3; ++k) w[k] /= d;
+    {
+        double m2 = rad__hr_lateral(h, lk->r, w) + rad__hr_lateral(h, lk->s, w);
+        /* d^2 plus the ends' spread across the centre line: the mean of 1 / r^2 over two
+           facing pieces is below the value at their centres (a point on the axis of a
+           disk of radius a sees a^2 / (h^2 + a^2), not a^2 / h^2) */
+        fu = (float)(rad__hr_projected(h, lk->s, w, &ev->proj[task]) / (RAD__PI * ((double)d * (double)d + m2)));
+    }
+    if (fu > 1.0f) fu = 1.0f;
+    if (!rad__hr_is_cl(lk->r)) {
+        float cosr = -rad__dot(h->el[lk->r].n, w);
+        fu = cosr > 0.0f ? fu * cosr : 0.0f;
+    }
+    lk->Fu = fu;
+    if (!(fu > 0.0f)) return RAD_SUCCESS;
+    if (h->o.skip_visibility) {
+        lk->F = fu;
+        return RAD_SUCCESS;
+    }
+    /* up to 4K draws for K pairs that face each other */
+    for (a = 0; a < 4u * K && got < K; ++a) {
+        uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s ^ rad__hash(a + 0x632be5abu))));
+        uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
+        float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2;
+        rad__hr_node_point(h, lk->r, (float)(h1 >> 8) / 16777216.0f, (float)(h2 & 0xFFFFu) / 65536.0f,
+                           (float)(h2 >> 16) / 65536.0f, x, n1);
+        rad__hr_node_point(h, lk->s, (float)(h3 >> 8) / 16777216.0f, (float)(h1 & 0xFFu) / 256.0f + (float)(h3 & 0xFFu) / 65536.0f,
+                           (float)((h3 >> 8) & 0xFFFFu) / 65536.0f, y, n2);
+        c1 = -rad__dot(n1, w);
+        c2 = rad__dot(n2, w);
+        if (!(c1 > 0.0f && c2 > 0.0f)) continue;
+        wt[got] = c1 * c2;
+        wsum += (double)wt[got];
+        ++got;
+    }
+    if (!(wsum > 0.0)) { /* no facing pair found: nothing known of visibility */
+        lk->F = fu;
+        return RAD_SUCCESS;
+    }
+    for (a = 0; a < got; ++a) {
+        rad_ray *ray = ev->rays + base + *nrays;
+        float len;
+        for (k = 0; k < 3; ++k) {
+            ray->origin[k] = xs[3 * a + k] + nx[3 * a + k] * h->ray_eps;
+            ray->dir[k] = (ys[3 * a + k] + ny[3 * a + k] * h->ray_eps) - ray->origin[k];
+        }
+        len = rad__len(ray->dir);
+        ray->tmin = 0.0f;
+        ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+        ev->w[base + *nrays] = (float)((double)fu * (double)wt[a] / wsum);
+        ev->idx[base + *nrays] = l;
+        if (++*nrays == RAD__RAY_BATCH) {
+            rad_result r = rad__hr_flush(ev, task, *nrays);
+            *nrays = 0;
+            if (r != RAD_SUCCESS) return r;
+        }
+    }
     return RAD_SUCCESS;
 }
 
@@ -8175,7 +8600,13 @@ static void rad__hr_eval_task(void *data, uint32_t task)
     rad_result r = RAD_SUCCESS;
     for (l = b; l < e && r == RAD_SUCCESS; ++l) {
         rad__hr_link *lk = &ev->links[l];
-        const rad__hr_elem *er = &h->el[lk->r], *es = &h->el[lk->s];
+        const rad__hr_elem *er, *es;
+        if (rad__hr_is_cl(lk->r) || rad__hr_is_cl(lk->s)) {
+            r = rad__hr_eval_cluster(ev, task, l, &nrays);
+            continue;
+        }
+        er = &h->el[lk->r];
+        es = &h->el[lk->s];
         uint32_t hs = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s)));
         float r1 = (float)(hs & 0xFFFFu) / 65536.0f, r2 = (float)(hs >> 16) / 65536.0f;
         float xs[3 * RAD__HR_MAX_RAYS], ys[3 * RAD__HR_MAX_RAYS];
@@ -8259,19 +8690,21 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
     ev.idx = (size_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(size_t));
     ev.kernels = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
     ev.rays_cast = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
+    ev.proj = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
     ev.results = (rad_result *)rad__alloc_array(&h->allocator, tasks, sizeof(rad_result));
-    if (!ev.rays || !ev.occ || !ev.w || !ev.idx || !ev.kernels || !ev.rays_cast || !ev.results) {
+    if (!ev.rays || !ev.occ || !ev.w || !ev.idx || !ev.kernels || !ev.rays_cast || !ev.proj || !ev.results) {
         rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the link evaluation scratch");
         r = RAD_ERROR_OUT_OF_MEMORY;
     } else {
         for (t = 0; t < ev.tasks; ++t) {
-            ev.kernels[t] = ev.rays_cast[t] = 0;
+            ev.kernels[t] = ev.rays_cast[t] = ev.proj[t] = 0;
             ev.results[t] = RAD_SUCCESS;
         }
         c->parallel_for(c->parallel_user, ev.tasks, rad__hr_eval_task, &ev);
         for (t = 0; t < ev.tasks; ++t) {
             h->st.kernel_evaluations += ev.kernels[t];
             h->st.rays_cast += ev.rays_cast[t];
+            h->st.projections += ev.proj[t];
             if (ev.results[t] != RAD_SUCCESS && r == RAD_SUCCESS) r = ev.results[t];
         }
         h->st.links_evaluated += count;
@@ -8283,6 +8716,7 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
     rad__free(&h->allocator, ev.idx);
     rad__free(&h->allocator, ev.kernels);
     rad__free(&h->allocator, ev.rays_cast);
+    rad__free(&h->allocator, ev.proj);
     rad__free(&h->allocator, ev.results);
     return r;
 }
@@ -8295,7 +8729,16 @@ typedef struct rad__hr_list {
 
 static rad_result rad__hr_push(rad_hierarchical *h, rad__hr_list *L, uint32_t r, uint32_t s, const rad__ctx *c)
 {
-    if (!rad__ff_facing(h->el[r].v, h->el[r].n, h->el[s].v, h->el[s].n)) return RAD_SUCCESS;
+    int cr = rad__hr_is_cl(r), cs = rad__hr_is_cl(s);
+    if (!cr && !cs) {
+        if (!rad__ff_facing(h->el[r].v, h->el[r].n, h->el[s].v, h->el[s].n)) return RAD_SUCCESS;
+    } else if (cr != cs) { /* a cluster whose sphere lies wholly behind the element's plane */
+        const rad__hr_elem *e = &h->el[cr ? s : r];
+        float cc[3], rad, d[3];
+        rad__hr_node(h, cr ? r : s, cc, &rad, NULL, NULL, NULL);
+        rad__sub(d, cc, e->v);
+        if (rad__dot(d, e->n) <= -rad) return RAD_SUCCESS;
+    }
     if (L->n == L->cap) {
         size_t cap = L->cap ? 2u * L->cap : 1024u, old_bytes, new_bytes;
         rad__hr_link *g;
@@ -8325,10 +8768,34 @@ static rad_result rad__hr_push(rad_hierarchical *h, rad__hr_list *L, uint32_t r,
    splits the receiver (so that no leaf gathers over a link whose F differs much across it). */
 static int rad__hr_oracle(const rad_hierarchical *h, const rad__hr_link *l, uint32_t *split)
 {
-    const rad__hr_elem *er = &h->el[l->r], *es = &h->el[l->s];
-    float bs = es->B[0] > es->B[1] ? es->B[0] : es->B[1];
-    int can_r = er->area * 0.25f >= h->min_area, can_s = es->area * 0.25f >= h->min_area;
+    const rad__hr_elem *er, *es;
+    float bs;
+    int can_r, can_s;
     double pw;
+    if (rad__hr_is_cl(l->r) || rad__hr_is_cl(l->s)) {
+        /* a cluster link: overlapping spheres, or the bound on its power over eps_abs, split
+           the end with the larger sphere (a source that is dark now waits for a later round) */
+        float cr[3], cs[3], rr, rs, ar, as, d[3], gap;
+        rad__hr_node(h, l->r, cr, &rr, &ar, NULL, NULL);
+        rad__hr_node(h, l->s, cs, &rs, &as, NULL, &bs);
+        if (!(bs > 0.0f)) return 0;
+        rad__sub(d, cr, cs);
+        gap = rad__len(d) - rr - rs;
+        if (gap > 0.0f) {
+            double f = (double)as / (RAD__PI * (double)gap * (double)gap);
+            if (!((double)bs * (double)ar * (f < 1.0 ? f : 1.0) > h->eps_abs)) return 0;
+        }
+        can_r = rad__hr_is_cl(l->r) || h->el[l->r].area * 0.25f >= h->min_area;
+        can_s = rad__hr_is_cl(l->s) || h->el[l->s].area * 0.25f >= h->min_area;
+        if (!can_r && !can_s) return 0;
+        *split = (can_s && (rs >= rr || !can_r)) ? l->s : l->r;
+        return 1;
+    }
+    er = &h->el[l->r];
+    es = &h->el[l->s];
+    bs = es->B[0] > es->B[1] ? es->B[0] : es->B[1];
+    can_r = er->area * 0.25f >= h->min_area;
+    can_s = es->area * 0.25f >= h->min_area;
     if (es->B[2] > bs) bs = es->B[2];
     pw = (double)er->area * (double)bs;
     if (can_r && pw * (double)l->Fd > h->eps_abs) {
@@ -8369,6 +8836,12 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
                 continue;
             }
             *changed = 1;
+            if (rad__hr_is_cl(e)) {
+                const uint32_t *ch = h->cl[e & ~RAD__HR_CL].child;
+                for (k = 0; k < 2u && r == RAD_SUCCESS; ++k)
+                    r = e == l.s ? rad__hr_push(h, &next, l.r, ch[k], c) : rad__hr_push(h, &next, ch[k], l.s, c);
+                continue;
+            }
             if ((r = rad__hr_split(h, e, c)) != RAD_SUCCESS) break;
             for (k = 0; k < 4u && r == RAD_SUCCESS; ++k) {
                 uint32_t ch = h->el[e].child + k;
@@ -8389,8 +8862,92 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
     return r;
 }
 
+/* The links into clusters grouped by receiver (after each refinement), with the direction
+   from the receiver's centre to the source's. */
+static rad_result rad__hr_build_in(rad_hierarchical *h, const rad__ctx *c)
+{
+    size_t l, n = 0;
+    uint32_t i;
+    rad__free(&h->allocator, h->in);
+    h->in = NULL;
+    if (!h->in_first) {
+        h->in_first = (uint32_t *)rad__alloc_array(&h->allocator, (size_t)h->ncl + 1u, sizeof(uint32_t));
+        if (!h->in_first) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the clusters' links");
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+    }
+    memset(h->in_first, 0, ((size_t)h->ncl + 1u) * sizeof(uint32_t));
+    for (l = 0; l < h->nlinks; ++l)
+        if (rad__hr_is_cl(h->links[l].r)) {
+            h->in_first[(h->links[l].r & ~RAD__HR_CL) + 1u]++;
+            ++n;
+        }
+    if (n > 0xFFFFFFFEu) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: more than 2^32 links into clusters");
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    h->in = (rad__hr_in *)rad__alloc_array(&h->allocator, n ? n : 1u, sizeof(rad__hr_in));
+    if (!h->in) {
+        rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for %llu links into clusters", (unsigned long long)n);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < h->ncl; ++i) h->in_first[i + 1u] += h->in_first[i];
+    for (l = 0; l < h->nlinks; ++l) {
+        const rad__hr_link *lk = &h->links[l];
+        uint32_t cr = lk->r & ~RAD__HR_CL, at;
+        rad__hr_in *e;
+        float cs[3];
+        if (!rad__hr_is_cl(lk->r)) continue;
+        at = h->in_first[cr]++; /* advanced to the next group's start; shifted back below */
+        e = &h->in[at];
+        rad__hr_node(h, lk->s, cs, NULL, NULL, NULL, NULL);
+        rad__sub(e->u, cs, h->cl[cr].c);
+        rad__normalize(e->u);
+        e->F = lk->F;
+        e->s = lk->s;
+    }
+    for (i = h->ncl; i > 0; --i) h->in_first[i] = h->in_first[i - 1u];
+    h->in_first[0] = 0;
+    return RAD_SUCCESS;
+}
+
+typedef struct rad__hr_gather {
+    rad_hierarchical *h;
+    uint32_t tasks;
+} rad__hr_gather;
+
+/* Each scene triangle (the root of its quadtree) gathers over the links into the clusters
+   above it, by its own cosine to each source: a task writes only its own triangles. */
+static void rad__hr_gather_task(void *data, uint32_t task)
+{
+    const rad__hr_gather *g = (const rad__hr_gather *)data;
+    rad_hierarchical *h = g->h;
+    uint32_t T = h->scene->triangle_count, i;
+    uint32_t b = (uint32_t)((uint64_t)T * task / g->tasks), e = (uint32_t)((uint64_t)T * (task + 1u) / g->tasks);
+    for (i = b; i < e; ++i) {
+        rad__hr_elem *el = &h->el[i];
+        double G[3] = { 0.0, 0.0, 0.0 }, S = 0.0;
+        uint32_t a, j, k;
+        for (a = h->tri_parent[i]; a != RAD_NONE; a = h->cl[a].parent)
+            for (j = h->in_first[a]; j < h->in_first[a + 1u]; ++j) {
+                const rad__hr_in *in = &h->in[j];
+                float cs = rad__dot(el->n, in->u);
+                const float *B;
+                double f;
+                if (!(cs > 0.0f)) continue;
+                f = (double)in->F * (double)cs;
+                rad__hr_node(h, in->s, NULL, NULL, NULL, &B, NULL);
+                for (k = 0; k < 3; ++k) G[k] += f * (double)B[k];
+                S += f;
+            }
+        for (k = 0; k < 3; ++k) el->G[k] += G[k];
+        el->S += S;
+    }
+}
+
 /* One gather and push-pull sweep; returns the largest change of a leaf's B over max B */
-static double rad__hr_sweep(rad_hierarchical *h)
+static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
 {
     uint32_t i, k;
     size_t l;
@@ -8402,10 +8959,21 @@ static double rad__hr_sweep(rad_hierarchical *h)
     }
     for (l = 0; l < h->nlinks; ++l) {
         const rad__hr_link *lk = &h->links[l];
-        rad__hr_elem *er = &h->el[lk->r];
-        const float *B = h->el[lk->s].B;
+        rad__hr_elem *er;
+        const float *B;
+        if (rad__hr_is_cl(lk->r)) continue; /* below, per member */
+        er = &h->el[lk->r];
+        rad__hr_node(h, lk->s, NULL, NULL, NULL, &B, NULL);
         for (k = 0; k < 3; ++k) er->G[k] += (double)lk->F * (double)B[k];
         er->S += (double)lk->F;
+    }
+    if (h->cl) {
+        rad__hr_gather g;
+        uint32_t T = h->scene->triangle_count;
+        g.h = h;
+        g.tasks = (T + 1023u) / 1024u < c->tasks ? (T + 1023u) / 1024u : c->tasks;
+        if (g.tasks == 0) g.tasks = 1;
+        c->parallel_for(c->parallel_user, g.tasks, rad__hr_gather_task, &g);
     }
     for (i = 0; i < h->nel; ++i) { /* push: parents come first */
         rad__hr_elem *e = &h->el[i];
@@ -8434,6 +9002,7 @@ static double rad__hr_sweep(rad_hierarchical *h)
             for (k = 0; k < 3; ++k) e->B[k] = a > 0.0 ? (float)(s[k] / a) : 0.0f;
         }
     }
+    rad__hr_cluster_pull(h);
     return bmax > 0.0 ? change / bmax : 0.0;
 }
 
@@ -8577,9 +9146,14 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
     }
     h->eps_abs = h->o.tolerance * P;
     memset(&L, 0, sizeof(L));
-    for (i = 0; i < T && r == RAD_SUCCESS; ++i)
-        for (j = 0; j < T && r == RAD_SUCCESS; ++j)
-            if (i != j) r = rad__hr_push(h, &L, i, j, &c);
+    if (h->cl) { /* one link, the root cluster to itself */
+        rad__hr_cluster_pull(h);
+        r = rad__hr_push(h, &L, RAD__HR_CL, RAD__HR_CL, &c);
+    } else {
+        for (i = 0; i < T && r == RAD_SUCCESS; ++i)
+            for (j = 0; j < T && r == RAD_SUCCESS; ++j)
+                if (i != j) r = rad__hr_push(h, &L, i, j, &c);
+    }
     h->links = L.a;
     h->nlinks = L.n;
     if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, h->links, h->nlinks, &c);
@@ -8589,9 +9163,10 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
         double res = 0.0;
         r = rad__hr_refine(h, &changed, &c);
         if (r == RAD_SUCCESS) r = rad__hr_sources(h, first, &c);
+        if (r == RAD_SUCCESS && h->cl) r = rad__hr_build_in(h, &c);
         if (r != RAD_SUCCESS) break;
         for (s = 0; s < RAD__HR_MAX_SWEEPS; ++s) {
-            res = rad__hr_sweep(h);
+            res = rad__hr_sweep(h, &c);
             h->st.sweeps++;
             if (res < RAD__HR_SWEEP_TOLERANCE) break;
         }
@@ -8618,6 +9193,13 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
     h->st.elements = h->nel;
     h->st.leaves = h->nleaf;
     h->st.links = h->nlinks;
+    h->st.clusters = h->ncl;
+    h->st.cluster_links = 0;
+    {
+        size_t l;
+        for (l = 0; l < h->nlinks; ++l)
+            if (rad__hr_is_cl(h->links[l].r) || rad__hr_is_cl(h->links[l].s)) h->st.cluster_links++;
+    }
     h->state = 1;
     return RAD_SUCCESS;
 }
@@ -8656,13 +9238,13 @@ RAD_API rad_result rad_hierarchical_links(const rad_hierarchical *h, uint64_t fi
     for (i = 0; i < count; ++i) {
         const rad__hr_link *l = &h->links[(size_t)first + i];
         if (out_points) {
-            rad__hr_centroid(&h->el[l->r], out_points + 6 * (size_t)i);
-            rad__hr_centroid(&h->el[l->s], out_points + 6 * (size_t)i + 3);
+            rad__hr_node(h, l->r, out_points + 6 * (size_t)i, NULL, NULL, NULL, NULL);
+            rad__hr_node(h, l->s, out_points + 6 * (size_t)i + 3, NULL, NULL, NULL, NULL);
         }
         if (out_form_factors) out_form_factors[i] = l->F;
         if (out_depths) {
-            out_depths[2 * (size_t)i] = h->el[l->r].depth;
-            out_depths[2 * (size_t)i + 1] = h->el[l->s].depth;
+            out_depths[2 * (size_t)i] = rad__hr_is_cl(l->r) ? RAD_NONE : h->el[l->r].depth;
+            out_depths[2 * (size_t)i + 1] = rad__hr_is_cl(l->s) ? RAD_NONE : h->el[l->s].depth;
         }
     }
     return RAD_SUCCESS;

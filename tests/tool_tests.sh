@@ -564,6 +564,18 @@ if [ -s "$TMP/ref.pfm" ]; then
     else
         fail "hierarchical renders the Cornell box" "$(head -c 300 "$TMP/err.txt")"
     fi
+    # hierarchical bake: the solution's H resampled onto the bake's 300 patches; rendered from
+    # the bake it stays close to the direct (adaptive) hierarchical render
+    if "$RAD" bake cornell --patches 300 --method hierarchical --hr-eps 3e-3 -o "$TMP/hr.radb" > /dev/null 2> "$TMP/err.txt" &&
+        "$RAD" render cornell $M --method hierarchical --bake "$TMP/hr.radb" -o "$TMP/hrb.pfm" > /dev/null 2>> "$TMP/err.txt"; then
+        ok "hierarchical bakes and renders from the bake"
+        "$RAD" info "$TMP/hr.radb" > "$TMP/info.txt" 2>&1 && grep -q "method: hierarchical, --hr-eps 0.003" "$TMP/info.txt" &&
+            grep -q "leaves, [0-9]* links" "$TMP/info.txt" && ! grep -q "FF_DENSE" "$TMP/info.txt" &&
+            ok "info shows a hierarchical bake" || fail "info shows a hierarchical bake" "$(head -c 600 "$TMP/info.txt")"
+        psnr_check "hierarchical render --bake ~ the direct hierarchical render" "$TMP/hr.pfm" "$TMP/hrb.pfm" 45 # measured 52.6
+    else
+        fail "hierarchical bakes and renders from the bake" "$(head -c 300 "$TMP/err.txt")"
+    fi
     # --proxy: the run-time methods over the same virtual patches give the aavp image (the
     # full solution: multibounce inf and local over every patch exactly, temporal to its noise)
     if "$RAD" render cornell $M --method aavp --vp-resolution 4 --bounces inf -o "$TMP/pref.pfm" > /dev/null 2> "$TMP/err.txt"; then
@@ -663,7 +675,7 @@ bad "--sr-estimator foo" "unknown --sr-estimator 'foo'" bake cornell --method st
 bad "--sr-rays 0" "--sr-rays must be in 1.." render cornell --method stochastic --sr-rays 0 -o "$TMP/y.pfm"
 bad "--bounces with stochastic" "--bounces is for --method multibounce, not stochastic" render cornell --method stochastic --bounces 3 -o "$TMP/y.pfm"
 bad "--sr-iterations with vp" "--sr-iterations is not an option of --method vp" render cornell --method vp --sr-iterations 3 -o "$TMP/y.pfm"
-bad "bake --method hierarchical" "method 'hierarchical' is render-only" bake cornell --method hierarchical -o "$TMP/y.radb"
+bad "bake --method hierarchical --bounces" "--bounces is not an option of --method hierarchical" bake cornell --method hierarchical --bounces 3 -o "$TMP/y.radb"
 bad "--hr-eps 2" "--hr-eps must be in (0, 1)" render cornell --method hierarchical --hr-eps 2 -o "$TMP/y.pfm"
 bad "--hr-rays 5" "--hr-rays must be a square" render cornell --method hierarchical --hr-rays 5 -o "$TMP/y.pfm"
 bad "--hr-min-area -1" "--hr-min-area must be a positive area" render cornell --method hierarchical --hr-min-area -1 -o "$TMP/y.pfm"

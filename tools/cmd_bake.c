@@ -1,6 +1,6 @@
 /* cmd_bake.c - `rad bake`: a solution computed (the classic one by classic.c) and saved.
 
-   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|aavp|vp] [--solver jacobi|gauss-seidel|direct]
+   rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|hierarchical|aavp|vp] [--solver jacobi|gauss-seidel|direct]
             [--bounces K] [--patches N] [--max-edge L] [--samples S] [--light-samples N]
             [method options, see methods.c] [--threads N]
 
@@ -12,7 +12,8 @@
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
    were made with, so `rad render --bake` can check that the file fits the scene (with the
    library's signature section, which also holds the hash of rad.options: rad_tool_sign_options).
-   --method multibounce, temporal and stochastic bake through methods.c (rad_tool_method_bake); aavp
+   --method multibounce, temporal, stochastic and hierarchical bake through methods.c
+   (rad_tool_method_bake); aavp
    and vp save the virtual patches with sparse rows (bake_vp). */
 #include "tool.h"
 #include <stdio.h>
@@ -169,7 +170,7 @@ done:
 
 static void bake_usage(FILE *f)
 {
-    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|aavp|vp] [options]\n"
+    fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|hierarchical|aavp|vp] [options]\n"
                "Computes patches, form factors and the patches' direct light E = rho D, then by method:\n"
                "  classic      the indirect solution L; saves patches, F, E, B = E + L (and L, H = F B, D)\n"
                "  multibounce  F_mb = sum_k (rho o F)^k, stored as float, half or compressed\n"
@@ -178,10 +179,13 @@ static void bake_usage(FILE *f)
                "               patches, E, D, F's row sums and the tables (no F)\n"
                "  stochastic   no F: L by stochastic Jacobi or random walks over rays; saves patches, E, D,\n"
                "               row sums estimated by rays and L\n"
+               "  hierarchical the hierarchical solution (--hr-*), its H resampled onto the patches as\n"
+               "               L = rho H; saved as the stochastic bake (patches, E, D, row sums by rays, L)\n"
                "  aavp, vp     virtual patches (--vp-resolution, --face-points) with sparse rows and\n"
                "               their E; rad render --method aavp|vp or --proxy aavp|vp --bake loads them\n"
                "  -o FILE            output file (required)\n"
-               "  --method M         classic (default), multibounce, temporal, stochastic, aavp or vp\n"
+               "  --method M         classic (default), multibounce, temporal, stochastic, hierarchical,\n"
+               "                     aavp or vp\n"
                "%s"
                "%s"
                "%s"

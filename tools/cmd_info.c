@@ -60,11 +60,24 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
     if (!s || s->elem_size != sizeof mi || s->count != 1) return 0;
     memcpy(&mi, s->data, sizeof mi);
     if (mi.magic != RAD_TOOL_METHOD_MAGIC ||
-        (mi.method != RAD_TOOL_MULTIBOUNCE && mi.method != RAD_TOOL_TEMPORAL && mi.method != RAD_TOOL_STOCHASTIC)) {
+        (mi.method != RAD_TOOL_MULTIBOUNCE && mi.method != RAD_TOOL_TEMPORAL && mi.method != RAD_TOOL_STOCHASTIC &&
+         mi.method != RAD_TOOL_HIERARCHICAL)) {
         fprintf(stderr, "rad info: the rad.method section is damaged\n");
         return 1;
     }
     bytes = (uint64_t)mi.bytes_lo | ((uint64_t)mi.bytes_hi << 32);
+    if (mi.method == RAD_TOOL_HIERARCHICAL) { /* the record's fields as methods.c fills them for this method */
+        const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
+        printf("method: hierarchical, --hr-eps %g\n"
+               "  solution 'L' (rho H resampled onto the patches): %s, %u leaves, %llu links, %u rounds, solved in %.2f s\n",
+               (double)mi.w, ls && ls->elem_size == 12 ? "present" : "MISSING", mi.k, (unsigned long long)bytes, mi.bounces,
+               (double)mi.build_seconds);
+        if (!ls || ls->elem_size != 12) {
+            fprintf(stderr, "rad info: the hierarchical bake holds no vector L\n");
+            return 1;
+        }
+        return 0;
+    }
     if (mi.method == RAD_TOOL_STOCHASTIC) { /* the record's fields as methods.c fills them for this method */
         const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
         printf("method: stochastic, --sr-estimator %s, --sr-rays %u, --sr-iterations %u, --seed %u\n"

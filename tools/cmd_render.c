@@ -63,7 +63,8 @@ static void render_usage(FILE *f)
             "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
             "                     hierarchical (quadtrees and links, Hanrahan et al. 1991), lightmap (classic\n"
             "                     baked into a lightmap, the indirect light looked up per pixel)\n"
-            "  --bake FILE.radb   classic, multibounce, temporal: use a bake of that method made by\n"
+            "  --bake FILE.radb   classic, multibounce, temporal, stochastic, hierarchical: use a bake of\n"
+            "                     that method made by\n"
             "                     'rad bake' from this scene instead of computing it here\n"
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
             "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
@@ -1369,7 +1370,7 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
             rad_tool_close_world(&w);
             return 1;
         }
-    } else if (mo.method >= RAD_TOOL_LOCAL || mo.proxy) {
+    } else if ((mo.method >= RAD_TOOL_LOCAL && !(mo.method == RAD_TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
         rc = mo.method == RAD_TOOL_LOCAL && !mo.proxy
                  ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
              : mo.method == RAD_TOOL_HIERARCHICAL
@@ -1381,7 +1382,8 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
             rad_tool_close_world(&w);
             return 1;
         }
-    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_STOCHASTIC) {
+    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_STOCHASTIC ||
+               mo.method == RAD_TOOL_HIERARCHICAL) { /* hierarchical here: from a bake (resampled onto its patches) */
         rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                 &img);
         if (rc) {

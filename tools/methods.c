@@ -513,11 +513,9 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
         fprintf(stderr, "rad %s: method 'lightmap' is render-only (rad lightmap writes the lightmap itself)\n", cmd);
         return 2;
     }
-    if (!render && (mo->method == RAD_TOOL_LOCAL || mo->method == RAD_TOOL_HIERARCHICAL)) {
-        fprintf(stderr, "rad %s: method '%s' is render-only (rad render --method %s builds it in memory: %s)\n", cmd,
-                rad_tool_method_name(mo->method), rad_tool_method_name(mo->method),
-                mo->method == RAD_TOOL_LOCAL ? "its matrix depends on the camera; a classic bake holds its F"
-                                             : "the container has no section for quadtrees and links yet");
+    if (!render && mo->method == RAD_TOOL_LOCAL) {
+        fprintf(stderr, "rad %s: method 'local' is render-only (rad render --method local builds it in memory: its "
+                        "matrix depends on the camera; a classic bake holds its F)\n", cmd);
         return 2;
     }
     if (!render && (mo->method == RAD_TOOL_VP || mo->method == RAD_TOOL_AAVP) && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
@@ -677,6 +675,45 @@ static uint32_t mb_bounces(uint32_t bounces)
     return bounces == RAD_MB_INFINITE ? RAD_MB_INFINITE : bounces + 1u;
 }
 
+/* --method hierarchical baked: the solution's H resampled onto the bake's patches, as the
+   stochastic bake's L = rho H (the mean of the leaf values at the patch's centroid and half
+   way from it to each corner) */
+static rad_result hierarchical_to_patches(const rad_hierarchical *h, const rad_scene *s, const rad_patches *P, float *L)
+{
+    uint32_t i, q, k;
+    for (i = 0; i < P->count; ++i) {
+        const rad_patch *pt = &P->patches[i];
+        const float *T = s->positions + 9 * (size_t)pt->triangle;
+        float ax[3], ay[3], aa, bb, ab, det, bc[8], H[12];
+        uint32_t tris[4];
+        rad_result r;
+        for (k = 0; k < 3; ++k) {
+            ax[k] = T[3 + k] - T[k];
+            ay[k] = T[6 + k] - T[k];
+        }
+        aa = ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2];
+        bb = ay[0] * ay[0] + ay[1] * ay[1] + ay[2] * ay[2];
+        ab = ax[0] * ay[0] + ax[1] * ay[1] + ax[2] * ay[2];
+        det = aa * bb - ab * ab;
+        for (q = 0; q < 4; ++q) {
+            float p[3], pa, pb;
+            for (k = 0; k < 3; ++k) {
+                p[k] = pt->centroid[k];
+                if (q > 0) p[k] = 0.5f * (p[k] + P->vertices[3 * (size_t)pt->vertices[q - 1] + k]);
+                p[k] -= T[k];
+            }
+            pa = p[0] * ax[0] + p[1] * ax[1] + p[2] * ax[2];
+            pb = p[0] * ay[0] + p[1] * ay[1] + p[2] * ay[2];
+            bc[2 * q] = det > 0.0f ? (pa * bb - pb * ab) / det : 1.0f / 3.0f;
+            bc[2 * q + 1] = det > 0.0f ? (pb * aa - pa * ab) / det : 1.0f / 3.0f;
+            tris[q] = pt->triangle;
+        }
+        if ((r = rad_hierarchical_lookup(h, RAD_HIERARCHICAL_GATHERED, 0, tris, bc, 4, H)) != RAD_SUCCESS) return r;
+        for (k = 0; k < 3; ++k) L[3 * (size_t)i + k] = pt->albedo[k] * 0.25f * (H[k] + H[3 + k] + H[6 + k] + H[9 + k]);
+    }
+    return RAD_SUCCESS;
+}
+
 int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
                          const rad_tool_method_options *mo, void **out, size_t *out_size)
 {
@@ -704,7 +741,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     *out = NULL;
     *out_size = 0;
     so.sources_only = 1;
-    so.no_form_factors = mo->method == RAD_TOOL_STOCHASTIC;
+    so.no_form_factors = mo->method == RAD_TOOL_STOCHASTIC || mo->method == RAD_TOOL_HIERARCHICAL;
     if (rad_tool_classic_solve(cmd, w, &so, &c)) return 1;
     n = c.patches->count;
     rad_tool_context(&ctx, NULL);
@@ -713,7 +750,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     ones = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     rows3 = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     S = (float *)rad_tool_calloc(n, sizeof(float));
-    if (mo->method == RAD_TOOL_STOCHASTIC) {
+    if (so.no_form_factors) {
         if ((r = stochastic_rowsums(w, c.patches, S)) != RAD_SUCCESS) {
             what = "row sums by rays";
             goto fail;
@@ -809,6 +846,22 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
             bytes = (size_t)3 * n * n * (mo->format == RAD_TOOL_MB_HALF ? 2u : 4u);
             fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", cmd, format_name(mo->format), (unsigned long)bytes);
         }
+    } else if (mo->method == RAD_TOOL_HIERARCHICAL) {
+        rad_hierarchical *h = NULL;
+        rad_hierarchical_stats st;
+        if (rad_tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) goto fail;
+        L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+        r = hierarchical_to_patches(h, w->scene, c.patches, L);
+        rad_hierarchical_get_stats(h, &st);
+        rad_hierarchical_destroy(h);
+        if (r != RAD_SUCCESS) {
+            what = "rad_hierarchical_lookup";
+            goto fail;
+        }
+        bytes = (size_t)st.links; /* the record's byte count holds the links here */
+        mi.k = st.leaves;
+        mi.bounces = st.rounds;
+        mi.w = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5f;
     } else if (mo->method == RAD_TOOL_STOCHASTIC) {
         rad_stochastic_options sto;
         rad_stochastic_stats st;
@@ -902,7 +955,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
             goto fail;
         }
         k += added;
-    } else if (mo->method == RAD_TOOL_STOCHASTIC) {
+    } else if (mo->method == RAD_TOOL_STOCHASTIC || mo->method == RAD_TOOL_HIERARCHICAL) {
         secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = L;
         strcpy(secs[k++].name, "L");
     } else if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
@@ -1033,7 +1086,7 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
     m->S = (const float *)s->data;
     m->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
     rad_tool_context(&m->ctx, NULL);
-    if (mo->method == RAD_TOOL_STOCHASTIC) {
+    if (mo->method == RAD_TOOL_STOCHASTIC || mo->method == RAD_TOOL_HIERARCHICAL) {
         const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
         uint32_t i;
         if (!ls || ls->elem_size != 12 || ls->count != n) {
@@ -1050,9 +1103,14 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
                 return 1;
             }
         m->solve_seconds = mi.build_seconds;
-        fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
-                mi.mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
-                (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo), (double)mi.build_seconds);
+        if (mo->method == RAD_TOOL_HIERARCHICAL)
+            fprintf(stderr, "rad %s: hierarchical (--hr-eps %g: %u leaves, %llu links, resampled onto %u patches), solved in "
+                            "%.3f s\n", cmd, (double)mi.w, mi.k, (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo),
+                    n, (double)mi.build_seconds);
+        else
+            fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
+                    mi.mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
+                    (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo), (double)mi.build_seconds);
     } else if (mo->method == RAD_TOOL_MULTIBOUNCE) {
         const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
         uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;

@@ -316,7 +316,7 @@ typedef enum rad_tool_method {
     RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
     RAD_TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
     RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7, /* render only (cmd_render.c); vp, aavp also bake_vp (cmd_bake.c) */
-    RAD_TOOL_HIERARCHICAL = 8, /* render only (cmd_render.c) */
+    RAD_TOOL_HIERARCHICAL = 8, /* cmd_render.c; baked as rho H on patches (rad_tool_method_bake) */
     RAD_TOOL_LIGHTMAP = 9      /* render only (cmd_render.c): a lightmap bake shades the indirect light */
 } rad_tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
