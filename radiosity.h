@@ -95,6 +95,10 @@
                                                      bad input is an error code, never an assert)
        RAD_NO_STDIO               (undefined)        everywhere: removes rad_save_file and
                                                      rad_load_file (no <stdio.h> file access)
+       RAD_NO_GLSL                (undefined)        implementing file: leaves out the GLSL
+                                                     kernels' text (about 60 KB); rad_glsl_name
+                                                     and rad_glsl_pieces return NULL and
+                                                     rad_glsl_source RAD_ERROR_UNAVAILABLE
        RAD_NO_SIMD                (undefined)        implementing file: scalar code only. SIMD
                                                      (SSE2/AVX) is used only when the compiler
                                                      already enables it (-msse2 is the x86-64
@@ -372,6 +376,12 @@ typedef struct rad_context {
     int (*progress)(void *user, float fraction);
     void *progress_user;
 } rad_context;
+
+/* The baked-data types of >>api_container, named here because the methods' save and load
+   functions take them. */
+typedef struct rad_section rad_section;
+typedef struct rad_container rad_container;
+typedef struct rad_bake rad_bake;
 
 /* ======================================================================================== */
 /* >>api_scene: scene input and validation                                                  */
@@ -1673,15 +1683,13 @@ typedef enum rad_section_type {
 
 /* One section, for writing (data borrowed) or as found by rad_container_find (data points
    into the container's bytes). */
-typedef struct rad_section {
+struct rad_section {
     uint32_t type;
     uint32_t elem_size;     /* bytes per element */
     uint64_t count;         /* elements */
     const void *data;       /* count * elem_size bytes */
     char name[24];          /* NUL-terminated, may be empty */
-} rad_section;
-
-typedef struct rad_container rad_container;
+};
 
 /* Bytes that rad_container_write needs for these sections (SIZE_OVERFLOW if it overflows). */
 RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes);
@@ -1731,7 +1739,7 @@ RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry
    scene), the form-factor matrix (rows == 0 when the bake has none) and the named vectors.
    Everything points into the loaded bytes; free it with rad_bake_destroy, never with
    rad_patches_destroy. */
-typedef struct rad_bake {
+struct rad_bake {
     rad_patches patches;
     rad_matrix F;
     const float *E;          /* "E" vector or NULL */
@@ -1740,7 +1748,7 @@ typedef struct rad_bake {
     rad_container *container;
     void *owned;             /* private: bytes read from a file */
     rad_allocator allocator; /* private */
-} rad_bake;
+};
 
 /* Saves patches (required), a matrix (optional: NULL) and the vectors E and B (optional:
    NULL; 3 * patches->count floats) into a new buffer *out of *out_size bytes, allocated with
@@ -2054,7 +2062,8 @@ RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
    *out_length (optional) receives the length without the NUL, on success and when dst is too
    small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
    INVALID_ARGUMENT (unknown id; dst NULL with out_length NULL or dst_size > 0), SIZE_MISMATCH
-   (dst_size <= length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). */
+   (dst_size <= length: nothing written), UNAVAILABLE (built with RAD_NO_GLSL, under which
+   rad_glsl_name and rad_glsl_pieces return NULL). Pure, thread-safe, no allocation. Cost: O(length). */
 RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
 
 /* ======================================================================================== */
@@ -11566,6 +11575,8 @@ typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28
                                          offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
                                          offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
 
+#ifndef RAD_NO_GLSL
+
 typedef struct rad__glsl_entry {
     const char *name;
     const char *const *pieces;
@@ -12791,6 +12802,32 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
     dst[at] = '\0';
     return RAD_SUCCESS;
 }
+
+#else /* RAD_NO_GLSL: the kernels' text is left out; the ids and the functions stay */
+
+RAD_API const char *rad_glsl_name(rad_glsl_id id)
+{
+    (void)id;
+    return NULL;
+}
+
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
+{
+    (void)id;
+    if (out_count) *out_count = 0;
+    return NULL;
+}
+
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
+{
+    (void)id;
+    (void)dst;
+    (void)dst_size;
+    if (out_length) *out_length = 0;
+    return RAD_ERROR_UNAVAILABLE;
+}
+
+#endif /* RAD_NO_GLSL */
 
 /* ======================================================================================== */
 /* >>multibounce: multi-bounce matrix, GEMM, binary16, BC1/BC4, compression, container      */
