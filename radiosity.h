@@ -3634,6 +3634,202 @@ static uint32_t rad__lattice_side(uint32_t samples)
 }
 
 /* ======================================================================================== */
+/* >>format: the container's bytes (offsets, CRC-32, header and table checks)               */
+/* ======================================================================================== */
+
+/* The byte layout described in >>api_container, by name: every writer and reader of a
+   container (rad_container_write, rad_container_open, rad_row_stream_open, rad_load_file)
+   uses these, so they cannot drift apart. */
+#define RAD__HEADER_BYTES 64u
+#define RAD__ENTRY_BYTES 64u
+#define RAD__ALIGN 64u
+#define RAD__FLAG_BIG_ENDIAN 1u
+#define RAD__MAX_SECTIONS 0x00FFFFFFu
+/* header fields (byte offsets; "RADB" at 0) */
+#define RAD__H_VERSION 4u
+#define RAD__H_COUNT 8u
+#define RAD__H_HEADER_SIZE 12u
+#define RAD__H_TABLE 16u
+#define RAD__H_FILE_SIZE 24u
+#define RAD__H_FLAGS 32u
+#define RAD__H_TABLE_CRC 36u
+#define RAD__H_CRC 60u
+/* table entry fields (byte offsets; bytes 36..39 are reserved zeros) */
+#define RAD__E_TYPE 0u
+#define RAD__E_ELEM_SIZE 4u
+#define RAD__E_COUNT 8u
+#define RAD__E_OFFSET 16u
+#define RAD__E_BYTES 24u
+#define RAD__E_CRC 32u
+#define RAD__E_NAME 40u
+
+static uint32_t rad__crc32(const void *data, size_t size)
+{
+    static const uint32_t nibble[16] = { 0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
+                                         0x4DB26158u, 0x5005713Cu, 0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
+                                         0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
+    const unsigned char *p = (const unsigned char *)data;
+    uint32_t c = 0xFFFFFFFFu;
+    size_t i;
+    for (i = 0; i < size; ++i) {
+        c ^= p[i];
+        c = (c >> 4) ^ nibble[c & 15u];
+        c = (c >> 4) ^ nibble[c & 15u];
+    }
+    return c ^ 0xFFFFFFFFu;
+}
+
+static void rad__put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
+static void rad__put64(unsigned char *p, uint64_t v) { rad__put32(p, (uint32_t)v); rad__put32(p + 4, (uint32_t)(v >> 32)); }
+static uint32_t rad__get32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint64_t rad__get64(const unsigned char *p) { return (uint64_t)rad__get32(p) | (uint64_t)rad__get32(p + 4) << 32; }
+static int rad__host_big_endian(void) { const uint32_t one = 1; return *(const unsigned char *)&one == 0; }
+static uint64_t rad__align_up(uint64_t x) { return (x + (RAD__ALIGN - 1)) & ~(uint64_t)(RAD__ALIGN - 1); }
+
+/* What a valid header says. */
+typedef struct rad__header {
+    uint32_t count;        /* sections */
+    uint64_t file_size;    /* bytes of the container */
+    uint64_t first_data;   /* where the section data may start: after the table, aligned */
+} rad__header;
+
+/* Checks the 64 header bytes at p: magic, checksum, version, byte order, header size, table
+   offset, section count, a table that fits, and a container of at most 'available' bytes.
+   Errors: CORRUPT, VERSION, TRUNCATED (the container is longer than 'available'), each logged
+   with 'who' (what is being read) in front. */
+static rad_result rad__header_parse(const unsigned char *p, uint64_t available, const rad__ctx *c, const char *who,
+                                    rad__header *h)
+{
+    uint32_t flags;
+    uint64_t table;
+    if (memcmp(p, "RADB", 4) != 0) {
+        rad__log(c, RAD_LOG_ERROR, "%s: no RADB magic (not a radiosity.h container)", who);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (rad__get32(p + RAD__H_CRC) != rad__crc32(p, RAD__H_CRC)) {
+        rad__log(c, RAD_LOG_ERROR, "%s: header checksum mismatch", who);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (rad__get32(p + RAD__H_VERSION) != RAD_CONTAINER_VERSION) {
+        rad__log(c, RAD_LOG_ERROR, "%s: container version %u, this library reads version %u", who,
+                 rad__get32(p + RAD__H_VERSION), RAD_CONTAINER_VERSION);
+        return RAD_ERROR_VERSION;
+    }
+    flags = rad__get32(p + RAD__H_FLAGS);
+    if ((flags & ~RAD__FLAG_BIG_ENDIAN) != 0 || ((flags & RAD__FLAG_BIG_ENDIAN) != 0) != rad__host_big_endian()) {
+        rad__log(c, RAD_LOG_ERROR, "%s: flags %#x (byte order or features this build does not read)", who, flags);
+        return RAD_ERROR_VERSION;
+    }
+    h->count = rad__get32(p + RAD__H_COUNT);
+    table = rad__get64(p + RAD__H_TABLE);
+    h->file_size = rad__get64(p + RAD__H_FILE_SIZE);
+    if (rad__get32(p + RAD__H_HEADER_SIZE) != RAD__HEADER_BYTES || table != RAD__HEADER_BYTES || h->count > RAD__MAX_SECTIONS) {
+        rad__log(c, RAD_LOG_ERROR, "%s: bad header (header size %u, table offset %llu, %u sections)", who,
+                 rad__get32(p + RAD__H_HEADER_SIZE), (unsigned long long)table, h->count);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (h->file_size > available) {
+        rad__log(c, RAD_LOG_ERROR, "%s: %llu bytes given, the container is %llu bytes", who, (unsigned long long)available,
+                 (unsigned long long)h->file_size);
+        return RAD_ERROR_TRUNCATED;
+    }
+    h->first_data = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * h->count);
+    if (h->first_data > h->file_size) {
+        rad__log(c, RAD_LOG_ERROR, "%s: the table of %u sections does not fit in %llu bytes", who, h->count,
+                 (unsigned long long)h->file_size);
+        return RAD_ERROR_CORRUPT;
+    }
+    return RAD_SUCCESS;
+}
+
+/* The section table's checksum against the header's (CORRUPT, logged, when they differ). */
+static rad_result rad__table_check(const unsigned char *header, const unsigned char *table, uint32_t count,
+                                   const rad__ctx *c, const char *who)
+{
+    if (rad__get32(header + RAD__H_TABLE_CRC) == rad__crc32(table, (size_t)RAD__ENTRY_BYTES * count)) return RAD_SUCCESS;
+    rad__log(c, RAD_LOG_ERROR, "%s: section table checksum mismatch", who);
+    return RAD_ERROR_CORRUPT;
+}
+
+/* One table entry. */
+typedef struct rad__entry {
+    uint32_t type, elem_size, crc;
+    uint64_t count, offset, bytes;
+} rad__entry;
+
+/* Reads the table entry at e and checks it against the header: a NUL-terminated name, element
+   size x count = byte size, an aligned offset after the table, data inside the container,
+   reserved bytes zero. Returns NULL, or why the entry is bad (the data's checksum is the
+   caller's: a streaming reader checks only what it reads). */
+static const char *rad__entry_parse(const unsigned char *e, const rad__header *h, rad__entry *x)
+{
+    uint32_t k;
+    x->type = rad__get32(e + RAD__E_TYPE);
+    x->elem_size = rad__get32(e + RAD__E_ELEM_SIZE);
+    x->count = rad__get64(e + RAD__E_COUNT);
+    x->offset = rad__get64(e + RAD__E_OFFSET);
+    x->bytes = rad__get64(e + RAD__E_BYTES);
+    x->crc = rad__get32(e + RAD__E_CRC);
+    if (e[RAD__E_NAME + 23u] != 0) return "its name is not NUL-terminated";
+    if (x->elem_size == 0 || x->count > UINT64_MAX / x->elem_size || x->count * x->elem_size != x->bytes)
+        return "element size x count differs from its byte size";
+    if (x->offset % RAD__ALIGN != 0 || x->offset < h->first_data) return "its offset is misaligned or inside the table";
+    if (x->bytes > h->file_size || x->offset > h->file_size - x->bytes) return "it extends past the end of the container";
+    for (k = RAD__E_CRC + 4u; k < RAD__E_NAME; ++k)
+        if (e[k]) return "reserved bytes are not zero";
+    return NULL;
+}
+
+static void rad__section(rad_section *s, uint32_t type, uint32_t elem_size, uint64_t count, const void *data, const char *name)
+{
+    memset(s, 0, sizeof(*s));
+    s->type = type;
+    s->elem_size = elem_size;
+    s->count = count;
+    s->data = data;
+    if (name) {
+        size_t n = strlen(name);
+        if (n > sizeof(s->name) - 1) n = sizeof(s->name) - 1;
+        memcpy(s->name, name, n);
+    }
+}
+
+/* The value rule of every loader (>>api_container VALUES): n floats, each finite (else
+   NON_FINITE) and of magnitude <= RAD_BAKE_VALUE_MAX, and >= 0 when 'nonneg' (-0 passes)
+   (else CORRUPT). One branch-free pass on the bit patterns (NaN and infinity have larger
+   magnitude bits than any finite bound), then the first bad entry is found again for the
+   message, which names 'what', the entry and its value. */
+static rad_result rad__check_values(const rad__ctx *c, const char *what, const float *v, uint64_t n, int nonneg)
+{
+    const float vmax = RAD_BAKE_VALUE_MAX;
+    uint32_t maxbits, sign = nonneg ? 0x80000000u : 0u, bad = 0;
+    uint64_t i, j;
+    memcpy(&maxbits, &vmax, 4);
+    for (i = 0; i < n && !bad; i += 4096) {
+        uint64_t e = n - i < 4096 ? n : i + 4096;
+        for (j = i; j < e; ++j) {
+            uint32_t b;
+            memcpy(&b, v + j, 4);
+            bad |= (uint32_t)((b & 0x7FFFFFFFu) > maxbits) | (uint32_t)((b & sign) != 0 && b != sign);
+        }
+    }
+    if (!bad) return RAD_SUCCESS;
+    for (i = 0; i < n; ++i) {
+        const float x = v[i];
+        if (!rad__finite(x)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (not finite)", what, (unsigned long long)i, (double)x);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (x > vmax || x < -vmax || (nonneg && x < 0.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (%s)", what, (unsigned long long)i, (double)x,
+                     nonneg && x < 0.0f ? "negative" : "beyond RAD_BAKE_VALUE_MAX = 1e30");
+            return RAD_ERROR_CORRUPT;
+        }
+    }
+    return RAD_SUCCESS; /* not reached */
+}
+
+/* ======================================================================================== */
 /* >>scene: scene input and validation                                                      */
 /* ======================================================================================== */
 
@@ -10756,46 +10952,18 @@ typedef char rad__check_shading_gpu_size[(sizeof(rad_shading_gpu) == 96) ? 1 : -
 typedef char rad__check_patch_size[(sizeof(rad_patch) == 68) ? 1 : -1];
 typedef char rad__check_signature_size[(sizeof(rad_bake_signature) == 32) ? 1 : -1];
 
-#define RAD__HEADER_BYTES 64u
-#define RAD__ENTRY_BYTES 64u
-#define RAD__ALIGN 64u
-#define RAD__FLAG_BIG_ENDIAN 1u
-
 struct rad_container {
     rad_section *sections;
     uint32_t count;
     rad_allocator allocator;
 };
 
-static uint32_t rad__crc32(const void *data, size_t size)
-{
-    static const uint32_t nibble[16] = { 0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
-                                         0x4DB26158u, 0x5005713Cu, 0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
-                                         0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
-    const unsigned char *p = (const unsigned char *)data;
-    uint32_t c = 0xFFFFFFFFu;
-    size_t i;
-    for (i = 0; i < size; ++i) {
-        c ^= p[i];
-        c = (c >> 4) ^ nibble[c & 15u];
-        c = (c >> 4) ^ nibble[c & 15u];
-    }
-    return c ^ 0xFFFFFFFFu;
-}
-
-static void rad__put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
-static void rad__put64(unsigned char *p, uint64_t v) { rad__put32(p, (uint32_t)v); rad__put32(p + 4, (uint32_t)(v >> 32)); }
-static uint32_t rad__get32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
-static uint64_t rad__get64(const unsigned char *p) { return (uint64_t)rad__get32(p) | (uint64_t)rad__get32(p + 4) << 32; }
-static int rad__host_big_endian(void) { const uint32_t one = 1; return *(const unsigned char *)&one == 0; }
-static uint64_t rad__align_up(uint64_t x) { return (x + (RAD__ALIGN - 1)) & ~(uint64_t)(RAD__ALIGN - 1); }
-
 RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes)
 {
     uint64_t at, bytes;
     uint32_t i;
     if (!out_bytes || (count > 0 && !sections)) return RAD_ERROR_INVALID_ARGUMENT;
-    if (count > 0x00FFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    if (count > RAD__MAX_SECTIONS) return RAD_ERROR_SIZE_OVERFLOW;
     at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
     for (i = 0; i < count; ++i) {
         if (sections[i].elem_size == 0 || (sections[i].count > 0 && !sections[i].data)) return RAD_ERROR_INVALID_ARGUMENT;
@@ -10825,25 +10993,25 @@ RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t cou
         uint64_t bytes = sections[i].count * sections[i].elem_size;
         size_t nl = 0;
         if (bytes) memcpy(base + at, sections[i].data, (size_t)bytes);
-        rad__put32(e, sections[i].type);
-        rad__put32(e + 4, sections[i].elem_size);
-        rad__put64(e + 8, sections[i].count);
-        rad__put64(e + 16, at);
-        rad__put64(e + 24, bytes);
-        rad__put32(e + 32, rad__crc32(base + at, (size_t)bytes));
+        rad__put32(e + RAD__E_TYPE, sections[i].type);
+        rad__put32(e + RAD__E_ELEM_SIZE, sections[i].elem_size);
+        rad__put64(e + RAD__E_COUNT, sections[i].count);
+        rad__put64(e + RAD__E_OFFSET, at);
+        rad__put64(e + RAD__E_BYTES, bytes);
+        rad__put32(e + RAD__E_CRC, rad__crc32(base + at, (size_t)bytes));
         while (nl < sizeof(sections[i].name) - 1 && sections[i].name[nl]) ++nl;
-        memcpy(e + 40, sections[i].name, nl);
+        memcpy(e + RAD__E_NAME, sections[i].name, nl);
         at = rad__align_up(at + bytes);
     }
     memcpy(base, "RADB", 4);
-    rad__put32(base + 4, RAD_CONTAINER_VERSION);
-    rad__put32(base + 8, count);
-    rad__put32(base + 12, RAD__HEADER_BYTES);
-    rad__put64(base + 16, RAD__HEADER_BYTES);
-    rad__put64(base + 24, (uint64_t)need);
-    rad__put32(base + 32, rad__host_big_endian() ? RAD__FLAG_BIG_ENDIAN : 0u);
-    rad__put32(base + 36, rad__crc32(base + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count)); /* the table */
-    rad__put32(base + 60, rad__crc32(base, 60));
+    rad__put32(base + RAD__H_VERSION, RAD_CONTAINER_VERSION);
+    rad__put32(base + RAD__H_COUNT, count);
+    rad__put32(base + RAD__H_HEADER_SIZE, RAD__HEADER_BYTES);
+    rad__put64(base + RAD__H_TABLE, RAD__HEADER_BYTES);
+    rad__put64(base + RAD__H_FILE_SIZE, (uint64_t)need);
+    rad__put32(base + RAD__H_FLAGS, rad__host_big_endian() ? RAD__FLAG_BIG_ENDIAN : 0u);
+    rad__put32(base + RAD__H_TABLE_CRC, rad__crc32(base + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count));
+    rad__put32(base + RAD__H_CRC, rad__crc32(base, RAD__H_CRC));
     return RAD_SUCCESS;
 }
 
@@ -10860,8 +11028,9 @@ RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_c
 {
     rad__ctx c;
     const unsigned char *p = (const unsigned char *)data;
-    uint64_t file_size, table, first_data;
-    uint32_t count, i, flags;
+    rad__header h;
+    uint32_t i;
+    rad_result r;
     rad_container *ct;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -10875,76 +11044,32 @@ RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_c
         rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes, shorter than the %u-byte header", (unsigned long long)size, RAD__HEADER_BYTES);
         return size >= 4 && memcmp(p, "RADB", 4) != 0 ? RAD_ERROR_CORRUPT : RAD_ERROR_TRUNCATED;
     }
-    if (memcmp(p, "RADB", 4) != 0) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: no RADB magic (not a radiosity.h container)");
-        return RAD_ERROR_CORRUPT;
-    }
-    if (rad__get32(p + 60) != rad__crc32(p, 60)) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: header checksum mismatch");
-        return RAD_ERROR_CORRUPT;
-    }
-    if (rad__get32(p + 4) != RAD_CONTAINER_VERSION) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: container version %u, this library reads version %u", rad__get32(p + 4),
-                 RAD_CONTAINER_VERSION);
-        return RAD_ERROR_VERSION;
-    }
-    flags = rad__get32(p + 32);
-    if ((flags & ~RAD__FLAG_BIG_ENDIAN) != 0 || ((flags & RAD__FLAG_BIG_ENDIAN) != 0) != rad__host_big_endian()) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: flags %#x (byte order or features this build does not read)", flags);
-        return RAD_ERROR_VERSION;
-    }
-    count = rad__get32(p + 8);
-    table = rad__get64(p + 16);
-    file_size = rad__get64(p + 24);
-    if (rad__get32(p + 12) != RAD__HEADER_BYTES || table != RAD__HEADER_BYTES || count > 0x00FFFFFFu) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: bad header (header size %u, table offset %llu, %u sections)", rad__get32(p + 12),
-                 (unsigned long long)table, count);
-        return RAD_ERROR_CORRUPT;
-    }
-    if (file_size > (uint64_t)size) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes given, the container is %llu bytes", (unsigned long long)size,
-                 (unsigned long long)file_size);
-        return RAD_ERROR_TRUNCATED;
-    }
-    first_data = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
-    if (first_data > file_size) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: the table of %u sections does not fit in %llu bytes", count, (unsigned long long)file_size);
-        return RAD_ERROR_CORRUPT;
-    }
-    if (rad__get32(p + 36) != rad__crc32(p + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count)) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: section table checksum mismatch");
-        return RAD_ERROR_CORRUPT;
-    }
+    if ((r = rad__header_parse(p, (uint64_t)size, &c, "baked data", &h)) != RAD_SUCCESS ||
+        (r = rad__table_check(p, p + RAD__HEADER_BYTES, h.count, &c, "baked data")) != RAD_SUCCESS)
+        return r;
     ct = (rad_container *)rad__alloc(&c.allocator, sizeof(rad_container));
     if (!ct) return RAD_ERROR_OUT_OF_MEMORY;
     ct->allocator = c.allocator;
-    ct->count = count;
-    ct->sections = (rad_section *)rad__alloc_array(&c.allocator, count ? count : 1u, sizeof(rad_section));
+    ct->count = h.count;
+    ct->sections = (rad_section *)rad__alloc_array(&c.allocator, h.count ? h.count : 1u, sizeof(rad_section));
     if (!ct->sections) { rad__free(&c.allocator, ct); return RAD_ERROR_OUT_OF_MEMORY; }
-    for (i = 0; i < count; ++i) {
+    for (i = 0; i < h.count; ++i) {
         const unsigned char *e = p + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
         rad_section *sec = &ct->sections[i];
-        uint64_t off = rad__get64(e + 16), bytes = rad__get64(e + 24), n = rad__get64(e + 8);
-        uint32_t esz = rad__get32(e + 4), k;
-        const char *why = NULL;
+        rad__entry x;
+        const char *why = rad__entry_parse(e, &h, &x);
         memset(sec, 0, sizeof(*sec));
-        sec->type = rad__get32(e);
-        sec->elem_size = esz;
-        sec->count = n;
-        memcpy(sec->name, e + 40, 24);
-        if (sec->name[23] != 0) why = "its name is not NUL-terminated";
-        else if (esz == 0 || n > UINT64_MAX / esz || n * esz != bytes) why = "element size x count differs from its byte size";
-        else if (off % RAD__ALIGN != 0 || off < first_data) why = "its offset is misaligned or inside the table";
-        else if (bytes > file_size || off > file_size - bytes) why = "it extends past the end of the container";
-        else if (rad__get32(e + 32) != rad__crc32(p + off, (size_t)bytes)) why = "checksum mismatch";
-        for (k = 36; k < 40 && !why; ++k)
-            if (e[k]) why = "reserved bytes are not zero";
+        sec->type = x.type;
+        sec->elem_size = x.elem_size;
+        sec->count = x.count;
+        memcpy(sec->name, e + RAD__E_NAME, 24);
+        if (!why && x.crc != rad__crc32(p + x.offset, (size_t)x.bytes)) why = "checksum mismatch";
         if (why) {
             rad__log(&c, RAD_LOG_ERROR, "baked data: section %u (type %u, '%.23s'): %s", i, sec->type, sec->name, why);
             rad_container_close(ct);
             return RAD_ERROR_CORRUPT;
         }
-        sec->data = p + off;
+        sec->data = p + x.offset;
     }
     *out = ct;
     return RAD_SUCCESS;
@@ -10964,55 +11089,6 @@ RAD_API const rad_section *rad_container_find(const rad_container *c, uint32_t t
     for (i = 0; i < c->count; ++i)
         if (c->sections[i].type == type && (!name || strcmp(c->sections[i].name, name) == 0)) return &c->sections[i];
     return NULL;
-}
-
-static void rad__section(rad_section *s, uint32_t type, uint32_t elem_size, uint64_t count, const void *data, const char *name)
-{
-    memset(s, 0, sizeof(*s));
-    s->type = type;
-    s->elem_size = elem_size;
-    s->count = count;
-    s->data = data;
-    if (name) {
-        size_t n = strlen(name);
-        if (n > sizeof(s->name) - 1) n = sizeof(s->name) - 1;
-        memcpy(s->name, name, n);
-    }
-}
-
-/* The value rule of every loader (>>api_container VALUES): n floats, each finite (else
-   NON_FINITE) and of magnitude <= RAD_BAKE_VALUE_MAX, and >= 0 when 'nonneg' (-0 passes)
-   (else CORRUPT). One branch-free pass on the bit patterns (NaN and infinity have larger
-   magnitude bits than any finite bound), then the first bad entry is found again for the
-   message, which names 'what', the entry and its value. */
-static rad_result rad__check_values(const rad__ctx *c, const char *what, const float *v, uint64_t n, int nonneg)
-{
-    const float vmax = RAD_BAKE_VALUE_MAX;
-    uint32_t maxbits, sign = nonneg ? 0x80000000u : 0u, bad = 0;
-    uint64_t i, j;
-    memcpy(&maxbits, &vmax, 4);
-    for (i = 0; i < n && !bad; i += 4096) {
-        uint64_t e = n - i < 4096 ? n : i + 4096;
-        for (j = i; j < e; ++j) {
-            uint32_t b;
-            memcpy(&b, v + j, 4);
-            bad |= (uint32_t)((b & 0x7FFFFFFFu) > maxbits) | (uint32_t)((b & sign) != 0 && b != sign);
-        }
-    }
-    if (!bad) return RAD_SUCCESS;
-    for (i = 0; i < n; ++i) {
-        const float x = v[i];
-        if (!rad__finite(x)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (not finite)", what, (unsigned long long)i, (double)x);
-            return RAD_ERROR_NON_FINITE;
-        }
-        if (x > vmax || x < -vmax || (nonneg && x < 0.0f)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (%s)", what, (unsigned long long)i, (double)x,
-                     nonneg && x < 0.0f ? "negative" : "beyond RAD_BAKE_VALUE_MAX = 1e30");
-            return RAD_ERROR_CORRUPT;
-        }
-    }
-    return RAD_SUCCESS; /* not reached */
 }
 
 static int rad__all_finite(const float *v, uint64_t n)
@@ -11479,7 +11555,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
     FILE *f;
     long len;
     void *buf;
-    unsigned char head[64];
+    unsigned char head[RAD__HEADER_BYTES];
     size_t got;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -11510,10 +11586,10 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
         rad__log(&c, RAD_LOG_ERROR, "cannot size '%s'", path);
         return RAD_ERROR_IO;
     }
-    if (rad__get64(head + 24) > (uint64_t)len) {
+    if (rad__get64(head + RAD__H_FILE_SIZE) > (uint64_t)len) {
         fclose(f);
         rad__log(&c, RAD_LOG_ERROR, "'%s' has %ld bytes, its header says %llu: the file is truncated", path, len,
-                 (unsigned long long)rad__get64(head + 24));
+                 (unsigned long long)rad__get64(head + RAD__H_FILE_SIZE));
         return RAD_ERROR_TRUNCATED;
     }
     buf = rad__alloc(&c.allocator, (size_t)len);
@@ -15193,15 +15269,157 @@ RAD_API void rad_row_stream_source(rad_row_stream *s, rad_row_source *out)
 
 RAD_API size_t rad_row_stream_memory(const rad_row_stream *s) { return s ? s->bytes : 0; }
 
+/* The sections a row stream reads, the first of each type. */
+enum { RAD__SL_PATCHES, RAD__SL_OFFSETS, RAD__SL_COLUMNS, RAD__SL_VALUES, RAD__SL_VP_AREAS, RAD__SL_VP_ALBEDO, RAD__SL_COUNT };
+
+typedef struct rad__stream_layout {
+    rad__entry at[RAD__SL_COUNT];
+    uint32_t found;   /* a bit per slot */
+    int vps;          /* a saved virtual-patch set: its areas and albedos stand for the patches */
+} rad__stream_layout;
+
+/* Stage 1 of rad_row_stream_open: the header and the section table, checked as
+   rad_container_open checks them (the same rad__header_parse). *out_table is the table. */
+static rad_result rad__stream_table(FILE *f, uint64_t actual, const rad__ctx *c, const char *who, rad__header *h,
+                                    unsigned char **out_table)
+{
+    unsigned char head[RAD__HEADER_BYTES], *table;
+    rad_result r;
+    *out_table = NULL;
+    if (actual < RAD__HEADER_BYTES || !rad__stream_read(f, 0, head, RAD__HEADER_BYTES)) {
+        rad__log(c, RAD_LOG_ERROR, "%s: shorter than the container header", who);
+        return RAD_ERROR_TRUNCATED;
+    }
+    if ((r = rad__header_parse(head, actual, c, who, h)) != RAD_SUCCESS) return r;
+    table = (unsigned char *)rad__alloc_array(&c->allocator, h->count ? h->count : 1u, RAD__ENTRY_BYTES);
+    if (!table) return RAD_ERROR_OUT_OF_MEMORY;
+    if (!rad__stream_read(f, RAD__HEADER_BYTES, table, (size_t)RAD__ENTRY_BYTES * h->count)) r = RAD_ERROR_IO;
+    else r = rad__table_check(head, table, h->count, c, who);
+    if (r != RAD_SUCCESS) {
+        rad__free(&c->allocator, table);
+        return r;
+    }
+    *out_table = table;
+    return RAD_SUCCESS;
+}
+
+/* Stage 2: finds the patches (or a virtual-patch set's areas and albedos) and the CSR matrix
+   in the table. */
+static rad_result rad__stream_find(const unsigned char *table, const rad__header *h, const rad__ctx *c, const char *who,
+                                   rad__stream_layout *L)
+{
+    static const uint32_t type[RAD__SL_COUNT] = { RAD_SECTION_PATCHES, RAD_SECTION_FF_ROW_OFFSETS, RAD_SECTION_FF_COLUMNS,
+                                                   RAD_SECTION_FF_VALUES, RAD_SECTION_VP_AREAS, RAD_SECTION_VP_ALBEDO };
+    static const uint32_t elem[RAD__SL_COUNT] = { (uint32_t)sizeof(rad_patch), 8u, 4u, 4u, 4u, 12u };
+    const rad__entry *at = L->at;
+    uint32_t i, slot;
+    memset(L, 0, sizeof(*L));
+    for (i = 0; i < h->count; ++i) {
+        rad__entry x;
+        const char *why = rad__entry_parse(table + (size_t)RAD__ENTRY_BYTES * i, h, &x);
+        for (slot = 0; slot < RAD__SL_COUNT && type[slot] != x.type; ++slot) {}
+        if (!why && (slot == RAD__SL_COUNT || (L->found & (1u << slot)))) continue;
+        if (!why && x.elem_size != elem[slot]) why = "an element size this section type does not have";
+        if (why) {
+            rad__log(c, RAD_LOG_ERROR, "%s: section %u (type %u): %s", who, i, x.type, why);
+            return RAD_ERROR_CORRUPT;
+        }
+        L->at[slot] = x;
+        L->found |= 1u << slot;
+    }
+    if (!(L->found & (1u << RAD__SL_PATCHES)) && (L->found >> RAD__SL_VP_AREAS) == 3u &&
+        at[RAD__SL_VP_AREAS].count == at[RAD__SL_VP_ALBEDO].count) {
+        L->vps = 1;
+        L->at[RAD__SL_PATCHES] = at[RAD__SL_VP_AREAS];
+        L->found |= 1u << RAD__SL_PATCHES;
+    }
+    if ((L->found & 15u) != 15u || at[0].count == 0 || at[0].count > 0xFFFFFFFEu || at[1].count != at[0].count + 1 ||
+        at[2].count != at[3].count) {
+        rad__log(c, RAD_LOG_ERROR, "%s holds no patches with a CSR form-factor matrix of matching size", who);
+        return (L->found & 15u) != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
+    }
+    return RAD_SUCCESS;
+}
+
+/* Stage 3: reads what the stream keeps in memory (areas, albedos, row offsets), checks their
+   checksums and values. */
+static rad_result rad__stream_patches(rad_row_stream *s, const rad__stream_layout *L, const rad__ctx *c, const char *who)
+{
+    const rad__entry *at = L->at;
+    const int vps = L->vps;
+    const size_t rec = vps ? 12u : sizeof(rad_patch);
+    unsigned char *buf;
+    rad_result r = RAD_SUCCESS;
+    uint32_t i, k;
+    s->n = (uint32_t)at[RAD__SL_PATCHES].count;
+    s->col_at = at[RAD__SL_COLUMNS].offset;
+    s->val_at = at[RAD__SL_VALUES].offset;
+    s->areas = (float *)rad__alloc_array(&c->allocator, s->n, sizeof(float));
+    s->albedo = (float *)rad__alloc_array(&c->allocator, s->n, 3 * sizeof(float));
+    s->offsets = (uint64_t *)rad__alloc_array(&c->allocator, (size_t)s->n + 1u, sizeof(uint64_t));
+    buf = (unsigned char *)rad__alloc_array(&c->allocator, s->n, rec);
+    if (!s->areas || !s->albedo || !s->offsets || !buf) {
+        rad__free(&c->allocator, buf);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    s->bytes = sizeof(*s) + (size_t)s->n * 16u + ((size_t)s->n + 1u) * 8u;
+    if (!rad__stream_read(s->f, at[RAD__SL_PATCHES].offset, vps ? (void *)s->areas : (void *)buf, (size_t)s->n * (vps ? 4u : rec)) ||
+        (vps && !rad__stream_read(s->f, at[RAD__SL_VP_ALBEDO].offset, buf, (size_t)s->n * 12u)) ||
+        !rad__stream_read(s->f, at[RAD__SL_OFFSETS].offset, s->offsets, ((size_t)s->n + 1u) * 8u)) {
+        rad__free(&c->allocator, buf);
+        return RAD_ERROR_IO;
+    }
+    if ((vps ? rad__crc32((const unsigned char *)s->areas, (size_t)s->n * 4u) != at[RAD__SL_PATCHES].crc ||
+                   rad__crc32(buf, (size_t)s->n * 12u) != at[RAD__SL_VP_ALBEDO].crc
+             : rad__crc32(buf, (size_t)s->n * rec) != at[RAD__SL_PATCHES].crc) ||
+        rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != at[RAD__SL_OFFSETS].crc) {
+        rad__log(c, RAD_LOG_ERROR, "%s: checksum mismatch in the patches or the row offsets", who);
+        rad__free(&c->allocator, buf);
+        return RAD_ERROR_CORRUPT;
+    }
+    for (i = 0; i < s->n && r == RAD_SUCCESS; ++i) {
+        if (vps) {
+            memcpy(s->albedo + 3 * (size_t)i, buf + 12u * (size_t)i, 12);
+        } else {
+            rad_patch p;
+            memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
+            s->areas[i] = p.area;
+            for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
+        }
+        for (k = 0; vps && k < 3 && r == RAD_SUCCESS; ++k) /* the patches' loader checked a classic bake's */
+            if (!(s->albedo[3 * (size_t)i + k] >= 0.0f && s->albedo[3 * (size_t)i + k] < 1.0f)) {
+                rad__log(c, RAD_LOG_ERROR, "%s: patch %u has albedo %g (must be in [0, 1))", who, i,
+                         (double)s->albedo[3 * (size_t)i + k]);
+                r = RAD_ERROR_ALBEDO_RANGE;
+            }
+        if (r == RAD_SUCCESS && vps && (!(s->areas[i] > 0.0f) || !rad__finite(s->areas[i]))) {
+            rad__log(c, RAD_LOG_ERROR, "%s: patch %u has area %g", who, i, (double)s->areas[i]);
+            r = RAD_ERROR_CORRUPT;
+        }
+        if (r == RAD_SUCCESS && s->offsets[i + 1] < s->offsets[i]) {
+            rad__log(c, RAD_LOG_ERROR, "%s: row offsets decrease at row %u", who, i);
+            r = RAD_ERROR_CORRUPT;
+        }
+    }
+    if (r == RAD_SUCCESS && (s->offsets[0] != 0 || s->offsets[s->n] != at[RAD__SL_COLUMNS].count)) {
+        rad__log(c, RAD_LOG_ERROR, "%s: row offsets do not span the %llu entries", who,
+                 (unsigned long long)at[RAD__SL_COLUMNS].count);
+        r = RAD_ERROR_CORRUPT;
+    }
+    rad__free(&c->allocator, buf);
+    return r;
+}
+
 RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx, rad_row_stream **out)
 {
     rad__ctx c;
     rad_row_stream *s;
-    unsigned char head[RAD__HEADER_BYTES], *table = NULL, *buf = NULL;
-    uint64_t file_size, actual, off[6] = {0, 0, 0, 0, 0, 0}, cnt[6] = {0, 0, 0, 0, 0, 0};
-    uint32_t count, i, crc[6] = {0, 0, 0, 0, 0, 0}, found = 0, vps = 0;
+    unsigned char *table = NULL;
+    rad__header h;
+    rad__stream_layout L;
+    char who[288];
     long end;
-    rad_result r = RAD_SUCCESS;
+    rad_result r;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
@@ -15217,146 +15435,19 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
         rad_row_stream_close(s);
         return RAD_ERROR_IO;
     }
-    if (fseek(s->f, 0, SEEK_END) != 0 || (end = ftell(s->f)) < 0) { r = RAD_ERROR_IO; goto fail; }
-    actual = (uint64_t)end;
-    if (actual < RAD__HEADER_BYTES || !rad__stream_read(s->f, 0, head, RAD__HEADER_BYTES)) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' is shorter than the container header", path);
-        r = RAD_ERROR_TRUNCATED;
-        goto fail;
-    }
-    if (memcmp(head, "RADB", 4) != 0 || rad__get32(head + 60) != rad__crc32(head, 60)) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': no RADB magic or a bad header checksum", path);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    if (rad__get32(head + 4) != RAD_CONTAINER_VERSION || (rad__get32(head + 32) & ~RAD__FLAG_BIG_ENDIAN) != 0u ||
-        ((rad__get32(head + 32) & RAD__FLAG_BIG_ENDIAN) != 0u) != rad__host_big_endian()) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': container version %u or byte order this build does not read", path,
-                 rad__get32(head + 4));
-        r = RAD_ERROR_VERSION;
-        goto fail;
-    }
-    count = rad__get32(head + 8);
-    file_size = rad__get64(head + 24);
-    if (rad__get64(head + 16) != RAD__HEADER_BYTES || count > 0x00FFFFFFu) { r = RAD_ERROR_CORRUPT; goto fail; }
-    if (file_size > actual) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' has %llu bytes, the container %llu", path, (unsigned long long)actual,
-                 (unsigned long long)file_size);
-        r = RAD_ERROR_TRUNCATED;
-        goto fail;
-    }
-    table = (unsigned char *)rad__alloc_array(&c.allocator, count ? count : 1u, RAD__ENTRY_BYTES);
-    if (!table) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
-    if ((uint64_t)RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count > file_size ||
-        !rad__stream_read(s->f, RAD__HEADER_BYTES, table, (size_t)RAD__ENTRY_BYTES * count)) {
-        r = RAD_ERROR_TRUNCATED;
-        goto fail;
-    }
-    if (rad__get32(head + 36) != rad__crc32(table, (size_t)RAD__ENTRY_BYTES * count)) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': section table checksum mismatch", path);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    /* 0: patches, 1: row offsets, 2: columns, 3: values (the first of each type) */
-    for (i = 0; i < count; ++i) {
-        const unsigned char *e = table + (size_t)RAD__ENTRY_BYTES * i;
-        uint32_t type = rad__get32(e), esz = rad__get32(e + 4), want, slot;
-        uint64_t n = rad__get64(e + 8), at = rad__get64(e + 16), bytes = rad__get64(e + 24);
-        if (type == RAD_SECTION_PATCHES) { slot = 0; want = (uint32_t)sizeof(rad_patch); }
-        else if (type == RAD_SECTION_VP_AREAS) { slot = 4; want = 4u; }
-        else if (type == RAD_SECTION_VP_ALBEDO) { slot = 5; want = 12u; }
-        else if (type == RAD_SECTION_FF_ROW_OFFSETS) { slot = 1; want = 8u; }
-        else if (type == RAD_SECTION_FF_COLUMNS) { slot = 2; want = 4u; }
-        else if (type == RAD_SECTION_FF_VALUES) { slot = 3; want = 4u; }
-        else continue;
-        if (found & (1u << slot)) continue;
-        if (esz != want || n > UINT64_MAX / esz || n * esz != bytes || bytes > file_size || at > file_size - bytes) {
-            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': section %u (type %u) has a bad size or extends past the end", path, i, type);
-            r = RAD_ERROR_CORRUPT;
-            goto fail;
-        }
-        off[slot] = at;
-        cnt[slot] = n;
-        crc[slot] = rad__get32(e + 32);
-        found |= 1u << slot;
-    }
-    /* a saved virtual-patch set (rad_vp_sections): its areas and albedos stand for the patches */
-    if (!(found & 1u) && (found & 48u) == 48u && cnt[4] == cnt[5]) {
-        vps = 1;
-        off[0] = off[4], cnt[0] = cnt[4], crc[0] = crc[4];
-        found |= 1u;
-    }
-    if ((found & 15u) != 15u || cnt[0] == 0 || cnt[0] > 0xFFFFFFFEu || cnt[1] != cnt[0] + 1 || cnt[2] != cnt[3]) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' holds no patches with a CSR form-factor matrix of matching size", path);
-        r = (found & 15u) != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    s->n = (uint32_t)cnt[0];
-    s->col_at = off[2];
-    s->val_at = off[3];
-    s->areas = (float *)rad__alloc_array(&c.allocator, s->n, sizeof(float));
-    s->albedo = (float *)rad__alloc_array(&c.allocator, s->n, 3 * sizeof(float));
-    s->offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)s->n + 1u, sizeof(uint64_t));
-    buf = (unsigned char *)rad__alloc_array(&c.allocator, s->n, vps ? 12u : sizeof(rad_patch));
-    if (!s->areas || !s->albedo || !s->offsets || !buf) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
-    s->bytes = sizeof(*s) + (size_t)s->n * 16u + ((size_t)s->n + 1u) * 8u;
-    if (!rad__stream_read(s->f, off[0], vps ? (void *)s->areas : (void *)buf, (size_t)s->n * (vps ? 4u : sizeof(rad_patch))) ||
-        (vps && !rad__stream_read(s->f, off[5], buf, (size_t)s->n * 12u)) ||
-        !rad__stream_read(s->f, off[1], s->offsets, ((size_t)s->n + 1u) * 8u)) {
-        r = RAD_ERROR_IO;
-        goto fail;
-    }
-    if ((vps ? rad__crc32((const unsigned char *)s->areas, (size_t)s->n * 4u) != crc[0] ||
-                   rad__crc32(buf, (size_t)s->n * 12u) != crc[5]
-             : rad__crc32(buf, (size_t)s->n * sizeof(rad_patch)) != crc[0]) ||
-        rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != crc[1]) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': checksum mismatch in the patches or the row offsets", path);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    for (i = 0; i < s->n; ++i) {
-        uint32_t k;
-        if (vps) {
-            memcpy(s->albedo + 3 * (size_t)i, buf + 12u * (size_t)i, 12);
-        } else {
-            rad_patch p;
-            memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
-            s->areas[i] = p.area;
-            for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
-        }
-        for (k = 0; vps && k < 3; ++k) /* the patches' loader checked a classic bake's */
-            if (!(s->albedo[3 * (size_t)i + k] >= 0.0f && s->albedo[3 * (size_t)i + k] < 1.0f)) {
-                rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has albedo %g (must be in [0, 1))", path, i,
-                         (double)s->albedo[3 * (size_t)i + k]);
-                r = RAD_ERROR_ALBEDO_RANGE;
-                goto fail;
-            }
-        if (vps && (!(s->areas[i] > 0.0f) || !rad__finite(s->areas[i]))) {
-            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has area %g", path, i, (double)s->areas[i]);
-            r = RAD_ERROR_CORRUPT;
-            goto fail;
-        }
-        if (s->offsets[i + 1] < s->offsets[i]) {
-            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets decrease at row %u", path, i);
-            r = RAD_ERROR_CORRUPT;
-            goto fail;
-        }
-    }
-    if (s->offsets[0] != 0 || s->offsets[s->n] != cnt[2]) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets do not span the %llu entries", path, (unsigned long long)cnt[2]);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
+    snprintf(who, sizeof(who), "row stream: '%s'", path);
+    if (fseek(s->f, 0, SEEK_END) != 0 || (end = ftell(s->f)) < 0) r = RAD_ERROR_IO;
+    else if ((r = rad__stream_table(s->f, (uint64_t)end, &c, who, &h, &table)) == RAD_SUCCESS &&
+             (r = rad__stream_find(table, &h, &c, who, &L)) == RAD_SUCCESS)
+        r = rad__stream_patches(s, &L, &c, who);
     rad__free(&c.allocator, table);
-    rad__free(&c.allocator, buf);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_IO) rad__log(&c, RAD_LOG_ERROR, "row stream: reading '%s' failed", path);
+        rad_row_stream_close(s);
+        return r;
+    }
     *out = s;
     return RAD_SUCCESS;
-fail:
-    if (r == RAD_ERROR_IO) rad__log(&c, RAD_LOG_ERROR, "row stream: reading '%s' failed", path);
-    rad__free(&c.allocator, table);
-    rad__free(&c.allocator, buf);
-    rad_row_stream_close(s);
-    return r;
 }
 #endif
 
