@@ -203,11 +203,9 @@
        rad_save_memory / rad_save_file write patches, a form-factor matrix (dense or CSR) and
        named RGB vectors ("E", "B") into one container; rad_load_memory reads it in place (the
        bytes must be 8-byte aligned and outlive the rad_bake) and rad_load_file reads a file.
-       Layout: a 64-byte header (magic "RADB", version, section count, file size, flags, CRC-32
-       of the section table, CRC-32 of the header), 64-byte table entries (type, element size,
-       count, offset, bytes, CRC-32, name), then the sections, each on a 64-byte boundary.
-       Section data is in the writer's byte order, recorded in the flags; a reader of the other
-       byte order refuses it (RAD_ERROR_VERSION). Every size, offset, checksum and index is
+       The byte layout (a little-endian header and section table, then the section data in
+       the writer's byte order) is described once, in >>api_container. Every size, offset,
+       checksum and index is
        checked before use: a truncated file gives RAD_ERROR_TRUNCATED, a damaged one
        RAD_ERROR_CORRUPT, another version RAD_ERROR_VERSION, an index out of range
        RAD_ERROR_INDEX_OUT_OF_RANGE; nothing is read outside the given bytes. Behind a valid
@@ -1642,12 +1640,20 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
 /* >>api_container: baked data                                                              */
 /* ======================================================================================== */
 
-/* One versioned binary container for everything a bake produces (docs/methods/container.md). Layout, all
-   little-endian: a 64-byte header ("RADB", version, section count, table offset, file size,
-   flags, CRC-32 of the table, CRC-32 of the header), a table of 64-byte section entries (type, element size, element count,
-   offset, byte size, CRC-32 of the data, a 24-byte name), and the section data, each section
-   starting on a 64-byte boundary so the file can be memory-mapped and read in place.
-   Loading validates every size, offset, checksum and index before anything is used.
+/* One versioned binary container for everything a bake produces (docs/methods/container.md
+   teaches it). THE LAYOUT (this is its one description):
+     header, 64 bytes, its fields little-endian (byte offset: field):
+       0: "RADB"  4: version (uint32)  8: section count  12: header size (64)
+       16: table offset (uint64, 64)  24: file size (uint64)  32: flags (bit 0: the section
+       data is big-endian)  36: CRC-32 of the table  40..59: zero  60: CRC-32 of bytes 0..59
+     table, one 64-byte entry per section, its fields little-endian:
+       0: type (rad_section_type)  4: element size  8: element count (uint64)  16: offset
+       (uint64)  24: byte size (uint64)  32: CRC-32 of the data  36..39: zero  40: name (24
+       bytes, NUL-terminated)
+     data: each section from an offset that is a multiple of 64, in the WRITER'S byte order
+       (flag bit 0), so that a file can be memory-mapped and read in place; a reader of the
+       other byte order refuses it (RAD_ERROR_VERSION) instead of converting.
+   CRC-32 is the common reflected one (polynomial 0xEDB88320, as zlib's crc32). Loading validates every size, offset, checksum and index before anything is used.
    VERSIONING: RAD_CONTAINER_VERSION changes only when the header or the table entry layout
    changes (a reader refuses another version with RAD_ERROR_VERSION). New section types are
    added without a version change: readers look sections up by type and name and skip the
@@ -1668,6 +1674,7 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
    larger values in what it writes, so whatever it writes loads. */
 #define RAD_BAKE_VALUE_MAX 1e30f
 
+/* Every section type the library writes, in one table. */
 typedef enum rad_section_type {
     RAD_SECTION_PATCHES = 1,         /* rad_patch records */
     RAD_SECTION_PATCH_VERTICES = 2,  /* 3 floats per welded vertex */
@@ -1678,8 +1685,45 @@ typedef enum rad_section_type {
     RAD_SECTION_FF_VALUES = 7,       /* CSR: floats */
     RAD_SECTION_VECTOR = 8,          /* a named RGB vector, 3N floats ("E", "B", "L", "H", ...) */
     RAD_SECTION_SIGNATURE = 9,       /* one rad_bake_signature ("signature"): what it was made from */
+    /* the multi-bounce objects (>>api_multibounce), 16..31 */
+    RAD_SECTION_MB_INFO = 16,              /* 16 uint32: see rad_multibounce_sections */
+    RAD_SECTION_MB_FLOAT = 17,             /* 3 N^2 floats: the R, G, B planes */
+    RAD_SECTION_MB_HALF = 18,              /* 3 N^2 binary16 values */
+    RAD_SECTION_MB_ROW_PERM = 19,          /* N uint32 */
+    RAD_SECTION_MB_COL_PERM = 20,          /* N uint32 */
+    RAD_SECTION_MB_BC1 = 21,               /* ceil(N/4)^2 8-byte BC1 blocks */
+    RAD_SECTION_MB_BC4 = 22,               /* 3 ceil(N/4)^2 8-byte BC4 blocks: R plane, G, B */
+    RAD_SECTION_MB_SCALES = 23,            /* 3 floats (R, G, B) per scale tile */
+    RAD_SECTION_MB_OUTLIER_OFFSETS = 24,   /* N+1 uint64, CSR by original row */
+    RAD_SECTION_MB_OUTLIER_COLUMNS = 25,   /* uint32 original columns */
+    RAD_SECTION_MB_OUTLIER_VALUES = 26,    /* 3 floats (exact RGB) per outlier */
+    /* the alias tables (>>api_temporal), 32..39 */
+    RAD_SECTION_TEMPORAL_ROW_OFFSETS = 32, /* alias tables: rows + 1 uint64, offsets in bins */
+    RAD_SECTION_TEMPORAL_BINS = 33,        /* alias tables: the bins, 2 or 3 uint32 words each */
+    RAD_SECTION_TEMPORAL_TOTALS = 34,      /* alias tables: T_i, one float per row */
+    /* virtual patches (>>api_vp), 40..63 */
+    RAD_SECTION_VP_INFO = 40,              /* the set's sizes and grid: see rad_vp_sections */
+    RAD_SECTION_VP_AREAS = 41,             /* N floats */
+    RAD_SECTION_VP_ALBEDO = 42,            /* 3 N floats */
+    RAD_SECTION_VP_NORMALS = 43,           /* 3 N floats */
+    RAD_SECTION_VP_AXIS = 44,              /* N uint8 */
+    RAD_SECTION_VP_VOXEL = 45,             /* N uint32 */
+    RAD_SECTION_VP_VOXEL_KEYS = 46,        /* voxel_count uint64 */
+    RAD_SECTION_VP_VOXEL_FIRST = 47,       /* voxel_count + 1 uint32 */
+    RAD_SECTION_VP_VOXEL_PATCH = 48,       /* 6 uint32 per voxel */
+    RAD_SECTION_VP_SAMPLE_FIRST = 49,      /* voxel_count + 1 uint32 */
+    RAD_SECTION_VP_SAMPLE_POSITIONS = 50,  /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_NORMALS = 51,    /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_ALBEDO = 52,     /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_AREAS = 53,      /* M floats */
+    RAD_SECTION_VP_SAMPLE_WEIGHTS = 54,    /* 6 M floats */
+    RAD_SECTION_VP_SAMPLE_TRIANGLES = 55,  /* M uint32 */
     RAD_SECTION_USER = 0x10000       /* types from here up are the application's own */
 } rad_section_type;
+
+/* The name of a section type without its prefix ("PATCHES", "MB_BC1", "VP_AREAS"), "USER"
+   from RAD_SECTION_USER up, NULL for a type the library does not know. Pure. */
+RAD_API const char *rad_section_type_name(uint32_t type);
 
 /* One section, for writing (data borrowed) or as found by rad_container_find (data points
    into the container's bytes). */
@@ -2086,18 +2130,7 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 
 #define RAD_MB_INFINITE 0xFFFFFFFFu   /* rad_multibounce_options.bounces: K = infinity */
 
-/* Container section types of the multi-bounce objects (16..31 are reserved for them). */
-#define RAD_SECTION_MB_INFO 16u            /* 16 uint32: see rad_multibounce_sections */
-#define RAD_SECTION_MB_FLOAT 17u           /* 3 N^2 floats: the R, G, B planes */
-#define RAD_SECTION_MB_HALF 18u            /* 3 N^2 binary16 values */
-#define RAD_SECTION_MB_ROW_PERM 19u        /* N uint32 */
-#define RAD_SECTION_MB_COL_PERM 20u        /* N uint32 */
-#define RAD_SECTION_MB_BC1 21u             /* ceil(N/4)^2 8-byte BC1 blocks */
-#define RAD_SECTION_MB_BC4 22u             /* 3 ceil(N/4)^2 8-byte BC4 blocks: R plane, G, B */
-#define RAD_SECTION_MB_SCALES 23u          /* 3 floats (R, G, B) per scale tile */
-#define RAD_SECTION_MB_OUTLIER_OFFSETS 24u /* N+1 uint64, CSR by original row */
-#define RAD_SECTION_MB_OUTLIER_COLUMNS 25u /* uint32 original columns */
-#define RAD_SECTION_MB_OUTLIER_VALUES 26u  /* 3 floats (exact RGB) per outlier */
+/* Container section types: RAD_SECTION_MB_* (16..31) in the table of >>api_container. */
 #define RAD_MB_MAX_SECTIONS 10u            /* most sections one object writes */
 
 typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
@@ -2598,9 +2631,7 @@ RAD_API rad_result rad_local_lit(const float *E, const uint32_t *candidates, uin
    per channel (MULTIBOUNCE with 3 tables) channel c only accumulates its own component.
    The OUTPUT IS THE INDIRECT LIGHT (never E itself): add E for the total. */
 
-#define RAD_SECTION_TEMPORAL_ROW_OFFSETS 32u /* alias tables: rows + 1 uint64, offsets in bins */
-#define RAD_SECTION_TEMPORAL_BINS 33u        /* alias tables: the bins, 2 or 3 uint32 words each */
-#define RAD_SECTION_TEMPORAL_TOTALS 34u      /* alias tables: T_i, one float per row */
+/* Container section types: RAD_SECTION_TEMPORAL_* (32..39) in the table of >>api_container. */
 
 typedef enum rad_alias_format {
     RAD_ALIAS_AUTO = 0,    /* compact when cols <= 65535, else wide (the builders' choice) */
@@ -2740,8 +2771,12 @@ typedef struct rad_temporal rad_temporal;
 /* Temporal state for N = tables[0]->rows patches. tables: table_count (1, or 3 in
    MULTIBOUNCE mode: one per channel) borrowed tables, which must outlive the state; all of
    the same size N x N. albedo: 3N floats, borrowed, required for SINGLE and FEEDBACK, unused
-   (may be NULL) for MULTIBOUNCE. B starts at 0. Errors: INVALID_ARGUMENT, SIZE_MISMATCH,
-   OUT_OF_MEMORY. Thread safety: reentrant. Memory: O(N). docs/methods/temporal.md. */
+   (may be NULL) for MULTIBOUNCE. B starts at 0. ctx (NULL: the defaults) is COPIED into the
+   state and used by every later call on it (rad_temporal_step takes no context, so that a
+   frame is one call): its allocator frees the state, its parallel_for runs each step, its
+   logger reports the step's errors, so whatever their user pointers point to must outlive
+   the state. Errors: INVALID_ARGUMENT, SIZE_MISMATCH, OUT_OF_MEMORY. Thread safety:
+   reentrant. Memory: O(N). docs/methods/temporal.md. */
 RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, uint32_t table_count, const float *albedo,
                                        const rad_temporal_options *options, const rad_context *ctx,
                                        rad_temporal **out);
@@ -2757,7 +2792,8 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
 /* One frame: E (3N floats, borrowed during the call), E0 (the sky/environment RGB value, NULL
    for 0). Advances the frame counter. Writes the new indirect light B (3N floats, never
    including E) to out_indirect when it is not NULL; rad_temporal_indirect returns it too.
-   Parallel over rows through ctx->parallel_for; the bits do not depend on the thread count
+   Parallel over rows through the parallel_for of the context given to rad_temporal_create
+   (kept by the state); the bits do not depend on the thread count
    or task split (each row's draws depend only on seed, frame, row and sample).
    Errors: INVALID_ARGUMENT, NON_FINITE (E or E0 not finite, or B overflows float: the
    step is then undone). Cost: O(N k) random reads into the tables and E: the draws
@@ -3055,22 +3091,7 @@ RAD_API rad_result rad_vp_gather_mesh(const rad_virtual_patches *vp, const float
    bake's (it takes the areas and albedos from these sections when the file has no patches).
    *out_count receives how many were written (at most RAD_VP_MAX_SECTIONS). Errors:
    INVALID_ARGUMENT. */
-#define RAD_SECTION_VP_INFO 40u
-#define RAD_SECTION_VP_AREAS 41u            /* N floats */
-#define RAD_SECTION_VP_ALBEDO 42u           /* 3 N floats */
-#define RAD_SECTION_VP_NORMALS 43u          /* 3 N floats */
-#define RAD_SECTION_VP_AXIS 44u             /* N uint8 */
-#define RAD_SECTION_VP_VOXEL 45u            /* N uint32 */
-#define RAD_SECTION_VP_VOXEL_KEYS 46u       /* voxel_count uint64 */
-#define RAD_SECTION_VP_VOXEL_FIRST 47u      /* voxel_count + 1 uint32 */
-#define RAD_SECTION_VP_VOXEL_PATCH 48u      /* 6 uint32 per voxel */
-#define RAD_SECTION_VP_SAMPLE_FIRST 49u     /* voxel_count + 1 uint32 */
-#define RAD_SECTION_VP_SAMPLE_POSITIONS 50u /* 3 M floats */
-#define RAD_SECTION_VP_SAMPLE_NORMALS 51u   /* 3 M floats */
-#define RAD_SECTION_VP_SAMPLE_ALBEDO 52u    /* 3 M floats */
-#define RAD_SECTION_VP_SAMPLE_AREAS 53u     /* M floats */
-#define RAD_SECTION_VP_SAMPLE_WEIGHTS 54u   /* 6 M floats */
-#define RAD_SECTION_VP_SAMPLE_TRIANGLES 55u /* M uint32 */
+/* (section types RAD_SECTION_VP_* (40..63) in the table of >>api_container) */
 #define RAD_VP_MAX_SECTIONS 19u
 RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count);
 
@@ -3285,9 +3306,28 @@ RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], 
 #  define RAD__SSE2 1
 #  include <emmintrin.h>
 #endif
+/* SIMD: every feature macro is chosen here, once, from what the compiler already enables
+   (RAD_NO_SIMD: none); the kernels test these and never the compiler's own macros.
+   RAD__SSE2, RAD__AVX   the BVH, dot products and matrix-vector kernels;
+   RAD__MB_AVX2, _FMA, _F16C   the GEMM, binary16 and compressed-block kernels (>>kernels,
+                         >>multibounce, >>local);
+   RAD__TEMPORAL_AVX2    the temporal step hashing 8 draws at once (rad__tpipe_issue8; x86-64
+                         only, for its 64-bit lanes). */
 #if !defined(RAD_NO_SIMD) && defined(__AVX__)
 #  define RAD__AVX 1
 #  include <immintrin.h>
+#endif
+#if defined(RAD__AVX) && defined(__AVX2__)
+#  define RAD__MB_AVX2 1
+#endif
+#if defined(RAD__AVX) && defined(__FMA__)
+#  define RAD__MB_FMA 1
+#endif
+#if defined(RAD__AVX) && defined(__F16C__)
+#  define RAD__MB_F16C 1
+#endif
+#if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
+#  define RAD__TEMPORAL_AVX2 1
 #endif
 
 /* Linux: madvise(MADV_HUGEPAGE) on large alias tables (>>temporal). Strict ISO C (-std=c99)
@@ -11077,6 +11117,22 @@ RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_c
 
 RAD_API uint32_t rad_container_section_count(const rad_container *c) { return c ? c->count : 0; }
 
+RAD_API const char *rad_section_type_name(uint32_t type)
+{
+    static const char *const names[] = {
+        NULL, "PATCHES", "PATCH_VERTICES", "TRIANGLES", "FF_DENSE", "FF_ROW_OFFSETS", "FF_COLUMNS", "FF_VALUES",
+        "VECTOR", "SIGNATURE", NULL, NULL, NULL, NULL, NULL, NULL,
+        "MB_INFO", "MB_FLOAT", "MB_HALF", "MB_ROW_PERM", "MB_COL_PERM", "MB_BC1", "MB_BC4", "MB_SCALES",
+        "MB_OUTLIER_OFFSETS", "MB_OUTLIER_COLUMNS", "MB_OUTLIER_VALUES", NULL, NULL, NULL, NULL, NULL,
+        "TEMPORAL_ROW_OFFSETS", "TEMPORAL_BINS", "TEMPORAL_TOTALS", NULL, NULL, NULL, NULL, NULL,
+        "VP_INFO", "VP_AREAS", "VP_ALBEDO", "VP_NORMALS", "VP_AXIS", "VP_VOXEL", "VP_VOXEL_KEYS", "VP_VOXEL_FIRST",
+        "VP_VOXEL_PATCH", "VP_SAMPLE_FIRST", "VP_SAMPLE_POSITIONS", "VP_SAMPLE_NORMALS", "VP_SAMPLE_ALBEDO",
+        "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES"
+    };
+    if (type >= RAD_SECTION_USER) return "USER";
+    return type < sizeof(names) / sizeof(names[0]) ? names[type] : NULL;
+}
+
 RAD_API const rad_section *rad_container_section(const rad_container *c, uint32_t index)
 {
     return (c && index < c->count) ? &c->sections[index] : NULL;
@@ -12908,16 +12964,6 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 /* ======================================================================================== */
 /* >>multibounce: multi-bounce matrix, GEMM, binary16, BC1/BC4, compression, container      */
 /* ======================================================================================== */
-
-#if defined(RAD__AVX) && defined(__AVX2__)
-#  define RAD__MB_AVX2 1
-#endif
-#if defined(RAD__AVX) && defined(__FMA__)
-#  define RAD__MB_FMA 1
-#endif
-#if defined(RAD__AVX) && defined(__F16C__)
-#  define RAD__MB_F16C 1
-#endif
 
 #if defined(RAD__MB_FMA)
 #  define RAD__MB_MADD(a, b, c) _mm256_fmadd_ps(a, b, c)
@@ -17158,9 +17204,6 @@ typedef struct rad__tstep {
 #else
 #  define RAD__PREFETCH(p) ((void)0)
 #  define RAD__HOT static inline
-#endif
-#if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
-#  define RAD__TEMPORAL_AVX2 1 /* hashes 8 draws at once (rad__tpipe_issue8) */
 #endif
 /* draws whose bins are in flight ahead of the one resolved. AVX2 issues cheaper, so more of
    them overlap: 64 -> 128 took 4.8-5.1 to 4.2-4.5 ns per draw with 450 MB of tables (BENCHMARKS.md) */
