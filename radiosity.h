@@ -809,6 +809,12 @@ RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const fl
 /* >>api_solve: classic solvers                                                             */
 /* ======================================================================================== */
 
+/* Indirect light or the total, chosen the same way by every call that offers both: a
+   rad_output, in the options of the solvers (rad_solve_options.output,
+   rad_stochastic_options.output) and as the parameter after the output array of the applies
+   (rad_multibounce_apply, rad_multibounce_blocks_apply, rad_local_apply); the GPU kernels take
+   its value as the bit RAD_GLSL_FLAG_TOTAL (equal to RAD_OUTPUT_TOTAL). Methods whose state is
+   the indirect light alone (rad_temporal_step) always return L: add E for the total. */
 typedef enum rad_output { RAD_OUTPUT_INDIRECT = 0, RAD_OUTPUT_TOTAL = 1 } rad_output;
 
 /* The linear system B = E + (rho o F) B. All pointers borrowed. */
@@ -2004,7 +2010,7 @@ typedef enum rad_glsl_id {
 /* >>glsl ids end */
 
 #define RAD_GLSL_SPEC_LOCAL_SIZE 0u   /* specialization constant id of the workgroup x size */
-#define RAD_GLSL_FLAG_TOTAL 1u        /* gather, multi-bounce apply: add E (RAD_OUTPUT_TOTAL) */
+#define RAD_GLSL_FLAG_TOTAL 1u        /* gather, applies: add E; the value of RAD_OUTPUT_TOTAL */
 #define RAD_GLSL_FLAG_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
 #define RAD_GLSL_FLAG_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
 #define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
@@ -2111,6 +2117,15 @@ RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
 RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
 
 /* ======================================================================================== */
+/* >>api_kernels: shared numeric kernels                                                    */
+/* ======================================================================================== */
+
+/* IEEE 754 binary16 conversion: round to nearest, ties to even; overflow gives infinity,
+   subnormals are kept, NaN stays NaN. */
+RAD_API uint16_t rad_half_from_float(float value);
+RAD_API float rad_half_to_float(uint16_t value);
+
+/* ======================================================================================== */
 /* >>api_multibounce: multi-bounce matrix and its compression                               */
 /* ======================================================================================== */
 
@@ -2191,10 +2206,6 @@ RAD_API void rad_multibounce_destroy(rad_multibounce *mb);
 RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float *E, float *out, rad_output output,
                                          const rad_context *ctx);
 
-/* IEEE 754 binary16 conversion: round to nearest, ties to even; overflow gives infinity,
-   subnormals are kept, NaN stays NaN. */
-RAD_API uint16_t rad_half_from_float(float value);
-RAD_API float rad_half_to_float(uint16_t value);
 
 /* ---- block compression ---- */
 
@@ -11669,6 +11680,9 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
 /* >>glsl: GLSL compute kernels (generated sources, access)                                 */
 /* ======================================================================================== */
 
+/* a rad_output passes to the kernels unchanged as their TOTAL bit */
+typedef char rad__check_glsl_output_flag[(RAD_GLSL_FLAG_TOTAL == (uint32_t)RAD_OUTPUT_TOTAL) ? 1 : -1];
+
 /* push-constant mirrors: the GLSL blocks are 4-byte members in declaration order */
 typedef char rad__check_glsl_dense_push[(sizeof(rad_glsl_gather_dense_push) == 20 &&
                                          offsetof(rad_glsl_gather_dense_push, f_base) == 12 &&
@@ -12962,8 +12976,12 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #endif /* RAD_NO_GLSL */
 
 /* ======================================================================================== */
-/* >>multibounce: multi-bounce matrix, GEMM, binary16, BC1/BC4, compression, container      */
+/* >>kernels: shared numeric kernels (binary16, dot products, GEMM)                        */
 /* ======================================================================================== */
+
+/* Used by more than one method (>>multibounce builds F_mb with the GEMM and applies it with
+   the dots; >>local builds its matrix with the same GEMM; the half conversions serve the
+   binary16 planes and their GLSL path). */
 
 #if defined(RAD__MB_FMA)
 #  define RAD__MB_MADD(a, b, c) _mm256_fmadd_ps(a, b, c)
@@ -12973,11 +12991,11 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #  define RAD__MB_MADD4(a, b, c) _mm_add_ps(c, _mm_mul_ps(a, b))
 #endif
 
-#define RAD__MB_MR 6u
-#define RAD__MB_NR 16u
-#define RAD__MB_KC 256u
-#define RAD__MB_MC 96u
-#define RAD__MB_NC 2048u
+#define RAD__GEMM_MR 6u
+#define RAD__GEMM_NR 16u
+#define RAD__GEMM_KC 256u
+#define RAD__GEMM_MC 96u
+#define RAD__GEMM_NC 2048u
 
 /* ---- binary16 ---- */
 
@@ -13018,7 +13036,176 @@ RAD_API float rad_half_to_float(uint16_t value)
     return f;
 }
 
-/* ---- objects ---- */
+/* ---- dot products ---- */
+
+static float rad__dot_f32(const float *a, const float *x, uint32_t n)
+{
+    uint32_t j = 0;
+    float s = 0.0f;
+#if defined(RAD__AVX)
+    {
+        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
+        float t[8];
+        int k;
+        for (; j + 32 <= n; j += 32) {
+            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(x + j)));
+            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_loadu_ps(a + j + 8), _mm256_loadu_ps(x + j + 8)));
+            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_loadu_ps(a + j + 16), _mm256_loadu_ps(x + j + 16)));
+            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_loadu_ps(a + j + 24), _mm256_loadu_ps(x + j + 24)));
+        }
+        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
+        for (k = 0; k < 8; ++k) s += t[k];
+    }
+#endif
+    for (; j < n; ++j) s += a[j] * x[j];
+    return s;
+}
+
+static float rad__dot_f16(const uint16_t *a, const float *x, uint32_t n)
+{
+    uint32_t j = 0;
+    float s = 0.0f;
+#if defined(RAD__MB_F16C)
+    {
+        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
+        float t[8];
+        int k;
+        for (; j + 32 <= n; j += 32) {
+            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j))), _mm256_loadu_ps(x + j)));
+            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 8))), _mm256_loadu_ps(x + j + 8)));
+            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 16))), _mm256_loadu_ps(x + j + 16)));
+            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 24))), _mm256_loadu_ps(x + j + 24)));
+        }
+        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
+        for (k = 0; k < 8; ++k) s += t[k];
+    }
+#endif
+    for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
+    return s;
+}
+
+/* ---- GEMM: C (m x n) += A (m x k) B (k x n), row-major, packed and cache-blocked ---- */
+
+typedef struct rad__gemm {
+    const float *A, *B;
+    float *C;
+    size_t lda, ldb, ldc;
+    uint32_t m, n, k;
+    uint32_t pc, kc, jc, nc;
+    const float *bp;   /* packed B block: ceil(nc/NR) panels of kc x NR */
+    float *ap;         /* packed A: one MC x KC slab per row chunk */
+} rad__gemm;
+
+static void rad__gemm_kernel(uint32_t kc, const float *a, const float *b, float *c, size_t ldc, uint32_t mr, uint32_t nr)
+{
+    uint32_t i, j, p;
+#if defined(RAD__AVX)
+    __m256 c0[RAD__GEMM_MR], c1[RAD__GEMM_MR];
+    float tmp[RAD__GEMM_MR][RAD__GEMM_NR];
+    for (i = 0; i < RAD__GEMM_MR; ++i) { c0[i] = _mm256_setzero_ps(); c1[i] = _mm256_setzero_ps(); }
+    for (p = 0; p < kc; ++p) {
+        __m256 b0 = _mm256_loadu_ps(b + (size_t)p * RAD__GEMM_NR), b1 = _mm256_loadu_ps(b + (size_t)p * RAD__GEMM_NR + 8);
+        const float *ap = a + (size_t)p * RAD__GEMM_MR;
+        for (i = 0; i < RAD__GEMM_MR; ++i) {
+            __m256 av = _mm256_broadcast_ss(ap + i);
+#if defined(RAD__MB_FMA)
+            c0[i] = _mm256_fmadd_ps(av, b0, c0[i]);
+            c1[i] = _mm256_fmadd_ps(av, b1, c1[i]);
+#else
+            c0[i] = _mm256_add_ps(c0[i], _mm256_mul_ps(av, b0));
+            c1[i] = _mm256_add_ps(c1[i], _mm256_mul_ps(av, b1));
+#endif
+        }
+    }
+    if (mr == RAD__GEMM_MR && nr == RAD__GEMM_NR) {
+        for (i = 0; i < RAD__GEMM_MR; ++i) {
+            float *ci = c + (size_t)i * ldc;
+            _mm256_storeu_ps(ci, _mm256_add_ps(_mm256_loadu_ps(ci), c0[i]));
+            _mm256_storeu_ps(ci + 8, _mm256_add_ps(_mm256_loadu_ps(ci + 8), c1[i]));
+        }
+        return;
+    }
+    for (i = 0; i < RAD__GEMM_MR; ++i) { _mm256_storeu_ps(tmp[i], c0[i]); _mm256_storeu_ps(tmp[i] + 8, c1[i]); }
+#else
+    float tmp[RAD__GEMM_MR][RAD__GEMM_NR];
+    memset(tmp, 0, sizeof(tmp));
+    for (p = 0; p < kc; ++p) {
+        const float *ap = a + (size_t)p * RAD__GEMM_MR, *bq = b + (size_t)p * RAD__GEMM_NR;
+        for (i = 0; i < RAD__GEMM_MR; ++i) {
+            float av = ap[i];
+            for (j = 0; j < RAD__GEMM_NR; ++j) tmp[i][j] += av * bq[j];
+        }
+    }
+#endif
+    for (i = 0; i < mr; ++i)
+        for (j = 0; j < nr; ++j) c[(size_t)i * ldc + j] += tmp[i][j];
+}
+
+static void rad__gemm_task(void *data, uint32_t t)
+{
+    const rad__gemm *g = (const rad__gemm *)data;
+    uint32_t ic = t * RAD__GEMM_MC, mc = g->m - ic < RAD__GEMM_MC ? g->m - ic : RAD__GEMM_MC, q, p, i, kk;
+    float *ap = g->ap + (size_t)t * RAD__GEMM_MC * RAD__GEMM_KC;
+    uint32_t panels_a = (mc + RAD__GEMM_MR - 1) / RAD__GEMM_MR, panels_b = (g->nc + RAD__GEMM_NR - 1) / RAD__GEMM_NR;
+    for (q = 0; q < panels_a; ++q)
+        for (kk = 0; kk < g->kc; ++kk)
+            for (i = 0; i < RAD__GEMM_MR; ++i) {
+                uint32_t row = q * RAD__GEMM_MR + i;
+                ap[((size_t)q * g->kc + kk) * RAD__GEMM_MR + i] = row < mc ? g->A[(size_t)(ic + row) * g->lda + g->pc + kk] : 0.0f;
+            }
+    for (p = 0; p < panels_b; ++p) {
+        uint32_t nr = g->nc - p * RAD__GEMM_NR < RAD__GEMM_NR ? g->nc - p * RAD__GEMM_NR : RAD__GEMM_NR;
+        for (q = 0; q < panels_a; ++q) {
+            uint32_t mr = mc - q * RAD__GEMM_MR < RAD__GEMM_MR ? mc - q * RAD__GEMM_MR : RAD__GEMM_MR;
+            rad__gemm_kernel(g->kc, ap + (size_t)q * g->kc * RAD__GEMM_MR, g->bp + (size_t)p * g->kc * RAD__GEMM_NR,
+                           g->C + (size_t)(ic + q * RAD__GEMM_MR) * g->ldc + g->jc + p * RAD__GEMM_NR, g->ldc, mr, nr);
+        }
+    }
+}
+
+/* C += A B. The summation order of every entry is fixed (k blocks in order), so the bits do
+   not depend on the number of tasks. */
+static rad_result rad__sgemm(const rad__ctx *c, uint32_t m, uint32_t n, uint32_t k, const float *A, size_t lda,
+                               const float *B, size_t ldb, float *C, size_t ldc)
+{
+    rad__gemm g;
+    float *bp, *ap;
+    uint32_t chunks = (m + RAD__GEMM_MC - 1) / RAD__GEMM_MC, jc, pc;
+    size_t bp_count = (size_t)RAD__GEMM_KC * (RAD__GEMM_NC + RAD__GEMM_NR), ap_count;
+    if (m == 0 || n == 0 || k == 0) return RAD_SUCCESS;
+    if (!rad__mul((size_t)chunks, (size_t)RAD__GEMM_MC * RAD__GEMM_KC, &ap_count)) return RAD_ERROR_SIZE_OVERFLOW;
+    bp = (float *)rad__alloc_array(&c->allocator, bp_count, sizeof(float));
+    ap = (float *)rad__alloc_array(&c->allocator, ap_count, sizeof(float));
+    if (!bp || !ap) { rad__free(&c->allocator, bp); rad__free(&c->allocator, ap); return RAD_ERROR_OUT_OF_MEMORY; }
+    g.A = A; g.B = B; g.C = C; g.lda = lda; g.ldb = ldb; g.ldc = ldc; g.m = m; g.n = n; g.k = k;
+    g.bp = bp; g.ap = ap;
+    for (jc = 0; jc < n; jc += RAD__GEMM_NC) {
+        g.jc = jc;
+        g.nc = n - jc < RAD__GEMM_NC ? n - jc : RAD__GEMM_NC;
+        for (pc = 0; pc < k; pc += RAD__GEMM_KC) {
+            uint32_t panels = (g.nc + RAD__GEMM_NR - 1) / RAD__GEMM_NR, p, kk, j;
+            g.pc = pc;
+            g.kc = k - pc < RAD__GEMM_KC ? k - pc : RAD__GEMM_KC;
+            for (p = 0; p < panels; ++p)
+                for (kk = 0; kk < g.kc; ++kk) {
+                    float *dst = bp + ((size_t)p * g.kc + kk) * RAD__GEMM_NR;
+                    const float *src = B + (size_t)(pc + kk) * ldb + jc + p * RAD__GEMM_NR;
+                    uint32_t cols = g.nc - p * RAD__GEMM_NR < RAD__GEMM_NR ? g.nc - p * RAD__GEMM_NR : RAD__GEMM_NR;
+                    for (j = 0; j < cols; ++j) dst[j] = src[j];
+                    for (; j < RAD__GEMM_NR; ++j) dst[j] = 0.0f;
+                }
+            c->parallel_for(c->parallel_user, chunks, rad__gemm_task, &g);
+        }
+    }
+    rad__free(&c->allocator, bp);
+    rad__free(&c->allocator, ap);
+    return RAD_SUCCESS;
+}
+
+/* ======================================================================================== */
+/* >>multibounce: multi-bounce matrix, BC1/BC4 compression, container sections             */
+/* ======================================================================================== */
+
 
 RAD_API void rad_multibounce_options_default(rad_multibounce_options *o)
 {
@@ -13093,124 +13280,6 @@ static void rad__mb_info(uint32_t *info, uint32_t kind, uint32_t n, uint32_t k, 
     info[6] = flags;
 }
 
-/* ---- GEMM: C (m x n) += A (m x k) B (k x n), row-major, packed and cache-blocked ---- */
-
-typedef struct rad__gemm {
-    const float *A, *B;
-    float *C;
-    size_t lda, ldb, ldc;
-    uint32_t m, n, k;
-    uint32_t pc, kc, jc, nc;
-    const float *bp;   /* packed B block: ceil(nc/NR) panels of kc x NR */
-    float *ap;         /* packed A: one MC x KC slab per row chunk */
-} rad__gemm;
-
-static void rad__mb_kernel(uint32_t kc, const float *a, const float *b, float *c, size_t ldc, uint32_t mr, uint32_t nr)
-{
-    uint32_t i, j, p;
-#if defined(RAD__AVX)
-    __m256 c0[RAD__MB_MR], c1[RAD__MB_MR];
-    float tmp[RAD__MB_MR][RAD__MB_NR];
-    for (i = 0; i < RAD__MB_MR; ++i) { c0[i] = _mm256_setzero_ps(); c1[i] = _mm256_setzero_ps(); }
-    for (p = 0; p < kc; ++p) {
-        __m256 b0 = _mm256_loadu_ps(b + (size_t)p * RAD__MB_NR), b1 = _mm256_loadu_ps(b + (size_t)p * RAD__MB_NR + 8);
-        const float *ap = a + (size_t)p * RAD__MB_MR;
-        for (i = 0; i < RAD__MB_MR; ++i) {
-            __m256 av = _mm256_broadcast_ss(ap + i);
-#if defined(RAD__MB_FMA)
-            c0[i] = _mm256_fmadd_ps(av, b0, c0[i]);
-            c1[i] = _mm256_fmadd_ps(av, b1, c1[i]);
-#else
-            c0[i] = _mm256_add_ps(c0[i], _mm256_mul_ps(av, b0));
-            c1[i] = _mm256_add_ps(c1[i], _mm256_mul_ps(av, b1));
-#endif
-        }
-    }
-    if (mr == RAD__MB_MR && nr == RAD__MB_NR) {
-        for (i = 0; i < RAD__MB_MR; ++i) {
-            float *ci = c + (size_t)i * ldc;
-            _mm256_storeu_ps(ci, _mm256_add_ps(_mm256_loadu_ps(ci), c0[i]));
-            _mm256_storeu_ps(ci + 8, _mm256_add_ps(_mm256_loadu_ps(ci + 8), c1[i]));
-        }
-        return;
-    }
-    for (i = 0; i < RAD__MB_MR; ++i) { _mm256_storeu_ps(tmp[i], c0[i]); _mm256_storeu_ps(tmp[i] + 8, c1[i]); }
-#else
-    float tmp[RAD__MB_MR][RAD__MB_NR];
-    memset(tmp, 0, sizeof(tmp));
-    for (p = 0; p < kc; ++p) {
-        const float *ap = a + (size_t)p * RAD__MB_MR, *bq = b + (size_t)p * RAD__MB_NR;
-        for (i = 0; i < RAD__MB_MR; ++i) {
-            float av = ap[i];
-            for (j = 0; j < RAD__MB_NR; ++j) tmp[i][j] += av * bq[j];
-        }
-    }
-#endif
-    for (i = 0; i < mr; ++i)
-        for (j = 0; j < nr; ++j) c[(size_t)i * ldc + j] += tmp[i][j];
-}
-
-static void rad__gemm_task(void *data, uint32_t t)
-{
-    const rad__gemm *g = (const rad__gemm *)data;
-    uint32_t ic = t * RAD__MB_MC, mc = g->m - ic < RAD__MB_MC ? g->m - ic : RAD__MB_MC, q, p, i, kk;
-    float *ap = g->ap + (size_t)t * RAD__MB_MC * RAD__MB_KC;
-    uint32_t panels_a = (mc + RAD__MB_MR - 1) / RAD__MB_MR, panels_b = (g->nc + RAD__MB_NR - 1) / RAD__MB_NR;
-    for (q = 0; q < panels_a; ++q)
-        for (kk = 0; kk < g->kc; ++kk)
-            for (i = 0; i < RAD__MB_MR; ++i) {
-                uint32_t row = q * RAD__MB_MR + i;
-                ap[((size_t)q * g->kc + kk) * RAD__MB_MR + i] = row < mc ? g->A[(size_t)(ic + row) * g->lda + g->pc + kk] : 0.0f;
-            }
-    for (p = 0; p < panels_b; ++p) {
-        uint32_t nr = g->nc - p * RAD__MB_NR < RAD__MB_NR ? g->nc - p * RAD__MB_NR : RAD__MB_NR;
-        for (q = 0; q < panels_a; ++q) {
-            uint32_t mr = mc - q * RAD__MB_MR < RAD__MB_MR ? mc - q * RAD__MB_MR : RAD__MB_MR;
-            rad__mb_kernel(g->kc, ap + (size_t)q * g->kc * RAD__MB_MR, g->bp + (size_t)p * g->kc * RAD__MB_NR,
-                           g->C + (size_t)(ic + q * RAD__MB_MR) * g->ldc + g->jc + p * RAD__MB_NR, g->ldc, mr, nr);
-        }
-    }
-}
-
-/* C += A B. The summation order of every entry is fixed (k blocks in order), so the bits do
-   not depend on the number of tasks. */
-static rad_result rad__mb_gemm(const rad__ctx *c, uint32_t m, uint32_t n, uint32_t k, const float *A, size_t lda,
-                               const float *B, size_t ldb, float *C, size_t ldc)
-{
-    rad__gemm g;
-    float *bp, *ap;
-    uint32_t chunks = (m + RAD__MB_MC - 1) / RAD__MB_MC, jc, pc;
-    size_t bp_count = (size_t)RAD__MB_KC * (RAD__MB_NC + RAD__MB_NR), ap_count;
-    if (m == 0 || n == 0 || k == 0) return RAD_SUCCESS;
-    if (!rad__mul((size_t)chunks, (size_t)RAD__MB_MC * RAD__MB_KC, &ap_count)) return RAD_ERROR_SIZE_OVERFLOW;
-    bp = (float *)rad__alloc_array(&c->allocator, bp_count, sizeof(float));
-    ap = (float *)rad__alloc_array(&c->allocator, ap_count, sizeof(float));
-    if (!bp || !ap) { rad__free(&c->allocator, bp); rad__free(&c->allocator, ap); return RAD_ERROR_OUT_OF_MEMORY; }
-    g.A = A; g.B = B; g.C = C; g.lda = lda; g.ldb = ldb; g.ldc = ldc; g.m = m; g.n = n; g.k = k;
-    g.bp = bp; g.ap = ap;
-    for (jc = 0; jc < n; jc += RAD__MB_NC) {
-        g.jc = jc;
-        g.nc = n - jc < RAD__MB_NC ? n - jc : RAD__MB_NC;
-        for (pc = 0; pc < k; pc += RAD__MB_KC) {
-            uint32_t panels = (g.nc + RAD__MB_NR - 1) / RAD__MB_NR, p, kk, j;
-            g.pc = pc;
-            g.kc = k - pc < RAD__MB_KC ? k - pc : RAD__MB_KC;
-            for (p = 0; p < panels; ++p)
-                for (kk = 0; kk < g.kc; ++kk) {
-                    float *dst = bp + ((size_t)p * g.kc + kk) * RAD__MB_NR;
-                    const float *src = B + (size_t)(pc + kk) * ldb + jc + p * RAD__MB_NR;
-                    uint32_t cols = g.nc - p * RAD__MB_NR < RAD__MB_NR ? g.nc - p * RAD__MB_NR : RAD__MB_NR;
-                    for (j = 0; j < cols; ++j) dst[j] = src[j];
-                    for (; j < RAD__MB_NR; ++j) dst[j] = 0.0f;
-                }
-            c->parallel_for(c->parallel_user, chunks, rad__gemm_task, &g);
-        }
-    }
-    rad__free(&c->allocator, bp);
-    rad__free(&c->allocator, ap);
-    return RAD_SUCCESS;
-}
-
 /* ---- building F_mb ---- */
 
 static double rad__mb_max_row_sum(const float *M, uint32_t n)
@@ -13238,7 +13307,7 @@ static rad_result rad__mb_product(rad__mb_build *b, float *dst, const float *add
     rad_result r;
     if (add) memcpy(dst, add, b->nn * sizeof(float));
     else memset(dst, 0, b->nn * sizeof(float));
-    r = rad__mb_gemm(b->c, b->n, b->n, b->n, X, b->n, Y, b->n, dst, b->n);
+    r = rad__sgemm(b->c, b->n, b->n, b->n, X, b->n, Y, b->n, dst, b->n);
     if (r != RAD_SUCCESS) return r;
     ++b->products;
     if (b->c->progress && b->c->progress(b->c->progress_user, b->total ? (float)b->products / (float)b->total : 0.5f))
@@ -13461,52 +13530,6 @@ RAD_API rad_result rad_multibounce_convert(const rad_multibounce *src, rad_mb_pr
 
 /* ---- applying F_mb ---- */
 
-static float rad__mb_dot(const float *a, const float *x, uint32_t n)
-{
-    uint32_t j = 0;
-    float s = 0.0f;
-#if defined(RAD__AVX)
-    {
-        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        float t[8];
-        int k;
-        for (; j + 32 <= n; j += 32) {
-            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(x + j)));
-            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_loadu_ps(a + j + 8), _mm256_loadu_ps(x + j + 8)));
-            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_loadu_ps(a + j + 16), _mm256_loadu_ps(x + j + 16)));
-            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_loadu_ps(a + j + 24), _mm256_loadu_ps(x + j + 24)));
-        }
-        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-        for (k = 0; k < 8; ++k) s += t[k];
-    }
-#endif
-    for (; j < n; ++j) s += a[j] * x[j];
-    return s;
-}
-
-static float rad__mb_dot_half(const uint16_t *a, const float *x, uint32_t n)
-{
-    uint32_t j = 0;
-    float s = 0.0f;
-#if defined(RAD__MB_F16C)
-    {
-        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        float t[8];
-        int k;
-        for (; j + 32 <= n; j += 32) {
-            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j))), _mm256_loadu_ps(x + j)));
-            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 8))), _mm256_loadu_ps(x + j + 8)));
-            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 16))), _mm256_loadu_ps(x + j + 16)));
-            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 24))), _mm256_loadu_ps(x + j + 24)));
-        }
-        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-        for (k = 0; k < 8; ++k) s += t[k];
-    }
-#endif
-    for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
-    return s;
-}
-
 typedef struct rad__mb_apply {
     const rad_multibounce *mb;
     const float *x;    /* 3 n, SoA, permuted column order */
@@ -13524,8 +13547,8 @@ static void rad__mb_apply_task(void *data, uint32_t t)
     for (ch = 0; ch < 3; ++ch)
         for (i = i0; i < i1; ++i) {
             size_t at = ch * nn + (size_t)i * n;
-            a->y[ch * (size_t)n + i] = a->mb->planes ? rad__mb_dot(a->mb->planes + at, a->x + ch * (size_t)n, n)
-                                                     : rad__mb_dot_half(a->mb->half + at, a->x + ch * (size_t)n, n);
+            a->y[ch * (size_t)n + i] = a->mb->planes ? rad__dot_f32(a->mb->planes + at, a->x + ch * (size_t)n, n)
+                                                     : rad__dot_f16(a->mb->half + at, a->x + ch * (size_t)n, n);
         }
 }
 
@@ -13879,7 +13902,7 @@ static rad_result rad__mb_reorder_perms(const rad__ctx *c, const float *W, uint3
         for (s = 0; s < samples; ++s)
             for (i = 0; i < n; ++i) XT[(size_t)i * samples + s] = X[(size_t)s * n + i];
         memset(G, 0, nn * sizeof(float));
-        r = rad__mb_gemm(c, n, n, samples, XT, samples, X, n, G, n);
+        r = rad__sgemm(c, n, n, samples, XT, samples, X, n, G, n);
         if (method == RAD_REORDER_MATCH) {
             if (r == RAD_SUCCESS) r = rad__mb_distances(c, G, n);
             if (r == RAD_SUCCESS) r = rad__mb_match_groups(c, G, n, pass == 0 ? col_perm : row_perm);
@@ -16127,10 +16150,10 @@ static rad_result rad__local_invert(const rad__ctx *c, float *X, uint32_t m, siz
         for (i = 0; i < m; ++i)
             for (j = 0; j < b; ++j) cbuf[(size_t)i * b + j] = (i >= kb && i < kb + b) ? 0.0f : -X[(size_t)i * ld + kb + j];
         memset(rp, 0, sizeof(float) * (size_t)b * m);
-        r = rad__mb_gemm(c, b, m, b, dinv, b, rbuf, m, rp, m);                 /* R' = D^-1 R */
-        if (r == RAD_SUCCESS) r = rad__mb_gemm(c, m, m, b, cbuf, b, rp, m, X, ld); /* O += (-C) R' */
+        r = rad__sgemm(c, b, m, b, dinv, b, rbuf, m, rp, m);                 /* R' = D^-1 R */
+        if (r == RAD_SUCCESS) r = rad__sgemm(c, m, m, b, cbuf, b, rp, m, X, ld); /* O += (-C) R' */
         memset(tmp, 0, sizeof(float) * (size_t)m * b);
-        if (r == RAD_SUCCESS) r = rad__mb_gemm(c, m, b, b, cbuf, b, dinv, b, tmp, b); /* C' = -C D^-1 */
+        if (r == RAD_SUCCESS) r = rad__sgemm(c, m, b, b, cbuf, b, dinv, b, tmp, b); /* C' = -C D^-1 */
         if (r != RAD_SUCCESS) break;
         for (i = 0; i < b; ++i)
             for (j = 0; j < m; ++j)
@@ -16258,7 +16281,7 @@ static void rad__local_apply_task(void *data, uint32_t t)
     rad__local_range(J->row_count, J->tasks, t, &r0, &r1);
     for (r = r0; r < r1; ++r)
         for (ch = 0; ch < 3; ++ch)
-            J->y[3 * (size_t)r + ch] = rad__mb_dot(J->st->planes + ch * MM + (size_t)J->rows[r] * J->M,
+            J->y[3 * (size_t)r + ch] = rad__dot_f32(J->st->planes + ch * MM + (size_t)J->rows[r] * J->M,
                                                    J->e + (size_t)ch * J->end, J->end);
 }
 
