@@ -2724,8 +2724,9 @@ RAD_API void rad_temporal_random(uint32_t seed, uint32_t frame, uint32_t row, ui
 RAD_API uint32_t rad_alias_draw(const uint32_t *bins, uint32_t n, rad_alias_format format, uint32_t u1, uint32_t u2);
 
 /* Sections for writing the tables into a container (rad_container_write), named 'name'
-   (up to 23 characters; the three sections share it). Data borrowed from the tables. */
-RAD_API void rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section out[3]);
+   (up to 23 characters; the three sections share it), into out[0..2]. Data borrowed from the
+   tables. */
+RAD_API void rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section *out);
 
 /* A non-owning view of tables stored in a container under 'name', validated once (offsets
    monotone, bin counts in [1, N + 1], columns and aliases <= cols, totals > 0 and at most
@@ -16989,7 +16990,7 @@ done:
     return r;
 }
 
-RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section out[3])
+RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section *out)
 {
     if (!out) return;
     memset(out, 0, 3 * sizeof(rad_section));
