@@ -1665,6 +1665,10 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
    added without a version change: readers look sections up by type and name and skip the
    ones they do not know, so a file without a newer section (RAD_SECTION_SIGNATURE, added
    in 0.1.0) still loads, and an older reader loads a newer file.
+   NAMES. Each object's way in and out of a container: X_sections fills the sections that
+   write it (data borrowed from the object); X_load makes a new object from a container (free
+   it with X_destroy); X_view fills a caller's struct that points into the container (nothing
+   to free: rad_alias_tables_view, whose struct is public).
    VALUES: behind a valid checksum a section may still hold values that would make every
    later step NaN, infinite or slow, so each loader (rad_load_memory, rad_multibounce_load,
    rad_multibounce_blocks_load, rad_alias_tables_view) checks the values it hands out, once,
@@ -2214,13 +2218,16 @@ typedef enum rad_block_format {
     RAD_BLOCK_BC4X3 = 1        /* three BC4 textures (R, G, B): 8-bit endpoints, 1.5 bytes per entry */
 } rad_block_format;
 
-#define RAD_REORDER_NONE 0        /* rad_block_options.reorder: keep the patch order */
-#define RAD_REORDER_GREEDY 1      /* greedy nearest-neighbour chain (Shcherbakov 2025) */
-#define RAD_REORDER_GREEDY_2OPT 2 /* the greedy chain, then 2-opt reversals that shorten it */
-#define RAD_REORDER_GROUPS 3      /* 2-opt chain, then swaps between the groups of four rows
-                                     (columns) that make each 4x4 block's rows more alike */
-#define RAD_REORDER_MATCH 4       /* groups of four by greedy matching (rows into pairs, pairs
-                                     into fours) on the same distance, then the group swaps */
+/* rad_block_options.reorder (an int holding one of these, as every flags field does). */
+typedef enum rad_reorder {
+    RAD_REORDER_NONE = 0,        /* keep the patch order */
+    RAD_REORDER_GREEDY = 1,      /* greedy nearest-neighbour chain (Shcherbakov 2025) */
+    RAD_REORDER_GREEDY_2OPT = 2, /* the greedy chain, then 2-opt reversals that shorten it */
+    RAD_REORDER_GROUPS = 3,      /* 2-opt chain, then swaps between the groups of four rows
+                                    (columns) that make each 4x4 block's rows more alike */
+    RAD_REORDER_MATCH = 4        /* groups of four by greedy matching (rows into pairs, pairs
+                                    into fours) on the same distance, then the group swaps */
+} rad_reorder;
 
 /* Start from rad_block_options_default: here zero is a setting, not the default (a zeroed
    struct asks for BC1, no outliers, no reordering and one scale per channel). */
