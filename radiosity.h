@@ -3349,6 +3349,47 @@ RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], 
 #  define RAD__TEMPORAL_AVX2 1
 #endif
 
+/* A vector of floats at the widest width the build has (RAD__VW lanes), for kernels written
+   once for AVX and SSE, and the horizontal sums: lane 0 first, from 0.0f, so a sum's bits
+   follow the lanes' values alone. */
+#if defined(RAD__AVX)
+typedef __m256 rad__vf;
+#  define RAD__VW 8u
+#  define rad__vf_zero() _mm256_setzero_ps()
+#  define rad__vf_load(p) _mm256_loadu_ps(p)
+#  define rad__vf_madd(acc, a, b) _mm256_add_ps(acc, _mm256_mul_ps(a, b))
+#  define rad__vf_add(a, b) _mm256_add_ps(a, b)
+#  define rad__vf_store(p, v) _mm256_storeu_ps(p, v)
+#elif defined(RAD__SSE2)
+typedef __m128 rad__vf;
+#  define RAD__VW 4u
+#  define rad__vf_zero() _mm_setzero_ps()
+#  define rad__vf_load(p) _mm_loadu_ps(p)
+#  define rad__vf_madd(acc, a, b) _mm_add_ps(acc, _mm_mul_ps(a, b))
+#  define rad__vf_add(a, b) _mm_add_ps(a, b)
+#  define rad__vf_store(p, v) _mm_storeu_ps(p, v)
+#endif
+#if defined(RAD__VW)
+static inline float rad__vf_sum(rad__vf v)
+{
+    float t[RAD__VW], sum = 0.0f;
+    unsigned k;
+    rad__vf_store(t, v);
+    for (k = 0; k < RAD__VW; ++k) sum += t[k];
+    return sum;
+}
+#endif
+#if defined(RAD__AVX)
+static inline float rad__hsum8(__m256 v)
+{
+    float t[8], sum = 0.0f;
+    int k;
+    _mm256_storeu_ps(t, v);
+    for (k = 0; k < 8; ++k) sum += t[k];
+    return sum;
+}
+#endif
+
 /* Linux: madvise(MADV_HUGEPAGE) on large alias tables (>>temporal). Strict ISO C (-std=c99)
    hides the declaration in <sys/mman.h>; the function and the value 14 (asm-generic, which
    these architectures use) are Linux ABI. */
@@ -6875,49 +6916,24 @@ static void rad__dot3(const float *row, const float *xr, const float *xg, const 
 {
     uint32_t j = 0;
     float sr = 0.0f, sg = 0.0f, sb = 0.0f;
-#if defined(RAD__AVX)
+#if defined(RAD__VW)
     {
-        __m256 ar = _mm256_setzero_ps(), ag = _mm256_setzero_ps(), ab = _mm256_setzero_ps();
-        __m256 ar2 = _mm256_setzero_ps(), ag2 = _mm256_setzero_ps(), ab2 = _mm256_setzero_ps();
-        float t[8];
-        int k;
+        rad__vf ar = rad__vf_zero(), ag = rad__vf_zero(), ab = rad__vf_zero();
+        rad__vf ar2 = rad__vf_zero(), ag2 = rad__vf_zero(), ab2 = rad__vf_zero();
         /* six independent sums keep the adders busy; the matrix row streams once */
-        for (; j + 16 <= n; j += 16) {
-            __m256 f = _mm256_loadu_ps(row + j), f2 = _mm256_loadu_ps(row + j + 8);
+        for (; j + 2 * RAD__VW <= n; j += 2 * RAD__VW) {
+            rad__vf f = rad__vf_load(row + j), f2 = rad__vf_load(row + j + RAD__VW);
             _mm_prefetch((const char *)(row + j + 256), _MM_HINT_T0); /* 1 KiB ahead */
-            ar = _mm256_add_ps(ar, _mm256_mul_ps(f, _mm256_loadu_ps(xr + j)));
-            ag = _mm256_add_ps(ag, _mm256_mul_ps(f, _mm256_loadu_ps(xg + j)));
-            ab = _mm256_add_ps(ab, _mm256_mul_ps(f, _mm256_loadu_ps(xb + j)));
-            ar2 = _mm256_add_ps(ar2, _mm256_mul_ps(f2, _mm256_loadu_ps(xr + j + 8)));
-            ag2 = _mm256_add_ps(ag2, _mm256_mul_ps(f2, _mm256_loadu_ps(xg + j + 8)));
-            ab2 = _mm256_add_ps(ab2, _mm256_mul_ps(f2, _mm256_loadu_ps(xb + j + 8)));
+            ar = rad__vf_madd(ar, f, rad__vf_load(xr + j));
+            ag = rad__vf_madd(ag, f, rad__vf_load(xg + j));
+            ab = rad__vf_madd(ab, f, rad__vf_load(xb + j));
+            ar2 = rad__vf_madd(ar2, f2, rad__vf_load(xr + j + RAD__VW));
+            ag2 = rad__vf_madd(ag2, f2, rad__vf_load(xg + j + RAD__VW));
+            ab2 = rad__vf_madd(ab2, f2, rad__vf_load(xb + j + RAD__VW));
         }
-        ar = _mm256_add_ps(ar, ar2);
-        ag = _mm256_add_ps(ag, ag2);
-        ab = _mm256_add_ps(ab, ab2);
-        _mm256_storeu_ps(t, ar); for (k = 0; k < 8; ++k) sr += t[k];
-        _mm256_storeu_ps(t, ag); for (k = 0; k < 8; ++k) sg += t[k];
-        _mm256_storeu_ps(t, ab); for (k = 0; k < 8; ++k) sb += t[k];
-    }
-#elif defined(RAD__SSE2)
-    {
-        __m128 ar = _mm_setzero_ps(), ag = _mm_setzero_ps(), ab = _mm_setzero_ps();
-        __m128 ar2 = _mm_setzero_ps(), ag2 = _mm_setzero_ps(), ab2 = _mm_setzero_ps();
-        float t[4];
-        int k;
-        for (; j + 8 <= n; j += 8) {
-            __m128 f = _mm_loadu_ps(row + j), f2 = _mm_loadu_ps(row + j + 4);
-            _mm_prefetch((const char *)(row + j + 256), _MM_HINT_T0); /* 1 KiB ahead */
-            ar = _mm_add_ps(ar, _mm_mul_ps(f, _mm_loadu_ps(xr + j)));
-            ag = _mm_add_ps(ag, _mm_mul_ps(f, _mm_loadu_ps(xg + j)));
-            ab = _mm_add_ps(ab, _mm_mul_ps(f, _mm_loadu_ps(xb + j)));
-            ar2 = _mm_add_ps(ar2, _mm_mul_ps(f2, _mm_loadu_ps(xr + j + 4)));
-            ag2 = _mm_add_ps(ag2, _mm_mul_ps(f2, _mm_loadu_ps(xg + j + 4)));
-            ab2 = _mm_add_ps(ab2, _mm_mul_ps(f2, _mm_loadu_ps(xb + j + 4)));
-        }
-        _mm_storeu_ps(t, _mm_add_ps(ar, ar2)); for (k = 0; k < 4; ++k) sr += t[k];
-        _mm_storeu_ps(t, _mm_add_ps(ag, ag2)); for (k = 0; k < 4; ++k) sg += t[k];
-        _mm_storeu_ps(t, _mm_add_ps(ab, ab2)); for (k = 0; k < 4; ++k) sb += t[k];
+        sr = rad__vf_sum(rad__vf_add(ar, ar2));
+        sg = rad__vf_sum(rad__vf_add(ag, ag2));
+        sb = rad__vf_sum(rad__vf_add(ab, ab2));
     }
 #endif
     for (; j < n; ++j) {
@@ -6937,9 +6953,8 @@ static void rad__dot3x2(const float *r0, const float *r1, const float *xr, const
 {
     __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps(), a2 = _mm256_setzero_ps();
     __m256 b0 = _mm256_setzero_ps(), b1 = _mm256_setzero_ps(), b2 = _mm256_setzero_ps();
-    float t[8], s[6] = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f };
+    float s[6];
     uint32_t j = 0;
-    int k;
     for (; j + 8 <= n; j += 8) {
         __m256 f = _mm256_loadu_ps(r0 + j), g = _mm256_loadu_ps(r1 + j);
         __m256 x0 = _mm256_loadu_ps(xr + j), x1 = _mm256_loadu_ps(xg + j), x2 = _mm256_loadu_ps(xb + j);
@@ -6952,12 +6967,12 @@ static void rad__dot3x2(const float *r0, const float *r1, const float *xr, const
         b1 = _mm256_add_ps(b1, _mm256_mul_ps(g, x1));
         b2 = _mm256_add_ps(b2, _mm256_mul_ps(g, x2));
     }
-    _mm256_storeu_ps(t, a0); for (k = 0; k < 8; ++k) s[0] += t[k];
-    _mm256_storeu_ps(t, a1); for (k = 0; k < 8; ++k) s[1] += t[k];
-    _mm256_storeu_ps(t, a2); for (k = 0; k < 8; ++k) s[2] += t[k];
-    _mm256_storeu_ps(t, b0); for (k = 0; k < 8; ++k) s[3] += t[k];
-    _mm256_storeu_ps(t, b1); for (k = 0; k < 8; ++k) s[4] += t[k];
-    _mm256_storeu_ps(t, b2); for (k = 0; k < 8; ++k) s[5] += t[k];
+    s[0] = rad__hsum8(a0);
+    s[1] = rad__hsum8(a1);
+    s[2] = rad__hsum8(a2);
+    s[3] = rad__hsum8(b0);
+    s[4] = rad__hsum8(b1);
+    s[5] = rad__hsum8(b2);
     for (; j < n; ++j) {
         s[0] += r0[j] * xr[j]; s[1] += r0[j] * xg[j]; s[2] += r0[j] * xb[j];
         s[3] += r1[j] * xr[j]; s[4] += r1[j] * xg[j]; s[5] += r1[j] * xb[j];
@@ -13053,16 +13068,13 @@ static float rad__dot_f32(const float *a, const float *x, uint32_t n)
 #if defined(RAD__AVX)
     {
         __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        float t[8];
-        int k;
         for (; j + 32 <= n; j += 32) {
             s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(x + j)));
             s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_loadu_ps(a + j + 8), _mm256_loadu_ps(x + j + 8)));
             s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_loadu_ps(a + j + 16), _mm256_loadu_ps(x + j + 16)));
             s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_loadu_ps(a + j + 24), _mm256_loadu_ps(x + j + 24)));
         }
-        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-        for (k = 0; k < 8; ++k) s += t[k];
+        s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
     }
 #endif
     for (; j < n; ++j) s += a[j] * x[j];
@@ -13076,16 +13088,13 @@ static float rad__dot_f16(const uint16_t *a, const float *x, uint32_t n)
 #if defined(RAD__MB_F16C)
     {
         __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        float t[8];
-        int k;
         for (; j + 32 <= n; j += 32) {
             s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j))), _mm256_loadu_ps(x + j)));
             s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 8))), _mm256_loadu_ps(x + j + 8)));
             s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 16))), _mm256_loadu_ps(x + j + 16)));
             s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 24))), _mm256_loadu_ps(x + j + 24)));
         }
-        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-        for (k = 0; k < 8; ++k) s += t[k];
+        s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
     }
 #endif
     for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
@@ -14324,6 +14333,21 @@ static rad_result rad__mb_select(const rad__ctx *c, const float *W, size_t nn, u
     return RAD_SUCCESS;
 }
 
+/* 1 when entry 'at' of the planes W (nn entries each) is an outlier: its largest channel
+   magnitude has bits above T, or equal to T while fewer than take_equal ties are taken
+   (*taken counts them; both passes scan in row-major order, so they take the same entries). */
+static int rad__mb_is_outlier(const float *W, size_t nn, size_t at, uint32_t T, uint64_t take_equal, uint64_t *taken)
+{
+    float m = fabsf(W[at]);
+    uint32_t u;
+    if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
+    if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
+    u = rad__f32_bits(m);
+    if (u < T || (u == T && *taken >= take_equal)) return 0;
+    if (u == T) ++*taken;
+    return 1;
+}
+
 RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
                                                  const rad_context *ctx, rad_multibounce_blocks **out,
                                                  rad_block_report *report)
@@ -14382,15 +14406,7 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     for (i = 0; i < n; ++i) {
         uint64_t k = 0;
         if (target > 0)
-            for (j = 0; j < n; ++j) {
-                size_t at = (size_t)i * n + j;
-                float m = fabsf(W[at]);
-                uint32_t u;
-                if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
-                if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
-                u = rad__f32_bits(m);
-                if (u > T || (u == T && taken < take_equal)) { if (u == T) ++taken; ++k; }
-            }
+            for (j = 0; j < n; ++j) k += (uint64_t)rad__mb_is_outlier(W, nn, (size_t)i * n + j, T, take_equal, &taken);
         row_count[i + 1] = row_count[i] + k;
     }
     count = row_count[n];
@@ -14428,13 +14444,7 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
         for (i = 0; i < n; ++i)
             for (j = 0; j < n; ++j) {
                 size_t at = (size_t)i * n + j;
-                float m = fabsf(W[at]);
-                uint32_t u;
-                if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
-                if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
-                u = rad__f32_bits(m);
-                if (u > T || (u == T && taken < take_equal)) {
-                    if (u == T) ++taken;
+                if (rad__mb_is_outlier(W, nn, at, T, take_equal, &taken)) {
                     cols[k] = j;
                     for (ch = 0; ch < 3; ++ch) { vals[3 * k + ch] = W[ch * nn + at]; W[ch * nn + at] = 0.0f; }
                     ++k;
