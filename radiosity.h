@@ -95,6 +95,10 @@
                                                      bad input is an error code, never an assert)
        RAD_NO_STDIO               (undefined)        everywhere: removes rad_save_file and
                                                      rad_load_file (no <stdio.h> file access)
+       RAD_NO_GLSL                (undefined)        implementing file: leaves out the GLSL
+                                                     kernels' text (about 60 KB); rad_glsl_name
+                                                     and rad_glsl_pieces return NULL and
+                                                     rad_glsl_source RAD_ERROR_UNAVAILABLE
        RAD_NO_SIMD                (undefined)        implementing file: scalar code only. SIMD
                                                      (SSE2/AVX) is used only when the compiler
                                                      already enables it (-msse2 is the x86-64
@@ -199,11 +203,9 @@
        rad_save_memory / rad_save_file write patches, a form-factor matrix (dense or CSR) and
        named RGB vectors ("E", "B") into one container; rad_load_memory reads it in place (the
        bytes must be 8-byte aligned and outlive the rad_bake) and rad_load_file reads a file.
-       Layout: a 64-byte header (magic "RADB", version, section count, file size, flags, CRC-32
-       of the section table, CRC-32 of the header), 64-byte table entries (type, element size,
-       count, offset, bytes, CRC-32, name), then the sections, each on a 64-byte boundary.
-       Section data is in the writer's byte order, recorded in the flags; a reader of the other
-       byte order refuses it (RAD_ERROR_VERSION). Every size, offset, checksum and index is
+       The byte layout (a little-endian header and section table, then the section data in
+       the writer's byte order) is described once, in >>api_container. Every size, offset,
+       checksum and index is
        checked before use: a truncated file gives RAD_ERROR_TRUNCATED, a damaged one
        RAD_ERROR_CORRUPT, another version RAD_ERROR_VERSION, an index out of range
        RAD_ERROR_INDEX_OUT_OF_RANGE; nothing is read outside the given bytes. Behind a valid
@@ -372,6 +374,12 @@ typedef struct rad_context {
     int (*progress)(void *user, float fraction);
     void *progress_user;
 } rad_context;
+
+/* The baked-data types of >>api_container, named here because the methods' save and load
+   functions take them. */
+typedef struct rad_section rad_section;
+typedef struct rad_container rad_container;
+typedef struct rad_bake rad_bake;
 
 /* ======================================================================================== */
 /* >>api_scene: scene input and validation                                                  */
@@ -801,6 +809,12 @@ RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const fl
 /* >>api_solve: classic solvers                                                             */
 /* ======================================================================================== */
 
+/* Indirect light or the total, chosen the same way by every call that offers both: a
+   rad_output, in the options of the solvers (rad_solve_options.output,
+   rad_stochastic_options.output) and as the parameter after the output array of the applies
+   (rad_multibounce_apply, rad_multibounce_blocks_apply, rad_local_apply); the GPU kernels take
+   its value as the bit RAD_GLSL_FLAG_TOTAL (equal to RAD_OUTPUT_TOTAL). Methods whose state is
+   the indirect light alone (rad_temporal_step) always return L: add E for the total. */
 typedef enum rad_output { RAD_OUTPUT_INDIRECT = 0, RAD_OUTPUT_TOTAL = 1 } rad_output;
 
 /* The linear system B = E + (rho o F) B. All pointers borrowed. */
@@ -1711,17 +1725,29 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
 /* >>api_container: baked data                                                              */
 /* ======================================================================================== */
 
-/* One versioned binary container for everything a bake produces (docs/methods/container.md). Layout, all
-   little-endian: a 64-byte header ("RADB", version, section count, table offset, file size,
-   flags, CRC-32 of the table, CRC-32 of the header), a table of 64-byte section entries (type, element size, element count,
-   offset, byte size, CRC-32 of the data, a 24-byte name), and the section data, each section
-   starting on a 64-byte boundary so the file can be memory-mapped and read in place.
-   Loading validates every size, offset, checksum and index before anything is used.
+/* One versioned binary container for everything a bake produces (docs/methods/container.md
+   teaches it). THE LAYOUT (this is its one description):
+     header, 64 bytes, its fields little-endian (byte offset: field):
+       0: "RADB"  4: version (uint32)  8: section count  12: header size (64)
+       16: table offset (uint64, 64)  24: file size (uint64)  32: flags (bit 0: the section
+       data is big-endian)  36: CRC-32 of the table  40..59: zero  60: CRC-32 of bytes 0..59
+     table, one 64-byte entry per section, its fields little-endian:
+       0: type (rad_section_type)  4: element size  8: element count (uint64)  16: offset
+       (uint64)  24: byte size (uint64)  32: CRC-32 of the data  36..39: zero  40: name (24
+       bytes, NUL-terminated)
+     data: each section from an offset that is a multiple of 64, in the WRITER'S byte order
+       (flag bit 0), so that a file can be memory-mapped and read in place; a reader of the
+       other byte order refuses it (RAD_ERROR_VERSION) instead of converting.
+   CRC-32 is the common reflected one (polynomial 0xEDB88320, as zlib's crc32). Loading validates every size, offset, checksum and index before anything is used.
    VERSIONING: RAD_CONTAINER_VERSION changes only when the header or the table entry layout
    changes (a reader refuses another version with RAD_ERROR_VERSION). New section types are
    added without a version change: readers look sections up by type and name and skip the
    ones they do not know, so a file without a newer section (RAD_SECTION_SIGNATURE, added
    in 0.1.0) still loads, and an older reader loads a newer file.
+   NAMES. Each object's way in and out of a container: X_sections fills the sections that
+   write it (data borrowed from the object); X_load makes a new object from a container (free
+   it with X_destroy); X_view fills a caller's struct that points into the container (nothing
+   to free: rad_alias_tables_view, whose struct is public).
    VALUES: behind a valid checksum a section may still hold values that would make every
    later step NaN, infinite or slow, so each loader (rad_load_memory, rad_multibounce_load,
    rad_multibounce_blocks_load, rad_alias_tables_view) checks the values it hands out, once,
@@ -1737,6 +1763,7 @@ RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v
    larger values in what it writes, so whatever it writes loads. */
 #define RAD_BAKE_VALUE_MAX 1e30f
 
+/* Every section type the library writes, in one table. */
 typedef enum rad_section_type {
     RAD_SECTION_PATCHES = 1,         /* rad_patch records */
     RAD_SECTION_PATCH_VERTICES = 2,  /* 3 floats per welded vertex */
@@ -1747,20 +1774,55 @@ typedef enum rad_section_type {
     RAD_SECTION_FF_VALUES = 7,       /* CSR: floats */
     RAD_SECTION_VECTOR = 8,          /* a named RGB vector, 3N floats ("E", "B", "L", "H", ...) */
     RAD_SECTION_SIGNATURE = 9,       /* one rad_bake_signature ("signature"): what it was made from */
+    /* the multi-bounce objects (>>api_multibounce), 16..31 */
+    RAD_SECTION_MB_INFO = 16,              /* 16 uint32: see rad_multibounce_sections */
+    RAD_SECTION_MB_FLOAT = 17,             /* 3 N^2 floats: the R, G, B planes */
+    RAD_SECTION_MB_HALF = 18,              /* 3 N^2 binary16 values */
+    RAD_SECTION_MB_ROW_PERM = 19,          /* N uint32 */
+    RAD_SECTION_MB_COL_PERM = 20,          /* N uint32 */
+    RAD_SECTION_MB_BC1 = 21,               /* ceil(N/4)^2 8-byte BC1 blocks */
+    RAD_SECTION_MB_BC4 = 22,               /* 3 ceil(N/4)^2 8-byte BC4 blocks: R plane, G, B */
+    RAD_SECTION_MB_SCALES = 23,            /* 3 floats (R, G, B) per scale tile */
+    RAD_SECTION_MB_OUTLIER_OFFSETS = 24,   /* N+1 uint64, CSR by original row */
+    RAD_SECTION_MB_OUTLIER_COLUMNS = 25,   /* uint32 original columns */
+    RAD_SECTION_MB_OUTLIER_VALUES = 26,    /* 3 floats (exact RGB) per outlier */
+    /* the alias tables (>>api_temporal), 32..39 */
+    RAD_SECTION_TEMPORAL_ROW_OFFSETS = 32, /* alias tables: rows + 1 uint64, offsets in bins */
+    RAD_SECTION_TEMPORAL_BINS = 33,        /* alias tables: the bins, 2 or 3 uint32 words each */
+    RAD_SECTION_TEMPORAL_TOTALS = 34,      /* alias tables: T_i, one float per row */
+    /* virtual patches (>>api_vp), 40..63 */
+    RAD_SECTION_VP_INFO = 40,              /* the set's sizes and grid: see rad_vp_sections */
+    RAD_SECTION_VP_AREAS = 41,             /* N floats */
+    RAD_SECTION_VP_ALBEDO = 42,            /* 3 N floats */
+    RAD_SECTION_VP_NORMALS = 43,           /* 3 N floats */
+    RAD_SECTION_VP_AXIS = 44,              /* N uint8 */
+    RAD_SECTION_VP_VOXEL = 45,             /* N uint32 */
+    RAD_SECTION_VP_VOXEL_KEYS = 46,        /* voxel_count uint64 */
+    RAD_SECTION_VP_VOXEL_FIRST = 47,       /* voxel_count + 1 uint32 */
+    RAD_SECTION_VP_VOXEL_PATCH = 48,       /* 6 uint32 per voxel */
+    RAD_SECTION_VP_SAMPLE_FIRST = 49,      /* voxel_count + 1 uint32 */
+    RAD_SECTION_VP_SAMPLE_POSITIONS = 50,  /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_NORMALS = 51,    /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_ALBEDO = 52,     /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_AREAS = 53,      /* M floats */
+    RAD_SECTION_VP_SAMPLE_WEIGHTS = 54,    /* 6 M floats */
+    RAD_SECTION_VP_SAMPLE_TRIANGLES = 55,  /* M uint32 */
     RAD_SECTION_USER = 0x10000       /* types from here up are the application's own */
 } rad_section_type;
 
+/* The name of a section type without its prefix ("PATCHES", "MB_BC1", "VP_AREAS"), "USER"
+   from RAD_SECTION_USER up, NULL for a type the library does not know. Pure. */
+RAD_API const char *rad_section_type_name(uint32_t type);
+
 /* One section, for writing (data borrowed) or as found by rad_container_find (data points
    into the container's bytes). */
-typedef struct rad_section {
+struct rad_section {
     uint32_t type;
     uint32_t elem_size;     /* bytes per element */
     uint64_t count;         /* elements */
     const void *data;       /* count * elem_size bytes */
     char name[24];          /* NUL-terminated, may be empty */
-} rad_section;
-
-typedef struct rad_container rad_container;
+};
 
 /* Bytes that rad_container_write needs for these sections (SIZE_OVERFLOW if it overflows). */
 RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes);
@@ -1810,7 +1872,7 @@ RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry
    scene), the form-factor matrix (rows == 0 when the bake has none) and the named vectors.
    Everything points into the loaded bytes; free it with rad_bake_destroy, never with
    rad_patches_destroy. */
-typedef struct rad_bake {
+struct rad_bake {
     rad_patches patches;
     rad_matrix F;
     const float *E;          /* "E" vector or NULL */
@@ -1819,7 +1881,7 @@ typedef struct rad_bake {
     rad_container *container;
     void *owned;             /* private: bytes read from a file */
     rad_allocator allocator; /* private */
-} rad_bake;
+};
 
 /* Saves patches (required), a matrix (optional: NULL) and the vectors E and B (optional:
    NULL; 3 * patches->count floats) into a new buffer *out of *out_size bytes, allocated with
@@ -2044,7 +2106,7 @@ typedef enum rad_glsl_id {
 /* >>glsl ids end */
 
 #define RAD_GLSL_SPEC_LOCAL_SIZE 0u   /* specialization constant id of the workgroup x size */
-#define RAD_GLSL_FLAG_TOTAL 1u        /* gather, multi-bounce apply: add E (RAD_OUTPUT_TOTAL) */
+#define RAD_GLSL_FLAG_TOTAL 1u        /* gather, applies: add E; the value of RAD_OUTPUT_TOTAL */
 #define RAD_GLSL_FLAG_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
 #define RAD_GLSL_FLAG_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
 #define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
@@ -2153,8 +2215,18 @@ RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
    *out_length (optional) receives the length without the NUL, on success and when dst is too
    small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
    INVALID_ARGUMENT (unknown id; dst NULL with out_length NULL or dst_size > 0), SIZE_MISMATCH
-   (dst_size <= length: nothing written). Pure, thread-safe, no allocation. Cost: O(length). */
+   (dst_size <= length: nothing written), UNAVAILABLE (built with RAD_NO_GLSL, under which
+   rad_glsl_name and rad_glsl_pieces return NULL). Pure, thread-safe, no allocation. Cost: O(length). */
 RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
+
+/* ======================================================================================== */
+/* >>api_kernels: shared numeric kernels                                                    */
+/* ======================================================================================== */
+
+/* IEEE 754 binary16 conversion: round to nearest, ties to even; overflow gives infinity,
+   subnormals are kept, NaN stays NaN. */
+RAD_API uint16_t rad_half_from_float(float value);
+RAD_API float rad_half_to_float(uint16_t value);
 
 /* ======================================================================================== */
 /* >>api_multibounce: multi-bounce matrix and its compression                               */
@@ -2176,18 +2248,7 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 
 #define RAD_MB_INFINITE 0xFFFFFFFFu   /* rad_multibounce_options.bounces: K = infinity */
 
-/* Container section types of the multi-bounce objects (16..31 are reserved for them). */
-#define RAD_SECTION_MB_INFO 16u            /* 16 uint32: see rad_multibounce_sections */
-#define RAD_SECTION_MB_FLOAT 17u           /* 3 N^2 floats: the R, G, B planes */
-#define RAD_SECTION_MB_HALF 18u            /* 3 N^2 binary16 values */
-#define RAD_SECTION_MB_ROW_PERM 19u        /* N uint32 */
-#define RAD_SECTION_MB_COL_PERM 20u        /* N uint32 */
-#define RAD_SECTION_MB_BC1 21u             /* ceil(N/4)^2 8-byte BC1 blocks */
-#define RAD_SECTION_MB_BC4 22u             /* 3 ceil(N/4)^2 8-byte BC4 blocks: R plane, G, B */
-#define RAD_SECTION_MB_SCALES 23u          /* 3 floats (R, G, B) per scale tile */
-#define RAD_SECTION_MB_OUTLIER_OFFSETS 24u /* N+1 uint64, CSR by original row */
-#define RAD_SECTION_MB_OUTLIER_COLUMNS 25u /* uint32 original columns */
-#define RAD_SECTION_MB_OUTLIER_VALUES 26u  /* 3 floats (exact RGB) per outlier */
+/* Container section types: RAD_SECTION_MB_* (16..31) in the table of >>api_container. */
 #define RAD_MB_MAX_SECTIONS 10u            /* most sections one object writes */
 
 typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
@@ -2248,10 +2309,6 @@ RAD_API void rad_multibounce_destroy(rad_multibounce *mb);
 RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float *E, float *out, rad_output output,
                                          const rad_context *ctx);
 
-/* IEEE 754 binary16 conversion: round to nearest, ties to even; overflow gives infinity,
-   subnormals are kept, NaN stays NaN. */
-RAD_API uint16_t rad_half_from_float(float value);
-RAD_API float rad_half_to_float(uint16_t value);
 
 /* ---- block compression ---- */
 
@@ -2260,13 +2317,16 @@ typedef enum rad_block_format {
     RAD_BLOCK_BC4X3 = 1        /* three BC4 textures (R, G, B): 8-bit endpoints, 1.5 bytes per entry */
 } rad_block_format;
 
-#define RAD_REORDER_NONE 0        /* rad_block_options.reorder: keep the patch order */
-#define RAD_REORDER_GREEDY 1      /* greedy nearest-neighbour chain (Shcherbakov 2025) */
-#define RAD_REORDER_GREEDY_2OPT 2 /* the greedy chain, then 2-opt reversals that shorten it */
-#define RAD_REORDER_GROUPS 3      /* 2-opt chain, then swaps between the groups of four rows
-                                     (columns) that make each 4x4 block's rows more alike */
-#define RAD_REORDER_MATCH 4       /* groups of four by greedy matching (rows into pairs, pairs
-                                     into fours) on the same distance, then the group swaps */
+/* rad_block_options.reorder (an int holding one of these, as every flags field does). */
+typedef enum rad_reorder {
+    RAD_REORDER_NONE = 0,        /* keep the patch order */
+    RAD_REORDER_GREEDY = 1,      /* greedy nearest-neighbour chain (Shcherbakov 2025) */
+    RAD_REORDER_GREEDY_2OPT = 2, /* the greedy chain, then 2-opt reversals that shorten it */
+    RAD_REORDER_GROUPS = 3,      /* 2-opt chain, then swaps between the groups of four rows
+                                    (columns) that make each 4x4 block's rows more alike */
+    RAD_REORDER_MATCH = 4        /* groups of four by greedy matching (rows into pairs, pairs
+                                    into fours) on the same distance, then the group swaps */
+} rad_reorder;
 
 /* Start from rad_block_options_default: here zero is a setting, not the default (a zeroed
    struct asks for BC1, no outliers, no reordering and one scale per channel). */
@@ -2686,9 +2746,7 @@ RAD_API rad_result rad_local_lit(const float *E, const uint32_t *candidates, uin
    per channel (MULTIBOUNCE with 3 tables) channel c only accumulates its own component.
    The OUTPUT IS THE INDIRECT LIGHT (never E itself): add E for the total. */
 
-#define RAD_SECTION_TEMPORAL_ROW_OFFSETS 32u /* alias tables: rows + 1 uint64, offsets in bins */
-#define RAD_SECTION_TEMPORAL_BINS 33u        /* alias tables: the bins, 2 or 3 uint32 words each */
-#define RAD_SECTION_TEMPORAL_TOTALS 34u      /* alias tables: T_i, one float per row */
+/* Container section types: RAD_SECTION_TEMPORAL_* (32..39) in the table of >>api_container. */
 
 typedef enum rad_alias_format {
     RAD_ALIAS_AUTO = 0,    /* compact when cols <= 65535, else wide (the builders' choice) */
@@ -2769,8 +2827,9 @@ RAD_API void rad_temporal_random(uint32_t seed, uint32_t frame, uint32_t row, ui
 RAD_API uint32_t rad_alias_draw(const uint32_t *bins, uint32_t n, rad_alias_format format, uint32_t u1, uint32_t u2);
 
 /* Sections for writing the tables into a container (rad_container_write), named 'name'
-   (up to 23 characters; the three sections share it). Data borrowed from the tables. */
-RAD_API void rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section out[3]);
+   (up to 23 characters; the three sections share it), into out[0..2]. Data borrowed from the
+   tables. */
+RAD_API void rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section *out);
 
 /* A non-owning view of tables stored in a container under 'name', validated once (offsets
    monotone, bin counts in [1, N + 1], columns and aliases <= cols, totals > 0 and at most
@@ -2827,8 +2886,12 @@ typedef struct rad_temporal rad_temporal;
 /* Temporal state for N = tables[0]->rows patches. tables: table_count (1, or 3 in
    MULTIBOUNCE mode: one per channel) borrowed tables, which must outlive the state; all of
    the same size N x N. albedo: 3N floats, borrowed, required for SINGLE and FEEDBACK, unused
-   (may be NULL) for MULTIBOUNCE. B starts at 0. Errors: INVALID_ARGUMENT, SIZE_MISMATCH,
-   OUT_OF_MEMORY. Thread safety: reentrant. Memory: O(N). docs/methods/temporal.md. */
+   (may be NULL) for MULTIBOUNCE. B starts at 0. ctx (NULL: the defaults) is COPIED into the
+   state and used by every later call on it (rad_temporal_step takes no context, so that a
+   frame is one call): its allocator frees the state, its parallel_for runs each step, its
+   logger reports the step's errors, so whatever their user pointers point to must outlive
+   the state. Errors: INVALID_ARGUMENT, SIZE_MISMATCH, OUT_OF_MEMORY. Thread safety:
+   reentrant. Memory: O(N). docs/methods/temporal.md. */
 RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, uint32_t table_count, const float *albedo,
                                        const rad_temporal_options *options, const rad_context *ctx,
                                        rad_temporal **out);
@@ -2844,7 +2907,8 @@ RAD_API void rad_temporal_signal_change(rad_temporal *temporal);
 /* One frame: E (3N floats, borrowed during the call), E0 (the sky/environment RGB value, NULL
    for 0). Advances the frame counter. Writes the new indirect light B (3N floats, never
    including E) to out_indirect when it is not NULL; rad_temporal_indirect returns it too.
-   Parallel over rows through ctx->parallel_for; the bits do not depend on the thread count
+   Parallel over rows through the parallel_for of the context given to rad_temporal_create
+   (kept by the state); the bits do not depend on the thread count
    or task split (each row's draws depend only on seed, frame, row and sample).
    Errors: INVALID_ARGUMENT, NON_FINITE (E or E0 not finite, or B overflows float: the
    step is then undone). Cost: O(N k) random reads into the tables and E: the draws
@@ -3234,22 +3298,7 @@ RAD_API void rad_vp_lights_destroy(rad_vp_lights *state);
    bake's (it takes the areas and albedos from these sections when the file has no patches).
    *out_count receives how many were written (at most RAD_VP_MAX_SECTIONS). Errors:
    INVALID_ARGUMENT. */
-#define RAD_SECTION_VP_INFO 40u
-#define RAD_SECTION_VP_AREAS 41u            /* N floats */
-#define RAD_SECTION_VP_ALBEDO 42u           /* 3 N floats */
-#define RAD_SECTION_VP_NORMALS 43u          /* 3 N floats */
-#define RAD_SECTION_VP_AXIS 44u             /* N uint8 */
-#define RAD_SECTION_VP_VOXEL 45u            /* N uint32 */
-#define RAD_SECTION_VP_VOXEL_KEYS 46u       /* voxel_count uint64 */
-#define RAD_SECTION_VP_VOXEL_FIRST 47u      /* voxel_count + 1 uint32 */
-#define RAD_SECTION_VP_VOXEL_PATCH 48u      /* 6 uint32 per voxel */
-#define RAD_SECTION_VP_SAMPLE_FIRST 49u     /* voxel_count + 1 uint32 */
-#define RAD_SECTION_VP_SAMPLE_POSITIONS 50u /* 3 M floats */
-#define RAD_SECTION_VP_SAMPLE_NORMALS 51u   /* 3 M floats */
-#define RAD_SECTION_VP_SAMPLE_ALBEDO 52u    /* 3 M floats */
-#define RAD_SECTION_VP_SAMPLE_AREAS 53u     /* M floats */
-#define RAD_SECTION_VP_SAMPLE_WEIGHTS 54u   /* 6 M floats */
-#define RAD_SECTION_VP_SAMPLE_TRIANGLES 55u /* M uint32 */
+/* (section types RAD_SECTION_VP_* (40..63) in the table of >>api_container) */
 #define RAD_VP_MAX_SECTIONS 19u
 RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count);
 
@@ -3476,9 +3525,69 @@ RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], 
 #  define RAD__SSE2 1
 #  include <emmintrin.h>
 #endif
+/* SIMD: every feature macro is chosen here, once, from what the compiler already enables
+   (RAD_NO_SIMD: none); the kernels test these and never the compiler's own macros.
+   RAD__SSE2, RAD__AVX   the BVH, dot products and matrix-vector kernels;
+   RAD__MB_AVX2, _FMA, _F16C   the GEMM, binary16 and compressed-block kernels (>>kernels,
+                         >>multibounce, >>local);
+   RAD__TEMPORAL_AVX2    the temporal step hashing 8 draws at once (rad__tpipe_issue8; x86-64
+                         only, for its 64-bit lanes). */
 #if !defined(RAD_NO_SIMD) && defined(__AVX__)
 #  define RAD__AVX 1
 #  include <immintrin.h>
+#endif
+#if defined(RAD__AVX) && defined(__AVX2__)
+#  define RAD__MB_AVX2 1
+#endif
+#if defined(RAD__AVX) && defined(__FMA__)
+#  define RAD__MB_FMA 1
+#endif
+#if defined(RAD__AVX) && defined(__F16C__)
+#  define RAD__MB_F16C 1
+#endif
+#if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
+#  define RAD__TEMPORAL_AVX2 1
+#endif
+
+/* A vector of floats at the widest width the build has (RAD__VW lanes), for kernels written
+   once for AVX and SSE, and the horizontal sums: lane 0 first, from 0.0f, so a sum's bits
+   follow the lanes' values alone. */
+#if defined(RAD__AVX)
+typedef __m256 rad__vf;
+#  define RAD__VW 8u
+#  define rad__vf_zero() _mm256_setzero_ps()
+#  define rad__vf_load(p) _mm256_loadu_ps(p)
+#  define rad__vf_madd(acc, a, b) _mm256_add_ps(acc, _mm256_mul_ps(a, b))
+#  define rad__vf_add(a, b) _mm256_add_ps(a, b)
+#  define rad__vf_store(p, v) _mm256_storeu_ps(p, v)
+#elif defined(RAD__SSE2)
+typedef __m128 rad__vf;
+#  define RAD__VW 4u
+#  define rad__vf_zero() _mm_setzero_ps()
+#  define rad__vf_load(p) _mm_loadu_ps(p)
+#  define rad__vf_madd(acc, a, b) _mm_add_ps(acc, _mm_mul_ps(a, b))
+#  define rad__vf_add(a, b) _mm_add_ps(a, b)
+#  define rad__vf_store(p, v) _mm_storeu_ps(p, v)
+#endif
+#if defined(RAD__VW)
+static inline float rad__vf_sum(rad__vf v)
+{
+    float t[RAD__VW], sum = 0.0f;
+    unsigned k;
+    rad__vf_store(t, v);
+    for (k = 0; k < RAD__VW; ++k) sum += t[k];
+    return sum;
+}
+#endif
+#if defined(RAD__AVX)
+static inline float rad__hsum8(__m256 v)
+{
+    float t[8], sum = 0.0f;
+    int k;
+    _mm256_storeu_ps(t, v);
+    for (k = 0; k < 8; ++k) sum += t[k];
+    return sum;
+}
 #endif
 
 /* Linux: madvise(MADV_HUGEPAGE) on large alias tables (>>temporal). Strict ISO C (-std=c99)
@@ -3822,6 +3931,202 @@ static uint32_t rad__lattice_side(uint32_t samples)
 {
     uint32_t n = (uint32_t)floor(sqrt((double)samples) + 0.5);
     return n ? n : 1u;
+}
+
+/* ======================================================================================== */
+/* >>format: the container's bytes (offsets, CRC-32, header and table checks)               */
+/* ======================================================================================== */
+
+/* The byte layout described in >>api_container, by name: every writer and reader of a
+   container (rad_container_write, rad_container_open, rad_row_stream_open, rad_load_file)
+   uses these, so they cannot drift apart. */
+#define RAD__HEADER_BYTES 64u
+#define RAD__ENTRY_BYTES 64u
+#define RAD__ALIGN 64u
+#define RAD__FLAG_BIG_ENDIAN 1u
+#define RAD__MAX_SECTIONS 0x00FFFFFFu
+/* header fields (byte offsets; "RADB" at 0) */
+#define RAD__H_VERSION 4u
+#define RAD__H_COUNT 8u
+#define RAD__H_HEADER_SIZE 12u
+#define RAD__H_TABLE 16u
+#define RAD__H_FILE_SIZE 24u
+#define RAD__H_FLAGS 32u
+#define RAD__H_TABLE_CRC 36u
+#define RAD__H_CRC 60u
+/* table entry fields (byte offsets; bytes 36..39 are reserved zeros) */
+#define RAD__E_TYPE 0u
+#define RAD__E_ELEM_SIZE 4u
+#define RAD__E_COUNT 8u
+#define RAD__E_OFFSET 16u
+#define RAD__E_BYTES 24u
+#define RAD__E_CRC 32u
+#define RAD__E_NAME 40u
+
+static uint32_t rad__crc32(const void *data, size_t size)
+{
+    static const uint32_t nibble[16] = { 0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
+                                         0x4DB26158u, 0x5005713Cu, 0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
+                                         0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
+    const unsigned char *p = (const unsigned char *)data;
+    uint32_t c = 0xFFFFFFFFu;
+    size_t i;
+    for (i = 0; i < size; ++i) {
+        c ^= p[i];
+        c = (c >> 4) ^ nibble[c & 15u];
+        c = (c >> 4) ^ nibble[c & 15u];
+    }
+    return c ^ 0xFFFFFFFFu;
+}
+
+static void rad__put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
+static void rad__put64(unsigned char *p, uint64_t v) { rad__put32(p, (uint32_t)v); rad__put32(p + 4, (uint32_t)(v >> 32)); }
+static uint32_t rad__get32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
+static uint64_t rad__get64(const unsigned char *p) { return (uint64_t)rad__get32(p) | (uint64_t)rad__get32(p + 4) << 32; }
+static int rad__host_big_endian(void) { const uint32_t one = 1; return *(const unsigned char *)&one == 0; }
+static uint64_t rad__align_up(uint64_t x) { return (x + (RAD__ALIGN - 1)) & ~(uint64_t)(RAD__ALIGN - 1); }
+
+/* What a valid header says. */
+typedef struct rad__header {
+    uint32_t count;        /* sections */
+    uint64_t file_size;    /* bytes of the container */
+    uint64_t first_data;   /* where the section data may start: after the table, aligned */
+} rad__header;
+
+/* Checks the 64 header bytes at p: magic, checksum, version, byte order, header size, table
+   offset, section count, a table that fits, and a container of at most 'available' bytes.
+   Errors: CORRUPT, VERSION, TRUNCATED (the container is longer than 'available'), each logged
+   with 'who' (what is being read) in front. */
+static rad_result rad__header_parse(const unsigned char *p, uint64_t available, const rad__ctx *c, const char *who,
+                                    rad__header *h)
+{
+    uint32_t flags;
+    uint64_t table;
+    if (memcmp(p, "RADB", 4) != 0) {
+        rad__log(c, RAD_LOG_ERROR, "%s: no RADB magic (not a radiosity.h container)", who);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (rad__get32(p + RAD__H_CRC) != rad__crc32(p, RAD__H_CRC)) {
+        rad__log(c, RAD_LOG_ERROR, "%s: header checksum mismatch", who);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (rad__get32(p + RAD__H_VERSION) != RAD_CONTAINER_VERSION) {
+        rad__log(c, RAD_LOG_ERROR, "%s: container version %u, this library reads version %u", who,
+                 rad__get32(p + RAD__H_VERSION), RAD_CONTAINER_VERSION);
+        return RAD_ERROR_VERSION;
+    }
+    flags = rad__get32(p + RAD__H_FLAGS);
+    if ((flags & ~RAD__FLAG_BIG_ENDIAN) != 0 || ((flags & RAD__FLAG_BIG_ENDIAN) != 0) != rad__host_big_endian()) {
+        rad__log(c, RAD_LOG_ERROR, "%s: flags %#x (byte order or features this build does not read)", who, flags);
+        return RAD_ERROR_VERSION;
+    }
+    h->count = rad__get32(p + RAD__H_COUNT);
+    table = rad__get64(p + RAD__H_TABLE);
+    h->file_size = rad__get64(p + RAD__H_FILE_SIZE);
+    if (rad__get32(p + RAD__H_HEADER_SIZE) != RAD__HEADER_BYTES || table != RAD__HEADER_BYTES || h->count > RAD__MAX_SECTIONS) {
+        rad__log(c, RAD_LOG_ERROR, "%s: bad header (header size %u, table offset %llu, %u sections)", who,
+                 rad__get32(p + RAD__H_HEADER_SIZE), (unsigned long long)table, h->count);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (h->file_size > available) {
+        rad__log(c, RAD_LOG_ERROR, "%s: %llu bytes given, the container is %llu bytes", who, (unsigned long long)available,
+                 (unsigned long long)h->file_size);
+        return RAD_ERROR_TRUNCATED;
+    }
+    h->first_data = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * h->count);
+    if (h->first_data > h->file_size) {
+        rad__log(c, RAD_LOG_ERROR, "%s: the table of %u sections does not fit in %llu bytes", who, h->count,
+                 (unsigned long long)h->file_size);
+        return RAD_ERROR_CORRUPT;
+    }
+    return RAD_SUCCESS;
+}
+
+/* The section table's checksum against the header's (CORRUPT, logged, when they differ). */
+static rad_result rad__table_check(const unsigned char *header, const unsigned char *table, uint32_t count,
+                                   const rad__ctx *c, const char *who)
+{
+    if (rad__get32(header + RAD__H_TABLE_CRC) == rad__crc32(table, (size_t)RAD__ENTRY_BYTES * count)) return RAD_SUCCESS;
+    rad__log(c, RAD_LOG_ERROR, "%s: section table checksum mismatch", who);
+    return RAD_ERROR_CORRUPT;
+}
+
+/* One table entry. */
+typedef struct rad__entry {
+    uint32_t type, elem_size, crc;
+    uint64_t count, offset, bytes;
+} rad__entry;
+
+/* Reads the table entry at e and checks it against the header: a NUL-terminated name, element
+   size x count = byte size, an aligned offset after the table, data inside the container,
+   reserved bytes zero. Returns NULL, or why the entry is bad (the data's checksum is the
+   caller's: a streaming reader checks only what it reads). */
+static const char *rad__entry_parse(const unsigned char *e, const rad__header *h, rad__entry *x)
+{
+    uint32_t k;
+    x->type = rad__get32(e + RAD__E_TYPE);
+    x->elem_size = rad__get32(e + RAD__E_ELEM_SIZE);
+    x->count = rad__get64(e + RAD__E_COUNT);
+    x->offset = rad__get64(e + RAD__E_OFFSET);
+    x->bytes = rad__get64(e + RAD__E_BYTES);
+    x->crc = rad__get32(e + RAD__E_CRC);
+    if (e[RAD__E_NAME + 23u] != 0) return "its name is not NUL-terminated";
+    if (x->elem_size == 0 || x->count > UINT64_MAX / x->elem_size || x->count * x->elem_size != x->bytes)
+        return "element size x count differs from its byte size";
+    if (x->offset % RAD__ALIGN != 0 || x->offset < h->first_data) return "its offset is misaligned or inside the table";
+    if (x->bytes > h->file_size || x->offset > h->file_size - x->bytes) return "it extends past the end of the container";
+    for (k = RAD__E_CRC + 4u; k < RAD__E_NAME; ++k)
+        if (e[k]) return "reserved bytes are not zero";
+    return NULL;
+}
+
+static void rad__section(rad_section *s, uint32_t type, uint32_t elem_size, uint64_t count, const void *data, const char *name)
+{
+    memset(s, 0, sizeof(*s));
+    s->type = type;
+    s->elem_size = elem_size;
+    s->count = count;
+    s->data = data;
+    if (name) {
+        size_t n = strlen(name);
+        if (n > sizeof(s->name) - 1) n = sizeof(s->name) - 1;
+        memcpy(s->name, name, n);
+    }
+}
+
+/* The value rule of every loader (>>api_container VALUES): n floats, each finite (else
+   NON_FINITE) and of magnitude <= RAD_BAKE_VALUE_MAX, and >= 0 when 'nonneg' (-0 passes)
+   (else CORRUPT). One branch-free pass on the bit patterns (NaN and infinity have larger
+   magnitude bits than any finite bound), then the first bad entry is found again for the
+   message, which names 'what', the entry and its value. */
+static rad_result rad__check_values(const rad__ctx *c, const char *what, const float *v, uint64_t n, int nonneg)
+{
+    const float vmax = RAD_BAKE_VALUE_MAX;
+    uint32_t maxbits, sign = nonneg ? 0x80000000u : 0u, bad = 0;
+    uint64_t i, j;
+    memcpy(&maxbits, &vmax, 4);
+    for (i = 0; i < n && !bad; i += 4096) {
+        uint64_t e = n - i < 4096 ? n : i + 4096;
+        for (j = i; j < e; ++j) {
+            uint32_t b;
+            memcpy(&b, v + j, 4);
+            bad |= (uint32_t)((b & 0x7FFFFFFFu) > maxbits) | (uint32_t)((b & sign) != 0 && b != sign);
+        }
+    }
+    if (!bad) return RAD_SUCCESS;
+    for (i = 0; i < n; ++i) {
+        const float x = v[i];
+        if (!rad__finite(x)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (not finite)", what, (unsigned long long)i, (double)x);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (x > vmax || x < -vmax || (nonneg && x < 0.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (%s)", what, (unsigned long long)i, (double)x,
+                     nonneg && x < 0.0f ? "negative" : "beyond RAD_BAKE_VALUE_MAX = 1e30");
+            return RAD_ERROR_CORRUPT;
+        }
+    }
+    return RAD_SUCCESS; /* not reached */
 }
 
 /* ======================================================================================== */
@@ -6879,49 +7184,24 @@ static void rad__dot3(const float *row, const float *xr, const float *xg, const 
 {
     uint32_t j = 0;
     float sr = 0.0f, sg = 0.0f, sb = 0.0f;
-#if defined(RAD__AVX)
+#if defined(RAD__VW)
     {
-        __m256 ar = _mm256_setzero_ps(), ag = _mm256_setzero_ps(), ab = _mm256_setzero_ps();
-        __m256 ar2 = _mm256_setzero_ps(), ag2 = _mm256_setzero_ps(), ab2 = _mm256_setzero_ps();
-        float t[8];
-        int k;
+        rad__vf ar = rad__vf_zero(), ag = rad__vf_zero(), ab = rad__vf_zero();
+        rad__vf ar2 = rad__vf_zero(), ag2 = rad__vf_zero(), ab2 = rad__vf_zero();
         /* six independent sums keep the adders busy; the matrix row streams once */
-        for (; j + 16 <= n; j += 16) {
-            __m256 f = _mm256_loadu_ps(row + j), f2 = _mm256_loadu_ps(row + j + 8);
+        for (; j + 2 * RAD__VW <= n; j += 2 * RAD__VW) {
+            rad__vf f = rad__vf_load(row + j), f2 = rad__vf_load(row + j + RAD__VW);
             _mm_prefetch((const char *)(row + j + 256), _MM_HINT_T0); /* 1 KiB ahead */
-            ar = _mm256_add_ps(ar, _mm256_mul_ps(f, _mm256_loadu_ps(xr + j)));
-            ag = _mm256_add_ps(ag, _mm256_mul_ps(f, _mm256_loadu_ps(xg + j)));
-            ab = _mm256_add_ps(ab, _mm256_mul_ps(f, _mm256_loadu_ps(xb + j)));
-            ar2 = _mm256_add_ps(ar2, _mm256_mul_ps(f2, _mm256_loadu_ps(xr + j + 8)));
-            ag2 = _mm256_add_ps(ag2, _mm256_mul_ps(f2, _mm256_loadu_ps(xg + j + 8)));
-            ab2 = _mm256_add_ps(ab2, _mm256_mul_ps(f2, _mm256_loadu_ps(xb + j + 8)));
+            ar = rad__vf_madd(ar, f, rad__vf_load(xr + j));
+            ag = rad__vf_madd(ag, f, rad__vf_load(xg + j));
+            ab = rad__vf_madd(ab, f, rad__vf_load(xb + j));
+            ar2 = rad__vf_madd(ar2, f2, rad__vf_load(xr + j + RAD__VW));
+            ag2 = rad__vf_madd(ag2, f2, rad__vf_load(xg + j + RAD__VW));
+            ab2 = rad__vf_madd(ab2, f2, rad__vf_load(xb + j + RAD__VW));
         }
-        ar = _mm256_add_ps(ar, ar2);
-        ag = _mm256_add_ps(ag, ag2);
-        ab = _mm256_add_ps(ab, ab2);
-        _mm256_storeu_ps(t, ar); for (k = 0; k < 8; ++k) sr += t[k];
-        _mm256_storeu_ps(t, ag); for (k = 0; k < 8; ++k) sg += t[k];
-        _mm256_storeu_ps(t, ab); for (k = 0; k < 8; ++k) sb += t[k];
-    }
-#elif defined(RAD__SSE2)
-    {
-        __m128 ar = _mm_setzero_ps(), ag = _mm_setzero_ps(), ab = _mm_setzero_ps();
-        __m128 ar2 = _mm_setzero_ps(), ag2 = _mm_setzero_ps(), ab2 = _mm_setzero_ps();
-        float t[4];
-        int k;
-        for (; j + 8 <= n; j += 8) {
-            __m128 f = _mm_loadu_ps(row + j), f2 = _mm_loadu_ps(row + j + 4);
-            _mm_prefetch((const char *)(row + j + 256), _MM_HINT_T0); /* 1 KiB ahead */
-            ar = _mm_add_ps(ar, _mm_mul_ps(f, _mm_loadu_ps(xr + j)));
-            ag = _mm_add_ps(ag, _mm_mul_ps(f, _mm_loadu_ps(xg + j)));
-            ab = _mm_add_ps(ab, _mm_mul_ps(f, _mm_loadu_ps(xb + j)));
-            ar2 = _mm_add_ps(ar2, _mm_mul_ps(f2, _mm_loadu_ps(xr + j + 4)));
-            ag2 = _mm_add_ps(ag2, _mm_mul_ps(f2, _mm_loadu_ps(xg + j + 4)));
-            ab2 = _mm_add_ps(ab2, _mm_mul_ps(f2, _mm_loadu_ps(xb + j + 4)));
-        }
-        _mm_storeu_ps(t, _mm_add_ps(ar, ar2)); for (k = 0; k < 4; ++k) sr += t[k];
-        _mm_storeu_ps(t, _mm_add_ps(ag, ag2)); for (k = 0; k < 4; ++k) sg += t[k];
-        _mm_storeu_ps(t, _mm_add_ps(ab, ab2)); for (k = 0; k < 4; ++k) sb += t[k];
+        sr = rad__vf_sum(rad__vf_add(ar, ar2));
+        sg = rad__vf_sum(rad__vf_add(ag, ag2));
+        sb = rad__vf_sum(rad__vf_add(ab, ab2));
     }
 #endif
     for (; j < n; ++j) {
@@ -6941,9 +7221,8 @@ static void rad__dot3x2(const float *r0, const float *r1, const float *xr, const
 {
     __m256 a0 = _mm256_setzero_ps(), a1 = _mm256_setzero_ps(), a2 = _mm256_setzero_ps();
     __m256 b0 = _mm256_setzero_ps(), b1 = _mm256_setzero_ps(), b2 = _mm256_setzero_ps();
-    float t[8], s[6] = { 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f };
+    float s[6];
     uint32_t j = 0;
-    int k;
     for (; j + 8 <= n; j += 8) {
         __m256 f = _mm256_loadu_ps(r0 + j), g = _mm256_loadu_ps(r1 + j);
         __m256 x0 = _mm256_loadu_ps(xr + j), x1 = _mm256_loadu_ps(xg + j), x2 = _mm256_loadu_ps(xb + j);
@@ -6956,12 +7235,12 @@ static void rad__dot3x2(const float *r0, const float *r1, const float *xr, const
         b1 = _mm256_add_ps(b1, _mm256_mul_ps(g, x1));
         b2 = _mm256_add_ps(b2, _mm256_mul_ps(g, x2));
     }
-    _mm256_storeu_ps(t, a0); for (k = 0; k < 8; ++k) s[0] += t[k];
-    _mm256_storeu_ps(t, a1); for (k = 0; k < 8; ++k) s[1] += t[k];
-    _mm256_storeu_ps(t, a2); for (k = 0; k < 8; ++k) s[2] += t[k];
-    _mm256_storeu_ps(t, b0); for (k = 0; k < 8; ++k) s[3] += t[k];
-    _mm256_storeu_ps(t, b1); for (k = 0; k < 8; ++k) s[4] += t[k];
-    _mm256_storeu_ps(t, b2); for (k = 0; k < 8; ++k) s[5] += t[k];
+    s[0] = rad__hsum8(a0);
+    s[1] = rad__hsum8(a1);
+    s[2] = rad__hsum8(a2);
+    s[3] = rad__hsum8(b0);
+    s[4] = rad__hsum8(b1);
+    s[5] = rad__hsum8(b2);
     for (; j < n; ++j) {
         s[0] += r0[j] * xr[j]; s[1] += r0[j] * xg[j]; s[2] += r0[j] * xb[j];
         s[3] += r1[j] * xr[j]; s[4] += r1[j] * xg[j]; s[5] += r1[j] * xb[j];
@@ -11800,46 +12079,18 @@ typedef char rad__check_shading_gpu_size[(sizeof(rad_shading_gpu) == 96) ? 1 : -
 typedef char rad__check_patch_size[(sizeof(rad_patch) == 68) ? 1 : -1];
 typedef char rad__check_signature_size[(sizeof(rad_bake_signature) == 32) ? 1 : -1];
 
-#define RAD__HEADER_BYTES 64u
-#define RAD__ENTRY_BYTES 64u
-#define RAD__ALIGN 64u
-#define RAD__FLAG_BIG_ENDIAN 1u
-
 struct rad_container {
     rad_section *sections;
     uint32_t count;
     rad_allocator allocator;
 };
 
-static uint32_t rad__crc32(const void *data, size_t size)
-{
-    static const uint32_t nibble[16] = { 0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
-                                         0x4DB26158u, 0x5005713Cu, 0xEDB88320u, 0xF00F9344u, 0xD6D6A3E8u, 0xCB61B38Cu,
-                                         0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
-    const unsigned char *p = (const unsigned char *)data;
-    uint32_t c = 0xFFFFFFFFu;
-    size_t i;
-    for (i = 0; i < size; ++i) {
-        c ^= p[i];
-        c = (c >> 4) ^ nibble[c & 15u];
-        c = (c >> 4) ^ nibble[c & 15u];
-    }
-    return c ^ 0xFFFFFFFFu;
-}
-
-static void rad__put32(unsigned char *p, uint32_t v) { p[0] = (unsigned char)v; p[1] = (unsigned char)(v >> 8); p[2] = (unsigned char)(v >> 16); p[3] = (unsigned char)(v >> 24); }
-static void rad__put64(unsigned char *p, uint64_t v) { rad__put32(p, (uint32_t)v); rad__put32(p + 4, (uint32_t)(v >> 32)); }
-static uint32_t rad__get32(const unsigned char *p) { return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24; }
-static uint64_t rad__get64(const unsigned char *p) { return (uint64_t)rad__get32(p) | (uint64_t)rad__get32(p + 4) << 32; }
-static int rad__host_big_endian(void) { const uint32_t one = 1; return *(const unsigned char *)&one == 0; }
-static uint64_t rad__align_up(uint64_t x) { return (x + (RAD__ALIGN - 1)) & ~(uint64_t)(RAD__ALIGN - 1); }
-
 RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes)
 {
     uint64_t at, bytes;
     uint32_t i;
     if (!out_bytes || (count > 0 && !sections)) return RAD_ERROR_INVALID_ARGUMENT;
-    if (count > 0x00FFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    if (count > RAD__MAX_SECTIONS) return RAD_ERROR_SIZE_OVERFLOW;
     at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
     for (i = 0; i < count; ++i) {
         if (sections[i].elem_size == 0 || (sections[i].count > 0 && !sections[i].data)) return RAD_ERROR_INVALID_ARGUMENT;
@@ -11869,25 +12120,25 @@ RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t cou
         uint64_t bytes = sections[i].count * sections[i].elem_size;
         size_t nl = 0;
         if (bytes) memcpy(base + at, sections[i].data, (size_t)bytes);
-        rad__put32(e, sections[i].type);
-        rad__put32(e + 4, sections[i].elem_size);
-        rad__put64(e + 8, sections[i].count);
-        rad__put64(e + 16, at);
-        rad__put64(e + 24, bytes);
-        rad__put32(e + 32, rad__crc32(base + at, (size_t)bytes));
+        rad__put32(e + RAD__E_TYPE, sections[i].type);
+        rad__put32(e + RAD__E_ELEM_SIZE, sections[i].elem_size);
+        rad__put64(e + RAD__E_COUNT, sections[i].count);
+        rad__put64(e + RAD__E_OFFSET, at);
+        rad__put64(e + RAD__E_BYTES, bytes);
+        rad__put32(e + RAD__E_CRC, rad__crc32(base + at, (size_t)bytes));
         while (nl < sizeof(sections[i].name) - 1 && sections[i].name[nl]) ++nl;
-        memcpy(e + 40, sections[i].name, nl);
+        memcpy(e + RAD__E_NAME, sections[i].name, nl);
         at = rad__align_up(at + bytes);
     }
     memcpy(base, "RADB", 4);
-    rad__put32(base + 4, RAD_CONTAINER_VERSION);
-    rad__put32(base + 8, count);
-    rad__put32(base + 12, RAD__HEADER_BYTES);
-    rad__put64(base + 16, RAD__HEADER_BYTES);
-    rad__put64(base + 24, (uint64_t)need);
-    rad__put32(base + 32, rad__host_big_endian() ? RAD__FLAG_BIG_ENDIAN : 0u);
-    rad__put32(base + 36, rad__crc32(base + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count)); /* the table */
-    rad__put32(base + 60, rad__crc32(base, 60));
+    rad__put32(base + RAD__H_VERSION, RAD_CONTAINER_VERSION);
+    rad__put32(base + RAD__H_COUNT, count);
+    rad__put32(base + RAD__H_HEADER_SIZE, RAD__HEADER_BYTES);
+    rad__put64(base + RAD__H_TABLE, RAD__HEADER_BYTES);
+    rad__put64(base + RAD__H_FILE_SIZE, (uint64_t)need);
+    rad__put32(base + RAD__H_FLAGS, rad__host_big_endian() ? RAD__FLAG_BIG_ENDIAN : 0u);
+    rad__put32(base + RAD__H_TABLE_CRC, rad__crc32(base + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count));
+    rad__put32(base + RAD__H_CRC, rad__crc32(base, RAD__H_CRC));
     return RAD_SUCCESS;
 }
 
@@ -11904,8 +12155,9 @@ RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_c
 {
     rad__ctx c;
     const unsigned char *p = (const unsigned char *)data;
-    uint64_t file_size, table, first_data;
-    uint32_t count, i, flags;
+    rad__header h;
+    uint32_t i;
+    rad_result r;
     rad_container *ct;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -11919,82 +12171,54 @@ RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_c
         rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes, shorter than the %u-byte header", (unsigned long long)size, RAD__HEADER_BYTES);
         return size >= 4 && memcmp(p, "RADB", 4) != 0 ? RAD_ERROR_CORRUPT : RAD_ERROR_TRUNCATED;
     }
-    if (memcmp(p, "RADB", 4) != 0) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: no RADB magic (not a radiosity.h container)");
-        return RAD_ERROR_CORRUPT;
-    }
-    if (rad__get32(p + 60) != rad__crc32(p, 60)) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: header checksum mismatch");
-        return RAD_ERROR_CORRUPT;
-    }
-    if (rad__get32(p + 4) != RAD_CONTAINER_VERSION) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: container version %u, this library reads version %u", rad__get32(p + 4),
-                 RAD_CONTAINER_VERSION);
-        return RAD_ERROR_VERSION;
-    }
-    flags = rad__get32(p + 32);
-    if ((flags & ~RAD__FLAG_BIG_ENDIAN) != 0 || ((flags & RAD__FLAG_BIG_ENDIAN) != 0) != rad__host_big_endian()) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: flags %#x (byte order or features this build does not read)", flags);
-        return RAD_ERROR_VERSION;
-    }
-    count = rad__get32(p + 8);
-    table = rad__get64(p + 16);
-    file_size = rad__get64(p + 24);
-    if (rad__get32(p + 12) != RAD__HEADER_BYTES || table != RAD__HEADER_BYTES || count > 0x00FFFFFFu) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: bad header (header size %u, table offset %llu, %u sections)", rad__get32(p + 12),
-                 (unsigned long long)table, count);
-        return RAD_ERROR_CORRUPT;
-    }
-    if (file_size > (uint64_t)size) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes given, the container is %llu bytes", (unsigned long long)size,
-                 (unsigned long long)file_size);
-        return RAD_ERROR_TRUNCATED;
-    }
-    first_data = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
-    if (first_data > file_size) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: the table of %u sections does not fit in %llu bytes", count, (unsigned long long)file_size);
-        return RAD_ERROR_CORRUPT;
-    }
-    if (rad__get32(p + 36) != rad__crc32(p + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count)) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: section table checksum mismatch");
-        return RAD_ERROR_CORRUPT;
-    }
+    if ((r = rad__header_parse(p, (uint64_t)size, &c, "baked data", &h)) != RAD_SUCCESS ||
+        (r = rad__table_check(p, p + RAD__HEADER_BYTES, h.count, &c, "baked data")) != RAD_SUCCESS)
+        return r;
     ct = (rad_container *)rad__alloc(&c.allocator, sizeof(rad_container));
     if (!ct) return RAD_ERROR_OUT_OF_MEMORY;
     ct->allocator = c.allocator;
-    ct->count = count;
-    ct->sections = (rad_section *)rad__alloc_array(&c.allocator, count ? count : 1u, sizeof(rad_section));
+    ct->count = h.count;
+    ct->sections = (rad_section *)rad__alloc_array(&c.allocator, h.count ? h.count : 1u, sizeof(rad_section));
     if (!ct->sections) { rad__free(&c.allocator, ct); return RAD_ERROR_OUT_OF_MEMORY; }
-    for (i = 0; i < count; ++i) {
+    for (i = 0; i < h.count; ++i) {
         const unsigned char *e = p + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
         rad_section *sec = &ct->sections[i];
-        uint64_t off = rad__get64(e + 16), bytes = rad__get64(e + 24), n = rad__get64(e + 8);
-        uint32_t esz = rad__get32(e + 4), k;
-        const char *why = NULL;
+        rad__entry x;
+        const char *why = rad__entry_parse(e, &h, &x);
         memset(sec, 0, sizeof(*sec));
-        sec->type = rad__get32(e);
-        sec->elem_size = esz;
-        sec->count = n;
-        memcpy(sec->name, e + 40, 24);
-        if (sec->name[23] != 0) why = "its name is not NUL-terminated";
-        else if (esz == 0 || n > UINT64_MAX / esz || n * esz != bytes) why = "element size x count differs from its byte size";
-        else if (off % RAD__ALIGN != 0 || off < first_data) why = "its offset is misaligned or inside the table";
-        else if (bytes > file_size || off > file_size - bytes) why = "it extends past the end of the container";
-        else if (rad__get32(e + 32) != rad__crc32(p + off, (size_t)bytes)) why = "checksum mismatch";
-        for (k = 36; k < 40 && !why; ++k)
-            if (e[k]) why = "reserved bytes are not zero";
+        sec->type = x.type;
+        sec->elem_size = x.elem_size;
+        sec->count = x.count;
+        memcpy(sec->name, e + RAD__E_NAME, 24);
+        if (!why && x.crc != rad__crc32(p + x.offset, (size_t)x.bytes)) why = "checksum mismatch";
         if (why) {
             rad__log(&c, RAD_LOG_ERROR, "baked data: section %u (type %u, '%.23s'): %s", i, sec->type, sec->name, why);
             rad_container_close(ct);
             return RAD_ERROR_CORRUPT;
         }
-        sec->data = p + off;
+        sec->data = p + x.offset;
     }
     *out = ct;
     return RAD_SUCCESS;
 }
 
 RAD_API uint32_t rad_container_section_count(const rad_container *c) { return c ? c->count : 0; }
+
+RAD_API const char *rad_section_type_name(uint32_t type)
+{
+    static const char *const names[] = {
+        NULL, "PATCHES", "PATCH_VERTICES", "TRIANGLES", "FF_DENSE", "FF_ROW_OFFSETS", "FF_COLUMNS", "FF_VALUES",
+        "VECTOR", "SIGNATURE", NULL, NULL, NULL, NULL, NULL, NULL,
+        "MB_INFO", "MB_FLOAT", "MB_HALF", "MB_ROW_PERM", "MB_COL_PERM", "MB_BC1", "MB_BC4", "MB_SCALES",
+        "MB_OUTLIER_OFFSETS", "MB_OUTLIER_COLUMNS", "MB_OUTLIER_VALUES", NULL, NULL, NULL, NULL, NULL,
+        "TEMPORAL_ROW_OFFSETS", "TEMPORAL_BINS", "TEMPORAL_TOTALS", NULL, NULL, NULL, NULL, NULL,
+        "VP_INFO", "VP_AREAS", "VP_ALBEDO", "VP_NORMALS", "VP_AXIS", "VP_VOXEL", "VP_VOXEL_KEYS", "VP_VOXEL_FIRST",
+        "VP_VOXEL_PATCH", "VP_SAMPLE_FIRST", "VP_SAMPLE_POSITIONS", "VP_SAMPLE_NORMALS", "VP_SAMPLE_ALBEDO",
+        "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES"
+    };
+    if (type >= RAD_SECTION_USER) return "USER";
+    return type < sizeof(names) / sizeof(names[0]) ? names[type] : NULL;
+}
 
 RAD_API const rad_section *rad_container_section(const rad_container *c, uint32_t index)
 {
@@ -12008,55 +12232,6 @@ RAD_API const rad_section *rad_container_find(const rad_container *c, uint32_t t
     for (i = 0; i < c->count; ++i)
         if (c->sections[i].type == type && (!name || strcmp(c->sections[i].name, name) == 0)) return &c->sections[i];
     return NULL;
-}
-
-static void rad__section(rad_section *s, uint32_t type, uint32_t elem_size, uint64_t count, const void *data, const char *name)
-{
-    memset(s, 0, sizeof(*s));
-    s->type = type;
-    s->elem_size = elem_size;
-    s->count = count;
-    s->data = data;
-    if (name) {
-        size_t n = strlen(name);
-        if (n > sizeof(s->name) - 1) n = sizeof(s->name) - 1;
-        memcpy(s->name, name, n);
-    }
-}
-
-/* The value rule of every loader (>>api_container VALUES): n floats, each finite (else
-   NON_FINITE) and of magnitude <= RAD_BAKE_VALUE_MAX, and >= 0 when 'nonneg' (-0 passes)
-   (else CORRUPT). One branch-free pass on the bit patterns (NaN and infinity have larger
-   magnitude bits than any finite bound), then the first bad entry is found again for the
-   message, which names 'what', the entry and its value. */
-static rad_result rad__check_values(const rad__ctx *c, const char *what, const float *v, uint64_t n, int nonneg)
-{
-    const float vmax = RAD_BAKE_VALUE_MAX;
-    uint32_t maxbits, sign = nonneg ? 0x80000000u : 0u, bad = 0;
-    uint64_t i, j;
-    memcpy(&maxbits, &vmax, 4);
-    for (i = 0; i < n && !bad; i += 4096) {
-        uint64_t e = n - i < 4096 ? n : i + 4096;
-        for (j = i; j < e; ++j) {
-            uint32_t b;
-            memcpy(&b, v + j, 4);
-            bad |= (uint32_t)((b & 0x7FFFFFFFu) > maxbits) | (uint32_t)((b & sign) != 0 && b != sign);
-        }
-    }
-    if (!bad) return RAD_SUCCESS;
-    for (i = 0; i < n; ++i) {
-        const float x = v[i];
-        if (!rad__finite(x)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (not finite)", what, (unsigned long long)i, (double)x);
-            return RAD_ERROR_NON_FINITE;
-        }
-        if (x > vmax || x < -vmax || (nonneg && x < 0.0f)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: %s: entry %llu is %g (%s)", what, (unsigned long long)i, (double)x,
-                     nonneg && x < 0.0f ? "negative" : "beyond RAD_BAKE_VALUE_MAX = 1e30");
-            return RAD_ERROR_CORRUPT;
-        }
-    }
-    return RAD_SUCCESS; /* not reached */
 }
 
 static int rad__all_finite(const float *v, uint64_t n)
@@ -12523,7 +12698,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
     FILE *f;
     long len;
     void *buf;
-    unsigned char head[64];
+    unsigned char head[RAD__HEADER_BYTES];
     size_t got;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -12554,10 +12729,10 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
         rad__log(&c, RAD_LOG_ERROR, "cannot size '%s'", path);
         return RAD_ERROR_IO;
     }
-    if (rad__get64(head + 24) > (uint64_t)len) {
+    if (rad__get64(head + RAD__H_FILE_SIZE) > (uint64_t)len) {
         fclose(f);
         rad__log(&c, RAD_LOG_ERROR, "'%s' has %ld bytes, its header says %llu: the file is truncated", path, len,
-                 (unsigned long long)rad__get64(head + 24));
+                 (unsigned long long)rad__get64(head + RAD__H_FILE_SIZE));
         return RAD_ERROR_TRUNCATED;
     }
     buf = rad__alloc(&c.allocator, (size_t)len);
@@ -12580,6 +12755,9 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
 /* ======================================================================================== */
 /* >>glsl: GLSL compute kernels (generated sources, access)                                 */
 /* ======================================================================================== */
+
+/* a rad_output passes to the kernels unchanged as their TOTAL bit */
+typedef char rad__check_glsl_output_flag[(RAD_GLSL_FLAG_TOTAL == (uint32_t)RAD_OUTPUT_TOTAL) ? 1 : -1];
 
 /* push-constant mirrors: the GLSL blocks are 4-byte members in declaration order */
 typedef char rad__check_glsl_dense_push[(sizeof(rad_glsl_gather_dense_push) == 20 &&
@@ -12620,6 +12798,8 @@ typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 
 typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28 &&
                                          offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
                                          offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
+
+#ifndef RAD_NO_GLSL
 
 typedef struct rad__glsl_entry {
     const char *name;
@@ -13908,19 +14088,39 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
     return RAD_SUCCESS;
 }
 
+#else /* RAD_NO_GLSL: the kernels' text is left out; the ids and the functions stay */
+
+RAD_API const char *rad_glsl_name(rad_glsl_id id)
+{
+    (void)id;
+    return NULL;
+}
+
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
+{
+    (void)id;
+    if (out_count) *out_count = 0;
+    return NULL;
+}
+
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
+{
+    (void)id;
+    (void)dst;
+    (void)dst_size;
+    if (out_length) *out_length = 0;
+    return RAD_ERROR_UNAVAILABLE;
+}
+
+#endif /* RAD_NO_GLSL */
+
 /* ======================================================================================== */
-/* >>multibounce: multi-bounce matrix, GEMM, binary16, BC1/BC4, compression, container      */
+/* >>kernels: shared numeric kernels (binary16, dot products, GEMM)                        */
 /* ======================================================================================== */
 
-#if defined(RAD__AVX) && defined(__AVX2__)
-#  define RAD__MB_AVX2 1
-#endif
-#if defined(RAD__AVX) && defined(__FMA__)
-#  define RAD__MB_FMA 1
-#endif
-#if defined(RAD__AVX) && defined(__F16C__)
-#  define RAD__MB_F16C 1
-#endif
+/* Used by more than one method (>>multibounce builds F_mb with the GEMM and applies it with
+   the dots; >>local builds its matrix with the same GEMM; the half conversions serve the
+   binary16 planes and their GLSL path). */
 
 #if defined(RAD__MB_FMA)
 #  define RAD__MB_MADD(a, b, c) _mm256_fmadd_ps(a, b, c)
@@ -13930,11 +14130,11 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #  define RAD__MB_MADD4(a, b, c) _mm_add_ps(c, _mm_mul_ps(a, b))
 #endif
 
-#define RAD__MB_MR 6u
-#define RAD__MB_NR 16u
-#define RAD__MB_KC 256u
-#define RAD__MB_MC 96u
-#define RAD__MB_NC 2048u
+#define RAD__GEMM_MR 6u
+#define RAD__GEMM_NR 16u
+#define RAD__GEMM_KC 256u
+#define RAD__GEMM_MC 96u
+#define RAD__GEMM_NC 2048u
 
 /* ---- binary16 ---- */
 
@@ -13975,7 +14175,170 @@ RAD_API float rad_half_to_float(uint16_t value)
     return f;
 }
 
-/* ---- objects ---- */
+/* ---- dot products ---- */
+
+static float rad__dot_f32(const float *a, const float *x, uint32_t n)
+{
+    uint32_t j = 0;
+    float s = 0.0f;
+#if defined(RAD__AVX)
+    {
+        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
+        for (; j + 32 <= n; j += 32) {
+            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(x + j)));
+            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_loadu_ps(a + j + 8), _mm256_loadu_ps(x + j + 8)));
+            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_loadu_ps(a + j + 16), _mm256_loadu_ps(x + j + 16)));
+            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_loadu_ps(a + j + 24), _mm256_loadu_ps(x + j + 24)));
+        }
+        s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
+    }
+#endif
+    for (; j < n; ++j) s += a[j] * x[j];
+    return s;
+}
+
+static float rad__dot_f16(const uint16_t *a, const float *x, uint32_t n)
+{
+    uint32_t j = 0;
+    float s = 0.0f;
+#if defined(RAD__MB_F16C)
+    {
+        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
+        for (; j + 32 <= n; j += 32) {
+            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j))), _mm256_loadu_ps(x + j)));
+            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 8))), _mm256_loadu_ps(x + j + 8)));
+            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 16))), _mm256_loadu_ps(x + j + 16)));
+            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 24))), _mm256_loadu_ps(x + j + 24)));
+        }
+        s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
+    }
+#endif
+    for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
+    return s;
+}
+
+/* ---- GEMM: C (m x n) += A (m x k) B (k x n), row-major, packed and cache-blocked ---- */
+
+typedef struct rad__gemm {
+    const float *A, *B;
+    float *C;
+    size_t lda, ldb, ldc;
+    uint32_t m, n, k;
+    uint32_t pc, kc, jc, nc;
+    const float *bp;   /* packed B block: ceil(nc/NR) panels of kc x NR */
+    float *ap;         /* packed A: one MC x KC slab per row chunk */
+} rad__gemm;
+
+static void rad__gemm_kernel(uint32_t kc, const float *a, const float *b, float *c, size_t ldc, uint32_t mr, uint32_t nr)
+{
+    uint32_t i, j, p;
+#if defined(RAD__AVX)
+    __m256 c0[RAD__GEMM_MR], c1[RAD__GEMM_MR];
+    float tmp[RAD__GEMM_MR][RAD__GEMM_NR];
+    for (i = 0; i < RAD__GEMM_MR; ++i) { c0[i] = _mm256_setzero_ps(); c1[i] = _mm256_setzero_ps(); }
+    for (p = 0; p < kc; ++p) {
+        __m256 b0 = _mm256_loadu_ps(b + (size_t)p * RAD__GEMM_NR), b1 = _mm256_loadu_ps(b + (size_t)p * RAD__GEMM_NR + 8);
+        const float *ap = a + (size_t)p * RAD__GEMM_MR;
+        for (i = 0; i < RAD__GEMM_MR; ++i) {
+            __m256 av = _mm256_broadcast_ss(ap + i);
+#if defined(RAD__MB_FMA)
+            c0[i] = _mm256_fmadd_ps(av, b0, c0[i]);
+            c1[i] = _mm256_fmadd_ps(av, b1, c1[i]);
+#else
+            c0[i] = _mm256_add_ps(c0[i], _mm256_mul_ps(av, b0));
+            c1[i] = _mm256_add_ps(c1[i], _mm256_mul_ps(av, b1));
+#endif
+        }
+    }
+    if (mr == RAD__GEMM_MR && nr == RAD__GEMM_NR) {
+        for (i = 0; i < RAD__GEMM_MR; ++i) {
+            float *ci = c + (size_t)i * ldc;
+            _mm256_storeu_ps(ci, _mm256_add_ps(_mm256_loadu_ps(ci), c0[i]));
+            _mm256_storeu_ps(ci + 8, _mm256_add_ps(_mm256_loadu_ps(ci + 8), c1[i]));
+        }
+        return;
+    }
+    for (i = 0; i < RAD__GEMM_MR; ++i) { _mm256_storeu_ps(tmp[i], c0[i]); _mm256_storeu_ps(tmp[i] + 8, c1[i]); }
+#else
+    float tmp[RAD__GEMM_MR][RAD__GEMM_NR];
+    memset(tmp, 0, sizeof(tmp));
+    for (p = 0; p < kc; ++p) {
+        const float *ap = a + (size_t)p * RAD__GEMM_MR, *bq = b + (size_t)p * RAD__GEMM_NR;
+        for (i = 0; i < RAD__GEMM_MR; ++i) {
+            float av = ap[i];
+            for (j = 0; j < RAD__GEMM_NR; ++j) tmp[i][j] += av * bq[j];
+        }
+    }
+#endif
+    for (i = 0; i < mr; ++i)
+        for (j = 0; j < nr; ++j) c[(size_t)i * ldc + j] += tmp[i][j];
+}
+
+static void rad__gemm_task(void *data, uint32_t t)
+{
+    const rad__gemm *g = (const rad__gemm *)data;
+    uint32_t ic = t * RAD__GEMM_MC, mc = g->m - ic < RAD__GEMM_MC ? g->m - ic : RAD__GEMM_MC, q, p, i, kk;
+    float *ap = g->ap + (size_t)t * RAD__GEMM_MC * RAD__GEMM_KC;
+    uint32_t panels_a = (mc + RAD__GEMM_MR - 1) / RAD__GEMM_MR, panels_b = (g->nc + RAD__GEMM_NR - 1) / RAD__GEMM_NR;
+    for (q = 0; q < panels_a; ++q)
+        for (kk = 0; kk < g->kc; ++kk)
+            for (i = 0; i < RAD__GEMM_MR; ++i) {
+                uint32_t row = q * RAD__GEMM_MR + i;
+                ap[((size_t)q * g->kc + kk) * RAD__GEMM_MR + i] = row < mc ? g->A[(size_t)(ic + row) * g->lda + g->pc + kk] : 0.0f;
+            }
+    for (p = 0; p < panels_b; ++p) {
+        uint32_t nr = g->nc - p * RAD__GEMM_NR < RAD__GEMM_NR ? g->nc - p * RAD__GEMM_NR : RAD__GEMM_NR;
+        for (q = 0; q < panels_a; ++q) {
+            uint32_t mr = mc - q * RAD__GEMM_MR < RAD__GEMM_MR ? mc - q * RAD__GEMM_MR : RAD__GEMM_MR;
+            rad__gemm_kernel(g->kc, ap + (size_t)q * g->kc * RAD__GEMM_MR, g->bp + (size_t)p * g->kc * RAD__GEMM_NR,
+                           g->C + (size_t)(ic + q * RAD__GEMM_MR) * g->ldc + g->jc + p * RAD__GEMM_NR, g->ldc, mr, nr);
+        }
+    }
+}
+
+/* C += A B. The summation order of every entry is fixed (k blocks in order), so the bits do
+   not depend on the number of tasks. */
+static rad_result rad__sgemm(const rad__ctx *c, uint32_t m, uint32_t n, uint32_t k, const float *A, size_t lda,
+                               const float *B, size_t ldb, float *C, size_t ldc)
+{
+    rad__gemm g;
+    float *bp, *ap;
+    uint32_t chunks = (m + RAD__GEMM_MC - 1) / RAD__GEMM_MC, jc, pc;
+    size_t bp_count = (size_t)RAD__GEMM_KC * (RAD__GEMM_NC + RAD__GEMM_NR), ap_count;
+    if (m == 0 || n == 0 || k == 0) return RAD_SUCCESS;
+    if (!rad__mul((size_t)chunks, (size_t)RAD__GEMM_MC * RAD__GEMM_KC, &ap_count)) return RAD_ERROR_SIZE_OVERFLOW;
+    bp = (float *)rad__alloc_array(&c->allocator, bp_count, sizeof(float));
+    ap = (float *)rad__alloc_array(&c->allocator, ap_count, sizeof(float));
+    if (!bp || !ap) { rad__free(&c->allocator, bp); rad__free(&c->allocator, ap); return RAD_ERROR_OUT_OF_MEMORY; }
+    g.A = A; g.B = B; g.C = C; g.lda = lda; g.ldb = ldb; g.ldc = ldc; g.m = m; g.n = n; g.k = k;
+    g.bp = bp; g.ap = ap;
+    for (jc = 0; jc < n; jc += RAD__GEMM_NC) {
+        g.jc = jc;
+        g.nc = n - jc < RAD__GEMM_NC ? n - jc : RAD__GEMM_NC;
+        for (pc = 0; pc < k; pc += RAD__GEMM_KC) {
+            uint32_t panels = (g.nc + RAD__GEMM_NR - 1) / RAD__GEMM_NR, p, kk, j;
+            g.pc = pc;
+            g.kc = k - pc < RAD__GEMM_KC ? k - pc : RAD__GEMM_KC;
+            for (p = 0; p < panels; ++p)
+                for (kk = 0; kk < g.kc; ++kk) {
+                    float *dst = bp + ((size_t)p * g.kc + kk) * RAD__GEMM_NR;
+                    const float *src = B + (size_t)(pc + kk) * ldb + jc + p * RAD__GEMM_NR;
+                    uint32_t cols = g.nc - p * RAD__GEMM_NR < RAD__GEMM_NR ? g.nc - p * RAD__GEMM_NR : RAD__GEMM_NR;
+                    for (j = 0; j < cols; ++j) dst[j] = src[j];
+                    for (; j < RAD__GEMM_NR; ++j) dst[j] = 0.0f;
+                }
+            c->parallel_for(c->parallel_user, chunks, rad__gemm_task, &g);
+        }
+    }
+    rad__free(&c->allocator, bp);
+    rad__free(&c->allocator, ap);
+    return RAD_SUCCESS;
+}
+
+/* ======================================================================================== */
+/* >>multibounce: multi-bounce matrix, BC1/BC4 compression, container sections             */
+/* ======================================================================================== */
+
 
 RAD_API void rad_multibounce_options_default(rad_multibounce_options *o)
 {
@@ -14050,124 +14413,6 @@ static void rad__mb_info(uint32_t *info, uint32_t kind, uint32_t n, uint32_t k, 
     info[6] = flags;
 }
 
-/* ---- GEMM: C (m x n) += A (m x k) B (k x n), row-major, packed and cache-blocked ---- */
-
-typedef struct rad__gemm {
-    const float *A, *B;
-    float *C;
-    size_t lda, ldb, ldc;
-    uint32_t m, n, k;
-    uint32_t pc, kc, jc, nc;
-    const float *bp;   /* packed B block: ceil(nc/NR) panels of kc x NR */
-    float *ap;         /* packed A: one MC x KC slab per row chunk */
-} rad__gemm;
-
-static void rad__mb_kernel(uint32_t kc, const float *a, const float *b, float *c, size_t ldc, uint32_t mr, uint32_t nr)
-{
-    uint32_t i, j, p;
-#if defined(RAD__AVX)
-    __m256 c0[RAD__MB_MR], c1[RAD__MB_MR];
-    float tmp[RAD__MB_MR][RAD__MB_NR];
-    for (i = 0; i < RAD__MB_MR; ++i) { c0[i] = _mm256_setzero_ps(); c1[i] = _mm256_setzero_ps(); }
-    for (p = 0; p < kc; ++p) {
-        __m256 b0 = _mm256_loadu_ps(b + (size_t)p * RAD__MB_NR), b1 = _mm256_loadu_ps(b + (size_t)p * RAD__MB_NR + 8);
-        const float *ap = a + (size_t)p * RAD__MB_MR;
-        for (i = 0; i < RAD__MB_MR; ++i) {
-            __m256 av = _mm256_broadcast_ss(ap + i);
-#if defined(RAD__MB_FMA)
-            c0[i] = _mm256_fmadd_ps(av, b0, c0[i]);
-            c1[i] = _mm256_fmadd_ps(av, b1, c1[i]);
-#else
-            c0[i] = _mm256_add_ps(c0[i], _mm256_mul_ps(av, b0));
-            c1[i] = _mm256_add_ps(c1[i], _mm256_mul_ps(av, b1));
-#endif
-        }
-    }
-    if (mr == RAD__MB_MR && nr == RAD__MB_NR) {
-        for (i = 0; i < RAD__MB_MR; ++i) {
-            float *ci = c + (size_t)i * ldc;
-            _mm256_storeu_ps(ci, _mm256_add_ps(_mm256_loadu_ps(ci), c0[i]));
-            _mm256_storeu_ps(ci + 8, _mm256_add_ps(_mm256_loadu_ps(ci + 8), c1[i]));
-        }
-        return;
-    }
-    for (i = 0; i < RAD__MB_MR; ++i) { _mm256_storeu_ps(tmp[i], c0[i]); _mm256_storeu_ps(tmp[i] + 8, c1[i]); }
-#else
-    float tmp[RAD__MB_MR][RAD__MB_NR];
-    memset(tmp, 0, sizeof(tmp));
-    for (p = 0; p < kc; ++p) {
-        const float *ap = a + (size_t)p * RAD__MB_MR, *bq = b + (size_t)p * RAD__MB_NR;
-        for (i = 0; i < RAD__MB_MR; ++i) {
-            float av = ap[i];
-            for (j = 0; j < RAD__MB_NR; ++j) tmp[i][j] += av * bq[j];
-        }
-    }
-#endif
-    for (i = 0; i < mr; ++i)
-        for (j = 0; j < nr; ++j) c[(size_t)i * ldc + j] += tmp[i][j];
-}
-
-static void rad__gemm_task(void *data, uint32_t t)
-{
-    const rad__gemm *g = (const rad__gemm *)data;
-    uint32_t ic = t * RAD__MB_MC, mc = g->m - ic < RAD__MB_MC ? g->m - ic : RAD__MB_MC, q, p, i, kk;
-    float *ap = g->ap + (size_t)t * RAD__MB_MC * RAD__MB_KC;
-    uint32_t panels_a = (mc + RAD__MB_MR - 1) / RAD__MB_MR, panels_b = (g->nc + RAD__MB_NR - 1) / RAD__MB_NR;
-    for (q = 0; q < panels_a; ++q)
-        for (kk = 0; kk < g->kc; ++kk)
-            for (i = 0; i < RAD__MB_MR; ++i) {
-                uint32_t row = q * RAD__MB_MR + i;
-                ap[((size_t)q * g->kc + kk) * RAD__MB_MR + i] = row < mc ? g->A[(size_t)(ic + row) * g->lda + g->pc + kk] : 0.0f;
-            }
-    for (p = 0; p < panels_b; ++p) {
-        uint32_t nr = g->nc - p * RAD__MB_NR < RAD__MB_NR ? g->nc - p * RAD__MB_NR : RAD__MB_NR;
-        for (q = 0; q < panels_a; ++q) {
-            uint32_t mr = mc - q * RAD__MB_MR < RAD__MB_MR ? mc - q * RAD__MB_MR : RAD__MB_MR;
-            rad__mb_kernel(g->kc, ap + (size_t)q * g->kc * RAD__MB_MR, g->bp + (size_t)p * g->kc * RAD__MB_NR,
-                           g->C + (size_t)(ic + q * RAD__MB_MR) * g->ldc + g->jc + p * RAD__MB_NR, g->ldc, mr, nr);
-        }
-    }
-}
-
-/* C += A B. The summation order of every entry is fixed (k blocks in order), so the bits do
-   not depend on the number of tasks. */
-static rad_result rad__mb_gemm(const rad__ctx *c, uint32_t m, uint32_t n, uint32_t k, const float *A, size_t lda,
-                               const float *B, size_t ldb, float *C, size_t ldc)
-{
-    rad__gemm g;
-    float *bp, *ap;
-    uint32_t chunks = (m + RAD__MB_MC - 1) / RAD__MB_MC, jc, pc;
-    size_t bp_count = (size_t)RAD__MB_KC * (RAD__MB_NC + RAD__MB_NR), ap_count;
-    if (m == 0 || n == 0 || k == 0) return RAD_SUCCESS;
-    if (!rad__mul((size_t)chunks, (size_t)RAD__MB_MC * RAD__MB_KC, &ap_count)) return RAD_ERROR_SIZE_OVERFLOW;
-    bp = (float *)rad__alloc_array(&c->allocator, bp_count, sizeof(float));
-    ap = (float *)rad__alloc_array(&c->allocator, ap_count, sizeof(float));
-    if (!bp || !ap) { rad__free(&c->allocator, bp); rad__free(&c->allocator, ap); return RAD_ERROR_OUT_OF_MEMORY; }
-    g.A = A; g.B = B; g.C = C; g.lda = lda; g.ldb = ldb; g.ldc = ldc; g.m = m; g.n = n; g.k = k;
-    g.bp = bp; g.ap = ap;
-    for (jc = 0; jc < n; jc += RAD__MB_NC) {
-        g.jc = jc;
-        g.nc = n - jc < RAD__MB_NC ? n - jc : RAD__MB_NC;
-        for (pc = 0; pc < k; pc += RAD__MB_KC) {
-            uint32_t panels = (g.nc + RAD__MB_NR - 1) / RAD__MB_NR, p, kk, j;
-            g.pc = pc;
-            g.kc = k - pc < RAD__MB_KC ? k - pc : RAD__MB_KC;
-            for (p = 0; p < panels; ++p)
-                for (kk = 0; kk < g.kc; ++kk) {
-                    float *dst = bp + ((size_t)p * g.kc + kk) * RAD__MB_NR;
-                    const float *src = B + (size_t)(pc + kk) * ldb + jc + p * RAD__MB_NR;
-                    uint32_t cols = g.nc - p * RAD__MB_NR < RAD__MB_NR ? g.nc - p * RAD__MB_NR : RAD__MB_NR;
-                    for (j = 0; j < cols; ++j) dst[j] = src[j];
-                    for (; j < RAD__MB_NR; ++j) dst[j] = 0.0f;
-                }
-            c->parallel_for(c->parallel_user, chunks, rad__gemm_task, &g);
-        }
-    }
-    rad__free(&c->allocator, bp);
-    rad__free(&c->allocator, ap);
-    return RAD_SUCCESS;
-}
-
 /* ---- building F_mb ---- */
 
 static double rad__mb_max_row_sum(const float *M, uint32_t n)
@@ -14195,7 +14440,7 @@ static rad_result rad__mb_product(rad__mb_build *b, float *dst, const float *add
     rad_result r;
     if (add) memcpy(dst, add, b->nn * sizeof(float));
     else memset(dst, 0, b->nn * sizeof(float));
-    r = rad__mb_gemm(b->c, b->n, b->n, b->n, X, b->n, Y, b->n, dst, b->n);
+    r = rad__sgemm(b->c, b->n, b->n, b->n, X, b->n, Y, b->n, dst, b->n);
     if (r != RAD_SUCCESS) return r;
     ++b->products;
     if (b->c->progress && b->c->progress(b->c->progress_user, b->total ? (float)b->products / (float)b->total : 0.5f))
@@ -14418,52 +14663,6 @@ RAD_API rad_result rad_multibounce_convert(const rad_multibounce *src, rad_mb_pr
 
 /* ---- applying F_mb ---- */
 
-static float rad__mb_dot(const float *a, const float *x, uint32_t n)
-{
-    uint32_t j = 0;
-    float s = 0.0f;
-#if defined(RAD__AVX)
-    {
-        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        float t[8];
-        int k;
-        for (; j + 32 <= n; j += 32) {
-            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(x + j)));
-            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_loadu_ps(a + j + 8), _mm256_loadu_ps(x + j + 8)));
-            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_loadu_ps(a + j + 16), _mm256_loadu_ps(x + j + 16)));
-            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_loadu_ps(a + j + 24), _mm256_loadu_ps(x + j + 24)));
-        }
-        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-        for (k = 0; k < 8; ++k) s += t[k];
-    }
-#endif
-    for (; j < n; ++j) s += a[j] * x[j];
-    return s;
-}
-
-static float rad__mb_dot_half(const uint16_t *a, const float *x, uint32_t n)
-{
-    uint32_t j = 0;
-    float s = 0.0f;
-#if defined(RAD__MB_F16C)
-    {
-        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        float t[8];
-        int k;
-        for (; j + 32 <= n; j += 32) {
-            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j))), _mm256_loadu_ps(x + j)));
-            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 8))), _mm256_loadu_ps(x + j + 8)));
-            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 16))), _mm256_loadu_ps(x + j + 16)));
-            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 24))), _mm256_loadu_ps(x + j + 24)));
-        }
-        _mm256_storeu_ps(t, _mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-        for (k = 0; k < 8; ++k) s += t[k];
-    }
-#endif
-    for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
-    return s;
-}
-
 typedef struct rad__mb_apply {
     const rad_multibounce *mb;
     const float *x;    /* 3 n, SoA, permuted column order */
@@ -14481,8 +14680,8 @@ static void rad__mb_apply_task(void *data, uint32_t t)
     for (ch = 0; ch < 3; ++ch)
         for (i = i0; i < i1; ++i) {
             size_t at = ch * nn + (size_t)i * n;
-            a->y[ch * (size_t)n + i] = a->mb->planes ? rad__mb_dot(a->mb->planes + at, a->x + ch * (size_t)n, n)
-                                                     : rad__mb_dot_half(a->mb->half + at, a->x + ch * (size_t)n, n);
+            a->y[ch * (size_t)n + i] = a->mb->planes ? rad__dot_f32(a->mb->planes + at, a->x + ch * (size_t)n, n)
+                                                     : rad__dot_f16(a->mb->half + at, a->x + ch * (size_t)n, n);
         }
 }
 
@@ -14836,7 +15035,7 @@ static rad_result rad__mb_reorder_perms(const rad__ctx *c, const float *W, uint3
         for (s = 0; s < samples; ++s)
             for (i = 0; i < n; ++i) XT[(size_t)i * samples + s] = X[(size_t)s * n + i];
         memset(G, 0, nn * sizeof(float));
-        r = rad__mb_gemm(c, n, n, samples, XT, samples, X, n, G, n);
+        r = rad__sgemm(c, n, n, samples, XT, samples, X, n, G, n);
         if (method == RAD_REORDER_MATCH) {
             if (r == RAD_SUCCESS) r = rad__mb_distances(c, G, n);
             if (r == RAD_SUCCESS) r = rad__mb_match_groups(c, G, n, pass == 0 ? col_perm : row_perm);
@@ -15250,6 +15449,21 @@ static rad_result rad__mb_select(const rad__ctx *c, const float *W, size_t nn, u
     return RAD_SUCCESS;
 }
 
+/* 1 when entry 'at' of the planes W (nn entries each) is an outlier: its largest channel
+   magnitude has bits above T, or equal to T while fewer than take_equal ties are taken
+   (*taken counts them; both passes scan in row-major order, so they take the same entries). */
+static int rad__mb_is_outlier(const float *W, size_t nn, size_t at, uint32_t T, uint64_t take_equal, uint64_t *taken)
+{
+    float m = fabsf(W[at]);
+    uint32_t u;
+    if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
+    if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
+    u = rad__f32_bits(m);
+    if (u < T || (u == T && *taken >= take_equal)) return 0;
+    if (u == T) ++*taken;
+    return 1;
+}
+
 RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
                                                  const rad_context *ctx, rad_multibounce_blocks **out,
                                                  rad_block_report *report)
@@ -15308,15 +15522,7 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     for (i = 0; i < n; ++i) {
         uint64_t k = 0;
         if (target > 0)
-            for (j = 0; j < n; ++j) {
-                size_t at = (size_t)i * n + j;
-                float m = fabsf(W[at]);
-                uint32_t u;
-                if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
-                if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
-                u = rad__f32_bits(m);
-                if (u > T || (u == T && taken < take_equal)) { if (u == T) ++taken; ++k; }
-            }
+            for (j = 0; j < n; ++j) k += (uint64_t)rad__mb_is_outlier(W, nn, (size_t)i * n + j, T, take_equal, &taken);
         row_count[i + 1] = row_count[i] + k;
     }
     count = row_count[n];
@@ -15354,13 +15560,7 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
         for (i = 0; i < n; ++i)
             for (j = 0; j < n; ++j) {
                 size_t at = (size_t)i * n + j;
-                float m = fabsf(W[at]);
-                uint32_t u;
-                if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
-                if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
-                u = rad__f32_bits(m);
-                if (u > T || (u == T && taken < take_equal)) {
-                    if (u == T) ++taken;
+                if (rad__mb_is_outlier(W, nn, at, T, take_equal, &taken)) {
                     cols[k] = j;
                     for (ch = 0; ch < 3; ++ch) { vals[3 * k + ch] = W[ch * nn + at]; W[ch * nn + at] = 0.0f; }
                     ++k;
@@ -16263,15 +16463,157 @@ RAD_API void rad_row_stream_source(rad_row_stream *s, rad_row_source *out)
 
 RAD_API size_t rad_row_stream_memory(const rad_row_stream *s) { return s ? s->bytes : 0; }
 
+/* The sections a row stream reads, the first of each type. */
+enum { RAD__SL_PATCHES, RAD__SL_OFFSETS, RAD__SL_COLUMNS, RAD__SL_VALUES, RAD__SL_VP_AREAS, RAD__SL_VP_ALBEDO, RAD__SL_COUNT };
+
+typedef struct rad__stream_layout {
+    rad__entry at[RAD__SL_COUNT];
+    uint32_t found;   /* a bit per slot */
+    int vps;          /* a saved virtual-patch set: its areas and albedos stand for the patches */
+} rad__stream_layout;
+
+/* Stage 1 of rad_row_stream_open: the header and the section table, checked as
+   rad_container_open checks them (the same rad__header_parse). *out_table is the table. */
+static rad_result rad__stream_table(FILE *f, uint64_t actual, const rad__ctx *c, const char *who, rad__header *h,
+                                    unsigned char **out_table)
+{
+    unsigned char head[RAD__HEADER_BYTES], *table;
+    rad_result r;
+    *out_table = NULL;
+    if (actual < RAD__HEADER_BYTES || !rad__stream_read(f, 0, head, RAD__HEADER_BYTES)) {
+        rad__log(c, RAD_LOG_ERROR, "%s: shorter than the container header", who);
+        return RAD_ERROR_TRUNCATED;
+    }
+    if ((r = rad__header_parse(head, actual, c, who, h)) != RAD_SUCCESS) return r;
+    table = (unsigned char *)rad__alloc_array(&c->allocator, h->count ? h->count : 1u, RAD__ENTRY_BYTES);
+    if (!table) return RAD_ERROR_OUT_OF_MEMORY;
+    if (!rad__stream_read(f, RAD__HEADER_BYTES, table, (size_t)RAD__ENTRY_BYTES * h->count)) r = RAD_ERROR_IO;
+    else r = rad__table_check(head, table, h->count, c, who);
+    if (r != RAD_SUCCESS) {
+        rad__free(&c->allocator, table);
+        return r;
+    }
+    *out_table = table;
+    return RAD_SUCCESS;
+}
+
+/* Stage 2: finds the patches (or a virtual-patch set's areas and albedos) and the CSR matrix
+   in the table. */
+static rad_result rad__stream_find(const unsigned char *table, const rad__header *h, const rad__ctx *c, const char *who,
+                                   rad__stream_layout *L)
+{
+    static const uint32_t type[RAD__SL_COUNT] = { RAD_SECTION_PATCHES, RAD_SECTION_FF_ROW_OFFSETS, RAD_SECTION_FF_COLUMNS,
+                                                   RAD_SECTION_FF_VALUES, RAD_SECTION_VP_AREAS, RAD_SECTION_VP_ALBEDO };
+    static const uint32_t elem[RAD__SL_COUNT] = { (uint32_t)sizeof(rad_patch), 8u, 4u, 4u, 4u, 12u };
+    const rad__entry *at = L->at;
+    uint32_t i, slot;
+    memset(L, 0, sizeof(*L));
+    for (i = 0; i < h->count; ++i) {
+        rad__entry x;
+        const char *why = rad__entry_parse(table + (size_t)RAD__ENTRY_BYTES * i, h, &x);
+        for (slot = 0; slot < RAD__SL_COUNT && type[slot] != x.type; ++slot) {}
+        if (!why && (slot == RAD__SL_COUNT || (L->found & (1u << slot)))) continue;
+        if (!why && x.elem_size != elem[slot]) why = "an element size this section type does not have";
+        if (why) {
+            rad__log(c, RAD_LOG_ERROR, "%s: section %u (type %u): %s", who, i, x.type, why);
+            return RAD_ERROR_CORRUPT;
+        }
+        L->at[slot] = x;
+        L->found |= 1u << slot;
+    }
+    if (!(L->found & (1u << RAD__SL_PATCHES)) && (L->found >> RAD__SL_VP_AREAS) == 3u &&
+        at[RAD__SL_VP_AREAS].count == at[RAD__SL_VP_ALBEDO].count) {
+        L->vps = 1;
+        L->at[RAD__SL_PATCHES] = at[RAD__SL_VP_AREAS];
+        L->found |= 1u << RAD__SL_PATCHES;
+    }
+    if ((L->found & 15u) != 15u || at[0].count == 0 || at[0].count > 0xFFFFFFFEu || at[1].count != at[0].count + 1 ||
+        at[2].count != at[3].count) {
+        rad__log(c, RAD_LOG_ERROR, "%s holds no patches with a CSR form-factor matrix of matching size", who);
+        return (L->found & 15u) != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
+    }
+    return RAD_SUCCESS;
+}
+
+/* Stage 3: reads what the stream keeps in memory (areas, albedos, row offsets), checks their
+   checksums and values. */
+static rad_result rad__stream_patches(rad_row_stream *s, const rad__stream_layout *L, const rad__ctx *c, const char *who)
+{
+    const rad__entry *at = L->at;
+    const int vps = L->vps;
+    const size_t rec = vps ? 12u : sizeof(rad_patch);
+    unsigned char *buf;
+    rad_result r = RAD_SUCCESS;
+    uint32_t i, k;
+    s->n = (uint32_t)at[RAD__SL_PATCHES].count;
+    s->col_at = at[RAD__SL_COLUMNS].offset;
+    s->val_at = at[RAD__SL_VALUES].offset;
+    s->areas = (float *)rad__alloc_array(&c->allocator, s->n, sizeof(float));
+    s->albedo = (float *)rad__alloc_array(&c->allocator, s->n, 3 * sizeof(float));
+    s->offsets = (uint64_t *)rad__alloc_array(&c->allocator, (size_t)s->n + 1u, sizeof(uint64_t));
+    buf = (unsigned char *)rad__alloc_array(&c->allocator, s->n, rec);
+    if (!s->areas || !s->albedo || !s->offsets || !buf) {
+        rad__free(&c->allocator, buf);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    s->bytes = sizeof(*s) + (size_t)s->n * 16u + ((size_t)s->n + 1u) * 8u;
+    if (!rad__stream_read(s->f, at[RAD__SL_PATCHES].offset, vps ? (void *)s->areas : (void *)buf, (size_t)s->n * (vps ? 4u : rec)) ||
+        (vps && !rad__stream_read(s->f, at[RAD__SL_VP_ALBEDO].offset, buf, (size_t)s->n * 12u)) ||
+        !rad__stream_read(s->f, at[RAD__SL_OFFSETS].offset, s->offsets, ((size_t)s->n + 1u) * 8u)) {
+        rad__free(&c->allocator, buf);
+        return RAD_ERROR_IO;
+    }
+    if ((vps ? rad__crc32((const unsigned char *)s->areas, (size_t)s->n * 4u) != at[RAD__SL_PATCHES].crc ||
+                   rad__crc32(buf, (size_t)s->n * 12u) != at[RAD__SL_VP_ALBEDO].crc
+             : rad__crc32(buf, (size_t)s->n * rec) != at[RAD__SL_PATCHES].crc) ||
+        rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != at[RAD__SL_OFFSETS].crc) {
+        rad__log(c, RAD_LOG_ERROR, "%s: checksum mismatch in the patches or the row offsets", who);
+        rad__free(&c->allocator, buf);
+        return RAD_ERROR_CORRUPT;
+    }
+    for (i = 0; i < s->n && r == RAD_SUCCESS; ++i) {
+        if (vps) {
+            memcpy(s->albedo + 3 * (size_t)i, buf + 12u * (size_t)i, 12);
+        } else {
+            rad_patch p;
+            memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
+            s->areas[i] = p.area;
+            for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
+        }
+        for (k = 0; vps && k < 3 && r == RAD_SUCCESS; ++k) /* the patches' loader checked a classic bake's */
+            if (!(s->albedo[3 * (size_t)i + k] >= 0.0f && s->albedo[3 * (size_t)i + k] < 1.0f)) {
+                rad__log(c, RAD_LOG_ERROR, "%s: patch %u has albedo %g (must be in [0, 1))", who, i,
+                         (double)s->albedo[3 * (size_t)i + k]);
+                r = RAD_ERROR_ALBEDO_RANGE;
+            }
+        if (r == RAD_SUCCESS && vps && (!(s->areas[i] > 0.0f) || !rad__finite(s->areas[i]))) {
+            rad__log(c, RAD_LOG_ERROR, "%s: patch %u has area %g", who, i, (double)s->areas[i]);
+            r = RAD_ERROR_CORRUPT;
+        }
+        if (r == RAD_SUCCESS && s->offsets[i + 1] < s->offsets[i]) {
+            rad__log(c, RAD_LOG_ERROR, "%s: row offsets decrease at row %u", who, i);
+            r = RAD_ERROR_CORRUPT;
+        }
+    }
+    if (r == RAD_SUCCESS && (s->offsets[0] != 0 || s->offsets[s->n] != at[RAD__SL_COLUMNS].count)) {
+        rad__log(c, RAD_LOG_ERROR, "%s: row offsets do not span the %llu entries", who,
+                 (unsigned long long)at[RAD__SL_COLUMNS].count);
+        r = RAD_ERROR_CORRUPT;
+    }
+    rad__free(&c->allocator, buf);
+    return r;
+}
+
 RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx, rad_row_stream **out)
 {
     rad__ctx c;
     rad_row_stream *s;
-    unsigned char head[RAD__HEADER_BYTES], *table = NULL, *buf = NULL;
-    uint64_t file_size, actual, off[6] = {0, 0, 0, 0, 0, 0}, cnt[6] = {0, 0, 0, 0, 0, 0};
-    uint32_t count, i, crc[6] = {0, 0, 0, 0, 0, 0}, found = 0, vps = 0;
+    unsigned char *table = NULL;
+    rad__header h;
+    rad__stream_layout L;
+    char who[288];
     long end;
-    rad_result r = RAD_SUCCESS;
+    rad_result r;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
@@ -16287,146 +16629,19 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
         rad_row_stream_close(s);
         return RAD_ERROR_IO;
     }
-    if (fseek(s->f, 0, SEEK_END) != 0 || (end = ftell(s->f)) < 0) { r = RAD_ERROR_IO; goto fail; }
-    actual = (uint64_t)end;
-    if (actual < RAD__HEADER_BYTES || !rad__stream_read(s->f, 0, head, RAD__HEADER_BYTES)) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' is shorter than the container header", path);
-        r = RAD_ERROR_TRUNCATED;
-        goto fail;
-    }
-    if (memcmp(head, "RADB", 4) != 0 || rad__get32(head + 60) != rad__crc32(head, 60)) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': no RADB magic or a bad header checksum", path);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    if (rad__get32(head + 4) != RAD_CONTAINER_VERSION || (rad__get32(head + 32) & ~RAD__FLAG_BIG_ENDIAN) != 0u ||
-        ((rad__get32(head + 32) & RAD__FLAG_BIG_ENDIAN) != 0u) != rad__host_big_endian()) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': container version %u or byte order this build does not read", path,
-                 rad__get32(head + 4));
-        r = RAD_ERROR_VERSION;
-        goto fail;
-    }
-    count = rad__get32(head + 8);
-    file_size = rad__get64(head + 24);
-    if (rad__get64(head + 16) != RAD__HEADER_BYTES || count > 0x00FFFFFFu) { r = RAD_ERROR_CORRUPT; goto fail; }
-    if (file_size > actual) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' has %llu bytes, the container %llu", path, (unsigned long long)actual,
-                 (unsigned long long)file_size);
-        r = RAD_ERROR_TRUNCATED;
-        goto fail;
-    }
-    table = (unsigned char *)rad__alloc_array(&c.allocator, count ? count : 1u, RAD__ENTRY_BYTES);
-    if (!table) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
-    if ((uint64_t)RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count > file_size ||
-        !rad__stream_read(s->f, RAD__HEADER_BYTES, table, (size_t)RAD__ENTRY_BYTES * count)) {
-        r = RAD_ERROR_TRUNCATED;
-        goto fail;
-    }
-    if (rad__get32(head + 36) != rad__crc32(table, (size_t)RAD__ENTRY_BYTES * count)) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': section table checksum mismatch", path);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    /* 0: patches, 1: row offsets, 2: columns, 3: values (the first of each type) */
-    for (i = 0; i < count; ++i) {
-        const unsigned char *e = table + (size_t)RAD__ENTRY_BYTES * i;
-        uint32_t type = rad__get32(e), esz = rad__get32(e + 4), want, slot;
-        uint64_t n = rad__get64(e + 8), at = rad__get64(e + 16), bytes = rad__get64(e + 24);
-        if (type == RAD_SECTION_PATCHES) { slot = 0; want = (uint32_t)sizeof(rad_patch); }
-        else if (type == RAD_SECTION_VP_AREAS) { slot = 4; want = 4u; }
-        else if (type == RAD_SECTION_VP_ALBEDO) { slot = 5; want = 12u; }
-        else if (type == RAD_SECTION_FF_ROW_OFFSETS) { slot = 1; want = 8u; }
-        else if (type == RAD_SECTION_FF_COLUMNS) { slot = 2; want = 4u; }
-        else if (type == RAD_SECTION_FF_VALUES) { slot = 3; want = 4u; }
-        else continue;
-        if (found & (1u << slot)) continue;
-        if (esz != want || n > UINT64_MAX / esz || n * esz != bytes || bytes > file_size || at > file_size - bytes) {
-            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': section %u (type %u) has a bad size or extends past the end", path, i, type);
-            r = RAD_ERROR_CORRUPT;
-            goto fail;
-        }
-        off[slot] = at;
-        cnt[slot] = n;
-        crc[slot] = rad__get32(e + 32);
-        found |= 1u << slot;
-    }
-    /* a saved virtual-patch set (rad_vp_sections): its areas and albedos stand for the patches */
-    if (!(found & 1u) && (found & 48u) == 48u && cnt[4] == cnt[5]) {
-        vps = 1;
-        off[0] = off[4], cnt[0] = cnt[4], crc[0] = crc[4];
-        found |= 1u;
-    }
-    if ((found & 15u) != 15u || cnt[0] == 0 || cnt[0] > 0xFFFFFFFEu || cnt[1] != cnt[0] + 1 || cnt[2] != cnt[3]) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s' holds no patches with a CSR form-factor matrix of matching size", path);
-        r = (found & 15u) != 15u ? RAD_ERROR_INVALID_ARGUMENT : RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    s->n = (uint32_t)cnt[0];
-    s->col_at = off[2];
-    s->val_at = off[3];
-    s->areas = (float *)rad__alloc_array(&c.allocator, s->n, sizeof(float));
-    s->albedo = (float *)rad__alloc_array(&c.allocator, s->n, 3 * sizeof(float));
-    s->offsets = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)s->n + 1u, sizeof(uint64_t));
-    buf = (unsigned char *)rad__alloc_array(&c.allocator, s->n, vps ? 12u : sizeof(rad_patch));
-    if (!s->areas || !s->albedo || !s->offsets || !buf) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
-    s->bytes = sizeof(*s) + (size_t)s->n * 16u + ((size_t)s->n + 1u) * 8u;
-    if (!rad__stream_read(s->f, off[0], vps ? (void *)s->areas : (void *)buf, (size_t)s->n * (vps ? 4u : sizeof(rad_patch))) ||
-        (vps && !rad__stream_read(s->f, off[5], buf, (size_t)s->n * 12u)) ||
-        !rad__stream_read(s->f, off[1], s->offsets, ((size_t)s->n + 1u) * 8u)) {
-        r = RAD_ERROR_IO;
-        goto fail;
-    }
-    if ((vps ? rad__crc32((const unsigned char *)s->areas, (size_t)s->n * 4u) != crc[0] ||
-                   rad__crc32(buf, (size_t)s->n * 12u) != crc[5]
-             : rad__crc32(buf, (size_t)s->n * sizeof(rad_patch)) != crc[0]) ||
-        rad__crc32((const unsigned char *)s->offsets, ((size_t)s->n + 1u) * 8u) != crc[1]) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': checksum mismatch in the patches or the row offsets", path);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
-    for (i = 0; i < s->n; ++i) {
-        uint32_t k;
-        if (vps) {
-            memcpy(s->albedo + 3 * (size_t)i, buf + 12u * (size_t)i, 12);
-        } else {
-            rad_patch p;
-            memcpy(&p, buf + (size_t)i * sizeof(rad_patch), sizeof(rad_patch));
-            s->areas[i] = p.area;
-            for (k = 0; k < 3; ++k) s->albedo[3 * (size_t)i + k] = p.albedo[k];
-        }
-        for (k = 0; vps && k < 3; ++k) /* the patches' loader checked a classic bake's */
-            if (!(s->albedo[3 * (size_t)i + k] >= 0.0f && s->albedo[3 * (size_t)i + k] < 1.0f)) {
-                rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has albedo %g (must be in [0, 1))", path, i,
-                         (double)s->albedo[3 * (size_t)i + k]);
-                r = RAD_ERROR_ALBEDO_RANGE;
-                goto fail;
-            }
-        if (vps && (!(s->areas[i] > 0.0f) || !rad__finite(s->areas[i]))) {
-            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': patch %u has area %g", path, i, (double)s->areas[i]);
-            r = RAD_ERROR_CORRUPT;
-            goto fail;
-        }
-        if (s->offsets[i + 1] < s->offsets[i]) {
-            rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets decrease at row %u", path, i);
-            r = RAD_ERROR_CORRUPT;
-            goto fail;
-        }
-    }
-    if (s->offsets[0] != 0 || s->offsets[s->n] != cnt[2]) {
-        rad__log(&c, RAD_LOG_ERROR, "row stream: '%s': row offsets do not span the %llu entries", path, (unsigned long long)cnt[2]);
-        r = RAD_ERROR_CORRUPT;
-        goto fail;
-    }
+    snprintf(who, sizeof(who), "row stream: '%s'", path);
+    if (fseek(s->f, 0, SEEK_END) != 0 || (end = ftell(s->f)) < 0) r = RAD_ERROR_IO;
+    else if ((r = rad__stream_table(s->f, (uint64_t)end, &c, who, &h, &table)) == RAD_SUCCESS &&
+             (r = rad__stream_find(table, &h, &c, who, &L)) == RAD_SUCCESS)
+        r = rad__stream_patches(s, &L, &c, who);
     rad__free(&c.allocator, table);
-    rad__free(&c.allocator, buf);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_IO) rad__log(&c, RAD_LOG_ERROR, "row stream: reading '%s' failed", path);
+        rad_row_stream_close(s);
+        return r;
+    }
     *out = s;
     return RAD_SUCCESS;
-fail:
-    if (r == RAD_ERROR_IO) rad__log(&c, RAD_LOG_ERROR, "row stream: reading '%s' failed", path);
-    rad__free(&c.allocator, table);
-    rad__free(&c.allocator, buf);
-    rad_row_stream_close(s);
-    return r;
 }
 #endif
 
@@ -17060,10 +17275,10 @@ static rad_result rad__local_invert(const rad__ctx *c, float *X, uint32_t m, siz
         for (i = 0; i < m; ++i)
             for (j = 0; j < b; ++j) cbuf[(size_t)i * b + j] = (i >= kb && i < kb + b) ? 0.0f : -X[(size_t)i * ld + kb + j];
         memset(rp, 0, sizeof(float) * (size_t)b * m);
-        r = rad__mb_gemm(c, b, m, b, dinv, b, rbuf, m, rp, m);                 /* R' = D^-1 R */
-        if (r == RAD_SUCCESS) r = rad__mb_gemm(c, m, m, b, cbuf, b, rp, m, X, ld); /* O += (-C) R' */
+        r = rad__sgemm(c, b, m, b, dinv, b, rbuf, m, rp, m);                 /* R' = D^-1 R */
+        if (r == RAD_SUCCESS) r = rad__sgemm(c, m, m, b, cbuf, b, rp, m, X, ld); /* O += (-C) R' */
         memset(tmp, 0, sizeof(float) * (size_t)m * b);
-        if (r == RAD_SUCCESS) r = rad__mb_gemm(c, m, b, b, cbuf, b, dinv, b, tmp, b); /* C' = -C D^-1 */
+        if (r == RAD_SUCCESS) r = rad__sgemm(c, m, b, b, cbuf, b, dinv, b, tmp, b); /* C' = -C D^-1 */
         if (r != RAD_SUCCESS) break;
         for (i = 0; i < b; ++i)
             for (j = 0; j < m; ++j)
@@ -17191,7 +17406,7 @@ static void rad__local_apply_task(void *data, uint32_t t)
     rad__local_range(J->row_count, J->tasks, t, &r0, &r1);
     for (r = r0; r < r1; ++r)
         for (ch = 0; ch < 3; ++ch)
-            J->y[3 * (size_t)r + ch] = rad__mb_dot(J->st->planes + ch * MM + (size_t)J->rows[r] * J->M,
+            J->y[3 * (size_t)r + ch] = rad__dot_f32(J->st->planes + ch * MM + (size_t)J->rows[r] * J->M,
                                                    J->e + (size_t)ch * J->end, J->end);
 }
 
@@ -17899,7 +18114,7 @@ done:
     return r;
 }
 
-RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section out[3])
+RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section *out)
 {
     if (!out) return;
     memset(out, 0, 3 * sizeof(rad_section));
@@ -18137,9 +18352,6 @@ typedef struct rad__tstep {
 #else
 #  define RAD__PREFETCH(p) ((void)0)
 #  define RAD__HOT static inline
-#endif
-#if defined(RAD__AVX) && defined(__AVX2__) && (defined(__x86_64__) || defined(_M_X64))
-#  define RAD__TEMPORAL_AVX2 1 /* hashes 8 draws at once (rad__tpipe_issue8) */
 #endif
 /* draws whose bins are in flight ahead of the one resolved; AVX2 issues cheaper, so more of
    them can overlap */

@@ -612,6 +612,23 @@ static void ct_test_signature(void)
     ct_teardown(&f);
 }
 
+/* The one table of section ids: every id the library writes has the name of its enumerator,
+   the gaps between the ranges have none, user types are "USER". */
+static void ct_test_section_names(void)
+{
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_PATCHES), "PATCHES") == 0);
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_SIGNATURE), "SIGNATURE") == 0);
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_MB_INFO), "MB_INFO") == 0);
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_MB_OUTLIER_VALUES), "MB_OUTLIER_VALUES") == 0);
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_TEMPORAL_BINS), "TEMPORAL_BINS") == 0);
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_VP_INFO), "VP_INFO") == 0);
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_VP_SAMPLE_TRIANGLES), "VP_SAMPLE_TRIANGLES") == 0);
+    CHECK(strcmp(rad_section_type_name(RAD_SECTION_USER + 7u), "USER") == 0);
+    CHECK(rad_section_type_name(0) == NULL);
+    CHECK(rad_section_type_name(10) == NULL);
+    CHECK(rad_section_type_name(RAD_SECTION_VP_SAMPLE_TRIANGLES + 1u) == NULL);
+}
+
 static const rad_test_case tests_container[] = {
     { "container_round_trip", ct_test_round_trip },
     { "container_corruption", ct_test_corruption },
@@ -620,6 +637,7 @@ static const rad_test_case tests_container[] = {
     { "container_alloc_failure", ct_test_alloc_failure },
     { "container_bad_values", ct_test_bad_values },
     { "container_signature", ct_test_signature },
+    { "container_section_names", ct_test_section_names },
     { NULL, NULL }
 };
 

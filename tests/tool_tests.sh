@@ -432,7 +432,7 @@ if "$RAD" render cornell $M -o "$TMP/ref.pfm" > /dev/null 2> "$TMP/err.txt" &&
         grep -q "100 frames, temporal step .* ms per frame" "$TMP/err.txt" && ok "temporal prints the per-frame time" ||
             fail "temporal prints the per-frame time"
         "$RAD" info "$TMP/t.radb" > "$TMP/info.txt" 2>&1
-        grep -q "ALIAS_BINS" "$TMP/info.txt" && grep -q "method: temporal, --mode feedback, --k 10, --adaptive" "$TMP/info.txt" &&
+        grep -q "TEMPORAL_BINS" "$TMP/info.txt" && grep -q "method: temporal, --mode feedback, --k 10, --adaptive" "$TMP/info.txt" &&
             ok "info shows a temporal bake" || fail "info shows a temporal bake" "$(head -c 600 "$TMP/info.txt")"
         "$RAD" render cornell --method temporal --bake "$TMP/t.radb" --frames 4 $M -o "$TMP/t4.pfm" > /dev/null 2>&1
         p4=$(psnr_of "$TMP/ref.pfm" "$TMP/t4.pfm")

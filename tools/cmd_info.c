@@ -7,44 +7,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The library's name of a section type (rad_section_type_name), the tool's own user sections
+   by what they hold. */
 static const char *type_name(uint32_t type)
 {
+    const char *name;
     switch (type) {
-    case RAD_SECTION_PATCHES: return "PATCHES";
-    case RAD_SECTION_PATCH_VERTICES: return "PATCH_VERTICES";
-    case RAD_SECTION_TRIANGLES: return "TRIANGLES";
-    case RAD_SECTION_FF_DENSE: return "FF_DENSE";
-    case RAD_SECTION_FF_ROW_OFFSETS: return "FF_ROW_OFFSETS";
-    case RAD_SECTION_FF_COLUMNS: return "FF_COLUMNS";
-    case RAD_SECTION_FF_VALUES: return "FF_VALUES";
-    case RAD_SECTION_VECTOR: return "VECTOR";
-    case RAD_SECTION_SIGNATURE: return "SIGNATURE";
-    case RAD_SECTION_MB_INFO: return "MB_INFO";
-    case RAD_SECTION_MB_FLOAT: return "MB_FLOAT";
-    case RAD_SECTION_MB_HALF: return "MB_HALF";
-    case RAD_SECTION_MB_ROW_PERM: return "MB_ROW_PERM";
-    case RAD_SECTION_MB_COL_PERM: return "MB_COL_PERM";
-    case RAD_SECTION_MB_BC1: return "MB_BC1";
-    case RAD_SECTION_MB_BC4: return "MB_BC4";
-    case RAD_SECTION_MB_SCALES: return "MB_SCALES";
-    case RAD_SECTION_MB_OUTLIER_OFFSETS: return "MB_OUTLIER_OFFSETS";
-    case RAD_SECTION_MB_OUTLIER_COLUMNS: return "MB_OUTLIER_COLUMNS";
-    case RAD_SECTION_MB_OUTLIER_VALUES: return "MB_OUTLIER_VALUES";
-    case RAD_SECTION_TEMPORAL_ROW_OFFSETS: return "ALIAS_ROW_OFFSETS";
-    case RAD_SECTION_TEMPORAL_BINS: return "ALIAS_BINS";
-    case RAD_SECTION_TEMPORAL_TOTALS: return "ALIAS_TOTALS";
     case RAD_TOOL_SECTION_OPTIONS: return "USER(rad options)";
     case RAD_TOOL_SECTION_METHOD: return "USER(rad method)";
     case RAD_TOOL_SECTION_ROWSUMS: return "USER(row sums)";
-    default:
-        if (type >= RAD_SECTION_VP_INFO && type <= RAD_SECTION_VP_SAMPLE_TRIANGLES) {
-            static const char *const vp[] = {"VP_INFO", "VP_AREAS", "VP_ALBEDO", "VP_NORMALS", "VP_AXIS", "VP_VOXEL",
-                                             "VP_VOXEL_KEYS", "VP_VOXEL_FIRST", "VP_VOXEL_PATCH", "VP_SAMPLE_FIRST",
-                                             "VP_SAMPLE_POSITIONS", "VP_SAMPLE_NORMALS", "VP_SAMPLE_ALBEDO",
-                                             "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES"};
-            return vp[type - RAD_SECTION_VP_INFO];
-        }
-        return type >= RAD_SECTION_USER ? "USER" : "UNKNOWN";
+    default: name = rad_section_type_name(type); return name ? name : "UNKNOWN";
     }
 }
 

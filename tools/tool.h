@@ -278,7 +278,16 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
                            rad_tool_classic *out);
 void rad_tool_classic_free(rad_tool_classic *c);
 
-/* The user section a bake stores its options in (RAD_SECTION_USER, name "rad.options"). */
+/* The tool's own container sections (user types: the library's are in its rad_section_type
+   table), in one place. */
+#define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u) /* "rad.options": one rad_tool_bake_info */
+#define RAD_TOOL_SECTION_METHOD (RAD_SECTION_USER + 2u)  /* "rad.method": one rad_tool_method_info */
+#define RAD_TOOL_SECTION_ROWSUMS (RAD_SECTION_USER + 3u) /* "rad.rowsums": N floats */
+#define RAD_TOOL_SECTION_SHARD (RAD_SECTION_USER + 0x20u) /* a distributed bake's part: rad_tool_shard_info */
+#define RAD_TOOL_SECTION_ROWS (RAD_SECTION_USER + 0x21u)  /* the part's row ranges */
+#define RAD_TOOL_SECTION_PAIRS (RAD_SECTION_USER + 0x22u) /* the part's pairs */
+
+/* The record a bake stores its options in (RAD_TOOL_SECTION_OPTIONS, name "rad.options"). */
 typedef struct rad_tool_bake_info {
     uint32_t magic;          /* 0x52414442 */
     uint32_t patches;
@@ -289,7 +298,6 @@ typedef struct rad_tool_bake_info {
     uint32_t light_samples;
     uint32_t triangle_count; /* of the scene baked */
 } rad_tool_bake_info;
-#define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u)
 /* the rad.options record of a bake of w with o */
 void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, const rad_tool_classic_options *o);
 /* The hash of a rad.options record and of the lights given on the command line (w's lights
@@ -426,8 +434,6 @@ typedef struct rad_tool_method_info {
     uint32_t bytes_lo, bytes_hi; /* bytes the render reads: F_mb storage or alias tables */
 } rad_tool_method_info;
 #define RAD_TOOL_METHOD_MAGIC 0x5241444Du
-#define RAD_TOOL_SECTION_METHOD (RAD_SECTION_USER + 2u)  /* "rad.method": one rad_tool_method_info */
-#define RAD_TOOL_SECTION_ROWSUMS (RAD_SECTION_USER + 3u) /* "rad.rowsums": N floats */
 
 /* The bake of --method multibounce or temporal as container bytes (malloc'd, free with
    free()): patches, E, D, the row sums, rad.options, rad.method and the method's sections
@@ -481,9 +487,6 @@ typedef struct rad_tool_shard_info {
     double seconds;           /* the form factors of this part (a record of the run) */
 } rad_tool_shard_info;
 #define RAD_TOOL_SHARD_MAGIC 0x52414453u
-#define RAD_TOOL_SECTION_SHARD (RAD_SECTION_USER + 0x20u)
-#define RAD_TOOL_SECTION_ROWS (RAD_SECTION_USER + 0x21u)
-#define RAD_TOOL_SECTION_PAIRS (RAD_SECTION_USER + 0x22u)
 
 /* A classic bake's part as container bytes (malloc'd, free with free()). 0 or 1 (printed). */
 int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
