@@ -23,8 +23,8 @@ OPENMP  := $(shell printf 'int main(void){return 0;}' | $(CC) -fopenmp -x c - -o
 EMBREE  := $(shell test -f /usr/include/embree3/rtcore.h && echo -DRAD_EMBREE)
 EMBREE_LIB := $(if $(EMBREE),-lembree3,)
 # OpenEXR output of the tool (.exr) through tinyexr, when installed (package libtinyexr-dev)
-TOOL_EXR := $(shell test -f /usr/include/tinyexr.h && echo -DRAD_TOOL_EXR)
-TOOL_EXR_LIB := $(if $(TOOL_EXR),-ltinyexr,)
+EXR_CFLAGS := $(shell test -f /usr/include/tinyexr.h && echo -DTOOL_EXR)
+EXR_LIB := $(if $(EXR_CFLAGS),-ltinyexr,)
 # a folder holding the public meshes of docs/data.md, for the benchmarks and the report that
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
@@ -154,13 +154,13 @@ tools: $(BUILD)/rad $(if $(HAVE_MPICC),$(BUILD)/rad-mpi)
 rad-mpi: $(BUILD)/rad-mpi
 
 $(BUILD)/rad-mpi: tools/mpi/rad_mpi.c $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
-	$(MPICC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(TOOL_EXR) -I. $(filter-out tools/main.c,$(wildcard tools/*.c)) tools/mpi/rad_mpi.c -o $@ -lassimp $(TOOL_EXR_LIB) -lm
+	$(MPICC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(EXR_CFLAGS) -I. $(filter-out tools/main.c,$(wildcard tools/*.c)) tools/mpi/rad_mpi.c -o $@ -lassimp $(EXR_LIB) -lm
 	cp $@ tools/rad-mpi
 
 # the tool needs assimp (scene import) and stb (images): Debian libassimp-dev libstb-dev;
 # tinyexr (libtinyexr-dev) is optional: without it .exr outputs fail with a message
 $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(TOOL_EXR) -I. tools/*.c -o $@ -lassimp $(TOOL_EXR_LIB) -lm
+	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(EXR_CFLAGS) -I. tools/*.c -o $@ -lassimp $(EXR_LIB) -lm
 	cp $@ tools/rad
 
 # the evaluation report (tools/report.sh, issue #12): full quality into report/ (committed), or

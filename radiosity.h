@@ -658,6 +658,125 @@ RAD_API void rad_camera_ray(const rad_camera *camera, uint32_t width, uint32_t h
                             rad_ray *out);
 
 /* ======================================================================================== */
+/* >>api_light: lights and the source term                                                  */
+/* ======================================================================================== */
+
+typedef enum rad_light_type {
+    RAD_LIGHT_DIRECTIONAL = 0, /* sun: 'color' is the irradiance on a surface facing it;
+                                  'direction' points from the light into the scene */
+    RAD_LIGHT_POINT = 1,       /* 'color' is the intensity (W/sr) */
+    RAD_LIGHT_SPOT = 2,        /* point light limited to a cone around 'direction' */
+    RAD_LIGHT_SKY = 3          /* constant sky: 'color' is its exitance E_0 (= pi * its
+                                  radiance), the irradiance on an unoccluded surface */
+} rad_light_type;
+
+typedef enum rad_falloff {
+    RAD_FALLOFF_QUADRATIC = 0, /* I / d^2 (physical) */
+    RAD_FALLOFF_LINEAR = 1     /* I / d (the linear falloff of Korobeinikov 2022; not physical) */
+} rad_falloff;
+
+typedef struct rad_light {
+    rad_light_type type;
+    float color[3];
+    float position[3];         /* point, spot */
+    float direction[3];        /* directional, spot (need not be unit) */
+    rad_falloff falloff;       /* point, spot */
+    float min_distance;        /* point, spot: d is clamped from below to this (0: 1e-6 of
+                                  the scene diagonal) */
+    float inner_angle;         /* spot: half-angles in radians; full intensity inside inner, */
+    float outer_angle;         /* smoothstep to 0 at outer (outer > inner) */
+} rad_light;
+
+typedef struct rad_direct_options {
+    uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
+                                  of the patch's n x n sub-triangles */
+    uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
+    int include_emitters;      /* non-zero (default): emissive triangles are area lights;
+                                  0 leaves them out (a zeroed struct has no emitters: start
+                                  from rad_direct_options_default) */
+    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;
+} rad_direct_options;
+
+RAD_API void rad_direct_options_default(rad_direct_options *options);
+
+/* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
+   sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
+   (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
+   shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
+   gets the light of its visible part). A point receives nothing from behind its normal; normals need not
+   be unit (they are normalized), a zero one is refused. 'samples' is unused here.
+   Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, a negative
+   min_distance, a zero normal or ray_epsilon outside (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that
+   overflows float), NEGATIVE_EMISSION (a negative light colour), RAYCAST_FAILED. */
+RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
+                                         const rad_light *lights, uint32_t light_count,
+                                         const rad_direct_options *options, const float *points,
+                                         const float *normals, uint32_t count, float *out_irradiance,
+                                         const rad_context *ctx);
+
+/* Mean direct irradiance over each patch ('samples' lattice points per patch), 3N floats.
+   A patch's own triangle never lights it. */
+RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster,
+                                      const rad_light *lights, uint32_t light_count,
+                                      const rad_direct_options *options, float *out_irradiance,
+                                      const rad_context *ctx);
+
+typedef enum rad_source_mode {
+    RAD_SOURCE_EMISSION = 0,   /* E_i = pi * L_i: emitters are the source */
+    RAD_SOURCE_DIRECT = 1      /* E_i = rho_i * D_i: direct light is the source; emission is
+                                  kept out of the system */
+} rad_source_mode;
+
+/* Builds E (3N floats) from the patches one of the two ways of UNITS AND CONVENTIONS.
+   direct_irradiance (3N) is required for RAD_SOURCE_DIRECT and must be NULL for
+   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT).
+   A NaN or Inf in it is NON_FINITE, a negative value INVALID_ARGUMENT; out_E is written only on
+   success. */
+RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
+                               float *out_E);
+
+/* ---- final gather: one traced bounce in front of a radiosity solution ----
+   A proxy (patches or virtual patches) holds radiosity as an average over each patch, so a
+   point that sees more of the lit scene than its patch's average (open floors, the faces a
+   camera sees) gets too little indirect light, and a coarse proxy blurs it. The final gather
+   traces that one bounce instead: from each point, 'rays' cosine-distributed rays (stratified,
+   rotated per point); at each front-facing hit the reflected light is rho(hit) (D(hit) + H(hit))
+   with D the direct irradiance there (rad_direct_irradiance with the lights and emitters) and
+   H the indirect irradiance the solution gives there (the caller's lookup: rad_vp_gather of
+   H = F B for virtual patches, the per-vertex irradiance of patches), so
+       out(p) = (1 / rays) sum_k rho_k (D_k + H_k)          (indirect irradiance at p)
+   Misses and back faces give 0 (the sky and the emitters are direct light at p, counted by
+   rad_direct_irradiance there). The proxy's error then enters only through H at the hits,
+   one bounce further away. Cost per point: 'rays' closest-hit rays, 'rays' direct-light
+   evaluations (light_samples shadow rays per area light each) and 'rays' lookups. */
+typedef struct rad_final_gather_options {
+    uint32_t rays;           /* per point (0: 64; at most 4096) */
+    uint32_t light_samples;  /* shadow rays per hit and area light or sky (0: 4) */
+    float ray_epsilon;       /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;           /* decorrelates runs; same seed, same bits on any thread count */
+} rad_final_gather_options;
+
+/* H at 'count' hit points: hits[i] (triangle, barycentrics), points 3 floats, unit geometric
+   normals 3 floats; writes 3 floats per point of indirect irradiance into out. Called from
+   the thread that called rad_final_gather, with up to 65536 points at a time. */
+typedef rad_result (*rad_gather_lookup_fn)(void *user, const rad_hit *hits, const float *points, const float *normals,
+                                           uint32_t count, float *out_irradiance);
+
+RAD_API void rad_final_gather_options_default(rad_final_gather_options *options);
+
+/* Indirect irradiance (3 floats per point) at 'count' points with normals (normalized here;
+   a zero one is refused), as above. lookup may be NULL (H = 0: exactly the first bounce of
+   the lights). Errors: INVALID_ARGUMENT (NULL input, rays above 4096, a zero normal, bad
+   light or ray_epsilon), NON_FINITE (a point, normal or result), RAYCAST_FAILED, CANCELLED,
+   OUT_OF_MEMORY, or what lookup returned. Thread safety: reentrant; the ray work runs through
+   ctx->parallel_for. */
+RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
+                                    uint32_t light_count, const rad_final_gather_options *options,
+                                    rad_gather_lookup_fn lookup, void *lookup_user, const float *points,
+                                    const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx);
+
+/* ======================================================================================== */
 /* >>api_formfactor: form factors                                                           */
 /* ======================================================================================== */
 
@@ -813,7 +932,7 @@ RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const fl
    rad_output, in the options of the solvers (rad_solve_options.output,
    rad_stochastic_options.output) and as the parameter after the output array of the applies
    (rad_multibounce_apply, rad_multibounce_blocks_apply, rad_local_apply); the GPU kernels take
-   its value as the bit RAD_GLSL_FLAG_TOTAL (equal to RAD_OUTPUT_TOTAL). Methods whose state is
+   its value as the bit RAD_GLSL_OUTPUT_TOTAL (equal to RAD_OUTPUT_TOTAL). Methods whose state is
    the indirect light alone (rad_temporal_step) always return L: add E for the total. */
 typedef enum rad_output { RAD_OUTPUT_INDIRECT = 0, RAD_OUTPUT_TOTAL = 1 } rad_output;
 
@@ -1128,1098 +1247,6 @@ RAD_API rad_result rad_hierarchical_lookup(const rad_hierarchical *h, rad_hierar
                                            float *out);
 
 /* ======================================================================================== */
-/* >>api_light: lights and the source term                                                  */
-/* ======================================================================================== */
-
-typedef enum rad_light_type {
-    RAD_LIGHT_DIRECTIONAL = 0, /* sun: 'color' is the irradiance on a surface facing it;
-                                  'direction' points from the light into the scene */
-    RAD_LIGHT_POINT = 1,       /* 'color' is the intensity (W/sr) */
-    RAD_LIGHT_SPOT = 2,        /* point light limited to a cone around 'direction' */
-    RAD_LIGHT_SKY = 3          /* constant sky: 'color' is its exitance E_0 (= pi * its
-                                  radiance), the irradiance on an unoccluded surface */
-} rad_light_type;
-
-typedef enum rad_falloff {
-    RAD_FALLOFF_QUADRATIC = 0, /* I / d^2 (physical) */
-    RAD_FALLOFF_LINEAR = 1     /* I / d (the linear falloff of Korobeinikov 2022; not physical) */
-} rad_falloff;
-
-typedef struct rad_light {
-    rad_light_type type;
-    float color[3];
-    float position[3];         /* point, spot */
-    float direction[3];        /* directional, spot (need not be unit) */
-    rad_falloff falloff;       /* point, spot */
-    float min_distance;        /* point, spot: d is clamped from below to this (0: 1e-6 of
-                                  the scene diagonal) */
-    float inner_angle;         /* spot: half-angles in radians; full intensity inside inner, */
-    float outer_angle;         /* smoothstep to 0 at outer (outer > inner) */
-} rad_light;
-
-typedef struct rad_direct_options {
-    uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
-                                  of the patch's n x n sub-triangles */
-    uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
-    int include_emitters;      /* non-zero (default): emissive triangles are area lights;
-                                  0 leaves them out (a zeroed struct has no emitters: start
-                                  from rad_direct_options_default) */
-    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
-    uint32_t seed;
-} rad_direct_options;
-
-RAD_API void rad_direct_options_default(rad_direct_options *options);
-
-/* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
-   sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
-   (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
-   shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
-   gets the light of its visible part). A point receives nothing from behind its normal; normals need not
-   be unit (they are normalized), a zero one is refused. 'samples' is unused here.
-   Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, a negative
-   min_distance, a zero normal or ray_epsilon outside (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that
-   overflows float), NEGATIVE_EMISSION (a negative light colour), RAYCAST_FAILED. */
-RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
-                                         const rad_light *lights, uint32_t light_count,
-                                         const rad_direct_options *options, const float *points,
-                                         const float *normals, uint32_t count, float *out_irradiance,
-                                         const rad_context *ctx);
-
-/* Mean direct irradiance over each patch ('samples' lattice points per patch), 3N floats.
-   A patch's own triangle never lights it. */
-RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster,
-                                      const rad_light *lights, uint32_t light_count,
-                                      const rad_direct_options *options, float *out_irradiance,
-                                      const rad_context *ctx);
-
-typedef enum rad_source_mode {
-    RAD_SOURCE_EMISSION = 0,   /* E_i = pi * L_i: emitters are the source */
-    RAD_SOURCE_DIRECT = 1      /* E_i = rho_i * D_i: direct light is the source; emission is
-                                  kept out of the system */
-} rad_source_mode;
-
-/* Builds E (3N floats) from the patches one of the two ways of UNITS AND CONVENTIONS.
-   direct_irradiance (3N) is required for RAD_SOURCE_DIRECT and must be NULL for
-   RAD_SOURCE_EMISSION (passing it there is the double-counting mistake: INVALID_ARGUMENT).
-   A NaN or Inf in it is NON_FINITE, a negative value INVALID_ARGUMENT; out_E is written only on
-   success. */
-RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance,
-                               float *out_E);
-
-/* ---- final gather: one traced bounce in front of a radiosity solution ----
-   A proxy (patches or virtual patches) holds radiosity as an average over each patch, so a
-   point that sees more of the lit scene than its patch's average (open floors, the faces a
-   camera sees) gets too little indirect light, and a coarse proxy blurs it. The final gather
-   traces that one bounce instead: from each point, 'rays' cosine-distributed rays (stratified,
-   rotated per point); at each front-facing hit the reflected light is rho(hit) (D(hit) + H(hit))
-   with D the direct irradiance there (rad_direct_irradiance with the lights and emitters) and
-   H the indirect irradiance the solution gives there (the caller's lookup: rad_vp_gather of
-   H = F B for virtual patches, the per-vertex irradiance of patches), so
-       out(p) = (1 / rays) sum_k rho_k (D_k + H_k)          (indirect irradiance at p)
-   Misses and back faces give 0 (the sky and the emitters are direct light at p, counted by
-   rad_direct_irradiance there). The proxy's error then enters only through H at the hits,
-   one bounce further away. Cost per point: 'rays' closest-hit rays, 'rays' direct-light
-   evaluations (light_samples shadow rays per area light each) and 'rays' lookups. */
-typedef struct rad_final_gather_options {
-    uint32_t rays;           /* per point (0: 64; at most 4096) */
-    uint32_t light_samples;  /* shadow rays per hit and area light or sky (0: 4) */
-    float ray_epsilon;       /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
-    uint32_t seed;           /* decorrelates runs; same seed, same bits on any thread count */
-} rad_final_gather_options;
-
-/* H at 'count' hit points: hits[i] (triangle, barycentrics), points 3 floats, unit geometric
-   normals 3 floats; writes 3 floats per point of indirect irradiance into out. Called from
-   the thread that called rad_final_gather, with up to 65536 points at a time. */
-typedef rad_result (*rad_gather_lookup_fn)(void *user, const rad_hit *hits, const float *points, const float *normals,
-                                           uint32_t count, float *out_irradiance);
-
-RAD_API void rad_final_gather_options_default(rad_final_gather_options *options);
-
-/* Indirect irradiance (3 floats per point) at 'count' points with normals (normalized here;
-   a zero one is refused), as above. lookup may be NULL (H = 0: exactly the first bounce of
-   the lights). Errors: INVALID_ARGUMENT (NULL input, rays above 4096, a zero normal, bad
-   light or ray_epsilon), NON_FINITE (a point, normal or result), RAYCAST_FAILED, CANCELLED,
-   OUT_OF_MEMORY, or what lookup returned. Thread safety: reentrant; the ray work runs through
-   ctx->parallel_for. */
-RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
-                                    uint32_t light_count, const rad_final_gather_options *options,
-                                    rad_gather_lookup_fn lookup, void *lookup_user, const float *points,
-                                    const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx);
-
-
-/* ======================================================================================== */
-/* >>api_lightmap: lightmaps over a second UV set                                           */
-/* ======================================================================================== */
-
-/* Lightmaps (docs/methods/lightmap.md): the light of a solved patch set baked into a W x H
-   texture over the meshes' lightmap_uvs (rad_mesh_desc), the form engines consume for static
-   geometry. Steps: rad_lightmap_create (texels: rasterize, sample points, validity),
-   rad_lightmap_gather (+ rad_lightmap_direct), then rad_lightmap_dilate and rad_lightmap_stitch.
-   TEXELS. Texel (x, y) covers u in [x/W, (x+1)/W] and v in [y/H, (y+1)/H]; its centre is at
-   ((x + 1/2)/W, (y + 1/2)/H); values are stored row by row from y = 0. Coverage is
-   conservative: a texel belongs to every lightmapped triangle whose uv triangle overlaps its
-   square (a separating-axis test), however little, so bilinear filtering inside any triangle
-   reads only texels that were baked for it. Each texel has an n x n grid of sub-points
-   (samples, rounded to a square); every sub-point inside a triangle's uv triangle becomes a
-   SAMPLE on that triangle (world position by barycentric interpolation, the triangle's
-   geometric normal). A covered texel without any inside sub-point gets one sample: the point
-   of the nearest overlapping triangle closest (in uv) to the texel centre. Every sample then
-   moves 4 ray epsilons towards its triangle's centroid (at most half the way), so one on a
-   triangle's border is not on the plane of the wall that meets it there.
-   VALIDITY. From each sample, validity_rays cosine-distributed rays; one that hits a back
-   face means the sample lies inside or behind geometry (the floor under a wall standing on
-   it, the ceiling behind a one-sided lamp). A sample is invalid when more than
-   backface_limit of its rays hit back faces; a texel is valid when any of its samples is.
-   Invalid samples take no part in the gather, so a texel at a wall-floor contact is lit only
-   from the side of the wall its valid samples are on: no light leaks under a wall at least a
-   texel thick (a thinner one puts both sides into the same texel: use more texels).
-   Cost: O(texels samples) rasterization, validity_rays rays per sample. */
-
-typedef struct rad_lightmap_options {
-    uint32_t width, height;     /* texels (0: 256 each; at most 16384, and width * height * samples
-                                   at most 2^28) */
-    uint32_t samples;           /* sub-points per texel, rounded to a square n x n (0: 4; at most 16) */
-    uint32_t validity_rays;     /* rays per sample for the inside-geometry test (0: 16; at most
-                                   1024) */
-    float backface_limit;       /* a sample is invalid when more than this fraction of its
-                                   validity rays hit back faces (0: 0.1; in (0, 1]; 1 turns the
-                                   test off) */
-    float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
-    uint32_t seed;              /* rotates the validity rays */
-} rad_lightmap_options;
-
-/* Texel flags */
-#define RAD_TEXEL_COVERED 1u    /* some lightmapped triangle overlaps the texel */
-#define RAD_TEXEL_VALID 2u      /* ... and some of its samples passed the validity test */
-
-/* The texels of one atlas. Read-only after creation. Texel i = x + width * y. */
-typedef struct rad_lightmap {
-    uint32_t width, height;
-    uint8_t *flags;             /* width * height: RAD_TEXEL_* bits */
-    float *positions;           /* 3 per texel: mean of the valid samples (of all, when none is
-                                   valid; 0 when uncovered) */
-    float *normals;             /* 3 per texel: their normalized mean normal (0 when uncovered) */
-    uint32_t *sample_first;     /* width * height + 1: the samples of texel i are
-                                   [sample_first[i], sample_first[i + 1]) */
-    uint32_t sample_count;
-    float *sample_positions;    /* 3 per sample */
-    float *sample_normals;      /* 3 per sample: the unit geometric normal of its triangle */
-    uint32_t *sample_triangles; /* per sample: the scene triangle */
-    uint8_t *sample_valid;      /* per sample: 1 valid, 0 inside or behind geometry */
-    uint32_t covered_texels, valid_texels, invalid_samples;
-    uint64_t rays_cast;         /* validity rays */
-    const rad_scene *scene;     /* borrowed: must outlive this object */
-    rad_allocator allocator;    /* private */
-} rad_lightmap;
-
-RAD_API void rad_lightmap_options_default(rad_lightmap_options *options);
-
-/* Builds the texels of the scene's lightmapped triangles (those of meshes with lightmap_uvs;
-   uvs outside [0, 1] are clipped to the atlas). raycaster: its intersect() casts the validity
-   rays (borrowed for the call). Errors: INVALID_ARGUMENT (NULL input, a scene without
-   lightmap_uvs, an option out of range), SIZE_OVERFLOW, RAYCAST_FAILED, CANCELLED,
-   OUT_OF_MEMORY; the logger says which. Thread safety: reentrant; the validity rays run
-   through ctx->parallel_for; deterministic whatever the thread count. */
-RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
-                                       const rad_lightmap_options *options, const rad_context *ctx,
-                                       rad_lightmap **out);
-RAD_API void rad_lightmap_destroy(rad_lightmap *lightmap);
-
-/* GATHER. At each valid sample p (unit normal n) the irradiance from the secondary sources
-   (patch radiosities B_j, exitance W m^-2, Lambertian: radiance B_j / pi) is
-       H(p) = sum_j B_j F(p, j) V(p, j)
-   with F(p, j) the analytic point-to-polygon form factor of patch j clipped to p's upper
-   half-space (rad_ff_point_polygon) and V(p, j) its visible share: visibility_rays shadow rays
-   to stratified points y_k of patch j, each weighted by its kernel cos cos / r^2 (the ratio
-   estimator of the form-factor code). A texel holds the mean over its valid samples; texels
-   without one hold 0 (fill them with rad_lightmap_dilate).
-   RGB IRRADIANCE (RAD_LIGHTMAP_IRRADIANCE): 3 floats per texel, H in W m^-2. A Lambertian
-   surface of albedo rho shows radiance rho H / pi.
-   L1 SPHERICAL HARMONICS (RAD_LIGHTMAP_SH_L1): 12 floats per texel, coefficient-major
-   (L_0,0 rgb, L_1,-1 rgb, L_1,0 rgb, L_1,1 rgb) of the incident RADIANCE over the upper
-   hemisphere,  L_lm = integral L(w) Y_lm(w) dw,  in the real SH basis of Godot and Unity
-   (world axes, no normalization beyond the basis):
-       Y_0,0 = 0.282095   Y_1,-1 = 0.488603 y   Y_1,0 = 0.488603 z   Y_1,1 = 0.488603 x
-   Each patch contributes exactly (B_j / pi) V(p, j) times the integrals of Y over the solid
-   angle it subtends, in closed form: Y_0,0 times its solid angle, and 0.488603 times its
-   vector irradiance (1/2) sum_edges theta_e g_e (Arvo's contour integral, g_e the unit normal
-   of the plane through p and edge e, theta_e the angle the edge subtends). Reconstruction of
-   the irradiance at a normal m (Ramamoorthi and Hanrahan's convolution, A_0 = pi, A_1 = 2 pi / 3):
-       E(m) = pi 0.282095 L_0,0 + (2 pi / 3) 0.488603 (L_1,-1 m_y + L_1,0 m_z + L_1,1 m_x)
-   i.e. E(m) / pi = 0.282095 L_0,0 + 0.325735 (L_1,-1 m_y + L_1,0 m_z + L_1,1 m_x), the
-   weights Godot's directional lightmaps and Unity's SphericalHarmonicsL2 (first four terms)
-   evaluate. At m = n it gives back H within the L1 approximation (exact for uniform light). */
-typedef enum rad_lightmap_encoding {
-    RAD_LIGHTMAP_IRRADIANCE = 0, /* 3 floats per texel */
-    RAD_LIGHTMAP_SH_L1 = 1       /* 12 floats per texel */
-} rad_lightmap_encoding;
-
-/* HEMISPHERE GATHER (RAD_LIGHTMAP_GATHER_HEMISPHERE), for scenes with many patches, where the
-   exact gather's O(samples x patches) is too slow. The patches split in two by radiosity:
-   the BRIGHT ones (luminance above exact_ratio times the area-weighted mean luminance of the
-   lit patches, i.e. the lamps and what they light most) are gathered exactly as above; the
-   light of all the others comes from hemisphere_rays closest-hit rays per texel, shared among
-   its valid samples (each sample a Hammersley set of ceil(hemisphere_rays / valid samples)
-   directions, rotated by a hash of the sample: deterministic, stratified). A ray that hits
-   the front of a patch that is not bright brings its radiosity B_j; one that misses, hits a
-   back face or a bright patch brings 0 (the bright ones are counted exactly). Irradiance:
-   cosine-distributed directions, H = mean B_j (the radiance B_j / pi over the cosine pdf);
-   SH: uniform directions over the hemisphere, L_lm = 2 pi mean (B_j / pi) Y_lm(w). This
-   estimates the same sum as the exact gather (constant B_j per patch), unbiased, with a
-   noise that falls with the rays (docs/methods/lightmap.md measures it). Cost: O(samples x
-   bright patches) form factors plus hemisphere_rays rays per texel, whatever the patch count. */
-typedef enum rad_lightmap_gather_method {
-    RAD_LIGHTMAP_GATHER_EXACT = 0,     /* every lit patch by its analytic form factor (default) */
-    RAD_LIGHTMAP_GATHER_HEMISPHERE = 1 /* bright patches exactly, the rest by hemisphere rays */
-} rad_lightmap_gather_method;
-
-typedef struct rad_lightmap_gather_options {
-    rad_lightmap_encoding encoding;
-    uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64); with 1
-                                   the share is of the visible area, not of the form factor
-                                   (reads a few % low next to contacts) */
-    float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
-    uint32_t seed;
-    rad_lightmap_gather_method method; /* RAD_LIGHTMAP_GATHER_EXACT (0) or _HEMISPHERE */
-    uint32_t hemisphere_rays;   /* hemisphere: rays per texel (0: 256; at most 65536) */
-    float exact_ratio;          /* hemisphere: a patch is bright above this times the mean
-                                   luminance (0: 16; > 0; FLT_MAX: none is bright) */
-} rad_lightmap_gather_options;
-
-RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *options);
-/* Floats per texel of an encoding (3 or 12; 0 for an unknown one). */
-RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding);
-
-/* The gather above from any solved classic patch set: patch_radiosity 3N floats (B = E + L of
-   rad_solve_* with RAD_OUTPUT_TOTAL; with RAD_SOURCE_DIRECT the lightmap then holds the
-   indirect irradiance and the direct light is added per texel by rad_lightmap_direct or per
-   pixel by the engine; with RAD_SOURCE_EMISSION B holds the emitters and the lightmap the
-   total). patches must be of lightmap->scene. Patches with B = 0 and those behind a sample
-   cost nothing. out: width * height * channels floats. Errors: INVALID_ARGUMENT, NON_FINITE
-   (a B or result), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY. Cost: O(valid samples x patches)
-   form factors and up to visibility_rays shadow rays per pair (the hemisphere method: see
-   above). The raycaster needs occluded(), and intersect() for the hemisphere method.
-   Reentrant; parallel; deterministic whatever the thread count. */
-RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lightmap, const rad_patches *patches,
-                                       const float *patch_radiosity, const rad_raycaster *raycaster,
-                                       const rad_lightmap_gather_options *options, float *out,
-                                       const rad_context *ctx);
-
-/* Direct irradiance (rad_direct_irradiance with these lights and options) averaged over each
-   texel's valid samples, ADDED to out (3 floats per texel: an RGB irradiance lightmap);
-   texels without a valid sample are left as they are. Errors: those of
-   rad_direct_irradiance, OUT_OF_MEMORY. */
-RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lightmap, const rad_raycaster *raycaster,
-                                       const rad_light *lights, uint32_t light_count,
-                                       const rad_direct_options *options, float *out, const rad_context *ctx);
-
-/* DILATION. Every texel without RAD_TEXEL_VALID gets the mean of its 8 neighbours that have a
-   value (valid, or filled by an earlier pass), pass after pass: 'passes' passes (0: until
-   every texel reachable is filled), so the gutters between charts and invalid texels hold
-   their neighbours' light and bilinear filtering at a chart border reads no black.
-   values: width * height * channels floats, in place. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
-RAD_API rad_result rad_lightmap_dilate(const rad_lightmap *lightmap, uint32_t channels, float *values,
-                                       uint32_t passes, const rad_context *ctx);
-
-/* SEAMS. A seam is a triangle edge whose two lightmapped triangles share both end points in
-   space (the same floats) but not in the atlas, and whose normals differ by less than 30
-   degrees (across a sharper crease irradiance differs by right). Each seam gets sample pairs
-   along the edge, at most half a texel apart on either side; bilinear lookups of the two
-   sides should agree there. rad_lightmap_stitch moves the texels least, in the least-squares
-   sense, so that they do: the projection of the values onto {A x = 0} (A: one row per sample
-   pair, its bilinear weights on one side minus those of the other), by 'iterations' sweeps
-   of Kaczmarz's row projections (0: 64) from the baked values, each channel on its own.
-   values: in place (run it after rad_lightmap_dilate: gutter texels take part). out_stats
-   (optional): the seam count and the largest jump before and after. Errors:
-   INVALID_ARGUMENT, OUT_OF_MEMORY. Cost: O(seam samples x iterations). */
-typedef struct rad_lightmap_seam_stats {
-    uint32_t seams;             /* seam edges found */
-    uint32_t sample_pairs;      /* rows of A */
-    float max_jump_before;      /* largest |bilinear(a) - bilinear(b)| over the sample pairs and channels */
-    float max_jump_after;
-} rad_lightmap_seam_stats;
-
-RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lightmap, uint32_t channels, float *values,
-                                       uint32_t iterations, rad_lightmap_seam_stats *out_stats,
-                                       const rad_context *ctx);
-
-/* RUN TIME (rad_lightmap_weights_create, rad_lightmap_refresh): a lightmap refreshed from a
-   new patch solution (a temporal frame, a moved light's re-solve) in O(texels x few) without
-   a new gather. Each valid texel gets a sparse row of texel-from-patch weights: at each valid
-   sample the patch containing it (rad_patches_locate) and its three vertex weights, each
-   vertex standing for the area-weighted mean of the patches that share it (as
-   rad_patches_vertex_values), averaged over the texel's valid samples; so the row
-   interpolates the patches' irradiance H = F B smoothly. The row is then scaled by the
-   texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked) from the gathered
-   lightmap and the patch irradiance of the same solution (1 when either is NULL or the row
-   gives 0; at most 16), which keeps the gather's sub-patch detail (contact shadows, gradients
-   inside a patch). A refresh with H_baked gives back the bake's luminance exactly; with
-   another solution it is exact where the light's shape across each patch and its neighbours
-   does not change, and off by the change elsewhere (the test measures it).
-   LAYOUT. The rows are stored FACTORED, in two sparse stages, because the patches around a
-   vertex are shared by every texel near it: stage 1 makes a value per patch vertex,
-       V_v = sum_k vertex_weights[k] H[vertex_patches[k]],  k in [vertex_first[v], vertex_first[v + 1])
-   (the area shares: they sum to 1 around a vertex), stage 2 a value per texel with a row,
-       out[row_texels[r]] = sum_e entry_weights[e] V[entry_vertices[e]],  e in [row_first[r], row_first[r + 1])
-   (the mean barycentric weights times the detail factor: about 3 entries a texel, against
-   about 10 patches in the expanded row). The texel-from-patch row of the text above is the
-   product of the two (W_tp = sum_e entry_weights[e] vertex_weights[k] over the pairs with
-   vertex_patches[k] = p); the refresh gives it up to float rounding (1e-6 relative). The
-   rows run in increasing texel order, so the stage-2 writes stream through the lightmap. */
-typedef struct rad_lightmap_weights {
-    uint32_t texels;            /* width * height of the lightmap */
-    uint32_t patch_count;       /* N of the patches */
-    uint32_t vertex_count;      /* the patches' vertex_count */
-    uint32_t row_count;         /* texels with a row (a valid sample in a located patch) */
-    uint32_t *vertex_first;     /* vertex_count + 1 */
-    uint32_t *vertex_patches;   /* 3N: patch indices */
-    float *vertex_weights;      /* 3N: area shares */
-    uint32_t *row_texels;       /* row_count: the texel of each row, increasing */
-    uint32_t *row_first;        /* row_count + 1 */
-    uint32_t *entry_vertices;   /* row_first[row_count]: vertex indices */
-    float *entry_weights;       /* row_first[row_count]: weights (detail factor included) */
-    rad_allocator allocator;    /* private */
-} rad_lightmap_weights;
-
-/* Builds the rows above. baked_texels (3 per texel, an RGB irradiance gather of the solution,
-   before dilation) and baked_patch_irradiance (3N: H = F B of the same solution) are optional
-   together (both or neither). Errors: INVALID_ARGUMENT (NULL lightmap or patches, patches of
-   another scene, one of the two baked inputs without the other), SIZE_OVERFLOW (2^32 entries
-   or more), OUT_OF_MEMORY. O(samples). */
-RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lightmap, const rad_patches *patches,
-                                               const float *baked_texels, const float *baked_patch_irradiance,
-                                               const rad_context *ctx, rad_lightmap_weights **out);
-RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *weights);
-
-/* out[t] = sum_p W_tp H_p (3 floats per texel) for every texel with a row; texels without one
-   are left as they are (the gutters keep their dilated values). patch_irradiance: 3N floats.
-   Two passes through ctx->parallel_for (vertices, then rows in contiguous blocks), with a
-   scratch of 3 floats per vertex from the context's allocator. Deterministic whatever the
-   thread count. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
-RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, const float *patch_irradiance, float *out,
-                                        const rad_context *ctx);
-
-/* Bilinear lookup of a lightmap (channels floats per texel) at (u, v), clamped to the edge
-   texels, with the texel convention above. out: channels floats. */
-RAD_API void rad_lightmap_sample(const rad_lightmap *lightmap, uint32_t channels, const float *values, float u, float v,
-                                 float *out);
-
-/* ======================================================================================== */
-/* >>api_shading: lighting models and BRDFs                                                 */
-/* ======================================================================================== */
-
-/* Local lighting models for the direct term and the final shading (docs/methods/shading.md; the set of
-   models of Korobeinikov 2022, docs/references.md).
-   Radiosity gives the indirect light of diffuse surfaces; these functions give the response
-   of a surface to one light direction, the same in C and in glsl/lighting.glsl.
-
-   CONVENTION. l (towards the light), v (towards the viewer) and n (the normal) are unit
-   vectors. Two quantities are offered:
-     f  the BRDF (sr^-1): outgoing radiance L_o = f * max(n.l, 0) * E, with E the light's
-        irradiance on a surface facing it (rad_light.color for a directional light,
-        I / d^2 for a point light). rad_shading_brdf() returns it.
-     R  the response: L_o = R * E. For every model that has a BRDF, R = f * max(n.l, 0).
-        rad_shading_eval() returns it; this is what a shader adds per light.
-   The models usually stated as an "intensity" (a cosine-like number in
-   [0,1]) are scaled by albedo / pi so that a white model of intensity cos(theta) is exactly
-   Lambert: R = albedo / pi * intensity. For banded, f = R / (n.l). Half-Lambert (wrap)
-   lights points with n.l < 0, so it has no BRDF: rad_shading_brdf() refuses it.
-   Physical (reciprocal f(l,v) = f(v,l) and energy-conserving Integral f (n.l) dl <= 1 for
-   albedos <= 1; tests/test_shading.c measures both): Lambert; Phong and Blinn-Phong in their
-   normalized forms with kd + ks <= 1; Oren-Nayar nearly (the qualitative model: at albedo 1
-   its directional albedo reaches 1.0105 at grazing view for sigma = 0.25, and stays <= 1 for
-   sigma >= 0.5: 0.83 at sigma 1); the microfacet model with the Shirley diffuse term or none (with
-   Shirley at albedo 1 the sum reaches 1.0015 at grazing view). The Lambert diffuse
-   term (1 - F(n,l)) albedo / pi (the default, as in Korobeinikov 2022) is neither
-   reciprocal nor energy-conserving with the specular term (measured 1.07 at albedo 1).
-   Minnaert is reciprocal, energy-conserving only for k >= 1. Banded and half-Lambert are
-   neither. Every model returns 0 (f and R) when n.v <= 0: surfaces are one-sided. */
-
-typedef enum rad_shading_model {
-    RAD_SHADING_LAMBERT = 0,      /* f = albedo / pi */
-    RAD_SHADING_HALF_LAMBERT = 1, /* R = albedo / pi * max(0, (n.l + w) / (1 + w))^p (Valve's
-                                     half-Lambert: w = 1, p = 2; w = 0, p = 1 is Lambert) */
-    RAD_SHADING_BANDED = 2,       /* R = albedo / pi * ceil(bands * max(n.l, 0)) / bands */
-    RAD_SHADING_PHONG = 3,        /* f = kd / pi + ks (s + 2) / (2 pi) max(0, r.v)^s,
-                                     r = 2 (n.l) n - l (normalized modified Phong, Lewis 1994) */
-    RAD_SHADING_BLINN_PHONG = 4,  /* f = kd / pi + ks c(s) max(0, n.h)^s, h = (l + v) / |l + v|,
-                                     c(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s)): the
-                                     normalization that makes the lobe's albedo at normal
-                                     incidence exactly 1 (Real-Time Rendering; the common
-                                     (s + 8) / (8 pi) overshoots it, by up to 7.5 % at s = 9) */
-    RAD_SHADING_MINNAERT = 5,     /* f = albedo (k + 1) / (2 pi) (max(n.l n.v, 1e-6))^(k - 1)
-                                     (Minnaert 1941; albedo at normal incidence = albedo) */
-    RAD_SHADING_OREN_NAYAR = 6,   /* f = albedo / pi (A + B max(0, cos(phi_l - phi_v)) sin(a) tan(b)),
-                                     A = 1 - 0.5 s^2 / (s^2 + 0.33), B = 0.45 s^2 / (s^2 + 0.09),
-                                     a = max(theta_l, theta_v), b = min (Oren, Nayar 1994,
-                                     qualitative model); computed as (l.v - n.l n.v) / max(n.l, n.v) */
-    RAD_SHADING_MICROFACET = 7,   /* f = F(h,l) G2(l,v,h) D(h) / (4 |n.l| |n.v|) + f_diffuse (Cook & Torrance 1982) */
-    RAD_SHADING_MODEL_COUNT = 8
-} rad_shading_model;
-
-typedef enum rad_ndf {
-    RAD_NDF_BECKMANN = 0,         /* Beckmann; Lambda: the rational approximation of Walter et al. 2007 */
-    RAD_NDF_GGX = 1               /* Walter et al. 2007; Lambda: exact */
-} rad_ndf;
-
-typedef enum rad_masking {
-    RAD_MASKING_SEPARABLE = 0,         /* G2 = G1(v, h) G1(l, h)                (Heitz 2014) */
-    RAD_MASKING_HEIGHT_CORRELATED = 1  /* G2 = chi(h.v) chi(h.l) / (1 + L(v) + L(l)) (Heitz 2014) */
-} rad_masking;
-
-typedef enum rad_diffuse_term {
-    RAD_DIFFUSE_NONE = 0,         /* specular only */
-    RAD_DIFFUSE_LAMBERT = 1,      /* (1 - F(n,l)) albedo / pi, F the Schlick term below (Korobeinikov 2022) */
-    RAD_DIFFUSE_SHIRLEY = 2       /* (1 - F0) 21 albedo / (20 pi) (1 - (1 - n.l)^5) (1 - (1 - n.v)^5)
-                                     (Shirley et al. 1997) */
-} rad_diffuse_term;
-
-/* Ranges are checked by rad_shading_validate (and so by the two entries). Albedos, kd, ks,
-   f0 and f90 are per channel in [0, 1]. */
-typedef struct rad_lambert_params { float albedo[3]; } rad_lambert_params;
-typedef struct rad_half_lambert_params {
-    float albedo[3];
-    float wrap;                   /* w in [0, 1]; default 1 */
-    float exponent;               /* p in [1, 8]; default 2 */
-} rad_half_lambert_params;
-typedef struct rad_banded_params {
-    float albedo[3];
-    uint32_t bands;               /* in [1, 256]; default 4 */
-} rad_banded_params;
-typedef struct rad_phong_params {  /* Phong and Blinn-Phong */
-    float diffuse[3];             /* kd; default 0.5 */
-    float specular[3];            /* ks; default 0.3; physical when kd + ks <= 1 */
-    float shininess;              /* s in [1, 10000]; default 32 */
-} rad_phong_params;
-typedef struct rad_minnaert_params {
-    float albedo[3];
-    float k;                      /* in [0, 4]; 1 is Lambert; < 1 flattens the disc and
-                                     brightens the limb (lunar look); default 0.8 */
-} rad_minnaert_params;
-typedef struct rad_oren_nayar_params {
-    float albedo[3];
-    float sigma;                  /* roughness, standard deviation of facet slopes in radians,
-                                     in [0, 1.5]; 0 is Lambert; default 0.5 */
-} rad_oren_nayar_params;
-typedef struct rad_microfacet_params {
-    rad_ndf ndf;                  /* default GGX */
-    rad_masking masking;          /* default height-correlated */
-    rad_diffuse_term diffuse;     /* default Lambert */
-    float alpha_x, alpha_y;       /* roughness along t and b, each in [1e-3, 1]; equal values
-                                     make the model isotropic (t and b then unused); default 0.3 */
-    float f0[3];                  /* Fresnel reflectance at normal incidence; default 0.04 */
-    float f90[3];                 /* ... at grazing incidence (generalized Schlick); default 1 */
-    float fresnel_exponent;       /* 1/p of the generalized form, in [1, 10]; 5 is Schlick's; default 5 */
-    float albedo[3];              /* rho of the diffuse term; default 0.5 */
-} rad_microfacet_params;
-
-/* A material for the shading entries: the model and its parameters (only model's member is
-   read). */
-typedef struct rad_shading {
-    rad_shading_model model;
-    rad_lambert_params lambert;
-    rad_half_lambert_params half_lambert;
-    rad_banded_params banded;
-    rad_phong_params phong;       /* RAD_SHADING_PHONG and RAD_SHADING_BLINN_PHONG */
-    rad_minnaert_params minnaert;
-    rad_oren_nayar_params oren_nayar;
-    rad_microfacet_params microfacet;
-} rad_shading;
-
-/* The documented defaults. Thread-safe, O(1). */
-RAD_API void rad_lambert_params_default(rad_lambert_params *p);
-RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p);
-RAD_API void rad_banded_params_default(rad_banded_params *p);
-RAD_API void rad_phong_params_default(rad_phong_params *p);
-RAD_API void rad_minnaert_params_default(rad_minnaert_params *p);
-RAD_API void rad_oren_nayar_params_default(rad_oren_nayar_params *p);
-RAD_API void rad_microfacet_params_default(rad_microfacet_params *p);
-/* Every member at its default and s->model = model. */
-RAD_API void rad_shading_default(rad_shading *s, rad_shading_model model);
-
-/* A model's name ("lambert", "half-lambert", "banded", "phong", "blinn-phong", "minnaert",
-   "oren-nayar", "microfacet"), or NULL for a value out of range; and the reverse (returns
-   INVALID_ARGUMENT for an unknown name). */
-RAD_API const char *rad_shading_model_name(rad_shading_model model);
-RAD_API rad_result rad_shading_model_from_name(const char *name, rad_shading_model *out_model);
-
-/* Checks the model and the ranges of its parameters (only the active model's struct).
-   Errors: INVALID_ARGUMENT (NULL, unknown model or enum, parameter out of range; the logger
-   names it), NON_FINITE (a NaN or Inf parameter). Thread-safe, O(1). */
-RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context *ctx);
-
-/* The two evaluation entries (see CONVENTION above; docs/methods/shading.md).
-   l, v, n: non-zero finite 3-vectors, normalized here. t, b: the tangent frame, used only
-   by an anisotropic microfacet model (alpha_x != alpha_y); there t is required, made
-   orthogonal to n here, and b may be NULL (then b = n x t) or is made orthogonal to n and t.
-   out_rgb: 3 floats, written on success.
-   rad_shading_brdf writes f; rad_shading_eval writes R (f * max(n.l, 0), or the half-Lambert
-   response).
-   Errors: INVALID_ARGUMENT (NULL pointer, bad parameters as rad_shading_validate, a zero
-   vector, t missing or parallel to n for an anisotropic model, half-Lambert given to
-   rad_shading_brdf), NON_FINITE (a non-finite vector component). Thread-safe, O(1), no
-   allocation. For a hot loop: rad_shading_pack once, then rad_shade. */
-RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], const float v[3], const float n[3],
-                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
-RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
-                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
-
-/* Terms of the microfacet model, to compose your own (docs/methods/shading.md). Plain float math:
-   the caller guarantees valid inputs (cosines in [-1, 1], roughness in (0, 1]); nothing is
-   checked. All thread-safe and O(1). 'nm' is n.m, 'tm' t.m, 'bm' b.m for the microfacet
-   normal m (usually h). */
-RAD_API float rad_ndf_beckmann(float nm, float alpha);                                   /* Beckmann */
-RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y); /* Beckmann, anisotropic */
-RAD_API float rad_ndf_ggx(float nm, float alpha);                                        /* GGX */
-RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y);      /* GGX, anisotropic */
-/* The Smith variable a = n.s / sqrt(alpha_x^2 (t.s)^2 + alpha_y^2 (b.s)^2) (Heitz 2014; with
-   alpha_x = alpha_y = alpha it is n.s / (alpha sqrt(1 - (n.s)^2)), since (t.s)^2 + (b.s)^2 = 1 - (n.s)^2). Returns
-   +inf for s = n (no masking); requires n.s > 0. */
-RAD_API float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y);
-/* Lambda(a) for a > 0: GGX (exact); Beckmann's rational approximation (Walter et al. 2007; 0 for
-   a >= 1.6); Beckmann's exact form (with erf; C only, the reference for the
-   approximation). Each returns 0 for a = +inf. */
-RAD_API float rad_lambda_ggx(float a);
-RAD_API float rad_lambda_beckmann(float a);
-RAD_API float rad_lambda_beckmann_exact(float a);
-/* G1 = chi+(m.s) / (1 + Lambda(s)) (Heitz 2014). */
-RAD_API float rad_smith_g1(float ms, float lambda_s);
-/* G2 separable G1(v) G1(l) and height-correlated 1 / (1 + Lambda(v) + Lambda(l)) (Heitz 2014). */
-RAD_API float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l);
-RAD_API float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l);
-/* Schlick's Fresnel F0 + (1 - F0)(1 - max(c, 0))^5 (Schlick 1994) and its generalized form
-   F0 + (F90 - F0)(1 - max(c, 0))^exponent (Real-Time Rendering; exponent = 1/p). One channel. */
-RAD_API float rad_fresnel_schlick(float f0, float c);
-RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c);
-/* Diffuse terms, one channel: Lambert (1 - F) albedo / pi (F = F(n,l)), Shirley
-   et al. (1 - F0) 21 albedo / (20 pi) (1 - (1 - nl+)^5)(1 - (1 - nv+)^5). */
-RAD_API float rad_diffuse_lambert(float albedo, float F);
-RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv);
-
-/* The std430 mirror of glsl/lighting.glsl's ShadingParams (96 bytes, vec4-aligned):
-   albedo (albedo, or kd for Phong), specular (ks), f0, f90, p = (alpha_x, alpha_y, model
-   parameter: wrap / shininess / k / sigma, second parameter: half-Lambert exponent / bands /
-   Fresnel exponent), mode = (model, ndf, masking, diffuse). */
-typedef struct rad_shading_gpu {
-    float albedo[4];
-    float specular[4];
-    float f0[4];
-    float f90[4];
-    float p[4];
-    int32_t mode[4];
-} rad_shading_gpu;
-
-/* Validates a material and packs it for rad_shade and the GLSL functions. Errors as
-   rad_shading_validate. Thread-safe, O(1). */
-RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, const rad_context *ctx);
-
-/* The unchecked evaluator behind both entries, the C twin of GLSL rad_shade(): f (out_f)
-   and R (out_r; either may be NULL) for a material packed by rad_shading_pack and unit l, v,
-   n, with t, b an orthonormal tangent frame (read only when anisotropic; may be NULL then).
-   Garbage in, garbage out; no allocation; thread-safe; O(1). */
-RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
-                       const float b[3], float out_f[3], float out_r[3]);
-
-
-/* ======================================================================================== */
-/* >>api_container: baked data                                                              */
-/* ======================================================================================== */
-
-/* One versioned binary container for everything a bake produces (docs/methods/container.md
-   teaches it). THE LAYOUT (this is its one description):
-     header, 64 bytes, its fields little-endian (byte offset: field):
-       0: "RADB"  4: version (uint32)  8: section count  12: header size (64)
-       16: table offset (uint64, 64)  24: file size (uint64)  32: flags (bit 0: the section
-       data is big-endian)  36: CRC-32 of the table  40..59: zero  60: CRC-32 of bytes 0..59
-     table, one 64-byte entry per section, its fields little-endian:
-       0: type (rad_section_type)  4: element size  8: element count (uint64)  16: offset
-       (uint64)  24: byte size (uint64)  32: CRC-32 of the data  36..39: zero  40: name (24
-       bytes, NUL-terminated)
-     data: each section from an offset that is a multiple of 64, in the WRITER'S byte order
-       (flag bit 0), so that a file can be memory-mapped and read in place; a reader of the
-       other byte order refuses it (RAD_ERROR_VERSION) instead of converting.
-   CRC-32 is the common reflected one (polynomial 0xEDB88320, as zlib's crc32). Loading validates every size, offset, checksum and index before anything is used.
-   VERSIONING: RAD_CONTAINER_VERSION changes only when the header or the table entry layout
-   changes (a reader refuses another version with RAD_ERROR_VERSION). New section types are
-   added without a version change: readers look sections up by type and name and skip the
-   ones they do not know, so a file without a newer section (RAD_SECTION_SIGNATURE, added
-   in 0.1.0) still loads, and an older reader loads a newer file.
-   NAMES. Each object's way in and out of a container: X_sections fills the sections that
-   write it (data borrowed from the object); X_load makes a new object from a container (free
-   it with X_destroy); X_view fills a caller's struct that points into the container (nothing
-   to free: rad_alias_tables_view, whose struct is public).
-   VALUES: behind a valid checksum a section may still hold values that would make every
-   later step NaN, infinite or slow, so each loader (rad_load_memory, rad_multibounce_load,
-   rad_multibounce_blocks_load, rad_alias_tables_view) checks the values it hands out, once,
-   in O(size of the section): every float is finite (else RAD_ERROR_NON_FINITE) and of
-   magnitude at most RAD_BAKE_VALUE_MAX (patch areas excepted: they grow with the square of
-   the scene's scale), patch emission is >= 0 (RAD_ERROR_NEGATIVE_EMISSION), and the quantities that are non-negative by
-   definition (form factors, F_mb entries, block scales, outliers, alias totals) are >= 0
-   (else RAD_ERROR_CORRUPT); the logger names the section, the entry and the value. */
-#define RAD_CONTAINER_VERSION 1u
-/* The largest magnitude a loader accepts in a float section: 1e30, so that a sum of up to
-   3e8 such values (more than any row holds) stays finite. Nothing physical comes near (form
-   factors are <= 1, F_mb entries <= 1 / (1 - max albedo) <= 2^24); rad_save_memory refuses
-   larger values in what it writes, so whatever it writes loads. */
-#define RAD_BAKE_VALUE_MAX 1e30f
-
-/* Every section type the library writes, in one table. */
-typedef enum rad_section_type {
-    RAD_SECTION_PATCHES = 1,         /* rad_patch records */
-    RAD_SECTION_PATCH_VERTICES = 2,  /* 3 floats per welded vertex */
-    RAD_SECTION_TRIANGLES = 3,       /* 2 uint32 per scene triangle: first patch, subdivision */
-    RAD_SECTION_FF_DENSE = 4,        /* N*N floats, row-major */
-    RAD_SECTION_FF_ROW_OFFSETS = 5,  /* CSR: N+1 uint64 */
-    RAD_SECTION_FF_COLUMNS = 6,      /* CSR: uint32 */
-    RAD_SECTION_FF_VALUES = 7,       /* CSR: floats */
-    RAD_SECTION_VECTOR = 8,          /* a named RGB vector, 3N floats ("E", "B", "L", "H", ...) */
-    RAD_SECTION_SIGNATURE = 9,       /* one rad_bake_signature ("signature"): what it was made from */
-    /* the multi-bounce objects (>>api_multibounce), 16..31 */
-    RAD_SECTION_MB_INFO = 16,              /* 16 uint32: see rad_multibounce_sections */
-    RAD_SECTION_MB_FLOAT = 17,             /* 3 N^2 floats: the R, G, B planes */
-    RAD_SECTION_MB_HALF = 18,              /* 3 N^2 binary16 values */
-    RAD_SECTION_MB_ROW_PERM = 19,          /* N uint32 */
-    RAD_SECTION_MB_COL_PERM = 20,          /* N uint32 */
-    RAD_SECTION_MB_BC1 = 21,               /* ceil(N/4)^2 8-byte BC1 blocks */
-    RAD_SECTION_MB_BC4 = 22,               /* 3 ceil(N/4)^2 8-byte BC4 blocks: R plane, G, B */
-    RAD_SECTION_MB_SCALES = 23,            /* 3 floats (R, G, B) per scale tile */
-    RAD_SECTION_MB_OUTLIER_OFFSETS = 24,   /* N+1 uint64, CSR by original row */
-    RAD_SECTION_MB_OUTLIER_COLUMNS = 25,   /* uint32 original columns */
-    RAD_SECTION_MB_OUTLIER_VALUES = 26,    /* 3 floats (exact RGB) per outlier */
-    /* the alias tables (>>api_temporal), 32..39 */
-    RAD_SECTION_TEMPORAL_ROW_OFFSETS = 32, /* alias tables: rows + 1 uint64, offsets in bins */
-    RAD_SECTION_TEMPORAL_BINS = 33,        /* alias tables: the bins, 2 or 3 uint32 words each */
-    RAD_SECTION_TEMPORAL_TOTALS = 34,      /* alias tables: T_i, one float per row */
-    /* virtual patches (>>api_vp), 40..63 */
-    RAD_SECTION_VP_INFO = 40,              /* the set's sizes and grid: see rad_vp_sections */
-    RAD_SECTION_VP_AREAS = 41,             /* N floats */
-    RAD_SECTION_VP_ALBEDO = 42,            /* 3 N floats */
-    RAD_SECTION_VP_NORMALS = 43,           /* 3 N floats */
-    RAD_SECTION_VP_AXIS = 44,              /* N uint8 */
-    RAD_SECTION_VP_VOXEL = 45,             /* N uint32 */
-    RAD_SECTION_VP_VOXEL_KEYS = 46,        /* voxel_count uint64 */
-    RAD_SECTION_VP_VOXEL_FIRST = 47,       /* voxel_count + 1 uint32 */
-    RAD_SECTION_VP_VOXEL_PATCH = 48,       /* 6 uint32 per voxel */
-    RAD_SECTION_VP_SAMPLE_FIRST = 49,      /* voxel_count + 1 uint32 */
-    RAD_SECTION_VP_SAMPLE_POSITIONS = 50,  /* 3 M floats */
-    RAD_SECTION_VP_SAMPLE_NORMALS = 51,    /* 3 M floats */
-    RAD_SECTION_VP_SAMPLE_ALBEDO = 52,     /* 3 M floats */
-    RAD_SECTION_VP_SAMPLE_AREAS = 53,      /* M floats */
-    RAD_SECTION_VP_SAMPLE_WEIGHTS = 54,    /* 6 M floats */
-    RAD_SECTION_VP_SAMPLE_TRIANGLES = 55,  /* M uint32 */
-    RAD_SECTION_USER = 0x10000       /* types from here up are the application's own */
-} rad_section_type;
-
-/* The name of a section type without its prefix ("PATCHES", "MB_BC1", "VP_AREAS"), "USER"
-   from RAD_SECTION_USER up, NULL for a type the library does not know. Pure. */
-RAD_API const char *rad_section_type_name(uint32_t type);
-
-/* One section, for writing (data borrowed) or as found by rad_container_find (data points
-   into the container's bytes). */
-struct rad_section {
-    uint32_t type;
-    uint32_t elem_size;     /* bytes per element */
-    uint64_t count;         /* elements */
-    const void *data;       /* count * elem_size bytes */
-    char name[24];          /* NUL-terminated, may be empty */
-};
-
-/* Bytes that rad_container_write needs for these sections (SIZE_OVERFLOW if it overflows). */
-RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes);
-/* Writes the container into dst (dst_size >= rad_container_size). */
-RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t count, void *dst, size_t dst_size);
-/* Validates 'size' bytes at 'data' (borrowed: they must outlive the container, which reads
-   them in place: memory-mapped files work) and opens them. Errors: TRUNCATED, CORRUPT,
-   VERSION, INVALID_ARGUMENT, OUT_OF_MEMORY; the logger says which section and why. */
-RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_context *ctx, rad_container **out);
-RAD_API void rad_container_close(rad_container *container);
-RAD_API uint32_t rad_container_section_count(const rad_container *container);
-/* Section i (0 <= i < count), or NULL. */
-RAD_API const rad_section *rad_container_section(const rad_container *container, uint32_t index);
-/* The first section of 'type' whose name equals 'name' (any name when name is NULL), or NULL. */
-RAD_API const rad_section *rad_container_find(const rad_container *container, uint32_t type, const char *name);
-
-/* What a bake was made from (section RAD_SECTION_SIGNATURE, one 32-byte element), so that a
-   bake of another scene with the same triangle and patch counts is refused instead of
-   rendering silently wrong (rad_bake_matches_scene). A field of 0 was not recorded. */
-typedef struct rad_bake_signature {
-    uint64_t geometry;       /* rad_scene_hash: the triangles' positions */
-    uint64_t materials;      /* rad_scene_hash: each triangle's albedo, emission, texture id, uvs */
-    uint64_t options;        /* the application's hash of the options it baked with (rad_hash64) */
-    uint64_t reserved;       /* 0; readers ignore it */
-} rad_bake_signature;
-
-/* FNV-1a, 64 bits, over 'size' bytes, continuing from 'hash' (RAD_HASH64_INIT to start):
-   for each byte, hash = (hash ^ byte) * 0x100000001B3. rad_hash64("a", 1, RAD_HASH64_INIT)
-   is 0xAF63DC4C8601EC8C. Pure, O(size). */
-#define RAD_HASH64_INIT 0xCBF29CE484222325ull
-RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash);
-/* The two hashes of a signature, stable across platforms, byte orders and builds (only the
-   scene's input values enter, as the little-endian bytes of their IEEE bit patterns, never
-   values the library derives from them):
-     geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats;
-     materials = rad_hash64 of triangle_count, then per triangle its material's albedo[3],
-                 emission[3] (floats) and texture (uint32), then 1 and the 6 uv floats per
-                 triangle when the scene has uvs, else 0.
-   Indices are covered (positions are per triangle), and the geometric normals and areas follow
-   from the positions; shading normals are not kept by rad_scene, and a texture's contents
-   (the albedo_lookup callback) cannot be hashed, only its id. Either output may be NULL.
-   Errors: INVALID_ARGUMENT. Cost: O(triangles), no allocation. Thread safety: pure. */
-RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials);
-
-/* A loaded bake: patches (usable with rad_patches_locate, rad_patches_vertex_values and
-   rad_system_init; patches.scene is NULL, set it before calling functions that need the
-   scene), the form-factor matrix (rows == 0 when the bake has none) and the named vectors.
-   Everything points into the loaded bytes; free it with rad_bake_destroy, never with
-   rad_patches_destroy. */
-struct rad_bake {
-    rad_patches patches;
-    rad_matrix F;
-    const float *E;          /* "E" vector or NULL */
-    const float *B;          /* "B" vector (the solution as saved) or NULL */
-    const rad_bake_signature *signature; /* NULL when the bake has none (saved without a scene) */
-    rad_container *container;
-    void *owned;             /* private: bytes read from a file */
-    rad_allocator allocator; /* private */
-};
-
-/* Saves patches (required), a matrix (optional: NULL) and the vectors E and B (optional:
-   NULL; 3 * patches->count floats) into a new buffer *out of *out_size bytes, allocated with
-   ctx's allocator (free it with rad_free_buffer). When patches->scene is set, a signature
-   section records its rad_scene_hash (options 0: an application that wants its options
-   checked too rewrites that section with its own hash in 'options'). Values that a loader
-   would refuse (see VALUES above) are refused here: NON_FINITE, CORRUPT. */
-RAD_API rad_result rad_save_memory(const rad_patches *patches, const rad_matrix *F, const float *E, const float *B,
-                                   const rad_context *ctx, void **out, size_t *out_size);
-RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx);
-/* Opens a saved bake in place (data borrowed, must outlive the bake) and checks every index:
-   patch vertices < vertex count, patch triangles < triangle count, CSR offsets monotone and
-   columns < N, vector and matrix sizes equal to the patch count; and every value (VALUES
-   above): the form factors and every RAD_SECTION_VECTOR section (E, B and the application's
-   "H", "L", ...: each must hold 3N floats). A signature section, when present, must be one
-   32-byte element. Errors: the container's, NON_FINITE, CORRUPT, INDEX_OUT_OF_RANGE,
-   SIZE_MISMATCH, ALBEDO_RANGE, DEGENERATE_TRIANGLE, OUT_OF_MEMORY. */
-RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out);
-RAD_API void rad_bake_destroy(rad_bake *bake);
-/* RAD_SUCCESS when 'bake' was made from 'scene': the same triangle count and, when the bake
-   has a signature, the same geometry and materials hashes (rad_scene_hash), and the same
-   options hash when both 'options' and the bake's are non-zero. Otherwise
-   RAD_ERROR_SCENE_MISMATCH, and the logger says what differs (geometry, materials, options)
-   with both hashes. A bake without a signature (saved without a scene) is checked by its
-   triangle count only, with a warning through the logger. Errors: INVALID_ARGUMENT,
-   SCENE_MISMATCH. Cost: O(triangles). */
-RAD_API rad_result rad_bake_matches_scene(const rad_bake *bake, const rad_scene *scene, uint64_t options,
-                                          const rad_context *ctx);
-#ifndef RAD_NO_STDIO
-/* The same, through a file. Saving writes '<path>.partial' in the same folder and renames it
-   into place only when complete, so a failed save leaves the old file as it was (IO). Loading
-   reads the 64-byte header first and refuses a folder (IO), a file without the container
-   magic (CORRUPT) or one shorter than its header says (TRUNCATED) before reading the rest. */
-RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
-                                 const float *B, const rad_context *ctx);
-RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out);
-#endif
-
-/* ======================================================================================== */
-/* >>api_glsl: GLSL compute kernels                                                         */
-/* ======================================================================================== */
-
-/* The compute kernels, as GLSL 4.50 source text the application compiles (with
-   glslang or shaderc) and dispatches on its own Vulkan 1.1+ device (Vulkan GLSL: push
-   constants and specialization constants): radiosity.h never touches a GPU. The canonical
-   sources are the files glsl/<name> of the repository; the copy in the >>glsl section is
-   generated from them (make glsl) and a test fails when it is out of date. Every kernel is compiled and run by tests/test_vulkan.c on a Vulkan device
-   (Mesa's lavapipe in CI) and compared with the CPU function named in its entry.
-
-   COMMON RULES
-   - Compute only. Descriptor set 0, bindings as listed, every buffer a std430 storage buffer
-     of 32-bit scalars (float, uint) or uint64 row offsets read as uvec2 (low word first: the
-     little-endian layout of rad_matrix.row_offsets and rad_alias_tables.row_offsets, uploaded
-     unchanged). RGB vectors are 3N interleaved floats, as everywhere in radiosity.h.
-   - Workgroup: layout(local_size_x_id = 0): specialization constant RAD_GLSL_SPEC_LOCAL_SIZE
-     (id 0) sets the x size (default 1 when not specialized; 64 to 256 are good choices, any
-     size up to maxComputeWorkGroupInvocations works). Nothing depends on the subgroup size.
-   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*, LOCAL_APPLY, LOCAL_UPDATE) run
-     ONE WORKGROUP PER ROW: dispatch row_count groups in x (at most
-     maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
-     invocations read the row at consecutive addresses with a stride of the group size and sum
-     in shared memory (12 bytes per invocation). The temporal step, the alias build and
-     VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
-     (LOCAL_VECTORS: per row or column, see its entry).
-   - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
-     by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
-     checked at compile time).
-   - CHUNKING. Every kernel processes rows [row_offset, row_offset + row_count) and reads the
-     big array (the matrix, its entries or bins) relative to a base, so a matrix larger than
-     one storage-buffer range (maxStorageBufferRange: 128 MiB on lavapipe, 4 GiB on most
-     desktop drivers) is processed as several dispatches, each binding only its rows: bind the
-     range from an offset rounded down to minStorageBufferOffsetAlignment and pass the
-     remainder, in elements, as the base. Small arrays (vectors, row offsets) are bound whole.
-   - Results agree with the CPU path to float rounding: the tests accept 1e-5 relative. The
-     temporal kernel draws the same indices as rad_temporal_step (same generator, same alias
-     draw, integer arithmetic), so it is compared directly.
-
-   THE KERNELS (binding: contents)
-   RAD_GLSL_GATHER_DENSE   one classic bounce, out_i = rho_i sum_j F_ij E_j (+ E_i),
-       as rad_solve_jacobi with bounces = 1. Push: rad_glsl_gather_dense_push.
-       0: F, row-major, rows of the chunk (F[row_offset][0] at element f_base)  1: E (3N)
-       2: albedo (3N)  3: out (3N; rows of the chunk written)
-   RAD_GLSL_GATHER_CSR     the same with a CSR matrix. Push: rad_glsl_gather_csr_push.
-       0: row offsets (N + 1 uint64)  1: columns  2: values (entry k at element k - entry_base)
-       3: E  4: albedo  5: out
-   RAD_GLSL_MB_APPLY_FLOAT out = F_mb E (+ E) as rad_multibounce_apply, float planes.
-       Push: rad_glsl_mb_apply_push; flags RAD_GLSL_FLAG_TOTAL, RAD_GLSL_FLAG_PERMUTED.
-       0, 1, 2: the R, G, B planes (rows of the chunk, plane row row_offset at element base)
-       3: E (original order)  4: col_perm  5: row_perm (bind any buffer when not PERMUTED)
-       6: out (original order; rows row_perm[row_offset ..] written)
-   RAD_GLSL_MB_APPLY_HALF  the same with binary16 planes (rad_multibounce.half uploaded
-       unchanged, read as uint words with unpackHalf2x16; base counted in halves). Each plane's
-       buffer and each bound range must cover whole 4-byte words: pad a plane of odd N^2 to a
-       multiple of 4 bytes and round a chunk's range up, or the word holding its last value
-       reads as zero (robust buffer access).
-   RAD_GLSL_TEMPORAL_STEP  one frame of rad_temporal_step with a fixed weight (the adaptive
-       weight stays on the CPU). Push: rad_glsl_temporal_push.
-       0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
-       word w of the tables, bin b starting at w = b * words, at element w - word_base)
-       2: totals T_i  3: E  4: albedo  5: B^prev  6: B^next (ping-pong the two buffers
-       between frames)  7: bins per row, RAD_GLSL_FLAG_PADDED only (else bind any buffer).
-       MULTIBOUNCE mode with three table sets: three dispatches, channel c, sample_base c * k,
-       table set c bound. PADDED: the tables as RAD_GLSL_ALIAS_BUILD writes them (binding 0 =
-       its input row offsets, 2 and 7 its totals and counts), sampled without compaction.
-   RAD_GLSL_MB_APPLY_BLOCKS  out = F~ E (+ E) as rad_multibounce_blocks_apply: the blocks
-       uploaded unchanged as VK_FORMAT_BC1_RGB_UNORM_BLOCK or three VK_FORMAT_BC4_UNORM_BLOCK
-       images (feature textureCompressionBC), decoded by the texture unit with texelFetch
-       (decoders round differently: within 2/255 per channel of rad_bc1_decode_block and
-       rad_bc4_decode_block, measured 1.6/255 on lavapipe), times the tile scales, plus the
-       exact outliers. Push: rad_glsl_mb_blocks_push; flags RAD_GLSL_FLAG_TOTAL, _PERMUTED,
-       _BC1, _OUTLIERS. 0, 1, 2: combined image samplers (BC1:
-       the one image at all three; BC4X3: R, G, B planes)  3: scales (3 per tile)  4: E
-       5: col_perm  6: row_perm  7: outlier offsets (N + 1 uint64)  8: outlier columns
-       9: outlier values (3 each)  10: out. Rows are texel rows (chunks of row_offset, row_count
-       with row_offset + row_count <= N); the outlier arrays are bound whole (indexed by
-       original row), which limits them to one storage range (N of about 14 000 at 5%), and
-       the image to maxImageDimension2D texels (16384 on lavapipe).
-   RAD_GLSL_ALIAS_BUILD    alias tables of streamed rows (docs/methods/temporal.md), the bins of
-       rad_alias_build_row (Vose in double: needs the shaderFloat64 feature; bit-identical where
-       double arithmetic is IEEE, as on lavapipe). Push: rad_glsl_alias_build_push; flags
-       RAD_GLSL_FLAG_DENSE (rows of cols values, no column array). 0: input row offsets
-       (rows + 1 uint64)  1: columns  2: values (entry k at k - entry_base)  3: bins out, padded
-       layout: row i's bins from bin row_offsets[i] + i (room for its entries + 1), at word
-       (b - out_base) * words  4: scratch, one double per output bin  5: scratch, one uint per
-       output bin  6: bin count per row (0: a negative or non-finite entry, or a column >= cols)
-       7: T_i per row. RAD_GLSL_TEMPORAL_STEP samples this layout directly (RAD_GLSL_FLAG_PADDED).
-   RAD_GLSL_LIGHTING       an include, not a kernel: every lighting model and BRDF term of
-       >>api_shading as GLSL functions named as in C (rad_shade ...), no #version line: put
-       its text after yours (or resolve an #include to it). Its results agree with the C
-       functions to 1e-5 relative (tests/test_shading_vulkan.c, through glsl/lighting_eval.comp;
-       the header's copy is checked equal to glsl/lighting.glsl).
-   RAD_GLSL_LOCAL_APPLY    L_i = sum_{j in P_Lit} T_ij E_j (+ E_i) for i in P_Vis, as rad_local_apply,
-       on the planes of a rad_local (>>api_local; uploaded unchanged or kept resident on the
-       GPU). Push: rad_glsl_local_apply_push; flags RAD_GLSL_FLAG_TOTAL. ONE WORKGROUP PER
-       VISIBLE ENTRY. 0, 1, 2: the R, G, B planes (stride m = capacity; the rows slot_offset ..
-       slot_offset + slot_count - 1, row slot_offset at element base)  3: E (3n, world order)
-       4: lit map, slot_end uints: the world patch whose E lights column j, or RAD_NONE
-       (unlit or free slot)  5: slot of each visible entry  6: world patch of each visible entry
-       7: out (3n; the visible patches written). Chunks: an entry whose slot is outside the
-       bound rows is skipped, so each chunk's dispatch may take the whole visible list.
-   RAD_GLSL_LOCAL_VECTORS and RAD_GLSL_LOCAL_UPDATE  rad_local_add on T resident on the GPU:
-       the host keeps the slot bookkeeping (which slot, which member to evict) and streams only
-       the new patch's row and column over the slots, a_c[j] = rho_c[patch(j)] A_n F_nj / A_j and
-       b_c[j] = rho_c[n] F_nj (3 m floats each, channel-major, zero outside the members and at
-       the evicted slot), the list nz of the slots where F_nj != 0, and rho_n F_nn. VECTORS is
-       the small pre-pass: u = (I + T) a, v = b (I + T) (pass RAD_GLSL_LOCAL_PASS_GATHER, one
-       dispatch per row chunk, one invocation per row or column: max(row_count, end)
-       invocations), the corrections of the fused exact downdate when the add evicts slot ev
-       (pass _EVICT, end invocations) and s = 1 - ann - b.u with the factors of the exact or
-       first-order form (pass _SCALARS, 3 invocations), in float, into a work buffer of
-       RAD_GLSL_LOCAL_WORK_FLOATS(m) floats; UPDATE is the O(M^2) pass, ONE WORKGROUP PER ROW:
-       T += cuv u v - c r / g (rank 1, or rank 2 when evicting), the new row coef v and column
-       coef u, T_kk. Pushes: rad_glsl_local_vectors_push, rad_glsl_local_update_push; the
-       layout of the work buffer is in glsl/local_vectors.comp. VECTORS bindings: 0, 1, 2
-       planes (the chunk's rows at base; passes 1 and 2 read none: bind any range)  3: a
-       4: b  5: nz  6: work. UPDATE bindings: 0, 1, 2 planes (read-write, the chunk's rows)
-       3: work. A kernel cannot return an error: when s <= 1e-12 in some channel (rows that
-       break energy conservation: the CPU's RAD_ERROR_SINGULAR) UPDATE writes nothing; read s
-       (work[12 m + c]) back to detect it. With RAD_LOCAL_EVICT_DROP an add into a full set is
-       a plain add (ev = RAD_NONE) into the dropped member's slot k, with that member out of
-       the slot map: row and column k are overwritten as the drop would have zeroed them.
-       Each dispatch reads what the one before it wrote (pass 0's chunks accumulate v): in
-       one command buffer, put a compute-to-compute buffer memory barrier (shader write to
-       shader read) between consecutive dispatches, and before LOCAL_APPLY reads the planes.
-       The standalone rad_local_evict (a rank-1 downdate) has no kernel; hiding and showing
-       members (rad_local_remove, re-adding a hidden member) touch no plane. Measured on
-       lavapipe (tests/test_vulkan.c), T resident through 54 adds into M = 48 (the last 6 into
-       a full set: rank 2, or after a drop): at most 9.7e-7 relative from rad_local_add's
-       planes (exact and first-order), the float pre-pass against the CPU's double u, v, s.
-   RAD_GLSL_VP_GATHER      virtual-patch gathering at surface points (vertices, G-buffer
-       texels), as rad_vp_gather: split-weight (or, clustered, N . n) normal weights in each
-       voxel of the 2x2x2 block, trilinear weights across the voxels, voxels missing or with no
-       patch facing n skipped (>>api_vp). Push: rad_glsl_vp_gather_push (the grid of the
-       rad_virtual_patches); flags RAD_GLSL_FLAG_COSINE (weights RAD_VP_WEIGHTS_COSINE),
-       _CLUSTERED. ONE INVOCATION PER POINT. 0: points (3 floats each)  1: unit normals
-       (3 each)  2: values per patch (3N: B, L or H)  3: voxel_keys (voxel_count uint64, as
-       uvec2)  4: voxel_patch (6 per voxel)  5: patch normals (3N; read only when CLUSTERED,
-       else bind any buffer)  6: out (3 per point). Chunks: bindings 0, 1 and 6 hold the
-       chunk's points from element base (bind the three at the same offset). The grid
-       coordinate is computed as a float pair (TwoSum / Dekker products: the CPU uses double),
-       because its float rounding, about 1e-7 dims absolute, is large against small trilinear
-       weights (measured: 3e-5 relative without it, 2.9e-7 with it, on lavapipe).
-   RAD_GLSL_PROBE_UPDATE   irradiance probes from a new patch solution, as rad_probes_update
-       (>>api_probes): E_i = D_i + sum_e W_e,i B_patch(e), 27 coefficients per probe.
-       Push: rad_glsl_probe_update_push. ONE INVOCATION PER PROBE. The arrays of
-       rad_probes_weights uploaded unchanged: 0: first (probe count + 1 uint64)  1: patch index
-       per entry (entry k at element k - entry_base)  2: weights (9 per entry, entry k's at
-       element 9 k - weight_base)  3: direct (27 per probe)  4: B (3N)  5: out coefficients
-       (27 per probe; the chunk's probes written). Matches the CPU to 1e-5 (measured 6.8e-6 on
-       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c).
-   RAD_GLSL_LIGHTMAP_REFRESH  a lightmap from a new patch irradiance H, as rad_lightmap_refresh
-       (>>api_lightmap), on the arrays of rad_lightmap_weights uploaded unchanged, in TWO
-       PASSES (push member pass): RAD_GLSL_LIGHTMAP_PASS_VERTICES, one invocation per patch
-       vertex, V = the vertex values of H; then RAD_GLSL_LIGHTMAP_PASS_TEXELS, one invocation
-       per row, the texels from V (a compute-to-compute barrier between the two: pass 1 reads
-       binding 4). Push: rad_glsl_lightmap_refresh_push. 0: vertex_first (vertex_count + 1)
-       1: vertex_patches  2: vertex_weights (entry k of both at element k - entry_base in pass
-       0)  3: H (3N)  4: V, scratch of 3 floats per vertex  5: row_texels  6: row_first
-       (row_count + 1)  7: entry_vertices  8: entry_weights (entry e at element e - entry_base
-       in pass 1)  9: the lightmap (3 per texel; only texels with a row written). A pass reads
-       none of the other's bindings among 0..3 and 5..9: bind any buffer there. Matches the
-       CPU to 1e-5 (tests/test_vulkan.c). */
-
-/* >>glsl ids begin */
-typedef enum rad_glsl_id {
-    RAD_GLSL_GATHER_DENSE      =  0, /* glsl/gather_dense.comp */
-    RAD_GLSL_GATHER_CSR        =  1, /* glsl/gather_csr.comp */
-    RAD_GLSL_MB_APPLY_FLOAT    =  2, /* glsl/mb_apply_float.comp */
-    RAD_GLSL_MB_APPLY_HALF     =  3, /* glsl/mb_apply_half.comp */
-    RAD_GLSL_TEMPORAL_STEP     =  4, /* glsl/temporal_step.comp */
-    RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* glsl/mb_apply_blocks.comp */
-    RAD_GLSL_ALIAS_BUILD       =  6, /* glsl/alias_build.comp */
-    RAD_GLSL_LIGHTING          =  7, /* glsl/lighting.glsl */
-    RAD_GLSL_LOCAL_APPLY       =  8, /* glsl/local_apply.comp */
-    RAD_GLSL_LOCAL_VECTORS     =  9, /* glsl/local_vectors.comp */
-    RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
-    RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
-    RAD_GLSL_PROBE_UPDATE      = 12, /* glsl/probe_update.comp */
-    RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* glsl/lightmap_refresh.comp */
-    RAD_GLSL_COUNT = 14
-} rad_glsl_id;
-/* >>glsl ids end */
-
-#define RAD_GLSL_SPEC_LOCAL_SIZE 0u   /* specialization constant id of the workgroup x size */
-#define RAD_GLSL_FLAG_TOTAL 1u        /* gather, applies: add E; the value of RAD_OUTPUT_TOTAL */
-#define RAD_GLSL_FLAG_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
-#define RAD_GLSL_FLAG_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
-#define RAD_GLSL_FLAG_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
-#define RAD_GLSL_FLAG_PADDED 4u       /* temporal: tables in the padded layout of RAD_GLSL_ALIAS_BUILD */
-#define RAD_GLSL_FLAG_BC1 4u          /* block apply: one BC1 image (else three BC4 images) */
-#define RAD_GLSL_FLAG_OUTLIERS 8u     /* block apply: the outlier arrays are bound */
-#define RAD_GLSL_FLAG_DENSE 1u        /* alias build: dense rows, no column array */
-#define RAD_GLSL_FLAG_FIRST_CHUNK 1u  /* local vectors, pass 0: the first row chunk (v = b + ...) */
-#define RAD_GLSL_FLAG_FIRST_ORDER 2u  /* local vectors, pass 2: RAD_LOCAL_FIRST_ORDER factors */
-#define RAD_GLSL_LOCAL_PASS_GATHER 0u  /* local vectors: u, c, v, r from T (row-chunked) */
-#define RAD_GLSL_LOCAL_PASS_EVICT 1u   /* local vectors: the fused downdate's corrections (evicting adds) */
-#define RAD_GLSL_LOCAL_PASS_SCALARS 2u /* local vectors: s and the factors, 3 invocations */
-/* floats of the local-update work buffer for capacity m (u, v, c, r per channel, 12 scalars) */
-#define RAD_GLSL_FLAG_COSINE 1u       /* vp gather: RAD_VP_WEIGHTS_COSINE split weights */
-#define RAD_GLSL_FLAG_CLUSTERED 2u    /* vp gather: RAD_VP_CLUSTERED (w = N_a . n; binding 5 read) */
-#define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
-#define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
-#define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
-
-/* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
-typedef struct rad_glsl_gather_dense_push {
-    uint32_t row_offset, row_count, cols, f_base, flags;
-} rad_glsl_gather_dense_push;
-typedef struct rad_glsl_gather_csr_push {
-    uint32_t row_offset, row_count, entry_base, flags;
-} rad_glsl_gather_csr_push;
-typedef struct rad_glsl_mb_apply_push {   /* RAD_GLSL_MB_APPLY_FLOAT and _HALF */
-    uint32_t n, row_offset, row_count, base, flags;
-} rad_glsl_mb_apply_push;
-typedef struct rad_glsl_temporal_push {
-    uint32_t seed, frame;          /* rad_temporal_options.seed; the frame being computed (0, 1, ...) */
-    uint32_t row_offset, row_count;
-    uint32_t n;                    /* N: the environment's column */
-    uint32_t samples;              /* k */
-    uint32_t words;                /* (uint32_t)rad_alias_tables.format: 2 or 3 */
-    uint32_t flags;                /* RAD_GLSL_FLAG_ALBEDO, _FEEDBACK, _PADDED */
-    uint32_t channel;              /* 3: RGB from one table set; 0..2: this channel only */
-    uint32_t sample_base;          /* channel * k with three table sets, else 0 */
-    uint32_t word_base;            /* low 32 bits of the tables' word index at element 0 of binding 1 */
-    float weight;                  /* w */
-    float env[3];                  /* E_0 */
-} rad_glsl_temporal_push;
-typedef struct rad_glsl_mb_blocks_push {
-    uint32_t n, row_offset, row_count;
-    uint32_t tile, tiles_per_row;  /* rad_multibounce_blocks.tile, .tiles_per_row */
-    uint32_t flags;
-} rad_glsl_mb_blocks_push;
-typedef struct rad_glsl_alias_build_push {
-    uint32_t row_offset, row_count;
-    uint32_t cols;                 /* N: the environment's column */
-    uint32_t words;                /* 2 (RAD_ALIAS_COMPACT, cols <= 65535) or 3 (RAD_ALIAS_WIDE) */
-    uint32_t entry_base;           /* low 32 bits of the entry at element 0 of bindings 1, 2 */
-    uint32_t out_base;             /* low 32 bits of the bin at element 0 of bindings 3, 4, 5 */
-    uint32_t flags;                /* RAD_GLSL_FLAG_DENSE */
-} rad_glsl_alias_build_push;
-typedef struct rad_glsl_local_apply_push {
-    uint32_t m, end;               /* rad_local.capacity (plane stride), rad_local.slot_end */
-    uint32_t row_offset, row_count; /* visible entries of this dispatch */
-    uint32_t slot_offset, slot_count; /* plane rows held by bindings 0..2 */
-    uint32_t base;                 /* element of bindings 0..2 holding plane row slot_offset */
-    uint32_t flags;                /* RAD_GLSL_FLAG_TOTAL */
-} rad_glsl_local_apply_push;
-typedef struct rad_glsl_local_vectors_push {
-    uint32_t m, end;               /* capacity; slots in use after the add */
-    uint32_t row_offset, row_count, base; /* pass 0: the plane rows bound */
-    uint32_t nnz;                  /* slots in the nz list */
-    uint32_t ev;                   /* the slot evicted by this add, or RAD_NONE */
-    uint32_t pass;                 /* RAD_GLSL_LOCAL_PASS_* */
-    uint32_t flags;                /* RAD_GLSL_FLAG_FIRST_CHUNK, _FIRST_ORDER */
-    float ann[3];                  /* rho_n F_nn per channel */
-} rad_glsl_local_vectors_push;
-typedef struct rad_glsl_local_update_push {
-    uint32_t m, end, row_offset, row_count, base;
-    uint32_t k;                    /* the new patch's slot */
-    uint32_t ev;                   /* the slot evicted by this add (== k), or RAD_NONE */
-} rad_glsl_local_update_push;
-typedef struct rad_glsl_vp_gather_push {
-    float origin[3];               /* rad_virtual_patches.origin */
-    float voxel_size[3];           /* .voxel_size */
-    uint32_t dims[3];              /* .dims */
-    uint32_t voxel_count;          /* .voxel_count */
-    uint32_t row_offset, row_count; /* the points of this dispatch */
-    uint32_t base;                 /* element of bindings 0, 1, 6 holding point row_offset's x */
-    uint32_t flags;                /* RAD_GLSL_FLAG_COSINE, _CLUSTERED */
-} rad_glsl_vp_gather_push;
-typedef struct rad_glsl_probe_update_push {
-    uint32_t row_offset, row_count; /* the probes of this dispatch */
-    uint32_t entry_base;           /* low 32 bits of the entry at element 0 of binding 1 */
-    uint32_t weight_base;          /* low 32 bits of the float (9 x entry) at element 0 of binding 2 */
-} rad_glsl_probe_update_push;
-typedef struct rad_glsl_lightmap_refresh_push {
-    uint32_t pass;                 /* RAD_GLSL_LIGHTMAP_PASS_VERTICES or _TEXELS */
-    uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
-    uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
-} rad_glsl_lightmap_refresh_push;
-
-/* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
-RAD_API const char *rad_glsl_name(rad_glsl_id id);
-
-/* The source of kernel 'id' in pieces: returns an array of *out_count string pointers (static
-   storage, never freed) whose concatenation is the source, or NULL (and 0) for an unknown id.
-   Each piece is at most 4000 characters and ends at a line end. Pure, thread-safe. */
-RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
-
-/* The whole source of kernel 'id' (the pieces concatenated), NUL-terminated, into dst.
-   *out_length (optional) receives the length without the NUL, on success and when dst is too
-   small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
-   INVALID_ARGUMENT (unknown id; dst NULL with out_length NULL or dst_size > 0), SIZE_MISMATCH
-   (dst_size <= length: nothing written), UNAVAILABLE (built with RAD_NO_GLSL, under which
-   rad_glsl_name and rad_glsl_pieces return NULL). Pure, thread-safe, no allocation. Cost: O(length). */
-RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
-
-/* ======================================================================================== */
 /* >>api_kernels: shared numeric kernels                                                    */
 /* ======================================================================================== */
 
@@ -2519,7 +1546,7 @@ typedef struct rad_row_source {
    areas and albedo: they must outlive the source). With a rad_bake opened in place over a
    memory-mapped file (rad_load_memory on the mapping), opening reads the file once (it
    checks every section's checksum); after that the system may drop the pages and rows are
-   paged in as they are read. rad_row_stream_open never reads the matrix whole. Errors: INVALID_ARGUMENT, SIZE_MISMATCH
+   paged in as they are read. rad_row_stream_create never reads the matrix whole. Errors: INVALID_ARGUMENT, SIZE_MISMATCH
    (not square). Cost O(1); a fetch costs O(row entries) (O(n) for a dense matrix). */
 RAD_API rad_result rad_row_source_matrix(const rad_matrix *F, const float *areas, const float *albedo,
                                          rad_row_source *out);
@@ -2543,12 +1570,12 @@ RAD_API rad_result rad_row_source_bake(const rad_bake *bake, rad_row_source *out
    thread (fetches move the file position). Seeks go through fseek, so where long is 32 bits
    a row beyond 2 GiB into the file fails with IO. */
 typedef struct rad_row_stream rad_row_stream;
-RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx, rad_row_stream **out);
+RAD_API rad_result rad_row_stream_create(const char *path, const rad_context *ctx, rad_row_stream **out);
 /* Fills a row source that reads through 'stream' (which must outlive it). */
 RAD_API void rad_row_stream_source(rad_row_stream *stream, rad_row_source *out);
 /* Bytes the stream holds in memory (areas, albedos, row offsets). */
 RAD_API size_t rad_row_stream_memory(const rad_row_stream *stream);
-RAD_API void rad_row_stream_close(rad_row_stream *stream);
+RAD_API void rad_row_stream_destroy(rad_row_stream *stream);
 #endif
 
 typedef enum rad_local_update {
@@ -2650,7 +1677,7 @@ RAD_API rad_result rad_local_rebuild(rad_local *local, const uint32_t *patches, 
    safety: reentrant (local is read only). Cost: O(|visible| slot_end). docs/methods/local.md. */
 RAD_API rad_result rad_local_apply(const rad_local *local, const float *E, const uint32_t *visible,
                                    uint32_t visible_count, const uint32_t *lit, uint32_t lit_count,
-                                   rad_output output, float *out, const rad_context *ctx);
+                                   float *out, rad_output output, const rad_context *ctx);
 /* Bytes the object holds (planes, maps and scratch). */
 RAD_API size_t rad_local_memory(const rad_local *local);
 
@@ -2788,7 +1815,7 @@ RAD_API rad_result rad_alias_tables_create_dense(const float *plane, uint32_t n,
                                                  const rad_context *ctx, rad_alias_tables **out);
 
 /* Tables for every row of a rad_row_source (>>api_local): rows fetched one at a time, from
-   memory or streamed from a file (rad_row_stream_open, also over a saved virtual-patch set), so
+   memory or streamed from a file (rad_row_stream_create, also over a saved virtual-patch set), so
    the matrix is never held whole: memory is the tables' O(nnz) plus one row. Each row is read
    twice (a pass that counts the bins, then the build); a row whose columns do not ascend is
    sorted first, so the bins equal those of rad_alias_tables_create on the same matrix, bit for
@@ -2827,9 +1854,11 @@ RAD_API void rad_temporal_random(uint32_t seed, uint32_t frame, uint32_t row, ui
 RAD_API uint32_t rad_alias_draw(const uint32_t *bins, uint32_t n, rad_alias_format format, uint32_t u1, uint32_t u2);
 
 /* Sections for writing the tables into a container (rad_container_write), named 'name'
-   (up to 23 characters; the three sections share it), into out[0..2]. Data borrowed from the
-   tables. */
-RAD_API void rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section *out);
+   (up to 23 characters; the three sections share it), into out[0..2]; *out_count (optional)
+   receives 3. Data borrowed from the tables. Errors: INVALID_ARGUMENT (tables or out NULL;
+   out is then zeroed when not NULL). */
+RAD_API rad_result rad_alias_tables_sections(const rad_alias_tables *tables, const char *name, rad_section *out,
+                                             uint32_t *out_count);
 
 /* A non-owning view of tables stored in a container under 'name', validated once (offsets
    monotone, bin counts in [1, N + 1], columns and aliases <= cols, totals > 0 and at most
@@ -3013,7 +2042,7 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    is (CSR or dense): rad_solve_*, rad_matrix_multiply, rad_multibounce_create,
    rad_alias_tables_create (temporal radiosity), rad_row_source_matrix with vp->areas and
    vp->albedo (the local matrix, rad_alias_build_row on rows fetched one at a time), and
-   rad_vp_sections / rad_vp_load (>>api_vp, container) with rad_row_stream_open, which
+   rad_vp_sections / rad_vp_load (>>api_vp, container) with rad_row_stream_create, which
    streams the rows of a saved set from its file.
    USE: rad_vp_system makes a rad_system for every classic solver (the matrix is a dense
    row-major or CSR rad_matrix); rad_vp_sources gives the primary light E per patch; rad_vp_gather
@@ -3294,7 +2323,7 @@ RAD_API void rad_vp_lights_destroy(rad_vp_lights *state);
    per-sample arrays of rad_virtual_patches (types RAD_SECTION_VP_AREAS .. _SAMPLE_TRIANGLES,
    one each, in the struct's layout), and the matrix as RAD_SECTION_FF_DENSE or the three
    RAD_SECTION_FF_ROW_OFFSETS / _COLUMNS / _VALUES sections (CSR), so that
-   rad_row_stream_open streams the rows of a saved set from its file as it does a classic
+   rad_row_stream_create streams the rows of a saved set from its file as it does a classic
    bake's (it takes the areas and albedos from these sections when the file has no patches).
    *out_count receives how many were written (at most RAD_VP_MAX_SECTIONS). Errors:
    INVALID_ARGUMENT. */
@@ -3316,6 +2345,263 @@ RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *na
    INDEX_OUT_OF_RANGE (a sample triangle beyond the scene), OUT_OF_MEMORY. Cost: O(size). */
 RAD_API rad_result rad_vp_load(const rad_container *container, const char *name, const rad_scene *scene,
                                const rad_context *ctx, rad_virtual_patches **out);
+
+/* ======================================================================================== */
+/* >>api_lightmap: lightmaps over a second UV set                                           */
+/* ======================================================================================== */
+
+/* Lightmaps (docs/methods/lightmap.md): the light of a solved patch set baked into a W x H
+   texture over the meshes' lightmap_uvs (rad_mesh_desc), the form engines consume for static
+   geometry. Steps: rad_lightmap_create (texels: rasterize, sample points, validity),
+   rad_lightmap_gather (+ rad_lightmap_direct), then rad_lightmap_dilate and rad_lightmap_stitch.
+   TEXELS. Texel (x, y) covers u in [x/W, (x+1)/W] and v in [y/H, (y+1)/H]; its centre is at
+   ((x + 1/2)/W, (y + 1/2)/H); values are stored row by row from y = 0. Coverage is
+   conservative: a texel belongs to every lightmapped triangle whose uv triangle overlaps its
+   square (a separating-axis test), however little, so bilinear filtering inside any triangle
+   reads only texels that were baked for it. Each texel has an n x n grid of sub-points
+   (samples, rounded to a square); every sub-point inside a triangle's uv triangle becomes a
+   SAMPLE on that triangle (world position by barycentric interpolation, the triangle's
+   geometric normal). A covered texel without any inside sub-point gets one sample: the point
+   of the nearest overlapping triangle closest (in uv) to the texel centre. Every sample then
+   moves 4 ray epsilons towards its triangle's centroid (at most half the way), so one on a
+   triangle's border is not on the plane of the wall that meets it there.
+   VALIDITY. From each sample, validity_rays cosine-distributed rays; one that hits a back
+   face means the sample lies inside or behind geometry (the floor under a wall standing on
+   it, the ceiling behind a one-sided lamp). A sample is invalid when more than
+   backface_limit of its rays hit back faces; a texel is valid when any of its samples is.
+   Invalid samples take no part in the gather, so a texel at a wall-floor contact is lit only
+   from the side of the wall its valid samples are on: no light leaks under a wall at least a
+   texel thick (a thinner one puts both sides into the same texel: use more texels).
+   Cost: O(texels samples) rasterization, validity_rays rays per sample. */
+
+typedef struct rad_lightmap_options {
+    uint32_t width, height;     /* texels (0: 256 each; at most 16384, and width * height * samples
+                                   at most 2^28) */
+    uint32_t samples;           /* sub-points per texel, rounded to a square n x n (0: 4; at most 16) */
+    uint32_t validity_rays;     /* rays per sample for the inside-geometry test (0: 16; at most
+                                   1024) */
+    float backface_limit;       /* a sample is invalid when more than this fraction of its
+                                   validity rays hit back faces (0: 0.1; in (0, 1]; 1 turns the
+                                   test off) */
+    float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;              /* rotates the validity rays */
+} rad_lightmap_options;
+
+/* Texel flags */
+#define RAD_TEXEL_COVERED 1u    /* some lightmapped triangle overlaps the texel */
+#define RAD_TEXEL_VALID 2u      /* ... and some of its samples passed the validity test */
+
+/* The texels of one atlas. Read-only after creation. Texel i = x + width * y. */
+typedef struct rad_lightmap {
+    uint32_t width, height;
+    uint8_t *flags;             /* width * height: RAD_TEXEL_* bits */
+    float *positions;           /* 3 per texel: mean of the valid samples (of all, when none is
+                                   valid; 0 when uncovered) */
+    float *normals;             /* 3 per texel: their normalized mean normal (0 when uncovered) */
+    uint32_t *sample_first;     /* width * height + 1: the samples of texel i are
+                                   [sample_first[i], sample_first[i + 1]) */
+    uint32_t sample_count;
+    float *sample_positions;    /* 3 per sample */
+    float *sample_normals;      /* 3 per sample: the unit geometric normal of its triangle */
+    uint32_t *sample_triangles; /* per sample: the scene triangle */
+    uint8_t *sample_valid;      /* per sample: 1 valid, 0 inside or behind geometry */
+    uint32_t covered_texels, valid_texels, invalid_samples;
+    uint64_t rays_cast;         /* validity rays */
+    const rad_scene *scene;     /* borrowed: must outlive this object */
+    rad_allocator allocator;    /* private */
+} rad_lightmap;
+
+RAD_API void rad_lightmap_options_default(rad_lightmap_options *options);
+
+/* Builds the texels of the scene's lightmapped triangles (those of meshes with lightmap_uvs;
+   uvs outside [0, 1] are clipped to the atlas). raycaster: its intersect() casts the validity
+   rays (borrowed for the call). Errors: INVALID_ARGUMENT (NULL input, a scene without
+   lightmap_uvs, an option out of range), SIZE_OVERFLOW, RAYCAST_FAILED, CANCELLED,
+   OUT_OF_MEMORY; the logger says which. Thread safety: reentrant; the validity rays run
+   through ctx->parallel_for; deterministic whatever the thread count. */
+RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                       const rad_lightmap_options *options, const rad_context *ctx,
+                                       rad_lightmap **out);
+RAD_API void rad_lightmap_destroy(rad_lightmap *lightmap);
+
+/* GATHER. At each valid sample p (unit normal n) the irradiance from the secondary sources
+   (patch radiosities B_j, exitance W m^-2, Lambertian: radiance B_j / pi) is
+       H(p) = sum_j B_j F(p, j) V(p, j)
+   with F(p, j) the analytic point-to-polygon form factor of patch j clipped to p's upper
+   half-space (rad_ff_point_polygon) and V(p, j) its visible share: visibility_rays shadow rays
+   to stratified points y_k of patch j, each weighted by its kernel cos cos / r^2 (the ratio
+   estimator of the form-factor code). A texel holds the mean over its valid samples; texels
+   without one hold 0 (fill them with rad_lightmap_dilate).
+   RGB IRRADIANCE (RAD_LIGHTMAP_IRRADIANCE): 3 floats per texel, H in W m^-2. A Lambertian
+   surface of albedo rho shows radiance rho H / pi.
+   L1 SPHERICAL HARMONICS (RAD_LIGHTMAP_SH_L1): 12 floats per texel, coefficient-major
+   (L_0,0 rgb, L_1,-1 rgb, L_1,0 rgb, L_1,1 rgb) of the incident RADIANCE over the upper
+   hemisphere,  L_lm = integral L(w) Y_lm(w) dw,  in the real SH basis of Godot and Unity
+   (world axes, no normalization beyond the basis):
+       Y_0,0 = 0.282095   Y_1,-1 = 0.488603 y   Y_1,0 = 0.488603 z   Y_1,1 = 0.488603 x
+   Each patch contributes exactly (B_j / pi) V(p, j) times the integrals of Y over the solid
+   angle it subtends, in closed form: Y_0,0 times its solid angle, and 0.488603 times its
+   vector irradiance (1/2) sum_edges theta_e g_e (Arvo's contour integral, g_e the unit normal
+   of the plane through p and edge e, theta_e the angle the edge subtends). Reconstruction of
+   the irradiance at a normal m (Ramamoorthi and Hanrahan's convolution, A_0 = pi, A_1 = 2 pi / 3):
+       E(m) = pi 0.282095 L_0,0 + (2 pi / 3) 0.488603 (L_1,-1 m_y + L_1,0 m_z + L_1,1 m_x)
+   i.e. E(m) / pi = 0.282095 L_0,0 + 0.325735 (L_1,-1 m_y + L_1,0 m_z + L_1,1 m_x), the
+   weights Godot's directional lightmaps and Unity's SphericalHarmonicsL2 (first four terms)
+   evaluate. At m = n it gives back H within the L1 approximation (exact for uniform light). */
+typedef enum rad_lightmap_encoding {
+    RAD_LIGHTMAP_IRRADIANCE = 0, /* 3 floats per texel */
+    RAD_LIGHTMAP_SH_L1 = 1       /* 12 floats per texel */
+} rad_lightmap_encoding;
+
+/* HEMISPHERE GATHER (RAD_LIGHTMAP_GATHER_HEMISPHERE), for scenes with many patches, where the
+   exact gather's O(samples x patches) is too slow. The patches split in two by radiosity:
+   the BRIGHT ones (luminance above exact_ratio times the area-weighted mean luminance of the
+   lit patches, i.e. the lamps and what they light most) are gathered exactly as above; the
+   light of all the others comes from hemisphere_rays closest-hit rays per texel, shared among
+   its valid samples (each sample a Hammersley set of ceil(hemisphere_rays / valid samples)
+   directions, rotated by a hash of the sample: deterministic, stratified). A ray that hits
+   the front of a patch that is not bright brings its radiosity B_j; one that misses, hits a
+   back face or a bright patch brings 0 (the bright ones are counted exactly). Irradiance:
+   cosine-distributed directions, H = mean B_j (the radiance B_j / pi over the cosine pdf);
+   SH: uniform directions over the hemisphere, L_lm = 2 pi mean (B_j / pi) Y_lm(w). This
+   estimates the same sum as the exact gather (constant B_j per patch), unbiased, with a
+   noise that falls with the rays (docs/methods/lightmap.md measures it). Cost: O(samples x
+   bright patches) form factors plus hemisphere_rays rays per texel, whatever the patch count. */
+typedef enum rad_lightmap_gather_method {
+    RAD_LIGHTMAP_GATHER_EXACT = 0,     /* every lit patch by its analytic form factor (default) */
+    RAD_LIGHTMAP_GATHER_HEMISPHERE = 1 /* bright patches exactly, the rest by hemisphere rays */
+} rad_lightmap_gather_method;
+
+typedef struct rad_lightmap_gather_options {
+    rad_lightmap_encoding encoding;
+    uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64); with 1
+                                   the share is of the visible area, not of the form factor
+                                   (reads a few % low next to contacts) */
+    float ray_epsilon;          /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;
+    rad_lightmap_gather_method method; /* RAD_LIGHTMAP_GATHER_EXACT (0) or _HEMISPHERE */
+    uint32_t hemisphere_rays;   /* hemisphere: rays per texel (0: 256; at most 65536) */
+    float exact_ratio;          /* hemisphere: a patch is bright above this times the mean
+                                   luminance (0: 16; > 0; FLT_MAX: none is bright) */
+} rad_lightmap_gather_options;
+
+RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *options);
+/* Floats per texel of an encoding (3 or 12; 0 for an unknown one). */
+RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding);
+
+/* The gather above from any solved classic patch set: patch_radiosity 3N floats (B = E + L of
+   rad_solve_* with RAD_OUTPUT_TOTAL; with RAD_SOURCE_DIRECT the lightmap then holds the
+   indirect irradiance and the direct light is added per texel by rad_lightmap_direct or per
+   pixel by the engine; with RAD_SOURCE_EMISSION B holds the emitters and the lightmap the
+   total). patches must be of lightmap->scene. Patches with B = 0 and those behind a sample
+   cost nothing. out: width * height * channels floats. Errors: INVALID_ARGUMENT, NON_FINITE
+   (a B or result), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY. Cost: O(valid samples x patches)
+   form factors and up to visibility_rays shadow rays per pair (the hemisphere method: see
+   above). The raycaster needs occluded(), and intersect() for the hemisphere method.
+   Reentrant; parallel; deterministic whatever the thread count. */
+RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lightmap, const rad_patches *patches,
+                                       const float *patch_radiosity, const rad_raycaster *raycaster,
+                                       const rad_lightmap_gather_options *options, float *out,
+                                       const rad_context *ctx);
+
+/* Direct irradiance (rad_direct_irradiance with these lights and options) averaged over each
+   texel's valid samples, ADDED to out (3 floats per texel: an RGB irradiance lightmap);
+   texels without a valid sample are left as they are. Errors: those of
+   rad_direct_irradiance, OUT_OF_MEMORY. */
+RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lightmap, const rad_raycaster *raycaster,
+                                       const rad_light *lights, uint32_t light_count,
+                                       const rad_direct_options *options, float *out, const rad_context *ctx);
+
+/* DILATION. Every texel without RAD_TEXEL_VALID gets the mean of its 8 neighbours that have a
+   value (valid, or filled by an earlier pass), pass after pass: 'passes' passes (0: until
+   every texel reachable is filled), so the gutters between charts and invalid texels hold
+   their neighbours' light and bilinear filtering at a chart border reads no black.
+   values: width * height * channels floats, in place. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
+RAD_API rad_result rad_lightmap_dilate(const rad_lightmap *lightmap, uint32_t channels, float *values,
+                                       uint32_t passes, const rad_context *ctx);
+
+/* SEAMS. A seam is a triangle edge whose two lightmapped triangles share both end points in
+   space (the same floats) but not in the atlas, and whose normals differ by less than 30
+   degrees (across a sharper crease irradiance differs by right). Each seam gets sample pairs
+   along the edge, at most half a texel apart on either side; bilinear lookups of the two
+   sides should agree there. rad_lightmap_stitch moves the texels least, in the least-squares
+   sense, so that they do: the projection of the values onto {A x = 0} (A: one row per sample
+   pair, its bilinear weights on one side minus those of the other), by 'iterations' sweeps
+   of Kaczmarz's row projections (0: 64) from the baked values, each channel on its own.
+   values: in place (run it after rad_lightmap_dilate: gutter texels take part). out_stats
+   (optional): the seam count and the largest jump before and after. Errors:
+   INVALID_ARGUMENT, OUT_OF_MEMORY. Cost: O(seam samples x iterations). */
+typedef struct rad_lightmap_seam_stats {
+    uint32_t seams;             /* seam edges found */
+    uint32_t sample_pairs;      /* rows of A */
+    float max_jump_before;      /* largest |bilinear(a) - bilinear(b)| over the sample pairs and channels */
+    float max_jump_after;
+} rad_lightmap_seam_stats;
+
+RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lightmap, uint32_t channels, float *values,
+                                       uint32_t iterations, rad_lightmap_seam_stats *out_stats,
+                                       const rad_context *ctx);
+
+/* RUN TIME (rad_lightmap_weights_create, rad_lightmap_refresh): a lightmap refreshed from a
+   new patch solution (a temporal frame, a moved light's re-solve) in O(texels x few) without
+   a new gather. Each valid texel gets a sparse row of texel-from-patch weights: at each valid
+   sample the patch containing it (rad_patches_locate) and its three vertex weights, each
+   vertex standing for the area-weighted mean of the patches that share it (as
+   rad_patches_vertex_values), averaged over the texel's valid samples; so the row
+   interpolates the patches' irradiance H = F B smoothly. The row is then scaled by the
+   texel's DETAIL factor, c = sum_rgb baked / sum_rgb (row . H_baked) from the gathered
+   lightmap and the patch irradiance of the same solution (1 when either is NULL or the row
+   gives 0; at most 16), which keeps the gather's sub-patch detail (contact shadows, gradients
+   inside a patch). A refresh with H_baked gives back the bake's luminance exactly; with
+   another solution it is exact where the light's shape across each patch and its neighbours
+   does not change, and off by the change elsewhere (the test measures it).
+   LAYOUT. The rows are stored FACTORED, in two sparse stages, because the patches around a
+   vertex are shared by every texel near it: stage 1 makes a value per patch vertex,
+       V_v = sum_k vertex_weights[k] H[vertex_patches[k]],  k in [vertex_first[v], vertex_first[v + 1])
+   (the area shares: they sum to 1 around a vertex), stage 2 a value per texel with a row,
+       out[row_texels[r]] = sum_e entry_weights[e] V[entry_vertices[e]],  e in [row_first[r], row_first[r + 1])
+   (the mean barycentric weights times the detail factor: about 3 entries a texel, against
+   about 10 patches in the expanded row). The texel-from-patch row of the text above is the
+   product of the two (W_tp = sum_e entry_weights[e] vertex_weights[k] over the pairs with
+   vertex_patches[k] = p); the refresh gives it up to float rounding (1e-6 relative). The
+   rows run in increasing texel order, so the stage-2 writes stream through the lightmap. */
+typedef struct rad_lightmap_weights {
+    uint32_t texels;            /* width * height of the lightmap */
+    uint32_t patch_count;       /* N of the patches */
+    uint32_t vertex_count;      /* the patches' vertex_count */
+    uint32_t row_count;         /* texels with a row (a valid sample in a located patch) */
+    uint32_t *vertex_first;     /* vertex_count + 1 */
+    uint32_t *vertex_patches;   /* 3N: patch indices */
+    float *vertex_weights;      /* 3N: area shares */
+    uint32_t *row_texels;       /* row_count: the texel of each row, increasing */
+    uint32_t *row_first;        /* row_count + 1 */
+    uint32_t *entry_vertices;   /* row_first[row_count]: vertex indices */
+    float *entry_weights;       /* row_first[row_count]: weights (detail factor included) */
+    rad_allocator allocator;    /* private */
+} rad_lightmap_weights;
+
+/* Builds the rows above. baked_texels (3 per texel, an RGB irradiance gather of the solution,
+   before dilation) and baked_patch_irradiance (3N: H = F B of the same solution) are optional
+   together (both or neither). Errors: INVALID_ARGUMENT (NULL lightmap or patches, patches of
+   another scene, one of the two baked inputs without the other), SIZE_OVERFLOW (2^32 entries
+   or more), OUT_OF_MEMORY. O(samples). */
+RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lightmap, const rad_patches *patches,
+                                               const float *baked_texels, const float *baked_patch_irradiance,
+                                               const rad_context *ctx, rad_lightmap_weights **out);
+RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *weights);
+
+/* out[t] = sum_p W_tp H_p (3 floats per texel) for every texel with a row; texels without one
+   are left as they are (the gutters keep their dilated values). patch_irradiance: 3N floats.
+   Two passes through ctx->parallel_for (vertices, then rows in contiguous blocks), with a
+   scratch of 3 floats per vertex from the context's allocator. Deterministic whatever the
+   thread count. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
+RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, const float *patch_irradiance, float *out,
+                                        const rad_context *ctx);
+
+/* Bilinear lookup of a lightmap (channels floats per texel) at (u, v), clamped to the edge
+   texels, with the texel convention above. out: channels floats. */
+RAD_API void rad_lightmap_sample(const rad_lightmap *lightmap, uint32_t channels, const float *values, float u, float v,
+                                 float *out);
 
 /* ======================================================================================== */
 /* >>api_probes: irradiance probes (SH L2) from a patch solution                            */
@@ -3486,6 +2772,720 @@ RAD_API void rad_probes_weights(const rad_probes *probes, const uint64_t **first
 RAD_API void rad_sh9_basis(const float d[3], float out[9]);
 /* E(n) = sum_i E_i Y_i(n) per channel from 27 coefficients (layout above), not clamped. */
 RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], float out_rgb[3]);
+
+/* ======================================================================================== */
+/* >>api_shading: lighting models and BRDFs                                                 */
+/* ======================================================================================== */
+
+/* Local lighting models for the direct term and the final shading (docs/methods/shading.md; the set of
+   models of Korobeinikov 2022, docs/references.md).
+   Radiosity gives the indirect light of diffuse surfaces; these functions give the response
+   of a surface to one light direction, the same in C and in glsl/lighting.glsl.
+
+   CONVENTION. l (towards the light), v (towards the viewer) and n (the normal) are unit
+   vectors. Two quantities are offered:
+     f  the BRDF (sr^-1): outgoing radiance L_o = f * max(n.l, 0) * E, with E the light's
+        irradiance on a surface facing it (rad_light.color for a directional light,
+        I / d^2 for a point light). rad_shading_brdf() returns it.
+     R  the response: L_o = R * E. For every model that has a BRDF, R = f * max(n.l, 0).
+        rad_shading_eval() returns it; this is what a shader adds per light.
+   The models usually stated as an "intensity" (a cosine-like number in
+   [0,1]) are scaled by albedo / pi so that a white model of intensity cos(theta) is exactly
+   Lambert: R = albedo / pi * intensity. For banded, f = R / (n.l). Half-Lambert (wrap)
+   lights points with n.l < 0, so it has no BRDF: rad_shading_brdf() refuses it.
+   Physical (reciprocal f(l,v) = f(v,l) and energy-conserving Integral f (n.l) dl <= 1 for
+   albedos <= 1; tests/test_shading.c measures both): Lambert; Phong and Blinn-Phong in their
+   normalized forms with kd + ks <= 1; Oren-Nayar nearly (the qualitative model: at albedo 1
+   its directional albedo reaches 1.0105 at grazing view for sigma = 0.25, and stays <= 1 for
+   sigma >= 0.5: 0.83 at sigma 1); the microfacet model with the Shirley diffuse term or none (with
+   Shirley at albedo 1 the sum reaches 1.0015 at grazing view). The Lambert diffuse
+   term (1 - F(n,l)) albedo / pi (the default, as in Korobeinikov 2022) is neither
+   reciprocal nor energy-conserving with the specular term (measured 1.07 at albedo 1).
+   Minnaert is reciprocal, energy-conserving only for k >= 1. Banded and half-Lambert are
+   neither. Every model returns 0 (f and R) when n.v <= 0: surfaces are one-sided. */
+
+typedef enum rad_shading_model {
+    RAD_SHADING_LAMBERT = 0,      /* f = albedo / pi */
+    RAD_SHADING_HALF_LAMBERT = 1, /* R = albedo / pi * max(0, (n.l + w) / (1 + w))^p (Valve's
+                                     half-Lambert: w = 1, p = 2; w = 0, p = 1 is Lambert) */
+    RAD_SHADING_BANDED = 2,       /* R = albedo / pi * ceil(bands * max(n.l, 0)) / bands */
+    RAD_SHADING_PHONG = 3,        /* f = kd / pi + ks (s + 2) / (2 pi) max(0, r.v)^s,
+                                     r = 2 (n.l) n - l (normalized modified Phong, Lewis 1994) */
+    RAD_SHADING_BLINN_PHONG = 4,  /* f = kd / pi + ks c(s) max(0, n.h)^s, h = (l + v) / |l + v|,
+                                     c(s) = (s + 2)(s + 4) / (8 pi (2^(-s/2) + s)): the
+                                     normalization that makes the lobe's albedo at normal
+                                     incidence exactly 1 (Real-Time Rendering; the common
+                                     (s + 8) / (8 pi) overshoots it, by up to 7.5 % at s = 9) */
+    RAD_SHADING_MINNAERT = 5,     /* f = albedo (k + 1) / (2 pi) (max(n.l n.v, 1e-6))^(k - 1)
+                                     (Minnaert 1941; albedo at normal incidence = albedo) */
+    RAD_SHADING_OREN_NAYAR = 6,   /* f = albedo / pi (A + B max(0, cos(phi_l - phi_v)) sin(a) tan(b)),
+                                     A = 1 - 0.5 s^2 / (s^2 + 0.33), B = 0.45 s^2 / (s^2 + 0.09),
+                                     a = max(theta_l, theta_v), b = min (Oren, Nayar 1994,
+                                     qualitative model); computed as (l.v - n.l n.v) / max(n.l, n.v) */
+    RAD_SHADING_MICROFACET = 7,   /* f = F(h,l) G2(l,v,h) D(h) / (4 |n.l| |n.v|) + f_diffuse (Cook & Torrance 1982) */
+    RAD_SHADING_MODEL_COUNT = 8
+} rad_shading_model;
+
+typedef enum rad_ndf {
+    RAD_NDF_BECKMANN = 0,         /* Beckmann; Lambda: the rational approximation of Walter et al. 2007 */
+    RAD_NDF_GGX = 1               /* Walter et al. 2007; Lambda: exact */
+} rad_ndf;
+
+typedef enum rad_masking {
+    RAD_MASKING_SEPARABLE = 0,         /* G2 = G1(v, h) G1(l, h)                (Heitz 2014) */
+    RAD_MASKING_HEIGHT_CORRELATED = 1  /* G2 = chi(h.v) chi(h.l) / (1 + L(v) + L(l)) (Heitz 2014) */
+} rad_masking;
+
+typedef enum rad_diffuse_term {
+    RAD_DIFFUSE_NONE = 0,         /* specular only */
+    RAD_DIFFUSE_LAMBERT = 1,      /* (1 - F(n,l)) albedo / pi, F the Schlick term below (Korobeinikov 2022) */
+    RAD_DIFFUSE_SHIRLEY = 2       /* (1 - F0) 21 albedo / (20 pi) (1 - (1 - n.l)^5) (1 - (1 - n.v)^5)
+                                     (Shirley et al. 1997) */
+} rad_diffuse_term;
+
+/* Ranges are checked by rad_shading_validate (and so by the two entries). Albedos, kd, ks,
+   f0 and f90 are per channel in [0, 1]. */
+typedef struct rad_lambert_params { float albedo[3]; } rad_lambert_params;
+typedef struct rad_half_lambert_params {
+    float albedo[3];
+    float wrap;                   /* w in [0, 1]; default 1 */
+    float exponent;               /* p in [1, 8]; default 2 */
+} rad_half_lambert_params;
+typedef struct rad_banded_params {
+    float albedo[3];
+    uint32_t bands;               /* in [1, 256]; default 4 */
+} rad_banded_params;
+typedef struct rad_phong_params {  /* Phong and Blinn-Phong */
+    float diffuse[3];             /* kd; default 0.5 */
+    float specular[3];            /* ks; default 0.3; physical when kd + ks <= 1 */
+    float shininess;              /* s in [1, 10000]; default 32 */
+} rad_phong_params;
+typedef struct rad_minnaert_params {
+    float albedo[3];
+    float k;                      /* in [0, 4]; 1 is Lambert; < 1 flattens the disc and
+                                     brightens the limb (lunar look); default 0.8 */
+} rad_minnaert_params;
+typedef struct rad_oren_nayar_params {
+    float albedo[3];
+    float sigma;                  /* roughness, standard deviation of facet slopes in radians,
+                                     in [0, 1.5]; 0 is Lambert; default 0.5 */
+} rad_oren_nayar_params;
+typedef struct rad_microfacet_params {
+    rad_ndf ndf;                  /* default GGX */
+    rad_masking masking;          /* default height-correlated */
+    rad_diffuse_term diffuse;     /* default Lambert */
+    float alpha_x, alpha_y;       /* roughness along t and b, each in [1e-3, 1]; equal values
+                                     make the model isotropic (t and b then unused); default 0.3 */
+    float f0[3];                  /* Fresnel reflectance at normal incidence; default 0.04 */
+    float f90[3];                 /* ... at grazing incidence (generalized Schlick); default 1 */
+    float fresnel_exponent;       /* 1/p of the generalized form, in [1, 10]; 5 is Schlick's; default 5 */
+    float albedo[3];              /* rho of the diffuse term; default 0.5 */
+} rad_microfacet_params;
+
+/* A material for the shading entries: the model and its parameters (only model's member is
+   read). */
+typedef struct rad_shading {
+    rad_shading_model model;
+    rad_lambert_params lambert;
+    rad_half_lambert_params half_lambert;
+    rad_banded_params banded;
+    rad_phong_params phong;       /* RAD_SHADING_PHONG and RAD_SHADING_BLINN_PHONG */
+    rad_minnaert_params minnaert;
+    rad_oren_nayar_params oren_nayar;
+    rad_microfacet_params microfacet;
+} rad_shading;
+
+/* The documented defaults. Thread-safe, O(1). */
+RAD_API void rad_lambert_params_default(rad_lambert_params *p);
+RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p);
+RAD_API void rad_banded_params_default(rad_banded_params *p);
+RAD_API void rad_phong_params_default(rad_phong_params *p);
+RAD_API void rad_minnaert_params_default(rad_minnaert_params *p);
+RAD_API void rad_oren_nayar_params_default(rad_oren_nayar_params *p);
+RAD_API void rad_microfacet_params_default(rad_microfacet_params *p);
+/* Every member at its default and s->model = model. */
+RAD_API void rad_shading_default(rad_shading *s, rad_shading_model model);
+
+/* A model's name ("lambert", "half-lambert", "banded", "phong", "blinn-phong", "minnaert",
+   "oren-nayar", "microfacet"), or NULL for a value out of range; and the reverse (returns
+   INVALID_ARGUMENT for an unknown name). */
+RAD_API const char *rad_shading_model_name(rad_shading_model model);
+RAD_API rad_result rad_shading_model_from_name(const char *name, rad_shading_model *out_model);
+
+/* Checks the model and the ranges of its parameters (only the active model's struct).
+   Errors: INVALID_ARGUMENT (NULL, unknown model or enum, parameter out of range; the logger
+   names it), NON_FINITE (a NaN or Inf parameter). Thread-safe, O(1). */
+RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context *ctx);
+
+/* The two evaluation entries (see CONVENTION above; docs/methods/shading.md).
+   l, v, n: non-zero finite 3-vectors, normalized here. t, b: the tangent frame, used only
+   by an anisotropic microfacet model (alpha_x != alpha_y); there t is required, made
+   orthogonal to n here, and b may be NULL (then b = n x t) or is made orthogonal to n and t.
+   out_rgb: 3 floats, written on success.
+   rad_shading_brdf writes f; rad_shading_eval writes R (f * max(n.l, 0), or the half-Lambert
+   response).
+   Errors: INVALID_ARGUMENT (NULL pointer, bad parameters as rad_shading_validate, a zero
+   vector, t missing or parallel to n for an anisotropic model, half-Lambert given to
+   rad_shading_brdf), NON_FINITE (a non-finite vector component). Thread-safe, O(1), no
+   allocation. For a hot loop: rad_shading_pack once, then rad_shade. */
+RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
+RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx);
+
+/* Terms of the microfacet model, to compose your own (docs/methods/shading.md). Plain float math:
+   the caller guarantees valid inputs (cosines in [-1, 1], roughness in (0, 1]); nothing is
+   checked. All thread-safe and O(1). 'nm' is n.m, 'tm' t.m, 'bm' b.m for the microfacet
+   normal m (usually h). */
+RAD_API float rad_ndf_beckmann(float nm, float alpha);                                   /* Beckmann */
+RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y); /* Beckmann, anisotropic */
+RAD_API float rad_ndf_ggx(float nm, float alpha);                                        /* GGX */
+RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y);      /* GGX, anisotropic */
+/* The Smith variable a = n.s / sqrt(alpha_x^2 (t.s)^2 + alpha_y^2 (b.s)^2) (Heitz 2014; with
+   alpha_x = alpha_y = alpha it is n.s / (alpha sqrt(1 - (n.s)^2)), since (t.s)^2 + (b.s)^2 = 1 - (n.s)^2). Returns
+   +inf for s = n (no masking); requires n.s > 0. */
+RAD_API float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y);
+/* Lambda(a) for a > 0: GGX (exact); Beckmann's rational approximation (Walter et al. 2007; 0 for
+   a >= 1.6); Beckmann's exact form (with erf; C only, the reference for the
+   approximation). Each returns 0 for a = +inf. */
+RAD_API float rad_lambda_ggx(float a);
+RAD_API float rad_lambda_beckmann(float a);
+RAD_API float rad_lambda_beckmann_exact(float a);
+/* G1 = chi+(m.s) / (1 + Lambda(s)) (Heitz 2014). */
+RAD_API float rad_smith_g1(float ms, float lambda_s);
+/* G2 separable G1(v) G1(l) and height-correlated 1 / (1 + Lambda(v) + Lambda(l)) (Heitz 2014). */
+RAD_API float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l);
+RAD_API float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l);
+/* Schlick's Fresnel F0 + (1 - F0)(1 - max(c, 0))^5 (Schlick 1994) and its generalized form
+   F0 + (F90 - F0)(1 - max(c, 0))^exponent (Real-Time Rendering; exponent = 1/p). One channel. */
+RAD_API float rad_fresnel_schlick(float f0, float c);
+RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c);
+/* Diffuse terms, one channel: Lambert (1 - F) albedo / pi (F = F(n,l)), Shirley
+   et al. (1 - F0) 21 albedo / (20 pi) (1 - (1 - nl+)^5)(1 - (1 - nv+)^5). */
+RAD_API float rad_diffuse_lambert(float albedo, float F);
+RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv);
+
+/* The std430 mirror of glsl/lighting.glsl's ShadingParams (96 bytes, vec4-aligned):
+   albedo (albedo, or kd for Phong), specular (ks), f0, f90, p = (alpha_x, alpha_y, model
+   parameter: wrap / shininess / k / sigma, second parameter: half-Lambert exponent / bands /
+   Fresnel exponent), mode = (model, ndf, masking, diffuse). */
+typedef struct rad_shading_gpu {
+    float albedo[4];
+    float specular[4];
+    float f0[4];
+    float f90[4];
+    float p[4];
+    int32_t mode[4];
+} rad_shading_gpu;
+
+/* Validates a material and packs it for rad_shade and the GLSL functions. Errors as
+   rad_shading_validate. Thread-safe, O(1). */
+RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, const rad_context *ctx);
+
+/* The unchecked evaluator behind both entries, the C twin of GLSL rad_shade(): f (out_f)
+   and R (out_r; either may be NULL) for a material packed by rad_shading_pack and unit l, v,
+   n, with t, b an orthonormal tangent frame (read only when anisotropic; may be NULL then).
+   Garbage in, garbage out; no allocation; thread-safe; O(1). */
+RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
+                       const float b[3], float out_f[3], float out_r[3]);
+
+/* ======================================================================================== */
+/* >>api_container: baked data                                                              */
+/* ======================================================================================== */
+
+/* One versioned binary container for everything a bake produces (docs/methods/container.md
+   teaches it). THE LAYOUT (this is its one description):
+     header, 64 bytes, its fields little-endian (byte offset: field):
+       0: "RADB"  4: version (uint32)  8: section count  12: header size (64)
+       16: table offset (uint64, 64)  24: file size (uint64)  32: flags (bit 0: the section
+       data is big-endian)  36: CRC-32 of the table  40..59: zero  60: CRC-32 of bytes 0..59
+     table, one 64-byte entry per section, its fields little-endian:
+       0: type (rad_section_type)  4: element size  8: element count (uint64)  16: offset
+       (uint64)  24: byte size (uint64)  32: CRC-32 of the data  36..39: zero  40: name (24
+       bytes, NUL-terminated)
+     data: each section from an offset that is a multiple of 64, in the WRITER'S byte order
+       (flag bit 0), so that a file can be memory-mapped and read in place; a reader of the
+       other byte order refuses it (RAD_ERROR_VERSION) instead of converting.
+   CRC-32 is the common reflected one (polynomial 0xEDB88320, as zlib's crc32). Loading validates every size, offset, checksum and index before anything is used.
+   VERSIONING: RAD_CONTAINER_VERSION changes only when the header or the table entry layout
+   changes (a reader refuses another version with RAD_ERROR_VERSION). New section types are
+   added without a version change: readers look sections up by type and name and skip the
+   ones they do not know, so a file without a newer section (RAD_SECTION_SIGNATURE, added
+   in 0.1.0) still loads, and an older reader loads a newer file.
+   NAMES. Each object's way in and out of a container: X_sections fills the sections that
+   write it (data borrowed from the object); X_load makes a new object from a container (free
+   it with X_destroy); X_view fills a caller's struct that points into the container (nothing
+   to free: rad_alias_tables_view, whose struct is public).
+   VALUES: behind a valid checksum a section may still hold values that would make every
+   later step NaN, infinite or slow, so each loader (rad_load_memory, rad_multibounce_load,
+   rad_multibounce_blocks_load, rad_alias_tables_view) checks the values it hands out, once,
+   in O(size of the section): every float is finite (else RAD_ERROR_NON_FINITE) and of
+   magnitude at most RAD_BAKE_VALUE_MAX (patch areas excepted: they grow with the square of
+   the scene's scale), patch emission is >= 0 (RAD_ERROR_NEGATIVE_EMISSION), and the quantities that are non-negative by
+   definition (form factors, F_mb entries, block scales, outliers, alias totals) are >= 0
+   (else RAD_ERROR_CORRUPT); the logger names the section, the entry and the value. */
+#define RAD_CONTAINER_VERSION 1u
+/* The largest magnitude a loader accepts in a float section: 1e30, so that a sum of up to
+   3e8 such values (more than any row holds) stays finite. Nothing physical comes near (form
+   factors are <= 1, F_mb entries <= 1 / (1 - max albedo) <= 2^24); rad_save_memory refuses
+   larger values in what it writes, so whatever it writes loads. */
+#define RAD_BAKE_VALUE_MAX 1e30f
+
+/* Every section type the library writes, in one table. */
+typedef enum rad_section_type {
+    RAD_SECTION_PATCHES = 1,         /* rad_patch records */
+    RAD_SECTION_PATCH_VERTICES = 2,  /* 3 floats per welded vertex */
+    RAD_SECTION_TRIANGLES = 3,       /* 2 uint32 per scene triangle: first patch, subdivision */
+    RAD_SECTION_FF_DENSE = 4,        /* N*N floats, row-major */
+    RAD_SECTION_FF_ROW_OFFSETS = 5,  /* CSR: N+1 uint64 */
+    RAD_SECTION_FF_COLUMNS = 6,      /* CSR: uint32 */
+    RAD_SECTION_FF_VALUES = 7,       /* CSR: floats */
+    RAD_SECTION_VECTOR = 8,          /* a named RGB vector, 3N floats ("E", "B", "L", "H", ...) */
+    RAD_SECTION_SIGNATURE = 9,       /* one rad_bake_signature ("signature"): what it was made from */
+    /* the multi-bounce objects (>>api_multibounce), 16..31 */
+    RAD_SECTION_MB_INFO = 16,              /* 16 uint32: see rad_multibounce_sections */
+    RAD_SECTION_MB_FLOAT = 17,             /* 3 N^2 floats: the R, G, B planes */
+    RAD_SECTION_MB_HALF = 18,              /* 3 N^2 binary16 values */
+    RAD_SECTION_MB_ROW_PERM = 19,          /* N uint32 */
+    RAD_SECTION_MB_COL_PERM = 20,          /* N uint32 */
+    RAD_SECTION_MB_BC1 = 21,               /* ceil(N/4)^2 8-byte BC1 blocks */
+    RAD_SECTION_MB_BC4 = 22,               /* 3 ceil(N/4)^2 8-byte BC4 blocks: R plane, G, B */
+    RAD_SECTION_MB_SCALES = 23,            /* 3 floats (R, G, B) per scale tile */
+    RAD_SECTION_MB_OUTLIER_OFFSETS = 24,   /* N+1 uint64, CSR by original row */
+    RAD_SECTION_MB_OUTLIER_COLUMNS = 25,   /* uint32 original columns */
+    RAD_SECTION_MB_OUTLIER_VALUES = 26,    /* 3 floats (exact RGB) per outlier */
+    /* the alias tables (>>api_temporal), 32..39 */
+    RAD_SECTION_TEMPORAL_ROW_OFFSETS = 32, /* alias tables: rows + 1 uint64, offsets in bins */
+    RAD_SECTION_TEMPORAL_BINS = 33,        /* alias tables: the bins, 2 or 3 uint32 words each */
+    RAD_SECTION_TEMPORAL_TOTALS = 34,      /* alias tables: T_i, one float per row */
+    /* virtual patches (>>api_vp), 40..63 */
+    RAD_SECTION_VP_INFO = 40,              /* the set's sizes and grid: see rad_vp_sections */
+    RAD_SECTION_VP_AREAS = 41,             /* N floats */
+    RAD_SECTION_VP_ALBEDO = 42,            /* 3 N floats */
+    RAD_SECTION_VP_NORMALS = 43,           /* 3 N floats */
+    RAD_SECTION_VP_AXIS = 44,              /* N uint8 */
+    RAD_SECTION_VP_VOXEL = 45,             /* N uint32 */
+    RAD_SECTION_VP_VOXEL_KEYS = 46,        /* voxel_count uint64 */
+    RAD_SECTION_VP_VOXEL_FIRST = 47,       /* voxel_count + 1 uint32 */
+    RAD_SECTION_VP_VOXEL_PATCH = 48,       /* 6 uint32 per voxel */
+    RAD_SECTION_VP_SAMPLE_FIRST = 49,      /* voxel_count + 1 uint32 */
+    RAD_SECTION_VP_SAMPLE_POSITIONS = 50,  /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_NORMALS = 51,    /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_ALBEDO = 52,     /* 3 M floats */
+    RAD_SECTION_VP_SAMPLE_AREAS = 53,      /* M floats */
+    RAD_SECTION_VP_SAMPLE_WEIGHTS = 54,    /* 6 M floats */
+    RAD_SECTION_VP_SAMPLE_TRIANGLES = 55,  /* M uint32 */
+    RAD_SECTION_USER = 0x10000       /* types from here up are the application's own */
+} rad_section_type;
+
+/* The name of a section type without its prefix ("PATCHES", "MB_BC1", "VP_AREAS"), "USER"
+   from RAD_SECTION_USER up, NULL for a type the library does not know. Pure. */
+RAD_API const char *rad_section_type_name(uint32_t type);
+
+/* One section, for writing (data borrowed) or as found by rad_container_find (data points
+   into the container's bytes). */
+struct rad_section {
+    uint32_t type;
+    uint32_t elem_size;     /* bytes per element */
+    uint64_t count;         /* elements */
+    const void *data;       /* count * elem_size bytes */
+    char name[24];          /* NUL-terminated, may be empty */
+};
+
+/* Bytes that rad_container_write needs for these sections (SIZE_OVERFLOW if it overflows). */
+RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes);
+/* Writes the container into dst (dst_size >= rad_container_size). */
+RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t count, void *dst, size_t dst_size);
+/* Validates 'size' bytes at 'data' (borrowed: they must outlive the container, which reads
+   them in place: memory-mapped files work) and opens them. Errors: TRUNCATED, CORRUPT,
+   VERSION, INVALID_ARGUMENT, OUT_OF_MEMORY; the logger says which section and why. */
+RAD_API rad_result rad_container_create(const void *data, size_t size, const rad_context *ctx, rad_container **out);
+RAD_API void rad_container_destroy(rad_container *container);
+RAD_API uint32_t rad_container_section_count(const rad_container *container);
+/* Section i (0 <= i < count), or NULL. */
+RAD_API const rad_section *rad_container_section(const rad_container *container, uint32_t index);
+/* The first section of 'type' whose name equals 'name' (any name when name is NULL), or NULL. */
+RAD_API const rad_section *rad_container_find(const rad_container *container, uint32_t type, const char *name);
+
+/* What a bake was made from (section RAD_SECTION_SIGNATURE, one 32-byte element), so that a
+   bake of another scene with the same triangle and patch counts is refused instead of
+   rendering silently wrong (rad_bake_matches_scene). A field of 0 was not recorded. */
+typedef struct rad_bake_signature {
+    uint64_t geometry;       /* rad_scene_hash: the triangles' positions */
+    uint64_t materials;      /* rad_scene_hash: each triangle's albedo, emission, texture id, uvs */
+    uint64_t options;        /* the application's hash of the options it baked with (rad_hash64) */
+    uint64_t reserved;       /* 0; readers ignore it */
+} rad_bake_signature;
+
+/* FNV-1a, 64 bits, over 'size' bytes, continuing from 'hash' (RAD_HASH64_INIT to start):
+   for each byte, hash = (hash ^ byte) * 0x100000001B3. rad_hash64("a", 1, RAD_HASH64_INIT)
+   is 0xAF63DC4C8601EC8C. Pure, O(size). */
+#define RAD_HASH64_INIT 0xCBF29CE484222325ull
+RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash);
+/* The two hashes of a signature, stable across platforms, byte orders and builds (only the
+   scene's input values enter, as the little-endian bytes of their IEEE bit patterns, never
+   values the library derives from them):
+     geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats;
+     materials = rad_hash64 of triangle_count, then per triangle its material's albedo[3],
+                 emission[3] (floats) and texture (uint32), then 1 and the 6 uv floats per
+                 triangle when the scene has uvs, else 0.
+   Indices are covered (positions are per triangle), and the geometric normals and areas follow
+   from the positions; shading normals are not kept by rad_scene, and a texture's contents
+   (the albedo_lookup callback) cannot be hashed, only its id. Either output may be NULL.
+   Errors: INVALID_ARGUMENT. Cost: O(triangles), no allocation. Thread safety: pure. */
+RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials);
+
+/* A loaded bake: patches (usable with rad_patches_locate, rad_patches_vertex_values and
+   rad_system_init; patches.scene is NULL, set it before calling functions that need the
+   scene), the form-factor matrix (rows == 0 when the bake has none) and the named vectors.
+   Everything points into the loaded bytes; free it with rad_bake_destroy, never with
+   rad_patches_destroy. */
+struct rad_bake {
+    rad_patches patches;
+    rad_matrix F;
+    const float *E;          /* "E" vector or NULL */
+    const float *B;          /* "B" vector (the solution as saved) or NULL */
+    const rad_bake_signature *signature; /* NULL when the bake has none (saved without a scene) */
+    rad_container *container;
+    void *owned;             /* private: bytes read from a file */
+    rad_allocator allocator; /* private */
+};
+
+/* Saves patches (required), a matrix (optional: NULL) and the vectors E and B (optional:
+   NULL; 3 * patches->count floats) into a new buffer *out of *out_size bytes, allocated with
+   ctx's allocator (free it with rad_free_buffer). When patches->scene is set, a signature
+   section records its rad_scene_hash (options 0: an application that wants its options
+   checked too rewrites that section with its own hash in 'options'). Values that a loader
+   would refuse (see VALUES above) are refused here: NON_FINITE, CORRUPT. */
+RAD_API rad_result rad_save_memory(const rad_patches *patches, const rad_matrix *F, const float *E, const float *B,
+                                   const rad_context *ctx, void **out, size_t *out_size);
+RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx);
+/* Opens a saved bake in place (data borrowed, must outlive the bake) and checks every index:
+   patch vertices < vertex count, patch triangles < triangle count, CSR offsets monotone and
+   columns < N, vector and matrix sizes equal to the patch count; and every value (VALUES
+   above): the form factors and every RAD_SECTION_VECTOR section (E, B and the application's
+   "H", "L", ...: each must hold 3N floats). A signature section, when present, must be one
+   32-byte element. Errors: the container's, NON_FINITE, CORRUPT, INDEX_OUT_OF_RANGE,
+   SIZE_MISMATCH, ALBEDO_RANGE, DEGENERATE_TRIANGLE, OUT_OF_MEMORY. */
+RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out);
+RAD_API void rad_bake_destroy(rad_bake *bake);
+/* RAD_SUCCESS when 'bake' was made from 'scene': the same triangle count and, when the bake
+   has a signature, the same geometry and materials hashes (rad_scene_hash), and the same
+   options hash when both 'options' and the bake's are non-zero. Otherwise
+   RAD_ERROR_SCENE_MISMATCH, and the logger says what differs (geometry, materials, options)
+   with both hashes. A bake without a signature (saved without a scene) is checked by its
+   triangle count only, with a warning through the logger. Errors: INVALID_ARGUMENT,
+   SCENE_MISMATCH. Cost: O(triangles). */
+RAD_API rad_result rad_bake_matches_scene(const rad_bake *bake, const rad_scene *scene, uint64_t options,
+                                          const rad_context *ctx);
+#ifndef RAD_NO_STDIO
+/* The same, through a file. Saving writes '<path>.partial' in the same folder and renames it
+   into place only when complete, so a failed save leaves the old file as it was (IO). Loading
+   reads the 64-byte header first and refuses a folder (IO), a file without the container
+   magic (CORRUPT) or one shorter than its header says (TRUNCATED) before reading the rest. */
+RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
+                                 const float *B, const rad_context *ctx);
+RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out);
+#endif
+
+/* ======================================================================================== */
+/* >>api_glsl: GLSL compute kernels                                                         */
+/* ======================================================================================== */
+
+/* The compute kernels, as GLSL 4.50 source text the application compiles (with
+   glslang or shaderc) and dispatches on its own Vulkan 1.1+ device (Vulkan GLSL: push
+   constants and specialization constants): radiosity.h never touches a GPU. The canonical
+   sources are the files glsl/<name> of the repository; the copy in the >>glsl section is
+   generated from them (make glsl) and a test fails when it is out of date. Every kernel is compiled and run by tests/test_vulkan.c on a Vulkan device
+   (Mesa's lavapipe in CI) and compared with the CPU function named in its entry.
+
+   COMMON RULES
+   - Compute only. Descriptor set 0, bindings as listed, every buffer a std430 storage buffer
+     of 32-bit scalars (float, uint) or uint64 row offsets read as uvec2 (low word first: the
+     little-endian layout of rad_matrix.row_offsets and rad_alias_tables.row_offsets, uploaded
+     unchanged). RGB vectors are 3N interleaved floats, as everywhere in radiosity.h.
+   - Workgroup: layout(local_size_x_id = 0): specialization constant RAD_GLSL_SPEC_LOCAL_SIZE
+     (id 0) sets the x size (default 1 when not specialized; 64 to 256 are good choices, any
+     size up to maxComputeWorkGroupInvocations works). Nothing depends on the subgroup size.
+   - Dispatch. The gathers and applies (GATHER_*, MB_APPLY_*, LOCAL_APPLY, LOCAL_UPDATE) run
+     ONE WORKGROUP PER ROW: dispatch row_count groups in x (at most
+     maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
+     invocations read the row at consecutive addresses with a stride of the group size and sum
+     in shared memory (12 bytes per invocation). The temporal step, the alias build and
+     VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
+     (LOCAL_VECTORS: per row or column, see its entry).
+   - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
+     by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
+     checked at compile time).
+   - CHUNKING. Every kernel processes rows [row_offset, row_offset + row_count) and reads the
+     big array (the matrix, its entries or bins) relative to a base, so a matrix larger than
+     one storage-buffer range (maxStorageBufferRange: 128 MiB on lavapipe, 4 GiB on most
+     desktop drivers) is processed as several dispatches, each binding only its rows: bind the
+     range from an offset rounded down to minStorageBufferOffsetAlignment and pass the
+     remainder, in elements, as the base. Small arrays (vectors, row offsets) are bound whole.
+   - Results agree with the CPU path to float rounding: the tests accept 1e-5 relative. The
+     temporal kernel draws the same indices as rad_temporal_step (same generator, same alias
+     draw, integer arithmetic), so it is compared directly.
+
+   THE KERNELS (binding: contents)
+   RAD_GLSL_GATHER_DENSE   one classic bounce, out_i = rho_i sum_j F_ij E_j (+ E_i),
+       as rad_solve_jacobi with bounces = 1. Push: rad_glsl_gather_dense_push.
+       0: F, row-major, rows of the chunk (F[row_offset][0] at element f_base)  1: E (3N)
+       2: albedo (3N)  3: out (3N; rows of the chunk written)
+   RAD_GLSL_GATHER_CSR     the same with a CSR matrix. Push: rad_glsl_gather_csr_push.
+       0: row offsets (N + 1 uint64)  1: columns  2: values (entry k at element k - entry_base)
+       3: E  4: albedo  5: out
+   RAD_GLSL_MB_APPLY_FLOAT out = F_mb E (+ E) as rad_multibounce_apply, float planes.
+       Push: rad_glsl_mb_apply_push; flags RAD_GLSL_OUTPUT_TOTAL, RAD_GLSL_MB_PERMUTED.
+       0, 1, 2: the R, G, B planes (rows of the chunk, plane row row_offset at element base)
+       3: E (original order)  4: col_perm  5: row_perm (bind any buffer when not PERMUTED)
+       6: out (original order; rows row_perm[row_offset ..] written)
+   RAD_GLSL_MB_APPLY_HALF  the same with binary16 planes (rad_multibounce.half uploaded
+       unchanged, read as uint words with unpackHalf2x16; base counted in halves). Each plane's
+       buffer and each bound range must cover whole 4-byte words: pad a plane of odd N^2 to a
+       multiple of 4 bytes and round a chunk's range up, or the word holding its last value
+       reads as zero (robust buffer access).
+   RAD_GLSL_TEMPORAL_STEP  one frame of rad_temporal_step with a fixed weight (the adaptive
+       weight stays on the CPU). Push: rad_glsl_temporal_push.
+       0: row offsets of the tables (rows + 1 uint64, in bins)  1: bins (2 or 3 words each;
+       word w of the tables, bin b starting at w = b * words, at element w - word_base)
+       2: totals T_i  3: E  4: albedo  5: B^prev  6: B^next (ping-pong the two buffers
+       between frames)  7: bins per row, RAD_GLSL_TEMPORAL_PADDED only (else bind any buffer).
+       MULTIBOUNCE mode with three table sets: three dispatches, channel c, sample_base c * k,
+       table set c bound. PADDED: the tables as RAD_GLSL_ALIAS_BUILD writes them (binding 0 =
+       its input row offsets, 2 and 7 its totals and counts), sampled without compaction.
+   RAD_GLSL_MB_APPLY_BLOCKS  out = F~ E (+ E) as rad_multibounce_blocks_apply: the blocks
+       uploaded unchanged as VK_FORMAT_BC1_RGB_UNORM_BLOCK or three VK_FORMAT_BC4_UNORM_BLOCK
+       images (feature textureCompressionBC), decoded by the texture unit with texelFetch
+       (decoders round differently: within 2/255 per channel of rad_bc1_decode_block and
+       rad_bc4_decode_block, measured 1.6/255 on lavapipe), times the tile scales, plus the
+       exact outliers. Push: rad_glsl_mb_blocks_push; flags RAD_GLSL_OUTPUT_TOTAL, _PERMUTED,
+       _BC1, _OUTLIERS. 0, 1, 2: combined image samplers (BC1:
+       the one image at all three; BC4X3: R, G, B planes)  3: scales (3 per tile)  4: E
+       5: col_perm  6: row_perm  7: outlier offsets (N + 1 uint64)  8: outlier columns
+       9: outlier values (3 each)  10: out. Rows are texel rows (chunks of row_offset, row_count
+       with row_offset + row_count <= N); the outlier arrays are bound whole (indexed by
+       original row), which limits them to one storage range (N of about 14 000 at 5%), and
+       the image to maxImageDimension2D texels (16384 on lavapipe).
+   RAD_GLSL_ALIAS_BUILD    alias tables of streamed rows (docs/methods/temporal.md), the bins of
+       rad_alias_build_row (Vose in double: needs the shaderFloat64 feature; bit-identical where
+       double arithmetic is IEEE, as on lavapipe). Push: rad_glsl_alias_build_push; flags
+       RAD_GLSL_ALIAS_DENSE (rows of cols values, no column array). 0: input row offsets
+       (rows + 1 uint64)  1: columns  2: values (entry k at k - entry_base)  3: bins out, padded
+       layout: row i's bins from bin row_offsets[i] + i (room for its entries + 1), at word
+       (b - out_base) * words  4: scratch, one double per output bin  5: scratch, one uint per
+       output bin  6: bin count per row (0: a negative or non-finite entry, or a column >= cols)
+       7: T_i per row. RAD_GLSL_TEMPORAL_STEP samples this layout directly (RAD_GLSL_TEMPORAL_PADDED).
+   RAD_GLSL_LIGHTING       an include, not a kernel: every lighting model and BRDF term of
+       >>api_shading as GLSL functions named as in C (rad_shade ...), no #version line: put
+       its text after yours (or resolve an #include to it). Its results agree with the C
+       functions to 1e-5 relative (tests/test_shading_vulkan.c, through glsl/lighting_eval.comp;
+       the header's copy is checked equal to glsl/lighting.glsl).
+   RAD_GLSL_LOCAL_APPLY    L_i = sum_{j in P_Lit} T_ij E_j (+ E_i) for i in P_Vis, as rad_local_apply,
+       on the planes of a rad_local (>>api_local; uploaded unchanged or kept resident on the
+       GPU). Push: rad_glsl_local_apply_push; flags RAD_GLSL_OUTPUT_TOTAL. ONE WORKGROUP PER
+       VISIBLE ENTRY. 0, 1, 2: the R, G, B planes (stride m = capacity; the rows slot_offset ..
+       slot_offset + slot_count - 1, row slot_offset at element base)  3: E (3n, world order)
+       4: lit map, slot_end uints: the world patch whose E lights column j, or RAD_NONE
+       (unlit or free slot)  5: slot of each visible entry  6: world patch of each visible entry
+       7: out (3n; the visible patches written). Chunks: an entry whose slot is outside the
+       bound rows is skipped, so each chunk's dispatch may take the whole visible list.
+   RAD_GLSL_LOCAL_VECTORS and RAD_GLSL_LOCAL_UPDATE  rad_local_add on T resident on the GPU:
+       the host keeps the slot bookkeeping (which slot, which member to evict) and streams only
+       the new patch's row and column over the slots, a_c[j] = rho_c[patch(j)] A_n F_nj / A_j and
+       b_c[j] = rho_c[n] F_nj (3 m floats each, channel-major, zero outside the members and at
+       the evicted slot), the list nz of the slots where F_nj != 0, and rho_n F_nn. VECTORS is
+       the small pre-pass: u = (I + T) a, v = b (I + T) (pass RAD_GLSL_LOCAL_PASS_GATHER, one
+       dispatch per row chunk, one invocation per row or column: max(row_count, end)
+       invocations), the corrections of the fused exact downdate when the add evicts slot ev
+       (pass _EVICT, end invocations) and s = 1 - ann - b.u with the factors of the exact or
+       first-order form (pass _SCALARS, 3 invocations), in float, into a work buffer of
+       RAD_GLSL_LOCAL_WORK_FLOATS(m) floats; UPDATE is the O(M^2) pass, ONE WORKGROUP PER ROW:
+       T += cuv u v - c r / g (rank 1, or rank 2 when evicting), the new row coef v and column
+       coef u, T_kk. Pushes: rad_glsl_local_vectors_push, rad_glsl_local_update_push; the
+       layout of the work buffer is in glsl/local_vectors.comp. VECTORS bindings: 0, 1, 2
+       planes (the chunk's rows at base; passes 1 and 2 read none: bind any range)  3: a
+       4: b  5: nz  6: work. UPDATE bindings: 0, 1, 2 planes (read-write, the chunk's rows)
+       3: work. A kernel cannot return an error: when s <= 1e-12 in some channel (rows that
+       break energy conservation: the CPU's RAD_ERROR_SINGULAR) UPDATE writes nothing; read s
+       (work[12 m + c]) back to detect it. With RAD_LOCAL_EVICT_DROP an add into a full set is
+       a plain add (ev = RAD_NONE) into the dropped member's slot k, with that member out of
+       the slot map: row and column k are overwritten as the drop would have zeroed them.
+       Each dispatch reads what the one before it wrote (pass 0's chunks accumulate v): in
+       one command buffer, put a compute-to-compute buffer memory barrier (shader write to
+       shader read) between consecutive dispatches, and before LOCAL_APPLY reads the planes.
+       The standalone rad_local_evict (a rank-1 downdate) has no kernel; hiding and showing
+       members (rad_local_remove, re-adding a hidden member) touch no plane. Measured on
+       lavapipe (tests/test_vulkan.c), T resident through 54 adds into M = 48 (the last 6 into
+       a full set: rank 2, or after a drop): at most 9.7e-7 relative from rad_local_add's
+       planes (exact and first-order), the float pre-pass against the CPU's double u, v, s.
+   RAD_GLSL_VP_GATHER      virtual-patch gathering at surface points (vertices, G-buffer
+       texels), as rad_vp_gather: split-weight (or, clustered, N . n) normal weights in each
+       voxel of the 2x2x2 block, trilinear weights across the voxels, voxels missing or with no
+       patch facing n skipped (>>api_vp). Push: rad_glsl_vp_gather_push (the grid of the
+       rad_virtual_patches); flags RAD_GLSL_VP_COSINE (weights RAD_VP_WEIGHTS_COSINE),
+       _CLUSTERED. ONE INVOCATION PER POINT. 0: points (3 floats each)  1: unit normals
+       (3 each)  2: values per patch (3N: B, L or H)  3: voxel_keys (voxel_count uint64, as
+       uvec2)  4: voxel_patch (6 per voxel)  5: patch normals (3N; read only when CLUSTERED,
+       else bind any buffer)  6: out (3 per point). Chunks: bindings 0, 1 and 6 hold the
+       chunk's points from element base (bind the three at the same offset). The grid
+       coordinate is computed as a float pair (TwoSum / Dekker products: the CPU uses double),
+       because its float rounding, about 1e-7 dims absolute, is large against small trilinear
+       weights (measured: 3e-5 relative without it, 2.9e-7 with it, on lavapipe).
+   RAD_GLSL_PROBE_UPDATE   irradiance probes from a new patch solution, as rad_probes_update
+       (>>api_probes): E_i = D_i + sum_e W_e,i B_patch(e), 27 coefficients per probe.
+       Push: rad_glsl_probe_update_push. ONE INVOCATION PER PROBE. The arrays of
+       rad_probes_weights uploaded unchanged: 0: first (probe count + 1 uint64)  1: patch index
+       per entry (entry k at element k - entry_base)  2: weights (9 per entry, entry k's at
+       element 9 k - weight_base)  3: direct (27 per probe)  4: B (3N)  5: out coefficients
+       (27 per probe; the chunk's probes written). Matches the CPU to 1e-5 (measured 6.8e-6 on
+       lavapipe, relative to each coefficient or 1e-3 of the largest: tests/test_vulkan.c).
+   RAD_GLSL_LIGHTMAP_REFRESH  a lightmap from a new patch irradiance H, as rad_lightmap_refresh
+       (>>api_lightmap), on the arrays of rad_lightmap_weights uploaded unchanged, in TWO
+       PASSES (push member pass): RAD_GLSL_LIGHTMAP_PASS_VERTICES, one invocation per patch
+       vertex, V = the vertex values of H; then RAD_GLSL_LIGHTMAP_PASS_TEXELS, one invocation
+       per row, the texels from V (a compute-to-compute barrier between the two: pass 1 reads
+       binding 4). Push: rad_glsl_lightmap_refresh_push. 0: vertex_first (vertex_count + 1)
+       1: vertex_patches  2: vertex_weights (entry k of both at element k - entry_base in pass
+       0)  3: H (3N)  4: V, scratch of 3 floats per vertex  5: row_texels  6: row_first
+       (row_count + 1)  7: entry_vertices  8: entry_weights (entry e at element e - entry_base
+       in pass 1)  9: the lightmap (3 per texel; only texels with a row written). A pass reads
+       none of the other's bindings among 0..3 and 5..9: bind any buffer there. Matches the
+       CPU to 1e-5 (tests/test_vulkan.c). */
+
+/* >>glsl ids begin */
+typedef enum rad_glsl_id {
+    RAD_GLSL_GATHER_DENSE      =  0, /* glsl/gather_dense.comp */
+    RAD_GLSL_GATHER_CSR        =  1, /* glsl/gather_csr.comp */
+    RAD_GLSL_MB_APPLY_FLOAT    =  2, /* glsl/mb_apply_float.comp */
+    RAD_GLSL_MB_APPLY_HALF     =  3, /* glsl/mb_apply_half.comp */
+    RAD_GLSL_TEMPORAL_STEP     =  4, /* glsl/temporal_step.comp */
+    RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* glsl/mb_apply_blocks.comp */
+    RAD_GLSL_ALIAS_BUILD       =  6, /* glsl/alias_build.comp */
+    RAD_GLSL_LIGHTING          =  7, /* glsl/lighting.glsl */
+    RAD_GLSL_LOCAL_APPLY       =  8, /* glsl/local_apply.comp */
+    RAD_GLSL_LOCAL_VECTORS     =  9, /* glsl/local_vectors.comp */
+    RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
+    RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
+    RAD_GLSL_PROBE_UPDATE      = 12, /* glsl/probe_update.comp */
+    RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* glsl/lightmap_refresh.comp */
+    RAD_GLSL_COUNT = 14
+} rad_glsl_id;
+/* >>glsl ids end */
+
+#define RAD_GLSL_SPEC_LOCAL_SIZE 0u   /* specialization constant id of the workgroup x size */
+#define RAD_GLSL_OUTPUT_TOTAL 1u        /* gather, applies: add E; the value of RAD_OUTPUT_TOTAL */
+#define RAD_GLSL_MB_PERMUTED 2u     /* multi-bounce apply: row_perm and col_perm are bound */
+#define RAD_GLSL_TEMPORAL_ALBEDO 1u       /* temporal: X *= rho (SINGLE, FEEDBACK) */
+#define RAD_GLSL_TEMPORAL_FEEDBACK 2u     /* temporal: sample V = E + B^prev (FEEDBACK) */
+#define RAD_GLSL_TEMPORAL_PADDED 4u       /* temporal: tables in the padded layout of RAD_GLSL_ALIAS_BUILD */
+#define RAD_GLSL_BLOCKS_BC1 4u          /* block apply: one BC1 image (else three BC4 images) */
+#define RAD_GLSL_BLOCKS_OUTLIERS 8u     /* block apply: the outlier arrays are bound */
+#define RAD_GLSL_ALIAS_DENSE 1u        /* alias build: dense rows, no column array */
+#define RAD_GLSL_LOCAL_FIRST_CHUNK 1u  /* local vectors, pass 0: the first row chunk (v = b + ...) */
+#define RAD_GLSL_LOCAL_FIRST_ORDER 2u  /* local vectors, pass 2: RAD_LOCAL_FIRST_ORDER factors */
+#define RAD_GLSL_LOCAL_PASS_GATHER 0u  /* local vectors: u, c, v, r from T (row-chunked) */
+#define RAD_GLSL_LOCAL_PASS_EVICT 1u   /* local vectors: the fused downdate's corrections (evicting adds) */
+#define RAD_GLSL_LOCAL_PASS_SCALARS 2u /* local vectors: s and the factors, 3 invocations */
+/* floats of the local-update work buffer for capacity m (u, v, c, r per channel, 12 scalars) */
+#define RAD_GLSL_VP_COSINE 1u       /* vp gather: RAD_VP_WEIGHTS_COSINE split weights */
+#define RAD_GLSL_VP_CLUSTERED 2u    /* vp gather: RAD_VP_CLUSTERED (w = N_a . n; binding 5 read) */
+#define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
+#define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
+#define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
+
+/* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
+typedef struct rad_glsl_gather_dense_push {
+    uint32_t row_offset, row_count, cols, f_base, flags;
+} rad_glsl_gather_dense_push;
+typedef struct rad_glsl_gather_csr_push {
+    uint32_t row_offset, row_count, entry_base, flags;
+} rad_glsl_gather_csr_push;
+typedef struct rad_glsl_mb_apply_push {   /* RAD_GLSL_MB_APPLY_FLOAT and _HALF */
+    uint32_t n, row_offset, row_count, base, flags;
+} rad_glsl_mb_apply_push;
+typedef struct rad_glsl_temporal_push {
+    uint32_t seed, frame;          /* rad_temporal_options.seed; the frame being computed (0, 1, ...) */
+    uint32_t row_offset, row_count;
+    uint32_t n;                    /* N: the environment's column */
+    uint32_t samples;              /* k */
+    uint32_t words;                /* (uint32_t)rad_alias_tables.format: 2 or 3 */
+    uint32_t flags;                /* RAD_GLSL_TEMPORAL_ALBEDO, _FEEDBACK, _PADDED */
+    uint32_t channel;              /* 3: RGB from one table set; 0..2: this channel only */
+    uint32_t sample_base;          /* channel * k with three table sets, else 0 */
+    uint32_t word_base;            /* low 32 bits of the tables' word index at element 0 of binding 1 */
+    float weight;                  /* w */
+    float env[3];                  /* E_0 */
+} rad_glsl_temporal_push;
+typedef struct rad_glsl_mb_blocks_push {
+    uint32_t n, row_offset, row_count;
+    uint32_t tile, tiles_per_row;  /* rad_multibounce_blocks.tile, .tiles_per_row */
+    uint32_t flags;
+} rad_glsl_mb_blocks_push;
+typedef struct rad_glsl_alias_build_push {
+    uint32_t row_offset, row_count;
+    uint32_t cols;                 /* N: the environment's column */
+    uint32_t words;                /* 2 (RAD_ALIAS_COMPACT, cols <= 65535) or 3 (RAD_ALIAS_WIDE) */
+    uint32_t entry_base;           /* low 32 bits of the entry at element 0 of bindings 1, 2 */
+    uint32_t out_base;             /* low 32 bits of the bin at element 0 of bindings 3, 4, 5 */
+    uint32_t flags;                /* RAD_GLSL_ALIAS_DENSE */
+} rad_glsl_alias_build_push;
+typedef struct rad_glsl_local_apply_push {
+    uint32_t m, end;               /* rad_local.capacity (plane stride), rad_local.slot_end */
+    uint32_t row_offset, row_count; /* visible entries of this dispatch */
+    uint32_t slot_offset, slot_count; /* plane rows held by bindings 0..2 */
+    uint32_t base;                 /* element of bindings 0..2 holding plane row slot_offset */
+    uint32_t flags;                /* RAD_GLSL_OUTPUT_TOTAL */
+} rad_glsl_local_apply_push;
+typedef struct rad_glsl_local_vectors_push {
+    uint32_t m, end;               /* capacity; slots in use after the add */
+    uint32_t row_offset, row_count, base; /* pass 0: the plane rows bound */
+    uint32_t nnz;                  /* slots in the nz list */
+    uint32_t ev;                   /* the slot evicted by this add, or RAD_NONE */
+    uint32_t pass;                 /* RAD_GLSL_LOCAL_PASS_* */
+    uint32_t flags;                /* RAD_GLSL_LOCAL_FIRST_CHUNK, _FIRST_ORDER */
+    float ann[3];                  /* rho_n F_nn per channel */
+} rad_glsl_local_vectors_push;
+typedef struct rad_glsl_local_update_push {
+    uint32_t m, end, row_offset, row_count, base;
+    uint32_t k;                    /* the new patch's slot */
+    uint32_t ev;                   /* the slot evicted by this add (== k), or RAD_NONE */
+} rad_glsl_local_update_push;
+typedef struct rad_glsl_vp_gather_push {
+    float origin[3];               /* rad_virtual_patches.origin */
+    float voxel_size[3];           /* .voxel_size */
+    uint32_t dims[3];              /* .dims */
+    uint32_t voxel_count;          /* .voxel_count */
+    uint32_t row_offset, row_count; /* the points of this dispatch */
+    uint32_t base;                 /* element of bindings 0, 1, 6 holding point row_offset's x */
+    uint32_t flags;                /* RAD_GLSL_VP_COSINE, _CLUSTERED */
+} rad_glsl_vp_gather_push;
+typedef struct rad_glsl_probe_update_push {
+    uint32_t row_offset, row_count; /* the probes of this dispatch */
+    uint32_t entry_base;           /* low 32 bits of the entry at element 0 of binding 1 */
+    uint32_t weight_base;          /* low 32 bits of the float (9 x entry) at element 0 of binding 2 */
+} rad_glsl_probe_update_push;
+typedef struct rad_glsl_lightmap_refresh_push {
+    uint32_t pass;                 /* RAD_GLSL_LIGHTMAP_PASS_VERTICES or _TEXELS */
+    uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
+    uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
+} rad_glsl_lightmap_refresh_push;
+
+/* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
+RAD_API const char *rad_glsl_name(rad_glsl_id id);
+
+/* The source of kernel 'id' in pieces: returns an array of *out_count string pointers (static
+   storage, never freed) whose concatenation is the source, or NULL (and 0) for an unknown id.
+   Each piece is at most 4000 characters and ends at a line end. Pure, thread-safe. */
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count);
+
+/* The whole source of kernel 'id' (the pieces concatenated), NUL-terminated, into dst.
+   *out_length (optional) receives the length without the NUL, on success and when dst is too
+   small. Call with dst = NULL and dst_size = 0 to ask for the length. Errors:
+   INVALID_ARGUMENT (unknown id; dst NULL with out_length NULL or dst_size > 0), SIZE_MISMATCH
+   (dst_size <= length: nothing written), UNAVAILABLE (built with RAD_NO_GLSL, under which
+   rad_glsl_name and rad_glsl_pieces return NULL). Pure, thread-safe, no allocation. Cost: O(length). */
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length);
 
 #ifdef __cplusplus
 }
@@ -3938,7 +3938,7 @@ static uint32_t rad__lattice_side(uint32_t samples)
 /* ======================================================================================== */
 
 /* The byte layout described in >>api_container, by name: every writer and reader of a
-   container (rad_container_write, rad_container_open, rad_row_stream_open, rad_load_file)
+   container (rad_container_write, rad_container_create, rad_row_stream_create, rad_load_file)
    uses these, so they cannot drift apart. */
 #define RAD__HEADER_BYTES 64u
 #define RAD__ENTRY_BYTES 64u
@@ -6078,6 +6078,645 @@ RAD_API void rad_camera_ray(const rad_camera *cam, uint32_t width, uint32_t heig
 }
 
 /* ======================================================================================== */
+/* >>light: direct light and the source term                                                */
+/* ======================================================================================== */
+
+/* functions defined in later sections, used here (written by reorder.py) */
+static double rad__ff_point_tri(const double *p, const double *n, const float *v);
+/* end of functions defined in later sections */
+
+RAD_API void rad_direct_options_default(rad_direct_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->samples = 16;
+    o->light_samples = 16;
+    o->include_emitters = 1;
+    o->ray_epsilon = 1e-5f;
+}
+
+#define RAD__DIRECT_GROUP 64u /* points per task row when lighting arbitrary points */
+
+typedef struct rad__direct {
+    const rad_scene *S;
+    const rad_raycaster *rc;
+    const rad_light *lights;
+    uint32_t light_count;
+    rad_direct_options o;
+    float eps;
+    uint32_t *emitters;          /* emissive triangles */
+    uint32_t emitter_count;
+    /* per task scratch */
+    rad_ray *rays;
+    uint8_t *occ;
+    float *ray_w;                /* 3 per ray */
+    uint32_t *ray_slot;
+    double *acc;                 /* 3 * RAD__DIRECT_GROUP per task */
+    /* job */
+    const float *points, *normals;
+    uint32_t count;
+    const rad_patches *P;        /* patch mode when set */
+    float *out;
+} rad__direct;
+
+static rad_result rad__direct_flush(rad__direct *d, uint32_t task, uint32_t count)
+{
+    rad_ray *rays = d->rays + (size_t)task * RAD__RAY_BATCH;
+    uint8_t *occ = d->occ + (size_t)task * RAD__RAY_BATCH;
+    const float *w = d->ray_w + (size_t)task * RAD__RAY_BATCH * 3u;
+    const uint32_t *slot = d->ray_slot + (size_t)task * RAD__RAY_BATCH;
+    double *acc = d->acc + (size_t)task * RAD__DIRECT_GROUP * 3u;
+    uint32_t k;
+    if (count == 0) return RAD_SUCCESS;
+    if (d->rc->occluded(d->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k)
+        if (!occ[k]) {
+            acc[3 * (size_t)slot[k]] += w[3 * (size_t)k];
+            acc[3 * (size_t)slot[k] + 1] += w[3 * (size_t)k + 1];
+            acc[3 * (size_t)slot[k] + 2] += w[3 * (size_t)k + 2];
+        }
+    return RAD_SUCCESS;
+}
+
+/* the shadow ray from p (offset eps along n) to 'to' (a point, offset along to_n when given)
+   or along 'dir' to infinity */
+static void rad__shadow_ray(rad_ray *ray, const float *p, const float *n, const float *to, const float *to_n,
+                            const float *dir, float eps)
+{
+    int k;
+    for (k = 0; k < 3; ++k) ray->origin[k] = p[k] + n[k] * eps;
+    if (to) {
+        float len;
+        for (k = 0; k < 3; ++k) ray->dir[k] = to[k] + (to_n ? to_n[k] * eps : 0.0f) - ray->origin[k];
+        len = rad__len(ray->dir);
+        ray->tmin = 0.0f;
+        ray->tmax = len > 2.0f * eps ? 1.0f - eps / len : 0.5f;
+    } else {
+        for (k = 0; k < 3; ++k) ray->dir[k] = dir[k];
+        ray->tmin = 0.0f;
+        ray->tmax = FLT_MAX;
+    }
+}
+
+/* The unshadowed irradiance w (RGB) of one directional, point or spot light at p (unit
+   normal n): 1 with w and, for a directional light, the unit direction towards it in v
+   (point and spot: the shadow ray goes to li->position); 0 when the light gives nothing
+   there (behind the normal, outside the cone). The one formula of rad_direct_irradiance
+   and rad_vp_lights_update, so that both give the same bits. */
+static int rad__light_unshadowed(const rad_light *li, float diagonal, const float *p, const float *n, float *w, float *v)
+{
+    float dist, cosn;
+    int k;
+    if (li->type == RAD_LIGHT_DIRECTIONAL) {
+        for (k = 0; k < 3; ++k) v[k] = -li->direction[k];
+        rad__normalize(v);
+        cosn = rad__dot(v, n);
+        if (!(cosn > 0.0f)) return 0;
+        for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn;
+        return 1;
+    } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
+        float dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * diagonal;
+        rad__sub(v, li->position, p);
+        dist = rad__len(v);
+        if (!(dist > 0.0f)) return 0;
+        cosn = rad__dot(v, n) / dist;
+        if (!(cosn > 0.0f)) return 0;
+        dc = dist > md ? dist : md;
+        atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
+        if (li->type == RAD_LIGHT_SPOT) {
+            float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
+            memcpy(axis, li->direction, sizeof(axis));
+            rad__normalize(axis);
+            ca = -rad__dot(v, axis) / dist;
+            if (ci > co) {
+                t = (ca - co) / (ci - co);
+                t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+                atten *= t * t * (3.0f - 2.0f * t);
+            } else if (!(ca >= co)) {
+                atten = 0.0f;
+            }
+            if (!(atten > 0.0f)) return 0;
+        }
+        for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn * atten;
+        return 1;
+    }
+    return 0;
+}
+
+/* queues a shadow ray from p (offset along n) to 'to' (a point, offset along to_n when given)
+   or along 'dir' to infinity, carrying weight w (scaled by 'scale') into slot */
+static rad_result rad__direct_ray(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
+                                  const float *to, const float *to_n, const float *dir, const float *w, float scale,
+                                  uint32_t slot)
+{
+    size_t at = (size_t)task * RAD__RAY_BATCH + *nrays;
+    int k;
+    rad__shadow_ray(d->rays + at, p, n, to, to_n, dir, d->eps);
+    for (k = 0; k < 3; ++k) d->ray_w[3 * at + (size_t)k] = w[k] * scale;
+    d->ray_slot[at] = slot;
+    if (++*nrays == RAD__RAY_BATCH) {
+        rad_result r = rad__direct_flush(d, task, *nrays);
+        *nrays = 0;
+        return r;
+    }
+    return RAD_SUCCESS;
+}
+
+/* Two unit tangents completing the unit normal n to a frame. */
+static void rad__tangent_frame(const float *n, float *t1, float *t2)
+{
+    float a[3] = { 1.0f, 0.0f, 0.0f };
+    if (fabs((double)n[0]) > 0.5) { a[0] = 0.0f; a[1] = 1.0f; }
+    rad__cross(t1, n, a);
+    rad__normalize(t1);
+    rad__cross(t2, n, t1);
+}
+
+/* Direction s of n cosine-distributed ones around n (frame t1, t2): Hammersley point s of n,
+   rotated by the two 16-bit halves of h, lifted from the disk. */
+static void rad__cosine_dir(const float *n, const float *t1, const float *t2, uint32_t s, uint32_t count, uint32_t h,
+                            float *dir)
+{
+    float u1, u2, rr, ph;
+    int k;
+    rad__hammersley(s, count, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
+    rr = (float)sqrt((double)u1);
+    ph = (float)(2.0 * RAD__PI) * u2;
+    for (k = 0; k < 3; ++k)
+        dir[k] = t1[k] * rr * (float)cos((double)ph) + t2[k] * rr * (float)sin((double)ph) + n[k] * (float)sqrt((double)(1.0f - u1));
+}
+
+/* all lights at one point into slot, each contribution times 'scale' */
+static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
+                                    uint32_t slot, float scale, uint32_t seed)
+{
+    uint32_t l, s, L = d->o.light_samples;
+    rad_result r;
+    int k;
+    for (l = 0; l < d->light_count; ++l) {
+        const rad_light *li = &d->lights[l];
+        float v[3], w[3];
+        if (li->type == RAD_LIGHT_DIRECTIONAL) {
+            if (!rad__light_unshadowed(li, d->S->diagonal, p, n, w, v)) continue;
+            r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, v, w, scale, slot);
+            if (r != RAD_SUCCESS) return r;
+        } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
+            if (!rad__light_unshadowed(li, d->S->diagonal, p, n, w, v)) continue;
+            r = rad__direct_ray(d, task, nrays, p, n, li->position, NULL, NULL, w, scale, slot);
+            if (r != RAD_SUCCESS) return r;
+        } else if (li->type == RAD_LIGHT_SKY) {
+            /* cosine-weighted directions: unoccluded fraction of the hemisphere times E_0 */
+            float t1[3], t2[3];
+            uint32_t h = rad__hash(seed ^ 0x5bd1e995u ^ l);
+            rad__tangent_frame(n, t1, t2);
+            for (s = 0; s < L; ++s) {
+                float dir[3];
+                rad__cosine_dir(n, t1, t2, s, L, h, dir);
+                r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, li->color, scale / (float)L, slot);
+                if (r != RAD_SUCCESS) return r;
+            }
+        }
+    }
+    if (d->o.include_emitters) {
+        double P[3], N[3], ks[RAD__MAX_SAMPLES], ksum;
+        float ys[3 * RAD__MAX_SAMPLES];
+        for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
+        for (l = 0; l < d->emitter_count; ++l) {
+            uint32_t t = d->emitters[l], h;
+            const float *tv = d->S->positions + 9 * (size_t)t, *tn = d->S->normals + 3 * (size_t)t;
+            const float *Le = d->S->materials_table[d->S->materials[t]].emission;
+            float dv[3], F, w[3], r1, r2;
+            rad__sub(dv, p, tv);
+            if (!(rad__dot(dv, tn) > 0.0f)) continue; /* behind the emitter, or on its plane */
+            F = (float)fabs(rad__ff_point_tri(P, N, tv));
+            if (!(F > 0.0f)) continue;
+            for (k = 0; k < 3; ++k) w[k] = (float)RAD__PI * Le[k] * F;
+            h = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
+            r1 = (float)(h & 0xFFFFu) / 65536.0f;
+            r2 = (float)(h >> 16) / 65536.0f;
+            /* Each shadow ray carries its sample's share of the kernel cos cos / r^2 (zero
+               behind p's plane): the visible fraction is then weighted as the form factor
+               weights the emitter's points. Equal shares were exact only when visibility does
+               not depend on where the point lies (a large emitter seen through an opening got
+               a fraction of its light). Unoccluded, the shares sum to the analytic F. */
+            ksum = 0.0;
+            for (s = 0; s < L; ++s) {
+                float u1, u2, *y = ys + 3 * s, dy[3], r2y;
+                double kern;
+                rad__hammersley(s, L, r1, r2, &u1, &u2);
+                rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
+                rad__sub(dy, y, p);
+                r2y = rad__dot(dy, dy);
+                kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
+                ks[s] = kern > 0.0 ? kern : 0.0;
+                ksum += ks[s];
+            }
+            for (s = 0; s < L; ++s) {
+                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)L;
+                if (!(share > 0.0f)) continue;
+                r = rad__direct_ray(d, task, nrays, p, n, ys + 3 * s, tn, NULL, w, scale * share, slot);
+                if (r != RAD_SUCCESS) return r;
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__direct_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__direct *d = (rad__direct *)data;
+    double *acc = d->acc + (size_t)task * RAD__DIRECT_GROUP * 3u;
+    uint32_t nrays = 0, i, first, count;
+    rad_result r = RAD_SUCCESS;
+    uint32_t seed = rad__hash(d->o.seed + 0x9E3779B9u * (row + 1u));
+    if (d->P) {
+        /* patch mode: 'samples' points of patch 'row', averaged into slot 0 */
+        const rad_patch *pt = &d->P->patches[row];
+        float v[9];
+        uint32_t s, S = d->o.samples;
+        int m, k;
+        for (m = 0; m < 3; ++m)
+            for (k = 0; k < 3; ++k) v[3 * m + k] = d->P->vertices[3 * (size_t)pt->vertices[m] + (size_t)k];
+        acc[0] = acc[1] = acc[2] = 0.0;
+        for (s = 0; s < S && r == RAD_SUCCESS; ++s) {
+            float x[3];
+            rad__lattice_point(v, v + 3, v + 6, rad__lattice_side(S), s, x);
+            r = rad__direct_point(d, task, &nrays, x, pt->normal, 0, 1.0f / (float)S, rad__hash(seed + s));
+        }
+        if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
+        if (r != RAD_SUCCESS) return r;
+        for (k = 0; k < 3; ++k) d->out[3 * (size_t)row + (size_t)k] = (float)acc[k];
+        return RAD_SUCCESS;
+    }
+    first = row * RAD__DIRECT_GROUP;
+    count = d->count - first < RAD__DIRECT_GROUP ? d->count - first : RAD__DIRECT_GROUP;
+    for (i = 0; i < 3 * count; ++i) acc[i] = 0.0;
+    for (i = 0; i < count && r == RAD_SUCCESS; ++i) {
+        const float *p = d->points + 3 * (size_t)(first + i), *n = d->normals + 3 * (size_t)(first + i);
+        r = rad__direct_point(d, task, &nrays, p, n, i, 1.0f, rad__hash(seed + i));
+    }
+    if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
+    if (r != RAD_SUCCESS) return r;
+    for (i = 0; i < 3 * count; ++i) d->out[3 * (size_t)first + i] = (float)acc[i];
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__direct_run(rad__direct *d, const rad__ctx *c, uint32_t rows)
+{
+    uint32_t T = c->tasks < rows ? c->tasks : rows, t, ne = 0;
+    rad_result r;
+    if (T == 0) return RAD_SUCCESS;
+    d->rays = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    d->occ = (uint8_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    d->ray_w = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
+    d->ray_slot = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    d->acc = (double *)rad__alloc_array(&c->allocator, (size_t)T * RAD__DIRECT_GROUP, 3 * sizeof(double));
+    d->emitters = (uint32_t *)rad__alloc_array(&c->allocator, d->S->triangle_count, sizeof(uint32_t));
+    if (!d->rays || !d->occ || !d->ray_w || !d->ray_slot || !d->acc || !d->emitters) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        for (t = 0; t < d->S->triangle_count; ++t) {
+            const float *e = d->S->materials_table[d->S->materials[t]].emission;
+            if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) d->emitters[ne++] = t;
+        }
+        d->emitter_count = ne;
+        r = rad__for_rows(c, rows, T, rad__direct_row, d);
+    }
+    rad__free(&c->allocator, d->rays);
+    rad__free(&c->allocator, d->occ);
+    rad__free(&c->allocator, d->ray_w);
+    rad__free(&c->allocator, d->ray_slot);
+    rad__free(&c->allocator, d->acc);
+    rad__free(&c->allocator, d->emitters);
+    return r;
+}
+
+static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const rad_raycaster *rc, const rad_light *lights,
+                                    uint32_t light_count, const rad_direct_options *options, const rad__ctx *c)
+{
+    uint32_t l;
+    memset(d, 0, sizeof(*d));
+    if (!S || !rc || !rc->occluded || (light_count > 0 && !lights)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (options) d->o = *options; else rad_direct_options_default(&d->o);
+    if (d->o.samples == 0) d->o.samples = 16;
+    if (d->o.samples > RAD__MAX_SAMPLES) d->o.samples = RAD__MAX_SAMPLES;
+    d->o.samples = rad__lattice_side(d->o.samples) * rad__lattice_side(d->o.samples); /* a square */
+    if (d->o.light_samples == 0) d->o.light_samples = 16;
+    if (d->o.light_samples > RAD__MAX_SAMPLES) d->o.light_samples = RAD__MAX_SAMPLES;
+    if (d->o.ray_epsilon == 0.0f) d->o.ray_epsilon = 1e-5f;
+    if (!(d->o.ray_epsilon > 0.0f && d->o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(c, RAD_LOG_ERROR, "direct light options: ray_epsilon %g must be in (0, %g] (relative to the scene diagonal)",
+                 (double)d->o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (l = 0; l < light_count; ++l) {
+        const rad_light *li = &lights[l];
+        if (!rad__finite3(li->color) || !rad__finite3(li->position) || !rad__finite3(li->direction) ||
+            !rad__finite(li->min_distance) || !rad__finite(li->inner_angle) || !rad__finite(li->outer_angle)) {
+            rad__log(c, RAD_LOG_ERROR, "light %u has a non-finite field", l);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (li->color[0] < 0.0f || li->color[1] < 0.0f || li->color[2] < 0.0f) {
+            rad__log(c, RAD_LOG_ERROR, "light %u has a negative colour", l);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+        if ((int)li->type < 0 || (int)li->type > RAD_LIGHT_SKY || (li->falloff != RAD_FALLOFF_QUADRATIC && li->falloff != RAD_FALLOFF_LINEAR) ||
+            li->min_distance < 0.0f ||
+            ((li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_SPOT) && rad__dot(li->direction, li->direction) == 0.0f) ||
+            (li->type == RAD_LIGHT_SPOT && (li->inner_angle < 0.0f || li->outer_angle < li->inner_angle || li->outer_angle > (float)RAD__PI))) {
+            rad__log(c, RAD_LOG_ERROR, "light %u: bad type, falloff, direction or spot angles", l);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    d->S = S;
+    d->rc = rc;
+    d->lights = lights;
+    d->light_count = light_count;
+    d->eps = d->o.ray_epsilon * S->diagonal;
+    return RAD_SUCCESS;
+}
+
+/* Points first .. first + count - 1 and their normals: finite (else NON_FINITE) and non-zero
+   (else INVALID_ARGUMENT), each logged with 'what'; the unit normals into unit (3 per point). */
+static rad_result rad__unit_normals(const rad__ctx *c, const char *what, const float *points, const float *normals,
+                                    uint32_t first, uint32_t count, float *unit)
+{
+    uint32_t i;
+    for (i = first; i < first + count; ++i)
+        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
+            rad__log(c, RAD_LOG_ERROR, "%s: point %u or its normal is not finite", what, i);
+            return RAD_ERROR_NON_FINITE;
+        }
+    for (i = 0; i < count; ++i) {
+        const float *n = normals + 3 * (size_t)(first + i);
+        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        int k;
+        if (!(len > 0.0) || len - len != 0.0) {
+            rad__log(c, RAD_LOG_ERROR, "%s: the normal of point %u has length %g (must be non-zero)", what, first + i, len);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        for (k = 0; k < 3; ++k) unit[3 * (size_t)i + (size_t)k] = (float)((double)n[k] / len);
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
+                                         uint32_t light_count, const rad_direct_options *options, const float *points,
+                                         const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__direct d;
+    rad_result r;
+    float *unit;
+    rad__ctx_init(&c, ctx);
+    if (!points || !normals || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__direct_setup(&d, scene, raycaster, lights, light_count, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    /* the cosines need unit normals: the caller's are normalized into a copy */
+    unit = (float *)rad__alloc_array(&c.allocator, count ? (size_t)count : 1u, 3 * sizeof(float));
+    if (!unit) {
+        rad__log(&c, RAD_LOG_ERROR, "direct irradiance: out of memory for %u normals", count);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    r = rad__unit_normals(&c, "direct irradiance", points, normals, 0, count, unit);
+    if (r != RAD_SUCCESS) {
+        rad__free(&c.allocator, unit);
+        return r;
+    }
+    d.points = points;
+    d.normals = unit;
+    d.count = count;
+    d.out = out_irradiance;
+    r = rad__direct_run(&d, &c, (count + RAD__DIRECT_GROUP - 1) / RAD__DIRECT_GROUP);
+    rad__free(&c.allocator, unit);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "direct irradiance", out_irradiance, 3 * (size_t)count) : r;
+}
+
+RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster, const rad_light *lights,
+                                      uint32_t light_count, const rad_direct_options *options, float *out_irradiance,
+                                      const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__direct d;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!patches || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__direct_setup(&d, patches->scene, raycaster, lights, light_count, options, &c);
+    if (r != RAD_SUCCESS) return r;
+    d.P = patches;
+    d.out = out_irradiance;
+    r = rad__direct_run(&d, &c, patches->count);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "direct irradiance", out_irradiance, 3 * (size_t)patches->count) : r;
+}
+
+RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance, float *out_E)
+{
+    uint32_t i;
+    int k;
+    if (!patches || !out_E) return RAD_ERROR_INVALID_ARGUMENT;
+    if (mode == RAD_SOURCE_EMISSION) {
+        if (direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT; /* that would count the lights twice */
+        for (i = 0; i < patches->count; ++i)
+            for (k = 0; k < 3; ++k)
+                if (!rad__finite((float)RAD__PI * patches->patches[i].emission[k])) return RAD_ERROR_NON_FINITE; /* pi L overflows */
+        for (i = 0; i < patches->count; ++i)
+            for (k = 0; k < 3; ++k) out_E[3 * (size_t)i + (size_t)k] = (float)RAD__PI * patches->patches[i].emission[k];
+        return RAD_SUCCESS;
+    }
+    if (mode == RAD_SOURCE_DIRECT) {
+        if (!direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
+        for (i = 0; i < 3 * patches->count; ++i)
+            if (!rad__finite(direct_irradiance[i])) return RAD_ERROR_NON_FINITE;
+        for (i = 0; i < 3 * patches->count; ++i)
+            if (direct_irradiance[i] < 0.0f) return RAD_ERROR_INVALID_ARGUMENT; /* finite but no irradiance */
+        for (i = 0; i < 3 * patches->count; ++i) out_E[i] = patches->albedo[i] * direct_irradiance[i];
+        return RAD_SUCCESS;
+    }
+    return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+/* ---- final gather ---- */
+
+#define RAD__FG_CHUNK 65536u /* hit points per lookup call */
+
+typedef struct rad__fg {
+    const rad_scene *S;
+    const rad_raycaster *rc;
+    const float *points, *normals; /* the chunk's points (unit normals) */
+    uint32_t rays, seed, first;    /* first: index of the chunk's first point */
+    float eps;
+    rad_ray *ray_buf;              /* per task RAD__RAY_BATCH */
+    rad_hit *hits;                 /* the chunk's hits, rays per point */
+    float *hit_p, *hit_n;          /* 3 per hit (kept where hits[].triangle is not RAD_NONE) */
+} rad__fg;
+
+static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__fg *g = (rad__fg *)data;
+    const float *p = g->points + 3 * (size_t)row, *n = g->normals + 3 * (size_t)row;
+    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    float t1[3], t2[3];
+    uint32_t seed = rad__hash(g->seed ^ rad__hash(g->first + row + 0x68E31DA4u)), k0, k;
+    int c;
+    rad__tangent_frame(n, t1, t2);
+    for (k0 = 0; k0 < g->rays; k0 += RAD__RAY_BATCH) {
+        uint32_t m = g->rays - k0 < RAD__RAY_BATCH ? g->rays - k0 : RAD__RAY_BATCH;
+        rad_hit *h = g->hits + (size_t)row * g->rays + k0;
+        for (k = 0; k < m; ++k) {
+            rad__cosine_dir(n, t1, t2, k0 + k, g->rays, seed, rays[k].dir);
+            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c] + n[c] * g->eps;
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = FLT_MAX;
+        }
+        if (g->rc->intersect(g->rc->user, rays, m, h) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        for (k = 0; k < m; ++k) {
+            size_t at = 3 * ((size_t)row * g->rays + k0 + k);
+            uint32_t t = h[k].triangle;
+            const float *v, *nt;
+            if (t == RAD_NONE || t >= g->S->triangle_count) { /* a miss: packed out below */
+                h[k].triangle = RAD_NONE;
+                continue;
+            }
+            v = g->S->positions + 9 * (size_t)t;
+            nt = g->S->normals + 3 * (size_t)t;
+            for (c = 0; c < 3; ++c) {
+                g->hit_p[at + (size_t)c] = v[c] + h[k].b1 * (v[3 + c] - v[c]) + h[k].b2 * (v[6 + c] - v[c]);
+                g->hit_n[at + (size_t)c] = nt[c];
+            }
+            if (!(rad__dot(nt, rays[k].dir) < 0.0f)) h[k].triangle = RAD_NONE; /* a back face: one-sided, black */
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_final_gather_options_default(rad_final_gather_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->rays = 64;
+    o->light_samples = 4;
+    o->ray_epsilon = 1e-5f;
+}
+
+RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
+                                    uint32_t light_count, const rad_final_gather_options *options,
+                                    rad_gather_lookup_fn lookup, void *lookup_user, const float *points,
+                                    const float *normals, uint32_t count, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__fg g;
+    rad_final_gather_options o;
+    rad_direct_options dopt;
+    rad_context quiet;
+    float *unit = NULL, *D = NULL, *H = NULL, *albedo = NULL;
+    uint32_t per, first, i, T, *owner = NULL;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!scene || !raycaster || !raycaster->intersect || !raycaster->occluded || !points || !normals || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "final gather: NULL scene, raycaster (with intersect and occluded), points, normals or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else rad_final_gather_options_default(&o);
+    if (o.rays == 0) o.rays = 64;
+    if (o.light_samples == 0) o.light_samples = 4;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (o.rays > 4096 || !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "final gather: rays %u (at most 4096) or ray_epsilon %g (in (0, %g]) out of range", o.rays,
+                 (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (count == 0) return RAD_SUCCESS;
+    memset(&g, 0, sizeof(g));
+    g.S = scene;
+    g.rc = raycaster;
+    g.rays = o.rays;
+    g.seed = o.seed;
+    g.eps = o.ray_epsilon * scene->diagonal;
+    rad_direct_options_default(&dopt);
+    dopt.light_samples = o.light_samples;
+    dopt.ray_epsilon = o.ray_epsilon;
+    dopt.seed = rad__hash(o.seed + 0x5BD1E995u);
+    /* the direct-light calls inside run without progress: this call's progress counts points */
+    if (ctx) quiet = *ctx;
+    else memset(&quiet, 0, sizeof(quiet));
+    quiet.progress = NULL;
+    per = RAD__FG_CHUNK / o.rays;
+    if (per == 0) per = 1;
+    T = c.tasks < per ? c.tasks : per;
+    unit = (float *)rad__alloc_array(&c.allocator, per, 3 * sizeof(float));
+    g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    g.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, sizeof(rad_hit));
+    g.hit_p = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    g.hit_n = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    D = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    H = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    albedo = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
+    owner = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, sizeof(uint32_t)); /* each hit's point */
+    if (!unit || !g.ray_buf || !g.hits || !g.hit_p || !g.hit_n || !D || !H || !albedo || !owner) {
+        rad__log(&c, RAD_LOG_ERROR, "final gather: out of memory for %u points of %u rays", per, o.rays);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (first = 0; first < count && r == RAD_SUCCESS; first += per) {
+        uint32_t m = count - first < per ? count - first : per, nh = 0, k;
+        size_t hits = (size_t)m * o.rays, j;
+        r = rad__unit_normals(&c, "final gather", points, normals, first, m, unit);
+        if (r != RAD_SUCCESS) break;
+        g.points = points + 3 * (size_t)first;
+        g.normals = unit;
+        g.first = first;
+        r = rad__for_rows(&c, m, T, rad__fg_row, &g);
+        if (r != RAD_SUCCESS) break;
+        /* the front-facing hits, packed to the front of the hit arrays */
+        for (j = 0; j < hits; ++j) {
+            if (g.hits[j].triangle == RAD_NONE) continue;
+            if (j != nh) {
+                g.hits[nh] = g.hits[j];
+                memcpy(g.hit_p + 3 * (size_t)nh, g.hit_p + 3 * j, 3 * sizeof(float));
+                memcpy(g.hit_n + 3 * (size_t)nh, g.hit_n + 3 * j, 3 * sizeof(float));
+            }
+            owner[nh++] = (uint32_t)(j / o.rays);
+        }
+        if (nh > 0) {
+            r = rad_direct_irradiance(scene, raycaster, lights, light_count, &dopt, g.hit_p, g.hit_n, nh, D, &quiet);
+            if (r != RAD_SUCCESS) {
+                rad__log(&c, RAD_LOG_ERROR, "final gather: direct light at the hits failed: %s", rad_result_string(r));
+                break;
+            }
+            if (lookup) {
+                r = lookup(lookup_user, g.hits, g.hit_p, g.hit_n, nh, H);
+                if (r != RAD_SUCCESS) {
+                    rad__log(&c, RAD_LOG_ERROR, "final gather: the lookup callback returned %s", rad_result_string(r));
+                    break;
+                }
+            } else {
+                memset(H, 0, sizeof(float) * 3 * (size_t)nh);
+            }
+            for (j = 0; j < nh; ++j) rad_scene_albedo(scene, g.hits[j].triangle, g.hits[j].b1, g.hits[j].b2, albedo + 3 * j);
+        }
+        for (i = 0; i < m; ++i) out[3 * (size_t)(first + i)] = out[3 * (size_t)(first + i) + 1] = out[3 * (size_t)(first + i) + 2] = 0.0f;
+        for (j = 0; j < nh; ++j) {
+            uint32_t pt = first + owner[j];
+            for (k = 0; k < 3; ++k)
+                out[3 * (size_t)pt + k] += albedo[3 * j + k] * (D[3 * j + k] + H[3 * j + k]) / (float)o.rays;
+        }
+        if (c.progress && c.progress(c.progress_user, (float)((double)(first + m) / (double)count))) {
+            rad__log(&c, RAD_LOG_INFO, "final gather: cancelled by the progress callback after %u of %u points", first + m, count);
+            r = RAD_ERROR_CANCELLED;
+        }
+    }
+    rad__free(&c.allocator, unit);
+    rad__free(&c.allocator, g.ray_buf);
+    rad__free(&c.allocator, g.hits);
+    rad__free(&c.allocator, g.hit_p);
+    rad__free(&c.allocator, g.hit_n);
+    rad__free(&c.allocator, D);
+    rad__free(&c.allocator, H);
+    rad__free(&c.allocator, albedo);
+    rad__free(&c.allocator, owner);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "final gather", out, 3 * (size_t)count) : r;
+}
+
+/* ======================================================================================== */
 /* >>formfactor: form factors                                                               */
 /* ======================================================================================== */
 
@@ -7723,8 +8362,6 @@ typedef struct rad__sr {
     rad_ray *rays;   /* RAD__RAY_BATCH per task */
     rad_hit *hits;   /* RAD__RAY_BATCH per task */
 } rad__sr;
-
-static void rad__tangent_frame(const float *n, float *t1, float *t2); /* >>light */
 
 /* uniform in (0, 1) from the top 24 bits of a hash */
 static float rad__sr_unit(uint32_t h) { return ((float)(h >> 8) + 0.5f) * (1.0f / 16777216.0f); }
@@ -9571,4548 +10208,6 @@ RAD_API rad_result rad_hierarchical_lookup(const rad_hierarchical *h, rad_hierar
     }
     return RAD_SUCCESS;
 }
-
-/* ======================================================================================== */
-/* >>light: direct light and the source term                                                */
-/* ======================================================================================== */
-
-RAD_API void rad_direct_options_default(rad_direct_options *o)
-{
-    if (!o) return;
-    memset(o, 0, sizeof(*o));
-    o->samples = 16;
-    o->light_samples = 16;
-    o->include_emitters = 1;
-    o->ray_epsilon = 1e-5f;
-}
-
-#define RAD__DIRECT_GROUP 64u /* points per task row when lighting arbitrary points */
-
-typedef struct rad__direct {
-    const rad_scene *S;
-    const rad_raycaster *rc;
-    const rad_light *lights;
-    uint32_t light_count;
-    rad_direct_options o;
-    float eps;
-    uint32_t *emitters;          /* emissive triangles */
-    uint32_t emitter_count;
-    /* per task scratch */
-    rad_ray *rays;
-    uint8_t *occ;
-    float *ray_w;                /* 3 per ray */
-    uint32_t *ray_slot;
-    double *acc;                 /* 3 * RAD__DIRECT_GROUP per task */
-    /* job */
-    const float *points, *normals;
-    uint32_t count;
-    const rad_patches *P;        /* patch mode when set */
-    float *out;
-} rad__direct;
-
-static rad_result rad__direct_flush(rad__direct *d, uint32_t task, uint32_t count)
-{
-    rad_ray *rays = d->rays + (size_t)task * RAD__RAY_BATCH;
-    uint8_t *occ = d->occ + (size_t)task * RAD__RAY_BATCH;
-    const float *w = d->ray_w + (size_t)task * RAD__RAY_BATCH * 3u;
-    const uint32_t *slot = d->ray_slot + (size_t)task * RAD__RAY_BATCH;
-    double *acc = d->acc + (size_t)task * RAD__DIRECT_GROUP * 3u;
-    uint32_t k;
-    if (count == 0) return RAD_SUCCESS;
-    if (d->rc->occluded(d->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
-    for (k = 0; k < count; ++k)
-        if (!occ[k]) {
-            acc[3 * (size_t)slot[k]] += w[3 * (size_t)k];
-            acc[3 * (size_t)slot[k] + 1] += w[3 * (size_t)k + 1];
-            acc[3 * (size_t)slot[k] + 2] += w[3 * (size_t)k + 2];
-        }
-    return RAD_SUCCESS;
-}
-
-/* the shadow ray from p (offset eps along n) to 'to' (a point, offset along to_n when given)
-   or along 'dir' to infinity */
-static void rad__shadow_ray(rad_ray *ray, const float *p, const float *n, const float *to, const float *to_n,
-                            const float *dir, float eps)
-{
-    int k;
-    for (k = 0; k < 3; ++k) ray->origin[k] = p[k] + n[k] * eps;
-    if (to) {
-        float len;
-        for (k = 0; k < 3; ++k) ray->dir[k] = to[k] + (to_n ? to_n[k] * eps : 0.0f) - ray->origin[k];
-        len = rad__len(ray->dir);
-        ray->tmin = 0.0f;
-        ray->tmax = len > 2.0f * eps ? 1.0f - eps / len : 0.5f;
-    } else {
-        for (k = 0; k < 3; ++k) ray->dir[k] = dir[k];
-        ray->tmin = 0.0f;
-        ray->tmax = FLT_MAX;
-    }
-}
-
-/* The unshadowed irradiance w (RGB) of one directional, point or spot light at p (unit
-   normal n): 1 with w and, for a directional light, the unit direction towards it in v
-   (point and spot: the shadow ray goes to li->position); 0 when the light gives nothing
-   there (behind the normal, outside the cone). The one formula of rad_direct_irradiance
-   and rad_vp_lights_update, so that both give the same bits. */
-static int rad__light_unshadowed(const rad_light *li, float diagonal, const float *p, const float *n, float *w, float *v)
-{
-    float dist, cosn;
-    int k;
-    if (li->type == RAD_LIGHT_DIRECTIONAL) {
-        for (k = 0; k < 3; ++k) v[k] = -li->direction[k];
-        rad__normalize(v);
-        cosn = rad__dot(v, n);
-        if (!(cosn > 0.0f)) return 0;
-        for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn;
-        return 1;
-    } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
-        float dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * diagonal;
-        rad__sub(v, li->position, p);
-        dist = rad__len(v);
-        if (!(dist > 0.0f)) return 0;
-        cosn = rad__dot(v, n) / dist;
-        if (!(cosn > 0.0f)) return 0;
-        dc = dist > md ? dist : md;
-        atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
-        if (li->type == RAD_LIGHT_SPOT) {
-            float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
-            memcpy(axis, li->direction, sizeof(axis));
-            rad__normalize(axis);
-            ca = -rad__dot(v, axis) / dist;
-            if (ci > co) {
-                t = (ca - co) / (ci - co);
-                t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-                atten *= t * t * (3.0f - 2.0f * t);
-            } else if (!(ca >= co)) {
-                atten = 0.0f;
-            }
-            if (!(atten > 0.0f)) return 0;
-        }
-        for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn * atten;
-        return 1;
-    }
-    return 0;
-}
-
-/* queues a shadow ray from p (offset along n) to 'to' (a point, offset along to_n when given)
-   or along 'dir' to infinity, carrying weight w (scaled by 'scale') into slot */
-static rad_result rad__direct_ray(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
-                                  const float *to, const float *to_n, const float *dir, const float *w, float scale,
-                                  uint32_t slot)
-{
-    size_t at = (size_t)task * RAD__RAY_BATCH + *nrays;
-    int k;
-    rad__shadow_ray(d->rays + at, p, n, to, to_n, dir, d->eps);
-    for (k = 0; k < 3; ++k) d->ray_w[3 * at + (size_t)k] = w[k] * scale;
-    d->ray_slot[at] = slot;
-    if (++*nrays == RAD__RAY_BATCH) {
-        rad_result r = rad__direct_flush(d, task, *nrays);
-        *nrays = 0;
-        return r;
-    }
-    return RAD_SUCCESS;
-}
-
-/* Two unit tangents completing the unit normal n to a frame. */
-static void rad__tangent_frame(const float *n, float *t1, float *t2)
-{
-    float a[3] = { 1.0f, 0.0f, 0.0f };
-    if (fabs((double)n[0]) > 0.5) { a[0] = 0.0f; a[1] = 1.0f; }
-    rad__cross(t1, n, a);
-    rad__normalize(t1);
-    rad__cross(t2, n, t1);
-}
-
-/* Direction s of n cosine-distributed ones around n (frame t1, t2): Hammersley point s of n,
-   rotated by the two 16-bit halves of h, lifted from the disk. */
-static void rad__cosine_dir(const float *n, const float *t1, const float *t2, uint32_t s, uint32_t count, uint32_t h,
-                            float *dir)
-{
-    float u1, u2, rr, ph;
-    int k;
-    rad__hammersley(s, count, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
-    rr = (float)sqrt((double)u1);
-    ph = (float)(2.0 * RAD__PI) * u2;
-    for (k = 0; k < 3; ++k)
-        dir[k] = t1[k] * rr * (float)cos((double)ph) + t2[k] * rr * (float)sin((double)ph) + n[k] * (float)sqrt((double)(1.0f - u1));
-}
-
-/* all lights at one point into slot, each contribution times 'scale' */
-static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
-                                    uint32_t slot, float scale, uint32_t seed)
-{
-    uint32_t l, s, L = d->o.light_samples;
-    rad_result r;
-    int k;
-    for (l = 0; l < d->light_count; ++l) {
-        const rad_light *li = &d->lights[l];
-        float v[3], w[3];
-        if (li->type == RAD_LIGHT_DIRECTIONAL) {
-            if (!rad__light_unshadowed(li, d->S->diagonal, p, n, w, v)) continue;
-            r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, v, w, scale, slot);
-            if (r != RAD_SUCCESS) return r;
-        } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
-            if (!rad__light_unshadowed(li, d->S->diagonal, p, n, w, v)) continue;
-            r = rad__direct_ray(d, task, nrays, p, n, li->position, NULL, NULL, w, scale, slot);
-            if (r != RAD_SUCCESS) return r;
-        } else if (li->type == RAD_LIGHT_SKY) {
-            /* cosine-weighted directions: unoccluded fraction of the hemisphere times E_0 */
-            float t1[3], t2[3];
-            uint32_t h = rad__hash(seed ^ 0x5bd1e995u ^ l);
-            rad__tangent_frame(n, t1, t2);
-            for (s = 0; s < L; ++s) {
-                float dir[3];
-                rad__cosine_dir(n, t1, t2, s, L, h, dir);
-                r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, li->color, scale / (float)L, slot);
-                if (r != RAD_SUCCESS) return r;
-            }
-        }
-    }
-    if (d->o.include_emitters) {
-        double P[3], N[3], ks[RAD__MAX_SAMPLES], ksum;
-        float ys[3 * RAD__MAX_SAMPLES];
-        for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
-        for (l = 0; l < d->emitter_count; ++l) {
-            uint32_t t = d->emitters[l], h;
-            const float *tv = d->S->positions + 9 * (size_t)t, *tn = d->S->normals + 3 * (size_t)t;
-            const float *Le = d->S->materials_table[d->S->materials[t]].emission;
-            float dv[3], F, w[3], r1, r2;
-            rad__sub(dv, p, tv);
-            if (!(rad__dot(dv, tn) > 0.0f)) continue; /* behind the emitter, or on its plane */
-            F = (float)fabs(rad__ff_point_tri(P, N, tv));
-            if (!(F > 0.0f)) continue;
-            for (k = 0; k < 3; ++k) w[k] = (float)RAD__PI * Le[k] * F;
-            h = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
-            r1 = (float)(h & 0xFFFFu) / 65536.0f;
-            r2 = (float)(h >> 16) / 65536.0f;
-            /* Each shadow ray carries its sample's share of the kernel cos cos / r^2 (zero
-               behind p's plane): the visible fraction is then weighted as the form factor
-               weights the emitter's points. Equal shares were exact only when visibility does
-               not depend on where the point lies (a large emitter seen through an opening got
-               a fraction of its light). Unoccluded, the shares sum to the analytic F. */
-            ksum = 0.0;
-            for (s = 0; s < L; ++s) {
-                float u1, u2, *y = ys + 3 * s, dy[3], r2y;
-                double kern;
-                rad__hammersley(s, L, r1, r2, &u1, &u2);
-                rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
-                rad__sub(dy, y, p);
-                r2y = rad__dot(dy, dy);
-                kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
-                ks[s] = kern > 0.0 ? kern : 0.0;
-                ksum += ks[s];
-            }
-            for (s = 0; s < L; ++s) {
-                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)L;
-                if (!(share > 0.0f)) continue;
-                r = rad__direct_ray(d, task, nrays, p, n, ys + 3 * s, tn, NULL, w, scale * share, slot);
-                if (r != RAD_SUCCESS) return r;
-            }
-        }
-    }
-    return RAD_SUCCESS;
-}
-
-static rad_result rad__direct_row(void *data, uint32_t row, uint32_t task)
-{
-    rad__direct *d = (rad__direct *)data;
-    double *acc = d->acc + (size_t)task * RAD__DIRECT_GROUP * 3u;
-    uint32_t nrays = 0, i, first, count;
-    rad_result r = RAD_SUCCESS;
-    uint32_t seed = rad__hash(d->o.seed + 0x9E3779B9u * (row + 1u));
-    if (d->P) {
-        /* patch mode: 'samples' points of patch 'row', averaged into slot 0 */
-        const rad_patch *pt = &d->P->patches[row];
-        float v[9];
-        uint32_t s, S = d->o.samples;
-        int m, k;
-        for (m = 0; m < 3; ++m)
-            for (k = 0; k < 3; ++k) v[3 * m + k] = d->P->vertices[3 * (size_t)pt->vertices[m] + (size_t)k];
-        acc[0] = acc[1] = acc[2] = 0.0;
-        for (s = 0; s < S && r == RAD_SUCCESS; ++s) {
-            float x[3];
-            rad__lattice_point(v, v + 3, v + 6, rad__lattice_side(S), s, x);
-            r = rad__direct_point(d, task, &nrays, x, pt->normal, 0, 1.0f / (float)S, rad__hash(seed + s));
-        }
-        if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
-        if (r != RAD_SUCCESS) return r;
-        for (k = 0; k < 3; ++k) d->out[3 * (size_t)row + (size_t)k] = (float)acc[k];
-        return RAD_SUCCESS;
-    }
-    first = row * RAD__DIRECT_GROUP;
-    count = d->count - first < RAD__DIRECT_GROUP ? d->count - first : RAD__DIRECT_GROUP;
-    for (i = 0; i < 3 * count; ++i) acc[i] = 0.0;
-    for (i = 0; i < count && r == RAD_SUCCESS; ++i) {
-        const float *p = d->points + 3 * (size_t)(first + i), *n = d->normals + 3 * (size_t)(first + i);
-        r = rad__direct_point(d, task, &nrays, p, n, i, 1.0f, rad__hash(seed + i));
-    }
-    if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
-    if (r != RAD_SUCCESS) return r;
-    for (i = 0; i < 3 * count; ++i) d->out[3 * (size_t)first + i] = (float)acc[i];
-    return RAD_SUCCESS;
-}
-
-static rad_result rad__direct_run(rad__direct *d, const rad__ctx *c, uint32_t rows)
-{
-    uint32_t T = c->tasks < rows ? c->tasks : rows, t, ne = 0;
-    rad_result r;
-    if (T == 0) return RAD_SUCCESS;
-    d->rays = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
-    d->occ = (uint8_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 1);
-    d->ray_w = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
-    d->ray_slot = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-    d->acc = (double *)rad__alloc_array(&c->allocator, (size_t)T * RAD__DIRECT_GROUP, 3 * sizeof(double));
-    d->emitters = (uint32_t *)rad__alloc_array(&c->allocator, d->S->triangle_count, sizeof(uint32_t));
-    if (!d->rays || !d->occ || !d->ray_w || !d->ray_slot || !d->acc || !d->emitters) {
-        r = RAD_ERROR_OUT_OF_MEMORY;
-    } else {
-        for (t = 0; t < d->S->triangle_count; ++t) {
-            const float *e = d->S->materials_table[d->S->materials[t]].emission;
-            if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) d->emitters[ne++] = t;
-        }
-        d->emitter_count = ne;
-        r = rad__for_rows(c, rows, T, rad__direct_row, d);
-    }
-    rad__free(&c->allocator, d->rays);
-    rad__free(&c->allocator, d->occ);
-    rad__free(&c->allocator, d->ray_w);
-    rad__free(&c->allocator, d->ray_slot);
-    rad__free(&c->allocator, d->acc);
-    rad__free(&c->allocator, d->emitters);
-    return r;
-}
-
-static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const rad_raycaster *rc, const rad_light *lights,
-                                    uint32_t light_count, const rad_direct_options *options, const rad__ctx *c)
-{
-    uint32_t l;
-    memset(d, 0, sizeof(*d));
-    if (!S || !rc || !rc->occluded || (light_count > 0 && !lights)) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) d->o = *options; else rad_direct_options_default(&d->o);
-    if (d->o.samples == 0) d->o.samples = 16;
-    if (d->o.samples > RAD__MAX_SAMPLES) d->o.samples = RAD__MAX_SAMPLES;
-    d->o.samples = rad__lattice_side(d->o.samples) * rad__lattice_side(d->o.samples); /* a square */
-    if (d->o.light_samples == 0) d->o.light_samples = 16;
-    if (d->o.light_samples > RAD__MAX_SAMPLES) d->o.light_samples = RAD__MAX_SAMPLES;
-    if (d->o.ray_epsilon == 0.0f) d->o.ray_epsilon = 1e-5f;
-    if (!(d->o.ray_epsilon > 0.0f && d->o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(c, RAD_LOG_ERROR, "direct light options: ray_epsilon %g must be in (0, %g] (relative to the scene diagonal)",
-                 (double)d->o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    for (l = 0; l < light_count; ++l) {
-        const rad_light *li = &lights[l];
-        if (!rad__finite3(li->color) || !rad__finite3(li->position) || !rad__finite3(li->direction) ||
-            !rad__finite(li->min_distance) || !rad__finite(li->inner_angle) || !rad__finite(li->outer_angle)) {
-            rad__log(c, RAD_LOG_ERROR, "light %u has a non-finite field", l);
-            return RAD_ERROR_NON_FINITE;
-        }
-        if (li->color[0] < 0.0f || li->color[1] < 0.0f || li->color[2] < 0.0f) {
-            rad__log(c, RAD_LOG_ERROR, "light %u has a negative colour", l);
-            return RAD_ERROR_NEGATIVE_EMISSION;
-        }
-        if ((int)li->type < 0 || (int)li->type > RAD_LIGHT_SKY || (li->falloff != RAD_FALLOFF_QUADRATIC && li->falloff != RAD_FALLOFF_LINEAR) ||
-            li->min_distance < 0.0f ||
-            ((li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_SPOT) && rad__dot(li->direction, li->direction) == 0.0f) ||
-            (li->type == RAD_LIGHT_SPOT && (li->inner_angle < 0.0f || li->outer_angle < li->inner_angle || li->outer_angle > (float)RAD__PI))) {
-            rad__log(c, RAD_LOG_ERROR, "light %u: bad type, falloff, direction or spot angles", l);
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-    }
-    d->S = S;
-    d->rc = rc;
-    d->lights = lights;
-    d->light_count = light_count;
-    d->eps = d->o.ray_epsilon * S->diagonal;
-    return RAD_SUCCESS;
-}
-
-/* Points first .. first + count - 1 and their normals: finite (else NON_FINITE) and non-zero
-   (else INVALID_ARGUMENT), each logged with 'what'; the unit normals into unit (3 per point). */
-static rad_result rad__unit_normals(const rad__ctx *c, const char *what, const float *points, const float *normals,
-                                    uint32_t first, uint32_t count, float *unit)
-{
-    uint32_t i;
-    for (i = first; i < first + count; ++i)
-        if (!rad__finite3(points + 3 * (size_t)i) || !rad__finite3(normals + 3 * (size_t)i)) {
-            rad__log(c, RAD_LOG_ERROR, "%s: point %u or its normal is not finite", what, i);
-            return RAD_ERROR_NON_FINITE;
-        }
-    for (i = 0; i < count; ++i) {
-        const float *n = normals + 3 * (size_t)(first + i);
-        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-        int k;
-        if (!(len > 0.0) || len - len != 0.0) {
-            rad__log(c, RAD_LOG_ERROR, "%s: the normal of point %u has length %g (must be non-zero)", what, first + i, len);
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-        for (k = 0; k < 3; ++k) unit[3 * (size_t)i + (size_t)k] = (float)((double)n[k] / len);
-    }
-    return RAD_SUCCESS;
-}
-
-RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
-                                         uint32_t light_count, const rad_direct_options *options, const float *points,
-                                         const float *normals, uint32_t count, float *out_irradiance, const rad_context *ctx)
-{
-    rad__ctx c;
-    rad__direct d;
-    rad_result r;
-    float *unit;
-    rad__ctx_init(&c, ctx);
-    if (!points || !normals || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
-    r = rad__direct_setup(&d, scene, raycaster, lights, light_count, options, &c);
-    if (r != RAD_SUCCESS) return r;
-    /* the cosines need unit normals: the caller's are normalized into a copy */
-    unit = (float *)rad__alloc_array(&c.allocator, count ? (size_t)count : 1u, 3 * sizeof(float));
-    if (!unit) {
-        rad__log(&c, RAD_LOG_ERROR, "direct irradiance: out of memory for %u normals", count);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    r = rad__unit_normals(&c, "direct irradiance", points, normals, 0, count, unit);
-    if (r != RAD_SUCCESS) {
-        rad__free(&c.allocator, unit);
-        return r;
-    }
-    d.points = points;
-    d.normals = unit;
-    d.count = count;
-    d.out = out_irradiance;
-    r = rad__direct_run(&d, &c, (count + RAD__DIRECT_GROUP - 1) / RAD__DIRECT_GROUP);
-    rad__free(&c.allocator, unit);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "direct irradiance", out_irradiance, 3 * (size_t)count) : r;
-}
-
-RAD_API rad_result rad_direct_patches(const rad_patches *patches, const rad_raycaster *raycaster, const rad_light *lights,
-                                      uint32_t light_count, const rad_direct_options *options, float *out_irradiance,
-                                      const rad_context *ctx)
-{
-    rad__ctx c;
-    rad__direct d;
-    rad_result r;
-    rad__ctx_init(&c, ctx);
-    if (!patches || !out_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
-    r = rad__direct_setup(&d, patches->scene, raycaster, lights, light_count, options, &c);
-    if (r != RAD_SUCCESS) return r;
-    d.P = patches;
-    d.out = out_irradiance;
-    r = rad__direct_run(&d, &c, patches->count);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "direct irradiance", out_irradiance, 3 * (size_t)patches->count) : r;
-}
-
-RAD_API rad_result rad_sources(const rad_patches *patches, rad_source_mode mode, const float *direct_irradiance, float *out_E)
-{
-    uint32_t i;
-    int k;
-    if (!patches || !out_E) return RAD_ERROR_INVALID_ARGUMENT;
-    if (mode == RAD_SOURCE_EMISSION) {
-        if (direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT; /* that would count the lights twice */
-        for (i = 0; i < patches->count; ++i)
-            for (k = 0; k < 3; ++k)
-                if (!rad__finite((float)RAD__PI * patches->patches[i].emission[k])) return RAD_ERROR_NON_FINITE; /* pi L overflows */
-        for (i = 0; i < patches->count; ++i)
-            for (k = 0; k < 3; ++k) out_E[3 * (size_t)i + (size_t)k] = (float)RAD__PI * patches->patches[i].emission[k];
-        return RAD_SUCCESS;
-    }
-    if (mode == RAD_SOURCE_DIRECT) {
-        if (!direct_irradiance) return RAD_ERROR_INVALID_ARGUMENT;
-        for (i = 0; i < 3 * patches->count; ++i)
-            if (!rad__finite(direct_irradiance[i])) return RAD_ERROR_NON_FINITE;
-        for (i = 0; i < 3 * patches->count; ++i)
-            if (direct_irradiance[i] < 0.0f) return RAD_ERROR_INVALID_ARGUMENT; /* finite but no irradiance */
-        for (i = 0; i < 3 * patches->count; ++i) out_E[i] = patches->albedo[i] * direct_irradiance[i];
-        return RAD_SUCCESS;
-    }
-    return RAD_ERROR_INVALID_ARGUMENT;
-}
-
-/* ---- final gather ---- */
-
-#define RAD__FG_CHUNK 65536u /* hit points per lookup call */
-
-typedef struct rad__fg {
-    const rad_scene *S;
-    const rad_raycaster *rc;
-    const float *points, *normals; /* the chunk's points (unit normals) */
-    uint32_t rays, seed, first;    /* first: index of the chunk's first point */
-    float eps;
-    rad_ray *ray_buf;              /* per task RAD__RAY_BATCH */
-    rad_hit *hits;                 /* the chunk's hits, rays per point */
-    float *hit_p, *hit_n;          /* 3 per hit (kept where hits[].triangle is not RAD_NONE) */
-} rad__fg;
-
-static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
-{
-    rad__fg *g = (rad__fg *)data;
-    const float *p = g->points + 3 * (size_t)row, *n = g->normals + 3 * (size_t)row;
-    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
-    float t1[3], t2[3];
-    uint32_t seed = rad__hash(g->seed ^ rad__hash(g->first + row + 0x68E31DA4u)), k0, k;
-    int c;
-    rad__tangent_frame(n, t1, t2);
-    for (k0 = 0; k0 < g->rays; k0 += RAD__RAY_BATCH) {
-        uint32_t m = g->rays - k0 < RAD__RAY_BATCH ? g->rays - k0 : RAD__RAY_BATCH;
-        rad_hit *h = g->hits + (size_t)row * g->rays + k0;
-        for (k = 0; k < m; ++k) {
-            rad__cosine_dir(n, t1, t2, k0 + k, g->rays, seed, rays[k].dir);
-            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c] + n[c] * g->eps;
-            rays[k].tmin = 0.0f;
-            rays[k].tmax = FLT_MAX;
-        }
-        if (g->rc->intersect(g->rc->user, rays, m, h) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
-        for (k = 0; k < m; ++k) {
-            size_t at = 3 * ((size_t)row * g->rays + k0 + k);
-            uint32_t t = h[k].triangle;
-            const float *v, *nt;
-            if (t == RAD_NONE || t >= g->S->triangle_count) { /* a miss: packed out below */
-                h[k].triangle = RAD_NONE;
-                continue;
-            }
-            v = g->S->positions + 9 * (size_t)t;
-            nt = g->S->normals + 3 * (size_t)t;
-            for (c = 0; c < 3; ++c) {
-                g->hit_p[at + (size_t)c] = v[c] + h[k].b1 * (v[3 + c] - v[c]) + h[k].b2 * (v[6 + c] - v[c]);
-                g->hit_n[at + (size_t)c] = nt[c];
-            }
-            if (!(rad__dot(nt, rays[k].dir) < 0.0f)) h[k].triangle = RAD_NONE; /* a back face: one-sided, black */
-        }
-    }
-    return RAD_SUCCESS;
-}
-
-RAD_API void rad_final_gather_options_default(rad_final_gather_options *o)
-{
-    if (!o) return;
-    memset(o, 0, sizeof(*o));
-    o->rays = 64;
-    o->light_samples = 4;
-    o->ray_epsilon = 1e-5f;
-}
-
-RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
-                                    uint32_t light_count, const rad_final_gather_options *options,
-                                    rad_gather_lookup_fn lookup, void *lookup_user, const float *points,
-                                    const float *normals, uint32_t count, float *out, const rad_context *ctx)
-{
-    rad__ctx c;
-    rad__fg g;
-    rad_final_gather_options o;
-    rad_direct_options dopt;
-    rad_context quiet;
-    float *unit = NULL, *D = NULL, *H = NULL, *albedo = NULL;
-    uint32_t per, first, i, T, *owner = NULL;
-    rad_result r = RAD_SUCCESS;
-    rad__ctx_init(&c, ctx);
-    if (!scene || !raycaster || !raycaster->intersect || !raycaster->occluded || !points || !normals || !out) {
-        rad__log(&c, RAD_LOG_ERROR, "final gather: NULL scene, raycaster (with intersect and occluded), points, normals or output");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (options) o = *options; else rad_final_gather_options_default(&o);
-    if (o.rays == 0) o.rays = 64;
-    if (o.light_samples == 0) o.light_samples = 4;
-    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
-    if (o.rays > 4096 || !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(&c, RAD_LOG_ERROR, "final gather: rays %u (at most 4096) or ray_epsilon %g (in (0, %g]) out of range", o.rays,
-                 (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (count == 0) return RAD_SUCCESS;
-    memset(&g, 0, sizeof(g));
-    g.S = scene;
-    g.rc = raycaster;
-    g.rays = o.rays;
-    g.seed = o.seed;
-    g.eps = o.ray_epsilon * scene->diagonal;
-    rad_direct_options_default(&dopt);
-    dopt.light_samples = o.light_samples;
-    dopt.ray_epsilon = o.ray_epsilon;
-    dopt.seed = rad__hash(o.seed + 0x5BD1E995u);
-    /* the direct-light calls inside run without progress: this call's progress counts points */
-    if (ctx) quiet = *ctx;
-    else memset(&quiet, 0, sizeof(quiet));
-    quiet.progress = NULL;
-    per = RAD__FG_CHUNK / o.rays;
-    if (per == 0) per = 1;
-    T = c.tasks < per ? c.tasks : per;
-    unit = (float *)rad__alloc_array(&c.allocator, per, 3 * sizeof(float));
-    g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
-    g.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, sizeof(rad_hit));
-    g.hit_p = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
-    g.hit_n = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
-    D = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
-    H = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
-    albedo = (float *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, 3 * sizeof(float));
-    owner = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)per * o.rays, sizeof(uint32_t)); /* each hit's point */
-    if (!unit || !g.ray_buf || !g.hits || !g.hit_p || !g.hit_n || !D || !H || !albedo || !owner) {
-        rad__log(&c, RAD_LOG_ERROR, "final gather: out of memory for %u points of %u rays", per, o.rays);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-    }
-    for (first = 0; first < count && r == RAD_SUCCESS; first += per) {
-        uint32_t m = count - first < per ? count - first : per, nh = 0, k;
-        size_t hits = (size_t)m * o.rays, j;
-        r = rad__unit_normals(&c, "final gather", points, normals, first, m, unit);
-        if (r != RAD_SUCCESS) break;
-        g.points = points + 3 * (size_t)first;
-        g.normals = unit;
-        g.first = first;
-        r = rad__for_rows(&c, m, T, rad__fg_row, &g);
-        if (r != RAD_SUCCESS) break;
-        /* the front-facing hits, packed to the front of the hit arrays */
-        for (j = 0; j < hits; ++j) {
-            if (g.hits[j].triangle == RAD_NONE) continue;
-            if (j != nh) {
-                g.hits[nh] = g.hits[j];
-                memcpy(g.hit_p + 3 * (size_t)nh, g.hit_p + 3 * j, 3 * sizeof(float));
-                memcpy(g.hit_n + 3 * (size_t)nh, g.hit_n + 3 * j, 3 * sizeof(float));
-            }
-            owner[nh++] = (uint32_t)(j / o.rays);
-        }
-        if (nh > 0) {
-            r = rad_direct_irradiance(scene, raycaster, lights, light_count, &dopt, g.hit_p, g.hit_n, nh, D, &quiet);
-            if (r != RAD_SUCCESS) {
-                rad__log(&c, RAD_LOG_ERROR, "final gather: direct light at the hits failed: %s", rad_result_string(r));
-                break;
-            }
-            if (lookup) {
-                r = lookup(lookup_user, g.hits, g.hit_p, g.hit_n, nh, H);
-                if (r != RAD_SUCCESS) {
-                    rad__log(&c, RAD_LOG_ERROR, "final gather: the lookup callback returned %s", rad_result_string(r));
-                    break;
-                }
-            } else {
-                memset(H, 0, sizeof(float) * 3 * (size_t)nh);
-            }
-            for (j = 0; j < nh; ++j) rad_scene_albedo(scene, g.hits[j].triangle, g.hits[j].b1, g.hits[j].b2, albedo + 3 * j);
-        }
-        for (i = 0; i < m; ++i) out[3 * (size_t)(first + i)] = out[3 * (size_t)(first + i) + 1] = out[3 * (size_t)(first + i) + 2] = 0.0f;
-        for (j = 0; j < nh; ++j) {
-            uint32_t pt = first + owner[j];
-            for (k = 0; k < 3; ++k)
-                out[3 * (size_t)pt + k] += albedo[3 * j + k] * (D[3 * j + k] + H[3 * j + k]) / (float)o.rays;
-        }
-        if (c.progress && c.progress(c.progress_user, (float)((double)(first + m) / (double)count))) {
-            rad__log(&c, RAD_LOG_INFO, "final gather: cancelled by the progress callback after %u of %u points", first + m, count);
-            r = RAD_ERROR_CANCELLED;
-        }
-    }
-    rad__free(&c.allocator, unit);
-    rad__free(&c.allocator, g.ray_buf);
-    rad__free(&c.allocator, g.hits);
-    rad__free(&c.allocator, g.hit_p);
-    rad__free(&c.allocator, g.hit_n);
-    rad__free(&c.allocator, D);
-    rad__free(&c.allocator, H);
-    rad__free(&c.allocator, albedo);
-    rad__free(&c.allocator, owner);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "final gather", out, 3 * (size_t)count) : r;
-}
-
-/* ======================================================================================== */
-/* >>lightmap: lightmaps over a second UV set                                               */
-/* ======================================================================================== */
-
-#define RAD__LM_MAX_SIDE 16384u
-#define RAD__LM_MAX_SUB 16u
-#define RAD__LM_MAX_SLOTS ((uint64_t)1 << 28)
-#define RAD__LM_GROUP 64u          /* samples per validity row */
-#define RAD__LM_SH_Y0 0.282094792f /* 1 / (2 sqrt(pi)) */
-#define RAD__LM_SH_Y1 0.488602512f /* sqrt(3) / (2 sqrt(pi)) */
-
-RAD_API void rad_lightmap_options_default(rad_lightmap_options *o)
-{
-    if (!o) return;
-    memset(o, 0, sizeof(*o));
-    o->width = o->height = 256;
-    o->samples = 4;
-    o->validity_rays = 16;
-    o->backface_limit = 0.1f;
-    o->ray_epsilon = 1e-5f;
-}
-
-RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *o)
-{
-    if (!o) return;
-    memset(o, 0, sizeof(*o));
-    o->encoding = RAD_LIGHTMAP_IRRADIANCE;
-    o->visibility_rays = 4;
-    o->ray_epsilon = 1e-5f;
-    o->method = RAD_LIGHTMAP_GATHER_EXACT;
-    o->hemisphere_rays = 256;
-    o->exact_ratio = 16.0f;
-}
-
-RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding)
-{
-    return encoding == RAD_LIGHTMAP_IRRADIANCE ? 3u : encoding == RAD_LIGHTMAP_SH_L1 ? 12u : 0u;
-}
-
-RAD_API void rad_lightmap_destroy(rad_lightmap *lm)
-{
-    rad_allocator a;
-    if (!lm) return;
-    a = lm->allocator;
-    rad__free(&a, lm->flags);
-    rad__free(&a, lm->positions);
-    rad__free(&a, lm->normals);
-    rad__free(&a, lm->sample_first);
-    rad__free(&a, lm->sample_positions);
-    rad__free(&a, lm->sample_normals);
-    rad__free(&a, lm->sample_triangles);
-    rad__free(&a, lm->sample_valid);
-    rad__free(&a, lm);
-}
-
-/* 1 when the uv triangle t (texel units, 6 doubles) and the box [x0,x1] x [y0,y1] overlap
-   with positive area (separating axes: the box's two and the triangle's three edge normals);
-   touching along a line does not count, so an edge on a texel border leaves the next texel out */
-static int rad__lm_overlap(const double *t, double x0, double y0, double x1, double y1)
-{
-    double mn, mx;
-    int e, k;
-    mn = mx = t[0];
-    for (k = 1; k < 3; ++k) { if (t[2 * k] < mn) mn = t[2 * k]; if (t[2 * k] > mx) mx = t[2 * k]; }
-    if (mx <= x0 || mn >= x1) return 0;
-    mn = mx = t[1];
-    for (k = 1; k < 3; ++k) { if (t[2 * k + 1] < mn) mn = t[2 * k + 1]; if (t[2 * k + 1] > mx) mx = t[2 * k + 1]; }
-    if (mx <= y0 || mn >= y1) return 0;
-    for (e = 0; e < 3; ++e) {
-        const double *a = t + 2 * e, *b = t + 2 * ((e + 1) % 3), *c = t + 2 * ((e + 2) % 3);
-        double nx = -(b[1] - a[1]), ny = b[0] - a[0], ta = nx * a[0] + ny * a[1], tc = nx * c[0] + ny * c[1];
-        double bx[4], lo, hi;
-        bx[0] = nx * x0 + ny * y0; bx[1] = nx * x1 + ny * y0; bx[2] = nx * x0 + ny * y1; bx[3] = nx * x1 + ny * y1;
-        lo = hi = bx[0];
-        for (k = 1; k < 4; ++k) { if (bx[k] < lo) lo = bx[k]; if (bx[k] > hi) hi = bx[k]; }
-        /* the triangle projects to [min(ta, tc), max(ta, tc)] (a and b project alike) */
-        if ((ta <= tc && (hi <= ta || lo >= tc)) || (ta > tc && (hi <= tc || lo >= ta))) return 0;
-    }
-    return 1;
-}
-
-/* barycentrics (b1, b2) of q in the uv triangle t; returns 0 for a degenerate triangle */
-static int rad__lm_bary(const double *t, double qx, double qy, double *b1, double *b2)
-{
-    double e1x = t[2] - t[0], e1y = t[3] - t[1], e2x = t[4] - t[0], e2y = t[5] - t[1];
-    double d = e1x * e2y - e1y * e2x, px = qx - t[0], py = qy - t[1];
-    if (!(fabs(d) > 1e-300)) return 0;
-    *b1 = (px * e2y - py * e2x) / d;
-    *b2 = (e1x * py - e1y * px) / d;
-    return 1;
-}
-
-/* the point of uv triangle t closest to q: barycentrics and squared distance */
-static double rad__lm_closest(const double *t, double qx, double qy, double *b1, double *b2)
-{
-    double best = DBL_MAX, x, y;
-    int e;
-    if (rad__lm_bary(t, qx, qy, b1, b2) && *b1 >= 0.0 && *b2 >= 0.0 && *b1 + *b2 <= 1.0) return 0.0;
-    for (e = 0; e < 3; ++e) {
-        const double *a = t + 2 * e, *b = t + 2 * ((e + 1) % 3);
-        double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy, s = 0.0, d2;
-        if (l2 > 0.0) s = ((qx - a[0]) * dx + (qy - a[1]) * dy) / l2;
-        if (s < 0.0) s = 0.0;
-        if (s > 1.0) s = 1.0;
-        x = a[0] + s * dx;
-        y = a[1] + s * dy;
-        d2 = (x - qx) * (x - qx) + (y - qy) * (y - qy);
-        if (d2 < best) {
-            /* barycentrics of the edge point: vertex e weight 1 - s, vertex e + 1 weight s */
-            double w[3] = { 0.0, 0.0, 0.0 };
-            best = d2;
-            w[e] = 1.0 - s;
-            w[(e + 1) % 3] = s;
-            *b1 = w[1];
-            *b2 = w[2];
-        }
-    }
-    return best;
-}
-
-typedef struct rad__lm_valid {
-    rad_lightmap *lm;
-    const rad_raycaster *rc;
-    uint32_t rays;
-    uint32_t limit;               /* back-face hits allowed */
-    uint32_t seed;
-    float eps;
-    rad_ray *ray_buf;             /* per task 'rays' */
-    rad_hit *hit_buf;
-    uint64_t *rays_cast;          /* per task */
-} rad__lm_valid;
-
-static rad_result rad__lm_valid_row(void *data, uint32_t row, uint32_t task)
-{
-    rad__lm_valid *v = (rad__lm_valid *)data;
-    rad_lightmap *lm = v->lm;
-    rad_ray *rays = v->ray_buf + (size_t)task * v->rays;
-    rad_hit *hits = v->hit_buf + (size_t)task * v->rays;
-    uint32_t s, end = (row + 1u) * RAD__LM_GROUP, k;
-    int c;
-    if (end > lm->sample_count) end = lm->sample_count;
-    for (s = row * RAD__LM_GROUP; s < end; ++s) {
-        const float *p = lm->sample_positions + 3 * (size_t)s, *n = lm->sample_normals + 3 * (size_t)s;
-        float t1[3], t2[3];
-        uint32_t h = rad__hash(v->seed ^ rad__hash(s + 0x2545F491u)), back = 0;
-        rad__tangent_frame(n, t1, t2);
-        for (k = 0; k < v->rays; ++k) {
-            rad__cosine_dir(n, t1, t2, k, v->rays, h, rays[k].dir);
-            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c] + n[c] * v->eps;
-            rays[k].tmin = 0.0f;
-            rays[k].tmax = FLT_MAX;
-        }
-        if (v->rc->intersect(v->rc->user, rays, v->rays, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
-        v->rays_cast[task] += v->rays;
-        for (k = 0; k < v->rays; ++k) {
-            uint32_t t = hits[k].triangle;
-            if (t != RAD_NONE && t < lm->scene->triangle_count && rad__dot(lm->scene->normals + 3 * (size_t)t, rays[k].dir) > 0.0f)
-                ++back;
-        }
-        lm->sample_valid[s] = back > v->limit ? 0u : 1u;
-    }
-    return RAD_SUCCESS;
-}
-
-RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
-                                       const rad_lightmap_options *options, const rad_context *ctx, rad_lightmap **out)
-{
-    rad__ctx c;
-    rad_lightmap_options o;
-    rad_lightmap *lm = NULL;
-    uint32_t W, H, n, S, t, x, y, i, total = 0;
-    size_t texels, slots;
-    uint32_t *slot_tri = NULL, *fb_tri = NULL;
-    float *slot_b = NULL, *fb_b = NULL, *fb_d = NULL;
-    rad__lm_valid v;
-    rad_result r = RAD_SUCCESS;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (!scene || !raycaster || !raycaster->intersect) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: NULL scene or raycaster (with intersect)");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (!scene->lightmap_uvs || !scene->lightmapped) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: no mesh of the scene has lightmap_uvs");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (options) o = *options; else rad_lightmap_options_default(&o);
-    if (o.width == 0) o.width = 256;
-    if (o.height == 0) o.height = 256;
-    if (o.samples == 0) o.samples = 4;
-    if (o.validity_rays == 0) o.validity_rays = 16;
-    if (o.backface_limit == 0.0f) o.backface_limit = 0.1f;
-    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
-    if (o.width > RAD__LM_MAX_SIDE || o.height > RAD__LM_MAX_SIDE || o.samples > RAD__LM_MAX_SUB ||
-        o.validity_rays > 1024u || !(o.backface_limit > 0.0f && o.backface_limit <= 1.0f) ||
-        !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: an option is out of range (size %ux%u, at most %u; samples %u, at most %u; "
-                 "validity_rays %u, at most 1024; backface_limit %g in (0, 1]; ray_epsilon %g in (0, %g])", o.width, o.height,
-                 RAD__LM_MAX_SIDE, o.samples, RAD__LM_MAX_SUB, o.validity_rays, (double)o.backface_limit,
-                 (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    W = o.width;
-    H = o.height;
-    n = rad__lattice_side(o.samples);
-    if (n * n > RAD__LM_MAX_SUB) n = 4;
-    S = n * n;
-    texels = (size_t)W * H;
-    if ((uint64_t)texels * S > RAD__LM_MAX_SLOTS) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: %ux%u texels of %u samples pass the limit of 2^28 sample slots", W, H, S);
-        return RAD_ERROR_SIZE_OVERFLOW;
-    }
-    slots = texels * S;
-    lm = (rad_lightmap *)rad__alloc(&c.allocator, sizeof(rad_lightmap));
-    if (!lm) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(lm, 0, sizeof(*lm));
-    lm->allocator = c.allocator;
-    lm->width = W;
-    lm->height = H;
-    lm->scene = scene;
-    lm->flags = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
-    lm->positions = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
-    lm->normals = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
-    lm->sample_first = (uint32_t *)rad__alloc_array(&c.allocator, texels + 1, sizeof(uint32_t));
-    slot_tri = (uint32_t *)rad__alloc_array(&c.allocator, slots, sizeof(uint32_t));
-    slot_b = (float *)rad__alloc_array(&c.allocator, slots, 2 * sizeof(float));
-    fb_tri = (uint32_t *)rad__alloc_array(&c.allocator, texels, sizeof(uint32_t));
-    fb_b = (float *)rad__alloc_array(&c.allocator, texels, 2 * sizeof(float));
-    fb_d = (float *)rad__alloc_array(&c.allocator, texels, sizeof(float));
-    if (!lm->flags || !lm->positions || !lm->normals || !lm->sample_first || !slot_tri || !slot_b || !fb_tri || !fb_b || !fb_d) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %ux%u texels", W, H);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-        goto done;
-    }
-    memset(lm->flags, 0, texels);
-    memset(lm->positions, 0, texels * 3 * sizeof(float));
-    memset(lm->normals, 0, texels * 3 * sizeof(float));
-    for (i = 0; i < slots; ++i) slot_tri[i] = RAD_NONE;
-    for (i = 0; i < texels; ++i) { fb_tri[i] = RAD_NONE; fb_d[i] = FLT_MAX; }
-    /* rasterize: serial, each triangle over the texels of its uv bounds */
-    for (t = 0; t < scene->triangle_count; ++t) {
-        double tu[6], mnx, mny, mxx, mxy;
-        int64_t x0, x1, y0, y1;
-        int k;
-        if (!scene->lightmapped[t]) continue;
-        for (k = 0; k < 3; ++k) {
-            tu[2 * k] = (double)scene->lightmap_uvs[6 * (size_t)t + 2 * (size_t)k] * W;
-            tu[2 * k + 1] = (double)scene->lightmap_uvs[6 * (size_t)t + 2 * (size_t)k + 1] * H;
-        }
-        {
-            double b1, b2;
-            if (!rad__lm_bary(tu, tu[0], tu[1], &b1, &b2)) continue; /* zero uv area: nothing to bake */
-        }
-        mnx = mxx = tu[0];
-        mny = mxy = tu[1];
-        for (k = 1; k < 3; ++k) {
-            if (tu[2 * k] < mnx) mnx = tu[2 * k];
-            if (tu[2 * k] > mxx) mxx = tu[2 * k];
-            if (tu[2 * k + 1] < mny) mny = tu[2 * k + 1];
-            if (tu[2 * k + 1] > mxy) mxy = tu[2 * k + 1];
-        }
-        if (mxx <= 0.0 || mxy <= 0.0 || mnx >= (double)W || mny >= (double)H) continue;
-        x0 = (int64_t)floor(mnx); x1 = (int64_t)floor(mxx);
-        y0 = (int64_t)floor(mny); y1 = (int64_t)floor(mxy);
-        if (x0 < 0) x0 = 0;
-        if (y0 < 0) y0 = 0;
-        if (x1 > (int64_t)W - 1) x1 = (int64_t)W - 1;
-        if (y1 > (int64_t)H - 1) y1 = (int64_t)H - 1;
-        for (y = (uint32_t)y0; y <= (uint32_t)y1; ++y)
-            for (x = (uint32_t)x0; x <= (uint32_t)x1; ++x) {
-                size_t ti = (size_t)y * W + x;
-                uint32_t a, b, got = 0;
-                double b1, b2, d2;
-                if (!rad__lm_overlap(tu, (double)x, (double)y, (double)x + 1.0, (double)y + 1.0)) continue;
-                lm->flags[ti] |= RAD_TEXEL_COVERED;
-                for (b = 0; b < n; ++b)
-                    for (a = 0; a < n; ++a) {
-                        size_t si = ti * S + (size_t)b * n + a;
-                        if (!rad__lm_bary(tu, x + (a + 0.5) / n, y + (b + 0.5) / n, &b1, &b2)) continue;
-                        if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0) continue;
-                        got = 1;
-                        if (slot_tri[si] != RAD_NONE) continue; /* the first triangle keeps a shared sub-point */
-                        slot_tri[si] = t;
-                        slot_b[2 * si] = (float)b1;
-                        slot_b[2 * si + 1] = (float)b2;
-                    }
-                if (got) continue;
-                d2 = rad__lm_closest(tu, x + 0.5, y + 0.5, &b1, &b2);
-                if (d2 < (double)fb_d[ti]) {
-                    fb_d[ti] = (float)d2;
-                    fb_tri[ti] = t;
-                    fb_b[2 * ti] = (float)b1;
-                    fb_b[2 * ti + 1] = (float)b2;
-                }
-            }
-    }
-    /* the samples, texel by texel */
-    for (i = 0; i < texels; ++i) {
-        uint32_t m = 0, s;
-        lm->sample_first[i] = total;
-        if (!(lm->flags[i] & RAD_TEXEL_COVERED)) continue;
-        for (s = 0; s < S; ++s) if (slot_tri[(size_t)i * S + s] != RAD_NONE) ++m;
-        if (m == 0 && fb_tri[i] != RAD_NONE) m = 1;
-        if ((uint64_t)total + m >= (uint64_t)RAD_NONE) { r = RAD_ERROR_SIZE_OVERFLOW; goto done; }
-        total += m;
-    }
-    lm->sample_first[texels] = total;
-    lm->sample_count = total;
-    lm->sample_positions = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
-    lm->sample_normals = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
-    lm->sample_triangles = (uint32_t *)rad__alloc_array(&c.allocator, total ? total : 1u, sizeof(uint32_t));
-    lm->sample_valid = (uint8_t *)rad__alloc_array(&c.allocator, total ? total : 1u, 1);
-    if (!lm->sample_positions || !lm->sample_normals || !lm->sample_triangles || !lm->sample_valid) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %u samples", total);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-        goto done;
-    }
-    for (i = 0; i < texels; ++i) {
-        uint32_t at = lm->sample_first[i], s, m = lm->sample_first[i + 1] - at, j = 0;
-        for (s = 0; s < S && j < m; ++s) {
-            size_t si = (size_t)i * S + s;
-            uint32_t tt = slot_tri[si];
-            float b1, b2;
-            const float *P;
-            int k;
-            if (tt == RAD_NONE && !(s == S - 1 && j == 0)) continue;
-            if (tt == RAD_NONE) { /* no sub-point inside: the fallback point */
-                tt = fb_tri[i];
-                b1 = fb_b[2 * (size_t)i];
-                b2 = fb_b[2 * (size_t)i + 1];
-            } else {
-                b1 = slot_b[2 * si];
-                b2 = slot_b[2 * si + 1];
-            }
-            P = scene->positions + 9 * (size_t)tt;
-            {
-                /* a point on the triangle's border (a fallback point, a sub-point on an edge)
-                   lies on the plane of the wall that meets it there, where its validity rays
-                   would start behind that wall: it moves towards the centroid by a few ray
-                   epsilons (at most half the way) */
-                float *X = lm->sample_positions + 3 * (size_t)(at + j), dc[3], len, step;
-                for (k = 0; k < 3; ++k) {
-                    X[k] = P[k] + b1 * (P[3 + k] - P[k]) + b2 * (P[6 + k] - P[k]);
-                    dc[k] = (P[k] + P[3 + k] + P[6 + k]) / 3.0f - X[k];
-                    lm->sample_normals[3 * (size_t)(at + j) + k] = scene->normals[3 * (size_t)tt + k];
-                }
-                len = rad__len(dc);
-                step = 4.0f * o.ray_epsilon * scene->diagonal;
-                if (len > 0.0f) {
-                    if (step > 0.5f * len) step = 0.5f * len;
-                    for (k = 0; k < 3; ++k) X[k] += dc[k] * (step / len);
-                }
-            }
-            lm->sample_triangles[at + j] = tt;
-            ++j;
-        }
-    }
-    /* validity */
-    memset(&v, 0, sizeof(v));
-    v.lm = lm;
-    v.rc = raycaster;
-    v.rays = o.validity_rays;
-    v.limit = (uint32_t)floor((double)o.backface_limit * o.validity_rays + 1e-9);
-    v.seed = o.seed;
-    v.eps = o.ray_epsilon * scene->diagonal;
-    if (total > 0) {
-        uint32_t rows = (total + RAD__LM_GROUP - 1) / RAD__LM_GROUP, T = c.tasks < rows ? c.tasks : rows;
-        v.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_ray));
-        v.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_hit));
-        v.rays_cast = (uint64_t *)rad__alloc_array(&c.allocator, T, sizeof(uint64_t));
-        if (!v.ray_buf || !v.hit_buf || !v.rays_cast) {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-        } else {
-            memset(v.rays_cast, 0, sizeof(uint64_t) * T);
-            r = rad__for_rows(&c, rows, T, rad__lm_valid_row, &v);
-            for (i = 0; i < T; ++i) lm->rays_cast += v.rays_cast[i];
-        }
-        rad__free(&c.allocator, v.ray_buf);
-        rad__free(&c.allocator, v.hit_buf);
-        rad__free(&c.allocator, v.rays_cast);
-        if (r != RAD_SUCCESS) goto done;
-    }
-    /* texel position and normal */
-    for (i = 0; i < texels; ++i) {
-        uint32_t s, a = lm->sample_first[i], b = lm->sample_first[i + 1], any = 0;
-        float cnt = 0.0f, *P = lm->positions + 3 * (size_t)i, *N = lm->normals + 3 * (size_t)i;
-        int k;
-        if (a == b) continue;
-        ++lm->covered_texels;
-        for (s = a; s < b; ++s) {
-            if (lm->sample_valid[s]) any = 1;
-            else ++lm->invalid_samples;
-        }
-        if (any) { lm->flags[i] |= RAD_TEXEL_VALID; ++lm->valid_texels; }
-        for (s = a; s < b; ++s) {
-            if (any && !lm->sample_valid[s]) continue;
-            for (k = 0; k < 3; ++k) {
-                P[k] += lm->sample_positions[3 * (size_t)s + k];
-                N[k] += lm->sample_normals[3 * (size_t)s + k];
-            }
-            cnt += 1.0f;
-        }
-        for (k = 0; k < 3; ++k) P[k] /= cnt;
-        if (rad__len(N) > 0.0f) rad__normalize(N);
-        else memcpy(N, lm->sample_normals + 3 * (size_t)a, 3 * sizeof(float));
-    }
-done:
-    rad__free(&c.allocator, slot_tri);
-    rad__free(&c.allocator, slot_b);
-    rad__free(&c.allocator, fb_tri);
-    rad__free(&c.allocator, fb_b);
-    rad__free(&c.allocator, fb_d);
-    if (r != RAD_SUCCESS) {
-        if (r == RAD_ERROR_SIZE_OVERFLOW) rad__log(&c, RAD_LOG_ERROR, "lightmap: more than 2^32 - 2 samples");
-        rad_lightmap_destroy(lm);
-        return r;
-    }
-    *out = lm;
-    return RAD_SUCCESS;
-}
-
-/* The projections of the radiance of a Lambertian polygon (triangle v, 9 floats) seen from p
-   (unit normal n), clipped to p's upper half-space: out[0] its solid angle, out[1..3] its
-   vector irradiance integral w dw (so n . out[1..3] = pi F). Returns 0 when nothing is left. */
-static int rad__lm_polygon(const double *p, const double *n, const float *v, double *out)
-{
-    double q[3][3], d[3], poly[4][3], r[4][3], vec[3] = { 0.0, 0.0, 0.0 }, omega = 0.0, dn;
-    int i, k, m = 0;
-    for (i = 0; i < 3; ++i) {
-        for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
-        d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
-    }
-    for (i = 0; i < 3; ++i) {
-        int j = (i + 1) % 3;
-        if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) poly[m][k] = q[i][k]; ++m; }
-        if ((d[i] > 0.0 && d[j] < 0.0) || (d[i] < 0.0 && d[j] > 0.0)) {
-            double s = d[i] / (d[i] - d[j]);
-            for (k = 0; k < 3; ++k) poly[m][k] = q[i][k] + s * (q[j][k] - q[i][k]);
-            ++m;
-        }
-    }
-    if (m < 3) return 0;
-    for (i = 0; i < m; ++i) {
-        double l = sqrt(poly[i][0] * poly[i][0] + poly[i][1] * poly[i][1] + poly[i][2] * poly[i][2]);
-        if (!(l > 0.0)) return 0; /* p on the polygon's boundary */
-        for (k = 0; k < 3; ++k) r[i][k] = poly[i][k] / l;
-    }
-    for (i = 0; i < m; ++i) {
-        const double *a = r[i], *b = r[(i + 1) % m];
-        double cr[3], cl, dot;
-        cr[0] = a[1] * b[2] - a[2] * b[1];
-        cr[1] = a[2] * b[0] - a[0] * b[2];
-        cr[2] = a[0] * b[1] - a[1] * b[0];
-        cl = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-        if (!(cl > 1e-300)) continue;
-        dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        for (k = 0; k < 3; ++k) vec[k] += 0.5 * atan2(cl, dot) * cr[k] / cl;
-    }
-    /* solid angle: a fan of spherical triangles (Van Oosterom and Strackee) */
-    for (i = 1; i + 1 < m; ++i) {
-        const double *a = r[0], *b = r[i], *cc = r[i + 1];
-        double trip = a[0] * (b[1] * cc[2] - b[2] * cc[1]) + a[1] * (b[2] * cc[0] - b[0] * cc[2]) + a[2] * (b[0] * cc[1] - b[1] * cc[0]);
-        double den = 1.0 + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) + (b[0] * cc[0] + b[1] * cc[1] + b[2] * cc[2]) +
-                     (cc[0] * a[0] + cc[1] * a[1] + cc[2] * a[2]);
-        omega += 2.0 * atan2(trip, den);
-    }
-    /* the winding decides the signs; the polygon lies above p's plane, so n . vec >= 0 */
-    dn = vec[0] * n[0] + vec[1] * n[1] + vec[2] * n[2];
-    if (dn < 0.0) { for (k = 0; k < 3; ++k) vec[k] = -vec[k]; dn = -dn; }
-    if (!(dn > 0.0)) return 0;
-    out[0] = fabs(omega);
-    for (k = 0; k < 3; ++k) out[1 + k] = vec[k];
-    return 1;
-}
-
-typedef struct rad__lm_gather {
-    const rad_lightmap *lm;
-    const rad_patches *P;
-    const float *B;
-    const rad_raycaster *rc;
-    uint32_t ch, vis, seed, hemi;
-    float eps;
-    uint32_t *list;               /* the patches gathered exactly: every lit one, or the bright ones */
-    uint32_t list_count;
-    uint8_t *skip;                /* hemisphere: per patch, 1 when a hit on it brings nothing */
-    rad_ray *ray_buf;             /* per task RAD__RAY_BATCH */
-    uint8_t *occ_buf;
-    float *ray_c;                 /* per task RAD__RAY_BATCH x ch: each ray's contribution */
-    rad_hit *hit_buf;             /* hemisphere: per task RAD__RAY_BATCH */
-    float *hit_w;                 /* hemisphere: per task RAD__RAY_BATCH x 4 (weight, SH direction) */
-    float *out;
-} rad__lm_gather;
-
-static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count, double *acc)
-{
-    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
-    uint8_t *occ = g->occ_buf + (size_t)task * RAD__RAY_BATCH;
-    const float *w = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
-    uint32_t k, ch;
-    if (count == 0) return RAD_SUCCESS;
-    if (g->rc->occluded(g->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
-    for (k = 0; k < count; ++k)
-        if (!occ[k])
-            for (ch = 0; ch < g->ch; ++ch) acc[ch] += (double)w[(size_t)k * g->ch + ch];
-    return RAD_SUCCESS;
-}
-
-/* hemisphere rays: each hit on the front of a patch that is not counted exactly brings its B */
-static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t count, double *sum)
-{
-    const rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
-    rad_hit *hits = g->hit_buf + (size_t)task * RAD__RAY_BATCH;
-    const float *hw = g->hit_w + (size_t)task * RAD__RAY_BATCH * 4;
-    const rad_scene *S = g->lm->scene;
-    uint32_t k, j;
-    int c;
-    if (count == 0) return RAD_SUCCESS;
-    if (g->rc->intersect(g->rc->user, rays, count, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
-    for (k = 0; k < count; ++k) {
-        const rad_hit *h = hits + k;
-        const float *w = hw + 4 * (size_t)k;
-        float wt[3];
-        if (h->triangle == RAD_NONE || h->triangle >= S->triangle_count) continue;
-        if (!(rad__dot(S->normals + 3 * (size_t)h->triangle, rays[k].dir) < 0.0f)) continue; /* back face */
-        j = rad_patches_locate(g->P, h->triangle, h->b1, h->b2, wt);
-        if (j == RAD_NONE || g->skip[j]) continue;
-        for (c = 0; c < 3; ++c) {
-            double b = (double)g->B[3 * (size_t)j + (size_t)c] * w[0];
-            if (g->ch == 3) {
-                sum[c] += b;
-            } else {
-                sum[c] += b * RAD__LM_SH_Y0;
-                sum[3 + c] += b * RAD__LM_SH_Y1 * w[2];
-                sum[6 + c] += b * RAD__LM_SH_Y1 * w[3];
-                sum[9 + c] += b * RAD__LM_SH_Y1 * w[1];
-            }
-        }
-    }
-    return RAD_SUCCESS;
-}
-
-/* one texel: the mean over its valid samples of the patches' light */
-static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
-{
-    rad__lm_gather *g = (rad__lm_gather *)data;
-    const rad_lightmap *lm = g->lm;
-    const rad_patches *P = g->P;
-    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
-    float *rc = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
-    float *hw = g->hit_w ? g->hit_w + (size_t)task * RAD__RAY_BATCH * 4 : NULL;
-    double acc[12], sum[12];
-    uint32_t s, li, ch, nval = 0, nr = 0, nh = 0, per = 0;
-    float *out = g->out + (size_t)texel * g->ch;
-    int k;
-    rad_result r;
-    for (ch = 0; ch < g->ch; ++ch) sum[ch] = 0.0;
-    if (g->hemi) {
-        for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) nval += lm->sample_valid[s] ? 1u : 0u;
-        per = nval ? (g->hemi + nval - 1) / nval : 0u;
-        nval = 0;
-    }
-    for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) {
-        const float *pf = lm->sample_positions + 3 * (size_t)s, *nf = lm->sample_normals + 3 * (size_t)s;
-        double p[3], n[3];
-        uint32_t h;
-        if (!lm->sample_valid[s]) continue;
-        ++nval;
-        for (k = 0; k < 3; ++k) { p[k] = pf[k]; n[k] = nf[k]; }
-        for (ch = 0; ch < g->ch; ++ch) acc[ch] = 0.0;
-        h = rad__hash(g->seed ^ rad__hash(s * 0x9E3779B9u + 0x3C6EF372u));
-        for (li = 0; li < g->list_count; ++li) {
-            uint32_t j = g->list[li];
-            const rad_patch *pj = &P->patches[j];
-            float tri[9], y[3], d[3], r1, r2, u1, u2;
-            double proj[4], kw[64], ksum = 0.0, full[12], Lr[3];
-            uint32_t m, q;
-            if (pj->triangle == lm->sample_triangles[s]) continue;
-            for (m = 0; m < 3; ++m)
-                for (k = 0; k < 3; ++k) tri[3 * m + k] = P->vertices[3 * (size_t)pj->vertices[m] + (size_t)k];
-            rad__sub(d, pf, tri);
-            if (!(rad__dot(d, pj->normal) > 0.0f)) continue; /* p behind the patch */
-            if (!rad__lm_polygon(p, n, tri, proj)) continue;
-            for (k = 0; k < 3; ++k) Lr[k] = (double)g->B[3 * (size_t)j + k] / RAD__PI;
-            /* the patch's unoccluded contribution in the encoding */
-            if (g->ch == 3) {
-                double ndv = n[0] * proj[1] + n[1] * proj[2] + n[2] * proj[3];
-                for (k = 0; k < 3; ++k) full[k] = Lr[k] * ndv;
-            } else {
-                for (k = 0; k < 3; ++k) {
-                    full[k] = Lr[k] * RAD__LM_SH_Y0 * proj[0];
-                    full[3 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[2];
-                    full[6 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[3];
-                    full[9 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[1];
-                }
-            }
-            /* visibility: rays to stratified points of the patch, each carrying its kernel's
-               share of the contribution */
-            r1 = (float)((h ^ rad__hash(j)) & 0xFFFFu) / 65536.0f;
-            r2 = (float)((h ^ rad__hash(j)) >> 16) / 65536.0f;
-            for (q = 0; q < g->vis; ++q) {
-                float dd[3], l2, cp, cq;
-                rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
-                rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
-                rad__sub(dd, y, pf);
-                l2 = rad__dot(dd, dd);
-                cp = rad__dot(dd, nf);
-                cq = -rad__dot(dd, pj->normal);
-                kw[q] = (l2 > 0.0f && cp > 0.0f && cq > 0.0f) ? (double)cp * cq / ((double)l2 * l2) : 0.0;
-                ksum += kw[q];
-            }
-            if (!(ksum > 0.0)) continue;
-            for (q = 0; q < g->vis; ++q) {
-                rad_ray *ray;
-                float len;
-                if (!(kw[q] > 0.0)) continue;
-                rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
-                rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
-                ray = rays + nr;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pf[k] + nf[k] * g->eps;
-                    ray->dir[k] = (y[k] + pj->normal[k] * g->eps) - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * g->eps ? 1.0f - g->eps / len : 0.5f;
-                for (ch = 0; ch < g->ch; ++ch) rc[(size_t)nr * g->ch + ch] = (float)(full[ch] * kw[q] / ksum);
-                if (++nr == RAD__RAY_BATCH) {
-                    r = rad__lm_flush(g, task, nr, acc);
-                    nr = 0;
-                    if (r != RAD_SUCCESS) return r;
-                }
-            }
-        }
-        r = rad__lm_flush(g, task, nr, acc);
-        nr = 0;
-        if (r != RAD_SUCCESS) return r;
-        for (ch = 0; ch < g->ch; ++ch) sum[ch] += acc[ch];
-        if (per) {
-            /* this sample's share of the texel's hemisphere rays (the exact rays above are
-               flushed, so the buffer is the hemisphere rays' alone) */
-            float t1[3], t2[3], u1, u2, w = g->ch == 3 ? 1.0f / (float)per : 2.0f / (float)per;
-            uint32_t q, hr = rad__hash(h ^ 0x85EBCA6Bu);
-            rad__tangent_frame(nf, t1, t2);
-            for (q = 0; q < per; ++q) {
-                rad_ray *ray = rays + nh;
-                float *wq = hw + 4 * (size_t)nh;
-                if (g->ch == 3) {
-                    rad__cosine_dir(nf, t1, t2, q, per, hr, ray->dir);
-                } else {
-                    /* uniform over the hemisphere: cos theta = u1 */
-                    float st, ph;
-                    rad__hammersley(q, per, (float)(hr & 0xFFFFu) / 65536.0f, (float)(hr >> 16) / 65536.0f, &u1, &u2);
-                    st = (float)sqrt((double)(1.0f - u1 * u1));
-                    ph = (float)(2.0 * RAD__PI) * u2;
-                    for (k = 0; k < 3; ++k)
-                        ray->dir[k] = t1[k] * st * (float)cos((double)ph) + t2[k] * st * (float)sin((double)ph) + nf[k] * u1;
-                }
-                for (k = 0; k < 3; ++k) ray->origin[k] = pf[k] + nf[k] * g->eps;
-                ray->tmin = 0.0f;
-                ray->tmax = FLT_MAX;
-                wq[0] = w;
-                for (k = 0; k < 3; ++k) wq[1 + k] = ray->dir[k];
-                if (++nh == RAD__RAY_BATCH) {
-                    r = rad__lm_flush_hits(g, task, nh, sum);
-                    nh = 0;
-                    if (r != RAD_SUCCESS) return r;
-                }
-            }
-            r = rad__lm_flush_hits(g, task, nh, sum);
-            nh = 0;
-            if (r != RAD_SUCCESS) return r;
-        }
-    }
-    for (ch = 0; ch < g->ch; ++ch) out[ch] = nval ? (float)(sum[ch] / nval) : 0.0f;
-    return RAD_SUCCESS;
-}
-
-RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches *patches, const float *B,
-                                       const rad_raycaster *raycaster, const rad_lightmap_gather_options *options, float *out,
-                                       const rad_context *ctx)
-{
-    rad__ctx c;
-    rad__lm_gather g;
-    rad_lightmap_gather_options o;
-    uint32_t T, i, texels;
-    rad_result r;
-    int hemi;
-    rad__ctx_init(&c, ctx);
-    if (!lm || !patches || !B || !raycaster || !raycaster->occluded || !out) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: NULL lightmap, patches, radiosity, raycaster (with occluded) or output");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (patches->scene != lm->scene) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the patches were made from another scene than the lightmap");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (options) o = *options; else rad_lightmap_gather_options_default(&o);
-    if (o.visibility_rays == 0) o.visibility_rays = 4;
-    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
-    if (o.hemisphere_rays == 0) o.hemisphere_rays = 256;
-    if (o.exact_ratio == 0.0f) o.exact_ratio = 16.0f;
-    if (rad_lightmap_channels(o.encoding) == 0 || o.visibility_rays > 64u ||
-        !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: encoding %d, visibility_rays %u (at most 64) or ray_epsilon %g out of range",
-                 (int)o.encoding, o.visibility_rays, (double)o.ray_epsilon);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if ((o.method != RAD_LIGHTMAP_GATHER_EXACT && o.method != RAD_LIGHTMAP_GATHER_HEMISPHERE) || o.hemisphere_rays > 65536u ||
-        !(o.exact_ratio > 0.0f)) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: method %d, hemisphere_rays %u (at most 65536) or exact_ratio %g out of range",
-                 (int)o.method, o.hemisphere_rays, (double)o.exact_ratio);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    hemi = o.method == RAD_LIGHTMAP_GATHER_HEMISPHERE;
-    if (hemi && !raycaster->intersect) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the hemisphere method needs the raycaster's intersect()");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    r = rad__check_input(&c, "lightmap gather: patch radiosity", B, 3 * (size_t)patches->count);
-    if (r != RAD_SUCCESS) return r;
-    memset(&g, 0, sizeof(g));
-    g.lm = lm;
-    g.P = patches;
-    g.B = B;
-    g.rc = raycaster;
-    g.ch = rad_lightmap_channels(o.encoding);
-    g.vis = o.visibility_rays;
-    g.seed = o.seed;
-    g.hemi = hemi ? o.hemisphere_rays : 0u;
-    g.eps = o.ray_epsilon * lm->scene->diagonal;
-    g.out = out;
-    texels = lm->width * lm->height;
-    T = c.tasks < texels ? c.tasks : texels;
-    g.list = (uint32_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, sizeof(uint32_t));
-    g.skip = (uint8_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, 1);
-    g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
-    g.occ_buf = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
-    g.ray_c = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, g.ch * sizeof(float));
-    if (hemi) {
-        g.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
-        g.hit_w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 4 * sizeof(float));
-    }
-    if (!g.list || !g.skip || !g.ray_buf || !g.occ_buf || !g.ray_c || (hemi && (!g.hit_buf || !g.hit_w))) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: out of memory for %u tasks", T);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-    } else {
-        double lum_area = 0.0, area = 0.0, limit = 0.0;
-        for (i = 0; i < patches->count; ++i) {
-            const float *b = B + 3 * (size_t)i;
-            double lum = 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2];
-            if (b[0] == 0.0f && b[1] == 0.0f && b[2] == 0.0f) continue;
-            lum_area += lum * patches->patches[i].area;
-            area += patches->patches[i].area;
-        }
-        if (area > 0.0) limit = (double)o.exact_ratio * lum_area / area;
-        for (i = 0; i < patches->count; ++i) {
-            const float *b = B + 3 * (size_t)i;
-            int lit = b[0] != 0.0f || b[1] != 0.0f || b[2] != 0.0f;
-            /* the hemisphere method counts only the bright patches exactly */
-            int exact = lit && (!hemi || 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2] > limit);
-            g.skip[i] = (uint8_t)(exact || !lit);
-            if (exact) g.list[g.list_count++] = i;
-        }
-        r = rad__for_rows(&c, texels, T, rad__lm_gather_row, &g);
-    }
-    rad__free(&c.allocator, g.list);
-    rad__free(&c.allocator, g.skip);
-    rad__free(&c.allocator, g.ray_buf);
-    rad__free(&c.allocator, g.occ_buf);
-    rad__free(&c.allocator, g.ray_c);
-    rad__free(&c.allocator, g.hit_buf);
-    rad__free(&c.allocator, g.hit_w);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather", out, (size_t)texels * g.ch) : r;
-}
-
-RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lm, const rad_raycaster *raycaster, const rad_light *lights,
-                                       uint32_t light_count, const rad_direct_options *options, float *out,
-                                       const rad_context *ctx)
-{
-    rad__ctx c;
-    float *pts, *nrm, *D;
-    uint32_t *owner, i, s, m = 0;
-    rad_result r;
-    rad__ctx_init(&c, ctx);
-    if (!lm || !out) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap direct: NULL lightmap or output");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    pts = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
-    nrm = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
-    D = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
-    owner = (uint32_t *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, sizeof(uint32_t));
-    if (!pts || !nrm || !D || !owner) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap direct: out of memory for %u samples", lm->sample_count);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-        goto done;
-    }
-    for (i = 0; i < lm->width * lm->height; ++i)
-        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
-            if (!lm->sample_valid[s]) continue;
-            memcpy(pts + 3 * (size_t)m, lm->sample_positions + 3 * (size_t)s, 3 * sizeof(float));
-            memcpy(nrm + 3 * (size_t)m, lm->sample_normals + 3 * (size_t)s, 3 * sizeof(float));
-            owner[m++] = i;
-        }
-    r = m ? rad_direct_irradiance(lm->scene, raycaster, lights, light_count, options, pts, nrm, m, D, ctx) : RAD_SUCCESS;
-    if (r == RAD_SUCCESS) {
-        uint32_t a = 0, b;
-        while (a < m) {
-            uint32_t texel = owner[a], k;
-            double sum[3] = { 0.0, 0.0, 0.0 };
-            for (b = a; b < m && owner[b] == texel; ++b)
-                for (k = 0; k < 3; ++k) sum[k] += D[3 * (size_t)b + k];
-            for (k = 0; k < 3; ++k) out[3 * (size_t)texel + k] += (float)(sum[k] / (double)(b - a));
-            a = b;
-        }
-    }
-done:
-    rad__free(&c.allocator, pts);
-    rad__free(&c.allocator, nrm);
-    rad__free(&c.allocator, D);
-    rad__free(&c.allocator, owner);
-    return r;
-}
-
-RAD_API rad_result rad_lightmap_dilate(const rad_lightmap *lm, uint32_t channels, float *values, uint32_t passes,
-                                       const rad_context *ctx)
-{
-    rad__ctx c;
-    uint8_t *have, *next;
-    uint32_t W, H, pass, x, y, ch;
-    size_t texels, i;
-    rad__ctx_init(&c, ctx);
-    if (!lm || !values || channels == 0 || channels > 64u) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap dilate: NULL lightmap or values, or channels %u not in 1..64", channels);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    W = lm->width;
-    H = lm->height;
-    texels = (size_t)W * H;
-    have = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
-    next = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
-    if (!have || !next) {
-        rad__free(&c.allocator, have);
-        rad__free(&c.allocator, next);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    for (i = 0; i < texels; ++i) have[i] = (lm->flags[i] & RAD_TEXEL_VALID) ? 1u : 0u;
-    for (pass = 0; passes == 0 || pass < passes; ++pass) {
-        int changed = 0;
-        memcpy(next, have, texels);
-        for (y = 0; y < H; ++y)
-            for (x = 0; x < W; ++x) {
-                size_t ti = (size_t)y * W + x;
-                float acc[64];
-                int dx, dy, cnt = 0;
-                if (have[ti]) continue;
-                for (ch = 0; ch < channels; ++ch) acc[ch] = 0.0f;
-                for (dy = -1; dy <= 1; ++dy)
-                    for (dx = -1; dx <= 1; ++dx) {
-                        int64_t nx = (int64_t)x + dx, ny = (int64_t)y + dy;
-                        size_t ni;
-                        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= (int64_t)W || ny >= (int64_t)H) continue;
-                        ni = (size_t)ny * W + (size_t)nx;
-                        if (!have[ni]) continue;
-                        for (ch = 0; ch < channels; ++ch) acc[ch] += values[ni * channels + ch];
-                        ++cnt;
-                    }
-                if (!cnt) continue;
-                for (ch = 0; ch < channels; ++ch) values[ti * channels + ch] = acc[ch] / (float)cnt;
-                next[ti] = 1;
-                changed = 1;
-            }
-        memcpy(have, next, texels);
-        if (!changed) break;
-    }
-    rad__free(&c.allocator, have);
-    rad__free(&c.allocator, next);
-    return RAD_SUCCESS;
-}
-
-/* bilinear taps of (u, v): texel indices and weights, clamped to the edge texels */
-static void rad__lm_taps(const rad_lightmap *lm, float u, float v, uint32_t *idx, float *w)
-{
-    double x = (double)u * lm->width - 0.5, y = (double)v * lm->height - 0.5, fx, fy;
-    int64_t x0, y0, x1, y1;
-    if (!(x > 0.0)) x = 0.0;
-    if (!(y > 0.0)) y = 0.0;
-    if (x > (double)lm->width - 1.0) x = (double)lm->width - 1.0;
-    if (y > (double)lm->height - 1.0) y = (double)lm->height - 1.0;
-    x0 = (int64_t)floor(x);
-    y0 = (int64_t)floor(y);
-    fx = x - (double)x0;
-    fy = y - (double)y0;
-    x1 = x0 + 1 < (int64_t)lm->width ? x0 + 1 : x0;
-    y1 = y0 + 1 < (int64_t)lm->height ? y0 + 1 : y0;
-    idx[0] = (uint32_t)(y0 * lm->width + x0); w[0] = (float)((1.0 - fx) * (1.0 - fy));
-    idx[1] = (uint32_t)(y0 * lm->width + x1); w[1] = (float)(fx * (1.0 - fy));
-    idx[2] = (uint32_t)(y1 * lm->width + x0); w[2] = (float)((1.0 - fx) * fy);
-    idx[3] = (uint32_t)(y1 * lm->width + x1); w[3] = (float)(fx * fy);
-}
-
-RAD_API void rad_lightmap_sample(const rad_lightmap *lm, uint32_t channels, const float *values, float u, float v, float *out)
-{
-    uint32_t idx[4], ch;
-    float w[4];
-    int k;
-    if (!lm || !values || !out) return;
-    rad__lm_taps(lm, u, v, idx, w);
-    for (ch = 0; ch < channels; ++ch) {
-        float s = 0.0f;
-        for (k = 0; k < 4; ++k) s += w[k] * values[(size_t)idx[k] * channels + ch];
-        out[ch] = s;
-    }
-}
-
-RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
-{
-    rad_allocator a;
-    if (!w) return;
-    a = w->allocator;
-    rad__free(&a, w->vertex_first);
-    rad__free(&a, w->vertex_patches);
-    rad__free(&a, w->vertex_weights);
-    rad__free(&a, w->row_texels);
-    rad__free(&a, w->row_first);
-    rad__free(&a, w->entry_vertices);
-    rad__free(&a, w->entry_weights);
-    rad__free(&a, w);
-}
-
-/* barycentrics (b1, b2) of point x in triangle v (9 floats), least squares in its plane */
-static void rad__lm_bary3(const float *v, const float *x, float *b1, float *b2)
-{
-    double e1[3], e2[3], d[3], d00 = 0.0, d01 = 0.0, d11 = 0.0, d20 = 0.0, d21 = 0.0, den, u, w;
-    int k;
-    for (k = 0; k < 3; ++k) {
-        e1[k] = (double)v[3 + k] - v[k];
-        e2[k] = (double)v[6 + k] - v[k];
-        d[k] = (double)x[k] - v[k];
-        d00 += e1[k] * e1[k]; d01 += e1[k] * e2[k]; d11 += e2[k] * e2[k];
-        d20 += d[k] * e1[k]; d21 += d[k] * e2[k];
-    }
-    den = d00 * d11 - d01 * d01;
-    u = den > 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
-    w = den > 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
-    if (u < 0.0) u = 0.0;
-    if (w < 0.0) w = 0.0;
-    if (u + w > 1.0) { double s = u + w; u /= s; w /= s; }
-    *b1 = (float)u;
-    *b2 = (float)w;
-}
-
-/* distinct vertices one texel's row may gather before merging stops adding (a texel spans a
-   few patches: never reached with welded meshes) */
-#define RAD__LM_ROW_MAX 128u
-
-RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad_patches *P, const float *baked_texels,
-                                               const float *baked_H, const rad_context *ctx, rad_lightmap_weights **out)
-{
-    rad__ctx c;
-    rad_lightmap_weights *W = NULL;
-    uint32_t *fill = NULL, i, texels, rows = 0, col[RAD__LM_ROW_MAX];
-    double *varea = NULL, *vbaked = NULL, val[RAD__LM_ROW_MAX];
-    uint64_t total = 0, cap = 0;
-    rad_result r = RAD_SUCCESS;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (!lm || !P || P->scene != lm->scene || (!baked_texels) != (!baked_H)) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: NULL lightmap or patches, patches of another scene, or only one of "
-                 "baked_texels and baked_patch_irradiance");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if ((uint64_t)P->count * 3u >= 0xFFFFFFFFu) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: %u patches give 2^32 vertex entries or more", P->count);
-        return RAD_ERROR_SIZE_OVERFLOW;
-    }
-    texels = lm->width * lm->height;
-    for (i = 0; i < texels; ++i) { /* the rows to come: texels with a valid sample */
-        uint32_t s;
-        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1] && !lm->sample_valid[s]; ++s) {}
-        rows += s < lm->sample_first[i + 1];
-    }
-    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
-    if (!W) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(W, 0, sizeof(*W));
-    W->allocator = c.allocator;
-    W->texels = texels;
-    W->patch_count = P->count;
-    W->vertex_count = P->vertex_count;
-    /* stage 1: the patches around each vertex and their area shares */
-    W->vertex_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
-    W->vertex_patches = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
-    W->vertex_weights = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(float));
-    fill = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
-    varea = (double *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(double));
-    W->row_texels = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
-    W->row_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
-    rows = 0;
-    if (baked_H) vbaked = (double *)rad__alloc_array(&c.allocator, 3 * (size_t)P->vertex_count + 1, sizeof(double));
-    if (!W->vertex_first || !W->vertex_patches || !W->vertex_weights || !fill || !varea || !W->row_texels || !W->row_first ||
-        (baked_H && !vbaked)) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    memset(fill, 0, sizeof(uint32_t) * ((size_t)P->vertex_count + 1));
-    memset(varea, 0, sizeof(double) * ((size_t)P->vertex_count + 1));
-    for (i = 0; i < P->count; ++i) {
-        int k;
-        for (k = 0; k < 3; ++k) { fill[P->patches[i].vertices[k]]++; varea[P->patches[i].vertices[k]] += P->patches[i].area; }
-    }
-    W->vertex_first[0] = 0;
-    for (i = 0; i < P->vertex_count; ++i) { W->vertex_first[i + 1] = W->vertex_first[i] + fill[i]; fill[i] = 0; }
-    for (i = 0; i < P->count; ++i) {
-        int k;
-        for (k = 0; k < 3; ++k) {
-            uint32_t v = P->patches[i].vertices[k], e = W->vertex_first[v] + fill[v]++;
-            W->vertex_patches[e] = i;
-            W->vertex_weights[e] = varea[v] > 0.0 ? (float)(P->patches[i].area / varea[v]) : 0.0f;
-        }
-    }
-    if (vbaked) /* the baked solution's vertex values, for the detail factors */
-        for (i = 0; i < P->vertex_count; ++i) {
-            uint32_t e;
-            int k;
-            for (k = 0; k < 3; ++k) vbaked[3 * (size_t)i + k] = 0.0;
-            for (e = W->vertex_first[i]; e < W->vertex_first[i + 1]; ++e)
-                for (k = 0; k < 3; ++k)
-                    vbaked[3 * (size_t)i + k] += (double)W->vertex_weights[e] * baked_H[3 * (size_t)W->vertex_patches[e] + k];
-        }
-    /* stage 2: rows, texel by texel, appended to growing arrays */
-    for (i = 0; i < texels; ++i) {
-        uint32_t s, n = 0, nv = 0, e;
-        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
-            uint32_t t = lm->sample_triangles[s], p, k;
-            float b1, b2, vw[3];
-            if (!lm->sample_valid[s]) continue;
-            ++nv;
-            rad__lm_bary3(lm->scene->positions + 9 * (size_t)t, lm->sample_positions + 3 * (size_t)s, &b1, &b2);
-            p = rad_patches_locate(P, t, b1, b2, vw);
-            if (p == RAD_NONE) continue;
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = P->patches[p].vertices[k], m;
-                if (!(varea[v] > 0.0) || !(vw[k] != 0.0f)) continue;
-                for (m = 0; m < n && col[m] != v; ++m) {}
-                if (m == n) {
-                    if (n == RAD__LM_ROW_MAX) continue;
-                    col[n] = v;
-                    val[n++] = 0.0;
-                }
-                val[m] += vw[k];
-            }
-        }
-        if (nv == 0 || n == 0) continue;
-        for (e = 0; e < n; ++e) val[e] /= nv;
-        if (vbaked) {
-            double num = 0.0, den = 0.0, cf = 1.0;
-            int k;
-            for (k = 0; k < 3; ++k) num += baked_texels[3 * (size_t)i + k];
-            for (e = 0; e < n; ++e)
-                for (k = 0; k < 3; ++k) den += val[e] * vbaked[3 * (size_t)col[e] + k];
-            if (den > 0.0 && num >= 0.0) cf = num / den < 16.0 ? num / den : 16.0;
-            for (e = 0; e < n; ++e) val[e] *= cf;
-        }
-        if (total + n >= 0xFFFFFFFFu) {
-            rad__log(&c, RAD_LOG_ERROR, "lightmap weights: 2^32 entries or more");
-            r = RAD_ERROR_SIZE_OVERFLOW;
-            goto done;
-        }
-        if (total + n > cap) {
-            uint64_t nc = cap ? 2 * cap : 4096;
-            uint32_t *ncol;
-            float *nval;
-            while (nc < total + n) nc *= 2;
-            ncol = (uint32_t *)rad__realloc(&c.allocator, W->entry_vertices, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
-            if (!ncol) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-            W->entry_vertices = ncol;
-            nval = (float *)rad__realloc(&c.allocator, W->entry_weights, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
-            if (!nval) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-            W->entry_weights = nval;
-            cap = nc;
-        }
-        W->row_texels[rows] = i;
-        W->row_first[rows++] = (uint32_t)total;
-        for (e = 0; e < n; ++e) { W->entry_vertices[total + e] = col[e]; W->entry_weights[total + e] = (float)val[e]; }
-        total += n;
-    }
-    W->row_first[rows] = (uint32_t)total;
-    W->row_count = rows;
-    if (!W->entry_vertices) { /* no row at all: keep the arrays non-NULL */
-        W->entry_vertices = (uint32_t *)rad__alloc(&c.allocator, sizeof(uint32_t));
-        W->entry_weights = (float *)rad__alloc(&c.allocator, sizeof(float));
-        if (!W->entry_vertices || !W->entry_weights) r = RAD_ERROR_OUT_OF_MEMORY;
-    }
-done:
-    rad__free(&c.allocator, fill);
-    rad__free(&c.allocator, varea);
-    rad__free(&c.allocator, vbaked);
-    if (r != RAD_SUCCESS) {
-        if (r == RAD_ERROR_OUT_OF_MEMORY) rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
-        rad_lightmap_weights_destroy(W);
-        return r;
-    }
-    *out = W;
-    return RAD_SUCCESS;
-}
-
-#define RAD__LM_REFRESH_GRAIN 65536u /* entries (and rows) a refresh task takes at least */
-
-typedef struct rad__lm_refresh {
-    const rad_lightmap_weights *W;
-    const float *H;
-    float *V;                   /* 3 per vertex: stage 1's output */
-    float *out;
-    uint32_t tasks;
-} rad__lm_refresh;
-
-static void rad__lm_refresh_vertices(void *data, uint32_t task)
-{
-    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
-    const rad_lightmap_weights *W = f->W;
-    uint32_t v = (uint32_t)((uint64_t)W->vertex_count * task / f->tasks);
-    uint32_t end = (uint32_t)((uint64_t)W->vertex_count * (task + 1) / f->tasks);
-    for (; v < end; ++v) {
-        uint32_t e;
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        for (e = W->vertex_first[v]; e < W->vertex_first[v + 1]; ++e) {
-            const float *h = f->H + 3 * (size_t)W->vertex_patches[e], w = W->vertex_weights[e];
-            s0 += w * h[0];
-            s1 += w * h[1];
-            s2 += w * h[2];
-        }
-        f->V[3 * (size_t)v] = s0;
-        f->V[3 * (size_t)v + 1] = s1;
-        f->V[3 * (size_t)v + 2] = s2;
-    }
-}
-
-/* one contiguous block of rows per task: the rows are short, so a cyclic split would make
-   the tasks write the same cache lines of out */
-static void rad__lm_refresh_rows(void *data, uint32_t task)
-{
-    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
-    const rad_lightmap_weights *W = f->W;
-    const uint32_t *first = W->row_first, *ev = W->entry_vertices;
-    const float *ew = W->entry_weights, *V = f->V;
-    uint32_t r = (uint32_t)((uint64_t)W->row_count * task / f->tasks);
-    uint32_t end = (uint32_t)((uint64_t)W->row_count * (task + 1) / f->tasks);
-    for (; r < end; ++r) {
-        uint32_t e = first[r], b = first[r + 1];
-        float *o = f->out + 3 * (size_t)W->row_texels[r];
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        for (; e < b; ++e) {
-            const float *x = V + 3 * (size_t)ev[e], w = ew[e];
-            s0 += w * x[0];
-            s1 += w * x[1];
-            s2 += w * x[2];
-        }
-        o[0] = s0;
-        o[1] = s1;
-        o[2] = s2;
-    }
-}
-
-RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const float *H, float *out, const rad_context *ctx)
-{
-    rad__ctx c;
-    rad__lm_refresh f;
-    uint64_t most;
-    rad__ctx_init(&c, ctx);
-    if (!W || !H || !out) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    f.W = W;
-    f.H = H;
-    f.out = out;
-    f.V = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)W->vertex_count + 1, sizeof(float));
-    if (!f.V) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: out of memory (%u vertex values)", W->vertex_count);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    /* stage 1 is small (3 entries a patch): in the calling thread unless the patches are
-       many, as a parallel region's start and join can cost more than it on busy cores */
-    most = W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN;
-    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
-    if (f.tasks < 2) {
-        f.tasks = 1;
-        rad__lm_refresh_vertices(&f, 0);
-    } else {
-        c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_vertices, &f);
-    }
-    /* stage 2: a task per block of at least RAD__LM_REFRESH_GRAIN entries */
-    most = (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u;
-    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
-    if (f.tasks < 2) {
-        f.tasks = 1;
-        rad__lm_refresh_rows(&f, 0);
-    } else c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_rows, &f);
-    rad__free(&c.allocator, f.V);
-    return RAD_SUCCESS;
-}
-
-/* one edge of a lightmapped triangle, its end points in canonical (lexicographic) order */
-typedef struct rad__lm_edge {
-    float a[3], b[3];
-    float ua[2], ub[2];
-    uint32_t tri;
-} rad__lm_edge;
-
-static int rad__lm_pcmp(const float *a, const float *b)
-{
-    int k;
-    for (k = 0; k < 3; ++k) {
-        if (a[k] < b[k]) return -1;
-        if (a[k] > b[k]) return 1;
-    }
-    return 0;
-}
-
-static int rad__lm_edge_cmp(const void *x, const void *y)
-{
-    const rad__lm_edge *e = (const rad__lm_edge *)x, *f = (const rad__lm_edge *)y;
-    int r = rad__lm_pcmp(e->a, f->a);
-    if (r) return r;
-    r = rad__lm_pcmp(e->b, f->b);
-    if (r) return r;
-    return e->tri < f->tri ? -1 : e->tri > f->tri ? 1 : 0;
-}
-
-/* one row of A: up to 8 (texel, weight) taps, duplicates merged */
-typedef struct rad__lm_row {
-    uint32_t idx[8];
-    float w[8];
-    uint32_t n;
-    float norm;                   /* sum of w^2 */
-} rad__lm_row;
-
-static void rad__lm_row_add(rad__lm_row *row, uint32_t idx, float w)
-{
-    uint32_t k;
-    for (k = 0; k < row->n; ++k)
-        if (row->idx[k] == idx) { row->w[k] += w; return; }
-    row->idx[row->n] = idx;
-    row->w[row->n++] = w;
-}
-
-static float rad__lm_rows_jump(const rad__lm_row *rows, size_t count, uint32_t channels, const float *x)
-{
-    float worst = 0.0f;
-    size_t r;
-    uint32_t ch, k;
-    for (r = 0; r < count; ++r)
-        for (ch = 0; ch < channels; ++ch) {
-            float d = 0.0f;
-            for (k = 0; k < rows[r].n; ++k) d += rows[r].w[k] * x[(size_t)rows[r].idx[k] * channels + ch];
-            if (fabs((double)d) > worst) worst = (float)fabs((double)d);
-        }
-    return worst;
-}
-
-RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lm, uint32_t channels, float *values, uint32_t iterations,
-                                       rad_lightmap_seam_stats *stats, const rad_context *ctx)
-{
-    rad__ctx c;
-    const rad_scene *S;
-    rad__lm_edge *edges = NULL;
-    rad__lm_row *rows = NULL;
-    size_t ne = 0, nrows = 0, cap = 0, i, j;
-    uint32_t t, seams = 0, it, ch;
-    rad_result r = RAD_SUCCESS;
-    rad__ctx_init(&c, ctx);
-    if (stats) memset(stats, 0, sizeof(*stats));
-    if (!lm || !values || channels == 0) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap stitch: NULL lightmap or values, or zero channels");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (iterations == 0) iterations = 64;
-    S = lm->scene;
-    edges = (rad__lm_edge *)rad__alloc_array(&c.allocator, (size_t)S->triangle_count * 3u, sizeof(rad__lm_edge));
-    if (!edges) return RAD_ERROR_OUT_OF_MEMORY;
-    for (t = 0; t < S->triangle_count; ++t) {
-        int e;
-        if (!S->lightmapped[t]) continue;
-        for (e = 0; e < 3; ++e) {
-            rad__lm_edge *E = &edges[ne++];
-            const float *pa = S->positions + 9 * (size_t)t + 3 * e, *pb = S->positions + 9 * (size_t)t + 3 * ((e + 1) % 3);
-            const float *ua = S->lightmap_uvs + 6 * (size_t)t + 2 * e, *ub = S->lightmap_uvs + 6 * (size_t)t + 2 * ((e + 1) % 3);
-            if (rad__lm_pcmp(pa, pb) > 0) { const float *tmp = pa; pa = pb; pb = tmp; tmp = ua; ua = ub; ub = tmp; }
-            memcpy(E->a, pa, sizeof(E->a));
-            memcpy(E->b, pb, sizeof(E->b));
-            memcpy(E->ua, ua, sizeof(E->ua));
-            memcpy(E->ub, ub, sizeof(E->ub));
-            E->tri = t;
-        }
-    }
-    qsort(edges, ne, sizeof(rad__lm_edge), rad__lm_edge_cmp);
-    for (i = 0; i + 1 < ne; ++i) {
-        const rad__lm_edge *A = &edges[i], *Bv = &edges[i + 1];
-        double la, lb, tol = 1e-3 / (double)(lm->width > lm->height ? lm->width : lm->height);
-        uint32_t m, q;
-        if (rad__lm_pcmp(A->a, Bv->a) || rad__lm_pcmp(A->b, Bv->b) || A->tri == Bv->tri) continue;
-        if (rad__dot(S->normals + 3 * (size_t)A->tri, S->normals + 3 * (size_t)Bv->tri) < 0.8660254f) continue;
-        if (fabs((double)A->ua[0] - Bv->ua[0]) <= tol && fabs((double)A->ua[1] - Bv->ua[1]) <= tol &&
-            fabs((double)A->ub[0] - Bv->ub[0]) <= tol && fabs((double)A->ub[1] - Bv->ub[1]) <= tol)
-            continue; /* the same edge in the atlas: not a seam */
-        ++seams;
-        la = sqrt(pow(((double)A->ub[0] - A->ua[0]) * lm->width, 2) + pow(((double)A->ub[1] - A->ua[1]) * lm->height, 2));
-        lb = sqrt(pow(((double)Bv->ub[0] - Bv->ua[0]) * lm->width, 2) + pow(((double)Bv->ub[1] - Bv->ua[1]) * lm->height, 2));
-        if (lb > la) la = lb;
-        m = (uint32_t)ceil(2.0 * (la < 1e6 ? la : 1e6)) + 1u;
-        if (m < 2) m = 2;
-        for (q = 0; q <= m; ++q) {
-            float s = (float)q / (float)m, uvA[2], uvB[2], w[4];
-            uint32_t idx[4], k;
-            rad__lm_row *row;
-            if (nrows == cap) {
-                size_t nc = cap ? 2 * cap : 1024;
-                rad__lm_row *nr = (rad__lm_row *)rad__realloc(&c.allocator, rows, cap * sizeof(rad__lm_row), nc * sizeof(rad__lm_row));
-                if (!nr) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-                rows = nr;
-                cap = nc;
-            }
-            row = &rows[nrows];
-            row->n = 0;
-            for (k = 0; k < 2; ++k) {
-                uvA[k] = A->ua[k] + s * (A->ub[k] - A->ua[k]);
-                uvB[k] = Bv->ua[k] + s * (Bv->ub[k] - Bv->ua[k]);
-            }
-            rad__lm_taps(lm, uvA[0], uvA[1], idx, w);
-            for (k = 0; k < 4; ++k) if (w[k] != 0.0f) rad__lm_row_add(row, idx[k], w[k]);
-            rad__lm_taps(lm, uvB[0], uvB[1], idx, w);
-            for (k = 0; k < 4; ++k) if (w[k] != 0.0f) rad__lm_row_add(row, idx[k], -w[k]);
-            row->norm = 0.0f;
-            for (k = 0; k < row->n; ++k) row->norm += row->w[k] * row->w[k];
-            if (row->norm > 1e-12f) ++nrows;
-        }
-    }
-    if (stats) {
-        stats->seams = seams;
-        stats->sample_pairs = (uint32_t)(nrows < 0xFFFFFFFFu ? nrows : 0xFFFFFFFFu);
-        stats->max_jump_before = rad__lm_rows_jump(rows, nrows, channels, values);
-    }
-    /* Kaczmarz: each row's residual projected out in turn; from the baked values it converges
-       to their nearest (least-squares) point on the consistent set */
-    for (it = 0; it < iterations; ++it)
-        for (ch = 0; ch < channels; ++ch)
-            for (j = 0; j < nrows; ++j) {
-                const rad__lm_row *row = &rows[j];
-                float d = 0.0f;
-                uint32_t k;
-                for (k = 0; k < row->n; ++k) d += row->w[k] * values[(size_t)row->idx[k] * channels + ch];
-                d /= row->norm;
-                for (k = 0; k < row->n; ++k) values[(size_t)row->idx[k] * channels + ch] -= d * row->w[k];
-            }
-    if (stats) stats->max_jump_after = rad__lm_rows_jump(rows, nrows, channels, values);
-done:
-    rad__free(&c.allocator, edges);
-    rad__free(&c.allocator, rows);
-    if (r != RAD_SUCCESS) rad__log(&c, RAD_LOG_ERROR, "lightmap stitch: out of memory for %lu seam samples", (unsigned long)nrows);
-    return r;
-}
-
-/* ======================================================================================== */
-/* >>shading: lighting models and BRDFs                                                     */
-/* ======================================================================================== */
-
-/* Everything here is float arithmetic written in the same order as glsl/lighting.glsl, so
-   that the C and GLSL results agree to a few ulps (the tests compare them). */
-
-#define RAD__INV_PI 0.318309886183790671537767526745f
-
-RAD_API void rad_lambert_params_default(rad_lambert_params *p)
-{
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-}
-
-RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p)
-{
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->wrap = 1.0f;
-    p->exponent = 2.0f;
-}
-
-RAD_API void rad_banded_params_default(rad_banded_params *p)
-{
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->bands = 4;
-}
-
-RAD_API void rad_phong_params_default(rad_phong_params *p)
-{
-    if (!p) return;
-    p->diffuse[0] = p->diffuse[1] = p->diffuse[2] = 0.5f;
-    p->specular[0] = p->specular[1] = p->specular[2] = 0.3f;
-    p->shininess = 32.0f;
-}
-
-RAD_API void rad_minnaert_params_default(rad_minnaert_params *p)
-{
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->k = 0.8f;
-}
-
-RAD_API void rad_oren_nayar_params_default(rad_oren_nayar_params *p)
-{
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->sigma = 0.5f;
-}
-
-RAD_API void rad_microfacet_params_default(rad_microfacet_params *p)
-{
-    int k;
-    if (!p) return;
-    p->ndf = RAD_NDF_GGX;
-    p->masking = RAD_MASKING_HEIGHT_CORRELATED;
-    p->diffuse = RAD_DIFFUSE_LAMBERT;
-    p->alpha_x = p->alpha_y = 0.3f;
-    for (k = 0; k < 3; ++k) {
-        p->f0[k] = 0.04f;
-        p->f90[k] = 1.0f;
-        p->albedo[k] = 0.5f;
-    }
-    p->fresnel_exponent = 5.0f;
-}
-
-RAD_API void rad_shading_default(rad_shading *s, rad_shading_model model)
-{
-    if (!s) return;
-    memset(s, 0, sizeof(*s));
-    s->model = model;
-    rad_lambert_params_default(&s->lambert);
-    rad_half_lambert_params_default(&s->half_lambert);
-    rad_banded_params_default(&s->banded);
-    rad_phong_params_default(&s->phong);
-    rad_minnaert_params_default(&s->minnaert);
-    rad_oren_nayar_params_default(&s->oren_nayar);
-    rad_microfacet_params_default(&s->microfacet);
-}
-
-static const char *const rad__shading_names[RAD_SHADING_MODEL_COUNT] = {
-    "lambert", "half-lambert", "banded", "phong", "blinn-phong", "minnaert", "oren-nayar", "microfacet"
-};
-
-RAD_API const char *rad_shading_model_name(rad_shading_model model)
-{
-    if ((int)model < 0 || (int)model >= (int)RAD_SHADING_MODEL_COUNT) return NULL;
-    return rad__shading_names[model];
-}
-
-RAD_API rad_result rad_shading_model_from_name(const char *name, rad_shading_model *out_model)
-{
-    int i;
-    if (!name || !out_model) return RAD_ERROR_INVALID_ARGUMENT;
-    for (i = 0; i < (int)RAD_SHADING_MODEL_COUNT; ++i)
-        if (strcmp(name, rad__shading_names[i]) == 0) {
-            *out_model = (rad_shading_model)i;
-            return RAD_SUCCESS;
-        }
-    return RAD_ERROR_INVALID_ARGUMENT;
-}
-
-/* value in [lo, hi]: 0 ok, else the error (NON_FINITE or INVALID_ARGUMENT), logged */
-static rad_result rad__shading_range(const rad__ctx *c, const char *what, const float *x, int count, float lo, float hi)
-{
-    int k;
-    for (k = 0; k < count; ++k) {
-        if (!rad__finite(x[k])) {
-            rad__log(c, RAD_LOG_ERROR, "shading: %s[%d] is not finite", what, k);
-            return RAD_ERROR_NON_FINITE;
-        }
-        if (x[k] < lo || x[k] > hi) {
-            rad__log(c, RAD_LOG_ERROR, "shading: %s[%d] = %g is outside [%g, %g]", what, k, (double)x[k], (double)lo,
-                     (double)hi);
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-    }
-    return RAD_SUCCESS;
-}
-
-static rad_result rad__shading_validate(const rad_shading *s, const rad__ctx *c)
-{
-    rad_result r = RAD_SUCCESS;
-    if (!s) return RAD_ERROR_INVALID_ARGUMENT;
-    switch (s->model) {
-    case RAD_SHADING_LAMBERT: return rad__shading_range(c, "lambert.albedo", s->lambert.albedo, 3, 0.0f, 1.0f);
-    case RAD_SHADING_HALF_LAMBERT:
-        if ((r = rad__shading_range(c, "half_lambert.albedo", s->half_lambert.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        if ((r = rad__shading_range(c, "half_lambert.wrap", &s->half_lambert.wrap, 1, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        return rad__shading_range(c, "half_lambert.exponent", &s->half_lambert.exponent, 1, 1.0f, 8.0f);
-    case RAD_SHADING_BANDED:
-        if (s->banded.bands < 1 || s->banded.bands > 256) {
-            rad__log(c, RAD_LOG_ERROR, "shading: banded.bands = %u is outside [1, 256]", s->banded.bands);
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-        return rad__shading_range(c, "banded.albedo", s->banded.albedo, 3, 0.0f, 1.0f);
-    case RAD_SHADING_PHONG:
-    case RAD_SHADING_BLINN_PHONG:
-        if ((r = rad__shading_range(c, "phong.diffuse", s->phong.diffuse, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        if ((r = rad__shading_range(c, "phong.specular", s->phong.specular, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        return rad__shading_range(c, "phong.shininess", &s->phong.shininess, 1, 1.0f, 10000.0f);
-    case RAD_SHADING_MINNAERT:
-        if ((r = rad__shading_range(c, "minnaert.albedo", s->minnaert.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        return rad__shading_range(c, "minnaert.k", &s->minnaert.k, 1, 0.0f, 4.0f);
-    case RAD_SHADING_OREN_NAYAR:
-        if ((r = rad__shading_range(c, "oren_nayar.albedo", s->oren_nayar.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        return rad__shading_range(c, "oren_nayar.sigma", &s->oren_nayar.sigma, 1, 0.0f, 1.5f);
-    case RAD_SHADING_MICROFACET: {
-        const rad_microfacet_params *m = &s->microfacet;
-        if ((int)m->ndf < 0 || (int)m->ndf > (int)RAD_NDF_GGX || (int)m->masking < 0 ||
-            (int)m->masking > (int)RAD_MASKING_HEIGHT_CORRELATED || (int)m->diffuse < 0 ||
-            (int)m->diffuse > (int)RAD_DIFFUSE_SHIRLEY) {
-            rad__log(c, RAD_LOG_ERROR, "shading: microfacet ndf %d, masking %d or diffuse %d is not a valid value",
-                     (int)m->ndf, (int)m->masking, (int)m->diffuse);
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-        if ((r = rad__shading_range(c, "microfacet.alpha_x", &m->alpha_x, 1, 1e-3f, 1.0f)) != RAD_SUCCESS) return r;
-        if ((r = rad__shading_range(c, "microfacet.alpha_y", &m->alpha_y, 1, 1e-3f, 1.0f)) != RAD_SUCCESS) return r;
-        if ((r = rad__shading_range(c, "microfacet.f0", m->f0, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        if ((r = rad__shading_range(c, "microfacet.f90", m->f90, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
-        if ((r = rad__shading_range(c, "microfacet.fresnel_exponent", &m->fresnel_exponent, 1, 1.0f, 10.0f)) != RAD_SUCCESS)
-            return r;
-        return rad__shading_range(c, "microfacet.albedo", m->albedo, 3, 0.0f, 1.0f);
-    }
-    case RAD_SHADING_MODEL_COUNT: break;
-    }
-    rad__log(c, RAD_LOG_ERROR, "shading: unknown model %d", (int)s->model);
-    return RAD_ERROR_INVALID_ARGUMENT;
-}
-
-RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context *ctx)
-{
-    rad__ctx c;
-    rad__ctx_init(&c, ctx);
-    return rad__shading_validate(s, &c);
-}
-
-static void rad__shading_pack(const rad_shading *s, rad_shading_gpu *g)
-{
-    int k;
-    const float *alb = s->lambert.albedo;
-    memset(g, 0, sizeof(*g));
-    g->mode[0] = (int32_t)s->model;
-    switch (s->model) {
-    case RAD_SHADING_HALF_LAMBERT:
-        alb = s->half_lambert.albedo;
-        g->p[2] = s->half_lambert.wrap;
-        g->p[3] = s->half_lambert.exponent;
-        break;
-    case RAD_SHADING_BANDED:
-        alb = s->banded.albedo;
-        g->p[3] = (float)s->banded.bands;
-        break;
-    case RAD_SHADING_PHONG:
-    case RAD_SHADING_BLINN_PHONG:
-        alb = s->phong.diffuse;
-        for (k = 0; k < 3; ++k) g->specular[k] = s->phong.specular[k];
-        g->p[2] = s->phong.shininess;
-        break;
-    case RAD_SHADING_MINNAERT: alb = s->minnaert.albedo; g->p[2] = s->minnaert.k; break;
-    case RAD_SHADING_OREN_NAYAR: alb = s->oren_nayar.albedo; g->p[2] = s->oren_nayar.sigma; break;
-    case RAD_SHADING_MICROFACET:
-        alb = s->microfacet.albedo;
-        for (k = 0; k < 3; ++k) {
-            g->f0[k] = s->microfacet.f0[k];
-            g->f90[k] = s->microfacet.f90[k];
-        }
-        g->p[0] = s->microfacet.alpha_x;
-        g->p[1] = s->microfacet.alpha_y;
-        g->p[3] = s->microfacet.fresnel_exponent;
-        g->mode[1] = (int32_t)s->microfacet.ndf;
-        g->mode[2] = (int32_t)s->microfacet.masking;
-        g->mode[3] = (int32_t)s->microfacet.diffuse;
-        break;
-    default: break;
-    }
-    for (k = 0; k < 3; ++k) g->albedo[k] = alb[k];
-}
-
-RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, const rad_context *ctx)
-{
-    rad__ctx c;
-    rad_result r;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    if ((r = rad__shading_validate(s, &c)) != RAD_SUCCESS) return r;
-    rad__shading_pack(s, out);
-    return RAD_SUCCESS;
-}
-
-/* ---- terms of the microfacet model ---- */
-
-RAD_API float rad_ndf_beckmann(float nm, float alpha)
-{
-    float a2 = alpha * alpha, c2 = nm * nm;
-    if (!(nm > 0.0f)) return 0.0f;
-    return expf((c2 - 1.0f) / (a2 * c2)) / ((float)RAD__PI * a2 * c2 * c2);
-}
-
-RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
-{
-    float c2 = nm * nm, e;
-    if (!(nm > 0.0f)) return 0.0f;
-    e = (tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y)) / c2;
-    return expf(-e) / ((float)RAD__PI * alpha_x * alpha_y * c2 * c2);
-}
-
-RAD_API float rad_ndf_ggx(float nm, float alpha)
-{
-    float a2 = alpha * alpha, d;
-    if (!(nm > 0.0f)) return 0.0f;
-    d = 1.0f + nm * nm * (a2 - 1.0f);
-    return a2 / ((float)RAD__PI * d * d);
-}
-
-RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
-{
-    float d;
-    if (!(nm > 0.0f)) return 0.0f;
-    d = tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y) + nm * nm;
-    return 1.0f / ((float)RAD__PI * alpha_x * alpha_y * d * d);
-}
-
-RAD_API float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)
-{
-    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;
-    if (!(d2 > 0.0f)) return HUGE_VALF;
-    return ns / sqrtf(d2);
-}
-
-RAD_API float rad_lambda_ggx(float a)
-{
-    if (!(a < HUGE_VALF)) return 0.0f;
-    return 0.5f * (-1.0f + sqrtf(1.0f + 1.0f / (a * a)));
-}
-
-RAD_API float rad_lambda_beckmann(float a)
-{
-    if (!(a < 1.6f)) return 0.0f;
-    return (1.0f - 1.259f * a + 0.396f * a * a) / (3.535f * a + 2.181f * a * a);
-}
-
-RAD_API float rad_lambda_beckmann_exact(float a)
-{
-    double x = (double)a;
-    if (!(a < HUGE_VALF)) return 0.0f;
-    return (float)(0.5 * (erf(x) - 1.0) + exp(-x * x) / (2.0 * x * sqrt(RAD__PI)));
-}
-
-RAD_API float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0f ? 1.0f / (1.0f + lambda_s) : 0.0f; }
-
-RAD_API float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)
-{
-    return (mv > 0.0f && ml > 0.0f) ? 1.0f / ((1.0f + lambda_v) * (1.0f + lambda_l)) : 0.0f;
-}
-
-RAD_API float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)
-{
-    return (mv > 0.0f && ml > 0.0f) ? 1.0f / (1.0f + lambda_v + lambda_l) : 0.0f;
-}
-
-RAD_API float rad_fresnel_schlick(float f0, float c)
-{
-    float x = 1.0f - (c > 0.0f ? c : 0.0f), x2 = x * x;
-    return f0 + (1.0f - f0) * (x2 * x2 * x);
-}
-
-RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)
-{
-    return f0 + (f90 - f0) * powf(1.0f - (c > 0.0f ? c : 0.0f), exponent);
-}
-
-RAD_API float rad_diffuse_lambert(float albedo, float F) { return (1.0f - F) * albedo * RAD__INV_PI; }
-
-RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)
-{
-    float a = 1.0f - (nl > 0.0f ? nl : 0.0f), b = 1.0f - (nv > 0.0f ? nv : 0.0f);
-    float a5 = a * a * a * a * a, b5 = b * b * b * b * b;
-    return (1.0f - f0) * (21.0f / 20.0f) * albedo * RAD__INV_PI * (1.0f - a5) * (1.0f - b5);
-}
-
-/* ---- the evaluator, the mirror of glsl/lighting.glsl's shade() ---- */
-
-static float rad__sdot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-/* Lambda from n.s, t.s, b.s without forming a (no division by zero at s = n) */
-static float rad__shading_lambda(int ndf, int iso, float ns, float ts, float bs, float ax, float ay)
-{
-    float d2 = iso ? ax * ax * (1.0f - ns * ns) : ax * ax * ts * ts + ay * ay * bs * bs;
-    float a;
-    if (!(d2 > 0.0f)) return 0.0f;
-    if (ndf == (int)RAD_NDF_GGX) return 0.5f * (-1.0f + sqrtf(1.0f + d2 / (ns * ns)));
-    a = ns / sqrtf(d2);
-    return rad_lambda_beckmann(a);
-}
-
-/* f and R of a packed material for unit l, v, n and orthonormal t, b (any when isotropic) */
-static void rad__shade(const rad_shading_gpu *g, const float *l, const float *v, const float *n, const float *t,
-                       const float *b, float *out_f, float *out_r)
-{
-    float nl = rad__sdot(n, l), nv = rad__sdot(n, v), f[3] = {0.0f, 0.0f, 0.0f}, rr[3] = {0.0f, 0.0f, 0.0f};
-    int k, model = g->mode[0];
-    if (nv > 0.0f) {
-        if (model == (int)RAD_SHADING_HALF_LAMBERT) {
-            float x = (nl + g->p[2]) / (1.0f + g->p[2]);
-            float q = powf(x > 0.0f ? x : 0.0f, g->p[3]);
-            for (k = 0; k < 3; ++k) rr[k] = g->albedo[k] * RAD__INV_PI * q;
-        } else if (nl > 0.0f) {
-            if (model == (int)RAD_SHADING_LAMBERT) {
-                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI;
-            } else if (model == (int)RAD_SHADING_BANDED) {
-                float q = ceilf(g->p[3] * nl) / g->p[3] / nl;
-                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI * q;
-            } else if (model == (int)RAD_SHADING_PHONG) {
-                float r[3], rv, s = g->p[2], q;
-                for (k = 0; k < 3; ++k) r[k] = 2.0f * nl * n[k] - l[k];
-                rv = rad__sdot(r, v);
-                q = (s + 2.0f) * (0.5f * RAD__INV_PI) * powf(rv > 0.0f ? rv : 0.0f, s);
-                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI + g->specular[k] * q;
-            } else if (model == (int)RAD_SHADING_BLINN_PHONG) {
-                float h[3], len, nh = 0.0f, s = g->p[2], q;
-                for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
-                len = sqrtf(rad__sdot(h, h));
-                if (len > 0.0f) nh = rad__sdot(n, h) / len;
-                q = (s + 2.0f) * (s + 4.0f) * (0.125f * RAD__INV_PI) / (exp2f(-0.5f * s) + s) * powf(nh > 0.0f ? nh : 0.0f, s);
-                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI + g->specular[k] * q;
-            } else if (model == (int)RAD_SHADING_MINNAERT) {
-                float kk = g->p[2], c = nl * nv;
-                float q = (kk + 1.0f) * (0.5f * RAD__INV_PI) * powf(c > 1e-6f ? c : 1e-6f, kk - 1.0f);
-                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * q;
-            } else if (model == (int)RAD_SHADING_OREN_NAYAR) {
-                float s2 = g->p[2] * g->p[2], A = 1.0f - 0.5f * s2 / (s2 + 0.33f), B = 0.45f * s2 / (s2 + 0.09f);
-                float s = rad__sdot(l, v) - nl * nv, q = s > 0.0f ? s / (nl > nv ? nl : nv) : 0.0f;
-                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI * (A + B * q);
-            } else if (model == (int)RAD_SHADING_MICROFACET) {
-                float h[3], len, nh, th, bh, lh, vh, ax = g->p[0], ay = g->p[1], D, G, lv, ll, sp;
-                int iso = ax == ay, ndf = g->mode[1];
-                for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
-                len = sqrtf(rad__sdot(h, h));
-                if (len > 0.0f) {
-                    for (k = 0; k < 3; ++k) h[k] /= len;
-                    nh = rad__sdot(n, h); lh = rad__sdot(l, h); vh = rad__sdot(v, h);
-                    if (iso) {
-                        th = bh = 0.0f;
-                        D = ndf == (int)RAD_NDF_GGX ? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);
-                    } else {
-                        th = rad__sdot(t, h); bh = rad__sdot(b, h);
-                        D = ndf == (int)RAD_NDF_GGX ? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)
-                                                    : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);
-                    }
-                    lv = rad__shading_lambda(ndf, iso, nv, iso ? 0.0f : rad__sdot(t, v), iso ? 0.0f : rad__sdot(b, v), ax, ay);
-                    ll = rad__shading_lambda(ndf, iso, nl, iso ? 0.0f : rad__sdot(t, l), iso ? 0.0f : rad__sdot(b, l), ax, ay);
-                    G = g->mode[2] == (int)RAD_MASKING_SEPARABLE ? rad_smith_g2_separable(vh, lh, lv, ll)
-                                                                : rad_smith_g2_height_correlated(vh, lh, lv, ll);
-                    sp = G * D / (4.0f * nl * nv);
-                    for (k = 0; k < 3; ++k) f[k] = rad_fresnel_schlick_f90(g->f0[k], g->f90[k], g->p[3], lh) * sp;
-                }
-                for (k = 0; k < 3; ++k) {
-                    if (g->mode[3] == (int)RAD_DIFFUSE_LAMBERT)
-                        f[k] += rad_diffuse_lambert(g->albedo[k], rad_fresnel_schlick_f90(g->f0[k], g->f90[k], g->p[3], nl));
-                    else if (g->mode[3] == (int)RAD_DIFFUSE_SHIRLEY)
-                        f[k] += rad_diffuse_shirley(g->albedo[k], g->f0[k], nl, nv);
-                }
-            }
-            for (k = 0; k < 3; ++k) rr[k] = f[k] * nl;
-        }
-    }
-    for (k = 0; k < 3; ++k) {
-        if (out_f) out_f[k] = f[k];
-        if (out_r) out_r[k] = rr[k];
-    }
-}
-
-/* normalizes src into dst; 0 on a zero or non-finite vector (result set) */
-static rad_result rad__shading_unit(const rad__ctx *c, const char *what, const float *src, float *dst)
-{
-    double len;
-    int k;
-    if (!rad__finite3(src)) {
-        rad__log(c, RAD_LOG_ERROR, "shading: vector %s is not finite", what);
-        return RAD_ERROR_NON_FINITE;
-    }
-    len = sqrt((double)src[0] * src[0] + (double)src[1] * src[1] + (double)src[2] * src[2]);
-    if (!(len > 1e-30)) {
-        rad__log(c, RAD_LOG_ERROR, "shading: vector %s has zero length", what);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    for (k = 0; k < 3; ++k) dst[k] = (float)(src[k] / len);
-    return RAD_SUCCESS;
-}
-
-static rad_result rad__shading_entry(const rad_shading *s, const float *l, const float *v, const float *n,
-                                     const float *t, const float *b, float *out, int want_f, const rad_context *ctx)
-{
-    rad__ctx c;
-    rad_result r;
-    rad_shading_gpu g;
-    float L[3], V[3], N[3], T[3] = {0.0f, 0.0f, 0.0f}, B[3] = {0.0f, 0.0f, 0.0f};
-    int k;
-    rad__ctx_init(&c, ctx);
-    if (!s || !l || !v || !n || !out) {
-        rad__log(&c, RAD_LOG_ERROR, "shading: NULL material, vector or output");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if ((r = rad__shading_validate(s, &c)) != RAD_SUCCESS) return r;
-    if (want_f && s->model == RAD_SHADING_HALF_LAMBERT) {
-        rad__log(&c, RAD_LOG_ERROR, "shading: half-Lambert lights n.l < 0 and has no BRDF; use rad_shading_eval");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if ((r = rad__shading_unit(&c, "l", l, L)) != RAD_SUCCESS) return r;
-    if ((r = rad__shading_unit(&c, "v", v, V)) != RAD_SUCCESS) return r;
-    if ((r = rad__shading_unit(&c, "n", n, N)) != RAD_SUCCESS) return r;
-    if (s->model == RAD_SHADING_MICROFACET && s->microfacet.alpha_x != s->microfacet.alpha_y) {
-        float tt[3], d;
-        if (!t) {
-            rad__log(&c, RAD_LOG_ERROR, "shading: an anisotropic microfacet model needs the tangent t");
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-        if (!rad__finite3(t) || (b && !rad__finite3(b))) {
-            rad__log(&c, RAD_LOG_ERROR, "shading: vector t or b is not finite");
-            return RAD_ERROR_NON_FINITE;
-        }
-        d = rad__sdot(t, N);
-        for (k = 0; k < 3; ++k) tt[k] = t[k] - d * N[k];
-        if ((r = rad__shading_unit(&c, "t (minus its n component)", tt, T)) != RAD_SUCCESS) return r;
-        if (b) {
-            float bb[3], e = rad__sdot(b, N), f = rad__sdot(b, T);
-            for (k = 0; k < 3; ++k) bb[k] = b[k] - e * N[k] - f * T[k];
-            if ((r = rad__shading_unit(&c, "b (minus its n and t components)", bb, B)) != RAD_SUCCESS) return r;
-        } else {
-            B[0] = N[1] * T[2] - N[2] * T[1];
-            B[1] = N[2] * T[0] - N[0] * T[2];
-            B[2] = N[0] * T[1] - N[1] * T[0];
-        }
-    }
-    rad__shading_pack(s, &g);
-    if (want_f) rad__shade(&g, L, V, N, T, B, out, NULL);
-    else rad__shade(&g, L, V, N, T, B, NULL, out);
-    return RAD_SUCCESS;
-}
-
-RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], const float v[3], const float n[3],
-                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx)
-{
-    return rad__shading_entry(s, l, v, n, t, b, out_rgb, 1, ctx);
-}
-
-RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
-                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx)
-{
-    return rad__shading_entry(s, l, v, n, t, b, out_rgb, 0, ctx);
-}
-
-RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
-                       const float b[3], float out_f[3], float out_r[3])
-{
-    static const float zero[3] = { 0.0f, 0.0f, 0.0f };
-    rad__shade(g, l, v, n, t ? t : zero, b ? b : zero, out_f, out_r);
-}
-
-typedef char rad__check_shading_gpu_size[(sizeof(rad_shading_gpu) == 96) ? 1 : -1];
-
-/* ======================================================================================== */
-/* >>container: baked data                                                                  */
-/* ======================================================================================== */
-
-typedef char rad__check_patch_size[(sizeof(rad_patch) == 68) ? 1 : -1];
-typedef char rad__check_signature_size[(sizeof(rad_bake_signature) == 32) ? 1 : -1];
-
-struct rad_container {
-    rad_section *sections;
-    uint32_t count;
-    rad_allocator allocator;
-};
-
-RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes)
-{
-    uint64_t at, bytes;
-    uint32_t i;
-    if (!out_bytes || (count > 0 && !sections)) return RAD_ERROR_INVALID_ARGUMENT;
-    if (count > RAD__MAX_SECTIONS) return RAD_ERROR_SIZE_OVERFLOW;
-    at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
-    for (i = 0; i < count; ++i) {
-        if (sections[i].elem_size == 0 || (sections[i].count > 0 && !sections[i].data)) return RAD_ERROR_INVALID_ARGUMENT;
-        if (sections[i].count > UINT64_MAX / sections[i].elem_size) return RAD_ERROR_SIZE_OVERFLOW;
-        bytes = sections[i].count * sections[i].elem_size;
-        if (bytes > UINT64_MAX - at - RAD__ALIGN) return RAD_ERROR_SIZE_OVERFLOW;
-        at = rad__align_up(at + bytes);
-    }
-    if (at > (uint64_t)(size_t)-1) return RAD_ERROR_SIZE_OVERFLOW;
-    *out_bytes = (size_t)at;
-    return RAD_SUCCESS;
-}
-
-RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t count, void *dst, size_t dst_size)
-{
-    unsigned char *base = (unsigned char *)dst;
-    size_t need;
-    uint64_t at;
-    uint32_t i;
-    rad_result r = rad_container_size(sections, count, &need);
-    if (r != RAD_SUCCESS) return r;
-    if (!dst || dst_size < need) return RAD_ERROR_INVALID_ARGUMENT;
-    memset(base, 0, need);
-    at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
-    for (i = 0; i < count; ++i) {
-        unsigned char *e = base + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
-        uint64_t bytes = sections[i].count * sections[i].elem_size;
-        size_t nl = 0;
-        if (bytes) memcpy(base + at, sections[i].data, (size_t)bytes);
-        rad__put32(e + RAD__E_TYPE, sections[i].type);
-        rad__put32(e + RAD__E_ELEM_SIZE, sections[i].elem_size);
-        rad__put64(e + RAD__E_COUNT, sections[i].count);
-        rad__put64(e + RAD__E_OFFSET, at);
-        rad__put64(e + RAD__E_BYTES, bytes);
-        rad__put32(e + RAD__E_CRC, rad__crc32(base + at, (size_t)bytes));
-        while (nl < sizeof(sections[i].name) - 1 && sections[i].name[nl]) ++nl;
-        memcpy(e + RAD__E_NAME, sections[i].name, nl);
-        at = rad__align_up(at + bytes);
-    }
-    memcpy(base, "RADB", 4);
-    rad__put32(base + RAD__H_VERSION, RAD_CONTAINER_VERSION);
-    rad__put32(base + RAD__H_COUNT, count);
-    rad__put32(base + RAD__H_HEADER_SIZE, RAD__HEADER_BYTES);
-    rad__put64(base + RAD__H_TABLE, RAD__HEADER_BYTES);
-    rad__put64(base + RAD__H_FILE_SIZE, (uint64_t)need);
-    rad__put32(base + RAD__H_FLAGS, rad__host_big_endian() ? RAD__FLAG_BIG_ENDIAN : 0u);
-    rad__put32(base + RAD__H_TABLE_CRC, rad__crc32(base + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count));
-    rad__put32(base + RAD__H_CRC, rad__crc32(base, RAD__H_CRC));
-    return RAD_SUCCESS;
-}
-
-RAD_API void rad_container_close(rad_container *c)
-{
-    rad_allocator a;
-    if (!c) return;
-    a = c->allocator;
-    rad__free(&a, c->sections);
-    rad__free(&a, c);
-}
-
-RAD_API rad_result rad_container_open(const void *data, size_t size, const rad_context *ctx, rad_container **out)
-{
-    rad__ctx c;
-    const unsigned char *p = (const unsigned char *)data;
-    rad__header h;
-    uint32_t i;
-    rad_result r;
-    rad_container *ct;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (!data) return RAD_ERROR_INVALID_ARGUMENT;
-    if (((uintptr_t)data & 7u) != 0) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data must start on an 8-byte boundary (it is read in place)");
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (size < RAD__HEADER_BYTES) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes, shorter than the %u-byte header", (unsigned long long)size, RAD__HEADER_BYTES);
-        return size >= 4 && memcmp(p, "RADB", 4) != 0 ? RAD_ERROR_CORRUPT : RAD_ERROR_TRUNCATED;
-    }
-    if ((r = rad__header_parse(p, (uint64_t)size, &c, "baked data", &h)) != RAD_SUCCESS ||
-        (r = rad__table_check(p, p + RAD__HEADER_BYTES, h.count, &c, "baked data")) != RAD_SUCCESS)
-        return r;
-    ct = (rad_container *)rad__alloc(&c.allocator, sizeof(rad_container));
-    if (!ct) return RAD_ERROR_OUT_OF_MEMORY;
-    ct->allocator = c.allocator;
-    ct->count = h.count;
-    ct->sections = (rad_section *)rad__alloc_array(&c.allocator, h.count ? h.count : 1u, sizeof(rad_section));
-    if (!ct->sections) { rad__free(&c.allocator, ct); return RAD_ERROR_OUT_OF_MEMORY; }
-    for (i = 0; i < h.count; ++i) {
-        const unsigned char *e = p + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
-        rad_section *sec = &ct->sections[i];
-        rad__entry x;
-        const char *why = rad__entry_parse(e, &h, &x);
-        memset(sec, 0, sizeof(*sec));
-        sec->type = x.type;
-        sec->elem_size = x.elem_size;
-        sec->count = x.count;
-        memcpy(sec->name, e + RAD__E_NAME, 24);
-        if (!why && x.crc != rad__crc32(p + x.offset, (size_t)x.bytes)) why = "checksum mismatch";
-        if (why) {
-            rad__log(&c, RAD_LOG_ERROR, "baked data: section %u (type %u, '%.23s'): %s", i, sec->type, sec->name, why);
-            rad_container_close(ct);
-            return RAD_ERROR_CORRUPT;
-        }
-        sec->data = p + x.offset;
-    }
-    *out = ct;
-    return RAD_SUCCESS;
-}
-
-RAD_API uint32_t rad_container_section_count(const rad_container *c) { return c ? c->count : 0; }
-
-RAD_API const char *rad_section_type_name(uint32_t type)
-{
-    static const char *const names[] = {
-        NULL, "PATCHES", "PATCH_VERTICES", "TRIANGLES", "FF_DENSE", "FF_ROW_OFFSETS", "FF_COLUMNS", "FF_VALUES",
-        "VECTOR", "SIGNATURE", NULL, NULL, NULL, NULL, NULL, NULL,
-        "MB_INFO", "MB_FLOAT", "MB_HALF", "MB_ROW_PERM", "MB_COL_PERM", "MB_BC1", "MB_BC4", "MB_SCALES",
-        "MB_OUTLIER_OFFSETS", "MB_OUTLIER_COLUMNS", "MB_OUTLIER_VALUES", NULL, NULL, NULL, NULL, NULL,
-        "TEMPORAL_ROW_OFFSETS", "TEMPORAL_BINS", "TEMPORAL_TOTALS", NULL, NULL, NULL, NULL, NULL,
-        "VP_INFO", "VP_AREAS", "VP_ALBEDO", "VP_NORMALS", "VP_AXIS", "VP_VOXEL", "VP_VOXEL_KEYS", "VP_VOXEL_FIRST",
-        "VP_VOXEL_PATCH", "VP_SAMPLE_FIRST", "VP_SAMPLE_POSITIONS", "VP_SAMPLE_NORMALS", "VP_SAMPLE_ALBEDO",
-        "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES"
-    };
-    if (type >= RAD_SECTION_USER) return "USER";
-    return type < sizeof(names) / sizeof(names[0]) ? names[type] : NULL;
-}
-
-RAD_API const rad_section *rad_container_section(const rad_container *c, uint32_t index)
-{
-    return (c && index < c->count) ? &c->sections[index] : NULL;
-}
-
-RAD_API const rad_section *rad_container_find(const rad_container *c, uint32_t type, const char *name)
-{
-    uint32_t i;
-    if (!c) return NULL;
-    for (i = 0; i < c->count; ++i)
-        if (c->sections[i].type == type && (!name || strcmp(c->sections[i].name, name) == 0)) return &c->sections[i];
-    return NULL;
-}
-
-static int rad__all_finite(const float *v, uint64_t n)
-{
-    uint64_t i;
-    for (i = 0; i < n; ++i)
-        if (!rad__finite(v[i])) return 0;
-    return 1;
-}
-
-/* the float fields of a patch record: finite (NON_FINITE), of magnitude <= RAD_BAKE_VALUE_MAX
-   (CORRUPT) except the area (it grows with the square of the scene's scale, and rad_system
-   only divides areas by areas), emission >= 0 (NEGATIVE_EMISSION) */
-static rad_result rad__check_patch_values(const rad__ctx *c, const rad_patch *p, uint32_t i)
-{
-    float f[13];
-    uint32_t k;
-    memcpy(f, p->centroid, 3 * sizeof(float));
-    memcpy(f + 3, p->normal, 3 * sizeof(float));
-    f[6] = p->area;
-    memcpy(f + 7, p->albedo, 3 * sizeof(float));
-    memcpy(f + 10, p->emission, 3 * sizeof(float));
-    for (k = 0; k < 13; ++k)
-        if (!rad__all_finite(f + k, 1) || (k != 6 && (f[k] > RAD_BAKE_VALUE_MAX || f[k] < -RAD_BAKE_VALUE_MAX))) {
-            const int finite = rad__finite(f[k]);
-            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has %s %g (%s)", i,
-                     k < 3 ? "centroid" : k < 6 ? "normal" : k == 6 ? "area" : k < 10 ? "albedo" : "emission", (double)f[k],
-                     finite ? "beyond RAD_BAKE_VALUE_MAX = 1e30" : "not finite");
-            return finite ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE;
-        }
-    for (k = 10; k < 13; ++k)
-        if (f[k] < 0.0f) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has emission %g", i, (double)f[k]);
-            return RAD_ERROR_NEGATIVE_EMISSION;
-        }
-    return RAD_SUCCESS;
-}
-
-/* ---- scene hashes and the signature ---- */
-
-RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash)
-{
-    const unsigned char *p = (const unsigned char *)data;
-    size_t i;
-    if (!p) return hash;
-    for (i = 0; i < size; ++i) hash = (hash ^ p[i]) * 0x100000001B3ull;
-    return hash;
-}
-
-/* hash of n uint32 words (or float bit patterns) as little-endian bytes */
-static uint64_t rad__hash_words(uint64_t h, const void *words, size_t n)
-{
-    const unsigned char *p = (const unsigned char *)words;
-    size_t i;
-    for (i = 0; i < n; ++i) {
-        uint32_t w;
-        unsigned char b[4];
-        memcpy(&w, p + 4 * i, 4);
-        rad__put32(b, w);
-        h = rad_hash64(b, 4, h);
-    }
-    return h;
-}
-
-RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials)
-{
-    uint64_t g = RAD_HASH64_INIT, m = RAD_HASH64_INIT;
-    uint32_t t, flag;
-    if (out_geometry) *out_geometry = 0;
-    if (out_materials) *out_materials = 0;
-    if (!scene || !scene->positions || !scene->materials || !scene->materials_table) return RAD_ERROR_INVALID_ARGUMENT;
-    g = rad__hash_words(g, &scene->triangle_count, 1);
-    g = rad__hash_words(g, scene->positions, 9u * (size_t)scene->triangle_count);
-    m = rad__hash_words(m, &scene->triangle_count, 1);
-    for (t = 0; t < scene->triangle_count; ++t) {
-        const uint32_t mi = scene->materials[t];
-        if (mi >= scene->material_count) return RAD_ERROR_INVALID_ARGUMENT;
-        m = rad__hash_words(m, scene->materials_table[mi].albedo, 3);
-        m = rad__hash_words(m, scene->materials_table[mi].emission, 3);
-        m = rad__hash_words(m, &scene->materials_table[mi].texture, 1);
-    }
-    flag = scene->uvs ? 1u : 0u;
-    m = rad__hash_words(m, &flag, 1);
-    if (scene->uvs) m = rad__hash_words(m, scene->uvs, 6u * (size_t)scene->triangle_count);
-    if (out_geometry) *out_geometry = g;
-    if (out_materials) *out_materials = m;
-    return RAD_SUCCESS;
-}
-
-RAD_API rad_result rad_bake_matches_scene(const rad_bake *bake, const rad_scene *scene, uint64_t options, const rad_context *ctx)
-{
-    rad__ctx c;
-    const rad_bake_signature *s;
-    uint64_t g = 0, m = 0;
-    int dg, dm, dopt;
-    rad_result r;
-    rad__ctx_init(&c, ctx);
-    if (!bake || !scene) return RAD_ERROR_INVALID_ARGUMENT;
-    if (bake->patches.triangle_count != scene->triangle_count) {
-        rad__log(&c, RAD_LOG_ERROR, "baked data was made from another scene: the geometry differs (%u triangles in the bake, %u in the scene)",
-                 bake->patches.triangle_count, scene->triangle_count);
-        return RAD_ERROR_SCENE_MISMATCH;
-    }
-    s = bake->signature;
-    if (!s) {
-        rad__log(&c, RAD_LOG_WARNING, "baked data has no signature (saved without its scene, or by an older version): only its triangle count (%u) was compared",
-                 scene->triangle_count);
-        return RAD_SUCCESS;
-    }
-    if ((r = rad_scene_hash(scene, &g, &m)) != RAD_SUCCESS) return r;
-    dg = s->geometry != 0 && s->geometry != g;
-    dm = s->materials != 0 && s->materials != m;
-    dopt = options != 0 && s->options != 0 && s->options != options;
-    if (!dg && !dm && !dopt) return RAD_SUCCESS;
-    {
-        const char *part[3];
-        char list[64];
-        int np = 0, i;
-        if (dg) part[np++] = "geometry";
-        if (dm) part[np++] = "materials";
-        if (dopt) part[np++] = "options";
-        list[0] = '\0';
-        for (i = 0; i < np; ++i) {
-            if (i > 0) strcat(list, i == np - 1 ? " and " : ", ");
-            strcat(list, part[i]);
-        }
-        rad__log(&c, RAD_LOG_ERROR,
-                 "baked data was made from another scene or with other options: the %s differ%s (bake / scene hashes: geometry "
-                 "%016llx / %016llx, materials %016llx / %016llx, options %016llx / %016llx)",
-                 list, np == 1 && !dm && !dopt ? "s" : "", (unsigned long long)s->geometry, (unsigned long long)g,
-                 (unsigned long long)s->materials, (unsigned long long)m, (unsigned long long)s->options,
-                 (unsigned long long)options);
-    }
-    return RAD_ERROR_SCENE_MISMATCH;
-}
-
-RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx)
-{
-    rad__ctx c;
-    rad__ctx_init(&c, ctx);
-    rad__free(&c.allocator, buffer);
-}
-
-RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, const float *E, const float *B,
-                                   const rad_context *ctx, void **out, size_t *out_size)
-{
-    rad__ctx c;
-    rad_section s[9];
-    rad_bake_signature sig;
-    uint32_t n = 0, t, *tri = NULL;
-    size_t bytes;
-    void *buf;
-    rad_result r;
-    rad__ctx_init(&c, ctx);
-    if (!out || !out_size) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    *out_size = 0;
-    if (!P || P->count == 0) return RAD_ERROR_INVALID_ARGUMENT;
-    if (F) {
-        r = rad__check_matrix(F, &c);
-        if (r != RAD_SUCCESS) return r;
-        if (F->rows != P->count || F->cols != P->count) {
-            rad__log(&c, RAD_LOG_ERROR, "save: the matrix is %u x %u but there are %u patches", F->rows, F->cols, P->count);
-            return RAD_ERROR_SIZE_MISMATCH;
-        }
-        /* what the loader would refuse is not written */
-        r = F->storage == RAD_STORAGE_DENSE
-                ? rad__check_values(&c, "dense form factors (FF_DENSE)", F->dense, (uint64_t)F->rows * F->cols, 1)
-                : rad__check_values(&c, "sparse form factors (FF_VALUES)", F->values, F->row_offsets[F->rows], 1);
-        if (r != RAD_SUCCESS) return r;
-    }
-    for (t = 0; t < P->count; ++t)
-        if ((r = rad__check_patch_values(&c, &P->patches[t], t)) != RAD_SUCCESS) return r;
-    if (E && (r = rad__check_values(&c, "vector 'E'", E, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
-    if (B && (r = rad__check_values(&c, "vector 'B'", B, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
-    memset(&sig, 0, sizeof(sig));
-    if (P->scene && (r = rad_scene_hash(P->scene, &sig.geometry, &sig.materials)) != RAD_SUCCESS) return r;
-    tri = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->triangle_count * 2u, sizeof(uint32_t));
-    if (!tri) return RAD_ERROR_OUT_OF_MEMORY;
-    for (t = 0; t < P->triangle_count; ++t) { tri[2 * (size_t)t] = P->first_patch[t]; tri[2 * (size_t)t + 1] = P->subdivision[t]; }
-    rad__section(&s[n++], RAD_SECTION_PATCHES, sizeof(rad_patch), P->count, P->patches, "patches");
-    rad__section(&s[n++], RAD_SECTION_PATCH_VERTICES, 3 * sizeof(float), P->vertex_count, P->vertices, "vertices");
-    rad__section(&s[n++], RAD_SECTION_TRIANGLES, 2 * sizeof(uint32_t), P->triangle_count, tri, "triangles");
-    if (F && F->storage == RAD_STORAGE_DENSE) {
-        rad__section(&s[n++], RAD_SECTION_FF_DENSE, sizeof(float), (uint64_t)F->rows * F->cols, F->dense, "F");
-    } else if (F) {
-        uint64_t nnz = F->row_offsets[F->rows];
-        rad__section(&s[n++], RAD_SECTION_FF_ROW_OFFSETS, sizeof(uint64_t), (uint64_t)F->rows + 1u, F->row_offsets, "F");
-        rad__section(&s[n++], RAD_SECTION_FF_COLUMNS, sizeof(uint32_t), nnz, F->columns, "F");
-        rad__section(&s[n++], RAD_SECTION_FF_VALUES, sizeof(float), nnz, F->values, "F");
-    }
-    if (E) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, E, "E");
-    if (B) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, B, "B");
-    if (P->scene) rad__section(&s[n++], RAD_SECTION_SIGNATURE, (uint32_t)sizeof(sig), 1, &sig, "signature");
-    r = rad_container_size(s, n, &bytes);
-    if (r != RAD_SUCCESS) { rad__free(&c.allocator, tri); return r; }
-    buf = rad__alloc(&c.allocator, bytes);
-    if (!buf) { rad__free(&c.allocator, tri); return RAD_ERROR_OUT_OF_MEMORY; }
-    r = rad_container_write(s, n, buf, bytes);
-    rad__free(&c.allocator, tri);
-    if (r != RAD_SUCCESS) { rad__free(&c.allocator, buf); return r; }
-    *out = buf;
-    *out_size = bytes;
-    return RAD_SUCCESS;
-}
-
-RAD_API void rad_bake_destroy(rad_bake *b)
-{
-    rad_allocator a;
-    if (!b) return;
-    a = b->allocator;
-    rad_container_close(b->container);
-    rad__free(&a, b->patches.areas);
-    rad__free(&a, b->patches.albedo);
-    rad__free(&a, b->patches.first_patch);
-    rad__free(&a, b->patches.subdivision);
-    rad__free(&a, b->owned);
-    rad__free(&a, b);
-}
-
-/* the single section of 'type' (named when name is given), checked for its element size */
-static rad_result rad__bake_section(const rad__ctx *c, const rad_container *ct, uint32_t type, const char *name,
-                                    uint32_t elem_size, int required, const rad_section **out)
-{
-    const rad_section *s = rad_container_find(ct, type, name);
-    *out = NULL;
-    if (!s) {
-        if (!required) return RAD_SUCCESS;
-        rad__log(c, RAD_LOG_ERROR, "baked data: section of type %u ('%s') is missing", type, name ? name : "");
-        return RAD_ERROR_CORRUPT;
-    }
-    if (s->elem_size != elem_size) {
-        rad__log(c, RAD_LOG_ERROR, "baked data: section type %u has %u-byte elements, expected %u", type, s->elem_size, elem_size);
-        return RAD_ERROR_CORRUPT;
-    }
-    *out = s;
-    return RAD_SUCCESS;
-}
-
-static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
-{
-    const rad_section *sp, *sv, *st, *sd, *so, *sc, *sx, *se, *sb;
-    rad_result r;
-    uint32_t N, i, k;
-    uint64_t T;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_PATCHES, NULL, sizeof(rad_patch), 1, &sp)) != RAD_SUCCESS) return r;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_PATCH_VERTICES, NULL, 12, 1, &sv)) != RAD_SUCCESS) return r;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_TRIANGLES, NULL, 8, 1, &st)) != RAD_SUCCESS) return r;
-    if (sp->count == 0 || sp->count >= RAD_NONE || sv->count >= RAD_NONE || st->count >= RAD_NONE) {
-        rad__log(c, RAD_LOG_ERROR, "baked data: %llu patches, %llu vertices, %llu triangles (out of range)",
-                 (unsigned long long)sp->count, (unsigned long long)sv->count, (unsigned long long)st->count);
-        return RAD_ERROR_CORRUPT;
-    }
-    N = (uint32_t)sp->count;
-    T = st->count;
-    b->patches.count = N;
-    b->patches.patches = (rad_patch *)(uintptr_t)sp->data;
-    b->patches.vertex_count = (uint32_t)sv->count;
-    b->patches.vertices = (float *)(uintptr_t)sv->data;
-    b->patches.triangle_count = (uint32_t)T;
-    if ((r = rad__check_values(c, "patch vertices (PATCH_VERTICES)", b->patches.vertices, sv->count * 3u, 0)) != RAD_SUCCESS) return r;
-    b->patches.first_patch = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
-    b->patches.subdivision = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
-    b->patches.areas = (float *)rad__alloc_array(&b->allocator, N, sizeof(float));
-    b->patches.albedo = (float *)rad__alloc_array(&b->allocator, (size_t)N * 3u, sizeof(float));
-    if (!b->patches.first_patch || !b->patches.subdivision || !b->patches.areas || !b->patches.albedo) return RAD_ERROR_OUT_OF_MEMORY;
-    for (i = 0; i < (uint32_t)T; ++i) {
-        const uint32_t *tv = (const uint32_t *)st->data + 2 * (size_t)i;
-        uint64_t n = tv[1];
-        b->patches.first_patch[i] = tv[0];
-        b->patches.subdivision[i] = tv[1];
-        if (n == 0 || n > 65535u || (uint64_t)tv[0] + n * n > N) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: triangle %u claims patches [%u, %llu) of %u", i, tv[0],
-                     (unsigned long long)((uint64_t)tv[0] + n * n), N);
-            return RAD_ERROR_INDEX_OUT_OF_RANGE;
-        }
-    }
-    for (i = 0; i < N; ++i) {
-        const rad_patch *p = &b->patches.patches[i];
-        for (k = 0; k < 3; ++k)
-            if (p->vertices[k] >= b->patches.vertex_count) {
-                rad__log(c, RAD_LOG_ERROR, "baked data: patch %u uses vertex %u of %u", i, p->vertices[k], b->patches.vertex_count);
-                return RAD_ERROR_INDEX_OUT_OF_RANGE;
-            }
-        if (p->triangle >= T) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u lies on triangle %u of %llu", i, p->triangle, (unsigned long long)T);
-            return RAD_ERROR_INDEX_OUT_OF_RANGE;
-        }
-        if ((r = rad__check_patch_values(c, p, i)) != RAD_SUCCESS) return r;
-        if (!(p->area > 0.0f)) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has area %g", i, (double)p->area);
-            return RAD_ERROR_DEGENERATE_TRIANGLE;
-        }
-        for (k = 0; k < 3; ++k)
-            if (p->albedo[k] < 0.0f || p->albedo[k] >= 1.0f) {
-                rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has albedo %g", i, (double)p->albedo[k]);
-                return RAD_ERROR_ALBEDO_RANGE;
-            }
-        b->patches.areas[i] = p->area;
-        memcpy(b->patches.albedo + 3 * (size_t)i, p->albedo, 3 * sizeof(float));
-    }
-    /* form factors: dense, or the three CSR sections, or none */
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_DENSE, NULL, 4, 0, &sd)) != RAD_SUCCESS) return r;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_ROW_OFFSETS, NULL, 8, 0, &so)) != RAD_SUCCESS) return r;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_COLUMNS, NULL, 4, 0, &sc)) != RAD_SUCCESS) return r;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_VALUES, NULL, 4, 0, &sx)) != RAD_SUCCESS) return r;
-    if (sd) {
-        if (sd->count != (uint64_t)N * N) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: dense matrix of %llu entries for %u patches", (unsigned long long)sd->count, N);
-            return RAD_ERROR_SIZE_MISMATCH;
-        }
-        if ((r = rad__check_values(c, "dense form factors (FF_DENSE)", (const float *)sd->data, sd->count, 1)) != RAD_SUCCESS)
-            return r;
-        b->F.rows = b->F.cols = N;
-        b->F.storage = RAD_STORAGE_DENSE;
-        b->F.dense = (const float *)sd->data;
-    } else if (so || sc || sx) {
-        const uint64_t *off;
-        const uint32_t *col;
-        if (!so || !sc || !sx || so->count != (uint64_t)N + 1u || sc->count != sx->count) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: incomplete or inconsistent CSR sections");
-            return RAD_ERROR_CORRUPT;
-        }
-        off = (const uint64_t *)so->data;
-        col = (const uint32_t *)sc->data;
-        if (off[0] != 0 || off[N] != sc->count) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: CSR offsets start at %llu and end at %llu, %llu entries",
-                     (unsigned long long)off[0], (unsigned long long)off[N], (unsigned long long)sc->count);
-            return RAD_ERROR_CORRUPT;
-        }
-        for (i = 0; i < N; ++i) {
-            uint64_t q;
-            if (off[i + 1] < off[i] || off[i + 1] > sc->count) {
-                rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u offsets are not monotone", i);
-                return RAD_ERROR_CORRUPT;
-            }
-            for (q = off[i]; q < off[i + 1]; ++q) {
-                if (col[q] >= N) {
-                    rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u has column %u of %u", i, col[q], N);
-                    return RAD_ERROR_INDEX_OUT_OF_RANGE;
-                }
-                if (q > off[i] && col[q] <= col[q - 1]) {
-                    rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u columns are not ascending", i);
-                    return RAD_ERROR_CORRUPT;
-                }
-            }
-        }
-        if ((r = rad__check_values(c, "sparse form factors (FF_VALUES)", (const float *)sx->data, sx->count, 1)) != RAD_SUCCESS)
-            return r;
-        b->F.rows = b->F.cols = N;
-        b->F.storage = RAD_STORAGE_SPARSE;
-        b->F.row_offsets = off;
-        b->F.columns = col;
-        b->F.values = (const float *)sx->data;
-    }
-    /* every vector, not only E and B: the application's ("H", "L", ...) are read in place too */
-    for (k = 0; k < rad_container_section_count(b->container); ++k) {
-        const rad_section *s = rad_container_section(b->container, k);
-        char what[48];
-        if (s->type != RAD_SECTION_VECTOR) continue;
-        if (s->elem_size != 12u || s->count != N) {
-            rad__log(c, RAD_LOG_ERROR, "baked data: vector '%s' has %llu elements of %u bytes, expected %u RGB triples", s->name,
-                     (unsigned long long)s->count, s->elem_size, N);
-            return RAD_ERROR_SIZE_MISMATCH;
-        }
-        snprintf(what, sizeof(what), "vector '%s'", s->name);
-        if ((r = rad__check_values(c, what, (const float *)s->data, s->count * 3u, 0)) != RAD_SUCCESS) return r;
-    }
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "E", 12, 0, &se)) != RAD_SUCCESS) return r;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "B", 12, 0, &sb)) != RAD_SUCCESS) return r;
-    b->E = se ? (const float *)se->data : NULL;
-    b->B = sb ? (const float *)sb->data : NULL;
-    if ((r = rad__bake_section(c, b->container, RAD_SECTION_SIGNATURE, NULL, (uint32_t)sizeof(rad_bake_signature), 0, &se)) != RAD_SUCCESS)
-        return r;
-    if (se && se->count != 1u) {
-        rad__log(c, RAD_LOG_ERROR, "baked data: the signature section holds %llu records, expected 1", (unsigned long long)se->count);
-        return RAD_ERROR_CORRUPT;
-    }
-    b->signature = se ? (const rad_bake_signature *)se->data : NULL;
-    return RAD_SUCCESS;
-}
-
-static rad_result rad__load(const void *data, size_t size, void *owned, const rad__ctx *c, const rad_context *ctx,
-                            rad_bake **out)
-{
-    rad_bake *b = (rad_bake *)rad__alloc(&c->allocator, sizeof(rad_bake));
-    rad_result r;
-    if (!b) { rad__free(&c->allocator, owned); return RAD_ERROR_OUT_OF_MEMORY; }
-    memset(b, 0, sizeof(*b));
-    b->allocator = c->allocator;
-    b->owned = owned;
-    b->patches.allocator = c->allocator;
-    r = rad_container_open(data, size, ctx, &b->container);
-    if (r == RAD_SUCCESS) r = rad__bake_fill(b, c);
-    if (r != RAD_SUCCESS) { rad_bake_destroy(b); return r; }
-    *out = b;
-    return RAD_SUCCESS;
-}
-
-RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out)
-{
-    rad__ctx c;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (!data) return RAD_ERROR_INVALID_ARGUMENT;
-    return rad__load(data, size, NULL, &c, ctx, out);
-}
-
-#ifndef RAD_NO_STDIO
-/* Writes 'size' bytes to '<path>.partial' beside path and renames it over path only when
-   every byte is written and closed: a failed save leaves the old file (or none) in place. */
-static rad_result rad__write_file_atomic(const rad__ctx *c, const char *path, const void *data, size_t size)
-{
-    size_t len = strlen(path);
-    char *tmp = (char *)rad__alloc(&c->allocator, len + 9u);
-    FILE *f;
-    int ok;
-    if (!tmp) {
-        rad__log(c, RAD_LOG_ERROR, "saving '%s': out of memory for the temporary name", path);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".partial", 9u);
-    f = fopen(tmp, "wb");
-    if (!f) {
-        rad__log(c, RAD_LOG_ERROR, "cannot open '%s' for writing (the folder must exist and be writable)", tmp);
-        rad__free(&c->allocator, tmp);
-        return RAD_ERROR_IO;
-    }
-    ok = fwrite(data, 1, size, f) == size;
-    ok = (fclose(f) == 0) && ok;
-    if (ok && rename(tmp, path) != 0) {
-        /* where rename does not replace an existing file (Windows), replace it by hand */
-        ok = remove(path) == 0 && rename(tmp, path) == 0;
-    }
-    if (!ok) {
-        remove(tmp);
-        rad__log(c, RAD_LOG_ERROR, "cannot write '%s' (disk full or not writable): the old file, if any, is unchanged", path);
-    }
-    rad__free(&c->allocator, tmp);
-    return ok ? RAD_SUCCESS : RAD_ERROR_IO;
-}
-
-RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
-                                 const float *B, const rad_context *ctx)
-{
-    rad__ctx c;
-    void *buf = NULL;
-    size_t size = 0;
-    rad_result r;
-    rad__ctx_init(&c, ctx);
-    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
-    r = rad_save_memory(patches, F, E, B, ctx, &buf, &size);
-    if (r != RAD_SUCCESS) return r;
-    r = rad__write_file_atomic(&c, path, buf, size);
-    rad__free(&c.allocator, buf);
-    return r;
-}
-
-RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out)
-{
-    rad__ctx c;
-    FILE *f;
-    long len;
-    void *buf;
-    unsigned char head[RAD__HEADER_BYTES];
-    size_t got;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
-    f = fopen(path, "rb");
-    if (!f) {
-        rad__log(&c, RAD_LOG_ERROR, "cannot open '%s'", path);
-        return RAD_ERROR_IO;
-    }
-    /* the header first: a folder, a file of another kind or a truncated bake is refused
-       before anything of its size is allocated or read */
-    got = fread(head, 1, sizeof(head), f);
-    if (got < sizeof(head)) {
-        int err = ferror(f);
-        fclose(f);
-        rad__log(&c, RAD_LOG_ERROR, err ? "cannot read '%s' (a folder, or not readable)" :
-                 "'%s' is shorter than a container header (64 bytes)", path);
-        return err ? RAD_ERROR_IO : RAD_ERROR_TRUNCATED;
-    }
-    if (memcmp(head, "RADB", 4) != 0) {
-        fclose(f);
-        rad__log(&c, RAD_LOG_ERROR, "'%s' is not a radiosity.h container (no RADB magic)", path);
-        return RAD_ERROR_CORRUPT;
-    }
-    if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        fclose(f);
-        rad__log(&c, RAD_LOG_ERROR, "cannot size '%s'", path);
-        return RAD_ERROR_IO;
-    }
-    if (rad__get64(head + RAD__H_FILE_SIZE) > (uint64_t)len) {
-        fclose(f);
-        rad__log(&c, RAD_LOG_ERROR, "'%s' has %ld bytes, its header says %llu: the file is truncated", path, len,
-                 (unsigned long long)rad__get64(head + RAD__H_FILE_SIZE));
-        return RAD_ERROR_TRUNCATED;
-    }
-    buf = rad__alloc(&c.allocator, (size_t)len);
-    if (!buf) {
-        fclose(f);
-        rad__log(&c, RAD_LOG_ERROR, "loading '%s': out of memory for its %ld bytes", path, len);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    if (fread(buf, 1, (size_t)len, f) != (size_t)len) {
-        fclose(f);
-        rad__free(&c.allocator, buf);
-        rad__log(&c, RAD_LOG_ERROR, "cannot read '%s'", path);
-        return RAD_ERROR_IO;
-    }
-    fclose(f);
-    return rad__load(buf, (size_t)len, buf, &c, ctx, out);
-}
-#endif
-
-/* ======================================================================================== */
-/* >>glsl: GLSL compute kernels (generated sources, access)                                 */
-/* ======================================================================================== */
-
-/* a rad_output passes to the kernels unchanged as their TOTAL bit */
-typedef char rad__check_glsl_output_flag[(RAD_GLSL_FLAG_TOTAL == (uint32_t)RAD_OUTPUT_TOTAL) ? 1 : -1];
-
-/* push-constant mirrors: the GLSL blocks are 4-byte members in declaration order */
-typedef char rad__check_glsl_dense_push[(sizeof(rad_glsl_gather_dense_push) == 20 &&
-                                         offsetof(rad_glsl_gather_dense_push, f_base) == 12 &&
-                                         offsetof(rad_glsl_gather_dense_push, flags) == 16) ? 1 : -1];
-typedef char rad__check_glsl_csr_push[(sizeof(rad_glsl_gather_csr_push) == 16 &&
-                                       offsetof(rad_glsl_gather_csr_push, entry_base) == 8 &&
-                                       offsetof(rad_glsl_gather_csr_push, flags) == 12) ? 1 : -1];
-typedef char rad__check_glsl_mb_push[(sizeof(rad_glsl_mb_apply_push) == 20 &&
-                                      offsetof(rad_glsl_mb_apply_push, base) == 12 &&
-                                      offsetof(rad_glsl_mb_apply_push, flags) == 16) ? 1 : -1];
-typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60 &&
-                                            offsetof(rad_glsl_temporal_push, words) == 24 &&
-                                            offsetof(rad_glsl_temporal_push, word_base) == 40 &&
-                                            offsetof(rad_glsl_temporal_push, weight) == 44 &&
-                                            offsetof(rad_glsl_temporal_push, env) == 48) ? 1 : -1];
-typedef char rad__check_glsl_blocks_push[(sizeof(rad_glsl_mb_blocks_push) == 24 &&
-                                          offsetof(rad_glsl_mb_blocks_push, tile) == 12 &&
-                                          offsetof(rad_glsl_mb_blocks_push, flags) == 20) ? 1 : -1];
-typedef char rad__check_glsl_local_apply_push[(sizeof(rad_glsl_local_apply_push) == 32 &&
-                                               offsetof(rad_glsl_local_apply_push, slot_offset) == 16 &&
-                                               offsetof(rad_glsl_local_apply_push, flags) == 28) ? 1 : -1];
-typedef char rad__check_glsl_local_vectors_push[(sizeof(rad_glsl_local_vectors_push) == 48 &&
-                                                 offsetof(rad_glsl_local_vectors_push, nnz) == 20 &&
-                                                 offsetof(rad_glsl_local_vectors_push, flags) == 32 &&
-                                                 offsetof(rad_glsl_local_vectors_push, ann) == 36) ? 1 : -1];
-typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_push) == 28 &&
-                                                offsetof(rad_glsl_local_update_push, base) == 16 &&
-                                                offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
-typedef char rad__check_glsl_probe_update_push[(sizeof(rad_glsl_probe_update_push) == 16 &&
-                                               offsetof(rad_glsl_probe_update_push, weight_base) == 12) ? 1 : -1];
-typedef char rad__check_glsl_lightmap_refresh_push[(sizeof(rad_glsl_lightmap_refresh_push) == 16 &&
-                                                   offsetof(rad_glsl_lightmap_refresh_push, entry_base) == 12) ? 1 : -1];
-typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
-                                             offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
-                                             offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
-                                             offsetof(rad_glsl_vp_gather_push, flags) == 52) ? 1 : -1];
-typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28 &&
-                                         offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
-                                         offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
-
-#ifndef RAD_NO_GLSL
-
-typedef struct rad__glsl_entry {
-    const char *name;
-    const char *const *pieces;
-    uint32_t count;
-    uint32_t length;
-} rad__glsl_entry;
-
-/* Generated by glsl/embed.c from the files glsl/<name>: edit those, then run make glsl. */
-/* >>glsl begin */
-static const char rad__glsl_0_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_GATHER_DENSE: one classic bounce with a dense form-factor matrix,\n"
-    "//   out_i = rho_i * sum_j F_ij E_j            (flags bit 0 clear: RAD_OUTPUT_INDIRECT)\n"
-    "//   out_i = E_i + rho_i * sum_j F_ij E_j      (flags bit 0 set:   RAD_OUTPUT_TOTAL)\n"
-    "// for rows i = row_offset .. row_offset + row_count - 1. ONE WORKGROUP PER ROW: dispatch\n"
-    "// row_count groups; the invocations of a group read the row with a stride of the group size\n"
-    "// (consecutive invocations read consecutive columns) and sum in shared memory.\n"
-    "// Chunking: binding 0 holds the rows of this chunk only; F_ij is F[f_base + (i - row_offset) * cols + j],\n"
-    "// so a matrix larger than one storage-buffer range runs as several dispatches.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer MatrixF { float F[]; };\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer VectorE { float E[]; };      // 3 N, RGB interleaved\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer Albedo { float rho[]; };     // 3 N\n"
-    "layout(std430, set = 0, binding = 3) buffer Output { float outv[]; };             // 3 N\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint row_offset;  // first row of this dispatch (global index)\n"
-    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
-    "    uint cols;        // N\n"
-    "    uint f_base;      // element of binding 0 that holds F[row_offset][0]\n"
-    "    uint flags;       // bit 0: add E (total)\n"
-    "} pc;\n"
-    "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;               // the whole group: barriers stay uniform\n"
-    "    uint i = pc.row_offset + r;\n"
-    "    uint at = pc.f_base + r * pc.cols;\n"
-    "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint j = lid; j < pc.cols; j += gl_WorkGroupSize.x) {\n"
-    "        float f = F[at + j];\n"
-    "        acc += f * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
-    "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {   // any group size, no subgroup assumption\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
-    "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
-    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
-    "    outv[3u * i] = o.x;\n"
-    "    outv[3u * i + 1u] = o.y;\n"
-    "    outv[3u * i + 2u] = o.z;\n"
-    "}\n";
-static const char *const rad__glsl_pieces_0[] = { rad__glsl_0_0 };
-static const char rad__glsl_1_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_GATHER_CSR: one classic bounce with a CSR (sparse) form-factor matrix,\n"
-    "//   out_i = rho_i * sum_k values[k] E_columns[k]  (+ E_i when flags bit 0 is set)\n"
-    "// for rows i = row_offset .. row_offset + row_count - 1, ONE WORKGROUP PER ROW (dispatch\n"
-    "// row_count groups; the group strides over the row's entries and sums in shared memory).\n"
-    "// Binding 0 holds all N + 1 row offsets as uint64 (two uint words each, low word first, as\n"
-    "// rad_matrix.row_offsets stores them). Chunking: bindings 1 and 2 may hold only the entries of\n"
-    "// this chunk's rows; entry k of the matrix is element k - entry_base of them (entry_base = the\n"
-    "// low 32 bits of the first entry index the bound ranges start at; a chunk spans < 2^32 entries).\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; };\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };      // 3 N\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };     // 3 N\n"
-    "layout(std430, set = 0, binding = 5) buffer Output { float outv[]; };             // 3 N\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint row_offset;  // first row of this dispatch (global index)\n"
-    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
-    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
-    "    uint flags;       // bit 0: add E (total)\n"
-    "} pc;\n"
-    "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    uint i = pc.row_offset + r;\n"
-    "    uint k0 = row_offsets[i].x - pc.entry_base;       // wraps correctly: only the difference matters\n"
-    "    uint count = row_offsets[i + 1u].x - row_offsets[i].x;\n"
-    "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint e = lid; e < count; e += gl_WorkGroupSize.x) {\n"
-    "        uint j = columns[k0 + e];\n"
-    "        acc += values[k0 + e] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
-    "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
-    "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
-    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
-    "    outv[3u * i] = o.x;\n"
-    "    outv[3u * i + 1u] = o.y;\n"
-    "    outv[3u * i + 2u] = o.z;\n"
-    "}\n";
-static const char *const rad__glsl_pieces_1[] = { rad__glsl_1_0 };
-static const char rad__glsl_2_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_MB_APPLY_FLOAT: the multi-bounce apply L = F_mb E with float planes\n"
-    "// (rad_multibounce with precision RAD_MB_FLOAT). Plane row i' (permuted order) is original row\n"
-    "// row_perm[i'], plane column j' is original column col_perm[j'] (identity when flags bit 1 is clear):\n"
-    "//   out[row_perm[i']] = sum_j' plane_c[i'][j'] * E[col_perm[j']]  (+ E[row_perm[i']] when flags bit 0)\n"
-    "// for plane rows i' = row_offset .. row_offset + row_count - 1, channels c = R, G, B.\n"
-    "// ONE WORKGROUP PER ROW: dispatch row_count groups; the group strides over the columns.\n"
-    "// Chunking: bindings 0..2 may hold only this chunk's rows; entry (i', j') of plane c is element\n"
-    "// base + (i' - row_offset) * n + j' of binding c.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };       // 3 N, original order\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; }; // N (unused without bit 1)\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; }; // N (unused without bit 1)\n"
-    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };              // 3 N, original order\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint n;           // N\n"
-    "    uint row_offset;  // first plane row of this dispatch\n"
-    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
-    "    uint base;        // element of bindings 0..2 that holds plane row row_offset, column 0\n"
-    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
-    "} pc;\n"
-    "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    bool perm = (pc.flags & 2u) != 0u;\n"
-    "    uint ip = pc.row_offset + r;\n"
-    "    uint at = pc.base + r * pc.n;\n"
-    "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
-    "        uint e = 3u * (perm \? col_perm[j] : j);\n"
-    "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
-    "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
-    "    if (lid != 0u) return;\n"
-    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    precise vec3 s = partial[0];\n"
-    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
-    "    outv[o] = s.x;\n"
-    "    outv[o + 1u] = s.y;\n"
-    "    outv[o + 2u] = s.z;\n"
-    "}\n";
-static const char *const rad__glsl_pieces_2[] = { rad__glsl_2_0 };
-static const char rad__glsl_3_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_MB_APPLY_HALF: the multi-bounce apply L = F_mb E with IEEE binary16\n"
-    "// planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint\n"
-    "// word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage\n"
-    "// feature is needed. Same bindings, push constants, permutations, dispatch (one workgroup per\n"
-    "// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may\n"
-    "// be odd). Buffers and bound ranges must cover whole 32-bit words: round a range's end up to a\n"
-    "// multiple of 4 bytes, or the word holding the last value reads as zero.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { uint R[]; };\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { uint G[]; };\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { uint B[]; };\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; };\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; };\n"
-    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint n;\n"
-    "    uint row_offset;\n"
-    "    uint row_count;\n"
-    "    uint base;        // binary16 value of bindings 0..2 that holds plane row row_offset, column 0\n"
-    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
-    "} pc;\n"
-    "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
-    "\n"
-    "float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u \? v.y : v.x; }\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    bool perm = (pc.flags & 2u) != 0u;\n"
-    "    uint ip = pc.row_offset + r;\n"
-    "    uint at = pc.base + r * pc.n;\n"
-    "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
-    "        uint e = 3u * (perm \? col_perm[j] : j), h = at + j;\n"
-    "        vec3 f = vec3(half_at(R[h >> 1u], h), half_at(G[h >> 1u], h), half_at(B[h >> 1u], h));\n"
-    "        acc += f * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
-    "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
-    "    if (lid != 0u) return;\n"
-    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    precise vec3 s = partial[0];\n"
-    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
-    "    outv[o] = s.x;\n"
-    "    outv[o + 1u] = s.y;\n"
-    "    outv[o + 2u] = s.z;\n"
-    "}\n";
-static const char *const rad__glsl_pieces_3[] = { rad__glsl_3_0 };
-static const char rad__glsl_4_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_TEMPORAL_STEP: one frame of temporal radiosity (rad_temporal_step\n"
-    "// with a fixed weight), drawing exactly the indices the CPU draws: the counter-based generator\n"
-    "// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. One invocation per row i\n"
-    "// (dispatch ceil(row_count / group size) groups):\n"
-    "//   acc = 0; for s = 0..k-1: J = draw(sample = sample_base + s); acc += V_J\n"
-    "//   X = acc * (T_i / k); X *= rho_i (flags bit 0); B_i = w B_i^prev + (1 - w) X\n"
-    "// V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).\n"
-    "// channel = 3: one table set serves R, G and B. channel = c < 3: this dispatch uses table set c\n"
-    "// (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.\n"
-    "// Chunking: binding 1 may hold only this chunk's bins: word w of the tables (bin b starts at word\n"
-    "// b * words) is element w - word_base of it (word_base: low 32 bits; a chunk spans < 2^32 words).\n"
-    "// PADDED tables (flags bit 2), as RAD_GLSL_ALIAS_BUILD writes them for streamed rows: row i's\n"
-    "// bins start at bin row_offsets[i] + i (binding 0 = the input entry offsets) and counts[i]\n"
-    "// (binding 7) says how many there are, so the build's output is sampled without compaction.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer Totals { float totals[]; };         // T_i per row\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };             // 3 N\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };            // 3 N (flags bit 0)\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer Previous { float Bprev[]; };        // 3 N\n"
-    "layout(std430, set = 0, binding = 6) buffer Next { float Bnext[]; };                     // 3 N\n"
-    "layout(std430, set = 0, binding = 7) readonly buffer Counts { uint counts[]; };          // bins per row (bit 2)\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint seed;        // rad_temporal_options.seed\n"
-    "    uint frame;       // rad_temporal_frame() before the step\n"
-    "    uint row_offset;  // first row of this dispatch\n"
-    "    uint row_count;   // rows in this dispatch\n"
-    "    uint n;           // N: the environment's column index\n"
-    "    uint samples;     // k\n"
-    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
-    "    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK); bit 2: PADDED\n"
-    "    uint channel;     // 3: RGB from one table set; 0..2: this channel only\n"
-    "    uint sample_base; // channel * k with three table sets, else 0\n"
-    "    uint word_base;   // low 32 bits of the tables' word index at element 0 of binding 1\n"
-    "    float weight;     // w in [0, 1)\n"
-    "    float env_r, env_g, env_b; // E_0\n"
-    "} pc;\n"
-    "\n"
-    "uint rad_pcg(uint v)\n"
-    "{\n"
-    "    uint s = v * 747796405u + 2891336453u;\n"
-    "    uint t = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;\n"
-    "    return (t >> 22u) ^ t;\n"
-    "}\n"
-    "\n"
-    "float value_at(uint j, uint c)\n"
-    "{\n"
-    "    if (j >= pc.n) return c == 0u \? pc.env_r : (c == 1u \? pc.env_g : pc.env_b);\n"
-    "    float v = E[3u * j + c];\n"
-    "    if ((pc.flags & 2u) != 0u) v += Bprev[3u * j + c];\n"
-    "    return v;\n"
-    "}\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    uint i = pc.row_offset + r;\n"
-    "    uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);\n"
-    "    bool padded = (pc.flags & 4u) != 0u;\n"
-    "    uint first = row_offsets[i].x + (padded \? i : 0u);\n"
-    "    uint nb = padded \? counts[i] : row_offsets[i + 1u].x - row_offsets[i].x;\n"
-    "    uint c0 = pc.channel < 3u \? pc.channel : 0u, c1 = pc.channel < 3u \? pc.channel : 2u;\n"
-    "    precise float acc[3] = float[3](0.0, 0.0, 0.0);\n"
-    "    for (uint s = 0u; s < pc.samples; ++s) {\n"
-    "        uint u1 = rad_pcg(key ^ ((pc.sample_base + s) * 0x9E3779B9u));\n";
-static const char rad__glsl_4_1[] =
-    "        uint u2 = rad_pcg(u1 ^ 0x68E31DA4u);\n"
-    "        uint hi, lo;\n"
-    "        umulExtended(u1, nb, hi, lo);\n"
-    "        uint w = (first + hi) * pc.words - pc.word_base, j;   // wraps correctly: only the difference matters\n"
-    "        if (pc.words == 2u) j = u2 < bins[w] \? (bins[w + 1u] & 0xFFFFu) : (bins[w + 1u] >> 16u);\n"
-    "        else j = u2 < bins[w] \? bins[w + 1u] : bins[w + 2u];\n"
-    "        for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);\n"
-    "    }\n"
-    "    precise float scale = totals[i] / float(pc.samples);\n"
-    "    for (uint c = c0; c <= c1; ++c) {\n"
-    "        precise float x = acc[c] * scale;\n"
-    "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n"
-    "        precise float b = pc.weight * Bprev[3u * i + c] + (1.0 - pc.weight) * x;\n"
-    "        Bnext[3u * i + c] = b;\n"
-    "    }\n"
-    "}\n";
-static const char *const rad__glsl_pieces_4[] = { rad__glsl_4_0, rad__glsl_4_1 };
-static const char rad__glsl_5_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_MB_APPLY_BLOCKS: the multi-bounce apply from the block-compressed\n"
-    "// matrix (rad_multibounce_blocks), as rad_multibounce_blocks_apply: the texture unit decodes the\n"
-    "// blocks (texelFetch), each texel is multiplied by its tile's scale, the outliers are added\n"
-    "// exactly and the permutations are applied:\n"
-    "//   out[row_perm[y]] = sum_x decoded(x, y) * scale(tile of x, y) * E[col_perm[x]]\n"
-    "//                      + sum over the outliers of original row row_perm[y] of value * E[column]\n"
-    "//                      (+ E[row_perm[y]] when flags bit 0 is set)\n"
-    "// for texel rows y = row_offset .. row_offset + row_count - 1 (<= N), RGB. ONE WORKGROUP PER ROW:\n"
-    "// dispatch row_count groups; the group strides over the columns (neighbouring invocations fetch\n"
-    "// neighbouring texels) and sums in shared memory.\n"
-    "// Formats: RAD_BLOCK_BC1 (flags bit 2): one VK_FORMAT_BC1_RGB_UNORM_BLOCK image bound to\n"
-    "// bindings 0, 1 and 2 (its .rgb is read from binding 0); RAD_BLOCK_BC4X3: three\n"
-    "// VK_FORMAT_BC4_UNORM_BLOCK images (R, G, B planes) at bindings 0, 1, 2 (.r of each). The images\n"
-    "// are blocks_per_row * 4 texels square; texel (x, y) is entry (row y, column x).\n"
-    "// The outlier arrays are bound whole (they are indexed by original row, which a chunk of\n"
-    "// permuted rows does not keep contiguous): with the default 5% of N^2 they fit 128 MiB up to\n"
-    "// N of about 14 000.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(set = 0, binding = 0) uniform sampler2D texR;   // BC1: the RGB texture; BC4X3: R plane\n"
-    "layout(set = 0, binding = 1) uniform sampler2D texG;   // BC4X3: G plane (BC1: any, unused)\n"
-    "layout(set = 0, binding = 2) uniform sampler2D texB;   // BC4X3: B plane (BC1: any, unused)\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer Scales { float scales[]; };          // 3 per tile\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer VectorE { float E[]; };              // 3 N\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer ColPerm { uint col_perm[]; };        // N (flags bit 1)\n"
-    "layout(std430, set = 0, binding = 6) readonly buffer RowPerm { uint row_perm[]; };        // N (flags bit 1)\n"
-    "layout(std430, set = 0, binding = 7) readonly buffer OutlierOffsets { uvec2 out_off[]; }; // N + 1 uint64 (bit 3)\n"
-    "layout(std430, set = 0, binding = 8) readonly buffer OutlierColumns { uint out_col[]; };  // (bit 3)\n"
-    "layout(std430, set = 0, binding = 9) readonly buffer OutlierValues { float out_val[]; };  // 3 per outlier (bit 3)\n"
-    "layout(std430, set = 0, binding = 10) buffer Output { float outv[]; };                    // 3 N\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint n;             // N\n"
-    "    uint row_offset;    // first texel row of this dispatch\n"
-    "    uint row_count;     // rows in this dispatch\n"
-    "    uint tile;          // scale tile in texels (0: one scale per channel)\n"
-    "    uint tiles_per_row; // ceil(N / tile), 1 when tile is 0\n"
-    "    uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound\n"
-    "} pc;\n"
-    "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    bool perm = (pc.flags & 2u) != 0u, bc1 = (pc.flags & 4u) != 0u;\n"
-    "    uint y = pc.row_offset + r;\n"
-    "    uint trow = pc.tile != 0u \? (y / pc.tile) * pc.tiles_per_row : 0u;\n"
-    "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint x = lid; x < pc.n; x += gl_WorkGroupSize.x) {\n"
-    "        ivec2 p = ivec2(int(x), int(y));\n"
-    "        vec3 d = bc1 \? texelFetch(texR, p, 0).rgb\n"
-    "                     : vec3(texelFetch(texR, p, 0).r, texelFetch(texG, p, 0).r, texelFetch(texB, p, 0).r);\n"
-    "        uint t = 3u * (trow + (pc.tile != 0u \? x / pc.tile : 0u));\n"
-    "        uint e = 3u * (perm \? col_perm[x] : x);\n"
-    "        acc += (d * vec3(scales[t], scales[t + 1u], scales[t + 2u])) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
-    "    }\n"
-    "    uint i = perm \? row_perm[y] : y;\n"
-    "    precise vec3 s = vec3(0.0);\n"
-    "    if ((pc.flags & 8u) != 0u) {\n"
-    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n";
-static const char rad__glsl_5_1[] =
-    "        for (uint k = k0 + lid; k < k0 + count; k += gl_WorkGroupSize.x) {\n"
-    "            uint j = 3u * out_col[k];\n"
-    "            s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);\n"
-    "        }\n"
-    "    }\n"
-    "    partial[lid] = acc + s;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
-    "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0];\n"
-    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
-    "    outv[3u * i] = o.x;\n"
-    "    outv[3u * i + 1u] = o.y;\n"
-    "    outv[3u * i + 2u] = o.z;\n"
-    "}\n";
-static const char *const rad__glsl_pieces_5[] = { rad__glsl_5_0, rad__glsl_5_1 };
-static const char rad__glsl_6_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_ALIAS_BUILD: alias tables of streamed rows built on the GPU\n"
-    "// (docs/methods/temporal.md), the same bins as rad_alias_build_row (Vose's robust variant in double, the\n"
-    "// order of operations of the >>api_temporal doc block; bit-identical where double arithmetic is\n"
-    "// IEEE, as on lavapipe), one invocation per row.\n"
-    "// Input rows in CSR form: row i's entries are k = in_off[i] .. in_off[i+1]-1 (uint64, global), at\n"
-    "// element k - entry_base of bindings 1 and 2; flags bit 0 (DENSE): no columns bound, the column\n"
-    "// of entry k is k - in_off[i]. Entries <= 0 are skipped; a negative or non-finite entry or a\n"
-    "// column >= cols makes the row's bin count 0 (the CPU builder returns INVALID_ARGUMENT).\n"
-    "// Output, padded layout: row i gets room for (its entry count + 1) bins starting at bin\n"
-    "// in_off[i] + i (bin b at word (b - out_base) * words of binding 3); counts[i] receives the bins\n"
-    "// written and totals[i] T_i. Binding 4 (double) and 5 (uint) are scratch of one element per\n"
-    "// output bin at the same positions. Needs the shaderFloat64 feature.\n"
-    "// RAD_GLSL_TEMPORAL_STEP samples this layout directly (its PADDED flag).\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 in_off[]; }; // rows + 1 uint64\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };    // (not DENSE)\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
-    "layout(std430, set = 0, binding = 3) buffer Bins { uint bins[]; };                   // 2 or 3 words per bin\n"
-    "layout(std430, set = 0, binding = 4) buffer ScratchQ { double q[]; };\n"
-    "layout(std430, set = 0, binding = 5) buffer ScratchStack { uint stack[]; };\n"
-    "layout(std430, set = 0, binding = 6) buffer Counts { uint counts[]; };               // per row (global index)\n"
-    "layout(std430, set = 0, binding = 7) buffer Totals { float totals[]; };              // per row (global index)\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint row_offset;  // first row of this dispatch\n"
-    "    uint row_count;   // rows in this dispatch\n"
-    "    uint cols;        // N: the environment's column (COMPACT needs cols <= 65535)\n"
-    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
-    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
-    "    uint out_base;    // low 32 bits of the bin index at element 0 of bindings 3, 4 and 5\n"
-    "    uint flags;       // bit 0: DENSE rows (no column array)\n"
-    "} pc;\n"
-    "\n"
-    "void set_bin(uint b, uint threshold, uint col, uint alias_col)\n"
-    "{\n"
-    "    uint w = b * pc.words;\n"
-    "    bins[w] = threshold;\n"
-    "    if (pc.words == 2u) bins[w + 1u] = col | (alias_col << 16u);\n"
-    "    else { bins[w + 1u] = col; bins[w + 2u] = alias_col; }\n"
-    "}\n"
-    "\n"
-    "uint col_of(uint b) { return pc.words == 2u \? (bins[b * 2u + 1u] & 0xFFFFu) : bins[b * 3u + 1u]; }\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    uint i = pc.row_offset + r;\n"
-    "    uint k0 = in_off[i].x, count = in_off[i + 1u].x - k0;\n"
-    "    uint b0 = k0 + i - pc.out_base;          // this row's first bin (local)\n"
-    "    bool dense = (pc.flags & 1u) != 0u;\n"
-    "    precise double W = 0.0;\n"
-    "    uint n = 0u;\n"
-    "    for (uint e = 0u; e < count; ++e) {\n"
-    "        float v = values[k0 - pc.entry_base + e];\n"
-    "        uint col = dense \? e : columns[k0 - pc.entry_base + e];\n"
-    "        if (isnan(v) || isinf(v) || v < 0.0 || col >= pc.cols) { counts[i] = 0u; totals[i] = 0.0; return; }\n"
-    "        if (v > 0.0) {\n"
-    "            q[b0 + n] = double(v);\n"
-    "            set_bin(b0 + n, 0xFFFFFFFFu, col, col);\n"
-    "            W += double(v);\n"
-    "            ++n;\n"
-    "        }\n"
-    "    }\n"
-    "    precise double env = 1.0 - W;\n"
-    "    double total = W;\n"
-    "    if (env > 0.0) {\n"
-    "        q[b0 + n] = env;\n"
-    "        set_bin(b0 + n, 0xFFFFFFFFu, pc.cols, pc.cols);\n"
-    "        ++n;\n"
-    "        total = 1.0;\n"
-    "    }\n"
-    "    W += env > 0.0 \? env : 0.0;\n"
-    "    // Vose, robust variant: Small grows up from stack[0], Large down from stack[n-1]\n"
-    "    uint small_top = 0u, large_bottom = n;\n";
-static const char rad__glsl_6_1[] =
-    "    for (uint b = 0u; b < n; ++b) {\n"
-    "        precise double qb = double(n) * q[b0 + b] / W;\n"
-    "        q[b0 + b] = qb;\n"
-    "        if (qb < 1.0) stack[b0 + small_top++] = b;\n"
-    "        else stack[b0 + --large_bottom] = b;\n"
-    "    }\n"
-    "    while (small_top > 0u && large_bottom < n) {\n"
-    "        uint l = stack[b0 + --small_top], g = stack[b0 + large_bottom++];\n"
-    "        precise double p = q[b0 + l] * 4294967296.0 + 0.5;\n"
-    "        set_bin(b0 + l, p >= 4294967295.0 \? 0xFFFFFFFFu : uint(p), col_of(b0 + l), col_of(b0 + g));\n"
-    "        precise double qg = (q[b0 + g] + q[b0 + l]) - 1.0;\n"
-    "        q[b0 + g] = qg;\n"
-    "        if (qg < 1.0) stack[b0 + small_top++] = g;\n"
-    "        else stack[b0 + --large_bottom] = g;\n"
-    "    }\n"
-    "    counts[i] = n;\n"
-    "    totals[i] = float(total);\n"
-    "}\n";
-static const char *const rad__glsl_pieces_6[] = { rad__glsl_6_0, rad__glsl_6_1 };
-static const char rad__glsl_7_0[] =
-    "// lighting.glsl - the lighting models and BRDF terms of radiosity.h (docs/methods/shading.md, >>shading),\n"
-    "// GLSL 450. An include: no #version; it defines only functions and one struct, all named\n"
-    "// as their C counterparts (rad_ndf_ggx ...). The arithmetic is written in the same order as\n"
-    "// the C code so the results agree to float rounding (tests/test_shading_vulkan.c checks\n"
-    "// 1e-5 relative). Conventions (l, v, n unit; f the BRDF; R = f * max(n.l, 0) the response)\n"
-    "// are those of the >>api_shading comment in radiosity.h.\n"
-    "//\n"
-    "// Including it: either with GL_GOOGLE_include_directive (as glsl/lighting_eval.comp does:\n"
-    "// glslangValidator resolves it relative to the including file), or by pasting this file's\n"
-    "// text after your #version line.\n"
-    "#ifndef RAD_LIGHTING_GLSL\n"
-    "#define RAD_LIGHTING_GLSL\n"
-    "\n"
-    "#define RAD_SHADING_LAMBERT 0\n"
-    "#define RAD_SHADING_HALF_LAMBERT 1\n"
-    "#define RAD_SHADING_BANDED 2\n"
-    "#define RAD_SHADING_PHONG 3\n"
-    "#define RAD_SHADING_BLINN_PHONG 4\n"
-    "#define RAD_SHADING_MINNAERT 5\n"
-    "#define RAD_SHADING_OREN_NAYAR 6\n"
-    "#define RAD_SHADING_MICROFACET 7\n"
-    "#define RAD_NDF_BECKMANN 0\n"
-    "#define RAD_NDF_GGX 1\n"
-    "#define RAD_MASKING_SEPARABLE 0\n"
-    "#define RAD_MASKING_HEIGHT_CORRELATED 1\n"
-    "#define RAD_DIFFUSE_NONE 0\n"
-    "#define RAD_DIFFUSE_LAMBERT 1\n"
-    "#define RAD_DIFFUSE_SHIRLEY 2\n"
-    "\n"
-    "const float RAD_PI = 3.14159265358979323846;\n"
-    "const float RAD_INV_PI = 0.318309886183790671537767526745;\n"
-    "\n"
-    "// The std430 mirror of rad_shading_gpu (96 bytes), filled by rad_shading_pack():\n"
-    "// albedo (or kd), specular (ks), f0, f90, p = (alpha_x, alpha_y, wrap / shininess / k / sigma,\n"
-    "// half-Lambert exponent / bands / Fresnel exponent), mode = (model, ndf, masking, diffuse).\n"
-    "struct RadShadingParams {\n"
-    "    vec4 albedo;\n"
-    "    vec4 specular;\n"
-    "    vec4 f0;\n"
-    "    vec4 f90;\n"
-    "    vec4 p;\n"
-    "    ivec4 mode;\n"
-    "};\n"
-    "\n"
-    "// Beckmann NDF\n"
-    "float rad_ndf_beckmann(float nm, float alpha)\n"
-    "{\n"
-    "    float a2 = alpha * alpha, c2 = nm * nm;\n"
-    "    if (!(nm > 0.0)) return 0.0;\n"
-    "    return exp((c2 - 1.0) / (a2 * c2)) / (RAD_PI * a2 * c2 * c2);\n"
-    "}\n"
-    "\n"
-    "// Beckmann NDF, anisotropic\n"
-    "float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
-    "{\n"
-    "    float c2 = nm * nm;\n"
-    "    if (!(nm > 0.0)) return 0.0;\n"
-    "    float e = (tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y)) / c2;\n"
-    "    return exp(-e) / (RAD_PI * alpha_x * alpha_y * c2 * c2);\n"
-    "}\n"
-    "\n"
-    "// GGX NDF (Walter et al. 2007)\n"
-    "float rad_ndf_ggx(float nm, float alpha)\n"
-    "{\n"
-    "    float a2 = alpha * alpha;\n"
-    "    if (!(nm > 0.0)) return 0.0;\n"
-    "    float d = 1.0 + nm * nm * (a2 - 1.0);\n"
-    "    return a2 / (RAD_PI * d * d);\n"
-    "}\n"
-    "\n"
-    "// GGX NDF, anisotropic\n"
-    "float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
-    "{\n"
-    "    if (!(nm > 0.0)) return 0.0;\n"
-    "    float d = tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y) + nm * nm;\n"
-    "    return 1.0 / (RAD_PI * alpha_x * alpha_y * d * d);\n"
-    "}\n"
-    "\n"
-    "// the Smith variable a (anisotropic; the isotropic form when alpha_x = alpha_y); the largest float for\n"
-    "// s = n (C returns +inf there; both give Lambda = 0)\n"
-    "float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)\n"
-    "{\n"
-    "    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;\n"
-    "    if (!(d2 > 0.0)) return 3.402823466e38;\n"
-    "    return ns / sqrt(d2);\n"
-    "}\n"
-    "\n"
-    "// Lambda of GGX (exact), for a > 0\n"
-    "// (Beckmann's exact Lambda needs erf, which GLSL lacks: it is C only.)\n"
-    "float rad_lambda_ggx(float a)\n"
-    "{\n"
-    "    return 0.5 * (-1.0 + sqrt(1.0 + 1.0 / (a * a)));\n"
-    "}\n"
-    "\n"
-    "// Lambda of Beckmann, rational approximation (Walter et al. 2007)\n"
-    "float rad_lambda_beckmann(float a)\n"
-    "{\n"
-    "    if (!(a < 1.6)) return 0.0;\n"
-    "    return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);\n"
-    "}\n"
-    "\n"
-    "// Smith G1 (Heitz 2014)\n"
-    "float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0 \? 1.0 / (1.0 + lambda_s) : 0.0; }\n"
-    "\n"
-    "// Smith G2, separable and height-correlated (Heitz 2014)\n"
-    "float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)\n"
-    "{\n"
-    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / ((1.0 + lambda_v) * (1.0 + lambda_l)) : 0.0;\n"
-    "}\n"
-    "\n";
-static const char rad__glsl_7_1[] =
-    "float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)\n"
-    "{\n"
-    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / (1.0 + lambda_v + lambda_l) : 0.0;\n"
-    "}\n"
-    "\n"
-    "// Schlick's Fresnel and its generalized F90 form (one channel)\n"
-    "float rad_fresnel_schlick(float f0, float c)\n"
-    "{\n"
-    "    float x = 1.0 - (c > 0.0 \? c : 0.0), x2 = x * x;\n"
-    "    return f0 + (1.0 - f0) * (x2 * x2 * x);\n"
-    "}\n"
-    "\n"
-    "float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)\n"
-    "{\n"
-    "    return f0 + (f90 - f0) * pow(1.0 - (c > 0.0 \? c : 0.0), exponent);\n"
-    "}\n"
-    "\n"
-    "// diffuse terms: Lambert (1 - F) and Shirley et al. 1997 (one channel)\n"
-    "float rad_diffuse_lambert(float albedo, float F) { return (1.0 - F) * albedo * RAD_INV_PI; }\n"
-    "\n"
-    "float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)\n"
-    "{\n"
-    "    float a = 1.0 - (nl > 0.0 \? nl : 0.0), b = 1.0 - (nv > 0.0 \? nv : 0.0);\n"
-    "    float a5 = a * a * a * a * a, b5 = b * b * b * b * b;\n"
-    "    return (1.0 - f0) * (21.0 / 20.0) * albedo * RAD_INV_PI * (1.0 - a5) * (1.0 - b5);\n"
-    "}\n"
-    "\n"
-    "// Lambda from n.s, t.s, b.s without forming a (no division by zero at s = n)\n"
-    "float rad_shading_lambda(int ndf, bool iso, float ns, float ts, float bs, float ax, float ay)\n"
-    "{\n"
-    "    float d2 = iso \? ax * ax * (1.0 - ns * ns) : ax * ax * ts * ts + ay * ay * bs * bs;\n"
-    "    if (!(d2 > 0.0)) return 0.0;\n"
-    "    if (ndf == RAD_NDF_GGX) return 0.5 * (-1.0 + sqrt(1.0 + d2 / (ns * ns)));\n"
-    "    return rad_lambda_beckmann(ns / sqrt(d2));\n"
-    "}\n"
-    "\n"
-    "// f (out_f) and R (return value) for unit l, v, n and an orthonormal t, b (anything when the\n"
-    "// model is isotropic). f is 0 for half-Lambert, which has no BRDF.\n"
-    "vec3 rad_shade(RadShadingParams g, vec3 l, vec3 v, vec3 n, vec3 t, vec3 b, out vec3 out_f)\n"
-    "{\n"
-    "    float nl = dot(n, l), nv = dot(n, v);\n"
-    "    vec3 f = vec3(0.0), rr = vec3(0.0);\n"
-    "    int model = g.mode.x;\n"
-    "    if (nv > 0.0) {\n"
-    "        if (model == RAD_SHADING_HALF_LAMBERT) {\n"
-    "            float x = (nl + g.p.z) / (1.0 + g.p.z);\n"
-    "            float q = pow(x > 0.0 \? x : 0.0, g.p.w);\n"
-    "            rr = g.albedo.xyz * RAD_INV_PI * q;\n"
-    "        } else if (nl > 0.0) {\n"
-    "            if (model == RAD_SHADING_LAMBERT) {\n"
-    "                f = g.albedo.xyz * RAD_INV_PI;\n"
-    "            } else if (model == RAD_SHADING_BANDED) {\n"
-    "                float q = ceil(g.p.w * nl) / g.p.w / nl;\n"
-    "                f = g.albedo.xyz * RAD_INV_PI * q;\n"
-    "            } else if (model == RAD_SHADING_PHONG) {\n"
-    "                vec3 r = 2.0 * nl * n - l;\n"
-    "                float rv = dot(r, v), s = g.p.z;\n"
-    "                float q = (s + 2.0) * (0.5 * RAD_INV_PI) * pow(rv > 0.0 \? rv : 0.0, s);\n"
-    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
-    "            } else if (model == RAD_SHADING_BLINN_PHONG) {\n"
-    "                vec3 h = l + v;\n"
-    "                float len = sqrt(dot(h, h)), nh = 0.0, s = g.p.z;\n"
-    "                if (len > 0.0) nh = dot(n, h) / len;\n"
-    "                float q = (s + 2.0) * (s + 4.0) * (0.125 * RAD_INV_PI) / (exp2(-0.5 * s) + s) * pow(nh > 0.0 \? nh : 0.0, s);\n"
-    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
-    "            } else if (model == RAD_SHADING_MINNAERT) {\n"
-    "                float kk = g.p.z, c = nl * nv;\n"
-    "                float q = (kk + 1.0) * (0.5 * RAD_INV_PI) * pow(c > 1e-6 \? c : 1e-6, kk - 1.0);\n"
-    "                f = g.albedo.xyz * q;\n"
-    "            } else if (model == RAD_SHADING_OREN_NAYAR) {\n"
-    "                float s2 = g.p.z * g.p.z, A = 1.0 - 0.5 * s2 / (s2 + 0.33), B = 0.45 * s2 / (s2 + 0.09);\n"
-    "                float s = dot(l, v) - nl * nv, q = s > 0.0 \? s / (nl > nv \? nl : nv) : 0.0;\n"
-    "                f = g.albedo.xyz * RAD_INV_PI * (A + B * q);\n"
-    "            } else if (model == RAD_SHADING_MICROFACET) {\n"
-    "                float ax = g.p.x, ay = g.p.y;\n"
-    "                bool iso = ax == ay;\n"
-    "                int ndf = g.mode.y;\n"
-    "                vec3 h = l + v;\n"
-    "                float len = sqrt(dot(h, h));\n"
-    "                if (len > 0.0) {\n"
-    "                    h /= len;\n"
-    "                    float nh = dot(n, h), lh = dot(l, h), vh = dot(v, h), D;\n"
-    "                    if (iso) {\n";
-static const char rad__glsl_7_2[] =
-    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);\n"
-    "                    } else {\n"
-    "                        float th = dot(t, h), bh = dot(b, h);\n"
-    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)\n"
-    "                                               : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);\n"
-    "                    }\n"
-    "                    float lv = rad_shading_lambda(ndf, iso, nv, iso \? 0.0 : dot(t, v), iso \? 0.0 : dot(b, v), ax, ay);\n"
-    "                    float ll = rad_shading_lambda(ndf, iso, nl, iso \? 0.0 : dot(t, l), iso \? 0.0 : dot(b, l), ax, ay);\n"
-    "                    float G = g.mode.z == RAD_MASKING_SEPARABLE \? rad_smith_g2_separable(vh, lh, lv, ll)\n"
-    "                                                               : rad_smith_g2_height_correlated(vh, lh, lv, ll);\n"
-    "                    float sp = G * D / (4.0 * nl * nv);\n"
-    "                    for (int k = 0; k < 3; ++k) f[k] = rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, lh) * sp;\n"
-    "                }\n"
-    "                for (int k = 0; k < 3; ++k) {\n"
-    "                    if (g.mode.w == RAD_DIFFUSE_LAMBERT)\n"
-    "                        f[k] += rad_diffuse_lambert(g.albedo[k], rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, nl));\n"
-    "                    else if (g.mode.w == RAD_DIFFUSE_SHIRLEY)\n"
-    "                        f[k] += rad_diffuse_shirley(g.albedo[k], g.f0[k], nl, nv);\n"
-    "                }\n"
-    "            }\n"
-    "            rr = f * nl;\n"
-    "        }\n"
-    "    }\n"
-    "    out_f = f;\n"
-    "    return rr;\n"
-    "}\n"
-    "\n"
-    "#endif\n";
-static const char *const rad__glsl_pieces_7[] = { rad__glsl_7_0, rad__glsl_7_1, rad__glsl_7_2 };
-static const char rad__glsl_8_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_LOCAL_APPLY: the local multi-bounce apply of rad_local_apply\n"
-    "// (docs/methods/local.md): for every visible entry r = row_offset .. row_offset + row_count - 1,\n"
-    "// with slot i = vis_slot[r] and world patch p = vis_patch[r],\n"
-    "//   out[p] = sum_{j < end, lit_patch[j] != NONE} T_c[i][j] * E[lit_patch[j]]   (+ E[p] when flags bit 0)\n"
-    "// for channels c = R, G, B. T is rad_local.planes: three M x M planes, row = receiving slot,\n"
-    "// stride m. ONE WORKGROUP PER VISIBLE ENTRY: dispatch row_count groups; the group strides over\n"
-    "// the columns j < end and sums in shared memory.\n"
-    "// Chunking: bindings 0..2 may hold only plane rows slot_offset .. slot_offset + slot_count - 1\n"
-    "// (row i at element base + (i - slot_offset) * m); an entry whose slot lies outside them is\n"
-    "// skipped, so one dispatch per chunk over the whole visible list (or over the part of a list\n"
-    "// sorted by slot that falls in the chunk) covers every row.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };        // 3 n, world order\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer LitPatch { uint lit_patch[]; }; // end: patch of slot j, or ~0u\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer VisSlot { uint vis_slot[]; };   // visible entries: slots\n"
-    "layout(std430, set = 0, binding = 6) readonly buffer VisPatch { uint vis_patch[]; }; // visible entries: patches\n"
-    "layout(std430, set = 0, binding = 7) buffer Output { float outv[]; };               // 3 n, world order\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint m;            // M: rad_local.capacity, the plane stride\n"
-    "    uint end;          // rad_local.slot_end: columns j < end\n"
-    "    uint row_offset;   // first visible entry of this dispatch\n"
-    "    uint row_count;    // visible entries in this dispatch (= workgroups)\n"
-    "    uint slot_offset;  // first plane row held by bindings 0..2\n"
-    "    uint slot_count;   // plane rows held by bindings 0..2\n"
-    "    uint base;         // element of bindings 0..2 that holds plane row slot_offset, column 0\n"
-    "    uint flags;        // bit 0: add E (RAD_OUTPUT_TOTAL)\n"
-    "} pc;\n"
-    "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;                    // the whole group: barriers stay uniform\n"
-    "    uint i = vis_slot[pc.row_offset + r];\n"
-    "    if (i < pc.slot_offset || i - pc.slot_offset >= pc.slot_count) return; // another chunk's row\n"
-    "    uint at = pc.base + (i - pc.slot_offset) * pc.m;\n"
-    "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
-    "        uint p = lit_patch[j];\n"
-    "        if (p == 0xFFFFFFFFu) continue;\n"
-    "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[3u * p], E[3u * p + 1u], E[3u * p + 2u]);\n"
-    "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
-    "    if (lid != 0u) return;\n"
-    "    uint o = 3u * vis_patch[pc.row_offset + r];\n"
-    "    precise vec3 s = partial[0];\n"
-    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
-    "    outv[o] = s.x;\n"
-    "    outv[o + 1u] = s.y;\n"
-    "    outv[o + 2u] = s.z;\n"
-    "}\n";
-static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0 };
-static const char rad__glsl_9_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_LOCAL_VECTORS: the small pre-pass of a local-matrix add\n"
-    "// (rad_local_add, docs/methods/local.md) computed from T resident on the GPU: the vectors u, v and the scalar\n"
-    "// s of the Sherman-Morrison update (fused with the exact downdate of slot ev when an add evicts),\n"
-    "// which RAD_GLSL_LOCAL_UPDATE then applies. T is rad_local.planes (three M x M planes, stride m,\n"
-    "// row = receiving slot). The host streams only the new patch's row and column over the slots:\n"
-    "//   a_c[j] = rho_c[patch(j)] * A_n F_nj / A_j (column by reciprocity), b_c[j] = rho_c[n] * F_nj\n"
-    "// for member slots j != ev (zero elsewhere; channel-major, a[c * m + j]), nz = the slots with a\n"
-    "// non-zero F_nj (any order), ann_c = rho_c[n] F_nn. Work buffer (binding 6), channel c at c * 4m:\n"
-    "//   u[j] at +j, v[j] at +m + j, c[j] = T[j][ev] at +2m + j, r[j] = T[ev][j] at +3m + j;\n"
-    "//   then 12 scalars at 12m: s[3], cuv[3] (rank-1 factor), coef[3] (new row/column factor), tnn[3].\n"
-    "// Passes (push 'pass'), run in this order, each one dispatch (or one per row chunk for pass 0):\n"
-    "//   0  GATHER, row-chunked: ONE INVOCATION PER ITEM, max(row_count, end) invocations.\n"
-    "//      Invocation x as row i = row_offset + x: u[i] = a[i] + sum_p T[i][nz_p] a[nz_p], c[i] = T[i][ev];\n"
-    "//      as column j = x < end: v[j] (=, flags bit 0 on the first chunk; else +=) b[j] +\n"
-    "//      sum over nz_p in the chunk of b[nz_p] T[nz_p][j]; r[j] = T[ev][j] when ev is in the chunk.\n"
-    "//   1  EVICT (only when ev != ~0u), end invocations, reads no plane: with g = 1 + r[ev],\n"
-    "//      u[i] -= c[i] (r.a) / g, v[i] -= (b.c) r[i] / g, u[ev] = v[ev] = 0.\n"
-    "//   2  SCALARS, 3 invocations (one per channel): s = 1 - ann - b.u, and the factors:\n"
-    "//      exact (flags bit 1 clear): cuv = coef = 1/s, tnn = 1/s - 1 (as (ann + b.u) / s); first order (bit 1 set,\n"
-    "//      RAD_LOCAL_FIRST_ORDER): d = ann + b.a, coef = 1 + d, cuv = (1 + d)^2, tnn = d.\n"
-    "// Float arithmetic (the CPU accumulates u, v, s in double): within 1e-5 relative of rad_local_add\n"
-    "// for the tested sets. A kernel cannot fail: s <= 1e-12 (rows that break energy conservation)\n"
-    "// makes RAD_GLSL_LOCAL_UPDATE leave T unchanged; read s back to detect it.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer VecA { float a[]; };   // 3 m, channel-major\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer VecB { float b[]; };   // 3 m, channel-major\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer NonZero { uint nz[]; }; // nnz slots\n"
-    "layout(std430, set = 0, binding = 6) buffer Work { float w[]; };            // 12 m + 12\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint m;            // M: rad_local.capacity, the plane stride\n"
-    "    uint end;          // slots in use after the add: max(new slot + 1, rad_local.slot_end)\n"
-    "    uint row_offset;   // pass 0: first plane row held by bindings 0..2\n"
-    "    uint row_count;    // pass 0: plane rows held by bindings 0..2 (row_offset + row_count <= end)\n"
-    "    uint base;         // pass 0: element of bindings 0..2 that holds plane row row_offset, column 0\n"
-    "    uint nnz;          // entries of nz\n"
-    "    uint ev;           // the slot evicted by this add, or 0xFFFFFFFF\n"
-    "    uint pass;         // 0, 1, 2 (see above)\n"
-    "    uint flags;        // bit 0: first chunk of pass 0 (v = b + ...); bit 1: first-order update\n"
-    "    float ann_r, ann_g, ann_b; // rho_n F_nn per channel\n"
-    "} pc;\n"
-    "\n"
-    "float plane(uint c, uint e) { return c == 0u \? R[e] : c == 1u \? G[e] : B[e]; }\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint x = gl_GlobalInvocationID.x, m = pc.m, c;\n"
-    "    bool evict = pc.ev != 0xFFFFFFFFu;\n"
-    "    if (pc.pass == 0u) {\n"
-    "        if (x < pc.row_count) { // row i of the chunk\n"
-    "            uint i = pc.row_offset + x, at = pc.base + x * m;\n"
-    "            for (c = 0u; c < 3u; ++c) {\n";
-static const char rad__glsl_9_1[] =
-    "                precise float acc = a[c * m + i];\n"
-    "                for (uint p = 0u; p < pc.nnz; ++p) acc += plane(c, at + nz[p]) * a[c * m + nz[p]];\n"
-    "                w[c * 4u * m + i] = acc;\n"
-    "                w[c * 4u * m + 2u * m + i] = (evict && i != pc.ev) \? plane(c, at + pc.ev) : 0.0;\n"
-    "            }\n"
-    "        }\n"
-    "        if (x < pc.end) { // column j\n"
-    "            uint j = x;\n"
-    "            bool ev_here = evict && pc.ev >= pc.row_offset && pc.ev - pc.row_offset < pc.row_count;\n"
-    "            for (c = 0u; c < 3u; ++c) {\n"
-    "                precise float acc = (pc.flags & 1u) != 0u \? b[c * m + j] : w[c * 4u * m + m + j];\n"
-    "                for (uint p = 0u; p < pc.nnz; ++p) {\n"
-    "                    uint r = nz[p];\n"
-    "                    if (r >= pc.row_offset && r - pc.row_offset < pc.row_count)\n"
-    "                        acc += b[c * m + r] * plane(c, pc.base + (r - pc.row_offset) * m + j);\n"
-    "                }\n"
-    "                w[c * 4u * m + m + j] = acc;\n"
-    "                if (ev_here) w[c * 4u * m + 3u * m + j] = plane(c, pc.base + (pc.ev - pc.row_offset) * m + j);\n"
-    "            }\n"
-    "        }\n"
-    "    } else if (pc.pass == 1u) {\n"
-    "        if (x >= pc.end || !evict) return;\n"
-    "        for (c = 0u; c < 3u; ++c) {\n"
-    "            uint o = c * 4u * m;\n"
-    "            float g = 1.0 + w[o + 3u * m + pc.ev];\n"
-    "            precise float ra = 0.0, bc = 0.0;  // r.a and b.c (a and b are zero at ev)\n"
-    "            for (uint p = 0u; p < pc.nnz; ++p) {\n"
-    "                uint j = nz[p];\n"
-    "                ra += w[o + 3u * m + j] * a[c * m + j];\n"
-    "                bc += b[c * m + j] * w[o + 2u * m + j];\n"
-    "            }\n"
-    "            if (x == pc.ev) {\n"
-    "                w[o + x] = 0.0;\n"
-    "                w[o + m + x] = 0.0;\n"
-    "            } else {\n"
-    "                w[o + x] -= w[o + 2u * m + x] * (ra / g);\n"
-    "                w[o + m + x] -= (bc / g) * w[o + 3u * m + x];\n"
-    "            }\n"
-    "        }\n"
-    "    } else if (pc.pass == 2u) {\n"
-    "        if (x >= 3u) return;\n"
-    "        c = x;\n"
-    "        precise float bu = 0.0, ba = 0.0;\n"
-    "        for (uint p = 0u; p < pc.nnz; ++p) {\n"
-    "            uint j = nz[p];\n"
-    "            bu += b[c * m + j] * w[c * 4u * m + j];\n"
-    "            ba += b[c * m + j] * a[c * m + j];\n"
-    "        }\n"
-    "        float ann = c == 0u \? pc.ann_r : c == 1u \? pc.ann_g : pc.ann_b;\n"
-    "        precise float q = ann + bu, s = 1.0 - q; // q: no cancellation\n"
-    "        uint o = 12u * m;\n"
-    "        w[o + c] = s;\n"
-    "        if ((pc.flags & 2u) == 0u) {\n"
-    "            w[o + 3u + c] = 1.0 / s;\n"
-    "            w[o + 6u + c] = 1.0 / s;\n"
-    "            w[o + 9u + c] = q / s;                 // 1/s - 1 without its cancellation\n"
-    "        } else {\n"
-    "            precise float d = ann + ba;\n"
-    "            w[o + 3u + c] = (1.0 + d) * (1.0 + d);\n"
-    "            w[o + 6u + c] = 1.0 + d;\n"
-    "            w[o + 9u + c] = d;\n"
-    "        }\n"
-    "    }\n"
-    "}\n";
-static const char *const rad__glsl_pieces_9[] = { rad__glsl_9_0, rad__glsl_9_1 };
-static const char rad__glsl_10_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_LOCAL_UPDATE: the O(M^2) pass of a local-matrix add\n"
-    "// (rad_local_add, docs/methods/local.md) on T resident on the GPU, after RAD_GLSL_LOCAL_VECTORS filled the work\n"
-    "// buffer (its comment has the layout: u, v, c, r per channel and the scalars s, cuv, coef, tnn).\n"
-    "// For plane rows i = row_offset .. row_offset + row_count - 1 (all < end), channels R, G, B:\n"
-    "//   i == k (the new patch's slot):  T[k][j] = coef v[j] (j != k), T[k][k] = tnn\n"
-    "//   else: T[i][j] += cuv u[i] v[j] - c[i] r[j] / g   (j < end, j != k; the second term only when\n"
-    "//         an add evicts slot ev = k, g = 1 + r[ev]: the exact downdate fused into a rank-2 pass)\n"
-    "//         T[i][k] = coef u[i]\n"
-    "// which is rad_local_add's update, new row and new column; with the factors of the first-order\n"
-    "// form when RAD_GLSL_LOCAL_VECTORS ran with it. Nothing is written when some channel has\n"
-    "// s <= 1e-12 (the CPU returns RAD_ERROR_SINGULAR and leaves T unchanged). Rows and columns >= end\n"
-    "// are not touched. ONE WORKGROUP PER ROW: dispatch row_count groups; the group strides over j.\n"
-    "// Chunking: bindings 0..2 may hold only this chunk's rows, row i at element base + (i - row_offset) * m.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) buffer PlaneR { float R[]; };\n"
-    "layout(std430, set = 0, binding = 1) buffer PlaneG { float G[]; };\n"
-    "layout(std430, set = 0, binding = 2) buffer PlaneB { float B[]; };\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer Work { float w[]; }; // 12 m + 12, from LOCAL_VECTORS\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint m;            // M: rad_local.capacity, the plane stride\n"
-    "    uint end;          // slots in use after the add (as given to RAD_GLSL_LOCAL_VECTORS)\n"
-    "    uint row_offset;   // first plane row of this dispatch\n"
-    "    uint row_count;    // rows in this dispatch (= workgroups)\n"
-    "    uint base;         // element of bindings 0..2 that holds plane row row_offset, column 0\n"
-    "    uint k;            // the new patch's slot\n"
-    "    uint ev;           // the slot evicted by this add (then ev == k), or 0xFFFFFFFF\n"
-    "} pc;\n"
-    "\n"
-    "void update(uint c, uint at, uint i)\n"
-    "{\n"
-    "    uint m = pc.m, o = c * 4u * m, s = 12u * m, lid = gl_LocalInvocationID.x;\n"
-    "    float cuv = w[s + 3u + c], coef = w[s + 6u + c];\n"
-    "    if (i == pc.k) {\n"
-    "        for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
-    "            precise float t = j == pc.k \? w[s + 9u + c] : coef * w[o + m + j];\n"
-    "            if (c == 0u) R[at + j] = t; else if (c == 1u) G[at + j] = t; else B[at + j] = t;\n"
-    "        }\n"
-    "        return;\n"
-    "    }\n"
-    "    precise float ui = cuv * w[o + i];\n"
-    "    precise float ci = pc.ev != 0xFFFFFFFFu \? -w[o + 2u * m + i] / (1.0 + w[o + 3u * m + pc.ev]) : 0.0;\n"
-    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
-    "        precise float t;\n"
-    "        if (j == pc.k) t = coef * w[o + i];\n"
-    "        else {\n"
-    "            t = c == 0u \? R[at + j] : c == 1u \? G[at + j] : B[at + j];\n"
-    "            if (ui != 0.0 || ci != 0.0) t += ci * w[o + 3u * m + j] + ui * w[o + m + j];\n"
-    "        }\n"
-    "        if (c == 0u) R[at + j] = t; else if (c == 1u) G[at + j] = t; else B[at + j] = t;\n"
-    "    }\n"
-    "}\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_WorkGroupID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    uint s = 12u * pc.m;\n"
-    "    for (uint c = 0u; c < 3u; ++c)\n"
-    "        if (!(w[s + c] > 1e-12)) return; // singular: T stays as it was\n"
-    "    uint at = pc.base + r * pc.m, i = pc.row_offset + r;\n"
-    "    for (uint c = 0u; c < 3u; ++c) update(c, at, i);\n"
-    "}\n";
-static const char *const rad__glsl_pieces_10[] = { rad__glsl_10_0 };
-static const char rad__glsl_11_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_VP_GATHER: virtual-patch gathering at surface points, as\n"
-    "// rad_vp_gather / rad_vp_gather_point (docs/methods/virtual-patches.md). For point i with unit\n"
-    "// normal n: in each voxel v of the 2x2x2 block around p (by voxel centres; the grid coordinate\n"
-    "// x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),\n"
-    "//   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0\n"
-    "// (axis-aligned: w_a the split weights of n, max(0, +-n_k)^2 or max(0, +-n_k) normalized to\n"
-    "// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = N_a . n); voxels outside the grid,\n"
-    "// empty or with no patch facing n are skipped, and\n"
-    "//   out_i = sum_v t_v L(v) / sum_v t_v       (t_v the trilinear weights; 0 when no voxel is used;\n"
-    "//   the plain mean of the used L(v) when their t_v sum to 0)\n"
-    "// ONE INVOCATION PER POINT: dispatch ceil(row_count / size) groups for the points\n"
-    "// row_offset .. row_offset + row_count - 1. Chunking: bindings 0, 1 and 6 may hold only this\n"
-    "// chunk's points, point i at elements base + 3 (i - row_offset) .. + 2 of each (bind the three at\n"
-    "// the same element offset). Voxel keys are the uint64 rad_virtual_patches.voxel_keys (ascending,\n"
-    "// ix + dims0 (iy + dims1 iz)), read as uvec2 (low word first) and found by binary search.\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer Points { float P[]; };       // 3 per point\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer Normals { float Nrm[]; };    // 3 per point, unit\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer Values { float X[]; };       // 3 N, per patch\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer VoxelKeys { uvec2 keys[]; }; // voxel_count uint64\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer VoxelPatch { uint vpatch[]; }; // 6 per voxel, or ~0u\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N (clustered only)\n"
-    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };             // 3 per point\n"
-    "layout(push_constant) uniform Push {\n"
-    "    float origin_x, origin_y, origin_z;   // rad_virtual_patches.origin\n"
-    "    float size_x, size_y, size_z;         // .voxel_size\n"
-    "    uint dims_x, dims_y, dims_z;          // .dims\n"
-    "    uint voxel_count;                     // .voxel_count\n"
-    "    uint row_offset;                      // first point of this dispatch\n"
-    "    uint row_count;                       // points in this dispatch\n"
-    "    uint base;                            // element of bindings 0, 1, 6 holding point row_offset\n"
-    "    uint flags;                           // bit 0: cosine split weights; bit 1: clustered\n"
-    "} pc;\n"
-    "\n"
-    "uvec2 mul64(uint a, uvec2 b) { uint hi, lo; umulExtended(a, b.x, hi, lo); return uvec2(lo, hi + a * b.y); }\n"
-    "uvec2 add64(uvec2 a, uint b) { uint c; uint lo = uaddCarry(a.x, b, c); return uvec2(lo, a.y + c); }\n"
-    "bool less64(uvec2 a, uvec2 b) { return a.y < b.y || (a.y == b.y && a.x < b.x); }\n"
-    "\n"
-    "uint find_voxel(uvec2 key)\n"
-    "{\n"
-    "    uint lo = 0u, hi = pc.voxel_count;\n"
-    "    while (lo < hi) {\n"
-    "        uint mid = lo + (hi - lo) / 2u;\n"
-    "        if (less64(keys[mid], key)) lo = mid + 1u; else hi = mid;\n"
-    "    }\n"
-    "    return lo < pc.voxel_count && keys[lo] == key \? lo : 0xFFFFFFFFu;\n"
-    "}\n"
-    "\n"
-    "// a + b exactly, as the pair (sum, error) (Knuth's TwoSum)\n"
-    "vec2 two_sum(float a, float b)\n"
-    "{\n"
-    "    precise float s = a + b;\n"
-    "    precise float bb = s - a;\n"
-    "    precise float e = (a - (s - bb)) + (b - bb);\n"
-    "    return vec2(s, e);\n"
-    "}\n"
-    "// a * b exactly, as the pair (product, error) (Dekker, Veltkamp's split; no fma needed)\n"
-    "vec2 two_prod(float a, float b)\n"
-    "{\n"
-    "    precise float ca = 4097.0 * a, cb = 4097.0 * b;\n"
-    "    precise float ah = ca - (ca - a), bh = cb - (cb - b);\n"
-    "    precise float al = a - ah, bl = b - bh;\n"
-    "    precise float q = a * b;\n"
-    "    precise float e = ((ah * bh - q) + ah * bl + al * bh) + al * bl;\n"
-    "    return vec2(q, e);\n"
-    "}\n"
-    "// (p - o) / s - 1/2 as an unevaluated float pair (hi, lo), to about 1e-14 relative\n";
-static const char rad__glsl_11_1[] =
-    "vec2 grid_coordinate(float p, float o, float s)\n"
-    "{\n"
-    "    vec2 d = two_sum(p, -o);                      // p - o exactly\n"
-    "    precise float q = d.x / s;\n"
-    "    vec2 qs = two_prod(q, s);\n"
-    "    precise float r = ((d.x - qs.x) - qs.y) + d.y; // the remainder d - q s\n"
-    "    precise float ql = r / s;\n"
-    "    vec2 x = two_sum(q, -0.5);\n"
-    "    precise float lo = x.y + ql;\n"
-    "    return vec2(x.x, lo);\n"
-    "}\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    uint at = pc.base + 3u * r;\n"
-    "    vec3 p = vec3(P[at], P[at + 1u], P[at + 2u]), n = vec3(Nrm[at], Nrm[at + 1u], Nrm[at + 2u]);\n"
-    "    vec3 origin = vec3(pc.origin_x, pc.origin_y, pc.origin_z), size = vec3(pc.size_x, pc.size_y, pc.size_z);\n"
-    "    uvec3 dims = uvec3(pc.dims_x, pc.dims_y, pc.dims_z);\n"
-    "    bool clustered = (pc.flags & 2u) != 0u;\n"
-    "    // the split weights of n (+x, -x, +y, -y, +z, -z)\n"
-    "    vec3 wp = max(n, vec3(0.0)), wm = max(-n, vec3(0.0));\n"
-    "    if ((pc.flags & 1u) == 0u) { wp *= wp; wm *= wm; }\n"
-    "    float wsum = wp.x + wm.x + wp.y + wm.y + wp.z + wm.z;\n"
-    "    float w[6] = float[6](wp.x, wm.x, wp.y, wm.y, wp.z, wm.z);\n"
-    "    if (wsum > 0.0) for (int a = 0; a < 6; ++a) w[a] /= wsum;\n"
-    "    // the grid coordinate as a float pair (the CPU computes it in double: a float x would carry\n"
-    "    // an absolute error of about 1e-7 dims, large against the small trilinear weights)\n"
-    "    ivec3 b;\n"
-    "    vec3 g0, g1;\n"
-    "    for (int k = 0; k < 3; ++k) {\n"
-    "        vec2 x = grid_coordinate(p[k], origin[k], size[k]);\n"
-    "        float top = float(dims[k]) + 1.0;\n"
-    "        if (x.x < -2.0 || (x.x == -2.0 && x.y < 0.0)) x = vec2(-2.0, 0.0);\n"
-    "        if (x.x > top || (x.x == top && x.y > 0.0)) x = vec2(top, 0.0);\n"
-    "        float fb = floor(x.x);\n"
-    "        precise float f = x.x - fb;             // exact\n"
-    "        if (f + x.y < 0.0) fb -= 1.0; else if (f + x.y >= 1.0) fb += 1.0;\n"
-    "        f = x.x - fb;\n"
-    "        b[k] = int(fb);\n"
-    "        g1[k] = f + x.y;                        // the weight of the upper cell, g\n"
-    "        g0[k] = (1.0 - f) - x.y;                // 1 - g, from the pair: no cancellation near g = 1\n"
-    "    }\n"
-    "    precise vec3 acc = vec3(0.0), facc = vec3(0.0);\n"
-    "    precise float tsum = 0.0;\n"
-    "    uint used = 0u;\n"
-    "    for (uint corner = 0u; corner < 8u; ++corner) {\n"
-    "        ivec3 bit = ivec3(int(corner & 1u), int((corner >> 1) & 1u), int((corner >> 2) & 1u));\n"
-    "        ivec3 cell = b + bit;\n"
-    "        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(uvec3(cell), dims))) continue;\n"
-    "        vec3 tt = mix(g0, g1, vec3(bit));\n"
-    "        float t = tt.x * tt.y * tt.z;\n"
-    "        uvec2 key = add64(mul64(dims.x, add64(mul64(dims.y, uvec2(uint(cell.z), 0u)), uint(cell.y))), uint(cell.x));\n"
-    "        uint v = find_voxel(key);\n"
-    "        if (v == 0xFFFFFFFFu) continue;\n"
-    "        precise vec3 L = vec3(0.0);\n"
-    "        precise float ws = 0.0;\n"
-    "        for (uint a = 0u; a < 6u; ++a) {\n"
-    "            uint q = vpatch[6u * v + a];\n"
-    "            if (q == 0xFFFFFFFFu) continue;\n"
-    "            float wa = clustered \? dot(vec3(PN[3u * q], PN[3u * q + 1u], PN[3u * q + 2u]), n) : w[a];\n"
-    "            if (!(wa > 0.0)) continue;\n"
-    "            ws += wa;\n"
-    "            L += wa * vec3(X[3u * q], X[3u * q + 1u], X[3u * q + 2u]);\n"
-    "        }\n"
-    "        if (!(ws > 0.0)) continue; // nothing in this voxel faces n\n"
-    "        used++;\n"
-    "        acc += t * L / ws;\n"
-    "        facc += L / ws;\n"
-    "        tsum += t;\n"
-    "    }\n"
-    "    vec3 o = used == 0u \? vec3(0.0) : (tsum > 0.0 \? acc / tsum : facc / float(used));\n"
-    "    outv[at] = o.x;\n"
-    "    outv[at + 1u] = o.y;\n"
-    "    outv[at + 2u] = o.z;\n"
-    "}\n";
-static const char *const rad__glsl_pieces_11[] = { rad__glsl_11_0, rad__glsl_11_1 };
-static const char rad__glsl_12_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_PROBE_UPDATE: irradiance probes from a new patch solution, as\n"
-    "// rad_probes_update (docs/methods/probes.md):\n"
-    "//   E_i(probe) = D_i(probe) + sum over the probe's entries e of W_e,i B_patch(e)\n"
-    "// 27 coefficients per probe (coefficient-major, RGB interleaved: [27 p + 3 i + c]) for probes\n"
-    "// p = row_offset .. row_offset + row_count - 1, ONE INVOCATION PER PROBE. Binding 0 holds all\n"
-    "// probe count + 1 entry offsets as uint64 (two uint words each, low word first: rad_probes_weights'\n"
-    "// first array uploaded unchanged). Chunking: bindings 1 and 2 may hold only this chunk's entries:\n"
-    "// entry k is element k - entry_base of binding 1 and elements 9 k - weight_base .. + 8 of binding 2\n"
-    "// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries).\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer First { uvec2 first[]; };\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer Patch { uint patch_index[]; };\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer Weights { float weights[]; };   // 9 per entry\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer Direct { float direct[]; };     // 27 per probe\n"
-    "layout(std430, set = 0, binding = 4) readonly buffer Radiosity { float B[]; };       // 3 N\n"
-    "layout(std430, set = 0, binding = 5) buffer Output { float coefficients[]; };        // 27 per probe\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint row_offset;  // first probe of this dispatch\n"
-    "    uint row_count;   // probes in this dispatch\n"
-    "    uint entry_base;  // low 32 bits of the entry index at element 0 of binding 1\n"
-    "    uint weight_base; // low 32 bits of the float index (9 k) at element 0 of binding 2\n"
-    "} pc;\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint r = gl_GlobalInvocationID.x;\n"
-    "    if (r >= pc.row_count) return;\n"
-    "    uint p = pc.row_offset + r;\n"
-    "    uint k0 = first[p].x - pc.entry_base;             // wraps correctly: only the difference matters\n"
-    "    uint w0 = 9u * first[p].x - pc.weight_base;\n"
-    "    uint count = first[p + 1u].x - first[p].x;\n"
-    "    precise vec3 acc[9];\n"
-    "    for (uint i = 0u; i < 9u; ++i) {\n"
-    "        uint d = 27u * p + 3u * i;\n"
-    "        acc[i] = vec3(direct[d], direct[d + 1u], direct[d + 2u]);\n"
-    "    }\n"
-    "    for (uint e = 0u; e < count; ++e) {\n"
-    "        uint j = patch_index[k0 + e];\n"
-    "        vec3 b = vec3(B[3u * j], B[3u * j + 1u], B[3u * j + 2u]);\n"
-    "        for (uint i = 0u; i < 9u; ++i) acc[i] += weights[w0 + 9u * e + i] * b;\n"
-    "    }\n"
-    "    for (uint i = 0u; i < 9u; ++i) {\n"
-    "        coefficients[27u * p + 3u * i] = acc[i].x;\n"
-    "        coefficients[27u * p + 3u * i + 1u] = acc[i].y;\n"
-    "        coefficients[27u * p + 3u * i + 2u] = acc[i].z;\n"
-    "    }\n"
-    "}\n";
-static const char *const rad__glsl_pieces_12[] = { rad__glsl_12_0 };
-static const char rad__glsl_13_0[] =
-    "#version 450\n"
-    "// radiosity.h kernel RAD_GLSL_LIGHTMAP_REFRESH: a lightmap refreshed from a new patch\n"
-    "// irradiance H, as rad_lightmap_refresh (docs/methods/lightmap.md), in its two stages:\n"
-    "//   pass 0 (RAD_GLSL_LIGHTMAP_PASS_VERTICES), one invocation per patch vertex v:\n"
-    "//     V[v] = sum over k in [vertex_first[v], vertex_first[v + 1]) of vertex_weights[k] H[vertex_patches[k]]\n"
-    "//   pass 1 (RAD_GLSL_LIGHTMAP_PASS_TEXELS), one invocation per row r (a texel with a row):\n"
-    "//     out[row_texels[r]] = sum over e in [row_first[r], row_first[r + 1]) of entry_weights[e] V[entry_vertices[e]]\n"
-    "// rows (vertices or texel rows) row_offset .. row_offset + row_count - 1. RGB vectors are\n"
-    "// interleaved (3 floats each). Pass 1 reads what pass 0 wrote into binding 4: put a\n"
-    "// compute-to-compute barrier between them. Texels without a row are not written.\n"
-    "// Chunking: the entry arrays of the pass (bindings 1 and 2, or 7 and 8) may hold only this\n"
-    "// chunk's entries: entry k is element k - entry_base. The offsets (0, 6), vectors (3, 4) and\n"
-    "// out (9) are bound whole. A pass reads none of the other pass's bindings (bind any buffer).\n"
-    "layout(local_size_x_id = 0) in;\n"
-    "layout(std430, set = 0, binding = 0) readonly buffer VertexFirst { uint vertex_first[]; };   // vertices + 1\n"
-    "layout(std430, set = 0, binding = 1) readonly buffer VertexPatches { uint vertex_patches[]; };\n"
-    "layout(std430, set = 0, binding = 2) readonly buffer VertexWeights { float vertex_weights[]; };\n"
-    "layout(std430, set = 0, binding = 3) readonly buffer Irradiance { float H[]; };              // 3 N\n"
-    "layout(std430, set = 0, binding = 4) buffer VertexValues { float V[]; };                      // 3 per vertex\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer RowTexels { uint row_texels[]; };\n"
-    "layout(std430, set = 0, binding = 6) readonly buffer RowFirst { uint row_first[]; };         // rows + 1\n"
-    "layout(std430, set = 0, binding = 7) readonly buffer EntryVertices { uint entry_vertices[]; };\n"
-    "layout(std430, set = 0, binding = 8) readonly buffer EntryWeights { float entry_weights[]; };\n"
-    "layout(std430, set = 0, binding = 9) buffer Output { float lightmap[]; };                    // 3 per texel\n"
-    "layout(push_constant) uniform Push {\n"
-    "    uint pass;        // 0: vertices, 1: texel rows\n"
-    "    uint row_offset;  // first vertex or row of this dispatch\n"
-    "    uint row_count;   // vertices or rows in this dispatch\n"
-    "    uint entry_base;  // the entry index at element 0 of the pass's entry bindings\n"
-    "} pc;\n"
-    "\n"
-    "void main()\n"
-    "{\n"
-    "    uint i = gl_GlobalInvocationID.x;\n"
-    "    if (i >= pc.row_count) return;\n"
-    "    uint r = pc.row_offset + i;\n"
-    "    precise vec3 acc = vec3(0.0);\n"
-    "    if (pc.pass == 0u) {\n"
-    "        uint a = vertex_first[r] - pc.entry_base, b = vertex_first[r + 1u] - pc.entry_base;\n"
-    "        for (uint k = a; k < b; ++k) {\n"
-    "            uint j = 3u * vertex_patches[k];\n"
-    "            acc += vertex_weights[k] * vec3(H[j], H[j + 1u], H[j + 2u]);\n"
-    "        }\n"
-    "        V[3u * r] = acc.x;\n"
-    "        V[3u * r + 1u] = acc.y;\n"
-    "        V[3u * r + 2u] = acc.z;\n"
-    "    } else {\n"
-    "        uint a = row_first[r] - pc.entry_base, b = row_first[r + 1u] - pc.entry_base;\n"
-    "        for (uint e = a; e < b; ++e) {\n"
-    "            uint j = 3u * entry_vertices[e];\n"
-    "            acc += entry_weights[e] * vec3(V[j], V[j + 1u], V[j + 2u]);\n"
-    "        }\n"
-    "        uint t = 3u * row_texels[r];\n"
-    "        lightmap[t] = acc.x;\n"
-    "        lightmap[t + 1u] = acc.y;\n"
-    "        lightmap[t + 2u] = acc.z;\n"
-    "    }\n"
-    "}\n";
-static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
-static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
-    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
-    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
-    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
-    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
-    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
-    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
-    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4700u },
-    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9441u },
-    { "local_apply.comp", rad__glsl_pieces_8, 1u, 3519u },
-    { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
-    { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
-    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
-    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u },
-    { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
-};
-/* >>glsl end */
-
-RAD_API const char *rad_glsl_name(rad_glsl_id id)
-{
-    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) return NULL;
-    return rad__glsl_table[id].name;
-}
-
-RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
-{
-    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) {
-        if (out_count) *out_count = 0;
-        return NULL;
-    }
-    if (out_count) *out_count = rad__glsl_table[id].count;
-    return rad__glsl_table[id].pieces;
-}
-
-RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
-{
-    const rad__glsl_entry *e;
-    uint32_t p;
-    size_t at = 0;
-    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT || (!dst && !out_length)) return RAD_ERROR_INVALID_ARGUMENT;
-    e = &rad__glsl_table[id];
-    if (out_length) *out_length = e->length;
-    if (!dst) return dst_size == 0 ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
-    if (dst_size <= e->length) return RAD_ERROR_SIZE_MISMATCH;
-    for (p = 0; p < e->count; ++p) {
-        size_t n = strlen(e->pieces[p]);
-        memcpy(dst + at, e->pieces[p], n);
-        at += n;
-    }
-    RAD_ASSERT(at == e->length);
-    dst[at] = '\0';
-    return RAD_SUCCESS;
-}
-
-#else /* RAD_NO_GLSL: the kernels' text is left out; the ids and the functions stay */
-
-RAD_API const char *rad_glsl_name(rad_glsl_id id)
-{
-    (void)id;
-    return NULL;
-}
-
-RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
-{
-    (void)id;
-    if (out_count) *out_count = 0;
-    return NULL;
-}
-
-RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
-{
-    (void)id;
-    (void)dst;
-    (void)dst_size;
-    if (out_length) *out_length = 0;
-    return RAD_ERROR_UNAVAILABLE;
-}
-
-#endif /* RAD_NO_GLSL */
 
 /* ======================================================================================== */
 /* >>kernels: shared numeric kernels (binary16, dot products, GEMM)                        */
@@ -16403,7 +12498,7 @@ struct rad_row_stream {
     rad__ctx log;              /* the context given at open: fetch failures are logged through it */
 };
 
-RAD_API void rad_row_stream_close(rad_row_stream *s)
+RAD_API void rad_row_stream_destroy(rad_row_stream *s)
 {
     rad_allocator a;
     if (!s) return;
@@ -16472,8 +12567,8 @@ typedef struct rad__stream_layout {
     int vps;          /* a saved virtual-patch set: its areas and albedos stand for the patches */
 } rad__stream_layout;
 
-/* Stage 1 of rad_row_stream_open: the header and the section table, checked as
-   rad_container_open checks them (the same rad__header_parse). *out_table is the table. */
+/* Stage 1 of rad_row_stream_create: the header and the section table, checked as
+   rad_container_create checks them (the same rad__header_parse). *out_table is the table. */
 static rad_result rad__stream_table(FILE *f, uint64_t actual, const rad__ctx *c, const char *who, rad__header *h,
                                     unsigned char **out_table)
 {
@@ -16604,7 +12699,7 @@ static rad_result rad__stream_patches(rad_row_stream *s, const rad__stream_layou
     return r;
 }
 
-RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx, rad_row_stream **out)
+RAD_API rad_result rad_row_stream_create(const char *path, const rad_context *ctx, rad_row_stream **out)
 {
     rad__ctx c;
     rad_row_stream *s;
@@ -16626,7 +12721,7 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
     s->f = fopen(path, "rb");
     if (!s->f) {
         rad__log(&c, RAD_LOG_ERROR, "row stream: cannot open '%s'", path);
-        rad_row_stream_close(s);
+        rad_row_stream_destroy(s);
         return RAD_ERROR_IO;
     }
     snprintf(who, sizeof(who), "row stream: '%s'", path);
@@ -16637,7 +12732,7 @@ RAD_API rad_result rad_row_stream_open(const char *path, const rad_context *ctx,
     rad__free(&c.allocator, table);
     if (r != RAD_SUCCESS) {
         if (r == RAD_ERROR_IO) rad__log(&c, RAD_LOG_ERROR, "row stream: reading '%s' failed", path);
-        rad_row_stream_close(s);
+        rad_row_stream_destroy(s);
         return r;
     }
     *out = s;
@@ -17433,7 +13528,7 @@ static rad_result rad__local_slots(const rad__ctx *c, const rad_local *L, const 
 
 RAD_API rad_result rad_local_apply(const rad_local *L, const float *E, const uint32_t *visible,
                                    uint32_t visible_count, const uint32_t *lit, uint32_t lit_count,
-                                   rad_output output, float *out, const rad_context *ctx)
+                                   float *out, rad_output output, const rad_context *ctx)
 {
     rad__ctx c;
     rad__local_job J;
@@ -18114,14 +14209,18 @@ done:
     return r;
 }
 
-RAD_API void rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section *out)
+RAD_API rad_result rad_alias_tables_sections(const rad_alias_tables *t, const char *name, rad_section *out,
+                                             uint32_t *out_count)
 {
-    if (!out) return;
+    if (out_count) *out_count = 0;
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     memset(out, 0, 3 * sizeof(rad_section));
-    if (!t) return;
+    if (!t) return RAD_ERROR_INVALID_ARGUMENT;
     rad__section(&out[0], RAD_SECTION_TEMPORAL_ROW_OFFSETS, 8u, (uint64_t)t->rows + 1u, t->row_offsets, name);
     rad__section(&out[1], RAD_SECTION_TEMPORAL_BINS, 4u * (uint32_t)t->format, t->row_offsets[t->rows], t->bins, name);
     rad__section(&out[2], RAD_SECTION_TEMPORAL_TOTALS, 4u, t->rows, t->totals, name);
+    if (out_count) *out_count = 3;
+    return RAD_SUCCESS;
 }
 
 RAD_API rad_result rad_alias_tables_view(const rad_container *ct, const char *name, const rad_context *ctx,
@@ -21147,6 +17246,1367 @@ RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const 
 }
 
 /* ======================================================================================== */
+/* >>lightmap: lightmaps over a second UV set                                               */
+/* ======================================================================================== */
+
+#define RAD__LM_MAX_SIDE 16384u
+#define RAD__LM_MAX_SUB 16u
+#define RAD__LM_MAX_SLOTS ((uint64_t)1 << 28)
+#define RAD__LM_GROUP 64u          /* samples per validity row */
+#define RAD__LM_SH_Y0 0.282094792f /* 1 / (2 sqrt(pi)) */
+#define RAD__LM_SH_Y1 0.488602512f /* sqrt(3) / (2 sqrt(pi)) */
+
+RAD_API void rad_lightmap_options_default(rad_lightmap_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->width = o->height = 256;
+    o->samples = 4;
+    o->validity_rays = 16;
+    o->backface_limit = 0.1f;
+    o->ray_epsilon = 1e-5f;
+}
+
+RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->encoding = RAD_LIGHTMAP_IRRADIANCE;
+    o->visibility_rays = 4;
+    o->ray_epsilon = 1e-5f;
+    o->method = RAD_LIGHTMAP_GATHER_EXACT;
+    o->hemisphere_rays = 256;
+    o->exact_ratio = 16.0f;
+}
+
+RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding)
+{
+    return encoding == RAD_LIGHTMAP_IRRADIANCE ? 3u : encoding == RAD_LIGHTMAP_SH_L1 ? 12u : 0u;
+}
+
+RAD_API void rad_lightmap_destroy(rad_lightmap *lm)
+{
+    rad_allocator a;
+    if (!lm) return;
+    a = lm->allocator;
+    rad__free(&a, lm->flags);
+    rad__free(&a, lm->positions);
+    rad__free(&a, lm->normals);
+    rad__free(&a, lm->sample_first);
+    rad__free(&a, lm->sample_positions);
+    rad__free(&a, lm->sample_normals);
+    rad__free(&a, lm->sample_triangles);
+    rad__free(&a, lm->sample_valid);
+    rad__free(&a, lm);
+}
+
+/* 1 when the uv triangle t (texel units, 6 doubles) and the box [x0,x1] x [y0,y1] overlap
+   with positive area (separating axes: the box's two and the triangle's three edge normals);
+   touching along a line does not count, so an edge on a texel border leaves the next texel out */
+static int rad__lm_overlap(const double *t, double x0, double y0, double x1, double y1)
+{
+    double mn, mx;
+    int e, k;
+    mn = mx = t[0];
+    for (k = 1; k < 3; ++k) { if (t[2 * k] < mn) mn = t[2 * k]; if (t[2 * k] > mx) mx = t[2 * k]; }
+    if (mx <= x0 || mn >= x1) return 0;
+    mn = mx = t[1];
+    for (k = 1; k < 3; ++k) { if (t[2 * k + 1] < mn) mn = t[2 * k + 1]; if (t[2 * k + 1] > mx) mx = t[2 * k + 1]; }
+    if (mx <= y0 || mn >= y1) return 0;
+    for (e = 0; e < 3; ++e) {
+        const double *a = t + 2 * e, *b = t + 2 * ((e + 1) % 3), *c = t + 2 * ((e + 2) % 3);
+        double nx = -(b[1] - a[1]), ny = b[0] - a[0], ta = nx * a[0] + ny * a[1], tc = nx * c[0] + ny * c[1];
+        double bx[4], lo, hi;
+        bx[0] = nx * x0 + ny * y0; bx[1] = nx * x1 + ny * y0; bx[2] = nx * x0 + ny * y1; bx[3] = nx * x1 + ny * y1;
+        lo = hi = bx[0];
+        for (k = 1; k < 4; ++k) { if (bx[k] < lo) lo = bx[k]; if (bx[k] > hi) hi = bx[k]; }
+        /* the triangle projects to [min(ta, tc), max(ta, tc)] (a and b project alike) */
+        if ((ta <= tc && (hi <= ta || lo >= tc)) || (ta > tc && (hi <= tc || lo >= ta))) return 0;
+    }
+    return 1;
+}
+
+/* barycentrics (b1, b2) of q in the uv triangle t; returns 0 for a degenerate triangle */
+static int rad__lm_bary(const double *t, double qx, double qy, double *b1, double *b2)
+{
+    double e1x = t[2] - t[0], e1y = t[3] - t[1], e2x = t[4] - t[0], e2y = t[5] - t[1];
+    double d = e1x * e2y - e1y * e2x, px = qx - t[0], py = qy - t[1];
+    if (!(fabs(d) > 1e-300)) return 0;
+    *b1 = (px * e2y - py * e2x) / d;
+    *b2 = (e1x * py - e1y * px) / d;
+    return 1;
+}
+
+/* the point of uv triangle t closest to q: barycentrics and squared distance */
+static double rad__lm_closest(const double *t, double qx, double qy, double *b1, double *b2)
+{
+    double best = DBL_MAX, x, y;
+    int e;
+    if (rad__lm_bary(t, qx, qy, b1, b2) && *b1 >= 0.0 && *b2 >= 0.0 && *b1 + *b2 <= 1.0) return 0.0;
+    for (e = 0; e < 3; ++e) {
+        const double *a = t + 2 * e, *b = t + 2 * ((e + 1) % 3);
+        double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy, s = 0.0, d2;
+        if (l2 > 0.0) s = ((qx - a[0]) * dx + (qy - a[1]) * dy) / l2;
+        if (s < 0.0) s = 0.0;
+        if (s > 1.0) s = 1.0;
+        x = a[0] + s * dx;
+        y = a[1] + s * dy;
+        d2 = (x - qx) * (x - qx) + (y - qy) * (y - qy);
+        if (d2 < best) {
+            /* barycentrics of the edge point: vertex e weight 1 - s, vertex e + 1 weight s */
+            double w[3] = { 0.0, 0.0, 0.0 };
+            best = d2;
+            w[e] = 1.0 - s;
+            w[(e + 1) % 3] = s;
+            *b1 = w[1];
+            *b2 = w[2];
+        }
+    }
+    return best;
+}
+
+typedef struct rad__lm_valid {
+    rad_lightmap *lm;
+    const rad_raycaster *rc;
+    uint32_t rays;
+    uint32_t limit;               /* back-face hits allowed */
+    uint32_t seed;
+    float eps;
+    rad_ray *ray_buf;             /* per task 'rays' */
+    rad_hit *hit_buf;
+    uint64_t *rays_cast;          /* per task */
+} rad__lm_valid;
+
+static rad_result rad__lm_valid_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__lm_valid *v = (rad__lm_valid *)data;
+    rad_lightmap *lm = v->lm;
+    rad_ray *rays = v->ray_buf + (size_t)task * v->rays;
+    rad_hit *hits = v->hit_buf + (size_t)task * v->rays;
+    uint32_t s, end = (row + 1u) * RAD__LM_GROUP, k;
+    int c;
+    if (end > lm->sample_count) end = lm->sample_count;
+    for (s = row * RAD__LM_GROUP; s < end; ++s) {
+        const float *p = lm->sample_positions + 3 * (size_t)s, *n = lm->sample_normals + 3 * (size_t)s;
+        float t1[3], t2[3];
+        uint32_t h = rad__hash(v->seed ^ rad__hash(s + 0x2545F491u)), back = 0;
+        rad__tangent_frame(n, t1, t2);
+        for (k = 0; k < v->rays; ++k) {
+            rad__cosine_dir(n, t1, t2, k, v->rays, h, rays[k].dir);
+            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c] + n[c] * v->eps;
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = FLT_MAX;
+        }
+        if (v->rc->intersect(v->rc->user, rays, v->rays, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        v->rays_cast[task] += v->rays;
+        for (k = 0; k < v->rays; ++k) {
+            uint32_t t = hits[k].triangle;
+            if (t != RAD_NONE && t < lm->scene->triangle_count && rad__dot(lm->scene->normals + 3 * (size_t)t, rays[k].dir) > 0.0f)
+                ++back;
+        }
+        lm->sample_valid[s] = back > v->limit ? 0u : 1u;
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                       const rad_lightmap_options *options, const rad_context *ctx, rad_lightmap **out)
+{
+    rad__ctx c;
+    rad_lightmap_options o;
+    rad_lightmap *lm = NULL;
+    uint32_t W, H, n, S, t, x, y, i, total = 0;
+    size_t texels, slots;
+    uint32_t *slot_tri = NULL, *fb_tri = NULL;
+    float *slot_b = NULL, *fb_b = NULL, *fb_d = NULL;
+    rad__lm_valid v;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!scene || !raycaster || !raycaster->intersect) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: NULL scene or raycaster (with intersect)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!scene->lightmap_uvs || !scene->lightmapped) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: no mesh of the scene has lightmap_uvs");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else rad_lightmap_options_default(&o);
+    if (o.width == 0) o.width = 256;
+    if (o.height == 0) o.height = 256;
+    if (o.samples == 0) o.samples = 4;
+    if (o.validity_rays == 0) o.validity_rays = 16;
+    if (o.backface_limit == 0.0f) o.backface_limit = 0.1f;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (o.width > RAD__LM_MAX_SIDE || o.height > RAD__LM_MAX_SIDE || o.samples > RAD__LM_MAX_SUB ||
+        o.validity_rays > 1024u || !(o.backface_limit > 0.0f && o.backface_limit <= 1.0f) ||
+        !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: an option is out of range (size %ux%u, at most %u; samples %u, at most %u; "
+                 "validity_rays %u, at most 1024; backface_limit %g in (0, 1]; ray_epsilon %g in (0, %g])", o.width, o.height,
+                 RAD__LM_MAX_SIDE, o.samples, RAD__LM_MAX_SUB, o.validity_rays, (double)o.backface_limit,
+                 (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    W = o.width;
+    H = o.height;
+    n = rad__lattice_side(o.samples);
+    if (n * n > RAD__LM_MAX_SUB) n = 4;
+    S = n * n;
+    texels = (size_t)W * H;
+    if ((uint64_t)texels * S > RAD__LM_MAX_SLOTS) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: %ux%u texels of %u samples pass the limit of 2^28 sample slots", W, H, S);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    slots = texels * S;
+    lm = (rad_lightmap *)rad__alloc(&c.allocator, sizeof(rad_lightmap));
+    if (!lm) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(lm, 0, sizeof(*lm));
+    lm->allocator = c.allocator;
+    lm->width = W;
+    lm->height = H;
+    lm->scene = scene;
+    lm->flags = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
+    lm->positions = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
+    lm->normals = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
+    lm->sample_first = (uint32_t *)rad__alloc_array(&c.allocator, texels + 1, sizeof(uint32_t));
+    slot_tri = (uint32_t *)rad__alloc_array(&c.allocator, slots, sizeof(uint32_t));
+    slot_b = (float *)rad__alloc_array(&c.allocator, slots, 2 * sizeof(float));
+    fb_tri = (uint32_t *)rad__alloc_array(&c.allocator, texels, sizeof(uint32_t));
+    fb_b = (float *)rad__alloc_array(&c.allocator, texels, 2 * sizeof(float));
+    fb_d = (float *)rad__alloc_array(&c.allocator, texels, sizeof(float));
+    if (!lm->flags || !lm->positions || !lm->normals || !lm->sample_first || !slot_tri || !slot_b || !fb_tri || !fb_b || !fb_d) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %ux%u texels", W, H);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    memset(lm->flags, 0, texels);
+    memset(lm->positions, 0, texels * 3 * sizeof(float));
+    memset(lm->normals, 0, texels * 3 * sizeof(float));
+    for (i = 0; i < slots; ++i) slot_tri[i] = RAD_NONE;
+    for (i = 0; i < texels; ++i) { fb_tri[i] = RAD_NONE; fb_d[i] = FLT_MAX; }
+    /* rasterize: serial, each triangle over the texels of its uv bounds */
+    for (t = 0; t < scene->triangle_count; ++t) {
+        double tu[6], mnx, mny, mxx, mxy;
+        int64_t x0, x1, y0, y1;
+        int k;
+        if (!scene->lightmapped[t]) continue;
+        for (k = 0; k < 3; ++k) {
+            tu[2 * k] = (double)scene->lightmap_uvs[6 * (size_t)t + 2 * (size_t)k] * W;
+            tu[2 * k + 1] = (double)scene->lightmap_uvs[6 * (size_t)t + 2 * (size_t)k + 1] * H;
+        }
+        {
+            double b1, b2;
+            if (!rad__lm_bary(tu, tu[0], tu[1], &b1, &b2)) continue; /* zero uv area: nothing to bake */
+        }
+        mnx = mxx = tu[0];
+        mny = mxy = tu[1];
+        for (k = 1; k < 3; ++k) {
+            if (tu[2 * k] < mnx) mnx = tu[2 * k];
+            if (tu[2 * k] > mxx) mxx = tu[2 * k];
+            if (tu[2 * k + 1] < mny) mny = tu[2 * k + 1];
+            if (tu[2 * k + 1] > mxy) mxy = tu[2 * k + 1];
+        }
+        if (mxx <= 0.0 || mxy <= 0.0 || mnx >= (double)W || mny >= (double)H) continue;
+        x0 = (int64_t)floor(mnx); x1 = (int64_t)floor(mxx);
+        y0 = (int64_t)floor(mny); y1 = (int64_t)floor(mxy);
+        if (x0 < 0) x0 = 0;
+        if (y0 < 0) y0 = 0;
+        if (x1 > (int64_t)W - 1) x1 = (int64_t)W - 1;
+        if (y1 > (int64_t)H - 1) y1 = (int64_t)H - 1;
+        for (y = (uint32_t)y0; y <= (uint32_t)y1; ++y)
+            for (x = (uint32_t)x0; x <= (uint32_t)x1; ++x) {
+                size_t ti = (size_t)y * W + x;
+                uint32_t a, b, got = 0;
+                double b1, b2, d2;
+                if (!rad__lm_overlap(tu, (double)x, (double)y, (double)x + 1.0, (double)y + 1.0)) continue;
+                lm->flags[ti] |= RAD_TEXEL_COVERED;
+                for (b = 0; b < n; ++b)
+                    for (a = 0; a < n; ++a) {
+                        size_t si = ti * S + (size_t)b * n + a;
+                        if (!rad__lm_bary(tu, x + (a + 0.5) / n, y + (b + 0.5) / n, &b1, &b2)) continue;
+                        if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0) continue;
+                        got = 1;
+                        if (slot_tri[si] != RAD_NONE) continue; /* the first triangle keeps a shared sub-point */
+                        slot_tri[si] = t;
+                        slot_b[2 * si] = (float)b1;
+                        slot_b[2 * si + 1] = (float)b2;
+                    }
+                if (got) continue;
+                d2 = rad__lm_closest(tu, x + 0.5, y + 0.5, &b1, &b2);
+                if (d2 < (double)fb_d[ti]) {
+                    fb_d[ti] = (float)d2;
+                    fb_tri[ti] = t;
+                    fb_b[2 * ti] = (float)b1;
+                    fb_b[2 * ti + 1] = (float)b2;
+                }
+            }
+    }
+    /* the samples, texel by texel */
+    for (i = 0; i < texels; ++i) {
+        uint32_t m = 0, s;
+        lm->sample_first[i] = total;
+        if (!(lm->flags[i] & RAD_TEXEL_COVERED)) continue;
+        for (s = 0; s < S; ++s) if (slot_tri[(size_t)i * S + s] != RAD_NONE) ++m;
+        if (m == 0 && fb_tri[i] != RAD_NONE) m = 1;
+        if ((uint64_t)total + m >= (uint64_t)RAD_NONE) { r = RAD_ERROR_SIZE_OVERFLOW; goto done; }
+        total += m;
+    }
+    lm->sample_first[texels] = total;
+    lm->sample_count = total;
+    lm->sample_positions = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
+    lm->sample_normals = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
+    lm->sample_triangles = (uint32_t *)rad__alloc_array(&c.allocator, total ? total : 1u, sizeof(uint32_t));
+    lm->sample_valid = (uint8_t *)rad__alloc_array(&c.allocator, total ? total : 1u, 1);
+    if (!lm->sample_positions || !lm->sample_normals || !lm->sample_triangles || !lm->sample_valid) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %u samples", total);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < texels; ++i) {
+        uint32_t at = lm->sample_first[i], s, m = lm->sample_first[i + 1] - at, j = 0;
+        for (s = 0; s < S && j < m; ++s) {
+            size_t si = (size_t)i * S + s;
+            uint32_t tt = slot_tri[si];
+            float b1, b2;
+            const float *P;
+            int k;
+            if (tt == RAD_NONE && !(s == S - 1 && j == 0)) continue;
+            if (tt == RAD_NONE) { /* no sub-point inside: the fallback point */
+                tt = fb_tri[i];
+                b1 = fb_b[2 * (size_t)i];
+                b2 = fb_b[2 * (size_t)i + 1];
+            } else {
+                b1 = slot_b[2 * si];
+                b2 = slot_b[2 * si + 1];
+            }
+            P = scene->positions + 9 * (size_t)tt;
+            {
+                /* a point on the triangle's border (a fallback point, a sub-point on an edge)
+                   lies on the plane of the wall that meets it there, where its validity rays
+                   would start behind that wall: it moves towards the centroid by a few ray
+                   epsilons (at most half the way) */
+                float *X = lm->sample_positions + 3 * (size_t)(at + j), dc[3], len, step;
+                for (k = 0; k < 3; ++k) {
+                    X[k] = P[k] + b1 * (P[3 + k] - P[k]) + b2 * (P[6 + k] - P[k]);
+                    dc[k] = (P[k] + P[3 + k] + P[6 + k]) / 3.0f - X[k];
+                    lm->sample_normals[3 * (size_t)(at + j) + k] = scene->normals[3 * (size_t)tt + k];
+                }
+                len = rad__len(dc);
+                step = 4.0f * o.ray_epsilon * scene->diagonal;
+                if (len > 0.0f) {
+                    if (step > 0.5f * len) step = 0.5f * len;
+                    for (k = 0; k < 3; ++k) X[k] += dc[k] * (step / len);
+                }
+            }
+            lm->sample_triangles[at + j] = tt;
+            ++j;
+        }
+    }
+    /* validity */
+    memset(&v, 0, sizeof(v));
+    v.lm = lm;
+    v.rc = raycaster;
+    v.rays = o.validity_rays;
+    v.limit = (uint32_t)floor((double)o.backface_limit * o.validity_rays + 1e-9);
+    v.seed = o.seed;
+    v.eps = o.ray_epsilon * scene->diagonal;
+    if (total > 0) {
+        uint32_t rows = (total + RAD__LM_GROUP - 1) / RAD__LM_GROUP, T = c.tasks < rows ? c.tasks : rows;
+        v.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_ray));
+        v.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_hit));
+        v.rays_cast = (uint64_t *)rad__alloc_array(&c.allocator, T, sizeof(uint64_t));
+        if (!v.ray_buf || !v.hit_buf || !v.rays_cast) {
+            r = RAD_ERROR_OUT_OF_MEMORY;
+        } else {
+            memset(v.rays_cast, 0, sizeof(uint64_t) * T);
+            r = rad__for_rows(&c, rows, T, rad__lm_valid_row, &v);
+            for (i = 0; i < T; ++i) lm->rays_cast += v.rays_cast[i];
+        }
+        rad__free(&c.allocator, v.ray_buf);
+        rad__free(&c.allocator, v.hit_buf);
+        rad__free(&c.allocator, v.rays_cast);
+        if (r != RAD_SUCCESS) goto done;
+    }
+    /* texel position and normal */
+    for (i = 0; i < texels; ++i) {
+        uint32_t s, a = lm->sample_first[i], b = lm->sample_first[i + 1], any = 0;
+        float cnt = 0.0f, *P = lm->positions + 3 * (size_t)i, *N = lm->normals + 3 * (size_t)i;
+        int k;
+        if (a == b) continue;
+        ++lm->covered_texels;
+        for (s = a; s < b; ++s) {
+            if (lm->sample_valid[s]) any = 1;
+            else ++lm->invalid_samples;
+        }
+        if (any) { lm->flags[i] |= RAD_TEXEL_VALID; ++lm->valid_texels; }
+        for (s = a; s < b; ++s) {
+            if (any && !lm->sample_valid[s]) continue;
+            for (k = 0; k < 3; ++k) {
+                P[k] += lm->sample_positions[3 * (size_t)s + k];
+                N[k] += lm->sample_normals[3 * (size_t)s + k];
+            }
+            cnt += 1.0f;
+        }
+        for (k = 0; k < 3; ++k) P[k] /= cnt;
+        if (rad__len(N) > 0.0f) rad__normalize(N);
+        else memcpy(N, lm->sample_normals + 3 * (size_t)a, 3 * sizeof(float));
+    }
+done:
+    rad__free(&c.allocator, slot_tri);
+    rad__free(&c.allocator, slot_b);
+    rad__free(&c.allocator, fb_tri);
+    rad__free(&c.allocator, fb_b);
+    rad__free(&c.allocator, fb_d);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_SIZE_OVERFLOW) rad__log(&c, RAD_LOG_ERROR, "lightmap: more than 2^32 - 2 samples");
+        rad_lightmap_destroy(lm);
+        return r;
+    }
+    *out = lm;
+    return RAD_SUCCESS;
+}
+
+/* The projections of the radiance of a Lambertian polygon (triangle v, 9 floats) seen from p
+   (unit normal n), clipped to p's upper half-space: out[0] its solid angle, out[1..3] its
+   vector irradiance integral w dw (so n . out[1..3] = pi F). Returns 0 when nothing is left. */
+static int rad__lm_polygon(const double *p, const double *n, const float *v, double *out)
+{
+    double q[3][3], d[3], poly[4][3], r[4][3], vec[3] = { 0.0, 0.0, 0.0 }, omega = 0.0, dn;
+    int i, k, m = 0;
+    for (i = 0; i < 3; ++i) {
+        for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
+        d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
+    }
+    for (i = 0; i < 3; ++i) {
+        int j = (i + 1) % 3;
+        if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) poly[m][k] = q[i][k]; ++m; }
+        if ((d[i] > 0.0 && d[j] < 0.0) || (d[i] < 0.0 && d[j] > 0.0)) {
+            double s = d[i] / (d[i] - d[j]);
+            for (k = 0; k < 3; ++k) poly[m][k] = q[i][k] + s * (q[j][k] - q[i][k]);
+            ++m;
+        }
+    }
+    if (m < 3) return 0;
+    for (i = 0; i < m; ++i) {
+        double l = sqrt(poly[i][0] * poly[i][0] + poly[i][1] * poly[i][1] + poly[i][2] * poly[i][2]);
+        if (!(l > 0.0)) return 0; /* p on the polygon's boundary */
+        for (k = 0; k < 3; ++k) r[i][k] = poly[i][k] / l;
+    }
+    for (i = 0; i < m; ++i) {
+        const double *a = r[i], *b = r[(i + 1) % m];
+        double cr[3], cl, dot;
+        cr[0] = a[1] * b[2] - a[2] * b[1];
+        cr[1] = a[2] * b[0] - a[0] * b[2];
+        cr[2] = a[0] * b[1] - a[1] * b[0];
+        cl = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+        if (!(cl > 1e-300)) continue;
+        dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        for (k = 0; k < 3; ++k) vec[k] += 0.5 * atan2(cl, dot) * cr[k] / cl;
+    }
+    /* solid angle: a fan of spherical triangles (Van Oosterom and Strackee) */
+    for (i = 1; i + 1 < m; ++i) {
+        const double *a = r[0], *b = r[i], *cc = r[i + 1];
+        double trip = a[0] * (b[1] * cc[2] - b[2] * cc[1]) + a[1] * (b[2] * cc[0] - b[0] * cc[2]) + a[2] * (b[0] * cc[1] - b[1] * cc[0]);
+        double den = 1.0 + (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) + (b[0] * cc[0] + b[1] * cc[1] + b[2] * cc[2]) +
+                     (cc[0] * a[0] + cc[1] * a[1] + cc[2] * a[2]);
+        omega += 2.0 * atan2(trip, den);
+    }
+    /* the winding decides the signs; the polygon lies above p's plane, so n . vec >= 0 */
+    dn = vec[0] * n[0] + vec[1] * n[1] + vec[2] * n[2];
+    if (dn < 0.0) { for (k = 0; k < 3; ++k) vec[k] = -vec[k]; dn = -dn; }
+    if (!(dn > 0.0)) return 0;
+    out[0] = fabs(omega);
+    for (k = 0; k < 3; ++k) out[1 + k] = vec[k];
+    return 1;
+}
+
+typedef struct rad__lm_gather {
+    const rad_lightmap *lm;
+    const rad_patches *P;
+    const float *B;
+    const rad_raycaster *rc;
+    uint32_t ch, vis, seed, hemi;
+    float eps;
+    uint32_t *list;               /* the patches gathered exactly: every lit one, or the bright ones */
+    uint32_t list_count;
+    uint8_t *skip;                /* hemisphere: per patch, 1 when a hit on it brings nothing */
+    rad_ray *ray_buf;             /* per task RAD__RAY_BATCH */
+    uint8_t *occ_buf;
+    float *ray_c;                 /* per task RAD__RAY_BATCH x ch: each ray's contribution */
+    rad_hit *hit_buf;             /* hemisphere: per task RAD__RAY_BATCH */
+    float *hit_w;                 /* hemisphere: per task RAD__RAY_BATCH x 4 (weight, SH direction) */
+    float *out;
+} rad__lm_gather;
+
+static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count, double *acc)
+{
+    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    uint8_t *occ = g->occ_buf + (size_t)task * RAD__RAY_BATCH;
+    const float *w = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
+    uint32_t k, ch;
+    if (count == 0) return RAD_SUCCESS;
+    if (g->rc->occluded(g->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k)
+        if (!occ[k])
+            for (ch = 0; ch < g->ch; ++ch) acc[ch] += (double)w[(size_t)k * g->ch + ch];
+    return RAD_SUCCESS;
+}
+
+/* hemisphere rays: each hit on the front of a patch that is not counted exactly brings its B */
+static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t count, double *sum)
+{
+    const rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = g->hit_buf + (size_t)task * RAD__RAY_BATCH;
+    const float *hw = g->hit_w + (size_t)task * RAD__RAY_BATCH * 4;
+    const rad_scene *S = g->lm->scene;
+    uint32_t k, j;
+    int c;
+    if (count == 0) return RAD_SUCCESS;
+    if (g->rc->intersect(g->rc->user, rays, count, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (k = 0; k < count; ++k) {
+        const rad_hit *h = hits + k;
+        const float *w = hw + 4 * (size_t)k;
+        float wt[3];
+        if (h->triangle == RAD_NONE || h->triangle >= S->triangle_count) continue;
+        if (!(rad__dot(S->normals + 3 * (size_t)h->triangle, rays[k].dir) < 0.0f)) continue; /* back face */
+        j = rad_patches_locate(g->P, h->triangle, h->b1, h->b2, wt);
+        if (j == RAD_NONE || g->skip[j]) continue;
+        for (c = 0; c < 3; ++c) {
+            double b = (double)g->B[3 * (size_t)j + (size_t)c] * w[0];
+            if (g->ch == 3) {
+                sum[c] += b;
+            } else {
+                sum[c] += b * RAD__LM_SH_Y0;
+                sum[3 + c] += b * RAD__LM_SH_Y1 * w[2];
+                sum[6 + c] += b * RAD__LM_SH_Y1 * w[3];
+                sum[9 + c] += b * RAD__LM_SH_Y1 * w[1];
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+/* one texel: the mean over its valid samples of the patches' light */
+static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
+{
+    rad__lm_gather *g = (rad__lm_gather *)data;
+    const rad_lightmap *lm = g->lm;
+    const rad_patches *P = g->P;
+    rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
+    float *rc = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
+    float *hw = g->hit_w ? g->hit_w + (size_t)task * RAD__RAY_BATCH * 4 : NULL;
+    double acc[12], sum[12];
+    uint32_t s, li, ch, nval = 0, nr = 0, nh = 0, per = 0;
+    float *out = g->out + (size_t)texel * g->ch;
+    int k;
+    rad_result r;
+    for (ch = 0; ch < g->ch; ++ch) sum[ch] = 0.0;
+    if (g->hemi) {
+        for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) nval += lm->sample_valid[s] ? 1u : 0u;
+        per = nval ? (g->hemi + nval - 1) / nval : 0u;
+        nval = 0;
+    }
+    for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) {
+        const float *pf = lm->sample_positions + 3 * (size_t)s, *nf = lm->sample_normals + 3 * (size_t)s;
+        double p[3], n[3];
+        uint32_t h;
+        if (!lm->sample_valid[s]) continue;
+        ++nval;
+        for (k = 0; k < 3; ++k) { p[k] = pf[k]; n[k] = nf[k]; }
+        for (ch = 0; ch < g->ch; ++ch) acc[ch] = 0.0;
+        h = rad__hash(g->seed ^ rad__hash(s * 0x9E3779B9u + 0x3C6EF372u));
+        for (li = 0; li < g->list_count; ++li) {
+            uint32_t j = g->list[li];
+            const rad_patch *pj = &P->patches[j];
+            float tri[9], y[3], d[3], r1, r2, u1, u2;
+            double proj[4], kw[64], ksum = 0.0, full[12], Lr[3];
+            uint32_t m, q;
+            if (pj->triangle == lm->sample_triangles[s]) continue;
+            for (m = 0; m < 3; ++m)
+                for (k = 0; k < 3; ++k) tri[3 * m + k] = P->vertices[3 * (size_t)pj->vertices[m] + (size_t)k];
+            rad__sub(d, pf, tri);
+            if (!(rad__dot(d, pj->normal) > 0.0f)) continue; /* p behind the patch */
+            if (!rad__lm_polygon(p, n, tri, proj)) continue;
+            for (k = 0; k < 3; ++k) Lr[k] = (double)g->B[3 * (size_t)j + k] / RAD__PI;
+            /* the patch's unoccluded contribution in the encoding */
+            if (g->ch == 3) {
+                double ndv = n[0] * proj[1] + n[1] * proj[2] + n[2] * proj[3];
+                for (k = 0; k < 3; ++k) full[k] = Lr[k] * ndv;
+            } else {
+                for (k = 0; k < 3; ++k) {
+                    full[k] = Lr[k] * RAD__LM_SH_Y0 * proj[0];
+                    full[3 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[2];
+                    full[6 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[3];
+                    full[9 + k] = Lr[k] * RAD__LM_SH_Y1 * proj[1];
+                }
+            }
+            /* visibility: rays to stratified points of the patch, each carrying its kernel's
+               share of the contribution */
+            r1 = (float)((h ^ rad__hash(j)) & 0xFFFFu) / 65536.0f;
+            r2 = (float)((h ^ rad__hash(j)) >> 16) / 65536.0f;
+            for (q = 0; q < g->vis; ++q) {
+                float dd[3], l2, cp, cq;
+                rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
+                rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
+                rad__sub(dd, y, pf);
+                l2 = rad__dot(dd, dd);
+                cp = rad__dot(dd, nf);
+                cq = -rad__dot(dd, pj->normal);
+                kw[q] = (l2 > 0.0f && cp > 0.0f && cq > 0.0f) ? (double)cp * cq / ((double)l2 * l2) : 0.0;
+                ksum += kw[q];
+            }
+            if (!(ksum > 0.0)) continue;
+            for (q = 0; q < g->vis; ++q) {
+                rad_ray *ray;
+                float len;
+                if (!(kw[q] > 0.0)) continue;
+                rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
+                rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
+                ray = rays + nr;
+                for (k = 0; k < 3; ++k) {
+                    ray->origin[k] = pf[k] + nf[k] * g->eps;
+                    ray->dir[k] = (y[k] + pj->normal[k] * g->eps) - ray->origin[k];
+                }
+                len = rad__len(ray->dir);
+                ray->tmin = 0.0f;
+                ray->tmax = len > 2.0f * g->eps ? 1.0f - g->eps / len : 0.5f;
+                for (ch = 0; ch < g->ch; ++ch) rc[(size_t)nr * g->ch + ch] = (float)(full[ch] * kw[q] / ksum);
+                if (++nr == RAD__RAY_BATCH) {
+                    r = rad__lm_flush(g, task, nr, acc);
+                    nr = 0;
+                    if (r != RAD_SUCCESS) return r;
+                }
+            }
+        }
+        r = rad__lm_flush(g, task, nr, acc);
+        nr = 0;
+        if (r != RAD_SUCCESS) return r;
+        for (ch = 0; ch < g->ch; ++ch) sum[ch] += acc[ch];
+        if (per) {
+            /* this sample's share of the texel's hemisphere rays (the exact rays above are
+               flushed, so the buffer is the hemisphere rays' alone) */
+            float t1[3], t2[3], u1, u2, w = g->ch == 3 ? 1.0f / (float)per : 2.0f / (float)per;
+            uint32_t q, hr = rad__hash(h ^ 0x85EBCA6Bu);
+            rad__tangent_frame(nf, t1, t2);
+            for (q = 0; q < per; ++q) {
+                rad_ray *ray = rays + nh;
+                float *wq = hw + 4 * (size_t)nh;
+                if (g->ch == 3) {
+                    rad__cosine_dir(nf, t1, t2, q, per, hr, ray->dir);
+                } else {
+                    /* uniform over the hemisphere: cos theta = u1 */
+                    float st, ph;
+                    rad__hammersley(q, per, (float)(hr & 0xFFFFu) / 65536.0f, (float)(hr >> 16) / 65536.0f, &u1, &u2);
+                    st = (float)sqrt((double)(1.0f - u1 * u1));
+                    ph = (float)(2.0 * RAD__PI) * u2;
+                    for (k = 0; k < 3; ++k)
+                        ray->dir[k] = t1[k] * st * (float)cos((double)ph) + t2[k] * st * (float)sin((double)ph) + nf[k] * u1;
+                }
+                for (k = 0; k < 3; ++k) ray->origin[k] = pf[k] + nf[k] * g->eps;
+                ray->tmin = 0.0f;
+                ray->tmax = FLT_MAX;
+                wq[0] = w;
+                for (k = 0; k < 3; ++k) wq[1 + k] = ray->dir[k];
+                if (++nh == RAD__RAY_BATCH) {
+                    r = rad__lm_flush_hits(g, task, nh, sum);
+                    nh = 0;
+                    if (r != RAD_SUCCESS) return r;
+                }
+            }
+            r = rad__lm_flush_hits(g, task, nh, sum);
+            nh = 0;
+            if (r != RAD_SUCCESS) return r;
+        }
+    }
+    for (ch = 0; ch < g->ch; ++ch) out[ch] = nval ? (float)(sum[ch] / nval) : 0.0f;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches *patches, const float *B,
+                                       const rad_raycaster *raycaster, const rad_lightmap_gather_options *options, float *out,
+                                       const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__lm_gather g;
+    rad_lightmap_gather_options o;
+    uint32_t T, i, texels;
+    rad_result r;
+    int hemi;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !patches || !B || !raycaster || !raycaster->occluded || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: NULL lightmap, patches, radiosity, raycaster (with occluded) or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (patches->scene != lm->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the patches were made from another scene than the lightmap");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else rad_lightmap_gather_options_default(&o);
+    if (o.visibility_rays == 0) o.visibility_rays = 4;
+    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (o.hemisphere_rays == 0) o.hemisphere_rays = 256;
+    if (o.exact_ratio == 0.0f) o.exact_ratio = 16.0f;
+    if (rad_lightmap_channels(o.encoding) == 0 || o.visibility_rays > 64u ||
+        !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: encoding %d, visibility_rays %u (at most 64) or ray_epsilon %g out of range",
+                 (int)o.encoding, o.visibility_rays, (double)o.ray_epsilon);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((o.method != RAD_LIGHTMAP_GATHER_EXACT && o.method != RAD_LIGHTMAP_GATHER_HEMISPHERE) || o.hemisphere_rays > 65536u ||
+        !(o.exact_ratio > 0.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: method %d, hemisphere_rays %u (at most 65536) or exact_ratio %g out of range",
+                 (int)o.method, o.hemisphere_rays, (double)o.exact_ratio);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    hemi = o.method == RAD_LIGHTMAP_GATHER_HEMISPHERE;
+    if (hemi && !raycaster->intersect) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the hemisphere method needs the raycaster's intersect()");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    r = rad__check_input(&c, "lightmap gather: patch radiosity", B, 3 * (size_t)patches->count);
+    if (r != RAD_SUCCESS) return r;
+    memset(&g, 0, sizeof(g));
+    g.lm = lm;
+    g.P = patches;
+    g.B = B;
+    g.rc = raycaster;
+    g.ch = rad_lightmap_channels(o.encoding);
+    g.vis = o.visibility_rays;
+    g.seed = o.seed;
+    g.hemi = hemi ? o.hemisphere_rays : 0u;
+    g.eps = o.ray_epsilon * lm->scene->diagonal;
+    g.out = out;
+    texels = lm->width * lm->height;
+    T = c.tasks < texels ? c.tasks : texels;
+    g.list = (uint32_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, sizeof(uint32_t));
+    g.skip = (uint8_t *)rad__alloc_array(&c.allocator, patches->count ? patches->count : 1u, 1);
+    g.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    g.occ_buf = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    g.ray_c = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, g.ch * sizeof(float));
+    if (hemi) {
+        g.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
+        g.hit_w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 4 * sizeof(float));
+    }
+    if (!g.list || !g.skip || !g.ray_buf || !g.occ_buf || !g.ray_c || (hemi && (!g.hit_buf || !g.hit_w))) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather: out of memory for %u tasks", T);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        double lum_area = 0.0, area = 0.0, limit = 0.0;
+        for (i = 0; i < patches->count; ++i) {
+            const float *b = B + 3 * (size_t)i;
+            double lum = 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2];
+            if (b[0] == 0.0f && b[1] == 0.0f && b[2] == 0.0f) continue;
+            lum_area += lum * patches->patches[i].area;
+            area += patches->patches[i].area;
+        }
+        if (area > 0.0) limit = (double)o.exact_ratio * lum_area / area;
+        for (i = 0; i < patches->count; ++i) {
+            const float *b = B + 3 * (size_t)i;
+            int lit = b[0] != 0.0f || b[1] != 0.0f || b[2] != 0.0f;
+            /* the hemisphere method counts only the bright patches exactly */
+            int exact = lit && (!hemi || 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2] > limit);
+            g.skip[i] = (uint8_t)(exact || !lit);
+            if (exact) g.list[g.list_count++] = i;
+        }
+        r = rad__for_rows(&c, texels, T, rad__lm_gather_row, &g);
+    }
+    rad__free(&c.allocator, g.list);
+    rad__free(&c.allocator, g.skip);
+    rad__free(&c.allocator, g.ray_buf);
+    rad__free(&c.allocator, g.occ_buf);
+    rad__free(&c.allocator, g.ray_c);
+    rad__free(&c.allocator, g.hit_buf);
+    rad__free(&c.allocator, g.hit_w);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather", out, (size_t)texels * g.ch) : r;
+}
+
+RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lm, const rad_raycaster *raycaster, const rad_light *lights,
+                                       uint32_t light_count, const rad_direct_options *options, float *out,
+                                       const rad_context *ctx)
+{
+    rad__ctx c;
+    float *pts, *nrm, *D;
+    uint32_t *owner, i, s, m = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap direct: NULL lightmap or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    pts = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    D = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    owner = (uint32_t *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, sizeof(uint32_t));
+    if (!pts || !nrm || !D || !owner) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap direct: out of memory for %u samples", lm->sample_count);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < lm->width * lm->height; ++i)
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+            if (!lm->sample_valid[s]) continue;
+            memcpy(pts + 3 * (size_t)m, lm->sample_positions + 3 * (size_t)s, 3 * sizeof(float));
+            memcpy(nrm + 3 * (size_t)m, lm->sample_normals + 3 * (size_t)s, 3 * sizeof(float));
+            owner[m++] = i;
+        }
+    r = m ? rad_direct_irradiance(lm->scene, raycaster, lights, light_count, options, pts, nrm, m, D, ctx) : RAD_SUCCESS;
+    if (r == RAD_SUCCESS) {
+        uint32_t a = 0, b;
+        while (a < m) {
+            uint32_t texel = owner[a], k;
+            double sum[3] = { 0.0, 0.0, 0.0 };
+            for (b = a; b < m && owner[b] == texel; ++b)
+                for (k = 0; k < 3; ++k) sum[k] += D[3 * (size_t)b + k];
+            for (k = 0; k < 3; ++k) out[3 * (size_t)texel + k] += (float)(sum[k] / (double)(b - a));
+            a = b;
+        }
+    }
+done:
+    rad__free(&c.allocator, pts);
+    rad__free(&c.allocator, nrm);
+    rad__free(&c.allocator, D);
+    rad__free(&c.allocator, owner);
+    return r;
+}
+
+RAD_API rad_result rad_lightmap_dilate(const rad_lightmap *lm, uint32_t channels, float *values, uint32_t passes,
+                                       const rad_context *ctx)
+{
+    rad__ctx c;
+    uint8_t *have, *next;
+    uint32_t W, H, pass, x, y, ch;
+    size_t texels, i;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !values || channels == 0 || channels > 64u) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap dilate: NULL lightmap or values, or channels %u not in 1..64", channels);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    W = lm->width;
+    H = lm->height;
+    texels = (size_t)W * H;
+    have = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
+    next = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
+    if (!have || !next) {
+        rad__free(&c.allocator, have);
+        rad__free(&c.allocator, next);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < texels; ++i) have[i] = (lm->flags[i] & RAD_TEXEL_VALID) ? 1u : 0u;
+    for (pass = 0; passes == 0 || pass < passes; ++pass) {
+        int changed = 0;
+        memcpy(next, have, texels);
+        for (y = 0; y < H; ++y)
+            for (x = 0; x < W; ++x) {
+                size_t ti = (size_t)y * W + x;
+                float acc[64];
+                int dx, dy, cnt = 0;
+                if (have[ti]) continue;
+                for (ch = 0; ch < channels; ++ch) acc[ch] = 0.0f;
+                for (dy = -1; dy <= 1; ++dy)
+                    for (dx = -1; dx <= 1; ++dx) {
+                        int64_t nx = (int64_t)x + dx, ny = (int64_t)y + dy;
+                        size_t ni;
+                        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= (int64_t)W || ny >= (int64_t)H) continue;
+                        ni = (size_t)ny * W + (size_t)nx;
+                        if (!have[ni]) continue;
+                        for (ch = 0; ch < channels; ++ch) acc[ch] += values[ni * channels + ch];
+                        ++cnt;
+                    }
+                if (!cnt) continue;
+                for (ch = 0; ch < channels; ++ch) values[ti * channels + ch] = acc[ch] / (float)cnt;
+                next[ti] = 1;
+                changed = 1;
+            }
+        memcpy(have, next, texels);
+        if (!changed) break;
+    }
+    rad__free(&c.allocator, have);
+    rad__free(&c.allocator, next);
+    return RAD_SUCCESS;
+}
+
+/* bilinear taps of (u, v): texel indices and weights, clamped to the edge texels */
+static void rad__lm_taps(const rad_lightmap *lm, float u, float v, uint32_t *idx, float *w)
+{
+    double x = (double)u * lm->width - 0.5, y = (double)v * lm->height - 0.5, fx, fy;
+    int64_t x0, y0, x1, y1;
+    if (!(x > 0.0)) x = 0.0;
+    if (!(y > 0.0)) y = 0.0;
+    if (x > (double)lm->width - 1.0) x = (double)lm->width - 1.0;
+    if (y > (double)lm->height - 1.0) y = (double)lm->height - 1.0;
+    x0 = (int64_t)floor(x);
+    y0 = (int64_t)floor(y);
+    fx = x - (double)x0;
+    fy = y - (double)y0;
+    x1 = x0 + 1 < (int64_t)lm->width ? x0 + 1 : x0;
+    y1 = y0 + 1 < (int64_t)lm->height ? y0 + 1 : y0;
+    idx[0] = (uint32_t)(y0 * lm->width + x0); w[0] = (float)((1.0 - fx) * (1.0 - fy));
+    idx[1] = (uint32_t)(y0 * lm->width + x1); w[1] = (float)(fx * (1.0 - fy));
+    idx[2] = (uint32_t)(y1 * lm->width + x0); w[2] = (float)((1.0 - fx) * fy);
+    idx[3] = (uint32_t)(y1 * lm->width + x1); w[3] = (float)(fx * fy);
+}
+
+RAD_API void rad_lightmap_sample(const rad_lightmap *lm, uint32_t channels, const float *values, float u, float v, float *out)
+{
+    uint32_t idx[4], ch;
+    float w[4];
+    int k;
+    if (!lm || !values || !out) return;
+    rad__lm_taps(lm, u, v, idx, w);
+    for (ch = 0; ch < channels; ++ch) {
+        float s = 0.0f;
+        for (k = 0; k < 4; ++k) s += w[k] * values[(size_t)idx[k] * channels + ch];
+        out[ch] = s;
+    }
+}
+
+RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
+{
+    rad_allocator a;
+    if (!w) return;
+    a = w->allocator;
+    rad__free(&a, w->vertex_first);
+    rad__free(&a, w->vertex_patches);
+    rad__free(&a, w->vertex_weights);
+    rad__free(&a, w->row_texels);
+    rad__free(&a, w->row_first);
+    rad__free(&a, w->entry_vertices);
+    rad__free(&a, w->entry_weights);
+    rad__free(&a, w);
+}
+
+/* barycentrics (b1, b2) of point x in triangle v (9 floats), least squares in its plane */
+static void rad__lm_bary3(const float *v, const float *x, float *b1, float *b2)
+{
+    double e1[3], e2[3], d[3], d00 = 0.0, d01 = 0.0, d11 = 0.0, d20 = 0.0, d21 = 0.0, den, u, w;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)v[3 + k] - v[k];
+        e2[k] = (double)v[6 + k] - v[k];
+        d[k] = (double)x[k] - v[k];
+        d00 += e1[k] * e1[k]; d01 += e1[k] * e2[k]; d11 += e2[k] * e2[k];
+        d20 += d[k] * e1[k]; d21 += d[k] * e2[k];
+    }
+    den = d00 * d11 - d01 * d01;
+    u = den > 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
+    w = den > 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
+    if (u < 0.0) u = 0.0;
+    if (w < 0.0) w = 0.0;
+    if (u + w > 1.0) { double s = u + w; u /= s; w /= s; }
+    *b1 = (float)u;
+    *b2 = (float)w;
+}
+
+/* distinct vertices one texel's row may gather before merging stops adding (a texel spans a
+   few patches: never reached with welded meshes) */
+#define RAD__LM_ROW_MAX 128u
+
+RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad_patches *P, const float *baked_texels,
+                                               const float *baked_H, const rad_context *ctx, rad_lightmap_weights **out)
+{
+    rad__ctx c;
+    rad_lightmap_weights *W = NULL;
+    uint32_t *fill = NULL, i, texels, rows = 0, col[RAD__LM_ROW_MAX];
+    double *varea = NULL, *vbaked = NULL, val[RAD__LM_ROW_MAX];
+    uint64_t total = 0, cap = 0;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!lm || !P || P->scene != lm->scene || (!baked_texels) != (!baked_H)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: NULL lightmap or patches, patches of another scene, or only one of "
+                 "baked_texels and baked_patch_irradiance");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((uint64_t)P->count * 3u >= 0xFFFFFFFFu) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights: %u patches give 2^32 vertex entries or more", P->count);
+        return RAD_ERROR_SIZE_OVERFLOW;
+    }
+    texels = lm->width * lm->height;
+    for (i = 0; i < texels; ++i) { /* the rows to come: texels with a valid sample */
+        uint32_t s;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1] && !lm->sample_valid[s]; ++s) {}
+        rows += s < lm->sample_first[i + 1];
+    }
+    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    if (!W) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(W, 0, sizeof(*W));
+    W->allocator = c.allocator;
+    W->texels = texels;
+    W->patch_count = P->count;
+    W->vertex_count = P->vertex_count;
+    /* stage 1: the patches around each vertex and their area shares */
+    W->vertex_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    W->vertex_patches = (uint32_t *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(uint32_t));
+    W->vertex_weights = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)P->count + 1, sizeof(float));
+    fill = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(uint32_t));
+    varea = (double *)rad__alloc_array(&c.allocator, (size_t)P->vertex_count + 1, sizeof(double));
+    W->row_texels = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    W->row_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    rows = 0;
+    if (baked_H) vbaked = (double *)rad__alloc_array(&c.allocator, 3 * (size_t)P->vertex_count + 1, sizeof(double));
+    if (!W->vertex_first || !W->vertex_patches || !W->vertex_weights || !fill || !varea || !W->row_texels || !W->row_first ||
+        (baked_H && !vbaked)) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(fill, 0, sizeof(uint32_t) * ((size_t)P->vertex_count + 1));
+    memset(varea, 0, sizeof(double) * ((size_t)P->vertex_count + 1));
+    for (i = 0; i < P->count; ++i) {
+        int k;
+        for (k = 0; k < 3; ++k) { fill[P->patches[i].vertices[k]]++; varea[P->patches[i].vertices[k]] += P->patches[i].area; }
+    }
+    W->vertex_first[0] = 0;
+    for (i = 0; i < P->vertex_count; ++i) { W->vertex_first[i + 1] = W->vertex_first[i] + fill[i]; fill[i] = 0; }
+    for (i = 0; i < P->count; ++i) {
+        int k;
+        for (k = 0; k < 3; ++k) {
+            uint32_t v = P->patches[i].vertices[k], e = W->vertex_first[v] + fill[v]++;
+            W->vertex_patches[e] = i;
+            W->vertex_weights[e] = varea[v] > 0.0 ? (float)(P->patches[i].area / varea[v]) : 0.0f;
+        }
+    }
+    if (vbaked) /* the baked solution's vertex values, for the detail factors */
+        for (i = 0; i < P->vertex_count; ++i) {
+            uint32_t e;
+            int k;
+            for (k = 0; k < 3; ++k) vbaked[3 * (size_t)i + k] = 0.0;
+            for (e = W->vertex_first[i]; e < W->vertex_first[i + 1]; ++e)
+                for (k = 0; k < 3; ++k)
+                    vbaked[3 * (size_t)i + k] += (double)W->vertex_weights[e] * baked_H[3 * (size_t)W->vertex_patches[e] + k];
+        }
+    /* stage 2: rows, texel by texel, appended to growing arrays */
+    for (i = 0; i < texels; ++i) {
+        uint32_t s, n = 0, nv = 0, e;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+            uint32_t t = lm->sample_triangles[s], p, k;
+            float b1, b2, vw[3];
+            if (!lm->sample_valid[s]) continue;
+            ++nv;
+            rad__lm_bary3(lm->scene->positions + 9 * (size_t)t, lm->sample_positions + 3 * (size_t)s, &b1, &b2);
+            p = rad_patches_locate(P, t, b1, b2, vw);
+            if (p == RAD_NONE) continue;
+            for (k = 0; k < 3; ++k) {
+                uint32_t v = P->patches[p].vertices[k], m;
+                if (!(varea[v] > 0.0) || !(vw[k] != 0.0f)) continue;
+                for (m = 0; m < n && col[m] != v; ++m) {}
+                if (m == n) {
+                    if (n == RAD__LM_ROW_MAX) continue;
+                    col[n] = v;
+                    val[n++] = 0.0;
+                }
+                val[m] += vw[k];
+            }
+        }
+        if (nv == 0 || n == 0) continue;
+        for (e = 0; e < n; ++e) val[e] /= nv;
+        if (vbaked) {
+            double num = 0.0, den = 0.0, cf = 1.0;
+            int k;
+            for (k = 0; k < 3; ++k) num += baked_texels[3 * (size_t)i + k];
+            for (e = 0; e < n; ++e)
+                for (k = 0; k < 3; ++k) den += val[e] * vbaked[3 * (size_t)col[e] + k];
+            if (den > 0.0 && num >= 0.0) cf = num / den < 16.0 ? num / den : 16.0;
+            for (e = 0; e < n; ++e) val[e] *= cf;
+        }
+        if (total + n >= 0xFFFFFFFFu) {
+            rad__log(&c, RAD_LOG_ERROR, "lightmap weights: 2^32 entries or more");
+            r = RAD_ERROR_SIZE_OVERFLOW;
+            goto done;
+        }
+        if (total + n > cap) {
+            uint64_t nc = cap ? 2 * cap : 4096;
+            uint32_t *ncol;
+            float *nval;
+            while (nc < total + n) nc *= 2;
+            ncol = (uint32_t *)rad__realloc(&c.allocator, W->entry_vertices, (size_t)cap * sizeof(uint32_t), (size_t)nc * sizeof(uint32_t));
+            if (!ncol) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+            W->entry_vertices = ncol;
+            nval = (float *)rad__realloc(&c.allocator, W->entry_weights, (size_t)cap * sizeof(float), (size_t)nc * sizeof(float));
+            if (!nval) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+            W->entry_weights = nval;
+            cap = nc;
+        }
+        W->row_texels[rows] = i;
+        W->row_first[rows++] = (uint32_t)total;
+        for (e = 0; e < n; ++e) { W->entry_vertices[total + e] = col[e]; W->entry_weights[total + e] = (float)val[e]; }
+        total += n;
+    }
+    W->row_first[rows] = (uint32_t)total;
+    W->row_count = rows;
+    if (!W->entry_vertices) { /* no row at all: keep the arrays non-NULL */
+        W->entry_vertices = (uint32_t *)rad__alloc(&c.allocator, sizeof(uint32_t));
+        W->entry_weights = (float *)rad__alloc(&c.allocator, sizeof(float));
+        if (!W->entry_vertices || !W->entry_weights) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+done:
+    rad__free(&c.allocator, fill);
+    rad__free(&c.allocator, varea);
+    rad__free(&c.allocator, vbaked);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_OUT_OF_MEMORY) rad__log(&c, RAD_LOG_ERROR, "lightmap weights: out of memory (%llu entries)", (unsigned long long)total);
+        rad_lightmap_weights_destroy(W);
+        return r;
+    }
+    *out = W;
+    return RAD_SUCCESS;
+}
+
+#define RAD__LM_REFRESH_GRAIN 65536u /* entries (and rows) a refresh task takes at least */
+
+typedef struct rad__lm_refresh {
+    const rad_lightmap_weights *W;
+    const float *H;
+    float *V;                   /* 3 per vertex: stage 1's output */
+    float *out;
+    uint32_t tasks;
+} rad__lm_refresh;
+
+static void rad__lm_refresh_vertices(void *data, uint32_t task)
+{
+    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
+    const rad_lightmap_weights *W = f->W;
+    uint32_t v = (uint32_t)((uint64_t)W->vertex_count * task / f->tasks);
+    uint32_t end = (uint32_t)((uint64_t)W->vertex_count * (task + 1) / f->tasks);
+    for (; v < end; ++v) {
+        uint32_t e;
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        for (e = W->vertex_first[v]; e < W->vertex_first[v + 1]; ++e) {
+            const float *h = f->H + 3 * (size_t)W->vertex_patches[e], w = W->vertex_weights[e];
+            s0 += w * h[0];
+            s1 += w * h[1];
+            s2 += w * h[2];
+        }
+        f->V[3 * (size_t)v] = s0;
+        f->V[3 * (size_t)v + 1] = s1;
+        f->V[3 * (size_t)v + 2] = s2;
+    }
+}
+
+/* one contiguous block of rows per task: the rows are short, so a cyclic split would make
+   the tasks write the same cache lines of out */
+static void rad__lm_refresh_rows(void *data, uint32_t task)
+{
+    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
+    const rad_lightmap_weights *W = f->W;
+    const uint32_t *first = W->row_first, *ev = W->entry_vertices;
+    const float *ew = W->entry_weights, *V = f->V;
+    uint32_t r = (uint32_t)((uint64_t)W->row_count * task / f->tasks);
+    uint32_t end = (uint32_t)((uint64_t)W->row_count * (task + 1) / f->tasks);
+    for (; r < end; ++r) {
+        uint32_t e = first[r], b = first[r + 1];
+        float *o = f->out + 3 * (size_t)W->row_texels[r];
+        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+        for (; e < b; ++e) {
+            const float *x = V + 3 * (size_t)ev[e], w = ew[e];
+            s0 += w * x[0];
+            s1 += w * x[1];
+            s2 += w * x[2];
+        }
+        o[0] = s0;
+        o[1] = s1;
+        o[2] = s2;
+    }
+}
+
+RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const float *H, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__lm_refresh f;
+    uint64_t most;
+    rad__ctx_init(&c, ctx);
+    if (!W || !H || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    f.W = W;
+    f.H = H;
+    f.out = out;
+    f.V = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)W->vertex_count + 1, sizeof(float));
+    if (!f.V) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: out of memory (%u vertex values)", W->vertex_count);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    /* stage 1 is small (3 entries a patch): in the calling thread unless the patches are
+       many, as a parallel region's start and join can cost more than it on busy cores */
+    most = W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN;
+    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
+    if (f.tasks < 2) {
+        f.tasks = 1;
+        rad__lm_refresh_vertices(&f, 0);
+    } else {
+        c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_vertices, &f);
+    }
+    /* stage 2: a task per block of at least RAD__LM_REFRESH_GRAIN entries */
+    most = (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u;
+    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
+    if (f.tasks < 2) {
+        f.tasks = 1;
+        rad__lm_refresh_rows(&f, 0);
+    } else c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_rows, &f);
+    rad__free(&c.allocator, f.V);
+    return RAD_SUCCESS;
+}
+
+/* one edge of a lightmapped triangle, its end points in canonical (lexicographic) order */
+typedef struct rad__lm_edge {
+    float a[3], b[3];
+    float ua[2], ub[2];
+    uint32_t tri;
+} rad__lm_edge;
+
+static int rad__lm_pcmp(const float *a, const float *b)
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        if (a[k] < b[k]) return -1;
+        if (a[k] > b[k]) return 1;
+    }
+    return 0;
+}
+
+static int rad__lm_edge_cmp(const void *x, const void *y)
+{
+    const rad__lm_edge *e = (const rad__lm_edge *)x, *f = (const rad__lm_edge *)y;
+    int r = rad__lm_pcmp(e->a, f->a);
+    if (r) return r;
+    r = rad__lm_pcmp(e->b, f->b);
+    if (r) return r;
+    return e->tri < f->tri ? -1 : e->tri > f->tri ? 1 : 0;
+}
+
+/* one row of A: up to 8 (texel, weight) taps, duplicates merged */
+typedef struct rad__lm_row {
+    uint32_t idx[8];
+    float w[8];
+    uint32_t n;
+    float norm;                   /* sum of w^2 */
+} rad__lm_row;
+
+static void rad__lm_row_add(rad__lm_row *row, uint32_t idx, float w)
+{
+    uint32_t k;
+    for (k = 0; k < row->n; ++k)
+        if (row->idx[k] == idx) { row->w[k] += w; return; }
+    row->idx[row->n] = idx;
+    row->w[row->n++] = w;
+}
+
+static float rad__lm_rows_jump(const rad__lm_row *rows, size_t count, uint32_t channels, const float *x)
+{
+    float worst = 0.0f;
+    size_t r;
+    uint32_t ch, k;
+    for (r = 0; r < count; ++r)
+        for (ch = 0; ch < channels; ++ch) {
+            float d = 0.0f;
+            for (k = 0; k < rows[r].n; ++k) d += rows[r].w[k] * x[(size_t)rows[r].idx[k] * channels + ch];
+            if (fabs((double)d) > worst) worst = (float)fabs((double)d);
+        }
+    return worst;
+}
+
+RAD_API rad_result rad_lightmap_stitch(const rad_lightmap *lm, uint32_t channels, float *values, uint32_t iterations,
+                                       rad_lightmap_seam_stats *stats, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_scene *S;
+    rad__lm_edge *edges = NULL;
+    rad__lm_row *rows = NULL;
+    size_t ne = 0, nrows = 0, cap = 0, i, j;
+    uint32_t t, seams = 0, it, ch;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (stats) memset(stats, 0, sizeof(*stats));
+    if (!lm || !values || channels == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap stitch: NULL lightmap or values, or zero channels");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (iterations == 0) iterations = 64;
+    S = lm->scene;
+    edges = (rad__lm_edge *)rad__alloc_array(&c.allocator, (size_t)S->triangle_count * 3u, sizeof(rad__lm_edge));
+    if (!edges) return RAD_ERROR_OUT_OF_MEMORY;
+    for (t = 0; t < S->triangle_count; ++t) {
+        int e;
+        if (!S->lightmapped[t]) continue;
+        for (e = 0; e < 3; ++e) {
+            rad__lm_edge *E = &edges[ne++];
+            const float *pa = S->positions + 9 * (size_t)t + 3 * e, *pb = S->positions + 9 * (size_t)t + 3 * ((e + 1) % 3);
+            const float *ua = S->lightmap_uvs + 6 * (size_t)t + 2 * e, *ub = S->lightmap_uvs + 6 * (size_t)t + 2 * ((e + 1) % 3);
+            if (rad__lm_pcmp(pa, pb) > 0) { const float *tmp = pa; pa = pb; pb = tmp; tmp = ua; ua = ub; ub = tmp; }
+            memcpy(E->a, pa, sizeof(E->a));
+            memcpy(E->b, pb, sizeof(E->b));
+            memcpy(E->ua, ua, sizeof(E->ua));
+            memcpy(E->ub, ub, sizeof(E->ub));
+            E->tri = t;
+        }
+    }
+    qsort(edges, ne, sizeof(rad__lm_edge), rad__lm_edge_cmp);
+    for (i = 0; i + 1 < ne; ++i) {
+        const rad__lm_edge *A = &edges[i], *Bv = &edges[i + 1];
+        double la, lb, tol = 1e-3 / (double)(lm->width > lm->height ? lm->width : lm->height);
+        uint32_t m, q;
+        if (rad__lm_pcmp(A->a, Bv->a) || rad__lm_pcmp(A->b, Bv->b) || A->tri == Bv->tri) continue;
+        if (rad__dot(S->normals + 3 * (size_t)A->tri, S->normals + 3 * (size_t)Bv->tri) < 0.8660254f) continue;
+        if (fabs((double)A->ua[0] - Bv->ua[0]) <= tol && fabs((double)A->ua[1] - Bv->ua[1]) <= tol &&
+            fabs((double)A->ub[0] - Bv->ub[0]) <= tol && fabs((double)A->ub[1] - Bv->ub[1]) <= tol)
+            continue; /* the same edge in the atlas: not a seam */
+        ++seams;
+        la = sqrt(pow(((double)A->ub[0] - A->ua[0]) * lm->width, 2) + pow(((double)A->ub[1] - A->ua[1]) * lm->height, 2));
+        lb = sqrt(pow(((double)Bv->ub[0] - Bv->ua[0]) * lm->width, 2) + pow(((double)Bv->ub[1] - Bv->ua[1]) * lm->height, 2));
+        if (lb > la) la = lb;
+        m = (uint32_t)ceil(2.0 * (la < 1e6 ? la : 1e6)) + 1u;
+        if (m < 2) m = 2;
+        for (q = 0; q <= m; ++q) {
+            float s = (float)q / (float)m, uvA[2], uvB[2], w[4];
+            uint32_t idx[4], k;
+            rad__lm_row *row;
+            if (nrows == cap) {
+                size_t nc = cap ? 2 * cap : 1024;
+                rad__lm_row *nr = (rad__lm_row *)rad__realloc(&c.allocator, rows, cap * sizeof(rad__lm_row), nc * sizeof(rad__lm_row));
+                if (!nr) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+                rows = nr;
+                cap = nc;
+            }
+            row = &rows[nrows];
+            row->n = 0;
+            for (k = 0; k < 2; ++k) {
+                uvA[k] = A->ua[k] + s * (A->ub[k] - A->ua[k]);
+                uvB[k] = Bv->ua[k] + s * (Bv->ub[k] - Bv->ua[k]);
+            }
+            rad__lm_taps(lm, uvA[0], uvA[1], idx, w);
+            for (k = 0; k < 4; ++k) if (w[k] != 0.0f) rad__lm_row_add(row, idx[k], w[k]);
+            rad__lm_taps(lm, uvB[0], uvB[1], idx, w);
+            for (k = 0; k < 4; ++k) if (w[k] != 0.0f) rad__lm_row_add(row, idx[k], -w[k]);
+            row->norm = 0.0f;
+            for (k = 0; k < row->n; ++k) row->norm += row->w[k] * row->w[k];
+            if (row->norm > 1e-12f) ++nrows;
+        }
+    }
+    if (stats) {
+        stats->seams = seams;
+        stats->sample_pairs = (uint32_t)(nrows < 0xFFFFFFFFu ? nrows : 0xFFFFFFFFu);
+        stats->max_jump_before = rad__lm_rows_jump(rows, nrows, channels, values);
+    }
+    /* Kaczmarz: each row's residual projected out in turn; from the baked values it converges
+       to their nearest (least-squares) point on the consistent set */
+    for (it = 0; it < iterations; ++it)
+        for (ch = 0; ch < channels; ++ch)
+            for (j = 0; j < nrows; ++j) {
+                const rad__lm_row *row = &rows[j];
+                float d = 0.0f;
+                uint32_t k;
+                for (k = 0; k < row->n; ++k) d += row->w[k] * values[(size_t)row->idx[k] * channels + ch];
+                d /= row->norm;
+                for (k = 0; k < row->n; ++k) values[(size_t)row->idx[k] * channels + ch] -= d * row->w[k];
+            }
+    if (stats) stats->max_jump_after = rad__lm_rows_jump(rows, nrows, channels, values);
+done:
+    rad__free(&c.allocator, edges);
+    rad__free(&c.allocator, rows);
+    if (r != RAD_SUCCESS) rad__log(&c, RAD_LOG_ERROR, "lightmap stitch: out of memory for %lu seam samples", (unsigned long)nrows);
+    return r;
+}
+
+/* ======================================================================================== */
 /* >>probes: irradiance probes (SH L2) from a patch solution                                */
 /* ======================================================================================== */
 
@@ -21942,6 +19402,2552 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
     if (spacing) *spacing = pr->spacing;
     return 1;
 }
+
+/* ======================================================================================== */
+/* >>shading: lighting models and BRDFs                                                     */
+/* ======================================================================================== */
+
+/* Everything here is float arithmetic written in the same order as glsl/lighting.glsl, so
+   that the C and GLSL results agree to a few ulps (the tests compare them). */
+
+#define RAD__INV_PI 0.318309886183790671537767526745f
+
+RAD_API void rad_lambert_params_default(rad_lambert_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+}
+
+RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->wrap = 1.0f;
+    p->exponent = 2.0f;
+}
+
+RAD_API void rad_banded_params_default(rad_banded_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->bands = 4;
+}
+
+RAD_API void rad_phong_params_default(rad_phong_params *p)
+{
+    if (!p) return;
+    p->diffuse[0] = p->diffuse[1] = p->diffuse[2] = 0.5f;
+    p->specular[0] = p->specular[1] = p->specular[2] = 0.3f;
+    p->shininess = 32.0f;
+}
+
+RAD_API void rad_minnaert_params_default(rad_minnaert_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->k = 0.8f;
+}
+
+RAD_API void rad_oren_nayar_params_default(rad_oren_nayar_params *p)
+{
+    if (!p) return;
+    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    p->sigma = 0.5f;
+}
+
+RAD_API void rad_microfacet_params_default(rad_microfacet_params *p)
+{
+    int k;
+    if (!p) return;
+    p->ndf = RAD_NDF_GGX;
+    p->masking = RAD_MASKING_HEIGHT_CORRELATED;
+    p->diffuse = RAD_DIFFUSE_LAMBERT;
+    p->alpha_x = p->alpha_y = 0.3f;
+    for (k = 0; k < 3; ++k) {
+        p->f0[k] = 0.04f;
+        p->f90[k] = 1.0f;
+        p->albedo[k] = 0.5f;
+    }
+    p->fresnel_exponent = 5.0f;
+}
+
+RAD_API void rad_shading_default(rad_shading *s, rad_shading_model model)
+{
+    if (!s) return;
+    memset(s, 0, sizeof(*s));
+    s->model = model;
+    rad_lambert_params_default(&s->lambert);
+    rad_half_lambert_params_default(&s->half_lambert);
+    rad_banded_params_default(&s->banded);
+    rad_phong_params_default(&s->phong);
+    rad_minnaert_params_default(&s->minnaert);
+    rad_oren_nayar_params_default(&s->oren_nayar);
+    rad_microfacet_params_default(&s->microfacet);
+}
+
+static const char *const rad__shading_names[RAD_SHADING_MODEL_COUNT] = {
+    "lambert", "half-lambert", "banded", "phong", "blinn-phong", "minnaert", "oren-nayar", "microfacet"
+};
+
+RAD_API const char *rad_shading_model_name(rad_shading_model model)
+{
+    if ((int)model < 0 || (int)model >= (int)RAD_SHADING_MODEL_COUNT) return NULL;
+    return rad__shading_names[model];
+}
+
+RAD_API rad_result rad_shading_model_from_name(const char *name, rad_shading_model *out_model)
+{
+    int i;
+    if (!name || !out_model) return RAD_ERROR_INVALID_ARGUMENT;
+    for (i = 0; i < (int)RAD_SHADING_MODEL_COUNT; ++i)
+        if (strcmp(name, rad__shading_names[i]) == 0) {
+            *out_model = (rad_shading_model)i;
+            return RAD_SUCCESS;
+        }
+    return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+/* value in [lo, hi]: 0 ok, else the error (NON_FINITE or INVALID_ARGUMENT), logged */
+static rad_result rad__shading_range(const rad__ctx *c, const char *what, const float *x, int count, float lo, float hi)
+{
+    int k;
+    for (k = 0; k < count; ++k) {
+        if (!rad__finite(x[k])) {
+            rad__log(c, RAD_LOG_ERROR, "shading: %s[%d] is not finite", what, k);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (x[k] < lo || x[k] > hi) {
+            rad__log(c, RAD_LOG_ERROR, "shading: %s[%d] = %g is outside [%g, %g]", what, k, (double)x[k], (double)lo,
+                     (double)hi);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__shading_validate(const rad_shading *s, const rad__ctx *c)
+{
+    rad_result r = RAD_SUCCESS;
+    if (!s) return RAD_ERROR_INVALID_ARGUMENT;
+    switch (s->model) {
+    case RAD_SHADING_LAMBERT: return rad__shading_range(c, "lambert.albedo", s->lambert.albedo, 3, 0.0f, 1.0f);
+    case RAD_SHADING_HALF_LAMBERT:
+        if ((r = rad__shading_range(c, "half_lambert.albedo", s->half_lambert.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "half_lambert.wrap", &s->half_lambert.wrap, 1, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "half_lambert.exponent", &s->half_lambert.exponent, 1, 1.0f, 8.0f);
+    case RAD_SHADING_BANDED:
+        if (s->banded.bands < 1 || s->banded.bands > 256) {
+            rad__log(c, RAD_LOG_ERROR, "shading: banded.bands = %u is outside [1, 256]", s->banded.bands);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        return rad__shading_range(c, "banded.albedo", s->banded.albedo, 3, 0.0f, 1.0f);
+    case RAD_SHADING_PHONG:
+    case RAD_SHADING_BLINN_PHONG:
+        if ((r = rad__shading_range(c, "phong.diffuse", s->phong.diffuse, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "phong.specular", s->phong.specular, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "phong.shininess", &s->phong.shininess, 1, 1.0f, 10000.0f);
+    case RAD_SHADING_MINNAERT:
+        if ((r = rad__shading_range(c, "minnaert.albedo", s->minnaert.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "minnaert.k", &s->minnaert.k, 1, 0.0f, 4.0f);
+    case RAD_SHADING_OREN_NAYAR:
+        if ((r = rad__shading_range(c, "oren_nayar.albedo", s->oren_nayar.albedo, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        return rad__shading_range(c, "oren_nayar.sigma", &s->oren_nayar.sigma, 1, 0.0f, 1.5f);
+    case RAD_SHADING_MICROFACET: {
+        const rad_microfacet_params *m = &s->microfacet;
+        if ((int)m->ndf < 0 || (int)m->ndf > (int)RAD_NDF_GGX || (int)m->masking < 0 ||
+            (int)m->masking > (int)RAD_MASKING_HEIGHT_CORRELATED || (int)m->diffuse < 0 ||
+            (int)m->diffuse > (int)RAD_DIFFUSE_SHIRLEY) {
+            rad__log(c, RAD_LOG_ERROR, "shading: microfacet ndf %d, masking %d or diffuse %d is not a valid value",
+                     (int)m->ndf, (int)m->masking, (int)m->diffuse);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if ((r = rad__shading_range(c, "microfacet.alpha_x", &m->alpha_x, 1, 1e-3f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.alpha_y", &m->alpha_y, 1, 1e-3f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.f0", m->f0, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.f90", m->f90, 3, 0.0f, 1.0f)) != RAD_SUCCESS) return r;
+        if ((r = rad__shading_range(c, "microfacet.fresnel_exponent", &m->fresnel_exponent, 1, 1.0f, 10.0f)) != RAD_SUCCESS)
+            return r;
+        return rad__shading_range(c, "microfacet.albedo", m->albedo, 3, 0.0f, 1.0f);
+    }
+    case RAD_SHADING_MODEL_COUNT: break;
+    }
+    rad__log(c, RAD_LOG_ERROR, "shading: unknown model %d", (int)s->model);
+    return RAD_ERROR_INVALID_ARGUMENT;
+}
+
+RAD_API rad_result rad_shading_validate(const rad_shading *s, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    return rad__shading_validate(s, &c);
+}
+
+static void rad__shading_pack(const rad_shading *s, rad_shading_gpu *g)
+{
+    int k;
+    const float *alb = s->lambert.albedo;
+    memset(g, 0, sizeof(*g));
+    g->mode[0] = (int32_t)s->model;
+    switch (s->model) {
+    case RAD_SHADING_HALF_LAMBERT:
+        alb = s->half_lambert.albedo;
+        g->p[2] = s->half_lambert.wrap;
+        g->p[3] = s->half_lambert.exponent;
+        break;
+    case RAD_SHADING_BANDED:
+        alb = s->banded.albedo;
+        g->p[3] = (float)s->banded.bands;
+        break;
+    case RAD_SHADING_PHONG:
+    case RAD_SHADING_BLINN_PHONG:
+        alb = s->phong.diffuse;
+        for (k = 0; k < 3; ++k) g->specular[k] = s->phong.specular[k];
+        g->p[2] = s->phong.shininess;
+        break;
+    case RAD_SHADING_MINNAERT: alb = s->minnaert.albedo; g->p[2] = s->minnaert.k; break;
+    case RAD_SHADING_OREN_NAYAR: alb = s->oren_nayar.albedo; g->p[2] = s->oren_nayar.sigma; break;
+    case RAD_SHADING_MICROFACET:
+        alb = s->microfacet.albedo;
+        for (k = 0; k < 3; ++k) {
+            g->f0[k] = s->microfacet.f0[k];
+            g->f90[k] = s->microfacet.f90[k];
+        }
+        g->p[0] = s->microfacet.alpha_x;
+        g->p[1] = s->microfacet.alpha_y;
+        g->p[3] = s->microfacet.fresnel_exponent;
+        g->mode[1] = (int32_t)s->microfacet.ndf;
+        g->mode[2] = (int32_t)s->microfacet.masking;
+        g->mode[3] = (int32_t)s->microfacet.diffuse;
+        break;
+    default: break;
+    }
+    for (k = 0; k < 3; ++k) g->albedo[k] = alb[k];
+}
+
+RAD_API rad_result rad_shading_pack(const rad_shading *s, rad_shading_gpu *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__shading_validate(s, &c)) != RAD_SUCCESS) return r;
+    rad__shading_pack(s, out);
+    return RAD_SUCCESS;
+}
+
+/* ---- terms of the microfacet model ---- */
+
+RAD_API float rad_ndf_beckmann(float nm, float alpha)
+{
+    float a2 = alpha * alpha, c2 = nm * nm;
+    if (!(nm > 0.0f)) return 0.0f;
+    return expf((c2 - 1.0f) / (a2 * c2)) / ((float)RAD__PI * a2 * c2 * c2);
+}
+
+RAD_API float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
+{
+    float c2 = nm * nm, e;
+    if (!(nm > 0.0f)) return 0.0f;
+    e = (tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y)) / c2;
+    return expf(-e) / ((float)RAD__PI * alpha_x * alpha_y * c2 * c2);
+}
+
+RAD_API float rad_ndf_ggx(float nm, float alpha)
+{
+    float a2 = alpha * alpha, d;
+    if (!(nm > 0.0f)) return 0.0f;
+    d = 1.0f + nm * nm * (a2 - 1.0f);
+    return a2 / ((float)RAD__PI * d * d);
+}
+
+RAD_API float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)
+{
+    float d;
+    if (!(nm > 0.0f)) return 0.0f;
+    d = tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y) + nm * nm;
+    return 1.0f / ((float)RAD__PI * alpha_x * alpha_y * d * d);
+}
+
+RAD_API float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)
+{
+    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;
+    if (!(d2 > 0.0f)) return HUGE_VALF;
+    return ns / sqrtf(d2);
+}
+
+RAD_API float rad_lambda_ggx(float a)
+{
+    if (!(a < HUGE_VALF)) return 0.0f;
+    return 0.5f * (-1.0f + sqrtf(1.0f + 1.0f / (a * a)));
+}
+
+RAD_API float rad_lambda_beckmann(float a)
+{
+    if (!(a < 1.6f)) return 0.0f;
+    return (1.0f - 1.259f * a + 0.396f * a * a) / (3.535f * a + 2.181f * a * a);
+}
+
+RAD_API float rad_lambda_beckmann_exact(float a)
+{
+    double x = (double)a;
+    if (!(a < HUGE_VALF)) return 0.0f;
+    return (float)(0.5 * (erf(x) - 1.0) + exp(-x * x) / (2.0 * x * sqrt(RAD__PI)));
+}
+
+RAD_API float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0f ? 1.0f / (1.0f + lambda_s) : 0.0f; }
+
+RAD_API float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)
+{
+    return (mv > 0.0f && ml > 0.0f) ? 1.0f / ((1.0f + lambda_v) * (1.0f + lambda_l)) : 0.0f;
+}
+
+RAD_API float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)
+{
+    return (mv > 0.0f && ml > 0.0f) ? 1.0f / (1.0f + lambda_v + lambda_l) : 0.0f;
+}
+
+RAD_API float rad_fresnel_schlick(float f0, float c)
+{
+    float x = 1.0f - (c > 0.0f ? c : 0.0f), x2 = x * x;
+    return f0 + (1.0f - f0) * (x2 * x2 * x);
+}
+
+RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)
+{
+    return f0 + (f90 - f0) * powf(1.0f - (c > 0.0f ? c : 0.0f), exponent);
+}
+
+RAD_API float rad_diffuse_lambert(float albedo, float F) { return (1.0f - F) * albedo * RAD__INV_PI; }
+
+RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)
+{
+    float a = 1.0f - (nl > 0.0f ? nl : 0.0f), b = 1.0f - (nv > 0.0f ? nv : 0.0f);
+    float a5 = a * a * a * a * a, b5 = b * b * b * b * b;
+    return (1.0f - f0) * (21.0f / 20.0f) * albedo * RAD__INV_PI * (1.0f - a5) * (1.0f - b5);
+}
+
+/* ---- the evaluator, the mirror of glsl/lighting.glsl's shade() ---- */
+
+static float rad__sdot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Lambda from n.s, t.s, b.s without forming a (no division by zero at s = n) */
+static float rad__shading_lambda(int ndf, int iso, float ns, float ts, float bs, float ax, float ay)
+{
+    float d2 = iso ? ax * ax * (1.0f - ns * ns) : ax * ax * ts * ts + ay * ay * bs * bs;
+    float a;
+    if (!(d2 > 0.0f)) return 0.0f;
+    if (ndf == (int)RAD_NDF_GGX) return 0.5f * (-1.0f + sqrtf(1.0f + d2 / (ns * ns)));
+    a = ns / sqrtf(d2);
+    return rad_lambda_beckmann(a);
+}
+
+/* f and R of a packed material for unit l, v, n and orthonormal t, b (any when isotropic) */
+static void rad__shade(const rad_shading_gpu *g, const float *l, const float *v, const float *n, const float *t,
+                       const float *b, float *out_f, float *out_r)
+{
+    float nl = rad__sdot(n, l), nv = rad__sdot(n, v), f[3] = {0.0f, 0.0f, 0.0f}, rr[3] = {0.0f, 0.0f, 0.0f};
+    int k, model = g->mode[0];
+    if (nv > 0.0f) {
+        if (model == (int)RAD_SHADING_HALF_LAMBERT) {
+            float x = (nl + g->p[2]) / (1.0f + g->p[2]);
+            float q = powf(x > 0.0f ? x : 0.0f, g->p[3]);
+            for (k = 0; k < 3; ++k) rr[k] = g->albedo[k] * RAD__INV_PI * q;
+        } else if (nl > 0.0f) {
+            if (model == (int)RAD_SHADING_LAMBERT) {
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI;
+            } else if (model == (int)RAD_SHADING_BANDED) {
+                float q = ceilf(g->p[3] * nl) / g->p[3] / nl;
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI * q;
+            } else if (model == (int)RAD_SHADING_PHONG) {
+                float r[3], rv, s = g->p[2], q;
+                for (k = 0; k < 3; ++k) r[k] = 2.0f * nl * n[k] - l[k];
+                rv = rad__sdot(r, v);
+                q = (s + 2.0f) * (0.5f * RAD__INV_PI) * powf(rv > 0.0f ? rv : 0.0f, s);
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI + g->specular[k] * q;
+            } else if (model == (int)RAD_SHADING_BLINN_PHONG) {
+                float h[3], len, nh = 0.0f, s = g->p[2], q;
+                for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
+                len = sqrtf(rad__sdot(h, h));
+                if (len > 0.0f) nh = rad__sdot(n, h) / len;
+                q = (s + 2.0f) * (s + 4.0f) * (0.125f * RAD__INV_PI) / (exp2f(-0.5f * s) + s) * powf(nh > 0.0f ? nh : 0.0f, s);
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI + g->specular[k] * q;
+            } else if (model == (int)RAD_SHADING_MINNAERT) {
+                float kk = g->p[2], c = nl * nv;
+                float q = (kk + 1.0f) * (0.5f * RAD__INV_PI) * powf(c > 1e-6f ? c : 1e-6f, kk - 1.0f);
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * q;
+            } else if (model == (int)RAD_SHADING_OREN_NAYAR) {
+                float s2 = g->p[2] * g->p[2], A = 1.0f - 0.5f * s2 / (s2 + 0.33f), B = 0.45f * s2 / (s2 + 0.09f);
+                float s = rad__sdot(l, v) - nl * nv, q = s > 0.0f ? s / (nl > nv ? nl : nv) : 0.0f;
+                for (k = 0; k < 3; ++k) f[k] = g->albedo[k] * RAD__INV_PI * (A + B * q);
+            } else if (model == (int)RAD_SHADING_MICROFACET) {
+                float h[3], len, nh, th, bh, lh, vh, ax = g->p[0], ay = g->p[1], D, G, lv, ll, sp;
+                int iso = ax == ay, ndf = g->mode[1];
+                for (k = 0; k < 3; ++k) h[k] = l[k] + v[k];
+                len = sqrtf(rad__sdot(h, h));
+                if (len > 0.0f) {
+                    for (k = 0; k < 3; ++k) h[k] /= len;
+                    nh = rad__sdot(n, h); lh = rad__sdot(l, h); vh = rad__sdot(v, h);
+                    if (iso) {
+                        th = bh = 0.0f;
+                        D = ndf == (int)RAD_NDF_GGX ? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);
+                    } else {
+                        th = rad__sdot(t, h); bh = rad__sdot(b, h);
+                        D = ndf == (int)RAD_NDF_GGX ? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)
+                                                    : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);
+                    }
+                    lv = rad__shading_lambda(ndf, iso, nv, iso ? 0.0f : rad__sdot(t, v), iso ? 0.0f : rad__sdot(b, v), ax, ay);
+                    ll = rad__shading_lambda(ndf, iso, nl, iso ? 0.0f : rad__sdot(t, l), iso ? 0.0f : rad__sdot(b, l), ax, ay);
+                    G = g->mode[2] == (int)RAD_MASKING_SEPARABLE ? rad_smith_g2_separable(vh, lh, lv, ll)
+                                                                : rad_smith_g2_height_correlated(vh, lh, lv, ll);
+                    sp = G * D / (4.0f * nl * nv);
+                    for (k = 0; k < 3; ++k) f[k] = rad_fresnel_schlick_f90(g->f0[k], g->f90[k], g->p[3], lh) * sp;
+                }
+                for (k = 0; k < 3; ++k) {
+                    if (g->mode[3] == (int)RAD_DIFFUSE_LAMBERT)
+                        f[k] += rad_diffuse_lambert(g->albedo[k], rad_fresnel_schlick_f90(g->f0[k], g->f90[k], g->p[3], nl));
+                    else if (g->mode[3] == (int)RAD_DIFFUSE_SHIRLEY)
+                        f[k] += rad_diffuse_shirley(g->albedo[k], g->f0[k], nl, nv);
+                }
+            }
+            for (k = 0; k < 3; ++k) rr[k] = f[k] * nl;
+        }
+    }
+    for (k = 0; k < 3; ++k) {
+        if (out_f) out_f[k] = f[k];
+        if (out_r) out_r[k] = rr[k];
+    }
+}
+
+/* normalizes src into dst; 0 on a zero or non-finite vector (result set) */
+static rad_result rad__shading_unit(const rad__ctx *c, const char *what, const float *src, float *dst)
+{
+    double len;
+    int k;
+    if (!rad__finite3(src)) {
+        rad__log(c, RAD_LOG_ERROR, "shading: vector %s is not finite", what);
+        return RAD_ERROR_NON_FINITE;
+    }
+    len = sqrt((double)src[0] * src[0] + (double)src[1] * src[1] + (double)src[2] * src[2]);
+    if (!(len > 1e-30)) {
+        rad__log(c, RAD_LOG_ERROR, "shading: vector %s has zero length", what);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (k = 0; k < 3; ++k) dst[k] = (float)(src[k] / len);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__shading_entry(const rad_shading *s, const float *l, const float *v, const float *n,
+                                     const float *t, const float *b, float *out, int want_f, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_result r;
+    rad_shading_gpu g;
+    float L[3], V[3], N[3], T[3] = {0.0f, 0.0f, 0.0f}, B[3] = {0.0f, 0.0f, 0.0f};
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!s || !l || !v || !n || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "shading: NULL material, vector or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((r = rad__shading_validate(s, &c)) != RAD_SUCCESS) return r;
+    if (want_f && s->model == RAD_SHADING_HALF_LAMBERT) {
+        rad__log(&c, RAD_LOG_ERROR, "shading: half-Lambert lights n.l < 0 and has no BRDF; use rad_shading_eval");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((r = rad__shading_unit(&c, "l", l, L)) != RAD_SUCCESS) return r;
+    if ((r = rad__shading_unit(&c, "v", v, V)) != RAD_SUCCESS) return r;
+    if ((r = rad__shading_unit(&c, "n", n, N)) != RAD_SUCCESS) return r;
+    if (s->model == RAD_SHADING_MICROFACET && s->microfacet.alpha_x != s->microfacet.alpha_y) {
+        float tt[3], d;
+        if (!t) {
+            rad__log(&c, RAD_LOG_ERROR, "shading: an anisotropic microfacet model needs the tangent t");
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (!rad__finite3(t) || (b && !rad__finite3(b))) {
+            rad__log(&c, RAD_LOG_ERROR, "shading: vector t or b is not finite");
+            return RAD_ERROR_NON_FINITE;
+        }
+        d = rad__sdot(t, N);
+        for (k = 0; k < 3; ++k) tt[k] = t[k] - d * N[k];
+        if ((r = rad__shading_unit(&c, "t (minus its n component)", tt, T)) != RAD_SUCCESS) return r;
+        if (b) {
+            float bb[3], e = rad__sdot(b, N), f = rad__sdot(b, T);
+            for (k = 0; k < 3; ++k) bb[k] = b[k] - e * N[k] - f * T[k];
+            if ((r = rad__shading_unit(&c, "b (minus its n and t components)", bb, B)) != RAD_SUCCESS) return r;
+        } else {
+            B[0] = N[1] * T[2] - N[2] * T[1];
+            B[1] = N[2] * T[0] - N[0] * T[2];
+            B[2] = N[0] * T[1] - N[1] * T[0];
+        }
+    }
+    rad__shading_pack(s, &g);
+    if (want_f) rad__shade(&g, L, V, N, T, B, out, NULL);
+    else rad__shade(&g, L, V, N, T, B, NULL, out);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_shading_brdf(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx)
+{
+    return rad__shading_entry(s, l, v, n, t, b, out_rgb, 1, ctx);
+}
+
+RAD_API rad_result rad_shading_eval(const rad_shading *s, const float l[3], const float v[3], const float n[3],
+                                    const float t[3], const float b[3], float out_rgb[3], const rad_context *ctx)
+{
+    return rad__shading_entry(s, l, v, n, t, b, out_rgb, 0, ctx);
+}
+
+RAD_API void rad_shade(const rad_shading_gpu *g, const float l[3], const float v[3], const float n[3], const float t[3],
+                       const float b[3], float out_f[3], float out_r[3])
+{
+    static const float zero[3] = { 0.0f, 0.0f, 0.0f };
+    rad__shade(g, l, v, n, t ? t : zero, b ? b : zero, out_f, out_r);
+}
+
+typedef char rad__check_shading_gpu_size[(sizeof(rad_shading_gpu) == 96) ? 1 : -1];
+
+/* ======================================================================================== */
+/* >>container: baked data                                                                  */
+/* ======================================================================================== */
+
+typedef char rad__check_patch_size[(sizeof(rad_patch) == 68) ? 1 : -1];
+typedef char rad__check_signature_size[(sizeof(rad_bake_signature) == 32) ? 1 : -1];
+
+struct rad_container {
+    rad_section *sections;
+    uint32_t count;
+    rad_allocator allocator;
+};
+
+RAD_API rad_result rad_container_size(const rad_section *sections, uint32_t count, size_t *out_bytes)
+{
+    uint64_t at, bytes;
+    uint32_t i;
+    if (!out_bytes || (count > 0 && !sections)) return RAD_ERROR_INVALID_ARGUMENT;
+    if (count > RAD__MAX_SECTIONS) return RAD_ERROR_SIZE_OVERFLOW;
+    at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
+    for (i = 0; i < count; ++i) {
+        if (sections[i].elem_size == 0 || (sections[i].count > 0 && !sections[i].data)) return RAD_ERROR_INVALID_ARGUMENT;
+        if (sections[i].count > UINT64_MAX / sections[i].elem_size) return RAD_ERROR_SIZE_OVERFLOW;
+        bytes = sections[i].count * sections[i].elem_size;
+        if (bytes > UINT64_MAX - at - RAD__ALIGN) return RAD_ERROR_SIZE_OVERFLOW;
+        at = rad__align_up(at + bytes);
+    }
+    if (at > (uint64_t)(size_t)-1) return RAD_ERROR_SIZE_OVERFLOW;
+    *out_bytes = (size_t)at;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t count, void *dst, size_t dst_size)
+{
+    unsigned char *base = (unsigned char *)dst;
+    size_t need;
+    uint64_t at;
+    uint32_t i;
+    rad_result r = rad_container_size(sections, count, &need);
+    if (r != RAD_SUCCESS) return r;
+    if (!dst || dst_size < need) return RAD_ERROR_INVALID_ARGUMENT;
+    memset(base, 0, need);
+    at = rad__align_up(RAD__HEADER_BYTES + (uint64_t)RAD__ENTRY_BYTES * count);
+    for (i = 0; i < count; ++i) {
+        unsigned char *e = base + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
+        uint64_t bytes = sections[i].count * sections[i].elem_size;
+        size_t nl = 0;
+        if (bytes) memcpy(base + at, sections[i].data, (size_t)bytes);
+        rad__put32(e + RAD__E_TYPE, sections[i].type);
+        rad__put32(e + RAD__E_ELEM_SIZE, sections[i].elem_size);
+        rad__put64(e + RAD__E_COUNT, sections[i].count);
+        rad__put64(e + RAD__E_OFFSET, at);
+        rad__put64(e + RAD__E_BYTES, bytes);
+        rad__put32(e + RAD__E_CRC, rad__crc32(base + at, (size_t)bytes));
+        while (nl < sizeof(sections[i].name) - 1 && sections[i].name[nl]) ++nl;
+        memcpy(e + RAD__E_NAME, sections[i].name, nl);
+        at = rad__align_up(at + bytes);
+    }
+    memcpy(base, "RADB", 4);
+    rad__put32(base + RAD__H_VERSION, RAD_CONTAINER_VERSION);
+    rad__put32(base + RAD__H_COUNT, count);
+    rad__put32(base + RAD__H_HEADER_SIZE, RAD__HEADER_BYTES);
+    rad__put64(base + RAD__H_TABLE, RAD__HEADER_BYTES);
+    rad__put64(base + RAD__H_FILE_SIZE, (uint64_t)need);
+    rad__put32(base + RAD__H_FLAGS, rad__host_big_endian() ? RAD__FLAG_BIG_ENDIAN : 0u);
+    rad__put32(base + RAD__H_TABLE_CRC, rad__crc32(base + RAD__HEADER_BYTES, (size_t)RAD__ENTRY_BYTES * count));
+    rad__put32(base + RAD__H_CRC, rad__crc32(base, RAD__H_CRC));
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_container_destroy(rad_container *c)
+{
+    rad_allocator a;
+    if (!c) return;
+    a = c->allocator;
+    rad__free(&a, c->sections);
+    rad__free(&a, c);
+}
+
+RAD_API rad_result rad_container_create(const void *data, size_t size, const rad_context *ctx, rad_container **out)
+{
+    rad__ctx c;
+    const unsigned char *p = (const unsigned char *)data;
+    rad__header h;
+    uint32_t i;
+    rad_result r;
+    rad_container *ct;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data) return RAD_ERROR_INVALID_ARGUMENT;
+    if (((uintptr_t)data & 7u) != 0) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data must start on an 8-byte boundary (it is read in place)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (size < RAD__HEADER_BYTES) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data: %llu bytes, shorter than the %u-byte header", (unsigned long long)size, RAD__HEADER_BYTES);
+        return size >= 4 && memcmp(p, "RADB", 4) != 0 ? RAD_ERROR_CORRUPT : RAD_ERROR_TRUNCATED;
+    }
+    if ((r = rad__header_parse(p, (uint64_t)size, &c, "baked data", &h)) != RAD_SUCCESS ||
+        (r = rad__table_check(p, p + RAD__HEADER_BYTES, h.count, &c, "baked data")) != RAD_SUCCESS)
+        return r;
+    ct = (rad_container *)rad__alloc(&c.allocator, sizeof(rad_container));
+    if (!ct) return RAD_ERROR_OUT_OF_MEMORY;
+    ct->allocator = c.allocator;
+    ct->count = h.count;
+    ct->sections = (rad_section *)rad__alloc_array(&c.allocator, h.count ? h.count : 1u, sizeof(rad_section));
+    if (!ct->sections) { rad__free(&c.allocator, ct); return RAD_ERROR_OUT_OF_MEMORY; }
+    for (i = 0; i < h.count; ++i) {
+        const unsigned char *e = p + RAD__HEADER_BYTES + (size_t)RAD__ENTRY_BYTES * i;
+        rad_section *sec = &ct->sections[i];
+        rad__entry x;
+        const char *why = rad__entry_parse(e, &h, &x);
+        memset(sec, 0, sizeof(*sec));
+        sec->type = x.type;
+        sec->elem_size = x.elem_size;
+        sec->count = x.count;
+        memcpy(sec->name, e + RAD__E_NAME, 24);
+        if (!why && x.crc != rad__crc32(p + x.offset, (size_t)x.bytes)) why = "checksum mismatch";
+        if (why) {
+            rad__log(&c, RAD_LOG_ERROR, "baked data: section %u (type %u, '%.23s'): %s", i, sec->type, sec->name, why);
+            rad_container_destroy(ct);
+            return RAD_ERROR_CORRUPT;
+        }
+        sec->data = p + x.offset;
+    }
+    *out = ct;
+    return RAD_SUCCESS;
+}
+
+RAD_API uint32_t rad_container_section_count(const rad_container *c) { return c ? c->count : 0; }
+
+RAD_API const char *rad_section_type_name(uint32_t type)
+{
+    static const char *const names[] = {
+        NULL, "PATCHES", "PATCH_VERTICES", "TRIANGLES", "FF_DENSE", "FF_ROW_OFFSETS", "FF_COLUMNS", "FF_VALUES",
+        "VECTOR", "SIGNATURE", NULL, NULL, NULL, NULL, NULL, NULL,
+        "MB_INFO", "MB_FLOAT", "MB_HALF", "MB_ROW_PERM", "MB_COL_PERM", "MB_BC1", "MB_BC4", "MB_SCALES",
+        "MB_OUTLIER_OFFSETS", "MB_OUTLIER_COLUMNS", "MB_OUTLIER_VALUES", NULL, NULL, NULL, NULL, NULL,
+        "TEMPORAL_ROW_OFFSETS", "TEMPORAL_BINS", "TEMPORAL_TOTALS", NULL, NULL, NULL, NULL, NULL,
+        "VP_INFO", "VP_AREAS", "VP_ALBEDO", "VP_NORMALS", "VP_AXIS", "VP_VOXEL", "VP_VOXEL_KEYS", "VP_VOXEL_FIRST",
+        "VP_VOXEL_PATCH", "VP_SAMPLE_FIRST", "VP_SAMPLE_POSITIONS", "VP_SAMPLE_NORMALS", "VP_SAMPLE_ALBEDO",
+        "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES"
+    };
+    if (type >= RAD_SECTION_USER) return "USER";
+    return type < sizeof(names) / sizeof(names[0]) ? names[type] : NULL;
+}
+
+RAD_API const rad_section *rad_container_section(const rad_container *c, uint32_t index)
+{
+    return (c && index < c->count) ? &c->sections[index] : NULL;
+}
+
+RAD_API const rad_section *rad_container_find(const rad_container *c, uint32_t type, const char *name)
+{
+    uint32_t i;
+    if (!c) return NULL;
+    for (i = 0; i < c->count; ++i)
+        if (c->sections[i].type == type && (!name || strcmp(c->sections[i].name, name) == 0)) return &c->sections[i];
+    return NULL;
+}
+
+static int rad__all_finite(const float *v, uint64_t n)
+{
+    uint64_t i;
+    for (i = 0; i < n; ++i)
+        if (!rad__finite(v[i])) return 0;
+    return 1;
+}
+
+/* the float fields of a patch record: finite (NON_FINITE), of magnitude <= RAD_BAKE_VALUE_MAX
+   (CORRUPT) except the area (it grows with the square of the scene's scale, and rad_system
+   only divides areas by areas), emission >= 0 (NEGATIVE_EMISSION) */
+static rad_result rad__check_patch_values(const rad__ctx *c, const rad_patch *p, uint32_t i)
+{
+    float f[13];
+    uint32_t k;
+    memcpy(f, p->centroid, 3 * sizeof(float));
+    memcpy(f + 3, p->normal, 3 * sizeof(float));
+    f[6] = p->area;
+    memcpy(f + 7, p->albedo, 3 * sizeof(float));
+    memcpy(f + 10, p->emission, 3 * sizeof(float));
+    for (k = 0; k < 13; ++k)
+        if (!rad__all_finite(f + k, 1) || (k != 6 && (f[k] > RAD_BAKE_VALUE_MAX || f[k] < -RAD_BAKE_VALUE_MAX))) {
+            const int finite = rad__finite(f[k]);
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has %s %g (%s)", i,
+                     k < 3 ? "centroid" : k < 6 ? "normal" : k == 6 ? "area" : k < 10 ? "albedo" : "emission", (double)f[k],
+                     finite ? "beyond RAD_BAKE_VALUE_MAX = 1e30" : "not finite");
+            return finite ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE;
+        }
+    for (k = 10; k < 13; ++k)
+        if (f[k] < 0.0f) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u (PATCHES) has emission %g", i, (double)f[k]);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+    return RAD_SUCCESS;
+}
+
+/* ---- scene hashes and the signature ---- */
+
+RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    size_t i;
+    if (!p) return hash;
+    for (i = 0; i < size; ++i) hash = (hash ^ p[i]) * 0x100000001B3ull;
+    return hash;
+}
+
+/* hash of n uint32 words (or float bit patterns) as little-endian bytes */
+static uint64_t rad__hash_words(uint64_t h, const void *words, size_t n)
+{
+    const unsigned char *p = (const unsigned char *)words;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        uint32_t w;
+        unsigned char b[4];
+        memcpy(&w, p + 4 * i, 4);
+        rad__put32(b, w);
+        h = rad_hash64(b, 4, h);
+    }
+    return h;
+}
+
+RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials)
+{
+    uint64_t g = RAD_HASH64_INIT, m = RAD_HASH64_INIT;
+    uint32_t t, flag;
+    if (out_geometry) *out_geometry = 0;
+    if (out_materials) *out_materials = 0;
+    if (!scene || !scene->positions || !scene->materials || !scene->materials_table) return RAD_ERROR_INVALID_ARGUMENT;
+    g = rad__hash_words(g, &scene->triangle_count, 1);
+    g = rad__hash_words(g, scene->positions, 9u * (size_t)scene->triangle_count);
+    m = rad__hash_words(m, &scene->triangle_count, 1);
+    for (t = 0; t < scene->triangle_count; ++t) {
+        const uint32_t mi = scene->materials[t];
+        if (mi >= scene->material_count) return RAD_ERROR_INVALID_ARGUMENT;
+        m = rad__hash_words(m, scene->materials_table[mi].albedo, 3);
+        m = rad__hash_words(m, scene->materials_table[mi].emission, 3);
+        m = rad__hash_words(m, &scene->materials_table[mi].texture, 1);
+    }
+    flag = scene->uvs ? 1u : 0u;
+    m = rad__hash_words(m, &flag, 1);
+    if (scene->uvs) m = rad__hash_words(m, scene->uvs, 6u * (size_t)scene->triangle_count);
+    if (out_geometry) *out_geometry = g;
+    if (out_materials) *out_materials = m;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_bake_matches_scene(const rad_bake *bake, const rad_scene *scene, uint64_t options, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_bake_signature *s;
+    uint64_t g = 0, m = 0;
+    int dg, dm, dopt;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!bake || !scene) return RAD_ERROR_INVALID_ARGUMENT;
+    if (bake->patches.triangle_count != scene->triangle_count) {
+        rad__log(&c, RAD_LOG_ERROR, "baked data was made from another scene: the geometry differs (%u triangles in the bake, %u in the scene)",
+                 bake->patches.triangle_count, scene->triangle_count);
+        return RAD_ERROR_SCENE_MISMATCH;
+    }
+    s = bake->signature;
+    if (!s) {
+        rad__log(&c, RAD_LOG_WARNING, "baked data has no signature (saved without its scene, or by an older version): only its triangle count (%u) was compared",
+                 scene->triangle_count);
+        return RAD_SUCCESS;
+    }
+    if ((r = rad_scene_hash(scene, &g, &m)) != RAD_SUCCESS) return r;
+    dg = s->geometry != 0 && s->geometry != g;
+    dm = s->materials != 0 && s->materials != m;
+    dopt = options != 0 && s->options != 0 && s->options != options;
+    if (!dg && !dm && !dopt) return RAD_SUCCESS;
+    {
+        const char *part[3];
+        char list[64];
+        int np = 0, i;
+        if (dg) part[np++] = "geometry";
+        if (dm) part[np++] = "materials";
+        if (dopt) part[np++] = "options";
+        list[0] = '\0';
+        for (i = 0; i < np; ++i) {
+            if (i > 0) strcat(list, i == np - 1 ? " and " : ", ");
+            strcat(list, part[i]);
+        }
+        rad__log(&c, RAD_LOG_ERROR,
+                 "baked data was made from another scene or with other options: the %s differ%s (bake / scene hashes: geometry "
+                 "%016llx / %016llx, materials %016llx / %016llx, options %016llx / %016llx)",
+                 list, np == 1 && !dm && !dopt ? "s" : "", (unsigned long long)s->geometry, (unsigned long long)g,
+                 (unsigned long long)s->materials, (unsigned long long)m, (unsigned long long)s->options,
+                 (unsigned long long)options);
+    }
+    return RAD_ERROR_SCENE_MISMATCH;
+}
+
+RAD_API void rad_free_buffer(void *buffer, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    rad__free(&c.allocator, buffer);
+}
+
+RAD_API rad_result rad_save_memory(const rad_patches *P, const rad_matrix *F, const float *E, const float *B,
+                                   const rad_context *ctx, void **out, size_t *out_size)
+{
+    rad__ctx c;
+    rad_section s[9];
+    rad_bake_signature sig;
+    uint32_t n = 0, t, *tri = NULL;
+    size_t bytes;
+    void *buf;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out || !out_size) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    *out_size = 0;
+    if (!P || P->count == 0) return RAD_ERROR_INVALID_ARGUMENT;
+    if (F) {
+        r = rad__check_matrix(F, &c);
+        if (r != RAD_SUCCESS) return r;
+        if (F->rows != P->count || F->cols != P->count) {
+            rad__log(&c, RAD_LOG_ERROR, "save: the matrix is %u x %u but there are %u patches", F->rows, F->cols, P->count);
+            return RAD_ERROR_SIZE_MISMATCH;
+        }
+        /* what the loader would refuse is not written */
+        r = F->storage == RAD_STORAGE_DENSE
+                ? rad__check_values(&c, "dense form factors (FF_DENSE)", F->dense, (uint64_t)F->rows * F->cols, 1)
+                : rad__check_values(&c, "sparse form factors (FF_VALUES)", F->values, F->row_offsets[F->rows], 1);
+        if (r != RAD_SUCCESS) return r;
+    }
+    for (t = 0; t < P->count; ++t)
+        if ((r = rad__check_patch_values(&c, &P->patches[t], t)) != RAD_SUCCESS) return r;
+    if (E && (r = rad__check_values(&c, "vector 'E'", E, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
+    if (B && (r = rad__check_values(&c, "vector 'B'", B, 3u * (uint64_t)P->count, 0)) != RAD_SUCCESS) return r;
+    memset(&sig, 0, sizeof(sig));
+    if (P->scene && (r = rad_scene_hash(P->scene, &sig.geometry, &sig.materials)) != RAD_SUCCESS) return r;
+    tri = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)P->triangle_count * 2u, sizeof(uint32_t));
+    if (!tri) return RAD_ERROR_OUT_OF_MEMORY;
+    for (t = 0; t < P->triangle_count; ++t) { tri[2 * (size_t)t] = P->first_patch[t]; tri[2 * (size_t)t + 1] = P->subdivision[t]; }
+    rad__section(&s[n++], RAD_SECTION_PATCHES, sizeof(rad_patch), P->count, P->patches, "patches");
+    rad__section(&s[n++], RAD_SECTION_PATCH_VERTICES, 3 * sizeof(float), P->vertex_count, P->vertices, "vertices");
+    rad__section(&s[n++], RAD_SECTION_TRIANGLES, 2 * sizeof(uint32_t), P->triangle_count, tri, "triangles");
+    if (F && F->storage == RAD_STORAGE_DENSE) {
+        rad__section(&s[n++], RAD_SECTION_FF_DENSE, sizeof(float), (uint64_t)F->rows * F->cols, F->dense, "F");
+    } else if (F) {
+        uint64_t nnz = F->row_offsets[F->rows];
+        rad__section(&s[n++], RAD_SECTION_FF_ROW_OFFSETS, sizeof(uint64_t), (uint64_t)F->rows + 1u, F->row_offsets, "F");
+        rad__section(&s[n++], RAD_SECTION_FF_COLUMNS, sizeof(uint32_t), nnz, F->columns, "F");
+        rad__section(&s[n++], RAD_SECTION_FF_VALUES, sizeof(float), nnz, F->values, "F");
+    }
+    if (E) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, E, "E");
+    if (B) rad__section(&s[n++], RAD_SECTION_VECTOR, 3 * sizeof(float), P->count, B, "B");
+    if (P->scene) rad__section(&s[n++], RAD_SECTION_SIGNATURE, (uint32_t)sizeof(sig), 1, &sig, "signature");
+    r = rad_container_size(s, n, &bytes);
+    if (r != RAD_SUCCESS) { rad__free(&c.allocator, tri); return r; }
+    buf = rad__alloc(&c.allocator, bytes);
+    if (!buf) { rad__free(&c.allocator, tri); return RAD_ERROR_OUT_OF_MEMORY; }
+    r = rad_container_write(s, n, buf, bytes);
+    rad__free(&c.allocator, tri);
+    if (r != RAD_SUCCESS) { rad__free(&c.allocator, buf); return r; }
+    *out = buf;
+    *out_size = bytes;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_bake_destroy(rad_bake *b)
+{
+    rad_allocator a;
+    if (!b) return;
+    a = b->allocator;
+    rad_container_destroy(b->container);
+    rad__free(&a, b->patches.areas);
+    rad__free(&a, b->patches.albedo);
+    rad__free(&a, b->patches.first_patch);
+    rad__free(&a, b->patches.subdivision);
+    rad__free(&a, b->owned);
+    rad__free(&a, b);
+}
+
+/* the single section of 'type' (named when name is given), checked for its element size */
+static rad_result rad__bake_section(const rad__ctx *c, const rad_container *ct, uint32_t type, const char *name,
+                                    uint32_t elem_size, int required, const rad_section **out)
+{
+    const rad_section *s = rad_container_find(ct, type, name);
+    *out = NULL;
+    if (!s) {
+        if (!required) return RAD_SUCCESS;
+        rad__log(c, RAD_LOG_ERROR, "baked data: section of type %u ('%s') is missing", type, name ? name : "");
+        return RAD_ERROR_CORRUPT;
+    }
+    if (s->elem_size != elem_size) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: section type %u has %u-byte elements, expected %u", type, s->elem_size, elem_size);
+        return RAD_ERROR_CORRUPT;
+    }
+    *out = s;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
+{
+    const rad_section *sp, *sv, *st, *sd, *so, *sc, *sx, *se, *sb;
+    rad_result r;
+    uint32_t N, i, k;
+    uint64_t T;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_PATCHES, NULL, sizeof(rad_patch), 1, &sp)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_PATCH_VERTICES, NULL, 12, 1, &sv)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_TRIANGLES, NULL, 8, 1, &st)) != RAD_SUCCESS) return r;
+    if (sp->count == 0 || sp->count >= RAD_NONE || sv->count >= RAD_NONE || st->count >= RAD_NONE) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: %llu patches, %llu vertices, %llu triangles (out of range)",
+                 (unsigned long long)sp->count, (unsigned long long)sv->count, (unsigned long long)st->count);
+        return RAD_ERROR_CORRUPT;
+    }
+    N = (uint32_t)sp->count;
+    T = st->count;
+    b->patches.count = N;
+    b->patches.patches = (rad_patch *)(uintptr_t)sp->data;
+    b->patches.vertex_count = (uint32_t)sv->count;
+    b->patches.vertices = (float *)(uintptr_t)sv->data;
+    b->patches.triangle_count = (uint32_t)T;
+    if ((r = rad__check_values(c, "patch vertices (PATCH_VERTICES)", b->patches.vertices, sv->count * 3u, 0)) != RAD_SUCCESS) return r;
+    b->patches.first_patch = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
+    b->patches.subdivision = (uint32_t *)rad__alloc_array(&b->allocator, T ? (size_t)T : 1u, sizeof(uint32_t));
+    b->patches.areas = (float *)rad__alloc_array(&b->allocator, N, sizeof(float));
+    b->patches.albedo = (float *)rad__alloc_array(&b->allocator, (size_t)N * 3u, sizeof(float));
+    if (!b->patches.first_patch || !b->patches.subdivision || !b->patches.areas || !b->patches.albedo) return RAD_ERROR_OUT_OF_MEMORY;
+    for (i = 0; i < (uint32_t)T; ++i) {
+        const uint32_t *tv = (const uint32_t *)st->data + 2 * (size_t)i;
+        uint64_t n = tv[1];
+        b->patches.first_patch[i] = tv[0];
+        b->patches.subdivision[i] = tv[1];
+        if (n == 0 || n > 65535u || (uint64_t)tv[0] + n * n > N) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: triangle %u claims patches [%u, %llu) of %u", i, tv[0],
+                     (unsigned long long)((uint64_t)tv[0] + n * n), N);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+    }
+    for (i = 0; i < N; ++i) {
+        const rad_patch *p = &b->patches.patches[i];
+        for (k = 0; k < 3; ++k)
+            if (p->vertices[k] >= b->patches.vertex_count) {
+                rad__log(c, RAD_LOG_ERROR, "baked data: patch %u uses vertex %u of %u", i, p->vertices[k], b->patches.vertex_count);
+                return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        if (p->triangle >= T) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u lies on triangle %u of %llu", i, p->triangle, (unsigned long long)T);
+            return RAD_ERROR_INDEX_OUT_OF_RANGE;
+        }
+        if ((r = rad__check_patch_values(c, p, i)) != RAD_SUCCESS) return r;
+        if (!(p->area > 0.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has area %g", i, (double)p->area);
+            return RAD_ERROR_DEGENERATE_TRIANGLE;
+        }
+        for (k = 0; k < 3; ++k)
+            if (p->albedo[k] < 0.0f || p->albedo[k] >= 1.0f) {
+                rad__log(c, RAD_LOG_ERROR, "baked data: patch %u has albedo %g", i, (double)p->albedo[k]);
+                return RAD_ERROR_ALBEDO_RANGE;
+            }
+        b->patches.areas[i] = p->area;
+        memcpy(b->patches.albedo + 3 * (size_t)i, p->albedo, 3 * sizeof(float));
+    }
+    /* form factors: dense, or the three CSR sections, or none */
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_DENSE, NULL, 4, 0, &sd)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_ROW_OFFSETS, NULL, 8, 0, &so)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_COLUMNS, NULL, 4, 0, &sc)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_VALUES, NULL, 4, 0, &sx)) != RAD_SUCCESS) return r;
+    if (sd) {
+        if (sd->count != (uint64_t)N * N) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: dense matrix of %llu entries for %u patches", (unsigned long long)sd->count, N);
+            return RAD_ERROR_SIZE_MISMATCH;
+        }
+        if ((r = rad__check_values(c, "dense form factors (FF_DENSE)", (const float *)sd->data, sd->count, 1)) != RAD_SUCCESS)
+            return r;
+        b->F.rows = b->F.cols = N;
+        b->F.storage = RAD_STORAGE_DENSE;
+        b->F.dense = (const float *)sd->data;
+    } else if (so || sc || sx) {
+        const uint64_t *off;
+        const uint32_t *col;
+        if (!so || !sc || !sx || so->count != (uint64_t)N + 1u || sc->count != sx->count) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: incomplete or inconsistent CSR sections");
+            return RAD_ERROR_CORRUPT;
+        }
+        off = (const uint64_t *)so->data;
+        col = (const uint32_t *)sc->data;
+        if (off[0] != 0 || off[N] != sc->count) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: CSR offsets start at %llu and end at %llu, %llu entries",
+                     (unsigned long long)off[0], (unsigned long long)off[N], (unsigned long long)sc->count);
+            return RAD_ERROR_CORRUPT;
+        }
+        for (i = 0; i < N; ++i) {
+            uint64_t q;
+            if (off[i + 1] < off[i] || off[i + 1] > sc->count) {
+                rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u offsets are not monotone", i);
+                return RAD_ERROR_CORRUPT;
+            }
+            for (q = off[i]; q < off[i + 1]; ++q) {
+                if (col[q] >= N) {
+                    rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u has column %u of %u", i, col[q], N);
+                    return RAD_ERROR_INDEX_OUT_OF_RANGE;
+                }
+                if (q > off[i] && col[q] <= col[q - 1]) {
+                    rad__log(c, RAD_LOG_ERROR, "baked data: CSR row %u columns are not ascending", i);
+                    return RAD_ERROR_CORRUPT;
+                }
+            }
+        }
+        if ((r = rad__check_values(c, "sparse form factors (FF_VALUES)", (const float *)sx->data, sx->count, 1)) != RAD_SUCCESS)
+            return r;
+        b->F.rows = b->F.cols = N;
+        b->F.storage = RAD_STORAGE_SPARSE;
+        b->F.row_offsets = off;
+        b->F.columns = col;
+        b->F.values = (const float *)sx->data;
+    }
+    /* every vector, not only E and B: the application's ("H", "L", ...) are read in place too */
+    for (k = 0; k < rad_container_section_count(b->container); ++k) {
+        const rad_section *s = rad_container_section(b->container, k);
+        char what[48];
+        if (s->type != RAD_SECTION_VECTOR) continue;
+        if (s->elem_size != 12u || s->count != N) {
+            rad__log(c, RAD_LOG_ERROR, "baked data: vector '%s' has %llu elements of %u bytes, expected %u RGB triples", s->name,
+                     (unsigned long long)s->count, s->elem_size, N);
+            return RAD_ERROR_SIZE_MISMATCH;
+        }
+        snprintf(what, sizeof(what), "vector '%s'", s->name);
+        if ((r = rad__check_values(c, what, (const float *)s->data, s->count * 3u, 0)) != RAD_SUCCESS) return r;
+    }
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "E", 12, 0, &se)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_VECTOR, "B", 12, 0, &sb)) != RAD_SUCCESS) return r;
+    b->E = se ? (const float *)se->data : NULL;
+    b->B = sb ? (const float *)sb->data : NULL;
+    if ((r = rad__bake_section(c, b->container, RAD_SECTION_SIGNATURE, NULL, (uint32_t)sizeof(rad_bake_signature), 0, &se)) != RAD_SUCCESS)
+        return r;
+    if (se && se->count != 1u) {
+        rad__log(c, RAD_LOG_ERROR, "baked data: the signature section holds %llu records, expected 1", (unsigned long long)se->count);
+        return RAD_ERROR_CORRUPT;
+    }
+    b->signature = se ? (const rad_bake_signature *)se->data : NULL;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__load(const void *data, size_t size, void *owned, const rad__ctx *c, const rad_context *ctx,
+                            rad_bake **out)
+{
+    rad_bake *b = (rad_bake *)rad__alloc(&c->allocator, sizeof(rad_bake));
+    rad_result r;
+    if (!b) { rad__free(&c->allocator, owned); return RAD_ERROR_OUT_OF_MEMORY; }
+    memset(b, 0, sizeof(*b));
+    b->allocator = c->allocator;
+    b->owned = owned;
+    b->patches.allocator = c->allocator;
+    r = rad_container_create(data, size, ctx, &b->container);
+    if (r == RAD_SUCCESS) r = rad__bake_fill(b, c);
+    if (r != RAD_SUCCESS) { rad_bake_destroy(b); return r; }
+    *out = b;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_context *ctx, rad_bake **out)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data) return RAD_ERROR_INVALID_ARGUMENT;
+    return rad__load(data, size, NULL, &c, ctx, out);
+}
+
+#ifndef RAD_NO_STDIO
+/* Writes 'size' bytes to '<path>.partial' beside path and renames it over path only when
+   every byte is written and closed: a failed save leaves the old file (or none) in place. */
+static rad_result rad__write_file_atomic(const rad__ctx *c, const char *path, const void *data, size_t size)
+{
+    size_t len = strlen(path);
+    char *tmp = (char *)rad__alloc(&c->allocator, len + 9u);
+    FILE *f;
+    int ok;
+    if (!tmp) {
+        rad__log(c, RAD_LOG_ERROR, "saving '%s': out of memory for the temporary name", path);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".partial", 9u);
+    f = fopen(tmp, "wb");
+    if (!f) {
+        rad__log(c, RAD_LOG_ERROR, "cannot open '%s' for writing (the folder must exist and be writable)", tmp);
+        rad__free(&c->allocator, tmp);
+        return RAD_ERROR_IO;
+    }
+    ok = fwrite(data, 1, size, f) == size;
+    ok = (fclose(f) == 0) && ok;
+    if (ok && rename(tmp, path) != 0) {
+        /* where rename does not replace an existing file (Windows), replace it by hand */
+        ok = remove(path) == 0 && rename(tmp, path) == 0;
+    }
+    if (!ok) {
+        remove(tmp);
+        rad__log(c, RAD_LOG_ERROR, "cannot write '%s' (disk full or not writable): the old file, if any, is unchanged", path);
+    }
+    rad__free(&c->allocator, tmp);
+    return ok ? RAD_SUCCESS : RAD_ERROR_IO;
+}
+
+RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
+                                 const float *B, const rad_context *ctx)
+{
+    rad__ctx c;
+    void *buf = NULL;
+    size_t size = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad_save_memory(patches, F, E, B, ctx, &buf, &size);
+    if (r != RAD_SUCCESS) return r;
+    r = rad__write_file_atomic(&c, path, buf, size);
+    rad__free(&c.allocator, buf);
+    return r;
+}
+
+RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out)
+{
+    rad__ctx c;
+    FILE *f;
+    long len;
+    void *buf;
+    unsigned char head[RAD__HEADER_BYTES];
+    size_t got;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
+    f = fopen(path, "rb");
+    if (!f) {
+        rad__log(&c, RAD_LOG_ERROR, "cannot open '%s'", path);
+        return RAD_ERROR_IO;
+    }
+    /* the header first: a folder, a file of another kind or a truncated bake is refused
+       before anything of its size is allocated or read */
+    got = fread(head, 1, sizeof(head), f);
+    if (got < sizeof(head)) {
+        int err = ferror(f);
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, err ? "cannot read '%s' (a folder, or not readable)" :
+                 "'%s' is shorter than a container header (64 bytes)", path);
+        return err ? RAD_ERROR_IO : RAD_ERROR_TRUNCATED;
+    }
+    if (memcmp(head, "RADB", 4) != 0) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "'%s' is not a radiosity.h container (no RADB magic)", path);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "cannot size '%s'", path);
+        return RAD_ERROR_IO;
+    }
+    if (rad__get64(head + RAD__H_FILE_SIZE) > (uint64_t)len) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "'%s' has %ld bytes, its header says %llu: the file is truncated", path, len,
+                 (unsigned long long)rad__get64(head + RAD__H_FILE_SIZE));
+        return RAD_ERROR_TRUNCATED;
+    }
+    buf = rad__alloc(&c.allocator, (size_t)len);
+    if (!buf) {
+        fclose(f);
+        rad__log(&c, RAD_LOG_ERROR, "loading '%s': out of memory for its %ld bytes", path, len);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (fread(buf, 1, (size_t)len, f) != (size_t)len) {
+        fclose(f);
+        rad__free(&c.allocator, buf);
+        rad__log(&c, RAD_LOG_ERROR, "cannot read '%s'", path);
+        return RAD_ERROR_IO;
+    }
+    fclose(f);
+    return rad__load(buf, (size_t)len, buf, &c, ctx, out);
+}
+#endif
+
+/* ======================================================================================== */
+/* >>glsl: GLSL compute kernels (generated sources, access)                                 */
+/* ======================================================================================== */
+
+/* a rad_output passes to the kernels unchanged as their TOTAL bit */
+typedef char rad__check_glsl_output_flag[(RAD_GLSL_OUTPUT_TOTAL == (uint32_t)RAD_OUTPUT_TOTAL) ? 1 : -1];
+
+/* push-constant mirrors: the GLSL blocks are 4-byte members in declaration order */
+typedef char rad__check_glsl_dense_push[(sizeof(rad_glsl_gather_dense_push) == 20 &&
+                                         offsetof(rad_glsl_gather_dense_push, f_base) == 12 &&
+                                         offsetof(rad_glsl_gather_dense_push, flags) == 16) ? 1 : -1];
+typedef char rad__check_glsl_csr_push[(sizeof(rad_glsl_gather_csr_push) == 16 &&
+                                       offsetof(rad_glsl_gather_csr_push, entry_base) == 8 &&
+                                       offsetof(rad_glsl_gather_csr_push, flags) == 12) ? 1 : -1];
+typedef char rad__check_glsl_mb_push[(sizeof(rad_glsl_mb_apply_push) == 20 &&
+                                      offsetof(rad_glsl_mb_apply_push, base) == 12 &&
+                                      offsetof(rad_glsl_mb_apply_push, flags) == 16) ? 1 : -1];
+typedef char rad__check_glsl_temporal_push[(sizeof(rad_glsl_temporal_push) == 60 &&
+                                            offsetof(rad_glsl_temporal_push, words) == 24 &&
+                                            offsetof(rad_glsl_temporal_push, word_base) == 40 &&
+                                            offsetof(rad_glsl_temporal_push, weight) == 44 &&
+                                            offsetof(rad_glsl_temporal_push, env) == 48) ? 1 : -1];
+typedef char rad__check_glsl_blocks_push[(sizeof(rad_glsl_mb_blocks_push) == 24 &&
+                                          offsetof(rad_glsl_mb_blocks_push, tile) == 12 &&
+                                          offsetof(rad_glsl_mb_blocks_push, flags) == 20) ? 1 : -1];
+typedef char rad__check_glsl_local_apply_push[(sizeof(rad_glsl_local_apply_push) == 32 &&
+                                               offsetof(rad_glsl_local_apply_push, slot_offset) == 16 &&
+                                               offsetof(rad_glsl_local_apply_push, flags) == 28) ? 1 : -1];
+typedef char rad__check_glsl_local_vectors_push[(sizeof(rad_glsl_local_vectors_push) == 48 &&
+                                                 offsetof(rad_glsl_local_vectors_push, nnz) == 20 &&
+                                                 offsetof(rad_glsl_local_vectors_push, flags) == 32 &&
+                                                 offsetof(rad_glsl_local_vectors_push, ann) == 36) ? 1 : -1];
+typedef char rad__check_glsl_local_update_push[(sizeof(rad_glsl_local_update_push) == 28 &&
+                                                offsetof(rad_glsl_local_update_push, base) == 16 &&
+                                                offsetof(rad_glsl_local_update_push, ev) == 24) ? 1 : -1];
+typedef char rad__check_glsl_probe_update_push[(sizeof(rad_glsl_probe_update_push) == 16 &&
+                                               offsetof(rad_glsl_probe_update_push, weight_base) == 12) ? 1 : -1];
+typedef char rad__check_glsl_lightmap_refresh_push[(sizeof(rad_glsl_lightmap_refresh_push) == 16 &&
+                                                   offsetof(rad_glsl_lightmap_refresh_push, entry_base) == 12) ? 1 : -1];
+typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
+                                             offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
+                                             offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
+                                             offsetof(rad_glsl_vp_gather_push, flags) == 52) ? 1 : -1];
+typedef char rad__check_glsl_alias_push[(sizeof(rad_glsl_alias_build_push) == 28 &&
+                                         offsetof(rad_glsl_alias_build_push, entry_base) == 16 &&
+                                         offsetof(rad_glsl_alias_build_push, flags) == 24) ? 1 : -1];
+
+#ifndef RAD_NO_GLSL
+
+typedef struct rad__glsl_entry {
+    const char *name;
+    const char *const *pieces;
+    uint32_t count;
+    uint32_t length;
+} rad__glsl_entry;
+
+/* Generated by glsl/embed.c from the files glsl/<name>: edit those, then run make glsl. */
+/* >>glsl begin */
+static const char rad__glsl_0_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_GATHER_DENSE: one classic bounce with a dense form-factor matrix,\n"
+    "//   out_i = rho_i * sum_j F_ij E_j            (flags bit 0 clear: RAD_OUTPUT_INDIRECT)\n"
+    "//   out_i = E_i + rho_i * sum_j F_ij E_j      (flags bit 0 set:   RAD_OUTPUT_TOTAL)\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1. ONE WORKGROUP PER ROW: dispatch\n"
+    "// row_count groups; the invocations of a group read the row with a stride of the group size\n"
+    "// (consecutive invocations read consecutive columns) and sum in shared memory.\n"
+    "// Chunking: binding 0 holds the rows of this chunk only; F_ij is F[f_base + (i - row_offset) * cols + j],\n"
+    "// so a matrix larger than one storage-buffer range runs as several dispatches.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer MatrixF { float F[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer VectorE { float E[]; };      // 3 N, RGB interleaved\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Albedo { float rho[]; };     // 3 N\n"
+    "layout(std430, set = 0, binding = 3) buffer Output { float outv[]; };             // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch (global index)\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
+    "    uint cols;        // N\n"
+    "    uint f_base;      // element of binding 0 that holds F[row_offset][0]\n"
+    "    uint flags;       // bit 0: add E (total)\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;               // the whole group: barriers stay uniform\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint at = pc.f_base + r * pc.cols;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.cols; j += gl_WorkGroupSize.x) {\n"
+    "        float f = F[at + j];\n"
+    "        acc += f * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {   // any group size, no subgroup assumption\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_0[] = { rad__glsl_0_0 };
+static const char rad__glsl_1_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_GATHER_CSR: one classic bounce with a CSR (sparse) form-factor matrix,\n"
+    "//   out_i = rho_i * sum_k values[k] E_columns[k]  (+ E_i when flags bit 0 is set)\n"
+    "// for rows i = row_offset .. row_offset + row_count - 1, ONE WORKGROUP PER ROW (dispatch\n"
+    "// row_count groups; the group strides over the row's entries and sums in shared memory).\n"
+    "// Binding 0 holds all N + 1 row offsets as uint64 (two uint words each, low word first, as\n"
+    "// rad_matrix.row_offsets stores them). Chunking: bindings 1 and 2 may hold only the entries of\n"
+    "// this chunk's rows; entry k of the matrix is element k - entry_base of them (entry_base = the\n"
+    "// low 32 bits of the first entry index the bound ranges start at; a chunk spans < 2^32 entries).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };      // 3 N\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };     // 3 N\n"
+    "layout(std430, set = 0, binding = 5) buffer Output { float outv[]; };             // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch (global index)\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
+    "    uint flags;       // bit 0: add E (total)\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint k0 = row_offsets[i].x - pc.entry_base;       // wraps correctly: only the difference matters\n"
+    "    uint count = row_offsets[i + 1u].x - row_offsets[i].x;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint e = lid; e < count; e += gl_WorkGroupSize.x) {\n"
+    "        uint j = columns[k0 + e];\n"
+    "        acc += values[k0 + e] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_1[] = { rad__glsl_1_0 };
+static const char rad__glsl_2_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_FLOAT: the multi-bounce apply L = F_mb E with float planes\n"
+    "// (rad_multibounce with precision RAD_MB_FLOAT). Plane row i' (permuted order) is original row\n"
+    "// row_perm[i'], plane column j' is original column col_perm[j'] (identity when flags bit 1 is clear):\n"
+    "//   out[row_perm[i']] = sum_j' plane_c[i'][j'] * E[col_perm[j']]  (+ E[row_perm[i']] when flags bit 0)\n"
+    "// for plane rows i' = row_offset .. row_offset + row_count - 1, channels c = R, G, B.\n"
+    "// ONE WORKGROUP PER ROW: dispatch row_count groups; the group strides over the columns.\n"
+    "// Chunking: bindings 0..2 may hold only this chunk's rows; entry (i', j') of plane c is element\n"
+    "// base + (i' - row_offset) * n + j' of binding c.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };       // 3 N, original order\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; }; // N (unused without bit 1)\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; }; // N (unused without bit 1)\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };              // 3 N, original order\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;           // N\n"
+    "    uint row_offset;  // first plane row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch (= workgroups)\n"
+    "    uint base;        // element of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u;\n"
+    "    uint ip = pc.row_offset + r;\n"
+    "    uint at = pc.base + r * pc.n;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
+    "        uint e = 3u * (perm \? col_perm[j] : j);\n"
+    "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_2[] = { rad__glsl_2_0 };
+static const char rad__glsl_3_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_HALF: the multi-bounce apply L = F_mb E with IEEE binary16\n"
+    "// planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint\n"
+    "// word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage\n"
+    "// feature is needed. Same bindings, push constants, permutations, dispatch (one workgroup per\n"
+    "// row) and chunking as RAD_GLSL_MB_APPLY_FLOAT, with 'base' counted in binary16 values (it may\n"
+    "// be odd). Buffers and bound ranges must cover whole 32-bit words: round a range's end up to a\n"
+    "// multiple of 4 bytes, or the word holding the last value reads as zero.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { uint R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { uint G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { uint B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer ColPerm { uint col_perm[]; };\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowPerm { uint row_perm[]; };\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;\n"
+    "    uint row_offset;\n"
+    "    uint row_count;\n"
+    "    uint base;        // binary16 value of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u \? v.y : v.x; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u;\n"
+    "    uint ip = pc.row_offset + r;\n"
+    "    uint at = pc.base + r * pc.n;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.n; j += gl_WorkGroupSize.x) {\n"
+    "        uint e = 3u * (perm \? col_perm[j] : j), h = at + j;\n"
+    "        vec3 f = vec3(half_at(R[h >> 1u], h), half_at(G[h >> 1u], h), half_at(B[h >> 1u], h));\n"
+    "        acc += f * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_3[] = { rad__glsl_3_0 };
+static const char rad__glsl_4_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_TEMPORAL_STEP: one frame of temporal radiosity (rad_temporal_step\n"
+    "// with a fixed weight), drawing exactly the indices the CPU draws: the counter-based generator\n"
+    "// and the alias draw of the >>api_temporal doc block, in 32-bit integer arithmetic. One invocation per row i\n"
+    "// (dispatch ceil(row_count / group size) groups):\n"
+    "//   acc = 0; for s = 0..k-1: J = draw(sample = sample_base + s); acc += V_J\n"
+    "//   X = acc * (T_i / k); X *= rho_i (flags bit 0); B_i = w B_i^prev + (1 - w) X\n"
+    "// V_j = E_j, or E_j + B_j^prev (flags bit 1: FEEDBACK); V_N = env (the sky E_0).\n"
+    "// channel = 3: one table set serves R, G and B. channel = c < 3: this dispatch uses table set c\n"
+    "// (MULTIBOUNCE with three tables, sample_base = c k) and reads and writes component c only.\n"
+    "// Chunking: binding 1 may hold only this chunk's bins: word w of the tables (bin b starts at word\n"
+    "// b * words) is element w - word_base of it (word_base: low 32 bits; a chunk spans < 2^32 words).\n"
+    "// PADDED tables (flags bit 2), as RAD_GLSL_ALIAS_BUILD writes them for streamed rows: row i's\n"
+    "// bins start at bin row_offsets[i] + i (binding 0 = the input entry offsets) and counts[i]\n"
+    "// (binding 7) says how many there are, so the build's output is sampled without compaction.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 row_offsets[]; }; // rows + 1 uint64, in bins\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Bins { uint bins[]; };              // 2 or 3 words per bin\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Totals { float totals[]; };         // T_i per row\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };             // 3 N\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Albedo { float rho[]; };            // 3 N (flags bit 0)\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer Previous { float Bprev[]; };        // 3 N\n"
+    "layout(std430, set = 0, binding = 6) buffer Next { float Bnext[]; };                     // 3 N\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer Counts { uint counts[]; };          // bins per row (bit 2)\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint seed;        // rad_temporal_options.seed\n"
+    "    uint frame;       // rad_temporal_frame() before the step\n"
+    "    uint row_offset;  // first row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint n;           // N: the environment's column index\n"
+    "    uint samples;     // k\n"
+    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
+    "    uint flags;       // bit 0: multiply by rho (SINGLE, FEEDBACK); bit 1: V = E + B^prev (FEEDBACK); bit 2: PADDED\n"
+    "    uint channel;     // 3: RGB from one table set; 0..2: this channel only\n"
+    "    uint sample_base; // channel * k with three table sets, else 0\n"
+    "    uint word_base;   // low 32 bits of the tables' word index at element 0 of binding 1\n"
+    "    float weight;     // w in [0, 1)\n"
+    "    float env_r, env_g, env_b; // E_0\n"
+    "} pc;\n"
+    "\n"
+    "uint rad_pcg(uint v)\n"
+    "{\n"
+    "    uint s = v * 747796405u + 2891336453u;\n"
+    "    uint t = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;\n"
+    "    return (t >> 22u) ^ t;\n"
+    "}\n"
+    "\n"
+    "float value_at(uint j, uint c)\n"
+    "{\n"
+    "    if (j >= pc.n) return c == 0u \? pc.env_r : (c == 1u \? pc.env_g : pc.env_b);\n"
+    "    float v = E[3u * j + c];\n"
+    "    if ((pc.flags & 2u) != 0u) v += Bprev[3u * j + c];\n"
+    "    return v;\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint key = rad_pcg(rad_pcg(rad_pcg(pc.seed) ^ pc.frame) ^ i);\n"
+    "    bool padded = (pc.flags & 4u) != 0u;\n"
+    "    uint first = row_offsets[i].x + (padded \? i : 0u);\n"
+    "    uint nb = padded \? counts[i] : row_offsets[i + 1u].x - row_offsets[i].x;\n"
+    "    uint c0 = pc.channel < 3u \? pc.channel : 0u, c1 = pc.channel < 3u \? pc.channel : 2u;\n"
+    "    precise float acc[3] = float[3](0.0, 0.0, 0.0);\n"
+    "    for (uint s = 0u; s < pc.samples; ++s) {\n"
+    "        uint u1 = rad_pcg(key ^ ((pc.sample_base + s) * 0x9E3779B9u));\n";
+static const char rad__glsl_4_1[] =
+    "        uint u2 = rad_pcg(u1 ^ 0x68E31DA4u);\n"
+    "        uint hi, lo;\n"
+    "        umulExtended(u1, nb, hi, lo);\n"
+    "        uint w = (first + hi) * pc.words - pc.word_base, j;   // wraps correctly: only the difference matters\n"
+    "        if (pc.words == 2u) j = u2 < bins[w] \? (bins[w + 1u] & 0xFFFFu) : (bins[w + 1u] >> 16u);\n"
+    "        else j = u2 < bins[w] \? bins[w + 1u] : bins[w + 2u];\n"
+    "        for (uint c = c0; c <= c1; ++c) acc[c] += value_at(j, c);\n"
+    "    }\n"
+    "    precise float scale = totals[i] / float(pc.samples);\n"
+    "    for (uint c = c0; c <= c1; ++c) {\n"
+    "        precise float x = acc[c] * scale;\n"
+    "        if ((pc.flags & 1u) != 0u) x *= rho[3u * i + c];\n"
+    "        precise float b = pc.weight * Bprev[3u * i + c] + (1.0 - pc.weight) * x;\n"
+    "        Bnext[3u * i + c] = b;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_4[] = { rad__glsl_4_0, rad__glsl_4_1 };
+static const char rad__glsl_5_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_MB_APPLY_BLOCKS: the multi-bounce apply from the block-compressed\n"
+    "// matrix (rad_multibounce_blocks), as rad_multibounce_blocks_apply: the texture unit decodes the\n"
+    "// blocks (texelFetch), each texel is multiplied by its tile's scale, the outliers are added\n"
+    "// exactly and the permutations are applied:\n"
+    "//   out[row_perm[y]] = sum_x decoded(x, y) * scale(tile of x, y) * E[col_perm[x]]\n"
+    "//                      + sum over the outliers of original row row_perm[y] of value * E[column]\n"
+    "//                      (+ E[row_perm[y]] when flags bit 0 is set)\n"
+    "// for texel rows y = row_offset .. row_offset + row_count - 1 (<= N), RGB. ONE WORKGROUP PER ROW:\n"
+    "// dispatch row_count groups; the group strides over the columns (neighbouring invocations fetch\n"
+    "// neighbouring texels) and sums in shared memory.\n"
+    "// Formats: RAD_BLOCK_BC1 (flags bit 2): one VK_FORMAT_BC1_RGB_UNORM_BLOCK image bound to\n"
+    "// bindings 0, 1 and 2 (its .rgb is read from binding 0); RAD_BLOCK_BC4X3: three\n"
+    "// VK_FORMAT_BC4_UNORM_BLOCK images (R, G, B planes) at bindings 0, 1, 2 (.r of each). The images\n"
+    "// are blocks_per_row * 4 texels square; texel (x, y) is entry (row y, column x).\n"
+    "// The outlier arrays are bound whole (they are indexed by original row, which a chunk of\n"
+    "// permuted rows does not keep contiguous): with the default 5% of N^2 they fit 128 MiB up to\n"
+    "// N of about 14 000.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(set = 0, binding = 0) uniform sampler2D texR;   // BC1: the RGB texture; BC4X3: R plane\n"
+    "layout(set = 0, binding = 1) uniform sampler2D texG;   // BC4X3: G plane (BC1: any, unused)\n"
+    "layout(set = 0, binding = 2) uniform sampler2D texB;   // BC4X3: B plane (BC1: any, unused)\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Scales { float scales[]; };          // 3 per tile\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VectorE { float E[]; };              // 3 N\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer ColPerm { uint col_perm[]; };        // N (flags bit 1)\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer RowPerm { uint row_perm[]; };        // N (flags bit 1)\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer OutlierOffsets { uvec2 out_off[]; }; // N + 1 uint64 (bit 3)\n"
+    "layout(std430, set = 0, binding = 8) readonly buffer OutlierColumns { uint out_col[]; };  // (bit 3)\n"
+    "layout(std430, set = 0, binding = 9) readonly buffer OutlierValues { float out_val[]; };  // 3 per outlier (bit 3)\n"
+    "layout(std430, set = 0, binding = 10) buffer Output { float outv[]; };                    // 3 N\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint n;             // N\n"
+    "    uint row_offset;    // first texel row of this dispatch\n"
+    "    uint row_count;     // rows in this dispatch\n"
+    "    uint tile;          // scale tile in texels (0: one scale per channel)\n"
+    "    uint tiles_per_row; // ceil(N / tile), 1 when tile is 0\n"
+    "    uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    bool perm = (pc.flags & 2u) != 0u, bc1 = (pc.flags & 4u) != 0u;\n"
+    "    uint y = pc.row_offset + r;\n"
+    "    uint trow = pc.tile != 0u \? (y / pc.tile) * pc.tiles_per_row : 0u;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint x = lid; x < pc.n; x += gl_WorkGroupSize.x) {\n"
+    "        ivec2 p = ivec2(int(x), int(y));\n"
+    "        vec3 d = bc1 \? texelFetch(texR, p, 0).rgb\n"
+    "                     : vec3(texelFetch(texR, p, 0).r, texelFetch(texG, p, 0).r, texelFetch(texB, p, 0).r);\n"
+    "        uint t = 3u * (trow + (pc.tile != 0u \? x / pc.tile : 0u));\n"
+    "        uint e = 3u * (perm \? col_perm[x] : x);\n"
+    "        acc += (d * vec3(scales[t], scales[t + 1u], scales[t + 2u])) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
+    "    }\n"
+    "    uint i = perm \? row_perm[y] : y;\n"
+    "    precise vec3 s = vec3(0.0);\n"
+    "    if ((pc.flags & 8u) != 0u) {\n"
+    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n";
+static const char rad__glsl_5_1[] =
+    "        for (uint k = k0 + lid; k < k0 + count; k += gl_WorkGroupSize.x) {\n"
+    "            uint j = 3u * out_col[k];\n"
+    "            s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);\n"
+    "        }\n"
+    "    }\n"
+    "    partial[lid] = acc + s;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    precise vec3 o = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
+    "    outv[3u * i] = o.x;\n"
+    "    outv[3u * i + 1u] = o.y;\n"
+    "    outv[3u * i + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_5[] = { rad__glsl_5_0, rad__glsl_5_1 };
+static const char rad__glsl_6_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_ALIAS_BUILD: alias tables of streamed rows built on the GPU\n"
+    "// (docs/methods/temporal.md), the same bins as rad_alias_build_row (Vose's robust variant in double, the\n"
+    "// order of operations of the >>api_temporal doc block; bit-identical where double arithmetic is\n"
+    "// IEEE, as on lavapipe), one invocation per row.\n"
+    "// Input rows in CSR form: row i's entries are k = in_off[i] .. in_off[i+1]-1 (uint64, global), at\n"
+    "// element k - entry_base of bindings 1 and 2; flags bit 0 (DENSE): no columns bound, the column\n"
+    "// of entry k is k - in_off[i]. Entries <= 0 are skipped; a negative or non-finite entry or a\n"
+    "// column >= cols makes the row's bin count 0 (the CPU builder returns INVALID_ARGUMENT).\n"
+    "// Output, padded layout: row i gets room for (its entry count + 1) bins starting at bin\n"
+    "// in_off[i] + i (bin b at word (b - out_base) * words of binding 3); counts[i] receives the bins\n"
+    "// written and totals[i] T_i. Binding 4 (double) and 5 (uint) are scratch of one element per\n"
+    "// output bin at the same positions. Needs the shaderFloat64 feature.\n"
+    "// RAD_GLSL_TEMPORAL_STEP samples this layout directly (its PADDED flag).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer RowOffsets { uvec2 in_off[]; }; // rows + 1 uint64\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Columns { uint columns[]; };    // (not DENSE)\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float values[]; };\n"
+    "layout(std430, set = 0, binding = 3) buffer Bins { uint bins[]; };                   // 2 or 3 words per bin\n"
+    "layout(std430, set = 0, binding = 4) buffer ScratchQ { double q[]; };\n"
+    "layout(std430, set = 0, binding = 5) buffer ScratchStack { uint stack[]; };\n"
+    "layout(std430, set = 0, binding = 6) buffer Counts { uint counts[]; };               // per row (global index)\n"
+    "layout(std430, set = 0, binding = 7) buffer Totals { float totals[]; };              // per row (global index)\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first row of this dispatch\n"
+    "    uint row_count;   // rows in this dispatch\n"
+    "    uint cols;        // N: the environment's column (COMPACT needs cols <= 65535)\n"
+    "    uint words;       // 2 (RAD_ALIAS_COMPACT) or 3 (RAD_ALIAS_WIDE)\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of bindings 1 and 2\n"
+    "    uint out_base;    // low 32 bits of the bin index at element 0 of bindings 3, 4 and 5\n"
+    "    uint flags;       // bit 0: DENSE rows (no column array)\n"
+    "} pc;\n"
+    "\n"
+    "void set_bin(uint b, uint threshold, uint col, uint alias_col)\n"
+    "{\n"
+    "    uint w = b * pc.words;\n"
+    "    bins[w] = threshold;\n"
+    "    if (pc.words == 2u) bins[w + 1u] = col | (alias_col << 16u);\n"
+    "    else { bins[w + 1u] = col; bins[w + 2u] = alias_col; }\n"
+    "}\n"
+    "\n"
+    "uint col_of(uint b) { return pc.words == 2u \? (bins[b * 2u + 1u] & 0xFFFFu) : bins[b * 3u + 1u]; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r;\n"
+    "    uint k0 = in_off[i].x, count = in_off[i + 1u].x - k0;\n"
+    "    uint b0 = k0 + i - pc.out_base;          // this row's first bin (local)\n"
+    "    bool dense = (pc.flags & 1u) != 0u;\n"
+    "    precise double W = 0.0;\n"
+    "    uint n = 0u;\n"
+    "    for (uint e = 0u; e < count; ++e) {\n"
+    "        float v = values[k0 - pc.entry_base + e];\n"
+    "        uint col = dense \? e : columns[k0 - pc.entry_base + e];\n"
+    "        if (isnan(v) || isinf(v) || v < 0.0 || col >= pc.cols) { counts[i] = 0u; totals[i] = 0.0; return; }\n"
+    "        if (v > 0.0) {\n"
+    "            q[b0 + n] = double(v);\n"
+    "            set_bin(b0 + n, 0xFFFFFFFFu, col, col);\n"
+    "            W += double(v);\n"
+    "            ++n;\n"
+    "        }\n"
+    "    }\n"
+    "    precise double env = 1.0 - W;\n"
+    "    double total = W;\n"
+    "    if (env > 0.0) {\n"
+    "        q[b0 + n] = env;\n"
+    "        set_bin(b0 + n, 0xFFFFFFFFu, pc.cols, pc.cols);\n"
+    "        ++n;\n"
+    "        total = 1.0;\n"
+    "    }\n"
+    "    W += env > 0.0 \? env : 0.0;\n"
+    "    // Vose, robust variant: Small grows up from stack[0], Large down from stack[n-1]\n"
+    "    uint small_top = 0u, large_bottom = n;\n";
+static const char rad__glsl_6_1[] =
+    "    for (uint b = 0u; b < n; ++b) {\n"
+    "        precise double qb = double(n) * q[b0 + b] / W;\n"
+    "        q[b0 + b] = qb;\n"
+    "        if (qb < 1.0) stack[b0 + small_top++] = b;\n"
+    "        else stack[b0 + --large_bottom] = b;\n"
+    "    }\n"
+    "    while (small_top > 0u && large_bottom < n) {\n"
+    "        uint l = stack[b0 + --small_top], g = stack[b0 + large_bottom++];\n"
+    "        precise double p = q[b0 + l] * 4294967296.0 + 0.5;\n"
+    "        set_bin(b0 + l, p >= 4294967295.0 \? 0xFFFFFFFFu : uint(p), col_of(b0 + l), col_of(b0 + g));\n"
+    "        precise double qg = (q[b0 + g] + q[b0 + l]) - 1.0;\n"
+    "        q[b0 + g] = qg;\n"
+    "        if (qg < 1.0) stack[b0 + small_top++] = g;\n"
+    "        else stack[b0 + --large_bottom] = g;\n"
+    "    }\n"
+    "    counts[i] = n;\n"
+    "    totals[i] = float(total);\n"
+    "}\n";
+static const char *const rad__glsl_pieces_6[] = { rad__glsl_6_0, rad__glsl_6_1 };
+static const char rad__glsl_7_0[] =
+    "// lighting.glsl - the lighting models and BRDF terms of radiosity.h (docs/methods/shading.md, >>shading),\n"
+    "// GLSL 450. An include: no #version; it defines only functions and one struct, all named\n"
+    "// as their C counterparts (rad_ndf_ggx ...). The arithmetic is written in the same order as\n"
+    "// the C code so the results agree to float rounding (tests/test_shading_vulkan.c checks\n"
+    "// 1e-5 relative). Conventions (l, v, n unit; f the BRDF; R = f * max(n.l, 0) the response)\n"
+    "// are those of the >>api_shading comment in radiosity.h.\n"
+    "//\n"
+    "// Including it: either with GL_GOOGLE_include_directive (as glsl/lighting_eval.comp does:\n"
+    "// glslangValidator resolves it relative to the including file), or by pasting this file's\n"
+    "// text after your #version line.\n"
+    "#ifndef RAD_LIGHTING_GLSL\n"
+    "#define RAD_LIGHTING_GLSL\n"
+    "\n"
+    "#define RAD_SHADING_LAMBERT 0\n"
+    "#define RAD_SHADING_HALF_LAMBERT 1\n"
+    "#define RAD_SHADING_BANDED 2\n"
+    "#define RAD_SHADING_PHONG 3\n"
+    "#define RAD_SHADING_BLINN_PHONG 4\n"
+    "#define RAD_SHADING_MINNAERT 5\n"
+    "#define RAD_SHADING_OREN_NAYAR 6\n"
+    "#define RAD_SHADING_MICROFACET 7\n"
+    "#define RAD_NDF_BECKMANN 0\n"
+    "#define RAD_NDF_GGX 1\n"
+    "#define RAD_MASKING_SEPARABLE 0\n"
+    "#define RAD_MASKING_HEIGHT_CORRELATED 1\n"
+    "#define RAD_DIFFUSE_NONE 0\n"
+    "#define RAD_DIFFUSE_LAMBERT 1\n"
+    "#define RAD_DIFFUSE_SHIRLEY 2\n"
+    "\n"
+    "const float RAD_PI = 3.14159265358979323846;\n"
+    "const float RAD_INV_PI = 0.318309886183790671537767526745;\n"
+    "\n"
+    "// The std430 mirror of rad_shading_gpu (96 bytes), filled by rad_shading_pack():\n"
+    "// albedo (or kd), specular (ks), f0, f90, p = (alpha_x, alpha_y, wrap / shininess / k / sigma,\n"
+    "// half-Lambert exponent / bands / Fresnel exponent), mode = (model, ndf, masking, diffuse).\n"
+    "struct RadShadingParams {\n"
+    "    vec4 albedo;\n"
+    "    vec4 specular;\n"
+    "    vec4 f0;\n"
+    "    vec4 f90;\n"
+    "    vec4 p;\n"
+    "    ivec4 mode;\n"
+    "};\n"
+    "\n"
+    "// Beckmann NDF\n"
+    "float rad_ndf_beckmann(float nm, float alpha)\n"
+    "{\n"
+    "    float a2 = alpha * alpha, c2 = nm * nm;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    return exp((c2 - 1.0) / (a2 * c2)) / (RAD_PI * a2 * c2 * c2);\n"
+    "}\n"
+    "\n"
+    "// Beckmann NDF, anisotropic\n"
+    "float rad_ndf_beckmann_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    float c2 = nm * nm;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float e = (tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y)) / c2;\n"
+    "    return exp(-e) / (RAD_PI * alpha_x * alpha_y * c2 * c2);\n"
+    "}\n"
+    "\n"
+    "// GGX NDF (Walter et al. 2007)\n"
+    "float rad_ndf_ggx(float nm, float alpha)\n"
+    "{\n"
+    "    float a2 = alpha * alpha;\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float d = 1.0 + nm * nm * (a2 - 1.0);\n"
+    "    return a2 / (RAD_PI * d * d);\n"
+    "}\n"
+    "\n"
+    "// GGX NDF, anisotropic\n"
+    "float rad_ndf_ggx_aniso(float nm, float tm, float bm, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    if (!(nm > 0.0)) return 0.0;\n"
+    "    float d = tm * tm / (alpha_x * alpha_x) + bm * bm / (alpha_y * alpha_y) + nm * nm;\n"
+    "    return 1.0 / (RAD_PI * alpha_x * alpha_y * d * d);\n"
+    "}\n"
+    "\n"
+    "// the Smith variable a (anisotropic; the isotropic form when alpha_x = alpha_y); the largest float for\n"
+    "// s = n (C returns +inf there; both give Lambda = 0)\n"
+    "float rad_smith_a(float ns, float ts, float bs, float alpha_x, float alpha_y)\n"
+    "{\n"
+    "    float d2 = alpha_x * alpha_x * ts * ts + alpha_y * alpha_y * bs * bs;\n"
+    "    if (!(d2 > 0.0)) return 3.402823466e38;\n"
+    "    return ns / sqrt(d2);\n"
+    "}\n"
+    "\n"
+    "// Lambda of GGX (exact), for a > 0\n"
+    "// (Beckmann's exact Lambda needs erf, which GLSL lacks: it is C only.)\n"
+    "float rad_lambda_ggx(float a)\n"
+    "{\n"
+    "    return 0.5 * (-1.0 + sqrt(1.0 + 1.0 / (a * a)));\n"
+    "}\n"
+    "\n"
+    "// Lambda of Beckmann, rational approximation (Walter et al. 2007)\n"
+    "float rad_lambda_beckmann(float a)\n"
+    "{\n"
+    "    if (!(a < 1.6)) return 0.0;\n"
+    "    return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);\n"
+    "}\n"
+    "\n"
+    "// Smith G1 (Heitz 2014)\n"
+    "float rad_smith_g1(float ms, float lambda_s) { return ms > 0.0 \? 1.0 / (1.0 + lambda_s) : 0.0; }\n"
+    "\n"
+    "// Smith G2, separable and height-correlated (Heitz 2014)\n"
+    "float rad_smith_g2_separable(float mv, float ml, float lambda_v, float lambda_l)\n"
+    "{\n"
+    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / ((1.0 + lambda_v) * (1.0 + lambda_l)) : 0.0;\n"
+    "}\n"
+    "\n";
+static const char rad__glsl_7_1[] =
+    "float rad_smith_g2_height_correlated(float mv, float ml, float lambda_v, float lambda_l)\n"
+    "{\n"
+    "    return (mv > 0.0 && ml > 0.0) \? 1.0 / (1.0 + lambda_v + lambda_l) : 0.0;\n"
+    "}\n"
+    "\n"
+    "// Schlick's Fresnel and its generalized F90 form (one channel)\n"
+    "float rad_fresnel_schlick(float f0, float c)\n"
+    "{\n"
+    "    float x = 1.0 - (c > 0.0 \? c : 0.0), x2 = x * x;\n"
+    "    return f0 + (1.0 - f0) * (x2 * x2 * x);\n"
+    "}\n"
+    "\n"
+    "float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float c)\n"
+    "{\n"
+    "    return f0 + (f90 - f0) * pow(1.0 - (c > 0.0 \? c : 0.0), exponent);\n"
+    "}\n"
+    "\n"
+    "// diffuse terms: Lambert (1 - F) and Shirley et al. 1997 (one channel)\n"
+    "float rad_diffuse_lambert(float albedo, float F) { return (1.0 - F) * albedo * RAD_INV_PI; }\n"
+    "\n"
+    "float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)\n"
+    "{\n"
+    "    float a = 1.0 - (nl > 0.0 \? nl : 0.0), b = 1.0 - (nv > 0.0 \? nv : 0.0);\n"
+    "    float a5 = a * a * a * a * a, b5 = b * b * b * b * b;\n"
+    "    return (1.0 - f0) * (21.0 / 20.0) * albedo * RAD_INV_PI * (1.0 - a5) * (1.0 - b5);\n"
+    "}\n"
+    "\n"
+    "// Lambda from n.s, t.s, b.s without forming a (no division by zero at s = n)\n"
+    "float rad_shading_lambda(int ndf, bool iso, float ns, float ts, float bs, float ax, float ay)\n"
+    "{\n"
+    "    float d2 = iso \? ax * ax * (1.0 - ns * ns) : ax * ax * ts * ts + ay * ay * bs * bs;\n"
+    "    if (!(d2 > 0.0)) return 0.0;\n"
+    "    if (ndf == RAD_NDF_GGX) return 0.5 * (-1.0 + sqrt(1.0 + d2 / (ns * ns)));\n"
+    "    return rad_lambda_beckmann(ns / sqrt(d2));\n"
+    "}\n"
+    "\n"
+    "// f (out_f) and R (return value) for unit l, v, n and an orthonormal t, b (anything when the\n"
+    "// model is isotropic). f is 0 for half-Lambert, which has no BRDF.\n"
+    "vec3 rad_shade(RadShadingParams g, vec3 l, vec3 v, vec3 n, vec3 t, vec3 b, out vec3 out_f)\n"
+    "{\n"
+    "    float nl = dot(n, l), nv = dot(n, v);\n"
+    "    vec3 f = vec3(0.0), rr = vec3(0.0);\n"
+    "    int model = g.mode.x;\n"
+    "    if (nv > 0.0) {\n"
+    "        if (model == RAD_SHADING_HALF_LAMBERT) {\n"
+    "            float x = (nl + g.p.z) / (1.0 + g.p.z);\n"
+    "            float q = pow(x > 0.0 \? x : 0.0, g.p.w);\n"
+    "            rr = g.albedo.xyz * RAD_INV_PI * q;\n"
+    "        } else if (nl > 0.0) {\n"
+    "            if (model == RAD_SHADING_LAMBERT) {\n"
+    "                f = g.albedo.xyz * RAD_INV_PI;\n"
+    "            } else if (model == RAD_SHADING_BANDED) {\n"
+    "                float q = ceil(g.p.w * nl) / g.p.w / nl;\n"
+    "                f = g.albedo.xyz * RAD_INV_PI * q;\n"
+    "            } else if (model == RAD_SHADING_PHONG) {\n"
+    "                vec3 r = 2.0 * nl * n - l;\n"
+    "                float rv = dot(r, v), s = g.p.z;\n"
+    "                float q = (s + 2.0) * (0.5 * RAD_INV_PI) * pow(rv > 0.0 \? rv : 0.0, s);\n"
+    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_BLINN_PHONG) {\n"
+    "                vec3 h = l + v;\n"
+    "                float len = sqrt(dot(h, h)), nh = 0.0, s = g.p.z;\n"
+    "                if (len > 0.0) nh = dot(n, h) / len;\n"
+    "                float q = (s + 2.0) * (s + 4.0) * (0.125 * RAD_INV_PI) / (exp2(-0.5 * s) + s) * pow(nh > 0.0 \? nh : 0.0, s);\n"
+    "                f = g.albedo.xyz * RAD_INV_PI + g.specular.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_MINNAERT) {\n"
+    "                float kk = g.p.z, c = nl * nv;\n"
+    "                float q = (kk + 1.0) * (0.5 * RAD_INV_PI) * pow(c > 1e-6 \? c : 1e-6, kk - 1.0);\n"
+    "                f = g.albedo.xyz * q;\n"
+    "            } else if (model == RAD_SHADING_OREN_NAYAR) {\n"
+    "                float s2 = g.p.z * g.p.z, A = 1.0 - 0.5 * s2 / (s2 + 0.33), B = 0.45 * s2 / (s2 + 0.09);\n"
+    "                float s = dot(l, v) - nl * nv, q = s > 0.0 \? s / (nl > nv \? nl : nv) : 0.0;\n"
+    "                f = g.albedo.xyz * RAD_INV_PI * (A + B * q);\n"
+    "            } else if (model == RAD_SHADING_MICROFACET) {\n"
+    "                float ax = g.p.x, ay = g.p.y;\n"
+    "                bool iso = ax == ay;\n"
+    "                int ndf = g.mode.y;\n"
+    "                vec3 h = l + v;\n"
+    "                float len = sqrt(dot(h, h));\n"
+    "                if (len > 0.0) {\n"
+    "                    h /= len;\n"
+    "                    float nh = dot(n, h), lh = dot(l, h), vh = dot(v, h), D;\n"
+    "                    if (iso) {\n";
+static const char rad__glsl_7_2[] =
+    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx(nh, ax) : rad_ndf_beckmann(nh, ax);\n"
+    "                    } else {\n"
+    "                        float th = dot(t, h), bh = dot(b, h);\n"
+    "                        D = ndf == RAD_NDF_GGX \? rad_ndf_ggx_aniso(nh, th, bh, ax, ay)\n"
+    "                                               : rad_ndf_beckmann_aniso(nh, th, bh, ax, ay);\n"
+    "                    }\n"
+    "                    float lv = rad_shading_lambda(ndf, iso, nv, iso \? 0.0 : dot(t, v), iso \? 0.0 : dot(b, v), ax, ay);\n"
+    "                    float ll = rad_shading_lambda(ndf, iso, nl, iso \? 0.0 : dot(t, l), iso \? 0.0 : dot(b, l), ax, ay);\n"
+    "                    float G = g.mode.z == RAD_MASKING_SEPARABLE \? rad_smith_g2_separable(vh, lh, lv, ll)\n"
+    "                                                               : rad_smith_g2_height_correlated(vh, lh, lv, ll);\n"
+    "                    float sp = G * D / (4.0 * nl * nv);\n"
+    "                    for (int k = 0; k < 3; ++k) f[k] = rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, lh) * sp;\n"
+    "                }\n"
+    "                for (int k = 0; k < 3; ++k) {\n"
+    "                    if (g.mode.w == RAD_DIFFUSE_LAMBERT)\n"
+    "                        f[k] += rad_diffuse_lambert(g.albedo[k], rad_fresnel_schlick_f90(g.f0[k], g.f90[k], g.p.w, nl));\n"
+    "                    else if (g.mode.w == RAD_DIFFUSE_SHIRLEY)\n"
+    "                        f[k] += rad_diffuse_shirley(g.albedo[k], g.f0[k], nl, nv);\n"
+    "                }\n"
+    "            }\n"
+    "            rr = f * nl;\n"
+    "        }\n"
+    "    }\n"
+    "    out_f = f;\n"
+    "    return rr;\n"
+    "}\n"
+    "\n"
+    "#endif\n";
+static const char *const rad__glsl_pieces_7[] = { rad__glsl_7_0, rad__glsl_7_1, rad__glsl_7_2 };
+static const char rad__glsl_8_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LOCAL_APPLY: the local multi-bounce apply of rad_local_apply\n"
+    "// (docs/methods/local.md): for every visible entry r = row_offset .. row_offset + row_count - 1,\n"
+    "// with slot i = vis_slot[r] and world patch p = vis_patch[r],\n"
+    "//   out[p] = sum_{j < end, lit_patch[j] != NONE} T_c[i][j] * E[lit_patch[j]]   (+ E[p] when flags bit 0)\n"
+    "// for channels c = R, G, B. T is rad_local.planes: three M x M planes, row = receiving slot,\n"
+    "// stride m. ONE WORKGROUP PER VISIBLE ENTRY: dispatch row_count groups; the group strides over\n"
+    "// the columns j < end and sums in shared memory.\n"
+    "// Chunking: bindings 0..2 may hold only plane rows slot_offset .. slot_offset + slot_count - 1\n"
+    "// (row i at element base + (i - slot_offset) * m); an entry whose slot lies outside them is\n"
+    "// skipped, so one dispatch per chunk over the whole visible list (or over the part of a list\n"
+    "// sorted by slot that falls in the chunk) covers every row.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VectorE { float E[]; };        // 3 n, world order\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer LitPatch { uint lit_patch[]; }; // end: patch of slot j, or ~0u\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer VisSlot { uint vis_slot[]; };   // visible entries: slots\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer VisPatch { uint vis_patch[]; }; // visible entries: patches\n"
+    "layout(std430, set = 0, binding = 7) buffer Output { float outv[]; };               // 3 n, world order\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint m;            // M: rad_local.capacity, the plane stride\n"
+    "    uint end;          // rad_local.slot_end: columns j < end\n"
+    "    uint row_offset;   // first visible entry of this dispatch\n"
+    "    uint row_count;    // visible entries in this dispatch (= workgroups)\n"
+    "    uint slot_offset;  // first plane row held by bindings 0..2\n"
+    "    uint slot_count;   // plane rows held by bindings 0..2\n"
+    "    uint base;         // element of bindings 0..2 that holds plane row slot_offset, column 0\n"
+    "    uint flags;        // bit 0: add E (RAD_OUTPUT_TOTAL)\n"
+    "} pc;\n"
+    "\n"
+    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;                    // the whole group: barriers stay uniform\n"
+    "    uint i = vis_slot[pc.row_offset + r];\n"
+    "    if (i < pc.slot_offset || i - pc.slot_offset >= pc.slot_count) return; // another chunk's row\n"
+    "    uint at = pc.base + (i - pc.slot_offset) * pc.m;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "        uint p = lit_patch[j];\n"
+    "        if (p == 0xFFFFFFFFu) continue;\n"
+    "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[3u * p], E[3u * p + 1u], E[3u * p + 2u]);\n"
+    "    }\n"
+    "    partial[lid] = acc;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    if (lid != 0u) return;\n"
+    "    uint o = 3u * vis_patch[pc.row_offset + r];\n"
+    "    precise vec3 s = partial[0];\n"
+    "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
+    "    outv[o] = s.x;\n"
+    "    outv[o + 1u] = s.y;\n"
+    "    outv[o + 2u] = s.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0 };
+static const char rad__glsl_9_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LOCAL_VECTORS: the small pre-pass of a local-matrix add\n"
+    "// (rad_local_add, docs/methods/local.md) computed from T resident on the GPU: the vectors u, v and the scalar\n"
+    "// s of the Sherman-Morrison update (fused with the exact downdate of slot ev when an add evicts),\n"
+    "// which RAD_GLSL_LOCAL_UPDATE then applies. T is rad_local.planes (three M x M planes, stride m,\n"
+    "// row = receiving slot). The host streams only the new patch's row and column over the slots:\n"
+    "//   a_c[j] = rho_c[patch(j)] * A_n F_nj / A_j (column by reciprocity), b_c[j] = rho_c[n] * F_nj\n"
+    "// for member slots j != ev (zero elsewhere; channel-major, a[c * m + j]), nz = the slots with a\n"
+    "// non-zero F_nj (any order), ann_c = rho_c[n] F_nn. Work buffer (binding 6), channel c at c * 4m:\n"
+    "//   u[j] at +j, v[j] at +m + j, c[j] = T[j][ev] at +2m + j, r[j] = T[ev][j] at +3m + j;\n"
+    "//   then 12 scalars at 12m: s[3], cuv[3] (rank-1 factor), coef[3] (new row/column factor), tnn[3].\n"
+    "// Passes (push 'pass'), run in this order, each one dispatch (or one per row chunk for pass 0):\n"
+    "//   0  GATHER, row-chunked: ONE INVOCATION PER ITEM, max(row_count, end) invocations.\n"
+    "//      Invocation x as row i = row_offset + x: u[i] = a[i] + sum_p T[i][nz_p] a[nz_p], c[i] = T[i][ev];\n"
+    "//      as column j = x < end: v[j] (=, flags bit 0 on the first chunk; else +=) b[j] +\n"
+    "//      sum over nz_p in the chunk of b[nz_p] T[nz_p][j]; r[j] = T[ev][j] when ev is in the chunk.\n"
+    "//   1  EVICT (only when ev != ~0u), end invocations, reads no plane: with g = 1 + r[ev],\n"
+    "//      u[i] -= c[i] (r.a) / g, v[i] -= (b.c) r[i] / g, u[ev] = v[ev] = 0.\n"
+    "//   2  SCALARS, 3 invocations (one per channel): s = 1 - ann - b.u, and the factors:\n"
+    "//      exact (flags bit 1 clear): cuv = coef = 1/s, tnn = 1/s - 1 (as (ann + b.u) / s); first order (bit 1 set,\n"
+    "//      RAD_LOCAL_FIRST_ORDER): d = ann + b.a, coef = 1 + d, cuv = (1 + d)^2, tnn = d.\n"
+    "// Float arithmetic (the CPU accumulates u, v, s in double): within 1e-5 relative of rad_local_add\n"
+    "// for the tested sets. A kernel cannot fail: s <= 1e-12 (rows that break energy conservation)\n"
+    "// makes RAD_GLSL_LOCAL_UPDATE leave T unchanged; read s back to detect it.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VecA { float a[]; };   // 3 m, channel-major\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VecB { float b[]; };   // 3 m, channel-major\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer NonZero { uint nz[]; }; // nnz slots\n"
+    "layout(std430, set = 0, binding = 6) buffer Work { float w[]; };            // 12 m + 12\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint m;            // M: rad_local.capacity, the plane stride\n"
+    "    uint end;          // slots in use after the add: max(new slot + 1, rad_local.slot_end)\n"
+    "    uint row_offset;   // pass 0: first plane row held by bindings 0..2\n"
+    "    uint row_count;    // pass 0: plane rows held by bindings 0..2 (row_offset + row_count <= end)\n"
+    "    uint base;         // pass 0: element of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint nnz;          // entries of nz\n"
+    "    uint ev;           // the slot evicted by this add, or 0xFFFFFFFF\n"
+    "    uint pass;         // 0, 1, 2 (see above)\n"
+    "    uint flags;        // bit 0: first chunk of pass 0 (v = b + ...); bit 1: first-order update\n"
+    "    float ann_r, ann_g, ann_b; // rho_n F_nn per channel\n"
+    "} pc;\n"
+    "\n"
+    "float plane(uint c, uint e) { return c == 0u \? R[e] : c == 1u \? G[e] : B[e]; }\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint x = gl_GlobalInvocationID.x, m = pc.m, c;\n"
+    "    bool evict = pc.ev != 0xFFFFFFFFu;\n"
+    "    if (pc.pass == 0u) {\n"
+    "        if (x < pc.row_count) { // row i of the chunk\n"
+    "            uint i = pc.row_offset + x, at = pc.base + x * m;\n"
+    "            for (c = 0u; c < 3u; ++c) {\n";
+static const char rad__glsl_9_1[] =
+    "                precise float acc = a[c * m + i];\n"
+    "                for (uint p = 0u; p < pc.nnz; ++p) acc += plane(c, at + nz[p]) * a[c * m + nz[p]];\n"
+    "                w[c * 4u * m + i] = acc;\n"
+    "                w[c * 4u * m + 2u * m + i] = (evict && i != pc.ev) \? plane(c, at + pc.ev) : 0.0;\n"
+    "            }\n"
+    "        }\n"
+    "        if (x < pc.end) { // column j\n"
+    "            uint j = x;\n"
+    "            bool ev_here = evict && pc.ev >= pc.row_offset && pc.ev - pc.row_offset < pc.row_count;\n"
+    "            for (c = 0u; c < 3u; ++c) {\n"
+    "                precise float acc = (pc.flags & 1u) != 0u \? b[c * m + j] : w[c * 4u * m + m + j];\n"
+    "                for (uint p = 0u; p < pc.nnz; ++p) {\n"
+    "                    uint r = nz[p];\n"
+    "                    if (r >= pc.row_offset && r - pc.row_offset < pc.row_count)\n"
+    "                        acc += b[c * m + r] * plane(c, pc.base + (r - pc.row_offset) * m + j);\n"
+    "                }\n"
+    "                w[c * 4u * m + m + j] = acc;\n"
+    "                if (ev_here) w[c * 4u * m + 3u * m + j] = plane(c, pc.base + (pc.ev - pc.row_offset) * m + j);\n"
+    "            }\n"
+    "        }\n"
+    "    } else if (pc.pass == 1u) {\n"
+    "        if (x >= pc.end || !evict) return;\n"
+    "        for (c = 0u; c < 3u; ++c) {\n"
+    "            uint o = c * 4u * m;\n"
+    "            float g = 1.0 + w[o + 3u * m + pc.ev];\n"
+    "            precise float ra = 0.0, bc = 0.0;  // r.a and b.c (a and b are zero at ev)\n"
+    "            for (uint p = 0u; p < pc.nnz; ++p) {\n"
+    "                uint j = nz[p];\n"
+    "                ra += w[o + 3u * m + j] * a[c * m + j];\n"
+    "                bc += b[c * m + j] * w[o + 2u * m + j];\n"
+    "            }\n"
+    "            if (x == pc.ev) {\n"
+    "                w[o + x] = 0.0;\n"
+    "                w[o + m + x] = 0.0;\n"
+    "            } else {\n"
+    "                w[o + x] -= w[o + 2u * m + x] * (ra / g);\n"
+    "                w[o + m + x] -= (bc / g) * w[o + 3u * m + x];\n"
+    "            }\n"
+    "        }\n"
+    "    } else if (pc.pass == 2u) {\n"
+    "        if (x >= 3u) return;\n"
+    "        c = x;\n"
+    "        precise float bu = 0.0, ba = 0.0;\n"
+    "        for (uint p = 0u; p < pc.nnz; ++p) {\n"
+    "            uint j = nz[p];\n"
+    "            bu += b[c * m + j] * w[c * 4u * m + j];\n"
+    "            ba += b[c * m + j] * a[c * m + j];\n"
+    "        }\n"
+    "        float ann = c == 0u \? pc.ann_r : c == 1u \? pc.ann_g : pc.ann_b;\n"
+    "        precise float q = ann + bu, s = 1.0 - q; // q: no cancellation\n"
+    "        uint o = 12u * m;\n"
+    "        w[o + c] = s;\n"
+    "        if ((pc.flags & 2u) == 0u) {\n"
+    "            w[o + 3u + c] = 1.0 / s;\n"
+    "            w[o + 6u + c] = 1.0 / s;\n"
+    "            w[o + 9u + c] = q / s;                 // 1/s - 1 without its cancellation\n"
+    "        } else {\n"
+    "            precise float d = ann + ba;\n"
+    "            w[o + 3u + c] = (1.0 + d) * (1.0 + d);\n"
+    "            w[o + 6u + c] = 1.0 + d;\n"
+    "            w[o + 9u + c] = d;\n"
+    "        }\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_9[] = { rad__glsl_9_0, rad__glsl_9_1 };
+static const char rad__glsl_10_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LOCAL_UPDATE: the O(M^2) pass of a local-matrix add\n"
+    "// (rad_local_add, docs/methods/local.md) on T resident on the GPU, after RAD_GLSL_LOCAL_VECTORS filled the work\n"
+    "// buffer (its comment has the layout: u, v, c, r per channel and the scalars s, cuv, coef, tnn).\n"
+    "// For plane rows i = row_offset .. row_offset + row_count - 1 (all < end), channels R, G, B:\n"
+    "//   i == k (the new patch's slot):  T[k][j] = coef v[j] (j != k), T[k][k] = tnn\n"
+    "//   else: T[i][j] += cuv u[i] v[j] - c[i] r[j] / g   (j < end, j != k; the second term only when\n"
+    "//         an add evicts slot ev = k, g = 1 + r[ev]: the exact downdate fused into a rank-2 pass)\n"
+    "//         T[i][k] = coef u[i]\n"
+    "// which is rad_local_add's update, new row and new column; with the factors of the first-order\n"
+    "// form when RAD_GLSL_LOCAL_VECTORS ran with it. Nothing is written when some channel has\n"
+    "// s <= 1e-12 (the CPU returns RAD_ERROR_SINGULAR and leaves T unchanged). Rows and columns >= end\n"
+    "// are not touched. ONE WORKGROUP PER ROW: dispatch row_count groups; the group strides over j.\n"
+    "// Chunking: bindings 0..2 may hold only this chunk's rows, row i at element base + (i - row_offset) * m.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) buffer PlaneR { float R[]; };\n"
+    "layout(std430, set = 0, binding = 1) buffer PlaneG { float G[]; };\n"
+    "layout(std430, set = 0, binding = 2) buffer PlaneB { float B[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Work { float w[]; }; // 12 m + 12, from LOCAL_VECTORS\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint m;            // M: rad_local.capacity, the plane stride\n"
+    "    uint end;          // slots in use after the add (as given to RAD_GLSL_LOCAL_VECTORS)\n"
+    "    uint row_offset;   // first plane row of this dispatch\n"
+    "    uint row_count;    // rows in this dispatch (= workgroups)\n"
+    "    uint base;         // element of bindings 0..2 that holds plane row row_offset, column 0\n"
+    "    uint k;            // the new patch's slot\n"
+    "    uint ev;           // the slot evicted by this add (then ev == k), or 0xFFFFFFFF\n"
+    "} pc;\n"
+    "\n"
+    "void update(uint c, uint at, uint i)\n"
+    "{\n"
+    "    uint m = pc.m, o = c * 4u * m, s = 12u * m, lid = gl_LocalInvocationID.x;\n"
+    "    float cuv = w[s + 3u + c], coef = w[s + 6u + c];\n"
+    "    if (i == pc.k) {\n"
+    "        for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "            precise float t = j == pc.k \? w[s + 9u + c] : coef * w[o + m + j];\n"
+    "            if (c == 0u) R[at + j] = t; else if (c == 1u) G[at + j] = t; else B[at + j] = t;\n"
+    "        }\n"
+    "        return;\n"
+    "    }\n"
+    "    precise float ui = cuv * w[o + i];\n"
+    "    precise float ci = pc.ev != 0xFFFFFFFFu \? -w[o + 2u * m + i] / (1.0 + w[o + 3u * m + pc.ev]) : 0.0;\n"
+    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "        precise float t;\n"
+    "        if (j == pc.k) t = coef * w[o + i];\n"
+    "        else {\n"
+    "            t = c == 0u \? R[at + j] : c == 1u \? G[at + j] : B[at + j];\n"
+    "            if (ui != 0.0 || ci != 0.0) t += ci * w[o + 3u * m + j] + ui * w[o + m + j];\n"
+    "        }\n"
+    "        if (c == 0u) R[at + j] = t; else if (c == 1u) G[at + j] = t; else B[at + j] = t;\n"
+    "    }\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_WorkGroupID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint s = 12u * pc.m;\n"
+    "    for (uint c = 0u; c < 3u; ++c)\n"
+    "        if (!(w[s + c] > 1e-12)) return; // singular: T stays as it was\n"
+    "    uint at = pc.base + r * pc.m, i = pc.row_offset + r;\n"
+    "    for (uint c = 0u; c < 3u; ++c) update(c, at, i);\n"
+    "}\n";
+static const char *const rad__glsl_pieces_10[] = { rad__glsl_10_0 };
+static const char rad__glsl_11_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_VP_GATHER: virtual-patch gathering at surface points, as\n"
+    "// rad_vp_gather / rad_vp_gather_point (docs/methods/virtual-patches.md). For point i with unit\n"
+    "// normal n: in each voxel v of the 2x2x2 block around p (by voxel centres; the grid coordinate\n"
+    "// x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),\n"
+    "//   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0\n"
+    "// (axis-aligned: w_a the split weights of n, max(0, +-n_k)^2 or max(0, +-n_k) normalized to\n"
+    "// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = N_a . n); voxels outside the grid,\n"
+    "// empty or with no patch facing n are skipped, and\n"
+    "//   out_i = sum_v t_v L(v) / sum_v t_v       (t_v the trilinear weights; 0 when no voxel is used;\n"
+    "//   the plain mean of the used L(v) when their t_v sum to 0)\n"
+    "// ONE INVOCATION PER POINT: dispatch ceil(row_count / size) groups for the points\n"
+    "// row_offset .. row_offset + row_count - 1. Chunking: bindings 0, 1 and 6 may hold only this\n"
+    "// chunk's points, point i at elements base + 3 (i - row_offset) .. + 2 of each (bind the three at\n"
+    "// the same element offset). Voxel keys are the uint64 rad_virtual_patches.voxel_keys (ascending,\n"
+    "// ix + dims0 (iy + dims1 iz)), read as uvec2 (low word first) and found by binary search.\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer Points { float P[]; };       // 3 per point\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Normals { float Nrm[]; };    // 3 per point, unit\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Values { float X[]; };       // 3 N, per patch\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer VoxelKeys { uvec2 keys[]; }; // voxel_count uint64\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer VoxelPatch { uint vpatch[]; }; // 6 per voxel, or ~0u\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N (clustered only)\n"
+    "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };             // 3 per point\n"
+    "layout(push_constant) uniform Push {\n"
+    "    float origin_x, origin_y, origin_z;   // rad_virtual_patches.origin\n"
+    "    float size_x, size_y, size_z;         // .voxel_size\n"
+    "    uint dims_x, dims_y, dims_z;          // .dims\n"
+    "    uint voxel_count;                     // .voxel_count\n"
+    "    uint row_offset;                      // first point of this dispatch\n"
+    "    uint row_count;                       // points in this dispatch\n"
+    "    uint base;                            // element of bindings 0, 1, 6 holding point row_offset\n"
+    "    uint flags;                           // bit 0: cosine split weights; bit 1: clustered\n"
+    "} pc;\n"
+    "\n"
+    "uvec2 mul64(uint a, uvec2 b) { uint hi, lo; umulExtended(a, b.x, hi, lo); return uvec2(lo, hi + a * b.y); }\n"
+    "uvec2 add64(uvec2 a, uint b) { uint c; uint lo = uaddCarry(a.x, b, c); return uvec2(lo, a.y + c); }\n"
+    "bool less64(uvec2 a, uvec2 b) { return a.y < b.y || (a.y == b.y && a.x < b.x); }\n"
+    "\n"
+    "uint find_voxel(uvec2 key)\n"
+    "{\n"
+    "    uint lo = 0u, hi = pc.voxel_count;\n"
+    "    while (lo < hi) {\n"
+    "        uint mid = lo + (hi - lo) / 2u;\n"
+    "        if (less64(keys[mid], key)) lo = mid + 1u; else hi = mid;\n"
+    "    }\n"
+    "    return lo < pc.voxel_count && keys[lo] == key \? lo : 0xFFFFFFFFu;\n"
+    "}\n"
+    "\n"
+    "// a + b exactly, as the pair (sum, error) (Knuth's TwoSum)\n"
+    "vec2 two_sum(float a, float b)\n"
+    "{\n"
+    "    precise float s = a + b;\n"
+    "    precise float bb = s - a;\n"
+    "    precise float e = (a - (s - bb)) + (b - bb);\n"
+    "    return vec2(s, e);\n"
+    "}\n"
+    "// a * b exactly, as the pair (product, error) (Dekker, Veltkamp's split; no fma needed)\n"
+    "vec2 two_prod(float a, float b)\n"
+    "{\n"
+    "    precise float ca = 4097.0 * a, cb = 4097.0 * b;\n"
+    "    precise float ah = ca - (ca - a), bh = cb - (cb - b);\n"
+    "    precise float al = a - ah, bl = b - bh;\n"
+    "    precise float q = a * b;\n"
+    "    precise float e = ((ah * bh - q) + ah * bl + al * bh) + al * bl;\n"
+    "    return vec2(q, e);\n"
+    "}\n"
+    "// (p - o) / s - 1/2 as an unevaluated float pair (hi, lo), to about 1e-14 relative\n";
+static const char rad__glsl_11_1[] =
+    "vec2 grid_coordinate(float p, float o, float s)\n"
+    "{\n"
+    "    vec2 d = two_sum(p, -o);                      // p - o exactly\n"
+    "    precise float q = d.x / s;\n"
+    "    vec2 qs = two_prod(q, s);\n"
+    "    precise float r = ((d.x - qs.x) - qs.y) + d.y; // the remainder d - q s\n"
+    "    precise float ql = r / s;\n"
+    "    vec2 x = two_sum(q, -0.5);\n"
+    "    precise float lo = x.y + ql;\n"
+    "    return vec2(x.x, lo);\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint at = pc.base + 3u * r;\n"
+    "    vec3 p = vec3(P[at], P[at + 1u], P[at + 2u]), n = vec3(Nrm[at], Nrm[at + 1u], Nrm[at + 2u]);\n"
+    "    vec3 origin = vec3(pc.origin_x, pc.origin_y, pc.origin_z), size = vec3(pc.size_x, pc.size_y, pc.size_z);\n"
+    "    uvec3 dims = uvec3(pc.dims_x, pc.dims_y, pc.dims_z);\n"
+    "    bool clustered = (pc.flags & 2u) != 0u;\n"
+    "    // the split weights of n (+x, -x, +y, -y, +z, -z)\n"
+    "    vec3 wp = max(n, vec3(0.0)), wm = max(-n, vec3(0.0));\n"
+    "    if ((pc.flags & 1u) == 0u) { wp *= wp; wm *= wm; }\n"
+    "    float wsum = wp.x + wm.x + wp.y + wm.y + wp.z + wm.z;\n"
+    "    float w[6] = float[6](wp.x, wm.x, wp.y, wm.y, wp.z, wm.z);\n"
+    "    if (wsum > 0.0) for (int a = 0; a < 6; ++a) w[a] /= wsum;\n"
+    "    // the grid coordinate as a float pair (the CPU computes it in double: a float x would carry\n"
+    "    // an absolute error of about 1e-7 dims, large against the small trilinear weights)\n"
+    "    ivec3 b;\n"
+    "    vec3 g0, g1;\n"
+    "    for (int k = 0; k < 3; ++k) {\n"
+    "        vec2 x = grid_coordinate(p[k], origin[k], size[k]);\n"
+    "        float top = float(dims[k]) + 1.0;\n"
+    "        if (x.x < -2.0 || (x.x == -2.0 && x.y < 0.0)) x = vec2(-2.0, 0.0);\n"
+    "        if (x.x > top || (x.x == top && x.y > 0.0)) x = vec2(top, 0.0);\n"
+    "        float fb = floor(x.x);\n"
+    "        precise float f = x.x - fb;             // exact\n"
+    "        if (f + x.y < 0.0) fb -= 1.0; else if (f + x.y >= 1.0) fb += 1.0;\n"
+    "        f = x.x - fb;\n"
+    "        b[k] = int(fb);\n"
+    "        g1[k] = f + x.y;                        // the weight of the upper cell, g\n"
+    "        g0[k] = (1.0 - f) - x.y;                // 1 - g, from the pair: no cancellation near g = 1\n"
+    "    }\n"
+    "    precise vec3 acc = vec3(0.0), facc = vec3(0.0);\n"
+    "    precise float tsum = 0.0;\n"
+    "    uint used = 0u;\n"
+    "    for (uint corner = 0u; corner < 8u; ++corner) {\n"
+    "        ivec3 bit = ivec3(int(corner & 1u), int((corner >> 1) & 1u), int((corner >> 2) & 1u));\n"
+    "        ivec3 cell = b + bit;\n"
+    "        if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(uvec3(cell), dims))) continue;\n"
+    "        vec3 tt = mix(g0, g1, vec3(bit));\n"
+    "        float t = tt.x * tt.y * tt.z;\n"
+    "        uvec2 key = add64(mul64(dims.x, add64(mul64(dims.y, uvec2(uint(cell.z), 0u)), uint(cell.y))), uint(cell.x));\n"
+    "        uint v = find_voxel(key);\n"
+    "        if (v == 0xFFFFFFFFu) continue;\n"
+    "        precise vec3 L = vec3(0.0);\n"
+    "        precise float ws = 0.0;\n"
+    "        for (uint a = 0u; a < 6u; ++a) {\n"
+    "            uint q = vpatch[6u * v + a];\n"
+    "            if (q == 0xFFFFFFFFu) continue;\n"
+    "            float wa = clustered \? dot(vec3(PN[3u * q], PN[3u * q + 1u], PN[3u * q + 2u]), n) : w[a];\n"
+    "            if (!(wa > 0.0)) continue;\n"
+    "            ws += wa;\n"
+    "            L += wa * vec3(X[3u * q], X[3u * q + 1u], X[3u * q + 2u]);\n"
+    "        }\n"
+    "        if (!(ws > 0.0)) continue; // nothing in this voxel faces n\n"
+    "        used++;\n"
+    "        acc += t * L / ws;\n"
+    "        facc += L / ws;\n"
+    "        tsum += t;\n"
+    "    }\n"
+    "    vec3 o = used == 0u \? vec3(0.0) : (tsum > 0.0 \? acc / tsum : facc / float(used));\n"
+    "    outv[at] = o.x;\n"
+    "    outv[at + 1u] = o.y;\n"
+    "    outv[at + 2u] = o.z;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_11[] = { rad__glsl_11_0, rad__glsl_11_1 };
+static const char rad__glsl_12_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_PROBE_UPDATE: irradiance probes from a new patch solution, as\n"
+    "// rad_probes_update (docs/methods/probes.md):\n"
+    "//   E_i(probe) = D_i(probe) + sum over the probe's entries e of W_e,i B_patch(e)\n"
+    "// 27 coefficients per probe (coefficient-major, RGB interleaved: [27 p + 3 i + c]) for probes\n"
+    "// p = row_offset .. row_offset + row_count - 1, ONE INVOCATION PER PROBE. Binding 0 holds all\n"
+    "// probe count + 1 entry offsets as uint64 (two uint words each, low word first: rad_probes_weights'\n"
+    "// first array uploaded unchanged). Chunking: bindings 1 and 2 may hold only this chunk's entries:\n"
+    "// entry k is element k - entry_base of binding 1 and elements 9 k - weight_base .. + 8 of binding 2\n"
+    "// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer First { uvec2 first[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Patch { uint patch_index[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer Weights { float weights[]; };   // 9 per entry\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Direct { float direct[]; };     // 27 per probe\n"
+    "layout(std430, set = 0, binding = 4) readonly buffer Radiosity { float B[]; };       // 3 N\n"
+    "layout(std430, set = 0, binding = 5) buffer Output { float coefficients[]; };        // 27 per probe\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;  // first probe of this dispatch\n"
+    "    uint row_count;   // probes in this dispatch\n"
+    "    uint entry_base;  // low 32 bits of the entry index at element 0 of binding 1\n"
+    "    uint weight_base; // low 32 bits of the float index (9 k) at element 0 of binding 2\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint p = pc.row_offset + r;\n"
+    "    uint k0 = first[p].x - pc.entry_base;             // wraps correctly: only the difference matters\n"
+    "    uint w0 = 9u * first[p].x - pc.weight_base;\n"
+    "    uint count = first[p + 1u].x - first[p].x;\n"
+    "    precise vec3 acc[9];\n"
+    "    for (uint i = 0u; i < 9u; ++i) {\n"
+    "        uint d = 27u * p + 3u * i;\n"
+    "        acc[i] = vec3(direct[d], direct[d + 1u], direct[d + 2u]);\n"
+    "    }\n"
+    "    for (uint e = 0u; e < count; ++e) {\n"
+    "        uint j = patch_index[k0 + e];\n"
+    "        vec3 b = vec3(B[3u * j], B[3u * j + 1u], B[3u * j + 2u]);\n"
+    "        for (uint i = 0u; i < 9u; ++i) acc[i] += weights[w0 + 9u * e + i] * b;\n"
+    "    }\n"
+    "    for (uint i = 0u; i < 9u; ++i) {\n"
+    "        coefficients[27u * p + 3u * i] = acc[i].x;\n"
+    "        coefficients[27u * p + 3u * i + 1u] = acc[i].y;\n"
+    "        coefficients[27u * p + 3u * i + 2u] = acc[i].z;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_12[] = { rad__glsl_12_0 };
+static const char rad__glsl_13_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LIGHTMAP_REFRESH: a lightmap refreshed from a new patch\n"
+    "// irradiance H, as rad_lightmap_refresh (docs/methods/lightmap.md), in its two stages:\n"
+    "//   pass 0 (RAD_GLSL_LIGHTMAP_PASS_VERTICES), one invocation per patch vertex v:\n"
+    "//     V[v] = sum over k in [vertex_first[v], vertex_first[v + 1]) of vertex_weights[k] H[vertex_patches[k]]\n"
+    "//   pass 1 (RAD_GLSL_LIGHTMAP_PASS_TEXELS), one invocation per row r (a texel with a row):\n"
+    "//     out[row_texels[r]] = sum over e in [row_first[r], row_first[r + 1]) of entry_weights[e] V[entry_vertices[e]]\n"
+    "// rows (vertices or texel rows) row_offset .. row_offset + row_count - 1. RGB vectors are\n"
+    "// interleaved (3 floats each). Pass 1 reads what pass 0 wrote into binding 4: put a\n"
+    "// compute-to-compute barrier between them. Texels without a row are not written.\n"
+    "// Chunking: the entry arrays of the pass (bindings 1 and 2, or 7 and 8) may hold only this\n"
+    "// chunk's entries: entry k is element k - entry_base. The offsets (0, 6), vectors (3, 4) and\n"
+    "// out (9) are bound whole. A pass reads none of the other pass's bindings (bind any buffer).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer VertexFirst { uint vertex_first[]; };   // vertices + 1\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer VertexPatches { uint vertex_patches[]; };\n"
+    "layout(std430, set = 0, binding = 2) readonly buffer VertexWeights { float vertex_weights[]; };\n"
+    "layout(std430, set = 0, binding = 3) readonly buffer Irradiance { float H[]; };              // 3 N\n"
+    "layout(std430, set = 0, binding = 4) buffer VertexValues { float V[]; };                      // 3 per vertex\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer RowTexels { uint row_texels[]; };\n"
+    "layout(std430, set = 0, binding = 6) readonly buffer RowFirst { uint row_first[]; };         // rows + 1\n"
+    "layout(std430, set = 0, binding = 7) readonly buffer EntryVertices { uint entry_vertices[]; };\n"
+    "layout(std430, set = 0, binding = 8) readonly buffer EntryWeights { float entry_weights[]; };\n"
+    "layout(std430, set = 0, binding = 9) buffer Output { float lightmap[]; };                    // 3 per texel\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint pass;        // 0: vertices, 1: texel rows\n"
+    "    uint row_offset;  // first vertex or row of this dispatch\n"
+    "    uint row_count;   // vertices or rows in this dispatch\n"
+    "    uint entry_base;  // the entry index at element 0 of the pass's entry bindings\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint i = gl_GlobalInvocationID.x;\n"
+    "    if (i >= pc.row_count) return;\n"
+    "    uint r = pc.row_offset + i;\n"
+    "    precise vec3 acc = vec3(0.0);\n"
+    "    if (pc.pass == 0u) {\n"
+    "        uint a = vertex_first[r] - pc.entry_base, b = vertex_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint k = a; k < b; ++k) {\n"
+    "            uint j = 3u * vertex_patches[k];\n"
+    "            acc += vertex_weights[k] * vec3(H[j], H[j + 1u], H[j + 2u]);\n"
+    "        }\n"
+    "        V[3u * r] = acc.x;\n"
+    "        V[3u * r + 1u] = acc.y;\n"
+    "        V[3u * r + 2u] = acc.z;\n"
+    "    } else {\n"
+    "        uint a = row_first[r] - pc.entry_base, b = row_first[r + 1u] - pc.entry_base;\n"
+    "        for (uint e = a; e < b; ++e) {\n"
+    "            uint j = 3u * entry_vertices[e];\n"
+    "            acc += entry_weights[e] * vec3(V[j], V[j + 1u], V[j + 2u]);\n"
+    "        }\n"
+    "        uint t = 3u * row_texels[r];\n"
+    "        lightmap[t] = acc.x;\n"
+    "        lightmap[t + 1u] = acc.y;\n"
+    "        lightmap[t + 2u] = acc.z;\n"
+    "    }\n"
+    "}\n";
+static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
+static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
+    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
+    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
+    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
+    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
+    { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
+    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
+    { "alias_build.comp", rad__glsl_pieces_6, 2u, 4700u },
+    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9441u },
+    { "local_apply.comp", rad__glsl_pieces_8, 1u, 3519u },
+    { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
+    { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
+    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u },
+    { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
+};
+/* >>glsl end */
+
+RAD_API const char *rad_glsl_name(rad_glsl_id id)
+{
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) return NULL;
+    return rad__glsl_table[id].name;
+}
+
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
+{
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT) {
+        if (out_count) *out_count = 0;
+        return NULL;
+    }
+    if (out_count) *out_count = rad__glsl_table[id].count;
+    return rad__glsl_table[id].pieces;
+}
+
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
+{
+    const rad__glsl_entry *e;
+    uint32_t p;
+    size_t at = 0;
+    if ((unsigned)id >= (unsigned)RAD_GLSL_COUNT || (!dst && !out_length)) return RAD_ERROR_INVALID_ARGUMENT;
+    e = &rad__glsl_table[id];
+    if (out_length) *out_length = e->length;
+    if (!dst) return dst_size == 0 ? RAD_SUCCESS : RAD_ERROR_INVALID_ARGUMENT;
+    if (dst_size <= e->length) return RAD_ERROR_SIZE_MISMATCH;
+    for (p = 0; p < e->count; ++p) {
+        size_t n = strlen(e->pieces[p]);
+        memcpy(dst + at, e->pieces[p], n);
+        at += n;
+    }
+    RAD_ASSERT(at == e->length);
+    dst[at] = '\0';
+    return RAD_SUCCESS;
+}
+
+#else /* RAD_NO_GLSL: the kernels' text is left out; the ids and the functions stay */
+
+RAD_API const char *rad_glsl_name(rad_glsl_id id)
+{
+    (void)id;
+    return NULL;
+}
+
+RAD_API const char *const *rad_glsl_pieces(rad_glsl_id id, uint32_t *out_count)
+{
+    (void)id;
+    if (out_count) *out_count = 0;
+    return NULL;
+}
+
+RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, size_t *out_length)
+{
+    (void)id;
+    (void)dst;
+    (void)dst_size;
+    if (out_length) *out_length = 0;
+    return RAD_ERROR_UNAVAILABLE;
+}
+
+#endif /* RAD_NO_GLSL */
 
 #endif /* RADIOSITY_IMPLEMENTATION */
 

@@ -134,7 +134,7 @@ static rad_scene *unwrapped(const rad_scene *S, uint32_t N, float **uvs_out)
     float *uvs = (float *)calloc(6 * (size_t)S->triangle_count, sizeof(float));
     rad_scene *U = NULL;
     uint32_t charts = 0;
-    if (rad_tool_unwrap(S, N, N, uvs, &charts)) exit(1);
+    if (tool_unwrap(S, N, N, uvs, &charts)) exit(1);
     memcpy(mats, S->materials_table, sizeof(rad_material) * S->material_count);
     memset(&mesh, 0, sizeof mesh);
     mesh.name = "unwrapped";

@@ -149,7 +149,7 @@ static double frame_apply(world *w, const rad_local *L, const rad_camera *cam, u
     nc = members(L, cand);
     if ((r = rad_local_lit(w->E, cand, nc, 0.0f, lit, &nl)) != RAD_SUCCESS) die("lit", r);
     t1 = now();
-    if ((r = rad_local_apply(L, w->E, vis, nv, lit, nl, RAD_OUTPUT_INDIRECT, out, &g_ctx)) != RAD_SUCCESS) die("apply", r);
+    if ((r = rad_local_apply(L, w->E, vis, nv, lit, nl, out, RAD_OUTPUT_INDIRECT, &g_ctx)) != RAD_SUCCESS) die("apply", r);
     *sets_s = t1 - t0;
     *nv_out = nv;
     *nl_out = nl;
@@ -358,7 +358,7 @@ static void bench_error(void)
         {
             uint32_t nc = members(L[1], cand), nl1 = 0;
             rad_local_lit(w.E, cand, nc, 0.0f, lit, &nl1);
-            if ((r = rad_local_apply(L[1], w.E, vis, nv, lit, nl1, RAD_OUTPUT_INDIRECT, outr, &g_ctx)) != RAD_SUCCESS) die("apply", r);
+            if ((r = rad_local_apply(L[1], w.E, vis, nv, lit, nl1, outr, RAD_OUTPUT_INDIRECT, &g_ctx)) != RAD_SUCCESS) die("apply", r);
             for (i = 0; i < nv; ++i)
                 for (j = 0; j < 3; ++j) {
                     double d = (double)outr[3 * (size_t)vis[i] + j] - Lfull[3 * (size_t)vis[i] + j];
@@ -370,7 +370,7 @@ static void bench_error(void)
                 }
             nc = members(R, cand);
             rad_local_lit(w.E, cand, nc, 0.0f, lit, &nl1);
-            if ((r = rad_local_apply(R, w.E, vis, nv, lit, nl1, RAD_OUTPUT_INDIRECT, outr, &g_ctx)) != RAD_SUCCESS) die("apply", r);
+            if ((r = rad_local_apply(R, w.E, vis, nv, lit, nl1, outr, RAD_OUTPUT_INDIRECT, &g_ctx)) != RAD_SUCCESS) die("apply", r);
             for (i = 0; i < nv; ++i)
                 for (j = 0; j < 3; ++j) {
                     double d = (double)outr[3 * (size_t)vis[i] + j] - Lfull[3 * (size_t)vis[i] + j];

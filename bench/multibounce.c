@@ -718,7 +718,7 @@ static int apply_only(uint32_t target, const char *cache, const char *label, int
     buf = malloc(bytes);
     if (!buf || fread(buf, 1, bytes, fp) != bytes) return 1;
     fclose(fp);
-    if (rad_container_open(buf, bytes, NULL, &ct)) return 1;
+    if (rad_container_create(buf, bytes, NULL, &ct)) return 1;
     memset(&F, 0, sizeof(F));
     F.rows = F.cols = n;
     F.storage = RAD_STORAGE_DENSE;
@@ -768,7 +768,7 @@ static int apply_only(uint32_t target, const char *cache, const char *label, int
             rad_multibounce_blocks_destroy(b);
         }
     if (dense && apply_dense(&sys, &F, albedo, E, out, ref, threads)) return 1;
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(buf); free(E); free(albedo); free(out); free(ref); free(Fd);
     return 0;
 }

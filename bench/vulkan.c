@@ -196,7 +196,7 @@ int main(int argc, char **argv)
         rg[4] = vk_whole(&bR); rg[5] = vk_whole(&bB0); rg[6] = vk_whole(&bB1); rg[7] = vk_whole(&bTot);
         memset(&pc, 0, sizeof(pc));
         pc.row_count = n; pc.n = n; pc.samples = to.samples; pc.words = (uint32_t)tables->format;
-        pc.flags = RAD_GLSL_FLAG_ALBEDO; pc.channel = 3; pc.weight = to.weight;
+        pc.flags = RAD_GLSL_TEMPORAL_ALBEDO; pc.channel = 3; pc.weight = to.weight;
         for (r = 0; r < reps; ++r) {
             double t0 = now();
             pc.frame = (uint32_t)r;

@@ -69,7 +69,7 @@ static void *bake(uint32_t patch_target, size_t *out_size)
     memset(s, 0, sizeof(s));
     s[0].type = RAD_SECTION_VECTOR; s[0].elem_size = 12; s[0].count = patches->count; s[0].data = E; strcpy(s[0].name, "E");
     s[1].type = RAD_SECTION_VECTOR; s[1].elem_size = 12; s[1].count = patches->count; s[1].data = patches->albedo; strcpy(s[1].name, "albedo");
-    rad_alias_tables_sections(tables, "F", s + 2);
+    rad_alias_tables_sections(tables, "F", s + 2, NULL);
     CHECK_RAD(rad_multibounce_sections(mb, "F_mb", s + 5, &mb_count));
     count = 5 + mb_count;
     CHECK_RAD(rad_container_size(s, count, out_size));
@@ -406,7 +406,7 @@ int main(int argc, char **argv)
     }
 
     /* 2. views into the container: nothing is copied */
-    CHECK_RAD(rad_container_open(bytes, size, NULL, &ct));
+    CHECK_RAD(rad_container_create(bytes, size, NULL, &ct));
     sE = rad_container_find(ct, RAD_SECTION_VECTOR, "E");
     sA = rad_container_find(ct, RAD_SECTION_VECTOR, "albedo");
     if (!sE || !sA) { fprintf(stderr, "the container has no E or albedo vector\n"); return 1; }
@@ -436,7 +436,7 @@ int main(int argc, char **argv)
         t0[0] = t1[0] = &bOff; t0[1] = t1[1] = &bBins; t0[2] = t1[2] = &bTot; t0[3] = t1[3] = &bE; t0[4] = t1[4] = &bAlb;
         t0[5] = &bB[0]; t0[6] = &bB[1];
         t1[5] = &bB[1]; t1[6] = &bB[0];
-        t0[7] = t1[7] = &bPerm; /* bins per row: only for padded tables (RAD_GLSL_FLAG_PADDED) */
+        t0[7] = t1[7] = &bPerm; /* bins per row: only for padded tables (RAD_GLSL_TEMPORAL_PADDED) */
         kt[0] = kernel_create(&g, RAD_GLSL_TEMPORAL_STEP, sizeof(rad_glsl_temporal_push), local_size, t0, 8);
         kt[1] = kernel_create(&g, RAD_GLSL_TEMPORAL_STEP, sizeof(rad_glsl_temporal_push), local_size, t1, 8);
         m[0] = &bPlanes[0]; m[1] = &bPlanes[1]; m[2] = &bPlanes[2]; m[3] = &bE; m[4] = &bPerm; m[5] = &bPerm; m[6] = &bL;
@@ -478,7 +478,7 @@ int main(int argc, char **argv)
         tpc.n = n;
         tpc.samples = samples;
         tpc.words = (uint32_t)tables.format;
-        tpc.flags = RAD_GLSL_FLAG_ALBEDO | RAD_GLSL_FLAG_FEEDBACK;
+        tpc.flags = RAD_GLSL_TEMPORAL_ALBEDO | RAD_GLSL_TEMPORAL_FEEDBACK;
         tpc.channel = 3;
         tpc.weight = topt.weight;
         memset(&mpc, 0, sizeof(mpc));
@@ -544,7 +544,7 @@ int main(int argc, char **argv)
     vkDestroyInstance(g.instance, NULL);
     rad_temporal_destroy(cpu);
     rad_multibounce_destroy(mb);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(bytes); free(L_cpu); free(B_cpu);
     return worst_gpu_cpu <= 1e-5 ? 0 : 1;
 }

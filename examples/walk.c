@@ -174,7 +174,7 @@ int main(int argc, char **argv)
         /* 3. B = E + T E over P_Vis x P_Lit; everything else black */
         t0 = now_s();
         memcpy(B, E, sizeof(float) * 3 * n); /* the lamps glow everywhere; walls only through T */
-        check(rad_local_apply(L, E, vis, nv, lit, nl, RAD_OUTPUT_TOTAL, B, NULL), "rad_local_apply");
+        check(rad_local_apply(L, E, vis, nv, lit, nl, B, RAD_OUTPUT_TOTAL, NULL), "rad_local_apply");
         t_ap = now_s() - t0;
 
         /* 4. draw */

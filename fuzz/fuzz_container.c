@@ -1,5 +1,5 @@
 /* fuzz_container.c - libFuzzer harness for the baked-data loader.
-   Any bytes go to rad_container_open and rad_load_memory (copied into an aligned buffer, as a
+   Any bytes go to rad_container_create and rad_load_memory (copied into an aligned buffer, as a
    mapped file would be); then a second copy whose table, section and header checksums the
    harness recomputes goes through the same calls, so mutations also reach the structural and
    index checks behind the checksums. When a bake loads, everything it claims is used: every
@@ -31,7 +31,7 @@ static void exercise(void *buf, size_t size)
 {
     rad_container *c = NULL;
     rad_bake *b = NULL;
-    if (rad_container_open(buf, size, NULL, &c) == RAD_SUCCESS) {
+    if (rad_container_create(buf, size, NULL, &c) == RAD_SUCCESS) {
         uint32_t i, n = rad_container_section_count(c);
         volatile uint8_t sink = 0;
         for (i = 0; i < n; ++i) {
@@ -39,7 +39,7 @@ static void exercise(void *buf, size_t size)
             if (s->count && s->elem_size) sink ^= ((const uint8_t *)s->data)[s->count * s->elem_size - 1];
         }
         (void)sink;
-        rad_container_close(c);
+        rad_container_destroy(c);
     }
     if (rad_load_memory(buf, size, NULL, &b) == RAD_SUCCESS) {
         uint32_t N = b->patches.count, t;

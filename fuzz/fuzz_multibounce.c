@@ -1,7 +1,7 @@
 /* fuzz_multibounce.c - libFuzzer harness for the multi-bounce loaders: rad_multibounce_load
    (F_mb in float or half, with or without permutations) and rad_multibounce_blocks_load (the
    BC1 and 3xBC4 forms with their scales, permutations and outliers), both views into
-   container bytes. The input goes to rad_container_open (copied into an aligned buffer, as
+   container bytes. The input goes to rad_container_create (copied into an aligned buffer, as
    a mapped file would be), then a second copy with recomputed checksums (fuzz_common.h), so
    mutations reach the loaders' own checks. Every object a multi-bounce info section names
    (up to 4 per input) is loaded both ways; what loads is used:
@@ -49,7 +49,7 @@ static int rewrite(const rad_section *s, uint32_t count, void **buf, rad_contain
     *buf = malloc(bytes);
     if (!*buf) return 0;
     if (rad_container_write(s, count, *buf, bytes) != RAD_SUCCESS) abort();
-    if (rad_container_open(*buf, bytes, NULL, ct) != RAD_SUCCESS) abort(); /* what the library wrote, it reads */
+    if (rad_container_create(*buf, bytes, NULL, ct) != RAD_SUCCESS) abort(); /* what the library wrote, it reads */
     return 1;
 }
 
@@ -76,7 +76,7 @@ static void dense(const rad_multibounce *mb, const char *name, const float *E, f
             abort();
     }
     rad_multibounce_destroy(again);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(buf);
 }
 
@@ -104,7 +104,7 @@ static void blocks(const rad_multibounce_blocks *b, const char *name, const floa
             abort();
     }
     rad_multibounce_blocks_destroy(again);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(buf);
 }
 
@@ -112,7 +112,7 @@ static void exercise(const void *buf, size_t size)
 {
     rad_container *ct = NULL;
     uint32_t i, n, objects = 0;
-    if (rad_container_open(buf, size, NULL, &ct) != RAD_SUCCESS) return;
+    if (rad_container_create(buf, size, NULL, &ct) != RAD_SUCCESS) return;
     n = rad_container_section_count(ct);
     for (i = 0; i < n && objects < FUZZ_MAX_OBJECTS; ++i) {
         const rad_section *info = rad_container_section(ct, i);
@@ -139,7 +139,7 @@ static void exercise(const void *buf, size_t size)
         }
         rad_multibounce_blocks_destroy(b);
     }
-    rad_container_close(ct);
+    rad_container_destroy(ct);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

@@ -1,4 +1,4 @@
-/* fuzz_stream.c - libFuzzer harness for the row stream (rad_row_stream_open), the loader
+/* fuzz_stream.c - libFuzzer harness for the row stream (rad_row_stream_create), the loader
    that reads a bake from a path and never holds its matrix: the input bytes are written to
    a temporary file (one per process, rewritten for every input) and opened as a stream;
    then a second copy whose checksums the harness recomputes (fuzz_common.h), so mutations
@@ -53,7 +53,7 @@ static void apply_and_check(const rad_local *L, const float *E, float *out)
 {
     uint32_t i;
     memset(out, 0, sizeof(float) * 3 * (size_t)L->n);
-    if (rad_local_apply(L, E, NULL, 0, NULL, 0, RAD_OUTPUT_TOTAL, out, NULL) == RAD_SUCCESS)
+    if (rad_local_apply(L, E, NULL, 0, NULL, 0, out, RAD_OUTPUT_TOTAL, NULL) == RAD_SUCCESS)
         for (i = 0; i < L->slot_end; ++i)
             if (L->slot_patch[i] != RAD_NONE) fuzz_check_finite(out + 3 * (size_t)L->slot_patch[i], 3);
 }
@@ -107,9 +107,9 @@ static void run(const uint8_t *bytes, size_t size)
     if (!f) abort();
     if (size && fwrite(bytes, 1, size, f) != size) abort();
     if (fclose(f) != 0) abort();
-    if (rad_row_stream_open(path, NULL, &s) == RAD_SUCCESS) {
+    if (rad_row_stream_create(path, NULL, &s) == RAD_SUCCESS) {
         exercise(s);
-        rad_row_stream_close(s);
+        rad_row_stream_destroy(s);
     }
 }
 

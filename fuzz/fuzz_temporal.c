@@ -1,6 +1,6 @@
 /* fuzz_temporal.c - libFuzzer harness for the temporal alias-table view
    (rad_alias_tables_view: row offsets, bins and totals in container bytes). The input goes
-   to rad_container_open (copied into an aligned buffer, as a mapped file would be), then a
+   to rad_container_create (copied into an aligned buffer, as a mapped file would be), then a
    second copy with recomputed checksums (fuzz_common.h), so mutations reach the view's own
    checks. Every table set a bins section names (up to 4 per input) is viewed; each view that
    opens is used:
@@ -81,15 +81,15 @@ static void use_view(const rad_alias_tables *v, const char *name)
         steps(one, 1, &o, NULL, E, out, tame, 2);
     }
     /* the round trip */
-    rad_alias_tables_sections(v, name, sec);
+    rad_alias_tables_sections(v, name, sec, NULL);
     if (rad_container_size(sec, 3, &bytes) != RAD_SUCCESS) abort();
     buf = malloc(bytes);
     if (buf) {
-        if (rad_container_write(sec, 3, buf, bytes) != RAD_SUCCESS || rad_container_open(buf, bytes, NULL, &ct) != RAD_SUCCESS ||
+        if (rad_container_write(sec, 3, buf, bytes) != RAD_SUCCESS || rad_container_create(buf, bytes, NULL, &ct) != RAD_SUCCESS ||
             rad_alias_tables_view(ct, name, NULL, &again) != RAD_SUCCESS || again.rows != n || again.format != v->format ||
             memcmp(again.bins, v->bins, (size_t)v->row_offsets[n] * v->format * 4u) != 0)
             abort();
-        rad_container_close(ct);
+        rad_container_destroy(ct);
         free(buf);
     }
     free(E);
@@ -102,7 +102,7 @@ static void exercise(const void *buf, size_t size)
     rad_container *ct = NULL;
     rad_alias_tables views[FUZZ_MAX_VIEWS];
     uint32_t i, n, count = 0;
-    if (rad_container_open(buf, size, NULL, &ct) != RAD_SUCCESS) return;
+    if (rad_container_create(buf, size, NULL, &ct) != RAD_SUCCESS) return;
     n = rad_container_section_count(ct);
     for (i = 0; i < n && count < FUZZ_MAX_VIEWS; ++i) {
         const rad_section *s = rad_container_section(ct, i);
@@ -129,7 +129,7 @@ static void exercise(const void *buf, size_t size)
         free(E);
         free(out);
     }
-    rad_container_close(ct);
+    rad_container_destroy(ct);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

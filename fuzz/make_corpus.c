@@ -3,7 +3,7 @@
    - container: valid bakes of the Cornell box (dense and sparse, with and without vectors);
    - scene: scene inputs describing a quad and the Cornell box's first meshes in
      fuzz_scene.c's byte format;
-   - stream: CSR bakes (what rad_row_stream_open reads), at two sizes;
+   - stream: CSR bakes (what rad_row_stream_create reads), at two sizes;
    - multibounce: F_mb of a small Cornell box as saved by rad_multibounce_sections and
      rad_multibounce_blocks_sections: float, half with permutations, 3xBC4 with scale tiles,
      permutations and outliers, BC1 with one scale and none, BC1 with all of them, and one
@@ -111,11 +111,11 @@ static void write_method_seeds(const char *root, const rad_scene *s, const rad_r
     for (c = 0; c < 3; ++c)
         need(rad_alias_tables_create_dense(mb->planes + (size_t)c * mb->n * mb->n, mb->n, RAD_ALIAS_AUTO, NULL, &ch[c]),
              "per-channel alias tables");
-    rad_alias_tables_sections(compact, "F", sec);
+    rad_alias_tables_sections(compact, "F", sec, NULL);
     write_sections(tdir, "compact.radb", sec, 3);
-    rad_alias_tables_sections(wide, "F", sec);
+    rad_alias_tables_sections(wide, "F", sec, NULL);
     write_sections(tdir, "wide.radb", sec, 3);
-    for (c = 0; c < 3; ++c) rad_alias_tables_sections(ch[c], chname[c], sec + 3 * c);
+    for (c = 0; c < 3; ++c) rad_alias_tables_sections(ch[c], chname[c], sec + 3 * c, NULL);
     write_sections(tdir, "fmb_channels.radb", sec, 9);
     for (c = 0; c < 3; ++c) rad_alias_tables_destroy(ch[c]);
     rad_alias_tables_destroy(compact);

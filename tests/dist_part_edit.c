@@ -17,7 +17,7 @@ int main(int argc, char **argv)
     unsigned char *in, *out;
     rad_container *ct = NULL;
     rad_section secs[32];
-    rad_tool_shard_info sh;
+    tool_shard_info sh;
     uint32_t n, i;
     size_t size;
     if (argc != 4 || !(f = fopen(argv[1], "rb"))) return 2;
@@ -27,12 +27,12 @@ int main(int argc, char **argv)
     in = (unsigned char *)malloc((size_t)len);
     if (!in || fread(in, 1, (size_t)len, f) != (size_t)len) return 1;
     fclose(f);
-    if (rad_container_open(in, (size_t)len, NULL, &ct) != RAD_SUCCESS) return 1;
+    if (rad_container_create(in, (size_t)len, NULL, &ct) != RAD_SUCCESS) return 1;
     n = rad_container_section_count(ct);
     if (n > 32) return 1;
     for (i = 0; i < n; ++i) {
         secs[i] = *rad_container_section(ct, i);
-        if (secs[i].type == RAD_TOOL_SECTION_SHARD && secs[i].elem_size == sizeof sh) {
+        if (secs[i].type == TOOL_SECTION_SHARD && secs[i].elem_size == sizeof sh) {
             memcpy(&sh, secs[i].data, sizeof sh);
             memset(sh.library, 0, sizeof sh.library);
             strncpy(sh.library, argv[3], sizeof sh.library - 1);
@@ -43,7 +43,7 @@ int main(int argc, char **argv)
         rad_container_write(secs, n, out, size) != RAD_SUCCESS)
         return 1;
     if (!(f = fopen(argv[2], "wb")) || fwrite(out, 1, size, f) != size || fclose(f) != 0) return 1;
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(in);
     free(out);
     return 0;

@@ -341,8 +341,8 @@ s_vulkan() {
 }
 
 # ---- the rad tool (needs assimp and stb; OpenEXR output with tinyexr when installed)
-TOOL_EXR=""; TOOL_EXR_LIB=""
-[ -f /usr/include/tinyexr.h ] && { TOOL_EXR="-DRAD_TOOL_EXR"; TOOL_EXR_LIB="-ltinyexr"; }
+EXR_CFLAGS=""; EXR_LIB=""
+[ -f /usr/include/tinyexr.h ] && { EXR_CFLAGS="-DTOOL_EXR"; EXR_LIB="-ltinyexr"; }
 have_tool_deps() { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; }
 # The tool's objects, compiled once: rad links them with main.c, rad-mpi with its own main; the
 # tool, report and distributed suites all run this rad.
@@ -356,10 +356,10 @@ s_tool_build() {
     rm -rf "$BUILD/rad" "$TOOL_OBJ" # the suites below run rad when it exists: never one from an older run
     mkdir -p "$TOOL_OBJ"
     for f in tools/*.c; do
-        build "tool-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP -I. $TOOL_EXR -c "$f" -o "$TOOL_OBJ/$(basename "$f" .c).o" ||
+        build "tool-$(basename "$f" .c)" $CC -std=c99 $WARN -O2 $OMP -I. $EXR_CFLAGS -c "$f" -o "$TOOL_OBJ/$(basename "$f" .c).o" ||
             { fail "tool-build ($f)"; return; }
     done
-    if build tool-link $CC $OMP "$TOOL_OBJ"/*.o -o "$BUILD/rad" -lassimp $TOOL_EXR_LIB -lm; then pass tool-build; else fail tool-build; fi
+    if build tool-link $CC $OMP "$TOOL_OBJ"/*.o -o "$BUILD/rad" -lassimp $EXR_LIB -lm; then pass tool-build; else fail tool-build; fi
 }
 s_tool() {
     [ -x "$BUILD/rad" ] || return 0
@@ -402,7 +402,7 @@ s_dist() {
     fi
     if have mpicc && have mpirun; then
         if build rad-mpi mpicc -std=c99 $WARN -O2 $OMP -I. tools/mpi/rad_mpi.c $(ls "$TOOL_OBJ"/*.o | grep -v '/main\.o$') \
-               -o "$BUILD/rad-mpi" -lassimp $TOOL_EXR_LIB -lm; then
+               -o "$BUILD/rad-mpi" -lassimp $EXR_LIB -lm; then
             mpi="$BUILD/rad-mpi"
         else
             fail "rad-mpi (build)"

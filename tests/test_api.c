@@ -69,13 +69,13 @@ static int api_fx_build(api_fx *f)
     if (rad_solve_direct(&f->sys, &so, f->B, &serial) != RAD_SUCCESS) return 0;
     if (rad_save_memory(f->P, &f->ffs->matrix, f->E, f->B, NULL, &f->bytes, &f->size) != RAD_SUCCESS) return 0;
     if (rad_load_memory(f->bytes, f->size, NULL, &f->bake) != RAD_SUCCESS) return 0;
-    if (rad_container_open(f->bytes, f->size, NULL, &f->ct) != RAD_SUCCESS) return 0;
+    if (rad_container_create(f->bytes, f->size, NULL, &f->ct) != RAD_SUCCESS) return 0;
     return 1;
 }
 
 static void api_fx_free(api_fx *f)
 {
-    rad_container_close(f->ct);
+    rad_container_destroy(f->ct);
     rad_bake_destroy(f->bake);
     rad_free_buffer(f->bytes, NULL);
     free(f->E); free(f->B); free(f->buf); free(f->buf2);
@@ -154,7 +154,7 @@ static void api_destroy_null(api_fx *f)
     rad_bvh_destroy(NULL);
     rad_embree_destroy(NULL);
     rad_form_factors_destroy(NULL);
-    rad_container_close(NULL);
+    rad_container_destroy(NULL);
     rad_bake_destroy(NULL);
     CHECK(1);
 }
@@ -893,23 +893,23 @@ static void api_container_args(api_fx *f)
     for (i = 0; i < sizeof(dst); ++i) if (dst[i] != 0xCD) break;
     CHECK(i == sizeof(dst));
     /* open */
-    CHECK_RESULT(rad_container_open(f->bytes, f->size, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
-    CHECK_RESULT(rad_container_open(NULL, f->size, NULL, &ct), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_container_create(f->bytes, f->size, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_container_create(NULL, f->size, NULL, &ct), RAD_ERROR_INVALID_ARGUMENT);
     CHECK(ct == NULL);
     ct = API_SENTINEL(rad_container);
-    CHECK_RESULT(rad_container_open(f->bytes, 0, NULL, &ct), RAD_ERROR_TRUNCATED);
+    CHECK_RESULT(rad_container_create(f->bytes, 0, NULL, &ct), RAD_ERROR_TRUNCATED);
     CHECK(ct == NULL);
     ct = API_SENTINEL(rad_container);
-    CHECK_RESULT(rad_container_open(f->bytes, 63, NULL, &ct), RAD_ERROR_TRUNCATED);
+    CHECK_RESULT(rad_container_create(f->bytes, 63, NULL, &ct), RAD_ERROR_TRUNCATED);
     CHECK(ct == NULL);
     ct = API_SENTINEL(rad_container);
-    CHECK_RESULT(rad_container_open(f->bytes, f->size - 1, NULL, &ct), RAD_ERROR_TRUNCATED);
+    CHECK_RESULT(rad_container_create(f->bytes, f->size - 1, NULL, &ct), RAD_ERROR_TRUNCATED);
     CHECK(ct == NULL);
     odd = malloc(f->size + 8);
     if (odd) {
         memcpy((char *)odd + 4, f->bytes, f->size);
         ct = API_SENTINEL(rad_container);
-        CHECK_RESULT(rad_container_open((char *)odd + 4, f->size, NULL, &ct), RAD_ERROR_INVALID_ARGUMENT); /* not 8-aligned */
+        CHECK_RESULT(rad_container_create((char *)odd + 4, f->size, NULL, &ct), RAD_ERROR_INVALID_ARGUMENT); /* not 8-aligned */
         CHECK(ct == NULL);
         free(odd);
     }

@@ -263,13 +263,13 @@ static void ct_test_user_sections(void)
     buf = malloc(size);
     CHECK_RESULT(rad_container_write(s, 2, buf, size - 1), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_OK(rad_container_write(s, 2, buf, size));
-    CHECK_OK(rad_container_open(buf, size, NULL, &c));
+    CHECK_OK(rad_container_create(buf, size, NULL, &c));
     q = rad_container_find(c, RAD_SECTION_USER + 1, "doubles");
     CHECK(q && q->count == 3 && memcmp(q->data, payload, sizeof(payload)) == 0);
     q = rad_container_find(c, RAD_SECTION_USER + 2, NULL);
     CHECK(q && strcmp((const char *)q->data, "hello") == 0);
     CHECK(rad_container_section(c, 2) == NULL);
-    rad_container_close(c);
+    rad_container_destroy(c);
     free(buf);
 }
 
@@ -346,7 +346,7 @@ static void *ct_save_with_h(const ct_fixture *f, const rad_matrix *F, uint32_t h
     uint32_t k = 0, i;
     *out_size = 0;
     if (rad_save_memory(f->P, F, f->E, f->B, NULL, &buf, &size) != RAD_SUCCESS) return NULL;
-    if (rad_container_open(buf, size, NULL, &ct) == RAD_SUCCESS && rad_container_section_count(ct) < 15) {
+    if (rad_container_create(buf, size, NULL, &ct) == RAD_SUCCESS && rad_container_section_count(ct) < 15) {
         for (i = 0; i < rad_container_section_count(ct); ++i) s[k++] = *rad_container_section(ct, i);
         memset(&s[k], 0, sizeof(s[k]));
         s[k].type = RAD_SECTION_VECTOR;
@@ -360,7 +360,7 @@ static void *ct_save_with_h(const ct_fixture *f, const rad_matrix *F, uint32_t h
             dst = NULL;
         }
     }
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     rad_free_buffer(buf, NULL);
     return dst;
 }

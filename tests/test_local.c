@@ -214,9 +214,9 @@ static void test_local_remove_and_evict(void)
         CHECK_RESULT(rad_local_remove(X, gone, NULL), RAD_ERROR_INVALID_ARGUMENT);
         /* the default rows skip it; as an explicit lit patch it still counts */
         for (i = 0; i < 3 * w.n; ++i) out[i] = -1.0f;
-        CHECK_OK(rad_local_apply(X, w.E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, out, NULL));
+        CHECK_OK(rad_local_apply(X, w.E, NULL, 0, NULL, 0, out, RAD_OUTPUT_INDIRECT, NULL));
         CHECK(out[3 * (size_t)gone] == -1.0f && out[3 * (size_t)ids[0]] >= 0.0f);
-        CHECK_OK(rad_local_apply(X, w.E, &gone, 1, &gone, 1, RAD_OUTPUT_INDIRECT, out, NULL));
+        CHECK_OK(rad_local_apply(X, w.E, &gone, 1, &gone, 1, out, RAD_OUTPUT_INDIRECT, NULL));
         /* showing it again restores it exactly; then evict */
         CHECK_OK(rad_local_add(X, gone, NULL));
         CHECK(X->hidden == 0 && X->count == m && memcmp(before, X->planes, sizeof(float) * planes) == 0);
@@ -364,8 +364,8 @@ static void test_local_walk_bounded(void)
     CHECK(above <= 1e-4 * big);
     CHECK(below <= 1e-4 * big);
     /* L over the visible set from the visible sources, against the full-world transport */
-    CHECK_OK(rad_local_apply(L, w.E, want, V, want, V, RAD_OUTPUT_INDIRECT, Lw, NULL));
-    CHECK_OK(rad_local_apply(R, w.E, want, V, want, V, RAD_OUTPUT_INDIRECT, Lr, NULL));
+    CHECK_OK(rad_local_apply(L, w.E, want, V, want, V, Lw, RAD_OUTPUT_INDIRECT, NULL));
+    CHECK_OK(rad_local_apply(R, w.E, want, V, want, V, Lr, RAD_OUTPUT_INDIRECT, NULL));
     {
         double ew = 0.0, er = 0.0, nf = 0.0;
         for (ch = 0; ch < 3; ++ch)
@@ -465,8 +465,8 @@ static void test_local_apply_subsets(void)
     for (i = 0; i < 10; ++i) vis[nv++] = ids[3 * i];
     for (i = 0; i < 20; ++i) lit[nl++] = ids[2 * i + 1];
     for (i = 0; i < 3 * w.n; ++i) out[i] = tot[i] = -1.0f;
-    CHECK_OK(rad_local_apply(L, w.E, vis, nv, lit, nl, RAD_OUTPUT_INDIRECT, out, NULL));
-    CHECK_OK(rad_local_apply(L, w.E, vis, nv, lit, nl, RAD_OUTPUT_TOTAL, tot, NULL));
+    CHECK_OK(rad_local_apply(L, w.E, vis, nv, lit, nl, out, RAD_OUTPUT_INDIRECT, NULL));
+    CHECK_OK(rad_local_apply(L, w.E, vis, nv, lit, nl, tot, RAD_OUTPUT_TOTAL, NULL));
     for (i = 0; i < nv; ++i)
         for (ch = 0; ch < 3; ++ch) {
             double s = 0.0;
@@ -477,8 +477,8 @@ static void test_local_apply_subsets(void)
     CHECK(out[3 * (size_t)ids[1]] == -1.0f); /* not visible: untouched */
     /* errors */
     vis[0] = ids[50]; /* not in the set */
-    CHECK_RESULT(rad_local_apply(L, w.E, vis, nv, lit, nl, RAD_OUTPUT_INDIRECT, out, NULL), RAD_ERROR_INDEX_OUT_OF_RANGE);
-    CHECK_RESULT(rad_local_apply(L, w.E, NULL, 0, NULL, 0, (rad_output)7, out, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_apply(L, w.E, vis, nv, lit, nl, out, RAD_OUTPUT_INDIRECT, NULL), RAD_ERROR_INDEX_OUT_OF_RANGE);
+    CHECK_RESULT(rad_local_apply(L, w.E, NULL, 0, NULL, 0, out, (rad_output)7, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_local_add(L, ids[7], NULL), RAD_ERROR_INVALID_ARGUMENT);     /* already there */
     CHECK_RESULT(rad_local_add(L, ids[50], NULL), RAD_ERROR_INVALID_ARGUMENT);    /* full */
     CHECK_RESULT(rad_local_add(L, w.n, NULL), RAD_ERROR_INDEX_OUT_OF_RANGE);
@@ -610,7 +610,7 @@ static void test_local_row_sources(void)
         int wrote = f && fwrite(buf, 1, size, f) == size;
         if (f) fclose(f);
         CHECK(wrote);
-        CHECK_OK(rad_row_stream_open(path, NULL, &st));
+        CHECK_OK(rad_row_stream_create(path, NULL, &st));
         if (st) {
             rad_row_stream_source(st, &sf);
             CHECK(sf.n == w.n && rad_row_stream_memory(st) < 64u * w.n);
@@ -620,19 +620,19 @@ static void test_local_row_sources(void)
                 CHECK(memcmp(Lf->planes, Ls->planes, sizeof(float) * 3 * (size_t)o.capacity * o.capacity) == 0);
             }
             rad_local_destroy(Lf);
-            rad_row_stream_close(st);
+            rad_row_stream_destroy(st);
         }
         /* truncated, then a flipped byte in the row offsets' region of the header table */
         f = fopen(path, "wb");
         if (f) { fwrite(buf, 1, size / 2, f); fclose(f); }
-        CHECK_RESULT(rad_row_stream_open(path, NULL, &st), RAD_ERROR_TRUNCATED);
+        CHECK_RESULT(rad_row_stream_create(path, NULL, &st), RAD_ERROR_TRUNCATED);
         ((unsigned char *)buf)[70] ^= 1u;
         f = fopen(path, "wb");
         if (f) { fwrite(buf, 1, size, f); fclose(f); }
-        CHECK_RESULT(rad_row_stream_open(path, NULL, &st), RAD_ERROR_CORRUPT);
+        CHECK_RESULT(rad_row_stream_create(path, NULL, &st), RAD_ERROR_CORRUPT);
         ((unsigned char *)buf)[70] ^= 1u;
         remove(path);
-        CHECK_RESULT(rad_row_stream_open(path, NULL, &st), RAD_ERROR_IO);
+        CHECK_RESULT(rad_row_stream_create(path, NULL, &st), RAD_ERROR_IO);
         CHECK(st == NULL);
     }
 #endif
@@ -737,7 +737,7 @@ static void test_local_repeated_columns(void)
                 if (f) fclose(f);
                 free(copy);
                 CHECK(wrote);
-                CHECK_OK(rad_row_stream_open(path, NULL, &st));
+                CHECK_OK(rad_row_stream_create(path, NULL, &st));
                 if (st) {
                     rad_row_stream_source(st, &sf);
                     rad_local_options_default(&o);
@@ -750,7 +750,7 @@ static void test_local_repeated_columns(void)
                         CHECK(Lf->count == 1);
                     }
                     rad_local_destroy(Lf);
-                    rad_row_stream_close(st);
+                    rad_row_stream_destroy(st);
                 }
                 remove(path);
             }
@@ -890,7 +890,7 @@ static void test_local_alloc_failure(void)
             for (i = 0; i < 20 && r[1] == RAD_SUCCESS; ++i) r[1] = rad_local_add(L, ids[i], &ctx);
             for (i = 0; i < 3 && r[1] == RAD_SUCCESS; ++i) r[1] = rad_local_remove(L, ids[i], &ctx);
             for (i = 20; i < 23 && r[1] == RAD_SUCCESS; ++i) r[1] = rad_local_add(L, ids[i], &ctx);
-            r[2] = rad_local_apply(L, w.E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, out, &ctx);
+            r[2] = rad_local_apply(L, w.E, NULL, 0, NULL, 0, out, RAD_OUTPUT_INDIRECT, &ctx);
             r[3] = rad_local_rebuild(L, ids + 10, 20, &ctx);
         }
         o.rebuild = RAD_LOCAL_REBUILD_NEUMANN;
@@ -939,7 +939,7 @@ static void test_local_null_arguments(void)
     CHECK_RESULT(rad_local_remove(NULL, 0, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_local_evict(NULL, 0, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_local_rebuild(NULL, ids, 2, NULL), RAD_ERROR_INVALID_ARGUMENT);
-    CHECK_RESULT(rad_local_apply(NULL, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, E, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_local_apply(NULL, E, NULL, 0, NULL, 0, E, RAD_OUTPUT_INDIRECT, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_local_nearest(NULL, pos, 1, out, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_local_visible(NULL, NULL, NULL, 1.0f, ids, 2, out, &count, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_local_lit(NULL, ids, 2, 0.0f, out, &count), RAD_ERROR_INVALID_ARGUMENT);
@@ -974,19 +974,19 @@ static void test_local_null_arguments(void)
         CHECK_OK(rad_local_rebuild(L, ids, 0, NULL));
         E[0] = (float)NAN;
         CHECK_OK(rad_local_add(L, 0, NULL));
-        CHECK_RESULT(rad_local_apply(L, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, E + 3, NULL), RAD_ERROR_NON_FINITE);
-        CHECK_RESULT(rad_local_apply(L, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_local_apply(L, E, NULL, 0, NULL, 0, E + 3, RAD_OUTPUT_INDIRECT, NULL), RAD_ERROR_NON_FINITE);
+        CHECK_RESULT(rad_local_apply(L, E, NULL, 0, NULL, 0, NULL, RAD_OUTPUT_INDIRECT, NULL), RAD_ERROR_INVALID_ARGUMENT);
         rad_local_destroy(L);
     }
 #ifndef RAD_NO_STDIO
-    CHECK_RESULT(rad_row_stream_open(NULL, NULL, &st), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_row_stream_create(NULL, NULL, &st), RAD_ERROR_INVALID_ARGUMENT);
     CHECK(st == NULL);
-    CHECK_RESULT(rad_row_stream_open("no/such/file.radb", NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_row_stream_create("no/such/file.radb", NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK(rad_row_stream_memory(NULL) == 0);
     rad_row_stream_source(NULL, &src);
     CHECK(src.fetch == NULL && src.n == 0);
     rad_row_stream_source(NULL, NULL);
-    rad_row_stream_close(NULL);
+    rad_row_stream_destroy(NULL);
 #endif
 }
 

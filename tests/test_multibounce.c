@@ -447,7 +447,7 @@ static void mb_container(void)
     CHECK_OK(rad_container_size(s, k1 + k2 + k3, &bytes));
     buf = malloc(bytes);
     CHECK_OK(rad_container_write(s, k1 + k2 + k3, buf, bytes));
-    CHECK_OK(rad_container_open(buf, bytes, NULL, &ct));
+    CHECK_OK(rad_container_create(buf, bytes, NULL, &ct));
     if (!ct) goto done;
     CHECK_OK(rad_multibounce_blocks_load(ct, "Fmb-bc4", NULL, &lb));
     CHECK_RESULT(rad_multibounce_load(ct, "Fmb-bc4", NULL, &lmb), RAD_ERROR_CORRUPT); /* wrong kind */
@@ -466,7 +466,7 @@ static void mb_container(void)
     lmb = NULL;
     rad_multibounce_blocks_destroy(lb);
     lb = NULL;
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     ct = NULL;
     /* a corrupted permutation (a repeated index, valid checksum) and an outlier column >= N */
     {
@@ -483,10 +483,10 @@ static void mb_container(void)
             CHECK_OK(rad_container_size(t, kt, &bytes));
             buf = malloc(bytes);
             CHECK_OK(rad_container_write(t, kt, buf, bytes));
-            CHECK_OK(rad_container_open(buf, bytes, NULL, &ct));
+            CHECK_OK(rad_container_create(buf, bytes, NULL, &ct));
             CHECK_RESULT(rad_multibounce_blocks_load(ct, "x", NULL, &lb), RAD_ERROR_CORRUPT);
             CHECK(lb == NULL);
-            rad_container_close(ct);
+            rad_container_destroy(ct);
             ct = NULL;
             memcpy(badcol, b->outlier_columns, sizeof(uint32_t) * b->outlier_count);
             badcol[b->outlier_count / 2] = n;
@@ -495,16 +495,16 @@ static void mb_container(void)
                 if (t[i].type == RAD_SECTION_MB_OUTLIER_COLUMNS) t[i].data = badcol;
             }
             CHECK_OK(rad_container_write(t, kt, buf, bytes));
-            CHECK_OK(rad_container_open(buf, bytes, NULL, &ct));
+            CHECK_OK(rad_container_create(buf, bytes, NULL, &ct));
             CHECK_RESULT(rad_multibounce_blocks_load(ct, "x", NULL, &lb), RAD_ERROR_INDEX_OUT_OF_RANGE);
-            rad_container_close(ct);
+            rad_container_destroy(ct);
             ct = NULL;
         }
         free(bad);
         free(badcol);
     }
 done:
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(buf);
     rad_multibounce_destroy(mb);
     rad_multibounce_destroy(h);
@@ -928,7 +928,7 @@ static void mb_expect_load(const void *buf, size_t size, uint32_t type, const ch
     rad_context ctx;
     CHECK(copy != NULL);
     if (!copy) return;
-    CHECK_OK(rad_container_open(copy, size, NULL, &ct));
+    CHECK_OK(rad_container_create(copy, size, NULL, &ct));
     ct_log_context(&ctx);
     if (type == RAD_SECTION_MB_SCALES || type == RAD_SECTION_MB_OUTLIER_VALUES) {
         CHECK_RESULT(rad_multibounce_blocks_load(ct, name, &ctx, &b), expected);
@@ -943,7 +943,7 @@ static void mb_expect_load(const void *buf, size_t size, uint32_t type, const ch
     }
     rad_multibounce_destroy(mb);
     rad_multibounce_blocks_destroy(b);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(copy);
 }
 

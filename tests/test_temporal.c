@@ -576,16 +576,16 @@ static void tp_container(void)
     ctx.log = tp_log;
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
     if (t) {
-        rad_alias_tables_sections(t, "F", sec);
+        rad_alias_tables_sections(t, "F", sec, NULL);
         CHECK_OK(rad_container_size(sec, 3, &size));
         buf = malloc(size);
         CHECK_OK(rad_container_write(sec, 3, buf, size));
-        CHECK_OK(rad_container_open(buf, size, NULL, &ct));
+        CHECK_OK(rad_container_create(buf, size, NULL, &ct));
         CHECK_OK(rad_alias_tables_view(ct, "F", NULL, &v));
         CHECK(v.rows == n && v.format == t->format && v.row_offsets[n] == t->row_offsets[n]);
         CHECK(memcmp(v.bins, t->bins, (size_t)t->row_offsets[n] * t->format * 4) == 0);
         CHECK_RESULT(rad_alias_tables_view(ct, "G", &ctx, &v), RAD_ERROR_INVALID_ARGUMENT);
-        rad_container_close(ct);
+        rad_container_destroy(ct);
         ct = NULL;
         {
             /* a corrupt copy of the bins, written with a valid checksum */
@@ -595,11 +595,11 @@ static void tp_container(void)
             bad[1] = (uint32_t)(n + 1u);
             sec[1].data = bad;
             CHECK_OK(rad_container_write(sec, 3, buf, size));
-            CHECK_OK(rad_container_open(buf, size, NULL, &ct));
+            CHECK_OK(rad_container_create(buf, size, NULL, &ct));
             tp_log_count = 0;
             CHECK_RESULT(rad_alias_tables_view(ct, "F", &ctx, &v), RAD_ERROR_CORRUPT);
             CHECK(tp_log_count == 1);
-            rad_container_close(ct);
+            rad_container_destroy(ct);
             free(bad);
         }
     }
@@ -783,7 +783,7 @@ static void tp_bad_values(void)
     if (!tp_cornell_build(&c, 60, 0)) { CHECK(0); fx_world_free(&c); return; }
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
     if (t) {
-        rad_alias_tables_sections(t, "F", sec);
+        rad_alias_tables_sections(t, "F", sec, NULL);
         CHECK_OK(rad_container_size(sec, 3, &size));
         buf = malloc(size);
         CHECK_OK(rad_container_write(sec, 3, buf, size));
@@ -792,11 +792,11 @@ static void tp_bad_values(void)
             unsigned char *copy = ct_poke(buf, size, RAD_SECTION_TEMPORAL_TOTALS, "F", 3 * 4, &value, 4);
             CHECK(copy != NULL);
             if (!copy) continue;
-            CHECK_OK(rad_container_open(copy, size, NULL, &ct));
+            CHECK_OK(rad_container_create(copy, size, NULL, &ct));
             ct_log_context(&ctx);
             CHECK_RESULT(rad_alias_tables_view(ct, "F", &ctx, &v), q == 1 ? RAD_ERROR_NON_FINITE : RAD_ERROR_CORRUPT);
             CHECK(strstr(ct_log_last, "TEMPORAL_TOTALS") != NULL && strstr(ct_log_last, "row 3") != NULL);
-            rad_container_close(ct);
+            rad_container_destroy(ct);
             ct = NULL;
             free(copy);
         }

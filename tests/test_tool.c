@@ -39,7 +39,7 @@ static float frand(void)
     return (float)(lcg_state >> 8) / 16777216.0f;
 }
 
-static void fill(rad_image *img, float v)
+static void fill(tool_image *img, float v)
 {
     size_t i, n = (size_t)img->width * (size_t)img->height * 3u;
     for (i = 0; i < n; ++i) img->rgb[i] = v;
@@ -49,118 +49,118 @@ static void fill(rad_image *img, float v)
 
 static void test_metrics_identity(void)
 {
-    rad_image a;
+    tool_image a;
     size_t i;
-    CHECK(rad_image_alloc(&a, 40, 30) == 0);
+    CHECK(tool_image_alloc(&a, 40, 30) == 0);
     for (i = 0; i < 40 * 30 * 3; ++i) a.rgb[i] = frand();
-    CHECK_NEAR(rad_image_ssim(&a, &a), 1.0, 1e-12);
-    CHECK(isinf(rad_image_psnr(&a, &a)) && rad_image_psnr(&a, &a) > 0.0);
-    CHECK(rad_image_mse(&a, &a) == 0.0);
-    rad_image_free(&a);
+    CHECK_NEAR(tool_image_ssim(&a, &a), 1.0, 1e-12);
+    CHECK(isinf(tool_image_psnr(&a, &a)) && tool_image_psnr(&a, &a) > 0.0);
+    CHECK(tool_image_mse(&a, &a) == 0.0);
+    tool_image_free(&a);
 }
 
 static void test_metrics_constant(void)
 {
-    rad_image a, b;
-    CHECK(rad_image_alloc(&a, 32, 24) == 0);
-    CHECK(rad_image_alloc(&b, 32, 24) == 0);
+    tool_image a, b;
+    CHECK(tool_image_alloc(&a, 32, 24) == 0);
+    CHECK(tool_image_alloc(&b, 32, 24) == 0);
     fill(&a, 0.5f);
     fill(&b, 0.6f);
     /* (2*0.5*0.6 + C1) C2 / ((0.25 + 0.36 + C1) C2) = 0.6001 / 0.6101 */
-    CHECK_NEAR(rad_image_ssim(&a, &b), 0.98360924, 1e-6);
-    CHECK_NEAR(rad_image_mse(&a, &b), 0.01, 1e-8);
+    CHECK_NEAR(tool_image_ssim(&a, &b), 0.98360924, 1e-6);
+    CHECK_NEAR(tool_image_mse(&a, &b), 0.01, 1e-8);
     /* the image stores floats: 0.6f = 0.600000024, so PSNR is 20 dB to 2e-6; to 1e-9 it is
        the value for the float's exact difference */
-    CHECK_NEAR(rad_image_psnr(&a, &b), 20.0, 1e-5);
-    CHECK_NEAR(rad_image_psnr(&a, &b), -20.0 * log10((double)0.6f - 0.5), 1e-9);
-    rad_image_free(&a);
-    rad_image_free(&b);
+    CHECK_NEAR(tool_image_psnr(&a, &b), 20.0, 1e-5);
+    CHECK_NEAR(tool_image_psnr(&a, &b), -20.0 * log10((double)0.6f - 0.5), 1e-9);
+    tool_image_free(&a);
+    tool_image_free(&b);
 }
 
 static void test_metrics_constant_exact(void)
 {
     /* 0.5 and 0.625 are exact in binary: MSE = 0.015625 exactly, PSNR to 1e-9 */
-    rad_image a, b;
-    CHECK(rad_image_alloc(&a, 16, 16) == 0);
-    CHECK(rad_image_alloc(&b, 16, 16) == 0);
+    tool_image a, b;
+    CHECK(tool_image_alloc(&a, 16, 16) == 0);
+    CHECK(tool_image_alloc(&b, 16, 16) == 0);
     fill(&a, 0.5f);
     fill(&b, 0.625f);
-    CHECK(rad_image_mse(&a, &b) == 0.015625);
-    CHECK_NEAR(rad_image_psnr(&a, &b), 10.0 * log10(64.0), 1e-9);
-    rad_image_free(&a);
-    rad_image_free(&b);
+    CHECK(tool_image_mse(&a, &b) == 0.015625);
+    CHECK_NEAR(tool_image_psnr(&a, &b), 10.0 * log10(64.0), 1e-9);
+    tool_image_free(&a);
+    tool_image_free(&b);
 }
 
 static void test_metrics_noise(void)
 {
-    rad_image a, b;
+    tool_image a, b;
     size_t i, n = 64 * 48 * 3;
     double s;
-    CHECK(rad_image_alloc(&a, 64, 48) == 0);
-    CHECK(rad_image_alloc(&b, 64, 48) == 0);
+    CHECK(tool_image_alloc(&a, 64, 48) == 0);
+    CHECK(tool_image_alloc(&b, 64, 48) == 0);
     for (i = 0; i < n; ++i) {
         a.rgb[i] = frand();
         b.rgb[i] = a.rgb[i] + 0.1f * (frand() - 0.5f);
     }
-    s = rad_image_ssim(&a, &b);
+    s = tool_image_ssim(&a, &b);
     CHECK(s < 0.999 && s > 0.5);
-    CHECK(rad_image_psnr(&a, &b) > 20.0 && rad_image_psnr(&a, &b) < 60.0);
-    printf("    random vs itself + noise: SSIM %.6f, PSNR %.3f dB\n", s, rad_image_psnr(&a, &b));
-    rad_image_free(&a);
-    rad_image_free(&b);
+    CHECK(tool_image_psnr(&a, &b) > 20.0 && tool_image_psnr(&a, &b) < 60.0);
+    printf("    random vs itself + noise: SSIM %.6f, PSNR %.3f dB\n", s, tool_image_psnr(&a, &b));
+    tool_image_free(&a);
+    tool_image_free(&b);
 }
 
 static void test_metrics_clamp(void)
 {
-    rad_image a, b;
-    CHECK(rad_image_alloc(&a, 20, 20) == 0);
-    CHECK(rad_image_alloc(&b, 20, 20) == 0);
+    tool_image a, b;
+    CHECK(tool_image_alloc(&a, 20, 20) == 0);
+    CHECK(tool_image_alloc(&b, 20, 20) == 0);
     fill(&a, 1.0f);
     fill(&b, 1.0f);
     a.rgb[7] = 5.0f;    /* above 1: compares as 1 */
     a.rgb[100] = 1e30f;
     b.rgb[50] = -2.0f;  /* below 0: compares as 0 */
-    CHECK_NEAR(rad_image_mse(&a, &b), 1.0 / (20.0 * 20.0 * 3.0), 1e-15);
+    CHECK_NEAR(tool_image_mse(&a, &b), 1.0 / (20.0 * 20.0 * 3.0), 1e-15);
     b.rgb[50] = 1.0f;
-    CHECK(rad_image_mse(&a, &b) == 0.0);
-    CHECK(isinf(rad_image_psnr(&a, &b)));
-    CHECK_NEAR(rad_image_ssim(&a, &b), 1.0, 1e-12);
-    rad_image_free(&a);
-    rad_image_free(&b);
+    CHECK(tool_image_mse(&a, &b) == 0.0);
+    CHECK(isinf(tool_image_psnr(&a, &b)));
+    CHECK_NEAR(tool_image_ssim(&a, &b), 1.0, 1e-12);
+    tool_image_free(&a);
+    tool_image_free(&b);
 }
 
 static void test_metrics_heatmap(void)
 {
-    rad_image a, b, h = { 0, 0, NULL };
-    CHECK(rad_image_alloc(&a, 4, 2) == 0);
-    CHECK(rad_image_alloc(&b, 4, 2) == 0);
+    tool_image a, b, h = { 0, 0, NULL };
+    CHECK(tool_image_alloc(&a, 4, 2) == 0);
+    CHECK(tool_image_alloc(&b, 4, 2) == 0);
     a.rgb[3 * 5] = a.rgb[3 * 5 + 1] = a.rgb[3 * 5 + 2] = 0.5f;
-    CHECK(rad_image_diff_heatmap(&a, &b, 0.5f, &h) == 0);
+    CHECK(tool_image_diff_heatmap(&a, &b, 0.5f, &h) == 0);
     CHECK(h.width == 4 && h.height == 2);
     CHECK(h.rgb[0] == 0.0f && h.rgb[1] == 0.0f && h.rgb[2] == 0.0f);                   /* no difference: black */
     CHECK(h.rgb[15] > 0.99f && h.rgb[16] > 0.99f && h.rgb[17] > 0.99f);                 /* full scale: white */
-    rad_image_free(&h);
-    rad_image_free(&a);
-    rad_image_free(&b);
+    tool_image_free(&h);
+    tool_image_free(&a);
+    tool_image_free(&b);
 }
 
 /* ---- images ------------------------------------------------------------------------------ */
 
 static void test_pfm_roundtrip(void)
 {
-    rad_image a, b = { 0, 0, NULL };
+    tool_image a, b = { 0, 0, NULL };
     size_t i, n = 7 * 5 * 3;
     char err[256];
     FILE *f;
-    CHECK(rad_image_alloc(&a, 7, 5) == 0);
+    CHECK(tool_image_alloc(&a, 7, 5) == 0);
     for (i = 0; i < n; ++i) a.rgb[i] = (frand() - 0.3f) * 1000.0f * frand() * frand();
     a.rgb[0] = 1.25f;  /* top-left */
     a.rgb[1] = 2.5f;
     a.rgb[2] = 3.75f;
     a.rgb[3 * 4 * 7] = -7.0f; /* bottom-left red */
     a.rgb[5] = 1e-40f; /* subnormal */
-    CHECK(rad_image_write_pfm(tmp_path("rt.pfm"), &a) == 0);
-    CHECK(rad_image_read_pfm(tmp_path("rt.pfm"), &b, err, sizeof(err)) == 0);
+    CHECK(tool_image_write_pfm(tmp_path("rt.pfm"), &a) == 0);
+    CHECK(tool_image_read_pfm(tmp_path("rt.pfm"), &b, err, sizeof(err)) == 0);
     CHECK(b.width == 7 && b.height == 5);
     if (b.rgb && b.width == 7 && b.height == 5) {
         CHECK(memcmp(a.rgb, b.rgb, n * sizeof(float)) == 0);
@@ -186,26 +186,26 @@ static void test_pfm_roundtrip(void)
         CHECK(v == -7.0f);
         fclose(f);
     }
-    /* written through rad_image_write by extension, exposure ignored for PFM */
-    rad_image_free(&b);
-    CHECK(rad_image_write(tmp_path("rt2.pfm"), &a, 4.0f) == 0);
-    CHECK(rad_image_read(tmp_path("rt2.pfm"), &b, err, sizeof(err)) == 0);
+    /* written through tool_image_write by extension, exposure ignored for PFM */
+    tool_image_free(&b);
+    CHECK(tool_image_write(tmp_path("rt2.pfm"), &a, 4.0f) == 0);
+    CHECK(tool_image_read(tmp_path("rt2.pfm"), &b, err, sizeof(err)) == 0);
     CHECK(b.rgb && memcmp(a.rgb, b.rgb, n * sizeof(float)) == 0);
-    rad_image_free(&b);
+    tool_image_free(&b);
     /* errors */
-    CHECK(rad_image_read_pfm(tmp_path("does-not-exist.pfm"), &b, err, sizeof(err)) != 0 && err[0]);
-    rad_image_free(&a);
+    CHECK(tool_image_read_pfm(tmp_path("does-not-exist.pfm"), &b, err, sizeof(err)) != 0 && err[0]);
+    tool_image_free(&a);
     remove(tmp_path("rt.pfm"));
     remove(tmp_path("rt2.pfm"));
 }
 
 static void test_png_write(void)
 {
-    rad_image a, b = { 0, 0, NULL };
+    tool_image a, b = { 0, 0, NULL };
     int w, h, comp;
     unsigned char *px;
     char err[256];
-    CHECK(rad_image_alloc(&a, 3, 2) == 0);
+    CHECK(tool_image_alloc(&a, 3, 2) == 0);
     /* row 0: 0, 0.5, 1 (grey); row 1: 0.18, 2.0, (0.0031308, 0.25, -1) */
     fill(&a, 0.0f);
     a.rgb[3] = a.rgb[4] = a.rgb[5] = 0.5f;
@@ -215,7 +215,7 @@ static void test_png_write(void)
     a.rgb[15] = 0.0031308f;
     a.rgb[16] = 0.25f;
     a.rgb[17] = -1.0f;
-    CHECK(rad_image_write(tmp_path("w.png"), &a, 1.0f) == 0);
+    CHECK(tool_image_write(tmp_path("w.png"), &a, 1.0f) == 0);
     px = stbi_load(tmp_path("w.png"), &w, &h, &comp, 3);
     CHECK(px != NULL);
     if (px) {
@@ -231,22 +231,22 @@ static void test_png_write(void)
         stbi_image_free(px);
     }
     /* exposure scales before encoding */
-    CHECK(rad_image_write_png(tmp_path("w2.png"), &a, 2.0f) == 0);
+    CHECK(tool_image_write_png(tmp_path("w2.png"), &a, 2.0f) == 0);
     px = stbi_load(tmp_path("w2.png"), &w, &h, &comp, 3);
     CHECK(px != NULL);
     if (px) {
         CHECK(px[3] == 255 && px[16] == 188);
         stbi_image_free(px);
     }
-    /* read back through rad_image_read: decoded to linear */
-    CHECK(rad_image_read(tmp_path("w.png"), &b, err, sizeof(err)) == 0);
+    /* read back through tool_image_read: decoded to linear */
+    CHECK(tool_image_read(tmp_path("w.png"), &b, err, sizeof(err)) == 0);
     if (b.rgb) {
         CHECK_NEAR(b.rgb[3], 0.5, 0.003);
         CHECK_NEAR(b.rgb[9], 0.18, 0.002);
         CHECK(b.rgb[6] == 1.0f && b.rgb[0] == 0.0f);
     }
-    rad_image_free(&b);
-    rad_image_free(&a);
+    tool_image_free(&b);
+    tool_image_free(&a);
     remove(tmp_path("w.png"));
     remove(tmp_path("w2.png"));
 }
@@ -315,7 +315,7 @@ static rad_scene *box_scene(const rad_material *mats)
     return s;
 }
 
-static void image_mean(const rad_image *img, double out[3])
+static void image_mean(const tool_image *img, double out[3])
 {
     size_t i, n = (size_t)img->width * (size_t)img->height;
     out[0] = out[1] = out[2] = 0.0;
@@ -337,8 +337,8 @@ static void test_trace_furnace(void)
     rad_bvh *bvh = NULL;
     rad_raycaster rc;
     rad_camera cam = { { 0.5f, 0.5f, 0.5f }, { 0.5f, 0.5f, 0.0f }, { 0.0f, 1.0f, 0.0f }, 90.0f };
-    rad_trace_options o;
-    rad_image img = { 0, 0, NULL };
+    tool_trace_options o;
+    tool_image img = { 0, 0, NULL };
     double mean[3];
     const float L[3] = { 1.0f, 0.5f, 0.25f }, rho = 0.5f;
     int f, k;
@@ -353,12 +353,12 @@ static void test_trace_furnace(void)
     if (!s) return;
     CHECK_OK(rad_bvh_create(s, NULL, &bvh));
     rad_bvh_raycaster(bvh, &rc);
-    rad_trace_options_default(&o);
+    tool_trace_options_default(&o);
     o.width = 16;
     o.height = 16;
     o.spp = 64;
     o.seed = 7;
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) == 0);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) == 0);
     image_mean(&img, mean);
     printf("    furnace (rho 0.5, L 1 0.5 0.25): mean radiance %.5f %.5f %.5f, exact %.5f %.5f %.5f\n", mean[0], mean[1],
            mean[2], L[0] / (1.0 - rho), L[1] / (1.0 - rho), L[2] / (1.0 - rho));
@@ -374,13 +374,13 @@ static void test_trace_furnace(void)
     if (s && bvh) {
         rad_bvh_raycaster(bvh, &rc);
         o.spp = rad_test_quick() ? 64 : 256;
-        CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) == 0);
+        CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) == 0);
         image_mean(&img, mean);
         printf("    furnace (rho 0.8): mean radiance %.5f %.5f %.5f, exact %.5f %.5f %.5f\n", mean[0], mean[1], mean[2],
                L[0] / 0.2, L[1] / 0.2, L[2] / 0.2);
         for (k = 0; k < 3; ++k) CHECK_REL(mean[k], L[k] / 0.2, 0.02);
     }
-    rad_image_free(&img);
+    tool_image_free(&img);
     rad_bvh_destroy(bvh);
     rad_scene_destroy(s);
 }
@@ -400,8 +400,8 @@ static void test_trace_sky(void)
     rad_light sky;
     rad_camera down = { { 0.0f, 0.5f, 0.0f }, { 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 1.0f }, 30.0f };
     rad_camera up = { { 0.0f, 0.5f, 0.0f }, { 0.0f, 1.0f, 0.0f }, { 0.0f, 0.0f, 1.0f }, 30.0f };
-    rad_trace_options o;
-    rad_image img = { 0, 0, NULL };
+    tool_trace_options o;
+    tool_image img = { 0, 0, NULL };
     double mean[3];
     memset(&m, 0, sizeof(m));
     memset(&d, 0, sizeof(d));
@@ -421,18 +421,18 @@ static void test_trace_sky(void)
     rad_bvh_raycaster(bvh, &rc);
     sky.type = RAD_LIGHT_SKY;
     sky.color[0] = sky.color[1] = sky.color[2] = (float)RAD__PI; /* radiance 1 */
-    rad_trace_options_default(&o);
+    tool_trace_options_default(&o);
     o.width = o.height = 8;
     o.spp = 16;
-    CHECK(rad_trace_image(s, &rc, &sky, 1, &up, &o, NULL, &img) == 0);
+    CHECK(tool_trace_image(s, &rc, &sky, 1, &up, &o, NULL, &img) == 0);
     image_mean(&img, mean);
     CHECK_NEAR(mean[0], 1.0, 1e-5);
     /* looking down at the floor centre: it sees the whole sky, reflects rho * E0 / pi = 0.5 */
-    CHECK(rad_trace_image(s, &rc, &sky, 1, &down, &o, NULL, &img) == 0);
+    CHECK(tool_trace_image(s, &rc, &sky, 1, &down, &o, NULL, &img) == 0);
     image_mean(&img, mean);
     printf("    sky over a floor: floor radiance %.5f, exact 0.5\n", mean[0]);
     CHECK_NEAR(mean[0], 0.5, 1e-5); /* every bounce escapes: no variance at all */
-    rad_image_free(&img);
+    tool_image_free(&img);
     rad_bvh_destroy(bvh);
     rad_scene_destroy(s);
 }
@@ -454,8 +454,8 @@ static void test_trace_vs_radiosity(void)
     /* inside the box, looking at the wall x = 0 (the ceiling y = 1 emits); the view (y and z
        in [0.08, 0.92]) stays inside the wall, so every pixel's footprint lies on it */
     rad_camera cam = { { 0.9f, 0.5f, 0.5f }, { 0.0f, 0.5f, 0.5f }, { 0.0f, 1.0f, 0.0f }, 50.0f };
-    rad_trace_options o;
-    rad_image img = { 0, 0, NULL };
+    tool_trace_options o;
+    tool_image img = { 0, 0, NULL };
     float *E = NULL, *B = NULL;
     double tr[2][3] = { { 0, 0, 0 }, { 0, 0, 0 } }, ra[2][3] = { { 0, 0, 0 }, { 0, 0, 0 } };
     int f, k, x, y, cnt[2] = { 0, 0 };
@@ -485,12 +485,12 @@ static void test_trace_vs_radiosity(void)
     so.output = RAD_OUTPUT_TOTAL;
     CHECK_OK(rad_solve_direct(&sys, &so, B, NULL));
 
-    rad_trace_options_default(&o);
+    tool_trace_options_default(&o);
     o.width = 24;
     o.height = 24;
     o.spp = 256;
     o.seed = 3;
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) == 0);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) == 0);
     /* top half and bottom half of the image separately (the wall is brighter near the light) */
     for (y = 0; y < o.height; ++y)
         for (x = 0; x < o.width; ++x) {
@@ -519,7 +519,7 @@ static void test_trace_vs_radiosity(void)
 done:
     free(E);
     free(B);
-    rad_image_free(&img);
+    tool_image_free(&img);
     rad_form_factors_destroy(ff);
     rad_patches_destroy(P);
     rad_bvh_destroy(bvh);
@@ -541,16 +541,16 @@ static void test_trace_determinism(void)
     rad_scene *s = NULL;
     rad_bvh *bvh = NULL;
     rad_raycaster rc;
-    rad_trace_options o;
+    tool_trace_options o;
     rad_context ctx;
-    rad_image a = { 0, 0, NULL }, b = { 0, 0, NULL }, c = { 0, 0, NULL }, d = { 0, 0, NULL };
+    tool_image a = { 0, 0, NULL }, b = { 0, 0, NULL }, c = { 0, 0, NULL }, d = { 0, 0, NULL };
     size_t bytes;
     rad_cornell_box(&desc, &cam);
     CHECK_OK(rad_scene_create(&desc, NULL, &s));
     if (!s) return;
     CHECK_OK(rad_bvh_create(s, NULL, &bvh));
     rad_bvh_raycaster(bvh, &rc);
-    rad_trace_options_default(&o);
+    tool_trace_options_default(&o);
     o.width = 32;
     o.height = 24;
     o.spp = 8;
@@ -558,28 +558,28 @@ static void test_trace_determinism(void)
 #ifdef _OPENMP
     omp_set_num_threads(1);
 #endif
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &a) == 0);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &a) == 0);
 #ifdef _OPENMP
     omp_set_num_threads(2);
 #endif
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &b) == 0);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &b) == 0);
     memset(&ctx, 0, sizeof(ctx));
     ctx.parallel_for = reverse_parallel_for;
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, &ctx, &c) == 0);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, &ctx, &c) == 0);
     o.seed = 43;
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &d) == 0);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &d) == 0);
     bytes = (size_t)o.width * (size_t)o.height * 3u * sizeof(float);
     CHECK(a.rgb && b.rgb && c.rgb && d.rgb);
     if (a.rgb && b.rgb && c.rgb && d.rgb) {
         CHECK(memcmp(a.rgb, b.rgb, bytes) == 0); /* 1 vs 2 threads */
         CHECK(memcmp(a.rgb, c.rgb, bytes) == 0); /* reverse task order */
         CHECK(memcmp(a.rgb, d.rgb, bytes) != 0); /* another seed */
-        CHECK(rad_image_mse(&a, &d) > 0.0);
+        CHECK(tool_image_mse(&a, &d) > 0.0);
     }
-    rad_image_free(&a);
-    rad_image_free(&b);
-    rad_image_free(&c);
-    rad_image_free(&d);
+    tool_image_free(&a);
+    tool_image_free(&b);
+    tool_image_free(&c);
+    tool_image_free(&d);
     rad_bvh_destroy(bvh);
     rad_scene_destroy(s);
 }
@@ -593,8 +593,8 @@ static void test_trace_basics(void)
     rad_scene *s = NULL;
     rad_bvh *bvh = NULL;
     rad_raycaster rc;
-    rad_trace_options o;
-    rad_image img = { 0, 0, NULL };
+    tool_trace_options o;
+    tool_image img = { 0, 0, NULL };
     rad_cornell_box(&desc, &cam);
     CHECK_OK(rad_scene_create(&desc, NULL, &s));
     if (!s) return;
@@ -612,10 +612,10 @@ static void test_trace_basics(void)
     up.up[1] = 0.0f;
     up.up[2] = 1.0f;
     up.fov_y_degrees = 5.0f;
-    rad_trace_options_default(&o);
+    tool_trace_options_default(&o);
     o.width = o.height = 4;
     o.spp = 4;
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &up, &o, NULL, &img) == 0);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &up, &o, NULL, &img) == 0);
     if (img.rgb) {
         /* emission plus a little light reflected by the light's albedo 0.78 from below */
         CHECK(img.rgb[0] >= 17.0f && img.rgb[0] < 17.5f);
@@ -623,9 +623,9 @@ static void test_trace_basics(void)
         CHECK(img.rgb[2] >= 4.0f && img.rgb[2] < 4.5f);
     }
     o.spp = 0;
-    CHECK(rad_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) != 0);
-    CHECK(rad_trace_image(NULL, &rc, NULL, 0, &cam, &o, NULL, &img) != 0);
-    rad_image_free(&img);
+    CHECK(tool_trace_image(s, &rc, NULL, 0, &cam, &o, NULL, &img) != 0);
+    CHECK(tool_trace_image(NULL, &rc, NULL, 0, &cam, &o, NULL, &img) != 0);
+    tool_image_free(&img);
     rad_bvh_destroy(bvh);
     rad_scene_destroy(s);
 }
@@ -643,8 +643,8 @@ static void test_trace_point_light(void)
     rad_raycaster rc;
     rad_light li;
     rad_camera down = { { 0.0f, 0.5f, 0.0f }, { 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 1.0f }, 0.5f };
-    rad_trace_options o;
-    rad_image img = { 0, 0, NULL };
+    tool_trace_options o;
+    tool_image img = { 0, 0, NULL };
     double mean[3];
     memset(&m, 0, sizeof(m));
     memset(&d, 0, sizeof(d));
@@ -664,14 +664,14 @@ static void test_trace_point_light(void)
     li.type = RAD_LIGHT_POINT;
     li.color[0] = li.color[1] = li.color[2] = 4.0f;
     li.position[1] = 2.0f;
-    rad_trace_options_default(&o);
+    tool_trace_options_default(&o);
     o.width = o.height = 2;
     o.spp = 4;
-    CHECK(rad_trace_image(s, &rc, &li, 1, &down, &o, NULL, &img) == 0);
+    CHECK(tool_trace_image(s, &rc, &li, 1, &down, &o, NULL, &img) == 0);
     image_mean(&img, mean);
     /* E = 4 / 2^2 = 1 at the centre; L = 0.5 / pi (the view covers a tiny spot) */
     CHECK_REL(mean[0], 0.5 / RAD__PI, 1e-3);
-    rad_image_free(&img);
+    tool_image_free(&img);
     rad_bvh_destroy(bvh);
     rad_scene_destroy(s);
 }

@@ -221,7 +221,7 @@ static void vpr_test_container(void)
     buf = (unsigned char *)vpr_save(vp, &size);
     CHECK(buf != NULL);
     if (!buf) goto out;
-    CHECK_OK(rad_container_open(buf, size, NULL, &ct));
+    CHECK_OK(rad_container_create(buf, size, NULL, &ct));
     CHECK_OK(rad_vp_load(ct, "vp", scene, NULL, &back));
     CHECK_RESULT(rad_vp_load(ct, "other", scene, &quiet, &bad), RAD_ERROR_INVALID_ARGUMENT);
     if (!back) goto out;
@@ -248,7 +248,7 @@ static void vpr_test_container(void)
     back = NULL;
     CHECK_OK(rad_vp_load(ct, "vp", NULL, NULL, &back));
     if (back && N <= 8) CHECK_RESULT(rad_vp_sources(back, &rc, NULL, 0, NULL, RAD_SOURCE_EMISSION, E, &quiet), RAD_ERROR_INVALID_ARGUMENT);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     ct = NULL;
     /* damaged data behind valid checksums: a patch pointing at another voxel, a NaN weight */
     {
@@ -272,13 +272,13 @@ static void vpr_test_container(void)
                 }
                 CHECK_OK(rad_container_size(sec, count, &n2));
                 b2 = (unsigned char *)malloc(n2);
-                if (b2 && rad_container_write(sec, count, b2, n2) == RAD_SUCCESS && rad_container_open(b2, n2, NULL, &c2) == RAD_SUCCESS) {
+                if (b2 && rad_container_write(sec, count, b2, n2) == RAD_SUCCESS && rad_container_create(b2, n2, NULL, &c2) == RAD_SUCCESS) {
                     CHECK_RESULT(rad_vp_load(c2, "vp", scene, &quiet, &bad), k == 0 ? RAD_ERROR_CORRUPT : RAD_ERROR_NON_FINITE);
                     CHECK(bad == NULL);
                 } else {
                     CHECK(0);
                 }
-                rad_container_close(c2);
+                rad_container_destroy(c2);
                 free(b2);
             }
         }
@@ -287,7 +287,7 @@ static void vpr_test_container(void)
     }
 out:
     free(values);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(buf);
     rad_vp_destroy(vp);
     rad_vp_destroy(back);
@@ -342,7 +342,7 @@ static void vpr_test_streamed_rows(void)
     f = fopen(path, "wb");
     CHECK(buf && f && fwrite(buf, 1, size, f) == size);
     if (f) fclose(f);
-    CHECK_OK(rad_row_stream_open(path, NULL, &st));
+    CHECK_OK(rad_row_stream_create(path, NULL, &st));
     CHECK_OK(rad_alias_tables_create(&vp->matrix, RAD_ALIAS_AUTO, NULL, &at));
     if (!st || !at) goto out;
     rad_row_stream_source(st, &src);
@@ -423,7 +423,7 @@ out:
     rad_local_destroy(l2);
     free(set);
     free(cols); free(vals); free(bins); free(scratch);
-    rad_row_stream_close(st);
+    rad_row_stream_destroy(st);
     rad_alias_tables_destroy(at);
     free(buf);
     remove(path);

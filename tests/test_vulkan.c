@@ -185,7 +185,7 @@ static void test_gather(int sparse)
                     p.row_offset = cut[q];
                     p.row_count = cut[q + 1] - cut[q];
                     p.entry_base = (uint32_t)e0 - base;
-                    p.flags = total ? RAD_GLSL_FLAG_TOTAL : 0u;
+                    p.flags = total ? RAD_GLSL_OUTPUT_TOTAL : 0u;
                     T_CHECK(vk_dispatch(&g_vk, &k, r, &p, p.row_count));
                 } else {
                     rad_glsl_gather_dense_push p;
@@ -194,7 +194,7 @@ static void test_gather(int sparse)
                     p.row_offset = cut[q];
                     p.row_count = cut[q + 1] - cut[q];
                     p.cols = n;
-                    p.flags = total ? RAD_GLSL_FLAG_TOTAL : 0u;
+                    p.flags = total ? RAD_GLSL_OUTPUT_TOTAL : 0u;
                     T_CHECK(vk_dispatch(&g_vk, &k, r, &p, p.row_count));
                 }
             }
@@ -316,7 +316,7 @@ static int gpu_mb_apply(const rad_multibounce *mb, const float *E, rad_output ou
         p.row_offset = cut[q];
         p.row_count = cut[q + 1] - cut[q];
         p.base = base;
-        p.flags = (output == RAD_OUTPUT_TOTAL ? RAD_GLSL_FLAG_TOTAL : 0u) | (mb->row_perm ? RAD_GLSL_FLAG_PERMUTED : 0u);
+        p.flags = (output == RAD_OUTPUT_TOTAL ? RAD_GLSL_OUTPUT_TOTAL : 0u) | (mb->row_perm ? RAD_GLSL_MB_PERMUTED : 0u);
         if (p.row_count) ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
     }
     if (ok) memcpy(out, bOut.map, 3 * (size_t)n * 4);
@@ -434,8 +434,8 @@ static int gpu_blocks_apply(gpu_blocks *g, const rad_multibounce_blocks *b, cons
         p.row_count = cut[q + 1] - cut[q];
         p.tile = b->tile;
         p.tiles_per_row = b->tiles_per_row;
-        p.flags = (output == RAD_OUTPUT_TOTAL ? RAD_GLSL_FLAG_TOTAL : 0u) | (b->row_perm ? RAD_GLSL_FLAG_PERMUTED : 0u) |
-                  (b->format == RAD_BLOCK_BC1 ? RAD_GLSL_FLAG_BC1 : 0u) | (b->outlier_count ? RAD_GLSL_FLAG_OUTLIERS : 0u);
+        p.flags = (output == RAD_OUTPUT_TOTAL ? RAD_GLSL_OUTPUT_TOTAL : 0u) | (b->row_perm ? RAD_GLSL_MB_PERMUTED : 0u) |
+                  (b->format == RAD_BLOCK_BC1 ? RAD_GLSL_BLOCKS_BC1 : 0u) | (b->outlier_count ? RAD_GLSL_BLOCKS_OUTLIERS : 0u);
         ok &= vk_dispatch_images(&g_vk, &g->k, views, r, &p, p.row_count);
     }
     if (ok) memcpy(out, g->out.map, 3 * (size_t)n * 4);
@@ -593,8 +593,8 @@ static void temporal_case(const char *what, const rad_alias_tables *const *table
                 p.n = n;
                 p.samples = o->samples;
                 p.words = words;
-                p.flags = (o->mode != RAD_TEMPORAL_MULTIBOUNCE ? RAD_GLSL_FLAG_ALBEDO : 0u) |
-                          (o->mode == RAD_TEMPORAL_FEEDBACK ? RAD_GLSL_FLAG_FEEDBACK : 0u);
+                p.flags = (o->mode != RAD_TEMPORAL_MULTIBOUNCE ? RAD_GLSL_TEMPORAL_ALBEDO : 0u) |
+                          (o->mode == RAD_TEMPORAL_FEEDBACK ? RAD_GLSL_TEMPORAL_FEEDBACK : 0u);
                 p.channel = table_count == 1 ? 3u : c;
                 p.sample_base = table_count == 1 ? 0u : c * o->samples;
                 p.word_base = (uint32_t)(b0 * words) - base;
@@ -739,7 +739,7 @@ static void test_alias_build(void)
                     p.words = words;
                     p.entry_base = (uint32_t)e0 - ebase;
                     p.out_base = (uint32_t)(o0 / 16 * 16);
-                    p.flags = dense ? RAD_GLSL_FLAG_DENSE : 0u;
+                    p.flags = dense ? RAD_GLSL_ALIAS_DENSE : 0u;
                     if (r[3].offset != (o0 / 16 * 16) * words * 4 || r[4].offset != (o0 / 16 * 16) * 8 || obase != 0) {
                         printf("    alignment %lu too coarse for this test\n", (unsigned long)g_vk.props.limits.minStorageBufferOffsetAlignment);
                         ok = 0;
@@ -803,7 +803,7 @@ static void test_alias_build(void)
                             p.n = n;
                             p.samples = o.samples;
                             p.words = words;
-                            p.flags = RAD_GLSL_FLAG_ALBEDO | RAD_GLSL_FLAG_FEEDBACK | RAD_GLSL_FLAG_PADDED;
+                            p.flags = RAD_GLSL_TEMPORAL_ALBEDO | RAD_GLSL_TEMPORAL_FEEDBACK | RAD_GLSL_TEMPORAL_PADDED;
                             p.channel = 3;
                             p.weight = o.weight;
                             ok &= vk_dispatch(&g_vk, &kt, r, &p, n);
@@ -891,7 +891,7 @@ static int gpu_local_add(gpu_local *g, const float *F, uint32_t n, const float *
         p.nnz = nnz;
         p.ev = ev;
         p.pass = RAD_GLSL_LOCAL_PASS_GATHER;
-        p.flags = (first ? RAD_GLSL_FLAG_FIRST_CHUNK : 0u) | (first_order ? RAD_GLSL_FLAG_FIRST_ORDER : 0u);
+        p.flags = (first ? RAD_GLSL_LOCAL_FIRST_CHUNK : 0u) | (first_order ? RAD_GLSL_LOCAL_FIRST_ORDER : 0u);
         memcpy(p.ann, ann, sizeof(ann));
         first = 0;
         ok &= vk_dispatch(&g_vk, &g->kv, r, &p, p.row_count > end ? p.row_count : end);
@@ -906,7 +906,7 @@ static int gpu_local_add(gpu_local *g, const float *F, uint32_t n, const float *
         p.end = end;
         p.nnz = nnz;
         p.ev = ev;
-        p.flags = first_order ? RAD_GLSL_FLAG_FIRST_ORDER : 0u;
+        p.flags = first_order ? RAD_GLSL_LOCAL_FIRST_ORDER : 0u;
         memcpy(p.ann, ann, sizeof(ann));
         if (ev != RAD_NONE) {
             p.pass = RAD_GLSL_LOCAL_PASS_EVICT;
@@ -1005,7 +1005,7 @@ static int gpu_local_apply(gpu_local *g, const rad_local *L, const float *E, con
         p.row_count = nvis; /* every entry, each chunk: the kernel skips rows it does not hold */
         p.slot_offset = cut[q];
         p.slot_count = cut[q + 1] - cut[q];
-        p.flags = output == RAD_OUTPUT_TOTAL ? RAD_GLSL_FLAG_TOTAL : 0u;
+        p.flags = output == RAD_OUTPUT_TOTAL ? RAD_GLSL_OUTPUT_TOTAL : 0u;
         ok &= vk_dispatch(&g_vk, &g->ka, r, &p, nvis);
     }
     if (ok) memcpy(out, bOut.map, 3 * (size_t)n * 4);
@@ -1103,7 +1103,7 @@ static void local_case(const float *F, uint32_t n, const float *areas, const flo
     for (total = 0; ok && total < 2; ++total) {
         rad_output out = total ? RAD_OUTPUT_TOTAL : RAD_OUTPUT_INDIRECT;
         float *gv = (float *)malloc(3 * (size_t)nvis * 4), *cv = (float *)malloc(3 * (size_t)nvis * 4);
-        T_CHECK(rad_local_apply(L, E, vis, nvis, lit, nlit, out, cpu, NULL) == RAD_SUCCESS);
+        T_CHECK(rad_local_apply(L, E, vis, nvis, lit, nlit, cpu, out, NULL) == RAD_SUCCESS);
         T_CHECK(gpu_local_apply(&g, L, E, vis, nvis, lit, nlit, out, gpu));
         if (gv && cv) {
             for (i = 0; i < 3 * nvis; ++i) { gv[i] = gpu[3 * vis[i / 3] + i % 3]; cv[i] = cpu[3 * vis[i / 3] + i % 3]; }
@@ -1193,7 +1193,7 @@ static void vp_run(const rad_virtual_patches *vp, const float *values, const flo
         p.voxel_count = vp->voxel_count;
         p.row_offset = cut[q];
         p.row_count = cut[q + 1] - cut[q];
-        p.flags = (weights == RAD_VP_WEIGHTS_COSINE ? RAD_GLSL_FLAG_COSINE : 0u) | (kind == RAD_VP_CLUSTERED ? RAD_GLSL_FLAG_CLUSTERED : 0u);
+        p.flags = (weights == RAD_VP_WEIGHTS_COSINE ? RAD_GLSL_VP_COSINE : 0u) | (kind == RAD_VP_CLUSTERED ? RAD_GLSL_VP_CLUSTERED : 0u);
         ok &= vk_dispatch(&g_vk, &k, r, &p, p.row_count);
     }
     T_CHECK(ok);

@@ -6,7 +6,7 @@
    factors) ran without a word until the machine gave out. So before the patches are made
    (N at least the triangle count) and again once N is known, the tool estimates the memory
    and the time, and refuses a build that exceeds the memory limit (--max-memory, else
-   /proc/meminfo's MemAvailable) or RAD_TOOL_DENSE_MAX_SECONDS, naming the virtual-patch
+   /proc/meminfo's MemAvailable) or TOOL_DENSE_MAX_SECONDS, naming the virtual-patch
    methods instead; --force runs it anyway.
 
    Memory per N^2 entry (the arrays that are alive at the peak): F 4 bytes; the direct solver's
@@ -14,9 +14,9 @@
    half-precision 6; temporal alias tables 12 (wide: an upper bound for compact's 8), per
    channel in --mode multibounce; a classic bake writes F twice more (rad_save_memory's buffer
    and the container); local adds 12 M^2 for T. Time: the form factors at
-   RAD_TOOL_FF_RATE sample pairs per second per thread (measured on the Cornell box: 2188
+   TOOL_FF_RATE sample pairs per second per thread (measured on the Cornell box: 2188
    patches, 16 samples, 22.6 s on 2 threads), plus N^3 / 3 (LU) or 2 N^3 per squaring
-   (multibounce) flops at RAD_TOOL_FLOP_RATE per thread: rough, within a factor of a few. */
+   (multibounce) flops at TOOL_FLOP_RATE per thread: rough, within a factor of a few. */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
@@ -26,10 +26,10 @@
 #include <omp.h>
 #endif
 
-#define RAD_TOOL_FF_RATE 1.7e6
-#define RAD_TOOL_FLOP_RATE 2e9
+#define TOOL_FF_RATE 1.7e6
+#define TOOL_FLOP_RATE 2e9
 
-int rad_tool_parse_bytes(const char *cmd, const char *opt, const char *text, double *out)
+int tool_parse_bytes(const char *cmd, const char *opt, const char *text, double *out)
 {
     char *end;
     double v, unit = 1.0;
@@ -55,7 +55,7 @@ bad:
     return 2;
 }
 
-double rad_tool_mem_available(void)
+double tool_mem_available(void)
 {
     FILE *f = fopen("/proc/meminfo", "r");
     char line[256];
@@ -70,18 +70,18 @@ double rad_tool_mem_available(void)
     return kb > 0.0 ? kb * 1024.0 : 0.0;
 }
 
-void rad_tool_dense_plan(rad_tool_classic_options *o, const rad_tool_method_options *mo, int bake)
+void tool_dense_plan(tool_classic_options *o, const tool_method_options *mo, int bake)
 {
     double per = 4.0; /* F */
     o->dense_local_m = 0;
-    o->dense_method = rad_tool_method_name(mo->method);
+    o->dense_method = tool_method_name(mo->method);
     o->dense_cubic = 0.0;
     switch (mo->method) {
-    case RAD_TOOL_MULTIBOUNCE:
-        per += mo->format == RAD_TOOL_MB_HALF ? 22.0 : 28.0;
+    case TOOL_MULTIBOUNCE:
+        per += mo->format == TOOL_MB_HALF ? 22.0 : 28.0;
         o->dense_cubic = 2.0 * ceil(log2((double)(mo->bounces > 1024u ? 1024u : mo->bounces) + 2.0));
         break;
-    case RAD_TOOL_TEMPORAL:
+    case TOOL_TEMPORAL:
         if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
             per += 28.0 + 3.0 * 12.0;
             o->dense_cubic = 2.0 * ceil(log2((double)(mo->bounces > 1024u ? 1024u : mo->bounces) + 2.0));
@@ -89,11 +89,11 @@ void rad_tool_dense_plan(rad_tool_classic_options *o, const rad_tool_method_opti
             per += 12.0;
         }
         break;
-    case RAD_TOOL_LOCAL:
-        o->dense_local_m = mo->local_m ? mo->local_m : RAD_TOOL_LOCAL_M_AUTO_MAX;
+    case TOOL_LOCAL:
+        o->dense_local_m = mo->local_m ? mo->local_m : TOOL_LOCAL_M_AUTO_MAX;
         break;
     default:
-        if (o->solver == RAD_TOOL_DIRECT) {
+        if (o->solver == TOOL_DIRECT) {
             per += 8.0;
             o->dense_cubic = 1.0 / 3.0;
         }
@@ -126,7 +126,7 @@ static void print_time(char *buf, size_t len, double s)
     else snprintf(buf, len, "%.0f days", s / 86400.0);
 }
 
-int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uint32_t n, int lower_bound)
+int tool_dense_check(const char *cmd, const tool_classic_options *o, uint32_t n, int lower_bound)
 {
     double N = (double)n, per = o->dense_bytes_per_n2 > 0.0 ? o->dense_bytes_per_n2 : 4.0, bytes, seconds, limit;
     double m = o->dense_local_m ? (N < (double)o->dense_local_m ? N : (double)o->dense_local_m) : 0.0;
@@ -135,12 +135,12 @@ int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uin
     char tbuf[64], bbuf[64], lbuf[64];
     if (o->sources_only && o->no_form_factors) return 0; /* stochastic: no N x N matrix */
     bytes = per * N * N + 12.0 * m * m + 200.0 * N; /* + the patches, vectors and per-patch data */
-    seconds = N * N * (double)(o->samples ? o->samples : 16u) / (RAD_TOOL_FF_RATE * th) +
-              (o->dense_cubic * N * N * N + 6.0 * m * m * m) / (RAD_TOOL_FLOP_RATE * th);
+    seconds = N * N * (double)(o->samples ? o->samples : 16u) / (TOOL_FF_RATE * th) +
+              (o->dense_cubic * N * N * N + 6.0 * m * m * m) / (TOOL_FLOP_RATE * th);
     if (o->max_memory > 0.0) limit = o->max_memory, limit_from = "--max-memory";
-    else limit = rad_tool_mem_available(), limit_from = "MemAvailable in /proc/meminfo";
+    else limit = tool_mem_available(), limit_from = "MemAvailable in /proc/meminfo";
     mem_over = limit > 0.0 && bytes > limit;
-    time_over = seconds > RAD_TOOL_DENSE_MAX_SECONDS;
+    time_over = seconds > TOOL_DENSE_MAX_SECONDS;
     print_time(tbuf, sizeof tbuf, seconds);
     print_bytes(bbuf, sizeof bbuf, bytes);
     print_bytes(lbuf, sizeof lbuf, limit);
@@ -157,7 +157,7 @@ int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uin
             o->samples ? o->samples : 16u, th);
     if (mem_over) fprintf(stderr, "; only %s may be used (%s)", lbuf, limit_from);
     if (time_over) fprintf(stderr, "%s more than the %.0f minutes the tool starts a dense build for",
-                           mem_over ? ", and" : ";", RAD_TOOL_DENSE_MAX_SECONDS / 60.0);
+                           mem_over ? ", and" : ";", TOOL_DENSE_MAX_SECONDS / 60.0);
     fprintf(stderr, ".\nrad %s: use %s--method aavp or --method vp (virtual patches: a few thousand patches whatever the "
                     "triangle count; --vp-max-patches B sets how many; --proxy aavp runs multibounce, temporal or local over them), "
                     "or give --force to build it anyway%s\n",

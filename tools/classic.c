@@ -1,7 +1,7 @@
 /* classic.c - the classic radiosity solution the tool's commands share: options and their
    parsing, patches, F, direct light as the source E = rho D, the solve and H = F (E + L)
-   (rad_tool_classic_*), and the signature of a bake's options (rad_tool_bake_info_fill,
-   rad_tool_options_hash, rad_tool_sign_options). cmd_bake.c saves it; render, lightmap,
+   (tool_classic_*), and the signature of a bake's options (tool_bake_info_fill,
+   tool_options_hash, tool_sign_options). cmd_bake.c saves it; render, lightmap,
    probes, merge and the methods of methods.c call it. */
 #include "tool.h"
 #include <stdio.h>
@@ -9,18 +9,18 @@
 #include <string.h>
 #include <time.h>
 
-void rad_tool_classic_options_default(rad_tool_classic_options *o)
+void tool_classic_options_default(tool_classic_options *o)
 {
     memset(o, 0, sizeof *o);
     o->patches = 2000;
     o->max_edge = 0.0f;
     o->samples = 16;
-    o->solver = RAD_TOOL_JACOBI;
+    o->solver = TOOL_JACOBI;
     o->bounces = 64;
     o->light_samples = 16;
 }
 
-const char *rad_tool_classic_help(void)
+const char *tool_classic_help(void)
 {
     return "  --solver S         jacobi (default), gauss-seidel or direct (LU)\n"
            "  --bounces K        Jacobi bounces of indirect light (default 64)\n"
@@ -33,7 +33,7 @@ const char *rad_tool_classic_help(void)
            "  --force            build it whatever the estimate\n";
 }
 
-int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o)
+int tool_classic_option(const char *cmd, int argc, char **argv, int *a, tool_classic_options *o)
 {
     const char *opt = argv[*a];
     static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples",
@@ -53,36 +53,36 @@ int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_
     ++*a;
     switch (i) {
     case 0:
-        if (!strcmp(argv[*a], "jacobi")) o->solver = RAD_TOOL_JACOBI;
-        else if (!strcmp(argv[*a], "gauss-seidel") || !strcmp(argv[*a], "gs")) o->solver = RAD_TOOL_GAUSS_SEIDEL;
-        else if (!strcmp(argv[*a], "direct") || !strcmp(argv[*a], "lu")) o->solver = RAD_TOOL_DIRECT;
+        if (!strcmp(argv[*a], "jacobi")) o->solver = TOOL_JACOBI;
+        else if (!strcmp(argv[*a], "gauss-seidel") || !strcmp(argv[*a], "gs")) o->solver = TOOL_GAUSS_SEIDEL;
+        else if (!strcmp(argv[*a], "direct") || !strcmp(argv[*a], "lu")) o->solver = TOOL_DIRECT;
         else {
             fprintf(stderr, "rad %s: unknown solver '%s' (jacobi, gauss-seidel or direct)\n", cmd, argv[*a]);
             return 2;
         }
         return 1;
-    case 1: return rad_tool_parse_uint(cmd, opt, argv[*a], &o->bounces) ? 2 : 1;
+    case 1: return tool_parse_uint(cmd, opt, argv[*a], &o->bounces) ? 2 : 1;
     case 2:
-        if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->patches)) return 2;
+        if (tool_parse_uint(cmd, opt, argv[*a], &o->patches)) return 2;
         if (o->patches == 0) { fprintf(stderr, "rad %s: --patches must be > 0\n", cmd); return 2; }
         return 1;
     case 3:
-        if (rad_tool_parse_float(cmd, opt, argv[*a], &o->max_edge)) return 2;
+        if (tool_parse_float(cmd, opt, argv[*a], &o->max_edge)) return 2;
         if (o->max_edge < 0.0f) { fprintf(stderr, "rad %s: --max-edge must be >= 0\n", cmd); return 2; }
         return 1;
     case 4:
-        if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
+        if (tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
         if (o->samples == 0) { fprintf(stderr, "rad %s: --samples must be > 0\n", cmd); return 2; }
         return 1;
-    case 6: return rad_tool_parse_bytes(cmd, opt, argv[*a], &o->max_memory) ? 2 : 1;
+    case 6: return tool_parse_bytes(cmd, opt, argv[*a], &o->max_memory) ? 2 : 1;
     default:
-        if (rad_tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
+        if (tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
         if (o->light_samples == 0) { fprintf(stderr, "rad %s: --light-samples must be > 0\n", cmd); return 2; }
         return 1;
     }
 }
 
-void rad_tool_classic_free(rad_tool_classic *c)
+void tool_classic_free(tool_classic *c)
 {
     rad_form_factors_destroy(c->ff);
     rad_patches_destroy(c->patches);
@@ -94,53 +94,53 @@ void rad_tool_classic_free(rad_tool_classic *c)
     memset(c, 0, sizeof *c);
 }
 
-int rad_tool_classic_sources(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                             rad_tool_classic *out)
+int tool_classic_sources(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                             tool_classic *out)
 {
     rad_patch_options po;
     rad_direct_options dopt;
     rad_context ctx;
     rad_result r;
     uint32_t n;
-    double t0 = rad_tool_seconds();
+    double t0 = tool_seconds();
     memset(out, 0, sizeof *out);
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     rad_patch_options_default(&po);
     po.target_count = o->patches;
     po.max_edge = o->max_edge;
     /* at least one patch per triangle: a scene too big for F is refused before any work */
-    if (rad_tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
+    if (tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
     if ((r = rad_patches_create(w->scene, &po, &ctx, &out->patches)) != RAD_SUCCESS)
-        return rad_tool_fail(cmd, "rad_patches_create", r);
+        return tool_fail(cmd, "rad_patches_create", r);
     n = out->patches->count;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w->scene->triangle_count, n);
-    if (rad_tool_dense_check(cmd, o, n, 0)) {
-        rad_tool_classic_free(out);
+    if (tool_dense_check(cmd, o, n, 0)) {
+        tool_classic_free(out);
         return 1;
     }
-    out->D = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    out->E = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    out->D = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    out->E = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
     dopt.light_samples = o->light_samples;
-    rad_tool_context(&ctx, "direct light");
+    tool_context(&ctx, "direct light");
     r = rad_direct_patches(out->patches, &w->rc, w->file.lights, w->file.light_count, &dopt, out->D, &ctx);
-    rad_tool_progress_end();
+    tool_progress_end();
     if (r != RAD_SUCCESS) {
-        rad_tool_classic_free(out);
-        return rad_tool_fail(cmd, "rad_direct_patches", r);
+        tool_classic_free(out);
+        return tool_fail(cmd, "rad_direct_patches", r);
     }
     /* E = rho D: direct light is the source, emission stays out of the system (the renderer adds D per pixel) */
     if ((r = rad_sources(out->patches, RAD_SOURCE_DIRECT, out->D, out->E)) != RAD_SUCCESS) {
-        rad_tool_classic_free(out);
-        return rad_tool_fail(cmd, "rad_sources", r);
+        tool_classic_free(out);
+        return tool_fail(cmd, "rad_sources", r);
     }
-    fprintf(stderr, "rad %s: direct light in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    fprintf(stderr, "rad %s: direct light in %.2f s\n", cmd, tool_seconds() - t0);
     return 0;
 }
 
-int rad_tool_classic_indirect(const char *cmd, const rad_tool_classic_options *o, const rad_matrix *F,
-                              rad_tool_classic *c)
+int tool_classic_indirect(const char *cmd, const tool_classic_options *o, const rad_matrix *F,
+                              tool_classic *c)
 {
     rad_solve_options so;
     rad_solve_stats stats;
@@ -149,18 +149,18 @@ int rad_tool_classic_indirect(const char *cmd, const rad_tool_classic_options *o
     rad_result r;
     uint32_t n = c->patches->count, i;
     double t1;
-    c->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    c->B = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    c->H = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+    c->L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    c->B = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    c->H = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     rad_system_init(&sys, F, c->patches, c->E);
     rad_solve_options_default(&so);
     so.output = RAD_OUTPUT_INDIRECT;
     so.bounces = o->bounces;
     memset(&stats, 0, sizeof stats);
-    rad_tool_context(&ctx, "solve");
-    t1 = rad_tool_seconds();
+    tool_context(&ctx, "solve");
+    t1 = tool_seconds();
     switch (o->solver) {
-    case RAD_TOOL_GAUSS_SEIDEL:
+    case TOOL_GAUSS_SEIDEL:
         r = rad_solve_gauss_seidel(&sys, &so, c->L, &stats, &ctx);
         if (r == RAD_ERROR_NOT_CONVERGED) {
             fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge (residual %g after %u sweeps)\n", cmd,
@@ -168,23 +168,23 @@ int rad_tool_classic_indirect(const char *cmd, const rad_tool_classic_options *o
             r = RAD_SUCCESS;
         }
         break;
-    case RAD_TOOL_DIRECT: r = rad_solve_direct(&sys, &so, c->L, &ctx); break;
+    case TOOL_DIRECT: r = rad_solve_direct(&sys, &so, c->L, &ctx); break;
     default: r = rad_solve_jacobi(&sys, &so, c->L, &stats, &ctx); break;
     }
-    c->solve_seconds = rad_tool_seconds() - t1;
-    rad_tool_progress_end();
-    if (r != RAD_SUCCESS) return rad_tool_fail(cmd, "solve", r);
+    c->solve_seconds = tool_seconds() - t1;
+    tool_progress_end();
+    if (r != RAD_SUCCESS) return tool_fail(cmd, "solve", r);
     for (i = 0; i < 3 * n; ++i) c->B[i] = c->E[i] + c->L[i];
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_matrix_multiply(F, c->B, c->H, &ctx)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_matrix_multiply", r);
+    tool_context(&ctx, NULL);
+    if ((r = rad_matrix_multiply(F, c->B, c->H, &ctx)) != RAD_SUCCESS) return tool_fail(cmd, "rad_matrix_multiply", r);
     fprintf(stderr, "rad %s: %s solve in %.2f s\n", cmd,
-            o->solver == RAD_TOOL_GAUSS_SEIDEL ? "Gauss-Seidel" : o->solver == RAD_TOOL_DIRECT ? "direct (LU)" : "Jacobi",
+            o->solver == TOOL_GAUSS_SEIDEL ? "Gauss-Seidel" : o->solver == TOOL_DIRECT ? "direct (LU)" : "Jacobi",
             c->solve_seconds);
     return 0;
 }
 
-int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                           rad_tool_classic *out)
+int tool_classic_solve(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                           tool_classic *out)
 {
     rad_form_factor_options fo;
     rad_context ctx;
@@ -192,33 +192,33 @@ int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_t
     uint32_t n;
     double t0;
     clock_t c0;
-    if (rad_tool_classic_sources(cmd, w, o, out)) return 1;
+    if (tool_classic_sources(cmd, w, o, out)) return 1;
     if (o->sources_only && o->no_form_factors) return 0;
     n = out->patches->count;
-    t0 = rad_tool_seconds();
+    t0 = tool_seconds();
     c0 = clock();
     rad_form_factor_options_default(&fo);
     fo.samples = o->samples;
-    rad_tool_context(&ctx, "form factors");
+    tool_context(&ctx, "form factors");
     r = rad_form_factors_dense(out->patches, &w->rc, &fo, &ctx, &out->ff);
-    rad_tool_progress_end();
+    tool_progress_end();
     if (r != RAD_SUCCESS) {
-        rad_tool_classic_free(out);
-        return rad_tool_fail(cmd, "rad_form_factors_dense", r);
+        tool_classic_free(out);
+        return tool_fail(cmd, "rad_form_factors_dense", r);
     }
     /* the CPU time too: the work of a sharded bake is compared with it (docs/distributed.md) */
     fprintf(stderr, "rad %s: form factors %u x %u (%.1f MB), %llu pairs evaluated, in %.2f s (%.2f s CPU)\n", cmd, n, n,
-            4.0 * n * (double)n / 1e6, (unsigned long long)out->ff->pairs_evaluated, rad_tool_seconds() - t0,
+            4.0 * n * (double)n / 1e6, (unsigned long long)out->ff->pairs_evaluated, tool_seconds() - t0,
             (double)(clock() - c0) / CLOCKS_PER_SEC);
     if (o->sources_only) return 0;
-    if (rad_tool_classic_indirect(cmd, o, &out->ff->matrix, out)) {
-        rad_tool_classic_free(out);
+    if (tool_classic_indirect(cmd, o, &out->ff->matrix, out)) {
+        tool_classic_free(out);
         return 1;
     }
     return 0;
 }
 
-void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, const rad_tool_classic_options *o)
+void tool_bake_info_fill(tool_bake_info *info, const tool_world *w, const tool_classic_options *o)
 {
     memset(info, 0, sizeof *info);
     info->magic = 0x52414442u;
@@ -231,24 +231,24 @@ void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, 
     info->triangle_count = w->scene->triangle_count;
 }
 
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w)
+uint64_t tool_options_hash(const tool_bake_info *info, const tool_world *w)
 {
     uint64_t h = rad_hash64(info, sizeof *info, RAD_HASH64_INIT);
     /* the command line's lights, so that a bake lit by --sun is not rendered under another sun;
        none leaves the hash of bakes made before those options unchanged */
     if (w && w->file.light_count > w->file_light_count)
-        h = rad_tool_lights_hash(w->file.lights + w->file_light_count, w->file.light_count - w->file_light_count, h);
+        h = tool_lights_hash(w->file.lights + w->file_light_count, w->file.light_count - w->file_light_count, h);
     return h;
 }
 
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+void tool_sign_options(rad_section *secs, uint32_t count, const tool_bake_info *info, const tool_world *w,
                            rad_bake_signature *sig)
 {
     uint32_t i;
     for (i = 0; i < count; ++i)
         if (secs[i].type == RAD_SECTION_SIGNATURE && secs[i].elem_size == sizeof *sig && secs[i].count == 1) {
             memcpy(sig, secs[i].data, sizeof *sig);
-            sig->options = rad_tool_options_hash(info, w);
+            sig->options = tool_options_hash(info, w);
             secs[i].data = sig;
         }
 }

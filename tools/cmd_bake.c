@@ -11,9 +11,9 @@
    its per-pixel direct light. The bake holds the patches, F, E and B (rad_save_memory), plus
    the vectors "L", "H" and "D" and a user section "rad.options" with the options the patches
    were made with, so `rad render --bake` can check that the file fits the scene (with the
-   library's signature section, which also holds the hash of rad.options: rad_tool_sign_options).
+   library's signature section, which also holds the hash of rad.options: tool_sign_options).
    --method multibounce, temporal, stochastic and hierarchical bake through methods.c
-   (rad_tool_method_bake); aavp
+   (tool_method_bake); aavp
    and vp save the virtual patches with sparse rows (bake_vp). */
 #include "tool.h"
 #include <stdio.h>
@@ -28,10 +28,10 @@ static int write_sections(const char *cmd, const char *path, const rad_section *
     void *dst;
     rad_result r;
     int rc = 1;
-    if ((r = rad_container_size(secs, k, out_size)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_container_size", r);
-    dst = rad_tool_calloc(*out_size, 1);
-    if ((r = rad_container_write(secs, k, dst, *out_size)) != RAD_SUCCESS) rad_tool_fail(cmd, "rad_container_write", r);
-    else if (rad_tool_write_file(path, dst, *out_size) != 0) fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+    if ((r = rad_container_size(secs, k, out_size)) != RAD_SUCCESS) return tool_fail(cmd, "rad_container_size", r);
+    dst = tool_calloc(*out_size, 1);
+    if ((r = rad_container_write(secs, k, dst, *out_size)) != RAD_SUCCESS) tool_fail(cmd, "rad_container_write", r);
+    else if (tool_write_file(path, dst, *out_size) != 0) fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
     else rc = 0;
     free(dst);
     return rc;
@@ -39,45 +39,45 @@ static int write_sections(const char *cmd, const char *path, const rad_section *
 
 /* rad_save_memory's container plus our sections, written to 'path'. rad merge (cmd_merge.c)
    writes the same sections in the same order from a sharded bake's parts: change both. */
-static int save_bake(const char *cmd, const char *path, const rad_tool_world *w, const rad_tool_classic_options *o,
-                     const rad_tool_classic *c)
+static int save_bake(const char *cmd, const char *path, const tool_world *w, const tool_classic_options *o,
+                     const tool_classic *c)
 {
     rad_context ctx;
     void *buf = NULL;
     size_t size = 0, dst_size = 0;
     rad_container *ct = NULL;
     rad_section *secs;
-    rad_tool_bake_info info;
+    tool_bake_info info;
     rad_bake_signature sig;
     uint32_t count, i, k = 0, n = c->patches->count;
     rad_result r;
     int rc = 1;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     if ((r = rad_save_memory(c->patches, &c->ff->matrix, c->E, c->B, &ctx, &buf, &size)) != RAD_SUCCESS)
-        return rad_tool_fail(cmd, "rad_save_memory", r);
-    if ((r = rad_container_open(buf, size, &ctx, &ct)) != RAD_SUCCESS) {
+        return tool_fail(cmd, "rad_save_memory", r);
+    if ((r = rad_container_create(buf, size, &ctx, &ct)) != RAD_SUCCESS) {
         rad_free_buffer(buf, &ctx);
-        return rad_tool_fail(cmd, "rad_container_open", r);
+        return tool_fail(cmd, "rad_container_create", r);
     }
     count = rad_container_section_count(ct);
-    secs = (rad_section *)rad_tool_calloc((size_t)count + 4, sizeof(rad_section));
+    secs = (rad_section *)tool_calloc((size_t)count + 4, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
-    rad_tool_bake_info_fill(&info, w, o);
-    rad_tool_sign_options(secs, k, &info, w, &sig);
+    tool_bake_info_fill(&info, w, o);
+    tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->L;
     strcpy(secs[k++].name, "L");
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->H;
     strcpy(secs[k++].name, "H");
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c->D;
     strcpy(secs[k++].name, "D");
-    secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
+    secs[k].type = TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
     if (write_sections(cmd, path, secs, k, &dst_size)) goto done;
     printf("wrote %s: %u patches, %u sections, %lu bytes\n", path, n, k, (unsigned long)dst_size);
     rc = 0;
 done:
     free(secs);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     rad_free_buffer(buf, &ctx);
     return rc;
 }
@@ -85,8 +85,8 @@ done:
 /* the bytes to 'path' (a temporary renamed into place); 0 or 1 (message printed) */
 static int write_bytes(const char *cmd, const char *path, const void *data, size_t size)
 {
-    if (rad_tool_write_file(path, data, size) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+    if (tool_write_file(path, data, size) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         return 1;
     }
     return 0;
@@ -96,14 +96,14 @@ static int write_bytes(const char *cmd, const char *path, const void *data, size
    source E = rho D at the samples (vector "E"), the scene's signature with the hash of the
    options (resolution, face points, light samples in rad.options) and rad.options itself.
    rad render --method aavp|vp (or --proxy) --bake FILE loads it instead of building. */
-static int bake_vp(const char *cmd, const char *path, const rad_tool_world *w, const rad_tool_classic_options *o,
-                   const rad_tool_method_options *mo)
+static int bake_vp(const char *cmd, const char *path, const tool_world *w, const tool_classic_options *o,
+                   const tool_method_options *mo)
 {
     rad_vp_options vo;
     rad_virtual_patches *vp = NULL;
     rad_direct_options dopt;
     rad_section secs[RAD_VP_MAX_SECTIONS + 3];
-    rad_tool_bake_info info;
+    tool_bake_info info;
     rad_bake_signature sig;
     rad_context ctx;
     rad_result r;
@@ -114,26 +114,26 @@ static int bake_vp(const char *cmd, const char *path, const rad_tool_world *w, c
     rad_vp_options_default(&vo);
     vo.resolution = mo->vp_resolution;
     vo.face_points = mo->face_points;
-    vo.kind = mo->method == RAD_TOOL_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    vo.kind = mo->method == TOOL_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
     vo.storage = RAD_STORAGE_SPARSE;
-    rad_tool_context(&ctx, "virtual patches");
+    tool_context(&ctx, "virtual patches");
     r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &vp);
-    rad_tool_progress_end();
-    if (r != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_vp_create", r);
-    E = (float *)rad_tool_calloc(3 * (size_t)vp->count, sizeof(float));
+    tool_progress_end();
+    if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_create", r);
+    E = (float *)tool_calloc(3 * (size_t)vp->count, sizeof(float));
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
     dopt.light_samples = o->light_samples;
-    rad_tool_context(&ctx, "direct light");
+    tool_context(&ctx, "direct light");
     r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
-    rad_tool_progress_end();
-    rad_tool_context(&ctx, NULL);
+    tool_progress_end();
+    tool_context(&ctx, NULL);
     if (r != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_vp_sources", r);
+        tool_fail(cmd, "rad_vp_sources", r);
         goto done;
     }
     if ((r = rad_vp_sections(vp, "vp", secs, &k)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_vp_sections", r);
+        tool_fail(cmd, "rad_vp_sections", r);
         goto done;
     }
     memset(&info, 0, sizeof info);
@@ -146,20 +146,20 @@ static int bake_vp(const char *cmd, const char *path, const rad_tool_world *w, c
     info.triangle_count = w->scene->triangle_count;
     memset(&sig, 0, sizeof sig);
     if ((r = rad_scene_hash(w->scene, &sig.geometry, &sig.materials)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_scene_hash", r);
+        tool_fail(cmd, "rad_scene_hash", r);
         goto done;
     }
-    sig.options = rad_tool_options_hash(&info, w);
+    sig.options = tool_options_hash(&info, w);
     memset(&secs[k], 0, 3 * sizeof secs[0]);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = vp->count, secs[k].data = E;
     strcpy(secs[k++].name, "E");
     secs[k].type = RAD_SECTION_SIGNATURE, secs[k].elem_size = sizeof sig, secs[k].count = 1, secs[k].data = &sig;
     strcpy(secs[k++].name, "signature");
-    secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
+    secs[k].type = TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
     if (write_sections(cmd, path, secs, k, &dst_size)) goto done;
     printf("wrote %s: %s, %u virtual patches at resolution %u, %llu non-zeros, %lu bytes\n", path,
-           rad_tool_method_name(mo->method), vp->count, mo->vp_resolution,
+           tool_method_name(mo->method), vp->count, mo->vp_resolution,
            (unsigned long long)vp->matrix.row_offsets[vp->count], (unsigned long)dst_size);
     rc = 0;
 done:
@@ -193,25 +193,25 @@ static void bake_usage(FILE *f)
                "                     N parts into the bake itself (docs/distributed.md)\n"
                "  --rows A:B         classic: bake the part holding rows A to B-1 (instead of --shard)\n"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(0), rad_tool_light_help());
+            tool_classic_help(), tool_method_help(0), tool_light_help());
 }
 
-int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_args *args)
+int tool_bake_parse(const char *cmd, int argc, char **argv, tool_bake_args *args)
 {
     int a, rc;
     memset(args, 0, sizeof *args);
-    rad_tool_classic_options_default(&args->o);
-    rad_tool_method_options_default(&args->mo);
+    tool_classic_options_default(&args->o);
+    tool_method_options_default(&args->mo);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { bake_usage(stdout); return 0; }
-        rc = rad_tool_method_option(cmd, argc, argv, &a, &args->mo);
+        rc = tool_method_option(cmd, argc, argv, &a, &args->mo);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        rc = rad_tool_classic_option(cmd, argc, argv, &a, &args->o);
+        rc = tool_classic_option(cmd, argc, argv, &a, &args->o);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        rc = rad_tool_light_option(cmd, argc, argv, &a, &args->lights);
+        rc = tool_light_option(cmd, argc, argv, &a, &args->lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--shard") || !strcmp(opt, "--rows")) &&
@@ -221,11 +221,11 @@ int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_ar
         }
         if (!strcmp(opt, "-o")) args->out = argv[++a];
         else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_threads(cmd, opt, argv[++a], &args->threads)) return 2;
+            if (tool_parse_threads(cmd, opt, argv[++a], &args->threads)) return 2;
         } else if (!strcmp(opt, "--shard")) {
-            if (rad_tool_parse_shard(cmd, argv[++a], &args->shard)) return 2;
+            if (tool_parse_shard(cmd, argv[++a], &args->shard)) return 2;
         } else if (!strcmp(opt, "--rows")) {
-            if (rad_tool_parse_rows(cmd, argv[++a], &args->shard)) return 2;
+            if (tool_parse_rows(cmd, argv[++a], &args->shard)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad bake --help)\n", cmd, opt);
             return 2;
@@ -241,63 +241,63 @@ int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_ar
         fprintf(stderr, "rad %s: --shard and --rows both choose the part: give one\n", cmd);
         return 2;
     }
-    if ((args->shard.rows || args->shard.count) && args->mo.method != RAD_TOOL_CLASSIC) {
+    if ((args->shard.rows || args->shard.count) && args->mo.method != TOOL_CLASSIC) {
         fprintf(stderr, "rad %s: --shard and --rows split the classic bake's form factors; --method %s builds on the "
                         "whole matrix (merge a classic bake, or bake it on one machine)\n",
-                cmd, rad_tool_method_name(args->mo.method));
+                cmd, tool_method_name(args->mo.method));
         return 2;
     }
-    if (rad_tool_method_check(cmd, 0, &args->mo, &args->o)) return 2;
-    rad_tool_dense_plan(&args->o, &args->mo, 1);
+    if (tool_method_check(cmd, 0, &args->mo, &args->o)) return 2;
+    tool_dense_plan(&args->o, &args->mo, 1);
     return -1;
 }
 
-static int bake_main(const char *cmd, rad_tool_bake_args *args)
+static int bake_main(const char *cmd, tool_bake_args *args)
 {
-    rad_tool_world w;
-    rad_tool_classic c;
-    double t0 = rad_tool_seconds();
+    tool_world w;
+    tool_classic c;
+    double t0 = tool_seconds();
     int rc;
-    if (rad_tool_check_output(cmd, args->out, &args->scene, 1)) return 1;
-    rad_tool_set_threads((int)args->threads);
-    if (rad_tool_open_world_lit(cmd, args->scene, &args->lights, &w)) return 1;
-    if (args->mo.method == RAD_TOOL_VP || args->mo.method == RAD_TOOL_AAVP) {
+    if (tool_check_output(cmd, args->out, &args->scene, 1)) return 1;
+    tool_set_threads((int)args->threads);
+    if (tool_open_world_lit(cmd, args->scene, &args->lights, &w)) return 1;
+    if (args->mo.method == TOOL_VP || args->mo.method == TOOL_AAVP) {
         rc = bake_vp(cmd, args->out, &w, &args->o, &args->mo);
-        rad_tool_close_world(&w);
-        if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+        tool_close_world(&w);
+        if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, tool_seconds() - t0);
         return rc;
     }
-    if (args->mo.method != RAD_TOOL_CLASSIC || args->shard.rows || args->shard.count) {
+    if (args->mo.method != TOOL_CLASSIC || args->shard.rows || args->shard.count) {
         void *buf = NULL;
         size_t size = 0;
-        if (args->mo.method != RAD_TOOL_CLASSIC) rc = rad_tool_method_bake(cmd, &w, &args->o, &args->mo, &buf, &size);
-        else rc = rad_tool_bake_part(cmd, &w, &args->o, &args->shard, &buf, &size);
+        if (args->mo.method != TOOL_CLASSIC) rc = tool_method_bake(cmd, &w, &args->o, &args->mo, &buf, &size);
+        else rc = tool_bake_part(cmd, &w, &args->o, &args->shard, &buf, &size);
         if (rc == 0) rc = write_bytes(cmd, args->out, buf, size);
         if (rc == 0)
             printf("wrote %s: %s, %lu bytes\n", args->out,
-                   args->mo.method != RAD_TOOL_CLASSIC ? rad_tool_method_name(args->mo.method) : "a part of a classic bake",
+                   args->mo.method != TOOL_CLASSIC ? tool_method_name(args->mo.method) : "a part of a classic bake",
                    (unsigned long)size);
         free(buf);
-        rad_tool_close_world(&w);
-        if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+        tool_close_world(&w);
+        if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, tool_seconds() - t0);
         return rc;
     }
-    if (rad_tool_classic_solve(cmd, &w, &args->o, &c)) {
-        rad_tool_close_world(&w);
+    if (tool_classic_solve(cmd, &w, &args->o, &c)) {
+        tool_close_world(&w);
         return 1;
     }
     rc = save_bake(cmd, args->out, &w, &args->o, &c);
-    rad_tool_classic_free(&c);
-    rad_tool_close_world(&w);
-    if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    tool_classic_free(&c);
+    tool_close_world(&w);
+    if (rc == 0) fprintf(stderr, "rad %s: done in %.2f s\n", cmd, tool_seconds() - t0);
     return rc;
 }
 
-int rad_cmd_bake(int argc, char **argv)
+int tool_cmd_bake(int argc, char **argv)
 {
-    rad_tool_bake_args args;
-    int rc = rad_tool_bake_parse("bake", argc, argv, &args);
+    tool_bake_args args;
+    int rc = tool_bake_parse("bake", argc, argv, &args);
     if (rc < 0) rc = bake_main("bake", &args);
-    rad_tool_lights_free(&args.lights);
+    tool_lights_free(&args.lights);
     return rc;
 }

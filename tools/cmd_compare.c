@@ -18,7 +18,7 @@
 #include <string.h>
 
 /* how many values of img are NaN / infinite; the first such pixel in *first (-1: none) */
-static void count_nonfinite(const rad_image *img, size_t *nan, size_t *inf, long *first)
+static void count_nonfinite(const tool_image *img, size_t *nan, size_t *inf, long *first)
 {
     size_t k, n = (size_t)img->width * (size_t)img->height * 3u;
     *nan = *inf = 0;
@@ -33,7 +33,7 @@ static void count_nonfinite(const rad_image *img, size_t *nan, size_t *inf, long
 }
 
 /* prints one line when img has NaN or infinite values; returns 1 then */
-static double mean_radiance(const rad_image *img)
+static double mean_radiance(const tool_image *img)
 {
     size_t k, n = (size_t)img->width * (size_t)img->height * 3u, m = 0;
     double sum = 0.0;
@@ -42,7 +42,7 @@ static double mean_radiance(const rad_image *img)
     return m ? sum / (double)m : 0.0;
 }
 
-static int report_nonfinite(const char *name, const char *path, const rad_image *img)
+static int report_nonfinite(const char *name, const char *path, const tool_image *img)
 {
     size_t nan, inf;
     long first;
@@ -72,11 +72,11 @@ static void compare_usage(FILE *f)
                "  'nonfinite' line), or the images cannot be read or differ in size\n");
 }
 
-int rad_cmd_compare(int argc, char **argv)
+int tool_cmd_compare(int argc, char **argv)
 {
     const char *pa = NULL, *pb = NULL, *diff = NULL, *png = NULL;
     float scale = 0.0f, exposure = 1.0f, png_exposure = 0.0f; /* 0: the same as exposure */
-    rad_image a = { 0, 0, NULL }, b = { 0, 0, NULL };
+    tool_image a = { 0, 0, NULL }, b = { 0, 0, NULL };
     char err[512];
     double mse, psnr, ssim;
     int i, bad;
@@ -144,24 +144,24 @@ int rad_cmd_compare(int argc, char **argv)
         const char *inputs[2];
         inputs[0] = pa;
         inputs[1] = pb;
-        if ((diff && rad_tool_check_output("compare", diff, inputs, 2)) ||
-            (png && rad_tool_check_output("compare", png, inputs, 2)))
+        if ((diff && tool_check_output("compare", diff, inputs, 2)) ||
+            (png && tool_check_output("compare", png, inputs, 2)))
             return 1;
     }
-    if (rad_image_read(pa, &a, err, sizeof(err)) != 0) {
+    if (tool_image_read(pa, &a, err, sizeof(err)) != 0) {
         fprintf(stderr, "rad compare: %s\n", err);
         return 1;
     }
-    if (rad_image_read(pb, &b, err, sizeof(err)) != 0) {
+    if (tool_image_read(pb, &b, err, sizeof(err)) != 0) {
         fprintf(stderr, "rad compare: %s\n", err);
-        rad_image_free(&a);
+        tool_image_free(&a);
         return 1;
     }
     if (a.width != b.width || a.height != b.height) {
         fprintf(stderr, "rad compare: the images differ in size: %s is %dx%d, %s is %dx%d\n", pa, a.width, a.height,
                 pb, b.width, b.height);
-        rad_image_free(&a);
-        rad_image_free(&b);
+        tool_image_free(&a);
+        tool_image_free(&b);
         return 1;
     }
     bad = report_nonfinite("A", pa, &a);
@@ -170,9 +170,9 @@ int rad_cmd_compare(int argc, char **argv)
         size_t k, n = (size_t)a.width * (size_t)a.height * 3u;
         for (k = 0; k < n; ++k) a.rgb[k] *= exposure, b.rgb[k] *= exposure;
     }
-    mse = rad_image_mse(&a, &b);
-    psnr = rad_image_psnr(&a, &b);
-    ssim = rad_image_ssim(&a, &b);
+    mse = tool_image_mse(&a, &b);
+    psnr = tool_image_psnr(&a, &b);
+    ssim = tool_image_ssim(&a, &b);
     printf("A: %s\nB: %s\nsize: %dx%d\n", pa, pb, a.width, a.height);
     if (exposure != 1.0f)
         printf("values: linear times --exposure %g, clamped to [0,1] (PNG decoded from sRGB); peak L = 1\n", (double)exposure);
@@ -200,7 +200,7 @@ int rad_cmd_compare(int argc, char **argv)
         printf("max |A-B|: %.9g (linear, before clamping)\n", top);
     }
     if (diff) {
-        rad_image heat = { 0, 0, NULL };
+        tool_image heat = { 0, 0, NULL };
         if (!(scale > 0.0f)) {
             size_t k, n = (size_t)a.width * (size_t)a.height;
             double top = 0.0;
@@ -217,34 +217,34 @@ int rad_cmd_compare(int argc, char **argv)
             }
             scale = top > 0.0 ? (float)top : 1.0f;
         }
-        if (rad_image_diff_heatmap(&a, &b, scale, &heat) != 0) {
+        if (tool_image_diff_heatmap(&a, &b, scale, &heat) != 0) {
             fprintf(stderr, "rad compare: out of memory for the difference image '%s'\n", diff);
-            rad_image_free(&heat);
-            rad_image_free(&a);
-            rad_image_free(&b);
+            tool_image_free(&heat);
+            tool_image_free(&a);
+            tool_image_free(&b);
             return 1;
         }
-        if (rad_image_write(diff, &heat, 1.0f) != 0) {
-            fprintf(stderr, "rad compare: the difference image: %s\n", rad_tool_output_error());
-            rad_image_free(&heat);
-            rad_image_free(&a);
-            rad_image_free(&b);
+        if (tool_image_write(diff, &heat, 1.0f) != 0) {
+            fprintf(stderr, "rad compare: the difference image: %s\n", tool_output_error());
+            tool_image_free(&heat);
+            tool_image_free(&a);
+            tool_image_free(&b);
             return 1;
         }
         printf("diff: %s (mean |A-B| over RGB; white = %.6g)\n", diff, (double)scale);
-        rad_image_free(&heat);
+        tool_image_free(&heat);
     }
     if (png) {
         /* a holds A times exposure already */
-        if (rad_image_write_png(png, &a, png_exposure > 0.0f ? png_exposure / exposure : 1.0f) != 0) {
-            fprintf(stderr, "rad compare: %s\n", rad_tool_output_error());
-            rad_image_free(&a);
-            rad_image_free(&b);
+        if (tool_image_write_png(png, &a, png_exposure > 0.0f ? png_exposure / exposure : 1.0f) != 0) {
+            fprintf(stderr, "rad compare: %s\n", tool_output_error());
+            tool_image_free(&a);
+            tool_image_free(&b);
             return 1;
         }
         printf("png: %s (A, exposure %g)\n", png, (double)(png_exposure > 0.0f ? png_exposure : exposure));
     }
-    rad_image_free(&a);
-    rad_image_free(&b);
+    tool_image_free(&a);
+    tool_image_free(&b);
     return bad ? 1 : 0;
 }

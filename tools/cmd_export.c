@@ -11,7 +11,7 @@
    digits, which a float reads back exactly. What OBJ cannot hold is reported on stderr and
    left out: the scene's camera (written as a comment, with the --camera/--fov options that
    restore it), analytic lights, and albedo textures (the material's colour factor is written).
-   Both files go through rad_tool_output_* (a temporary renamed into place), and neither may
+   Both files go through tool_output_* (a temporary renamed into place), and neither may
    be the scene or one of the MTL files it names. */
 #include "tool.h"
 #include <ctype.h>
@@ -75,14 +75,14 @@ static void write_rgb(FILE *f, const char *key, const float *v)
     fprintf(f, "%s %.9g %.9g %.9g\n", key, (double)v[0], (double)v[1], (double)v[2]);
 }
 
-int rad_cmd_export(int argc, char **argv)
+int tool_cmd_export(int argc, char **argv)
 {
     const char *cmd = "export", *scene_name = NULL, *out_path = NULL;
     char err[1024], mtl_path[4096], mtllibs[EXPORT_MAX_MTLLIB][1024], name[256];
     const char *inputs[EXPORT_MAX_MTLLIB + 1];
     const char *mtl_base;
-    rad_tool_scene ts;
-    rad_tool_output obj, mtl;
+    tool_scene ts;
+    tool_output obj, mtl;
     const rad_scene_desc *d;
     uint32_t m, t, k, textured = 0, written_tris = 0;
     uint64_t base = 1; /* OBJ indices count from 1 over the whole file */
@@ -119,23 +119,23 @@ int rad_cmd_export(int argc, char **argv)
     nlib = strcmp(scene_name, "cornell") ? obj_mtllibs(scene_name, mtllibs, EXPORT_MAX_MTLLIB) : 0;
     inputs[0] = scene_name;
     for (i = 0; i < nlib; ++i) inputs[1 + i] = mtllibs[i];
-    if (rad_tool_check_output(cmd, out_path, inputs, 1 + nlib) || rad_tool_check_output(cmd, mtl_path, inputs, 1 + nlib))
+    if (tool_check_output(cmd, out_path, inputs, 1 + nlib) || tool_check_output(cmd, mtl_path, inputs, 1 + nlib))
         return 1;
 
-    if (rad_tool_load_scene(scene_name, &ts, err, sizeof err) != 0) {
+    if (tool_load_scene(scene_name, &ts, err, sizeof err) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, err);
         return 1;
     }
     d = &ts.desc;
-    if (rad_tool_output_open(&mtl, mtl_path) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
-        rad_tool_free_scene(&ts);
+    if (tool_output_open(&mtl, mtl_path) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+        tool_free_scene(&ts);
         return 1;
     }
-    if (rad_tool_output_open(&obj, out_path) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
-        rad_tool_output_abort(&mtl);
-        rad_tool_free_scene(&ts);
+    if (tool_output_open(&obj, out_path) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+        tool_output_abort(&mtl);
+        tool_free_scene(&ts);
         return 1;
     }
 
@@ -185,15 +185,15 @@ int rad_cmd_export(int argc, char **argv)
         base += md->vertex_count;
     }
     ok = !ferror(obj.f) && !ferror(mtl.f);
-    if (rad_tool_output_commit(&mtl, ok) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
-        rad_tool_output_abort(&obj);
-        rad_tool_free_scene(&ts);
+    if (tool_output_commit(&mtl, ok) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+        tool_output_abort(&obj);
+        tool_free_scene(&ts);
         return 1;
     }
-    if (rad_tool_output_commit(&obj, ok) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
-        rad_tool_free_scene(&ts);
+    if (tool_output_commit(&obj, ok) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+        tool_free_scene(&ts);
         return 1;
     }
     if (ts.light_count)
@@ -203,6 +203,6 @@ int rad_cmd_export(int argc, char **argv)
                 cmd, textured);
     printf("wrote %s and %s (%u meshes, %u triangles, %u materials)\n", out_path, mtl_path, d->mesh_count, written_tris,
            d->material_count);
-    rad_tool_free_scene(&ts);
+    tool_free_scene(&ts);
     return 0;
 }

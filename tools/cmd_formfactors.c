@@ -24,13 +24,13 @@ static void formfactors_usage(FILE *f)
 
 /* ---- formfactors ----------------------------------------------------------------------- */
 
-int rad_cmd_formfactors(int argc, char **argv)
+int tool_cmd_formfactors(int argc, char **argv)
 {
     const char *scene_name = NULL, *cmd = "formfactors";
     uint32_t patches_target = 2000, samples = 16, threads = 0, G, H, i, j, gc, hemicube_res = 0;
     rad_ff_method ff_method = RAD_FF_ANALYTIC;
     float max_edge = 0.0f;
-    rad_tool_world w;
+    tool_world w;
     rad_patches *P = NULL;
     rad_form_factors *ff = NULL;
     rad_patch_options po;
@@ -39,8 +39,8 @@ int rad_cmd_formfactors(int argc, char **argv)
     rad_result r;
     double *num, *den;
     int a;
-    rad_tool_classic_options budget;
-    rad_tool_classic_options_default(&budget);
+    tool_classic_options budget;
+    tool_classic_options_default(&budget);
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
         int need = !strcmp(o, "--patches") || !strcmp(o, "--samples") || !strcmp(o, "--threads") || !strcmp(o, "--max-edge") ||
@@ -49,15 +49,15 @@ int rad_cmd_formfactors(int argc, char **argv)
         if (!strcmp(o, "--force")) { budget.force = 1; continue; }
         if (!strcmp(o, "--max-memory")) {
             if (a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
-            if (rad_tool_parse_bytes(cmd, o, argv[++a], &budget.max_memory)) return 2;
+            if (tool_parse_bytes(cmd, o, argv[++a], &budget.max_memory)) return 2;
             continue;
         }
         if (need && a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
-        if (!strcmp(o, "--patches")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
-        else if (!strcmp(o, "--samples")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
-        else if (!strcmp(o, "--threads")) { if (rad_tool_parse_threads(cmd, o, argv[++a], &threads)) return 2; }
-        else if (!strcmp(o, "--max-edge")) { if (rad_tool_parse_float(cmd, o, argv[++a], &max_edge)) return 2; }
-        else if (!strcmp(o, "--hemicube-res")) { if (rad_tool_parse_uint(cmd, o, argv[++a], &hemicube_res)) return 2; }
+        if (!strcmp(o, "--patches")) { if (tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
+        else if (!strcmp(o, "--samples")) { if (tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
+        else if (!strcmp(o, "--threads")) { if (tool_parse_threads(cmd, o, argv[++a], &threads)) return 2; }
+        else if (!strcmp(o, "--max-edge")) { if (tool_parse_float(cmd, o, argv[++a], &max_edge)) return 2; }
+        else if (!strcmp(o, "--hemicube-res")) { if (tool_parse_uint(cmd, o, argv[++a], &hemicube_res)) return 2; }
         else if (!strcmp(o, "--ff")) {
             const char *m = argv[++a];
             if (!strcmp(m, "analytic")) ff_method = RAD_FF_ANALYTIC;
@@ -71,37 +71,37 @@ int rad_cmd_formfactors(int argc, char **argv)
     }
     if (!scene_name) { fprintf(stderr, "rad %s: no scene given\n", cmd); formfactors_usage(stderr); return 2; }
     if (samples == 0 || max_edge < 0.0f) { fprintf(stderr, "rad %s: --samples must be > 0, --max-edge >= 0\n", cmd); return 2; }
-    rad_tool_set_threads((int)threads);
+    tool_set_threads((int)threads);
     budget.samples = samples;
-    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
-    if (rad_tool_dense_check(cmd, &budget, w.scene->triangle_count, 1)) {
-        rad_tool_close_world(&w);
+    if (tool_open_world(cmd, scene_name, &w)) return 1;
+    if (tool_dense_check(cmd, &budget, w.scene->triangle_count, 1)) {
+        tool_close_world(&w);
         return 1;
     }
-    rad_tool_context(&ctx, "form factors");
+    tool_context(&ctx, "form factors");
     rad_patch_options_default(&po);
     po.target_count = patches_target;
     po.max_edge = max_edge;
     if ((r = rad_patches_create(w.scene, &po, &ctx, &P)) != RAD_SUCCESS) {
-        rad_tool_close_world(&w);
-        return rad_tool_fail(cmd, "rad_patches_create", r);
+        tool_close_world(&w);
+        return tool_fail(cmd, "rad_patches_create", r);
     }
     rad_form_factor_options_default(&fo);
     fo.samples = samples;
     fo.method = ff_method;
     if (hemicube_res) fo.hemicube_resolution = hemicube_res;
     fprintf(stderr, "rad %s: %u triangles, %u patches\n", cmd, w.scene->triangle_count, P->count);
-    if (rad_tool_dense_check(cmd, &budget, P->count, 0)) {
+    if (tool_dense_check(cmd, &budget, P->count, 0)) {
         rad_patches_destroy(P);
-        rad_tool_close_world(&w);
+        tool_close_world(&w);
         return 1;
     }
     r = rad_form_factors_dense(P, &w.rc, &fo, &ctx, &ff);
-    rad_tool_progress_end();
+    tool_progress_end();
     if (r != RAD_SUCCESS) {
         rad_patches_destroy(P);
-        rad_tool_close_world(&w);
-        return rad_tool_fail(cmd, "rad_form_factors_dense", r);
+        tool_close_world(&w);
+        return tool_fail(cmd, "rad_form_factors_dense", r);
     }
     gc = w.scene->mesh_count;
     num = (double *)calloc((size_t)gc * gc, sizeof(double));
@@ -124,6 +124,6 @@ int rad_cmd_formfactors(int argc, char **argv)
     free(den);
     rad_form_factors_destroy(ff);
     rad_patches_destroy(P);
-    rad_tool_close_world(&w);
+    tool_close_world(&w);
     return 0;
 }

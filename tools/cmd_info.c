@@ -1,5 +1,5 @@
 /* cmd_info.c - `rad info FILE.radb`: what a baked-data container holds, after checking it
-   (rad_container_open validates every size, offset and checksum; rad_load_memory every
+   (rad_container_create validates every size, offset and checksum; rad_load_memory every
    index). A damaged file gives the loader's error and detail and exit code 1. */
 #include "tool.h"
 #include <math.h>
@@ -13,9 +13,9 @@ static const char *type_name(uint32_t type)
 {
     const char *name;
     switch (type) {
-    case RAD_TOOL_SECTION_OPTIONS: return "USER(rad options)";
-    case RAD_TOOL_SECTION_METHOD: return "USER(rad method)";
-    case RAD_TOOL_SECTION_ROWSUMS: return "USER(row sums)";
+    case TOOL_SECTION_OPTIONS: return "USER(rad options)";
+    case TOOL_SECTION_METHOD: return "USER(rad method)";
+    case TOOL_SECTION_ROWSUMS: return "USER(row sums)";
     default: name = rad_section_type_name(type); return name ? name : "UNKNOWN";
     }
 }
@@ -24,21 +24,21 @@ static const char *type_name(uint32_t type)
    0, or 1 when they do not open (message printed). */
 static int method_info(const rad_container *ct, const rad_context *ctx)
 {
-    const rad_section *s = rad_container_find(ct, RAD_TOOL_SECTION_METHOD, "rad.method");
-    rad_tool_method_info mi;
+    const rad_section *s = rad_container_find(ct, TOOL_SECTION_METHOD, "rad.method");
+    tool_method_info mi;
     rad_result r = RAD_SUCCESS;
     uint64_t bytes;
     uint32_t i;
     if (!s || s->elem_size != sizeof mi || s->count != 1) return 0;
     memcpy(&mi, s->data, sizeof mi);
-    if (mi.magic != RAD_TOOL_METHOD_MAGIC ||
-        (mi.method != RAD_TOOL_MULTIBOUNCE && mi.method != RAD_TOOL_TEMPORAL && mi.method != RAD_TOOL_STOCHASTIC &&
-         mi.method != RAD_TOOL_HIERARCHICAL)) {
+    if (mi.magic != TOOL_METHOD_MAGIC ||
+        (mi.method != TOOL_MULTIBOUNCE && mi.method != TOOL_TEMPORAL && mi.method != TOOL_STOCHASTIC &&
+         mi.method != TOOL_HIERARCHICAL)) {
         fprintf(stderr, "rad info: the rad.method section is damaged\n");
         return 1;
     }
     bytes = (uint64_t)mi.bytes_lo | ((uint64_t)mi.bytes_hi << 32);
-    if (mi.method == RAD_TOOL_HIERARCHICAL) { /* the record's fields as methods.c fills them for this method */
+    if (mi.method == TOOL_HIERARCHICAL) { /* the record's fields as methods.c fills them for this method */
         const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
         printf("method: hierarchical, --hr-eps %g\n"
                "  solution 'L' (rho H resampled onto the patches): %s, %u leaves, %llu links, %u rounds, solved in %.2f s\n",
@@ -50,7 +50,7 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
         }
         return 0;
     }
-    if (mi.method == RAD_TOOL_STOCHASTIC) { /* the record's fields as methods.c fills them for this method */
+    if (mi.method == TOOL_STOCHASTIC) { /* the record's fields as methods.c fills them for this method */
         const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
         printf("method: stochastic, --sr-estimator %s, --sr-rays %u, --sr-iterations %u, --seed %u\n"
                "  solution 'L': %s, %llu rays, solved in %.2f s\n",
@@ -62,7 +62,7 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
         }
         return 0;
     }
-    if (mi.method == RAD_TOOL_MULTIBOUNCE) {
+    if (mi.method == TOOL_MULTIBOUNCE) {
         static const char *const fmt[] = {"float", "half", "bc1", "bc4x3"};
         rad_multibounce *mb = NULL;
         rad_multibounce_blocks *bl = NULL;
@@ -99,7 +99,7 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
         printf(", %llu bytes, built in %.2f s\n", (unsigned long long)bytes, (double)mi.build_seconds);
     }
     if (r != RAD_SUCCESS) {
-        fprintf(stderr, "rad info: the %s data does not open: %s\n", mi.method == RAD_TOOL_MULTIBOUNCE ? "multibounce" : "temporal",
+        fprintf(stderr, "rad info: the %s data does not open: %s\n", mi.method == TOOL_MULTIBOUNCE ? "multibounce" : "temporal",
                 rad_result_string(r));
         return 1;
     }
@@ -115,7 +115,7 @@ static void info_usage(FILE *f)
                "for damaged files.\n");
 }
 
-int rad_cmd_info(int argc, char **argv)
+int tool_cmd_info(int argc, char **argv)
 {
     const char *cmd = "info", *path = NULL;
     FILE *f;
@@ -131,7 +131,7 @@ int rad_cmd_info(int argc, char **argv)
         if (!strcmp(argv[a], "--help") || !strcmp(argv[a], "-h")) { info_usage(stdout); return 0; }
         if (!strcmp(argv[a], "--threads") && a + 1 < argc) {
             uint32_t t;
-            if (rad_tool_parse_threads(cmd, argv[a], argv[a + 1], &t)) return 2;
+            if (tool_parse_threads(cmd, argv[a], argv[a + 1], &t)) return 2;
             ++a;
             continue;
         }
@@ -155,8 +155,8 @@ int rad_cmd_info(int argc, char **argv)
         return 1;
     }
     fclose(f);
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_container_open(data, (size_t)len, &ctx, &ct)) != RAD_SUCCESS) {
+    tool_context(&ctx, NULL);
+    if ((r = rad_container_create(data, (size_t)len, &ctx, &ct)) != RAD_SUCCESS) {
         fprintf(stderr, "rad %s: '%s' is not a valid bake: %s\n", cmd, path, rad_result_string(r));
         free(data);
         return 1;
@@ -179,14 +179,14 @@ int rad_cmd_info(int argc, char **argv)
             printf("virtual patches '%s': %s, %u patches in %u voxels (grid %u x %u x %u), %u samples, form factors %s\n",
                    vi->name, rec[0] == (uint32_t)RAD_VP_CLUSTERED ? "clustered (vp)" : "axis-aligned (aavp)", rec[2],
                    rec[3], rec[5], rec[6], rec[7], rec[4], rows ? "sparse (CSR)" : "dense");
-            rad_container_close(ct);
+            rad_container_destroy(ct);
             free(data);
             return 0;
         }
     }
     if ((r = rad_load_memory(data, (size_t)len, &ctx, &bake)) != RAD_SUCCESS) {
         fprintf(stderr, "rad %s: '%s' holds sections but not a valid bake: %s\n", cmd, path, rad_result_string(r));
-        rad_container_close(ct);
+        rad_container_destroy(ct);
         free(data);
         return 1;
     }
@@ -216,11 +216,11 @@ int rad_cmd_info(int argc, char **argv)
     else
         printf("signature: none (a bake of another scene with the same triangle count cannot be told apart)\n");
     {
-        const rad_section *s = rad_container_find(ct, RAD_TOOL_SECTION_OPTIONS, "rad.options");
-        if (s && s->elem_size == sizeof(rad_tool_bake_info) && s->count == 1) {
-            rad_tool_bake_info info;
+        const rad_section *s = rad_container_find(ct, TOOL_SECTION_OPTIONS, "rad.options");
+        if (s && s->elem_size == sizeof(tool_bake_info) && s->count == 1) {
+            tool_bake_info info;
             memcpy(&info, s->data, sizeof info);
-            if (info.magic == 0x52414442u && rad_container_find(ct, RAD_TOOL_SECTION_METHOD, "rad.method"))
+            if (info.magic == 0x52414442u && rad_container_find(ct, TOOL_SECTION_METHOD, "rad.method"))
                 printf("baked with: --patches %u --max-edge %g --samples %u --light-samples %u (scene of %u triangles)\n",
                        info.patches, (double)info.max_edge, info.samples, info.light_samples, info.triangle_count);
             else if (info.magic == 0x52414442u)
@@ -233,13 +233,13 @@ int rad_cmd_info(int argc, char **argv)
     }
     if (method_info(ct, &ctx)) {
         rad_bake_destroy(bake);
-        rad_container_close(ct);
+        rad_container_destroy(ct);
         free(data);
         return 1;
     }
     printf("checksums: all OK\n");
     rad_bake_destroy(bake);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(data);
     return 0;
 }

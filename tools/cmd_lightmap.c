@@ -43,7 +43,7 @@ static void lightmap_usage(FILE *f)
                "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
                "                        the radiance of a white surface)\n"
                "  --threads N           worker threads (default: all cores)\n"
-               "%s", rad_tool_classic_help());
+               "%s", tool_classic_help());
 }
 
 /* a path with 'tag' inserted before the extension: a.pfm -> a.L00.pfm */
@@ -51,7 +51,7 @@ static char *lightmap_tagged(const char *path, const char *tag)
 {
     const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
     size_t stem = (dot && (!slash || dot > slash)) ? (size_t)(dot - path) : strlen(path);
-    char *out = (char *)rad_tool_calloc(strlen(path) + strlen(tag) + 3, 1);
+    char *out = (char *)tool_calloc(strlen(path) + strlen(tag) + 3, 1);
     memcpy(out, path, stem);
     sprintf(out + stem, ".%s%s", tag, path + stem);
     return out;
@@ -59,15 +59,15 @@ static char *lightmap_tagged(const char *path, const char *tag)
 
 /* the view shaded from an RGB irradiance lightmap: one closest hit per sample, the lightmap
    read at the hit's lightmap uv; back faces and misses are black (one-sided like rad trace) */
-static int lightmap_render(const rad_tool_world *w, const rad_lightmap *lm, const float *values, int width, int height,
+static int lightmap_render(const tool_world *w, const rad_lightmap *lm, const float *values, int width, int height,
                            int aa, const char *path, float exposure)
 {
     rad_camera cam = w->file.camera;
-    rad_image img;
+    tool_image img;
     int x, y, sx, sy, bad;
-    if (!w->file.has_camera) rad_tool_choose_camera("lightmap", w->scene, &w->rc, width, height, &cam);
+    if (!w->file.has_camera) tool_choose_camera("lightmap", w->scene, &w->rc, width, height, &cam);
     if (!(cam.fov_y_degrees > 0.0f)) cam.fov_y_degrees = 45.0f;
-    if (rad_image_alloc(&img, width, height)) { fprintf(stderr, "rad lightmap: out of memory for the view\n"); return 1; }
+    if (tool_image_alloc(&img, width, height)) { fprintf(stderr, "rad lightmap: out of memory for the view\n"); return 1; }
     for (y = 0; y < height; ++y)
         for (x = 0; x < width; ++x) {
             float acc[3] = {0.0f, 0.0f, 0.0f};
@@ -96,9 +96,9 @@ static int lightmap_render(const rad_tool_world *w, const rad_lightmap *lm, cons
                 }
             for (sx = 0; sx < 3; ++sx) img.rgb[3 * ((size_t)y * width + x) + sx] = acc[sx] / (float)(aa * aa);
         }
-    bad = rad_image_write(path, &img, exposure * 3.14159265f);
-    rad_image_free(&img);
-    if (bad) { fprintf(stderr, "rad lightmap: %s\n", rad_tool_output_error()); return 1; }
+    bad = tool_image_write(path, &img, exposure * 3.14159265f);
+    tool_image_free(&img);
+    if (bad) { fprintf(stderr, "rad lightmap: %s\n", tool_output_error()); return 1; }
     fprintf(stderr, "rad lightmap: wrote the view %s\n", path);
     return 0;
 }
@@ -109,11 +109,11 @@ static int lightmap_is_png(const char *path)
     return n >= 4 && (!strcmp(path + n - 4, ".png") || !strcmp(path + n - 4, ".PNG"));
 }
 
-void rad_tool_lightmap_bake_free(rad_tool_lightmap_baked *b)
+void tool_lightmap_bake_free(tool_lightmap_baked *b)
 {
     free(b->values);
     rad_lightmap_destroy(b->lm);
-    rad_tool_classic_free(&b->cl);
+    tool_classic_free(&b->cl);
     if (b->own_scene) {
         rad_bvh_destroy(b->w.bvh);
         rad_scene_destroy(b->w.scene);
@@ -122,11 +122,11 @@ void rad_tool_lightmap_bake_free(rad_tool_lightmap_baked *b)
     memset(b, 0, sizeof *b);
 }
 
-int rad_tool_lightmap_bake(const char *cmd, const rad_tool_world *world, const rad_tool_classic_options *co, int width,
+int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
                            int height, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
-                           int force_unwrap, int direct, rad_tool_lightmap_baked *out)
+                           int force_unwrap, int direct, tool_lightmap_baked *out)
 {
-    rad_tool_world w2 = *world;
+    tool_world w2 = *world;
     rad_lightmap_options lo;
     rad_lightmap_gather_options go;
     rad_lightmap_seam_stats st;
@@ -136,14 +136,14 @@ int rad_tool_lightmap_bake(const char *cmd, const rad_tool_world *world, const r
     double t0;
     rad_mesh_desc mesh;
     rad_scene_desc desc;
-    const rad_tool_world *w = world;
+    const tool_world *w = world;
     memset(out, 0, sizeof *out);
     /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
     if (force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
         if (!force_unwrap && w->scene->lightmap_uvs)
             fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
-        out->uvs = (float *)rad_tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
-        if (rad_tool_unwrap(w->scene, (uint32_t)width, (uint32_t)height, out->uvs, NULL)) goto fail;
+        out->uvs = (float *)tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
+        if (tool_unwrap(w->scene, (uint32_t)width, (uint32_t)height, out->uvs, NULL)) goto fail;
         memset(&mesh, 0, sizeof mesh);
         mesh.name = "unwrapped";
         mesh.positions = w->scene->positions;
@@ -159,26 +159,26 @@ int rad_tool_lightmap_bake(const char *cmd, const rad_tool_world *world, const r
         w2.bvh = NULL;
         out->own_scene = 1;
         out->w = w2;
-        rad_tool_context(&ctx, NULL);
-        if ((r = rad_scene_create(&desc, &ctx, &out->w.scene)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_scene_create", r); goto fail; }
-        if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_bvh_create", r); goto fail; }
+        tool_context(&ctx, NULL);
+        if ((r = rad_scene_create(&desc, &ctx, &out->w.scene)) != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); goto fail; }
+        if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { tool_fail(cmd, "rad_bvh_create", r); goto fail; }
         rad_bvh_raycaster(out->w.bvh, &out->w.rc);
     } else {
         out->w = w2;
         fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
     }
     w = &out->w;
-    if (rad_tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
+    if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
     /* the gather wants the total radiosity of the secondary sources: B = E + L */
-    t0 = rad_tool_seconds();
+    t0 = tool_seconds();
     rad_lightmap_options_default(&lo);
     lo.width = (uint32_t)width;
     lo.height = (uint32_t)height;
     lo.samples = texel_samples;
-    rad_tool_context(&ctx, "lightmap texels");
+    tool_context(&ctx, "lightmap texels");
     r = rad_lightmap_create(w->scene, &w->rc, &lo, &ctx, &out->lm);
-    rad_tool_progress_end();
-    if (r != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_create", r); goto fail; }
+    tool_progress_end();
+    if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_create", r); goto fail; }
     fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
             out->lm->width, out->lm->height, out->lm->covered_texels, out->lm->valid_texels, out->lm->invalid_samples,
             out->lm->sample_count);
@@ -193,40 +193,40 @@ int rad_tool_lightmap_bake(const char *cmd, const rad_tool_world *world, const r
     if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
         fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, hemi_rays);
     ch = rad_lightmap_channels(go.encoding);
-    out->values = (float *)rad_tool_calloc((size_t)width * height * ch, sizeof(float));
-    rad_tool_context(&ctx, "lightmap gather");
+    out->values = (float *)tool_calloc((size_t)width * height * ch, sizeof(float));
+    tool_context(&ctx, "lightmap gather");
     r = rad_lightmap_gather(out->lm, out->cl.patches, out->cl.B, &w->rc, &go, out->values, &ctx);
-    rad_tool_progress_end();
-    if (r != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
+    tool_progress_end();
+    if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
     if (direct && !sh) {
         rad_direct_options dopt;
         rad_direct_options_default(&dopt);
         dopt.include_emitters = 1;
         dopt.light_samples = co->light_samples;
-        rad_tool_context(&ctx, "lightmap direct");
+        tool_context(&ctx, "lightmap direct");
         r = rad_lightmap_direct(out->lm, &w->rc, w->file.lights, w->file.light_count, &dopt, out->values, &ctx);
-        rad_tool_progress_end();
-        if (r != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_direct", r); goto fail; }
+        tool_progress_end();
+        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_direct", r); goto fail; }
     }
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_lightmap_dilate(out->lm, ch, out->values, 0, &ctx)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_dilate", r); goto fail; }
-    if ((r = rad_lightmap_stitch(out->lm, ch, out->values, 0, &st, &ctx)) != RAD_SUCCESS) { rad_tool_fail(cmd, "rad_lightmap_stitch", r); goto fail; }
+    tool_context(&ctx, NULL);
+    if ((r = rad_lightmap_dilate(out->lm, ch, out->values, 0, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_dilate", r); goto fail; }
+    if ((r = rad_lightmap_stitch(out->lm, ch, out->values, 0, &st, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_stitch", r); goto fail; }
     fprintf(stderr, "rad %s: lightmap baked in %.2f s; %u seams, largest jump %.4g before stitching, %.4g after\n", cmd,
-            rad_tool_seconds() - t0, st.seams, (double)st.max_jump_before, (double)st.max_jump_after);
+            tool_seconds() - t0, st.seams, (double)st.max_jump_before, (double)st.max_jump_after);
     return 0;
 fail:
-    rad_tool_lightmap_bake_free(out);
+    tool_lightmap_bake_free(out);
     return 1;
 }
 
-int rad_cmd_lightmap(int argc, char **argv)
+int tool_cmd_lightmap(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
     int rw = 256, rh = 256;
     uint32_t aa = 2;
-    rad_tool_classic_options co;
-    rad_tool_world w;
-    rad_tool_lightmap_baked bk;
+    tool_classic_options co;
+    tool_world w;
+    tool_lightmap_baked bk;
     const rad_lightmap *lm = NULL;
     int width = 256, height = 256, sh = 0, force_unwrap = 0, a, code = 1;
     uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
@@ -234,7 +234,7 @@ int rad_cmd_lightmap(int argc, char **argv)
     const float *values = NULL;
     float exposure = 0.31830988f;
     memset(&bk, 0, sizeof bk);
-    rad_tool_classic_options_default(&co);
+    tool_classic_options_default(&co);
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
         int k;
@@ -242,7 +242,7 @@ int rad_cmd_lightmap(int argc, char **argv)
             lightmap_usage(stdout);
             return 0;
         }
-        if ((k = rad_tool_classic_option("lightmap", argc, argv, &a, &co)) != 0) {
+        if ((k = tool_classic_option("lightmap", argc, argv, &a, &co)) != 0) {
             if (k == 2) return 2;
             continue;
         }
@@ -255,20 +255,20 @@ int rad_cmd_lightmap(int argc, char **argv)
         if (!strcmp(o, "-o")) out_path = argv[++a];
         else if (!strcmp(o, "--render")) render_path = argv[++a];
         else if (!strcmp(o, "--render-size")) {
-            if (rad_tool_parse_size(argv[++a], &rw, &rh) || rad_tool_check_size("lightmap", rw, rh)) {
+            if (tool_parse_size(argv[++a], &rw, &rh) || tool_check_size("lightmap", rw, rh)) {
                 fprintf(stderr, "rad lightmap: bad --render-size '%s'\n", argv[a]);
                 return 2;
             }
         } else if (!strcmp(o, "--aa")) {
-            if (rad_tool_parse_uint("lightmap", o, argv[++a], &aa)) return 2;
+            if (tool_parse_uint("lightmap", o, argv[++a], &aa)) return 2;
             if (aa == 0 || aa > 16) { fprintf(stderr, "rad lightmap: --aa must be 1 to 16\n"); return 2; }
         } else if (!strcmp(o, "--size")) {
             const char *v = argv[++a];
             if (strchr(v, 'x')) {
-                if (rad_tool_parse_size(v, &width, &height)) { fprintf(stderr, "rad lightmap: bad --size '%s'\n", v); return 2; }
+                if (tool_parse_size(v, &width, &height)) { fprintf(stderr, "rad lightmap: bad --size '%s'\n", v); return 2; }
             } else {
                 uint32_t n;
-                if (rad_tool_parse_uint("lightmap", o, v, &n)) return 2;
+                if (tool_parse_uint("lightmap", o, v, &n)) return 2;
                 width = height = (int)(n > 16384u ? 16385u : n);
             }
             if (width < 4 || height < 4 || width > 16384 || height > 16384) {
@@ -276,10 +276,10 @@ int rad_cmd_lightmap(int argc, char **argv)
                 return 2;
             }
         } else if (!strcmp(o, "--texel-samples")) {
-            if (rad_tool_parse_uint("lightmap", o, argv[++a], &texel_samples)) return 2;
+            if (tool_parse_uint("lightmap", o, argv[++a], &texel_samples)) return 2;
             if (texel_samples == 0 || texel_samples > 16) { fprintf(stderr, "rad lightmap: --texel-samples must be 1 to 16\n"); return 2; }
         } else if (!strcmp(o, "--visibility-rays")) {
-            if (rad_tool_parse_uint("lightmap", o, argv[++a], &vis)) return 2;
+            if (tool_parse_uint("lightmap", o, argv[++a], &vis)) return 2;
             if (vis == 0 || vis > 64) { fprintf(stderr, "rad lightmap: --visibility-rays must be 1 to 64\n"); return 2; }
         } else if (!strcmp(o, "--gather")) {
             const char *v = argv[++a];
@@ -287,12 +287,12 @@ int rad_cmd_lightmap(int argc, char **argv)
             else if (v && !strcmp(v, "hemisphere")) gather = RAD_LIGHTMAP_GATHER_HEMISPHERE;
             else { fprintf(stderr, "rad lightmap: --gather must be exact or hemisphere\n"); return 2; }
         } else if (!strcmp(o, "--hemisphere-rays")) {
-            if (rad_tool_parse_uint("lightmap", o, argv[++a], &hemi_rays)) return 2;
+            if (tool_parse_uint("lightmap", o, argv[++a], &hemi_rays)) return 2;
             if (hemi_rays == 0 || hemi_rays > 65536) { fprintf(stderr, "rad lightmap: --hemisphere-rays must be 1 to 65536\n"); return 2; }
         } else if (!strcmp(o, "--exposure")) {
-            if (rad_tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
+            if (tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
         } else if (!strcmp(o, "--threads")) {
-            if (rad_tool_parse_threads("lightmap", o, argv[++a], &threads)) return 2;
+            if (tool_parse_threads("lightmap", o, argv[++a], &threads)) return 2;
         } else if (o[0] == '-' && o[1]) {
             fprintf(stderr, "rad lightmap: unknown option '%s' (try rad lightmap --help)\n", o);
             return 2;
@@ -315,34 +315,34 @@ int rad_cmd_lightmap(int argc, char **argv)
         fprintf(stderr, "rad lightmap: --render shades from the RGB lightmap: leave out --sh\n");
         return 2;
     }
-    if (rad_tool_check_size("lightmap", width, height)) return 2;
-    if (rad_image_check_format("lightmap", out_path) || (render_path && rad_image_check_format("lightmap", render_path))) return 2;
+    if (tool_check_size("lightmap", width, height)) return 2;
+    if (tool_image_check_format("lightmap", out_path) || (render_path && tool_image_check_format("lightmap", render_path))) return 2;
     {
         const char *inputs[1];
         inputs[0] = scene_path;
-        if (rad_tool_check_output("lightmap", out_path, inputs, 1)) return 1;
-        if (render_path && rad_tool_check_output("lightmap", render_path, inputs, 1)) return 1;
+        if (tool_check_output("lightmap", out_path, inputs, 1)) return 1;
+        if (render_path && tool_check_output("lightmap", render_path, inputs, 1)) return 1;
     }
-    rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world("lightmap", scene_path, &w)) return 1;
-    if (rad_tool_lightmap_bake("lightmap", &w, &co, width, height, texel_samples, vis, gather, hemi_rays, sh, force_unwrap, !sh, &bk)) goto done;
+    tool_set_threads((int)threads);
+    if (tool_open_world("lightmap", scene_path, &w)) return 1;
+    if (tool_lightmap_bake("lightmap", &w, &co, width, height, texel_samples, vis, gather, hemi_rays, sh, force_unwrap, !sh, &bk)) goto done;
     lm = bk.lm;
     values = bk.values;
     ch = sh ? 12u : 3u;
     {
-        rad_image img;
+        tool_image img;
         uint32_t layers = sh ? 4u : 1u, l;
         static const char *const tags[4] = {"L00", "L1m1", "L10", "L11"};
         for (l = 0; l < layers; ++l) {
             char *path = sh ? lightmap_tagged(out_path, tags[l]) : NULL;
             const char *dst = path ? path : out_path;
             int bad;
-            if (rad_image_alloc(&img, width, height)) { free(path); fprintf(stderr, "rad lightmap: out of memory\n"); goto done; }
+            if (tool_image_alloc(&img, width, height)) { free(path); fprintf(stderr, "rad lightmap: out of memory\n"); goto done; }
             for (i = 0; i < (uint32_t)(width * height); ++i) memcpy(img.rgb + 3 * (size_t)i, values + (size_t)i * ch + 3 * l, 3 * sizeof(float));
-            bad = rad_image_write(dst, &img, exposure);
-            rad_image_free(&img);
+            bad = tool_image_write(dst, &img, exposure);
+            tool_image_free(&img);
             if (bad) {
-                fprintf(stderr, "rad lightmap: %s\n", rad_tool_output_error());
+                fprintf(stderr, "rad lightmap: %s\n", tool_output_error());
                 free(path);
                 goto done;
             }
@@ -353,7 +353,7 @@ int rad_cmd_lightmap(int argc, char **argv)
     if (render_path && lightmap_render(&bk.w, lm, values, rw, rh, (int)aa, render_path, exposure)) goto done;
     code = 0;
 done:
-    rad_tool_lightmap_bake_free(&bk);
-    rad_tool_close_world(&w);
+    tool_lightmap_bake_free(&bk);
+    tool_close_world(&w);
     return code;
 }

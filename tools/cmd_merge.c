@@ -26,7 +26,7 @@
 
 /* ---- the shard split ------------------------------------------------------------------- */
 
-int rad_tool_parse_shard(const char *cmd, const char *text, rad_tool_shard_spec *s)
+int tool_parse_shard(const char *cmd, const char *text, tool_shard_spec *s)
 {
     unsigned long i, n;
     char *end;
@@ -34,17 +34,17 @@ int rad_tool_parse_shard(const char *cmd, const char *text, rad_tool_shard_spec 
     i = strtoul(text, &end, 10);
     if (*end != '/' || end[1] < '0' || end[1] > '9') goto bad;
     n = strtoul(end + 1, &end, 10);
-    if (*end != '\0' || n == 0 || n > RAD_TOOL_MAX_SHARDS || i >= n) goto bad;
+    if (*end != '\0' || n == 0 || n > TOOL_MAX_SHARDS || i >= n) goto bad;
     s->index = (uint32_t)i;
     s->count = (uint32_t)n;
     return 0;
 bad:
     fprintf(stderr, "rad %s: bad value '%s' for --shard (want I/N with 0 <= I < N <= %u)\n", cmd, text ? text : "",
-            RAD_TOOL_MAX_SHARDS);
+            TOOL_MAX_SHARDS);
     return 2;
 }
 
-int rad_tool_parse_rows(const char *cmd, const char *text, rad_tool_shard_spec *s)
+int tool_parse_rows(const char *cmd, const char *text, tool_shard_spec *s)
 {
     unsigned long a, b;
     char *end;
@@ -68,9 +68,9 @@ bad:
    the cost of a pair varies with where it is (near pairs take 16x the points, rays cross
    different geometry), and 64 chunks a shard average that out where 8 did not.
    Adjacent chunks of one shard are joined. */
-uint32_t rad_tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ranges)
+uint32_t tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ranges)
 {
-    uint32_t K = N < RAD_TOOL_SHARD_CHUNKS * n ? N : RAD_TOOL_SHARD_CHUNKS * n, q, count = 0;
+    uint32_t K = N < TOOL_SHARD_CHUNKS * n ? N : TOOL_SHARD_CHUNKS * n, q, count = 0;
     for (q = 0; q < K; ++q) {
         uint32_t round = q / n, pos = q % n, shard = (round & 1u) ? n - 1u - pos : pos;
         uint32_t b = (uint32_t)((uint64_t)q * N / K), e = (uint32_t)((uint64_t)(q + 1u) * N / K);
@@ -83,21 +83,21 @@ uint32_t rad_tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ran
 
 /* ---- writing a part -------------------------------------------------------------------- */
 
-int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                       const rad_tool_shard_spec *spec, void **out, size_t *out_size)
+int tool_bake_part(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                       const tool_shard_spec *spec, void **out, size_t *out_size)
 {
-    rad_tool_classic c;
+    tool_classic c;
     rad_form_factor_options fo;
     rad_context ctx;
     rad_result r;
-    rad_tool_bake_info info;
-    rad_tool_shard_info sh;
+    tool_bake_info info;
+    tool_shard_info sh;
     rad_bake_signature sig;
     rad_container *ct = NULL;
     rad_section *secs = NULL;
     void *base = NULL, *dst = NULL;
     size_t base_size = 0, dst_size = 0;
-    uint32_t ranges[2 * RAD_TOOL_SHARD_CHUNKS], nr, N, k, i, count;
+    uint32_t ranges[2 * TOOL_SHARD_CHUNKS], nr, N, k, i, count;
     uint64_t pairs = 0;
     float *up = NULL, *lo = NULL;
     double t0;
@@ -105,7 +105,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     int rc = 1;
     *out = NULL;
     *out_size = 0;
-    if (rad_tool_classic_sources(cmd, w, o, &c)) return 1;
+    if (tool_classic_sources(cmd, w, o, &c)) return 1;
     N = c.patches->count;
     if (spec->rows) {
         if (spec->row_end > N) {
@@ -115,17 +115,17 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
         }
         ranges[0] = spec->row_begin, ranges[1] = spec->row_end, nr = 1;
     } else {
-        nr = rad_tool_shard_ranges(N, spec->index, spec->count, ranges);
+        nr = tool_shard_ranges(N, spec->index, spec->count, ranges);
     }
     for (k = 0; k < nr; ++k) pairs += rad_form_factor_pair_count(N, ranges[2 * k], ranges[2 * k + 1]);
     if (pairs > (uint64_t)((size_t)-1 / sizeof(float))) {
         fprintf(stderr, "rad %s: %llu pairs do not fit in memory addresses\n", cmd, (unsigned long long)pairs);
         goto done;
     }
-    up = (float *)rad_tool_calloc((size_t)pairs, sizeof(float));
-    lo = (float *)rad_tool_calloc((size_t)pairs, sizeof(float));
+    up = (float *)tool_calloc((size_t)pairs, sizeof(float));
+    lo = (float *)tool_calloc((size_t)pairs, sizeof(float));
     memset(&sh, 0, sizeof sh);
-    sh.magic = RAD_TOOL_SHARD_MAGIC;
+    sh.magic = TOOL_SHARD_MAGIC;
     sh.format = 1;
     strncpy(sh.library, RAD_VERSION_STRING, sizeof sh.library - 1);
     sh.patches = N;
@@ -135,17 +135,17 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
     sh.pairs = pairs;
     rad_form_factor_options_default(&fo);
     fo.samples = o->samples;
-    t0 = rad_tool_seconds();
+    t0 = tool_seconds();
     c0 = clock();
-    rad_tool_context(&ctx, "form factors");
+    tool_context(&ctx, "form factors");
     /* one call for all the ranges: the threads share every row of the part */
     r = rad_form_factor_pairs(c.patches, &w->rc, &fo, ranges, nr, up, lo, &sh.pairs_evaluated, &ctx);
-    rad_tool_progress_end();
+    tool_progress_end();
     if (r != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_form_factor_pairs", r);
+        tool_fail(cmd, "rad_form_factor_pairs", r);
         goto done;
     }
-    sh.seconds = rad_tool_seconds() - t0;
+    sh.seconds = tool_seconds() - t0;
     if (spec->rows) fprintf(stderr, "rad %s: rows %u:%u", cmd, ranges[0], ranges[1]);
     else fprintf(stderr, "rad %s: shard %u/%u (%u row ranges)", cmd, spec->index, spec->count, nr);
     fprintf(stderr, ": %llu of %llu pairs (%.1f%%), %llu evaluated, in %.2f s (%.2f s CPU)\n", (unsigned long long)pairs,
@@ -154,35 +154,35 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
             (unsigned long long)sh.pairs_evaluated, sh.seconds, (double)(clock() - c0) / CLOCKS_PER_SEC);
 
     /* patches, vertices, triangles, E and the signature, then ours */
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     if ((r = rad_save_memory(c.patches, NULL, c.E, NULL, &ctx, &base, &base_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_save_memory", r);
+        tool_fail(cmd, "rad_save_memory", r);
         goto done;
     }
-    if ((r = rad_container_open(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_open", r);
+    if ((r = rad_container_create(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
+        tool_fail(cmd, "rad_container_create", r);
         goto done;
     }
     count = rad_container_section_count(ct);
-    secs = (rad_section *)rad_tool_calloc((size_t)count + 6, sizeof(rad_section));
+    secs = (rad_section *)tool_calloc((size_t)count + 6, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[i] = *rad_container_section(ct, i);
-    rad_tool_bake_info_fill(&info, w, o);
-    rad_tool_sign_options(secs, count, &info, w, &sig);
+    tool_bake_info_fill(&info, w, o);
+    tool_sign_options(secs, count, &info, w, &sig);
     k = count;
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = N, secs[k].data = c.D;
     strcpy(secs[k++].name, "D");
-    secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
+    secs[k].type = TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
-    secs[k].type = RAD_TOOL_SECTION_SHARD, secs[k].elem_size = sizeof sh, secs[k].count = 1, secs[k].data = &sh;
+    secs[k].type = TOOL_SECTION_SHARD, secs[k].elem_size = sizeof sh, secs[k].count = 1, secs[k].data = &sh;
     strcpy(secs[k++].name, "rad.shard");
-    secs[k].type = RAD_TOOL_SECTION_ROWS, secs[k].elem_size = 8, secs[k].count = nr, secs[k].data = ranges;
+    secs[k].type = TOOL_SECTION_ROWS, secs[k].elem_size = 8, secs[k].count = nr, secs[k].data = ranges;
     strcpy(secs[k++].name, "rad.rows");
-    secs[k].type = RAD_TOOL_SECTION_PAIRS, secs[k].elem_size = 4, secs[k].count = pairs, secs[k].data = up;
+    secs[k].type = TOOL_SECTION_PAIRS, secs[k].elem_size = 4, secs[k].count = pairs, secs[k].data = up;
     strcpy(secs[k++].name, "F.upper");
-    secs[k].type = RAD_TOOL_SECTION_PAIRS, secs[k].elem_size = 4, secs[k].count = pairs, secs[k].data = lo;
+    secs[k].type = TOOL_SECTION_PAIRS, secs[k].elem_size = 4, secs[k].count = pairs, secs[k].data = lo;
     strcpy(secs[k++].name, "F.lower");
     if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_size", r);
+        tool_fail(cmd, "rad_container_size", r);
         goto done;
     }
     dst = malloc(dst_size);
@@ -191,7 +191,7 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
         goto done;
     }
     if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_write", r);
+        tool_fail(cmd, "rad_container_write", r);
         goto done;
     }
     *out = dst;
@@ -201,11 +201,11 @@ int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_
 done:
     free(dst);
     free(secs);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     rad_free_buffer(base, &ctx);
     free(up);
     free(lo);
-    rad_tool_classic_free(&c);
+    tool_classic_free(&c);
     return rc;
 }
 
@@ -214,8 +214,8 @@ done:
 /* one part, opened and checked on its own */
 typedef struct part_view {
     rad_bake *bake;
-    const rad_tool_shard_info *sh;
-    const rad_tool_bake_info *info;
+    const tool_shard_info *sh;
+    const tool_bake_info *info;
     const rad_bake_signature *sig;
     const uint32_t *ranges;
     const float *up, *lo;
@@ -224,7 +224,7 @@ typedef struct part_view {
 
 static const char *const keep_names[5] = {"patches", "vertices", "triangles", "E", "D"};
 
-static int open_part(const char *cmd, const rad_tool_part *p, part_view *v)
+static int open_part(const char *cmd, const tool_part *p, part_view *v)
 {
     rad_context ctx;
     rad_result r;
@@ -235,31 +235,31 @@ static int open_part(const char *cmd, const rad_tool_part *p, part_view *v)
     static const uint32_t keep_types[5] = {RAD_SECTION_PATCHES, RAD_SECTION_PATCH_VERTICES, RAD_SECTION_TRIANGLES,
                                            RAD_SECTION_VECTOR, RAD_SECTION_VECTOR};
     memset(v, 0, sizeof *v);
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     if ((r = rad_load_memory(p->data, p->size, &ctx, &v->bake)) != RAD_SUCCESS) {
         fprintf(stderr, "rad %s: %s is not a readable bake part: %s\n", cmd, p->name, rad_result_string(r));
         return 1;
     }
     ct = v->bake->container;
-    s = rad_container_find(ct, RAD_TOOL_SECTION_SHARD, "rad.shard");
+    s = rad_container_find(ct, TOOL_SECTION_SHARD, "rad.shard");
     if (!s) {
         fprintf(stderr, "rad %s: %s is not a part of a sharded bake (it has no rad.shard section; "
                         "rad bake --shard I/N or --rows A:B writes parts)\n", cmd, p->name);
         return 1;
     }
-    if (s->elem_size != sizeof *v->sh || s->count != 1 || ((const rad_tool_shard_info *)s->data)->magic != RAD_TOOL_SHARD_MAGIC ||
-        ((const rad_tool_shard_info *)s->data)->format != 1) {
+    if (s->elem_size != sizeof *v->sh || s->count != 1 || ((const tool_shard_info *)s->data)->magic != TOOL_SHARD_MAGIC ||
+        ((const tool_shard_info *)s->data)->format != 1) {
         fprintf(stderr, "rad %s: %s holds a rad.shard record of another format (another version of rad?)\n", cmd, p->name);
         return 1;
     }
-    v->sh = (const rad_tool_shard_info *)s->data;
+    v->sh = (const tool_shard_info *)s->data;
     N = v->bake->patches.count;
-    s = rad_container_find(ct, RAD_TOOL_SECTION_OPTIONS, "rad.options");
+    s = rad_container_find(ct, TOOL_SECTION_OPTIONS, "rad.options");
     if (!s || s->elem_size != sizeof *v->info || s->count != 1 || !v->bake->signature) {
         fprintf(stderr, "rad %s: %s has no rad.options record or signature\n", cmd, p->name);
         return 1;
     }
-    v->info = (const rad_tool_bake_info *)s->data;
+    v->info = (const tool_bake_info *)s->data;
     v->sig = v->bake->signature;
     for (k = 0; k < 5; ++k) {
         v->keep[k] = rad_container_find(ct, keep_types[k], k >= 3 ? keep_names[k] : NULL);
@@ -272,7 +272,7 @@ static int open_part(const char *cmd, const rad_tool_part *p, part_view *v)
         fprintf(stderr, "rad %s: %s: its rad.shard record says %u patches, it holds %u\n", cmd, p->name, v->sh->patches, N);
         return 1;
     }
-    s = rad_container_find(ct, RAD_TOOL_SECTION_ROWS, "rad.rows");
+    s = rad_container_find(ct, TOOL_SECTION_ROWS, "rad.rows");
     if (!s || s->elem_size != 8 || s->count != v->sh->range_count) {
         fprintf(stderr, "rad %s: %s: its row ranges (rad.rows) are missing or do not match rad.shard\n", cmd, p->name);
         return 1;
@@ -288,7 +288,7 @@ static int open_part(const char *cmd, const rad_tool_part *p, part_view *v)
         pairs += rad_form_factor_pair_count(N, b, e);
     }
     for (k = 0; k < 2; ++k) {
-        s = rad_container_find(ct, RAD_TOOL_SECTION_PAIRS, k ? "F.lower" : "F.upper");
+        s = rad_container_find(ct, TOOL_SECTION_PAIRS, k ? "F.lower" : "F.upper");
         if (!s || s->elem_size != 4 || s->count != pairs || pairs != v->sh->pairs) {
             fprintf(stderr, "rad %s: %s: %s is missing or does not hold the %llu pairs of its rows\n", cmd, p->name,
                     k ? "F.lower" : "F.upper", (unsigned long long)pairs);
@@ -301,10 +301,10 @@ static int open_part(const char *cmd, const rad_tool_part *p, part_view *v)
 }
 
 /* 0 when part b agrees with part a on everything but its rows; else prints why */
-static int same_bake(const char *cmd, const rad_tool_part *pa, const part_view *a, const rad_tool_part *pb,
+static int same_bake(const char *cmd, const tool_part *pa, const part_view *a, const tool_part *pb,
                      const part_view *b)
 {
-    const rad_tool_bake_info *x = a->info, *y = b->info;
+    const tool_bake_info *x = a->info, *y = b->info;
     uint32_t k;
     if (strncmp(a->sh->library, b->sh->library, sizeof a->sh->library)) {
         fprintf(stderr, "rad %s: %s was baked by radiosity.h %.16s and %s by %.16s: the parts of one bake come from one "
@@ -365,7 +365,7 @@ static int range_cmp(const void *a, const void *b)
 }
 
 /* every row in exactly one part; else prints what is given twice or missing */
-static int check_cover(const char *cmd, const rad_tool_part *parts, const part_view *v, uint32_t count)
+static int check_cover(const char *cmd, const tool_part *parts, const part_view *v, uint32_t count)
 {
     uint32_t N = v[0].sh->patches, n = v[0].sh->shard_count, p, k, total = 0, at = 0, missing = 0, first = 0;
     range_ref *rr;
@@ -376,7 +376,7 @@ static int check_cover(const char *cmd, const rad_tool_part *parts, const part_v
     }
     /* shards first: the duplicate or missing one by its number */
     if (all_shards) {
-        uint32_t *seen = (uint32_t *)rad_tool_calloc(n, sizeof(uint32_t));
+        uint32_t *seen = (uint32_t *)tool_calloc(n, sizeof(uint32_t));
         for (p = 0; p < count; ++p) {
             uint32_t I = v[p].sh->shard;
             if (I >= n) {
@@ -406,7 +406,7 @@ static int check_cover(const char *cmd, const rad_tool_part *parts, const part_v
             fprintf(stderr, " of %u are missing (%u of %u parts given): bake each with --shard I/%u\n", n, count, n, n);
         if (missing) return 1;
     }
-    rr = (range_ref *)rad_tool_calloc(total, sizeof(range_ref));
+    rr = (range_ref *)tool_calloc(total, sizeof(range_ref));
     for (p = 0, k = 0; p < count; ++p) {
         uint32_t q;
         for (q = 0; q < v[p].sh->range_count; ++q, ++k)
@@ -440,11 +440,11 @@ static int check_cover(const char *cmd, const rad_tool_part *parts, const part_v
     return 0;
 }
 
-int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, const char *out_path)
+int tool_merge(const char *cmd, const tool_part *parts, uint32_t count, const char *out_path)
 {
     part_view *v;
-    rad_tool_classic c;
-    rad_tool_classic_options o;
+    tool_classic c;
+    tool_classic_options o;
     rad_matrix F;
     rad_section secs[11];
     rad_result r;
@@ -453,14 +453,14 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
     size_t dst_size = 0;
     uint32_t p, N, k;
     uint64_t evaluated = 0;
-    double seconds = 0.0, t0 = rad_tool_seconds();
+    double seconds = 0.0, t0 = tool_seconds();
     int rc = 1;
     memset(&c, 0, sizeof c);
     if (count == 0) {
         fprintf(stderr, "rad %s: no parts given\n", cmd);
         return 2;
     }
-    v = (part_view *)rad_tool_calloc(count, sizeof *v);
+    v = (part_view *)tool_calloc(count, sizeof *v);
     for (p = 0; p < count; ++p)
         if (open_part(cmd, &parts[p], &v[p])) goto done;
     if (strncmp(v[0].sh->library, RAD_VERSION_STRING, sizeof v[0].sh->library)) {
@@ -474,7 +474,7 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
 
     /* F: the diagonal 0, each pair from the part that holds its row */
     N = v[0].sh->patches;
-    full = (float *)rad_tool_calloc((size_t)N * N, sizeof(float));
+    full = (float *)tool_calloc((size_t)N * N, sizeof(float));
     for (p = 0; p < count; ++p) {
         uint64_t at = 0;
         for (k = 0; k < v[p].sh->range_count; ++k) {
@@ -501,19 +501,19 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
     F.dense = full;
 
     /* the solve of rad bake, with its options */
-    rad_tool_classic_options_default(&o);
+    tool_classic_options_default(&o);
     o.patches = v[0].info->patches;
     o.max_edge = v[0].info->max_edge;
     o.samples = v[0].info->samples;
-    o.solver = (rad_tool_solver)v[0].info->solver;
+    o.solver = (tool_solver)v[0].info->solver;
     o.bounces = v[0].info->bounces;
     o.light_samples = v[0].info->light_samples;
     c.patches = &v[0].bake->patches;
-    c.E = (float *)rad_tool_calloc(3 * (size_t)N, sizeof(float));
+    c.E = (float *)tool_calloc(3 * (size_t)N, sizeof(float));
     memcpy(c.E, v[0].keep[3]->data, 12 * (size_t)N);
     fprintf(stderr, "rad %s: %u parts, %u patches, %llu pairs evaluated (%.2f s of form factors in the parts)\n", cmd,
             count, N, (unsigned long long)evaluated, seconds);
-    if (rad_tool_classic_indirect(cmd, &o, &F, &c)) goto done;
+    if (tool_classic_indirect(cmd, &o, &F, &c)) goto done;
 
     /* save_bake's sections in its order (cmd_bake.c) */
     for (k = 0; k < 3; ++k) secs[k] = *v[0].keep[k];
@@ -529,9 +529,9 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
     secs[8].type = RAD_SECTION_VECTOR, secs[8].elem_size = 12, secs[8].count = N, secs[8].data = c.H;
     strcpy(secs[8].name, "H");
     secs[9] = *v[0].keep[4];
-    secs[10] = *rad_container_find(v[0].bake->container, RAD_TOOL_SECTION_OPTIONS, "rad.options");
+    secs[10] = *rad_container_find(v[0].bake->container, TOOL_SECTION_OPTIONS, "rad.options");
     if ((r = rad_container_size(secs, 11, &dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_size", r);
+        tool_fail(cmd, "rad_container_size", r);
         goto done;
     }
     dst = malloc(dst_size);
@@ -540,7 +540,7 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
         goto done;
     }
     if ((r = rad_container_write(secs, 11, dst, dst_size)) != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_container_write", r);
+        tool_fail(cmd, "rad_container_write", r);
         goto done;
     }
     /* the solution's vectors are checked as rad_save_memory checks them (F was, above; the
@@ -552,12 +552,12 @@ int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, 
                     (double)c.B[k], (double)c.L[k], (double)c.H[k]);
             goto done;
         }
-    if (rad_tool_write_file(out_path, dst, dst_size) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+    if (tool_write_file(out_path, dst, dst_size) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
     printf("wrote %s: %u patches, 11 sections, %lu bytes\n", out_path, N, (unsigned long)dst_size);
-    fprintf(stderr, "rad %s: merged in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    fprintf(stderr, "rad %s: merged in %.2f s\n", cmd, tool_seconds() - t0);
     rc = 0;
 done:
     free(dst);
@@ -585,7 +585,7 @@ static void merge_usage(FILE *f)
 }
 
 /* a whole file into malloc'd memory (malloc: aligned as the loader wants); 0 or 1 */
-static int read_part(const char *cmd, const char *path, rad_tool_part *p)
+static int read_part(const char *cmd, const char *path, tool_part *p)
 {
     FILE *f = fopen(path, "rb");
     long len;
@@ -611,14 +611,14 @@ static int read_part(const char *cmd, const char *path, rad_tool_part *p)
     return 0;
 }
 
-int rad_cmd_merge(int argc, char **argv)
+int tool_cmd_merge(int argc, char **argv)
 {
     const char *cmd = "merge", *out_path = NULL;
     const char **inputs;
-    rad_tool_part *parts;
+    tool_part *parts;
     uint32_t n = 0, threads = 0, i;
     int a, rc = 1;
-    inputs = (const char **)rad_tool_calloc((size_t)argc + 1, sizeof *inputs);
+    inputs = (const char **)tool_calloc((size_t)argc + 1, sizeof *inputs);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) {
@@ -633,7 +633,7 @@ int rad_cmd_merge(int argc, char **argv)
         }
         if (!strcmp(opt, "-o")) out_path = argv[++a];
         else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) { free(inputs); return 2; }
+            if (tool_parse_threads(cmd, opt, argv[++a], &threads)) { free(inputs); return 2; }
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad merge --help)\n", cmd, opt);
             free(inputs);
@@ -646,12 +646,12 @@ int rad_cmd_merge(int argc, char **argv)
         free(inputs);
         return 2;
     }
-    if (rad_tool_check_output(cmd, out_path, inputs, (int)n)) { free(inputs); return 1; }
-    rad_tool_set_threads((int)threads);
-    parts = (rad_tool_part *)rad_tool_calloc(n, sizeof *parts);
+    if (tool_check_output(cmd, out_path, inputs, (int)n)) { free(inputs); return 1; }
+    tool_set_threads((int)threads);
+    parts = (tool_part *)tool_calloc(n, sizeof *parts);
     for (i = 0; i < n; ++i)
         if (read_part(cmd, inputs[i], &parts[i])) goto done;
-    rc = rad_tool_merge(cmd, parts, n, out_path);
+    rc = tool_merge(cmd, parts, n, out_path);
 done:
     for (i = 0; i < n; ++i) free((void *)(size_t)parts[i].data);
     free(parts);

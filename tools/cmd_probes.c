@@ -34,7 +34,7 @@ static void probes_usage(FILE *f)
                "  --indirect         only the indirect light (default: direct light too)\n"
                "%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help());
+            tool_classic_help());
 }
 
 static const char *state_name(uint8_t s)
@@ -99,27 +99,27 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
     return ok;
 }
 
-int rad_cmd_probes(int argc, char **argv)
+int tool_cmd_probes(int argc, char **argv)
 {
     const char *cmd = "probes", *scene_name = NULL, *out_path = NULL;
-    rad_tool_classic_options o;
-    rad_tool_world w;
-    rad_tool_classic c;
+    tool_classic_options o;
+    tool_world w;
+    tool_classic c;
     rad_probe_options po;
     rad_probes *pr = NULL;
     rad_context ctx;
-    rad_tool_output out;
+    tool_output out;
     uint32_t threads = 0, i, counts[3] = {0, 0, 0};
-    double t0 = rad_tool_seconds();
+    double t0 = tool_seconds();
     int a, rc, json, total = 1;
     size_t len;
     rad_result r;
-    rad_tool_classic_options_default(&o);
+    tool_classic_options_default(&o);
     rad_probe_options_default(&po);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { probes_usage(stdout); return 0; }
-        rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        rc = tool_classic_option(cmd, argc, argv, &a, &o);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if (!strcmp(opt, "--indirect")) { total = 0; continue; }
@@ -129,15 +129,15 @@ int rad_cmd_probes(int argc, char **argv)
             return 2;
         }
         if (!strcmp(opt, "-o")) out_path = argv[++a];
-        else if (!strcmp(opt, "--threads")) { if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2; }
+        else if (!strcmp(opt, "--threads")) { if (tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2; }
         else if (!strcmp(opt, "--spacing")) {
-            if (rad_tool_parse_float(cmd, opt, argv[++a], &po.spacing)) return 2;
+            if (tool_parse_float(cmd, opt, argv[++a], &po.spacing)) return 2;
             if (!(po.spacing > 0.0f)) { fprintf(stderr, "rad %s: --spacing must be > 0\n", cmd); return 2; }
         } else if (!strcmp(opt, "--rays")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &po.rays)) return 2;
+            if (tool_parse_uint(cmd, opt, argv[++a], &po.rays)) return 2;
             if (po.rays == 0 || po.rays > 65536) { fprintf(stderr, "rad %s: --rays must be in 1..65536\n", cmd); return 2; }
         } else if (!strcmp(opt, "--patch-samples")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &po.patch_samples)) return 2;
+            if (tool_parse_uint(cmd, opt, argv[++a], &po.patch_samples)) return 2;
             if (po.patch_samples == 0 || po.patch_samples > 256) {
                 fprintf(stderr, "rad %s: --patch-samples must be in 1..256\n", cmd);
                 return 2;
@@ -159,39 +159,39 @@ int rad_cmd_probes(int argc, char **argv)
         fprintf(stderr, "rad %s: the output must end in .json or .bin: '%s'\n", cmd, out_path);
         return 2;
     }
-    if (rad_tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
-    rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world(cmd, scene_name, &w)) return 1;
-    if (rad_tool_classic_solve(cmd, &w, &o, &c)) {
-        rad_tool_close_world(&w);
+    if (tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
+    tool_set_threads((int)threads);
+    if (tool_open_world(cmd, scene_name, &w)) return 1;
+    if (tool_classic_solve(cmd, &w, &o, &c)) {
+        tool_close_world(&w);
         return 1;
     }
     if (total) po.flags |= RAD_PROBES_DIRECT;
-    rad_tool_context(&ctx, "probes");
+    tool_context(&ctx, "probes");
     r = rad_probes_create(c.patches, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &po, c.B, &ctx, &pr);
-    rad_tool_progress_end();
+    tool_progress_end();
     rc = 1;
     if (r != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_probes_create", r);
+        tool_fail(cmd, "rad_probes_create", r);
         goto done;
     }
     for (i = 0; i < rad_probes_count(pr); ++i) counts[rad_probes_states(pr)[i] % 3u]++;
-    if (rad_tool_output_open(&out, out_path) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+    if (tool_output_open(&out, out_path) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
-    if (rad_tool_output_commit(&out, write_probes(out.f, json, pr, total)) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+    if (tool_output_commit(&out, write_probes(out.f, json, pr, total)) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
     printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light\n", out_path,
            rad_probes_count(pr), counts[RAD_PROBE_VALID], counts[RAD_PROBE_MOVED], counts[RAD_PROBE_DISABLED],
            (unsigned long)rad_probes_entry_count(pr), total ? "total" : "indirect");
-    fprintf(stderr, "rad %s: done in %.2f s\n", cmd, rad_tool_seconds() - t0);
+    fprintf(stderr, "rad %s: done in %.2f s\n", cmd, tool_seconds() - t0);
     rc = 0;
 done:
     rad_probes_destroy(pr);
-    rad_tool_classic_free(&c);
-    rad_tool_close_world(&w);
+    tool_classic_free(&c);
+    tool_close_world(&w);
     return rc;
 }

@@ -15,7 +15,7 @@
    correction from the bake's row sums of F.
 
    Local (render_local_method; Shcherbakov 2025, ch. 4, in docs/references.md): the classic patches, F and E; a rad_local of capacity
-   --local-m M (default: every patch, up to RAD_TOOL_LOCAL_M_AUTO_MAX) filled with the M patches
+   --local-m M (default: every patch, up to TOOL_LOCAL_M_AUTO_MAX) filled with the M patches
    nearest the camera (rad_local_nearest, one
    rad_local_rebuild), L = T E over P_Vis x P_Lit (rad_local_visible, rad_local_lit), H = L / rho
    and the classic render; patches outside the set or not visible get no indirect light.
@@ -86,7 +86,7 @@ static void render_usage(FILE *f)
             "%s"
             "%s"
             "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            rad_tool_classic_help(), rad_tool_method_help(1), rad_tool_light_help());
+            tool_classic_help(), tool_method_help(1), tool_light_help());
 }
 
 /* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
@@ -95,9 +95,9 @@ static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H
 {
     rad_context ctx;
     rad_result r;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     r = rad_patches_vertex_irradiance(P, H, S, Hv, &ctx);
-    return r == RAD_SUCCESS ? 0 : rad_tool_fail("render", "per-vertex H", r);
+    return r == RAD_SUCCESS ? 0 : tool_fail("render", "per-vertex H", r);
 }
 
 /* the same with the row sums computed from F */
@@ -109,11 +109,11 @@ static int vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, f
     rad_context ctx;
     rad_result r;
     int rc;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
     r = rad_matrix_multiply(F, ones, rs, &ctx);
     for (i = 0; i < n; ++i) S[i] = rs[3 * i];
-    rc = r == RAD_SUCCESS ? vertex_H_rowsums(P, S, H, Hv) : rad_tool_fail("render", "per-vertex H", r);
+    rc = r == RAD_SUCCESS ? vertex_H_rowsums(P, S, H, Hv) : tool_fail("render", "per-vertex H", r);
     free(ones);
     free(rs);
     free(S);
@@ -165,7 +165,7 @@ static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *poi
     int i;
     if (render_vp) {
         rad_context quiet;
-        rad_tool_context(&quiet, NULL);
+        tool_context(&quiet, NULL);
         return rad_vp_gather(render_vp, render_vp_H, points, normals, count, out, &quiet);
     }
     if (render_hr) return hr_lookup(hits, NULL, count, out);
@@ -200,8 +200,8 @@ static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t
     return r;
 }
 
-static int render_classic(const rad_tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
-                          int width, int height, uint32_t aa, uint32_t light_samples, rad_image *img)
+static int render_classic(const tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
+                          int width, int height, uint32_t aa, uint32_t light_samples, tool_image *img)
 {
     const rad_scene *scene = w->scene;
     uint32_t strata, spp;
@@ -236,7 +236,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
     dopt.light_samples = light_samples;
-    rad_tool_context(&quiet, NULL);
+    tool_context(&quiet, NULL);
     /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
     for (k = 0; k < w->file.light_count; ++k)
         if (w->file.lights[k].type == RAD_LIGHT_SKY)
@@ -267,7 +267,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
                 if (w->rc.intersect(w->rc.user, rays + b, e - b, hits + b) != RAD_SUCCESS) failed |= 1;
             }
             if (failed) {
-                result = rad_tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
+                result = tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
                 break;
             }
         }
@@ -296,14 +296,14 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
             r = rad_direct_irradiance(scene, &w->rc, w->file.lights, w->file.light_count, &dopt, points, normals, nvalid,
                                       irr, &quiet);
             if (r != RAD_SUCCESS) {
-                result = rad_tool_fail("render", "rad_direct_irradiance", r);
+                result = tool_fail("render", "rad_direct_irradiance", r);
                 break;
             }
         }
         if (render_final_gather && nvalid > 0) {
             rad_final_gather_options fo;
             fg_lookup lk;
-            double tg = rad_tool_seconds();
+            double tg = tool_seconds();
             rad_final_gather_options_default(&fo);
             fo.rays = render_final_gather;
             fo.seed = (uint32_t)y0 * 0x9E3779B9u;
@@ -311,13 +311,13 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
             lk.Hv = Hv;
             r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, &lk, points, normals,
                                  nvalid, gathered, &quiet);
-            render_vp_gather_seconds += rad_tool_seconds() - tg;
+            render_vp_gather_seconds += tool_seconds() - tg;
             if (r != RAD_SUCCESS) {
-                result = rad_tool_fail("render", "rad_final_gather", r);
+                result = tool_fail("render", "rad_final_gather", r);
                 break;
             }
         } else if (render_lm && nvalid > 0) {
-            double tg = rad_tool_seconds();
+            double tg = tool_seconds();
             for (k = 0; k < nvalid; ++k) {
                 const rad_hit *h = &hits[valid[k]];
                 const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
@@ -325,14 +325,14 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
                 float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
                 rad_lightmap_sample(render_lm, 3, render_lm_values, u, v, gathered + 3 * k);
             }
-            render_vp_gather_seconds += rad_tool_seconds() - tg;
+            render_vp_gather_seconds += tool_seconds() - tg;
         } else if (gathered && nvalid > 0) {
-            double tg = rad_tool_seconds();
+            double tg = tool_seconds();
             r = render_hr ? hr_lookup(hits, valid, nvalid, gathered)
                           : rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
-            render_vp_gather_seconds += rad_tool_seconds() - tg;
+            render_vp_gather_seconds += tool_seconds() - tg;
             if (r != RAD_SUCCESS) {
-                result = rad_tool_fail("render", "rad_vp_gather", r);
+                result = tool_fail("render", "rad_vp_gather", r);
                 break;
             }
         }
@@ -343,7 +343,7 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
                 for (i = 0; i < 3; ++i) shade_v[3 * k + i] = -ry->dir[i] / len;
                 rad_scene_albedo(scene, hits[valid[k]].triangle, hits[valid[k]].b1, hits[valid[k]].b2, shade_a + 3 * k);
             }
-            if (rad_tool_shade_direct(w, render_shading, light_samples, points, normals, shade_v, shade_a, nvalid, shaded)) {
+            if (tool_shade_direct(w, render_shading, light_samples, points, normals, shade_v, shade_a, nvalid, shaded)) {
                 result = 1;
                 break;
             }
@@ -368,9 +368,9 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
             }
         }
         done_px += (size_t)(y1 - y0) * width;
-        rad_tool_progress((void *)(size_t)"render", (float)((double)done_px / (double)total));
+        tool_progress((void *)(size_t)"render", (float)((double)done_px / (double)total));
     }
-    rad_tool_progress_end();
+    tool_progress_end();
     {
         size_t q;
         float inv = 1.0f / (float)spp;
@@ -390,30 +390,30 @@ static int render_classic(const rad_tool_world *w, const rad_patches *P, const f
 }
 
 /* the bake's options section, or NULL */
-static const rad_tool_bake_info *bake_info(const rad_bake *bake)
+static const tool_bake_info *bake_info(const rad_bake *bake)
 {
-    const rad_section *s = rad_container_find(bake->container, RAD_TOOL_SECTION_OPTIONS, "rad.options");
-    const rad_tool_bake_info *info;
-    if (!s || s->elem_size != sizeof(rad_tool_bake_info) || s->count != 1) return NULL;
-    info = (const rad_tool_bake_info *)s->data;
+    const rad_section *s = rad_container_find(bake->container, TOOL_SECTION_OPTIONS, "rad.options");
+    const tool_bake_info *info;
+    if (!s || s->elem_size != sizeof(tool_bake_info) || s->count != 1) return NULL;
+    info = (const tool_bake_info *)s->data;
     return info->magic == 0x52414442u ? info : NULL;
 }
 
 /* 0 when a loaded bake was made from this scene (rad_bake_matches_scene: its triangle count,
    geometry and materials, and its options section is the one it was baked with; then the
    patch count its options give on this scene); else 1 with a message */
-static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bake *bake, const rad_tool_world *w)
+static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bake *bake, const tool_world *w)
 {
-    const rad_tool_bake_info *info = bake_info(bake);
+    const tool_bake_info *info = bake_info(bake);
     rad_context ctx;
     rad_result r;
     int rc = 0;
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_bake_matches_scene(bake, w->scene, info ? rad_tool_options_hash(info, w) : 0u, &ctx)) != RAD_SUCCESS) {
+    tool_context(&ctx, NULL);
+    if ((r = rad_bake_matches_scene(bake, w->scene, info ? tool_options_hash(info, w) : 0u, &ctx)) != RAD_SUCCESS) {
         /* the same options without this command line's lights: then only the lights differ */
-        rad_tool_world bare = *w;
+        tool_world bare = *w;
         bare.file_light_count = w->file.light_count;
-        if (info && rad_bake_matches_scene(bake, w->scene, rad_tool_options_hash(info, &bare), NULL) == RAD_SUCCESS)
+        if (info && rad_bake_matches_scene(bake, w->scene, tool_options_hash(info, &bare), NULL) == RAD_SUCCESS)
             fprintf(stderr, "rad %s: bake '%s' was made with other lights than this command line's --sun, --sky, "
                             "--point and --spot: give the bake's light options, or render without --bake\n",
                     cmd, bake_path);
@@ -429,7 +429,7 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
         po.target_count = info->patches;
         po.max_edge = info->max_edge;
         if ((r = rad_patches_create(w->scene, &po, &ctx, &check)) != RAD_SUCCESS) {
-            rc = rad_tool_fail(cmd, "rad_patches_create", r);
+            rc = tool_fail(cmd, "rad_patches_create", r);
         } else if (check->count != bake->patches.count) {
             fprintf(stderr, "rad %s: bake '%s' has %u patches; this scene with its options (--patches %u) gives %u: "
                             "not the scene it was baked from\n",
@@ -447,19 +447,19 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
 /* --method multibounce|temporal: the patches' indirect light from the bake's F_mb (one
    product) or alias tables (--frames steps), then the classic pixel pipeline (per-pixel direct
    light + interpolated H). --sequence writes every --every-th frame (and the last) as a PNG. */
-static int render_method(const char *cmd, const rad_tool_world *w, const rad_bake *bake, const char *bake_name,
-                         const rad_tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
-                         uint32_t light_samples, float exposure, rad_image *img)
+static int render_method(const char *cmd, const tool_world *w, const rad_bake *bake, const char *bake_name,
+                         const tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
+                         uint32_t light_samples, float exposure, tool_image *img)
 {
-    rad_tool_indirect *m = NULL;
+    tool_indirect *m = NULL;
     const rad_patches *P = &bake->patches;
-    uint32_t frames = mo->method == RAD_TOOL_TEMPORAL ? mo->frames : 1u, f;
+    uint32_t frames = mo->method == TOOL_TEMPORAL ? mo->frames : 1u, f;
     /* multibounce: the product is repeated (same result each time) so its time is a median */
-    uint32_t reps = mo->method == RAD_TOOL_TEMPORAL ? frames : 9u;
+    uint32_t reps = mo->method == TOOL_TEMPORAL ? frames : 9u;
     double t = 0.0, sum = 0.0, tmin = 1e300, tmax = 0.0, *times;
     float *H, *Hv;
     int rc = 0;
-    if (rad_tool_indirect_open(cmd, bake_name, bake, mo, &m)) return 1;
+    if (tool_indirect_open(cmd, bake_name, bake, mo, &m)) return 1;
     times = (double *)xmalloc(sizeof(double) * reps);
     H = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->count);
     Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
@@ -467,63 +467,63 @@ static int render_method(const char *cmd, const rad_tool_world *w, const rad_bak
     if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
 #endif
     for (f = 1; f <= frames && rc == 0; ++f) {
-        rc = rad_tool_indirect_step(m, H, &t);
+        rc = tool_indirect_step(m, H, &t);
         times[f - 1] = t;
         sum += t;
         if (t < tmin) tmin = t;
         if (t > tmax) tmax = t;
         if (rc == 0 && mo->sequence && f % mo->every == 0 && f != frames) { /* the last one: below */
             char path[4096];
-            rad_image frame;
+            tool_image frame;
             memset(&frame, 0, sizeof frame);
             snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, f);
-            if (rad_image_alloc(&frame, width, height) != 0) {
+            if (tool_image_alloc(&frame, width, height) != 0) {
                 fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
                 rc = 1;
             }
-            if (rc == 0) rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
+            if (rc == 0) rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
             if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, &frame);
-            if (rc == 0 && rad_image_write_png(path, &frame, exposure) != 0) {
-                fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+            if (rc == 0 && tool_image_write_png(path, &frame, exposure) != 0) {
+                fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
                 rc = 1;
             }
-            rad_image_free(&frame);
+            tool_image_free(&frame);
         }
     }
-    for (f = frames + 1; f <= reps && rc == 0; ++f) rc = rad_tool_indirect_step(m, H, &times[f - 1]);
+    for (f = frames + 1; f <= reps && rc == 0; ++f) rc = tool_indirect_step(m, H, &times[f - 1]);
     if (rc == 0) {
         qsort(times, reps, sizeof(double), cmp_double);
         /* one line for scripts (tools/report.sh): the method's per-frame work alone */
         fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=%u step_ms_median=%.6f step_ms_min=%.6f\n", cmd,
-                rad_tool_method_name(mo->method), P->count, reps, 1e3 * times[reps / 2], 1e3 * times[0]);
-        if (mo->method == RAD_TOOL_TEMPORAL)
+                tool_method_name(mo->method), P->count, reps, 1e3 * times[reps / 2], 1e3 * times[0]);
+        if (mo->method == TOOL_TEMPORAL)
             fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
                     cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
-        else if (mo->method == RAD_TOOL_MULTIBOUNCE)
+        else if (mo->method == TOOL_MULTIBOUNCE)
             fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
-        rc = vertex_H_rowsums(P, rad_tool_indirect_rowsums(m), H, Hv);
+        rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
     }
     if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, img);
     if (rc == 0 && mo->sequence) {
         char path[4096];
         snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
-        if (rad_image_write_png(path, img, exposure) != 0) {
-            fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+        if (tool_image_write_png(path, img, exposure) != 0) {
+            fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
             rc = 1;
         }
     }
     free(H);
     free(Hv);
     free(times);
-    rad_tool_indirect_close(m);
+    tool_indirect_close(m);
     return rc;
 }
 
 /* the bake (--bake, checked against the scene) or one made here, then render_method */
-static int render_with_method(const char *cmd, const rad_tool_world *w, const char *bake_path,
-                              const rad_tool_classic_options *o, const rad_tool_method_options *mo,
+static int render_with_method(const char *cmd, const tool_world *w, const char *bake_path,
+                              const tool_classic_options *o, const tool_method_options *mo,
                               const rad_camera *cam, int width, int height, uint32_t aa, uint32_t light_samples,
-                              float exposure, rad_image *img)
+                              float exposure, tool_image *img)
 {
     rad_bake *bake = NULL;
     void *buf = NULL;
@@ -531,10 +531,10 @@ static int render_with_method(const char *cmd, const rad_tool_world *w, const ch
     rad_context ctx;
     rad_result r;
     int rc;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     if (bake_path) {
-        if (mo->given & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_SR |
-                         (mo->method == RAD_TOOL_STOCHASTIC ? RAD_TOOL_OPT_SEED : 0u)))
+        if (mo->given & (TOOL_OPT_MB_BUILD | TOOL_OPT_BOUNCES | TOOL_OPT_MODE | TOOL_OPT_SR |
+                         (mo->method == TOOL_STOCHASTIC ? TOOL_OPT_SEED : 0u)))
             fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile, "
                             "--mode, --sr-* (and the stochastic solve's --seed); those given here are ignored\n",
                     cmd, bake_path);
@@ -547,10 +547,10 @@ static int render_with_method(const char *cmd, const rad_tool_world *w, const ch
             return 1;
         }
     } else {
-        if (rad_tool_method_bake(cmd, w, o, mo, &buf, &size)) return 1;
+        if (tool_method_bake(cmd, w, o, mo, &buf, &size)) return 1;
         if ((r = rad_load_memory(buf, size, &ctx, &bake)) != RAD_SUCCESS) {
             free(buf);
-            return rad_tool_fail(cmd, "rad_load_memory", r);
+            return tool_fail(cmd, "rad_load_memory", r);
         }
         bake_path = "(made here)";
     }
@@ -577,7 +577,7 @@ static double peak_rss_mib(void)
 }
 
 /* rad_vp_create at 'resolution' (progress labelled), or NULL with the error printed */
-static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+static rad_virtual_patches *vp_build(const char *cmd, const tool_world *w, const tool_method_options *mo,
                                      uint32_t resolution)
 {
     rad_vp_options vo;
@@ -587,14 +587,14 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
     rad_vp_options_default(&vo);
     vo.resolution = resolution;
     vo.face_points = mo->face_points;
-    if (mo->method == RAD_TOOL_VP || mo->proxy == RAD_TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
+    if (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
     /* the run-time methods over a proxy take its rows as CSR: O(non-zeros) once built */
     if (mo->proxy) vo.storage = RAD_STORAGE_SPARSE;
-    rad_tool_context(&ctx, "virtual patches");
+    tool_context(&ctx, "virtual patches");
     r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &vp);
-    rad_tool_progress_end();
+    tool_progress_end();
     if (r != RAD_SUCCESS) {
-        rad_tool_fail(cmd, "rad_vp_create", r);
+        tool_fail(cmd, "rad_vp_create", r);
         return NULL;
     }
     fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches, %u voxels, %u samples\n", cmd,
@@ -608,7 +608,7 @@ static rad_virtual_patches *vp_build(const char *cmd, const rad_tool_world *w, c
 }
 
 /* the patch count rad_vp_create would give at 'resolution' (rad_vp_count); 0 or 1 (printed) */
-static int vp_count(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo, uint32_t resolution,
+static int vp_count(const char *cmd, const tool_world *w, const tool_method_options *mo, uint32_t resolution,
                     uint32_t *count)
 {
     rad_vp_options vo;
@@ -618,9 +618,9 @@ static int vp_count(const char *cmd, const rad_tool_world *w, const rad_tool_met
     rad_vp_options_default(&vo);
     vo.resolution = resolution;
     vo.face_points = mo->face_points;
-    if (mo->method == RAD_TOOL_VP || mo->proxy == RAD_TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return rad_tool_fail(cmd, "rad_vp_count", r);
+    if (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
+    tool_context(&ctx, NULL);
+    if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_count", r);
     *count = cnt.patches;
     return 0;
 }
@@ -638,35 +638,35 @@ static int cmp_near(const void *a, const void *b)
 }
 
 static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const float *E,
-                          const rad_tool_method_options *mo, const rad_camera *cam, float *L, double *step_seconds)
+                          const tool_method_options *mo, const rad_camera *cam, float *L, double *step_seconds)
 {
     rad_multibounce *mb = NULL;
     rad_alias_tables *tables[3] = {NULL, NULL, NULL};
     rad_temporal *tp = NULL;
     rad_local *local = NULL;
     uint32_t *order = NULL, n = vp->count, i;
-    double *steps = NULL, t0 = rad_tool_seconds();
+    double *steps = NULL, t0 = tool_seconds();
     const char *what = NULL;
     rad_context ctx;
     rad_result r = RAD_SUCCESS;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     memset(L, 0, sizeof(float) * 3 * (size_t)n);
-    if (mo->method == RAD_TOOL_MULTIBOUNCE || (mo->method == RAD_TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
+    if (mo->method == TOOL_MULTIBOUNCE || (mo->method == TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
         rad_multibounce_options mbo;
         rad_multibounce_options_default(&mbo);
         mbo.bounces = mo->bounces;
-        rad_tool_context(&ctx, "multi-bounce matrix");
+        tool_context(&ctx, "multi-bounce matrix");
         r = rad_multibounce_create(&vp->matrix, vp->albedo, &mbo, &ctx, &mb);
-        rad_tool_progress_end();
-        rad_tool_context(&ctx, NULL);
+        tool_progress_end();
+        tool_context(&ctx, NULL);
         if (r != RAD_SUCCESS) { what = "rad_multibounce_create"; goto done; }
-        if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+        if (mo->method == TOOL_MULTIBOUNCE) {
             if ((r = rad_multibounce_apply(mb, E, L, RAD_OUTPUT_INDIRECT, &ctx)) != RAD_SUCCESS) what = "rad_multibounce_apply";
-            *step_seconds = rad_tool_seconds() - t0;
+            *step_seconds = tool_seconds() - t0;
             goto done;
         }
     }
-    if (mo->method == RAD_TOOL_TEMPORAL) {
+    if (mo->method == TOOL_TEMPORAL) {
         const rad_alias_tables *tp3[3];
         rad_temporal_options to;
         uint32_t count = mb ? 3u : 1u, f;
@@ -679,15 +679,15 @@ static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const 
         rad_temporal_options_default(&to);
         to.mode = mo->mode;
         to.samples = mo->k;
-        to.adaptive = mo->adaptive && !(mo->given & RAD_TOOL_OPT_W);
+        to.adaptive = mo->adaptive && !(mo->given & TOOL_OPT_W);
         to.weight = mo->w;
         to.seed = mo->seed;
         if ((r = rad_temporal_create(tp3, count, vp->albedo, &to, &ctx, &tp)) != RAD_SUCCESS) { what = "rad_temporal_create"; goto done; }
         steps = (double *)xmalloc(sizeof(double) * mo->frames);
         for (f = 0; f < mo->frames; ++f) {
-            double ts = rad_tool_seconds();
+            double ts = tool_seconds();
             if ((r = rad_temporal_step(tp, E, NULL, NULL)) != RAD_SUCCESS) { what = "rad_temporal_step"; goto done; }
-            steps[f] = rad_tool_seconds() - ts;
+            steps[f] = tool_seconds() - ts;
         }
         memcpy(L, rad_temporal_indirect(tp), sizeof(float) * 3 * (size_t)n);
         qsort(steps, mo->frames, sizeof(double), cmp_double);
@@ -695,10 +695,10 @@ static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const 
         fprintf(stderr, "rad %s: temporal over %u virtual patches: %u frames, k %u, tables %.1f MiB, step %.3f ms (median)\n",
                 cmd, n, mo->frames, mo->k, (double)(rad_alias_tables_memory(tables[0]) * count) / 1048576.0,
                 1e3 * *step_seconds);
-    } else if (mo->method == RAD_TOOL_LOCAL) {
+    } else if (mo->method == TOOL_LOCAL) {
         rad_row_source src;
         rad_local_options lo;
-        uint32_t m = mo->local_m ? mo->local_m : (n < RAD_TOOL_LOCAL_M_AUTO_MAX ? n : RAD_TOOL_LOCAL_M_AUTO_MAX);
+        uint32_t m = mo->local_m ? mo->local_m : (n < TOOL_LOCAL_M_AUTO_MAX ? n : TOOL_LOCAL_M_AUTO_MAX);
         proxy_near *d2 = (proxy_near *)xmalloc(sizeof(proxy_near) * (size_t)n);
         if (m > n) m = n;
         order = (uint32_t *)xmalloc(sizeof(uint32_t) * (size_t)n);
@@ -723,13 +723,13 @@ static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const 
         lo.capacity = m;
         if ((r = rad_row_source_matrix(&vp->matrix, vp->areas, vp->albedo, &src)) != RAD_SUCCESS) { what = "rad_row_source_matrix"; goto done; }
         if ((r = rad_local_create(&src, &lo, &ctx, &local)) != RAD_SUCCESS) { what = "rad_local_create"; goto done; }
-        rad_tool_context(&ctx, "local matrix");
+        tool_context(&ctx, "local matrix");
         r = rad_local_rebuild(local, order, m, &ctx);
-        rad_tool_progress_end();
-        rad_tool_context(&ctx, NULL);
+        tool_progress_end();
+        tool_context(&ctx, NULL);
         if (r != RAD_SUCCESS) { what = "rad_local_rebuild"; goto done; }
-        if ((r = rad_local_apply(local, E, NULL, 0, NULL, 0, RAD_OUTPUT_INDIRECT, L, &ctx)) != RAD_SUCCESS) { what = "rad_local_apply"; goto done; }
-        *step_seconds = rad_tool_seconds() - t0;
+        if ((r = rad_local_apply(local, E, NULL, 0, NULL, 0, L, RAD_OUTPUT_INDIRECT, &ctx)) != RAD_SUCCESS) { what = "rad_local_apply"; goto done; }
+        *step_seconds = tool_seconds() - t0;
         fprintf(stderr, "rad %s: local matrix over %u of %u virtual patches (nearest the camera)\n", cmd, m, n);
     }
 done:
@@ -739,7 +739,7 @@ done:
     rad_temporal_destroy(tp);
     for (i = 0; i < 3; ++i) rad_alias_tables_destroy(tables[i]);
     rad_multibounce_destroy(mb);
-    return what ? rad_tool_fail(cmd, what, r) : 0;
+    return what ? tool_fail(cmd, what, r) : 0;
 }
 
 /* --method temporal --proxy aavp|vp with --light-path or --sequence: the frames of a light
@@ -750,8 +750,8 @@ done:
    per pixel from the moved light), and the last. The light ends where the last frame puts it,
    so the final image (rendered by the caller from E and L) is that frame. Stage times: their
    medians. */
-static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const rad_virtual_patches *vp, float *E,
-                                 const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
+static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad_virtual_patches *vp, float *E,
+                                 const tool_method_options *mo, const rad_camera *cam, int width, int height,
                                  uint32_t aa, uint32_t light_samples, uint32_t patch_light_samples, float exposure,
                                  float *L, double *step_seconds)
 {
@@ -770,7 +770,7 @@ static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const
     float *B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n), *H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     uint64_t rays = 0;
     int rc = 0;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     if (mo->light_path) {
         for (i = w->file.light_count; i > w->file_light_count; --i)
             if (w->file.lights[i - 1].type == RAD_LIGHT_POINT || w->file.lights[i - 1].type == RAD_LIGHT_SPOT) {
@@ -788,7 +788,7 @@ static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const
     rad_temporal_options_default(&to);
     to.mode = mo->mode;
     to.samples = mo->k;
-    to.adaptive = mo->adaptive && !(mo->given & RAD_TOOL_OPT_W);
+    to.adaptive = mo->adaptive && !(mo->given & TOOL_OPT_W);
     to.weight = mo->w;
     to.seed = mo->seed;
     if ((r = rad_temporal_create(tp1, 1, vp->albedo, &to, &ctx, &tp)) != RAD_SUCCESS) { what = "rad_temporal_create"; goto done; }
@@ -815,21 +815,21 @@ static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const
                 moving->position[2] = q[2] + q[3] * sinf(a);
             }
         }
-        t0 = rad_tool_seconds();
+        t0 = tool_seconds();
         if ((r = rad_vp_lights_update(dyn, w->file.lights, w->file.light_count, E, &ctx)) != RAD_SUCCESS) { what = "rad_vp_lights_update"; goto done; }
-        te[f - 1] = rad_tool_seconds() - t0;
+        te[f - 1] = tool_seconds() - t0;
         rays += rad_vp_lights_rays(dyn);
-        t0 = rad_tool_seconds();
+        t0 = tool_seconds();
         if ((r = rad_temporal_step(tp, E, NULL, L)) != RAD_SUCCESS) { what = "rad_temporal_step"; goto done; }
-        ts[f - 1] = rad_tool_seconds() - t0;
+        ts[f - 1] = tool_seconds() - t0;
         if (mo->sequence && (f % mo->every == 0 || f == frames)) { /* the last one too, as render_method */
             char path[4096];
-            rad_image frame;
+            tool_image frame;
             memset(&frame, 0, sizeof frame);
             for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
             if ((r = rad_matrix_multiply(&vp->matrix, B, H, &ctx)) != RAD_SUCCESS) { what = "rad_matrix_multiply"; goto done; }
             snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, f);
-            if (rad_image_alloc(&frame, width, height) != 0) {
+            if (tool_image_alloc(&frame, width, height) != 0) {
                 fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
                 rc = 1;
                 goto done;
@@ -837,11 +837,11 @@ static int proxy_temporal_frames(const char *cmd, const rad_tool_world *w, const
             render_vp = vp, render_vp_H = H;
             rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, &frame);
             render_vp = NULL, render_vp_H = NULL;
-            if (rc == 0 && rad_image_write_png(path, &frame, exposure) != 0) {
-                fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
+            if (rc == 0 && tool_image_write_png(path, &frame, exposure) != 0) {
+                fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
                 rc = 1;
             }
-            rad_image_free(&frame);
+            tool_image_free(&frame);
             if (rc) goto done;
         }
     }
@@ -860,7 +860,7 @@ done:
     rad_vp_lights_destroy(dyn);
     rad_temporal_destroy(tp);
     rad_alias_tables_destroy(tables);
-    if (what) return rad_tool_fail(cmd, what, r);
+    if (what) return tool_fail(cmd, what, r);
     return rc;
 }
 
@@ -870,7 +870,7 @@ done:
 /* --bake FILE with --method aavp|vp or --proxy: the set saved by rad bake --method aavp|vp
    (rad_vp_load, checked against the scene's signature and the kind asked for) and its E into
    *E_out; NULL with the error printed */
-static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, const rad_tool_world *w, int clustered,
+static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, const tool_world *w, int clustered,
                                          float **E_out)
 {
     FILE *f = fopen(path, "rb");
@@ -894,8 +894,8 @@ static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, cons
         free(buf);
         return NULL;
     }
-    rad_tool_context(&ctx, NULL);
-    if ((r = rad_container_open(buf, (size_t)size, &ctx, &ct)) != RAD_SUCCESS ||
+    tool_context(&ctx, NULL);
+    if ((r = rad_container_create(buf, (size_t)size, &ctx, &ct)) != RAD_SUCCESS ||
         (r = rad_vp_load(ct, "vp", w->scene, &ctx, &vp)) != RAD_SUCCESS) {
         fprintf(stderr, "rad %s: bake '%s' holds no virtual patches (bake them with --method aavp|vp): %s\n", cmd, path,
                 rad_result_string(r));
@@ -909,15 +909,15 @@ static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, cons
     }
     {
         /* the options record and the command line's lights (a bake lit by --sun holds that sun's E) */
-        const rad_section *so = rad_container_find(ct, RAD_TOOL_SECTION_OPTIONS, "rad.options");
-        rad_tool_bake_info info;
+        const rad_section *so = rad_container_find(ct, TOOL_SECTION_OPTIONS, "rad.options");
+        tool_bake_info info;
         uint64_t want;
         if (!so || so->elem_size != sizeof info || so->count != 1) {
             fprintf(stderr, "rad %s: bake '%s' holds no rad.options record\n", cmd, path);
             goto fail;
         }
         memcpy(&info, so->data, sizeof info);
-        want = rad_tool_options_hash(&info, w);
+        want = tool_options_hash(&info, w);
         if (memcmp((const unsigned char *)sg->data + 16, &want, 8)) {
             fprintf(stderr, "rad %s: bake '%s' was made with other lights or options (the --sun, --sky, --point, --spot "
                             "of the bake must be given again)\n", cmd, path);
@@ -946,7 +946,7 @@ static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, cons
                 goto fail;
             }
     }
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(buf);
     fprintf(stderr, "rad %s: loaded %u virtual patches (%llu non-zeros) from '%s'\n", cmd, vp->count,
             vp->matrix.storage == RAD_STORAGE_SPARSE ? (unsigned long long)vp->matrix.row_offsets[vp->count]
@@ -954,14 +954,14 @@ static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, cons
     return vp;
 fail:
     rad_vp_destroy(vp);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     free(buf);
     return NULL;
 }
 
-static int render_vp_method(const char *cmd, const rad_tool_world *w, const char *bake_path,
-                            const rad_tool_classic_options *o, const rad_tool_method_options *mo, const rad_camera *cam,
-                            int width, int height, uint32_t aa, uint32_t light_samples, float exposure, rad_image *img)
+static int render_vp_method(const char *cmd, const tool_world *w, const char *bake_path,
+                            const tool_classic_options *o, const tool_method_options *mo, const rad_camera *cam,
+                            int width, int height, uint32_t aa, uint32_t light_samples, float exposure, tool_image *img)
 {
     rad_virtual_patches *vp = NULL;
     rad_direct_options dopt;
@@ -972,22 +972,22 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const char
     rad_result r;
     float *E = NULL, *L = NULL, *B = NULL, *H = NULL;
     uint32_t n, i, res = mo->vp_resolution;
-    double t0 = rad_tool_seconds(), t_build, t_E, t_solve, t_step = 0.0;
+    double t0 = tool_seconds(), t_build, t_E, t_solve, t_step = 0.0;
     int rc = 0;
     if (bake_path) {
-        if (mo->given & RAD_TOOL_OPT_VP) {
+        if (mo->given & TOOL_OPT_VP) {
             fprintf(stderr, "rad %s: --vp-resolution, --vp-max-patches and --face-points are the bake's with --bake\n", cmd);
             return 1;
         }
-        if (!(vp = vp_load_bake(cmd, bake_path, w, mo->method == RAD_TOOL_VP || mo->proxy == RAD_TOOL_PROXY_VP, &E)))
+        if (!(vp = vp_load_bake(cmd, bake_path, w, mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP, &E)))
             return 1;
-    } else if (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES) {
+    } else if (mo->given & TOOL_OPT_VP_MAX_PATCHES) {
         /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build
            up to the patches, without the form factors that take nearly all of its time), then
            one build. The count grows about as R^2 (surface voxels): predict from the nearest
            count, count, narrow the bracket [lo, hi) to adjacent resolutions. */
         uint32_t lo = 0, hi = 4097, counts = 0, c = 0;
-        double tc = rad_tool_seconds();
+        double tc = tool_seconds();
         res = mo->vp_resolution ? mo->vp_resolution : 16;
         while (counts < 24 && hi - lo > 1) {
             uint32_t next;
@@ -1007,12 +1007,12 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const char
         }
         res = lo;
         fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd,
-                mo->vp_max_patches, res, counts, rad_tool_seconds() - tc);
+                mo->vp_max_patches, res, counts, tool_seconds() - tc);
         if (!(vp = vp_build(cmd, w, mo, res))) return 1;
     } else if (!(vp = vp_build(cmd, w, mo, res))) {
         return 1;
     }
-    t_build = rad_tool_seconds() - t0;
+    t_build = tool_seconds() - t0;
     n = vp->count;
     if (!E) E = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
@@ -1021,22 +1021,22 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const char
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
     dopt.light_samples = o->light_samples;
-    rad_tool_context(&ctx, "direct light");
-    t0 = rad_tool_seconds();
+    tool_context(&ctx, "direct light");
+    t0 = tool_seconds();
     r = bake_path ? RAD_SUCCESS /* the bake's E */
                   : rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
-    rad_tool_progress_end();
-    t_E = rad_tool_seconds() - t0;
-    if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "rad_vp_sources", r);
+    tool_progress_end();
+    t_E = tool_seconds() - t0;
+    if (r != RAD_SUCCESS) rc = tool_fail(cmd, "rad_vp_sources", r);
     if (rc == 0) {
         rad_vp_system(&sys, vp, E);
         rad_solve_options_default(&so);
         so.output = RAD_OUTPUT_INDIRECT;
         so.bounces = mo->bounces;
         memset(&stats, 0, sizeof stats);
-        rad_tool_context(&ctx, NULL);
-        t0 = rad_tool_seconds();
-        if (mo->proxy && mo->method == RAD_TOOL_TEMPORAL && (mo->light_path || mo->sequence)) {
+        tool_context(&ctx, NULL);
+        t0 = tool_seconds();
+        if (mo->proxy && mo->method == TOOL_TEMPORAL && (mo->light_path || mo->sequence)) {
             r = RAD_SUCCESS;
             if (proxy_temporal_frames(cmd, w, vp, E, mo, cam, width, height, aa, light_samples, o->light_samples, exposure,
                                       L, &t_step)) rc = 1;
@@ -1055,13 +1055,13 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const char
         }
         for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
         if (r == RAD_SUCCESS && rc == 0) r = rad_matrix_multiply(&vp->matrix, B, H, &ctx);
-        t_solve = rad_tool_seconds() - t0;
+        t_solve = tool_seconds() - t0;
         if (!mo->proxy) t_step = t_solve;
-        if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "solve", r);
+        if (r != RAD_SUCCESS) rc = tool_fail(cmd, "solve", r);
     }
     if (rc == 0) {
         render_vp = vp, render_vp_H = H, render_vp_gather_seconds = 0.0;
-        t0 = rad_tool_seconds();
+        t0 = tool_seconds();
         rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
         render_vp = NULL, render_vp_H = NULL;
         /* one line for scripts: step = the solve (K bounces + H = F B) as classic's */
@@ -1069,13 +1069,13 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const char
             fprintf(stderr, "rad %s: timing: method=%s%s patches=%u frames=%u bounces=%s%.0u step_ms_median=%.6f "
                             "step_ms_min=%.6f build_ms=%.1f sources_ms=%.1f gather_ms=%.1f render_ms=%.1f "
                             "resolution=%u vp_mib=%.1f peak_rss_mib=%.1f\n",
-                    cmd, rad_tool_method_name(mo->method),
-                    mo->proxy == RAD_TOOL_PROXY_VP ? " proxy=vp" : mo->proxy ? " proxy=aavp" : "", n,
-                    mo->proxy && mo->method == RAD_TOOL_TEMPORAL ? mo->frames : 1u,
+                    cmd, tool_method_name(mo->method),
+                    mo->proxy == TOOL_PROXY_VP ? " proxy=vp" : mo->proxy ? " proxy=aavp" : "", n,
+                    mo->proxy && mo->method == TOOL_TEMPORAL ? mo->frames : 1u,
                     mo->bounces == RAD_MB_INFINITE ? "inf" : "",
                     mo->bounces == RAD_MB_INFINITE ? 0u : mo->bounces,
                     1e3 * t_step, 1e3 * t_step, 1e3 * t_build, 1e3 * t_E, 1e3 * render_vp_gather_seconds,
-                    1e3 * (rad_tool_seconds() - t0), res, (double)rad_vp_memory(vp) / 1048576.0, peak_rss_mib());
+                    1e3 * (tool_seconds() - t0), res, (double)rad_vp_memory(vp) / 1048576.0, peak_rss_mib());
         }
     }
     free(E);
@@ -1086,28 +1086,28 @@ static int render_vp_method(const char *cmd, const rad_tool_world *w, const char
     return rc;
 }
 
-/* --method hierarchical: the solution (rad_tool_hierarchical_build), then the classic render
+/* --method hierarchical: the solution (tool_hierarchical_build), then the classic render
    with H looked up at each sample */
-static int render_hr_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                            const rad_tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
-                            uint32_t light_samples, rad_image *img)
+static int render_hr_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                            const tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
+                            uint32_t light_samples, tool_image *img)
 {
     rad_hierarchical *h = NULL;
     rad_hierarchical_stats st;
-    double t0 = rad_tool_seconds(), t_solve;
+    double t0 = tool_seconds(), t_solve;
     int rc;
-    if (rad_tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) return 1;
-    t_solve = rad_tool_seconds() - t0;
+    if (tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) return 1;
+    t_solve = tool_seconds() - t0;
     rad_hierarchical_get_stats(h, &st);
     render_hr = h;
-    t0 = rad_tool_seconds();
+    t0 = tool_seconds();
     rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
     render_hr = NULL;
     if (rc == 0)
         fprintf(stderr, "rad %s: timing: method=hierarchical patches=%u frames=1 step_ms_median=%.6f step_ms_min=%.6f "
                         "links=%llu kernels=%llu rays=%llu render_ms=%.1f\n",
                 cmd, st.leaves, 1e3 * t_solve, 1e3 * t_solve, (unsigned long long)st.links,
-                (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, 1e3 * (rad_tool_seconds() - t0));
+                (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, 1e3 * (tool_seconds() - t0));
     rad_hierarchical_destroy(h);
     return rc;
 }
@@ -1115,12 +1115,12 @@ static int render_hr_method(const char *cmd, const rad_tool_world *w, const rad_
 /* --method local: the classic patches, F and E; a local matrix of capacity M over F's
    rows filled with the M patches nearest the camera (rad_local_rebuild), L = T E over P_Vis x
    P_Lit, H = L / rho (L = rho F (E + L) within the set), rendered as classic. */
-static int render_local_method(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *oc,
-                               const rad_tool_method_options *mo, const rad_camera *cam, int width, int height,
-                               uint32_t aa, uint32_t light_samples, rad_image *img)
+static int render_local_method(const char *cmd, const tool_world *w, const tool_classic_options *oc,
+                               const tool_method_options *mo, const rad_camera *cam, int width, int height,
+                               uint32_t aa, uint32_t light_samples, tool_image *img)
 {
-    rad_tool_classic_options o = *oc;
-    rad_tool_classic sol;
+    tool_classic_options o = *oc;
+    tool_classic sol;
     rad_local_options lo;
     rad_local *local = NULL;
     rad_row_source src;
@@ -1132,10 +1132,10 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
     double t0, t_rebuild = 0.0, times[9];
     int rc = 0, k;
     o.sources_only = 1;
-    if (rad_tool_classic_solve(cmd, w, &o, &sol)) return 1;
+    if (tool_classic_solve(cmd, w, &o, &sol)) return 1;
     n = sol.patches->count;
     if (mo->local_m == 0) { /* the default: the whole scene when it is small enough */
-        m = n < RAD_TOOL_LOCAL_M_AUTO_MAX ? n : RAD_TOOL_LOCAL_M_AUTO_MAX;
+        m = n < TOOL_LOCAL_M_AUTO_MAX ? n : TOOL_LOCAL_M_AUTO_MAX;
         if (m < n)
             fprintf(stderr, "rad %s: warning: the default --local-m covers %u of the %u patches (the nearest to the "
                             "camera; the others get no indirect light): give --local-m %u for all of them\n",
@@ -1157,26 +1157,26 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
         for (c = 0; c < 3; ++c) albedo[3 * i + c] = sol.patches->patches[i].albedo[c];
     }
     for (i = 0; i < 3 * n; ++i) L[i] = 0.0f;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     rad_local_options_default(&lo);
     lo.capacity = m;
     r = rad_row_source_matrix(&sol.ff->matrix, areas, albedo, &src);
     if (r == RAD_SUCCESS) r = rad_local_create(&src, &lo, &ctx, &local);
     if (r == RAD_SUCCESS) r = rad_local_nearest(sol.patches, cam->position, m, set, &ctx);
     if (r == RAD_SUCCESS) {
-        t0 = rad_tool_seconds();
+        t0 = tool_seconds();
         r = rad_local_rebuild(local, set, m, &ctx);
-        t_rebuild = rad_tool_seconds() - t0;
+        t_rebuild = tool_seconds() - t0;
     }
     if (r == RAD_SUCCESS)
         r = rad_local_visible(sol.patches, &w->rc, cam, (float)width / (float)height, set, m, vis, &nvis, &ctx);
     if (r == RAD_SUCCESS) r = rad_local_lit(sol.E, set, m, 0.0f, lit, &nlit);
     for (k = 0; k < 9 && r == RAD_SUCCESS; ++k) {
-        t0 = rad_tool_seconds();
-        r = rad_local_apply(local, sol.E, vis, nvis, lit, nlit, RAD_OUTPUT_INDIRECT, L, &ctx);
-        times[k] = rad_tool_seconds() - t0;
+        t0 = tool_seconds();
+        r = rad_local_apply(local, sol.E, vis, nvis, lit, nlit, L, RAD_OUTPUT_INDIRECT, &ctx);
+        times[k] = tool_seconds() - t0;
     }
-    if (r != RAD_SUCCESS) rc = rad_tool_fail(cmd, "local matrix", r);
+    if (r != RAD_SUCCESS) rc = tool_fail(cmd, "local matrix", r);
     if (rc == 0) {
         qsort(times, 9, sizeof(double), cmp_double);
         fprintf(stderr, "rad %s: local matrix: M = %u of %u patches, |P_Vis| = %u, |P_Lit| = %u, %.1f MiB\n", cmd, m,
@@ -1199,37 +1199,37 @@ static int render_local_method(const char *cmd, const rad_tool_world *w, const r
     free(set);
     free(vis);
     free(lit);
-    rad_tool_classic_free(&sol);
+    tool_classic_free(&sol);
     return rc;
 }
 
-static int render_main(int argc, char **argv, rad_tool_lights *lights)
+static int render_main(int argc, char **argv, tool_lights *lights)
 {
     const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
-    rad_tool_classic_options o;
-    rad_tool_method_options mo;
-    rad_tool_world w;
+    tool_classic_options o;
+    tool_method_options mo;
+    tool_world w;
     rad_camera cam;
-    rad_image img;
+    tool_image img;
     rad_context ctx;
     int width = 512, height = 512, a, rc, have_cam = 0, pathtrace;
     uint32_t aa = 16, spp = 64, seed = 0, threads = 0, pixel_light_samples = 16;
     int lightmap_opts = 0;
     float fov = 0.0f, exposure = 1.0f;
-    double t0 = rad_tool_seconds();
-    rad_tool_classic_options_default(&o);
-    rad_tool_method_options_default(&mo);
+    double t0 = tool_seconds();
+    tool_classic_options_default(&o);
+    tool_method_options_default(&mo);
     memset(&img, 0, sizeof img);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { render_usage(stdout); return 0; }
-        rc = rad_tool_method_option(cmd, argc, argv, &a, &mo); /* --method, --seed and the methods' options */
+        rc = tool_method_option(cmd, argc, argv, &a, &mo); /* --method, --seed and the methods' options */
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        rc = rad_tool_classic_option(cmd, argc, argv, &a, &o);
+        rc = tool_classic_option(cmd, argc, argv, &a, &o);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        rc = rad_tool_light_option(cmd, argc, argv, &a, lights);
+        rc = tool_light_option(cmd, argc, argv, &a, lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if (opt[0] == '-' && opt[1] && a + 1 >= argc) {
@@ -1239,45 +1239,45 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         if (!strcmp(opt, "-o")) out_path = argv[++a];
         else if (!strcmp(opt, "--bake")) bake_path = argv[++a];
         else if (!strcmp(opt, "--camera")) {
-            if (rad_tool_parse_camera(argv[++a], &cam)) {
+            if (tool_parse_camera(argv[++a], &cam)) {
                 fprintf(stderr, "rad %s: bad camera '%s' (want PX,PY,PZ:TX,TY,TZ:UX,UY,UZ)\n", cmd, argv[a]);
                 return 2;
             }
             have_cam = 1;
         } else if (!strcmp(opt, "--fov")) {
-            if (rad_tool_parse_float(cmd, opt, argv[++a], &fov)) return 2;
+            if (tool_parse_float(cmd, opt, argv[++a], &fov)) return 2;
             if (!(fov > 0.0f && fov < 180.0f)) { fprintf(stderr, "rad %s: --fov must be in (0, 180)\n", cmd); return 2; }
         } else if (!strcmp(opt, "--size")) {
-            if (rad_tool_parse_size(argv[++a], &width, &height)) {
+            if (tool_parse_size(argv[++a], &width, &height)) {
                 fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, argv[a]);
                 return 2;
             }
-            if (rad_tool_check_size(cmd, width, height)) return 2;
+            if (tool_check_size(cmd, width, height)) return 2;
         } else if (!strcmp(opt, "--aa")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
+            if (tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
             if (aa == 0) { fprintf(stderr, "rad %s: --aa must be > 0\n", cmd); return 2; }
         } else if (!strcmp(opt, "--spp")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &spp)) return 2;
+            if (tool_parse_uint(cmd, opt, argv[++a], &spp)) return 2;
             if (spp == 0 || spp > 1u << 20) { fprintf(stderr, "rad %s: --spp must be in 1..1048576\n", cmd); return 2; }
         } else if (!strcmp(opt, "--pixel-light-samples")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
+            if (tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
             if (pixel_light_samples == 0) { fprintf(stderr, "rad %s: %s must be > 0\n", cmd, opt); return 2; }
         } else if (!strcmp(opt, "--lightmap-size") || !strcmp(opt, "--texel-samples") || !strcmp(opt, "--visibility-rays")) {
             uint32_t *dst = opt[2] == 'l' ? &render_lm_size : opt[2] == 't' ? &render_lm_samples : &render_lm_vis;
             uint32_t lo = opt[2] == 'l' ? 4u : 1u, hi = opt[2] == 'l' ? 16384u : opt[2] == 't' ? 16u : 64u;
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
+            if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
             if (*dst < lo || *dst > hi) { fprintf(stderr, "rad %s: %s must be %u to %u\n", cmd, opt, lo, hi); return 2; }
             lightmap_opts = 1;
         } else if (!strcmp(opt, "--final-gather")) {
-            if (rad_tool_parse_uint(cmd, opt, argv[++a], &render_final_gather)) return 2;
+            if (tool_parse_uint(cmd, opt, argv[++a], &render_final_gather)) return 2;
             if (render_final_gather > 4096) { fprintf(stderr, "rad %s: %s is at most 4096\n", cmd, opt); return 2; }
         } else if (!strcmp(opt, "--exposure")) {
-            if (rad_tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
+            if (tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
             if (!(exposure > 0.0f)) { fprintf(stderr, "rad %s: --exposure must be > 0\n", cmd); return 2; }
         } else if (!strcmp(opt, "--shading")) {
-            if (rad_tool_parse_shading(cmd, argv[++a], &render_shading)) return 2;
+            if (tool_parse_shading(cmd, argv[++a], &render_shading)) return 2;
         } else if (!strcmp(opt, "--threads")) {
-            if (rad_tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
+            if (tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad render --help)\n", cmd, opt);
             return 2;
@@ -1289,25 +1289,25 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         render_usage(stderr);
         return 2;
     }
-    if (rad_tool_method_check(cmd, 1, &mo, &o)) return 2;
-    if (lightmap_opts && mo.method != RAD_TOOL_LIGHTMAP) {
+    if (tool_method_check(cmd, 1, &mo, &o)) return 2;
+    if (lightmap_opts && mo.method != TOOL_LIGHTMAP) {
         fprintf(stderr, "rad %s: --lightmap-size, --texel-samples and --visibility-rays are for --method lightmap\n", cmd);
         return 2;
     }
-    if (mo.method == RAD_TOOL_LIGHTMAP && (bake_path || render_final_gather)) {
+    if (mo.method == TOOL_LIGHTMAP && (bake_path || render_final_gather)) {
         fprintf(stderr, "rad %s: --method lightmap bakes its own lightmap: %s is not used\n", cmd,
                 bake_path ? "--bake" : "--final-gather");
         return 2;
     }
-    rad_tool_dense_plan(&o, &mo, 0);
-    method = rad_tool_method_name(mo.method);
+    tool_dense_plan(&o, &mo, 0);
+    method = tool_method_name(mo.method);
     seed = mo.seed;
-    pathtrace = mo.method == RAD_TOOL_PATHTRACE;
+    pathtrace = mo.method == TOOL_PATHTRACE;
     if (pathtrace && render_shading >= 0) {
         fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
-    if (mo.method == RAD_TOOL_LOCAL && !mo.proxy && bake_path) {
+    if (mo.method == TOOL_LOCAL && !mo.proxy && bake_path) {
         fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd, method);
         return 2;
     }
@@ -1315,15 +1315,15 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
     }
-    if (rad_image_check_format(cmd, out_path)) return 2;
+    if (tool_image_check_format(cmd, out_path)) return 2;
     {
         const char *inputs[2];
         inputs[0] = scene_name;
         inputs[1] = bake_path;
-        if (rad_tool_check_output(cmd, out_path, inputs, 2)) return 1;
+        if (tool_check_output(cmd, out_path, inputs, 2)) return 1;
     }
-    rad_tool_set_threads((int)threads);
-    if (rad_tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
+    tool_set_threads((int)threads);
+    if (tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
     {
         uint32_t t, emitters = 0;
         for (t = 0; t < w.scene->triangle_count; ++t) {
@@ -1332,8 +1332,8 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         }
         if (!emitters && !w.file.light_count)
             fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_LOCAL || mo.method == RAD_TOOL_STOCHASTIC ||
-             mo.method == RAD_TOOL_LIGHTMAP) &&
+        if ((mo.method <= TOOL_TEMPORAL || mo.method == TOOL_LOCAL || mo.method == TOOL_STOCHASTIC ||
+             mo.method == TOOL_LIGHTMAP) &&
             !mo.proxy && !pathtrace && !bake_path &&
             o.patches < w.scene->triangle_count)
             fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
@@ -1341,19 +1341,19 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
     }
     if (!have_cam) {
         if (w.file.has_camera) cam = w.file.camera;
-        else rad_tool_choose_camera(cmd, w.scene, &w.rc, width, height, &cam);
+        else tool_choose_camera(cmd, w.scene, &w.rc, width, height, &cam);
     } else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
     if (fov > 0.0f) cam.fov_y_degrees = fov;
-    if (rad_image_alloc(&img, width, height) != 0) {
+    if (tool_image_alloc(&img, width, height) != 0) {
         fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
-        rad_tool_close_world(&w);
+        tool_close_world(&w);
         return 1;
     }
 
-    if (mo.method == RAD_TOOL_LIGHTMAP) {
-        rad_tool_lightmap_baked bk;
+    if (mo.method == TOOL_LIGHTMAP) {
+        tool_lightmap_baked bk;
         int lsz = (int)render_lm_size;
-        rc = rad_tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0, &bk);
+        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0, &bk);
         if (rc == 0) {
             fprintf(stderr, "rad %s: timing: method=lightmap patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                             "step_ms_min=%.6f\n",
@@ -1363,52 +1363,52 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
             rc = render_classic(&bk.w, bk.cl.patches, NULL, &cam, width, height, aa, pixel_light_samples, &img);
             render_lm = NULL;
             render_lm_values = NULL;
-            rad_tool_lightmap_bake_free(&bk);
+            tool_lightmap_bake_free(&bk);
         }
         if (rc) {
-            rad_image_free(&img);
-            rad_tool_close_world(&w);
+            tool_image_free(&img);
+            tool_close_world(&w);
             return 1;
         }
-    } else if ((mo.method >= RAD_TOOL_LOCAL && !(mo.method == RAD_TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
-        rc = mo.method == RAD_TOOL_LOCAL && !mo.proxy
+    } else if ((mo.method >= TOOL_LOCAL && !(mo.method == TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
+        rc = mo.method == TOOL_LOCAL && !mo.proxy
                  ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
-             : mo.method == RAD_TOOL_HIERARCHICAL
+             : mo.method == TOOL_HIERARCHICAL
                  ? render_hr_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
                  : render_vp_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                     &img);
         if (rc) {
-            rad_image_free(&img);
-            rad_tool_close_world(&w);
+            tool_image_free(&img);
+            tool_close_world(&w);
             return 1;
         }
-    } else if (mo.method == RAD_TOOL_MULTIBOUNCE || mo.method == RAD_TOOL_TEMPORAL || mo.method == RAD_TOOL_STOCHASTIC ||
-               mo.method == RAD_TOOL_HIERARCHICAL) { /* hierarchical here: from a bake (resampled onto its patches) */
+    } else if (mo.method == TOOL_MULTIBOUNCE || mo.method == TOOL_TEMPORAL || mo.method == TOOL_STOCHASTIC ||
+               mo.method == TOOL_HIERARCHICAL) { /* hierarchical here: from a bake (resampled onto its patches) */
         rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
                                 &img);
         if (rc) {
-            rad_image_free(&img);
-            rad_tool_close_world(&w);
+            tool_image_free(&img);
+            tool_close_world(&w);
             return 1;
         }
     } else if (pathtrace) {
-        rad_trace_options to;
+        tool_trace_options to;
         rad_result r;
-        rad_trace_options_default(&to);
+        tool_trace_options_default(&to);
         to.width = width;
         to.height = height;
         to.spp = (int)spp;
         to.seed = seed;
-        rad_tool_context(&ctx, "path tracing");
-        r = (rad_result)rad_trace_image(w.scene, &w.rc, w.file.lights, w.file.light_count, &cam, &to, &ctx, &img);
-        rad_tool_progress_end();
+        tool_context(&ctx, "path tracing");
+        r = (rad_result)tool_trace_image(w.scene, &w.rc, w.file.lights, w.file.light_count, &cam, &to, &ctx, &img);
+        tool_progress_end();
         if (r != RAD_SUCCESS) {
-            rad_image_free(&img);
-            rad_tool_close_world(&w);
-            return rad_tool_fail(cmd, "rad_trace_image", r);
+            tool_image_free(&img);
+            tool_close_world(&w);
+            return tool_fail(cmd, "tool_trace_image", r);
         }
     } else {
-        rad_tool_classic sol;
+        tool_classic sol;
         rad_bake *bake = NULL;
         const rad_patches *P;
         const float *H;
@@ -1417,25 +1417,25 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         if (bake_path) {
             const rad_section *hs;
             rad_result r;
-            rad_tool_context(&ctx, NULL);
+            tool_context(&ctx, NULL);
             if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
                 fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
-                rad_image_free(&img);
-                rad_tool_close_world(&w);
+                tool_image_free(&img);
+                tool_close_world(&w);
                 return 1;
             }
             rc = bake_fits_scene(cmd, bake_path, bake, &w);
             if (rc == 0 && (bake->F.rows == 0 || !bake->B)) {
                 fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B%s\n", cmd, bake_path,
-                        rad_container_find(bake->container, RAD_TOOL_SECTION_METHOD, "rad.method")
+                        rad_container_find(bake->container, TOOL_SECTION_METHOD, "rad.method")
                             ? " (it is a multibounce or temporal bake: render it with that --method)"
                             : "");
                 rc = 1;
             }
             if (rc) {
                 rad_bake_destroy(bake);
-                rad_image_free(&img);
-                rad_tool_close_world(&w);
+                tool_image_free(&img);
+                tool_close_world(&w);
                 return 1;
             }
             bake->patches.scene = w.scene;
@@ -1449,17 +1449,17 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
                 if ((r = rad_matrix_multiply(&bake->F, bake->B, Hmine, &ctx)) != RAD_SUCCESS) {
                     free(Hmine);
                     rad_bake_destroy(bake);
-                    rad_image_free(&img);
-                    rad_tool_close_world(&w);
-                    return rad_tool_fail(cmd, "rad_matrix_multiply", r);
+                    tool_image_free(&img);
+                    tool_close_world(&w);
+                    return tool_fail(cmd, "rad_matrix_multiply", r);
                 }
                 H = Hmine;
             }
             fprintf(stderr, "rad %s: bake '%s': %u patches\n", cmd, bake_path, P->count);
         } else {
-            if (rad_tool_classic_solve(cmd, &w, &o, &sol)) {
-                rad_image_free(&img);
-                rad_tool_close_world(&w);
+            if (tool_classic_solve(cmd, &w, &o, &sol)) {
+                tool_image_free(&img);
+                tool_close_world(&w);
                 return 1;
             }
             P = sol.patches;
@@ -1474,31 +1474,31 @@ static int render_main(int argc, char **argv, rad_tool_lights *lights)
         free(Hv);
         free(Hmine);
         rad_bake_destroy(bake);
-        rad_tool_classic_free(&sol);
+        tool_classic_free(&sol);
         if (rc) {
-            rad_image_free(&img);
-            rad_tool_close_world(&w);
+            tool_image_free(&img);
+            tool_close_world(&w);
             return 1;
         }
     }
-    if (rad_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, rad_tool_output_error());
-        rad_image_free(&img);
-        rad_tool_close_world(&w);
+    if (tool_image_write(out_path, &img, exposure) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+        tool_image_free(&img);
+        tool_close_world(&w);
         return 1;
     }
-    printf("wrote %s (%dx%d, %s) in %.2f s\n", out_path, width, height, method, rad_tool_seconds() - t0);
-    rad_image_free(&img);
-    rad_tool_close_world(&w);
+    printf("wrote %s (%dx%d, %s) in %.2f s\n", out_path, width, height, method, tool_seconds() - t0);
+    tool_image_free(&img);
+    tool_close_world(&w);
     return 0;
 }
 
-int rad_cmd_render(int argc, char **argv)
+int tool_cmd_render(int argc, char **argv)
 {
-    rad_tool_lights lights;
+    tool_lights lights;
     int rc;
     memset(&lights, 0, sizeof lights);
     rc = render_main(argc, argv, &lights);
-    rad_tool_lights_free(&lights);
+    tool_lights_free(&lights);
     return rc;
 }

@@ -28,7 +28,7 @@ static void trace_usage(FILE *f)
                "  --threads N        worker threads (default: all cores; at most 1024)\n"
                "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
                "  -o FILE            .pfm (linear float radiance) or .png (8-bit sRGB)\n"
-               "%s", rad_tool_light_help());
+               "%s", tool_light_help());
 }
 
 static double trace_now(void)
@@ -51,34 +51,34 @@ static int parse_int(const char *s, long lo, long hi, long *out)
     return 0;
 }
 
-static int trace_main(int argc, char **argv, rad_tool_lights *lights)
+static int trace_main(int argc, char **argv, tool_lights *lights)
 {
     const char *scene_path = NULL, *out_path = NULL, *camera_text = NULL;
-    rad_trace_options opt;
+    tool_trace_options opt;
     float fov = 0.0f, exposure = 1.0f;
     long threads = 0, v;
     int i, code = 1;
     char err[512];
-    rad_tool_scene ts;
+    tool_scene ts;
     rad_scene *scene = NULL;
     rad_bvh *bvh = NULL;
     rad_raycaster rc;
     rad_camera cam;
     rad_context ctx;
-    rad_image img = { 0, 0, NULL };
+    tool_image img = { 0, 0, NULL };
     rad_result r;
     double t0, t1;
     void *light_storage = NULL;
     int lr;
 
-    rad_trace_options_default(&opt);
+    tool_trace_options_default(&opt);
     for (i = 0; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
             trace_usage(stdout);
             return 0;
         }
-        lr = rad_tool_light_option("trace", argc, argv, &i, lights);
+        lr = tool_light_option("trace", argc, argv, &i, lights);
         if (lr == 2) return 2;
         if (lr == 1) continue;
         if (a[0] != '-' || !a[1]) {
@@ -106,11 +106,11 @@ static int trace_main(int argc, char **argv, rad_tool_lights *lights)
                 return 2;
             }
         } else if (!strcmp(a, "--size")) {
-            if (rad_tool_parse_size(next, &opt.width, &opt.height) != 0 || opt.width <= 0 || opt.height <= 0) {
+            if (tool_parse_size(next, &opt.width, &opt.height) != 0 || opt.width <= 0 || opt.height <= 0) {
                 fprintf(stderr, "rad trace: --size wants WxH, got '%s'\n", next);
                 return 2;
             }
-            if (rad_tool_check_size("trace", opt.width, opt.height)) return 2;
+            if (tool_check_size("trace", opt.width, opt.height)) return 2;
         } else if (!strcmp(a, "--spp")) {
             if (parse_int(next, 1, 1L << 24, &v) != 0) {
                 fprintf(stderr, "rad trace: --spp wants a positive integer, got '%s'\n", next);
@@ -137,7 +137,7 @@ static int trace_main(int argc, char **argv, rad_tool_lights *lights)
             opt.rr_depth = (int)v;
         } else if (!strcmp(a, "--threads")) {
             uint32_t t = 0;
-            if (rad_tool_parse_threads("trace", a, next, &t)) return 2;
+            if (tool_parse_threads("trace", a, next, &t)) return 2;
             threads = (long)t;
         } else if (!strcmp(a, "--exposure")) {
             char *end;
@@ -164,24 +164,24 @@ static int trace_main(int argc, char **argv, rad_tool_lights *lights)
             return 2;
         }
     }
-    if (rad_tool_check_output("trace", out_path, &scene_path, 1)) return 1;
-    rad_tool_set_threads((int)threads);
+    if (tool_check_output("trace", out_path, &scene_path, 1)) return 1;
+    tool_set_threads((int)threads);
 
     memset(&ts, 0, sizeof(ts));
-    if (rad_tool_load_scene(scene_path, &ts, err, sizeof(err)) != 0) {
+    if (tool_load_scene(scene_path, &ts, err, sizeof(err)) != 0) {
         fprintf(stderr, "rad trace: %s\n", err);
         return 1;
     }
-    if (rad_tool_add_lights("trace", &ts, lights, &light_storage)) {
-        rad_tool_free_scene(&ts);
+    if (tool_add_lights("trace", &ts, lights, &light_storage)) {
+        tool_free_scene(&ts);
         return 1;
     }
     if (camera_text) {
         memset(&cam, 0, sizeof(cam));
-        if (rad_tool_parse_camera(camera_text, &cam) != 0) {
+        if (tool_parse_camera(camera_text, &cam) != 0) {
             fprintf(stderr, "rad trace: --camera wants PX,PY,PZ:TX,TY,TZ:UX,UY,UZ, got '%s'\n", camera_text);
-            rad_tool_free_scene(&ts);
-            rad_tool_lights_release(light_storage);
+            tool_free_scene(&ts);
+            tool_lights_release(light_storage);
             return 2;
         }
         cam.fov_y_degrees = fov > 0.0f ? fov : (ts.has_camera ? ts.camera.fov_y_degrees : 45.0f);
@@ -192,8 +192,8 @@ static int trace_main(int argc, char **argv, rad_tool_lights *lights)
     }
 
     memset(&ctx, 0, sizeof(ctx));
-    ctx.log = rad_tool_log;
-    ctx.progress = rad_tool_progress;
+    ctx.log = tool_log;
+    ctx.progress = tool_progress;
     r = rad_scene_create(&ts.desc, &ctx, &scene);
     if (r != RAD_SUCCESS) {
         fprintf(stderr, "rad trace: %s: rad_scene_create failed: %s\n", scene_path, rad_result_string(r));
@@ -206,7 +206,7 @@ static int trace_main(int argc, char **argv, rad_tool_lights *lights)
     }
     rad_bvh_raycaster(bvh, &rc);
     if (!camera_text && !ts.has_camera) {
-        rad_tool_choose_camera("trace", scene, &rc, opt.width, opt.height, &cam);
+        tool_choose_camera("trace", scene, &rc, opt.width, opt.height, &cam);
         if (fov > 0.0f) cam.fov_y_degrees = fov;
     }
     {
@@ -222,7 +222,7 @@ static int trace_main(int argc, char **argv, rad_tool_lights *lights)
             fprintf(stderr, "rad trace: warning: the scene has no emitters and no lights: the image is black\n");
     }
     t0 = trace_now();
-    r = (rad_result)rad_trace_image(scene, &rc, ts.lights, ts.light_count, &cam, &opt, &ctx, &img);
+    r = (rad_result)tool_trace_image(scene, &rc, ts.lights, ts.light_count, &cam, &opt, &ctx, &img);
     t1 = trace_now();
     if (r != RAD_SUCCESS) {
         fprintf(stderr, "rad trace: path tracing failed: %s\n", rad_result_string(r));
@@ -230,27 +230,27 @@ static int trace_main(int argc, char **argv, rad_tool_lights *lights)
     }
     fprintf(stderr, "rad trace: %.2f s (%.3g samples/s)\n", t1 - t0,
             (double)opt.width * (double)opt.height * (double)opt.spp / (t1 - t0 > 0.0 ? t1 - t0 : 1e-9));
-    if (rad_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad trace: %s\n", rad_tool_output_error());
+    if (tool_image_write(out_path, &img, exposure) != 0) {
+        fprintf(stderr, "rad trace: %s\n", tool_output_error());
         goto done;
     }
     fprintf(stderr, "rad trace: wrote %s\n", out_path);
     code = 0;
 done:
-    rad_image_free(&img);
+    tool_image_free(&img);
     rad_bvh_destroy(bvh);
     rad_scene_destroy(scene);
-    rad_tool_free_scene(&ts);
-    rad_tool_lights_release(light_storage);
+    tool_free_scene(&ts);
+    tool_lights_release(light_storage);
     return code;
 }
 
-int rad_cmd_trace(int argc, char **argv)
+int tool_cmd_trace(int argc, char **argv)
 {
-    rad_tool_lights lights;
+    tool_lights lights;
     int rc;
     memset(&lights, 0, sizeof lights);
     rc = trace_main(argc, argv, &lights);
-    rad_tool_lights_free(&lights);
+    tool_lights_free(&lights);
     return rc;
 }

@@ -16,9 +16,9 @@
 #endif
 #if defined(__unix__) || defined(__APPLE__)
 #include <unistd.h>
-#define RAD_TOOL_ISATTY(fd) isatty(fd)
+#define TOOL_ISATTY(fd) isatty(fd)
 #else
-#define RAD_TOOL_ISATTY(fd) 0
+#define TOOL_ISATTY(fd) 0
 #endif
 
 /* ---- shared helpers ------------------------------------------------------------------- */
@@ -29,7 +29,7 @@ static struct {
     int open;     /* a bar line is open on a terminal */
 } g_progress = {NULL, -1, 0};
 
-void rad_tool_progress_end(void)
+void tool_progress_end(void)
 {
     if (g_progress.open) fprintf(stderr, "\n");
     g_progress.open = 0;
@@ -37,7 +37,7 @@ void rad_tool_progress_end(void)
     g_progress.label = NULL;
 }
 
-int rad_tool_progress(void *user, float fraction)
+int tool_progress(void *user, float fraction)
 {
     const char *label = user ? (const char *)user : "working";
     int pct;
@@ -45,11 +45,11 @@ int rad_tool_progress(void *user, float fraction)
     if (fraction > 1.0f) fraction = 1.0f;
     pct = (int)(fraction * 100.0f);
     if (g_progress.label != user || pct < g_progress.last) {
-        rad_tool_progress_end();
+        tool_progress_end();
         g_progress.label = user;
     }
     if (pct == g_progress.last) return 0;
-    if (RAD_TOOL_ISATTY(2)) {
+    if (TOOL_ISATTY(2)) {
         char bar[31];
         int i, fill = pct * 30 / 100;
         for (i = 0; i < 30; ++i) bar[i] = i < fill ? '#' : '.';
@@ -73,7 +73,7 @@ int rad_tool_progress(void *user, float fraction)
     return 0;
 }
 
-void rad_tool_log(void *user, rad_log_level level, const char *message)
+void tool_log(void *user, rad_log_level level, const char *message)
 {
     (void)user;
     if (g_progress.open) {
@@ -86,32 +86,32 @@ void rad_tool_log(void *user, rad_log_level level, const char *message)
 
 static int g_progress_on = 1;
 
-void rad_tool_show_progress(int on)
+void tool_show_progress(int on)
 {
     g_progress_on = on;
 }
 
-void rad_tool_context(rad_context *ctx, const char *label)
+void tool_context(rad_context *ctx, const char *label)
 {
     memset(ctx, 0, sizeof *ctx);
-    ctx->log = rad_tool_log;
+    ctx->log = tool_log;
     if (label && g_progress_on) {
-        ctx->progress = rad_tool_progress;
+        ctx->progress = tool_progress;
         ctx->progress_user = (void *)(size_t)label;
     }
 }
 
-void rad_tool_set_threads(int threads)
+void tool_set_threads(int threads)
 {
 #ifdef _OPENMP
-    if (threads > (int)RAD_TOOL_MAX_THREADS) threads = (int)RAD_TOOL_MAX_THREADS; /* the parsers refuse more */
+    if (threads > (int)TOOL_MAX_THREADS) threads = (int)TOOL_MAX_THREADS; /* the parsers refuse more */
     if (threads > 0) omp_set_num_threads(threads);
 #else
     (void)threads;
 #endif
 }
 
-void *rad_tool_calloc(size_t n, size_t size)
+void *tool_calloc(size_t n, size_t size)
 {
     void *p = calloc(n ? n : 1, size);
     if (!p) {
@@ -121,14 +121,14 @@ void *rad_tool_calloc(size_t n, size_t size)
     return p;
 }
 
-int rad_tool_fail(const char *cmd, const char *what, rad_result r)
+int tool_fail(const char *cmd, const char *what, rad_result r)
 {
-    rad_tool_progress_end();
+    tool_progress_end();
     fprintf(stderr, "rad %s: %s failed: %s\n", cmd, what, rad_result_string(r));
     return 1;
 }
 
-int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out)
+int tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out)
 {
     char *end;
     unsigned long v;
@@ -142,20 +142,20 @@ bad:
     return 2;
 }
 
-int rad_tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out)
+int tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out)
 {
     uint32_t v = 0;
-    if (rad_tool_parse_uint(cmd, opt, text, &v)) return 2;
-    if (v > RAD_TOOL_MAX_THREADS) {
+    if (tool_parse_uint(cmd, opt, text, &v)) return 2;
+    if (v > TOOL_MAX_THREADS) {
         fprintf(stderr, "rad %s: %s %s is too many (at most %u; 0 means all cores)\n", cmd, opt, text,
-                RAD_TOOL_MAX_THREADS);
+                TOOL_MAX_THREADS);
         return 2;
     }
     *out = v;
     return 0;
 }
 
-int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out)
+int tool_parse_float(const char *cmd, const char *opt, const char *text, float *out)
 {
     char *end;
     float v;
@@ -169,7 +169,7 @@ bad:
     return 2;
 }
 
-double rad_tool_seconds(void)
+double tool_seconds(void)
 {
 #if defined(_OPENMP)
     return omp_get_wtime();
@@ -182,7 +182,7 @@ double rad_tool_seconds(void)
 #endif
 }
 
-int rad_tool_parse_camera(const char *text, rad_camera *out)
+int tool_parse_camera(const char *text, rad_camera *out)
 {
     float v[9];
     char extra;
@@ -207,7 +207,7 @@ int rad_tool_parse_camera(const char *text, rad_camera *out)
     return 0;
 }
 
-int rad_tool_parse_size(const char *text, int *w, int *h)
+int tool_parse_size(const char *text, int *w, int *h)
 {
     unsigned long a, b;
     char extra;
@@ -218,60 +218,60 @@ int rad_tool_parse_size(const char *text, int *w, int *h)
     return 0;
 }
 
-int rad_tool_check_size(const char *cmd, int w, int h)
+int tool_check_size(const char *cmd, int w, int h)
 {
     double bytes = (double)w * (double)h * 3.0 * sizeof(float);
     if (w <= 0 || h <= 0) return 2;
-    if (bytes > RAD_TOOL_MAX_IMAGE_BYTES) {
+    if (bytes > TOOL_MAX_IMAGE_BYTES) {
         fprintf(stderr, "rad %s: --size %dx%d needs %.0f bytes (%.1f GiB) for the image, more than the limit of %.0f bytes (%.0f GiB)\n",
-                cmd, w, h, bytes, bytes / 1073741824.0, RAD_TOOL_MAX_IMAGE_BYTES, RAD_TOOL_MAX_IMAGE_BYTES / 1073741824.0);
+                cmd, w, h, bytes, bytes / 1073741824.0, TOOL_MAX_IMAGE_BYTES, TOOL_MAX_IMAGE_BYTES / 1073741824.0);
         return 2;
     }
     return 0;
 }
 
-int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w)
+int tool_open_world(const char *cmd, const char *path_or_name, tool_world *w)
 {
-    return rad_tool_open_world_lit(cmd, path_or_name, NULL, w);
+    return tool_open_world_lit(cmd, path_or_name, NULL, w);
 }
 
-int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
-                            rad_tool_world *w)
+int tool_open_world_lit(const char *cmd, const char *path_or_name, const tool_lights *lights,
+                            tool_world *w)
 {
     char err[1024];
     rad_context ctx;
     rad_result r;
     memset(w, 0, sizeof *w);
-    if (rad_tool_load_scene(path_or_name, &w->file, err, sizeof err) != 0) {
+    if (tool_load_scene(path_or_name, &w->file, err, sizeof err) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, err);
         return 1;
     }
     w->file_light_count = w->file.light_count;
-    if (rad_tool_add_lights(cmd, &w->file, lights, &w->lights_storage)) {
-        rad_tool_free_scene(&w->file);
+    if (tool_add_lights(cmd, &w->file, lights, &w->lights_storage)) {
+        tool_free_scene(&w->file);
         return 1;
     }
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     if ((r = rad_scene_create(&w->file.desc, &ctx, &w->scene)) != RAD_SUCCESS) {
-        rad_tool_close_world(w);
-        return rad_tool_fail(cmd, "rad_scene_create", r);
+        tool_close_world(w);
+        return tool_fail(cmd, "rad_scene_create", r);
     }
     if (w->scene->skipped_triangles)
         fprintf(stderr, "rad: warning: %u degenerate triangles skipped\n", w->scene->skipped_triangles);
     if ((r = rad_bvh_create(w->scene, &ctx, &w->bvh)) != RAD_SUCCESS) {
-        rad_tool_close_world(w);
-        return rad_tool_fail(cmd, "rad_bvh_create", r);
+        tool_close_world(w);
+        return tool_fail(cmd, "rad_bvh_create", r);
     }
     rad_bvh_raycaster(w->bvh, &w->rc);
     return 0;
 }
 
-void rad_tool_close_world(rad_tool_world *w)
+void tool_close_world(tool_world *w)
 {
     rad_bvh_destroy(w->bvh);
     rad_scene_destroy(w->scene);
-    rad_tool_free_scene(&w->file);
-    rad_tool_lights_release(w->lights_storage);
+    tool_free_scene(&w->file);
+    tool_lights_release(w->lights_storage);
     memset(w, 0, sizeof *w);
 }
 
@@ -302,7 +302,7 @@ static void camera_score(const rad_scene *scene, const rad_raycaster *rc, const 
     }
 }
 
-void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
+void tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
                             rad_camera *cam)
 {
     /* view directions in order of preference: along +z first (the Cornell box's camera and

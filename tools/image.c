@@ -3,16 +3,16 @@
 
    PFM (Portable Float Map): a text header "PF\n<width> <height>\n<scale>\n" followed by
    width*height*3 binary floats, little-endian when scale < 0 (what we write: -1.0), rows stored
-   BOTTOM row first. rad_image keeps the top row first, so rows are flipped on the way in and
+   BOTTOM row first. tool_image keeps the top row first, so rows are flipped on the way in and
    out. "Pf" (greyscale) files are read too and replicated to RGB.
 
    OpenEXR (.exr): through tinyexr (Debian libtinyexr-dev) when the tool is built with
-   -DRAD_TOOL_EXR (the Makefile and tests/run.sh do when /usr/include/tinyexr.h exists): three
+   -DTOOL_EXR (the Makefile and tests/run.sh do when /usr/include/tinyexr.h exists): three
    32-bit float channels B, G, R (the alphabetical order EXR files keep), ZIP compression,
-   the top row first as in rad_image; reading takes the R, G, B of any EXR tinyexr loads.
+   the top row first as in tool_image; reading takes the R, G, B of any EXR tinyexr loads.
    Without it, .exr paths fail with a message naming the package.
 
-   Every file the tool writes goes through rad_tool_output_open/commit below: the bytes go to a
+   Every file the tool writes goes through tool_output_open/commit below: the bytes go to a
    temporary file in the destination's folder, which is renamed onto the destination only when
    every write, the flush and the close succeeded, so a failed write leaves the old file as it
    was (issue 23). */
@@ -30,7 +30,7 @@
 #if defined(__unix__) || defined(__APPLE__)
 #include <sys/stat.h>
 #include <unistd.h>
-#define RAD_TOOL_POSIX 1
+#define TOOL_POSIX 1
 #endif
 
 #if defined(__GNUC__)
@@ -59,7 +59,7 @@
 
 static char g_output_error[1024];
 
-const char *rad_tool_output_error(void)
+const char *tool_output_error(void)
 {
     return g_output_error[0] ? g_output_error : "unknown error";
 }
@@ -86,7 +86,7 @@ static void output_folder(const char *path, char *buf, size_t cap)
     buf[n] = '\0';
 }
 
-int rad_tool_output_open(rad_tool_output *o, const char *path)
+int tool_output_open(tool_output *o, const char *path)
 {
     size_t n;
     memset(o, 0, sizeof *o);
@@ -109,7 +109,7 @@ int rad_tool_output_open(rad_tool_output *o, const char *path)
         return -1;
     }
     memcpy(o->path, path, n + 1);
-#ifdef RAD_TOOL_POSIX
+#ifdef TOOL_POSIX
     {
         /* "DIR/.NAME.tmpXXXXXX": same folder, so the rename cannot cross file systems */
         const char *slash = strrchr(path, '/');
@@ -119,7 +119,7 @@ int rad_tool_output_open(rad_tool_output *o, const char *path)
         struct stat st;
         if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
             output_error(path, "cannot write", EISDIR);
-            rad_tool_output_abort(o);
+            tool_output_abort(o);
             return -1;
         }
         memcpy(o->tmp, path, dl);
@@ -132,7 +132,7 @@ int rad_tool_output_open(rad_tool_output *o, const char *path)
             snprintf(g_output_error, sizeof g_output_error, "cannot write '%.400s': cannot create a file in '%.400s': %s", path,
                      folder, strerror(e));
             o->tmp[0] = '\0';
-            rad_tool_output_abort(o);
+            tool_output_abort(o);
             return -1;
         }
         /* mkstemp makes the file 0600: give it the old file's mode, or the one a plain fopen
@@ -149,7 +149,7 @@ int rad_tool_output_open(rad_tool_output *o, const char *path)
             int e = errno;
             close(fd);
             output_error(path, "cannot write", e);
-            rad_tool_output_abort(o);
+            tool_output_abort(o);
             return -1;
         }
     }
@@ -159,14 +159,14 @@ int rad_tool_output_open(rad_tool_output *o, const char *path)
     if (!o->f) {
         output_error(o->tmp, "cannot create", errno);
         o->tmp[0] = '\0';
-        rad_tool_output_abort(o);
+        tool_output_abort(o);
         return -1;
     }
 #endif
     return 0;
 }
 
-void rad_tool_output_abort(rad_tool_output *o)
+void tool_output_abort(tool_output *o)
 {
     if (o->f) fclose(o->f);
     if (o->tmp && o->tmp[0]) remove(o->tmp);
@@ -175,55 +175,55 @@ void rad_tool_output_abort(rad_tool_output *o)
     memset(o, 0, sizeof *o);
 }
 
-int rad_tool_output_commit(rad_tool_output *o, int ok)
+int tool_output_commit(tool_output *o, int ok)
 {
     int e = 0;
     if (!o->f) {
-        rad_tool_output_abort(o);
+        tool_output_abort(o);
         return -1;
     }
     if (!ok || ferror(o->f)) {
         if (!g_output_error[0]) output_error(o->path, "error writing", EIO);
-        rad_tool_output_abort(o);
+        tool_output_abort(o);
         return -1;
     }
     if (fflush(o->f) != 0) e = errno ? errno : EIO;
-#ifdef RAD_TOOL_POSIX
+#ifdef TOOL_POSIX
     if (!e && fsync(fileno(o->f)) != 0 && errno != EINVAL && errno != EROFS) e = errno; /* the bytes are on disk before the rename */
 #endif
     if (fclose(o->f) != 0 && !e) e = errno ? errno : EIO;
     o->f = NULL;
     if (e) {
         output_error(o->path, "error writing", e);
-        rad_tool_output_abort(o);
+        tool_output_abort(o);
         return -1;
     }
-#ifndef RAD_TOOL_POSIX
+#ifndef TOOL_POSIX
     remove(o->path); /* rename does not replace a file on every system */
 #endif
     if (rename(o->tmp, o->path) != 0) {
         output_error(o->path, "cannot replace", errno);
-        rad_tool_output_abort(o);
+        tool_output_abort(o);
         return -1;
     }
     o->tmp[0] = '\0'; /* it is the destination now */
-    rad_tool_output_abort(o);
+    tool_output_abort(o);
     return 0;
 }
 
-int rad_tool_write_file(const char *path, const void *data, size_t size)
+int tool_write_file(const char *path, const void *data, size_t size)
 {
-    rad_tool_output o;
+    tool_output o;
     int ok;
-    if (rad_tool_output_open(&o, path) != 0) return -1;
+    if (tool_output_open(&o, path) != 0) return -1;
     ok = fwrite(data, 1, size, o.f) == size;
     if (!ok) output_error(path, "error writing", errno ? errno : EIO);
-    return rad_tool_output_commit(&o, ok);
+    return tool_output_commit(&o, ok);
 }
 
-int rad_tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count)
+int tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count)
 {
-#ifdef RAD_TOOL_POSIX
+#ifdef TOOL_POSIX
     struct stat so, si;
     char folder[4096];
     int i;
@@ -260,7 +260,7 @@ int rad_tool_check_output(const char *cmd, const char *path, const char *const *
     return 0;
 }
 
-int rad_image_alloc(rad_image *img, int width, int height)
+int tool_image_alloc(tool_image *img, int width, int height)
 {
     size_t n;
     if (!img) return -1;
@@ -276,7 +276,7 @@ int rad_image_alloc(rad_image *img, int width, int height)
     return 0;
 }
 
-void rad_image_free(rad_image *img)
+void tool_image_free(tool_image *img)
 {
     if (!img) return;
     free(img->rgb);
@@ -284,7 +284,7 @@ void rad_image_free(rad_image *img)
     img->width = img->height = 0;
 }
 
-static int rad__host_little_endian(void)
+static int tool__host_little_endian(void)
 {
     const uint32_t one = 1u;
     unsigned char b;
@@ -292,7 +292,7 @@ static int rad__host_little_endian(void)
     return b == 1;
 }
 
-static void rad__swap4(unsigned char *p)
+static void tool__swap4(unsigned char *p)
 {
     unsigned char t = p[0];
     p[0] = p[3];
@@ -302,9 +302,9 @@ static void rad__swap4(unsigned char *p)
     p[2] = t;
 }
 
-int rad_image_write_pfm(const char *path, const rad_image *img)
+int tool_image_write_pfm(const char *path, const tool_image *img)
 {
-    rad_tool_output o;
+    tool_output o;
     int y, ok = 1;
     size_t row = 0;
     unsigned char *buf = NULL;
@@ -313,10 +313,10 @@ int rad_image_write_pfm(const char *path, const rad_image *img)
         output_error(path ? path : "", "no image to write to", 0);
         return -1;
     }
-    if (rad_tool_output_open(&o, path) != 0) return -1;
+    if (tool_output_open(&o, path) != 0) return -1;
     if (fprintf(o.f, "PF\n%d %d\n-1.0\n", img->width, img->height) < 0) ok = 0;
     row = (size_t)img->width * 3u * sizeof(float);
-    if (ok && !rad__host_little_endian()) {
+    if (ok && !tool__host_little_endian()) {
         buf = (unsigned char *)malloc(row);
         if (!buf) ok = 0;
     }
@@ -325,7 +325,7 @@ int rad_image_write_pfm(const char *path, const rad_image *img)
         if (buf) {
             size_t k;
             memcpy(buf, src, row);
-            for (k = 0; k < row; k += 4) rad__swap4(buf + k);
+            for (k = 0; k < row; k += 4) tool__swap4(buf + k);
             if (fwrite(buf, 1, row, o.f) != row) ok = 0;
         } else if (fwrite(src, 1, row, o.f) != row) {
             ok = 0;
@@ -333,11 +333,11 @@ int rad_image_write_pfm(const char *path, const rad_image *img)
     }
     if (!ok) output_error(path, "error writing", errno ? errno : EIO);
     free(buf);
-    return rad_tool_output_commit(&o, ok);
+    return tool_output_commit(&o, ok);
 }
 
 /* reads one whitespace-separated header token (skipping '#' comments); 0 on success */
-static int rad__pfm_token(FILE *f, char *tok, size_t cap)
+static int tool__pfm_token(FILE *f, char *tok, size_t cap)
 {
     int c;
     size_t n = 0;
@@ -360,7 +360,7 @@ static int rad__pfm_token(FILE *f, char *tok, size_t cap)
     return 0;
 }
 
-int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errlen)
+int tool_image_read_pfm(const char *path, tool_image *img, char *err, size_t errlen)
 {
     FILE *f;
     char tok[64];
@@ -377,29 +377,29 @@ int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errle
         if (err) snprintf(err, errlen, "%s: cannot open", path);
         return -1;
     }
-    if (rad__pfm_token(f, tok, sizeof(tok)) != 0 || (strcmp(tok, "PF") != 0 && strcmp(tok, "Pf") != 0)) {
+    if (tool__pfm_token(f, tok, sizeof(tok)) != 0 || (strcmp(tok, "PF") != 0 && strcmp(tok, "Pf") != 0)) {
         if (err) snprintf(err, errlen, "%s: not a PFM file (no 'PF' or 'Pf' magic)", path);
         fclose(f);
         return -1;
     }
     channels = tok[1] == 'F' ? 3 : 1;
-    if (rad__pfm_token(f, tok, sizeof(tok)) != 0 || (w = (int)strtol(tok, &end, 10)) <= 0 || *end ||
-        rad__pfm_token(f, tok, sizeof(tok)) != 0 || (h = (int)strtol(tok, &end, 10)) <= 0 || *end ||
-        rad__pfm_token(f, tok, sizeof(tok)) != 0 || ((scale = strtod(tok, &end)), *end) || scale == 0.0 ||
+    if (tool__pfm_token(f, tok, sizeof(tok)) != 0 || (w = (int)strtol(tok, &end, 10)) <= 0 || *end ||
+        tool__pfm_token(f, tok, sizeof(tok)) != 0 || (h = (int)strtol(tok, &end, 10)) <= 0 || *end ||
+        tool__pfm_token(f, tok, sizeof(tok)) != 0 || ((scale = strtod(tok, &end)), *end) || scale == 0.0 ||
         !(scale == scale)) {
         if (err) snprintf(err, errlen, "%s: bad PFM header", path);
         fclose(f);
         return -1;
     }
-    swap = (scale < 0.0) != rad__host_little_endian();
-    if ((double)w * (double)h * 3.0 * sizeof(float) > RAD_TOOL_MAX_IMAGE_BYTES) {
+    swap = (scale < 0.0) != tool__host_little_endian();
+    if ((double)w * (double)h * 3.0 * sizeof(float) > TOOL_MAX_IMAGE_BYTES) {
         if (err)
             snprintf(err, errlen, "%s: a %dx%d image needs %.0f bytes, more than the limit of %.0f", path, w, h,
-                     (double)w * (double)h * 3.0 * sizeof(float), RAD_TOOL_MAX_IMAGE_BYTES);
+                     (double)w * (double)h * 3.0 * sizeof(float), TOOL_MAX_IMAGE_BYTES);
         fclose(f);
         return -1;
     }
-    if (rad_image_alloc(img, w, h) != 0) {
+    if (tool_image_alloc(img, w, h) != 0) {
         if (err) snprintf(err, errlen, "%s: %dx%d image: out of memory", path, w, h);
         fclose(f);
         return -1;
@@ -407,7 +407,7 @@ int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errle
     row = (float *)malloc((size_t)w * (size_t)channels * sizeof(float));
     if (!row) {
         if (err) snprintf(err, errlen, "%s: out of memory", path);
-        rad_image_free(img);
+        tool_image_free(img);
         fclose(f);
         return -1;
     }
@@ -417,13 +417,13 @@ int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errle
         if (fread(row, sizeof(float), count, f) != count) {
             if (err) snprintf(err, errlen, "%s: truncated PFM data", path);
             free(row);
-            rad_image_free(img);
+            tool_image_free(img);
             fclose(f);
             return -1;
         }
         if (swap) {
             size_t k;
-            for (k = 0; k < count; ++k) rad__swap4((unsigned char *)(row + k));
+            for (k = 0; k < count; ++k) tool__swap4((unsigned char *)(row + k));
         }
         for (x = 0; x < w; ++x) {
             if (channels == 3) {
@@ -441,21 +441,21 @@ int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errle
 }
 
 /* linear -> sRGB transfer function (IEC 61966-2-1), input clamped to [0,1] */
-static double rad__srgb_encode(double v)
+static double tool__srgb_encode(double v)
 {
     if (!(v > 0.0)) return 0.0;
     if (v >= 1.0) return 1.0;
     return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
 }
 
-static double rad__srgb_decode(double v)
+static double tool__srgb_decode(double v)
 {
     return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
 }
 
-unsigned char rad_image_srgb8(float linear)
+unsigned char tool_image_srgb8(float linear)
 {
-    return (unsigned char)(rad__srgb_encode((double)linear) * 255.0 + 0.5);
+    return (unsigned char)(tool__srgb_encode((double)linear) * 255.0 + 0.5);
 }
 
 /* stb_image_write's sink: every chunk to the temporary file, failures remembered */
@@ -475,11 +475,11 @@ static void png_sink_write(void *user, void *data, int size)
     }
 }
 
-int rad_image_write_png(const char *path, const rad_image *img, float exposure)
+int tool_image_write_png(const char *path, const tool_image *img, float exposure)
 {
     unsigned char *px;
     size_t i, n;
-    rad_tool_output o;
+    tool_output o;
     png_sink sink;
     g_output_error[0] = '\0';
     if (!path || !img || !img->rgb || img->width <= 0 || img->height <= 0) {
@@ -492,8 +492,8 @@ int rad_image_write_png(const char *path, const rad_image *img, float exposure)
         output_error(path, "cannot write", ENOMEM);
         return -1;
     }
-    for (i = 0; i < n; ++i) px[i] = rad_image_srgb8(img->rgb[i] * exposure);
-    if (rad_tool_output_open(&o, path) != 0) {
+    for (i = 0; i < n; ++i) px[i] = tool_image_srgb8(img->rgb[i] * exposure);
+    if (tool_output_open(&o, path) != 0) {
         free(px);
         return -1;
     }
@@ -509,10 +509,10 @@ int rad_image_write_png(const char *path, const rad_image *img, float exposure)
         output_error(path, "error writing", sink.errnum);
     }
     free(px);
-    return rad_tool_output_commit(&o, sink.ok);
+    return tool_output_commit(&o, sink.ok);
 }
 
-int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen)
+int tool_image_read_png(const char *path, tool_image *img, char *err, size_t errlen)
 {
     int w, h, comp, x, y;
     unsigned char *px;
@@ -526,19 +526,19 @@ int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errle
         if (err) snprintf(err, errlen, "%s: cannot read PNG (%s)", path, stbi_failure_reason());
         return -1;
     }
-    if (rad_image_alloc(img, w, h) != 0) {
+    if (tool_image_alloc(img, w, h) != 0) {
         if (err) snprintf(err, errlen, "%s: out of memory", path);
         stbi_image_free(px);
         return -1;
     }
-    for (x = 0; x < 256; ++x) table[x] = (float)rad__srgb_decode((double)x / 255.0);
+    for (x = 0; x < 256; ++x) table[x] = (float)tool__srgb_decode((double)x / 255.0);
     for (y = 0; y < h; ++y)
         for (x = 0; x < 3 * w; ++x) img->rgb[(size_t)y * (size_t)w * 3u + (size_t)x] = table[px[(size_t)y * (size_t)w * 3u + (size_t)x]];
     stbi_image_free(px);
     return 0;
 }
 
-static int rad__has_ext(const char *path, const char *ext)
+static int tool__has_ext(const char *path, const char *ext)
 {
     size_t n = strlen(path), m = strlen(ext), i;
     if (n < m) return 0;
@@ -547,10 +547,10 @@ static int rad__has_ext(const char *path, const char *ext)
     return 1;
 }
 
-#ifdef RAD_TOOL_EXR
+#ifdef TOOL_EXR
 #include <tinyexr.h>
 
-int rad_image_write_exr(const char *path, const rad_image *img)
+int tool_image_write_exr(const char *path, const tool_image *img)
 {
     EXRHeader hd;
     EXRImage im;
@@ -560,7 +560,7 @@ int rad_image_write_exr(const char *path, const rad_image *img)
     unsigned char *mem = NULL;
     const char *err = NULL;
     size_t n, k, size;
-    rad_tool_output o;
+    tool_output o;
     g_output_error[0] = '\0';
     if (!path || !img || !img->rgb || img->width <= 0 || img->height <= 0) {
         output_error(path ? path : "", "no image to write to", 0);
@@ -604,14 +604,14 @@ int rad_image_write_exr(const char *path, const rad_image *img)
         free(mem);
         return -1;
     }
-    if (rad_tool_output_open(&o, path) != 0) { free(mem); return -1; }
+    if (tool_output_open(&o, path) != 0) { free(mem); return -1; }
     ok = fwrite(mem, 1, size, o.f) == size;
     if (!ok) output_error(path, "error writing", errno ? errno : EIO);
     free(mem);
-    return rad_tool_output_commit(&o, ok);
+    return tool_output_commit(&o, ok);
 }
 
-int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errlen)
+int tool_image_read_exr(const char *path, tool_image *img, char *err, size_t errlen)
 {
     float *rgba = NULL;
     int w = 0, h = 0;
@@ -627,7 +627,7 @@ int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errle
         free(rgba);
         return -1;
     }
-    if (rad_image_alloc(img, w, h) != 0) {
+    if (tool_image_alloc(img, w, h) != 0) {
         if (err) snprintf(err, errlen, "%s: out of memory", path);
         free(rgba);
         return -1;
@@ -642,7 +642,7 @@ int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errle
     return 0;
 }
 #else
-int rad_image_write_exr(const char *path, const rad_image *img)
+int tool_image_write_exr(const char *path, const tool_image *img)
 {
     (void)img;
     output_error(path ? path : "", "cannot write OpenEXR (this rad was built without tinyexr: install libtinyexr-dev "
@@ -650,7 +650,7 @@ int rad_image_write_exr(const char *path, const rad_image *img)
     return -1;
 }
 
-int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errlen)
+int tool_image_read_exr(const char *path, tool_image *img, char *err, size_t errlen)
 {
     if (img) { img->width = img->height = 0; img->rgb = NULL; }
     if (err) snprintf(err, errlen, "%s: cannot read OpenEXR: this rad was built without tinyexr (install libtinyexr-dev and rebuild)",
@@ -659,26 +659,26 @@ int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errle
 }
 #endif
 
-int rad_image_write(const char *path, const rad_image *img, float exposure)
+int tool_image_write(const char *path, const tool_image *img, float exposure)
 {
     g_output_error[0] = '\0';
     if (!path) return -1;
     /* PFM holds the radiance itself: exposure applies to the 8-bit PNG only */
-    if (rad__has_ext(path, ".pfm")) return rad_image_write_pfm(path, img);
-    if (rad__has_ext(path, ".png")) return rad_image_write_png(path, img, exposure);
-    if (rad__has_ext(path, ".exr")) return rad_image_write_exr(path, img);
+    if (tool__has_ext(path, ".pfm")) return tool_image_write_pfm(path, img);
+    if (tool__has_ext(path, ".png")) return tool_image_write_png(path, img, exposure);
+    if (tool__has_ext(path, ".exr")) return tool_image_write_exr(path, img);
     output_error(path, "cannot write (want a .png, .pfm or .exr name)", 0);
     return -1;
 }
 
-int rad_image_check_format(const char *cmd, const char *path)
+int tool_image_check_format(const char *cmd, const char *path)
 {
-    if (!path || !(rad__has_ext(path, ".pfm") || rad__has_ext(path, ".png") || rad__has_ext(path, ".exr"))) {
+    if (!path || !(tool__has_ext(path, ".pfm") || tool__has_ext(path, ".png") || tool__has_ext(path, ".exr"))) {
         fprintf(stderr, "rad %s: output '%s' must end in .png, .pfm or .exr\n", cmd, path ? path : "");
         return 2;
     }
-#ifndef RAD_TOOL_EXR
-    if (rad__has_ext(path, ".exr")) {
+#ifndef TOOL_EXR
+    if (tool__has_ext(path, ".exr")) {
         fprintf(stderr, "rad %s: cannot write '%s': this rad was built without OpenEXR support (install libtinyexr-dev "
                 "and rebuild; the Makefile detects it)\n", cmd, path);
         return 2;
@@ -687,9 +687,9 @@ int rad_image_check_format(const char *cmd, const char *path)
     return 0;
 }
 
-int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen)
+int tool_image_read(const char *path, tool_image *img, char *err, size_t errlen)
 {
-    if (path && rad__has_ext(path, ".png")) return rad_image_read_png(path, img, err, errlen);
-    if (path && rad__has_ext(path, ".exr")) return rad_image_read_exr(path, img, err, errlen);
-    return rad_image_read_pfm(path, img, err, errlen);
+    if (path && tool__has_ext(path, ".png")) return tool_image_read_png(path, img, err, errlen);
+    if (path && tool__has_ext(path, ".exr")) return tool_image_read_exr(path, img, err, errlen);
+    return tool_image_read_pfm(path, img, err, errlen);
 }

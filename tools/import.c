@@ -159,7 +159,7 @@ static void free_storage(imp_storage *st)
     free(st);
 }
 
-void rad_tool_free_scene(rad_tool_scene *scene)
+void tool_free_scene(tool_scene *scene)
 {
     if (!scene) return;
     free_storage((imp_storage *)scene->storage);
@@ -621,7 +621,7 @@ static imp_group *group_for(imp_storage *st, const char *name)
 typedef struct walk_state {
     imp_storage *st;
     const struct aiScene *sc;
-    rad_tool_scene *out;
+    tool_scene *out;
     int camera_done;
     unsigned unnamed;
     uint32_t bad_indices;  /* faces with an index past the mesh's vertices (dropped) */
@@ -777,7 +777,7 @@ static void default_camera(const float bmin[3], const float bmax[3], rad_camera 
     cam->up[0] = 0.0f, cam->up[1] = 1.0f, cam->up[2] = 0.0f;
 }
 
-int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err, size_t errlen)
+int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen)
 {
     const struct aiScene *sc;
     imp_storage *st;
@@ -850,7 +850,7 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
             if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &clamped[i], err, errlen)) {
                 free(clamped);
                 aiReleaseImport(sc);
-                rad_tool_free_scene(out);
+                tool_free_scene(out);
                 return 1;
             }
         } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
@@ -890,7 +890,7 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
         char n[32];
         snprintf(n, sizeof n, "%u", ws.bad_indices);
         set_err(err, errlen, "'%s' is broken: %s faces have an index past their mesh's vertices", path_or_name, n);
-        rad_tool_free_scene(out);
+        tool_free_scene(out);
         return 1;
     }
     st->meshes = (rad_mesh_desc *)xrealloc(NULL, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
@@ -921,7 +921,7 @@ int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err
     }
     if (tris == 0) {
         set_err(err, errlen, "'%s' has no triangles%s", path_or_name, NULL);
-        rad_tool_free_scene(out);
+        tool_free_scene(out);
         return 1;
     }
     out->desc.meshes = st->meshes;

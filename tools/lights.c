@@ -19,8 +19,8 @@
                                 mesh "area_light_K", albedo 0), emitting radiance RGB
                                 (W m^-2 sr^-1) from the side U x V points to: an area light
                                 exactly like an emissive triangle of the file
-   The analytic lights are appended to rad_tool_scene.lights; the area lights are appended to
-   the scene description before rad_scene_create (rad_tool_open_world_lit), so every method,
+   The analytic lights are appended to tool_scene.lights; the area lights are appended to
+   the scene description before rad_scene_create (tool_open_world_lit), so every method,
    the path tracer and the bake see the same lights. */
 #include "tool.h"
 #include <math.h>
@@ -30,7 +30,7 @@
 
 #define LIGHTS_DEG 0.017453292519943295
 
-const char *rad_tool_light_help(void)
+const char *tool_light_help(void)
 {
     return "lights added to the scene's own (repeatable; RGB is R,G,B or one grey value):\n"
            "  --sun DIR:RGB      directional light travelling along DIR (0,-1,0: down); RGB = irradiance\n"
@@ -95,7 +95,7 @@ static int split_parts(const char *text, const char **part, size_t *plen, int ma
     }
 }
 
-void rad_tool_lights_free(rad_tool_lights *L)
+void tool_lights_free(tool_lights *L)
 {
     if (!L) return;
     free(L->lights);
@@ -103,7 +103,7 @@ void rad_tool_lights_free(rad_tool_lights *L)
     memset(L, 0, sizeof *L);
 }
 
-int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_tool_lights *L)
+int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_lights *L)
 {
     static const char *const names[] = {"--sun", "--sky", "--point", "--spot", "--area"};
     static const char *const forms[] = {"DIR:RGB, e.g. 0.3,-1,0.2:5", "RGB, e.g. 0.4,0.5,0.8", "POS:RGB, e.g. 0,1.5,0:10",
@@ -114,7 +114,7 @@ int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_to
     size_t plen[5];
     int i, n;
     rad_light li;
-    rad_tool_area_light al;
+    tool_area_light al;
     for (i = 0; i < 5; ++i)
         if (!strcmp(opt, names[i])) break;
     if (i == 5) return 0;
@@ -179,7 +179,7 @@ int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_to
         return 2;
     }
     if (i == 4) {
-        rad_tool_area_light *g = (rad_tool_area_light *)realloc(L->areas, sizeof *g * (L->area_count + 1u));
+        tool_area_light *g = (tool_area_light *)realloc(L->areas, sizeof *g * (L->area_count + 1u));
         if (!g) { fprintf(stderr, "rad %s: out of memory\n", cmd); return 2; }
         L->areas = g;
         L->areas[L->area_count++] = al;
@@ -212,10 +212,10 @@ static void storage_free(lights_storage *s)
     free(s);
 }
 
-void rad_tool_lights_release(void *storage) { storage_free((lights_storage *)storage); }
+void tool_lights_release(void *storage) { storage_free((lights_storage *)storage); }
 
 /* appends the area lights to f->desc; the arrays are kept in *out (NULL when none) */
-static int add_areas(rad_tool_scene *f, const rad_tool_lights *L, lights_storage **out)
+static int add_areas(tool_scene *f, const tool_lights *L, lights_storage **out)
 {
     lights_storage *s;
     uint32_t nm = f->desc.mesh_count, nmat = f->desc.material_count, i, k;
@@ -237,7 +237,7 @@ static int add_areas(rad_tool_scene *f, const rad_tool_lights *L, lights_storage
     if (nmat) memcpy(s->materials, f->desc.materials, sizeof *s->materials * nmat);
     for (i = 0; i < nmat; ++i) s->material_names[i] = f->material_names ? f->material_names[i] : "";
     for (i = 0; i < L->area_count; ++i) {
-        const rad_tool_area_light *al = &L->areas[i];
+        const tool_area_light *al = &L->areas[i];
         float *p = s->positions + 12 * (size_t)i;
         char *mesh_name = s->names + 64 * (size_t)i, *mat_name = mesh_name + 32;
         rad_mesh_desc *md = &s->meshes[nm + i];
@@ -268,7 +268,7 @@ static int add_areas(rad_tool_scene *f, const rad_tool_lights *L, lights_storage
     return 0;
 }
 
-int rad_tool_add_lights(const char *cmd, rad_tool_scene *f, const rad_tool_lights *L, void **storage)
+int tool_add_lights(const char *cmd, tool_scene *f, const tool_lights *L, void **storage)
 {
     lights_storage *s = NULL;
     uint32_t i, counts[4] = {0, 0, 0, 0};
@@ -298,7 +298,7 @@ int rad_tool_add_lights(const char *cmd, rad_tool_scene *f, const rad_tool_light
     return 0;
 }
 
-uint64_t rad_tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h)
+uint64_t tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h)
 {
     uint32_t i;
     /* field by field: the structs are memset, but the hash should not depend on that */

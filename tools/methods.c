@@ -24,12 +24,12 @@
 
 /* ---- options ------------------------------------------------------------------------------ */
 
-void rad_tool_method_options_default(rad_tool_method_options *mo)
+void tool_method_options_default(tool_method_options *mo)
 {
     memset(mo, 0, sizeof *mo);
-    mo->method = RAD_TOOL_CLASSIC;
+    mo->method = TOOL_CLASSIC;
     mo->bounces = 64;
-    mo->format = RAD_TOOL_MB_BC4X3;
+    mo->format = TOOL_MB_BC4X3;
     mo->outliers = 0.05f;
     mo->reorder = RAD_REORDER_MATCH;
     mo->tile = 64;
@@ -49,21 +49,21 @@ void rad_tool_method_options_default(rad_tool_method_options *mo)
     mo->every = 1;
     mo->vp_resolution = 16;
     mo->face_points = 16;
-    mo->local_m = 0; /* every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX (cmd_render.c) */
+    mo->local_m = 0; /* every patch up to TOOL_LOCAL_M_AUTO_MAX (cmd_render.c) */
 }
 
-const char *rad_tool_method_name(rad_tool_method method)
+const char *tool_method_name(tool_method method)
 {
     switch (method) {
-    case RAD_TOOL_MULTIBOUNCE: return "multibounce";
-    case RAD_TOOL_TEMPORAL: return "temporal";
-    case RAD_TOOL_PATHTRACE: return "pathtrace";
-    case RAD_TOOL_STOCHASTIC: return "stochastic";
-    case RAD_TOOL_LOCAL: return "local";
-    case RAD_TOOL_VP: return "vp";
-    case RAD_TOOL_AAVP: return "aavp";
-    case RAD_TOOL_HIERARCHICAL: return "hierarchical";
-    case RAD_TOOL_LIGHTMAP: return "lightmap";
+    case TOOL_MULTIBOUNCE: return "multibounce";
+    case TOOL_TEMPORAL: return "temporal";
+    case TOOL_PATHTRACE: return "pathtrace";
+    case TOOL_STOCHASTIC: return "stochastic";
+    case TOOL_LOCAL: return "local";
+    case TOOL_VP: return "vp";
+    case TOOL_AAVP: return "aavp";
+    case TOOL_HIERARCHICAL: return "hierarchical";
+    case TOOL_LIGHTMAP: return "lightmap";
     default: return "classic";
     }
 }
@@ -100,7 +100,7 @@ static const char light_path_help[] =
     "                     in turn (default 0: every sample every frame; shadows at most\n"
     "                     samples / N frames old, the light's falloff exact every frame)\n";
 
-const char *rad_tool_method_help(int render)
+const char *tool_method_help(int render)
 {
     static char buf[8192];
     snprintf(buf, sizeof buf, render ? "multibounce and temporal (without --bake: baked here first; with --bake the bake's own):\n"
@@ -171,7 +171,7 @@ const char *rad_tool_method_help(int render)
 }
 
 /* --proxy patches|aavp|vp: 1 taken, 2 bad value, 0 not this option */
-static int proxy_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo)
+static int proxy_option(const char *cmd, int argc, char **argv, int *a, tool_method_options *mo)
 {
     const char *v;
     if (strcmp(argv[*a], "--proxy")) return 0;
@@ -180,14 +180,14 @@ static int proxy_option(const char *cmd, int argc, char **argv, int *a, rad_tool
         return 2;
     }
     v = argv[++*a];
-    if (!strcmp(v, "patches")) mo->proxy = RAD_TOOL_PROXY_PATCHES;
-    else if (!strcmp(v, "aavp")) mo->proxy = RAD_TOOL_PROXY_AAVP;
-    else if (!strcmp(v, "vp")) mo->proxy = RAD_TOOL_PROXY_VP;
+    if (!strcmp(v, "patches")) mo->proxy = TOOL_PROXY_PATCHES;
+    else if (!strcmp(v, "aavp")) mo->proxy = TOOL_PROXY_AAVP;
+    else if (!strcmp(v, "vp")) mo->proxy = TOOL_PROXY_VP;
     else {
         fprintf(stderr, "rad %s: unknown --proxy '%s' (patches, aavp or vp)\n", cmd, v);
         return 2;
     }
-    mo->given |= RAD_TOOL_OPT_PROXY;
+    mo->given |= TOOL_OPT_PROXY;
     return 1;
 }
 
@@ -195,7 +195,7 @@ static const char *given_name(uint32_t bits);
 
 /* --proxy aavp|vp: render only, with multibounce, temporal or local; the proxy's F_mb is
    float and its frames are not written one by one, so the options for those are refused */
-static int proxy_check(const char *cmd, int render, const rad_tool_method_options *mo)
+static int proxy_check(const char *cmd, int render, const tool_method_options *mo)
 {
     uint32_t bad;
     if (!mo->proxy) return 0;
@@ -203,26 +203,26 @@ static int proxy_check(const char *cmd, int render, const rad_tool_method_option
         fprintf(stderr, "rad %s: --proxy is an option of rad render (bake virtual patches with --method aavp|vp)\n", cmd);
         return 2;
     }
-    if (mo->method != RAD_TOOL_MULTIBOUNCE && mo->method != RAD_TOOL_TEMPORAL && mo->method != RAD_TOOL_LOCAL) {
+    if (mo->method != TOOL_MULTIBOUNCE && mo->method != TOOL_TEMPORAL && mo->method != TOOL_LOCAL) {
         fprintf(stderr, "rad %s: --proxy %s is for --method multibounce, temporal or local, not %s\n", cmd,
-                mo->proxy == RAD_TOOL_PROXY_VP ? "vp" : "aavp", rad_tool_method_name(mo->method));
+                mo->proxy == TOOL_PROXY_VP ? "vp" : "aavp", tool_method_name(mo->method));
         return 2;
     }
-    bad = mo->given & (RAD_TOOL_OPT_MB_BUILD |
-                       (mo->method == RAD_TOOL_TEMPORAL ? 0u : RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY));
+    bad = mo->given & (TOOL_OPT_MB_BUILD |
+                       (mo->method == TOOL_TEMPORAL ? 0u : TOOL_OPT_SEQUENCE | TOOL_OPT_EVERY));
     if (bad) {
         fprintf(stderr, "rad %s: %s is not an option of --proxy %s (its F_mb is float; one image, no sequence)\n", cmd,
-                given_name(bad), mo->proxy == RAD_TOOL_PROXY_VP ? "vp" : "aavp");
+                given_name(bad), mo->proxy == TOOL_PROXY_VP ? "vp" : "aavp");
         return 2;
     }
-    if ((mo->given & RAD_TOOL_OPT_VP_RESOLUTION) && (mo->given & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
+    if ((mo->given & TOOL_OPT_VP_RESOLUTION) && (mo->given & TOOL_OPT_VP_MAX_PATCHES)) {
         fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
         return 2;
     }
     return 0;
 }
 
-int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo)
+int tool_method_option(const char *cmd, int argc, char **argv, int *a, tool_method_options *mo)
 {
     static const char *const names[] = {"--method", "--bounces", "--format",    "--outliers", "--reorder-samples",
                                         "--tile",   "--mode",    "--k",         "--w",        "--seed",
@@ -246,13 +246,13 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
             }
         } else {
             uint32_t *dst = which ? &mo->sr_iterations : &mo->sr_rays, hi = which ? 1000000u : (1u << 26);
-            if (rad_tool_parse_uint(cmd, opt, v, dst)) return 2;
+            if (tool_parse_uint(cmd, opt, v, dst)) return 2;
             if (*dst == 0 || *dst > hi) {
                 fprintf(stderr, "rad %s: %s must be in 1..%u, not %s\n", cmd, opt, hi, v);
                 return 2;
             }
         }
-        mo->given |= RAD_TOOL_OPT_SR_RAYS << which;
+        mo->given |= TOOL_OPT_SR_RAYS << which;
         return 1;
     }
     if (!strcmp(opt, "--light-path") || !strcmp(opt, "--light-rays")) {
@@ -262,8 +262,8 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         }
         v = argv[++*a];
         if (opt[8] == 'r') {
-            if (rad_tool_parse_uint(cmd, opt, v, &mo->light_rays)) return 2;
-            mo->given |= RAD_TOOL_OPT_LIGHT_RAYS;
+            if (tool_parse_uint(cmd, opt, v, &mo->light_rays)) return 2;
+            mo->given |= TOOL_OPT_LIGHT_RAYS;
             return 1;
         }
         {
@@ -282,7 +282,7 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
                 return 2;
             }
         }
-        mo->given |= RAD_TOOL_OPT_LIGHT_PATH;
+        mo->given |= TOOL_OPT_LIGHT_PATH;
         return 1;
     }
     if (!strcmp(opt, "--hr-eps") || !strcmp(opt, "--hr-min-area") || !strcmp(opt, "--hr-rays")) {
@@ -293,27 +293,27 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         v = argv[++*a];
         if (opt[5] == 'r') {
             uint32_t n = 1;
-            if (rad_tool_parse_uint(cmd, opt, v, &mo->hr_rays)) return 2;
+            if (tool_parse_uint(cmd, opt, v, &mo->hr_rays)) return 2;
             while (n * n < mo->hr_rays) ++n;
             if (mo->hr_rays == 0 || mo->hr_rays > 64 || n * n != mo->hr_rays) {
                 fprintf(stderr, "rad %s: --hr-rays must be a square from 1 to 64 (1, 4, 9 ...), not %s\n", cmd, v);
                 return 2;
             }
-            mo->given |= RAD_TOOL_OPT_HR_RAYS;
+            mo->given |= TOOL_OPT_HR_RAYS;
         } else if (opt[5] == 'e') {
-            if (rad_tool_parse_float(cmd, opt, v, &mo->hr_eps)) return 2;
+            if (tool_parse_float(cmd, opt, v, &mo->hr_eps)) return 2;
             if (!(mo->hr_eps > 0.0f && mo->hr_eps < 1.0f)) {
                 fprintf(stderr, "rad %s: --hr-eps must be in (0, 1) (e.g. 1e-3), not %s\n", cmd, v);
                 return 2;
             }
-            mo->given |= RAD_TOOL_OPT_HR_EPS;
+            mo->given |= TOOL_OPT_HR_EPS;
         } else {
-            if (rad_tool_parse_float(cmd, opt, v, &mo->hr_min_area)) return 2;
+            if (tool_parse_float(cmd, opt, v, &mo->hr_min_area)) return 2;
             if (!(mo->hr_min_area > 0.0f) || mo->hr_min_area > 1e30f) {
                 fprintf(stderr, "rad %s: --hr-min-area must be a positive area, not %s\n", cmd, v);
                 return 2;
             }
-            mo->given |= RAD_TOOL_OPT_HR_MIN_AREA;
+            mo->given |= TOOL_OPT_HR_MIN_AREA;
         }
         return 1;
     }
@@ -334,12 +334,12 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
                 return 2;
             }
             v = argv[++*a];
-            if (rad_tool_parse_uint(cmd, opt, v, dst)) return 2;
+            if (tool_parse_uint(cmd, opt, v, dst)) return 2;
             if (*dst == 0 || *dst > hi) {
                 fprintf(stderr, "rad %s: %s must be in 1..%u, not %s\n", cmd, opt, hi, v);
                 return 2;
             }
-            mo->given |= RAD_TOOL_OPT_VP_RESOLUTION << i;
+            mo->given |= TOOL_OPT_VP_RESOLUTION << i;
             return 1;
         }
     }
@@ -347,8 +347,8 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
         if (!strcmp(opt, names[i])) break;
     if (i == sizeof names / sizeof names[0]) return 0;
     if (i >= 13) { /* flags */
-        if (i == 15) mo->adaptive = 1, mo->given |= RAD_TOOL_OPT_ADAPTIVE;
-        else mo->reorder = i == 13 ? RAD_REORDER_MATCH : RAD_REORDER_NONE, mo->given |= RAD_TOOL_OPT_REORDER;
+        if (i == 15) mo->adaptive = 1, mo->given |= TOOL_OPT_ADAPTIVE;
+        else mo->reorder = i == 13 ? RAD_REORDER_MATCH : RAD_REORDER_NONE, mo->given |= TOOL_OPT_REORDER;
         return 1;
     }
     if (*a + 1 >= argc) {
@@ -358,30 +358,30 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
     v = argv[++*a];
     switch (i) {
     case 0:
-        if (!strcmp(v, "classic")) mo->method = RAD_TOOL_CLASSIC;
-        else if (!strcmp(v, "multibounce")) mo->method = RAD_TOOL_MULTIBOUNCE;
-        else if (!strcmp(v, "temporal")) mo->method = RAD_TOOL_TEMPORAL;
-        else if (!strcmp(v, "pathtrace")) mo->method = RAD_TOOL_PATHTRACE;
-        else if (!strcmp(v, "local")) mo->method = RAD_TOOL_LOCAL;
-        else if (!strcmp(v, "vp")) mo->method = RAD_TOOL_VP;
-        else if (!strcmp(v, "aavp")) mo->method = RAD_TOOL_AAVP;
-        else if (!strcmp(v, "stochastic")) mo->method = RAD_TOOL_STOCHASTIC;
-        else if (!strcmp(v, "hierarchical")) mo->method = RAD_TOOL_HIERARCHICAL;
-        else if (!strcmp(v, "lightmap")) mo->method = RAD_TOOL_LIGHTMAP;
+        if (!strcmp(v, "classic")) mo->method = TOOL_CLASSIC;
+        else if (!strcmp(v, "multibounce")) mo->method = TOOL_MULTIBOUNCE;
+        else if (!strcmp(v, "temporal")) mo->method = TOOL_TEMPORAL;
+        else if (!strcmp(v, "pathtrace")) mo->method = TOOL_PATHTRACE;
+        else if (!strcmp(v, "local")) mo->method = TOOL_LOCAL;
+        else if (!strcmp(v, "vp")) mo->method = TOOL_VP;
+        else if (!strcmp(v, "aavp")) mo->method = TOOL_AAVP;
+        else if (!strcmp(v, "stochastic")) mo->method = TOOL_STOCHASTIC;
+        else if (!strcmp(v, "hierarchical")) mo->method = TOOL_HIERARCHICAL;
+        else if (!strcmp(v, "lightmap")) mo->method = TOOL_LIGHTMAP;
         else {
             fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal, stochastic%s)\n", cmd, v,
                     strcmp(cmd, "render") ? "" : ", pathtrace, local, vp, aavp, hierarchical or lightmap");
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_METHOD;
+        mo->given |= TOOL_OPT_METHOD;
         return 1;
     case 1:
-        mo->given |= RAD_TOOL_OPT_BOUNCES;
+        mo->given |= TOOL_OPT_BOUNCES;
         if (!strcmp(v, "inf")) {
             mo->bounces = RAD_MB_INFINITE;
             return 1;
         }
-        if (rad_tool_parse_uint(cmd, opt, v, &mo->bounces)) return 2;
+        if (tool_parse_uint(cmd, opt, v, &mo->bounces)) return 2;
         if (mo->bounces >= 0xFFFFFFF0u) {
             fprintf(stderr, "rad %s: --bounces %s is too large (use 'inf' for the full solution)\n", cmd, v);
             return 2;
@@ -396,27 +396,27 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
             return 2;
         }
         mo->format = f;
-        mo->given |= RAD_TOOL_OPT_FORMAT;
+        mo->given |= TOOL_OPT_FORMAT;
         return 1;
     }
     case 3:
-        if (rad_tool_parse_float(cmd, opt, v, &mo->outliers)) return 2;
+        if (tool_parse_float(cmd, opt, v, &mo->outliers)) return 2;
         if (!(mo->outliers >= 0.0f && mo->outliers < 1.0f)) {
             fprintf(stderr, "rad %s: --outliers must be a fraction in [0, 1) (e.g. 0.05), not %s\n", cmd, v);
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_OUTLIERS;
+        mo->given |= TOOL_OPT_OUTLIERS;
         return 1;
     case 4:
-        mo->given |= RAD_TOOL_OPT_REORDER_SAMPLES;
-        return rad_tool_parse_uint(cmd, opt, v, &mo->reorder_samples) ? 2 : 1;
+        mo->given |= TOOL_OPT_REORDER_SAMPLES;
+        return tool_parse_uint(cmd, opt, v, &mo->reorder_samples) ? 2 : 1;
     case 5:
-        if (rad_tool_parse_uint(cmd, opt, v, &mo->tile)) return 2;
+        if (tool_parse_uint(cmd, opt, v, &mo->tile)) return 2;
         if (mo->tile % 4 != 0) {
             fprintf(stderr, "rad %s: --tile must be a multiple of 4 (0: one scale per matrix), not %s\n", cmd, v);
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_TILE;
+        mo->given |= TOOL_OPT_TILE;
         return 1;
     case 6:
         if (!strcmp(v, "feedback")) mo->mode = RAD_TEMPORAL_FEEDBACK;
@@ -426,34 +426,34 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
             fprintf(stderr, "rad %s: unknown --mode '%s' (feedback, single or multibounce)\n", cmd, v);
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_MODE;
+        mo->given |= TOOL_OPT_MODE;
         return 1;
     case 7:
-        if (rad_tool_parse_uint(cmd, opt, v, &mo->k)) return 2;
+        if (tool_parse_uint(cmd, opt, v, &mo->k)) return 2;
         if (mo->k == 0 || mo->k > 65536) {
             fprintf(stderr, "rad %s: --k must be in 1..65536, not %s\n", cmd, v);
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_K;
+        mo->given |= TOOL_OPT_K;
         return 1;
     case 8:
-        if (rad_tool_parse_float(cmd, opt, v, &mo->w)) return 2;
+        if (tool_parse_float(cmd, opt, v, &mo->w)) return 2;
         if (!(mo->w >= 0.0f && mo->w < 1.0f)) {
             fprintf(stderr, "rad %s: --w must be in [0, 1), not %s\n", cmd, v);
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_W;
+        mo->given |= TOOL_OPT_W;
         return 1;
     case 9:
-        mo->given |= RAD_TOOL_OPT_SEED;
-        return rad_tool_parse_uint(cmd, opt, v, &mo->seed) ? 2 : 1;
+        mo->given |= TOOL_OPT_SEED;
+        return tool_parse_uint(cmd, opt, v, &mo->seed) ? 2 : 1;
     case 10:
-        if (rad_tool_parse_uint(cmd, opt, v, &mo->frames)) return 2;
+        if (tool_parse_uint(cmd, opt, v, &mo->frames)) return 2;
         if (mo->frames == 0 || mo->frames > 10000000u) {
             fprintf(stderr, "rad %s: --frames must be in 1..10000000, not %s\n", cmd, v);
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_FRAMES;
+        mo->given |= TOOL_OPT_FRAMES;
         return 1;
     case 11:
         if (!*v) {
@@ -461,15 +461,15 @@ int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_t
             return 2;
         }
         mo->sequence = v;
-        mo->given |= RAD_TOOL_OPT_SEQUENCE;
+        mo->given |= TOOL_OPT_SEQUENCE;
         return 1;
     default:
-        if (rad_tool_parse_uint(cmd, opt, v, &mo->every)) return 2;
+        if (tool_parse_uint(cmd, opt, v, &mo->every)) return 2;
         if (mo->every == 0) {
             fprintf(stderr, "rad %s: --every must be > 0\n", cmd);
             return 2;
         }
-        mo->given |= RAD_TOOL_OPT_EVERY;
+        mo->given |= TOOL_OPT_EVERY;
         return 1;
     }
 }
@@ -489,113 +489,113 @@ static const char *given_name(uint32_t bits)
     return "?";
 }
 
-int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o)
+int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool_classic_options *o)
 {
     /* with --proxy the virtual patches' options belong to the proxy */
-    uint32_t g = mo->given & ~(mo->proxy ? RAD_TOOL_OPT_VP : 0u), bad = 0;
+    uint32_t g = mo->given & ~(mo->proxy ? TOOL_OPT_VP : 0u), bad = 0;
     const char *want = NULL;
     if (proxy_check(cmd, render, mo)) return 2;
-    if ((mo->given & (RAD_TOOL_OPT_LIGHT_PATH | RAD_TOOL_OPT_LIGHT_RAYS)) && render &&
-        (mo->method != RAD_TOOL_TEMPORAL || !mo->proxy)) {
+    if ((mo->given & (TOOL_OPT_LIGHT_PATH | TOOL_OPT_LIGHT_RAYS)) && render &&
+        (mo->method != TOOL_TEMPORAL || !mo->proxy)) {
         fprintf(stderr, "rad %s: %s is for --method temporal --proxy aavp|vp\n", cmd,
-                given_name(mo->given & (RAD_TOOL_OPT_LIGHT_PATH | RAD_TOOL_OPT_LIGHT_RAYS)));
+                given_name(mo->given & (TOOL_OPT_LIGHT_PATH | TOOL_OPT_LIGHT_RAYS)));
         return 2;
     }
-    if ((mo->given & RAD_TOOL_OPT_LIGHT_RAYS) && !(mo->given & RAD_TOOL_OPT_LIGHT_PATH)) {
+    if ((mo->given & TOOL_OPT_LIGHT_RAYS) && !(mo->given & TOOL_OPT_LIGHT_PATH)) {
         fprintf(stderr, "rad %s: --light-rays needs --light-path\n", cmd);
         return 2;
     }
-    if (!render && (g & RAD_TOOL_OPT_RENDER_ONLY)) {
-        fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & RAD_TOOL_OPT_RENDER_ONLY));
+    if (!render && (g & TOOL_OPT_RENDER_ONLY)) {
+        fprintf(stderr, "rad %s: %s is an option of rad render\n", cmd, given_name(g & TOOL_OPT_RENDER_ONLY));
         return 2;
     }
-    if (!render && mo->method == RAD_TOOL_LIGHTMAP) {
+    if (!render && mo->method == TOOL_LIGHTMAP) {
         fprintf(stderr, "rad %s: method 'lightmap' is render-only (rad lightmap writes the lightmap itself)\n", cmd);
         return 2;
     }
-    if (!render && mo->method == RAD_TOOL_LOCAL) {
+    if (!render && mo->method == TOOL_LOCAL) {
         fprintf(stderr, "rad %s: method 'local' is render-only (rad render --method local builds it in memory: its "
                         "matrix depends on the camera; a classic bake holds its F)\n", cmd);
         return 2;
     }
-    if (!render && (mo->method == RAD_TOOL_VP || mo->method == RAD_TOOL_AAVP) && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
+    if (!render && (mo->method == TOOL_VP || mo->method == TOOL_AAVP) && (g & TOOL_OPT_VP_MAX_PATCHES)) {
         fprintf(stderr, "rad %s: --vp-max-patches is an option of rad render (bake with --vp-resolution)\n", cmd);
         return 2;
     }
-    if (mo->method >= RAD_TOOL_LOCAL) {
-        uint32_t other = mo->method == RAD_TOOL_LOCAL          ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_HR
-                         : mo->method == RAD_TOOL_HIERARCHICAL ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_LOCAL_M
-                         : mo->method == RAD_TOOL_LIGHTMAP     ? RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR
-                                                               : RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR;
-        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED |
-                   RAD_TOOL_OPT_SR | other);
+    if (mo->method >= TOOL_LOCAL) {
+        uint32_t other = mo->method == TOOL_LOCAL          ? TOOL_OPT_VP | TOOL_OPT_BOUNCES | TOOL_OPT_HR
+                         : mo->method == TOOL_HIERARCHICAL ? TOOL_OPT_VP | TOOL_OPT_BOUNCES | TOOL_OPT_LOCAL_M
+                         : mo->method == TOOL_LIGHTMAP     ? TOOL_OPT_VP | TOOL_OPT_LOCAL_M | TOOL_OPT_HR
+                                                               : TOOL_OPT_LOCAL_M | TOOL_OPT_HR;
+        bad = g & (TOOL_OPT_MB_BUILD | TOOL_OPT_TEMPORAL | TOOL_OPT_RENDER_ONLY | TOOL_OPT_SEED |
+                   TOOL_OPT_SR | other);
         if (bad) {
             fprintf(stderr, "rad %s: %s is not an option of --method %s%s\n", cmd, given_name(bad),
-                    rad_tool_method_name(mo->method),
-                    mo->method == RAD_TOOL_LOCAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (T is the full solution in the set)"
-                    : mo->method == RAD_TOOL_HIERARCHICAL && (bad & RAD_TOOL_OPT_BOUNCES) ? " (it solves to convergence)"
+                    tool_method_name(mo->method),
+                    mo->method == TOOL_LOCAL && (bad & TOOL_OPT_BOUNCES) ? " (T is the full solution in the set)"
+                    : mo->method == TOOL_HIERARCHICAL && (bad & TOOL_OPT_BOUNCES) ? " (it solves to convergence)"
                                                                                           : "");
             return 2;
         }
-        if ((g & RAD_TOOL_OPT_VP_RESOLUTION) && (g & RAD_TOOL_OPT_VP_MAX_PATCHES)) {
+        if ((g & TOOL_OPT_VP_RESOLUTION) && (g & TOOL_OPT_VP_MAX_PATCHES)) {
             fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
             return 2;
         }
         return 0;
     }
-    if (g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR)) {
+    if (g & (TOOL_OPT_VP | TOOL_OPT_LOCAL_M | TOOL_OPT_HR)) {
         fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd,
-                given_name(g & (RAD_TOOL_OPT_VP | RAD_TOOL_OPT_LOCAL_M | RAD_TOOL_OPT_HR)),
-                (g & RAD_TOOL_OPT_VP) ? "vp or aavp" : (g & RAD_TOOL_OPT_LOCAL_M) ? "local" : "hierarchical",
-                rad_tool_method_name(mo->method));
+                given_name(g & (TOOL_OPT_VP | TOOL_OPT_LOCAL_M | TOOL_OPT_HR)),
+                (g & TOOL_OPT_VP) ? "vp or aavp" : (g & TOOL_OPT_LOCAL_M) ? "local" : "hierarchical",
+                tool_method_name(mo->method));
         return 2;
     }
-    if ((g & RAD_TOOL_OPT_SR) && mo->method != RAD_TOOL_STOCHASTIC) {
-        fprintf(stderr, "rad %s: %s is for --method stochastic, not %s\n", cmd, given_name(g & RAD_TOOL_OPT_SR),
-                rad_tool_method_name(mo->method));
+    if ((g & TOOL_OPT_SR) && mo->method != TOOL_STOCHASTIC) {
+        fprintf(stderr, "rad %s: %s is for --method stochastic, not %s\n", cmd, given_name(g & TOOL_OPT_SR),
+                tool_method_name(mo->method));
         return 2;
     }
-    if (!render && mo->method == RAD_TOOL_PATHTRACE) {
+    if (!render && mo->method == TOOL_PATHTRACE) {
         fprintf(stderr, "rad %s: method 'pathtrace' needs no bake (use rad render --method pathtrace)\n", cmd);
         return 2;
     }
     switch (mo->method) {
-    case RAD_TOOL_CLASSIC:
-        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY |
-                   (render ? 0u : RAD_TOOL_OPT_SEED));
-        want = (bad & RAD_TOOL_OPT_MB_BUILD) ? "multibounce" : "temporal";
+    case TOOL_CLASSIC:
+        bad = g & (TOOL_OPT_MB_BUILD | TOOL_OPT_TEMPORAL | TOOL_OPT_RENDER_ONLY |
+                   (render ? 0u : TOOL_OPT_SEED));
+        want = (bad & TOOL_OPT_MB_BUILD) ? "multibounce" : "temporal";
         if (!bad && mo->bounces == RAD_MB_INFINITE) {
             fprintf(stderr, "rad %s: --bounces inf is for --method multibounce (classic Jacobi needs a count)\n", cmd);
             return 2;
         }
-        if (g & RAD_TOOL_OPT_BOUNCES) o->bounces = mo->bounces;
+        if (g & TOOL_OPT_BOUNCES) o->bounces = mo->bounces;
         break;
-    case RAD_TOOL_PATHTRACE:
-        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_BOUNCES);
-        want = (bad & RAD_TOOL_OPT_MB_BUILD) || (bad & RAD_TOOL_OPT_BOUNCES) ? "multibounce" : "temporal";
+    case TOOL_PATHTRACE:
+        bad = g & (TOOL_OPT_MB_BUILD | TOOL_OPT_TEMPORAL | TOOL_OPT_RENDER_ONLY | TOOL_OPT_BOUNCES);
+        want = (bad & TOOL_OPT_MB_BUILD) || (bad & TOOL_OPT_BOUNCES) ? "multibounce" : "temporal";
         break;
-    case RAD_TOOL_MULTIBOUNCE:
-        bad = g & (RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY | RAD_TOOL_OPT_SEED);
+    case TOOL_MULTIBOUNCE:
+        bad = g & (TOOL_OPT_TEMPORAL | TOOL_OPT_RENDER_ONLY | TOOL_OPT_SEED);
         want = "temporal";
         break;
-    case RAD_TOOL_STOCHASTIC:
-        bad = g & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES | RAD_TOOL_OPT_TEMPORAL | RAD_TOOL_OPT_RENDER_ONLY);
-        want = (bad & (RAD_TOOL_OPT_MB_BUILD | RAD_TOOL_OPT_BOUNCES)) ? "multibounce" : "temporal";
+    case TOOL_STOCHASTIC:
+        bad = g & (TOOL_OPT_MB_BUILD | TOOL_OPT_BOUNCES | TOOL_OPT_TEMPORAL | TOOL_OPT_RENDER_ONLY);
+        want = (bad & (TOOL_OPT_MB_BUILD | TOOL_OPT_BOUNCES)) ? "multibounce" : "temporal";
         break;
     default:
-        bad = g & RAD_TOOL_OPT_MB_BUILD;
+        bad = g & TOOL_OPT_MB_BUILD;
         want = "multibounce";
-        if (!bad && (g & RAD_TOOL_OPT_BOUNCES) && mo->mode != RAD_TEMPORAL_MULTIBOUNCE) {
+        if (!bad && (g & TOOL_OPT_BOUNCES) && mo->mode != RAD_TEMPORAL_MULTIBOUNCE) {
             fprintf(stderr, "rad %s: --bounces is for --mode multibounce with --method temporal (mode %s samples F)\n",
                     cmd, mode_name(mo->mode));
             return 2;
         }
-        if (!bad && (g & RAD_TOOL_OPT_W) && (g & RAD_TOOL_OPT_ADAPTIVE)) {
+        if (!bad && (g & TOOL_OPT_W) && (g & TOOL_OPT_ADAPTIVE)) {
             fprintf(stderr, "rad %s: --w and --adaptive exclude each other\n", cmd);
             return 2;
         }
-        if (g & RAD_TOOL_OPT_W) mo->adaptive = 0; /* a fixed weight replaces the adaptive default */
-        if (!bad && (g & RAD_TOOL_OPT_EVERY) && !(g & RAD_TOOL_OPT_SEQUENCE)) {
+        if (g & TOOL_OPT_W) mo->adaptive = 0; /* a fixed weight replaces the adaptive default */
+        if (!bad && (g & TOOL_OPT_EVERY) && !(g & TOOL_OPT_SEQUENCE)) {
             fprintf(stderr, "rad %s: --every needs --sequence DIR\n", cmd);
             return 2;
         }
@@ -603,14 +603,14 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
     }
     if (bad) {
         fprintf(stderr, "rad %s: %s is for --method %s, not %s\n", cmd, given_name(bad), want,
-                rad_tool_method_name(mo->method));
+                tool_method_name(mo->method));
         return 2;
     }
-    if (mo->method == RAD_TOOL_MULTIBOUNCE && mo->format <= RAD_TOOL_MB_HALF &&
-        (g & (RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE))) {
+    if (mo->method == TOOL_MULTIBOUNCE && mo->format <= TOOL_MB_HALF &&
+        (g & (TOOL_OPT_OUTLIERS | TOOL_OPT_REORDER | TOOL_OPT_REORDER_SAMPLES | TOOL_OPT_TILE))) {
         fprintf(stderr, "rad %s: %s is for the compressed formats (--format bc1 or bc4x3), not %s\n", cmd,
-                given_name(g & (RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | RAD_TOOL_OPT_REORDER_SAMPLES |
-                                RAD_TOOL_OPT_TILE)),
+                given_name(g & (TOOL_OPT_OUTLIERS | TOOL_OPT_REORDER | TOOL_OPT_REORDER_SAMPLES |
+                                TOOL_OPT_TILE)),
                 format_name(mo->format));
         return 2;
     }
@@ -623,7 +623,7 @@ int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *
    hemisphere that sees a patch's front) are estimated by rays: 64 per patch from stratified
    points in cosine-distributed directions, the fraction that lands on a front face. */
 #define SR_ROWSUM_RAYS 64u
-static rad_result stochastic_rowsums(const rad_tool_world *w, const rad_patches *P, float *S)
+static rad_result stochastic_rowsums(const tool_world *w, const rad_patches *P, float *S)
 {
     rad_ray rays[SR_ROWSUM_RAYS];
     rad_hit hits[SR_ROWSUM_RAYS];
@@ -714,20 +714,20 @@ static rad_result hierarchical_to_patches(const rad_hierarchical *h, const rad_s
     return RAD_SUCCESS;
 }
 
-int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                         const rad_tool_method_options *mo, void **out, size_t *out_size)
+int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                         const tool_method_options *mo, void **out, size_t *out_size)
 {
-    rad_tool_classic_options so = *o;
-    rad_tool_classic c;
+    tool_classic_options so = *o;
+    tool_classic c;
     rad_context ctx;
     rad_result r = RAD_SUCCESS;
     rad_multibounce *mb = NULL;
     rad_multibounce_blocks *blocks = NULL;
     rad_alias_tables *tables[3] = {NULL, NULL, NULL};
     rad_block_report report;
-    rad_tool_bake_info info;
+    tool_bake_info info;
     rad_bake_signature sig;
-    rad_tool_method_info mi;
+    tool_method_info mi;
     rad_container *ct = NULL;
     rad_section *secs = NULL;
     void *base = NULL, *dst = NULL;
@@ -741,15 +741,15 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     *out = NULL;
     *out_size = 0;
     so.sources_only = 1;
-    so.no_form_factors = mo->method == RAD_TOOL_STOCHASTIC || mo->method == RAD_TOOL_HIERARCHICAL;
-    if (rad_tool_classic_solve(cmd, w, &so, &c)) return 1;
+    so.no_form_factors = mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL;
+    if (tool_classic_solve(cmd, w, &so, &c)) return 1;
     n = c.patches->count;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
 
     /* row sums of F for the halo correction */
-    ones = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    rows3 = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    S = (float *)rad_tool_calloc(n, sizeof(float));
+    ones = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    rows3 = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    S = (float *)tool_calloc(n, sizeof(float));
     if (so.no_form_factors) {
         if ((r = stochastic_rowsums(w, c.patches, S)) != RAD_SUCCESS) {
             what = "row sums by rays";
@@ -765,7 +765,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     }
 
     memset(&mi, 0, sizeof mi);
-    mi.magic = RAD_TOOL_METHOD_MAGIC;
+    mi.magic = TOOL_METHOD_MAGIC;
     mi.method = (uint32_t)mo->method;
     mi.bounces = mo->bounces;
     mi.format = mo->format;
@@ -778,50 +778,50 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     mi.w = mo->w;
     mi.adaptive = (uint32_t)mo->adaptive;
     mi.seed = mo->seed;
-    if (mo->method == RAD_TOOL_STOCHASTIC) {
+    if (mo->method == TOOL_STOCHASTIC) {
         mi.k = mo->sr_rays;
         mi.bounces = mo->sr_iterations;
         mi.mode = mo->sr_estimator;
     }
 
-    t0 = rad_tool_seconds();
-    if (mo->method == RAD_TOOL_MULTIBOUNCE ||
-        (mo->method == RAD_TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
+    t0 = tool_seconds();
+    if (mo->method == TOOL_MULTIBOUNCE ||
+        (mo->method == TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
         rad_multibounce_options mbo;
         rad_multibounce_options_default(&mbo);
         mbo.bounces = mb_bounces(mo->bounces);
-        mbo.precision = mo->method == RAD_TOOL_MULTIBOUNCE && mo->format == RAD_TOOL_MB_HALF ? RAD_MB_HALF : RAD_MB_FLOAT;
-        rad_tool_context(&ctx, "F_mb");
+        mbo.precision = mo->method == TOOL_MULTIBOUNCE && mo->format == TOOL_MB_HALF ? RAD_MB_HALF : RAD_MB_FLOAT;
+        tool_context(&ctx, "F_mb");
         r = rad_multibounce_create(&c.ff->matrix, c.patches->albedo, &mbo, &ctx, &mb);
-        rad_tool_progress_end();
-        rad_tool_context(&ctx, NULL);
+        tool_progress_end();
+        tool_context(&ctx, NULL);
         if (r != RAD_SUCCESS) {
             what = "rad_multibounce_create";
             goto fail;
         }
         if (mbo.bounces == RAD_MB_INFINITE)
             fprintf(stderr, "rad %s: F_mb (inf bounces, %s) built in %.2f s\n", cmd,
-                    mbo.precision == RAD_MB_HALF ? "half" : "float", rad_tool_seconds() - t0);
+                    mbo.precision == RAD_MB_HALF ? "half" : "float", tool_seconds() - t0);
         else
             fprintf(stderr, "rad %s: F_mb (%u bounces: --bounces %u and the renderer's gather, %s) built in %.2f s\n",
                     cmd, mbo.bounces, mo->bounces, mbo.precision == RAD_MB_HALF ? "half" : "float",
-                    rad_tool_seconds() - t0);
+                    tool_seconds() - t0);
     }
-    if (mo->method == RAD_TOOL_MULTIBOUNCE) {
-        if (mo->format >= RAD_TOOL_MB_BC1) {
+    if (mo->method == TOOL_MULTIBOUNCE) {
+        if (mo->format >= TOOL_MB_BC1) {
             rad_block_options bo;
-            double t1 = rad_tool_seconds();
+            double t1 = tool_seconds();
             rad_block_options_default(&bo);
-            bo.format = mo->format == RAD_TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
+            bo.format = mo->format == TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
             bo.outlier_fraction = mo->outliers;
             bo.reorder = mo->reorder;
             bo.reorder_samples = mo->reorder_samples;
             bo.tile = mo->tile;
             memset(&report, 0, sizeof report);
-            rad_tool_context(&ctx, "compression");
+            tool_context(&ctx, "compression");
             r = rad_multibounce_blocks_create(mb, &bo, &ctx, &blocks, &report);
-            rad_tool_progress_end();
-            rad_tool_context(&ctx, NULL);
+            tool_progress_end();
+            tool_context(&ctx, NULL);
             if (r != RAD_SUCCESS) {
                 what = "rad_multibounce_blocks_create";
                 goto fail;
@@ -834,7 +834,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
                     "rad %s: compressed to %s in %.2f s: %lu bytes (blocks %lu, scales %lu, %llu outliers %lu, "
                     "permutations %lu) vs %lu float F_mb, %.1fx; decoded-matrix RMS error %.3g (%.3g%% of the "
                     "RMS entry), max %.3g\n",
-                    cmd, format_name(mo->format), rad_tool_seconds() - t1, (unsigned long)report.bytes_total,
+                    cmd, format_name(mo->format), tool_seconds() - t1, (unsigned long)report.bytes_total,
                     (unsigned long)report.bytes_blocks, (unsigned long)report.bytes_scales,
                     (unsigned long long)report.outlier_count, (unsigned long)report.bytes_outliers,
                     (unsigned long)report.bytes_permutations, (unsigned long)report.bytes_float_mb,
@@ -843,14 +843,14 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
                     report.source_mean_square > 0.0 ? 100.0 * sqrt(report.mse / report.source_mean_square) : 0.0,
                     report.max_abs_error);
         } else {
-            bytes = (size_t)3 * n * n * (mo->format == RAD_TOOL_MB_HALF ? 2u : 4u);
+            bytes = (size_t)3 * n * n * (mo->format == TOOL_MB_HALF ? 2u : 4u);
             fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", cmd, format_name(mo->format), (unsigned long)bytes);
         }
-    } else if (mo->method == RAD_TOOL_HIERARCHICAL) {
+    } else if (mo->method == TOOL_HIERARCHICAL) {
         rad_hierarchical *h = NULL;
         rad_hierarchical_stats st;
-        if (rad_tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) goto fail;
-        L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
+        if (tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) goto fail;
+        L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
         r = hierarchical_to_patches(h, w->scene, c.patches, L);
         rad_hierarchical_get_stats(h, &st);
         rad_hierarchical_destroy(h);
@@ -862,7 +862,7 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
         mi.k = st.leaves;
         mi.bounces = st.rounds;
         mi.w = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5f;
-    } else if (mo->method == RAD_TOOL_STOCHASTIC) {
+    } else if (mo->method == TOOL_STOCHASTIC) {
         rad_stochastic_options sto;
         rad_stochastic_stats st;
         rad_stochastic_options_default(&sto);
@@ -870,29 +870,29 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
         sto.rays = mo->sr_rays;
         sto.iterations = mo->sr_iterations;
         sto.seed = mo->seed;
-        L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-        rad_tool_context(&ctx, "stochastic radiosity");
+        L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+        tool_context(&ctx, "stochastic radiosity");
         r = rad_solve_stochastic(c.patches, &w->rc, c.E, &sto, L, &st, &ctx);
-        rad_tool_progress_end();
-        rad_tool_context(&ctx, NULL);
+        tool_progress_end();
+        tool_context(&ctx, NULL);
         if (r != RAD_SUCCESS) {
             what = "rad_solve_stochastic";
             goto fail;
         }
         bytes = (size_t)st.rays_cast; /* the record's byte count holds the rays cast here */
         fprintf(stderr, "rad %s: stochastic radiosity (%s) in %.2f s: %u iterations, %llu rays, unshot %.2g\n", cmd,
-                sto.method == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", rad_tool_seconds() - t0, st.iterations,
+                sto.method == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", tool_seconds() - t0, st.iterations,
                 (unsigned long long)st.rays_cast, st.unshot);
     } else {
-        rad_tool_context(&ctx, "alias tables");
+        tool_context(&ctx, "alias tables");
         if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
             for (i = 0; i < 3 && r == RAD_SUCCESS; ++i)
                 r = rad_alias_tables_create_dense(mb->planes + (size_t)i * n * n, n, RAD_ALIAS_AUTO, &ctx, &tables[i]);
         } else {
             r = rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, &ctx, &tables[0]);
         }
-        rad_tool_progress_end();
-        rad_tool_context(&ctx, NULL);
+        tool_progress_end();
+        tool_context(&ctx, NULL);
         if (r != RAD_SUCCESS) {
             what = "alias tables";
             goto fail;
@@ -907,12 +907,12 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
             fprintf(stderr,
                     "rad %s: alias tables (%s) built in %.2f s: %llu bins, %lu bytes (%.2f bytes per bin) from a "
                     "%llu-entry float matrix (%lu bytes)\n",
-                    cmd, mode_name(mo->mode), rad_tool_seconds() - t0, (unsigned long long)bins, (unsigned long)bytes,
+                    cmd, mode_name(mo->mode), tool_seconds() - t0, (unsigned long long)bins, (unsigned long)bytes,
                     bins ? (double)bytes / (double)bins : 0.0, (unsigned long long)entries,
                     (unsigned long)(entries * 4u));
         }
     }
-    mi.build_seconds = (float)(rad_tool_seconds() - t0);
+    mi.build_seconds = (float)(tool_seconds() - t0);
     mi.bytes_lo = (uint32_t)((uint64_t)bytes & 0xFFFFFFFFu);
     mi.bytes_hi = (uint32_t)((uint64_t)bytes >> 32);
 
@@ -921,12 +921,12 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
         what = "rad_save_memory";
         goto fail;
     }
-    if ((r = rad_container_open(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
-        what = "rad_container_open";
+    if ((r = rad_container_create(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
+        what = "rad_container_create";
         goto fail;
     }
     count = rad_container_section_count(ct);
-    secs = (rad_section *)rad_tool_calloc((size_t)count + 4 + 3 * 3 + RAD_MB_MAX_SECTIONS, sizeof(rad_section));
+    secs = (rad_section *)tool_calloc((size_t)count + 4 + 3 * 3 + RAD_MB_MAX_SECTIONS, sizeof(rad_section));
     for (i = 0; i < count; ++i) secs[k++] = *rad_container_section(ct, i);
     memset(&info, 0, sizeof info);
     info.magic = 0x52414442u;
@@ -937,16 +937,16 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     info.bounces = mo->bounces;
     info.light_samples = o->light_samples;
     info.triangle_count = w->scene->triangle_count;
-    rad_tool_sign_options(secs, k, &info, w, &sig);
+    tool_sign_options(secs, k, &info, w, &sig);
     secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c.D;
     strcpy(secs[k++].name, "D");
-    secs[k].type = RAD_TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;
+    secs[k].type = TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;
     strcpy(secs[k++].name, "rad.rowsums");
-    secs[k].type = RAD_TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
+    secs[k].type = TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
-    secs[k].type = RAD_TOOL_SECTION_METHOD, secs[k].elem_size = sizeof mi, secs[k].count = 1, secs[k].data = &mi;
+    secs[k].type = TOOL_SECTION_METHOD, secs[k].elem_size = sizeof mi, secs[k].count = 1, secs[k].data = &mi;
     strcpy(secs[k++].name, "rad.method");
-    if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+    if (mo->method == TOOL_MULTIBOUNCE) {
         uint32_t added = 0;
         r = blocks ? rad_multibounce_blocks_sections(blocks, "Fmb", secs + k, &added)
                    : rad_multibounce_sections(mb, "Fmb", secs + k, &added);
@@ -955,21 +955,21 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
             goto fail;
         }
         k += added;
-    } else if (mo->method == RAD_TOOL_STOCHASTIC || mo->method == RAD_TOOL_HIERARCHICAL) {
+    } else if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) {
         secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = L;
         strcpy(secs[k++].name, "L");
     } else if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
         static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
-        for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(tables[i], names[i], secs + k);
+        for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(tables[i], names[i], secs + k, NULL);
     } else {
-        rad_alias_tables_sections(tables[0], "F", secs + k);
+        rad_alias_tables_sections(tables[0], "F", secs + k, NULL);
         k += 3;
     }
     if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
         what = "rad_container_size";
         goto fail;
     }
-    dst = rad_tool_calloc(dst_size, 1);
+    dst = tool_calloc(dst_size, 1);
     if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
         what = "rad_container_write";
         goto fail;
@@ -979,10 +979,10 @@ int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_too
     dst = NULL;
     rc = 0;
 fail:
-    if (what) rad_tool_fail(cmd, what, r);
+    if (what) tool_fail(cmd, what, r);
     free(dst);
     free(secs);
-    rad_container_close(ct);
+    rad_container_destroy(ct);
     rad_free_buffer(base, &ctx);
     for (i = 0; i < 3; ++i) rad_alias_tables_destroy(tables[i]);
     rad_multibounce_blocks_destroy(blocks);
@@ -991,15 +991,15 @@ fail:
     free(rows3);
     free(S);
     free(L);
-    rad_tool_classic_free(&c);
+    tool_classic_free(&c);
     return rc;
 }
 
 /* ---- render side ---------------------------------------------------------------------------- */
 
-struct rad_tool_indirect {
+struct tool_indirect {
     const char *cmd;
-    rad_tool_method method;
+    tool_method method;
     uint32_t n;
     const float *E, *albedo, *S;
     rad_multibounce *mb;
@@ -1012,7 +1012,7 @@ struct rad_tool_indirect {
     rad_context ctx;
 };
 
-void rad_tool_indirect_close(rad_tool_indirect *m)
+void tool_indirect_close(tool_indirect *m)
 {
     if (!m) return;
     rad_temporal_destroy(m->temporal);
@@ -1022,40 +1022,40 @@ void rad_tool_indirect_close(rad_tool_indirect *m)
     free(m);
 }
 
-const float *rad_tool_indirect_rowsums(const rad_tool_indirect *m) { return m->S; }
+const float *tool_indirect_rowsums(const tool_indirect *m) { return m->S; }
 
-int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
-                           const rad_tool_method_options *mo, rad_tool_indirect **out)
+int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
+                           const tool_method_options *mo, tool_indirect **out)
 {
     const rad_container *ct = bake->container;
     const rad_section *s;
-    rad_tool_method_info mi;
-    rad_tool_indirect *m;
+    tool_method_info mi;
+    tool_indirect *m;
     rad_result r;
     uint32_t n = bake->patches.count;
-    const char *mname = rad_tool_method_name(mo->method);
+    const char *mname = tool_method_name(mo->method);
     *out = NULL;
-    s = rad_container_find(ct, RAD_TOOL_SECTION_METHOD, "rad.method");
+    s = rad_container_find(ct, TOOL_SECTION_METHOD, "rad.method");
     if (!s || s->elem_size != sizeof mi || s->count != 1) {
         fprintf(stderr, "rad %s: bake '%s' holds no %s data (no rad.method section: bake it with --method %s)\n", cmd,
                 bake_name, mname, mname);
         return 1;
     }
     memcpy(&mi, s->data, sizeof mi);
-    if (mi.magic != RAD_TOOL_METHOD_MAGIC) {
+    if (mi.magic != TOOL_METHOD_MAGIC) {
         fprintf(stderr, "rad %s: bake '%s' has a damaged rad.method section\n", cmd, bake_name);
         return 1;
     }
     if (mi.method != (uint32_t)mo->method) {
         fprintf(stderr, "rad %s: bake '%s' was made with --method %s, not %s\n", cmd, bake_name,
-                rad_tool_method_name((rad_tool_method)mi.method), mname);
+                tool_method_name((tool_method)mi.method), mname);
         return 1;
     }
     if (!bake->E) {
         fprintf(stderr, "rad %s: bake '%s' holds no source vector E\n", cmd, bake_name);
         return 1;
     }
-    s = rad_container_find(ct, RAD_TOOL_SECTION_ROWSUMS, "rad.rowsums");
+    s = rad_container_find(ct, TOOL_SECTION_ROWSUMS, "rad.rowsums");
     if (!s || s->elem_size != 4 || s->count != n) {
         fprintf(stderr, "rad %s: bake '%s' holds no row sums of F for its %u patches (section rad.rowsums)\n", cmd,
                 bake_name, n);
@@ -1072,26 +1072,26 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
                 return 1;
             }
     }
-    if (mo->method == RAD_TOOL_TEMPORAL && !(mo->given & RAD_TOOL_OPT_K) && (mi.k == 0 || mi.k > RAD_TEMPORAL_MAX_SAMPLES)) {
+    if (mo->method == TOOL_TEMPORAL && !(mo->given & TOOL_OPT_K) && (mi.k == 0 || mi.k > RAD_TEMPORAL_MAX_SAMPLES)) {
         fprintf(stderr, "rad %s: bake '%s': section rad.method has k = %u draws per row (1 to %u, as --k)\n", cmd, bake_name,
                 mi.k, RAD_TEMPORAL_MAX_SAMPLES);
         return 1;
     }
-    m = (rad_tool_indirect *)rad_tool_calloc(1, sizeof *m);
+    m = (tool_indirect *)tool_calloc(1, sizeof *m);
     m->cmd = cmd;
     m->method = mo->method;
     m->n = n;
     m->E = bake->E;
     m->albedo = bake->patches.albedo;
     m->S = (const float *)s->data;
-    m->L = (float *)rad_tool_calloc(3 * (size_t)n, sizeof(float));
-    rad_tool_context(&m->ctx, NULL);
-    if (mo->method == RAD_TOOL_STOCHASTIC || mo->method == RAD_TOOL_HIERARCHICAL) {
+    m->L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    tool_context(&m->ctx, NULL);
+    if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) {
         const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
         uint32_t i;
         if (!ls || ls->elem_size != 12 || ls->count != n) {
             fprintf(stderr, "rad %s: bake '%s' holds no solution L for its %u patches (vector section L)\n", cmd, bake_name, n);
-            rad_tool_indirect_close(m);
+            tool_indirect_close(m);
             return 1;
         }
         m->Ls = (const float *)ls->data;
@@ -1099,11 +1099,11 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
             if (!(m->Ls[i] >= 0.0f && m->Ls[i] <= RAD_BAKE_VALUE_MAX)) {
                 fprintf(stderr, "rad %s: bake '%s': vector L, value %u is %g (not in [0, 1e30])\n", cmd, bake_name, i,
                         (double)m->Ls[i]);
-                rad_tool_indirect_close(m);
+                tool_indirect_close(m);
                 return 1;
             }
         m->solve_seconds = mi.build_seconds;
-        if (mo->method == RAD_TOOL_HIERARCHICAL)
+        if (mo->method == TOOL_HIERARCHICAL)
             fprintf(stderr, "rad %s: hierarchical (--hr-eps %g: %u leaves, %llu links, resampled onto %u patches), solved in "
                             "%.3f s\n", cmd, (double)mi.w, mi.k, (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo),
                     n, (double)mi.build_seconds);
@@ -1111,12 +1111,12 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
             fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
                     mi.mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
                     (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo), (double)mi.build_seconds);
-    } else if (mo->method == RAD_TOOL_MULTIBOUNCE) {
+    } else if (mo->method == TOOL_MULTIBOUNCE) {
         const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
         uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;
         if (kind > 3) {
             fprintf(stderr, "rad %s: bake '%s' holds no multi-bounce matrix 'Fmb'\n", cmd, bake_name);
-            rad_tool_indirect_close(m);
+            tool_indirect_close(m);
             return 1;
         }
         r = kind >= 2 ? rad_multibounce_blocks_load(ct, "Fmb", &m->ctx, &m->blocks)
@@ -1124,13 +1124,13 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
         if (r == RAD_SUCCESS && (kind >= 2 ? m->blocks->n : m->mb->n) != n) {
             fprintf(stderr, "rad %s: bake '%s': F_mb is %u x %u for %u patches\n", cmd, bake_name,
                     kind >= 2 ? m->blocks->n : m->mb->n, kind >= 2 ? m->blocks->n : m->mb->n, n);
-            rad_tool_indirect_close(m);
+            tool_indirect_close(m);
             return 1;
         }
         if (r != RAD_SUCCESS) {
-            rad_tool_indirect_close(m);
+            tool_indirect_close(m);
             fprintf(stderr, "rad %s: bake '%s': cannot open its multi-bounce matrix\n", cmd, bake_name);
-            return rad_tool_fail(cmd, "rad_multibounce_load", r);
+            return tool_fail(cmd, "rad_multibounce_load", r);
         }
         if (mi.bounces == RAD_MB_INFINITE)
             fprintf(stderr, "rad %s: F_mb %s, bounces inf, %u patches\n", cmd, format_name(kind), n);
@@ -1146,30 +1146,30 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
             const char *name = tcount == 3 ? names[i] : "F";
             if (!rad_container_find(ct, RAD_SECTION_TEMPORAL_BINS, name)) {
                 fprintf(stderr, "rad %s: bake '%s' holds no alias tables '%s'\n", cmd, bake_name, name);
-                rad_tool_indirect_close(m);
+                tool_indirect_close(m);
                 return 1;
             }
             if ((r = rad_alias_tables_view(ct, name, &m->ctx, &m->tables[i])) != RAD_SUCCESS) {
-                rad_tool_indirect_close(m);
-                return rad_tool_fail(cmd, "rad_alias_tables_view", r);
+                tool_indirect_close(m);
+                return tool_fail(cmd, "rad_alias_tables_view", r);
             }
             if (m->tables[i].rows != n) {
                 fprintf(stderr, "rad %s: bake '%s': alias tables '%s' have %u rows for %u patches\n", cmd, bake_name,
                         name, m->tables[i].rows, n);
-                rad_tool_indirect_close(m);
+                tool_indirect_close(m);
                 return 1;
             }
             tp[i] = &m->tables[i];
         }
         rad_temporal_options_default(&to);
         to.mode = (rad_temporal_mode)mi.mode;
-        to.samples = (mo->given & RAD_TOOL_OPT_K) ? mo->k : mi.k;
-        to.adaptive = (mo->given & RAD_TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & RAD_TOOL_OPT_W) ? 0 : (int)mi.adaptive;
-        to.weight = (mo->given & RAD_TOOL_OPT_W) ? mo->w : mi.w;
-        to.seed = (mo->given & RAD_TOOL_OPT_SEED) ? mo->seed : mi.seed;
+        to.samples = (mo->given & TOOL_OPT_K) ? mo->k : mi.k;
+        to.adaptive = (mo->given & TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & TOOL_OPT_W) ? 0 : (int)mi.adaptive;
+        to.weight = (mo->given & TOOL_OPT_W) ? mo->w : mi.w;
+        to.seed = (mo->given & TOOL_OPT_SEED) ? mo->seed : mi.seed;
         if ((r = rad_temporal_create(tp, tcount, m->albedo, &to, &m->ctx, &m->temporal)) != RAD_SUCCESS) {
-            rad_tool_indirect_close(m);
-            return rad_tool_fail(cmd, "rad_temporal_create", r);
+            tool_indirect_close(m);
+            return tool_fail(cmd, "rad_temporal_create", r);
         }
         fprintf(stderr, "rad %s: temporal, mode %s, k %u, %s%.4g, seed %u, %u patches\n", cmd, mode_name(mi.mode),
                 to.samples, to.adaptive ? "adaptive w, max " : "w ", (double)(to.adaptive ? to.weight_max : to.weight),
@@ -1179,11 +1179,11 @@ int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bak
     return 0;
 }
 
-int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds)
+int tool_indirect_step(tool_indirect *m, float *H, double *seconds)
 {
     rad_result r;
     uint32_t i;
-    double t0 = rad_tool_seconds();
+    double t0 = tool_seconds();
     const float *L = m->L;
     if (m->Ls) { /* solved at bake time: its time is the solve's */
         for (i = 0; i < 3 * m->n; ++i) H[i] = m->albedo[i] > 0.0f ? m->Ls[i] / m->albedo[i] : 0.0f;
@@ -1196,9 +1196,9 @@ int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds)
         r = rad_temporal_step(m->temporal, m->E, NULL, NULL);
         L = rad_temporal_indirect(m->temporal);
     }
-    *seconds = rad_tool_seconds() - t0;
+    *seconds = tool_seconds() - t0;
     if (r != RAD_SUCCESS)
-        return rad_tool_fail(m->cmd, m->temporal ? "rad_temporal_step" : "multi-bounce apply", r);
+        return tool_fail(m->cmd, m->temporal ? "rad_temporal_step" : "multi-bounce apply", r);
     /* H = L_{K+1} / rho (see the top of this file) */
     for (i = 0; i < 3 * m->n; ++i) H[i] = m->albedo[i] > 0.0f ? L[i] / m->albedo[i] : 0.0f;
     return 0;
@@ -1207,7 +1207,7 @@ int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds)
 /* ---- hierarchical (render only) ------------------------------------------------------------ */
 
 typedef struct hr_source_data {
-    const rad_tool_world *w;
+    const tool_world *w;
     rad_direct_options dopt;
 } hr_source_data;
 
@@ -1220,7 +1220,7 @@ static rad_result hr_source(void *user, const float *points, const float *normal
     rad_result r;
     uint32_t i;
     (void)triangles;
-    rad_tool_context(&quiet, NULL);
+    tool_context(&quiet, NULL);
     r = rad_direct_irradiance(d->w->scene, &d->w->rc, d->w->file.lights, d->w->file.light_count, &d->dopt, points,
                               normals, count, out_E, &quiet);
     if (r == RAD_SUCCESS)
@@ -1228,7 +1228,7 @@ static rad_result hr_source(void *user, const float *points, const float *normal
     return r;
 }
 
-int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_method_options *mo,
                                 uint32_t light_samples, rad_hierarchical **out)
 {
     rad_hierarchical_options ho;
@@ -1236,7 +1236,7 @@ int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const 
     hr_source_data sd;
     rad_context ctx;
     rad_result r;
-    double t0 = rad_tool_seconds();
+    double t0 = tool_seconds();
     *out = NULL;
     rad_hierarchical_options_default(&ho);
     /* finer than the library's teaching default: a still image as close to the path tracer as
@@ -1250,22 +1250,22 @@ int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const 
     sd.dopt.light_samples = light_samples;
     ho.source = hr_source;
     ho.source_user = &sd;
-    rad_tool_context(&ctx, NULL);
+    tool_context(&ctx, NULL);
     if ((r = rad_hierarchical_create(w->scene, &w->rc, &ho, &ctx, out)) != RAD_SUCCESS)
-        return rad_tool_fail(cmd, "rad_hierarchical_create", r);
-    rad_tool_context(&ctx, "hierarchical");
+        return tool_fail(cmd, "rad_hierarchical_create", r);
+    tool_context(&ctx, "hierarchical");
     r = rad_hierarchical_solve(*out, &ctx);
-    rad_tool_progress_end();
+    tool_progress_end();
     if (r != RAD_SUCCESS) {
         rad_hierarchical_destroy(*out);
         *out = NULL;
-        return rad_tool_fail(cmd, "rad_hierarchical_solve", r);
+        return tool_fail(cmd, "rad_hierarchical_solve", r);
     }
     rad_hierarchical_get_stats(*out, &st);
     fprintf(stderr, "rad %s: hierarchical: %u triangles, %u elements, %u leaves, %llu links, %llu kernel evaluations, "
                     "%llu rays, %u rounds, %u sweeps in %.2f s\n",
             cmd, w->scene->triangle_count, st.elements, st.leaves, (unsigned long long)st.links,
             (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, st.rounds, st.sweeps,
-            rad_tool_seconds() - t0);
+            tool_seconds() - t0);
     return 0;
 }

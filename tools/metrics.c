@@ -11,8 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define RAD__SSIM_WIN 11
-#define RAD__SSIM_RAD 5
+#define TOOL__SSIM_WIN 11
+#define TOOL__SSIM_RAD 5
 
 static double rad__clamp01(float v)
 {
@@ -21,17 +21,17 @@ static double rad__clamp01(float v)
     return (double)v;
 }
 
-static int rad__same_size(const rad_image *a, const rad_image *b)
+static int tool__same_size(const tool_image *a, const tool_image *b)
 {
     return a && b && a->rgb && b->rgb && a->width == b->width && a->height == b->height && a->width > 0 &&
            a->height > 0;
 }
 
-double rad_image_mse(const rad_image *a, const rad_image *b)
+double tool_image_mse(const tool_image *a, const tool_image *b)
 {
     size_t i, n;
     double sum = 0.0;
-    if (!rad__same_size(a, b)) return NAN;
+    if (!tool__same_size(a, b)) return NAN;
     n = (size_t)a->width * (size_t)a->height * 3u;
     for (i = 0; i < n; ++i) {
         double d = rad__clamp01(a->rgb[i]) - rad__clamp01(b->rgb[i]);
@@ -40,22 +40,22 @@ double rad_image_mse(const rad_image *a, const rad_image *b)
     return sum / (double)n;
 }
 
-double rad_image_psnr(const rad_image *a, const rad_image *b)
+double tool_image_psnr(const tool_image *a, const tool_image *b)
 {
-    double mse = rad_image_mse(a, b);
+    double mse = tool_image_mse(a, b);
     if (mse != mse) return NAN;
     if (mse == 0.0) return INFINITY;
     return 10.0 * log10(1.0 / mse);
 }
 
-static double rad__ssim_formula(double mx, double my, double sxx, double syy, double sxy)
+static double tool__ssim_formula(double mx, double my, double sxx, double syy, double sxy)
 {
     const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03;
     return ((2.0 * mx * my + C1) * (2.0 * sxy + C2)) / ((mx * mx + my * my + C1) * (sxx + syy + C2));
 }
 
 /* one channel of SSIM, whole image as a single uniform window (tiny images) */
-static double rad__ssim_global(const rad_image *a, const rad_image *b, int c)
+static double tool__ssim_global(const tool_image *a, const tool_image *b, int c)
 {
     size_t i, n = (size_t)a->width * (size_t)a->height;
     double mx = 0, my = 0, xx = 0, yy = 0, xy = 0;
@@ -69,27 +69,27 @@ static double rad__ssim_global(const rad_image *a, const rad_image *b, int c)
     }
     mx /= (double)n;
     my /= (double)n;
-    return rad__ssim_formula(mx, my, xx / (double)n - mx * mx, yy / (double)n - my * my, xy / (double)n - mx * my);
+    return tool__ssim_formula(mx, my, xx / (double)n - mx * mx, yy / (double)n - my * my, xy / (double)n - mx * my);
 }
 
-double rad_image_ssim(const rad_image *a, const rad_image *b)
+double tool_image_ssim(const tool_image *a, const tool_image *b)
 {
-    double g[RAD__SSIM_WIN], gsum = 0.0, total = 0.0;
+    double g[TOOL__SSIM_WIN], gsum = 0.0, total = 0.0;
     double *plane = NULL, *tmp = NULL;
     int W, H, VW, VH, c, x, y, k, q;
-    if (!rad__same_size(a, b)) return NAN;
+    if (!tool__same_size(a, b)) return NAN;
     W = a->width;
     H = a->height;
-    if (W < RAD__SSIM_WIN || H < RAD__SSIM_WIN)
-        return (rad__ssim_global(a, b, 0) + rad__ssim_global(a, b, 1) + rad__ssim_global(a, b, 2)) / 3.0;
-    VW = W - (RAD__SSIM_WIN - 1);
-    VH = H - (RAD__SSIM_WIN - 1);
-    for (k = 0; k < RAD__SSIM_WIN; ++k) {
-        double d = (double)(k - RAD__SSIM_RAD);
+    if (W < TOOL__SSIM_WIN || H < TOOL__SSIM_WIN)
+        return (tool__ssim_global(a, b, 0) + tool__ssim_global(a, b, 1) + tool__ssim_global(a, b, 2)) / 3.0;
+    VW = W - (TOOL__SSIM_WIN - 1);
+    VH = H - (TOOL__SSIM_WIN - 1);
+    for (k = 0; k < TOOL__SSIM_WIN; ++k) {
+        double d = (double)(k - TOOL__SSIM_RAD);
         g[k] = exp(-d * d / (2.0 * 1.5 * 1.5));
         gsum += g[k];
     }
-    for (k = 0; k < RAD__SSIM_WIN; ++k) g[k] /= gsum;
+    for (k = 0; k < TOOL__SSIM_WIN; ++k) g[k] /= gsum;
     /* 5 input planes (x, y, x^2, y^2, xy), filtered horizontally into tmp (VW x H each) */
     plane = (double *)malloc(sizeof(double) * 2u * (size_t)W * (size_t)H);
     tmp = (double *)malloc(sizeof(double) * 5u * (size_t)VW * (size_t)H);
@@ -109,7 +109,7 @@ double rad_image_ssim(const rad_image *a, const rad_image *b)
         for (y = 0; y < H; ++y)
             for (x = 0; x < VW; ++x) {
                 double s[5] = { 0, 0, 0, 0, 0 };
-                for (k = 0; k < RAD__SSIM_WIN; ++k) {
+                for (k = 0; k < TOOL__SSIM_WIN; ++k) {
                     size_t i = (size_t)y * (size_t)W + (size_t)(x + k);
                     double px = plane[2 * i], py = plane[2 * i + 1];
                     s[0] += g[k] * px;
@@ -123,9 +123,9 @@ double rad_image_ssim(const rad_image *a, const rad_image *b)
         for (y = 0; y < VH; ++y)
             for (x = 0; x < VW; ++x) {
                 double s[5] = { 0, 0, 0, 0, 0 };
-                for (k = 0; k < RAD__SSIM_WIN; ++k)
+                for (k = 0; k < TOOL__SSIM_WIN; ++k)
                     for (q = 0; q < 5; ++q) s[q] += g[k] * tmp[5 * ((size_t)(y + k) * (size_t)VW + (size_t)x) + (size_t)q];
-                sum += rad__ssim_formula(s[0], s[1], s[2] - s[0] * s[0], s[3] - s[1] * s[1], s[4] - s[0] * s[1]);
+                sum += tool__ssim_formula(s[0], s[1], s[2] - s[0] * s[0], s[3] - s[1] * s[1], s[4] - s[0] * s[1]);
             }
         total += sum / ((double)VW * (double)VH);
     }
@@ -136,7 +136,7 @@ double rad_image_ssim(const rad_image *a, const rad_image *b)
 
 /* linear-RGB colour map (black, purple, red, orange, yellow, white: an "inferno"-like ramp
    given in sRGB and decoded so the 8-bit PNG shows these colours) */
-static void rad__heat(double t, float out[3])
+static void tool__heat(double t, float out[3])
 {
     static const double stops[6][3] = {
         { 0.0, 0.0, 0.0 }, { 0.34, 0.06, 0.43 }, { 0.73, 0.21, 0.33 },
@@ -156,18 +156,18 @@ static void rad__heat(double t, float out[3])
     }
 }
 
-int rad_image_diff_heatmap(const rad_image *a, const rad_image *b, float scale, rad_image *out)
+int tool_image_diff_heatmap(const tool_image *a, const tool_image *b, float scale, tool_image *out)
 {
     size_t i, n;
-    if (!out || !rad__same_size(a, b)) return -1;
-    if (rad_image_alloc(out, a->width, a->height) != 0) return -1;
+    if (!out || !tool__same_size(a, b)) return -1;
+    if (tool_image_alloc(out, a->width, a->height) != 0) return -1;
     n = (size_t)a->width * (size_t)a->height;
     for (i = 0; i < n; ++i) {
         double d = 0.0;
         int k;
         for (k = 0; k < 3; ++k) d += fabs(rad__clamp01(a->rgb[3 * i + (size_t)k]) - rad__clamp01(b->rgb[3 * i + (size_t)k]));
         d /= 3.0;
-        rad__heat(scale > 0.0f ? d / (double)scale : 0.0, out->rgb + 3 * i);
+        tool__heat(scale > 0.0f ? d / (double)scale : 0.0, out->rgb + 3 * i);
     }
     return 0;
 }

@@ -56,15 +56,15 @@ static void usage(FILE *f)
 /* ---- dispatch -------------------------------------------------------------------------- */
 
 /* main.c calls it; tools/mpi/rad_mpi.c links the other sources with a main of its own */
-int rad_tool_main(int argc, char **argv)
+int tool_main(int argc, char **argv)
 {
     static const struct {
         const char *name;
         int (*fn)(int, char **);
-    } cmds[] = {{"formfactors", rad_cmd_formfactors}, {"bake", rad_cmd_bake},       {"render", rad_cmd_render},
-                {"trace", rad_cmd_trace},             {"compare", rad_cmd_compare}, {"info", rad_cmd_info},
-                {"export", rad_cmd_export},           {"probes", rad_cmd_probes},   {"merge", rad_cmd_merge},
-                {"lightmap", rad_cmd_lightmap}};
+    } cmds[] = {{"formfactors", tool_cmd_formfactors}, {"bake", tool_cmd_bake},       {"render", tool_cmd_render},
+                {"trace", tool_cmd_trace},             {"compare", tool_cmd_compare}, {"info", tool_cmd_info},
+                {"export", tool_cmd_export},           {"probes", tool_cmd_probes},   {"merge", tool_cmd_merge},
+                {"lightmap", tool_cmd_lightmap}};
     size_t i;
     if (argc < 2) {
         usage(stderr);

@@ -21,7 +21,7 @@
 #include <string.h>
 #include <math.h>
 
-int rad_tool_parse_shading(const char *cmd, const char *text, int *out_model)
+int tool_parse_shading(const char *cmd, const char *text, int *out_model)
 {
     rad_shading_model m;
     int i;
@@ -45,7 +45,7 @@ static void shading_material(rad_shading_model model, const float *albedo, rad_s
     }
 }
 
-int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_samples, const float *points,
+int tool_shade_direct(const tool_world *w, int model, uint32_t light_samples, const float *points,
                           const float *normals, const float *views, const float *albedos, uint32_t count,
                           float *out_rgb)
 {
@@ -60,11 +60,11 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
     int result = 0;
     rad_direct_options_default(&dopt);
     dopt.light_samples = light_samples;
-    rad_tool_context(&quiet, NULL);
+    tool_context(&quiet, NULL);
     dirs = (float *)malloc(sizeof(float) * 3 * (count ? count : 1));
     irr = (float *)malloc(sizeof(float) * 3 * (count ? count : 1));
     rest = (rad_light *)malloc(sizeof(rad_light) * (nl ? nl : 1));
-    if (!dirs || !irr || !rest) { result = rad_tool_fail("render", "shading", RAD_ERROR_OUT_OF_MEMORY); goto done; }
+    if (!dirs || !irr || !rest) { result = tool_fail("render", "shading", RAD_ERROR_OUT_OF_MEMORY); goto done; }
     for (i = 0; i < count; ++i) out_rgb[3 * i] = out_rgb[3 * i + 1] = out_rgb[3 * i + 2] = 0.0f;
     /* the analytic lights, one at a time: irradiance on a surface facing the light (the
        "normal" handed to rad_direct_irradiance is l itself), times R(l, v, n) */
@@ -81,20 +81,20 @@ int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_sam
             for (k = 0; k < 3; ++k) dirs[3 * i + k] = d[k] / len;
         }
         r = rad_direct_irradiance(w->scene, &w->rc, L, 1, &dopt, points, dirs, count, irr, &quiet);
-        if (r != RAD_SUCCESS) { result = rad_tool_fail("render", "rad_direct_irradiance (shading)", r); goto done; }
+        if (r != RAD_SUCCESS) { result = tool_fail("render", "rad_direct_irradiance (shading)", r); goto done; }
         for (i = 0; i < count; ++i) {
             float R[3];
             if (irr[3 * i] == 0.0f && irr[3 * i + 1] == 0.0f && irr[3 * i + 2] == 0.0f) continue;
             shading_material((rad_shading_model)model, albedos + 3 * i, &s);
             r = rad_shading_eval(&s, dirs + 3 * i, views + 3 * i, normals + 3 * i, NULL, NULL, R, &quiet);
-            if (r != RAD_SUCCESS) { result = rad_tool_fail("render", "rad_shading_eval", r); goto done; }
+            if (r != RAD_SUCCESS) { result = tool_fail("render", "rad_shading_eval", r); goto done; }
             for (k = 0; k < 3; ++k) out_rgb[3 * i + k] += irr[3 * i + k] * R[k];
         }
     }
     /* emissive triangles and the sky: Lambertian */
     dopt.include_emitters = 1;
     r = rad_direct_irradiance(w->scene, &w->rc, rest, nrest, &dopt, points, normals, count, irr, &quiet);
-    if (r != RAD_SUCCESS) { result = rad_tool_fail("render", "rad_direct_irradiance (area lights)", r); goto done; }
+    if (r != RAD_SUCCESS) { result = tool_fail("render", "rad_direct_irradiance (area lights)", r); goto done; }
     for (i = 0; i < 3 * count; ++i) out_rgb[i] += albedos[i] * (float)(1.0 / 3.14159265358979323846) * irr[i];
 done:
     free(dirs);

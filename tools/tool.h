@@ -1,8 +1,8 @@
 /* tool.h - what the rad tool's source files share. Each subcommand lives in its own file and
    is dispatched from rad.c; every file includes radiosity.h without the implementation, which
    common.c holds. */
-#ifndef RAD_TOOL_H
-#define RAD_TOOL_H
+#ifndef TOOL_H
+#define TOOL_H
 #include "../radiosity.h"
 #include <stddef.h>
 #include <stdio.h>
@@ -11,224 +11,224 @@
 
 /* A scene loaded for the tool: the descriptor and everything it points to (owned here), plus
    the lights, camera and names that came with it. */
-typedef struct rad_tool_scene {
+typedef struct tool_scene {
     rad_scene_desc desc;
     rad_camera camera;       /* the file's first camera, or a framing of the bounds from -z (render
-                                and trace choose their own then: rad_tool_choose_camera) */
+                                and trace choose their own then: tool_choose_camera) */
     int has_camera;          /* 1 when the camera came from the file or the built-in scene */
     rad_light *lights;       /* analytic lights found in the file (may be none) */
     uint32_t light_count;
     const char *const *material_names; /* desc.material_count names ("" when unnamed), or NULL */
     void *storage;           /* private */
-} rad_tool_scene;
+} tool_scene;
 
 /* 'cornell' (the built-in box) or a file assimp can read (OBJ+MTL, glTF 2.0, FBX, PLY ...).
    Materials: albedo from Kd / glTF base colour (with the base-colour texture sampled through
    the albedo callback), emission (radiance) from Ke / glTF emissive x strength. Object and
    group names are kept as mesh names. Returns 0 on success; on failure writes a message to
    err (errlen bytes). */
-int rad_tool_load_scene(const char *path_or_name, rad_tool_scene *out, char *err, size_t errlen);
-void rad_tool_free_scene(rad_tool_scene *scene);
+int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen);
+void tool_free_scene(tool_scene *scene);
 
 /* ---- images (image.c) ------------------------------------------------------------------ */
 
 /* Linear RGB floats, row-major, top row first. */
-typedef struct rad_image {
+typedef struct tool_image {
     int width, height;
     float *rgb;
-} rad_image;
+} tool_image;
 
-int rad_image_alloc(rad_image *img, int width, int height); /* 0 on success, zero-filled */
-void rad_image_free(rad_image *img);
-int rad_image_write_pfm(const char *path, const rad_image *img);         /* 0 on success */
-int rad_image_read_pfm(const char *path, rad_image *img, char *err, size_t errlen);
+int tool_image_alloc(tool_image *img, int width, int height); /* 0 on success, zero-filled */
+void tool_image_free(tool_image *img);
+int tool_image_write_pfm(const char *path, const tool_image *img);         /* 0 on success */
+int tool_image_read_pfm(const char *path, tool_image *img, char *err, size_t errlen);
 /* sRGB-encoded 8-bit PNG of exposure * linear value, clamped */
-int rad_image_write_png(const char *path, const rad_image *img, float exposure);
-/* OpenEXR, 32-bit float RGB (tinyexr; without -DRAD_TOOL_EXR both fail with a message naming
+int tool_image_write_png(const char *path, const tool_image *img, float exposure);
+/* OpenEXR, 32-bit float RGB (tinyexr; without -DTOOL_EXR both fail with a message naming
    the package libtinyexr-dev) */
-int rad_image_write_exr(const char *path, const rad_image *img);         /* 0 on success */
-int rad_image_read_exr(const char *path, rad_image *img, char *err, size_t errlen);
+int tool_image_write_exr(const char *path, const tool_image *img);         /* 0 on success */
+int tool_image_read_exr(const char *path, tool_image *img, char *err, size_t errlen);
 /* 0 when 'path' names an image format this build writes (.pfm, .png, .exr with tinyexr);
    else prints why ("rad CMD: ...") and returns 2 */
-int rad_image_check_format(const char *cmd, const char *path);
+int tool_image_check_format(const char *cmd, const char *path);
 /* writes .pfm, .png or .exr by the path's extension: .pfm and .exr ignore 'exposure' (they
    keep the radiance); .png applies it */
-int rad_image_write(const char *path, const rad_image *img, float exposure);
+int tool_image_write(const char *path, const tool_image *img, float exposure);
 /* Reads .png (8-bit sRGB through stb_image, decoded to linear), .exr (tinyexr) or else PFM; 0 on success. */
-int rad_image_read(const char *path, rad_image *img, char *err, size_t errlen);
-int rad_image_read_png(const char *path, rad_image *img, char *err, size_t errlen);
+int tool_image_read(const char *path, tool_image *img, char *err, size_t errlen);
+int tool_image_read_png(const char *path, tool_image *img, char *err, size_t errlen);
 /* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
-unsigned char rad_image_srgb8(float linear);
+unsigned char tool_image_srgb8(float linear);
 
 /* ---- output files (image.c): every file the tool writes ------------------------------- */
-/* A temporary file in the destination's folder, renamed onto it by rad_tool_output_commit
+/* A temporary file in the destination's folder, renamed onto it by tool_output_commit
    only when everything was written: a failure leaves the old file (if any) untouched and no
    temporary behind. The image writers and the bake writers all use it. */
-typedef struct rad_tool_output {
+typedef struct tool_output {
     FILE *f;        /* write here */
     char *path;     /* the destination */
     char *tmp;      /* the temporary */
-} rad_tool_output;
-/* 0, or -1 with the reason in rad_tool_output_error() */
-int rad_tool_output_open(rad_tool_output *o, const char *path);
+} tool_output;
+/* 0, or -1 with the reason in tool_output_error() */
+int tool_output_open(tool_output *o, const char *path);
 /* ok: 1 when every write succeeded. Flushes, syncs, closes and renames; on any failure
-   removes the temporary and returns -1 (reason in rad_tool_output_error()). */
-int rad_tool_output_commit(rad_tool_output *o, int ok);
-void rad_tool_output_abort(rad_tool_output *o); /* closes and removes the temporary */
+   removes the temporary and returns -1 (reason in tool_output_error()). */
+int tool_output_commit(tool_output *o, int ok);
+void tool_output_abort(tool_output *o); /* closes and removes the temporary */
 /* size bytes to path through the above; 0 or -1 */
-int rad_tool_write_file(const char *path, const void *data, size_t size);
+int tool_write_file(const char *path, const void *data, size_t size);
 /* why the last output (or image write) failed, e.g. "cannot write 'x.png': cannot create a
    file in 'dir': Permission denied" */
-const char *rad_tool_output_error(void);
+const char *tool_output_error(void);
 /* Before the work: refuses an output that is one of the inputs (the same file by st_dev and
    st_ino, so another name or a link for it counts), is a directory, or whose folder is
    missing or not writable. 0 when fine, else prints "rad CMD: ..." and returns 1. */
-int rad_tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count);
+int tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count);
 
 /* ---- metrics (metrics.c): MSE, PSNR, SSIM on values clamped to [0,1] ------------------- */
-double rad_image_mse(const rad_image *a, const rad_image *b);
-double rad_image_psnr(const rad_image *a, const rad_image *b);  /* L = 1; +inf for equal images */
-double rad_image_ssim(const rad_image *a, const rad_image *b);  /* per channel, averaged */
+double tool_image_mse(const tool_image *a, const tool_image *b);
+double tool_image_psnr(const tool_image *a, const tool_image *b);  /* L = 1; +inf for equal images */
+double tool_image_ssim(const tool_image *a, const tool_image *b);  /* per channel, averaged */
 /* heat map of the per-pixel mean absolute difference (scaled so 'scale' maps to the top) */
-int rad_image_diff_heatmap(const rad_image *a, const rad_image *b, float scale, rad_image *out);
+int tool_image_diff_heatmap(const tool_image *a, const tool_image *b, float scale, tool_image *out);
 
 /* ---- reference path tracer (trace.c) ---------------------------------------------------- */
-typedef struct rad_trace_options {
+typedef struct tool_trace_options {
     int width, height;
     int spp;                  /* samples per pixel, spread uniformly over the pixel (box filter) */
     uint32_t seed;
     int max_depth;            /* path length cap (default 64) */
     int rr_depth;             /* Russian roulette only after this many bounces (default 16) */
-} rad_trace_options;
+} tool_trace_options;
 
 /* Diffuse path tracing with next-event estimation and multiple importance sampling for the
    scene's emissive triangles, plus the analytic lights (point, spot, directional: NEE only;
    sky: escaping rays). Output: linear radiance (W m^-2 sr^-1). Deterministic for a seed. */
-int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
-                    const rad_camera *camera, const rad_trace_options *options, const rad_context *ctx,
-                    rad_image *out);
+int tool_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
+                    const rad_camera *camera, const tool_trace_options *options, const rad_context *ctx,
+                    tool_image *out);
 /* Fills options with the defaults (256x256, 64 spp, seed 0, max_depth 64, rr_depth 16).
-   rad_trace_image: 'out' must be zero-initialised or a live image (reallocated when its size
+   tool_trace_image: 'out' must be zero-initialised or a live image (reallocated when its size
    differs); returns 0 or a rad_result error (INVALID_ARGUMENT, OUT_OF_MEMORY,
    RAYCAST_FAILED, CANCELLED by ctx->progress). Surfaces are one-sided like the patches. */
-void rad_trace_options_default(rad_trace_options *options);
+void tool_trace_options_default(tool_trace_options *options);
 
 /* ---- subcommands: int cmd(int argc, char **argv) with argv[0] the subcommand's first
    argument; return the process exit code (0 ok, 1 failure, 2 usage error) ------------- */
-int rad_cmd_formfactors(int argc, char **argv);
-int rad_cmd_bake(int argc, char **argv);
-int rad_cmd_render(int argc, char **argv);
-int rad_cmd_trace(int argc, char **argv);
-int rad_cmd_compare(int argc, char **argv);
-int rad_cmd_info(int argc, char **argv);
-int rad_cmd_export(int argc, char **argv);
-int rad_cmd_probes(int argc, char **argv);
+int tool_cmd_formfactors(int argc, char **argv);
+int tool_cmd_bake(int argc, char **argv);
+int tool_cmd_render(int argc, char **argv);
+int tool_cmd_trace(int argc, char **argv);
+int tool_cmd_compare(int argc, char **argv);
+int tool_cmd_info(int argc, char **argv);
+int tool_cmd_export(int argc, char **argv);
+int tool_cmd_probes(int argc, char **argv);
 
 /* the rad program (rad.c): dispatches argv[1] to a subcommand; the exit code (main.c) */
-int rad_tool_main(int argc, char **argv);
+int tool_main(int argc, char **argv);
 
 /* ---- shared helpers (common.c) ----------------------------------------------------------- */
 /* progress to stderr: a bar when stderr is a terminal, a plain percentage line otherwise */
-int rad_tool_progress(void *user, float fraction);
-void rad_tool_log(void *user, rad_log_level level, const char *message);
+int tool_progress(void *user, float fraction);
+void tool_log(void *user, rad_log_level level, const char *message);
 /* --threads N (0: all): sets the OpenMP thread count when built with OpenMP */
-void rad_tool_set_threads(int threads);
+void tool_set_threads(int threads);
 /* The most --threads accepts: libgomp crashes creating 100000 threads (issue 23), and more
    threads than this helps no machine the tool runs on. */
-#define RAD_TOOL_MAX_THREADS 1024u
-/* --threads N: a whole number in 0..RAD_TOOL_MAX_THREADS; 0 on success, else prints
+#define TOOL_MAX_THREADS 1024u
+/* --threads N: a whole number in 0..TOOL_MAX_THREADS; 0 on success, else prints
    "rad CMD: ..." and returns 2 */
-int rad_tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out);
+int tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out);
 /* parses "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ"; 0 on success */
-int rad_tool_parse_camera(const char *text, rad_camera *out);
+int tool_parse_camera(const char *text, rad_camera *out);
 /* parses "WxH"; 0 on success */
-int rad_tool_parse_size(const char *text, int *w, int *h);
+int tool_parse_size(const char *text, int *w, int *h);
 /* The most memory an image may take (linear RGB floats, 12 bytes a pixel): 2 GiB, e.g.
    16384x8192. --size 32768x32768 allocated 12 GiB without a word (issue 23). */
-#define RAD_TOOL_MAX_IMAGE_BYTES 2147483648.0
-/* --size: 0 when the image fits RAD_TOOL_MAX_IMAGE_BYTES, else prints "rad CMD: ..." with the
+#define TOOL_MAX_IMAGE_BYTES 2147483648.0
+/* --size: 0 when the image fits TOOL_MAX_IMAGE_BYTES, else prints "rad CMD: ..." with the
    bytes and returns 2 */
-int rad_tool_check_size(const char *cmd, int w, int h);
+int tool_check_size(const char *cmd, int w, int h);
 
 
 /* ---- more shared helpers (common.c) ------------------------------------------------------ */
 /* A context whose log goes to stderr and whose progress is drawn with 'label' (NULL: no
    progress). */
-void rad_tool_context(rad_context *ctx, const char *label);
+void tool_context(rad_context *ctx, const char *label);
 /* 0: contexts made from now on draw no progress (rad-mpi's ranks other than 0) */
-void rad_tool_show_progress(int on);
+void tool_show_progress(int on);
 /* ends a progress line that did not reach 100% */
-void rad_tool_progress_end(void);
+void tool_progress_end(void);
 /* "rad CMD: what failed: RAD_ERROR_...: ..." on stderr; returns 1 */
-int rad_tool_fail(const char *cmd, const char *what, rad_result r);
+int tool_fail(const char *cmd, const char *what, rad_result r);
 /* calloc of n elements (at least one) that prints and exits on failure */
-void *rad_tool_calloc(size_t n, size_t size);
+void *tool_calloc(size_t n, size_t size);
 /* option values: 0 on success, else prints "rad CMD: bad value ..." and returns 2 */
-int rad_tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out);
-int rad_tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
-double rad_tool_seconds(void);
+int tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out);
+int tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
+double tool_seconds(void);
 
 /* ---- lights from the command line (lights.c) ------------------------------------------- */
 /* --area P:U:V:RGB: an emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB */
-typedef struct rad_tool_area_light {
+typedef struct tool_area_light {
     float p[3], u[3], v[3], radiance[3];
-} rad_tool_area_light;
-/* What --sun, --sky, --point, --spot and --area gave (units: lights.c and rad_tool_light_help) */
-typedef struct rad_tool_lights {
+} tool_area_light;
+/* What --sun, --sky, --point, --spot and --area gave (units: lights.c and tool_light_help) */
+typedef struct tool_lights {
     rad_light *lights;              /* the analytic ones, in the library's units */
     uint32_t count;
-    rad_tool_area_light *areas;
+    tool_area_light *areas;
     uint32_t area_count;
-} rad_tool_lights;
+} tool_lights;
 /* argv[*a] is one of the light options: parses it (and its value, advancing *a) and returns 1;
    0 when it is not one; 2 on a bad value (message naming the option printed) */
-int rad_tool_light_option(const char *cmd, int argc, char **argv, int *a, rad_tool_lights *L);
-const char *rad_tool_light_help(void);
-void rad_tool_lights_free(rad_tool_lights *L);
+int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_lights *L);
+const char *tool_light_help(void);
+void tool_lights_free(tool_lights *L);
 /* Appends L to a loaded scene: the analytic lights to f->lights, the area lights to f->desc
    (meshes "area_light_K", emissive materials); *storage keeps the new arrays (free with
-   rad_tool_lights_release after the scene is destroyed). Prints what was added. 0 or 1. */
-int rad_tool_add_lights(const char *cmd, rad_tool_scene *f, const rad_tool_lights *L, void **storage);
-void rad_tool_lights_release(void *storage);
+   tool_lights_release after the scene is destroyed). Prints what was added. 0 or 1. */
+int tool_add_lights(const char *cmd, tool_scene *f, const tool_lights *L, void **storage);
+void tool_lights_release(void *storage);
 /* rad_hash64 of the lights' fields, continuing from h */
-uint64_t rad_tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h);
+uint64_t tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h);
 
 /* A scene ready for ray queries: the loaded file, the validated scene and its BVH. */
-typedef struct rad_tool_world {
-    rad_tool_scene file;      /* file.lights: the file's lights, then those of the command line */
+typedef struct tool_world {
+    tool_scene file;      /* file.lights: the file's lights, then those of the command line */
     rad_scene *scene;
     rad_bvh *bvh;
     rad_raycaster rc;
     uint32_t file_light_count; /* lights of the file itself (the rest came from the command line) */
-    void *lights_storage;      /* private (rad_tool_add_lights) */
-} rad_tool_world;
+    void *lights_storage;      /* private (tool_add_lights) */
+} tool_world;
 /* loads, validates and builds the BVH; prints the error and returns 1 on failure, else 0 */
-int rad_tool_open_world(const char *cmd, const char *path_or_name, rad_tool_world *w);
+int tool_open_world(const char *cmd, const char *path_or_name, tool_world *w);
 /* the same with the command line's lights added (lights may be NULL) */
-int rad_tool_open_world_lit(const char *cmd, const char *path_or_name, const rad_tool_lights *lights,
-                            rad_tool_world *w);
-void rad_tool_close_world(rad_tool_world *w);
-/* A camera for a scene that has none (rad_tool_scene.has_camera 0): of the views from outside
+int tool_open_world_lit(const char *cmd, const char *path_or_name, const tool_lights *lights,
+                            tool_world *w);
+void tool_close_world(tool_world *w);
+/* A camera for a scene that has none (tool_scene.has_camera 0): of the views from outside
    the bounds along +z, -z, +x, -x, -y, +y (the bounding sphere in view) and from inside them,
    the first outside one whose sample rays hit mostly front faces (fov 39.3 degrees), else the
    inside one that sees most front faces (fov 75, from near the bounds' side behind it); a
    camera behind a box's back wall sees only back faces, which render black.
    Prints the bounds and the camera chosen, as --camera and --fov options, to stderr. */
-void rad_tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
+void tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
                             rad_camera *cam);
 
 /* ---- the classic method: patches, F, direct light, solve (classic.c) ---------------------- */
-typedef enum rad_tool_solver { RAD_TOOL_JACOBI = 0, RAD_TOOL_GAUSS_SEIDEL = 1, RAD_TOOL_DIRECT = 2 } rad_tool_solver;
-typedef struct rad_tool_classic_options {
+typedef enum tool_solver { TOOL_JACOBI = 0, TOOL_GAUSS_SEIDEL = 1, TOOL_DIRECT = 2 } tool_solver;
+typedef struct tool_classic_options {
     uint32_t patches;        /* --patches N: target patch count (default 2000) */
     float max_edge;          /* --max-edge L (0: none) */
     uint32_t samples;        /* --samples S: form-factor samples per patch pair (default 16) */
-    rad_tool_solver solver;  /* --solver jacobi|gauss-seidel|direct */
+    tool_solver solver;  /* --solver jacobi|gauss-seidel|direct */
     uint32_t bounces;        /* --bounces K (Jacobi; default 64) */
     uint32_t light_samples;  /* --light-samples N: shadow rays per point (default 16) */
-    int sources_only;        /* 1: rad_tool_classic_solve stops after E (L, B, H stay NULL) */
+    int sources_only;        /* 1: tool_classic_solve stops after E (L, B, H stay NULL) */
     int no_form_factors;     /* with sources_only: F is not built (ff stays NULL; --method stochastic) */
-    /* the dense build's budget (budget.c): checked by rad_tool_classic_solve before the patches
+    /* the dense build's budget (budget.c): checked by tool_classic_solve before the patches
        (N at least the triangle count) and after them */
     double max_memory;       /* --max-memory SIZE in bytes (0: MemAvailable) */
     int force;               /* --force: build whatever the estimate */
@@ -236,59 +236,59 @@ typedef struct rad_tool_classic_options {
     double dense_cubic;      /* flops / N^3 beyond the form factors (LU, multibounce) */
     uint32_t dense_local_m;  /* local: capacity M of the 12 M^2 bytes of T (0: none) */
     const char *dense_method; /* the method named in the refusal (NULL: classic) */
-} rad_tool_classic_options;
-void rad_tool_classic_options_default(rad_tool_classic_options *o);
+} tool_classic_options;
+void tool_classic_options_default(tool_classic_options *o);
 /* argv[*a] is one of the options above: parses it (and its value, advancing *a) and returns
    1; returns 0 when it is not one of them, 2 on a bad value (message printed) */
-int rad_tool_classic_option(const char *cmd, int argc, char **argv, int *a, rad_tool_classic_options *o);
-const char *rad_tool_classic_help(void);
+int tool_classic_option(const char *cmd, int argc, char **argv, int *a, tool_classic_options *o);
+const char *tool_classic_help(void);
 
 /* ---- the dense build's budget (budget.c) ------------------------------------------------ */
 /* A dense build estimated to take longer than this is refused (without --force). */
-#define RAD_TOOL_DENSE_MAX_SECONDS 3600.0
+#define TOOL_DENSE_MAX_SECONDS 3600.0
 /* --max-memory SIZE: bytes with an optional K, M, G or T (powers of 1024); 0 or 2 (printed) */
-int rad_tool_parse_bytes(const char *cmd, const char *opt, const char *text, double *out);
+int tool_parse_bytes(const char *cmd, const char *opt, const char *text, double *out);
 /* MemAvailable of /proc/meminfo in bytes; 0 where unknown (then only --max-memory limits) */
-double rad_tool_mem_available(void);
-struct rad_tool_method_options;
+double tool_mem_available(void);
+struct tool_method_options;
 /* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice). */
-void rad_tool_dense_plan(rad_tool_classic_options *o, const struct rad_tool_method_options *mo, int bake);
+void tool_dense_plan(tool_classic_options *o, const struct tool_method_options *mo, int bake);
 /* Before a dense build of n patches (lower_bound: n is the triangle count, the patches not made
-   yet): 0 when the estimate fits the memory limit and RAD_TOOL_DENSE_MAX_SECONDS (or
+   yet): 0 when the estimate fits the memory limit and TOOL_DENSE_MAX_SECONDS (or
    o->force); else prints the estimate, the limit and the virtual-patch methods, returns 1. */
-int rad_tool_dense_check(const char *cmd, const rad_tool_classic_options *o, uint32_t n, int lower_bound);
+int tool_dense_check(const char *cmd, const tool_classic_options *o, uint32_t n, int lower_bound);
 
 /* Patches, dense F, direct irradiance D of the patches (emitters and analytic lights),
    E = rho D (RAD_SOURCE_DIRECT), the indirect solution L, B = E + L and H = F B. */
-typedef struct rad_tool_classic {
+typedef struct tool_classic {
     rad_patches *patches;
     rad_form_factors *ff;
     float *D, *E, *L, *B, *H;   /* 3N floats each */
     double solve_seconds;       /* the solver call alone (the per-frame cost of the method) */
-} rad_tool_classic;
+} tool_classic;
 /* prints progress and errors; returns 0 or 1 */
 /* Its steps, for the distributed bake (cmd_merge.c): the patches, D and E only (ff, L, B, H
    stay NULL); then, given c->patches, c->E and F, the solve of o->solver into c->L, c->B and
-   c->H (allocated here; rad_tool_classic_free or free() them). 0 or 1 (message printed). */
-int rad_tool_classic_sources(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                             rad_tool_classic *out);
-int rad_tool_classic_indirect(const char *cmd, const rad_tool_classic_options *o, const rad_matrix *F,
-                              rad_tool_classic *c);
-int rad_tool_classic_solve(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                           rad_tool_classic *out);
-void rad_tool_classic_free(rad_tool_classic *c);
+   c->H (allocated here; tool_classic_free or free() them). 0 or 1 (message printed). */
+int tool_classic_sources(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                             tool_classic *out);
+int tool_classic_indirect(const char *cmd, const tool_classic_options *o, const rad_matrix *F,
+                              tool_classic *c);
+int tool_classic_solve(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                           tool_classic *out);
+void tool_classic_free(tool_classic *c);
 
 /* The tool's own container sections (user types: the library's are in its rad_section_type
    table), in one place. */
-#define RAD_TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u) /* "rad.options": one rad_tool_bake_info */
-#define RAD_TOOL_SECTION_METHOD (RAD_SECTION_USER + 2u)  /* "rad.method": one rad_tool_method_info */
-#define RAD_TOOL_SECTION_ROWSUMS (RAD_SECTION_USER + 3u) /* "rad.rowsums": N floats */
-#define RAD_TOOL_SECTION_SHARD (RAD_SECTION_USER + 0x20u) /* a distributed bake's part: rad_tool_shard_info */
-#define RAD_TOOL_SECTION_ROWS (RAD_SECTION_USER + 0x21u)  /* the part's row ranges */
-#define RAD_TOOL_SECTION_PAIRS (RAD_SECTION_USER + 0x22u) /* the part's pairs */
+#define TOOL_SECTION_OPTIONS (RAD_SECTION_USER + 1u) /* "rad.options": one tool_bake_info */
+#define TOOL_SECTION_METHOD (RAD_SECTION_USER + 2u)  /* "rad.method": one tool_method_info */
+#define TOOL_SECTION_ROWSUMS (RAD_SECTION_USER + 3u) /* "rad.rowsums": N floats */
+#define TOOL_SECTION_SHARD (RAD_SECTION_USER + 0x20u) /* a distributed bake's part: tool_shard_info */
+#define TOOL_SECTION_ROWS (RAD_SECTION_USER + 0x21u)  /* the part's row ranges */
+#define TOOL_SECTION_PAIRS (RAD_SECTION_USER + 0x22u) /* the part's pairs */
 
-/* The record a bake stores its options in (RAD_TOOL_SECTION_OPTIONS, name "rad.options"). */
-typedef struct rad_tool_bake_info {
+/* The record a bake stores its options in (TOOL_SECTION_OPTIONS, name "rad.options"). */
+typedef struct tool_bake_info {
     uint32_t magic;          /* 0x52414442 */
     uint32_t patches;
     float max_edge;
@@ -297,45 +297,45 @@ typedef struct rad_tool_bake_info {
     uint32_t bounces;
     uint32_t light_samples;
     uint32_t triangle_count; /* of the scene baked */
-} rad_tool_bake_info;
+} tool_bake_info;
 /* the rad.options record of a bake of w with o */
-void rad_tool_bake_info_fill(rad_tool_bake_info *info, const rad_tool_world *w, const rad_tool_classic_options *o);
+void tool_bake_info_fill(tool_bake_info *info, const tool_world *w, const tool_classic_options *o);
 /* The hash of a rad.options record and of the lights given on the command line (w's lights
    past file_light_count; none: the hash of the record alone, as before those options), kept
    in the bake's signature (rad_bake_signature.options) so that a bake's options section and
    lights are known to be the ones it was made with. */
-uint64_t rad_tool_options_hash(const rad_tool_bake_info *info, const rad_tool_world *w);
+uint64_t tool_options_hash(const tool_bake_info *info, const tool_world *w);
 /* Points the signature section among secs[0..count) (written by rad_save_memory with the scene's
    hashes) at *sig, a copy with the options hash of 'info' and w's lights added. */
-void rad_tool_sign_options(rad_section *secs, uint32_t count, const rad_tool_bake_info *info, const rad_tool_world *w,
+void tool_sign_options(rad_section *secs, uint32_t count, const tool_bake_info *info, const tool_world *w,
                            rad_bake_signature *sig);
 
 /* ---- lighting models for the direct term (shading.c) ------------------------------------ */
 /* "none" (-1) or a rad_shading_model name; 0 on success, else prints and returns 2 */
-int rad_tool_parse_shading(const char *cmd, const char *text, int *out_model);
+int tool_parse_shading(const char *cmd, const char *text, int *out_model);
 /* Direct radiance at 'count' points (normals n, unit directions to the viewer v, albedos):
    sum over the analytic lights of E V R(l, v, n) for the model, plus albedo / pi times the
    irradiance of the emissive triangles and the sky. 0 on success, 1 (message printed). */
-int rad_tool_shade_direct(const rad_tool_world *w, int model, uint32_t light_samples, const float *points,
+int tool_shade_direct(const tool_world *w, int model, uint32_t light_samples, const float *points,
                           const float *normals, const float *views, const float *albedos, uint32_t count,
                           float *out_rgb);
 /* ---- the multi-bounce and temporal methods (methods.c) ------------------------------------ */
-typedef enum rad_tool_method {
-    RAD_TOOL_CLASSIC = 0, RAD_TOOL_MULTIBOUNCE = 1, RAD_TOOL_TEMPORAL = 2, RAD_TOOL_PATHTRACE = 3,
-    RAD_TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
-    RAD_TOOL_LOCAL = 5, RAD_TOOL_VP = 6, RAD_TOOL_AAVP = 7, /* render only (cmd_render.c); vp, aavp also bake_vp (cmd_bake.c) */
-    RAD_TOOL_HIERARCHICAL = 8, /* cmd_render.c; baked as rho H on patches (rad_tool_method_bake) */
-    RAD_TOOL_LIGHTMAP = 9      /* render only (cmd_render.c): a lightmap bake shades the indirect light */
-} rad_tool_method;
+typedef enum tool_method {
+    TOOL_CLASSIC = 0, TOOL_MULTIBOUNCE = 1, TOOL_TEMPORAL = 2, TOOL_PATHTRACE = 3,
+    TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
+    TOOL_LOCAL = 5, TOOL_VP = 6, TOOL_AAVP = 7, /* render only (cmd_render.c); vp, aavp also bake_vp (cmd_bake.c) */
+    TOOL_HIERARCHICAL = 8, /* cmd_render.c; baked as rho H on patches (tool_method_bake) */
+    TOOL_LIGHTMAP = 9      /* render only (cmd_render.c): a lightmap bake shades the indirect light */
+} tool_method;
 /* --format: the storage of F_mb (the values are the kinds of the header's MB info record) */
-typedef enum rad_tool_mb_format {
-    RAD_TOOL_MB_FLOAT = 0, RAD_TOOL_MB_HALF = 1, RAD_TOOL_MB_BC1 = 2, RAD_TOOL_MB_BC4X3 = 3
-} rad_tool_mb_format;
+typedef enum tool_mb_format {
+    TOOL_MB_FLOAT = 0, TOOL_MB_HALF = 1, TOOL_MB_BC1 = 2, TOOL_MB_BC4X3 = 3
+} tool_mb_format;
 
-/* Options of the two methods; 'given' has bit RAD_TOOL_OPT_x set for each option on the
+/* Options of the two methods; 'given' has bit TOOL_OPT_x set for each option on the
    command line (to reject options that do not apply and to let render override a bake). */
-typedef struct rad_tool_method_options {
-    rad_tool_method method;   /* --method */
+typedef struct tool_method_options {
+    tool_method method;   /* --method */
     uint32_t bounces;         /* --bounces K|inf (RAD_MB_INFINITE); default 64 like classic */
     uint32_t format;          /* --format float|half|bc1|bc4x3 (default bc4x3) */
     float outliers;           /* --outliers P: fraction of F_mb entries kept exactly (default 0.05) */
@@ -354,7 +354,7 @@ typedef struct rad_tool_method_options {
     uint32_t vp_max_patches;  /* --vp-max-patches B: the finest resolution with at most B patches (0: off) */
     uint32_t face_points;     /* --face-points P: Hammersley points per voxel face (default 16) */
     uint32_t local_m;         /* --local-m M: local matrix capacity, at most the patches (0, the
-                                 default: every patch up to RAD_TOOL_LOCAL_M_AUTO_MAX) */
+                                 default: every patch up to TOOL_LOCAL_M_AUTO_MAX) */
     uint32_t sr_rays;         /* --sr-rays N: stochastic rays of the first iteration / walks (0: the library's 64 per patch) */
     uint32_t sr_iterations;   /* --sr-iterations N: Jacobi shooting iterations at most / walk batches (0: the library's) */
     uint32_t sr_estimator;    /* --sr-estimator jacobi|walk: a rad_stochastic_method (default jacobi) */
@@ -364,52 +364,52 @@ typedef struct rad_tool_method_options {
     uint32_t light_path;      /* --light-path: 0 none, 1 line, 2 circle (render, temporal over a proxy) */
     float path[6];            /* line: P0 (0..2), P1 (3..5); circle: centre (0..2), radius (3) */
     uint32_t light_rays;      /* --light-rays N: shadow rays per moving light and frame (0: every sample) */
-    uint32_t proxy;           /* --proxy patches|aavp|vp (rad_tool_proxy; render, with multibounce,
+    uint32_t proxy;           /* --proxy patches|aavp|vp (tool_proxy; render, with multibounce,
                                  temporal and local: the method runs over virtual patches) */
-    uint32_t given;           /* RAD_TOOL_OPT_* bits */
-} rad_tool_method_options;
+    uint32_t given;           /* TOOL_OPT_* bits */
+} tool_method_options;
 /* --proxy: what multibounce, temporal and local run over (default: classic patches) */
-typedef enum rad_tool_proxy { RAD_TOOL_PROXY_PATCHES = 0, RAD_TOOL_PROXY_AAVP = 1, RAD_TOOL_PROXY_VP = 2 } rad_tool_proxy;
-#define RAD_TOOL_OPT_PROXY (1u << 28)
+typedef enum tool_proxy { TOOL_PROXY_PATCHES = 0, TOOL_PROXY_AAVP = 1, TOOL_PROXY_VP = 2 } tool_proxy;
+#define TOOL_OPT_PROXY (1u << 28)
 enum {
-    RAD_TOOL_OPT_BOUNCES = 1u << 0, RAD_TOOL_OPT_FORMAT = 1u << 1, RAD_TOOL_OPT_OUTLIERS = 1u << 2,
-    RAD_TOOL_OPT_REORDER = 1u << 3, RAD_TOOL_OPT_REORDER_SAMPLES = 1u << 4, RAD_TOOL_OPT_TILE = 1u << 5,
-    RAD_TOOL_OPT_MODE = 1u << 6, RAD_TOOL_OPT_K = 1u << 7, RAD_TOOL_OPT_W = 1u << 8, RAD_TOOL_OPT_ADAPTIVE = 1u << 9,
-    RAD_TOOL_OPT_SEED = 1u << 10, RAD_TOOL_OPT_FRAMES = 1u << 11, RAD_TOOL_OPT_SEQUENCE = 1u << 12,
-    RAD_TOOL_OPT_EVERY = 1u << 13, RAD_TOOL_OPT_METHOD = 1u << 14, RAD_TOOL_OPT_VP_RESOLUTION = 1u << 15,
-    RAD_TOOL_OPT_VP_MAX_PATCHES = 1u << 16, RAD_TOOL_OPT_FACE_POINTS = 1u << 17, RAD_TOOL_OPT_LOCAL_M = 1u << 18,
-    RAD_TOOL_OPT_SR_RAYS = 1u << 19, RAD_TOOL_OPT_SR_ITERATIONS = 1u << 20, RAD_TOOL_OPT_SR_ESTIMATOR = 1u << 21,
-    RAD_TOOL_OPT_HR_EPS = 1u << 22, RAD_TOOL_OPT_HR_MIN_AREA = 1u << 23, RAD_TOOL_OPT_HR_RAYS = 1u << 24,
-    RAD_TOOL_OPT_LIGHT_PATH = 1u << 25, RAD_TOOL_OPT_LIGHT_RAYS = 1u << 26
+    TOOL_OPT_BOUNCES = 1u << 0, TOOL_OPT_FORMAT = 1u << 1, TOOL_OPT_OUTLIERS = 1u << 2,
+    TOOL_OPT_REORDER = 1u << 3, TOOL_OPT_REORDER_SAMPLES = 1u << 4, TOOL_OPT_TILE = 1u << 5,
+    TOOL_OPT_MODE = 1u << 6, TOOL_OPT_K = 1u << 7, TOOL_OPT_W = 1u << 8, TOOL_OPT_ADAPTIVE = 1u << 9,
+    TOOL_OPT_SEED = 1u << 10, TOOL_OPT_FRAMES = 1u << 11, TOOL_OPT_SEQUENCE = 1u << 12,
+    TOOL_OPT_EVERY = 1u << 13, TOOL_OPT_METHOD = 1u << 14, TOOL_OPT_VP_RESOLUTION = 1u << 15,
+    TOOL_OPT_VP_MAX_PATCHES = 1u << 16, TOOL_OPT_FACE_POINTS = 1u << 17, TOOL_OPT_LOCAL_M = 1u << 18,
+    TOOL_OPT_SR_RAYS = 1u << 19, TOOL_OPT_SR_ITERATIONS = 1u << 20, TOOL_OPT_SR_ESTIMATOR = 1u << 21,
+    TOOL_OPT_HR_EPS = 1u << 22, TOOL_OPT_HR_MIN_AREA = 1u << 23, TOOL_OPT_HR_RAYS = 1u << 24,
+    TOOL_OPT_LIGHT_PATH = 1u << 25, TOOL_OPT_LIGHT_RAYS = 1u << 26
 };
-#define RAD_TOOL_OPT_SR (RAD_TOOL_OPT_SR_RAYS | RAD_TOOL_OPT_SR_ITERATIONS | RAD_TOOL_OPT_SR_ESTIMATOR)
-#define RAD_TOOL_OPT_HR (RAD_TOOL_OPT_HR_EPS | RAD_TOOL_OPT_HR_MIN_AREA | RAD_TOOL_OPT_HR_RAYS)
-#define RAD_TOOL_OPT_VP (RAD_TOOL_OPT_VP_RESOLUTION | RAD_TOOL_OPT_VP_MAX_PATCHES | RAD_TOOL_OPT_FACE_POINTS)
-#define RAD_TOOL_OPT_MB_BUILD (RAD_TOOL_OPT_FORMAT | RAD_TOOL_OPT_OUTLIERS | RAD_TOOL_OPT_REORDER | \
-                               RAD_TOOL_OPT_REORDER_SAMPLES | RAD_TOOL_OPT_TILE)
-#define RAD_TOOL_OPT_TEMPORAL (RAD_TOOL_OPT_MODE | RAD_TOOL_OPT_K | RAD_TOOL_OPT_W | RAD_TOOL_OPT_ADAPTIVE)
-#define RAD_TOOL_OPT_RENDER_ONLY (RAD_TOOL_OPT_FRAMES | RAD_TOOL_OPT_SEQUENCE | RAD_TOOL_OPT_EVERY | \
-                                  RAD_TOOL_OPT_LIGHT_PATH | RAD_TOOL_OPT_LIGHT_RAYS)
+#define TOOL_OPT_SR (TOOL_OPT_SR_RAYS | TOOL_OPT_SR_ITERATIONS | TOOL_OPT_SR_ESTIMATOR)
+#define TOOL_OPT_HR (TOOL_OPT_HR_EPS | TOOL_OPT_HR_MIN_AREA | TOOL_OPT_HR_RAYS)
+#define TOOL_OPT_VP (TOOL_OPT_VP_RESOLUTION | TOOL_OPT_VP_MAX_PATCHES | TOOL_OPT_FACE_POINTS)
+#define TOOL_OPT_MB_BUILD (TOOL_OPT_FORMAT | TOOL_OPT_OUTLIERS | TOOL_OPT_REORDER | \
+                               TOOL_OPT_REORDER_SAMPLES | TOOL_OPT_TILE)
+#define TOOL_OPT_TEMPORAL (TOOL_OPT_MODE | TOOL_OPT_K | TOOL_OPT_W | TOOL_OPT_ADAPTIVE)
+#define TOOL_OPT_RENDER_ONLY (TOOL_OPT_FRAMES | TOOL_OPT_SEQUENCE | TOOL_OPT_EVERY | \
+                                  TOOL_OPT_LIGHT_PATH | TOOL_OPT_LIGHT_RAYS)
 
 /* The default --local-m covers every patch of a scene up to this many (the set is then the
    whole scene and local gives the classic solution): T takes 12 M^2 bytes (192 MiB here) and
    its rebuild 6 M^3 flops (2188 patches: 12.6 s on 2 cores). The old fixed 1024 left half of
    the 2188-patch Cornell box without indirect light (29.5 dB against classic). */
-#define RAD_TOOL_LOCAL_M_AUTO_MAX 4096u
-void rad_tool_method_options_default(rad_tool_method_options *mo);
+#define TOOL_LOCAL_M_AUTO_MAX 4096u
+void tool_method_options_default(tool_method_options *mo);
 /* argv[*a] is --method or one of the options above: parses it (and its value, advancing *a)
    and returns 1; 0 when it is not one of them; 2 on a bad value (message printed). */
-int rad_tool_method_option(const char *cmd, int argc, char **argv, int *a, rad_tool_method_options *mo);
+int tool_method_option(const char *cmd, int argc, char **argv, int *a, tool_method_options *mo);
 /* After parsing: rejects options that do not apply to mo->method (and render-only options
    when !render), moves a finite --bounces into o->bounces for classic; 0 or 2 (printed). */
-int rad_tool_method_check(const char *cmd, int render, rad_tool_method_options *mo, rad_tool_classic_options *o);
-const char *rad_tool_method_help(int render);
-const char *rad_tool_method_name(rad_tool_method method);
+int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool_classic_options *o);
+const char *tool_method_help(int render);
+const char *tool_method_name(tool_method method);
 /* --method hierarchical: rad_hierarchical_create and solve over the world with E = rho D at
    the elements' centroids (D: rad_direct_irradiance with light_samples shadow rays, emitters
    included, as the classic patches' D) and mo's --hr-* options; prints the counts and the
    form-factor work. 0 (*out owned by the caller) or 1 (message printed). */
-int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const rad_tool_method_options *mo,
+int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_method_options *mo,
                                 uint32_t light_samples, rad_hierarchical **out);
 
 /* The user sections the methods add: what was built, and the row sums S_i of F (the halo
@@ -418,11 +418,11 @@ int rad_tool_hierarchical_build(const char *cmd, const rad_tool_world *w, const 
    mode, the seed in seed, the solve's seconds in build_seconds and its rays cast in
    bytes_lo/bytes_hi; its bake holds the solution L as the vector "L" and row sums estimated
    by rays (it builds no F). */
-typedef struct rad_tool_method_info {
+typedef struct tool_method_info {
     uint32_t magic;           /* 0x5241444D */
-    uint32_t method;          /* RAD_TOOL_MULTIBOUNCE or RAD_TOOL_TEMPORAL */
+    uint32_t method;          /* TOOL_MULTIBOUNCE or TOOL_TEMPORAL */
     uint32_t bounces;         /* as given (--bounces; F_mb holds bounces + 1, see methods.c) */
-    uint32_t format;          /* rad_tool_mb_format */
+    uint32_t format;          /* tool_mb_format */
     float outliers;
     uint32_t reorder, reorder_samples, tile;
     uint32_t mode;            /* rad_temporal_mode */
@@ -432,51 +432,51 @@ typedef struct rad_tool_method_info {
     float build_seconds;      /* F_mb (+ compression) or alias tables */
     float mse, max_abs_error, source_mean_square; /* compression report (bc1, bc4x3), else 0 */
     uint32_t bytes_lo, bytes_hi; /* bytes the render reads: F_mb storage or alias tables */
-} rad_tool_method_info;
-#define RAD_TOOL_METHOD_MAGIC 0x5241444Du
+} tool_method_info;
+#define TOOL_METHOD_MAGIC 0x5241444Du
 
 /* The bake of --method multibounce or temporal as container bytes (malloc'd, free with
    free()): patches, E, D, the row sums, rad.options, rad.method and the method's sections
    (F_mb as "Fmb"; alias tables "F", or "Fmb.r", "Fmb.g", "Fmb.b" in --mode multibounce).
    Prints what was built to stderr. 0 or 1 (message printed). */
-int rad_tool_method_bake(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                         const rad_tool_method_options *mo, void **out, size_t *out_size);
+int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                         const tool_method_options *mo, void **out, size_t *out_size);
 
 /* The render side: the indirect light of a loaded bake, step by step. */
-typedef struct rad_tool_indirect rad_tool_indirect;
+typedef struct tool_indirect tool_indirect;
 /* mo: the render's options (method, and --k, --w, --adaptive, --seed overriding the bake's).
    Errors name what the bake lacks. 0 or 1 (message printed). */
-int rad_tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
-                           const rad_tool_method_options *mo, rad_tool_indirect **out);
+int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
+                           const tool_method_options *mo, tool_indirect **out);
 /* multibounce: L = F_mb E (every call the same); temporal: one more frame. Writes the patches'
    irradiance from the secondary sources H = L / rho (3N floats; 0 where rho is 0) and the
    seconds the method's own work took. 0 or 1 (message printed). */
-int rad_tool_indirect_step(rad_tool_indirect *m, float *H, double *seconds);
-const float *rad_tool_indirect_rowsums(const rad_tool_indirect *m);
-void rad_tool_indirect_close(rad_tool_indirect *m);
+int tool_indirect_step(tool_indirect *m, float *H, double *seconds);
+const float *tool_indirect_rowsums(const tool_indirect *m);
+void tool_indirect_close(tool_indirect *m);
 
 /* ---- the distributed bake: parts and merge (cmd_merge.c; docs/distributed.md) ----------- */
 /* rad bake --shard I/N or --rows A:B */
-typedef struct rad_tool_shard_spec {
+typedef struct tool_shard_spec {
     uint32_t index, count;        /* --shard I/N (count 0: not given) */
     int rows;                     /* 1: --rows A:B given */
     uint32_t row_begin, row_end;  /* --rows: rows A to B-1 */
-} rad_tool_shard_spec;
-#define RAD_TOOL_MAX_SHARDS 65536u
-/* chunks of rows per shard (the snake of rad_tool_shard_ranges) */
-#define RAD_TOOL_SHARD_CHUNKS 64u
+} tool_shard_spec;
+#define TOOL_MAX_SHARDS 65536u
+/* chunks of rows per shard (the snake of tool_shard_ranges) */
+#define TOOL_SHARD_CHUNKS 64u
 /* "I/N" and "A:B" into s; 0, or 2 with a message */
-int rad_tool_parse_shard(const char *cmd, const char *text, rad_tool_shard_spec *s);
-int rad_tool_parse_rows(const char *cmd, const char *text, rad_tool_shard_spec *s);
+int tool_parse_shard(const char *cmd, const char *text, tool_shard_spec *s);
+int tool_parse_rows(const char *cmd, const char *text, tool_shard_spec *s);
 /* The rows of shard I of n over N rows as ranges [ranges[2k], ranges[2k+1]), ascending; returns
-   their count (at most RAD_TOOL_SHARD_CHUNKS; 0 when n > N leaves the shard nothing). Shards of one n cover the
+   their count (at most TOOL_SHARD_CHUNKS; 0 when n > N leaves the shard nothing). Shards of one n cover the
    rows exactly once, with nearly equal pair counts (rad_form_factor_pair_count). */
-uint32_t rad_tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ranges);
+uint32_t tool_shard_ranges(uint32_t N, uint32_t I, uint32_t n, uint32_t *ranges);
 
-/* The record a part holds (RAD_TOOL_SECTION_SHARD, "rad.shard"), beside its row ranges
+/* The record a part holds (TOOL_SECTION_SHARD, "rad.shard"), beside its row ranges
    ("rad.rows": uint32 pairs) and its pairs ("F.upper", "F.lower": rad_form_factor_pairs). */
-typedef struct rad_tool_shard_info {
-    uint32_t magic;           /* RAD_TOOL_SHARD_MAGIC */
+typedef struct tool_shard_info {
+    uint32_t magic;           /* TOOL_SHARD_MAGIC */
     uint32_t format;          /* 1 */
     char library[16];         /* RAD_VERSION_STRING of the build that baked it */
     uint32_t patches;         /* N */
@@ -485,60 +485,60 @@ typedef struct rad_tool_shard_info {
     uint64_t pairs;           /* pairs {i, j}, j > i, of its rows */
     uint64_t pairs_evaluated; /* of those, the facing ones computed */
     double seconds;           /* the form factors of this part (a record of the run) */
-} rad_tool_shard_info;
-#define RAD_TOOL_SHARD_MAGIC 0x52414453u
+} tool_shard_info;
+#define TOOL_SHARD_MAGIC 0x52414453u
 
 /* A classic bake's part as container bytes (malloc'd, free with free()). 0 or 1 (printed). */
-int rad_tool_bake_part(const char *cmd, const rad_tool_world *w, const rad_tool_classic_options *o,
-                       const rad_tool_shard_spec *spec, void **out, size_t *out_size);
+int tool_bake_part(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                       const tool_shard_spec *spec, void **out, size_t *out_size);
 /* A part in memory, named for messages (a file name, "rank 2") */
-typedef struct rad_tool_part {
+typedef struct tool_part {
     const char *name;
     const void *data;
     size_t size;
-} rad_tool_part;
+} tool_part;
 /* Checks the parts, joins them, solves, writes out_path (a temporary renamed into place, so a
    failure leaves nothing). 0, 1 (message printed naming the part and the reason) or 2. */
-int rad_tool_merge(const char *cmd, const rad_tool_part *parts, uint32_t count, const char *out_path);
-int rad_cmd_merge(int argc, char **argv);
+int tool_merge(const char *cmd, const tool_part *parts, uint32_t count, const char *out_path);
+int tool_cmd_merge(int argc, char **argv);
 
 /* rad bake's command line (cmd_bake.c), shared with tools/mpi/rad_mpi.c */
-typedef struct rad_tool_bake_args {
+typedef struct tool_bake_args {
     const char *scene, *out;
-    rad_tool_classic_options o;
-    rad_tool_method_options mo;
+    tool_classic_options o;
+    tool_method_options mo;
     uint32_t threads;
-    rad_tool_shard_spec shard;
-    rad_tool_lights lights;       /* --sun, --sky, ...: free with rad_tool_lights_free */
-} rad_tool_bake_args;
+    tool_shard_spec shard;
+    tool_lights lights;       /* --sun, --sky, ...: free with tool_lights_free */
+} tool_bake_args;
 /* -1: go on and bake; else the exit code (--help: 0 after printing it; 2: bad usage, printed).
-   args->lights is to be freed (rad_tool_lights_free) whatever it returns. */
-int rad_tool_bake_parse(const char *cmd, int argc, char **argv, rad_tool_bake_args *args);
+   args->lights is to be freed (tool_lights_free) whatever it returns. */
+int tool_bake_parse(const char *cmd, int argc, char **argv, tool_bake_args *args);
 /* ---- lightmaps (cmd_lightmap.c, unwrap.c) ------------------------------------------------ */
-int rad_cmd_lightmap(int argc, char **argv);
+int tool_cmd_lightmap(int argc, char **argv);
 /* A simple automatic lightmap unwrap (unwrap.c: charts of connected triangles within 30
    degrees, planar projection, shelf packing with 2-texel gutters): 6 floats per scene triangle
    into out_uvs, the chart count into out_charts (may be NULL). 0, or 1 with a message printed. */
 /* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
-typedef struct rad_tool_lightmap_baked {
-    rad_tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
-    rad_tool_classic cl;     /* the classic solution gathered (patches of w.scene) */
+typedef struct tool_lightmap_baked {
+    tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
+    tool_classic cl;     /* the classic solution gathered (patches of w.scene) */
     rad_lightmap *lm;
     float *values;           /* width * height * (3 or 12) floats, dilated and stitched */
     float *uvs;              /* the unwrap's lightmap uvs, or NULL */
     int own_scene;           /* w.scene and w.bvh are ours */
-} rad_tool_lightmap_baked;
+} tool_lightmap_baked;
 /* Solves the classic method over the lightmapped world (the file's second uv set, else the
    unwrap) and bakes: texels, gather of B (sh: L1 SH, else RGB irradiance), with direct != 0
    and RGB the direct light of the lights and emitters added per texel, dilation, stitching.
    gather: a rad_lightmap_gather_method, or -1 to choose by the work (the hemisphere gather with
    hemisphere_rays rays a texel past 2e7 sample-patch pairs). 0, or 1 after printing why (out
-   freed). Free with rad_tool_lightmap_bake_free. */
-int rad_tool_lightmap_bake(const char *cmd, const rad_tool_world *world, const rad_tool_classic_options *co, int width,
+   freed). Free with tool_lightmap_bake_free. */
+int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
                            int height, uint32_t texel_samples, uint32_t visibility_rays, int gather,
                            uint32_t hemisphere_rays, int sh, int force_unwrap,
-                           int direct, rad_tool_lightmap_baked *out);
-void rad_tool_lightmap_bake_free(rad_tool_lightmap_baked *b);
-int rad_tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts);
+                           int direct, tool_lightmap_baked *out);
+void tool_lightmap_bake_free(tool_lightmap_baked *b);
+int tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts);
 
 #endif

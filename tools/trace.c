@@ -31,10 +31,10 @@
 #include <omp.h>
 #endif
 
-#define RAD__TPI 3.14159265358979323846
-#define RAD__DIMS_PER_BOUNCE 8u
+#define TOOL__TPI 3.14159265358979323846
+#define TOOL__DIMS_PER_BOUNCE 8u
 
-void rad_trace_options_default(rad_trace_options *o)
+void tool_trace_options_default(tool_trace_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
@@ -46,13 +46,13 @@ void rad_trace_options_default(rad_trace_options *o)
     o->rr_depth = 16;
 }
 
-typedef struct rad__tracer {
+typedef struct tool__tracer {
     const rad_scene *S;
     const rad_raycaster *rc;
     const rad_light *lights;
     uint32_t light_count;
     const rad_camera *cam;
-    rad_trace_options o;
+    tool_trace_options o;
     int sx, sy;              /* pixel strata */
     float eps;
     uint32_t emitter_count;
@@ -61,13 +61,13 @@ typedef struct rad__tracer {
     float *select_pdf;       /* per triangle: probability to be chosen (0 for non-emitters) */
     float sky[3];            /* radiance of escaping rays */
     int has_delta;
-    rad_image *out;
+    tool_image *out;
     volatile int failed;
     uint32_t row0;           /* first row of the current batch (parallel_for path) */
-} rad__tracer;
+} tool__tracer;
 
 /* lowbias32 (C. Wellons): a good 32-bit integer hash */
-static uint32_t rad__th(uint32_t x)
+static uint32_t tool__th(uint32_t x)
 {
     x ^= x >> 16;
     x *= 0x7feb352du;
@@ -78,16 +78,16 @@ static uint32_t rad__th(uint32_t x)
 }
 
 /* uniform in [0,1) from (seed, pixel, sample, dimension) */
-static float rad__rnd(uint32_t seed, uint32_t pixel, uint32_t sample, uint32_t dim)
+static float tool__rnd(uint32_t seed, uint32_t pixel, uint32_t sample, uint32_t dim)
 {
-    uint32_t h = rad__th(seed ^ rad__th(pixel ^ rad__th(sample ^ rad__th(dim + 0x9E3779B9u))));
+    uint32_t h = tool__th(seed ^ tool__th(pixel ^ tool__th(sample ^ tool__th(dim + 0x9E3779B9u))));
     return (float)(h >> 8) * (1.0f / 16777216.0f);
 }
 
-static float rad__tdot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static float tool__tdot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* orthonormal basis around unit n (Duff et al. 2017) */
-static void rad__basis(const float *n, float *t1, float *t2)
+static void tool__basis(const float *n, float *t1, float *t2)
 {
     float s = n[2] >= 0.0f ? 1.0f : -1.0f;
     float a = -1.0f / (s + n[2]);
@@ -101,13 +101,13 @@ static void rad__basis(const float *n, float *t1, float *t2)
 }
 
 /* power heuristic (beta = 2) weight of the strategy with density a against b */
-static float rad__mis(float a, float b)
+static float tool__mis(float a, float b)
 {
     float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
 }
 
-static uint32_t rad__pick_emitter(const rad__tracer *T, float u)
+static uint32_t tool__pick_emitter(const tool__tracer *T, float u)
 {
     uint32_t lo = 0, hi = T->emitter_count; /* find i with cdf[i] <= u < cdf[i+1] */
     double du = (double)u;
@@ -122,7 +122,7 @@ static uint32_t rad__pick_emitter(const rad__tracer *T, float u)
 }
 
 /* shadow ray from p (offset along n) to q (offset along qn when given) or along dir */
-static int rad__visible(const rad__tracer *T, const float *p, const float *n, const float *q, const float *qn,
+static int tool__visible(const tool__tracer *T, const float *p, const float *n, const float *q, const float *qn,
                         const float *dir, int *ok)
 {
     rad_ray ray;
@@ -133,7 +133,7 @@ static int rad__visible(const rad__tracer *T, const float *p, const float *n, co
     if (q) {
         float len;
         for (k = 0; k < 3; ++k) ray.dir[k] = q[k] + (qn ? qn[k] * T->eps : 0.0f) - ray.origin[k];
-        len = sqrtf(rad__tdot(ray.dir, ray.dir));
+        len = sqrtf(tool__tdot(ray.dir, ray.dir));
         ray.tmax = len > 2.0f * T->eps ? 1.0f - T->eps / len : 0.5f;
     } else {
         for (k = 0; k < 3; ++k) ray.dir[k] = dir[k];
@@ -147,7 +147,7 @@ static int rad__visible(const rad__tracer *T, const float *p, const float *n, co
 }
 
 /* radiance of one camera sample; *ok = 0 when a ray query failed */
-static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sample, float px, float py,
+static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t sample, float px, float py,
                               double *acc, int *ok)
 {
     const rad_scene *S = T->S;
@@ -162,7 +162,7 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
         const float *v, *n;
         const float *Le;
         float p[3], albedo[3], cosi, t1[3], t2[3];
-        uint32_t tri, dim = (uint32_t)depth * RAD__DIMS_PER_BOUNCE;
+        uint32_t tri, dim = (uint32_t)depth * TOOL__DIMS_PER_BOUNCE;
         if (T->rc->intersect(T->rc->user, &ray, 1, &hit) != RAD_SUCCESS) {
             *ok = 0;
             return;
@@ -174,7 +174,7 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
         tri = hit.triangle;
         v = S->positions + 9 * (size_t)tri;
         n = S->normals + 3 * (size_t)tri;
-        cosi = -rad__tdot(ray.dir, n); /* ray.dir is unit */
+        cosi = -tool__tdot(ray.dir, n); /* ray.dir is unit */
         if (!(cosi > 0.0f)) break;     /* back face: one-sided, black */
         for (k = 0; k < 3; ++k) p[k] = v[k] + hit.b1 * (v[3 + k] - v[k]) + hit.b2 * (v[6 + k] - v[k]);
         Le = S->materials_table[S->materials[tri]].emission;
@@ -182,7 +182,7 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
             float w = 1.0f;
             if (depth > 0) {
                 float pl = T->select_pdf[tri] / S->areas[tri] * hit.t * hit.t / cosi;
-                w = rad__mis(prev_pdf, pl);
+                w = tool__mis(prev_pdf, pl);
             }
             for (k = 0; k < 3; ++k) L[k] += thr[k] * Le[k] * w;
         }
@@ -191,27 +191,27 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
         if (!(albedo[0] > 0.0f || albedo[1] > 0.0f || albedo[2] > 0.0f)) break;
         /* next-event estimation: one area light */
         if (T->emitter_count) {
-            uint32_t e = rad__pick_emitter(T, rad__rnd(seed, pixel, sample, dim + 0));
+            uint32_t e = tool__pick_emitter(T, tool__rnd(seed, pixel, sample, dim + 0));
             uint32_t lt = T->emitters[e];
             if (lt != tri) {
                 const float *lv = S->positions + 9 * (size_t)lt, *ln = S->normals + 3 * (size_t)lt;
                 const float *lL = S->materials_table[S->materials[lt]].emission;
-                float u1 = rad__rnd(seed, pixel, sample, dim + 1), u2 = rad__rnd(seed, pixel, sample, dim + 2);
+                float u1 = tool__rnd(seed, pixel, sample, dim + 1), u2 = tool__rnd(seed, pixel, sample, dim + 2);
                 float su = sqrtf(u1), b0 = 1.0f - su, bb1 = u2 * su, bb2 = 1.0f - b0 - bb1;
                 float q[3], d[3], d2, dist, cs, cl;
                 for (k = 0; k < 3; ++k) {
                     q[k] = b0 * lv[k] + bb1 * lv[3 + k] + bb2 * lv[6 + k];
                     d[k] = q[k] - p[k];
                 }
-                d2 = rad__tdot(d, d);
+                d2 = tool__tdot(d, d);
                 if (d2 > 0.0f) {
                     dist = sqrtf(d2);
-                    cs = rad__tdot(d, n) / dist;
-                    cl = -rad__tdot(d, ln) / dist;
-                    if (cs > 0.0f && cl > 0.0f && rad__visible(T, p, n, q, ln, NULL, ok)) {
+                    cs = tool__tdot(d, n) / dist;
+                    cl = -tool__tdot(d, ln) / dist;
+                    if (cs > 0.0f && cl > 0.0f && tool__visible(T, p, n, q, ln, NULL, ok)) {
                         float pl = T->select_pdf[lt] / S->areas[lt] * d2 / cl; /* solid angle */
-                        float pb = cs / (float)RAD__TPI;
-                        float f = rad__mis(pl, pb) * cs / ((float)RAD__TPI * pl);
+                        float pb = cs / (float)TOOL__TPI;
+                        float f = tool__mis(pl, pb) * cs / ((float)TOOL__TPI * pl);
                         for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * lL[k] * f;
                     }
                     if (!*ok) return;
@@ -227,31 +227,31 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
                 if (li->type == RAD_LIGHT_DIRECTIONAL) {
                     float len;
                     for (k = 0; k < 3; ++k) dd[k] = -li->direction[k];
-                    len = sqrtf(rad__tdot(dd, dd));
+                    len = sqrtf(tool__tdot(dd, dd));
                     if (!(len > 0.0f)) continue;
                     for (k = 0; k < 3; ++k) dd[k] /= len;
-                    cs = rad__tdot(dd, n);
+                    cs = tool__tdot(dd, n);
                     if (!(cs > 0.0f)) continue;
                     for (k = 0; k < 3; ++k) w[k] = li->color[k] * cs;
-                    if (!rad__visible(T, p, n, NULL, NULL, dd, ok)) {
+                    if (!tool__visible(T, p, n, NULL, NULL, dd, ok)) {
                         if (!*ok) return;
                         continue;
                     }
                 } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
                     float dist, dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * S->diagonal;
                     for (k = 0; k < 3; ++k) dd[k] = li->position[k] - p[k];
-                    dist = sqrtf(rad__tdot(dd, dd));
+                    dist = sqrtf(tool__tdot(dd, dd));
                     if (!(dist > 0.0f)) continue;
-                    cs = rad__tdot(dd, n) / dist;
+                    cs = tool__tdot(dd, n) / dist;
                     if (!(cs > 0.0f)) continue;
                     dc = dist > md ? dist : md;
                     atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
                     if (li->type == RAD_LIGHT_SPOT) {
                         float axis[3], alen, ca, ci = cosf(li->inner_angle), co = cosf(li->outer_angle), s;
                         for (k = 0; k < 3; ++k) axis[k] = li->direction[k];
-                        alen = sqrtf(rad__tdot(axis, axis));
+                        alen = sqrtf(tool__tdot(axis, axis));
                         if (!(alen > 0.0f)) continue;
-                        ca = -rad__tdot(dd, axis) / (dist * alen);
+                        ca = -tool__tdot(dd, axis) / (dist * alen);
                         if (ci > co) {
                             s = (ca - co) / (ci - co);
                             s = s < 0.0f ? 0.0f : (s > 1.0f ? 1.0f : s);
@@ -262,7 +262,7 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
                         if (!(atten > 0.0f)) continue;
                     }
                     for (k = 0; k < 3; ++k) w[k] = li->color[k] * cs * atten;
-                    if (!rad__visible(T, p, n, li->position, NULL, NULL, ok)) {
+                    if (!tool__visible(T, p, n, li->position, NULL, NULL, ok)) {
                         if (!*ok) return;
                         continue;
                     }
@@ -270,24 +270,24 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
                     continue; /* sky: escaping rays */
                 }
                 /* reflected radiance = albedo / pi * irradiance */
-                for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * w[k] / (float)RAD__TPI;
+                for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * w[k] / (float)TOOL__TPI;
             }
         }
         /* continue with a cosine-weighted direction: the throughput gains the albedo */
         {
-            float u1 = rad__rnd(seed, pixel, sample, dim + 3), u2 = rad__rnd(seed, pixel, sample, dim + 4);
-            float r = sqrtf(u1), ph = 2.0f * (float)RAD__TPI * u2, cz = sqrtf(1.0f - u1 > 0.0f ? 1.0f - u1 : 0.0f);
+            float u1 = tool__rnd(seed, pixel, sample, dim + 3), u2 = tool__rnd(seed, pixel, sample, dim + 4);
+            float r = sqrtf(u1), ph = 2.0f * (float)TOOL__TPI * u2, cz = sqrtf(1.0f - u1 > 0.0f ? 1.0f - u1 : 0.0f);
             float cx = r * cosf(ph), cy = r * sinf(ph), len;
-            rad__basis(n, t1, t2);
+            tool__basis(n, t1, t2);
             for (k = 0; k < 3; ++k) {
                 ray.origin[k] = p[k] + n[k] * T->eps;
                 ray.dir[k] = t1[k] * cx + t2[k] * cy + n[k] * cz;
             }
-            len = sqrtf(rad__tdot(ray.dir, ray.dir));
+            len = sqrtf(tool__tdot(ray.dir, ray.dir));
             for (k = 0; k < 3; ++k) ray.dir[k] /= len;
             ray.tmin = 0.0f;
             ray.tmax = FLT_MAX;
-            prev_pdf = cz / (float)RAD__TPI;
+            prev_pdf = cz / (float)TOOL__TPI;
             if (!(prev_pdf > 0.0f)) break;
             for (k = 0; k < 3; ++k) thr[k] *= albedo[k];
         }
@@ -295,7 +295,7 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
             float q = thr[0] > thr[1] ? thr[0] : thr[1];
             q = q > thr[2] ? q : thr[2];
             if (q > 0.95f) q = 0.95f;
-            if (!(rad__rnd(seed, pixel, sample, dim + 5) < q)) break;
+            if (!(tool__rnd(seed, pixel, sample, dim + 5) < q)) break;
             for (k = 0; k < 3; ++k) thr[k] /= q;
         }
     }
@@ -303,7 +303,7 @@ static void rad__trace_sample(const rad__tracer *T, uint32_t pixel, uint32_t sam
         if (L[k] == L[k] && L[k] < FLT_MAX) acc[k] += (double)L[k]; /* a NaN/Inf sample is dropped */
 }
 
-static int rad__trace_row(rad__tracer *T, int y)
+static int tool__trace_row(tool__tracer *T, int y)
 {
     int x, s, ok = 1;
     for (x = 0; x < T->o.width && ok; ++x) {
@@ -313,11 +313,11 @@ static int rad__trace_row(rad__tracer *T, int y)
         for (s = 0; s < T->o.spp && ok; ++s) {
             /* stratum (s % sx, s / sx) of an sx x sy grid, jittered inside */
             int cx = s % T->sx, cy = s / T->sx;
-            float jx = rad__rnd(T->o.seed, pixel, (uint32_t)s, 0xFFFFFF00u);
-            float jy = rad__rnd(T->o.seed, pixel, (uint32_t)s, 0xFFFFFF01u);
+            float jx = tool__rnd(T->o.seed, pixel, (uint32_t)s, 0xFFFFFF00u);
+            float jy = tool__rnd(T->o.seed, pixel, (uint32_t)s, 0xFFFFFF01u);
             float px = (float)x + ((float)cx + jx) / (float)T->sx;
             float py = (float)y + ((float)cy + jy) / (float)T->sy;
-            rad__trace_sample(T, pixel, (uint32_t)s, px, py, acc, &ok);
+            tool__trace_sample(T, pixel, (uint32_t)s, px, py, acc, &ok);
         }
         dst[0] = (float)(acc[0] / (double)T->o.spp);
         dst[1] = (float)(acc[1] / (double)T->o.spp);
@@ -326,18 +326,18 @@ static int rad__trace_row(rad__tracer *T, int y)
     return ok;
 }
 
-static void rad__trace_task(void *data, uint32_t index)
+static void tool__trace_task(void *data, uint32_t index)
 {
-    rad__tracer *T = (rad__tracer *)data;
+    tool__tracer *T = (tool__tracer *)data;
     if (T->failed) return;
-    if (!rad__trace_row(T, (int)(T->row0 + index))) T->failed = 1;
+    if (!tool__trace_row(T, (int)(T->row0 + index))) T->failed = 1;
 }
 
-int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
-                    const rad_camera *camera, const rad_trace_options *options, const rad_context *ctx,
-                    rad_image *out)
+int tool_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
+                    const rad_camera *camera, const tool_trace_options *options, const rad_context *ctx,
+                    tool_image *out)
 {
-    rad__tracer T;
+    tool__tracer T;
     uint32_t t, e, l;
     double total = 0.0, run = 0.0;
     int y, batch, result = RAD_SUCCESS, s;
@@ -345,7 +345,7 @@ int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_l
         return RAD_ERROR_INVALID_ARGUMENT;
     memset(&T, 0, sizeof(T));
     if (options) T.o = *options;
-    else rad_trace_options_default(&T.o);
+    else tool_trace_options_default(&T.o);
     if (T.o.max_depth <= 0) T.o.max_depth = 64;
     if (T.o.rr_depth <= 0) T.o.rr_depth = 16;
     if (T.o.width <= 0 || T.o.height <= 0 || T.o.spp <= 0) return RAD_ERROR_INVALID_ARGUMENT;
@@ -366,7 +366,7 @@ int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_l
         for (k = 0; k < 3; ++k)
             if (!(li->color[k] >= -FLT_MAX && li->color[k] <= FLT_MAX)) return RAD_ERROR_NON_FINITE;
         if (li->type == RAD_LIGHT_SKY) {
-            for (k = 0; k < 3; ++k) T.sky[k] += li->color[k] / (float)RAD__TPI;
+            for (k = 0; k < 3; ++k) T.sky[k] += li->color[k] / (float)TOOL__TPI;
         } else if (li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
             T.has_delta = 1;
         } else {
@@ -374,8 +374,8 @@ int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_l
         }
     }
     if (out->width != T.o.width || out->height != T.o.height || !out->rgb) {
-        rad_image_free(out);
-        if (rad_image_alloc(out, T.o.width, T.o.height) != 0) return RAD_ERROR_OUT_OF_MEMORY;
+        tool_image_free(out);
+        if (tool_image_alloc(out, T.o.width, T.o.height) != 0) return RAD_ERROR_OUT_OF_MEMORY;
     }
     T.out = out;
     /* emitters and their selection probabilities */
@@ -397,7 +397,7 @@ int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_l
         for (t = 0, e = 0; t < scene->triangle_count; ++t) {
             const float *Le = scene->materials_table[scene->materials[t]].emission;
             if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
-                double pw = RAD__TPI * (double)scene->areas[t] * ((double)Le[0] + (double)Le[1] + (double)Le[2]);
+                double pw = TOOL__TPI * (double)scene->areas[t] * ((double)Le[0] + (double)Le[1] + (double)Le[2]);
                 T.emitters[e] = t;
                 T.cdf[e] = total;
                 total += pw;
@@ -418,14 +418,14 @@ int rad_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_l
         int y1 = y + batch < T.o.height ? y + batch : T.o.height;
         if (ctx && ctx->parallel_for) {
             T.row0 = (uint32_t)y;
-            ctx->parallel_for(ctx->parallel_user, (uint32_t)(y1 - y), rad__trace_task, &T);
+            ctx->parallel_for(ctx->parallel_user, (uint32_t)(y1 - y), tool__trace_task, &T);
         } else {
             int yy;
 #ifdef _OPENMP
 #pragma omp parallel for schedule(dynamic, 1)
 #endif
             for (yy = y; yy < y1; ++yy) {
-                if (!T.failed && !rad__trace_row(&T, yy)) T.failed = 1;
+                if (!T.failed && !tool__trace_row(&T, yy)) T.failed = 1;
             }
         }
         if (T.failed) result = RAD_ERROR_RAYCAST_FAILED;

@@ -80,7 +80,7 @@ static int uw_pack(uw_chart *c, uint32_t n, double s, uint32_t W, uint32_t H)
     return 1;
 }
 
-int rad_tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts)
+int tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts)
 {
     uint32_t T = scene->triangle_count, t, i, nch = 0, *chart = NULL, *queue = NULL, *first = NULL, *adj = NULL;
     uint32_t *deg = NULL;

@@ -4,8 +4,8 @@
 
        mpirun -np 64 tools/rad-mpi bake scene.gltf --patches 100000 -o scene.radb
 
-   Each rank loads the scene and bakes its part in memory (rad_tool_bake_part); rank 0 gathers
-   the parts and merges them (rad_tool_merge: the same checks as rad merge). A rank that fails
+   Each rank loads the scene and bakes its part in memory (tool_bake_part); rank 0 gathers
+   the parts and merges them (tool_merge: the same checks as rad merge). A rank that fails
    prints its message, prefixed with its rank, and the whole run exits 1 with nothing written:
    only rank 0 writes, through a temporary renamed into place after the merge succeeded. Built
    with mpicc from the rad tool's sources but tools/main.c (make rad-mpi); the library knows
@@ -21,7 +21,7 @@
 #endif
 
 /* parts move in pieces of at most this many bytes (MPI counts are int) */
-#define RAD_MPI_CHUNK ((size_t)1 << 30)
+#define TOOL_MPI_CHUNK ((size_t)1 << 30)
 
 static void usage(FILE *f)
 {
@@ -34,7 +34,7 @@ static void usage(FILE *f)
 static void send_bytes(const unsigned char *p, size_t n, int to)
 {
     while (n > 0) {
-        size_t k = n < RAD_MPI_CHUNK ? n : RAD_MPI_CHUNK;
+        size_t k = n < TOOL_MPI_CHUNK ? n : TOOL_MPI_CHUNK;
         MPI_Send((void *)(size_t)p, (int)k, MPI_BYTE, to, 1, MPI_COMM_WORLD);
         p += k;
         n -= k;
@@ -44,7 +44,7 @@ static void send_bytes(const unsigned char *p, size_t n, int to)
 static void recv_bytes(unsigned char *p, size_t n, int from)
 {
     while (n > 0) {
-        size_t k = n < RAD_MPI_CHUNK ? n : RAD_MPI_CHUNK;
+        size_t k = n < TOOL_MPI_CHUNK ? n : TOOL_MPI_CHUNK;
         MPI_Recv(p, (int)k, MPI_BYTE, from, 1, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
         p += k;
         n -= k;
@@ -58,14 +58,14 @@ static void choose_threads(uint32_t given)
     MPI_Comm node;
     int local = 1, procs;
     if (given || getenv("OMP_NUM_THREADS")) {
-        rad_tool_set_threads((int)given);
+        tool_set_threads((int)given);
         return;
     }
     MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
     MPI_Comm_size(node, &local);
     MPI_Comm_free(&node);
     procs = omp_get_num_procs(); /* the cores this rank is bound to, when mpirun binds it */
-    rad_tool_set_threads(procs / local > 1 ? procs / local : 1);
+    tool_set_threads(procs / local > 1 ? procs / local : 1);
 #else
     (void)given;
 #endif
@@ -73,8 +73,8 @@ static void choose_threads(uint32_t given)
 
 int main(int argc, char **argv)
 {
-    rad_tool_bake_args args;
-    rad_tool_world w;
+    tool_bake_args args;
+    tool_world w;
     char cmd[64];
     void *part = NULL;
     size_t part_size = 0;
@@ -85,7 +85,7 @@ int main(int argc, char **argv)
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
     t0 = MPI_Wtime();
     sprintf(cmd, "mpi bake [rank %d/%d]", rank, ranks);
-    rad_tool_show_progress(rank == 0); /* one progress line, not one per rank */
+    tool_show_progress(rank == 0); /* one progress line, not one per rank */
     /* the command line: rank 0 says what is wrong with it, once */
     if (rank == 0) {
         if (argc < 2 || strcmp(argv[1], "bake")) {
@@ -97,35 +97,35 @@ int main(int argc, char **argv)
                 rc = 2;
             }
         } else {
-            rc = rad_tool_bake_parse("mpi bake", argc - 2, argv + 2, &args);
-            if (rc < 0 && (args.shard.count || args.shard.rows || (args.mo.given & RAD_TOOL_OPT_METHOD))) {
+            rc = tool_bake_parse("mpi bake", argc - 2, argv + 2, &args);
+            if (rc < 0 && (args.shard.count || args.shard.rows || (args.mo.given & TOOL_OPT_METHOD))) {
                 fprintf(stderr, "rad mpi bake: the ranks are the shards (--shard, --rows) and the method is classic "
                                 "(--method): leave them out\n");
                 rc = 2;
             }
-            if (rc < 0 && rad_tool_check_output("mpi bake", args.out, &args.scene, 1)) rc = 1;
+            if (rc < 0 && tool_check_output("mpi bake", args.out, &args.scene, 1)) rc = 1;
         }
     }
     MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (rc >= 0) {
-        if (rank == 0 && argc >= 2 && !strcmp(argv[1], "bake")) rad_tool_lights_free(&args.lights);
+        if (rank == 0 && argc >= 2 && !strcmp(argv[1], "bake")) tool_lights_free(&args.lights);
         MPI_Finalize();
         return rc;
     }
-    if (rank != 0 && rad_tool_bake_parse(cmd, argc - 2, argv + 2, &args) >= 0) fail = 1; /* rank 0 accepted it */
+    if (rank != 0 && tool_bake_parse(cmd, argc - 2, argv + 2, &args) >= 0) fail = 1; /* rank 0 accepted it */
     if (!fail) {
-        rad_tool_shard_spec spec;
+        tool_shard_spec spec;
         memset(&spec, 0, sizeof spec);
         spec.index = (uint32_t)rank;
         spec.count = (uint32_t)ranks;
         choose_threads(args.threads);
-        if (rad_tool_open_world_lit(cmd, args.scene, &args.lights, &w)) fail = 1;
+        if (tool_open_world_lit(cmd, args.scene, &args.lights, &w)) fail = 1;
         else {
-            fail = rad_tool_bake_part(cmd, &w, &args.o, &spec, &part, &part_size) != 0;
-            rad_tool_close_world(&w);
+            fail = tool_bake_part(cmd, &w, &args.o, &spec, &part, &part_size) != 0;
+            tool_close_world(&w);
         }
     }
-    rad_tool_lights_free(&args.lights);
+    tool_lights_free(&args.lights);
     MPI_Allreduce(&fail, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     if (any) {
         if (rank == 0) fprintf(stderr, "rad mpi bake: a rank failed (its message is above): nothing written\n");
@@ -135,11 +135,11 @@ int main(int argc, char **argv)
     }
     {
         uint64_t mine = part_size, *sizes = NULL;
-        if (rank == 0) sizes = (uint64_t *)rad_tool_calloc((size_t)ranks, sizeof *sizes);
+        if (rank == 0) sizes = (uint64_t *)tool_calloc((size_t)ranks, sizeof *sizes);
         MPI_Gather(&mine, 1, MPI_UINT64_T, sizes, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
         if (rank == 0) {
-            rad_tool_part *parts = (rad_tool_part *)rad_tool_calloc((size_t)ranks, sizeof *parts);
-            char (*names)[32] = (char (*)[32])rad_tool_calloc((size_t)ranks, sizeof *names);
+            tool_part *parts = (tool_part *)tool_calloc((size_t)ranks, sizeof *parts);
+            char (*names)[32] = (char (*)[32])tool_calloc((size_t)ranks, sizeof *names);
             int r;
             for (r = 0; r < ranks; ++r) {
                 sprintf(names[r], "rank %d", r);
@@ -157,7 +157,7 @@ int main(int argc, char **argv)
                     parts[r].data = buf;
                 }
             }
-            rc = rad_tool_merge("mpi bake", parts, (uint32_t)ranks, args.out);
+            rc = tool_merge("mpi bake", parts, (uint32_t)ranks, args.out);
             for (r = 1; r < ranks; ++r) free((void *)(size_t)parts[r].data);
             free(parts);
             free(names);
