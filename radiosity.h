@@ -6158,6 +6158,27 @@ static void rad__shadow_ray(rad_ray *ray, const float *p, const float *n, const 
     }
 }
 
+/* The distance falloff of a point or spot light at distance dist along v (light to point,
+   unnormalised), no closer than md, times a spot's smoothstep cone: 0 outside the cone. */
+static float rad__light_atten(const rad_light *li, const float v[3], float dist, float md)
+{
+    float dc = dist > md ? dist : md, atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
+    if (li->type == RAD_LIGHT_SPOT) {
+        float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
+        memcpy(axis, li->direction, sizeof(axis));
+        rad__normalize(axis);
+        ca = -rad__dot(v, axis) / dist;
+        if (ci > co) {
+            t = (ca - co) / (ci - co);
+            t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+            atten *= t * t * (3.0f - 2.0f * t);
+        } else if (!(ca >= co)) {
+            atten = 0.0f;
+        }
+    }
+    return atten;
+}
+
 /* The unshadowed irradiance w (RGB) of one directional, point or spot light at p (unit
    normal n): 1 with w and, for a directional light, the unit direction towards it in v
    (point and spot: the shadow ray goes to li->position); 0 when the light gives nothing
@@ -6175,28 +6196,14 @@ static int rad__light_unshadowed(const rad_light *li, float diagonal, const floa
         for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn;
         return 1;
     } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
-        float dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * diagonal;
+        float atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * diagonal;
         rad__sub(v, li->position, p);
         dist = rad__len(v);
         if (!(dist > 0.0f)) return 0;
         cosn = rad__dot(v, n) / dist;
         if (!(cosn > 0.0f)) return 0;
-        dc = dist > md ? dist : md;
-        atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
-        if (li->type == RAD_LIGHT_SPOT) {
-            float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
-            memcpy(axis, li->direction, sizeof(axis));
-            rad__normalize(axis);
-            ca = -rad__dot(v, axis) / dist;
-            if (ci > co) {
-                t = (ca - co) / (ci - co);
-                t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-                atten *= t * t * (3.0f - 2.0f * t);
-            } else if (!(ca >= co)) {
-                atten = 0.0f;
-            }
-            if (!(atten > 0.0f)) return 0;
-        }
+        atten = rad__light_atten(li, v, dist, md);
+        if (!(atten > 0.0f)) return 0;
         for (k = 0; k < 3; ++k) w[k] = li->color[k] * cosn * atten;
         return 1;
     }
@@ -16387,6 +16394,48 @@ static uint32_t rad__vp_find(const rad_virtual_patches *vp, uint64_t key)
     return lo < vp->voxel_count && vp->voxel_keys[lo] == key ? lo : RAD_NONE;
 }
 
+/* The weight voxel v's patch on axis a gets at normal n (w: the axis weights of n), its patch
+   in *q; 0 when the axis has no patch. */
+static float rad__vp_face_weight(const rad_virtual_patches *vp, uint32_t v, uint32_t a, const float n[3], const float w[6],
+                                 uint32_t *q)
+{
+    *q = vp->voxel_patch[6 * (size_t)v + a];
+    if (*q == RAD_NONE) return 0.0f;
+    return vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)*q, n) : w[a];
+}
+
+/* The trilinear lattice of a point: the voxel-centre cell below p (clamped two cells outside
+   the grid) in base, the fractions in g. */
+static void rad__vp_lattice(const rad_virtual_patches *vp, const float p[3], int64_t base[3], double g[3])
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        double x = ((double)p[k] - (double)vp->origin[k]) / (double)vp->voxel_size[k] - 0.5;
+        if (x < -2.0) x = -2.0;
+        if (x > (double)vp->dims[k] + 1.0) x = (double)vp->dims[k] + 1.0;
+        base[k] = (int64_t)floor(x);
+        g[k] = x - (double)base[k];
+    }
+}
+
+/* Corner 'corner' (bit k: +1 along axis k) of the lattice cell: its trilinear weight in *t and
+   its voxel, or RAD_NONE when the corner lies outside the grid or holds no voxel. */
+static uint32_t rad__vp_corner(const rad_virtual_patches *vp, const int64_t base[3], const double g[3], uint32_t corner,
+                               double *t)
+{
+    int64_t cell[3];
+    int k, inside = 1;
+    *t = 1.0;
+    for (k = 0; k < 3; ++k) {
+        int bit = (int)((corner >> k) & 1u);
+        cell[k] = base[k] + bit;
+        *t *= bit ? g[k] : 1.0 - g[k];
+        if (cell[k] < 0 || cell[k] >= (int64_t)vp->dims[k]) inside = 0;
+    }
+    if (!inside) return RAD_NONE;
+    return rad__vp_find(vp, (uint64_t)cell[0] + (uint64_t)vp->dims[0] * ((uint64_t)cell[1] + (uint64_t)vp->dims[1] * (uint64_t)cell[2]));
+}
+
 RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float *values, const float p[3],
                                      const float n[3], float out[3])
 {
@@ -16399,32 +16448,14 @@ RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float 
     out[0] = out[1] = out[2] = 0.0f;
     if (!vp || !values || !p || !n || !rad__finite3(p) || !rad__finite3(n)) return 0;
     rad__vp_weights(vp->weights, n, w);
-    for (k = 0; k < 3; ++k) {
-        double x = ((double)p[k] - (double)vp->origin[k]) / (double)vp->voxel_size[k] - 0.5;
-        if (x < -2.0) x = -2.0;
-        if (x > (double)vp->dims[k] + 1.0) x = (double)vp->dims[k] + 1.0;
-        base[k] = (int64_t)floor(x);
-        g[k] = x - (double)base[k];
-    }
+    rad__vp_lattice(vp, p, base, g);
     for (corner = 0; corner < 8; ++corner) {
-        int64_t cell[3];
-        double t = 1.0, L[3] = { 0.0, 0.0, 0.0 }, ws = 0.0;
-        uint32_t v, a;
-        int inside = 1;
-        for (k = 0; k < 3; ++k) {
-            int bit = (int)((corner >> k) & 1u);
-            cell[k] = base[k] + bit;
-            t *= bit ? g[k] : 1.0 - g[k];
-            if (cell[k] < 0 || cell[k] >= (int64_t)vp->dims[k]) inside = 0;
-        }
-        if (!inside) continue;
-        v = rad__vp_find(vp, (uint64_t)cell[0] + (uint64_t)vp->dims[0] * ((uint64_t)cell[1] + (uint64_t)vp->dims[1] * (uint64_t)cell[2]));
+        double t, L[3] = { 0.0, 0.0, 0.0 }, ws = 0.0;
+        uint32_t a, v = rad__vp_corner(vp, base, g, corner, &t);
         if (v == RAD_NONE) continue;
         for (a = 0; a < 6; ++a) {
-            uint32_t q = vp->voxel_patch[6 * (size_t)v + a];
-            float wa;
-            if (q == RAD_NONE) continue;
-            wa = vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)q, n) : w[a];
+            uint32_t q;
+            float wa = rad__vp_face_weight(vp, v, a, n, w, &q);
             if (!(wa > 0.0f)) continue;
             ws += (double)wa;
             for (k = 0; k < 3; ++k) L[k] += (double)wa * (double)values[3 * (size_t)q + k];
@@ -16559,35 +16590,16 @@ static uint32_t rad__vp_gather_weights(const rad_virtual_patches *vp, const floa
     uint32_t start[9], corner, used = 0, cnt = 0, u, e;
     int64_t base[3];
     float w[6];
-    int k;
     if (!rad__finite3(p) || !rad__finite3(n)) return 0;
     rad__vp_weights(vp->weights, n, w);
-    for (k = 0; k < 3; ++k) {
-        double x = ((double)p[k] - (double)vp->origin[k]) / (double)vp->voxel_size[k] - 0.5;
-        if (x < -2.0) x = -2.0;
-        if (x > (double)vp->dims[k] + 1.0) x = (double)vp->dims[k] + 1.0;
-        base[k] = (int64_t)floor(x);
-        g[k] = x - (double)base[k];
-    }
+    rad__vp_lattice(vp, p, base, g);
     for (corner = 0; corner < 8; ++corner) {
-        int64_t cell[3];
-        double t = 1.0, ws = 0.0;
-        uint32_t v, a, first = cnt;
-        int inside = 1;
-        for (k = 0; k < 3; ++k) {
-            int bit = (int)((corner >> k) & 1u);
-            cell[k] = base[k] + bit;
-            t *= bit ? g[k] : 1.0 - g[k];
-            if (cell[k] < 0 || cell[k] >= (int64_t)vp->dims[k]) inside = 0;
-        }
-        if (!inside) continue;
-        v = rad__vp_find(vp, (uint64_t)cell[0] + (uint64_t)vp->dims[0] * ((uint64_t)cell[1] + (uint64_t)vp->dims[1] * (uint64_t)cell[2]));
+        double t, ws = 0.0;
+        uint32_t a, first = cnt, v = rad__vp_corner(vp, base, g, corner, &t);
         if (v == RAD_NONE) continue;
         for (a = 0; a < 6; ++a) {
-            uint32_t q = vp->voxel_patch[6 * (size_t)v + a];
-            float wa;
-            if (q == RAD_NONE) continue;
-            wa = vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)q, n) : w[a];
+            uint32_t q;
+            float wa = rad__vp_face_weight(vp, v, a, n, w, &q);
             if (!(wa > 0.0f)) continue;
             ws += (double)wa;
             idx[cnt] = q;
@@ -18901,26 +18913,12 @@ static rad_result rad__pb_gather(void *data, uint32_t row, uint32_t task)
                 rad__normalize(v);
                 r = rad__pb_queue(b, task, row, &nq, p, v, NULL, 1.0f, RAD_NONE, li->color);
             } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
-                float dist, dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * b->S->diagonal;
+                float dist, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * b->S->diagonal;
                 rad__sub(v, li->position, p);
                 dist = rad__len(v);
                 if (!(dist > 0.0f)) continue;
-                dc = dist > md ? dist : md;
-                atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
-                if (li->type == RAD_LIGHT_SPOT) {
-                    float axis[3], ca, ci = (float)cos((double)li->inner_angle), co = (float)cos((double)li->outer_angle), t;
-                    memcpy(axis, li->direction, sizeof(axis));
-                    rad__normalize(axis);
-                    ca = -rad__dot(v, axis) / dist;
-                    if (ci > co) {
-                        t = (ca - co) / (ci - co);
-                        t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-                        atten *= t * t * (3.0f - 2.0f * t);
-                    } else if (!(ca >= co)) {
-                        atten = 0.0f;
-                    }
-                    if (!(atten > 0.0f)) continue;
-                }
+                atten = rad__light_atten(li, v, dist, md);
+                if (!(atten > 0.0f)) continue;
                 for (c = 0; c < 3; ++c) col[c] = li->color[c] * atten;
                 /* to the light's point: the ray ends just short of it (ny = 0 keeps it there) */
                 {
