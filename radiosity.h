@@ -4644,6 +4644,118 @@ static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const fl
     return RAD_SUCCESS;
 }
 
+/* Stage 1 of rad_patches_create: the cuts per edge of every triangle (by max_edge and
+   max_area), each triangle's first patch, and the total patch and lattice-vertex counts. */
+static rad_result rad__patches_plan(rad_patches *P, const rad_scene *scene, float max_area, float max_edge, rad__ctx *c,
+                                    uint64_t *out_total, uint64_t *out_lattice_total)
+{
+    uint64_t total = 0, lattice_total = 0;
+    uint32_t t;
+    for (t = 0; t < scene->triangle_count; ++t) {
+        const float *v = scene->positions + 9 * (size_t)t;
+        float e[3][3];
+        double n = 1.0, le = 0.0;
+        int k;
+        rad__sub(e[0], v + 3, v);
+        rad__sub(e[1], v + 6, v + 3);
+        rad__sub(e[2], v, v + 6);
+        for (k = 0; k < 3; ++k) { double l = rad__len(e[k]); if (l > le) le = l; }
+        if (max_edge > 0.0f) { double m = ceil(le / (double)max_edge); if (m > n) n = m; }
+        if (max_area > 0.0f) { double m = ceil(sqrt((double)scene->areas[t] / (double)max_area)); if (m > n) n = m; }
+        if (!(n < 65536.0)) {
+            rad__log(c, RAD_LOG_ERROR, "triangle %u would be cut %g times per edge (more than 65535)", t, n);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+        P->subdivision[t] = (uint32_t)n;
+        P->first_patch[t] = (uint32_t)total;
+        total += (uint64_t)n * (uint64_t)n;
+        lattice_total += ((uint64_t)n + 1u) * ((uint64_t)n + 2u) / 2u;
+        if (total >= (uint64_t)RAD_NONE || lattice_total >= (uint64_t)RAD_NONE) {
+            rad__log(c, RAD_LOG_ERROR, "more than %u patches: reduce the subdivision", RAD_NONE - 1u);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+    }
+    *out_total = total;
+    *out_lattice_total = lattice_total;
+    return RAD_SUCCESS;
+}
+
+/* Stage 2, per triangle t cut n times per edge: the welded lattice vertices, their ids in
+   lattice_ids (rad__lattice order). */
+static void rad__patches_lattice(rad_patches *P, const rad_scene *scene, uint32_t t, uint32_t n, rad__weld *w,
+                                 uint32_t *nv, float eps, uint32_t *lattice_ids)
+{
+    const float *v = scene->positions + 9 * (size_t)t, *tn = scene->normals + 3 * (size_t)t;
+    uint32_t i, j;
+    for (j = 0; j <= n; ++j)
+        for (i = 0; i + j <= n; ++i) {
+            float p[3], a = (float)i / (float)n, b = (float)j / (float)n;
+            int k;
+            for (k = 0; k < 3; ++k) p[k] = v[k] + a * (v[3 + k] - v[k]) + b * (v[6 + k] - v[k]);
+            if (i == n) memcpy(p, v + 3, sizeof(p)); /* corners exactly */
+            if (j == n) memcpy(p, v + 6, sizeof(p));
+            lattice_ids[rad__lattice(n, i, j)] = rad__weld_vertex(w, P->vertices, nv, p, tn, eps, scene->bounds_min);
+        }
+}
+
+/* Stage 3, per triangle t: its n^2 patches (the "up" and "down" sub-triangles of the lattice)
+   with area, normal, emission, centroid and albedo (averaged over the texture when there is one). */
+static rad_result rad__patches_fill(rad_patches *P, const rad_scene *scene, uint32_t t, uint32_t n,
+                                    const uint32_t *lattice_ids, uint32_t albedo_samples, rad__ctx *c)
+{
+    const float *tn = scene->normals + 3 * (size_t)t;
+    const rad_material *mat = &scene->materials_table[scene->materials[t]];
+    uint32_t i, j, base = P->first_patch[t];
+    float sub_area = scene->areas[t] / ((float)n * (float)n);
+    rad_result r = RAD_SUCCESS;
+    for (j = 0; j < n && r == RAD_SUCCESS; ++j)
+        for (i = 0; i + j < n && r == RAD_SUCCESS; ++i) {
+            int up;
+            for (up = 1; up >= 0 && r == RAD_SUCCESS; --up) {
+                uint32_t idx, a0, a1, a2;
+                float lb[3][2];
+                rad_patch *pt;
+                int k;
+                if (up) {
+                    idx = base + rad__sub_up(n, i, j);
+                    a0 = lattice_ids[rad__lattice(n, i, j)];
+                    a1 = lattice_ids[rad__lattice(n, i + 1, j)];
+                    a2 = lattice_ids[rad__lattice(n, i, j + 1)];
+                    lb[0][0] = (float)i; lb[0][1] = (float)j;
+                    lb[1][0] = (float)(i + 1); lb[1][1] = (float)j;
+                    lb[2][0] = (float)i; lb[2][1] = (float)(j + 1);
+                } else {
+                    if (i + j + 2 > n) continue;
+                    idx = base + rad__sub_down(n, i, j);
+                    a0 = lattice_ids[rad__lattice(n, i + 1, j)];
+                    a1 = lattice_ids[rad__lattice(n, i + 1, j + 1)];
+                    a2 = lattice_ids[rad__lattice(n, i, j + 1)];
+                    lb[0][0] = (float)(i + 1); lb[0][1] = (float)j;
+                    lb[1][0] = (float)(i + 1); lb[1][1] = (float)(j + 1);
+                    lb[2][0] = (float)i; lb[2][1] = (float)(j + 1);
+                }
+                pt = &P->patches[idx];
+                pt->vertices[0] = a0; pt->vertices[1] = a1; pt->vertices[2] = a2;
+                pt->triangle = t;
+                pt->area = sub_area;
+                memcpy(pt->normal, tn, 3 * sizeof(float));
+                memcpy(pt->emission, mat->emission, 3 * sizeof(float));
+                for (k = 0; k < 3; ++k)
+                    pt->centroid[k] = (P->vertices[3 * (size_t)a0 + (size_t)k] + P->vertices[3 * (size_t)a1 + (size_t)k] +
+                                       P->vertices[3 * (size_t)a2 + (size_t)k]) / 3.0f;
+                if (mat->texture && scene->albedo_lookup && scene->uvs) {
+                    for (k = 0; k < 3; ++k) { lb[k][0] /= (float)n; lb[k][1] /= (float)n; }
+                    r = rad__patch_albedo(scene, t, (const float(*)[2])lb, albedo_samples, c, pt->albedo);
+                } else {
+                    memcpy(pt->albedo, mat->albedo, 3 * sizeof(float));
+                }
+                P->areas[idx] = pt->area;
+                memcpy(P->albedo + 3 * (size_t)idx, pt->albedo, 3 * sizeof(float));
+            }
+        }
+    return r;
+}
+
 RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_options *options, const rad_context *ctx,
                                       rad_patches **out)
 {
@@ -4685,31 +4797,9 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
     P->first_patch = (uint32_t *)rad__alloc_array(&c.allocator, scene->triangle_count, sizeof(uint32_t));
     P->subdivision = (uint32_t *)rad__alloc_array(&c.allocator, scene->triangle_count, sizeof(uint32_t));
     if (!P->first_patch || !P->subdivision) { rad_patches_destroy(P); return RAD_ERROR_OUT_OF_MEMORY; }
-    for (t = 0; t < scene->triangle_count; ++t) {
-        const float *v = scene->positions + 9 * (size_t)t;
-        float e[3][3];
-        double n = 1.0, le = 0.0;
-        int k;
-        rad__sub(e[0], v + 3, v);
-        rad__sub(e[1], v + 6, v + 3);
-        rad__sub(e[2], v, v + 6);
-        for (k = 0; k < 3; ++k) { double l = rad__len(e[k]); if (l > le) le = l; }
-        if (max_edge > 0.0f) { double m = ceil(le / (double)max_edge); if (m > n) n = m; }
-        if (max_area > 0.0f) { double m = ceil(sqrt((double)scene->areas[t] / (double)max_area)); if (m > n) n = m; }
-        if (!(n < 65536.0)) {
-            rad__log(&c, RAD_LOG_ERROR, "triangle %u would be cut %g times per edge (more than 65535)", t, n);
-            rad_patches_destroy(P);
-            return RAD_ERROR_SIZE_OVERFLOW;
-        }
-        P->subdivision[t] = (uint32_t)n;
-        P->first_patch[t] = (uint32_t)total;
-        total += (uint64_t)n * (uint64_t)n;
-        lattice_total += ((uint64_t)n + 1u) * ((uint64_t)n + 2u) / 2u;
-        if (total >= (uint64_t)RAD_NONE || lattice_total >= (uint64_t)RAD_NONE) {
-            rad__log(&c, RAD_LOG_ERROR, "more than %u patches: reduce the subdivision", RAD_NONE - 1u);
-            rad_patches_destroy(P);
-            return RAD_ERROR_SIZE_OVERFLOW;
-        }
+    if ((r = rad__patches_plan(P, scene, max_area, max_edge, &c, &total, &lattice_total)) != RAD_SUCCESS) {
+        rad_patches_destroy(P);
+        return r;
     }
     P->count = (uint32_t)total;
     P->patches = (rad_patch *)rad__alloc_array(&c.allocator, P->count, sizeof(rad_patch));
@@ -4731,71 +4821,16 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
     /* weld distance: far below any patch size, far above float rounding of the positions */
     eps = scene->diagonal * 1e-6f;
     for (t = 0; t < scene->triangle_count && r == RAD_SUCCESS; ++t) {
-        const float *v = scene->positions + 9 * (size_t)t, *tn = scene->normals + 3 * (size_t)t;
-        const rad_material *mat = &scene->materials_table[scene->materials[t]];
-        uint32_t n = P->subdivision[t], i, j, base = P->first_patch[t];
+        uint32_t n = P->subdivision[t];
         size_t lcount = ((size_t)n + 1u) * ((size_t)n + 2u) / 2u;
-        float sub_area = scene->areas[t] / ((float)n * (float)n);
         if (lcount > lattice_cap) {
             rad__free(&c.allocator, lattice_ids);
             lattice_ids = (uint32_t *)rad__alloc_array(&c.allocator, lcount, sizeof(uint32_t));
             lattice_cap = lcount;
             if (!lattice_ids) { lattice_cap = 0; r = RAD_ERROR_OUT_OF_MEMORY; break; }
         }
-        for (j = 0; j <= n; ++j)
-            for (i = 0; i + j <= n; ++i) {
-                float p[3], a = (float)i / (float)n, b = (float)j / (float)n;
-                int k;
-                for (k = 0; k < 3; ++k) p[k] = v[k] + a * (v[3 + k] - v[k]) + b * (v[6 + k] - v[k]);
-                if (i == n) memcpy(p, v + 3, sizeof(p)); /* corners exactly */
-                if (j == n) memcpy(p, v + 6, sizeof(p));
-                lattice_ids[rad__lattice(n, i, j)] = rad__weld_vertex(&w, P->vertices, &nv, p, tn, eps, scene->bounds_min);
-            }
-        for (j = 0; j < n && r == RAD_SUCCESS; ++j)
-            for (i = 0; i + j < n && r == RAD_SUCCESS; ++i) {
-                int up;
-                for (up = 1; up >= 0 && r == RAD_SUCCESS; --up) {
-                    uint32_t idx, a0, a1, a2;
-                    float lb[3][2];
-                    rad_patch *pt;
-                    int k;
-                    if (up) {
-                        idx = base + rad__sub_up(n, i, j);
-                        a0 = lattice_ids[rad__lattice(n, i, j)];
-                        a1 = lattice_ids[rad__lattice(n, i + 1, j)];
-                        a2 = lattice_ids[rad__lattice(n, i, j + 1)];
-                        lb[0][0] = (float)i; lb[0][1] = (float)j;
-                        lb[1][0] = (float)(i + 1); lb[1][1] = (float)j;
-                        lb[2][0] = (float)i; lb[2][1] = (float)(j + 1);
-                    } else {
-                        if (i + j + 2 > n) continue;
-                        idx = base + rad__sub_down(n, i, j);
-                        a0 = lattice_ids[rad__lattice(n, i + 1, j)];
-                        a1 = lattice_ids[rad__lattice(n, i + 1, j + 1)];
-                        a2 = lattice_ids[rad__lattice(n, i, j + 1)];
-                        lb[0][0] = (float)(i + 1); lb[0][1] = (float)j;
-                        lb[1][0] = (float)(i + 1); lb[1][1] = (float)(j + 1);
-                        lb[2][0] = (float)i; lb[2][1] = (float)(j + 1);
-                    }
-                    pt = &P->patches[idx];
-                    pt->vertices[0] = a0; pt->vertices[1] = a1; pt->vertices[2] = a2;
-                    pt->triangle = t;
-                    pt->area = sub_area;
-                    memcpy(pt->normal, tn, 3 * sizeof(float));
-                    memcpy(pt->emission, mat->emission, 3 * sizeof(float));
-                    for (k = 0; k < 3; ++k)
-                        pt->centroid[k] = (P->vertices[3 * (size_t)a0 + (size_t)k] + P->vertices[3 * (size_t)a1 + (size_t)k] +
-                                           P->vertices[3 * (size_t)a2 + (size_t)k]) / 3.0f;
-                    if (mat->texture && scene->albedo_lookup && scene->uvs) {
-                        for (k = 0; k < 3; ++k) { lb[k][0] /= (float)n; lb[k][1] /= (float)n; }
-                        r = rad__patch_albedo(scene, t, (const float(*)[2])lb, o.albedo_samples, &c, pt->albedo);
-                    } else {
-                        memcpy(pt->albedo, mat->albedo, 3 * sizeof(float));
-                    }
-                    P->areas[idx] = pt->area;
-                    memcpy(P->albedo + 3 * (size_t)idx, pt->albedo, 3 * sizeof(float));
-                }
-            }
+        rad__patches_lattice(P, scene, t, n, &w, &nv, eps, lattice_ids);
+        r = rad__patches_fill(P, scene, t, n, lattice_ids, o.albedo_samples, &c);
     }
     P->vertex_count = nv;
 done:
