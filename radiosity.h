@@ -20339,9 +20339,11 @@ static rad_result rad__bake_section(const rad__ctx *c, const rad_container *ct, 
     return RAD_SUCCESS;
 }
 
-static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
+/* Loading a bake, stage 1: the patches, their vertices and triangles, every index and value checked;
+   the areas and albedo copied out of the records. */
+static rad_result rad__bake_patches(rad_bake *b, const rad__ctx *c)
 {
-    const rad_section *sp, *sv, *st, *sd, *so, *sc, *sx, *se, *sb;
+    const rad_section *sp, *sv, *st;
     rad_result r;
     uint32_t N, i, k;
     uint64_t T;
@@ -20401,7 +20403,15 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
         b->patches.areas[i] = p->area;
         memcpy(b->patches.albedo + 3 * (size_t)i, p->albedo, 3 * sizeof(float));
     }
-    /* form factors: dense, or the three CSR sections, or none */
+    return RAD_SUCCESS;
+}
+
+/* Stage 2: the form factors, dense or the three CSR sections (checked row by row), or none. */
+static rad_result rad__bake_matrix(rad_bake *b, const rad__ctx *c)
+{
+    const rad_section *sd, *so, *sc, *sx;
+    rad_result r;
+    uint32_t N = b->patches.count, i;
     if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_DENSE, NULL, 4, 0, &sd)) != RAD_SUCCESS) return r;
     if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_ROW_OFFSETS, NULL, 8, 0, &so)) != RAD_SUCCESS) return r;
     if ((r = rad__bake_section(c, b->container, RAD_SECTION_FF_COLUMNS, NULL, 4, 0, &sc)) != RAD_SUCCESS) return r;
@@ -20455,6 +20465,15 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
         b->F.columns = col;
         b->F.values = (const float *)sx->data;
     }
+    return RAD_SUCCESS;
+}
+
+/* Stage 3: every RGB vector checked (E and B kept), and the signature. */
+static rad_result rad__bake_vectors(rad_bake *b, const rad__ctx *c)
+{
+    const rad_section *se, *sb;
+    rad_result r;
+    uint32_t N = b->patches.count, k;
     /* every vector, not only E and B: the application's ("H", "L", ...) are read in place too */
     for (k = 0; k < rad_container_section_count(b->container); ++k) {
         const rad_section *s = rad_container_section(b->container, k);
@@ -20480,6 +20499,14 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
     }
     b->signature = se ? (const rad_bake_signature *)se->data : NULL;
     return RAD_SUCCESS;
+}
+
+static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
+{
+    rad_result r;
+    if ((r = rad__bake_patches(b, c)) != RAD_SUCCESS) return r;
+    if ((r = rad__bake_matrix(b, c)) != RAD_SUCCESS) return r;
+    return rad__bake_vectors(b, c);
 }
 
 static rad_result rad__load(const void *data, size_t size, void *owned, const rad__ctx *c, const rad_context *ctx,
