@@ -12277,11 +12277,16 @@ static rad_result rad__mb_section(const rad__ctx *c, const rad_container *ct, ui
     return RAD_SUCCESS;
 }
 
-static rad_result rad__mb_load_info(const rad__ctx *c, const rad_container *ct, const char *name, uint32_t *info)
+/* The loaders' start: the context set up in *c, the container checked, the info record read
+   and checked into info. */
+static rad_result rad__mb_load_info(rad__ctx *c, const rad_context *ctx, const rad_container *ct, const char *name,
+                                    uint32_t *info)
 {
     const void *p;
-    rad_result r = rad__mb_section(c, ct, RAD_SECTION_MB_INFO, name, sizeof(uint32_t), 16, &p);
-    if (r != RAD_SUCCESS) return r;
+    rad_result r;
+    rad__ctx_init(c, ctx);
+    if (!ct) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__mb_section(c, ct, RAD_SECTION_MB_INFO, name, sizeof(uint32_t), 16, &p)) != RAD_SUCCESS) return r;
     memcpy(info, p, 16 * sizeof(uint32_t));
     if (info[0] != 1u) {
         rad__log(c, RAD_LOG_ERROR, "multibounce '%s': info version %u (expected 1)", name ? name : "", info[0]);
@@ -12353,12 +12358,9 @@ RAD_API rad_result rad_multibounce_load(const rad_container *ct, const char *nam
     const void *data;
     uint64_t total;
     rad_result r;
-    rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
-    if (!ct) return RAD_ERROR_INVALID_ARGUMENT;
-    r = rad__mb_load_info(&c, ct, name, info);
-    if (r != RAD_SUCCESS) return r;
+    if ((r = rad__mb_load_info(&c, ctx, ct, name, info)) != RAD_SUCCESS) return r;
     if (info[1] > 1u || (info[6] & 2u)) {
         rad__log(&c, RAD_LOG_ERROR, "multibounce '%s': kind %u is not a dense matrix", name ? name : "", info[1]);
         return RAD_ERROR_CORRUPT;
@@ -12400,12 +12402,9 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *ct, const ch
     const void *p;
     uint64_t nblocks, i;
     rad_result r;
-    rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
-    if (!ct) return RAD_ERROR_INVALID_ARGUMENT;
-    r = rad__mb_load_info(&c, ct, name, info);
-    if (r != RAD_SUCCESS) return r;
+    if ((r = rad__mb_load_info(&c, ctx, ct, name, info)) != RAD_SUCCESS) return r;
     n = info[2];
     bpr = (uint32_t)(((uint64_t)n + 3u) / 4u);
     tpr = info[4] ? (uint32_t)(((uint64_t)n + info[4] - 1u) / info[4]) : 1u;
