@@ -143,7 +143,9 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         if (!force_unwrap && w->scene->lightmap_uvs)
             fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
         out->uvs = (float *)tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
-        if (tool_unwrap(w->scene, (uint32_t)width, (uint32_t)height, out->uvs, NULL)) goto fail;
+        if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, (uint32_t)width, (uint32_t)height,
+                        out->uvs, NULL))
+            goto fail;
         memset(&mesh, 0, sizeof mesh);
         mesh.name = "unwrapped";
         mesh.positions = w->scene->positions;

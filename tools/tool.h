@@ -518,7 +518,10 @@ int tool_bake_parse(const char *cmd, int argc, char **argv, tool_bake_args *args
 int tool_cmd_lightmap(int argc, char **argv);
 /* A simple automatic lightmap unwrap (unwrap.c: charts of connected triangles within 30
    degrees, planar projection, shelf packing with 2-texel gutters): 6 floats per scene triangle
-   into out_uvs, the chart count into out_charts (may be NULL). 0, or 1 with a message printed. */
+   into out_uvs, the chart count into out_charts (may be NULL). 0, or 1 with a message printed
+   as "rad CMD: ..." that names size_option when the atlas is too small. */
+int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t width, uint32_t height,
+                float *out_uvs, uint32_t *out_charts);
 /* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
 typedef struct tool_lightmap_baked {
     tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
@@ -539,6 +542,5 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
                            uint32_t hemisphere_rays, int sh, int force_unwrap,
                            int direct, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
-int tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts);
 
 #endif

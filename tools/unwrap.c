@@ -80,7 +80,8 @@ static int uw_pack(uw_chart *c, uint32_t n, double s, uint32_t W, uint32_t H)
     return 1;
 }
 
-int tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *out_uvs, uint32_t *out_charts)
+int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t width, uint32_t height,
+                float *out_uvs, uint32_t *out_charts)
 {
     uint32_t T = scene->triangle_count, t, i, nch = 0, *chart = NULL, *queue = NULL, *first = NULL, *adj = NULL;
     uint32_t *deg = NULL;
@@ -176,8 +177,8 @@ int tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *
     hi = area > 0.0 ? sqrt((double)width * height / area) : 1.0;
     lo = 0.0;
     if (!uw_pack(charts, nch, 0.0, width, height)) {
-        fprintf(stderr, "rad lightmap: %u charts do not fit a %ux%u atlas even as single texels: use a larger --size\n", nch,
-                width, height);
+        fprintf(stderr, "rad %s: %u charts do not fit a %ux%u atlas even as single texels: use a larger %s\n", cmd, nch,
+                width, height, size_option);
         goto done;
     }
     for (it = 0; it < 40; ++it) {
@@ -205,7 +206,7 @@ int tool_unwrap(const rad_scene *scene, uint32_t width, uint32_t height, float *
         }
     }
     if (out_charts) *out_charts = nch;
-    fprintf(stderr, "rad lightmap: unwrapped %u triangles into %u charts, %.1f texels per unit\n", T, nch, s);
+    fprintf(stderr, "rad %s: unwrapped %u triangles into %u charts, %.1f texels per unit\n", cmd, T, nch, s);
     ok = 1;
 done:
     free(edges);
