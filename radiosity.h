@@ -10314,21 +10314,28 @@ RAD_API float rad_half_to_float(uint16_t value)
 
 /* ---- dot products ---- */
 
+/* The AVX body of both dots: four independent sums over 32 entries a step, added in one fixed
+   order, so the bits depend on n only. LOAD8(p) reads eight entries of a as floats. */
+#define RAD__DOT_AVX(LOAD8)                                                                       \
+    {                                                                                             \
+        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps(); \
+        for (; j + 32 <= n; j += 32) {                                                            \
+            s0 = _mm256_add_ps(s0, _mm256_mul_ps(LOAD8(a + j), _mm256_loadu_ps(x + j)));           \
+            s1 = _mm256_add_ps(s1, _mm256_mul_ps(LOAD8(a + j + 8), _mm256_loadu_ps(x + j + 8)));   \
+            s2 = _mm256_add_ps(s2, _mm256_mul_ps(LOAD8(a + j + 16), _mm256_loadu_ps(x + j + 16))); \
+            s3 = _mm256_add_ps(s3, _mm256_mul_ps(LOAD8(a + j + 24), _mm256_loadu_ps(x + j + 24))); \
+        }                                                                                         \
+        s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));              \
+    }
+#define RAD__LOAD8_F32(p) _mm256_loadu_ps(p)
+#define RAD__LOAD8_F16(p) _mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(p)))
+
 static float rad__dot_f32(const float *a, const float *x, uint32_t n)
 {
     uint32_t j = 0;
     float s = 0.0f;
 #if defined(RAD__AVX)
-    {
-        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        for (; j + 32 <= n; j += 32) {
-            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_loadu_ps(a + j), _mm256_loadu_ps(x + j)));
-            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_loadu_ps(a + j + 8), _mm256_loadu_ps(x + j + 8)));
-            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_loadu_ps(a + j + 16), _mm256_loadu_ps(x + j + 16)));
-            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_loadu_ps(a + j + 24), _mm256_loadu_ps(x + j + 24)));
-        }
-        s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-    }
+    RAD__DOT_AVX(RAD__LOAD8_F32)
 #endif
     for (; j < n; ++j) s += a[j] * x[j];
     return s;
@@ -10339,16 +10346,7 @@ static float rad__dot_f16(const uint16_t *a, const float *x, uint32_t n)
     uint32_t j = 0;
     float s = 0.0f;
 #if defined(RAD__MB_F16C)
-    {
-        __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(), s3 = _mm256_setzero_ps();
-        for (; j + 32 <= n; j += 32) {
-            s0 = _mm256_add_ps(s0, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j))), _mm256_loadu_ps(x + j)));
-            s1 = _mm256_add_ps(s1, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 8))), _mm256_loadu_ps(x + j + 8)));
-            s2 = _mm256_add_ps(s2, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 16))), _mm256_loadu_ps(x + j + 16)));
-            s3 = _mm256_add_ps(s3, _mm256_mul_ps(_mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(a + j + 24))), _mm256_loadu_ps(x + j + 24)));
-        }
-        s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));
-    }
+    RAD__DOT_AVX(RAD__LOAD8_F16)
 #endif
     for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
     return s;
@@ -11553,6 +11551,15 @@ static rad_result rad__mb_encode_row(void *data, uint32_t by, uint32_t task)
     return RAD_SUCCESS;
 }
 
+/* the float bits of the largest channel magnitude of entry 'at' of the planes W (nn each) */
+static uint32_t rad__mb_max_bits(const float *W, size_t nn, size_t at)
+{
+    float m = fabsf(W[at]);
+    if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
+    if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
+    return rad__f32_bits(m);
+}
+
 /* threshold bits T and how many entries equal to T to take so that 'target' entries of the
    largest magnitude are chosen (radix select on the float bits; magnitudes are >= 0) */
 static rad_result rad__mb_select(const rad__ctx *c, const float *W, size_t nn, uint64_t target, uint32_t *T, uint64_t *take_equal)
@@ -11562,20 +11569,11 @@ static rad_result rad__mb_select(const rad__ctx *c, const float *W, size_t nn, u
     uint32_t hb, lb;
     if (!hist) return RAD_ERROR_OUT_OF_MEMORY;
     memset(hist, 0, 65536u * sizeof(uint64_t));
-    for (i = 0; i < nn; ++i) {
-        float m = fabsf(W[i]);
-        if (fabsf(W[nn + i]) > m) m = fabsf(W[nn + i]);
-        if (fabsf(W[2 * nn + i]) > m) m = fabsf(W[2 * nn + i]);
-        hist[rad__f32_bits(m) >> 16]++;
-    }
+    for (i = 0; i < nn; ++i) hist[rad__mb_max_bits(W, nn, i) >> 16]++;
     for (hb = 65535u; hb > 0 && above + hist[hb] < target; --hb) above += hist[hb];
     memset(hist, 0, 65536u * sizeof(uint64_t));
     for (i = 0; i < nn; ++i) {
-        float m = fabsf(W[i]);
-        uint32_t u;
-        if (fabsf(W[nn + i]) > m) m = fabsf(W[nn + i]);
-        if (fabsf(W[2 * nn + i]) > m) m = fabsf(W[2 * nn + i]);
-        u = rad__f32_bits(m);
+        uint32_t u = rad__mb_max_bits(W, nn, i);
         if (u >> 16 == hb) hist[u & 0xFFFFu]++;
     }
     for (lb = 65535u; lb > 0 && above + hist[lb] < target; --lb) above += hist[lb];
@@ -11591,14 +11589,145 @@ static rad_result rad__mb_select(const rad__ctx *c, const float *W, size_t nn, u
    (*taken counts them; both passes scan in row-major order, so they take the same entries). */
 static int rad__mb_is_outlier(const float *W, size_t nn, size_t at, uint32_t T, uint64_t take_equal, uint64_t *taken)
 {
-    float m = fabsf(W[at]);
-    uint32_t u;
-    if (fabsf(W[nn + at]) > m) m = fabsf(W[nn + at]);
-    if (fabsf(W[2 * nn + at]) > m) m = fabsf(W[2 * nn + at]);
-    u = rad__f32_bits(m);
+    uint32_t u = rad__mb_max_bits(W, nn, at);
     if (u < T || (u == T && *taken >= take_equal)) return 0;
     if (u == T) ++*taken;
     return 1;
+}
+
+/* The outlier choice of rad_multibounce_blocks_create: T and take_equal pick the 'target'
+   entries of the largest magnitude (none when target is 0); row_count[i + 1] - row_count[i]
+   of them lie in row i. */
+typedef struct rad__mb_outliers {
+    uint64_t target, take_equal, *row_count;
+    uint32_t T;
+} rad__mb_outliers;
+
+static rad_result rad__mb_options_check(const rad__ctx *c, const rad_block_options *o)
+{
+    if ((o->format != RAD_BLOCK_BC1 && o->format != RAD_BLOCK_BC4X3) || !(o->outlier_fraction >= 0.0f && o->outlier_fraction < 1.0f) ||
+        (o->tile % 4u) != 0 || o->reorder < RAD_REORDER_NONE || o->reorder > RAD_REORDER_MATCH) {
+        rad__log(c, RAD_LOG_ERROR, "blocks: bad options (format %d, outlier fraction %g, tile %u: a multiple of 4, reorder %d: 0..4)",
+                 (int)o->format, (double)o->outlier_fraction, o->tile, o->reorder);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return RAD_SUCCESS;
+}
+
+/* stage 1a: the threshold, and the outliers of each row counted in the order they are taken */
+static rad_result rad__mb_outliers_count(const rad__ctx *c, const float *W, uint32_t n, float fraction, rad__mb_outliers *ol)
+{
+    size_t nn = (size_t)n * n;
+    uint64_t taken = 0;
+    uint32_t i, j;
+    if (fraction > 0.0f) {
+        ol->target = (uint64_t)((double)fraction * (double)nn);
+        if (ol->target > 0) {
+            rad_result r = rad__mb_select(c, W, nn, ol->target, &ol->T, &ol->take_equal);
+            if (r != RAD_SUCCESS) return r;
+        }
+    }
+    ol->row_count[0] = 0;
+    for (i = 0; i < n; ++i) {
+        uint64_t k = 0;
+        if (ol->target > 0)
+            for (j = 0; j < n; ++j) k += (uint64_t)rad__mb_is_outlier(W, nn, (size_t)i * n + j, ol->T, ol->take_equal, &taken);
+        ol->row_count[i + 1] = ol->row_count[i] + k;
+    }
+    return RAD_SUCCESS;
+}
+
+/* the byte counts of the seven parts: blocks, scales, row and column permutations, outlier
+   offsets, columns and values */
+static rad_result rad__mb_blocks_sizes(uint32_t n, uint32_t bpr, uint32_t tpr, uint32_t planes, int reorder, uint64_t count, size_t bytes[7])
+{
+    size_t nblocks;
+    if (!rad__mul((size_t)bpr, (size_t)bpr, &nblocks) || !rad__mul3(nblocks, planes, 8, &bytes[0]) ||
+        !rad__mul3((size_t)tpr * tpr, 3, sizeof(float), &bytes[1]))
+        return RAD_ERROR_SIZE_OVERFLOW;
+    bytes[2] = bytes[3] = reorder ? (size_t)n * sizeof(uint32_t) : 0;
+    bytes[4] = count ? ((size_t)n + 1u) * sizeof(uint64_t) : 0;
+    if (!rad__mul((size_t)count, sizeof(uint32_t), &bytes[5]) || !rad__mul3((size_t)count, 3, sizeof(float), &bytes[6]))
+        return RAD_ERROR_SIZE_OVERFLOW;
+    return RAD_SUCCESS;
+}
+
+/* stage 1b: moves the outliers out of W into b's sparse rows, in the order they were counted */
+static void rad__mb_outliers_extract(rad_multibounce_blocks *b, float *W, const rad__mb_outliers *ol)
+{
+    uint32_t n = b->n, i, j, ch;
+    size_t nn = (size_t)n * n;
+    uint64_t *off = (uint64_t *)b->outlier_offsets, k = 0, taken = 0;
+    uint32_t *cols = (uint32_t *)b->outlier_columns;
+    float *vals = (float *)b->outlier_values;
+    memcpy(off, ol->row_count, ((size_t)n + 1u) * sizeof(uint64_t));
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            size_t at = (size_t)i * n + j;
+            if (rad__mb_is_outlier(W, nn, at, ol->T, ol->take_equal, &taken)) {
+                cols[k] = j;
+                for (ch = 0; ch < 3; ++ch) { vals[3 * k + ch] = W[ch * nn + at]; W[ch * nn + at] = 0.0f; }
+                ++k;
+            }
+        }
+}
+
+/* stage 2: the greedy row and column orders, and W in them (*Wp, allocated) */
+static rad_result rad__mb_reorder_planes(const rad__ctx *c, rad_multibounce_blocks *b, const float *W, const rad_block_options *o,
+                                         size_t total, float **Wp)
+{
+    uint32_t n = b->n, i, j, ch;
+    size_t nn = (size_t)n * n;
+    rad_result r = rad__mb_reorder_perms(c, W, n, o->reorder_samples, o->reorder, (uint32_t *)b->row_perm, (uint32_t *)b->col_perm);
+    if (r != RAD_SUCCESS) return r;
+    *Wp = (float *)rad__alloc(&c->allocator, total);
+    if (!*Wp) return RAD_ERROR_OUT_OF_MEMORY;
+    for (ch = 0; ch < 3; ++ch)
+        for (i = 0; i < n; ++i) {
+            const float *from = W + ch * nn + (size_t)b->row_perm[i] * n;
+            float *to = *Wp + ch * nn + (size_t)i * n;
+            for (j = 0; j < n; ++j) to[j] = from[b->col_perm[j]];
+        }
+    return RAD_SUCCESS;
+}
+
+/* stage 3: the scales, the largest value of each channel in each tile of P */
+static void rad__mb_tile_scales(rad_multibounce_blocks *b, const float *P, size_t scale_bytes)
+{
+    float *s = (float *)b->scales;
+    uint32_t n = b->n, tile = b->tile, tpr = b->tiles_per_row, i, j, ch;
+    size_t nn = (size_t)n * n;
+    memset(s, 0, scale_bytes);
+    for (ch = 0; ch < 3; ++ch)
+        for (i = 0; i < n; ++i)
+            for (j = 0; j < n; ++j) {
+                float v = P[ch * nn + (size_t)i * n + j];
+                size_t t = tile ? (size_t)(i / tile) * tpr + j / tile : 0;
+                if (v > s[3 * t + ch]) s[3 * t + ch] = v;
+            }
+}
+
+/* the sizes and errors of a finished encoding; src holds the uncompressed planes */
+static void rad__mb_blocks_report(const rad_multibounce_blocks *b, const float *src, const size_t bytes[7], const double *sse,
+                                  const float *max_err, rad_block_report *report)
+{
+    uint32_t n = b->n, bpr = b->blocks_per_row, i;
+    size_t nn = (size_t)n * n, q;
+    double s = 0.0, ms = 0.0;
+    float me = 0.0f;
+    for (i = 0; i < bpr; ++i) { s += sse[i]; if (max_err[i] > me) me = max_err[i]; }
+    for (q = 0; q < 3 * nn; ++q) ms += (double)src[q] * src[q];
+    report->tiles = b->tiles_per_row * b->tiles_per_row;
+    report->bytes_float_f = nn * sizeof(float);
+    report->bytes_float_mb = 3 * nn * sizeof(float);
+    report->bytes_blocks = bytes[0];
+    report->bytes_scales = bytes[1];
+    report->bytes_permutations = bytes[2] + bytes[3];
+    report->bytes_outliers = bytes[4] + bytes[5] + bytes[6];
+    report->bytes_total = bytes[0] + bytes[1] + bytes[2] + bytes[3] + bytes[4] + bytes[5] + bytes[6];
+    report->mse = s / (3.0 * (double)nn);
+    report->max_abs_error = me;
+    report->source_mean_square = ms / (3.0 * (double)nn);
 }
 
 RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, const rad_block_options *options,
@@ -11611,10 +11740,11 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     float *owned = NULL, *W = NULL, *Wp = NULL, *max_err = NULL;
     double *sse = NULL;
     const float *src;
-    uint32_t n, bpr, tpr, planes, i, j, ch, T = 0;
-    uint64_t target = 0, take_equal = 0, taken = 0, count = 0, *row_count = NULL;
-    size_t nn, nblocks, total, bytes[7];
+    uint32_t n, bpr, tpr;
+    uint64_t count;
+    size_t total, bytes[7];
     void *parts[7];
+    rad__mb_outliers ol;
     rad__mb_encode enc;
     rad_result r;
     rad__ctx_init(&c, ctx);
@@ -11623,55 +11753,30 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     if (report) memset(report, 0, sizeof(*report));
     if (rad__mb_check(mb) != RAD_SUCCESS || mb->row_perm) return RAD_ERROR_INVALID_ARGUMENT;
     if (options) o = *options; else rad_block_options_default(&o);
-    if ((o.format != RAD_BLOCK_BC1 && o.format != RAD_BLOCK_BC4X3) || !(o.outlier_fraction >= 0.0f && o.outlier_fraction < 1.0f) ||
-        (o.tile % 4u) != 0 || o.reorder < RAD_REORDER_NONE || o.reorder > RAD_REORDER_MATCH) {
-        rad__log(&c, RAD_LOG_ERROR, "blocks: bad options (format %d, outlier fraction %g, tile %u: a multiple of 4, reorder %d: 0..4)",
-                 (int)o.format, (double)o.outlier_fraction, o.tile, o.reorder);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
+    r = rad__mb_options_check(&c, &o);
+    if (r != RAD_SUCCESS) return r;
     n = mb->n;
-    nn = (size_t)n * n;
     bpr = (n + 3u) / 4u;
     tpr = o.tile ? (n + o.tile - 1u) / o.tile : 1u;
-    planes = o.format == RAD_BLOCK_BC1 ? 1u : 3u;
-    if (!rad__mul((size_t)bpr, (size_t)bpr, &nblocks) || !rad__mul3(nblocks, planes, 8, &bytes[0]) ||
-        !rad__mul3(nn, 3, sizeof(float), &total))
+    if (rad__mb_blocks_sizes(n, bpr, tpr, o.format == RAD_BLOCK_BC1 ? 1u : 3u, 0, 0, bytes) != RAD_SUCCESS ||
+        !rad__mul3((size_t)n * n, 3, sizeof(float), &total))
         return RAD_ERROR_SIZE_OVERFLOW;
+    memset(&ol, 0, sizeof(ol));
     src = rad__mb_float_planes(&c, mb, &owned);
     W = (float *)rad__alloc(&c.allocator, total);
-    row_count = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)n + 1u, sizeof(uint64_t));
+    ol.row_count = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)n + 1u, sizeof(uint64_t));
     sse = (double *)rad__alloc_array(&c.allocator, bpr, sizeof(double));
     max_err = (float *)rad__alloc_array(&c.allocator, bpr, sizeof(float));
     b = (rad_multibounce_blocks *)rad__alloc(&c.allocator, sizeof(*b));
     if (b) { memset(b, 0, sizeof(*b)); b->allocator = c.allocator; } /* before the fail path destroys it */
-    if (!src || !W || !row_count || !sse || !max_err || !b) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    if (!src || !W || !ol.row_count || !sse || !max_err || !b) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
     memcpy(W, src, total);
 
-    /* 1. outliers: count per row in the order they will be taken */
-    if (o.outlier_fraction > 0.0f) {
-        target = (uint64_t)((double)o.outlier_fraction * (double)nn);
-        if (target > 0) {
-            r = rad__mb_select(&c, W, nn, target, &T, &take_equal);
-            if (r != RAD_SUCCESS) goto done;
-        }
-    }
-    row_count[0] = 0;
-    for (i = 0; i < n; ++i) {
-        uint64_t k = 0;
-        if (target > 0)
-            for (j = 0; j < n; ++j) k += (uint64_t)rad__mb_is_outlier(W, nn, (size_t)i * n + j, T, take_equal, &taken);
-        row_count[i + 1] = row_count[i] + k;
-    }
-    count = row_count[n];
-
-    /* storage: blocks, scales, permutations, outliers */
-    if (!rad__mul3((size_t)tpr * tpr, 3, sizeof(float), &bytes[1])) { r = RAD_ERROR_SIZE_OVERFLOW; goto done; }
-    bytes[2] = bytes[3] = o.reorder ? (size_t)n * sizeof(uint32_t) : 0;
-    bytes[4] = count ? ((size_t)n + 1u) * sizeof(uint64_t) : 0;
-    if (!rad__mul((size_t)count, sizeof(uint32_t), &bytes[5]) || !rad__mul3((size_t)count, 3, sizeof(float), &bytes[6])) {
-        r = RAD_ERROR_SIZE_OVERFLOW;
-        goto done;
-    }
+    r = rad__mb_outliers_count(&c, W, n, o.outlier_fraction, &ol);
+    if (r != RAD_SUCCESS) goto done;
+    count = ol.row_count[n];
+    r = rad__mb_blocks_sizes(n, bpr, tpr, o.format == RAD_BLOCK_BC1 ? 1u : 3u, o.reorder, count, bytes);
+    if (r != RAD_SUCCESS) goto done;
     b->storage = rad__mb_carve(&c, bytes, 7, parts, &r);
     if (!b->storage) goto done;
     b->n = n;
@@ -11688,56 +11793,14 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     b->outlier_offsets = (const uint64_t *)parts[4];
     b->outlier_columns = (const uint32_t *)parts[5];
     b->outlier_values = (const float *)parts[6];
-    if (count) {
-        uint64_t *off = (uint64_t *)b->outlier_offsets, k = 0;
-        uint32_t *cols = (uint32_t *)b->outlier_columns;
-        float *vals = (float *)b->outlier_values;
-        memcpy(off, row_count, ((size_t)n + 1u) * sizeof(uint64_t));
-        taken = 0;
-        for (i = 0; i < n; ++i)
-            for (j = 0; j < n; ++j) {
-                size_t at = (size_t)i * n + j;
-                if (rad__mb_is_outlier(W, nn, at, T, take_equal, &taken)) {
-                    cols[k] = j;
-                    for (ch = 0; ch < 3; ++ch) { vals[3 * k + ch] = W[ch * nn + at]; W[ch * nn + at] = 0.0f; }
-                    ++k;
-                }
-            }
-    }
-    if (report) {
-        report->outlier_count = count;
-        { float th; memcpy(&th, &T, sizeof(th)); report->outlier_threshold = count ? th : 0.0f; }
-    }
-
-    /* 2. greedy reordering */
+    if (count) rad__mb_outliers_extract(b, W, &ol);
     if (o.reorder) {
-        r = rad__mb_reorder_perms(&c, W, n, o.reorder_samples, o.reorder, (uint32_t *)b->row_perm, (uint32_t *)b->col_perm);
+        r = rad__mb_reorder_planes(&c, b, W, &o, total, &Wp);
         if (r != RAD_SUCCESS) goto done;
-        Wp = (float *)rad__alloc(&c.allocator, total);
-        if (!Wp) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-        for (ch = 0; ch < 3; ++ch)
-            for (i = 0; i < n; ++i) {
-                const float *from = W + ch * nn + (size_t)b->row_perm[i] * n;
-                float *to = Wp + ch * nn + (size_t)i * n;
-                for (j = 0; j < n; ++j) to[j] = from[b->col_perm[j]];
-            }
     }
+    rad__mb_tile_scales(b, Wp ? Wp : W, bytes[1]);
 
-    /* 3. scales: the largest value of each channel in each tile */
-    {
-        float *s = (float *)b->scales;
-        const float *P = Wp ? Wp : W;
-        memset(s, 0, bytes[1]);
-        for (ch = 0; ch < 3; ++ch)
-            for (i = 0; i < n; ++i)
-                for (j = 0; j < n; ++j) {
-                    float v = P[ch * nn + (size_t)i * n + j];
-                    size_t t = o.tile ? (size_t)(i / o.tile) * tpr + j / o.tile : 0;
-                    if (v > s[3 * t + ch]) s[3 * t + ch] = v;
-                }
-    }
-
-    /* 4. block encoding, parallel over block rows, with the error of each */
+    /* stage 4: block encoding, parallel over block rows, with the error of each */
     enc.b = b;
     enc.Wp = Wp ? Wp : W;
     enc.sse = sse;
@@ -11747,23 +11810,12 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     rad__mb_info(b->info, o.format == RAD_BLOCK_BC1 ? 2u : 3u, n, mb->bounces, o.tile, tpr,
                  (o.reorder ? 1u : 0u) | (count ? 2u : 0u));
     if (report) {
-        double s = 0.0, ms = 0.0;
-        float me = 0.0f;
-        size_t q;
-        for (i = 0; i < bpr; ++i) { s += sse[i]; if (max_err[i] > me) me = max_err[i]; }
-        for (q = 0; q < 3 * nn; ++q) ms += (double)src[q] * src[q];
+        float th;
+        memcpy(&th, &ol.T, sizeof(th));
+        rad__mb_blocks_report(b, src, bytes, sse, max_err, report);
         report->reordered = o.reorder != 0;
-        report->tiles = tpr * tpr;
-        report->bytes_float_f = nn * sizeof(float);
-        report->bytes_float_mb = total;
-        report->bytes_blocks = bytes[0];
-        report->bytes_scales = bytes[1];
-        report->bytes_permutations = bytes[2] + bytes[3];
-        report->bytes_outliers = bytes[4] + bytes[5] + bytes[6];
-        report->bytes_total = bytes[0] + bytes[1] + bytes[2] + bytes[3] + bytes[4] + bytes[5] + bytes[6];
-        report->mse = s / (3.0 * (double)nn);
-        report->max_abs_error = me;
-        report->source_mean_square = ms / (3.0 * (double)nn);
+        report->outlier_count = count;
+        report->outlier_threshold = count ? th : 0.0f;
     }
     *out = b;
     b = NULL;
@@ -11772,7 +11824,7 @@ done:
     rad__free(&c.allocator, owned);
     rad__free(&c.allocator, W);
     rad__free(&c.allocator, Wp);
-    rad__free(&c.allocator, row_count);
+    rad__free(&c.allocator, ol.row_count);
     rad__free(&c.allocator, sse);
     rad__free(&c.allocator, max_err);
     rad_multibounce_blocks_destroy(b);
@@ -13098,70 +13150,69 @@ static uint32_t rad__local_free_slot(const rad_local *L)
     return RAD_NONE;
 }
 
-RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context *ctx)
+/* The stages of rad_local_add, in the order it runs them. */
+
+/* checks the patch; a hidden member only becomes visible again (*done = 1): its transport is
+   all there */
+static rad_result rad__local_add_check(const rad__ctx *c, rad_local *L, uint32_t patch, int *done)
 {
-    rad__ctx c;
-    rad__local_storage *st;
-    rad__local_scratch *s;
-    rad__local_job J;
-    uint32_t k, count = 0, p, ch, i, end, M, evicted = RAD_NONE;
-    double ann[3], coef_col[3], coef_row[3], tnn[3], an, rho_n[3];
-    size_t MM;
-    rad_result r;
-    rad__ctx_init(&c, ctx);
-    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
+    rad__local_storage *st = (rad__local_storage *)L->storage;
+    uint32_t k;
+    *done = 0;
     if (patch >= L->n) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_local_add: patch %u >= n = %u", patch, L->n);
+        rad__log(c, RAD_LOG_ERROR, "rad_local_add: patch %u >= n = %u", patch, L->n);
         return RAD_ERROR_INDEX_OUT_OF_RANGE;
     }
-    st = (rad__local_storage *)L->storage;
     k = L->patch_slot[patch];
     if (k != RAD_NONE && st->slot_hidden[k]) {
-        /* a hidden member: its transport is all there, it only becomes visible again */
         st->slot_hidden[k] = 0;
         L->hidden--;
         L->count++;
+        *done = 1;
         return RAD_SUCCESS;
     }
     if (k != RAD_NONE || L->count >= L->capacity) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_local_add: patch %u %s", patch,
+        rad__log(c, RAD_LOG_ERROR, "rad_local_add: patch %u %s", patch,
                  k != RAD_NONE ? "is already in the set" : "does not fit: the set is full of visible members");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    s = &st->s;
-    M = L->capacity;
-    MM = (size_t)M * M;
-    r = rad__local_fetch(&c, L, patch, &count);
-    if (r != RAD_SUCCESS) return r;
-    J.ev = RAD_NONE;
-    if (L->count + L->hidden >= L->capacity) {
-        /* full: evict the member hidden longest ago. The exact downdate is fused with this
-           add (one rank-2 pass instead of two rank-1 passes): with c = T[:, e], r = T[e, :],
-           g = 1 + T_ee, the add's vectors over the downdated T are u = a + T a - c (r.a) / g
-           and v = b + b T - (b.c) r / g, and T += -c r / g + u v / s. The drop (RAD_LOCAL_EVICT_DROP) is
-           cheap and done first. */
-        uint32_t oldest = RAD_NONE;
-        for (i = 0; i < L->slot_end; ++i)
-            if (st->slot_hidden[i] && (oldest == RAD_NONE || st->hide_order[i] < st->hide_order[oldest])) oldest = i;
-        if (L->evict == RAD_LOCAL_EVICT_DROP) {
-            r = rad_local_evict(L, st->slot_patch[oldest], ctx);
-            if (r != RAD_SUCCESS) return r;
-        } else {
-            J.ev = oldest;
-            evicted = st->slot_patch[oldest];
-            st->patch_slot[evicted] = RAD_NONE; /* its column is no longer part of the new row */
-        }
-    }
-    k = J.ev != RAD_NONE ? J.ev : rad__local_free_slot(L);
-    end = k + 1 > L->slot_end ? k + 1 : L->slot_end;
+    return RAD_SUCCESS;
+}
+
+/* a full set evicts the member hidden longest ago. The exact downdate is fused with this add
+   (one rank-2 pass instead of two rank-1 passes): with c = T[:, e], r = T[e, :], g = 1 + T_ee,
+   the add's vectors over the downdated T are u = a + T a - c (r.a) / g and
+   v = b + b T - (b.c) r / g, and T += -c r / g + u v / s. That slot goes to *ev and its patch
+   to *evicted. The drop (RAD_LOCAL_EVICT_DROP) is cheap and done here, leaving both RAD_NONE. */
+static rad_result rad__local_add_evict(rad_local *L, const rad_context *ctx, uint32_t *ev, uint32_t *evicted)
+{
+    rad__local_storage *st = (rad__local_storage *)L->storage;
+    uint32_t oldest = RAD_NONE, i;
+    *ev = *evicted = RAD_NONE;
+    if (L->count + L->hidden < L->capacity) return RAD_SUCCESS;
+    for (i = 0; i < L->slot_end; ++i)
+        if (st->slot_hidden[i] && (oldest == RAD_NONE || st->hide_order[i] < st->hide_order[oldest])) oldest = i;
+    if (L->evict == RAD_LOCAL_EVICT_DROP) return rad_local_evict(L, st->slot_patch[oldest], ctx);
+    *ev = oldest;
+    *evicted = st->slot_patch[oldest];
+    st->patch_slot[*evicted] = RAD_NONE; /* its column is no longer part of the new row */
+    return RAD_SUCCESS;
+}
+
+/* the new patch's column a (a_j = rho_j F_jn) and row b (b_j = rho_n F_nj) over the member
+   slots, from the fetched row of 'count' entries; ann = rho_n F_nn; J->nz lists the slots set */
+static void rad__local_add_vectors(const rad_local *L, rad__local_job *J, uint32_t patch, uint32_t count, double ann[3])
+{
+    rad__local_scratch *s = &J->st->s;
+    uint32_t M = J->M, p, ch;
+    double an = (double)L->source.areas[patch], rho_n[3];
     for (ch = 0; ch < 3; ++ch) {
-        memset(s->a + (size_t)ch * M, 0, sizeof(double) * end);
-        memset(s->b + (size_t)ch * M, 0, sizeof(double) * end);
+        memset(s->a + (size_t)ch * M, 0, sizeof(double) * J->end);
+        memset(s->b + (size_t)ch * M, 0, sizeof(double) * J->end);
         ann[ch] = 0.0;
         rho_n[ch] = (double)L->source.albedo[3 * (size_t)patch + ch];
     }
-    an = (double)L->source.areas[patch];
-    J.nnz = 0;
+    J->nnz = 0;
     for (p = 0; p < count; ++p) {
         uint32_t j = s->row_columns[p], sj;
         double f = (double)s->row_values[p];
@@ -13177,70 +13228,138 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
             s->a[(size_t)ch * M + sj] = (double)L->source.albedo[3 * (size_t)j + ch] * (an * f / (double)L->source.areas[j]);
             s->b[(size_t)ch * M + sj] = rho_n[ch] * f;
         }
-        s->nz[J.nnz++] = sj;
+        s->nz[J->nnz++] = sj;
     }
-    J.st = st;
-    J.M = M;
-    J.end = end;
-    J.tasks = rad__local_tasks(&c, end);
-    if (J.ev != RAD_NONE)
-        for (ch = 0; ch < 3; ++ch) {
-            const float *P = st->planes + ch * MM;
-            double *cc = s->cc + (size_t)ch * M;
-            J.g[ch] = 1.0 + (double)P[(size_t)J.ev * M + J.ev];
-            for (i = 0; i < end; ++i) cc[i] = i == J.ev ? 0.0 : (double)P[(size_t)i * M + J.ev];
-        }
-    rad__local_run(&c, J.tasks, rad__local_u_task, &J);
-    if (J.ev != RAD_NONE)
-        for (ch = 0; ch < 3; ++ch) {
-            double *u = s->u + (size_t)ch * M, ra = u[J.ev] / J.g[ch]; /* a_e = 0: u_e = (T a)_e = r.a */
-            const double *cc = s->cc + (size_t)ch * M;
-            for (i = 0; i < end; ++i) u[i] -= cc[i] * ra;
-            u[J.ev] = 0.0;
-        }
+}
+
+/* fused eviction: g = 1 + T_ee and the column c = T[:, e] (c_e = 0) */
+static void rad__local_add_evict_column(rad__local_job *J)
+{
+    rad__local_scratch *s = &J->st->s;
+    size_t MM = (size_t)J->M * J->M;
+    uint32_t ch, i;
+    for (ch = 0; ch < 3; ++ch) {
+        const float *P = J->st->planes + ch * MM;
+        double *cc = s->cc + (size_t)ch * J->M;
+        J->g[ch] = 1.0 + (double)P[(size_t)J->ev * J->M + J->ev];
+        for (i = 0; i < J->end; ++i) cc[i] = i == J->ev ? 0.0 : (double)P[(size_t)i * J->M + J->ev];
+    }
+}
+
+/* fused eviction: u -= c (r.a) / g, with a_e = 0 so that u_e = (T a)_e = r.a */
+static void rad__local_add_evict_u(rad__local_job *J)
+{
+    rad__local_scratch *s = &J->st->s;
+    uint32_t ch, i;
+    for (ch = 0; ch < 3; ++ch) {
+        double *u = s->u + (size_t)ch * J->M, ra = u[J->ev] / J->g[ch];
+        const double *cc = s->cc + (size_t)ch * J->M;
+        for (i = 0; i < J->end; ++i) u[i] -= cc[i] * ra;
+        u[J->ev] = 0.0;
+    }
+}
+
+/* fused eviction: v -= (b.c) r / g, with b_e = 0 so that v_e = (b T)_e = b.c */
+static void rad__local_add_evict_v(rad__local_job *J)
+{
+    rad__local_scratch *s = &J->st->s;
+    size_t MM = (size_t)J->M * J->M;
+    uint32_t ch, i;
+    for (ch = 0; ch < 3; ++ch) {
+        double *v = s->v + (size_t)ch * J->M, bc = v[J->ev] / J->g[ch];
+        const float *re = J->st->planes + ch * MM + (size_t)J->ev * J->M;
+        for (i = 0; i < J->end; ++i) v[i] -= bc * (double)re[i];
+        v[J->ev] = 0.0;
+    }
+}
+
+/* the Schur complement s = 1 - ann - b.u of each channel and from it the scale of the new
+   row and column (coef), of the rank-1 update (J->cuv) and the new diagonal entry (tnn) */
+static rad_result rad__local_add_coefficients(const rad__ctx *c, const rad_local *L, rad__local_job *J, uint32_t patch,
+                                              const double ann[3], double coef[3], double tnn[3])
+{
+    const rad__local_scratch *s = &J->st->s;
+    uint32_t M = J->M, ch, p;
     for (ch = 0; ch < 3; ++ch) {
         double bu = 0.0, ba = 0.0, sv, d;
-        for (p = 0; p < J.nnz; ++p) {
+        for (p = 0; p < J->nnz; ++p) {
             uint32_t j = s->nz[p];
             bu += s->b[(size_t)ch * M + j] * s->u[(size_t)ch * M + j];
             ba += s->b[(size_t)ch * M + j] * s->a[(size_t)ch * M + j];
         }
         sv = 1.0 - ann[ch] - bu;
         if (!(sv > 1e-12) || sv != sv) {
-            rad__log(&c, RAD_LOG_ERROR, "rad_local_add: patch %u channel %u: s = 1 - b.(I+T)a = %g <= 0 (the form factors or "
+            rad__log(c, RAD_LOG_ERROR, "rad_local_add: patch %u channel %u: s = 1 - b.(I+T)a = %g <= 0 (the form factors or "
                      "albedos break energy conservation)", patch, ch, sv);
-            if (evicted != RAD_NONE) st->patch_slot[evicted] = J.ev; /* nothing was written: the set is unchanged */
             return RAD_ERROR_SINGULAR;
         }
         if (L->update == RAD_LOCAL_EXACT) {
-            coef_col[ch] = coef_row[ch] = J.cuv[ch] = 1.0 / sv;
+            coef[ch] = J->cuv[ch] = 1.0 / sv;
             tnn[ch] = 1.0 / sv - 1.0;
         } else {
             d = ann[ch] + ba;
-            coef_col[ch] = coef_row[ch] = 1.0 + d;
-            J.cuv[ch] = (1.0 + d) * (1.0 + d);
+            coef[ch] = 1.0 + d;
+            J->cuv[ch] = (1.0 + d) * (1.0 + d);
             tnn[ch] = d;
         }
     }
-    rad__local_run(&c, J.tasks, rad__local_v_task, &J);
-    if (J.ev != RAD_NONE)
-        for (ch = 0; ch < 3; ++ch) {
-            double *v = s->v + (size_t)ch * M, bc = v[J.ev] / J.g[ch]; /* b_e = 0: v_e = (b T)_e = b.c */
-            const float *re = st->planes + ch * MM + (size_t)J.ev * M;
-            for (i = 0; i < end; ++i) v[i] -= bc * (double)re[i];
-            v[J.ev] = 0.0;
-        }
-    for (i = 0; i < 3 * M; ++i) s->vf[i] = (float)s->v[i];
-    rad__local_run(&c, J.tasks, rad__local_update_task, &J);
+    return RAD_SUCCESS;
+}
+
+/* writes slot k's row (coef v), column (coef u) and diagonal (tnn) */
+static void rad__local_add_border(rad__local_job *J, uint32_t k, const double coef[3], const double tnn[3])
+{
+    const rad__local_scratch *s = &J->st->s;
+    size_t MM = (size_t)J->M * J->M;
+    uint32_t M = J->M, ch, i;
     for (ch = 0; ch < 3; ++ch) {
-        float *P = st->planes + ch * MM;
+        float *P = J->st->planes + ch * MM;
         const double *u = s->u + (size_t)ch * M, *v = s->v + (size_t)ch * M;
-        for (i = 0; i < end; ++i) {
-            P[(size_t)k * M + i] = (float)(coef_row[ch] * v[i]);
-            P[(size_t)i * M + k] = (float)(coef_col[ch] * u[i]);
+        for (i = 0; i < J->end; ++i) {
+            P[(size_t)k * M + i] = (float)(coef[ch] * v[i]);
+            P[(size_t)i * M + k] = (float)(coef[ch] * u[i]);
         }
         P[(size_t)k * M + k] = (float)tnn[ch];
     }
+}
+
+RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__local_storage *st;
+    rad__local_job J;
+    uint32_t k, count = 0, i, evicted;
+    double ann[3], coef[3], tnn[3];
+    int done;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
+    r = rad__local_add_check(&c, L, patch, &done);
+    if (r != RAD_SUCCESS || done) return r;
+    st = (rad__local_storage *)L->storage;
+    r = rad__local_fetch(&c, L, patch, &count);
+    if (r != RAD_SUCCESS) return r;
+    r = rad__local_add_evict(L, ctx, &J.ev, &evicted);
+    if (r != RAD_SUCCESS) return r;
+    k = J.ev != RAD_NONE ? J.ev : rad__local_free_slot(L);
+    J.st = st;
+    J.M = L->capacity;
+    J.end = k + 1 > L->slot_end ? k + 1 : L->slot_end;
+    J.tasks = rad__local_tasks(&c, J.end);
+    rad__local_add_vectors(L, &J, patch, count, ann);
+    if (J.ev != RAD_NONE) rad__local_add_evict_column(&J);
+    rad__local_run(&c, J.tasks, rad__local_u_task, &J);
+    if (J.ev != RAD_NONE) rad__local_add_evict_u(&J);
+    r = rad__local_add_coefficients(&c, L, &J, patch, ann, coef, tnn);
+    if (r != RAD_SUCCESS) {
+        if (evicted != RAD_NONE) st->patch_slot[evicted] = J.ev; /* nothing was written: the set is unchanged */
+        return r;
+    }
+    rad__local_run(&c, J.tasks, rad__local_v_task, &J);
+    if (J.ev != RAD_NONE) rad__local_add_evict_v(&J);
+    for (i = 0; i < 3 * J.M; ++i) st->s.vf[i] = (float)st->s.v[i];
+    rad__local_run(&c, J.tasks, rad__local_update_task, &J);
+    rad__local_add_border(&J, k, coef, tnn);
     if (evicted != RAD_NONE) {
         st->slot_hidden[k] = 0;
         L->hidden--;
@@ -13248,7 +13367,7 @@ RAD_API rad_result rad_local_add(rad_local *L, uint32_t patch, const rad_context
     }
     st->slot_patch[k] = patch;
     st->patch_slot[patch] = k;
-    L->slot_end = end;
+    L->slot_end = J.end;
     L->count++;
     L->adds++;
     return RAD_SUCCESS;
