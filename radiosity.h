@@ -3706,6 +3706,20 @@ static void rad__free(const rad_allocator *a, void *p)
     else RAD_FREE(p);
 }
 
+/* Free an object's blocks, the struct that holds the allocator last, through a copy of that
+   allocator: rad__free_each a list of them, rad__free_object a struct and one block. */
+static void rad__free_each(rad_allocator a, void *const *blocks, size_t count)
+{
+    size_t i;
+    for (i = 0; i < count; ++i) rad__free(&a, blocks[i]);
+}
+
+static void rad__free_object(rad_allocator a, void *block, void *object)
+{
+    rad__free(&a, block);
+    rad__free(&a, object);
+}
+
 /* Grows a buffer from old_size to new_size bytes, keeping the contents. */
 static void *rad__realloc(const rad_allocator *a, void *p, size_t old_size, size_t new_size)
 {
@@ -3799,6 +3813,37 @@ static void rad__normalize(float *a)
 {
     float l = rad__len(a);
     if (l > 0.0f) { a[0] /= l; a[1] /= l; a[2] /= l; }
+}
+
+/* A pinhole camera's unit frame (forward f, right r = f x up, up u = r x f) and the tangent
+   of half its vertical field of view: the one definition of a camera's view (rad_camera_ray
+   and rad_local_visible). */
+static float rad__camera_frame(const rad_camera *cam, float f[3], float r[3], float u[3])
+{
+    rad__sub(f, cam->target, cam->position);
+    rad__normalize(f);
+    rad__cross(r, f, cam->up);
+    rad__normalize(r);
+    rad__cross(u, r, f);
+    return (float)tan(0.5 * (double)cam->fov_y_degrees * RAD__PI / 180.0);
+}
+
+/* out (3 floats) = the sparse row (columns cols[k], values vals[k], k in [k0, k1)) times the
+   interleaved RGB vector x, summed in k order: every CSR-by-RGB product of the library */
+static void rad__sparse_row3(const uint32_t *cols, const float *vals, uint64_t k0, uint64_t k1, const float *x, float *out)
+{
+    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
+    uint64_t k;
+    for (k = k0; k < k1; ++k) {
+        const float *xj = x + 3 * (size_t)cols[k];
+        float v = vals[k];
+        s0 += v * xj[0];
+        s1 += v * xj[1];
+        s2 += v * xj[2];
+    }
+    out[0] = s0;
+    out[1] = s1;
+    out[2] = s2;
 }
 
 /* ---- tasks over rows, with progress and cancel ---- */
@@ -4170,24 +4215,16 @@ static uint32_t rad__mesh_index(const rad_mesh_desc *m, uint32_t t, int k)
 
 RAD_API void rad_scene_destroy(rad_scene *scene)
 {
-    rad_allocator a;
     uint32_t i;
     if (!scene) return;
-    a = scene->allocator;
-    rad__free(&a, scene->positions);
-    rad__free(&a, scene->normals);
-    rad__free(&a, scene->uvs);
-    rad__free(&a, scene->lightmap_uvs);
-    rad__free(&a, scene->lightmapped);
-    rad__free(&a, scene->areas);
-    rad__free(&a, scene->materials);
-    rad__free(&a, scene->meshes);
-    rad__free(&a, scene->source_triangles);
-    rad__free(&a, scene->materials_table);
     if (scene->mesh_names)
-        for (i = 0; i < scene->mesh_count; ++i) rad__free(&a, scene->mesh_names[i]);
-    rad__free(&a, scene->mesh_names);
-    rad__free(&a, scene);
+        for (i = 0; i < scene->mesh_count; ++i) rad__free(&scene->allocator, scene->mesh_names[i]);
+    {
+        void *blocks[] = { scene->positions, scene->normals, scene->uvs, scene->lightmap_uvs,
+                           scene->lightmapped, scene->areas, scene->materials, scene->meshes,
+                           scene->source_triangles, scene->materials_table, scene->mesh_names, scene };
+        rad__free_each(scene->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 static rad_result rad__validate_materials(const rad_scene_desc *desc, const rad__ctx *c)
@@ -4539,16 +4576,10 @@ RAD_API void rad_patch_options_default(rad_patch_options *options)
 
 RAD_API void rad_patches_destroy(rad_patches *p)
 {
-    rad_allocator a;
-    if (!p) return;
-    a = p->allocator;
-    rad__free(&a, p->patches);
-    rad__free(&a, p->vertices);
-    rad__free(&a, p->first_patch);
-    rad__free(&a, p->subdivision);
-    rad__free(&a, p->areas);
-    rad__free(&a, p->albedo);
-    rad__free(&a, p);
+    if (p) {
+        void *blocks[] = { p->patches, p->vertices, p->first_patch, p->subdivision, p->areas, p->albedo, p };
+        rad__free_each(p->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* local index of the up (i, j) and down (i, j) sub-triangles of an n x n subdivision: row j
@@ -7776,8 +7807,7 @@ fail:
 RAD_API void rad_solve_options_default(rad_solve_options *o)
 {
     if (!o) return;
-    memset(o, 0, sizeof(*o));
-    o->output = RAD_OUTPUT_INDIRECT;
+    memset(o, 0, sizeof(*o)); /* output RAD_OUTPUT_INDIRECT */
     o->bounces = 8;
     o->tolerance = 1e-6;
 }
@@ -7932,11 +7962,11 @@ static void rad__dot3x2(const float *r0, const float *r1, const float *xr, const
 #endif
 
 typedef struct rad__mv {
+    uint32_t tasks;
     const rad_matrix *F;
     const float *x;          /* interleaved RGB */
     const float *soa;        /* dense: x as three arrays of n */
     float *out;
-    uint32_t tasks;
 } rad__mv;
 
 static void rad__mv_task(void *data, uint32_t t)
@@ -7959,20 +7989,8 @@ static void rad__mv_task(void *data, uint32_t t)
             }
 #endif
             rad__dot3(F->dense + (size_t)i * F->cols, xr, xg, xb, F->cols, m->out + 3 * (size_t)i);
-        } else {
-            uint64_t k;
-            float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-            for (k = F->row_offsets[i]; k < F->row_offsets[i + 1]; ++k) {
-                const float *xj = m->x + 3 * (size_t)F->columns[k];
-                float v = F->values[k];
-                s0 += v * xj[0];
-                s1 += v * xj[1];
-                s2 += v * xj[2];
-            }
-            m->out[3 * (size_t)i] = s0;
-            m->out[3 * (size_t)i + 1] = s1;
-            m->out[3 * (size_t)i + 2] = s2;
-        }
+        } else
+            rad__sparse_row3(F->columns, F->values, F->row_offsets[i], F->row_offsets[i + 1], m->x, m->out + 3 * (size_t)i);
     }
 }
 
@@ -8382,9 +8400,7 @@ done:
 RAD_API void rad_stochastic_options_default(rad_stochastic_options *o)
 {
     if (!o) return;
-    memset(o, 0, sizeof(*o));
-    o->method = RAD_STOCHASTIC_JACOBI;
-    o->output = RAD_OUTPUT_INDIRECT;
+    memset(o, 0, sizeof(*o)); /* method RAD_STOCHASTIC_JACOBI, output RAD_OUTPUT_INDIRECT */
     o->tolerance = 1e-4;
     o->ray_epsilon = 1e-5f;
 }
@@ -8872,23 +8888,11 @@ RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *o)
 
 RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
 {
-    rad_allocator a;
-    if (!h) return;
-    a = h->allocator;
-    rad__free(&a, h->el);
-    rad__free(&a, h->links);
-    rad__free(&a, h->leaf);
-    rad__free(&a, h->leaf_of);
-    rad__free(&a, h->leaf_vert);
-    rad__free(&a, h->vert_B);
-    rad__free(&a, h->vert_H);
-    rad__free(&a, h->cl);
-    rad__free(&a, h->perm);
-    rad__free(&a, h->tri_parent);
-    rad__free(&a, h->cum_area);
-    rad__free(&a, h->in);
-    rad__free(&a, h->in_first);
-    rad__free(&a, h);
+    if (h) {
+        void *blocks[] = { h->el, h->links, h->leaf, h->leaf_of, h->leaf_vert, h->vert_B, h->vert_H, h->cl,
+                           h->perm, h->tri_parent, h->cum_area, h->in, h->in_first, h };
+        rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 static void rad__hr_normal_area(rad__hr_elem *e)
@@ -10327,16 +10331,25 @@ RAD_API float rad_half_to_float(uint16_t value)
         }                                                                                         \
         s = rad__hsum8(_mm256_add_ps(_mm256_add_ps(s0, s1), _mm256_add_ps(s2, s3)));              \
     }
-#define RAD__LOAD8_F32(p) _mm256_loadu_ps(p)
-#define RAD__LOAD8_F16(p) _mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(p)))
+/* each dot's SIMD part, empty where its instructions are not enabled */
+#if defined(RAD__AVX)
+#  define RAD__LOAD8_F32(p) _mm256_loadu_ps(p)
+#  define RAD__DOT_F32_SIMD RAD__DOT_AVX(RAD__LOAD8_F32)
+#else
+#  define RAD__DOT_F32_SIMD
+#endif
+#if defined(RAD__MB_F16C)
+#  define RAD__LOAD8_F16(p) _mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)(p)))
+#  define RAD__DOT_F16_SIMD RAD__DOT_AVX(RAD__LOAD8_F16)
+#else
+#  define RAD__DOT_F16_SIMD
+#endif
 
 static float rad__dot_f32(const float *a, const float *x, uint32_t n)
 {
     uint32_t j = 0;
     float s = 0.0f;
-#if defined(RAD__AVX)
-    RAD__DOT_AVX(RAD__LOAD8_F32)
-#endif
+    RAD__DOT_F32_SIMD
     for (; j < n; ++j) s += a[j] * x[j];
     return s;
 }
@@ -10345,9 +10358,7 @@ static float rad__dot_f16(const uint16_t *a, const float *x, uint32_t n)
 {
     uint32_t j = 0;
     float s = 0.0f;
-#if defined(RAD__MB_F16C)
-    RAD__DOT_AVX(RAD__LOAD8_F16)
-#endif
+    RAD__DOT_F16_SIMD
     for (; j < n; ++j) s += rad_half_to_float(a[j]) * x[j];
     return s;
 }
@@ -10498,20 +10509,12 @@ RAD_API void rad_block_options_default(rad_block_options *o)
 
 RAD_API void rad_multibounce_destroy(rad_multibounce *mb)
 {
-    rad_allocator a;
-    if (!mb) return;
-    a = mb->allocator;
-    rad__free(&a, mb->storage);
-    rad__free(&a, mb);
+    if (mb) rad__free_object(mb->allocator, mb->storage, mb);
 }
 
 RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *b)
 {
-    rad_allocator a;
-    if (!b) return;
-    a = b->allocator;
-    rad__free(&a, b->storage);
-    rad__free(&a, b);
+    if (b) rad__free_object(b->allocator, b->storage, b);
 }
 
 /* One allocation holding 'parts' arrays of the given byte sizes, each 64-byte aligned. */
@@ -11853,27 +11856,24 @@ typedef struct rad__mb_bapply {
    m = x r (r = 1/d) corrected once by the residual, m + (x - m d) r. For every quotient the
    BC1 and BC4 palettes form (endpoints over 31, 63, 255; interpolants over 3, 5, 7; all
    endpoint pairs) this equals the division: tests/test_multibounce.c checks all of them. */
-static inline __m256 rad__mb_div(__m256 x, __m256 d, __m256 r)
-{
+/* one definition for both widths (W: 256 or 128 bits, P: the intrinsics' prefix) */
 #if defined(RAD__MB_FMA)
-    __m256 m = _mm256_mul_ps(x, r);
-    return _mm256_fmadd_ps(_mm256_fnmadd_ps(m, d, x), r, m);
+#  define RAD__MB_DIV_FN(name, W, P)                                                   \
+    static inline W name(W x, W d, W r)                                                 \
+    {                                                                                   \
+        W m = P##_mul_ps(x, r);                                                         \
+        return P##_fmadd_ps(P##_fnmadd_ps(m, d, x), r, m);                              \
+    }
 #else
-    (void)r;
-    return _mm256_div_ps(x, d);
+#  define RAD__MB_DIV_FN(name, W, P)                                                   \
+    static inline W name(W x, W d, W r)                                                 \
+    {                                                                                   \
+        (void)r;                                                                        \
+        return P##_div_ps(x, d);                                                        \
+    }
 #endif
-}
-
-static inline __m128 rad__mb_div4(__m128 x, __m128 d, __m128 r)
-{
-#if defined(RAD__MB_FMA)
-    __m128 m = _mm_mul_ps(x, r);
-    return _mm_fmadd_ps(_mm_fnmadd_ps(m, d, x), r, m);
-#else
-    (void)r;
-    return _mm_div_ps(x, d);
-#endif
-}
+RAD__MB_DIV_FN(rad__mb_div, __m256, _mm256)
+RAD__MB_DIV_FN(rad__mb_div4, __m128, _mm)
 #else
 static void rad__mb_block_palettes(const rad_multibounce_blocks *b, const uint8_t *blk, size_t nblocks, const float *scale,
                                    float pal[3][8])
@@ -12866,11 +12866,7 @@ typedef struct rad__local_storage {
 
 RAD_API void rad_local_destroy(rad_local *local)
 {
-    rad_allocator a;
-    if (!local) return;
-    a = local->allocator;
-    rad__free(&a, local->storage);
-    rad__free(&a, local);
+    if (local) rad__free_object(local->allocator, local->storage, local);
 }
 
 RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_local_options *options,
@@ -13693,16 +13689,18 @@ RAD_API rad_result rad_local_apply(const rad_local *L, const float *E, const uin
     rad__ctx c;
     rad__local_job J;
     uint32_t *rows = NULL, *cols = NULL, ncols = 0, nrows = 0, i, ch;
-    float *e = NULL, *y = NULL;
+    size_t row_cap;
+    float *e = NULL, *y;       /* one allocation: e (3 per slot), then y (3 per visible row) */
     rad_result r;
     rad__ctx_init(&c, ctx);
     if (!L || !E || !out || (output != RAD_OUTPUT_INDIRECT && output != RAD_OUTPUT_TOTAL)) return RAD_ERROR_INVALID_ARGUMENT;
     if (L->count + L->hidden == 0) return RAD_SUCCESS;
-    rows = (uint32_t *)rad__alloc_array(&c.allocator, visible ? (size_t)visible_count : (size_t)L->slot_end, sizeof(uint32_t));
+    row_cap = visible ? (size_t)visible_count : (size_t)L->slot_end;
+    rows = (uint32_t *)rad__alloc_array(&c.allocator, row_cap, sizeof(uint32_t));
     cols = (uint32_t *)rad__alloc_array(&c.allocator, lit ? (size_t)lit_count : (size_t)L->slot_end, sizeof(uint32_t));
-    e = (float *)rad__alloc_array(&c.allocator, (size_t)L->slot_end, 3 * sizeof(float));
-    y = (float *)rad__alloc_array(&c.allocator, visible ? (size_t)visible_count : (size_t)L->slot_end, 3 * sizeof(float));
-    if (!rows || !cols || !e || !y) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    if (row_cap <= (size_t)-1 - L->slot_end) e = (float *)rad__alloc_array(&c.allocator, L->slot_end + row_cap, 3 * sizeof(float));
+    if (!rows || !cols || !e) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    y = e + 3 * (size_t)L->slot_end;
     r = rad__local_slots(&c, L, visible, visible_count, "visible", rows, &nrows);
     if (r == RAD_SUCCESS) r = rad__local_slots(&c, L, lit, lit_count, "lit", cols, &ncols);
     if (r != RAD_SUCCESS) goto done;
@@ -13739,7 +13737,6 @@ done:
     rad__free(&c.allocator, rows);
     rad__free(&c.allocator, cols);
     rad__free(&c.allocator, e);
-    rad__free(&c.allocator, y);
     return r;
 }
 
@@ -13811,12 +13808,7 @@ RAD_API rad_result rad_local_visible(const rad_patches *patches, const rad_rayca
         rad__log(&c, RAD_LOG_ERROR, "rad_local_visible: fov_y_degrees %g must be in (0, 180)", (double)camera->fov_y_degrees);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    rad__sub(f, camera->target, camera->position);
-    rad__normalize(f);
-    rad__cross(r, f, camera->up);
-    rad__normalize(r);
-    rad__cross(u, r, f);
-    th = (float)tan(0.5 * (double)camera->fov_y_degrees * RAD__PI / 180.0);
+    th = rad__camera_frame(camera, f, r, u);
     tw = th * aspect;
     for (i = 0; i < count; ++i)
         if (candidates[i] >= patches->count) {
@@ -14021,11 +14013,7 @@ RAD_API rad_result rad_alias_build_row(const uint32_t *columns, const float *val
 
 RAD_API void rad_alias_tables_destroy(rad_alias_tables *t)
 {
-    rad_allocator a;
-    if (!t) return;
-    a = t->allocator;
-    rad__free(&a, t->storage);
-    rad__free(&a, t);
+    if (t) rad__free_object(t->allocator, t->storage, t);
 }
 
 RAD_API size_t rad_alias_tables_memory(const rad_alias_tables *t)
@@ -14482,18 +14470,10 @@ RAD_API void rad_temporal_options_default(rad_temporal_options *o)
 
 RAD_API void rad_temporal_destroy(rad_temporal *t)
 {
-    rad_allocator a;
-    if (!t) return;
-    a = t->c.allocator;
-    rad__free(&a, t->B);
-    rad__free(&a, t->B_next);
-    rad__free(&a, t->V);
-    rad__free(&a, t->w);
-    rad__free(&a, t->mean);
-    rad__free(&a, t->var);
-    rad__free(&a, t->fast);
-    rad__free(&a, t->count);
-    rad__free(&a, t);
+    if (t) {
+        void *blocks[] = { t->B, t->B_next, t->V, t->w, t->mean, t->var, t->fast, t->count, t };
+        rad__free_each(t->c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 RAD_API void rad_temporal_reset(rad_temporal *t)
@@ -19563,47 +19543,47 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
 
 #define RAD__INV_PI 0.318309886183790671537767526745f
 
+/* The documented defaults as data: each _default function copies its struct. */
+static const rad_lambert_params rad__lambert_default = { { 0.5f, 0.5f, 0.5f } };
+
 RAD_API void rad_lambert_params_default(rad_lambert_params *p)
 {
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
+    if (p) *p = rad__lambert_default;
 }
 
-RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p)
-{
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->wrap = 1.0f;
-    p->exponent = 2.0f;
-}
+static const rad_banded_params rad__banded_default = { { 0.5f, 0.5f, 0.5f }, 4 };
 
 RAD_API void rad_banded_params_default(rad_banded_params *p)
 {
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->bands = 4;
+    if (p) *p = rad__banded_default;
 }
 
-RAD_API void rad_phong_params_default(rad_phong_params *p)
+static const rad_half_lambert_params rad__half_lambert_default = { { 0.5f, 0.5f, 0.5f }, 1.0f, 2.0f };
+
+RAD_API void rad_half_lambert_params_default(rad_half_lambert_params *p)
 {
-    if (!p) return;
-    p->diffuse[0] = p->diffuse[1] = p->diffuse[2] = 0.5f;
-    p->specular[0] = p->specular[1] = p->specular[2] = 0.3f;
-    p->shininess = 32.0f;
+    if (p) *p = rad__half_lambert_default;
 }
+
+static const rad_minnaert_params rad__minnaert_default = { { 0.5f, 0.5f, 0.5f }, 0.8f };
 
 RAD_API void rad_minnaert_params_default(rad_minnaert_params *p)
 {
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->k = 0.8f;
+    if (p) *p = rad__minnaert_default;
 }
+
+static const rad_phong_params rad__phong_default = { { 0.5f, 0.5f, 0.5f }, { 0.3f, 0.3f, 0.3f }, 32.0f };
+
+RAD_API void rad_phong_params_default(rad_phong_params *p)
+{
+    if (p) *p = rad__phong_default;
+}
+
+static const rad_oren_nayar_params rad__oren_nayar_default = { { 0.5f, 0.5f, 0.5f }, 0.5f };
 
 RAD_API void rad_oren_nayar_params_default(rad_oren_nayar_params *p)
 {
-    if (!p) return;
-    p->albedo[0] = p->albedo[1] = p->albedo[2] = 0.5f;
-    p->sigma = 0.5f;
+    if (p) *p = rad__oren_nayar_default;
 }
 
 RAD_API void rad_microfacet_params_default(rad_microfacet_params *p)
@@ -20130,11 +20110,7 @@ RAD_API rad_result rad_container_write(const rad_section *sections, uint32_t cou
 
 RAD_API void rad_container_destroy(rad_container *c)
 {
-    rad_allocator a;
-    if (!c) return;
-    a = c->allocator;
-    rad__free(&a, c->sections);
-    rad__free(&a, c);
+    if (c) rad__free_object(c->allocator, c->sections, c);
 }
 
 RAD_API rad_result rad_container_create(const void *data, size_t size, const rad_context *ctx, rad_container **out)
