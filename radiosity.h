@@ -8787,19 +8787,10 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
         rad__log(&c, RAD_LOG_INFO, "stochastic radiosity: cancelled by the progress callback after %u iterations", s.iteration);
     }
 done:
-    rad__free(&c.allocator, s.cum);
-    rad__free(&c.allocator, s.acc);
-    rad__free(&c.allocator, s.cur);
-    rad__free(&c.allocator, s.B);
-    rad__free(&c.allocator, s.mean);
-    rad__free(&c.allocator, s.est);
-    rad__free(&c.allocator, s.src);
-    rad__free(&c.allocator, s.key);
-    rad__free(&c.allocator, s.dst);
-    rad__free(&c.allocator, s.walk);
-    rad__free(&c.allocator, s.power);
-    rad__free(&c.allocator, s.w.rays);
-    rad__free(&c.allocator, s.w.hits);
+    {
+        void *blocks[] = { s.cum, s.acc, s.cur, s.B, s.mean, s.est, s.src, s.key, s.dst, s.walk, s.power, s.w.rays, s.w.hits };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -13682,6 +13673,27 @@ static rad_result rad__local_slots(const rad__ctx *c, const rad_local *L, const 
     return RAD_SUCCESS;
 }
 
+/* rad_local_apply's e: E of the lit slots cols[0 .. ncols), channel-major over slot_end
+   (zero elsewhere); NON_FINITE names a patch whose E is not finite */
+static rad_result rad__local_apply_e(const rad__ctx *c, const rad_local *L, const float *E, const uint32_t *cols, uint32_t ncols,
+                                     float *e)
+{
+    uint32_t i, ch;
+    memset(e, 0, sizeof(float) * 3 * (size_t)L->slot_end);
+    for (i = 0; i < ncols; ++i) {
+        uint32_t p = L->slot_patch[cols[i]];
+        for (ch = 0; ch < 3; ++ch) {
+            float x = E[3 * (size_t)p + ch];
+            if (!rad__finite(x)) {
+                rad__log(c, RAD_LOG_ERROR, "rad_local_apply: E of patch %u is not finite", p);
+                return RAD_ERROR_NON_FINITE;
+            }
+            e[(size_t)ch * L->slot_end + cols[i]] = x;
+        }
+    }
+    return RAD_SUCCESS;
+}
+
 RAD_API rad_result rad_local_apply(const rad_local *L, const float *E, const uint32_t *visible,
                                    uint32_t visible_count, const uint32_t *lit, uint32_t lit_count,
                                    float *out, rad_output output, const rad_context *ctx)
@@ -13703,20 +13715,8 @@ RAD_API rad_result rad_local_apply(const rad_local *L, const float *E, const uin
     y = e + 3 * (size_t)L->slot_end;
     r = rad__local_slots(&c, L, visible, visible_count, "visible", rows, &nrows);
     if (r == RAD_SUCCESS) r = rad__local_slots(&c, L, lit, lit_count, "lit", cols, &ncols);
+    if (r == RAD_SUCCESS) r = rad__local_apply_e(&c, L, E, cols, ncols, e);
     if (r != RAD_SUCCESS) goto done;
-    memset(e, 0, sizeof(float) * 3 * (size_t)L->slot_end);
-    for (i = 0; i < ncols; ++i) {
-        uint32_t p = L->slot_patch[cols[i]];
-        for (ch = 0; ch < 3; ++ch) {
-            float x = E[3 * (size_t)p + ch];
-            if (!rad__finite(x)) {
-                rad__log(&c, RAD_LOG_ERROR, "rad_local_apply: E of patch %u is not finite", p);
-                r = RAD_ERROR_NON_FINITE;
-                goto done;
-            }
-            e[(size_t)ch * L->slot_end + cols[i]] = x;
-        }
-    }
     J.st = (rad__local_storage *)L->storage;
     J.M = L->capacity;
     J.end = L->slot_end;
@@ -13781,6 +13781,42 @@ RAD_API rad_result rad_local_nearest(const rad_patches *patches, const float pos
     return RAD_SUCCESS;
 }
 
+/* rad_local_visible's rays: from the centroid and the three edge midpoints of each front-facing
+   candidate inside the view (frame f, r, u; half extents tw, th) to the camera; owner[k] is the
+   candidate of ray k. Returns the ray count. */
+static uint32_t rad__local_visible_rays(const rad_patches *patches, const rad_camera *camera, const float f[3], const float r[3],
+                                        const float u[3], float tw, float th, const uint32_t *candidates, uint32_t count,
+                                        rad_ray *rays, uint32_t *owner)
+{
+    uint32_t nrays = 0, i, k, s;
+    for (i = 0; i < count; ++i) {
+        const rad_patch *p = &patches->patches[candidates[i]];
+        float to[3];
+        rad__sub(to, camera->position, p->centroid);
+        if (!(rad__dot(to, p->normal) > 0.0f)) continue; /* back face */
+        for (s = 0; s < 4; ++s) {
+            float q[3], d[3], z, x, y, dist;
+            for (k = 0; k < 3; ++k)
+                q[k] = s == 0 ? p->centroid[k] : 0.5f * (p->centroid[k] + patches->vertices[3 * (size_t)p->vertices[s - 1] + k]);
+            rad__sub(d, q, camera->position);
+            z = rad__dot(d, f);
+            if (!(z > 0.0f)) continue;
+            x = rad__dot(d, r) / z;
+            y = rad__dot(d, u) / z;
+            if (x < -tw || x > tw || y < -th || y > th) continue;
+            dist = rad__len(d);
+            for (k = 0; k < 3; ++k) {
+                rays[nrays].origin[k] = q[k] + p->normal[k] * 1e-4f * dist;
+                rays[nrays].dir[k] = camera->position[k] - rays[nrays].origin[k];
+            }
+            rays[nrays].tmin = 0.0f;
+            rays[nrays].tmax = 1.0f;
+            owner[nrays++] = i;
+        }
+    }
+    return nrays;
+}
+
 RAD_API rad_result rad_local_visible(const rad_patches *patches, const rad_raycaster *raycaster,
                                      const rad_camera *camera, float aspect, const uint32_t *candidates,
                                      uint32_t count, uint32_t *out_visible, uint32_t *out_count,
@@ -13790,7 +13826,7 @@ RAD_API rad_result rad_local_visible(const rad_patches *patches, const rad_rayca
     float f[3], r[3], u[3], th, tw;
     rad_ray *rays = NULL;
     uint8_t *occ = NULL;
-    uint32_t *owner = NULL, nrays = 0, i, k, s, nv = 0;
+    uint32_t *owner = NULL, nrays = 0, i, k, nv = 0;
     rad_result res = RAD_SUCCESS;
     rad__ctx_init(&c, ctx);
     if (!patches || !raycaster || !raycaster->occluded || !camera || !out_visible || !out_count || (count > 0 && !candidates) ||
@@ -13820,31 +13856,7 @@ RAD_API rad_result rad_local_visible(const rad_patches *patches, const rad_rayca
     occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)count * 4u, 1);
     owner = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)count * 4u, sizeof(uint32_t));
     if (!rays || !occ || !owner) { res = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    for (i = 0; i < count; ++i) {
-        const rad_patch *p = &patches->patches[candidates[i]];
-        float to[3];
-        rad__sub(to, camera->position, p->centroid);
-        if (!(rad__dot(to, p->normal) > 0.0f)) continue; /* back face */
-        for (s = 0; s < 4; ++s) {
-            float q[3], d[3], z, x, y, dist;
-            for (k = 0; k < 3; ++k)
-                q[k] = s == 0 ? p->centroid[k] : 0.5f * (p->centroid[k] + patches->vertices[3 * (size_t)p->vertices[s - 1] + k]);
-            rad__sub(d, q, camera->position);
-            z = rad__dot(d, f);
-            if (!(z > 0.0f)) continue;
-            x = rad__dot(d, r) / z;
-            y = rad__dot(d, u) / z;
-            if (x < -tw || x > tw || y < -th || y > th) continue;
-            dist = rad__len(d);
-            for (k = 0; k < 3; ++k) {
-                rays[nrays].origin[k] = q[k] + p->normal[k] * 1e-4f * dist;
-                rays[nrays].dir[k] = camera->position[k] - rays[nrays].origin[k];
-            }
-            rays[nrays].tmin = 0.0f;
-            rays[nrays].tmax = 1.0f;
-            owner[nrays++] = i;
-        }
-    }
+    nrays = rad__local_visible_rays(patches, camera, f, r, u, tw, th, candidates, count, rays, owner);
     if (nrays > 0) {
         res = raycaster->occluded(raycaster->user, rays, nrays, occ);
         if (res != RAD_SUCCESS) {
