@@ -2059,8 +2059,9 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    M: the full rows would cost M^2 per voxel pass. Each sample then belongs to one patch
    (weight = the area correction), and the form factors are built by step 5 unchanged, so the
    merged rows and columns are exactly these merge rules applied to the whole sample matrix, with
-   visibility. E uses w_ij = max(0, N_j . n_i) over the voxel's samples (rad_vp_from_samples)
-   and gathering w_j = max(0, N_j . n), both normalized.
+   visibility. E is the area-weighted mean over the cluster's own samples (rad_vp_from_samples;
+   DEPARTURE: the thesis weights every sample of the voxel by max(0, N_j . n_i), which does not
+   conserve the samples' power) and gathering uses w_j = max(0, N_j . n), normalized.
    LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
    sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
    patch facing its normal gets 0. */
@@ -2184,8 +2185,9 @@ RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
 RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E);
 
 /* Per-patch values from per-sample values (the primary light, normalized):
-   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel (axis-aligned), or
-   out_j = sum_i w_ij s_i v_i / sum_i w_ij s_i with w_ij = max(0, N_j . n_i) (clustered). sample_values: 3M floats
+   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel, w_ia the corrected split
+   weights of sample_weights (clustered: the area correction on the sample's own cluster, 0 on
+   the others), so the power sum_a A_a out_a equals sum_i e_i v_i. sample_values: 3M floats
    (for instance rho_i D_i from the engine's own shadow maps); out: 3N floats.
    Errors: INVALID_ARGUMENT. O(M). */
 RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out);
@@ -16366,12 +16368,11 @@ RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const floa
             uint32_t p = vp->voxel_patch[6 * (size_t)v + a];
             double acc[3] = { 0.0, 0.0, 0.0 }, wsum = 0.0;
             if (p == RAD_NONE) continue;
+            /* the weights that make the patch's area and form factors (clustered: 1 on the
+               sample's own cluster), so sum_a A_a out_a = sum_i e_i v_i: a cluster that took
+               its neighbours' values by normal would emit power its samples do not send */
             for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
                 double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
-                if (vp->kind == RAD_VP_CLUSTERED) {
-                    double cosw = (double)rad__dot(vp->normals + 3 * (size_t)p, vp->sample_normals + 3 * (size_t)s);
-                    w = cosw > 0.0 ? cosw * (double)vp->sample_areas[s] : 0.0;
-                }
                 wsum += w;
                 for (k = 0; k < 3; ++k) acc[k] += w * (double)sample_values[3 * (size_t)s + k];
             }

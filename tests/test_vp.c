@@ -985,8 +985,86 @@ static void vp_test_count(void)
     rad_scene_destroy(scene);
 }
 
+/* rad_vp_from_samples keeps the samples' power: sum_a A_a E_a = sum_i e_i v_i (e_i the sample's
+   corrected area), and a value constant over each patch's own samples comes back exactly, for
+   both kinds. The clustered kind once weighted every sample of the voxel by max(0, N_j . n_i), so
+   a cluster took its neighbours' light (power off by the clusters' overlap of normals). */
+static void vp_test_source_power(void)
+{
+    rad_scene_desc desc;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    uint32_t kind;
+    rad_cornell_box(&desc, NULL);
+    CHECK_OK(rad_scene_create(&desc, NULL, &scene));
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    rad_bvh_raycaster(bvh, &rc);
+    for (kind = 0; kind < 2; ++kind) {
+        rad_vp_options o;
+        rad_virtual_patches *vp = NULL;
+        float *val, *out;
+        uint32_t i, a, v, owned = 0, mixed = 0;
+        double have = 0.0, want = 0.0;
+        rad_vp_options_default(&o);
+        o.resolution = 5;
+        o.face_points = 4;
+        if (kind) { o.kind = RAD_VP_CLUSTERED; o.max_clusters = 2; }
+        CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
+        if (!vp) continue;
+        val = (float *)malloc(sizeof(float) * 3 * (size_t)vp->sample_count);
+        out = (float *)malloc(sizeof(float) * 3 * (size_t)vp->count);
+        CHECK(val && out);
+        if (!val || !out) { free(val); free(out); rad_vp_destroy(vp); continue; }
+        /* power: arbitrary positive values */
+        for (i = 0; i < 3 * vp->sample_count; ++i) val[i] = 0.25f + (float)((i * 2654435761u) >> 20) / 4096.0f;
+        CHECK_OK(rad_vp_from_samples(vp, val, out));
+        for (i = 0; i < vp->count; ++i) have += (double)vp->areas[i] * (double)out[3 * (size_t)i + 1];
+        for (i = 0; i < vp->sample_count; ++i) {
+            double e = 0.0;
+            for (a = 0; a < 6; ++a) e += (double)vp->sample_weights[6 * (size_t)i + a];
+            want += e * (double)vp->sample_areas[i] * (double)val[3 * (size_t)i + 1];
+        }
+        CHECK_NEAR(have / want, 1.0, 1e-5);
+        /* clustered: a value constant on each cluster's samples is that cluster's value */
+        if (kind) {
+            for (v = 0; v < vp->voxel_count; ++v)
+                for (i = vp->sample_first[v]; i < vp->sample_first[v + 1]; ++i)
+                    for (a = 0; a < 6; ++a)
+                        if (vp->sample_weights[6 * (size_t)i + a] > 0.0f) {
+                            val[3 * (size_t)i] = val[3 * (size_t)i + 1] = val[3 * (size_t)i + 2] = (float)(vp->voxel_patch[6 * (size_t)v + a] + 1u);
+                            break;
+                        }
+            CHECK_OK(rad_vp_from_samples(vp, val, out));
+            for (i = 0; i < vp->count; ++i) {
+                CHECK_NEAR(out[3 * (size_t)i], (double)(i + 1u), 1e-5 * (double)(i + 1u));
+                owned++;
+            }
+            /* the box's voxels hold clusters whose normals are not perpendicular (the
+               blocks' faces and the walls merged), so the old weighting would differ here */
+            for (i = 0; i < vp->count; ++i) {
+                uint32_t q, b2;
+                for (b2 = 0; b2 < 6; ++b2) {
+                    q = vp->voxel_patch[6 * (size_t)vp->voxel[i] + b2];
+                    if (q != RAD_NONE && q != i &&
+                        vp->normals[3 * (size_t)i] * vp->normals[3 * (size_t)q] + vp->normals[3 * (size_t)i + 1] * vp->normals[3 * (size_t)q + 1] +
+                                vp->normals[3 * (size_t)i + 2] * vp->normals[3 * (size_t)q + 2] > 0.01f)
+                        mixed++;
+                }
+            }
+            CHECK(owned == vp->count && mixed > 0);
+        }
+        free(val);
+        free(out);
+        rad_vp_destroy(vp);
+    }
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 static const rad_test_case tests_vp[] = {
     { "vp_count", vp_test_count },
+    { "vp_source_power", vp_test_source_power },
     { "vp_reciprocity", vp_test_reciprocity },
     { "vp_furnace", vp_test_furnace },
     { "vp_memory", vp_test_memory },
