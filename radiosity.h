@@ -15011,6 +15011,7 @@ RAD_API void rad_vp_options_default(rad_vp_options *o)
     o->weights = RAD_VP_WEIGHTS_SQUARED;
     o->ray_epsilon = 1e-5f;
     o->visibility_rays = 16;
+    o->share_rays = 16;
     o->kind = RAD_VP_AXIS_ALIGNED;
     o->max_clusters = 6;
     o->metric_columns = 64;

@@ -675,6 +675,9 @@ static void vp_test_arguments(void)
     o.visibility_rays = 5000;
     CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
     rad_vp_options_default(&o);
+    o.share_rays = 5000;
+    CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
+    rad_vp_options_default(&o);
     o.weights = (rad_vp_weights)7;
     CHECK_RESULT(rad_vp_create(scene, &rc, &o, NULL, &vp), RAD_ERROR_INVALID_ARGUMENT);
     /* per-axis voxel sizes work, and the gathering rejects bad points */
