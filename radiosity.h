@@ -1996,12 +1996,21 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
         (P_ba = P_ab) and divided: F_ab = P_ab / A_a. This is the axis merge of docs/methods/aavp.md (row
         F_a,j = sum_i w_ia s_i F_ij / A_a, column F_j,a = sum_i w_ia F_ji) applied to both
         indices, so A_a F_ab = A_b F_ba holds to float rounding.
-     6. Row sums above 1 (the point kernel next to a tiny patch overshoots: rows up to 1.68
-        in the bunny-and-ogre scene at 16 voxels) are scaled down without breaking
-        reciprocity: with c_a = 1 / max(1, sum_b P_ab / A_a),
-        F_ab = P_ab min(c_a, c_b) / A_a, so every row sums to at most 1 and every solver
-        converges. In a closed box this lowers the mean row sum by about 1% (keep_row_sums
-        turns it off).
+     6. Row sums. The point kernel gets the rows' totals wrong where samples are close
+        (concave corners overshoot: rows up to 1.68 in the bunny-and-ogre scene at 16
+        voxels) and where a voxel's samples stand for surface they do not see like (crowded
+        voxels fall short). The exact row sum of a patch is the share of its hemisphere
+        that lands on the front of a triangle, so each sample casts share_rays (default
+        16) cosine-distributed rays, its share is the fraction that hits a front face, and
+        t_a = sum_i w_ia s_i share_i. P is then scaled symmetrically, P_ab d_a d_b, with
+        d from RAD__VP_MATCH_STEPS steps of d_a <- sqrt(d_a t_a / sum_b P_ab d_b), so every
+        row's exchange sum_b P_ab approaches t_a <= A_a while P stays symmetric (a patch
+        buried in other geometry, t_a = 0, exchanges nothing). Then, as a guard, rows still
+        above 1 are scaled down without breaking reciprocity: with
+        c_a = 1 / max(1, sum_b P_ab / A_a), F_ab = P_ab min(c_a, c_b) / A_a, so every solver
+        converges. cap_row_sums keeps only this cap (the earlier form, which took light
+        from every row next to an overshooting one); keep_row_sums skips step 6;
+        skip_visibility skips the matching (its form factors are the unoccluded ones).
    VISIBILITY. One shadow ray per sample pair costs M^2 / 2 rays (hundreds of millions for a
    real mesh), so by default the kernel is summed over
    every sample pair but visibility is estimated per pair of voxels (u, v): 'visibility_rays'
@@ -2059,8 +2068,9 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    M: the full rows would cost M^2 per voxel pass. Each sample then belongs to one patch
    (weight = the area correction), and the form factors are built by step 5 unchanged, so the
    merged rows and columns are exactly these merge rules applied to the whole sample matrix, with
-   visibility. E uses w_ij = max(0, N_j . n_i) over the voxel's samples (rad_vp_from_samples)
-   and gathering w_j = max(0, N_j . n), both normalized.
+   visibility. E is the area-weighted mean over the cluster's own samples (rad_vp_from_samples;
+   DEPARTURE: the thesis weights every sample of the voxel by max(0, N_j . n_i), which does not
+   conserve the samples' power) and gathering uses w_j = max(0, N_j . n), normalized.
    LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
    sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
    patch facing its normal gets 0. */
@@ -2102,6 +2112,9 @@ typedef struct rad_vp_options {
                                  (CSR, see SPARSE ROWS in the section comment) */
     float drop_threshold;     /* RAD_STORAGE_SPARSE: entries F_ab <= it are dropped (0 keeps every
                                  non-zero; >= 0, finite) */
+    uint32_t share_rays;      /* step 6: cosine rays per sample that measure each patch's share of
+                                 the scene (default 16, at most 1024) */
+    int cap_row_sums;         /* non-zero: step 6 only caps row sums at 1 (no traced shares) */
 } rad_vp_options;
 
 /* Axis-aligned virtual patches with their form factors. Read-only after creation.
@@ -2184,8 +2197,9 @@ RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp);
 RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, const float *E);
 
 /* Per-patch values from per-sample values (the primary light, normalized):
-   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel (axis-aligned), or
-   out_j = sum_i w_ij s_i v_i / sum_i w_ij s_i with w_ij = max(0, N_j . n_i) (clustered). sample_values: 3M floats
+   out_a = sum_i w_ia s_i v_i / A_a over the samples i of a's voxel, w_ia the corrected split
+   weights of sample_weights (clustered: the area correction on the sample's own cluster, 0 on
+   the others), so the power sum_a A_a out_a equals sum_i e_i v_i. sample_values: 3M floats
    (for instance rho_i D_i from the engine's own shadow maps); out: 3N floats.
    Errors: INVALID_ARGUMENT. O(M). */
 RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out);
@@ -15092,6 +15106,7 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
 #define RAD__VP_MARGIN 0.4827f           /* voxels of padding around the scene bounds */
 #define RAD__VP_CHUNK_RAYS (1u << 21)     /* face-ray hits kept at once */
 #define RAD__VP_PAIRS 16384u              /* pair records per task for sampled visibility */
+#define RAD__VP_MATCH_STEPS 32u           /* steps of the symmetric row-sum scaling (step 6) */
 
 typedef struct rad__vp_pair {
     uint32_t i, j;
@@ -15107,6 +15122,7 @@ RAD_API void rad_vp_options_default(rad_vp_options *o)
     o->weights = RAD_VP_WEIGHTS_SQUARED;
     o->ray_epsilon = 1e-5f;
     o->visibility_rays = 16;
+    o->share_rays = 16;
     o->kind = RAD_VP_AXIS_ALIGNED;
     o->max_clusters = 6;
     o->metric_columns = 64;
@@ -15198,6 +15214,12 @@ typedef struct rad__vp_build {
     uint32_t *sample_voxel;      /* M */
     float *eff;                  /* M: s_i times the sum of its corrected weights (the clamp) */
     float *rowf;                 /* N: 1 / max(1, row sum) */
+    float *share;                /* M: the traced share of each sample (step 6), NULL when off */
+    rad_hit *share_hits;         /* RAD__RAY_BATCH per task */
+    double *target, *dscale, *dnext; /* N: sum_i w_ia s_i share_i; the symmetric scaling d_a */
+    const uint64_t *csr_off;     /* step 6 on sparse rows: the full CSR rows of P */
+    const uint32_t *csr_col;
+    float *csr_val;
     /* clustering (RAD_VP_CLUSTERED) */
     float *vscale;               /* per voxel: exact area / sum of s_i */
     uint32_t *cols, kc, nmax;    /* the metric's column samples */
@@ -15598,6 +15620,8 @@ static int rad__vp_grow_csr(const rad_allocator *A, uint32_t **col, float **val,
    chunk's upper parts (columns from the row voxel's first patch on) kept as CSR; then the
    mirror, step 6 and the drop threshold on the CSR rows. The entries and their arithmetic are
    those of the dense path, so the kept values are the same bits. */
+static rad_result rad__vp_match(rad__vp_build *b, const rad__ctx *cc, uint32_t T);
+
 static rad_result rad__vp_sparse_rows(rad__vp_build *b, const rad__ctx *c, uint32_t T, size_t budget)
 {
     rad_virtual_patches *vp = b->vp;
@@ -15665,7 +15689,12 @@ static rad_result rad__vp_sparse_rows(rad__vp_build *b, const rad__ctx *c, uint3
             memcpy(col + pos[p], ucol + uoff[p], sizeof(uint32_t) * (size_t)(uoff[p + 1] - uoff[p]));
             memcpy(val + pos[p], uval + uoff[p], sizeof(float) * (size_t)(uoff[p + 1] - uoff[p]));
         }
-        /* step 6 as rad__vp_rowsum_row and rad__vp_divide_row, on the non-zeros */
+        /* step 6 as rad__vp_match, rad__vp_rowsum_row and rad__vp_divide_row, on the non-zeros */
+        b->csr_off = off, b->csr_col = col, b->csr_val = val;
+        r = rad__vp_match(b, &quiet, T);
+        b->csr_off = NULL, b->csr_col = NULL, b->csr_val = NULL;
+    }
+    if (r == RAD_SUCCESS) {
         for (p = 0; p < N; ++p) {
             double sum = 0.0;
             for (e = off[p]; e < off[p + 1]; ++e) sum += (double)val[e];
@@ -15999,6 +16028,91 @@ static rad_result rad__vp_candidates(rad__vp_build *b, const rad__ctx *c, uint64
 
 /* BUILD steps 5 and 6: the form factors into vp->matrix (dense: 'bytes' of N x N floats; sparse
    rows: chunks of row voxels), with the task scratch in b (freed by the caller) */
+/* Step 6, the traced shares: each sample casts share_rays cosine-distributed rays; the
+   fraction that hits the front of a triangle is its row sum of the exact form factors (a
+   back face absorbs, the sky takes the rest). One voxel's samples per call. */
+static rad_result rad__vp_share_row(void *data, uint32_t u, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    const rad_virtual_patches *vp = b->vp;
+    uint32_t K = b->o.share_rays, i, k, n = 0;
+    rad_ray *rays = b->rays + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = b->share_hits + (size_t)task * RAD__RAY_BATCH;
+    for (i = vp->sample_first[u]; i < vp->sample_first[u + 1]; ++i) {
+        const float *p = vp->sample_positions + 3 * (size_t)i, *nr = vp->sample_normals + 3 * (size_t)i;
+        float t1[3], t2[3];
+        uint32_t h = rad__hash(i * 0x9E3779B9u ^ 0x5BD1E995u), front = 0;
+        int q;
+        rad__tangent_frame(nr, t1, t2);
+        for (k = 0; k < K; ++k) {
+            rad__cosine_dir(nr, t1, t2, k, K, h, rays[k].dir);
+            for (q = 0; q < 3; ++q) rays[k].origin[q] = p[q] + nr[q] * b->eps;
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = FLT_MAX;
+        }
+        if (b->rc->intersect(b->rc->user, rays, K, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        for (k = 0; k < K; ++k)
+            if (hits[k].triangle != RAD_NONE && rad__dot(rays[k].dir, b->S->normals + 3 * (size_t)hits[k].triangle) < 0.0f) front++;
+        b->share[i] = (float)front / (float)K;
+        n += K;
+    }
+    b->rays_cast[task] += n;
+    return RAD_SUCCESS;
+}
+
+/* one step of the symmetric scaling d_a <- sqrt(d_a t_a / sum_c P_ac d_c) on row a (dense P
+   or the full CSR rows); a row with no exchange keeps its d */
+static rad_result rad__vp_match_row(void *data, uint32_t p, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    uint32_t N = b->vp->count, c;
+    double sum = 0.0;
+    (void)task;
+    if (b->csr_off) {
+        uint64_t e;
+        for (e = b->csr_off[p]; e < b->csr_off[p + 1]; ++e) sum += (double)b->csr_val[e] * b->dscale[b->csr_col[e]];
+    } else {
+        const float *row = b->P + (size_t)p * N;
+        for (c = 0; c < N; ++c) sum += (double)row[c] * b->dscale[c];
+    }
+    b->dnext[p] = sum > 0.0 ? sqrt(b->dscale[p] * b->target[p] / sum) : b->dscale[p];
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__vp_match_apply(void *data, uint32_t p, uint32_t task)
+{
+    rad__vp_build *b = (rad__vp_build *)data;
+    uint32_t N = b->vp->count, c;
+    double dp = b->dscale[p];
+    (void)task;
+    if (b->csr_off) {
+        uint64_t e;
+        for (e = b->csr_off[p]; e < b->csr_off[p + 1]; ++e) b->csr_val[e] = (float)((double)b->csr_val[e] * dp * b->dscale[b->csr_col[e]]);
+    } else {
+        float *row = b->P + (size_t)p * N;
+        for (c = 0; c < N; ++c) row[c] = (float)((double)row[c] * dp * b->dscale[c]);
+    }
+    return RAD_SUCCESS;
+}
+
+/* Step 6, matching: scales the symmetric P to P_ac d_a d_c so that every row's exchange
+   sum_c P_ac equals its patch's traced share t_a = sum_i w_ia s_i share_i (the row sums of the
+   exact form factors, which the point kernel misses near corners and in crowded voxels).
+   P stays symmetric, so reciprocity holds; the cap that follows then rarely acts. */
+static rad_result rad__vp_match(rad__vp_build *b, const rad__ctx *cc, uint32_t T)
+{
+    uint32_t N = b->vp->count, it, p;
+    rad_result r = RAD_SUCCESS;
+    if (!b->share) return RAD_SUCCESS;
+    for (p = 0; p < N; ++p) b->dscale[p] = 1.0;
+    for (it = 0; it < RAD__VP_MATCH_STEPS && r == RAD_SUCCESS; ++it) {
+        r = rad__for_rows(cc, N, T, rad__vp_match_row, b);
+        if (r == RAD_SUCCESS) memcpy(b->dscale, b->dnext, sizeof(double) * N);
+    }
+    if (r == RAD_SUCCESS) r = rad__for_rows(cc, N, T, rad__vp_match_apply, b);
+    return r;
+}
+
 static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size_t bytes)
 {
     rad_virtual_patches *vp = b->vp;
@@ -16045,6 +16159,28 @@ static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     memset(b->rays_cast, 0, sizeof(uint64_t) * T);
+    /* step 6's traced shares, before the pairs (they need only the samples) */
+    if (!b->o.keep_row_sums && !b->o.cap_row_sums && !b->o.skip_visibility) {
+        uint32_t s2, v2, a2;
+        rad__ctx quiet = *c;
+        quiet.progress = NULL;
+        b->share = (float *)rad__alloc_array(A, vp->sample_count, sizeof(float));
+        b->share_hits = (rad_hit *)rad__alloc_array(A, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
+        b->target = (double *)rad__alloc_array(A, N, sizeof(double));
+        b->dscale = (double *)rad__alloc_array(A, N, sizeof(double));
+        b->dnext = (double *)rad__alloc_array(A, N, sizeof(double));
+        if (!b->share || !b->share_hits || !b->target || !b->dscale || !b->dnext) return RAD_ERROR_OUT_OF_MEMORY;
+        r = rad__for_rows(&quiet, vp->voxel_count, T, rad__vp_share_row, b);
+        if (r != RAD_SUCCESS) return r;
+        memset(b->target, 0, sizeof(double) * N);
+        for (v2 = 0; v2 < vp->voxel_count; ++v2)
+            for (s2 = vp->sample_first[v2]; s2 < vp->sample_first[v2 + 1]; ++s2)
+                for (a2 = 0; a2 < 6; ++a2) {
+                    float w = vp->sample_weights[6 * (size_t)s2 + a2];
+                    if (w > 0.0f)
+                        b->target[vp->voxel_patch[6 * (size_t)v2 + a2]] += (double)w * (double)vp->sample_areas[s2] * (double)b->share[s2];
+                }
+    }
     /* progress of this stage maps to [0.1, 1] */
     if (c->progress && c->progress(c->progress_user, 0.1f)) return RAD_ERROR_CANCELLED;
     if (b->o.storage == RAD_STORAGE_SPARSE) {
@@ -16057,6 +16193,7 @@ static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size
     if (r == RAD_SUCCESS) {
         cc.progress = NULL;
         r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
+        if (r == RAD_SUCCESS) r = rad__vp_match(b, &cc, T);
         if (r == RAD_SUCCESS && !b->o.keep_row_sums) r = rad__for_rows(&cc, N, T, rad__vp_rowsum_row, b);
         else if (r == RAD_SUCCESS)
             for (i = 0; i < N; ++i) b->rowf[i] = 1.0f;
@@ -16327,6 +16464,11 @@ done:
     rad__free(A, b->pairs);
     rad__free(A, b->eff);
     rad__free(A, b->rowf);
+    rad__free(A, b->share);
+    rad__free(A, b->share_hits);
+    rad__free(A, b->target);
+    rad__free(A, b->dscale);
+    rad__free(A, b->dnext);
     rad__free(A, b->vscale);
     rad__free(A, b->cols);
     rad__free(A, b->cscratch);
@@ -16355,6 +16497,7 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
     if (options) b.o = *options; else rad_vp_options_default(&b.o);
     if (b.o.resolution == 0) b.o.resolution = 16;
     if (b.o.face_points == 0) b.o.face_points = 16;
+    if (b.o.share_rays == 0) b.o.share_rays = 16;
     if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
     if (b.o.max_clusters == 0) b.o.max_clusters = 6;
     if (b.o.metric_columns == 0) b.o.metric_columns = 64;
@@ -16369,12 +16512,12 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
         }
         if (b.o.voxel_size[k] > 0.0f) given++;
     }
-    if ((given != 0 && given != 3) || b.o.face_points > 4096u || b.o.visibility_rays > RAD__RAY_BATCH || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
+    if ((given != 0 && given != 3) || b.o.face_points > 4096u || b.o.visibility_rays > RAD__RAY_BATCH || b.o.share_rays > RAD__RAY_BATCH || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
         !(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || (!b.o.skip_visibility && !raycaster->occluded) ||
         (b.o.storage != RAD_STORAGE_DENSE && b.o.storage != RAD_STORAGE_SPARSE) || !rad__finite(b.o.drop_threshold) ||
         b.o.drop_threshold < 0.0f) {
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size must be all 0 or all > 0; face_points <= 4096; visibility_rays "
-                 "<= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility; "
+                 "and share_rays <= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility; "
                  "storage dense or sparse; drop_threshold finite and >= 0",
                  (double)b.o.ray_epsilon);
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -16477,12 +16620,11 @@ RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const floa
             uint32_t p = vp->voxel_patch[6 * (size_t)v + a];
             double acc[3] = { 0.0, 0.0, 0.0 }, wsum = 0.0;
             if (p == RAD_NONE) continue;
+            /* the weights that make the patch's area and form factors (clustered: 1 on the
+               sample's own cluster), so sum_a A_a out_a = sum_i e_i v_i: a cluster that took
+               its neighbours' values by normal would emit power its samples do not send */
             for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
                 double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
-                if (vp->kind == RAD_VP_CLUSTERED) {
-                    double cosw = (double)rad__dot(vp->normals + 3 * (size_t)p, vp->sample_normals + 3 * (size_t)s);
-                    w = cosw > 0.0 ? cosw * (double)vp->sample_areas[s] : 0.0;
-                }
                 wsum += w;
                 for (k = 0; k < 3; ++k) acc[k] += w * (double)sample_values[3 * (size_t)s + k];
             }
