@@ -3665,6 +3665,11 @@ static void rad__parallel_default(void *user, uint32_t count, rad_task_fn fn, vo
 #ifdef _OPENMP
     int i, n = (int)count;
     (void)user;
+    /* one task: no parallel region (it would still wake the whole team and wait for it) */
+    if (count <= 1u) {
+        if (count) fn(data, 0);
+        return;
+    }
 #pragma omp parallel for schedule(dynamic, 1)
     for (i = 0; i < n; ++i) fn(data, (uint32_t)i);
 #else
@@ -3672,6 +3677,19 @@ static void rad__parallel_default(void *user, uint32_t count, rad_task_fn fn, vo
     (void)user;
     for (i = 0; i < count; ++i) fn(data, i);
 #endif
+}
+
+/* Per-frame calls (rad_temporal_step, rad_vp_lights_update) whose work is estimated below this
+   many nanoseconds of one core run as one task on the calling thread when the default
+   parallel_for is in use: an OpenMP region costs microseconds on an idle machine and up to
+   milliseconds when other processes hold the cores (the threads of a region wait for each
+   other). Every such call computes each output in one task in a fixed order, so the bits do
+   not depend on it. A caller's own parallel_for always gets the tasks. */
+#define RAD__SERIAL_WORK_NS 200000.0
+static uint32_t rad__frame_tasks(const rad__ctx *c, uint32_t tasks, double work_ns)
+{
+    if (c->parallel_for == rad__parallel_default && work_ns < RAD__SERIAL_WORK_NS) return 1u;
+    return tasks ? tasks : 1u;
 }
 
 static void rad__ctx_init(rad__ctx *c, const rad_context *ctx)
@@ -14953,6 +14971,8 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
     if (t->restart_all && t->o.adaptive) memset(t->count, 0, (size_t)t->n * sizeof(uint32_t));
     t->restart_all = 0;
     st.tasks = t->c.tasks < t->n ? t->c.tasks : t->n;
+    /* about 5 ns a draw once the tables outgrow the caches (random reads, overlapped) */
+    st.tasks = rad__frame_tasks(&t->c, st.tasks, 5.0 * (double)t->n * (double)t->o.samples * (double)t->table_count);
     t->c.parallel_for(t->c.parallel_user, st.tasks, rad__temporal_task, &st);
     if (rad__check_output(&t->c, "rad_temporal_step", t->B_next, n3) != RAD_SUCCESS) {
         /* the step is undone: B and the frame stay as they were; adaptive weights restart */
@@ -17050,7 +17070,17 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     }
     rows = (M + RAD__VP_LIGHTS_CHUNK - 1) / RAD__VP_LIGHTS_CHUNK;
     T = c.tasks < rows ? c.tasks : rows;
-    if (T == 0) T = 1;
+    /* the work: a few ns of arithmetic per sample and light, and for the samples whose turn
+       it is a shadow ray (a few hundred ns; about half of them face the light) */
+    {
+        double work = 0.0;
+        for (l = 0; l < light_count; ++l) {
+            if (lights[l].type == RAD_LIGHT_SKY) continue;
+            work += 10.0 * (double)M;
+            if (!j.skip[l]) work += 150.0 * (j.full[l] ? (double)M : (double)M / (double)s->period);
+        }
+        T = rad__frame_tasks(&c, T, work);
+    }
     j.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
     j.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
     j.ray_sample = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
