@@ -3679,8 +3679,8 @@ static void rad__parallel_default(void *user, uint32_t count, rad_task_fn fn, vo
 #endif
 }
 
-/* Per-frame calls (rad_temporal_step, rad_vp_lights_update) whose work is estimated below this
-   many nanoseconds of one core run as one task on the calling thread when the default
+/* Per-frame calls (rad_temporal_step, rad_vp_lights_update, rad_vp_gather_table_apply) whose
+   work is estimated below this many nanoseconds of one core run as one task on the calling thread when the default
    parallel_for is in use: an OpenMP region costs microseconds on an idle machine and up to
    milliseconds when other processes hold the cores (the threads of a region wait for each
    other). Every such call computes each output in one task in a fixed order, so the bits do
@@ -16806,6 +16806,8 @@ RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, c
     j.values = values, j.out = out, j.count = table->count, j.pass = 2;
     /* one task per 4096 points at least: below that the threads cost more than the work */
     j.tasks = c.tasks < (table->count + 4095u) / 4096u ? c.tasks : (table->count + 4095u) / 4096u;
+    /* about 1.5 ns an entry (random reads of 3 floats per patch, mostly cached) */
+    j.tasks = rad__frame_tasks(&c, j.tasks, 1.5 * (double)table->offsets[table->count]);
     if (j.tasks <= 1) rad__vp_table_task(&j, 0); /* a small mesh: no thread wake-up at all */
     else c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
     return RAD_SUCCESS;
