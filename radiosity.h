@@ -16937,7 +16937,9 @@ typedef struct rad__vp_lights_job {
     rad_vp_lights *s;
     const rad_light *lights;
     uint32_t light_count, phase;
-    uint8_t full[RAD_VP_LIGHTS_MAX], skip[RAD_VP_LIGHTS_MAX];
+    uint8_t full[RAD_VP_LIGHTS_MAX], skip[RAD_VP_LIGHTS_MAX], cone[RAD_VP_LIGHTS_MAX];
+    float axis[RAD_VP_LIGHTS_MAX][3]; /* spot: the unit axis, and a bound below the cosine of the */
+    float cos_out[RAD_VP_LIGHTS_MAX]; /* outer angle outside which it gives nothing */
     float eps, diagonal;
     rad_ray *rays;           /* RAD__RAY_BATCH per task */
     uint8_t *occ;            /* RAD__RAY_BATCH per task */
@@ -16958,6 +16960,16 @@ static rad_result rad__vp_lights_flush(rad__vp_lights_job *j, uint32_t task, uin
     return RAD_SUCCESS;
 }
 
+/* 1 when p lies surely outside spot light l's cone (its unshadowed light there is 0): a test
+   without the cosines rad__light_unshadowed takes of the angles at every call */
+static int rad__vp_light_outside(const rad__vp_lights_job *j, uint32_t l, const float *p)
+{
+    float v[3];
+    if (!j->cone[l]) return 0;
+    rad__sub(v, j->lights[l].position, p);
+    return -rad__dot(v, j->axis[l]) < j->cos_out[l] * (float)sqrt((double)rad__dot(v, v));
+}
+
 static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
 {
     rad__vp_lights_job *j = (rad__vp_lights_job *)data;
@@ -16968,15 +16980,17 @@ static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
     rad_result r;
     int k;
     if (i1 > vp->sample_count) i1 = vp->sample_count;
-    /* 1. the shadow rays of this update: the samples whose turn it is, facing the light */
-    for (i = i0; i < i1; ++i) {
-        const float *p = vp->sample_positions + 3 * (size_t)i, *n = s->normals + 3 * (size_t)i;
-        for (l = 0; l < j->light_count; ++l) {
-            const rad_light *li = &j->lights[l];
+    /* 1. the shadow rays of this update: the samples whose turn it is ((i + l) mod P = phase:
+       every P-th sample from the first such one), facing the light */
+    for (l = 0; l < j->light_count; ++l) {
+        const rad_light *li = &j->lights[l];
+        uint32_t step = j->full[l] ? 1u : P, first = i0;
+        if (li->type == RAD_LIGHT_SKY || j->skip[l]) continue;
+        if (step > 1u) first = i0 + ((j->phase + P - l % P) % P + P - i0 % P) % P;
+        for (i = first; i < i1; i += step) {
+            const float *p = vp->sample_positions + 3 * (size_t)i, *n = s->normals + 3 * (size_t)i;
             float w[3], v[3];
-            if (li->type == RAD_LIGHT_SKY || j->skip[l]) continue;
-            if (!j->full[l] && (i % P + l % P) % P != j->phase) continue;
-            if (!rad__light_unshadowed(li, j->diagonal, p, n, w, v)) continue;
+            if (rad__vp_light_outside(j, l, p) || !rad__light_unshadowed(li, j->diagonal, p, n, w, v)) continue;
             rad__shadow_ray(j->rays + at + nr, p, n, li->type == RAD_LIGHT_DIRECTIONAL ? NULL : li->position, NULL,
                             li->type == RAD_LIGHT_DIRECTIONAL ? v : NULL, j->eps);
             j->ray_sample[at + nr] = i;
@@ -16997,7 +17011,7 @@ static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
             float w[3], v[3];
             if (li->type == RAD_LIGHT_SKY) {
                 for (k = 0; k < 3; ++k) acc[k] += (double)(li->color[k] * s->sky[i]);
-            } else if (s->vis[l][i] && rad__light_unshadowed(li, j->diagonal, p, n, w, v)) {
+            } else if (s->vis[l][i] && !rad__vp_light_outside(j, l, p) && rad__light_unshadowed(li, j->diagonal, p, n, w, v)) {
                 for (k = 0; k < 3; ++k) acc[k] += (double)w[k];
             }
         }
@@ -17046,6 +17060,15 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
         else if (memcmp(key, s->key[l], sizeof key)) settled[l] = 0;
         else settled[l] = s->settled[l] < s->period ? s->settled[l] + 1u : s->period;
         j.skip[l] = !j.full[l] && settled[l] >= s->period;
+        if (lights[l].type == RAD_LIGHT_SPOT) {
+            /* cos_out a little below the cosine rad__light_atten compares with, so that only
+               samples surely outside the cone are skipped (the rest take the exact test) */
+            float co = (float)cos((double)lights[l].outer_angle);
+            memcpy(j.axis[l], lights[l].direction, sizeof(j.axis[l]));
+            rad__normalize(j.axis[l]);
+            j.cos_out[l] = co - 1e-3f;
+            j.cone[l] = co - 1e-3f > -1.0f;
+        }
     }
     if (has_sky && !s->sky) {
         /* the sky's visibility depends on the geometry only: traced once, with a unit sky */
