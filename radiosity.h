@@ -172,7 +172,11 @@
        through rad_context.parallel_for; the default runs them one after another, or on OpenMP
        threads when the implementing file is compiled with OpenMP. Tasks write disjoint
        outputs and reductions happen in a fixed order, so results are bit-identical whatever
-       the number of threads (same inputs, same seed, same build).
+       the number of threads (same inputs, same seed, same build). With the default, a call
+       of one task runs on the calling thread, and the per-frame calls (rad_temporal_step,
+       rad_vp_lights_update, rad_vp_gather_table_apply) take one task when their work is
+       estimated below about 0.2 ms; with task_count 1 they always do (an OpenMP region
+       waits for all its threads, which on a shared machine costs a time slice).
        rad_context.progress is called on the calling thread between batches of tasks with the
        fraction done; returning non-zero cancels the call, which frees what it allocated and
        returns RAD_ERROR_CANCELLED.
