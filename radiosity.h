@@ -172,7 +172,11 @@
        through rad_context.parallel_for; the default runs them one after another, or on OpenMP
        threads when the implementing file is compiled with OpenMP. Tasks write disjoint
        outputs and reductions happen in a fixed order, so results are bit-identical whatever
-       the number of threads (same inputs, same seed, same build).
+       the number of threads (same inputs, same seed, same build). With the default, a call
+       of one task runs on the calling thread, and the per-frame calls (rad_temporal_step,
+       rad_vp_lights_update, rad_vp_gather_table_apply) take one task when their work is
+       estimated below about 0.2 ms; with task_count 1 they always do (an OpenMP region
+       waits for all its threads, which on a shared machine costs a time slice).
        rad_context.progress is called on the calling thread between batches of tasks with the
        fraction done; returning non-zero cancels the call, which frees what it allocated and
        returns RAD_ERROR_CANCELLED.
@@ -3679,6 +3683,11 @@ static void rad__parallel_default(void *user, uint32_t count, rad_task_fn fn, vo
 #ifdef _OPENMP
     int i, n = (int)count;
     (void)user;
+    /* one task: no parallel region (it would still wake the whole team and wait for it) */
+    if (count <= 1u) {
+        if (count) fn(data, 0);
+        return;
+    }
 #pragma omp parallel for schedule(dynamic, 1)
     for (i = 0; i < n; ++i) fn(data, (uint32_t)i);
 #else
@@ -3686,6 +3695,19 @@ static void rad__parallel_default(void *user, uint32_t count, rad_task_fn fn, vo
     (void)user;
     for (i = 0; i < count; ++i) fn(data, i);
 #endif
+}
+
+/* Per-frame calls (rad_temporal_step, rad_vp_lights_update, rad_vp_gather_table_apply) whose
+   work is estimated below this many nanoseconds of one core run as one task on the calling thread when the default
+   parallel_for is in use: an OpenMP region costs microseconds on an idle machine and up to
+   milliseconds when other processes hold the cores (the threads of a region wait for each
+   other). Every such call computes each output in one task in a fixed order, so the bits do
+   not depend on it. A caller's own parallel_for always gets the tasks. */
+#define RAD__SERIAL_WORK_NS 200000.0
+static uint32_t rad__frame_tasks(const rad__ctx *c, uint32_t tasks, double work_ns)
+{
+    if (c->parallel_for == rad__parallel_default && work_ns < RAD__SERIAL_WORK_NS) return 1u;
+    return tasks ? tasks : 1u;
 }
 
 static void rad__ctx_init(rad__ctx *c, const rad_context *ctx)
@@ -15078,6 +15100,8 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
     if (t->restart_all && t->o.adaptive) memset(t->count, 0, (size_t)t->n * sizeof(uint32_t));
     t->restart_all = 0;
     st.tasks = t->c.tasks < t->n ? t->c.tasks : t->n;
+    /* about 5 ns a draw once the tables outgrow the caches (random reads, overlapped) */
+    st.tasks = rad__frame_tasks(&t->c, st.tasks, 5.0 * (double)t->n * (double)t->o.samples * (double)t->table_count);
     t->c.parallel_for(t->c.parallel_user, st.tasks, rad__temporal_task, &st);
     if (rad__check_output(&t->c, "rad_temporal_step", t->B_next, n3) != RAD_SUCCESS) {
         /* the step is undone: B and the frame stay as they were; adaptive weights restart */
@@ -17039,6 +17063,8 @@ RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, c
     j.values = values, j.out = out, j.count = table->count, j.pass = 2;
     /* one task per 4096 points at least: below that the threads cost more than the work */
     j.tasks = c.tasks < (table->count + 4095u) / 4096u ? c.tasks : (table->count + 4095u) / 4096u;
+    /* about 1.5 ns an entry (random reads of 3 floats per patch, mostly cached) */
+    j.tasks = rad__frame_tasks(&c, j.tasks, 1.5 * (double)table->offsets[table->count]);
     if (j.tasks <= 1) rad__vp_table_task(&j, 0); /* a small mesh: no thread wake-up at all */
     else c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
     return RAD_SUCCESS;
@@ -17168,7 +17194,9 @@ typedef struct rad__vp_lights_job {
     rad_vp_lights *s;
     const rad_light *lights;
     uint32_t light_count, phase;
-    uint8_t full[RAD_VP_LIGHTS_MAX], skip[RAD_VP_LIGHTS_MAX];
+    uint8_t full[RAD_VP_LIGHTS_MAX], skip[RAD_VP_LIGHTS_MAX], cone[RAD_VP_LIGHTS_MAX];
+    float axis[RAD_VP_LIGHTS_MAX][3]; /* spot: the unit axis, and a bound below the cosine of the */
+    float cos_out[RAD_VP_LIGHTS_MAX]; /* outer angle outside which it gives nothing */
     float eps, diagonal;
     rad_ray *rays;           /* RAD__RAY_BATCH per task */
     uint8_t *occ;            /* RAD__RAY_BATCH per task */
@@ -17189,6 +17217,16 @@ static rad_result rad__vp_lights_flush(rad__vp_lights_job *j, uint32_t task, uin
     return RAD_SUCCESS;
 }
 
+/* 1 when p lies surely outside spot light l's cone (its unshadowed light there is 0): a test
+   without the cosines rad__light_unshadowed takes of the angles at every call */
+static int rad__vp_light_outside(const rad__vp_lights_job *j, uint32_t l, const float *p)
+{
+    float v[3];
+    if (!j->cone[l]) return 0;
+    rad__sub(v, j->lights[l].position, p);
+    return -rad__dot(v, j->axis[l]) < j->cos_out[l] * (float)sqrt((double)rad__dot(v, v));
+}
+
 static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
 {
     rad__vp_lights_job *j = (rad__vp_lights_job *)data;
@@ -17199,15 +17237,17 @@ static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
     rad_result r;
     int k;
     if (i1 > vp->sample_count) i1 = vp->sample_count;
-    /* 1. the shadow rays of this update: the samples whose turn it is, facing the light */
-    for (i = i0; i < i1; ++i) {
-        const float *p = vp->sample_positions + 3 * (size_t)i, *n = s->normals + 3 * (size_t)i;
-        for (l = 0; l < j->light_count; ++l) {
-            const rad_light *li = &j->lights[l];
+    /* 1. the shadow rays of this update: the samples whose turn it is ((i + l) mod P = phase:
+       every P-th sample from the first such one), facing the light */
+    for (l = 0; l < j->light_count; ++l) {
+        const rad_light *li = &j->lights[l];
+        uint32_t step = j->full[l] ? 1u : P, first = i0;
+        if (li->type == RAD_LIGHT_SKY || j->skip[l]) continue;
+        if (step > 1u) first = i0 + ((j->phase + P - l % P) % P + P - i0 % P) % P;
+        for (i = first; i < i1; i += step) {
+            const float *p = vp->sample_positions + 3 * (size_t)i, *n = s->normals + 3 * (size_t)i;
             float w[3], v[3];
-            if (li->type == RAD_LIGHT_SKY || j->skip[l]) continue;
-            if (!j->full[l] && (i % P + l % P) % P != j->phase) continue;
-            if (!rad__light_unshadowed(li, j->diagonal, p, n, w, v)) continue;
+            if (rad__vp_light_outside(j, l, p) || !rad__light_unshadowed(li, j->diagonal, p, n, w, v)) continue;
             rad__shadow_ray(j->rays + at + nr, p, n, li->type == RAD_LIGHT_DIRECTIONAL ? NULL : li->position, NULL,
                             li->type == RAD_LIGHT_DIRECTIONAL ? v : NULL, j->eps);
             j->ray_sample[at + nr] = i;
@@ -17228,7 +17268,7 @@ static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
             float w[3], v[3];
             if (li->type == RAD_LIGHT_SKY) {
                 for (k = 0; k < 3; ++k) acc[k] += (double)(li->color[k] * s->sky[i]);
-            } else if (s->vis[l][i] && rad__light_unshadowed(li, j->diagonal, p, n, w, v)) {
+            } else if (s->vis[l][i] && !rad__vp_light_outside(j, l, p) && rad__light_unshadowed(li, j->diagonal, p, n, w, v)) {
                 for (k = 0; k < 3; ++k) acc[k] += (double)w[k];
             }
         }
@@ -17277,6 +17317,15 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
         else if (memcmp(key, s->key[l], sizeof key)) settled[l] = 0;
         else settled[l] = s->settled[l] < s->period ? s->settled[l] + 1u : s->period;
         j.skip[l] = !j.full[l] && settled[l] >= s->period;
+        if (lights[l].type == RAD_LIGHT_SPOT) {
+            /* cos_out a little below the cosine rad__light_atten compares with, so that only
+               samples surely outside the cone are skipped (the rest take the exact test) */
+            float co = (float)cos((double)lights[l].outer_angle);
+            memcpy(j.axis[l], lights[l].direction, sizeof(j.axis[l]));
+            rad__normalize(j.axis[l]);
+            j.cos_out[l] = co - 1e-3f;
+            j.cone[l] = co - 1e-3f > -1.0f;
+        }
     }
     if (has_sky && !s->sky) {
         /* the sky's visibility depends on the geometry only: traced once, with a unit sky */
@@ -17303,7 +17352,17 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     }
     rows = (M + RAD__VP_LIGHTS_CHUNK - 1) / RAD__VP_LIGHTS_CHUNK;
     T = c.tasks < rows ? c.tasks : rows;
-    if (T == 0) T = 1;
+    /* the work: a few ns of arithmetic per sample and light, and for the samples whose turn
+       it is a shadow ray (a few hundred ns; about half of them face the light) */
+    {
+        double work = 0.0;
+        for (l = 0; l < light_count; ++l) {
+            if (lights[l].type == RAD_LIGHT_SKY) continue;
+            work += 10.0 * (double)M;
+            if (!j.skip[l]) work += 150.0 * (j.full[l] ? (double)M : (double)M / (double)s->period);
+        }
+        T = rad__frame_tasks(&c, T, work);
+    }
     j.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
     j.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
     j.ray_sample = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));

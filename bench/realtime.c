@@ -7,7 +7,8 @@
      - per frame, medians over the frames of a light circling the scene: the E update
        (rad_vp_lights: every sample re-tested each frame, and a budget of M/4 rays per light),
        the temporal step (k = 10, feedback; also on one thread), the per-vertex gather of every
-       mesh (rad_vp_gather_table_apply of E + L);
+       mesh (rad_vp_gather_table_apply of E + L); wall clock with all threads, and the thread CPU
+       time of the same frames on one thread;
      - the lag after the light jumps across the scene: frames until the patches' power
        sum A (E + L) is within 1% of the converged value of the new position (and stays there
        10 frames), with w = 0.9 (exact E, and the M/4 budget) and with the adaptive weight
@@ -48,6 +49,13 @@ static double now_ms(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+/* CPU time of the calling thread: what one core spent, whatever the machine's load */
+static double cpu_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
     return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
 }
 static void check(rad_result r, const char *what)
@@ -215,7 +223,7 @@ static void run(const char *name, const rad_scene_desc *desc, const rad_light *f
     rad_solve_options so;
     uint32_t N, M, i, m, f, frames = quick ? 40 : 120, nl = fixed_count + 1, res, V = 0, variant, lag[3];
     float *E, *L, *B, *Lref, **vout, **vref;
-    double t, t_build, t_tables, t_gt, *te, *ts, *tg, st1[64], med[2][3], pref, rms = 0.0, nrm = 0.0, pacc = 0.0;
+    double t, t_build, t_tables, t_gt, *te, *ts, *tg, st1[64], med[4][3], pref, rms = 0.0, nrm = 0.0, pacc = 0.0;
     double vl1 = 0.0, vsum = 0.0, noise = 0.0;
     if (fixed_count) memcpy(lights, fixed, sizeof(rad_light) * fixed_count);
     memset(&lights[fixed_count], 0, sizeof(rad_light));
@@ -258,47 +266,53 @@ static void run(const char *name, const rad_scene_desc *desc, const rad_light *f
     emit("| %s | %u | %u | %u | %llu | %.1f s | %.0f MiB | %.0f ms | %.0f ms |", name, res, N, M,
          (unsigned long long)vp->matrix.row_offsets[N], t_build / 1e3, (double)cnt.peak / 1048576.0, t_tables, t_gt);
 
-    /* 1. the frames of a circling light: exact E, then a budget of M/4 rays per light */
-    for (variant = 0; variant < 2; ++variant) {
+    /* 1. the frames of a circling light: exact E, then a budget of M/4 rays per light; all
+       threads (wall clock), then one thread (its CPU time: the work of one core per frame, which
+       the load of a shared machine does not inflate) */
+    memset(&one, 0, sizeof one);
+    one.parallel_for = serial_for, one.task_count = 1;
+    for (variant = 0; variant < 4; ++variant) {
+        const rad_context *vc = variant >= 2 ? &one : NULL;
+        double (*clk)(void) = variant >= 2 ? cpu_ms : now_ms;
         rad_temporal_options_default(&to);
         to.mode = RAD_TEMPORAL_FEEDBACK, to.samples = 10, to.weight = 0.9f;
-        check(rad_temporal_create(tp1, 1, vp->albedo, &to, NULL, &tp), "rad_temporal_create");
+        check(rad_temporal_create(tp1, 1, vp->albedo, &to, vc, &tp), "rad_temporal_create");
         rad_vp_lights_options_default(&lo);
-        lo.rays_per_frame = variant ? (M + 3) / 4 : 0;
+        lo.rays_per_frame = variant & 1 ? (M + 3) / 4 : 0;
         lo.direct.include_emitters = emitters;
         lo.direct.light_samples = 4;
-        check(rad_vp_lights_create(vp, &rc, &lo, NULL, &dyn), "rad_vp_lights_create");
+        check(rad_vp_lights_create(vp, &rc, &lo, vc, &dyn), "rad_vp_lights_create");
         for (f = 0; f < frames + 4; ++f) { /* 4 warm-up frames: the lights' first full test */
             double t0, t1, t2, t3;
             place(&lights[fixed_count], centre, radius, 6.2831853f * (float)f / (float)frames);
-            t0 = now_ms();
-            check(rad_vp_lights_update(dyn, lights, nl, E, NULL), "rad_vp_lights_update");
-            t1 = now_ms();
+            t0 = clk();
+            check(rad_vp_lights_update(dyn, lights, nl, E, vc), "rad_vp_lights_update");
+            t1 = clk();
             check(rad_temporal_step(tp, E, NULL, L), "rad_temporal_step");
-            t2 = now_ms();
+            t2 = clk();
             for (i = 0; i < 3 * N; ++i) B[i] = E[i] + L[i];
-            for (m = 0; m < desc->mesh_count; ++m) check(rad_vp_gather_table_apply(gt[m], B, vout[m], NULL), "gather");
-            t3 = now_ms();
+            for (m = 0; m < desc->mesh_count; ++m) check(rad_vp_gather_table_apply(gt[m], B, vout[m], vc), "gather");
+            t3 = clk();
             if (f >= 4) te[f - 4] = t1 - t0, ts[f - 4] = t2 - t1, tg[f - 4] = t3 - t2;
         }
         med[variant][0] = median(te, frames), med[variant][1] = median(ts, frames), med[variant][2] = median(tg, frames);
         rad_vp_lights_destroy(dyn), dyn = NULL;
         rad_temporal_destroy(tp), tp = NULL;
     }
-    /* the step on one thread */
-    memset(&one, 0, sizeof one);
-    one.parallel_for = serial_for, one.task_count = 1;
+    /* the step alone on one thread, 64 steps in a row */
     rad_temporal_options_default(&to);
     to.mode = RAD_TEMPORAL_FEEDBACK, to.samples = 10, to.weight = 0.9f;
     check(rad_temporal_create(tp1, 1, vp->albedo, &to, &one, &tp), "rad_temporal_create");
     for (f = 0; f < 64; ++f) {
-        t = now_ms();
+        t = cpu_ms();
         check(rad_temporal_step(tp, E, NULL, L), "rad_temporal_step");
-        st1[f] = now_ms() - t;
+        st1[f] = cpu_ms() - t;
     }
     rad_temporal_destroy(tp), tp = NULL;
     emit(" %.2f / %.2f ms | %.3f ms (1 thread %.3f) | %.2f ms (%u vertices) | %.1f / %.1f ms |", med[0][0], med[1][0],
          med[0][1], median(st1, 64), med[0][2], V, med[0][0] + med[0][1] + med[0][2], med[1][0] + med[1][1] + med[1][2]);
+    emit(" %.2f / %.2f, %.3f, %.2f: %.1f / %.1f ms |", med[2][0], med[3][0], med[2][1], med[2][2], med[2][0] + med[2][1] + med[2][2],
+         med[3][0] + med[3][1] + med[3][2]);
 
     /* 2. the jump: converged at A, then B; the reference: Gauss-Seidel on E of B */
     rad_vp_lights_options_default(&lo);
@@ -395,14 +409,16 @@ int main(int argc, char **argv)
         return 0;
     }
     emit("Per frame: E update (rad_vp_lights, exact / M/4 rays per light), temporal step (k 10, feedback, w 0.9; "
-         "all threads and one), per-vertex gather of E + L (rad_vp_gather_table_apply), medians. Lag: frames after a "
+         "all threads and one), per-vertex gather of E + L (rad_vp_gather_table_apply), medians of the wall clock with all "
+         "threads; then the same frames on one thread in that thread's CPU time (the work of one core, which the "
+         "load of a shared machine does not inflate). Lag: frames after a "
          "jump of the point light across the scene until the error of B = E + L per patch (area-weighted L1 against "
          "Gauss-Seidel on the same patches, relative to the power) is within 1%% of its converged value (noise) for "
          "10 frames (w 0.9 exact E / w 0.9 M/4 rays / adaptive w). Converged: the mean of the last frames' L "
          "against the solve (power ratio, relative RMS per patch, relative L1 per vertex of E + L).\n\n");
     emit("| scene | res | patches | samples | non-zeros | build | peak | tables | gather tables | E update | step | "
-         "gather | frame | lag (frames) | noise | power | RMS | vertex L1 |\n");
-    emit("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+         "gather | frame | one core, CPU: E / E M/4, step, gather: frame / frame M/4 | lag (frames) | noise | power | RMS | vertex L1 |\n");
+    emit("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     snprintf(path, sizeof path, "%s/sponza.obj", dir);
     if (load_obj(path, &sponza)) {
         rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0};

@@ -533,6 +533,77 @@ out:
     rad_scene_destroy(scene);
 }
 
+/* a parallel_for that runs the tasks last to first (any order is allowed) */
+static void vpr_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+    (void)user;
+    while (count) fn(data, --count);
+}
+
+/* the per-frame calls on a small set run as one task on the calling thread with the default
+   parallel_for; the bits equal those of a caller's parallel_for that splits the same calls into
+   7 tasks run in reverse order (E update with a budget and a moving light, the temporal step) */
+static void vpr_test_serial_same_bits(void)
+{
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_virtual_patches *vp = NULL;
+    rad_vp_lights *d1 = NULL, *d7 = NULL;
+    rad_vp_lights_options lo;
+    rad_light lights[3];
+    rad_alias_tables *at = NULL;
+    const rad_alias_tables *tabs[1];
+    rad_temporal_options to;
+    rad_temporal *t1 = NULL, *t7 = NULL;
+    rad_context seven;
+    float *E1 = NULL, *E7 = NULL, *L1 = NULL, *L7 = NULL;
+    uint32_t N, i, f, bad = 0;
+    uint64_t rays1 = 0, rays7 = 0;
+    CHECK_OK(vpr_dyn_setup(&scene, &bvh, &rc, &vp));
+    if (!vp) goto out;
+    N = vp->count;
+    E1 = (float *)malloc(sizeof(float) * 3 * N), E7 = (float *)malloc(sizeof(float) * 3 * N);
+    L1 = (float *)malloc(sizeof(float) * 3 * N), L7 = (float *)malloc(sizeof(float) * 3 * N);
+    if (!E1 || !E7 || !L1 || !L7) goto out;
+    memset(&seven, 0, sizeof seven);
+    seven.parallel_for = vpr_reverse_for;
+    seven.task_count = 7;
+    rad_vp_lights_options_default(&lo);
+    lo.rays_per_frame = vp->sample_count / 3u + 1u;
+    CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &d1));
+    CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &d7));
+    CHECK_OK(rad_alias_tables_create(&vp->matrix, RAD_ALIAS_AUTO, NULL, &at));
+    if (!d1 || !d7 || !at) goto out;
+    tabs[0] = at;
+    rad_temporal_options_default(&to);
+    to.mode = RAD_TEMPORAL_FEEDBACK, to.samples = 10, to.adaptive = 1;
+    CHECK_OK(rad_temporal_create(tabs, 1, vp->albedo, &to, NULL, &t1));
+    CHECK_OK(rad_temporal_create(tabs, 1, vp->albedo, &to, &seven, &t7));
+    if (!t1 || !t7) goto out;
+    for (f = 0; f < 12; ++f) {
+        vpr_dyn_lights(lights, scene, -0.3f + 0.05f * (float)f);
+        CHECK_OK(rad_vp_lights_update(d1, lights, 3, E1, NULL));
+        CHECK_OK(rad_vp_lights_update(d7, lights, 3, E7, &seven));
+        rays1 += rad_vp_lights_rays(d1), rays7 += rad_vp_lights_rays(d7);
+        CHECK_OK(rad_temporal_step(t1, E1, NULL, L1));
+        CHECK_OK(rad_temporal_step(t7, E7, NULL, L7));
+        for (i = 0; i < 3 * N; ++i) bad += (memcmp(&E1[i], &E7[i], sizeof(float)) != 0) + (memcmp(&L1[i], &L7[i], sizeof(float)) != 0);
+    }
+    CHECK(bad == 0);
+    CHECK(rays1 == rays7 && rays1 > 0);
+    for (i = 0; i < 3 * N && L1[i] == 0.0f; ++i) {}
+    CHECK(i < 3 * N); /* the step did something */
+out:
+    free(E1), free(E7), free(L1), free(L7);
+    rad_temporal_destroy(t1), rad_temporal_destroy(t7);
+    rad_alias_tables_destroy(at);
+    rad_vp_lights_destroy(d1), rad_vp_lights_destroy(d7);
+    rad_vp_destroy(vp);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 /* a bounded budget: P = 5 updates per round; a moved light casts at most the budget per slot,
    its E is stale in the shadows for fewer than P updates, then equals the exact E bit for bit
    and lights at rest cast no more rays;
@@ -690,6 +761,7 @@ static const rad_test_case tests_vp_runtime[] = {
     { "vp_dynamic_lights_exact", vpr_test_dynamic_lights_exact },
     { "vp_dynamic_lights_converge", vpr_test_dynamic_lights_converge },
     { "vp_gather_table", vpr_test_gather_table },
+    { "vp_serial_same_bits", vpr_test_serial_same_bits },
     { NULL, NULL }
 };
 
