@@ -5364,7 +5364,8 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
         for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
-                for (a = 0; a < 3; ++a) { node->lo[a][k] = 0.0f; node->hi[a][k] = 0.0f; }
+                /* an inverted box, which the slab test never enters */
+                for (a = 0; a < 3; ++a) { node->lo[a][k] = FLT_MAX; node->hi[a][k] = -FLT_MAX; }
                 node->child[k] = RAD_NONE;
                 node->count[k] = 0;
                 continue;
@@ -5520,12 +5521,16 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     return RAD_SUCCESS;
 }
 
-/* Per-ray constants of the watertight test (Woop, Benthin, Wald 2013). */
+/* Per-ray constants of the watertight test (Woop, Benthin, Wald 2013) and of the slab test:
+   the reciprocal direction, and per axis the byte offsets in a wide node of the plane the ray
+   enters a box by (lo for a positive direction, hi for a negative one) and of the plane it
+   leaves by, so each box test takes no min/max to order them. */
 typedef struct rad__wray {
     float o[3], d[3], inv[3];
     float sx, sy, sz;
     int kx, ky, kz;
     float tmin, tmax;
+    uint32_t near_off[3], far_off[3];
 } rad__wray;
 
 static void rad__wray_init(rad__wray *w, const rad_ray *r)
@@ -5533,9 +5538,16 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
     float ax = (float)fabs((double)r->dir[0]), ay = (float)fabs((double)r->dir[1]), az = (float)fabs((double)r->dir[2]);
     int k;
     for (k = 0; k < 3; ++k) {
+        /* zero components become +-1e-30: the slab test then never forms 0 * inf */
+        float d = r->dir[k];
+        if (fabs((double)d) < 1e-30) d = d < 0.0f ? -1e-30f : 1e-30f;
         w->o[k] = r->origin[k];
         w->d[k] = r->dir[k];
-        w->inv[k] = 1.0f / r->dir[k]; /* +-inf for 0: the slab test handles it */
+        w->inv[k] = 1.0f / d;
+        w->near_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, lo) : offsetof(rad__bvhw, hi)) +
+                                    (size_t)k * sizeof(float) * RAD__BVH_W);
+        w->far_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, hi) : offsetof(rad__bvhw, lo)) +
+                                   (size_t)k * sizeof(float) * RAD__BVH_W);
     }
     w->kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
     w->kx = (w->kz + 1) % 3;
@@ -5597,46 +5609,56 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
 }
 #endif
 
-/* Slab test of a ray against the child boxes of a node: bit k of the result is set when
-   child k is hit within [tmin, tmax]; tnear[k] receives its entry distance. Zero direction
-   components were replaced by +-1e-30 in inv (no NaN from 0 * inf). Each slab's far distance
-   is widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
-   through shared vertices on box faces). */
-static int rad__bvhw_boxes(const rad__bvhw *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
-{
+/* The slab test's vector operations at the node width (RAD__BVH_W == RAD__VW lanes), so one
+   body serves AVX and SSE. */
 #if defined(RAD__AVX)
-    __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm256_set1_ps(1.0000004f);
-    int a;
-    for (a = 0; a < 3; ++a) {
-        __m256 oa = _mm256_set1_ps(o[a]), ia = _mm256_set1_ps(inv[a]);
-        __m256 x = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->lo[a]), oa), ia);
-        __m256 y = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->hi[a]), oa), ia);
-        t0 = _mm256_max_ps(t0, _mm256_min_ps(x, y));
-        t1 = _mm256_min_ps(t1, _mm256_mul_ps(_mm256_max_ps(x, y), widen));
-    }
-    _mm256_storeu_ps(tnear, t0);
-    return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+#  define rad__bv_set1(x) _mm256_set1_ps(x)
+#  define rad__bv_load(p) _mm256_load_ps(p)
+#  define rad__bv_sub(a, b) _mm256_sub_ps(a, b)
+#  define rad__bv_mul(a, b) _mm256_mul_ps(a, b)
+#  define rad__bv_min(a, b) _mm256_min_ps(a, b)
+#  define rad__bv_max(a, b) _mm256_max_ps(a, b)
+#  define rad__bv_le_mask(a, b) _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OQ))
 #elif defined(RAD__SSE2)
-    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm_set1_ps(1.0000004f);
+#  define rad__bv_set1(x) _mm_set1_ps(x)
+#  define rad__bv_load(p) _mm_load_ps(p)
+#  define rad__bv_sub(a, b) _mm_sub_ps(a, b)
+#  define rad__bv_mul(a, b) _mm_mul_ps(a, b)
+#  define rad__bv_min(a, b) _mm_min_ps(a, b)
+#  define rad__bv_max(a, b) _mm_max_ps(a, b)
+#  define rad__bv_le_mask(a, b) _mm_movemask_ps(_mm_cmple_ps(a, b))
+#endif
+
+/* Slab test of a ray against the child boxes of a node: bit k of the result is set when
+   child k is hit within [tmin, tmax]; tnear[k] receives its entry distance. The entry plane
+   of each axis is read at w->near_off, the exit plane at w->far_off (the same values a
+   min/max of the two would pick, since rounding is monotonic). Each slab's far distance is
+   widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
+   through shared vertices on box faces). */
+static int rad__bvhw_boxes(const rad__bvhw *n, const rad__wray *w, float tmax, float *tnear)
+{
+    const char *base = (const char *)n;
+#if defined(RAD__SSE2)
+    rad__vf t0 = rad__bv_set1(w->tmin), t1 = rad__bv_set1(tmax * 1.0000004f + 1e-30f), widen = rad__bv_set1(1.0000004f);
     int a;
     for (a = 0; a < 3; ++a) {
-        __m128 oa = _mm_set1_ps(o[a]), ia = _mm_set1_ps(inv[a]);
-        __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->lo[a]), oa), ia);
-        __m128 y = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->hi[a]), oa), ia);
-        t0 = _mm_max_ps(t0, _mm_min_ps(x, y));
-        t1 = _mm_min_ps(t1, _mm_mul_ps(_mm_max_ps(x, y), widen));
+        rad__vf oa = rad__bv_set1(w->o[a]), ia = rad__bv_set1(w->inv[a]);
+        rad__vf x = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->near_off[a])), oa), ia);
+        rad__vf y = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->far_off[a])), oa), ia);
+        t0 = rad__bv_max(t0, x);
+        t1 = rad__bv_min(t1, rad__bv_mul(y, widen));
     }
-    _mm_storeu_ps(tnear, t0);
-    return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
+    rad__vf_store(tnear, t0);
+    return rad__bv_le_mask(t0, t1);
 #else
     int k, a, mask = 0;
     for (k = 0; k < RAD__BVH_W; ++k) {
-        float t0 = tmin, t1 = tmax * 1.0000004f + 1e-30f;
+        float t0 = w->tmin, t1 = tmax * 1.0000004f + 1e-30f;
         for (a = 0; a < 3; ++a) {
-            float x = (n->lo[a][k] - o[a]) * inv[a], y = (n->hi[a][k] - o[a]) * inv[a];
-            float lo = x < y ? x : y, hi = (x < y ? y : x) * 1.0000004f;
-            if (lo > t0) t0 = lo;
-            if (hi < t1) t1 = hi;
+            float x = (((const float *)(const void *)(base + w->near_off[a]))[k] - w->o[a]) * w->inv[a];
+            float y = (((const float *)(const void *)(base + w->far_off[a]))[k] - w->o[a]) * w->inv[a] * 1.0000004f;
+            if (x > t0) t0 = x;
+            if (y < t1) t1 = y;
         }
         tnear[k] = t0;
         if (t0 <= t1) mask |= 1 << k;
@@ -5753,32 +5775,26 @@ static int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count
 #endif
 }
 
-static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_hit *hit)
+/* The closest hit (any = 0, into *hit) or any hit (any = 1) of the ray set up in w. Returns 1
+   on a hit; with any, *hit_leaf and *hit_count name the leaf that held it. */
+static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_hit *hit, const rad__tri4 **hit_leaf,
+                          uint32_t *hit_count)
 {
-    rad__wray w;
     /* a node pushes at most RAD__BVH_W - 1 children more than it pops, once per level */
     uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0;
-    float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = ray->tmax, inv[3];
-    int found = 0, a;
-    if (!(ray->tmax > ray->tmin)) return 0;
-    rad__wray_init(&w, ray);
-    for (a = 0; a < 3; ++a) {
-        float d = ray->dir[a];
-        if (fabs((double)d) < 1e-30) d = d < 0.0f ? -1e-30f : 1e-30f;
-        inv[a] = 1.0f / d;
-    }
+    float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = w->tmax;
+    int found = 0;
     stack[sp] = 0;
-    stack_t[sp++] = ray->tmin;
+    stack_t[sp++] = w->tmin;
     while (sp > 0) {
         const rad__bvhw *n;
         float tn[RAD__BVH_W];
-        uint32_t order[RAD__BVH_W], no = 0, k, ni;
+        uint32_t order[RAD__BVH_W], no = 0, k;
         int mask;
         --sp;
         if (stack_t[sp] > tmax) continue; /* entered beyond the closest hit found since */
-        ni = stack[sp];
-        n = &bvh->nodes[ni];
-        mask = rad__bvhw_boxes(n, w.o, inv, ray->tmin, tmax, tn);
+        n = &bvh->nodes[stack[sp]];
+        mask = rad__bvhw_boxes(n, w, tmax, tn);
         while (mask) {
             uint32_t ch;
             k = rad__low_bit((uint32_t)mask);
@@ -5788,10 +5804,14 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
             if (ch & RAD__BVH4_LEAF) {
                 const rad__tri4 *q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
                 float t = 0.0f, b1 = 0.0f, b2 = 0.0f;
-                int j = rad__wray_tri4(&w, q, n->count[k], any, &tmax, &t, &b1, &b2);
+                int j = rad__wray_tri4(w, q, n->count[k], any, &tmax, &t, &b1, &b2);
                 if (j >= 0) {
                     found = 1;
-                    if (any) return 1;
+                    if (any) {
+                        *hit_leaf = q;
+                        *hit_count = n->count[k];
+                        return 1;
+                    }
                     hit->t = t;
                     hit->triangle = q->id[j];
                     hit->b1 = b1;
@@ -5801,19 +5821,27 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
                 order[no++] = k;
             }
         }
-        /* push inner children far to near, so the nearest is visited first */
+        /* push inner children far to near, so the nearest is visited first (two, the common
+           case, by one compare) */
         if (no == 1) {
             stack[sp] = n->child[order[0]];
             stack_t[sp++] = tn[order[0]];
-            continue;
-        }
-        while (no > 0) {
-            uint32_t far = 0, q;
-            for (q = 1; q < no; ++q)
-                if (tn[order[q]] > tn[order[far]]) far = q;
-            stack[sp] = n->child[order[far]];
-            stack_t[sp++] = tn[order[far]];
-            order[far] = order[--no];
+        } else if (no == 2) {
+            uint32_t f = order[0], c = order[1];
+            if (tn[c] > tn[f]) { f = order[1]; c = order[0]; }
+            stack[sp] = n->child[f];
+            stack_t[sp++] = tn[f];
+            stack[sp] = n->child[c];
+            stack_t[sp++] = tn[c];
+        } else {
+            while (no > 0) {
+                uint32_t far = 0, q;
+                for (q = 1; q < no; ++q)
+                    if (tn[order[q]] > tn[order[far]]) far = q;
+                stack[sp] = n->child[order[far]];
+                stack_t[sp++] = tn[order[far]];
+                order[far] = order[--no];
+            }
         }
     }
     return found;
@@ -5822,9 +5850,32 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
 static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
 {
     const rad_bvh *bvh = (const rad_bvh *)user;
-    uint32_t i;
+    const rad__tri4 *last = NULL;
+    uint32_t i, last_count = 0;
     rad_hit h;
-    for (i = 0; i < count; ++i) out[i] = (uint8_t)rad__bvh_trace(bvh, &rays[i], 1, &h);
+    for (i = 0; i < count; ++i) {
+        rad__wray w;
+        const rad__tri4 *leaf = NULL;
+        uint32_t leaf_count = 0;
+        float tmax, t, b1, b2;
+        out[i] = 0;
+        if (!(rays[i].tmax > rays[i].tmin)) continue;
+        rad__wray_init(&w, &rays[i]);
+        /* the rays of one call come from one caller in order (a form-factor row, an image row,
+           the shadow rays of neighbouring points), and consecutive ones are often stopped by
+           the same triangles: the leaf that stopped the last occluded ray is tried first.
+           Any hit in (tmin, tmax) occludes, so the answer is the traversal's. */
+        tmax = w.tmax;
+        if (last && rad__wray_tri4(&w, last, last_count, 1, &tmax, &t, &b1, &b2) >= 0) {
+            out[i] = 1;
+            continue;
+        }
+        if (rad__bvh_trace(bvh, &w, 1, &h, &leaf, &leaf_count)) {
+            out[i] = 1;
+            last = leaf;
+            last_count = leaf_count;
+        }
+    }
     return RAD_SUCCESS;
 }
 
@@ -5833,10 +5884,13 @@ static rad_result rad__bvh_intersect(void *user, const rad_ray *rays, uint32_t c
     const rad_bvh *bvh = (const rad_bvh *)user;
     uint32_t i;
     for (i = 0; i < count; ++i) {
+        rad__wray w;
         out[i].t = rays[i].tmax;
         out[i].triangle = RAD_NONE;
         out[i].b1 = out[i].b2 = 0.0f;
-        rad__bvh_trace(bvh, &rays[i], 0, &out[i]);
+        if (!(rays[i].tmax > rays[i].tmin)) continue;
+        rad__wray_init(&w, &rays[i]);
+        (void)rad__bvh_trace(bvh, &w, 0, &out[i], NULL, NULL);
     }
     return RAD_SUCCESS;
 }
