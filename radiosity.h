@@ -5084,26 +5084,36 @@ struct rad_bvh {
 };
 
 #define RAD__BVH_BINS 16
+#define RAD__BVH_FEW 32  /* ranges below this many triangles use RAD__BVH_BINS / 2 bins */
 #define RAD__BVH_LEAF 4
 #define RAD__BVH_STACK 128
 #define RAD__BVH_SAH_DEPTH 64
 
-typedef struct rad__aabb { float lo[3], hi[3]; } rad__aabb;
+/* A box of the build; the fourth lane of lo and hi rides along in the SIMD grow and is never
+   read. */
+typedef struct rad__aabb { float lo[4], hi[4]; } rad__aabb;
 
 static void rad__aabb_empty(rad__aabb *b)
 {
-    b->lo[0] = b->lo[1] = b->lo[2] = FLT_MAX;
-    b->hi[0] = b->hi[1] = b->hi[2] = -FLT_MAX;
+    b->lo[0] = b->lo[1] = b->lo[2] = b->lo[3] = FLT_MAX;
+    b->hi[0] = b->hi[1] = b->hi[2] = b->hi[3] = -FLT_MAX;
 }
+/* grows b by the box (lo, hi), four floats each (the fourth unused); a NaN keeps the old bound */
 static void rad__aabb_grow(rad__aabb *b, const float *lo, const float *hi)
 {
+#if defined(RAD__SSE2)
+    /* _mm_min_ps(x, y) returns y when either is NaN */
+    _mm_storeu_ps(b->lo, _mm_min_ps(_mm_loadu_ps(lo), _mm_loadu_ps(b->lo)));
+    _mm_storeu_ps(b->hi, _mm_max_ps(_mm_loadu_ps(hi), _mm_loadu_ps(b->hi)));
+#else
     int k;
     /* selects rather than conditional stores: they compile to min/max without branches,
-       which the build's binning loop mispredicted (a NaN keeps the old bound either way) */
+       which the build's binning loop mispredicted */
     for (k = 0; k < 3; ++k) {
         b->lo[k] = lo[k] < b->lo[k] ? lo[k] : b->lo[k];
         b->hi[k] = hi[k] > b->hi[k] ? hi[k] : b->hi[k];
     }
+#endif
 }
 static float rad__aabb_area(const rad__aabb *b)
 {
@@ -5129,7 +5139,10 @@ RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
 
 /* A triangle reference of the build: its bounds and scene triangle. The build sorts these in
    place, so every pass over a node's range reads memory in order. */
-typedef struct rad__bref { float lo[3], hi[3]; uint32_t id; } rad__bref;
+typedef struct rad__bref { float lo[3]; uint32_t id; float hi[4]; } rad__bref;
+
+/* the centroid coordinate of a reference (lo + hi may overflow) */
+#define RAD__BREF_CEN(r, a) (0.5f * (r)->lo[a] + 0.5f * (r)->hi[a])
 
 /* Stage 1 of the build: one reference per triangle, its box. Returns NULL when out of
    memory. */
@@ -5151,64 +5164,79 @@ static rad__bref *rad__bvh_refs(rad__ctx *c, const rad_scene *scene)
             refs[i].hi[k] = hi;
         }
         refs[i].id = i;
+        refs[i].hi[3] = 0.0f;
     }
     return refs;
 }
 
-/* bin of a centroid coordinate, in double so coordinates near +-FLT_MAX cannot overflow, and
-   never converting a NaN or out-of-range value to int */
-static int rad__bvh_bin(float cen, float lo, double scale)
+/* The bins of a reference's centroid on the three axes, (centroid - lo) * scale truncated and
+   clamped to [0, nbins - 1] (a NaN, from overflow, goes to bin 0); out[3] is unused. The
+   binning and the partition both use this, so they agree on every reference. */
+static void rad__bvh_bins(const rad__bref *r, const float *lo, const float *scale, uint32_t nbins, int32_t *out)
 {
-    double x = ((double)cen - (double)lo) * scale;
-    if (!(x > 0.0)) return 0;
-    if (!(x < (double)RAD__BVH_BINS)) return RAD__BVH_BINS - 1;
-    return (int)x;
+#if defined(RAD__SSE2)
+    __m128 half = _mm_set1_ps(0.5f);
+    __m128 c = _mm_add_ps(_mm_mul_ps(half, _mm_loadu_ps(r->lo)), _mm_mul_ps(half, _mm_loadu_ps(r->hi)));
+    __m128 x = _mm_mul_ps(_mm_sub_ps(c, _mm_loadu_ps(lo)), _mm_loadu_ps(scale));
+    /* _mm_max_ps(x, 0) is 0 for a NaN x */
+    x = _mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps((float)(nbins - 1u)));
+    _mm_storeu_si128((__m128i *)(void *)out, _mm_cvttps_epi32(x));
+#else
+    int a;
+    for (a = 0; a < 3; ++a) {
+        float x = (RAD__BREF_CEN(r, a) - lo[a]) * scale[a];
+        out[a] = !(x > 0.0f) ? 0 : !(x < (float)(nbins - 1u)) ? (int32_t)nbins - 1 : (int32_t)x;
+    }
+    out[3] = 0;
+#endif
 }
-
-/* the centroid coordinate of a reference (lo + hi may overflow) */
-#define RAD__BREF_CEN(r, a) (0.5f * (r)->lo[a] + 0.5f * (r)->hi[a])
 
 /* Binned SAH split of binary node 'node' over refs[first, first + count): stores its bounds and
    returns the split position (refs partitioned around it), or 0 when it stays a leaf. */
 static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t depth)
 {
-    uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, i;
+    uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, i, nbins;
     rad__aabb nb, cb, bins[3][RAD__BVH_BINS];
     uint32_t cnt[3][RAD__BVH_BINS];
-    double scale[3];
-    float best_cost = FLT_MAX;
+    float scale[4], best_cost = FLT_MAX;
+    int32_t bin[4];
     int axis, use[3];
     rad__aabb_empty(&nb);
     rad__aabb_empty(&cb);
     for (i = first; i < first + count; ++i) {
         const rad__bref *r = &refs[i];
-        float c[3];
-        c[0] = RAD__BREF_CEN(r, 0); c[1] = RAD__BREF_CEN(r, 1); c[2] = RAD__BREF_CEN(r, 2);
+        float c[4];
+        c[0] = RAD__BREF_CEN(r, 0); c[1] = RAD__BREF_CEN(r, 1); c[2] = RAD__BREF_CEN(r, 2); c[3] = 0.0f;
         rad__aabb_grow(&nb, r->lo, r->hi);
         rad__aabb_grow(&cb, c, c);
     }
-    memcpy(node->bmin, nb.lo, sizeof(nb.lo));
-    memcpy(node->bmax, nb.hi, sizeof(nb.hi));
+    memcpy(node->bmin, nb.lo, sizeof(node->bmin));
+    memcpy(node->bmax, nb.hi, sizeof(node->bmax));
     /* a leaf's triangles are tested together in one SIMD pass (rad__wray_tri4), about the cost
        of testing one: any range that fits in a leaf is one */
     if (count <= RAD__BVH_LEAF) return 0;
     /* past RAD__BVH_SAH_DEPTH levels, ranges are split in half: the depth stays below
        RAD__BVH_SAH_DEPTH + 32, so traversal stacks of RAD__BVH_STACK entries never overflow */
+    /* small ranges: half the bins (clearing and sweeping them costs more than binning the
+       references there) */
+    nbins = count < RAD__BVH_FEW ? RAD__BVH_BINS / 2u : RAD__BVH_BINS;
+    scale[3] = 0.0f;
     for (axis = 0; axis < 3; ++axis) {
-        double extent = (double)cb.hi[axis] - (double)cb.lo[axis];
+        float extent = cb.hi[axis] - cb.lo[axis];
         uint32_t bi;
-        use[axis] = depth < RAD__BVH_SAH_DEPTH && extent > 0.0;
-        scale[axis] = use[axis] ? (double)RAD__BVH_BINS / extent : 0.0;
-        for (bi = 0; bi < RAD__BVH_BINS; ++bi) { rad__aabb_empty(&bins[axis][bi]); cnt[axis][bi] = 0; }
+        /* an extent that overflows to inf gives scale 0: every centroid in bin 0, no split */
+        use[axis] = depth < RAD__BVH_SAH_DEPTH && extent > 0.0f;
+        scale[axis] = use[axis] ? (float)nbins / extent : 0.0f;
+        for (bi = 0; bi < nbins; ++bi) { rad__aabb_empty(&bins[axis][bi]); cnt[axis][bi] = 0; }
     }
     if (use[0] || use[1] || use[2]) {
         /* one pass bins all three axes */
         for (i = first; i < first + count; ++i) {
             const rad__bref *r = &refs[i];
+            rad__bvh_bins(r, cb.lo, scale, nbins, bin);
             for (axis = 0; axis < 3; ++axis) {
-                int bin = rad__bvh_bin(RAD__BREF_CEN(r, axis), cb.lo[axis], scale[axis]);
-                cnt[axis][bin]++;
-                rad__aabb_grow(&bins[axis][bin], r->lo, r->hi);
+                cnt[axis][bin[axis]]++;
+                rad__aabb_grow(&bins[axis][bin[axis]], r->lo, r->hi);
             }
         }
     }
@@ -5218,14 +5246,14 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
         float right_area[RAD__BVH_BINS];
         if (!use[axis]) continue;
         rad__aabb_empty(&right);
-        for (bi = RAD__BVH_BINS - 1; bi > 0; --bi) {
+        for (bi = nbins - 1u; bi > 0; --bi) {
             rad__aabb_grow(&right, bins[axis][bi].lo, bins[axis][bi].hi);
             rc += cnt[axis][bi];
             right_area[bi] = rad__aabb_area(&right);
             right_count[bi] = rc;
         }
         rad__aabb_empty(&left);
-        for (bi = 0; bi + 1 < RAD__BVH_BINS; ++bi) {
+        for (bi = 0; bi + 1 < nbins; ++bi) {
             float cost;
             rad__aabb_grow(&left, bins[axis][bi].lo, bins[axis][bi].hi);
             lc += cnt[axis][bi];
@@ -5241,7 +5269,8 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
     } else {
         uint32_t lo = first, hi = first + count;
         while (lo < hi) {
-            if ((uint32_t)rad__bvh_bin(RAD__BREF_CEN(&refs[lo], best_axis), cb.lo[best_axis], scale[best_axis]) < best_split) {
+            rad__bvh_bins(&refs[lo], cb.lo, scale, nbins, bin);
+            if ((uint32_t)bin[best_axis] < best_split) {
                 ++lo;
             } else {
                 rad__bref t = refs[lo];
@@ -5256,6 +5285,26 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
     return mid;
 }
 
+/* Splits binary node ni (at 'depth') at refs position mid: its children become nodes k2 and
+   k2 + 1, which are pushed on 'stack' (node, depth; the left one on top) at sp. Returns the new
+   sp. */
+static uint32_t rad__bvh_children(rad__bvh_node *tree, uint32_t ni, uint32_t mid, uint32_t k2, uint32_t depth,
+                                  uint32_t *stack, uint32_t sp)
+{
+    uint32_t first = tree[ni].first, count = tree[ni].count;
+    tree[k2].first = first;
+    tree[k2].count = mid - first;
+    tree[k2 + 1].first = mid;
+    tree[k2 + 1].count = first + count - mid;
+    tree[ni].first = k2;
+    tree[ni].count = 0;
+    stack[sp++] = k2 + 1;
+    stack[sp++] = depth + 1;
+    stack[sp++] = k2;
+    stack[sp++] = depth + 1;
+    return sp;
+}
+
 /* Builds the subtree under binary node 'root' (at 'depth'), its nodes numbered from 'next' on
    in pairs. Returns its leaf count. */
 static uint32_t rad__bvh_build_sub(rad__bvh_node *tree, rad__bref *refs, uint32_t root, uint32_t depth0, uint32_t next)
@@ -5264,23 +5313,11 @@ static uint32_t rad__bvh_build_sub(rad__bvh_node *tree, rad__bref *refs, uint32_
     stack[sp++] = root;
     stack[sp++] = depth0;
     while (sp > 0) {
-        uint32_t depth = stack[--sp], ni = stack[--sp], mid, k2, first, count;
+        uint32_t depth = stack[--sp], ni = stack[--sp], mid;
         mid = rad__bvh_split(&tree[ni], refs, depth);
         if (!mid) { ++leaves; continue; }
-        first = tree[ni].first;
-        count = tree[ni].count;
-        k2 = next;
+        sp = rad__bvh_children(tree, ni, mid, next, depth, stack, sp);
         next += 2;
-        tree[k2].first = first;
-        tree[k2].count = mid - first;
-        tree[k2 + 1].first = mid;
-        tree[k2 + 1].count = first + count - mid;
-        tree[ni].first = k2;
-        tree[ni].count = 0;
-        stack[sp++] = k2 + 1;
-        stack[sp++] = depth + 1;
-        stack[sp++] = k2;
-        stack[sp++] = depth + 1;
     }
     return leaves;
 }
@@ -5415,7 +5452,7 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
     stack[sp++] = root;
     stack[sp++] = 0;
     while (sp > 0) {
-        uint32_t depth = stack[--sp], ni = stack[--sp], mid, first, count;
+        uint32_t depth = stack[--sp], ni = stack[--sp], mid;
         if (tree[ni].count <= threshold) {
             task[tasks] = ni;
             task_depth[tasks++] = depth;
@@ -5423,18 +5460,7 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
         }
         mid = rad__bvh_split(&tree[ni], refs, depth);
         if (!mid) { ++leaves; continue; }
-        first = tree[ni].first;
-        count = tree[ni].count;
-        tree[top].first = first;
-        tree[top].count = mid - first;
-        tree[top + 1].first = mid;
-        tree[top + 1].count = first + count - mid;
-        tree[ni].first = top;
-        tree[ni].count = 0;
-        stack[sp++] = top + 1;
-        stack[sp++] = depth + 1;
-        stack[sp++] = top;
-        stack[sp++] = depth + 1;
+        sp = rad__bvh_children(tree, ni, mid, top, depth, stack, sp);
         top += 2;
     }
     if (tasks > 0) {
