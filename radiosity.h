@@ -5877,7 +5877,8 @@ static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t co
 {
     const rad_bvh *bvh = (const rad_bvh *)user;
     const rad__tri4 *last = NULL;
-    uint32_t i, last_count = 0;
+    uint32_t i, last_count = 0, since = 0;
+    int score = 0;
     rad_hit h;
     for (i = 0; i < count; ++i) {
         rad__wray w;
@@ -5890,11 +5891,18 @@ static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t co
         /* the rays of one call come from one caller in order (a form-factor row, an image row,
            the shadow rays of neighbouring points), and consecutive ones are often stopped by
            the same triangles: the leaf that stopped the last occluded ray is tried first.
-           Any hit in (tmin, tmax) occludes, so the answer is the traversal's. */
-        tmax = w.tmax;
-        if (last && rad__wray_tri4(&w, last, last_count, 1, &tmax, &t, &b1, &b2) >= 0) {
-            out[i] = 1;
-            continue;
+           Any hit in (tmin, tmax) occludes, so the answer is the traversal's. 'score' counts
+           +4 per success and -1 per failure: below 0 (incoherent rays, where the extra test
+           is only cost) the leaf is tried on every 32nd ray alone. */
+        if (last && (score >= 0 || ++since >= 32u)) {
+            since = 0;
+            tmax = w.tmax;
+            if (rad__wray_tri4(&w, last, last_count, 1, &tmax, &t, &b1, &b2) >= 0) {
+                score = score < 0 ? 4 : score < 60 ? score + 4 : 64;
+                out[i] = 1;
+                continue;
+            }
+            score = score > -8 ? score - 1 : -8;
         }
         if (rad__bvh_trace(bvh, &w, 1, &h, &leaf, &leaf_count)) {
             out[i] = 1;
