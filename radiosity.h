@@ -5151,26 +5151,36 @@ struct rad_bvh {
 };
 
 #define RAD__BVH_BINS 16
+#define RAD__BVH_FEW 32  /* ranges below this many triangles use RAD__BVH_BINS / 2 bins */
 #define RAD__BVH_LEAF 4
 #define RAD__BVH_STACK 128
 #define RAD__BVH_SAH_DEPTH 64
 
-typedef struct rad__aabb { float lo[3], hi[3]; } rad__aabb;
+/* A box of the build; the fourth lane of lo and hi rides along in the SIMD grow and is never
+   read. */
+typedef struct rad__aabb { float lo[4], hi[4]; } rad__aabb;
 
 static void rad__aabb_empty(rad__aabb *b)
 {
-    b->lo[0] = b->lo[1] = b->lo[2] = FLT_MAX;
-    b->hi[0] = b->hi[1] = b->hi[2] = -FLT_MAX;
+    b->lo[0] = b->lo[1] = b->lo[2] = b->lo[3] = FLT_MAX;
+    b->hi[0] = b->hi[1] = b->hi[2] = b->hi[3] = -FLT_MAX;
 }
+/* grows b by the box (lo, hi), four floats each (the fourth unused); a NaN keeps the old bound */
 static void rad__aabb_grow(rad__aabb *b, const float *lo, const float *hi)
 {
+#if defined(RAD__SSE2)
+    /* _mm_min_ps(x, y) returns y when either is NaN */
+    _mm_storeu_ps(b->lo, _mm_min_ps(_mm_loadu_ps(lo), _mm_loadu_ps(b->lo)));
+    _mm_storeu_ps(b->hi, _mm_max_ps(_mm_loadu_ps(hi), _mm_loadu_ps(b->hi)));
+#else
     int k;
     /* selects rather than conditional stores: they compile to min/max without branches,
-       which the build's binning loop mispredicted (a NaN keeps the old bound either way) */
+       which the build's binning loop mispredicted */
     for (k = 0; k < 3; ++k) {
         b->lo[k] = lo[k] < b->lo[k] ? lo[k] : b->lo[k];
         b->hi[k] = hi[k] > b->hi[k] ? hi[k] : b->hi[k];
     }
+#endif
 }
 static float rad__aabb_area(const rad__aabb *b)
 {
@@ -5196,7 +5206,10 @@ RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
 
 /* A triangle reference of the build: its bounds and scene triangle. The build sorts these in
    place, so every pass over a node's range reads memory in order. */
-typedef struct rad__bref { float lo[3], hi[3]; uint32_t id; } rad__bref;
+typedef struct rad__bref { float lo[3]; uint32_t id; float hi[4]; } rad__bref;
+
+/* the centroid coordinate of a reference (lo + hi may overflow) */
+#define RAD__BREF_CEN(r, a) (0.5f * (r)->lo[a] + 0.5f * (r)->hi[a])
 
 /* Stage 1 of the build: one reference per triangle, its box. Returns NULL when out of
    memory. */
@@ -5218,64 +5231,79 @@ static rad__bref *rad__bvh_refs(rad__ctx *c, const rad_scene *scene)
             refs[i].hi[k] = hi;
         }
         refs[i].id = i;
+        refs[i].hi[3] = 0.0f;
     }
     return refs;
 }
 
-/* bin of a centroid coordinate, in double so coordinates near +-FLT_MAX cannot overflow, and
-   never converting a NaN or out-of-range value to int */
-static int rad__bvh_bin(float cen, float lo, double scale)
+/* The bins of a reference's centroid on the three axes, (centroid - lo) * scale truncated and
+   clamped to [0, nbins - 1] (a NaN, from overflow, goes to bin 0); out[3] is unused. The
+   binning and the partition both use this, so they agree on every reference. */
+static void rad__bvh_bins(const rad__bref *r, const float *lo, const float *scale, uint32_t nbins, int32_t *out)
 {
-    double x = ((double)cen - (double)lo) * scale;
-    if (!(x > 0.0)) return 0;
-    if (!(x < (double)RAD__BVH_BINS)) return RAD__BVH_BINS - 1;
-    return (int)x;
+#if defined(RAD__SSE2)
+    __m128 half = _mm_set1_ps(0.5f);
+    __m128 c = _mm_add_ps(_mm_mul_ps(half, _mm_loadu_ps(r->lo)), _mm_mul_ps(half, _mm_loadu_ps(r->hi)));
+    __m128 x = _mm_mul_ps(_mm_sub_ps(c, _mm_loadu_ps(lo)), _mm_loadu_ps(scale));
+    /* _mm_max_ps(x, 0) is 0 for a NaN x */
+    x = _mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), _mm_set1_ps((float)(nbins - 1u)));
+    _mm_storeu_si128((__m128i *)(void *)out, _mm_cvttps_epi32(x));
+#else
+    int a;
+    for (a = 0; a < 3; ++a) {
+        float x = (RAD__BREF_CEN(r, a) - lo[a]) * scale[a];
+        out[a] = !(x > 0.0f) ? 0 : !(x < (float)(nbins - 1u)) ? (int32_t)nbins - 1 : (int32_t)x;
+    }
+    out[3] = 0;
+#endif
 }
-
-/* the centroid coordinate of a reference (lo + hi may overflow) */
-#define RAD__BREF_CEN(r, a) (0.5f * (r)->lo[a] + 0.5f * (r)->hi[a])
 
 /* Binned SAH split of binary node 'node' over refs[first, first + count): stores its bounds and
    returns the split position (refs partitioned around it), or 0 when it stays a leaf. */
 static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t depth)
 {
-    uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, i;
+    uint32_t first = node->first, count = node->count, best_axis = 3, best_split = 0, mid, i, nbins;
     rad__aabb nb, cb, bins[3][RAD__BVH_BINS];
     uint32_t cnt[3][RAD__BVH_BINS];
-    double scale[3];
-    float best_cost = FLT_MAX;
+    float scale[4], best_cost = FLT_MAX;
+    int32_t bin[4];
     int axis, use[3];
     rad__aabb_empty(&nb);
     rad__aabb_empty(&cb);
     for (i = first; i < first + count; ++i) {
         const rad__bref *r = &refs[i];
-        float c[3];
-        c[0] = RAD__BREF_CEN(r, 0); c[1] = RAD__BREF_CEN(r, 1); c[2] = RAD__BREF_CEN(r, 2);
+        float c[4];
+        c[0] = RAD__BREF_CEN(r, 0); c[1] = RAD__BREF_CEN(r, 1); c[2] = RAD__BREF_CEN(r, 2); c[3] = 0.0f;
         rad__aabb_grow(&nb, r->lo, r->hi);
         rad__aabb_grow(&cb, c, c);
     }
-    memcpy(node->bmin, nb.lo, sizeof(nb.lo));
-    memcpy(node->bmax, nb.hi, sizeof(nb.hi));
+    memcpy(node->bmin, nb.lo, sizeof(node->bmin));
+    memcpy(node->bmax, nb.hi, sizeof(node->bmax));
     /* a leaf's triangles are tested together in one SIMD pass (rad__wray_tri4), about the cost
        of testing one: any range that fits in a leaf is one */
     if (count <= RAD__BVH_LEAF) return 0;
     /* past RAD__BVH_SAH_DEPTH levels, ranges are split in half: the depth stays below
        RAD__BVH_SAH_DEPTH + 32, so traversal stacks of RAD__BVH_STACK entries never overflow */
+    /* small ranges: half the bins (clearing and sweeping them costs more than binning the
+       references there) */
+    nbins = count < RAD__BVH_FEW ? RAD__BVH_BINS / 2u : RAD__BVH_BINS;
+    scale[3] = 0.0f;
     for (axis = 0; axis < 3; ++axis) {
-        double extent = (double)cb.hi[axis] - (double)cb.lo[axis];
+        float extent = cb.hi[axis] - cb.lo[axis];
         uint32_t bi;
-        use[axis] = depth < RAD__BVH_SAH_DEPTH && extent > 0.0;
-        scale[axis] = use[axis] ? (double)RAD__BVH_BINS / extent : 0.0;
-        for (bi = 0; bi < RAD__BVH_BINS; ++bi) { rad__aabb_empty(&bins[axis][bi]); cnt[axis][bi] = 0; }
+        /* an extent that overflows to inf gives scale 0: every centroid in bin 0, no split */
+        use[axis] = depth < RAD__BVH_SAH_DEPTH && extent > 0.0f;
+        scale[axis] = use[axis] ? (float)nbins / extent : 0.0f;
+        for (bi = 0; bi < nbins; ++bi) { rad__aabb_empty(&bins[axis][bi]); cnt[axis][bi] = 0; }
     }
     if (use[0] || use[1] || use[2]) {
         /* one pass bins all three axes */
         for (i = first; i < first + count; ++i) {
             const rad__bref *r = &refs[i];
+            rad__bvh_bins(r, cb.lo, scale, nbins, bin);
             for (axis = 0; axis < 3; ++axis) {
-                int bin = rad__bvh_bin(RAD__BREF_CEN(r, axis), cb.lo[axis], scale[axis]);
-                cnt[axis][bin]++;
-                rad__aabb_grow(&bins[axis][bin], r->lo, r->hi);
+                cnt[axis][bin[axis]]++;
+                rad__aabb_grow(&bins[axis][bin[axis]], r->lo, r->hi);
             }
         }
     }
@@ -5285,14 +5313,14 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
         float right_area[RAD__BVH_BINS];
         if (!use[axis]) continue;
         rad__aabb_empty(&right);
-        for (bi = RAD__BVH_BINS - 1; bi > 0; --bi) {
+        for (bi = nbins - 1u; bi > 0; --bi) {
             rad__aabb_grow(&right, bins[axis][bi].lo, bins[axis][bi].hi);
             rc += cnt[axis][bi];
             right_area[bi] = rad__aabb_area(&right);
             right_count[bi] = rc;
         }
         rad__aabb_empty(&left);
-        for (bi = 0; bi + 1 < RAD__BVH_BINS; ++bi) {
+        for (bi = 0; bi + 1 < nbins; ++bi) {
             float cost;
             rad__aabb_grow(&left, bins[axis][bi].lo, bins[axis][bi].hi);
             lc += cnt[axis][bi];
@@ -5308,7 +5336,8 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
     } else {
         uint32_t lo = first, hi = first + count;
         while (lo < hi) {
-            if ((uint32_t)rad__bvh_bin(RAD__BREF_CEN(&refs[lo], best_axis), cb.lo[best_axis], scale[best_axis]) < best_split) {
+            rad__bvh_bins(&refs[lo], cb.lo, scale, nbins, bin);
+            if ((uint32_t)bin[best_axis] < best_split) {
                 ++lo;
             } else {
                 rad__bref t = refs[lo];
@@ -5323,6 +5352,26 @@ static uint32_t rad__bvh_split(rad__bvh_node *node, rad__bref *refs, uint32_t de
     return mid;
 }
 
+/* Splits binary node ni (at 'depth') at refs position mid: its children become nodes k2 and
+   k2 + 1, which are pushed on 'stack' (node, depth; the left one on top) at sp. Returns the new
+   sp. */
+static uint32_t rad__bvh_children(rad__bvh_node *tree, uint32_t ni, uint32_t mid, uint32_t k2, uint32_t depth,
+                                  uint32_t *stack, uint32_t sp)
+{
+    uint32_t first = tree[ni].first, count = tree[ni].count;
+    tree[k2].first = first;
+    tree[k2].count = mid - first;
+    tree[k2 + 1].first = mid;
+    tree[k2 + 1].count = first + count - mid;
+    tree[ni].first = k2;
+    tree[ni].count = 0;
+    stack[sp++] = k2 + 1;
+    stack[sp++] = depth + 1;
+    stack[sp++] = k2;
+    stack[sp++] = depth + 1;
+    return sp;
+}
+
 /* Builds the subtree under binary node 'root' (at 'depth'), its nodes numbered from 'next' on
    in pairs. Returns its leaf count. */
 static uint32_t rad__bvh_build_sub(rad__bvh_node *tree, rad__bref *refs, uint32_t root, uint32_t depth0, uint32_t next)
@@ -5331,23 +5380,11 @@ static uint32_t rad__bvh_build_sub(rad__bvh_node *tree, rad__bref *refs, uint32_
     stack[sp++] = root;
     stack[sp++] = depth0;
     while (sp > 0) {
-        uint32_t depth = stack[--sp], ni = stack[--sp], mid, k2, first, count;
+        uint32_t depth = stack[--sp], ni = stack[--sp], mid;
         mid = rad__bvh_split(&tree[ni], refs, depth);
         if (!mid) { ++leaves; continue; }
-        first = tree[ni].first;
-        count = tree[ni].count;
-        k2 = next;
+        sp = rad__bvh_children(tree, ni, mid, next, depth, stack, sp);
         next += 2;
-        tree[k2].first = first;
-        tree[k2].count = mid - first;
-        tree[k2 + 1].first = mid;
-        tree[k2 + 1].count = first + count - mid;
-        tree[ni].first = k2;
-        tree[ni].count = 0;
-        stack[sp++] = k2 + 1;
-        stack[sp++] = depth + 1;
-        stack[sp++] = k2;
-        stack[sp++] = depth + 1;
     }
     return leaves;
 }
@@ -5431,7 +5468,8 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
         for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
-                for (a = 0; a < 3; ++a) { node->lo[a][k] = 0.0f; node->hi[a][k] = 0.0f; }
+                /* an inverted box, which the slab test never enters */
+                for (a = 0; a < 3; ++a) { node->lo[a][k] = FLT_MAX; node->hi[a][k] = -FLT_MAX; }
                 node->child[k] = RAD_NONE;
                 node->count[k] = 0;
                 continue;
@@ -5481,7 +5519,7 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
     stack[sp++] = root;
     stack[sp++] = 0;
     while (sp > 0) {
-        uint32_t depth = stack[--sp], ni = stack[--sp], mid, first, count;
+        uint32_t depth = stack[--sp], ni = stack[--sp], mid;
         if (tree[ni].count <= threshold) {
             task[tasks] = ni;
             task_depth[tasks++] = depth;
@@ -5489,18 +5527,7 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
         }
         mid = rad__bvh_split(&tree[ni], refs, depth);
         if (!mid) { ++leaves; continue; }
-        first = tree[ni].first;
-        count = tree[ni].count;
-        tree[top].first = first;
-        tree[top].count = mid - first;
-        tree[top + 1].first = mid;
-        tree[top + 1].count = first + count - mid;
-        tree[ni].first = top;
-        tree[ni].count = 0;
-        stack[sp++] = top + 1;
-        stack[sp++] = depth + 1;
-        stack[sp++] = top;
-        stack[sp++] = depth + 1;
+        sp = rad__bvh_children(tree, ni, mid, top, depth, stack, sp);
         top += 2;
     }
     if (tasks > 0) {
@@ -5587,12 +5614,16 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     return RAD_SUCCESS;
 }
 
-/* Per-ray constants of the watertight test (Woop, Benthin, Wald 2013). */
+/* Per-ray constants of the watertight test (Woop, Benthin, Wald 2013) and of the slab test:
+   the reciprocal direction, and per axis the byte offsets in a wide node of the plane the ray
+   enters a box by (lo for a positive direction, hi for a negative one) and of the plane it
+   leaves by, so each box test takes no min/max to order them. */
 typedef struct rad__wray {
     float o[3], d[3], inv[3];
     float sx, sy, sz;
     int kx, ky, kz;
     float tmin, tmax;
+    uint32_t near_off[3], far_off[3];
 } rad__wray;
 
 static void rad__wray_init(rad__wray *w, const rad_ray *r)
@@ -5600,9 +5631,16 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
     float ax = (float)fabs((double)r->dir[0]), ay = (float)fabs((double)r->dir[1]), az = (float)fabs((double)r->dir[2]);
     int k;
     for (k = 0; k < 3; ++k) {
+        /* zero components become +-1e-30: the slab test then never forms 0 * inf */
+        float d = r->dir[k];
+        if (fabs((double)d) < 1e-30) d = d < 0.0f ? -1e-30f : 1e-30f;
         w->o[k] = r->origin[k];
         w->d[k] = r->dir[k];
-        w->inv[k] = 1.0f / r->dir[k]; /* +-inf for 0: the slab test handles it */
+        w->inv[k] = 1.0f / d;
+        w->near_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, lo) : offsetof(rad__bvhw, hi)) +
+                                    (size_t)k * sizeof(float) * RAD__BVH_W);
+        w->far_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, hi) : offsetof(rad__bvhw, lo)) +
+                                   (size_t)k * sizeof(float) * RAD__BVH_W);
     }
     w->kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
     w->kx = (w->kz + 1) % 3;
@@ -5664,46 +5702,56 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
 }
 #endif
 
-/* Slab test of a ray against the child boxes of a node: bit k of the result is set when
-   child k is hit within [tmin, tmax]; tnear[k] receives its entry distance. Zero direction
-   components were replaced by +-1e-30 in inv (no NaN from 0 * inf). Each slab's far distance
-   is widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
-   through shared vertices on box faces). */
-static int rad__bvhw_boxes(const rad__bvhw *n, const float *o, const float *inv, float tmin, float tmax, float *tnear)
-{
+/* The slab test's vector operations at the node width (RAD__BVH_W == RAD__VW lanes), so one
+   body serves AVX and SSE. */
 #if defined(RAD__AVX)
-    __m256 t0 = _mm256_set1_ps(tmin), t1 = _mm256_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm256_set1_ps(1.0000004f);
-    int a;
-    for (a = 0; a < 3; ++a) {
-        __m256 oa = _mm256_set1_ps(o[a]), ia = _mm256_set1_ps(inv[a]);
-        __m256 x = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->lo[a]), oa), ia);
-        __m256 y = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(n->hi[a]), oa), ia);
-        t0 = _mm256_max_ps(t0, _mm256_min_ps(x, y));
-        t1 = _mm256_min_ps(t1, _mm256_mul_ps(_mm256_max_ps(x, y), widen));
-    }
-    _mm256_storeu_ps(tnear, t0);
-    return _mm256_movemask_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OQ));
+#  define rad__bv_set1(x) _mm256_set1_ps(x)
+#  define rad__bv_load(p) _mm256_load_ps(p)
+#  define rad__bv_sub(a, b) _mm256_sub_ps(a, b)
+#  define rad__bv_mul(a, b) _mm256_mul_ps(a, b)
+#  define rad__bv_min(a, b) _mm256_min_ps(a, b)
+#  define rad__bv_max(a, b) _mm256_max_ps(a, b)
+#  define rad__bv_le_mask(a, b) _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OQ))
 #elif defined(RAD__SSE2)
-    __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax * 1.0000004f + 1e-30f), widen = _mm_set1_ps(1.0000004f);
+#  define rad__bv_set1(x) _mm_set1_ps(x)
+#  define rad__bv_load(p) _mm_load_ps(p)
+#  define rad__bv_sub(a, b) _mm_sub_ps(a, b)
+#  define rad__bv_mul(a, b) _mm_mul_ps(a, b)
+#  define rad__bv_min(a, b) _mm_min_ps(a, b)
+#  define rad__bv_max(a, b) _mm_max_ps(a, b)
+#  define rad__bv_le_mask(a, b) _mm_movemask_ps(_mm_cmple_ps(a, b))
+#endif
+
+/* Slab test of a ray against the child boxes of a node: bit k of the result is set when
+   child k is hit within [tmin, tmax]; tnear[k] receives its entry distance. The entry plane
+   of each axis is read at w->near_off, the exit plane at w->far_off (the same values a
+   min/max of the two would pick, since rounding is monotonic). Each slab's far distance is
+   widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
+   through shared vertices on box faces). */
+static int rad__bvhw_boxes(const rad__bvhw *n, const rad__wray *w, float tmax, float *tnear)
+{
+    const char *base = (const char *)n;
+#if defined(RAD__SSE2)
+    rad__vf t0 = rad__bv_set1(w->tmin), t1 = rad__bv_set1(tmax * 1.0000004f + 1e-30f), widen = rad__bv_set1(1.0000004f);
     int a;
     for (a = 0; a < 3; ++a) {
-        __m128 oa = _mm_set1_ps(o[a]), ia = _mm_set1_ps(inv[a]);
-        __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->lo[a]), oa), ia);
-        __m128 y = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(n->hi[a]), oa), ia);
-        t0 = _mm_max_ps(t0, _mm_min_ps(x, y));
-        t1 = _mm_min_ps(t1, _mm_mul_ps(_mm_max_ps(x, y), widen));
+        rad__vf oa = rad__bv_set1(w->o[a]), ia = rad__bv_set1(w->inv[a]);
+        rad__vf x = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->near_off[a])), oa), ia);
+        rad__vf y = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->far_off[a])), oa), ia);
+        t0 = rad__bv_max(t0, x);
+        t1 = rad__bv_min(t1, rad__bv_mul(y, widen));
     }
-    _mm_storeu_ps(tnear, t0);
-    return _mm_movemask_ps(_mm_cmple_ps(t0, t1));
+    rad__vf_store(tnear, t0);
+    return rad__bv_le_mask(t0, t1);
 #else
     int k, a, mask = 0;
     for (k = 0; k < RAD__BVH_W; ++k) {
-        float t0 = tmin, t1 = tmax * 1.0000004f + 1e-30f;
+        float t0 = w->tmin, t1 = tmax * 1.0000004f + 1e-30f;
         for (a = 0; a < 3; ++a) {
-            float x = (n->lo[a][k] - o[a]) * inv[a], y = (n->hi[a][k] - o[a]) * inv[a];
-            float lo = x < y ? x : y, hi = (x < y ? y : x) * 1.0000004f;
-            if (lo > t0) t0 = lo;
-            if (hi < t1) t1 = hi;
+            float x = (((const float *)(const void *)(base + w->near_off[a]))[k] - w->o[a]) * w->inv[a];
+            float y = (((const float *)(const void *)(base + w->far_off[a]))[k] - w->o[a]) * w->inv[a] * 1.0000004f;
+            if (x > t0) t0 = x;
+            if (y < t1) t1 = y;
         }
         tnear[k] = t0;
         if (t0 <= t1) mask |= 1 << k;
@@ -5820,32 +5868,26 @@ static int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count
 #endif
 }
 
-static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_hit *hit)
+/* The closest hit (any = 0, into *hit) or any hit (any = 1) of the ray set up in w. Returns 1
+   on a hit; with any, *hit_leaf and *hit_count name the leaf that held it. */
+static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_hit *hit, const rad__tri4 **hit_leaf,
+                          uint32_t *hit_count)
 {
-    rad__wray w;
     /* a node pushes at most RAD__BVH_W - 1 children more than it pops, once per level */
     uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0;
-    float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = ray->tmax, inv[3];
-    int found = 0, a;
-    if (!(ray->tmax > ray->tmin)) return 0;
-    rad__wray_init(&w, ray);
-    for (a = 0; a < 3; ++a) {
-        float d = ray->dir[a];
-        if (fabs((double)d) < 1e-30) d = d < 0.0f ? -1e-30f : 1e-30f;
-        inv[a] = 1.0f / d;
-    }
+    float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = w->tmax;
+    int found = 0;
     stack[sp] = 0;
-    stack_t[sp++] = ray->tmin;
+    stack_t[sp++] = w->tmin;
     while (sp > 0) {
         const rad__bvhw *n;
         float tn[RAD__BVH_W];
-        uint32_t order[RAD__BVH_W], no = 0, k, ni;
+        uint32_t order[RAD__BVH_W], no = 0, k;
         int mask;
         --sp;
         if (stack_t[sp] > tmax) continue; /* entered beyond the closest hit found since */
-        ni = stack[sp];
-        n = &bvh->nodes[ni];
-        mask = rad__bvhw_boxes(n, w.o, inv, ray->tmin, tmax, tn);
+        n = &bvh->nodes[stack[sp]];
+        mask = rad__bvhw_boxes(n, w, tmax, tn);
         while (mask) {
             uint32_t ch;
             k = rad__low_bit((uint32_t)mask);
@@ -5855,10 +5897,14 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
             if (ch & RAD__BVH4_LEAF) {
                 const rad__tri4 *q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
                 float t = 0.0f, b1 = 0.0f, b2 = 0.0f;
-                int j = rad__wray_tri4(&w, q, n->count[k], any, &tmax, &t, &b1, &b2);
+                int j = rad__wray_tri4(w, q, n->count[k], any, &tmax, &t, &b1, &b2);
                 if (j >= 0) {
                     found = 1;
-                    if (any) return 1;
+                    if (any) {
+                        *hit_leaf = q;
+                        *hit_count = n->count[k];
+                        return 1;
+                    }
                     hit->t = t;
                     hit->triangle = q->id[j];
                     hit->b1 = b1;
@@ -5868,19 +5914,27 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
                 order[no++] = k;
             }
         }
-        /* push inner children far to near, so the nearest is visited first */
+        /* push inner children far to near, so the nearest is visited first (two, the common
+           case, by one compare) */
         if (no == 1) {
             stack[sp] = n->child[order[0]];
             stack_t[sp++] = tn[order[0]];
-            continue;
-        }
-        while (no > 0) {
-            uint32_t far = 0, q;
-            for (q = 1; q < no; ++q)
-                if (tn[order[q]] > tn[order[far]]) far = q;
-            stack[sp] = n->child[order[far]];
-            stack_t[sp++] = tn[order[far]];
-            order[far] = order[--no];
+        } else if (no == 2) {
+            uint32_t f = order[0], c = order[1];
+            if (tn[c] > tn[f]) { f = order[1]; c = order[0]; }
+            stack[sp] = n->child[f];
+            stack_t[sp++] = tn[f];
+            stack[sp] = n->child[c];
+            stack_t[sp++] = tn[c];
+        } else {
+            while (no > 0) {
+                uint32_t far = 0, q;
+                for (q = 1; q < no; ++q)
+                    if (tn[order[q]] > tn[order[far]]) far = q;
+                stack[sp] = n->child[order[far]];
+                stack_t[sp++] = tn[order[far]];
+                order[far] = order[--no];
+            }
         }
     }
     return found;
@@ -5889,9 +5943,40 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad_ray *ray, int any, rad_h
 static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
 {
     const rad_bvh *bvh = (const rad_bvh *)user;
-    uint32_t i;
+    const rad__tri4 *last = NULL;
+    uint32_t i, last_count = 0, since = 0;
+    int score = 0;
     rad_hit h;
-    for (i = 0; i < count; ++i) out[i] = (uint8_t)rad__bvh_trace(bvh, &rays[i], 1, &h);
+    for (i = 0; i < count; ++i) {
+        rad__wray w;
+        const rad__tri4 *leaf = NULL;
+        uint32_t leaf_count = 0;
+        float tmax, t, b1, b2;
+        out[i] = 0;
+        if (!(rays[i].tmax > rays[i].tmin)) continue;
+        rad__wray_init(&w, &rays[i]);
+        /* the rays of one call come from one caller in order (a form-factor row, an image row,
+           the shadow rays of neighbouring points), and consecutive ones are often stopped by
+           the same triangles: the leaf that stopped the last occluded ray is tried first.
+           Any hit in (tmin, tmax) occludes, so the answer is the traversal's. 'score' counts
+           +4 per success and -1 per failure: below 0 (incoherent rays, where the extra test
+           is only cost) the leaf is tried on every 32nd ray alone. */
+        if (last && (score >= 0 || ++since >= 32u)) {
+            since = 0;
+            tmax = w.tmax;
+            if (rad__wray_tri4(&w, last, last_count, 1, &tmax, &t, &b1, &b2) >= 0) {
+                score = score < 0 ? 4 : score < 60 ? score + 4 : 64;
+                out[i] = 1;
+                continue;
+            }
+            score = score > -8 ? score - 1 : -8;
+        }
+        if (rad__bvh_trace(bvh, &w, 1, &h, &leaf, &leaf_count)) {
+            out[i] = 1;
+            last = leaf;
+            last_count = leaf_count;
+        }
+    }
     return RAD_SUCCESS;
 }
 
@@ -5900,10 +5985,13 @@ static rad_result rad__bvh_intersect(void *user, const rad_ray *rays, uint32_t c
     const rad_bvh *bvh = (const rad_bvh *)user;
     uint32_t i;
     for (i = 0; i < count; ++i) {
+        rad__wray w;
         out[i].t = rays[i].tmax;
         out[i].triangle = RAD_NONE;
         out[i].b1 = out[i].b2 = 0.0f;
-        rad__bvh_trace(bvh, &rays[i], 0, &out[i]);
+        if (!(rays[i].tmax > rays[i].tmin)) continue;
+        rad__wray_init(&w, &rays[i]);
+        (void)rad__bvh_trace(bvh, &w, 0, &out[i], NULL, NULL);
     }
     return RAD_SUCCESS;
 }

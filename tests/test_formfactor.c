@@ -930,6 +930,114 @@ static void ff_test_bvh_brute_force(void)
     ff_bvh_soup(1, 2000, 99u); /* a single triangle: the root is a leaf */
 }
 
+/* The smallest barycentric coordinate of the line's crossing of triangle v (double), negative
+   outside: near 0 the float watertight test and ff_mt may decide either way. */
+static double ff_edge_margin(const rad_ray *ray, const float *v)
+{
+    double e1[3], e2[3], p[3], q[3], s[3], det, u, w, m;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)v[3 + k] - v[k];
+        e2[k] = (double)v[6 + k] - v[k];
+        s[k] = (double)ray->origin[k] - v[k];
+    }
+    p[0] = (double)ray->dir[1] * e2[2] - (double)ray->dir[2] * e2[1];
+    p[1] = (double)ray->dir[2] * e2[0] - (double)ray->dir[0] * e2[2];
+    p[2] = (double)ray->dir[0] * e2[1] - (double)ray->dir[1] * e2[0];
+    det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (det == 0.0) return -1.0;
+    u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
+    q[0] = s[1] * e1[2] - s[2] * e1[1];
+    q[1] = s[2] * e1[0] - s[0] * e1[2];
+    q[2] = s[0] * e1[1] - s[1] * e1[0];
+    w = ((double)ray->dir[0] * q[0] + (double)ray->dir[1] * q[1] + (double)ray->dir[2] * q[2]) / det;
+    m = u < w ? u : w;
+    return m < 1.0 - u - w ? m : 1.0 - u - w;
+}
+
+/* Occlusion of coherent rays in one call (an image of a fan of rays, as a form-factor row or
+   a camera casts them): the BVH tries the leaf that stopped the previous ray first, so the
+   intervals change from ray to ray here (before, between and past two layers of holed quads)
+   and that leaf's triangles are often hit outside the next ray's interval. Every answer must
+   equal brute force and the answer of the ray cast alone. */
+static void ff_test_bvh_occlusion_coherent(void)
+{
+    enum { G = 10, R = 64, N = R * R };
+    static float pos[2 * G * G * 18];
+    static rad_ray rays[N];
+    static uint8_t batch[N], single[N];
+    rad_mesh_desc m;
+    rad_scene_desc d;
+    rad_scene *scene = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    uint32_t i, tr, pass, bad = 0, alone = 0, grazing = 0, occluded = 0, tri_count = 2 * G * G * 2;
+    int layer, gx, gy, k;
+    float *q = pos;
+    /* two layers of G x G quads with gaps, at z = 1 and z = 2, the second shifted half a cell */
+    for (layer = 0; layer < 2; ++layer)
+        for (gy = 0; gy < G; ++gy)
+            for (gx = 0; gx < G; ++gx) {
+                float x0 = 0.1f * (float)gx + 0.01f + 0.05f * (float)layer, y0 = 0.1f * (float)gy + 0.01f + 0.05f * (float)layer;
+                float x1 = x0 + 0.08f, y1 = y0 + 0.08f, z = 1.0f + (float)layer;
+                float c[4][3];
+                c[0][0] = x0; c[0][1] = y0; c[1][0] = x1; c[1][1] = y0; c[2][0] = x1; c[2][1] = y1; c[3][0] = x0; c[3][1] = y1;
+                for (k = 0; k < 4; ++k) c[k][2] = z;
+                for (k = 0; k < 3; ++k) { q[k] = c[0][k]; q[3 + k] = c[1][k]; q[6 + k] = c[2][k]; }
+                for (k = 0; k < 3; ++k) { q[9 + k] = c[0][k]; q[12 + k] = c[2][k]; q[15 + k] = c[3][k]; }
+                q += 18;
+            }
+    memset(&m, 0, sizeof(m));
+    m.positions = pos;
+    m.vertex_count = 3 * tri_count;
+    m.triangle_count = tri_count;
+    ff_desc(&d, &m, 1);
+    CHECK_OK(rad_scene_create(&d, NULL, &scene));
+    if (!scene) return;
+    CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
+    if (!bvh) { rad_scene_destroy(scene); return; }
+    rad_bvh_raycaster(bvh, &rc);
+    for (pass = 0; pass < 2; ++pass) {
+        for (i = 0; i < N; ++i) {
+            /* pass 0: mostly whole rays (the leaf that stopped one often stops the next), and
+               every 8th pair ends before the first layer or starts past it, where that leaf
+               is hit outside the interval; pass 1: the interval changes every image row */
+            uint32_t kind = pass == 0 ? (i % 8u == 6u ? 0u : i % 8u == 7u ? 3u : 2u) : (i / R) % 4u;
+            rad_ray *r = &rays[i];
+            float tx = ((float)(i % R) + 0.5f) / (float)R, ty = ((float)(i / R) + 0.5f) / (float)R;
+            r->origin[0] = 0.5f; r->origin[1] = 0.5f; r->origin[2] = 0.0f;
+            r->dir[0] = tx - 0.5f; r->dir[1] = ty - 0.5f; r->dir[2] = 1.0f; /* t = 1, 2 at the layers */
+            r->tmin = kind == 3 ? 1.5f : 0.0f;
+            r->tmax = kind == 0 ? 0.5f : kind == 1 ? 1.5f : FLT_MAX;
+        }
+        CHECK_OK(rc.occluded(rc.user, rays, N, batch));
+        for (i = 0; i < N; ++i) CHECK_OK(rc.occluded(rc.user, &rays[i], 1, &single[i]));
+        for (i = 0; i < N; ++i) {
+            int any = 0, edge = 0;
+            for (tr = 0; tr < tri_count; ++tr) {
+                double t, b1, b2;
+                if (fabs(ff_edge_margin(&rays[i], scene->positions + 9 * (size_t)tr)) < 1e-6) edge = 1;
+                if (ff_mt(&rays[i], scene->positions + 9 * (size_t)tr, &t, &b1, &b2) && t > rays[i].tmin && t < rays[i].tmax)
+                    any = 1;
+            }
+            occluded += batch[i] != 0;
+            if (batch[i] != single[i]) alone++;
+            if ((batch[i] != 0) != any) {
+                if (edge) grazing++;
+                else bad++;
+            }
+        }
+    }
+    printf("    coherent occlusion: %u rays, %u occluded, %u wrong, %u differ from the ray alone, %u grazing\n", 2u * N,
+           occluded, bad, alone, grazing);
+    CHECK(occluded > N / 4 && occluded < 2u * N - N / 4); /* both answers are common */
+    CHECK(bad == 0);
+    CHECK(alone == 0);
+    CHECK(grazing <= 2);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(scene);
+}
+
 /* Watertightness: rays aimed exactly at shared edges and vertices must hit something. */
 static void ff_watertight_mesh(const float *pos, uint32_t vcount, const uint32_t *idx, uint32_t tcount,
                                const uint32_t (*edges)[2], uint32_t ecount, const float *normal, int vertex_inside,
@@ -1125,6 +1233,7 @@ static const rad_test_case tests_formfactor[] = {
     { "formfactor_cornell", ff_test_cornell },
     { "formfactor_bvh_brute_force", ff_test_bvh_brute_force },
     { "formfactor_bvh_watertight", ff_test_bvh_watertight },
+    { "formfactor_bvh_occlusion_coherent", ff_test_bvh_occlusion_coherent },
     { NULL, NULL }
 };
 
