@@ -1353,11 +1353,18 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     if (mo.method == TOOL_LIGHTMAP) {
         tool_lightmap_baked bk;
         int lsz = (int)render_lm_size;
-        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0, &bk);
+        tool_lightmap_proxy px;
+        memset(&px, 0, sizeof px);
+        px.kind = (int)mo.proxy;
+        px.resolution = mo.vp_resolution;
+        px.face_points = mo.face_points;
+        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0,
+                                mo.proxy ? &px : NULL, &bk);
         if (rc == 0) {
-            fprintf(stderr, "rad %s: timing: method=lightmap patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+            fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                             "step_ms_min=%.6f\n",
-                    cmd, bk.cl.patches->count, o.bounces, 1e3 * bk.cl.solve_seconds, 1e3 * bk.cl.solve_seconds);
+                    cmd, mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : mo.proxy ? " proxy=aavp" : "", bk.patches, o.bounces,
+                    1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
             render_lm = bk.lm;
             render_lm_values = bk.values;
             rc = render_classic(&bk.w, bk.cl.patches, NULL, &cam, width, height, aa, pixel_light_samples, &img);
