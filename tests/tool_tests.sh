@@ -1215,6 +1215,9 @@ if "$RAD" lightmap cornell -o "$TMP/lmc.pfm" --size 32 --patches 100 --texel-sam
 else
     fail "lightmap --proxy vp" "$(head -c 300 "$TMP/err.txt")"
 fi
+"$RAD" lightmap cornell --sun 0,-1,0:5 -o "$TMP/x.pfm" --size 32 --patches 60 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" &&
+    grep -q "lights from the command line: 1 sun" "$TMP/err.txt" && ok "lightmap takes --sun (lights from the command line)" ||
+    fail "lightmap takes --sun" "$(head -c 300 "$TMP/err.txt")"
 bad "lightmap --proxy with --sh" "--sh needs the classic gather" lightmap cornell -o "$TMP/x.pfm" --sh --proxy aavp
 bad "lightmap --vp-resolution without --proxy" "--vp-resolution and --face-points are for --proxy" lightmap cornell -o "$TMP/x.pfm" --vp-resolution 4
 bad "lightmap --proxy sideways" "unknown --proxy 'sideways'" lightmap cornell -o "$TMP/x.pfm" --proxy sideways

@@ -48,7 +48,7 @@ static void lightmap_usage(FILE *f)
                "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
                "                        the radiance of a white surface)\n"
                "  --threads N           worker threads (default: all cores)\n"
-               "%s", tool_classic_help());
+               "%s%s", tool_classic_help(), tool_light_help());
 }
 
 /* a path with 'tag' inserted before the extension: a.pfm -> a.L00.pfm */
@@ -332,7 +332,7 @@ fail:
     return 1;
 }
 
-int tool_cmd_lightmap(int argc, char **argv)
+static int lightmap_main(int argc, char **argv, tool_lights *lights)
 {
     const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
     int rw = 256, rh = 256;
@@ -359,6 +359,10 @@ int tool_cmd_lightmap(int argc, char **argv)
             return 0;
         }
         if ((k = tool_classic_option("lightmap", argc, argv, &a, &co)) != 0) {
+            if (k == 2) return 2;
+            continue;
+        }
+        if ((k = tool_light_option("lightmap", argc, argv, &a, lights)) != 0) {
             if (k == 2) return 2;
             continue;
         }
@@ -463,7 +467,7 @@ int tool_cmd_lightmap(int argc, char **argv)
         if (render_path && tool_check_output("lightmap", render_path, inputs, 1)) return 1;
     }
     tool_set_threads((int)threads);
-    if (tool_open_world("lightmap", scene_path, &w)) return 1;
+    if (tool_open_world_lit("lightmap", scene_path, lights, &w)) return 1;
     if (tool_lightmap_bake("lightmap", &w, &co, width, height, texel_samples, vis, gather, hemi_rays, sh, force_unwrap, !sh,
                            px.kind ? &px : NULL, &bk))
         goto done;
@@ -497,4 +501,14 @@ done:
     tool_lightmap_bake_free(&bk);
     tool_close_world(&w);
     return code;
+}
+
+int tool_cmd_lightmap(int argc, char **argv)
+{
+    tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = lightmap_main(argc, argv, &lights);
+    tool_lights_free(&lights);
+    return rc;
 }
