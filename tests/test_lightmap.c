@@ -1033,6 +1033,8 @@ static void lm_test_other_sources(void)
         CHECK(worst_rel < 1e-5);
         CHECK(wt->row_first[wt->row_count] <= 48u * wt->row_count);
     }
+    rad_lightmap_weights_destroy(wt);
+    wt = NULL;
     /* bad input */
     CHECK_RESULT(rad_lightmap_gather_vp(NULL, vp, Pv, Hv, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_lightmap_gather_vp(lm, vp, NULL, Hv, NULL), RAD_ERROR_INVALID_ARGUMENT);
