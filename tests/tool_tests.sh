@@ -1218,6 +1218,18 @@ fi
 "$RAD" lightmap cornell --sun 0,-1,0:5 -o "$TMP/x.pfm" --size 32 --patches 60 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" &&
     grep -q "lights from the command line: 1 sun" "$TMP/err.txt" && ok "lightmap takes --sun (lights from the command line)" ||
     fail "lightmap takes --sun" "$(head -c 300 "$TMP/err.txt")"
+# --proxy hierarchical (rad lightmap only): the hierarchical solution's smooth lookup per sample
+# (measured: mean ratio 1.02 at --hr-eps 3e-3)
+if [ -s "$TMP/lmc.pfm" ] &&
+    "$RAD" lightmap cornell -o "$TMP/lmh.pfm" --size 32 --proxy hierarchical --hr-eps 3e-3 --texel-samples 1 > /dev/null 2> "$TMP/err.txt"; then
+    q=$("$RAD" compare "$TMP/lmh.pfm" "$TMP/lmc.pfm" 2> /dev/null | awk '/^mean/ { print $NF }')
+    close "$q" 1 0.1 && grep -q "with the hierarchical solution" "$TMP/err.txt" &&
+        ok "lightmap --proxy hierarchical has the classic lightmap's mean (ratio $q)" ||
+        fail "lightmap --proxy hierarchical has the classic lightmap's mean" "ratio '$q'"
+else
+    fail "lightmap --proxy hierarchical" "$(head -c 300 "$TMP/err.txt")"
+fi
+bad "lightmap --hr-eps without --proxy hierarchical" "--hr-eps is for --proxy hierarchical" lightmap cornell -o "$TMP/x.pfm" --proxy aavp --hr-eps 1e-3
 bad "lightmap --proxy with --sh" "--sh needs the classic gather" lightmap cornell -o "$TMP/x.pfm" --sh --proxy aavp
 bad "lightmap --vp-resolution without --proxy" "--vp-resolution and --face-points are for --proxy" lightmap cornell -o "$TMP/x.pfm" --vp-resolution 4
 bad "lightmap --proxy sideways" "unknown --proxy 'sideways'" lightmap cornell -o "$TMP/x.pfm" --proxy sideways

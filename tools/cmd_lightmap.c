@@ -40,7 +40,9 @@ static void lightmap_usage(FILE *f)
                "  --proxy P             the indirect light from patches (the classic solution, default), aavp or\n"
                "                        vp (virtual patches: a few thousand unknowns whatever the triangle count,\n"
                "                        for real buildings; each texel gathers their H at its sample points; RGB\n"
-               "                        only, not --sh); --vp-resolution R (default 16), --face-points P (default 16)\n"
+               "                        only, not --sh); --vp-resolution R (default 16), --face-points P (default 16);\n"
+               "                        or hierarchical (the hierarchical solution's smooth lookup at each sample;\n"
+               "                        --hr-eps E, default 1e-5: coarser is faster on large scenes)\n"
                "  --render VIEW         also render the camera view shaded from the lightmap (.png, .pfm, .exr;\n"
                "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
                "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 4, as\n"
@@ -120,6 +122,7 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b)
     rad_lightmap_destroy(b->lm);
     tool_classic_free(&b->cl);
     rad_vp_destroy(b->vp);
+    rad_hierarchical_destroy(b->hr);
     if (b->own_scene) {
         rad_bvh_destroy(b->w.bvh);
         rad_scene_destroy(b->w.scene);
@@ -263,7 +266,17 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
     }
     w = &out->w;
-    if (proxy) {
+    if (proxy && proxy->kind == TOOL_LIGHTMAP_HIERARCHICAL) {
+        tool_method_options mo;
+        rad_hierarchical_stats hs;
+        double th = tool_seconds();
+        tool_method_options_default(&mo);
+        mo.hr_eps = proxy->hr_eps;
+        if (tool_hierarchical_build(cmd, w, &mo, co->light_samples, &out->hr)) goto fail;
+        rad_hierarchical_get_stats(out->hr, &hs);
+        out->patches = hs.leaves;
+        out->solve_seconds = tool_seconds() - th;
+    } else if (proxy) {
         if (lightmap_vp_solve(cmd, w, co, proxy, out, &vp_H)) goto fail;
     } else {
         if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
@@ -291,9 +304,10 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     out->values = (float *)tool_calloc((size_t)width * height * ch, sizeof(float));
     if (proxy) {
         tool_context(&ctx, "lightmap gather");
-        r = rad_lightmap_gather_vp(out->lm, out->vp, vp_H, out->values, &ctx);
+        r = out->hr ? rad_lightmap_gather_hierarchical(out->lm, out->hr, RAD_HIERARCHICAL_GATHERED, out->values, &ctx)
+                    : rad_lightmap_gather_vp(out->lm, out->vp, vp_H, out->values, &ctx);
         tool_progress_end();
-        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_gather_vp", r); goto fail; }
+        if (r != RAD_SUCCESS) { tool_fail(cmd, out->hr ? "rad_lightmap_gather_hierarchical" : "rad_lightmap_gather_vp", r); goto fail; }
     } else {
         /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
         if (gather < 0)
@@ -321,7 +335,7 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     if ((r = rad_lightmap_stitch(out->lm, ch, out->values, 0, &st, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_stitch", r); goto fail; }
     fprintf(stderr, "rad %s: lightmap baked in %.2f s (%.2f s with the %s solution; %ux%u, %.1f MiB of values); %u seams, "
                     "largest jump %.4g before stitching, %.4g after\n", cmd, tool_seconds() - t0, tool_seconds() - t_all,
-            proxy ? "virtual-patch" : "classic", out->lm->width, out->lm->height,
+            out->hr ? "hierarchical" : proxy ? "virtual-patch" : "classic", out->lm->width, out->lm->height,
             (double)width * height * ch * sizeof(float) / 1048576.0, st.seams, (double)st.max_jump_before,
             (double)st.max_jump_after);
     free(vp_H);
@@ -345,7 +359,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
     int gather = -1; /* -1: by the work, else a rad_lightmap_gather_method */
     tool_lightmap_proxy px;
-    int px_opts = 0;
+    int px_opts = 0, hr_opts = 0;
     const float *values = NULL;
     float exposure = 0.31830988f;
     memset(&bk, 0, sizeof bk);
@@ -371,8 +385,9 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             const char *v = argv[++a];
             if (!strcmp(v, "aavp")) px.kind = TOOL_PROXY_AAVP;
             else if (!strcmp(v, "vp")) px.kind = TOOL_PROXY_VP;
+            else if (!strcmp(v, "hierarchical")) px.kind = TOOL_LIGHTMAP_HIERARCHICAL;
             else if (!strcmp(v, "patches")) px.kind = TOOL_PROXY_PATCHES;
-            else { fprintf(stderr, "rad lightmap: unknown --proxy '%s' (patches, aavp or vp)\n", v); return 2; }
+            else { fprintf(stderr, "rad lightmap: unknown --proxy '%s' (patches, aavp, vp or hierarchical)\n", v); return 2; }
             continue;
         }
         if ((!strcmp(o, "--vp-resolution") || !strcmp(o, "--face-points")) && a + 1 < argc) {
@@ -380,6 +395,12 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             if (tool_parse_uint("lightmap", o, argv[++a], dst)) return 2;
             if (*dst == 0 || *dst > hi) { fprintf(stderr, "rad lightmap: %s must be 1 to %u\n", o, hi); return 2; }
             px_opts = 1;
+            continue;
+        }
+        if (!strcmp(o, "--hr-eps") && a + 1 < argc) {
+            if (tool_parse_float("lightmap", o, argv[++a], &px.hr_eps)) return 2;
+            if (!(px.hr_eps > 0.0f && px.hr_eps < 1.0f)) { fprintf(stderr, "rad lightmap: --hr-eps must be in (0, 1)\n"); return 2; }
+            hr_opts = 1;
             continue;
         }
         if (!strcmp(o, "--unwrap")) { force_unwrap = 1; continue; }
@@ -442,8 +463,12 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
         lightmap_usage(stderr);
         return 2;
     }
-    if (px_opts && !px.kind) {
+    if (px_opts && (!px.kind || px.kind == TOOL_LIGHTMAP_HIERARCHICAL)) {
         fprintf(stderr, "rad lightmap: --vp-resolution and --face-points are for --proxy aavp|vp\n");
+        return 2;
+    }
+    if (hr_opts && px.kind != TOOL_LIGHTMAP_HIERARCHICAL) {
+        fprintf(stderr, "rad lightmap: --hr-eps is for --proxy hierarchical\n");
         return 2;
     }
     if (px.kind && sh) {

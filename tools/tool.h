@@ -526,14 +526,19 @@ int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene
 /* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
 /* --proxy aavp|vp: the indirect light from virtual patches instead of classic patches */
 typedef struct tool_lightmap_proxy {
-    int kind;                /* TOOL_PROXY_AAVP or TOOL_PROXY_VP */
+    int kind;                /* TOOL_PROXY_AAVP, TOOL_PROXY_VP or TOOL_LIGHTMAP_HIERARCHICAL */
     uint32_t resolution;     /* voxels along the longest axis (0: 16) */
     uint32_t face_points;    /* Hammersley points per voxel face (0: 16) */
+    float hr_eps;            /* hierarchical: BF tolerance (0: the tool's 1e-5) */
 } tool_lightmap_proxy;
+/* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth
+   lookup (rad_lightmap_gather_hierarchical); a kind of its own, past the tool_proxy values */
+#define TOOL_LIGHTMAP_HIERARCHICAL 3
 typedef struct tool_lightmap_baked {
     tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
     tool_classic cl;     /* the classic solution gathered (patches of w.scene), or zero with a proxy */
     rad_virtual_patches *vp; /* the proxy's set (of w.scene), or NULL */
+    rad_hierarchical *hr;    /* --proxy hierarchical: the solution (of w.scene), or NULL */
     uint32_t patches;        /* unknowns of the solution: classic patches or virtual patches */
     double solve_seconds;    /* the solve (K bounces and H = F B) */
     rad_lightmap *lm;
