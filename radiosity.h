@@ -2621,6 +2621,56 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, con
 RAD_API void rad_lightmap_sample(const rad_lightmap *lightmap, uint32_t channels, const float *values, float u, float v,
                                  float *out);
 
+/* LIGHTMAPS FROM OTHER SOLUTIONS. rad_lightmap_gather needs a classic patch set, whose dense
+   N x N form factors a real building cannot afford (at least one patch per triangle). The
+   same texels take their indirect light from the solutions built for such scenes:
+   VIRTUAL PATCHES (rad_lightmap_gather_vp, >>api_vp): at each valid sample (position p, the
+   unit geometric normal n of its triangle) the virtual-patch gather rad_vp_gather_point of
+   the per-patch values (normally the patch irradiance H = F (E + L) of a solved set: the
+   indirect irradiance, as rad render --method aavp shades), trilinear over the 2x2x2 voxels
+   around p with the normal weights; a texel holds the mean over its valid samples that the
+   gather reaches (a sample whose block holds no patch facing n is left out; a texel without
+   a valid sample or with none reached holds 0: fill it with rad_lightmap_dilate). RGB
+   irradiance only (3 floats per texel): the gather has no direction to project into SH.
+   Cost: O(valid samples) look-ups, no rays; whatever the triangle count. The result is
+   LINEAR in the values, so rad_lightmap_weights_create_vp stores it exactly as weights:
+   rad_lightmap_refresh with a new H (a temporal frame, a moved light's re-solve on the same
+   set) equals a fresh rad_lightmap_gather_vp to float rounding, with no detail factor.
+   HIERARCHICAL (rad_lightmap_gather_hierarchical, >>api_hierarchical): at each valid sample
+   the solved object's smooth lookup (rad_hierarchical_lookup, smooth 1) of the gathered
+   irradiance H (the default) or of B, by the sample's triangle and barycentrics; a texel holds
+   the mean over its valid samples. Cost: O(valid samples) look-ups.
+   In both, the direct light per texel comes from rad_lightmap_direct as with the classic
+   gather (or per pixel, by the engine), then rad_lightmap_dilate and rad_lightmap_stitch.
+   docs/methods/lightmap.md, "Other solutions". */
+
+/* The virtual-patch gather above into out (width * height * 3 floats; every texel written).
+   patch_values: 3 * vp->count floats. vp's scene must be the lightmap's (a set loaded without
+   a scene, vp->scene NULL, is taken as built from it). Errors: INVALID_ARGUMENT (NULL, a set
+   of another scene), NON_FINITE (a value or result), CANCELLED, OUT_OF_MEMORY. Parallel
+   through ctx->parallel_for; deterministic whatever the thread count. */
+RAD_API rad_result rad_lightmap_gather_vp(const rad_lightmap *lightmap, const rad_virtual_patches *vp,
+                                          const float *patch_values, float *out, const rad_context *ctx);
+
+/* Refresh weights of the virtual-patch gather (the LAYOUT of rad_lightmap_weights with stage 1
+   the identity: vertex_count = patch_count = vp->count, vertex_first[v] = v, one entry per
+   patch of weight 1; stage 2 the texel rows over the patches, the merged rad_vp_gather_table
+   rows of the texel's reached valid samples divided by their count, at most 48 entries per
+   sample and about 10 to 20 per texel). rad_lightmap_refresh(weights, H, out) then writes
+   every texel with a row to rad_lightmap_gather_vp(H)'s value; texels without one keep theirs.
+   Errors: INVALID_ARGUMENT (NULL, a set of another scene), SIZE_OVERFLOW (2^32 entries or
+   more), OUT_OF_MEMORY. Cost: two passes of gather look-ups per valid sample. */
+RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lightmap, const rad_virtual_patches *vp,
+                                                  const rad_context *ctx, rad_lightmap_weights **out);
+
+/* The hierarchical gather above into out (width * height * 3 floats; every texel written).
+   value: RAD_HIERARCHICAL_GATHERED (H, the indirect irradiance with the solve's sources as
+   rad render --method hierarchical uses them) or RAD_HIERARCHICAL_RADIOSITY (B). h: solved,
+   of the lightmap's scene. Errors: INVALID_ARGUMENT (NULL, not solved, another scene, a bad
+   value), NON_FINITE, OUT_OF_MEMORY. */
+RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lightmap, const rad_hierarchical *h,
+                                                    rad_hierarchical_value value, float *out, const rad_context *ctx);
+
 /* ======================================================================================== */
 /* >>api_probes: irradiance probes (SH L2) from a patch solution                            */
 /* ======================================================================================== */
@@ -19050,6 +19100,229 @@ done:
     rad__free(&c.allocator, rows);
     if (r != RAD_SUCCESS) rad__log(&c, RAD_LOG_ERROR, "lightmap stitch: out of memory for %lu seam samples", (unsigned long)nrows);
     return r;
+}
+
+/* ---- lightmaps from virtual patches and from the hierarchical solution ---- */
+
+typedef struct rad__lm_other {
+    const rad_lightmap *lm;
+    const rad_virtual_patches *vp;     /* the virtual-patch gather, or */
+    const rad_hierarchical *h;         /* the hierarchical lookup */
+    rad_hierarchical_value value;
+    const float *values;
+    float *out;
+} rad__lm_other;
+
+static rad_result rad__lm_vp_row(void *data, uint32_t texel, uint32_t task)
+{
+    const rad__lm_other *g = (const rad__lm_other *)data;
+    const rad_lightmap *lm = g->lm;
+    double sum[3] = {0.0, 0.0, 0.0};
+    uint32_t s, reached = 0, k;
+    (void)task;
+    for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) {
+        float v[3];
+        if (!lm->sample_valid[s]) continue;
+        /* a sample no patch faces would darken the texel: it is left out of the mean */
+        if (!rad_vp_gather_point(g->vp, g->values, lm->sample_positions + 3 * (size_t)s, lm->sample_normals + 3 * (size_t)s, v))
+            continue;
+        ++reached;
+        for (k = 0; k < 3; ++k) sum[k] += v[k];
+    }
+    for (k = 0; k < 3; ++k) g->out[3 * (size_t)texel + k] = reached ? (float)(sum[k] / reached) : 0.0f;
+    return RAD_SUCCESS;
+}
+
+/* the set's scene must be the lightmap's (NULL: a set loaded without one) */
+static rad_result rad__lm_check_vp(const rad__ctx *c, const char *what, const rad_lightmap *lm, const rad_virtual_patches *vp)
+{
+    if (!lm || !vp) {
+        rad__log(c, RAD_LOG_ERROR, "%s: NULL lightmap or virtual patches", what);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (vp->scene && vp->scene != lm->scene) {
+        rad__log(c, RAD_LOG_ERROR, "%s: the virtual patches were built from another scene than the lightmap", what);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_lightmap_gather_vp(const rad_lightmap *lm, const rad_virtual_patches *vp, const float *values,
+                                          float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__lm_other g;
+    uint32_t texels, T;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if ((r = rad__lm_check_vp(&c, "lightmap gather (virtual patches)", lm, vp)) != RAD_SUCCESS) return r;
+    if (!values || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather (virtual patches): NULL patch values or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    r = rad__check_input(&c, "lightmap gather (virtual patches): patch values", values, 3 * (size_t)vp->count);
+    if (r != RAD_SUCCESS) return r;
+    memset(&g, 0, sizeof g);
+    g.lm = lm;
+    g.vp = vp;
+    g.values = values;
+    g.out = out;
+    texels = lm->width * lm->height;
+    T = c.tasks < texels ? c.tasks : texels;
+    r = rad__for_rows(&c, texels, T ? T : 1u, rad__lm_vp_row, &g);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather (virtual patches)", out, 3 * (size_t)texels) : r;
+}
+
+RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lm, const rad_virtual_patches *vp,
+                                                  const rad_context *ctx, rad_lightmap_weights **out)
+{
+    rad__ctx c;
+    rad_lightmap_weights *W = NULL;
+    rad_vp_gather_table *tab = NULL;
+    float *pts = NULL, *nrm = NULL;
+    double *val = NULL;
+    uint32_t *col = NULL, *first = NULL, i, m = 0, texels, rows = 0, most = 1;
+    uint64_t total = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap weights (virtual patches): NULL output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    if ((r = rad__lm_check_vp(&c, "lightmap weights (virtual patches)", lm, vp)) != RAD_SUCCESS) return r;
+    texels = lm->width * lm->height;
+    /* the valid samples in texel order, and the most a texel has */
+    first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)texels + 1, sizeof(uint32_t));
+    pts = (float *)rad__alloc_array(&c.allocator, (size_t)lm->sample_count + 1, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c.allocator, (size_t)lm->sample_count + 1, 3 * sizeof(float));
+    if (!first || !pts || !nrm) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (i = 0; i < texels; ++i) {
+        uint32_t s, n = 0;
+        first[i] = m;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+            if (!lm->sample_valid[s]) continue;
+            memcpy(pts + 3 * (size_t)m, lm->sample_positions + 3 * (size_t)s, 3 * sizeof(float));
+            memcpy(nrm + 3 * (size_t)m, lm->sample_normals + 3 * (size_t)s, 3 * sizeof(float));
+            ++m;
+            ++n;
+        }
+        if (n > most) most = n;
+        rows += n > 0;
+    }
+    first[texels] = m;
+    if ((r = rad_vp_gather_table_create(vp, pts, nrm, m, ctx, &tab)) != RAD_SUCCESS) goto done;
+    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    if (!W) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    memset(W, 0, sizeof(*W));
+    W->allocator = c.allocator;
+    W->texels = texels;
+    W->patch_count = vp->count;
+    W->vertex_count = vp->count;
+    /* stage 1 is the identity: the rows below address the patches themselves */
+    W->vertex_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)vp->count + 1, sizeof(uint32_t));
+    W->vertex_patches = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)vp->count + 1, sizeof(uint32_t));
+    W->vertex_weights = (float *)rad__alloc_array(&c.allocator, (size_t)vp->count + 1, sizeof(float));
+    W->row_texels = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    W->row_first = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)rows + 1, sizeof(uint32_t));
+    /* a texel's row has at most the entries of its samples' rows (at most 48 each) */
+    col = (uint32_t *)rad__alloc_array(&c.allocator, 48u * (size_t)most, sizeof(uint32_t));
+    val = (double *)rad__alloc_array(&c.allocator, 48u * (size_t)most, sizeof(double));
+    W->entry_vertices = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)tab->offsets[m] + 1, sizeof(uint32_t));
+    W->entry_weights = (float *)rad__alloc_array(&c.allocator, (size_t)tab->offsets[m] + 1, sizeof(float));
+    if (!W->vertex_first || !W->vertex_patches || !W->vertex_weights || !W->row_texels || !W->row_first || !col || !val ||
+        !W->entry_vertices || !W->entry_weights) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    for (i = 0; i < vp->count; ++i) { W->vertex_first[i] = i; W->vertex_patches[i] = i; W->vertex_weights[i] = 1.0f; }
+    W->vertex_first[vp->count] = vp->count;
+    rows = 0;
+    for (i = 0; i < texels; ++i) {
+        uint32_t s, n = 0, reached = 0, e, q;
+        for (s = first[i]; s < first[i + 1]; ++s) {
+            if (tab->offsets[s] == tab->offsets[s + 1]) continue; /* not reached: left out, as the gather */
+            ++reached;
+            for (e = tab->offsets[s]; e < tab->offsets[s + 1]; ++e) {
+                for (q = 0; q < n && col[q] != tab->patch[e]; ++q) {}
+                if (q == n) { col[n] = tab->patch[e]; val[n++] = 0.0; }
+                val[q] += tab->weight[e];
+            }
+        }
+        if (!reached) continue;
+        /* merged entries never outnumber the table's, which fit in 32 bits */
+        W->row_texels[rows] = i;
+        W->row_first[rows++] = (uint32_t)total;
+        for (q = 0; q < n; ++q) {
+            W->entry_vertices[total + q] = col[q];
+            W->entry_weights[total + q] = (float)(val[q] / reached);
+        }
+        total += n;
+    }
+    W->row_first[rows] = (uint32_t)total;
+    W->row_count = rows;
+done:
+    rad_vp_gather_table_destroy(tab);
+    rad__free(&c.allocator, first);
+    rad__free(&c.allocator, pts);
+    rad__free(&c.allocator, nrm);
+    rad__free(&c.allocator, col);
+    rad__free(&c.allocator, val);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_OUT_OF_MEMORY)
+            rad__log(&c, RAD_LOG_ERROR, "lightmap weights (virtual patches): out of memory for %u samples", m);
+        rad_lightmap_weights_destroy(W);
+        return r;
+    }
+    *out = W;
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__lm_hr_row(void *data, uint32_t texel, uint32_t task)
+{
+    const rad__lm_other *g = (const rad__lm_other *)data;
+    const rad_lightmap *lm = g->lm;
+    double sum[3] = {0.0, 0.0, 0.0};
+    uint32_t s, nv = 0, k;
+    rad_result r;
+    (void)task;
+    for (s = lm->sample_first[texel]; s < lm->sample_first[texel + 1]; ++s) {
+        uint32_t t = lm->sample_triangles[s];
+        float b[2], v[3];
+        if (!lm->sample_valid[s]) continue;
+        rad__lm_bary3(lm->scene->positions + 9 * (size_t)t, lm->sample_positions + 3 * (size_t)s, &b[0], &b[1]);
+        if ((r = rad_hierarchical_lookup(g->h, g->value, 1, &t, b, 1, v)) != RAD_SUCCESS) return r;
+        ++nv;
+        for (k = 0; k < 3; ++k) sum[k] += v[k];
+    }
+    for (k = 0; k < 3; ++k) g->out[3 * (size_t)texel + k] = nv ? (float)(sum[k] / nv) : 0.0f;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lm, const rad_hierarchical *h,
+                                                    rad_hierarchical_value value, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__lm_other g;
+    uint32_t texels, T;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !h || !out || (value != RAD_HIERARCHICAL_RADIOSITY && value != RAD_HIERARCHICAL_GATHERED)) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather (hierarchical): NULL lightmap, solution or output, or value %d unknown",
+                 (int)value);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (h->state != 1 || h->scene != lm->scene) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap gather (hierarchical): the solution is %s",
+                 h->state != 1 ? "not solved" : "of another scene than the lightmap");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    memset(&g, 0, sizeof g);
+    g.lm = lm;
+    g.h = h;
+    g.value = value;
+    g.out = out;
+    texels = lm->width * lm->height;
+    T = c.tasks < texels ? c.tasks : texels;
+    r = rad__for_rows(&c, texels, T ? T : 1u, rad__lm_hr_row, &g);
+    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather (hierarchical)", out, 3 * (size_t)texels) : r;
 }
 
 /* ======================================================================================== */

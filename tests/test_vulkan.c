@@ -1470,8 +1470,10 @@ static void test_lightmap_refresh(void)
     rad_raycaster rc;
     rad_lightmap_options lo;
     rad_lightmap *lm = NULL;
-    rad_lightmap_weights *w0 = NULL, *w = NULL;
-    float *H = NULL, *base = NULL, *cpu = NULL;
+    rad_lightmap_weights *w0 = NULL, *w = NULL, *wv = NULL;
+    rad_virtual_patches *vp = NULL;
+    rad_vp_options vo;
+    float *H = NULL, *base = NULL, *cpu = NULL, *Hv = NULL, *cpuv = NULL;
     uint32_t i, m, q, cell = 0, cut[4], s, texels;
     const uint32_t size = 64, cells = 6;
     g_worst_what = "relative error of the texels";
@@ -1511,28 +1513,45 @@ static void test_lightmap_refresh(void)
     T_CHECK(rad_lightmap_refresh(w, H, cpu, NULL) == RAD_SUCCESS);
     printf("    %u vertices (%u entries), %u rows (%u entries)\n", w->vertex_count, w->vertex_first[w->vertex_count], w->row_count,
            w->row_first[w->row_count]);
-    for (s = 0; s < 2; ++s) {
+    /* the weights of the virtual-patch gather (stage 1 the identity) run through the same kernel */
+    rad_vp_options_default(&vo);
+    vo.resolution = 4;
+    if (rad_vp_create(S, &rc, &vo, NULL, &vp) != RAD_SUCCESS || rad_lightmap_weights_create_vp(lm, vp, NULL, &wv) != RAD_SUCCESS) {
+        T_CHECK(0);
+        goto done;
+    }
+    Hv = (float *)malloc(3 * (size_t)vp->count * 4);
+    cpuv = (float *)malloc(3 * (size_t)texels * 4);
+    if (!Hv || !cpuv) { T_CHECK(0); goto done; }
+    for (i = 0; i < 3 * vp->count; ++i) Hv[i] = 2.0f * frand();
+    for (i = 0; i < 3 * texels; ++i) cpuv[i] = -1.0f;
+    T_CHECK(rad_lightmap_refresh(wv, Hv, cpuv, NULL) == RAD_SUCCESS);
+    for (s = 0; s < 4; ++s) {
+        /* s 0, 1: the classic weights at the two workgroup sizes; 2, 3: the virtual patches' */
+        const rad_lightmap_weights *W = s < 2 ? w : wv;
+        const float *HH = s < 2 ? H : Hv, *ref = s < 2 ? cpu : cpuv;
+        uint32_t np = s < 2 ? P->count : vp->count;
         vk_kernel k;
         vk_buf bVF, bVP, bVW, bH, bV, bRT, bRF, bEV, bEW, bO;
         int ok = 1, pass;
-        if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_LIGHTMAP_REFRESH, 0, 10, (uint32_t)sizeof(rad_glsl_lightmap_refresh_push), g_local_sizes[s])) {
+        if (!vk_kernel_create(&g_vk, &k, RAD_GLSL_LIGHTMAP_REFRESH, 0, 10, (uint32_t)sizeof(rad_glsl_lightmap_refresh_push), g_local_sizes[s % 2])) {
             T_CHECK(0);
             break;
         }
-        ok &= vk_buffer(&g_vk, &bVF, ((VkDeviceSize)w->vertex_count + 1) * 4, w->vertex_first);
-        ok &= vk_buffer(&g_vk, &bVP, (VkDeviceSize)w->vertex_first[w->vertex_count] * 4 + 4, w->vertex_patches);
-        ok &= vk_buffer(&g_vk, &bVW, (VkDeviceSize)w->vertex_first[w->vertex_count] * 4 + 4, w->vertex_weights);
-        ok &= vk_buffer(&g_vk, &bH, 3 * (VkDeviceSize)P->count * 4, H);
-        ok &= vk_buffer(&g_vk, &bV, 3 * (VkDeviceSize)w->vertex_count * 4 + 4, NULL);
-        ok &= vk_buffer(&g_vk, &bRT, (VkDeviceSize)w->row_count * 4 + 4, w->row_texels);
-        ok &= vk_buffer(&g_vk, &bRF, ((VkDeviceSize)w->row_count + 1) * 4, w->row_first);
-        ok &= vk_buffer(&g_vk, &bEV, (VkDeviceSize)w->row_first[w->row_count] * 4 + 4, w->entry_vertices);
-        ok &= vk_buffer(&g_vk, &bEW, (VkDeviceSize)w->row_first[w->row_count] * 4 + 4, w->entry_weights);
+        ok &= vk_buffer(&g_vk, &bVF, ((VkDeviceSize)W->vertex_count + 1) * 4, W->vertex_first);
+        ok &= vk_buffer(&g_vk, &bVP, (VkDeviceSize)W->vertex_first[W->vertex_count] * 4 + 4, W->vertex_patches);
+        ok &= vk_buffer(&g_vk, &bVW, (VkDeviceSize)W->vertex_first[W->vertex_count] * 4 + 4, W->vertex_weights);
+        ok &= vk_buffer(&g_vk, &bH, 3 * (VkDeviceSize)np * 4, HH);
+        ok &= vk_buffer(&g_vk, &bV, 3 * (VkDeviceSize)W->vertex_count * 4 + 4, NULL);
+        ok &= vk_buffer(&g_vk, &bRT, (VkDeviceSize)W->row_count * 4 + 4, W->row_texels);
+        ok &= vk_buffer(&g_vk, &bRF, ((VkDeviceSize)W->row_count + 1) * 4, W->row_first);
+        ok &= vk_buffer(&g_vk, &bEV, (VkDeviceSize)W->row_first[W->row_count] * 4 + 4, W->entry_vertices);
+        ok &= vk_buffer(&g_vk, &bEW, (VkDeviceSize)W->row_first[W->row_count] * 4 + 4, W->entry_weights);
         ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)texels * 4, NULL);
         if (ok) for (i = 0; i < 3 * texels; ++i) ((float *)bO.map)[i] = -1.0f;
         for (pass = 0; pass < 2 && ok; ++pass) {
-            uint32_t n = pass == 0 ? w->vertex_count : w->row_count;
-            const uint32_t *first = pass == 0 ? w->vertex_first : w->row_first;
+            uint32_t n = pass == 0 ? W->vertex_count : W->row_count;
+            const uint32_t *first = pass == 0 ? W->vertex_first : W->row_first;
             chunks(n, cut);
             for (q = 0; q < 3 && ok; ++q) {
                 rad_glsl_lightmap_refresh_push p;
@@ -1559,16 +1578,18 @@ static void test_lightmap_refresh(void)
             }
         }
         T_CHECK(ok);
-        if (ok) compare("lightmap refresh", (const float *)bO.map, cpu, 3 * (size_t)texels, 1e-5);
+        if (ok) compare("lightmap refresh", (const float *)bO.map, ref, 3 * (size_t)texels, 1e-5);
         vk_buffer_free(&g_vk, &bVF); vk_buffer_free(&g_vk, &bVP); vk_buffer_free(&g_vk, &bVW); vk_buffer_free(&g_vk, &bH);
         vk_buffer_free(&g_vk, &bV); vk_buffer_free(&g_vk, &bRT); vk_buffer_free(&g_vk, &bRF); vk_buffer_free(&g_vk, &bEV);
         vk_buffer_free(&g_vk, &bEW); vk_buffer_free(&g_vk, &bO);
         vk_kernel_destroy(&g_vk, &k);
     }
 done:
-    free(H); free(base); free(cpu);
+    free(H); free(base); free(cpu); free(Hv); free(cpuv);
     rad_lightmap_weights_destroy(w0);
     rad_lightmap_weights_destroy(w);
+    rad_lightmap_weights_destroy(wv);
+    rad_vp_destroy(vp);
     rad_lightmap_destroy(lm);
     rad_bvh_destroy(bvh);
     rad_patches_destroy(P);

@@ -158,6 +158,11 @@ int tool_dense_check(const char *cmd, const tool_classic_options *o, uint32_t n,
     if (mem_over) fprintf(stderr, "; only %s may be used (%s)", lbuf, limit_from);
     if (time_over) fprintf(stderr, "%s more than the %.0f minutes the tool starts a dense build for",
                            mem_over ? ", and" : ";", TOOL_DENSE_MAX_SECONDS / 60.0);
+    if (o->dense_instead) {
+        fprintf(stderr, ".\nrad %s: use %s, or give --force to build it anyway%s\n", cmd, o->dense_instead,
+                mem_over ? " (or --max-memory SIZE for another limit)" : "");
+        return 1;
+    }
     fprintf(stderr, ".\nrad %s: use %s--method aavp or --method vp (virtual patches: a few thousand patches whatever the "
                     "triangle count; --vp-max-patches B sets how many; --proxy aavp runs multibounce, temporal or local over them), "
                     "or give --force to build it anyway%s\n",

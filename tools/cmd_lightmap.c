@@ -1,11 +1,12 @@
 /* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
 
-   rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [--size N|WxH] [--sh] [--texel-samples N]
+   rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [--size N|WxH] [--sh] [--texel-samples N] [--proxy aavp|vp]
                 [--visibility-rays N] [--gather exact|hemisphere] [--hemisphere-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
                 [classic options] [--threads N] [--exposure X]
 
-   The classic solution (classic.c: patches, F, direct light as the source, B = E + L) is
-   gathered into the texels of the lightmap uv set (>>api_lightmap): every mesh's second uv set
+   The classic solution (classic.c: patches, F, direct light as the source, B = E + L), or with
+   --proxy aavp|vp the virtual patches' (H = F (E + L) per virtual patch, rad_lightmap_gather_vp),
+   is gathered into the texels of the lightmap uv set (>>api_lightmap): every mesh's second uv set
    (glTF TEXCOORD_1, assimp's second channel), or, when some mesh has none (or --unwrap), the
    simple automatic unwrap of unwrap.c. RGB: irradiance (W m^-2) = the direct light of the
    lights and emitters per texel + the irradiance from the secondary sources; --sh: the L1
@@ -36,6 +37,12 @@ static void lightmap_usage(FILE *f)
                "                        exceeds 2e7\n"
                "  --hemisphere-rays N   rays per texel of the hemisphere gather (default 256, at most 65536)\n"
                "  --unwrap              unwrap even when the file has a second uv set\n"
+               "  --proxy P             the indirect light from patches (the classic solution, default), aavp or\n"
+               "                        vp (virtual patches: a few thousand unknowns whatever the triangle count,\n"
+               "                        for real buildings; each texel gathers their H at its sample points; RGB\n"
+               "                        only, not --sh); --vp-resolution R (default 16), --face-points P (default 16);\n"
+               "                        or hierarchical (the hierarchical solution's smooth lookup at each sample;\n"
+               "                        --hr-eps E, default 1e-5: coarser is faster on large scenes)\n"
                "  --render VIEW         also render the camera view shaded from the lightmap (.png, .pfm, .exr;\n"
                "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
                "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 4, as\n"
@@ -43,7 +50,7 @@ static void lightmap_usage(FILE *f)
                "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
                "                        the radiance of a white surface)\n"
                "  --threads N           worker threads (default: all cores)\n"
-               "%s", tool_classic_help());
+               "%s%s", tool_classic_help(), tool_light_help());
 }
 
 /* a path with 'tag' inserted before the extension: a.pfm -> a.L00.pfm */
@@ -114,6 +121,8 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b)
     free(b->values);
     rad_lightmap_destroy(b->lm);
     tool_classic_free(&b->cl);
+    rad_vp_destroy(b->vp);
+    rad_hierarchical_destroy(b->hr);
     if (b->own_scene) {
         rad_bvh_destroy(b->w.bvh);
         rad_scene_destroy(b->w.scene);
@@ -122,10 +131,84 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b)
     memset(b, 0, sizeof *b);
 }
 
+/* --proxy aavp|vp: virtual patches of w's scene, E = rho D at their samples, L by K Jacobi
+   bounces (Gauss-Seidel with --solver gauss-seidel), H = F (E + L) per patch into *H_out (3N
+   floats, to free) */
+static int lightmap_vp_solve(const char *cmd, const tool_world *w, const tool_classic_options *co,
+                             const tool_lightmap_proxy *px, tool_lightmap_baked *out, float **H_out)
+{
+    rad_vp_options vo;
+    rad_direct_options dopt;
+    rad_solve_options so;
+    rad_system sys;
+    rad_context ctx;
+    rad_result r;
+    float *E, *L, *H;
+    uint32_t n, i;
+    double t0 = tool_seconds();
+    *H_out = NULL;
+    rad_vp_options_default(&vo);
+    if (px->resolution) vo.resolution = px->resolution;
+    if (px->face_points) vo.face_points = px->face_points;
+    if (px->kind == TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
+    /* CSR rows: O(non-zeros), as rad render --proxy keeps them */
+    vo.storage = RAD_STORAGE_SPARSE;
+    tool_context(&ctx, "virtual patches");
+    r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &out->vp);
+    tool_progress_end();
+    if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_create", r);
+    n = out->vp->count;
+    out->patches = n;
+    fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches, %u voxels, %u samples, %.1f MiB, built in %.2f s\n",
+            cmd, px->kind == TOOL_PROXY_VP ? "vp" : "aavp", vo.resolution, n, out->vp->voxel_count, out->vp->sample_count,
+            (double)rad_vp_memory(out->vp) / 1048576.0, tool_seconds() - t0);
+    E = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    H = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+    rad_direct_options_default(&dopt);
+    dopt.include_emitters = 1;
+    dopt.light_samples = co->light_samples;
+    tool_context(&ctx, "direct light");
+    r = rad_vp_sources(out->vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
+    tool_progress_end();
+    if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_vp_sources", r); goto fail; }
+    t0 = tool_seconds();
+    rad_vp_system(&sys, out->vp, E);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_INDIRECT;
+    so.bounces = co->bounces;
+    tool_context(&ctx, NULL);
+    if (co->solver == TOOL_GAUSS_SEIDEL) {
+        r = rad_solve_gauss_seidel(&sys, &so, L, NULL, &ctx);
+        if (r == RAD_ERROR_NOT_CONVERGED) {
+            fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge\n", cmd);
+            r = RAD_SUCCESS;
+        }
+    } else {
+        r = rad_solve_jacobi(&sys, &so, L, NULL, &ctx);
+    }
+    if (r != RAD_SUCCESS) { tool_fail(cmd, "solve", r); goto fail; }
+    for (i = 0; i < 3 * n; ++i) L[i] += E[i];
+    if ((r = rad_matrix_multiply(&out->vp->matrix, L, H, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_matrix_multiply", r); goto fail; }
+    out->solve_seconds = tool_seconds() - t0;
+    free(E);
+    free(L);
+    *H_out = H;
+    return 0;
+fail:
+    free(E);
+    free(L);
+    free(H);
+    return 1;
+}
+
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
                            int height, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
-                           int force_unwrap, int direct, tool_lightmap_baked *out)
+                           int force_unwrap, int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out)
 {
+    tool_classic_options co2 = *co;
+    float *vp_H = NULL;
+    double t_all = tool_seconds();
     tool_world w2 = *world;
     rad_lightmap_options lo;
     rad_lightmap_gather_options go;
@@ -138,6 +221,19 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     rad_scene_desc desc;
     const tool_world *w = world;
     memset(out, 0, sizeof *out);
+    if (proxy && sh) {
+        fprintf(stderr, "rad %s: --sh needs the classic gather (the virtual patches' gather has no direction): leave out --proxy\n", cmd);
+        return 1;
+    }
+    if (proxy && co->solver == TOOL_DIRECT) {
+        fprintf(stderr, "rad %s: --solver direct is for classic patches: with --proxy use jacobi or gauss-seidel\n", cmd);
+        return 1;
+    }
+    /* a scene too big for the dense classic build is refused before the unwrap, with the way out */
+    co2.dense_instead = "--proxy aavp or --proxy vp (the lightmap's indirect light from virtual patches: a few thousand "
+                        "whatever the triangle count; --vp-resolution R sets how many)";
+    co = &co2;
+    if (!proxy && tool_dense_check(cmd, co, w->scene->triangle_count, 1)) return 1;
     /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
     if (force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
         if (!force_unwrap && w->scene->lightmap_uvs)
@@ -170,7 +266,23 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
     }
     w = &out->w;
-    if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
+    if (proxy && proxy->kind == TOOL_LIGHTMAP_HIERARCHICAL) {
+        tool_method_options mo;
+        rad_hierarchical_stats hs;
+        double th = tool_seconds();
+        tool_method_options_default(&mo);
+        mo.hr_eps = proxy->hr_eps;
+        if (tool_hierarchical_build(cmd, w, &mo, co->light_samples, &out->hr)) goto fail;
+        rad_hierarchical_get_stats(out->hr, &hs);
+        out->patches = hs.leaves;
+        out->solve_seconds = tool_seconds() - th;
+    } else if (proxy) {
+        if (lightmap_vp_solve(cmd, w, co, proxy, out, &vp_H)) goto fail;
+    } else {
+        if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
+        out->patches = out->cl.patches->count;
+        out->solve_seconds = out->cl.solve_seconds;
+    }
     /* the gather wants the total radiosity of the secondary sources: B = E + L */
     t0 = tool_seconds();
     rad_lightmap_options_default(&lo);
@@ -188,18 +300,26 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
     go.visibility_rays = vis;
     go.hemisphere_rays = hemi_rays;
-    /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
-    if (gather < 0)
-        gather = (double)out->lm->sample_count * out->cl.patches->count > 2e7 ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
-    go.method = (rad_lightmap_gather_method)gather;
-    if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
-        fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, hemi_rays);
     ch = rad_lightmap_channels(go.encoding);
     out->values = (float *)tool_calloc((size_t)width * height * ch, sizeof(float));
-    tool_context(&ctx, "lightmap gather");
-    r = rad_lightmap_gather(out->lm, out->cl.patches, out->cl.B, &w->rc, &go, out->values, &ctx);
-    tool_progress_end();
-    if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
+    if (proxy) {
+        tool_context(&ctx, "lightmap gather");
+        r = out->hr ? rad_lightmap_gather_hierarchical(out->lm, out->hr, RAD_HIERARCHICAL_GATHERED, out->values, &ctx)
+                    : rad_lightmap_gather_vp(out->lm, out->vp, vp_H, out->values, &ctx);
+        tool_progress_end();
+        if (r != RAD_SUCCESS) { tool_fail(cmd, out->hr ? "rad_lightmap_gather_hierarchical" : "rad_lightmap_gather_vp", r); goto fail; }
+    } else {
+        /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
+        if (gather < 0)
+            gather = (double)out->lm->sample_count * out->cl.patches->count > 2e7 ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
+        go.method = (rad_lightmap_gather_method)gather;
+        if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
+            fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, hemi_rays);
+        tool_context(&ctx, "lightmap gather");
+        r = rad_lightmap_gather(out->lm, out->cl.patches, out->cl.B, &w->rc, &go, out->values, &ctx);
+        tool_progress_end();
+        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
+    }
     if (direct && !sh) {
         rad_direct_options dopt;
         rad_direct_options_default(&dopt);
@@ -213,15 +333,20 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     tool_context(&ctx, NULL);
     if ((r = rad_lightmap_dilate(out->lm, ch, out->values, 0, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_dilate", r); goto fail; }
     if ((r = rad_lightmap_stitch(out->lm, ch, out->values, 0, &st, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_stitch", r); goto fail; }
-    fprintf(stderr, "rad %s: lightmap baked in %.2f s; %u seams, largest jump %.4g before stitching, %.4g after\n", cmd,
-            tool_seconds() - t0, st.seams, (double)st.max_jump_before, (double)st.max_jump_after);
+    fprintf(stderr, "rad %s: lightmap baked in %.2f s (%.2f s with the %s solution; %ux%u, %.1f MiB of values); %u seams, "
+                    "largest jump %.4g before stitching, %.4g after\n", cmd, tool_seconds() - t0, tool_seconds() - t_all,
+            out->hr ? "hierarchical" : proxy ? "virtual-patch" : "classic", out->lm->width, out->lm->height,
+            (double)width * height * ch * sizeof(float) / 1048576.0, st.seams, (double)st.max_jump_before,
+            (double)st.max_jump_after);
+    free(vp_H);
     return 0;
 fail:
+    free(vp_H);
     tool_lightmap_bake_free(out);
     return 1;
 }
 
-int tool_cmd_lightmap(int argc, char **argv)
+static int lightmap_main(int argc, char **argv, tool_lights *lights)
 {
     const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
     int rw = 256, rh = 256;
@@ -233,9 +358,12 @@ int tool_cmd_lightmap(int argc, char **argv)
     int width = 256, height = 256, sh = 0, force_unwrap = 0, a, code = 1;
     uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
     int gather = -1; /* -1: by the work, else a rad_lightmap_gather_method */
+    tool_lightmap_proxy px;
+    int px_opts = 0, hr_opts = 0;
     const float *values = NULL;
     float exposure = 0.31830988f;
     memset(&bk, 0, sizeof bk);
+    memset(&px, 0, sizeof px);
     tool_classic_options_default(&co);
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
@@ -248,7 +376,33 @@ int tool_cmd_lightmap(int argc, char **argv)
             if (k == 2) return 2;
             continue;
         }
+        if ((k = tool_light_option("lightmap", argc, argv, &a, lights)) != 0) {
+            if (k == 2) return 2;
+            continue;
+        }
         if (!strcmp(o, "--sh")) { sh = 1; continue; }
+        if (!strcmp(o, "--proxy") && a + 1 < argc) {
+            const char *v = argv[++a];
+            if (!strcmp(v, "aavp")) px.kind = TOOL_PROXY_AAVP;
+            else if (!strcmp(v, "vp")) px.kind = TOOL_PROXY_VP;
+            else if (!strcmp(v, "hierarchical")) px.kind = TOOL_LIGHTMAP_HIERARCHICAL;
+            else if (!strcmp(v, "patches")) px.kind = TOOL_PROXY_PATCHES;
+            else { fprintf(stderr, "rad lightmap: unknown --proxy '%s' (patches, aavp, vp or hierarchical)\n", v); return 2; }
+            continue;
+        }
+        if ((!strcmp(o, "--vp-resolution") || !strcmp(o, "--face-points")) && a + 1 < argc) {
+            uint32_t *dst = o[2] == 'v' ? &px.resolution : &px.face_points, hi = 4096u;
+            if (tool_parse_uint("lightmap", o, argv[++a], dst)) return 2;
+            if (*dst == 0 || *dst > hi) { fprintf(stderr, "rad lightmap: %s must be 1 to %u\n", o, hi); return 2; }
+            px_opts = 1;
+            continue;
+        }
+        if (!strcmp(o, "--hr-eps") && a + 1 < argc) {
+            if (tool_parse_float("lightmap", o, argv[++a], &px.hr_eps)) return 2;
+            if (!(px.hr_eps > 0.0f && px.hr_eps < 1.0f)) { fprintf(stderr, "rad lightmap: --hr-eps must be in (0, 1)\n"); return 2; }
+            hr_opts = 1;
+            continue;
+        }
         if (!strcmp(o, "--unwrap")) { force_unwrap = 1; continue; }
         if (o[0] == '-' && strcmp(o, "-") != 0 && a + 1 >= argc) {
             fprintf(stderr, "rad lightmap: %s needs a value (or is unknown; try rad lightmap --help)\n", o);
@@ -309,6 +463,18 @@ int tool_cmd_lightmap(int argc, char **argv)
         lightmap_usage(stderr);
         return 2;
     }
+    if (px_opts && (!px.kind || px.kind == TOOL_LIGHTMAP_HIERARCHICAL)) {
+        fprintf(stderr, "rad lightmap: --vp-resolution and --face-points are for --proxy aavp|vp\n");
+        return 2;
+    }
+    if (hr_opts && px.kind != TOOL_LIGHTMAP_HIERARCHICAL) {
+        fprintf(stderr, "rad lightmap: --hr-eps is for --proxy hierarchical\n");
+        return 2;
+    }
+    if (px.kind && sh) {
+        fprintf(stderr, "rad lightmap: --sh needs the classic gather (the virtual patches' gather has no direction): leave out --proxy\n");
+        return 2;
+    }
     if (sh && lightmap_is_png(out_path)) {
         fprintf(stderr, "rad lightmap: --sh writes PFM or EXR files (PNG cannot hold negative coefficients): use -o NAME.pfm or NAME.exr\n");
         return 2;
@@ -326,8 +492,10 @@ int tool_cmd_lightmap(int argc, char **argv)
         if (render_path && tool_check_output("lightmap", render_path, inputs, 1)) return 1;
     }
     tool_set_threads((int)threads);
-    if (tool_open_world("lightmap", scene_path, &w)) return 1;
-    if (tool_lightmap_bake("lightmap", &w, &co, width, height, texel_samples, vis, gather, hemi_rays, sh, force_unwrap, !sh, &bk)) goto done;
+    if (tool_open_world_lit("lightmap", scene_path, lights, &w)) return 1;
+    if (tool_lightmap_bake("lightmap", &w, &co, width, height, texel_samples, vis, gather, hemi_rays, sh, force_unwrap, !sh,
+                           px.kind ? &px : NULL, &bk))
+        goto done;
     lm = bk.lm;
     values = bk.values;
     ch = sh ? 12u : 3u;
@@ -358,4 +526,14 @@ done:
     tool_lightmap_bake_free(&bk);
     tool_close_world(&w);
     return code;
+}
+
+int tool_cmd_lightmap(int argc, char **argv)
+{
+    tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = lightmap_main(argc, argv, &lights);
+    tool_lights_free(&lights);
+    return rc;
 }

@@ -61,8 +61,9 @@ static void render_usage(FILE *f)
             "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
             "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
             "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
-            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991), lightmap (classic\n"
-            "                     baked into a lightmap, the indirect light looked up per pixel)\n"
+            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991), lightmap (classic,\n"
+            "                     or virtual patches with --proxy aavp|vp, baked into a lightmap, the indirect\n"
+            "                     light looked up per pixel)\n"
             "  --bake FILE.radb   classic, multibounce, temporal, stochastic, hierarchical: use a bake of\n"
             "                     that method made by\n"
             "                     'rad bake' from this scene instead of computing it here\n"
@@ -1353,11 +1354,18 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     if (mo.method == TOOL_LIGHTMAP) {
         tool_lightmap_baked bk;
         int lsz = (int)render_lm_size;
-        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0, &bk);
+        tool_lightmap_proxy px;
+        memset(&px, 0, sizeof px);
+        px.kind = (int)mo.proxy;
+        px.resolution = mo.vp_resolution;
+        px.face_points = mo.face_points;
+        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0,
+                                mo.proxy ? &px : NULL, &bk);
         if (rc == 0) {
-            fprintf(stderr, "rad %s: timing: method=lightmap patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+            fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                             "step_ms_min=%.6f\n",
-                    cmd, bk.cl.patches->count, o.bounces, 1e3 * bk.cl.solve_seconds, 1e3 * bk.cl.solve_seconds);
+                    cmd, mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : mo.proxy ? " proxy=aavp" : "", bk.patches, o.bounces,
+                    1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
             render_lm = bk.lm;
             render_lm_values = bk.values;
             rc = render_classic(&bk.w, bk.cl.patches, NULL, &cam, width, height, aa, pixel_light_samples, &img);

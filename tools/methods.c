@@ -130,7 +130,7 @@ const char *tool_method_help(int render)
                     "  --vp-max-patches B the finest resolution whose patch count is at most B (replaces\n"
                     "                     --vp-resolution; found by building at predicted resolutions, <= 6 builds)\n"
                     "  --face-points P    Hammersley points per voxel face (default 16)\n"
-                    "  --proxy P          multibounce, temporal, local: run over patches (default), aavp or vp\n"
+                    "  --proxy P          multibounce, temporal, local, lightmap: run over patches (default), aavp or vp\n"
                     "                     (virtual patches with sparse rows, built with --vp-resolution etc.;\n"
                     "                     E at their samples, the indirect light gathered per pixel as --method aavp)\n"
                     "%s"
@@ -149,7 +149,9 @@ const char *tool_method_help(int render)
                     "automatic unwrap, as rad lightmap; direct light per pixel, the indirect light a bilinear\n"
                     "lookup of the lightmap; render only):\n"
                     "  --lightmap-size N  atlas texels a side (default 256); --texel-samples N (default 4),\n"
-                    "                     --visibility-rays N (default 2) as rad lightmap\n"
+                    "                     --visibility-rays N (default 2) as rad lightmap; --proxy aavp|vp: the\n"
+                    "                     indirect light from virtual patches (--vp-resolution R, --face-points P),\n"
+                    "                     for scenes the dense classic build cannot hold\n"
                     "%s"
                   : "%.0smultibounce:\n"
                     "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
@@ -193,7 +195,7 @@ static int proxy_option(const char *cmd, int argc, char **argv, int *a, tool_met
 
 static const char *given_name(uint32_t bits);
 
-/* --proxy aavp|vp: render only, with multibounce, temporal or local; the proxy's F_mb is
+/* --proxy aavp|vp: render only, with multibounce, temporal, local or lightmap; the proxy's F_mb is
    float and its frames are not written one by one, so the options for those are refused */
 static int proxy_check(const char *cmd, int render, const tool_method_options *mo)
 {
@@ -203,8 +205,16 @@ static int proxy_check(const char *cmd, int render, const tool_method_options *m
         fprintf(stderr, "rad %s: --proxy is an option of rad render (bake virtual patches with --method aavp|vp)\n", cmd);
         return 2;
     }
+    if (mo->method == TOOL_LIGHTMAP && mo->proxy) {
+        /* the lightmap bake builds the set at one resolution (rad lightmap --proxy) */
+        if (mo->given & TOOL_OPT_VP_MAX_PATCHES) {
+            fprintf(stderr, "rad %s: --vp-max-patches is not an option of --method lightmap --proxy: give --vp-resolution\n", cmd);
+            return 2;
+        }
+        return 0;
+    }
     if (mo->method != TOOL_MULTIBOUNCE && mo->method != TOOL_TEMPORAL && mo->method != TOOL_LOCAL) {
-        fprintf(stderr, "rad %s: --proxy %s is for --method multibounce, temporal or local, not %s\n", cmd,
+        fprintf(stderr, "rad %s: --proxy %s is for --method multibounce, temporal, local or lightmap, not %s\n", cmd,
                 mo->proxy == TOOL_PROXY_VP ? "vp" : "aavp", tool_method_name(mo->method));
         return 2;
     }
@@ -540,6 +550,14 @@ int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool
         if ((g & TOOL_OPT_VP_RESOLUTION) && (g & TOOL_OPT_VP_MAX_PATCHES)) {
             fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
             return 2;
+        }
+        /* the lightmap's solve (classic or over the proxy) runs Jacobi with the classic option */
+        if (mo->method == TOOL_LIGHTMAP && (g & TOOL_OPT_BOUNCES)) {
+            if (mo->bounces == RAD_MB_INFINITE) {
+                fprintf(stderr, "rad %s: --bounces inf is not for --method lightmap (Jacobi needs a count; or --solver gauss-seidel)\n", cmd);
+                return 2;
+            }
+            o->bounces = mo->bounces;
         }
         return 0;
     }

@@ -236,6 +236,7 @@ typedef struct tool_classic_options {
     double dense_cubic;      /* flops / N^3 beyond the form factors (LU, multibounce) */
     uint32_t dense_local_m;  /* local: capacity M of the 12 M^2 bytes of T (0: none) */
     const char *dense_method; /* the method named in the refusal (NULL: classic) */
+    const char *dense_instead; /* the refusal's advice (NULL: --method aavp or vp) */
 } tool_classic_options;
 void tool_classic_options_default(tool_classic_options *o);
 /* argv[*a] is one of the options above: parses it (and its value, advancing *a) and returns
@@ -523,24 +524,42 @@ int tool_cmd_lightmap(int argc, char **argv);
 int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t width, uint32_t height,
                 float *out_uvs, uint32_t *out_charts);
 /* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
+/* --proxy aavp|vp: the indirect light from virtual patches instead of classic patches */
+typedef struct tool_lightmap_proxy {
+    int kind;                /* TOOL_PROXY_AAVP, TOOL_PROXY_VP or TOOL_LIGHTMAP_HIERARCHICAL */
+    uint32_t resolution;     /* voxels along the longest axis (0: 16) */
+    uint32_t face_points;    /* Hammersley points per voxel face (0: 16) */
+    float hr_eps;            /* hierarchical: BF tolerance (0: the tool's 1e-5) */
+} tool_lightmap_proxy;
+/* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth
+   lookup (rad_lightmap_gather_hierarchical); a kind of its own, past the tool_proxy values */
+#define TOOL_LIGHTMAP_HIERARCHICAL 3
 typedef struct tool_lightmap_baked {
     tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
-    tool_classic cl;     /* the classic solution gathered (patches of w.scene) */
+    tool_classic cl;     /* the classic solution gathered (patches of w.scene), or zero with a proxy */
+    rad_virtual_patches *vp; /* the proxy's set (of w.scene), or NULL */
+    rad_hierarchical *hr;    /* --proxy hierarchical: the solution (of w.scene), or NULL */
+    uint32_t patches;        /* unknowns of the solution: classic patches or virtual patches */
+    double solve_seconds;    /* the solve (K bounces and H = F B) */
     rad_lightmap *lm;
     float *values;           /* width * height * (3 or 12) floats, dilated and stitched */
     float *uvs;              /* the unwrap's lightmap uvs, or NULL */
     int own_scene;           /* w.scene and w.bvh are ours */
 } tool_lightmap_baked;
-/* Solves the classic method over the lightmapped world (the file's second uv set, else the
-   unwrap) and bakes: texels, gather of B (sh: L1 SH, else RGB irradiance), with direct != 0
-   and RGB the direct light of the lights and emitters added per texel, dilation, stitching.
-   gather: a rad_lightmap_gather_method, or -1 to choose by the work (the hemisphere gather with
-   hemisphere_rays rays a texel past 2e7 sample-patch pairs). 0, or 1 after printing why (out
-   freed). Free with tool_lightmap_bake_free. */
+/* Solves the classic method (proxy NULL) or virtual patches (E = rho D at their samples, K
+   Jacobi bounces of --bounces, Gauss-Seidel with --solver gauss-seidel, H = F (E + L)) over
+   the lightmapped world (the file's second uv set, else the unwrap) and bakes: texels, gather
+   (classic: of B, sh: L1 SH, else RGB irradiance; proxy: rad_lightmap_gather_vp of H, RGB
+   only), with direct != 0 and RGB the direct light of the lights and emitters added per
+   texel, dilation, stitching. Without a proxy a scene whose dense build would be refused is
+   refused before the unwrap, naming --proxy aavp. gather: a rad_lightmap_gather_method, or -1
+   to choose by the work (the hemisphere gather with hemisphere_rays rays a texel past 2e7
+   sample-patch pairs). 0, or 1 after printing why (out freed). Free with
+   tool_lightmap_bake_free. */
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
                            int height, uint32_t texel_samples, uint32_t visibility_rays, int gather,
                            uint32_t hemisphere_rays, int sh, int force_unwrap,
-                           int direct, tool_lightmap_baked *out);
+                           int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
 
 #endif
