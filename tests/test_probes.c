@@ -606,31 +606,35 @@ static void pb_test_alloc(void)
     sc_alloc_state st;
     rad_context ctx;
     long n, total = 1;
+    int pass;
     if (!pb_cornell_init(&f, 50)) { CHECK(0); pb_cornell_free(&f); return; }
     rad_probe_options_default(&o);
     o.spacing = 0.2f;
     o.rays = 32;
-    o.flags = RAD_PROBES_DIRECT;
     memset(&ctx, 0, sizeof(ctx));
     ctx.allocator.alloc = sc_alloc_fn;
     ctx.allocator.free = sc_free_fn;
     ctx.allocator.user = &st;
     ctx.task_count = 4;
-    for (n = 0; n <= total; ++n) {
-        rad_probes *pr = NULL;
-        rad_result r;
-        memset(&st, 0, sizeof(st));
-        st.fail_at = n;
-        r = rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, &ctx, &pr);
-        if (r != RAD_SUCCESS) CHECK(pr == NULL);
-        if (r == RAD_SUCCESS) r = rad_probes_update(pr, f.B, &ctx);
-        CHECK(r == RAD_SUCCESS || r == RAD_ERROR_OUT_OF_MEMORY);
-        if (n > 0 && n <= st.calls) CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
-        rad_probes_destroy(pr);
-        CHECK(st.allocs == st.frees && st.live_bytes == 0 && st.corrupt == 0);
-        if (n == 0) total = st.calls;
+    for (pass = 0; pass < 2; ++pass) { /* then with the band-4 arrays */
+        o.flags = pass ? RAD_PROBES_DIRECT | RAD_PROBES_BAND4 : RAD_PROBES_DIRECT;
+        total = 1;
+        for (n = 0; n <= total; ++n) {
+            rad_probes *pr = NULL;
+            rad_result r;
+            memset(&st, 0, sizeof(st));
+            st.fail_at = n;
+            r = rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, &ctx, &pr);
+            if (r != RAD_SUCCESS) CHECK(pr == NULL);
+            if (r == RAD_SUCCESS) r = rad_probes_update(pr, f.B, &ctx);
+            CHECK(r == RAD_SUCCESS || r == RAD_ERROR_OUT_OF_MEMORY);
+            if (n > 0 && n <= st.calls) CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
+            rad_probes_destroy(pr);
+            CHECK(st.allocs == st.frees && st.live_bytes == 0 && st.corrupt == 0);
+            if (n == 0) total = st.calls;
+        }
+        CHECK(total >= 10);
     }
-    CHECK(total >= 10);
     pb_cornell_free(&f);
 }
 

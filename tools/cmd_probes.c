@@ -36,7 +36,7 @@ static void probes_usage(FILE *f)
                "  --rays R           rays per probe for the inside-geometry test (default 256)\n"
                "  --patch-samples N  points per patch for the probes' gather (default 4)\n"
                "  --indirect         only the indirect light (default: direct light too)\n"
-               "  --band4            also band 4 (9 more coefficients per colour: within 5%% where L2 is not)\n"
+               "  --band4            also band 4 (9 more coefficients per colour: sharper E(n) than L2)\n"
                "%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
             tool_classic_help());
