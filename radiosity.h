@@ -2746,7 +2746,7 @@ RAD_API void rad_probe_options_default(rad_probe_options *options);
    weighting, a bad light or ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
    probes: a larger spacing), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY; the log names which.
    Thread safety: reentrant; the rays run through ctx->parallel_for. Cost: probes x (rays +
-   patches x patch_samples) rays; memory 40 bytes per (probe, visible patch). */
+   patches x patch_samples) rays; memory 40 bytes per (probe, visible patch), 76 with band 4. */
 RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_raycaster *raycaster,
                                      const rad_light *lights, uint32_t light_count, const float *positions,
                                      uint32_t count, const rad_probe_options *options, const float *B,
@@ -21968,7 +21968,9 @@ static const char rad__glsl_12_0[] =
     "// probe count + 1 entry offsets as uint64 (two uint words each, low word first: rad_probes_weights'\n"
     "// first array uploaded unchanged). Chunking: bindings 1 and 2 may hold only this chunk's entries:\n"
     "// entry k is element k - entry_base of binding 1 and elements 9 k - weight_base .. + 8 of binding 2\n"
-    "// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries).\n"
+    "// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries). Band 4 (RAD_PROBES_BAND4) is the\n"
+    "// same sum: bind rad_probes_weights_band4's weights and direct at bindings 2 and 3, and binding 5\n"
+    "// receives the band-4 block (27 floats per probe, the layout of rad_probes_band4).\n"
     "layout(local_size_x_id = 0) in;\n"
     "layout(std430, set = 0, binding = 0) readonly buffer First { uvec2 first[]; };\n"
     "layout(std430, set = 0, binding = 1) readonly buffer Patch { uint patch_index[]; };\n"
@@ -22081,7 +22083,7 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
-    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u },
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2832u },
     { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
 };
 /* >>glsl end */
