@@ -710,7 +710,7 @@ static double pb_quartic(const float *w)
 static void pb_test_band4(void)
 {
     static const float ns[4][3] = { { 0, 0, 1 }, { 1, 0, 0 }, { 0.6f, -0.48f, -0.64f }, { -0.26726124f, 0.53452248f, -0.80178373f } };
-    int iz, ip, k, q, i, NZ = 400, NP = 400;
+    int iz, ip, k, q, i, NZ = 200, NP = 200;
     double G[18][18], L[18], Lb[9];
     float co[27], b4[27];
     memset(G, 0, sizeof(G));
