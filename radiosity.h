@@ -2703,6 +2703,29 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lightmap
    probe, coefficient-major with RGB interleaved: E_i of channel c at [27 probe + 3 i + c].
    An engine that wants radiance coefficients divides E_i by A_l.
 
+   BAND 4 (RAD_PROBES_BAND4, optional). The L2 sum misses the sharp parts of E(n): a dim
+   normal facing an opening or a dark corner, next to bright ones, can be tens of percent off.
+   The cosine kernel has no odd band above 1 (A_3 = A_5 = 0), so the next term of the exact
+   expansion of E is band 4, 9 more coefficients per colour, stored alongside (the L2 block is
+   unchanged, engines that read 27 floats read the same ones):
+       Z0 = 2.503343 x y (x^2 - y^2)              (3/4) sqrt(35/pi)       m = -4
+       Z1 = 1.770131 y z (3 x^2 - y^2)            (3/4) sqrt(35/(2 pi))   m = -3
+       Z2 = 0.946175 x y (7 z^2 - 1)              (3/4) sqrt(5/pi)        m = -2
+       Z3 = 0.669047 y z (7 z^2 - 3)              (3/4) sqrt(5/(2 pi))    m = -1
+       Z4 = 0.105786 (35 z^4 - 30 z^2 + 3)        (3/16) sqrt(1/pi)       m = 0
+       Z5 = 0.669047 x z (7 z^2 - 3)                                      m = 1
+       Z6 = 0.473087 (x^2 - y^2) (7 z^2 - 1)      (3/8) sqrt(5/pi)        m = 2
+       Z7 = 1.770131 x z (x^2 - 3 y^2)                                    m = 3
+       Z8 = 0.625836 (x^4 - 6 x^2 y^2 + y^4)      (3/16) sqrt(35/pi)      m = 4
+   (real, orthonormal, the same convention as bands 0-2: no Condon-Shortley sign), stored
+   convolved, F_m = A_4 L_4m with A_4 = -pi/24, 27 floats per probe in the same layout
+   (F_m of channel c at [27 probe + 3 m + c], m counted from 0), and
+       E(n) = sum_{i=0..8} E_i Y_i(n) + sum_{m=0..8} F_m Z_m(n)    (rad_sh_l4_irradiance)
+   is the irradiance with every band up to 5 (radiance of degree 5 or less is reproduced
+   exactly). rad_probes_sample uses it when stored. The update costs twice the L2 one; the
+   band-4 weights have the same entries (rad_probes_weights_band4), so the GLSL update runs
+   on them unchanged.
+
    THE GATHER. Per probe and patch j whose front faces p, the patch is cut into the lattice of
    'patch_samples' points y (16x as many when p is within 4 patch sizes); each sample that a
    shadow ray from p reaches adds the solid angle dw = (A_j / S) cos_j / max(|y - p|^2,
@@ -2737,7 +2760,8 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lightmap
    also skips the probes a shadow ray from p does not reach (a wall between p and a probe). */
 
 typedef enum rad_probe_flags {
-    RAD_PROBES_DIRECT = 1      /* add the direct light D_i (THE GATHER above) */
+    RAD_PROBES_DIRECT = 1,     /* add the direct light D_i (THE GATHER above) */
+    RAD_PROBES_BAND4 = 2       /* also store band 4 (BAND 4 above): twice the weights */
 } rad_probe_flags;
 
 typedef enum rad_probe_state {
@@ -2790,7 +2814,7 @@ RAD_API void rad_probe_options_default(rad_probe_options *options);
    weighting, a bad light or ray_epsilon), NON_FINITE (a position or B value), SIZE_OVERFLOW (a grid of more than 2^24
    probes: a larger spacing), RAYCAST_FAILED, CANCELLED, OUT_OF_MEMORY; the log names which.
    Thread safety: reentrant; the rays run through ctx->parallel_for. Cost: probes x (rays +
-   patches x patch_samples) rays; memory 40 bytes per (probe, visible patch). */
+   patches x patch_samples) rays; memory 40 bytes per (probe, visible patch), 76 with band 4. */
 RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_raycaster *raycaster,
                                      const rad_light *lights, uint32_t light_count, const float *positions,
                                      uint32_t count, const rad_probe_options *options, const float *B,
@@ -2829,17 +2853,30 @@ RAD_API const float *rad_probes_coefficients(const rad_probes *probes);
 RAD_API int rad_probes_grid(const rad_probes *probes, uint32_t dims[3], float origin[3], float *spacing);
 /* Stored (probe, patch) weight entries: the cost of one update. */
 RAD_API size_t rad_probes_entry_count(const rad_probes *probes);
+/* With RAD_PROBES_BAND4: the band-4 coefficients, 27 floats per probe (BAND 4 above); NULL
+   without the flag. */
+RAD_API const float *rad_probes_band4(const rad_probes *probes);
 /* The arrays of an update, for running it elsewhere (RAD_GLSL_PROBE_UPDATE uploads them
    unchanged): first (count + 1 offsets: the entries of probe i are first[i] .. first[i+1] - 1),
    patch (the patch index of each entry), weights (9 floats per entry: W_ij) and direct (27
    floats per probe: D_i). Owned by the probes; any output may be NULL. */
 RAD_API void rad_probes_weights(const rad_probes *probes, const uint64_t **first, const uint32_t **patch,
                                 const float **weights, const float **direct);
+/* The band-4 counterparts with RAD_PROBES_BAND4 (NULL without): weights (9 floats per entry,
+   the entries of rad_probes_weights: same first and patch) and direct (27 floats per probe).
+   RAD_GLSL_PROBE_UPDATE with these two in place of the L2 ones writes the band-4 block. */
+RAD_API void rad_probes_weights_band4(const rad_probes *probes, const float **weights, const float **direct);
 
 /* The 9 basis values Y_0..Y_8 at direction d (normalized here; 0 for a zero d). */
 RAD_API void rad_sh9_basis(const float d[3], float out[9]);
 /* E(n) = sum_i E_i Y_i(n) per channel from 27 coefficients (layout above), not clamped. */
 RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], float out_rgb[3]);
+/* The 9 band-4 basis values Z_0..Z_8 at direction d (BAND 4 above; normalized here; 0 for a
+   zero d). */
+RAD_API void rad_sh_band4_basis(const float d[3], float out[9]);
+/* E(n) with band 4: the L2 sum of rad_sh9_irradiance plus sum_m F_m Z_m(n), per channel, not
+   clamped. */
+RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band4[27], const float n[3], float out_rgb[3]);
 
 /* ======================================================================================== */
 /* >>api_shading: lighting models and BRDFs                                                 */
@@ -19339,6 +19376,9 @@ struct rad_probes {
     uint64_t *first;           /* count + 1: entries of probe i are [first[i], first[i+1]) */
     uint32_t *patch;           /* per entry */
     float *weights;            /* 9 per entry */
+    float *band4;              /* RAD_PROBES_BAND4: 27 per probe (band-4 coefficients), else NULL */
+    float *direct4;            /* 27 per probe: band 4 of D */
+    float *weights4;           /* 9 per entry: band 4 of W */
     size_t entries;
     int grid;
     int plain;                 /* RAD_PROBE_WEIGHT_PLAIN: no normal factor in sampling */
@@ -19365,6 +19405,52 @@ static void rad__sh9(const float *d, float *y)
     y[6] = 0.315391565f * (3.0f * z * z - 1.0f);
     y[7] = 1.092548431f * x * z;
     y[8] = 0.546274215f * (x * x - yy * yy);
+}
+
+/* the cosine-convolution factor of band 4: 2 pi (-1)^(l/2 - 1) / ((l + 2)(l - 1)) l! / (2^l ((l/2)!)^2) at l = 4 */
+#define RAD__SH_A4 (-0.130899694f)
+
+/* band-4 basis values at a unit direction, m = -4..4 */
+static void rad__sh_band4(const float *d, float *y)
+{
+    float x = d[0], yy = d[1], z = d[2], x2 = x * x, y2 = yy * yy, z2 = z * z;
+    y[0] = 2.503342942f * x * yy * (x2 - y2);
+    y[1] = 1.770130769f * yy * z * (3.0f * x2 - y2);
+    y[2] = 0.946174696f * x * yy * (7.0f * z2 - 1.0f);
+    y[3] = 0.669046544f * yy * z * (7.0f * z2 - 3.0f);
+    y[4] = 0.105785547f * (35.0f * z2 * z2 - 30.0f * z2 + 3.0f);
+    y[5] = 0.669046544f * x * z * (7.0f * z2 - 3.0f);
+    y[6] = 0.473087348f * (x2 - y2) * (7.0f * z2 - 1.0f);
+    y[7] = 1.770130769f * x * z * (x2 - 3.0f * y2);
+    y[8] = 0.625835735f * (x2 * x2 - 6.0f * x2 * y2 + y2 * y2);
+}
+
+RAD_API void rad_sh_band4_basis(const float d[3], float out[9])
+{
+    float u[3];
+    int k;
+    if (!d || !out) return;
+    u[0] = d[0]; u[1] = d[1]; u[2] = d[2];
+    if (!(rad__dot(u, u) > 0.0f)) {
+        for (k = 0; k < 9; ++k) out[k] = 0.0f;
+        return;
+    }
+    rad__normalize(u);
+    rad__sh_band4(u, out);
+}
+
+RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band4[27], const float n[3], float out_rgb[3])
+{
+    float y[9], y4[9];
+    int i, c;
+    if (!coefficients || !band4 || !n || !out_rgb) return;
+    rad_sh9_basis(n, y);
+    rad_sh_band4_basis(n, y4);
+    for (c = 0; c < 3; ++c) {
+        double s = 0.0;
+        for (i = 0; i < 9; ++i) s += (double)coefficients[3 * i + c] * y[i] + (double)band4[3 * i + c] * y4[i];
+        out_rgb[c] = (float)s;
+    }
 }
 
 RAD_API void rad_sh9_basis(const float d[3], float out[9])
@@ -19434,8 +19520,10 @@ typedef struct rad__pb {
     float *col;                /* 3 per queued ray (direct light colour) */
     /* chunk */
     uint32_t first;            /* the chunk's first probe */
-    float *dense;              /* 9 N per probe of the chunk */
+    float *dense;              /* nw N per probe of the chunk */
     float *direct;             /* 27 per probe (all probes) */
+    float *direct4;            /* 27 per probe with band 4, else NULL */
+    uint32_t nw;               /* weights per (probe, patch): 9, or 18 with band 4 */
 } rad__pb;
 
 /* Traces the validity rays at p: the number that hit a back face, and the nearest such hit
@@ -19499,20 +19587,22 @@ static rad_result rad__pb_place(void *data, uint32_t i, uint32_t task)
 static rad_result rad__pb_flush(rad__pb *b, uint32_t task, uint32_t row, uint32_t count)
 {
     size_t base = (size_t)task * RAD__RAY_BATCH;
-    float *dense = b->dense + (size_t)(row - b->first) * 9u * b->P->count, *direct = b->direct + 27 * (size_t)row;
-    uint32_t k;
-    int i, c;
+    uint32_t nw = b->nw, k, i;
+    float *dense = b->dense + (size_t)(row - b->first) * nw * b->P->count, *direct = b->direct + 27 * (size_t)row;
+    int c;
     if (count == 0) return RAD_SUCCESS;
     if (b->rc->occluded(b->rc->user, b->rays + base, count, b->occ + base) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
     for (k = 0; k < count; ++k) {
-        const float *w = b->w + 9 * (base + k);
+        const float *w = b->w + (size_t)nw * (base + k);
         uint32_t j = b->target[base + k];
         if (b->occ[base + k]) continue;
         if (j != RAD_NONE)
-            for (i = 0; i < 9; ++i) dense[9 * (size_t)j + (size_t)i] += w[i];
+            for (i = 0; i < nw; ++i) dense[(size_t)nw * j + i] += w[i];
         else
-            for (i = 0; i < 9; ++i)
-                for (c = 0; c < 3; ++c) direct[3 * i + c] += w[i] * b->col[3 * (base + k) + (size_t)c];
+            for (i = 0; i < nw; ++i) {
+                float *to = i < 9u ? direct + 3 * i : b->direct4 + 27 * (size_t)row + 3 * (i - 9u);
+                for (c = 0; c < 3; ++c) to[c] += w[i] * b->col[3 * (base + k) + (size_t)c];
+            }
     }
     return RAD_SUCCESS;
 }
@@ -19524,7 +19614,7 @@ static rad_result rad__pb_queue(rad__pb *b, uint32_t task, uint32_t row, uint32_
 {
     size_t at = (size_t)task * RAD__RAY_BATCH + *nq;
     rad_ray *ray = b->rays + at;
-    float dir[3], Y[9], len;
+    float dir[3], Y[9], len, *w = b->w + (size_t)b->nw * at;
     int c, i;
     for (c = 0; c < 3; ++c) ray->origin[c] = p[c];
     if (ny) {
@@ -19540,7 +19630,11 @@ static rad_result rad__pb_queue(rad__pb *b, uint32_t task, uint32_t row, uint32_
     for (c = 0; c < 3; ++c) dir[c] = ray->dir[c];
     rad__normalize(dir);
     rad__sh9(dir, Y);
-    for (i = 0; i < 9; ++i) b->w[9 * at + (size_t)i] = scale * rad__sh_A[i] * Y[i];
+    for (i = 0; i < 9; ++i) w[i] = scale * rad__sh_A[i] * Y[i];
+    if (b->nw > 9u) {
+        rad__sh_band4(dir, Y);
+        for (i = 0; i < 9; ++i) w[9 + i] = scale * RAD__SH_A4 * Y[i];
+    }
     b->target[at] = target;
     if (col)
         for (c = 0; c < 3; ++c) b->col[3 * at + (size_t)c] = col[c];
@@ -19669,6 +19763,14 @@ static void rad__probes_update_one(rad_probes *pr, const float *B, uint32_t i)
             for (c = 0; c < 3; ++c) acc[3 * k + c] += (double)w[k] * b[c];
     }
     for (k = 0; k < 27; ++k) pr->coefficients[27 * (size_t)i + (size_t)k] = (float)acc[k];
+    if (!pr->band4) return;
+    for (k = 0; k < 27; ++k) acc[k] = pr->direct4[27 * (size_t)i + (size_t)k];
+    for (e = (size_t)pr->first[i]; e < (size_t)pr->first[i + 1]; ++e) {
+        const float *w = pr->weights4 + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
+        for (k = 0; k < 9; ++k)
+            for (c = 0; c < 3; ++c) acc[3 * k + c] += (double)w[k] * b[c];
+    }
+    for (k = 0; k < 27; ++k) pr->band4[27 * (size_t)i + (size_t)k] = (float)acc[k];
 }
 
 static rad_result rad__probes_update_row(void *data, uint32_t row, uint32_t task)
@@ -19696,7 +19798,9 @@ RAD_API rad_result rad_probes_update(rad_probes *probes, const float *B, const r
     c.progress = NULL; /* O(entries): too short to report */
     r = rad__for_rows(&c, probes->count, c.tasks < probes->count ? c.tasks : probes->count, rad__probes_update_row, &u);
     if (r != RAD_SUCCESS) return r;
-    return rad__check_output(&c, "probes update", probes->coefficients, 27 * (size_t)probes->count);
+    r = rad__check_output(&c, "probes update", probes->coefficients, 27 * (size_t)probes->count);
+    if (r == RAD_SUCCESS && probes->band4) r = rad__check_output(&c, "probes update (band 4)", probes->band4, 27 * (size_t)probes->count);
+    return r;
 }
 
 RAD_API void rad_probes_destroy(rad_probes *pr)
@@ -19711,33 +19815,41 @@ RAD_API void rad_probes_destroy(rad_probes *pr)
     rad__free(&a, pr->first);
     rad__free(&a, pr->patch);
     rad__free(&a, pr->weights);
+    rad__free(&a, pr->band4);
+    rad__free(&a, pr->direct4);
+    rad__free(&a, pr->weights4);
     rad__free(&a, pr);
 }
 
 /* appends the non-zero rows of a probe's dense weights to the entry arrays */
-static rad_result rad__probes_pack(rad_probes *pr, const float *dense, uint32_t N, size_t *cap)
+static rad_result rad__probes_pack(rad_probes *pr, const float *dense, uint32_t N, uint32_t nw, size_t *cap)
 {
-    uint32_t j;
-    int k;
+    uint32_t j, k;
     for (j = 0; j < N; ++j) {
-        const float *w = dense + 9 * (size_t)j;
+        const float *w = dense + (size_t)nw * j;
         int any = 0;
-        for (k = 0; k < 9; ++k) any |= w[k] != 0.0f;
+        for (k = 0; k < nw; ++k) any |= w[k] != 0.0f;
         if (!any) continue;
         if (pr->entries == *cap) {
             size_t nc = *cap ? 2 * *cap : 1024, b9, b1;
-            void *np, *nw;
+            void *np, *nv;
             if (!rad__mul(nc, 9 * sizeof(float), &b9) || !rad__mul(nc, sizeof(uint32_t), &b1)) return RAD_ERROR_SIZE_OVERFLOW;
             np = rad__realloc(&pr->allocator, pr->patch, *cap * sizeof(uint32_t), b1);
             if (!np) return RAD_ERROR_OUT_OF_MEMORY;
             pr->patch = (uint32_t *)np;
-            nw = rad__realloc(&pr->allocator, pr->weights, *cap * 9 * sizeof(float), b9);
-            if (!nw) return RAD_ERROR_OUT_OF_MEMORY;
-            pr->weights = (float *)nw;
+            nv = rad__realloc(&pr->allocator, pr->weights, *cap * 9 * sizeof(float), b9);
+            if (!nv) return RAD_ERROR_OUT_OF_MEMORY;
+            pr->weights = (float *)nv;
+            if (nw > 9u) {
+                nv = rad__realloc(&pr->allocator, pr->weights4, *cap * 9 * sizeof(float), b9);
+                if (!nv) return RAD_ERROR_OUT_OF_MEMORY;
+                pr->weights4 = (float *)nv;
+            }
             *cap = nc;
         }
         pr->patch[pr->entries] = j;
         memcpy(pr->weights + 9 * pr->entries, w, 9 * sizeof(float));
+        if (nw > 9u) memcpy(pr->weights4 + 9 * pr->entries, w + 9, 9 * sizeof(float));
         ++pr->entries;
     }
     return RAD_SUCCESS;
@@ -19801,7 +19913,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
                  (double)b.o.spacing, (double)b.o.clearance, (double)b.o.max_move);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (b.o.flags & ~(uint32_t)RAD_PROBES_DIRECT) {
+    if (b.o.flags & ~(uint32_t)(RAD_PROBES_DIRECT | RAD_PROBES_BAND4)) {
         rad__log(&c, RAD_LOG_ERROR, "probes: unknown flags 0x%x", b.o.flags);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
@@ -19868,7 +19980,14 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
     pr->direct = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
     pr->first = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)pr->count + 1u, sizeof(uint64_t));
-    if (!pr->positions || !pr->states || !pr->coefficients || !pr->direct || !pr->first) {
+    b.nw = 9u;
+    if (b.o.flags & RAD_PROBES_BAND4) {
+        b.nw = 18u;
+        pr->band4 = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
+        pr->direct4 = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
+    }
+    if (!pr->positions || !pr->states || !pr->coefficients || !pr->direct || !pr->first ||
+        ((b.o.flags & RAD_PROBES_BAND4) && (!pr->band4 || !pr->direct4))) {
         rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for %u probes", pr->count);
         rad_probes_destroy(pr);
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -19887,6 +20006,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
                 }
     }
     memset(pr->direct, 0, sizeof(float) * 27 * (size_t)pr->count);
+    if (pr->direct4) memset(pr->direct4, 0, sizeof(float) * 27 * (size_t)pr->count);
     {
         float move_default = pr->grid ? 0.5f * spacing : 0.05f * S->diagonal;
         b.max_move = b.o.max_move == 0.0f ? move_default : b.o.max_move;
@@ -19901,7 +20021,8 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     b.pos = pr->positions;
     b.states = pr->states;
     b.direct = pr->direct;
-    per = N ? (uint32_t)(RAD__PROBES_CHUNK_FLOATS / (9u * (size_t)N)) : pr->count;
+    b.direct4 = pr->direct4;
+    per = N ? (uint32_t)(RAD__PROBES_CHUNK_FLOATS / ((size_t)b.nw * N)) : pr->count;
     if (per == 0) per = 1;
     if (per > pr->count) per = pr->count;
     T = c.tasks < pr->count ? c.tasks : pr->count;
@@ -19909,10 +20030,10 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     b.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
     b.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
     b.target = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-    b.w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 9 * sizeof(float));
+    b.w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, b.nw * sizeof(float));
     b.col = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
     b.emitters = (uint32_t *)rad__alloc_array(&c.allocator, S->triangle_count, sizeof(uint32_t));
-    b.dense = (float *)rad__alloc_array(&c.allocator, (size_t)per * 9u, N ? (size_t)N * sizeof(float) : 1u);
+    b.dense = (float *)rad__alloc_array(&c.allocator, (size_t)per * b.nw, N ? (size_t)N * sizeof(float) : 1u);
     if (!b.rays || !b.hits || !b.occ || !b.target || !b.w || !b.col || !b.emitters || !b.dense) {
         rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for the ray buffers of %u tasks", T);
         r = RAD_ERROR_OUT_OF_MEMORY;
@@ -19926,7 +20047,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     }
     for (first = 0; first < pr->count && r == RAD_SUCCESS; first += per) {
         uint32_t m = pr->count - first < per ? pr->count - first : per, q;
-        memset(b.dense, 0, sizeof(float) * 9 * (size_t)N * m);
+        memset(b.dense, 0, sizeof(float) * b.nw * (size_t)N * m);
         b.first = first;
         {
             rad__ctx cc = c;
@@ -19936,7 +20057,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         }
         for (q = 0; q < m && r == RAD_SUCCESS; ++q) {
             pr->first[first + q] = pr->entries;
-            r = rad__probes_pack(pr, b.dense + 9 * (size_t)N * q, N, &cap);
+            r = rad__probes_pack(pr, b.dense + (size_t)b.nw * N * q, N, b.nw, &cap);
             if (r != RAD_SUCCESS)
                 rad__log(&c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
         }
@@ -19955,9 +20076,13 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     rad__free(&c.allocator, b.emitters);
     rad__free(&c.allocator, b.dense);
     if (r == RAD_SUCCESS) r = rad__check_output(&c, "probes (direct light)", pr->direct, 27 * (size_t)pr->count);
+    if (r == RAD_SUCCESS && pr->direct4) r = rad__check_output(&c, "probes (direct light, band 4)", pr->direct4, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS) {
         if (B) r = rad_probes_update(pr, B, ctx);
-        else memset(pr->coefficients, 0, sizeof(float) * 27 * (size_t)pr->count);
+        else {
+            memset(pr->coefficients, 0, sizeof(float) * 27 * (size_t)pr->count);
+            if (pr->band4) memset(pr->band4, 0, sizeof(float) * 27 * (size_t)pr->count);
+        }
     }
     if (r != RAD_SUCCESS) {
         rad_probes_destroy(pr);
@@ -19985,6 +20110,13 @@ static int rad__probe_visible(const rad_probes *pr, const rad_raycaster *rc, con
     ray.tmax = len > 2.0f * pr->eps ? 1.0f - pr->eps / len : 0.5f;
     if (rc->occluded(rc->user, &ray, 1, &occ) != RAD_SUCCESS) return -1;
     return occ ? 0 : 1;
+}
+
+/* E(n) of probe i: bands 0-2, plus band 4 when stored */
+static void rad__probe_eval(const rad_probes *pr, uint32_t i, const float *un, float *e)
+{
+    if (pr->band4) rad_sh_l4_irradiance(pr->coefficients + 27 * (size_t)i, pr->band4 + 27 * (size_t)i, un, e);
+    else rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
 }
 
 static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *rc, const float p[3], const float n[3],
@@ -20026,7 +20158,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
                     vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
                     if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
                     if (!vis) continue;
-                    rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
+                    rad__probe_eval(pr, i, un, e);
                     for (k = 0; k < 3; ++k) acc[k] += w * e[k];
                     wsum += w;
                 }
@@ -20042,7 +20174,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
             if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
             if (!vis) continue;
-            rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
+            rad__probe_eval(pr, i, un, e);
             for (k = 0; k < 3; ++k) acc[k] += w * e[k];
             wsum += w;
         }
@@ -20059,7 +20191,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             if (len2 < best) { best = len2; bi = i; }
         }
         if (bi == RAD_NONE) return RAD_SUCCESS;
-        rad_sh9_irradiance(pr->coefficients + 27 * (size_t)bi, un, acc);
+        rad__probe_eval(pr, bi, un, acc);
         wsum = 1.0;
     }
     for (k = 0; k < 3; ++k) {
@@ -20086,6 +20218,14 @@ RAD_API const float *rad_probes_positions(const rad_probes *pr) { return pr ? pr
 RAD_API const uint8_t *rad_probes_states(const rad_probes *pr) { return pr ? pr->states : NULL; }
 RAD_API const float *rad_probes_coefficients(const rad_probes *pr) { return pr ? pr->coefficients : NULL; }
 RAD_API size_t rad_probes_entry_count(const rad_probes *pr) { return pr ? pr->entries : 0u; }
+RAD_API const float *rad_probes_band4(const rad_probes *pr) { return pr ? pr->band4 : NULL; }
+
+RAD_API void rad_probes_weights_band4(const rad_probes *pr, const float **weights, const float **direct)
+{
+    int has = pr && pr->band4;
+    if (weights) *weights = has ? pr->weights4 : NULL;
+    if (direct) *direct = has ? pr->direct4 : NULL;
+}
 
 RAD_API void rad_probes_weights(const rad_probes *pr, const uint64_t **first, const uint32_t **patch, const float **weights,
                                 const float **direct)
@@ -22497,7 +22637,9 @@ static const char rad__glsl_12_0[] =
     "// probe count + 1 entry offsets as uint64 (two uint words each, low word first: rad_probes_weights'\n"
     "// first array uploaded unchanged). Chunking: bindings 1 and 2 may hold only this chunk's entries:\n"
     "// entry k is element k - entry_base of binding 1 and elements 9 k - weight_base .. + 8 of binding 2\n"
-    "// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries).\n"
+    "// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries). Band 4 (RAD_PROBES_BAND4) is the\n"
+    "// same sum: bind rad_probes_weights_band4's weights and direct at bindings 2 and 3, and binding 5\n"
+    "// receives the band-4 block (27 floats per probe, the layout of rad_probes_band4).\n"
     "layout(local_size_x_id = 0) in;\n"
     "layout(std430, set = 0, binding = 0) readonly buffer First { uvec2 first[]; };\n"
     "layout(std430, set = 0, binding = 1) readonly buffer Patch { uint patch_index[]; };\n"
@@ -22610,7 +22752,7 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
-    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2616u },
+    { "probe_update.comp", rad__glsl_pieces_12, 1u, 2832u },
     { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
 };
 /* >>glsl end */

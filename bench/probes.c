@@ -12,6 +12,8 @@
    each with the direct light (RAD_PROBES_DIRECT, "total") and without it ("indirect", what an
    engine adds to per-pixel direct light). Also the create and update times and the entries.
 
+   Each of these also with RAD_PROBES_BAND4 (band 4 stored beside L2, rows marked "band 4").
+
    Build: cc -std=c99 -O2 -fopenmp -I. bench/probes.c -o build/probes -lm
    Run:   probes [--quick] [--half-spacing] [--append FILE.md]
    The grid rows come twice: with the default normal weighting of rad_probes_sample and with
@@ -76,6 +78,22 @@ static void reference(const float *p, const float *n, int direct, uint32_t rays,
     free(hh);
 }
 
+static float pts[SPHERES * PER][3], nrm[SPHERES * PER][3];
+
+/* relative errors of grid probes read by rad_probes_sample at the test points */
+static void grid_errors(const rad_probe_options *o, float (*ref)[3], double *err)
+{
+    rad_probes *pp = NULL;
+    int i, c;
+    rad_probes_create(P, &rc, NULL, 0, NULL, 0, o, B, NULL, &pp);
+    for (i = 0; i < SPHERES * PER; ++i) {
+        float e[3];
+        rad_probes_sample(pp, pts[i], nrm[i], e);
+        for (c = 0; c < 3; ++c) err[3 * i + c] = fabs(e[c] - ref[i][c]) / ref[i][c];
+    }
+    rad_probes_destroy(pp);
+}
+
 static int cmp(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -103,7 +121,7 @@ int main(int argc, char **argv)
     rad_form_factor_options fo;
     rad_system sys;
     rad_solve_options so;
-    float *D, *E, pts[SPHERES * PER][3], nrm[SPHERES * PER][3], ref[2][SPHERES * PER][3], cref[2][SPHERES * PER][3];
+    float *D, *E, ref[2][SPHERES * PER][3], cref[2][SPHERES * PER][3];
     double err[SPHERES * PER * 3];
     uint32_t patches, psamples = 0;
     for (a = 1; a < argc; ++a) {
@@ -169,6 +187,20 @@ int main(int argc, char **argv)
             for (c = 0; c < 3; ++c) err[3 * i + c] = fabs(e[c] - cref[mode][i][c]) / cref[mode][i][c];
         }
         report(mode == 0 ? "centre probes, total" : "centre probes, indirect", err, SPHERES * PER * 3);
+        {
+            /* the same probes with band 4 */
+            rad_probes *p4 = NULL;
+            o.flags |= RAD_PROBES_BAND4;
+            rad_probes_create(P, &rc, NULL, 0, &centres[0][0], SPHERES, &o, B, NULL, &p4);
+            o.flags &= ~(uint32_t)RAD_PROBES_BAND4;
+            for (i = 0; i < SPHERES * PER; ++i) {
+                float e[3];
+                rad_sh_l4_irradiance(rad_probes_coefficients(p4) + 27 * (i / PER), rad_probes_band4(p4) + 27 * (i / PER), nrm[i], e);
+                for (c = 0; c < 3; ++c) err[3 * i + c] = fabs(e[c] - cref[mode][i][c]) / cref[mode][i][c];
+            }
+            report(mode == 0 ? "centre probes band 4, total" : "centre probes band 4, indirect", err, SPHERES * PER * 3);
+            rad_probes_destroy(p4);
+        }
         for (i = 0; i < SPHERES * PER; ++i) {
             float e[3];
             rad_probes_sample(pg, pts[i], nrm[i], e);
@@ -187,6 +219,15 @@ int main(int argc, char **argv)
                 for (c = 0; c < 3; ++c) err[3 * i + c] = fabs(e[c] - ref[mode][i][c]) / ref[mode][i][c];
             }
             report(mode == 0 ? "grid 8x8x8, sampled plain, total" : "grid 8x8x8, sampled plain, indirect", err, SPHERES * PER * 3);
+            o.flags |= RAD_PROBES_BAND4;
+            grid_errors(&o, ref[mode], err);
+            report(mode == 0 ? "grid 8x8x8 band 4, sampled, total" : "grid 8x8x8 band 4, sampled, indirect", err, SPHERES * PER * 3);
+            o.weighting = RAD_PROBE_WEIGHT_PLAIN;
+            grid_errors(&o, ref[mode], err);
+            report(mode == 0 ? "grid 8x8x8 band 4, sampled plain, total" : "grid 8x8x8 band 4, sampled plain, indirect", err,
+                   SPHERES * PER * 3);
+            o.weighting = RAD_PROBE_WEIGHT_NORMAL;
+            o.flags &= ~(uint32_t)RAD_PROBES_BAND4;
             if (half) {
                 /* and a grid of half the spacing (8x the probes) */
                 o.weighting = RAD_PROBE_WEIGHT_PLAIN;
@@ -203,6 +244,15 @@ int main(int argc, char **argv)
                 }
                 report(mode == 0 ? "grid spacing 0.035 (4096), sampled plain, total" : "grid spacing 0.035 (4096), sampled plain, indirect",
                        err, SPHERES * PER * 3);
+                o.weighting = RAD_PROBE_WEIGHT_PLAIN;
+                o.spacing = 0.035f;
+                o.flags |= RAD_PROBES_BAND4;
+                grid_errors(&o, ref[mode], err);
+                report(mode == 0 ? "grid spacing 0.035 (4096) band 4, sampled plain, total"
+                                 : "grid spacing 0.035 (4096) band 4, sampled plain, indirect", err, SPHERES * PER * 3);
+                o.flags &= ~(uint32_t)RAD_PROBES_BAND4;
+                o.weighting = RAD_PROBE_WEIGHT_NORMAL;
+                o.spacing = 0.0f;
             }
             rad_probes_destroy(pp);
         }

@@ -7,7 +7,9 @@
 // probe count + 1 entry offsets as uint64 (two uint words each, low word first: rad_probes_weights'
 // first array uploaded unchanged). Chunking: bindings 1 and 2 may hold only this chunk's entries:
 // entry k is element k - entry_base of binding 1 and elements 9 k - weight_base .. + 8 of binding 2
-// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries).
+// (both bases in 32 bits: a chunk spans < 2^32 / 9 entries). Band 4 (RAD_PROBES_BAND4) is the
+// same sum: bind rad_probes_weights_band4's weights and direct at bindings 2 and 3, and binding 5
+// receives the band-4 block (27 floats per probe, the layout of rad_probes_band4).
 layout(local_size_x_id = 0) in;
 layout(std430, set = 0, binding = 0) readonly buffer First { uvec2 first[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Patch { uint patch_index[]; };

@@ -1096,6 +1096,20 @@ if "$RAD" probes cornell --patches 200 --spacing 0.14 -o "$TMP/probes.json" > "$
 else
     fail "probes cornell" "$(head -c 300 "$TMP/err.txt")"
 fi
+# --band4: the binary record grows by 27 floats and the flags say so; JSON carries "band4" per probe
+if "$RAD" probes cornell --patches 200 --spacing 0.14 --band4 -o "$TMP/probes4.bin" > /dev/null 2> "$TMP/err.txt" &&
+    "$RAD" probes cornell --patches 200 --spacing 0.14 --band4 -o "$TMP/probes4.json" > /dev/null 2>> "$TMP/err.txt"; then
+    size=$(wc -c < "$TMP/probes4.bin" | tr -d ' ')
+    flags=$(od -An -tu4 -j 16 -N 4 "$TMP/probes4.bin" | tr -d ' ')
+    n4=$(grep -c '"band4": \[\[' "$TMP/probes4.json")
+    if [ "$size" = $((48 + 64 * 232)) ] && [ "$flags" = 3 ] && [ "$n4" = 64 ]; then
+        ok "probes --band4: binary $size bytes, flags $flags, band4 in every JSON probe"
+    else
+        fail "probes --band4" "size '$size' flags '$flags' json probes with band4 '$n4'"
+    fi
+else
+    fail "probes --band4" "$(head -c 300 "$TMP/err.txt")"
+fi
 "$RAD" probes cornell --spacing 0 -o "$TMP/p0.json" > /dev/null 2>&1
 rc1=$?
 "$RAD" probes cornell -o "$TMP/p0.txt" > /dev/null 2>&1

@@ -1,7 +1,7 @@
 /* cmd_probes.c - `rad probes`: irradiance probes (SH L2) from the classic solution.
 
    rad probes SCENE -o OUT.json|OUT.bin [--spacing S] [--rays R] [--patch-samples N] [--indirect]
-              [classic options: --patches N ...] [--threads N]
+              [--band4] [classic options: --patches N ...] [--threads N]
 
    Solves the scene as `rad bake` does (B = E + L with the direct light as the source, emitters
    out of the system), places a probe grid over the scene's bounds (rad_probes_create; probes
@@ -9,13 +9,17 @@
    irradiance coefficients (docs/methods/probes.md). By default the probes hold all the light
    (the direct light of the emitters and the file's lights is added: RAD_PROBES_DIRECT);
    --indirect keeps only the indirect light, for a renderer that draws direct light per pixel.
+   --band4 also bakes and writes the 9 band-4 coefficients per colour (RAD_PROBES_BAND4): the
+   irradiance is then E(n) = sum_i E_i Y_i(n) + sum_m F_m Z_m(n) (rad_sh_l4_irradiance).
 
    OUT.json: { "format": "radiosity.h probes", "version": 1, "basis": ..., "light": "total" or
    "indirect", "grid": { "dims": [x, y, z], "origin": [x, y, z], "spacing": s }, "count": n,
    "probes": [ { "p": [x, y, z], "state": "valid"|"moved"|"disabled", "sh": [[r, g, b] x 9] } ] }
+   with --band4 also "basis_band4" and per probe "band4": [[r, g, b] x 9] (F_0..F_8).
    OUT.bin (little-endian, all 4-byte fields): "RADPROBE" (8 bytes), version 1, count, flags (1:
-   total light), dims[3], origin[3] (float), spacing (float), then per probe position[3] (float),
-   state (uint32, rad_probe_state), coefficients[27] (float, E_i of channel c at 3 i + c).
+   total light, 2: band 4), dims[3], origin[3] (float), spacing (float), then per probe
+   position[3] (float), state (uint32, rad_probe_state), coefficients[27] (float, E_i of channel
+   c at 3 i + c) and, with flag 2, band4[27] (float, F_m of channel c at 3 m + c).
    The file is written to a temporary and renamed into place. */
 #include "tool.h"
 #include <stdio.h>
@@ -32,6 +36,7 @@ static void probes_usage(FILE *f)
                "  --rays R           rays per probe for the inside-geometry test (default 256)\n"
                "  --patch-samples N  points per patch for the probes' gather (default 4)\n"
                "  --indirect         only the indirect light (default: direct light too)\n"
+               "  --band4            also band 4 (9 more coefficients per colour: sharper E(n) than L2)\n"
                "%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
             tool_classic_help());
@@ -61,7 +66,7 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
 {
     uint32_t n = rad_probes_count(pr), i, dims[3] = {0, 0, 0}, k;
     float origin[3] = {0, 0, 0}, spacing = 0.0f;
-    const float *pos = rad_probes_positions(pr), *co = rad_probes_coefficients(pr);
+    const float *pos = rad_probes_positions(pr), *co = rad_probes_coefficients(pr), *b4 = rad_probes_band4(pr);
     const uint8_t *st = rad_probes_states(pr);
     int ok = 1;
     rad_probes_grid(pr, dims, origin, &spacing);
@@ -74,6 +79,12 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
                          "\"spacing\": %.9g },\n  \"count\": %u,\n  \"probes\": [\n",
                       total ? "total" : "indirect", dims[0], dims[1], dims[2], (double)origin[0], (double)origin[1],
                       (double)origin[2], (double)spacing, n) > 0;
+        if (b4)
+            ok &= fprintf(f, "  \"basis_band4\": \"band-4 irradiance coefficients F_m, added: E(n) += sum_m F_m Z_m(n), "
+                             "Z0 = 2.503343 xy(x^2 - y^2), Z1 = 1.770131 yz(3x^2 - y^2), Z2 = 0.946175 xy(7z^2 - 1), "
+                             "Z3 = 0.669047 yz(7z^2 - 3), Z4 = 0.105786 (35z^4 - 30z^2 + 3), Z5 = 0.669047 xz(7z^2 - 3), "
+                             "Z6 = 0.473087 (x^2 - y^2)(7z^2 - 1), Z7 = 1.770131 xz(x^2 - 3y^2), "
+                             "Z8 = 0.625836 (x^4 - 6x^2 y^2 + y^4)\",\n") > 0;
         for (i = 0; i < n && ok; ++i) {
             const float *c = co + 27 * (size_t)i;
             ok &= fprintf(f, "    { \"p\": [%.9g, %.9g, %.9g], \"state\": \"%s\", \"sh\": [", (double)pos[3 * i],
@@ -81,13 +92,20 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
             for (k = 0; k < 9; ++k)
                 ok &= fprintf(f, "%s[%.9g, %.9g, %.9g]", k ? ", " : "", (double)c[3 * k], (double)c[3 * k + 1],
                               (double)c[3 * k + 2]) > 0;
+            if (b4) {
+                const float *g = b4 + 27 * (size_t)i;
+                ok &= fprintf(f, "], \"band4\": [") > 0;
+                for (k = 0; k < 9; ++k)
+                    ok &= fprintf(f, "%s[%.9g, %.9g, %.9g]", k ? ", " : "", (double)g[3 * k], (double)g[3 * k + 1],
+                                  (double)g[3 * k + 2]) > 0;
+            }
             ok &= fprintf(f, "] }%s\n", i + 1 < n ? "," : "") > 0;
         }
         ok &= fprintf(f, "  ]\n}\n") > 0;
         return ok;
     }
     ok &= fwrite("RADPROBE", 1, 8, f) == 8;
-    ok &= put_u32(f, 1) && put_u32(f, n) && put_u32(f, total ? 1u : 0u);
+    ok &= put_u32(f, 1) && put_u32(f, n) && put_u32(f, (total ? 1u : 0u) | (b4 ? 2u : 0u));
     for (k = 0; k < 3; ++k) ok &= put_u32(f, dims[k]);
     for (k = 0; k < 3; ++k) ok &= put_f32(f, origin[k]);
     ok &= put_f32(f, spacing);
@@ -95,6 +113,8 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
         for (k = 0; k < 3; ++k) ok &= put_f32(f, pos[3 * (size_t)i + k]);
         ok &= put_u32(f, st[i]);
         for (k = 0; k < 27; ++k) ok &= put_f32(f, co[27 * (size_t)i + k]);
+        if (b4)
+            for (k = 0; k < 27; ++k) ok &= put_f32(f, b4[27 * (size_t)i + k]);
     }
     return ok;
 }
@@ -123,6 +143,7 @@ int tool_cmd_probes(int argc, char **argv)
         if (rc == 2) return 2;
         if (rc == 1) continue;
         if (!strcmp(opt, "--indirect")) { total = 0; continue; }
+        if (!strcmp(opt, "--band4")) { po.flags |= RAD_PROBES_BAND4; continue; }
         if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--spacing") || !strcmp(opt, "--rays") ||
              !strcmp(opt, "--patch-samples")) && a + 1 >= argc) {
             fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
@@ -184,9 +205,9 @@ int tool_cmd_probes(int argc, char **argv)
         fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
-    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light\n", out_path,
+    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light%s\n", out_path,
            rad_probes_count(pr), counts[RAD_PROBE_VALID], counts[RAD_PROBE_MOVED], counts[RAD_PROBE_DISABLED],
-           (unsigned long)rad_probes_entry_count(pr), total ? "total" : "indirect");
+           (unsigned long)rad_probes_entry_count(pr), total ? "total" : "indirect", rad_probes_band4(pr) ? ", band 4" : "");
     fprintf(stderr, "rad %s: done in %.2f s\n", cmd, tool_seconds() - t0);
     rc = 0;
 done:
