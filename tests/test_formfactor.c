@@ -1147,17 +1147,13 @@ static void ff_test_bvh_watertight(void)
 /* the test table                                                                           */
 /* ---------------------------------------------------------------------------------------- */
 
-/* A small patch under a large source square (10 x 10 at height 1) with an occluder (1 x 1 at
-   height 0.5) straight between them: the occluder hides the 2 x 2 middle of the source, where
-   the kernel peaks. The visible form factor is F(10 x 10) - F(2 x 2) at the patch, in closed
-   form. A visibility ray aimed at a uniform point of the source saw the 4% of its area that
-   is hidden instead of the third of its form factor. */
-static void ff_test_partly_hidden_source(void)
+/* F from a small patch (0.02 x 0.02 at the origin, facing up) to a source of two triangles
+   'src' (facing down), with the occluder 'occ' (two triangles) between them, 64 samples; with
+   'whole' the source's triangles must stay one patch each (checked). Negative when the setup
+   failed. */
+static double ff_hidden_source_F(const float *occ, const float *src, int whole)
 {
     static const float rec[12] = { -0.01f, 0, -0.01f, -0.01f, 0, 0.01f, 0.01f, 0, 0.01f, 0.01f, 0, -0.01f };
-    static const float occ[12] = { -0.5f, 0.5f, -0.5f, 0.5f, 0.5f, -0.5f, 0.5f, 0.5f, 0.5f, -0.5f, 0.5f, 0.5f };
-    static const float src[12] = { -5, 1, -5, 5, 1, -5, 5, 1, 5, -5, 1, 5 };
-    static const float big[12] = { -5, 1, -5, 5, 1, -5, 5, 1, 5, -5, 1, 5 }, mid[12] = { -1, 1, -1, 1, 1, -1, 1, 1, 1, -1, 1, 1 };
     static const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
     rad_material m = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0 };
     rad_mesh_desc mesh[3];
@@ -1168,9 +1164,9 @@ static void ff_test_partly_hidden_source(void)
     rad_bvh *b = NULL;
     rad_raycaster rc;
     rad_form_factor_options fo;
-    float *rows = NULL, p0[3] = { 0, 0, 0 }, n0[3] = { 0, 1, 0 };
+    float *rows = NULL;
     uint32_t i, r = RAD_NONE, N;
-    double F = 0.0, exact;
+    double F = -1.0;
     memset(mesh, 0, sizeof(mesh));
     mesh[0].positions = rec;
     mesh[1].positions = occ;
@@ -1187,7 +1183,7 @@ static void ff_test_partly_hidden_source(void)
     d.material_count = 1;
     CHECK_OK(rad_scene_create(&d, NULL, &S));
     rad_patch_options_default(&po);
-    po.target_count = 6; /* one patch per triangle */
+    po.target_count = 6;
     if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
     if (S) CHECK_OK(rad_bvh_create(S, NULL, &b));
     if (!P || !b) goto done;
@@ -1198,26 +1194,63 @@ static void ff_test_partly_hidden_source(void)
     rows = (float *)malloc(sizeof(float) * N * N);
     if (!rows) goto done;
     CHECK_OK(rad_form_factor_rows(P, &rc, &fo, 0, N, rows, NULL));
-    for (i = 0; i < N; ++i)
-        if (S->meshes[P->patches[i].triangle] == 0 && r == RAD_NONE) r = i;
+    for (i = 0; i < N; ++i) {
+        uint32_t t = P->patches[i].triangle;
+        if (S->meshes[t] == 0 && r == RAD_NONE) r = i;
+        if (whole && S->meshes[t] == 2) CHECK(P->subdivision[t] == 1);
+    }
     CHECK(r != RAD_NONE);
     if (r == RAD_NONE) goto done;
+    F = 0.0;
     for (i = 0; i < N; ++i)
         if (S->meshes[P->patches[i].triangle] == 2) F += rows[(size_t)r * N + i];
-    exact = (double)rad_ff_point_polygon(p0, n0, big, 4) - (double)rad_ff_point_polygon(p0, n0, mid, 4);
-    /* the polygons' fronts face down, towards the patch; counter-clockwise from below */
-    printf("    F(patch -> source) %.4f, visible part in closed form %.4f (unoccluded %.4f)\n", F, exact,
-           (double)rad_ff_point_polygon(p0, n0, big, 4));
-    CHECK_REL(F, exact, 0.05);
 done:
     free(rows);
     rad_bvh_destroy(b);
     rad_patches_destroy(P);
     rad_scene_destroy(S);
+    return F;
+}
+
+/* A large source square (10 x 10 at height 1) with an occluder (1 x 1 at height 0.5) straight
+   between it and the patch: the occluder hides the 2 x 2 middle of the source, where the
+   kernel peaks. The visible form factor is F(10 x 10) - F(2 x 2) at the patch, in closed
+   form. A visibility ray aimed at a uniform point of the source saw the 4% of its area that
+   is hidden instead of the third of its form factor. */
+static void ff_test_partly_hidden_source(void)
+{
+    static const float occ[12] = { -0.5f, 0.5f, -0.5f, 0.5f, 0.5f, -0.5f, 0.5f, 0.5f, 0.5f, -0.5f, 0.5f, 0.5f };
+    static const float src[12] = { -5, 1, -5, 5, 1, -5, 5, 1, 5, -5, 1, 5 };
+    static const float mid[12] = { -1, 1, -1, 1, 1, -1, 1, 1, 1, -1, 1, 1 };
+    float p0[3] = { 0, 0, 0 }, n0[3] = { 0, 1, 0 };
+    double F = ff_hidden_source_F(occ, src, 0);
+    /* the polygons' fronts face down, towards the patch; counter-clockwise from below */
+    double exact = (double)rad_ff_point_polygon(p0, n0, src, 4) - (double)rad_ff_point_polygon(p0, n0, mid, 4);
+    printf("    F(patch -> source) %.4f, visible part in closed form %.4f (unoccluded %.4f)\n", F, exact,
+           (double)rad_ff_point_polygon(p0, n0, src, 4));
+    CHECK_REL(F, exact, 0.05);
+}
+
+/* A long thin source (a 10 x 0.2 strip at height 1, two triangles that each run its whole
+   length: the shape decimation leaves on arches and mouldings) whose end x > 1 is hidden by a
+   plate at height 0.5 over x > 0.5. The visible part, x < 1, is 60% of the strip's area but
+   91% of its form factor, since the kernel peaks over the patch: uniform visibility targets
+   gave 0.66 of the closed form, whatever the sample count. */
+static void ff_test_long_thin_source(void)
+{
+    static const float occ[12] = { 0.5f, 0.5f, -1, 6, 0.5f, -1, 6, 0.5f, 1, 0.5f, 0.5f, 1 };
+    static const float src[12] = { -5, 1, -0.1f, 5, 1, -0.1f, 5, 1, 0.1f, -5, 1, 0.1f };
+    static const float vis[12] = { -5, 1, -0.1f, 1, 1, -0.1f, 1, 1, 0.1f, -5, 1, 0.1f };
+    float p0[3] = { 0, 0, 0 }, n0[3] = { 0, 1, 0 };
+    double F = ff_hidden_source_F(occ, src, 1), exact = (double)rad_ff_point_polygon(p0, n0, vis, 4);
+    printf("    F(patch -> strip) %.4f, visible part in closed form %.4f (unoccluded %.4f)\n", F, exact,
+           (double)rad_ff_point_polygon(p0, n0, src, 4));
+    CHECK_REL(F, exact, 0.03);
 }
 
 static const rad_test_case tests_formfactor[] = {
     {"formfactor_partly_hidden_source", ff_test_partly_hidden_source},
+    {"formfactor_long_thin_source", ff_test_long_thin_source},
     { "formfactor_point_polygon_square", ff_test_point_polygon_square },
     { "formfactor_point_polygon_disk", ff_test_point_polygon_disk },
     { "formfactor_point_polygon_clip", ff_test_point_polygon_clip },
