@@ -463,7 +463,8 @@ s_clang_asan_O1() {
     RAD_TEST_QUICK=1 RAD_TEST_SKIP="$COVER_SKIP" unit unit-clang-asan-ubsan-O1-scalar-cover clang -std=c99 $WARN -O1 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
 }
 # libFuzzer smoke runs (the long runs are `make fuzz`, recorded in FUZZING.md); TMPDIR: where
-# fuzz_stream writes its input file (left behind when it crashes)
+# fuzz_stream writes its input file (left behind when it crashes). One binary holds every
+# harness (tests/fuzz_smoke.c, FUZZ_TARGET picks one), so the implementation is compiled once.
 FUZZERS="container scene stream multibounce temporal"
 s_fuzz() {
     have clang || return 0
@@ -475,11 +476,13 @@ s_fuzz() {
            "$BUILD/make_corpus" "$BUILD/fuzz"; }; then
         fail fuzz-corpus; return
     fi
+    rm -f "$BUILD/fuzz_smoke"
+    if ! build fuzz-smoke clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. tests/fuzz_smoke.c -o "$BUILD/fuzz_smoke" -lm; then
+        fail "fuzz (build)"; return
+    fi
     for f in $FUZZERS; do
-        rm -f "$BUILD/fuzz_$f"
-        if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
-           { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
-           "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
+        if { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || FUZZ_TARGET=$f "$BUILD/fuzz_smoke" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
+           FUZZ_TARGET=$f "$BUILD/fuzz_smoke" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
                "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
             pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
         else
