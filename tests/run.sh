@@ -176,13 +176,16 @@ s_unit_embree() {
 # run, between them, every basic block of radiosity.h that the whole quick suite runs (measured
 # per test with clang's -fsanitize-coverage; docs/performance-notes.md says how to measure it
 # again); the tests it leaves out run the same code again at other sizes, orders, seeds or
-# thread counts. Valgrind and three of the five sanitizer builds run the cover subset; the
-# sanitizer builds of gcc (-O1, this machine's SIMD, OpenMP) and clang (-O2, SSE) and every
-# other build run every test. A new test is in the subset until it is listed.
+# thread counts. The short subset leaves out also the tests of tests/short_skip.txt (69 of
+# the 5,667 blocks, more than half the cover subset's time). Valgrind and gcc's -O0 sanitizer
+# build run the short subset, the two scalar sanitizer builds the cover subset; the sanitizer
+# builds of gcc (-O1, this machine's SIMD, OpenMP) and clang (-O2, SSE) and every other build
+# run every test. A new test is in both subsets until it is listed.
 skip_list() { grep -hv '^#' "$@" | grep . | paste -sd, -; }
 COVER_SKIP=$(skip_list tests/cover_skip.txt)
+SHORT_SKIP=$(skip_list tests/cover_skip.txt tests/short_skip.txt)
 # sanitizers at the quick sizes
-s_asan_O0() { RAD_TEST_QUICK=1 RAD_TEST_SKIP="$COVER_SKIP" unit unit-asan-ubsan-O0-cover $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c; }
+s_asan_O0() { RAD_TEST_QUICK=1 RAD_TEST_SKIP="$SHORT_SKIP" unit unit-asan-ubsan-O0-short $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c; }
 s_asan_O2_scalar() { RAD_TEST_QUICK=1 RAD_TEST_SKIP="$COVER_SKIP" unit unit-asan-ubsan-O2-scalar-cover $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD $SAN -I. tests/test_main.c; }
 # the SIMD paths of this machine (AVX2 temporal lanes, BC1/BC4 apply, BVH) and the threads
 # under the sanitizers, every test
@@ -495,20 +498,17 @@ s_fuzz() {
 # ---- valgrind memcheck: the -O2 -g unit build, the cover subset at the quick sizes, in two
 # halves that run side by side. What valgrind finds that the sanitizers do not is a read of
 # memory never written (and it checks the -O2 code gcc makes, which no sanitizer build runs);
-# such a read shows when its code runs, so running each block once is what counts. It leaves
-# out, besides the tests outside the cover subset, the few whose own blocks cost the most
-# (tests/valgrind_skip.txt: 26 of the 5,667 blocks, half the subset's time); valgrind runs a
-# third of the quick suite's CPU seconds.
+# such a read shows when its code runs, so running each block once is what counts: valgrind
+# runs the short subset (above), a quarter of the quick suite's CPU seconds.
 VALGRIND_SHARDS=2
-VALGRIND_SKIP=$(skip_list tests/cover_skip.txt tests/valgrind_skip.txt)
 s_valgrind_shard() {
     local i=$1
     if ! have valgrind; then [ "$i" != 0 ] || skip valgrind-memcheck "valgrind is not installed (package valgrind)"; return; fi
     after build-unit
     [ -x "$BUILD/unit-O2-g" ] || return 0
-    RAD_TEST_QUICK=1 RAD_TEST_SHARD="$i/$VALGRIND_SHARDS" RAD_TEST_SKIP="$VALGRIND_SKIP" UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" \
+    RAD_TEST_QUICK=1 RAD_TEST_SHARD="$i/$VALGRIND_SHARDS" RAD_TEST_SKIP="$SHORT_SKIP" UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" \
         UNIT_WRAP="valgrind --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --quiet" \
-        unit "valgrind-memcheck-cover-$((i + 1))of$VALGRIND_SHARDS"
+        unit "valgrind-memcheck-short-$((i + 1))of$VALGRIND_SHARDS"
 }
 s_valgrind_0() { s_valgrind_shard 0; }
 s_valgrind_1() { s_valgrind_shard 1; }
