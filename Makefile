@@ -99,11 +99,11 @@ $(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
 
 # the lightmap gather: hemisphere against exact, and the 1024^2 bunny-box bake (needs $(RAD_DATA_DIR))
-$(BUILD)/bench_lightmap_gather: bench/lightmap_gather.c tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
+$(BUILD)/bench_lightmap_gather: bench/lightmap_gather.c bench/bench_common.h bench/bench_scenes.h tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap_gather.c tools/unwrap.c -o $@ -lm
 
 # lightmap timings and noise (BENCHMARKS.md "Lightmaps")
-$(BUILD)/bench_lightmap: bench/lightmap.c radiosity.h | $(BUILD)
+$(BUILD)/bench_lightmap: bench/lightmap.c bench/bench_common.h bench/bench_scenes.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap.c -o $@ -lm
 
 $(BUILD)/local: bench/local.c examples/rooms.h radiosity.h | $(BUILD)
@@ -119,7 +119,7 @@ $(BUILD)/probes: bench/probes.c bench/bench_common.h radiosity.h | $(BUILD)
 $(BUILD)/bench_realtime: bench/realtime.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/realtime.c -o $@ -lm
 
-$(BUILD)/rays: bench/rays.c radiosity.h | $(BUILD)
+$(BUILD)/rays: bench/rays.c bench/bench_common.h bench/bench_scenes.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
 bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime

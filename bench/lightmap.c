@@ -6,39 +6,20 @@
    atlas, the refresh weights and the best of 20 refreshes, in the factored layout of
    rad_lightmap_weights and, side by side, in the expanded texel-from-patch layout it
    replaced (with the largest difference between the two). */
+#include "bench_common.h" /* first: it asks for POSIX clock_gettime */
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
+#include "bench_scenes.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#define NOW() omp_get_wtime()
-#else
-#include <time.h>
-#define NOW() ((double)clock() / CLOCKS_PER_SEC)
-#endif
 
+/* the atlas box and its BVH */
 static rad_scene *cornell_atlas(uint32_t N, rad_bvh **bvh)
 {
-    static rad_mesh_desc meshes[16];
-    static float luv[16][2 * 20]; /* the blocks have 5 quads of 4 vertices */
-    rad_scene_desc desc;
-    rad_scene *S = NULL;
-    uint32_t m, q, i, cell = 0, cells = 6;
-    rad_cornell_box(&desc, NULL);
-    memcpy(meshes, desc.meshes, sizeof(rad_mesh_desc) * desc.mesh_count);
-    for (m = 0; m < desc.mesh_count; ++m) {
-        for (q = 0; q < meshes[m].vertex_count / 4; ++q, ++cell) {
-            static const float cu[4] = { 0, 1, 1, 0 }, cv[4] = { 0, 0, 1, 1 };
-            float x0 = (float)(cell % cells) / cells, y0 = (float)(cell / cells) / cells, g = 1.0f / N, s = 1.0f / cells - 2.0f * g;
-            for (i = 0; i < 4; ++i) { luv[m][8 * q + 2 * i] = x0 + g + s * cu[i]; luv[m][8 * q + 2 * i + 1] = y0 + g + s * cv[i]; }
-        }
-        meshes[m].lightmap_uvs = luv[m];
-    }
-    desc.meshes = meshes;
-    if (rad_scene_create(&desc, NULL, &S) != RAD_SUCCESS || rad_bvh_create(S, NULL, bvh) != RAD_SUCCESS) exit(1);
+    rad_scene *S = bench_cornell_atlas(N);
+    if (rad_bvh_create(S, NULL, bvh) != RAD_SUCCESS) exit(1);
     return S;
 }
 
@@ -147,22 +128,22 @@ int main(int argc, char **argv)
     rad_sources(P, RAD_SOURCE_EMISSION, NULL, E); rad_system_init(&sys, &ff->matrix, P, E);
     rad_solve_options_default(&so); so.output = RAD_OUTPUT_TOTAL; rad_solve_gauss_seidel(&sys, &so, B, NULL, NULL);
     lo.width = lo.height = N;
-    t = NOW();
+    t = now();
     if (rad_lightmap_create(S, &rc, &lo, NULL, &lm) != RAD_SUCCESS) return 1;
-    printf("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", N, N, P->count, NOW() - t, lm->sample_count, lm->valid_texels);
+    printf("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", N, N, P->count, now() - t, lm->sample_count, lm->valid_texels);
     H1 = (float *)calloc(3 * (size_t)N * N, 4); H2 = (float *)calloc(3 * (size_t)N * N, 4);
     for (vr = 1; vr <= 4; vr *= 4) {
         double num = 0.0, den = 0.0;
         rad_lightmap_gather_options_default(&go); go.visibility_rays = vr;
-        t = NOW(); rad_lightmap_gather(lm, P, B, &rc, &go, H1, NULL); t = NOW() - t;
+        t = now(); rad_lightmap_gather(lm, P, B, &rc, &go, H1, NULL); t = now() - t;
         go.seed = 12345; rad_lightmap_gather(lm, P, B, &rc, &go, H2, NULL);
         for (i = 0; i < N * N; ++i)
             if (lm->flags[i] & RAD_TEXEL_VALID) { double d = H1[3 * i + 1] - H2[3 * i + 1]; num += d * d; den += H1[3 * i + 1]; }
         printf("| | gather, %u visibility ray%s | %.2f s | seed-to-seed rms difference %.4f of the mean texel |\n", vr, vr > 1 ? "s" : "", t,
                sqrt(num / lm->valid_texels) / (den / lm->valid_texels));
     }
-    t = NOW(); rad_lightmap_dilate(lm, 3, H1, 0, NULL); printf("| | dilate (all passes) | %.4f s | |\n", NOW() - t);
-    t = NOW(); rad_lightmap_stitch(lm, 3, H1, 0, &st, NULL); printf("| | stitch | %.4f s | %u seams |\n", NOW() - t, st.seams);
+    t = now(); rad_lightmap_dilate(lm, 3, H1, 0, NULL); printf("| | dilate (all passes) | %.4f s | |\n", now() - t);
+    t = now(); rad_lightmap_stitch(lm, 3, H1, 0, &st, NULL); printf("| | stitch | %.4f s | %u seams |\n", now() - t, st.seams);
     rad_lightmap_destroy(lm); rad_form_factors_destroy(ff); rad_patches_destroy(P); rad_bvh_destroy(bvh); rad_scene_destroy(S);
 refresh:
     /* refresh on a larger atlas: no gather needed (weights without a detail factor) */
@@ -171,12 +152,12 @@ refresh:
     po.target_count = Rtarget;
     if (rad_patches_create(S, &po, NULL, &P) != RAD_SUCCESS) return 1;
     lo.width = lo.height = RN;
-    t = NOW();
+    t = now();
     if (rad_lightmap_create(S, &rc, &lo, NULL, &lm) != RAD_SUCCESS) return 1;
-    printf("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", RN, RN, P->count, NOW() - t, lm->sample_count, lm->valid_texels);
-    t = NOW();
+    printf("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", RN, RN, P->count, now() - t, lm->sample_count, lm->valid_texels);
+    t = now();
     if (rad_lightmap_weights_create(lm, P, NULL, NULL, NULL, &w) != RAD_SUCCESS) return 1;
-    printf("| | refresh weights | %.2f s | %.1f vertex entries per valid texel, %u vertices |\n", NOW() - t,
+    printf("| | refresh weights | %.2f s | %.1f vertex entries per valid texel, %u vertices |\n", now() - t,
            (double)w->row_first[w->row_count] / lm->valid_texels, w->vertex_count);
     old_expand(w, &ow);
     printf("| | expanded texel-from-patch rows (the old layout) | | %.1f patch entries per valid texel |\n",
@@ -188,9 +169,9 @@ refresh:
     for (k = 0; k < 20; ++k) {
         old_job oj;
         oj.W = &ow; oj.H = Hp; oj.out = out_old; oj.tasks = 64;
-        t = NOW(); rad__parallel_default(NULL, oj.tasks, old_refresh_task, &oj); t = NOW() - t; if (t < best_old) best_old = t;
-        t = NOW(); rad_lightmap_refresh(w, Hp, out, NULL); t = NOW() - t; if (t < best) best = t;
-        t = NOW(); rad_lightmap_refresh(w, Hp, out, &serial); t = NOW() - t; if (t < best_serial) best_serial = t;
+        t = now(); rad__parallel_default(NULL, oj.tasks, old_refresh_task, &oj); t = now() - t; if (t < best_old) best_old = t;
+        t = now(); rad_lightmap_refresh(w, Hp, out, NULL); t = now() - t; if (t < best) best = t;
+        t = now(); rad_lightmap_refresh(w, Hp, out, &serial); t = now() - t; if (t < best_serial) best_serial = t;
     }
     for (i = 0; i < 3 * RN * RN; ++i) {
         double d = fabs((double)out[i] - out_old[i]) / (fabs((double)out_old[i]) > 1e-3 ? fabs((double)out_old[i]) : 1e-3);

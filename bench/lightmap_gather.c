@@ -13,27 +13,16 @@
    --bunny-size texels, timed (wall and process CPU time: on a shared machine the CPU time
    over the core count is the run's cost on idle cores). LMG_DEBUG=1 in the environment prints
    the texels whose two gathers differ by more than 30%. */
-#if defined(__unix__) && !defined(_POSIX_C_SOURCE)
-#define _POSIX_C_SOURCE 199309L
-#endif
+#include "bench_common.h" /* first: it asks for POSIX clock_gettime */
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
+#include "bench_scenes.h"
 #include "tools/tool.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#if defined(__unix__) && !defined(_POSIX_C_SOURCE)
-#define _POSIX_C_SOURCE 199309L
-#endif
 #include <time.h>
-#ifdef _OPENMP
-#include <omp.h>
-#define NOW() omp_get_wtime()
-#else
-#include <time.h>
-#define NOW() ((double)clock() / CLOCKS_PER_SEC)
-#endif
 
 /* CPU time of the process, all threads: on a shared machine the wall time of a parallel run
    mostly measures the other jobs; CPU / cores is what the run costs on idle cores */
@@ -48,54 +37,6 @@ static double cpu_now(void)
 #endif
 }
 
-static rad_scene *cornell_atlas(uint32_t N)
-{
-    static rad_mesh_desc meshes[16];
-    static float luv[16][2 * 20];
-    rad_scene_desc desc;
-    rad_scene *S = NULL;
-    uint32_t m, q, i, cell = 0, cells = 6;
-    rad_cornell_box(&desc, NULL);
-    memcpy(meshes, desc.meshes, sizeof(rad_mesh_desc) * desc.mesh_count);
-    for (m = 0; m < desc.mesh_count; ++m) {
-        for (q = 0; q < meshes[m].vertex_count / 4; ++q, ++cell) {
-            static const float cu[4] = { 0, 1, 1, 0 }, cv[4] = { 0, 0, 1, 1 };
-            float x0 = (float)(cell % cells) / cells, y0 = (float)(cell / cells) / cells, g = 1.0f / N, s = 1.0f / cells - 2.0f * g;
-            for (i = 0; i < 4; ++i) { luv[m][8 * q + 2 * i] = x0 + g + s * cu[i]; luv[m][8 * q + 2 * i + 1] = y0 + g + s * cv[i]; }
-        }
-        meshes[m].lightmap_uvs = luv[m];
-    }
-    desc.meshes = meshes;
-    if (rad_scene_create(&desc, NULL, &S) != RAD_SUCCESS) exit(1);
-    return S;
-}
-
-static int load_obj(const char *path, float **pos, uint32_t *nv, uint32_t **idx, uint32_t *nt)
-{
-    FILE *f = fopen(path, "r");
-    char line[1024];
-    size_t vc = 0, vcap = 0, tc = 0, tcap = 0;
-    float *v = NULL;
-    uint32_t *t = NULL;
-    if (!f) return 0;
-    while (fgets(line, sizeof(line), f)) {
-        if (line[0] == 'v' && line[1] == ' ') {
-            if (vc == vcap) { vcap = vcap ? 2 * vcap : 4096; v = (float *)realloc(v, vcap * 3 * sizeof(float)); }
-            if (sscanf(line + 2, "%f %f %f", &v[3 * vc], &v[3 * vc + 1], &v[3 * vc + 2]) == 3) vc++;
-        } else if (line[0] == 'f' && line[1] == ' ') {
-            unsigned a, b, c;
-            if (sscanf(line + 2, "%u%*[^ ] %u%*[^ ] %u", &a, &b, &c) != 3 && sscanf(line + 2, "%u %u %u", &a, &b, &c) != 3) continue;
-            if (!a || !b || !c) continue;
-            if (tc == tcap) { tcap = tcap ? 2 * tcap : 4096; t = (uint32_t *)realloc(t, tcap * 3 * sizeof(uint32_t)); }
-            t[3 * tc] = a - 1; t[3 * tc + 1] = b - 1; t[3 * tc + 2] = c - 1;
-            tc++;
-        }
-    }
-    fclose(f);
-    *pos = v; *nv = (uint32_t)vc; *idx = t; *nt = (uint32_t)tc;
-    return tc > 0;
-}
-
 /* the box without its blocks, plus the bunny 0.25 m tall in the middle of the floor */
 static rad_scene *bunny_box(const char *path)
 {
@@ -105,7 +46,7 @@ static rad_scene *bunny_box(const char *path)
     float lo[3] = { 1e30f, 1e30f, 1e30f }, hi[3] = { -1e30f, -1e30f, -1e30f }, sc;
     rad_scene *S = NULL;
     int k;
-    if (!load_obj(path, &bp, &nv, &bi, &nt)) return NULL;
+    if (!bench_load_obj(path, &bp, &nv, &bi, &nt)) return NULL;
     rad_cornell_box(&desc, NULL);
     for (m = 0; m < desc.mesh_count; ++m)
         if (!desc.meshes[m].name || !strstr(desc.meshes[m].name, "block")) meshes[n++] = desc.meshes[m];
@@ -134,7 +75,7 @@ static rad_scene *unwrapped(const rad_scene *S, uint32_t N, float **uvs_out)
     float *uvs = (float *)calloc(6 * (size_t)S->triangle_count, sizeof(float));
     rad_scene *U = NULL;
     uint32_t charts = 0;
-    if (tool_unwrap(S, N, N, uvs, &charts)) exit(1);
+    if (tool_unwrap("lightmap_gather", "--bunny-size or --bunny-exact-size", S, N, N, uvs, &charts)) exit(1);
     memcpy(mats, S->materials_table, sizeof(rad_material) * S->material_count);
     memset(&mesh, 0, sizeof mesh);
     mesh.name = "unwrapped";
@@ -214,7 +155,7 @@ static void run_compare(const char *name, const rad_lightmap *lm, const rad_patc
     rad_lightmap_gather_options_default(&go);
     if (exact) {
         go.visibility_rays = exact_vis;
-        t = NOW(); if (rad_lightmap_gather(lm, P, B, rc, &go, X, NULL) != RAD_SUCCESS) exit(1); tx = NOW() - t;
+        t = now(); if (rad_lightmap_gather(lm, P, B, rc, &go, X, NULL) != RAD_SUCCESS) exit(1); tx = now() - t;
         printf("| %s, %ux%u, %u patches, %u valid texels | exact, %u visibility rays | %.2f s | | | | |\n", name, lm->width,
                lm->height, P->count, lm->valid_texels, exact_vis, tx);
         go.visibility_rays = 4;
@@ -222,7 +163,7 @@ static void run_compare(const char *name, const rad_lightmap *lm, const rad_patc
     for (k = 0; k < nrays; ++k) {
         go.method = RAD_LIGHTMAP_GATHER_HEMISPHERE;
         go.hemisphere_rays = rays[k];
-        t = NOW(); if (rad_lightmap_gather(lm, P, B, rc, &go, Hh, NULL) != RAD_SUCCESS) exit(1); t = NOW() - t;
+        t = now(); if (rad_lightmap_gather(lm, P, B, rc, &go, Hh, NULL) != RAD_SUCCESS) exit(1); t = now() - t;
         if (exact) {
             compare(lm, Hh, X, &mean, &p95, &mx, &rms);
             printf("| | hemisphere, %u rays a texel | %.2f s | %.2f%% | %.2f%% | %.1f%% | %.2f%% |\n", rays[k], t, 100 * mean, 100 * p95,
@@ -259,7 +200,7 @@ int main(int argc, char **argv)
     }
     printf("| scene | gather | time | mean rel. diff. | 95th pct. | max | rms / mean texel |\n|---|---|---:|---:|---:|---:|---:|\n");
     if (N) {
-        S = cornell_atlas(N);
+        S = bench_cornell_atlas(N);
         if (rad_bvh_create(S, NULL, &bvh) != RAD_SUCCESS) return 1;
         rad_bvh_raycaster(bvh, &rc);
         rad_patch_options_default(&po); po.target_count = target;
@@ -296,16 +237,16 @@ int main(int argc, char **argv)
             E = (float *)malloc(12 * (size_t)P->count); B = (float *)malloc(12 * (size_t)P->count);
             rad_sources(P, RAD_SOURCE_EMISSION, NULL, E);
             rad_stochastic_options_default(&sto); sto.output = RAD_OUTPUT_TOTAL;
-            t = NOW();
+            t = now();
             if (rad_solve_stochastic(P, &rc, E, &sto, B, &sst, NULL) != RAD_SUCCESS) return 1;
             printf("| bunny box, %u triangles, %u patches | stochastic Jacobi | %.2f s | %llu rays | | | |\n", U->triangle_count, P->count,
-                   NOW() - t, (unsigned long long)sst.rays_cast);
+                   now() - t, (unsigned long long)sst.rays_cast);
             fflush(stdout);
             rad_lightmap_options_default(&lo); lo.width = lo.height = size;
             if (a == 0) lo.samples = 1;
-            t0 = NOW(); c0 = cpu_now();
+            t0 = now(); c0 = cpu_now();
             if (rad_lightmap_create(U, &rc, &lo, NULL, &lm) != RAD_SUCCESS) return 1;
-            t = NOW() - t0; cb = cpu_now() - c0;
+            t = now() - t0; cb = cpu_now() - c0;
             printf("| | texels (rasterize, validity) | %.2f s (CPU %.2f s) | %u samples, %u valid texels | | | |\n", t, cb, lm->sample_count, lm->valid_texels);
             fflush(stdout);
             if (a == 0) {
@@ -333,17 +274,17 @@ int main(int argc, char **argv)
                 go.method = RAD_LIGHTMAP_GATHER_HEMISPHERE;
                 for (i = 0; i < nrays; ++i) {
                     go.hemisphere_rays = rays[i];
-                    t = NOW(); c0 = cpu_now();
+                    t = now(); c0 = cpu_now();
                     if (rad_lightmap_gather(lm, P, B, &rc, &go, H, NULL) != RAD_SUCCESS) return 1;
                     cg = cpu_now() - c0;
-                    printf("| | hemisphere gather, %u rays a texel | %.2f s (CPU %.2f s) | | | | |\n", rays[i], NOW() - t, cg);
+                    printf("| | hemisphere gather, %u rays a texel | %.2f s (CPU %.2f s) | | | | |\n", rays[i], now() - t, cg);
                     fflush(stdout);
                 }
-                t = NOW(); c0 = cpu_now();
+                t = now(); c0 = cpu_now();
                 rad_lightmap_dilate(lm, 3, H, 0, NULL);
                 rad_lightmap_stitch(lm, 3, H, 0, &st, NULL);
                 cd = cpu_now() - c0;
-                printf("| | dilate + stitch | %.2f s (CPU %.2f s) | %u seams | | | |\n", NOW() - t, cd, st.seams);
+                printf("| | dilate + stitch | %.2f s (CPU %.2f s) | %u seams | | | |\n", now() - t, cd, st.seams);
                 printf("| | bake (texels + last gather + dilate + stitch) | CPU %.2f s: %.1f s on 2 idle cores | | | | |\n", cb + cg + cd,
                        (cb + cg + cd) / 2.0);
                 free(H);

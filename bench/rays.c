@@ -24,6 +24,7 @@
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
+#include "bench_scenes.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -312,43 +313,6 @@ static void run_scene(const char *name, const rad_scene *scene, uint32_t target,
     rad_patches_destroy(P);
 }
 
-/* reads "v x y z" and "f" lines (indices "a", "a/b" or "a/b/c", polygons fanned) */
-static int load_obj(const char *path, float **pos, uint32_t *nv, uint32_t **idx, uint32_t *nt)
-{
-    FILE *f = fopen(path, "r");
-    char line[1024];
-    size_t vc = 0, vcap = 0, tc = 0, tcap = 0;
-    float *v = NULL;
-    uint32_t *t = NULL;
-    if (!f) return 0;
-    while (fgets(line, sizeof(line), f)) {
-        if (line[0] == 'v' && line[1] == ' ') {
-            if (vc == vcap) { vcap = vcap ? 2 * vcap : 4096; v = (float *)realloc(v, vcap * 3 * sizeof(float)); }
-            if (sscanf(line + 2, "%f %f %f", &v[3 * vc], &v[3 * vc + 1], &v[3 * vc + 2]) == 3) vc++;
-        } else if (line[0] == 'f' && line[1] == ' ') {
-            char *p = line + 2, *end;
-            unsigned long ix[64];
-            int m = 0, j;
-            while (m < 64) {
-                ix[m] = strtoul(p, &end, 10);
-                if (end == p) break;
-                m++;
-                p = end;
-                while (*p && *p != ' ' && *p != '\t' && *p != '\n' && *p != '\r') p++;
-            }
-            for (j = 2; j < m; ++j) {
-                if (ix[0] == 0 || ix[j - 1] == 0 || ix[j] == 0) continue;
-                if (tc == tcap) { tcap = tcap ? 2 * tcap : 4096; t = (uint32_t *)realloc(t, tcap * 3 * sizeof(uint32_t)); }
-                t[3 * tc] = (uint32_t)ix[0] - 1; t[3 * tc + 1] = (uint32_t)ix[j - 1] - 1; t[3 * tc + 2] = (uint32_t)ix[j] - 1;
-                tc++;
-            }
-        }
-    }
-    fclose(f);
-    *pos = v; *nv = (uint32_t)vc; *idx = t; *nt = (uint32_t)tc;
-    return tc > 0;
-}
-
 int main(int argc, char **argv)
 {
     rad_scene_desc desc;
@@ -381,7 +345,7 @@ int main(int argc, char **argv)
     if (!dir || !dir[0]) {
         emit("\n### Stanford bunny in the Cornell box, Sponza: skipped (no data folder: pass --data DIR or set RAD_DATA_DIR; "
              "see docs/data.md)\n");
-    } else if (load_obj(path, &bpos, &bnv, &bidx, &bnt)) {
+    } else if (bench_load_obj(path, &bpos, &bnv, &bidx, &bnt)) {
         /* the bunny, scaled to 0.25 m tall, standing in the middle of the Cornell floor */
         rad_mesh_desc *meshes = (rad_mesh_desc *)calloc(desc.mesh_count + 1, sizeof(rad_mesh_desc));
         rad_scene_desc d2 = desc;
@@ -423,7 +387,7 @@ int main(int argc, char **argv)
         emit("\n### Stanford bunny in the Cornell box: skipped (%s not found; see docs/data.md)\n", path);
     }
     snprintf(path, sizeof(path), "%s/sponza.obj", dir ? dir : "");
-    if (dir && dir[0] && load_obj(path, &bpos, &bnv, &bidx, &bnt)) {
+    if (dir && dir[0] && bench_load_obj(path, &bpos, &bnv, &bidx, &bnt)) {
         /* the atrium as modelled (x along the nave, y up); one material; camera at one end of the
            nave looking down it, the point light high in the open roof */
         rad_mesh_desc mesh;

@@ -100,6 +100,11 @@ stage() {
         echo "  [$(date +%H:%M:%S)] $name: $PASSED passed, $FAILED failed, $SKIPPED skipped ($secs s, CPU $cpu s)"
     ) &
 }
+# after NAME: waits until the stage NAME has finished (its counts are written last); a stage
+# that runs what another builds calls it first, so it can take its place in the queue at once
+after() {
+    while [ ! -f "$STAGES/$1.count" ]; do sleep 1; done
+}
 wanted() {
     local w=" ${RAD_TEST_STAGES:-$1} "
     case "$1" in
@@ -148,6 +153,7 @@ s_unit_build() {
     build unit-O2-g $CC -std=c99 $WARN -O2 -g -I. tests/test_main.c -o "$BUILD/unit-O2-g" -lm || fail "unit-O2 (build)"
 }
 s_unit_O2() {
+    after build-unit
     [ -x "$BUILD/unit-O2-g" ] || return 0
     UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" unit unit-O2
 }
@@ -166,10 +172,23 @@ s_unit_embree() {
         skip unit-embree "Embree 3 is not installed (package libembree-dev)"
     fi
 }
+# The cover subset: the unit tests less those named in tests/cover_skip.txt. The tests it keeps
+# run, between them, every basic block of radiosity.h that the whole quick suite runs (measured
+# per test with clang's -fsanitize-coverage; docs/performance-notes.md says how to measure it
+# again); the tests it leaves out run the same code again at other sizes, orders, seeds or
+# thread counts. The short subset leaves out also the tests of tests/short_skip.txt (69 of
+# the 5,667 blocks, more than half the cover subset's time). Valgrind and gcc's -O0 sanitizer
+# build run the short subset, the two scalar sanitizer builds the cover subset; the sanitizer
+# builds of gcc (-O1, this machine's SIMD, OpenMP) and clang (-O2, SSE) and every other build
+# run every test. A new test is in both subsets until it is listed.
+skip_list() { grep -hv '^#' "$@" | grep . | paste -sd, -; }
+COVER_SKIP=$(skip_list tests/cover_skip.txt)
+SHORT_SKIP=$(skip_list tests/cover_skip.txt tests/short_skip.txt)
 # sanitizers at the quick sizes
-s_asan_O0() { RAD_TEST_QUICK=1 unit unit-asan-ubsan-O0 $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c; }
-s_asan_O2_scalar() { RAD_TEST_QUICK=1 unit unit-asan-ubsan-O2-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD $SAN -I. tests/test_main.c; }
-# the SIMD paths of this machine (AVX2 temporal lanes, BC1/BC4 apply, BVH) under the sanitizers
+s_asan_O0() { RAD_TEST_QUICK=1 RAD_TEST_SKIP="$SHORT_SKIP" unit unit-asan-ubsan-O0-short $CC -std=c99 $WARN -O0 $SAN -I. tests/test_main.c; }
+s_asan_O2_scalar() { RAD_TEST_QUICK=1 RAD_TEST_SKIP="$COVER_SKIP" unit unit-asan-ubsan-O2-scalar-cover $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD $SAN -I. tests/test_main.c; }
+# the SIMD paths of this machine (AVX2 temporal lanes, BC1/BC4 apply, BVH) and the threads
+# under the sanitizers, every test
 s_asan_O1_native() { RAD_TEST_QUICK=1 unit unit-asan-ubsan-O1-native $CC -std=c99 $WARN -O1 -march=native $OMP $SAN -I. tests/test_main.c; }
 
 s_compile() {
@@ -362,6 +381,7 @@ s_tool_build() {
     if build tool-link $CC $OMP "$TOOL_OBJ"/*.o -o "$BUILD/rad" -lassimp $EXR_LIB -lm; then pass tool-build; else fail tool-build; fi
 }
 s_tool() {
+    after build-tool
     [ -x "$BUILD/rad" ] || return 0
     echo "== tool tests"
     local out nf ns
@@ -383,6 +403,7 @@ s_tool() {
 # the evaluation report at quick quality (make report-quick): every table cell filled, every
 # image written (tools/report.sh --check)
 s_report() {
+    after build-tool
     [ -x "$BUILD/rad" ] || return 0
     if build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
        bash tools/report.sh --quick --out "$BUILD/report-quick" \
@@ -395,6 +416,7 @@ s_report() {
 # the distributed bake (tests/dist_tests.sh): shards, merge and, with OpenMPI, tools/rad-mpi
 # (the tool's objects linked with its own main)
 s_dist() {
+    after build-tool
     [ -x "$BUILD/rad" ] || return 0
     local mpi="" out nf ns
     if ! build dist-part-edit $CC -std=c99 $WARN -O2 -I. tests/dist_part_edit.c -o "$BUILD/dist_part_edit" -lm; then
@@ -441,10 +463,11 @@ s_clang_asan_O2() {
 # (gcc's sanitizer build covers -O0; clang's scalar one runs at -O1, three times faster)
 s_clang_asan_O1() {
     [ "$HAVE_ASAN_CLANG" = 1 ] || return 0
-    RAD_TEST_QUICK=1 unit unit-clang-asan-ubsan-O1-scalar clang -std=c99 $WARN -O1 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
+    RAD_TEST_QUICK=1 RAD_TEST_SKIP="$COVER_SKIP" unit unit-clang-asan-ubsan-O1-scalar-cover clang -std=c99 $WARN -O1 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
 }
 # libFuzzer smoke runs (the long runs are `make fuzz`, recorded in FUZZING.md); TMPDIR: where
-# fuzz_stream writes its input file (left behind when it crashes)
+# fuzz_stream writes its input file (left behind when it crashes). One binary holds every
+# harness (tests/fuzz_smoke.c, FUZZ_TARGET picks one), so the implementation is compiled once.
 FUZZERS="container scene stream multibounce temporal"
 s_fuzz() {
     have clang || return 0
@@ -456,11 +479,13 @@ s_fuzz() {
            "$BUILD/make_corpus" "$BUILD/fuzz"; }; then
         fail fuzz-corpus; return
     fi
+    rm -f "$BUILD/fuzz_smoke"
+    if ! build fuzz-smoke clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. tests/fuzz_smoke.c -o "$BUILD/fuzz_smoke" -lm; then
+        fail "fuzz (build)"; return
+    fi
     for f in $FUZZERS; do
-        rm -f "$BUILD/fuzz_$f"
-        if build "fuzz-$f" clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. "fuzz/fuzz_$f.c" -o "$BUILD/fuzz_$f" -lm &&
-           { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || "$BUILD/fuzz_$f" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
-           "$BUILD/fuzz_$f" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
+        if { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || FUZZ_TARGET=$f "$BUILD/fuzz_smoke" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
+           FUZZ_TARGET=$f "$BUILD/fuzz_smoke" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
                "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
             pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"
         else
@@ -470,23 +495,20 @@ s_fuzz() {
     done
 }
 
-# ---- valgrind memcheck: one build, the quick suite split in two halves that run side by side.
-# Left out: tests that repeat the same computations in other orders or at other scales (they
-# are a third of its time; every build above runs them, five under the sanitizers), and the
-# stochastic statistics (16 seeds of the same solve; the furnace and thread tests keep both
-# estimators under valgrind); also the larger repeats of code the other tests cover: the
-# hierarchical solve at ever smaller tolerances, the lightmap on the whole Cornell box, the box
-# at six scales, the reorderings again on a scrambled patch order
+# ---- valgrind memcheck: the -O2 -g unit build, the cover subset at the quick sizes, in two
+# halves that run side by side. What valgrind finds that the sanitizers do not is a read of
+# memory never written (and it checks the -O2 code gcc makes, which no sanitizer build runs);
+# such a read shows when its code runs, so running each block once is what counts: valgrind
+# runs the short subset (above), a quarter of the quick suite's CPU seconds.
 VALGRIND_SHARDS=2
-VALGRIND_SKIP=formfactor_determinism,robust_determinism,solve_jacobi_deterministic,solve_cornell_agree,robust_scale_invariance,robust_nearly_parallel,formfactor_c41_disks,stochastic_mean_jacobi,stochastic_mean_walk,stochastic_variance_jacobi,stochastic_variance_walk
-VALGRIND_SKIP="$VALGRIND_SKIP,hierarchical_converges,lightmap_cornell,regress_scene_scale,multibounce: reordering methods on a scrambled patch order"
 s_valgrind_shard() {
     local i=$1
     if ! have valgrind; then [ "$i" != 0 ] || skip valgrind-memcheck "valgrind is not installed (package valgrind)"; return; fi
+    after build-unit
     [ -x "$BUILD/unit-O2-g" ] || return 0
-    RAD_TEST_QUICK=1 RAD_TEST_SHARD="$i/$VALGRIND_SHARDS" RAD_TEST_SKIP="$VALGRIND_SKIP" UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" \
+    RAD_TEST_QUICK=1 RAD_TEST_SHARD="$i/$VALGRIND_SHARDS" RAD_TEST_SKIP="$SHORT_SKIP" UNIT_PREBUILT=1 UNIT_BIN="$BUILD/unit-O2-g" \
         UNIT_WRAP="valgrind --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite,indirect,possible --quiet" \
-        unit "valgrind-memcheck-$((i + 1))of$VALGRIND_SHARDS"
+        unit "valgrind-memcheck-short-$((i + 1))of$VALGRIND_SHARDS"
 }
 s_valgrind_0() { s_valgrind_shard 0; }
 s_valgrind_1() { s_valgrind_shard 1; }
@@ -494,32 +516,32 @@ s_valgrind_1() { s_valgrind_shard 1; }
 # ---- run: the longest first, so the last to finish are short ----------------------------
 echo "running the suites, $JOBS at a time (logs in $STAGES)"
 RUN_START=$(date +%s)
-# first the shared builds, side by side; the suites that run them start when both are done
+# first the shared builds, side by side; the suites that run them wait for them (after)
 stage build-unit s_unit_build
 stage build-tool s_tool_build
-wait
+# in the order of their CPU seconds on an idle machine (printed at the end of each run)
+stage fuzz s_fuzz
 stage valgrind-1 s_valgrind_0
 stage valgrind-2 s_valgrind_1
 stage asan-O0 s_asan_O0
-stage clang-asan-O1 s_clang_asan_O1
-stage tool s_tool
-stage report s_report
-stage dist s_dist
 stage asan-O1-native s_asan_O1_native
 stage asan-O2-scalar s_asan_O2_scalar
 stage clang-asan-O2 s_clang_asan_O2
-stage fuzz s_fuzz
-stage vulkan s_vulkan
+stage clang-asan-O1 s_clang_asan_O1
 stage unit-O2 s_unit_O2
-stage examples s_examples
+stage tool s_tool
 stage unit-openmp s_unit_openmp
-stage clang s_clang
 stage unit-scalar s_unit_scalar
-stage unit-avx s_unit_avx
-stage unit-native s_unit_native
 stage unit-embree s_unit_embree
+stage unit-native s_unit_native
+stage vulkan s_vulkan
+stage report s_report
+stage clang s_clang
+stage unit-avx s_unit_avx
+stage examples s_examples
 stage compile s_compile
 stage test-tool s_test_tool
+stage dist s_dist
 wait
 RUN_SECS=$(( $(date +%s) - RUN_START ))
 
