@@ -5278,11 +5278,7 @@ static float rad__aabb_area(const rad__aabb *b)
 
 RAD_API void rad_bvh_destroy(rad_bvh *bvh)
 {
-    rad_allocator a;
-    if (!bvh) return;
-    a = bvh->allocator;
-    rad__free(&a, bvh->block);
-    rad__free(&a, bvh);
+    if (bvh) rad__free_object(bvh->allocator, bvh->block, bvh);
 }
 
 RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
@@ -6337,12 +6333,7 @@ RAD_API void rad_camera_ray(const rad_camera *cam, uint32_t width, uint32_t heig
     if (!out) return;
     memset(out, 0, sizeof(*out));
     if (!cam || width == 0 || height == 0) return;
-    rad__sub(f, cam->target, cam->position);
-    rad__normalize(f);
-    rad__cross(r, f, cam->up);
-    rad__normalize(r);
-    rad__cross(u, r, f);
-    h = (float)tan(0.5 * (double)cam->fov_y_degrees * RAD__PI / 180.0);
+    h = rad__camera_frame(cam, f, r, u);
     x = (2.0f * px / (float)width - 1.0f) * h * (float)width / (float)height;
     y = (1.0f - 2.0f * py / (float)height) * h;
     for (k = 0; k < 3; ++k) {
@@ -7855,14 +7846,15 @@ RAD_API rad_result rad_form_factor_pairs(const rad_patches *patches, const rad_r
 
 RAD_API void rad_form_factors_destroy(rad_form_factors *ff)
 {
-    rad_allocator a;
-    if (!ff) return;
-    a = ff->allocator;
-    rad__free(&a, ff->storage);
-    rad__free(&a, (void *)(uintptr_t)ff->matrix.row_offsets);
-    rad__free(&a, (void *)(uintptr_t)ff->matrix.columns);
-    rad__free(&a, (void *)(uintptr_t)ff->matrix.values);
-    rad__free(&a, ff);
+    if (ff) {
+        void *blocks[5];
+        blocks[0] = ff->storage;
+        blocks[1] = (void *)(uintptr_t)ff->matrix.row_offsets;
+        blocks[2] = (void *)(uintptr_t)ff->matrix.columns;
+        blocks[3] = (void *)(uintptr_t)ff->matrix.values;
+        blocks[4] = ff;
+        rad__free_each(ff->allocator, blocks, 5);
+    }
 }
 
 RAD_API rad_result rad_form_factors_dense(const rad_patches *patches, const rad_raycaster *raycaster,
@@ -18899,19 +18891,9 @@ static void rad__lm_refresh_vertices(void *data, uint32_t task)
     const rad_lightmap_weights *W = f->W;
     uint32_t v = (uint32_t)((uint64_t)W->vertex_count * task / f->tasks);
     uint32_t end = (uint32_t)((uint64_t)W->vertex_count * (task + 1) / f->tasks);
-    for (; v < end; ++v) {
-        uint32_t e;
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        for (e = W->vertex_first[v]; e < W->vertex_first[v + 1]; ++e) {
-            const float *h = f->H + 3 * (size_t)W->vertex_patches[e], w = W->vertex_weights[e];
-            s0 += w * h[0];
-            s1 += w * h[1];
-            s2 += w * h[2];
-        }
-        f->V[3 * (size_t)v] = s0;
-        f->V[3 * (size_t)v + 1] = s1;
-        f->V[3 * (size_t)v + 2] = s2;
-    }
+    for (; v < end; ++v)
+        rad__sparse_row3(W->vertex_patches, W->vertex_weights, W->vertex_first[v], W->vertex_first[v + 1], f->H,
+                         f->V + 3 * (size_t)v);
 }
 
 /* one contiguous block of rows per task: the rows are short, so a cyclic split would make
