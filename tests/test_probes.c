@@ -351,6 +351,14 @@ static void pb_test_constant_room(void)
         CHECK_NEAR(org[0], 0.05, 1e-6);
         CHECK(rad_probes_count(pr) == 64);
         for (i = 0; i < 64; ++i) CHECK(rad_probes_states(pr)[i] == RAD_PROBE_VALID);
+        /* every probe reads 2 for every normal, so any weighting must too: the fit's weights
+           sum to 1 (a constant is read back exactly) */
+        for (i = 0; i < 3; ++i)
+            for (k = 0; k < 4; ++k) {
+                float e[3];
+                CHECK_OK(rad_probes_sample(pr, pts[i], ns[k], e));
+                CHECK_REL(e[1], 2.0, 0.01);
+            }
     }
 done:
     rad_probes_destroy(pr);
