@@ -2758,7 +2758,9 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lightmap
        of the weighted least-squares fit E_k(n) ~ a + b . (q_k - p) over those probes, with a
        ridge 0.003 trace(M) on b (M = sum w_k (q_k - p)(q_k - p)^T): the lobe's lean towards
        the probes n faces is fitted out where the light varies linearly, and the ridge keeps
-       b from being read off the few probes behind the surface (the wall case);
+       b from being read off the few probes behind the surface (the wall case); with user
+       positions the value is kept within the range of the probes' E_k(n) (p may lie outside
+       them, where the plane would extrapolate);
      NORMAL: w_k times ((1 + cos) / 2)^2, renormalized (the weighted mean);
      PLAIN: w_k alone, renormalized.
    When no weight is left (every neighbour disabled) the nearest enabled probe is used. The
@@ -20121,6 +20123,7 @@ static void rad__probe_eval(const rad_probes *pr, uint32_t i, const float *un, f
    NORMAL_FIT also the first and second moments of the offsets d = q - p and s1 = sum w d E */
 typedef struct rad__probe_acc {
     double W, s0[3], m1[3], M[6], s1[3][3]; /* M: xx, yy, zz, xy, xz, yz */
+    float lo[3], hi[3];                      /* the range of the E_k read */
 } rad__probe_acc;
 
 /* the normal factor of weighting wt for the cosine cs */
@@ -20135,6 +20138,10 @@ static float rad__probe_lobe(rad_probe_weighting wt, float cs)
 static void rad__probe_acc_add(rad__probe_acc *a, double w, const float *d, const float *e)
 {
     int k, c;
+    for (c = 0; c < 3; ++c) {
+        if (a->W == 0.0 || e[c] < a->lo[c]) a->lo[c] = e[c];
+        if (a->W == 0.0 || e[c] > a->hi[c]) a->hi[c] = e[c];
+    }
     a->W += w;
     for (c = 0; c < 3; ++c) a->s0[c] += w * e[c];
     for (k = 0; k < 3; ++k) {
@@ -20258,6 +20265,10 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
         rad__probe_eval(pr, bi, un, v);
     } else if (pr->weighting != RAD_PROBE_WEIGHT_NORMAL_FIT || !rad__probe_fit(&a, v)) {
         for (k = 0; k < 3; ++k) v[k] = (float)(a.s0[k] / a.W);
+    } else if (!pr->grid) {
+        /* user positions: p may lie outside the probes, where the fitted plane extrapolates;
+           it stays within the values it was fitted to (a grid cell always holds p) */
+        for (k = 0; k < 3; ++k) v[k] = v[k] < a.lo[k] ? a.lo[k] : (v[k] > a.hi[k] ? a.hi[k] : v[k]);
     }
     for (k = 0; k < 3; ++k) out_rgb[k] = v[k] > 0.0f ? v[k] : 0.0f;
     return RAD_SUCCESS;

@@ -434,6 +434,16 @@ static void pb_test_sampling_update(void)
         CHECK_OK(rad_probes_sample(pr, two[0], toB, e));
         rad_sh9_irradiance(rad_probes_coefficients(pr), toB, a);
         for (c = 0; c < 3; ++c) CHECK_NEAR(e[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-3 * a[1]);
+        {
+            /* beyond the second probe on their line the fitted plane would extrapolate (its
+               slope is the difference of the two); the read stays between the two values */
+            float far[3] = { 0.52f, 0.4f, 0.28f }, up[3] = { 0.0f, 1.0f, 0.0f }, b[3];
+            CHECK_OK(rad_probes_sample(pr, far, up, e));
+            rad_sh9_irradiance(rad_probes_coefficients(pr), up, a);
+            rad_sh9_irradiance(rad_probes_coefficients(pr) + 27, up, b);
+            CHECK(fabsf(a[0] - b[0]) > 0.02f * (a[0] + b[0])); /* two different values */
+            for (c = 0; c < 3; ++c) CHECK(e[c] >= (a[c] < b[c] ? a[c] : b[c]) && e[c] <= (a[c] > b[c] ? a[c] : b[c]));
+        }
     }
     rad_probes_destroy(pr);
     pr = NULL;
