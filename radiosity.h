@@ -2750,14 +2750,23 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lightmap
 
    SAMPLING. rad_probes_sample(p, n): on a grid, the 8 probes of p's cell (p clamped into the
    grid) with trilinear weights; with user positions, every probe with the weight
-   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal. With RAD_PROBE_WEIGHT_NORMAL (the
-   default) each weight is multiplied by ((1 + cos) / 2)^2, cos the cosine between n and the
-   direction from p to the probe (a probe behind the surface counts little, one straight
-   behind it not at all; RAD_PROBE_WEIGHT_PLAIN leaves this out), disabled probes are
-   skipped, and the weights are renormalized. When no weight is left (every neighbour
-   disabled) the nearest enabled probe is used. The result is clamped at 0 (an L2 sum can dip
-   below zero behind a strong light). It is continuous in p and n. rad_probes_sample_visible
-   also skips the probes a shadow ray from p does not reach (a wall between p and a probe). */
+   1 / (|q - p|^2 + h^2), h = 1e-3 of the scene diagonal; disabled probes are skipped. Then,
+   by rad_probe_options.weighting, with cos the cosine between n and the direction from p to
+   the probe and w_k the weights above:
+     NORMAL_FIT (the default): w_k times ((1 + cos) / 2)^6 (a probe behind the surface counts
+       very little, one straight behind it not at all), and the value is the constant term a
+       of the weighted least-squares fit E_k(n) ~ a + b . (q_k - p) over those probes, with a
+       ridge 0.003 trace(M) on b (M = sum w_k (q_k - p)(q_k - p)^T): the lobe's lean towards
+       the probes n faces is fitted out where the light varies linearly, and the ridge keeps
+       b from being read off the few probes behind the surface (the wall case); with user
+       positions the value is kept within the range of the probes' E_k(n) (p may lie outside
+       them, where the plane would extrapolate);
+     NORMAL: w_k times ((1 + cos) / 2)^2, renormalized (the weighted mean);
+     PLAIN: w_k alone, renormalized.
+   When no weight is left (every neighbour disabled) the nearest enabled probe is used. The
+   result is clamped at 0 (an L2 sum can dip below zero behind a strong light; the fit's
+   weights can be negative). It is continuous in p and n. rad_probes_sample_visible also
+   skips the probes a shadow ray from p does not reach (a wall between p and a probe). */
 
 typedef enum rad_probe_flags {
     RAD_PROBES_DIRECT = 1,     /* add the direct light D_i (THE GATHER above) */
@@ -2770,14 +2779,19 @@ typedef enum rad_probe_state {
     RAD_PROBE_MOVED = 2        /* was inside geometry, moved out (positions hold the new place) */
 } rad_probe_state;
 
-/* The weights of SAMPLING. NORMAL (the default): each probe's weight times ((1 + cos) / 2)^2,
-   so that a probe behind a surface counts little (a probe on the far side of a wall). PLAIN:
-   the trilinear (or inverse-distance) weights alone: for points in open air (a dynamic object
-   in a room), where the normal factor only biases the mix towards the probes the normal
-   faces; there rad_probes_sample_visible keeps probes behind a wall out by shadow rays. */
+/* The weights of SAMPLING (formulas there). All three skip disabled probes. */
 typedef enum rad_probe_weighting {
-    RAD_PROBE_WEIGHT_NORMAL = 0,
-    RAD_PROBE_WEIGHT_PLAIN = 1
+    /* The default: a sharp normal lobe ((1 + cos) / 2)^6, so that a probe behind a surface
+       (the far side of a wall) counts very little, and a local linear fit instead of the
+       weighted mean, so that in open air the lobe does not pull the value towards the probes
+       the normal faces (a linear field is read back exactly, up to the ridge). */
+    RAD_PROBE_WEIGHT_NORMAL_FIT = 0,
+    /* The trilinear (or inverse-distance) weights alone: for points in open air (a dynamic
+       object in a room); there rad_probes_sample_visible keeps probes behind a wall out. */
+    RAD_PROBE_WEIGHT_PLAIN = 1,
+    /* The weighted mean with the factor ((1 + cos) / 2)^2 (the default before NORMAL_FIT):
+       every weight stays positive, but the mix leans towards the probes the normal faces. */
+    RAD_PROBE_WEIGHT_NORMAL = 2
 } rad_probe_weighting;
 
 typedef struct rad_probe_options {
@@ -2796,7 +2810,7 @@ typedef struct rad_probe_options {
                                   (0: a fifth of the max_move default) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t flags;            /* rad_probe_flags */
-    rad_probe_weighting weighting; /* how rad_probes_sample weighs the probes (0: by normal) */
+    rad_probe_weighting weighting; /* how rad_probes_sample weighs the probes (0: NORMAL_FIT) */
 } rad_probe_options;
 
 typedef struct rad_probes rad_probes;
@@ -19363,7 +19377,7 @@ struct rad_probes {
     float *weights4;           /* 9 per entry: band 4 of W */
     size_t entries;
     int grid;
-    int plain;                 /* RAD_PROBE_WEIGHT_PLAIN: no normal factor in sampling */
+    rad_probe_weighting weighting; /* how sampling weighs the probes */
     uint32_t dims[3];
     float origin[3], spacing, h2;
     float eps;                 /* ray offset (ray_epsilon x the scene diagonal) */
@@ -19880,7 +19894,8 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         rad__log(&c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)b.o.backface_fraction);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (b.o.weighting != RAD_PROBE_WEIGHT_NORMAL && b.o.weighting != RAD_PROBE_WEIGHT_PLAIN) {
+    if (b.o.weighting != RAD_PROBE_WEIGHT_NORMAL_FIT && b.o.weighting != RAD_PROBE_WEIGHT_NORMAL &&
+        b.o.weighting != RAD_PROBE_WEIGHT_PLAIN) {
         rad__log(&c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)b.o.weighting);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
@@ -19956,7 +19971,7 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
             pr->origin[k] = 0.5f * (S->bounds_min[k] + S->bounds_max[k]) - 0.5f * (float)(pr->dims[k] - 1u) * spacing;
         pr->count = pr->dims[0] * pr->dims[1] * pr->dims[2];
     }
-    pr->plain = b.o.weighting == RAD_PROBE_WEIGHT_PLAIN;
+    pr->weighting = b.o.weighting;
     pr->positions = (float *)rad__alloc_array(&c.allocator, pr->count, 3 * sizeof(float));
     pr->states = (uint8_t *)rad__alloc_array(&c.allocator, pr->count, 1);
     pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
@@ -20101,19 +20116,114 @@ static void rad__probe_eval(const rad_probes *pr, uint32_t i, const float *un, f
     else rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
 }
 
+/* the ridge of RAD_PROBE_WEIGHT_NORMAL_FIT, a share of trace(M) (SAMPLING in >>api_probes) */
+#define RAD__PROBE_FIT_RIDGE 0.003
+
+/* the running sums of one sample: the weighted mean needs W and s0; the linear fit of
+   NORMAL_FIT also the first and second moments of the offsets d = q - p and s1 = sum w d E */
+typedef struct rad__probe_acc {
+    double W, s0[3], m1[3], M[6], s1[3][3]; /* M: xx, yy, zz, xy, xz, yz */
+    float lo[3], hi[3];                      /* the range of the E_k read */
+} rad__probe_acc;
+
+/* the normal factor of weighting wt for the cosine cs */
+static float rad__probe_lobe(rad_probe_weighting wt, float cs)
+{
+    float h = 0.5f * (1.0f + cs), h2 = h * h;
+    if (wt == RAD_PROBE_WEIGHT_PLAIN) return 1.0f;
+    if (wt == RAD_PROBE_WEIGHT_NORMAL) return h2;
+    return h2 * h2 * h2;
+}
+
+static void rad__probe_acc_add(rad__probe_acc *a, double w, const float *d, const float *e)
+{
+    int k, c;
+    for (c = 0; c < 3; ++c) {
+        if (a->W == 0.0 || e[c] < a->lo[c]) a->lo[c] = e[c];
+        if (a->W == 0.0 || e[c] > a->hi[c]) a->hi[c] = e[c];
+    }
+    a->W += w;
+    for (c = 0; c < 3; ++c) a->s0[c] += w * e[c];
+    for (k = 0; k < 3; ++k) {
+        a->m1[k] += w * d[k];
+        for (c = 0; c < 3; ++c) a->s1[k][c] += w * d[k] * e[c];
+    }
+    a->M[0] += w * d[0] * d[0]; a->M[1] += w * d[1] * d[1]; a->M[2] += w * d[2] * d[2];
+    a->M[3] += w * d[0] * d[1]; a->M[4] += w * d[0] * d[2]; a->M[5] += w * d[1] * d[2];
+}
+
+/* The fit's constant term: with x = (M + r I)^-1 m1 (r the ridge), a = (s0 - x . s1) / (W - m1 . x)
+   (the first row of the inverse of the 4x4 normal equations, by the Schur complement). 0 when
+   the system is degenerate (every probe at p), and the weighted mean is used. */
+static int rad__probe_fit(const rad__probe_acc *a, float *out)
+{
+    double r = RAD__PROBE_FIT_RIDGE * (a->M[0] + a->M[1] + a->M[2]), L[3][3], y[3], x[3], den;
+    double A[3][3];
+    int i, j, k;
+    if (!(r > 0.0)) return 0;
+    A[0][0] = a->M[0] + r; A[1][1] = a->M[1] + r; A[2][2] = a->M[2] + r;
+    A[1][0] = A[0][1] = a->M[3]; A[2][0] = A[0][2] = a->M[4]; A[2][1] = A[1][2] = a->M[5];
+    /* Cholesky: A is symmetric positive definite (a sum of w d d^T plus r I) */
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j <= i; ++j) {
+            double v = A[i][j];
+            for (k = 0; k < j; ++k) v -= L[i][k] * L[j][k];
+            if (i == j) {
+                if (!(v > 0.0)) return 0;
+                L[i][i] = sqrt(v);
+            } else L[i][j] = v / L[j][j];
+        }
+    for (i = 0; i < 3; ++i) {
+        double v = a->m1[i];
+        for (k = 0; k < i; ++k) v -= L[i][k] * y[k];
+        y[i] = v / L[i][i];
+    }
+    for (i = 2; i >= 0; --i) {
+        double v = y[i];
+        for (k = i + 1; k < 3; ++k) v -= L[k][i] * x[k];
+        x[i] = v / L[i][i];
+    }
+    den = a->W - (a->m1[0] * x[0] + a->m1[1] * x[1] + a->m1[2] * x[2]);
+    if (!(den > 1e-12 * a->W)) return 0;
+    for (k = 0; k < 3; ++k) out[k] = (float)((a->s0[k] - x[0] * a->s1[0][k] - x[1] * a->s1[1][k] - x[2] * a->s1[2][k]) / den);
+    return 1;
+}
+
+/* adds probe i with the base weight w (trilinear or inverse distance) to the sums of point p:
+   0, or -1 when the raycaster failed */
+static int rad__probe_gather(const rad_probes *pr, const rad_raycaster *rc, const float *p, const float *un, uint32_t i, float w,
+                             rad__probe_acc *a)
+{
+    float d[3], len, cs, e[3];
+    int vis;
+    if (pr->states[i] == RAD_PROBE_DISABLED) return 0;
+    rad__sub(d, pr->positions + 3 * (size_t)i, p);
+    len = rad__len(d);
+    cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
+    w *= rad__probe_lobe(pr->weighting, cs);
+    if (!(w > 0.0f)) return 0;
+    vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
+    if (vis < 0) return -1;
+    if (!vis) return 0;
+    rad__probe_eval(pr, i, un, e);
+    rad__probe_acc_add(a, (double)w, d, e);
+    return 0;
+}
+
 static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *rc, const float p[3], const float n[3],
                                      float out_rgb[3])
 {
-    float un[3], e[3], acc[3] = { 0.0f, 0.0f, 0.0f };
-    double wsum = 0.0;
+    float un[3], v[3];
+    rad__probe_acc a;
     uint32_t i;
-    int k, vis;
+    int k;
     if (!pr || !p || !n || !out_rgb) return RAD_ERROR_INVALID_ARGUMENT;
     out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
     if (!rad__finite3(p) || !rad__finite3(n)) return RAD_ERROR_NON_FINITE;
     un[0] = n[0]; un[1] = n[1]; un[2] = n[2];
     if (!(rad__dot(un, un) > 0.0f)) return RAD_ERROR_INVALID_ARGUMENT;
     rad__normalize(un);
+    memset(&a, 0, sizeof(a));
     if (pr->grid) {
         uint32_t i0[3], x, y, z;
         float f[3];
@@ -20128,40 +20238,19 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             for (y = 0; y < 2; ++y)
                 for (x = 0; x < 2; ++x) {
                     uint32_t ix = i0[0] + x, iy = i0[1] + y, iz = i0[2] + z;
-                    float w = (x ? f[0] : 1.0f - f[0]) * (y ? f[1] : 1.0f - f[1]) * (z ? f[2] : 1.0f - f[2]), d[3], len, cs;
+                    float w = (x ? f[0] : 1.0f - f[0]) * (y ? f[1] : 1.0f - f[1]) * (z ? f[2] : 1.0f - f[2]);
                     if (ix >= pr->dims[0] || iy >= pr->dims[1] || iz >= pr->dims[2] || !(w > 0.0f)) continue;
-                    i = ix + pr->dims[0] * (iy + pr->dims[1] * iz);
-                    if (pr->states[i] == RAD_PROBE_DISABLED) continue;
-                    rad__sub(d, pr->positions + 3 * (size_t)i, p);
-                    len = rad__len(d);
-                    cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
-                    if (!pr->plain) w *= 0.25f * (1.0f + cs) * (1.0f + cs);
-                    if (!(w > 0.0f)) continue;
-                    vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
-                    if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
-                    if (!vis) continue;
-                    rad__probe_eval(pr, i, un, e);
-                    for (k = 0; k < 3; ++k) acc[k] += w * e[k];
-                    wsum += w;
+                    if (rad__probe_gather(pr, rc, p, un, ix + pr->dims[0] * (iy + pr->dims[1] * iz), w, &a) < 0)
+                        return RAD_ERROR_RAYCAST_FAILED;
                 }
     } else {
         for (i = 0; i < pr->count; ++i) {
-            float d[3], len2, cs, w;
-            if (pr->states[i] == RAD_PROBE_DISABLED) continue;
+            float d[3];
             rad__sub(d, pr->positions + 3 * (size_t)i, p);
-            len2 = rad__dot(d, d);
-            cs = len2 > 0.0f ? rad__dot(d, un) / (float)sqrt((double)len2) : 1.0f;
-            w = (pr->plain ? 1.0f : 0.25f * (1.0f + cs) * (1.0f + cs)) / (len2 + pr->h2);
-            if (!(w > 0.0f)) continue;
-            vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
-            if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
-            if (!vis) continue;
-            rad__probe_eval(pr, i, un, e);
-            for (k = 0; k < 3; ++k) acc[k] += w * e[k];
-            wsum += w;
+            if (rad__probe_gather(pr, rc, p, un, i, 1.0f / (rad__dot(d, d) + pr->h2), &a) < 0) return RAD_ERROR_RAYCAST_FAILED;
         }
     }
-    if (!(wsum > 0.0)) {
+    if (!(a.W > 0.0)) {
         /* every neighbour disabled or straight behind: the nearest enabled probe */
         float best = FLT_MAX;
         uint32_t bi = RAD_NONE;
@@ -20173,13 +20262,15 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             if (len2 < best) { best = len2; bi = i; }
         }
         if (bi == RAD_NONE) return RAD_SUCCESS;
-        rad__probe_eval(pr, bi, un, acc);
-        wsum = 1.0;
+        rad__probe_eval(pr, bi, un, v);
+    } else if (pr->weighting != RAD_PROBE_WEIGHT_NORMAL_FIT || !rad__probe_fit(&a, v)) {
+        for (k = 0; k < 3; ++k) v[k] = (float)(a.s0[k] / a.W);
+    } else if (!pr->grid) {
+        /* user positions: p may lie outside the probes, where the fitted plane extrapolates;
+           it stays within the values it was fitted to (a grid cell always holds p) */
+        for (k = 0; k < 3; ++k) v[k] = v[k] < a.lo[k] ? a.lo[k] : (v[k] > a.hi[k] ? a.hi[k] : v[k]);
     }
-    for (k = 0; k < 3; ++k) {
-        float v = (float)((double)acc[k] / wsum);
-        out_rgb[k] = v > 0.0f ? v : 0.0f;
-    }
+    for (k = 0; k < 3; ++k) out_rgb[k] = v[k] > 0.0f ? v[k] : 0.0f;
     return RAD_SUCCESS;
 }
 

@@ -15,10 +15,12 @@
    Each of these also with RAD_PROBES_BAND4 (band 4 stored beside L2, rows marked "band 4").
 
    Build: cc -std=c99 -O2 -fopenmp -I. bench/probes.c -o build/probes -lm
-   Run:   probes [--quick] [--half-spacing] [--append FILE.md]
-   The grid rows come twice: with the default normal weighting of rad_probes_sample and with
-   RAD_PROBE_WEIGHT_PLAIN (trilinear alone); --half-spacing adds a plain grid of spacing
-   0.035 m (4096 probes, 8x the create time). */
+   Run:   probes [--quick] [--half-spacing] [--sweep] [--append FILE.md]
+   The grid rows come three times: with the default weighting of rad_probes_sample
+   (RAD_PROBE_WEIGHT_NORMAL_FIT), with RAD_PROBE_WEIGHT_NORMAL and with RAD_PROBE_WEIGHT_PLAIN
+   (trilinear alone); --half-spacing adds grids of spacing 0.035 m (4096 probes, 8x the create
+   time); --sweep adds band-4 grids of 12^3 to 24^3 probes, indirect light, with their memory
+   (24^3: about 700 MB and 20 s). */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
@@ -80,12 +82,27 @@ static void reference(const float *p, const float *n, int direct, uint32_t rays,
 
 static float pts[SPHERES * PER][3], nrm[SPHERES * PER][3];
 
+static const rad_probe_weighting weightings[3] = {RAD_PROBE_WEIGHT_NORMAL_FIT, RAD_PROBE_WEIGHT_NORMAL, RAD_PROBE_WEIGHT_PLAIN};
+static const char *const wnames[3] = {"", " normal", " plain"};
+static double g_mb, g_create; /* the last grid_errors grid: memory (MB) and create time (s) */
+static uint32_t g_dims[3];
+
 /* relative errors of grid probes read by rad_probes_sample at the test points */
 static void grid_errors(const rad_probe_options *o, float (*ref)[3], double *err)
 {
     rad_probes *pp = NULL;
     int i, c;
-    rad_probes_create(P, &rc, NULL, 0, NULL, 0, o, B, NULL, &pp);
+    double t0 = now();
+    if (rad_probes_create(P, &rc, NULL, 0, NULL, 0, o, B, NULL, &pp) != RAD_SUCCESS) {
+        fprintf(stderr, "probes: create failed\n");
+        exit(1);
+    }
+    g_create = now() - t0;
+    /* the create's doc: 40 bytes per entry (76 with band 4), and per probe its position, state,
+       offset and 27 coefficients and direct terms (twice that with band 4) */
+    g_mb = 1e-6 * ((double)rad_probes_entry_count(pp) * (rad_probes_band4(pp) ? 76.0 : 40.0) +
+                   (double)rad_probes_count(pp) * (12.0 + 1.0 + 8.0 + (rad_probes_band4(pp) ? 432.0 : 216.0)));
+    rad_probes_grid(pp, g_dims, NULL, NULL);
     for (i = 0; i < SPHERES * PER; ++i) {
         float e[3];
         rad_probes_sample(pp, pts[i], nrm[i], e);
@@ -112,7 +129,8 @@ static void report(const char *what, double *err, int n)
 int main(int argc, char **argv)
 {
     static const float centres[SPHERES][3] = {{0.15f, 0.35f, 0.15f}, {0.40f, 0.45f, 0.15f}, {0.278f, 0.25f, 0.10f}, {0.15f, 0.30f, 0.42f}};
-    int quick = 0, half = 0, a, s, i, c, mode;
+    int quick = 0, half = 0, sweep = 0, a, s, i, c, mode, w;
+    char name[128];
     const char *append = NULL;
     rad_scene_desc d;
     rad_patch_options po;
@@ -129,6 +147,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--append") && a + 1 < argc) append = argv[++a];
         else if (!strcmp(argv[a], "--patch-samples") && a + 1 < argc) psamples = (uint32_t)atoi(argv[++a]);
         else if (!strcmp(argv[a], "--half-spacing")) half = 1;
+        else if (!strcmp(argv[a], "--sweep")) sweep = 1;
     }
     if (append && !(g_md = fopen(append, "a"))) { perror(append); return 1; }
     patches = quick ? 300 : 1000;
@@ -207,61 +226,71 @@ int main(int argc, char **argv)
             for (c = 0; c < 3; ++c) err[3 * i + c] = fabs(e[c] - ref[mode][i][c]) / ref[mode][i][c];
         }
         report(mode == 0 ? "grid 8x8x8, sampled, total" : "grid 8x8x8, sampled, indirect", err, SPHERES * PER * 3);
-        {
-            /* the same grid read with the plain trilinear weights (RAD_PROBE_WEIGHT_PLAIN) */
-            rad_probes *pp = NULL;
-            o.weighting = RAD_PROBE_WEIGHT_PLAIN;
-            rad_probes_create(P, &rc, NULL, 0, NULL, 0, &o, B, NULL, &pp);
-            o.weighting = RAD_PROBE_WEIGHT_NORMAL;
-            for (i = 0; i < SPHERES * PER; ++i) {
-                float e[3];
-                rad_probes_sample(pp, pts[i], nrm[i], e);
-                for (c = 0; c < 3; ++c) err[3 * i + c] = fabs(e[c] - ref[mode][i][c]) / ref[mode][i][c];
-            }
-            report(mode == 0 ? "grid 8x8x8, sampled plain, total" : "grid 8x8x8, sampled plain, indirect", err, SPHERES * PER * 3);
-            o.flags |= RAD_PROBES_BAND4;
-            grid_errors(&o, ref[mode], err);
-            report(mode == 0 ? "grid 8x8x8 band 4, sampled, total" : "grid 8x8x8 band 4, sampled, indirect", err, SPHERES * PER * 3);
-            o.weighting = RAD_PROBE_WEIGHT_PLAIN;
-            grid_errors(&o, ref[mode], err);
-            report(mode == 0 ? "grid 8x8x8 band 4, sampled plain, total" : "grid 8x8x8 band 4, sampled plain, indirect", err,
-                   SPHERES * PER * 3);
-            o.weighting = RAD_PROBE_WEIGHT_NORMAL;
-            o.flags &= ~(uint32_t)RAD_PROBES_BAND4;
-            if (half) {
-                /* and a grid of half the spacing (8x the probes) */
-                o.weighting = RAD_PROBE_WEIGHT_PLAIN;
-                o.spacing = 0.035f;
-                rad_probes_destroy(pp);
-                pp = NULL;
-                rad_probes_create(P, &rc, NULL, 0, NULL, 0, &o, B, NULL, &pp);
-                o.weighting = RAD_PROBE_WEIGHT_NORMAL;
-                o.spacing = 0.0f;
-                for (i = 0; i < SPHERES * PER; ++i) {
-                    float e[3];
-                    rad_probes_sample(pp, pts[i], nrm[i], e);
-                    for (c = 0; c < 3; ++c) err[3 * i + c] = fabs(e[c] - ref[mode][i][c]) / ref[mode][i][c];
-                }
-                report(mode == 0 ? "grid spacing 0.035 (4096), sampled plain, total" : "grid spacing 0.035 (4096), sampled plain, indirect",
-                       err, SPHERES * PER * 3);
-                o.weighting = RAD_PROBE_WEIGHT_PLAIN;
-                o.spacing = 0.035f;
+        /* the same grid read with the other weightings, then all three with band 4 */
+        o.weighting = RAD_PROBE_WEIGHT_NORMAL;
+        grid_errors(&o, ref[mode], err);
+        report(mode == 0 ? "grid 8x8x8, sampled normal, total" : "grid 8x8x8, sampled normal, indirect", err, SPHERES * PER * 3);
+        o.weighting = RAD_PROBE_WEIGHT_PLAIN;
+        grid_errors(&o, ref[mode], err);
+        report(mode == 0 ? "grid 8x8x8, sampled plain, total" : "grid 8x8x8, sampled plain, indirect", err, SPHERES * PER * 3);
+        o.flags |= RAD_PROBES_BAND4;
+        o.weighting = RAD_PROBE_WEIGHT_NORMAL_FIT;
+        grid_errors(&o, ref[mode], err);
+        report(mode == 0 ? "grid 8x8x8 band 4, sampled, total" : "grid 8x8x8 band 4, sampled, indirect", err, SPHERES * PER * 3);
+        o.weighting = RAD_PROBE_WEIGHT_NORMAL;
+        grid_errors(&o, ref[mode], err);
+        report(mode == 0 ? "grid 8x8x8 band 4, sampled normal, total" : "grid 8x8x8 band 4, sampled normal, indirect", err,
+               SPHERES * PER * 3);
+        o.weighting = RAD_PROBE_WEIGHT_PLAIN;
+        grid_errors(&o, ref[mode], err);
+        report(mode == 0 ? "grid 8x8x8 band 4, sampled plain, total" : "grid 8x8x8 band 4, sampled plain, indirect", err,
+               SPHERES * PER * 3);
+        o.flags &= ~(uint32_t)RAD_PROBES_BAND4;
+        if (half) {
+            /* and a grid of half the spacing (8x the probes) */
+            o.spacing = 0.035f;
+            for (w = 0; w < 3; ++w) {
+                o.weighting = weightings[w];
+                grid_errors(&o, ref[mode], err);
+                snprintf(name, sizeof(name), "grid spacing 0.035 (4096), sampled%s, %s", wnames[w], mode == 0 ? "total" : "indirect");
+                report(name, err, SPHERES * PER * 3);
                 o.flags |= RAD_PROBES_BAND4;
                 grid_errors(&o, ref[mode], err);
-                report(mode == 0 ? "grid spacing 0.035 (4096) band 4, sampled plain, total"
-                                 : "grid spacing 0.035 (4096) band 4, sampled plain, indirect", err, SPHERES * PER * 3);
+                snprintf(name, sizeof(name), "grid spacing 0.035 (4096) band 4, sampled%s, %s", wnames[w], mode == 0 ? "total" : "indirect");
+                report(name, err, SPHERES * PER * 3);
                 o.flags &= ~(uint32_t)RAD_PROBES_BAND4;
-                o.weighting = RAD_PROBE_WEIGHT_NORMAL;
-                o.spacing = 0.0f;
             }
-            rad_probes_destroy(pp);
+            o.spacing = 0.0f;
         }
+        o.weighting = RAD_PROBE_WEIGHT_NORMAL_FIT;
         if (mode == 0)
             emit("\nGrid of %u probes: create %.2f s, update from a solution %.3f ms (%lu entries), 2 threads.\n\n"
                  "| probes, light | values | within 5%% | median error | 95th percentile |\n|---|---|---|---|---|\n",
                  rad_probes_count(pg), tc, 1e3 * tu, (unsigned long)rad_probes_entry_count(pg));
         rad_probes_destroy(pc);
         rad_probes_destroy(pg);
+    }
+    if (sweep) {
+        /* finer grids, band 4, indirect light: where the target is met, and what it costs */
+        static const float spacings[4] = {0.0463f, 0.035f, 0.0278f, 0.0232f};
+        rad_probe_options o;
+        rad_probe_options_default(&o);
+        o.flags = RAD_PROBES_BAND4;
+        o.patch_samples = psamples;
+        emit("\nFiner grids, band 4, indirect light (memory: weights and coefficients; create: wall time, 2 threads):\n\n"
+             "| grid, weighting | values | within 5%% | median error | 95th percentile | memory | create |\n|---|---|---|---|---|---|---|\n");
+        for (s = 0; s < 4; ++s)
+            for (w = 0; w < 3; ++w) {
+                int n = SPHERES * PER * 3, within = 0;
+                o.spacing = spacings[s];
+                o.weighting = weightings[w];
+                grid_errors(&o, ref[1], err);
+                for (i = 0; i < n; ++i) within += err[i] <= 0.05;
+                qsort(err, (size_t)n, sizeof(double), cmp);
+                emit("| %ux%ux%u (%.4f)%s | %d | %.1f%% | %.2f%% | %.2f%% | %.0f MB | %.1f s |\n", g_dims[0], g_dims[1], g_dims[2],
+                     (double)spacings[s], w == 0 ? " normal fit (default)" : wnames[w], n, 100.0 * within / n, 100.0 * err[n / 2],
+                     100.0 * err[(n * 95) / 100], g_mb, g_create);
+            }
     }
     free(D); free(E); free(B);
     rad_form_factors_destroy(ff);

@@ -351,6 +351,14 @@ static void pb_test_constant_room(void)
         CHECK_NEAR(org[0], 0.05, 1e-6);
         CHECK(rad_probes_count(pr) == 64);
         for (i = 0; i < 64; ++i) CHECK(rad_probes_states(pr)[i] == RAD_PROBE_VALID);
+        /* every probe reads 2 for every normal, so any weighting must too: the fit's weights
+           sum to 1 (a constant is read back exactly) */
+        for (i = 0; i < 3; ++i)
+            for (k = 0; k < 4; ++k) {
+                float e[3];
+                CHECK_OK(rad_probes_sample(pr, pts[i], ns[k], e));
+                CHECK_REL(e[1], 2.0, 0.01);
+            }
     }
 done:
     rad_probes_destroy(pr);
@@ -426,6 +434,16 @@ static void pb_test_sampling_update(void)
         CHECK_OK(rad_probes_sample(pr, two[0], toB, e));
         rad_sh9_irradiance(rad_probes_coefficients(pr), toB, a);
         for (c = 0; c < 3; ++c) CHECK_NEAR(e[c], a[c] > 0.0f ? a[c] : 0.0f, 1e-3 * a[1]);
+        {
+            /* beyond the second probe on their line the fitted plane would extrapolate (its
+               slope is the difference of the two); the read stays between the two values */
+            float far[3] = { 0.52f, 0.4f, 0.28f }, up[3] = { 0.0f, 1.0f, 0.0f }, b[3];
+            CHECK_OK(rad_probes_sample(pr, far, up, e));
+            rad_sh9_irradiance(rad_probes_coefficients(pr), up, a);
+            rad_sh9_irradiance(rad_probes_coefficients(pr) + 27, up, b);
+            CHECK(fabsf(a[0] - b[0]) > 0.02f * (a[0] + b[0])); /* two different values */
+            for (c = 0; c < 3; ++c) CHECK(e[c] >= (a[c] < b[c] ? a[c] : b[c]) && e[c] <= (a[c] > b[c] ? a[c] : b[c]));
+        }
     }
     rad_probes_destroy(pr);
     pr = NULL;
@@ -565,7 +583,7 @@ static void pb_test_bad_options(void)
     o.spacing = 1e-5f;
     CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, NULL, NULL, &pr), RAD_ERROR_SIZE_OVERFLOW);
     rad_probe_options_default(&o);
-    o.weighting = (rad_probe_weighting)2;
+    o.weighting = (rad_probe_weighting)3;
     CHECK_RESULT(rad_probes_create(f.P, &f.rc, NULL, 0, p, 1, &o, NULL, NULL, &pr), RAD_ERROR_INVALID_ARGUMENT);
     rad_probe_options_default(&o);
     o.ray_epsilon = 0.5f;
@@ -639,45 +657,54 @@ static void pb_test_alloc(void)
 }
 
 /* Sampling in open air: points on a sphere in the middle of the Cornell box, the grid read
-   with the default normal weighting and with RAD_PROBE_WEIGHT_PLAIN, against the independent
-   indirect irradiance at each point. The normal factor leans every point towards the probes
-   its normal faces, away from the point itself: plain trilinear weights are closer there,
-   and reproduce a probe's own value at its position for any normal */
+   with each weighting against the independent indirect irradiance at each point. The normal
+   factor of RAD_PROBE_WEIGHT_NORMAL leans every point towards the probes its normal faces,
+   away from the point itself: plain trilinear weights are closer there, and so is the default
+   NORMAL_FIT, whose linear fit takes that lean out; plain reproduces a probe's own value at
+   its position for any normal */
 static void pb_test_plain_weighting(void)
 {
     static const float centre[3] = { 0.15f, 0.35f, 0.15f };
     pb_cornell f;
     rad_probe_options o;
-    rad_probes *pn = NULL, *pp = NULL;
-    double en = 0.0, ep = 0.0;
-    int i, c, K = rad_test_quick() ? 12 : 24;
+    rad_probes *pn = NULL, *pp = NULL, *pf = NULL;
+    double en = 0.0, ep = 0.0, ef = 0.0;
+    int i, c, K = 24;
     if (!pb_cornell_init(&f, 100)) { CHECK(0); pb_cornell_free(&f); return; }
     rad_probe_options_default(&o);
     o.spacing = 0.1f;
     o.rays = 64;
+    CHECK(o.weighting == RAD_PROBE_WEIGHT_NORMAL_FIT);
+    CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, NULL, &pf));
+    o.weighting = RAD_PROBE_WEIGHT_NORMAL;
     CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, NULL, &pn));
     o.weighting = RAD_PROBE_WEIGHT_PLAIN;
     CHECK_OK(rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, NULL, &pp));
-    if (pn && pp) {
+    if (pn && pp && pf) {
         for (i = 0; i < K; ++i) {
-            float n[3], p[3], r[3], a[3], b[3];
+            float n[3], p[3], r[3], a[3], b[3], g[3];
             double z = 1.0 - (2.0 * i + 1.0) / K, rr = sqrt(1.0 - z * z), ph = i * 2.39996322972865332;
             n[0] = (float)(rr * cos(ph)); n[1] = (float)(rr * sin(ph)); n[2] = (float)z;
             for (c = 0; c < 3; ++c) p[c] = centre[c] + 0.05f * n[c];
             pb_reference(&f, p, n, 4096, 0, r);
             CHECK_OK(rad_probes_sample(pn, p, n, a));
             CHECK_OK(rad_probes_sample(pp, p, n, b));
+            CHECK_OK(rad_probes_sample(pf, p, n, g));
             for (c = 0; c < 3; ++c) {
                 en += fabs(a[c] - r[c]) / r[c];
                 ep += fabs(b[c] - r[c]) / r[c];
+                ef += fabs(g[c] - r[c]) / r[c];
             }
         }
         en /= 3 * K;
         ep /= 3 * K;
+        ef /= 3 * K;
         if (rad_test_failures || getenv("RAD_TEST_VERBOSE"))
-            printf("    open air: mean relative error %.4f with the normal factor, %.4f plain\n", en, ep);
+            printf("    open air: mean relative error %.4f normal, %.4f normal fit (default), %.4f plain\n", en, ef, ep);
         CHECK(ep < en);
         CHECK(ep < 0.05);
+        CHECK(ef < 0.8 * en);
+        CHECK(ef < 0.1);
         {
             /* at a valid probe, any normal: that probe's own irradiance */
             uint32_t dims[3], id;
@@ -694,7 +721,145 @@ static void pb_test_plain_weighting(void)
     }
     rad_probes_destroy(pn);
     rad_probes_destroy(pp);
+    rad_probes_destroy(pf);
     pb_cornell_free(&f);
+}
+
+/* A quad soup for the two-room scene: o, o + a, o + a + b, o + b (front face by a x b). */
+typedef struct pb_soup {
+    float pos[3 * 4 * 16];
+    uint32_t idx[3 * 2 * 16];
+    uint32_t nv, nt;
+} pb_soup;
+
+static void pb_soup_quad(pb_soup *s, const float *o, const float *a, const float *b)
+{
+    uint32_t v = s->nv;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        s->pos[3 * v + k] = o[k];
+        s->pos[3 * (v + 1) + k] = o[k] + a[k];
+        s->pos[3 * (v + 2) + k] = o[k] + a[k] + b[k];
+        s->pos[3 * (v + 3) + k] = o[k] + b[k];
+    }
+    s->idx[3 * s->nt] = v; s->idx[3 * s->nt + 1] = v + 1; s->idx[3 * s->nt + 2] = v + 2;
+    s->idx[3 * s->nt + 3] = v; s->idx[3 * s->nt + 4] = v + 2; s->idx[3 * s->nt + 5] = v + 3;
+    s->nv += 4;
+    s->nt += 2;
+}
+
+/* No light through a wall without rays: two rooms (x in [0, 0.98] and [1.06, 2]) split by an
+   8 cm wall, the lamp in the left one; no patch spans both, so the right room's patches are
+   exactly dark. A grid of spacing 0.2 has probe planes at x = 0.9 and 1.1, on both sides of
+   the wall. Points on the wall's dark face, normal into the dark room: plain trilinear weights
+   read a fifth of the lit side's light there (the leak the normal factor exists to stop); the
+   default NORMAL_FIT keeps it to a few thousandths of the lit face's value and no more than
+   NORMAL does; with visibility every lit probe is out and the dark face reads exactly 0. */
+static void pb_test_fit_wall(void)
+{
+    pb_soup room, lamp;
+    rad_mesh_desc m[2];
+    rad_scene_desc d;
+    rad_material mats[2] = { { { 0.7f, 0.7f, 0.7f }, { 0, 0, 0 }, 0 }, { { 0.5f, 0.5f, 0.5f }, { 10, 10, 10 }, 0 } };
+    const float O[3] = { 0, 0, 0 }, Y[3] = { 0, 1, 0 }, Z[3] = { 0, 0, 1 }, R[3] = { 2, 0, 0 };
+    const float W0[3] = { 0.98f, 0, 0 }, W1[3] = { 1.06f, 0, 0 };
+    const float L0[3] = { 0.3f, 0.999f, 0.3f }, LX[3] = { 0.4f, 0, 0 }, LZ[3] = { 0, 0, 0.4f };
+    static const rad_probe_weighting wt[3] = { RAD_PROBE_WEIGHT_NORMAL_FIT, RAD_PROBE_WEIGHT_NORMAL, RAD_PROBE_WEIGHT_PLAIN };
+    rad_scene *S = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_form_factors *ff = NULL;
+    rad_system sys;
+    rad_solve_options so;
+    rad_probe_options o;
+    float *E = NULL, *B = NULL;
+    double dark[3] = { 0, 0, 0 }, lit[3] = { 0, 0, 0 }, vis = 0.0;
+    uint32_t i;
+    int w, iy, iz, N = rad_test_quick() ? 4 : 8;
+    memset(&room, 0, sizeof(room));
+    memset(&lamp, 0, sizeof(lamp));
+    for (i = 0; i < 3; ++i) {
+        /* floor, ceiling and the long walls in three pieces split at the wall's faces */
+        const float x0 = i == 0 ? 0.0f : i == 1 ? 0.98f : 1.06f, x1 = i == 0 ? 0.98f : i == 1 ? 1.06f : 2.0f;
+        const float o0[3] = { x0, 0, 0 }, o1[3] = { x0, 1, 0 }, o2[3] = { x0, 0, 1 }, dx[3] = { x1 - x0, 0, 0 };
+        pb_soup_quad(&room, o0, Z, dx);
+        pb_soup_quad(&room, o1, dx, Z);
+        pb_soup_quad(&room, o0, dx, Y);
+        pb_soup_quad(&room, o2, Y, dx);
+    }
+    pb_soup_quad(&room, O, Y, Z);
+    pb_soup_quad(&room, R, Z, Y);
+    pb_soup_quad(&room, W0, Z, Y); /* facing -x (the lit room) */
+    pb_soup_quad(&room, W1, Y, Z); /* facing +x (the dark room) */
+    pb_soup_quad(&lamp, L0, LX, LZ);
+    memset(m, 0, sizeof(m));
+    m[0].positions = room.pos; m[0].vertex_count = room.nv; m[0].indices = room.idx; m[0].triangle_count = room.nt;
+    m[1].positions = lamp.pos; m[1].vertex_count = lamp.nv; m[1].indices = lamp.idx; m[1].triangle_count = lamp.nt;
+    m[1].material = 1;
+    memset(&d, 0, sizeof(d));
+    d.meshes = m; d.mesh_count = 2; d.materials = mats; d.material_count = 2;
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
+    if (!bvh) goto out;
+    rad_bvh_raycaster(bvh, &rc);
+    rad_patch_options_default(&po);
+    po.max_edge = rad_test_quick() ? 0.5f : 0.25f;
+    CHECK_OK(rad_patches_create(S, &po, NULL, &P));
+    rad_form_factor_options_default(&fo);
+    fo.samples = rad_test_quick() ? 1 : 4;
+    if (P) CHECK_OK(rad_form_factors_dense(P, &rc, &fo, NULL, &ff));
+    if (!P || !ff) goto out;
+    E = (float *)malloc(sizeof(float) * 3 * P->count);
+    B = (float *)malloc(sizeof(float) * 3 * P->count);
+    if (!E || !B) { CHECK(0); goto out; }
+    CHECK_OK(rad_sources(P, RAD_SOURCE_EMISSION, NULL, E));
+    rad_system_init(&sys, &ff->matrix, P, E);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_TOTAL;
+    so.bounces = 8;
+    CHECK_OK(rad_solve_jacobi(&sys, &so, B, NULL, NULL));
+    rad_probe_options_default(&o);
+    o.spacing = 0.2f;
+    o.rays = 64;
+    for (w = 0; w < 3; ++w) {
+        rad_probes *pr = NULL;
+        o.weighting = wt[w];
+        CHECK_OK(rad_probes_create(P, &rc, NULL, 0, NULL, 0, &o, B, NULL, &pr));
+        if (!pr) continue;
+        for (iy = 0; iy < N; ++iy)
+            for (iz = 0; iz < N; ++iz) {
+                float p[3] = { 1.0601f, 0.0f, 0.0f }, q[3] = { 0.9799f, 0.0f, 0.0f }, n[3] = { 1, 0, 0 }, nl[3] = { -1, 0, 0 }, e[3];
+                p[1] = q[1] = (iy + 0.5f) / (float)N;
+                p[2] = q[2] = (iz + 0.5f) / (float)N;
+                CHECK_OK(rad_probes_sample(pr, p, n, e));
+                dark[w] += e[0] + e[1] + e[2];
+                CHECK_OK(rad_probes_sample(pr, q, nl, e));
+                lit[w] += e[0] + e[1] + e[2];
+                if (w == 0) {
+                    CHECK_OK(rad_probes_sample_visible(pr, &rc, p, n, e));
+                    vis += e[0] + e[1] + e[2];
+                }
+            }
+        rad_probes_destroy(pr);
+    }
+    if (rad_test_failures || getenv("RAD_TEST_VERBOSE"))
+        printf("    dark face / lit face: normal fit %.5f, normal %.5f, plain %.4f; normal fit with visibility %g\n", dark[0] / lit[0],
+               dark[1] / lit[1], dark[2] / lit[2], vis);
+    CHECK(lit[0] > 0.0 && lit[1] > 0.0 && lit[2] > 0.0);
+    CHECK(dark[2] > 0.1 * lit[2]);
+    CHECK(dark[0] < 0.005 * lit[0]);
+    CHECK(dark[0] / lit[0] <= dark[1] / lit[1]);
+    CHECK(vis == 0.0);
+out:
+    free(E);
+    free(B);
+    rad_form_factors_destroy(ff);
+    rad_patches_destroy(P);
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(S);
 }
 
 /* Band 4 (RAD_PROBES_BAND4). The basis: orthonormal, and orthogonal to bands 0-2 (quadrature).
@@ -836,6 +1001,7 @@ static const rad_test_case tests_probes[] = {
     { "probes_sampling_update", pb_test_sampling_update },
     { "probes_lights", pb_test_lights },
     { "probes_plain_weighting", pb_test_plain_weighting },
+    { "probes_fit_wall", pb_test_fit_wall },
     { "probes_band4", pb_test_band4 },
     { "probes_band4_cornell", pb_test_band4_cornell },
     { "probes_bad_options", pb_test_bad_options },
