@@ -4988,11 +4988,10 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
     }
     P->vertex_count = nv;
 done:
-    rad__free(&c.allocator, lattice_ids);
-    rad__free(&c.allocator, w.keys);
-    rad__free(&c.allocator, w.heads);
-    rad__free(&c.allocator, w.next);
-    rad__free(&c.allocator, w.normals);
+    {
+        void *blocks[] = { lattice_ids, w.keys, w.heads, w.next, w.normals };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) { rad_patches_destroy(P); return r; }
     *out = P;
     return RAD_SUCCESS;
@@ -5687,11 +5686,10 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
     if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, order);
-    rad__free(&c.allocator, refs);
-    rad__free(&c.allocator, stack);
-    rad__free(&c.allocator, task);
-    rad__free(&c.allocator, order);
-    rad__free(&c.allocator, tree);
+    {
+        void *blocks[] = { refs, stack, task, order, tree };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) { rad_bvh_destroy(b); return r; }
     *out = b;
     return RAD_SUCCESS;
@@ -6657,12 +6655,10 @@ static rad_result rad__direct_run(rad__direct *d, const rad__ctx *c, uint32_t ro
         d->emitter_count = ne;
         r = rad__for_rows(c, rows, T, rad__direct_row, d);
     }
-    rad__free(&c->allocator, d->rays);
-    rad__free(&c->allocator, d->occ);
-    rad__free(&c->allocator, d->ray_w);
-    rad__free(&c->allocator, d->ray_slot);
-    rad__free(&c->allocator, d->acc);
-    rad__free(&c->allocator, d->emitters);
+    {
+        void *blocks[] = { d->rays, d->occ, d->ray_w, d->ray_slot, d->acc, d->emitters };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -6979,15 +6975,10 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
             r = RAD_ERROR_CANCELLED;
         }
     }
-    rad__free(&c.allocator, unit);
-    rad__free(&c.allocator, g.ray_buf);
-    rad__free(&c.allocator, g.hits);
-    rad__free(&c.allocator, g.hit_p);
-    rad__free(&c.allocator, g.hit_n);
-    rad__free(&c.allocator, D);
-    rad__free(&c.allocator, H);
-    rad__free(&c.allocator, albedo);
-    rad__free(&c.allocator, owner);
+    {
+        void *blocks[] = { unit, g.ray_buf, g.hits, g.hit_p, g.hit_n, D, H, albedo, owner };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r == RAD_SUCCESS ? rad__check_output(&c, "final gather", out, 3 * (size_t)count) : r;
 }
 
@@ -7595,19 +7586,11 @@ static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
 
 static void rad__ff_release(rad__ff *f, const rad_allocator *a)
 {
-    rad__free(a, f->pts);
-    rad__free(a, f->rays);
-    rad__free(a, f->occ);
-    rad__free(a, f->ray_w);
-    rad__free(a, f->ray_slot);
-    rad__free(a, f->acc);
-    rad__free(a, f->rays_cast);
-    rad__free(a, f->pairs);
-    rad__free(a, f->hc_centre);
-    rad__free(a, f->hc_dtop);
-    rad__free(a, f->hc_dside);
-    rad__free(a, f->hc_item);
-    rad__free(a, f->hc_depth);
+    {
+        void *blocks[] = { f->pts, f->rays, f->occ, f->ray_w, f->ray_slot, f->acc, f->rays_cast, f->pairs,
+                           f->hc_centre, f->hc_dtop, f->hc_dside, f->hc_item, f->hc_depth };
+        rad__free_each(*a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     memset(f, 0, sizeof(*f));
 }
 
@@ -7995,11 +7978,10 @@ RAD_API rad_result rad_form_factors_sparse(const rad_patches *patches, const rad
     return RAD_SUCCESS;
 fail:
     rad__ff_release(&f, &c.allocator);
-    rad__free(&c.allocator, buf);
-    rad__free(&c.allocator, offs);
-    rad__free(&c.allocator, cols);
-    rad__free(&c.allocator, vals);
-    rad__free(&c.allocator, ff);
+    {
+        void *blocks[] = { buf, offs, cols, vals, ff };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -9866,14 +9848,10 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
         h->st.links_evaluated += count;
         if (r != RAD_SUCCESS) rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the raycaster failed");
     }
-    rad__free(&h->allocator, ev.rays);
-    rad__free(&h->allocator, ev.occ);
-    rad__free(&h->allocator, ev.w);
-    rad__free(&h->allocator, ev.idx);
-    rad__free(&h->allocator, ev.kernels);
-    rad__free(&h->allocator, ev.rays_cast);
-    rad__free(&h->allocator, ev.proj);
-    rad__free(&h->allocator, ev.results);
+    {
+        void *blocks[] = { ev.rays, ev.occ, ev.w, ev.idx, ev.kernels, ev.rays_cast, ev.proj, ev.results };
+        rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -11331,11 +11309,10 @@ static rad_result rad__mb_match_groups(const rad__ctx *c, const float *D, uint32
         if (!used[i]) order[at++] = i;
     r = RAD_SUCCESS;
 done:
-    rad__free(&c->allocator, partner);
-    rad__free(&c->allocator, ident);
-    rad__free(&c->allocator, pairs);
-    rad__free(&c->allocator, quads);
-    rad__free(&c->allocator, used);
+    {
+        void *blocks[] = { partner, ident, pairs, quads, used };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -12018,12 +11995,10 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     b = NULL;
     r = RAD_SUCCESS;
 done:
-    rad__free(&c.allocator, owned);
-    rad__free(&c.allocator, W);
-    rad__free(&c.allocator, Wp);
-    rad__free(&c.allocator, ol.row_count);
-    rad__free(&c.allocator, sse);
-    rad__free(&c.allocator, max_err);
+    {
+        void *blocks[] = { owned, W, Wp, ol.row_count, sse, max_err };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     rad_multibounce_blocks_destroy(b);
     return r;
 }
@@ -12791,10 +12766,10 @@ RAD_API void rad_row_stream_destroy(rad_row_stream *s)
     if (!s) return;
     a = s->allocator;
     if (s->f) fclose(s->f);
-    rad__free(&a, s->areas);
-    rad__free(&a, s->albedo);
-    rad__free(&a, s->offsets);
-    rad__free(&a, s);
+    {
+        void *blocks[] = { s->areas, s->albedo, s->offsets, s };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 static int rad__stream_read(FILE *f, uint64_t at, void *dst, size_t bytes)
@@ -13733,12 +13708,10 @@ static rad_result rad__local_invert(const rad__ctx *c, float *X, uint32_t m, siz
                 X[(size_t)i * ld + kb + j] = (i >= kb && i < kb + b) ? dinv[(size_t)(i - kb) * b + j] : tmp[(size_t)i * b + j];
     }
 done:
-    rad__free(&c->allocator, cbuf);
-    rad__free(&c->allocator, rbuf);
-    rad__free(&c->allocator, rp);
-    rad__free(&c->allocator, tmp);
-    rad__free(&c->allocator, dinv);
-    rad__free(&c->allocator, d);
+    {
+        void *blocks[] = { cbuf, rbuf, rp, tmp, dinv, d };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -14565,10 +14538,10 @@ RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *src, rad_a
     }
 done:
     rad_alias_tables_destroy(t);
-    rad__free(&c.allocator, off);
-    rad__free(&c.allocator, cols);
-    rad__free(&c.allocator, vals);
-    rad__free(&c.allocator, scratch);
+    {
+        void *blocks[] = { off, cols, vals, scratch };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -15346,26 +15319,14 @@ RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
     rad_allocator a;
     if (!vp) return;
     a = vp->allocator;
-    rad__free(&a, vp->areas);
-    rad__free(&a, vp->albedo);
-    rad__free(&a, vp->normals);
-    rad__free(&a, vp->axis);
-    rad__free(&a, vp->voxel);
-    rad__free(&a, (void *)vp->matrix.dense);
-    rad__free(&a, (void *)vp->matrix.row_offsets);
-    rad__free(&a, (void *)vp->matrix.columns);
-    rad__free(&a, (void *)vp->matrix.values);
-    rad__free(&a, vp->voxel_keys);
-    rad__free(&a, vp->voxel_first);
-    rad__free(&a, vp->voxel_patch);
-    rad__free(&a, vp->sample_first);
-    rad__free(&a, vp->sample_positions);
-    rad__free(&a, vp->sample_normals);
-    rad__free(&a, vp->sample_albedo);
-    rad__free(&a, vp->sample_areas);
-    rad__free(&a, vp->sample_weights);
-    rad__free(&a, vp->sample_triangles);
-    rad__free(&a, vp);
+    {
+        void *blocks[] = { vp->areas, vp->albedo, vp->normals, vp->axis, vp->voxel, (void *)vp->matrix.dense,
+                           (void *)vp->matrix.row_offsets, (void *)vp->matrix.columns, (void *)vp->matrix.values,
+                           vp->voxel_keys, vp->voxel_first, vp->voxel_patch, vp->sample_first, vp->sample_positions,
+                           vp->sample_normals, vp->sample_albedo, vp->sample_areas, vp->sample_weights,
+                           vp->sample_triangles, vp };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp)
@@ -15927,11 +15888,10 @@ static rad_result rad__vp_sparse_rows(rad__vp_build *b, const rad__ctx *c, uint3
             }
         }
     }
-    rad__free(A, uoff);
-    rad__free(A, ucol);
-    rad__free(A, uval);
-    rad__free(A, lcnt);
-    rad__free(A, pos);
+    {
+        void *blocks[] = { uoff, ucol, uval, lcnt, pos };
+        rad__free_each(*A, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) {
         rad__free(A, off);
         rad__free(A, col);
@@ -16635,37 +16595,13 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     r = rad__vp_form_factors(b, c, bytes);
 done:
     if (b->o.storage == RAD_STORAGE_SPARSE) rad__free(A, b->P); /* the chunk buffer (NULL once used) */
-    rad__free(A, cand);
-    rad__free(A, cand_area);
-    rad__free(A, voxel_cand);
-    rad__free(A, cand_first);
-    rad__free(A, tri_count);
-    rad__free(A, s_pos);
-    rad__free(A, s_tri);
-    rad__free(A, s_vox);
-    rad__free(A, s_bary);
-    rad__free(A, b->hits);
-    rad__free(A, b->rays);
-    rad__free(A, b->occ);
-    rad__free(A, b->ray_i);
-    rad__free(A, b->ray_j);
-    rad__free(A, b->ray_g);
-    rad__free(A, b->rays_cast);
-    rad__free(A, b->acc);
-    rad__free(A, b->pairs);
-    rad__free(A, b->eff);
-    rad__free(A, b->rowf);
-    rad__free(A, b->share);
-    rad__free(A, b->share_hits);
-    rad__free(A, b->target);
-    rad__free(A, b->dscale);
-    rad__free(A, b->dnext);
-    rad__free(A, b->vscale);
-    rad__free(A, b->cols);
-    rad__free(A, b->cscratch);
-    rad__free(A, b->slot);
-    rad__free(A, b->ncl);
-    rad__free(A, b->sample_voxel);
+    {
+        void *blocks[] = { cand, cand_area, voxel_cand, cand_first, tri_count, s_pos, s_tri, s_vox, s_bary, b->hits,
+                           b->rays, b->occ, b->ray_i, b->ray_j, b->ray_g, b->rays_cast, b->acc, b->pairs, b->eff,
+                           b->rowf, b->share, b->share_hits, b->target, b->dscale, b->dnext, b->vscale, b->cols,
+                           b->cscratch, b->slot, b->ncl, b->sample_voxel };
+        rad__free_each(*A, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -17137,10 +17073,10 @@ RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table)
     rad_allocator a;
     if (!table) return;
     a = table->allocator;
-    rad__free(&a, table->offsets);
-    rad__free(&a, table->patch);
-    rad__free(&a, table->weight);
-    rad__free(&a, table);
+    {
+        void *blocks[] = { table->offsets, table->patch, table->weight, table };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, const float *points, const float *normals,
@@ -17274,11 +17210,10 @@ RAD_API void rad_vp_lights_destroy(rad_vp_lights *s)
     if (!s) return;
     a = s->allocator;
     for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) rad__free(&a, s->vis[l]);
-    rad__free(&a, s->normals);
-    rad__free(&a, s->v);
-    rad__free(&a, s->emit);
-    rad__free(&a, s->sky);
-    rad__free(&a, s);
+    {
+        void *blocks[] = { s->normals, s->v, s->emit, s->sky, s };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 RAD_API void rad_vp_lights_refresh(rad_vp_lights *s)
@@ -17558,11 +17493,10 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     } else {
         rad_vp_lights_refresh(s);
     }
-    rad__free(&c.allocator, j.rays);
-    rad__free(&c.allocator, j.occ);
-    rad__free(&c.allocator, j.ray_sample);
-    rad__free(&c.allocator, j.ray_light);
-    rad__free(&c.allocator, j.task_rays);
+    {
+        void *blocks[] = { j.rays, j.occ, j.ray_sample, j.ray_light, j.task_rays };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -17814,15 +17748,11 @@ RAD_API void rad_lightmap_destroy(rad_lightmap *lm)
     rad_allocator a;
     if (!lm) return;
     a = lm->allocator;
-    rad__free(&a, lm->flags);
-    rad__free(&a, lm->positions);
-    rad__free(&a, lm->normals);
-    rad__free(&a, lm->sample_first);
-    rad__free(&a, lm->sample_positions);
-    rad__free(&a, lm->sample_normals);
-    rad__free(&a, lm->sample_triangles);
-    rad__free(&a, lm->sample_valid);
-    rad__free(&a, lm);
+    {
+        void *blocks[] = { lm->flags, lm->positions, lm->normals, lm->sample_first, lm->sample_positions,
+                           lm->sample_normals, lm->sample_triangles, lm->sample_valid, lm };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* 1 when the uv triangle t (texel units, 6 doubles) and the box [x0,x1] x [y0,y1] overlap
@@ -18178,11 +18108,10 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
         else memcpy(N, lm->sample_normals + 3 * (size_t)a, 3 * sizeof(float));
     }
 done:
-    rad__free(&c.allocator, slot_tri);
-    rad__free(&c.allocator, slot_b);
-    rad__free(&c.allocator, fb_tri);
-    rad__free(&c.allocator, fb_b);
-    rad__free(&c.allocator, fb_d);
+    {
+        void *blocks[] = { slot_tri, slot_b, fb_tri, fb_b, fb_d };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) {
         if (r == RAD_ERROR_SIZE_OVERFLOW) rad__log(&c, RAD_LOG_ERROR, "lightmap: more than 2^32 - 2 samples");
         rad_lightmap_destroy(lm);
@@ -18536,13 +18465,10 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
         }
         r = rad__for_rows(&c, texels, T, rad__lm_gather_row, &g);
     }
-    rad__free(&c.allocator, g.list);
-    rad__free(&c.allocator, g.skip);
-    rad__free(&c.allocator, g.ray_buf);
-    rad__free(&c.allocator, g.occ_buf);
-    rad__free(&c.allocator, g.ray_c);
-    rad__free(&c.allocator, g.hit_buf);
-    rad__free(&c.allocator, g.hit_w);
+    {
+        void *blocks[] = { g.list, g.skip, g.ray_buf, g.occ_buf, g.ray_c, g.hit_buf, g.hit_w };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather", out, (size_t)texels * g.ch) : r;
 }
 
@@ -18588,10 +18514,10 @@ RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lm, const rad_raycast
         }
     }
 done:
-    rad__free(&c.allocator, pts);
-    rad__free(&c.allocator, nrm);
-    rad__free(&c.allocator, D);
-    rad__free(&c.allocator, owner);
+    {
+        void *blocks[] = { pts, nrm, D, owner };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -18691,14 +18617,11 @@ RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
     rad_allocator a;
     if (!w) return;
     a = w->allocator;
-    rad__free(&a, w->vertex_first);
-    rad__free(&a, w->vertex_patches);
-    rad__free(&a, w->vertex_weights);
-    rad__free(&a, w->row_texels);
-    rad__free(&a, w->row_first);
-    rad__free(&a, w->entry_vertices);
-    rad__free(&a, w->entry_weights);
-    rad__free(&a, w);
+    {
+        void *blocks[] = { w->vertex_first, w->vertex_patches, w->vertex_weights, w->row_texels, w->row_first,
+                           w->entry_vertices, w->entry_weights, w };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* barycentrics (b1, b2) of point x in triangle v (9 floats), least squares in its plane */
@@ -19279,11 +19202,10 @@ RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lm, const 
     W->row_count = rows;
 done:
     rad_vp_gather_table_destroy(tab);
-    rad__free(&c.allocator, first);
-    rad__free(&c.allocator, pts);
-    rad__free(&c.allocator, nrm);
-    rad__free(&c.allocator, col);
-    rad__free(&c.allocator, val);
+    {
+        void *blocks[] = { first, pts, nrm, col, val };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) {
         if (r == RAD_ERROR_OUT_OF_MEMORY)
             rad__log(&c, RAD_LOG_ERROR, "lightmap weights (virtual patches): out of memory for %u samples", m);
@@ -19790,17 +19712,11 @@ RAD_API void rad_probes_destroy(rad_probes *pr)
     rad_allocator a;
     if (!pr) return;
     a = pr->allocator;
-    rad__free(&a, pr->positions);
-    rad__free(&a, pr->states);
-    rad__free(&a, pr->coefficients);
-    rad__free(&a, pr->direct);
-    rad__free(&a, pr->first);
-    rad__free(&a, pr->patch);
-    rad__free(&a, pr->weights);
-    rad__free(&a, pr->band4);
-    rad__free(&a, pr->direct4);
-    rad__free(&a, pr->weights4);
-    rad__free(&a, pr);
+    {
+        void *blocks[] = { pr->positions, pr->states, pr->coefficients, pr->direct, pr->first, pr->patch,
+                           pr->weights, pr->band4, pr->direct4, pr->weights4, pr };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* appends the non-zero rows of a probe's dense weights to the entry arrays */
@@ -20049,14 +19965,10 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         }
     }
     pr->first[pr->count] = pr->entries;
-    rad__free(&c.allocator, b.rays);
-    rad__free(&c.allocator, b.hits);
-    rad__free(&c.allocator, b.occ);
-    rad__free(&c.allocator, b.target);
-    rad__free(&c.allocator, b.w);
-    rad__free(&c.allocator, b.col);
-    rad__free(&c.allocator, b.emitters);
-    rad__free(&c.allocator, b.dense);
+    {
+        void *blocks[] = { b.rays, b.hits, b.occ, b.target, b.w, b.col, b.emitters, b.dense };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r == RAD_SUCCESS) r = rad__check_output(&c, "probes (direct light)", pr->direct, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS && pr->direct4) r = rad__check_output(&c, "probes (direct light, band 4)", pr->direct4, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS) {
@@ -21102,12 +21014,11 @@ RAD_API void rad_bake_destroy(rad_bake *b)
     if (!b) return;
     a = b->allocator;
     rad_container_destroy(b->container);
-    rad__free(&a, b->patches.areas);
-    rad__free(&a, b->patches.albedo);
-    rad__free(&a, b->patches.first_patch);
-    rad__free(&a, b->patches.subdivision);
-    rad__free(&a, b->owned);
-    rad__free(&a, b);
+    {
+        void *blocks[] = { b->patches.areas, b->patches.albedo, b->patches.first_patch, b->patches.subdivision,
+                           b->owned, b };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* the single section of 'type' (named when name is given), checked for its element size */
