@@ -15431,6 +15431,33 @@ static rad_result rad__vp_face_row(void *data, uint32_t row, uint32_t task)
 
 /* ---- form factors: one row voxel per call ---- */
 
+/* The kernel G_ij of samples i and j: cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2;
+   each factor s (c / d^2) is a length, so no product leaves float's range (s_i s_j alone
+   overflowed in scenes of 1e12 and underflowed below 1e-9); 0 when they do not face. */
+static inline float rad__vp_pair_kernel(const rad__vp_build *b, uint32_t i, uint32_t j)
+{
+    const rad_virtual_patches *vp = b->vp;
+    const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
+    const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
+    float d[3], d2, ci, cj, ei = b->eff[i], ej = b->eff[j], fl;
+    rad__sub(d, pj, pi_);
+    ci = rad__dot(d, ni);
+    if (!(ci > 0.0f)) return 0.0f;
+    cj = -rad__dot(d, nj);
+    if (!(cj > 0.0f)) return 0.0f;
+    d2 = rad__dot(d, d);
+    fl = (ei > ej ? ei : ej) / (float)RAD__PI;
+    return (vp->sample_areas[i] * (ci / d2)) * (vp->sample_areas[j] * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI;
+}
+
+/* the shadow ray between samples i and j, both ends lifted off their surfaces */
+static void rad__vp_pair_ray(const rad__vp_build *b, rad_ray *ray, uint32_t i, uint32_t j)
+{
+    const rad_virtual_patches *vp = b->vp;
+    rad__shadow_ray(ray, vp->sample_positions + 3 * (size_t)i, vp->sample_normals + 3 * (size_t)i,
+                    vp->sample_positions + 3 * (size_t)j, vp->sample_normals + 3 * (size_t)j, NULL, b->eps);
+}
+
 static void rad__vp_pair_add(rad__vp_build *b, double *acc, uint32_t u, uint32_t i, uint32_t j, double g)
 {
     const rad_virtual_patches *vp = b->vp;
@@ -15474,37 +15501,15 @@ static rad_result rad__vp_ff_row(void *data, uint32_t u, uint32_t task)
     rad_result r = RAD_SUCCESS;
     for (a = 0; a < 6; ++a) memset(acc + (size_t)a * N + pf, 0, sizeof(double) * (N - pf));
     for (i = vp->sample_first[u]; i < vp->sample_first[u + 1] && r == RAD_SUCCESS; ++i) {
-        const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
-        float ei = b->eff[i];
         for (j = i + 1; j < M; ++j) {
-            const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
-            float d[3], d2, ci, cj, ej = b->eff[j], fl, g, len;
-            int k;
-            rad__sub(d, pj, pi_);
-            ci = rad__dot(d, ni);
-            if (!(ci > 0.0f)) continue;
-            cj = -rad__dot(d, nj);
-            if (!(cj > 0.0f)) continue;
-            d2 = rad__dot(d, d);
-            fl = (ei > ej ? ei : ej) / (float)RAD__PI;
-            /* cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2; each factor s (c / d^2)
-               is a length, so no product leaves float's range (s_i s_j alone overflowed in
-               scenes of 1e12 and underflowed below 1e-9) */
-            g = (vp->sample_areas[i] * (ci / d2)) * (vp->sample_areas[j] * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI;
+            float g = rad__vp_pair_kernel(b, i, j);
             if (!(g > 0.0f)) continue;
             if (b->o.skip_visibility) {
                 rad__vp_pair_add(b, acc, u, i, j, (double)g);
                 continue;
             }
             {
-                rad_ray *ray = b->rays + at + nrays;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
-                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+                rad__vp_pair_ray(b, b->rays + at + nrays, i, j);
                 b->ray_i[at + nrays] = i;
                 b->ray_j[at + nrays] = j;
                 b->ray_g[at + nrays] = g;
@@ -15561,23 +15566,12 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
         uint32_t n = 0, stride = 1, seen = 0, s, nr = 0;
         memset(p0, 0, sizeof(p0));
         for (i = vp->sample_first[u]; i < vp->sample_first[u + 1]; ++i) {
-            const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
             const float *wi = vp->sample_weights + 6 * (size_t)i;
-            float si = vp->sample_areas[i], ei = b->eff[i];
             double t6[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; /* sum_j g_ij w_jc */
             for (j = (v == u ? i + 1 : vp->sample_first[v]); j < vp->sample_first[v + 1]; ++j) {
-                const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
                 const float *wj = vp->sample_weights + 6 * (size_t)j;
-                float d[3], d2, ci, cj, sj = vp->sample_areas[j], ej = b->eff[j], fl, g;
+                float g = rad__vp_pair_kernel(b, i, j);
                 uint32_t c;
-                rad__sub(d, pj, pi_);
-                ci = rad__dot(d, ni);
-                if (!(ci > 0.0f)) continue;
-                cj = -rad__dot(d, nj);
-                if (!(cj > 0.0f)) continue;
-                d2 = rad__dot(d, d);
-                fl = (ei > ej ? ei : ej) / (float)RAD__PI;
-                g = (si * (ci / d2)) * (sj * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI; /* as above */
                 if (!(g > 0.0f)) continue;
                 for (c = 0; c < 6; ++c) t6[c] += (double)g * (double)wj[c];
                 if (b->o.skip_visibility) continue;
@@ -15607,21 +15601,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
         for (s = 0; s < n; ++s) total += (double)list[s].g;
         if (n <= K) {
             /* every pair its ray: the kernel-weighted visible fraction */
-            for (s = 0; s < n; ++s) {
-                const rad__vp_pair *q = &list[s];
-                rad_ray *ray = b->rays + at + s;
-                const float *pi_ = vp->sample_positions + 3 * (size_t)q->i, *ni = vp->sample_normals + 3 * (size_t)q->i;
-                const float *pj = vp->sample_positions + 3 * (size_t)q->j, *nj = vp->sample_normals + 3 * (size_t)q->j;
-                float len;
-                int k;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
-                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
-            }
+            for (s = 0; s < n; ++s) rad__vp_pair_ray(b, b->rays + at + s, list[s].i, list[s].j);
             nr = n;
         } else {
             /* K pairs drawn with probability proportional to g, stratified */
@@ -15630,22 +15610,8 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
             uint32_t q = 0;
             for (s = 0; s < K; ++s) {
                 double target = ((double)s + r) / (double)K * total;
-                rad_ray *ray = b->rays + at + s;
-                const float *pi_, *ni, *pj, *nj;
-                float len;
-                int k;
                 while (q + 1 < n && cum + (double)list[q].g <= target) cum += (double)list[q++].g;
-                pi_ = vp->sample_positions + 3 * (size_t)list[q].i;
-                ni = vp->sample_normals + 3 * (size_t)list[q].i;
-                pj = vp->sample_positions + 3 * (size_t)list[q].j;
-                nj = vp->sample_normals + 3 * (size_t)list[q].j;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
-                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+                rad__vp_pair_ray(b, b->rays + at + s, list[q].i, list[q].j);
                 b->ray_g[at + s] = 1.0f;
                 b->ray_i[at + s] = list[q].i;
                 b->ray_j[at + s] = list[q].j;
@@ -16818,6 +16784,23 @@ static float rad__vp_face_weight(const rad_virtual_patches *vp, uint32_t v, uint
     return vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)*q, n) : w[a];
 }
 
+/* The patches of voxel v that face normal n (w: the axis weights of n): their patches in q,
+   weights in wa and count in *count, in axis order; returns the weights' sum. */
+static double rad__vp_voxel_faces(const rad_virtual_patches *vp, uint32_t v, const float n[3], const float w[6],
+                                  uint32_t *q, double *wa, uint32_t *count)
+{
+    double ws = 0.0;
+    uint32_t a;
+    *count = 0;
+    for (a = 0; a < 6; ++a) {
+        float x = rad__vp_face_weight(vp, v, a, n, w, q + *count);
+        if (!(x > 0.0f)) continue;
+        ws += (double)x;
+        wa[(*count)++] = (double)x;
+    }
+    return ws;
+}
+
 /* The trilinear lattice of a point: the voxel-centre cell below p (clamped two cells outside
    the grid) in base, the fractions in g. */
 static void rad__vp_lattice(const rad_virtual_patches *vp, const float p[3], int64_t base[3], double g[3])
@@ -16864,17 +16847,13 @@ RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float 
     rad__vp_weights(vp->weights, n, w);
     rad__vp_lattice(vp, p, base, g);
     for (corner = 0; corner < 8; ++corner) {
-        double t, L[3] = { 0.0, 0.0, 0.0 }, ws = 0.0;
-        uint32_t a, v = rad__vp_corner(vp, base, g, corner, &t);
+        double t, L[3] = { 0.0, 0.0, 0.0 }, ws, wa[6];
+        uint32_t q[6], f, nf, v = rad__vp_corner(vp, base, g, corner, &t);
         if (v == RAD_NONE) continue;
-        for (a = 0; a < 6; ++a) {
-            uint32_t q;
-            float wa = rad__vp_face_weight(vp, v, a, n, w, &q);
-            if (!(wa > 0.0f)) continue;
-            ws += (double)wa;
-            for (k = 0; k < 3; ++k) L[k] += (double)wa * (double)values[3 * (size_t)q + k];
-        }
+        ws = rad__vp_voxel_faces(vp, v, n, w, q, wa, &nf);
         if (!(ws > 0.0)) continue; /* nothing in this voxel faces n */
+        for (f = 0; f < nf; ++f)
+            for (k = 0; k < 3; ++k) L[k] += wa[f] * (double)values[3 * (size_t)q[f] + k];
         used++;
         for (k = 0; k < 3; ++k) {
             acc[k] += t * L[k] / ws;
@@ -17008,19 +16987,13 @@ static uint32_t rad__vp_gather_weights(const rad_virtual_patches *vp, const floa
     rad__vp_weights(vp->weights, n, w);
     rad__vp_lattice(vp, p, base, g);
     for (corner = 0; corner < 8; ++corner) {
-        double t, ws = 0.0;
-        uint32_t a, first = cnt, v = rad__vp_corner(vp, base, g, corner, &t);
+        double t, ws;
+        uint32_t nf, v = rad__vp_corner(vp, base, g, corner, &t);
         if (v == RAD_NONE) continue;
-        for (a = 0; a < 6; ++a) {
-            uint32_t q;
-            float wa = rad__vp_face_weight(vp, v, a, n, w, &q);
-            if (!(wa > 0.0f)) continue;
-            ws += (double)wa;
-            idx[cnt] = q;
-            raw[cnt++] = (double)wa;
-        }
-        if (!(ws > 0.0)) { cnt = first; continue; } /* nothing in this voxel faces n */
-        start[used] = first;
+        ws = rad__vp_voxel_faces(vp, v, n, w, idx + cnt, raw + cnt, &nf);
+        if (!(ws > 0.0)) continue; /* nothing in this voxel faces n */
+        start[used] = cnt;
+        cnt += nf;
         tv[used] = t;
         wsv[used++] = ws;
         tsum += t;
@@ -17056,14 +17029,7 @@ static void rad__vp_table_task(void *data, uint32_t task)
             memcpy(j->t->weight + j->t->offsets[i], w, sizeof(float) * n);
         } else { /* apply */
             const rad_vp_gather_table *t = j->t;
-            const float *x = j->values;
-            float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f;
-            uint32_t e;
-            for (e = t->offsets[i]; e < t->offsets[i + 1]; ++e) {
-                const float *q = x + 3 * (size_t)t->patch[e], g = t->weight[e];
-                a0 += g * q[0], a1 += g * q[1], a2 += g * q[2];
-            }
-            j->out[3 * (size_t)i] = a0, j->out[3 * (size_t)i + 1] = a1, j->out[3 * (size_t)i + 2] = a2;
+            rad__sparse_row3(t->patch, t->weight, t->offsets[i], t->offsets[i + 1], j->values, j->out + 3 * (size_t)i);
         }
     }
 }
@@ -17502,6 +17468,25 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
 
 /* ---- container ---- */
 
+/* The set's arrays in section order (type, bytes per element, count of N patches, V voxels or
+   M samples, field, element type): rad_vp_sections writes them and rad_vp_load reads them. */
+#define RAD__VP_ARRAYS(X)                                                        \
+    X(RAD_SECTION_VP_AREAS, 4, N, areas, float)                                  \
+    X(RAD_SECTION_VP_ALBEDO, 12, N, albedo, float)                               \
+    X(RAD_SECTION_VP_NORMALS, 12, N, normals, float)                             \
+    X(RAD_SECTION_VP_AXIS, 1, N, axis, uint8_t)                                  \
+    X(RAD_SECTION_VP_VOXEL, 4, N, voxel, uint32_t)                               \
+    X(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys, uint64_t)                     \
+    X(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first, uint32_t)    \
+    X(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch, uint32_t)                  \
+    X(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first, uint32_t)  \
+    X(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions, float)           \
+    X(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals, float)               \
+    X(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo, float)                 \
+    X(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas, float)                    \
+    X(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights, float)               \
+    X(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles, uint32_t)
+
 RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count)
 {
     uint32_t N, V, M, k = 0;
@@ -17509,21 +17494,9 @@ RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *na
     if (!vp || !out || !out_count || !vp->matrix.rows) return RAD_ERROR_INVALID_ARGUMENT;
     N = vp->count, V = vp->voxel_count, M = vp->sample_count;
     rad__section(&out[k++], RAD_SECTION_VP_INFO, 4, 16, vp->info_record, name);
-    rad__section(&out[k++], RAD_SECTION_VP_AREAS, 4, N, vp->areas, name);
-    rad__section(&out[k++], RAD_SECTION_VP_ALBEDO, 12, N, vp->albedo, name);
-    rad__section(&out[k++], RAD_SECTION_VP_NORMALS, 12, N, vp->normals, name);
-    rad__section(&out[k++], RAD_SECTION_VP_AXIS, 1, N, vp->axis, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL, 4, N, vp->voxel, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_KEYS, 8, V, vp->voxel_keys, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, vp->voxel_first, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_PATCH, 24, V, vp->voxel_patch, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, vp->sample_first, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, vp->sample_positions, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, vp->sample_normals, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, vp->sample_albedo, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_AREAS, 4, M, vp->sample_areas, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, vp->sample_weights, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, vp->sample_triangles, name);
+#define RAD__VP_SECTION(type, elem, count, field, ctype) rad__section(&out[k++], type, elem, count, vp->field, name);
+    RAD__VP_ARRAYS(RAD__VP_SECTION)
+#undef RAD__VP_SECTION
     if (vp->matrix.storage == RAD_STORAGE_SPARSE) {
         uint64_t nnz = vp->matrix.row_offsets[N];
         rad__section(&out[k++], RAD_SECTION_FF_ROW_OFFSETS, 8, (uint64_t)N + 1u, vp->matrix.row_offsets, name);
@@ -17656,21 +17629,7 @@ RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const 
         r = rad__vp_take(&c, ct, name, type, elem, count, &p_);                                        \
         vp->field = (ctype *)p_;                                                                       \
     }
-    RAD__VP_TAKE(RAD_SECTION_VP_AREAS, 4, N, areas, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_ALBEDO, 12, N, albedo, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_NORMALS, 12, N, normals, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_AXIS, 1, N, axis, uint8_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL, 4, N, voxel, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys, uint64_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles, uint32_t)
+    RAD__VP_ARRAYS(RAD__VP_TAKE)
 #undef RAD__VP_TAKE
     vp->matrix.rows = vp->matrix.cols = N;
     if (r == RAD_SUCCESS && rad_container_find(ct, RAD_SECTION_FF_ROW_OFFSETS, name)) {
@@ -18193,12 +18152,14 @@ typedef struct rad__lm_gather {
     float *out;
 } rad__lm_gather;
 
-static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count, double *acc)
+/* exact rays: each unoccluded one brings its contribution; the flushes empty the queue (*n = 0) */
+static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t *n, double *acc)
 {
     rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
     uint8_t *occ = g->occ_buf + (size_t)task * RAD__RAY_BATCH;
     const float *w = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
-    uint32_t k, ch;
+    uint32_t k, ch, count = *n;
+    *n = 0;
     if (count == 0) return RAD_SUCCESS;
     if (g->rc->occluded(g->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
     for (k = 0; k < count; ++k)
@@ -18208,14 +18169,15 @@ static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count
 }
 
 /* hemisphere rays: each hit on the front of a patch that is not counted exactly brings its B */
-static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t count, double *sum)
+static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t *n, double *sum)
 {
     const rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
     rad_hit *hits = g->hit_buf + (size_t)task * RAD__RAY_BATCH;
     const float *hw = g->hit_w + (size_t)task * RAD__RAY_BATCH * 4;
     const rad_scene *S = g->lm->scene;
-    uint32_t k, j;
+    uint32_t k, j, count = *n;
     int c;
+    *n = 0;
     if (count == 0) return RAD_SUCCESS;
     if (g->rc->intersect(g->rc->user, rays, count, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
     for (k = 0; k < count; ++k) {
@@ -18312,30 +18274,15 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
             }
             if (!(ksum > 0.0)) continue;
             for (q = 0; q < g->vis; ++q) {
-                rad_ray *ray;
-                float len;
                 if (!(kw[q] > 0.0)) continue;
                 rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
                 rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
-                ray = rays + nr;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pf[k] + nf[k] * g->eps;
-                    ray->dir[k] = (y[k] + pj->normal[k] * g->eps) - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * g->eps ? 1.0f - g->eps / len : 0.5f;
+                rad__shadow_ray(rays + nr, pf, nf, y, pj->normal, NULL, g->eps);
                 for (ch = 0; ch < g->ch; ++ch) rc[(size_t)nr * g->ch + ch] = (float)(full[ch] * kw[q] / ksum);
-                if (++nr == RAD__RAY_BATCH) {
-                    r = rad__lm_flush(g, task, nr, acc);
-                    nr = 0;
-                    if (r != RAD_SUCCESS) return r;
-                }
+                if (++nr == RAD__RAY_BATCH && (r = rad__lm_flush(g, task, &nr, acc)) != RAD_SUCCESS) return r;
             }
         }
-        r = rad__lm_flush(g, task, nr, acc);
-        nr = 0;
-        if (r != RAD_SUCCESS) return r;
+        if ((r = rad__lm_flush(g, task, &nr, acc)) != RAD_SUCCESS) return r;
         for (ch = 0; ch < g->ch; ++ch) sum[ch] += acc[ch];
         if (per) {
             /* this sample's share of the texel's hemisphere rays (the exact rays above are
@@ -18362,15 +18309,9 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
                 ray->tmax = FLT_MAX;
                 wq[0] = w;
                 for (k = 0; k < 3; ++k) wq[1 + k] = ray->dir[k];
-                if (++nh == RAD__RAY_BATCH) {
-                    r = rad__lm_flush_hits(g, task, nh, sum);
-                    nh = 0;
-                    if (r != RAD_SUCCESS) return r;
-                }
+                if (++nh == RAD__RAY_BATCH && (r = rad__lm_flush_hits(g, task, &nh, sum)) != RAD_SUCCESS) return r;
             }
-            r = rad__lm_flush_hits(g, task, nh, sum);
-            nh = 0;
-            if (r != RAD_SUCCESS) return r;
+            if ((r = rad__lm_flush_hits(g, task, &nh, sum)) != RAD_SUCCESS) return r;
         }
     }
     for (ch = 0; ch < g->ch; ++ch) out[ch] = nval ? (float)(sum[ch] / nval) : 0.0f;
@@ -18825,24 +18766,11 @@ static void rad__lm_refresh_rows(void *data, uint32_t task)
 {
     const rad__lm_refresh *f = (const rad__lm_refresh *)data;
     const rad_lightmap_weights *W = f->W;
-    const uint32_t *first = W->row_first, *ev = W->entry_vertices;
-    const float *ew = W->entry_weights, *V = f->V;
     uint32_t r = (uint32_t)((uint64_t)W->row_count * task / f->tasks);
     uint32_t end = (uint32_t)((uint64_t)W->row_count * (task + 1) / f->tasks);
-    for (; r < end; ++r) {
-        uint32_t e = first[r], b = first[r + 1];
-        float *o = f->out + 3 * (size_t)W->row_texels[r];
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        for (; e < b; ++e) {
-            const float *x = V + 3 * (size_t)ev[e], w = ew[e];
-            s0 += w * x[0];
-            s1 += w * x[1];
-            s2 += w * x[2];
-        }
-        o[0] = s0;
-        o[1] = s1;
-        o[2] = s2;
-    }
+    for (; r < end; ++r)
+        rad__sparse_row3(W->entry_vertices, W->entry_weights, W->row_first[r], W->row_first[r + 1], f->V,
+                         f->out + 3 * (size_t)W->row_texels[r]);
 }
 
 RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const float *H, float *out, const rad_context *ctx)
@@ -19075,6 +19003,18 @@ static rad_result rad__lm_vp_row(void *data, uint32_t texel, uint32_t task)
     return RAD_SUCCESS;
 }
 
+/* runs row over every texel of lm into out (3 per texel), g's other fields set by the caller */
+static rad_result rad__lm_other_run(const rad__ctx *c, rad__lm_other *g, const rad_lightmap *lm, float *out,
+                                    rad__row_fn row, const char *what)
+{
+    uint32_t texels = lm->width * lm->height, T = c->tasks < texels ? c->tasks : texels;
+    rad_result r;
+    g->lm = lm;
+    g->out = out;
+    r = rad__for_rows(c, texels, T ? T : 1u, row, g);
+    return r == RAD_SUCCESS ? rad__check_output(c, what, out, 3 * (size_t)texels) : r;
+}
+
 /* the set's scene must be the lightmap's (NULL: a set loaded without one) */
 static rad_result rad__lm_check_vp(const rad__ctx *c, const char *what, const rad_lightmap *lm, const rad_virtual_patches *vp)
 {
@@ -19094,7 +19034,6 @@ RAD_API rad_result rad_lightmap_gather_vp(const rad_lightmap *lm, const rad_virt
 {
     rad__ctx c;
     rad__lm_other g;
-    uint32_t texels, T;
     rad_result r;
     rad__ctx_init(&c, ctx);
     if ((r = rad__lm_check_vp(&c, "lightmap gather (virtual patches)", lm, vp)) != RAD_SUCCESS) return r;
@@ -19105,14 +19044,9 @@ RAD_API rad_result rad_lightmap_gather_vp(const rad_lightmap *lm, const rad_virt
     r = rad__check_input(&c, "lightmap gather (virtual patches): patch values", values, 3 * (size_t)vp->count);
     if (r != RAD_SUCCESS) return r;
     memset(&g, 0, sizeof g);
-    g.lm = lm;
     g.vp = vp;
     g.values = values;
-    g.out = out;
-    texels = lm->width * lm->height;
-    T = c.tasks < texels ? c.tasks : texels;
-    r = rad__for_rows(&c, texels, T ? T : 1u, rad__lm_vp_row, &g);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather (virtual patches)", out, 3 * (size_t)texels) : r;
+    return rad__lm_other_run(&c, &g, lm, out, rad__lm_vp_row, "lightmap gather (virtual patches)");
 }
 
 RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lm, const rad_virtual_patches *vp,
@@ -19242,8 +19176,6 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lm, cons
 {
     rad__ctx c;
     rad__lm_other g;
-    uint32_t texels, T;
-    rad_result r;
     rad__ctx_init(&c, ctx);
     if (!lm || !h || !out || (value != RAD_HIERARCHICAL_RADIOSITY && value != RAD_HIERARCHICAL_GATHERED)) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather (hierarchical): NULL lightmap, solution or output, or value %d unknown",
@@ -19256,14 +19188,9 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lm, cons
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     memset(&g, 0, sizeof g);
-    g.lm = lm;
     g.h = h;
     g.value = value;
-    g.out = out;
-    texels = lm->width * lm->height;
-    T = c.tasks < texels ? c.tasks : texels;
-    r = rad__for_rows(&c, texels, T ? T : 1u, rad__lm_hr_row, &g);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather (hierarchical)", out, 3 * (size_t)texels) : r;
+    return rad__lm_other_run(&c, &g, lm, out, rad__lm_hr_row, "lightmap gather (hierarchical)");
 }
 
 /* ======================================================================================== */
@@ -19329,7 +19256,8 @@ static void rad__sh_band4(const float *d, float *y)
     y[8] = 0.625835735f * (x2 * x2 - 6.0f * x2 * y2 + y2 * y2);
 }
 
-RAD_API void rad_sh_band4_basis(const float d[3], float out[9])
+/* A basis at direction d: eval at d normalised, or zeros for a zero or NULL direction. */
+static void rad__sh_basis_at(const float *d, float *out, void (*eval)(const float *, float *))
 {
     float u[3];
     int k;
@@ -19340,7 +19268,12 @@ RAD_API void rad_sh_band4_basis(const float d[3], float out[9])
         return;
     }
     rad__normalize(u);
-    rad__sh_band4(u, out);
+    eval(u, out);
+}
+
+RAD_API void rad_sh_band4_basis(const float d[3], float out[9])
+{
+    rad__sh_basis_at(d, out, rad__sh_band4);
 }
 
 RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band4[27], const float n[3], float out_rgb[3])
@@ -19359,16 +19292,7 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
 
 RAD_API void rad_sh9_basis(const float d[3], float out[9])
 {
-    float u[3];
-    int k;
-    if (!d || !out) return;
-    u[0] = d[0]; u[1] = d[1]; u[2] = d[2];
-    if (!(rad__dot(u, u) > 0.0f)) {
-        for (k = 0; k < 9; ++k) out[k] = 0.0f;
-        return;
-    }
-    rad__normalize(u);
-    rad__sh9(u, out);
+    rad__sh_basis_at(d, out, rad__sh9);
 }
 
 RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], float out_rgb[3])
@@ -20013,13 +19937,28 @@ static void rad__probe_eval(const rad_probes *pr, uint32_t i, const float *un, f
     else rad_sh9_irradiance(pr->coefficients + 27 * (size_t)i, un, e);
 }
 
+/* adds probe i's irradiance at normal un with weight w when it sees p: -1 when a ray failed */
+static int rad__probe_add(const rad_probes *pr, const rad_raycaster *rc, const float *p, const float *un, uint32_t i,
+                          float w, float acc[3], double *wsum)
+{
+    float e[3];
+    int k, vis;
+    if (!(w > 0.0f)) return 0;
+    vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
+    if (vis <= 0) return vis;
+    rad__probe_eval(pr, i, un, e);
+    for (k = 0; k < 3; ++k) acc[k] += w * e[k];
+    *wsum += w;
+    return 0;
+}
+
 static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *rc, const float p[3], const float n[3],
                                      float out_rgb[3])
 {
-    float un[3], e[3], acc[3] = { 0.0f, 0.0f, 0.0f };
+    float un[3], acc[3] = { 0.0f, 0.0f, 0.0f };
     double wsum = 0.0;
     uint32_t i;
-    int k, vis;
+    int k;
     if (!pr || !p || !n || !out_rgb) return RAD_ERROR_INVALID_ARGUMENT;
     out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
     if (!rad__finite3(p) || !rad__finite3(n)) return RAD_ERROR_NON_FINITE;
@@ -20048,13 +19987,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
                     len = rad__len(d);
                     cs = len > 0.0f ? rad__dot(d, un) / len : 1.0f;
                     if (!pr->plain) w *= 0.25f * (1.0f + cs) * (1.0f + cs);
-                    if (!(w > 0.0f)) continue;
-                    vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
-                    if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
-                    if (!vis) continue;
-                    rad__probe_eval(pr, i, un, e);
-                    for (k = 0; k < 3; ++k) acc[k] += w * e[k];
-                    wsum += w;
+                    if (rad__probe_add(pr, rc, p, un, i, w, acc, &wsum) < 0) return RAD_ERROR_RAYCAST_FAILED;
                 }
     } else {
         for (i = 0; i < pr->count; ++i) {
@@ -20064,13 +19997,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
             len2 = rad__dot(d, d);
             cs = len2 > 0.0f ? rad__dot(d, un) / (float)sqrt((double)len2) : 1.0f;
             w = (pr->plain ? 1.0f : 0.25f * (1.0f + cs) * (1.0f + cs)) / (len2 + pr->h2);
-            if (!(w > 0.0f)) continue;
-            vis = rad__probe_visible(pr, rc, p, un, pr->positions + 3 * (size_t)i);
-            if (vis < 0) return RAD_ERROR_RAYCAST_FAILED;
-            if (!vis) continue;
-            rad__probe_eval(pr, i, un, e);
-            for (k = 0; k < 3; ++k) acc[k] += w * e[k];
-            wsum += w;
+            if (rad__probe_add(pr, rc, p, un, i, w, acc, &wsum) < 0) return RAD_ERROR_RAYCAST_FAILED;
         }
     }
     if (!(wsum > 0.0)) {
