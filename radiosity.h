@@ -6995,28 +6995,42 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
 #define RAD__HC_NONE 0xFFFFFFFFu  /* a cell that sees nothing */
 #define RAD__HC_BACK 0xFFFFFFFEu  /* a cell that sees a patch from behind: counts for no column */
 
+/* The count points of q (up to 4) projected onto the unit sphere into r; 0 when one is the
+   origin (the receiver point on the polygon's boundary). */
+static int rad__sphere_points(const double (*q)[3], int count, double (*r)[3])
+{
+    int i, k;
+    for (i = 0; i < count; ++i) {
+        double l = sqrt(q[i][0] * q[i][0] + q[i][1] * q[i][1] + q[i][2] * q[i][2]);
+        if (!(l > 0.0)) return 0;
+        for (k = 0; k < 3; ++k) r[i][k] = q[i][k] / l;
+    }
+    return 1;
+}
+
+/* The arc from unit vector a to b: a x b in c, its length in *cl and the angle between them
+   in *angle; 0 for a degenerate arc, which adds nothing to a contour integral. */
+static int rad__sphere_arc(const double *a, const double *b, double c[3], double *cl, double *angle)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+    *cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(*cl > 1e-300)) return 0;
+    *angle = atan2(*cl, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+    return 1;
+}
+
 /* Contour integral over one convex polygon q (points relative to the receiver point, in its
    upper half-space), against unit normal n, in double. Signed by the winding. */
 static double rad__contour(const double (*q)[3], int count, const double *n)
 {
-    double sum = 0.0, r[4][3];
-    int i, k;
-    for (i = 0; i < count; ++i) {
-        double l = sqrt(q[i][0] * q[i][0] + q[i][1] * q[i][1] + q[i][2] * q[i][2]);
-        if (!(l > 0.0)) return 0.0; /* the point is on the polygon's boundary */
-        for (k = 0; k < 3; ++k) r[i][k] = q[i][k] / l;
-    }
-    for (i = 0; i < count; ++i) {
-        const double *a = r[i], *b = r[(i + 1) % count];
-        double c[3], cl, d;
-        c[0] = a[1] * b[2] - a[2] * b[1];
-        c[1] = a[2] * b[0] - a[0] * b[2];
-        c[2] = a[0] * b[1] - a[1] * b[0];
-        cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        if (!(cl > 1e-300)) continue;
-        d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        sum += atan2(cl, d) * (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / cl;
-    }
+    double sum = 0.0, r[4][3], c[3], cl, angle;
+    int i;
+    if (!rad__sphere_points(q, count, r)) return 0.0;
+    for (i = 0; i < count; ++i)
+        if (rad__sphere_arc(r[i], r[(i + 1) % count], c, &cl, &angle))
+            sum += angle * (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / cl;
     return sum;
 }
 
@@ -8245,6 +8259,21 @@ static rad_result rad__solve_begin(const rad_system *s, const rad_solve_options 
     return rad__check_solve_options(o, c);
 }
 
+/* What every iterative solver does last with its result r after 'steps' steps (a step being
+   'unit'): the stats, the output asked for and its check, a warning when short of tol. */
+static rad_result rad__solve_end(const rad_system *s, const rad_solve_options *o, const char *name, const char *unit,
+                                 const rad__ctx *c, rad_result r, uint32_t steps, double residual, double tol, float *out,
+                                 rad_solve_stats *stats)
+{
+    if (stats) { stats->iterations = steps; stats->residual = residual; }
+    if (r == RAD_ERROR_CANCELLED) return r;
+    rad__finish_output(s, o->output, out, 1);
+    if (rad__check_output(c, name, out, 3 * (size_t)s->n) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
+    if (r == RAD_ERROR_NOT_CONVERGED)
+        rad__log(c, RAD_LOG_WARNING, "%s: residual %g after %u %s (tolerance %g)", name, residual, steps, unit, tol);
+    return r;
+}
+
 RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options *options, float *out, rad_solve_stats *stats,
                                     const rad_context *ctx)
 {
@@ -8354,13 +8383,7 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
             if (residual < tol) { r = RAD_SUCCESS; break; }
             if (c.progress && c.progress(c.progress_user, (float)it / (float)max_it)) { r = RAD_ERROR_CANCELLED; break; }
         }
-    if (stats) { stats->iterations = it; stats->residual = residual; }
-    if (r == RAD_ERROR_CANCELLED) return r;
-    rad__finish_output(s, o.output, out, 1);
-    if (rad__check_output(&c, "Gauss-Seidel", out, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
-    if (r == RAD_ERROR_NOT_CONVERGED)
-        rad__log(&c, RAD_LOG_WARNING, "Gauss-Seidel: residual %g after %u sweeps (tolerance %g)", residual, it, tol);
-    return r;
+    return rad__solve_end(s, &o, "Gauss-Seidel", "sweeps", &c, r, it, residual, tol, out, stats);
 }
 
 RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_options *options, float *out,
@@ -8446,13 +8469,7 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
         }
     }
     rad__free(&c.allocator, dB);
-    if (stats) { stats->iterations = step; stats->residual = residual; }
-    if (r == RAD_ERROR_CANCELLED) return r;
-    rad__finish_output(s, o.output, out, 1);
-    if (rad__check_output(&c, "progressive refinement", out, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
-    if (r == RAD_ERROR_NOT_CONVERGED)
-        rad__log(&c, RAD_LOG_WARNING, "progressive refinement: residual %g after %u steps (tolerance %g)", residual, step, tol);
-    return r;
+    return rad__solve_end(s, &o, "progressive refinement", "steps", &c, r, step, residual, tol, out, stats);
 }
 
 typedef struct rad__lu_job {
@@ -18100,22 +18117,11 @@ static int rad__lm_polygon(const double *p, const double *n, const float *v, dou
             ++m;
         }
     }
-    if (m < 3) return 0;
+    if (m < 3 || !rad__sphere_points((const double(*)[3])poly, m, r)) return 0;
     for (i = 0; i < m; ++i) {
-        double l = sqrt(poly[i][0] * poly[i][0] + poly[i][1] * poly[i][1] + poly[i][2] * poly[i][2]);
-        if (!(l > 0.0)) return 0; /* p on the polygon's boundary */
-        for (k = 0; k < 3; ++k) r[i][k] = poly[i][k] / l;
-    }
-    for (i = 0; i < m; ++i) {
-        const double *a = r[i], *b = r[(i + 1) % m];
-        double cr[3], cl, dot;
-        cr[0] = a[1] * b[2] - a[2] * b[1];
-        cr[1] = a[2] * b[0] - a[0] * b[2];
-        cr[2] = a[0] * b[1] - a[1] * b[0];
-        cl = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-        if (!(cl > 1e-300)) continue;
-        dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        for (k = 0; k < 3; ++k) vec[k] += 0.5 * atan2(cl, dot) * cr[k] / cl;
+        double cr[3], cl, angle;
+        if (!rad__sphere_arc(r[i], r[(i + 1) % m], cr, &cl, &angle)) continue;
+        for (k = 0; k < 3; ++k) vec[k] += 0.5 * angle * cr[k] / cl;
     }
     /* solid angle: a fan of spherical triangles (Van Oosterom and Strackee) */
     for (i = 1; i + 1 < m; ++i) {
@@ -18746,38 +18752,44 @@ typedef struct rad__lm_refresh {
     const float *H;
     float *V;                   /* 3 per vertex: stage 1's output */
     float *out;
-    uint32_t tasks;
+    uint32_t tasks, stage;      /* stage 1: V from H; stage 2: out from V */
 } rad__lm_refresh;
-
-static void rad__lm_refresh_vertices(void *data, uint32_t task)
-{
-    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
-    const rad_lightmap_weights *W = f->W;
-    uint32_t v = (uint32_t)((uint64_t)W->vertex_count * task / f->tasks);
-    uint32_t end = (uint32_t)((uint64_t)W->vertex_count * (task + 1) / f->tasks);
-    for (; v < end; ++v)
-        rad__sparse_row3(W->vertex_patches, W->vertex_weights, W->vertex_first[v], W->vertex_first[v + 1], f->H,
-                         f->V + 3 * (size_t)v);
-}
 
 /* one contiguous block of rows per task: the rows are short, so a cyclic split would make
    the tasks write the same cache lines of out */
-static void rad__lm_refresh_rows(void *data, uint32_t task)
+static void rad__lm_refresh_task(void *data, uint32_t task)
 {
     const rad__lm_refresh *f = (const rad__lm_refresh *)data;
     const rad_lightmap_weights *W = f->W;
-    uint32_t r = (uint32_t)((uint64_t)W->row_count * task / f->tasks);
-    uint32_t end = (uint32_t)((uint64_t)W->row_count * (task + 1) / f->tasks);
-    for (; r < end; ++r)
-        rad__sparse_row3(W->entry_vertices, W->entry_weights, W->row_first[r], W->row_first[r + 1], f->V,
-                         f->out + 3 * (size_t)W->row_texels[r]);
+    uint64_t n = f->stage == 1 ? W->vertex_count : W->row_count;
+    uint32_t i = (uint32_t)(n * task / f->tasks), end = (uint32_t)(n * (task + 1) / f->tasks);
+    if (f->stage == 1)
+        for (; i < end; ++i)
+            rad__sparse_row3(W->vertex_patches, W->vertex_weights, W->vertex_first[i], W->vertex_first[i + 1], f->H,
+                             f->V + 3 * (size_t)i);
+    else
+        for (; i < end; ++i)
+            rad__sparse_row3(W->entry_vertices, W->entry_weights, W->row_first[i], W->row_first[i + 1], f->V,
+                             f->out + 3 * (size_t)W->row_texels[i]);
+}
+
+/* a stage in at most 'most' tasks, in the calling thread when that is one */
+static void rad__lm_refresh_stage(const rad__ctx *c, rad__lm_refresh *f, uint32_t stage, uint64_t most)
+{
+    f->stage = stage;
+    f->tasks = c->tasks < most ? c->tasks : (uint32_t)most;
+    if (f->tasks < 2) {
+        f->tasks = 1;
+        rad__lm_refresh_task(f, 0);
+    } else {
+        c->parallel_for(c->parallel_user, f->tasks, rad__lm_refresh_task, f);
+    }
 }
 
 RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const float *H, float *out, const rad_context *ctx)
 {
     rad__ctx c;
     rad__lm_refresh f;
-    uint64_t most;
     rad__ctx_init(&c, ctx);
     if (!W || !H || !out) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
@@ -18793,21 +18805,9 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
     }
     /* stage 1 is small (3 entries a patch): in the calling thread unless the patches are
        many, as a parallel region's start and join can cost more than it on busy cores */
-    most = W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN;
-    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
-    if (f.tasks < 2) {
-        f.tasks = 1;
-        rad__lm_refresh_vertices(&f, 0);
-    } else {
-        c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_vertices, &f);
-    }
+    rad__lm_refresh_stage(&c, &f, 1, W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN);
     /* stage 2: a task per block of at least RAD__LM_REFRESH_GRAIN entries */
-    most = (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u;
-    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
-    if (f.tasks < 2) {
-        f.tasks = 1;
-        rad__lm_refresh_rows(&f, 0);
-    } else c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_rows, &f);
+    rad__lm_refresh_stage(&c, &f, 2, (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u);
     rad__free(&c.allocator, f.V);
     return RAD_SUCCESS;
 }
