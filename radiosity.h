@@ -3822,6 +3822,14 @@ static void *rad__alloc(const rad_allocator *a, size_t size)
     return RAD_MALLOC(size);
 }
 
+/* A zeroed block: every object starts so, its zero fields meaning nothing owned yet. */
+static void *rad__alloc_zero(const rad_allocator *a, size_t size)
+{
+    void *p = rad__alloc(a, size);
+    if (p) memset(p, 0, size);
+    return p;
+}
+
 static void rad__free(const rad_allocator *a, void *p)
 {
     if (!p) return;
@@ -4502,9 +4510,8 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
         return RAD_ERROR_SIZE_OVERFLOW;
     }
     n = (uint32_t)total;
-    s = (rad_scene *)rad__alloc(&c.allocator, sizeof(rad_scene));
+    s = (rad_scene *)rad__alloc_zero(&c.allocator, sizeof(rad_scene));
     if (!s) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof(*s));
     s->allocator = c.allocator;
     s->triangle_count = n;
     s->material_count = desc->material_count;
@@ -4942,9 +4949,8 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
         for (t = 0; t < scene->triangle_count; ++t) sum += scene->areas[t];
         max_area = (float)(sum / (double)o.target_count);
     }
-    P = (rad_patches *)rad__alloc(&c.allocator, sizeof(rad_patches));
+    P = (rad_patches *)rad__alloc_zero(&c.allocator, sizeof(rad_patches));
     if (!P) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(P, 0, sizeof(*P));
     P->allocator = c.allocator;
     P->scene = scene;
     P->triangle_count = scene->triangle_count;
@@ -5661,9 +5667,8 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         rad__log(&c, RAD_LOG_ERROR, "the built-in BVH holds at most %u triangles", RAD__BVH4_LEAF / 4u - 1u);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
-    b = (rad_bvh *)rad__alloc(&c.allocator, sizeof(rad_bvh));
+    b = (rad_bvh *)rad__alloc_zero(&c.allocator, sizeof(rad_bvh));
     if (!b) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(b, 0, sizeof(*b));
     b->allocator = c.allocator;
     b->tri_count = n;
     /* Stage 1, the references; stage 2, the binary tree */
@@ -6147,9 +6152,8 @@ RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!scene || scene->triangle_count == 0) return RAD_ERROR_INVALID_ARGUMENT;
-    e = (rad_embree *)rad__alloc(&c.allocator, sizeof(rad_embree));
+    e = (rad_embree *)rad__alloc_zero(&c.allocator, sizeof(rad_embree));
     if (!e) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(e, 0, sizeof(*e));
     e->allocator = c.allocator;
     e->log = c.log;
     e->log_user = c.log_user;
@@ -6192,9 +6196,8 @@ RAD_API rad_result rad_embree_wrap(void *rtc_scene, const uint32_t *first_triang
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!rtc_scene || (first_triangle && geometry_count == 0)) return RAD_ERROR_INVALID_ARGUMENT;
-    e = (rad_embree *)rad__alloc(&c.allocator, sizeof(rad_embree));
+    e = (rad_embree *)rad__alloc_zero(&c.allocator, sizeof(rad_embree));
     if (!e) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(e, 0, sizeof(*e));
     e->allocator = c.allocator;
     e->scene = (RTCScene)rtc_scene;
     if (first_triangle) {
@@ -7034,18 +7037,17 @@ static double rad__contour(const double (*q)[3], int count, const double *n)
     return sum;
 }
 
-/* Point-to-triangle kernel: p, n the receiver point and unit normal, v 9 floats. Clips the
-   triangle to n.(x - p) >= 0. Returns the signed contour sum / (2 pi). */
-static double rad__ff_point_tri(const double *p, const double *n, const float *v)
+/* Triangle v (9 floats) relative to point p, clipped to n.(x - p) >= 0: its points (up to 4,
+   the triangle itself when wholly above) in out, their count returned; d gets the corners'
+   heights n.(v_i - p). */
+static int rad__clip_tri(const double *p, const double *n, const float *v, double d[3], double (*out)[3])
 {
-    double q[3][3], d[3], out[4][3];
+    double q[3][3];
     int i, k, m = 0;
     for (i = 0; i < 3; ++i) {
         for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
         d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
     }
-    if (d[0] <= 0.0 && d[1] <= 0.0 && d[2] <= 0.0) return 0.0;
-    if (d[0] >= 0.0 && d[1] >= 0.0 && d[2] >= 0.0) return rad__contour((const double(*)[3])q, 3, n) / (2.0 * RAD__PI);
     for (i = 0; i < 3; ++i) {
         int j = (i + 1) % 3;
         if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) out[m][k] = q[i][k]; ++m; }
@@ -7055,7 +7057,17 @@ static double rad__ff_point_tri(const double *p, const double *n, const float *v
             ++m;
         }
     }
-    if (m < 3) return 0.0;
+    return m;
+}
+
+/* Point-to-triangle kernel: p, n the receiver point and unit normal, v 9 floats. Clips the
+   triangle to n.(x - p) >= 0. Returns the signed contour sum / (2 pi). */
+static double rad__ff_point_tri(const double *p, const double *n, const float *v)
+{
+    double d[3], out[4][3];
+    int m = rad__clip_tri(p, n, v, d, out);
+    /* wholly at or below p's plane (lying in it too): nothing */
+    if ((d[0] <= 0.0 && d[1] <= 0.0 && d[2] <= 0.0) || m < 3) return 0.0;
     return rad__contour((const double(*)[3])out, m, n) / (2.0 * RAD__PI);
 }
 
@@ -7873,9 +7885,8 @@ RAD_API rad_result rad_form_factors_dense(const rad_patches *patches, const rad_
         rad__log(&c, RAD_LOG_ERROR, "a dense %u x %u matrix does not fit in memory addresses", N, N);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
-    ff = (rad_form_factors *)rad__alloc(&c.allocator, sizeof(rad_form_factors));
+    ff = (rad_form_factors *)rad__alloc_zero(&c.allocator, sizeof(rad_form_factors));
     if (!ff) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(ff, 0, sizeof(*ff));
     ff->allocator = c.allocator;
     ff->storage = rad__alloc(&c.allocator, bytes);
     if (!ff->storage) {
@@ -7930,11 +7941,10 @@ RAD_API rad_result rad_form_factors_sparse(const rad_patches *patches, const rad
     batch = (uint32_t)(((size_t)1 << 24) / (N ? N : 1));
     if (batch < f.tasks) batch = f.tasks;
     if (batch > N) batch = N;
-    ff = (rad_form_factors *)rad__alloc(&c.allocator, sizeof(rad_form_factors));
+    ff = (rad_form_factors *)rad__alloc_zero(&c.allocator, sizeof(rad_form_factors));
     buf = (float *)rad__alloc_array(&c.allocator, (size_t)batch * N, sizeof(float));
     offs = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)N + 1u, sizeof(uint64_t));
     if (!ff || !buf || !offs) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
-    memset(ff, 0, sizeof(*ff));
     ff->allocator = c.allocator;
     f.out = buf;
     f.out_stride = N;
@@ -9465,12 +9475,11 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
                  "passes 2^28 elements", (double)o.min_area, total);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    h = (rad_hierarchical *)rad__alloc(&c.allocator, sizeof(*h));
+    h = (rad_hierarchical *)rad__alloc_zero(&c.allocator, sizeof(*h));
     if (!h) {
         rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: out of memory");
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    memset(h, 0, sizeof(*h));
     h->allocator = c.allocator;
     h->scene = scene;
     if (raycaster) h->rc = *raycaster;
@@ -10933,9 +10942,8 @@ static rad_result rad__mb_new(const rad__ctx *c, uint32_t n, uint32_t k, rad_mb_
     if (!rad__mul((size_t)n, (size_t)n, &nn) || !rad__mul3(nn, 3, precision == RAD_MB_HALF ? 2u : 4u, &bytes[0]))
         return RAD_ERROR_SIZE_OVERFLOW;
     bytes[1] = bytes[2] = perms ? (size_t)n * sizeof(uint32_t) : 0;
-    mb = (rad_multibounce *)rad__alloc(&c->allocator, sizeof(*mb));
+    mb = (rad_multibounce *)rad__alloc_zero(&c->allocator, sizeof(*mb));
     if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(mb, 0, sizeof(*mb));
     mb->allocator = c->allocator;
     mb->storage = rad__mb_carve(c, bytes, 3, parts, &r);
     if (!mb->storage) { rad__free(&c->allocator, mb); return r; }
@@ -12615,9 +12623,8 @@ RAD_API rad_result rad_multibounce_load(const rad_container *ct, const char *nam
         r = rad__check_values(&c, what, (const float *)data, total, 1);
     }
     if (r != RAD_SUCCESS) return r;
-    mb = (rad_multibounce *)rad__alloc(&c.allocator, sizeof(*mb));
+    mb = (rad_multibounce *)rad__alloc_zero(&c.allocator, sizeof(*mb));
     if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(mb, 0, sizeof(*mb));
     mb->allocator = c.allocator;
     mb->n = info[2];
     mb->bounces = info[3];
@@ -12651,9 +12658,8 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *ct, const ch
                  name ? name : "", info[1], info[4], info[5], n);
         return RAD_ERROR_CORRUPT;
     }
-    b = (rad_multibounce_blocks *)rad__alloc(&c.allocator, sizeof(*b));
+    b = (rad_multibounce_blocks *)rad__alloc_zero(&c.allocator, sizeof(*b));
     if (!b) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(b, 0, sizeof(*b));
     b->allocator = c.allocator;
     b->n = n;
     b->bounces = info[3];
@@ -12992,9 +12998,8 @@ RAD_API rad_result rad_row_stream_create(const char *path, const rad_context *ct
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!path) return RAD_ERROR_INVALID_ARGUMENT;
-    s = (rad_row_stream *)rad__alloc(&c.allocator, sizeof(rad_row_stream));
+    s = (rad_row_stream *)rad__alloc_zero(&c.allocator, sizeof(rad_row_stream));
     if (!s) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof(*s));
     s->allocator = c.allocator;
     s->log = c;
     s->f = fopen(path, "rb");
@@ -13117,9 +13122,8 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
         if (part < sizes[k] || total + part < total) return RAD_ERROR_SIZE_OVERFLOW;
         total += part;
     }
-    L = (rad_local *)rad__alloc(&c.allocator, sizeof(rad_local));
+    L = (rad_local *)rad__alloc_zero(&c.allocator, sizeof(rad_local));
     if (!L) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(L, 0, sizeof(*L));
     L->allocator = c.allocator;
     mem = (unsigned char *)rad__alloc(&c.allocator, total + 64u);
     if (!mem) { rad__free(&c.allocator, L); return RAD_ERROR_OUT_OF_MEMORY; }
@@ -14368,9 +14372,8 @@ static rad_result rad__alias_build(const rad_matrix *F, const float *plane, uint
     bins_off = tot_off + ((tot_bytes + 7u) & ~(size_t)7u);
     total = bins_off + bin_bytes;
     if (total < bin_bytes) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_SIZE_OVERFLOW; }
-    t = (rad_alias_tables *)rad__alloc(&c.allocator, sizeof(rad_alias_tables));
+    t = (rad_alias_tables *)rad__alloc_zero(&c.allocator, sizeof(rad_alias_tables));
     if (!t) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_OUT_OF_MEMORY; }
-    memset(t, 0, sizeof(*t));
     t->allocator = c.allocator;
     base = rad__alias_alloc(&c.allocator, total, &t->storage);
     job.scratch_stride = (rad_alias_row_scratch_size((uint32_t)maxrow) + 7u) & ~(size_t)7u;
@@ -14486,9 +14489,8 @@ RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *src, rad_a
             bins_off = tot_off + ((tot_bytes + 7u) & ~(size_t)7u);
             total = bins_off + bin_bytes;
             if (total < bin_bytes) { r = RAD_ERROR_SIZE_OVERFLOW; break; }
-            t = (rad_alias_tables *)rad__alloc(&c.allocator, sizeof(rad_alias_tables));
+            t = (rad_alias_tables *)rad__alloc_zero(&c.allocator, sizeof(rad_alias_tables));
             if (!t) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
-            memset(t, 0, sizeof(*t));
             t->allocator = c.allocator;
             base = rad__alias_alloc(&c.allocator, total, &t->storage);
             if (!base) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
@@ -14751,9 +14753,8 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
         }
     }
     if ((uint64_t)o.samples * table_count > 0xFFFFFFFFull) return RAD_ERROR_INVALID_ARGUMENT;
-    t = (rad_temporal *)rad__alloc(&c.allocator, sizeof(rad_temporal));
+    t = (rad_temporal *)rad__alloc_zero(&c.allocator, sizeof(rad_temporal));
     if (!t) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(t, 0, sizeof(*t));
     t->c = c;
     for (k = 0; k < table_count; ++k) t->tables[k] = tables[k];
     t->table_count = table_count;
@@ -16632,9 +16633,8 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
                  (double)b.o.ray_epsilon);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    vp = (rad_virtual_patches *)rad__alloc_zero(&c.allocator, sizeof(*vp));
     if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(vp, 0, sizeof(*vp));
     vp->allocator = c.allocator;
     vp->scene = scene;
     vp->weights = b.o.weights;
@@ -17078,9 +17078,8 @@ RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, con
             rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_table_create: point %u or its normal is not finite", i);
             return RAD_ERROR_NON_FINITE;
         }
-    t = (rad_vp_gather_table *)rad__alloc(&c.allocator, sizeof(*t));
+    t = (rad_vp_gather_table *)rad__alloc_zero(&c.allocator, sizeof(*t));
     if (!t) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(t, 0, sizeof(*t));
     t->allocator = c.allocator;
     t->count = count;
     t->patches = vp->count;
@@ -17224,9 +17223,8 @@ RAD_API rad_result rad_vp_lights_create(const rad_virtual_patches *vp, const rad
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_lights_create: the set has no scene (rad_vp_load with scene NULL)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    s = (rad_vp_lights *)rad__alloc(&c.allocator, sizeof(*s));
+    s = (rad_vp_lights *)rad__alloc_zero(&c.allocator, sizeof(*s));
     if (!s) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof(*s));
     s->allocator = c.allocator;
     s->vp = vp;
     s->rc = raycaster;
@@ -17625,9 +17623,8 @@ RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const 
     N = info[2], V = info[3], M = info[4];
     if (info[0] > 1u || info[1] > 1u || N == 0 || V == 0 || M == 0 || N > 6u * (uint64_t)V || info[15] != 0)
         return rad__vp_bad(&c, "VP_INFO: unknown kind or weights, or counts out of range", 0);
-    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    vp = (rad_virtual_patches *)rad__alloc_zero(&c.allocator, sizeof(*vp));
     if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(vp, 0, sizeof(*vp));
     vp->allocator = c.allocator;
     vp->scene = scene;
     vp->kind = (rad_vp_kind)info[0];
@@ -17890,9 +17887,8 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
         return RAD_ERROR_SIZE_OVERFLOW;
     }
     slots = texels * S;
-    lm = (rad_lightmap *)rad__alloc(&c.allocator, sizeof(rad_lightmap));
+    lm = (rad_lightmap *)rad__alloc_zero(&c.allocator, sizeof(rad_lightmap));
     if (!lm) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(lm, 0, sizeof(*lm));
     lm->allocator = c.allocator;
     lm->width = W;
     lm->height = H;
@@ -18102,21 +18098,8 @@ done:
    vector irradiance integral w dw (so n . out[1..3] = pi F). Returns 0 when nothing is left. */
 static int rad__lm_polygon(const double *p, const double *n, const float *v, double *out)
 {
-    double q[3][3], d[3], poly[4][3], r[4][3], vec[3] = { 0.0, 0.0, 0.0 }, omega = 0.0, dn;
-    int i, k, m = 0;
-    for (i = 0; i < 3; ++i) {
-        for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
-        d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
-    }
-    for (i = 0; i < 3; ++i) {
-        int j = (i + 1) % 3;
-        if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) poly[m][k] = q[i][k]; ++m; }
-        if ((d[i] > 0.0 && d[j] < 0.0) || (d[i] < 0.0 && d[j] > 0.0)) {
-            double s = d[i] / (d[i] - d[j]);
-            for (k = 0; k < 3; ++k) poly[m][k] = q[i][k] + s * (q[j][k] - q[i][k]);
-            ++m;
-        }
-    }
+    double d[3], poly[4][3], r[4][3], vec[3] = { 0.0, 0.0, 0.0 }, omega = 0.0, dn;
+    int i, k, m = rad__clip_tri(p, n, v, d, poly);
     if (m < 3 || !rad__sphere_points((const double(*)[3])poly, m, r)) return 0;
     for (i = 0; i < m; ++i) {
         double cr[3], cl, angle;
@@ -18624,9 +18607,8 @@ RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad
         for (s = lm->sample_first[i]; s < lm->sample_first[i + 1] && !lm->sample_valid[s]; ++s) {}
         rows += s < lm->sample_first[i + 1];
     }
-    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    W = (rad_lightmap_weights *)rad__alloc_zero(&c.allocator, sizeof(*W));
     if (!W) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(W, 0, sizeof(*W));
     W->allocator = c.allocator;
     W->texels = texels;
     W->patch_count = P->count;
@@ -19088,9 +19070,8 @@ RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lm, const 
     }
     first[texels] = m;
     if ((r = rad_vp_gather_table_create(vp, pts, nrm, m, ctx, &tab)) != RAD_SUCCESS) goto done;
-    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    W = (rad_lightmap_weights *)rad__alloc_zero(&c.allocator, sizeof(*W));
     if (!W) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    memset(W, 0, sizeof(*W));
     W->allocator = c.allocator;
     W->texels = texels;
     W->patch_count = vp->count;
@@ -19756,12 +19737,11 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         if (r != RAD_SUCCESS) return r;
     }
     for (k = 0; k < 3; ++k) ext[k] = S->bounds_max[k] - S->bounds_min[k];
-    pr = (rad_probes *)rad__alloc(&c.allocator, sizeof(rad_probes));
+    pr = (rad_probes *)rad__alloc_zero(&c.allocator, sizeof(rad_probes));
     if (!pr) {
         rad__log(&c, RAD_LOG_ERROR, "probes: out of memory");
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    memset(pr, 0, sizeof(*pr));
     pr->allocator = c.allocator;
     pr->patch_count = N;
     pr->h2 = 1e-6f * S->diagonal * S->diagonal;
@@ -21140,10 +21120,9 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
 static rad_result rad__load(const void *data, size_t size, void *owned, const rad__ctx *c, const rad_context *ctx,
                             rad_bake **out)
 {
-    rad_bake *b = (rad_bake *)rad__alloc(&c->allocator, sizeof(rad_bake));
+    rad_bake *b = (rad_bake *)rad__alloc_zero(&c->allocator, sizeof(rad_bake));
     rad_result r;
     if (!b) { rad__free(&c->allocator, owned); return RAD_ERROR_OUT_OF_MEMORY; }
-    memset(b, 0, sizeof(*b));
     b->allocator = c->allocator;
     b->owned = owned;
     b->patches.allocator = c->allocator;
