@@ -13338,17 +13338,26 @@ static uint32_t rad__local_free_slot(const rad_local *L)
 
 /* The stages of rad_local_add, in the order it runs them. */
 
+/* the set and a patch index a call names, logged under the call's name when out of range */
+static rad_result rad__local_patch_check(const rad__ctx *c, const rad_local *L, uint32_t patch, const char *name)
+{
+    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
+    if (patch >= L->n) {
+        rad__log(c, RAD_LOG_ERROR, "%s: patch %u >= n = %u", name, patch, L->n);
+        return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    }
+    return RAD_SUCCESS;
+}
+
 /* checks the patch; a hidden member only becomes visible again (*done = 1): its transport is
    all there */
 static rad_result rad__local_add_check(const rad__ctx *c, rad_local *L, uint32_t patch, int *done)
 {
     rad__local_storage *st = (rad__local_storage *)L->storage;
     uint32_t k;
+    rad_result r;
     *done = 0;
-    if (patch >= L->n) {
-        rad__log(c, RAD_LOG_ERROR, "rad_local_add: patch %u >= n = %u", patch, L->n);
-        return RAD_ERROR_INDEX_OUT_OF_RANGE;
-    }
+    if ((r = rad__local_patch_check(c, L, patch, "rad_local_add")) != RAD_SUCCESS) return r;
     k = L->patch_slot[patch];
     if (k != RAD_NONE && st->slot_hidden[k]) {
         st->slot_hidden[k] = 0;
@@ -13564,12 +13573,9 @@ RAD_API rad_result rad_local_remove(rad_local *L, uint32_t patch, const rad_cont
     rad__ctx c;
     rad__local_storage *st;
     uint32_t k;
+    rad_result r;
     rad__ctx_init(&c, ctx);
-    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
-    if (patch >= L->n) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_local_remove: patch %u >= n = %u", patch, L->n);
-        return RAD_ERROR_INDEX_OUT_OF_RANGE;
-    }
+    if ((r = rad__local_patch_check(&c, L, patch, "rad_local_remove")) != RAD_SUCCESS) return r;
     st = (rad__local_storage *)L->storage;
     k = L->patch_slot[patch];
     if (k == RAD_NONE || st->slot_hidden[k]) {
@@ -13612,12 +13618,9 @@ RAD_API rad_result rad_local_evict(rad_local *L, uint32_t patch, const rad_conte
     rad__local_job J;
     uint32_t k, i, j, ch, M;
     size_t MM;
+    rad_result r;
     rad__ctx_init(&c, ctx);
-    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
-    if (patch >= L->n) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_local_evict: patch %u >= n = %u", patch, L->n);
-        return RAD_ERROR_INDEX_OUT_OF_RANGE;
-    }
+    if ((r = rad__local_patch_check(&c, L, patch, "rad_local_evict")) != RAD_SUCCESS) return r;
     k = L->patch_slot[patch];
     if (k == RAD_NONE) {
         rad__log(&c, RAD_LOG_ERROR, "rad_local_evict: patch %u is not a member", patch);
@@ -19560,26 +19563,26 @@ typedef struct rad__pu {
     const float *B;
 } rad__pu;
 
-static void rad__probes_update_one(rad_probes *pr, const float *B, uint32_t i)
+/* probe i's 27 coefficients of one basis: its direct part plus its weights times B */
+static void rad__probes_update_basis(const rad_probes *pr, const float *B, uint32_t i, const float *direct,
+                                     const float *weights, float *out)
 {
     double acc[27];
     size_t e;
     int k, c;
-    for (k = 0; k < 27; ++k) acc[k] = pr->direct[27 * (size_t)i + (size_t)k];
+    for (k = 0; k < 27; ++k) acc[k] = direct[27 * (size_t)i + (size_t)k];
     for (e = (size_t)pr->first[i]; e < (size_t)pr->first[i + 1]; ++e) {
-        const float *w = pr->weights + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
+        const float *w = weights + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
         for (k = 0; k < 9; ++k)
             for (c = 0; c < 3; ++c) acc[3 * k + c] += (double)w[k] * b[c];
     }
-    for (k = 0; k < 27; ++k) pr->coefficients[27 * (size_t)i + (size_t)k] = (float)acc[k];
-    if (!pr->band4) return;
-    for (k = 0; k < 27; ++k) acc[k] = pr->direct4[27 * (size_t)i + (size_t)k];
-    for (e = (size_t)pr->first[i]; e < (size_t)pr->first[i + 1]; ++e) {
-        const float *w = pr->weights4 + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
-        for (k = 0; k < 9; ++k)
-            for (c = 0; c < 3; ++c) acc[3 * k + c] += (double)w[k] * b[c];
-    }
-    for (k = 0; k < 27; ++k) pr->band4[27 * (size_t)i + (size_t)k] = (float)acc[k];
+    for (k = 0; k < 27; ++k) out[27 * (size_t)i + (size_t)k] = (float)acc[k];
+}
+
+static void rad__probes_update_one(rad_probes *pr, const float *B, uint32_t i)
+{
+    rad__probes_update_basis(pr, B, i, pr->direct, pr->weights, pr->coefficients);
+    if (pr->band4) rad__probes_update_basis(pr, B, i, pr->direct4, pr->weights4, pr->band4);
 }
 
 static rad_result rad__probes_update_row(void *data, uint32_t row, uint32_t task)
