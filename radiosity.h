@@ -13192,19 +13192,24 @@ static void rad__local_range(uint32_t count, uint32_t tasks, uint32_t t, uint32_
     *e = (uint32_t)((uint64_t)count * (t + 1) / tasks);
 }
 
+/* row i of channel ch's plane of the inverse (M x M floats a channel) */
+static float *rad__local_row(const rad__local_job *J, uint32_t ch, uint32_t i)
+{
+    return J->st->planes + ch * ((size_t)J->M * J->M) + (size_t)i * J->M;
+}
+
 /* u_i = a_i + sum_j T_ij a_j over the slots, in double */
 static void rad__local_u_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
     const rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t i0, i1, i, ch, p;
     rad__local_range(J->end, J->tasks, t, &i0, &i1);
     for (ch = 0; ch < 3; ++ch) {
         const double *a = s->a + (size_t)ch * J->M;
         double *u = s->u + (size_t)ch * J->M;
         for (i = i0; i < i1; ++i) {
-            const float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+            const float *row = rad__local_row(J, ch, i);
             double acc = a[i];
             /* a is non-zero only on the slots of the new row: a sparse gather, exact in double */
             for (p = 0; p < J->nnz; ++p) {
@@ -13221,7 +13226,6 @@ static void rad__local_v_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
     const rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t j0, j1, j, ch, p;
     rad__local_range(J->end, J->tasks, t, &j0, &j1);
     for (ch = 0; ch < 3; ++ch) {
@@ -13230,7 +13234,7 @@ static void rad__local_v_task(void *data, uint32_t t)
         for (j = j0; j < j1; ++j) v[j] = b[j];
         for (p = 0; p < J->nnz; ++p) {
             uint32_t i = s->nz[p];
-            const float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+            const float *row = rad__local_row(J, ch, i);
             double bi = b[i];
             for (j = j0; j < j1; ++j) v[j] += bi * (double)row[j];
         }
@@ -13243,7 +13247,6 @@ static void rad__local_update_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
     const rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t i0, i1, i, j, ch;
     rad__local_range(J->end, J->tasks, t, &i0, &i1);
     for (ch = 0; ch < 3; ++ch) {
@@ -13251,17 +13254,17 @@ static void rad__local_update_task(void *data, uint32_t t)
         const float *v = s->vf + (size_t)ch * J->M;
         if (J->ev == RAD_NONE) {
             for (i = i0; i < i1; ++i) {
-                float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+                float *row = rad__local_row(J, ch, i);
                 float ui = (float)(J->cuv[ch] * u[i]);
                 if (ui == 0.0f) continue;
                 for (j = 0; j < J->end; ++j) row[j] += ui * v[j];
             }
         } else {
             /* rank 2: the downdate of slot e and the new patch's update in one pass */
-            const float *re = J->st->planes + ch * MM + (size_t)J->ev * J->M;
+            const float *re = rad__local_row(J, ch, J->ev);
             const double *cc = s->cc + (size_t)ch * J->M;
             for (i = i0; i < i1; ++i) {
-                float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+                float *row = rad__local_row(J, ch, i);
                 float ui = (float)(J->cuv[ch] * u[i]), ci = (float)(-cc[i] / J->g[ch]);
                 if (i == J->ev || (ui == 0.0f && ci == 0.0f)) continue;
                 for (j = 0; j < J->end; ++j) row[j] += ci * re[j] + ui * v[j];
@@ -13458,11 +13461,10 @@ static void rad__local_add_evict_u(rad__local_job *J)
 static void rad__local_add_evict_v(rad__local_job *J)
 {
     rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t ch, i;
     for (ch = 0; ch < 3; ++ch) {
         double *v = s->v + (size_t)ch * J->M, bc = v[J->ev] / J->g[ch];
-        const float *re = J->st->planes + ch * MM + (size_t)J->ev * J->M;
+        const float *re = rad__local_row(J, ch, J->ev);
         for (i = 0; i < J->end; ++i) v[i] -= bc * (double)re[i];
         v[J->ev] = 0.0;
     }
@@ -13843,12 +13845,11 @@ RAD_API rad_result rad_local_rebuild(rad_local *L, const uint32_t *patches, uint
 static void rad__local_apply_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t r0, r1, r, ch;
     rad__local_range(J->row_count, J->tasks, t, &r0, &r1);
     for (r = r0; r < r1; ++r)
         for (ch = 0; ch < 3; ++ch)
-            J->y[3 * (size_t)r + ch] = rad__dot_f32(J->st->planes + ch * MM + (size_t)J->rows[r] * J->M,
+            J->y[3 * (size_t)r + ch] = rad__dot_f32(rad__local_row(J, ch, J->rows[r]),
                                                    J->e + (size_t)ch * J->end, J->end);
 }
 
