@@ -6407,6 +6407,20 @@ static rad_result rad__direct_flush(rad__direct *d, uint32_t task, uint32_t coun
     return RAD_SUCCESS;
 }
 
+/* the shadow ray from p to q, both lifted eps off their surfaces (normals n and nq) */
+static void rad__segment_ray(rad_ray *ray, const float *p, const float *n, const float *q, const float *nq, float eps)
+{
+    float len;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        ray->origin[k] = p[k] + n[k] * eps;
+        ray->dir[k] = (q[k] + nq[k] * eps) - ray->origin[k];
+    }
+    len = rad__len(ray->dir);
+    ray->tmin = 0.0f;
+    ray->tmax = len > 2.0f * eps ? 1.0f - eps / len : 0.5f;
+}
+
 /* the shadow ray from p (offset eps along n) to 'to' (a point, offset along to_n when given)
    or along 'dir' to infinity */
 static void rad__shadow_ray(rad_ray *ray, const float *p, const float *n, const float *to, const float *to_n,
@@ -7292,15 +7306,7 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
         }
         {
             size_t at = (size_t)task * RAD__RAY_BATCH + *nrays;
-            rad_ray *ray = f->rays + at;
-            float len;
-            for (k = 0; k < 3; ++k) {
-                ray->origin[k] = x[k] + pl->normal[k] * f->eps;
-                ray->dir[k] = (y[k] + ph->normal[k] * f->eps) - ray->origin[k];
-            }
-            len = rad__len(ray->dir);
-            ray->tmin = 0.0f;
-            ray->tmax = len > 2.0f * f->eps ? 1.0f - f->eps / len : 0.5f;
+            rad__segment_ray(f->rays + at, x, pl->normal, y, ph->normal, f->eps);
             f->ray_w[at] = w;
             f->ray_slot[at] = slot;
             if (++*nrays == RAD__RAY_BATCH) {
@@ -9729,15 +9735,7 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
         return RAD_SUCCESS;
     }
     for (a = 0; a < got; ++a) {
-        rad_ray *ray = ev->rays + base + *nrays;
-        float len;
-        for (k = 0; k < 3; ++k) {
-            ray->origin[k] = xs[3 * a + k] + nx[3 * a + k] * h->ray_eps;
-            ray->dir[k] = (ys[3 * a + k] + ny[3 * a + k] * h->ray_eps) - ray->origin[k];
-        }
-        len = rad__len(ray->dir);
-        ray->tmin = 0.0f;
-        ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+        rad__segment_ray(ev->rays + base + *nrays, xs + 3 * a, nx + 3 * a, ys + 3 * a, ny + 3 * a, h->ray_eps);
         ev->w[base + *nrays] = (float)((double)fu * (double)wt[a] / wsum);
         ev->idx[base + *nrays] = l;
         if (++*nrays == RAD__RAY_BATCH) {
@@ -9812,17 +9810,8 @@ static void rad__hr_eval_task(void *data, uint32_t task)
         for (s = 0; s < K && r == RAD_SUCCESS; ++s) {
             /* no usable kernel (every end point grazing): each ray carries its point's f */
             double w = ksum > 0.0 ? fu * kern[s] / ksum : f[s];
-            rad_ray *ray;
-            float len;
             if (!(w > 0.0)) continue;
-            ray = ev->rays + base + nrays;
-            for (k = 0; k < 3; ++k) {
-                ray->origin[k] = xs[3 * s + (uint32_t)k] + er->n[k] * h->ray_eps;
-                ray->dir[k] = (ys[3 * s + (uint32_t)k] + es->n[k] * h->ray_eps) - ray->origin[k];
-            }
-            len = rad__len(ray->dir);
-            ray->tmin = 0.0f;
-            ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+            rad__segment_ray(ev->rays + base + nrays, xs + 3 * s, er->n, ys + 3 * s, es->n, h->ray_eps);
             ev->w[base + nrays] = (float)w;
             ev->idx[base + nrays] = l;
             if (++nrays == RAD__RAY_BATCH) {
@@ -15476,8 +15465,8 @@ static inline float rad__vp_pair_kernel(const rad__vp_build *b, uint32_t i, uint
 static void rad__vp_pair_ray(const rad__vp_build *b, rad_ray *ray, uint32_t i, uint32_t j)
 {
     const rad_virtual_patches *vp = b->vp;
-    rad__shadow_ray(ray, vp->sample_positions + 3 * (size_t)i, vp->sample_normals + 3 * (size_t)i,
-                    vp->sample_positions + 3 * (size_t)j, vp->sample_normals + 3 * (size_t)j, NULL, b->eps);
+    rad__segment_ray(ray, vp->sample_positions + 3 * (size_t)i, vp->sample_normals + 3 * (size_t)i,
+                     vp->sample_positions + 3 * (size_t)j, vp->sample_normals + 3 * (size_t)j, b->eps);
 }
 
 static void rad__vp_pair_add(rad__vp_build *b, double *acc, uint32_t u, uint32_t i, uint32_t j, double g)
@@ -18270,7 +18259,7 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
                 if (!(kw[q] > 0.0)) continue;
                 rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
                 rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
-                rad__shadow_ray(rays + nr, pf, nf, y, pj->normal, NULL, g->eps);
+                rad__segment_ray(rays + nr, pf, nf, y, pj->normal, g->eps);
                 for (ch = 0; ch < g->ch; ++ch) rc[(size_t)nr * g->ch + ch] = (float)(full[ch] * kw[q] / ksum);
                 if (++nr == RAD__RAY_BATCH && (r = rad__lm_flush(g, task, &nr, acc)) != RAD_SUCCESS) return r;
             }
