@@ -3836,6 +3836,14 @@ static void *rad__alloc(const rad_allocator *a, size_t size)
     return RAD_MALLOC(size);
 }
 
+/* A zeroed block: every object starts so, its zero fields meaning nothing owned yet. */
+static void *rad__alloc_zero(const rad_allocator *a, size_t size)
+{
+    void *p = rad__alloc(a, size);
+    if (p) memset(p, 0, size);
+    return p;
+}
+
 static void rad__free(const rad_allocator *a, void *p)
 {
     if (!p) return;
@@ -4516,9 +4524,8 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
         return RAD_ERROR_SIZE_OVERFLOW;
     }
     n = (uint32_t)total;
-    s = (rad_scene *)rad__alloc(&c.allocator, sizeof(rad_scene));
+    s = (rad_scene *)rad__alloc_zero(&c.allocator, sizeof(rad_scene));
     if (!s) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof(*s));
     s->allocator = c.allocator;
     s->triangle_count = n;
     s->material_count = desc->material_count;
@@ -4956,9 +4963,8 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
         for (t = 0; t < scene->triangle_count; ++t) sum += scene->areas[t];
         max_area = (float)(sum / (double)o.target_count);
     }
-    P = (rad_patches *)rad__alloc(&c.allocator, sizeof(rad_patches));
+    P = (rad_patches *)rad__alloc_zero(&c.allocator, sizeof(rad_patches));
     if (!P) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(P, 0, sizeof(*P));
     P->allocator = c.allocator;
     P->scene = scene;
     P->triangle_count = scene->triangle_count;
@@ -5002,11 +5008,10 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
     }
     P->vertex_count = nv;
 done:
-    rad__free(&c.allocator, lattice_ids);
-    rad__free(&c.allocator, w.keys);
-    rad__free(&c.allocator, w.heads);
-    rad__free(&c.allocator, w.next);
-    rad__free(&c.allocator, w.normals);
+    {
+        void *blocks[] = { lattice_ids, w.keys, w.heads, w.next, w.normals };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) { rad_patches_destroy(P); return r; }
     *out = P;
     return RAD_SUCCESS;
@@ -5676,9 +5681,8 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         rad__log(&c, RAD_LOG_ERROR, "the built-in BVH holds at most %u triangles", RAD__BVH4_LEAF / 4u - 1u);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
-    b = (rad_bvh *)rad__alloc(&c.allocator, sizeof(rad_bvh));
+    b = (rad_bvh *)rad__alloc_zero(&c.allocator, sizeof(rad_bvh));
     if (!b) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(b, 0, sizeof(*b));
     b->allocator = c.allocator;
     b->tri_count = n;
     /* Stage 1, the references; stage 2, the binary tree */
@@ -5701,11 +5705,10 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
     if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, order);
-    rad__free(&c.allocator, refs);
-    rad__free(&c.allocator, stack);
-    rad__free(&c.allocator, task);
-    rad__free(&c.allocator, order);
-    rad__free(&c.allocator, tree);
+    {
+        void *blocks[] = { refs, stack, task, order, tree };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) { rad_bvh_destroy(b); return r; }
     *out = b;
     return RAD_SUCCESS;
@@ -6163,9 +6166,8 @@ RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!scene || scene->triangle_count == 0) return RAD_ERROR_INVALID_ARGUMENT;
-    e = (rad_embree *)rad__alloc(&c.allocator, sizeof(rad_embree));
+    e = (rad_embree *)rad__alloc_zero(&c.allocator, sizeof(rad_embree));
     if (!e) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(e, 0, sizeof(*e));
     e->allocator = c.allocator;
     e->log = c.log;
     e->log_user = c.log_user;
@@ -6208,9 +6210,8 @@ RAD_API rad_result rad_embree_wrap(void *rtc_scene, const uint32_t *first_triang
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!rtc_scene || (first_triangle && geometry_count == 0)) return RAD_ERROR_INVALID_ARGUMENT;
-    e = (rad_embree *)rad__alloc(&c.allocator, sizeof(rad_embree));
+    e = (rad_embree *)rad__alloc_zero(&c.allocator, sizeof(rad_embree));
     if (!e) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(e, 0, sizeof(*e));
     e->allocator = c.allocator;
     e->scene = (RTCScene)rtc_scene;
     if (first_triangle) {
@@ -6418,6 +6419,20 @@ static rad_result rad__direct_flush(rad__direct *d, uint32_t task, uint32_t coun
             acc[3 * (size_t)slot[k] + 2] += w[3 * (size_t)k + 2];
         }
     return RAD_SUCCESS;
+}
+
+/* the shadow ray from p to q, both lifted eps off their surfaces (normals n and nq) */
+static void rad__segment_ray(rad_ray *ray, const float *p, const float *n, const float *q, const float *nq, float eps)
+{
+    float len;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        ray->origin[k] = p[k] + n[k] * eps;
+        ray->dir[k] = (q[k] + nq[k] * eps) - ray->origin[k];
+    }
+    len = rad__len(ray->dir);
+    ray->tmin = 0.0f;
+    ray->tmax = len > 2.0f * eps ? 1.0f - eps / len : 0.5f;
 }
 
 /* the shadow ray from p (offset eps along n) to 'to' (a point, offset along to_n when given)
@@ -6671,12 +6686,10 @@ static rad_result rad__direct_run(rad__direct *d, const rad__ctx *c, uint32_t ro
         d->emitter_count = ne;
         r = rad__for_rows(c, rows, T, rad__direct_row, d);
     }
-    rad__free(&c->allocator, d->rays);
-    rad__free(&c->allocator, d->occ);
-    rad__free(&c->allocator, d->ray_w);
-    rad__free(&c->allocator, d->ray_slot);
-    rad__free(&c->allocator, d->acc);
-    rad__free(&c->allocator, d->emitters);
+    {
+        void *blocks[] = { d->rays, d->occ, d->ray_w, d->ray_slot, d->acc, d->emitters };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -6993,15 +7006,10 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
             r = RAD_ERROR_CANCELLED;
         }
     }
-    rad__free(&c.allocator, unit);
-    rad__free(&c.allocator, g.ray_buf);
-    rad__free(&c.allocator, g.hits);
-    rad__free(&c.allocator, g.hit_p);
-    rad__free(&c.allocator, g.hit_n);
-    rad__free(&c.allocator, D);
-    rad__free(&c.allocator, H);
-    rad__free(&c.allocator, albedo);
-    rad__free(&c.allocator, owner);
+    {
+        void *blocks[] = { unit, g.ray_buf, g.hits, g.hit_p, g.hit_n, D, H, albedo, owner };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r == RAD_SUCCESS ? rad__check_output(&c, "final gather", out, 3 * (size_t)count) : r;
 }
 
@@ -7018,43 +7026,56 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
 #define RAD__HC_NONE 0xFFFFFFFFu  /* a cell that sees nothing */
 #define RAD__HC_BACK 0xFFFFFFFEu  /* a cell that sees a patch from behind: counts for no column */
 
+/* The count points of q (up to 4) projected onto the unit sphere into r; 0 when one is the
+   origin (the receiver point on the polygon's boundary). */
+static int rad__sphere_points(const double (*q)[3], int count, double (*r)[3])
+{
+    int i, k;
+    for (i = 0; i < count; ++i) {
+        double l = sqrt(q[i][0] * q[i][0] + q[i][1] * q[i][1] + q[i][2] * q[i][2]);
+        if (!(l > 0.0)) return 0;
+        for (k = 0; k < 3; ++k) r[i][k] = q[i][k] / l;
+    }
+    return 1;
+}
+
+/* The arc from unit vector a to b: a x b in c, its length in *cl and the angle between them
+   in *angle; 0 for a degenerate arc, which adds nothing to a contour integral. */
+static int rad__sphere_arc(const double *a, const double *b, double c[3], double *cl, double *angle)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+    *cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    if (!(*cl > 1e-300)) return 0;
+    *angle = atan2(*cl, a[0] * b[0] + a[1] * b[1] + a[2] * b[2]);
+    return 1;
+}
+
 /* Contour integral over one convex polygon q (points relative to the receiver point, in its
    upper half-space), against unit normal n, in double. Signed by the winding. */
 static double rad__contour(const double (*q)[3], int count, const double *n)
 {
-    double sum = 0.0, r[4][3];
-    int i, k;
-    for (i = 0; i < count; ++i) {
-        double l = sqrt(q[i][0] * q[i][0] + q[i][1] * q[i][1] + q[i][2] * q[i][2]);
-        if (!(l > 0.0)) return 0.0; /* the point is on the polygon's boundary */
-        for (k = 0; k < 3; ++k) r[i][k] = q[i][k] / l;
-    }
-    for (i = 0; i < count; ++i) {
-        const double *a = r[i], *b = r[(i + 1) % count];
-        double c[3], cl, d;
-        c[0] = a[1] * b[2] - a[2] * b[1];
-        c[1] = a[2] * b[0] - a[0] * b[2];
-        c[2] = a[0] * b[1] - a[1] * b[0];
-        cl = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        if (!(cl > 1e-300)) continue;
-        d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        sum += atan2(cl, d) * (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / cl;
-    }
+    double sum = 0.0, r[4][3], c[3], cl, angle;
+    int i;
+    if (!rad__sphere_points(q, count, r)) return 0.0;
+    for (i = 0; i < count; ++i)
+        if (rad__sphere_arc(r[i], r[(i + 1) % count], c, &cl, &angle))
+            sum += angle * (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / cl;
     return sum;
 }
 
-/* Point-to-triangle kernel: p, n the receiver point and unit normal, v 9 floats. Clips the
-   triangle to n.(x - p) >= 0. Returns the signed contour sum / (2 pi). */
-static double rad__ff_point_tri(const double *p, const double *n, const float *v)
+/* Triangle v (9 floats) relative to point p, clipped to n.(x - p) >= 0: its points (up to 4,
+   the triangle itself when wholly above) in out, their count returned; d gets the corners'
+   heights n.(v_i - p). */
+static int rad__clip_tri(const double *p, const double *n, const float *v, double d[3], double (*out)[3])
 {
-    double q[3][3], d[3], out[4][3];
+    double q[3][3];
     int i, k, m = 0;
     for (i = 0; i < 3; ++i) {
         for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
         d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
     }
-    if (d[0] <= 0.0 && d[1] <= 0.0 && d[2] <= 0.0) return 0.0;
-    if (d[0] >= 0.0 && d[1] >= 0.0 && d[2] >= 0.0) return rad__contour((const double(*)[3])q, 3, n) / (2.0 * RAD__PI);
     for (i = 0; i < 3; ++i) {
         int j = (i + 1) % 3;
         if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) out[m][k] = q[i][k]; ++m; }
@@ -7064,7 +7085,17 @@ static double rad__ff_point_tri(const double *p, const double *n, const float *v
             ++m;
         }
     }
-    if (m < 3) return 0.0;
+    return m;
+}
+
+/* Point-to-triangle kernel: p, n the receiver point and unit normal, v 9 floats. Clips the
+   triangle to n.(x - p) >= 0. Returns the signed contour sum / (2 pi). */
+static double rad__ff_point_tri(const double *p, const double *n, const float *v)
+{
+    double d[3], out[4][3];
+    int m = rad__clip_tri(p, n, v, d, out);
+    /* wholly at or below p's plane (lying in it too): nothing */
+    if ((d[0] <= 0.0 && d[1] <= 0.0 && d[2] <= 0.0) || m < 3) return 0.0;
     return rad__contour((const double(*)[3])out, m, n) / (2.0 * RAD__PI);
 }
 
@@ -7289,15 +7320,7 @@ static rad_result rad__ff_pair(rad__ff *f, uint32_t lo, uint32_t hi, uint32_t sl
         }
         {
             size_t at = (size_t)task * RAD__RAY_BATCH + *nrays;
-            rad_ray *ray = f->rays + at;
-            float len;
-            for (k = 0; k < 3; ++k) {
-                ray->origin[k] = x[k] + pl->normal[k] * f->eps;
-                ray->dir[k] = (y[k] + ph->normal[k] * f->eps) - ray->origin[k];
-            }
-            len = rad__len(ray->dir);
-            ray->tmin = 0.0f;
-            ray->tmax = len > 2.0f * f->eps ? 1.0f - f->eps / len : 0.5f;
+            rad__segment_ray(f->rays + at, x, pl->normal, y, ph->normal, f->eps);
             f->ray_w[at] = w;
             f->ray_slot[at] = slot;
             if (++*nrays == RAD__RAY_BATCH) {
@@ -7609,19 +7632,11 @@ static rad_result rad__ff_row(void *data, uint32_t i, uint32_t task)
 
 static void rad__ff_release(rad__ff *f, const rad_allocator *a)
 {
-    rad__free(a, f->pts);
-    rad__free(a, f->rays);
-    rad__free(a, f->occ);
-    rad__free(a, f->ray_w);
-    rad__free(a, f->ray_slot);
-    rad__free(a, f->acc);
-    rad__free(a, f->rays_cast);
-    rad__free(a, f->pairs);
-    rad__free(a, f->hc_centre);
-    rad__free(a, f->hc_dtop);
-    rad__free(a, f->hc_dside);
-    rad__free(a, f->hc_item);
-    rad__free(a, f->hc_depth);
+    {
+        void *blocks[] = { f->pts, f->rays, f->occ, f->ray_w, f->ray_slot, f->acc, f->rays_cast, f->pairs,
+                           f->hc_centre, f->hc_dtop, f->hc_dside, f->hc_item, f->hc_depth };
+        rad__free_each(*a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     memset(f, 0, sizeof(*f));
 }
 
@@ -7890,9 +7905,8 @@ RAD_API rad_result rad_form_factors_dense(const rad_patches *patches, const rad_
         rad__log(&c, RAD_LOG_ERROR, "a dense %u x %u matrix does not fit in memory addresses", N, N);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
-    ff = (rad_form_factors *)rad__alloc(&c.allocator, sizeof(rad_form_factors));
+    ff = (rad_form_factors *)rad__alloc_zero(&c.allocator, sizeof(rad_form_factors));
     if (!ff) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(ff, 0, sizeof(*ff));
     ff->allocator = c.allocator;
     ff->storage = rad__alloc(&c.allocator, bytes);
     if (!ff->storage) {
@@ -7947,11 +7961,10 @@ RAD_API rad_result rad_form_factors_sparse(const rad_patches *patches, const rad
     batch = (uint32_t)(((size_t)1 << 24) / (N ? N : 1));
     if (batch < f.tasks) batch = f.tasks;
     if (batch > N) batch = N;
-    ff = (rad_form_factors *)rad__alloc(&c.allocator, sizeof(rad_form_factors));
+    ff = (rad_form_factors *)rad__alloc_zero(&c.allocator, sizeof(rad_form_factors));
     buf = (float *)rad__alloc_array(&c.allocator, (size_t)batch * N, sizeof(float));
     offs = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)N + 1u, sizeof(uint64_t));
     if (!ff || !buf || !offs) { r = RAD_ERROR_OUT_OF_MEMORY; goto fail; }
-    memset(ff, 0, sizeof(*ff));
     ff->allocator = c.allocator;
     f.out = buf;
     f.out_stride = N;
@@ -8009,11 +8022,10 @@ RAD_API rad_result rad_form_factors_sparse(const rad_patches *patches, const rad
     return RAD_SUCCESS;
 fail:
     rad__ff_release(&f, &c.allocator);
-    rad__free(&c.allocator, buf);
-    rad__free(&c.allocator, offs);
-    rad__free(&c.allocator, cols);
-    rad__free(&c.allocator, vals);
-    rad__free(&c.allocator, ff);
+    {
+        void *blocks[] = { buf, offs, cols, vals, ff };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -8277,6 +8289,21 @@ static rad_result rad__solve_begin(const rad_system *s, const rad_solve_options 
     return rad__check_solve_options(o, c);
 }
 
+/* What every iterative solver does last with its result r after 'steps' steps (a step being
+   'unit'): the stats, the output asked for and its check, a warning when short of tol. */
+static rad_result rad__solve_end(const rad_system *s, const rad_solve_options *o, const char *name, const char *unit,
+                                 const rad__ctx *c, rad_result r, uint32_t steps, double residual, double tol, float *out,
+                                 rad_solve_stats *stats)
+{
+    if (stats) { stats->iterations = steps; stats->residual = residual; }
+    if (r == RAD_ERROR_CANCELLED) return r;
+    rad__finish_output(s, o->output, out, 1);
+    if (rad__check_output(c, name, out, 3 * (size_t)s->n) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
+    if (r == RAD_ERROR_NOT_CONVERGED)
+        rad__log(c, RAD_LOG_WARNING, "%s: residual %g after %u %s (tolerance %g)", name, residual, steps, unit, tol);
+    return r;
+}
+
 RAD_API rad_result rad_solve_jacobi(const rad_system *s, const rad_solve_options *options, float *out, rad_solve_stats *stats,
                                     const rad_context *ctx)
 {
@@ -8386,13 +8413,7 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
             if (residual < tol) { r = RAD_SUCCESS; break; }
             if (c.progress && c.progress(c.progress_user, (float)it / (float)max_it)) { r = RAD_ERROR_CANCELLED; break; }
         }
-    if (stats) { stats->iterations = it; stats->residual = residual; }
-    if (r == RAD_ERROR_CANCELLED) return r;
-    rad__finish_output(s, o.output, out, 1);
-    if (rad__check_output(&c, "Gauss-Seidel", out, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
-    if (r == RAD_ERROR_NOT_CONVERGED)
-        rad__log(&c, RAD_LOG_WARNING, "Gauss-Seidel: residual %g after %u sweeps (tolerance %g)", residual, it, tol);
-    return r;
+    return rad__solve_end(s, &o, "Gauss-Seidel", "sweeps", &c, r, it, residual, tol, out, stats);
 }
 
 RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_options *options, float *out,
@@ -8478,13 +8499,7 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
         }
     }
     rad__free(&c.allocator, dB);
-    if (stats) { stats->iterations = step; stats->residual = residual; }
-    if (r == RAD_ERROR_CANCELLED) return r;
-    rad__finish_output(s, o.output, out, 1);
-    if (rad__check_output(&c, "progressive refinement", out, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
-    if (r == RAD_ERROR_NOT_CONVERGED)
-        rad__log(&c, RAD_LOG_WARNING, "progressive refinement: residual %g after %u steps (tolerance %g)", residual, step, tol);
-    return r;
+    return rad__solve_end(s, &o, "progressive refinement", "steps", &c, r, step, residual, tol, out, stats);
 }
 
 typedef struct rad__lu_job {
@@ -9480,12 +9495,11 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
                  "passes 2^28 elements", (double)o.min_area, total);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    h = (rad_hierarchical *)rad__alloc(&c.allocator, sizeof(*h));
+    h = (rad_hierarchical *)rad__alloc_zero(&c.allocator, sizeof(*h));
     if (!h) {
         rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: out of memory");
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    memset(h, 0, sizeof(*h));
     h->allocator = c.allocator;
     h->scene = scene;
     if (raycaster) h->rc = *raycaster;
@@ -9735,15 +9749,7 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
         return RAD_SUCCESS;
     }
     for (a = 0; a < got; ++a) {
-        rad_ray *ray = ev->rays + base + *nrays;
-        float len;
-        for (k = 0; k < 3; ++k) {
-            ray->origin[k] = xs[3 * a + k] + nx[3 * a + k] * h->ray_eps;
-            ray->dir[k] = (ys[3 * a + k] + ny[3 * a + k] * h->ray_eps) - ray->origin[k];
-        }
-        len = rad__len(ray->dir);
-        ray->tmin = 0.0f;
-        ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+        rad__segment_ray(ev->rays + base + *nrays, xs + 3 * a, nx + 3 * a, ys + 3 * a, ny + 3 * a, h->ray_eps);
         ev->w[base + *nrays] = (float)((double)fu * (double)wt[a] / wsum);
         ev->idx[base + *nrays] = l;
         if (++*nrays == RAD__RAY_BATCH) {
@@ -9818,17 +9824,8 @@ static void rad__hr_eval_task(void *data, uint32_t task)
         for (s = 0; s < K && r == RAD_SUCCESS; ++s) {
             /* no usable kernel (every end point grazing): each ray carries its point's f */
             double w = ksum > 0.0 ? fu * kern[s] / ksum : f[s];
-            rad_ray *ray;
-            float len;
             if (!(w > 0.0)) continue;
-            ray = ev->rays + base + nrays;
-            for (k = 0; k < 3; ++k) {
-                ray->origin[k] = xs[3 * s + (uint32_t)k] + er->n[k] * h->ray_eps;
-                ray->dir[k] = (ys[3 * s + (uint32_t)k] + es->n[k] * h->ray_eps) - ray->origin[k];
-            }
-            len = rad__len(ray->dir);
-            ray->tmin = 0.0f;
-            ray->tmax = len > 2.0f * h->ray_eps ? 1.0f - h->ray_eps / len : 0.5f;
+            rad__segment_ray(ev->rays + base + nrays, xs + 3 * s, er->n, ys + 3 * s, es->n, h->ray_eps);
             ev->w[base + nrays] = (float)w;
             ev->idx[base + nrays] = l;
             if (++nrays == RAD__RAY_BATCH) {
@@ -9880,14 +9877,10 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
         h->st.links_evaluated += count;
         if (r != RAD_SUCCESS) rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the raycaster failed");
     }
-    rad__free(&h->allocator, ev.rays);
-    rad__free(&h->allocator, ev.occ);
-    rad__free(&h->allocator, ev.w);
-    rad__free(&h->allocator, ev.idx);
-    rad__free(&h->allocator, ev.kernels);
-    rad__free(&h->allocator, ev.rays_cast);
-    rad__free(&h->allocator, ev.proj);
-    rad__free(&h->allocator, ev.results);
+    {
+        void *blocks[] = { ev.rays, ev.occ, ev.w, ev.idx, ev.kernels, ev.rays_cast, ev.proj, ev.results };
+        rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -10952,9 +10945,8 @@ static rad_result rad__mb_new(const rad__ctx *c, uint32_t n, uint32_t k, rad_mb_
     if (!rad__mul((size_t)n, (size_t)n, &nn) || !rad__mul3(nn, 3, precision == RAD_MB_HALF ? 2u : 4u, &bytes[0]))
         return RAD_ERROR_SIZE_OVERFLOW;
     bytes[1] = bytes[2] = perms ? (size_t)n * sizeof(uint32_t) : 0;
-    mb = (rad_multibounce *)rad__alloc(&c->allocator, sizeof(*mb));
+    mb = (rad_multibounce *)rad__alloc_zero(&c->allocator, sizeof(*mb));
     if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(mb, 0, sizeof(*mb));
     mb->allocator = c->allocator;
     mb->storage = rad__mb_carve(c, bytes, 3, parts, &r);
     if (!mb->storage) { rad__free(&c->allocator, mb); return r; }
@@ -11345,11 +11337,10 @@ static rad_result rad__mb_match_groups(const rad__ctx *c, const float *D, uint32
         if (!used[i]) order[at++] = i;
     r = RAD_SUCCESS;
 done:
-    rad__free(&c->allocator, partner);
-    rad__free(&c->allocator, ident);
-    rad__free(&c->allocator, pairs);
-    rad__free(&c->allocator, quads);
-    rad__free(&c->allocator, used);
+    {
+        void *blocks[] = { partner, ident, pairs, quads, used };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -12032,12 +12023,10 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     b = NULL;
     r = RAD_SUCCESS;
 done:
-    rad__free(&c.allocator, owned);
-    rad__free(&c.allocator, W);
-    rad__free(&c.allocator, Wp);
-    rad__free(&c.allocator, ol.row_count);
-    rad__free(&c.allocator, sse);
-    rad__free(&c.allocator, max_err);
+    {
+        void *blocks[] = { owned, W, Wp, ol.row_count, sse, max_err };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     rad_multibounce_blocks_destroy(b);
     return r;
 }
@@ -12637,9 +12626,8 @@ RAD_API rad_result rad_multibounce_load(const rad_container *ct, const char *nam
         r = rad__check_values(&c, what, (const float *)data, total, 1);
     }
     if (r != RAD_SUCCESS) return r;
-    mb = (rad_multibounce *)rad__alloc(&c.allocator, sizeof(*mb));
+    mb = (rad_multibounce *)rad__alloc_zero(&c.allocator, sizeof(*mb));
     if (!mb) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(mb, 0, sizeof(*mb));
     mb->allocator = c.allocator;
     mb->n = info[2];
     mb->bounces = info[3];
@@ -12673,9 +12661,8 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *ct, const ch
                  name ? name : "", info[1], info[4], info[5], n);
         return RAD_ERROR_CORRUPT;
     }
-    b = (rad_multibounce_blocks *)rad__alloc(&c.allocator, sizeof(*b));
+    b = (rad_multibounce_blocks *)rad__alloc_zero(&c.allocator, sizeof(*b));
     if (!b) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(b, 0, sizeof(*b));
     b->allocator = c.allocator;
     b->n = n;
     b->bounces = info[3];
@@ -12805,10 +12792,10 @@ RAD_API void rad_row_stream_destroy(rad_row_stream *s)
     if (!s) return;
     a = s->allocator;
     if (s->f) fclose(s->f);
-    rad__free(&a, s->areas);
-    rad__free(&a, s->albedo);
-    rad__free(&a, s->offsets);
-    rad__free(&a, s);
+    {
+        void *blocks[] = { s->areas, s->albedo, s->offsets, s };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 static int rad__stream_read(FILE *f, uint64_t at, void *dst, size_t bytes)
@@ -13014,9 +13001,8 @@ RAD_API rad_result rad_row_stream_create(const char *path, const rad_context *ct
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!path) return RAD_ERROR_INVALID_ARGUMENT;
-    s = (rad_row_stream *)rad__alloc(&c.allocator, sizeof(rad_row_stream));
+    s = (rad_row_stream *)rad__alloc_zero(&c.allocator, sizeof(rad_row_stream));
     if (!s) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof(*s));
     s->allocator = c.allocator;
     s->log = c;
     s->f = fopen(path, "rb");
@@ -13139,9 +13125,8 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
         if (part < sizes[k] || total + part < total) return RAD_ERROR_SIZE_OVERFLOW;
         total += part;
     }
-    L = (rad_local *)rad__alloc(&c.allocator, sizeof(rad_local));
+    L = (rad_local *)rad__alloc_zero(&c.allocator, sizeof(rad_local));
     if (!L) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(L, 0, sizeof(*L));
     L->allocator = c.allocator;
     mem = (unsigned char *)rad__alloc(&c.allocator, total + 64u);
     if (!mem) { rad__free(&c.allocator, L); return RAD_ERROR_OUT_OF_MEMORY; }
@@ -13210,19 +13195,24 @@ static void rad__local_range(uint32_t count, uint32_t tasks, uint32_t t, uint32_
     *e = (uint32_t)((uint64_t)count * (t + 1) / tasks);
 }
 
+/* row i of channel ch's plane of the inverse (M x M floats a channel) */
+static float *rad__local_row(const rad__local_job *J, uint32_t ch, uint32_t i)
+{
+    return J->st->planes + ch * ((size_t)J->M * J->M) + (size_t)i * J->M;
+}
+
 /* u_i = a_i + sum_j T_ij a_j over the slots, in double */
 static void rad__local_u_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
     const rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t i0, i1, i, ch, p;
     rad__local_range(J->end, J->tasks, t, &i0, &i1);
     for (ch = 0; ch < 3; ++ch) {
         const double *a = s->a + (size_t)ch * J->M;
         double *u = s->u + (size_t)ch * J->M;
         for (i = i0; i < i1; ++i) {
-            const float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+            const float *row = rad__local_row(J, ch, i);
             double acc = a[i];
             /* a is non-zero only on the slots of the new row: a sparse gather, exact in double */
             for (p = 0; p < J->nnz; ++p) {
@@ -13239,7 +13229,6 @@ static void rad__local_v_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
     const rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t j0, j1, j, ch, p;
     rad__local_range(J->end, J->tasks, t, &j0, &j1);
     for (ch = 0; ch < 3; ++ch) {
@@ -13248,7 +13237,7 @@ static void rad__local_v_task(void *data, uint32_t t)
         for (j = j0; j < j1; ++j) v[j] = b[j];
         for (p = 0; p < J->nnz; ++p) {
             uint32_t i = s->nz[p];
-            const float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+            const float *row = rad__local_row(J, ch, i);
             double bi = b[i];
             for (j = j0; j < j1; ++j) v[j] += bi * (double)row[j];
         }
@@ -13261,7 +13250,6 @@ static void rad__local_update_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
     const rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t i0, i1, i, j, ch;
     rad__local_range(J->end, J->tasks, t, &i0, &i1);
     for (ch = 0; ch < 3; ++ch) {
@@ -13269,17 +13257,17 @@ static void rad__local_update_task(void *data, uint32_t t)
         const float *v = s->vf + (size_t)ch * J->M;
         if (J->ev == RAD_NONE) {
             for (i = i0; i < i1; ++i) {
-                float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+                float *row = rad__local_row(J, ch, i);
                 float ui = (float)(J->cuv[ch] * u[i]);
                 if (ui == 0.0f) continue;
                 for (j = 0; j < J->end; ++j) row[j] += ui * v[j];
             }
         } else {
             /* rank 2: the downdate of slot e and the new patch's update in one pass */
-            const float *re = J->st->planes + ch * MM + (size_t)J->ev * J->M;
+            const float *re = rad__local_row(J, ch, J->ev);
             const double *cc = s->cc + (size_t)ch * J->M;
             for (i = i0; i < i1; ++i) {
-                float *row = J->st->planes + ch * MM + (size_t)i * J->M;
+                float *row = rad__local_row(J, ch, i);
                 float ui = (float)(J->cuv[ch] * u[i]), ci = (float)(-cc[i] / J->g[ch]);
                 if (i == J->ev || (ui == 0.0f && ci == 0.0f)) continue;
                 for (j = 0; j < J->end; ++j) row[j] += ci * re[j] + ui * v[j];
@@ -13356,17 +13344,26 @@ static uint32_t rad__local_free_slot(const rad_local *L)
 
 /* The stages of rad_local_add, in the order it runs them. */
 
+/* the set and a patch index a call names, logged under the call's name when out of range */
+static rad_result rad__local_patch_check(const rad__ctx *c, const rad_local *L, uint32_t patch, const char *name)
+{
+    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
+    if (patch >= L->n) {
+        rad__log(c, RAD_LOG_ERROR, "%s: patch %u >= n = %u", name, patch, L->n);
+        return RAD_ERROR_INDEX_OUT_OF_RANGE;
+    }
+    return RAD_SUCCESS;
+}
+
 /* checks the patch; a hidden member only becomes visible again (*done = 1): its transport is
    all there */
 static rad_result rad__local_add_check(const rad__ctx *c, rad_local *L, uint32_t patch, int *done)
 {
     rad__local_storage *st = (rad__local_storage *)L->storage;
     uint32_t k;
+    rad_result r;
     *done = 0;
-    if (patch >= L->n) {
-        rad__log(c, RAD_LOG_ERROR, "rad_local_add: patch %u >= n = %u", patch, L->n);
-        return RAD_ERROR_INDEX_OUT_OF_RANGE;
-    }
+    if ((r = rad__local_patch_check(c, L, patch, "rad_local_add")) != RAD_SUCCESS) return r;
     k = L->patch_slot[patch];
     if (k != RAD_NONE && st->slot_hidden[k]) {
         st->slot_hidden[k] = 0;
@@ -13467,11 +13464,10 @@ static void rad__local_add_evict_u(rad__local_job *J)
 static void rad__local_add_evict_v(rad__local_job *J)
 {
     rad__local_scratch *s = &J->st->s;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t ch, i;
     for (ch = 0; ch < 3; ++ch) {
         double *v = s->v + (size_t)ch * J->M, bc = v[J->ev] / J->g[ch];
-        const float *re = J->st->planes + ch * MM + (size_t)J->ev * J->M;
+        const float *re = rad__local_row(J, ch, J->ev);
         for (i = 0; i < J->end; ++i) v[i] -= bc * (double)re[i];
         v[J->ev] = 0.0;
     }
@@ -13582,12 +13578,9 @@ RAD_API rad_result rad_local_remove(rad_local *L, uint32_t patch, const rad_cont
     rad__ctx c;
     rad__local_storage *st;
     uint32_t k;
+    rad_result r;
     rad__ctx_init(&c, ctx);
-    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
-    if (patch >= L->n) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_local_remove: patch %u >= n = %u", patch, L->n);
-        return RAD_ERROR_INDEX_OUT_OF_RANGE;
-    }
+    if ((r = rad__local_patch_check(&c, L, patch, "rad_local_remove")) != RAD_SUCCESS) return r;
     st = (rad__local_storage *)L->storage;
     k = L->patch_slot[patch];
     if (k == RAD_NONE || st->slot_hidden[k]) {
@@ -13630,12 +13623,9 @@ RAD_API rad_result rad_local_evict(rad_local *L, uint32_t patch, const rad_conte
     rad__local_job J;
     uint32_t k, i, j, ch, M;
     size_t MM;
+    rad_result r;
     rad__ctx_init(&c, ctx);
-    if (!L) return RAD_ERROR_INVALID_ARGUMENT;
-    if (patch >= L->n) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_local_evict: patch %u >= n = %u", patch, L->n);
-        return RAD_ERROR_INDEX_OUT_OF_RANGE;
-    }
+    if ((r = rad__local_patch_check(&c, L, patch, "rad_local_evict")) != RAD_SUCCESS) return r;
     k = L->patch_slot[patch];
     if (k == RAD_NONE) {
         rad__log(&c, RAD_LOG_ERROR, "rad_local_evict: patch %u is not a member", patch);
@@ -13747,12 +13737,10 @@ static rad_result rad__local_invert(const rad__ctx *c, float *X, uint32_t m, siz
                 X[(size_t)i * ld + kb + j] = (i >= kb && i < kb + b) ? dinv[(size_t)(i - kb) * b + j] : tmp[(size_t)i * b + j];
     }
 done:
-    rad__free(&c->allocator, cbuf);
-    rad__free(&c->allocator, rbuf);
-    rad__free(&c->allocator, rp);
-    rad__free(&c->allocator, tmp);
-    rad__free(&c->allocator, dinv);
-    rad__free(&c->allocator, d);
+    {
+        void *blocks[] = { cbuf, rbuf, rp, tmp, dinv, d };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -13860,12 +13848,11 @@ RAD_API rad_result rad_local_rebuild(rad_local *L, const uint32_t *patches, uint
 static void rad__local_apply_task(void *data, uint32_t t)
 {
     const rad__local_job *J = (const rad__local_job *)data;
-    size_t MM = (size_t)J->M * J->M;
     uint32_t r0, r1, r, ch;
     rad__local_range(J->row_count, J->tasks, t, &r0, &r1);
     for (r = r0; r < r1; ++r)
         for (ch = 0; ch < 3; ++ch)
-            J->y[3 * (size_t)r + ch] = rad__dot_f32(J->st->planes + ch * MM + (size_t)J->rows[r] * J->M,
+            J->y[3 * (size_t)r + ch] = rad__dot_f32(rad__local_row(J, ch, J->rows[r]),
                                                    J->e + (size_t)ch * J->end, J->end);
 }
 
@@ -14392,9 +14379,8 @@ static rad_result rad__alias_build(const rad_matrix *F, const float *plane, uint
     bins_off = tot_off + ((tot_bytes + 7u) & ~(size_t)7u);
     total = bins_off + bin_bytes;
     if (total < bin_bytes) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_SIZE_OVERFLOW; }
-    t = (rad_alias_tables *)rad__alloc(&c.allocator, sizeof(rad_alias_tables));
+    t = (rad_alias_tables *)rad__alloc_zero(&c.allocator, sizeof(rad_alias_tables));
     if (!t) { rad__free(&c.allocator, job.offsets); return RAD_ERROR_OUT_OF_MEMORY; }
-    memset(t, 0, sizeof(*t));
     t->allocator = c.allocator;
     base = rad__alias_alloc(&c.allocator, total, &t->storage);
     job.scratch_stride = (rad_alias_row_scratch_size((uint32_t)maxrow) + 7u) & ~(size_t)7u;
@@ -14510,9 +14496,8 @@ RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *src, rad_a
             bins_off = tot_off + ((tot_bytes + 7u) & ~(size_t)7u);
             total = bins_off + bin_bytes;
             if (total < bin_bytes) { r = RAD_ERROR_SIZE_OVERFLOW; break; }
-            t = (rad_alias_tables *)rad__alloc(&c.allocator, sizeof(rad_alias_tables));
+            t = (rad_alias_tables *)rad__alloc_zero(&c.allocator, sizeof(rad_alias_tables));
             if (!t) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
-            memset(t, 0, sizeof(*t));
             t->allocator = c.allocator;
             base = rad__alias_alloc(&c.allocator, total, &t->storage);
             if (!base) { r = RAD_ERROR_OUT_OF_MEMORY; break; }
@@ -14579,10 +14564,10 @@ RAD_API rad_result rad_alias_tables_create_rows(const rad_row_source *src, rad_a
     }
 done:
     rad_alias_tables_destroy(t);
-    rad__free(&c.allocator, off);
-    rad__free(&c.allocator, cols);
-    rad__free(&c.allocator, vals);
-    rad__free(&c.allocator, scratch);
+    {
+        void *blocks[] = { off, cols, vals, scratch };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -14775,9 +14760,8 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
         }
     }
     if ((uint64_t)o.samples * table_count > 0xFFFFFFFFull) return RAD_ERROR_INVALID_ARGUMENT;
-    t = (rad_temporal *)rad__alloc(&c.allocator, sizeof(rad_temporal));
+    t = (rad_temporal *)rad__alloc_zero(&c.allocator, sizeof(rad_temporal));
     if (!t) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(t, 0, sizeof(*t));
     t->c = c;
     for (k = 0; k < table_count; ++k) t->tables[k] = tables[k];
     t->table_count = table_count;
@@ -15360,26 +15344,14 @@ RAD_API void rad_vp_destroy(rad_virtual_patches *vp)
     rad_allocator a;
     if (!vp) return;
     a = vp->allocator;
-    rad__free(&a, vp->areas);
-    rad__free(&a, vp->albedo);
-    rad__free(&a, vp->normals);
-    rad__free(&a, vp->axis);
-    rad__free(&a, vp->voxel);
-    rad__free(&a, (void *)vp->matrix.dense);
-    rad__free(&a, (void *)vp->matrix.row_offsets);
-    rad__free(&a, (void *)vp->matrix.columns);
-    rad__free(&a, (void *)vp->matrix.values);
-    rad__free(&a, vp->voxel_keys);
-    rad__free(&a, vp->voxel_first);
-    rad__free(&a, vp->voxel_patch);
-    rad__free(&a, vp->sample_first);
-    rad__free(&a, vp->sample_positions);
-    rad__free(&a, vp->sample_normals);
-    rad__free(&a, vp->sample_albedo);
-    rad__free(&a, vp->sample_areas);
-    rad__free(&a, vp->sample_weights);
-    rad__free(&a, vp->sample_triangles);
-    rad__free(&a, vp);
+    {
+        void *blocks[] = { vp->areas, vp->albedo, vp->normals, vp->axis, vp->voxel, (void *)vp->matrix.dense,
+                           (void *)vp->matrix.row_offsets, (void *)vp->matrix.columns, (void *)vp->matrix.values,
+                           vp->voxel_keys, vp->voxel_first, vp->voxel_patch, vp->sample_first, vp->sample_positions,
+                           vp->sample_normals, vp->sample_albedo, vp->sample_areas, vp->sample_weights,
+                           vp->sample_triangles, vp };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 RAD_API size_t rad_vp_memory(const rad_virtual_patches *vp)
@@ -15484,6 +15456,33 @@ static rad_result rad__vp_face_row(void *data, uint32_t row, uint32_t task)
 
 /* ---- form factors: one row voxel per call ---- */
 
+/* The kernel G_ij of samples i and j: cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2;
+   each factor s (c / d^2) is a length, so no product leaves float's range (s_i s_j alone
+   overflowed in scenes of 1e12 and underflowed below 1e-9); 0 when they do not face. */
+static inline float rad__vp_pair_kernel(const rad__vp_build *b, uint32_t i, uint32_t j)
+{
+    const rad_virtual_patches *vp = b->vp;
+    const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
+    const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
+    float d[3], d2, ci, cj, ei = b->eff[i], ej = b->eff[j], fl;
+    rad__sub(d, pj, pi_);
+    ci = rad__dot(d, ni);
+    if (!(ci > 0.0f)) return 0.0f;
+    cj = -rad__dot(d, nj);
+    if (!(cj > 0.0f)) return 0.0f;
+    d2 = rad__dot(d, d);
+    fl = (ei > ej ? ei : ej) / (float)RAD__PI;
+    return (vp->sample_areas[i] * (ci / d2)) * (vp->sample_areas[j] * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI;
+}
+
+/* the shadow ray between samples i and j, both ends lifted off their surfaces */
+static void rad__vp_pair_ray(const rad__vp_build *b, rad_ray *ray, uint32_t i, uint32_t j)
+{
+    const rad_virtual_patches *vp = b->vp;
+    rad__segment_ray(ray, vp->sample_positions + 3 * (size_t)i, vp->sample_normals + 3 * (size_t)i,
+                     vp->sample_positions + 3 * (size_t)j, vp->sample_normals + 3 * (size_t)j, b->eps);
+}
+
 static void rad__vp_pair_add(rad__vp_build *b, double *acc, uint32_t u, uint32_t i, uint32_t j, double g)
 {
     const rad_virtual_patches *vp = b->vp;
@@ -15527,37 +15526,15 @@ static rad_result rad__vp_ff_row(void *data, uint32_t u, uint32_t task)
     rad_result r = RAD_SUCCESS;
     for (a = 0; a < 6; ++a) memset(acc + (size_t)a * N + pf, 0, sizeof(double) * (N - pf));
     for (i = vp->sample_first[u]; i < vp->sample_first[u + 1] && r == RAD_SUCCESS; ++i) {
-        const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
-        float ei = b->eff[i];
         for (j = i + 1; j < M; ++j) {
-            const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
-            float d[3], d2, ci, cj, ej = b->eff[j], fl, g, len;
-            int k;
-            rad__sub(d, pj, pi_);
-            ci = rad__dot(d, ni);
-            if (!(ci > 0.0f)) continue;
-            cj = -rad__dot(d, nj);
-            if (!(cj > 0.0f)) continue;
-            d2 = rad__dot(d, d);
-            fl = (ei > ej ? ei : ej) / (float)RAD__PI;
-            /* cos_i cos_j / d^2 = ci cj / d^4 with the clamp on d^2; each factor s (c / d^2)
-               is a length, so no product leaves float's range (s_i s_j alone overflowed in
-               scenes of 1e12 and underflowed below 1e-9) */
-            g = (vp->sample_areas[i] * (ci / d2)) * (vp->sample_areas[j] * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI;
+            float g = rad__vp_pair_kernel(b, i, j);
             if (!(g > 0.0f)) continue;
             if (b->o.skip_visibility) {
                 rad__vp_pair_add(b, acc, u, i, j, (double)g);
                 continue;
             }
             {
-                rad_ray *ray = b->rays + at + nrays;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
-                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+                rad__vp_pair_ray(b, b->rays + at + nrays, i, j);
                 b->ray_i[at + nrays] = i;
                 b->ray_j[at + nrays] = j;
                 b->ray_g[at + nrays] = g;
@@ -15614,23 +15591,12 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
         uint32_t n = 0, stride = 1, seen = 0, s, nr = 0;
         memset(p0, 0, sizeof(p0));
         for (i = vp->sample_first[u]; i < vp->sample_first[u + 1]; ++i) {
-            const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
             const float *wi = vp->sample_weights + 6 * (size_t)i;
-            float si = vp->sample_areas[i], ei = b->eff[i];
             double t6[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; /* sum_j g_ij w_jc */
             for (j = (v == u ? i + 1 : vp->sample_first[v]); j < vp->sample_first[v + 1]; ++j) {
-                const float *pj = vp->sample_positions + 3 * (size_t)j, *nj = vp->sample_normals + 3 * (size_t)j;
                 const float *wj = vp->sample_weights + 6 * (size_t)j;
-                float d[3], d2, ci, cj, sj = vp->sample_areas[j], ej = b->eff[j], fl, g;
+                float g = rad__vp_pair_kernel(b, i, j);
                 uint32_t c;
-                rad__sub(d, pj, pi_);
-                ci = rad__dot(d, ni);
-                if (!(ci > 0.0f)) continue;
-                cj = -rad__dot(d, nj);
-                if (!(cj > 0.0f)) continue;
-                d2 = rad__dot(d, d);
-                fl = (ei > ej ? ei : ej) / (float)RAD__PI;
-                g = (si * (ci / d2)) * (sj * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI; /* as above */
                 if (!(g > 0.0f)) continue;
                 for (c = 0; c < 6; ++c) t6[c] += (double)g * (double)wj[c];
                 if (b->o.skip_visibility) continue;
@@ -15660,21 +15626,7 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
         for (s = 0; s < n; ++s) total += (double)list[s].g;
         if (n <= K) {
             /* every pair its ray: the kernel-weighted visible fraction */
-            for (s = 0; s < n; ++s) {
-                const rad__vp_pair *q = &list[s];
-                rad_ray *ray = b->rays + at + s;
-                const float *pi_ = vp->sample_positions + 3 * (size_t)q->i, *ni = vp->sample_normals + 3 * (size_t)q->i;
-                const float *pj = vp->sample_positions + 3 * (size_t)q->j, *nj = vp->sample_normals + 3 * (size_t)q->j;
-                float len;
-                int k;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
-                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
-            }
+            for (s = 0; s < n; ++s) rad__vp_pair_ray(b, b->rays + at + s, list[s].i, list[s].j);
             nr = n;
         } else {
             /* K pairs drawn with probability proportional to g, stratified */
@@ -15683,22 +15635,8 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
             uint32_t q = 0;
             for (s = 0; s < K; ++s) {
                 double target = ((double)s + r) / (double)K * total;
-                rad_ray *ray = b->rays + at + s;
-                const float *pi_, *ni, *pj, *nj;
-                float len;
-                int k;
                 while (q + 1 < n && cum + (double)list[q].g <= target) cum += (double)list[q++].g;
-                pi_ = vp->sample_positions + 3 * (size_t)list[q].i;
-                ni = vp->sample_normals + 3 * (size_t)list[q].i;
-                pj = vp->sample_positions + 3 * (size_t)list[q].j;
-                nj = vp->sample_normals + 3 * (size_t)list[q].j;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pi_[k] + ni[k] * b->eps;
-                    ray->dir[k] = pj[k] + nj[k] * b->eps - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * b->eps ? 1.0f - b->eps / len : 0.5f;
+                rad__vp_pair_ray(b, b->rays + at + s, list[q].i, list[q].j);
                 b->ray_g[at + s] = 1.0f;
                 b->ray_i[at + s] = list[q].i;
                 b->ray_j[at + s] = list[q].j;
@@ -15941,11 +15879,10 @@ static rad_result rad__vp_sparse_rows(rad__vp_build *b, const rad__ctx *c, uint3
             }
         }
     }
-    rad__free(A, uoff);
-    rad__free(A, ucol);
-    rad__free(A, uval);
-    rad__free(A, lcnt);
-    rad__free(A, pos);
+    {
+        void *blocks[] = { uoff, ucol, uval, lcnt, pos };
+        rad__free_each(*A, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) {
         rad__free(A, off);
         rad__free(A, col);
@@ -16649,37 +16586,13 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     r = rad__vp_form_factors(b, c, bytes);
 done:
     if (b->o.storage == RAD_STORAGE_SPARSE) rad__free(A, b->P); /* the chunk buffer (NULL once used) */
-    rad__free(A, cand);
-    rad__free(A, cand_area);
-    rad__free(A, voxel_cand);
-    rad__free(A, cand_first);
-    rad__free(A, tri_count);
-    rad__free(A, s_pos);
-    rad__free(A, s_tri);
-    rad__free(A, s_vox);
-    rad__free(A, s_bary);
-    rad__free(A, b->hits);
-    rad__free(A, b->rays);
-    rad__free(A, b->occ);
-    rad__free(A, b->ray_i);
-    rad__free(A, b->ray_j);
-    rad__free(A, b->ray_g);
-    rad__free(A, b->rays_cast);
-    rad__free(A, b->acc);
-    rad__free(A, b->pairs);
-    rad__free(A, b->eff);
-    rad__free(A, b->rowf);
-    rad__free(A, b->share);
-    rad__free(A, b->share_hits);
-    rad__free(A, b->target);
-    rad__free(A, b->dscale);
-    rad__free(A, b->dnext);
-    rad__free(A, b->vscale);
-    rad__free(A, b->cols);
-    rad__free(A, b->cscratch);
-    rad__free(A, b->slot);
-    rad__free(A, b->ncl);
-    rad__free(A, b->sample_voxel);
+    {
+        void *blocks[] = { cand, cand_area, voxel_cand, cand_first, tri_count, s_pos, s_tri, s_vox, s_bary, b->hits,
+                           b->rays, b->occ, b->ray_i, b->ray_j, b->ray_g, b->rays_cast, b->acc, b->pairs, b->eff,
+                           b->rowf, b->share, b->share_hits, b->target, b->dscale, b->dnext, b->vscale, b->cols,
+                           b->cscratch, b->slot, b->ncl, b->sample_voxel };
+        rad__free_each(*A, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -16727,9 +16640,8 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
                  (double)b.o.ray_epsilon);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    vp = (rad_virtual_patches *)rad__alloc_zero(&c.allocator, sizeof(*vp));
     if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(vp, 0, sizeof(*vp));
     vp->allocator = c.allocator;
     vp->scene = scene;
     vp->weights = b.o.weights;
@@ -16896,6 +16808,23 @@ static float rad__vp_face_weight(const rad_virtual_patches *vp, uint32_t v, uint
     return vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)*q, n) : w[a];
 }
 
+/* The patches of voxel v that face normal n (w: the axis weights of n): their patches in q,
+   weights in wa and count in *count, in axis order; returns the weights' sum. */
+static double rad__vp_voxel_faces(const rad_virtual_patches *vp, uint32_t v, const float n[3], const float w[6],
+                                  uint32_t *q, double *wa, uint32_t *count)
+{
+    double ws = 0.0;
+    uint32_t a;
+    *count = 0;
+    for (a = 0; a < 6; ++a) {
+        float x = rad__vp_face_weight(vp, v, a, n, w, q + *count);
+        if (!(x > 0.0f)) continue;
+        ws += (double)x;
+        wa[(*count)++] = (double)x;
+    }
+    return ws;
+}
+
 /* The trilinear lattice of a point: the voxel-centre cell below p (clamped two cells outside
    the grid) in base, the fractions in g. */
 static void rad__vp_lattice(const rad_virtual_patches *vp, const float p[3], int64_t base[3], double g[3])
@@ -16942,17 +16871,13 @@ RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float 
     rad__vp_weights(vp->weights, n, w);
     rad__vp_lattice(vp, p, base, g);
     for (corner = 0; corner < 8; ++corner) {
-        double t, L[3] = { 0.0, 0.0, 0.0 }, ws = 0.0;
-        uint32_t a, v = rad__vp_corner(vp, base, g, corner, &t);
+        double t, L[3] = { 0.0, 0.0, 0.0 }, ws, wa[6];
+        uint32_t q[6], f, nf, v = rad__vp_corner(vp, base, g, corner, &t);
         if (v == RAD_NONE) continue;
-        for (a = 0; a < 6; ++a) {
-            uint32_t q;
-            float wa = rad__vp_face_weight(vp, v, a, n, w, &q);
-            if (!(wa > 0.0f)) continue;
-            ws += (double)wa;
-            for (k = 0; k < 3; ++k) L[k] += (double)wa * (double)values[3 * (size_t)q + k];
-        }
+        ws = rad__vp_voxel_faces(vp, v, n, w, q, wa, &nf);
         if (!(ws > 0.0)) continue; /* nothing in this voxel faces n */
+        for (f = 0; f < nf; ++f)
+            for (k = 0; k < 3; ++k) L[k] += wa[f] * (double)values[3 * (size_t)q[f] + k];
         used++;
         for (k = 0; k < 3; ++k) {
             acc[k] += t * L[k] / ws;
@@ -17086,19 +17011,13 @@ static uint32_t rad__vp_gather_weights(const rad_virtual_patches *vp, const floa
     rad__vp_weights(vp->weights, n, w);
     rad__vp_lattice(vp, p, base, g);
     for (corner = 0; corner < 8; ++corner) {
-        double t, ws = 0.0;
-        uint32_t a, first = cnt, v = rad__vp_corner(vp, base, g, corner, &t);
+        double t, ws;
+        uint32_t nf, v = rad__vp_corner(vp, base, g, corner, &t);
         if (v == RAD_NONE) continue;
-        for (a = 0; a < 6; ++a) {
-            uint32_t q;
-            float wa = rad__vp_face_weight(vp, v, a, n, w, &q);
-            if (!(wa > 0.0f)) continue;
-            ws += (double)wa;
-            idx[cnt] = q;
-            raw[cnt++] = (double)wa;
-        }
-        if (!(ws > 0.0)) { cnt = first; continue; } /* nothing in this voxel faces n */
-        start[used] = first;
+        ws = rad__vp_voxel_faces(vp, v, n, w, idx + cnt, raw + cnt, &nf);
+        if (!(ws > 0.0)) continue; /* nothing in this voxel faces n */
+        start[used] = cnt;
+        cnt += nf;
         tv[used] = t;
         wsv[used++] = ws;
         tsum += t;
@@ -17134,14 +17053,7 @@ static void rad__vp_table_task(void *data, uint32_t task)
             memcpy(j->t->weight + j->t->offsets[i], w, sizeof(float) * n);
         } else { /* apply */
             const rad_vp_gather_table *t = j->t;
-            const float *x = j->values;
-            float a0 = 0.0f, a1 = 0.0f, a2 = 0.0f;
-            uint32_t e;
-            for (e = t->offsets[i]; e < t->offsets[i + 1]; ++e) {
-                const float *q = x + 3 * (size_t)t->patch[e], g = t->weight[e];
-                a0 += g * q[0], a1 += g * q[1], a2 += g * q[2];
-            }
-            j->out[3 * (size_t)i] = a0, j->out[3 * (size_t)i + 1] = a1, j->out[3 * (size_t)i + 2] = a2;
+            rad__sparse_row3(t->patch, t->weight, t->offsets[i], t->offsets[i + 1], j->values, j->out + 3 * (size_t)i);
         }
     }
 }
@@ -17151,10 +17063,10 @@ RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table)
     rad_allocator a;
     if (!table) return;
     a = table->allocator;
-    rad__free(&a, table->offsets);
-    rad__free(&a, table->patch);
-    rad__free(&a, table->weight);
-    rad__free(&a, table);
+    {
+        void *blocks[] = { table->offsets, table->patch, table->weight, table };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, const float *points, const float *normals,
@@ -17173,9 +17085,8 @@ RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, con
             rad__log(&c, RAD_LOG_ERROR, "rad_vp_gather_table_create: point %u or its normal is not finite", i);
             return RAD_ERROR_NON_FINITE;
         }
-    t = (rad_vp_gather_table *)rad__alloc(&c.allocator, sizeof(*t));
+    t = (rad_vp_gather_table *)rad__alloc_zero(&c.allocator, sizeof(*t));
     if (!t) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(t, 0, sizeof(*t));
     t->allocator = c.allocator;
     t->count = count;
     t->patches = vp->count;
@@ -17288,11 +17199,10 @@ RAD_API void rad_vp_lights_destroy(rad_vp_lights *s)
     if (!s) return;
     a = s->allocator;
     for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) rad__free(&a, s->vis[l]);
-    rad__free(&a, s->normals);
-    rad__free(&a, s->v);
-    rad__free(&a, s->emit);
-    rad__free(&a, s->sky);
-    rad__free(&a, s);
+    {
+        void *blocks[] = { s->normals, s->v, s->emit, s->sky, s };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 RAD_API void rad_vp_lights_refresh(rad_vp_lights *s)
@@ -17320,9 +17230,8 @@ RAD_API rad_result rad_vp_lights_create(const rad_virtual_patches *vp, const rad
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_lights_create: the set has no scene (rad_vp_load with scene NULL)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    s = (rad_vp_lights *)rad__alloc(&c.allocator, sizeof(*s));
+    s = (rad_vp_lights *)rad__alloc_zero(&c.allocator, sizeof(*s));
     if (!s) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof(*s));
     s->allocator = c.allocator;
     s->vp = vp;
     s->rc = raycaster;
@@ -17572,15 +17481,33 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     } else {
         rad_vp_lights_refresh(s);
     }
-    rad__free(&c.allocator, j.rays);
-    rad__free(&c.allocator, j.occ);
-    rad__free(&c.allocator, j.ray_sample);
-    rad__free(&c.allocator, j.ray_light);
-    rad__free(&c.allocator, j.task_rays);
+    {
+        void *blocks[] = { j.rays, j.occ, j.ray_sample, j.ray_light, j.task_rays };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
 /* ---- container ---- */
+
+/* The set's arrays in section order (type, bytes per element, count of N patches, V voxels or
+   M samples, field, element type): rad_vp_sections writes them and rad_vp_load reads them. */
+#define RAD__VP_ARRAYS(X)                                                        \
+    X(RAD_SECTION_VP_AREAS, 4, N, areas, float)                                  \
+    X(RAD_SECTION_VP_ALBEDO, 12, N, albedo, float)                               \
+    X(RAD_SECTION_VP_NORMALS, 12, N, normals, float)                             \
+    X(RAD_SECTION_VP_AXIS, 1, N, axis, uint8_t)                                  \
+    X(RAD_SECTION_VP_VOXEL, 4, N, voxel, uint32_t)                               \
+    X(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys, uint64_t)                     \
+    X(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first, uint32_t)    \
+    X(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch, uint32_t)                  \
+    X(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first, uint32_t)  \
+    X(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions, float)           \
+    X(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals, float)               \
+    X(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo, float)                 \
+    X(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas, float)                    \
+    X(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights, float)               \
+    X(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles, uint32_t)
 
 RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *name, rad_section *out, uint32_t *out_count)
 {
@@ -17589,21 +17516,9 @@ RAD_API rad_result rad_vp_sections(const rad_virtual_patches *vp, const char *na
     if (!vp || !out || !out_count || !vp->matrix.rows) return RAD_ERROR_INVALID_ARGUMENT;
     N = vp->count, V = vp->voxel_count, M = vp->sample_count;
     rad__section(&out[k++], RAD_SECTION_VP_INFO, 4, 16, vp->info_record, name);
-    rad__section(&out[k++], RAD_SECTION_VP_AREAS, 4, N, vp->areas, name);
-    rad__section(&out[k++], RAD_SECTION_VP_ALBEDO, 12, N, vp->albedo, name);
-    rad__section(&out[k++], RAD_SECTION_VP_NORMALS, 12, N, vp->normals, name);
-    rad__section(&out[k++], RAD_SECTION_VP_AXIS, 1, N, vp->axis, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL, 4, N, vp->voxel, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_KEYS, 8, V, vp->voxel_keys, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, vp->voxel_first, name);
-    rad__section(&out[k++], RAD_SECTION_VP_VOXEL_PATCH, 24, V, vp->voxel_patch, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, vp->sample_first, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, vp->sample_positions, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, vp->sample_normals, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, vp->sample_albedo, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_AREAS, 4, M, vp->sample_areas, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, vp->sample_weights, name);
-    rad__section(&out[k++], RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, vp->sample_triangles, name);
+#define RAD__VP_SECTION(type, elem, count, field, ctype) rad__section(&out[k++], type, elem, count, vp->field, name);
+    RAD__VP_ARRAYS(RAD__VP_SECTION)
+#undef RAD__VP_SECTION
     if (vp->matrix.storage == RAD_STORAGE_SPARSE) {
         uint64_t nnz = vp->matrix.row_offsets[N];
         rad__section(&out[k++], RAD_SECTION_FF_ROW_OFFSETS, 8, (uint64_t)N + 1u, vp->matrix.row_offsets, name);
@@ -17715,9 +17630,8 @@ RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const 
     N = info[2], V = info[3], M = info[4];
     if (info[0] > 1u || info[1] > 1u || N == 0 || V == 0 || M == 0 || N > 6u * (uint64_t)V || info[15] != 0)
         return rad__vp_bad(&c, "VP_INFO: unknown kind or weights, or counts out of range", 0);
-    vp = (rad_virtual_patches *)rad__alloc(&c.allocator, sizeof(*vp));
+    vp = (rad_virtual_patches *)rad__alloc_zero(&c.allocator, sizeof(*vp));
     if (!vp) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(vp, 0, sizeof(*vp));
     vp->allocator = c.allocator;
     vp->scene = scene;
     vp->kind = (rad_vp_kind)info[0];
@@ -17736,21 +17650,7 @@ RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const 
         r = rad__vp_take(&c, ct, name, type, elem, count, &p_);                                        \
         vp->field = (ctype *)p_;                                                                       \
     }
-    RAD__VP_TAKE(RAD_SECTION_VP_AREAS, 4, N, areas, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_ALBEDO, 12, N, albedo, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_NORMALS, 12, N, normals, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_AXIS, 1, N, axis, uint8_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL, 4, N, voxel, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_KEYS, 8, V, voxel_keys, uint64_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_FIRST, 4, (uint64_t)V + 1u, voxel_first, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_VOXEL_PATCH, 24, V, voxel_patch, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_FIRST, 4, (uint64_t)V + 1u, sample_first, uint32_t)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_POSITIONS, 12, M, sample_positions, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_NORMALS, 12, M, sample_normals, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_ALBEDO, 12, M, sample_albedo, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_AREAS, 4, M, sample_areas, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_WEIGHTS, 24, M, sample_weights, float)
-    RAD__VP_TAKE(RAD_SECTION_VP_SAMPLE_TRIANGLES, 4, M, sample_triangles, uint32_t)
+    RAD__VP_ARRAYS(RAD__VP_TAKE)
 #undef RAD__VP_TAKE
     vp->matrix.rows = vp->matrix.cols = N;
     if (r == RAD_SUCCESS && rad_container_find(ct, RAD_SECTION_FF_ROW_OFFSETS, name)) {
@@ -17828,15 +17728,11 @@ RAD_API void rad_lightmap_destroy(rad_lightmap *lm)
     rad_allocator a;
     if (!lm) return;
     a = lm->allocator;
-    rad__free(&a, lm->flags);
-    rad__free(&a, lm->positions);
-    rad__free(&a, lm->normals);
-    rad__free(&a, lm->sample_first);
-    rad__free(&a, lm->sample_positions);
-    rad__free(&a, lm->sample_normals);
-    rad__free(&a, lm->sample_triangles);
-    rad__free(&a, lm->sample_valid);
-    rad__free(&a, lm);
+    {
+        void *blocks[] = { lm->flags, lm->positions, lm->normals, lm->sample_first, lm->sample_positions,
+                           lm->sample_normals, lm->sample_triangles, lm->sample_valid, lm };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* 1 when the uv triangle t (texel units, 6 doubles) and the box [x0,x1] x [y0,y1] overlap
@@ -17998,9 +17894,8 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
         return RAD_ERROR_SIZE_OVERFLOW;
     }
     slots = texels * S;
-    lm = (rad_lightmap *)rad__alloc(&c.allocator, sizeof(rad_lightmap));
+    lm = (rad_lightmap *)rad__alloc_zero(&c.allocator, sizeof(rad_lightmap));
     if (!lm) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(lm, 0, sizeof(*lm));
     lm->allocator = c.allocator;
     lm->width = W;
     lm->height = H;
@@ -18192,11 +18087,10 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
         else memcpy(N, lm->sample_normals + 3 * (size_t)a, 3 * sizeof(float));
     }
 done:
-    rad__free(&c.allocator, slot_tri);
-    rad__free(&c.allocator, slot_b);
-    rad__free(&c.allocator, fb_tri);
-    rad__free(&c.allocator, fb_b);
-    rad__free(&c.allocator, fb_d);
+    {
+        void *blocks[] = { slot_tri, slot_b, fb_tri, fb_b, fb_d };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) {
         if (r == RAD_ERROR_SIZE_OVERFLOW) rad__log(&c, RAD_LOG_ERROR, "lightmap: more than 2^32 - 2 samples");
         rad_lightmap_destroy(lm);
@@ -18211,37 +18105,13 @@ done:
    vector irradiance integral w dw (so n . out[1..3] = pi F). Returns 0 when nothing is left. */
 static int rad__lm_polygon(const double *p, const double *n, const float *v, double *out)
 {
-    double q[3][3], d[3], poly[4][3], r[4][3], vec[3] = { 0.0, 0.0, 0.0 }, omega = 0.0, dn;
-    int i, k, m = 0;
-    for (i = 0; i < 3; ++i) {
-        for (k = 0; k < 3; ++k) q[i][k] = (double)v[3 * i + k] - p[k];
-        d[i] = q[i][0] * n[0] + q[i][1] * n[1] + q[i][2] * n[2];
-    }
-    for (i = 0; i < 3; ++i) {
-        int j = (i + 1) % 3;
-        if (d[i] >= 0.0) { for (k = 0; k < 3; ++k) poly[m][k] = q[i][k]; ++m; }
-        if ((d[i] > 0.0 && d[j] < 0.0) || (d[i] < 0.0 && d[j] > 0.0)) {
-            double s = d[i] / (d[i] - d[j]);
-            for (k = 0; k < 3; ++k) poly[m][k] = q[i][k] + s * (q[j][k] - q[i][k]);
-            ++m;
-        }
-    }
-    if (m < 3) return 0;
+    double d[3], poly[4][3], r[4][3], vec[3] = { 0.0, 0.0, 0.0 }, omega = 0.0, dn;
+    int i, k, m = rad__clip_tri(p, n, v, d, poly);
+    if (m < 3 || !rad__sphere_points((const double(*)[3])poly, m, r)) return 0;
     for (i = 0; i < m; ++i) {
-        double l = sqrt(poly[i][0] * poly[i][0] + poly[i][1] * poly[i][1] + poly[i][2] * poly[i][2]);
-        if (!(l > 0.0)) return 0; /* p on the polygon's boundary */
-        for (k = 0; k < 3; ++k) r[i][k] = poly[i][k] / l;
-    }
-    for (i = 0; i < m; ++i) {
-        const double *a = r[i], *b = r[(i + 1) % m];
-        double cr[3], cl, dot;
-        cr[0] = a[1] * b[2] - a[2] * b[1];
-        cr[1] = a[2] * b[0] - a[0] * b[2];
-        cr[2] = a[0] * b[1] - a[1] * b[0];
-        cl = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-        if (!(cl > 1e-300)) continue;
-        dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        for (k = 0; k < 3; ++k) vec[k] += 0.5 * atan2(cl, dot) * cr[k] / cl;
+        double cr[3], cl, angle;
+        if (!rad__sphere_arc(r[i], r[(i + 1) % m], cr, &cl, &angle)) continue;
+        for (k = 0; k < 3; ++k) vec[k] += 0.5 * angle * cr[k] / cl;
     }
     /* solid angle: a fan of spherical triangles (Van Oosterom and Strackee) */
     for (i = 1; i + 1 < m; ++i) {
@@ -18278,12 +18148,14 @@ typedef struct rad__lm_gather {
     float *out;
 } rad__lm_gather;
 
-static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count, double *acc)
+/* exact rays: each unoccluded one brings its contribution; the flushes empty the queue (*n = 0) */
+static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t *n, double *acc)
 {
     rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
     uint8_t *occ = g->occ_buf + (size_t)task * RAD__RAY_BATCH;
     const float *w = g->ray_c + (size_t)task * RAD__RAY_BATCH * g->ch;
-    uint32_t k, ch;
+    uint32_t k, ch, count = *n;
+    *n = 0;
     if (count == 0) return RAD_SUCCESS;
     if (g->rc->occluded(g->rc->user, rays, count, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
     for (k = 0; k < count; ++k)
@@ -18293,14 +18165,15 @@ static rad_result rad__lm_flush(rad__lm_gather *g, uint32_t task, uint32_t count
 }
 
 /* hemisphere rays: each hit on the front of a patch that is not counted exactly brings its B */
-static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t count, double *sum)
+static rad_result rad__lm_flush_hits(rad__lm_gather *g, uint32_t task, uint32_t *n, double *sum)
 {
     const rad_ray *rays = g->ray_buf + (size_t)task * RAD__RAY_BATCH;
     rad_hit *hits = g->hit_buf + (size_t)task * RAD__RAY_BATCH;
     const float *hw = g->hit_w + (size_t)task * RAD__RAY_BATCH * 4;
     const rad_scene *S = g->lm->scene;
-    uint32_t k, j;
+    uint32_t k, j, count = *n;
     int c;
+    *n = 0;
     if (count == 0) return RAD_SUCCESS;
     if (g->rc->intersect(g->rc->user, rays, count, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
     for (k = 0; k < count; ++k) {
@@ -18397,30 +18270,15 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
             }
             if (!(ksum > 0.0)) continue;
             for (q = 0; q < g->vis; ++q) {
-                rad_ray *ray;
-                float len;
                 if (!(kw[q] > 0.0)) continue;
                 rad__hammersley(q, g->vis, r1, r2, &u1, &u2);
                 rad__triangle_point(tri, tri + 3, tri + 6, u1, u2, y);
-                ray = rays + nr;
-                for (k = 0; k < 3; ++k) {
-                    ray->origin[k] = pf[k] + nf[k] * g->eps;
-                    ray->dir[k] = (y[k] + pj->normal[k] * g->eps) - ray->origin[k];
-                }
-                len = rad__len(ray->dir);
-                ray->tmin = 0.0f;
-                ray->tmax = len > 2.0f * g->eps ? 1.0f - g->eps / len : 0.5f;
+                rad__segment_ray(rays + nr, pf, nf, y, pj->normal, g->eps);
                 for (ch = 0; ch < g->ch; ++ch) rc[(size_t)nr * g->ch + ch] = (float)(full[ch] * kw[q] / ksum);
-                if (++nr == RAD__RAY_BATCH) {
-                    r = rad__lm_flush(g, task, nr, acc);
-                    nr = 0;
-                    if (r != RAD_SUCCESS) return r;
-                }
+                if (++nr == RAD__RAY_BATCH && (r = rad__lm_flush(g, task, &nr, acc)) != RAD_SUCCESS) return r;
             }
         }
-        r = rad__lm_flush(g, task, nr, acc);
-        nr = 0;
-        if (r != RAD_SUCCESS) return r;
+        if ((r = rad__lm_flush(g, task, &nr, acc)) != RAD_SUCCESS) return r;
         for (ch = 0; ch < g->ch; ++ch) sum[ch] += acc[ch];
         if (per) {
             /* this sample's share of the texel's hemisphere rays (the exact rays above are
@@ -18447,15 +18305,9 @@ static rad_result rad__lm_gather_row(void *data, uint32_t texel, uint32_t task)
                 ray->tmax = FLT_MAX;
                 wq[0] = w;
                 for (k = 0; k < 3; ++k) wq[1 + k] = ray->dir[k];
-                if (++nh == RAD__RAY_BATCH) {
-                    r = rad__lm_flush_hits(g, task, nh, sum);
-                    nh = 0;
-                    if (r != RAD_SUCCESS) return r;
-                }
+                if (++nh == RAD__RAY_BATCH && (r = rad__lm_flush_hits(g, task, &nh, sum)) != RAD_SUCCESS) return r;
             }
-            r = rad__lm_flush_hits(g, task, nh, sum);
-            nh = 0;
-            if (r != RAD_SUCCESS) return r;
+            if ((r = rad__lm_flush_hits(g, task, &nh, sum)) != RAD_SUCCESS) return r;
         }
     }
     for (ch = 0; ch < g->ch; ++ch) out[ch] = nval ? (float)(sum[ch] / nval) : 0.0f;
@@ -18550,13 +18402,10 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
         }
         r = rad__for_rows(&c, texels, T, rad__lm_gather_row, &g);
     }
-    rad__free(&c.allocator, g.list);
-    rad__free(&c.allocator, g.skip);
-    rad__free(&c.allocator, g.ray_buf);
-    rad__free(&c.allocator, g.occ_buf);
-    rad__free(&c.allocator, g.ray_c);
-    rad__free(&c.allocator, g.hit_buf);
-    rad__free(&c.allocator, g.hit_w);
+    {
+        void *blocks[] = { g.list, g.skip, g.ray_buf, g.occ_buf, g.ray_c, g.hit_buf, g.hit_w };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather", out, (size_t)texels * g.ch) : r;
 }
 
@@ -18602,10 +18451,10 @@ RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lm, const rad_raycast
         }
     }
 done:
-    rad__free(&c.allocator, pts);
-    rad__free(&c.allocator, nrm);
-    rad__free(&c.allocator, D);
-    rad__free(&c.allocator, owner);
+    {
+        void *blocks[] = { pts, nrm, D, owner };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     return r;
 }
 
@@ -18705,14 +18554,11 @@ RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *w)
     rad_allocator a;
     if (!w) return;
     a = w->allocator;
-    rad__free(&a, w->vertex_first);
-    rad__free(&a, w->vertex_patches);
-    rad__free(&a, w->vertex_weights);
-    rad__free(&a, w->row_texels);
-    rad__free(&a, w->row_first);
-    rad__free(&a, w->entry_vertices);
-    rad__free(&a, w->entry_weights);
-    rad__free(&a, w);
+    {
+        void *blocks[] = { w->vertex_first, w->vertex_patches, w->vertex_weights, w->row_texels, w->row_first,
+                           w->entry_vertices, w->entry_weights, w };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* barycentrics (b1, b2) of point x in triangle v (9 floats), least squares in its plane */
@@ -18768,9 +18614,8 @@ RAD_API rad_result rad_lightmap_weights_create(const rad_lightmap *lm, const rad
         for (s = lm->sample_first[i]; s < lm->sample_first[i + 1] && !lm->sample_valid[s]; ++s) {}
         rows += s < lm->sample_first[i + 1];
     }
-    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    W = (rad_lightmap_weights *)rad__alloc_zero(&c.allocator, sizeof(*W));
     if (!W) return RAD_ERROR_OUT_OF_MEMORY;
-    memset(W, 0, sizeof(*W));
     W->allocator = c.allocator;
     W->texels = texels;
     W->patch_count = P->count;
@@ -18896,43 +18741,37 @@ typedef struct rad__lm_refresh {
     const float *H;
     float *V;                   /* 3 per vertex: stage 1's output */
     float *out;
-    uint32_t tasks;
+    uint32_t tasks, stage;      /* stage 1: V from H; stage 2: out from V */
 } rad__lm_refresh;
-
-static void rad__lm_refresh_vertices(void *data, uint32_t task)
-{
-    const rad__lm_refresh *f = (const rad__lm_refresh *)data;
-    const rad_lightmap_weights *W = f->W;
-    uint32_t v = (uint32_t)((uint64_t)W->vertex_count * task / f->tasks);
-    uint32_t end = (uint32_t)((uint64_t)W->vertex_count * (task + 1) / f->tasks);
-    for (; v < end; ++v)
-        rad__sparse_row3(W->vertex_patches, W->vertex_weights, W->vertex_first[v], W->vertex_first[v + 1], f->H,
-                         f->V + 3 * (size_t)v);
-}
 
 /* one contiguous block of rows per task: the rows are short, so a cyclic split would make
    the tasks write the same cache lines of out */
-static void rad__lm_refresh_rows(void *data, uint32_t task)
+static void rad__lm_refresh_task(void *data, uint32_t task)
 {
     const rad__lm_refresh *f = (const rad__lm_refresh *)data;
     const rad_lightmap_weights *W = f->W;
-    const uint32_t *first = W->row_first, *ev = W->entry_vertices;
-    const float *ew = W->entry_weights, *V = f->V;
-    uint32_t r = (uint32_t)((uint64_t)W->row_count * task / f->tasks);
-    uint32_t end = (uint32_t)((uint64_t)W->row_count * (task + 1) / f->tasks);
-    for (; r < end; ++r) {
-        uint32_t e = first[r], b = first[r + 1];
-        float *o = f->out + 3 * (size_t)W->row_texels[r];
-        float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-        for (; e < b; ++e) {
-            const float *x = V + 3 * (size_t)ev[e], w = ew[e];
-            s0 += w * x[0];
-            s1 += w * x[1];
-            s2 += w * x[2];
-        }
-        o[0] = s0;
-        o[1] = s1;
-        o[2] = s2;
+    uint64_t n = f->stage == 1 ? W->vertex_count : W->row_count;
+    uint32_t i = (uint32_t)(n * task / f->tasks), end = (uint32_t)(n * (task + 1) / f->tasks);
+    if (f->stage == 1)
+        for (; i < end; ++i)
+            rad__sparse_row3(W->vertex_patches, W->vertex_weights, W->vertex_first[i], W->vertex_first[i + 1], f->H,
+                             f->V + 3 * (size_t)i);
+    else
+        for (; i < end; ++i)
+            rad__sparse_row3(W->entry_vertices, W->entry_weights, W->row_first[i], W->row_first[i + 1], f->V,
+                             f->out + 3 * (size_t)W->row_texels[i]);
+}
+
+/* a stage in at most 'most' tasks, in the calling thread when that is one */
+static void rad__lm_refresh_stage(const rad__ctx *c, rad__lm_refresh *f, uint32_t stage, uint64_t most)
+{
+    f->stage = stage;
+    f->tasks = c->tasks < most ? c->tasks : (uint32_t)most;
+    if (f->tasks < 2) {
+        f->tasks = 1;
+        rad__lm_refresh_task(f, 0);
+    } else {
+        c->parallel_for(c->parallel_user, f->tasks, rad__lm_refresh_task, f);
     }
 }
 
@@ -18940,7 +18779,6 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
 {
     rad__ctx c;
     rad__lm_refresh f;
-    uint64_t most;
     rad__ctx_init(&c, ctx);
     if (!W || !H || !out) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap refresh: NULL weights, patch irradiance or output");
@@ -18956,21 +18794,9 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
     }
     /* stage 1 is small (3 entries a patch): in the calling thread unless the patches are
        many, as a parallel region's start and join can cost more than it on busy cores */
-    most = W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN;
-    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
-    if (f.tasks < 2) {
-        f.tasks = 1;
-        rad__lm_refresh_vertices(&f, 0);
-    } else {
-        c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_vertices, &f);
-    }
+    rad__lm_refresh_stage(&c, &f, 1, W->vertex_first[W->vertex_count] / RAD__LM_REFRESH_GRAIN);
     /* stage 2: a task per block of at least RAD__LM_REFRESH_GRAIN entries */
-    most = (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u;
-    f.tasks = c.tasks < most ? c.tasks : (uint32_t)most;
-    if (f.tasks < 2) {
-        f.tasks = 1;
-        rad__lm_refresh_rows(&f, 0);
-    } else c.parallel_for(c.parallel_user, f.tasks, rad__lm_refresh_rows, &f);
+    rad__lm_refresh_stage(&c, &f, 2, (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u);
     rad__free(&c.allocator, f.V);
     return RAD_SUCCESS;
 }
@@ -19166,6 +18992,18 @@ static rad_result rad__lm_vp_row(void *data, uint32_t texel, uint32_t task)
     return RAD_SUCCESS;
 }
 
+/* runs row over every texel of lm into out (3 per texel), g's other fields set by the caller */
+static rad_result rad__lm_other_run(const rad__ctx *c, rad__lm_other *g, const rad_lightmap *lm, float *out,
+                                    rad__row_fn row, const char *what)
+{
+    uint32_t texels = lm->width * lm->height, T = c->tasks < texels ? c->tasks : texels;
+    rad_result r;
+    g->lm = lm;
+    g->out = out;
+    r = rad__for_rows(c, texels, T ? T : 1u, row, g);
+    return r == RAD_SUCCESS ? rad__check_output(c, what, out, 3 * (size_t)texels) : r;
+}
+
 /* the set's scene must be the lightmap's (NULL: a set loaded without one) */
 static rad_result rad__lm_check_vp(const rad__ctx *c, const char *what, const rad_lightmap *lm, const rad_virtual_patches *vp)
 {
@@ -19185,7 +19023,6 @@ RAD_API rad_result rad_lightmap_gather_vp(const rad_lightmap *lm, const rad_virt
 {
     rad__ctx c;
     rad__lm_other g;
-    uint32_t texels, T;
     rad_result r;
     rad__ctx_init(&c, ctx);
     if ((r = rad__lm_check_vp(&c, "lightmap gather (virtual patches)", lm, vp)) != RAD_SUCCESS) return r;
@@ -19196,14 +19033,9 @@ RAD_API rad_result rad_lightmap_gather_vp(const rad_lightmap *lm, const rad_virt
     r = rad__check_input(&c, "lightmap gather (virtual patches): patch values", values, 3 * (size_t)vp->count);
     if (r != RAD_SUCCESS) return r;
     memset(&g, 0, sizeof g);
-    g.lm = lm;
     g.vp = vp;
     g.values = values;
-    g.out = out;
-    texels = lm->width * lm->height;
-    T = c.tasks < texels ? c.tasks : texels;
-    r = rad__for_rows(&c, texels, T ? T : 1u, rad__lm_vp_row, &g);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather (virtual patches)", out, 3 * (size_t)texels) : r;
+    return rad__lm_other_run(&c, &g, lm, out, rad__lm_vp_row, "lightmap gather (virtual patches)");
 }
 
 RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lm, const rad_virtual_patches *vp,
@@ -19245,9 +19077,8 @@ RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lm, const 
     }
     first[texels] = m;
     if ((r = rad_vp_gather_table_create(vp, pts, nrm, m, ctx, &tab)) != RAD_SUCCESS) goto done;
-    W = (rad_lightmap_weights *)rad__alloc(&c.allocator, sizeof(*W));
+    W = (rad_lightmap_weights *)rad__alloc_zero(&c.allocator, sizeof(*W));
     if (!W) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    memset(W, 0, sizeof(*W));
     W->allocator = c.allocator;
     W->texels = texels;
     W->patch_count = vp->count;
@@ -19293,11 +19124,10 @@ RAD_API rad_result rad_lightmap_weights_create_vp(const rad_lightmap *lm, const 
     W->row_count = rows;
 done:
     rad_vp_gather_table_destroy(tab);
-    rad__free(&c.allocator, first);
-    rad__free(&c.allocator, pts);
-    rad__free(&c.allocator, nrm);
-    rad__free(&c.allocator, col);
-    rad__free(&c.allocator, val);
+    {
+        void *blocks[] = { first, pts, nrm, col, val };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r != RAD_SUCCESS) {
         if (r == RAD_ERROR_OUT_OF_MEMORY)
             rad__log(&c, RAD_LOG_ERROR, "lightmap weights (virtual patches): out of memory for %u samples", m);
@@ -19334,8 +19164,6 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lm, cons
 {
     rad__ctx c;
     rad__lm_other g;
-    uint32_t texels, T;
-    rad_result r;
     rad__ctx_init(&c, ctx);
     if (!lm || !h || !out || (value != RAD_HIERARCHICAL_RADIOSITY && value != RAD_HIERARCHICAL_GATHERED)) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather (hierarchical): NULL lightmap, solution or output, or value %d unknown",
@@ -19348,14 +19176,9 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lm, cons
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     memset(&g, 0, sizeof g);
-    g.lm = lm;
     g.h = h;
     g.value = value;
-    g.out = out;
-    texels = lm->width * lm->height;
-    T = c.tasks < texels ? c.tasks : texels;
-    r = rad__for_rows(&c, texels, T ? T : 1u, rad__lm_hr_row, &g);
-    return r == RAD_SUCCESS ? rad__check_output(&c, "lightmap gather (hierarchical)", out, 3 * (size_t)texels) : r;
+    return rad__lm_other_run(&c, &g, lm, out, rad__lm_hr_row, "lightmap gather (hierarchical)");
 }
 
 /* ======================================================================================== */
@@ -19421,7 +19244,8 @@ static void rad__sh_band4(const float *d, float *y)
     y[8] = 0.625835735f * (x2 * x2 - 6.0f * x2 * y2 + y2 * y2);
 }
 
-RAD_API void rad_sh_band4_basis(const float d[3], float out[9])
+/* A basis at direction d: eval at d normalised, or zeros for a zero or NULL direction. */
+static void rad__sh_basis_at(const float *d, float *out, void (*eval)(const float *, float *))
 {
     float u[3];
     int k;
@@ -19432,7 +19256,12 @@ RAD_API void rad_sh_band4_basis(const float d[3], float out[9])
         return;
     }
     rad__normalize(u);
-    rad__sh_band4(u, out);
+    eval(u, out);
+}
+
+RAD_API void rad_sh_band4_basis(const float d[3], float out[9])
+{
+    rad__sh_basis_at(d, out, rad__sh_band4);
 }
 
 RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band4[27], const float n[3], float out_rgb[3])
@@ -19451,16 +19280,7 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
 
 RAD_API void rad_sh9_basis(const float d[3], float out[9])
 {
-    float u[3];
-    int k;
-    if (!d || !out) return;
-    u[0] = d[0]; u[1] = d[1]; u[2] = d[2];
-    if (!(rad__dot(u, u) > 0.0f)) {
-        for (k = 0; k < 9; ++k) out[k] = 0.0f;
-        return;
-    }
-    rad__normalize(u);
-    rad__sh9(u, out);
+    rad__sh_basis_at(d, out, rad__sh9);
 }
 
 RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], float out_rgb[3])
@@ -19747,26 +19567,26 @@ typedef struct rad__pu {
     const float *B;
 } rad__pu;
 
-static void rad__probes_update_one(rad_probes *pr, const float *B, uint32_t i)
+/* probe i's 27 coefficients of one basis: its direct part plus its weights times B */
+static void rad__probes_update_basis(const rad_probes *pr, const float *B, uint32_t i, const float *direct,
+                                     const float *weights, float *out)
 {
     double acc[27];
     size_t e;
     int k, c;
-    for (k = 0; k < 27; ++k) acc[k] = pr->direct[27 * (size_t)i + (size_t)k];
+    for (k = 0; k < 27; ++k) acc[k] = direct[27 * (size_t)i + (size_t)k];
     for (e = (size_t)pr->first[i]; e < (size_t)pr->first[i + 1]; ++e) {
-        const float *w = pr->weights + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
+        const float *w = weights + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
         for (k = 0; k < 9; ++k)
             for (c = 0; c < 3; ++c) acc[3 * k + c] += (double)w[k] * b[c];
     }
-    for (k = 0; k < 27; ++k) pr->coefficients[27 * (size_t)i + (size_t)k] = (float)acc[k];
-    if (!pr->band4) return;
-    for (k = 0; k < 27; ++k) acc[k] = pr->direct4[27 * (size_t)i + (size_t)k];
-    for (e = (size_t)pr->first[i]; e < (size_t)pr->first[i + 1]; ++e) {
-        const float *w = pr->weights4 + 9 * e, *b = B + 3 * (size_t)pr->patch[e];
-        for (k = 0; k < 9; ++k)
-            for (c = 0; c < 3; ++c) acc[3 * k + c] += (double)w[k] * b[c];
-    }
-    for (k = 0; k < 27; ++k) pr->band4[27 * (size_t)i + (size_t)k] = (float)acc[k];
+    for (k = 0; k < 27; ++k) out[27 * (size_t)i + (size_t)k] = (float)acc[k];
+}
+
+static void rad__probes_update_one(rad_probes *pr, const float *B, uint32_t i)
+{
+    rad__probes_update_basis(pr, B, i, pr->direct, pr->weights, pr->coefficients);
+    if (pr->band4) rad__probes_update_basis(pr, B, i, pr->direct4, pr->weights4, pr->band4);
 }
 
 static rad_result rad__probes_update_row(void *data, uint32_t row, uint32_t task)
@@ -19804,17 +19624,11 @@ RAD_API void rad_probes_destroy(rad_probes *pr)
     rad_allocator a;
     if (!pr) return;
     a = pr->allocator;
-    rad__free(&a, pr->positions);
-    rad__free(&a, pr->states);
-    rad__free(&a, pr->coefficients);
-    rad__free(&a, pr->direct);
-    rad__free(&a, pr->first);
-    rad__free(&a, pr->patch);
-    rad__free(&a, pr->weights);
-    rad__free(&a, pr->band4);
-    rad__free(&a, pr->direct4);
-    rad__free(&a, pr->weights4);
-    rad__free(&a, pr);
+    {
+        void *blocks[] = { pr->positions, pr->states, pr->coefficients, pr->direct, pr->first, pr->patch,
+                           pr->weights, pr->band4, pr->direct4, pr->weights4, pr };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* appends the non-zero rows of a probe's dense weights to the entry arrays */
@@ -19931,12 +19745,11 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         if (r != RAD_SUCCESS) return r;
     }
     for (k = 0; k < 3; ++k) ext[k] = S->bounds_max[k] - S->bounds_min[k];
-    pr = (rad_probes *)rad__alloc(&c.allocator, sizeof(rad_probes));
+    pr = (rad_probes *)rad__alloc_zero(&c.allocator, sizeof(rad_probes));
     if (!pr) {
         rad__log(&c, RAD_LOG_ERROR, "probes: out of memory");
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    memset(pr, 0, sizeof(*pr));
     pr->allocator = c.allocator;
     pr->patch_count = N;
     pr->h2 = 1e-6f * S->diagonal * S->diagonal;
@@ -20064,14 +19877,10 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         }
     }
     pr->first[pr->count] = pr->entries;
-    rad__free(&c.allocator, b.rays);
-    rad__free(&c.allocator, b.hits);
-    rad__free(&c.allocator, b.occ);
-    rad__free(&c.allocator, b.target);
-    rad__free(&c.allocator, b.w);
-    rad__free(&c.allocator, b.col);
-    rad__free(&c.allocator, b.emitters);
-    rad__free(&c.allocator, b.dense);
+    {
+        void *blocks[] = { b.rays, b.hits, b.occ, b.target, b.w, b.col, b.emitters, b.dense };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
     if (r == RAD_SUCCESS) r = rad__check_output(&c, "probes (direct light)", pr->direct, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS && pr->direct4) r = rad__check_output(&c, "probes (direct light, band 4)", pr->direct4, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS) {
@@ -21193,12 +21002,11 @@ RAD_API void rad_bake_destroy(rad_bake *b)
     if (!b) return;
     a = b->allocator;
     rad_container_destroy(b->container);
-    rad__free(&a, b->patches.areas);
-    rad__free(&a, b->patches.albedo);
-    rad__free(&a, b->patches.first_patch);
-    rad__free(&a, b->patches.subdivision);
-    rad__free(&a, b->owned);
-    rad__free(&a, b);
+    {
+        void *blocks[] = { b->patches.areas, b->patches.albedo, b->patches.first_patch, b->patches.subdivision,
+                           b->owned, b };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
 }
 
 /* the single section of 'type' (named when name is given), checked for its element size */
@@ -21393,10 +21201,9 @@ static rad_result rad__bake_fill(rad_bake *b, const rad__ctx *c)
 static rad_result rad__load(const void *data, size_t size, void *owned, const rad__ctx *c, const rad_context *ctx,
                             rad_bake **out)
 {
-    rad_bake *b = (rad_bake *)rad__alloc(&c->allocator, sizeof(rad_bake));
+    rad_bake *b = (rad_bake *)rad__alloc_zero(&c->allocator, sizeof(rad_bake));
     rad_result r;
     if (!b) { rad__free(&c->allocator, owned); return RAD_ERROR_OUT_OF_MEMORY; }
-    memset(b, 0, sizeof(*b));
     b->allocator = c->allocator;
     b->owned = owned;
     b->patches.allocator = c->allocator;
