@@ -131,7 +131,7 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/temporal --append BENCHMARKS.md
 	./$(BUILD)/shading --append BENCHMARKS.md
 	./$(BUILD)/local --append BENCHMARKS.md
-	./$(BUILD)/probes --append BENCHMARKS.md
+	./$(BUILD)/probes --sweep --append BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/realtime.sh $(BUILD) BENCHMARKS.md
 
 bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
