@@ -3674,6 +3674,18 @@ typedef __m128 rad__vf;
 #  define rad__vf_add(a, b) _mm_add_ps(a, b)
 #  define rad__vf_store(p, v) _mm_storeu_ps(p, v)
 #endif
+/* RAD__HOT: a helper inlined into its hot loops even where the compiler's size heuristics
+   would call it (the temporal step's per-draw helpers, the BVH's leaf test) */
+#if defined(__GNUC__) || defined(__clang__)
+#  define RAD__PREFETCH(p) __builtin_prefetch(p)
+#  define RAD__HOT static inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static __forceinline
+#else
+#  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static inline
+#endif
 #if defined(RAD__VW)
 static inline float rad__vf_sum(rad__vf v)
 {
@@ -5709,26 +5721,42 @@ typedef struct rad__wray {
     uint32_t near_off[3], far_off[3];
 } rad__wray;
 
+/* The set-up takes no branch on the direction: for incoherent rays (path-tracer bounces)
+   each sign or axis choice is a coin flip, and their mispredictions cost as much as a node
+   visit. Same values as the branching form. */
 static void rad__wray_init(rad__wray *w, const rad_ray *r)
 {
     float ax = (float)fabs((double)r->dir[0]), ay = (float)fabs((double)r->dir[1]), az = (float)fabs((double)r->dir[2]);
-    int k;
+    float mxy;
+    int k, xy, neg, swap;
     for (k = 0; k < 3; ++k) {
         /* zero components become +-1e-30: the slab test then never forms 0 * inf */
         float d = r->dir[k];
+        uint32_t sign;
         if (fabs((double)d) < 1e-30) d = d < 0.0f ? -1e-30f : 1e-30f;
         w->o[k] = r->origin[k];
         w->d[k] = r->dir[k];
         w->inv[k] = 1.0f / d;
-        w->near_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, lo) : offsetof(rad__bvhw, hi)) +
+        /* the sign bit of inv (d is never zero here, so inv is never -0 with d > 0) */
+        memcpy(&sign, &w->inv[k], sizeof(sign));
+        sign >>= 31;
+        w->near_off[k] = (uint32_t)(offsetof(rad__bvhw, lo) + sign * (offsetof(rad__bvhw, hi) - offsetof(rad__bvhw, lo)) +
                                     (size_t)k * sizeof(float) * RAD__BVH_W);
-        w->far_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, hi) : offsetof(rad__bvhw, lo)) +
+        w->far_off[k] = (uint32_t)(offsetof(rad__bvhw, hi) - sign * (offsetof(rad__bvhw, hi) - offsetof(rad__bvhw, lo)) +
                                    (size_t)k * sizeof(float) * RAD__BVH_W);
     }
-    w->kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    /* kz: the axis of the largest |d| (ties to the later axis, as (ax > ay) ? (ax > az ? 0 :
+       2) : (ay > az ? 1 : 2)) */
+    xy = ax > ay;
+    mxy = xy ? ax : ay;
+    w->kz = 2 - (mxy > az) * (1 + xy);
     w->kx = (w->kz + 1) % 3;
     w->ky = (w->kx + 1) % 3;
-    if (w->d[w->kz] < 0.0f) { int t = w->kx; w->kx = w->ky; w->ky = t; }
+    /* kx and ky swapped for a negative d[kz], so the triangle's winding keeps its sign */
+    neg = w->d[w->kz] < 0.0f;
+    swap = (w->kx ^ w->ky) & -neg;
+    w->kx ^= swap;
+    w->ky ^= swap;
     w->sx = w->d[w->kx] / w->d[w->kz];
     w->sy = w->d[w->ky] / w->d[w->kz];
     w->sz = 1.0f / w->d[w->kz];
@@ -5857,8 +5885,9 @@ static uint32_t rad__low_bit(uint32_t m)
 
 /* The triangles of leaf q (count of them) against the ray, in lane order, as rad__wray_tri
    would test them one by one: returns the last lane that hit (each hit lowers *tmax, so it is
-   the closest, the first of equal ones), or -1. With 'any' it returns at the first hit. */
-static int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count, int any, float *tmax, float *t_out,
+   the closest, the first of equal ones), or -1. With 'any' it returns at the first hit.
+   Inlined: as a call its pointer arguments go through memory on every leaf. */
+RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count, int any, float *tmax, float *t_out,
                           float *b1, float *b2)
 {
 #if defined(RAD__SSE2)
@@ -14797,16 +14826,6 @@ typedef struct rad__tstep {
     uint32_t tasks;
 } rad__tstep;
 
-#if defined(__GNUC__) || defined(__clang__)
-#  define RAD__PREFETCH(p) __builtin_prefetch(p)
-#  define RAD__HOT static inline __attribute__((always_inline)) /* the step's per-draw helpers */
-#elif defined(_MSC_VER)
-#  define RAD__PREFETCH(p) ((void)0)
-#  define RAD__HOT static __forceinline
-#else
-#  define RAD__PREFETCH(p) ((void)0)
-#  define RAD__HOT static inline
-#endif
 /* draws whose bins are in flight ahead of the one resolved; AVX2 issues cheaper, so more of
    them can overlap */
 #ifndef RAD__TEMPORAL_AHEAD
