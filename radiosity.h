@@ -5980,76 +5980,111 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
 #endif
 }
 
+/* bit k set when child k of the node is a leaf (or an empty slot): the sign bits of the
+   child words, RAD__BVH4_LEAF being bit 31 */
+static int rad__bvhw_leaf_bits(const rad__bvhw *n)
+{
+#if defined(RAD__AVX)
+    return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_load_si256((const __m256i *)(const void *)n->child)));
+#elif defined(RAD__SSE2)
+    return _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128((const __m128i *)(const void *)n->child)));
+#else
+    int k, m = 0;
+    for (k = 0; k < RAD__BVH_W; ++k) m |= (int)(n->child[k] >> 31) << k;
+    return m;
+#endif
+}
+
 /* The closest hit (any = 0, into *hit) or any hit (any = 1) of the ray set up in w. Returns 1
-   on a hit; with any, *hit_leaf and *hit_count name the leaf that held it. */
+   on a hit; with any, *hit_leaf and *hit_count name the leaf that held it.
+   Per node: the leaf children the ray enters are tested at once (in slot order), and of the
+   inner children the nearest is descended into without going through the stack, the others
+   pushed far to near. Most nodes have zero or one inner child hit, so the loop takes one
+   predictable branch on how many there are instead of a branch per child: on incoherent rays
+   the per-child loop's exit mispredicted at almost every node. */
 static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_hit *hit, const rad__tri4 **hit_leaf,
                           uint32_t *hit_count)
 {
     /* a node pushes at most RAD__BVH_W - 1 children more than it pops, once per level */
-    uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0;
+    uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0, cur = 0;
     float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = w->tmax;
     int found = 0;
-    stack[sp] = 0;
-    stack_t[sp++] = w->tmin;
-    while (sp > 0) {
-        const rad__bvhw *n;
+    for (;;) {
+        const rad__bvhw *n = &bvh->nodes[cur];
         float tn[RAD__BVH_W];
-        uint32_t order[RAD__BVH_W], no = 0, k;
-        int mask;
-        --sp;
-        if (stack_t[sp] > tmax) continue; /* entered beyond the closest hit found since */
-        n = &bvh->nodes[stack[sp]];
-        mask = rad__bvhw_boxes(n, w, tmax, tn);
-        while (mask) {
+        uint32_t mask = (uint32_t)rad__bvhw_boxes(n, w, tmax, tn), leaves = mask & (uint32_t)rad__bvhw_leaf_bits(n);
+        uint32_t inner = mask & ~leaves, k;
+        while (leaves) {
             uint32_t ch;
-            k = rad__low_bit((uint32_t)mask);
-            mask &= mask - 1;
+            const rad__tri4 *q;
+            float t = 0.0f, b1 = 0.0f, b2 = 0.0f;
+            int j;
+            k = rad__low_bit(leaves);
+            leaves &= leaves - 1;
             ch = n->child[k];
-            if (ch == RAD_NONE) continue;
-            if (ch & RAD__BVH4_LEAF) {
-                const rad__tri4 *q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
-                float t = 0.0f, b1 = 0.0f, b2 = 0.0f;
-                int j = rad__wray_tri4(w, q, n->count[k], any, &tmax, &t, &b1, &b2);
-                if (j >= 0) {
-                    found = 1;
-                    if (any) {
-                        *hit_leaf = q;
-                        *hit_count = n->count[k];
-                        return 1;
-                    }
-                    hit->t = t;
-                    hit->triangle = q->id[j];
-                    hit->b1 = b1;
-                    hit->b2 = b2;
+            if (ch == RAD_NONE) continue; /* empty slots hold inverted boxes: never entered */
+            q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
+            j = rad__wray_tri4(w, q, n->count[k], any, &tmax, &t, &b1, &b2);
+            if (j >= 0) {
+                found = 1;
+                if (any) {
+                    *hit_leaf = q;
+                    *hit_count = n->count[k];
+                    return 1;
                 }
-            } else {
-                order[no++] = k;
+                hit->t = t;
+                hit->triangle = q->id[j];
+                hit->b1 = b1;
+                hit->b2 = b2;
             }
         }
-        /* push inner children far to near, so the nearest is visited first (two, the common
-           case, by one compare) */
-        if (no == 1) {
-            stack[sp] = n->child[order[0]];
-            stack_t[sp++] = tn[order[0]];
-        } else if (no == 2) {
-            uint32_t f = order[0], c = order[1];
-            if (tn[c] > tn[f]) { f = order[1]; c = order[0]; }
-            stack[sp] = n->child[f];
-            stack_t[sp++] = tn[f];
-            stack[sp] = n->child[c];
-            stack_t[sp++] = tn[c];
-        } else {
-            while (no > 0) {
-                uint32_t far = 0, q;
-                for (q = 1; q < no; ++q)
-                    if (tn[order[q]] > tn[order[far]]) far = q;
-                stack[sp] = n->child[order[far]];
-                stack_t[sp++] = tn[order[far]];
-                order[far] = order[--no];
+        if (inner) {
+            uint32_t near = rad__low_bit(inner);
+            inner &= inner - 1;
+            if (inner) {
+                uint32_t k2 = rad__low_bit(inner);
+                inner &= inner - 1;
+                if (!inner) {
+                    /* two: the later slot first on a tie, as the general case orders them */
+                    uint32_t far = near;
+                    if (tn[k2] > tn[near]) far = k2; else near = k2;
+                    stack[sp] = n->child[far];
+                    stack_t[sp++] = tn[far];
+                } else {
+                    /* three or more: pushed far to near (the first of equal distances
+                       first), the nearest kept */
+                    uint32_t order[RAD__BVH_W], no = 2;
+                    order[0] = near;
+                    order[1] = k2;
+                    while (inner) {
+                        order[no++] = rad__low_bit(inner);
+                        inner &= inner - 1;
+                    }
+                    while (no > 1) {
+                        uint32_t far = 0, q;
+                        for (q = 1; q < no; ++q)
+                            if (tn[order[q]] > tn[order[far]]) far = q;
+                        stack[sp] = n->child[order[far]];
+                        stack_t[sp++] = tn[order[far]];
+                        order[far] = order[--no];
+                    }
+                    near = order[0];
+                }
+            }
+            /* the nearest child, unless a leaf of this node hit closer than it starts */
+            if (!(tn[near] > tmax)) {
+                cur = n->child[near];
+                continue;
             }
         }
+        /* pop, skipping children entered beyond the closest hit found since they were pushed */
+        for (;;) {
+            if (sp == 0) return found;
+            --sp;
+            if (!(stack_t[sp] > tmax)) break;
+        }
+        cur = stack[sp];
     }
-    return found;
 }
 
 static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
