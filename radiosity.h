@@ -6060,15 +6060,28 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
                         order[no++] = rad__low_bit(inner);
                         inner &= inner - 1;
                     }
-                    while (no > 1) {
-                        uint32_t far = 0, q;
-                        for (q = 1; q < no; ++q)
-                            if (tn[order[q]] > tn[order[far]]) far = q;
-                        stack[sp] = n->child[order[far]];
-                        stack_t[sp++] = tn[order[far]];
-                        order[far] = order[--no];
+                    if (any) {
+                        /* any hit ends the ray wherever it is: the nearest first, the others
+                           in slot order, unsorted */
+                        uint32_t best = 0, q;
+                        for (q = 1; q < no; ++q) best = tn[order[q]] < tn[order[best]] ? q : best;
+                        near = order[best];
+                        order[best] = order[--no];
+                        for (q = 0; q < no; ++q) {
+                            stack[sp] = n->child[order[q]];
+                            stack_t[sp++] = tn[order[q]];
+                        }
+                    } else {
+                        while (no > 1) {
+                            uint32_t far = 0, q;
+                            for (q = 1; q < no; ++q)
+                                if (tn[order[q]] > tn[order[far]]) far = q;
+                            stack[sp] = n->child[order[far]];
+                            stack_t[sp++] = tn[order[far]];
+                            order[far] = order[--no];
+                        }
+                        near = order[0];
                     }
-                    near = order[0];
                 }
             }
             /* the nearest child, unless a leaf of this node hit closer than it starts */
