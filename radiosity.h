@@ -5998,8 +5998,8 @@ static int rad__bvhw_leaf_bits(const rad__bvhw *n)
 /* The closest hit (any = 0, into *hit) or any hit (any = 1) of the ray set up in w. Returns 1
    on a hit; with any, *hit_leaf and *hit_count name the leaf that held it.
    Per node: the leaf children the ray enters are tested at once (in slot order), and of the
-   inner children the nearest is descended into without going through the stack, the others
-   pushed far to near. Most nodes have zero or one inner child hit, so the loop takes one
+   inner children one is descended into without going through the stack, the others pushed
+   (closest hit: the nearest, the others far to near; any hit: in slot order). Most nodes have zero or one inner child hit, so the loop takes one
    predictable branch on how many there are instead of a branch per child: on incoherent rays
    the per-child loop's exit mispredicted at almost every node. */
 static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_hit *hit, const rad__tri4 **hit_leaf,
@@ -6038,6 +6038,23 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
                 hit->b2 = b2;
             }
         }
+        if (inner && any) {
+            /* any hit ends the ray wherever it lies, so the order cannot change the answer; and
+               rays that start on a surface (bounces, shadow and form-factor rays) enter the
+               boxes around their origin first, where a nearest-first order spends its visits on
+               the geometry they leave. Occlusion takes the children in slot order: the first
+               descended into, the others pushed. */
+            uint32_t first = rad__low_bit(inner);
+            inner &= inner - 1;
+            while (inner) {
+                k = rad__low_bit(inner);
+                inner &= inner - 1;
+                stack[sp] = n->child[k];
+                stack_t[sp++] = tn[k];
+            }
+            cur = n->child[first];
+            continue;
+        }
         if (inner) {
             uint32_t near = rad__low_bit(inner);
             inner &= inner - 1;
@@ -6060,28 +6077,15 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
                         order[no++] = rad__low_bit(inner);
                         inner &= inner - 1;
                     }
-                    if (any) {
-                        /* any hit ends the ray wherever it is: the nearest first, the others
-                           in slot order, unsorted */
-                        uint32_t best = 0, q;
-                        for (q = 1; q < no; ++q) best = tn[order[q]] < tn[order[best]] ? q : best;
-                        near = order[best];
-                        order[best] = order[--no];
-                        for (q = 0; q < no; ++q) {
-                            stack[sp] = n->child[order[q]];
-                            stack_t[sp++] = tn[order[q]];
-                        }
-                    } else {
-                        while (no > 1) {
-                            uint32_t far = 0, q;
-                            for (q = 1; q < no; ++q)
-                                if (tn[order[q]] > tn[order[far]]) far = q;
-                            stack[sp] = n->child[order[far]];
-                            stack_t[sp++] = tn[order[far]];
-                            order[far] = order[--no];
-                        }
-                        near = order[0];
+                    while (no > 1) {
+                        uint32_t far = 0, q;
+                        for (q = 1; q < no; ++q)
+                            if (tn[order[q]] > tn[order[far]]) far = q;
+                        stack[sp] = n->child[order[far]];
+                        stack_t[sp++] = tn[order[far]];
+                        order[far] = order[--no];
                     }
+                    near = order[0];
                 }
             }
             /* the nearest child, unless a leaf of this node hit closer than it starts */
