@@ -5737,7 +5737,8 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
         w->o[k] = r->origin[k];
         w->d[k] = r->dir[k];
         w->inv[k] = 1.0f / d;
-        /* the sign bit of inv (d is never zero here, so inv is never -0 with d > 0) */
+        /* the sign bit of inv: the choice of inv >= 0 but for inv = -0 (d = -inf), where
+           both planes give t = 0 alike */
         memcpy(&sign, &w->inv[k], sizeof(sign));
         sign >>= 31;
         w->near_off[k] = (uint32_t)(offsetof(rad__bvhw, lo) + sign * (offsetof(rad__bvhw, hi) - offsetof(rad__bvhw, lo)) +
@@ -5999,9 +6000,10 @@ static int rad__bvhw_leaf_bits(const rad__bvhw *n)
    on a hit; with any, *hit_leaf and *hit_count name the leaf that held it.
    Per node: the leaf children the ray enters are tested at once (in slot order), and of the
    inner children one is descended into without going through the stack, the others pushed
-   (closest hit: the nearest, the others far to near; any hit: in slot order). Most nodes have zero or one inner child hit, so the loop takes one
-   predictable branch on how many there are instead of a branch per child: on incoherent rays
-   the per-child loop's exit mispredicted at almost every node. */
+   (closest hit: the nearest, the others far to near; any hit: in slot order). Most nodes
+   have zero or one inner child hit, so the loop takes one predictable branch on how many
+   there are instead of a branch per child: on incoherent rays the per-child loop's exit
+   mispredicted at almost every node. */
 static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_hit *hit, const rad__tri4 **hit_leaf,
                           uint32_t *hit_count)
 {
