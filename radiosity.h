@@ -3688,6 +3688,18 @@ typedef __m128 rad__vf;
 #  define rad__vf_add(a, b) _mm_add_ps(a, b)
 #  define rad__vf_store(p, v) _mm_storeu_ps(p, v)
 #endif
+/* RAD__HOT: a helper inlined into its hot loops even where the compiler's size heuristics
+   would call it (the temporal step's per-draw helpers, the BVH's leaf test) */
+#if defined(__GNUC__) || defined(__clang__)
+#  define RAD__PREFETCH(p) __builtin_prefetch(p)
+#  define RAD__HOT static inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static __forceinline
+#else
+#  define RAD__PREFETCH(p) ((void)0)
+#  define RAD__HOT static inline
+#endif
 #if defined(RAD__VW)
 static inline float rad__vf_sum(rad__vf v)
 {
@@ -5726,26 +5738,43 @@ typedef struct rad__wray {
     uint32_t near_off[3], far_off[3];
 } rad__wray;
 
+/* The set-up takes no branch on the direction: for incoherent rays (path-tracer bounces)
+   each sign or axis choice is a coin flip, and their mispredictions cost as much as a node
+   visit. Same values as the branching form. */
 static void rad__wray_init(rad__wray *w, const rad_ray *r)
 {
     float ax = (float)fabs((double)r->dir[0]), ay = (float)fabs((double)r->dir[1]), az = (float)fabs((double)r->dir[2]);
-    int k;
+    float mxy;
+    int k, xy, neg, swap;
     for (k = 0; k < 3; ++k) {
         /* zero components become +-1e-30: the slab test then never forms 0 * inf */
         float d = r->dir[k];
+        uint32_t sign;
         if (fabs((double)d) < 1e-30) d = d < 0.0f ? -1e-30f : 1e-30f;
         w->o[k] = r->origin[k];
         w->d[k] = r->dir[k];
         w->inv[k] = 1.0f / d;
-        w->near_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, lo) : offsetof(rad__bvhw, hi)) +
+        /* the sign bit of inv: the choice of inv >= 0 but for inv = -0 (d = -inf), where
+           both planes give t = 0 alike */
+        memcpy(&sign, &w->inv[k], sizeof(sign));
+        sign >>= 31;
+        w->near_off[k] = (uint32_t)(offsetof(rad__bvhw, lo) + sign * (offsetof(rad__bvhw, hi) - offsetof(rad__bvhw, lo)) +
                                     (size_t)k * sizeof(float) * RAD__BVH_W);
-        w->far_off[k] = (uint32_t)((w->inv[k] >= 0.0f ? offsetof(rad__bvhw, hi) : offsetof(rad__bvhw, lo)) +
+        w->far_off[k] = (uint32_t)(offsetof(rad__bvhw, hi) - sign * (offsetof(rad__bvhw, hi) - offsetof(rad__bvhw, lo)) +
                                    (size_t)k * sizeof(float) * RAD__BVH_W);
     }
-    w->kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    /* kz: the axis of the largest |d| (ties to the later axis, as (ax > ay) ? (ax > az ? 0 :
+       2) : (ay > az ? 1 : 2)) */
+    xy = ax > ay;
+    mxy = xy ? ax : ay;
+    w->kz = 2 - (mxy > az) * (1 + xy);
     w->kx = (w->kz + 1) % 3;
     w->ky = (w->kx + 1) % 3;
-    if (w->d[w->kz] < 0.0f) { int t = w->kx; w->kx = w->ky; w->ky = t; }
+    /* kx and ky swapped for a negative d[kz], so the triangle's winding keeps its sign */
+    neg = w->d[w->kz] < 0.0f;
+    swap = (w->kx ^ w->ky) & -neg;
+    w->kx ^= swap;
+    w->ky ^= swap;
     w->sx = w->d[w->kx] / w->d[w->kz];
     w->sy = w->d[w->ky] / w->d[w->kz];
     w->sz = 1.0f / w->d[w->kz];
@@ -5874,8 +5903,9 @@ static uint32_t rad__low_bit(uint32_t m)
 
 /* The triangles of leaf q (count of them) against the ray, in lane order, as rad__wray_tri
    would test them one by one: returns the last lane that hit (each hit lowers *tmax, so it is
-   the closest, the first of equal ones), or -1. With 'any' it returns at the first hit. */
-static int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count, int any, float *tmax, float *t_out,
+   the closest, the first of equal ones), or -1. With 'any' it returns at the first hit.
+   Inlined: as a call its pointer arguments go through memory on every leaf. */
+RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count, int any, float *tmax, float *t_out,
                           float *b1, float *b2)
 {
 #if defined(RAD__SSE2)
@@ -5968,76 +5998,129 @@ static int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t count
 #endif
 }
 
+/* bit k set when child k of the node is a leaf (or an empty slot): the sign bits of the
+   child words, RAD__BVH4_LEAF being bit 31 */
+static int rad__bvhw_leaf_bits(const rad__bvhw *n)
+{
+#if defined(RAD__AVX)
+    return _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_load_si256((const __m256i *)(const void *)n->child)));
+#elif defined(RAD__SSE2)
+    return _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128((const __m128i *)(const void *)n->child)));
+#else
+    int k, m = 0;
+    for (k = 0; k < RAD__BVH_W; ++k) m |= (int)(n->child[k] >> 31) << k;
+    return m;
+#endif
+}
+
 /* The closest hit (any = 0, into *hit) or any hit (any = 1) of the ray set up in w. Returns 1
-   on a hit; with any, *hit_leaf and *hit_count name the leaf that held it. */
+   on a hit; with any, *hit_leaf and *hit_count name the leaf that held it.
+   Per node: the leaf children the ray enters are tested at once (in slot order), and of the
+   inner children one is descended into without going through the stack, the others pushed
+   (closest hit: the nearest, the others far to near; any hit: in slot order). Most nodes
+   have zero or one inner child hit, so the loop takes one predictable branch on how many
+   there are instead of a branch per child: on incoherent rays the per-child loop's exit
+   mispredicted at almost every node. */
 static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_hit *hit, const rad__tri4 **hit_leaf,
                           uint32_t *hit_count)
 {
     /* a node pushes at most RAD__BVH_W - 1 children more than it pops, once per level */
-    uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0;
+    uint32_t stack[(RAD__BVH_W - 1) * RAD__BVH_STACK], sp = 0, cur = 0;
     float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = w->tmax;
     int found = 0;
-    stack[sp] = 0;
-    stack_t[sp++] = w->tmin;
-    while (sp > 0) {
-        const rad__bvhw *n;
+    for (;;) {
+        const rad__bvhw *n = &bvh->nodes[cur];
         float tn[RAD__BVH_W];
-        uint32_t order[RAD__BVH_W], no = 0, k;
-        int mask;
-        --sp;
-        if (stack_t[sp] > tmax) continue; /* entered beyond the closest hit found since */
-        n = &bvh->nodes[stack[sp]];
-        mask = rad__bvhw_boxes(n, w, tmax, tn);
-        while (mask) {
+        uint32_t mask = (uint32_t)rad__bvhw_boxes(n, w, tmax, tn), leaves = mask & (uint32_t)rad__bvhw_leaf_bits(n);
+        uint32_t inner = mask & ~leaves, k;
+        while (leaves) {
             uint32_t ch;
-            k = rad__low_bit((uint32_t)mask);
-            mask &= mask - 1;
+            const rad__tri4 *q;
+            float t = 0.0f, b1 = 0.0f, b2 = 0.0f;
+            int j;
+            k = rad__low_bit(leaves);
+            leaves &= leaves - 1;
             ch = n->child[k];
-            if (ch == RAD_NONE) continue;
-            if (ch & RAD__BVH4_LEAF) {
-                const rad__tri4 *q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
-                float t = 0.0f, b1 = 0.0f, b2 = 0.0f;
-                int j = rad__wray_tri4(w, q, n->count[k], any, &tmax, &t, &b1, &b2);
-                if (j >= 0) {
-                    found = 1;
-                    if (any) {
-                        *hit_leaf = q;
-                        *hit_count = n->count[k];
-                        return 1;
-                    }
-                    hit->t = t;
-                    hit->triangle = q->id[j];
-                    hit->b1 = b1;
-                    hit->b2 = b2;
+            if (ch == RAD_NONE) continue; /* empty slots hold inverted boxes: never entered */
+            q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
+            j = rad__wray_tri4(w, q, n->count[k], any, &tmax, &t, &b1, &b2);
+            if (j >= 0) {
+                found = 1;
+                if (any) {
+                    *hit_leaf = q;
+                    *hit_count = n->count[k];
+                    return 1;
                 }
-            } else {
-                order[no++] = k;
+                hit->t = t;
+                hit->triangle = q->id[j];
+                hit->b1 = b1;
+                hit->b2 = b2;
             }
         }
-        /* push inner children far to near, so the nearest is visited first (two, the common
-           case, by one compare) */
-        if (no == 1) {
-            stack[sp] = n->child[order[0]];
-            stack_t[sp++] = tn[order[0]];
-        } else if (no == 2) {
-            uint32_t f = order[0], c = order[1];
-            if (tn[c] > tn[f]) { f = order[1]; c = order[0]; }
-            stack[sp] = n->child[f];
-            stack_t[sp++] = tn[f];
-            stack[sp] = n->child[c];
-            stack_t[sp++] = tn[c];
-        } else {
-            while (no > 0) {
-                uint32_t far = 0, q;
-                for (q = 1; q < no; ++q)
-                    if (tn[order[q]] > tn[order[far]]) far = q;
-                stack[sp] = n->child[order[far]];
-                stack_t[sp++] = tn[order[far]];
-                order[far] = order[--no];
+        if (inner && any) {
+            /* any hit ends the ray wherever it lies, so the order cannot change the answer; and
+               rays that start on a surface (bounces, shadow and form-factor rays) enter the
+               boxes around their origin first, where a nearest-first order spends its visits on
+               the geometry they leave. Occlusion takes the children in slot order: the first
+               descended into, the others pushed. */
+            uint32_t first = rad__low_bit(inner);
+            inner &= inner - 1;
+            while (inner) {
+                k = rad__low_bit(inner);
+                inner &= inner - 1;
+                stack[sp] = n->child[k];
+                stack_t[sp++] = tn[k];
+            }
+            cur = n->child[first];
+            continue;
+        }
+        if (inner) {
+            uint32_t near = rad__low_bit(inner);
+            inner &= inner - 1;
+            if (inner) {
+                uint32_t k2 = rad__low_bit(inner);
+                inner &= inner - 1;
+                if (!inner) {
+                    /* two: the later slot first on a tie, as the general case orders them */
+                    uint32_t far = near;
+                    if (tn[k2] > tn[near]) far = k2; else near = k2;
+                    stack[sp] = n->child[far];
+                    stack_t[sp++] = tn[far];
+                } else {
+                    /* three or more: pushed far to near (the first of equal distances
+                       first), the nearest kept */
+                    uint32_t order[RAD__BVH_W], no = 2;
+                    order[0] = near;
+                    order[1] = k2;
+                    while (inner) {
+                        order[no++] = rad__low_bit(inner);
+                        inner &= inner - 1;
+                    }
+                    while (no > 1) {
+                        uint32_t far = 0, q;
+                        for (q = 1; q < no; ++q)
+                            if (tn[order[q]] > tn[order[far]]) far = q;
+                        stack[sp] = n->child[order[far]];
+                        stack_t[sp++] = tn[order[far]];
+                        order[far] = order[--no];
+                    }
+                    near = order[0];
+                }
+            }
+            /* the nearest child, unless a leaf of this node hit closer than it starts */
+            if (!(tn[near] > tmax)) {
+                cur = n->child[near];
+                continue;
             }
         }
+        /* pop, skipping children entered beyond the closest hit found since they were pushed */
+        for (;;) {
+            if (sp == 0) return found;
+            --sp;
+            if (!(stack_t[sp] > tmax)) break;
+        }
+        cur = stack[sp];
     }
-    return found;
 }
 
 static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t count, uint8_t *out)
@@ -14795,16 +14878,6 @@ typedef struct rad__tstep {
     uint32_t tasks;
 } rad__tstep;
 
-#if defined(__GNUC__) || defined(__clang__)
-#  define RAD__PREFETCH(p) __builtin_prefetch(p)
-#  define RAD__HOT static inline __attribute__((always_inline)) /* the step's per-draw helpers */
-#elif defined(_MSC_VER)
-#  define RAD__PREFETCH(p) ((void)0)
-#  define RAD__HOT static __forceinline
-#else
-#  define RAD__PREFETCH(p) ((void)0)
-#  define RAD__HOT static inline
-#endif
 /* draws whose bins are in flight ahead of the one resolved; AVX2 issues cheaper, so more of
    them can overlap */
 #ifndef RAD__TEMPORAL_AHEAD
