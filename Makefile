@@ -122,7 +122,7 @@ $(BUILD)/bench_realtime: bench/realtime.c radiosity.h | $(BUILD)
 $(BUILD)/rays: bench/rays.c bench/bench_common.h bench/bench_scenes.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
+bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime $(BUILD)/bench_lightmap
 	./$(BUILD)/bench BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
 	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
@@ -132,6 +132,7 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/shading --append BENCHMARKS.md
 	./$(BUILD)/local --append BENCHMARKS.md
 	./$(BUILD)/probes --sweep --append BENCHMARKS.md
+	./$(BUILD)/bench_lightmap --append BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/realtime.sh $(BUILD) BENCHMARKS.md
 
 bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime

@@ -1,6 +1,7 @@
 /* lightmap.c - lightmap timings and noise (docs/methods/lightmap.md; docs/performance-notes.md
    "Lightmaps"): the Cornell box with one atlas cell per quad (as examples/lightmap.c).
    Usage: lightmap [--size N] [--patches N] [--refresh-size N] [--refresh-patches N] [--refresh-only 1]
+                   [--append FILE.md]
    Prints: texel build, the gather with 1 and 4 visibility rays and the texel-to-texel
    difference between two seeds (the gather's noise), dilation, stitching; then, on a larger
    atlas, the refresh weights and the best of 20 refreshes, in the factored layout of
@@ -109,12 +110,18 @@ int main(int argc, char **argv)
     int a;
     for (a = 1; a + 1 < argc; a += 2) {
         uint32_t v = (uint32_t)atoi(argv[a + 1]);
-        if (!strcmp(argv[a], "--size")) N = v;
+        if (!strcmp(argv[a], "--append")) {
+            if (!(g_md = fopen(argv[a + 1], "a"))) return fprintf(stderr, "lightmap: cannot open %s\n", argv[a + 1]), 1;
+        } else if (!strcmp(argv[a], "--size")) N = v;
         else if (!strcmp(argv[a], "--patches")) target = v;
         else if (!strcmp(argv[a], "--refresh-size")) RN = v;
         else if (!strcmp(argv[a], "--refresh-patches")) Rtarget = v;
         else if (!strcmp(argv[a], "--refresh-only")) refresh_only = v;
     }
+    emit("\n## Lightmaps: bake stages and the refresh (bench/lightmap.c)\n\n"
+         "The Cornell box with one atlas cell per quad; the gather's noise is the texel-to-texel difference between two "
+         "seeds; the refresh rebuilds the lightmap from a new patch solution (2 threads, and in the calling thread).\n\n"
+         "| atlas | stage | time | note |\n|---|---|---|---|\n");
     rad_patch_options_default(&po);
     rad_lightmap_options_default(&lo);
     E = B = H1 = H2 = NULL;
@@ -130,7 +137,7 @@ int main(int argc, char **argv)
     lo.width = lo.height = N;
     t = now();
     if (rad_lightmap_create(S, &rc, &lo, NULL, &lm) != RAD_SUCCESS) return 1;
-    printf("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", N, N, P->count, now() - t, lm->sample_count, lm->valid_texels);
+    emit("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", N, N, P->count, now() - t, lm->sample_count, lm->valid_texels);
     H1 = (float *)calloc(3 * (size_t)N * N, 4); H2 = (float *)calloc(3 * (size_t)N * N, 4);
     for (vr = 1; vr <= 4; vr *= 4) {
         double num = 0.0, den = 0.0;
@@ -139,11 +146,11 @@ int main(int argc, char **argv)
         go.seed = 12345; rad_lightmap_gather(lm, P, B, &rc, &go, H2, NULL);
         for (i = 0; i < N * N; ++i)
             if (lm->flags[i] & RAD_TEXEL_VALID) { double d = H1[3 * i + 1] - H2[3 * i + 1]; num += d * d; den += H1[3 * i + 1]; }
-        printf("| | gather, %u visibility ray%s | %.2f s | seed-to-seed rms difference %.4f of the mean texel |\n", vr, vr > 1 ? "s" : "", t,
+        emit("| | gather, %u visibility ray%s | %.2f s | seed-to-seed rms difference %.4f of the mean texel |\n", vr, vr > 1 ? "s" : "", t,
                sqrt(num / lm->valid_texels) / (den / lm->valid_texels));
     }
-    t = now(); rad_lightmap_dilate(lm, 3, H1, 0, NULL); printf("| | dilate (all passes) | %.4f s | |\n", now() - t);
-    t = now(); rad_lightmap_stitch(lm, 3, H1, 0, &st, NULL); printf("| | stitch | %.4f s | %u seams |\n", now() - t, st.seams);
+    t = now(); rad_lightmap_dilate(lm, 3, H1, 0, NULL); emit("| | dilate (all passes) | %.4f s | |\n", now() - t);
+    t = now(); rad_lightmap_stitch(lm, 3, H1, 0, &st, NULL); emit("| | stitch | %.4f s | %u seams |\n", now() - t, st.seams);
     rad_lightmap_destroy(lm); rad_form_factors_destroy(ff); rad_patches_destroy(P); rad_bvh_destroy(bvh); rad_scene_destroy(S);
 refresh:
     /* refresh on a larger atlas: no gather needed (weights without a detail factor) */
@@ -154,13 +161,13 @@ refresh:
     lo.width = lo.height = RN;
     t = now();
     if (rad_lightmap_create(S, &rc, &lo, NULL, &lm) != RAD_SUCCESS) return 1;
-    printf("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", RN, RN, P->count, now() - t, lm->sample_count, lm->valid_texels);
+    emit("| %ux%u, %u patches | texels | %.2f s | %u samples, %u valid texels |\n", RN, RN, P->count, now() - t, lm->sample_count, lm->valid_texels);
     t = now();
     if (rad_lightmap_weights_create(lm, P, NULL, NULL, NULL, &w) != RAD_SUCCESS) return 1;
-    printf("| | refresh weights | %.2f s | %.1f vertex entries per valid texel, %u vertices |\n", now() - t,
+    emit("| | refresh weights | %.2f s | %.1f vertex entries per valid texel, %u vertices |\n", now() - t,
            (double)w->row_first[w->row_count] / lm->valid_texels, w->vertex_count);
     old_expand(w, &ow);
-    printf("| | expanded texel-from-patch rows (the old layout) | | %.1f patch entries per valid texel |\n",
+    emit("| | expanded texel-from-patch rows (the old layout) | | %.1f patch entries per valid texel |\n",
            (double)ow.row_offsets[ow.texels] / lm->valid_texels);
     Hp = (float *)malloc(12 * (size_t)P->count); out = (float *)calloc(3 * (size_t)RN * RN, 4);
     out_old = (float *)calloc(3 * (size_t)RN * RN, 4);
@@ -177,13 +184,14 @@ refresh:
         double d = fabs((double)out[i] - out_old[i]) / (fabs((double)out_old[i]) > 1e-3 ? fabs((double)out_old[i]) : 1e-3);
         if (d > worst) worst = d;
     }
-    printf("| | refresh, old layout (best of 20) | %.2f ms | %.0f MB read |\n", best_old * 1e3,
+    emit("| | refresh, old layout (best of 20) | %.2f ms | %.0f MB read |\n", best_old * 1e3,
            (12.0 * ow.texels + 8.0 * (double)ow.row_offsets[ow.texels] + 12.0 * lm->valid_texels) / 1e6);
-    printf("| | refresh, factored layout (best of 20) | %.2f ms | %.0f MB read; largest difference from the old %.1e relative |\n",
+    emit("| | refresh, factored layout (best of 20) | %.2f ms | %.0f MB read; largest difference from the old %.1e relative |\n",
            best * 1e3, (8.0 * w->row_count + 8.0 * w->row_first[w->row_count] + 12.0 * lm->valid_texels) / 1e6, worst);
-    printf("| | refresh, factored layout, task_count 1 (best of 20) | %.2f ms | in the calling thread |\n", best_serial * 1e3);
+    emit("| | refresh, factored layout, task_count 1 (best of 20) | %.2f ms | in the calling thread |\n", best_serial * 1e3);
     free(ow.row_offsets); free(ow.columns); free(ow.values); free(out_old);
     rad_lightmap_weights_destroy(w); rad_lightmap_destroy(lm); rad_patches_destroy(P); rad_bvh_destroy(bvh); rad_scene_destroy(S);
     free(E); free(B); free(H1); free(H2); free(Hp); free(out);
+    if (g_md) fclose(g_md);
     return 0;
 }
