@@ -582,4 +582,127 @@ static inline int fx_cornell(fx_world *w, uint32_t target, uint32_t samples, int
     return 1;
 }
 
+/* ---- two rooms split by a wall, and their classic solution (lm_, fx_) ------------------------ */
+
+/* A growing quad soup: one mesh per call of lm_quad's caller, positions, indices and
+   (optional) lightmap uvs per vertex. */
+typedef struct lm_soup {
+    float pos[3 * 256];
+    float luv[2 * 256];
+    uint32_t idx[3 * 128];
+    uint32_t nv, nt;
+} lm_soup;
+
+/* quad o, o + a, o + a + b, o + b (front: a x b); lightmap uv of corner o and the uv edges */
+static inline void lm_quad(lm_soup *s, const float *o, const float *a, const float *b, const float *uv0, const float *ua,
+                    const float *ub)
+{
+    uint32_t v = s->nv;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        s->pos[3 * v + k] = o[k];
+        s->pos[3 * (v + 1) + k] = o[k] + a[k];
+        s->pos[3 * (v + 2) + k] = o[k] + a[k] + b[k];
+        s->pos[3 * (v + 3) + k] = o[k] + b[k];
+    }
+    for (k = 0; k < 2; ++k) {
+        float u0 = uv0 ? uv0[k] : 0.0f, da = ua ? ua[k] : 0.0f, db = ub ? ub[k] : 0.0f;
+        s->luv[2 * v + k] = u0;
+        s->luv[2 * (v + 1) + k] = u0 + da;
+        s->luv[2 * (v + 2) + k] = u0 + da + db;
+        s->luv[2 * (v + 3) + k] = u0 + db;
+    }
+    s->idx[3 * s->nt] = v; s->idx[3 * s->nt + 1] = v + 1; s->idx[3 * s->nt + 2] = v + 2;
+    s->idx[3 * s->nt + 3] = v; s->idx[3 * s->nt + 4] = v + 2; s->idx[3 * s->nt + 5] = v + 3;
+    s->nv += 4;
+    s->nt += 2;
+}
+
+static inline void lm_mesh(rad_mesh_desc *m, const lm_soup *s, uint32_t material, int lightmapped)
+{
+    memset(m, 0, sizeof(*m));
+    m->positions = s->pos;
+    m->vertex_count = s->nv;
+    m->indices = s->idx;
+    m->triangle_count = s->nt;
+    m->material = material;
+    m->lightmap_uvs = lightmapped ? s->luv : NULL;
+}
+
+/* Two rooms (x in [0, 0.98] and [1.06, 2], y and z in [0, 1]) split by an 8 cm wall, the lamp
+   (10 10 10) under the left room's ceiling; m[0] the rooms (floor uv = (x / 2, z), lightmapped),
+   m[1] the wall's two faces, m[2] the lamp; mats[0] grey 0.7, mats[1] the lamp. The leak tests
+   of the lightmap and the probes read it. */
+static inline void fx_two_rooms(lm_soup *room, lm_soup *wall, lm_soup *lamp, rad_mesh_desc m[3], rad_scene_desc *d,
+                                rad_material mats[2])
+{
+    const float O[3] = { 0, 0, 0 }, Y[3] = { 0, 1, 0 }, Z[3] = { 0, 0, 1 }, R[3] = { 2, 0, 0 }, V[2] = { 0, 1 };
+    const float W0[3] = { 0.98f, 0, 0 }, W1[3] = { 1.06f, 0, 0 };
+    const float L0[3] = { 0.3f, 0.999f, 0.3f }, LX[3] = { 0.4f, 0, 0 }, LZ[3] = { 0, 0, 0.4f };
+    uint32_t i;
+    memset(mats, 0, 2 * sizeof(rad_material));
+    for (i = 0; i < 3; ++i) {
+        mats[0].albedo[i] = 0.7f;
+        mats[1].albedo[i] = 0.5f;
+        mats[1].emission[i] = 10.0f;
+    }
+    memset(room, 0, sizeof(*room));
+    memset(wall, 0, sizeof(*wall));
+    memset(lamp, 0, sizeof(*lamp));
+    /* floor, ceiling and the long walls in three pieces split at the wall's faces, so that
+       no patch spans both rooms (a patch across the wall would carry light over it: a leak
+       of the patch solution, not of the lightmap); floor uv = (x / 2, z) */
+    for (i = 0; i < 3; ++i) {
+        const float x0 = i == 0 ? 0.0f : i == 1 ? 0.98f : 1.06f, x1 = i == 0 ? 0.98f : i == 1 ? 1.06f : 2.0f;
+        const float o0[3] = { x0, 0, 0 }, o1[3] = { x0, 1, 0 }, o2[3] = { x0, 0, 1 }, dx[3] = { x1 - x0, 0, 0 };
+        const float uv0[2] = { x0 / 2.0f, 0.0f }, du[2] = { (x1 - x0) / 2.0f, 0.0f };
+        lm_quad(room, o0, Z, dx, uv0, V, du);      /* floor, up */
+        lm_quad(room, o1, dx, Z, NULL, NULL, NULL); /* ceiling, down */
+        lm_quad(room, o0, dx, Y, NULL, NULL, NULL); /* z = 0 */
+        lm_quad(room, o2, Y, dx, NULL, NULL, NULL); /* z = 1 */
+    }
+    lm_quad(room, O, Y, Z, NULL, NULL, NULL);  /* x = 0 */
+    lm_quad(room, R, Z, Y, NULL, NULL, NULL);  /* x = 2 */
+    lm_quad(wall, W0, Z, Y, NULL, NULL, NULL); /* facing -x (the lit room) */
+    lm_quad(wall, W1, Y, Z, NULL, NULL, NULL); /* facing +x (the dark room) */
+    lm_quad(lamp, L0, LX, LZ, NULL, NULL, NULL);
+    lm_mesh(&m[0], room, 0, 1);
+    lm_mesh(&m[1], wall, 0, 0);
+    lm_mesh(&m[2], lamp, 1, 0);
+    memset(d, 0, sizeof(*d));
+    d->meshes = m; d->mesh_count = 3; d->materials = mats; d->material_count = 2;
+}
+
+/* The classic solution of a scene the leak tests share: patches (max_edge 0.25, 0.5 quick),
+   dense form factors (4 samples, 1 quick), E the emission and B the total after 8 Jacobi
+   bounces. 0 when a step failed (its CHECK failed too); the caller frees what is non-NULL. */
+static inline int fx_classic_jacobi8(const rad_scene *S, const rad_raycaster *rc, rad_patches **P, rad_form_factors **ff,
+                                     float **E, float **B)
+{
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_system sys;
+    rad_solve_options so;
+    rad_patch_options_default(&po);
+    po.max_edge = rad_test_quick() ? 0.5f : 0.25f;
+    CHECK_OK(rad_patches_create(S, &po, NULL, P));
+    rad_form_factor_options_default(&fo);
+    fo.samples = rad_test_quick() ? 1 : 4;
+    if (*P) CHECK_OK(rad_form_factors_dense(*P, rc, &fo, NULL, ff));
+    if (!*P || !*ff) return 0;
+    *E = (float *)malloc(sizeof(float) * 3 * (*P)->count);
+    *B = (float *)malloc(sizeof(float) * 3 * (*P)->count);
+    if (!*E || !*B) {
+        CHECK(0);
+        return 0;
+    }
+    CHECK_OK(rad_sources(*P, RAD_SOURCE_EMISSION, NULL, *E));
+    rad_system_init(&sys, &(*ff)->matrix, *P, *E);
+    rad_solve_options_default(&so);
+    so.output = RAD_OUTPUT_TOTAL;
+    so.bounces = 8;
+    CHECK_OK(rad_solve_jacobi(&sys, &so, *B, NULL, NULL));
+    return 1;
+}
+
 #endif

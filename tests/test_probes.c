@@ -725,29 +725,6 @@ static void pb_test_plain_weighting(void)
     pb_cornell_free(&f);
 }
 
-/* A quad soup for the two-room scene: o, o + a, o + a + b, o + b (front face by a x b). */
-typedef struct pb_soup {
-    float pos[3 * 4 * 16];
-    uint32_t idx[3 * 2 * 16];
-    uint32_t nv, nt;
-} pb_soup;
-
-static void pb_soup_quad(pb_soup *s, const float *o, const float *a, const float *b)
-{
-    uint32_t v = s->nv;
-    int k;
-    for (k = 0; k < 3; ++k) {
-        s->pos[3 * v + k] = o[k];
-        s->pos[3 * (v + 1) + k] = o[k] + a[k];
-        s->pos[3 * (v + 2) + k] = o[k] + a[k] + b[k];
-        s->pos[3 * (v + 3) + k] = o[k] + b[k];
-    }
-    s->idx[3 * s->nt] = v; s->idx[3 * s->nt + 1] = v + 1; s->idx[3 * s->nt + 2] = v + 2;
-    s->idx[3 * s->nt + 3] = v; s->idx[3 * s->nt + 4] = v + 2; s->idx[3 * s->nt + 5] = v + 3;
-    s->nv += 4;
-    s->nt += 2;
-}
-
 /* No light through a wall without rays: two rooms (x in [0, 0.98] and [1.06, 2]) split by an
    8 cm wall, the lamp in the left one; no patch spans both, so the right room's patches are
    exactly dark. A grid of spacing 0.2 has probe planes at x = 0.9 and 1.1, on both sides of
@@ -757,70 +734,26 @@ static void pb_soup_quad(pb_soup *s, const float *o, const float *a, const float
    NORMAL does; with visibility every lit probe is out and the dark face reads exactly 0. */
 static void pb_test_fit_wall(void)
 {
-    pb_soup room, lamp;
-    rad_mesh_desc m[2];
+    lm_soup room, wall, lamp;
+    rad_mesh_desc m[3];
     rad_scene_desc d;
-    rad_material mats[2] = { { { 0.7f, 0.7f, 0.7f }, { 0, 0, 0 }, 0 }, { { 0.5f, 0.5f, 0.5f }, { 10, 10, 10 }, 0 } };
-    const float O[3] = { 0, 0, 0 }, Y[3] = { 0, 1, 0 }, Z[3] = { 0, 0, 1 }, R[3] = { 2, 0, 0 };
-    const float W0[3] = { 0.98f, 0, 0 }, W1[3] = { 1.06f, 0, 0 };
-    const float L0[3] = { 0.3f, 0.999f, 0.3f }, LX[3] = { 0.4f, 0, 0 }, LZ[3] = { 0, 0, 0.4f };
+    rad_material mats[2];
     static const rad_probe_weighting wt[3] = { RAD_PROBE_WEIGHT_NORMAL_FIT, RAD_PROBE_WEIGHT_NORMAL, RAD_PROBE_WEIGHT_PLAIN };
     rad_scene *S = NULL;
     rad_bvh *bvh = NULL;
     rad_raycaster rc;
     rad_patches *P = NULL;
-    rad_patch_options po;
-    rad_form_factor_options fo;
     rad_form_factors *ff = NULL;
-    rad_system sys;
-    rad_solve_options so;
     rad_probe_options o;
     float *E = NULL, *B = NULL;
     double dark[3] = { 0, 0, 0 }, lit[3] = { 0, 0, 0 }, vis = 0.0;
-    uint32_t i;
     int w, iy, iz, N = rad_test_quick() ? 4 : 8;
-    memset(&room, 0, sizeof(room));
-    memset(&lamp, 0, sizeof(lamp));
-    for (i = 0; i < 3; ++i) {
-        /* floor, ceiling and the long walls in three pieces split at the wall's faces */
-        const float x0 = i == 0 ? 0.0f : i == 1 ? 0.98f : 1.06f, x1 = i == 0 ? 0.98f : i == 1 ? 1.06f : 2.0f;
-        const float o0[3] = { x0, 0, 0 }, o1[3] = { x0, 1, 0 }, o2[3] = { x0, 0, 1 }, dx[3] = { x1 - x0, 0, 0 };
-        pb_soup_quad(&room, o0, Z, dx);
-        pb_soup_quad(&room, o1, dx, Z);
-        pb_soup_quad(&room, o0, dx, Y);
-        pb_soup_quad(&room, o2, Y, dx);
-    }
-    pb_soup_quad(&room, O, Y, Z);
-    pb_soup_quad(&room, R, Z, Y);
-    pb_soup_quad(&room, W0, Z, Y); /* facing -x (the lit room) */
-    pb_soup_quad(&room, W1, Y, Z); /* facing +x (the dark room) */
-    pb_soup_quad(&lamp, L0, LX, LZ);
-    memset(m, 0, sizeof(m));
-    m[0].positions = room.pos; m[0].vertex_count = room.nv; m[0].indices = room.idx; m[0].triangle_count = room.nt;
-    m[1].positions = lamp.pos; m[1].vertex_count = lamp.nv; m[1].indices = lamp.idx; m[1].triangle_count = lamp.nt;
-    m[1].material = 1;
-    memset(&d, 0, sizeof(d));
-    d.meshes = m; d.mesh_count = 2; d.materials = mats; d.material_count = 2;
+    fx_two_rooms(&room, &wall, &lamp, m, &d, mats);
     CHECK_OK(rad_scene_create(&d, NULL, &S));
     if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
     if (!bvh) goto out;
     rad_bvh_raycaster(bvh, &rc);
-    rad_patch_options_default(&po);
-    po.max_edge = rad_test_quick() ? 0.5f : 0.25f;
-    CHECK_OK(rad_patches_create(S, &po, NULL, &P));
-    rad_form_factor_options_default(&fo);
-    fo.samples = rad_test_quick() ? 1 : 4;
-    if (P) CHECK_OK(rad_form_factors_dense(P, &rc, &fo, NULL, &ff));
-    if (!P || !ff) goto out;
-    E = (float *)malloc(sizeof(float) * 3 * P->count);
-    B = (float *)malloc(sizeof(float) * 3 * P->count);
-    if (!E || !B) { CHECK(0); goto out; }
-    CHECK_OK(rad_sources(P, RAD_SOURCE_EMISSION, NULL, E));
-    rad_system_init(&sys, &ff->matrix, P, E);
-    rad_solve_options_default(&so);
-    so.output = RAD_OUTPUT_TOTAL;
-    so.bounces = 8;
-    CHECK_OK(rad_solve_jacobi(&sys, &so, B, NULL, NULL));
+    if (!fx_classic_jacobi8(S, &rc, &P, &ff, &E, &B)) goto out;
     rad_probe_options_default(&o);
     o.spacing = 0.2f;
     o.rays = 64;
