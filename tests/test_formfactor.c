@@ -751,10 +751,12 @@ static double ff_rand(void) /* [0, 1) */
     return (double)(ff_lcg_state >> 8) / 16777216.0;
 }
 
-/* Moller-Trumbore in double, two-sided; returns 1 and t, b1, b2 on a hit of the line */
-static int ff_mt(const rad_ray *ray, const float *v, double *t, double *b1, double *b2)
+/* Where the ray's line crosses triangle v's plane, in double (Moller-Trumbore): the line
+   parameter t and the barycentric coordinates u, w of the crossing; 0 when the line is
+   parallel to the plane. */
+static int ff_line_cross(const rad_ray *ray, const float *v, double *t, double *u, double *w)
 {
-    double e1[3], e2[3], p[3], q[3], s[3], det, inv, u, w;
+    double e1[3], e2[3], p[3], q[3], s[3], det, inv;
     int k;
     for (k = 0; k < 3; ++k) {
         e1[k] = (double)v[3 + k] - v[k];
@@ -767,17 +769,20 @@ static int ff_mt(const rad_ray *ray, const float *v, double *t, double *b1, doub
     det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
     if (det == 0.0) return 0;
     inv = 1.0 / det;
-    u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
-    if (u < 0.0 || u > 1.0) return 0;
     q[0] = s[1] * e1[2] - s[2] * e1[1];
     q[1] = s[2] * e1[0] - s[0] * e1[2];
     q[2] = s[0] * e1[1] - s[1] * e1[0];
-    w = ((double)ray->dir[0] * q[0] + (double)ray->dir[1] * q[1] + (double)ray->dir[2] * q[2]) * inv;
-    if (w < 0.0 || u + w > 1.0) return 0;
+    *u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
+    *w = ((double)ray->dir[0] * q[0] + (double)ray->dir[1] * q[1] + (double)ray->dir[2] * q[2]) * inv;
     *t = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) * inv;
-    *b1 = u;
-    *b2 = w;
     return 1;
+}
+
+/* two-sided line-triangle hit in double: 1 and t, b1, b2 when the line crosses the triangle */
+static int ff_mt(const rad_ray *ray, const float *v, double *t, double *b1, double *b2)
+{
+    if (!ff_line_cross(ray, v, t, b1, b2)) return 0;
+    return *b1 >= 0.0 && *b1 <= 1.0 && *b2 >= 0.0 && *b1 + *b2 <= 1.0;
 }
 
 static int ff_close(double a, double b, double rel)
@@ -934,23 +939,8 @@ static void ff_test_bvh_brute_force(void)
    outside: near 0 the float watertight test and ff_mt may decide either way. */
 static double ff_edge_margin(const rad_ray *ray, const float *v)
 {
-    double e1[3], e2[3], p[3], q[3], s[3], det, u, w, m;
-    int k;
-    for (k = 0; k < 3; ++k) {
-        e1[k] = (double)v[3 + k] - v[k];
-        e2[k] = (double)v[6 + k] - v[k];
-        s[k] = (double)ray->origin[k] - v[k];
-    }
-    p[0] = (double)ray->dir[1] * e2[2] - (double)ray->dir[2] * e2[1];
-    p[1] = (double)ray->dir[2] * e2[0] - (double)ray->dir[0] * e2[2];
-    p[2] = (double)ray->dir[0] * e2[1] - (double)ray->dir[1] * e2[0];
-    det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
-    if (det == 0.0) return -1.0;
-    u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) / det;
-    q[0] = s[1] * e1[2] - s[2] * e1[1];
-    q[1] = s[2] * e1[0] - s[0] * e1[2];
-    q[2] = s[0] * e1[1] - s[1] * e1[0];
-    w = ((double)ray->dir[0] * q[0] + (double)ray->dir[1] * q[1] + (double)ray->dir[2] * q[2]) / det;
+    double t, u, w, m;
+    if (!ff_line_cross(ray, v, &t, &u, &w)) return -1.0;
     m = u < w ? u : w;
     return m < 1.0 - u - w ? m : 1.0 - u - w;
 }
