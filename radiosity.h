@@ -2009,7 +2009,11 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
         t_a = sum_i w_ia s_i share_i. P is then scaled symmetrically, P_ab d_a d_b, with
         d from RAD__VP_MATCH_STEPS steps of d_a <- sqrt(d_a t_a / sum_b P_ab d_b), so every
         row's exchange sum_b P_ab approaches t_a <= A_a while P stays symmetric (a patch
-        buried in other geometry, t_a = 0, exchanges nothing). Then, as a guard, rows still
+        buried in other geometry, t_a = 0, exchanges nothing). The same rays find samples
+        inside geometry (more than backface_limit of them hit back faces: the floor under a
+        column, the ceiling behind a one-sided lamp): they leave every patch that keeps
+        another sample, whose area and albedo are summed again without them, so their area no
+        longer dilutes the light of the exposed samples (rad__vp_bury). Then, as a guard, rows still
         above 1 are scaled down without breaking reciprocity: with
         c_a = 1 / max(1, sum_b P_ab / A_a), F_ab = P_ab min(c_a, c_b) / A_a, so every solver
         converges. cap_row_sums keeps only this cap (the earlier form, which took light
@@ -2119,6 +2123,9 @@ typedef struct rad_vp_options {
     uint32_t share_rays;      /* step 6: cosine rays per sample that measure each patch's share of
                                  the scene (default 16, at most 1024) */
     int cap_row_sums;         /* non-zero: step 6 only caps row sums at 1 (no traced shares) */
+    float backface_limit;     /* step 6: a sample more than this fraction of whose share rays
+                                 hit back faces lies inside geometry and is left out of its
+                                 patch (0: 0.25; in (0, 1]; 1 keeps every sample) */
 } rad_vp_options;
 
 /* Axis-aligned virtual patches with their form factors. Read-only after creation.
@@ -2155,6 +2162,7 @@ typedef struct rad_virtual_patches {
     uint32_t candidate_voxels;  /* voxels overlapped by triangle bounds (step 1) */
     uint64_t face_rays;         /* rays cast from voxel faces */
     uint64_t pair_rays;         /* shadow rays between samples */
+    uint32_t buried_samples;    /* samples step 6 left out as inside geometry (0 when loaded) */
     const rad_scene *scene;     /* borrowed: must outlive this object */
     rad_vp_kind kind;
     rad_vp_weights weights;
@@ -15385,6 +15393,7 @@ RAD_API void rad_vp_options_default(rad_vp_options *o)
     o->ray_epsilon = 1e-5f;
     o->visibility_rays = 16;
     o->share_rays = 16;
+    o->backface_limit = 0.25f;
     o->kind = RAD_VP_AXIS_ALIGNED;
     o->max_clusters = 6;
     o->metric_columns = 64;
@@ -15465,6 +15474,7 @@ typedef struct rad__vp_build {
     float *eff;                  /* M: s_i times the sum of its corrected weights (the clamp) */
     float *rowf;                 /* N: 1 / max(1, row sum) */
     float *share;                /* M: the traced share of each sample (step 6), NULL when off */
+    uint32_t back_limit;         /* step 6: most back-face hits of a sample outside geometry */
     rad_hit *share_hits;         /* RAD__RAY_BATCH per task */
     double *target, *dscale, *dnext; /* N: sum_i w_ia s_i share_i; the symmetric scaling d_a */
     const uint64_t *csr_off;     /* step 6 on sparse rows: the full CSR rows of P */
@@ -16256,7 +16266,7 @@ static rad_result rad__vp_share_row(void *data, uint32_t u, uint32_t task)
     for (i = vp->sample_first[u]; i < vp->sample_first[u + 1]; ++i) {
         const float *p = vp->sample_positions + 3 * (size_t)i, *nr = vp->sample_normals + 3 * (size_t)i;
         float t1[3], t2[3];
-        uint32_t h = rad__hash(i * 0x9E3779B9u ^ 0x5BD1E995u), front = 0;
+        uint32_t h = rad__hash(i * 0x9E3779B9u ^ 0x5BD1E995u), front = 0, back = 0;
         int q;
         rad__tangent_frame(nr, t1, t2);
         for (k = 0; k < K; ++k) {
@@ -16266,9 +16276,13 @@ static rad_result rad__vp_share_row(void *data, uint32_t u, uint32_t task)
             rays[k].tmax = FLT_MAX;
         }
         if (b->rc->intersect(b->rc->user, rays, K, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
-        for (k = 0; k < K; ++k)
-            if (hits[k].triangle != RAD_NONE && rad__dot(rays[k].dir, b->S->normals + 3 * (size_t)hits[k].triangle) < 0.0f) front++;
-        b->share[i] = (float)front / (float)K;
+        for (k = 0; k < K; ++k) {
+            if (hits[k].triangle == RAD_NONE) continue;
+            if (rad__dot(rays[k].dir, b->S->normals + 3 * (size_t)hits[k].triangle) < 0.0f) front++;
+            else back++;
+        }
+        /* -1 marks a sample inside geometry for rad__vp_bury */
+        b->share[i] = back > b->back_limit ? -1.0f : (float)front / (float)K;
         n += K;
     }
     b->rays_cast[task] += n;
@@ -16328,6 +16342,48 @@ static rad_result rad__vp_match(rad__vp_build *b, const rad__ctx *cc, uint32_t T
     return r;
 }
 
+/* Step 6, samples inside geometry (the floor under a column standing on it, a face buried in
+   a wall): they neither receive nor send light, yet their area in a patch would dilute the
+   light of its exposed samples (the patch's power spread over more area than radiates), a
+   loss that does not fall with more rays. Such samples leave each patch that keeps another
+   sample (their weight there 0), and the patch's area and albedo are summed again over the
+   samples left; a patch with no other sample stays as it was (exchanging nothing), so every
+   patch keeps samples and gathering reads no empty patch. */
+static void rad__vp_bury(rad__vp_build *b)
+{
+    rad_virtual_patches *vp = b->vp;
+    uint32_t v, s, a, k;
+    for (v = 0; v < vp->voxel_count; ++v) {
+        uint32_t s0 = vp->sample_first[v], s1 = vp->sample_first[v + 1], any = 0;
+        for (s = s0; s < s1; ++s) any |= b->share[s] < 0.0f;
+        if (!any) continue;
+        for (a = 0; a < 6; ++a) {
+            uint32_t p = vp->voxel_patch[6 * (size_t)v + a];
+            double area = 0.0, col[3] = { 0.0, 0.0, 0.0 };
+            if (p == RAD_NONE) continue;
+            /* clustered: a sample's weight sits on its cluster's slot a */
+            for (s = s0; s < s1; ++s) {
+                double w = (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+                if (b->share[s] < 0.0f) continue;
+                area += w;
+                for (k = 0; k < 3; ++k) col[k] += w * (double)vp->sample_albedo[3 * (size_t)s + k];
+            }
+            if (!(area > 0.0)) continue;
+            for (s = s0; s < s1; ++s)
+                if (b->share[s] < 0.0f) vp->sample_weights[6 * (size_t)s + a] = 0.0f;
+            vp->areas[p] = (float)area;
+            for (k = 0; k < 3; ++k) vp->albedo[3 * (size_t)p + k] = (float)(col[k] / area);
+        }
+        for (s = s0; s < s1; ++s) {
+            const float *w = vp->sample_weights + 6 * (size_t)s;
+            if (!(b->share[s] < 0.0f)) continue;
+            b->share[s] = 0.0f;
+            b->eff[s] = vp->sample_areas[s] * (w[0] + w[1] + w[2] + w[3] + w[4] + w[5]);
+            vp->buried_samples++;
+        }
+    }
+}
+
 static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size_t bytes)
 {
     rad_virtual_patches *vp = b->vp;
@@ -16385,8 +16441,10 @@ static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size
         b->dscale = (double *)rad__alloc_array(A, N, sizeof(double));
         b->dnext = (double *)rad__alloc_array(A, N, sizeof(double));
         if (!b->share || !b->share_hits || !b->target || !b->dscale || !b->dnext) return RAD_ERROR_OUT_OF_MEMORY;
+        b->back_limit = (uint32_t)floor((double)b->o.backface_limit * b->o.share_rays + 1e-9);
         r = rad__for_rows(&quiet, vp->voxel_count, T, rad__vp_share_row, b);
         if (r != RAD_SUCCESS) return r;
+        rad__vp_bury(b);
         memset(b->target, 0, sizeof(double) * N);
         for (v2 = 0; v2 < vp->voxel_count; ++v2)
             for (s2 = vp->sample_first[v2]; s2 < vp->sample_first[v2 + 1]; ++s2)
@@ -16689,6 +16747,7 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
     if (b.o.resolution == 0) b.o.resolution = 16;
     if (b.o.face_points == 0) b.o.face_points = 16;
     if (b.o.share_rays == 0) b.o.share_rays = 16;
+    if (b.o.backface_limit == 0.0f) b.o.backface_limit = 0.25f;
     if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
     if (b.o.max_clusters == 0) b.o.max_clusters = 6;
     if (b.o.metric_columns == 0) b.o.metric_columns = 64;
@@ -16706,11 +16765,11 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
     if ((given != 0 && given != 3) || b.o.face_points > 4096u || b.o.visibility_rays > RAD__RAY_BATCH || b.o.share_rays > RAD__RAY_BATCH || (b.o.weights != RAD_VP_WEIGHTS_SQUARED && b.o.weights != RAD_VP_WEIGHTS_COSINE) ||
         !(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || (!b.o.skip_visibility && !raycaster->occluded) ||
         (b.o.storage != RAD_STORAGE_DENSE && b.o.storage != RAD_STORAGE_SPARSE) || !rad__finite(b.o.drop_threshold) ||
-        b.o.drop_threshold < 0.0f) {
+        b.o.drop_threshold < 0.0f || !(b.o.backface_limit > 0.0f && b.o.backface_limit <= 1.0f)) {
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: voxel_size must be all 0 or all > 0; face_points <= 4096; visibility_rays "
                  "and share_rays <= 1024; weights valid; ray_epsilon in (0, 1e-2] (got %g); an occluded callback unless skip_visibility; "
-                 "storage dense or sparse; drop_threshold finite and >= 0",
-                 (double)b.o.ray_epsilon);
+                 "storage dense or sparse; drop_threshold finite and >= 0; backface_limit in (0, 1] (got %g)",
+                 (double)b.o.ray_epsilon, (double)b.o.backface_limit);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     vp = (rad_virtual_patches *)rad__alloc_zero(&c.allocator, sizeof(*vp));

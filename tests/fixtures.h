@@ -393,7 +393,7 @@ static inline void vp_peak_free(void *user, void *ptr)
 }
 
 /* Up to 10 axis-aligned quads, each cut into an n x n grid of triangle pairs. */
-#define VP_MAX_QUADS 10
+#define VP_MAX_QUADS 16
 typedef struct vp_scene {
     float pos[VP_MAX_QUADS][3 * 41 * 41];
     uint32_t idx[VP_MAX_QUADS][6 * 40 * 40];

@@ -9,7 +9,7 @@
 /* ---- helpers ------------------------------------------------------------------------------ */
 
 /* the thin-wall leak of vp_partition: the most the dark room may get, as a multiple of classic */
-#define VP_PARTITION_LEAK 1.7
+#define VP_PARTITION_LEAK 1.75
 
 /* ---- reciprocity --------------------------------------------------------------------------- */
 
@@ -57,7 +57,7 @@ static void vp_test_reciprocity(void)
     rad_bvh_raycaster(bvh, &rc);
     for (w = 0; w < 4; ++w) {
         uint32_t p, v;
-        double sample_area = 0.0, patch_area = 0.0, scene_area = 0.0;
+        double sample_area = 0.0, patch_area = 0.0, scene_area = 0.0, inside_area = 0.0;
         rad_vp_options_default(&o);
         o.resolution = rad_test_quick() ? 4 : 6;
         o.face_points = rad_test_quick() ? 4 : 9;
@@ -69,12 +69,25 @@ static void vp_test_reciprocity(void)
         vp_check_reciprocity(vp);
         /* the patches hold the exact clipped area of the surface in their voxels (less the
            rare voxel axis that has area but no sample): at most the scene's area, and nearly
-           all of it, although the samples' own areas S_t / n_t miss every triangle no ray hit */
+           all of it, although the samples' own areas S_t / n_t miss every triangle no ray hit;
+           less the surface inside geometry (step 6): the floor under the two blocks (their
+           tops' area) and the ceiling behind the one-sided lamp (the lamp's area), except
+           in a patch that holds nothing else */
         for (p = 0; p < vp->sample_count; ++p) sample_area += vp->sample_areas[p];
         for (p = 0; p < vp->count; ++p) patch_area += vp->areas[p];
-        for (p = 0; p < scene->triangle_count; ++p) scene_area += scene->areas[p];
+        for (p = 0; p < scene->triangle_count; ++p) {
+            const float *nt = scene->normals + 3 * (size_t)p, *tv = scene->positions + 9 * (size_t)p;
+            const float *Le = scene->materials_table[scene->materials[p]].emission;
+            double cy = (tv[1] + tv[4] + tv[7]) / 3.0 - scene->bounds_min[1];
+            scene_area += scene->areas[p];
+            if ((nt[1] > 0.99f && cy > 0.01 * scene->diagonal) || Le[0] + Le[1] + Le[2] > 0.0f) inside_area += scene->areas[p];
+        }
         CHECK(patch_area <= scene_area * (1.0 + 1e-5));
-        CHECK(patch_area >= 0.99 * scene_area);
+        CHECK(vp->buried_samples > 0);
+        CHECK(patch_area >= scene_area - 1.25 * inside_area);
+        CHECK(patch_area <= scene_area - 0.5 * inside_area); /* a patch of buried samples alone stays */
+        printf("    patch area %.4f, scene %.4f, inside geometry %.4f (%u of %u samples left out)\n", patch_area, scene_area,
+                   inside_area, vp->buried_samples, vp->sample_count);
         CHECK(sample_area <= scene_area * (1.0 + 1e-5));
         /* at most six patches per voxel, normals along the axes */
         for (v = 0; v < vp->voxel_count; ++v) CHECK(vp->voxel_first[v + 1] - vp->voxel_first[v] <= (w == 3 ? 3u : 6u));
@@ -637,6 +650,91 @@ out:
     vp_pl_close(&w);
 }
 
+/* Samples inside geometry (step 6): a room with blocks standing on its floor, which goes on
+   under them. Left in their patches, the buried samples spread the patches' power over area
+   that does not radiate, and the indirect light falls short of classic radiosity's (which
+   gives each patch under a block its own, dark, value); left out, it comes back. The power of
+   L on the virtual patches against classic radiosity with visibility. */
+static int vp_under_block(const float *c)
+{
+    uint32_t b;
+    for (b = 0; b < 2; ++b) {
+        float x = 0.3f + 0.8f * (float)b, z = 0.35f + 0.7f * (float)b, d = 0.5f;
+        if (c[1] < 1e-3f && c[0] > x && c[0] < x + d && c[2] > z && c[2] < z + d) return 1;
+    }
+    return 0;
+}
+
+static void vp_buried_errors(const vp_pl *w, double *rms, double *ratio)
+{
+    double num = 0.0, den = 0.0, sv = 0.0, sc = 0.0;
+    uint32_t i;
+    for (i = 0; i < w->n; ++i) {
+        double a = w->P->patches[i].area, d = w->g[3 * i] - w->Lc[3 * i];
+        if (vp_under_block(w->P->patches[i].centroid)) continue;
+        num += a * d * d;
+        den += a * (double)w->Lc[3 * i] * w->Lc[3 * i];
+        sv += a * (double)w->g[3 * i];
+        sc += a * (double)w->Lc[3 * i];
+    }
+    *rms = sqrt(num / den);
+    *ratio = sv / sc;
+}
+
+static void vp_test_buried(void)
+{
+    static vp_scene s;
+    static const float light_pos[3] = { 0.9f, 1.7f, 1.1f };
+    rad_scene_desc desc;
+    rad_vp_options o;
+    vp_pl w;
+    double rms_on, rms_off, ratio_on, ratio_off;
+    uint32_t buried = 0, b;
+    vp_box(&s, 2.0f, 2.0f, 2.0f, 6, 0);
+    for (b = 0; b < 2; ++b) {
+        /* a block 0.5 wide and 0.3 tall, faces out, no bottom */
+        float x = 0.3f + 0.8f * (float)b, z = 0.35f + 0.7f * (float)b, h = 0.3f, d = 0.5f;
+        float p0[3], p1[3], p2[3], p3[3], top[3];
+        float X[3] = { 0.0f, 0.0f, 0.0f }, Y[3] = { 0.0f, 0.0f, 0.0f }, Z[3] = { 0.0f, 0.0f, 0.0f };
+        float mX[3] = { 0.0f, 0.0f, 0.0f }, mZ[3] = { 0.0f, 0.0f, 0.0f };
+        X[0] = d, Y[1] = h, Z[2] = d, mX[0] = -d, mZ[2] = -d;
+        p0[0] = x, p0[1] = 0.0f, p0[2] = z;
+        p1[0] = x + d, p1[1] = 0.0f, p1[2] = z;
+        p2[0] = x + d, p2[1] = 0.0f, p2[2] = z + d;
+        p3[0] = x, p3[1] = 0.0f, p3[2] = z + d;
+        top[0] = x, top[1] = h, top[2] = z;
+        vp_add_quad(&s, p0, Y, X, 0, 2);   /* normal -z */
+        vp_add_quad(&s, p1, Y, Z, 0, 2);   /* +x */
+        vp_add_quad(&s, p2, Y, mX, 0, 2);  /* +z */
+        vp_add_quad(&s, p3, Y, mZ, 0, 2);  /* -x */
+        vp_add_quad(&s, top, Z, X, 0, 2);  /* +y */
+    }
+    vp_desc(&s, &desc, 0.6f, 0.0f);
+    rad_vp_options_default(&o);
+    o.resolution = 5;
+    o.face_points = 16;
+    if (!vp_pl_open(&w, &desc, light_pos, rad_test_quick() ? 400 : 900, 1)) goto out;
+    o.backface_limit = 1.0f; /* every sample kept: the earlier build */
+    if (!vp_pl_aavp(&w, &o)) goto out;
+    CHECK(w.vp->buried_samples == 0);
+    vp_buried_errors(&w, &rms_off, &ratio_off);
+    o.backface_limit = 0.0f; /* the default */
+    if (!vp_pl_aavp(&w, &o)) goto out;
+    buried = w.vp->buried_samples;
+    vp_buried_errors(&w, &rms_on, &ratio_on);
+    printf("    classic %u patches, AAVP %u (%u of %u samples inside geometry): L gathered on the exposed classic patches, "
+           "relative RMS error %.4f, mean %.4f of classic (all samples kept: %.4f, %.4f)\n", w.n, w.vp->count, buried,
+           w.vp->sample_count, rms_on, ratio_on, rms_off, ratio_off);
+    CHECK(buried > 0);
+    /* measured: 0.041 against 0.048 (quick), 0.045 against 0.060 */
+    CHECK(rms_on < rms_off);
+    CHECK(rms_on < 0.05);
+    CHECK(ratio_on > ratio_off); /* the light the buried samples diluted, back */
+    CHECK_NEAR(ratio_on, 1.0, 0.03);
+out:
+    vp_pl_close(&w);
+}
+
 /* ---- argument checks ----------------------------------------------------------------------- */
 
 static void vp_test_arguments(void)
@@ -1140,12 +1238,22 @@ static void vp_test_row_shares(void)
             }
             CHECK(most <= 1.0 + 1e-5);
             if (sc == 0) {
-                double m = vp_row_group(vm, -1, NULL), c = vp_row_group(vc, -1, NULL);
-                printf("    closed room with a pillar, %u patches: area-weighted row sum %.4f (cap only %.4f), largest %.4f\n", N, m, c,
-                       most);
-                /* the floor under the pillar and the ceiling over it (0.5 of 28) are buried */
-                CHECK_NEAR(m, 1.0 - 0.5 / 28.0, 0.005);
-                CHECK(fabs(m - (1.0 - 0.5 / 28.0)) < fabs(c - (1.0 - 0.5 / 28.0)));
+                double total = 0.0, m = vp_row_group(vm, -1, &total), c = vp_row_group(vc, -1, NULL), inside = 0.0, exact;
+                uint32_t q, k;
+                /* the floor under the pillar and the ceiling over it (0.5 of 28) are buried: row
+                   sum 0 there, 1 on every exposed surface of the closed room. Step 6 leaves
+                   those samples out of every patch that keeps another, so the exact
+                   area-weighted row sum is 1 less the buried area the patches still hold */
+                for (q = 0; q < vm->sample_count; ++q) {
+                    const float *y = vm->sample_positions + 3 * (size_t)q;
+                    if ((y[1] < 0.01f || y[1] > 1.99f) && y[0] > 0.7f && y[0] < 1.2f && y[2] > 0.8f && y[2] < 1.3f)
+                        for (k = 0; k < 6; ++k) inside += (double)vm->sample_weights[6 * (size_t)q + k] * vm->sample_areas[q];
+                }
+                exact = 1.0 - inside / total;
+                printf("    closed room with a pillar, %u patches: area-weighted row sum %.4f (exact %.4f; cap only %.4f against "
+                       "%.4f), largest %.4f\n", N, m, exact, c, 1.0 - 0.5 / 28.0, most);
+                CHECK_NEAR(m, exact, 0.005);
+                CHECK(fabs(c - (1.0 - 0.5 / 28.0)) > 0.005);
             } else {
                 double fm = vp_row_group(vm, 2, NULL), wm = vp_row_group(vm, -4, NULL);
                 double fc = vp_row_group(vc, 2, NULL), wc = vp_row_group(vc, -4, NULL);
@@ -1174,6 +1282,7 @@ static const rad_test_case tests_vp[] = {
     { "vp_classic", vp_test_classic },
     { "vp_axis_visibility", vp_test_axis_visibility },
     { "vp_partition", vp_test_partition },
+    { "vp_buried", vp_test_buried },
     { "vp_continuity", vp_test_continuity },
     { "vp_arguments", vp_test_arguments },
     { "vp_robustness", vp_test_robustness },
