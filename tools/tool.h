@@ -534,6 +534,14 @@ typedef struct tool_lightmap_proxy {
 /* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth
    lookup (rad_lightmap_gather_hierarchical); a kind of its own, past the tool_proxy values */
 #define TOOL_LIGHTMAP_HIERARCHICAL 3
+/* --proxy aavp|vp (rad lightmap, rad probes): virtual patches of w's scene at px's resolution
+   and face points (CSR rows), E = rho D at their samples (the lights of w, emitters included,
+   co->light_samples), L by co->bounces Jacobi bounces (Gauss-Seidel with --solver
+   gauss-seidel); *B_out = E + L and *H_out = F (E + L) per virtual patch (3N floats to free;
+   either output may be NULL), *solve_seconds the solve and H (may be NULL). Prints what it
+   built. 0, or 1 after printing why (nothing left to free). */
+int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic_options *co, const tool_lightmap_proxy *px,
+                        rad_virtual_patches **vp_out, float **B_out, float **H_out, double *solve_seconds);
 typedef struct tool_lightmap_baked {
     tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
     tool_classic cl;     /* the classic solution gathered (patches of w.scene), or zero with a proxy */
