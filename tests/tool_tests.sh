@@ -1121,7 +1121,8 @@ rc3=$?
     fail "probes refuses bad options" "exits $rc1 $rc2 $rc3: $(head -c 200 "$TMP/err.txt")"
 # --proxy aavp: the probes over virtual patches (rad_probes_create_vp) hold the classic probes'
 # light: E(up) and E(down) of the top probe nearest the light and the mean E_0 over the valid
-# probes within 10% of the classic file's (measured: MEASURED)
+# probes within 5% of the classic file's (measured at resolution 6: 0.04%, 1.0% and 0.3%; E(up)
+# is mostly the direct light, the same in both, E(down) mostly indirect)
 if [ -s "$TMP/probes.json" ] &&
     "$RAD" probes cornell --proxy aavp --vp-resolution 6 --spacing 0.14 -o "$TMP/probes_vp.json" > "$TMP/probes.txt" 2> "$TMP/err.txt"; then
     read -r vup vdn <<< "$(sh_up_down "$TMP/probes_vp.json")"
@@ -1129,7 +1130,7 @@ if [ -s "$TMP/probes.json" ] &&
     e0() { awk '/"p": \[/ && /"valid"/ { gsub(/[\[\],"{}:]/, " "); split($0, t, " "); s += t[8]; n++ } END { if (n) printf "%g\n", s / n }' "$1"; }
     m=$(e0 "$TMP/probes.json")
     mv=$(e0 "$TMP/probes_vp.json")
-    close "$vup" "$up" 0.1 && close "$vdn" "$dn" 0.1 && close "$mv" "$m" 0.1 && grep -q "over aavp virtual patches" "$TMP/probes.txt" &&
+    close "$vup" "$up" 0.05 && close "$vdn" "$dn" 0.05 && close "$mv" "$m" 0.05 && grep -q "over aavp virtual patches" "$TMP/probes.txt" &&
         ok "probes --proxy aavp holds the classic probes' light (E(up) $vup vs $up, E(down) $vdn vs $dn, mean E_0 $mv vs $m)" ||
         fail "probes --proxy aavp holds the classic probes' light" "E(up) $vup vs $up, E(down) $vdn vs $dn, mean E_0 $mv vs $m"
 else
