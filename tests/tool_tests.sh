@@ -1140,7 +1140,13 @@ fi
     grep -q "lights from the command line: 1 sun" "$TMP/err.txt" && ok "probes takes --sun (lights from the command line)" ||
     fail "probes takes --sun" "$(head -c 300 "$TMP/err.txt")"
 bad "probes --proxy sideways" "unknown --proxy 'sideways'" probes cornell -o "$TMP/x.json" --proxy sideways
-bad "probes --vp-resolution without --proxy" "--vp-resolution and --face-points are for --proxy" probes cornell -o "$TMP/x.json" --vp-resolution 4
+bad "probes --vp-resolution without --proxy" "--vp-resolution, --vp-max-patches and --face-points are for --proxy" probes cornell -o "$TMP/x.json" --vp-resolution 4
+bad "probes --vp-resolution with --vp-max-patches" "exclude each other" probes cornell -o "$TMP/x.json" --proxy aavp --vp-resolution 4 --vp-max-patches 100
+# --vp-max-patches: the finest resolution within the budget, by counting, then one build
+"$RAD" probes cornell --proxy vp --vp-max-patches 600 --spacing 0.2 -o "$TMP/x.json" > /dev/null 2> "$TMP/err.txt" &&
+    n=$(sed -n 's/.*vp virtual patches at resolution [0-9]*: \([0-9]*\) patches.*/\1/p' "$TMP/err.txt") && [ -n "$n" ] && [ "$n" -le 600 ] &&
+    grep -q -- "--vp-max-patches 600: resolution" "$TMP/err.txt" && ok "probes --vp-max-patches 600 builds $n patches" ||
+    fail "probes --vp-max-patches" "'$n': $(head -c 300 "$TMP/err.txt")"
 bad "probes --vp-rays without --proxy" "--vp-rays is for --proxy" probes cornell -o "$TMP/x.json" --vp-rays 64
 bad "probes --patch-samples with --proxy" "--patch-samples is for classic patches" probes cornell -o "$TMP/x.json" --proxy aavp --patch-samples 4
 # too big for the dense build: refused at once, naming --proxy aavp

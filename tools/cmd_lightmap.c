@@ -151,6 +151,8 @@ int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic
     if (px->resolution) vo.resolution = px->resolution;
     if (px->face_points) vo.face_points = px->face_points;
     if (px->kind == TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
+    if (px->max_patches && tool_vp_resolution_within(cmd, w, vo.kind, vo.face_points, px->max_patches, 0, &vo.resolution))
+        return 1;
     /* CSR rows: O(non-zeros), as rad render --proxy keeps them */
     vo.storage = RAD_STORAGE_SPARSE;
     tool_context(&ctx, "virtual patches");

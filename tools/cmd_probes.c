@@ -2,7 +2,8 @@
    virtual patches.
 
    rad probes SCENE -o OUT.json|OUT.bin [--spacing S] [--rays R] [--patch-samples N] [--indirect]
-              [--band4] [--proxy aavp|vp [--vp-resolution R] [--face-points P] [--vp-rays N]]
+              [--band4] [--proxy aavp|vp [--vp-resolution R | --vp-max-patches B] [--face-points P]
+              [--vp-rays N]]
               [classic options: --patches N ...] [lights: --sun, --sky, --point, --spot, --area]
               [--threads N]
 
@@ -44,7 +45,8 @@ static void probes_usage(FILE *f)
                "  --band4            also band 4 (9 more coefficients per colour: sharper E(n) than L2)\n"
                "  --proxy P          the light from classic patches (patches, the default) or from virtual patches,\n"
                "                     aavp or vp: a few thousand unknowns whatever the triangle count, for real\n"
-               "                     buildings (rad_probes_create_vp); --vp-resolution R (default 16),\n"
+               "                     buildings (rad_probes_create_vp); --vp-resolution R (default 16) or\n"
+               "                     --vp-max-patches B (the finest resolution with at most B patches),\n"
                "                     --face-points P (default 16), --vp-rays N gather rays per probe (default 2048)\n"
                "%s%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
@@ -163,7 +165,8 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
         if (!strcmp(opt, "--band4")) { po.flags |= RAD_PROBES_BAND4; continue; }
         if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--spacing") || !strcmp(opt, "--rays") ||
              !strcmp(opt, "--patch-samples") || !strcmp(opt, "--proxy") || !strcmp(opt, "--vp-resolution") ||
-             !strcmp(opt, "--face-points") || !strcmp(opt, "--vp-rays")) && a + 1 >= argc) {
+             !strcmp(opt, "--face-points") || !strcmp(opt, "--vp-rays") || !strcmp(opt, "--vp-max-patches")) &&
+            a + 1 >= argc) {
             fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
             return 2;
         }
@@ -197,6 +200,10 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
             if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
             if (*dst == 0 || *dst > 4096u) { fprintf(stderr, "rad %s: %s must be 1 to 4096\n", cmd, opt); return 2; }
             px_opts = 1;
+        } else if (!strcmp(opt, "--vp-max-patches")) {
+            if (tool_parse_uint(cmd, opt, argv[++a], &px.max_patches)) return 2;
+            if (px.max_patches == 0) { fprintf(stderr, "rad %s: --vp-max-patches must be at least 1\n", cmd); return 2; }
+            px_opts = 1;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad probes --help)\n", cmd, opt);
             return 2;
@@ -209,7 +216,11 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
         return 2;
     }
     if (px_opts && !px.kind) {
-        fprintf(stderr, "rad %s: --vp-resolution and --face-points are for --proxy aavp|vp\n", cmd);
+        fprintf(stderr, "rad %s: --vp-resolution, --vp-max-patches and --face-points are for --proxy aavp|vp\n", cmd);
+        return 2;
+    }
+    if (px.resolution && px.max_patches) {
+        fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
         return 2;
     }
     if (vp_rays_given && !px.kind) {
