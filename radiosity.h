@@ -19864,7 +19864,7 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
     if (b.o.patch_samples > RAD__MAX_SAMPLES) b.o.patch_samples = RAD__MAX_SAMPLES;
     if (b.o.light_samples > RAD__MAX_SAMPLES) b.o.light_samples = RAD__MAX_SAMPLES;
-    if (b.o.rays > 65536u || b.o.vp_rays > 65536u) {
+    if (b.o.rays > 65536u || (vp && b.o.vp_rays > 65536u)) {
         rad__log(&c, RAD_LOG_ERROR, "probes: rays %u or vp_rays %u above 65536", b.o.rays, b.o.vp_rays);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
