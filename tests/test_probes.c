@@ -616,14 +616,18 @@ static void pb_test_bad_options(void)
     pb_cornell_free(&f);
 }
 
-/* every allocation of a create and an update failing in turn: OUT_OF_MEMORY, nothing leaked */
+/* every allocation of a create and an update failing in turn (classic, band 4, virtual
+   patches): OUT_OF_MEMORY, nothing leaked */
 static void pb_test_alloc(void)
 {
     pb_cornell f;
     rad_probe_options o;
     sc_alloc_state st;
     rad_context ctx;
+    rad_virtual_patches *vp = NULL;
+    float *Bv = NULL;
     long n, total = 1;
+    uint32_t k;
     int pass;
     if (!pb_cornell_init(&f, 50)) { CHECK(0); pb_cornell_free(&f); return; }
     rad_probe_options_default(&o);
@@ -634,17 +638,30 @@ static void pb_test_alloc(void)
     ctx.allocator.free = sc_free_fn;
     ctx.allocator.user = &st;
     ctx.task_count = 4;
-    for (pass = 0; pass < 2; ++pass) { /* then with the band-4 arrays */
-        o.flags = pass ? RAD_PROBES_DIRECT | RAD_PROBES_BAND4 : RAD_PROBES_DIRECT;
+    {
+        rad_vp_options vo;
+        rad_vp_options_default(&vo);
+        vo.resolution = 4;
+        CHECK_OK(rad_vp_create(f.S, &f.rc, &vo, NULL, &vp));
+        if (vp) {
+            Bv = (float *)malloc(sizeof(float) * 3 * vp->count);
+            for (k = 0; Bv && k < 3 * vp->count; ++k) Bv[k] = 0.25f;
+        }
+    }
+    for (pass = 0; pass < 3; ++pass) { /* then with the band-4 arrays, then over virtual patches */
+        o.flags = pass == 1 ? RAD_PROBES_DIRECT | RAD_PROBES_BAND4 : RAD_PROBES_DIRECT;
+        o.vp_rays = 64;
+        if (pass == 2 && (!vp || !Bv)) break;
         total = 1;
         for (n = 0; n <= total; ++n) {
             rad_probes *pr = NULL;
             rad_result r;
             memset(&st, 0, sizeof(st));
             st.fail_at = n;
-            r = rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, &ctx, &pr);
+            r = pass < 2 ? rad_probes_create(f.P, &f.rc, NULL, 0, NULL, 0, &o, f.B, &ctx, &pr)
+                         : rad_probes_create_vp(vp, &f.rc, NULL, 0, NULL, 0, &o, Bv, &ctx, &pr);
             if (r != RAD_SUCCESS) CHECK(pr == NULL);
-            if (r == RAD_SUCCESS) r = rad_probes_update(pr, f.B, &ctx);
+            if (r == RAD_SUCCESS) r = rad_probes_update(pr, pass < 2 ? f.B : Bv, &ctx);
             CHECK(r == RAD_SUCCESS || r == RAD_ERROR_OUT_OF_MEMORY);
             if (n > 0 && n <= st.calls) CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
             rad_probes_destroy(pr);
@@ -653,6 +670,9 @@ static void pb_test_alloc(void)
         }
         CHECK(total >= 10);
     }
+    CHECK(pass == 3);
+    free(Bv);
+    rad_vp_destroy(vp);
     pb_cornell_free(&f);
 }
 
