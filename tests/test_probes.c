@@ -649,7 +649,7 @@ static void pb_test_alloc(void)
         }
     }
     for (pass = 0; pass < 3; ++pass) { /* then with the band-4 arrays, then over virtual patches */
-        o.flags = pass == 1 ? RAD_PROBES_DIRECT | RAD_PROBES_BAND4 : RAD_PROBES_DIRECT;
+        o.flags = pass ? RAD_PROBES_DIRECT | RAD_PROBES_BAND4 : RAD_PROBES_DIRECT;
         o.vp_rays = 64;
         if (pass == 2 && (!vp || !Bv)) break;
         total = 1;
