@@ -2749,6 +2749,23 @@ RAD_API rad_result rad_lightmap_gather_hierarchical(const rad_lightmap *lightmap
    emitters' own light (RAD_SOURCE_DIRECT, or RAD_OUTPUT_INDIRECT), never with
    RAD_SOURCE_EMISSION and RAD_OUTPUT_TOTAL (that counts the emitters twice).
 
+   VIRTUAL PATCHES (rad_probes_create_vp). A real building has no classic patch set (its dense
+   N x N build is out of reach) and THE GATHER above costs probes x patches x samples rays. Over
+   virtual patches (>>api_vp) the weights come from 'vp_rays' directions w_k of a spherical
+   Fibonacci set (equal areas, 4 pi / R steradians each, the same set for every probe): the
+   closest hit y_k of each, when it is the front of a triangle (normal n_k), sees the radiance
+   B(y_k) / pi, B(y_k) = sum_j g_j(y_k, n_k) B_j the virtual-patch gather of rad_vp_gather_point
+   (its weights g_j: the 2x2x2 voxels around y_k, trilinear, with the normal weights), so
+       W_ij = (A_l / pi) (4 pi / R) sum_k Y_i(w_k) g_j(y_k, n_k)
+   (band 4 the same with A_4 and Z_m). A back face or a miss adds nothing, as a patch whose back
+   faces p. Cost: probes x vp_rays closest-hit rays and at most 48 weights per hit, whatever the
+   triangle count; an entry per (probe, virtual patch) some hit reaches. It is a quadrature of
+   the sphere, not of each patch: constant radiance is reproduced exactly (the weights of a hit
+   sum to 1), and the noise of a band falls as the rays grow (docs/methods/probes.md, "Over
+   virtual patches"). D_i (RAD_PROBES_DIRECT) is computed as above, and placement, inside
+   geometry, storage, rad_probes_update and sampling are the same: B holds the 3N radiosities
+   of the virtual patches (vp->count).
+
    PROBES INSIDE GEOMETRY. 'rays' rays in a spherical Fibonacci set leave every probe; when
    more than 'backface_fraction' of them hit a back face (the one-sided patches face away:
    the probe is inside a solid, behind a wall or outside a closed room), the probe is moved
@@ -2819,6 +2836,8 @@ typedef struct rad_probe_options {
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t flags;            /* rad_probe_flags */
     rad_probe_weighting weighting; /* how rad_probes_sample weighs the probes (0: NORMAL_FIT) */
+    uint32_t vp_rays;          /* rad_probes_create_vp: gather rays per probe (0: 2048; at most
+                                  65536; VIRTUAL PATCHES above) */
 } rad_probe_options;
 
 typedef struct rad_probes rad_probes;
@@ -2841,6 +2860,19 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
                                      const rad_light *lights, uint32_t light_count, const float *positions,
                                      uint32_t count, const rad_probe_options *options, const float *B,
                                      const rad_context *ctx, rad_probes **out);
+/* The same over virtual patches (VIRTUAL PATCHES above): the weights W_ij of probe i and
+   virtual patch j from vp_rays closest-hit rays per probe, each hit blended over the patches by
+   the virtual-patch gather. vp (built on its scene, vp->scene; a set loaded without one is
+   refused) is borrowed for the call; B, when not NULL, holds 3 * vp->count radiosities (the
+   virtual patches' B = E + L, with RAD_SOURCE_DIRECT and RAD_PROBES_DIRECT for all the light).
+   rad_probes_update then takes 3 * vp->count floats. Errors: those of rad_probes_create
+   (INVALID_ARGUMENT for a NULL vp, a set without its scene or vp_rays above 65536). Cost:
+   probes x (rays + vp_rays) rays and the direct light as rad_probes_create; memory 40 bytes per
+   (probe, virtual patch reached), 76 with band 4. */
+RAD_API rad_result rad_probes_create_vp(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
+                                        const rad_light *lights, uint32_t light_count, const float *positions,
+                                        uint32_t count, const rad_probe_options *options, const float *B,
+                                        const rad_context *ctx, rad_probes **out);
 RAD_API void rad_probes_destroy(rad_probes *probes);
 
 /* New coefficients from a new solution B (3N floats, N the patch count at creation):
@@ -19428,6 +19460,8 @@ RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], 
     }
 }
 
+#define RAD__PROBES_VP_RAYS 2048u /* rad_probe_options.vp_rays' default */
+
 RAD_API void rad_probe_options_default(rad_probe_options *o)
 {
     if (!o) return;
@@ -19437,6 +19471,7 @@ RAD_API void rad_probe_options_default(rad_probe_options *o)
     o->light_samples = 64;
     o->backface_fraction = 0.25f;
     o->ray_epsilon = 1e-5f;
+    o->vp_rays = RAD__PROBES_VP_RAYS;
 }
 
 /* direction k of n in a spherical Fibonacci set: equal areas, deterministic */
@@ -19449,7 +19484,9 @@ static void rad__fibonacci_dir(uint32_t k, uint32_t n, float *d)
 }
 
 typedef struct rad__pb {
-    const rad_patches *P;
+    const rad_patches *P;      /* the classic patches, or NULL */
+    const rad_virtual_patches *V; /* or the virtual patches (rad_probes_create_vp) */
+    uint32_t N;                /* their count */
     const rad_scene *S;
     const rad_raycaster *rc;
     const rad_light *lights;
@@ -19536,7 +19573,7 @@ static rad_result rad__pb_flush(rad__pb *b, uint32_t task, uint32_t row, uint32_
 {
     size_t base = (size_t)task * RAD__RAY_BATCH;
     uint32_t nw = b->nw, k, i;
-    float *dense = b->dense + (size_t)(row - b->first) * nw * b->P->count, *direct = b->direct + 27 * (size_t)row;
+    float *dense = b->dense + (size_t)(row - b->first) * nw * b->N, *direct = b->direct + 27 * (size_t)row;
     int c;
     if (count == 0) return RAD_SUCCESS;
     if (b->rc->occluded(b->rc->user, b->rays + base, count, b->occ + base) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
@@ -19624,6 +19661,51 @@ static rad_result rad__pb_triangle(rad__pb *b, uint32_t task, uint32_t row, uint
     return RAD_SUCCESS;
 }
 
+/* The virtual-patch gather of one probe (>>api_probes, VIRTUAL PATCHES): vp_rays directions
+   of a spherical Fibonacci set, each standing for 4 pi / R steradians of radiance B / pi at its
+   closest front-facing hit, where B is the virtual-patch gather's blend of the patches
+   (rad__vp_gather_weights at the hit point with its triangle's normal). */
+static rad_result rad__pb_gather_vp(rad__pb *b, uint32_t task, uint32_t row, const float *p)
+{
+    rad_ray *rays = b->rays + (size_t)task * RAD__RAY_BATCH;
+    rad_hit *hits = b->hits + (size_t)task * RAD__RAY_BATCH;
+    uint32_t k0, k, e, R = b->o.vp_rays, nw = b->nw, idx[48];
+    float *dense = b->dense + (size_t)(row - b->first) * nw * b->N, gw[48], Y[18], scale = 4.0f / (float)R;
+    int c, i;
+    for (k0 = 0; k0 < R; k0 += RAD__RAY_BATCH) {
+        uint32_t m = R - k0 < RAD__RAY_BATCH ? R - k0 : RAD__RAY_BATCH;
+        for (k = 0; k < m; ++k) {
+            rad__fibonacci_dir(k0 + k, R, rays[k].dir);
+            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c];
+            rays[k].tmin = 0.0f;
+            rays[k].tmax = FLT_MAX;
+        }
+        if (b->rc->intersect(b->rc->user, rays, m, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+        for (k = 0; k < m; ++k) {
+            uint32_t t = hits[k].triangle, cnt;
+            const float *n;
+            float y[3];
+            if (t == RAD_NONE || t >= b->S->triangle_count) continue;
+            n = b->S->normals + 3 * (size_t)t;
+            if (!(rad__dot(n, rays[k].dir) < 0.0f)) continue; /* a back face sends no light */
+            for (c = 0; c < 3; ++c) y[c] = p[c] + hits[k].t * rays[k].dir[c];
+            cnt = rad__vp_gather_weights(b->V, y, n, idx, gw);
+            if (!cnt) continue;
+            rad__sh9(rays[k].dir, Y);
+            for (i = 0; i < 9; ++i) Y[i] *= scale * rad__sh_A[i];
+            if (nw > 9u) {
+                rad__sh_band4(rays[k].dir, Y + 9);
+                for (i = 9; i < 18; ++i) Y[i] *= scale * RAD__SH_A4;
+            }
+            for (e = 0; e < cnt; ++e) {
+                float *to = dense + (size_t)nw * idx[e];
+                for (i = 0; i < (int)nw; ++i) to[i] += gw[e] * Y[i];
+            }
+        }
+    }
+    return RAD_SUCCESS;
+}
+
 /* the gather of one probe: patch weights into its dense row, direct light into direct */
 static rad_result rad__pb_gather(void *data, uint32_t row, uint32_t task)
 {
@@ -19634,7 +19716,8 @@ static rad_result rad__pb_gather(void *data, uint32_t row, uint32_t task)
     rad_result r = RAD_SUCCESS;
     int c;
     if (b->states[row] == RAD_PROBE_DISABLED) return RAD_SUCCESS;
-    for (j = 0; j < P->count && r == RAD_SUCCESS; ++j) {
+    if (b->V) r = rad__pb_gather_vp(b, task, row, p);
+    for (j = 0; P && j < P->count && r == RAD_SUCCESS; ++j) {
         const rad_patch *pt = &P->patches[j];
         float v[9], d[3];
         int m;
@@ -19800,10 +19883,12 @@ static rad_result rad__probes_pack(rad_probes *pr, const float *dense, uint32_t 
 #define RAD__PROBES_MAX_GRID (1u << 24)
 #define RAD__PROBES_CHUNK_FLOATS (1u << 22) /* dense scratch per chunk of probes (16 MiB) */
 
-RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_raycaster *raycaster, const rad_light *lights,
-                                     uint32_t light_count, const float *positions, uint32_t count,
-                                     const rad_probe_options *options, const float *B, const rad_context *ctx,
-                                     rad_probes **out)
+/* rad_probes_create (patches) and rad_probes_create_vp (vp): the same placement, checks and
+   storage; only the gather of the weights differs (rad__pb_gather) */
+static rad_result rad__probes_create(const rad_patches *patches, const rad_virtual_patches *vp,
+                                     const rad_raycaster *raycaster, const rad_light *lights, uint32_t light_count,
+                                     const float *positions, uint32_t count, const rad_probe_options *options,
+                                     const float *B, const rad_context *ctx, rad_probes **out)
 {
     rad__ctx c;
     rad__pb b;
@@ -19817,23 +19902,29 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     int k;
     rad__ctx_init(&c, ctx);
     if (out) *out = NULL;
-    if (!patches || !patches->scene || !raycaster || !raycaster->intersect || !raycaster->occluded || !out) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: NULL patches, raycaster (with intersect and occluded) or output");
+    if ((vp ? !vp->scene : (!patches || !patches->scene)) || !raycaster || !raycaster->intersect || !raycaster->occluded ||
+        !out) {
+        if (vp && !vp->scene)
+            rad__log(&c, RAD_LOG_ERROR, "probes: the virtual patches have no scene (rad_vp_load with scene NULL)");
+        else
+            rad__log(&c, RAD_LOG_ERROR, "probes: NULL %s, raycaster (with intersect and occluded) or output",
+                     patches || !vp ? "patches" : "virtual patches");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    S = patches->scene;
-    N = patches->count;
+    S = vp ? vp->scene : patches->scene;
+    N = vp ? vp->count : patches->count;
     memset(&b, 0, sizeof(b));
     if (options) b.o = *options; else rad_probe_options_default(&b.o);
     if (b.o.rays == 0) b.o.rays = 256;
+    if (b.o.vp_rays == 0) b.o.vp_rays = RAD__PROBES_VP_RAYS;
     if (b.o.patch_samples == 0) b.o.patch_samples = 4;
     if (b.o.light_samples == 0) b.o.light_samples = 64;
     if (b.o.backface_fraction == 0.0f) b.o.backface_fraction = 0.25f;
     if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
     if (b.o.patch_samples > RAD__MAX_SAMPLES) b.o.patch_samples = RAD__MAX_SAMPLES;
     if (b.o.light_samples > RAD__MAX_SAMPLES) b.o.light_samples = RAD__MAX_SAMPLES;
-    if (b.o.rays > 65536u) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: rays %u above 65536", b.o.rays);
+    if (b.o.rays > 65536u || (vp && b.o.vp_rays > 65536u)) {
+        rad__log(&c, RAD_LOG_ERROR, "probes: rays %u or vp_rays %u above 65536", b.o.rays, b.o.vp_rays);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!(b.o.backface_fraction >= 0.0f && b.o.backface_fraction <= 1.0f)) {
@@ -19954,7 +20045,9 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
         b.max_move = b.o.max_move == 0.0f ? move_default : b.o.max_move;
         b.clearance = b.o.clearance > 0.0f ? b.o.clearance : 0.2f * move_default;
     }
-    b.P = patches;
+    b.P = vp ? NULL : patches;
+    b.V = vp;
+    b.N = N;
     b.S = S;
     b.rc = raycaster;
     b.lights = lights;
@@ -20028,6 +20121,36 @@ RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_rayca
     }
     *out = pr;
     return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_probes_create(const rad_patches *patches, const rad_raycaster *raycaster, const rad_light *lights,
+                                     uint32_t light_count, const float *positions, uint32_t count,
+                                     const rad_probe_options *options, const float *B, const rad_context *ctx,
+                                     rad_probes **out)
+{
+    if (!patches) {
+        rad__ctx c;
+        rad__ctx_init(&c, ctx);
+        if (out) *out = NULL;
+        rad__log(&c, RAD_LOG_ERROR, "probes: NULL patches");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return rad__probes_create(patches, NULL, raycaster, lights, light_count, positions, count, options, B, ctx, out);
+}
+
+RAD_API rad_result rad_probes_create_vp(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
+                                        const rad_light *lights, uint32_t light_count, const float *positions,
+                                        uint32_t count, const rad_probe_options *options, const float *B,
+                                        const rad_context *ctx, rad_probes **out)
+{
+    if (!vp) {
+        rad__ctx c;
+        rad__ctx_init(&c, ctx);
+        if (out) *out = NULL;
+        rad__log(&c, RAD_LOG_ERROR, "probes: NULL virtual patches");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return rad__probes_create(NULL, vp, raycaster, lights, light_count, positions, count, options, B, ctx, out);
 }
 
 /* 1 when a shadow ray from p (offset along the unit normal un) reaches q, or when there is no

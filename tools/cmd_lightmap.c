@@ -131,11 +131,8 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b)
     memset(b, 0, sizeof *b);
 }
 
-/* --proxy aavp|vp: virtual patches of w's scene, E = rho D at their samples, L by K Jacobi
-   bounces (Gauss-Seidel with --solver gauss-seidel), H = F (E + L) per patch into *H_out (3N
-   floats, to free) */
-static int lightmap_vp_solve(const char *cmd, const tool_world *w, const tool_classic_options *co,
-                             const tool_lightmap_proxy *px, tool_lightmap_baked *out, float **H_out)
+int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic_options *co, const tool_lightmap_proxy *px,
+                        rad_virtual_patches **vp_out, float **B_out, float **H_out, double *solve_seconds)
 {
     rad_vp_options vo;
     rad_direct_options dopt;
@@ -143,37 +140,40 @@ static int lightmap_vp_solve(const char *cmd, const tool_world *w, const tool_cl
     rad_system sys;
     rad_context ctx;
     rad_result r;
-    float *E, *L, *H;
+    rad_virtual_patches *vp = NULL;
+    float *E, *L, *H = NULL;
     uint32_t n, i;
     double t0 = tool_seconds();
-    *H_out = NULL;
+    *vp_out = NULL;
+    if (B_out) *B_out = NULL;
+    if (H_out) *H_out = NULL;
     rad_vp_options_default(&vo);
     if (px->resolution) vo.resolution = px->resolution;
     if (px->face_points) vo.face_points = px->face_points;
     if (px->kind == TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
+    if (px->max_patches && tool_vp_resolution_within(cmd, w, vo.kind, vo.face_points, px->max_patches, 0, &vo.resolution))
+        return 1;
     /* CSR rows: O(non-zeros), as rad render --proxy keeps them */
     vo.storage = RAD_STORAGE_SPARSE;
     tool_context(&ctx, "virtual patches");
-    r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &out->vp);
+    r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &vp);
     tool_progress_end();
     if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_create", r);
-    n = out->vp->count;
-    out->patches = n;
+    n = vp->count;
     fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches, %u voxels, %u samples, %.1f MiB, built in %.2f s\n",
-            cmd, px->kind == TOOL_PROXY_VP ? "vp" : "aavp", vo.resolution, n, out->vp->voxel_count, out->vp->sample_count,
-            (double)rad_vp_memory(out->vp) / 1048576.0, tool_seconds() - t0);
+            cmd, px->kind == TOOL_PROXY_VP ? "vp" : "aavp", vo.resolution, n, vp->voxel_count, vp->sample_count,
+            (double)rad_vp_memory(vp) / 1048576.0, tool_seconds() - t0);
     E = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-    H = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     rad_direct_options_default(&dopt);
     dopt.include_emitters = 1;
     dopt.light_samples = co->light_samples;
     tool_context(&ctx, "direct light");
-    r = rad_vp_sources(out->vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
+    r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
     tool_progress_end();
     if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_vp_sources", r); goto fail; }
     t0 = tool_seconds();
-    rad_vp_system(&sys, out->vp, E);
+    rad_vp_system(&sys, vp, E);
     rad_solve_options_default(&so);
     so.output = RAD_OUTPUT_INDIRECT;
     so.bounces = co->bounces;
@@ -189,16 +189,21 @@ static int lightmap_vp_solve(const char *cmd, const tool_world *w, const tool_cl
     }
     if (r != RAD_SUCCESS) { tool_fail(cmd, "solve", r); goto fail; }
     for (i = 0; i < 3 * n; ++i) L[i] += E[i];
-    if ((r = rad_matrix_multiply(&out->vp->matrix, L, H, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_matrix_multiply", r); goto fail; }
-    out->solve_seconds = tool_seconds() - t0;
+    if (H_out) {
+        H = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
+        if ((r = rad_matrix_multiply(&vp->matrix, L, H, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_matrix_multiply", r); goto fail; }
+    }
+    if (solve_seconds) *solve_seconds = tool_seconds() - t0;
     free(E);
-    free(L);
-    *H_out = H;
+    if (B_out) *B_out = L; else free(L);
+    if (H_out) *H_out = H;
+    *vp_out = vp;
     return 0;
 fail:
     free(E);
     free(L);
     free(H);
+    rad_vp_destroy(vp);
     return 1;
 }
 
@@ -277,7 +282,8 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         out->patches = hs.leaves;
         out->solve_seconds = tool_seconds() - th;
     } else if (proxy) {
-        if (lightmap_vp_solve(cmd, w, co, proxy, out, &vp_H)) goto fail;
+        if (tool_vp_proxy_solve(cmd, w, co, proxy, &out->vp, NULL, &vp_H, &out->solve_seconds)) goto fail;
+        out->patches = out->vp->count;
     } else {
         if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
         out->patches = out->cl.patches->count;

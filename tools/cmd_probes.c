@@ -1,10 +1,16 @@
-/* cmd_probes.c - `rad probes`: irradiance probes (SH L2) from the classic solution.
+/* cmd_probes.c - `rad probes`: irradiance probes (SH L2) from the classic solution or from
+   virtual patches.
 
    rad probes SCENE -o OUT.json|OUT.bin [--spacing S] [--rays R] [--patch-samples N] [--indirect]
-              [--band4] [classic options: --patches N ...] [--threads N]
+              [--band4] [--proxy aavp|vp [--vp-resolution R | --vp-max-patches B] [--face-points P]
+              [--vp-rays N]]
+              [classic options: --patches N ...] [lights: --sun, --sky, --point, --spot, --area]
+              [--threads N]
 
    Solves the scene as `rad bake` does (B = E + L with the direct light as the source, emitters
-   out of the system), places a probe grid over the scene's bounds (rad_probes_create; probes
+   out of the system), or with --proxy aavp|vp over virtual patches as `rad lightmap --proxy`
+   does (tool_vp_proxy_solve; rad_probes_create_vp gathers the probes from them: a scene too
+   big for the dense classic build is refused without --proxy, naming it), places a probe grid over the scene's bounds (rad_probes_create; probes
    inside geometry moved out or disabled) and writes every probe's position, state and its 27
    irradiance coefficients (docs/methods/probes.md). By default the probes hold all the light
    (the direct light of the emitters and the file's lights is added: RAD_PROBES_DIRECT);
@@ -28,18 +34,23 @@
 
 static void probes_usage(FILE *f)
 {
-    fprintf(f, "usage: rad probes SCENE -o OUT.json|OUT.bin [--spacing S] [--rays R] [--indirect] [options]\n"
-               "Solves the scene (classic radiosity, direct light as the source) and bakes SH L2 irradiance\n"
-               "probes on a grid over its bounds: E(n) = sum_i E_i Y_i(n) (docs/methods/probes.md).\n"
+    fprintf(f, "usage: rad probes SCENE -o OUT.json|OUT.bin [--spacing S] [--rays R] [--indirect] [--proxy aavp|vp] [options]\n"
+               "Solves the scene (classic radiosity, or virtual patches with --proxy; direct light as the source) and\n"
+               "bakes SH L2 irradiance probes on a grid over its bounds: E(n) = sum_i E_i Y_i(n) (docs/methods/probes.md).\n"
                "  -o FILE            OUT.json (text) or OUT.bin (binary; layout in tools/cmd_probes.c)\n"
                "  --spacing S        grid spacing in scene units (default: the largest extent / 8)\n"
                "  --rays R           rays per probe for the inside-geometry test (default 256)\n"
-               "  --patch-samples N  points per patch for the probes' gather (default 4)\n"
+               "  --patch-samples N  points per patch for the probes' gather (default 4; classic patches)\n"
                "  --indirect         only the indirect light (default: direct light too)\n"
                "  --band4            also band 4 (9 more coefficients per colour: sharper E(n) than L2)\n"
-               "%s"
+               "  --proxy P          the light from classic patches (patches, the default) or from virtual patches,\n"
+               "                     aavp or vp: a few thousand unknowns whatever the triangle count, for real\n"
+               "                     buildings (rad_probes_create_vp); --vp-resolution R (default 16) or\n"
+               "                     --vp-max-patches B (the finest resolution with at most B patches),\n"
+               "                     --face-points P (default 16), --vp-rays N gather rays per probe (default 2048)\n"
+               "%s%s"
                "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            tool_classic_help());
+            tool_classic_help(), tool_light_help());
 }
 
 static const char *state_name(uint8_t s)
@@ -119,33 +130,43 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
     return ok;
 }
 
-int tool_cmd_probes(int argc, char **argv)
+static int probes_main(int argc, char **argv, tool_lights *lights)
 {
     const char *cmd = "probes", *scene_name = NULL, *out_path = NULL;
     tool_classic_options o;
     tool_world w;
     tool_classic c;
+    tool_lightmap_proxy px;
+    rad_virtual_patches *vp = NULL;
+    float *vp_B = NULL;
     rad_probe_options po;
     rad_probes *pr = NULL;
     rad_context ctx;
     tool_output out;
     uint32_t threads = 0, i, counts[3] = {0, 0, 0};
-    double t0 = tool_seconds();
-    int a, rc, json, total = 1;
+    double t0 = tool_seconds(), tp;
+    int a, rc, json, total = 1, px_opts = 0, vp_rays_given = 0, patch_samples_given = 0;
     size_t len;
     rad_result r;
     tool_classic_options_default(&o);
     rad_probe_options_default(&po);
+    memset(&px, 0, sizeof px);
+    memset(&c, 0, sizeof c);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
         if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { probes_usage(stdout); return 0; }
         rc = tool_classic_option(cmd, argc, argv, &a, &o);
         if (rc == 2) return 2;
         if (rc == 1) continue;
+        rc = tool_light_option(cmd, argc, argv, &a, lights);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
         if (!strcmp(opt, "--indirect")) { total = 0; continue; }
         if (!strcmp(opt, "--band4")) { po.flags |= RAD_PROBES_BAND4; continue; }
         if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--spacing") || !strcmp(opt, "--rays") ||
-             !strcmp(opt, "--patch-samples")) && a + 1 >= argc) {
+             !strcmp(opt, "--patch-samples") || !strcmp(opt, "--proxy") || !strcmp(opt, "--vp-resolution") ||
+             !strcmp(opt, "--face-points") || !strcmp(opt, "--vp-rays") || !strcmp(opt, "--vp-max-patches")) &&
+            a + 1 >= argc) {
             fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
             return 2;
         }
@@ -157,12 +178,32 @@ int tool_cmd_probes(int argc, char **argv)
         } else if (!strcmp(opt, "--rays")) {
             if (tool_parse_uint(cmd, opt, argv[++a], &po.rays)) return 2;
             if (po.rays == 0 || po.rays > 65536) { fprintf(stderr, "rad %s: --rays must be in 1..65536\n", cmd); return 2; }
+        } else if (!strcmp(opt, "--vp-rays")) {
+            if (tool_parse_uint(cmd, opt, argv[++a], &po.vp_rays)) return 2;
+            if (po.vp_rays == 0 || po.vp_rays > 65536) { fprintf(stderr, "rad %s: --vp-rays must be in 1..65536\n", cmd); return 2; }
+            vp_rays_given = 1;
         } else if (!strcmp(opt, "--patch-samples")) {
             if (tool_parse_uint(cmd, opt, argv[++a], &po.patch_samples)) return 2;
             if (po.patch_samples == 0 || po.patch_samples > 256) {
                 fprintf(stderr, "rad %s: --patch-samples must be in 1..256\n", cmd);
                 return 2;
             }
+            patch_samples_given = 1;
+        } else if (!strcmp(opt, "--proxy")) {
+            const char *v = argv[++a];
+            if (!strcmp(v, "aavp")) px.kind = TOOL_PROXY_AAVP;
+            else if (!strcmp(v, "vp")) px.kind = TOOL_PROXY_VP;
+            else if (!strcmp(v, "patches")) px.kind = TOOL_PROXY_PATCHES;
+            else { fprintf(stderr, "rad %s: unknown --proxy '%s' (patches, aavp or vp)\n", cmd, v); return 2; }
+        } else if (!strcmp(opt, "--vp-resolution") || !strcmp(opt, "--face-points")) {
+            uint32_t *dst = opt[2] == 'v' ? &px.resolution : &px.face_points;
+            if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
+            if (*dst == 0 || *dst > 4096u) { fprintf(stderr, "rad %s: %s must be 1 to 4096\n", cmd, opt); return 2; }
+            px_opts = 1;
+        } else if (!strcmp(opt, "--vp-max-patches")) {
+            if (tool_parse_uint(cmd, opt, argv[++a], &px.max_patches)) return 2;
+            if (px.max_patches == 0) { fprintf(stderr, "rad %s: --vp-max-patches must be at least 1\n", cmd); return 2; }
+            px_opts = 1;
         } else if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad probes --help)\n", cmd, opt);
             return 2;
@@ -174,6 +215,26 @@ int tool_cmd_probes(int argc, char **argv)
         probes_usage(stderr);
         return 2;
     }
+    if (px_opts && !px.kind) {
+        fprintf(stderr, "rad %s: --vp-resolution, --vp-max-patches and --face-points are for --proxy aavp|vp\n", cmd);
+        return 2;
+    }
+    if (px.resolution && px.max_patches) {
+        fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
+        return 2;
+    }
+    if (vp_rays_given && !px.kind) {
+        fprintf(stderr, "rad %s: --vp-rays is for --proxy aavp|vp (classic patches: --patch-samples)\n", cmd);
+        return 2;
+    }
+    if (patch_samples_given && px.kind) {
+        fprintf(stderr, "rad %s: --patch-samples is for classic patches (with --proxy: --vp-rays)\n", cmd);
+        return 2;
+    }
+    if (px.kind && o.solver == TOOL_DIRECT) {
+        fprintf(stderr, "rad %s: --solver direct is for classic patches: with --proxy use jacobi or gauss-seidel\n", cmd);
+        return 2;
+    }
     len = strlen(out_path);
     json = len >= 5 && !strcmp(out_path + len - 5, ".json");
     if (!json && !(len >= 4 && !strcmp(out_path + len - 4, ".bin"))) {
@@ -182,20 +243,31 @@ int tool_cmd_probes(int argc, char **argv)
     }
     if (tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
     tool_set_threads((int)threads);
-    if (tool_open_world(cmd, scene_name, &w)) return 1;
-    if (tool_classic_solve(cmd, &w, &o, &c)) {
+    if (tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
+    /* a scene too big for the dense classic build is refused with the way out */
+    o.dense_instead = "--proxy aavp or --proxy vp (the probes' light from virtual patches: a few thousand whatever the "
+                      "triangle count; --vp-resolution R sets how many)";
+    if (px.kind) {
+        if (tool_vp_proxy_solve(cmd, &w, &o, &px, &vp, &vp_B, NULL, NULL)) {
+            tool_close_world(&w);
+            return 1;
+        }
+    } else if (tool_classic_solve(cmd, &w, &o, &c)) {
         tool_close_world(&w);
         return 1;
     }
     if (total) po.flags |= RAD_PROBES_DIRECT;
     tool_context(&ctx, "probes");
-    r = rad_probes_create(c.patches, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &po, c.B, &ctx, &pr);
+    tp = tool_seconds();
+    r = vp ? rad_probes_create_vp(vp, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &po, vp_B, &ctx, &pr)
+           : rad_probes_create(c.patches, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &po, c.B, &ctx, &pr);
     tool_progress_end();
     rc = 1;
     if (r != RAD_SUCCESS) {
-        tool_fail(cmd, "rad_probes_create", r);
+        tool_fail(cmd, vp ? "rad_probes_create_vp" : "rad_probes_create", r);
         goto done;
     }
+    tp = tool_seconds() - tp;
     for (i = 0; i < rad_probes_count(pr); ++i) counts[rad_probes_states(pr)[i] % 3u]++;
     if (tool_output_open(&out, out_path) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
@@ -205,14 +277,27 @@ int tool_cmd_probes(int argc, char **argv)
         fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
-    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light%s\n", out_path,
+    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light%s%s\n", out_path,
            rad_probes_count(pr), counts[RAD_PROBE_VALID], counts[RAD_PROBE_MOVED], counts[RAD_PROBE_DISABLED],
-           (unsigned long)rad_probes_entry_count(pr), total ? "total" : "indirect", rad_probes_band4(pr) ? ", band 4" : "");
-    fprintf(stderr, "rad %s: done in %.2f s\n", cmd, tool_seconds() - t0);
+           (unsigned long)rad_probes_entry_count(pr), total ? "total" : "indirect", rad_probes_band4(pr) ? ", band 4" : "",
+           vp ? (px.kind == TOOL_PROXY_VP ? ", over vp virtual patches" : ", over aavp virtual patches") : "");
+    fprintf(stderr, "rad %s: probes gathered in %.2f s; done in %.2f s\n", cmd, tp, tool_seconds() - t0);
     rc = 0;
 done:
     rad_probes_destroy(pr);
+    free(vp_B);
+    rad_vp_destroy(vp);
     tool_classic_free(&c);
     tool_close_world(&w);
+    return rc;
+}
+
+int tool_cmd_probes(int argc, char **argv)
+{
+    tool_lights lights;
+    int rc;
+    memset(&lights, 0, sizeof lights);
+    rc = probes_main(argc, argv, &lights);
+    tool_lights_free(&lights);
     return rc;
 }

@@ -609,7 +609,7 @@ static rad_virtual_patches *vp_build(const char *cmd, const tool_world *w, const
 }
 
 /* the patch count rad_vp_create would give at 'resolution' (rad_vp_count); 0 or 1 (printed) */
-static int vp_count(const char *cmd, const tool_world *w, const tool_method_options *mo, uint32_t resolution,
+static int vp_count(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points, uint32_t resolution,
                     uint32_t *count)
 {
     rad_vp_options vo;
@@ -618,11 +618,41 @@ static int vp_count(const char *cmd, const tool_world *w, const tool_method_opti
     rad_result r;
     rad_vp_options_default(&vo);
     vo.resolution = resolution;
-    vo.face_points = mo->face_points;
-    if (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
+    vo.face_points = face_points;
+    vo.kind = kind;
     tool_context(&ctx, NULL);
     if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_count", r);
     *count = cnt.patches;
+    return 0;
+}
+
+int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
+                              uint32_t max_patches, uint32_t start, uint32_t *out)
+{
+    /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build up
+       to the patches, without the form factors that take nearly all of its time). The count
+       grows about as R^2 (surface voxels): predict from the nearest count, count, narrow the
+       bracket [lo, hi) to adjacent resolutions. */
+    uint32_t lo = 0, hi = 4097, counts = 0, c = 0, res = start ? start : 16;
+    double tc = tool_seconds();
+    while (counts < 24 && hi - lo > 1) {
+        uint32_t next;
+        if (vp_count(cmd, w, kind, face_points, res, &c)) return 1;
+        ++counts;
+        if (c <= max_patches) lo = res;
+        else hi = res;
+        next = (uint32_t)((double)res * sqrt((double)max_patches / (double)(c ? c : 1)));
+        if (next <= lo) next = lo + 1;
+        if (next >= hi) next = hi - 1;
+        res = next;
+    }
+    if (lo == 0) {
+        fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd, max_patches);
+        return 1;
+    }
+    fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd, max_patches, lo,
+            counts, tool_seconds() - tc);
+    *out = lo;
     return 0;
 }
 
@@ -983,32 +1013,10 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
         if (!(vp = vp_load_bake(cmd, bake_path, w, mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP, &E)))
             return 1;
     } else if (mo->given & TOOL_OPT_VP_MAX_PATCHES) {
-        /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build
-           up to the patches, without the form factors that take nearly all of its time), then
-           one build. The count grows about as R^2 (surface voxels): predict from the nearest
-           count, count, narrow the bracket [lo, hi) to adjacent resolutions. */
-        uint32_t lo = 0, hi = 4097, counts = 0, c = 0;
-        double tc = tool_seconds();
-        res = mo->vp_resolution ? mo->vp_resolution : 16;
-        while (counts < 24 && hi - lo > 1) {
-            uint32_t next;
-            if (vp_count(cmd, w, mo, res, &c)) return 1;
-            ++counts;
-            if (c <= mo->vp_max_patches) lo = res;
-            else hi = res;
-            next = (uint32_t)((double)res * sqrt((double)mo->vp_max_patches / (double)(c ? c : 1)));
-            if (next <= lo) next = lo + 1;
-            if (next >= hi) next = hi - 1;
-            res = next;
-        }
-        if (lo == 0) {
-            fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd,
-                    mo->vp_max_patches);
+        if (tool_vp_resolution_within(cmd, w, mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP ? RAD_VP_CLUSTERED
+                                                                                                    : RAD_VP_AXIS_ALIGNED,
+                                      mo->face_points, mo->vp_max_patches, mo->vp_resolution, &res))
             return 1;
-        }
-        res = lo;
-        fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd,
-                mo->vp_max_patches, res, counts, tool_seconds() - tc);
         if (!(vp = vp_build(cmd, w, mo, res))) return 1;
     } else if (!(vp = vp_build(cmd, w, mo, res))) {
         return 1;

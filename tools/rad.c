@@ -42,15 +42,17 @@ static void usage(FILE *f)
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
                "  info FILE.radb           list what a bake holds and check it\n"
                "  export SCENE -o OUT.obj  write the scene as OBJ + MTL (Kd albedo, Ke emission)\n"
-               "  probes SCENE -o OUT      irradiance probes (SH L2) on a grid: OUT.json or OUT.bin\n"
+               "  probes SCENE -o OUT      irradiance probes (SH L2) on a grid: OUT.json or OUT.bin;\n"
+               "                           --proxy aavp|vp for buildings too big for classic patches\n"
                "  lightmap SCENE -o OUT    bake a lightmap (.pfm or .png) over the second uv set, or an\n"
                "                           automatic unwrap; --sh for L1 spherical harmonics\n"
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
-               "at most 1024). render, trace and bake add lights to the file's own: --sun DIR:RGB,\n"
-               "--sky RGB, --point POS:RGB, --spot POS:DIR:ANGLES:RGB, --area P:U:V:RGB (units: rad render\n"
-               "--help). Dense methods (classic, multibounce, temporal, local) refuse a build estimated\n"
-               "beyond the free memory (--max-memory SIZE) or an hour; --force runs it anyway.\n");
+               "at most 1024). render, trace, bake, lightmap and probes add lights to the file's own:\n"
+               "--sun DIR:RGB, --sky RGB, --point POS:RGB, --spot POS:DIR:ANGLES:RGB, --area P:U:V:RGB\n"
+               "(units: rad render --help). Dense methods (classic, multibounce, temporal, local) refuse\n"
+               "a build estimated beyond the free memory (--max-memory SIZE) or an hour; --force runs it\n"
+               "anyway.\n");
 }
 
 /* ---- dispatch -------------------------------------------------------------------------- */

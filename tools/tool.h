@@ -530,10 +530,25 @@ typedef struct tool_lightmap_proxy {
     uint32_t resolution;     /* voxels along the longest axis (0: 16) */
     uint32_t face_points;    /* Hammersley points per voxel face (0: 16) */
     float hr_eps;            /* hierarchical: BF tolerance (0: the tool's 1e-5) */
+    uint32_t max_patches;    /* aavp, vp: the finest resolution with at most this many patches
+                                (tool_vp_resolution_within; 0: resolution as given) */
 } tool_lightmap_proxy;
+/* --vp-max-patches B: the finest voxel resolution whose set of 'kind' has at most B patches,
+   found by counting (rad_vp_count) from 'start' (0: 16); prints the choice. 0, or 1 after
+   printing why (even resolution 1 gives more). (cmd_render.c) */
+int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
+                              uint32_t max_patches, uint32_t start, uint32_t *out);
 /* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth
    lookup (rad_lightmap_gather_hierarchical); a kind of its own, past the tool_proxy values */
 #define TOOL_LIGHTMAP_HIERARCHICAL 3
+/* --proxy aavp|vp (rad lightmap, rad probes): virtual patches of w's scene at px's resolution
+   (or the finest within px->max_patches) and face points (CSR rows), E = rho D at their samples (the lights of w, emitters included,
+   co->light_samples), L by co->bounces Jacobi bounces (Gauss-Seidel with --solver
+   gauss-seidel); *B_out = E + L and *H_out = F (E + L) per virtual patch (3N floats to free;
+   either output may be NULL), *solve_seconds the solve and H (may be NULL). Prints what it
+   built. 0, or 1 after printing why (nothing left to free). */
+int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic_options *co, const tool_lightmap_proxy *px,
+                        rad_virtual_patches **vp_out, float **B_out, float **H_out, double *solve_seconds);
 typedef struct tool_lightmap_baked {
     tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
     tool_classic cl;     /* the classic solution gathered (patches of w.scene), or zero with a proxy */
