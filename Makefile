@@ -134,6 +134,7 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/probes --sweep --append BENCHMARKS.md
 	./$(BUILD)/bench_lightmap --append BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/realtime.sh $(BUILD) BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/sponza.sh $(BUILD)/rad BENCHMARKS.md
 
 bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
