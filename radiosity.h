@@ -15191,6 +15191,7 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
     rad_temporal *t = st->t;
     const uint32_t k = t->o.samples, sets = t->table_count;
     const __m256i sign = _mm256_set1_epi32((int)0x80000000u), sixteen = _mm256_set1_epi32(16), low16 = _mm256_set1_epi32(0xFFFF);
+    const __m256i nvec = _mm256_set1_epi32((int)t->n);
     const float kf = (float)k, *V4 = st->V4;
     rad__tvec p;
     uint32_t row, c, s, q = 0, j;
@@ -15228,9 +15229,11 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
                 cw = _mm256_castps_si256(_mm256_shuffle_ps(_mm256_castsi256_ps(glo), _mm256_castsi256_ps(ghi), 0xDD));
                 thr = _mm256_permute4x64_epi64(thr, 0xD8);
                 cw = _mm256_permute4x64_epi64(cw, 0xD8);
-                /* u2 < threshold (unsigned): the own column (low half), else the alias (high half) */
+                /* u2 < threshold (unsigned): the own column (low half), else the alias (high half);
+                   a column past N reads E_0, as in the row-at-a-time pipeline, never past V4 */
                 sel = _mm256_cmpgt_epi32(_mm256_xor_si256(thr, sign), _mm256_xor_si256(u2, sign));
-                _mm256_storeu_si256((__m256i *)(void *)col, _mm256_and_si256(_mm256_srlv_epi32(cw, _mm256_andnot_si256(sel, sixteen)), low16));
+                sel = _mm256_and_si256(_mm256_srlv_epi32(cw, _mm256_andnot_si256(sel, sixteen)), low16);
+                _mm256_storeu_si256((__m256i *)(void *)col, _mm256_min_epu32(sel, nvec));
                 for (j = 0; j < 8u; ++j) acc[j] = _mm_add_ps(acc[j], _mm_loadu_ps(V4 + 4u * (size_t)col[j]));
             }
             for (j = 0; j < 8u; ++j) T[j] = t->tables[c]->totals[row + j < r1 ? row + j : r1 - 1u];
