@@ -15116,10 +15116,11 @@ static void rad__temporal_finish(rad_temporal *t, uint32_t i, float *X)
    vector draw is draw s of table set c for 8 consecutive rows; a task's vector draws run block
    of 8 rows by block, set by set, sample by sample. The issuing side hashes vector draw
    d + RAD__TVEC_AHEAD (both words and the bin on 8 lanes) and prefetches its 8 bins while
-   vector draw d is resolved with 8 scalar 64-bit loads (the bins) and one masked gather per
-   channel (V, or E_0 for the environment column). Each lane adds its own row's values in the
-   documented order, so the bits equal the plain loop's; the scalar work per draw is about a
-   third of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
+   vector draw d is resolved with 8 scalar 64-bit loads (the bins), the columns on 8 lanes, and
+   per lane one 16-byte load of the sampled vector padded to RGB0 (V4, whose entry N is E_0, so
+   the environment needs no branch), added to that row's RGB0 sum. Each lane adds its own row's
+   values in the documented order, so the bits equal the plain loop's; the work per draw is a
+   fraction of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
 #ifndef RAD__TVEC_AHEAD
 #  define RAD__TVEC_AHEAD 16u /* vector draws in flight: 128 draws, the measured best */
 #endif
