@@ -14785,7 +14785,8 @@ struct rad_temporal {
     rad_temporal_options o;
     uint32_t n, frame;
     float *B, *B_next;     /* 3N each; B is the current result */
-    float *V;              /* FEEDBACK: 3N sampled vector E + B^prev */
+    float *V;              /* FEEDBACK without V4: 3N sampled vector E + B^prev */
+    float *V4;             /* the vector step: the sampled vector as N + 1 padded RGB0 entries, entry N = E_0 */
     float *w;              /* adaptive: N per-row weights of the last step */
     float *mean, *var, *fast; /* adaptive: N each */
     uint32_t *count;       /* adaptive: frames since restart */
@@ -14808,7 +14809,7 @@ RAD_API void rad_temporal_options_default(rad_temporal_options *o)
 RAD_API void rad_temporal_destroy(rad_temporal *t)
 {
     if (t) {
-        void *blocks[] = { t->B, t->B_next, t->V, t->w, t->mean, t->var, t->fast, t->count, t };
+        void *blocks[] = { t->B, t->B_next, t->V, t->V4, t->w, t->mean, t->var, t->fast, t->count, t };
         rad__free_each(t->c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
 }
@@ -14893,7 +14894,16 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
     t->n = n;
     t->B = (float *)rad__alloc_array(&c.allocator, (size_t)n, 3u * sizeof(float));
     t->B_next = (float *)rad__alloc_array(&c.allocator, (size_t)n, 3u * sizeof(float));
-    if (o.mode == RAD_TEMPORAL_FEEDBACK) t->V = (float *)rad__alloc_array(&c.allocator, (size_t)n, 3u * sizeof(float));
+#if defined(RAD__TEMPORAL_AVX2)
+    /* the vector step (every table set compact) reads each sampled value as one 16-byte load */
+    for (k = 0; k < table_count && tables[k]->format == RAD_ALIAS_COMPACT; ++k) {}
+    if (k == table_count) t->V4 = (float *)rad__alloc_array(&c.allocator, (size_t)n + 1u, 4u * sizeof(float));
+    if (k == table_count && !t->V4) {
+        rad_temporal_destroy(t);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+#endif
+    if (o.mode == RAD_TEMPORAL_FEEDBACK && !t->V4) t->V = (float *)rad__alloc_array(&c.allocator, (size_t)n, 3u * sizeof(float));
     if (o.adaptive) {
         t->w = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
         t->mean = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
@@ -14901,7 +14911,7 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
         t->fast = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
         t->count = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
     }
-    if (!t->B || !t->B_next || (o.mode == RAD_TEMPORAL_FEEDBACK && !t->V) ||
+    if (!t->B || !t->B_next || (o.mode == RAD_TEMPORAL_FEEDBACK && !t->V && !t->V4) ||
         (o.adaptive && (!t->w || !t->mean || !t->var || !t->fast || !t->count))) {
         rad_temporal_destroy(t);
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -14913,7 +14923,8 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
 
 typedef struct rad__tstep {
     rad_temporal *t;
-    const float *V;        /* sampled vector, 3N */
+    const float *V;        /* sampled vector, 3N (the row-at-a-time pipeline) */
+    const float *V4;       /* the same as N + 1 RGB0 entries, entry N = E_0 (the vector step) */
     float env[3];
     uint32_t tasks;
 } rad__tstep;
@@ -15145,10 +15156,11 @@ static void rad__temporal_finish(rad_temporal *t, uint32_t i, float *X)
    vector draw is draw s of table set c for 8 consecutive rows; a task's vector draws run block
    of 8 rows by block, set by set, sample by sample. The issuing side hashes vector draw
    d + RAD__TVEC_AHEAD (both words and the bin on 8 lanes) and prefetches its 8 bins while
-   vector draw d is resolved with 8 scalar 64-bit loads (the bins) and one masked gather per
-   channel (V, or E_0 for the environment column). Each lane adds its own row's values in the
-   documented order, so the bits equal the plain loop's; the scalar work per draw is about a
-   third of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
+   vector draw d is resolved with 8 scalar 64-bit loads (the bins), the columns on 8 lanes, and
+   per lane one 16-byte load of the sampled vector padded to RGB0 (V4, whose entry N is E_0, so
+   the environment needs no branch), added to that row's RGB0 sum. Each lane adds its own row's
+   values in the documented order, so the bits equal the plain loop's; the work per draw is a
+   fraction of the row-at-a-time pipeline's (rad__tpipe), which matters once the misses overlap. */
 #ifndef RAD__TVEC_AHEAD
 #  define RAD__TVEC_AHEAD 16u /* vector draws in flight: 128 draws, the measured best */
 #endif
@@ -15219,10 +15231,9 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
 {
     rad_temporal *t = st->t;
     const uint32_t k = t->o.samples, sets = t->table_count;
-    const __m256i sign = _mm256_set1_epi32((int)0x80000000u), nvec = _mm256_set1_epi32((int)t->n);
-    const __m256i sixteen = _mm256_set1_epi32(16), low16 = _mm256_set1_epi32(0xFFFF);
-    const float kf = (float)k;
-    const __m256 env0 = _mm256_set1_ps(st->env[0]), env1 = _mm256_set1_ps(st->env[1]), env2 = _mm256_set1_ps(st->env[2]);
+    const __m256i sign = _mm256_set1_epi32((int)0x80000000u), sixteen = _mm256_set1_epi32(16), low16 = _mm256_set1_epi32(0xFFFF);
+    const __m256i nvec = _mm256_set1_epi32((int)t->n);
+    const float kf = (float)k, *V4 = st->V4;
     rad__tvec p;
     uint32_t row, c, s, q = 0, j;
     p.t = t;
@@ -15239,7 +15250,11 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
         float X[3][8], T[8];
         for (c = 0; c < sets; ++c) {
             const uint32_t *gb = t->tables[c]->bins;
-            __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, scale;
+            /* one sum per lane (row), RGB0: each draw adds one 16-byte entry of V4, which costs
+               less than three 8-lane gathers of the channels */
+            __m128 acc[8];
+            uint32_t col[8];
+            for (j = 0; j < 8u; ++j) acc[j] = _mm_setzero_ps();
             for (s = 0; s < k; ++s) {
                 /* the 8 bins, read before the slot is reused (scalar loads: 64-bit gathers were
                    slower) */
@@ -15247,8 +15262,7 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
                 const __m256i u2 = _mm256_loadu_si256((const __m256i *)(const void *)(p.u2 + 8u * q));
                 const __m256i glo = _mm256_set_epi64x(rad__bin64(gb, bn[3]), rad__bin64(gb, bn[2]), rad__bin64(gb, bn[1]), rad__bin64(gb, bn[0]));
                 const __m256i ghi = _mm256_set_epi64x(rad__bin64(gb, bn[7]), rad__bin64(gb, bn[6]), rad__bin64(gb, bn[5]), rad__bin64(gb, bn[4]));
-                __m256i thr, cw, col, idx3;
-                __m256 valid;
+                __m256i thr, cw, sel;
                 rad__tvec_issue(&p, q);
                 q = q + 1u == RAD__TVEC_AHEAD ? 0u : q + 1u;
                 /* [t0 c0 t1 c1 | t2 c2 t3 c3], [t4 c4 ..] -> thresholds and column words in lane order */
@@ -15256,27 +15270,20 @@ static void rad__temporal_task_vec(const rad__tstep *st, uint32_t r0, uint32_t r
                 cw = _mm256_castps_si256(_mm256_shuffle_ps(_mm256_castsi256_ps(glo), _mm256_castsi256_ps(ghi), 0xDD));
                 thr = _mm256_permute4x64_epi64(thr, 0xD8);
                 cw = _mm256_permute4x64_epi64(cw, 0xD8);
-                /* u2 < threshold (unsigned): the own column (low half), else the alias (high half) */
-                col = _mm256_cmpgt_epi32(_mm256_xor_si256(thr, sign), _mm256_xor_si256(u2, sign));
-                col = _mm256_and_si256(_mm256_srlv_epi32(cw, _mm256_andnot_si256(col, sixteen)), low16);
-                valid = _mm256_castsi256_ps(_mm256_cmpgt_epi32(nvec, col));
-                idx3 = _mm256_add_epi32(col, _mm256_add_epi32(col, col));
-                if (sets == 1u) {
-                    a0 = _mm256_add_ps(a0, _mm256_mask_i32gather_ps(env0, st->V, idx3, valid, 4));
-                    a1 = _mm256_add_ps(a1, _mm256_mask_i32gather_ps(env1, st->V + 1, idx3, valid, 4));
-                    a2 = _mm256_add_ps(a2, _mm256_mask_i32gather_ps(env2, st->V + 2, idx3, valid, 4));
-                } else {
-                    a0 = _mm256_add_ps(a0, _mm256_mask_i32gather_ps(_mm256_set1_ps(st->env[c]), st->V + c, idx3, valid, 4));
-                }
+                /* u2 < threshold (unsigned): the own column (low half), else the alias (high half);
+                   a column past N reads E_0, as in the row-at-a-time pipeline, never past V4 */
+                sel = _mm256_cmpgt_epi32(_mm256_xor_si256(thr, sign), _mm256_xor_si256(u2, sign));
+                sel = _mm256_and_si256(_mm256_srlv_epi32(cw, _mm256_andnot_si256(sel, sixteen)), low16);
+                _mm256_storeu_si256((__m256i *)(void *)col, _mm256_min_epu32(sel, nvec));
+                for (j = 0; j < 8u; ++j) acc[j] = _mm_add_ps(acc[j], _mm_loadu_ps(V4 + 4u * (size_t)col[j]));
             }
             for (j = 0; j < 8u; ++j) T[j] = t->tables[c]->totals[row + j < r1 ? row + j : r1 - 1u];
-            scale = _mm256_div_ps(_mm256_loadu_ps(T), _mm256_set1_ps(kf)); /* T_i / k in float */
-            if (sets == 1u) {
-                _mm256_storeu_ps(X[0], _mm256_mul_ps(a0, scale));
-                _mm256_storeu_ps(X[1], _mm256_mul_ps(a1, scale));
-                _mm256_storeu_ps(X[2], _mm256_mul_ps(a2, scale));
-            } else {
-                _mm256_storeu_ps(X[c], _mm256_mul_ps(a0, scale));
+            _mm256_storeu_ps(T, _mm256_div_ps(_mm256_loadu_ps(T), _mm256_set1_ps(kf))); /* T_i / k in float */
+            for (j = 0; j < 8u; ++j) {
+                float a[4];
+                _mm_storeu_ps(a, _mm_mul_ps(acc[j], _mm_set1_ps(T[j])));
+                if (sets == 1u) X[0][j] = a[0], X[1][j] = a[1], X[2][j] = a[2];
+                else X[c][j] = a[c];
             }
         }
         for (j = 0; j < 8u && row + j < r1; ++j) {
@@ -15301,8 +15308,7 @@ static void rad__temporal_task(void *data, uint32_t task)
     uint32_t i, c, s, q;
     if (r0 >= r1) return;
 #if defined(RAD__TEMPORAL_AVX2)
-    for (c = 0; c < sets && t->tables[c]->format == RAD_ALIAS_COMPACT; ++c) {}
-    if (c == sets) {
+    if (st->V4) {
         rad__temporal_task_vec(st, r0, r1);
         return;
     }
@@ -15369,7 +15375,30 @@ RAD_API rad_result rad_temporal_step(rad_temporal *t, const float *E, const floa
     st.env[0] = E0 ? E0[0] : 0.0f;
     st.env[1] = E0 ? E0[1] : 0.0f;
     st.env[2] = E0 ? E0[2] : 0.0f;
-    if (t->o.mode == RAD_TEMPORAL_FEEDBACK) {
+    st.V = st.V4 = NULL;
+    if (t->V4) {
+        float *v4 = t->V4;
+        const size_t n = t->n;
+        if (t->o.mode == RAD_TEMPORAL_FEEDBACK)
+            for (j = 0; j < n; ++j) {
+                v4[4u * j] = E[3u * j] + t->B[3u * j];
+                v4[4u * j + 1u] = E[3u * j + 1u] + t->B[3u * j + 1u];
+                v4[4u * j + 2u] = E[3u * j + 2u] + t->B[3u * j + 2u];
+                v4[4u * j + 3u] = 0.0f;
+            }
+        else
+            for (j = 0; j < n; ++j) {
+                v4[4u * j] = E[3u * j];
+                v4[4u * j + 1u] = E[3u * j + 1u];
+                v4[4u * j + 2u] = E[3u * j + 2u];
+                v4[4u * j + 3u] = 0.0f;
+            }
+        v4[4u * n] = st.env[0];
+        v4[4u * n + 1u] = st.env[1];
+        v4[4u * n + 2u] = st.env[2];
+        v4[4u * n + 3u] = 0.0f;
+        st.V4 = v4;
+    } else if (t->o.mode == RAD_TEMPORAL_FEEDBACK) {
         for (j = 0; j < n3; ++j) t->V[j] = E[j] + t->B[j];
         st.V = t->V;
     } else {

@@ -659,7 +659,8 @@ static void tp_pipeline_bits(void)
     rad_temporal_options o;
     float *ref, *out, *plane, E0[3] = { 0.2f, 0.4f, 0.1f };
     uint32_t n, v, i;
-    static const uint32_t ks[5] = { 1, 10, 70, 10, 3 }, tasks[5] = { 4096, 0, 7, 3, 7 };
+    /* v: 0, 1 single compact; 2 feedback wide; 3 multibounce mixed; 4 multibounce compact; 5 feedback compact */
+    static const uint32_t ks[6] = { 1, 10, 70, 10, 3, 9 }, tasks[6] = { 4096, 0, 7, 3, 7, 5 };
     if (!tp_cornell_build(&c, rad_test_quick() ? 40 : 80, 0)) { CHECK(0); fx_world_free(&c); return; }
     n = c.n;
     ref = (float *)malloc(sizeof(float) * 3 * n);
@@ -672,18 +673,18 @@ static void tp_pipeline_bits(void)
         CHECK_OK(rad_alias_tables_create_dense(plane, n, v == 1 ? RAD_ALIAS_WIDE : RAD_ALIAS_COMPACT, NULL, &tc[v]));
         CHECK_OK(rad_alias_tables_create_dense(plane, n, RAD_ALIAS_COMPACT, NULL, &tk[v]));
     }
-    for (v = 0; v < 5 && t && tw && tc[0] && tc[1] && tc[2] && tk[0] && tk[1] && tk[2]; ++v) {
+    for (v = 0; v < 6 && t && tw && tc[0] && tc[1] && tc[2] && tk[0] && tk[1] && tk[2]; ++v) {
         const rad_alias_tables *const *tb = v == 4 ? (const rad_alias_tables *const *)tk
                                           : v == 3 ? (const rad_alias_tables *const *)tc
                                                    : (const rad_alias_tables *const *)(v == 2 ? &tw : &t);
-        const uint32_t sets = v >= 3 ? 3u : 1u;
+        const uint32_t sets = v == 3 || v == 4 ? 3u : 1u;
         rad_temporal *tm = NULL;
         uint32_t fr;
         rad_temporal_options_default(&o);
         o.samples = ks[v];
         o.seed = 1234u + v;
         o.weight = 0.75f;
-        o.mode = v == 2 ? RAD_TEMPORAL_FEEDBACK : v >= 3 ? RAD_TEMPORAL_MULTIBOUNCE : RAD_TEMPORAL_SINGLE;
+        o.mode = v == 2 || v == 5 ? RAD_TEMPORAL_FEEDBACK : v >= 3 ? RAD_TEMPORAL_MULTIBOUNCE : RAD_TEMPORAL_SINGLE;
         memset(&ctx, 0, sizeof(ctx));
         if (tasks[v]) { ctx.parallel_for = fx_reverse_for; ctx.task_count = tasks[v]; }
         tp_plain_steps(tb, sets, c.patches->albedo, &o, c.E, E0, 3, ref);
@@ -818,6 +819,49 @@ static void tp_bad_values(void)
     fx_world_free(&c);
 }
 
+/* a hand-made table whose bins name a column past N: every step path reads E_0 for it (as
+   for the environment column N) and never reads past the sampled vector; 11 rows, so the
+   vector step has a full block of 8 and a partial one */
+static void tp_column_past_n(void)
+{
+    enum { N = 11 };
+    uint64_t offsets[N + 1];
+    uint32_t bins[2 * N];
+    float totals[N], albedo[3 * N], E[3 * N], out[3 * N], E0[3] = { 0.5f, 0.25f, 2.0f };
+    rad_alias_tables tb;
+    const rad_alias_tables *tp1[1];
+    rad_temporal_options o;
+    rad_temporal *tm = NULL;
+    uint32_t i, mode;
+    for (i = 0; i < N; ++i) {
+        offsets[i] = i;
+        bins[2 * i] = 0xFFFFFFFFu; /* probability 1: the bin's own column */
+        bins[2 * i + 1] = (i % 2 ? 40000u : (uint32_t)N) | (7u << 16);
+        totals[i] = 1.0f;
+        albedo[3 * i] = albedo[3 * i + 1] = albedo[3 * i + 2] = 1.0f;
+        E[3 * i] = E[3 * i + 1] = E[3 * i + 2] = 3.0f;
+    }
+    offsets[N] = N;
+    memset(&tb, 0, sizeof(tb));
+    tb.rows = tb.cols = N;
+    tb.format = RAD_ALIAS_COMPACT;
+    tb.row_offsets = offsets;
+    tb.bins = bins;
+    tb.totals = totals;
+    tp1[0] = &tb;
+    for (mode = 0; mode < 2; ++mode) {
+        rad_temporal_options_default(&o);
+        o.mode = mode ? RAD_TEMPORAL_FEEDBACK : RAD_TEMPORAL_SINGLE;
+        o.samples = 4;
+        o.weight = 0.0f;
+        CHECK_OK(rad_temporal_create(tp1, 1, albedo, &o, NULL, &tm));
+        if (!tm) continue;
+        CHECK_OK(rad_temporal_step(tm, E, E0, out));
+        for (i = 0; i < 3 * N; ++i) CHECK(out[i] == E0[i % 3]);
+        rad_temporal_destroy(tm);
+    }
+}
+
 static const rad_test_case tests_temporal[] = {
     { "temporal_random_vectors", tp_random_vectors },
     { "temporal_alias_chi_square", tp_alias_chi_square },
@@ -833,6 +877,7 @@ static const rad_test_case tests_temporal[] = {
     { "temporal_bad_values", tp_bad_values },
     { "temporal_pipeline_bits", tp_pipeline_bits },
     { "temporal_huge_tables", tp_huge_tables },
+    { "temporal_column_past_n", tp_column_past_n },
     { NULL, NULL }
 };
 
