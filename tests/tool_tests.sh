@@ -1166,7 +1166,7 @@ fi
 "$RAD" lightmap cornell -o "$TMP/lm.png" --sh > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 2 ] && grep -q "PNG cannot hold negative" "$TMP/err.txt" && ok "lightmap --sh refuses a PNG" || fail "lightmap --sh refuses a PNG" "exit $rc"
-if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 16 --patches 60 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" &&
+if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 32 --patches 60 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" &&
     [ -s "$TMP/sh.L00.pfm" ] && [ -s "$TMP/sh.L1m1.pfm" ] && [ -s "$TMP/sh.L10.pfm" ] && [ -s "$TMP/sh.L11.pfm" ]; then
     ok "lightmap --sh writes four PFM layers"
 else
