@@ -335,7 +335,7 @@ run_real_scenes() {
         return
     fi
     {
-        echo "The Dabrovic Sponza atrium ($(grep -c '^f ' "$TMP/sponza.obj") faces in \`$DATA/sponza.obj\`; the script gives it one stone material, albedo 0.7 0.68 0.63, as bench/realtime.c does),"
+        echo "The Dabrovic Sponza atrium ($(grep -c '^f ' "$TMP/sponza.obj") faces in \`RAD_DATA_DIR/sponza.obj\`, docs/data.md; the script gives it one stone material, albedo 0.7 0.68 0.63, as bench/realtime.c does),"
         echo "lit by a sun and, separately, by a sky window (a one-sided rectangle above the open roof, facing down, so most of the"
         echo "building sees only bounced light). The dense methods (classic, multi-bounce, temporal and local over patches) need at least one patch"
         echo "per triangle and an N x N matrix (66k triangles: 17.7 GB), so they are not run; the virtual patches are the methods for"
@@ -344,7 +344,8 @@ run_real_scenes() {
         echo "as the tool reports it (its timing line's build_ms, or the lightmap's \"built in\"); solve or step = the tool's"
         echo "step_ms_median (aavp, vp and lightmap: the solve on the patches, K Jacobi bounces and H = F B; temporal: one"
         echo "\`rad_temporal_step\`, median over the frames); wall and peak = the whole command (\`/usr/bin/time\`: elapsed and maximum"
-        echo "resident set size). PNGs at exposure $REAL_EXPOSURE."
+        echo "resident set size). PNGs at exposure $REAL_EXPOSURE. The sky window's rectangle is scene geometry above the roof, so it"
+        echo "enlarges the bounds that the voxel grid divides: the same resolution gives other patch counts than under the sun."
     } >> "$TMP/real.md"
     run_real sponza-sun "Sponza under a sun (\`--sun 0.3,-1,0.2:3\`)" "--sun 0.3,-1,0.2:3"
     run_real sponza-sky "Sponza under a sky window (\`--area -18,16.5,-8:36,0,0:0,0,16:1\`)" "--area -18,16.5,-8:36,0,0:0,0,16:1"
@@ -367,11 +368,12 @@ run_real_scenes() {
         run_timed "$OUT/data/realtime-box.log" "$RTBENCH" --data "$DATA" --scene box --size 2000 --append "$rt" && box=1
     fi
     {
-        echo "\`$(basename "$RTBENCH") $rtq${rtq:+ }--scene sponza\`$([ -n "$box" ] && echo " and \`--scene box --size 2000\` (the bunny and the ogre, 193k triangles, in the Cornell box)") (bench/realtime.c, the loop of examples/realtime.c): a sun and a point light"
+        echo "bench/realtime.c (the loop of examples/realtime.c), \`$(basename "$RTBENCH") $rtq${rtq:+ }--scene sponza\`$([ -n "$box" ] && echo " and \`--scene box --size 2000\` (the bunny and the ogre, 193k triangles, in the Cornell box)"): a sun and a point light"
         echo "circling the scene; per frame the E update of the virtual patches, one temporal step (k 10, feedback) and the"
         echo "per-vertex gather, medians in ms; lag = frames after the point light jumps until the error is back to its noise"
         echo "(fixed w 0.9 exact E / M/4 rays / adaptive w); power, RMS and vertex L1 = the converged temporal solution against"
-        echo "Gauss-Seidel on the same patches. Its own log has the column definitions (data/realtime.md)."
+        echo "Gauss-Seidel on the same patches. Its own log has the column definitions (data/realtime.md). On a shared machine"
+        echo "the wall-clock medians with all threads wait for the scheduler; the one-core CPU times are the work itself."
         echo
         grep -m1 '^| scene | res |' "$rt"
         grep -m1 '^|---|' "$rt"
@@ -382,7 +384,9 @@ run_real_scenes() {
         echo
         echo "| figure | thesis, Table 3 (GPU) | ours (CPU, this run) |"
         echo "|---|---|---|"
-        awk -F'|' '/^\| Sponza/ { gsub(/^ +| +$/, "", $4); gsub(/^ +| +$/, "", $12); gsub(/^ +| +$/, "", $14); s = s (s ? "; " : "") $4 " patches: step " $12 ", whole frame " $14 }
+        # the one-core column: "E / E M/4, step, gather: frame / frame M/4 ms"
+        awk -F'|' '/^\| Sponza/ { gsub(/^ +| +$/, "", $4); gsub(/^ +| +$/, "", $12); split($15, c, /, |: /); split(c[4], f, / /)
+                s = s (s ? "; " : "") "Sponza, " $4 " patches: step " c[2] " ms, whole frame (E update, step, gather) " f[1] " ms on one core (CPU time; wall with all threads: step " $12 ")" }
             END { printf "| temporal radiosity, time per frame | 0.08 ms (the step) | %s |\n", (s ? s : "-") }' "$rt"
         printf '| temporal radiosity vs a path-traced reference | SSIM 0.73, PSNR 23.54 | temporal over the 2k AAVP (%s frames): sun SSIM %s, PSNR %s; sky window SSIM %s, PSNR %s |\n' 1024 \
             "$(awk '$1 == "sponza-sun" && $2 == "temporal" { print $5 }' "$OUT/data/real-metrics.txt")" \
@@ -403,7 +407,7 @@ if make_bunny_scene "$TMP"; then
     cp "$TMP/bunny-box.obj" "$TMP/bunny-box.obj.keep" 2> /dev/null
     run_scene bunny "Stanford bunny in the Cornell box" "$TMP/bunny-box.obj" "$BUNNY_SIZE" "$BUNNY_SPP" "$((tris + 0))"
     {
-        printf '\nThe bunny scene is the built-in Cornell box (`rad export cornell`) without its two blocks plus `%s/stanford-bunny.obj` scaled to 0.25 m and standing in the middle of the floor (written by this script). ' "$DATA"
+        printf '\nThe bunny scene is the built-in Cornell box (`rad export cornell`) without its two blocks plus `RAD_DATA_DIR/stanford-bunny.obj` (docs/data.md) scaled to 0.25 m and standing in the middle of the floor (written by this script). '
         printf 'The `rad` tool makes at least one patch per triangle and stores F densely: with %s triangles that is a %s GB matrix (this machine: %s GB of memory) and about %s patch pairs of form factors, which at the measured ~1 Mpairs/s (BENCHMARKS.md a) is hours, so the dense methods (classic, multi-bounce, temporal) were not run on it. The virtual patches are the method meant for it (the local method of rad fetches its rows from the classic dense F, so it is not run here either).\n' \
             "$tris" "$(awk -v t="$tris" 'BEGIN { printf "%.1f", 4 * t * t / 1e9 }')" \
             "$(awk '/MemTotal/ { printf "%.0f", $2 / 1048576 }' /proc/meminfo)" "$(awk -v t="$tris" 'BEGIN { printf "%.1e", t * t / 2 }')"
