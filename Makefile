@@ -11,8 +11,8 @@
 #   make tools   builds the command-line tools in tools/ (and tools/rad-mpi when mpicc is installed)
 #   make glsl    regenerates the GLSL sources embedded in radiosity.h from glsl/
 #   make report  the evaluation report (every method vs the path-traced reference, plots; the
-#                real scenes when RAD_DATA_DIR holds sponza.obj) into report/ (long: about an
-#                hour on 2 shared cores); make report-quick: a small one into build/, checked
+#                real scenes when RAD_DATA_DIR holds sponza.obj) into report/ (long: 15-40 min
+#                on 2 shared cores); make report-quick: a small one into build/, checked
 #   make clean
 CC      ?= cc
 CXX     ?= c++
