@@ -10,8 +10,9 @@
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/ (and tools/rad-mpi when mpicc is installed)
 #   make glsl    regenerates the GLSL sources embedded in radiosity.h from glsl/
-#   make report  the evaluation report (every method vs the path-traced reference, plots) into
-#                report/ (long: about 15 min); make report-quick: a small one into build/, checked
+#   make report  the evaluation report (every method vs the path-traced reference, plots; the
+#                real scenes when RAD_DATA_DIR holds sponza.obj) into report/ (long: 15-40 min
+#                on 2 shared cores); make report-quick: a small one into build/, checked
 #   make clean
 CC      ?= cc
 CXX     ?= c++
@@ -167,8 +168,8 @@ $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
 
 # the evaluation report (tools/report.sh, issue #12): full quality into report/ (committed), or
 # quick into build/report-quick/ with every table cell and image checked (tests/run.sh runs it)
-report: $(BUILD)/rad $(BUILD)/temporal
-	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal
+report: $(BUILD)/rad $(BUILD)/temporal $(BUILD)/bench_realtime
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal --realtime-bench $(BUILD)/bench_realtime
 
 report-quick: $(BUILD)/rad $(BUILD)/temporal
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --quick --out $(BUILD)/report-quick --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal

@@ -15973,6 +15973,7 @@ static rad_result rad__vp_sparse_rows(rad__vp_build *b, const rad__ctx *c, uint3
                     col[at] = p, val[at] = uval[e];
                 }
         for (p = 0; p < N; ++p) {
+            if (uoff[p + 1] == uoff[p]) continue; /* ucol may be NULL when no pair sees another */
             memcpy(col + pos[p], ucol + uoff[p], sizeof(uint32_t) * (size_t)(uoff[p + 1] - uoff[p]));
             memcpy(val + pos[p], uval + uoff[p], sizeof(float) * (size_t)(uoff[p + 1] - uoff[p]));
         }

@@ -1202,7 +1202,7 @@ fi
 "$RAD" lightmap cornell -o "$TMP/lm.png" --sh > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 2 ] && grep -q "PNG cannot hold negative" "$TMP/err.txt" && ok "lightmap --sh refuses a PNG" || fail "lightmap --sh refuses a PNG" "exit $rc"
-if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 16 --patches 60 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" &&
+if "$RAD" lightmap cornell -o "$TMP/sh.pfm" --sh --size 32 --patches 60 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" &&
     [ -s "$TMP/sh.L00.pfm" ] && [ -s "$TMP/sh.L1m1.pfm" ] && [ -s "$TMP/sh.L10.pfm" ] && [ -s "$TMP/sh.L11.pfm" ]; then
     ok "lightmap --sh writes four PFM layers"
 else
@@ -1292,6 +1292,32 @@ for args in "lightmap" "render --method lightmap"; do
         ok "$args: a lightmap too big for the dense build is refused before the unwrap, naming --proxy aavp" ||
         fail "$args: a lightmap too big for the dense build is refused naming --proxy aavp" "exit $rc: $(head -c 300 "$TMP/err.txt")"
 done
+# an unwrap of many small charts (3000 separate triangles: each chart costs at least 5 x 5
+# texels with its gutters, 2601 fit 256 x 256): with no size given the tool picks the smallest
+# power of two that packs (512) and says so; a size given too small is refused, naming it
+awk 'BEGIN { for (i = 0; i < 60; ++i) for (j = 0; j < 50; ++j) { n++; printf "v %g 0 %g\nv %g 0 %g\nv %g 0 %g\nf %d %d %d\n",
+    0.2 * i, 0.2 * j, 0.2 * i, 0.2 * j + 0.1, 0.2 * i + 0.1, 0.2 * j, 3 * n - 2, 3 * n - 1, 3 * n } }' > "$TMP/tiles.obj"
+if "$RAD" lightmap "$TMP/tiles.obj" --proxy aavp --vp-resolution 4 --texel-samples 1 --visibility-rays 1 --sun 0.2,-1,0.1:1 \
+        -o "$TMP/tiles.pfm" > /dev/null 2> "$TMP/err.txt"; then
+    grep -q "3000 charts do not fit the default 256x256 atlas: using 512x512" "$TMP/err.txt" &&
+        [ "$(head -c 11 "$TMP/tiles.pfm" | tail -c 8)" = "512 512" ] &&
+        ok "lightmap without --size: an unwrap too fine for 256 gets the 512 atlas it fits, said on stderr" ||
+        fail "lightmap without --size picks the atlas the unwrap fits" "$(head -c 11 "$TMP/tiles.pfm" | tail -c 8): $(grep charts "$TMP/err.txt" | head -c 300)"
+else
+    fail "lightmap without --size picks the atlas the unwrap fits" "$(head -c 300 "$TMP/err.txt")"
+fi
+"$RAD" render "$TMP/tiles.obj" --method lightmap --proxy aavp --vp-resolution 4 --texel-samples 1 --visibility-rays 1 \
+    --sun 0.2,-1,0.1:1 --size 8x8 --aa 1 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt" &&
+    grep -q "using 512x512" "$TMP/err.txt" && grep -q "512x512 texels" "$TMP/err.txt" &&
+    ok "render --method lightmap without --lightmap-size bakes the 512 atlas the unwrap fits" ||
+    fail "render --method lightmap without --lightmap-size picks the atlas the unwrap fits" "$(head -c 300 "$TMP/err.txt")"
+for args in "lightmap --size 256|256x256 atlas even as single texels: use --size 512" \
+    "render --method lightmap --lightmap-size 128|128x128 atlas even as single texels: use --lightmap-size 512"; do
+    "$RAD" ${args%%|*} "$TMP/tiles.obj" --proxy aavp --vp-resolution 4 --sun 0.2,-1,0.1:1 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && grep -q -- "${args#*|}" "$TMP/err.txt" && ok "${args%%|*}: too small for the unwrap, refused naming the size that fits" ||
+        fail "${args%%|*}: too small for the unwrap, refused naming the size that fits" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+done
 # --bounces reaches the lightmap's solve
 "$RAD" render cornell --method lightmap --bounces 2 --patches 60 --lightmap-size 32 --texel-samples 1 --visibility-rays 1 \
     --size 8x8 --aa 1 -o "$TMP/x.pfm" > /dev/null 2> "$TMP/err.txt"
@@ -1320,6 +1346,12 @@ printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "n
     grep -q "using the file's second uv set" "$TMP/err.txt" && grep -q "64 covered" "$TMP/err.txt" &&
     ok "lightmap uses a glTF's TEXCOORD_1 (the quad covers all 64 texels)" ||
     fail "lightmap uses a glTF's TEXCOORD_1" "$(head -c 400 "$TMP/err.txt")"
+
+# the file's own second uv set: no unwrap, so no size to choose: the default 256 stays
+"$RAD" lightmap "$TMP/uv2.gltf" -o "$TMP/uv2.pfm" --patches 2 --texel-samples 1 > /dev/null 2> "$TMP/err.txt" &&
+    grep -q "256x256 texels" "$TMP/err.txt" && ! grep -q "using [0-9]*x" "$TMP/err.txt" &&
+    ok "lightmap over the file's second uv set keeps the default 256 atlas" ||
+    fail "lightmap over the file's second uv set keeps the default 256 atlas" "$(head -c 400 "$TMP/err.txt")"
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

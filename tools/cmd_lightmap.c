@@ -26,7 +26,8 @@ static void lightmap_usage(FILE *f)
     fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [options]\n"
                "  bakes the classic radiosity solution into a lightmap over the second uv set\n"
                "  (glTF TEXCOORD_1); meshes without one are unwrapped automatically (simple charts)\n"
-               "  --size N|WxH          atlas texels (default 256)\n"
+               "  --size N|WxH          atlas texels (default 256; with an unwrap whose charts do not fit,\n"
+               "                        the smallest power of two up to 4096 that they fit, said on stderr)\n"
                "  --sh                  L1 spherical harmonics of the indirect light (4 PFM or EXR files\n"
                "                        OUT.L00.pfm OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)\n"
                "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
@@ -208,7 +209,7 @@ fail:
 }
 
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
-                           int height, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
+                           int height, int auto_size, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
                            int force_unwrap, int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out)
 {
     tool_classic_options co2 = *co;
@@ -243,10 +244,21 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     if (force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
         if (!force_unwrap && w->scene->lightmap_uvs)
             fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
+        uint32_t uw = (uint32_t)width, uh = (uint32_t)height;
+        tool_unwrap_auto au;
         out->uvs = (float *)tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
-        if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, (uint32_t)width, (uint32_t)height,
-                        out->uvs, NULL))
+        /* the estimate: the texel records (flags, position, normal, sample index: 29 bytes),
+           the samples (position, normal, triangle, validity: 29 bytes each) and the values
+           with one working copy, plus an RGB image of the atlas */
+        au.max_side = TOOL_LIGHTMAP_AUTO_MAX;
+        au.bytes_per_texel = 29.0 + 29.0 * (texel_samples ? texel_samples : 4u) + 8.0 * (sh ? 12.0 : 3.0) + 12.0;
+        if (co->max_memory > 0.0) au.memory_limit = co->max_memory, au.memory_from = "--max-memory";
+        else au.memory_limit = tool_mem_available(), au.memory_from = "MemAvailable in /proc/meminfo";
+        if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, &uw, &uh,
+                        auto_size ? &au : NULL, out->uvs, NULL))
             goto fail;
+        width = (int)uw;
+        height = (int)uh;
         memset(&mesh, 0, sizeof mesh);
         mesh.name = "unwrapped";
         mesh.positions = w->scene->positions;
@@ -361,7 +373,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     tool_world w;
     tool_lightmap_baked bk;
     const rad_lightmap *lm = NULL;
-    int width = 256, height = 256, sh = 0, force_unwrap = 0, a, code = 1;
+    int width = 256, height = 256, size_given = 0, sh = 0, force_unwrap = 0, a, code = 1;
     uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
     int gather = -1; /* -1: by the work, else a rad_lightmap_gather_method */
     tool_lightmap_proxy px;
@@ -426,6 +438,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             if (aa == 0 || aa > 16) { fprintf(stderr, "rad lightmap: --aa must be 1 to 16\n"); return 2; }
         } else if (!strcmp(o, "--size")) {
             const char *v = argv[++a];
+            size_given = 1;
             if (strchr(v, 'x')) {
                 if (tool_parse_size(v, &width, &height)) { fprintf(stderr, "rad lightmap: bad --size '%s'\n", v); return 2; }
             } else {
@@ -499,9 +512,11 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     }
     tool_set_threads((int)threads);
     if (tool_open_world_lit("lightmap", scene_path, lights, &w)) return 1;
-    if (tool_lightmap_bake("lightmap", &w, &co, width, height, texel_samples, vis, gather, hemi_rays, sh, force_unwrap, !sh,
-                           px.kind ? &px : NULL, &bk))
+    if (tool_lightmap_bake("lightmap", &w, &co, width, height, !size_given, texel_samples, vis, gather, hemi_rays, sh,
+                           force_unwrap, !sh, px.kind ? &px : NULL, &bk))
         goto done;
+    width = (int)bk.lm->width; /* the unwrap may have chosen a larger atlas */
+    height = (int)bk.lm->height;
     lm = bk.lm;
     values = bk.values;
     ch = sh ? 12u : 3u;

@@ -149,6 +149,7 @@ static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t
 static const rad_lightmap *render_lm = NULL;
 static const float *render_lm_values = NULL;
 static uint32_t render_lm_size = 256, render_lm_samples = 4, render_lm_vis = 2;
+static int render_lm_size_given = 0; /* else an unwrap too fine for 256 gets a larger atlas */
 /* --final-gather N: rays per pixel sample for one traced bounce (0: off; rad_final_gather) */
 static uint32_t render_final_gather = 0;
 
@@ -1276,6 +1277,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
             uint32_t lo = opt[2] == 'l' ? 4u : 1u, hi = opt[2] == 'l' ? 16384u : opt[2] == 't' ? 16u : 64u;
             if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
             if (*dst < lo || *dst > hi) { fprintf(stderr, "rad %s: %s must be %u to %u\n", cmd, opt, lo, hi); return 2; }
+            if (opt[2] == 'l') render_lm_size_given = 1;
             lightmap_opts = 1;
         } else if (!strcmp(opt, "--final-gather")) {
             if (tool_parse_uint(cmd, opt, argv[++a], &render_final_gather)) return 2;
@@ -1367,7 +1369,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         px.kind = (int)mo.proxy;
         px.resolution = mo.vp_resolution;
         px.face_points = mo.face_points;
-        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0,
+        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, !render_lm_size_given, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0,
                                 mo.proxy ? &px : NULL, &bk);
         if (rc == 0) {
             fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "

@@ -517,12 +517,25 @@ typedef struct tool_bake_args {
 int tool_bake_parse(const char *cmd, int argc, char **argv, tool_bake_args *args);
 /* ---- lightmaps (cmd_lightmap.c, unwrap.c) ------------------------------------------------ */
 int tool_cmd_lightmap(int argc, char **argv);
+/* When the user gave no atlas size: pick the smallest square power of two from the default up
+   to max_side into which the charts pack, refused when its estimate (bytes_per_texel per
+   texel) passes memory_limit (0: no limit; memory_from names where the limit came from). */
+typedef struct tool_unwrap_auto {
+    uint32_t max_side;
+    double bytes_per_texel;
+    double memory_limit;
+    const char *memory_from;
+} tool_unwrap_auto;
+/* the largest atlas side the tool picks by itself (a larger one must be asked for) */
+#define TOOL_LIGHTMAP_AUTO_MAX 4096u
 /* A simple automatic lightmap unwrap (unwrap.c: charts of connected triangles within 30
    degrees, planar projection, shelf packing with 2-texel gutters): 6 floats per scene triangle
-   into out_uvs, the chart count into out_charts (may be NULL). 0, or 1 with a message printed
-   as "rad CMD: ..." that names size_option when the atlas is too small. */
-int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t width, uint32_t height,
-                float *out_uvs, uint32_t *out_charts);
+   into out_uvs, the chart count into out_charts (may be NULL). *width x *height is the atlas;
+   with autosize (may be NULL) a larger square one is chosen when the charts do not fit it,
+   written back and said on stderr. 0, or 1 with a message printed as "rad CMD: ..." that
+   names size_option and the smallest size that fits when the atlas is too small. */
+int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t *width, uint32_t *height,
+                const tool_unwrap_auto *autosize, float *out_uvs, uint32_t *out_charts);
 /* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
 /* --proxy aavp|vp: the indirect light from virtual patches instead of classic patches */
 typedef struct tool_lightmap_proxy {
@@ -569,10 +582,12 @@ typedef struct tool_lightmap_baked {
    texel, dilation, stitching. Without a proxy a scene whose dense build would be refused is
    refused before the unwrap, naming --proxy aavp. gather: a rad_lightmap_gather_method, or -1
    to choose by the work (the hemisphere gather with hemisphere_rays rays a texel past 2e7
-   sample-patch pairs). 0, or 1 after printing why (out freed). Free with
+   sample-patch pairs). auto_size: the user gave no size, so an unwrap whose charts do not fit
+   width x height gets a larger atlas (tool_unwrap_auto; out->lm has the size used). 0, or 1
+   after printing why (out freed). Free with
    tool_lightmap_bake_free. */
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
-                           int height, uint32_t texel_samples, uint32_t visibility_rays, int gather,
+                           int height, int auto_size, uint32_t texel_samples, uint32_t visibility_rays, int gather,
                            uint32_t hemisphere_rays, int sh, int force_unwrap,
                            int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);

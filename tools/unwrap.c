@@ -5,7 +5,10 @@
    that first normal (so it keeps its shape up to a cos 30 squeeze) and boxed; the boxes are
    packed in shelves (tallest first) at the largest common scale that fits the atlas, found by
    bisection, each box with a gutter of 2 texels on every side. No rotation, no overlap check
-   inside a chart (a strongly curved chart could fold onto itself within the 30 degrees). */
+   inside a chart (a strongly curved chart could fold onto itself within the 30 degrees).
+   Every chart costs at least 5 x 5 texels (one texel and its gutters), so a scene of many
+   small charts needs a larger atlas whatever its area: when the user gave no size, the tool
+   doubles the atlas until the charts pack. */
 #include "tool.h"
 #include <math.h>
 #include <stdio.h>
@@ -80,9 +83,30 @@ static int uw_pack(uw_chart *c, uint32_t n, double s, uint32_t W, uint32_t H)
     return 1;
 }
 
-int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t width, uint32_t height,
-                float *out_uvs, uint32_t *out_charts)
+/* a scale small enough that every chart of positive extent is one texel plus its gutters */
+#define UNWRAP_TINY 1e-12
+
+/* the smallest square power-of-two atlas in [from, to] into which the charts pack (at a
+   positive scale), or 0 */
+static uint32_t uw_fitting_side(uw_chart *c, uint32_t n, uint32_t from, uint32_t to)
 {
+    uint32_t p = 4;
+    while (p < from) p *= 2;
+    for (; p <= to; p *= 2)
+        if (uw_pack(c, n, UNWRAP_TINY, p, p)) return p;
+    return 0;
+}
+
+static void uw_bytes(char *buf, size_t len, double b)
+{
+    if (b >= 1073741824.0) snprintf(buf, len, "%.1f GiB", b / 1073741824.0);
+    else snprintf(buf, len, "%.0f MiB", b / 1048576.0);
+}
+
+int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t *width_io, uint32_t *height_io,
+                const tool_unwrap_auto *autosize, float *out_uvs, uint32_t *out_charts)
+{
+    uint32_t width = *width_io, height = *height_io;
     uint32_t T = scene->triangle_count, t, i, nch = 0, *chart = NULL, *queue = NULL, *first = NULL, *adj = NULL;
     uint32_t *deg = NULL;
     uw_edge *edges = NULL;
@@ -174,11 +198,39 @@ int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene
     }
     /* the largest scale that packs: bisection below the one that fills the atlas exactly */
     qsort(charts, nch, sizeof(uw_chart), uw_by_height);
+    if (autosize && !uw_pack(charts, nch, UNWRAP_TINY, width, height)) {
+        /* no size given: the smallest square power of two that packs, within the cap and memory */
+        uint32_t side = uw_fitting_side(charts, nch, width > height ? width : height, autosize->max_side);
+        double bytes = side ? (double)side * side * autosize->bytes_per_texel : 0.0;
+        char bbuf[32], lbuf[32];
+        if (!side) {
+            uint32_t need = uw_fitting_side(charts, nch, 2u * autosize->max_side, 16384u);
+            fprintf(stderr, "rad %s: %u charts do not fit a %ux%u atlas, the largest the tool picks by itself", cmd, nch,
+                    autosize->max_side, autosize->max_side);
+            if (need) fprintf(stderr, ": give %s %u (it fits) or a mesh with its own lightmap uvs\n", size_option, need);
+            else fprintf(stderr, ", nor the largest allowed (16384): give the meshes their own lightmap uvs\n");
+            goto done;
+        }
+        if (autosize->memory_limit > 0.0 && bytes > autosize->memory_limit) {
+            uw_bytes(bbuf, sizeof bbuf, bytes);
+            uw_bytes(lbuf, sizeof lbuf, autosize->memory_limit);
+            fprintf(stderr, "rad %s: %u charts need a %ux%u atlas, about %s of texels and samples; only %s may be used (%s): "
+                            "give the meshes their own lightmap uvs\n",
+                    cmd, nch, side, side, bbuf, lbuf, autosize->memory_from ? autosize->memory_from : "the memory limit");
+            goto done;
+        }
+        uw_bytes(bbuf, sizeof bbuf, bytes);
+        fprintf(stderr, "rad %s: %u charts do not fit the default %ux%u atlas: using %ux%u (about %s; %s N sets it)\n", cmd,
+                nch, width, height, side, side, bbuf, size_option);
+        width = height = side;
+    }
     hi = area > 0.0 ? sqrt((double)width * height / area) : 1.0;
-    lo = 0.0;
-    if (!uw_pack(charts, nch, 0.0, width, height)) {
-        fprintf(stderr, "rad %s: %u charts do not fit a %ux%u atlas even as single texels: use a larger %s\n", cmd, nch,
-                width, height, size_option);
+    lo = UNWRAP_TINY;
+    if (!uw_pack(charts, nch, UNWRAP_TINY, width, height)) {
+        uint32_t side = uw_fitting_side(charts, nch, 4u, 16384u);
+        fprintf(stderr, "rad %s: %u charts do not fit a %ux%u atlas even as single texels: ", cmd, nch, width, height);
+        if (side) fprintf(stderr, "use %s %u (the smallest power of two that fits)\n", size_option, side);
+        else fprintf(stderr, "they do not fit the largest allowed (16384) either: give the meshes their own lightmap uvs\n");
         goto done;
     }
     for (it = 0; it < 40; ++it) {
@@ -206,6 +258,8 @@ int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene
         }
     }
     if (out_charts) *out_charts = nch;
+    *width_io = width;
+    *height_io = height;
     fprintf(stderr, "rad %s: unwrapped %u triangles into %u charts, %.1f texels per unit\n", cmd, T, nch, s);
     ok = 1;
 done:
