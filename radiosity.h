@@ -19513,6 +19513,19 @@ static void rad__fibonacci_dir(uint32_t k, uint32_t n, float *d)
     d[2] = (float)z;
 }
 
+/* rays k0 .. k0 + m - 1 of the n-ray Fibonacci sphere around p (one batch of a probe's rays) */
+static void rad__fibonacci_rays(rad_ray *rays, uint32_t k0, uint32_t m, uint32_t n, const float *p)
+{
+    uint32_t k;
+    int c;
+    for (k = 0; k < m; ++k) {
+        rad__fibonacci_dir(k0 + k, n, rays[k].dir);
+        for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c];
+        rays[k].tmin = 0.0f;
+        rays[k].tmax = FLT_MAX;
+    }
+}
+
 typedef struct rad__pb {
     const rad_patches *P;      /* the classic patches, or NULL */
     const rad_virtual_patches *V; /* or the virtual patches (rad_probes_create_vp) */
@@ -19553,12 +19566,7 @@ static rad_result rad__pb_test(rad__pb *b, uint32_t task, const float *p, uint32
     *tnear = FLT_MAX;
     for (k0 = 0; k0 < R; k0 += RAD__RAY_BATCH) {
         uint32_t m = R - k0 < RAD__RAY_BATCH ? R - k0 : RAD__RAY_BATCH;
-        for (k = 0; k < m; ++k) {
-            rad__fibonacci_dir(k0 + k, R, rays[k].dir);
-            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c];
-            rays[k].tmin = 0.0f;
-            rays[k].tmax = FLT_MAX;
-        }
+        rad__fibonacci_rays(rays, k0, m, R, p);
         if (b->rc->intersect(b->rc->user, rays, m, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
         for (k = 0; k < m; ++k) {
             uint32_t t = hits[k].triangle;
@@ -19704,12 +19712,7 @@ static rad_result rad__pb_gather_vp(rad__pb *b, uint32_t task, uint32_t row, con
     int c, i;
     for (k0 = 0; k0 < R; k0 += RAD__RAY_BATCH) {
         uint32_t m = R - k0 < RAD__RAY_BATCH ? R - k0 : RAD__RAY_BATCH;
-        for (k = 0; k < m; ++k) {
-            rad__fibonacci_dir(k0 + k, R, rays[k].dir);
-            for (c = 0; c < 3; ++c) rays[k].origin[c] = p[c];
-            rays[k].tmin = 0.0f;
-            rays[k].tmax = FLT_MAX;
-        }
+        rad__fibonacci_rays(rays, k0, m, R, p);
         if (b->rc->intersect(b->rc->user, rays, m, hits) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
         for (k = 0; k < m; ++k) {
             uint32_t t = hits[k].triangle, cnt;
