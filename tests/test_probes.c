@@ -288,22 +288,17 @@ static const float pb_cube_pos[24 * 3] = {
 static const uint32_t pb_cube_idx[36] = { 0, 2, 1, 0, 3, 2, 4, 6, 5, 4, 7, 6, 8, 10, 9, 8, 11, 10,
                                           12, 14, 13, 12, 15, 14, 16, 18, 17, 16, 19, 18, 20, 22, 21, 20, 23, 22 };
 
-static void pb_test_constant_room(void)
+/* the test normals and points of the grey cube */
+static const float pb_cube_ns[4][3] = { { 0, 1, 0 }, { 0, 0, -1 }, { 1, 0, 0 }, { 0.48f, -0.6f, 0.64f } };
+static const float pb_cube_pts[3][3] = { { 0.5f, 0.5f, 0.5f }, { 0.2f, 0.7f, 0.35f }, { 0.9f, 0.1f, 0.8f } };
+
+/* the closed unit cube, faces in, albedo 0.5 (NULL on failure) */
+static rad_scene *pb_cube_scene(void)
 {
-    static const float ns[4][3] = { { 0, 1, 0 }, { 0, 0, -1 }, { 1, 0, 0 }, { 0.48f, -0.6f, 0.64f } };
-    static const float pts[3][3] = { { 0.5f, 0.5f, 0.5f }, { 0.2f, 0.7f, 0.35f }, { 0.9f, 0.1f, 0.8f } };
     rad_mesh_desc m;
     rad_material mat;
     rad_scene_desc d;
     rad_scene *S = NULL;
-    rad_patches *P = NULL;
-    rad_patch_options po;
-    rad_bvh *bvh = NULL;
-    rad_raycaster rc;
-    rad_probes *pr = NULL;
-    rad_probe_options o;
-    float *B = NULL;
-    uint32_t i, k;
     memset(&m, 0, sizeof(m));
     memset(&mat, 0, sizeof(mat));
     memset(&d, 0, sizeof(d));
@@ -317,6 +312,35 @@ static void pb_test_constant_room(void)
     d.materials = &mat;
     d.material_count = 1;
     CHECK_OK(rad_scene_create(&d, NULL, &S));
+    return S;
+}
+
+/* probes at the three test points of a room with B = 2 everywhere: valid, E(n) = 2 */
+static void pb_check_constant_probes(const rad_probes *pr)
+{
+    uint32_t i, k;
+    for (i = 0; i < 3; ++i) {
+        CHECK(rad_probes_states(pr)[i] == RAD_PROBE_VALID);
+        for (k = 0; k < 4; ++k) {
+            float e[3];
+            rad_sh9_irradiance(rad_probes_coefficients(pr) + 27 * i, pb_cube_ns[k], e);
+            CHECK_REL(e[1], 2.0, 0.01);
+        }
+    }
+}
+
+static void pb_test_constant_room(void)
+{
+    rad_scene *S = NULL;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_probes *pr = NULL;
+    rad_probe_options o;
+    float *B = NULL;
+    uint32_t i, k;
+    S = pb_cube_scene();
     rad_patch_options_default(&po);
     po.target_count = 200;
     if (S) CHECK_OK(rad_patches_create(S, &po, NULL, &P));
@@ -328,16 +352,8 @@ static void pb_test_constant_room(void)
     B = (float *)malloc(sizeof(float) * 3 * P->count);
     for (i = 0; i < 3 * P->count; ++i) B[i] = 2.0f;
     rad_probe_options_default(&o);
-    CHECK_OK(rad_probes_create(P, &rc, NULL, 0, &pts[0][0], 3, &o, B, NULL, &pr));
-    if (pr)
-        for (i = 0; i < 3; ++i) {
-            CHECK(rad_probes_states(pr)[i] == RAD_PROBE_VALID);
-            for (k = 0; k < 4; ++k) {
-                float e[3];
-                rad_sh9_irradiance(rad_probes_coefficients(pr) + 27 * i, ns[k], e);
-                CHECK_REL(e[1], 2.0, 0.01);
-            }
-        }
+    CHECK_OK(rad_probes_create(P, &rc, NULL, 0, &pb_cube_pts[0][0], 3, &o, B, NULL, &pr));
+    if (pr) pb_check_constant_probes(pr);
     rad_probes_destroy(pr);
     pr = NULL;
     /* the grid: spacing 0.3 over the unit cube is 4 x 4 x 4 probes, centred */
@@ -356,7 +372,7 @@ static void pb_test_constant_room(void)
         for (i = 0; i < 3; ++i)
             for (k = 0; k < 4; ++k) {
                 float e[3];
-                CHECK_OK(rad_probes_sample(pr, pts[i], ns[k], e));
+                CHECK_OK(rad_probes_sample(pr, pb_cube_pts[i], pb_cube_ns[k], e));
                 CHECK_REL(e[1], 2.0, 0.01);
             }
     }
@@ -1134,11 +1150,6 @@ static void pb_test_vp_cornell(void)
    mapping, against the closed form. */
 static void pb_test_vp_constant_room(void)
 {
-    static const float ns[4][3] = { { 0, 1, 0 }, { 0, 0, -1 }, { 1, 0, 0 }, { 0.48f, -0.6f, 0.64f } };
-    static const float pts[3][3] = { { 0.5f, 0.5f, 0.5f }, { 0.2f, 0.7f, 0.35f }, { 0.9f, 0.1f, 0.8f } };
-    rad_mesh_desc m;
-    rad_material mat;
-    rad_scene_desc d;
     rad_scene *S = NULL;
     rad_bvh *bvh = NULL;
     rad_raycaster rc;
@@ -1147,20 +1158,8 @@ static void pb_test_vp_constant_room(void)
     rad_probes *pr = NULL;
     rad_probe_options o;
     float *B = NULL;
-    uint32_t i, k;
-    memset(&m, 0, sizeof(m));
-    memset(&mat, 0, sizeof(mat));
-    memset(&d, 0, sizeof(d));
-    m.positions = pb_cube_pos;
-    m.vertex_count = 24;
-    m.indices = pb_cube_idx;
-    m.triangle_count = 12;
-    mat.albedo[0] = mat.albedo[1] = mat.albedo[2] = 0.5f;
-    d.meshes = &m;
-    d.mesh_count = 1;
-    d.materials = &mat;
-    d.material_count = 1;
-    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    uint32_t i;
+    S = pb_cube_scene();
     if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
     if (!bvh) goto done;
     rad_bvh_raycaster(bvh, &rc);
@@ -1172,16 +1171,8 @@ static void pb_test_vp_constant_room(void)
     for (i = 0; i < 3 * vp->count; ++i) B[i] = 2.0f;
     rad_probe_options_default(&o);
     o.rays = 64;
-    CHECK_OK(rad_probes_create_vp(vp, &rc, NULL, 0, &pts[0][0], 3, &o, B, NULL, &pr));
-    if (pr)
-        for (i = 0; i < 3; ++i) {
-            CHECK(rad_probes_states(pr)[i] == RAD_PROBE_VALID);
-            for (k = 0; k < 4; ++k) {
-                float e[3];
-                rad_sh9_irradiance(rad_probes_coefficients(pr) + 27 * i, ns[k], e);
-                CHECK_REL(e[1], 2.0, 0.01);
-            }
-        }
+    CHECK_OK(rad_probes_create_vp(vp, &rc, NULL, 0, &pb_cube_pts[0][0], 3, &o, B, NULL, &pr));
+    if (pr) pb_check_constant_probes(pr);
 done:
     rad_probes_destroy(pr);
     free(B);
