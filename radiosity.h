@@ -568,7 +568,10 @@ RAD_API rad_result rad_patches_vertex_values(const rad_patches *patches, const f
    are not partly covered (S_i >= 3/4 of the largest S at v). S (one float per patch) is the
    row sum of F (sum_j F_ij, how much of its hemisphere a patch sees: rad_matrix_multiply by
    ones); NULL gives rad_patches_vertex_values. H: 3 floats per patch; out: 3 per patch vertex.
-   Errors: INVALID_ARGUMENT, NON_FINITE (H or S not finite, S < 0), OUT_OF_MEMORY. O(patches). */
+   The sums and the ratio of the two S terms are taken in double, so row sums of any size,
+   denormals included, give H_v (a vertex whose patches all have S = 0 gets 0).
+   Errors: INVALID_ARGUMENT, NON_FINITE (H or S not finite, S < 0, or an H_v beyond the float
+   range), OUT_OF_MEMORY. O(patches). */
 RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, const float *H, const float *S,
                                                  float *out_vertex_H, const rad_context *ctx);
 
@@ -5143,9 +5146,9 @@ RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, con
                                                  float *out_vertex_H, const rad_context *ctx)
 {
     rad__ctx c;
-    float *S_v, *S_max, *S_area;
+    double *acc;
     uint32_t n, nv, i, k;
-    rad_result r;
+    rad_result r = RAD_SUCCESS;
     rad__ctx_init(&c, ctx);
     if (!patches || !H || !out_vertex_H) {
         rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: patches, H and out_vertex_H are required");
@@ -5165,40 +5168,51 @@ RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, con
                      i, (double)S[i]);
             return RAD_ERROR_NON_FINITE;
         }
-    S_v = (float *)rad__alloc_array(&c.allocator, 3 * (size_t)nv, sizeof(float));
-    if (!S_v) return RAD_ERROR_OUT_OF_MEMORY;
-    S_max = S_v + nv;
-    S_area = S_max + nv;
-    /* the bracket: vertex means of H and of S, both area-weighted over the patches at v */
-    r = rad_patches_vertex_values(patches, H, 3, out_vertex_H);
-    if (r == RAD_SUCCESS) r = rad_patches_vertex_values(patches, S, 1, S_v);
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < nv; ++i) S_max[i] = S_area[i] = 0.0f;
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = patches->patches[i].vertices[k];
-                if (S[i] > S_max[v]) S_max[v] = S[i];
-            }
-        for (i = 0; i < nv; ++i) {
-            float scale = S_v[i] > 0.0f ? 1.0f / S_v[i] : 0.0f;
-            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= scale;
-            S_v[i] = 0.0f;
-        }
-        /* S_v: how much the uncovered patches at v see */
-        for (i = 0; i < n; ++i)
-            for (k = 0; k < 3; ++k) {
-                uint32_t v = patches->patches[i].vertices[k];
-                if (S[i] >= 0.75f * S_max[v]) {
-                    S_v[v] += patches->patches[i].area * S[i];
-                    S_area[v] += patches->patches[i].area;
-                }
-            }
-        for (i = 0; i < nv; ++i) {
-            float s_v = S_area[i] > 0.0f ? S_v[i] / S_area[i] : 0.0f;
-            for (k = 0; k < 3; ++k) out_vertex_H[3 * (size_t)i + k] *= s_v;
+    /* per vertex, in double: sums of A H (3 channels), A, A S and the largest S, then A S and
+       A over the uncovered patches. The bracket's S cancels against S_v, so their ratio is
+       taken in double: a row sum too small for its reciprocal in float (1e-38, a denormal)
+       still gives H. */
+    acc = (double *)rad__alloc_array(&c.allocator, 8 * (size_t)nv, sizeof(double));
+    if (!acc) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(acc, 0, 8 * (size_t)nv * sizeof(double));
+    for (i = 0; i < n; ++i) {
+        const rad_patch *p = &patches->patches[i];
+        for (k = 0; k < 3; ++k) {
+            double *a = acc + 8 * (size_t)p->vertices[k];
+            a[0] += (double)p->area * H[3 * (size_t)i];
+            a[1] += (double)p->area * H[3 * (size_t)i + 1];
+            a[2] += (double)p->area * H[3 * (size_t)i + 2];
+            a[3] += p->area;
+            a[4] += (double)p->area * S[i];
+            if (S[i] > a[5]) a[5] = S[i];
         }
     }
-    rad__free(&c.allocator, S_v);
+    /* S_v: how much the uncovered patches at v see */
+    for (i = 0; i < n; ++i) {
+        const rad_patch *p = &patches->patches[i];
+        for (k = 0; k < 3; ++k) {
+            double *a = acc + 8 * (size_t)p->vertices[k];
+            if (S[i] >= 0.75 * a[5]) {
+                a[6] += (double)p->area * S[i];
+                a[7] += p->area;
+            }
+        }
+    }
+    for (i = 0; i < nv && r == RAD_SUCCESS; ++i) {
+        const double *a = acc + 8 * (size_t)i;
+        double ratio = a[4] > 0.0 && a[7] > 0.0 ? (a[6] / a[7]) / (a[4] / a[3]) : 0.0;
+        for (k = 0; k < 3; ++k) {
+            /* ratio is at most the area ratio of the patches at v: only an absurd H overflows */
+            double h = a[3] > 0.0 ? a[k] / a[3] * ratio : 0.0;
+            out_vertex_H[3 * (size_t)i + k] = (float)h;
+            if (!rad__finite(out_vertex_H[3 * (size_t)i + k])) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_patches_vertex_irradiance: the irradiance at vertex %u (%g) does not fit a float",
+                         i, h);
+                r = RAD_ERROR_NON_FINITE;
+            }
+        }
+    }
+    rad__free(&c.allocator, acc);
     return r;
 }
 
