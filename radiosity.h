@@ -1448,7 +1448,8 @@ RAD_API void rad_multibounce_blocks_destroy(rad_multibounce_blocks *blocks);
 RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *blocks, const float *E, float *out,
                                                 rad_output output, const rad_context *ctx);
 /* The decoded matrix in the original order (3 N^2 floats: R, G, B planes) with outliers, for
-   tests and error measurements. Cost: O(N^2). */
+   tests and error measurements. Errors: INVALID_ARGUMENT, NON_FINITE (a decoded entry not
+   finite: a huge scale or outlier of a loaded set). Cost: O(N^2). */
 RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *blocks, float *out_planes,
                                                  const rad_context *ctx);
 
@@ -2216,7 +2217,8 @@ RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, co
    weights of sample_weights (clustered: the area correction on the sample's own cluster, 0 on
    the others), so the power sum_a A_a out_a equals sum_i e_i v_i. sample_values: 3M floats
    (for instance rho_i D_i from the engine's own shadow maps); out: 3N floats.
-   Errors: INVALID_ARGUMENT. O(M). */
+   Errors: INVALID_ARGUMENT, NON_FINITE (an output not finite: a sample value NaN or infinite).
+   O(M). */
 RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out);
 
 /* The source E per patch (3N floats) one of the two ways of UNITS AND CONVENTIONS, through
@@ -2241,7 +2243,7 @@ RAD_API uint32_t rad_vp_gather_point(const rad_virtual_patches *vp, const float 
 
 /* The same at 'count' points (3 floats each) with unit normals, in parallel through
    ctx->parallel_for. out: 3 * count floats. Errors: INVALID_ARGUMENT, NON_FINITE (a point or
-   normal). */
+   normal, or an output: a value the point uses is NaN or infinite). */
 RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *values, const float *points,
                                  const float *normals, uint32_t count, float *out, const rad_context *ctx);
 
@@ -2281,7 +2283,8 @@ RAD_API rad_result rad_vp_gather_table_create(const rad_virtual_patches *vp, con
 RAD_API rad_result rad_vp_gather_table_mesh(const rad_virtual_patches *vp, const rad_mesh_desc *mesh, const rad_context *ctx,
                                             rad_vp_gather_table **out);
 /* out (3 * count floats) = the table times values (3N floats, per patch: B, L or H), in
-   parallel through ctx->parallel_for. Errors: INVALID_ARGUMENT (NULL). Cost: O(entries). */
+   parallel through ctx->parallel_for. Errors: INVALID_ARGUMENT (NULL), NON_FINITE (an output:
+   a value a point uses is NaN or infinite). Cost: O(entries), plus one pass over out. */
 RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, const float *values, float *out,
                                              const rad_context *ctx);
 RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table);
@@ -2536,7 +2539,8 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lightmap, const rad_p
 /* Direct irradiance (rad_direct_irradiance with these lights and options) averaged over each
    texel's valid samples, ADDED to out (3 floats per texel: an RGB irradiance lightmap);
    texels without a valid sample are left as they are. Errors: those of
-   rad_direct_irradiance, OUT_OF_MEMORY. */
+   rad_direct_irradiance, NON_FINITE (a value of out not finite after the sum, including one
+   the caller passed in), OUT_OF_MEMORY. */
 RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lightmap, const rad_raycaster *raycaster,
                                        const rad_light *lights, uint32_t light_count,
                                        const rad_direct_options *options, float *out, const rad_context *ctx);
@@ -2623,7 +2627,8 @@ RAD_API void rad_lightmap_weights_destroy(rad_lightmap_weights *weights);
    are left as they are (the gutters keep their dilated values). patch_irradiance: 3N floats.
    Two passes through ctx->parallel_for (vertices, then rows in contiguous blocks), with a
    scratch of 3 floats per vertex from the context's allocator. Deterministic whatever the
-   thread count. Errors: INVALID_ARGUMENT, OUT_OF_MEMORY. */
+   thread count. Errors: INVALID_ARGUMENT, NON_FINITE (a texel it wrote is not finite: a patch
+   irradiance NaN or infinite, or overflow; the logger names the texel), OUT_OF_MEMORY. */
 RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *weights, const float *patch_irradiance, float *out,
                                         const rad_context *ctx);
 
@@ -2886,7 +2891,7 @@ RAD_API rad_result rad_probes_update(rad_probes *probes, const float *B, const r
 
 /* Irradiance (3 floats, W m^-2) at point p for a surface of normal n (need not be unit),
    interpolated from the probes (SAMPLING above). Errors: INVALID_ARGUMENT (NULL, a zero
-   normal), NON_FINITE (p or n). out is 0 when every probe is disabled. Thread-safe, O(1) on a
+   normal), NON_FINITE (p or n, or a result that is not finite). out is 0 when every probe is disabled. Thread-safe, O(1) on a
    grid, O(probes) with user positions. */
 RAD_API rad_result rad_probes_sample(const rad_probes *probes, const float p[3], const float n[3], float out_rgb[3]);
 
@@ -3988,12 +3993,18 @@ static rad_result rad__check_input(const rad__ctx *c, const char *what, const fl
     return RAD_SUCCESS;
 }
 
+/* The check of every call that returns floats: a success never carries NaN or Inf. A run-time
+   call (a gather, refresh, apply or step) checks what it wrote, not its whole input, so the
+   cost follows the output (a gather at a few points of a large set stays cheap) and an input
+   value that no output uses is harmless. */
 static rad_result rad__check_output(const rad__ctx *c, const char *what, const float *v, size_t n)
 {
     size_t i;
     for (i = 0; i < n; ++i)
         if (!rad__finite(v[i])) {
-            rad__log(c, RAD_LOG_ERROR, "%s: value %llu is %g (overflows float: lights or emission too strong for this scene)",
+            rad__log(c, RAD_LOG_ERROR,
+                     "%s: output value %llu is %g (an input value is NaN or infinite, or the result overflows float: lights "
+                     "or emission too strong for this scene)",
                      what, (unsigned long long)i, (double)v[i]);
             return RAD_ERROR_NON_FINITE;
         }
@@ -12560,9 +12571,9 @@ RAD_API rad_result rad_multibounce_blocks_apply(const rad_multibounce_blocks *b,
 
 RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *b, float *out_planes, const rad_context *ctx)
 {
+    rad__ctx c;
     uint32_t n, bpr, bx, by, t, ch, i;
     size_t nn, nblocks;
-    (void)ctx;
     if (rad__mb_blocks_check(b) != RAD_SUCCESS || !out_planes) return RAD_ERROR_INVALID_ARGUMENT;
     n = b->n;
     nn = (size_t)n * n;
@@ -12594,7 +12605,8 @@ RAD_API rad_result rad_multibounce_blocks_decode(const rad_multibounce_blocks *b
         for (k = b->outlier_offsets[i]; k < b->outlier_offsets[i + 1]; ++k)
             for (ch = 0; ch < 3; ++ch) out_planes[ch * nn + (size_t)i * n + b->outlier_columns[k]] += b->outlier_values[3 * k + ch];
     }
-    return RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    return rad__check_output(&c, "rad_multibounce_blocks_decode", out_planes, 3 * nn);
 }
 
 /* ---- container sections ---- */
@@ -16937,6 +16949,7 @@ RAD_API void rad_vp_system(rad_system *system, const rad_virtual_patches *vp, co
 
 RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const float *sample_values, float *out)
 {
+    rad__ctx c;
     uint32_t v, a, s;
     int k;
     if (!vp || !sample_values || !out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -16955,7 +16968,8 @@ RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const floa
             }
             for (k = 0; k < 3; ++k) out[3 * (size_t)p + k] = wsum > 0.0 ? (float)(acc[k] / wsum) : 0.0f;
         }
-    return RAD_SUCCESS;
+    rad__ctx_init(&c, NULL);
+    return rad__check_output(&c, "rad_vp_from_samples", out, 3 * (size_t)vp->count);
 }
 
 RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster, const rad_light *lights,
@@ -17135,7 +17149,7 @@ RAD_API rad_result rad_vp_gather(const rad_virtual_patches *vp, const float *val
     j.count = count;
     j.tasks = c.tasks < count ? c.tasks : count;
     c.parallel_for(c.parallel_user, j.tasks, rad__vp_gather_task, &j);
-    return RAD_SUCCESS;
+    return rad__check_output(&c, "rad_vp_gather", out, 3 * (size_t)count);
 }
 
 /* a mesh's vertex positions and unit normals (its own, or the area-weighted mean of its
@@ -17367,7 +17381,7 @@ RAD_API rad_result rad_vp_gather_table_apply(const rad_vp_gather_table *table, c
     j.tasks = rad__frame_tasks(&c, j.tasks, 1.5 * (double)table->offsets[table->count]);
     if (j.tasks <= 1) rad__vp_table_task(&j, 0); /* a small mesh: no thread wake-up at all */
     else c.parallel_for(c.parallel_user, j.tasks, rad__vp_table_task, &j);
-    return RAD_SUCCESS;
+    return rad__check_output(&c, "rad_vp_gather_table_apply", out, 3 * (size_t)table->count);
 }
 
 /* ---- dynamic lights ---- */
@@ -18657,6 +18671,7 @@ RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lm, const rad_raycast
             for (k = 0; k < 3; ++k) out[3 * (size_t)texel + k] += (float)(sum[k] / (double)(b - a));
             a = b;
         }
+        r = rad__check_output(&c, "lightmap direct", out, 3 * (size_t)lm->width * lm->height);
     }
 done:
     {
@@ -19006,6 +19021,19 @@ RAD_API rad_result rad_lightmap_refresh(const rad_lightmap_weights *W, const flo
     /* stage 2: a task per block of at least RAD__LM_REFRESH_GRAIN entries */
     rad__lm_refresh_stage(&c, &f, 2, (W->row_first[W->row_count] + (uint64_t)W->row_count) / RAD__LM_REFRESH_GRAIN + 1u);
     rad__free(&c.allocator, f.V);
+    {
+        /* the texels it wrote (the others keep the caller's values) */
+        uint32_t i;
+        for (i = 0; i < W->row_count; ++i)
+            if (!rad__finite3(out + 3 * (size_t)W->row_texels[i])) {
+                const float *o = out + 3 * (size_t)W->row_texels[i];
+                rad__log(&c, RAD_LOG_ERROR,
+                         "lightmap refresh: texel %u is (%g %g %g) (a patch irradiance is NaN or infinite, or the result "
+                         "overflows float)",
+                         W->row_texels[i], (double)o[0], (double)o[1], (double)o[2]);
+                return RAD_ERROR_NON_FINITE;
+            }
+    }
     return RAD_SUCCESS;
 }
 
@@ -20382,6 +20410,11 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
         for (k = 0; k < 3; ++k) v[k] = v[k] < a.lo[k] ? a.lo[k] : (v[k] > a.hi[k] ? a.hi[k] : v[k]);
     }
     for (k = 0; k < 3; ++k) out_rgb[k] = v[k] > 0.0f ? v[k] : 0.0f;
+    if (!rad__finite3(out_rgb)) {
+        rad__ctx c;
+        rad__ctx_init(&c, NULL);
+        return rad__check_output(&c, "probes sample", out_rgb, 3);
+    }
     return RAD_SUCCESS;
 }
 

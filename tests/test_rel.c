@@ -66,8 +66,160 @@ static void rl_test_vertex_irradiance_tiny_rows(void)
     rad_scene_destroy(scene);
 }
 
+/* the last error the library logged (the tests check that it names the call and the place) */
+static char rl_log_last[512];
+static void rl_log(void *user, rad_log_level level, const char *message)
+{
+    (void)user;
+    if (level == RAD_LOG_ERROR) snprintf(rl_log_last, sizeof(rl_log_last), "%s", message);
+}
+
+/* the two rooms of fixtures.h (floor lightmapped) with a BVH and patches */
+typedef struct rl_rooms {
+    lm_soup room, wall, lamp;
+    rad_mesh_desc m[3];
+    rad_material mats[2];
+    rad_scene_desc d;
+    rad_scene *S;
+    rad_bvh *bvh;
+    rad_raycaster rc;
+    rad_patches *P;
+} rl_rooms;
+
+static int rl_rooms_make(rl_rooms *w)
+{
+    rad_patch_options po;
+    memset(w, 0, sizeof(*w));
+    fx_two_rooms(&w->room, &w->wall, &w->lamp, w->m, &w->d, w->mats);
+    if (rad_scene_create(&w->d, NULL, &w->S) != RAD_SUCCESS || rad_bvh_create(w->S, NULL, &w->bvh) != RAD_SUCCESS) return 0;
+    rad_bvh_raycaster(w->bvh, &w->rc);
+    rad_patch_options_default(&po);
+    po.max_edge = 0.5f;
+    return rad_patches_create(w->S, &po, NULL, &w->P) == RAD_SUCCESS;
+}
+
+static void rl_rooms_free(rl_rooms *w)
+{
+    rad_patches_destroy(w->P);
+    rad_bvh_destroy(w->bvh);
+    rad_scene_destroy(w->S);
+}
+
+static int rl_all_finite(const float *v, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+/* rad_lightmap_refresh: finite patch irradiance gives finite texels; a NaN or an Inf in the
+   patch that the first row's first vertex reads is refused (NON_FINITE, the texel named),
+   not returned as a lightmap with NaN texels. */
+static void rl_test_lightmap_refresh_nonfinite(void)
+{
+    static const float bad[2] = { NAN, INFINITY };
+    rl_rooms w;
+    rad_lightmap *lm = NULL;
+    rad_lightmap_options lo;
+    rad_lightmap_weights *W = NULL;
+    rad_context ctx;
+    float *H = NULL, *out = NULL;
+    uint32_t i, p, b;
+    if (!rl_rooms_make(&w)) { CHECK(!"rooms"); rl_rooms_free(&w); return; }
+    memset(&ctx, 0, sizeof ctx);
+    ctx.log = rl_log;
+    rad_lightmap_options_default(&lo);
+    lo.width = lo.height = 32;
+    CHECK_OK(rad_lightmap_create(w.S, &w.rc, &lo, NULL, &lm));
+    if (lm) CHECK_OK(rad_lightmap_weights_create(lm, w.P, NULL, NULL, NULL, &W));
+    H = (float *)malloc(sizeof(float) * 3 * w.P->count);
+    out = (float *)calloc(3 * 32 * 32, sizeof(float));
+    if (W && H && out && W->row_count > 0) {
+        for (i = 0; i < 3 * w.P->count; ++i) H[i] = 1.0f;
+        CHECK_OK(rad_lightmap_refresh(W, H, out, &ctx));
+        CHECK(rl_all_finite(out, 3 * 32 * 32));
+        p = W->vertex_patches[W->vertex_first[W->entry_vertices[W->row_first[0]]]];
+        for (b = 0; b < 2; ++b) {
+            H[3 * p + 1] = bad[b];
+            rl_log_last[0] = 0;
+            CHECK_RESULT(rad_lightmap_refresh(W, H, out, &ctx), RAD_ERROR_NON_FINITE);
+            CHECK(strstr(rl_log_last, "lightmap refresh: texel") != NULL);
+            H[3 * p + 1] = 1.0f;
+        }
+    } else {
+        CHECK(!"lightmap weights");
+    }
+    free(H);
+    free(out);
+    rad_lightmap_weights_destroy(W);
+    rad_lightmap_destroy(lm);
+    rl_rooms_free(&w);
+}
+
+/* The virtual-patch run-time calls: rad_vp_gather, rad_vp_gather_table_apply and
+   rad_vp_from_samples give finite outputs for finite values and refuse (NON_FINITE) per-patch
+   or per-sample values that are NaN or infinite, where they returned success with NaN. */
+static void rl_test_vp_runtime_nonfinite(void)
+{
+    rl_rooms w;
+    rad_vp_options vo;
+    rad_virtual_patches *vp = NULL;
+    rad_vp_gather_table *tab = NULL;
+    rad_context ctx;
+    float pts[3 * 16], nrm[3 * 16], out[3 * 16], *V = NULL, *S = NULL;
+    uint32_t i;
+    if (!rl_rooms_make(&w)) { CHECK(!"rooms"); rl_rooms_free(&w); return; }
+    memset(&ctx, 0, sizeof ctx);
+    ctx.log = rl_log;
+    rad_vp_options_default(&vo);
+    vo.resolution = 6;
+    vo.face_points = 4;
+    CHECK_OK(rad_vp_create(w.S, &w.rc, &vo, NULL, &vp));
+    for (i = 0; i < 16; ++i) {
+        pts[3 * i] = 0.05f + 0.06f * (float)i;
+        pts[3 * i + 1] = 0.001f;
+        pts[3 * i + 2] = 0.5f;
+        nrm[3 * i] = 0.0f;
+        nrm[3 * i + 1] = 1.0f;
+        nrm[3 * i + 2] = 0.0f;
+    }
+    if (vp) {
+        V = (float *)malloc(sizeof(float) * 3 * vp->count);
+        S = (float *)malloc(sizeof(float) * 3 * vp->sample_count);
+        CHECK_OK(rad_vp_gather_table_create(vp, pts, nrm, 16, NULL, &tab));
+    }
+    if (vp && V && S && tab) {
+        for (i = 0; i < 3 * vp->count; ++i) V[i] = 1.0f;
+        for (i = 0; i < 3 * vp->sample_count; ++i) S[i] = 1.0f;
+        CHECK_OK(rad_vp_gather(vp, V, pts, nrm, 16, out, &ctx));
+        CHECK(rl_all_finite(out, 48));
+        CHECK_OK(rad_vp_gather_table_apply(tab, V, out, &ctx));
+        CHECK(rl_all_finite(out, 48));
+        CHECK_OK(rad_vp_from_samples(vp, S, V));
+        for (i = 0; i < 3 * vp->count; ++i) V[i] = NAN;
+        rl_log_last[0] = 0;
+        CHECK_RESULT(rad_vp_gather(vp, V, pts, nrm, 16, out, &ctx), RAD_ERROR_NON_FINITE);
+        CHECK(strstr(rl_log_last, "rad_vp_gather") != NULL);
+        rl_log_last[0] = 0;
+        CHECK_RESULT(rad_vp_gather_table_apply(tab, V, out, &ctx), RAD_ERROR_NON_FINITE);
+        CHECK(strstr(rl_log_last, "rad_vp_gather_table_apply") != NULL);
+        S[3 * (vp->sample_count / 2)] = INFINITY;
+        CHECK_RESULT(rad_vp_from_samples(vp, S, V), RAD_ERROR_NON_FINITE);
+    } else {
+        CHECK(!"virtual patches");
+    }
+    free(V);
+    free(S);
+    rad_vp_gather_table_destroy(tab);
+    rad_vp_destroy(vp);
+    rl_rooms_free(&w);
+}
+
 static const rad_test_case tests_rel[] = {
     { "rel_vertex_irradiance_tiny_rows", rl_test_vertex_irradiance_tiny_rows },
+    { "rel_lightmap_refresh_nonfinite", rl_test_lightmap_refresh_nonfinite },
+    { "rel_vp_runtime_nonfinite", rl_test_vp_runtime_nonfinite },
     { NULL, NULL }
 };
 
