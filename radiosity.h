@@ -660,7 +660,11 @@ RAD_API void rad_embree_raycaster(const rad_embree *embree, rad_raycaster *out);
 RAD_API size_t rad_embree_memory(const rad_embree *embree);
 
 /* A camera ray through the point (px, py) of a width x height image, px right, py down,
-   pixel centres at +0.5. dir is unit, tmin 0, tmax +huge. */
+   pixel centres at +0.5. dir is unit, tmin 0, tmax +huge. The view direction (target -
+   position) and up are normalised in double where float would overflow or underflow, so
+   any finite camera of non-zero view direction gives the right ray; a camera with target ==
+   position or up parallel to the view has no frame (dir is then zero or meaningless: check
+   such a camera before rendering). */
 RAD_API void rad_camera_ray(const rad_camera *camera, uint32_t width, uint32_t height, float px, float py,
                             rad_ray *out);
 
@@ -686,7 +690,8 @@ typedef struct rad_light {
     rad_light_type type;
     float color[3];
     float position[3];         /* point, spot */
-    float direction[3];        /* directional, spot (need not be unit) */
+    float direction[3];        /* directional, spot: any finite non-zero length (normalised in
+                                  double where float overflows; zero: INVALID_ARGUMENT) */
     rad_falloff falloff;       /* point, spot */
     float min_distance;        /* point, spot: d is clamped from below to this (0: 1e-6 of
                                   the scene diagonal) */
@@ -2889,9 +2894,9 @@ RAD_API void rad_probes_destroy(rad_probes *probes);
    overflows). Cost: O(entries) (rad_probes_entry_count), parallel over probes, no ray. */
 RAD_API rad_result rad_probes_update(rad_probes *probes, const float *B, const rad_context *ctx);
 
-/* Irradiance (3 floats, W m^-2) at point p for a surface of normal n (need not be unit),
-   interpolated from the probes (SAMPLING above). Errors: INVALID_ARGUMENT (NULL, a zero
-   normal), NON_FINITE (p or n, or a result that is not finite). out is 0 when every probe is disabled. Thread-safe, O(1) on a
+/* Irradiance (3 floats, W m^-2) at point p for a surface of normal n (need not be unit: any
+   finite non-zero length), interpolated from the probes (SAMPLING above). Errors:
+   INVALID_ARGUMENT (NULL, a zero normal), NON_FINITE (p or n, or a result that is not finite). out is 0 when every probe is disabled. Thread-safe, O(1) on a
    grid, O(probes) with user positions. */
 RAD_API rad_result rad_probes_sample(const rad_probes *probes, const float p[3], const float n[3], float out_rgb[3]);
 
@@ -4020,10 +4025,47 @@ static void rad__cross(float *o, const float *a, const float *b)
     o[0] = x; o[1] = y; o[2] = z;
 }
 static float rad__len(const float *a) { return (float)sqrt((double)rad__dot(a, a)); }
+/* Scales a to unit length (a zero or non-finite a is left as it is). A vector whose squared
+   length is a normal float takes the float path; one whose squared length overflows (a
+   component above about 1.8e19) or underflows is scaled in double instead, so it keeps its
+   direction rather than becoming zero. */
 static void rad__normalize(float *a)
 {
-    float l = rad__len(a);
-    if (l > 0.0f) { a[0] /= l; a[1] /= l; a[2] /= l; }
+    float d = rad__dot(a, a);
+    if (d >= FLT_MIN && d <= FLT_MAX) {
+        float l = (float)sqrt((double)d);
+        a[0] /= l; a[1] /= l; a[2] /= l;
+    } else {
+        double l = sqrt((double)a[0] * a[0] + (double)a[1] * a[1] + (double)a[2] * a[2]);
+        if (l > 0.0 && l - l == 0.0) {
+            a[0] = (float)(a[0] / l); a[1] = (float)(a[1] / l); a[2] = (float)(a[2] / l);
+        }
+    }
+}
+
+/* Every direction or normal a caller gives (light and spot directions, normals of points,
+   of probe samples and of shading): finite (else NON_FINITE) and of non-zero length (else
+   INVALID_ARGUMENT), logged as "what [index] is (x y z)" (index RAD_NONE: none). The length
+   is taken in double, so any finite non-zero vector passes, however long or short, and its
+   unit vector goes to unit (NULL: only checked). */
+static rad_result rad__user_vector(const rad__ctx *c, const char *what, uint32_t index, const float v[3], float unit[3])
+{
+    double len;
+    char at[16] = "";
+    int k;
+    if (index != RAD_NONE) snprintf(at, sizeof(at), " %u", index);
+    if (!rad__finite3(v)) {
+        rad__log(c, RAD_LOG_ERROR, "%s%s is (%g %g %g): not finite", what, at, (double)v[0], (double)v[1], (double)v[2]);
+        return RAD_ERROR_NON_FINITE;
+    }
+    len = sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);
+    if (!(len > 0.0)) {
+        rad__log(c, RAD_LOG_ERROR, "%s%s is (0 0 0): a direction must have a non-zero length", what, at);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (unit)
+        for (k = 0; k < 3; ++k) unit[k] = (float)((double)v[k] / len);
+    return RAD_SUCCESS;
 }
 
 /* A pinhole camera's unit frame (forward f, right r = f x up, up u = r x f) and the tangent
@@ -4031,9 +4073,16 @@ static void rad__normalize(float *a)
    and rad_local_visible). */
 static float rad__camera_frame(const rad_camera *cam, float f[3], float r[3], float u[3])
 {
-    rad__sub(f, cam->target, cam->position);
-    rad__normalize(f);
-    rad__cross(r, f, cam->up);
+    float up[3];
+    double d[3], len;
+    int k;
+    /* target - position in double: far-apart points (1e38 each way) still give the direction */
+    for (k = 0; k < 3; ++k) d[k] = (double)cam->target[k] - (double)cam->position[k];
+    len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (k = 0; k < 3; ++k) f[k] = len > 0.0 ? (float)(d[k] / len) : 0.0f;
+    memcpy(up, cam->up, sizeof(up));
+    rad__normalize(up); /* a long up vector would overflow the cross product */
+    rad__cross(r, f, up);
     rad__normalize(r);
     rad__cross(u, r, f);
     return (float)tan(0.5 * (double)cam->fov_y_degrees * RAD__PI / 180.0);
@@ -6872,10 +6921,14 @@ static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const ra
         }
         if ((int)li->type < 0 || (int)li->type > RAD_LIGHT_SKY || (li->falloff != RAD_FALLOFF_QUADRATIC && li->falloff != RAD_FALLOFF_LINEAR) ||
             li->min_distance < 0.0f ||
-            ((li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_SPOT) && rad__dot(li->direction, li->direction) == 0.0f) ||
             (li->type == RAD_LIGHT_SPOT && (li->inner_angle < 0.0f || li->outer_angle < li->inner_angle || li->outer_angle > (float)RAD__PI))) {
-            rad__log(c, RAD_LOG_ERROR, "light %u: bad type, falloff, direction or spot angles", l);
+            rad__log(c, RAD_LOG_ERROR, "light %u: bad type, falloff or spot angles", l);
             return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_SPOT) {
+            char name[48];
+            snprintf(name, sizeof(name), "light %u (%s) direction", l, li->type == RAD_LIGHT_SPOT ? "spot" : "directional");
+            if (rad__user_vector(c, name, RAD_NONE, li->direction, NULL) != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
         }
     }
     d->S = S;
@@ -6898,14 +6951,11 @@ static rad_result rad__unit_normals(const rad__ctx *c, const char *what, const f
             return RAD_ERROR_NON_FINITE;
         }
     for (i = 0; i < count; ++i) {
-        const float *n = normals + 3 * (size_t)(first + i);
-        double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-        int k;
-        if (!(len > 0.0) || len - len != 0.0) {
-            rad__log(c, RAD_LOG_ERROR, "%s: the normal of point %u has length %g (must be non-zero)", what, first + i, len);
-            return RAD_ERROR_INVALID_ARGUMENT;
-        }
-        for (k = 0; k < 3; ++k) unit[3 * (size_t)i + (size_t)k] = (float)((double)n[k] / len);
+        char name[128];
+        rad_result r;
+        snprintf(name, sizeof(name), "%s: the normal of point", what);
+        r = rad__user_vector(c, name, first + i, normals + 3 * (size_t)(first + i), unit + 3 * (size_t)i);
+        if (r != RAD_SUCCESS) return r;
     }
     return RAD_SUCCESS;
 }
@@ -20356,11 +20406,17 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
     rad__probe_acc a;
     uint32_t i;
     int k;
+    rad__ctx c;
+    rad_result r;
     if (!pr || !p || !n || !out_rgb) return RAD_ERROR_INVALID_ARGUMENT;
     out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
-    if (!rad__finite3(p) || !rad__finite3(n)) return RAD_ERROR_NON_FINITE;
+    rad__ctx_init(&c, NULL);
+    if (!rad__finite3(p)) {
+        rad__log(&c, RAD_LOG_ERROR, "probes sample: the point is not finite");
+        return RAD_ERROR_NON_FINITE;
+    }
+    if ((r = rad__user_vector(&c, "probes sample: the normal", RAD_NONE, n, NULL)) != RAD_SUCCESS) return r;
     un[0] = n[0]; un[1] = n[1]; un[2] = n[2];
-    if (!(rad__dot(un, un) > 0.0f)) return RAD_ERROR_INVALID_ARGUMENT;
     rad__normalize(un);
     memset(&a, 0, sizeof(a));
     if (pr->grid) {
@@ -20410,12 +20466,7 @@ static rad_result rad__probes_sample(const rad_probes *pr, const rad_raycaster *
         for (k = 0; k < 3; ++k) v[k] = v[k] < a.lo[k] ? a.lo[k] : (v[k] > a.hi[k] ? a.hi[k] : v[k]);
     }
     for (k = 0; k < 3; ++k) out_rgb[k] = v[k] > 0.0f ? v[k] : 0.0f;
-    if (!rad__finite3(out_rgb)) {
-        rad__ctx c;
-        rad__ctx_init(&c, NULL);
-        return rad__check_output(&c, "probes sample", out_rgb, 3);
-    }
-    return RAD_SUCCESS;
+    return rad__check_output(&c, "probes sample", out_rgb, 3);
 }
 
 RAD_API rad_result rad_probes_sample(const rad_probes *pr, const float p[3], const float n[3], float out_rgb[3])
@@ -20883,19 +20934,9 @@ static void rad__shade(const rad_shading_gpu *g, const float *l, const float *v,
 /* normalizes src into dst; 0 on a zero or non-finite vector (result set) */
 static rad_result rad__shading_unit(const rad__ctx *c, const char *what, const float *src, float *dst)
 {
-    double len;
-    int k;
-    if (!rad__finite3(src)) {
-        rad__log(c, RAD_LOG_ERROR, "shading: vector %s is not finite", what);
-        return RAD_ERROR_NON_FINITE;
-    }
-    len = sqrt((double)src[0] * src[0] + (double)src[1] * src[1] + (double)src[2] * src[2]);
-    if (!(len > 1e-30)) {
-        rad__log(c, RAD_LOG_ERROR, "shading: vector %s has zero length", what);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    for (k = 0; k < 3; ++k) dst[k] = (float)(src[k] / len);
-    return RAD_SUCCESS;
+    char name[64];
+    snprintf(name, sizeof(name), "shading: vector %s", what);
+    return rad__user_vector(c, name, RAD_NONE, src, dst);
 }
 
 static rad_result rad__shading_entry(const rad_shading *s, const float *l, const float *v, const float *n,

@@ -216,10 +216,142 @@ static void rl_test_vp_runtime_nonfinite(void)
     rl_rooms_free(&w);
 }
 
+/* the floor irradiance sum of one light at 64 floor points of the Cornell box (-1: refused) */
+static double rl_floor_light(const rad_scene *S, const rad_raycaster *rc, const rad_light *L, rad_result *res)
+{
+    float p[3 * 64], n[3 * 64], e[3 * 64];
+    rad_direct_options o;
+    rad_context ctx;
+    double sum = 0.0;
+    int i;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.log = rl_log;
+    for (i = 0; i < 64; ++i) {
+        p[3 * i] = S->bounds_min[0] + (S->bounds_max[0] - S->bounds_min[0]) * ((float)(i % 8) + 0.5f) / 8.0f;
+        p[3 * i + 1] = S->bounds_min[1] + 1e-4f;
+        p[3 * i + 2] = S->bounds_min[2] + (S->bounds_max[2] - S->bounds_min[2]) * ((float)(i / 8) + 0.5f) / 8.0f;
+        n[3 * i] = 0.0f;
+        n[3 * i + 1] = 1.0f;
+        n[3 * i + 2] = 0.0f;
+    }
+    rad_direct_options_default(&o);
+    o.include_emitters = 0;
+    *res = rad_direct_irradiance(S, rc, L, 1, &o, p, n, 64, e, &ctx);
+    if (*res != RAD_SUCCESS) return -1.0;
+    for (i = 0; i < 64; ++i) sum += e[3 * i];
+    return sum;
+}
+
+/* Directions of any finite non-zero length keep their direction: a directional and a spot
+   light whose direction is scaled by 1e20 (its squared length overflows float) or 1e-25
+   (underflows) light the floor exactly as the unit direction does (they gave no light); a
+   zero direction is refused with the light named. */
+static void rl_test_light_direction_scale(void)
+{
+    static const float scales[3] = { 1e20f, 1e-25f, 3e38f };
+    rad_scene_desc d;
+    rad_scene *S = NULL;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_light L;
+    rad_result r;
+    int t, k;
+    rad_cornell_box(&d, NULL);
+    CHECK_OK(rad_scene_create(&d, NULL, &S));
+    if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
+    if (!bvh) { rad_scene_destroy(S); return; }
+    rad_bvh_raycaster(bvh, &rc);
+    for (t = 0; t < 2; ++t) {
+        double unit;
+        memset(&L, 0, sizeof L);
+        L.type = t ? RAD_LIGHT_SPOT : RAD_LIGHT_DIRECTIONAL;
+        L.falloff = RAD_FALLOFF_QUADRATIC;
+        L.color[0] = L.color[1] = L.color[2] = 5.0f;
+        L.position[0] = 0.5f * (S->bounds_min[0] + S->bounds_max[0]);
+        L.position[1] = 0.9f * S->bounds_max[1];
+        L.position[2] = 0.5f * (S->bounds_min[2] + S->bounds_max[2]);
+        L.inner_angle = 0.5f;
+        L.outer_angle = 0.6f;
+        L.direction[1] = -1.0f;
+        L.direction[2] = 0.3f;
+        unit = rl_floor_light(S, &rc, &L, &r);
+        CHECK_OK(r);
+        CHECK(unit > 1.0);
+        for (k = 0; k < 3; ++k) {
+            L.direction[1] = -scales[k];
+            L.direction[2] = 0.3f * scales[k];
+            CHECK_REL(rl_floor_light(S, &rc, &L, &r), unit, 1e-5);
+            CHECK_OK(r);
+        }
+        L.direction[0] = L.direction[1] = L.direction[2] = 0.0f;
+        rl_log_last[0] = 0;
+        CHECK(rl_floor_light(S, &rc, &L, &r) < 0.0);
+        CHECK(r == RAD_ERROR_INVALID_ARGUMENT);
+        CHECK(strstr(rl_log_last, "light 0") && strstr(rl_log_last, "direction"));
+    }
+    rad_bvh_destroy(bvh);
+    rad_scene_destroy(S);
+}
+
+/* rad_probes_sample: a normal of length 1e20 (or 1e-30) samples as the unit normal (it gave
+   0); a zero normal is INVALID_ARGUMENT, a NaN one NON_FINITE. The camera: a target 1e30
+   away and an up vector of length 1e25 give the ray of the unit camera. */
+static void rl_test_probe_normal_camera_scale(void)
+{
+    rad_scene *S;
+    rad_patches *P;
+    rad_bvh *bvh = NULL;
+    rad_raycaster rc;
+    rad_probes *pr = NULL;
+    rad_probe_options pro;
+    rad_scene_desc cd;
+    rad_camera cam, far;
+    rad_ray a, b;
+    float *B, q[3] = { 0.3f, 0.1f, 0.3f }, n1[3] = { 0, 1, 0 }, n2[3] = { 0, 1e20f, 0 }, n3[3] = { 0, 1e-30f, 0 };
+    float n0[3] = { 0, 0, 0 }, nn[3] = { 0, NAN, 0 }, o1[3], o2[3];
+    uint32_t i;
+    int k;
+    if (!rl_cornell_patches(200, &S, &P)) { CHECK(!"cornell patches"); return; }
+    CHECK_OK(rad_bvh_create(S, NULL, &bvh));
+    if (bvh) rad_bvh_raycaster(bvh, &rc);
+    B = (float *)malloc(sizeof(float) * 3 * P->count);
+    if (bvh && B) {
+        for (i = 0; i < 3 * P->count; ++i) B[i] = 1.0f;
+        rad_probe_options_default(&pro);
+        CHECK_OK(rad_probes_create(P, &rc, NULL, 0, NULL, 0, &pro, B, NULL, &pr));
+    }
+    if (pr) {
+        CHECK_OK(rad_probes_sample(pr, q, n1, o1));
+        CHECK(o1[0] > 0.0f);
+        CHECK_OK(rad_probes_sample(pr, q, n2, o2));
+        for (k = 0; k < 3; ++k) CHECK_REL(o2[k], o1[k], 1e-6);
+        CHECK_OK(rad_probes_sample(pr, q, n3, o2));
+        for (k = 0; k < 3; ++k) CHECK_REL(o2[k], o1[k], 1e-6);
+        CHECK_RESULT(rad_probes_sample(pr, q, n0, o2), RAD_ERROR_INVALID_ARGUMENT);
+        CHECK_RESULT(rad_probes_sample(pr, q, nn, o2), RAD_ERROR_NON_FINITE);
+    }
+    rad_cornell_box(&cd, &cam);
+    far = cam;
+    for (k = 0; k < 3; ++k) {
+        far.target[k] = cam.position[k] + 1e30f * (cam.target[k] - cam.position[k]);
+        far.up[k] = 1e25f * cam.up[k];
+    }
+    rad_camera_ray(&cam, 64, 48, 10.5f, 30.5f, &a);
+    rad_camera_ray(&far, 64, 48, 10.5f, 30.5f, &b);
+    for (k = 0; k < 3; ++k) CHECK_NEAR(b.dir[k], a.dir[k], 1e-5);
+    rad_probes_destroy(pr);
+    free(B);
+    rad_bvh_destroy(bvh);
+    rad_patches_destroy(P);
+    rad_scene_destroy(S);
+}
+
 static const rad_test_case tests_rel[] = {
     { "rel_vertex_irradiance_tiny_rows", rl_test_vertex_irradiance_tiny_rows },
     { "rel_lightmap_refresh_nonfinite", rl_test_lightmap_refresh_nonfinite },
     { "rel_vp_runtime_nonfinite", rl_test_vp_runtime_nonfinite },
+    { "rel_light_direction_scale", rl_test_light_direction_scale },
+    { "rel_probe_normal_camera_scale", rl_test_probe_normal_camera_scale },
     { NULL, NULL }
 };
 
