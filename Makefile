@@ -180,9 +180,9 @@ report-quick: $(BUILD)/rad $(BUILD)/temporal
 # One harness: make fuzz FUZZ_HARNESSES=stream
 FUZZ_SECONDS ?= 300
 FUZZ_CC ?= clang
-FUZZ_HARNESSES ?= container scene stream multibounce temporal
+FUZZ_HARNESSES ?= container scene stream multibounce temporal vp
 fuzz: | $(BUILD)
-	mkdir -p $(addprefix $(BUILD)/fuzz/corpus/,container scene stream multibounce temporal)
+	mkdir -p $(addprefix $(BUILD)/fuzz/corpus/,container scene stream multibounce temporal vp)
 	$(CC) -std=c99 -O2 -I. fuzz/make_corpus.c -o $(BUILD)/fuzz/make_corpus -lm
 	./$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus
 	failed=""; for f in $(FUZZ_HARNESSES); do \

@@ -10,7 +10,10 @@
      container holding several objects;
    - temporal: alias tables as saved by rad_alias_tables_sections: compact tables of the
      sparse F, wide tables of the dense F, and the three per-channel tables of F_mb
-     (Fmb.r, Fmb.g, Fmb.b) in one container.
+     (Fmb.r, Fmb.g, Fmb.b) in one container;
+   - vp: virtual-patch sets of the Cornell box as saved by rad_vp_sections (a coarse grid so
+     the inputs stay small): axis-aligned dense, axis-aligned CSR, clustered with cosine
+     weights, and two sets in one container.
    Usage: make_corpus DIR */
 #define RADIOSITY_IMPLEMENTATION
 #include "../radiosity.h"
@@ -131,6 +134,44 @@ static void write_method_seeds(const char *root, const rad_scene *s, const rad_r
     rad_patches_destroy(P);
 }
 
+/* the virtual-patch seeds: coarse sets of the Cornell box (2 voxels along its longest axis, one
+   point per voxel face: inputs of a few kilobytes) */
+static void write_vp_seeds(const char *root, const rad_scene *s, const rad_raycaster *rc)
+{
+    char dir[1024];
+    rad_vp_options o;
+    rad_virtual_patches *aa = NULL, *csr = NULL, *cl = NULL;
+    rad_section sec[2 * RAD_VP_MAX_SECTIONS];
+    uint32_t k, k2;
+    snprintf(dir, sizeof(dir), "%s/vp", root);
+    rad_vp_options_default(&o);
+    o.resolution = 2;
+    o.face_points = 1;
+    o.share_rays = 4;
+    need(rad_vp_create(s, rc, &o, NULL, &aa), "axis-aligned virtual patches");
+    o.storage = RAD_STORAGE_SPARSE;
+    o.drop_threshold = 1e-3f;
+    need(rad_vp_create(s, rc, &o, NULL, &csr), "sparse virtual patches");
+    o.storage = RAD_STORAGE_DENSE;
+    o.drop_threshold = 0.0f;
+    o.kind = RAD_VP_CLUSTERED;
+    o.max_clusters = 3;
+    o.weights = RAD_VP_WEIGHTS_COSINE;
+    need(rad_vp_create(s, rc, &o, NULL, &cl), "clustered virtual patches");
+    need(rad_vp_sections(aa, "vp", sec, &k), "sections");
+    write_sections(dir, "aavp_dense.radb", sec, k);
+    need(rad_vp_sections(csr, "vp", sec, &k), "sections");
+    write_sections(dir, "aavp_csr.radb", sec, k);
+    need(rad_vp_sections(cl, "vp", sec, &k), "sections");
+    write_sections(dir, "clustered.radb", sec, k);
+    need(rad_vp_sections(aa, "a", sec, &k), "sections");
+    need(rad_vp_sections(csr, "b", sec + k, &k2), "sections");
+    write_sections(dir, "two_sets.radb", sec, k + k2);
+    rad_vp_destroy(cl);
+    rad_vp_destroy(csr);
+    rad_vp_destroy(aa);
+}
+
 static void put_f(unsigned char **p, float v) { memcpy(*p, &v, 4); *p += 4; }
 
 int main(int argc, char **argv)
@@ -149,7 +190,7 @@ int main(int argc, char **argv)
     uint32_t i;
     char dir[5][1024];
     static const char *const sub[5] = { "container", "scene", "stream", "multibounce", "temporal" };
-    if (argc != 2) { fprintf(stderr, "usage: make_corpus DIR (with DIR/container, scene, stream, multibounce, temporal)\n"); return 2; }
+    if (argc != 2) { fprintf(stderr, "usage: make_corpus DIR (with DIR/container, scene, stream, multibounce, temporal, vp)\n"); return 2; }
     for (i = 0; i < 5; ++i) snprintf(dir[i], sizeof(dir[i]), "%s/%s", argv[1], sub[i]);
     rad_cornell_box(&d, NULL);
     if (rad_scene_create(&d, NULL, &s) != RAD_SUCCESS) return 1;
@@ -219,6 +260,7 @@ int main(int argc, char **argv)
         rad_patches_destroy(Q);
     }
     write_method_seeds(argv[1], s, &rc);
+    write_vp_seeds(argv[1], s, &rc);
     free(E);
     rad_form_factors_destroy(dense);
     rad_form_factors_destroy(sparse);

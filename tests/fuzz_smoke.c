@@ -1,7 +1,7 @@
 /* fuzz_smoke.c - the libFuzzer harnesses of fuzz/ in one binary, for the short runs of
    tests/run.sh: the implementation is compiled once instead of once per harness (each harness
    includes it, and uses its internal rad__ helpers, so they cannot share an object). The
-   harness code is included unchanged; FUZZ_TARGET=container|scene|stream|multibounce|temporal
+   harness code is included unchanged; FUZZ_TARGET=container|scene|stream|multibounce|temporal|vp
    in the environment picks the one a run drives. make fuzz still builds one binary each. */
 #define _POSIX_C_SOURCE 200809L /* first, as fuzz_stream.c asks: mkstemp, unlink */
 #include <stdint.h>
@@ -39,6 +39,12 @@
 #undef LLVMFuzzerTestOneInput
 #undef exercise
 
+#define LLVMFuzzerTestOneInput fuzz_vp_one
+#define exercise vp_exercise
+#include "../fuzz/fuzz_vp.c"
+#undef LLVMFuzzerTestOneInput
+#undef exercise
+
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -48,7 +54,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     static const struct { const char *name; int (*fn)(const uint8_t *, size_t); } harnesses[] = {
         { "container", fuzz_container_one }, { "scene", fuzz_scene_one }, { "stream", fuzz_stream_one },
-        { "multibounce", fuzz_multibounce_one }, { "temporal", fuzz_temporal_one },
+        { "multibounce", fuzz_multibounce_one }, { "temporal", fuzz_temporal_one }, { "vp", fuzz_vp_one },
     };
     const char *want = getenv("FUZZ_TARGET");
     size_t i;
@@ -57,7 +63,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     for (i = 0; want && i < sizeof(harnesses) / sizeof(harnesses[0]); ++i)
         if (!strcmp(want, harnesses[i].name)) fuzz_smoke_target = harnesses[i].fn;
     if (!fuzz_smoke_target) {
-        fprintf(stderr, "fuzz_smoke: FUZZ_TARGET='%s' names no harness (container scene stream multibounce temporal)\n", want ? want : "");
+        fprintf(stderr, "fuzz_smoke: FUZZ_TARGET='%s' names no harness (container scene stream multibounce temporal vp)\n", want ? want : "");
         exit(2);
     }
     return 0;

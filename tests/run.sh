@@ -468,7 +468,7 @@ s_clang_asan_O1() {
 # libFuzzer smoke runs (the long runs are `make fuzz`, recorded in FUZZING.md); TMPDIR: where
 # fuzz_stream writes its input file (left behind when it crashes). One binary holds every
 # harness (tests/fuzz_smoke.c, FUZZ_TARGET picks one), so the implementation is compiled once.
-FUZZERS="container scene stream multibounce temporal"
+FUZZERS="container scene stream multibounce temporal vp"
 s_fuzz() {
     have clang || return 0
     if [ "$HAVE_FUZZER" != 1 ]; then skip fuzz-smoke "clang has no libFuzzer runtime (package libclang-rt-14-dev)"; return; fi
