@@ -94,7 +94,8 @@
        RAD_ASSERT(x)              assert(x)          implementing file (internal invariants only;
                                                      bad input is an error code, never an assert)
        RAD_NO_STDIO               (undefined)        everywhere: removes rad_save_file and
-                                                     rad_load_file (no <stdio.h> file access)
+                                                     rad_load_file (no <stdio.h> file access,
+                                                     no POSIX file headers)
        RAD_NO_GLSL                (undefined)        implementing file: leaves out the GLSL
                                                      kernels' text (about 60 KB); rad_glsl_name
                                                      and rad_glsl_pieces return NULL and
@@ -3351,8 +3352,17 @@ RAD_API void rad_bake_destroy(rad_bake *bake);
 RAD_API rad_result rad_bake_matches_scene(const rad_bake *bake, const rad_scene *scene, uint64_t options,
                                           const rad_context *ctx);
 #ifndef RAD_NO_STDIO
-/* The same, through a file. Saving writes '<path>.partial' in the same folder and renames it
-   into place only when complete, so a failed save leaves the old file as it was (IO). Loading
+/* The same, through a file. SAVING never writes into path itself: it creates a new
+   temporary file beside it (".rad-XXXXXXXX.tmp" in the same folder, created exclusively, so
+   an existing file or symbolic link of that name is never opened or followed), writes it,
+   flushes it to the disk (fsync on POSIX, also of the folder after the rename) and renames it
+   over path. So path holds the old file or the whole new one, never a part; two processes
+   saving to one path each succeed and the last rename's file stays whole; a failure
+   removes the temporary and leaves the old file as it was (IO, the logger says why). A
+   folder at path is refused (IO), never removed. The new file gets the default permissions
+   (0666 less the umask), not those of the file it replaces. Without POSIX (Windows, bare
+   ISO C) the temporary gets a name checked not to exist (no exclusive create in C99) and,
+   where rename does not replace a file, the old file is removed just before. Loading
    reads the 64-byte header first and refuses a folder (IO), a file without the container
    magic (CORRUPT) or one shorter than its header says (TRUNCATED) before reading the rest. */
 RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, const rad_matrix *F, const float *E,
@@ -3677,6 +3687,21 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #include <stdio.h>
 #include <limits.h>
 #include <stdarg.h>
+#include <time.h>
+/* POSIX file calls for the safe write of rad_save_file (exclusive create, fsync, rename) */
+#if !defined(RAD_NO_STDIO) && (defined(__unix__) || defined(__unix) || (defined(__APPLE__) && defined(__MACH__)))
+#  define RAD__POSIX_FILES 1
+#  include <errno.h>
+#  include <fcntl.h>
+#  include <sys/stat.h>
+#  include <sys/types.h>
+#  include <unistd.h>
+#  ifdef O_NOFOLLOW
+#    define RAD__O_NOFOLLOW O_NOFOLLOW
+#  else
+#    define RAD__O_NOFOLLOW 0 /* O_EXCL alone already refuses a symbolic link */
+#  endif
+#endif
 
 #if defined(RAD_MALLOC) && defined(RAD_REALLOC) && defined(RAD_FREE)
 /* all three given */
@@ -21601,35 +21626,138 @@ RAD_API rad_result rad_load_memory(const void *data, size_t size, const rad_cont
 }
 
 #ifndef RAD_NO_STDIO
-/* Writes 'size' bytes to '<path>.partial' beside path and renames it over path only when
-   every byte is written and closed: a failed save leaves the old file (or none) in place. */
+/* The temporary file of a safe write, into tmp (room for path plus 24): in the destination's
+   folder (so the final rename stays on one file system), named ".rad-XXXXXXXX.tmp", the
+   number a hash of the process, the time, a stack address (one per thread) and the attempt.
+   A name can still be taken: the caller creates it exclusively and tries the next attempt. */
+static void rad__temp_name(const char *path, uint32_t attempt, char *tmp)
+{
+    size_t dir = strlen(path);
+    uint32_t h = 2166136261u, x[5];
+    char local = 0;
+    int k;
+    while (dir > 0 && path[dir - 1] != '/' && path[dir - 1] != '\\') --dir;
+    x[0] = (uint32_t)(uintptr_t)&local;
+    x[1] = (uint32_t)time(NULL);
+    x[2] = (uint32_t)clock();
+    x[3] = (uint32_t)((uint64_t)(uintptr_t)&local >> 32);
+    x[4] = attempt;
+#if defined(RAD__POSIX_FILES)
+    x[0] ^= (uint32_t)getpid() * 2654435761u;
+#endif
+    for (k = 0; k < 20; ++k) h = (h ^ ((x[k / 4] >> (8 * (k % 4))) & 0xFFu)) * 16777619u;
+    memcpy(tmp, path, dir);
+    snprintf(tmp + dir, 19, ".rad-%08x.tmp", (unsigned)h);
+}
+
+/* Writes 'size' bytes to path safely: a new temporary file beside it (created exclusively,
+   so an existing file or symbolic link of that name is never opened), written, flushed to the
+   disk, then renamed over path. A failure removes the temporary and leaves the old file as it
+   was; a folder at path is refused (never removed). POSIX: open(O_CREAT | O_EXCL, and
+   O_NOFOLLOW where defined), fsync of the file and of its folder, rename (atomic: a reader
+   sees the old file or the new one, and of concurrent saves the last rename wins, each a
+   whole file). Elsewhere (ISO C only): a fresh name checked not to exist, fopen, fflush,
+   rename, and where rename does not replace a file (Windows), remove then rename. */
 static rad_result rad__write_file_atomic(const rad__ctx *c, const char *path, const void *data, size_t size)
 {
     size_t len = strlen(path);
-    char *tmp = (char *)rad__alloc(&c->allocator, len + 9u);
-    FILE *f;
-    int ok;
+    char *tmp = (char *)rad__alloc(&c->allocator, len + 24u);
+    uint32_t attempt;
+    int ok = 0, made = 0;
     if (!tmp) {
         rad__log(c, RAD_LOG_ERROR, "saving '%s': out of memory for the temporary name", path);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".partial", 9u);
-    f = fopen(tmp, "wb");
-    if (!f) {
-        rad__log(c, RAD_LOG_ERROR, "cannot open '%s' for writing (the folder must exist and be writable)", tmp);
+    if (len == 0 || path[len - 1] == '/' || path[len - 1] == '\\') {
+        rad__log(c, RAD_LOG_ERROR, "saving '%s': the path names a folder, not a file", path);
         rad__free(&c->allocator, tmp);
         return RAD_ERROR_IO;
     }
-    ok = fwrite(data, 1, size, f) == size;
-    ok = (fclose(f) == 0) && ok;
-    if (ok && rename(tmp, path) != 0) {
-        /* where rename does not replace an existing file (Windows), replace it by hand */
-        ok = remove(path) == 0 && rename(tmp, path) == 0;
+#if defined(RAD__POSIX_FILES)
+    {
+        struct stat st;
+        int fd = -1;
+        const unsigned char *p = (const unsigned char *)data;
+        size_t left = size;
+        if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+            rad__log(c, RAD_LOG_ERROR, "saving '%s': that is a folder (it is left as it is): choose a file name", path);
+            rad__free(&c->allocator, tmp);
+            return RAD_ERROR_IO;
+        }
+        for (attempt = 0; attempt < 64 && fd < 0; ++attempt) {
+            rad__temp_name(path, attempt, tmp);
+            fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | RAD__O_NOFOLLOW, 0666);
+            if (fd < 0 && errno != EEXIST && errno != EINTR) break;
+        }
+        if (fd < 0) {
+            rad__log(c, RAD_LOG_ERROR, "saving '%s': cannot create a temporary file beside it (%s): the folder must exist and be writable",
+                     path, strerror(errno));
+            rad__free(&c->allocator, tmp);
+            return RAD_ERROR_IO;
+        }
+        made = 1;
+        ok = 1;
+        while (ok && left > 0) {
+            size_t chunk = left < ((size_t)1 << 30) ? left : ((size_t)1 << 30);
+            ssize_t w = write(fd, p, chunk);
+            if (w < 0 && errno == EINTR) continue;
+            if (w <= 0) ok = 0;
+            else { p += w; left -= (size_t)w; }
+        }
+        if (ok && fsync(fd) != 0) ok = 0;
+        if (close(fd) != 0) ok = 0;
+        if (ok && rename(tmp, path) != 0) ok = 0;
+        if (ok) {
+            /* the rename itself reaches the disk with the folder's entry */
+            size_t dir = strlen(path);
+            while (dir > 0 && path[dir - 1] != '/') --dir;
+            if (dir == 0) {
+                memcpy(tmp, ".", 2u);
+            } else {
+                memcpy(tmp, path, dir);
+                tmp[dir > 1 ? dir - 1 : 1] = '\0'; /* "a/b/" -> "a/b", "/" stays */
+            }
+            fd = open(tmp, O_RDONLY);
+            if (fd >= 0) {
+                (void)fsync(fd);
+                (void)close(fd);
+            }
+            made = 0;
+        }
     }
+#else
+    {
+        FILE *f = NULL;
+        for (attempt = 0; attempt < 64 && !f; ++attempt) {
+            FILE *probe;
+            rad__temp_name(path, attempt, tmp);
+            if ((probe = fopen(tmp, "rb")) != NULL) { /* taken: another name */
+                fclose(probe);
+                continue;
+            }
+            f = fopen(tmp, "wb");
+            if (!f) break;
+        }
+        if (!f) {
+            rad__log(c, RAD_LOG_ERROR, "saving '%s': cannot create a temporary file beside it: the folder must exist and be writable", path);
+            rad__free(&c->allocator, tmp);
+            return RAD_ERROR_IO;
+        }
+        made = 1;
+        ok = fwrite(data, 1, size, f) == size;
+        ok = fflush(f) == 0 && ok;
+        ok = (fclose(f) == 0) && ok;
+        if (ok && rename(tmp, path) != 0) {
+            /* where rename does not replace an existing file (Windows), replace it by hand;
+               remove() deletes files only, so a folder at path stays and the save fails */
+            ok = remove(path) == 0 && rename(tmp, path) == 0;
+        }
+        if (ok) made = 0;
+    }
+#endif
     if (!ok) {
-        remove(tmp);
-        rad__log(c, RAD_LOG_ERROR, "cannot write '%s' (disk full or not writable): the old file, if any, is unchanged", path);
+        if (made) remove(tmp);
+        rad__log(c, RAD_LOG_ERROR, "cannot write '%s' (disk full, not writable, or a folder): the old file, if any, is unchanged", path);
     }
     rad__free(&c->allocator, tmp);
     return ok ? RAD_SUCCESS : RAD_ERROR_IO;

@@ -346,12 +346,136 @@ static void rl_test_probe_normal_camera_scale(void)
     rad_scene_destroy(S);
 }
 
+#if !defined(RAD_NO_STDIO) && defined(__unix__)
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <dirent.h>
+#include <unistd.h>
+int symlink(const char *target, const char *linkpath); /* POSIX; strict C99 hides it */
+
+/* entries of folder 'dir' whose name starts with ".rad-" (temporaries left behind) */
+static int rl_temporaries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    int n = 0;
+    if (!d) return -1;
+    while ((e = readdir(d)) != NULL) n += strncmp(e->d_name, ".rad-", 5) == 0;
+    closedir(d);
+    return n;
+}
+
+/* the patch count of the bake at path (0: it does not load) */
+static uint32_t rl_bake_count(const char *path)
+{
+    rad_bake *b = NULL;
+    uint32_t n = 0;
+    if (rad_load_file(path, NULL, &b) == RAD_SUCCESS) n = b->patches.count;
+    rad_bake_destroy(b);
+    return n;
+}
+
+/* rad_save_file writes through a new temporary created exclusively beside path, then renames:
+   - a symbolic link at the name the writer once used ('<path>.partial') is not followed: the
+     file it points to keeps its bytes;
+   - an empty folder at path is refused (IO, the logger names it) and still exists after;
+   - a path in a missing folder is IO and creates nothing;
+   - saving over a bake replaces it, and no temporary is left in the folder;
+   - two processes saving different bakes to one path, 6 rounds: both succeed and the file
+     left is one of the two, whole (with a shared temporary a loser removed the winner's
+     file, or the two writes mixed). */
+static void rl_test_save_file_safe(void)
+{
+    rad_scene *S;
+    rad_patches *P1, *P2 = NULL;
+    rad_patch_options po;
+    rad_context ctx;
+    rad_matrix F2;
+    float *dense = NULL;
+    char dir[512], path[600], link[620], victim[600], folder[600], missing[600], text[32] = { 0 };
+    struct stat st;
+    FILE *f;
+    int round;
+    if (!rl_cornell_patches(60, &S, &P1)) { CHECK(!"cornell patches"); return; }
+    rad_patch_options_default(&po);
+    po.target_count = rad_test_quick() ? 400 : 800;
+    CHECK_OK(rad_patches_create(S, &po, NULL, &P2));
+    memset(&F2, 0, sizeof F2);
+    memset(&ctx, 0, sizeof ctx);
+    ctx.log = rl_log;
+    snprintf(dir, sizeof dir, "%s", rad_test_path("rel_save"));
+    (void)mkdir(dir, 0755);
+    snprintf(path, sizeof path, "%s/out.radb", dir);
+    snprintf(link, sizeof link, "%s.partial", path);
+    snprintf(victim, sizeof victim, "%s/victim.txt", dir);
+    snprintf(folder, sizeof folder, "%s/folder.radb", dir);
+    snprintf(missing, sizeof missing, "%s/no/such/folder.radb", dir);
+    remove(path);
+    remove(link);
+    if (!P2 || !(dense = (float *)calloc((size_t)P2->count * P2->count, sizeof(float)))) goto done;
+    F2.dense = dense;
+    F2.rows = F2.cols = P2->count;
+    F2.storage = RAD_STORAGE_DENSE;
+    f = fopen(victim, "wb");
+    if (f) { fputs("precious", f); fclose(f); }
+    CHECK(symlink(victim, link) == 0);
+    CHECK_OK(rad_save_file(path, P1, NULL, NULL, NULL, &ctx));
+    f = fopen(victim, "rb");
+    if (f) { CHECK(fread(text, 1, 8, f) == 8); fclose(f); }
+    CHECK(strcmp(text, "precious") == 0);
+    CHECK(rl_bake_count(path) == P1->count);
+    /* a folder at path */
+    (void)mkdir(folder, 0755);
+    rl_log_last[0] = 0;
+    CHECK_RESULT(rad_save_file(folder, P1, NULL, NULL, NULL, &ctx), RAD_ERROR_IO);
+    CHECK(strstr(rl_log_last, "folder.radb") && strstr(rl_log_last, "folder"));
+    CHECK(stat(folder, &st) == 0 && S_ISDIR(st.st_mode));
+    (void)rmdir(folder);
+    /* a missing folder */
+    CHECK_RESULT(rad_save_file(missing, P1, NULL, NULL, NULL, &ctx), RAD_ERROR_IO);
+    CHECK(stat(missing, &st) != 0);
+    /* replacing, nothing left behind */
+    CHECK_OK(rad_save_file(path, P2, &F2, NULL, NULL, &ctx));
+    CHECK(rl_bake_count(path) == P2->count);
+    CHECK(rl_temporaries(dir) == 0);
+    /* two processes, one path */
+    fflush(NULL);
+    for (round = 0; round < 6; ++round) {
+        pid_t a, b;
+        int sa = 1, sb = 1;
+        uint32_t n;
+        remove(path);
+        if ((a = fork()) == 0) _exit(rad_save_file(path, P2, &F2, NULL, NULL, NULL) != RAD_SUCCESS);
+        if ((b = fork()) == 0) _exit(rad_save_file(path, P1, NULL, NULL, NULL, NULL) != RAD_SUCCESS);
+        if (a > 0) waitpid(a, &sa, 0);
+        if (b > 0) waitpid(b, &sb, 0);
+        CHECK(a > 0 && b > 0 && WIFEXITED(sa) && WEXITSTATUS(sa) == 0 && WIFEXITED(sb) && WEXITSTATUS(sb) == 0);
+        n = rl_bake_count(path);
+        CHECK(n == P1->count || n == P2->count);
+    }
+    CHECK(rl_temporaries(dir) == 0);
+done:
+    remove(path);
+    remove(link);
+    remove(victim);
+    remove(folder);
+    (void)rmdir(dir);
+    free(dense);
+    rad_patches_destroy(P2);
+    rad_patches_destroy(P1);
+    rad_scene_destroy(S);
+}
+#endif
+
 static const rad_test_case tests_rel[] = {
     { "rel_vertex_irradiance_tiny_rows", rl_test_vertex_irradiance_tiny_rows },
     { "rel_lightmap_refresh_nonfinite", rl_test_lightmap_refresh_nonfinite },
     { "rel_vp_runtime_nonfinite", rl_test_vp_runtime_nonfinite },
     { "rel_light_direction_scale", rl_test_light_direction_scale },
     { "rel_probe_normal_camera_scale", rl_test_probe_normal_camera_scale },
+#if !defined(RAD_NO_STDIO) && defined(__unix__)
+    { "rel_save_file_safe", rl_test_save_file_safe },
+#endif
     { NULL, NULL }
 };
 
