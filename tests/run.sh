@@ -224,6 +224,16 @@ s_compile() {
     fi
 }
 
+# what is written twice stays the same: docs/api.md is the header's index, the QUICK START
+# comment is examples/quickstart.c (tests/check_docs.sh says the command that fixes each)
+s_docs() {
+    local doc
+    for doc in api quickstart; do
+        if bash tests/check_docs.sh $doc >"$BUILD/check-docs-$doc.out" 2>&1; then pass "docs-$doc-current"
+        else sed "s/^/    /" "$BUILD/check-docs-$doc.out"; fail "docs-$doc-current"; fi
+    done
+}
+
 # The examples call only the API: each is compiled with
 # RADIOSITY_IMPLEMENTATION_INCLUDED predefined (so its own #define RADIOSITY_IMPLEMENTATION brings
 # in the declarations only) and linked with one object that holds the implementation, compiled
@@ -540,6 +550,7 @@ stage clang s_clang
 stage unit-avx s_unit_avx
 stage examples s_examples
 stage compile s_compile
+stage docs s_docs
 stage test-tool s_test_tool
 stage dist s_dist
 wait
