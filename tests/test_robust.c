@@ -322,7 +322,7 @@ static int rb_scaled_build(rb_scaled *c, float scale, uint32_t target)
     pl.type = RAD_LIGHT_POINT;
     for (k = 0; k < 3; ++k) pl.color[k] = 1.0f;
     pl.position[0] = 0.278f * scale; pl.position[1] = 0.45f * scale; pl.position[2] = 0.28f * scale;
-    dop.include_emitters = 0;
+    dop.exclude_emitters = 1;
     if (rad_direct_patches(c->P, &c->rc, &pl, 1, &dop, c->Dpt, rb_serial_ctx()) != RAD_SUCCESS) return 0;
     return 1;
 }
