@@ -103,6 +103,13 @@
                                                      (SSE2/AVX) is used only when the compiler
                                                      already enables it (-msse2 is the x86-64
                                                      default, -mavx / -march=native for AVX).
+       RAD_FMA                    (undefined)        implementing file: lets the compiler fuse
+                                                     a * b + c into one FMA and the kernels use
+                                                     FMA instructions (with -mfma / -march=native):
+                                                     a little faster, other bits than a build
+                                                     without it. Off (the default), no FMA is
+                                                     used whatever the compiler's contraction
+                                                     setting (-std=gnu99, clang, -ffp-contract).
        RAD_NO_HUGEPAGES           (undefined)        implementing file (Linux): alias tables of
                                                      4 MiB or more are not 2 MiB aligned nor
                                                      advised MADV_HUGEPAGE (see >>api_temporal)
@@ -3682,6 +3689,23 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #include <limits.h>
 #include <stdarg.h>
 
+/* Fused multiply-add only when asked (RAD_FMA): a fused a * b + c rounds once where the
+   separate operations round twice, so a build that lets the compiler contract expressions
+   (clang's default, gcc's -std=gnu* default, -ffp-contract=fast) would give other bits than
+   one that does not. Without RAD_FMA contraction is off for the implementation alone (the
+   caller's code after the include keeps its own setting) and no kernel uses FMA intrinsics. */
+#if defined(RAD_FMA) && defined(__FMA__)
+#  define RAD__FMA 1
+#endif
+#if !defined(RAD_FMA)
+#  if defined(__clang__)
+#    pragma STDC FP_CONTRACT OFF
+#  elif defined(__GNUC__)
+#    pragma GCC push_options
+#    pragma GCC optimize("fp-contract=off")
+#  endif
+#endif
+
 #if defined(RAD_MALLOC) && defined(RAD_REALLOC) && defined(RAD_FREE)
 /* all three given */
 #elif !defined(RAD_MALLOC) && !defined(RAD_REALLOC) && !defined(RAD_FREE)
@@ -3705,7 +3729,7 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
    (RAD_NO_SIMD: none); the kernels test these and never the compiler's own macros.
    RAD__SSE2, RAD__AVX   the BVH, dot products and matrix-vector kernels;
    RAD__MB_AVX2, _FMA, _F16C   the GEMM, binary16 and compressed-block kernels (>>kernels,
-                         >>multibounce, >>local);
+                         >>multibounce, >>local; _FMA only with RAD_FMA, as RAD__FMA);
    RAD__TEMPORAL_AVX2    the temporal step hashing 8 draws at once (rad__tpipe_issue8; x86-64
                          only, for its 64-bit lanes). */
 #if !defined(RAD_NO_SIMD) && defined(__AVX__)
@@ -3715,7 +3739,7 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #if defined(RAD__AVX) && defined(__AVX2__)
 #  define RAD__MB_AVX2 1
 #endif
-#if defined(RAD__AVX) && defined(__FMA__)
+#if defined(RAD__AVX) && defined(RAD__FMA)
 #  define RAD__MB_FMA 1
 #endif
 #if defined(RAD__AVX) && defined(__F16C__)
@@ -5861,14 +5885,14 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
        breaks the antisymmetry of a shared edge's test between its two triangles by up to one
        rounding, and rays slip between them. Standard C fuses only within an expression, but
        gcc with -std=gnu* (and any compiler with -ffp-contract=fast) fuses across statements,
-       so with FMA hardware any result within rounding of 0 is redone too. The redo is in
-       double, where a product of two floats is exact. */
+       so when RAD_FMA lets it (on FMA hardware) any result within rounding of 0 is redone too.
+       The redo is in double, where a product of two floats is exact. */
     {
         float cb = Cx * By, cy = Cy * Bx, ac = Ax * Cy, ay = Ay * Cx, ba = Bx * Ay, bb = By * Ax;
         U = cb - cy;
         V = ac - ay;
         W = ba - bb;
-#if defined(__FMA__)
+#if defined(RAD__FMA)
         if (fabsf(U) <= 1.2e-7f * (fabsf(cb) + fabsf(cy)) || fabsf(V) <= 1.2e-7f * (fabsf(ac) + fabsf(ay)) ||
             fabsf(W) <= 1.2e-7f * (fabsf(ba) + fabsf(bb)))
 #else
@@ -5991,7 +6015,7 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
     __m128 U = _mm_sub_ps(cb, cy), V = _mm_sub_ps(ac, ay), W = _mm_sub_ps(ba, bb), redo;
     float u[4], v[4], ww[4], az[4], bz[4], cz[4];
     int lanes = (1 << count) - 1, hit_mask, redo_mask, found = -1, j;
-#if defined(__FMA__)
+#if defined(RAD__FMA)
     {
         /* as in rad__wray_tri: the compiler may fuse these products into FMAs, so any result
            within rounding of zero is redone in double */
@@ -23093,6 +23117,13 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 
 #endif /* RAD_NO_GLSL */
 
+#if !defined(RAD_FMA)
+#  if defined(__clang__)
+#    pragma STDC FP_CONTRACT DEFAULT
+#  elif defined(__GNUC__)
+#    pragma GCC pop_options
+#  endif
+#endif
 #endif /* RADIOSITY_IMPLEMENTATION */
 
 /*
