@@ -171,7 +171,7 @@ $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(EXR_CFLAGS) -I. tools/*.c -o $@ -lassimp $(EXR_LIB) -lm
 	cp $@ tools/rad
 
-# the evaluation report (tools/report.sh, issue #12): full quality into report/ (committed), or
+# the evaluation report (tools/report.sh): full quality into report/ (committed), or
 # quick into build/report-quick/ with every table cell and image checked (tests/run.sh runs it)
 report: $(BUILD)/rad $(BUILD)/temporal $(BUILD)/bench_realtime
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal --realtime-bench $(BUILD)/bench_realtime

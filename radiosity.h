@@ -1016,7 +1016,7 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
    one step of the power equation A_j B_j = A_j E_j + rho_j sum_i F_ij A_i B_i. A miss or a back
    face absorbs the ray (F_ij is 0 for a patch facing away, as in the classic matrix).
 
-   RAD_STOCHASTIC_JACOBI: stochastic Jacobi iteration (Neumann et al. 1994; Bekaert's thesis).
+   RAD_STOCHASTIC_JACOBI: stochastic Jacobi iteration (Neumann et al. 1994; Bekaert 1999).
      Shooting (incremental) iterations: the unshot radiosity dB (first E) is shot with rays
      drawn in proportion to each patch's unshot power A_i (dB_r + dB_g + dB_b) (systematic
      sampling: patch i gets floor or ceil of its share), each ray carrying an equal share of
@@ -1038,7 +1038,7 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
    visibility): the mean over seeds converges to the classic direct solve up to its form-factor
    error, and the variance falls as 1 / rays (tests/test_stochastic.c checks both). The noise
    is per patch: a patch of area A receives about rays * A / A_total of the hits, so small
-   patches are noisy; Bekaert's thesis discusses the variance.
+   patches are noisy; Bekaert 1999 discusses the variance.
 
    DETERMINISM. Every ray's random numbers are a hash (the integer hash of >>core) of the seed,
    the iteration and the ray's (or walk's and bounce's) index, and deposits are summed in ray
@@ -2092,7 +2092,7 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    (weight = the area correction), and the form factors are built by step 5 unchanged, so the
    merged rows and columns are exactly these merge rules applied to the whole sample matrix, with
    visibility. E is the area-weighted mean over the cluster's own samples (rad_vp_from_samples;
-   DEPARTURE: the thesis weights every sample of the voxel by max(0, N_j . n_i), which does not
+   DEPARTURE: Shcherbakov 2025 (ch. 5) weights every sample of the voxel by max(0, N_j . n_i), which does not
    conserve the samples' power) and gathering uses w_j = max(0, N_j . n), normalized.
    LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
    sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no

@@ -949,7 +949,7 @@ static void mb_expect_load(const void *buf, size_t size, uint32_t type, const ch
 }
 
 /* F_mb planes (float and half), block scales and outliers with valid checksums but NaN, 3e38
-   or negative values are refused at load (issue 23: they rendered NaN with exit 0) */
+   or negative values are refused at load (else they render NaN with exit 0) */
 static void mb_bad_values(void)
 {
     mb_world w;

@@ -1,4 +1,4 @@
-/* test_robust.c - numeric robustness and determinism (issue 11, items 4 and 5): the Cornell
+/* test_robust.c - numeric robustness and determinism: the Cornell
    box scaled by 1e-3 and 1e4 gives the same lighting; hard geometry (coincident, touching,
    nearly parallel patches, thin triangles, albedo contrast, huge emission, tiny and huge
    scenes, one triangle) never puts a NaN or Inf into any output; the BVH on degenerate-ish

@@ -768,7 +768,7 @@ static void tp_huge_tables(void)
 }
 
 /* Alias totals with a valid checksum but NaN or 3e38 are refused at load, and the draw count k
-   is bounded (issue 23: a bake with k = 16M took 10 s per frame at 206 patches) */
+   is bounded (a bake with k = 16M took 10 s per frame at 206 patches) */
 static void tp_bad_values(void)
 {
     tp_cornell c;
