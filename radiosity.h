@@ -1,4 +1,4 @@
-/* radiosity.h - v0.1.0 - diffuse global illumination by the radiosity method
+/* radiosity.h - v0.3.0 - diffuse global illumination by the radiosity method
    public domain or MIT, your choice (see end of file)
 
    Do this:
@@ -278,16 +278,18 @@
        - Start threads, touch the GPU itself, or keep global state.
 
   13. HISTORY
-       0.1.0  scene input and validation, patches, built-in BVH (4-wide, SSE), Embree
-              backend, form factors (analytic, Monte Carlo, point-to-point; dense, sparse,
-              row ranges), Jacobi, Gauss-Seidel, progressive refinement, LU; direct light;
-              built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
-              compression and reordering; temporal radiosity with alias tables; local
-              matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
-              models and microfacet BRDFs; irradiance probes (SH L2); embedded GLSL kernels
-              for every run-time step; hemicube form factors; stochastic radiosity
-              (stochastic Jacobi, random walks); hierarchical radiosity.
-       The full history is in CHANGELOG.md.
+       0.3.0  hemicube form factors; stochastic radiosity; hierarchical radiosity with
+              clustering; lightmaps; irradiance probes (SH L2, band 4, over patches or
+              virtual patches); final gather; dynamic lights over virtual patches; sparse
+              virtual-patch matrices; distributed bakes; bake signatures; one rule for
+              non-finite values; scenes from 1e-15 to 1e18.
+       0.2.0  lighting models and microfacet BRDFs; embedded GLSL kernels for every run-time
+              step; local matrix (Sherman-Morrison); virtual and axis-aligned virtual patches.
+       0.1.0  scene input and validation, patches, built-in BVH, Embree backend, form factors
+              (analytic, Monte Carlo), Jacobi, Gauss-Seidel, progressive refinement, LU;
+              direct light; built-in Cornell box; baked-data container; multi-bounce matrix
+              with BC1/BC4 compression; temporal radiosity with alias tables.
+       What each version changed, for an upgrade, is in CHANGELOG.md.
 */
 
 #ifndef RADIOSITY_H
@@ -297,9 +299,9 @@
 #include <stdint.h>
 
 #define RAD_VERSION_MAJOR 0
-#define RAD_VERSION_MINOR 1
+#define RAD_VERSION_MINOR 3
 #define RAD_VERSION_PATCH 0
-#define RAD_VERSION_STRING "0.1.0"
+#define RAD_VERSION_STRING "0.3.0"
 
 #ifndef RAD_API
 #  ifdef RADIOSITY_STATIC
