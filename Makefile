@@ -10,6 +10,7 @@
 #   make bench   writes BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/ (and tools/rad-mpi when mpicc is installed)
 #   make glsl    regenerates the GLSL sources embedded in radiosity.h from glsl/
+#   make api     regenerates docs/api.md (the index of every public declaration) from radiosity.h
 #   make report  the evaluation report (every method vs the path-traced reference, plots; the
 #                real scenes when RAD_DATA_DIR holds sponza.obj) into report/ (long: 15-40 min
 #                on 2 shared cores); make report-quick: a small one into build/, checked
@@ -30,7 +31,7 @@ EXR_LIB := $(if $(EXR_CFLAGS),-ltinyexr,)
 # use them (empty: they say what they skipped)
 RAD_DATA_DIR ?=
 
-.PHONY: all demo gallery lightmap walk learn moving-light test bench bench-quick tools rad-mpi fuzz clean glsl report report-quick
+.PHONY: all demo gallery lightmap walk learn moving-light test bench bench-quick tools rad-mpi fuzz clean glsl api report report-quick
 
 all: $(BUILD)/cornell $(BUILD)/walk $(BUILD)/realtime tools
 
@@ -83,6 +84,10 @@ $(BUILD)/moving_light: examples/moving_light.c examples/png_write.h radiosity.h 
 moving-light: $(BUILD)/moving_light
 	mkdir -p $(BUILD)/moving_light_frames
 	./$(BUILD)/moving_light -o $(BUILD)/moving_light_frames/frame
+
+# the API index: the hand-written introduction of docs/api.md kept, the rest from the header
+api:
+	awk -f tools/api_index.awk docs/api.md radiosity.h radiosity.h >docs/api.md.new && mv docs/api.md.new docs/api.md
 
 test:
 	CC="$(CC)" CXX="$(CXX)" BUILD="$(BUILD)" bash tests/run.sh
@@ -166,7 +171,7 @@ $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(EXR_CFLAGS) -I. tools/*.c -o $@ -lassimp $(EXR_LIB) -lm
 	cp $@ tools/rad
 
-# the evaluation report (tools/report.sh, issue #12): full quality into report/ (committed), or
+# the evaluation report (tools/report.sh): full quality into report/ (committed), or
 # quick into build/report-quick/ with every table cell and image checked (tests/run.sh runs it)
 report: $(BUILD)/rad $(BUILD)/temporal $(BUILD)/bench_realtime
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal --realtime-bench $(BUILD)/bench_realtime

@@ -1,4 +1,4 @@
-/* radiosity.h - v0.1.0 - diffuse global illumination by the radiosity method
+/* radiosity.h - v0.3.0 - diffuse global illumination by the radiosity method
    public domain or MIT, your choice (see end of file)
 
    Do this:
@@ -104,6 +104,13 @@
                                                      (SSE2/AVX) is used only when the compiler
                                                      already enables it (-msse2 is the x86-64
                                                      default, -mavx / -march=native for AVX).
+       RAD_FMA                    (undefined)        implementing file: lets the compiler fuse
+                                                     a * b + c into one FMA and the kernels use
+                                                     FMA instructions (with -mfma / -march=native):
+                                                     a little faster, other bits than a build
+                                                     without it. Off (the default), no FMA is
+                                                     used whatever the compiler's contraction
+                                                     setting (-std=gnu99, clang, -ffp-contract).
        RAD_NO_HUGEPAGES           (undefined)        implementing file (Linux): alias tables of
                                                      4 MiB or more are not 2 MiB aligned nor
                                                      advised MADV_HUGEPAGE (see >>api_temporal)
@@ -272,16 +279,18 @@
        - Start threads, touch the GPU itself, or keep global state.
 
   13. HISTORY
-       0.1.0  scene input and validation, patches, built-in BVH (4-wide, SSE), Embree
-              backend, form factors (analytic, Monte Carlo, point-to-point; dense, sparse,
-              row ranges), Jacobi, Gauss-Seidel, progressive refinement, LU; direct light;
-              built-in Cornell box; baked-data container; multi-bounce matrix with BC1/BC4
-              compression and reordering; temporal radiosity with alias tables; local
-              matrix (Sherman-Morrison); virtual and axis-aligned virtual patches; lighting
-              models and microfacet BRDFs; irradiance probes (SH L2); embedded GLSL kernels
-              for every run-time step; hemicube form factors; stochastic radiosity
-              (stochastic Jacobi, random walks); hierarchical radiosity.
-       The full history is in CHANGELOG.md.
+       0.3.0  hemicube form factors; stochastic radiosity; hierarchical radiosity with
+              clustering; lightmaps; irradiance probes (SH L2, band 4, over patches or
+              virtual patches); final gather; dynamic lights over virtual patches; sparse
+              virtual-patch matrices; distributed bakes; bake signatures; one rule for
+              non-finite values; scenes from 1e-15 to 1e18.
+       0.2.0  lighting models and microfacet BRDFs; embedded GLSL kernels for every run-time
+              step; local matrix (Sherman-Morrison); virtual and axis-aligned virtual patches.
+       0.1.0  scene input and validation, patches, built-in BVH, Embree backend, form factors
+              (analytic, Monte Carlo), Jacobi, Gauss-Seidel, progressive refinement, LU;
+              direct light; built-in Cornell box; baked-data container; multi-bounce matrix
+              with BC1/BC4 compression; temporal radiosity with alias tables.
+       What each version changed, for an upgrade, is in CHANGELOG.md.
 */
 
 #ifndef RADIOSITY_H
@@ -291,9 +300,9 @@
 #include <stdint.h>
 
 #define RAD_VERSION_MAJOR 0
-#define RAD_VERSION_MINOR 1
+#define RAD_VERSION_MINOR 3
 #define RAD_VERSION_PATCH 0
-#define RAD_VERSION_STRING "0.1.0"
+#define RAD_VERSION_STRING "0.3.0"
 
 #ifndef RAD_API
 #  ifdef RADIOSITY_STATIC
@@ -539,6 +548,7 @@ typedef struct rad_patches {
     rad_allocator allocator;  /* private */
 } rad_patches;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_patch_options_default(rad_patch_options *options);
 
 /* Cuts the scene into patches. scene is borrowed and must outlive the result.
@@ -704,17 +714,17 @@ typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
     uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
-    int include_emitters;      /* non-zero (default): emissive triangles are area lights;
-                                  0 leaves them out (a zeroed struct has no emitters: start
-                                  from rad_direct_options_default) */
+    int exclude_emitters;      /* 0 (default): emissive triangles are area lights; non-zero
+                                  leaves them out (only the lights given) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     uint32_t seed;
 } rad_direct_options;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_direct_options_default(rad_direct_options *options);
 
 /* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
-   sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
+   sky (cosine-weighted shadow rays) and, unless exclude_emitters, every emissive triangle
    (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
    shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
    gets the light of its visible part). A point receives nothing from behind its normal; normals need not
@@ -776,6 +786,7 @@ typedef struct rad_final_gather_options {
 typedef rad_result (*rad_gather_lookup_fn)(void *user, const rad_hit *hits, const float *points, const float *normals,
                                            uint32_t count, float *out_irradiance);
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_final_gather_options_default(rad_final_gather_options *options);
 
 /* Indirect irradiance (3 floats per point) at 'count' points with normals (normalized here;
@@ -817,7 +828,7 @@ typedef enum rad_ff_method {
 } rad_ff_method;
 
 typedef struct rad_form_factor_options {
-    rad_ff_method method;
+    rad_ff_method method;   /* 0: RAD_FF_ANALYTIC */
     uint32_t samples;       /* points per patch pair (0: 16), rounded to a square n*n and
                                capped at 256: the emitter points are the centroids of the
                                patch's n x n sub-triangles (exact centroid, midpoint rule); the
@@ -842,7 +853,7 @@ typedef struct rad_form_factors {
     void *storage;             /* private */
 } rad_form_factors;
 
-/* Defaults: RAD_FF_ANALYTIC, samples 16, ray_epsilon 1e-5, hemicube_resolution 128, the rest 0. */
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_form_factor_options_default(rad_form_factor_options *options);
 
 /* HEMICUBE (RAD_FF_HEMICUBE; Cohen and Greenberg 1985). Row i is what a hemicube at patch i's
@@ -965,7 +976,8 @@ typedef int (*rad_residual_fn)(void *user, uint32_t iteration, double residual);
 
 typedef struct rad_solve_options {
     rad_output output;         /* RAD_OUTPUT_INDIRECT (default) or RAD_OUTPUT_TOTAL */
-    uint32_t bounces;          /* Jacobi: K (default 8; 0 returns 0 indirect / E total) */
+    uint32_t bounces;          /* Jacobi: K (0: 8). K = 0 would be no solve at all: the
+                                  indirect light 0, the total E */
     double tolerance;          /* Gauss-Seidel, shooting: relative (0: 1e-6) */
     uint32_t max_iterations;   /* GS sweeps (0: 1000), shooting steps (0: 100 N) */
     rad_residual_fn on_residual;
@@ -977,6 +989,7 @@ typedef struct rad_solve_stats {
     double residual;           /* last residual (see rad_residual_fn) */
 } rad_solve_stats;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_solve_options_default(rad_solve_options *options);
 /* Fills 'system' from patches (albedo, areas), a matrix and E. */
 RAD_API void rad_system_init(rad_system *system, const rad_matrix *F, const rad_patches *patches, const float *E);
@@ -1014,7 +1027,7 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
    one step of the power equation A_j B_j = A_j E_j + rho_j sum_i F_ij A_i B_i. A miss or a back
    face absorbs the ray (F_ij is 0 for a patch facing away, as in the classic matrix).
 
-   RAD_STOCHASTIC_JACOBI: stochastic Jacobi iteration (Neumann et al. 1994; Bekaert's thesis).
+   RAD_STOCHASTIC_JACOBI: stochastic Jacobi iteration (Neumann et al. 1994; Bekaert 1999).
      Shooting (incremental) iterations: the unshot radiosity dB (first E) is shot with rays
      drawn in proportion to each patch's unshot power A_i (dB_r + dB_g + dB_b) (systematic
      sampling: patch i gets floor or ceil of its share), each ray carrying an equal share of
@@ -1036,7 +1049,7 @@ RAD_API rad_result rad_solve_direct(const rad_system *system, const rad_solve_op
    visibility): the mean over seeds converges to the classic direct solve up to its form-factor
    error, and the variance falls as 1 / rays (tests/test_stochastic.c checks both). The noise
    is per patch: a patch of area A receives about rays * A / A_total of the hits, so small
-   patches are noisy; Bekaert's thesis discusses the variance.
+   patches are noisy; Bekaert 1999 discusses the variance.
 
    DETERMINISM. Every ray's random numbers are a hash (the integer hash of >>core) of the seed,
    the iteration and the ray's (or walk's and bounce's) index, and deposits are summed in ray
@@ -1080,8 +1093,7 @@ typedef struct rad_stochastic_stats {
                                      stopped (the truncation left out); walk: 0 */
 } rad_stochastic_stats;
 
-/* Defaults: RAD_STOCHASTIC_JACOBI, RAD_OUTPUT_INDIRECT, every count 0 (its documented default),
-   tolerance 1e-4, ray_epsilon 1e-5, seed 0, no callback. */
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_stochastic_options_default(rad_stochastic_options *options);
 
 /* Solves B = E + rho o (F B) on 'patches' (albedo from patches->albedo) by one of the two
@@ -1206,8 +1218,7 @@ typedef enum rad_hierarchical_value {
 
 typedef struct rad_hierarchical rad_hierarchical;
 
-/* Defaults: tolerance 1e-3, min_area 0 (total / 10000), visibility_rays 4, max_iterations 16,
-   ray_epsilon 1e-5, clustering AUTO, the rest 0. */
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *options);
 
 /* Checks the options and makes the roots (one element per scene triangle, its albedo at the
@@ -1294,9 +1305,8 @@ RAD_API float rad_half_to_float(uint16_t value);
 typedef enum rad_mb_precision { RAD_MB_FLOAT = 0, RAD_MB_HALF = 1 } rad_mb_precision;
 
 typedef struct rad_multibounce_options {
-    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (default 3; 0 is INVALID_ARGUMENT:
-                                  start from rad_multibounce_options_default) */
-    rad_mb_precision precision;/* storage of the result (default RAD_MB_FLOAT) */
+    uint32_t bounces;          /* K >= 1, or RAD_MB_INFINITE (0: 3) */
+    rad_mb_precision precision;/* storage of the result (0: RAD_MB_FLOAT) */
     double tolerance;          /* K = inf: Neumann doubling stops once max row sum of
                                   (rho o F)^m <= tolerance (0: 1e-8) */
     uint32_t max_doublings;    /* K = inf: NOT_CONVERGED after this many (0: 40) */
@@ -1316,6 +1326,7 @@ typedef struct rad_multibounce {
     uint32_t info[16];         /* private: the RAD_SECTION_MB_INFO record */
 } rad_multibounce;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_multibounce_options_default(rad_multibounce_options *options);
 
 /* Builds F_mb from a form-factor matrix F (N x N, dense or CSR; borrowed) and the albedo
@@ -1353,38 +1364,41 @@ RAD_API rad_result rad_multibounce_apply(const rad_multibounce *mb, const float 
 /* ---- block compression ---- */
 
 typedef enum rad_block_format {
-    RAD_BLOCK_BC1 = 0,         /* one BC1 texture: RGB565 endpoints, 0.5 byte per entry (all 3 channels) */
-    RAD_BLOCK_BC4X3 = 1        /* three BC4 textures (R, G, B): 8-bit endpoints, 1.5 bytes per entry */
+    RAD_BLOCK_BC4X3 = 0,       /* three BC4 textures (R, G, B): 8-bit endpoints, 1.5 bytes per entry (the default) */
+    RAD_BLOCK_BC1 = 1          /* one BC1 texture: RGB565 endpoints, 0.5 byte per entry (all 3 channels) */
 } rad_block_format;
 
-/* rad_block_options.reorder (an int holding one of these, as every flags field does). */
+/* rad_block_options.reorder (an int holding one of these, as every flags field does; 0 is the
+   default, RAD_REORDER_MATCH). */
 typedef enum rad_reorder {
-    RAD_REORDER_NONE = 0,        /* keep the patch order */
     RAD_REORDER_GREEDY = 1,      /* greedy nearest-neighbour chain (Shcherbakov 2025) */
     RAD_REORDER_GREEDY_2OPT = 2, /* the greedy chain, then 2-opt reversals that shorten it */
     RAD_REORDER_GROUPS = 3,      /* 2-opt chain, then swaps between the groups of four rows
                                     (columns) that make each 4x4 block's rows more alike */
-    RAD_REORDER_MATCH = 4        /* groups of four by greedy matching (rows into pairs, pairs
+    RAD_REORDER_MATCH = 4,       /* groups of four by greedy matching (rows into pairs, pairs
                                     into fours) on the same distance, then the group swaps */
+    RAD_REORDER_NONE = 5         /* keep the patch order */
 } rad_reorder;
 
-/* Start from rad_block_options_default: here zero is a setting, not the default (a zeroed
-   struct asks for BC1, no outliers, no reordering and one scale per channel). */
+/* rad_block_options.tile: one scale per channel for the whole matrix */
+#define RAD_BLOCK_WHOLE_MATRIX 0xFFFFFFFFu
+
+/* A zeroed struct is the default (as rad_block_options_default fills it). */
 typedef struct rad_block_options {
-    rad_block_format format;   /* default RAD_BLOCK_BC4X3 (0 is RAD_BLOCK_BC1) */
+    rad_block_format format;   /* 0: RAD_BLOCK_BC4X3; or RAD_BLOCK_BC1 */
     float outlier_fraction;    /* the largest fraction p of the N^2 entries (by their largest
-                                  channel) go exactly into the sparse list, zeros left in place;
-                                  0 disables the step (default 0.05) */
-    int reorder;               /* row and column reordering: RAD_REORDER_NONE (0),
-                                  RAD_REORDER_GREEDY (1, Shcherbakov 2025),
-                                  RAD_REORDER_GREEDY_2OPT (2), RAD_REORDER_GROUPS (3: lower
-                                  MSE than GREEDY) or RAD_REORDER_MATCH (4, the default: lower
-                                  still for the same build time; docs/methods/compression.md) */
+                                  channel) go exactly into the sparse list, zeros left in place
+                                  (0: 0.05; below 1; negative: no outlier step) */
+    int reorder;               /* row and column reordering (0: RAD_REORDER_MATCH, lowest MSE
+                                  for its build time; docs/methods/compression.md):
+                                  RAD_REORDER_GREEDY (Shcherbakov 2025), RAD_REORDER_GREEDY_2OPT,
+                                  RAD_REORDER_GROUPS (lower MSE than GREEDY), RAD_REORDER_MATCH,
+                                  or RAD_REORDER_NONE (keep the patch order) */
     uint32_t reorder_samples;  /* 0: L2 distances over all coordinates (the literal algorithm,
                                   through a Gram matrix); else over this many evenly spaced
-                                  coordinates (faster, a little worse; default 0) */
-    uint32_t tile;             /* scales per tile x tile texels (a multiple of 4); 0: one scale
-                                  per channel for the whole matrix (default 64) */
+                                  coordinates (faster, a little worse) */
+    uint32_t tile;             /* scales per tile x tile texels, a multiple of 4 (0: 64);
+                                  RAD_BLOCK_WHOLE_MATRIX: one scale per channel for the matrix */
 } rad_block_options;
 
 /* What rad_multibounce_blocks_create did, step by step. */
@@ -1422,6 +1436,7 @@ typedef struct rad_multibounce_blocks {
     uint32_t info[16];               /* private */
 } rad_multibounce_blocks;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_block_options_default(rad_block_options *options);
 
 /* Compresses mb (float or half, unpermuted) by the pipeline of rad_block_options; report
@@ -1609,11 +1624,11 @@ typedef enum rad_local_rebuild_method {
 } rad_local_rebuild_method;
 
 typedef struct rad_local_options {
-    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (default
-                                  1024; 0 is INVALID_ARGUMENT: start from rad_local_options_default) */
-    rad_local_update update;   /* default RAD_LOCAL_EXACT */
-    rad_local_eviction evict;  /* default RAD_LOCAL_EVICT_DOWNDATE */
-    rad_local_rebuild_method rebuild; /* default RAD_LOCAL_REBUILD_INVERSE */
+    uint32_t capacity;         /* M, the most members (visible and hidden) the set holds (0:
+                                  1024); more than the patch count n is taken as n */
+    rad_local_update update;   /* 0: RAD_LOCAL_EXACT */
+    rad_local_eviction evict;  /* 0: RAD_LOCAL_EVICT_DOWNDATE */
+    rad_local_rebuild_method rebuild; /* 0: RAD_LOCAL_REBUILD_INVERSE */
 } rad_local_options;
 
 /* A local multi-bounce matrix. Everything public is read-only. Slot s holds patch
@@ -1640,12 +1655,13 @@ typedef struct rad_local {
     void *scratch;             /* private */
 } rad_local;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_local_options_default(rad_local_options *options);
 
 /* Creates an empty set of capacity M over 'source' (copied; what it points to is borrowed
    and must outlive the object). Memory: 12 M^2 bytes of planes, 4 n bytes for patch_slot,
-   O(n + tasks M) bytes of scratch. Errors: INVALID_ARGUMENT (NULL, capacity 0 or > n, bad
-   update kind, a source without fetch, areas or albedo), ALBEDO_RANGE, SIZE_OVERFLOW,
+   O(n + tasks M) bytes of scratch. Errors: INVALID_ARGUMENT (NULL, a bad update, evict or
+   rebuild kind, a source without fetch, areas or albedo), ALBEDO_RANGE, SIZE_OVERFLOW,
    OUT_OF_MEMORY. Cost: O(M^2 + n). */
 RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_local_options *options,
                                     const rad_context *ctx, rad_local **out);
@@ -1894,15 +1910,14 @@ typedef enum rad_temporal_mode {
 #define RAD_TEMPORAL_MAX_SAMPLES 65536u
 
 typedef struct rad_temporal_options {
-    rad_temporal_mode mode;
-    uint32_t samples;      /* k draws per row and frame (default 10; 1 to RAD_TEMPORAL_MAX_SAMPLES,
-                              0 is INVALID_ARGUMENT: start from rad_temporal_options_default) */
-    float weight;          /* fixed w in [0, 1) (default 0.998; 0 keeps no history) */
+    rad_temporal_mode mode;/* 0: RAD_TEMPORAL_SINGLE */
+    uint32_t samples;      /* k draws per row and frame (0: 10; at most RAD_TEMPORAL_MAX_SAMPLES) */
+    float weight;          /* fixed w, below 1 (0: 0.998; negative: w = 0, no history) */
     uint32_t seed;         /* generator seed */
     int adaptive;          /* non-zero: per-row w from the estimator's variance (see below) */
-    float noise_target;    /* adaptive: target relative std of B_i in steady state (default 0.01) */
-    float weight_max;      /* adaptive: upper bound of w_i (default 0.999) */
-    float change_sigma;    /* adaptive: change test threshold in standard deviations (default 5) */
+    float noise_target;    /* adaptive: target relative std of B_i in steady state (0: 0.01) */
+    float weight_max;      /* adaptive: upper bound of w_i, below 1 (0: 0.999; negative: 0) */
+    float change_sigma;    /* adaptive: change test threshold in standard deviations (0: 5) */
 } rad_temporal_options;
 
 /* ADAPTIVE WEIGHT (the open problem stated by Shcherbakov et al. 2023). Per row, on the scalar x = sum of the
@@ -1922,6 +1937,8 @@ typedef struct rad_temporal_options {
    to weight_max and B lags (examples/moving_light.c, a light circling the box: 48.5% error
    against 15.3% with a fixed w = 0.8); for such motion cap weight_max (the lag is about
    1 / (1 - w) frames) or use a fixed weight. */
+
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_temporal_options_default(rad_temporal_options *options);
 
 typedef struct rad_temporal rad_temporal;
@@ -2087,7 +2104,7 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    (weight = the area correction), and the form factors are built by step 5 unchanged, so the
    merged rows and columns are exactly these merge rules applied to the whole sample matrix, with
    visibility. E is the area-weighted mean over the cluster's own samples (rad_vp_from_samples;
-   DEPARTURE: the thesis weights every sample of the voxel by max(0, N_j . n_i), which does not
+   DEPARTURE: Shcherbakov 2025 (ch. 5) weights every sample of the voxel by max(0, N_j . n_i), which does not
    conserve the samples' power) and gathering uses w_j = max(0, N_j . n), normalized.
    LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
    sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
@@ -2110,28 +2127,32 @@ typedef enum rad_vp_axis {
     RAD_VP_POS_X = 0, RAD_VP_NEG_X = 1, RAD_VP_POS_Y = 2, RAD_VP_NEG_Y = 3, RAD_VP_POS_Z = 4, RAD_VP_NEG_Z = 5
 } rad_vp_axis;
 
+/* rad_vp_options.visibility_rays: one shadow ray per pair of samples (the literal form) */
+#define RAD_VP_RAYS_PER_PAIR 0xFFFFFFFFu
+
+/* A zeroed struct is the default (as rad_vp_options_default fills it). */
 typedef struct rad_vp_options {
     float voxel_size[3];      /* per axis, world units; all 0 (default): cubes, 'resolution' of
                                  them along the longest axis of the scene bounds */
-    uint32_t resolution;      /* default 16 */
-    uint32_t face_points;     /* Hammersley points per voxel face (default 16, at most 4096) */
-    rad_vp_weights weights;   /* default RAD_VP_WEIGHTS_SQUARED */
+    uint32_t resolution;      /* voxels along the longest axis (0: 16) */
+    uint32_t face_points;     /* Hammersley points per voxel face (0: 16; at most 4096) */
+    rad_vp_weights weights;   /* 0: RAD_VP_WEIGHTS_SQUARED */
     float ray_epsilon;        /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
     int skip_visibility;      /* non-zero: V = 1 between samples (unoccluded form factors) */
-    uint32_t visibility_rays; /* shadow rays per pair of voxels (default 16, at most 1024); 0:
-                                 one ray per pair of samples (the literal form: cost
-                                 M^2 / 2 rays). See VISIBILITY in the section comment. */
+    uint32_t visibility_rays; /* shadow rays per pair of voxels (0: 16; at most 1024);
+                                 RAD_VP_RAYS_PER_PAIR: one ray per pair of samples (the literal
+                                 form: cost M^2 / 2 rays). See VISIBILITY in the section comment. */
     int keep_row_sums;        /* non-zero: skip step 6 (rows may then sum to more than 1) */
-    rad_vp_kind kind;         /* default RAD_VP_AXIS_ALIGNED */
-    uint32_t max_clusters;    /* RAD_VP_CLUSTERED: Q, patches per voxel at most (1..6, default 6) */
+    rad_vp_kind kind;         /* 0: RAD_VP_AXIS_ALIGNED */
+    uint32_t max_clusters;    /* RAD_VP_CLUSTERED: Q, patches per voxel at most (0: 6; 1..6) */
     uint32_t metric_columns;  /* RAD_VP_CLUSTERED: samples used as the columns k of the metric's
-                                 form-factor term (default 64, at most 4096) */
-    rad_storage storage;      /* of vp->matrix: RAD_STORAGE_DENSE (default) or RAD_STORAGE_SPARSE
+                                 form-factor term (0: 64; at most 4096) */
+    rad_storage storage;      /* of vp->matrix: 0 RAD_STORAGE_DENSE, or RAD_STORAGE_SPARSE
                                  (CSR, see SPARSE ROWS in the section comment) */
     float drop_threshold;     /* RAD_STORAGE_SPARSE: entries F_ab <= it are dropped (0 keeps every
                                  non-zero; >= 0, finite) */
     uint32_t share_rays;      /* step 6: cosine rays per sample that measure each patch's share of
-                                 the scene (default 16, at most 1024) */
+                                 the scene (0: 16; at most 1024) */
     int cap_row_sums;         /* non-zero: step 6 only caps row sums at 1 (no traced shares) */
     float backface_limit;     /* step 6: a sample more than this fraction of whose share rays
                                  hit back faces lies inside geometry and is left out of its
@@ -2180,6 +2201,7 @@ typedef struct rad_virtual_patches {
     uint32_t info_record[16];   /* private: the RAD_SECTION_VP_INFO record (rad_vp_sections) */
 } rad_virtual_patches;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_vp_options_default(rad_vp_options *options);
 
 /* Builds axis-aligned virtual patches for 'scene' (borrowed; must outlive the result).
@@ -2313,7 +2335,7 @@ RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table);
    unoccluded fraction of each sample's hemisphere (light_samples cosine rays, as
    rad_direct_irradiance) depends on the geometry only, so it is traced once, at the first
    update with a sky, and each update scales it by the sky's colour. Emissive triangles
-   (include_emitters): static, traced once at create. Then v_i = rho_i D_i and
+   (unless direct.exclude_emitters): static, traced once at create. Then v_i = rho_i D_i and
    E = rad_vp_from_samples(v). With rays_per_frame 0 (P = 1) every update re-tests every
    sample: E then equals rad_vp_sources with the same lights and options, bit for bit when
    there are only directional, point and spot lights (emitters: to float rounding; a sky: the
@@ -2325,12 +2347,13 @@ RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table);
 typedef struct rad_vp_lights_options {
     uint32_t rays_per_frame;   /* shadow rays per light slot and update at most (0: every sample
                                   every update, exact) */
-    rad_direct_options direct; /* ray_epsilon, light_samples (sky and emitters), include_emitters,
-                                  seed; rad_vp_lights_options_default: rad_direct_options_default
-                                  with include_emitters 0 */
+    rad_direct_options direct; /* ray_epsilon, light_samples (sky and emitters), exclude_emitters,
+                                  seed, each with its rad_direct_options default (emitters
+                                  included: set exclude_emitters when the engine lights them) */
 } rad_vp_lights_options;
 typedef struct rad_vp_lights rad_vp_lights;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_vp_lights_options_default(rad_vp_lights_options *options);
 /* vp (with its scene) and raycaster are borrowed and must outlive the state. Errors:
    INVALID_ARGUMENT (NULL, a set without a scene, bad ray_epsilon), NON_FINITE (a sample normal),
@@ -2449,6 +2472,7 @@ typedef struct rad_lightmap {
     rad_allocator allocator;    /* private */
 } rad_lightmap;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_lightmap_options_default(rad_lightmap_options *options);
 
 /* Builds the texels of the scene's lightmapped triangles (those of meshes with lightmap_uvs;
@@ -2511,7 +2535,7 @@ typedef enum rad_lightmap_gather_method {
 } rad_lightmap_gather_method;
 
 typedef struct rad_lightmap_gather_options {
-    rad_lightmap_encoding encoding;
+    rad_lightmap_encoding encoding; /* 0: RAD_LIGHTMAP_IRRADIANCE */
     uint32_t visibility_rays;   /* shadow rays per sample and patch (0: 4; at most 64); with 1
                                    the share is of the visible area, not of the form factor
                                    (reads a few % low next to contacts) */
@@ -2523,6 +2547,7 @@ typedef struct rad_lightmap_gather_options {
                                    luminance (0: 16; > 0; FLT_MAX: none is bright) */
 } rad_lightmap_gather_options;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *options);
 /* Floats per texel of an encoding (3 or 12; 0 for an unknown one). */
 RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding);
@@ -2856,6 +2881,7 @@ typedef struct rad_probe_options {
 
 typedef struct rad_probes rad_probes;
 
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
 RAD_API void rad_probe_options_default(rad_probe_options *options);
 
 /* Places probes (a grid over the scene bounds when positions is NULL, else the 'count' points
@@ -3703,6 +3729,23 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #  endif
 #endif
 
+/* Fused multiply-add only when asked (RAD_FMA): a fused a * b + c rounds once where the
+   separate operations round twice, so a build that lets the compiler contract expressions
+   (clang's default, gcc's -std=gnu* default, -ffp-contract=fast) would give other bits than
+   one that does not. Without RAD_FMA contraction is off for the implementation alone (the
+   caller's code after the include keeps its own setting) and no kernel uses FMA intrinsics. */
+#if defined(RAD_FMA) && defined(__FMA__)
+#  define RAD__FMA 1
+#endif
+#if !defined(RAD_FMA)
+#  if defined(__clang__)
+#    pragma STDC FP_CONTRACT OFF
+#  elif defined(__GNUC__)
+#    pragma GCC push_options
+#    pragma GCC optimize("fp-contract=off")
+#  endif
+#endif
+
 #if defined(RAD_MALLOC) && defined(RAD_REALLOC) && defined(RAD_FREE)
 /* all three given */
 #elif !defined(RAD_MALLOC) && !defined(RAD_REALLOC) && !defined(RAD_FREE)
@@ -3726,7 +3769,7 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
    (RAD_NO_SIMD: none); the kernels test these and never the compiler's own macros.
    RAD__SSE2, RAD__AVX   the BVH, dot products and matrix-vector kernels;
    RAD__MB_AVX2, _FMA, _F16C   the GEMM, binary16 and compressed-block kernels (>>kernels,
-                         >>multibounce, >>local);
+                         >>multibounce, >>local; _FMA only with RAD_FMA, as RAD__FMA);
    RAD__TEMPORAL_AVX2    the temporal step hashing 8 draws at once (rad__tpipe_issue8; x86-64
                          only, for its 64-bit lanes). */
 #if !defined(RAD_NO_SIMD) && defined(__AVX__)
@@ -3736,7 +3779,7 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 #if defined(RAD__AVX) && defined(__AVX2__)
 #  define RAD__MB_AVX2 1
 #endif
-#if defined(RAD__AVX) && defined(__FMA__)
+#if defined(RAD__AVX) && defined(RAD__FMA)
 #  define RAD__MB_FMA 1
 #endif
 #if defined(RAD__AVX) && defined(__F16C__)
@@ -4851,11 +4894,18 @@ RAD_API void rad_cornell_box(rad_scene_desc *desc, rad_camera *camera)
 /* >>patches: patches, welding, locating, per-vertex values                                 */
 /* ======================================================================================== */
 
+/* The defaults of rad_patch_options, written once: rad_patches_create and
+   rad_patch_options_default both pass through here, so a zeroed struct is the default. */
+static void rad__patch_options_resolve(rad_patch_options *o)
+{
+    if (o->albedo_samples == 0) o->albedo_samples = 16;
+}
+
 RAD_API void rad_patch_options_default(rad_patch_options *options)
 {
     if (!options) return;
     memset(options, 0, sizeof(*options));
-    options->albedo_samples = 16;
+    rad__patch_options_resolve(options);
 }
 
 RAD_API void rad_patches_destroy(rad_patches *p)
@@ -5088,13 +5138,13 @@ RAD_API rad_result rad_patches_create(const rad_scene *scene, const rad_patch_op
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (!scene) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_patch_options_default(&o);
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__patch_options_resolve(&o);
     if (!rad__finite(o.max_area) || o.max_area < 0.0f || !rad__finite(o.max_edge) || o.max_edge < 0.0f) {
         rad__log(&c, RAD_LOG_ERROR, "patch options: max_area %g and max_edge %g must be finite and >= 0", (double)o.max_area,
                  (double)o.max_edge);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (o.albedo_samples == 0) o.albedo_samples = 16;
     if (o.albedo_samples > RAD__MAX_SAMPLES) o.albedo_samples = RAD__MAX_SAMPLES;
     max_area = o.max_area;
     max_edge = o.max_edge;
@@ -5936,14 +5986,14 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
        breaks the antisymmetry of a shared edge's test between its two triangles by up to one
        rounding, and rays slip between them. Standard C fuses only within an expression, but
        gcc with -std=gnu* (and any compiler with -ffp-contract=fast) fuses across statements,
-       so with FMA hardware any result within rounding of 0 is redone too. The redo is in
-       double, where a product of two floats is exact. */
+       so when RAD_FMA lets it (on FMA hardware) any result within rounding of 0 is redone too.
+       The redo is in double, where a product of two floats is exact. */
     {
         float cb = Cx * By, cy = Cy * Bx, ac = Ax * Cy, ay = Ay * Cx, ba = Bx * Ay, bb = By * Ax;
         U = cb - cy;
         V = ac - ay;
         W = ba - bb;
-#if defined(__FMA__)
+#if defined(RAD__FMA)
         if (fabsf(U) <= 1.2e-7f * (fabsf(cb) + fabsf(cy)) || fabsf(V) <= 1.2e-7f * (fabsf(ac) + fabsf(ay)) ||
             fabsf(W) <= 1.2e-7f * (fabsf(ba) + fabsf(bb)))
 #else
@@ -6066,7 +6116,7 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
     __m128 U = _mm_sub_ps(cb, cy), V = _mm_sub_ps(ac, ay), W = _mm_sub_ps(ba, bb), redo;
     float u[4], v[4], ww[4], az[4], bz[4], cz[4];
     int lanes = (1 << count) - 1, hit_mask, redo_mask, found = -1, j;
-#if defined(__FMA__)
+#if defined(RAD__FMA)
     {
         /* as in rad__wray_tri: the compiler may fuse these products into FMAs, so any result
            within rounding of zero is redone in double */
@@ -6590,14 +6640,20 @@ RAD_API void rad_camera_ray(const rad_camera *cam, uint32_t width, uint32_t heig
 static double rad__ff_point_tri(const double *p, const double *n, const float *v);
 /* end of functions defined in later sections */
 
+/* The defaults of rad_direct_options, written once: every consumer and
+   rad_direct_options_default pass through here, so a zeroed struct is the default. */
+static void rad__direct_options_resolve(rad_direct_options *o)
+{
+    if (o->samples == 0) o->samples = 16;
+    if (o->light_samples == 0) o->light_samples = 16;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+}
+
 RAD_API void rad_direct_options_default(rad_direct_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->samples = 16;
-    o->light_samples = 16;
-    o->include_emitters = 1;
-    o->ray_epsilon = 1e-5f;
+    rad__direct_options_resolve(o);
 }
 
 #define RAD__DIRECT_GROUP 64u /* points per task row when lighting arbitrary points */
@@ -6803,7 +6859,7 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
             }
         }
     }
-    if (d->o.include_emitters) {
+    if (!d->o.exclude_emitters) {
         double P[3], N[3], ks[RAD__MAX_SAMPLES], ksum;
         float ys[3 * RAD__MAX_SAMPLES];
         for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
@@ -6921,13 +6977,11 @@ static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const ra
     uint32_t l;
     memset(d, 0, sizeof(*d));
     if (!S || !rc || !rc->occluded || (light_count > 0 && !lights)) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) d->o = *options; else rad_direct_options_default(&d->o);
-    if (d->o.samples == 0) d->o.samples = 16;
+    if (options) d->o = *options; else memset(&d->o, 0, sizeof(d->o));
+    rad__direct_options_resolve(&d->o);
     if (d->o.samples > RAD__MAX_SAMPLES) d->o.samples = RAD__MAX_SAMPLES;
     d->o.samples = rad__lattice_side(d->o.samples) * rad__lattice_side(d->o.samples); /* a square */
-    if (d->o.light_samples == 0) d->o.light_samples = 16;
     if (d->o.light_samples > RAD__MAX_SAMPLES) d->o.light_samples = RAD__MAX_SAMPLES;
-    if (d->o.ray_epsilon == 0.0f) d->o.ray_epsilon = 1e-5f;
     if (!(d->o.ray_epsilon > 0.0f && d->o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(c, RAD_LOG_ERROR, "direct light options: ray_epsilon %g must be in (0, %g] (relative to the scene diagonal)",
                  (double)d->o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
@@ -7114,13 +7168,20 @@ static rad_result rad__fg_row(void *data, uint32_t row, uint32_t task)
     return RAD_SUCCESS;
 }
 
+/* The defaults of rad_final_gather_options, written once (rad_final_gather and
+   rad_final_gather_options_default pass through here). */
+static void rad__final_gather_options_resolve(rad_final_gather_options *o)
+{
+    if (o->rays == 0) o->rays = 64;
+    if (o->light_samples == 0) o->light_samples = 4;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+}
+
 RAD_API void rad_final_gather_options_default(rad_final_gather_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->rays = 64;
-    o->light_samples = 4;
-    o->ray_epsilon = 1e-5f;
+    rad__final_gather_options_resolve(o);
 }
 
 RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster *raycaster, const rad_light *lights,
@@ -7141,10 +7202,8 @@ RAD_API rad_result rad_final_gather(const rad_scene *scene, const rad_raycaster 
         rad__log(&c, RAD_LOG_ERROR, "final gather: NULL scene, raycaster (with intersect and occluded), points, normals or output");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else rad_final_gather_options_default(&o);
-    if (o.rays == 0) o.rays = 64;
-    if (o.light_samples == 0) o.light_samples = 4;
-    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__final_gather_options_resolve(&o);
     if (o.rays > 4096 || !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "final gather: rays %u (at most 4096) or ray_epsilon %g (in (0, %g]) out of range", o.rays,
                  (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
@@ -7370,14 +7429,20 @@ RAD_API float rad_ff_point_point(const float pi_[3], const float ni[3], const fl
     return sj * ci * cj / ((float)RAD__PI * d2);
 }
 
+/* The defaults of rad_form_factor_options, written once (every form-factor build and
+   rad_form_factor_options_default pass through here); method 0 is RAD_FF_ANALYTIC. */
+static void rad__form_factor_options_resolve(rad_form_factor_options *o)
+{
+    if (o->samples == 0) o->samples = 16;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+    if (o->hemicube_resolution == 0) o->hemicube_resolution = RAD__HC_DEFAULT_RES;
+}
+
 RAD_API void rad_form_factor_options_default(rad_form_factor_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->method = RAD_FF_ANALYTIC;
-    o->samples = 16;
-    o->ray_epsilon = 1e-5f;
-    o->hemicube_resolution = RAD__HC_DEFAULT_RES;
+    rad__form_factor_options_resolve(o);
 }
 
 /* shared state of one form-factor computation */
@@ -7913,12 +7978,10 @@ static rad_result rad__ff_setup(rad__ff *f, const rad_patches *P, const rad_rayc
     uint32_t i, s, T;
     memset(f, 0, sizeof(*f));
     if (!P) return RAD_ERROR_INVALID_ARGUMENT;
-    if (o) f->o = *o; else rad_form_factor_options_default(&f->o);
-    if (f->o.samples == 0) f->o.samples = 16;
+    if (o) f->o = *o; else memset(&f->o, 0, sizeof(f->o));
+    rad__form_factor_options_resolve(&f->o);
     if (f->o.samples > RAD__MAX_SAMPLES) f->o.samples = RAD__MAX_SAMPLES;
     f->o.samples = rad__lattice_side(f->o.samples) * rad__lattice_side(f->o.samples); /* a square */
-    if (f->o.ray_epsilon == 0.0f) f->o.ray_epsilon = 1e-5f;
-    if (f->o.hemicube_resolution == 0) f->o.hemicube_resolution = RAD__HC_DEFAULT_RES;
     if (!(f->o.ray_epsilon > 0.0f && f->o.ray_epsilon <= RAD__MAX_RAY_EPSILON) || !rad__finite(f->o.drop_threshold) ||
         f->o.drop_threshold < 0.0f ||
         (f->o.method != RAD_FF_ANALYTIC && f->o.method != RAD_FF_MONTE_CARLO && f->o.method != RAD_FF_HEMICUBE)) {
@@ -8256,12 +8319,20 @@ fail:
 /* >>solve: classic solvers                                                                 */
 /* ======================================================================================== */
 
+/* The defaults of rad_solve_options, written once (every solver and rad_solve_options_default
+   pass through here); output 0 is RAD_OUTPUT_INDIRECT. max_iterations stays 0 here: its
+   default depends on the solver (1000 sweeps, 100 N shooting steps) and each solver says it. */
+static void rad__solve_options_resolve(rad_solve_options *o)
+{
+    if (o->bounces == 0) o->bounces = 8;
+    if (o->tolerance == 0.0) o->tolerance = 1e-6;
+}
+
 RAD_API void rad_solve_options_default(rad_solve_options *o)
 {
     if (!o) return;
-    memset(o, 0, sizeof(*o)); /* output RAD_OUTPUT_INDIRECT */
-    o->bounces = 8;
-    o->tolerance = 1e-6;
+    memset(o, 0, sizeof(*o));
+    rad__solve_options_resolve(o);
 }
 
 RAD_API void rad_system_init(rad_system *system, const rad_matrix *F, const rad_patches *patches, const float *E)
@@ -8508,7 +8579,8 @@ static rad_result rad__solve_begin(const rad_system *s, const rad_solve_options 
         rad__log(c, RAD_LOG_ERROR, "%s: out is NULL", name);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) *o = *options; else rad_solve_options_default(o);
+    if (options) *o = *options; else memset(o, 0, sizeof(*o));
+    rad__solve_options_resolve(o);
     return rad__check_solve_options(o, c);
 }
 
@@ -8609,7 +8681,7 @@ RAD_API rad_result rad_solve_gauss_seidel(const rad_system *s, const rad_solve_o
         rad_result begun = rad__solve_begin(s, options, out, "rad_solve_gauss_seidel", &c, &o);
         if (begun != RAD_SUCCESS) return begun;
     }
-    tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
+    tol = o.tolerance;
     max_it = o.max_iterations ? o.max_iterations : 1000;
     n3 = 3 * (size_t)s->n;
     memcpy(out, s->E, n3 * sizeof(float));
@@ -8658,7 +8730,7 @@ RAD_API rad_result rad_solve_progressive(const rad_system *s, const rad_solve_op
         rad__log(&c, RAD_LOG_ERROR, "progressive refinement needs system->areas");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    tol = o.tolerance > 0.0 ? o.tolerance : 1e-6;
+    tol = o.tolerance;
     max_steps = o.max_iterations ? o.max_iterations : (s->n > 42949672u ? 0xFFFFFFFFu : 100u * s->n);
     n3 = 3 * (size_t)s->n;
     dB = (float *)rad__alloc_array(&c.allocator, n3, sizeof(float));
@@ -8852,12 +8924,28 @@ done:
 /* >>stochastic: stochastic (Monte Carlo) radiosity                                         */
 /* ======================================================================================== */
 
+/* The defaults of rad_stochastic_options, written once (rad_solve_stochastic and
+   rad_stochastic_options_default pass through here); method 0 is RAD_STOCHASTIC_JACOBI, output
+   0 RAD_OUTPUT_INDIRECT. The counts' defaults depend on the method and the patch count, so they
+   are filled only when patch_count is known (the solver); the _default function leaves them 0,
+   which stays right when the method is changed after it. */
+static void rad__stochastic_options_resolve(rad_stochastic_options *o, uint32_t patch_count)
+{
+    if (o->tolerance == 0.0) o->tolerance = 1e-4;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+    if (patch_count == 0) return;
+    if (o->rays == 0) {
+        uint64_t d = 64u * (uint64_t)patch_count;
+        o->rays = d < 4096u ? 4096u : d > (1u << 26) ? (1u << 26) : (uint32_t)d;
+    }
+    if (o->iterations == 0) o->iterations = o->method == RAD_STOCHASTIC_JACOBI ? 256u : 1u;
+}
+
 RAD_API void rad_stochastic_options_default(rad_stochastic_options *o)
 {
     if (!o) return;
-    memset(o, 0, sizeof(*o)); /* method RAD_STOCHASTIC_JACOBI, output RAD_OUTPUT_INDIRECT */
-    o->tolerance = 1e-4;
-    o->ray_epsilon = 1e-5f;
+    memset(o, 0, sizeof(*o));
+    rad__stochastic_options_resolve(o, 0);
 }
 
 #define RAD__SR_WAVE (1u << 20)   /* rays traced per wave: bounds the per-ray arrays */
@@ -9149,7 +9237,8 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     memset(&s, 0, sizeof(s));
-    if (options) s.o = *options; else rad_stochastic_options_default(&s.o);
+    if (options) s.o = *options; else memset(&s.o, 0, sizeof(s.o));
+    rad__stochastic_options_resolve(&s.o, patches->count);
     if ((s.o.method != RAD_STOCHASTIC_JACOBI && s.o.method != RAD_STOCHASTIC_WALK) ||
         (s.o.output != RAD_OUTPUT_INDIRECT && s.o.output != RAD_OUTPUT_TOTAL)) {
         rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: method %d or output %d unknown (RAD_STOCHASTIC_JACOBI or _WALK; "
@@ -9160,7 +9249,6 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
         rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: tolerance %g must be finite and >= 0", s.o.tolerance);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (s.o.ray_epsilon == 0.0f) s.o.ray_epsilon = 1e-5f;
     if (!(s.o.ray_epsilon > 0.0f && s.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "stochastic radiosity: ray_epsilon %g outside (0, 1e-2]", (double)s.o.ray_epsilon);
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -9170,12 +9258,6 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
                  "averages 'iterations' batches", s.o.regular_iterations);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (s.o.rays == 0) {
-        uint64_t d = 64u * (uint64_t)patches->count;
-        s.o.rays = d < 4096u ? 4096u : d > (1u << 26) ? (1u << 26) : (uint32_t)d;
-    }
-    if (s.o.iterations == 0) s.o.iterations = s.o.method == RAD_STOCHASTIC_JACOBI ? 256u : 1u;
-    if (s.o.tolerance == 0.0) s.o.tolerance = 1e-4;
     n3 = 3 * (size_t)patches->count;
     if (rad__check_input(&c, "stochastic radiosity (E)", E, n3) != RAD_SUCCESS) return RAD_ERROR_NON_FINITE;
     for (i = 0; i < n3; ++i) {
@@ -9322,14 +9404,22 @@ struct rad_hierarchical {
     rad_allocator allocator;
 };
 
+/* The defaults of rad_hierarchical_options, written once (rad_hierarchical_create and
+   rad_hierarchical_options_default pass through here); min_area 0 stays 0 (the total area /
+   10000, known at create), clustering 0 is AUTO. */
+static void rad__hierarchical_options_resolve(rad_hierarchical_options *o)
+{
+    if (o->tolerance == 0.0) o->tolerance = RAD__HR_DEFAULT_TOLERANCE;
+    if (o->visibility_rays == 0) o->visibility_rays = RAD__HR_DEFAULT_RAYS;
+    if (o->max_iterations == 0) o->max_iterations = RAD__HR_DEFAULT_ROUNDS;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+}
+
 RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->tolerance = RAD__HR_DEFAULT_TOLERANCE;
-    o->visibility_rays = RAD__HR_DEFAULT_RAYS;
-    o->max_iterations = RAD__HR_DEFAULT_ROUNDS;
-    o->ray_epsilon = 1e-5f;
+    rad__hierarchical_options_resolve(o);
 }
 
 RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
@@ -9655,11 +9745,8 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (options) o = *options;
-    else rad_hierarchical_options_default(&o);
-    if (o.tolerance == 0.0) o.tolerance = RAD__HR_DEFAULT_TOLERANCE;
-    if (o.visibility_rays == 0) o.visibility_rays = RAD__HR_DEFAULT_RAYS;
-    if (o.max_iterations == 0) o.max_iterations = RAD__HR_DEFAULT_ROUNDS;
-    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    else memset(&o, 0, sizeof(o));
+    rad__hierarchical_options_resolve(&o);
     if (!(o.tolerance > 0.0 && o.tolerance < 1.0)) {
         rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_create: tolerance %g must be in (0, 1)", o.tolerance);
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -10910,25 +10997,36 @@ static rad_result rad__sgemm(const rad__ctx *c, uint32_t m, uint32_t n, uint32_t
 /* ======================================================================================== */
 
 
+/* The defaults of rad_multibounce_options, written once (rad_multibounce_create and
+   rad_multibounce_options_default pass through here); precision 0 is RAD_MB_FLOAT. */
+static void rad__multibounce_options_resolve(rad_multibounce_options *o)
+{
+    if (o->bounces == 0) o->bounces = 3;
+    if (o->tolerance == 0.0) o->tolerance = 1e-8;
+    if (o->max_doublings == 0) o->max_doublings = 40;
+}
+
 RAD_API void rad_multibounce_options_default(rad_multibounce_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->bounces = 3;
-    o->precision = RAD_MB_FLOAT;
-    o->tolerance = 1e-8;
-    o->max_doublings = 40;
+    rad__multibounce_options_resolve(o);
+}
+
+/* The defaults of rad_block_options, written once (rad_multibounce_blocks_create and
+   rad_block_options_default pass through here); format 0 is RAD_BLOCK_BC4X3. */
+static void rad__block_options_resolve(rad_block_options *o)
+{
+    if (o->outlier_fraction == 0.0f) o->outlier_fraction = 0.05f;
+    if (o->reorder == 0) o->reorder = RAD_REORDER_MATCH;
+    if (o->tile == 0) o->tile = 64;
 }
 
 RAD_API void rad_block_options_default(rad_block_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->format = RAD_BLOCK_BC4X3;
-    o->outlier_fraction = 0.05f;
-    o->reorder = RAD_REORDER_MATCH;
-    o->reorder_samples = 0;
-    o->tile = 64;
+    rad__block_options_resolve(o);
 }
 
 RAD_API void rad_multibounce_destroy(rad_multibounce *mb)
@@ -11088,13 +11186,12 @@ RAD_API rad_result rad_multibounce_create(const rad_matrix *F, const float *albe
     r = rad__check_matrix(F, &c);
     if (r == RAD_ERROR_CORRUPT) return r;
     if (r != RAD_SUCCESS || !albedo) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_multibounce_options_default(&o);
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__multibounce_options_resolve(&o);
     if (o.bounces == 0 || (o.precision != RAD_MB_FLOAT && o.precision != RAD_MB_HALF) || !(o.tolerance >= 0.0)) {
         rad__log(&c, RAD_LOG_ERROR, "multibounce: bounces must be >= 1 (or RAD_MB_INFINITE), precision float or half");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (o.tolerance == 0.0) o.tolerance = 1e-8;
-    if (o.max_doublings == 0) o.max_doublings = 40;
     n = F->rows;
     if (n == 0 || F->cols != n) {
         rad__log(&c, RAD_LOG_ERROR, "multibounce: the matrix is %u x %u, not square", F->rows, F->cols);
@@ -12030,9 +12127,11 @@ typedef struct rad__mb_outliers {
 
 static rad_result rad__mb_options_check(const rad__ctx *c, const rad_block_options *o)
 {
-    if ((o->format != RAD_BLOCK_BC1 && o->format != RAD_BLOCK_BC4X3) || !(o->outlier_fraction >= 0.0f && o->outlier_fraction < 1.0f) ||
-        (o->tile % 4u) != 0 || o->reorder < RAD_REORDER_NONE || o->reorder > RAD_REORDER_MATCH) {
-        rad__log(c, RAD_LOG_ERROR, "blocks: bad options (format %d, outlier fraction %g, tile %u: a multiple of 4, reorder %d: 0..4)",
+    if ((o->format != RAD_BLOCK_BC1 && o->format != RAD_BLOCK_BC4X3) || !(o->outlier_fraction < 1.0f) ||
+        !rad__finite(o->outlier_fraction) || ((o->tile % 4u) != 0 && o->tile != RAD_BLOCK_WHOLE_MATRIX) ||
+        o->reorder < RAD_REORDER_GREEDY || o->reorder > RAD_REORDER_NONE) {
+        rad__log(c, RAD_LOG_ERROR, "blocks: bad options (format %d, outlier fraction %g: below 1, tile %u: a multiple of 4 or "
+                 "RAD_BLOCK_WHOLE_MATRIX, reorder %d: a RAD_REORDER_ value)",
                  (int)o->format, (double)o->outlier_fraction, o->tile, o->reorder);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
@@ -12177,9 +12276,15 @@ RAD_API rad_result rad_multibounce_blocks_create(const rad_multibounce *mb, cons
     *out = NULL;
     if (report) memset(report, 0, sizeof(*report));
     if (rad__mb_check(mb) != RAD_SUCCESS || mb->row_perm) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_block_options_default(&o);
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__block_options_resolve(&o);
     r = rad__mb_options_check(&c, &o);
     if (r != RAD_SUCCESS) return r;
+    /* from here on the steps a setting leaves out are 0: no outliers, one scale per channel,
+       no reordering */
+    if (o.outlier_fraction < 0.0f) o.outlier_fraction = 0.0f;
+    if (o.tile == RAD_BLOCK_WHOLE_MATRIX) o.tile = 0;
+    if (o.reorder == RAD_REORDER_NONE) o.reorder = 0;
     n = mb->n;
     bpr = (n + 3u) / 4u;
     tpr = o.tile ? (n + o.tile - 1u) / o.tile : 1u;
@@ -13251,14 +13356,19 @@ RAD_API rad_result rad_row_stream_create(const char *path, const rad_context *ct
 }
 #endif
 
+/* The defaults of rad_local_options, written once (rad_local_create and
+   rad_local_options_default pass through here); update, evict and rebuild 0 are
+   RAD_LOCAL_EXACT, RAD_LOCAL_EVICT_DOWNDATE and RAD_LOCAL_REBUILD_INVERSE. */
+static void rad__local_options_resolve(rad_local_options *o)
+{
+    if (o->capacity == 0) o->capacity = 1024;
+}
+
 RAD_API void rad_local_options_default(rad_local_options *options)
 {
     if (!options) return;
     memset(options, 0, sizeof(*options));
-    options->capacity = 1024;
-    options->update = RAD_LOCAL_EXACT;
-    options->evict = RAD_LOCAL_EVICT_DOWNDATE;
-    options->rebuild = RAD_LOCAL_REBUILD_INVERSE;
+    rad__local_options_resolve(options);
 }
 
 /* private scratch of a rad_local */
@@ -13300,16 +13410,18 @@ RAD_API rad_result rad_local_create(const rad_row_source *source, const rad_loca
     rad__ctx_init(&c, ctx);
     if (out) *out = NULL;
     if (!source || !out) return RAD_ERROR_INVALID_ARGUMENT;
-    if (options) o = *options; else rad_local_options_default(&o);
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__local_options_resolve(&o);
     if (!source->fetch || !source->areas || !source->albedo || source->n == 0) {
         rad__log(&c, RAD_LOG_ERROR, "rad_local_create: the row source needs n > 0, fetch, areas and albedo");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (o.capacity == 0 || o.capacity > source->n || (o.update != RAD_LOCAL_EXACT && o.update != RAD_LOCAL_FIRST_ORDER) ||
+    if (o.capacity > source->n) o.capacity = source->n; /* a set never holds more than every patch */
+    if ((o.update != RAD_LOCAL_EXACT && o.update != RAD_LOCAL_FIRST_ORDER) ||
         (o.evict != RAD_LOCAL_EVICT_DOWNDATE && o.evict != RAD_LOCAL_EVICT_DROP) ||
         (o.rebuild != RAD_LOCAL_REBUILD_INVERSE && o.rebuild != RAD_LOCAL_REBUILD_NEUMANN)) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_local_create: capacity %u must be in [1, n = %u], update and evict 0 or 1 (got %d, %d)",
-                 o.capacity, source->n, (int)o.update, (int)o.evict);
+        rad__log(&c, RAD_LOG_ERROR, "rad_local_create: update, evict and rebuild must be 0 or 1 (got %d, %d, %d)",
+                 (int)o.update, (int)o.evict, (int)o.rebuild);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     for (i = 0; i < source->n; ++i) {
@@ -14895,16 +15007,22 @@ struct rad_temporal {
     rad__ctx c;
 };
 
+/* The defaults of rad_temporal_options, written once (rad_temporal_create and
+   rad_temporal_options_default pass through here); mode 0 is RAD_TEMPORAL_SINGLE. */
+static void rad__temporal_options_resolve(rad_temporal_options *o)
+{
+    if (o->samples == 0) o->samples = 10;
+    if (o->weight == 0.0f) o->weight = 0.998f;
+    if (o->noise_target == 0.0f) o->noise_target = 0.01f;
+    if (o->weight_max == 0.0f) o->weight_max = 0.999f;
+    if (o->change_sigma == 0.0f) o->change_sigma = 5.0f;
+}
+
 RAD_API void rad_temporal_options_default(rad_temporal_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->mode = RAD_TEMPORAL_SINGLE;
-    o->samples = 10;
-    o->weight = 0.998f;
-    o->noise_target = 0.01f;
-    o->weight_max = 0.999f;
-    o->change_sigma = 5.0f;
+    rad__temporal_options_resolve(o);
 }
 
 RAD_API void rad_temporal_destroy(rad_temporal *t)
@@ -14953,7 +15071,8 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     if (options) o = *options;
-    else rad_temporal_options_default(&o);
+    else memset(&o, 0, sizeof(o));
+    rad__temporal_options_resolve(&o);
     if (!tables || (table_count != 1u && table_count != 3u) || !tables[0]) return RAD_ERROR_INVALID_ARGUMENT;
     if (o.mode != RAD_TEMPORAL_SINGLE && o.mode != RAD_TEMPORAL_FEEDBACK && o.mode != RAD_TEMPORAL_MULTIBOUNCE) {
         rad__log(&c, RAD_LOG_ERROR, "temporal: unknown mode %d", (int)o.mode);
@@ -14967,13 +15086,15 @@ RAD_API rad_result rad_temporal_create(const rad_alias_tables *const *tables, ui
         rad__log(&c, RAD_LOG_ERROR, "temporal: modes SINGLE and FEEDBACK need the albedo");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (o.samples == 0 || o.samples > RAD_TEMPORAL_MAX_SAMPLES || !(o.weight >= 0.0f && o.weight < 1.0f) ||
-        (o.adaptive && (!(o.noise_target > 0.0f) || !(o.weight_max >= 0.0f && o.weight_max < 1.0f) ||
+    if (o.samples > RAD_TEMPORAL_MAX_SAMPLES || !(o.weight < 1.0f) || !rad__finite(o.weight) ||
+        (o.adaptive && (!(o.noise_target > 0.0f) || !(o.weight_max < 1.0f) || !rad__finite(o.weight_max) ||
                         !(o.change_sigma > 0.0f) || !rad__finite(o.noise_target) || !rad__finite(o.change_sigma)))) {
         rad__log(&c, RAD_LOG_ERROR, "temporal: bad options (samples %u, weight %g, target %g, weight_max %g, sigma %g)", o.samples,
                  (double)o.weight, (double)o.noise_target, (double)o.weight_max, (double)o.change_sigma);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (o.weight < 0.0f) o.weight = 0.0f;         /* negative: no history */
+    if (o.weight_max < 0.0f) o.weight_max = 0.0f;
     n = tables[0]->rows;
     for (k = 0; k < table_count; ++k) {
         const rad_alias_tables *tb = tables[k];
@@ -15545,20 +15666,26 @@ typedef struct rad__vp_pair {
     float g;
 } rad__vp_pair;
 
+/* The defaults of rad_vp_options, written once (rad_vp_create, rad_vp_count and
+   rad_vp_options_default pass through here); weights, kind and storage 0 are
+   RAD_VP_WEIGHTS_SQUARED, RAD_VP_AXIS_ALIGNED and RAD_STORAGE_DENSE. */
+static void rad__vp_options_resolve(rad_vp_options *o)
+{
+    if (o->resolution == 0) o->resolution = 16;
+    if (o->face_points == 0) o->face_points = 16;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+    if (o->visibility_rays == 0) o->visibility_rays = 16;
+    if (o->share_rays == 0) o->share_rays = 16;
+    if (o->backface_limit == 0.0f) o->backface_limit = 0.25f;
+    if (o->max_clusters == 0) o->max_clusters = 6;
+    if (o->metric_columns == 0) o->metric_columns = 64;
+}
+
 RAD_API void rad_vp_options_default(rad_vp_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->resolution = 16;
-    o->face_points = 16;
-    o->weights = RAD_VP_WEIGHTS_SQUARED;
-    o->ray_epsilon = 1e-5f;
-    o->visibility_rays = 16;
-    o->share_rays = 16;
-    o->backface_limit = 0.25f;
-    o->kind = RAD_VP_AXIS_ALIGNED;
-    o->max_clusters = 6;
-    o->metric_columns = 64;
+    rad__vp_options_resolve(o);
 }
 
 /* the six split weights of a unit normal (sum 1) */
@@ -16906,14 +17033,10 @@ static rad_result rad__vp_create(const rad_scene *scene, const rad_raycaster *ra
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     memset(&b, 0, sizeof(b));
-    if (options) b.o = *options; else rad_vp_options_default(&b.o);
-    if (b.o.resolution == 0) b.o.resolution = 16;
-    if (b.o.face_points == 0) b.o.face_points = 16;
-    if (b.o.share_rays == 0) b.o.share_rays = 16;
-    if (b.o.backface_limit == 0.0f) b.o.backface_limit = 0.25f;
-    if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
-    if (b.o.max_clusters == 0) b.o.max_clusters = 6;
-    if (b.o.metric_columns == 0) b.o.metric_columns = 64;
+    if (options) b.o = *options; else memset(&b.o, 0, sizeof(b.o));
+    rad__vp_options_resolve(&b.o);
+    /* from here on visibility_rays 0 is the literal form: one ray per pair of samples */
+    if (b.o.visibility_rays == RAD_VP_RAYS_PER_PAIR) b.o.visibility_rays = 0;
     if ((b.o.kind != RAD_VP_AXIS_ALIGNED && b.o.kind != RAD_VP_CLUSTERED) || b.o.max_clusters > 6 || b.o.metric_columns > 4096) {
         rad__log(&c, RAD_LOG_ERROR, "rad_vp_create: bad kind, max_clusters (1..6) or metric_columns (<= 4096)");
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -17470,7 +17593,7 @@ struct rad_vp_lights {
     rad_allocator allocator;
     float *normals;                   /* 3M unit sample normals */
     float *v;                         /* 3M: rho_i D_i of the last update */
-    float *emit;                      /* 3M: the emitters' D (include_emitters), else NULL */
+    float *emit;                      /* 3M: the emitters' D (unless exclude_emitters), else NULL */
     float *sky;                       /* M: unoccluded hemisphere fraction, once a sky was seen */
     uint8_t *vis[RAD_VP_LIGHTS_MAX];  /* M per slot: cached visibility */
     int type[RAD_VP_LIGHTS_MAX];      /* the slot's light type at the last update, -1: none */
@@ -17485,8 +17608,7 @@ RAD_API void rad_vp_lights_options_default(rad_vp_lights_options *options)
 {
     if (!options) return;
     memset(options, 0, sizeof(*options));
-    rad_direct_options_default(&options->direct);
-    options->direct.include_emitters = 0;
+    rad__direct_options_resolve(&options->direct);
 }
 
 RAD_API void rad_vp_lights_destroy(rad_vp_lights *s)
@@ -17533,7 +17655,8 @@ RAD_API rad_result rad_vp_lights_create(const rad_virtual_patches *vp, const rad
     s->vp = vp;
     s->rc = raycaster;
     if (options) s->o = *options;
-    else rad_vp_lights_options_default(&s->o);
+    else memset(&s->o, 0, sizeof(s->o));
+    rad__direct_options_resolve(&s->o.direct);
     for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) s->type[l] = -1, s->full[l] = 1;
     /* the options and raycaster, checked as rad_direct_irradiance checks them */
     if ((r = rad__direct_setup(&d, vp->scene, raycaster, NULL, 0, &s->o.direct, &c)) != RAD_SUCCESS) {
@@ -17554,7 +17677,7 @@ RAD_API rad_result rad_vp_lights_create(const rad_virtual_patches *vp, const rad
         rad_vp_lights_destroy(s);
         return r;
     }
-    if (s->o.direct.include_emitters) {
+    if (!s->o.direct.exclude_emitters) {
         s->emit = (float *)rad__alloc_array(&c.allocator, M ? (size_t)M : 1u, 3 * sizeof(float));
         if (!s->emit) r = RAD_ERROR_OUT_OF_MEMORY;
         else r = rad_direct_irradiance(vp->scene, raycaster, NULL, 0, &s->o.direct, vp->sample_positions, vp->sample_normals, M,
@@ -17725,7 +17848,7 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
         if (!tmp || !s->sky) r = RAD_ERROR_OUT_OF_MEMORY;
         else {
             rad_direct_options o = s->o.direct;
-            o.include_emitters = 0;
+            o.exclude_emitters = 1;
             r = rad_direct_irradiance(s->vp->scene, s->rc, &unit, 1, &o, s->vp->sample_positions, s->vp->sample_normals, M, tmp, ctx);
         }
         if (r == RAD_SUCCESS)
@@ -17992,27 +18115,41 @@ RAD_API rad_result rad_vp_load(const rad_container *ct, const char *name, const 
 #define RAD__LM_SH_Y0 0.282094792f /* 1 / (2 sqrt(pi)) */
 #define RAD__LM_SH_Y1 0.488602512f /* sqrt(3) / (2 sqrt(pi)) */
 
+/* The defaults of rad_lightmap_options, written once (rad_lightmap_create and
+   rad_lightmap_options_default pass through here). */
+static void rad__lightmap_options_resolve(rad_lightmap_options *o)
+{
+    if (o->width == 0) o->width = 256;
+    if (o->height == 0) o->height = 256;
+    if (o->samples == 0) o->samples = 4;
+    if (o->validity_rays == 0) o->validity_rays = 16;
+    if (o->backface_limit == 0.0f) o->backface_limit = 0.1f;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+}
+
 RAD_API void rad_lightmap_options_default(rad_lightmap_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->width = o->height = 256;
-    o->samples = 4;
-    o->validity_rays = 16;
-    o->backface_limit = 0.1f;
-    o->ray_epsilon = 1e-5f;
+    rad__lightmap_options_resolve(o);
+}
+
+/* The defaults of rad_lightmap_gather_options, written once (rad_lightmap_gather and
+   rad_lightmap_gather_options_default pass through here); encoding and method 0 are
+   RAD_LIGHTMAP_IRRADIANCE and RAD_LIGHTMAP_GATHER_EXACT. */
+static void rad__lightmap_gather_options_resolve(rad_lightmap_gather_options *o)
+{
+    if (o->visibility_rays == 0) o->visibility_rays = 4;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+    if (o->hemisphere_rays == 0) o->hemisphere_rays = 256;
+    if (o->exact_ratio == 0.0f) o->exact_ratio = 16.0f;
 }
 
 RAD_API void rad_lightmap_gather_options_default(rad_lightmap_gather_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->encoding = RAD_LIGHTMAP_IRRADIANCE;
-    o->visibility_rays = 4;
-    o->ray_epsilon = 1e-5f;
-    o->method = RAD_LIGHTMAP_GATHER_EXACT;
-    o->hemisphere_rays = 256;
-    o->exact_ratio = 16.0f;
+    rad__lightmap_gather_options_resolve(o);
 }
 
 RAD_API uint32_t rad_lightmap_channels(rad_lightmap_encoding encoding)
@@ -18164,13 +18301,8 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
         rad__log(&c, RAD_LOG_ERROR, "lightmap: no mesh of the scene has lightmap_uvs");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else rad_lightmap_options_default(&o);
-    if (o.width == 0) o.width = 256;
-    if (o.height == 0) o.height = 256;
-    if (o.samples == 0) o.samples = 4;
-    if (o.validity_rays == 0) o.validity_rays = 16;
-    if (o.backface_limit == 0.0f) o.backface_limit = 0.1f;
-    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__lightmap_options_resolve(&o);
     if (o.width > RAD__LM_MAX_SIDE || o.height > RAD__LM_MAX_SIDE || o.samples > RAD__LM_MAX_SUB ||
         o.validity_rays > 1024u || !(o.backface_limit > 0.0f && o.backface_limit <= 1.0f) ||
         !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
@@ -18630,11 +18762,8 @@ RAD_API rad_result rad_lightmap_gather(const rad_lightmap *lm, const rad_patches
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: the patches were made from another scene than the lightmap");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else rad_lightmap_gather_options_default(&o);
-    if (o.visibility_rays == 0) o.visibility_rays = 4;
-    if (o.ray_epsilon == 0.0f) o.ray_epsilon = 1e-5f;
-    if (o.hemisphere_rays == 0) o.hemisphere_rays = 256;
-    if (o.exact_ratio == 0.0f) o.exact_ratio = 16.0f;
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__lightmap_gather_options_resolve(&o);
     if (rad_lightmap_channels(o.encoding) == 0 || o.visibility_rays > 64u ||
         !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "lightmap gather: encoding %d, visibility_rays %u (at most 64) or ray_epsilon %g out of range",
@@ -19609,16 +19738,24 @@ RAD_API void rad_sh9_irradiance(const float coefficients[27], const float n[3], 
 
 #define RAD__PROBES_VP_RAYS 2048u /* rad_probe_options.vp_rays' default */
 
+/* The defaults of rad_probe_options, written once (rad_probes_create, rad_probes_create_vp and
+   rad_probe_options_default pass through here); spacing, max_move and clearance 0 stay 0 (their
+   defaults depend on the scene, known at create), weighting 0 is RAD_PROBE_WEIGHT_NORMAL_FIT. */
+static void rad__probe_options_resolve(rad_probe_options *o)
+{
+    if (o->rays == 0) o->rays = 256;
+    if (o->vp_rays == 0) o->vp_rays = RAD__PROBES_VP_RAYS;
+    if (o->patch_samples == 0) o->patch_samples = 4;
+    if (o->light_samples == 0) o->light_samples = 64;
+    if (o->backface_fraction == 0.0f) o->backface_fraction = 0.25f;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+}
+
 RAD_API void rad_probe_options_default(rad_probe_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->rays = 256;
-    o->patch_samples = 4;
-    o->light_samples = 64;
-    o->backface_fraction = 0.25f;
-    o->ray_epsilon = 1e-5f;
-    o->vp_rays = RAD__PROBES_VP_RAYS;
+    rad__probe_options_resolve(o);
 }
 
 /* direction k of n in a spherical Fibonacci set: equal areas, deterministic */
@@ -20064,13 +20201,8 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     S = vp ? vp->scene : patches->scene;
     N = vp ? vp->count : patches->count;
     memset(&b, 0, sizeof(b));
-    if (options) b.o = *options; else rad_probe_options_default(&b.o);
-    if (b.o.rays == 0) b.o.rays = 256;
-    if (b.o.vp_rays == 0) b.o.vp_rays = RAD__PROBES_VP_RAYS;
-    if (b.o.patch_samples == 0) b.o.patch_samples = 4;
-    if (b.o.light_samples == 0) b.o.light_samples = 64;
-    if (b.o.backface_fraction == 0.0f) b.o.backface_fraction = 0.25f;
-    if (b.o.ray_epsilon == 0.0f) b.o.ray_epsilon = 1e-5f;
+    if (options) b.o = *options; else memset(&b.o, 0, sizeof(b.o));
+    rad__probe_options_resolve(&b.o);
     if (b.o.patch_samples > RAD__MAX_SAMPLES) b.o.patch_samples = RAD__MAX_SAMPLES;
     if (b.o.light_samples > RAD__MAX_SAMPLES) b.o.light_samples = RAD__MAX_SAMPLES;
     if (b.o.rays > 65536u || (vp && b.o.vp_rays > 65536u)) {
@@ -23203,6 +23335,13 @@ RAD_API rad_result rad_glsl_source(rad_glsl_id id, char *dst, size_t dst_size, s
 
 #endif /* RAD_NO_GLSL */
 
+#if !defined(RAD_FMA)
+#  if defined(__clang__)
+#    pragma STDC FP_CONTRACT DEFAULT
+#  elif defined(__GNUC__)
+#    pragma GCC pop_options
+#  endif
+#endif
 #endif /* RADIOSITY_IMPLEMENTATION */
 
 /*

@@ -110,7 +110,7 @@ static int scrambled(const rad_multibounce *mb, double t_jac, size_t bytes_f)
             if (ro == RAD_REORDER_GREEDY_2OPT) continue;
             rad_block_options_default(&bo);
             bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
-            bo.reorder = (int)ro;
+            bo.reorder = ro ? (int)ro : RAD_REORDER_NONE; /* ro 0: "none" */
             if (rad_multibounce_blocks_create(&view, &bo, NULL, &b, &rep)) return 1;
             if (!ro) plain = rep.mse;
             emit("| %s | %d | %.3g | %.2f |\n", f ? "3xBC4" : "BC1", (int)ro, rep.mse, plain / rep.mse);
@@ -133,7 +133,7 @@ static int scrambled(const rad_multibounce *mb, double t_jac, size_t bytes_f)
             for (j = 0; j < 3 * n; ++j) E[j] = (float)((j * 2654435761u) % 1000u) / 1000.0f;
             rad_block_options_default(&bo);
             bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
-            bo.outlier_fraction = fractions[i];
+            bo.outlier_fraction = fractions[i] > 0.0f ? fractions[i] : -1.0f; /* 0%: no outlier step */
             if (rad_multibounce_blocks_create(mb, &bo, NULL, &b, &rep)) return 1;
             memset(&r, 0, sizeof(r));
             r.b = b;
@@ -234,9 +234,9 @@ static int bench_size(uint32_t target)
                         if (ki != 1 && (ro == RAD_REORDER_GREEDY_2OPT)) continue;
                         rad_block_options_default(&bo);
                         bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
-                        bo.reorder = (int)ro;
+                        bo.reorder = ro ? (int)ro : RAD_REORDER_NONE; /* ro 0: "none" */
                         bo.reorder_samples = 0;
-                        bo.tile = tl ? 0u : 64u;
+                        bo.tile = tl ? RAD_BLOCK_WHOLE_MATRIX : 64u;
                         t0 = now();
                         if (rad_multibounce_blocks_create(mb, &bo, NULL, &b, &rep)) return 1;
                         tb = now() - t0;
@@ -344,7 +344,7 @@ static int reorder_only(uint32_t target)
                 int rep_i;
                 rad_block_options_default(&bo);
                 bo.format = f ? RAD_BLOCK_BC4X3 : RAD_BLOCK_BC1;
-                bo.reorder = ro > RAD_REORDER_MATCH ? RAD_REORDER_MATCH : (int)ro;
+                bo.reorder = ro > RAD_REORDER_MATCH ? RAD_REORDER_MATCH : ro ? (int)ro : RAD_REORDER_NONE;
                 bo.reorder_samples = ro > RAD_REORDER_MATCH ? 256u : 0u;
                 for (rep_i = 0; rep_i < (sc ? 1 : 3); ++rep_i) { /* build time: best of 3 on the patch order */
                     rad_multibounce_blocks_destroy(b);

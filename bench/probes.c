@@ -151,7 +151,7 @@ static void proxy_rows(rad_vp_kind kind, uint32_t resolution, float (*ref)[SPHER
     Ev = (float *)malloc(sizeof(float) * 3 * vp->count);
     Bv = (float *)malloc(sizeof(float) * 3 * vp->count);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     rad_vp_sources(vp, &rc, NULL, 0, &dopt, RAD_SOURCE_DIRECT, Ev, NULL);
     rad_vp_system(&sys, vp, Ev);
     rad_solve_options_default(&so);

@@ -290,7 +290,7 @@ static void run(const char *name, const rad_scene_desc *desc, const rad_light *f
         check(rad_temporal_create(tp1, 1, vp->albedo, &to, vc, &tp), "rad_temporal_create");
         rad_vp_lights_options_default(&lo);
         lo.rays_per_frame = variant & 1 ? (M + 3) / 4 : 0;
-        lo.direct.include_emitters = emitters;
+        lo.direct.exclude_emitters = !emitters;
         lo.direct.light_samples = 4;
         check(rad_vp_lights_create(vp, &rc, &lo, vc, &dyn), "rad_vp_lights_create");
         for (f = 0; f < frames + 4; ++f) { /* 4 warm-up frames: the lights' first full test */
@@ -327,7 +327,7 @@ static void run(const char *name, const rad_scene_desc *desc, const rad_light *f
 
     /* 2. the jump: converged at A, then B; the reference: Gauss-Seidel on E of B */
     rad_vp_lights_options_default(&lo);
-    lo.direct.include_emitters = emitters;
+    lo.direct.exclude_emitters = !emitters;
     lo.direct.light_samples = 4;
     check(rad_vp_lights_create(vp, &rc, &lo, NULL, &dyn), "rad_vp_lights_create");
     place(&lights[fixed_count], centre, radius, 3.14159265f);

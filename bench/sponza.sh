@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# sponza.sh - how much of the light the virtual patches keep on a real building (issue 18's
-# accuracy target): the Sponza atrium under a sun and under a sky window above the open roof,
+# sponza.sh - how much of the light the virtual patches keep on a real building (the accuracy
+# that matters to users with real meshes): the Sponza atrium under a sun and under a sky window above the open roof,
 # `rad render --method aavp|vp` at about 4k and 12k patches against `rad trace --spp 256`:
 # ratio of mean radiance, PSNR and SSIM (`rad compare`), the build's wall time and peak memory.
 #   RAD_DATA_DIR=DIR bash bench/sponza.sh build/rad OUT.md

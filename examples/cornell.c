@@ -327,7 +327,7 @@ int main(int argc, char **argv)
     H = (float *)xmalloc(sizeof(float) * 3 * n);
     Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)patches->vertex_count);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     dopt.light_samples = 32;
     progress_begin(&ps, "direct light");
     t0 = now_seconds();
@@ -389,7 +389,7 @@ int main(int argc, char **argv)
     memset(accum, 0, sizeof(float) * 3 * (size_t)width * height);
     image = (unsigned char *)xmalloc((size_t)3 * width * height);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     dopt.light_samples = light_samples;
 
     t0 = now_seconds();

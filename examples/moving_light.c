@@ -202,7 +202,7 @@ int main(int argc, char **argv)
     else memset(Dc, 0, sizeof(float) * 3 * n);
     check(rad_sources(P, RAD_SOURCE_EMISSION, NULL, Em), "rad_sources (emission)");
     if (!ceiling) memset(Em, 0, sizeof(float) * 3 * n);
-    dopt.include_emitters = 0; /* per frame: the point light only */
+    dopt.exclude_emitters = 1; /* per frame: the point light only */
 
     for (i = 0; i < P->vertex_count; ++i)
         for (c = 0; c < 3; ++c) {
@@ -219,7 +219,7 @@ int main(int argc, char **argv)
     rad_temporal_options_default(&to);
     to.mode = single ? RAD_TEMPORAL_SINGLE : RAD_TEMPORAL_FEEDBACK;
     to.samples = k;
-    to.weight = w;
+    to.weight = w > 0.0f ? w : -1.0f; /* --w 0: no history (a weight of 0 is the default) */
     to.adaptive = (int)adaptive;
     to.seed = seed;
     {

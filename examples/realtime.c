@@ -197,6 +197,7 @@ int main(int argc, char **argv)
     }
     rad_vp_lights_options_default(&lo);
     lo.rays_per_frame = rays;
+    lo.direct.exclude_emitters = 1; /* the lights above only: the lamp's own light is not part of this loop */
     check(rad_vp_lights_create(vp, &rc, &lo, NULL, &dyn), "rad_vp_lights_create");
 
     /* 4. the frames */

@@ -163,8 +163,9 @@ s_unit_openmp() {
 }
 s_unit_scalar() { RAD_TEST_QUICK=1 unit unit-scalar $CC -std=c99 $WARN -O2 -DRAD_NO_SIMD -I. tests/test_main.c; }
 s_unit_avx() { RAD_TEST_QUICK=1 unit unit-avx $CC -std=c99 $WARN -O2 -mavx -I. tests/test_main.c; }
-# gnu99: contraction into FMA on, as in a default gcc build (the watertight test must hold)
-s_unit_native() { RAD_TEST_QUICK=1 unit unit-native $CC -std=gnu99 $WARN -O2 -march=native $OMP -I. tests/test_main.c; }
+# RAD_FMA and gnu99: the FMA kernels and contraction into FMA on (the watertight test must
+# hold, and every determinism test within this build); the other native builds run without FMA
+s_unit_native() { RAD_TEST_QUICK=1 unit unit-native $CC -std=gnu99 $WARN -O2 -march=native -DRAD_FMA $OMP -I. tests/test_main.c; }
 s_unit_embree() {
     if [ -f /usr/include/embree3/rtcore.h ]; then
         RAD_TEST_QUICK=1 unit unit-embree $CC -std=c99 $WARN -O2 $OMP -DRAD_EMBREE -DRAD_TEST_EMBREE -I. tests/test_main.c -lembree3
@@ -214,6 +215,7 @@ s_compile() {
         build "alone-$(basename "$t" .c)" $CC -std=c99 $WARN $OMP -fsyntax-only -I. "$t" || alone=0
     done
     if [ $alone = 1 ]; then pass test-files-alone; else fail test-files-alone; fi
+    fma_opt_in
     # ---- GLSL: the header holds the current glsl/ sources
     if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
        "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
@@ -222,6 +224,37 @@ s_compile() {
         sed "s/^/    /" "$BUILD/glsl-embed.out" 2>/dev/null
         fail glsl-embed-current
     fi
+}
+
+# FMA only with RAD_FMA: a -march=native build of the implementation holds no fused
+# multiply-add without it, and some with it (clang when installed: it contracts by default)
+fma_opt_in() {
+    local fcc=$CC n_off n_on
+    have clang && fcc=clang
+    if ! have objdump || ! $fcc -march=native -dM -E - </dev/null 2>/dev/null | grep -q __FMA__; then
+        skip fma-opt-in "no objdump, or $fcc -march=native has no FMA on this CPU"; return
+    fi
+    printf '#define RADIOSITY_IMPLEMENTATION\n#include "radiosity.h"\n' >"$BUILD/impl-fma.c"
+    if build fma-off $fcc -std=gnu99 -O1 -march=native -I. -c "$BUILD/impl-fma.c" -o "$BUILD/impl-fma-off.o" &&
+       build fma-on $fcc -std=gnu99 -O1 -march=native -DRAD_FMA -I. -c "$BUILD/impl-fma.c" -o "$BUILD/impl-fma-on.o"; then
+        n_off=$(objdump -d "$BUILD/impl-fma-off.o" | grep -cE 'vf(n)?m(add|sub)')
+        n_on=$(objdump -d "$BUILD/impl-fma-on.o" | grep -cE 'vf(n)?m(add|sub)')
+        if [ "$n_off" = 0 ] && [ "$n_on" -gt 0 ]; then pass fma-opt-in
+        else echo "    fused multiply-adds: $n_off without RAD_FMA (want 0), $n_on with it (want some)"; fail fma-opt-in; fi
+    else
+        fail fma-opt-in
+    fi
+}
+
+# what is written twice stays the same: docs/api.md is the header's index, the QUICK START
+# comment is examples/quickstart.c, and tests/test_defaults.c covers every option struct
+# (tests/check_docs.sh says the command that fixes each)
+s_docs() {
+    local doc
+    for doc in api quickstart defaults; do
+        if bash tests/check_docs.sh $doc >"$BUILD/check-docs-$doc.out" 2>&1; then pass "docs-$doc-current"
+        else sed "s/^/    /" "$BUILD/check-docs-$doc.out"; fail "docs-$doc-current"; fi
+    done
 }
 
 # The examples call only the API: each is compiled with
@@ -540,6 +573,7 @@ stage clang s_clang
 stage unit-avx s_unit_avx
 stage examples s_examples
 stage compile s_compile
+stage docs s_docs
 stage test-tool s_test_tool
 stage dist s_dist
 wait

@@ -1,5 +1,5 @@
-/* test_alloc.c - allocation failure injected at every allocation of the method builds that
-   came after the core (issue 11, item 2): multi-bounce matrix, its block compression, alias
+/* test_alloc.c - allocation failure injected at every allocation of the method builds beyond
+   the core, whose own allocations the scene tests cover: multi-bounce matrix, its block compression, alias
    tables and the temporal state with two steps. Every call returns success or
    RAD_ERROR_OUT_OF_MEMORY, nothing leaks and no block is overrun (the counting allocator of
    test_scene.c with its canaries). */

@@ -1,4 +1,4 @@
-/* test_api.c - argument checking over the whole public API (issue 11, item 6): every public
+/* test_api.c - argument checking over the whole public API: every public
    function with NULL pointers, zero sizes, out-of-range indices and bad option values returns
    the documented error without crashing and without writing outputs it should not. Functions
    returning void / float / uint32 / pointers must not crash on NULL and return their neutral

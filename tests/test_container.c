@@ -365,7 +365,7 @@ static void *ct_save_with_h(const ct_fixture *f, const rad_matrix *F, uint32_t h
     return dst;
 }
 
-/* Bakes with valid checksums but NaN, 3e38 or negative values (issue 23): every loader value
+/* Bakes with valid checksums but NaN, 3e38 or negative values: every loader value
    is checked once at load (NON_FINITE for NaN/Inf, CORRUPT for a finite value out of range),
    the message names the section, the entry and the value; rad_save_memory refuses to write
    what would not load. */
@@ -474,7 +474,7 @@ static uint64_t ct_fnv_words(uint64_t h, const void *words, size_t n)
 /* A scene of the same triangle count with one vertex moved, or one albedo changed, is refused
    with the reason; the same scene is accepted; a bake saved without a scene loads and is
    checked by its triangle count only (with a warning); the options hash is compared when both
-   sides have one (issue 23). */
+   sides have one, so a bake of other options is not used as if it were this one. */
 static void ct_test_signature(void)
 {
     ct_fixture f;

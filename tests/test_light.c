@@ -270,11 +270,11 @@ static void li_test_emissive_square(void)
         CHECK(D2[k] > 0.0f);
     }
     printf("    unoccluded D = %.5g, with the occluder %.5g (ratio %.3f)\n", D[0], D2[0], D2[0] / D[0]);
-    /* include_emitters = 0: nothing */
+    /* exclude_emitters: nothing */
     {
         rad_direct_options o;
         rad_direct_options_default(&o);
-        o.include_emitters = 0;
+        o.exclude_emitters = 1;
         CHECK_OK(rad_direct_irradiance(s.scene, &s.rc, NULL, 0, &o, p, up, 1, D2, NULL));
         CHECK(D2[0] == 0.0f && D2[1] == 0.0f && D2[2] == 0.0f);
     }

@@ -393,7 +393,7 @@ static int lm_cornell_make(lm_cornell *c, uint32_t cell, uint32_t patches, int d
         rad_direct_options dopt;
         float *D = (float *)malloc(sizeof(float) * 3 * c->P->count);
         rad_direct_options_default(&dopt);
-        dopt.include_emitters = 1;
+        dopt.exclude_emitters = 0;
         CHECK_OK(rad_direct_patches(c->P, &c->rc, NULL, 0, &dopt, D, NULL));
         CHECK_OK(rad_sources(c->P, RAD_SOURCE_DIRECT, D, c->E));
         free(D);
@@ -793,7 +793,7 @@ static rad_result lm_hr_source(void *user, const float *points, const float *nor
     uint32_t i;
     (void)triangles;
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     r = rad_direct_irradiance(d->S, d->rc, NULL, 0, &dopt, points, normals, count, out_E, NULL);
     for (i = 0; r == RAD_SUCCESS && i < 3 * count; ++i) out_E[i] *= albedos[i];
     return r;
@@ -848,7 +848,7 @@ static void lm_test_other_sources(void)
     Bv = (float *)malloc(sizeof(float) * 3 * vp->count);
     Pv = (float *)malloc(sizeof(float) * 3 * vp->count);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     CHECK_OK(rad_vp_sources(vp, &cb.rc, NULL, 0, &dopt, RAD_SOURCE_DIRECT, Ev, NULL));
     rad_vp_system(&sys, vp, Ev);
     rad_solve_options_default(&so);

@@ -521,8 +521,14 @@ static void test_local_bad_input(void)
     rad_local_options_default(&o);
     o.capacity = 2;
     CHECK_RESULT(rad_local_create(NULL, &o, NULL, &L), RAD_ERROR_INVALID_ARGUMENT);
-    o.capacity = 3;
+    o.capacity = 3; /* more than the n = 2 patches: taken as 2 */
+    CHECK_OK(rad_local_create(&src, &o, NULL, &L));
+    if (L) CHECK(L->capacity == 2);
+    rad_local_destroy(L);
+    L = NULL;
+    o.rebuild = (rad_local_rebuild_method)2;
     CHECK_RESULT(rad_local_create(&src, &o, NULL, &L), RAD_ERROR_INVALID_ARGUMENT);
+    o.rebuild = RAD_LOCAL_REBUILD_INVERSE;
     o.capacity = 2;
     albedo[4] = 1.0f;
     CHECK_RESULT(rad_local_create(&src, &o, NULL, &L), RAD_ERROR_ALBEDO_RANGE);

@@ -983,7 +983,7 @@ static float *pb_vp_solve(const pb_cornell *f, uint32_t resolution, rad_vp_kind 
     E = (float *)malloc(sizeof(float) * 3 * (*vp)->count);
     B = (float *)malloc(sizeof(float) * 3 * (*vp)->count);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     rad_solve_options_default(&so);
     so.output = RAD_OUTPUT_TOTAL;
     if (!E || !B || rad_vp_sources(*vp, &f->rc, NULL, 0, &dopt, RAD_SOURCE_DIRECT, E, NULL) != RAD_SUCCESS) {

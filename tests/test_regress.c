@@ -117,7 +117,7 @@ static void rg_test_extreme_area_ratio(void)
     rad_scene_destroy(s);
 }
 
-/* review of the run-time products (issue 23): a NaN or Inf in E, or a product that overflows
+/* the run-time products: a NaN or Inf in E, or a product that overflows
    float, returned success with NaN/Inf in the output from rad_matrix_multiply, the two
    multi-bounce applies and the temporal step, while the solvers refused it. One rule now:
    NON_FINITE, and the temporal state is left as it was. */
@@ -273,7 +273,7 @@ static void rg_test_hand_made_systems(void)
     CHECK_RESULT(rad_solve_jacobi(&sys, &so, y, NULL, NULL), RAD_ERROR_CORRUPT);
 }
 
-/* adversarial pass (issue 23): the BVH missed every ray of a Cornell box scaled 1e14 (the
+/* scale: the BVH missed every ray of a Cornell box scaled 1e14 (the
    watertight test's t was a length^3 product that overflowed float; below 1e-13 it
    underflowed), so images came out black with success. Radiosity is scale-free: the mean
    radiosity, the direct light and the camera hits must be those of the unit box at both
@@ -392,7 +392,7 @@ static void rg_test_scene_scale(void)
 }
 
 #ifndef RAD_NO_STDIO
-/* adversarial pass (issue 23): rad_load_file on a folder asked for a 9.2e18-byte buffer
+/* files: rad_load_file on a folder asked for a 9.2e18-byte buffer
    (OUT_OF_MEMORY), any file was read whole before its header was looked at, and a failed
    save left a partial file where the old one was. */
 static void rg_test_file_io(void)
@@ -467,7 +467,7 @@ static void rg_test_file_io(void)
 }
 #endif
 
-/* adversarial pass (issue 23): ray_epsilon 0.3 or 1e30 was accepted (rays then start past
+/* option ranges: ray_epsilon 0.3 or 1e30 was accepted (rays then start past
    the walls: row sums above 1, energy from nowhere), and rad_direct_irradiance scaled its
    answer by the length of the normal it was given (a zero normal gave 0 with success). */
 static void rg_test_epsilon_and_normals(void)
@@ -532,7 +532,7 @@ done:
     rad_scene_destroy(S);
 }
 
-/* adversarial pass (issue 23): a raycaster callback's failure came back as RAYCAST_FAILED
+/* errors name their cause: a raycaster callback's failure came back as RAYCAST_FAILED
    with nothing in the log, so a user could not tell which call or why. */
 static int rg_log_lines;
 static char rg_log_last[512];
@@ -583,7 +583,7 @@ done:
     rad_scene_destroy(S);
 }
 
-/* adversarial pass (issue 23): virtual patches failed at scale 1e12 (NaN form factors,
+/* scale: virtual patches failed at scale 1e12 (NaN form factors,
    reported as if the lights were too strong) and lost half the light at 1e-12 without a word:
    the pair kernel multiplied two sample areas (length^4) in float. */
 static double rg_vp_mean(double scale, rad_result *why)

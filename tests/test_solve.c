@@ -100,7 +100,7 @@ static void so_furnace(const float albedo[3])
 
     /* Jacobi, K bounces: E sum_{k=0..K} rho^k (total), E sum_{k=1..K} rho^k (indirect).
        A row sum off by d changes bounce k by at most k rho^k d E. */
-    for (K = 0; K <= 6; K += 3)
+    for (K = 1; K <= 7; K += 3) /* K = 0 would be the default, 8 */
         for (out_mode = 0; out_mode < 2; ++out_mode) {
             rad_solve_options_default(&so);
             so.bounces = K;

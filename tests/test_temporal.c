@@ -227,7 +227,7 @@ static void tp_expectation(void)
     }
     CHECK_OK(rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, NULL, &t));
     rad_temporal_options_default(&o);
-    o.weight = 0.0f;
+    o.weight = -1.0f; /* no history */
     o.samples = 10;
     CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)&t, 1, c.patches->albedo, &o, NULL, &tm));
     if (tm) {
@@ -338,7 +338,7 @@ static void tp_multibounce_channels(void)
     }
     rad_temporal_options_default(&o);
     o.mode = RAD_TEMPORAL_MULTIBOUNCE;
-    o.weight = 0.0f;
+    o.weight = -1.0f; /* no history */
     o.samples = 16;
     if (t[0] && t[1] && t[2]) {
         CHECK_OK(rad_temporal_create((const rad_alias_tables *const *)t, 3, NULL, &o, NULL, &tm));
@@ -527,11 +527,11 @@ static void tp_errors(void)
         const rad_alias_tables *pair[2];
         pair[0] = t; pair[1] = t3;
         CHECK_RESULT(rad_temporal_create(pair, 1, NULL, &o, &ctx, &tm), RAD_ERROR_INVALID_ARGUMENT); /* no albedo */
-        o.samples = 0;
+        o.samples = RAD_TEMPORAL_MAX_SAMPLES + 1u;
         CHECK_RESULT(rad_temporal_create(pair, 1, alb, &o, &ctx, &tm), RAD_ERROR_INVALID_ARGUMENT);
         o.samples = 4; o.weight = 1.0f;
         CHECK_RESULT(rad_temporal_create(pair, 1, alb, &o, &ctx, &tm), RAD_ERROR_INVALID_ARGUMENT);
-        o.weight = 0.5f; o.adaptive = 1; o.noise_target = 0.0f;
+        o.weight = 0.5f; o.adaptive = 1; o.noise_target = -1.0f;
         CHECK_RESULT(rad_temporal_create(pair, 1, alb, &o, &ctx, &tm), RAD_ERROR_INVALID_ARGUMENT);
         o.adaptive = 0;
         CHECK_RESULT(rad_temporal_create(pair, 2, alb, &o, &ctx, &tm), RAD_ERROR_INVALID_ARGUMENT);
@@ -768,7 +768,7 @@ static void tp_huge_tables(void)
 }
 
 /* Alias totals with a valid checksum but NaN or 3e38 are refused at load, and the draw count k
-   is bounded (issue 23: a bake with k = 16M took 10 s per frame at 206 patches) */
+   is bounded (a bake with k = 16M took 10 s per frame at 206 patches) */
 static void tp_bad_values(void)
 {
     tp_cornell c;
@@ -853,7 +853,7 @@ static void tp_column_past_n(void)
         rad_temporal_options_default(&o);
         o.mode = mode ? RAD_TEMPORAL_FEEDBACK : RAD_TEMPORAL_SINGLE;
         o.samples = 4;
-        o.weight = 0.0f;
+        o.weight = -1.0f; /* no history */
         CHECK_OK(rad_temporal_create(tp1, 1, albedo, &o, NULL, &tm));
         if (!tm) continue;
         CHECK_OK(rad_temporal_step(tm, E, E0, out));

@@ -62,7 +62,7 @@ static void vp_test_reciprocity(void)
         o.resolution = rad_test_quick() ? 4 : 6;
         o.face_points = rad_test_quick() ? 4 : 9;
         o.weights = w == 1 ? RAD_VP_WEIGHTS_COSINE : RAD_VP_WEIGHTS_SQUARED;
-        if (w == 2) o.visibility_rays = 0; /* a ray per sample pair */
+        if (w == 2) o.visibility_rays = RAD_VP_RAYS_PER_PAIR;
         if (w == 3) { o.kind = RAD_VP_CLUSTERED; o.max_clusters = 3; } /* general virtual patches */
         CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vp));
         if (!vp) break;
@@ -509,7 +509,7 @@ static void vp_test_sampled_visibility(void)
     o.resolution = rad_test_quick() ? 4 : 6;
     o.face_points = rad_test_quick() ? 4 : 9;
     CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &vs));
-    o.visibility_rays = 0;
+    o.visibility_rays = RAD_VP_RAYS_PER_PAIR;
     CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &ve));
     if (vs && ve) {
         uint32_t N = vs->count, a, b;
@@ -578,7 +578,7 @@ static void vp_test_axis_visibility(void)
     rad_vp_options_default(&o);
     o.resolution = 6;
     o.face_points = 4;
-    o.visibility_rays = 0;
+    o.visibility_rays = RAD_VP_RAYS_PER_PAIR;
     CHECK_OK(rad_vp_create(scene, &rc, &o, NULL, &ve));
     for (t = 0; t < 2 && ve; ++t) {
         rad_virtual_patches *vs = NULL;

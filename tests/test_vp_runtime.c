@@ -495,20 +495,21 @@ static void vpr_test_dynamic_lights_exact(void)
     Ex = (float *)malloc(sizeof(float) * 3 * N);
     if (!E || !Ex) goto out;
     rad_vp_lights_options_default(&lo);
+    lo.direct.exclude_emitters = 1;
     CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &dl));
-    lo.direct.include_emitters = 1;
+    lo.direct.exclude_emitters = 0;
     lo.direct.light_samples = 4;
     CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &de));
     if (!dl || !de) goto out;
     for (pass = 0; pass < 2; ++pass) {
         vpr_dyn_lights(lights, scene, pass ? -0.3f : 0.25f);
         rad_direct_options_default(&dopt);
-        dopt.include_emitters = 0;
+        dopt.exclude_emitters = 1;
         CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
         CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));
         CHECK(rad_vp_lights_rays(dl) > 0 && rad_vp_lights_rays(dl) <= 3u * vp->sample_count);
         for (i = 0; i < 3 * N; ++i) bad += memcmp(&E[i], &Ex[i], sizeof(float)) != 0;
-        dopt.include_emitters = 1;
+        dopt.exclude_emitters = 0;
         dopt.light_samples = 4;
         CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
         CHECK_OK(rad_vp_lights_update(de, lights, 3, E, NULL));
@@ -570,6 +571,7 @@ static void vpr_test_serial_same_bits(void)
     seven.parallel_for = vpr_reverse_for;
     seven.task_count = 7;
     rad_vp_lights_options_default(&lo);
+    lo.direct.exclude_emitters = 1;
     lo.rays_per_frame = vp->sample_count / 3u + 1u;
     CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &d1));
     CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &d7));
@@ -637,6 +639,7 @@ static void vpr_test_dynamic_lights_converge(void)
     if (!E || !Ex || !Ld || !L) goto out;
     budget = (vp->sample_count + P - 1) / P;
     rad_vp_lights_options_default(&lo);
+    lo.direct.exclude_emitters = 1; /* as the reference below */
     lo.rays_per_frame = budget;
     CHECK_OK(rad_vp_lights_create(vp, &rc, &lo, NULL, &dl));
     if (!dl) goto out;
@@ -644,7 +647,7 @@ static void vpr_test_dynamic_lights_converge(void)
     CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL)); /* the first: every sample */
     vpr_dyn_lights(lights, scene, -0.3f);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 0;
+    dopt.exclude_emitters = 1;
     CHECK_OK(rad_vp_sources(vp, &rc, lights, 3, &dopt, RAD_SOURCE_DIRECT, Ex, NULL));
     for (f = 0; f < P; ++f) {
         CHECK_OK(rad_vp_lights_update(dl, lights, 3, E, NULL));

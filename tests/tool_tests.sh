@@ -698,7 +698,7 @@ bad "--mode bogus" "unknown --mode 'bogus'" bake cornell --method temporal --mod
 bad "--method bogus" "unknown method 'bogus'" render cornell --method bogus -o "$TMP/y.pfm"
 bad "bake --method pathtrace" "needs no bake" bake cornell --method pathtrace -o "$TMP/y.radb"
 
-# ---- reliability (issue 23): the tool's side ---------------------------------------------------
+# ---- reliability: the tool refuses what it cannot do, with a message -----------------------------
 # --threads is bounded: 100000 crashed inside libgomp
 for c in formfactors bake render trace; do
     bad "$c --threads 100000" "--threads 100000 is too many (at most 1024" $c "$TMP/parallel.obj" --threads 100000 $([ $c = formfactors ] || echo -o "$TMP/y.pfm")

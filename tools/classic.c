@@ -121,7 +121,7 @@ int tool_classic_sources(const char *cmd, const tool_world *w, const tool_classi
     out->D = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     out->E = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     dopt.light_samples = o->light_samples;
     tool_context(&ctx, "direct light");
     r = rad_direct_patches(out->patches, &w->rc, w->file.lights, w->file.light_count, &dopt, out->D, &ctx);
@@ -169,7 +169,8 @@ int tool_classic_indirect(const char *cmd, const tool_classic_options *o, const 
         }
         break;
     case TOOL_DIRECT: r = rad_solve_direct(&sys, &so, c->L, &ctx); break;
-    default: r = rad_solve_jacobi(&sys, &so, c->L, &stats, &ctx); break;
+    /* --bounces 0: no indirect light (L stays 0; a solve's bounces of 0 would be its default) */
+    default: r = o->bounces ? rad_solve_jacobi(&sys, &so, c->L, &stats, &ctx) : RAD_SUCCESS; break;
     }
     c->solve_seconds = tool_seconds() - t1;
     tool_progress_end();

@@ -122,7 +122,7 @@ static int bake_vp(const char *cmd, const char *path, const tool_world *w, const
     if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_create", r);
     E = (float *)tool_calloc(3 * (size_t)vp->count, sizeof(float));
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     dopt.light_samples = o->light_samples;
     tool_context(&ctx, "direct light");
     r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);

@@ -167,7 +167,7 @@ int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic
     E = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     dopt.light_samples = co->light_samples;
     tool_context(&ctx, "direct light");
     r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
@@ -185,8 +185,11 @@ int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic
             fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge\n", cmd);
             r = RAD_SUCCESS;
         }
-    } else {
+    } else if (co->bounces) {
         r = rad_solve_jacobi(&sys, &so, L, NULL, &ctx);
+    } else {
+        memset(L, 0, sizeof(float) * 3 * (size_t)vp->count); /* --bounces 0: no indirect light */
+        r = RAD_SUCCESS;
     }
     if (r != RAD_SUCCESS) { tool_fail(cmd, "solve", r); goto fail; }
     for (i = 0; i < 3 * n; ++i) L[i] += E[i];
@@ -341,7 +344,7 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     if (direct && !sh) {
         rad_direct_options dopt;
         rad_direct_options_default(&dopt);
-        dopt.include_emitters = 1;
+        dopt.exclude_emitters = 0;
         dopt.light_samples = co->light_samples;
         tool_context(&ctx, "lightmap direct");
         r = rad_lightmap_direct(out->lm, &w->rc, w->file.lights, w->file.light_count, &dopt, out->values, &ctx);

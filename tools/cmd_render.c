@@ -236,7 +236,7 @@ static int render_classic(const tool_world *w, const rad_patches *P, const float
         shaded = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     }
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     dopt.light_samples = light_samples;
     tool_context(&quiet, NULL);
     /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
@@ -712,7 +712,7 @@ static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const 
         to.mode = mo->mode;
         to.samples = mo->k;
         to.adaptive = mo->adaptive && !(mo->given & TOOL_OPT_W);
-        to.weight = mo->w;
+        to.weight = mo->w > 0.0f ? mo->w : -1.0f; /* --w 0: no history */
         to.seed = mo->seed;
         if ((r = rad_temporal_create(tp3, count, vp->albedo, &to, &ctx, &tp)) != RAD_SUCCESS) { what = "rad_temporal_create"; goto done; }
         steps = (double *)xmalloc(sizeof(double) * mo->frames);
@@ -821,12 +821,12 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad
     to.mode = mo->mode;
     to.samples = mo->k;
     to.adaptive = mo->adaptive && !(mo->given & TOOL_OPT_W);
-    to.weight = mo->w;
+    to.weight = mo->w > 0.0f ? mo->w : -1.0f; /* --w 0: no history */
     to.seed = mo->seed;
     if ((r = rad_temporal_create(tp1, 1, vp->albedo, &to, &ctx, &tp)) != RAD_SUCCESS) { what = "rad_temporal_create"; goto done; }
     rad_vp_lights_options_default(&lo);
     lo.rays_per_frame = mo->light_rays;
-    lo.direct.include_emitters = 1;
+    lo.direct.exclude_emitters = 0;
     lo.direct.light_samples = patch_light_samples; /* as rad_vp_sources got them for the still image */
 #if defined(__unix__) || defined(__APPLE__)
     if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
@@ -1029,7 +1029,7 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
     B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     dopt.light_samples = o->light_samples;
     tool_context(&ctx, "direct light");
     t0 = tool_seconds();
@@ -1060,8 +1060,11 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
                         stats.residual, stats.iterations);
                 r = RAD_SUCCESS;
             }
-        } else {
+        } else if (mo->bounces) {
             r = rad_solve_jacobi(&sys, &so, L, &stats, &ctx);
+        } else {
+            memset(L, 0, sizeof(float) * 3 * (size_t)n); /* --bounces 0: no indirect light */
+            r = RAD_SUCCESS;
         }
         for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
         if (r == RAD_SUCCESS && rc == 0) r = rad_matrix_multiply(&vp->matrix, B, H, &ctx);

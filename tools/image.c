@@ -14,8 +14,8 @@
 
    Every file the tool writes goes through tool_output_open/commit below: the bytes go to a
    temporary file in the destination's folder, which is renamed onto the destination only when
-   every write, the flush and the close succeeded, so a failed write leaves the old file as it
-   was (issue 23). */
+   every write, the flush and the close succeeded, so a failed write (a full disk) leaves the
+   old file as it was. */
 #if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
 #define _POSIX_C_SOURCE 200809L /* mkstemp, fchmod, fsync */
 #endif

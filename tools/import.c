@@ -342,7 +342,7 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
 /* ---- assimp's log ------------------------------------------------------------------------- */
 
 /* assimp reports what it repaired or dropped only to its logger: a glTF with an out-of-range
-   index lost a triangle with exit 0 (issue 23). While a file is imported its warnings and
+   index lost a triangle with exit 0. While a file is imported its warnings and
    errors are shown (at most LOG_SHOWN), and one saying faces were dropped for out-of-range
    indices fails the import with that reason. */
 #define LOG_SHOWN 10
@@ -453,7 +453,7 @@ static unsigned gltf_required_extensions(const char *path, char *out, size_t cap
 
 /* assimp's aiProcess_JoinIdenticalVertices joins vertices closer than an absolute 1e-5: a
    Cornell box scaled by 3e-5 lost corners (the floor-to-ceiling form factor moved by 8%) and
-   at 1e-5 whole triangles collapsed (issue 23). The tool welds here instead, within each assimp
+   at 1e-5 whole triangles collapsed. The tool welds here instead, within each assimp
    mesh (like assimp), with a tolerance relative to that mesh's size: positions within
    WELD_REL x its bounding-box diagonal, and uvs and normals within assimp's 1e-5 (they do not
    scale with the scene), make one vertex. So the result does not depend on the scene's units. */

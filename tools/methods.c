@@ -789,7 +789,7 @@ int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_op
     mi.bounces = mo->bounces;
     mi.format = mo->format;
     mi.outliers = mo->outliers;
-    mi.reorder = (uint32_t)mo->reorder;
+    mi.reorder = mo->reorder == RAD_REORDER_NONE ? 0u : (uint32_t)mo->reorder; /* the record: 0 is no reordering */
     mi.reorder_samples = mo->reorder_samples;
     mi.tile = mo->tile;
     mi.mode = (uint32_t)mo->mode;
@@ -832,10 +832,10 @@ int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_op
             double t1 = tool_seconds();
             rad_block_options_default(&bo);
             bo.format = mo->format == TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
-            bo.outlier_fraction = mo->outliers;
+            bo.outlier_fraction = mo->outliers > 0.0f ? mo->outliers : -1.0f; /* --outliers 0: none */
             bo.reorder = mo->reorder;
             bo.reorder_samples = mo->reorder_samples;
-            bo.tile = mo->tile;
+            bo.tile = mo->tile ? mo->tile : RAD_BLOCK_WHOLE_MATRIX; /* --tile 0: one scale per matrix */
             memset(&report, 0, sizeof report);
             tool_context(&ctx, "compression");
             r = rad_multibounce_blocks_create(mb, &bo, &ctx, &blocks, &report);
@@ -1185,6 +1185,7 @@ int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *b
         to.samples = (mo->given & TOOL_OPT_K) ? mo->k : mi.k;
         to.adaptive = (mo->given & TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & TOOL_OPT_W) ? 0 : (int)mi.adaptive;
         to.weight = (mo->given & TOOL_OPT_W) ? mo->w : mi.w;
+        if (to.weight == 0.0f) to.weight = -1.0f; /* --w 0: no history (a weight of 0 is the default) */
         to.seed = (mo->given & TOOL_OPT_SEED) ? mo->seed : mi.seed;
         if ((r = rad_temporal_create(tp, tcount, m->albedo, &to, &m->ctx, &m->temporal)) != RAD_SUCCESS) {
             tool_indirect_close(m);
@@ -1265,7 +1266,7 @@ int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_met
     if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
     sd.w = w;
     rad_direct_options_default(&sd.dopt);
-    sd.dopt.include_emitters = 1;
+    sd.dopt.exclude_emitters = 0;
     sd.dopt.light_samples = light_samples;
     ho.source = hr_source;
     ho.source_user = &sd;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# tools/report.sh - the evaluation report (issue #12): every radiosity method of the `rad` tool
+# tools/report.sh - the evaluation report: every radiosity method of the `rad` tool
 # against the path-traced reference (`rad trace`), with MSE / PSNR / SSIM, per-frame times and
 # the published figures of Shcherbakov 2025 (docs/references.md; "T" below) side by side, difference heat maps, and plots
 # (per-frame time against N, temporal error against frame, compression error with and without
@@ -223,7 +223,7 @@ run_scene() {
     { cat "$md"; echo; cat "$imgs"; } >> "$TMP/scenes.md"
 }
 
-# ---- real scenes: the Dabrovic Sponza (issue 18) ------------------------------------------------
+# ---- real scenes: the Dabrovic Sponza, a real building ------------------------------------------
 # The view and lights of docs/performance-notes.md ("Row sums matched to traced shares"); the
 # model has no materials, so the script writes a copy with the one stone material that
 # bench/realtime.c gives it. Virtual patches at about 2k and 12k (the resolutions of the
@@ -546,7 +546,7 @@ MD="$OUT/REPORT.md"
     echo "# radiosity.h evaluation report"
     echo
     echo "Every method of the \`rad\` tool against a path-traced reference, side by side with the figures the"
-    echo "Shcherbakov 2025 publishes (T; docs/references.md lists it), all measured in one run of \`tools/report.sh\` (issue #12)."
+    echo "Shcherbakov 2025 publishes (T; docs/references.md lists it), all measured in one run of \`tools/report.sh\`."
     echo
     echo "| setting | value |"
     echo "|---|---|"

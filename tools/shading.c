@@ -68,7 +68,7 @@ int tool_shade_direct(const tool_world *w, int model, uint32_t light_samples, co
     for (i = 0; i < count; ++i) out_rgb[3 * i] = out_rgb[3 * i + 1] = out_rgb[3 * i + 2] = 0.0f;
     /* the analytic lights, one at a time: irradiance on a surface facing the light (the
        "normal" handed to rad_direct_irradiance is l itself), times R(l, v, n) */
-    dopt.include_emitters = 0;
+    dopt.exclude_emitters = 1;
     for (j = 0; j < nl; ++j) {
         const rad_light *L = &lights[j];
         if (L->type == RAD_LIGHT_SKY) { rest[nrest++] = *L; continue; }
@@ -92,7 +92,7 @@ int tool_shade_direct(const tool_world *w, int model, uint32_t light_samples, co
         }
     }
     /* emissive triangles and the sky: Lambertian */
-    dopt.include_emitters = 1;
+    dopt.exclude_emitters = 0;
     r = rad_direct_irradiance(w->scene, &w->rc, rest, nrest, &dopt, points, normals, count, irr, &quiet);
     if (r != RAD_SUCCESS) { result = tool_fail("render", "rad_direct_irradiance (area lights)", r); goto done; }
     for (i = 0; i < 3 * count; ++i) out_rgb[i] += albedos[i] * (float)(1.0 / 3.14159265358979323846) * irr[i];

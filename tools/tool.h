@@ -133,7 +133,7 @@ int tool_progress(void *user, float fraction);
 void tool_log(void *user, rad_log_level level, const char *message);
 /* --threads N (0: all): sets the OpenMP thread count when built with OpenMP */
 void tool_set_threads(int threads);
-/* The most --threads accepts: libgomp crashes creating 100000 threads (issue 23), and more
+/* The most --threads accepts: libgomp crashes creating 100000 threads, and more
    threads than this helps no machine the tool runs on. */
 #define TOOL_MAX_THREADS 1024u
 /* --threads N: a whole number in 0..TOOL_MAX_THREADS; 0 on success, else prints
@@ -144,7 +144,7 @@ int tool_parse_camera(const char *text, rad_camera *out);
 /* parses "WxH"; 0 on success */
 int tool_parse_size(const char *text, int *w, int *h);
 /* The most memory an image may take (linear RGB floats, 12 bytes a pixel): 2 GiB, e.g.
-   16384x8192. --size 32768x32768 allocated 12 GiB without a word (issue 23). */
+   16384x8192. --size 32768x32768 would allocate 12 GiB without a word. */
 #define TOOL_MAX_IMAGE_BYTES 2147483648.0
 /* --size: 0 when the image fits TOOL_MAX_IMAGE_BYTES, else prints "rad CMD: ..." with the
    bytes and returns 2 */
