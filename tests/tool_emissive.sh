@@ -1,0 +1,53 @@
+# tool_emissive.sh - emission through the importer (sourced by tool_tests.sh, which defines RAD,
+# TMP, ok, fail and close): the glTF Cornell box of tests/data (radiance 17 12 4 written as
+# emissiveFactor (1, 12/17, 4/17) x KHR_materials_emissive_strength 17, which assimp 5.2 does
+# not read) renders like the OBJ box, a 2 x 2 checker emissiveTexture (mean one half) halves
+# all the light in rad render and rad trace, and rad info reports each material.
+EM_DIR=$(dirname "${BASH_SOURCE[0]}")/data
+"$RAD" export cornell -o "$TMP/em_box.obj" > /dev/null 2>&1
+em_mean() { "$RAD" compare "$1" "$2" 2> /dev/null | awk '/^mean:/ { print $2, $3 }'; }
+if "$RAD" render "$TMP/em_box.obj" -o "$TMP/em_obj.pfm" --size 48x48 --aa 4 --patches 150 > /dev/null 2>&1 &&
+    "$RAD" render "$EM_DIR/cornell.gltf" -o "$TMP/em_gltf.pfm" --size 48x48 --aa 4 --patches 150 > /dev/null 2> "$TMP/em_err.txt" &&
+    "$RAD" render "$EM_DIR/cornell_textured.gltf" -o "$TMP/em_tex.pfm" --size 48x48 --aa 4 --patches 150 > /dev/null 2>&1; then
+    set -- $(em_mean "$TMP/em_gltf.pfm" "$TMP/em_obj.pfm")
+    close "$1" "$2" 0.01 && ok "glTF Cornell box (emissive strength 17) renders the OBJ box's energy ($1 vs $2)" ||
+        fail "glTF Cornell box (emissive strength 17) renders the OBJ box's energy" "mean $1 vs $2"
+    set -- $(em_mean "$TMP/em_tex.pfm" "$TMP/em_obj.pfm")
+    close "$1" "$(awk -v b="$2" 'BEGIN { print b / 2 }')" 0.01 &&
+        ok "a checker emissiveTexture halves the rendered light ($1 vs $2)" ||
+        fail "a checker emissiveTexture halves the rendered light" "mean $1 vs $2"
+else
+    fail "render of the glTF Cornell box" "$(head -c 300 "$TMP/em_err.txt")"
+fi
+if "$RAD" trace "$EM_DIR/cornell.gltf" -o "$TMP/em_tr.pfm" --size 32x32 --spp 16 > /dev/null 2>&1 &&
+    "$RAD" trace "$EM_DIR/cornell_textured.gltf" -o "$TMP/em_trt.pfm" --size 32x32 --spp 16 > /dev/null 2>&1; then
+    set -- $(em_mean "$TMP/em_trt.pfm" "$TMP/em_tr.pfm")
+    close "$1" "$(awk -v b="$2" 'BEGIN { print b / 2 }')" 0.03 &&
+        ok "rad trace: a checker emissiveTexture halves the light ($1 vs $2)" ||
+        fail "rad trace: a checker emissiveTexture halves the light" "mean $1 vs $2"
+else
+    fail "rad trace of the glTF Cornell box" ""
+fi
+# rad info SCENE: per material what was used and what was ignored, by name
+sed 's/"name": "m0_white",/"name": "m0_white", "normalTexture": {"index": 0}, "doubleSided": true, "alphaMode": "MASK", "alphaCutoff": 0.25, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}},/' \
+    "$EM_DIR/cornell_textured.gltf" > "$TMP/em_info.gltf"
+if "$RAD" info "$TMP/em_info.gltf" > "$TMP/em_info.txt" 2> "$TMP/em_err.txt"; then
+    awk '/^material .*m3_light/ { on = 1; next } /^material/ { on = 0 } on' "$TMP/em_info.txt" > "$TMP/em_light.txt"
+    grep -q "emission (radiance): texture '.*' x 17 12 4 (emissiveFactor 1 0.705882 0.235294 x KHR_materials_emissive_strength 17)" \
+        "$TMP/em_light.txt" && ok "rad info: the lamp's emission factor, strength and texture" ||
+        fail "rad info: the lamp's emission factor, strength and texture" "$(head -c 400 "$TMP/em_light.txt")"
+    awk '/^material .*m0_white/ { on = 1; next } /^material/ { on = 0 } on' "$TMP/em_info.txt" > "$TMP/em_white.txt"
+    grep -q "doubleSided: true (read" "$TMP/em_white.txt" && grep -q "alphaMode: MASK, alphaCutoff 0.25 (read" "$TMP/em_white.txt" &&
+        grep -q "ignored: .*normalTexture (not diffuse)" "$TMP/em_white.txt" &&
+        grep -q "ignored: .*KHR_materials_transmission (extension)" "$TMP/em_white.txt" &&
+        grep -q "ignored: .*metallicFactor (not diffuse)" "$TMP/em_white.txt" &&
+        ok "rad info: doubleSided, alphaMode read; normalTexture, metallicFactor, KHR_materials_transmission named as ignored" ||
+        fail "rad info: what a material read and ignored" "$(head -c 600 "$TMP/em_white.txt")"
+else
+    fail "rad info of a glTF scene" "$(head -c 300 "$TMP/em_err.txt")"
+fi
+if "$RAD" info cornell > "$TMP/em_ci.txt" 2>&1 && grep -q "emission (radiance): 17 12 4" "$TMP/em_ci.txt"; then
+    ok "rad info cornell lists the built-in materials"
+else
+    fail "rad info cornell lists the built-in materials" "$(head -c 300 "$TMP/em_ci.txt")"
+fi
