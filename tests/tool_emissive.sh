@@ -51,3 +51,10 @@ if "$RAD" info cornell > "$TMP/em_ci.txt" 2>&1 && grep -q "emission (radiance): 
 else
     fail "rad info cornell lists the built-in materials" "$(head -c 300 "$TMP/em_ci.txt")"
 fi
+# a negative emissive strength is refused naming the material, not dropped
+sed 's/"emissiveStrength": 17.0/"emissiveStrength": -17.0/' "$EM_DIR/cornell.gltf" > "$TMP/em_neg.gltf"
+"$RAD" info "$TMP/em_neg.gltf" > /dev/null 2> "$TMP/em_err.txt"
+rc=$?
+[ $rc -eq 1 ] && grep -q "material .* 'm3_light': emissive strength -17 is out of range" "$TMP/em_err.txt" &&
+    ok "a negative KHR_materials_emissive_strength is refused naming the material" ||
+    fail "a negative KHR_materials_emissive_strength is refused naming the material" "exit $rc: $(head -c 300 "$TMP/em_err.txt")"

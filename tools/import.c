@@ -278,6 +278,8 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
 
 /* The largest emission (radiance) accepted: what the tool's other inputs allow (1e30). */
 #define EMISSION_MAX 1e30f
+/* no KHR_materials_emissive_strength in a glTF material (gltf_emissive_strength) */
+#define GLTF_NO_STRENGTH (-1e300)
 
 /* 0, or 1 with the reason in err (a negative, NaN, infinite or overflowing emission: it used
    to become 0 without a word). *clamped: set to 1 when the albedo was clamped into
@@ -311,8 +313,8 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
             return 1;
         }
         strength = (float)fv;
-    } else if (json_strength >= 0.0) { /* KHR_materials_emissive_strength, read from the JSON */
-        if (!(json_strength <= (double)EMISSION_MAX)) {
+    } else if (json_strength != GLTF_NO_STRENGTH) { /* KHR_materials_emissive_strength, read from the JSON */
+        if (!(json_strength >= 0.0 && json_strength <= (double)EMISSION_MAX)) {
             if (err && errlen)
                 snprintf(err, errlen, "'%s': material %u '%s': emissive strength %g is out of range (want a finite value in [0, %g])",
                          file, index, name.data, json_strength, (double)EMISSION_MAX);
@@ -636,12 +638,12 @@ static const char *gltf_material(const char *json, unsigned i)
     return mats ? js_at(mats, i) : NULL;
 }
 
-/* KHR_materials_emissive_strength of glTF material m, or -1 when it has none (a value that is
-   not a number gives NaN: refused by convert_material) */
+/* KHR_materials_emissive_strength of glTF material m, or GLTF_NO_STRENGTH when it has none (a
+   value that is not a number gives NaN; it and a negative one are refused by convert_material) */
 static double gltf_emissive_strength(const char *m)
 {
     const char *ext = m ? js_get(m, "extensions") : NULL, *ks, *v;
-    if (!ext || !(ks = js_get(ext, "KHR_materials_emissive_strength"))) return -1.0;
+    if (!ext || !(ks = js_get(ext, "KHR_materials_emissive_strength"))) return GLTF_NO_STRENGTH;
     v = js_get(ks, "emissiveStrength");
     if (!v) return 1.0; /* the extension's default */
     if (!((*v >= '0' && *v <= '9') || *v == '-' || *v == '.')) return (double)NAN;
