@@ -58,3 +58,31 @@ rc=$?
 [ $rc -eq 1 ] && grep -q "material .* 'm3_light': emissive strength -17 is out of range" "$TMP/em_err.txt" &&
     ok "a negative KHR_materials_emissive_strength is refused naming the material" ||
     fail "a negative KHR_materials_emissive_strength is refused naming the material" "exit $rc: $(head -c 300 "$TMP/em_err.txt")"
+# OBJ: Ke x map_Ke, the glTF's checker written out as a PNG, uvs 0..1 across the lamp
+grep -o 'data:image/png;base64,[^"]*' "$EM_DIR/cornell_textured.gltf" | cut -d, -f2 | base64 -d > "$TMP/em_checker.png"
+awk 'BEGIN { print "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1" }
+     /^o / { lamp = ($2 == "light") }
+     /^v / { nv++; if (lamp && !first) first = nv }
+     lamp && /^f / { printf "f"; for (i = 2; i <= 4; ++i) printf " %d/%d", $i, $i - first + 1; print ""; next }
+     { print }' "$TMP/em_box.obj" | sed 's/^mtllib .*/mtllib em_tex.mtl/' > "$TMP/em_tex.obj"
+sed 's/^Ke 17 12 4$/Ke 17 12 4\nmap_Ke em_checker.png/' "$TMP/em_box.mtl" > "$TMP/em_tex.mtl"
+if "$RAD" render "$TMP/em_tex.obj" -o "$TMP/em_objtex.pfm" --size 48x48 --aa 4 --patches 150 > /dev/null 2> "$TMP/em_err.txt" &&
+    [ -f "$TMP/em_obj.pfm" ]; then
+    set -- $(em_mean "$TMP/em_objtex.pfm" "$TMP/em_obj.pfm")
+    close "$1" "$(awk -v b="$2" 'BEGIN { print b / 2 }')" 0.01 && ok "OBJ map_Ke (checker) x Ke halves the rendered light ($1 vs $2)" ||
+        fail "OBJ map_Ke (checker) x Ke halves the rendered light" "mean $1 vs $2"
+else
+    fail "render of an OBJ with map_Ke" "$(head -c 300 "$TMP/em_err.txt")"
+fi
+# the other methods follow the texture: the hierarchical elements' mean, AAVP's samples
+for em_m in hierarchical aavp; do
+    if "$RAD" render "$EM_DIR/cornell.gltf" -o "$TMP/em_a.pfm" --size 24x24 --aa 1 --method $em_m > /dev/null 2>&1 &&
+        "$RAD" render "$EM_DIR/cornell_textured.gltf" -o "$TMP/em_b.pfm" --size 24x24 --aa 1 --method $em_m > /dev/null 2> "$TMP/em_err.txt"; then
+        set -- $(em_mean "$TMP/em_b.pfm" "$TMP/em_a.pfm")
+        close "$1" "$(awk -v b="$2" 'BEGIN { print b / 2 }')" 0.01 &&
+            ok "--method $em_m: a checker emissiveTexture halves the light ($1 vs $2)" ||
+            fail "--method $em_m: a checker emissiveTexture halves the light" "mean $1 vs $2"
+    else
+        fail "--method $em_m render of the textured glTF box" "$(head -c 300 "$TMP/em_err.txt")"
+    fi
+done
