@@ -239,6 +239,41 @@ static void em_compare_checker(int vp)
 static void em_test_checker_classic(void) { em_compare_checker(0); }
 static void em_test_checker_aavp(void) { em_compare_checker(1); }
 
+/* a probe between floor and lamp with RAD_PROBES_DIRECT: the emitters' light takes the texture
+   per lattice point, so the half-black lamp gives the probe half of the plain lamp's irradiance
+   (by symmetry, under the lamp's centre) */
+static double em_probe_up(const em_world *w)
+{
+    ff_world fw;
+    rad_probe_options po;
+    rad_probes *pr = NULL;
+    const float pos[3] = { 0.5f, 0.25f, 0.5f }, up[3] = { 0.0f, 1.0f, 0.0f };
+    float e[3] = { -1.0f, -1.0f, -1.0f }, *B;
+    if (!ff_world_make(&w->d, 0.5f, 0, &fw)) return -1.0;
+    B = (float *)calloc(3 * (size_t)fw.patches->count, sizeof(float)); /* no bounce: the coefficients are D */
+    rad_probe_options_default(&po);
+    po.flags |= RAD_PROBES_DIRECT;
+    if (B) CHECK_OK(rad_probes_create(fw.patches, &fw.rc, NULL, 0, pos, 1, &po, B, NULL, &pr));
+    if (pr) CHECK_OK(rad_probes_sample(pr, pos, up, e));
+    rad_probes_destroy(pr);
+    free(B);
+    ff_world_free(&fw);
+    return e[1];
+}
+
+static void em_test_probes(void)
+{
+    em_world w;
+    double a, b;
+    em_make(&w, 0, 0);
+    a = em_probe_up(&w);
+    em_make(&w, 1, 0);
+    b = em_probe_up(&w);
+    printf("    probe irradiance facing the lamp: plain %.5f, half-black %.5f\n", a, b);
+    CHECK(a > 0.0);
+    CHECK_REL(2.0 * b, a, 0.02);
+}
+
 static void em_test_errors(void)
 {
     em_world w;
@@ -284,6 +319,7 @@ static const rad_test_case tests_emissive[] = {
     { "emissive_half_black", em_test_half_black },
     { "emissive_checker_classic", em_test_checker_classic },
     { "emissive_checker_aavp", em_test_checker_aavp },
+    { "emissive_probes", em_test_probes },
     { "emissive_errors", em_test_errors },
     { NULL, NULL }
 };
