@@ -419,7 +419,7 @@ typedef struct rad_mesh_desc {
     uint32_t vertex_count;
     const float *normals;          /* optional shading normals (unused by the solver) */
     size_t normal_stride;          /* 0: 3 * sizeof(float) */
-    const float *uvs;              /* optional u v, needed for textured materials */
+    const float *uvs;              /* optional u v, needed by materials with a texture or an emission_texture */
     size_t uv_stride;              /* 0: 2 * sizeof(float) */
     const uint32_t *indices;       /* 3 per triangle; NULL: vertices taken in threes */
     uint32_t triangle_count;
@@ -4552,7 +4552,7 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
                      rad__mesh_name(m), t, mat, desc->material_count);
             return RAD_ERROR_MATERIAL_OUT_OF_RANGE;
         }
-        if (desc->materials[mat].texture != 0 && !m->uvs) {
+        if ((desc->materials[mat].texture != 0 || desc->materials[mat].emission_texture != 0) && !m->uvs) {
             rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u uses textured material %u but the mesh has no uvs", mi,
                      rad__mesh_name(m), t, mat);
             return RAD_ERROR_INVALID_ARGUMENT;

@@ -289,6 +289,12 @@ static void em_test_errors(void)
     w.d.emission_lookup = NULL;
     CHECK_RESULT(rad_scene_create(&w.d, &ctx, &s), RAD_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(ct_log_last, "emission_lookup") != NULL);
+    /* a mesh without uvs under an emission texture */
+    em_make(&w, 1, 0);
+    w.m[1].uvs = NULL;
+    ct_log_last[0] = 0;
+    CHECK_RESULT(rad_scene_create(&w.d, &ctx, &s), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(ct_log_last, "no uvs") != NULL);
     /* NaN and negative texels: the patches name the material */
     for (tex = 3; tex <= 4; ++tex) {
         em_make(&w, tex, 0);
