@@ -405,11 +405,21 @@ typedef struct rad_bake rad_bake;
    (the material's texture id, never 0). Must be thread-safe. Values must lie in [0,1). */
 typedef void (*rad_albedo_fn)(void *user, uint32_t texture, float u, float v, float out_rgb[3]);
 
+/* Emission lookup by texture coordinate: writes the linear RGB at (u, v) of 'texture' (the
+   material's emission_texture id, never 0), which multiplies the material's emission. Must
+   be thread-safe. Values must be finite and >= 0 (no upper bound: an HDR emission map is
+   fine); anything else fails the method that met it with RAD_ERROR_NEGATIVE_EMISSION naming
+   the material. */
+typedef void (*rad_emission_fn)(void *user, uint32_t texture, float u, float v, float out_rgb[3]);
+
 typedef struct rad_material {
     float albedo[3];    /* diffuse reflectance, each channel in [0, 1) */
     float emission[3];  /* emitted RADIANCE L (W m^-2 sr^-1), >= 0; exitance is pi * L */
     uint32_t texture;   /* 0: none; else passed to rad_scene_desc.albedo_lookup, whose
                            result replaces albedo (needs uvs on the mesh) */
+    uint32_t emission_texture; /* 0: none (emission is constant); else passed to
+                           rad_scene_desc.emission_lookup, whose result is multiplied by
+                           'emission' (the factor) at each point (needs uvs on the mesh) */
 } rad_material;
 
 typedef struct rad_mesh_desc {
@@ -419,7 +429,7 @@ typedef struct rad_mesh_desc {
     uint32_t vertex_count;
     const float *normals;          /* optional shading normals (unused by the solver) */
     size_t normal_stride;          /* 0: 3 * sizeof(float) */
-    const float *uvs;              /* optional u v, needed for textured materials */
+    const float *uvs;              /* optional u v, needed by materials with a texture or an emission_texture */
     size_t uv_stride;              /* 0: 2 * sizeof(float) */
     const uint32_t *indices;       /* 3 per triangle; NULL: vertices taken in threes */
     uint32_t triangle_count;
@@ -444,6 +454,8 @@ typedef struct rad_scene_desc {
     rad_albedo_fn albedo_lookup;   /* optional */
     void *albedo_user;
     uint32_t flags;                /* rad_scene_flags */
+    rad_emission_fn emission_lookup; /* optional: needed by materials with an emission_texture */
+    void *emission_user;
 } rad_scene_desc;
 
 /* The validated scene, flattened: one array of triangles with world positions. Read-only.
@@ -470,6 +482,8 @@ typedef struct rad_scene {
     float bounds_min[3], bounds_max[3];
     float diagonal;                /* |bounds_max - bounds_min| */
     uint32_t skipped_triangles;    /* degenerate triangles dropped (RAD_SCENE_SKIP_DEGENERATE) */
+    rad_emission_fn emission_lookup;
+    void *emission_user;
     rad_allocator allocator;       /* private: the allocator that made it */
 } rad_scene;
 
@@ -490,6 +504,13 @@ RAD_API void rad_scene_destroy(rad_scene *scene);
 /* Albedo of triangle t at barycentrics (b1, b2) (weights of vertices 1 and 2): the material's
    albedo, or the texture lookup at the interpolated uv. */
 RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3]);
+
+/* Emitted radiance of triangle t at barycentrics (b1, b2): the material's emission, times the
+   emission_lookup at the interpolated uv when the material has an emission_texture. Every
+   method takes emission from here (patches average it over their area, virtual-patch samples
+   and direct light take it per point), so a texture shapes the light a surface sends. The
+   value is not checked here; the methods check it (RAD_ERROR_NEGATIVE_EMISSION). */
+RAD_API void rad_scene_emission(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3]);
 
 /* A pinhole camera. fov_y_degrees is the full vertical field of view. */
 typedef struct rad_camera {
@@ -517,7 +538,8 @@ typedef struct rad_patch {
     float normal[3];
     float area;
     float albedo[3];      /* mean albedo over the patch (texture-averaged when textured) */
-    float emission[3];    /* emitted radiance L of the material */
+    float emission[3];    /* emitted radiance L: the material's, averaged over the patch
+                             like the albedo when it has an emission_texture */
     uint32_t triangle;    /* scene triangle it lies on */
     uint32_t vertices[3]; /* indices into rad_patches.vertices, counter-clockwise */
 } rad_patch;
@@ -527,7 +549,8 @@ typedef struct rad_patch_options {
     float max_edge;       /* 0: no limit */
     uint32_t target_count;/* 0: none; else max_area is set to total area / target_count
                              (the result is near, not equal to, the target) */
-    uint32_t albedo_samples; /* texture samples per patch when textured (0: 16) */
+    uint32_t albedo_samples; /* texture samples per patch when textured (0: 16); the
+                                emission_texture average uses as many */
 } rad_patch_options;
 
 /* Patches: each scene triangle is cut into n*n congruent triangles (n >= 1, the smallest
@@ -2252,8 +2275,8 @@ RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const floa
 /* The source E per patch (3N floats) one of the two ways of UNITS AND CONVENTIONS, through
    rad_vp_from_samples: RAD_SOURCE_DIRECT: v_i = rho_i D_i, D_i the direct irradiance at
    sample i (rad_direct_irradiance with the lights; the emitters' own emission is kept out);
-   RAD_SOURCE_EMISSION: v_i = pi L_i of the sample's material (lights unused, raycaster may be
-   NULL). Errors: those of rad_direct_irradiance, OUT_OF_MEMORY. Cost: O(M) direct-light
+   RAD_SOURCE_EMISSION: v_i = pi L_i, L_i the emission at the sample (rad_scene_emission; lights unused, raycaster may be
+   NULL). Errors: those of rad_direct_irradiance, NEGATIVE_EMISSION, OUT_OF_MEMORY. Cost: O(M) direct-light
    evaluations. docs/methods/virtual-patches.md. */
 RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
                                   const rad_light *lights, uint32_t light_count, const rad_direct_options *options,
@@ -3326,11 +3349,12 @@ RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash);
    values the library derives from them):
      geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats;
      materials = rad_hash64 of triangle_count, then per triangle its material's albedo[3],
-                 emission[3] (floats) and texture (uint32), then 1 and the 6 uv floats per
-                 triangle when the scene has uvs, else 0.
+                 emission[3] (floats) and texture (uint32), and its emission_texture (uint32)
+                 when that is not 0, then 1 and the 6 uv floats per triangle when the scene
+                 has uvs, else 0.
    Indices are covered (positions are per triangle), and the geometric normals and areas follow
    from the positions; shading normals are not kept by rad_scene, and a texture's contents
-   (the albedo_lookup callback) cannot be hashed, only its id. Either output may be NULL.
+   (the albedo_lookup and emission_lookup callbacks) cannot be hashed, only its id. Either output may be NULL.
    Errors: INVALID_ARGUMENT. Cost: O(triangles), no allocation. Thread safety: pure. */
 RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials);
 
@@ -4580,6 +4604,11 @@ static rad_result rad__validate_materials(const rad_scene_desc *desc, const rad_
             rad__log(c, RAD_LOG_ERROR, "material %u has texture %u but the scene has no albedo_lookup callback", i, m->texture);
             return RAD_ERROR_INVALID_ARGUMENT;
         }
+        if (m->emission_texture != 0 && !desc->emission_lookup) {
+            rad__log(c, RAD_LOG_ERROR, "material %u has emission_texture %u but the scene has no emission_lookup callback", i,
+                     m->emission_texture);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
     }
     return RAD_SUCCESS;
 }
@@ -4654,7 +4683,7 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
                      rad__mesh_name(m), t, mat, desc->material_count);
             return RAD_ERROR_MATERIAL_OUT_OF_RANGE;
         }
-        if (desc->materials[mat].texture != 0 && !m->uvs) {
+        if ((desc->materials[mat].texture != 0 || desc->materials[mat].emission_texture != 0) && !m->uvs) {
             rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u uses textured material %u but the mesh has no uvs", mi,
                      rad__mesh_name(m), t, mat);
             return RAD_ERROR_INVALID_ARGUMENT;
@@ -4715,6 +4744,8 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     s->skipped_triangles = (uint32_t)(input - total);
     s->albedo_lookup = desc->albedo_lookup;
     s->albedo_user = desc->albedo_user;
+    s->emission_lookup = desc->emission_lookup;
+    s->emission_user = desc->emission_user;
     s->positions = (float *)rad__alloc_array(&c.allocator, (size_t)n * 9u, sizeof(float));
     s->normals = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
     s->areas = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
@@ -4826,6 +4857,81 @@ RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b
     }
 }
 
+RAD_API void rad_scene_emission(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3])
+{
+    const rad_material *m;
+    if (!out_rgb) return;
+    out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.0f;
+    if (!scene || triangle >= scene->triangle_count) return;
+    m = &scene->materials_table[scene->materials[triangle]];
+    out_rgb[0] = m->emission[0];
+    out_rgb[1] = m->emission[1];
+    out_rgb[2] = m->emission[2];
+    if (m->emission_texture && scene->emission_lookup && scene->uvs &&
+        (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f)) {
+        const float *uv = scene->uvs + 6 * (size_t)triangle;
+        float b0 = 1.0f - b1 - b2, rgb[3] = { 0.0f, 0.0f, 0.0f };
+        float u = b0 * uv[0] + b1 * uv[2] + b2 * uv[4];
+        float v = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
+        int k;
+        scene->emission_lookup(scene->emission_user, m->emission_texture, u, v, rgb);
+        for (k = 0; k < 3; ++k) out_rgb[k] *= rgb[k];
+    }
+}
+
+/* 1 when triangle t can emit: its material's emission factor is not zero (a texture can
+   only scale it) */
+static int rad__emits(const rad_scene *S, uint32_t t)
+{
+    const float *e = S->materials_table[S->materials[t]].emission;
+    return e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
+}
+
+/* 1 when triangle t's emission varies over it (an emission_texture the scene can look up) */
+static int rad__emission_textured(const rad_scene *S, uint32_t t)
+{
+    const rad_material *m = &S->materials_table[S->materials[t]];
+    return m->emission_texture != 0 && S->emission_lookup != NULL && S->uvs != NULL && rad__emits(S, t);
+}
+
+/* rad_scene_emission checked: NEGATIVE_EMISSION (logged with the material) when the lookup
+   gave a negative or non-finite value, or the product with the factor overflowed */
+static rad_result rad__emission_at(const rad_scene *S, uint32_t t, float b1, float b2, const rad__ctx *c, float out[3])
+{
+    int k;
+    rad_scene_emission(S, t, b1, b2, out);
+    for (k = 0; k < 3; ++k)
+        if (!rad__finite(out[k]) || out[k] < 0.0f) {
+            uint32_t mi = S->materials[t];
+            rad__log(c, RAD_LOG_ERROR,
+                     "material %u: emission_lookup of emission_texture %u gave %g (channel %d) on triangle %u "
+                     "(emission times the texture must be finite and >= 0)",
+                     mi, S->materials_table[mi].emission_texture, (double)out[k], k, t);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+    return RAD_SUCCESS;
+}
+
+/* Barycentrics (b1, b2) of point p (on or near the plane of triangle v) */
+static void rad__barycentric(const float *v, const float *p, float *b1, float *b2)
+{
+    double e1[3], e2[3], d[3], d11 = 0.0, d12 = 0.0, d22 = 0.0, p1 = 0.0, p2 = 0.0, det;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        e1[k] = (double)v[3 + k] - v[k];
+        e2[k] = (double)v[6 + k] - v[k];
+        d[k] = (double)p[k] - v[k];
+    }
+    for (k = 0; k < 3; ++k) {
+        d11 += e1[k] * e1[k]; d12 += e1[k] * e2[k]; d22 += e2[k] * e2[k];
+        p1 += d[k] * e1[k]; p2 += d[k] * e2[k];
+    }
+    det = d11 * d22 - d12 * d12;
+    if (!(det > 0.0)) { *b1 = *b2 = 1.0f / 3.0f; return; }
+    *b1 = (float)((d22 * p1 - d12 * p2) / det);
+    *b2 = (float)((d11 * p2 - d12 * p1) / det);
+}
+
 /* ---- the built-in Cornell box (original Cornell data in metres, as the cornell.obj of docs/data.md) ---- */
 
 static const float rad__cornell_positions[] = {
@@ -4855,10 +4961,10 @@ static const uint32_t rad__cornell_quad_indices[] = {
 };
 
 static const rad_material rad__cornell_materials[4] = {
-    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0 },    /* white */
-    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0 },    /* red */
-    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0 },    /* green */
-    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0 }    /* light */
+    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0, 0 },    /* white */
+    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0, 0 },    /* red */
+    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0, 0 },    /* green */
+    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0, 0 }    /* light */
 };
 
 #define RAD__CORNELL_MESH(name, first_vertex, quads, mat)                                                      \
@@ -5009,6 +5115,34 @@ static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const fl
     return RAD_SUCCESS;
 }
 
+/* Mean emission over the sub-triangle with corner barycentrics lb (of triangle t), the same
+   lattice as the albedo's: the patch sends the power its part of the texture sends. */
+static rad_result rad__patch_emission(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples,
+                                      const rad__ctx *c, float *out)
+{
+    double acc[3] = { 0.0, 0.0, 0.0 };
+    uint32_t s, side = rad__lattice_side(samples);
+    float c3[9]; /* the corners as 3-vectors (z = 0) for rad__lattice_point */
+    rad_result r;
+    int k;
+    samples = side * side;
+    for (k = 0; k < 3; ++k) { c3[3 * k] = lb[k][0]; c3[3 * k + 1] = lb[k][1]; c3[3 * k + 2] = 0.0f; }
+    for (s = 0; s < samples; ++s) {
+        float q[3], rgb[3];
+        rad__lattice_point(c3, c3 + 3, c3 + 6, side, s, q);
+        if ((r = rad__emission_at(scene, t, q[0], q[1], c, rgb)) != RAD_SUCCESS) return r;
+        for (k = 0; k < 3; ++k) acc[k] += rgb[k];
+    }
+    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)samples);
+    for (k = 0; k < 3; ++k)
+        if (!rad__finite(out[k])) {
+            rad__log(c, RAD_LOG_ERROR, "material %u: the mean textured emission on triangle %u overflows",
+                     scene->materials[t], t);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+    return RAD_SUCCESS;
+}
+
 /* Stage 1 of rad_patches_create: the cuts per edge of every triangle (by max_edge and
    max_area), each triangle's first patch, and the total patch and lattice-vertex counts. */
 static rad_result rad__patches_plan(rad_patches *P, const rad_scene *scene, float max_area, float max_edge, rad__ctx *c,
@@ -5108,12 +5242,14 @@ static rad_result rad__patches_fill(rad_patches *P, const rad_scene *scene, uint
                 for (k = 0; k < 3; ++k)
                     pt->centroid[k] = (P->vertices[3 * (size_t)a0 + (size_t)k] + P->vertices[3 * (size_t)a1 + (size_t)k] +
                                        P->vertices[3 * (size_t)a2 + (size_t)k]) / 3.0f;
+                for (k = 0; k < 3; ++k) { lb[k][0] /= (float)n; lb[k][1] /= (float)n; }
                 if (mat->texture && scene->albedo_lookup && scene->uvs) {
-                    for (k = 0; k < 3; ++k) { lb[k][0] /= (float)n; lb[k][1] /= (float)n; }
                     r = rad__patch_albedo(scene, t, (const float(*)[2])lb, albedo_samples, c, pt->albedo);
                 } else {
                     memcpy(pt->albedo, mat->albedo, 3 * sizeof(float));
                 }
+                if (r == RAD_SUCCESS && rad__emission_textured(scene, t))
+                    r = rad__patch_emission(scene, t, (const float(*)[2])lb, albedo_samples, c, pt->emission);
                 P->areas[idx] = pt->area;
                 memcpy(P->albedo + 3 * (size_t)idx, pt->albedo, 3 * sizeof(float));
             }
@@ -6667,6 +6803,7 @@ typedef struct rad__direct {
     float eps;
     uint32_t *emitters;          /* emissive triangles */
     uint32_t emitter_count;
+    const rad__ctx *c;           /* the running call's, for errors met per point */
     /* per task scratch */
     rad_ray *rays;
     uint8_t *occ;
@@ -6867,7 +7004,8 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
             uint32_t t = d->emitters[l], h;
             const float *tv = d->S->positions + 9 * (size_t)t, *tn = d->S->normals + 3 * (size_t)t;
             const float *Le = d->S->materials_table[d->S->materials[t]].emission;
-            float dv[3], F, w[3], r1, r2;
+            int textured = rad__emission_textured(d->S, t);
+            float dv[3], F, w[3], r1, r2, Ls[3 * RAD__MAX_SAMPLES];
             rad__sub(dv, p, tv);
             if (!(rad__dot(dv, tn) > 0.0f)) continue; /* behind the emitter, or on its plane */
             F = (float)fabs(rad__ff_point_tri(P, N, tv));
@@ -6880,13 +7018,23 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
                behind p's plane): the visible fraction is then weighted as the form factor
                weights the emitter's points. Equal shares were exact only when visibility does
                not depend on where the point lies (a large emitter seen through an opening got
-               a fraction of its light). Unoccluded, the shares sum to the analytic F. */
+               a fraction of its light). Unoccluded, the shares sum to the analytic F.
+               With an emission texture each ray also carries the radiance at its sample
+               point (relative to the factor Le): the analytic F times the kernel-weighted mean
+               of the texture over the L points, so the emitter's power follows its texture
+               (exact for a constant texture, a quadrature of L points otherwise). */
             ksum = 0.0;
             for (s = 0; s < L; ++s) {
                 float u1, u2, *y = ys + 3 * s, dy[3], r2y;
                 double kern;
                 rad__hammersley(s, L, r1, r2, &u1, &u2);
                 rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
+                if (textured) {
+                    float su = (float)sqrt((double)u1), e[3];
+                    rad_result re = rad__emission_at(d->S, t, u2 * su, su * (1.0f - u2), d->c, e);
+                    if (re != RAD_SUCCESS) return re;
+                    for (k = 0; k < 3; ++k) Ls[3 * s + k] = Le[k] > 0.0f ? e[k] / Le[k] : 0.0f;
+                }
                 rad__sub(dy, y, p);
                 r2y = rad__dot(dy, dy);
                 kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
@@ -6894,9 +7042,13 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
                 ksum += ks[s];
             }
             for (s = 0; s < L; ++s) {
-                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)L;
+                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)L, ws[3];
                 if (!(share > 0.0f)) continue;
-                r = rad__direct_ray(d, task, nrays, p, n, ys + 3 * s, tn, NULL, w, scale * share, slot);
+                if (textured) {
+                    for (k = 0; k < 3; ++k) ws[k] = w[k] * Ls[3 * s + k];
+                    if (!(ws[0] > 0.0f || ws[1] > 0.0f || ws[2] > 0.0f)) continue; /* a black texel sends nothing */
+                }
+                r = rad__direct_ray(d, task, nrays, p, n, ys + 3 * s, tn, NULL, textured ? ws : w, scale * share, slot);
                 if (r != RAD_SUCCESS) return r;
             }
         }
@@ -6957,11 +7109,10 @@ static rad_result rad__direct_run(rad__direct *d, const rad__ctx *c, uint32_t ro
     if (!d->rays || !d->occ || !d->ray_w || !d->ray_slot || !d->acc || !d->emitters) {
         r = RAD_ERROR_OUT_OF_MEMORY;
     } else {
-        for (t = 0; t < d->S->triangle_count; ++t) {
-            const float *e = d->S->materials_table[d->S->materials[t]].emission;
-            if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) d->emitters[ne++] = t;
-        }
+        for (t = 0; t < d->S->triangle_count; ++t)
+            if (rad__emits(d->S, t)) d->emitters[ne++] = t;
         d->emitter_count = ne;
+        d->c = c;
         r = rad__for_rows(c, rows, T, rad__direct_row, d);
     }
     {
@@ -9923,7 +10074,13 @@ static rad_result rad__hr_sources(rad_hierarchical *h, uint32_t first, const rad
     if (!h->o.source) {
         for (i = first; i < h->nel; ++i) {
             const rad_material *m = &h->scene->materials_table[h->scene->materials[h->el[i].tri]];
-            for (k = 0; k < 3; ++k) h->el[i].E[k] = (float)RAD__PI * m->emission[k];
+            float L[3];
+            memcpy(L, m->emission, sizeof(L));
+            /* a textured emitter: the mean over the element, as a patch's */
+            if (rad__emission_textured(h->scene, h->el[i].tri) &&
+                (r = rad__patch_emission(h->scene, h->el[i].tri, (const float(*)[2])h->el[i].b, 16u, c, L)) != RAD_SUCCESS)
+                return r;
+            for (k = 0; k < 3; ++k) h->el[i].E[k] = (float)RAD__PI * L[k];
         }
         return RAD_SUCCESS;
     }
@@ -17195,8 +17352,16 @@ RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_rayca
             for (i = 0; i < 3 * M; ++i) v[i] *= vp->sample_albedo[i];
     } else {
         const rad_scene *S = vp->scene;
-        for (i = 0; i < M; ++i) {
-            const float *L = S->materials_table[S->materials[vp->sample_triangles[i]]].emission;
+        for (i = 0; i < M && r == RAD_SUCCESS; ++i) {
+            uint32_t t = vp->sample_triangles[i];
+            const float *L = S->materials_table[S->materials[t]].emission;
+            float Lt[3];
+            if (rad__emission_textured(S, t)) { /* the texture at the sample's point */
+                float b1, b2;
+                rad__barycentric(S->positions + 9 * (size_t)t, vp->sample_positions + 3 * (size_t)i, &b1, &b2);
+                r = rad__emission_at(S, t, b1, b2, &c, Lt);
+                L = Lt;
+            }
             for (k = 0; k < 3; ++k) v[3 * (size_t)i + k] = (float)RAD__PI * L[k];
         }
     }
@@ -19793,6 +19958,7 @@ typedef struct rad__pb {
     float *pos;                /* 3 per probe */
     uint8_t *states;
     uint32_t *emitters, emitter_count;
+    const rad__ctx *c;         /* the running call's, for errors met per point */
     /* per task scratch */
     rad_ray *rays;             /* RAD__RAY_BATCH per task */
     rad_hit *hits;
@@ -19925,12 +20091,15 @@ static rad_result rad__pb_queue(rad__pb *b, uint32_t task, uint32_t row, uint32_
 
 /* The lattice points of triangle v seen from p: each queued with its solid angle times
    'scale' (1/pi for a patch of radiosity B, the radiance for an emitter). Patches closer
-   than 4 sizes get a 4x finer lattice: the kernel varies fast there. */
+   than 4 sizes get a 4x finer lattice: the kernel varies fast there. emit_tri: the scene
+   triangle of an emitter whose emission is textured (its radiance then taken per point),
+   else RAD_NONE. */
 static rad_result rad__pb_triangle(rad__pb *b, uint32_t task, uint32_t row, uint32_t *nq, const float *p, const float *v,
                                    const float *n, float area, uint32_t samples, float scale, uint32_t target,
-                                   const float *col)
+                                   const float *col, uint32_t emit_tri)
 {
-    float cen[3], d[3];
+    static const float unit[9] = { 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f };
+    float cen[3], d[3], Le[3];
     uint32_t side = rad__lattice_side(samples), S, s;
     int c;
     rad_result r;
@@ -19947,7 +20116,15 @@ static rad_result rad__pb_triangle(rad__pb *b, uint32_t task, uint32_t row, uint
         cj = -rad__dot(dy, n) / (float)sqrt((double)r2);
         if (!(cj > 0.0f)) continue;
         dw = (area / (float)S) * cj / (r2 > floor2 ? r2 : floor2);
-        r = rad__pb_queue(b, task, row, nq, p, y, n, dw * scale, target, col);
+        if (emit_tri != RAD_NONE) {
+            float q[3];
+            rad__lattice_point(unit, unit + 3, unit + 6, side, s, q); /* the point's barycentrics */
+            if ((r = rad__emission_at(b->S, emit_tri, q[0], q[1], b->c, Le)) != RAD_SUCCESS) return r;
+            if (!(Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f)) continue;
+            r = rad__pb_queue(b, task, row, nq, p, y, n, dw * scale, target, Le);
+        } else {
+            r = rad__pb_queue(b, task, row, nq, p, y, n, dw * scale, target, col);
+        }
         if (r != RAD_SUCCESS) return r;
     }
     return RAD_SUCCESS;
@@ -20012,7 +20189,8 @@ static rad_result rad__pb_gather(void *data, uint32_t row, uint32_t task)
         if (!(rad__dot(d, pt->normal) > 0.0f)) continue; /* p does not see the patch's front */
         for (m = 0; m < 3; ++m)
             for (c = 0; c < 3; ++c) v[3 * m + c] = P->vertices[3 * (size_t)pt->vertices[m] + (size_t)c];
-        r = rad__pb_triangle(b, task, row, &nq, p, v, pt->normal, pt->area, b->o.patch_samples, (float)(1.0 / RAD__PI), j, NULL);
+        r = rad__pb_triangle(b, task, row, &nq, p, v, pt->normal, pt->area, b->o.patch_samples, (float)(1.0 / RAD__PI), j, NULL,
+                             RAD_NONE);
     }
     if (r == RAD_SUCCESS && (b->o.flags & RAD_PROBES_DIRECT)) {
         for (l = 0; l < b->emitter_count && r == RAD_SUCCESS; ++l) {
@@ -20022,7 +20200,8 @@ static rad_result rad__pb_gather(void *data, uint32_t row, uint32_t task)
             rad__sub(d, p, tv);
             if (!(rad__dot(d, tn) > 0.0f)) continue;
             r = rad__pb_triangle(b, task, row, &nq, p, tv, tn, b->S->areas[t], b->o.light_samples, 1.0f, RAD_NONE,
-                                 b->S->materials_table[b->S->materials[t]].emission);
+                                 b->S->materials_table[b->S->materials[t]].emission,
+                                 rad__emission_textured(b->S, t) ? t : RAD_NONE);
         }
         for (l = 0; l < b->light_count && r == RAD_SUCCESS; ++l) {
             const rad_light *li = &b->lights[l];
@@ -20356,10 +20535,9 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
         r = RAD_ERROR_OUT_OF_MEMORY;
     }
     if (r == RAD_SUCCESS) {
-        for (i = 0; i < S->triangle_count; ++i) {
-            const float *e = S->materials_table[S->materials[i]].emission;
-            if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) b.emitters[b.emitter_count++] = i;
-        }
+        for (i = 0; i < S->triangle_count; ++i)
+            if (rad__emits(S, i)) b.emitters[b.emitter_count++] = i;
+        b.c = &c;
         r = rad__for_rows(&c, pr->count, T, rad__pb_place, &b);
     }
     for (first = 0; first < pr->count && r == RAD_SUCCESS; first += per) {
@@ -21403,6 +21581,8 @@ RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry
         m = rad__hash_words(m, scene->materials_table[mi].albedo, 3);
         m = rad__hash_words(m, scene->materials_table[mi].emission, 3);
         m = rad__hash_words(m, &scene->materials_table[mi].texture, 1);
+        if (scene->materials_table[mi].emission_texture) /* hashed only when set: older hashes stay valid */
+            m = rad__hash_words(m, &scene->materials_table[mi].emission_texture, 1);
     }
     flag = scene->uvs ? 1u : 0u;
     m = rad__hash_words(m, &flag, 1);

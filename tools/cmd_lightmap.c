@@ -90,10 +90,8 @@ static int lightmap_render(const tool_world *w, const rad_lightmap *lm, const fl
                     if (w->rc.intersect(w->rc.user, &ray, 1, &hit) != RAD_SUCCESS || hit.triangle == RAD_NONE) continue;
                     n = w->scene->normals + 3 * (size_t)hit.triangle;
                     if (n[0] * ray.dir[0] + n[1] * ray.dir[1] + n[2] * ray.dir[2] >= 0.0f) continue;
-                    {
-                        const rad_material *m = &w->scene->materials_table[w->scene->materials[hit.triangle]];
-                        for (k = 0; k < 3; ++k) acc[k] += m->emission[k];
-                    }
+                    rad_scene_emission(w->scene, hit.triangle, hit.b1, hit.b2, e);
+                    for (k = 0; k < 3; ++k) acc[k] += e[k];
                     if (!w->scene->lightmapped[hit.triangle]) continue;
                     t = w->scene->lightmap_uvs + 6 * (size_t)hit.triangle;
                     u = t[0] + hit.b1 * (t[2] - t[0]) + hit.b2 * (t[4] - t[0]);

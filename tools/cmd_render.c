@@ -354,19 +354,19 @@ static int render_classic(const tool_world *w, const rad_patches *P, const float
             uint32_t ray = valid[k];
             size_t pixel = (size_t)y0 * width + ray / spp;
             const rad_hit *h = &hits[ray];
-            const rad_material *m = &scene->materials_table[scene->materials[h->triangle]];
-            float albedo[3], wts[3];
+            float albedo[3], wts[3], emitted[3];
             uint32_t p = gathered ? 0u : rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
             const uint32_t *vi;
             if (p == RAD_NONE) continue;
             vi = gathered ? NULL : P->patches[p].vertices;
             rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
+            rad_scene_emission(scene, h->triangle, h->b1, h->b2, emitted);
             for (i = 0; i < 3; ++i) {
                 float hi = gathered ? gathered[3 * k + i]
                                     : wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
                                           wts[2] * Hv[3 * (size_t)vi[2] + i];
                 img->rgb[3 * pixel + i] += (shaded ? shaded[3 * k + i] + albedo[i] / PI_F * hi
-                                                   : albedo[i] / PI_F * (irr[3 * k + i] + hi)) + m->emission[i];
+                                                   : albedo[i] / PI_F * (irr[3 * k + i] + hi)) + emitted[i];
             }
         }
         done_px += (size_t)(y1 - y0) * width;

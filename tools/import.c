@@ -10,7 +10,10 @@
    when it uses several materials.
    Materials: albedo = Kd / glTF base colour (times the base-colour texture, sRGB-decoded, when
    there is one and the mesh has uvs: sampled through the albedo callback), clamped into
-   [0, 0.999] with a warning; emission = Ke / glTF emissive x emissive strength, as radiance.
+   [0, 0.999] with a warning; emission = Ke / glTF emissiveFactor x KHR_materials_emissive_strength
+   (read from the glTF JSON here: assimp 5.2 drops it), as radiance, times the emission
+   texture (map_Ke / emissiveTexture, sRGB-decoded, unclamped) through the emission callback.
+   What each material used and what it ignored is kept for `rad info` (material_reports).
    Lights: point, spot and directional lights of the file become rad_light (their node's
    transform applied). Camera: the file's first camera, else a default framing. */
 #include "tool.h"
@@ -75,6 +78,8 @@ typedef struct imp_storage {
     uint32_t material_count;
     imp_texture *textures;
     uint32_t texture_count;
+    char **material_reports;  /* per material: what the import used and ignored (rad info) */
+    int any_emission_texture;
     int builtin;
 } imp_storage;
 
@@ -88,10 +93,10 @@ static float srgb_to_linear(float c)
     return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
 }
 
-/* bilinear, repeat wrap, v up (assimp's convention: v = 0 is the bottom row of the image) */
-static void albedo_lookup(void *user, uint32_t texture, float u, float v, float out_rgb[3])
+/* bilinear, repeat wrap, v up (assimp's convention: v = 0 is the bottom row of the image),
+   clamped into [0, hi] */
+static void texture_sample(const imp_storage *st, uint32_t texture, float u, float v, float hi, float out_rgb[3])
 {
-    const imp_storage *st = (const imp_storage *)user;
     const imp_texture *t;
     float x, y, fx, fy;
     int x0, y0, x1, y1, c;
@@ -115,8 +120,19 @@ static void albedo_lookup(void *user, uint32_t texture, float u, float v, float 
         float a = t->rgb[3 * ((size_t)y0 * t->width + x0) + c], b = t->rgb[3 * ((size_t)y0 * t->width + x1) + c];
         float d = t->rgb[3 * ((size_t)y1 * t->width + x0) + c], e = t->rgb[3 * ((size_t)y1 * t->width + x1) + c];
         float val = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
-        out_rgb[c] = val < 0.0f ? 0.0f : (val > ALBEDO_MAX ? ALBEDO_MAX : val);
+        out_rgb[c] = val < 0.0f ? 0.0f : (val > hi ? hi : val);
     }
+}
+
+static void albedo_lookup(void *user, uint32_t texture, float u, float v, float out_rgb[3])
+{
+    texture_sample((const imp_storage *)user, texture, u, v, ALBEDO_MAX, out_rgb);
+}
+
+/* the emission texture's linear RGB (the factor multiplies it in the library) */
+static void emission_lookup(void *user, uint32_t texture, float u, float v, float out_rgb[3])
+{
+    texture_sample((const imp_storage *)user, texture, u, v, 1e30f, out_rgb);
 }
 
 static void *xrealloc(void *p, size_t size)
@@ -152,6 +168,8 @@ static void free_storage(imp_storage *st)
     for (i = 0; i < st->texture_count; ++i) free(st->textures[i].rgb);
     for (i = 0; st->material_names && i < st->material_count; ++i) free(st->material_names[i]);
     free(st->material_names);
+    for (i = 0; st->material_reports && i < st->material_count; ++i) free(st->material_reports[i]);
+    free(st->material_reports);
     free(st->groups);
     free(st->meshes);
     free(st->materials);
@@ -183,16 +201,20 @@ static const char *base_dir_join(const char *file, const char *rel, char *buf, s
     return buf;
 }
 
-/* index+1 of the texture, 0 when it cannot be loaded (warns) */
-static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const char *file, const char *tpath)
+/* index+1 of the texture, 0 when it cannot be loaded (warns). 'prefix' keeps copies apart:
+   an emission texture ("emissive:") is never clamped like an albedo one, even when both are
+   the same file. */
+static uint32_t load_texture_as(imp_storage *st, const struct aiScene *sc, const char *file, const char *tpath,
+                                const char *prefix)
 {
     unsigned char *px = NULL;
     int w = 0, h = 0, comp = 0;
     uint32_t i;
-    char full[1024];
+    char full[1024], key[256];
     imp_texture *t;
+    snprintf(key, sizeof key, "%s%s", prefix, tpath);
     for (i = 0; i < st->texture_count; ++i)
-        if (!strncmp(st->textures[i].path, tpath, sizeof st->textures[i].path - 1)) return i + 1;
+        if (!strncmp(st->textures[i].path, key, sizeof st->textures[i].path - 1)) return i + 1;
     if (tpath[0] == '*') {
         unsigned idx = (unsigned)atoi(tpath + 1);
         if (idx < sc->mNumTextures) {
@@ -229,9 +251,9 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
     t = &st->textures[st->texture_count];
     memset(t, 0, sizeof *t);
     {
-        size_t pl = strlen(tpath);
+        size_t pl = strlen(key);
         if (pl >= sizeof t->path) pl = sizeof t->path - 1;
-        memcpy(t->path, tpath, pl);
+        memcpy(t->path, key, pl);
         t->path[pl] = 0;
     }
     t->width = w;
@@ -247,16 +269,24 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
     return ++st->texture_count;
 }
 
+static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const char *file, const char *tpath)
+{
+    return load_texture_as(st, sc, file, tpath, "");
+}
+
 /* ---- materials --------------------------------------------------------------------------- */
 
 /* The largest emission (radiance) accepted: what the tool's other inputs allow (1e30). */
 #define EMISSION_MAX 1e30f
+/* no KHR_materials_emissive_strength in a glTF material (gltf_emissive_strength) */
+#define GLTF_NO_STRENGTH (-1e300)
 
 /* 0, or 1 with the reason in err (a negative, NaN, infinite or overflowing emission: it used
    to become 0 without a word). *clamped: set to 1 when the albedo was clamped into
    [0, ALBEDO_MAX] (the warning waits until it is known which materials are used). */
 static int convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
-                            uint32_t index, rad_material *out, unsigned char *clamped_out, char *err, size_t errlen)
+                            uint32_t index, double json_strength, rad_material *out, unsigned char *clamped_out, char *err,
+                            size_t errlen)
 {
     struct aiColor4D c;
     struct aiString name, tpath;
@@ -283,6 +313,14 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
             return 1;
         }
         strength = (float)fv;
+    } else if (json_strength != GLTF_NO_STRENGTH) { /* KHR_materials_emissive_strength, read from the JSON */
+        if (!(json_strength >= 0.0 && json_strength <= (double)EMISSION_MAX)) {
+            if (err && errlen)
+                snprintf(err, errlen, "'%s': material %u '%s': emissive strength %g is out of range (want a finite value in [0, %g])",
+                         file, index, name.data, json_strength, (double)EMISSION_MAX);
+            return 1;
+        }
+        strength = (float)json_strength;
     }
     for (k = 0; k < 3; ++k) {
         float e = out->emission[k], es = e * strength;
@@ -298,6 +336,15 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
         }
     }
     for (k = 0; k < 3; ++k) out->emission[k] *= strength;
+    /* emission texture (glTF emissiveTexture, OBJ map_Ke): multiplied by the factor above */
+    if (aiGetMaterialTexture(m, aiTextureType_EMISSIVE, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS &&
+        (out->emission[0] > 0.0f || out->emission[1] > 0.0f || out->emission[2] > 0.0f)) {
+        uint32_t id = load_texture_as(st, sc, file, tpath.data, "emissive:");
+        if (id) {
+            out->emission_texture = id;
+            st->any_emission_texture = 1;
+        }
+    }
     /* texture: base colour (glTF) or diffuse (OBJ map_Kd ...) */
     if (aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
         aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) {
@@ -447,6 +494,216 @@ static unsigned gltf_required_extensions(const char *path, char *out, size_t cap
     }
     free(json);
     return count;
+}
+
+/* ---- glTF materials as the JSON has them ------------------------------------------------------ */
+
+/* assimp 5.2 reads neither KHR_materials_emissive_strength nor tells which material
+   properties it dropped, so the "materials" array is read here with a small JSON walker (no
+   allocation; NULL on malformed input, which then only loses the report and the strength). */
+#define JS_DEPTH 64
+
+static const char *js_ws(const char *p)
+{
+    while (p && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')) ++p;
+    return p;
+}
+
+static const char *js_skip_depth(const char *p, int depth)
+{
+    p = js_ws(p);
+    if (!p || !*p || depth > JS_DEPTH) return NULL;
+    if (*p == '"') {
+        for (++p; *p && *p != '"'; ++p)
+            if (*p == '\\' && p[1]) ++p;
+        return *p == '"' ? p + 1 : NULL;
+    }
+    if (*p == '{' || *p == '[') {
+        char close = *p == '{' ? '}' : ']';
+        p = js_ws(p + 1);
+        if (p && *p == close) return p + 1;
+        for (;;) {
+            if (close == '}') {
+                p = js_skip_depth(p, depth + 1); /* the key */
+                p = js_ws(p);
+                if (!p || *p != ':') return NULL;
+                ++p;
+            }
+            p = js_ws(js_skip_depth(p, depth + 1));
+            if (!p) return NULL;
+            if (*p == ',') { ++p; continue; }
+            return *p == close ? p + 1 : NULL;
+        }
+    }
+    while (*p && *p != ',' && *p != '}' && *p != ']' && *p != ' ' && *p != '\n' && *p != '\r' && *p != '\t') ++p;
+    return p;
+}
+
+static const char *js_skip(const char *p) { return js_skip_depth(p, 0); }
+
+/* The i-th member of object o ('{'): its key into key (cap bytes) and a pointer to its value;
+   NULL past the end */
+static const char *js_member(const char *o, unsigned i, char *key, size_t cap)
+{
+    const char *p = js_ws(o);
+    unsigned n = 0;
+    if (!p || *p != '{') return NULL;
+    p = js_ws(p + 1);
+    while (p && *p == '"') {
+        const char *k = p + 1, *e = js_skip(p), *v;
+        if (!e) return NULL;
+        v = js_ws(e);
+        if (!v || *v != ':') return NULL;
+        v = js_ws(v + 1);
+        if (n++ == i) {
+            size_t len = (size_t)(e - 1 - k);
+            if (len >= cap) len = cap - 1;
+            memcpy(key, k, len);
+            key[len] = 0;
+            return v;
+        }
+        p = js_ws(js_skip(v));
+        if (p && *p == ',') p = js_ws(p + 1);
+    }
+    return NULL;
+}
+
+/* the value of 'name' in object o, or NULL */
+static const char *js_get(const char *o, const char *name)
+{
+    char key[128];
+    const char *v;
+    unsigned i;
+    for (i = 0; (v = js_member(o, i, key, sizeof key)) != NULL; ++i)
+        if (!strcmp(key, name)) return v;
+    return NULL;
+}
+
+/* element i of array a ('['), or NULL */
+static const char *js_at(const char *a, unsigned i)
+{
+    const char *p = js_ws(a);
+    unsigned n = 0;
+    if (!p || *p != '[') return NULL;
+    p = js_ws(p + 1);
+    if (p && *p == ']') return NULL;
+    while (p) {
+        if (n++ == i) return p;
+        p = js_ws(js_skip(p));
+        if (!p || *p != ',') return NULL;
+        p = js_ws(p + 1);
+    }
+    return NULL;
+}
+
+static void js_string(const char *v, char *out, size_t cap)
+{
+    const char *e = v && *v == '"' ? js_skip(v) : NULL;
+    size_t len = e ? (size_t)(e - v - 2) : 0;
+    if (len >= cap) len = cap - 1;
+    if (e) memcpy(out, v + 1, len);
+    out[len] = 0;
+}
+
+/* The JSON of a .gltf, or of a .glb's first chunk; NULL when the file is neither (free it) */
+static char *gltf_json(const char *path)
+{
+    FILE *f;
+    char *json = NULL;
+    unsigned char head[20];
+    size_t n = 0, len = strlen(path);
+    if (!((len > 5 && (!strcmp(path + len - 5, ".gltf") || !strcmp(path + len - 5, ".GLTF"))) ||
+          (len > 4 && (!strcmp(path + len - 4, ".glb") || !strcmp(path + len - 4, ".GLB")))))
+        return NULL;
+    if (!(f = fopen(path, "rb"))) return NULL;
+    if (fread(head, 1, 20, f) == 20 && !memcmp(head, "glTF", 4)) {
+        uint32_t clen = (uint32_t)head[12] | (uint32_t)head[13] << 8 | (uint32_t)head[14] << 16 | (uint32_t)head[15] << 24;
+        if (memcmp(head + 16, "JSON", 4) || clen > GLTF_JSON_MAX) { fclose(f); return NULL; }
+        json = (char *)xrealloc(NULL, (size_t)clen + 1);
+        n = fread(json, 1, clen, f);
+    } else {
+        rewind(f);
+        json = (char *)xrealloc(NULL, (size_t)GLTF_JSON_MAX + 1);
+        n = fread(json, 1, GLTF_JSON_MAX, f);
+    }
+    fclose(f);
+    json[n] = '\0';
+    return json;
+}
+
+/* glTF material i of the JSON's "materials", or NULL */
+static const char *gltf_material(const char *json, unsigned i)
+{
+    const char *mats = json ? js_get(json, "materials") : NULL;
+    return mats ? js_at(mats, i) : NULL;
+}
+
+/* KHR_materials_emissive_strength of glTF material m, or GLTF_NO_STRENGTH when it has none (a
+   value that is not a number gives NaN; it and a negative one are refused by convert_material) */
+static double gltf_emissive_strength(const char *m)
+{
+    const char *ext = m ? js_get(m, "extensions") : NULL, *ks, *v;
+    if (!ext || !(ks = js_get(ext, "KHR_materials_emissive_strength"))) return GLTF_NO_STRENGTH;
+    v = js_get(ks, "emissiveStrength");
+    if (!v) return 1.0; /* the extension's default */
+    if (!((*v >= '0' && *v <= '9') || *v == '-' || *v == '.')) return (double)NAN;
+    return strtod(v, NULL);
+}
+
+/* appends to a report line list */
+static void rep_add(char **r, const char *fmt, const char *a, const char *b)
+{
+    char line[600];
+    size_t n = *r ? strlen(*r) : 0;
+    snprintf(line, sizeof line, fmt, a ? a : "", b ? b : "");
+    *r = (char *)xrealloc(*r, n + strlen(line) + 2);
+    memcpy(*r + n, line, strlen(line));
+    (*r)[n + strlen(line)] = '\n';
+    (*r)[n + strlen(line) + 1] = 0;
+}
+
+/* whether texture-info object t carries KHR_texture_transform */
+static int gltf_has_transform(const char *t)
+{
+    const char *e = t ? js_get(t, "extensions") : NULL;
+    return e && js_get(e, "KHR_texture_transform") != NULL;
+}
+
+/* The glTF part of a material's report: what of m (its JSON object) the importer used, read
+   or ignored, each property and extension by name. */
+static void gltf_report(const char *m, char **r)
+{
+    static const char *const used[] = {"name", "pbrMetallicRoughness", "emissiveFactor", "emissiveTexture",
+                                       "extensions", "doubleSided", "alphaMode", "alphaCutoff", NULL};
+    char key[128], val[64], ign[1024] = "";
+    const char *v, *pbr = js_get(m, "pbrMetallicRoughness"), *ext = js_get(m, "extensions");
+    unsigned i, j, transform = 0;
+    size_t n = 0;
+    if ((v = js_get(m, "doubleSided")) != NULL)
+        rep_add(r, "  doubleSided: %s (read; the importer does not use it)", !strncmp(v, "true", 4) ? "true" : "false", NULL);
+    if ((v = js_get(m, "alphaMode")) != NULL) {
+        char cut[64] = "";
+        const char *c = js_get(m, "alphaCutoff");
+        js_string(v, val, sizeof val);
+        if (c) snprintf(cut, sizeof cut, ", alphaCutoff %g", strtod(c, NULL));
+        rep_add(r, "  alphaMode: %s%s (read; the importer does not use it)", val, cut);
+    }
+    transform += gltf_has_transform(js_get(m, "emissiveTexture"));
+    if (pbr) transform += gltf_has_transform(js_get(pbr, "baseColorTexture"));
+    if (transform) rep_add(r, "  KHR_texture_transform: ignored (textures are sampled at the untransformed uvs)%s%s", NULL, NULL);
+    for (i = 0; (v = js_member(m, i, key, sizeof key)) != NULL; ++i) {
+        for (j = 0; used[j] && strcmp(used[j], key); ++j) {}
+        if (!used[j])
+            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s%s", n ? ", " : "", key,
+                                  strstr(key, "Texture") ? " (not diffuse)" : "");
+    }
+    for (i = 0; pbr && (v = js_member(pbr, i, key, sizeof key)) != NULL; ++i)
+        if (strcmp(key, "baseColorFactor") && strcmp(key, "baseColorTexture"))
+            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s (not diffuse)", n ? ", " : "", key);
+    for (i = 0; ext && (v = js_member(ext, i, key, sizeof key)) != NULL; ++i)
+        if (strcmp(key, "KHR_materials_emissive_strength"))
+            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s (extension)", n ? ", " : "", key);
+    if (n) rep_add(r, "  ignored: %s%s", ign, NULL);
 }
 
 /* ---- vertex welding ------------------------------------------------------------------------ */
@@ -777,6 +1034,81 @@ static void default_camera(const float bmin[3], const float bmax[3], rad_camera 
     cam->up[0] = 0.0f, cam->up[1] = 1.0f, cam->up[2] = 0.0f;
 }
 
+/* glTF material i of the JSON, when assimp's material i is it: same name, or the JSON's is
+   unnamed; else the JSON material of that name (NULL: none, as for assimp's default material) */
+static const char *material_json(const char *json, uint32_t i, const char *name)
+{
+    const char *m = gltf_material(json, i), *nm;
+    char jn[256];
+    unsigned j;
+    if (!json) return NULL;
+    if (m) {
+        nm = js_get(m, "name");
+        if (!nm) return m;
+        js_string(nm, jn, sizeof jn);
+        if (!strcmp(jn, name)) return m;
+    }
+    for (j = 0; (m = gltf_material(json, j)) != NULL; ++j)
+        if ((nm = js_get(m, "name")) != NULL) {
+            js_string(nm, jn, sizeof jn);
+            if (name[0] && !strcmp(jn, name)) return m;
+        }
+    return NULL;
+}
+
+static const char *texture_name(const imp_storage *st, uint32_t id)
+{
+    const char *p = id && id <= st->texture_count ? st->textures[id - 1].path : "";
+    return !strncmp(p, "emissive:", 9) ? p + 9 : p;
+}
+
+/* What material i became and what of it was left out, for `rad info` (several lines).
+   gm: its glTF JSON object (is_gltf: the file is glTF; gm NULL there: assimp's own). */
+static void material_report(imp_storage *st, const struct aiMaterial *am, uint32_t i, const char *gm, int is_gltf)
+{
+    static const struct { enum aiTextureType type; const char *what; } other[] = {
+        {aiTextureType_NORMALS, "normal map"}, {aiTextureType_HEIGHT, "bump/height map"},
+        {aiTextureType_SPECULAR, "specular map"}, {aiTextureType_SHININESS, "shininess map"},
+        {aiTextureType_OPACITY, "opacity map (no cutouts)"}, {aiTextureType_AMBIENT, "ambient map"},
+        {aiTextureType_DISPLACEMENT, "displacement map"}, {aiTextureType_LIGHTMAP, "lightmap/occlusion map"},
+        {aiTextureType_REFLECTION, "reflection map"}, {aiTextureType_METALNESS, "metalness map"},
+        {aiTextureType_DIFFUSE_ROUGHNESS, "roughness map"}, {aiTextureType_UNKNOWN, "unknown-type map"}};
+    const rad_material *m = &st->materials[i];
+    char **r = &st->material_reports[i], buf[512];
+    struct aiColor4D c;
+    struct aiString tp;
+    unsigned k;
+    snprintf(buf, sizeof buf, "%g %g %g", (double)m->albedo[0], (double)m->albedo[1], (double)m->albedo[2]);
+    if (m->texture) rep_add(r, "  albedo: texture '%s' x %s", texture_name(st, m->texture), buf);
+    else rep_add(r, "  albedo: %s%s", buf, NULL);
+    if (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f) {
+        double strength = gm ? gltf_emissive_strength(gm) : -1.0;
+        char f[200] = "";
+        if (strength >= 0.0 && aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &c) == aiReturn_SUCCESS)
+            snprintf(f, sizeof f, " (emissiveFactor %g %g %g x KHR_materials_emissive_strength %g)", (double)c.r, (double)c.g,
+                     (double)c.b, strength);
+        snprintf(buf, sizeof buf, "%g %g %g%s", (double)m->emission[0], (double)m->emission[1], (double)m->emission[2], f);
+        if (m->emission_texture) rep_add(r, "  emission (radiance): texture '%s' x %s", texture_name(st, m->emission_texture), buf);
+        else rep_add(r, "  emission (radiance): %s%s", buf, NULL);
+    } else if (aiGetMaterialTexture(am, aiTextureType_EMISSIVE, 0, &tp, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) {
+        rep_add(r, "  emission texture '%s': ignored (the emission factor, Ke or emissiveFactor, is 0)%s", tp.data, NULL);
+    }
+    if (is_gltf && gm) gltf_report(gm, r);
+    else if (is_gltf) rep_add(r, "  (not in the file's materials: the importer's default)%s%s", NULL, NULL);
+    if (!is_gltf) /* other formats: the texture kinds assimp found that radiosity does not use */
+        for (k = 0; k < sizeof other / sizeof other[0]; ++k)
+            if (aiGetMaterialTextureCount(am, other[k].type) > 0 &&
+                aiGetMaterialTexture(am, other[k].type, 0, &tp, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS)
+                rep_add(r, "  ignored: %s '%s' (not diffuse)", other[k].what, tp.data);
+}
+
+int tool_is_scene_path(const char *path)
+{
+    const char *dot = path ? strrchr(path, '.') : NULL;
+    if (path && !strcmp(path, "cornell")) return 1;
+    return dot && strcmp(dot, ".radb") != 0 && aiIsExtensionSupported(dot) == AI_TRUE;
+}
+
 int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen)
 {
     const struct aiScene *sc;
@@ -785,6 +1117,7 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     struct aiMatrix4x4 id;
     uint32_t i, k, tris = 0;
     unsigned char *clamped = NULL;
+    char *json = NULL;
     float bmin[3] = {1e30f, 1e30f, 1e30f}, bmax[3] = {-1e30f, -1e30f, -1e30f};
     memset(out, 0, sizeof *out);
     if (!path_or_name || !*path_or_name) {
@@ -845,16 +1178,25 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
         st->material_names[i] = xstrdup(mname.data);
     }
     out->material_names = (const char *const *)st->material_names;
+    st->material_reports = (char **)xrealloc(NULL, sizeof(char *) * st->material_count);
+    memset(st->material_reports, 0, sizeof(char *) * st->material_count);
+    out->material_reports = (const char *const *)st->material_reports;
+    json = gltf_json(path_or_name);
     for (i = 0; i < st->material_count; ++i) {
         if (i < sc->mNumMaterials) {
-            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, &st->materials[i], &clamped[i], err, errlen)) {
+            const char *gm = material_json(json, i, st->material_names[i]);
+            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, gltf_emissive_strength(gm), &st->materials[i],
+                                 &clamped[i], err, errlen)) {
                 free(clamped);
+                free(json);
                 aiReleaseImport(sc);
                 tool_free_scene(out);
                 return 1;
             }
+            material_report(st, sc->mMaterials[i], i, json ? gm : NULL, json != NULL);
         } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
     }
+    free(json);
     /* geometry, lights, camera */
     memset(&id, 0, sizeof id);
     id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
@@ -907,7 +1249,7 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
         md->material_ids = g->material_ids;
         if (g->all_uv2) md->lightmap_uvs = g->uvs2;
         for (t = 0; t < g->triangle_count; ++t)
-            if (st->materials[g->material_ids[t]].texture) {
+            if (st->materials[g->material_ids[t]].texture || st->materials[g->material_ids[t]].emission_texture) {
                 md->uvs = g->uvs; /* zeros when the file had none */
                 if (!g->any_uv) fprintf(stderr, "rad: warning: mesh '%s' has a textured material but no uvs\n", g->name);
                 break;
@@ -930,6 +1272,8 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     out->desc.material_count = st->material_count;
     out->desc.albedo_lookup = st->texture_count ? albedo_lookup : NULL;
     out->desc.albedo_user = st;
+    out->desc.emission_lookup = st->any_emission_texture ? emission_lookup : NULL;
+    out->desc.emission_user = st;
     out->desc.flags = RAD_SCENE_SKIP_DEGENERATE;
     if (!out->has_camera) default_camera(bmin, bmax, &out->camera);
     return 0;

@@ -40,7 +40,7 @@ static void usage(FILE *f)
                "                           [--bake FILE.radb]\n"
                "  trace SCENE -o OUT       the reference path tracer\n"
                "  compare A B              compare two images (MSE, PSNR, SSIM)\n"
-               "  info FILE.radb           list what a bake holds and check it\n"
+               "  info FILE.radb | SCENE   list what a bake holds and check it; a scene's materials\n"
                "  export SCENE -o OUT.obj  write the scene as OBJ + MTL (Kd albedo, Ke emission)\n"
                "  probes SCENE -o OUT      irradiance probes (SH L2) on a grid: OUT.json or OUT.bin;\n"
                "                           --proxy aavp|vp for buildings too big for classic patches\n"

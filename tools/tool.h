@@ -19,16 +19,21 @@ typedef struct tool_scene {
     rad_light *lights;       /* analytic lights found in the file (may be none) */
     uint32_t light_count;
     const char *const *material_names; /* desc.material_count names ("" when unnamed), or NULL */
+    const char *const *material_reports; /* per material, lines "  what: ..." saying what the
+                                importer used, read and ignored of it (rad info), or NULL */
     void *storage;           /* private */
 } tool_scene;
 
 /* 'cornell' (the built-in box) or a file assimp can read (OBJ+MTL, glTF 2.0, FBX, PLY ...).
    Materials: albedo from Kd / glTF base colour (with the base-colour texture sampled through
-   the albedo callback), emission (radiance) from Ke / glTF emissive x strength. Object and
+   the albedo callback), emission (radiance) from Ke / glTF emissiveFactor x
+   KHR_materials_emissive_strength, times map_Ke / emissiveTexture through the emission callback. Object and
    group names are kept as mesh names. Returns 0 on success; on failure writes a message to
    err (errlen bytes). */
 int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen);
 void tool_free_scene(tool_scene *scene);
+/* 1 for 'cornell' and a file name whose extension the importer reads (not .radb) */
+int tool_is_scene_path(const char *path);
 
 /* ---- images (image.c) ------------------------------------------------------------------ */
 

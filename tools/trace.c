@@ -161,7 +161,7 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
         rad_hit hit;
         const float *v, *n;
         const float *Le;
-        float p[3], albedo[3], cosi, t1[3], t2[3];
+        float p[3], albedo[3], cosi, t1[3], t2[3], Lt[3];
         uint32_t tri, dim = (uint32_t)depth * TOOL__DIMS_PER_BOUNCE;
         if (T->rc->intersect(T->rc->user, &ray, 1, &hit) != RAD_SUCCESS) {
             *ok = 0;
@@ -180,6 +180,8 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
         Le = S->materials_table[S->materials[tri]].emission;
         if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
             float w = 1.0f;
+            rad_scene_emission(S, tri, hit.b1, hit.b2, Lt); /* the factor times the emission texture there */
+            Le = Lt;
             if (depth > 0) {
                 float pl = T->select_pdf[tri] / S->areas[tri] * hit.t * hit.t / cosi;
                 w = tool__mis(prev_pdf, pl);
@@ -195,10 +197,10 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
             uint32_t lt = T->emitters[e];
             if (lt != tri) {
                 const float *lv = S->positions + 9 * (size_t)lt, *ln = S->normals + 3 * (size_t)lt;
-                const float *lL = S->materials_table[S->materials[lt]].emission;
                 float u1 = tool__rnd(seed, pixel, sample, dim + 1), u2 = tool__rnd(seed, pixel, sample, dim + 2);
                 float su = sqrtf(u1), b0 = 1.0f - su, bb1 = u2 * su, bb2 = 1.0f - b0 - bb1;
-                float q[3], d[3], d2, dist, cs, cl;
+                float q[3], d[3], d2, dist, cs, cl, lL[3];
+                rad_scene_emission(S, lt, bb1, bb2, lL); /* at the light's sample point: textures vary it */
                 for (k = 0; k < 3; ++k) {
                     q[k] = b0 * lv[k] + bb1 * lv[3 + k] + bb2 * lv[6 + k];
                     d[k] = q[k] - p[k];
