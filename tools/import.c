@@ -298,6 +298,12 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
         }
     }
     for (k = 0; k < 3; ++k) out->emission[k] *= strength;
+    /* glTF doubleSided (and a few other formats' two-sided flags) */
+    {
+        int two = 0;
+        unsigned int n2 = 1;
+        if (aiGetMaterialIntegerArray(m, AI_MATKEY_TWOSIDED, &two, &n2) == aiReturn_SUCCESS && two) out->two_sided = 1;
+    }
     /* texture: base colour (glTF) or diffuse (OBJ map_Kd ...) */
     if (aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
         aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS) {
@@ -777,6 +783,57 @@ static void default_camera(const float bmin[3], const float bmax[3], rad_camera 
     cam->up[0] = 0.0f, cam->up[1] = 1.0f, cam->up[2] = 0.0f;
 }
 
+tool_two_sided_mode tool_two_sided = TOOL_TWO_SIDED_AUTO;
+
+/* A one-sided triangle is taken as wound: its front is the counter-clockwise side, whatever
+   its shading normals say. When many disagree with their normals the file most likely has
+   mixed windings (its surfaces would show black backs), so say so and name the remedy. */
+static void warn_mixed_windings(const rad_scene_desc *d, const char *file)
+{
+    uint64_t against = 0, total = 0;
+    uint32_t mi, t;
+    for (mi = 0; mi < d->mesh_count; ++mi) {
+        const rad_mesh_desc *m = &d->meshes[mi];
+        if (!m->normals || !m->positions) continue;
+        for (t = 0; t < m->triangle_count; ++t) {
+            uint32_t mat = m->material_ids ? m->material_ids[t] : m->material, v[3], k;
+            const float *p[3];
+            double e1[3], e2[3], cr[3], dot = 0.0;
+            if (mat >= d->material_count || d->materials[mat].two_sided) continue;
+            for (k = 0; k < 3; ++k) {
+                v[k] = m->indices ? m->indices[3 * (size_t)t + k] : 3 * t + k;
+                if (v[k] >= m->vertex_count) break;
+                p[k] = m->positions + 3 * (size_t)v[k];
+            }
+            if (k < 3) continue;
+            for (k = 0; k < 3; ++k) { e1[k] = (double)p[1][k] - p[0][k]; e2[k] = (double)p[2][k] - p[0][k]; }
+            cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            for (k = 0; k < 3; ++k) {
+                const float *n = m->normals + 3 * (size_t)v[k];
+                dot += cr[0] * n[0] + cr[1] * n[1] + cr[2] * n[2];
+            }
+            ++total;
+            if (dot < 0.0) ++against;
+        }
+    }
+    if (total && against * 100u >= total)
+        fprintf(stderr, "rad: warning: '%s': %llu of %llu one-sided triangles are wound against their normals (mixed "
+                "windings?): their fronts face away from the normals; --two-sided all makes every surface two-sided\n",
+                file, (unsigned long long)against, (unsigned long long)total);
+}
+
+int tool_two_sided_parse(const char *text, tool_two_sided_mode *out)
+{
+    if (!text) return 1;
+    if (!strcmp(text, "auto")) *out = TOOL_TWO_SIDED_AUTO;
+    else if (!strcmp(text, "all")) *out = TOOL_TWO_SIDED_ALL;
+    else if (!strcmp(text, "none")) *out = TOOL_TWO_SIDED_NONE;
+    else return 1;
+    return 0;
+}
+
 int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen)
 {
     const struct aiScene *sc;
@@ -800,6 +857,14 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
         if (out->desc.material_count == 4) out->material_names = cornell_names;
         out->has_camera = 1;
         out->storage = st;
+        if (tool_two_sided == TOOL_TWO_SIDED_ALL) {
+            /* the built-in materials are static: a copy takes the flag */
+            st->material_count = out->desc.material_count;
+            st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
+            memcpy(st->materials, out->desc.materials, sizeof(rad_material) * st->material_count);
+            for (i = 0; i < st->material_count; ++i) st->materials[i].two_sided = 1;
+            out->desc.materials = st->materials;
+        }
         return 0;
     }
     sc = import_logged(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
@@ -931,6 +996,11 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     out->desc.albedo_lookup = st->texture_count ? albedo_lookup : NULL;
     out->desc.albedo_user = st;
     out->desc.flags = RAD_SCENE_SKIP_DEGENERATE;
+    for (i = 0; i < st->material_count; ++i) {
+        if (tool_two_sided == TOOL_TWO_SIDED_ALL) st->materials[i].two_sided = 1;
+        if (tool_two_sided == TOOL_TWO_SIDED_NONE) st->materials[i].two_sided = 0;
+    }
+    warn_mixed_windings(&out->desc, path_or_name);
     if (!out->has_camera) default_camera(bmin, bmax, &out->camera);
     return 0;
 }
