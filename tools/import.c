@@ -76,6 +76,8 @@ typedef struct imp_storage {
     imp_texture *textures;
     uint32_t texture_count;
     int builtin;
+    uint64_t *wound_against;  /* per material: triangles wound against their shading normals */
+    uint64_t *wound_total;    /* per material: triangles with shading normals */
 } imp_storage;
 
 static void set_err(char *err, size_t errlen, const char *fmt, const char *a, const char *b)
@@ -155,6 +157,8 @@ static void free_storage(imp_storage *st)
     free(st->groups);
     free(st->meshes);
     free(st->materials);
+    free(st->wound_against);
+    free(st->wound_total);
     free(st->textures);
     free(st);
 }
@@ -696,6 +700,22 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
             ++ws->bad_indices; /* assimp checks; counted should one slip through */
             continue;
         }
+        if (mesh->mNormals && mesh->mMaterialIndex < ws->st->material_count) {
+            /* in the mesh's own space: a mirroring transform flips winding and normals alike */
+            const struct aiVector3D *a = &mesh->mVertices[face->mIndices[0]], *b = &mesh->mVertices[face->mIndices[1]],
+                                    *c = &mesh->mVertices[face->mIndices[2]];
+            double e1[3], e2[3], dot = 0.0;
+            int q;
+            e1[0] = (double)b->x - a->x, e1[1] = (double)b->y - a->y, e1[2] = (double)b->z - a->z;
+            e2[0] = (double)c->x - a->x, e2[1] = (double)c->y - a->y, e2[2] = (double)c->z - a->z;
+            for (q = 0; q < 3; ++q) {
+                const struct aiVector3D *n = &mesh->mNormals[face->mIndices[q]];
+                dot += (e1[1] * e2[2] - e1[2] * e2[1]) * n->x + (e1[2] * e2[0] - e1[0] * e2[2]) * n->y +
+                       (e1[0] * e2[1] - e1[1] * e2[0]) * n->z;
+            }
+            ws->st->wound_total[mesh->mMaterialIndex]++;
+            if (dot < 0.0) ws->st->wound_against[mesh->mMaterialIndex]++;
+        }
         ix[0] = base + remap[face->mIndices[0]];
         ix[1] = base + remap[det < 0 ? face->mIndices[2] : face->mIndices[1]];
         ix[2] = base + remap[det < 0 ? face->mIndices[1] : face->mIndices[2]];
@@ -788,36 +808,15 @@ tool_two_sided_mode tool_two_sided = TOOL_TWO_SIDED_AUTO;
 /* A one-sided triangle is taken as wound: its front is the counter-clockwise side, whatever
    its shading normals say. When many disagree with their normals the file most likely has
    mixed windings (its surfaces would show black backs), so say so and name the remedy. */
-static void warn_mixed_windings(const rad_scene_desc *d, const char *file)
+static void warn_mixed_windings(const imp_storage *st, const char *file)
 {
     uint64_t against = 0, total = 0;
-    uint32_t mi, t;
-    for (mi = 0; mi < d->mesh_count; ++mi) {
-        const rad_mesh_desc *m = &d->meshes[mi];
-        if (!m->normals || !m->positions) continue;
-        for (t = 0; t < m->triangle_count; ++t) {
-            uint32_t mat = m->material_ids ? m->material_ids[t] : m->material, v[3], k;
-            const float *p[3];
-            double e1[3], e2[3], cr[3], dot = 0.0;
-            if (mat >= d->material_count || d->materials[mat].two_sided) continue;
-            for (k = 0; k < 3; ++k) {
-                v[k] = m->indices ? m->indices[3 * (size_t)t + k] : 3 * t + k;
-                if (v[k] >= m->vertex_count) break;
-                p[k] = m->positions + 3 * (size_t)v[k];
-            }
-            if (k < 3) continue;
-            for (k = 0; k < 3; ++k) { e1[k] = (double)p[1][k] - p[0][k]; e2[k] = (double)p[2][k] - p[0][k]; }
-            cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
-            for (k = 0; k < 3; ++k) {
-                const float *n = m->normals + 3 * (size_t)v[k];
-                dot += cr[0] * n[0] + cr[1] * n[1] + cr[2] * n[2];
-            }
-            ++total;
-            if (dot < 0.0) ++against;
+    uint32_t i;
+    for (i = 0; i < st->material_count; ++i)
+        if (!st->materials[i].two_sided) {
+            against += st->wound_against[i];
+            total += st->wound_total[i];
         }
-    }
     if (total && against * 100u >= total)
         fprintf(stderr, "rad: warning: '%s': %llu of %llu one-sided triangles are wound against their normals (mixed "
                 "windings?): their fronts face away from the normals; --two-sided all makes every surface two-sided\n",
@@ -901,6 +900,10 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
     st->material_names = (char **)xrealloc(NULL, sizeof(char *) * st->material_count);
+    st->wound_against = (uint64_t *)xrealloc(NULL, sizeof(uint64_t) * st->material_count);
+    st->wound_total = (uint64_t *)xrealloc(NULL, sizeof(uint64_t) * st->material_count);
+    memset(st->wound_against, 0, sizeof(uint64_t) * st->material_count);
+    memset(st->wound_total, 0, sizeof(uint64_t) * st->material_count);
     clamped = (unsigned char *)xrealloc(NULL, st->material_count);
     memset(clamped, 0, st->material_count);
     for (i = 0; i < st->material_count; ++i) {
@@ -1000,7 +1003,7 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
         if (tool_two_sided == TOOL_TWO_SIDED_ALL) st->materials[i].two_sided = 1;
         if (tool_two_sided == TOOL_TWO_SIDED_NONE) st->materials[i].two_sided = 0;
     }
-    warn_mixed_windings(&out->desc, path_or_name);
+    warn_mixed_windings(st, path_or_name);
     if (!out->has_camera) default_camera(bmin, bmax, &out->camera);
     return 0;
 }
