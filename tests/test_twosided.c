@@ -515,6 +515,75 @@ static void ts_test_gather_mesh_reports_one_side(void)
         }
 }
 
+/* The lightmap of a two-sided sheet (a 1 x 1 square at z = 0, lightmap uvs = x y) over a black
+   emitter 0.5 below facing up: its texels hold the side the shading normals point out of and
+   nothing of the other. Normals down: every texel's normal is -z and its mean irradiance is
+   pi L F, F the closed form for parallel squares (C-11); normals up: +z, and nothing lights
+   that side. */
+static void ts_test_lightmap_reports_one_side(void)
+{
+    static const float uvq[8] = { 0, 0, 1, 0, 1, 1, 0, 1 };
+    ff_quad q[2];
+    rad_mesh_desc m[2];
+    rad_scene_desc d;
+    rad_material mats[2] = { { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 1 }, { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0 } };
+    float nrm[12];
+    int side, k;
+    ff_quad_set(&q[0], 0, 0, 0, 1, 0, 0, 0, 1, 0);
+    ff_quad_set(&q[1], 0, 0, -0.5f, 1, 0, 0, 0, 1, 0);
+    ts_quad_mesh(&m[0], &q[0], 0);
+    ts_quad_mesh(&m[1], &q[1], 1);
+    m[0].lightmap_uvs = uvq;
+    m[0].normals = nrm;
+    memset(&d, 0, sizeof(d));
+    d.meshes = m;
+    d.mesh_count = 2;
+    d.materials = mats;
+    d.material_count = 2;
+    for (side = 0; side < 2; ++side) {
+        const float nz = side ? 1.0f : -1.0f;
+        ff_world w;
+        rad_form_factors *ff = NULL;
+        rad_form_factor_options fo;
+        rad_lightmap *lm = NULL;
+        rad_lightmap_options lo;
+        rad_lightmap_gather_options go;
+        float *E = NULL, *H = NULL;
+        double sum = 0.0;
+        uint32_t i, valid = 0, wrong = 0;
+        for (k = 0; k < 4; ++k) { nrm[3 * k] = 0.0f; nrm[3 * k + 1] = 0.0f; nrm[3 * k + 2] = nz; }
+        if (!ff_world_make(&d, 0.25f, 0, &w)) return;
+        CHECK(w.scene->lightmapped[0] == 1 && w.scene->lightmapped[1] == 0);
+        rad_form_factor_options_default(&fo);
+        CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &ff));
+        rad_lightmap_options_default(&lo);
+        lo.width = lo.height = 8;
+        CHECK_OK(rad_lightmap_create(w.scene, &w.rc, &lo, NULL, &lm));
+        E = (float *)calloc(3 * (size_t)w.patches->count, sizeof(float));
+        H = lm ? (float *)calloc(3 * (size_t)lm->width * lm->height, sizeof(float)) : NULL;
+        if (ff && lm && E && H) {
+            CHECK_OK(rad_sources(w.patches, RAD_SOURCE_EMISSION, NULL, E));
+            rad_lightmap_gather_options_default(&go);
+            CHECK_OK(rad_lightmap_gather(lm, w.patches, E, &w.rc, &go, H, NULL));
+            for (i = 0; i < lm->width * lm->height; ++i) {
+                if (!(lm->flags[i] & RAD_TEXEL_VALID)) continue;
+                ++valid;
+                if (!(lm->normals[3 * i + 2] * nz > 0.99f)) ++wrong;
+                sum += H[3 * i];
+            }
+            CHECK(valid == 64);
+            CHECK(wrong == 0);
+            if (side == 0) CHECK_REL(sum / valid, FF_PI * 1.0 * ff_c11(1.0, 1.0, 0.5), 0.02);
+            else CHECK(sum == 0.0);
+        }
+        free(E);
+        free(H);
+        rad_lightmap_destroy(lm);
+        rad_form_factors_destroy(ff);
+        ff_world_free(&w);
+    }
+}
+
 /* A one-sided scene is the scene it always was: the Cornell box flattens to its mesh
    triangles in order, as wound, with no twins array. */
 static void ts_test_one_sided_unchanged(void)
@@ -548,6 +617,7 @@ static const rad_test_case tests_twosided[] = {
     { "twosided_sheet_closed_form", ts_test_sheet_closed_form },
     { "twosided_mixed_winding_box", ts_test_mixed_winding_box },
     { "twosided_gather_mesh_reports_one_side", ts_test_gather_mesh_reports_one_side },
+    { "twosided_lightmap_reports_one_side", ts_test_lightmap_reports_one_side },
     { "twosided_one_sided_unchanged", ts_test_one_sided_unchanged },
     { NULL, NULL }
 };
