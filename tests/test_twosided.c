@@ -209,28 +209,23 @@ static void ts_test_embree_matches_bvh(void)
 }
 #endif
 
-/* A square sheet (side 1, two-sided, albedo rho) at z = 0 between two black square emitters
-   of the same size, one at z = -c facing up with radiance L1, one at z = +c facing down with
-   radiance L2. Each side of the sheet sees only its emitter, so its mean radiosity is exactly
-   rho * pi * L * F, F Howell's C-11 for parallel opposed squares. One-sided, the back would
-   stay black. */
-static void ts_test_sheet_closed_form(void)
+/* Three parallel unit squares at z = -c, 0 and +c, the outer two facing the middle one, which
+   is two-sided. Returns the mean radiosity (red) of the middle sheet's side facing down and up
+   (middle = 1) or of the lower and upper outer square (middle = 0), after the classic solve. */
+static int ts_sheet_solve(const rad_material mats[3], double c, int middle, double *down, double *up)
 {
     ff_quad q[3];
     rad_mesh_desc m[3];
     rad_scene_desc d;
-    rad_material mats[3] = { { { 0.6f, 0.6f, 0.6f }, { 0, 0, 0 }, 0, 1 },
-                             { { 0.0f, 0.0f, 0.0f }, { 2.0f, 2.0f, 2.0f }, 0, 0 },
-                             { { 0.0f, 0.0f, 0.0f }, { 0.5f, 0.5f, 0.5f }, 0, 0 } };
-    const double c = 0.5, rho = 0.6, F = ff_c11(1.0, 1.0, c);
     ff_world w;
     rad_form_factors *ff = NULL;
     rad_form_factor_options fo;
     rad_system sys;
     rad_solve_options so;
     float *E = NULL, *B = NULL;
-    double up = 0.0, down = 0.0, aup = 0.0, adown = 0.0;
+    double s[2] = { 0.0, 0.0 }, a[2] = { 0.0, 0.0 };
     uint32_t i;
+    int ok = 0;
     ff_quad_set(&q[0], 0, 0, 0, 1, 0, 0, 0, 1, 0);                  /* the sheet, front +z */
     ff_quad_set(&q[1], 0, 0, (float)-c, 1, 0, 0, 0, 1, 0);          /* below, facing up */
     ff_quad_set(&q[2], 0, 0, (float)c, 0, 1, 0, 1, 0, 0);           /* above, facing down */
@@ -240,7 +235,7 @@ static void ts_test_sheet_closed_form(void)
     d.mesh_count = 3;
     d.materials = mats;
     d.material_count = 3;
-    if (!ff_world_make(&d, rad_test_quick() ? 0.25f : 0.125f, 0, &w)) return;
+    if (!ff_world_make(&d, rad_test_quick() ? 0.25f : 0.125f, 0, &w)) return 0;
     rad_form_factor_options_default(&fo);
     CHECK_OK(rad_form_factors_dense(w.patches, &w.rc, &fo, NULL, &ff));
     E = (float *)calloc(3 * (size_t)w.patches->count, sizeof(float));
@@ -254,20 +249,54 @@ static void ts_test_sheet_closed_form(void)
         CHECK_OK(rad_solve_jacobi(&sys, &so, B, NULL, NULL));
         for (i = 0; i < w.patches->count; ++i) {
             const rad_patch *p = &w.patches->patches[i];
-            if (w.scene->meshes[p->triangle] != 0) continue;
-            if (p->normal[2] > 0.0f) { up += p->area * B[3 * i]; aup += p->area; }
-            else { down += p->area * B[3 * i]; adown += p->area; }
+            uint32_t mesh = w.scene->meshes[p->triangle];
+            int k = middle ? (p->normal[2] > 0.0f) : (mesh == 2);
+            if (middle ? mesh != 0 : mesh == 0) continue;
+            s[k] += p->area * B[3 * i];
+            a[k] += p->area;
         }
-        CHECK_NEAR(aup, 1.0, 1e-5);
-        CHECK_NEAR(adown, 1.0, 1e-5);
-        /* the side facing down sees the emitter below, the side facing up the one above */
-        CHECK_REL(down / adown, rho * FF_PI * 2.0 * F, 0.01);
-        CHECK_REL(up / aup, rho * FF_PI * 0.5 * F, 0.01);
+        CHECK_NEAR(a[0], 1.0, 1e-5);
+        CHECK_NEAR(a[1], 1.0, 1e-5);
+        *down = s[0] / a[0];
+        *up = s[1] / a[1];
+        ok = 1;
     }
     free(E);
     free(B);
     rad_form_factors_destroy(ff);
     ff_world_free(&w);
+    return ok;
+}
+
+/* A two-sided sheet (albedo rho) between two black emitters of radiance 2 (below, facing up)
+   and 0.5 (above, facing down): each side sees only its emitter, so its mean radiosity is
+   exactly rho * pi * L * F, F Howell's C-11 for parallel opposed squares. One-sided, the back
+   would stay black. */
+static void ts_test_sheet_closed_form(void)
+{
+    const rad_material mats[3] = { { { 0.6f, 0.6f, 0.6f }, { 0, 0, 0 }, 0, 1 },
+                                   { { 0.0f, 0.0f, 0.0f }, { 2.0f, 2.0f, 2.0f }, 0, 0 },
+                                   { { 0.0f, 0.0f, 0.0f }, { 0.5f, 0.5f, 0.5f }, 0, 0 } };
+    const double c = 0.5, rho = 0.6, F = ff_c11(1.0, 1.0, c);
+    double down = 0.0, up = 0.0;
+    if (!ts_sheet_solve(mats, c, 1, &down, &up)) return;
+    CHECK_REL(down, rho * FF_PI * 2.0 * F, 0.01);
+    CHECK_REL(up, rho * FF_PI * 0.5 * F, 0.01);
+}
+
+/* A two-sided black emitter sheet (radiance 1) between two grey squares facing it: it emits
+   from both sides, each receiver gets rho * pi * L * F (one-sided, the upper one would get
+   nothing). */
+static void ts_test_sheet_emits_both_ways(void)
+{
+    const rad_material mats[3] = { { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 1 },
+                                   { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0 },
+                                   { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0 } };
+    const double c = 0.5, F = ff_c11(1.0, 1.0, c);
+    double below = 0.0, above = 0.0;
+    if (!ts_sheet_solve(mats, c, 0, &below, &above)) return;
+    CHECK_REL(below, 0.5 * FF_PI * F, 0.01);
+    CHECK_REL(above, 0.5 * FF_PI * F, 0.01);
 }
 
 /* ---- a closed box of mixed windings ---- */
@@ -615,6 +644,7 @@ static const rad_test_case tests_twosided[] = {
     { "twosided_embree_matches_bvh", ts_test_embree_matches_bvh },
 #endif
     { "twosided_sheet_closed_form", ts_test_sheet_closed_form },
+    { "twosided_sheet_emits_both_ways", ts_test_sheet_emits_both_ways },
     { "twosided_mixed_winding_box", ts_test_mixed_winding_box },
     { "twosided_gather_mesh_reports_one_side", ts_test_gather_mesh_reports_one_side },
     { "twosided_lightmap_reports_one_side", ts_test_lightmap_reports_one_side },
