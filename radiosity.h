@@ -603,7 +603,8 @@ RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, con
    the area-weighted mean over them (so a crease averages its sides, as the mesh's own smooth
    normals do), and a vertex no triangle uses (or only skipped degenerate ones) gets 0.
    out: 3 * desc->vertex_count floats. Errors: INVALID_ARGUMENT (mesh >= the scene's mesh count,
-   a NULL pointer), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
+   a NULL pointer, a two-sided mesh whose desc has no positions: they tell which of its two
+   sides the scene put first), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
    of that mesh beyond desc->triangle_count: another description), OUT_OF_MEMORY.
    O(triangles of the scene). */
 RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
