@@ -148,7 +148,10 @@
            RAD_OUTPUT_INDIRECT  L = B - E (the bounces only; the default)
            RAD_OUTPUT_TOTAL     B = E + L
        - Triangles are wound counter-clockwise seen from the front; the front is the side that
-         emits and receives. Patches are one-sided.
+         emits and receives. Patches are one-sided. A triangle of a two-sided material
+         (rad_material.two_sided) becomes two scene triangles, one per side, back to back
+         (rad_scene.twins): each side has its own patches and samples, so every method treats
+         the two sides as independent surfaces.
 
    4. MEMORY
        Every object is created by a rad_*_create call that returns RAD_SUCCESS and writes an
@@ -200,6 +203,12 @@
        normal by ray_epsilon (relative to the scene diagonal) and their [tmin, tmax] interval
        excludes the same distance at both ends. The raycaster itself reports any hit in
        (tmin, tmax) and adds no epsilon of its own.
+       Two-sided triangles (rad_scene.twins) are two back-to-back scene triangles. A raycaster
+       accepts a hit on a twinned triangle only on its front, the side the ray comes from
+       (dot(dir, normal) < 0), so a ray always reports the copy it sees and both copies block
+       occlusion rays; one-sided triangles are hit from either side as before. The BVH and
+       the Embree backend do this; a raycaster of your own must too (an Embree scene you wrap
+       with rad_embree_wrap needs the filter function described at >>api_rays).
 
    8. EMBREE
        With RAD_EMBREE defined in the implementing file (and -lembree3), rad_embree_create
@@ -420,6 +429,8 @@ typedef struct rad_material {
     uint32_t emission_texture; /* 0: none (emission is constant); else passed to
                            rad_scene_desc.emission_lookup, whose result is multiplied by
                            'emission' (the factor) at each point (needs uvs on the mesh) */
+    uint32_t two_sided; /* 0: one-sided, the back absorbs; non-zero: both sides receive,
+                           reflect and emit, each on its own (see rad_scene.twins) */
 } rad_material;
 
 typedef struct rad_mesh_desc {
@@ -461,7 +472,16 @@ typedef struct rad_scene_desc {
 /* The validated scene, flattened: one array of triangles with world positions. Read-only.
    Triangle t has vertices positions[9t .. 9t+8] (three xyz), normal normals[3t..3t+2]
    (geometric, unit, from the winding), area areas[t], material materials[t], mesh meshes[t],
-   and the index it had in its mesh, source_triangles[t]. */
+   and the index it had in its mesh, source_triangles[t].
+   TWO-SIDED MATERIALS. A mesh triangle of a two-sided material becomes two scene triangles
+   at t and t + 1, the same positions wound in opposite directions (opposite normals), with
+   the same material, mesh and source triangle: twins[t] = t + 1 and twins[t + 1] = t. The
+   first of the pair (the lower index) is the side the per-mesh outputs report
+   (rad_patches_gather_mesh, lightmap texels: lightmapped[t + 1] is 0): the side the mesh's
+   shading normals point out of when the mesh gives normals (their sum at the three corners
+   against the wound normal), else the side as wound. twins is NULL when no material is
+   two-sided (the scene is then exactly what it was before two-sided materials existed);
+   otherwise one-sided triangles have twins[t] = RAD_NONE. */
 typedef struct rad_scene {
     uint32_t triangle_count;
     float *positions;
@@ -473,6 +493,8 @@ typedef struct rad_scene {
     uint32_t *materials;
     uint32_t *meshes;
     uint32_t *source_triangles;
+    uint32_t *twins;               /* per triangle: the other side's index, RAD_NONE for a
+                                      one-sided triangle; NULL when no material is two-sided */
     uint32_t material_count;
     rad_material *materials_table;
     uint32_t mesh_count;
@@ -613,11 +635,13 @@ RAD_API rad_result rad_patches_vertex_irradiance(const rad_patches *patches, con
    'mesh' is the index the mesh had in rad_scene_desc.meshes and 'desc' the same description
    (its vertex count and indices). vertex_values: 3 floats per patch vertex (from
    rad_patches_vertex_values or rad_patches_vertex_irradiance). Each triangle corner takes the
-   value interpolated at that corner of its patch; a vertex shared by several triangles gets
+   value interpolated at that corner of its patch (a two-sided triangle: on the side the scene
+   reports, the first of its pair, see rad_scene); a vertex shared by several triangles gets
    the area-weighted mean over them (so a crease averages its sides, as the mesh's own smooth
    normals do), and a vertex no triangle uses (or only skipped degenerate ones) gets 0.
    out: 3 * desc->vertex_count floats. Errors: INVALID_ARGUMENT (mesh >= the scene's mesh count,
-   a NULL pointer), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
+   a NULL pointer, a two-sided mesh whose desc has no positions: they tell which of its two
+   sides the scene put first), INDEX_OUT_OF_RANGE (an index >= desc->vertex_count, or the scene has triangles
    of that mesh beyond desc->triangle_count: another description), OUT_OF_MEMORY.
    O(triangles of the scene). */
 RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const float *vertex_values, uint32_t mesh,
@@ -641,7 +665,14 @@ typedef struct rad_hit {
 } rad_hit;
 
 /* The ray-query table. Both functions must be thread-safe and return RAD_SUCCESS, or an
-   error that the library passes on (as RAD_ERROR_RAYCAST_FAILED). */
+   error that the library passes on (as RAD_ERROR_RAYCAST_FAILED).
+   TWO-SIDED TRIANGLES. For a triangle t with scene->twins[t] != RAD_NONE, a hit counts only
+   when the ray meets its front: dot(ray.dir, scene->normals[3t..3t+2]) < 0. Its twin, at the
+   same place facing the other way, takes the hits from the other side, so a ray through a
+   two-sided sheet reports the side it sees, and an occlusion ray is blocked from either side.
+   Triangles with twins[t] == RAD_NONE (and every triangle when twins is NULL) are hit from
+   both sides. In Embree this is an intersection and an occlusion filter function on the
+   geometry that rejects the back of a twinned triangle (what rad_embree_create installs). */
 typedef struct rad_raycaster {
     void *user;
     /* out_occluded[i] = 1 when anything is hit with tmin < t < tmax, else 0. */
@@ -683,7 +714,9 @@ RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *
 /* Wraps a user's committed RTCScene (passed as void * so this header needs no Embree types).
    A hit on (geomID, primID) is reported as triangle first_triangle[geomID] + primID; pass
    first_triangle = NULL when geometry 0 holds the scene's triangles in order. The scene is
-   borrowed: it must outlive the returned object, which does not release it. */
+   borrowed: it must outlive the returned object, which does not release it. With two-sided
+   materials the wrapped scene must reject back hits on twinned triangles itself (a filter
+   function, see TWO-SIDED TRIANGLES above). */
 RAD_API rad_result rad_embree_wrap(void *rtc_scene, const uint32_t *first_triangle, uint32_t geometry_count,
                                    const rad_context *ctx, rad_embree **out);
 RAD_API void rad_embree_destroy(rad_embree *embree);
@@ -4574,7 +4607,7 @@ RAD_API void rad_scene_destroy(rad_scene *scene)
     {
         void *blocks[] = { scene->positions, scene->normals, scene->uvs, scene->lightmap_uvs,
                            scene->lightmapped, scene->areas, scene->materials, scene->meshes,
-                           scene->source_triangles, scene->materials_table, scene->mesh_names, scene };
+                           scene->source_triangles, scene->twins, scene->materials_table, scene->mesh_names, scene };
         rad__free_each(scene->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
 }
@@ -4613,8 +4646,10 @@ static rad_result rad__validate_materials(const rad_scene_desc *desc, const rad_
     return RAD_SUCCESS;
 }
 
-/* Validates one mesh; counts its usable triangles into *kept. */
-static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, const rad__ctx *c, uint32_t *kept)
+/* Validates one mesh; counts its usable triangles into *kept, those of two-sided materials
+   (which become two scene triangles each) into *kept_two_sided. */
+static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, const rad__ctx *c, uint32_t *kept,
+                                     uint32_t *kept_two_sided)
 {
     const rad_mesh_desc *m = &desc->meshes[mi];
     size_t ps = m->position_stride ? m->position_stride : 3 * sizeof(float);
@@ -4624,6 +4659,7 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
     uint32_t v, t;
     int k;
     *kept = 0;
+    *kept_two_sided = 0;
     if (m->triangle_count == 0) return RAD_SUCCESS;
     if (!m->positions) {
         rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': positions is NULL", mi, rad__mesh_name(m));
@@ -4695,8 +4731,46 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
             return RAD_ERROR_DEGENERATE_TRIANGLE;
         }
         ++*kept;
+        if (desc->materials[mat].two_sided) ++*kept_two_sided;
     }
     return RAD_SUCCESS;
+}
+
+/* Writes scene triangle dst from triangle t of mesh m (index mi, material mat, corner
+   positions tri, twice-area vector cr of length cl), its corners taken in the order ord and
+   its normal cr / cl times sign (-1 for the reversed side of a two-sided triangle). */
+static void rad__scene_put(rad_scene *s, const rad_mesh_desc *m, uint32_t dst, uint32_t t, uint32_t mi, uint32_t mat,
+                           const float *tri, const int *ord, const double *cr, double cl, double sign)
+{
+    size_t us = m->uv_stride ? m->uv_stride : 2 * sizeof(float);
+    size_t ls = m->lightmap_uv_stride ? m->lightmap_uv_stride : 2 * sizeof(float);
+    float *P = s->positions + 9 * (size_t)dst;
+    int v, k;
+    for (v = 0; v < 3; ++v) memcpy(P + 3 * v, tri + 3 * ord[v], 3 * sizeof(float));
+    if (s->uvs)
+        for (v = 0; v < 3; ++v) {
+            const float *uv = m->uvs ? rad__strided(m->uvs, us, rad__mesh_index(m, t, ord[v])) : NULL;
+            s->uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
+            s->uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
+        }
+    if (s->lightmap_uvs) {
+        s->lightmapped[dst] = m->lightmap_uvs ? 1u : 0u;
+        for (v = 0; v < 3; ++v) {
+            const float *uv = m->lightmap_uvs ? rad__strided(m->lightmap_uvs, ls, rad__mesh_index(m, t, ord[v])) : NULL;
+            s->lightmap_uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
+            s->lightmap_uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
+        }
+    }
+    for (k = 0; k < 3; ++k) s->normals[3 * (size_t)dst + (size_t)k] = (float)(sign * cr[k] / cl);
+    s->areas[dst] = (float)(0.5 * cl);
+    s->materials[dst] = mat;
+    s->meshes[dst] = mi;
+    s->source_triangles[dst] = t;
+    for (v = 0; v < 3; ++v)
+        for (k = 0; k < 3; ++k) {
+            if (P[3 * v + k] < s->bounds_min[k]) s->bounds_min[k] = P[3 * v + k];
+            if (P[3 * v + k] > s->bounds_max[k]) s->bounds_max[k] = P[3 * v + k];
+        }
 }
 
 RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_context *ctx, rad_scene **out)
@@ -4704,7 +4778,7 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     rad__ctx c;
     rad_scene *s;
     rad_result r;
-    uint64_t total = 0, input = 0;
+    uint64_t total = 0, input = 0, two_sided = 0;
     uint32_t mi, t, n, dst;
     int k, any_uv = 0, any_lm = 0;
     rad__ctx_init(&c, ctx);
@@ -4718,21 +4792,23 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     r = rad__validate_materials(desc, &c);
     if (r != RAD_SUCCESS) return r;
     for (mi = 0; mi < desc->mesh_count; ++mi) {
-        uint32_t kept;
-        r = rad__validate_mesh(desc, mi, &c, &kept);
+        uint32_t kept, kept_two_sided;
+        r = rad__validate_mesh(desc, mi, &c, &kept, &kept_two_sided);
         if (r != RAD_SUCCESS) return r;
-        total += kept;
+        total += (uint64_t)kept + kept_two_sided;
+        two_sided += kept_two_sided;
         input += desc->meshes[mi].triangle_count;
         if (desc->meshes[mi].uvs) any_uv = 1;
         if (desc->meshes[mi].lightmap_uvs) any_lm = 1;
     }
     if (total == 0) {
         rad__log(&c, RAD_LOG_ERROR, "the scene has no triangles (%llu given, %llu degenerate)", (unsigned long long)input,
-                 (unsigned long long)(input - total));
+                 (unsigned long long)input);
         return RAD_ERROR_EMPTY_SCENE;
     }
     if (total >= (uint64_t)RAD_NONE) {
-        rad__log(&c, RAD_LOG_ERROR, "%llu triangles: at most %u are supported", (unsigned long long)total, RAD_NONE - 1u);
+        rad__log(&c, RAD_LOG_ERROR, "%llu triangles (%llu of them the second sides of two-sided ones): at most %u are supported",
+                 (unsigned long long)total, (unsigned long long)two_sided, RAD_NONE - 1u);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
     n = (uint32_t)total;
@@ -4741,7 +4817,7 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     s->allocator = c.allocator;
     s->triangle_count = n;
     s->material_count = desc->material_count;
-    s->skipped_triangles = (uint32_t)(input - total);
+    s->skipped_triangles = (uint32_t)(input - (total - two_sided));
     s->albedo_lookup = desc->albedo_lookup;
     s->albedo_user = desc->albedo_user;
     s->emission_lookup = desc->emission_lookup;
@@ -4754,13 +4830,15 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     s->source_triangles = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
     s->materials_table = (rad_material *)rad__alloc_array(&c.allocator, desc->material_count, sizeof(rad_material));
     s->mesh_names = (char **)rad__alloc_array(&c.allocator, desc->mesh_count, sizeof(char *));
+    if (two_sided) s->twins = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
     if (any_uv) s->uvs = (float *)rad__alloc_array(&c.allocator, (size_t)n * 6u, sizeof(float));
     if (any_lm) {
         s->lightmap_uvs = (float *)rad__alloc_array(&c.allocator, (size_t)n * 6u, sizeof(float));
         s->lightmapped = (uint8_t *)rad__alloc_array(&c.allocator, n, 1);
     }
     if (!s->positions || !s->normals || !s->areas || !s->materials || !s->meshes || !s->source_triangles ||
-        !s->materials_table || !s->mesh_names || (any_uv && !s->uvs) || (any_lm && (!s->lightmap_uvs || !s->lightmapped))) {
+        !s->materials_table || !s->mesh_names || (any_uv && !s->uvs) || (any_lm && (!s->lightmap_uvs || !s->lightmapped)) ||
+        (two_sided && !s->twins)) {
         rad_scene_destroy(s);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -4779,42 +4857,38 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     for (mi = 0; mi < desc->mesh_count; ++mi) {
         const rad_mesh_desc *m = &desc->meshes[mi];
         size_t ps = m->position_stride ? m->position_stride : 3 * sizeof(float);
-        size_t us = m->uv_stride ? m->uv_stride : 2 * sizeof(float);
-        size_t ls = m->lightmap_uv_stride ? m->lightmap_uv_stride : 2 * sizeof(float);
+        size_t ns = m->normal_stride ? m->normal_stride : 3 * sizeof(float);
         for (t = 0; t < m->triangle_count; ++t) {
+            /* corner orders: as wound, and reversed (the other side of a two-sided triangle) */
+            static const int order[2][3] = { { 0, 1, 2 }, { 0, 2, 1 } };
             double cr[3], cl;
-            float tri[9], *P;
-            int v;
+            float tri[9];
+            uint32_t mat = m->material_ids ? m->material_ids[t] : m->material;
+            int v, side, sides, first;
             for (v = 0; v < 3; ++v) memcpy(tri + 3 * v, rad__strided(m->positions, ps, rad__mesh_index(m, t, v)), 3 * sizeof(float));
             /* decide before writing: a skipped triangle must not touch the arrays (sized for the kept ones) */
             if (!rad__triangle_cross(tri, tri + 3, tri + 6, cr, &cl)) continue; /* skipped (validation checked the flag) */
-            P = s->positions + 9 * (size_t)dst;
-            memcpy(P, tri, sizeof(tri));
-            if (s->uvs)
+            sides = desc->materials[mat].two_sided ? 2 : 1;
+            first = 0;
+            if (sides == 2 && m->normals) {
+                /* the reported side (the pair's first) is the one the shading normals point out of */
+                double d = 0.0;
                 for (v = 0; v < 3; ++v) {
-                    const float *uv = m->uvs ? rad__strided(m->uvs, us, rad__mesh_index(m, t, v)) : NULL;
-                    s->uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
-                    s->uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
+                    const float *sn = rad__strided(m->normals, ns, rad__mesh_index(m, t, v));
+                    d += (double)sn[0] * cr[0] + (double)sn[1] * cr[1] + (double)sn[2] * cr[2];
                 }
-            if (s->lightmap_uvs) {
-                s->lightmapped[dst] = m->lightmap_uvs ? 1u : 0u;
-                for (v = 0; v < 3; ++v) {
-                    const float *uv = m->lightmap_uvs ? rad__strided(m->lightmap_uvs, ls, rad__mesh_index(m, t, v)) : NULL;
-                    s->lightmap_uvs[6 * (size_t)dst + 2 * (size_t)v] = uv ? uv[0] : 0.0f;
-                    s->lightmap_uvs[6 * (size_t)dst + 2 * (size_t)v + 1] = uv ? uv[1] : 0.0f;
-                }
+                first = d < 0.0;
             }
-            for (k = 0; k < 3; ++k) s->normals[3 * (size_t)dst + (size_t)k] = (float)(cr[k] / cl);
-            s->areas[dst] = (float)(0.5 * cl);
-            s->materials[dst] = m->material_ids ? m->material_ids[t] : m->material;
-            s->meshes[dst] = mi;
-            s->source_triangles[dst] = t;
-            for (v = 0; v < 3; ++v)
-                for (k = 0; k < 3; ++k) {
-                    if (P[3 * v + k] < s->bounds_min[k]) s->bounds_min[k] = P[3 * v + k];
-                    if (P[3 * v + k] > s->bounds_max[k]) s->bounds_max[k] = P[3 * v + k];
+            for (side = 0; side < sides; ++side) {
+                int o = side ^ first;
+                rad__scene_put(s, m, dst, t, mi, mat, tri, order[o], cr, cl, o ? -1.0 : 1.0);
+                if (s->twins) {
+                    s->twins[dst] = sides == 2 ? (side ? dst - 1u : dst + 1u) : RAD_NONE;
+                    /* the per-mesh outputs come from the first side only */
+                    if (side && s->lightmapped) s->lightmapped[dst] = 0;
                 }
-            ++dst;
+                ++dst;
+            }
         }
     }
     RAD_ASSERT(dst == n);
@@ -4961,10 +5035,10 @@ static const uint32_t rad__cornell_quad_indices[] = {
 };
 
 static const rad_material rad__cornell_materials[4] = {
-    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0, 0 },    /* white */
-    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0, 0 },    /* red */
-    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0, 0 },    /* green */
-    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0, 0 }    /* light */
+    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* white */
+    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* red */
+    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* green */
+    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0, 0, 0 }    /* light */
 };
 
 #define RAD__CORNELL_MESH(name, first_vertex, quads, mat)                                                      \
@@ -5512,6 +5586,7 @@ RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const flo
         uint32_t j = S->source_triangles[t], id[3];
         static const float corner[3][2] = { { 0.0f, 0.0f }, { 1.0f, 0.0f }, { 0.0f, 1.0f } };
         if (S->meshes[t] != mesh) continue;
+        if (S->twins && S->twins[t] < t) continue; /* a two-sided triangle reports its pair's first side */
         if (j >= desc->triangle_count) {
             rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: the scene's mesh %u has triangle %u, desc has %u triangles",
                      mesh, j, desc->triangle_count);
@@ -5524,6 +5599,21 @@ RAD_API rad_result rad_patches_gather_mesh(const rad_patches *patches, const flo
                 rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: triangle %u has vertex index %u >= %u", j, id[k], V);
                 rad__free(&c.allocator, acc);
                 return RAD_ERROR_INDEX_OUT_OF_RANGE;
+            }
+        }
+        if (S->twins && S->twins[t] != RAD_NONE) {
+            /* the reported side may be the reversed copy (corners 0 2 1 of the mesh triangle):
+               found by its corner 1, a copy of the mesh's vertex */
+            size_t ps = desc->position_stride ? desc->position_stride : 3 * sizeof(float);
+            if (!desc->positions) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_patches_gather_mesh: mesh %u is two-sided and desc has no positions", mesh);
+                rad__free(&c.allocator, acc);
+                return RAD_ERROR_INVALID_ARGUMENT;
+            }
+            if (memcmp(S->positions + 9 * (size_t)t + 3, rad__strided(desc->positions, ps, id[1]), 3 * sizeof(float)) != 0) {
+                uint32_t tmp = id[1];
+                id[1] = id[2];
+                id[2] = tmp;
             }
         }
         for (k = 0; k < 3; ++k) {
@@ -5579,8 +5669,11 @@ typedef struct rad__bvhw {
    never tested. */
 typedef struct rad__tri4 {
     float v[3][3][4];
-    uint32_t id[4];           /* scene triangle of each lane */
+    uint32_t id[4];           /* scene triangle of each lane, | RAD__BVH_FRONT_ONLY for a twinned one */
 } rad__tri4;
+/* A lane's id bit for a triangle of a two-sided pair (rad_scene.twins): hit from its front
+   only. Ids stay below 2^29, so the bit is free; one-sided scenes never set it. */
+#define RAD__BVH_FRONT_ONLY 0x80000000u
 
 struct rad_bvh {
     rad__bvhw *nodes;         /* in 'block', aligned to a cache line */
@@ -5894,7 +5987,7 @@ static void rad__bvhw_count(const rad__bvh_node *bin, uint32_t root, uint32_t *s
    inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
    entries per leaf. */
 static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t root, uint32_t *stack,
-                                     const float *positions, const uint32_t *order)
+                                     const float *positions, const uint32_t *twins, const uint32_t *order)
 {
     uint32_t sp = 0;
     b->node_count = 1;
@@ -5924,6 +6017,7 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
                     for (c = 0; c < 3; ++c)
                         for (a = 0; a < 3; ++a) q->v[c][a][j] = v[3 * c + (uint32_t)a];
                     q->id[j] = order[bin[slots[k]].first + j];
+                    if (twins && twins[q->id[j]] != RAD_NONE) q->id[j] |= RAD__BVH_FRONT_ONLY;
                 }
                 node->child[k] = RAD__BVH4_LEAF | b->leaf_count++;
                 node->count[k] = bin[slots[k]].count;
@@ -6041,7 +6135,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     /* Stage 3, the wide nodes and leaves, counted first so the block holds just them */
     rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
-    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, order);
+    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, scene->twins, order);
     {
         void *blocks[] = { refs, stack, task, order, tree };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
@@ -6108,9 +6202,10 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
 }
 
 #if !defined(RAD__SSE2)
-/* Watertight ray/triangle test, both faces. Returns 1 with t, b1, b2 on a hit in (tmin, tmax).
+/* Watertight ray/triangle test, both faces (the front only with front_only: det > 0, the
+   ray meeting the counter-clockwise side). Returns 1 with t, b1, b2 on a hit in (tmin, tmax).
    rad__wray_tri4 performs the same operations on four triangles at once with SIMD. */
-static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *t_out, float *b1, float *b2)
+static int rad__wray_tri(const rad__wray *w, const float *v, int front_only, float tmax, float *t_out, float *b1, float *b2)
 {
     float A[3], B[3], C[3], Ax, Ay, Bx, By, Cx, Cy, U, V, W, det, T;
     int k;
@@ -6143,7 +6238,7 @@ static int rad__wray_tri(const rad__wray *w, const float *v, float tmax, float *
     }
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     det = U + V + W;
-    if (det == 0.0f) return 0;
+    if (det == 0.0f || (front_only && det < 0.0f)) return 0;
     /* U, V, W scale as length^2, so the numerator of t (length^3) is formed in double: in
        float it overflows beyond scenes of about 1e12 and underflows below 1e-13 */
     T = (float)(((double)U * (double)(w->sz * A[w->kz]) + (double)V * (double)(w->sz * B[w->kz]) +
@@ -6294,7 +6389,8 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
         float det, T;
         if (!(hit_mask & (1 << j))) continue;
         det = u[j] + v[j] + ww[j];
-        if (det == 0.0f) continue;
+        /* det < 0: the ray meets the back, which a twinned triangle leaves to its twin */
+        if (det == 0.0f || (det < 0.0f && (q->id[j] & RAD__BVH_FRONT_ONLY))) continue;
         T = (float)(((double)u[j] * (double)(w->sz * az[j]) + (double)v[j] * (double)(w->sz * bz[j]) +
                      (double)ww[j] * (double)(w->sz * cz[j])) / (double)det);
         if (!(T > w->tmin && T < *tmax)) continue;
@@ -6312,7 +6408,7 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
     for (j = 0; j < count; ++j) {
         for (c = 0; c < 3; ++c)
             for (a = 0; a < 3; ++a) tri[3 * c + a] = q->v[c][a][j];
-        if (!rad__wray_tri(w, tri, *tmax, &t, &c1, &c2)) continue;
+        if (!rad__wray_tri(w, tri, (q->id[j] & RAD__BVH_FRONT_ONLY) != 0, *tmax, &t, &c1, &c2)) continue;
         *tmax = *t_out = t;
         *b1 = c1;
         *b2 = c2;
@@ -6377,7 +6473,7 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
                     return 1;
                 }
                 hit->t = t;
-                hit->triangle = q->id[j];
+                hit->triangle = q->id[j] & ~RAD__BVH_FRONT_ONLY;
                 hit->b1 = b1;
                 hit->b2 = b2;
             }
@@ -6526,7 +6622,29 @@ struct rad_embree {
     void (*log)(void *user, rad_log_level level, const char *message);
     void *log_user;
     size_t memory;           /* device memory reported by the monitor (bytes, >= 0) */
+    float *front_normals;    /* per triangle of a two-sided pair its normal, else 0 0 0; NULL
+                                without two-sided materials (no filter then) */
 };
+
+/* The filter of rad_embree_create's geometry when the scene has two-sided triangles: a hit on
+   the back of one (dot(dir, normal) >= 0) is rejected, so Embree goes on to its twin. */
+static void rad__embree_front_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    /* the packets' structure-of-arrays layout of rtcore_ray.h (its accessors are C++ only):
+       direction x y z at float rows 4 5 6 of the ray, primID at row 5 of the hit */
+    const rad_embree *e = (const rad_embree *)args->geometryUserPtr;
+    const float *ray = (const float *)(const void *)args->ray;
+    const unsigned int *hit = (const unsigned int *)(const void *)args->hit, N = args->N;
+    unsigned int i;
+    for (i = 0; i < N; ++i) {
+        const float *n;
+        float d;
+        if (args->valid[i] == 0) continue;
+        n = e->front_normals + 3 * (size_t)hit[5 * N + i];
+        d = ray[4 * N + i] * n[0] + ray[5 * N + i] * n[1] + ray[6 * N + i] * n[2];
+        if ((n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f) && !(d < 0.0f)) args->valid[i] = 0;
+    }
+}
 
 static void rad__embree_error(void *user, enum RTCError code, const char *str)
 {
@@ -6559,6 +6677,7 @@ RAD_API void rad_embree_destroy(rad_embree *e)
         rtcReleaseDevice(e->device);
     }
     rad__free(&a, e->first);
+    rad__free(&a, e->front_normals);
     rad__free(&a, e);
 }
 
@@ -6600,6 +6719,19 @@ RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *
     if (!v || !idx) { rtcReleaseGeometry(g); rad_embree_destroy(e); return RAD_ERROR_OUT_OF_MEMORY; }
     memcpy(v, scene->positions, 9 * sizeof(float) * (size_t)scene->triangle_count);
     for (t = 0; t < 3 * scene->triangle_count; ++t) idx[t] = t;
+    if (scene->twins) {
+        /* only scenes with two-sided triangles pay for a filter call per candidate hit */
+        e->front_normals = (float *)rad__alloc_array(&c.allocator, 3u * (size_t)scene->triangle_count, sizeof(float));
+        if (!e->front_normals) { rtcReleaseGeometry(g); rad_embree_destroy(e); return RAD_ERROR_OUT_OF_MEMORY; }
+        for (t = 0; t < scene->triangle_count; ++t) {
+            int k;
+            for (k = 0; k < 3; ++k)
+                e->front_normals[3 * (size_t)t + (size_t)k] = scene->twins[t] != RAD_NONE ? scene->normals[3 * (size_t)t + (size_t)k] : 0.0f;
+        }
+        rtcSetGeometryUserData(g, e);
+        rtcSetGeometryIntersectFilterFunction(g, rad__embree_front_filter);
+        rtcSetGeometryOccludedFilterFunction(g, rad__embree_front_filter);
+    }
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(e->scene, g, 0);
     rtcReleaseGeometry(g);

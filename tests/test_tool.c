@@ -347,6 +347,7 @@ static void test_trace_furnace(void)
             mats[f].albedo[k] = rho;
             mats[f].emission[k] = L[k];
             mats[f].texture = 0;
+            mats[f].two_sided = 0;
         }
     s = box_scene(mats);
     CHECK(s != NULL);
@@ -464,6 +465,7 @@ static void test_trace_vs_radiosity(void)
             mats[f].albedo[k] = k == 0 ? 0.5f : (k == 1 ? 0.7f : 0.3f);
             mats[f].emission[k] = f == 3 ? 1.0f : 0.0f;
             mats[f].texture = 0;
+            mats[f].two_sided = 0;
         }
     s = box_scene(mats);
     CHECK(s != NULL);

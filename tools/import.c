@@ -81,6 +81,8 @@ typedef struct imp_storage {
     char **material_reports;  /* per material: what the import used and ignored (rad info) */
     int any_emission_texture;
     int builtin;
+    uint64_t *wound_against;  /* per material: triangles wound against their shading normals */
+    uint64_t *wound_total;    /* per material: triangles with shading normals */
 } imp_storage;
 
 static void set_err(char *err, size_t errlen, const char *fmt, const char *a, const char *b)
@@ -173,6 +175,8 @@ static void free_storage(imp_storage *st)
     free(st->groups);
     free(st->meshes);
     free(st->materials);
+    free(st->wound_against);
+    free(st->wound_total);
     free(st->textures);
     free(st);
 }
@@ -344,6 +348,12 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
             out->emission_texture = id;
             st->any_emission_texture = 1;
         }
+    }
+    /* glTF doubleSided (and a few other formats' two-sided flags) */
+    {
+        int two = 0;
+        unsigned int n2 = 1;
+        if (aiGetMaterialIntegerArray(m, AI_MATKEY_TWOSIDED, &two, &n2) == aiReturn_SUCCESS && two) out->two_sided = 1;
     }
     /* texture: base colour (glTF) or diffuse (OBJ map_Kd ...) */
     if (aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &tpath, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS ||
@@ -947,6 +957,22 @@ static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiN
             ++ws->bad_indices; /* assimp checks; counted should one slip through */
             continue;
         }
+        if (mesh->mNormals && mesh->mMaterialIndex < ws->st->material_count) {
+            /* in the mesh's own space: a mirroring transform flips winding and normals alike */
+            const struct aiVector3D *a = &mesh->mVertices[face->mIndices[0]], *b = &mesh->mVertices[face->mIndices[1]],
+                                    *c = &mesh->mVertices[face->mIndices[2]];
+            double e1[3], e2[3], dot = 0.0;
+            int q;
+            e1[0] = (double)b->x - a->x, e1[1] = (double)b->y - a->y, e1[2] = (double)b->z - a->z;
+            e2[0] = (double)c->x - a->x, e2[1] = (double)c->y - a->y, e2[2] = (double)c->z - a->z;
+            for (q = 0; q < 3; ++q) {
+                const struct aiVector3D *n = &mesh->mNormals[face->mIndices[q]];
+                dot += (e1[1] * e2[2] - e1[2] * e2[1]) * n->x + (e1[2] * e2[0] - e1[0] * e2[2]) * n->y +
+                       (e1[0] * e2[1] - e1[1] * e2[0]) * n->z;
+            }
+            ws->st->wound_total[mesh->mMaterialIndex]++;
+            if (dot < 0.0) ws->st->wound_against[mesh->mMaterialIndex]++;
+        }
         ix[0] = base + remap[face->mIndices[0]];
         ix[1] = base + remap[det < 0 ? face->mIndices[2] : face->mIndices[1]];
         ix[2] = base + remap[det < 0 ? face->mIndices[1] : face->mIndices[2]];
@@ -1109,6 +1135,36 @@ int tool_is_scene_path(const char *path)
     return dot && strcmp(dot, ".radb") != 0 && aiIsExtensionSupported(dot) == AI_TRUE;
 }
 
+tool_two_sided_mode tool_two_sided = TOOL_TWO_SIDED_AUTO;
+
+/* A one-sided triangle is taken as wound: its front is the counter-clockwise side, whatever
+   its shading normals say. When many disagree with their normals the file most likely has
+   mixed windings (its surfaces would show black backs), so say so and name the remedy. */
+static void warn_mixed_windings(const imp_storage *st, const char *file)
+{
+    uint64_t against = 0, total = 0;
+    uint32_t i;
+    for (i = 0; i < st->material_count; ++i)
+        if (!st->materials[i].two_sided) {
+            against += st->wound_against[i];
+            total += st->wound_total[i];
+        }
+    if (total && against * 100u >= total)
+        fprintf(stderr, "rad: warning: '%s': %llu of %llu one-sided triangles are wound against their normals (mixed "
+                "windings?): their fronts face away from the normals; --two-sided all makes every surface two-sided\n",
+                file, (unsigned long long)against, (unsigned long long)total);
+}
+
+int tool_two_sided_parse(const char *text, tool_two_sided_mode *out)
+{
+    if (!text) return 1;
+    if (!strcmp(text, "auto")) *out = TOOL_TWO_SIDED_AUTO;
+    else if (!strcmp(text, "all")) *out = TOOL_TWO_SIDED_ALL;
+    else if (!strcmp(text, "none")) *out = TOOL_TWO_SIDED_NONE;
+    else return 1;
+    return 0;
+}
+
 int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen)
 {
     const struct aiScene *sc;
@@ -1133,6 +1189,14 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
         if (out->desc.material_count == 4) out->material_names = cornell_names;
         out->has_camera = 1;
         out->storage = st;
+        if (tool_two_sided == TOOL_TWO_SIDED_ALL) {
+            /* the built-in materials are static: a copy takes the flag */
+            st->material_count = out->desc.material_count;
+            st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
+            memcpy(st->materials, out->desc.materials, sizeof(rad_material) * st->material_count);
+            for (i = 0; i < st->material_count; ++i) st->materials[i].two_sided = 1;
+            out->desc.materials = st->materials;
+        }
         return 0;
     }
     sc = import_logged(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
@@ -1169,6 +1233,10 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
     st->material_names = (char **)xrealloc(NULL, sizeof(char *) * st->material_count);
+    st->wound_against = (uint64_t *)xrealloc(NULL, sizeof(uint64_t) * st->material_count);
+    st->wound_total = (uint64_t *)xrealloc(NULL, sizeof(uint64_t) * st->material_count);
+    memset(st->wound_against, 0, sizeof(uint64_t) * st->material_count);
+    memset(st->wound_total, 0, sizeof(uint64_t) * st->material_count);
     clamped = (unsigned char *)xrealloc(NULL, st->material_count);
     memset(clamped, 0, st->material_count);
     for (i = 0; i < st->material_count; ++i) {
@@ -1275,6 +1343,11 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     out->desc.emission_lookup = st->any_emission_texture ? emission_lookup : NULL;
     out->desc.emission_user = st;
     out->desc.flags = RAD_SCENE_SKIP_DEGENERATE;
+    for (i = 0; i < st->material_count; ++i) {
+        if (tool_two_sided == TOOL_TWO_SIDED_ALL) st->materials[i].two_sided = 1;
+        if (tool_two_sided == TOOL_TWO_SIDED_NONE) st->materials[i].two_sided = 0;
+    }
+    warn_mixed_windings(st, path_or_name);
     if (!out->has_camera) default_camera(bmin, bmax, &out->camera);
     return 0;
 }

@@ -50,7 +50,9 @@ static void usage(FILE *f)
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
                "at most 1024). render, trace, bake, lightmap and probes add lights to the file's own:\n"
                "--sun DIR:RGB, --sky RGB, --point POS:RGB, --spot POS:DIR:ANGLES:RGB, --area P:U:V:RGB\n"
-               "(units: rad render --help). Dense methods (classic, multibounce, temporal, local) refuse\n"
+               "(units: rad render --help). Surfaces: --two-sided [auto|all|none] (every command; default\n"
+               "auto: glTF doubleSided materials are two-sided, the rest one-sided as wound; bare\n"
+               "--two-sided: all). Dense methods (classic, multibounce, temporal, local) refuse\n"
                "a build estimated beyond the free memory (--max-memory SIZE) or an hour; --force runs it\n"
                "anyway.\n");
 }
@@ -85,6 +87,23 @@ int tool_main(int argc, char **argv)
     if (!strcmp(argv[1], "version") || !strcmp(argv[1], "--version")) {
         printf("rad (radiosity.h %s)\n", RAD_VERSION_STRING);
         return 0;
+    }
+    {
+        /* --two-sided [MODE] applies to every command's scene: taken out of argv here */
+        int a, o = 2;
+        for (a = 2; a < argc; ++a) {
+            if (!strcmp(argv[a], "--two-sided")) {
+                if (a + 1 < argc && tool_two_sided_parse(argv[a + 1], &tool_two_sided) == 0) ++a;
+                else if (a + 1 < argc && argv[a + 1][0] != '-' && strchr(argv[a + 1], '.') == NULL &&
+                         strcmp(argv[a + 1], "cornell") != 0) {
+                    fprintf(stderr, "rad: --two-sided wants auto, all or none, got '%s'\n", argv[a + 1]);
+                    return 2;
+                } else tool_two_sided = TOOL_TWO_SIDED_ALL;
+                continue;
+            }
+            argv[o++] = argv[a];
+        }
+        argc = o;
     }
     for (i = 0; i < sizeof cmds / sizeof cmds[0]; ++i)
         if (!strcmp(argv[1], cmds[i].name)) return cmds[i].fn(argc - 2, argv + 2);

@@ -35,6 +35,14 @@ void tool_free_scene(tool_scene *scene);
 /* 1 for 'cornell' and a file name whose extension the importer reads (not .radb) */
 int tool_is_scene_path(const char *path);
 
+/* --two-sided MODE of every command (rad.c takes it before the command sees its options):
+   auto (default) trusts the file's flag (glTF doubleSided; OBJ has none: one-sided), all makes
+   every material two-sided, none every material one-sided. */
+typedef enum tool_two_sided_mode { TOOL_TWO_SIDED_AUTO = 0, TOOL_TWO_SIDED_ALL = 1, TOOL_TWO_SIDED_NONE = 2 } tool_two_sided_mode;
+extern tool_two_sided_mode tool_two_sided;
+/* 0 and *out set for "auto", "all" or "none", else 1 */
+int tool_two_sided_parse(const char *text, tool_two_sided_mode *out);
+
 /* ---- images (image.c) ------------------------------------------------------------------ */
 
 /* Linear RGB floats, row-major, top row first. */

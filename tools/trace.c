@@ -5,7 +5,10 @@
    transport model the radiosity solvers use:
      - every surface is Lambertian with the albedo of rad_scene_albedo at the hit (textures
        work); surfaces are ONE-SIDED like the radiosity patches: the front is the CCW side
-       (scene->normals); a ray that hits a back face ends there (nothing reflected or emitted);
+       (scene->normals); a ray that hits a back face ends there (nothing reflected or emitted).
+       A two-sided material's triangle is two scene triangles back to back (rad_scene.twins),
+       and the raycaster reports the one whose front faces the ray, so both of its sides
+       reflect and emit, each on its own, with no code here;
      - emissive triangles emit radiance = material emission from their front only;
      - analytic lights: directional, point and spot lights by next-event estimation only (delta
        lights, same falloff and spot smoothstep as rad_direct_irradiance), the sky
