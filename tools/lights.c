@@ -15,6 +15,11 @@
                                 INNER,OUTER half-angles in degrees (full intensity inside
                                 INNER, smoothstep to 0 at OUTER; one angle: a hard edge);
                                 RGB = intensity in W/sr on the axis
+     --env FILE[:SCALE[:ROT]]   environment map: an equirectangular Radiance .hdr (stb_image)
+                                or .exr (tinyexr) of radiance in W m^-2 sr^-1, times SCALE
+                                (default 1), turned ROT degrees about +Y (+X towards +Z);
+                                +Y is up, the top row the zenith, the left edge looks along
+                                +X (the library's RAD_LIGHT_ENVIRONMENT convention)
      --area P:U:V:RGB           emissive parallelogram P, P+U, P+U+V, P+V (two triangles of a
                                 mesh "area_light_K", albedo 0), emitting radiance RGB
                                 (W m^-2 sr^-1) from the side U x V points to: an area light
@@ -23,6 +28,7 @@
    the scene description before rad_scene_create (tool_open_world_lit), so every method,
    the path tracer and the bake see the same lights. */
 #include "tool.h"
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,7 +46,10 @@ const char *tool_light_help(void)
            "  --spot POS:DIR:ANGLES:RGB  spot light aimed along DIR; ANGLES = OUTER or INNER,OUTER\n"
            "                     half-angles in degrees (smooth edge from INNER to OUTER); RGB = intensity W/sr\n"
            "  --area P:U:V:RGB   emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB (W/m^2/sr),\n"
-           "                     emitting towards U x V (an area light like an emissive triangle)\n";
+           "                     emitting towards U x V (an area light like an emissive triangle)\n"
+           "  --env FILE[:SCALE[:ROT]]  environment map: equirectangular .hdr or .exr of radiance\n"
+           "                     (W/m^2/sr) times SCALE, turned ROT degrees about +Y; +Y up, top row =\n"
+           "                     zenith, left edge looks along +X, a quarter across along +Z\n";
 }
 
 /* 'count' comma-separated finite numbers filling the whole of [s, s + len); 0 on success */
@@ -97,10 +106,103 @@ static int split_parts(const char *text, const char **part, size_t *plen, int ma
 
 void tool_lights_free(tool_lights *L)
 {
+    uint32_t i;
     if (!L) return;
+    for (i = 0; i < L->env_count; ++i) {
+        rad_environment_destroy(L->envs[i]);
+        tool_image_free(&L->env_images[i]);
+    }
+    free(L->envs);
+    free(L->env_images);
     free(L->lights);
     free(L->areas);
     memset(L, 0, sizeof *L);
+}
+
+/* keeps env (and the image it borrows) in L and appends a light of 'scale' that uses it */
+static int lights_keep_env(const char *cmd, tool_lights *L, rad_environment *env, tool_image *img, float scale)
+{
+    rad_environment **e = (rad_environment **)realloc(L->envs, sizeof *e * (L->env_count + 1u));
+    tool_image *im;
+    rad_light *g;
+    if (e) L->envs = e;
+    im = e ? (tool_image *)realloc(L->env_images, sizeof *im * (L->env_count + 1u)) : NULL;
+    if (im) L->env_images = im;
+    g = im ? (rad_light *)realloc(L->lights, sizeof *g * (L->count + 1u)) : NULL;
+    if (!g) {
+        fprintf(stderr, "rad %s: out of memory\n", cmd);
+        rad_environment_destroy(env);
+        tool_image_free(img);
+        return 2;
+    }
+    L->lights = g;
+    L->envs[L->env_count] = env;
+    L->env_images[L->env_count++] = *img;
+    memset(&L->lights[L->count], 0, sizeof L->lights[0]);
+    L->lights[L->count].type = RAD_LIGHT_ENVIRONMENT;
+    L->lights[L->count].color[0] = L->lights[L->count].color[1] = L->lights[L->count].color[2] = scale;
+    L->lights[L->count++].environment = env;
+    return 1;
+}
+
+static int lights_has_ext(const char *path, const char *ext)
+{
+    size_t n = strlen(path), m = strlen(ext), i;
+    if (n < m) return 0;
+    for (i = 0; i < m; ++i)
+        if (tolower((unsigned char)path[n - m + i]) != ext[i]) return 0;
+    return 1;
+}
+
+/* --env FILE[:SCALE[:ROT]]: the trailing ':'-parts that are numbers are SCALE and ROT */
+static int lights_env_option(const char *cmd, const char *text, tool_lights *L)
+{
+    char path[4096], err[512];
+    float num[2] = { 1.0f, 0.0f }, v;
+    int nn = 0, k;
+    size_t len = strlen(text);
+    tool_image img;
+    rad_environment_desc d;
+    rad_environment *env = NULL;
+    rad_result r;
+    if (len >= sizeof path) {
+        fprintf(stderr, "rad %s: --env: the path is too long\n", cmd);
+        return 2;
+    }
+    memcpy(path, text, len + 1);
+    while (nn < 2) {
+        char *colon = strrchr(path, ':');
+        if (!colon || parse_numbers(colon + 1, strlen(colon + 1), &v, 1)) break;
+        for (k = nn; k > 0; --k) num[k] = num[k - 1];
+        num[0] = v;
+        ++nn;
+        *colon = '\0';
+    }
+    if (nn == 1) num[1] = 0.0f; /* parsed right to left: one number is SCALE */
+    if (!(num[0] >= 0.0f)) {
+        fprintf(stderr, "rad %s: bad --env '%s': SCALE must be a number >= 0\n", cmd, text);
+        return 2;
+    }
+    if (lights_has_ext(path, ".exr")) k = tool_image_read_exr(path, &img, err, sizeof err);
+    else if (lights_has_ext(path, ".hdr") || lights_has_ext(path, ".rgbe")) k = tool_image_read_hdr(path, &img, err, sizeof err);
+    else {
+        fprintf(stderr, "rad %s: bad --env '%s': the map must be a Radiance .hdr or an OpenEXR .exr\n", cmd, text);
+        return 2;
+    }
+    if (k != 0) {
+        fprintf(stderr, "rad %s: --env: %s\n", cmd, err);
+        return 2;
+    }
+    memset(&d, 0, sizeof d);
+    d.pixels = img.rgb, d.width = (uint32_t)img.width, d.height = (uint32_t)img.height;
+    d.rotation = (float)(num[1] * LIGHTS_DEG);
+    r = rad_environment_create(&d, NULL, &env);
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: --env '%s': %s (a NaN, Inf or negative pixel, or a bad size)\n", cmd, path, rad_result_string(r));
+        tool_image_free(&img);
+        return 2;
+    }
+    return lights_keep_env(cmd, L, env, &img, num[0]);
 }
 
 int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_lights *L)
@@ -115,6 +217,13 @@ int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_light
     int i, n;
     rad_light li;
     tool_area_light al;
+    if (!strcmp(opt, "--env")) {
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: --env needs a value (FILE.hdr[:SCALE[:ROT_DEGREES]], e.g. sky.hdr:1:90)\n", cmd);
+            return 2;
+        }
+        return lights_env_option(cmd, argv[++*a], L);
+    }
     for (i = 0; i < 5; ++i)
         if (!strcmp(opt, names[i])) break;
     if (i == 5) return 0;
@@ -271,7 +380,7 @@ static int add_areas(tool_scene *f, const tool_lights *L, lights_storage **out)
 int tool_add_lights(const char *cmd, tool_scene *f, const tool_lights *L, void **storage)
 {
     lights_storage *s = NULL;
-    uint32_t i, counts[4] = {0, 0, 0, 0};
+    uint32_t i, counts[5] = {0, 0, 0, 0, 0};
     *storage = NULL;
     if (!L || (!L->count && !L->area_count)) return 0;
     if (add_areas(f, L, &s)) {
@@ -290,10 +399,10 @@ int tool_add_lights(const char *cmd, tool_scene *f, const tool_lights *L, void *
         f->light_count += L->count;
     }
     for (i = 0; i < L->count; ++i)
-        if ((int)L->lights[i].type >= 0 && (int)L->lights[i].type < 4) counts[L->lights[i].type]++;
-    fprintf(stderr, "rad %s: lights from the command line: %u sun, %u sky, %u point, %u spot, %u area\n", cmd,
-            counts[RAD_LIGHT_DIRECTIONAL], counts[RAD_LIGHT_SKY], counts[RAD_LIGHT_POINT], counts[RAD_LIGHT_SPOT],
-            L->area_count);
+        if ((int)L->lights[i].type >= 0 && (int)L->lights[i].type < 5) counts[L->lights[i].type]++;
+    fprintf(stderr, "rad %s: lights from the command line: %u sun, %u sky, %u environment, %u point, %u spot, %u area\n",
+            cmd, counts[RAD_LIGHT_DIRECTIONAL], counts[RAD_LIGHT_SKY], counts[RAD_LIGHT_ENVIRONMENT], counts[RAD_LIGHT_POINT],
+            counts[RAD_LIGHT_SPOT], L->area_count);
     *storage = s;
     return 0;
 }
@@ -313,6 +422,19 @@ uint64_t tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h)
         h = rad_hash64(&l->min_distance, sizeof(float), h);
         h = rad_hash64(&l->inner_angle, sizeof(float), h);
         h = rad_hash64(&l->outer_angle, sizeof(float), h);
+        if (l->type == RAD_LIGHT_ENVIRONMENT && l->environment) {
+            /* the map through its power and its radiance in 256 fixed directions */
+            double pw = rad_environment_power(l->environment);
+            uint32_t k;
+            h = rad_hash64(&pw, sizeof pw, h);
+            for (k = 0; k < 256u; ++k) {
+                float z = 1.0f - (2.0f * (float)k + 1.0f) / 256.0f, r = sqrtf(1.0f - z * z), ph = 2.39996323f * (float)k;
+                float dir[3], rgb[3];
+                dir[0] = r * cosf(ph), dir[1] = z, dir[2] = r * sinf(ph);
+                rad_environment_radiance(l->environment, dir, rgb);
+                h = rad_hash64(rgb, sizeof rgb, h);
+            }
+        }
     }
     return h;
 }
