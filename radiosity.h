@@ -747,6 +747,41 @@ typedef struct rad_light {
     const rad_environment *environment; /* RAD_LIGHT_ENVIRONMENT: the map (borrowed) */
 } rad_light;
 
+/* PHYSICAL SKY (Preetham, Shirley and Smits 1999, "A Practical Analytic Model for Daylight"):
+   the clear sky's luminance Y and chromaticity (x, y) in a direction at angle theta from the
+   zenith and gamma from the sun are each the zenith value times the Perez et al. (1993)
+   distribution F(theta, gamma) / F(0, theta_s), F = (1 + A e^(B / cos theta))(1 + C e^(D gamma)
+   + E cos^2 gamma), with A .. E linear in the turbidity T and the zenith values Y_z (kcd/m^2)
+   and x_z, y_z the paper's fits in T and the sun's zenith angle theta_s. xyY goes to linear
+   sRGB (Rec. 709 primaries, D65 white).
+   Units: the map holds luminance / 683 lm/W, i.e. "radiance" in W m^-2 sr^-1 of light at the
+   eye's peak efficacy, so that an RGB of 1 is 683 cd/m^2; a clear sky at noon gives a few
+   W m^-2 sr^-1 per channel. The sun is not in the map: out_sun receives a directional light
+   (direction from the sun into the scene, 'color' its irradiance on a surface facing it in
+   the same units): the extraterrestrial illuminance 133.8 klx over 683, times the direct
+   beam's transmittance through Rayleigh scattering exp(-0.008735 lambda^-4.08 m) and the
+   turbidity's haze exp(-beta lambda^-1.3 m), beta = 0.04608 T - 0.04586 (the paper's
+   appendix; ozone and water vapour left out), at lambda = 0.65, 0.55, 0.45 micrometres for
+   R, G, B, with the relative air mass m of Kasten and Young (1989). Below the horizon the
+   map is black (the ground is the scene's). */
+/* Fills out_rgb (width x height RGB, the equirectangular layout of rad_environment) with the
+   sky for turbidity in [1.7, 10] and the unit direction towards the sun 'to_sun' (normalized
+   here; +Y up), above the horizon. out_sun may be NULL. Errors: INVALID_ARGUMENT (NULL
+   out_rgb or to_sun, a zero size, turbidity out of range, a zero or non-finite direction,
+   the sun below the horizon: the model does not hold there). */
+RAD_API rad_result rad_sky_preetham(float turbidity, const float to_sun[3], uint32_t width, uint32_t height,
+                                    float *out_rgb, rad_light *out_sun, const rad_context *ctx);
+/* Preetham's zenith luminance Y_z in kcd/m^2: (4.0453 T - 4.9710) tan chi - 0.2155 T + 2.4192,
+   chi = (4/9 - T/120)(pi - 2 theta_s), theta_s the sun's zenith angle in radians. */
+RAD_API double rad_sky_preetham_zenith(float turbidity, float sun_zenith);
+/* The unit direction towards the sun at latitude_degrees (north > 0), day_of_year (1 = 1
+   January) and local solar time solar_hour (12 = the sun due south or north, highest), in
+   the frame +Y up, +X east, +Z south (so -Z is north): declination 23.44 sin(2 pi (284 + day)
+   / 365) degrees (Cooper 1969), hour angle 15 (hour - 12) degrees. out_dir[1] < 0: the sun is
+   below the horizon. Errors: INVALID_ARGUMENT (latitude outside [-90, 90], hour outside
+   [0, 24], day outside [1, 366], a non-finite value, NULL). */
+RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, float solar_hour, float out_dir[3]);
+
 typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
@@ -6975,6 +7010,118 @@ static rad_result rad__direct_env(rad__direct *d, uint32_t task, uint32_t *nrays
         r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, w, scale, slot);
         if (r != RAD_SUCCESS) return r;
     }
+    return RAD_SUCCESS;
+}
+
+/* ---- physical sky (Preetham 1999) ---- */
+
+/* the Perez distribution with coefficients c[0..4] (A .. E) */
+static double rad__perez(const double *c, double cos_theta, double gamma)
+{
+    double cg = cos(gamma);
+    if (cos_theta < 1e-3) cos_theta = 1e-3;
+    return (1.0 + c[0] * exp(c[1] / cos_theta)) * (1.0 + c[2] * exp(c[3] * gamma) + c[4] * cg * cg);
+}
+
+RAD_API double rad_sky_preetham_zenith(float turbidity, float sun_zenith)
+{
+    double T = turbidity, chi = (4.0 / 9.0 - T / 120.0) * (RAD__PI - 2.0 * (double)sun_zenith);
+    return (4.0453 * T - 4.9710) * tan(chi) - 0.2155 * T + 2.4192;
+}
+
+RAD_API rad_result rad_sky_preetham(float turbidity, const float to_sun[3], uint32_t width, uint32_t height,
+                                    float *out_rgb, rad_light *out_sun, const rad_context *ctx)
+{
+    rad__ctx c;
+    double T = turbidity, s[3], len, ts, t2, t3, Yz, xz, yz, cY[5], cx[5], cy[5], FY, Fx, Fy;
+    uint32_t i, j;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!out_rgb || !to_sun || width == 0 || height == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_sky_preetham: NULL output or direction, or a zero size");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(turbidity >= 1.7f && turbidity <= 10.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_sky_preetham: turbidity %g outside [1.7, 10] (the model's fit)", (double)turbidity);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    len = sqrt((double)to_sun[0] * to_sun[0] + (double)to_sun[1] * to_sun[1] + (double)to_sun[2] * to_sun[2]);
+    if (!rad__finite3(to_sun) || !(len > 0.0) || !(to_sun[1] >= 0.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_sky_preetham: the sun direction must be finite, non-zero and above the horizon");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (k = 0; k < 3; ++k) s[k] = (double)to_sun[k] / len;
+    ts = acos(s[1] > 1.0 ? 1.0 : s[1]);
+    t2 = ts * ts, t3 = t2 * ts;
+    Yz = rad_sky_preetham_zenith(turbidity, (float)ts) * 1000.0; /* cd/m^2 */
+    xz = (0.00166 * t3 - 0.00375 * t2 + 0.00209 * ts) * T * T + (-0.02903 * t3 + 0.06377 * t2 - 0.03202 * ts + 0.00394) * T +
+         (0.11693 * t3 - 0.21196 * t2 + 0.06052 * ts + 0.25886);
+    yz = (0.00275 * t3 - 0.00610 * t2 + 0.00317 * ts) * T * T + (-0.04214 * t3 + 0.08970 * t2 - 0.04153 * ts + 0.00516) * T +
+         (0.15346 * t3 - 0.26756 * t2 + 0.06670 * ts + 0.26688);
+    cY[0] = 0.1787 * T - 1.4630, cY[1] = -0.3554 * T + 0.4275, cY[2] = -0.0227 * T + 5.3251;
+    cY[3] = 0.1206 * T - 2.5771, cY[4] = -0.0670 * T + 0.3703;
+    cx[0] = -0.0193 * T - 0.2592, cx[1] = -0.0665 * T + 0.0008, cx[2] = -0.0004 * T + 0.2125;
+    cx[3] = -0.0641 * T - 0.8989, cx[4] = -0.0033 * T + 0.0452;
+    cy[0] = -0.0167 * T - 0.2608, cy[1] = -0.0950 * T + 0.0092, cy[2] = -0.0079 * T + 0.2102;
+    cy[3] = -0.0441 * T - 1.6537, cy[4] = -0.0109 * T + 0.0529;
+    FY = rad__perez(cY, 1.0, ts), Fx = rad__perez(cx, 1.0, ts), Fy = rad__perez(cy, 1.0, ts);
+    for (i = 0; i < height; ++i) {
+        double th = RAD__PI * ((double)i + 0.5) / (double)height, ct = cos(th), st = sin(th);
+        for (j = 0; j < width; ++j) {
+            float *o = out_rgb + 3 * ((size_t)i * width + j);
+            double ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)width, d[3], cg, g, Y, x, y, X, Z;
+            if (ct <= 0.0) {
+                o[0] = o[1] = o[2] = 0.0f;
+                continue;
+            }
+            d[0] = st * cos(ph), d[1] = ct, d[2] = st * sin(ph);
+            cg = d[0] * s[0] + d[1] * s[1] + d[2] * s[2];
+            g = acos(cg > 1.0 ? 1.0 : (cg < -1.0 ? -1.0 : cg));
+            Y = Yz * rad__perez(cY, ct, g) / FY;
+            x = xz * rad__perez(cx, ct, g) / Fx;
+            y = yz * rad__perez(cy, ct, g) / Fy;
+            X = y > 0.0 ? x * Y / y : 0.0, Z = y > 0.0 ? (1.0 - x - y) * Y / y : 0.0;
+            /* XYZ to linear sRGB, then candela to W at 683 lm/W; a negative primary (outside
+               the sRGB gamut) is clipped */
+            {
+                double r = 3.2406 * X - 1.5372 * Y - 0.4986 * Z, gg = -0.9689 * X + 1.8758 * Y + 0.0415 * Z,
+                       b = 0.0557 * X - 0.2040 * Y + 1.0570 * Z;
+                o[0] = (float)(r > 0.0 ? r / 683.0 : 0.0);
+                o[1] = (float)(gg > 0.0 ? gg / 683.0 : 0.0);
+                o[2] = (float)(b > 0.0 ? b / 683.0 : 0.0);
+            }
+        }
+    }
+    if (out_sun) {
+        static const double lambda[3] = { 0.65, 0.55, 0.45 };
+        double el = 90.0 - ts * 180.0 / RAD__PI, m, beta = 0.04608 * T - 0.04586;
+        m = 1.0 / (cos(ts) + 0.50572 * pow(el + 6.07995, -1.6364)); /* Kasten and Young 1989 */
+        memset(out_sun, 0, sizeof(*out_sun));
+        out_sun->type = RAD_LIGHT_DIRECTIONAL;
+        for (k = 0; k < 3; ++k) {
+            double tr = exp(-0.008735 * pow(lambda[k], -4.08) * m), ta = exp(-beta * pow(lambda[k], -1.3) * m);
+            out_sun->color[k] = (float)(133800.0 / 683.0 * tr * ta);
+            out_sun->direction[k] = (float)-s[k];
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, float solar_hour, float out_dir[3])
+{
+    double lat, dec, H, E, N, U;
+    if (!out_dir || !rad__finite(latitude_degrees) || !rad__finite(day_of_year) || !rad__finite(solar_hour) ||
+        !(latitude_degrees >= -90.0f && latitude_degrees <= 90.0f) || !(day_of_year >= 1.0f && day_of_year <= 366.0f) ||
+        !(solar_hour >= 0.0f && solar_hour <= 24.0f))
+        return RAD_ERROR_INVALID_ARGUMENT;
+    lat = (double)latitude_degrees * RAD__PI / 180.0;
+    dec = 23.44 * RAD__PI / 180.0 * sin(2.0 * RAD__PI * (284.0 + (double)day_of_year) / 365.0);
+    H = 15.0 * ((double)solar_hour - 12.0) * RAD__PI / 180.0;
+    /* east, north and up components of the direction to the sun */
+    E = -cos(dec) * sin(H);
+    N = cos(lat) * sin(dec) - sin(lat) * cos(dec) * cos(H);
+    U = sin(lat) * sin(dec) + cos(lat) * cos(dec) * cos(H);
+    out_dir[0] = (float)E, out_dir[1] = (float)U, out_dir[2] = (float)-N;
     return RAD_SUCCESS;
 }
 

@@ -364,12 +364,103 @@ out:
     free(E), free(Ex), free(E2), free(vs);
 }
 
+/* Preetham's sky: the zenith luminance formula at T = 2 and a sun 60 degrees from the zenith
+   is 3.4873 kcd/m^2 (the paper's fit evaluated by hand); the map's zenith pixel has that
+   luminance (times 1000 / 683 W per cd), and with the sun at the zenith the paper's zenith
+   chromaticity x_z = 0.00394 T + 0.25886, y_z = 0.00516 T + 0.26688; the sky is brightest
+   round the sun and black below the horizon; the sun's direct beam is 100 to 120 klx at a
+   high sun (clear-sky daylight), redder and dimmer low; bad input is refused. */
+static void en_test_preetham(void)
+{
+    enum { W = 4, H = 2048, SW = 64, SH = 32 };
+    static float px[3 * W * H], sky[3 * SW * SH];
+    const float zen[3] = { 0, 1, 0 };
+    float s60[3] = { (float)sin(EN_PI / 3.0), (float)cos(EN_PI / 3.0), 0.0f }, below[3] = { 1, -0.1f, 0 };
+    rad_light sun, sun_low;
+    double lum, X, Y, Z;
+    const float *z;
+    CHECK_NEAR(rad_sky_preetham_zenith(2.0f, (float)(EN_PI / 3.0)), 3.4873274, 1e-5);
+    CHECK_NEAR(rad_sky_preetham_zenith(3.0f, (float)(EN_PI / 6.0)), 10.4130869, 1e-5);
+    CHECK_OK(rad_sky_preetham(2.0f, s60, W, H, px, &sun_low, NULL));
+    z = px; /* row 0, 0.04 degrees from the zenith */
+    lum = (0.2126 * z[0] + 0.7152 * z[1] + 0.0722 * z[2]) * 683.0 / 1000.0;
+    CHECK_REL(lum, 3.4873274, 2e-3);
+    CHECK(px[3 * (H - 1) * W] == 0.0f && px[3 * (H / 2 + 1) * W + 1] == 0.0f);
+    CHECK_OK(rad_sky_preetham(2.0f, zen, W, H, px, &sun, NULL));
+    X = 0.4124 * z[0] + 0.3576 * z[1] + 0.1805 * z[2];
+    Y = 0.2126 * z[0] + 0.7152 * z[1] + 0.0722 * z[2];
+    Z = 0.0193 * z[0] + 0.1192 * z[1] + 0.9505 * z[2];
+    CHECK_NEAR(X / (X + Y + Z), 0.26674, 2e-3);
+    CHECK_NEAR(Y / (X + Y + Z), 0.27720, 2e-3);
+    /* the sun: high, 100 - 120 klx of direct beam, R > G > B; low, dimmer and redder */
+    CHECK(sun.type == RAD_LIGHT_DIRECTIONAL && sun.direction[1] < -0.999f);
+    CHECK(sun.color[1] * 683.0f > 100000.0f && sun.color[1] * 683.0f < 120000.0f);
+    CHECK(sun.color[0] > sun.color[1] && sun.color[1] > sun.color[2]);
+    CHECK(sun_low.color[1] < sun.color[1] && sun_low.color[2] / sun_low.color[0] < sun.color[2] / sun.color[0]);
+    /* circumsolar brighter than the zenith, which is brighter than 90 degrees from the sun low down */
+    {
+        float low[3] = { (float)cos(EN_PI / 9.0), (float)sin(EN_PI / 9.0), 0.0f }, d[3], rgb[3], rz[3], r90[3];
+        rad_environment *env;
+        double E;
+        CHECK_OK(rad_sky_preetham(3.0f, low, SW, SH, sky, NULL, NULL));
+        env = en_make(sky, SW, SH, 0.0f);
+        CHECK(env != NULL);
+        if (env) {
+            d[0] = (float)cos(EN_PI / 9.0 + 0.15), d[1] = (float)sin(EN_PI / 9.0 + 0.15), d[2] = 0.0f;
+            rad_environment_radiance(env, d, rgb);
+            rad_environment_radiance(env, zen, rz);
+            d[0] = 0.0f, d[1] = (float)sin(EN_PI / 9.0), d[2] = (float)cos(EN_PI / 9.0);
+            rad_environment_radiance(env, d, r90);
+            CHECK(rgb[1] > 2.0f * rz[1]);
+            CHECK(rz[1] > r90[1] * 0.5f);
+            CHECK(rz[2] > rz[0]); /* blue */
+            /* the clear sky's diffuse horizontal illuminance: 5 - 30 klx */
+            E = en_up_irradiance(sky, SW, SH) * 683.0;
+            CHECK(E > 5000.0 && E < 30000.0);
+            rad_environment_destroy(env);
+        }
+    }
+    CHECK_RESULT(rad_sky_preetham(1.0f, zen, W, H, px, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_sky_preetham(11.0f, zen, W, H, px, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_sky_preetham(3.0f, below, W, H, px, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_sky_preetham(3.0f, zen, 0, H, px, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    below[0] = NAN;
+    CHECK_RESULT(rad_sky_preetham(3.0f, below, W, H, px, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+}
+
+/* The sun's position: at the equator at noon on the March equinox (day 80, declination -0.4
+   degrees) the sun is at the zenith; at latitude 45 it is 45 degrees up due south (+Z) then,
+   on the June solstice (day 172) 68.44 degrees up; at 6 h solar time on the equinox it rises
+   due east (+X). */
+static void en_test_sun_direction(void)
+{
+    float d[3];
+    const double deg = EN_PI / 180.0;
+    CHECK_OK(rad_sun_direction(0.0f, 80.0f, 12.0f, d));
+    CHECK(d[1] > (float)cos(0.5 * deg));
+    CHECK_OK(rad_sun_direction(45.0f, 80.0f, 12.0f, d));
+    CHECK_NEAR(asin(d[1]) / deg, 45.0, 0.5);
+    CHECK(d[2] > 0.7f && fabs(d[0]) < 1e-5f);
+    CHECK_OK(rad_sun_direction(45.0f, 172.0f, 12.0f, d));
+    CHECK_NEAR(asin(d[1]) / deg, 68.44, 0.05);
+    CHECK_OK(rad_sun_direction(0.0f, 80.0f, 6.0f, d));
+    CHECK(d[0] > 0.999f && fabs(d[1]) < 0.01f);
+    CHECK_OK(rad_sun_direction(52.0f, 355.0f, 0.0f, d));
+    CHECK(d[1] < 0.0f); /* midnight in December at 52 N */
+    CHECK_RESULT(rad_sun_direction(91.0f, 80.0f, 12.0f, d), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_sun_direction(45.0f, 0.0f, 12.0f, d), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_sun_direction(45.0f, 80.0f, 25.0f, d), RAD_ERROR_INVALID_ARGUMENT);
+    CHECK_RESULT(rad_sun_direction(NAN, 80.0f, 12.0f, d), RAD_ERROR_INVALID_ARGUMENT);
+}
+
 static const rad_test_case tests_env[] = {
     { "env_validation", en_test_validation },
     { "env_constant_map", en_test_constant_map },
     { "env_one_texel", en_test_one_texel },
     { "env_importance", en_test_importance },
     { "env_vp_lights", en_test_vp_lights },
+    { "env_preetham", en_test_preetham },
+    { "env_sun_direction", en_test_sun_direction },
     { NULL, NULL }
 };
 

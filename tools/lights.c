@@ -20,6 +20,12 @@
                                 (default 1), turned ROT degrees about +Y (+X towards +Z);
                                 +Y is up, the top row the zenith, the left edge looks along
                                 +X (the library's RAD_LIGHT_ENVIRONMENT convention)
+     --sky-model preetham:T[:SCALE] --sun-time LAT:DAY:HOUR
+                                Preetham's clear sky of turbidity T (1.7 .. 10) as a 256 x 128
+                                environment map, plus its sun as a directional light, for the
+                                sun at latitude LAT degrees, day of year DAY, local solar time
+                                HOUR (rad_sky_preetham, rad_sun_direction: +X east, +Z south);
+                                units luminance / 683 (W m^-2 sr^-1 at 683 lm/W), times SCALE
      --area P:U:V:RGB           emissive parallelogram P, P+U, P+U+V, P+V (two triangles of a
                                 mesh "area_light_K", albedo 0), emitting radiance RGB
                                 (W m^-2 sr^-1) from the side U x V points to: an area light
@@ -49,7 +55,10 @@ const char *tool_light_help(void)
            "                     emitting towards U x V (an area light like an emissive triangle)\n"
            "  --env FILE[:SCALE[:ROT]]  environment map: equirectangular .hdr or .exr of radiance\n"
            "                     (W/m^2/sr) times SCALE, turned ROT degrees about +Y; +Y up, top row =\n"
-           "                     zenith, left edge looks along +X, a quarter across along +Z\n";
+           "                     zenith, left edge looks along +X, a quarter across along +Z\n"
+           "  --sky-model preetham:T[:SCALE] --sun-time LAT:DAY:HOUR  Preetham's clear sky (turbidity\n"
+           "                     T in 1.7..10) and its sun for latitude LAT, day of year DAY, solar time\n"
+           "                     HOUR (+X east, +Z south); units: luminance / 683 lm/W, times SCALE\n";
 }
 
 /* 'count' comma-separated finite numbers filling the whole of [s, s + len); 0 on success */
@@ -205,6 +214,57 @@ static int lights_env_option(const char *cmd, const char *text, tool_lights *L)
     return lights_keep_env(cmd, L, env, &img, num[0]);
 }
 
+/* --sky-model and --sun-time both given: the sky map and the sun */
+static int lights_make_sky(const char *cmd, tool_lights *L)
+{
+    tool_image img;
+    rad_light sun;
+    rad_environment_desc d;
+    rad_environment *env = NULL;
+    float dir[3];
+    rad_result r;
+    int k;
+    if (rad_sun_direction(L->sun_time[0], L->sun_time[1], L->sun_time[2], dir) != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bad --sun-time: LAT in [-90, 90], DAY in [1, 366], HOUR in [0, 24]\n", cmd);
+        return 2;
+    }
+    if (!(dir[1] > 0.0f)) {
+        fprintf(stderr, "rad %s: --sun-time %g:%g:%g puts the sun below the horizon (elevation %.1f degrees): the sky model "
+                "holds in daylight only\n", cmd, (double)L->sun_time[0], (double)L->sun_time[1], (double)L->sun_time[2],
+                asin((double)dir[1]) / LIGHTS_DEG);
+        return 2;
+    }
+    if (tool_image_alloc(&img, 256, 128) != 0) {
+        fprintf(stderr, "rad %s: out of memory\n", cmd);
+        return 2;
+    }
+    r = rad_sky_preetham(L->sky_turbidity, dir, 256, 128, img.rgb, &sun, NULL);
+    if (r == RAD_SUCCESS) {
+        size_t i;
+        for (i = 0; i < 3u * 256u * 128u; ++i) img.rgb[i] *= L->sky_scale;
+        for (k = 0; k < 3; ++k) sun.color[k] *= L->sky_scale;
+        memset(&d, 0, sizeof d);
+        d.pixels = img.rgb, d.width = 256, d.height = 128;
+        r = rad_environment_create(&d, NULL, &env);
+    }
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: --sky-model: %s\n", cmd, rad_result_string(r));
+        tool_image_free(&img);
+        return 2;
+    }
+    fprintf(stderr, "rad %s: sky model preetham turbidity %g, sun %.1f degrees up at azimuth %.1f (from north, east "
+            "positive), sun irradiance %g,%g,%g\n", cmd, (double)L->sky_turbidity, asin((double)dir[1]) / LIGHTS_DEG,
+            atan2((double)dir[0], -(double)dir[2]) / LIGHTS_DEG, (double)sun.color[0], (double)sun.color[1], (double)sun.color[2]);
+    if ((k = lights_keep_env(cmd, L, env, &img, 1.0f)) != 1) return k;
+    {
+        rad_light *g = (rad_light *)realloc(L->lights, sizeof *g * (L->count + 1u));
+        if (!g) { fprintf(stderr, "rad %s: out of memory\n", cmd); return 2; }
+        L->lights = g;
+        L->lights[L->count++] = sun;
+    }
+    return 1;
+}
+
 int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_lights *L)
 {
     static const char *const names[] = {"--sun", "--sky", "--point", "--spot", "--area"};
@@ -223,6 +283,46 @@ int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_light
             return 2;
         }
         return lights_env_option(cmd, argv[++*a], L);
+    }
+    if (!strcmp(opt, "--sky-model") || !strcmp(opt, "--sun-time")) {
+        int model = !strcmp(opt, "--sky-model"), np;
+        float num[3];
+        const char *v;
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value (%s)\n", cmd, opt, model ? "preetham:T[:SCALE], e.g. preetham:3" :
+                    "LAT:DAY:HOUR, e.g. 48.1:172:15.5");
+            return 2;
+        }
+        v = argv[++*a];
+        if (L->sky_parts & (model ? 1u : 2u)) {
+            fprintf(stderr, "rad %s: %s given twice (one sky model per command)\n", cmd, opt);
+            return 2;
+        }
+        if (model) {
+            np = split_parts(v, part, plen, 3);
+            if (np < 2 || plen[0] != 8 || strncmp(v, "preetham", 8) || parse_numbers(part[1], plen[1], num, 1) ||
+                (np == 3 && parse_numbers(part[2], plen[2], num + 1, 1))) {
+                fprintf(stderr, "rad %s: bad --sky-model '%s' (want preetham:T[:SCALE], e.g. preetham:3)\n", cmd, v);
+                return 2;
+            }
+            if (np == 2) num[1] = 1.0f;
+            if (!(num[0] >= 1.7f && num[0] <= 10.0f) || !(num[1] >= 0.0f)) {
+                fprintf(stderr, "rad %s: bad --sky-model '%s': turbidity T in [1.7, 10], SCALE >= 0\n", cmd, v);
+                return 2;
+            }
+            L->sky_turbidity = num[0], L->sky_scale = num[1];
+            L->sky_parts |= 1u;
+        } else {
+            np = split_parts(v, part, plen, 3);
+            if (np != 3 || parse_numbers(part[0], plen[0], num, 1) || parse_numbers(part[1], plen[1], num + 1, 1) ||
+                parse_numbers(part[2], plen[2], num + 2, 1)) {
+                fprintf(stderr, "rad %s: bad --sun-time '%s' (want LAT:DAY:HOUR, e.g. 48.1:172:15.5)\n", cmd, v);
+                return 2;
+            }
+            memcpy(L->sun_time, num, sizeof num);
+            L->sky_parts |= 2u;
+        }
+        return L->sky_parts == 3u ? lights_make_sky(cmd, L) : 1;
     }
     for (i = 0; i < 5; ++i)
         if (!strcmp(opt, names[i])) break;
@@ -382,6 +482,11 @@ int tool_add_lights(const char *cmd, tool_scene *f, const tool_lights *L, void *
     lights_storage *s = NULL;
     uint32_t i, counts[5] = {0, 0, 0, 0, 0};
     *storage = NULL;
+    if (L && (L->sky_parts == 1u || L->sky_parts == 2u)) {
+        fprintf(stderr, "rad %s: %s needs %s too\n", cmd, L->sky_parts == 1u ? "--sky-model" : "--sun-time",
+                L->sky_parts == 1u ? "--sun-time LAT:DAY:HOUR" : "--sky-model preetham:T");
+        return 1;
+    }
     if (!L || (!L->count && !L->area_count)) return 0;
     if (add_areas(f, L, &s)) {
         fprintf(stderr, "rad %s: out of memory for the area lights\n", cmd);

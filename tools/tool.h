@@ -184,6 +184,9 @@ typedef struct tool_lights {
     rad_environment **envs;         /* --env and --sky-model: the maps lights[] point to */
     tool_image *env_images;         /* their pixels (borrowed by envs) */
     uint32_t env_count;
+    float sky_turbidity, sky_scale; /* --sky-model preetham:T[:SCALE] */
+    float sun_time[3];              /* --sun-time LAT:DAY:HOUR */
+    unsigned sky_parts;             /* 1: --sky-model given, 2: --sun-time given (3: both, made) */
 } tool_lights;
 /* argv[*a] is one of the light options: parses it (and its value, advancing *a) and returns 1;
    0 when it is not one; 2 on a bad value (message naming the option printed) */
