@@ -744,9 +744,64 @@ typedef enum rad_light_type {
                                   'direction' points from the light into the scene */
     RAD_LIGHT_POINT = 1,       /* 'color' is the intensity (W/sr) */
     RAD_LIGHT_SPOT = 2,        /* point light limited to a cone around 'direction' */
-    RAD_LIGHT_SKY = 3          /* constant sky: 'color' is its exitance E_0 (= pi * its
+    RAD_LIGHT_SKY = 3,         /* constant sky: 'color' is its exitance E_0 (= pi * its
                                   radiance), the irradiance on an unoccluded surface */
+    RAD_LIGHT_ENVIRONMENT = 4  /* an environment map (rad_environment) seen in every direction
+                                  no surface hides: radiance = 'color' (RGB scale) times the
+                                  map's radiance; a map of constant radiance L with color 1
+                                  is RAD_LIGHT_SKY with color pi * L */
 } rad_light_type;
+
+/* ENVIRONMENT MAP: a light at infinity whose radiance depends on the direction, from an
+   equirectangular (latitude-longitude) RGB float image. Direction convention: +Y is up.
+   A unit direction d = (x, y, z) has polar angle theta = acos(y) from +Y and azimuth
+   phi = atan2(z, x) from +X towards +Z; it reads the pixel at
+       u = (phi - rotation) / (2 pi)  (wrapped into [0, 1)),   v = theta / pi,
+   column floor(u * width), row floor(v * height): row 0 is the zenith, the last row the
+   nadir, u = 0 (the left edge) looks along +X (rotated by 'rotation' about +Y), u = 0.25
+   along +Z, u = 0.5 along -X. Lookups take the nearest pixel (no filtering), so the map is
+   piecewise constant and its importance sampling exact (below). Units: radiance,
+   W m^-2 sr^-1 per channel, times the light's 'color'.
+   The object holds the 2D sampling distribution over the pixels (luminance times the
+   pixel's solid angle, marginal and conditional CDFs), built once at create: direct light
+   draws half its rays from it and half cosine-weighted, combined by multiple importance
+   sampling (power heuristic), so a small bright sun in the map does not make noise and a
+   dim uniform map no worse than RAD_LIGHT_SKY. */
+typedef struct rad_environment rad_environment;
+
+/* Radiance (3 floats into out_rgb) in the unit direction dir (the convention above, the
+   rotation already applied: dir is in the scene's frame). Called from worker threads:
+   must be thread safe. Values must be finite and >= 0. */
+typedef void (*rad_environment_fn)(void *user, const float dir[3], float out_rgb[3]);
+
+typedef struct rad_environment_desc {
+    const float *pixels;       /* width * height RGB triples, row-major from row 0 (zenith);
+                                  borrowed: must stay unchanged while the object lives. NULL
+                                  when 'lookup' gives the radiance */
+    uint32_t width, height;    /* the image, or with 'lookup' the resolution of the sampling
+                                  table (lookup evaluated at the pixel centres) */
+    float rotation;            /* radians about +Y: the map turned by this angle, +X towards +Z */
+    rad_environment_fn lookup; /* optional: radiance from a function instead of 'pixels' */
+    void *lookup_user;
+} rad_environment_desc;
+
+/* Builds the sampling distribution. Errors: INVALID_ARGUMENT (NULL desc or out, no pixels
+   and no lookup, both given, a zero width or height, a size above 2^14 x 2^14), NON_FINITE
+   (a NaN or Inf pixel or rotation), NEGATIVE_EMISSION (a negative pixel), OUT_OF_MEMORY;
+   each logged with the pixel it found. Memory: 4 (width + 1) height + 4 (height + 1) bytes. */
+RAD_API rad_result rad_environment_create(const rad_environment_desc *desc, const rad_context *ctx,
+                                          rad_environment **out);
+RAD_API void rad_environment_destroy(rad_environment *env);
+/* The map's radiance in a unit direction (scene frame; no light colour applied). */
+RAD_API void rad_environment_radiance(const rad_environment *env, const float dir[3], float out_rgb[3]);
+/* Draws a direction from the distribution with (u1, u2) in [0, 1)^2: the unit direction into
+   dir, and returns its density per steradian (0 when the map is black: nothing to draw). */
+RAD_API float rad_environment_sample(const rad_environment *env, float u1, float u2, float dir[3]);
+/* The density per steradian rad_environment_sample draws the unit direction dir with. */
+RAD_API float rad_environment_pdf(const rad_environment *env, const float dir[3]);
+/* The integral of the map's luminance (0.2126 R + 0.7152 G + 0.0722 B) over the sphere:
+   its "power" per unit area, W m^-2 (4 pi L for a constant map L). */
+RAD_API double rad_environment_power(const rad_environment *env);
 
 typedef enum rad_falloff {
     RAD_FALLOFF_QUADRATIC = 0, /* I / d^2 (physical) */
@@ -764,7 +819,43 @@ typedef struct rad_light {
                                   the scene diagonal) */
     float inner_angle;         /* spot: half-angles in radians; full intensity inside inner, */
     float outer_angle;         /* smoothstep to 0 at outer (outer > inner) */
+    const rad_environment *environment; /* RAD_LIGHT_ENVIRONMENT: the map (borrowed) */
 } rad_light;
+
+/* PHYSICAL SKY (Preetham, Shirley and Smits 1999, "A Practical Analytic Model for Daylight"):
+   the clear sky's luminance Y and chromaticity (x, y) in a direction at angle theta from the
+   zenith and gamma from the sun are each the zenith value times the Perez et al. (1993)
+   distribution F(theta, gamma) / F(0, theta_s), F = (1 + A e^(B / cos theta))(1 + C e^(D gamma)
+   + E cos^2 gamma), with A .. E linear in the turbidity T and the zenith values Y_z (kcd/m^2)
+   and x_z, y_z the paper's fits in T and the sun's zenith angle theta_s. xyY goes to linear
+   sRGB (Rec. 709 primaries, D65 white).
+   Units: the map holds luminance / 683 lm/W, i.e. "radiance" in W m^-2 sr^-1 of light at the
+   eye's peak efficacy, so that an RGB of 1 is 683 cd/m^2; a clear sky at noon gives a few
+   W m^-2 sr^-1 per channel. The sun is not in the map: out_sun receives a directional light
+   (direction from the sun into the scene, 'color' its irradiance on a surface facing it in
+   the same units): the extraterrestrial illuminance 133.8 klx over 683, times the direct
+   beam's transmittance through Rayleigh scattering exp(-0.008735 lambda^-4.08 m) and the
+   turbidity's haze exp(-beta lambda^-1.3 m), beta = 0.04608 T - 0.04586 (the paper's
+   appendix; ozone and water vapour left out), at lambda = 0.65, 0.55, 0.45 micrometres for
+   R, G, B, with the relative air mass m of Kasten and Young (1989). Below the horizon the
+   map is black (the ground is the scene's). */
+/* Fills out_rgb (width x height RGB, the equirectangular layout of rad_environment) with the
+   sky for turbidity in [1.7, 10] and the unit direction towards the sun 'to_sun' (normalized
+   here; +Y up), above the horizon. out_sun may be NULL. Errors: INVALID_ARGUMENT (NULL
+   out_rgb or to_sun, a zero size, turbidity out of range, a zero or non-finite direction,
+   the sun below the horizon: the model does not hold there). */
+RAD_API rad_result rad_sky_preetham(float turbidity, const float to_sun[3], uint32_t width, uint32_t height,
+                                    float *out_rgb, rad_light *out_sun, const rad_context *ctx);
+/* Preetham's zenith luminance Y_z in kcd/m^2: (4.0453 T - 4.9710) tan chi - 0.2155 T + 2.4192,
+   chi = (4/9 - T/120)(pi - 2 theta_s), theta_s the sun's zenith angle in radians. */
+RAD_API double rad_sky_preetham_zenith(float turbidity, float sun_zenith);
+/* The unit direction towards the sun at latitude_degrees (north > 0), day_of_year (1 = 1
+   January) and local solar time solar_hour (12 = the sun due south or north, highest), in
+   the frame +Y up, +X east, +Z south (so -Z is north): declination 23.44 sin(2 pi (284 + day)
+   / 365) degrees (Cooper 1969), hour angle 15 (hour - 12) degrees. out_dir[1] < 0: the sun is
+   below the horizon. Errors: INVALID_ARGUMENT (latitude outside [-90, 90], hour outside
+   [0, 24], day outside [1, 366], a non-finite value, NULL). */
+RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, float solar_hour, float out_dir[3]);
 
 typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
@@ -2390,15 +2481,18 @@ RAD_API void rad_vp_gather_table_destroy(rad_vp_gather_table *table);
    rad_vp_lights_refresh, is tested for all its samples in that update. Sky lights: the
    unoccluded fraction of each sample's hemisphere (light_samples cosine rays, as
    rad_direct_irradiance) depends on the geometry only, so it is traced once, at the first
-   update with a sky, and each update scales it by the sky's colour. Emissive triangles
+   update with a sky, and each update scales it by the sky's colour. Environment lights
+   likewise: each sample's D under the map with colour 1 (rad_direct_irradiance) is traced
+   when a slot first holds that map (the same pixels, size and rotation: a map made anew with
+   the same content counts as the same) and scaled by the colour after. Emissive triangles
    (unless direct.exclude_emitters): static, traced once at create. Then v_i = rho_i D_i and
    E = rad_vp_from_samples(v). With rays_per_frame 0 (P = 1) every update re-tests every
    sample: E then equals rad_vp_sources with the same lights and options, bit for bit when
    there are only directional, point and spot lights (emitters: to float rounding; a sky: the
    same estimator, with other ray directions unless it is lights[0]).
    Memory: 12 bytes per sample (unit normals) + 12 (v) + 1 per sample and light slot
-   (+ 4 with a sky, + 12 with emitters). The scene must be static (the visibility cache
-   assumes it). */
+   (+ 4 with a sky, + 12 with emitters, + 12 per environment slot). The scene must be static
+   (the visibility cache assumes it). */
 #define RAD_VP_LIGHTS_MAX 64u /* light slots (lights per update) at most */
 typedef struct rad_vp_lights_options {
     uint32_t rays_per_frame;   /* shadow rays per light slot and update at most (0: every sample
@@ -7097,6 +7191,364 @@ static void rad__cosine_dir(const float *n, const float *t1, const float *t2, ui
         dir[k] = t1[k] * rr * (float)cos((double)ph) + t2[k] * rr * (float)sin((double)ph) + n[k] * (float)sqrt((double)(1.0f - u1));
 }
 
+/* ---- environment map ---- */
+
+#define RAD__ENV_MAX_SIDE 16384u
+
+struct rad_environment {
+    rad_allocator allocator;
+    const float *pixels;       /* the caller's image, or 'table' */
+    float *table;              /* owned: the lookup's values at the pixel centres, or NULL */
+    uint32_t w, h;
+    float rotation;
+    rad_environment_fn lookup;
+    void *user;
+    float *marginal;           /* h + 1: the CDF over rows */
+    float *conditional;        /* h (w + 1): the CDF over each row's columns */
+    float *cos_edge;           /* h + 1: cos(theta) at the row edges, from +1 down to -1 */
+    double total;              /* sum over pixels of luminance times solid angle */
+    uint64_t key;              /* a hash of the pixels, size and rotation */
+};
+
+static float rad__env_lum(const float *rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
+
+/* the pixel (row, column) a unit direction in the scene's frame reads */
+static size_t rad__env_pixel(const rad_environment *e, const float *dir)
+{
+    double y = dir[1] < -1.0f ? -1.0 : (dir[1] > 1.0f ? 1.0 : (double)dir[1]);
+    double v = acos(y) / RAD__PI, u = (atan2((double)dir[2], (double)dir[0]) - (double)e->rotation) / (2.0 * RAD__PI);
+    uint32_t row, col;
+    u -= floor(u);
+    row = (uint32_t)(v * (double)e->h);
+    col = (uint32_t)(u * (double)e->w);
+    if (row >= e->h) row = e->h - 1u;
+    if (col >= e->w) col = e->w - 1u;
+    return (size_t)row * e->w + col;
+}
+
+RAD_API void rad_environment_destroy(rad_environment *env)
+{
+    if (!env) return;
+    {
+        rad_allocator a = env->allocator;
+        void *blocks[] = { env->table, env->marginal, env->conditional, env->cos_edge, env };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
+}
+
+RAD_API rad_result rad_environment_create(const rad_environment_desc *desc, const rad_context *ctx,
+                                          rad_environment **out)
+{
+    rad__ctx c;
+    rad_environment *e;
+    uint32_t i, j, W, H;
+    double rowsum, *rows;
+    uint64_t key = 1469598103934665603ull;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!desc || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    W = desc->width, H = desc->height;
+    if ((!desc->pixels) == (!desc->lookup)) {
+        rad__log(&c, RAD_LOG_ERROR, "environment map: give exactly one of pixels and lookup");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (W == 0 || H == 0 || W > RAD__ENV_MAX_SIDE || H > RAD__ENV_MAX_SIDE) {
+        rad__log(&c, RAD_LOG_ERROR, "environment map: size %u x %u (each side in 1 .. %u)", W, H, RAD__ENV_MAX_SIDE);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!rad__finite(desc->rotation)) {
+        rad__log(&c, RAD_LOG_ERROR, "environment map: the rotation is not finite");
+        return RAD_ERROR_NON_FINITE;
+    }
+    e = (rad_environment *)rad__alloc_zero(&c.allocator, sizeof(*e));
+    if (!e) return RAD_ERROR_OUT_OF_MEMORY;
+    e->allocator = c.allocator;
+    e->w = W, e->h = H, e->rotation = desc->rotation, e->lookup = desc->lookup, e->user = desc->lookup_user;
+    e->marginal = (float *)rad__alloc_array(&c.allocator, (size_t)H + 1u, sizeof(float));
+    e->conditional = (float *)rad__alloc_array(&c.allocator, (size_t)H, ((size_t)W + 1u) * sizeof(float));
+    e->cos_edge = (float *)rad__alloc_array(&c.allocator, (size_t)H + 1u, sizeof(float));
+    if (desc->lookup) e->table = (float *)rad__alloc_array(&c.allocator, (size_t)W * H, 3 * sizeof(float));
+    if (!e->marginal || !e->conditional || !e->cos_edge || (desc->lookup && !e->table)) {
+        rad_environment_destroy(e);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (desc->lookup) {
+        /* the lookup's values at the pixel centres make the sampling table */
+        for (i = 0; i < H; ++i)
+            for (j = 0; j < W; ++j) {
+                double th = RAD__PI * ((double)i + 0.5) / (double)H, ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)W + desc->rotation;
+                float d[3];
+                d[0] = (float)(sin(th) * cos(ph)), d[1] = (float)cos(th), d[2] = (float)(sin(th) * sin(ph));
+                desc->lookup(desc->lookup_user, d, e->table + 3 * ((size_t)i * W + j));
+            }
+        e->pixels = e->table;
+    } else {
+        e->pixels = desc->pixels;
+    }
+    for (i = 0; i < 3u * W * H; ++i) {
+        float x = e->pixels[i];
+        uint32_t bits;
+        if (!rad__finite(x) || x < 0.0f) {
+            rad__log(&c, RAD_LOG_ERROR, "environment map: pixel (%u, %u) channel %u is %g (must be finite and >= 0)",
+                     (i / 3u) % W, (i / 3u) / W, i % 3u, (double)x);
+            rad_environment_destroy(e);
+            return rad__finite(x) ? RAD_ERROR_NEGATIVE_EMISSION : RAD_ERROR_NON_FINITE;
+        }
+        memcpy(&bits, &x, sizeof bits);
+        key = (key ^ bits) * 1099511628211ull;
+    }
+    {
+        float rb = desc->rotation;
+        uint32_t bits;
+        memcpy(&bits, &rb, sizeof bits);
+        key = (((key ^ W) * 1099511628211ull ^ H) * 1099511628211ull ^ bits) * 1099511628211ull;
+        e->key = key;
+    }
+    /* pixel weight: luminance times the pixel's solid angle (2 pi / W)(cos theta0 - cos theta1),
+       so that a direction drawn uniformly in solid angle inside the pixel has density
+       luminance / total: proportional to the radiance it carries */
+    rows = (double *)rad__alloc_array(&c.allocator, (size_t)H, sizeof(double));
+    if (!rows) {
+        rad_environment_destroy(e);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i <= H; ++i) e->cos_edge[i] = i == 0 ? 1.0f : (i == H ? -1.0f : (float)cos(RAD__PI * (double)i / (double)H));
+    e->total = 0.0;
+    for (i = 0; i < H; ++i) {
+        float *cdf = e->conditional + (size_t)i * (W + 1u);
+        double dw = 2.0 * RAD__PI / (double)W * ((double)e->cos_edge[i] - (double)e->cos_edge[i + 1]);
+        rowsum = 0.0;
+        cdf[0] = 0.0f;
+        for (j = 0; j < W; ++j) {
+            rowsum += (double)rad__env_lum(e->pixels + 3 * ((size_t)i * W + j));
+            cdf[j + 1] = (float)rowsum;
+        }
+        for (j = 1; j <= W; ++j) cdf[j] = rowsum > 0.0 ? (float)((double)cdf[j] / rowsum) : (float)j / (float)W;
+        cdf[W] = 1.0f;
+        rows[i] = rowsum * dw;
+        e->total += rows[i];
+    }
+    e->marginal[0] = 0.0f;
+    rowsum = 0.0;
+    for (i = 0; i < H; ++i) {
+        rowsum += rows[i];
+        e->marginal[i + 1] = e->total > 0.0 ? (float)(rowsum / e->total) : (float)(i + 1) / (float)H;
+    }
+    e->marginal[H] = 1.0f;
+    rad__free(&c.allocator, rows);
+    *out = e;
+    return RAD_SUCCESS;
+}
+
+RAD_API void rad_environment_radiance(const rad_environment *e, const float dir[3], float out_rgb[3])
+{
+    if (!e || !dir || !out_rgb) return;
+    if (e->lookup) {
+        e->lookup(e->user, dir, out_rgb);
+    } else {
+        const float *px = e->pixels + 3 * rad__env_pixel(e, dir);
+        out_rgb[0] = px[0], out_rgb[1] = px[1], out_rgb[2] = px[2];
+    }
+}
+
+RAD_API float rad_environment_pdf(const rad_environment *e, const float dir[3])
+{
+    if (!e || !dir || !(e->total > 0.0)) return 0.0f;
+    return (float)((double)rad__env_lum(e->pixels + 3 * rad__env_pixel(e, dir)) / e->total);
+}
+
+RAD_API double rad_environment_power(const rad_environment *e) { return e ? e->total : 0.0; }
+
+/* the interval k of a CDF of n entries (cdf[0] = 0, cdf[n] = 1) holding u: the first k with
+   cdf[k + 1] > u (so an empty interval is never chosen), and u's place inside it in [0, 1) */
+static uint32_t rad__cdf_find(const float *cdf, uint32_t n, float u, float *t)
+{
+    uint32_t lo = 0, hi = n - 1u;
+    float span;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2u;
+        if (cdf[mid + 1] > u) hi = mid;
+        else lo = mid + 1u;
+    }
+    span = cdf[lo + 1] - cdf[lo];
+    *t = span > 0.0f ? (u - cdf[lo]) / span : 0.5f;
+    if (!(*t >= 0.0f)) *t = 0.0f;
+    if (*t > 0.99999994f) *t = 0.99999994f;
+    return lo;
+}
+
+RAD_API float rad_environment_sample(const rad_environment *e, float u1, float u2, float dir[3])
+{
+    uint32_t row, col;
+    float t1, t2;
+    double y, s, ph;
+    if (!e || !dir || !(e->total > 0.0)) return 0.0f;
+    if (!(u1 >= 0.0f)) u1 = 0.0f;
+    if (!(u1 < 1.0f)) u1 = 0.99999994f;
+    if (!(u2 >= 0.0f)) u2 = 0.0f;
+    if (!(u2 < 1.0f)) u2 = 0.99999994f;
+    row = rad__cdf_find(e->marginal, e->h, u1, &t1);
+    col = rad__cdf_find(e->conditional + (size_t)row * (e->w + 1u), e->w, u2, &t2);
+    /* uniform in solid angle inside the pixel: cos(theta) uniform between the row's edges */
+    y = (double)e->cos_edge[row] + (double)t1 * ((double)e->cos_edge[row + 1] - (double)e->cos_edge[row]);
+    s = sqrt(1.0 - y * y > 0.0 ? 1.0 - y * y : 0.0);
+    ph = 2.0 * RAD__PI * ((double)col + (double)t2) / (double)e->w + (double)e->rotation;
+    dir[0] = (float)(s * cos(ph)), dir[1] = (float)y, dir[2] = (float)(s * sin(ph));
+    return (float)((double)rad__env_lum(e->pixels + 3 * ((size_t)row * e->w + col)) / e->total);
+}
+
+/* An environment light at p (unit normal n), light_samples shadow rays: the first half drawn
+   from the map's distribution, the rest cosine-weighted, each weighted by the power heuristic
+   (a draw of strategy i carries f m_i p_i / ((m_e p_e)^2 + (m_c p_c)^2), f = L cos), so the
+   sum estimates the irradiance without bias whichever strategy finds the light (a sun: the
+   map's; a dim wide sky: the cosine's). The balance heuristic let a cosine ray that happened
+   onto a one-texel sun add 1/m_e of its light to that point; the power heuristic gives it
+   almost no weight. */
+static rad_result rad__direct_env(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
+                                  const rad_light *li, uint32_t l, uint32_t slot, float scale, uint32_t seed)
+{
+    const rad_environment *e = li->environment;
+    uint32_t L = d->o.light_samples, me = (L + 1u) / 2u, mc = L - me, s, h = rad__hash(seed ^ 0x27d4eb2fu ^ l);
+    float t1[3], t2[3];
+    rad_result r;
+    int k;
+    rad__tangent_frame(n, t1, t2);
+    for (s = 0; s < L; ++s) {
+        float dir[3], rgb[3], w[3], cosn, pe, pc, den;
+        if (s < me) {
+            float u1, u2;
+            rad__hammersley(s, me, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
+            if (!(rad_environment_sample(e, u1, u2, dir) > 0.0f)) continue;
+        } else {
+            rad__cosine_dir(n, t1, t2, s - me, mc, rad__hash(h + 0x85ebca6bu), dir);
+        }
+        cosn = rad__dot(dir, n);
+        if (!(cosn > 0.0f)) continue;
+        rad_environment_radiance(e, dir, rgb);
+        pe = (float)me * rad_environment_pdf(e, dir);
+        pc = (float)mc * cosn / (float)RAD__PI;
+        den = pe * pe + pc * pc;
+        if (!(den > 0.0f)) continue;
+        for (k = 0; k < 3; ++k) w[k] = li->color[k] * rgb[k] * cosn * (s < me ? pe : pc) / den;
+        if (!(w[0] > 0.0f || w[1] > 0.0f || w[2] > 0.0f)) continue;
+        r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, w, scale, slot);
+        if (r != RAD_SUCCESS) return r;
+    }
+    return RAD_SUCCESS;
+}
+
+/* ---- physical sky (Preetham 1999) ---- */
+
+/* the Perez distribution with coefficients c[0..4] (A .. E) */
+static double rad__perez(const double *c, double cos_theta, double gamma)
+{
+    double cg = cos(gamma);
+    if (cos_theta < 1e-3) cos_theta = 1e-3;
+    return (1.0 + c[0] * exp(c[1] / cos_theta)) * (1.0 + c[2] * exp(c[3] * gamma) + c[4] * cg * cg);
+}
+
+RAD_API double rad_sky_preetham_zenith(float turbidity, float sun_zenith)
+{
+    double T = turbidity, chi = (4.0 / 9.0 - T / 120.0) * (RAD__PI - 2.0 * (double)sun_zenith);
+    return (4.0453 * T - 4.9710) * tan(chi) - 0.2155 * T + 2.4192;
+}
+
+RAD_API rad_result rad_sky_preetham(float turbidity, const float to_sun[3], uint32_t width, uint32_t height,
+                                    float *out_rgb, rad_light *out_sun, const rad_context *ctx)
+{
+    rad__ctx c;
+    double T = turbidity, s[3], len, ts, t2, t3, Yz, xz, yz, cY[5], cx[5], cy[5], FY, Fx, Fy;
+    uint32_t i, j;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!out_rgb || !to_sun || width == 0 || height == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_sky_preetham: NULL output or direction, or a zero size");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(turbidity >= 1.7f && turbidity <= 10.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_sky_preetham: turbidity %g outside [1.7, 10] (the model's fit)", (double)turbidity);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    len = sqrt((double)to_sun[0] * to_sun[0] + (double)to_sun[1] * to_sun[1] + (double)to_sun[2] * to_sun[2]);
+    if (!rad__finite3(to_sun) || !(len > 0.0) || !(to_sun[1] >= 0.0f)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_sky_preetham: the sun direction must be finite, non-zero and above the horizon");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (k = 0; k < 3; ++k) s[k] = (double)to_sun[k] / len;
+    ts = acos(s[1] > 1.0 ? 1.0 : s[1]);
+    t2 = ts * ts, t3 = t2 * ts;
+    Yz = rad_sky_preetham_zenith(turbidity, (float)ts) * 1000.0; /* cd/m^2 */
+    xz = (0.00166 * t3 - 0.00375 * t2 + 0.00209 * ts) * T * T + (-0.02903 * t3 + 0.06377 * t2 - 0.03202 * ts + 0.00394) * T +
+         (0.11693 * t3 - 0.21196 * t2 + 0.06052 * ts + 0.25886);
+    yz = (0.00275 * t3 - 0.00610 * t2 + 0.00317 * ts) * T * T + (-0.04214 * t3 + 0.08970 * t2 - 0.04153 * ts + 0.00516) * T +
+         (0.15346 * t3 - 0.26756 * t2 + 0.06670 * ts + 0.26688);
+    cY[0] = 0.1787 * T - 1.4630, cY[1] = -0.3554 * T + 0.4275, cY[2] = -0.0227 * T + 5.3251;
+    cY[3] = 0.1206 * T - 2.5771, cY[4] = -0.0670 * T + 0.3703;
+    cx[0] = -0.0193 * T - 0.2592, cx[1] = -0.0665 * T + 0.0008, cx[2] = -0.0004 * T + 0.2125;
+    cx[3] = -0.0641 * T - 0.8989, cx[4] = -0.0033 * T + 0.0452;
+    cy[0] = -0.0167 * T - 0.2608, cy[1] = -0.0950 * T + 0.0092, cy[2] = -0.0079 * T + 0.2102;
+    cy[3] = -0.0441 * T - 1.6537, cy[4] = -0.0109 * T + 0.0529;
+    FY = rad__perez(cY, 1.0, ts), Fx = rad__perez(cx, 1.0, ts), Fy = rad__perez(cy, 1.0, ts);
+    for (i = 0; i < height; ++i) {
+        double th = RAD__PI * ((double)i + 0.5) / (double)height, ct = cos(th), st = sin(th);
+        for (j = 0; j < width; ++j) {
+            float *o = out_rgb + 3 * ((size_t)i * width + j);
+            double ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)width, d[3], cg, g, Y, x, y, X, Z;
+            if (ct <= 0.0) {
+                o[0] = o[1] = o[2] = 0.0f;
+                continue;
+            }
+            d[0] = st * cos(ph), d[1] = ct, d[2] = st * sin(ph);
+            cg = d[0] * s[0] + d[1] * s[1] + d[2] * s[2];
+            g = acos(cg > 1.0 ? 1.0 : (cg < -1.0 ? -1.0 : cg));
+            Y = Yz * rad__perez(cY, ct, g) / FY;
+            x = xz * rad__perez(cx, ct, g) / Fx;
+            y = yz * rad__perez(cy, ct, g) / Fy;
+            X = y > 0.0 ? x * Y / y : 0.0, Z = y > 0.0 ? (1.0 - x - y) * Y / y : 0.0;
+            /* XYZ to linear sRGB, then candela to W at 683 lm/W; a negative primary (outside
+               the sRGB gamut) is clipped */
+            {
+                double r = 3.2406 * X - 1.5372 * Y - 0.4986 * Z, gg = -0.9689 * X + 1.8758 * Y + 0.0415 * Z,
+                       b = 0.0557 * X - 0.2040 * Y + 1.0570 * Z;
+                o[0] = (float)(r > 0.0 ? r / 683.0 : 0.0);
+                o[1] = (float)(gg > 0.0 ? gg / 683.0 : 0.0);
+                o[2] = (float)(b > 0.0 ? b / 683.0 : 0.0);
+            }
+        }
+    }
+    if (out_sun) {
+        static const double lambda[3] = { 0.65, 0.55, 0.45 };
+        double el = 90.0 - ts * 180.0 / RAD__PI, m, beta = 0.04608 * T - 0.04586;
+        m = 1.0 / (cos(ts) + 0.50572 * pow(el + 6.07995, -1.6364)); /* Kasten and Young 1989 */
+        memset(out_sun, 0, sizeof(*out_sun));
+        out_sun->type = RAD_LIGHT_DIRECTIONAL;
+        for (k = 0; k < 3; ++k) {
+            double tr = exp(-0.008735 * pow(lambda[k], -4.08) * m), ta = exp(-beta * pow(lambda[k], -1.3) * m);
+            out_sun->color[k] = (float)(133800.0 / 683.0 * tr * ta);
+            out_sun->direction[k] = (float)-s[k];
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, float solar_hour, float out_dir[3])
+{
+    double lat, dec, H, E, N, U;
+    if (!out_dir || !rad__finite(latitude_degrees) || !rad__finite(day_of_year) || !rad__finite(solar_hour) ||
+        !(latitude_degrees >= -90.0f && latitude_degrees <= 90.0f) || !(day_of_year >= 1.0f && day_of_year <= 366.0f) ||
+        !(solar_hour >= 0.0f && solar_hour <= 24.0f))
+        return RAD_ERROR_INVALID_ARGUMENT;
+    lat = (double)latitude_degrees * RAD__PI / 180.0;
+    dec = 23.44 * RAD__PI / 180.0 * sin(2.0 * RAD__PI * (284.0 + (double)day_of_year) / 365.0);
+    H = 15.0 * ((double)solar_hour - 12.0) * RAD__PI / 180.0;
+    /* east, north and up components of the direction to the sun */
+    E = -cos(dec) * sin(H);
+    N = cos(lat) * sin(dec) - sin(lat) * cos(dec) * cos(H);
+    U = sin(lat) * sin(dec) + cos(lat) * cos(dec) * cos(H);
+    out_dir[0] = (float)E, out_dir[1] = (float)U, out_dir[2] = (float)-N;
+    return RAD_SUCCESS;
+}
+
 /* all lights at one point into slot, each contribution times 'scale' */
 static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
                                     uint32_t slot, float scale, uint32_t seed)
@@ -7126,6 +7578,9 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
                 r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, li->color, scale / (float)L, slot);
                 if (r != RAD_SUCCESS) return r;
             }
+        } else if (li->type == RAD_LIGHT_ENVIRONMENT) {
+            r = rad__direct_env(d, task, nrays, p, n, li, l, slot, scale, seed);
+            if (r != RAD_SUCCESS) return r;
         }
     }
     if (!d->o.exclude_emitters) {
@@ -7281,7 +7736,11 @@ static rad_result rad__direct_setup(rad__direct *d, const rad_scene *S, const ra
             rad__log(c, RAD_LOG_ERROR, "light %u has a negative colour", l);
             return RAD_ERROR_NEGATIVE_EMISSION;
         }
-        if ((int)li->type < 0 || (int)li->type > RAD_LIGHT_SKY || (li->falloff != RAD_FALLOFF_QUADRATIC && li->falloff != RAD_FALLOFF_LINEAR) ||
+        if (li->type == RAD_LIGHT_ENVIRONMENT && !li->environment) {
+            rad__log(c, RAD_LOG_ERROR, "light %u: an environment light without a map (rad_environment_create)", l);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if ((int)li->type < 0 || (int)li->type > RAD_LIGHT_ENVIRONMENT || (li->falloff != RAD_FALLOFF_QUADRATIC && li->falloff != RAD_FALLOFF_LINEAR) ||
             li->min_distance < 0.0f ||
             (li->type == RAD_LIGHT_SPOT && (li->inner_angle < 0.0f || li->outer_angle < li->inner_angle || li->outer_angle > (float)RAD__PI))) {
             rad__log(c, RAD_LOG_ERROR, "light %u: bad type, falloff or spot angles", l);
@@ -17892,6 +18351,8 @@ struct rad_vp_lights {
     float *v;                         /* 3M: rho_i D_i of the last update */
     float *emit;                      /* 3M: the emitters' D (unless exclude_emitters), else NULL */
     float *sky;                       /* M: unoccluded hemisphere fraction, once a sky was seen */
+    float *env[RAD_VP_LIGHTS_MAX];    /* 3M per environment slot: its D with color 1 */
+    uint64_t env_key[RAD_VP_LIGHTS_MAX]; /* the map that env[l] was traced for */
     uint8_t *vis[RAD_VP_LIGHTS_MAX];  /* M per slot: cached visibility */
     int type[RAD_VP_LIGHTS_MAX];      /* the slot's light type at the last update, -1: none */
     uint8_t full[RAD_VP_LIGHTS_MAX];  /* re-test every sample at the next update */
@@ -17914,7 +18375,7 @@ RAD_API void rad_vp_lights_destroy(rad_vp_lights *s)
     uint32_t l;
     if (!s) return;
     a = s->allocator;
-    for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) rad__free(&a, s->vis[l]);
+    for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) rad__free(&a, s->vis[l]), rad__free(&a, s->env[l]);
     {
         void *blocks[] = { s->normals, s->v, s->emit, s->sky, s };
         rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
@@ -18049,7 +18510,7 @@ static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
     for (l = 0; l < j->light_count; ++l) {
         const rad_light *li = &j->lights[l];
         uint32_t step = j->full[l] ? 1u : P, first = i0;
-        if (li->type == RAD_LIGHT_SKY || j->skip[l]) continue;
+        if (li->type == RAD_LIGHT_SKY || li->type == RAD_LIGHT_ENVIRONMENT || j->skip[l]) continue;
         if (step > 1u) first = i0 + ((j->phase + P - l % P) % P + P - i0 % P) % P;
         for (i = first; i < i1; i += step) {
             const float *p = vp->sample_positions + 3 * (size_t)i, *n = s->normals + 3 * (size_t)i;
@@ -18075,6 +18536,8 @@ static rad_result rad__vp_lights_row(void *data, uint32_t row, uint32_t task)
             float w[3], v[3];
             if (li->type == RAD_LIGHT_SKY) {
                 for (k = 0; k < 3; ++k) acc[k] += (double)(li->color[k] * s->sky[i]);
+            } else if (li->type == RAD_LIGHT_ENVIRONMENT) {
+                for (k = 0; k < 3; ++k) acc[k] += (double)(li->color[k] * s->env[l][3 * (size_t)i + k]);
             } else if (s->vis[l][i] && !rad__vp_light_outside(j, l, p) && rad__light_unshadowed(li, j->diagonal, p, n, w, v)) {
                 for (k = 0; k < 3; ++k) acc[k] += (double)w[k];
             }
@@ -18107,8 +18570,30 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     j.s = s, j.lights = lights, j.light_count = light_count, j.eps = d.eps, j.diagonal = s->vp->scene->diagonal;
     j.phase = s->update % s->period;
     for (l = 0; l < light_count; ++l) {
-        if (lights[l].type == RAD_LIGHT_SKY) { has_sky = 1; continue; }
         float key[8];
+        if (lights[l].type == RAD_LIGHT_SKY) { has_sky = 1; continue; }
+        if (lights[l].type == RAD_LIGHT_ENVIRONMENT) {
+            /* a map's shadows depend on the geometry and the map only: traced (color 1) when the
+               slot first holds this map, then scaled by the colour */
+            if (!s->env[l] || s->env_key[l] != lights[l].environment->key) {
+                rad_light unit = lights[l];
+                rad_direct_options o = s->o.direct;
+                if (!s->env[l]) s->env[l] = (float *)rad__alloc_array(&s->allocator, M ? (size_t)M : 1u, 3 * sizeof(float));
+                if (!s->env[l]) return RAD_ERROR_OUT_OF_MEMORY;
+                unit.color[0] = unit.color[1] = unit.color[2] = 1.0f;
+                o.include_emitters = 0;
+                s->env_key[l] = 0;
+                r = rad_direct_irradiance(s->vp->scene, s->rc, &unit, 1, &o, s->vp->sample_positions, s->vp->sample_normals,
+                                          M, s->env[l], ctx);
+                if (r != RAD_SUCCESS) {
+                    rad__free(&s->allocator, s->env[l]);
+                    s->env[l] = NULL;
+                    return r;
+                }
+                s->env_key[l] = lights[l].environment->key;
+            }
+            continue;
+        }
         rad__vp_light_key(&lights[l], key);
         j.full[l] = s->full[l] || s->type[l] != (int)lights[l].type;
         if (!s->vis[l]) {
@@ -18164,7 +18649,7 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
     {
         double work = 0.0;
         for (l = 0; l < light_count; ++l) {
-            if (lights[l].type == RAD_LIGHT_SKY) continue;
+            if (lights[l].type == RAD_LIGHT_SKY || lights[l].type == RAD_LIGHT_ENVIRONMENT) continue;
             work += 10.0 * (double)M;
             if (!j.skip[l]) work += 150.0 * (j.full[l] ? (double)M : (double)M / (double)s->period);
         }
@@ -18185,7 +18670,8 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
         for (t = 0; t < T; ++t) s->rays += j.task_rays[t];
         for (l = 0; l < RAD_VP_LIGHTS_MAX; ++l) {
             /* a slot not lit this update forgets its cache: it may come back as another light */
-            s->type[l] = l < light_count && lights[l].type != RAD_LIGHT_SKY ? (int)lights[l].type : -1;
+            s->type[l] = l < light_count && lights[l].type != RAD_LIGHT_SKY && lights[l].type != RAD_LIGHT_ENVIRONMENT
+                             ? (int)lights[l].type : -1;
             s->full[l] = 0;
             if (s->type[l] >= 0) {
                 rad__vp_light_key(&lights[l], s->key[l]);
@@ -20361,6 +20847,18 @@ static rad_result rad__pb_gather(void *data, uint32_t row, uint32_t task)
                 for (k = 0; k < b->o.rays && r == RAD_SUCCESS; ++k) {
                     rad__fibonacci_dir(k, b->o.rays, v);
                     r = rad__pb_queue(b, task, row, &nq, p, v, NULL, w, RAD_NONE, li->color);
+                }
+            } else if (li->type == RAD_LIGHT_ENVIRONMENT) {
+                /* the map's own distribution: radiance L over density pdf, 1 / rays each */
+                uint32_t h = rad__hash(row * 0x9E3779B9u ^ l ^ 0x27d4eb2fu);
+                for (k = 0; k < b->o.rays && r == RAD_SUCCESS; ++k) {
+                    float u1, u2, pdf, rgb[3];
+                    rad__hammersley(k, b->o.rays, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
+                    pdf = rad_environment_sample(li->environment, u1, u2, v);
+                    if (!(pdf > 0.0f)) continue;
+                    rad_environment_radiance(li->environment, v, rgb);
+                    for (c = 0; c < 3; ++c) col[c] = li->color[c] * rgb[c];
+                    r = rad__pb_queue(b, task, row, &nq, p, v, NULL, 1.0f / ((float)b->o.rays * pdf), RAD_NONE, col);
                 }
             }
         }

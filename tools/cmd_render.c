@@ -278,7 +278,15 @@ static int render_classic(const tool_world *w, const rad_patches *P, const float
             const float *v, *nt;
             if (t == RAD_NONE || t >= scene->triangle_count) {
                 size_t pixel = (size_t)y0 * width + k / spp;
+                uint32_t l;
                 for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
+                /* and an environment map its radiance in the ray's direction */
+                for (l = 0; l < w->file.light_count; ++l)
+                    if (w->file.lights[l].type == RAD_LIGHT_ENVIRONMENT) {
+                        float rgb[3];
+                        rad_environment_radiance(w->file.lights[l].environment, rays[k].dir, rgb);
+                        for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += w->file.lights[l].color[i] * rgb[i];
+                    }
                 hits[k].triangle = RAD_NONE;
                 continue;
             }

@@ -50,6 +50,7 @@
 #include <stb/stb_image_write.h>
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
+#define STBI_ONLY_HDR
 #include <stb/stb_image.h>
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
@@ -534,6 +535,34 @@ int tool_image_read_png(const char *path, tool_image *img, char *err, size_t err
     for (x = 0; x < 256; ++x) table[x] = (float)tool__srgb_decode((double)x / 255.0);
     for (y = 0; y < h; ++y)
         for (x = 0; x < 3 * w; ++x) img->rgb[(size_t)y * (size_t)w * 3u + (size_t)x] = table[px[(size_t)y * (size_t)w * 3u + (size_t)x]];
+    stbi_image_free(px);
+    return 0;
+}
+
+int tool_image_read_hdr(const char *path, tool_image *img, char *err, size_t errlen)
+{
+    int w, h, comp;
+    float *px;
+    if (err && errlen) err[0] = '\0';
+    if (!path || !img) return -1;
+    img->width = img->height = 0;
+    img->rgb = NULL;
+    if (!stbi_is_hdr(path)) {
+        if (err) snprintf(err, errlen, "%s: not a Radiance .hdr file (%s)", path,
+                          stbi_failure_reason() ? stbi_failure_reason() : "stb_image does not see an HDR header");
+        return -1;
+    }
+    px = stbi_loadf(path, &w, &h, &comp, 3);
+    if (!px) {
+        if (err) snprintf(err, errlen, "%s: cannot read HDR (%s)", path, stbi_failure_reason());
+        return -1;
+    }
+    if (tool_image_alloc(img, w, h) != 0) {
+        if (err) snprintf(err, errlen, "%s: out of memory", path);
+        stbi_image_free(px);
+        return -1;
+    }
+    memcpy(img->rgb, px, sizeof(float) * 3u * (size_t)w * (size_t)h);
     stbi_image_free(px);
     return 0;
 }

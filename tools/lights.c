@@ -15,6 +15,17 @@
                                 INNER,OUTER half-angles in degrees (full intensity inside
                                 INNER, smoothstep to 0 at OUTER; one angle: a hard edge);
                                 RGB = intensity in W/sr on the axis
+     --env FILE[:SCALE[:ROT]]   environment map: an equirectangular Radiance .hdr (stb_image)
+                                or .exr (tinyexr) of radiance in W m^-2 sr^-1, times SCALE
+                                (default 1), turned ROT degrees about +Y (+X towards +Z);
+                                +Y is up, the top row the zenith, the left edge looks along
+                                +X (the library's RAD_LIGHT_ENVIRONMENT convention)
+     --sky-model preetham:T[:SCALE] --sun-time LAT:DAY:HOUR
+                                Preetham's clear sky of turbidity T (1.7 .. 10) as a 256 x 128
+                                environment map, plus its sun as a directional light, for the
+                                sun at latitude LAT degrees, day of year DAY, local solar time
+                                HOUR (rad_sky_preetham, rad_sun_direction: +X east, +Z south);
+                                units luminance / 683 (W m^-2 sr^-1 at 683 lm/W), times SCALE
      --area P:U:V:RGB           emissive parallelogram P, P+U, P+U+V, P+V (two triangles of a
                                 mesh "area_light_K", albedo 0), emitting radiance RGB
                                 (W m^-2 sr^-1) from the side U x V points to: an area light
@@ -23,6 +34,7 @@
    the scene description before rad_scene_create (tool_open_world_lit), so every method,
    the path tracer and the bake see the same lights. */
 #include "tool.h"
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,7 +52,13 @@ const char *tool_light_help(void)
            "  --spot POS:DIR:ANGLES:RGB  spot light aimed along DIR; ANGLES = OUTER or INNER,OUTER\n"
            "                     half-angles in degrees (smooth edge from INNER to OUTER); RGB = intensity W/sr\n"
            "  --area P:U:V:RGB   emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB (W/m^2/sr),\n"
-           "                     emitting towards U x V (an area light like an emissive triangle)\n";
+           "                     emitting towards U x V (an area light like an emissive triangle)\n"
+           "  --env FILE[:SCALE[:ROT]]  environment map: equirectangular .hdr or .exr of radiance\n"
+           "                     (W/m^2/sr) times SCALE, turned ROT degrees about +Y; +Y up, top row =\n"
+           "                     zenith, left edge looks along +X, a quarter across along +Z\n"
+           "  --sky-model preetham:T[:SCALE] --sun-time LAT:DAY:HOUR  Preetham's clear sky (turbidity\n"
+           "                     T in 1.7..10) and its sun for latitude LAT, day of year DAY, solar time\n"
+           "                     HOUR (+X east, +Z south); units: luminance / 683 lm/W, times SCALE\n";
 }
 
 /* 'count' comma-separated finite numbers filling the whole of [s, s + len); 0 on success */
@@ -97,10 +115,154 @@ static int split_parts(const char *text, const char **part, size_t *plen, int ma
 
 void tool_lights_free(tool_lights *L)
 {
+    uint32_t i;
     if (!L) return;
+    for (i = 0; i < L->env_count; ++i) {
+        rad_environment_destroy(L->envs[i]);
+        tool_image_free(&L->env_images[i]);
+    }
+    free(L->envs);
+    free(L->env_images);
     free(L->lights);
     free(L->areas);
     memset(L, 0, sizeof *L);
+}
+
+/* keeps env (and the image it borrows) in L and appends a light of 'scale' that uses it */
+static int lights_keep_env(const char *cmd, tool_lights *L, rad_environment *env, tool_image *img, float scale)
+{
+    rad_environment **e = (rad_environment **)realloc(L->envs, sizeof *e * (L->env_count + 1u));
+    tool_image *im;
+    rad_light *g;
+    if (e) L->envs = e;
+    im = e ? (tool_image *)realloc(L->env_images, sizeof *im * (L->env_count + 1u)) : NULL;
+    if (im) L->env_images = im;
+    g = im ? (rad_light *)realloc(L->lights, sizeof *g * (L->count + 1u)) : NULL;
+    if (!g) {
+        fprintf(stderr, "rad %s: out of memory\n", cmd);
+        rad_environment_destroy(env);
+        tool_image_free(img);
+        return 2;
+    }
+    L->lights = g;
+    L->envs[L->env_count] = env;
+    L->env_images[L->env_count++] = *img;
+    memset(&L->lights[L->count], 0, sizeof L->lights[0]);
+    L->lights[L->count].type = RAD_LIGHT_ENVIRONMENT;
+    L->lights[L->count].color[0] = L->lights[L->count].color[1] = L->lights[L->count].color[2] = scale;
+    L->lights[L->count++].environment = env;
+    return 1;
+}
+
+static int lights_has_ext(const char *path, const char *ext)
+{
+    size_t n = strlen(path), m = strlen(ext), i;
+    if (n < m) return 0;
+    for (i = 0; i < m; ++i)
+        if (tolower((unsigned char)path[n - m + i]) != ext[i]) return 0;
+    return 1;
+}
+
+/* --env FILE[:SCALE[:ROT]]: the trailing ':'-parts that are numbers are SCALE and ROT */
+static int lights_env_option(const char *cmd, const char *text, tool_lights *L)
+{
+    char path[4096], err[512];
+    float num[2] = { 1.0f, 0.0f }, v;
+    int nn = 0, k;
+    size_t len = strlen(text);
+    tool_image img;
+    rad_environment_desc d;
+    rad_environment *env = NULL;
+    rad_result r;
+    if (len >= sizeof path) {
+        fprintf(stderr, "rad %s: --env: the path is too long\n", cmd);
+        return 2;
+    }
+    memcpy(path, text, len + 1);
+    while (nn < 2) {
+        char *colon = strrchr(path, ':');
+        if (!colon || parse_numbers(colon + 1, strlen(colon + 1), &v, 1)) break;
+        for (k = nn; k > 0; --k) num[k] = num[k - 1];
+        num[0] = v;
+        ++nn;
+        *colon = '\0';
+    }
+    if (nn == 1) num[1] = 0.0f; /* parsed right to left: one number is SCALE */
+    if (!(num[0] >= 0.0f)) {
+        fprintf(stderr, "rad %s: bad --env '%s': SCALE must be a number >= 0\n", cmd, text);
+        return 2;
+    }
+    if (lights_has_ext(path, ".exr")) k = tool_image_read_exr(path, &img, err, sizeof err);
+    else if (lights_has_ext(path, ".hdr") || lights_has_ext(path, ".rgbe")) k = tool_image_read_hdr(path, &img, err, sizeof err);
+    else {
+        fprintf(stderr, "rad %s: bad --env '%s': the map must be a Radiance .hdr or an OpenEXR .exr\n", cmd, text);
+        return 2;
+    }
+    if (k != 0) {
+        fprintf(stderr, "rad %s: --env: %s\n", cmd, err);
+        return 2;
+    }
+    memset(&d, 0, sizeof d);
+    d.pixels = img.rgb, d.width = (uint32_t)img.width, d.height = (uint32_t)img.height;
+    d.rotation = (float)(num[1] * LIGHTS_DEG);
+    r = rad_environment_create(&d, NULL, &env);
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: --env '%s': %s (a NaN, Inf or negative pixel, or a bad size)\n", cmd, path, rad_result_string(r));
+        tool_image_free(&img);
+        return 2;
+    }
+    return lights_keep_env(cmd, L, env, &img, num[0]);
+}
+
+/* --sky-model and --sun-time both given: the sky map and the sun */
+static int lights_make_sky(const char *cmd, tool_lights *L)
+{
+    tool_image img;
+    rad_light sun;
+    rad_environment_desc d;
+    rad_environment *env = NULL;
+    float dir[3];
+    rad_result r;
+    int k;
+    if (rad_sun_direction(L->sun_time[0], L->sun_time[1], L->sun_time[2], dir) != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bad --sun-time: LAT in [-90, 90], DAY in [1, 366], HOUR in [0, 24]\n", cmd);
+        return 2;
+    }
+    if (!(dir[1] > 0.0f)) {
+        fprintf(stderr, "rad %s: --sun-time %g:%g:%g puts the sun below the horizon (elevation %.1f degrees): the sky model "
+                "holds in daylight only\n", cmd, (double)L->sun_time[0], (double)L->sun_time[1], (double)L->sun_time[2],
+                asin((double)dir[1]) / LIGHTS_DEG);
+        return 2;
+    }
+    if (tool_image_alloc(&img, 256, 128) != 0) {
+        fprintf(stderr, "rad %s: out of memory\n", cmd);
+        return 2;
+    }
+    r = rad_sky_preetham(L->sky_turbidity, dir, 256, 128, img.rgb, &sun, NULL);
+    if (r == RAD_SUCCESS) {
+        size_t i;
+        for (i = 0; i < 3u * 256u * 128u; ++i) img.rgb[i] *= L->sky_scale;
+        for (k = 0; k < 3; ++k) sun.color[k] *= L->sky_scale;
+        memset(&d, 0, sizeof d);
+        d.pixels = img.rgb, d.width = 256, d.height = 128;
+        r = rad_environment_create(&d, NULL, &env);
+    }
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: --sky-model: %s\n", cmd, rad_result_string(r));
+        tool_image_free(&img);
+        return 2;
+    }
+    fprintf(stderr, "rad %s: sky model preetham turbidity %g, sun %.1f degrees up at azimuth %.1f (from north, east "
+            "positive), sun irradiance %g,%g,%g\n", cmd, (double)L->sky_turbidity, asin((double)dir[1]) / LIGHTS_DEG,
+            atan2((double)dir[0], -(double)dir[2]) / LIGHTS_DEG, (double)sun.color[0], (double)sun.color[1], (double)sun.color[2]);
+    if ((k = lights_keep_env(cmd, L, env, &img, 1.0f)) != 1) return k;
+    {
+        rad_light *g = (rad_light *)realloc(L->lights, sizeof *g * (L->count + 1u));
+        if (!g) { fprintf(stderr, "rad %s: out of memory\n", cmd); return 2; }
+        L->lights = g;
+        L->lights[L->count++] = sun;
+    }
+    return 1;
 }
 
 int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_lights *L)
@@ -115,6 +277,53 @@ int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_light
     int i, n;
     rad_light li;
     tool_area_light al;
+    if (!strcmp(opt, "--env")) {
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: --env needs a value (FILE.hdr[:SCALE[:ROT_DEGREES]], e.g. sky.hdr:1:90)\n", cmd);
+            return 2;
+        }
+        return lights_env_option(cmd, argv[++*a], L);
+    }
+    if (!strcmp(opt, "--sky-model") || !strcmp(opt, "--sun-time")) {
+        int model = !strcmp(opt, "--sky-model"), np;
+        float num[3];
+        const char *v;
+        if (*a + 1 >= argc) {
+            fprintf(stderr, "rad %s: %s needs a value (%s)\n", cmd, opt, model ? "preetham:T[:SCALE], e.g. preetham:3" :
+                    "LAT:DAY:HOUR, e.g. 48.1:172:15.5");
+            return 2;
+        }
+        v = argv[++*a];
+        if (L->sky_parts & (model ? 1u : 2u)) {
+            fprintf(stderr, "rad %s: %s given twice (one sky model per command)\n", cmd, opt);
+            return 2;
+        }
+        if (model) {
+            np = split_parts(v, part, plen, 3);
+            if (np < 2 || plen[0] != 8 || strncmp(v, "preetham", 8) || parse_numbers(part[1], plen[1], num, 1) ||
+                (np == 3 && parse_numbers(part[2], plen[2], num + 1, 1))) {
+                fprintf(stderr, "rad %s: bad --sky-model '%s' (want preetham:T[:SCALE], e.g. preetham:3)\n", cmd, v);
+                return 2;
+            }
+            if (np == 2) num[1] = 1.0f;
+            if (!(num[0] >= 1.7f && num[0] <= 10.0f) || !(num[1] >= 0.0f)) {
+                fprintf(stderr, "rad %s: bad --sky-model '%s': turbidity T in [1.7, 10], SCALE >= 0\n", cmd, v);
+                return 2;
+            }
+            L->sky_turbidity = num[0], L->sky_scale = num[1];
+            L->sky_parts |= 1u;
+        } else {
+            np = split_parts(v, part, plen, 3);
+            if (np != 3 || parse_numbers(part[0], plen[0], num, 1) || parse_numbers(part[1], plen[1], num + 1, 1) ||
+                parse_numbers(part[2], plen[2], num + 2, 1)) {
+                fprintf(stderr, "rad %s: bad --sun-time '%s' (want LAT:DAY:HOUR, e.g. 48.1:172:15.5)\n", cmd, v);
+                return 2;
+            }
+            memcpy(L->sun_time, num, sizeof num);
+            L->sky_parts |= 2u;
+        }
+        return L->sky_parts == 3u ? lights_make_sky(cmd, L) : 1;
+    }
     for (i = 0; i < 5; ++i)
         if (!strcmp(opt, names[i])) break;
     if (i == 5) return 0;
@@ -271,8 +480,13 @@ static int add_areas(tool_scene *f, const tool_lights *L, lights_storage **out)
 int tool_add_lights(const char *cmd, tool_scene *f, const tool_lights *L, void **storage)
 {
     lights_storage *s = NULL;
-    uint32_t i, counts[4] = {0, 0, 0, 0};
+    uint32_t i, counts[5] = {0, 0, 0, 0, 0};
     *storage = NULL;
+    if (L && (L->sky_parts == 1u || L->sky_parts == 2u)) {
+        fprintf(stderr, "rad %s: %s needs %s too\n", cmd, L->sky_parts == 1u ? "--sky-model" : "--sun-time",
+                L->sky_parts == 1u ? "--sun-time LAT:DAY:HOUR" : "--sky-model preetham:T");
+        return 1;
+    }
     if (!L || (!L->count && !L->area_count)) return 0;
     if (add_areas(f, L, &s)) {
         fprintf(stderr, "rad %s: out of memory for the area lights\n", cmd);
@@ -290,10 +504,10 @@ int tool_add_lights(const char *cmd, tool_scene *f, const tool_lights *L, void *
         f->light_count += L->count;
     }
     for (i = 0; i < L->count; ++i)
-        if ((int)L->lights[i].type >= 0 && (int)L->lights[i].type < 4) counts[L->lights[i].type]++;
-    fprintf(stderr, "rad %s: lights from the command line: %u sun, %u sky, %u point, %u spot, %u area\n", cmd,
-            counts[RAD_LIGHT_DIRECTIONAL], counts[RAD_LIGHT_SKY], counts[RAD_LIGHT_POINT], counts[RAD_LIGHT_SPOT],
-            L->area_count);
+        if ((int)L->lights[i].type >= 0 && (int)L->lights[i].type < 5) counts[L->lights[i].type]++;
+    fprintf(stderr, "rad %s: lights from the command line: %u sun, %u sky, %u environment, %u point, %u spot, %u area\n",
+            cmd, counts[RAD_LIGHT_DIRECTIONAL], counts[RAD_LIGHT_SKY], counts[RAD_LIGHT_ENVIRONMENT], counts[RAD_LIGHT_POINT],
+            counts[RAD_LIGHT_SPOT], L->area_count);
     *storage = s;
     return 0;
 }
@@ -313,6 +527,19 @@ uint64_t tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h)
         h = rad_hash64(&l->min_distance, sizeof(float), h);
         h = rad_hash64(&l->inner_angle, sizeof(float), h);
         h = rad_hash64(&l->outer_angle, sizeof(float), h);
+        if (l->type == RAD_LIGHT_ENVIRONMENT && l->environment) {
+            /* the map through its power and its radiance in 256 fixed directions */
+            double pw = rad_environment_power(l->environment);
+            uint32_t k;
+            h = rad_hash64(&pw, sizeof pw, h);
+            for (k = 0; k < 256u; ++k) {
+                float z = 1.0f - (2.0f * (float)k + 1.0f) / 256.0f, r = sqrtf(1.0f - z * z), ph = 2.39996323f * (float)k;
+                float dir[3], rgb[3];
+                dir[0] = r * cosf(ph), dir[1] = z, dir[2] = r * sinf(ph);
+                rad_environment_radiance(l->environment, dir, rgb);
+                h = rad_hash64(rgb, sizeof rgb, h);
+            }
+        }
     }
     return h;
 }

@@ -7,7 +7,7 @@
        rad render SCENE -o OUT.png|OUT.pfm     an image (classic, multibounce or temporal
                                        radiosity, or path tracing)
        rad trace SCENE -o OUT  the reference path tracer
-       (render, trace, bake: --sun, --sky, --point, --spot, --area add lights: lights.c)
+       (render, trace, bake: --sun, --sky, --point, --spot, --area, --env add lights: lights.c)
        rad compare A B         image metrics
        rad info FILE.radb      what a bake holds
        rad export SCENE -o OUT.obj     the scene as OBJ + MTL
@@ -49,7 +49,8 @@ static void usage(FILE *f)
                "SCENE is 'cornell' (the built-in Cornell box) or a file assimp reads\n"
                "(OBJ+MTL, glTF 2.0, FBX, PLY ...). Every command takes --threads N (default: all cores;\n"
                "at most 1024). render, trace, bake, lightmap and probes add lights to the file's own:\n"
-               "--sun DIR:RGB, --sky RGB, --point POS:RGB, --spot POS:DIR:ANGLES:RGB, --area P:U:V:RGB\n"
+               "--sun DIR:RGB, --sky RGB, --point POS:RGB, --spot POS:DIR:ANGLES:RGB, --area P:U:V:RGB,\n"
+               "--env FILE.hdr|.exr[:SCALE[:ROT]] (an equirectangular environment map)\n"
                "(units: rad render --help). Surfaces: --two-sided [auto|all|none] (every command; default\n"
                "auto: glTF doubleSided materials are two-sided, the rest one-sided as wound; bare\n"
                "--two-sided: all). Dense methods (classic, multibounce, temporal, local) refuse\n"

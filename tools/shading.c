@@ -71,7 +71,7 @@ int tool_shade_direct(const tool_world *w, int model, uint32_t light_samples, co
     dopt.exclude_emitters = 1;
     for (j = 0; j < nl; ++j) {
         const rad_light *L = &lights[j];
-        if (L->type == RAD_LIGHT_SKY) { rest[nrest++] = *L; continue; }
+        if (L->type == RAD_LIGHT_SKY || L->type == RAD_LIGHT_ENVIRONMENT) { rest[nrest++] = *L; continue; }
         for (i = 0; i < count; ++i) {
             float d[3], len;
             if (L->type == RAD_LIGHT_DIRECTIONAL) { d[0] = -L->direction[0]; d[1] = -L->direction[1]; d[2] = -L->direction[2]; }

@@ -70,6 +70,8 @@ int tool_image_write(const char *path, const tool_image *img, float exposure);
 /* Reads .png (8-bit sRGB through stb_image, decoded to linear), .exr (tinyexr) or else PFM; 0 on success. */
 int tool_image_read(const char *path, tool_image *img, char *err, size_t errlen);
 int tool_image_read_png(const char *path, tool_image *img, char *err, size_t errlen);
+/* Radiance .hdr (RGBE) through stb_image's stbi_loadf: linear float RGB, top row first */
+int tool_image_read_hdr(const char *path, tool_image *img, char *err, size_t errlen);
 /* The 8-bit sRGB code of a linear value (clamped to [0,1], rounded): what PNGs store. */
 unsigned char tool_image_srgb8(float linear);
 
@@ -192,6 +194,12 @@ typedef struct tool_lights {
     uint32_t count;
     tool_area_light *areas;
     uint32_t area_count;
+    rad_environment **envs;         /* --env and --sky-model: the maps lights[] point to */
+    tool_image *env_images;         /* their pixels (borrowed by envs) */
+    uint32_t env_count;
+    float sky_turbidity, sky_scale; /* --sky-model preetham:T[:SCALE] */
+    float sun_time[3];              /* --sun-time LAT:DAY:HOUR */
+    unsigned sky_parts;             /* 1: --sky-model given, 2: --sun-time given (3: both, made) */
 } tool_lights;
 /* argv[*a] is one of the light options: parses it (and its value, advancing *a) and returns 1;
    0 when it is not one; 2 on a bad value (message naming the option printed) */

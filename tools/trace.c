@@ -13,7 +13,13 @@
      - analytic lights: directional, point and spot lights by next-event estimation only (delta
        lights, same falloff and spot smoothstep as rad_direct_irradiance), the sky
        (RAD_LIGHT_SKY, colour = exitance E0) as a constant radiance E0 / pi seen by every ray
-       that escapes the scene (camera rays included).
+       that escapes the scene (camera rays included), an environment map
+       (RAD_LIGHT_ENVIRONMENT) as its radiance in the escaping ray's direction times the
+       light's colour.
+   Environment maps also get next-event estimation: one direction per vertex and map drawn
+   from the map's own distribution (rad_environment_sample, the one rad_direct_irradiance
+   uses), combined with the cosine continuation by the power heuristic (an escaping
+   continuation ray then weighs the map's radiance by its share against rad_environment_pdf).
    Estimator: next-event estimation for the area lights (one emitter per vertex, chosen with
    probability proportional to its power pi * area * (Lr + Lg + Lb), a point uniform on it)
    combined with the BSDF (cosine) sample by multiple importance sampling with the power
@@ -63,6 +69,8 @@ typedef struct tool__tracer {
     double *cdf;             /* emitter_count + 1, cdf[0] = 0, cdf[n] = 1 */
     float *select_pdf;       /* per triangle: probability to be chosen (0 for non-emitters) */
     float sky[3];            /* radiance of escaping rays */
+    const rad_light *env[8]; /* environment lights (at most 8) */
+    uint32_t env_count;
     int has_delta;
     tool_image *out;
     volatile int failed;
@@ -171,7 +179,14 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
             return;
         }
         if (hit.triangle == RAD_NONE || hit.triangle >= S->triangle_count) {
+            uint32_t l;
             for (k = 0; k < 3; ++k) L[k] += thr[k] * T->sky[k];
+            for (l = 0; l < T->env_count; ++l) {
+                const rad_light *li = T->env[l];
+                float rgb[3], w = depth > 0 ? tool__mis(prev_pdf, rad_environment_pdf(li->environment, ray.dir)) : 1.0f;
+                rad_environment_radiance(li->environment, ray.dir, rgb);
+                for (k = 0; k < 3; ++k) L[k] += thr[k] * li->color[k] * rgb[k] * w;
+            }
             break;
         }
         tri = hit.triangle;
@@ -223,6 +238,26 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
                 }
             }
         }
+        /* environment maps: one direction from each map's distribution */
+        {
+            uint32_t l;
+            for (l = 0; l < T->env_count; ++l) {
+                const rad_light *li = T->env[l];
+                float dd[3], rgb[3], pe, cs, f;
+                pe = rad_environment_sample(li->environment, tool__rnd(seed, pixel, sample, dim + 6),
+                                            tool__rnd(seed, pixel, sample, dim + 7), dd);
+                if (!(pe > 0.0f)) continue;
+                cs = tool__tdot(dd, n);
+                if (!(cs > 0.0f)) continue;
+                if (!tool__visible(T, p, n, NULL, NULL, dd, ok)) {
+                    if (!*ok) return;
+                    continue;
+                }
+                rad_environment_radiance(li->environment, dd, rgb);
+                f = tool__mis(pe, cs / (float)TOOL__TPI) * cs / ((float)TOOL__TPI * pe);
+                for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * li->color[k] * rgb[k] * f;
+            }
+        }
         /* delta lights (no MIS) */
         if (T->has_delta) {
             uint32_t l;
@@ -272,7 +307,7 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
                         continue;
                     }
                 } else {
-                    continue; /* sky: escaping rays */
+                    continue; /* sky and maps: above and on escaping rays */
                 }
                 /* reflected radiance = albedo / pi * irradiance */
                 for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * w[k] / (float)TOOL__TPI;
@@ -374,6 +409,8 @@ int tool_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_
             for (k = 0; k < 3; ++k) T.sky[k] += li->color[k] / (float)TOOL__TPI;
         } else if (li->type == RAD_LIGHT_DIRECTIONAL || li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
             T.has_delta = 1;
+        } else if (li->type == RAD_LIGHT_ENVIRONMENT && li->environment && T.env_count < 8u) {
+            T.env[T.env_count++] = li;
         } else {
             return RAD_ERROR_INVALID_ARGUMENT;
         }
