@@ -20575,7 +20575,8 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
 #define RAD__BAKER_FLOP_RATE 2e9       /* solver flops per second and thread */
 #define RAD__BAKER_RAY_RATE 5e6        /* shadow rays per second and thread */
 #define RAD__BAKER_VP_KERNEL_RATE 4e7  /* virtual-patch sample pairs per second and thread */
-#define RAD__BAKER_MIX_CHUNK 196608u   /* floats per mix task: a multiple of 12 */
+#define RAD__BAKER_MIX_CHUNK 24576u    /* floats per mix task (96 KiB, a multiple of 12) */
+#define RAD__BAKER_MIX_STREAMS 8u      /* layers read side by side in one pass */
 
 /* The user's progress seen through one stage: fractions of the stage map onto [lo, hi] of
    the whole bake, and a cancel is remembered. */
@@ -20617,33 +20618,40 @@ typedef struct rad__baker_mix_job {
     const uint8_t *active;  /* per group: a scale that is not 0 0 0 */
 } rad__baker_mix_job;
 
-/* One chunk of the mix: the output stays in cache while each layer streams through it once,
-   twelve floats (four RGB triples) per step so the scale pattern lines up with SIMD lanes. */
+/* One chunk of the mix, twelve floats (four RGB triples, so the scale pattern lines up with
+   SIMD lanes) at a time: every active layer is read once and the output written once, the
+   groups added in increasing order (the same bits whatever the chunking). */
 static void rad__baker_mix_task(void *data, uint32_t index)
 {
     const rad__baker_mix_job *J = (const rad__baker_mix_job *)data;
     size_t b = (size_t)index * RAD__BAKER_MIX_CHUNK, e = b + RAD__BAKER_MIX_CHUNK, j;
-    uint32_t g;
-    int first = 1;
+    const float *lay[RAD_BAKER_MAX_GROUPS], *sc[RAD_BAKER_MAX_GROUPS];
+    uint32_t g, g0, na = 0;
     float *o = J->out;
     if (e > J->count3) e = J->count3;
-    for (g = 0; g < J->groups; ++g) {
-        const float *l = J->layers + (size_t)g * J->count3, *s = J->pattern + 12 * (size_t)g;
-        int k;
-        if (!J->active[g]) continue;
-        if (first) {
-            for (j = b; j + 12 <= e; j += 12)
-                for (k = 0; k < 12; ++k) o[j + (size_t)k] = l[j + (size_t)k] * s[k];
-            for (; j < e; ++j) o[j] = l[j] * s[j % 12];
-            first = 0;
-        } else {
-            for (j = b; j + 12 <= e; j += 12)
-                for (k = 0; k < 12; ++k) o[j + (size_t)k] += l[j + (size_t)k] * s[k];
-            for (; j < e; ++j) o[j] += l[j] * s[j % 12];
+    for (g = 0; g < J->groups; ++g)
+        if (J->active[g]) {
+            lay[na] = J->layers + (size_t)g * J->count3;
+            sc[na++] = J->pattern + 12 * (size_t)g;
+        }
+    for (g0 = 0; g0 < na || g0 == 0; g0 += RAD__BAKER_MIX_STREAMS) {
+        uint32_t g1 = g0 + RAD__BAKER_MIX_STREAMS < na ? g0 + RAD__BAKER_MIX_STREAMS : na;
+        for (j = b; j + 12 <= e; j += 12) {
+            float acc[12];
+            int k;
+            for (k = 0; k < 12; ++k) acc[k] = g0 ? o[j + (size_t)k] : 0.0f;
+            for (g = g0; g < g1; ++g) {
+                const float *l = lay[g] + j, *s = sc[g];
+                for (k = 0; k < 12; ++k) acc[k] += l[k] * s[k];
+            }
+            for (k = 0; k < 12; ++k) o[j + (size_t)k] = acc[k];
+        }
+        for (; j < e; ++j) {
+            float acc = g0 ? o[j] : 0.0f;
+            for (g = g0; g < g1; ++g) acc += lay[g][j] * sc[g][j % 12];
+            o[j] = acc;
         }
     }
-    if (first)
-        for (j = b; j < e; ++j) o[j] = 0.0f;
 }
 
 RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
@@ -21204,7 +21212,6 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
     rad__baker b;
     rad_result r;
     uint32_t g;
-    char bb[32];
     memset(&b, 0, sizeof b);
     rad__ctx_init(&b.c, ctx);
     if (!desc || !out) {
@@ -21246,9 +21253,7 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
     }
     if (r == RAD_SUCCESS) r = rad__baker_plan(&b);
     if (r == RAD_SUCCESS) {
-        rad__baker_bytes(bb, sizeof bb, b.R->estimated_bytes);
-        rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: %s (%u groups; estimate %u patches, %s, %.3g s per thread)", b.R->reason,
-                 b.R->group_count, b.R->patch_count, bb, b.R->estimated_seconds);
+        rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: %s; %u light groups", b.R->reason, b.R->group_count);
         r = rad__baker_build(&b);
     }
     if (r == RAD_SUCCESS) r = rad__baker_alloc_outputs(&b);

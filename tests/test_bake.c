@@ -539,13 +539,14 @@ static void bk_test_bad_input(void)
     }
 }
 
-/* the mix kernel against a plain loop over sizes that are not multiples of its steps */
+/* the mix kernel against a plain loop, over sizes that are not multiples of its steps and
+   more groups than it reads in one pass */
 static void bk_test_mix_kernel(void)
 {
     const size_t n = 3 * 70001; /* past one task chunk, a tail of 12-float steps */
-    const uint32_t G = 5;
+    const uint32_t G = 11;
     float *layers = (float *)malloc(sizeof(float) * n * G), *out = (float *)malloc(sizeof(float) * n);
-    float s[15];
+    float s[33];
     size_t i;
     uint32_t g;
     int bad = 0;
@@ -556,7 +557,7 @@ static void bk_test_mix_kernel(void)
         return;
     }
     for (i = 0; i < n * G; ++i) layers[i] = (float)((i * 2654435761u) % 1000u) * 0.001f;
-    for (g = 0; g < 15; ++g) s[g] = 0.1f * (float)(g + 1);
+    for (g = 0; g < 33; ++g) s[g] = 0.1f * (float)(g + 1);
     s[6] = s[7] = s[8] = 0.0f; /* group 2 off */
     CHECK_OK(rad_baker_mix_layers(layers, G, n, s, out, NULL));
     for (i = 0; i < n; ++i) {
