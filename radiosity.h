@@ -2951,9 +2951,9 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    the same Jacobi bounces on rad_vp_system, rad_vp_gather_mesh, rad_lightmap_gather_vp and
    rad_probes_create_vp. AUTO takes CLASSIC when its estimate fits both max_memory and
    max_seconds, else VIRTUAL PATCHES. ESTIMATE: classic 4 N^2 bytes of F plus 300 per patch,
-   time N^2 ff_samples / 1.7e6 s (the measured form-factor rate of one thread) plus the bounces
+   time N^2 ff_samples / 3e6 s (the measured form-factor rate of one thread) plus the bounces
    and the lightmap gather; virtual patches (counted first by rad_vp_count) 4 N^2 plus 100
-   bytes per sample and 48 N per task, time M^2 / 4e7 s for M samples; both add the output
+   bytes per sample and 48 N per task, time M^2 / 1.5e8 s for M samples; both add the output
    layers. Rough: within a factor of a few. The estimate and the choice are logged
    (RAD_LOG_INFO) before the work and returned in the result (method, reason, numbers).
    SOURCE. Direct light is each group's source (RAD_SOURCE_DIRECT): the lights of the group
@@ -3030,7 +3030,7 @@ typedef struct rad_baker_options {
    rad_baker_mix (which rewrites vertex, lightmap and probes). */
 typedef struct rad_baker_result {
     rad_baker_method method;         /* CLASSIC or VIRTUAL_PATCHES: what AUTO chose */
-    char reason[384];               /* why, in a sentence with the numbers */
+    char reason[512];               /* why, in a sentence with the numbers */
     uint32_t patch_count;           /* patches or virtual patches */
     uint32_t vp_resolution;         /* virtual patches: the resolution built (0 for classic) */
     double estimated_bytes;         /* the estimate logged before the work */
@@ -20571,10 +20571,10 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
 /* >>bake: the engine tier (rad_baker_run, light layers, the mix)                           */
 /* ======================================================================================== */
 
-#define RAD__BAKER_FF_RATE 1.7e6       /* form-factor sample pairs per second and thread (measured) */
+#define RAD__BAKER_FF_RATE 3e6         /* form-factor sample pairs per second and thread (measured) */
 #define RAD__BAKER_FLOP_RATE 2e9       /* solver flops per second and thread */
 #define RAD__BAKER_RAY_RATE 5e6        /* shadow rays per second and thread */
-#define RAD__BAKER_VP_KERNEL_RATE 4e7  /* virtual-patch sample pairs per second and thread */
+#define RAD__BAKER_VP_KERNEL_RATE 1.5e8 /* virtual-patch sample pairs per second and thread (measured) */
 #define RAD__BAKER_MIX_CHUNK 24576u    /* floats per mix task (96 KiB, a multiple of 12) */
 #define RAD__BAKER_MIX_STREAMS 8u      /* layers read side by side in one pass */
 
@@ -20734,6 +20734,15 @@ static void rad__baker_bytes(char *buf, size_t len, double b)
     else snprintf(buf, len, "%.1f GiB", b / 1073741824.0);
 }
 
+static void rad__baker_time(char *buf, size_t len, double s)
+{
+    if (s < 120.0) snprintf(buf, len, "%.1f s", s);
+    else if (s < 7200.0) snprintf(buf, len, "%.0f minutes", s / 60.0);
+    else if (s < 172800.0) snprintf(buf, len, "%.1f hours", s / 3600.0);
+    else if (s < 1e9) snprintf(buf, len, "%.0f days", s / 86400.0);
+    else snprintf(buf, len, "ages");
+}
+
 /* Everything one bake holds while it runs; freed in one place. */
 typedef struct rad__baker {
     rad__ctx c;
@@ -20882,7 +20891,7 @@ static rad_result rad__baker_plan(rad__baker *b)
     double budget = b->o.max_memory, seconds_budget = b->o.max_seconds, N, bytes = 0.0, secs = 0.0, texels;
     double samples = (double)b->o.ff_samples;
     uint32_t probes_guess = b->d->probe_positions ? b->d->probe_count : 729u;
-    char bb[32], lb[32], why[160];
+    char bb[32], lb[32], tb[32], why[256];
     rad_result r;
     int classic_fits = 0;
     texels = (b->outputs & RAD_BAKER_LIGHTMAP) ? (double)R->lightmap_width * R->lightmap_height * b->o.lightmap_samples : 0.0;
@@ -20904,15 +20913,16 @@ static rad_result rad__baker_plan(rad__baker *b)
         secs = N * N * samples / RAD__BAKER_FF_RATE + 6.0 * N * N * b->o.bounces * R->group_count / RAD__BAKER_FLOP_RATE +
                texels * N * 4.0 / RAD__BAKER_RAY_RATE * (texels * N > 5e7 ? 5e7 / (texels * N) : 1.0) * R->group_count;
         classic_fits = bytes <= budget && secs <= seconds_budget;
+        rad__baker_time(tb, sizeof tb, secs);
         rad__baker_bytes(bb, sizeof bb, bytes);
         rad__baker_bytes(lb, sizeof lb, budget);
         if (b->o.method == RAD_BAKER_CLASSIC && bytes > budget) {
             rad_patches_destroy(b->patches);
             b->patches = NULL;
             rad__log(&b->c, RAD_LOG_ERROR,
-                     "rad_baker_run: the classic bake of %.3g patches needs about %s, over the budget of %s (max_memory); "
+                     "rad_baker_run: the classic bake of %lu patches needs about %s, over the budget of %s (max_memory); "
                      "use RAD_BAKER_AUTO or RAD_BAKER_VIRTUAL_PATCHES, or a larger budget",
-                     N, bb, lb);
+                     (unsigned long)N, bb, lb);
             return RAD_ERROR_OUT_OF_MEMORY;
         }
         if (b->o.method == RAD_BAKER_CLASSIC || classic_fits) {
@@ -20921,13 +20931,14 @@ static rad_result rad__baker_plan(rad__baker *b)
             R->estimated_bytes = bytes;
             R->estimated_seconds = secs;
             snprintf(R->reason, sizeof R->reason,
-                     "classic: %u triangles, %u patches; dense F and outputs about %s and %.3g s per thread, %s the budget of %s "
-                     "and %.3g s",
-                     S->triangle_count, R->patch_count, bb, secs, classic_fits ? "within" : "over (forced)", lb, seconds_budget);
+                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s per thread, %s the budget of %s "
+                     "and %lu s",
+                     S->triangle_count, R->patch_count, bb, tb, classic_fits ? "within" : "over (forced)", lb,
+                     (unsigned long)(seconds_budget < 1e9 ? seconds_budget : 1e9));
             return RAD_SUCCESS;
         }
-        snprintf(why, sizeof why, "classic would need %.3g patches, about %s and %.3g s per thread (budget %s, %.3g s); ", N, bb,
-                 secs, lb, seconds_budget);
+        snprintf(why, sizeof why, "classic would need %lu patches, about %s and %s per thread (budget %s, %lu s); ",
+                 (unsigned long)N, bb, tb, lb, (unsigned long)(seconds_budget < 1e9 ? seconds_budget : 1e9));
         rad_patches_destroy(b->patches);
         b->patches = NULL;
     }
@@ -20965,9 +20976,9 @@ static rad_result rad__baker_plan(rad__baker *b)
         R->estimated_seconds = secs;
         rad__baker_bytes(bb, sizeof bb, bytes);
         rad__baker_bytes(lb, sizeof lb, budget);
-        snprintf(R->reason, sizeof R->reason, "virtual patches: %s%s; resolution %u gives %u patches (%u samples), about %s and %.3g s per thread",
-                 b->o.method == RAD_BAKER_VIRTUAL_PATCHES ? "asked for" : why, b->o.method == RAD_BAKER_VIRTUAL_PATCHES ? "" : "too large",
-                 res, cnt.patches, cnt.samples, bb, secs);
+        rad__baker_time(tb, sizeof tb, secs);
+        snprintf(R->reason, sizeof R->reason, "virtual patches: %sresolution %u gives %u patches (%u samples), about %s and %s per thread",
+                 b->o.method == RAD_BAKER_VIRTUAL_PATCHES ? "(asked for) " : why, res, cnt.patches, cnt.samples, bb, tb);
     }
     return RAD_SUCCESS;
 }
@@ -21253,7 +21264,7 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
     }
     if (r == RAD_SUCCESS) r = rad__baker_plan(&b);
     if (r == RAD_SUCCESS) {
-        rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: %s; %u light groups", b.R->reason, b.R->group_count);
+        rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: %s; light groups: %u", b.R->reason, b.R->group_count);
         r = rad__baker_build(&b);
     }
     if (r == RAD_SUCCESS) r = rad__baker_alloc_outputs(&b);

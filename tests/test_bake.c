@@ -575,6 +575,54 @@ static void bk_test_mix_kernel(void)
     free(out);
 }
 
+/* a parallel_for that runs the tasks in reverse order on the calling thread */
+static void bk_reverse_for(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+    uint32_t i;
+    (void)user;
+    for (i = count; i-- > 0;) fn(data, i);
+}
+
+/* another task split and order give the same bits (classic with a lightmap and probes, and
+   virtual patches) */
+static void bk_test_deterministic(void)
+{
+    lm_soup room, wall, lamp;
+    rad_mesh_desc meshes[3];
+    rad_material mats[2];
+    rad_baker_desc d;
+    rad_baker_options o;
+    rad_baker_result *A = NULL, *B = NULL;
+    rad_context ctx;
+    int pass;
+    memset(&d, 0, sizeof d);
+    fx_two_rooms(&room, &wall, &lamp, meshes, &d.scene, mats);
+    d.outputs = RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES;
+    d.lightmap_width = 16;
+    d.probe_spacing = 0.5f;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.parallel_for = bk_reverse_for;
+    ctx.task_count = 7;
+    for (pass = 0; pass < 2; ++pass) {
+        bk_options(&o, pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC);
+        o.patches = 80;
+        o.vp_resolution = 6;
+        o.lightmap_samples = 1;
+        CHECK_OK(rad_baker_run(&d, &o, NULL, &A));
+        CHECK_OK(rad_baker_run(&d, &o, &ctx, &B));
+        if (A && B) {
+            CHECK(A->method == B->method && A->patch_count == B->patch_count && A->probe_count == B->probe_count);
+            CHECK(A->probe_count > 8 && A->probe_grid[0] > 1);
+            CHECK(bk_same_bits(A->vertex_layers, B->vertex_layers, 3 * (size_t)A->vertex_count));
+            CHECK(bk_same_bits(A->lightmap_layers, B->lightmap_layers, 3 * (size_t)A->lightmap_width * A->lightmap_height));
+            CHECK(bk_same_bits(A->probe_layers, B->probe_layers, 27 * (size_t)A->probe_count));
+        }
+        rad_baker_result_destroy(A);
+        rad_baker_result_destroy(B);
+        A = B = NULL;
+    }
+}
+
 static const rad_test_case tests_bake[] = {
     { "bake_classic_lower_level", bk_test_classic_lower_level },
     { "bake_auto_vp_lower_level", bk_test_auto_vp_lower_level },
@@ -584,6 +632,7 @@ static const rad_test_case tests_bake[] = {
     { "bake_zeroed_options", bk_test_zeroed_options },
     { "bake_bad_input", bk_test_bad_input },
     { "bake_mix_kernel", bk_test_mix_kernel },
+    { "bake_deterministic", bk_test_deterministic },
     { NULL, NULL }
 };
 
