@@ -72,7 +72,7 @@ gallery: $(BUILD)/gallery
 walk: $(BUILD)/walk
 
 # the teaching examples (examples/learn_*.c): each prints a small table
-LEARN = $(BUILD)/learn_formfactors $(BUILD)/learn_solvers $(BUILD)/learn_stochastic
+LEARN = $(BUILD)/learn_formfactors $(BUILD)/learn_solvers $(BUILD)/learn_stochastic $(BUILD)/learn_vertex_light
 learn: $(LEARN)
 $(BUILD)/learn_%: examples/learn_%.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. $< -o $@ -lm

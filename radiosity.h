@@ -3123,6 +3123,155 @@ RAD_API void rad_sh_band4_basis(const float d[3], float out[9]);
 RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band4[27], const float n[3], float out_rgb[3]);
 
 /* ======================================================================================== */
+/* >>api_bake: the engine tier: meshes and lights in, baked light out                       */
+/* ======================================================================================== */
+
+/* rad_baker_run (docs/methods/bake.md) is the bake step of an engine in one call, built on the
+   calls of the sections above: it validates the meshes, picks a method for the scene's size
+   and the budget, estimates and logs the cost before the work, solves, and returns the
+   bounced light per vertex, per lightmap texel and per probe, one layer per light group.
+   METHOD (rad_baker_options.method, RAD_BAKER_AUTO by default). CLASSIC: rad_patches_create
+   (about 'patches' patches, at least one per triangle), dense form factors
+   (rad_form_factors_dense, 'ff_samples' per pair), Jacobi bounces (rad_solve_jacobi), the
+   per-vertex irradiance without dark halos (rad_patches_vertex_irradiance with the row sums
+   of F) gathered per mesh (rad_patches_gather_mesh), the lightmap by rad_lightmap_gather
+   (exact, or the hemisphere gather when valid samples x patches passes 5e7) and probes by
+   rad_probes_create. VIRTUAL PATCHES: axis-aligned virtual patches (rad_vp_create, dense F)
+   at the finest resolution from vp_resolution down whose estimate fits the memory budget,
+   the same Jacobi bounces on rad_vp_system, rad_vp_gather_mesh, rad_lightmap_gather_vp and
+   rad_probes_create_vp. AUTO takes CLASSIC when its estimate fits both max_memory and
+   max_seconds, else VIRTUAL PATCHES. ESTIMATE: classic 4 N^2 bytes of F plus 300 per patch,
+   time N^2 ff_samples / 3e6 s (the measured form-factor rate of one thread) plus the bounces
+   and the lightmap gather; virtual patches (counted first by rad_vp_count) 4 N^2 plus 100
+   bytes per sample and 48 N per task, time M^2 / 1.5e8 s for M samples; both add the output
+   layers. Rough: within a factor of a few. The estimate and the choice are logged
+   (RAD_LOG_INFO) before the work and returned in the result (method, reason, numbers).
+   SOURCE. Direct light is each group's source (RAD_SOURCE_DIRECT): the lights of the group
+   and the emissive triangles whose material is in the group (rad_baker_desc.material_groups),
+   reflected once (E = rho D) and then bounced. Emission itself and direct light are NOT in
+   the outputs: an engine draws those itself (its own lights and shadows), and adds these.
+   OUTPUTS. All irradiance in W m^-2, RGB interleaved; a Lambertian surface of albedo rho shows
+   radiance rho H / pi. Vertices (RAD_BAKER_VERTEX): 3 floats per vertex of each mesh in its
+   own vertex order, mesh m at [3 vertex_first[m], 3 vertex_first[m + 1]). Lightmap
+   (RAD_BAKER_LIGHTMAP): width x height texels over the meshes' lightmap_uvs, 3 floats each, row
+   0 at v = 0 (>>api_lightmap TEXELS), dilated into the gutters. Probes (RAD_BAKER_PROBES): 27
+   floats per probe (SH L2 irradiance, >>api_probes WHAT IS STORED) at the given points or on
+   a grid over the scene bounds; sample them with rad_sh9_irradiance.
+   LIGHT LAYERS. Light adds: the system is linear in its source, so each group g is solved on
+   its own and kept as a layer (vertex_layers, lightmap_layers, probe_layers: group_count
+   planes, plane g at g times the output's float count, each laid out as the output).
+   rad_baker_mix writes the outputs as sum_g scale_g o layer_g for any RGB scale per group (a
+   dimmer, a colour, 0 to switch a group off), at memory speed, without a new bake; a group's
+   layer equals the layer of a bake with only that group's lights and emitters, bit for bit.
+   PROGRESS AND CANCEL. ctx->progress sees one fraction over the whole bake (build about 60%,
+   then the groups); a non-zero return stops the bake with RAD_ERROR_CANCELLED and frees
+   everything. Deterministic: the same bits whatever the thread count. */
+
+#define RAD_BAKER_MAX_GROUPS 64u /* light groups at most */
+
+typedef enum rad_baker_method {
+    RAD_BAKER_AUTO = 0,             /* the choice above */
+    RAD_BAKER_CLASSIC = 1,          /* patches with a dense form-factor matrix */
+    RAD_BAKER_VIRTUAL_PATCHES = 2   /* axis-aligned virtual patches */
+} rad_baker_method;
+
+typedef enum rad_baker_outputs {
+    RAD_BAKER_VERTEX = 1,           /* bounced irradiance per mesh vertex */
+    RAD_BAKER_LIGHTMAP = 2,         /* an RGB irradiance lightmap over the lightmap_uvs */
+    RAD_BAKER_PROBES = 4            /* SH L2 irradiance probes */
+} rad_baker_outputs;
+
+/* A light and the group it belongs to (group < RAD_BAKER_MAX_GROUPS). */
+typedef struct rad_baker_light {
+    rad_light light;
+    uint32_t group;
+} rad_baker_light;
+
+/* What to bake. Everything is borrowed for the call. */
+typedef struct rad_baker_desc {
+    rad_scene_desc scene;           /* meshes (with lightmap_uvs for a lightmap) and materials */
+    const rad_baker_light *lights;   /* light_count lights (may be 0 when materials emit) */
+    uint32_t light_count;
+    const uint32_t *material_groups;/* per material: the group of its emission (NULL: 0) */
+    uint32_t group_count;           /* layers (0: one more than the largest group named) */
+    uint32_t outputs;               /* rad_baker_outputs bits (0: RAD_BAKER_VERTEX) */
+    uint32_t lightmap_width;        /* texels (0: 256) */
+    uint32_t lightmap_height;       /* texels (0: the width) */
+    const float *probe_positions;   /* probe_count points, 3 floats each; NULL: a grid */
+    uint32_t probe_count;
+    float probe_spacing;            /* the grid's spacing (0: the largest extent / 8) */
+} rad_baker_desc;
+
+/* How to bake. A zeroed struct means every default. */
+typedef struct rad_baker_options {
+    rad_baker_method method;         /* RAD_BAKER_AUTO (0) */
+    double max_memory;              /* bytes the bake may hold (0: 1 GiB) */
+    double max_seconds;             /* time AUTO allows the classic method (0: 600) */
+    uint32_t patches;               /* classic: target patch count (0: 512) */
+    uint32_t vp_resolution;         /* virtual patches: the finest resolution tried (0: 16) */
+    uint32_t bounces;               /* Jacobi bounces (0: 16) */
+    uint32_t ff_samples;            /* form-factor samples per patch pair (0: 16) */
+    uint32_t light_samples;         /* shadow rays per area light and point (0: 16) */
+    uint32_t lightmap_samples;      /* sub-points per texel (0: 4) */
+    uint32_t seed;                  /* decorrelates the sampling (any value) */
+} rad_baker_options;
+
+/* What rad_baker_run returns; destroy with rad_baker_result_destroy. Read-only except through
+   rad_baker_mix (which rewrites vertex, lightmap and probes). */
+typedef struct rad_baker_result {
+    rad_baker_method method;         /* CLASSIC or VIRTUAL_PATCHES: what AUTO chose */
+    char reason[512];               /* why, in a sentence with the numbers */
+    uint32_t patch_count;           /* patches or virtual patches */
+    uint32_t vp_resolution;         /* virtual patches: the resolution built (0 for classic) */
+    double estimated_bytes;         /* the estimate logged before the work */
+    double estimated_seconds;       /* per thread */
+    uint32_t group_count;
+    uint32_t mesh_count;
+    uint32_t *vertex_first;         /* mesh_count + 1 (RAD_BAKER_VERTEX), else NULL */
+    uint32_t vertex_count;          /* sum of the meshes' vertex counts */
+    float *vertex;                  /* 3 per vertex: the mix (all scales 1 after rad_baker_run) */
+    float *vertex_layers;           /* group_count planes of 3 * vertex_count */
+    uint32_t lightmap_width, lightmap_height;
+    float *lightmap;                /* 3 per texel */
+    float *lightmap_layers;         /* group_count planes of 3 * width * height */
+    uint8_t *lightmap_flags;        /* per texel: RAD_TEXEL_* of >>api_lightmap */
+    uint32_t probe_count;
+    float *probe_positions;         /* 3 per probe (moved out of geometry where needed) */
+    uint8_t *probe_states;          /* rad_probe_state per probe */
+    uint32_t probe_grid[3];         /* probes per axis of the grid (0 0 0 for given points) */
+    float probe_origin[3];          /* the grid's first probe */
+    float probe_spacing;
+    float *probes;                  /* 27 per probe */
+    float *probe_layers;            /* group_count planes of 27 * probe_count */
+    rad_allocator allocator;        /* private */
+} rad_baker_result;
+
+/* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
+   result. Errors (the logger names the cause): INVALID_ARGUMENT (NULL, an unknown method or
+   output bit, a group >= RAD_BAKER_MAX_GROUPS or >= group_count, nothing that emits: no light
+   and no emissive material, a lightmap without any lightmap_uvs, a negative or non-finite
+   budget), the scene's errors (rad_scene_create: a bad mesh, material or value), the lights'
+   (rad_direct_irradiance), OUT_OF_MEMORY (also: the budget is too small for the smallest bake
+   of the method, or an allocation failed), CANCELLED, RAYCAST_FAILED. Thread safety:
+   reentrant; parallel through ctx->parallel_for. Cost: see ESTIMATE above. */
+RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_options *options, const rad_context *ctx,
+                            rad_baker_result **out);
+RAD_API void rad_baker_result_destroy(rad_baker_result *result);
+
+/* Rewrites the result's outputs (vertex, lightmap, probes; those it has) as
+   sum_g group_rgb[3g + c] layer_g per channel c. group_rgb: 3 * group_count floats (NULL: all
+   1, the plain sum), finite. Errors: INVALID_ARGUMENT (NULL result), NON_FINITE (a scale).
+   Cost: one pass over the layers whose scale is not 0 0 0, parallel through ctx. */
+RAD_API rad_result rad_baker_mix(rad_baker_result *result, const float *group_rgb, const rad_context *ctx);
+
+/* The kernel of rad_baker_mix on any planar layers: out[i] = sum_g group_rgb[3g + i mod 3]
+   layers[g count3 + i] for i < count3, the groups with scale 0 0 0 skipped (out is 0 when
+   every one is). count3: floats per layer, a multiple of 3. Errors: INVALID_ARGUMENT (NULL,
+   count3 not a multiple of 3, group_count 0), NON_FINITE (a scale). */
+RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
+                                       float *out, const rad_context *ctx);
+
+/* ======================================================================================== */
 /* >>api_shading: lighting models and BRDFs                                                 */
 /* ======================================================================================== */
 
@@ -21479,6 +21628,724 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
     }
     if (spacing) *spacing = pr->spacing;
     return 1;
+}
+
+/* ======================================================================================== */
+/* >>bake: the engine tier (rad_baker_run, light layers, the mix)                           */
+/* ======================================================================================== */
+
+#define RAD__BAKER_FF_RATE 3e6         /* form-factor sample pairs per second and thread (measured) */
+#define RAD__BAKER_FLOP_RATE 2e9       /* solver flops per second and thread */
+#define RAD__BAKER_RAY_RATE 5e6        /* shadow rays per second and thread */
+#define RAD__BAKER_VP_KERNEL_RATE 1.5e8 /* virtual-patch sample pairs per second and thread (measured) */
+#define RAD__BAKER_MIX_CHUNK 24576u    /* floats per mix task (96 KiB, a multiple of 12) */
+#define RAD__BAKER_MIX_STREAMS 8u      /* layers read side by side in one pass */
+
+/* The user's progress seen through one stage: fractions of the stage map onto [lo, hi] of
+   the whole bake, and a cancel is remembered. */
+typedef struct rad__baker_progress {
+    int (*fn)(void *user, float fraction);
+    void *user;
+    float lo, hi, last;            /* last: what the user saw, so the fraction never goes back */
+    int cancelled;
+} rad__baker_progress;
+
+static int rad__baker_progress_fn(void *user, float fraction)
+{
+    rad__baker_progress *p = (rad__baker_progress *)user;
+    float f;
+    if (!p->fn || p->cancelled) return p->cancelled;
+    if (!(fraction >= 0.0f)) fraction = 0.0f;
+    if (fraction > 1.0f) fraction = 1.0f;
+    f = p->lo + (p->hi - p->lo) * fraction;
+    if (f < p->last) f = p->last;
+    p->last = f;
+    p->cancelled = p->fn(p->user, f) != 0;
+    return p->cancelled;
+}
+
+/* Moves to stage [lo, hi] and reports its start; non-zero when the user cancels. */
+static int rad__baker_stage(rad__baker_progress *p, float lo, float hi)
+{
+    p->lo = lo;
+    p->hi = hi;
+    return rad__baker_progress_fn(p, 0.0f);
+}
+
+typedef struct rad__baker_mix_job {
+    const float *layers;
+    float *out;
+    size_t count3;
+    uint32_t groups;
+    const float *pattern;   /* 12 floats per group: its RGB scale repeated four times */
+    const uint8_t *active;  /* per group: a scale that is not 0 0 0 */
+} rad__baker_mix_job;
+
+/* One chunk of the mix, twelve floats (four RGB triples, so the scale pattern lines up with
+   SIMD lanes) at a time: every active layer is read once and the output written once, the
+   groups added in increasing order (the same bits whatever the chunking). */
+static void rad__baker_mix_task(void *data, uint32_t index)
+{
+    const rad__baker_mix_job *J = (const rad__baker_mix_job *)data;
+    size_t b = (size_t)index * RAD__BAKER_MIX_CHUNK, e = b + RAD__BAKER_MIX_CHUNK, j;
+    const float *lay[RAD_BAKER_MAX_GROUPS], *sc[RAD_BAKER_MAX_GROUPS];
+    uint32_t g, g0, na = 0;
+    float *o = J->out;
+    if (e > J->count3) e = J->count3;
+    for (g = 0; g < J->groups; ++g)
+        if (J->active[g]) {
+            lay[na] = J->layers + (size_t)g * J->count3;
+            sc[na++] = J->pattern + 12 * (size_t)g;
+        }
+    for (g0 = 0; g0 < na || g0 == 0; g0 += RAD__BAKER_MIX_STREAMS) {
+        uint32_t g1 = g0 + RAD__BAKER_MIX_STREAMS < na ? g0 + RAD__BAKER_MIX_STREAMS : na;
+        for (j = b; j + 12 <= e; j += 12) {
+            float acc[12];
+            int k;
+            for (k = 0; k < 12; ++k) acc[k] = g0 ? o[j + (size_t)k] : 0.0f;
+            for (g = g0; g < g1; ++g) {
+                const float *l = lay[g] + j, *s = sc[g];
+                for (k = 0; k < 12; ++k) acc[k] += l[k] * s[k];
+            }
+            for (k = 0; k < 12; ++k) o[j + (size_t)k] = acc[k];
+        }
+        for (; j < e; ++j) {
+            float acc = g0 ? o[j] : 0.0f;
+            for (g = g0; g < g1; ++g) acc += lay[g][j] * sc[g][j % 12];
+            o[j] = acc;
+        }
+    }
+}
+
+RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
+                                        float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__baker_mix_job J;
+    float pattern[12 * RAD_BAKER_MAX_GROUPS];
+    uint8_t active[RAD_BAKER_MAX_GROUPS];
+    size_t tasks;
+    uint32_t g;
+    int k;
+    rad__ctx_init(&c, ctx);
+    if (!layers || !out || group_count == 0 || group_count > RAD_BAKER_MAX_GROUPS || count3 % 3u) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix_layers: NULL layers or out, %u groups (1 to %u), or %lu floats (not RGB)",
+                 group_count, RAD_BAKER_MAX_GROUPS, (unsigned long)count3);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (g = 0; g < group_count; ++g) {
+        active[g] = 0;
+        for (k = 0; k < 12; ++k) {
+            float s = group_rgb ? group_rgb[3 * g + (uint32_t)(k % 3)] : 1.0f;
+            if (!rad__finite(s)) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix: the scale of group %u is not finite", g);
+                return RAD_ERROR_NON_FINITE;
+            }
+            pattern[12 * g + (uint32_t)k] = s;
+            active[g] |= s != 0.0f;
+        }
+    }
+    if (count3 == 0) return RAD_SUCCESS;
+    J.layers = layers;
+    J.out = out;
+    J.count3 = count3;
+    J.groups = group_count;
+    J.pattern = pattern;
+    J.active = active;
+    tasks = (count3 + RAD__BAKER_MIX_CHUNK - 1) / RAD__BAKER_MIX_CHUNK;
+    if (tasks > 0xFFFFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    if (tasks == 1) rad__baker_mix_task(&J, 0);
+    else c.parallel_for(c.parallel_user, (uint32_t)tasks, rad__baker_mix_task, &J);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_mix(rad_baker_result *R, const float *group_rgb, const rad_context *ctx)
+{
+    rad_result r = RAD_SUCCESS;
+    if (!R) return RAD_ERROR_INVALID_ARGUMENT;
+    if (R->vertex_layers)
+        r = rad_baker_mix_layers(R->vertex_layers, R->group_count, 3 * (size_t)R->vertex_count, group_rgb, R->vertex, ctx);
+    if (r == RAD_SUCCESS && R->lightmap_layers)
+        r = rad_baker_mix_layers(R->lightmap_layers, R->group_count, 3 * (size_t)R->lightmap_width * R->lightmap_height,
+                                 group_rgb, R->lightmap, ctx);
+    if (r == RAD_SUCCESS && R->probe_layers)
+        r = rad_baker_mix_layers(R->probe_layers, R->group_count, 27 * (size_t)R->probe_count, group_rgb, R->probes, ctx);
+    return r;
+}
+
+RAD_API void rad_baker_result_destroy(rad_baker_result *R)
+{
+    rad_allocator a;
+    if (!R) return;
+    a = R->allocator;
+    rad__free(&a, R->vertex_first);
+    rad__free(&a, R->vertex);
+    rad__free(&a, R->vertex_layers);
+    rad__free(&a, R->lightmap);
+    rad__free(&a, R->lightmap_layers);
+    rad__free(&a, R->lightmap_flags);
+    rad__free(&a, R->probe_positions);
+    rad__free(&a, R->probe_states);
+    rad__free(&a, R->probes);
+    rad__free(&a, R->probe_layers);
+    rad__free(&a, R);
+}
+
+static void rad__baker_bytes(char *buf, size_t len, double b)
+{
+    if (b < 1073741824.0) snprintf(buf, len, "%.1f MiB", b / 1048576.0);
+    else snprintf(buf, len, "%.1f GiB", b / 1073741824.0);
+}
+
+static void rad__baker_time(char *buf, size_t len, double s)
+{
+    if (s < 120.0) snprintf(buf, len, "%.1f s", s);
+    else if (s < 7200.0) snprintf(buf, len, "%.0f minutes", s / 60.0);
+    else if (s < 172800.0) snprintf(buf, len, "%.1f hours", s / 3600.0);
+    else if (s < 1e9) snprintf(buf, len, "%.0f days", s / 86400.0);
+    else snprintf(buf, len, "ages");
+}
+
+/* Everything one bake holds while it runs; freed in one place. */
+typedef struct rad__baker {
+    rad__ctx c;
+    rad_context sub;               /* the caller's context with the staged progress */
+    rad__baker_progress prog;
+    const rad_baker_desc *d;
+    rad_baker_options o;
+    rad_baker_result *R;
+    rad_scene *scene;
+    rad_bvh *bvh;
+    rad_raycaster rc;
+    rad_patches *patches;
+    rad_form_factors *ff;
+    rad_virtual_patches *vp;
+    rad_lightmap *lm;
+    rad_probes *probes;
+    rad_material *masked;          /* the materials with only one group's emission */
+    rad_light *lights;             /* one group's lights */
+    float *row_sums;               /* classic: S, the row sums of F */
+    float *work;                   /* D, E, L, B, H (3N each) and the vertex values */
+    uint8_t *group_emits;          /* per group: some emissive material is in it */
+    uint32_t emissive_groups;
+    size_t outputs_bytes;
+    uint32_t outputs;              /* rad_baker_desc.outputs, 0 made RAD_BAKER_VERTEX */
+} rad__baker;
+
+static void rad__baker_free(rad__baker *b)
+{
+    const rad_allocator *a = &b->c.allocator;
+    rad_probes_destroy(b->probes);
+    rad_lightmap_destroy(b->lm);
+    rad_vp_destroy(b->vp);
+    rad_form_factors_destroy(b->ff);
+    rad_patches_destroy(b->patches);
+    rad_bvh_destroy(b->bvh);
+    rad_scene_destroy(b->scene);
+    rad__free(a, b->masked);
+    rad__free(a, b->lights);
+    rad__free(a, b->row_sums);
+    rad__free(a, b->work);
+    rad__free(a, b->group_emits);
+}
+
+static int rad__baker_emits(const rad_material *m)
+{
+    return m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f;
+}
+
+/* The checks that need nothing built: groups, outputs, budget, something that emits. */
+static rad_result rad__baker_check(rad__baker *b)
+{
+    const rad_baker_desc *d = b->d;
+    uint32_t i, groups = 0, emitters = 0, lightmapped = 0;
+    if (b->o.method > RAD_BAKER_VIRTUAL_PATCHES) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown method %d", (int)b->o.method);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(b->o.max_memory >= 0.0 && b->o.max_memory < 1e30) || !(b->o.max_seconds >= 0.0 && b->o.max_seconds < 1e30)) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: max_memory and max_seconds must be finite and >= 0");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (d->outputs & ~(uint32_t)(RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES)) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown output bits 0x%x", d->outputs);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (d->light_count && !d->lights) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: light_count %u with lights NULL", d->light_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!d->scene.meshes || d->scene.mesh_count == 0 || (d->scene.material_count && !d->scene.materials)) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: the scene has no meshes (or material_count without materials)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (d->group_count > RAD_BAKER_MAX_GROUPS) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: group_count %u is above RAD_BAKER_MAX_GROUPS (%u)", d->group_count,
+                 RAD_BAKER_MAX_GROUPS);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (i = 0; i < d->light_count; ++i) {
+        uint32_t g = d->lights[i].group;
+        if (g >= RAD_BAKER_MAX_GROUPS || (d->group_count && g >= d->group_count)) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: light %u is in group %u, beyond the %u groups", i, g,
+                     d->group_count ? d->group_count : RAD_BAKER_MAX_GROUPS);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (g + 1 > groups) groups = g + 1;
+    }
+    for (i = 0; i < d->scene.material_count; ++i) {
+        uint32_t g = d->material_groups ? d->material_groups[i] : 0u;
+        if (!rad__baker_emits(&d->scene.materials[i])) continue;
+        ++emitters;
+        if (g >= RAD_BAKER_MAX_GROUPS || (d->group_count && g >= d->group_count)) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: emissive material %u is in group %u, beyond the %u groups", i, g,
+                     d->group_count ? d->group_count : RAD_BAKER_MAX_GROUPS);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (g + 1 > groups) groups = g + 1;
+    }
+    if (d->light_count == 0 && emitters == 0) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: nothing emits light (no lights and no material with emission > 0)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (i = 0; i < d->scene.mesh_count; ++i) lightmapped += d->scene.meshes[i].lightmap_uvs != NULL;
+    if ((b->outputs & RAD_BAKER_LIGHTMAP) && !lightmapped) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: a lightmap was asked for but no mesh has lightmap_uvs");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((b->outputs & RAD_BAKER_PROBES) && d->probe_positions == NULL && d->probe_count) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: probe_count %u with probe_positions NULL", d->probe_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(d->probe_spacing >= 0.0f) || !rad__finite(d->probe_spacing)) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: probe_spacing must be finite and >= 0");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    b->R->group_count = d->group_count ? d->group_count : groups;
+    b->group_emits = (uint8_t *)rad__alloc_zero(&b->c.allocator, RAD_BAKER_MAX_GROUPS);
+    if (!b->group_emits) return RAD_ERROR_OUT_OF_MEMORY;
+    for (i = 0; i < d->scene.material_count; ++i)
+        if (rad__baker_emits(&d->scene.materials[i])) {
+            uint32_t g = d->material_groups ? d->material_groups[i] : 0u;
+            b->emissive_groups += !b->group_emits[g];
+            b->group_emits[g] = 1;
+        }
+    return RAD_SUCCESS;
+}
+
+/* Bytes of the layers and mixed outputs, once the sizes are known. */
+static size_t rad__baker_output_bytes(const rad__baker *b, uint32_t probes)
+{
+    const rad_baker_desc *d = b->d;
+    size_t per = 0;
+    uint32_t m;
+    if (b->outputs & RAD_BAKER_VERTEX)
+        for (m = 0; m < d->scene.mesh_count; ++m) per += 12u * (size_t)d->scene.meshes[m].vertex_count;
+    if (b->outputs & RAD_BAKER_LIGHTMAP) per += 12u * (size_t)b->R->lightmap_width * b->R->lightmap_height;
+    if (b->outputs & RAD_BAKER_PROBES) per += 108u * (size_t)probes;
+    return per * ((size_t)b->R->group_count + 1u);
+}
+
+/* AUTO's choice and the estimates; the patches (classic) are built here, the rest later. */
+static rad_result rad__baker_plan(rad__baker *b)
+{
+    rad_baker_result *R = b->R;
+    const rad_scene *S = b->scene;
+    double budget = b->o.max_memory, seconds_budget = b->o.max_seconds, N, bytes = 0.0, secs = 0.0, texels;
+    double samples = (double)b->o.ff_samples;
+    uint32_t probes_guess = b->d->probe_positions ? b->d->probe_count : 729u;
+    char bb[32], lb[32], tb[32], why[256];
+    rad_result r;
+    int classic_fits = 0;
+    texels = (b->outputs & RAD_BAKER_LIGHTMAP) ? (double)R->lightmap_width * R->lightmap_height * b->o.lightmap_samples : 0.0;
+    b->outputs_bytes = rad__baker_output_bytes(b, probes_guess);
+    why[0] = 0;
+    if (b->o.method != RAD_BAKER_VIRTUAL_PATCHES) {
+        rad_patch_options po;
+        rad_patch_options_default(&po);
+        po.target_count = b->o.patches;
+        N = (double)(S->triangle_count > b->o.patches ? S->triangle_count : b->o.patches);
+        bytes = 4.0 * N * N + 300.0 * N + (double)b->outputs_bytes;
+        if (bytes <= budget) {
+            /* the patch count is only near the target: count them before the final estimate */
+            r = rad_patches_create(S, &po, &b->sub, &b->patches);
+            if (r != RAD_SUCCESS) return r;
+            N = (double)b->patches->count;
+            bytes = 4.0 * N * N + 300.0 * N + (double)b->outputs_bytes;
+        }
+        secs = N * N * samples / RAD__BAKER_FF_RATE + 6.0 * N * N * b->o.bounces * R->group_count / RAD__BAKER_FLOP_RATE +
+               texels * N * 4.0 / RAD__BAKER_RAY_RATE * (texels * N > 5e7 ? 5e7 / (texels * N) : 1.0) * R->group_count;
+        classic_fits = bytes <= budget && secs <= seconds_budget;
+        rad__baker_time(tb, sizeof tb, secs);
+        rad__baker_bytes(bb, sizeof bb, bytes);
+        rad__baker_bytes(lb, sizeof lb, budget);
+        if (b->o.method == RAD_BAKER_CLASSIC && bytes > budget) {
+            rad_patches_destroy(b->patches);
+            b->patches = NULL;
+            rad__log(&b->c, RAD_LOG_ERROR,
+                     "rad_baker_run: the classic bake of %lu patches needs about %s, over the budget of %s (max_memory); "
+                     "use RAD_BAKER_AUTO or RAD_BAKER_VIRTUAL_PATCHES, or a larger budget",
+                     (unsigned long)N, bb, lb);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        if (b->o.method == RAD_BAKER_CLASSIC || classic_fits) {
+            R->method = RAD_BAKER_CLASSIC;
+            R->patch_count = (uint32_t)N;
+            R->estimated_bytes = bytes;
+            R->estimated_seconds = secs;
+            snprintf(R->reason, sizeof R->reason,
+                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s per thread, %s the budget of %s "
+                     "and %lu s",
+                     S->triangle_count, R->patch_count, bb, tb, classic_fits ? "within" : "over (forced)", lb,
+                     (unsigned long)(seconds_budget < 1e9 ? seconds_budget : 1e9));
+            return RAD_SUCCESS;
+        }
+        snprintf(why, sizeof why, "classic would need %lu patches, about %s and %s per thread (budget %s, %lu s); ",
+                 (unsigned long)N, bb, tb, lb, (unsigned long)(seconds_budget < 1e9 ? seconds_budget : 1e9));
+        rad_patches_destroy(b->patches);
+        b->patches = NULL;
+    }
+    {
+        rad_vp_options vo;
+        rad_vp_counts cnt;
+        uint32_t res = b->o.vp_resolution;
+        rad_vp_options_default(&vo);
+        for (;;) {
+            double M, n;
+            vo.resolution = res;
+            r = rad_vp_count(S, &b->rc, &vo, &b->sub, &cnt);
+            if (r != RAD_SUCCESS) return r;
+            n = (double)cnt.patches;
+            M = (double)cnt.samples;
+            bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)b->c.tasks + (double)b->outputs_bytes;
+            secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 6.0 * n * n * b->o.bounces * R->group_count / RAD__BAKER_FLOP_RATE;
+            if (bytes <= budget) break;
+            if (res <= 2) {
+                rad__baker_bytes(bb, sizeof bb, bytes);
+                rad__baker_bytes(lb, sizeof lb, budget);
+                rad__log(&b->c, RAD_LOG_ERROR,
+                         "rad_baker_run: the budget of %s (max_memory) is too small for any bake: %sthe coarsest virtual "
+                         "patches (resolution %u, %u patches) need about %s",
+                         lb, why, res, cnt.patches, bb);
+                return RAD_ERROR_OUT_OF_MEMORY;
+            }
+            res = res * 3u / 4u;
+            if (res < 2) res = 2;
+        }
+        R->method = RAD_BAKER_VIRTUAL_PATCHES;
+        R->vp_resolution = res;
+        R->patch_count = cnt.patches;
+        R->estimated_bytes = bytes;
+        R->estimated_seconds = secs;
+        rad__baker_bytes(bb, sizeof bb, bytes);
+        rad__baker_bytes(lb, sizeof lb, budget);
+        rad__baker_time(tb, sizeof tb, secs);
+        snprintf(R->reason, sizeof R->reason, "virtual patches: %sresolution %u gives %u patches (%u samples), about %s and %s per thread",
+                 b->o.method == RAD_BAKER_VIRTUAL_PATCHES ? "(asked for) " : why, res, cnt.patches, cnt.samples, bb, tb);
+    }
+    return RAD_SUCCESS;
+}
+
+/* The lights of group g into b->lights; returns their count. */
+static uint32_t rad__baker_group_lights(rad__baker *b, uint32_t g)
+{
+    uint32_t i, n = 0;
+    for (i = 0; i < b->d->light_count; ++i)
+        if (b->d->lights[i].group == g) b->lights[n++] = b->d->lights[i].light;
+    return n;
+}
+
+/* A view of the scene whose materials emit only group g's light (the geometry is the same,
+   so the BVH, patches and texels built on the scene serve it unchanged). */
+static const rad_scene *rad__baker_group_scene(rad__baker *b, uint32_t g, rad_scene *view)
+{
+    uint32_t i;
+    if (!b->group_emits[g] || b->emissive_groups <= 1) return b->scene;
+    *view = *b->scene;
+    for (i = 0; i < b->scene->material_count; ++i) {
+        b->masked[i] = b->scene->materials_table[i];
+        if ((b->d->material_groups ? b->d->material_groups[i] : 0u) != g)
+            b->masked[i].emission[0] = b->masked[i].emission[1] = b->masked[i].emission[2] = 0.0f;
+    }
+    view->materials_table = b->masked;
+    return view;
+}
+
+/* Builds the method's objects (form factors or virtual patches, texels, probes). */
+static rad_result rad__baker_build(rad__baker *b)
+{
+    rad_baker_result *R = b->R;
+    rad_result r;
+    uint32_t n;
+    if (rad__baker_stage(&b->prog, 0.02f, 0.5f)) return RAD_ERROR_CANCELLED;
+    if (R->method == RAD_BAKER_CLASSIC) {
+        rad_form_factor_options fo;
+        float *ones;
+        uint32_t i;
+        rad_form_factor_options_default(&fo);
+        fo.samples = b->o.ff_samples;
+        fo.seed = b->o.seed;
+        r = rad_form_factors_dense(b->patches, &b->rc, &fo, &b->sub, &b->ff);
+        if (r != RAD_SUCCESS) return r;
+        n = b->patches->count;
+        b->row_sums = (float *)rad__alloc_array(&b->c.allocator, n, sizeof(float));
+        ones = (float *)rad__alloc_array(&b->c.allocator, n, 6 * sizeof(float));
+        if (!b->row_sums || !ones) {
+            rad__free(&b->c.allocator, ones);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
+        r = rad_matrix_multiply(&b->ff->matrix, ones, ones + 3 * (size_t)n, &b->sub);
+        for (i = 0; r == RAD_SUCCESS && i < n; ++i) b->row_sums[i] = ones[3 * (size_t)n + 3 * (size_t)i];
+        rad__free(&b->c.allocator, ones);
+        if (r != RAD_SUCCESS) return r;
+    } else {
+        rad_vp_options vo;
+        rad_vp_options_default(&vo);
+        vo.resolution = R->vp_resolution;
+        r = rad_vp_create(b->scene, &b->rc, &vo, &b->sub, &b->vp);
+        if (r != RAD_SUCCESS) return r;
+        n = b->vp->count;
+        R->patch_count = n;
+    }
+    if (b->outputs & RAD_BAKER_LIGHTMAP) {
+        rad_lightmap_options lo;
+        if (rad__baker_stage(&b->prog, 0.5f, 0.55f)) return RAD_ERROR_CANCELLED;
+        rad_lightmap_options_default(&lo);
+        lo.width = R->lightmap_width;
+        lo.height = R->lightmap_height;
+        lo.samples = b->o.lightmap_samples;
+        lo.seed = b->o.seed;
+        r = rad_lightmap_create(b->scene, &b->rc, &lo, &b->sub, &b->lm);
+        if (r != RAD_SUCCESS) return r;
+    }
+    if (b->outputs & RAD_BAKER_PROBES) {
+        rad_probe_options po;
+        if (rad__baker_stage(&b->prog, 0.55f, 0.6f)) return RAD_ERROR_CANCELLED;
+        rad_probe_options_default(&po);
+        po.spacing = b->d->probe_spacing;
+        r = R->method == RAD_BAKER_CLASSIC
+                ? rad_probes_create(b->patches, &b->rc, NULL, 0, b->d->probe_positions, b->d->probe_count, &po, NULL, &b->sub,
+                                    &b->probes)
+                : rad_probes_create_vp(b->vp, &b->rc, NULL, 0, b->d->probe_positions, b->d->probe_count, &po, NULL, &b->sub,
+                                       &b->probes);
+        if (r != RAD_SUCCESS) return r;
+    }
+    /* D, E, L, B, H: 3N each, then the vertex values of the patches (classic) */
+    b->work = (float *)rad__alloc_array(&b->c.allocator, 15u * (size_t)n +
+                                            (R->method == RAD_BAKER_CLASSIC ? 3u * (size_t)b->patches->vertex_count : 0u),
+                                        sizeof(float));
+    return b->work ? RAD_SUCCESS : RAD_ERROR_OUT_OF_MEMORY;
+}
+
+/* The output arrays, every layer zeroed (a group without light keeps a zero layer). */
+static rad_result rad__baker_alloc_outputs(rad__baker *b)
+{
+    rad_baker_result *R = b->R;
+    const rad_allocator *a = &b->c.allocator;
+    const rad_baker_desc *d = b->d;
+    size_t G = R->group_count, n;
+    uint32_t m;
+    R->mesh_count = d->scene.mesh_count;
+    if (b->outputs & RAD_BAKER_VERTEX) {
+        R->vertex_first = (uint32_t *)rad__alloc_array(a, (size_t)R->mesh_count + 1, sizeof(uint32_t));
+        if (!R->vertex_first) return RAD_ERROR_OUT_OF_MEMORY;
+        R->vertex_first[0] = 0;
+        for (m = 0; m < R->mesh_count; ++m) {
+            if (R->vertex_first[m] > 0xFFFFFFFFu - d->scene.meshes[m].vertex_count) return RAD_ERROR_SIZE_OVERFLOW;
+            R->vertex_first[m + 1] = R->vertex_first[m] + d->scene.meshes[m].vertex_count;
+        }
+        R->vertex_count = R->vertex_first[R->mesh_count];
+        n = 3 * (size_t)R->vertex_count;
+        R->vertex = (float *)rad__alloc_array(a, n, sizeof(float));
+        R->vertex_layers = (float *)rad__alloc_array(a, n * G, sizeof(float));
+        if (!R->vertex || !R->vertex_layers) return RAD_ERROR_OUT_OF_MEMORY;
+        memset(R->vertex_layers, 0, n * G * sizeof(float));
+    }
+    if (b->lm) {
+        n = 3 * (size_t)R->lightmap_width * R->lightmap_height;
+        R->lightmap = (float *)rad__alloc_array(a, n, sizeof(float));
+        R->lightmap_layers = (float *)rad__alloc_array(a, n * G, sizeof(float));
+        R->lightmap_flags = (uint8_t *)rad__alloc_array(a, n / 3, 1);
+        if (!R->lightmap || !R->lightmap_layers || !R->lightmap_flags) return RAD_ERROR_OUT_OF_MEMORY;
+        memset(R->lightmap_layers, 0, n * G * sizeof(float));
+        memcpy(R->lightmap_flags, b->lm->flags, n / 3);
+    }
+    if (b->probes) {
+        R->probe_count = rad_probes_count(b->probes);
+        n = 27 * (size_t)R->probe_count;
+        R->probes = (float *)rad__alloc_array(a, n, sizeof(float));
+        R->probe_layers = (float *)rad__alloc_array(a, n * G, sizeof(float));
+        R->probe_positions = (float *)rad__alloc_array(a, R->probe_count, 3 * sizeof(float));
+        R->probe_states = (uint8_t *)rad__alloc_array(a, R->probe_count, 1);
+        if (!R->probes || !R->probe_layers || !R->probe_positions || !R->probe_states) return RAD_ERROR_OUT_OF_MEMORY;
+        memset(R->probe_layers, 0, n * G * sizeof(float));
+        memcpy(R->probe_positions, rad_probes_positions(b->probes), 3 * sizeof(float) * R->probe_count);
+        memcpy(R->probe_states, rad_probes_states(b->probes), R->probe_count);
+        if (!rad_probes_grid(b->probes, R->probe_grid, R->probe_origin, &R->probe_spacing)) {
+            R->probe_grid[0] = R->probe_grid[1] = R->probe_grid[2] = 0;
+            R->probe_spacing = 0.0f;
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+/* One group's layer: its source, the bounces, and each output from the solution. */
+static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi)
+{
+    rad_baker_result *R = b->R;
+    rad_scene view;
+    const rad_scene *Sg = rad__baker_group_scene(b, g, &view);
+    uint32_t nl = rad__baker_group_lights(b, g), n = R->patch_count, m;
+    size_t i, N3 = 3 * (size_t)n;
+    float *D = b->work, *E = D + N3, *L = E + N3, *B = L + N3, *H = B + N3, *V = H + N3;
+    rad_direct_options dopt;
+    rad_solve_options so;
+    rad_system sys;
+    rad_result r;
+    if (nl == 0 && !b->group_emits[g]) return RAD_SUCCESS; /* nothing in the group: a zero layer */
+    /* the group's share of the progress: source 30%, bounces 20%, vertices 10%, lightmap 35% */
+#define RAD__BAKER_PART(a, z) if (rad__baker_stage(&b->prog, lo + (hi - lo) * (a), lo + (hi - lo) * (z))) return RAD_ERROR_CANCELLED
+    RAD__BAKER_PART(0.0f, 0.3f);
+    rad_direct_options_default(&dopt);
+    dopt.include_emitters = b->group_emits[g];
+    dopt.light_samples = b->o.light_samples;
+    dopt.seed = b->o.seed;
+    rad_solve_options_default(&so);
+    so.bounces = b->o.bounces;
+    so.output = RAD_OUTPUT_INDIRECT;
+    if (R->method == RAD_BAKER_CLASSIC) {
+        rad_patches pg = *b->patches; /* the same patches seen on the group's scene view */
+        pg.scene = Sg;
+        r = rad_direct_patches(&pg, &b->rc, b->lights, nl, &dopt, D, &b->sub);
+        if (r == RAD_SUCCESS) r = rad_sources(b->patches, RAD_SOURCE_DIRECT, D, E);
+        if (r != RAD_SUCCESS) return r;
+        rad_system_init(&sys, &b->ff->matrix, b->patches, E);
+    } else {
+        const rad_virtual_patches *vp = b->vp;
+        float *v = (float *)rad__alloc_array(&b->c.allocator, vp->sample_count, 3 * sizeof(float));
+        if (!v) return RAD_ERROR_OUT_OF_MEMORY;
+        /* rad_vp_sources with RAD_SOURCE_DIRECT, on the group's scene view */
+        r = rad_direct_irradiance(Sg, &b->rc, b->lights, nl, &dopt, vp->sample_positions, vp->sample_normals, vp->sample_count,
+                                  v, &b->sub);
+        if (r == RAD_SUCCESS) {
+            for (i = 0; i < 3 * (size_t)vp->sample_count; ++i) v[i] *= vp->sample_albedo[i];
+            r = rad_vp_from_samples(vp, v, E);
+        }
+        rad__free(&b->c.allocator, v);
+        if (r != RAD_SUCCESS) return r;
+        rad_vp_system(&sys, vp, E);
+    }
+    RAD__BAKER_PART(0.3f, 0.5f);
+    r = rad_solve_jacobi(&sys, &so, L, NULL, &b->sub);
+    if (r != RAD_SUCCESS) return r;
+    for (i = 0; i < N3; ++i) B[i] = E[i] + L[i];
+    r = rad_matrix_multiply(R->method == RAD_BAKER_CLASSIC ? &b->ff->matrix : &b->vp->matrix, B, H, &b->sub);
+    if (r != RAD_SUCCESS) return r;
+    RAD__BAKER_PART(0.5f, 0.6f);
+    if (R->vertex_layers) {
+        float *out = R->vertex_layers + (size_t)g * 3 * R->vertex_count;
+        if (R->method == RAD_BAKER_CLASSIC) r = rad_patches_vertex_irradiance(b->patches, H, b->row_sums, V, &b->sub);
+        for (m = 0; r == RAD_SUCCESS && m < R->mesh_count; ++m) {
+            const rad_mesh_desc *mesh = &b->d->scene.meshes[m];
+            float *o = out + 3 * (size_t)R->vertex_first[m];
+            r = R->method == RAD_BAKER_CLASSIC ? rad_patches_gather_mesh(b->patches, V, m, mesh, o, &b->sub)
+                                               : rad_vp_gather_mesh(b->vp, H, mesh, o, &b->sub);
+        }
+        if (r != RAD_SUCCESS) return r;
+    }
+    RAD__BAKER_PART(0.6f, 0.95f);
+    if (R->lightmap_layers) {
+        float *out = R->lightmap_layers + (size_t)g * 3 * R->lightmap_width * R->lightmap_height;
+        if (R->method == RAD_BAKER_CLASSIC) {
+            rad_lightmap_gather_options go;
+            rad_lightmap_gather_options_default(&go);
+            go.seed = b->o.seed;
+            if ((double)b->lm->sample_count * n > 5e7) go.method = RAD_LIGHTMAP_GATHER_HEMISPHERE;
+            r = rad_lightmap_gather(b->lm, b->patches, B, &b->rc, &go, out, &b->sub);
+        } else {
+            r = rad_lightmap_gather_vp(b->lm, b->vp, H, out, &b->sub);
+        }
+        if (r == RAD_SUCCESS) r = rad_lightmap_dilate(b->lm, 3, out, 0, &b->sub);
+        if (r != RAD_SUCCESS) return r;
+    }
+    RAD__BAKER_PART(0.95f, 1.0f);
+#undef RAD__BAKER_PART
+    if (R->probe_layers) {
+        r = rad_probes_update(b->probes, B, &b->sub);
+        if (r != RAD_SUCCESS) return r;
+        memcpy(R->probe_layers + (size_t)g * 27 * R->probe_count, rad_probes_coefficients(b->probes),
+               27 * sizeof(float) * R->probe_count);
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_options *options, const rad_context *ctx,
+                                 rad_baker_result **out)
+{
+    rad__baker b;
+    rad_result r;
+    uint32_t g;
+    memset(&b, 0, sizeof b);
+    rad__ctx_init(&b.c, ctx);
+    if (!desc || !out) {
+        rad__log(&b.c, RAD_LOG_ERROR, "rad_baker_run: NULL desc or out");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    b.d = desc;
+    b.outputs = desc->outputs ? desc->outputs : (uint32_t)RAD_BAKER_VERTEX;
+    if (options) b.o = *options;
+    if (b.o.max_memory == 0.0) b.o.max_memory = 1073741824.0;
+    if (b.o.max_seconds == 0.0) b.o.max_seconds = 600.0;
+    if (!b.o.patches) b.o.patches = 512;
+    if (!b.o.vp_resolution) b.o.vp_resolution = 16;
+    if (!b.o.bounces) b.o.bounces = 16;
+    if (!b.o.ff_samples) b.o.ff_samples = 16;
+    if (!b.o.light_samples) b.o.light_samples = 16;
+    if (!b.o.lightmap_samples) b.o.lightmap_samples = 4;
+    if (ctx) b.sub = *ctx;
+    b.prog.fn = ctx ? ctx->progress : NULL;
+    b.prog.user = ctx ? ctx->progress_user : NULL;
+    b.sub.progress = rad__baker_progress_fn;
+    b.sub.progress_user = &b.prog;
+    b.R = (rad_baker_result *)rad__alloc_zero(&b.c.allocator, sizeof(rad_baker_result));
+    if (!b.R) return RAD_ERROR_OUT_OF_MEMORY;
+    b.R->allocator = b.c.allocator;
+    b.R->lightmap_width = desc->lightmap_width ? desc->lightmap_width : 256u;
+    b.R->lightmap_height = desc->lightmap_height ? desc->lightmap_height : b.R->lightmap_width;
+    r = rad__baker_check(&b);
+    if (r == RAD_SUCCESS && rad__baker_stage(&b.prog, 0.0f, 0.02f)) r = RAD_ERROR_CANCELLED;
+    if (r == RAD_SUCCESS) r = rad_scene_create(&desc->scene, &b.sub, &b.scene);
+    if (r == RAD_SUCCESS) r = rad_bvh_create(b.scene, &b.sub, &b.bvh);
+    if (r == RAD_SUCCESS) {
+        rad_bvh_raycaster(b.bvh, &b.rc);
+        b.masked = (rad_material *)rad__alloc_array(&b.c.allocator, b.scene->material_count ? b.scene->material_count : 1u,
+                                                    sizeof(rad_material));
+        b.lights = (rad_light *)rad__alloc_array(&b.c.allocator, desc->light_count ? desc->light_count : 1u, sizeof(rad_light));
+        if (!b.masked || !b.lights) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) r = rad__baker_plan(&b);
+    if (r == RAD_SUCCESS) {
+        rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: %s; light groups: %u", b.R->reason, b.R->group_count);
+        r = rad__baker_build(&b);
+    }
+    if (r == RAD_SUCCESS) r = rad__baker_alloc_outputs(&b);
+    for (g = 0; r == RAD_SUCCESS && g < b.R->group_count; ++g) {
+        float lo = 0.6f + 0.4f * (float)g / (float)b.R->group_count, hi = 0.6f + 0.4f * (float)(g + 1) / (float)b.R->group_count;
+        r = rad__baker_group(&b, g, lo, hi);
+    }
+    if (r == RAD_SUCCESS) r = rad_baker_mix(b.R, NULL, &b.sub);
+    if (r == RAD_SUCCESS && b.prog.fn && b.prog.fn(b.prog.user, 1.0f)) r = RAD_ERROR_CANCELLED;
+    if (r != RAD_SUCCESS && b.prog.cancelled) r = RAD_ERROR_CANCELLED;
+    rad__baker_free(&b);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_CANCELLED) rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: cancelled by the progress callback");
+        rad_baker_result_destroy(b.R);
+        return r;
+    }
+    *out = b.R;
+    return RAD_SUCCESS;
 }
 
 /* ======================================================================================== */

@@ -1,97 +1,93 @@
-/* engine_bake.c - the engine path of the README: an engine keeps its own direct lighting and
-   wants the bounced light at the vertices of its own meshes. The meshes here are the built-in
-   Cornell box's (any rad_mesh_desc works), lit by its emissive ceiling light and one point
-   light of the engine's; direct light is the source (RAD_SOURCE_DIRECT), and the irradiance
-   from bounced light comes back per vertex of each mesh, in the mesh's own vertex order.
-   Prints the mean per mesh and checks that every value is finite and >= 0 (exit 1 if not). */
+/* engine_bake.c - the engine path of the README in one call: an engine keeps its own direct
+   lighting and wants the bounced light at the vertices of its own meshes, and probes for what
+   moves. The meshes are the built-in Cornell box's (any rad_mesh_desc works), lit by its
+   emissive ceiling light (light group 0) and one point light of the engine's (group 1).
+   rad_baker_run picks the method for the scene and the budget, logs its estimate, and returns
+   one layer per group; rad_baker_mix then dims or tints each group without a new bake.
+   examples/learn_vertex_light.c does the per-vertex part step by step with the lower-level
+   calls. Prints the mean per mesh, then after a mix, and checks that every value is finite
+   and >= 0 (exit 1 if not). */
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
-static int ok(rad_result r, const char *what)
+static void on_log(void *user, rad_log_level level, const char *message)
 {
-    if (r != RAD_SUCCESS) fprintf(stderr, "%s: %s\n", what, rad_result_string(r));
-    return r == RAD_SUCCESS;
+    (void)user;
+    fprintf(stderr, "%s: %s\n", level == RAD_LOG_ERROR ? "error" : level == RAD_LOG_WARNING ? "warning" : "info", message);
+}
+
+static int on_progress(void *user, float fraction)
+{
+    int *tenth = (int *)user;
+    while (fraction >= 0.1f * (float)(*tenth + 1) && *tenth < 10) fprintf(stderr, "%d%% ", 10 * ++*tenth);
+    if (*tenth == 10) fprintf(stderr, "\n"), ++*tenth;
+    return 0; /* non-zero cancels the bake */
+}
+
+static uint32_t print_means(const rad_baker_desc *d, const rad_baker_result *R, const char *title)
+{
+    uint32_t m, i, bad = 0;
+    printf("%s\n", title);
+    for (m = 0; m < R->mesh_count; ++m) {
+        const float *v = R->vertex + 3 * (size_t)R->vertex_first[m];
+        uint32_t n = R->vertex_first[m + 1] - R->vertex_first[m];
+        double mean[3] = { 0, 0, 0 };
+        for (i = 0; i < 3 * n; ++i) {
+            mean[i % 3] += v[i] / n;
+            bad += !(v[i] >= 0.0f && v[i] < 1e30f);
+        }
+        printf("  %-10s %2u vertices, mean bounced irradiance %.4f %.4f %.4f W/m^2\n", d->scene.meshes[m].name, n, mean[0],
+               mean[1], mean[2]);
+    }
+    return bad;
 }
 
 int main(void)
 {
-    rad_scene_desc desc;
-    rad_scene *scene = NULL;
-    rad_patches *patches = NULL;
-    rad_bvh *bvh = NULL;
-    rad_form_factors *ff = NULL;
-    rad_patch_options popt;
-    rad_form_factor_options fopt;
-    rad_direct_options dopt;
-    rad_solve_options sopt;
-    rad_raycaster rc;
-    rad_system sys;
-    rad_light lamp;
-    float *D = NULL, *E = NULL, *L = NULL, *EL = NULL, *H = NULL, *S = NULL, *Hp = NULL, *out = NULL;
-    uint32_t i, m, n, bad = 0;
-    int status = 1;
+    rad_baker_desc desc;
+    rad_baker_options options;
+    rad_baker_result *result = NULL;
+    rad_baker_light lamp;
+    rad_context ctx;
+    rad_result r;
+    int tenth = 0;
+    uint32_t bad;
+    /* group 0 (the ceiling light) at half strength, group 1 (the lamp) warm and twice as bright */
+    const float mix[6] = { 0.5f, 0.5f, 0.5f, 2.0f, 1.4f, 0.8f };
 
-    rad_cornell_box(&desc, NULL);                             /* the engine's meshes */
-    memset(&lamp, 0, sizeof lamp);                            /* and one light of its own */
-    lamp.type = RAD_LIGHT_POINT;
-    lamp.position[0] = 0.28f; lamp.position[1] = 0.35f; lamp.position[2] = 0.28f;
-    lamp.color[0] = lamp.color[1] = lamp.color[2] = 0.05f;    /* W/sr */
+    memset(&desc, 0, sizeof desc);
+    rad_cornell_box(&desc.scene, NULL);            /* the engine's meshes and materials */
+    memset(&lamp, 0, sizeof lamp);                 /* and one light of its own, in group 1 */
+    lamp.light.type = RAD_LIGHT_POINT;
+    lamp.light.position[0] = 0.28f; lamp.light.position[1] = 0.35f; lamp.light.position[2] = 0.28f;
+    lamp.light.color[0] = lamp.light.color[1] = lamp.light.color[2] = 0.05f; /* W/sr */
+    lamp.group = 1;
+    desc.lights = &lamp;
+    desc.light_count = 1;
+    desc.outputs = RAD_BAKER_VERTEX | RAD_BAKER_PROBES; /* the emissive materials are group 0 */
 
-    if (!ok(rad_scene_create(&desc, NULL, &scene), "rad_scene_create")) goto done;
-    rad_patch_options_default(&popt);
-    popt.target_count = 800;
-    if (!ok(rad_patches_create(scene, &popt, NULL, &patches), "rad_patches_create")) goto done;
-    if (!ok(rad_bvh_create(scene, NULL, &bvh), "rad_bvh_create")) goto done;
-    rad_bvh_raycaster(bvh, &rc);
-    rad_form_factor_options_default(&fopt);
-    if (!ok(rad_form_factors_dense(patches, &rc, &fopt, NULL, &ff), "rad_form_factors_dense")) goto done;
+    memset(&options, 0, sizeof options);           /* zero: the defaults (1 GiB, 600 s, ...) */
+    options.patches = 800;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.log = on_log;
+    ctx.progress = on_progress;
+    ctx.progress_user = &tenth;
 
-    n = patches->count;
-    D = (float *)malloc(sizeof(float) * 3 * n);
-    E = (float *)malloc(sizeof(float) * 3 * n);
-    L = (float *)malloc(sizeof(float) * 3 * n);
-    EL = (float *)malloc(sizeof(float) * 3 * n);
-    H = (float *)malloc(sizeof(float) * 3 * n);
-    S = (float *)malloc(sizeof(float) * n);
-    Hp = (float *)malloc(sizeof(float) * 3 * patches->vertex_count);
-    out = (float *)malloc(sizeof(float) * 3 * 64);            /* the box's meshes have few vertices */
-    if (!D || !E || !L || !EL || !H || !S || !Hp || !out) goto done;
-
-    rad_direct_options_default(&dopt);                        /* emissive triangles + the lamp */
-    if (!ok(rad_direct_patches(patches, &rc, &lamp, 1, &dopt, D, NULL), "rad_direct_patches")) goto done;
-    if (!ok(rad_sources(patches, RAD_SOURCE_DIRECT, D, E), "rad_sources")) goto done;
-    rad_system_init(&sys, &ff->matrix, patches, E);
-    rad_solve_options_default(&sopt);                         /* output: the indirect light L */
-    if (!ok(rad_solve_jacobi(&sys, &sopt, L, NULL, NULL), "rad_solve_jacobi")) goto done;
-    for (i = 0; i < 3 * n; ++i) EL[i] = 1.0f;                 /* row sums: how much each patch sees */
-    if (!ok(rad_matrix_multiply(&ff->matrix, EL, H, NULL), "rad_matrix_multiply")) goto done;
-    for (i = 0; i < n; ++i) S[i] = H[3 * i];
-    for (i = 0; i < 3 * n; ++i) EL[i] = E[i] + L[i];          /* H = F (E + L) */
-    if (!ok(rad_matrix_multiply(&ff->matrix, EL, H, NULL), "rad_matrix_multiply")) goto done;
-    if (!ok(rad_patches_vertex_irradiance(patches, H, S, Hp, NULL), "rad_patches_vertex_irradiance")) goto done;
-
-    for (m = 0; m < desc.mesh_count; ++m) {
-        const rad_mesh_desc *mesh = &desc.meshes[m];
-        double mean[3] = { 0, 0, 0 };
-        if (mesh->vertex_count > 64) continue;
-        if (!ok(rad_patches_gather_mesh(patches, Hp, m, mesh, out, NULL), "rad_patches_gather_mesh")) goto done;
-        for (i = 0; i < 3 * mesh->vertex_count; ++i) {
-            mean[i % 3] += out[i] / mesh->vertex_count;
-            bad += !(out[i] >= 0.0f && out[i] < 1e30f);
-        }
-        printf("%-10s %2u vertices, mean bounced irradiance %.4f %.4f %.4f W/m^2\n", mesh->name ? mesh->name : "",
-               mesh->vertex_count, mean[0], mean[1], mean[2]);
+    r = rad_baker_run(&desc, &options, &ctx, &result);
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad_baker_run: %s\n", rad_result_string(r));
+        return 1;
     }
-    status = bad ? 1 : 0;
+    printf("chose %s: %s\n%u probes on a %u x %u x %u grid\n",
+           result->method == RAD_BAKER_CLASSIC ? "classic patches" : "virtual patches", result->reason,
+           result->probe_count, result->probe_grid[0], result->probe_grid[1], result->probe_grid[2]);
+    bad = print_means(&desc, result, "both groups at full strength:");
+    r = rad_baker_mix(result, mix, NULL);          /* vertices and probes again, no new bake */
+    if (r == RAD_SUCCESS) bad += print_means(&desc, result, "ceiling at 50%, lamp warm and at 200%:");
+    else fprintf(stderr, "rad_baker_mix: %s\n", rad_result_string(r));
     if (bad) fprintf(stderr, "%u values not finite or negative\n", bad);
-done:
-    free(D); free(E); free(L); free(EL); free(H); free(S); free(Hp); free(out);
-    rad_form_factors_destroy(ff);
-    rad_bvh_destroy(bvh);
-    rad_patches_destroy(patches);
-    rad_scene_destroy(scene);
-    return status;
+    rad_baker_result_destroy(result);
+    return r == RAD_SUCCESS && bad == 0 ? 0 : 1;
 }
