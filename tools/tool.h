@@ -61,20 +61,42 @@ int tool_image_read_png(const char *path, tool_image *img, char *err, size_t err
 unsigned char tool_image_srgb8(float linear);
 
 /* ---- output files (image.c): every file the tool writes ------------------------------- */
-/* A temporary file in the destination's folder, renamed onto it by tool_output_commit
-   only when everything was written: a failure leaves the old file (if any) untouched and no
-   temporary behind. The image writers and the bake writers all use it. */
+/* A temporary file ".radtmp-XXXXXX" created exclusively (never through a symlink) in the
+   destination's folder, renamed onto it by tool_output_commit only when everything was
+   written, flushed and synced: a failure leaves the old file (if any) untouched and no
+   temporary behind, and a fatal signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE,
+   unless ignored when rad started) removes the open temporaries before the process ends.
+   The image writers and the bake writers all use it. */
 typedef struct tool_output {
     FILE *f;        /* write here */
     char *path;     /* the destination */
     char *tmp;      /* the temporary */
+    int slot;       /* private: the signal handler's record of tmp (0: none) */
+    int closed;     /* private: tool_output_close succeeded */
 } tool_output;
 /* 0, or -1 with the reason in tool_output_error() */
 int tool_output_open(tool_output *o, const char *path);
 /* ok: 1 when every write succeeded. Flushes, syncs, closes and renames; on any failure
    removes the temporary and returns -1 (reason in tool_output_error()). */
 int tool_output_commit(tool_output *o, int ok);
+/* the same without the rename: the temporary is complete on disk (0), or removed (-1) */
+int tool_output_close(tool_output *o, int ok);
 void tool_output_abort(tool_output *o); /* closes and removes the temporary */
+/* Files that replace their destinations together (OBJ + MTL, the layers of an SH lightmap):
+   each one is written and closed into its temporary (tool_output_set_add), and only when all
+   of them are, tool_output_set_commit renames them all; any failure before that removes every
+   temporary of the set and leaves each old file as it was. */
+#define TOOL_OUTPUT_SET_MAX 8
+typedef struct tool_output_set {
+    tool_output items[TOOL_OUTPUT_SET_MAX];
+    unsigned count;
+} tool_output_set; /* zero-initialise */
+/* closes o (tool_output_close) into the set; on a failure aborts o and the whole set; 0 or -1 */
+int tool_output_set_add(tool_output_set *set, tool_output *o, int ok);
+int tool_output_set_commit(tool_output_set *set); /* 0 or -1 (reason in tool_output_error()) */
+void tool_output_set_abort(tool_output_set *set);
+/* tool_image_write into a set (NULL: written at once); on a failure the set is aborted */
+int tool_image_write_into(tool_output_set *set, const char *path, const tool_image *img, float exposure);
 /* size bytes to path through the above; 0 or -1 */
 int tool_write_file(const char *path, const void *data, size_t size);
 /* why the last output (or image write) failed, e.g. "cannot write 'x.png': cannot create a
