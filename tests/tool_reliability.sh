@@ -89,3 +89,36 @@ long=$(printf 'a%.0s' $(seq 1 246)).png
 (cd "$REL/sig" && "$RAD" render cornell -o "$long" --size 8x8 --patches 20) > /dev/null 2> "$REL/err.txt" &&
     [ -s "$REL/sig/$long" ] && ok "an output name of 250 characters is written" ||
     fail "an output name of 250 characters is written" "$(head -c 300 "$REL/err.txt")"
+
+# ---- option values checked before the work --------------------------------------------------
+# rel_refused NAME ARGS...: exit 2 with a message naming the option (the first -- word of NAME)
+rel_refused() {
+    name=$1
+    shift
+    opt=$(printf '%s\n' "$name" | grep -o -- '--[a-z-]*' | head -n 1)
+    timeout 60 "$@" > /dev/null 2> "$REL/err.txt"
+    rc=$?
+    [ $rc -eq 2 ] && grep -q -- "$opt" "$REL/err.txt" && ok "$name refused (exit 2, names $opt)" ||
+        fail "$name refused" "exit $rc $(head -c 300 "$REL/err.txt")"
+}
+# a direction whose squared length overflows a float would be normalised to zero: no light
+rel_refused "render --sun 0,-0.3e20,1e20:5" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.pfm" --sun 0,-0.3e20,1e20:5
+rel_refused "render --sun 0,0,1e-30:5 (too short)" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.pfm" --sun 0,0,1e-30:5
+rel_refused "bake --spot with DIR 0,-1e20,0" "$RAD" bake cornell --patches 20 -o "$REL/q.radb" --spot 0,1,0:0,-1e20,0:30:5
+rel_refused "trace --sun 1e20,1e20,0:1" "$RAD" trace cornell --spp 1 --size 8x8 -o "$REL/q.pfm" --sun 1e20,1e20,0:1
+rel_refused "render --camera looking 1e20 away" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.pfm" --camera 0.278,0.274,-1.1:0.278,0.274,1e20:0,1,0
+rel_refused "trace --camera with up along the view" "$RAD" trace cornell --spp 1 --size 8x8 -o "$REL/q.pfm" --camera 0,0,0:0,0,1:0,0,2
+rel_refused "render --area whose U x V overflows" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.pfm" --area 0,1,0:3e19,0,0:0,0,3e19:1
+rel_refused "render --light-path beyond 1e30" "$RAD" render cornell --method temporal --patches 20 --size 8x8 -o "$REL/q.pfm" --light-path line:0,0,0:1e31,0,0
+# a light that overflows the transport is refused up front, not at the save after the bake
+rel_refused "bake --sky 1e30" "$RAD" bake cornell --patches 20 -o "$REL/q.radb" --sky 1e30
+rel_refused "lightmap --point with intensity 1e25" "$RAD" lightmap cornell --patches 20 --size 16 -o "$REL/q.pfm" --point 0,1,0:1e25
+# bounded counts and a positive exposure
+rel_refused "render --aa 4294967295" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.png" --aa 4294967295
+rel_refused "render --pixel-light-samples 100000000" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.png" --pixel-light-samples 100000000
+rel_refused "bake --light-samples 100000000" "$RAD" bake cornell --patches 20 -o "$REL/q.radb" --light-samples 100000000
+rel_refused "bake --samples 100000" "$RAD" bake cornell --patches 20 -o "$REL/q.radb" --samples 100000
+rel_refused "lightmap --exposure 0" "$RAD" lightmap cornell --patches 20 --size 16 -o "$REL/q.png" --exposure 0
+rel_refused "lightmap --exposure -1" "$RAD" lightmap cornell --patches 20 --size 16 -o "$REL/q.png" --exposure -1
+rel_refused "compare --diff-scale inf" "$RAD" compare "$REL/sig/a.pfm" "$REL/sig/a.pfm" --diff "$REL/d.png" --diff-scale inf
+"$RAD" render --help 2>&1 | grep -q -- "--aa N.*1 to 65536" && ok "render --help states the --aa limit" || fail "render --help states the --aa limit"

@@ -465,6 +465,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             if (hemi_rays == 0 || hemi_rays > 65536) { fprintf(stderr, "rad lightmap: --hemisphere-rays must be 1 to 65536\n"); return 2; }
         } else if (!strcmp(o, "--exposure")) {
             if (tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
+            if (!(exposure > 0.0f)) { fprintf(stderr, "rad lightmap: --exposure must be > 0\n"); return 2; }
         } else if (!strcmp(o, "--threads")) {
             if (tool_parse_threads("lightmap", o, argv[++a], &threads)) return 2;
         } else if (o[0] == '-' && o[1]) {

@@ -161,8 +161,13 @@ void tool_set_threads(int threads);
 /* --threads N: a whole number in 0..TOOL_MAX_THREADS; 0 on success, else prints
    "rad CMD: ..." and returns 2 */
 int tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out);
-/* parses "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ"; 0 on success */
-int tool_parse_camera(const char *text, rad_camera *out);
+/* parses "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ" (the points finite, within 1e30; the view direction and
+   up as tool_vector_problem's directions, not parallel); 0, or 1 with *why saying what is wrong */
+int tool_parse_camera(const char *text, rad_camera *out, const char **why);
+/* NULL when v is usable, else why not ("is not finite" ...): every component finite and within
+   1e30; a direction (direction != 0) also normalisable in float: its squared length finite
+   (a direction of length ~2e19 overflows and the library would take it as zero) and not zero */
+const char *tool_vector_problem(const float v[3], int direction);
 /* parses "WxH"; 0 on success */
 int tool_parse_size(const char *text, int *w, int *h);
 /* The most memory an image may take (linear RGB floats, 12 bytes a pixel): 2 GiB, e.g.
@@ -195,6 +200,10 @@ double tool_seconds(void);
 typedef struct tool_area_light {
     float p[3], u[3], v[3], radiance[3];
 } tool_area_light;
+/* The largest light value a light option takes (W/m^2, W/sr, W m^-2 sr^-1): past it the
+   transport (sky E_0 = pi RGB, times albedo, over bounces) overflows what a bake keeps
+   (RAD_BAKE_VALUE_MAX), so the option is refused instead of the save at the end. */
+#define TOOL_MAX_LIGHT_VALUE 1e20f
 /* What --sun, --sky, --point, --spot and --area gave (units: lights.c and tool_light_help) */
 typedef struct tool_lights {
     rad_light *lights;              /* the analytic ones, in the library's units */
