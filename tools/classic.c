@@ -27,7 +27,7 @@ const char *tool_classic_help(void)
            "  --patches N        target patch count (default 2000)\n"
            "  --max-edge L       longest patch edge (default: no limit)\n"
            "  --samples S        form-factor points per patch pair (default 16, up to 256)\n"
-           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16)\n"
+           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16, at most 65536)\n"
            "  --max-memory SIZE  refuse a dense N x N build estimated above SIZE (e.g. 8G; default: the\n"
            "                     MemAvailable of /proc/meminfo); builds estimated over an hour are refused too\n"
            "  --force            build it whatever the estimate\n";
@@ -72,12 +72,12 @@ int tool_classic_option(const char *cmd, int argc, char **argv, int *a, tool_cla
         return 1;
     case 4:
         if (tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
-        if (o->samples == 0) { fprintf(stderr, "rad %s: --samples must be > 0\n", cmd); return 2; }
+        if (o->samples == 0 || o->samples > 256) { fprintf(stderr, "rad %s: --samples must be 1 to 256\n", cmd); return 2; }
         return 1;
     case 6: return tool_parse_bytes(cmd, opt, argv[*a], &o->max_memory) ? 2 : 1;
     default:
         if (tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
-        if (o->light_samples == 0) { fprintf(stderr, "rad %s: --light-samples must be > 0\n", cmd); return 2; }
+        if (o->light_samples == 0 || o->light_samples > 65536) { fprintf(stderr, "rad %s: --light-samples must be 1 to 65536\n", cmd); return 2; }
         return 1;
     }
 }

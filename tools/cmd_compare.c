@@ -118,7 +118,7 @@ int tool_cmd_compare(int argc, char **argv)
             } else {
                 char *end;
                 scale = strtof(argv[++i], &end);
-                if (*end || !(scale > 0.0f)) {
+                if (*end || !(scale > 0.0f && scale < 1e30f)) {
                     fprintf(stderr, "rad compare: --diff-scale wants a positive number, got '%s'\n", argv[i]);
                     return 2;
                 }

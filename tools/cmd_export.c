@@ -11,8 +11,8 @@
    digits, which a float reads back exactly. What OBJ cannot hold is reported on stderr and
    left out: the scene's camera (written as a comment, with the --camera/--fov options that
    restore it), analytic lights, and albedo textures (the material's colour factor is written).
-   Both files go through tool_output_* (a temporary renamed into place), and neither may
-   be the scene or one of the MTL files it names. */
+   Both files go through one tool_output_set (two temporaries renamed into place only when
+   both are complete), and neither may be a file the scene was read from. */
 #include "tool.h"
 #include <ctype.h>
 #include <stdio.h>
@@ -184,17 +184,19 @@ int tool_cmd_export(int argc, char **argv)
         }
         base += md->vertex_count;
     }
-    ok = !ferror(obj.f) && !ferror(mtl.f);
-    if (tool_output_commit(&mtl, ok) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
-        tool_output_abort(&obj);
-        tool_free_scene(&ts);
-        return 1;
-    }
-    if (tool_output_commit(&obj, ok) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
-        tool_free_scene(&ts);
-        return 1;
+    {
+        /* the two files name each other's materials: they replace the old pair together, and
+           each is checked on its own so that an error names the file that hit it */
+        tool_output_set set;
+        memset(&set, 0, sizeof set);
+        ok = tool_output_set_add(&set, &mtl, !ferror(mtl.f)) == 0;
+        if (!ok) tool_output_abort(&obj);
+        else ok = tool_output_set_add(&set, &obj, !ferror(obj.f)) == 0;
+        if (!ok || tool_output_set_commit(&set) != 0) {
+            fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+            tool_free_scene(&ts);
+            return 1;
+        }
     }
     if (ts.light_count)
         fprintf(stderr, "rad %s: warning: %u analytic lights left out (OBJ has no lights)\n", cmd, ts.light_count);

@@ -68,7 +68,7 @@ static char *lightmap_tagged(const char *path, const char *tag)
 /* the view shaded from an RGB irradiance lightmap: one closest hit per sample, the lightmap
    read at the hit's lightmap uv; back faces and misses are black (one-sided like rad trace) */
 static int lightmap_render(const tool_world *w, const rad_lightmap *lm, const float *values, int width, int height,
-                           int aa, const char *path, float exposure)
+                           int aa, const char *path, float exposure, tool_output_set *set)
 {
     rad_camera cam = w->file.camera;
     tool_image img;
@@ -102,10 +102,9 @@ static int lightmap_render(const tool_world *w, const rad_lightmap *lm, const fl
                 }
             for (sx = 0; sx < 3; ++sx) img.rgb[3 * ((size_t)y * width + x) + sx] = acc[sx] / (float)(aa * aa);
         }
-    bad = tool_image_write(path, &img, exposure * 3.14159265f);
+    bad = tool_image_write_into(set, path, &img, exposure * 3.14159265f);
     tool_image_free(&img);
     if (bad) { fprintf(stderr, "rad lightmap: %s\n", tool_output_error()); return 1; }
-    fprintf(stderr, "rad lightmap: wrote the view %s\n", path);
     return 0;
 }
 
@@ -467,6 +466,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             if (hemi_rays == 0 || hemi_rays > 65536) { fprintf(stderr, "rad lightmap: --hemisphere-rays must be 1 to 65536\n"); return 2; }
         } else if (!strcmp(o, "--exposure")) {
             if (tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
+            if (!(exposure > 0.0f)) { fprintf(stderr, "rad lightmap: --exposure must be > 0\n"); return 2; }
         } else if (!strcmp(o, "--threads")) {
             if (tool_parse_threads("lightmap", o, argv[++a], &threads)) return 2;
         } else if (o[0] == '-' && o[1]) {
@@ -522,27 +522,44 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     values = bk.values;
     ch = sh ? 12u : 3u;
     {
+        /* the layers (and the --render view) replace the old files together or not at all */
         tool_image img;
+        tool_output_set set;
         uint32_t layers = sh ? 4u : 1u, l;
         static const char *const tags[4] = {"L00", "L1m1", "L10", "L11"};
-        for (l = 0; l < layers; ++l) {
-            char *path = sh ? lightmap_tagged(out_path, tags[l]) : NULL;
-            const char *dst = path ? path : out_path;
-            int bad;
-            if (tool_image_alloc(&img, width, height)) { free(path); fprintf(stderr, "rad lightmap: out of memory\n"); goto done; }
-            for (i = 0; i < (uint32_t)(width * height); ++i) memcpy(img.rgb + 3 * (size_t)i, values + (size_t)i * ch + 3 * l, 3 * sizeof(float));
-            bad = tool_image_write(dst, &img, exposure);
-            tool_image_free(&img);
-            if (bad) {
-                fprintf(stderr, "rad lightmap: %s\n", tool_output_error());
-                free(path);
-                goto done;
+        char *paths[4] = {NULL, NULL, NULL, NULL};
+        int bad = 0;
+        memset(&set, 0, sizeof set);
+        for (l = 0; l < layers && !bad; ++l) {
+            paths[l] = sh ? lightmap_tagged(out_path, tags[l]) : NULL;
+            if (tool_image_alloc(&img, width, height)) {
+                fprintf(stderr, "rad lightmap: out of memory\n");
+                tool_output_set_abort(&set);
+                bad = 1;
+                break;
             }
-            fprintf(stderr, "rad lightmap: wrote %s\n", dst);
-            free(path);
+            for (i = 0; i < (uint32_t)(width * height); ++i) memcpy(img.rgb + 3 * (size_t)i, values + (size_t)i * ch + 3 * l, 3 * sizeof(float));
+            if (tool_image_write_into(&set, paths[l] ? paths[l] : out_path, &img, exposure) != 0) {
+                fprintf(stderr, "rad lightmap: %s\n", tool_output_error());
+                bad = 1;
+            }
+            tool_image_free(&img);
         }
+        if (!bad && render_path && lightmap_render(&bk.w, lm, values, rw, rh, (int)aa, render_path, exposure, &set)) {
+            tool_output_set_abort(&set);
+            bad = 1;
+        }
+        if (!bad && tool_output_set_commit(&set) != 0) {
+            fprintf(stderr, "rad lightmap: %s\n", tool_output_error());
+            bad = 1;
+        }
+        for (l = 0; l < layers; ++l) {
+            if (!bad) fprintf(stderr, "rad lightmap: wrote %s\n", paths[l] ? paths[l] : out_path);
+            free(paths[l]);
+        }
+        if (bad) goto done;
+        if (render_path) fprintf(stderr, "rad lightmap: wrote the view %s\n", render_path);
     }
-    if (render_path && lightmap_render(&bk.w, lm, values, rw, rh, (int)aa, render_path, exposure)) goto done;
     code = 0;
 done:
     tool_lightmap_bake_free(&bk);

@@ -70,11 +70,11 @@ static void render_usage(FILE *f)
             "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
             "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
             "  --size WxH         image size (default 512x512; at most 2 GiB of image: 12 bytes a pixel)\n"
-            "  --aa N             radiosity methods: stratified samples per pixel, rounded down to a square (default 16)\n"
+            "  --aa N             radiosity methods: stratified samples per pixel, rounded down to a square (default 16, 1 to 65536)\n"
             "  --spp N            pathtrace: samples per pixel (default 64)\n"
             "  --seed S           pathtrace: random seed (default 0)\n"
             "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
-            "  --pixel-light-samples N   radiosity methods: shadow rays per pixel sample and light (default 16)\n"
+            "  --pixel-light-samples N   radiosity methods: shadow rays per pixel sample and light (default 16, at most 65536)\n"
             "  --final-gather N   classic, vp, aavp: trace the first bounce from each pixel sample with N\n"
             "                     rays (direct light at the hits, the solution's irradiance there): the\n"
             "                     indirect light of points a patch average misrepresents; default 0 (off)\n"
@@ -1260,8 +1260,9 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         if (!strcmp(opt, "-o")) out_path = argv[++a];
         else if (!strcmp(opt, "--bake")) bake_path = argv[++a];
         else if (!strcmp(opt, "--camera")) {
-            if (tool_parse_camera(argv[++a], &cam)) {
-                fprintf(stderr, "rad %s: bad camera '%s' (want PX,PY,PZ:TX,TY,TZ:UX,UY,UZ)\n", cmd, argv[a]);
+            const char *why;
+            if (tool_parse_camera(argv[++a], &cam, &why)) {
+                fprintf(stderr, "rad %s: bad --camera '%s': %s\n", cmd, argv[a], why);
                 return 2;
             }
             have_cam = 1;
@@ -1276,13 +1277,13 @@ static int render_main(int argc, char **argv, tool_lights *lights)
             if (tool_check_size(cmd, width, height)) return 2;
         } else if (!strcmp(opt, "--aa")) {
             if (tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
-            if (aa == 0) { fprintf(stderr, "rad %s: --aa must be > 0\n", cmd); return 2; }
+            if (aa == 0 || aa > 65536) { fprintf(stderr, "rad %s: --aa must be 1 to 65536\n", cmd); return 2; }
         } else if (!strcmp(opt, "--spp")) {
             if (tool_parse_uint(cmd, opt, argv[++a], &spp)) return 2;
             if (spp == 0 || spp > 1u << 20) { fprintf(stderr, "rad %s: --spp must be in 1..1048576\n", cmd); return 2; }
         } else if (!strcmp(opt, "--pixel-light-samples")) {
             if (tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
-            if (pixel_light_samples == 0) { fprintf(stderr, "rad %s: %s must be > 0\n", cmd, opt); return 2; }
+            if (pixel_light_samples == 0 || pixel_light_samples > 65536) { fprintf(stderr, "rad %s: %s must be 1 to 65536\n", cmd, opt); return 2; }
         } else if (!strcmp(opt, "--lightmap-size") || !strcmp(opt, "--texel-samples") || !strcmp(opt, "--visibility-rays")) {
             uint32_t *dst = opt[2] == 'l' ? &render_lm_size : opt[2] == 't' ? &render_lm_samples : &render_lm_vis;
             uint32_t lo = opt[2] == 'l' ? 4u : 1u, hi = opt[2] == 'l' ? 16384u : opt[2] == 't' ? 16u : 64u;

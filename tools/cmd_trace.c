@@ -178,8 +178,9 @@ static int trace_main(int argc, char **argv, tool_lights *lights)
     }
     if (camera_text) {
         memset(&cam, 0, sizeof(cam));
-        if (tool_parse_camera(camera_text, &cam) != 0) {
-            fprintf(stderr, "rad trace: --camera wants PX,PY,PZ:TX,TY,TZ:UX,UY,UZ, got '%s'\n", camera_text);
+        const char *why;
+        if (tool_parse_camera(camera_text, &cam, &why) != 0) {
+            fprintf(stderr, "rad trace: bad --camera '%s': %s\n", camera_text, why);
             tool_free_scene(&ts);
             tool_lights_release(light_storage);
             return 2;

@@ -6,6 +6,7 @@
 #endif
 #define RADIOSITY_IMPLEMENTATION
 #include "tool.h"
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -182,28 +183,66 @@ double tool_seconds(void)
 #endif
 }
 
-int tool_parse_camera(const char *text, rad_camera *out)
+const char *tool_vector_problem(const float v[3], int direction)
 {
-    float v[9];
+    float s;
+    int i;
+    for (i = 0; i < 3; ++i) {
+        if (!(v[i] - v[i] == 0.0f)) return "is not finite";
+        if (fabsf(v[i]) > 1e30f) return "has a component beyond 1e30";
+    }
+    if (!direction) return NULL;
+    /* what the library does with a direction: divide by the length computed in float */
+    s = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (!(s <= FLT_MAX)) return "is too long (its squared length overflows a float; scale it down)";
+    if (!(s >= FLT_MIN)) return "is zero (or too short to normalise)";
+    return NULL;
+}
+
+int tool_parse_camera(const char *text, rad_camera *out, const char **why)
+{
+    float v[9], d[3];
     char extra;
+    const char *w;
+    int i;
+    *why = "want PX,PY,PZ:TX,TY,TZ:UX,UY,UZ";
     if (!text) return 1;
     if (sscanf(text, "%f,%f,%f:%f,%f,%f:%f,%f,%f%c", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8],
                &extra) != 9)
         return 1;
+    if ((w = tool_vector_problem(v, 0)) != NULL || (w = tool_vector_problem(v + 3, 0)) != NULL) {
+        *why = w[0] == 'i' ? "a point is not finite" : "a point has a component beyond 1e30";
+        return 1;
+    }
+    for (i = 0; i < 3; ++i) d[i] = v[3 + i] - v[i];
+    if ((w = tool_vector_problem(d, 1)) != NULL) {
+        static char buf[128];
+        snprintf(buf, sizeof buf, "the view direction (target - position) %s", w);
+        *why = buf;
+        return 1;
+    }
+    if ((w = tool_vector_problem(v + 6, 1)) != NULL) {
+        static char buf[128];
+        snprintf(buf, sizeof buf, "the up vector %s", w);
+        *why = buf;
+        return 1;
+    }
     {
-        int i;
-        float d2 = 0.0f, u2 = 0.0f;
-        for (i = 0; i < 9; ++i)
-            if (!(v[i] == v[i]) || fabsf(v[i]) > 1e30f) return 1;
-        for (i = 0; i < 3; ++i) {
-            d2 += (v[3 + i] - v[i]) * (v[3 + i] - v[i]);
-            u2 += v[6 + i] * v[6 + i];
+        /* up along the view direction leaves the image's horizontal axis undefined */
+        double dl = sqrt((double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2]);
+        double ul = sqrt((double)v[6] * v[6] + (double)v[7] * v[7] + (double)v[8] * v[8]);
+        double c0 = ((double)d[1] * v[8] - (double)d[2] * v[7]) / (dl * ul);
+        double c1 = ((double)d[2] * v[6] - (double)d[0] * v[8]) / (dl * ul);
+        double c2 = ((double)d[0] * v[7] - (double)d[1] * v[6]) / (dl * ul);
+        if (!(c0 * c0 + c1 * c1 + c2 * c2 > 1e-12)) {
+            *why = "the up vector is parallel to the view direction";
+            return 1;
         }
-        if (!(d2 > 0.0f) || !(u2 > 0.0f)) return 1;
     }
     memcpy(out->position, v, 3 * sizeof(float));
     memcpy(out->target, v + 3, 3 * sizeof(float));
     memcpy(out->up, v + 6, 3 * sizeof(float));
+    *why = NULL;
     return 0;
 }
 

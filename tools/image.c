@@ -26,6 +26,7 @@
 #include <string.h>
 #include <math.h>
 #include <ctype.h>
+#include <signal.h>
 
 #if defined(__unix__) || defined(__APPLE__)
 #include <sys/stat.h>
@@ -87,6 +88,66 @@ static void output_folder(const char *path, char *buf, size_t cap)
     buf[n] = '\0';
 }
 
+/* ---- temporaries removed on a fatal signal ---------------------------------------------- */
+/* The temporaries now open, copied into fixed slots so that the handler touches no heap and
+   no lock (unlink and raise are async-signal-safe); a slot is filled before it is marked in
+   use and marked free before it is reused. */
+#define OUTPUT_SLOTS 64
+#define OUTPUT_SLOT_PATH 4096
+static char g_slot_path[OUTPUT_SLOTS][OUTPUT_SLOT_PATH];
+static volatile sig_atomic_t g_slot_used[OUTPUT_SLOTS];
+
+#ifdef TOOL_POSIX
+static void output_on_signal(int sig)
+{
+    int i;
+    for (i = 0; i < OUTPUT_SLOTS; ++i)
+        if (g_slot_used[i]) (void)unlink(g_slot_path[i]);
+    /* the handler was installed with SA_RESETHAND: the default action ends the process as
+       the signal would have */
+    (void)raise(sig);
+}
+
+static void output_install_handlers(void)
+{
+    static int done;
+    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE};
+    size_t i;
+    if (done) return;
+    done = 1;
+    for (i = 0; i < sizeof sigs / sizeof sigs[0]; ++i) {
+        struct sigaction sa, old;
+        /* a signal the caller ignores stays ignored (a shell's background job ignores SIGINT;
+           'trap "" XFSZ' turns a file-size limit into EFBIG, which the writers report) */
+        if (sigaction(sigs[i], NULL, &old) != 0 || old.sa_handler == SIG_IGN) continue;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = output_on_signal;
+        sigemptyset(&sa.sa_mask);
+        sa.sa_flags = (int)SA_RESETHAND;
+        (void)sigaction(sigs[i], &sa, NULL);
+    }
+}
+#endif
+
+static int output_register(const char *tmp)
+{
+    int i;
+    if (strlen(tmp) >= OUTPUT_SLOT_PATH) return -1;
+    for (i = 0; i < OUTPUT_SLOTS; ++i)
+        if (!g_slot_used[i]) {
+            strcpy(g_slot_path[i], tmp);
+            g_slot_used[i] = 1;
+            return i;
+        }
+    return -1;
+}
+
+static void output_unregister(tool_output *o)
+{
+    if (o->slot > 0) g_slot_used[o->slot - 1] = 0;
+    o->slot = 0;
+}
+
 int tool_output_open(tool_output *o, const char *path)
 {
     size_t n;
@@ -112,19 +173,22 @@ int tool_output_open(tool_output *o, const char *path)
     memcpy(o->path, path, n + 1);
 #ifdef TOOL_POSIX
     {
-        /* "DIR/.NAME.tmpXXXXXX": same folder, so the rename cannot cross file systems */
+        /* "DIR/.radtmp-XXXXXX": the same folder, so the rename cannot cross file systems, and a
+           short fixed name, so that any destination name the file system takes works.
+           mkstemp creates it with O_EXCL: a symlink or file already there is never followed. */
         const char *slash = strrchr(path, '/');
         size_t dl = slash ? (size_t)(slash - path + 1) : 0;
-        int fd;
+        int fd, slot;
         mode_t mask;
         struct stat st;
+        output_install_handlers();
         if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
             output_error(path, "cannot write", EISDIR);
             tool_output_abort(o);
             return -1;
         }
         memcpy(o->tmp, path, dl);
-        snprintf(o->tmp + dl, n + 32 - dl, ".%s.tmpXXXXXX", path + dl);
+        snprintf(o->tmp + dl, n + 32 - dl, ".radtmp-XXXXXX");
         fd = mkstemp(o->tmp);
         if (fd < 0) {
             char folder[4096];
@@ -136,6 +200,8 @@ int tool_output_open(tool_output *o, const char *path)
             tool_output_abort(o);
             return -1;
         }
+        slot = output_register(o->tmp);
+        o->slot = slot + 1;
         /* mkstemp makes the file 0600: give it the old file's mode, or the one a plain fopen
            would (0666 & ~umask) */
         if (stat(path, &st) == 0) {
@@ -163,6 +229,7 @@ int tool_output_open(tool_output *o, const char *path)
         tool_output_abort(o);
         return -1;
     }
+    o->slot = output_register(o->tmp) + 1;
 #endif
     return 0;
 }
@@ -171,23 +238,35 @@ void tool_output_abort(tool_output *o)
 {
     if (o->f) fclose(o->f);
     if (o->tmp && o->tmp[0]) remove(o->tmp);
+    output_unregister(o);
     free(o->tmp);
     free(o->path);
     memset(o, 0, sizeof *o);
 }
 
-int tool_output_commit(tool_output *o, int ok)
+int tool_output_close(tool_output *o, int ok)
 {
     int e = 0;
     if (!o->f) {
-        tool_output_abort(o);
-        return -1;
+        if (!o->closed) {
+            tool_output_abort(o);
+            return -1;
+        }
+        return 0;
     }
     if (!ok || ferror(o->f)) {
-        if (!g_output_error[0]) output_error(o->path, "error writing", EIO);
+        if (!g_output_error[0]) {
+            /* a failed fprintf keeps no errno: flushing what is left asks the system again
+               (ENOSPC, EFBIG, EIO) */
+            clearerr(o->f);
+            errno = 0;
+            e = fflush(o->f) != 0 && errno ? errno : EIO;
+            output_error(o->path, "error writing", e);
+        }
         tool_output_abort(o);
         return -1;
     }
+    errno = 0;
     if (fflush(o->f) != 0) e = errno ? errno : EIO;
 #ifdef TOOL_POSIX
     if (!e && fsync(fileno(o->f)) != 0 && errno != EINVAL && errno != EROFS) e = errno; /* the bytes are on disk before the rename */
@@ -199,6 +278,13 @@ int tool_output_commit(tool_output *o, int ok)
         tool_output_abort(o);
         return -1;
     }
+    o->closed = 1;
+    return 0;
+}
+
+/* the closed temporary onto its destination; 0 or -1 (the temporary removed) */
+static int output_rename(tool_output *o)
+{
 #ifndef TOOL_POSIX
     remove(o->path); /* rename does not replace a file on every system */
 #endif
@@ -210,6 +296,53 @@ int tool_output_commit(tool_output *o, int ok)
     o->tmp[0] = '\0'; /* it is the destination now */
     tool_output_abort(o);
     return 0;
+}
+
+int tool_output_commit(tool_output *o, int ok)
+{
+    if (tool_output_close(o, ok) != 0) return -1;
+    return output_rename(o);
+}
+
+void tool_output_set_abort(tool_output_set *set)
+{
+    unsigned i;
+    for (i = 0; i < set->count; ++i) tool_output_abort(&set->items[i]);
+    set->count = 0;
+}
+
+int tool_output_set_add(tool_output_set *set, tool_output *o, int ok)
+{
+    if (set->count >= TOOL_OUTPUT_SET_MAX) {
+        output_error(o->path ? o->path : "", "too many files in one set to write", 0);
+        tool_output_abort(o);
+        tool_output_set_abort(set);
+        return -1;
+    }
+    if (tool_output_close(o, ok) != 0) {
+        tool_output_set_abort(set);
+        return -1;
+    }
+    set->items[set->count++] = *o;
+    memset(o, 0, sizeof *o);
+    return 0;
+}
+
+int tool_output_set_commit(tool_output_set *set)
+{
+    unsigned i;
+    int rc = 0;
+    /* every temporary is complete and on disk: only renames are left, which within one folder
+       fail only when the folder changed under us */
+    for (i = 0; i < set->count; ++i) {
+        if (rc != 0) {
+            tool_output_abort(&set->items[i]);
+            continue;
+        }
+        if (output_rename(&set->items[i]) != 0) rc = -1;
+    }
+    set->count = 0;
+    return rc;
 }
 
 int tool_write_file(const char *path, const void *data, size_t size)
@@ -303,7 +436,13 @@ static void tool__swap4(unsigned char *p)
     p[2] = t;
 }
 
-int tool_image_write_pfm(const char *path, const tool_image *img)
+/* an image writer's temporary: renamed now (set NULL) or kept in the set */
+static int output_finish(tool_output *o, int ok, tool_output_set *set)
+{
+    return set ? tool_output_set_add(set, o, ok) : tool_output_commit(o, ok);
+}
+
+static int write_pfm(const char *path, const tool_image *img, tool_output_set *set)
 {
     tool_output o;
     int y, ok = 1;
@@ -334,8 +473,10 @@ int tool_image_write_pfm(const char *path, const tool_image *img)
     }
     if (!ok) output_error(path, "error writing", errno ? errno : EIO);
     free(buf);
-    return tool_output_commit(&o, ok);
+    return output_finish(&o, ok, set);
 }
+
+int tool_image_write_pfm(const char *path, const tool_image *img) { return write_pfm(path, img, NULL); }
 
 /* reads one whitespace-separated header token (skipping '#' comments); 0 on success */
 static int tool__pfm_token(FILE *f, char *tok, size_t cap)
@@ -476,7 +617,7 @@ static void png_sink_write(void *user, void *data, int size)
     }
 }
 
-int tool_image_write_png(const char *path, const tool_image *img, float exposure)
+static int write_png(const char *path, const tool_image *img, float exposure, tool_output_set *set)
 {
     unsigned char *px;
     size_t i, n;
@@ -510,8 +651,10 @@ int tool_image_write_png(const char *path, const tool_image *img, float exposure
         output_error(path, "error writing", sink.errnum);
     }
     free(px);
-    return tool_output_commit(&o, sink.ok);
+    return output_finish(&o, sink.ok, set);
 }
+
+int tool_image_write_png(const char *path, const tool_image *img, float exposure) { return write_png(path, img, exposure, NULL); }
 
 int tool_image_read_png(const char *path, tool_image *img, char *err, size_t errlen)
 {
@@ -579,7 +722,7 @@ static int tool__has_ext(const char *path, const char *ext)
 #ifdef TOOL_EXR
 #include <tinyexr.h>
 
-int tool_image_write_exr(const char *path, const tool_image *img)
+static int write_exr(const char *path, const tool_image *img, tool_output_set *set)
 {
     EXRHeader hd;
     EXRImage im;
@@ -637,8 +780,10 @@ int tool_image_write_exr(const char *path, const tool_image *img)
     ok = fwrite(mem, 1, size, o.f) == size;
     if (!ok) output_error(path, "error writing", errno ? errno : EIO);
     free(mem);
-    return tool_output_commit(&o, ok);
+    return output_finish(&o, ok, set);
 }
+
+int tool_image_write_exr(const char *path, const tool_image *img) { return write_exr(path, img, NULL); }
 
 int tool_image_read_exr(const char *path, tool_image *img, char *err, size_t errlen)
 {
@@ -671,13 +816,16 @@ int tool_image_read_exr(const char *path, tool_image *img, char *err, size_t err
     return 0;
 }
 #else
-int tool_image_write_exr(const char *path, const tool_image *img)
+static int write_exr(const char *path, const tool_image *img, tool_output_set *set)
 {
     (void)img;
+    (void)set;
     output_error(path ? path : "", "cannot write OpenEXR (this rad was built without tinyexr: install libtinyexr-dev "
                  "and rebuild) to", 0);
     return -1;
 }
+
+int tool_image_write_exr(const char *path, const tool_image *img) { return write_exr(path, img, NULL); }
 
 int tool_image_read_exr(const char *path, tool_image *img, char *err, size_t errlen)
 {
@@ -688,16 +836,23 @@ int tool_image_read_exr(const char *path, tool_image *img, char *err, size_t err
 }
 #endif
 
+int tool_image_write_into(tool_output_set *set, const char *path, const tool_image *img, float exposure)
+{
+    int rc = -1;
+    g_output_error[0] = '\0';
+    /* PFM holds the radiance itself: exposure applies to the 8-bit PNG only */
+    if (!path) output_error("", "no output file given:", 0);
+    else if (tool__has_ext(path, ".pfm")) rc = write_pfm(path, img, set);
+    else if (tool__has_ext(path, ".png")) rc = write_png(path, img, exposure, set);
+    else if (tool__has_ext(path, ".exr")) rc = write_exr(path, img, set);
+    else output_error(path, "cannot write (want a .png, .pfm or .exr name)", 0);
+    if (rc != 0 && set) tool_output_set_abort(set);
+    return rc;
+}
+
 int tool_image_write(const char *path, const tool_image *img, float exposure)
 {
-    g_output_error[0] = '\0';
-    if (!path) return -1;
-    /* PFM holds the radiance itself: exposure applies to the 8-bit PNG only */
-    if (tool__has_ext(path, ".pfm")) return tool_image_write_pfm(path, img);
-    if (tool__has_ext(path, ".png")) return tool_image_write_png(path, img, exposure);
-    if (tool__has_ext(path, ".exr")) return tool_image_write_exr(path, img);
-    output_error(path, "cannot write (want a .png, .pfm or .exr name)", 0);
-    return -1;
+    return tool_image_write_into(NULL, path, img, exposure);
 }
 
 int tool_image_check_format(const char *cmd, const char *path)

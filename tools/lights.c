@@ -44,7 +44,7 @@
 
 const char *tool_light_help(void)
 {
-    return "lights added to the scene's own (repeatable; RGB is R,G,B or one grey value):\n"
+    return "lights added to the scene's own (repeatable; RGB is R,G,B or one grey value, each 0 to 1e20):\n"
            "  --sun DIR:RGB      directional light travelling along DIR (0,-1,0: down); RGB = irradiance\n"
            "                     in W/m^2 on a surface facing it\n"
            "  --sky RGB          uniform sky of radiance RGB (W/m^2/sr): an unoccluded surface gets pi RGB\n"
@@ -85,14 +85,25 @@ static int parse_numbers(const char *s, size_t len, float *out, int count)
     return *p != 0;
 }
 
-/* an RGB: three numbers or one grey value, each >= 0 */
+/* An RGB: three numbers or one grey value, each in [0, TOOL_MAX_LIGHT_VALUE]; 0 on success,
+   1 when not numbers >= 0, 2 when one is beyond the limit */
 static int parse_rgb(const char *s, size_t len, float *rgb)
 {
     if (parse_numbers(s, len, rgb, 3) != 0) {
         if (parse_numbers(s, len, rgb, 1) != 0) return 1;
         rgb[1] = rgb[2] = rgb[0];
     }
-    return !(rgb[0] >= 0.0f && rgb[1] >= 0.0f && rgb[2] >= 0.0f);
+    if (!(rgb[0] >= 0.0f && rgb[1] >= 0.0f && rgb[2] >= 0.0f)) return 1;
+    return rgb[0] > TOOL_MAX_LIGHT_VALUE || rgb[1] > TOOL_MAX_LIGHT_VALUE || rgb[2] > TOOL_MAX_LIGHT_VALUE ? 2 : 0;
+}
+
+/* "DIR is too long (...)" into buf, or NULL when v is fine (tool_vector_problem) */
+static const char *vector_why(const float *v, int direction, const char *name, char *buf, size_t cap)
+{
+    const char *w = tool_vector_problem(v, direction);
+    if (!w) return NULL;
+    snprintf(buf, cap, "%s %s", name, w);
+    return buf;
 }
 
 static float len3(const float *v) { return sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
@@ -273,8 +284,9 @@ int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_light
                                         "P:U:V:RGB, e.g. -0.2,1.9,-0.2:0.4,0,0:0,0,0.4:15"};
     static const int nparts[] = {2, 1, 2, 4, 4};
     const char *opt = argv[*a], *text, *part[5], *why = NULL;
+    char buf[160];
     size_t plen[5];
-    int i, n;
+    int i, n, rgb;
     rad_light li;
     tool_area_light al;
     if (!strcmp(opt, "--env")) {
@@ -338,13 +350,14 @@ int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_light
     n = split_parts(text, part, plen, 4);
     if (n != nparts[i]) {
         why = "wrong number of ':'-separated parts";
-    } else if (parse_rgb(part[n - 1], plen[n - 1], i == 4 ? al.radiance : li.color)) {
-        why = "the RGB is not one or three numbers >= 0";
+    } else if ((rgb = parse_rgb(part[n - 1], plen[n - 1], i == 4 ? al.radiance : li.color)) != 0) {
+        why = rgb == 1 ? "the RGB is not one or three numbers >= 0"
+                       : "the RGB has a value above 1e20, which overflows the light's transport in float";
     } else switch (i) {
     case 0:
         li.type = RAD_LIGHT_DIRECTIONAL;
         if (parse_numbers(part[0], plen[0], li.direction, 3)) why = "DIR is not three numbers";
-        else if (!(len3(li.direction) > 0.0f)) why = "DIR is zero";
+        else why = vector_why(li.direction, 1, "DIR", buf, sizeof buf);
         break;
     case 1:
         li.type = RAD_LIGHT_SKY;
@@ -359,7 +372,7 @@ int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_light
         li.type = RAD_LIGHT_SPOT;
         if (parse_numbers(part[0], plen[0], li.position, 3)) why = "POS is not three numbers";
         else if (parse_numbers(part[1], plen[1], li.direction, 3)) why = "DIR is not three numbers";
-        else if (!(len3(li.direction) > 0.0f)) why = "DIR is zero";
+        else if ((why = vector_why(li.direction, 1, "DIR", buf, sizeof buf)) != NULL) break;
         else if (parse_numbers(part[2], plen[2], ang, 2) == 0) {
             if (!(ang[0] >= 0.0f && ang[1] > ang[0] && ang[1] <= 180.0f)) why = "ANGLES must be 0 <= INNER < OUTER <= 180 degrees";
             li.inner_angle = (float)(ang[0] * LIGHTS_DEG), li.outer_angle = (float)(ang[1] * LIGHTS_DEG);
@@ -379,7 +392,8 @@ int tool_light_option(const char *cmd, int argc, char **argv, int *a, tool_light
         c[0] = al.u[1] * al.v[2] - al.u[2] * al.v[1];
         c[1] = al.u[2] * al.v[0] - al.u[0] * al.v[2];
         c[2] = al.u[0] * al.v[1] - al.u[1] * al.v[0];
-        if (!(len3(c) > 0.0f)) why = "U and V span no area";
+        /* U x V is the light's normal: it must normalise in float as a direction does */
+        if (tool_vector_problem(c, 1)) why = !(len3(c) > 0.0f) ? "U and V span no area" : "U and V: their area (|U x V|) does not fit a float";
         break;
     }
     }

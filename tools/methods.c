@@ -286,7 +286,7 @@ int tool_method_option(const char *cmd, int argc, char **argv, int *a, tool_meth
                 ok = sscanf(v + 5, "%f,%f,%f:%f,%f,%f%c", q, q + 1, q + 2, q + 3, q + 4, q + 5, &tail) == 6, mo->light_path = 1;
             else if (!strncmp(v, "circle:", 7))
                 ok = sscanf(v + 7, "%f,%f,%f:%f%c", q, q + 1, q + 2, q + 3, &tail) == 4 && q[3] > 0.0f, mo->light_path = 2;
-            for (i = 0; ok && i < 6; ++i) ok = q[i] - q[i] == 0.0f; /* finite */
+            ok = ok && !tool_vector_problem(q, 0) && !tool_vector_problem(q + 3, 0); /* finite, within 1e30 */
             if (!ok) {
                 fprintf(stderr, "rad %s: --light-path must be line:X0,Y0,Z0:X1,Y1,Z1 or circle:CX,CY,CZ:R (R > 0), not '%s'\n",
                         cmd, v);

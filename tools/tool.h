@@ -76,20 +76,42 @@ int tool_image_read_hdr(const char *path, tool_image *img, char *err, size_t err
 unsigned char tool_image_srgb8(float linear);
 
 /* ---- output files (image.c): every file the tool writes ------------------------------- */
-/* A temporary file in the destination's folder, renamed onto it by tool_output_commit
-   only when everything was written: a failure leaves the old file (if any) untouched and no
-   temporary behind. The image writers and the bake writers all use it. */
+/* A temporary file ".radtmp-XXXXXX" created exclusively (never through a symlink) in the
+   destination's folder, renamed onto it by tool_output_commit only when everything was
+   written, flushed and synced: a failure leaves the old file (if any) untouched and no
+   temporary behind, and a fatal signal (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGXFSZ, SIGPIPE,
+   unless ignored when rad started) removes the open temporaries before the process ends.
+   The image writers and the bake writers all use it. */
 typedef struct tool_output {
     FILE *f;        /* write here */
     char *path;     /* the destination */
     char *tmp;      /* the temporary */
+    int slot;       /* private: the signal handler's record of tmp (0: none) */
+    int closed;     /* private: tool_output_close succeeded */
 } tool_output;
 /* 0, or -1 with the reason in tool_output_error() */
 int tool_output_open(tool_output *o, const char *path);
 /* ok: 1 when every write succeeded. Flushes, syncs, closes and renames; on any failure
    removes the temporary and returns -1 (reason in tool_output_error()). */
 int tool_output_commit(tool_output *o, int ok);
+/* the same without the rename: the temporary is complete on disk (0), or removed (-1) */
+int tool_output_close(tool_output *o, int ok);
 void tool_output_abort(tool_output *o); /* closes and removes the temporary */
+/* Files that replace their destinations together (OBJ + MTL, the layers of an SH lightmap):
+   each one is written and closed into its temporary (tool_output_set_add), and only when all
+   of them are, tool_output_set_commit renames them all; any failure before that removes every
+   temporary of the set and leaves each old file as it was. */
+#define TOOL_OUTPUT_SET_MAX 8
+typedef struct tool_output_set {
+    tool_output items[TOOL_OUTPUT_SET_MAX];
+    unsigned count;
+} tool_output_set; /* zero-initialise */
+/* closes o (tool_output_close) into the set; on a failure aborts o and the whole set; 0 or -1 */
+int tool_output_set_add(tool_output_set *set, tool_output *o, int ok);
+int tool_output_set_commit(tool_output_set *set); /* 0 or -1 (reason in tool_output_error()) */
+void tool_output_set_abort(tool_output_set *set);
+/* tool_image_write into a set (NULL: written at once); on a failure the set is aborted */
+int tool_image_write_into(tool_output_set *set, const char *path, const tool_image *img, float exposure);
 /* size bytes to path through the above; 0 or -1 */
 int tool_write_file(const char *path, const void *data, size_t size);
 /* why the last output (or image write) failed, e.g. "cannot write 'x.png': cannot create a
@@ -154,8 +176,13 @@ void tool_set_threads(int threads);
 /* --threads N: a whole number in 0..TOOL_MAX_THREADS; 0 on success, else prints
    "rad CMD: ..." and returns 2 */
 int tool_parse_threads(const char *cmd, const char *opt, const char *text, uint32_t *out);
-/* parses "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ"; 0 on success */
-int tool_parse_camera(const char *text, rad_camera *out);
+/* parses "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ" (the points finite, within 1e30; the view direction and
+   up as tool_vector_problem's directions, not parallel); 0, or 1 with *why saying what is wrong */
+int tool_parse_camera(const char *text, rad_camera *out, const char **why);
+/* NULL when v is usable, else why not ("is not finite" ...): every component finite and within
+   1e30; a direction (direction != 0) also normalisable in float: its squared length finite
+   (a direction of length ~2e19 overflows and the library would take it as zero) and not zero */
+const char *tool_vector_problem(const float v[3], int direction);
 /* parses "WxH"; 0 on success */
 int tool_parse_size(const char *text, int *w, int *h);
 /* The most memory an image may take (linear RGB floats, 12 bytes a pixel): 2 GiB, e.g.
@@ -188,6 +215,10 @@ double tool_seconds(void);
 typedef struct tool_area_light {
     float p[3], u[3], v[3], radiance[3];
 } tool_area_light;
+/* The largest light value a light option takes (W/m^2, W/sr, W m^-2 sr^-1): past it the
+   transport (sky E_0 = pi RGB, times albedo, over bounces) overflows what a bake keeps
+   (RAD_BAKE_VALUE_MAX), so the option is refused instead of the save at the end. */
+#define TOOL_MAX_LIGHT_VALUE 1e20f
 /* What --sun, --sky, --point, --spot and --area gave (units: lights.c and tool_light_help) */
 typedef struct tool_lights {
     rad_light *lights;              /* the analytic ones, in the library's units */
