@@ -18730,7 +18730,7 @@ RAD_API rad_result rad_vp_lights_update(rad_vp_lights *s, const rad_light *light
                 if (!s->env[l]) s->env[l] = (float *)rad__alloc_array(&s->allocator, M ? (size_t)M : 1u, 3 * sizeof(float));
                 if (!s->env[l]) return RAD_ERROR_OUT_OF_MEMORY;
                 unit.color[0] = unit.color[1] = unit.color[2] = 1.0f;
-                o.include_emitters = 0;
+                o.exclude_emitters = 1;
                 s->env_key[l] = 0;
                 r = rad_direct_irradiance(s->vp->scene, s->rc, &unit, 1, &o, s->vp->sample_positions, s->vp->sample_normals,
                                           M, s->env[l], ctx);
@@ -22208,7 +22208,7 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
 #define RAD__BAKER_PART(a, z) if (rad__baker_stage(&b->prog, lo + (hi - lo) * (a), lo + (hi - lo) * (z))) return RAD_ERROR_CANCELLED
     RAD__BAKER_PART(0.0f, 0.3f);
     rad_direct_options_default(&dopt);
-    dopt.include_emitters = b->group_emits[g];
+    dopt.exclude_emitters = !b->group_emits[g];
     dopt.light_samples = b->o.light_samples;
     dopt.seed = b->o.seed;
     rad_solve_options_default(&so);

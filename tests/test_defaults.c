@@ -30,7 +30,7 @@ static float *df_floats(size_t n)
 }
 
 static const rad_light df_sun = { RAD_LIGHT_DIRECTIONAL, { 3.0f, 3.0f, 3.0f }, { 0, 0, 0 }, { 0.3f, -1.0f, 0.2f },
-                                  RAD_FALLOFF_QUADRATIC, 0.0f, 0.0f, 0.0f };
+                                  RAD_FALLOFF_QUADRATIC, 0.0f, 0.0f, 0.0f, NULL };
 
 static void df_patches(void)
 {

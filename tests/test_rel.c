@@ -235,7 +235,7 @@ static double rl_floor_light(const rad_scene *S, const rad_raycaster *rc, const 
         n[3 * i + 2] = 0.0f;
     }
     rad_direct_options_default(&o);
-    o.include_emitters = 0;
+    o.exclude_emitters = 1;
     *res = rad_direct_irradiance(S, rc, L, 1, &o, p, n, 64, e, &ctx);
     if (*res != RAD_SUCCESS) return -1.0;
     for (i = 0; i < 64; ++i) sum += e[3 * i];
