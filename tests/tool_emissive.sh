@@ -86,3 +86,13 @@ for em_m in hierarchical aavp; do
         fail "--method $em_m render of the textured glTF box" "$(head -c 300 "$TMP/em_err.txt")"
     fi
 done
+# unnamed materials, the lamp's mesh first: assimp numbers materials by first use, not in the
+# file's order, so the strength is matched by base colour and emissive factor, not by index
+if "$RAD" render "$EM_DIR/cornell_unnamed.gltf" -o "$TMP/em_un.pfm" --size 48x48 --aa 4 --patches 150 > /dev/null 2> "$TMP/em_err.txt" &&
+    [ -f "$TMP/em_gltf.pfm" ]; then
+    set -- $(em_mean "$TMP/em_un.pfm" "$TMP/em_gltf.pfm")
+    close "$1" "$2" 0.01 && ok "unnamed glTF materials in another order keep the lamp's strength ($1 vs $2)" ||
+        fail "unnamed glTF materials in another order keep the lamp's strength" "mean $1 vs $2"
+else
+    fail "render of the unnamed glTF Cornell box" "$(head -c 300 "$TMP/em_err.txt")"
+fi
