@@ -662,6 +662,14 @@ static void rep_add(char **r, const char *fmt, const char *a, const char *b)
     (*r)[n + strlen(line) + 1] = 0;
 }
 
+/* appends "item what" to the comma-separated list in buf (cap bytes), "..." once it is full */
+static void list_add(char *buf, size_t cap, const char *item, const char *what)
+{
+    size_t n = strlen(buf), need = strlen(item) + strlen(what) + 2;
+    if (n + need + 4 < cap) snprintf(buf + n, cap - n, "%s%s%s", n ? ", " : "", item, what);
+    else if (n + 5 < cap && strcmp(buf + (n > 3 ? n - 3 : 0), "...")) snprintf(buf + n, cap - n, ", ...");
+}
+
 /* whether texture-info object t carries KHR_texture_transform */
 static int gltf_has_transform(const char *t)
 {
@@ -678,7 +686,7 @@ static void gltf_report(const char *m, char **r)
     char key[128], val[64], ign[1024] = "";
     const char *v, *pbr = js_get(m, "pbrMetallicRoughness"), *ext = js_get(m, "extensions");
     unsigned i, j, transform = 0;
-    size_t n = 0;
+    size_t n;
     if ((v = js_get(m, "doubleSided")) != NULL)
         rep_add(r, "  doubleSided: %s (read; the importer does not use it)", !strncmp(v, "true", 4) ? "true" : "false", NULL);
     if ((v = js_get(m, "alphaMode")) != NULL) {
@@ -694,16 +702,15 @@ static void gltf_report(const char *m, char **r)
     for (i = 0; (v = js_member(m, i, key, sizeof key)) != NULL; ++i) {
         for (j = 0; used[j] && strcmp(used[j], key); ++j) {}
         if (!used[j])
-            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s%s", n ? ", " : "", key,
-                                  strstr(key, "Texture") ? " (not diffuse)" : "");
+            list_add(ign, sizeof ign, key, strstr(key, "Texture") ? " (not diffuse)" : "");
     }
     for (i = 0; pbr && (v = js_member(pbr, i, key, sizeof key)) != NULL; ++i)
         if (strcmp(key, "baseColorFactor") && strcmp(key, "baseColorTexture"))
-            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s (not diffuse)", n ? ", " : "", key);
+            list_add(ign, sizeof ign, key, " (not diffuse)");
     for (i = 0; ext && (v = js_member(ext, i, key, sizeof key)) != NULL; ++i)
         if (strcmp(key, "KHR_materials_emissive_strength"))
-            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s (extension)", n ? ", " : "", key);
-    if (n) rep_add(r, "  ignored: %s%s", ign, NULL);
+            list_add(ign, sizeof ign, key, " (extension)");
+    if ((n = strlen(ign)) > 0) rep_add(r, "  ignored: %s%s", ign, NULL);
 }
 
 /* ---- vertex welding ------------------------------------------------------------------------ */
