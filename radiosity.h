@@ -874,11 +874,13 @@ RAD_API void rad_direct_options_default(rad_direct_options *options);
    sky (cosine-weighted shadow rays) and, unless exclude_emitters, every emissive triangle
    (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
    shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
-   gets the light of its visible part). A point receives nothing from behind its normal; normals need not
+   gets the light of its visible part; with an emission_texture each ray also carries the
+   texture at its point: docs/methods/emission.md). A point receives nothing from behind its normal; normals need not
    be unit (they are normalized), a zero one is refused. 'samples' is unused here.
    Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, a negative
    min_distance, a zero normal or ray_epsilon outside (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that
-   overflows float), NEGATIVE_EMISSION (a negative light colour), RAYCAST_FAILED. */
+   overflows float), NEGATIVE_EMISSION (a negative light colour, or an emission_lookup value
+   that is negative or not finite), RAYCAST_FAILED. */
 RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
                                          const rad_light *lights, uint32_t light_count,
                                          const rad_direct_options *options, const float *points,
@@ -2399,9 +2401,9 @@ RAD_API rad_result rad_vp_from_samples(const rad_virtual_patches *vp, const floa
 /* The source E per patch (3N floats) one of the two ways of UNITS AND CONVENTIONS, through
    rad_vp_from_samples: RAD_SOURCE_DIRECT: v_i = rho_i D_i, D_i the direct irradiance at
    sample i (rad_direct_irradiance with the lights; the emitters' own emission is kept out);
-   RAD_SOURCE_EMISSION: v_i = pi L_i, L_i the emission at the sample (rad_scene_emission; lights unused, raycaster may be
-   NULL). Errors: those of rad_direct_irradiance, NEGATIVE_EMISSION, OUT_OF_MEMORY. Cost: O(M) direct-light
-   evaluations. docs/methods/virtual-patches.md. */
+   RAD_SOURCE_EMISSION: v_i = pi L_i, L_i the emission at the sample (rad_scene_emission;
+   lights unused, raycaster may be NULL). Errors: those of rad_direct_irradiance,
+   NEGATIVE_EMISSION, OUT_OF_MEMORY. Cost: O(M) direct-light evaluations. docs/methods/virtual-patches.md. */
 RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_raycaster *raycaster,
                                   const rad_light *lights, uint32_t light_count, const rad_direct_options *options,
                                   rad_source_mode mode, float *out_E, const rad_context *ctx);
@@ -3630,7 +3632,8 @@ RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash);
                  has uvs, else 0.
    Indices are covered (positions are per triangle), and the geometric normals and areas follow
    from the positions; shading normals are not kept by rad_scene, and a texture's contents
-   (the albedo_lookup and emission_lookup callbacks) cannot be hashed, only its id. Either output may be NULL.
+   (the albedo_lookup and emission_lookup callbacks) cannot be hashed, only its id. Either
+   output may be NULL.
    Errors: INVALID_ARGUMENT. Cost: O(triangles), no allocation. Thread safety: pure. */
 RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry, uint64_t *out_materials);
 

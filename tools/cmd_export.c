@@ -10,7 +10,8 @@
    as radiance, so the round trip keeps the light). Numbers are printed with 9 significant
    digits, which a float reads back exactly. What OBJ cannot hold is reported on stderr and
    left out: the scene's camera (written as a comment, with the --camera/--fov options that
-   restore it), analytic lights, and albedo textures (the material's colour factor is written).
+   restore it), analytic lights, and albedo and emission textures (the material's colour
+   factor, Kd or Ke, is written).
    Both files go through one tool_output_set (two temporaries renamed into place only when
    both are complete), and neither may be a file the scene was read from. */
 #include "tool.h"
@@ -25,7 +26,7 @@ static void export_usage(FILE *f)
                "  writes SCENE ('cornell' or any file rad reads) as OUT.obj and OUT.mtl beside it:\n"
                "  one 'o' per mesh, one 'usemtl' per run of a material, Kd = albedo, Ke = emitted\n"
                "  radiance. The camera goes into a comment (with the --camera and --fov that restore\n"
-               "  it); analytic lights and albedo textures are left out with a warning.\n");
+               "  it); analytic lights and albedo and emission textures are left out with a warning.\n");
 }
 
 /* a name usable after 'o', 'usemtl' and 'newmtl': no whitespace or control characters */
@@ -147,7 +148,7 @@ int tool_cmd_export(int argc, char **argv)
         fprintf(mtl.f, "newmtl m%u%s%s\n", m, name[0] ? "_" : "", name);
         write_rgb(mtl.f, "Kd", mat->albedo);
         write_rgb(mtl.f, "Ke", mat->emission);
-        if (mat->texture) ++textured;
+        if (mat->texture || mat->emission_texture) ++textured;
     }
 
     fprintf(obj.f, "# written by rad export from '%s'\n", scene_name);
@@ -201,7 +202,7 @@ int tool_cmd_export(int argc, char **argv)
     if (ts.light_count)
         fprintf(stderr, "rad %s: warning: %u analytic lights left out (OBJ has no lights)\n", cmd, ts.light_count);
     if (textured)
-        fprintf(stderr, "rad %s: warning: %u textured materials written with their colour factor only (textures left out)\n",
+        fprintf(stderr, "rad %s: warning: %u textured materials written with their colour factors only (albedo and emission textures left out)\n",
                 cmd, textured);
     printf("wrote %s and %s (%u meshes, %u triangles, %u materials)\n", out_path, mtl_path, d->mesh_count, written_tris,
            d->material_count);

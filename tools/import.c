@@ -672,6 +672,14 @@ static void rep_add(char **r, const char *fmt, const char *a, const char *b)
     (*r)[n + strlen(line) + 1] = 0;
 }
 
+/* appends "item what" to the comma-separated list in buf (cap bytes), "..." once it is full */
+static void list_add(char *buf, size_t cap, const char *item, const char *what)
+{
+    size_t n = strlen(buf), need = strlen(item) + strlen(what) + 2;
+    if (n + need + 4 < cap) snprintf(buf + n, cap - n, "%s%s%s", n ? ", " : "", item, what);
+    else if (n + 5 < cap && strcmp(buf + (n > 3 ? n - 3 : 0), "...")) snprintf(buf + n, cap - n, ", ...");
+}
+
 /* whether texture-info object t carries KHR_texture_transform */
 static int gltf_has_transform(const char *t)
 {
@@ -688,7 +696,7 @@ static void gltf_report(const char *m, char **r)
     char key[128], val[64], ign[1024] = "";
     const char *v, *pbr = js_get(m, "pbrMetallicRoughness"), *ext = js_get(m, "extensions");
     unsigned i, j, transform = 0;
-    size_t n = 0;
+    size_t n;
     if ((v = js_get(m, "doubleSided")) != NULL)
         rep_add(r, "  doubleSided: %s (read; the importer does not use it)", !strncmp(v, "true", 4) ? "true" : "false", NULL);
     if ((v = js_get(m, "alphaMode")) != NULL) {
@@ -704,16 +712,15 @@ static void gltf_report(const char *m, char **r)
     for (i = 0; (v = js_member(m, i, key, sizeof key)) != NULL; ++i) {
         for (j = 0; used[j] && strcmp(used[j], key); ++j) {}
         if (!used[j])
-            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s%s", n ? ", " : "", key,
-                                  strstr(key, "Texture") ? " (not diffuse)" : "");
+            list_add(ign, sizeof ign, key, strstr(key, "Texture") ? " (not diffuse)" : "");
     }
     for (i = 0; pbr && (v = js_member(pbr, i, key, sizeof key)) != NULL; ++i)
         if (strcmp(key, "baseColorFactor") && strcmp(key, "baseColorTexture"))
-            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s (not diffuse)", n ? ", " : "", key);
+            list_add(ign, sizeof ign, key, " (not diffuse)");
     for (i = 0; ext && (v = js_member(ext, i, key, sizeof key)) != NULL; ++i)
         if (strcmp(key, "KHR_materials_emissive_strength"))
-            n += (size_t)snprintf(ign + n, n < sizeof ign ? sizeof ign - n : 0, "%s%s (extension)", n ? ", " : "", key);
-    if (n) rep_add(r, "  ignored: %s%s", ign, NULL);
+            list_add(ign, sizeof ign, key, " (extension)");
+    if ((n = strlen(ign)) > 0) rep_add(r, "  ignored: %s%s", ign, NULL);
 }
 
 /* ---- vertex welding ------------------------------------------------------------------------ */
@@ -1060,26 +1067,62 @@ static void default_camera(const float bmin[3], const float bmax[3], rad_camera 
     cam->up[0] = 0.0f, cam->up[1] = 1.0f, cam->up[2] = 0.0f;
 }
 
-/* glTF material i of the JSON, when assimp's material i is it: same name, or the JSON's is
-   unnamed; else the JSON material of that name (NULL: none, as for assimp's default material) */
-static const char *material_json(const char *json, uint32_t i, const char *name)
+/* up to n numbers of JSON array a into out; how many were read */
+static int js_floats(const char *a, float *out, int n)
 {
-    const char *m = gltf_material(json, i), *nm;
+    int k;
+    const char *v;
+    for (k = 0; k < n && (v = js_at(a, (unsigned)k)) != NULL; ++k) out[k] = (float)strtod(v, NULL);
+    return k;
+}
+
+/* 1 when glTF material m has the base colour and emissive factor of assimp's material am */
+static int gltf_same_factors(const char *m, const struct aiMaterial *am)
+{
+    float base[4] = {1, 1, 1, 1}, em[3] = {0, 0, 0};
+    const char *pbr = js_get(m, "pbrMetallicRoughness"), *v;
+    struct aiColor4D c;
+    int k;
+    if (pbr && (v = js_get(pbr, "baseColorFactor")) != NULL) js_floats(v, base, 4);
+    if ((v = js_get(m, "emissiveFactor")) != NULL) js_floats(v, em, 3);
+    if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &c) == aiReturn_SUCCESS)
+        for (k = 0; k < 3; ++k)
+            if (!(fabsf((&c.r)[k] - base[k]) <= 1e-5f)) return 0;
+    if (aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &c) != aiReturn_SUCCESS) c.r = c.g = c.b = 0.0f;
+    for (k = 0; k < 3; ++k)
+        if (!(fabsf((&c.r)[k] - em[k]) <= 1e-5f)) return 0;
+    return 1;
+}
+
+/* The glTF material (its JSON object) that assimp's material i is, or NULL (assimp's default
+   material). assimp does not keep the file's order (it numbers materials as meshes first use
+   them), so a named material is found by its name; an unnamed one among the unnamed by its
+   base colour and emissive factor. *ambiguous: set when unnamed candidates alike in both
+   differ in their emissive strength (which one is which cannot be told). */
+static const char *material_json(const char *json, uint32_t i, const char *name, const struct aiMaterial *am, int *ambiguous)
+{
+    const char *m, *nm, *found = NULL;
     char jn[256];
     unsigned j;
+    *ambiguous = 0;
     if (!json) return NULL;
-    if (m) {
+    for (j = 0; (m = gltf_material(json, j)) != NULL; ++j) {
         nm = js_get(m, "name");
-        if (!nm) return m;
-        js_string(nm, jn, sizeof jn);
-        if (!strcmp(jn, name)) return m;
-    }
-    for (j = 0; (m = gltf_material(json, j)) != NULL; ++j)
-        if ((nm = js_get(m, "name")) != NULL) {
-            js_string(nm, jn, sizeof jn);
-            if (name[0] && !strcmp(jn, name)) return m;
+        if (nm) js_string(nm, jn, sizeof jn);
+        else jn[0] = 0;
+        if (name[0]) {
+            if (!strcmp(jn, name)) return m;
+            continue;
         }
-    return NULL;
+        if (jn[0] || !gltf_same_factors(m, am)) continue;
+        if (!found || j == i) {
+            if (found && gltf_emissive_strength(found) != gltf_emissive_strength(m)) *ambiguous = 1;
+            found = m;
+        } else if (gltf_emissive_strength(found) != gltf_emissive_strength(m)) {
+            *ambiguous = 1;
+        }
+    }
+    return found;
 }
 
 static const char *texture_name(const imp_storage *st, uint32_t id)
@@ -1252,7 +1295,22 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     json = gltf_json(path_or_name);
     for (i = 0; i < st->material_count; ++i) {
         if (i < sc->mNumMaterials) {
-            const char *gm = material_json(json, i, st->material_names[i]);
+            int ambiguous = 0;
+            const char *gm = material_json(json, i, st->material_names[i], sc->mMaterials[i], &ambiguous);
+            if (ambiguous) {
+                char n[32];
+                snprintf(n, sizeof n, "%u", i);
+                set_err(err, errlen,
+                        "'%s': material %s is unnamed, and so are other glTF materials of the same base colour and emissive "
+                        "factor but another KHR_materials_emissive_strength: which is which cannot be told (give the "
+                        "materials names)",
+                        path_or_name, n);
+                free(clamped);
+                free(json);
+                aiReleaseImport(sc);
+                tool_free_scene(out);
+                return 1;
+            }
             if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, gltf_emissive_strength(gm), &st->materials[i],
                                  &clamped[i], err, errlen)) {
                 free(clamped);

@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
-"""mk_cornell_gltf.py OBJ OUT.gltf [--texture]: an OBJ + MTL (as `rad export cornell` writes
+"""mk_cornell_gltf.py OBJ OUT.gltf [--texture] [--unnamed]: an OBJ + MTL (as `rad export cornell` writes
 it) as a glTF 2.0 file with one embedded buffer. Each material's Ke becomes emissiveFactor
 Ke / max(Ke) times KHR_materials_emissive_strength max(Ke), the usual way to write a radiance
 above 1. With --texture the emitters also get an emissiveTexture: a 2 x 2 black and white
-checker (an embedded PNG) over uvs 0..1 across each emitter, whose mean is one half."""
+checker (an embedded PNG) over uvs 0..1 across each emitter, whose mean is one half. With
+--unnamed the materials have no names and the emitters' meshes come first (an importer that
+numbers materials by first use then sees them in another order than the file's)."""
 import base64, json, struct, sys, zlib
 
 obj, out = sys.argv[1], sys.argv[2]
 textured = '--texture' in sys.argv[3:]
+unnamed = '--unnamed' in sys.argv[3:]
 mtl, cur, mats, order = None, None, {}, []
 verts, meshes, name, usemtl = [], [], 'mesh', None
 for line in open(obj):
@@ -32,6 +35,8 @@ def png(rows):  # 8-bit RGB
     return (b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', len(rows[0]), len(rows), 8, 2, 0, 0, 0)) +
             chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
 
+if unnamed:
+    meshes.sort(key=lambda me: 0 if max(mats[me[1]].get('Ke', [0.0])) > 0 else 1)
 materials = []
 for m in order:
     kd, ke = mats[m].get('Kd', [0.5] * 3), mats[m].get('Ke', [0.0] * 3)
@@ -41,6 +46,7 @@ for m in order:
         g['emissiveFactor'] = [k / s for k in ke]
         if s != 1: g['extensions'] = {'KHR_materials_emissive_strength': {'emissiveStrength': s}}
         if textured: g['emissiveTexture'] = {'index': 0}
+    if unnamed: del g['name']
     materials.append(g)
 buf, views, accessors, gmeshes, nodes = b'', [], [], [], []
 def add(data, target=None):
