@@ -20576,7 +20576,10 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
 #define RAD__BAKER_RAY_RATE 5e6        /* shadow rays per second and thread */
 #define RAD__BAKER_VP_KERNEL_RATE 1.5e8 /* virtual-patch sample pairs per second and thread (measured) */
 #define RAD__BAKER_MIX_CHUNK 24576u    /* floats per mix task (96 KiB, a multiple of 12) */
-#define RAD__BAKER_MIX_STREAMS 8u      /* layers read side by side in one pass */
+/* layers read side by side in one pass: planes a power-of-two size apart (a 1024 x 1024 map's)
+   share cache sets, and eight streams and the output then evict each other (8 groups into
+   1024 x 1024: 3.5 ms with 4 streams, 14 ms with 8) */
+#define RAD__BAKER_MIX_STREAMS 4u
 
 /* The user's progress seen through one stage: fractions of the stage map onto [lo, hi] of
    the whole bake, and a cancel is remembered. */
@@ -20636,6 +20639,25 @@ static void rad__baker_mix_task(void *data, uint32_t index)
         }
     for (g0 = 0; g0 < na || g0 == 0; g0 += RAD__BAKER_MIX_STREAMS) {
         uint32_t g1 = g0 + RAD__BAKER_MIX_STREAMS < na ? g0 + RAD__BAKER_MIX_STREAMS : na;
+#if defined(RAD__SSE2)
+        for (j = b; j + 12 <= e; j += 12) {
+            __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0;
+            if (g0) {
+                a0 = _mm_loadu_ps(o + j);
+                a1 = _mm_loadu_ps(o + j + 4);
+                a2 = _mm_loadu_ps(o + j + 8);
+            }
+            for (g = g0; g < g1; ++g) {
+                const float *l = lay[g] + j, *s = sc[g];
+                a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_loadu_ps(l), _mm_loadu_ps(s)));
+                a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_loadu_ps(l + 4), _mm_loadu_ps(s + 4)));
+                a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_loadu_ps(l + 8), _mm_loadu_ps(s + 8)));
+            }
+            _mm_storeu_ps(o + j, a0);
+            _mm_storeu_ps(o + j + 4, a1);
+            _mm_storeu_ps(o + j + 8, a2);
+        }
+#else
         for (j = b; j + 12 <= e; j += 12) {
             float acc[12];
             int k;
@@ -20646,6 +20668,7 @@ static void rad__baker_mix_task(void *data, uint32_t index)
             }
             for (k = 0; k < 12; ++k) o[j + (size_t)k] = acc[k];
         }
+#endif
         for (; j < e; ++j) {
             float acc = g0 ? o[j] : 0.0f;
             for (g = g0; g < g1; ++g) acc += lay[g][j] * sc[g][j % 12];
