@@ -355,8 +355,9 @@ static void bk_test_emitter_groups(void)
     for (pass = 0; pass < 2; ++pass) {
         size_t nv;
         bk_options(&o, pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC);
-        o.patches = 120;
-        o.vp_resolution = 6;
+        o.patches = rad_test_quick() ? 60u : 120u;
+        o.vp_resolution = 4;
+        o.light_samples = 4;
         CHECK_OK(rad_baker_run(&d, &o, NULL, &A));
         one = d;
         one.material_groups = NULL;
