@@ -3146,7 +3146,8 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    time N^2 ff_samples / 3e6 s (the measured form-factor rate of one thread) plus the bounces
    and the lightmap gather; virtual patches (counted first by rad_vp_count) 4 N^2 plus 100
    bytes per sample and 48 N per task, time M^2 / 1.5e8 s for M samples; both add the output
-   layers. Rough: within a factor of a few. The estimate and the choice are logged
+   layers, about 30 bytes per texel and lightmap sample, and 40 per probe and patch (the
+   probes' weights, at most). Rough: within a factor of a few. The estimate and the choice are logged
    (RAD_LOG_INFO) before the work and returned in the result (method, reason, numbers).
    SOURCE. Direct light is each group's source (RAD_SOURCE_DIRECT): the lights of the group
    and the emissive triangles whose material is in the group (rad_baker_desc.material_groups),
@@ -21642,7 +21643,10 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
 #define RAD__BAKER_RAY_RATE 5e6        /* shadow rays per second and thread */
 #define RAD__BAKER_VP_KERNEL_RATE 1.5e8 /* virtual-patch sample pairs per second and thread (measured) */
 #define RAD__BAKER_MIX_CHUNK 24576u    /* floats per mix task (96 KiB, a multiple of 12) */
-#define RAD__BAKER_MIX_STREAMS 8u      /* layers read side by side in one pass */
+/* layers read side by side in one pass: planes a power-of-two size apart (a 1024 x 1024 map's)
+   share cache sets, and eight streams and the output then evict each other (8 groups into
+   1024 x 1024: 3.5 ms with 4 streams, 14 ms with 8) */
+#define RAD__BAKER_MIX_STREAMS 4u
 
 /* The user's progress seen through one stage: fractions of the stage map onto [lo, hi] of
    the whole bake, and a cancel is remembered. */
@@ -21702,6 +21706,25 @@ static void rad__baker_mix_task(void *data, uint32_t index)
         }
     for (g0 = 0; g0 < na || g0 == 0; g0 += RAD__BAKER_MIX_STREAMS) {
         uint32_t g1 = g0 + RAD__BAKER_MIX_STREAMS < na ? g0 + RAD__BAKER_MIX_STREAMS : na;
+#if defined(RAD__SSE2)
+        for (j = b; j + 12 <= e; j += 12) {
+            __m128 a0 = _mm_setzero_ps(), a1 = a0, a2 = a0;
+            if (g0) {
+                a0 = _mm_loadu_ps(o + j);
+                a1 = _mm_loadu_ps(o + j + 4);
+                a2 = _mm_loadu_ps(o + j + 8);
+            }
+            for (g = g0; g < g1; ++g) {
+                const float *l = lay[g] + j, *s = sc[g];
+                a0 = _mm_add_ps(a0, _mm_mul_ps(_mm_loadu_ps(l), _mm_loadu_ps(s)));
+                a1 = _mm_add_ps(a1, _mm_mul_ps(_mm_loadu_ps(l + 4), _mm_loadu_ps(s + 4)));
+                a2 = _mm_add_ps(a2, _mm_mul_ps(_mm_loadu_ps(l + 8), _mm_loadu_ps(s + 8)));
+            }
+            _mm_storeu_ps(o + j, a0);
+            _mm_storeu_ps(o + j + 4, a1);
+            _mm_storeu_ps(o + j + 8, a2);
+        }
+#else
         for (j = b; j + 12 <= e; j += 12) {
             float acc[12];
             int k;
@@ -21712,6 +21735,7 @@ static void rad__baker_mix_task(void *data, uint32_t index)
             }
             for (k = 0; k < 12; ++k) o[j + (size_t)k] = acc[k];
         }
+#endif
         for (; j < e; ++j) {
             float acc = g0 ? o[j] : 0.0f;
             for (g = g0; g < g1; ++g) acc += lay[g][j] * sc[g][j % 12];
@@ -21831,7 +21855,7 @@ typedef struct rad__baker {
     float *work;                   /* D, E, L, B, H (3N each) and the vertex values */
     uint8_t *group_emits;          /* per group: some emissive material is in it */
     uint32_t emissive_groups;
-    size_t outputs_bytes;
+    double outputs_bytes;
     uint32_t outputs;              /* rad_baker_desc.outputs, 0 made RAD_BAKER_VERTEX */
 } rad__baker;
 
@@ -21936,17 +21960,27 @@ static rad_result rad__baker_check(rad__baker *b)
     return RAD_SUCCESS;
 }
 
-/* Bytes of the layers and mixed outputs, once the sizes are known. */
-static size_t rad__baker_output_bytes(const rad__baker *b, uint32_t probes)
+/* Bytes of the layers and mixed outputs, and of the texels (about 30 bytes per texel and per
+   sample), once the sizes are known. */
+static double rad__baker_output_bytes(const rad__baker *b, uint32_t probes)
 {
     const rad_baker_desc *d = b->d;
-    size_t per = 0;
+    double per = 0.0, texels = (double)b->R->lightmap_width * b->R->lightmap_height, fixed = 0.0;
     uint32_t m;
     if (b->outputs & RAD_BAKER_VERTEX)
-        for (m = 0; m < d->scene.mesh_count; ++m) per += 12u * (size_t)d->scene.meshes[m].vertex_count;
-    if (b->outputs & RAD_BAKER_LIGHTMAP) per += 12u * (size_t)b->R->lightmap_width * b->R->lightmap_height;
-    if (b->outputs & RAD_BAKER_PROBES) per += 108u * (size_t)probes;
-    return per * ((size_t)b->R->group_count + 1u);
+        for (m = 0; m < d->scene.mesh_count; ++m) per += 12.0 * (double)d->scene.meshes[m].vertex_count;
+    if (b->outputs & RAD_BAKER_LIGHTMAP) {
+        per += 12.0 * texels;
+        fixed += 30.0 * texels * (1.0 + (double)b->o.lightmap_samples);
+    }
+    if (b->outputs & RAD_BAKER_PROBES) per += 108.0 * (double)probes;
+    return per * ((double)b->R->group_count + 1.0) + fixed;
+}
+
+/* The probes' weights: 40 bytes per (probe, patch) pair a probe sees; all of them, at most. */
+static double rad__baker_probe_bytes(const rad__baker *b, uint32_t probes, double patches)
+{
+    return (b->outputs & RAD_BAKER_PROBES) ? 40.0 * (double)probes * patches : 0.0;
 }
 
 /* AUTO's choice and the estimates; the patches (classic) are built here, the rest later. */
@@ -21956,11 +21990,20 @@ static rad_result rad__baker_plan(rad__baker *b)
     const rad_scene *S = b->scene;
     double budget = b->o.max_memory, seconds_budget = b->o.max_seconds, N, bytes = 0.0, secs = 0.0, texels;
     double samples = (double)b->o.ff_samples;
-    uint32_t probes_guess = b->d->probe_positions ? b->d->probe_count : 729u;
+    uint32_t probes_guess = b->d->probe_positions ? b->d->probe_count : 0u;
     char bb[32], lb[32], tb[32], why[256];
     rad_result r;
     int classic_fits = 0;
     texels = (b->outputs & RAD_BAKER_LIGHTMAP) ? (double)R->lightmap_width * R->lightmap_height * b->o.lightmap_samples : 0.0;
+    if (!b->d->probe_positions) { /* the grid rad_probes_create lays: about extent / spacing + 1 per axis */
+        double ext = 0.0, sp = b->d->probe_spacing, count = 1.0;
+        int k;
+        for (k = 0; k < 3; ++k)
+            if (S->bounds_max[k] - S->bounds_min[k] > ext) ext = S->bounds_max[k] - S->bounds_min[k];
+        if (!(sp > 0.0)) sp = ext / 8.0;
+        for (k = 0; k < 3; ++k) count *= sp > 0.0 ? ceil((S->bounds_max[k] - S->bounds_min[k]) / sp) + 1.0 : 1.0;
+        probes_guess = count < 16777216.0 ? (uint32_t)count : 16777216u;
+    }
     b->outputs_bytes = rad__baker_output_bytes(b, probes_guess);
     why[0] = 0;
     if (b->o.method != RAD_BAKER_VIRTUAL_PATCHES) {
@@ -21968,13 +22011,13 @@ static rad_result rad__baker_plan(rad__baker *b)
         rad_patch_options_default(&po);
         po.target_count = b->o.patches;
         N = (double)(S->triangle_count > b->o.patches ? S->triangle_count : b->o.patches);
-        bytes = 4.0 * N * N + 300.0 * N + (double)b->outputs_bytes;
+        bytes = 4.0 * N * N + 300.0 * N + b->outputs_bytes + rad__baker_probe_bytes(b, probes_guess, N);
         if (bytes <= budget) {
             /* the patch count is only near the target: count them before the final estimate */
             r = rad_patches_create(S, &po, &b->sub, &b->patches);
             if (r != RAD_SUCCESS) return r;
             N = (double)b->patches->count;
-            bytes = 4.0 * N * N + 300.0 * N + (double)b->outputs_bytes;
+            bytes = 4.0 * N * N + 300.0 * N + b->outputs_bytes + rad__baker_probe_bytes(b, probes_guess, N);
         }
         secs = N * N * samples / RAD__BAKER_FF_RATE + 6.0 * N * N * b->o.bounces * R->group_count / RAD__BAKER_FLOP_RATE +
                texels * N * 4.0 / RAD__BAKER_RAY_RATE * (texels * N > 5e7 ? 5e7 / (texels * N) : 1.0) * R->group_count;
@@ -22020,7 +22063,7 @@ static rad_result rad__baker_plan(rad__baker *b)
             if (r != RAD_SUCCESS) return r;
             n = (double)cnt.patches;
             M = (double)cnt.samples;
-            bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)b->c.tasks + (double)b->outputs_bytes;
+            bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)b->c.tasks + b->outputs_bytes + rad__baker_probe_bytes(b, probes_guess, n);
             secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 6.0 * n * n * b->o.bounces * R->group_count / RAD__BAKER_FLOP_RATE;
             if (bytes <= budget) break;
             if (res <= 2) {

@@ -320,6 +320,65 @@ static void bk_test_layers_lightmap_probes(void)
     rad_baker_result_destroy(R);
 }
 
+/* Emitters in two groups (the ceiling light 0, a glowing short block 1): each layer equals the
+   bake with only that group's material emitting, bit for bit, for both methods (the group's
+   view of the scene keeps only its own emission). */
+static void bk_test_emitter_groups(void)
+{
+    rad_baker_desc d, one;
+    rad_baker_options o;
+    rad_baker_result *A = NULL, *B0 = NULL, *B1 = NULL;
+    rad_mesh_desc meshes[16];
+    rad_material mats[17], m0[17], m1[17];
+    uint32_t groups[17], i, glow, pass;
+    memset(&d, 0, sizeof d);
+    rad_cornell_box(&d.scene, NULL);
+    CHECK(d.scene.mesh_count <= 16 && d.scene.material_count < 17);
+    if (d.scene.mesh_count > 16 || d.scene.material_count >= 17) return;
+    for (i = 0; i < d.scene.mesh_count; ++i) meshes[i] = d.scene.meshes[i];
+    for (i = 0; i < d.scene.material_count; ++i) mats[i] = d.scene.materials[i], groups[i] = 0;
+    glow = d.scene.material_count; /* a new material: white, glowing faintly blue */
+    mats[glow] = mats[meshes[6].material];
+    mats[glow].emission[0] = 0.5f; mats[glow].emission[1] = 1.0f; mats[glow].emission[2] = 3.0f;
+    groups[glow] = 1;
+    CHECK(meshes[6].material_ids == NULL && strcmp(meshes[6].name, "shortblock") == 0);
+    meshes[6].material = glow;
+    d.scene.meshes = meshes;
+    d.scene.materials = mats;
+    d.scene.material_count = glow + 1;
+    d.material_groups = groups;
+    for (i = 0; i <= glow; ++i) { /* m0: group 0's emission only, m1: group 1's */
+        m0[i] = m1[i] = mats[i];
+        if (groups[i] != 0) m0[i].emission[0] = m0[i].emission[1] = m0[i].emission[2] = 0.0f;
+        if (groups[i] != 1) m1[i].emission[0] = m1[i].emission[1] = m1[i].emission[2] = 0.0f;
+    }
+    for (pass = 0; pass < 2; ++pass) {
+        size_t nv;
+        bk_options(&o, pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC);
+        o.patches = rad_test_quick() ? 60u : 120u;
+        o.vp_resolution = 4;
+        o.light_samples = 4;
+        CHECK_OK(rad_baker_run(&d, &o, NULL, &A));
+        one = d;
+        one.material_groups = NULL;
+        one.scene.materials = m0;
+        CHECK_OK(rad_baker_run(&one, &o, NULL, &B0));
+        one.scene.materials = m1;
+        CHECK_OK(rad_baker_run(&one, &o, NULL, &B1));
+        if (A && B0 && B1) {
+            nv = 3 * (size_t)A->vertex_count;
+            CHECK(A->group_count == 2);
+            CHECK(bk_same_bits(A->vertex_layers, B0->vertex, nv));
+            CHECK(bk_same_bits(A->vertex_layers + nv, B1->vertex, nv));
+            CHECK(!bk_same_bits(B0->vertex, B1->vertex, nv));
+        }
+        rad_baker_result_destroy(A);
+        rad_baker_result_destroy(B0);
+        rad_baker_result_destroy(B1);
+        A = B0 = B1 = NULL;
+    }
+}
+
 typedef struct bk_progress {
     int calls, stop_at, backwards, out_of_range;
     float last;
@@ -628,6 +687,7 @@ static const rad_test_case tests_bake[] = {
     { "bake_auto_vp_lower_level", bk_test_auto_vp_lower_level },
     { "bake_layers_cornell", bk_test_layers_cornell },
     { "bake_layers_lightmap_probes", bk_test_layers_lightmap_probes },
+    { "bake_emitter_groups", bk_test_emitter_groups },
     { "bake_cancel", bk_test_cancel },
     { "bake_zeroed_options", bk_test_zeroed_options },
     { "bake_bad_input", bk_test_bad_input },
