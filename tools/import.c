@@ -698,13 +698,13 @@ static void gltf_report(const char *m, char **r)
     unsigned i, j, transform = 0;
     size_t n;
     if ((v = js_get(m, "doubleSided")) != NULL)
-        rep_add(r, "  doubleSided: %s (read; the importer does not use it)", !strncmp(v, "true", 4) ? "true" : "false", NULL);
+        rep_add(r, "  doubleSided: %s (used unless --two-sided all|none overrides it)", !strncmp(v, "true", 4) ? "true" : "false", NULL);
     if ((v = js_get(m, "alphaMode")) != NULL) {
         char cut[64] = "";
         const char *c = js_get(m, "alphaCutoff");
         js_string(v, val, sizeof val);
         if (c) snprintf(cut, sizeof cut, ", alphaCutoff %g", strtod(c, NULL));
-        rep_add(r, "  alphaMode: %s%s (read; the importer does not use it)", val, cut);
+        rep_add(r, "  alphaMode: %s%s (read; cutouts are not supported yet: the surface is opaque)", val, cut);
     }
     transform += gltf_has_transform(js_get(m, "emissiveTexture"));
     if (pbr) transform += gltf_has_transform(js_get(pbr, "baseColorTexture"));
@@ -1404,6 +1404,9 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     for (i = 0; i < st->material_count; ++i) {
         if (tool_two_sided == TOOL_TWO_SIDED_ALL) st->materials[i].two_sided = 1;
         if (tool_two_sided == TOOL_TWO_SIDED_NONE) st->materials[i].two_sided = 0;
+        if (st->material_reports)
+            rep_add(&st->material_reports[i], "  sides: %s", st->materials[i].two_sided ? "two (each side receives, reflects and emits)"
+                                                                                      : "one (front counter-clockwise, the back absorbs)", NULL);
     }
     warn_mixed_windings(st, path_or_name);
     if (!out->has_camera) default_camera(bmin, bmax, &out->camera);
