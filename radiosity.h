@@ -141,6 +141,9 @@
            RAD_OUTPUT_TOTAL     B = E + L
        - Triangles are wound counter-clockwise seen from the front; the front is the side that
          emits and receives. Patches are one-sided.
+       - Directions at infinity (environment maps, Preetham's sky, the sky transfer's bins):
+         +Y is up, azimuth from +X towards +Z; rad_sun_direction puts east at +X and south at
+         +Z (>>api_light, ENVIRONMENT MAP).
 
    4. MEMORY
        Every object is created by a rad_*_create call that returns RAD_SUCCESS and writes an
@@ -785,7 +788,8 @@ RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, 
 typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
-    uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
+    uint32_t light_samples;    /* shadow rays per point per area light, sky and environment
+                                  map (0: 16) */
     int include_emitters;      /* non-zero (default): emissive triangles are area lights;
                                   0 leaves them out (a zeroed struct has no emitters: start
                                   from rad_direct_options_default) */
@@ -796,14 +800,16 @@ typedef struct rad_direct_options {
 RAD_API void rad_direct_options_default(rad_direct_options *options);
 
 /* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
-   sky (cosine-weighted shadow rays) and, when include_emitters, every emissive triangle
+   sky (cosine-weighted shadow rays), environment maps (half the rays from the map's
+   distribution, half cosine-weighted, MIS) and, when include_emitters, every emissive triangle
    (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
    shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
    gets the light of its visible part). A point receives nothing from behind its normal; normals need not
    be unit (they are normalized), a zero one is refused. 'samples' is unused here.
-   Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, a negative
-   min_distance, a zero normal or ray_epsilon outside (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that
-   overflows float), NEGATIVE_EMISSION (a negative light colour), RAYCAST_FAILED. */
+   Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, an environment
+   light without a map, a negative min_distance, a zero normal or ray_epsilon outside
+   (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that overflows
+   float), NEGATIVE_EMISSION (a negative light colour), RAYCAST_FAILED. */
 RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
                                          const rad_light *lights, uint32_t light_count,
                                          const rad_direct_options *options, const float *points,
@@ -6917,7 +6923,8 @@ RAD_API rad_result rad_environment_create(const rad_environment_desc *desc, cons
         /* the lookup's values at the pixel centres make the sampling table */
         for (i = 0; i < H; ++i)
             for (j = 0; j < W; ++j) {
-                double th = RAD__PI * ((double)i + 0.5) / (double)H, ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)W + desc->rotation;
+                double th = RAD__PI * ((double)i + 0.5) / (double)H;
+                double ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)W + desc->rotation;
                 float d[3];
                 d[0] = (float)(sin(th) * cos(ph)), d[1] = (float)cos(th), d[2] = (float)(sin(th) * sin(ph));
                 desc->lookup(desc->lookup_user, d, e->table + 3 * ((size_t)i * W + j));
@@ -21147,7 +21154,8 @@ RAD_API rad_result rad_sky_transfer_create(const rad_patches *P, const rad_rayca
     for (k = 0; k < K && r == RAD_SUCCESS; ++k) {
         int ch;
         for (i = 0; i < N; ++i)
-            for (ch = 0; ch < 3; ++ch) E[3 * (size_t)i + ch] = P->albedo[3 * (size_t)i + ch] * t->transfer[(size_t)K * i + k];
+            for (ch = 0; ch < 3; ++ch)
+                E[3 * (size_t)i + ch] = P->albedo[3 * (size_t)i + ch] * t->transfer[(size_t)K * i + k];
         rad_system_init(&sys, F, P, E);
         r = rad_solve_gauss_seidel(&sys, &so, B, NULL, ctx);
         if (r == RAD_SUCCESS)

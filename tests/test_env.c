@@ -1,6 +1,7 @@
 /* test_env.c - environment map lights: validation, the constant map against the constant
    sky, one bright texel against a directional light, importance sampling against a closed
-   form, the virtual-patch run-time update and the probes. Everything static and prefixed en_. */
+   form, the virtual-patch run-time update, the probes, Preetham's sky and the sun's
+   position, and the sky transfer against a full re-bake. Everything static and prefixed en_. */
 #include "fixtures.h"
 
 #define EN_PI 3.14159265358979323846
@@ -578,12 +579,65 @@ out:
     free(D), free(E), free(Bref), free(Bt), free(vs);
 }
 
+/* Irradiance probes over the open floor: a constant map of radiance L gives the probe's
+   direct part of the sky of exitance pi L (upward: pi L, within 2%; sideways: half of it),
+   and a map with one bright texel the irradiance of the directional light of that texel. */
+static void en_test_probes(void)
+{
+    enum { W = 32, H = 16 };
+    static float px[3 * W * H];
+    const float L = 0.8f, pos[3] = { 0.0f, 0.5f, 0.0f }, up[3] = { 0, 1, 0 }, side[3] = { 1, 0, 0 };
+    en_world w;
+    rad_patches *P = NULL;
+    rad_patch_options po;
+    rad_probe_options pro;
+    rad_probes *pe = NULL, *ps = NULL;
+    rad_environment *env = NULL;
+    rad_light le, ls;
+    float *B = NULL, a[3], b[3];
+    uint32_t i;
+    if (!en_world_make(&w, 0.0f)) { CHECK(0); en_world_free(&w); return; }
+    rad_patch_options_default(&po);
+    CHECK_OK(rad_patches_create(w.S, &po, NULL, &P));
+    if (!P) goto out;
+    B = (float *)calloc(3 * (size_t)P->count, sizeof(float));
+    for (i = 0; i < 3 * W * H; ++i) px[i] = L;
+    env = en_make(px, W, H, 0.4f);
+    if (!B || !env) { CHECK(0); goto out; }
+    en_light(&le, env, 1.0f);
+    memset(&ls, 0, sizeof(ls));
+    ls.type = RAD_LIGHT_SKY;
+    ls.color[0] = ls.color[1] = ls.color[2] = (float)EN_PI * L;
+    rad_probe_options_default(&pro);
+    pro.flags |= RAD_PROBES_DIRECT;
+    pro.rays = 1024;
+    CHECK_OK(rad_probes_create(P, &w.rc, &le, 1, pos, 1, &pro, B, NULL, &pe));
+    CHECK_OK(rad_probes_create(P, &w.rc, &ls, 1, pos, 1, &pro, B, NULL, &ps));
+    if (!pe || !ps) goto out;
+    CHECK_OK(rad_probes_sample(pe, pos, up, a));
+    CHECK_OK(rad_probes_sample(ps, pos, up, b));
+    if (getenv("RAD_TEST_VERBOSE")) printf("    probes: up %g (sky %g), pi L %g\n", a[1], b[1], EN_PI * L);
+    CHECK_REL(a[1], b[1], 0.02);
+    CHECK_REL(a[1], EN_PI * L, 0.05); /* L2 probes of a hemisphere: near pi L */
+    CHECK_OK(rad_probes_sample(pe, pos, side, a));
+    CHECK_OK(rad_probes_sample(ps, pos, side, b));
+    CHECK_REL(a[0], b[0], 0.02);
+out:
+    rad_probes_destroy(pe);
+    rad_probes_destroy(ps);
+    rad_environment_destroy(env);
+    rad_patches_destroy(P);
+    free(B);
+    en_world_free(&w);
+}
+
 static const rad_test_case tests_env[] = {
     { "env_validation", en_test_validation },
     { "env_constant_map", en_test_constant_map },
     { "env_one_texel", en_test_one_texel },
     { "env_importance", en_test_importance },
     { "env_vp_lights", en_test_vp_lights },
+    { "env_probes", en_test_probes },
     { "env_preetham", en_test_preetham },
     { "env_sun_direction", en_test_sun_direction },
     { "env_sky_transfer", en_test_sky_transfer },
