@@ -6866,6 +6866,8 @@ static size_t rad__env_pixel(const rad_environment *e, const float *dir)
     double v = acos(y) / RAD__PI, u = (atan2((double)dir[2], (double)dir[0]) - (double)e->rotation) / (2.0 * RAD__PI);
     uint32_t row, col;
     u -= floor(u);
+    if (!(v >= 0.0)) v = 0.0; /* a NaN direction reads pixel (0, 0) rather than casting a NaN */
+    if (!(u >= 0.0)) u = 0.0;
     row = (uint32_t)(v * (double)e->h);
     col = (uint32_t)(u * (double)e->w);
     if (row >= e->h) row = e->h - 1u;
@@ -21013,6 +21015,8 @@ static uint32_t rad__sky_bin(const float *d)
     double v = acos(y) / RAD__PI, u = atan2((double)d[2], (double)d[0]) / (2.0 * RAD__PI);
     uint32_t row, col;
     u -= floor(u);
+    if (!(v >= 0.0)) v = 0.0;
+    if (!(u >= 0.0)) u = 0.0;
     row = (uint32_t)(v * RAD_SKY_BINS_V), col = (uint32_t)(u * RAD_SKY_BINS_U);
     if (row >= RAD_SKY_BINS_V) row = RAD_SKY_BINS_V - 1;
     if (col >= RAD_SKY_BINS_U) col = RAD_SKY_BINS_U - 1;
