@@ -113,3 +113,21 @@ bad "--sun-time 45:400:12" "LAT in \[-90, 90\], DAY in \[1, 366\]" render cornel
 rc=$?
 [ $rc -eq 1 ] && grep -q -- "--sky-model needs --sun-time" "$TMP/err.txt" && ok "rejects --sky-model without --sun-time" ||
     fail "rejects --sky-model without --sun-time" "exit $rc: $(head -c 200 "$TMP/err.txt")"
+
+# An OpenEXR map (tinyexr): rad render writes a constant image of the sky (0.5, 1, 2) as
+# .exr; read back as --env it shows that radiance to a camera looking away from the box
+if "$RAD" render cornell --sky 0.5,1,2 --size 8x4 --patches 20 --aa 1 --camera 0,0,-1:0,0,-2:0,1,0 \
+    -o "$TMP/env-c.exr" > /dev/null 2> "$TMP/err.txt"; then
+    if "$RAD" render cornell --env "$TMP/env-c.exr" --size 4x4 --patches 20 --aa 1 --camera 0,0,-1:0,0,-2:0,1,0 \
+        -o "$TMP/env-exr.pfm" > /dev/null 2> "$TMP/err.txt"; then
+        v=$(pfm_mean "$TMP/env-exr.pfm")
+        close "$v" 1.166667 1e-4 && ok "--env reads an OpenEXR map (mean radiance $v)" ||
+            fail "--env reads an OpenEXR map" "mean $v, want 1.166667"
+    else
+        grep -q "without tinyexr" "$TMP/err.txt" && skip_data "--env reads an OpenEXR map" "rad built without tinyexr" ||
+            fail "--env reads an OpenEXR map" "$(head -c 300 "$TMP/err.txt")"
+    fi
+else
+    grep -q "without tinyexr" "$TMP/err.txt" && skip_data "--env reads an OpenEXR map" "rad built without tinyexr" ||
+        fail "--env reads an OpenEXR map (writing it)" "$(head -c 300 "$TMP/err.txt")"
+fi
