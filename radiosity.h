@@ -708,7 +708,9 @@ typedef struct rad_environment_desc {
                                   borrowed: must stay unchanged while the object lives. NULL
                                   when 'lookup' gives the radiance */
     uint32_t width, height;    /* the image, or with 'lookup' the resolution of the sampling
-                                  table (lookup evaluated at the pixel centres) */
+                                  table (lookup evaluated at the pixel centres): a feature
+                                  smaller than its pixels (a sun) is then found by the
+                                  cosine rays only, without bias but with much noise */
     float rotation;            /* radians about +Y: the map turned by this angle, +X towards +Z */
     rad_environment_fn lookup; /* optional: radiance from a function instead of 'pixels' */
     void *lookup_user;
