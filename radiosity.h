@@ -152,6 +152,9 @@
          (rad_material.two_sided) becomes two scene triangles, one per side, back to back
          (rad_scene.twins): each side has its own patches and samples, so every method treats
          the two sides as independent surfaces.
+       - Directions at infinity (environment maps, Preetham's sky, the sky transfer's bins):
+         +Y is up, azimuth from +X towards +Z; rad_sun_direction puts east at +X and south at
+         +Z (>>api_light, ENVIRONMENT MAP).
 
    4. MEMORY
        Every object is created by a rad_*_create call that returns RAD_SUCCESS and writes an
@@ -779,7 +782,9 @@ typedef struct rad_environment_desc {
                                   borrowed: must stay unchanged while the object lives. NULL
                                   when 'lookup' gives the radiance */
     uint32_t width, height;    /* the image, or with 'lookup' the resolution of the sampling
-                                  table (lookup evaluated at the pixel centres) */
+                                  table (lookup evaluated at the pixel centres): a feature
+                                  smaller than its pixels (a sun) is then found by the
+                                  cosine rays only, without bias but with much noise */
     float rotation;            /* radians about +Y: the map turned by this angle, +X towards +Z */
     rad_environment_fn lookup; /* optional: radiance from a function instead of 'pixels' */
     void *lookup_user;
@@ -860,7 +865,8 @@ RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, 
 typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
-    uint32_t light_samples;    /* shadow rays per point per area light and sky (0: 16) */
+    uint32_t light_samples;    /* shadow rays per point per area light, sky and environment
+                                  map (0: 16) */
     int exclude_emitters;      /* 0 (default): emissive triangles are area lights; non-zero
                                   leaves them out (only the lights given) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
@@ -871,16 +877,18 @@ typedef struct rad_direct_options {
 RAD_API void rad_direct_options_default(rad_direct_options *options);
 
 /* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
-   sky (cosine-weighted shadow rays) and, unless exclude_emitters, every emissive triangle
+   sky (cosine-weighted shadow rays), environment maps (half the rays from the map's
+   distribution, half cosine-weighted, MIS) and, unless exclude_emitters, every emissive triangle
    (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
    shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
    gets the light of its visible part; with an emission_texture each ray also carries the
    texture at its point: docs/methods/emission.md). A point receives nothing from behind its normal; normals need not
    be unit (they are normalized), a zero one is refused. 'samples' is unused here.
-   Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, a negative
-   min_distance, a zero normal or ray_epsilon outside (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that
-   overflows float), NEGATIVE_EMISSION (a negative light colour, or an emission_lookup value
-   that is negative or not finite), RAYCAST_FAILED. */
+   Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, an environment
+   light without a map, a negative min_distance, a zero normal or ray_epsilon outside
+   (0, 1e-2]), NON_FINITE (a non-finite light field or point, or irradiance that overflows
+   float), NEGATIVE_EMISSION (a negative light colour, or an emission_lookup value that is
+   negative or not finite), RAYCAST_FAILED. */
 RAD_API rad_result rad_direct_irradiance(const rad_scene *scene, const rad_raycaster *raycaster,
                                          const rad_light *lights, uint32_t light_count,
                                          const rad_direct_options *options, const float *points,
@@ -3273,6 +3281,71 @@ RAD_API rad_result rad_baker_mix(rad_baker_result *result, const float *group_rg
    count3 not a multiple of 3, group_count 0), NON_FINITE (a scale). */
 RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
                                        float *out, const rad_context *ctx);
+
+/* ======================================================================================== */
+/* >>api_skytransfer: relighting by a new sky without a re-bake                             */
+/* ======================================================================================== */
+
+/* SKY TRANSFER: the radiosity B of a static scene is linear in the sky's radiance L(w). With
+   L written in a small basis, L ~ sum_k l_k Y_k, each patch's direct irradiance is
+   D_i = sum_k l_k T_ik with T_ik = (1 / A_i) int_patch int_hemisphere Y_k(w) V(x, w) cos dw dx
+   (V: 1 where the ray escapes), estimated once by cosine-distributed rays from the patch's
+   lattice points. B then equals sum_k l_k R_k, R_k the solution of
+   (I - rho o F) R_k = rho T_.k (one RGB Gauss-Seidel solve per basis function, with the
+   patches' own albedos per channel). A new sky (rad_sky_project of its map) gives B in
+   3 K N multiply-adds. Two bases:
+     RAD_SKY_BASIS_SH: the 16 real spherical harmonics of bands 0..3 (l_k = int L Y_k dw).
+       Smooth skies only: the sky's detail above band 3 is lost where it meets sharp
+       visibility (a window), several per cent per patch (docs/methods/environment.md).
+     RAD_SKY_BASIS_BINS: 128 directional bins, 8 bands of equal polar angle from the zenith
+       times 16 of azimuth (phi = atan2(z, x) from +X towards +Z, as the map), Y_k = 1 inside
+       bin k (l_k = the mean radiance over the bin). Exact for a sky constant over each bin.
+   Neither holds a sun (give it as a directional light and solve it the usual way), nor
+   anything but the sky changing. Memory: 16 K bytes per patch (T and R). */
+typedef enum rad_sky_basis {
+    RAD_SKY_BASIS_SH = 0,      /* 16 coefficients */
+    RAD_SKY_BASIS_BINS = 1     /* 128 coefficients */
+} rad_sky_basis;
+
+#define RAD_SKY_BINS_U 16
+#define RAD_SKY_BINS_V 8
+#define RAD_SKY_MAX_COEFFICIENTS 128 /* RAD_SKY_BINS_U * RAD_SKY_BINS_V */
+
+typedef struct rad_sky_transfer_options {
+    rad_sky_basis basis;       /* default RAD_SKY_BASIS_BINS */
+    uint32_t samples;          /* lattice points per patch (0: 16; a square n*n, at most 256) */
+    uint32_t rays;             /* cosine-distributed rays per point (0: 256; at most 4096) */
+    float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
+    uint32_t seed;
+    rad_solve_options solve;   /* Gauss-Seidel's tolerance and max_iterations (output: total B) */
+} rad_sky_transfer_options;
+
+typedef struct rad_sky_transfer {
+    rad_sky_basis basis;
+    uint32_t coefficients;     /* K: 16 or 128 */
+    uint32_t n;                /* patches */
+    float *transfer;           /* K N: T_ik at K i + k */
+    float *response;           /* 3 K N: R_k of patch i, channel c at 3 K i + 3 k + c */
+    rad_allocator allocator;   /* private */
+} rad_sky_transfer;
+
+RAD_API void rad_sky_transfer_options_default(rad_sky_transfer_options *options);
+/* Traces T and solves the K systems with the form factors F (N x N, the patches' matrix).
+   Errors: INVALID_ARGUMENT (NULL, bad options or basis), SIZE_MISMATCH (F not N x N),
+   ALBEDO_RANGE, RAYCAST_FAILED, OUT_OF_MEMORY, NOT_CONVERGED (a solve; nothing returned).
+   Cost: samples x rays shadow rays per patch, K Gauss-Seidel solves. */
+RAD_API rad_result rad_sky_transfer_create(const rad_patches *patches, const rad_raycaster *raycaster, const rad_matrix *F,
+                                           const rad_sky_transfer_options *options, const rad_context *ctx,
+                                           rad_sky_transfer **out);
+RAD_API void rad_sky_transfer_destroy(rad_sky_transfer *transfer);
+/* A map's coefficients in the transfer's basis, times 'scale' (RGB; NULL: 1): 3 K floats
+   (coefficient k, channel c at 3 k + c), by the map's pixels (centre direction, solid
+   angle). Errors: INVALID_ARGUMENT. */
+RAD_API rad_result rad_sky_project(const rad_sky_transfer *transfer, const rad_environment *env, const float scale[3],
+                                   float *out_coefficients);
+/* B (3N, total radiosity) for a sky of coefficients (3 K floats). Errors: INVALID_ARGUMENT,
+   NON_FINITE (a coefficient). O(3 K N). */
+RAD_API rad_result rad_sky_transfer_apply(const rad_sky_transfer *transfer, const float *coefficients, float *out_B);
 
 /* ======================================================================================== */
 /* >>api_shading: lighting models and BRDFs                                                 */
@@ -7372,6 +7445,8 @@ static size_t rad__env_pixel(const rad_environment *e, const float *dir)
     double v = acos(y) / RAD__PI, u = (atan2((double)dir[2], (double)dir[0]) - (double)e->rotation) / (2.0 * RAD__PI);
     uint32_t row, col;
     u -= floor(u);
+    if (!(v >= 0.0)) v = 0.0; /* a NaN direction reads pixel (0, 0) rather than casting a NaN */
+    if (!(u >= 0.0)) u = 0.0;
     row = (uint32_t)(v * (double)e->h);
     col = (uint32_t)(u * (double)e->w);
     if (row >= e->h) row = e->h - 1u;
@@ -7429,7 +7504,8 @@ RAD_API rad_result rad_environment_create(const rad_environment_desc *desc, cons
         /* the lookup's values at the pixel centres make the sampling table */
         for (i = 0; i < H; ++i)
             for (j = 0; j < W; ++j) {
-                double th = RAD__PI * ((double)i + 0.5) / (double)H, ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)W + desc->rotation;
+                double th = RAD__PI * ((double)i + 0.5) / (double)H;
+                double ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)W + desc->rotation;
                 float d[3];
                 d[0] = (float)(sin(th) * cos(ph)), d[1] = (float)cos(th), d[2] = (float)(sin(th) * sin(ph));
                 desc->lookup(desc->lookup_user, d, e->table + 3 * ((size_t)i * W + j));
@@ -22391,6 +22467,251 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
         return r;
     }
     *out = b.R;
+    return RAD_SUCCESS;
+}
+
+/* ======================================================================================== */
+/* >>skytransfer: relighting by a new sky without a re-bake                                 */
+/* ======================================================================================== */
+
+/* bands 0..3 at a unit direction: rad__sh9's nine, then band 3 (m = -3..3) */
+static void rad__sky_sh(const float *d, float *y)
+{
+    float x = d[0], yy = d[1], z = d[2];
+    rad__sh9(d, y);
+    y[9] = 0.590043589f * yy * (3.0f * x * x - yy * yy);
+    y[10] = 2.890611442f * x * yy * z;
+    y[11] = 0.457045799f * yy * (5.0f * z * z - 1.0f);
+    y[12] = 0.373176332f * z * (5.0f * z * z - 3.0f);
+    y[13] = 0.457045799f * x * (5.0f * z * z - 1.0f);
+    y[14] = 1.445305721f * z * (x * x - yy * yy);
+    y[15] = 0.590043589f * x * (x * x - 3.0f * yy * yy);
+}
+
+/* the directional bin of a unit direction (8 polar bands from +Y, 16 azimuth sectors) */
+static uint32_t rad__sky_bin(const float *d)
+{
+    double y = d[1] < -1.0f ? -1.0 : (d[1] > 1.0f ? 1.0 : (double)d[1]);
+    double v = acos(y) / RAD__PI, u = atan2((double)d[2], (double)d[0]) / (2.0 * RAD__PI);
+    uint32_t row, col;
+    u -= floor(u);
+    if (!(v >= 0.0)) v = 0.0;
+    if (!(u >= 0.0)) u = 0.0;
+    row = (uint32_t)(v * RAD_SKY_BINS_V), col = (uint32_t)(u * RAD_SKY_BINS_U);
+    if (row >= RAD_SKY_BINS_V) row = RAD_SKY_BINS_V - 1;
+    if (col >= RAD_SKY_BINS_U) col = RAD_SKY_BINS_U - 1;
+    return row * RAD_SKY_BINS_U + col;
+}
+
+RAD_API void rad_sky_transfer_options_default(rad_sky_transfer_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof(*o));
+    o->basis = RAD_SKY_BASIS_BINS;
+    o->samples = 16;
+    o->rays = 256;
+    o->ray_epsilon = 1e-5f;
+    rad_solve_options_default(&o->solve);
+}
+
+RAD_API void rad_sky_transfer_destroy(rad_sky_transfer *t)
+{
+    if (!t) return;
+    {
+        rad_allocator a = t->allocator;
+        void *blocks[] = { t->transfer, t->response, t };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
+}
+
+typedef struct rad__st_job {
+    const rad_patches *P;
+    const rad_raycaster *rc;
+    rad_sky_transfer_options o;
+    uint32_t K;
+    float eps;
+    rad_ray *rays;             /* samples * rays per task */
+    uint8_t *occ;
+    float *T;
+} rad__st_job;
+
+/* patch 'row': its samples x rays cosine rays, the unoccluded ones' basis values summed */
+static rad_result rad__st_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__st_job *j = (rad__st_job *)data;
+    const rad_patch *pt = &j->P->patches[row];
+    uint32_t S = j->o.samples, R = j->o.rays, s, r, m, side = rad__lattice_side(S), h, k;
+    size_t at = (size_t)task * S * R, q;
+    rad_ray *rays = j->rays + at;
+    uint8_t *occ = j->occ + at;
+    float v[9], t1[3], t2[3];
+    double acc[RAD_SKY_MAX_COEFFICIENTS];
+    int c;
+    for (k = 0; k < j->K; ++k) acc[k] = 0.0;
+    for (m = 0; m < 3; ++m)
+        for (c = 0; c < 3; ++c) v[3 * m + c] = j->P->vertices[3 * (size_t)pt->vertices[m] + (size_t)c];
+    rad__tangent_frame(pt->normal, t1, t2);
+    for (s = 0; s < S; ++s) {
+        float x[3];
+        rad__lattice_point(v, v + 3, v + 6, side, s, x);
+        h = rad__hash(j->o.seed ^ rad__hash(row * 0x9E3779B9u + s));
+        for (r = 0; r < R; ++r) {
+            rad_ray *ray = rays + (size_t)s * R + r;
+            rad__cosine_dir(pt->normal, t1, t2, r, R, h, ray->dir);
+            for (c = 0; c < 3; ++c) ray->origin[c] = x[c] + pt->normal[c] * j->eps;
+            ray->tmin = 0.0f;
+            ray->tmax = FLT_MAX;
+        }
+    }
+    if (j->rc->occluded(j->rc->user, rays, S * R, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (q = 0; q < (size_t)S * R; ++q) {
+        float y[16];
+        if (occ[q]) continue;
+        if (j->o.basis == RAD_SKY_BASIS_BINS) {
+            acc[rad__sky_bin(rays[q].dir)] += 1.0;
+        } else {
+            rad__sky_sh(rays[q].dir, y);
+            for (k = 0; k < 16u; ++k) acc[k] += (double)y[k];
+        }
+    }
+    /* int Y V cos dw = pi E[Y V] over cosine-distributed directions */
+    for (k = 0; k < j->K; ++k) j->T[(size_t)j->K * row + k] = (float)(RAD__PI * acc[k] / ((double)S * R));
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_sky_transfer_create(const rad_patches *P, const rad_raycaster *rc, const rad_matrix *F,
+                                           const rad_sky_transfer_options *options, const rad_context *ctx,
+                                           rad_sky_transfer **out)
+{
+    rad__ctx c;
+    rad__st_job j;
+    rad_sky_transfer *t;
+    rad_system sys;
+    rad_solve_options so;
+    float *E = NULL, *B = NULL;
+    uint32_t N, T, k, i, K;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if (!P || !rc || !rc->occluded || !F || !out || !P->scene) return RAD_ERROR_INVALID_ARGUMENT;
+    memset(&j, 0, sizeof j);
+    if (options) j.o = *options;
+    else rad_sky_transfer_options_default(&j.o);
+    if (j.o.samples == 0) j.o.samples = 16;
+    if (j.o.rays == 0) j.o.rays = 256;
+    if (j.o.ray_epsilon == 0.0f) j.o.ray_epsilon = 1e-5f;
+    if ((j.o.basis != RAD_SKY_BASIS_SH && j.o.basis != RAD_SKY_BASIS_BINS) || j.o.samples > RAD__MAX_SAMPLES ||
+        j.o.rays > 4096u || !(j.o.ray_epsilon > 0.0f && j.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(&c, RAD_LOG_ERROR, "sky transfer: basis %d (0 or 1), samples %u (at most %u), rays %u (at most 4096), "
+                 "ray_epsilon %g (in (0, %g])", (int)j.o.basis, j.o.samples, RAD__MAX_SAMPLES, j.o.rays,
+                 (double)j.o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    j.o.samples = rad__lattice_side(j.o.samples) * rad__lattice_side(j.o.samples);
+    K = j.K = j.o.basis == RAD_SKY_BASIS_BINS ? (uint32_t)RAD_SKY_MAX_COEFFICIENTS : 16u;
+    N = P->count;
+    if (F->rows != N || F->cols != N) {
+        rad__log(&c, RAD_LOG_ERROR, "sky transfer: the matrix is %u x %u for %u patches", F->rows, F->cols, N);
+        return RAD_ERROR_SIZE_MISMATCH;
+    }
+    t = (rad_sky_transfer *)rad__alloc_zero(&c.allocator, sizeof(*t));
+    if (!t) return RAD_ERROR_OUT_OF_MEMORY;
+    t->allocator = c.allocator;
+    t->basis = j.o.basis, t->coefficients = K, t->n = N;
+    t->transfer = (float *)rad__alloc_array(&c.allocator, N ? N : 1u, K * sizeof(float));
+    t->response = (float *)rad__alloc_array(&c.allocator, N ? N : 1u, 3u * K * sizeof(float));
+    E = (float *)rad__alloc_array(&c.allocator, N ? N : 1u, 3 * sizeof(float));
+    B = (float *)rad__alloc_array(&c.allocator, N ? N : 1u, 3 * sizeof(float));
+    T = c.tasks < N ? c.tasks : N;
+    if (T == 0) T = 1;
+    j.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * j.o.samples * j.o.rays, sizeof(rad_ray));
+    j.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * j.o.samples * j.o.rays, 1);
+    if (!t->transfer || !t->response || !E || !B || !j.rays || !j.occ) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        j.P = P, j.rc = rc, j.eps = j.o.ray_epsilon * P->scene->diagonal, j.T = t->transfer;
+        r = rad__for_rows(&c, N, T, rad__st_row, &j);
+    }
+    so = j.o.solve;
+    so.output = RAD_OUTPUT_TOTAL;
+    /* one RGB solve per basis function: the source rho_ic T_ik */
+    for (k = 0; k < K && r == RAD_SUCCESS; ++k) {
+        int ch;
+        for (i = 0; i < N; ++i)
+            for (ch = 0; ch < 3; ++ch)
+                E[3 * (size_t)i + ch] = P->albedo[3 * (size_t)i + ch] * t->transfer[(size_t)K * i + k];
+        rad_system_init(&sys, F, P, E);
+        r = rad_solve_gauss_seidel(&sys, &so, B, NULL, ctx);
+        if (r == RAD_SUCCESS)
+            for (i = 0; i < N; ++i)
+                for (ch = 0; ch < 3; ++ch) t->response[3 * ((size_t)K * i + k) + (size_t)ch] = B[3 * (size_t)i + ch];
+    }
+    {
+        void *blocks[] = { E, B, j.rays, j.occ };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
+    if (r != RAD_SUCCESS) {
+        rad_sky_transfer_destroy(t);
+        return r;
+    }
+    *out = t;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_sky_project(const rad_sky_transfer *t, const rad_environment *e, const float scale[3],
+                                   float *out)
+{
+    double acc[3 * RAD_SKY_MAX_COEFFICIENTS];
+    uint32_t i, j, k, K;
+    int ch;
+    if (!t || !e || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    K = t->coefficients;
+    memset(acc, 0, sizeof acc);
+    for (i = 0; i < e->h; ++i) {
+        double th = RAD__PI * ((double)i + 0.5) / (double)e->h;
+        double dw = 2.0 * RAD__PI / (double)e->w * ((double)e->cos_edge[i] - (double)e->cos_edge[i + 1]);
+        for (j = 0; j < e->w; ++j) {
+            double ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)e->w + (double)e->rotation;
+            float d[3], y[16], rgb[3];
+            d[0] = (float)(sin(th) * cos(ph)), d[1] = (float)cos(th), d[2] = (float)(sin(th) * sin(ph));
+            rad_environment_radiance(e, d, rgb);
+            if (t->basis == RAD_SKY_BASIS_BINS) {
+                k = rad__sky_bin(d);
+                for (ch = 0; ch < 3; ++ch) acc[3 * k + (uint32_t)ch] += (double)rgb[ch] * dw;
+            } else {
+                rad__sky_sh(d, y);
+                for (k = 0; k < 16u; ++k)
+                    for (ch = 0; ch < 3; ++ch) acc[3 * k + (uint32_t)ch] += (double)y[k] * rgb[ch] * dw;
+            }
+        }
+    }
+    if (t->basis == RAD_SKY_BASIS_BINS)
+        /* the mean radiance over each bin: its integral over the bin's solid angle */
+        for (k = 0; k < K; ++k) {
+            uint32_t row = k / RAD_SKY_BINS_U;
+            double om = 2.0 * RAD__PI / RAD_SKY_BINS_U *
+                        (cos(RAD__PI * row / RAD_SKY_BINS_V) - cos(RAD__PI * (row + 1u) / RAD_SKY_BINS_V));
+            for (ch = 0; ch < 3; ++ch) acc[3 * k + (uint32_t)ch] /= om;
+        }
+    for (k = 0; k < 3u * K; ++k) out[k] = (float)(acc[k] * (scale ? (double)scale[k % 3u] : 1.0));
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_sky_transfer_apply(const rad_sky_transfer *t, const float *coefficients, float *out_B)
+{
+    uint32_t i, k, K;
+    int ch;
+    if (!t || !coefficients || !out_B) return RAD_ERROR_INVALID_ARGUMENT;
+    K = t->coefficients;
+    for (k = 0; k < 3u * K; ++k)
+        if (!rad__finite(coefficients[k])) return RAD_ERROR_NON_FINITE;
+    for (i = 0; i < t->n; ++i) {
+        const float *R = t->response + 3u * (size_t)K * i;
+        float b[3] = { 0.0f, 0.0f, 0.0f };
+        for (k = 0; k < K; ++k)
+            for (ch = 0; ch < 3; ++ch) b[ch] += coefficients[3 * k + (uint32_t)ch] * R[3 * k + (uint32_t)ch];
+        for (ch = 0; ch < 3; ++ch) out_B[3 * (size_t)i + (uint32_t)ch] = b[ch];
+    }
     return RAD_SUCCESS;
 }
 

@@ -798,7 +798,7 @@ static void api_direct_args(api_fx *f)
         rad_result r = rad_direct_patches(f->P, &f->rc, &l, 1, NULL, f->buf, NULL);
         CHECK(r == RAD_ERROR_NEGATIVE_EMISSION || r == RAD_ERROR_INVALID_ARGUMENT);
     }
-    api_light_point(&l); l.type = (rad_light_type)4; api_direct_expect(f, &l, 1, NULL, RAD_ERROR_INVALID_ARGUMENT, "type 4");
+    api_light_point(&l); l.type = (rad_light_type)5; api_direct_expect(f, &l, 1, NULL, RAD_ERROR_INVALID_ARGUMENT, "type 5");
     api_light_point(&l); l.type = (rad_light_type)-1; api_direct_expect(f, &l, 1, NULL, RAD_ERROR_INVALID_ARGUMENT, "type -1");
     api_light_point(&l); l.falloff = (rad_falloff)2; api_direct_expect(f, &l, 1, NULL, RAD_ERROR_INVALID_ARGUMENT, "falloff 2");
     api_light_point(&l); l.type = RAD_LIGHT_DIRECTIONAL; l.direction[1] = 0.0f;
