@@ -3303,8 +3303,8 @@ RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_coun
    Neither holds a sun (give it as a directional light and solve it the usual way), nor
    anything but the sky changing. Memory: 16 K bytes per patch (T and R). */
 typedef enum rad_sky_basis {
-    RAD_SKY_BASIS_SH = 0,      /* 16 coefficients */
-    RAD_SKY_BASIS_BINS = 1     /* 128 coefficients */
+    RAD_SKY_BASIS_BINS = 0,    /* 128 coefficients (the default) */
+    RAD_SKY_BASIS_SH = 1       /* 16 coefficients */
 } rad_sky_basis;
 
 #define RAD_SKY_BINS_U 16
@@ -3312,7 +3312,7 @@ typedef enum rad_sky_basis {
 #define RAD_SKY_MAX_COEFFICIENTS 128 /* RAD_SKY_BINS_U * RAD_SKY_BINS_V */
 
 typedef struct rad_sky_transfer_options {
-    rad_sky_basis basis;       /* default RAD_SKY_BASIS_BINS */
+    rad_sky_basis basis;       /* 0: RAD_SKY_BASIS_BINS */
     uint32_t samples;          /* lattice points per patch (0: 16; a square n*n, at most 256) */
     uint32_t rays;             /* cosine-distributed rays per point (0: 256; at most 4096) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
@@ -22503,15 +22503,20 @@ static uint32_t rad__sky_bin(const float *d)
     return row * RAD_SKY_BINS_U + col;
 }
 
+/* the one place the sky transfer's defaults live: zero fields become them */
+static void rad__sky_transfer_options_resolve(rad_sky_transfer_options *o)
+{
+    if (o->samples == 0) o->samples = 16;
+    if (o->rays == 0) o->rays = 256;
+    if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+    rad__solve_options_resolve(&o->solve);
+}
+
 RAD_API void rad_sky_transfer_options_default(rad_sky_transfer_options *o)
 {
     if (!o) return;
     memset(o, 0, sizeof(*o));
-    o->basis = RAD_SKY_BASIS_BINS;
-    o->samples = 16;
-    o->rays = 256;
-    o->ray_epsilon = 1e-5f;
-    rad_solve_options_default(&o->solve);
+    rad__sky_transfer_options_resolve(o);
 }
 
 RAD_API void rad_sky_transfer_destroy(rad_sky_transfer *t)
@@ -22596,10 +22601,7 @@ RAD_API rad_result rad_sky_transfer_create(const rad_patches *P, const rad_rayca
     if (!P || !rc || !rc->occluded || !F || !out || !P->scene) return RAD_ERROR_INVALID_ARGUMENT;
     memset(&j, 0, sizeof j);
     if (options) j.o = *options;
-    else rad_sky_transfer_options_default(&j.o);
-    if (j.o.samples == 0) j.o.samples = 16;
-    if (j.o.rays == 0) j.o.rays = 256;
-    if (j.o.ray_epsilon == 0.0f) j.o.ray_epsilon = 1e-5f;
+    rad__sky_transfer_options_resolve(&j.o);
     if ((j.o.basis != RAD_SKY_BASIS_SH && j.o.basis != RAD_SKY_BASIS_BINS) || j.o.samples > RAD__MAX_SAMPLES ||
         j.o.rays > 4096u || !(j.o.ray_epsilon > 0.0f && j.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
         rad__log(&c, RAD_LOG_ERROR, "sky transfer: basis %d (0 or 1), samples %u (at most %u), rays %u (at most 4096), "

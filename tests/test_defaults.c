@@ -13,7 +13,7 @@ static const char *const df_covered[] = {
     "rad_hierarchical_options_default", "rad_multibounce_options_default", "rad_block_options_default",
     "rad_local_options_default", "rad_temporal_options_default", "rad_vp_options_default",
     "rad_vp_lights_options_default", "rad_lightmap_options_default", "rad_lightmap_gather_options_default",
-    "rad_probe_options_default", NULL
+    "rad_probe_options_default", "rad_sky_transfer_options_default", NULL
 };
 
 /* a and b hold the same bytes (n floats) */
@@ -457,6 +457,28 @@ static void df_probes(void)
     fx_world_free(&w);
 }
 
+/* the sky transfer: the response tables of a zeroed and a default struct (few rays: the fields
+   compared are the defaults, not the accuracy) */
+static void df_sky_transfer(void)
+{
+    fx_world w;
+    rad_sky_transfer_options z, d;
+    rad_sky_transfer *a = NULL, *b = NULL;
+    if (!fx_cornell(&w, 24, 1, 0)) { CHECK(0); return; }
+    memset(&z, 0, sizeof z);
+    rad_sky_transfer_options_default(&d);
+    z.rays = d.rays = 16;
+    CHECK_OK(rad_sky_transfer_create(w.patches, &w.rc, &w.ff->matrix, &z, NULL, &a));
+    CHECK_OK(rad_sky_transfer_create(w.patches, &w.rc, &w.ff->matrix, &d, NULL, &b));
+    if (a && b) {
+        CHECK(a->coefficients == b->coefficients && a->basis == RAD_SKY_BASIS_BINS);
+        CHECK(df_same(a->response, b->response, 3 * (size_t)a->coefficients * a->n));
+    }
+    rad_sky_transfer_destroy(a);
+    rad_sky_transfer_destroy(b);
+    fx_world_free(&w);
+}
+
 /* the list tests/check_docs.sh compares with the header is well formed */
 static void df_list(void)
 {
@@ -481,6 +503,7 @@ static const rad_test_case tests_defaults[] = {
     { "defaults_vp_lights", df_vp_lights },
     { "defaults_lightmap", df_lightmap },
     { "defaults_probes", df_probes },
+    { "defaults_sky_transfer", df_sky_transfer },
     { NULL, NULL }
 };
 
