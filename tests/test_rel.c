@@ -115,7 +115,8 @@ static int rl_all_finite(const float *v, size_t n)
 
 /* rad_lightmap_refresh: finite patch irradiance gives finite texels; a NaN or an Inf in the
    patch that the first row's first vertex reads is refused (NON_FINITE, the texel named),
-   not returned as a lightmap with NaN texels. */
+   not returned as a lightmap with NaN texels; a NaN the caller left in a gutter texel (no
+   row: the refresh does not write it) is not the refresh's and is accepted. */
 static void rl_test_lightmap_refresh_nonfinite(void)
 {
     static const float bad[2] = { NAN, INFINITY };
@@ -139,6 +140,22 @@ static void rl_test_lightmap_refresh_nonfinite(void)
         for (i = 0; i < 3 * w.P->count; ++i) H[i] = 1.0f;
         CHECK_OK(rad_lightmap_refresh(W, H, out, &ctx));
         CHECK(rl_all_finite(out, 3 * 32 * 32));
+        {
+            /* a texel without a row (a gutter) between rows holds the caller's value, whatever
+               it is: not the refresh's output, so not refused */
+            uint32_t r = 0, t, gutter = RAD_NONE;
+            for (t = W->row_texels[0]; t < W->row_texels[W->row_count - 1] && gutter == RAD_NONE; ++t) {
+                while (r < W->row_count && W->row_texels[r] < t) ++r;
+                if (W->row_texels[r] != t) gutter = t;
+            }
+            CHECK(gutter != RAD_NONE);
+            if (gutter != RAD_NONE) {
+                out[3 * gutter] = NAN;
+                CHECK_OK(rad_lightmap_refresh(W, H, out, &ctx));
+                CHECK(isnan(out[3 * gutter]));
+                out[3 * gutter] = 0.0f;
+            }
+        }
         p = W->vertex_patches[W->vertex_first[W->entry_vertices[W->row_first[0]]]];
         for (b = 0; b < 2; ++b) {
             H[3 * p + 1] = bad[b];
