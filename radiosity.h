@@ -21685,7 +21685,7 @@ static void rad__temp_name(const char *path, uint32_t attempt, char *tmp)
    O_NOFOLLOW where defined), fsync of the file and of its folder, rename (atomic: a reader
    sees the old file or the new one, and of concurrent saves the last rename wins, each a
    whole file). Elsewhere (ISO C only): a fresh name checked not to exist, fopen, fflush,
-   rename, and where rename does not replace a file (Windows), remove then rename. */
+   rename, and on Windows, where rename does not replace a file, remove then rename. */
 static rad_result rad__write_file_atomic(const rad__ctx *c, const char *path, const void *data, size_t size)
 {
     size_t len = strlen(path);
@@ -21776,9 +21776,13 @@ static rad_result rad__write_file_atomic(const rad__ctx *c, const char *path, co
         ok = fflush(f) == 0 && ok;
         ok = (fclose(f) == 0) && ok;
         if (ok && rename(tmp, path) != 0) {
-            /* where rename does not replace an existing file (Windows), replace it by hand;
-               remove() deletes files only, so a folder at path stays and the save fails */
+#if defined(_WIN32)
+            /* Windows' rename does not replace an existing file: replace it by hand (remove()
+               deletes files only, so a folder at path stays and the save fails) */
             ok = remove(path) == 0 && rename(tmp, path) == 0;
+#else
+            ok = 0;
+#endif
         }
         if (ok) made = 0;
     }
