@@ -115,7 +115,8 @@ static int rl_all_finite(const float *v, size_t n)
 
 /* rad_lightmap_refresh: finite patch irradiance gives finite texels; a NaN or an Inf in the
    patch that the first row's first vertex reads is refused (NON_FINITE, the texel named),
-   not returned as a lightmap with NaN texels. */
+   not returned as a lightmap with NaN texels; a NaN the caller left in a gutter texel (no
+   row: the refresh does not write it) is not the refresh's and is accepted. */
 static void rl_test_lightmap_refresh_nonfinite(void)
 {
     static const float bad[2] = { NAN, INFINITY };
@@ -139,6 +140,22 @@ static void rl_test_lightmap_refresh_nonfinite(void)
         for (i = 0; i < 3 * w.P->count; ++i) H[i] = 1.0f;
         CHECK_OK(rad_lightmap_refresh(W, H, out, &ctx));
         CHECK(rl_all_finite(out, 3 * 32 * 32));
+        {
+            /* a texel without a row (a gutter) between rows holds the caller's value, whatever
+               it is: not the refresh's output, so not refused */
+            uint32_t r = 0, t, gutter = RAD_NONE;
+            for (t = W->row_texels[0]; t < W->row_texels[W->row_count - 1] && gutter == RAD_NONE; ++t) {
+                while (r < W->row_count && W->row_texels[r] < t) ++r;
+                if (W->row_texels[r] != t) gutter = t;
+            }
+            CHECK(gutter != RAD_NONE);
+            if (gutter != RAD_NONE) {
+                out[3 * gutter] = NAN;
+                CHECK_OK(rad_lightmap_refresh(W, H, out, &ctx));
+                CHECK(isnan(out[3 * gutter]));
+                out[3 * gutter] = 0.0f;
+            }
+        }
         p = W->vertex_patches[W->vertex_first[W->entry_vertices[W->row_first[0]]]];
         for (b = 0; b < 2; ++b) {
             H[3 * p + 1] = bad[b];
@@ -467,8 +484,38 @@ done:
 }
 #endif
 
+/* The scan every input and output check uses (rad__all_finite: the exponent bits, in blocks
+   of 1024): every finite float passes, the extremes included (FLT_MAX, denormals, -0), and a
+   NaN, +Inf or -Inf is found wherever it sits: first, last, at the block edges, in the tail. */
+static void rl_test_finite_scan(void)
+{
+    static const size_t sizes[6] = { 1, 3, 1023, 1024, 1025, 5000 };
+    const float bad[3] = { NAN, INFINITY, -INFINITY };
+    const float good[6] = { FLT_MAX, -FLT_MAX, 1e-45f, -1e-45f, -0.0f, 1.0f };
+    float *v = (float *)malloc(sizeof(float) * 5000);
+    size_t s, i, at[6];
+    int b, k;
+    if (!v) { CHECK(!"memory"); return; }
+    for (s = 0; s < 6; ++s) {
+        size_t n = sizes[s];
+        for (i = 0; i < n; ++i) v[i] = good[i % 6];
+        CHECK(rad__all_finite(v, n));
+        at[0] = 0; at[1] = n - 1; at[2] = n / 2; at[3] = n > 1023 ? 1023 : 0; at[4] = n > 1024 ? 1024 : 0; at[5] = n > 2048 ? 2048 : n - 1;
+        for (k = 0; k < 6; ++k)
+            for (b = 0; b < 3; ++b) {
+                float keep = v[at[k]];
+                v[at[k]] = bad[b];
+                CHECK(!rad__all_finite(v, n));
+                v[at[k]] = keep;
+            }
+    }
+    CHECK(rad__all_finite(v, 0));
+    free(v);
+}
+
 static const rad_test_case tests_rel[] = {
     { "rel_vertex_irradiance_tiny_rows", rl_test_vertex_irradiance_tiny_rows },
+    { "rel_finite_scan", rl_test_finite_scan },
     { "rel_lightmap_refresh_nonfinite", rl_test_lightmap_refresh_nonfinite },
     { "rel_vp_runtime_nonfinite", rl_test_vp_runtime_nonfinite },
     { "rel_light_direction_scale", rl_test_light_direction_scale },
