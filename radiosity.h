@@ -1114,7 +1114,10 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
      3. gather and push-pull (Jacobi): G_r = sum over r's links of F_rs B_s; pushed down
         (an element receives what its ancestors gathered), B = E + rho G at the leaves,
         pulled up as area-weighted means; repeated until B changes by less than 1e-6 of
-        max B;
+        max B. A leaf whose form factors (its ancestors' included) sum past 1.2, which
+        coincident duplicate surfaces, overlapping sources that one visibility ray each
+        both pass, and cluster estimates can give, has G scaled to that sum 1.2 (lower where
+        rho times 1.2 passes 0.999): otherwise the sweeps can grow B without bound;
      4. steps 2 and 3 again with the new B, until no link is refined or max_iterations rounds.
    The result: per leaf, B (radiosity, W m^-2) and H = G (the irradiance from the other
    elements' radiosity, the classic H = F B; the renderer's indirect term is rho / pi H).
@@ -1212,9 +1215,10 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
                                            rad_hierarchical **out);
 /* Runs the solve (steps 1 to 4 above). Can be called once. ctx: logging, progress (after each
    round; cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
-   twice), RAYCAST_FAILED, NON_FINITE (a source value or the result), NEGATIVE_EMISSION (the
-   source gave E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000),
-   CANCELLED, OUT_OF_MEMORY. After an error the object can only be destroyed.
+   twice), RAYCAST_FAILED, NON_FINITE (a source value), NEGATIVE_EMISSION (the source gave
+   E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000; or a form factor
+   or B of the solver's own that is not finite, logged as "internal"), CANCELLED,
+   OUT_OF_MEMORY. After an error the object can only be destroyed.
    Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep; with
    clustering also O(members of the source) projections per cluster link evaluated and, per
    sweep, per triangle the links into the clusters above it. */
@@ -9160,6 +9164,8 @@ done:
 #define RAD__HR_MAX_SWEEPS 1000u
 #define RAD__HR_SWEEP_TOLERANCE 1e-6
 #define RAD__HR_SOURCE_BATCH 4096u
+#define RAD__HR_ROW_CAP 1.2      /* largest form-factor sum a leaf gathers over */
+#define RAD__HR_MAX_GAIN 0.999   /* largest rho times that sum */
 
 /* One quadtree node. Children are 4 consecutive elements, made after their parent, so index
    order is a top-down order and its reverse a bottom-up one. */
@@ -9851,8 +9857,8 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
         lk->F = fu;
         return RAD_SUCCESS;
     }
-    /* up to 4K draws for K pairs that face each other */
-    for (a = 0; a < 4u * K && got < K; ++a) {
+    /* up to 4K draws (64 at least: draws cost no rays) for K pairs that face each other */
+    for (a = 0; a < (K < 16u ? 64u : 4u * K) && got < K; ++a) {
         uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s ^ rad__hash(a + 0x632be5abu))));
         uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
         float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2;
@@ -9999,6 +10005,19 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
         }
         h->st.links_evaluated += count;
         if (r != RAD_SUCCESS) rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the raycaster failed");
+    }
+    if (r == RAD_SUCCESS) { /* the scene was checked at creation: a non-finite F is the solver's own */
+        size_t l;
+        for (l = 0; l < count; ++l)
+            if (!rad__finite(links[l].F) || !rad__finite(links[l].Fu) || !rad__finite(links[l].Fd)) {
+                rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: internal: non-finite form factor %g (unoccluded %g) "
+                         "of the link from node %u%s to node %u%s: a solver failure, not an input error",
+                         (double)links[l].F, (double)links[l].Fu, links[l].s & ~RAD__HR_CL,
+                         rad__hr_is_cl(links[l].s) ? " (cluster)" : "", links[l].r & ~RAD__HR_CL,
+                         rad__hr_is_cl(links[l].r) ? " (cluster)" : "");
+                r = RAD_ERROR_NOT_CONVERGED;
+                break;
+            }
     }
     {
         void *blocks[] = { ev.rays, ev.occ, ev.w, ev.idx, ev.kernels, ev.rays_cast, ev.proj, ev.results };
@@ -10232,8 +10251,15 @@ static void rad__hr_gather_task(void *data, uint32_t task)
     }
 }
 
-/* One gather and push-pull sweep; returns the largest change of a leaf's B over max B */
-static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
+/* One gather and push-pull sweep: *res gets the largest change of a leaf's B over max B.
+   A leaf's form factors can sum well past 1 (point-sampled visibility passing both of two
+   surfaces that overlap from where it stands, coincident duplicates, the cluster estimates);
+   where rho times the sum passes 1 the sweeps grow B without bound, to infinity. So a leaf's
+   sum S is scaled down to RAD__HR_ROW_CAP (the ordinary scatter about 1 stays), or lower
+   where rho times that would pass RAD__HR_MAX_GAIN: every leaf then gathers at most that
+   gain times the largest B, and the sweeps contract. NOT_CONVERGED (logged as internal) if
+   a B is not finite all the same. */
+static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *res)
 {
     uint32_t i, k;
     size_t l;
@@ -10266,6 +10292,16 @@ static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
         const rad__hr_elem *p = e->parent != RAD_NONE ? &h->el[e->parent] : NULL;
         for (k = 0; k < 3; ++k) e->Gt[k] = e->G[k] + (p ? p->Gt[k] : 0.0);
         e->St = e->S + (p ? p->St : 0.0);
+        if (e->child == RAD_NONE && e->St > 1.0) {
+            float rm = e->rho[0] > e->rho[1] ? (e->rho[0] > e->rho[2] ? e->rho[0] : e->rho[2])
+                                             : (e->rho[1] > e->rho[2] ? e->rho[1] : e->rho[2]);
+            double cap = (double)rm * RAD__HR_ROW_CAP < RAD__HR_MAX_GAIN ? RAD__HR_ROW_CAP : RAD__HR_MAX_GAIN / (double)rm;
+            if (cap < 1.0) cap = 1.0;
+            if (e->St > cap) {
+                for (k = 0; k < 3; ++k) e->Gt[k] *= cap / e->St;
+                e->St = cap;
+            }
+        }
     }
     for (i = h->nel; i-- > 0;) { /* pull: children come first */
         rad__hr_elem *e = &h->el[i];
@@ -10273,6 +10309,12 @@ static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
             for (k = 0; k < 3; ++k) {
                 float b = (float)((double)e->E[k] + (double)e->rho[k] * e->Gt[k]);
                 double d = fabs((double)b - (double)e->B[k]);
+                if (!rad__finite(b)) {
+                    rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: internal: non-finite radiosity %g at element %u "
+                             "(scene triangle %u, depth %u) after gathering %g over a form-factor sum of %g: a "
+                             "solver failure, not an input error", (double)b, i, e->tri, e->depth, e->Gt[k], e->St);
+                    return RAD_ERROR_NOT_CONVERGED;
+                }
                 if (d > change) change = d;
                 if ((double)b > bmax) bmax = (double)b;
                 e->B[k] = b;
@@ -10289,7 +10331,8 @@ static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
         }
     }
     rad__hr_cluster_pull(h);
-    return bmax > 0.0 ? change / bmax : 0.0;
+    *res = bmax > 0.0 ? change / bmax : 0.0;
+    return RAD_SUCCESS;
 }
 
 /* leaves in order, per-leaf corner vertices welded by position and plane, vertex values */
@@ -10452,10 +10495,11 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
         if (r == RAD_SUCCESS && h->cl) r = rad__hr_build_in(h, &c);
         if (r != RAD_SUCCESS) break;
         for (s = 0; s < RAD__HR_MAX_SWEEPS; ++s) {
-            res = rad__hr_sweep(h, &c);
+            if ((r = rad__hr_sweep(h, &c, &res)) != RAD_SUCCESS) break;
             h->st.sweeps++;
             if (res < RAD__HR_SWEEP_TOLERANCE) break;
         }
+        if (r != RAD_SUCCESS) break;
         h->st.residual = res;
         h->st.rounds = round + 1u;
         if (s == RAD__HR_MAX_SWEEPS) {
@@ -10470,9 +10514,6 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
             break;
         }
         if (!changed) break;
-    }
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < h->nel && r == RAD_SUCCESS; ++i) r = rad__check_output(&c, "rad_hierarchical_solve", h->el[i].B, 3);
     }
     if (r == RAD_SUCCESS) r = rad__hr_finish(h, &c);
     if (r != RAD_SUCCESS) return r;
