@@ -1140,7 +1140,9 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    straight to its member triangles, each by its own cosine to the source (so a cluster lit
    from one side lights only the triangles facing that side), before the push. Reentrant; the
    solve uses ctx->parallel_for for the links' form factors and the clusters' gather; after it
-   the accessors and lookups only read (any threads at once). */
+   the accessors and lookups only read (any threads at once). Progress is reported after each
+   level of refinement and each sweep (cancel stops either within that step); memory_limit
+   bounds the elements and links. */
 
 #define RAD_HIERARCHICAL_MAX_ROOT_PAIRS 50000000ull
 /* RAD_HIERARCHICAL_CLUSTER_AUTO clusters scenes with more ordered triangle pairs than this */
@@ -1175,6 +1177,10 @@ typedef struct rad_hierarchical_options {
     rad_hierarchical_source_fn source; /* NULL: E = pi * the material's emitted radiance */
     void *source_user;
     rad_hierarchical_clustering clustering; /* 0: AUTO */
+    uint64_t memory_limit;     /* bytes of elements and links (0: no limit): refinement stops
+                                  splitting links once the next split would pass it, they stay
+                                  where they are (stats.memory_limited) and the solve goes on;
+                                  links whose ends overlap (no F yet) are split all the same */
 } rad_hierarchical_options;
 
 typedef struct rad_hierarchical_stats {
@@ -1190,6 +1196,9 @@ typedef struct rad_hierarchical_stats {
     uint32_t clusters;         /* volume clusters built (0 without clustering) */
     uint64_t cluster_links;    /* links of the final solution with a cluster at either end */
     uint64_t projections;      /* member triangles projected for cluster links' F */
+    uint64_t peak_bytes;       /* most bytes of elements and links held at once (the
+                                  estimate memory_limit is checked against) */
+    uint64_t memory_limited;   /* refinements refused because of memory_limit, all rounds */
 } rad_hierarchical_stats;
 
 /* what rad_hierarchical_lookup returns */
@@ -1214,7 +1223,8 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
                                            const rad_hierarchical_options *options, const rad_context *ctx,
                                            rad_hierarchical **out);
 /* Runs the solve (steps 1 to 4 above). Can be called once. ctx: logging, progress (after each
-   round; cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
+   refinement level and each sweep, rising through max_iterations rounds, 1 at the end;
+   cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
    twice), RAYCAST_FAILED, NON_FINITE (a source value), NEGATIVE_EMISSION (the source gave
    E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000; or a form factor
    or B of the solver's own that is not finite, logged as "internal"), CANCELLED,
@@ -9225,8 +9235,24 @@ struct rad_hierarchical {
     uint32_t *in_first;
     rad_hierarchical_stats st;
     int state;           /* 0 created, 1 solved, -1 a solve failed */
+    uint32_t round;      /* the round under way, and the progress reported so far */
+    float reported;
     rad_allocator allocator;
 };
+
+/* Reports progress (round + within) / max_iterations, never going back; 1 when the caller
+   asked to stop (logged, naming the step). */
+static int rad__hr_progress(rad_hierarchical *h, const rad__ctx *c, double within, const char *step)
+{
+    float f = (float)(((double)h->round + (within < 0.0 ? 0.0 : within > 1.0 ? 1.0 : within)) / (double)h->o.max_iterations);
+    if (!c->progress) return 0;
+    if (f < h->reported) f = h->reported;
+    if (f > 1.0f) f = 1.0f;
+    h->reported = f;
+    if (!c->progress(c->progress_user, f)) return 0;
+    rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: cancelled during the %s of round %u", step, h->round);
+    return 1;
+}
 
 RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *o)
 {
@@ -10117,6 +10143,7 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
 {
     rad__hr_list keep, cand, next;
     size_t i;
+    double level_share = 1.0;
     rad_result r = RAD_SUCCESS;
     *changed = 0;
     memset(&keep, 0, sizeof(keep));
@@ -10130,7 +10157,22 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
         for (i = 0; i < cand.n && r == RAD_SUCCESS; ++i) {
             rad__hr_link l = cand.a[i];
             uint32_t e, k;
-            if (!rad__hr_oracle(h, &l, &e)) {
+            int split = rad__hr_oracle(h, &l, &e);
+            if (split && h->o.memory_limit && l.Fu > 0.0f) { /* Fu 0: overlapping ends, F unknown until split */
+                /* the bytes held once this split's links are pushed and, at worst, every
+                   candidate left is kept (the lists grow by doubling) */
+                uint64_t el_cap = h->cap_el, ncap = next.cap, kcap = keep.cap;
+                if (!rad__hr_is_cl(e) && h->el[e].child == RAD_NONE && h->nel + 4u > h->cap_el) el_cap *= 2u;
+                if (next.n + 4u > next.cap) ncap = next.cap ? 2u * next.cap : 1024u;
+                while (kcap < keep.n + (cand.n - i)) kcap = kcap ? 2u * kcap : 1024u;
+                if (el_cap * sizeof(rad__hr_elem) + (kcap + cand.cap + ncap) * sizeof(rad__hr_link) > h->o.memory_limit) {
+                    if (h->st.memory_limited++ == 0)
+                        rad__log(c, RAD_LOG_WARNING, "rad_hierarchical_solve: memory_limit %llu bytes reached in round %u: "
+                                 "links left unrefined from here on", (unsigned long long)h->o.memory_limit, h->round);
+                    split = 0;
+                }
+            }
+            if (!split) {
                 if (keep.n == keep.cap) {
                     /* rad__hr_push checks facing, which a kept link passed already */
                     r = rad__hr_push(h, &keep, l.r, l.s, c);
@@ -10154,6 +10196,13 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
             }
         }
         if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, next.a, next.n, c);
+        {
+            uint64_t held = (uint64_t)h->cap_el * sizeof(rad__hr_elem) + (uint64_t)(keep.cap + cand.cap + next.cap) * sizeof(rad__hr_link);
+            if (held > h->st.peak_bytes) h->st.peak_bytes = held;
+        }
+        /* the levels of a round: half of its progress, each level half of what is left */
+        level_share *= 0.5;
+        if (r == RAD_SUCCESS && rad__hr_progress(h, c, 0.5 * (1.0 - level_share), "refinement")) r = RAD_ERROR_CANCELLED;
         {
             rad__hr_list tmp = cand;
             cand = next;
@@ -10488,6 +10537,7 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
     if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, h->links, h->nlinks, &c);
     for (round = 0; round < h->o.max_iterations && r == RAD_SUCCESS; ++round) {
         int changed = 0;
+        h->round = round;
         uint32_t first = h->nel, s;
         double res = 0.0;
         r = rad__hr_refine(h, &changed, &c);
@@ -10498,6 +10548,11 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
             if ((r = rad__hr_sweep(h, &c, &res)) != RAD_SUCCESS) break;
             h->st.sweeps++;
             if (res < RAD__HR_SWEEP_TOLERANCE) break;
+            /* the sweeps: the other half, by how far the change has fallen toward 1e-6 */
+            if (rad__hr_progress(h, &c, res > 0.0 ? 0.5 + 0.5 * log(res) / log(RAD__HR_SWEEP_TOLERANCE) : 1.0, "sweeps")) {
+                r = RAD_ERROR_CANCELLED;
+                break;
+            }
         }
         if (r != RAD_SUCCESS) break;
         h->st.residual = res;
@@ -10508,8 +10563,9 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
             r = RAD_ERROR_NOT_CONVERGED;
             break;
         }
-        if (c.progress && c.progress(c.progress_user, (float)(round + 1u) / (float)h->o.max_iterations)) {
-            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: cancelled after round %u", round);
+        h->round = round + 1u;
+        if (!changed) h->round = h->o.max_iterations; /* done: the rounds left are not needed */
+        if (rad__hr_progress(h, &c, 0.0, "end")) {
             r = RAD_ERROR_CANCELLED;
             break;
         }

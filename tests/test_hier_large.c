@@ -222,16 +222,14 @@ static void hl_junk(hl_soup *s, uint32_t seed)
 #undef HL_RND
 }
 
-static void hl_test_junk_furnace(void)
+/* the junk furnace's world; returns the walls' triangle count (0 on failure) */
+static uint32_t hl_junk_world(hl_world *w)
 {
     static const rad_material mat = { { 0.8f, 0.8f, 0.8f }, { 1.0f, 1.0f, 1.0f }, 0 };
-    static const uint32_t rays[2] = { 1, 4 };
-    static const double tol[2] = { 1e-2, 1e-3 };
     ff_quad q[6];
     hl_soup s;
-    hl_world w;
-    uint32_t f, walls, t;
-    double exact = 3.14159265 / (1.0 - 0.8);
+    uint32_t f, walls;
+    int ok;
     memset(&s, 0, sizeof(s));
     ff_cube_quads(q);
     for (f = 0; f < 6; ++f) { /* ff_quad: o, o + u, o + u + v, o + v */
@@ -246,7 +244,19 @@ static void hl_test_junk_furnace(void)
     }
     walls = s.n;
     hl_junk(&s, 7u);
-    if (!hl_world_make(&s, &mat, NULL, 1, &w)) { free(s.v); return; }
+    ok = hl_world_make(&s, &mat, NULL, 1, w);
+    free(s.v);
+    return ok ? walls : 0u;
+}
+
+static void hl_test_junk_furnace(void)
+{
+    static const uint32_t rays[2] = { 1, 4 };
+    static const double tol[2] = { 1e-2, 1e-3 };
+    hl_world w;
+    uint32_t walls = hl_junk_world(&w), t;
+    double exact = 3.14159265 / (1.0 - 0.8);
+    if (!walls) return;
     for (t = 0; t < 2; ++t) {
         rad_hierarchical_options o;
         rad_hierarchical *h = NULL;
@@ -271,12 +281,85 @@ static void hl_test_junk_furnace(void)
         rad_hierarchical_destroy(h);
     }
     hl_world_free(&w);
-    free(s.v);
+}
+
+/* 3. Progress, cancel and memory_limit on the junk furnace. Progress comes after each
+   refinement level and sweep, more often than rounds, never falls, and ends at 1; a cancel at
+   the first report (inside the first refinement) and at the tenth (in the sweeps) gives
+   CANCELLED; a memory_limit of half the unlimited solve's peak refuses refinements, holds the
+   peak near it (splits of overlapping ends are not refused), and the furnace still holds
+   within 10% on the walls. */
+typedef struct hl_prog {
+    int calls, stop_at, fell;
+    float last;
+} hl_prog;
+
+static int hl_prog_fn(void *user, float f)
+{
+    hl_prog *p = (hl_prog *)user;
+    if (f < p->last) p->fell = 1;
+    p->last = f;
+    return ++p->calls == p->stop_at;
+}
+
+static void hl_test_progress_memory(void)
+{
+    hl_world w;
+    uint32_t walls = hl_junk_world(&w);
+    rad_hierarchical_options o;
+    rad_hierarchical *h = NULL;
+    rad_hierarchical_stats st, lim;
+    rad_context ctx;
+    hl_prog p;
+    double exact = 3.14159265 / (1.0 - 0.8), mw, bmax;
+    int stop;
+    if (!walls) return;
+    rad_hierarchical_options_default(&o);
+    o.clustering = RAD_HIERARCHICAL_CLUSTER_ON;
+    o.tolerance = 1e-3;
+    memset(&ctx, 0, sizeof(ctx));
+    ctx.progress = hl_prog_fn;
+    ctx.progress_user = &p;
+    memset(&p, 0, sizeof(p));
+    CHECK_OK(rad_hierarchical_create(w.scene, &w.rc, &o, NULL, &h));
+    if (h) CHECK_OK(rad_hierarchical_solve(h, &ctx));
+    rad_hierarchical_get_stats(h, &st);
+    rad_hierarchical_destroy(h);
+    printf("    %d progress reports over %u rounds and %u sweeps, last %.3f; peak %.2f MiB\n", p.calls, st.rounds, st.sweeps,
+           (double)p.last, (double)st.peak_bytes / 1048576.0);
+    CHECK(p.calls > (int)st.rounds + 2 && !p.fell && p.last == 1.0f);
+    CHECK(st.memory_limited == 0 && st.peak_bytes > 0);
+    for (stop = 1; stop <= 10; stop += 9) {
+        memset(&p, 0, sizeof(p));
+        p.stop_at = stop;
+        h = NULL;
+        CHECK_OK(rad_hierarchical_create(w.scene, &w.rc, &o, NULL, &h));
+        if (h) CHECK_RESULT(rad_hierarchical_solve(h, &ctx), RAD_ERROR_CANCELLED);
+        CHECK(p.calls == stop);
+        rad_hierarchical_destroy(h);
+    }
+    o.memory_limit = st.peak_bytes / 2u;
+    h = NULL;
+    CHECK_OK(rad_hierarchical_create(w.scene, &w.rc, &o, NULL, &h));
+    if (h) {
+        CHECK_OK(rad_hierarchical_solve(h, NULL));
+        rad_hierarchical_get_stats(h, &lim);
+        mw = hl_mean_B(h, 0, walls, &bmax);
+        printf("    memory_limit %.2f MiB: peak %.2f MiB, %llu refinements refused, %u leaves (%u unlimited); walls %.4f of "
+               "E / (1 - rho)\n", (double)o.memory_limit / 1048576.0, (double)lim.peak_bytes / 1048576.0,
+               (unsigned long long)lim.memory_limited, lim.leaves, st.leaves, mw / exact);
+        /* the splits of links whose ends overlap (no F yet) are made all the same */
+        CHECK(lim.memory_limited > 0 && lim.peak_bytes <= o.memory_limit + o.memory_limit / 4u);
+        CHECK(bmax > 0.0 && fabs(mw / exact - 1.0) < 0.1);
+        rad_hierarchical_destroy(h);
+    }
+    hl_world_free(&w);
 }
 
 static const rad_test_case tests_hier_large[] = {
     { "hier_large_coincident_layers", hl_test_coincident_layers },
     { "hier_large_junk_furnace", hl_test_junk_furnace },
+    { "hier_large_progress_memory", hl_test_progress_memory },
     { NULL, NULL }
 };
 RAD_TEST_MAIN(tests_hier_large)
