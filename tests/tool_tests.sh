@@ -1353,5 +1353,7 @@ printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "n
     ok "lightmap over the file's second uv set keeps the default 256 atlas" ||
     fail "lightmap over the file's second uv set keeps the default 256 atlas" "$(head -c 400 "$TMP/err.txt")"
 
+. "$(dirname "$0")/tool_hier_large.sh"
+
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]
