@@ -9883,8 +9883,8 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
         lk->F = fu;
         return RAD_SUCCESS;
     }
-    /* up to 4K draws (64 at least: draws cost no rays) for K pairs that face each other */
-    for (a = 0; a < (K < 16u ? 64u : 4u * K) && got < K; ++a) {
+    /* up to 4K draws for K pairs that face each other */
+    for (a = 0; a < 4u * K && got < K; ++a) {
         uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s ^ rad__hash(a + 0x632be5abu))));
         uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
         float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2;
