@@ -1292,7 +1292,10 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
      3. gather and push-pull (Jacobi): G_r = sum over r's links of F_rs B_s; pushed down
         (an element receives what its ancestors gathered), B = E + rho G at the leaves,
         pulled up as area-weighted means; repeated until B changes by less than 1e-6 of
-        max B;
+        max B. A leaf whose form factors (its ancestors' included) sum past 1.2, which
+        coincident duplicate surfaces, overlapping sources that one visibility ray each
+        both pass, and cluster estimates can give, has G scaled to that sum 1.2 (lower where
+        rho times 1.2 passes 0.999): otherwise the sweeps can grow B without bound;
      4. steps 2 and 3 again with the new B, until no link is refined or max_iterations rounds.
    The result: per leaf, B (radiosity, W m^-2) and H = G (the irradiance from the other
    elements' radiosity, the classic H = F B; the renderer's indirect term is rho / pi H).
@@ -1315,7 +1318,9 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    straight to its member triangles, each by its own cosine to the source (so a cluster lit
    from one side lights only the triangles facing that side), before the push. Reentrant; the
    solve uses ctx->parallel_for for the links' form factors and the clusters' gather; after it
-   the accessors and lookups only read (any threads at once). */
+   the accessors and lookups only read (any threads at once). Progress is reported after each
+   level of refinement and each sweep (cancel stops either within that step); memory_limit
+   bounds the elements and links. */
 
 #define RAD_HIERARCHICAL_MAX_ROOT_PAIRS 50000000ull
 /* RAD_HIERARCHICAL_CLUSTER_AUTO clusters scenes with more ordered triangle pairs than this */
@@ -1350,6 +1355,10 @@ typedef struct rad_hierarchical_options {
     rad_hierarchical_source_fn source; /* NULL: E = pi * the material's emitted radiance */
     void *source_user;
     rad_hierarchical_clustering clustering; /* 0: AUTO */
+    uint64_t memory_limit;     /* bytes of elements and links (0: no limit): refinement stops
+                                  splitting links once the next split would pass it, they stay
+                                  where they are (stats.memory_limited) and the solve goes on;
+                                  links whose ends overlap (no F yet) are split all the same */
 } rad_hierarchical_options;
 
 typedef struct rad_hierarchical_stats {
@@ -1365,6 +1374,9 @@ typedef struct rad_hierarchical_stats {
     uint32_t clusters;         /* volume clusters built (0 without clustering) */
     uint64_t cluster_links;    /* links of the final solution with a cluster at either end */
     uint64_t projections;      /* member triangles projected for cluster links' F */
+    uint64_t peak_bytes;       /* most bytes of elements and links held at once (the
+                                  estimate memory_limit is checked against) */
+    uint64_t memory_limited;   /* refinements refused because of memory_limit, all rounds */
 } rad_hierarchical_stats;
 
 /* what rad_hierarchical_lookup returns */
@@ -1388,10 +1400,12 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
                                            const rad_hierarchical_options *options, const rad_context *ctx,
                                            rad_hierarchical **out);
 /* Runs the solve (steps 1 to 4 above). Can be called once. ctx: logging, progress (after each
-   round; cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
-   twice), RAYCAST_FAILED, NON_FINITE (a source value or the result), NEGATIVE_EMISSION (the
-   source gave E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000),
-   CANCELLED, OUT_OF_MEMORY. After an error the object can only be destroyed.
+   refinement level and each sweep, rising through max_iterations rounds, 1 at the end;
+   cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
+   twice), RAYCAST_FAILED, NON_FINITE (a source value), NEGATIVE_EMISSION (the source gave
+   E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000; or a form factor
+   or B of the solver's own that is not finite, logged as "internal"), CANCELLED,
+   OUT_OF_MEMORY. After an error the object can only be destroyed.
    Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep; with
    clustering also O(members of the source) projections per cluster link evaluated and, per
    sweep, per triangle the links into the clusters above it. */
@@ -10338,6 +10352,8 @@ done:
 #define RAD__HR_MAX_SWEEPS 1000u
 #define RAD__HR_SWEEP_TOLERANCE 1e-6
 #define RAD__HR_SOURCE_BATCH 4096u
+#define RAD__HR_ROW_CAP 1.2      /* largest form-factor sum a leaf gathers over */
+#define RAD__HR_MAX_GAIN 0.999   /* largest rho times that sum */
 
 /* One quadtree node. Children are 4 consecutive elements, made after their parent, so index
    order is a top-down order and its reverse a bottom-up one. */
@@ -10397,6 +10413,8 @@ struct rad_hierarchical {
     uint32_t *in_first;
     rad_hierarchical_stats st;
     int state;           /* 0 created, 1 solved, -1 a solve failed */
+    uint32_t round;      /* the round under way, and the progress reported so far */
+    float reported;
     rad_allocator allocator;
 };
 
@@ -10409,6 +10427,20 @@ static void rad__hierarchical_options_resolve(rad_hierarchical_options *o)
     if (o->visibility_rays == 0) o->visibility_rays = RAD__HR_DEFAULT_RAYS;
     if (o->max_iterations == 0) o->max_iterations = RAD__HR_DEFAULT_ROUNDS;
     if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
+}
+
+/* Reports progress (round + within) / max_iterations, never going back; 1 when the caller
+   asked to stop (logged, naming the step). */
+static int rad__hr_progress(rad_hierarchical *h, const rad__ctx *c, double within, const char *step)
+{
+    float f = (float)(((double)h->round + (within < 0.0 ? 0.0 : within > 1.0 ? 1.0 : within)) / (double)h->o.max_iterations);
+    if (!c->progress) return 0;
+    if (f < h->reported) f = h->reported;
+    if (f > 1.0f) f = 1.0f;
+    h->reported = f;
+    if (!c->progress(c->progress_user, f)) return 0;
+    rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: cancelled during the %s of round %u", step, h->round);
+    return 1;
 }
 
 RAD_API void rad_hierarchical_options_default(rad_hierarchical_options *o)
@@ -11189,6 +11221,19 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
         h->st.links_evaluated += count;
         if (r != RAD_SUCCESS) rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the raycaster failed");
     }
+    if (r == RAD_SUCCESS) { /* the scene was checked at creation: a non-finite F is the solver's own */
+        size_t l;
+        for (l = 0; l < count; ++l)
+            if (!rad__finite(links[l].F) || !rad__finite(links[l].Fu) || !rad__finite(links[l].Fd)) {
+                rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: internal: non-finite form factor %g (unoccluded %g) "
+                         "of the link from node %u%s to node %u%s: a solver failure, not an input error",
+                         (double)links[l].F, (double)links[l].Fu, links[l].s & ~RAD__HR_CL,
+                         rad__hr_is_cl(links[l].s) ? " (cluster)" : "", links[l].r & ~RAD__HR_CL,
+                         rad__hr_is_cl(links[l].r) ? " (cluster)" : "");
+                r = RAD_ERROR_NOT_CONVERGED;
+                break;
+            }
+    }
     {
         void *blocks[] = { ev.rays, ev.occ, ev.w, ev.idx, ev.kernels, ev.rays_cast, ev.proj, ev.results };
         rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
@@ -11287,6 +11332,7 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
 {
     rad__hr_list keep, cand, next;
     size_t i;
+    double level_share = 1.0;
     rad_result r = RAD_SUCCESS;
     *changed = 0;
     memset(&keep, 0, sizeof(keep));
@@ -11300,7 +11346,22 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
         for (i = 0; i < cand.n && r == RAD_SUCCESS; ++i) {
             rad__hr_link l = cand.a[i];
             uint32_t e, k;
-            if (!rad__hr_oracle(h, &l, &e)) {
+            int split = rad__hr_oracle(h, &l, &e);
+            if (split && h->o.memory_limit && l.Fu > 0.0f) { /* Fu 0: overlapping ends, F unknown until split */
+                /* the bytes held once this split's links are pushed and, at worst, every
+                   candidate left is kept (the lists grow by doubling) */
+                uint64_t el_cap = h->cap_el, ncap = next.cap, kcap = keep.cap;
+                if (!rad__hr_is_cl(e) && h->el[e].child == RAD_NONE && h->nel + 4u > h->cap_el) el_cap *= 2u;
+                if (next.n + 4u > next.cap) ncap = next.cap ? 2u * next.cap : 1024u;
+                while (kcap < keep.n + (cand.n - i)) kcap = kcap ? 2u * kcap : 1024u;
+                if (el_cap * sizeof(rad__hr_elem) + (kcap + cand.cap + ncap) * sizeof(rad__hr_link) > h->o.memory_limit) {
+                    if (h->st.memory_limited++ == 0)
+                        rad__log(c, RAD_LOG_WARNING, "rad_hierarchical_solve: memory_limit %llu bytes reached in round %u: "
+                                 "links left unrefined from here on", (unsigned long long)h->o.memory_limit, h->round);
+                    split = 0;
+                }
+            }
+            if (!split) {
                 if (keep.n == keep.cap) {
                     /* rad__hr_push checks facing, which a kept link passed already */
                     r = rad__hr_push(h, &keep, l.r, l.s, c);
@@ -11324,6 +11385,13 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
             }
         }
         if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, next.a, next.n, c);
+        {
+            uint64_t held = (uint64_t)h->cap_el * sizeof(rad__hr_elem) + (uint64_t)(keep.cap + cand.cap + next.cap) * sizeof(rad__hr_link);
+            if (held > h->st.peak_bytes) h->st.peak_bytes = held;
+        }
+        /* the levels of a round: half of its progress, each level half of what is left */
+        level_share *= 0.5;
+        if (r == RAD_SUCCESS && rad__hr_progress(h, c, 0.5 * (1.0 - level_share), "refinement")) r = RAD_ERROR_CANCELLED;
         {
             rad__hr_list tmp = cand;
             cand = next;
@@ -11421,8 +11489,15 @@ static void rad__hr_gather_task(void *data, uint32_t task)
     }
 }
 
-/* One gather and push-pull sweep; returns the largest change of a leaf's B over max B */
-static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
+/* One gather and push-pull sweep: *res gets the largest change of a leaf's B over max B.
+   A leaf's form factors can sum well past 1 (point-sampled visibility passing both of two
+   surfaces that overlap from where it stands, coincident duplicates, the cluster estimates);
+   where rho times the sum passes 1 the sweeps grow B without bound, to infinity. So a leaf's
+   sum S is scaled down to RAD__HR_ROW_CAP (the ordinary scatter about 1 stays), or lower
+   where rho times that would pass RAD__HR_MAX_GAIN: every leaf then gathers at most that
+   gain times the largest B, and the sweeps contract. NOT_CONVERGED (logged as internal) if
+   a B is not finite all the same. */
+static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *res)
 {
     uint32_t i, k;
     size_t l;
@@ -11455,6 +11530,16 @@ static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
         const rad__hr_elem *p = e->parent != RAD_NONE ? &h->el[e->parent] : NULL;
         for (k = 0; k < 3; ++k) e->Gt[k] = e->G[k] + (p ? p->Gt[k] : 0.0);
         e->St = e->S + (p ? p->St : 0.0);
+        if (e->child == RAD_NONE && e->St > 1.0) {
+            float rm = e->rho[0] > e->rho[1] ? (e->rho[0] > e->rho[2] ? e->rho[0] : e->rho[2])
+                                             : (e->rho[1] > e->rho[2] ? e->rho[1] : e->rho[2]);
+            double cap = (double)rm * RAD__HR_ROW_CAP < RAD__HR_MAX_GAIN ? RAD__HR_ROW_CAP : RAD__HR_MAX_GAIN / (double)rm;
+            if (cap < 1.0) cap = 1.0;
+            if (e->St > cap) {
+                for (k = 0; k < 3; ++k) e->Gt[k] *= cap / e->St;
+                e->St = cap;
+            }
+        }
     }
     for (i = h->nel; i-- > 0;) { /* pull: children come first */
         rad__hr_elem *e = &h->el[i];
@@ -11462,6 +11547,12 @@ static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
             for (k = 0; k < 3; ++k) {
                 float b = (float)((double)e->E[k] + (double)e->rho[k] * e->Gt[k]);
                 double d = fabs((double)b - (double)e->B[k]);
+                if (!rad__finite(b)) {
+                    rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: internal: non-finite radiosity %g at element %u "
+                             "(scene triangle %u, depth %u) after gathering %g over a form-factor sum of %g: a "
+                             "solver failure, not an input error", (double)b, i, e->tri, e->depth, e->Gt[k], e->St);
+                    return RAD_ERROR_NOT_CONVERGED;
+                }
                 if (d > change) change = d;
                 if ((double)b > bmax) bmax = (double)b;
                 e->B[k] = b;
@@ -11478,7 +11569,8 @@ static double rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c)
         }
     }
     rad__hr_cluster_pull(h);
-    return bmax > 0.0 ? change / bmax : 0.0;
+    *res = bmax > 0.0 ? change / bmax : 0.0;
+    return RAD_SUCCESS;
 }
 
 /* leaves in order, per-leaf corner vertices welded by position and plane, vertex values */
@@ -11634,6 +11726,7 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
     if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, h->links, h->nlinks, &c);
     for (round = 0; round < h->o.max_iterations && r == RAD_SUCCESS; ++round) {
         int changed = 0;
+        h->round = round;
         uint32_t first = h->nel, s;
         double res = 0.0;
         r = rad__hr_refine(h, &changed, &c);
@@ -11641,10 +11734,16 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
         if (r == RAD_SUCCESS && h->cl) r = rad__hr_build_in(h, &c);
         if (r != RAD_SUCCESS) break;
         for (s = 0; s < RAD__HR_MAX_SWEEPS; ++s) {
-            res = rad__hr_sweep(h, &c);
+            if ((r = rad__hr_sweep(h, &c, &res)) != RAD_SUCCESS) break;
             h->st.sweeps++;
             if (res < RAD__HR_SWEEP_TOLERANCE) break;
+            /* the sweeps: the other half, by how far the change has fallen toward 1e-6 */
+            if (rad__hr_progress(h, &c, res > 0.0 ? 0.5 + 0.5 * log(res) / log(RAD__HR_SWEEP_TOLERANCE) : 1.0, "sweeps")) {
+                r = RAD_ERROR_CANCELLED;
+                break;
+            }
         }
+        if (r != RAD_SUCCESS) break;
         h->st.residual = res;
         h->st.rounds = round + 1u;
         if (s == RAD__HR_MAX_SWEEPS) {
@@ -11653,15 +11752,13 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
             r = RAD_ERROR_NOT_CONVERGED;
             break;
         }
-        if (c.progress && c.progress(c.progress_user, (float)(round + 1u) / (float)h->o.max_iterations)) {
-            rad__log(&c, RAD_LOG_ERROR, "rad_hierarchical_solve: cancelled after round %u", round);
+        h->round = round + 1u;
+        if (!changed) h->round = h->o.max_iterations; /* done: the rounds left are not needed */
+        if (rad__hr_progress(h, &c, 0.0, "end")) {
             r = RAD_ERROR_CANCELLED;
             break;
         }
         if (!changed) break;
-    }
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < h->nel && r == RAD_SUCCESS; ++i) r = rad__check_output(&c, "rad_hierarchical_solve", h->el[i].B, 3);
     }
     if (r == RAD_SUCCESS) r = rad__hr_finish(h, &c);
     if (r != RAD_SUCCESS) return r;

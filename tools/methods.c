@@ -1264,6 +1264,9 @@ int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_met
     ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
     ho.min_area = mo->hr_min_area;
     if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
+    /* a large scene at a fine tolerance refines coarser once its elements and links reach
+       1.5 GiB instead of growing until the machine runs out */
+    ho.memory_limit = (uint64_t)1536u << 20;
     sd.w = w;
     rad_direct_options_default(&sd.dopt);
     sd.dopt.exclude_emitters = 0;
@@ -1283,9 +1286,10 @@ int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_met
     }
     rad_hierarchical_get_stats(*out, &st);
     fprintf(stderr, "rad %s: hierarchical: %u triangles, %u elements, %u leaves, %llu links, %llu kernel evaluations, "
-                    "%llu rays, %u rounds, %u sweeps in %.2f s\n",
+                    "%llu rays, %u rounds, %u sweeps, %.0f MiB of elements and links%s in %.2f s\n",
             cmd, w->scene->triangle_count, st.elements, st.leaves, (unsigned long long)st.links,
             (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, st.rounds, st.sweeps,
+            (double)st.peak_bytes / 1048576.0, st.memory_limited ? " (memory limit reached: refined coarser)" : "",
             tool_seconds() - t0);
     return 0;
 }
