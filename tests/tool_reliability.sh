@@ -122,3 +122,84 @@ rel_refused "lightmap --exposure 0" "$RAD" lightmap cornell --patches 20 --size 
 rel_refused "lightmap --exposure -1" "$RAD" lightmap cornell --patches 20 --size 16 -o "$REL/q.png" --exposure -1
 rel_refused "compare --diff-scale inf" "$RAD" compare "$REL/sig/a.pfm" "$REL/sig/a.pfm" --diff "$REL/d.png" --diff-scale inf
 "$RAD" render --help 2>&1 | grep -q -- "--aa N.*1 to 65536" && ok "render --help states the --aa limit" || fail "render --help states the --aa limit"
+
+# ---- rad info refuses what the loaders refuse ------------------------------------------------
+# rel_edit IN OUT INDEX WORD TYPE VALUE: word WORD (4 bytes) of section INDEX (its row in
+# rad info's table) set to VALUE (f32 or u32), every CRC-32 recomputed (each section's bytes,
+# the table of 64-byte entries at 64, the header's first 60 bytes), so only the loaders'
+# checks of the values themselves can find it
+rel_edit() {
+    python3 - "$@" <<'PY'
+import struct, sys, zlib
+src, dst, sec, word, typ, val = sys.argv[1:7]
+b = bytearray(open(src, 'rb').read())
+n = struct.unpack_from('<I', b, 8)[0]
+e = 64 + 64 * int(sec)
+off = struct.unpack_from('<Q', b, e + 16)[0]
+struct.pack_into('<f' if typ == 'f32' else '<I', b, off + 4 * int(word), float(val) if typ == 'f32' else int(val))
+c = lambda x: zlib.crc32(bytes(x)) & 0xffffffff
+for i in range(n):
+    e = 64 + 64 * i
+    o, nb = struct.unpack_from('<QQ', b, e + 16)
+    struct.pack_into('<I', b, e + 32, c(b[o:o + nb]))
+struct.pack_into('<I', b, 36, c(b[64:64 + 64 * n]))
+struct.pack_into('<I', b, 60, c(b[0:60]))
+open(dst, 'wb').write(b)
+PY
+}
+# rel_section FILE TYPE [NAME]: the row of the first section of that type (and name)
+rel_section() { "$RAD" info "$1" 2> /dev/null | awk -v t="$2" -v n="${3:-}" '$2 == t && (n == "" || $3 == n) { print $1; exit }'; }
+# rel_damaged LABEL FILE SECTION-TYPE SECTION-NAME WORD TYPE VALUE RENDER-ARGS...: rad info and rad render both refuse
+rel_damaged() {
+    label=$1 src=$2 st=$3 sn=$4 wd=$5 ty=$6 va=$7
+    shift 7
+    idx=$(rel_section "$src" "$st" "$sn")
+    if [ -z "$idx" ] || ! rel_edit "$src" "$REL/bad.radb" "$idx" "$wd" "$ty" "$va" 2> /dev/null; then
+        fail "info refuses $label" "no section $st $sn in $src"
+        return
+    fi
+    "$RAD" info "$REL/bad.radb" > "$REL/info.txt" 2> "$REL/err.txt"
+    rc=$?
+    "$RAD" render cornell --patches 40 --size 8x8 -o "$REL/bad.pfm" --bake "$REL/bad.radb" "$@" > /dev/null 2>&1
+    rr=$?
+    [ $rc -eq 1 ] && [ $rr -ne 0 ] && ! grep -q "all OK" "$REL/info.txt" && [ -s "$REL/err.txt" ] &&
+        ok "info refuses $label, as render does" ||
+        fail "info refuses $label, as render does" "info exit $rc, render exit $rr: $(head -c 300 "$REL/err.txt")"
+}
+"$RAD" bake cornell --method aavp --vp-resolution 2 --face-points 4 -o "$REL/aavp.radb" > /dev/null 2>&1
+"$RAD" bake cornell --patches 40 --method temporal -o "$REL/tp.radb" > /dev/null 2>&1
+"$RAD" bake cornell --patches 40 --method stochastic -o "$REL/st.radb" > /dev/null 2>&1
+for f in aavp tp st; do
+    "$RAD" info "$REL/$f.radb" > "$REL/info.txt" 2>&1 && grep -q "all OK" "$REL/info.txt" && ok "info passes the intact $f bake" ||
+        fail "info passes the intact $f bake" "$(head -c 300 "$REL/info.txt")"
+done
+rel_damaged "a NaN virtual-patch form factor" "$REL/aavp.radb" FF_VALUES vp 5 f32 nan --method aavp
+rel_damaged "a virtual-patch form-factor column out of range" "$REL/aavp.radb" FF_COLUMNS vp 3 u32 100000 --method aavp
+rel_damaged "a virtual patch of albedo 1.5" "$REL/aavp.radb" VP_ALBEDO vp 0 f32 1.5 --method aavp
+rel_damaged "a NaN row sum (stochastic)" "$REL/st.radb" "USER(row" "" 3 f32 nan --method stochastic
+rel_damaged "a negative L (stochastic)" "$REL/st.radb" VECTOR L 0 f32 -1 --method stochastic
+rel_damaged "a temporal bake with k = 0" "$REL/tp.radb" "USER(rad" "method)" 9 u32 0 --method temporal
+rel_damaged "a temporal bake with mode 7" "$REL/tp.radb" "USER(rad" "method)" 8 u32 7 --method temporal
+# a damaged virtual-patch bake is called damaged; an intact one given to another method is
+# called what it is
+idx=$(rel_section "$REL/aavp.radb" FF_VALUES vp)
+rel_edit "$REL/aavp.radb" "$REL/bad.radb" "$idx" 5 f32 nan 2> /dev/null
+"$RAD" render cornell --method aavp --bake "$REL/bad.radb" -o "$REL/q.pfm" --size 8x8 > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && grep -q "damaged virtual patches" "$REL/err.txt" && ! grep -q "holds no virtual" "$REL/err.txt" &&
+    ok "render calls a damaged virtual-patch bake damaged" ||
+    fail "render calls a damaged virtual-patch bake damaged" "$(tail -c 300 "$REL/err.txt")"
+"$RAD" render cornell --method temporal --bake "$REL/aavp.radb" -o "$REL/q.pfm" --size 8x8 > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && tail -n 1 "$REL/err.txt" | grep -q "holds virtual patches.*--method aavp or vp" &&
+    ok "render names an intact virtual-patch bake given to --method temporal" ||
+    fail "render names an intact virtual-patch bake given to --method temporal" "$(tail -c 300 "$REL/err.txt")"
+# a file that cannot be read: the system's reason, not "truncated"
+if [ -r /proc/self/mem ]; then
+    "$RAD" info /proc/self/mem > /dev/null 2> "$REL/err.txt"
+    [ $? -eq 1 ] && grep -q "cannot read bake '/proc/self/mem': Input/output error" "$REL/err.txt" &&
+        ok "info on an unreadable file gives the system's error" ||
+        fail "info on an unreadable file gives the system's error" "$(head -c 300 "$REL/err.txt")"
+fi
+mkdir -p "$REL/adir"
+"$RAD" info "$REL/adir" > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && grep -q "Is a directory" "$REL/err.txt" && ok "info on a folder says it is one" ||
+    fail "info on a folder says it is one" "$(head -c 300 "$REL/err.txt")"

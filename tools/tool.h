@@ -190,6 +190,10 @@ void tool_progress_end(void);
 int tool_fail(const char *cmd, const char *what, rad_result r);
 /* calloc of n elements (at least one) that prints and exits on failure */
 void *tool_calloc(size_t n, size_t size);
+/* The whole file into *data (malloc'd, free with free()) and *size; 0, or 1 after printing
+   "rad CMD: cannot read WHAT 'PATH': <the system's reason>" (or that it is empty; cmd NULL:
+   nothing printed). */
+int tool_read_file(const char *cmd, const char *what, const char *path, void **data, size_t *size);
 /* option values: 0 on success, else prints "rad CMD: bad value ..." and returns 2 */
 int tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out);
 int tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
@@ -582,6 +586,13 @@ typedef struct tool_lightmap_proxy {
    printing why (even resolution 1 gives more). (cmd_render.c) */
 int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
                               uint32_t max_patches, uint32_t start, uint32_t *out);
+/* A bake of rad bake --method aavp|vp in memory (data, size: kept alive by the caller while
+   *ct_out lives): its container, its set "vp" (rad_vp_load; scene may be NULL) and its source
+   vector E (3 floats a patch, each in [0, RAD_BAKE_VALUE_MAX], malloc'd). The errors tell a
+   damaged file, a bake without virtual patches and damaged virtual patches apart. 0, or 1
+   after printing why (nothing to free). (cmd_render.c) */
+int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_t size, const rad_scene *scene,
+                      rad_container **ct_out, rad_virtual_patches **vp_out, float **E_out);
 /* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth
    lookup (rad_lightmap_gather_hierarchical); a kind of its own, past the tool_proxy values */
 #define TOOL_LIGHTMAP_HIERARCHICAL 3
