@@ -112,14 +112,14 @@ rel_refused "render --area whose U x V overflows" "$RAD" render cornell --patche
 rel_refused "render --light-path beyond 1e30" "$RAD" render cornell --method temporal --patches 20 --size 8x8 -o "$REL/q.pfm" --light-path line:0,0,0:1e31,0,0
 # a light that overflows the transport is refused up front, not at the save after the bake
 rel_refused "bake --sky 1e30" "$RAD" bake cornell --patches 20 -o "$REL/q.radb" --sky 1e30
-rel_refused "lightmap --point with intensity 1e25" "$RAD" lightmap cornell --patches 20 --size 16 -o "$REL/q.pfm" --point 0,1,0:1e25
+rel_refused "lightmap --point with intensity 1e25" "$RAD" lightmap cornell --patches 20 --size 32 -o "$REL/q.pfm" --point 0,1,0:1e25
 # bounded counts and a positive exposure
 rel_refused "render --aa 4294967295" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.png" --aa 4294967295
 rel_refused "render --pixel-light-samples 100000000" "$RAD" render cornell --patches 20 --size 8x8 -o "$REL/q.png" --pixel-light-samples 100000000
 rel_refused "bake --light-samples 100000000" "$RAD" bake cornell --patches 20 -o "$REL/q.radb" --light-samples 100000000
 rel_refused "bake --samples 100000" "$RAD" bake cornell --patches 20 -o "$REL/q.radb" --samples 100000
-rel_refused "lightmap --exposure 0" "$RAD" lightmap cornell --patches 20 --size 16 -o "$REL/q.png" --exposure 0
-rel_refused "lightmap --exposure -1" "$RAD" lightmap cornell --patches 20 --size 16 -o "$REL/q.png" --exposure -1
+rel_refused "lightmap --exposure 0" "$RAD" lightmap cornell --patches 20 --size 32 -o "$REL/q.png" --exposure 0
+rel_refused "lightmap --exposure -1" "$RAD" lightmap cornell --patches 20 --size 32 -o "$REL/q.png" --exposure -1
 rel_refused "compare --diff-scale inf" "$RAD" compare "$REL/sig/a.pfm" "$REL/sig/a.pfm" --diff "$REL/d.png" --diff-scale inf
 "$RAD" render --help 2>&1 | grep -q -- "--aa N.*1 to 65536" && ok "render --help states the --aa limit" || fail "render --help states the --aa limit"
 
@@ -203,3 +203,47 @@ mkdir -p "$REL/adir"
 "$RAD" info "$REL/adir" > /dev/null 2> "$REL/err.txt"
 [ $? -eq 1 ] && grep -q "Is a directory" "$REL/err.txt" && ok "info on a folder says it is one" ||
     fail "info on a folder says it is one" "$(head -c 300 "$REL/err.txt")"
+
+# ---- no output is an input of the same command, and no two outputs are one file ---------------
+# an OBJ whose floor takes its albedo from tex.png (map_Kd), lit by an emissive quad
+mkdir -p "$REL/tex"
+python3 - "$REL/tex" <<'PY'
+import struct, sys, zlib
+d = sys.argv[1]
+def chunk(t, b): return struct.pack('>I', len(b)) + t + b + struct.pack('>I', zlib.crc32(t + b) & 0xffffffff)
+raw = b''.join(b'\x00' + bytes((200, 30, 30)) * 8 for _ in range(8))
+open(d + '/tex.png', 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 8, 8, 8, 2, 0, 0, 0)) +
+                                 chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
+open(d + '/scene.mtl', 'w').write('newmtl floor\nKd 1 1 1\nmap_Kd tex.png\nnewmtl lamp\nKd 0 0 0\nKe 10 10 10\n')
+open(d + '/scene.obj', 'w').write('mtllib scene.mtl\no floor\nusemtl floor\nv 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\n'
+                                  'vt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nf 1/1 2/2 3/3 4/4\no lamp\nusemtl lamp\n'
+                                  'v 0.3 1 0.3\nv 0.7 1 0.3\nv 0.7 1 0.7\nv 0.3 1 0.7\nf 5 6 7 8\n')
+PY
+m0=$(cksum < "$REL/tex/tex.png")
+for c in "render --patches 20 --size 8x8" "trace --spp 1 --size 8x8" "lightmap --patches 20 --size 16"; do
+    "$RAD" ${c%% *} "$REL/tex/scene.obj" ${c#* } -o "$REL/tex/tex.png" > /dev/null 2> "$REL/err.txt"
+    rc=$?
+    [ $rc -eq 1 ] && [ "$(cksum < "$REL/tex/tex.png")" = "$m0" ] && grep -q "tex.png.*read from" "$REL/err.txt" &&
+        ok "${c%% *} -o the scene's own texture refused" ||
+        fail "${c%% *} -o the scene's own texture refused" "exit $rc $(tail -c 300 "$REL/err.txt")"
+done
+(cd "$REL/tex" && "$RAD" lightmap scene.obj --patches 20 --size 16 -o out.png --render ./tex.png) > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && [ "$(cksum < "$REL/tex/tex.png")" = "$m0" ] && ok "lightmap --render onto the texture (another spelling) refused" ||
+    fail "lightmap --render onto the texture (another spelling) refused" "$(tail -c 300 "$REL/err.txt")"
+"$RAD" export "$REL/tex/scene.obj" -o "$REL/tex/scene.obj" > /dev/null 2>&1
+[ $? -eq 1 ] && ok "export onto its own scene refused" || fail "export onto its own scene refused"
+# two outputs of one command naming one file (existing or not, spelled differently)
+rm -f "$REL/lm.pfm"
+"$RAD" lightmap cornell --patches 20 --size 32 -o "$REL/lm.pfm" --render "$REL/./lm.pfm" > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && grep -q "same file" "$REL/err.txt" && [ ! -e "$REL/lm.pfm" ] && ok "lightmap -o X --render X refused" ||
+    fail "lightmap -o X --render X refused" "$(tail -c 300 "$REL/err.txt")"
+"$RAD" compare "$REL/sig/a.pfm" "$REL/sig/a.pfm" --diff "$REL/d.png" --png "$REL/d.png" > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && grep -q "same file" "$REL/err.txt" && ok "compare --diff X --png X refused" ||
+    fail "compare --diff X --png X refused" "$(tail -c 300 "$REL/err.txt")"
+# the SH layers' own names are checked before the bake
+mkdir -p "$REL/shf"
+mkdir "$REL/shf/lm.L11.pfm"
+"$RAD" lightmap cornell --sh --patches 20 --size 32 -o "$REL/shf/lm.pfm" > "$REL/out.txt" 2> "$REL/err.txt"
+[ $? -eq 1 ] && grep -q "lm.L11.pfm' is a directory" "$REL/err.txt" && ! grep -q "direct light" "$REL/err.txt" &&
+    ok "lightmap --sh checks its layers' names before the bake" ||
+    fail "lightmap --sh checks its layers' names before the bake" "$(tail -c 300 "$REL/err.txt")"

@@ -1381,6 +1381,10 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     }
     tool_set_threads((int)threads);
     if (tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
+    if (tool_check_outputs(cmd, &out_path, 1, w.file.input_files, (int)w.file.input_file_count)) {
+        tool_close_world(&w);
+        return 1;
+    }
     {
         uint32_t t, emitters = 0;
         for (t = 0; t < w.scene->triangle_count; ++t) {

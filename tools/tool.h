@@ -19,6 +19,9 @@ typedef struct tool_scene {
     rad_light *lights;       /* analytic lights found in the file (may be none) */
     uint32_t light_count;
     const char *const *material_names; /* desc.material_count names ("" when unnamed), or NULL */
+    const char *const *input_files; /* the files it was read from: the scene file, the MTL
+                                       libraries an OBJ names, the textures loaded from disk */
+    uint32_t input_file_count;
     void *storage;           /* private */
 } tool_scene;
 
@@ -106,6 +109,11 @@ const char *tool_output_error(void);
    st_ino, so another name or a link for it counts), is a directory, or whose folder is
    missing or not writable. 0 when fine, else prints "rad CMD: ..." and returns 1. */
 int tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count);
+/* Refuses two outputs of one command that are the same file, and an output that is one of
+   the inputs (e.g. tool_scene.input_files: the scene, its MTL files, its textures): the same
+   device and inode where both exist, else the same resolved path. 0, or 1 after printing
+   "rad CMD: ..." */
+int tool_check_outputs(const char *cmd, const char *const *outputs, int count, const char *const *inputs, int input_count);
 
 /* ---- metrics (metrics.c): MSE, PSNR, SSIM on values clamped to [0,1] ------------------- */
 double tool_image_mse(const tool_image *a, const tool_image *b);
