@@ -247,3 +247,37 @@ mkdir "$REL/shf/lm.L11.pfm"
 [ $? -eq 1 ] && grep -q "lm.L11.pfm' is a directory" "$REL/err.txt" && ! grep -q "direct light" "$REL/err.txt" &&
     ok "lightmap --sh checks its layers' names before the bake" ||
     fail "lightmap --sh checks its layers' names before the bake" "$(tail -c 300 "$REL/err.txt")"
+
+# ---- inputs the tool reads ---------------------------------------------------------------------
+# a glTF quad whose second uv set is one point: no texel is covered, so no all-zero lightmap
+python3 - "$REL/deg.gltf" <<'PY'
+import base64, json, struct, sys
+pos = struct.pack('<12f', 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0)
+uv0 = struct.pack('<8f', 0, 0, 1, 0, 1, 1, 0, 1)
+uv1 = struct.pack('<8f', *([0.5] * 8))
+idx = struct.pack('<6I', 0, 1, 2, 0, 2, 3)
+buf = pos + uv0 + uv1 + idx
+views, off = [], 0
+for part in (pos, uv0, uv1, idx):
+    views.append({'buffer': 0, 'byteOffset': off, 'byteLength': len(part)})
+    off += len(part)
+doc = {'asset': {'version': '2.0'}, 'scene': 0, 'scenes': [{'nodes': [0]}], 'nodes': [{'mesh': 0}],
+       'meshes': [{'primitives': [{'attributes': {'POSITION': 0, 'TEXCOORD_0': 1, 'TEXCOORD_1': 2}, 'indices': 3}]}],
+       'buffers': [{'byteLength': len(buf), 'uri': 'data:application/octet-stream;base64,' + base64.b64encode(buf).decode()}],
+       'bufferViews': views,
+       'accessors': [{'bufferView': 0, 'componentType': 5126, 'count': 4, 'type': 'VEC3', 'min': [0, 0, 0], 'max': [1, 1, 0]},
+                     {'bufferView': 1, 'componentType': 5126, 'count': 4, 'type': 'VEC2'},
+                     {'bufferView': 2, 'componentType': 5126, 'count': 4, 'type': 'VEC2'},
+                     {'bufferView': 3, 'componentType': 5125, 'count': 6, 'type': 'SCALAR'}]}
+open(sys.argv[1], 'w').write(json.dumps(doc))
+PY
+"$RAD" lightmap "$REL/deg.gltf" -o "$REL/deg.pfm" --size 32 --patches 2 --sun 0,0,-1:1 > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && grep -q "covers no texel" "$REL/err.txt" && [ ! -e "$REL/deg.pfm" ] &&
+    ok "lightmap refuses a second uv set that covers no texel" ||
+    fail "lightmap refuses a second uv set that covers no texel" "$(tail -c 300 "$REL/err.txt")"
+# a PFM header whose width wraps to 16 as a 32-bit int is refused, not read as 16 wide
+python3 -c "import array;open('$REL/w.pfm','wb').write(b'PF\n4294967312 16\n-1.0\n'+array.array('f',[0.5]*768).tobytes())"
+python3 -c "import array;open('$REL/s.pfm','wb').write(b'PF\n16 16\n-1.0\n'+array.array('f',[0.5]*768).tobytes())"
+"$RAD" compare "$REL/w.pfm" "$REL/s.pfm" > /dev/null 2> "$REL/err.txt"
+[ $? -eq 1 ] && grep -q "bad PFM header" "$REL/err.txt" && ok "a PFM width of 4294967312 is refused" ||
+    fail "a PFM width of 4294967312 is refused" "$(tail -c 300 "$REL/err.txt")"

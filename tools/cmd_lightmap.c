@@ -313,6 +313,13 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
             out->lm->width, out->lm->height, out->lm->covered_texels, out->lm->valid_texels, out->lm->invalid_samples,
             out->lm->sample_count);
+    if (out->lm->covered_texels == 0) {
+        /* nothing to gather into: the map would be all zero */
+        fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
+                        "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
+                cmd, out->lm->width, out->lm->height);
+        goto fail;
+    }
     rad_lightmap_gather_options_default(&go);
     go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
     go.visibility_rays = vis;

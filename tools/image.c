@@ -563,6 +563,20 @@ static int tool__pfm_token(FILE *f, char *tok, size_t cap)
     return 0;
 }
 
+/* a PFM width or height: decimal digits only, 1 to 2^30 (a larger one cannot be an image the
+   tool holds; converting it to int would wrap, 4294967312 to 16); 0 when not */
+static int pfm_size(const char *tok)
+{
+    long long v = 0;
+    if (!*tok) return 0;
+    for (; *tok; ++tok) {
+        if (*tok < '0' || *tok > '9') return 0;
+        v = 10 * v + (*tok - '0');
+        if (v > (1LL << 30)) return 0;
+    }
+    return (int)v;
+}
+
 int tool_image_read_pfm(const char *path, tool_image *img, char *err, size_t errlen)
 {
     FILE *f;
@@ -586,8 +600,8 @@ int tool_image_read_pfm(const char *path, tool_image *img, char *err, size_t err
         return -1;
     }
     channels = tok[1] == 'F' ? 3 : 1;
-    if (tool__pfm_token(f, tok, sizeof(tok)) != 0 || (w = (int)strtol(tok, &end, 10)) <= 0 || *end ||
-        tool__pfm_token(f, tok, sizeof(tok)) != 0 || (h = (int)strtol(tok, &end, 10)) <= 0 || *end ||
+    if (tool__pfm_token(f, tok, sizeof(tok)) != 0 || (w = pfm_size(tok)) <= 0 ||
+        tool__pfm_token(f, tok, sizeof(tok)) != 0 || (h = pfm_size(tok)) <= 0 ||
         tool__pfm_token(f, tok, sizeof(tok)) != 0 || ((scale = strtod(tok, &end)), *end) || scale == 0.0 ||
         !(scale == scale)) {
         if (err) snprintf(err, errlen, "%s: bad PFM header", path);
