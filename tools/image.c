@@ -447,7 +447,7 @@ int tool_check_outputs(const char *cmd, const char *const *outputs, int count, c
             }
         for (j = 0; j < input_count; ++j)
             if (inputs[j] && output_same_file(outputs[i], inputs[j])) {
-                fprintf(stderr, "rad %s: the output '%s' is '%s', a file the scene is read from: refusing to overwrite it\n",
+                fprintf(stderr, "rad %s: the output '%s' is the input '%s' (a file the scene is read from): refusing to overwrite it\n",
                         cmd, outputs[i], inputs[j]);
                 return 1;
             }
