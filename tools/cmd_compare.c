@@ -144,8 +144,11 @@ int tool_cmd_compare(int argc, char **argv)
         const char *inputs[2];
         inputs[0] = pa;
         inputs[1] = pb;
+        const char *outs[2];
+        outs[0] = diff;
+        outs[1] = png;
         if ((diff && tool_check_output("compare", diff, inputs, 2)) ||
-            (png && tool_check_output("compare", png, inputs, 2)))
+            (png && tool_check_output("compare", png, inputs, 2)) || tool_check_outputs("compare", outs, 2, inputs, 2))
             return 1;
     }
     if (tool_image_read(pa, &a, err, sizeof(err)) != 0) {

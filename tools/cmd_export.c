@@ -41,36 +41,6 @@ static void clean_name(const char *name, char *buf, size_t cap)
     buf[i] = '\0';
 }
 
-/* the MTL files an OBJ names (mtllib lines), resolved against the OBJ's folder; returns the count */
-#define EXPORT_MAX_MTLLIB 16
-static int obj_mtllibs(const char *obj, char names[][1024], int cap)
-{
-    FILE *f;
-    char line[2048];
-    int count = 0;
-    size_t n = strlen(obj);
-    const char *slash = strrchr(obj, '/');
-    size_t dir = slash ? (size_t)(slash - obj + 1) : 0;
-    if (n < 4 || (strcmp(obj + n - 4, ".obj") && strcmp(obj + n - 4, ".OBJ"))) return 0;
-    if (!(f = fopen(obj, "r"))) return 0;
-    while (count < cap && fgets(line, sizeof line, f)) {
-        char *p = line, *e;
-        while (*p == ' ' || *p == '\t') ++p;
-        if (strncmp(p, "mtllib", 6) || !(p[6] == ' ' || p[6] == '\t')) continue;
-        p += 6;
-        while (*p == ' ' || *p == '\t') ++p;
-        for (e = p + strlen(p); e > p && isspace((unsigned char)e[-1]); --e) {
-        }
-        *e = '\0';
-        if (!*p) continue;
-        if (*p == '/') snprintf(names[count], 1024, "%s", p);
-        else snprintf(names[count], 1024, "%.*s%s", (int)dir, obj, p);
-        ++count;
-    }
-    fclose(f);
-    return count;
-}
-
 static void write_rgb(FILE *f, const char *key, const float *v)
 {
     fprintf(f, "%s %.9g %.9g %.9g\n", key, (double)v[0], (double)v[1], (double)v[2]);
@@ -79,15 +49,15 @@ static void write_rgb(FILE *f, const char *key, const float *v)
 int tool_cmd_export(int argc, char **argv)
 {
     const char *cmd = "export", *scene_name = NULL, *out_path = NULL;
-    char err[1024], mtl_path[4096], mtllibs[EXPORT_MAX_MTLLIB][1024], name[256];
-    const char *inputs[EXPORT_MAX_MTLLIB + 1];
+    char err[1024], mtl_path[4096], name[256];
+    const char *outs[2];
     const char *mtl_base;
     tool_scene ts;
     tool_output obj, mtl;
     const rad_scene_desc *d;
     uint32_t m, t, k, textured = 0, written_tris = 0;
     uint64_t base = 1; /* OBJ indices count from 1 over the whole file */
-    int a, nlib, i, ok;
+    int a, ok;
     size_t l;
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
@@ -116,15 +86,18 @@ int tool_cmd_export(int argc, char **argv)
     memcpy(mtl_path, out_path, l - 4);
     memcpy(mtl_path + l - 4, out_path[l - 3] == 'O' ? ".MTL" : ".mtl", 5);
     mtl_base = strrchr(mtl_path, '/') ? strrchr(mtl_path, '/') + 1 : mtl_path;
-    /* neither output may be the scene or an MTL file it names */
-    nlib = strcmp(scene_name, "cornell") ? obj_mtllibs(scene_name, mtllibs, EXPORT_MAX_MTLLIB) : 0;
-    inputs[0] = scene_name;
-    for (i = 0; i < nlib; ++i) inputs[1 + i] = mtllibs[i];
-    if (tool_check_output(cmd, out_path, inputs, 1 + nlib) || tool_check_output(cmd, mtl_path, inputs, 1 + nlib))
+    /* neither output may be a file the scene is read from (the scene, its MTL files, its
+       textures: known once it is loaded) */
+    if (tool_check_output(cmd, out_path, &scene_name, 1) || tool_check_output(cmd, mtl_path, &scene_name, 1))
         return 1;
-
     if (tool_load_scene(scene_name, &ts, err, sizeof err) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, err);
+        return 1;
+    }
+    outs[0] = out_path;
+    outs[1] = mtl_path;
+    if (tool_check_outputs(cmd, outs, 2, ts.input_files, (int)ts.input_file_count)) {
+        tool_free_scene(&ts);
         return 1;
     }
     d = &ts.desc;

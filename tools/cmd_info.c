@@ -22,10 +22,24 @@ static const char *type_name(uint32_t type)
     }
 }
 
+/* The method's data opened and checked exactly as rad render opens it (tool_indirect_open:
+   the row sums, L, the k of the record, the temporal state ...); 0, or 1 (printed). */
+static int method_open(const char *path, const rad_bake *bake, uint32_t method)
+{
+    tool_method_options mo;
+    tool_indirect *m = NULL;
+    tool_method_options_default(&mo);
+    mo.method = (tool_method)method;
+    if (tool_indirect_open("info", path, bake, &mo, &m)) return 1;
+    tool_indirect_close(m);
+    return 0;
+}
+
 /* The rad.method record and the method's objects (opened and validated like render does);
    0, or 1 when they do not open (message printed). */
-static int method_info(const rad_container *ct, const rad_context *ctx)
+static int method_info(const char *path, const rad_bake *bake, const rad_context *ctx)
 {
+    const rad_container *ct = bake->container;
     const rad_section *s = rad_container_find(ct, TOOL_SECTION_METHOD, "rad.method");
     tool_method_info mi;
     rad_result r = RAD_SUCCESS;
@@ -50,7 +64,7 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
             fprintf(stderr, "rad info: the hierarchical bake holds no vector L\n");
             return 1;
         }
-        return 0;
+        return method_open(path, bake, mi.method);
     }
     if (mi.method == TOOL_STOCHASTIC) { /* the record's fields as methods.c fills them for this method */
         const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
@@ -62,7 +76,7 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
             fprintf(stderr, "rad info: the stochastic bake holds no vector L\n");
             return 1;
         }
-        return 0;
+        return method_open(path, bake, mi.method);
     }
     if (mi.method == TOOL_MULTIBOUNCE) {
         static const char *const fmt[] = {"float", "half", "bc1", "bc4x3"};
@@ -105,7 +119,7 @@ static int method_info(const rad_container *ct, const rad_context *ctx)
                 rad_result_string(r));
         return 1;
     }
-    return 0;
+    return method_open(path, bake, mi.method);
 }
 
 static void info_usage(FILE *f)
@@ -163,8 +177,7 @@ static int scene_info(const char *path)
 int tool_cmd_info(int argc, char **argv)
 {
     const char *cmd = "info", *path = NULL;
-    FILE *f;
-    long len;
+    size_t len;
     void *data;
     rad_container *ct = NULL;
     rad_bake *bake = NULL;
@@ -186,21 +199,7 @@ int tool_cmd_info(int argc, char **argv)
     }
     if (!path) { fprintf(stderr, "rad %s: no file given\n", cmd); info_usage(stderr); return 2; }
     if (tool_is_scene_path(path)) return scene_info(path);
-    f = fopen(path, "rb");
-    if (!f) { fprintf(stderr, "rad %s: cannot open '%s'\n", cmd, path); return 1; }
-    if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        fclose(f);
-        fprintf(stderr, "rad %s: cannot read '%s'\n", cmd, path);
-        return 1;
-    }
-    data = malloc(len > 0 ? (size_t)len : 1); /* malloc: aligned for any type, as the loader wants */
-    if (!data || (len > 0 && fread(data, 1, (size_t)len, f) != (size_t)len)) {
-        fclose(f);
-        free(data);
-        fprintf(stderr, "rad %s: cannot read '%s'\n", cmd, path);
-        return 1;
-    }
-    fclose(f);
+    if (tool_read_file(cmd, "bake", path, &data, &len)) return 1;
     tool_context(&ctx, NULL);
     if ((r = rad_container_create(data, (size_t)len, &ctx, &ct)) != RAD_SUCCESS) {
         fprintf(stderr, "rad %s: '%s' is not a valid bake: %s\n", cmd, path, rad_result_string(r));
@@ -208,7 +207,7 @@ int tool_cmd_info(int argc, char **argv)
         return 1;
     }
     count = rad_container_section_count(ct);
-    printf("%s: %ld bytes, container version %u, %u sections\n", path, len, RAD_CONTAINER_VERSION, count);
+    printf("%s: %llu bytes, container version %u, %u sections\n", path, (unsigned long long)len, RAD_CONTAINER_VERSION, count);
     printf("  %-3s %-20s %-14s %9s %12s %14s  %s\n", "#", "type", "name", "elem size", "count", "bytes", "checksum");
     for (i = 0; i < count; ++i) {
         const rad_section *s = rad_container_section(ct, i);
@@ -218,14 +217,27 @@ int tool_cmd_info(int argc, char **argv)
     {
         /* a virtual-patch bake (rad bake --method aavp|vp): its info record, no classic patches */
         const rad_section *vi = rad_container_find(ct, RAD_SECTION_VP_INFO, NULL), *rows;
-        if (vi && vi->elem_size == 4 && vi->count == 16 && !rad_container_find(ct, RAD_SECTION_PATCHES, NULL)) {
+        if (vi && !rad_container_find(ct, RAD_SECTION_PATCHES, NULL)) {
+            /* opened as render opens it (rad_vp_load and the E check), without a scene */
+            rad_container *vct = NULL;
+            rad_virtual_patches *vp = NULL;
+            float *E = NULL;
             uint32_t rec[16];
-            memcpy(rec, vi->data, sizeof rec);
+            memset(rec, 0, sizeof rec);
+            if (vi->elem_size == 4 && vi->count == 16) memcpy(rec, vi->data, sizeof rec);
             rows = rad_container_find(ct, RAD_SECTION_FF_ROW_OFFSETS, vi->name);
             printf("virtual patches '%s': %s, %u patches in %u voxels (grid %u x %u x %u), %u samples, form factors %s\n",
                    vi->name, rec[0] == (uint32_t)RAD_VP_CLUSTERED ? "clustered (vp)" : "axis-aligned (aavp)", rec[2],
                    rec[3], rec[5], rec[6], rec[7], rec[4], rows ? "sparse (CSR)" : "dense");
             rad_container_destroy(ct);
+            if (tool_vp_bake_open(cmd, path, data, len, NULL, &vct, &vp, &E)) {
+                free(data);
+                return 1;
+            }
+            printf("checksums: all OK; virtual patches, form factors and E: all valid\n");
+            free(E);
+            rad_vp_destroy(vp);
+            rad_container_destroy(vct);
             free(data);
             return 0;
         }
@@ -277,7 +289,7 @@ int tool_cmd_info(int argc, char **argv)
                        info.light_samples, info.triangle_count);
         }
     }
-    if (method_info(ct, &ctx)) {
+    if (method_info(path, bake, &ctx)) {
         rad_bake_destroy(bake);
         rad_container_destroy(ct);
         free(data);

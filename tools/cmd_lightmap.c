@@ -314,6 +314,13 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
             out->lm->width, out->lm->height, out->lm->covered_texels, out->lm->valid_texels, out->lm->invalid_samples,
             out->lm->sample_count);
+    if (out->lm->covered_texels == 0) {
+        /* nothing to gather into: the map would be all zero */
+        fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
+                        "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
+                cmd, out->lm->width, out->lm->height);
+        goto fail;
+    }
     rad_lightmap_gather_options_default(&go);
     go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
     go.visibility_rays = vis;
@@ -506,13 +513,28 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     if (tool_check_size("lightmap", width, height)) return 2;
     if (tool_image_check_format("lightmap", out_path) || (render_path && tool_image_check_format("lightmap", render_path))) return 2;
     {
-        const char *inputs[1];
-        inputs[0] = scene_path;
-        if (tool_check_output("lightmap", out_path, inputs, 1)) return 1;
-        if (render_path && tool_check_output("lightmap", render_path, inputs, 1)) return 1;
+        /* the files written: OUT (or its four SH layers) and the view; checked before the
+           work, and again against every file the scene was read from once it is loaded */
+        static const char *const tags[4] = {"L00", "L1m1", "L10", "L11"};
+        char *layers[4] = {NULL, NULL, NULL, NULL};
+        const char *outs[5];
+        int n = 0, bad = 0, k;
+        if (sh)
+            for (k = 0; k < 4; ++k) outs[n++] = layers[k] = lightmap_tagged(out_path, tags[k]);
+        else
+            outs[n++] = out_path;
+        if (render_path) outs[n++] = render_path;
+        for (k = 0; k < n && !bad; ++k) bad = tool_check_output("lightmap", outs[k], &scene_path, 1);
+        if (!bad) bad = tool_check_outputs("lightmap", outs, n, &scene_path, 1);
+        tool_set_threads((int)threads);
+        if (!bad && tool_open_world_lit("lightmap", scene_path, lights, &w)) bad = 2;
+        if (!bad && tool_check_outputs("lightmap", outs, n, w.file.input_files, (int)w.file.input_file_count)) {
+            tool_close_world(&w);
+            bad = 1;
+        }
+        for (k = 0; k < 4; ++k) free(layers[k]);
+        if (bad) return 1;
     }
-    tool_set_threads((int)threads);
-    if (tool_open_world_lit("lightmap", scene_path, lights, &w)) return 1;
     if (tool_lightmap_bake("lightmap", &w, &co, width, height, !size_given, texel_samples, vis, gather, hemi_rays, sh,
                            force_unwrap, !sh, px.kind ? &px : NULL, &bk))
         goto done;

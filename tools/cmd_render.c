@@ -529,6 +529,30 @@ static int render_method(const char *cmd, const tool_world *w, const rad_bake *b
     return rc;
 }
 
+/* Why rad_load_file refused a bake: an intact virtual-patch bake (which holds no classic
+   patches) is another method's data, not a damaged file. */
+static void bake_load_failed(const char *cmd, const char *path, rad_result r)
+{
+    void *data = NULL;
+    size_t size = 0;
+    rad_container *ct = NULL;
+    rad_context ctx;
+    memset(&ctx, 0, sizeof ctx); /* no log: the load has said what it found */
+    if (r == RAD_ERROR_CORRUPT || r == RAD_ERROR_INVALID_ARGUMENT || r == RAD_ERROR_VERSION) {
+        if (tool_read_file(NULL, NULL, path, &data, &size) == 0 && rad_container_create(data, size, &ctx, &ct) == RAD_SUCCESS &&
+            rad_container_find(ct, RAD_SECTION_VP_INFO, NULL) && !rad_container_find(ct, RAD_SECTION_PATCHES, NULL)) {
+            fprintf(stderr, "rad %s: bake '%s' holds virtual patches (rad bake --method aavp|vp), not classic patches: "
+                            "render it with --method aavp or vp\n", cmd, path);
+            rad_container_destroy(ct);
+            free(data);
+            return;
+        }
+        rad_container_destroy(ct);
+        free(data);
+    }
+    fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, path, rad_result_string(r));
+}
+
 /* the bake (--bake, checked against the scene) or one made here, then render_method */
 static int render_with_method(const char *cmd, const tool_world *w, const char *bake_path,
                               const tool_classic_options *o, const tool_method_options *mo,
@@ -549,7 +573,7 @@ static int render_with_method(const char *cmd, const tool_world *w, const char *
                             "--mode, --sr-* (and the stochastic solve's --seed); those given here are ignored\n",
                     cmd, bake_path);
         if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
-            fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
+            bake_load_failed(cmd, bake_path, r);
             return 1;
         }
         if (bake_fits_scene(cmd, bake_path, bake, w)) {
@@ -910,36 +934,72 @@ done:
 /* --bake FILE with --method aavp|vp or --proxy: the set saved by rad bake --method aavp|vp
    (rad_vp_load, checked against the scene's signature and the kind asked for) and its E into
    *E_out; NULL with the error printed */
+int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_t size, const rad_scene *scene,
+                      rad_container **ct_out, rad_virtual_patches **vp_out, float **E_out)
+{
+    rad_container *ct = NULL;
+    rad_virtual_patches *vp = NULL;
+    const rad_section *vi, *se;
+    rad_context ctx;
+    rad_result r;
+    uint32_t i;
+    *ct_out = NULL;
+    *vp_out = NULL;
+    *E_out = NULL;
+    tool_context(&ctx, NULL);
+    if ((r = rad_container_create(data, size, &ctx, &ct)) != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bake '%s' is damaged: %s\n", cmd, path, rad_result_string(r));
+        return 1;
+    }
+    vi = rad_container_find(ct, RAD_SECTION_VP_INFO, "vp");
+    if (!vi) {
+        fprintf(stderr, "rad %s: bake '%s' holds no virtual patches (bake them with --method aavp|vp)\n", cmd, path);
+        rad_container_destroy(ct);
+        return 1;
+    }
+    if ((r = rad_vp_load(ct, "vp", scene, &ctx, &vp)) != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bake '%s' holds damaged virtual patches: %s\n", cmd, path, rad_result_string(r));
+        rad_container_destroy(ct);
+        return 1;
+    }
+    se = rad_container_find(ct, RAD_SECTION_VECTOR, "E");
+    if (!se || se->elem_size != 12 || se->count != vp->count) {
+        fprintf(stderr, "rad %s: bake '%s' holds no source vector E for its %u patches\n", cmd, path, vp->count);
+        rad_vp_destroy(vp);
+        rad_container_destroy(ct);
+        return 1;
+    }
+    *E_out = (float *)xmalloc(sizeof(float) * 3 * (size_t)vp->count);
+    memcpy(*E_out, se->data, sizeof(float) * 3 * (size_t)vp->count);
+    for (i = 0; i < 3 * vp->count; ++i)
+        if (!((*E_out)[i] >= 0.0f && (*E_out)[i] <= RAD_BAKE_VALUE_MAX)) {
+            fprintf(stderr, "rad %s: bake '%s': E entry %u is %g (not in [0, 1e30])\n", cmd, path, i, (double)(*E_out)[i]);
+            free(*E_out);
+            *E_out = NULL;
+            rad_vp_destroy(vp);
+            rad_container_destroy(ct);
+            return 1;
+        }
+    *ct_out = ct;
+    *vp_out = vp;
+    return 0;
+}
+
 static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, const tool_world *w, int clustered,
                                          float **E_out)
 {
-    FILE *f = fopen(path, "rb");
-    unsigned char *buf = NULL;
-    long size = -1;
+    void *buf = NULL;
+    size_t size = 0;
     rad_container *ct = NULL;
     rad_virtual_patches *vp = NULL;
-    const rad_section *se, *sg;
-    rad_context ctx;
+    const rad_section *sg;
     rad_result r;
     uint64_t geometry = 0, materials = 0;
     *E_out = NULL;
-    if (f && fseek(f, 0, SEEK_END) == 0) size = ftell(f);
-    if (size > 0 && fseek(f, 0, SEEK_SET) == 0) {
-        buf = (unsigned char *)xmalloc((size_t)size);
-        if (fread(buf, 1, (size_t)size, f) != (size_t)size) size = -1;
-    }
-    if (f) fclose(f);
-    if (size <= 0) {
-        fprintf(stderr, "rad %s: cannot read bake '%s'\n", cmd, path);
+    if (tool_read_file(cmd, "bake", path, &buf, &size)) return NULL;
+    if (tool_vp_bake_open(cmd, path, buf, size, w->scene, &ct, &vp, E_out)) {
         free(buf);
         return NULL;
-    }
-    tool_context(&ctx, NULL);
-    if ((r = rad_container_create(buf, (size_t)size, &ctx, &ct)) != RAD_SUCCESS ||
-        (r = rad_vp_load(ct, "vp", w->scene, &ctx, &vp)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' holds no virtual patches (bake them with --method aavp|vp): %s\n", cmd, path,
-                rad_result_string(r));
-        goto fail;
     }
     sg = rad_container_find(ct, RAD_SECTION_SIGNATURE, NULL);
     if ((r = rad_scene_hash(w->scene, &geometry, &materials)) != RAD_SUCCESS || !sg || sg->elem_size != sizeof(rad_bake_signature) ||
@@ -969,23 +1029,6 @@ static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, cons
                 vp->kind == RAD_VP_CLUSTERED ? "vp" : "aavp", clustered ? "vp" : "aavp");
         goto fail;
     }
-    se = rad_container_find(ct, RAD_SECTION_VECTOR, "E");
-    if (!se || se->elem_size != 12 || se->count != vp->count) {
-        fprintf(stderr, "rad %s: bake '%s' holds no source vector E for its %u patches\n", cmd, path, vp->count);
-        goto fail;
-    }
-    *E_out = (float *)xmalloc(sizeof(float) * 3 * (size_t)vp->count);
-    memcpy(*E_out, se->data, sizeof(float) * 3 * (size_t)vp->count);
-    {
-        uint32_t i;
-        for (i = 0; i < 3 * vp->count; ++i)
-            if (!((*E_out)[i] >= 0.0f && (*E_out)[i] <= RAD_BAKE_VALUE_MAX)) {
-                fprintf(stderr, "rad %s: bake '%s': E entry %u is %g (not in [0, 1e30])\n", cmd, path, i, (double)(*E_out)[i]);
-                free(*E_out);
-                *E_out = NULL;
-                goto fail;
-            }
-    }
     rad_container_destroy(ct);
     free(buf);
     fprintf(stderr, "rad %s: loaded %u virtual patches (%llu non-zeros) from '%s'\n", cmd, vp->count,
@@ -993,6 +1036,8 @@ static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, cons
                                                      : (unsigned long long)vp->count * vp->count, path);
     return vp;
 fail:
+    free(*E_out);
+    *E_out = NULL;
     rad_vp_destroy(vp);
     rad_container_destroy(ct);
     free(buf);
@@ -1347,6 +1392,10 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     }
     tool_set_threads((int)threads);
     if (tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
+    if (tool_check_outputs(cmd, &out_path, 1, w.file.input_files, (int)w.file.input_file_count)) {
+        tool_close_world(&w);
+        return 1;
+    }
     {
         uint32_t t, emitters = 0;
         for (t = 0; t < w.scene->triangle_count; ++t) {
@@ -1449,7 +1498,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
             rad_result r;
             tool_context(&ctx, NULL);
             if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
-                fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, bake_path, rad_result_string(r));
+                bake_load_failed(cmd, bake_path, r);
                 tool_image_free(&img);
                 tool_close_world(&w);
                 return 1;

@@ -172,7 +172,8 @@ static int trace_main(int argc, char **argv, tool_lights *lights)
         fprintf(stderr, "rad trace: %s\n", err);
         return 1;
     }
-    if (tool_add_lights("trace", &ts, lights, &light_storage)) {
+    if (tool_check_outputs("trace", &out_path, 1, ts.input_files, (int)ts.input_file_count) ||
+        tool_add_lights("trace", &ts, lights, &light_storage)) {
         tool_free_scene(&ts);
         return 1;
     }

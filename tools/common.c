@@ -6,6 +6,7 @@
 #endif
 #define RADIOSITY_IMPLEMENTATION
 #include "tool.h"
+#include <errno.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -401,4 +402,51 @@ void tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_rayca
             (double)cam->target[1], (double)cam->target[2], (double)cam->up[0], (double)cam->up[1], (double)cam->up[2],
             (double)cam->fov_y_degrees, pick < 6 ? "outside" : "inside", names[pick % 6], front[pick], 24u * 24u,
             back[pick]);
+}
+
+int tool_read_file(const char *cmd, const char *what, const char *path, void **data, size_t *size)
+{
+    FILE *f;
+    unsigned char *buf = NULL;
+    size_t n = 0, cap = 0;
+    int e = 0;
+    *data = NULL;
+    *size = 0;
+    errno = 0;
+    if (!(f = fopen(path, "rb"))) {
+        if (cmd) fprintf(stderr, "rad %s: cannot open %s '%s': %s\n", cmd, what, path, strerror(errno ? errno : ENOENT));
+        return 1;
+    }
+    /* read to the end rather than trust a size from the file system (pipes, /proc report 0) */
+    for (;;) {
+        size_t got;
+        if (n == cap) {
+            size_t ncap = cap ? cap * 2 : (size_t)1 << 16;
+            unsigned char *nb = ncap > cap ? (unsigned char *)realloc(buf, ncap) : NULL;
+            if (!nb) { e = ENOMEM; break; }
+            buf = nb;
+            cap = ncap;
+        }
+        errno = 0;
+        got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0) {
+            if (ferror(f)) e = errno ? errno : EIO;
+            break;
+        }
+    }
+    fclose(f);
+    if (e) {
+        if (cmd) fprintf(stderr, "rad %s: cannot read %s '%s': %s\n", cmd, what, path, strerror(e));
+        free(buf);
+        return 1;
+    }
+    if (n == 0) {
+        if (cmd) fprintf(stderr, "rad %s: %s '%s' is empty\n", cmd, what, path);
+        free(buf);
+        return 1;
+    }
+    *data = buf; /* malloc'd: aligned for any type, as the loaders want */
+    *size = n;
+    return 0;
 }

@@ -16,8 +16,8 @@
    temporary file in the destination's folder, which is renamed onto the destination only when
    every write, the flush and the close succeeded, so a failed write (a full disk) leaves the
    old file as it was. */
-#if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
-#define _POSIX_C_SOURCE 200809L /* mkstemp, fchmod, fsync */
+#if !defined(_WIN32) && !defined(_XOPEN_SOURCE)
+#define _XOPEN_SOURCE 700 /* mkstemp, fchmod, fsync, sigaction, realpath */
 #endif
 #include "tool.h"
 #include <errno.h>
@@ -87,6 +87,25 @@ static void output_folder(const char *path, char *buf, size_t cap)
     memcpy(buf, path, n);
     buf[n] = '\0';
 }
+
+#ifdef TOOL_POSIX
+/* path with its folder resolved (realpath of the folder, then the last name), malloc'd, or
+   NULL when the folder does not resolve */
+static char *output_resolved(const char *path)
+{
+    char folder[4096], *rf, *out;
+    const char *base = strrchr(path, '/');
+    size_t n;
+    base = base ? base + 1 : path;
+    output_folder(path, folder, sizeof folder);
+    if (!(rf = realpath(folder, NULL))) return NULL;
+    n = strlen(rf) + strlen(base) + 2;
+    out = (char *)malloc(n);
+    if (out) snprintf(out, n, "%s/%s", rf, base);
+    free(rf);
+    return out;
+}
+#endif
 
 /* ---- temporaries removed on a fatal signal ---------------------------------------------- */
 /* The temporaries now open, copied into fixed slots so that the handler touches no heap and
@@ -394,6 +413,49 @@ int tool_check_output(const char *cmd, const char *path, const char *const *inpu
     return 0;
 }
 
+/* 1 when a and b name the same file: the same device and inode where both exist, else the
+   same resolved path (the real folder and the last name), so that "x.png" and "./x.png" or a
+   link to the folder count as one file before either exists */
+static int output_same_file(const char *a, const char *b)
+{
+#ifdef TOOL_POSIX
+    struct stat sa, sb;
+    int ea = stat(a, &sa) == 0, eb = stat(b, &sb) == 0, same = 0;
+    char *ra, *rb;
+    if (ea && eb) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    if (ea != eb) return 0;
+    ra = output_resolved(a);
+    rb = output_resolved(b);
+    same = ra && rb && !strcmp(ra, rb);
+    free(ra);
+    free(rb);
+    return same;
+#else
+    return !strcmp(a, b);
+#endif
+}
+
+int tool_check_outputs(const char *cmd, const char *const *outputs, int count, const char *const *inputs, int input_count)
+{
+    int i, j;
+    for (i = 0; i < count; ++i) {
+        if (!outputs[i]) continue;
+        for (j = i + 1; j < count; ++j)
+            if (outputs[j] && output_same_file(outputs[i], outputs[j])) {
+                fprintf(stderr, "rad %s: two outputs are the same file ('%s' and '%s'): give each its own name\n", cmd,
+                        outputs[i], outputs[j]);
+                return 1;
+            }
+        for (j = 0; j < input_count; ++j)
+            if (inputs[j] && output_same_file(outputs[i], inputs[j])) {
+                fprintf(stderr, "rad %s: the output '%s' is the input '%s' (a file the scene is read from): refusing to overwrite it\n",
+                        cmd, outputs[i], inputs[j]);
+                return 1;
+            }
+    }
+    return 0;
+}
+
 int tool_image_alloc(tool_image *img, int width, int height)
 {
     size_t n;
@@ -502,6 +564,20 @@ static int tool__pfm_token(FILE *f, char *tok, size_t cap)
     return 0;
 }
 
+/* a PFM width or height: decimal digits only, 1 to 2^30 (a larger one cannot be an image the
+   tool holds; converting it to int would wrap, 4294967312 to 16); 0 when not */
+static int pfm_size(const char *tok)
+{
+    long long v = 0;
+    if (!*tok) return 0;
+    for (; *tok; ++tok) {
+        if (*tok < '0' || *tok > '9') return 0;
+        v = 10 * v + (*tok - '0');
+        if (v > (1LL << 30)) return 0;
+    }
+    return (int)v;
+}
+
 int tool_image_read_pfm(const char *path, tool_image *img, char *err, size_t errlen)
 {
     FILE *f;
@@ -525,8 +601,8 @@ int tool_image_read_pfm(const char *path, tool_image *img, char *err, size_t err
         return -1;
     }
     channels = tok[1] == 'F' ? 3 : 1;
-    if (tool__pfm_token(f, tok, sizeof(tok)) != 0 || (w = (int)strtol(tok, &end, 10)) <= 0 || *end ||
-        tool__pfm_token(f, tok, sizeof(tok)) != 0 || (h = (int)strtol(tok, &end, 10)) <= 0 || *end ||
+    if (tool__pfm_token(f, tok, sizeof(tok)) != 0 || (w = pfm_size(tok)) <= 0 ||
+        tool__pfm_token(f, tok, sizeof(tok)) != 0 || (h = pfm_size(tok)) <= 0 ||
         tool__pfm_token(f, tok, sizeof(tok)) != 0 || ((scale = strtod(tok, &end)), *end) || scale == 0.0 ||
         !(scale == scale)) {
         if (err) snprintf(err, errlen, "%s: bad PFM header", path);

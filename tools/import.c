@@ -17,6 +17,7 @@
    Lights: point, spot and directional lights of the file become rad_light (their node's
    transform applied). Camera: the file's first camera, else a default framing. */
 #include "tool.h"
+#include <ctype.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -80,10 +81,55 @@ typedef struct imp_storage {
     uint32_t texture_count;
     char **material_reports;  /* per material: what the import used and ignored (rad info) */
     int any_emission_texture;
+    char **inputs;          /* the files read: the scene, its MTL libraries, its textures */
+    uint32_t input_count;
     int builtin;
     uint64_t *wound_against;  /* per material: triangles wound against their shading normals */
     uint64_t *wound_total;    /* per material: triangles with shading normals */
 } imp_storage;
+
+static void *xrealloc(void *p, size_t size);
+
+/* path to the list of files the scene was read from (once each) */
+static void add_input(imp_storage *st, const char *path)
+{
+    uint32_t i;
+    size_t n = strlen(path);
+    char **g;
+    for (i = 0; i < st->input_count; ++i)
+        if (!strcmp(st->inputs[i], path)) return;
+    g = (char **)xrealloc(st->inputs, sizeof *g * (st->input_count + 1u));
+    st->inputs = g;
+    g[st->input_count] = (char *)xrealloc(NULL, n + 1);
+    memcpy(g[st->input_count++], path, n + 1);
+}
+
+/* the MTL files an OBJ names (mtllib lines), resolved against the OBJ's folder, as inputs */
+static void add_obj_mtllibs(imp_storage *st, const char *obj)
+{
+    FILE *f;
+    char line[2048], full[4096];
+    size_t n = strlen(obj);
+    const char *slash = strrchr(obj, '/');
+    int dir = slash ? (int)(slash - obj + 1) : 0;
+    if (n < 4 || (strcmp(obj + n - 4, ".obj") && strcmp(obj + n - 4, ".OBJ"))) return;
+    if (!(f = fopen(obj, "r"))) return;
+    while (fgets(line, sizeof line, f)) {
+        char *p = line, *e;
+        while (*p == ' ' || *p == '\t') ++p;
+        if (strncmp(p, "mtllib", 6) || !(p[6] == ' ' || p[6] == '\t')) continue;
+        p += 6;
+        while (*p == ' ' || *p == '\t') ++p;
+        for (e = p + strlen(p); e > p && isspace((unsigned char)e[-1]); --e) {
+        }
+        *e = '\0';
+        if (!*p) continue;
+        if (*p == '/') snprintf(full, sizeof full, "%s", p);
+        else snprintf(full, sizeof full, "%.*s%s", dir, obj, p);
+        add_input(st, full);
+    }
+    fclose(f);
+}
 
 static void set_err(char *err, size_t errlen, const char *fmt, const char *a, const char *b)
 {
@@ -169,6 +215,8 @@ static void free_storage(imp_storage *st)
     }
     for (i = 0; i < st->texture_count; ++i) free(st->textures[i].rgb);
     for (i = 0; st->material_names && i < st->material_count; ++i) free(st->material_names[i]);
+    for (i = 0; i < st->input_count; ++i) free(st->inputs[i]);
+    free(st->inputs);
     free(st->material_names);
     for (i = 0; st->material_reports && i < st->material_count; ++i) free(st->material_reports[i]);
     free(st->material_reports);
@@ -243,7 +291,8 @@ static uint32_t load_texture_as(imp_storage *st, const struct aiScene *sc, const
             if (sc->mTextures[i]->mHeight == 0 && !strcmp(sc->mTextures[i]->mFilename.data, tpath))
                 px = stbi_load_from_memory((const unsigned char *)sc->mTextures[i]->pcData, (int)sc->mTextures[i]->mWidth,
                                            &w, &h, &comp, 3);
-        if (!px) px = stbi_load(base_dir_join(file, tpath, full, sizeof full), &w, &h, &comp, 3);
+        if (!px && (px = stbi_load(base_dir_join(file, tpath, full, sizeof full), &w, &h, &comp, 3)) != NULL)
+            add_input(st, full);
     }
     if (!px || w <= 0 || h <= 0) {
         fprintf(stderr, "rad: warning: texture '%s' could not be loaded (%s); using the material colour\n", tpath,
@@ -1409,6 +1458,10 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
                                                                                       : "one (front counter-clockwise, the back absorbs)", NULL);
     }
     warn_mixed_windings(st, path_or_name);
+    add_input(st, path_or_name);
+    add_obj_mtllibs(st, path_or_name);
+    out->input_files = (const char *const *)st->inputs;
+    out->input_file_count = st->input_count;
     if (!out->has_camera) default_camera(bmin, bmax, &out->camera);
     return 0;
 }

@@ -21,6 +21,9 @@ typedef struct tool_scene {
     const char *const *material_names; /* desc.material_count names ("" when unnamed), or NULL */
     const char *const *material_reports; /* per material, lines "  what: ..." saying what the
                                 importer used, read and ignored of it (rad info), or NULL */
+    const char *const *input_files; /* the files it was read from: the scene file, the MTL
+                                       libraries an OBJ names, the textures loaded from disk */
+    uint32_t input_file_count;
     void *storage;           /* private */
 } tool_scene;
 
@@ -121,6 +124,11 @@ const char *tool_output_error(void);
    st_ino, so another name or a link for it counts), is a directory, or whose folder is
    missing or not writable. 0 when fine, else prints "rad CMD: ..." and returns 1. */
 int tool_check_output(const char *cmd, const char *path, const char *const *inputs, int input_count);
+/* Refuses two outputs of one command that are the same file, and an output that is one of
+   the inputs (e.g. tool_scene.input_files: the scene, its MTL files, its textures): the same
+   device and inode where both exist, else the same resolved path. 0, or 1 after printing
+   "rad CMD: ..." */
+int tool_check_outputs(const char *cmd, const char *const *outputs, int count, const char *const *inputs, int input_count);
 
 /* ---- metrics (metrics.c): MSE, PSNR, SSIM on values clamped to [0,1] ------------------- */
 double tool_image_mse(const tool_image *a, const tool_image *b);
@@ -205,6 +213,10 @@ void tool_progress_end(void);
 int tool_fail(const char *cmd, const char *what, rad_result r);
 /* calloc of n elements (at least one) that prints and exits on failure */
 void *tool_calloc(size_t n, size_t size);
+/* The whole file into *data (malloc'd, free with free()) and *size; 0, or 1 after printing
+   "rad CMD: cannot read WHAT 'PATH': <the system's reason>" (or that it is empty; cmd NULL:
+   nothing printed). */
+int tool_read_file(const char *cmd, const char *what, const char *path, void **data, size_t *size);
 /* option values: 0 on success, else prints "rad CMD: bad value ..." and returns 2 */
 int tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t *out);
 int tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
@@ -603,6 +615,13 @@ typedef struct tool_lightmap_proxy {
    printing why (even resolution 1 gives more). (cmd_render.c) */
 int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
                               uint32_t max_patches, uint32_t start, uint32_t *out);
+/* A bake of rad bake --method aavp|vp in memory (data, size: kept alive by the caller while
+   *ct_out lives): its container, its set "vp" (rad_vp_load; scene may be NULL) and its source
+   vector E (3 floats a patch, each in [0, RAD_BAKE_VALUE_MAX], malloc'd). The errors tell a
+   damaged file, a bake without virtual patches and damaged virtual patches apart. 0, or 1
+   after printing why (nothing to free). (cmd_render.c) */
+int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_t size, const rad_scene *scene,
+                      rad_container **ct_out, rad_virtual_patches **vp_out, float **E_out);
 /* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth
    lookup (rad_lightmap_gather_hierarchical); a kind of its own, past the tool_proxy values */
 #define TOOL_LIGHTMAP_HIERARCHICAL 3
