@@ -10125,7 +10125,9 @@ static rad_result rad__stoch_jacobi(rad__stoch *s, double p0)
         double pk = 0.0, frac;
         for (i = 0; i < s->n; ++i) pk += (double)s->P->areas[i] * (s->cur[3 * i] + s->cur[3 * i + 1] + s->cur[3 * i + 2]);
         if (pk < s->o.tolerance * p0) break;
-        r = rad__stoch_shoot(s, s->cur, rad__stoch_count(s->o.rays, pk, p0),
+        /* the unshot power never exceeds p0, but its sum in another order can by an ulp: one
+           ray more than 'rays' would overrun the arrays sized for a shooting wave */
+        r = rad__stoch_shoot(s, s->cur, rad__stoch_count(s->o.rays, pk < p0 ? pk : p0, p0),
                              rad__hash(s->o.seed ^ rad__hash(it + 0x9E3779B9u)), s->acc);
         if (r != RAD_SUCCESS) return r;
         for (i = 0; i < n3; ++i) { s->cur[i] = s->acc[i]; s->B[i] += s->acc[i]; }
