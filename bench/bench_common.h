@@ -20,7 +20,7 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-static void emit(const char *fmt, ...)
+static inline void emit(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);

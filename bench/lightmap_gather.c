@@ -74,8 +74,8 @@ static rad_scene *unwrapped(const rad_scene *S, uint32_t N, float **uvs_out)
     rad_material *mats = (rad_material *)malloc(sizeof(rad_material) * S->material_count);
     float *uvs = (float *)calloc(6 * (size_t)S->triangle_count, sizeof(float));
     rad_scene *U = NULL;
-    uint32_t charts = 0;
-    if (tool_unwrap("lightmap_gather", "--bunny-size or --bunny-exact-size", S, N, N, uvs, &charts)) exit(1);
+    uint32_t charts = 0, w = N, h = N;
+    if (tool_unwrap("lightmap_gather", "--bunny-size or --bunny-exact-size", S, &w, &h, NULL, uvs, &charts)) exit(1);
     memcpy(mats, S->materials_table, sizeof(rad_material) * S->material_count);
     memset(&mesh, 0, sizeof mesh);
     mesh.name = "unwrapped";
