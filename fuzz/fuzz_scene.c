@@ -52,6 +52,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (k = 0; k < 3; ++k) mats[m].emission[k] = rdf(&r);
         mats[m].texture = 0;
         mats[m].two_sided = 0;
+        mats[m].emission_texture = 0;
     }
     for (m = 0; m < nm; ++m) {
         uint32_t nv = rd8(&r) % 49, nt = rd8(&r) % 33, use_ids = rd8(&r) & 1u;

@@ -72,7 +72,7 @@ static void bk_test_classic_lower_level(void)
     if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
     if (!P || !bvh) goto done;
     CHECK(P->count == R->patch_count);
-    rad_bvh_raycaster(bvh, &rc);
+    (rad_bvh_raycaster)(bvh, &rc); /* the baker's own ray queries, also in the Embree build of the tests */
     rad_form_factor_options_default(&fo);
     fo.samples = o.ff_samples;
     CHECK_OK(rad_form_factors_dense(P, &rc, &fo, NULL, &ff));
@@ -161,7 +161,7 @@ static void bk_test_auto_vp_lower_level(void)
     CHECK_OK(rad_scene_create(&d.scene, NULL, &S));
     if (S) CHECK_OK(rad_bvh_create(S, NULL, &bvh));
     if (!bvh) goto done;
-    rad_bvh_raycaster(bvh, &rc);
+    (rad_bvh_raycaster)(bvh, &rc); /* the baker's own ray queries, also in the Embree build of the tests */
     rad_vp_options_default(&vo);
     vo.resolution = R->vp_resolution;
     CHECK_OK(rad_vp_create(S, &rc, &vo, NULL, &vp));

@@ -348,6 +348,7 @@ static void test_trace_furnace(void)
             mats[f].emission[k] = L[k];
             mats[f].texture = 0;
             mats[f].two_sided = 0;
+            mats[f].emission_texture = 0;
         }
     s = box_scene(mats);
     CHECK(s != NULL);
@@ -466,6 +467,7 @@ static void test_trace_vs_radiosity(void)
             mats[f].emission[k] = f == 3 ? 1.0f : 0.0f;
             mats[f].texture = 0;
             mats[f].two_sided = 0;
+            mats[f].emission_texture = 0;
         }
     s = box_scene(mats);
     CHECK(s != NULL);
