@@ -7,12 +7,12 @@
 #   make build/realtime  examples/realtime.c: per-frame light, E, temporal step and gather over AAVP
 #   make moving-light  temporal radiosity under a moving light: PNG frames and errors in build/moving_light_frames/
 #   make test    every test suite; ends with "N passed, N failed[, N skipped]"
-#   make bench   writes BENCHMARKS.md (long: minutes)
+#   make bench   writes docs/BENCHMARKS.md (long: minutes)
 #   make tools   builds the command-line tools in tools/ (and tools/rad-mpi when mpicc is installed)
-#   make glsl    regenerates the GLSL sources embedded in radiosity.h from glsl/
+#   make glsl    regenerates the GLSL sources embedded in radiosity.h from tools/glsl/
 #   make api     regenerates docs/api.md (the index of every public declaration) from radiosity.h
 #   make report  the evaluation report (every method vs the path-traced reference, plots; the
-#                real scenes when RAD_DATA_DIR holds sponza.obj) into report/ (long: 15-40 min
+#                real scenes when RAD_DATA_DIR holds sponza.obj) into tests/report/ (long: 15-40 min
 #                on 2 shared cores); make report-quick: a small one into build/, checked
 #   make clean
 CC      ?= cc
@@ -92,66 +92,66 @@ api:
 test:
 	CC="$(CC)" CXX="$(CXX)" BUILD="$(BUILD)" bash tests/run.sh
 
-$(BUILD)/bench: bench/bench.c radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -DBENCH_CFLAGS='"-std=c99 -O3 -march=native $(OPENMP)"' -I. bench/bench.c -o $@ -lm
+$(BUILD)/bench: tests/bench/bench.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -DBENCH_CFLAGS='"-std=c99 -O3 -march=native $(OPENMP)"' -I. tests/bench/bench.c -o $@ -lm
 
-$(BUILD)/multibounce: bench/multibounce.c radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/multibounce.c -o $@ -lm
+$(BUILD)/multibounce: tests/bench/multibounce.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/multibounce.c -o $@ -lm
 
-$(BUILD)/temporal: bench/temporal.c radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/temporal.c -o $@ -lm
+$(BUILD)/temporal: tests/bench/temporal.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/temporal.c -o $@ -lm
 
-$(BUILD)/shading: bench/shading.c radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native -I. bench/shading.c -o $@ -lm
+$(BUILD)/shading: tests/bench/shading.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native -I. tests/bench/shading.c -o $@ -lm
 
 # the lightmap gather: hemisphere against exact, and the 1024^2 bunny-box bake (needs $(RAD_DATA_DIR))
-$(BUILD)/bench_lightmap_gather: bench/lightmap_gather.c bench/bench_common.h bench/bench_scenes.h tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap_gather.c tools/unwrap.c -o $@ -lm
+$(BUILD)/bench_lightmap_gather: tests/bench/lightmap_gather.c tests/bench/bench_common.h tests/bench/bench_scenes.h tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/lightmap_gather.c tools/unwrap.c -o $@ -lm
 
-# lightmap timings and noise (BENCHMARKS.md "Lightmaps")
-$(BUILD)/bench_lightmap: bench/lightmap.c bench/bench_common.h bench/bench_scenes.h radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/lightmap.c -o $@ -lm
+# lightmap timings and noise (docs/BENCHMARKS.md "Lightmaps")
+$(BUILD)/bench_lightmap: tests/bench/lightmap.c tests/bench/bench_common.h tests/bench/bench_scenes.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/lightmap.c -o $@ -lm
 
-$(BUILD)/local: bench/local.c examples/rooms.h radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/local.c -o $@ -lm
+$(BUILD)/local: tests/bench/local.c examples/rooms.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/local.c -o $@ -lm
 
 $(BUILD)/walk: examples/walk.c examples/rooms.h examples/png_write.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) -I. examples/walk.c -o $@ -lm
 
-$(BUILD)/probes: bench/probes.c bench/bench_common.h radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O2 $(OPENMP) -I. bench/probes.c -o $@ -lm
+$(BUILD)/probes: tests/bench/probes.c tests/bench/bench_common.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O2 $(OPENMP) -I. tests/bench/probes.c -o $@ -lm
 
-# the real-time loop over AAVP on real meshes (bench/realtime.sh; needs $(RAD_DATA_DIR))
-$(BUILD)/bench_realtime: bench/realtime.c radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. bench/realtime.c -o $@ -lm
+# the real-time loop over AAVP on real meshes (tests/bench/realtime.sh; needs $(RAD_DATA_DIR))
+$(BUILD)/bench_realtime: tests/bench/realtime.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/realtime.c -o $@ -lm
 
-$(BUILD)/rays: bench/rays.c bench/bench_common.h bench/bench_scenes.h radiosity.h | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. bench/rays.c -o $@ -lm $(EMBREE_LIB)
+$(BUILD)/rays: tests/bench/rays.c tests/bench/bench_common.h tests/bench/bench_scenes.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. tests/bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
 bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime $(BUILD)/bench_lightmap
-	./$(BUILD)/bench BENCHMARKS.md
-	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append BENCHMARKS.md
-	bash bench/trace.sh $(BUILD)/rad BENCHMARKS.md
-	bash bench/methods.sh $(BUILD)/rad BENCHMARKS.md
-	./$(BUILD)/multibounce --append BENCHMARKS.md
-	./$(BUILD)/temporal --append BENCHMARKS.md
-	./$(BUILD)/shading --append BENCHMARKS.md
-	./$(BUILD)/local --append BENCHMARKS.md
-	./$(BUILD)/probes --sweep --append BENCHMARKS.md
-	./$(BUILD)/bench_lightmap --append BENCHMARKS.md
-	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/realtime.sh $(BUILD) BENCHMARKS.md
-	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/sponza.sh $(BUILD)/rad BENCHMARKS.md
+	./$(BUILD)/bench docs/BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append docs/BENCHMARKS.md
+	bash tests/bench/trace.sh $(BUILD)/rad docs/BENCHMARKS.md
+	bash tests/bench/methods.sh $(BUILD)/rad docs/BENCHMARKS.md
+	./$(BUILD)/multibounce --append docs/BENCHMARKS.md
+	./$(BUILD)/temporal --append docs/BENCHMARKS.md
+	./$(BUILD)/shading --append docs/BENCHMARKS.md
+	./$(BUILD)/local --append docs/BENCHMARKS.md
+	./$(BUILD)/probes --sweep --append docs/BENCHMARKS.md
+	./$(BUILD)/bench_lightmap --append docs/BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/realtime.sh $(BUILD) docs/BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/sponza.sh $(BUILD)/rad docs/BENCHMARKS.md
 
 bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append $(BUILD)/BENCHMARKS-quick.md
-	bash bench/methods.sh $(BUILD)/rad $(BUILD)/BENCHMARKS-quick.md --quick
+	bash tests/bench/methods.sh $(BUILD)/rad $(BUILD)/BENCHMARKS-quick.md --quick
 	./$(BUILD)/multibounce --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/temporal --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/shading --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/local --quick --append $(BUILD)/BENCHMARKS-quick.md
 	./$(BUILD)/probes --quick --append $(BUILD)/BENCHMARKS-quick.md
-	RAD_DATA_DIR=$(RAD_DATA_DIR) bash bench/realtime.sh --quick $(BUILD) $(BUILD)/BENCHMARKS-quick.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/realtime.sh --quick $(BUILD) $(BUILD)/BENCHMARKS-quick.md
 
 # the MPI driver of the distributed bake (docs/distributed.md), when OpenMPI is installed
 # (Debian libopenmpi-dev openmpi-bin): the tool's sources but main.c, with tools/mpi/rad_mpi.c's main
@@ -171,7 +171,7 @@ $(BUILD)/rad: $(wildcard tools/*.c) tools/tool.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) $(CFLAGS) $(OPENMP) $(EXR_CFLAGS) -I. tools/*.c -o $@ -lassimp $(EXR_LIB) -lm
 	cp $@ tools/rad
 
-# the evaluation report (tools/report.sh): full quality into report/ (committed), or
+# the evaluation report (tools/report.sh): full quality into tests/report/ (committed), or
 # quick into build/report-quick/ with every table cell and image checked (tests/run.sh runs it)
 report: $(BUILD)/rad $(BUILD)/temporal $(BUILD)/bench_realtime
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tools/report.sh --rad $(BUILD)/rad --temporal-bench $(BUILD)/temporal --realtime-bench $(BUILD)/bench_realtime
@@ -188,10 +188,10 @@ FUZZ_CC ?= clang
 FUZZ_HARNESSES ?= container scene stream multibounce temporal vp
 fuzz: | $(BUILD)
 	mkdir -p $(addprefix $(BUILD)/fuzz/corpus/,container scene stream multibounce temporal vp)
-	$(CC) -std=c99 -O2 -I. fuzz/make_corpus.c -o $(BUILD)/fuzz/make_corpus -lm
+	$(CC) -std=c99 -O2 -I. tests/fuzz/make_corpus.c -o $(BUILD)/fuzz/make_corpus -lm
 	./$(BUILD)/fuzz/make_corpus $(BUILD)/fuzz/corpus
 	failed=""; for f in $(FUZZ_HARNESSES); do \
-	    if $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm && \
+	    if $(FUZZ_CC) -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. tests/fuzz/fuzz_$$f.c -o $(BUILD)/fuzz/fuzz_$$f -lm && \
 	       TMPDIR=$(BUILD)/fuzz ./$(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/fuzz/$$f- $(BUILD)/fuzz/corpus/$$f; \
 	    then :; else failed="$$failed $$f"; fi; \
 	done; \
@@ -200,9 +200,9 @@ fuzz: | $(BUILD)
 clean:
 	rm -rf $(BUILD) cornell.png gallery.png lightmap.png tools/rad tools/rad-mpi
 
-# the GLSL kernels: glsl/*.comp are the canonical sources, embedded into radiosity.h
-$(BUILD)/glsl_embed: glsl/embed.c | $(BUILD)
-	$(CC) -std=c99 $(WARN) -O2 glsl/embed.c -o $@
+# the GLSL kernels: tools/glsl/*.comp are the canonical sources, embedded into radiosity.h
+$(BUILD)/glsl_embed: tools/glsl/embed.c | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O2 tools/glsl/embed.c -o $@
 
 glsl: $(BUILD)/glsl_embed
 	./$(BUILD)/glsl_embed radiosity.h

@@ -259,7 +259,7 @@
        an invocation (temporal step, alias build, local pre-pass, vp gather) per row, and
        row_offset / row_count / base in every kernel so a matrix larger than one
        storage-buffer range (128 MiB on lavapipe) runs in chunks. Bindings: the >>api_glsl section. Canonical
-       sources: the .comp files in glsl/ of the repository (make glsl regenerates the header's copy);
+       sources: the .comp files in tools/glsl/ of the repository (make glsl regenerates the header's copy);
        tests/test_vulkan.c runs every kernel against the CPU path; examples/vulkan_temporal.c
        is a complete program.
 
@@ -302,7 +302,7 @@
               (analytic, Monte Carlo), Jacobi, Gauss-Seidel, progressive refinement, LU;
               direct light; built-in Cornell box; baked-data container; multi-bounce matrix
               with BC1/BC4 compression; temporal radiosity with alias tables.
-       What each version changed, for an upgrade, is in CHANGELOG.md.
+       What each version changed, for an upgrade, is in docs/CHANGELOG.md.
 */
 
 #ifndef RADIOSITY_H
@@ -1699,7 +1699,7 @@ RAD_API rad_result rad_multibounce_blocks_load(const rad_container *container, c
      T_SS += u v / s, T_Sn = u / s, T_nS = v / s, T_nn = 1/s - 1. u, v and s are accumulated
      in double (u and v only over the slots where the new row is non-zero); T is stored and
      updated in float (one vectorised pass). Cost O(M^2) per patch. Measured drift against a
-     direct inverse: 7e-7 relative after 260 adds (tests), 4e-6 after 4096 (bench/local.c).
+     direct inverse: 7e-7 relative after 260 adds (tests), 4e-6 after 4096 (tests/bench/local.c).
    - The update of Shcherbakov 2025 (RAD_LOCAL_FIRST_ORDER) in this library's convention (the receiving
      row carries the albedo): d = b . a (the "double reflection": light leaving n, reflected
      once by S, back on n); the row and column are scaled by (1 + d) instead of 1/s, and the
@@ -3368,7 +3368,7 @@ RAD_API rad_result rad_sky_transfer_apply(const rad_sky_transfer *transfer, cons
 /* Local lighting models for the direct term and the final shading (docs/methods/shading.md; the set of
    models of Korobeinikov 2022, docs/references.md).
    Radiosity gives the indirect light of diffuse surfaces; these functions give the response
-   of a surface to one light direction, the same in C and in glsl/lighting.glsl.
+   of a surface to one light direction, the same in C and in tools/glsl/lighting.glsl.
 
    CONVENTION. l (towards the light), v (towards the viewer) and n (the normal) are unit
    vectors. Two quantities are offered:
@@ -3553,7 +3553,7 @@ RAD_API float rad_fresnel_schlick_f90(float f0, float f90, float exponent, float
 RAD_API float rad_diffuse_lambert(float albedo, float F);
 RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv);
 
-/* The std430 mirror of glsl/lighting.glsl's ShadingParams (96 bytes, vec4-aligned):
+/* The std430 mirror of tools/glsl/lighting.glsl's ShadingParams (96 bytes, vec4-aligned):
    albedo (albedo, or kd for Phong), specular (ks), f0, f90, p = (alpha_x, alpha_y, model
    parameter: wrap / shininess / k / sigma, second parameter: half-Lambert exponent / bands /
    Fresnel exponent), mode = (model, ndf, masking, diffuse). */
@@ -3794,7 +3794,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
 /* The compute kernels, as GLSL 4.50 source text the application compiles (with
    glslang or shaderc) and dispatches on its own Vulkan 1.1+ device (Vulkan GLSL: push
    constants and specialization constants): radiosity.h never touches a GPU. The canonical
-   sources are the files glsl/<name> of the repository; the copy in the >>glsl section is
+   sources are the files tools/glsl/<name> of the repository; the copy in the >>glsl section is
    generated from them (make glsl) and a test fails when it is out of date. Every kernel is compiled and run by tests/test_vulkan.c on a Vulkan device
    (Mesa's lavapipe in CI) and compared with the CPU function named in its entry.
 
@@ -3878,8 +3878,8 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
    RAD_GLSL_LIGHTING       an include, not a kernel: every lighting model and BRDF term of
        >>api_shading as GLSL functions named as in C (rad_shade ...), no #version line: put
        its text after yours (or resolve an #include to it). Its results agree with the C
-       functions to 1e-5 relative (tests/test_shading_vulkan.c, through glsl/lighting_eval.comp;
-       the header's copy is checked equal to glsl/lighting.glsl).
+       functions to 1e-5 relative (tests/test_shading_vulkan.c, through tools/glsl/lighting_eval.comp;
+       the header's copy is checked equal to tools/glsl/lighting.glsl).
    RAD_GLSL_LOCAL_APPLY    L_i = sum_{j in P_Lit} T_ij E_j (+ E_i) for i in P_Vis, as rad_local_apply,
        on the planes of a rad_local (>>api_local; uploaded unchanged or kept resident on the
        GPU). Push: rad_glsl_local_apply_push; flags RAD_GLSL_OUTPUT_TOTAL. ONE WORKGROUP PER
@@ -3902,7 +3902,7 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        RAD_GLSL_LOCAL_WORK_FLOATS(m) floats; UPDATE is the O(M^2) pass, ONE WORKGROUP PER ROW:
        T += cuv u v - c r / g (rank 1, or rank 2 when evicting), the new row coef v and column
        coef u, T_kk. Pushes: rad_glsl_local_vectors_push, rad_glsl_local_update_push; the
-       layout of the work buffer is in glsl/local_vectors.comp. VECTORS bindings: 0, 1, 2
+       layout of the work buffer is in tools/glsl/local_vectors.comp. VECTORS bindings: 0, 1, 2
        planes (the chunk's rows at base; passes 1 and 2 read none: bind any range)  3: a
        4: b  5: nz  6: work. UPDATE bindings: 0, 1, 2 planes (read-write, the chunk's rows)
        3: work. A kernel cannot return an error: when s <= 1e-12 in some channel (rows that
@@ -3954,20 +3954,20 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
-    RAD_GLSL_GATHER_DENSE      =  0, /* glsl/gather_dense.comp */
-    RAD_GLSL_GATHER_CSR        =  1, /* glsl/gather_csr.comp */
-    RAD_GLSL_MB_APPLY_FLOAT    =  2, /* glsl/mb_apply_float.comp */
-    RAD_GLSL_MB_APPLY_HALF     =  3, /* glsl/mb_apply_half.comp */
-    RAD_GLSL_TEMPORAL_STEP     =  4, /* glsl/temporal_step.comp */
-    RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* glsl/mb_apply_blocks.comp */
-    RAD_GLSL_ALIAS_BUILD       =  6, /* glsl/alias_build.comp */
-    RAD_GLSL_LIGHTING          =  7, /* glsl/lighting.glsl */
-    RAD_GLSL_LOCAL_APPLY       =  8, /* glsl/local_apply.comp */
-    RAD_GLSL_LOCAL_VECTORS     =  9, /* glsl/local_vectors.comp */
-    RAD_GLSL_LOCAL_UPDATE      = 10, /* glsl/local_update.comp */
-    RAD_GLSL_VP_GATHER         = 11, /* glsl/vp_gather.comp */
-    RAD_GLSL_PROBE_UPDATE      = 12, /* glsl/probe_update.comp */
-    RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* glsl/lightmap_refresh.comp */
+    RAD_GLSL_GATHER_DENSE      =  0, /* tools/glsl/gather_dense.comp */
+    RAD_GLSL_GATHER_CSR        =  1, /* tools/glsl/gather_csr.comp */
+    RAD_GLSL_MB_APPLY_FLOAT    =  2, /* tools/glsl/mb_apply_float.comp */
+    RAD_GLSL_MB_APPLY_HALF     =  3, /* tools/glsl/mb_apply_half.comp */
+    RAD_GLSL_TEMPORAL_STEP     =  4, /* tools/glsl/temporal_step.comp */
+    RAD_GLSL_MB_APPLY_BLOCKS   =  5, /* tools/glsl/mb_apply_blocks.comp */
+    RAD_GLSL_ALIAS_BUILD       =  6, /* tools/glsl/alias_build.comp */
+    RAD_GLSL_LIGHTING          =  7, /* tools/glsl/lighting.glsl */
+    RAD_GLSL_LOCAL_APPLY       =  8, /* tools/glsl/local_apply.comp */
+    RAD_GLSL_LOCAL_VECTORS     =  9, /* tools/glsl/local_vectors.comp */
+    RAD_GLSL_LOCAL_UPDATE      = 10, /* tools/glsl/local_update.comp */
+    RAD_GLSL_VP_GATHER         = 11, /* tools/glsl/vp_gather.comp */
+    RAD_GLSL_PROBE_UPDATE      = 12, /* tools/glsl/probe_update.comp */
+    RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* tools/glsl/lightmap_refresh.comp */
     RAD_GLSL_COUNT = 14
 } rad_glsl_id;
 /* >>glsl ids end */
@@ -22856,7 +22856,7 @@ RAD_API rad_result rad_sky_transfer_apply(const rad_sky_transfer *t, const float
 /* >>shading: lighting models and BRDFs                                                     */
 /* ======================================================================================== */
 
-/* Everything here is float arithmetic written in the same order as glsl/lighting.glsl, so
+/* Everything here is float arithmetic written in the same order as tools/glsl/lighting.glsl, so
    that the C and GLSL results agree to a few ulps (the tests compare them). */
 
 #define RAD__INV_PI 0.318309886183790671537767526745f
@@ -23175,7 +23175,7 @@ RAD_API float rad_diffuse_shirley(float albedo, float f0, float nl, float nv)
     return (1.0f - f0) * (21.0f / 20.0f) * albedo * RAD__INV_PI * (1.0f - a5) * (1.0f - b5);
 }
 
-/* ---- the evaluator, the mirror of glsl/lighting.glsl's shade() ---- */
+/* ---- the evaluator, the mirror of tools/glsl/lighting.glsl's shade() ---- */
 
 static float rad__sdot(const float *a, const float *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -24204,7 +24204,7 @@ typedef struct rad__glsl_entry {
     uint32_t length;
 } rad__glsl_entry;
 
-/* Generated by glsl/embed.c from the files glsl/<name>: edit those, then run make glsl. */
+/* Generated by tools/glsl/embed.c from the files tools/glsl/<name>: edit those, then run make glsl. */
 /* >>glsl begin */
 static const char rad__glsl_0_0[] =
     "#version 450\n"
@@ -24703,7 +24703,7 @@ static const char rad__glsl_7_0[] =
     "// 1e-5 relative). Conventions (l, v, n unit; f the BRDF; R = f * max(n.l, 0) the response)\n"
     "// are those of the >>api_shading comment in radiosity.h.\n"
     "//\n"
-    "// Including it: either with GL_GOOGLE_include_directive (as glsl/lighting_eval.comp does:\n"
+    "// Including it: either with GL_GOOGLE_include_directive (as tools/glsl/lighting_eval.comp does:\n"
     "// glslangValidator resolves it relative to the including file), or by pasting this file's\n"
     "// text after your #version line.\n"
     "#ifndef RAD_LIGHTING_GLSL\n"

@@ -27,7 +27,7 @@
    shrinks by sqrt((1 - w)/(1 + w)); hence the defaults k = 64, w = 0.8. --adaptive uses the
    per-row weight of rad_temporal_options.adaptive, made for lights that jump and then stay: a light that moves a
    little every frame does not trip its change test, so the weights climb towards weight_max
-   and B lags far behind (BENCHMARKS.md). The step's time includes the parallel_for's start and join
+   and B lags far behind (docs/BENCHMARKS.md). The step's time includes the parallel_for's start and join
    (OpenMP), which dominate at these sizes and on a busy machine.
 
    Build:  make moving-light   (cc -std=c99 -O2 -fopenmp -I. examples/moving_light.c -o build/moving_light -lm)
@@ -212,7 +212,7 @@ int main(int argc, char **argv)
     memset(&light, 0, sizeof(light));
     light.type = RAD_LIGHT_POINT;
     light.falloff = RAD_FALLOFF_QUADRATIC;
-    /* about as bright as the ceiling light (the jump of bench/temporal.c) */
+    /* about as bright as the ceiling light (the jump of tests/bench/temporal.c) */
     light.color[0] = light.color[1] = light.color[2] = 0.05f * (hi[1] - lo[1]) * (hi[1] - lo[1]) * 30.0f;
     light.color[2] *= 0.8f; /* slightly warm, to tell it from the ceiling */
 

@@ -1,6 +1,6 @@
 /* rooms.h - a generated large scene for the local multi-bounce matrix (docs/methods/local.md): rows of
    rooms along corridors, and a form-factor row source that computes rows on demand.
-   Used by examples/walk.c and bench/local.c. Public domain or MIT.
+   Used by examples/walk.c and tests/bench/local.c. Public domain or MIT.
 
    Layout (metres, y up): 'nz' rows of 'nx' rooms, each room R x R (R = 4) and H = 3 high;
    between two rows a corridor C = 2 wide runs the whole length in x. Every room has a door

@@ -216,8 +216,8 @@ s_compile() {
     done
     if [ $alone = 1 ]; then pass test-files-alone; else fail test-files-alone; fi
     fma_opt_in
-    # ---- GLSL: the header holds the current glsl/ sources
-    if build glsl-embed $CC -std=c99 $WARN -O2 glsl/embed.c -o "$BUILD/glsl_embed" &&
+    # ---- GLSL: the header holds the current tools/glsl/ sources
+    if build glsl-embed $CC -std=c99 $WARN -O2 tools/glsl/embed.c -o "$BUILD/glsl_embed" &&
        "$BUILD/glsl_embed" --check radiosity.h >"$BUILD/glsl-embed.out" 2>&1; then
         pass glsl-embed-current
     else
@@ -362,7 +362,7 @@ s_vulkan() {
         return
     fi
     echo "== GLSL sources compile on their own"
-    for f in glsl/*.comp; do
+    for f in tools/glsl/*.comp; do
         spv="$BUILD/$(basename "$f").spv"
         if glslangValidator -V --target-env vulkan1.1 "$f" -o "$spv" >"$BUILD/glslang.log" 2>&1 &&
            { ! have spirv-val || spirv-val --target-env vulkan1.1 "$spv" >>"$BUILD/glslang.log" 2>&1; }; then pass "glslang $f"
@@ -439,7 +439,7 @@ s_tool() {
 s_report() {
     after build-tool
     [ -x "$BUILD/rad" ] || return 0
-    if build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. bench/temporal.c -o "$BUILD/temporal" -lm &&
+    if build report-temporal $CC -std=c99 $WARN -O2 $OMP -I. tests/bench/temporal.c -o "$BUILD/temporal" -lm &&
        bash tools/report.sh --quick --out "$BUILD/report-quick" \
            --rad "$BUILD/rad" --temporal-bench "$BUILD/temporal" >"$BUILD/report-quick.log" 2>&1; then
         pass "report-quick ($(tail -n 1 "$BUILD/report-quick.log" | sed 's/.*: \([0-9]* table rows, [0-9]* images\).*/\1/'))"
@@ -499,9 +499,9 @@ s_clang_asan_O1() {
     [ "$HAVE_ASAN_CLANG" = 1 ] || return 0
     RAD_TEST_QUICK=1 RAD_TEST_SKIP="$COVER_SKIP" unit unit-clang-asan-ubsan-O1-scalar-cover clang -std=c99 $WARN -O1 -DRAD_NO_SIMD $SAN -I. tests/test_main.c
 }
-# libFuzzer smoke runs (the long runs are `make fuzz`, recorded in FUZZING.md); TMPDIR: where
+# libFuzzer smoke runs (the long runs are `make fuzz`, recorded in docs/FUZZING.md); TMPDIR: where
 # fuzz_stream writes its input file (left behind when it crashes). One binary holds every
-# harness (tests/fuzz_smoke.c, FUZZ_TARGET picks one), so the implementation is compiled once.
+# harness (tests/fuzz/smoke.c, FUZZ_TARGET picks one), so the implementation is compiled once.
 FUZZERS="container scene stream multibounce temporal vp"
 s_fuzz() {
     have clang || return 0
@@ -509,16 +509,16 @@ s_fuzz() {
     echo "== fuzz smoke"
     local f
     for f in $FUZZERS; do mkdir -p "$BUILD/fuzz/$f"; done
-    if ! { build make-corpus $CC -std=c99 -O2 -I. fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
+    if ! { build make-corpus $CC -std=c99 -O2 -I. tests/fuzz/make_corpus.c -o "$BUILD/make_corpus" -lm &&
            "$BUILD/make_corpus" "$BUILD/fuzz"; }; then
         fail fuzz-corpus; return
     fi
     rm -f "$BUILD/fuzz_smoke"
-    if ! build fuzz-smoke clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. tests/fuzz_smoke.c -o "$BUILD/fuzz_smoke" -lm; then
+    if ! build fuzz-smoke clang -std=c99 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -I. tests/fuzz/smoke.c -o "$BUILD/fuzz_smoke" -lm; then
         fail "fuzz (build)"; return
     fi
     for f in $FUZZERS; do
-        if { ! ls fuzz/crashes/"$f"-* >/dev/null 2>&1 || FUZZ_TARGET=$f "$BUILD/fuzz_smoke" fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
+        if { ! ls tests/fuzz/crashes/"$f"-* >/dev/null 2>&1 || FUZZ_TARGET=$f "$BUILD/fuzz_smoke" tests/fuzz/crashes/"$f"-* >"$BUILD/fuzz-$f.log" 2>&1; } &&
            FUZZ_TARGET=$f "$BUILD/fuzz_smoke" -max_total_time="${RAD_FUZZ_SECONDS:-15}" -rss_limit_mb=2048 -artifact_prefix="$BUILD/fuzz-$f-" \
                "$BUILD/fuzz/$f" >"$BUILD/fuzz-$f.log" 2>&1; then
             pass "fuzz-$f ($(grep -o 'Done [0-9]* runs' "$BUILD/fuzz-$f.log"))"

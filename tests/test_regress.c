@@ -1,10 +1,10 @@
 /* test_regress.c - regressions found by fuzzing and review, one test each, with where they
-   came from. The fuzzers' crash inputs live in fuzz/crashes and are replayed by the fuzz
+   came from. The fuzzers' crash inputs live in tests/fuzz/crashes and are replayed by the fuzz
    smoke suite. */
 #include "fixtures.h"
 
 
-/* fuzz_scene, fuzz/crashes/scene-nonfinite-1: a point light 1e-20 from a surface gave
+/* fuzz_scene, tests/fuzz/crashes/scene-nonfinite-1: a point light 1e-20 from a surface gave
    irradiance 1/d^2 = inf (here a 1e-15 quad with the light 1e-21 above it). Outputs must never carry Inf: the call reports NON_FINITE. */
 static void rg_test_point_light_overflow(void)
 {
@@ -72,7 +72,7 @@ static void rg_test_emission_overflow(void)
     rad_scene_destroy(s);
 }
 
-/* fuzz_scene, fuzz/crashes/scene-ff-nonfinite: a patch of area 4e-38 beside patches of area
+/* fuzz_scene, tests/fuzz/crashes/scene-ff-nonfinite: a patch of area 4e-38 beside patches of area
    1e3: the reciprocity factor A_j / A_i overflowed float and 0 * inf gave NaN form factors.
    Pairs are now integrated from the smaller patch, so the factor is at most 1. */
 static void rg_test_extreme_area_ratio(void)

@@ -1,8 +1,8 @@
-/* test_shading_vulkan.c - the GLSL lighting models (glsl/lighting.glsl) against the C ones
+/* test_shading_vulkan.c - the GLSL lighting models (tools/glsl/lighting.glsl) against the C ones
    (radiosity.h >>shading) on a Vulkan 1.1 compute device (Mesa's lavapipe is enough).
    Builds a few thousand cases (every model, both NDFs, both G2 forms, every diffuse term,
    isotropic and anisotropic, random directions including back-facing ones), compiles
-   glsl/lighting_eval.comp with glslangValidator at run time, runs it, and compares f, R and
+   tools/glsl/lighting_eval.comp with glslangValidator at run time, runs it, and compares f, R and
    every term function (sv_terms) value by value: |gpu - c| <= 1e-5 |c| + 1e-6 max|c of that case| + 1e-12. The second
    part matters only where a term cancels to nearly 0 inside a larger value; the third only
    far outside a specular lobe, where values below 1e-12 sr^-1 come from exp() of a large

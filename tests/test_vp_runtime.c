@@ -89,7 +89,7 @@ static void vpr_test_sparse_rows(void)
     CHECK(sd.live - st.live == 4LL * N * N - 8LL * (long long)above - 8LL * (N + 1));
     CHECK(rad_vp_memory(vd) - rad_vp_memory(vt) == (size_t)(4LL * N * N - 8LL * (long long)above - 8LL * (N + 1)));
     /* the chunked build ran (64 KiB of rows at a time in this suite, under half the matrix)
-       and gave the dense build's bits above; its peak is measured on Sponza (BENCHMARKS.md) */
+       and gave the dense build's bits above; its peak is measured on Sponza (docs/BENCHMARKS.md) */
     CHECK(RAD_VP_ROW_CHUNK_BYTES < 4u * N * N / 2u);
 out:
     rad_vp_destroy(vd);

@@ -1462,7 +1462,7 @@ done:
 /* ---- lightmaps: the refresh from a new patch irradiance ---------------------------------------- */
 
 /* RAD_GLSL_LIGHTMAP_REFRESH against rad_lightmap_refresh: the Cornell box with one atlas cell per
-   quad (as bench/lightmap.c), weights with detail factors from a first refresh, a random patch
+   quad (as tests/bench/lightmap.c), weights with detail factors from a first refresh, a random patch
    irradiance; both passes in three chunks whose entry ranges are bound at offsets */
 static void test_lightmap_refresh(void)
 {
@@ -1729,18 +1729,18 @@ static void test_push_mirrors(void)
 
 /* ---- the lighting include, as a user compiles it from memory ----------------------------------- */
 
-/* glsl/lighting_eval.comp (the kernel tests/test_shading_vulkan.c runs against the C models)
+/* tools/glsl/lighting_eval.comp (the kernel tests/test_shading_vulkan.c runs against the C models)
    with its #include replaced by the header's RAD_GLSL_LIGHTING text, as its comment tells a host
    without an includer to do, compiled by glslangValidator: the embedded include is usable as is */
 static void test_lighting_include(void)
 {
-    FILE *f = fopen("glsl/lighting_eval.comp", "rb");
+    FILE *f = fopen("tools/glsl/lighting_eval.comp", "rb");
     char *eval = NULL, *inc = NULL, path[600], cmd[2000];
     long n;
     size_t len = 0;
     const char *line;
     g_worst_what = "";
-    if (!f) { printf("    (glsl/lighting_eval.comp not found: run from the repository root)\n"); T_CHECK(0); return; }
+    if (!f) { printf("    (tools/glsl/lighting_eval.comp not found: run from the repository root)\n"); T_CHECK(0); return; }
     fseek(f, 0, SEEK_END);
     n = ftell(f);
     fseek(f, 0, SEEK_SET);

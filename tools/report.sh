@@ -9,13 +9,13 @@
 #                        [--realtime-bench PATH] [--real-only]
 #   bash tools/report.sh --check DIR      only check DIR/REPORT.md (every cell, every image)
 #
-# `make report` runs the full quality into report/ (committed); `make report-quick` a reduced
+# `make report` runs the full quality into tests/report/ (committed); `make report-quick` a reduced
 # one into build/report-quick/ and then --check (tests/run.sh counts it as a test).
 # Scenes: the built-in Cornell box, and the Stanford bunny in the box (the box from `rad export
 # cornell`, the bunny from RAD_DATA_DIR/stanford-bunny.obj: no default; the section says so and is
 # skipped when the file is absent); real scenes (full and medium quality): the Dabrovic Sponza
 # from RAD_DATA_DIR/sponza.obj under a sun and under a sky window, every method that runs a real
-# scene against `rad trace`, and the real-time loop of build/bench_realtime (bench/realtime.c;
+# scene against `rad trace`, and the real-time loop of build/bench_realtime (tests/bench/realtime.c;
 # with the bunny and ogre too when RAD_DATA_DIR holds them); skipped, saying why, without the
 # file or in quick mode. --real-only runs that section alone.
 #
@@ -142,7 +142,7 @@ compare() {
 
 # the bunny in the box: the built-in box (`rad export cornell`: its white material is m0_white)
 # without its two blocks, plus the bunny scaled to 0.25 m and standing in the middle of the floor
-# (as bench/rays.c places it)
+# (as tests/bench/rays.c places it)
 make_bunny_scene() {
     local dir=$1
     [ -n "$DATA" ] && [ -f "$DATA/stanford-bunny.obj" ] || return 1
@@ -226,7 +226,7 @@ run_scene() {
 # ---- real scenes: the Dabrovic Sponza, a real building ------------------------------------------
 # The view and lights of docs/performance-notes.md ("Row sums matched to traced shares"); the
 # model has no materials, so the script writes a copy with the one stone material that
-# bench/realtime.c gives it. Virtual patches at about 2k and 12k (the resolutions of the
+# tests/bench/realtime.c gives it. Virtual patches at about 2k and 12k (the resolutions of the
 # performance notes: AAVP 11 and 28, VP 10 and 23), then temporal and the lightmap over the 2k
 # AAVP set, so their rows differ from the AAVP 2k row only by the method.
 REAL_CAM="--camera -10,3,0:10,4,0:0,1,0 --fov 60"
@@ -335,7 +335,7 @@ run_real_scenes() {
         return
     fi
     {
-        echo "The Dabrovic Sponza atrium ($(grep -c '^f ' "$TMP/sponza.obj") faces in \`RAD_DATA_DIR/sponza.obj\`, docs/data.md; the script gives it one stone material, albedo 0.7 0.68 0.63, as bench/realtime.c does),"
+        echo "The Dabrovic Sponza atrium ($(grep -c '^f ' "$TMP/sponza.obj") faces in \`RAD_DATA_DIR/sponza.obj\`, docs/data.md; the script gives it one stone material, albedo 0.7 0.68 0.63, as tests/bench/realtime.c does),"
         echo "lit by a sun and, separately, by a sky window (a one-sided rectangle above the open roof, facing down, so most of the"
         echo "building sees only bounced light). The dense methods (classic, multi-bounce, temporal and local over patches) need at least one patch"
         echo "per triangle and an N x N matrix (66k triangles: 17.7 GB), so they are not run; the virtual patches are the methods for"
@@ -349,11 +349,11 @@ run_real_scenes() {
     } >> "$TMP/real.md"
     run_real sponza-sun "Sponza under a sun (\`--sun 0.3,-1,0.2:3\`)" "--sun 0.3,-1,0.2:3"
     run_real sponza-sky "Sponza under a sky window (\`--area -18,16.5,-8:36,0,0:0,0,16:1\`)" "--area -18,16.5,-8:36,0,0:0,0,16:1"
-    # the real-time loop (bench/realtime.c): per-frame stages at about 2k and 12k AAVP
+    # the real-time loop (tests/bench/realtime.c): per-frame stages at about 2k and 12k AAVP
     local rt=$OUT/data/realtime.md rtq="" box=""
     [ "$MODE" = full ] || rtq=--quick
     : > "$rt"
-    printf '\n### The real-time loop (bench/realtime.c) beside the thesis'"'"'s Table 3\n\n' >> "$TMP/real.md"
+    printf '\n### The real-time loop (tests/bench/realtime.c) beside the thesis'"'"'s Table 3\n\n' >> "$TMP/real.md"
     if [ ! -x "$RTBENCH" ]; then
         echo "FAILED: \`$RTBENCH\` is not built (\`make build/bench_realtime\`)." >> "$TMP/real.md"
         return
@@ -368,7 +368,7 @@ run_real_scenes() {
         run_timed "$OUT/data/realtime-box.log" "$RTBENCH" --data "$DATA" --scene box --size 2000 --append "$rt" && box=1
     fi
     {
-        echo "bench/realtime.c (the loop of examples/realtime.c), \`$(basename "$RTBENCH") $rtq${rtq:+ }--scene sponza\`$([ -n "$box" ] && echo " and \`--scene box --size 2000\` (the bunny and the ogre, 193k triangles, in the Cornell box)"): a sun and a point light"
+        echo "tests/bench/realtime.c (the loop of examples/realtime.c), \`$(basename "$RTBENCH") $rtq${rtq:+ }--scene sponza\`$([ -n "$box" ] && echo " and \`--scene box --size 2000\` (the bunny and the ogre, 193k triangles, in the Cornell box)"): a sun and a point light"
         echo "circling the scene; per frame the E update of the virtual patches, one temporal step (k 10, feedback) and the"
         echo "per-vertex gather, medians in ms; lag = frames after the point light jumps until the error is back to its noise"
         echo "(fixed w 0.9 exact E / M/4 rays / adaptive w); power, RMS and vertex L1 = the converged temporal solution against"
@@ -408,7 +408,7 @@ if make_bunny_scene "$TMP"; then
     run_scene bunny "Stanford bunny in the Cornell box" "$TMP/bunny-box.obj" "$BUNNY_SIZE" "$BUNNY_SPP" "$((tris + 0))"
     {
         printf '\nThe bunny scene is the built-in Cornell box (`rad export cornell`) without its two blocks plus `RAD_DATA_DIR/stanford-bunny.obj` (docs/data.md) scaled to 0.25 m and standing in the middle of the floor (written by this script). '
-        printf 'The `rad` tool makes at least one patch per triangle and stores F densely: with %s triangles that is a %s GB matrix (this machine: %s GB of memory) and about %s patch pairs of form factors, which at the measured ~1 Mpairs/s (BENCHMARKS.md a) is hours, so the dense methods (classic, multi-bounce, temporal) were not run on it. The virtual patches are the method meant for it (the local method of rad fetches its rows from the classic dense F, so it is not run here either).\n' \
+        printf 'The `rad` tool makes at least one patch per triangle and stores F densely: with %s triangles that is a %s GB matrix (this machine: %s GB of memory) and about %s patch pairs of form factors, which at the measured ~1 Mpairs/s (docs/BENCHMARKS.md a) is hours, so the dense methods (classic, multi-bounce, temporal) were not run on it. The virtual patches are the method meant for it (the local method of rad fetches its rows from the classic dense F, so it is not run here either).\n' \
             "$tris" "$(awk -v t="$tris" 'BEGIN { printf "%.1f", 4 * t * t / 1e9 }')" \
             "$(awk '/MemTotal/ { printf "%.0f", $2 / 1048576 }' /proc/meminfo)" "$(awk -v t="$tris" 'BEGIN { printf "%.1e", t * t / 2 }')"
     } >> "$TMP/scenes.md"
@@ -416,10 +416,10 @@ else
     printf '\n## Stanford bunny in the Cornell box\n\nSkipped: %s; set RAD_DATA_DIR to the directory that holds `stanford-bunny.obj`.\n' "$([ -n "$DATA" ] && echo "\`$DATA/stanford-bunny.obj\` not found" || echo "RAD_DATA_DIR is not set")" >> "$TMP/scenes.md"
 fi
 
-# ---- plot 1 and 2: temporal against the matrix-vector product (bench/temporal) -------------
+# ---- plot 1 and 2: temporal against the matrix-vector product (tests/bench/temporal) -------------
 TAB_T="$OUT/data/temporal.md"
 : > "$TAB_T"
-log "temporal against matrix-vector, N = $TSIZES (bench/temporal)"
+log "temporal against matrix-vector, N = $TSIZES (tests/bench/temporal)"
 if [ -x "$TBENCH" ] && "$TBENCH" --sizes "$TSIZES" --append "$TAB_T" --csv "$OUT/data/temporal_error.csv" > "$OUT/data/temporal.log" 2>&1; then
     # rows "| N (target) | step10 | step64 | MV | ..."
     {
@@ -574,7 +574,7 @@ MD="$OUT/REPORT.md"
     echo "## Temporal radiosity against the matrix-vector product (T table 1)"
     echo
     if [ "$T_OK" = 1 ]; then
-        echo "\`build/temporal --sizes $TSIZES\` (bench/temporal.c; the same code as \`make bench\`): Cornell box, single"
+        echo "\`build/temporal --sizes $TSIZES\` (tests/bench/temporal.c; the same code as \`make bench\`): Cornell box, single"
         echo "bounce, one thread. Times are medians in ms; the published column is T's RTX 3060 measurement."
         echo
         awk '/^\| N \(target\)/ { on = 1 } on && /^\|/ { print } on && !/^\|/ && NR > 1 { if (printed) exit } on && /^\|/ { printed = 1 }' "$TAB_T" | sed 's/| - |/| none (not a size T measured) |/'
@@ -628,7 +628,7 @@ MD="$OUT/REPORT.md"
     echo "## Raw data"
     echo
     echo "data/: the log of every command (the timing lines, the compression reports; *.log.time: wall time and peak memory),"
-    echo "metrics.txt and real-metrics.txt (id, method, MSE, PSNR, SSIM, [mean ratio,] ms), realtime.md (bench/realtime.c's tables), temporal.md"
+    echo "metrics.txt and real-metrics.txt (id, method, MSE, PSNR, SSIM, [mean ratio,] ms), realtime.md (tests/bench/realtime.c's tables), temporal.md"
     echo "(the bench's tables), the plots' data files (.dat). Regenerate: \`make report\` (about $((T_ALL / 60 + 1)) min here)."
 } > "$MD"
 log "wrote $MD in $T_ALL s"

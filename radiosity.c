@@ -1,2 +1,0 @@
-#define RADIOSITY_IMPLEMENTATION
-#include "radiosity.h"
