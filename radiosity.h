@@ -4692,6 +4692,28 @@ static void rad__hammersley(uint32_t s, uint32_t n, float r1, float r2, float *u
     *u2 = b;
 }
 
+/* Point k of the first two dimensions of Sobol's sequence (the van der Corput bits, then the
+   second dimension's generator, whose columns are the rows of Pascal's triangle mod 2), each
+   XORed with a scramble (x1, x2), in the open unit square. Any 2^m consecutive points starting
+   at a multiple of 2^m hold one point in each of the 2^m boxes of every dyadic shape (a
+   (0, m, 2)-net), and XOR keeps that true whatever the scramble: consecutive blocks of a
+   sample budget each stratify on their own and together, and any prefix is well spread. */
+static void rad__sobol2(uint32_t k, uint32_t x1, uint32_t x2, float *u1, float *u2)
+{
+    uint32_t a = k, b = 0u, v = 0x80000000u, i;
+    a = (a << 16) | (a >> 16);
+    a = ((a & 0x00ff00ffu) << 8) | ((a & 0xff00ff00u) >> 8);
+    a = ((a & 0x0f0f0f0fu) << 4) | ((a & 0xf0f0f0f0u) >> 4);
+    a = ((a & 0x33333333u) << 2) | ((a & 0xccccccccu) >> 2);
+    a = ((a & 0x55555555u) << 1) | ((a & 0xaaaaaaaau) >> 1);
+    for (i = k; i; i >>= 1, v ^= v >> 1)
+        if (i & 1u) b ^= v;
+    a ^= x1, b ^= x2;
+    /* 24 bits and half a step: strictly inside (0, 1), as a float holds them exactly */
+    *u1 = ((float)(a >> 8) + 0.5f) * (1.0f / 16777216.0f);
+    *u2 = ((float)(b >> 8) + 0.5f) * (1.0f / 16777216.0f);
+}
+
 /* Uniform point on triangle (v0, v1, v2) from (u1, u2) by the square-root map. */
 static void rad__triangle_point(const float *v0, const float *v1, const float *v2, float u1, float u2, float *out)
 {
@@ -7265,6 +7287,7 @@ RAD_API void rad_camera_ray(const rad_camera *cam, uint32_t width, uint32_t heig
 
 /* functions defined in later sections, used here (written by reorder.py) */
 static double rad__ff_point_tri(const double *p, const double *n, const float *v);
+static int rad__clip_tri(const double *p, const double *n, const float *v, double d[3], double (*out)[3]);
 /* end of functions defined in later sections */
 
 /* The defaults of rad_direct_options, written once: every consumer and
@@ -7442,18 +7465,26 @@ static void rad__tangent_frame(const float *n, float *t1, float *t2)
     rad__cross(t2, n, t1);
 }
 
-/* Direction s of n cosine-distributed ones around n (frame t1, t2): Hammersley point s of n,
-   rotated by the two 16-bit halves of h, lifted from the disk. */
-static void rad__cosine_dir(const float *n, const float *t1, const float *t2, uint32_t s, uint32_t count, uint32_t h,
-                            float *dir)
+/* The cosine-distributed direction around n (frame t1, t2) of (u1, u2) in the unit square,
+   lifted from the disk. */
+static void rad__cosine_lift(const float *n, const float *t1, const float *t2, float u1, float u2, float *dir)
 {
-    float u1, u2, rr, ph;
+    float rr, ph;
     int k;
-    rad__hammersley(s, count, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
     rr = (float)sqrt((double)u1);
     ph = (float)(2.0 * RAD__PI) * u2;
     for (k = 0; k < 3; ++k)
         dir[k] = t1[k] * rr * (float)cos((double)ph) + t2[k] * rr * (float)sin((double)ph) + n[k] * (float)sqrt((double)(1.0f - u1));
+}
+
+/* Direction s of n cosine-distributed ones around n (frame t1, t2): Hammersley point s of n,
+   rotated by the two 16-bit halves of h. */
+static void rad__cosine_dir(const float *n, const float *t1, const float *t2, uint32_t s, uint32_t count, uint32_t h,
+                            float *dir)
+{
+    float u1, u2;
+    rad__hammersley(s, count, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
+    rad__cosine_lift(n, t1, t2, u1, u2, dir);
 }
 
 /* ---- environment map ---- */
@@ -7673,22 +7704,23 @@ RAD_API float rad_environment_sample(const rad_environment *e, float u1, float u
    onto a one-texel sun add 1/m_e of its light to that point; the power heuristic gives it
    almost no weight. */
 static rad_result rad__direct_env(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
-                                  const rad_light *li, uint32_t l, uint32_t slot, float scale, uint32_t seed)
+                                  const rad_light *li, uint32_t l, uint32_t slot, float scale, uint32_t seed, uint32_t index)
 {
     const rad_environment *e = li->environment;
     uint32_t L = d->o.light_samples, me = (L + 1u) / 2u, mc = L - me, s, h = rad__hash(seed ^ 0x27d4eb2fu ^ l);
+    uint32_t hc = rad__hash(h + 0x85ebca6bu);
     float t1[3], t2[3];
     rad_result r;
     int k;
     rad__tangent_frame(n, t1, t2);
     for (s = 0; s < L; ++s) {
-        float dir[3], rgb[3], w[3], cosn, pe, pc, den;
+        float dir[3], rgb[3], w[3], cosn, pe, pc, den, u1, u2;
         if (s < me) {
-            float u1, u2;
-            rad__hammersley(s, me, (float)(h & 0xFFFFu) / 65536.0f, (float)(h >> 16) / 65536.0f, &u1, &u2);
+            rad__sobol2(index * me + s, h, rad__hash(h ^ 0x3c6ef372u), &u1, &u2);
             if (!(rad_environment_sample(e, u1, u2, dir) > 0.0f)) continue;
         } else {
-            rad__cosine_dir(n, t1, t2, s - me, mc, rad__hash(h + 0x85ebca6bu), dir);
+            rad__sobol2(index * mc + s - me, hc, rad__hash(hc ^ 0x3c6ef372u), &u1, &u2);
+            rad__cosine_lift(n, t1, t2, u1, u2, dir);
         }
         cosn = rad__dot(dir, n);
         if (!(cosn > 0.0f)) continue;
@@ -7817,11 +7849,95 @@ RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, 
     return RAD_SUCCESS;
 }
 
-/* all lights at one point into slot, each contribution times 'scale' */
-static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
-                                    uint32_t slot, float scale, uint32_t seed)
+/* ---- emitters sampled by solid angle ---- */
+
+/* One spherical triangle (unit vectors a, b, c seen from the receiver) set up for Arvo's (1995)
+   area-preserving map of the unit square onto it: u1 picks the sub-triangle a, b, c' of solid
+   angle u1 times the whole (c' on the arc from a to c), u2 the point on the arc from b to c'
+   that keeps the density uniform. */
+typedef struct rad__sph_tri {
+    double a[3], b[3], cp[3];      /* cp: the unit tangent at a towards c */
+    double ca, sa, alpha, cab;     /* cos, sin of the angle alpha at a; cos of the arc a b */
+    double area;                   /* solid angle (sr) */
+} rad__sph_tri;
+
+static double rad__ddot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* the unit normal of the great circle through unit vectors a and b: 0 when they coincide */
+static int rad__arc_normal(const double *a, const double *b, double *o)
 {
-    uint32_t l, s, L = d->o.light_samples;
+    double l;
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+    l = sqrt(rad__ddot(o, o));
+    if (!(l > 1e-12)) return 0;
+    o[0] /= l, o[1] /= l, o[2] /= l;
+    return 1;
+}
+
+static double rad__clamp1(double x) { return x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x); }
+
+/* 0 when the triangle is too thin or too small for the map to hold in double (the caller
+   samples such an emitter by area, where its kernel hardly varies) */
+static int rad__sph_tri_setup(rad__sph_tri *s, const double *a, const double *b, const double *c)
+{
+    double nab[3], nbc[3], nca[3], beta, gamma, l;
+    int k;
+    if (!rad__arc_normal(a, b, nab) || !rad__arc_normal(b, c, nbc) || !rad__arc_normal(c, a, nca)) return 0;
+    s->alpha = acos(rad__clamp1(-rad__ddot(nab, nca)));
+    beta = acos(rad__clamp1(-rad__ddot(nbc, nab)));
+    gamma = acos(rad__clamp1(-rad__ddot(nca, nbc)));
+    s->area = s->alpha + beta + gamma - RAD__PI;
+    s->ca = cos(s->alpha), s->sa = sin(s->alpha);
+    s->cab = rad__ddot(a, b);
+    l = rad__ddot(c, a);
+    for (k = 0; k < 3; ++k) s->cp[k] = c[k] - l * a[k], s->a[k] = a[k], s->b[k] = b[k];
+    l = sqrt(rad__ddot(s->cp, s->cp));
+    if (!(s->area > 1e-7) || !(s->sa > 1e-6) || !(l > 1e-12)) return 0;
+    for (k = 0; k < 3; ++k) s->cp[k] /= l;
+    return 1;
+}
+
+/* the unit direction of (u1, u2) in the unit square: uniform in solid angle over the triangle */
+static void rad__sph_tri_sample(const rad__sph_tri *s, double u1, double u2, double *dir)
+{
+    double ah = u1 * s->area - s->alpha, sn = sin(ah), cs = cos(ah), u = cs - s->ca, v = sn + s->sa * s->cab;
+    double den = (v * sn + u * cs) * s->sa, q = den != 0.0 ? rad__clamp1(((v * cs - u * sn) * s->ca - v) / den) : 1.0;
+    double c2[3], w[3], z, l, rq = sqrt(1.0 - q * q), rz;
+    int k;
+    for (k = 0; k < 3; ++k) c2[k] = q * s->a[k] + rq * s->cp[k];
+    z = rad__clamp1(1.0 - u2 * (1.0 - rad__ddot(c2, s->b)));
+    l = rad__ddot(c2, s->b);
+    for (k = 0; k < 3; ++k) w[k] = c2[k] - l * s->b[k];
+    l = sqrt(rad__ddot(w, w));
+    rz = sqrt(1.0 - z * z);
+    for (k = 0; k < 3; ++k) dir[k] = l > 1e-15 ? z * s->b[k] + rz * w[k] / l : s->b[k];
+}
+
+/* Shadow rays for one emitter at one point, from its form factor F there: L times the
+   smallest power of two m >= RAD__EMITTER_RAYS_MAX F, m from 1 to RAD__EMITTER_RAYS_MAX (and
+   at most RAD__MAX_SAMPLES rays). The rays follow the share of the point's irradiance the
+   emitter can give, so that a large emitter seen through an opening is not the noisy part of
+   the image while a small one costs what it did; a power of two, so that the neighbouring
+   points of a row (which mostly take the same count) cover whole blocks of the sequence. */
+#define RAD__EMITTER_RAYS_MAX 4u
+static uint32_t rad__emitter_rays(uint32_t L, float F)
+{
+    double f = (double)F * (double)RAD__EMITTER_RAYS_MAX;
+    uint32_t m = 1u;
+    while (m < RAD__EMITTER_RAYS_MAX && (double)m < f) m *= 2u;
+    return m * L > RAD__MAX_SAMPLES ? (L > RAD__MAX_SAMPLES ? L : RAD__MAX_SAMPLES) : m * L;
+}
+
+/* all lights at one point into slot, each contribution times 'scale'; 'seed' scrambles the
+   row's sample sequences and 'index' is the point's place in its row: point i takes samples
+   i * stride .. of each light's sequence, so the points of a row (a pixel's samples, a patch's
+   lattice) share one stratification instead of each drawing its own */
+static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
+                                    uint32_t slot, float scale, uint32_t seed, uint32_t index)
+{
+    uint32_t l, s, L = d->o.light_samples, base = index * L;
     rad_result r;
     int k;
     for (l = 0; l < d->light_count; ++l) {
@@ -7838,16 +7954,17 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
         } else if (li->type == RAD_LIGHT_SKY) {
             /* cosine-weighted directions: unoccluded fraction of the hemisphere times E_0 */
             float t1[3], t2[3];
-            uint32_t h = rad__hash(seed ^ 0x5bd1e995u ^ l);
+            uint32_t h = rad__hash(seed ^ 0x5bd1e995u ^ l), h2 = rad__hash(h ^ 0x3c6ef372u);
             rad__tangent_frame(n, t1, t2);
             for (s = 0; s < L; ++s) {
-                float dir[3];
-                rad__cosine_dir(n, t1, t2, s, L, h, dir);
+                float dir[3], u1, u2;
+                rad__sobol2(base + s, h, h2, &u1, &u2);
+                rad__cosine_lift(n, t1, t2, u1, u2, dir);
                 r = rad__direct_ray(d, task, nrays, p, n, NULL, NULL, dir, li->color, scale / (float)L, slot);
                 if (r != RAD_SUCCESS) return r;
             }
         } else if (li->type == RAD_LIGHT_ENVIRONMENT) {
-            r = rad__direct_env(d, task, nrays, p, n, li, l, slot, scale, seed);
+            r = rad__direct_env(d, task, nrays, p, n, li, l, slot, scale, seed, index);
             if (r != RAD_SUCCESS) return r;
         }
     }
@@ -7856,48 +7973,82 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
         float ys[3 * RAD__MAX_SAMPLES];
         for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
         for (l = 0; l < d->emitter_count; ++l) {
-            uint32_t t = d->emitters[l], h;
+            uint32_t t = d->emitters[l], h1, h2, ne, nst = 0;
             const float *tv = d->S->positions + 9 * (size_t)t, *tn = d->S->normals + 3 * (size_t)t;
             const float *Le = d->S->materials_table[d->S->materials[t]].emission;
-            int textured = rad__emission_textured(d->S, t);
-            float dv[3], F, w[3], r1, r2, Ls[3 * RAD__MAX_SAMPLES];
+            int textured = rad__emission_textured(d->S, t), m;
+            float dv[3], F, w[3], Ls[3 * RAD__MAX_SAMPLES];
+            double q[4][3], hq[3], area = 0.0, tnd[3], plane;
+            rad__sph_tri st[2];
             rad__sub(dv, p, tv);
             if (!(rad__dot(dv, tn) > 0.0f)) continue; /* behind the emitter, or on its plane */
             F = (float)fabs(rad__ff_point_tri(P, N, tv));
             if (!(F > 0.0f)) continue;
             for (k = 0; k < 3; ++k) w[k] = (float)RAD__PI * Le[k] * F;
-            h = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
-            r1 = (float)(h & 0xFFFFu) / 65536.0f;
-            r2 = (float)(h >> 16) / 65536.0f;
-            /* Each shadow ray carries its sample's share of the kernel cos cos / r^2 (zero
-               behind p's plane): the visible fraction is then weighted as the form factor
-               weights the emitter's points. Equal shares were exact only when visibility does
-               not depend on where the point lies (a large emitter seen through an opening got
-               a fraction of its light). Unoccluded, the shares sum to the analytic F.
-               With an emission texture each ray also carries the radiance at its sample
-               point (relative to the factor Le): the analytic F times the kernel-weighted mean
-               of the texture over the L points, so the emitter's power follows its texture
-               (exact for a constant texture, a quadrature of L points otherwise). */
+            ne = rad__emitter_rays(L, F);
+            base = index * ne;
+            h1 = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
+            h2 = rad__hash(h1 ^ 0x3c6ef372u);
+            /* The triangle's part above p's plane as one or two spherical triangles seen from p;
+               sampled uniformly in solid angle, a ray's share of the form factor is its cosine
+               at p, so the shares of the visible rays measure the light of the visible part
+               (the analytic F times that ratio). Too thin or too far to map: area samples
+               weighted by the whole kernel cos cos / r^2 instead, which is then nearly
+               constant over the triangle. */
+            m = rad__clip_tri(P, N, tv, hq, q);
+            if (m >= 3) {
+                double u[4][3], len;
+                int i, ok = 1;
+                for (i = 0; i < m && ok; ++i) {
+                    len = sqrt(rad__ddot(q[i], q[i]));
+                    ok = len > 0.0;
+                    for (k = 0; k < 3 && ok; ++k) u[i][k] = q[i][k] / len;
+                }
+                for (i = 0; i + 2 < m && ok; ++i) ok = rad__sph_tri_setup(&st[i], u[0], u[i + 1], u[i + 2]);
+                if (ok) {
+                    nst = (uint32_t)(m - 2);
+                    area = st[0].area + (nst > 1 ? st[1].area : 0.0);
+                }
+            }
+            for (k = 0; k < 3; ++k) tnd[k] = tn[k];
+            plane = ((double)tv[0] - P[0]) * tnd[0] + ((double)tv[1] - P[1]) * tnd[1] + ((double)tv[2] - P[2]) * tnd[2];
             ksum = 0.0;
-            for (s = 0; s < L; ++s) {
-                float u1, u2, *y = ys + 3 * s, dy[3], r2y;
+            for (s = 0; s < ne; ++s) {
+                float u1, u2, *y = ys + 3 * s, b1, b2;
                 double kern;
-                rad__hammersley(s, L, r1, r2, &u1, &u2);
-                rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
+                rad__sobol2(base + s, h1, h2, &u1, &u2);
+                if (nst > 0) {
+                    double x = (double)u1 * area, dir[3], dn;
+                    const rad__sph_tri *sp = &st[0];
+                    if (nst > 1 && x >= st[0].area) x -= st[0].area, sp = &st[1];
+                    rad__sph_tri_sample(sp, x / sp->area, (double)u2, dir);
+                    dn = rad__ddot(dir, tnd);
+                    kern = dn < 0.0 ? rad__ddot(dir, N) : 0.0;
+                    for (k = 0; k < 3; ++k) y[k] = (float)(P[k] + dir[k] * (dn < 0.0 ? plane / dn : 0.0));
+                    if (textured) rad__barycentric(tv, y, &b1, &b2);
+                } else {
+                    float dy[3], r2y, su;
+                    rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
+                    su = (float)sqrt((double)u1);
+                    b1 = u2 * su, b2 = su * (1.0f - u2);
+                    rad__sub(dy, y, p);
+                    r2y = rad__dot(dy, dy);
+                    kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
+                }
+                /* With an emission texture each ray also carries the radiance at its point
+                   (relative to the factor Le): F times the share-weighted mean of the texture,
+                   so the emitter's power follows its texture. */
                 if (textured) {
-                    float su = (float)sqrt((double)u1), e[3];
-                    rad_result re = rad__emission_at(d->S, t, u2 * su, su * (1.0f - u2), d->c, e);
+                    float e[3];
+                    rad_result re = rad__emission_at(d->S, t, b1, b2, d->c, e);
                     if (re != RAD_SUCCESS) return re;
                     for (k = 0; k < 3; ++k) Ls[3 * s + k] = Le[k] > 0.0f ? e[k] / Le[k] : 0.0f;
                 }
-                rad__sub(dy, y, p);
-                r2y = rad__dot(dy, dy);
-                kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
                 ks[s] = kern > 0.0 ? kern : 0.0;
                 ksum += ks[s];
             }
-            for (s = 0; s < L; ++s) {
-                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)L, ws[3];
+            for (s = 0; s < ne; ++s) {
+                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)ne, ws[3];
                 if (!(share > 0.0f)) continue;
                 if (textured) {
                     for (k = 0; k < 3; ++k) ws[k] = w[k] * Ls[3 * s + k];
@@ -7930,7 +8081,7 @@ static rad_result rad__direct_row(void *data, uint32_t row, uint32_t task)
         for (s = 0; s < S && r == RAD_SUCCESS; ++s) {
             float x[3];
             rad__lattice_point(v, v + 3, v + 6, rad__lattice_side(S), s, x);
-            r = rad__direct_point(d, task, &nrays, x, pt->normal, 0, 1.0f / (float)S, rad__hash(seed + s));
+            r = rad__direct_point(d, task, &nrays, x, pt->normal, 0, 1.0f / (float)S, seed, s);
         }
         if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
         if (r != RAD_SUCCESS) return r;
@@ -7942,7 +8093,7 @@ static rad_result rad__direct_row(void *data, uint32_t row, uint32_t task)
     for (i = 0; i < 3 * count; ++i) acc[i] = 0.0;
     for (i = 0; i < count && r == RAD_SUCCESS; ++i) {
         const float *p = d->points + 3 * (size_t)(first + i), *n = d->normals + 3 * (size_t)(first + i);
-        r = rad__direct_point(d, task, &nrays, p, n, i, 1.0f, rad__hash(seed + i));
+        r = rad__direct_point(d, task, &nrays, p, n, i, 1.0f, seed, i);
     }
     if (r == RAD_SUCCESS) r = rad__direct_flush(d, task, nrays);
     if (r != RAD_SUCCESS) return r;
