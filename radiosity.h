@@ -865,8 +865,9 @@ RAD_API rad_result rad_sun_direction(float latitude_degrees, float day_of_year, 
 typedef struct rad_direct_options {
     uint32_t samples;          /* points per patch (0: 16), rounded to a square n*n: the centroids
                                   of the patch's n x n sub-triangles */
-    uint32_t light_samples;    /* shadow rays per point per area light, sky and environment
-                                  map (0: 16) */
+    uint32_t light_samples;    /* shadow rays per point per sky and environment map, and per
+                                  emissive triangle 1 to 4 times as many by its form factor
+                                  there (0: 16) */
     int exclude_emitters;      /* 0 (default): emissive triangles are area lights; non-zero
                                   leaves them out (only the lights given) */
     float ray_epsilon;         /* relative to the scene diagonal (0: 1e-5; at most 1e-2) */
@@ -879,10 +880,14 @@ RAD_API void rad_direct_options_default(rad_direct_options *options);
 /* Direct irradiance D (W m^-2, RGB) at arbitrary points with unit normals: the lights, the
    sky (cosine-weighted shadow rays), environment maps (half the rays from the map's
    distribution, half cosine-weighted, MIS) and, unless exclude_emitters, every emissive triangle
-   (analytic point-to-polygon irradiance pi L F times the unoccluded share of 'light_samples'
-   shadow rays, each weighted by its point's cos cos / r^2, so a partly hidden large emitter
-   gets the light of its visible part; with an emission_texture each ray also carries the
-   texture at its point: docs/methods/emission.md). A point receives nothing from behind its normal; normals need not
+   (analytic point-to-polygon irradiance pi L F times the unoccluded share of shadow rays drawn
+   uniformly in solid angle over its part above the point's plane, each weighted by its cosine
+   at the point, so a partly hidden large emitter gets the light of its visible part and an
+   unhidden one exactly pi L F; 'light_samples' rays, up to 4 times as many for an emitter
+   filling much of the hemisphere; with an emission_texture each ray also carries the texture
+   at its point: docs/methods/emission.md). The samples of the points given one after another
+   (64 at a time) come from one stratified sequence, so the points of a pixel or a patch share
+   one stratification; the same seed gives the same bits on any thread count. A point receives nothing from behind its normal; normals need not
    be unit (they are normalized), a zero one is refused. 'samples' is unused here.
    Errors: INVALID_ARGUMENT (bad light type, falloff, direction, spot angles, an environment
    light without a map, a negative min_distance, a zero normal or ray_epsilon outside
