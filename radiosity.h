@@ -25440,7 +25440,7 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
     { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
     { "alias_build.comp", rad__glsl_pieces_6, 2u, 4700u },
-    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9441u },
+    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9447u },
     { "local_apply.comp", rad__glsl_pieces_8, 1u, 3519u },
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
