@@ -21343,99 +21343,69 @@ static rad_result rad__probes_pack(rad_probes *pr, const float *dense, uint32_t 
 #define RAD__PROBES_MAX_GRID (1u << 24)
 #define RAD__PROBES_CHUNK_FLOATS (1u << 22) /* dense scratch per chunk of probes (16 MiB) */
 
-/* rad_probes_create (patches) and rad_probes_create_vp (vp): the same placement, checks and
-   storage; only the gather of the weights differs (rad__pb_gather) */
-static rad_result rad__probes_create(const rad_patches *patches, const rad_virtual_patches *vp,
-                                     const rad_raycaster *raycaster, const rad_light *lights, uint32_t light_count,
-                                     const float *positions, uint32_t count, const rad_probe_options *options,
-                                     const float *B, const rad_context *ctx, rad_probes **out)
+/* rad__probes_create's first stage: the options (resolved by the caller) and the point list checked */
+static rad_result rad__probes_check(rad_probe_options *o, int vp, const float *positions, uint32_t count, rad__ctx *c)
 {
-    rad__ctx c;
-    rad__pb b;
-    rad__direct dv;
-    rad_probes *pr = NULL;
-    const rad_scene *S;
-    rad_result r = RAD_SUCCESS;
-    uint32_t i, T, N, per, first;
-    size_t cap = 0;
-    float ext[3], spacing = 0.0f;
-    int k;
-    rad__ctx_init(&c, ctx);
-    if (out) *out = NULL;
-    if ((vp ? !vp->scene : (!patches || !patches->scene)) || !raycaster || !raycaster->intersect || !raycaster->occluded ||
-        !out) {
-        if (vp && !vp->scene)
-            rad__log(&c, RAD_LOG_ERROR, "probes: the virtual patches have no scene (rad_vp_load with scene NULL)");
-        else
-            rad__log(&c, RAD_LOG_ERROR, "probes: NULL %s, raycaster (with intersect and occluded) or output",
-                     patches || !vp ? "patches" : "virtual patches");
+    if (o->patch_samples > RAD__MAX_SAMPLES) o->patch_samples = RAD__MAX_SAMPLES;
+    if (o->light_samples > RAD__MAX_SAMPLES) o->light_samples = RAD__MAX_SAMPLES;
+    if (o->rays > 65536u || (vp && o->vp_rays > 65536u)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: rays %u or vp_rays %u above 65536", o->rays, o->vp_rays);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    S = vp ? vp->scene : patches->scene;
-    N = vp ? vp->count : patches->count;
-    memset(&b, 0, sizeof(b));
-    if (options) b.o = *options; else memset(&b.o, 0, sizeof(b.o));
-    rad__probe_options_resolve(&b.o);
-    if (b.o.patch_samples > RAD__MAX_SAMPLES) b.o.patch_samples = RAD__MAX_SAMPLES;
-    if (b.o.light_samples > RAD__MAX_SAMPLES) b.o.light_samples = RAD__MAX_SAMPLES;
-    if (b.o.rays > 65536u || (vp && b.o.vp_rays > 65536u)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: rays %u or vp_rays %u above 65536", b.o.rays, b.o.vp_rays);
+    if (!(o->backface_fraction >= 0.0f && o->backface_fraction <= 1.0f)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)o->backface_fraction);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (!(b.o.backface_fraction >= 0.0f && b.o.backface_fraction <= 1.0f)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)b.o.backface_fraction);
+    if (o->weighting != RAD_PROBE_WEIGHT_NORMAL_FIT && o->weighting != RAD_PROBE_WEIGHT_NORMAL &&
+        o->weighting != RAD_PROBE_WEIGHT_PLAIN) {
+        rad__log(c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)o->weighting);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (b.o.weighting != RAD_PROBE_WEIGHT_NORMAL_FIT && b.o.weighting != RAD_PROBE_WEIGHT_NORMAL &&
-        b.o.weighting != RAD_PROBE_WEIGHT_PLAIN) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)b.o.weighting);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (!(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon,
+    if (!(o->ray_epsilon > 0.0f && o->ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)o->ray_epsilon,
                  (double)RAD__MAX_RAY_EPSILON);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (!rad__finite(b.o.spacing) || b.o.spacing < 0.0f || !rad__finite(b.o.max_move) || !rad__finite(b.o.clearance) ||
-        b.o.clearance < 0.0f) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: spacing %g and clearance %g must be finite and >= 0, max_move %g finite",
-                 (double)b.o.spacing, (double)b.o.clearance, (double)b.o.max_move);
+    if (!rad__finite(o->spacing) || o->spacing < 0.0f || !rad__finite(o->max_move) || !rad__finite(o->clearance) ||
+        o->clearance < 0.0f) {
+        rad__log(c, RAD_LOG_ERROR, "probes: spacing %g and clearance %g must be finite and >= 0, max_move %g finite",
+                 (double)o->spacing, (double)o->clearance, (double)o->max_move);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (b.o.flags & ~(uint32_t)(RAD_PROBES_DIRECT | RAD_PROBES_BAND4)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: unknown flags 0x%x", b.o.flags);
+    if (o->flags & ~(uint32_t)(RAD_PROBES_DIRECT | RAD_PROBES_BAND4)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: unknown flags 0x%x", o->flags);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (positions && count == 0) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: positions given with count 0");
+        rad__log(c, RAD_LOG_ERROR, "probes: positions given with count 0");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    /* the lights pass the checks of the direct-light code */
-    if (b.o.flags & RAD_PROBES_DIRECT) {
-        r = rad__direct_setup(&dv, S, raycaster, lights, light_count, NULL, &c);
-        if (r != RAD_SUCCESS) {
-            rad__log(&c, RAD_LOG_ERROR, "probes: the %u lights were refused (%s)", light_count, rad_result_string(r));
-            return r;
-        }
-    }
-    if (B) {
-        r = rad__check_input(&c, "probes", B, 3 * (size_t)N);
-        if (r != RAD_SUCCESS) return r;
-    }
+    return RAD_SUCCESS;
+}
+
+/* the second stage: the probes object with its positions (the given points, or a grid over the
+   scene's bounds at o->spacing) and the storage of its coefficients; *spacing_out is the grid's */
+static rad_result rad__probes_alloc(const rad_scene *S, uint32_t N, const float *positions, uint32_t count,
+                                    const rad_probe_options *o, rad__ctx *c, rad_probes **out, float *spacing_out)
+{
+    rad_probes *pr;
+    float ext[3], spacing = 0.0f;
+    uint32_t i;
+    int k;
     for (k = 0; k < 3; ++k) ext[k] = S->bounds_max[k] - S->bounds_min[k];
-    pr = (rad_probes *)rad__alloc_zero(&c.allocator, sizeof(rad_probes));
+    pr = (rad_probes *)rad__alloc_zero(&c->allocator, sizeof(rad_probes));
     if (!pr) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory");
+        rad__log(c, RAD_LOG_ERROR, "probes: out of memory");
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    pr->allocator = c.allocator;
+    pr->allocator = c->allocator;
     pr->patch_count = N;
     pr->h2 = 1e-6f * S->diagonal * S->diagonal;
-    pr->eps = b.o.ray_epsilon * S->diagonal;
+    pr->eps = o->ray_epsilon * S->diagonal;
     if (positions) {
         for (i = 0; i < count; ++i)
             if (!rad__finite3(positions + 3 * (size_t)i)) {
-                rad__log(&c, RAD_LOG_ERROR, "probes: position %u is not finite", i);
+                rad__log(c, RAD_LOG_ERROR, "probes: position %u is not finite", i);
                 rad_probes_destroy(pr);
                 return RAD_ERROR_NON_FINITE;
             }
@@ -21443,7 +21413,7 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     } else {
         double total = 1.0;
         float big = ext[0] > ext[1] ? (ext[0] > ext[2] ? ext[0] : ext[2]) : (ext[1] > ext[2] ? ext[1] : ext[2]);
-        spacing = b.o.spacing > 0.0f ? b.o.spacing : big / 8.0f;
+        spacing = o->spacing > 0.0f ? o->spacing : big / 8.0f;
         for (k = 0; k < 3; ++k) {
             double d = ceil((double)ext[k] / (double)spacing);
             if (d < 1.0) d = 1.0;
@@ -21451,7 +21421,7 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
             pr->dims[k] = total <= (double)RAD__PROBES_MAX_GRID ? (uint32_t)d : 0u;
         }
         if (total > (double)RAD__PROBES_MAX_GRID) {
-            rad__log(&c, RAD_LOG_ERROR, "probes: spacing %g gives %.0f probes over the bounds (at most %u): use a larger spacing",
+            rad__log(c, RAD_LOG_ERROR, "probes: spacing %g gives %.0f probes over the bounds (at most %u): use a larger spacing",
                      (double)spacing, total, RAD__PROBES_MAX_GRID);
             rad_probes_destroy(pr);
             return RAD_ERROR_SIZE_OVERFLOW;
@@ -21462,21 +21432,19 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
             pr->origin[k] = 0.5f * (S->bounds_min[k] + S->bounds_max[k]) - 0.5f * (float)(pr->dims[k] - 1u) * spacing;
         pr->count = pr->dims[0] * pr->dims[1] * pr->dims[2];
     }
-    pr->weighting = b.o.weighting;
-    pr->positions = (float *)rad__alloc_array(&c.allocator, pr->count, 3 * sizeof(float));
-    pr->states = (uint8_t *)rad__alloc_array(&c.allocator, pr->count, 1);
-    pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
-    pr->direct = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
-    pr->first = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)pr->count + 1u, sizeof(uint64_t));
-    b.nw = 9u;
-    if (b.o.flags & RAD_PROBES_BAND4) {
-        b.nw = 18u;
-        pr->band4 = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
-        pr->direct4 = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
+    pr->weighting = o->weighting;
+    pr->positions = (float *)rad__alloc_array(&c->allocator, pr->count, 3 * sizeof(float));
+    pr->states = (uint8_t *)rad__alloc_array(&c->allocator, pr->count, 1);
+    pr->coefficients = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
+    pr->direct = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
+    pr->first = (uint64_t *)rad__alloc_array(&c->allocator, (size_t)pr->count + 1u, sizeof(uint64_t));
+    if (o->flags & RAD_PROBES_BAND4) {
+        pr->band4 = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
+        pr->direct4 = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
     }
     if (!pr->positions || !pr->states || !pr->coefficients || !pr->direct || !pr->first ||
-        ((b.o.flags & RAD_PROBES_BAND4) && (!pr->band4 || !pr->direct4))) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for %u probes", pr->count);
+        ((o->flags & RAD_PROBES_BAND4) && (!pr->band4 || !pr->direct4))) {
+        rad__log(c, RAD_LOG_ERROR, "probes: out of memory for %u probes", pr->count);
         rad_probes_destroy(pr);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -21495,11 +21463,128 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     }
     memset(pr->direct, 0, sizeof(float) * 27 * (size_t)pr->count);
     if (pr->direct4) memset(pr->direct4, 0, sizeof(float) * 27 * (size_t)pr->count);
+    *spacing_out = spacing;
+    *out = pr;
+    return RAD_SUCCESS;
+}
+
+/* the third stage: each probe moved out of geometry (rad__pb_place), then the weights gathered
+   in chunks of probes into a dense scratch and packed to their non-zero entries */
+static rad_result rad__probes_weights(rad_probes *pr, rad__pb *b, float spacing, rad__ctx *c)
+{
+    const rad_scene *S = b->S;
+    rad_result r = RAD_SUCCESS;
+    uint32_t i, T, N = b->N, per, first;
+    size_t cap = 0;
     {
         float move_default = pr->grid ? 0.5f * spacing : 0.05f * S->diagonal;
-        b.max_move = b.o.max_move == 0.0f ? move_default : b.o.max_move;
-        b.clearance = b.o.clearance > 0.0f ? b.o.clearance : 0.2f * move_default;
+        b->max_move = b->o.max_move == 0.0f ? move_default : b->o.max_move;
+        b->clearance = b->o.clearance > 0.0f ? b->o.clearance : 0.2f * move_default;
     }
+    b->eps = b->o.ray_epsilon * S->diagonal;
+    b->pos = pr->positions;
+    b->states = pr->states;
+    b->direct = pr->direct;
+    b->direct4 = pr->direct4;
+    per = N ? (uint32_t)(RAD__PROBES_CHUNK_FLOATS / ((size_t)b->nw * N)) : pr->count;
+    if (per == 0) per = 1;
+    if (per > pr->count) per = pr->count;
+    T = c->tasks < pr->count ? c->tasks : pr->count;
+    b->rays = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    b->hits = (rad_hit *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
+    b->occ = (uint8_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    b->target = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    b->w = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, b->nw * sizeof(float));
+    b->col = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
+    b->emitters = (uint32_t *)rad__alloc_array(&c->allocator, S->triangle_count, sizeof(uint32_t));
+    b->dense = (float *)rad__alloc_array(&c->allocator, (size_t)per * b->nw, N ? (size_t)N * sizeof(float) : 1u);
+    if (!b->rays || !b->hits || !b->occ || !b->target || !b->w || !b->col || !b->emitters || !b->dense) {
+        rad__log(c, RAD_LOG_ERROR, "probes: out of memory for the ray buffers of %u tasks", T);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < S->triangle_count; ++i)
+            if (rad__emits(S, i)) b->emitters[b->emitter_count++] = i;
+        b->c = c;
+        r = rad__for_rows(c, pr->count, T, rad__pb_place, b);
+    }
+    for (first = 0; first < pr->count && r == RAD_SUCCESS; first += per) {
+        uint32_t m = pr->count - first < per ? pr->count - first : per, q;
+        memset(b->dense, 0, sizeof(float) * b->nw * (size_t)N * m);
+        b->first = first;
+        {
+            rad__ctx cc = *c;
+            uint32_t tt = T < m ? T : m;
+            cc.progress = NULL;
+            r = rad__for_rows(&cc, m, tt, rad__pb_gather_chunk, b);
+        }
+        for (q = 0; q < m && r == RAD_SUCCESS; ++q) {
+            pr->first[first + q] = pr->entries;
+            r = rad__probes_pack(pr, b->dense + (size_t)b->nw * N * q, N, b->nw, &cap);
+            if (r != RAD_SUCCESS)
+                rad__log(c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
+        }
+        if (r == RAD_SUCCESS && c->progress && c->progress(c->progress_user, (float)((double)(first + m) / (double)pr->count))) {
+            rad__log(c, RAD_LOG_INFO, "probes: cancelled by the progress callback after %u of %u probes", first + m, pr->count);
+            r = RAD_ERROR_CANCELLED;
+        }
+    }
+    pr->first[pr->count] = pr->entries;
+    {
+        void *blocks[] = { b->rays, b->hits, b->occ, b->target, b->w, b->col, b->emitters, b->dense };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
+    return r;
+}
+
+/* rad_probes_create (patches) and rad_probes_create_vp (vp): the same placement, checks and
+   storage; only the gather of the weights differs (rad__pb_gather) */
+static rad_result rad__probes_create(const rad_patches *patches, const rad_virtual_patches *vp,
+                                     const rad_raycaster *raycaster, const rad_light *lights, uint32_t light_count,
+                                     const float *positions, uint32_t count, const rad_probe_options *options,
+                                     const float *B, const rad_context *ctx, rad_probes **out)
+{
+    rad__ctx c;
+    rad__pb b;
+    rad__direct dv;
+    rad_probes *pr = NULL;
+    const rad_scene *S;
+    rad_result r = RAD_SUCCESS;
+    uint32_t N;
+    float spacing = 0.0f;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if ((vp ? !vp->scene : (!patches || !patches->scene)) || !raycaster || !raycaster->intersect || !raycaster->occluded ||
+        !out) {
+        if (vp && !vp->scene)
+            rad__log(&c, RAD_LOG_ERROR, "probes: the virtual patches have no scene (rad_vp_load with scene NULL)");
+        else
+            rad__log(&c, RAD_LOG_ERROR, "probes: NULL %s, raycaster (with intersect and occluded) or output",
+                     patches || !vp ? "patches" : "virtual patches");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    S = vp ? vp->scene : patches->scene;
+    N = vp ? vp->count : patches->count;
+    memset(&b, 0, sizeof(b));
+    if (options) b.o = *options; else memset(&b.o, 0, sizeof(b.o));
+    rad__probe_options_resolve(&b.o);
+    r = rad__probes_check(&b.o, vp != NULL, positions, count, &c);
+    if (r != RAD_SUCCESS) return r;
+    /* the lights pass the checks of the direct-light code */
+    if (b.o.flags & RAD_PROBES_DIRECT) {
+        r = rad__direct_setup(&dv, S, raycaster, lights, light_count, NULL, &c);
+        if (r != RAD_SUCCESS) {
+            rad__log(&c, RAD_LOG_ERROR, "probes: the %u lights were refused (%s)", light_count, rad_result_string(r));
+            return r;
+        }
+    }
+    if (B) {
+        r = rad__check_input(&c, "probes", B, 3 * (size_t)N);
+        if (r != RAD_SUCCESS) return r;
+    }
+    b.nw = (b.o.flags & RAD_PROBES_BAND4) ? 18u : 9u;
+    r = rad__probes_alloc(S, N, positions, count, &b.o, &c, &pr, &spacing);
+    if (r != RAD_SUCCESS) return r;
     b.P = vp ? NULL : patches;
     b.V = vp;
     b.N = N;
@@ -21507,59 +21592,7 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     b.rc = raycaster;
     b.lights = lights;
     b.light_count = (b.o.flags & RAD_PROBES_DIRECT) ? light_count : 0u;
-    b.eps = b.o.ray_epsilon * S->diagonal;
-    b.pos = pr->positions;
-    b.states = pr->states;
-    b.direct = pr->direct;
-    b.direct4 = pr->direct4;
-    per = N ? (uint32_t)(RAD__PROBES_CHUNK_FLOATS / ((size_t)b.nw * N)) : pr->count;
-    if (per == 0) per = 1;
-    if (per > pr->count) per = pr->count;
-    T = c.tasks < pr->count ? c.tasks : pr->count;
-    b.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
-    b.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
-    b.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
-    b.target = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-    b.w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, b.nw * sizeof(float));
-    b.col = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
-    b.emitters = (uint32_t *)rad__alloc_array(&c.allocator, S->triangle_count, sizeof(uint32_t));
-    b.dense = (float *)rad__alloc_array(&c.allocator, (size_t)per * b.nw, N ? (size_t)N * sizeof(float) : 1u);
-    if (!b.rays || !b.hits || !b.occ || !b.target || !b.w || !b.col || !b.emitters || !b.dense) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for the ray buffers of %u tasks", T);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-    }
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < S->triangle_count; ++i)
-            if (rad__emits(S, i)) b.emitters[b.emitter_count++] = i;
-        b.c = &c;
-        r = rad__for_rows(&c, pr->count, T, rad__pb_place, &b);
-    }
-    for (first = 0; first < pr->count && r == RAD_SUCCESS; first += per) {
-        uint32_t m = pr->count - first < per ? pr->count - first : per, q;
-        memset(b.dense, 0, sizeof(float) * b.nw * (size_t)N * m);
-        b.first = first;
-        {
-            rad__ctx cc = c;
-            uint32_t tt = T < m ? T : m;
-            cc.progress = NULL;
-            r = rad__for_rows(&cc, m, tt, rad__pb_gather_chunk, &b);
-        }
-        for (q = 0; q < m && r == RAD_SUCCESS; ++q) {
-            pr->first[first + q] = pr->entries;
-            r = rad__probes_pack(pr, b.dense + (size_t)b.nw * N * q, N, b.nw, &cap);
-            if (r != RAD_SUCCESS)
-                rad__log(&c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
-        }
-        if (r == RAD_SUCCESS && c.progress && c.progress(c.progress_user, (float)((double)(first + m) / (double)pr->count))) {
-            rad__log(&c, RAD_LOG_INFO, "probes: cancelled by the progress callback after %u of %u probes", first + m, pr->count);
-            r = RAD_ERROR_CANCELLED;
-        }
-    }
-    pr->first[pr->count] = pr->entries;
-    {
-        void *blocks[] = { b.rays, b.hits, b.occ, b.target, b.w, b.col, b.emitters, b.dense };
-        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
-    }
+    r = rad__probes_weights(pr, &b, spacing, &c);
     if (r == RAD_SUCCESS) r = rad__check_output(&c, "probes (direct light)", pr->direct, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS && pr->direct4) r = rad__check_output(&c, "probes (direct light, band 4)", pr->direct4, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS) {
@@ -24229,7 +24262,31 @@ static const char rad__glsl_0_0[] =
     "    uint flags;       // bit 0: add E (total)\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -24242,16 +24299,9 @@ static const char rad__glsl_0_0[] =
     "        float f = F[at + j];\n"
     "        acc += f * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {   // any group size, no subgroup assumption\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    precise vec3 o = sum * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -24282,7 +24332,31 @@ static const char rad__glsl_1_0[] =
     "    uint flags;       // bit 0: add E (total)\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -24296,16 +24370,9 @@ static const char rad__glsl_1_0[] =
     "        uint j = columns[k0 + e];\n"
     "        acc += values[k0 + e] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    precise vec3 o = sum * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -24338,7 +24405,31 @@ static const char rad__glsl_2_0[] =
     "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -24352,17 +24443,10 @@ static const char rad__glsl_2_0[] =
     "        uint e = 3u * (perm \? col_perm[j] : j);\n"
     "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
     "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    precise vec3 s = partial[0];\n"
+    "    precise vec3 s = sum;\n"
     "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
     "    outv[o] = s.x;\n"
     "    outv[o + 1u] = s.y;\n"
@@ -24394,7 +24478,31 @@ static const char rad__glsl_3_0[] =
     "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u \? v.y : v.x; }\n"
     "\n"
@@ -24411,17 +24519,10 @@ static const char rad__glsl_3_0[] =
     "        vec3 f = vec3(half_at(R[h >> 1u], h), half_at(G[h >> 1u], h), half_at(B[h >> 1u], h));\n"
     "        acc += f * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
     "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    precise vec3 s = partial[0];\n"
+    "    precise vec3 s = sum;\n"
     "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
     "    outv[o] = s.x;\n"
     "    outv[o + 1u] = s.y;\n"
@@ -24555,7 +24656,32 @@ static const char rad__glsl_5_0[] =
     "    uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n";
+static const char rad__glsl_5_1[] =
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -24576,23 +24702,15 @@ static const char rad__glsl_5_0[] =
     "    uint i = perm \? row_perm[y] : y;\n"
     "    precise vec3 s = vec3(0.0);\n"
     "    if ((pc.flags & 8u) != 0u) {\n"
-    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n";
-static const char rad__glsl_5_1[] =
+    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n"
     "        for (uint k = k0 + lid; k < k0 + count; k += gl_WorkGroupSize.x) {\n"
     "            uint j = 3u * out_col[k];\n"
     "            s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);\n"
     "        }\n"
     "    }\n"
-    "    partial[lid] = acc + s;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc + s);\n"
     "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0];\n"
+    "    precise vec3 o = sum;\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -24953,7 +25071,31 @@ static const char rad__glsl_8_0[] =
     "    uint flags;        // bit 0: add E (RAD_OUTPUT_TOTAL)\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -24963,28 +25105,22 @@ static const char rad__glsl_8_0[] =
     "    if (i < pc.slot_offset || i - pc.slot_offset >= pc.slot_count) return; // another chunk's row\n"
     "    uint at = pc.base + (i - pc.slot_offset) * pc.m;\n"
     "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n";
+static const char rad__glsl_8_1[] =
     "        uint p = lit_patch[j];\n"
     "        if (p == 0xFFFFFFFFu) continue;\n"
     "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[3u * p], E[3u * p + 1u], E[3u * p + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
     "    uint o = 3u * vis_patch[pc.row_offset + r];\n"
-    "    precise vec3 s = partial[0];\n"
+    "    precise vec3 s = sum;\n"
     "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
     "    outv[o] = s.x;\n"
     "    outv[o + 1u] = s.y;\n"
     "    outv[o + 2u] = s.z;\n"
     "}\n";
-static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0 };
+static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0, rad__glsl_8_1 };
 static const char rad__glsl_9_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_LOCAL_VECTORS: the small pre-pass of a local-matrix add\n"
@@ -25433,15 +25569,15 @@ static const char rad__glsl_13_0[] =
     "}\n";
 static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
-    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
-    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
-    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
-    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
+    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 3364u },
+    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 3620u },
+    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 3694u },
+    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 3580u },
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
-    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
+    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 5618u },
     { "alias_build.comp", rad__glsl_pieces_6, 2u, 4700u },
     { "lighting.glsl", rad__glsl_pieces_7, 3u, 9447u },
-    { "local_apply.comp", rad__glsl_pieces_8, 1u, 3519u },
+    { "local_apply.comp", rad__glsl_pieces_8, 2u, 4433u },
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
