@@ -329,6 +329,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--only") && a + 1 < argc) g_only = argv[++a];
         else if (!strcmp(argv[a], "--sets") && a + 1 < argc) g_sets = atoi(argv[++a]);
     emit("\n## c) Ray queries: built-in BVH against Embree\n\n");
+    emit_machine();
     emit("Ray sets: *form-factor rows* are the occlusion rays of a sample of rows (rad_form_factor_rows, default "
          "options), replayed as closest-hit queries with tmax = infinity; *camera* are 512x512 pinhole rays "
          "(coherent; occlusion = any hit along the ray); *bounce* are cosine-distributed rays from the camera hits "
