@@ -1,4 +1,4 @@
-/* radiosity.h - v0.3.0 - diffuse global illumination by the radiosity method
+/* radiosity.h - v0.4.0 - diffuse global illumination by the radiosity method
    public domain or MIT, your choice (see end of file)
 
    Do this:
@@ -291,6 +291,9 @@
        - Start threads, touch the GPU itself, or keep global state.
 
   13. HISTORY
+       0.4.0  two-sided materials; emission textures; environment maps, Preetham's sky and
+              the sky transfer; the engine tier (rad_baker_*) with light layers; zero means
+              default in every option struct; RAD_FMA opt-in; hierarchical memory limit.
        0.3.0  hemicube form factors; stochastic radiosity; hierarchical radiosity with
               clustering; lightmaps; irradiance probes (SH L2, band 4, over patches or
               virtual patches); final gather; dynamic lights over virtual patches; sparse
@@ -312,9 +315,9 @@
 #include <stdint.h>
 
 #define RAD_VERSION_MAJOR 0
-#define RAD_VERSION_MINOR 3
+#define RAD_VERSION_MINOR 4
 #define RAD_VERSION_PATCH 0
-#define RAD_VERSION_STRING "0.3.0"
+#define RAD_VERSION_STRING "0.4.0"
 
 #ifndef RAD_API
 #  ifdef RADIOSITY_STATIC
