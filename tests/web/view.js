@@ -1,0 +1,54 @@
+// Loads the glb named by ?glb= with three.js's GLTFLoader and draws it from its own camera,
+// lit by the baked lightmap alone: for each material whose extras carry RAD_lightmap, the
+// named texture becomes material.lightMap on the uv set texCoord (three.js's Texture.channel:
+// TEXCOORD_1 is the attribute uv1), decoded from sRGB and scaled by 'scale' (lightMapIntensity),
+// so three.js adds it to the irradiance and shades albedo x irradiance / pi + emission, as
+// `rad render --method lightmap` does. No tone mapping: the output is sRGB of the clamped
+// radiance, as the tool's PNGs are (exposure 1). The title says "ready" once drawn, or
+// "error: ..." when something failed.
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+
+const query = new URLSearchParams(location.search);
+const url = query.get('glb') || 'baked.glb';
+const width = Number(query.get('w')) || window.innerWidth;
+const height = Number(query.get('h')) || window.innerHeight;
+
+async function main() {
+    const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    renderer.setPixelRatio(1);
+    renderer.setSize(width, height);
+    renderer.outputColorSpace = THREE.SRGBColorSpace;
+    renderer.toneMapping = THREE.NoToneMapping;
+    document.body.appendChild(renderer.domElement);
+
+    const gltf = await new GLTFLoader().loadAsync(url);
+    const materials = new Set();
+    gltf.scene.traverse((o) => {
+        if (o.isMesh) (Array.isArray(o.material) ? o.material : [o.material]).forEach((m) => materials.add(m));
+    });
+    let lightmapped = 0;
+    for (const m of materials) {
+        const info = m.userData.RAD_lightmap; // the material's extras (GLTFLoader puts them in userData)
+        if (!info) continue;
+        const texture = await gltf.parser.getDependency('texture', info.texture);
+        texture.channel = info.texCoord;
+        texture.colorSpace = info.encoding === 'srgb' ? THREE.SRGBColorSpace : THREE.LinearSRGBColorSpace;
+        m.lightMap = texture;
+        m.lightMapIntensity = info.scale;
+        m.needsUpdate = true;
+        ++lightmapped;
+    }
+    if (lightmapped === 0) throw new Error('no material names a RAD_lightmap');
+    if (gltf.cameras.length === 0) throw new Error('the file has no camera');
+    const camera = gltf.cameras[0];
+    camera.aspect = width / height;
+    camera.updateProjectionMatrix();
+    let frames = 0;
+    renderer.setAnimationLoop(() => {
+        renderer.render(gltf.scene, camera);
+        if (++frames === 3) document.title = 'ready';
+    });
+}
+
+main().catch((e) => { document.title = 'error: ' + e.message; console.error(e); });
