@@ -2,7 +2,8 @@
 // lit by the baked lightmap alone: for each material whose extras carry RAD_lightmap, the
 // named texture becomes material.lightMap on the uv set texCoord (three.js's Texture.channel:
 // TEXCOORD_1 is the attribute uv1), decoded from sRGB and scaled by 'scale' (lightMapIntensity),
-// so three.js adds it to the irradiance and shades albedo x irradiance / pi + emission, as
+// so three.js adds it to the irradiance and shades albedo x irradiance / pi + emission (a
+// Lambert material), as
 // `rad render --method lightmap` does. No tone mapping: the output is sRGB of the clamped
 // radiance, as the tool's PNGs are (exposure 1). The title says "ready" once drawn, or
 // "error: ..." when something failed.
@@ -23,12 +24,21 @@ async function main() {
     document.body.appendChild(renderer.domElement);
 
     const gltf = await new GLTFLoader().loadAsync(url);
-    const materials = new Set();
+    // The lightmap is the irradiance of a Lambertian solution: each glTF material becomes a
+    // MeshLambertMaterial of the same colours (three.js's standard material would take the
+    // energy of its 4% specular layer out of the diffuse light, a few percent darker).
+    const lambert = new Map();
     gltf.scene.traverse((o) => {
-        if (o.isMesh) (Array.isArray(o.material) ? o.material : [o.material]).forEach((m) => materials.add(m));
+        if (!o.isMesh || Array.isArray(o.material)) return;
+        const src = o.material;
+        if (!lambert.has(src))
+            lambert.set(src, new THREE.MeshLambertMaterial({ name: src.name, color: src.color, emissive: src.emissive,
+                                                             emissiveIntensity: src.emissiveIntensity, side: src.side,
+                                                             userData: src.userData }));
+        o.material = lambert.get(src);
     });
     let lightmapped = 0;
-    for (const m of materials) {
+    for (const m of lambert.values()) {
         const info = m.userData.RAD_lightmap; // the material's extras (GLTFLoader puts them in userData)
         if (!info) continue;
         const texture = await gltf.parser.getDependency('texture', info.texture);
@@ -47,8 +57,14 @@ async function main() {
     let frames = 0;
     renderer.setAnimationLoop(() => {
         renderer.render(gltf.scene, camera);
-        if (++frames === 3) document.title = 'ready';
+        if (++frames === 3) say('ready');
     });
 }
 
-main().catch((e) => { document.title = 'error: ' + e.message; console.error(e); });
+// the title, and with ?report=1 the server that serves the page (tests/web/check.mjs)
+function say(s) {
+    document.title = s;
+    if (query.get('report')) fetch('/status?s=' + encodeURIComponent(s)).catch(() => {});
+}
+
+main().catch((e) => { say('error: ' + e.message); console.error(e); });
