@@ -593,6 +593,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             if (!(cam.fov_y_degrees > 0.0f)) cam.fov_y_degrees = 45.0f;
             memset(&gl, 0, sizeof gl);
             gl.scene = bk.w.scene;
+            gl.mesh_scene = w.scene;
             gl.material_names = w.file.material_names;
             gl.camera = &cam;
             gl.aspect = (float)rw / (float)rh;

@@ -4,7 +4,8 @@
    What is written (the convention is documented in docs/engine-formats.md):
    - one node and mesh per scene mesh, one primitive per material in it, not indexed (three
      vertices a triangle: the scene is a triangle soup with per-triangle normals), with
-     POSITION, NORMAL (the triangle's), TEXCOORD_0 (the scene's uvs, when it has some) and
+     POSITION, NORMAL (the triangle's), TEXCOORD_0 (the scene's uvs; without them the lightmap
+     uvs again, as glTF numbers uv sets without gaps) and
      TEXCOORD_1 (the lightmap uvs the bake used: the file's second set or the unwrap's);
      a two-sided material's two sides are two one-sided triangles with their own lightmap uvs;
    - materials as their constant colours: baseColorFactor = albedo, metallic 0, roughness 1,
@@ -220,19 +221,21 @@ static void gw_png_sink(void *user, void *data, int size)
 }
 
 /* triangles ordered by (mesh, material) so that each primitive is a run */
-static const rad_scene *gw_sort_scene;
+static const uint32_t *gw_sort_meshes, *gw_sort_materials;
 static int gw_tri_cmp(const void *pa, const void *pb)
 {
     uint32_t a = *(const uint32_t *)pa, b = *(const uint32_t *)pb;
-    const rad_scene *s = gw_sort_scene;
-    if (s->meshes[a] != s->meshes[b]) return s->meshes[a] < s->meshes[b] ? -1 : 1;
-    if (s->materials[a] != s->materials[b]) return s->materials[a] < s->materials[b] ? -1 : 1;
+    const uint32_t *me = gw_sort_meshes, *ma = gw_sort_materials;
+    if (me[a] != me[b]) return me[a] < me[b] ? -1 : 1;
+    if (ma[a] != ma[b]) return ma[a] < ma[b] ? -1 : 1;
     return a < b ? -1 : a > b;
 }
 
 int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap *in, tool_output_set *set)
 {
     const rad_scene *s = in->scene;
+    /* the meshes (and their names) that group the triangles */
+    const rad_scene *ms = in->mesh_scene && in->mesh_scene->triangle_count == s->triangle_count ? in->mesh_scene : s;
     const rad_lightmap *lm = in->lightmap;
     gw_buf bin, js, png, file;
     uint32_t *order = NULL, i, k, t, prim, mesh, nprim = 0, nmesh = 0, texel;
@@ -240,8 +243,8 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
     size_t n_texels = (size_t)lm->width * lm->height, vbytes;
     unsigned char *px = NULL;
     float scale = 0.0f;
-    int has_uv0 = s->uvs != NULL, glb = gw_has_ext(path, ".glb"), ok = 0, warned = 0;
-    uint32_t views_per_prim = has_uv0 ? 4u : 3u, png_view;
+    int glb = gw_has_ext(path, ".glb"), ok = 0, warned = 0;
+    uint32_t views_per_prim = 4u, png_view; /* POSITION, NORMAL, TEXCOORD_1, TEXCOORD_0 */
     char *bin_path = NULL;
     tool_output o;
     memset(&bin, 0, sizeof bin);
@@ -252,9 +255,9 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
         fprintf(stderr, "rad %s: cannot write '%s': the baked scene has no lightmap uvs\n", cmd, path);
         return 1;
     }
-    /* POSITION, NORMAL, TEXCOORD_1 (and TEXCOORD_0): 40 bytes a vertex, 3 vertices a triangle;
+    /* POSITION, NORMAL, TEXCOORD_1 and TEXCOORD_0: 40 bytes a vertex, 3 vertices a triangle;
        a GLB's chunk lengths and a glTF accessor's offsets are 32-bit */
-    vbytes = (size_t)(has_uv0 ? 40 : 32) * 3u * s->triangle_count;
+    vbytes = (size_t)40 * 3u * s->triangle_count;
     if ((double)vbytes + 4.0 * (double)n_texels > 4.0e9) {
         fprintf(stderr, "rad %s: cannot write '%s': %u triangles and a %ux%u lightmap pass the 4 GB a glTF buffer holds\n",
                 cmd, path, s->triangle_count, lm->width, lm->height);
@@ -279,13 +282,14 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
     run_count = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
     prim_mesh = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
     for (t = 0; t < s->triangle_count; ++t) order[t] = t;
-    gw_sort_scene = s;
+    gw_sort_meshes = ms->meshes;
+    gw_sort_materials = s->materials;
     qsort(order, s->triangle_count, sizeof(uint32_t), gw_tri_cmp);
     for (t = 0; t < s->triangle_count; ++t) {
-        if (t == 0 || s->meshes[order[t]] != s->meshes[order[t - 1]] || s->materials[order[t]] != s->materials[order[t - 1]]) {
+        if (t == 0 || ms->meshes[order[t]] != ms->meshes[order[t - 1]] || s->materials[order[t]] != s->materials[order[t - 1]]) {
             run_start[nprim] = t;
-            prim_mesh[nprim] = s->meshes[order[t]];
-            if (t == 0 || s->meshes[order[t]] != s->meshes[order[t - 1]]) ++nmesh;
+            prim_mesh[nprim] = ms->meshes[order[t]];
+            if (t == 0 || ms->meshes[order[t]] != ms->meshes[order[t - 1]]) ++nmesh;
             ++nprim;
         }
         ++run_count[nprim - 1];
@@ -317,16 +321,22 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
                 for (i = 0; i < 6; ++i) gw_f32(&bin, s->lightmap_uvs[6 * (size_t)t + i]);
             }
         off_uv0 = bin.size;
-        if (has_uv0)
-            for (prim = 0; prim < nprim; ++prim)
-                for (k = 0; k < run_count[prim]; ++k) {
-                    t = order[run_start[prim] + k];
-                    /* the scene's uvs have v up (assimp's convention); glTF's runs down */
-                    for (i = 0; i < 3; ++i) {
+        for (prim = 0; prim < nprim; ++prim)
+            for (k = 0; k < run_count[prim]; ++k) {
+                t = order[run_start[prim] + k];
+                /* the scene's uvs have v up (assimp's convention); glTF's runs down. A
+                   scene without uvs gets the lightmap's: glTF numbers the uv sets from 0
+                   without gaps, so TEXCOORD_1 needs a TEXCOORD_0 */
+                for (i = 0; i < 3; ++i) {
+                    if (s->uvs) {
                         gw_f32(&bin, s->uvs[6 * (size_t)t + 2 * i]);
                         gw_f32(&bin, 1.0f - s->uvs[6 * (size_t)t + 2 * i + 1]);
+                    } else {
+                        gw_f32(&bin, s->lightmap_uvs[6 * (size_t)t + 2 * i]);
+                        gw_f32(&bin, s->lightmap_uvs[6 * (size_t)t + 2 * i + 1]);
                     }
                 }
+            }
         png_view = (uint32_t)bin.size;
         gw_put(&bin, png.data, png.size);
         gw_align4(&bin, 0);
@@ -350,9 +360,9 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
         for (mesh = 0, prim = 0; mesh < nmesh; ++mesh) {
             uint32_t id = prim_mesh[prim];
             gw_printf(&js, "%s{\"mesh\":%u", mesh ? "," : "", mesh);
-            if (s->mesh_names && id < s->mesh_count && s->mesh_names[id] && s->mesh_names[id][0]) {
+            if (ms->mesh_names && id < ms->mesh_count && ms->mesh_names[id] && ms->mesh_names[id][0]) {
                 gw_printf(&js, ",\"name\":");
-                gw_string(&js, s->mesh_names[id]);
+                gw_string(&js, ms->mesh_names[id]);
             }
             gw_printf(&js, "}");
             while (prim < nprim && prim_mesh[prim] == id) ++prim;
@@ -368,12 +378,12 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
         gw_printf(&js, "]");
         if (in->camera) {
             double diag = s->diagonal > 0.0f ? (double)s->diagonal : 1.0;
-            gw_printf(&js, ",\"cameras\":[{\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g,\"zfar\":%.9g",
+            gw_printf(&js, ",\"cameras\":[{\"name\":\"rad view\",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g,\"zfar\":%.9g",
                       (double)in->camera->fov_y_degrees * 3.14159265358979323846 / 180.0, 1e-3 * diag, 1e2 * diag);
             if (in->aspect > 0.0f) gw_printf(&js, ",\"aspectRatio\":%.9g", (double)in->aspect);
             gw_printf(&js, "}}]");
         }
-        /* meshes and their primitives; accessors 4 per primitive (3 without uv0):
+        /* meshes and their primitives; accessors 4 per primitive:
            POSITION, NORMAL, TEXCOORD_1, TEXCOORD_0 */
         gw_printf(&js, ",\"meshes\":[");
         for (mesh = 0, prim = 0; mesh < nmesh; ++mesh) {
@@ -381,10 +391,10 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
             gw_printf(&js, "%s{\"primitives\":[", mesh ? "," : "");
             for (; prim < nprim && prim_mesh[prim] == id; ++prim, first = 0) {
                 uint32_t a = views_per_prim * prim;
-                gw_printf(&js, "%s{\"attributes\":{\"POSITION\":%u,\"NORMAL\":%u,\"TEXCOORD_1\":%u", first ? "" : ",", a, a + 1,
-                          a + 2);
-                if (has_uv0) gw_printf(&js, ",\"TEXCOORD_0\":%u", a + 3);
-                gw_printf(&js, "},\"material\":%u,\"mode\":4}", s->materials[order[run_start[prim]]]);
+                /* TEXCOORD_0 first: assimp reads the sets in the order written and refuses a gap */
+                gw_printf(&js, "%s{\"attributes\":{\"POSITION\":%u,\"NORMAL\":%u,\"TEXCOORD_0\":%u,\"TEXCOORD_1\":%u}",
+                          first ? "" : ",", a, a + 1, a + 3, a + 2);
+                gw_printf(&js, ",\"material\":%u,\"mode\":4}", s->materials[order[run_start[prim]]]);
             }
             gw_printf(&js, "]}");
         }
@@ -401,8 +411,7 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
                           (unsigned long)(off_n + 36u * done), (unsigned long)(36u * c));
                 gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
                           (unsigned long)(off_uv1 + 24u * done), (unsigned long)(24u * c));
-                if (has_uv0)
-                    gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
+                gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
                               (unsigned long)(off_uv0 + 24u * done), (unsigned long)(24u * c));
                 done += c;
             }
@@ -429,9 +438,7 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
                       (double)hi[1], (double)hi[2]);
             gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\"}", views_per_prim * prim + 1, c);
             gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", views_per_prim * prim + 2, c);
-            if (has_uv0)
-                gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}",
-                          views_per_prim * prim + 3, c);
+            gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", views_per_prim * prim + 3, c);
         }
         gw_printf(&js, "]");
         /* the lightmap: clamped, linear, no mipmaps (mip levels would mix neighbouring charts) */

@@ -667,6 +667,8 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b);
 /* A baked RGB irradiance lightmap and the scene it was baked over, for engines */
 typedef struct tool_gltf_lightmap {
     const rad_scene *scene;            /* the triangles, with the lightmap uvs the bake used */
+    const rad_scene *mesh_scene;       /* the same triangles in the same order whose meshes and
+                                          names group them (the scene before an unwrap), or NULL */
     const char *const *material_names; /* scene->material_count names, or NULL */
     const rad_camera *camera;          /* written as a camera node, or NULL */
     float aspect;                      /* the view's width / height (0: left to the engine) */
