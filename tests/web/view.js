@@ -16,7 +16,7 @@ const width = Number(query.get('w')) || window.innerWidth;
 const height = Number(query.get('h')) || window.innerHeight;
 
 async function main() {
-    const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    const renderer = new THREE.WebGLRenderer({ antialias: query.get('aa') !== '0', preserveDrawingBuffer: true });
     renderer.setPixelRatio(1);
     renderer.setSize(width, height);
     renderer.outputColorSpace = THREE.SRGBColorSpace;
