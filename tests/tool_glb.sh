@@ -48,3 +48,15 @@ fi
 rc=$?
 [ $rc = 2 ] && grep -q "leave out --sh" "$TMP/err.txt" && [ ! -e "$TMP/sh.glb" ] && ok "lightmap --sh -o x.glb is refused (exit 2)" ||
     fail "lightmap --sh -o x.glb is refused (exit 2)" "exit $rc"
+
+# names: the .bin's uri percent-encoded (a space in the file name), a material name that is not
+# UTF-8 (Latin-1 in an MTL) written with '?' so the JSON stays valid UTF-8
+printf 'newmtl caf\351\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n' > "$TMP/names.mtl"
+printf 'mtllib names.mtl\nv 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 0 1 0\nv 0 1 1\nv 1 1 1\nv 1 1 0\nusemtl caf\351\nf 1 4 3 2\nusemtl lamp\nf 5 8 7 6\n' > "$TMP/names.obj"
+if "$RAD" lightmap "$TMP/names.obj" --patches 20 --size 32 -o "$TMP/my scene.gltf" > /dev/null 2> "$TMP/err.txt" &&
+    grep -q '"uri":"my%20scene.bin"' "$TMP/my scene.gltf" && grep -q '"name":"caf?"' "$TMP/my scene.gltf" &&
+    [ -s "$TMP/my scene.bin" ]; then
+    ok "gltf names: the buffer's uri percent-encoded, a non-UTF-8 material name made valid"
+else
+    fail "gltf names: the buffer's uri percent-encoded, a non-UTF-8 material name made valid" "$(tail -n 2 "$TMP/err.txt")"
+fi

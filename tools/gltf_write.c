@@ -103,16 +103,44 @@ static void gw_f32(gw_buf *b, float f)
     gw_u32(b, u);
 }
 
-/* a JSON string: quotes, backslashes and control characters escaped; other bytes as they are
-   (names come from the scene file, UTF-8 in glTF and usually ASCII elsewhere) */
+/* the length of the well-formed UTF-8 sequence at s (1 to 4), or 0 */
+static int gw_utf8_length(const unsigned char *s)
+{
+    int n = s[0] < 0x80 ? 1 : (s[0] & 0xE0) == 0xC0 && s[0] >= 0xC2 ? 2 : (s[0] & 0xF0) == 0xE0 ? 3
+          : (s[0] & 0xF8) == 0xF0 && s[0] <= 0xF4 ? 4 : 0, i;
+    for (i = 1; i < n; ++i)
+        if ((s[i] & 0xC0) != 0x80) return 0;
+    return n;
+}
+
+/* a JSON string: quotes, backslashes and control characters escaped; a byte that is not part
+   of well-formed UTF-8 (an OBJ's Latin-1 name) becomes '?', since JSON text is UTF-8 */
 static void gw_string(gw_buf *b, const char *s)
 {
+    const unsigned char *p = (const unsigned char *)(s ? s : "");
     gw_put(b, "\"", 1);
-    for (; s && *s; ++s) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\') gw_printf(b, "\\%c", c);
-        else if (c < 0x20) gw_printf(b, "\\u%04x", c);
-        else gw_put(b, &c, 1);
+    while (*p) {
+        int n = gw_utf8_length(p);
+        if (*p == '"' || *p == '\\') gw_printf(b, "\\%c", *p);
+        else if (*p < 0x20) gw_printf(b, "\\u%04x", *p);
+        else if (n == 0) gw_put(b, "?", 1);
+        else gw_put(b, p, (size_t)n);
+        p += n ? n : 1;
+    }
+    gw_put(b, "\"", 1);
+}
+
+/* a file name as a relative URI (RFC 3986): bytes outside the unreserved set percent-encoded */
+static void gw_uri(gw_buf *b, const char *name)
+{
+    const unsigned char *p = (const unsigned char *)name;
+    gw_put(b, "\"", 1);
+    for (; *p; ++p) {
+        if ((*p >= 'A' && *p <= 'Z') || (*p >= 'a' && *p <= 'z') || (*p >= '0' && *p <= '9') || *p == '-' || *p == '.' ||
+            *p == '_' || *p == '~')
+            gw_put(b, p, 1);
+        else
+            gw_printf(b, "%%%02X", *p);
     }
     gw_put(b, "\"", 1);
 }
@@ -483,7 +511,7 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
         if (!glb) {
             bin_path = tool_gltf_bin_path(path);
             gw_printf(&js, ",\"uri\":");
-            gw_string(&js, gw_base(bin_path));
+            gw_uri(&js, gw_base(bin_path));
         }
         gw_printf(&js, "}]}");
         gw_align4(&js, ' ');
