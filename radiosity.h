@@ -212,6 +212,9 @@
        occlusion rays; one-sided triangles are hit from either side as before. The BVH and
        the Embree backend do this; a raycaster of your own must too (an Embree scene you wrap
        with rad_embree_wrap needs the filter function described at >>api_rays).
+       Alpha cutouts (rad_material.opacity_texture): a hit on a cutout triangle counts only
+       where rad_scene_opaque says the surface exists; rays go on through the holes, for
+       closest hits and occlusion alike (>>api_rays, ALPHA CUTOUTS).
 
    8. EMBREE
        With RAD_EMBREE defined in the implementing file (and -lembree3), rad_embree_create
@@ -424,6 +427,13 @@ typedef void (*rad_albedo_fn)(void *user, uint32_t texture, float u, float v, fl
    the material. */
 typedef void (*rad_emission_fn)(void *user, uint32_t texture, float u, float v, float out_rgb[3]);
 
+/* Opacity lookup by texture coordinate: returns the alpha (coverage) at (u, v) of 'texture'
+   (the material's opacity_texture id, never 0), in [0, 1]. Where it is below the material's
+   alpha_cutoff the surface is not there: rays pass through, and the point neither receives,
+   reflects nor emits (an alpha cutout). Must be thread-safe; it is called during ray
+   traversal, so it must be cheap. A NaN counts as transparent. */
+typedef float (*rad_opacity_fn)(void *user, uint32_t texture, float u, float v);
+
 typedef struct rad_material {
     float albedo[3];    /* diffuse reflectance, each channel in [0, 1) */
     float emission[3];  /* emitted RADIANCE L (W m^-2 sr^-1), >= 0; exitance is pi * L */
@@ -434,6 +444,11 @@ typedef struct rad_material {
                            'emission' (the factor) at each point (needs uvs on the mesh) */
     uint32_t two_sided; /* 0: one-sided, the back absorbs; non-zero: both sides receive,
                            reflect and emit, each on its own (see rad_scene.twins) */
+    uint32_t opacity_texture; /* 0: opaque everywhere; else an alpha cutout: passed to
+                           rad_scene_desc.opacity_lookup, and the surface exists only where
+                           the alpha is >= alpha_cutoff (needs uvs on the mesh) */
+    float alpha_cutoff; /* the cutout's threshold in [0, 1]; 0: 0.5 (glTF's default). Only
+                           read with an opacity_texture */
 } rad_material;
 
 typedef struct rad_mesh_desc {
@@ -443,7 +458,8 @@ typedef struct rad_mesh_desc {
     uint32_t vertex_count;
     const float *normals;          /* optional shading normals (unused by the solver) */
     size_t normal_stride;          /* 0: 3 * sizeof(float) */
-    const float *uvs;              /* optional u v, needed by materials with a texture or an emission_texture */
+    const float *uvs;              /* optional u v, needed by materials with a texture, an emission_texture
+                                      or an opacity_texture */
     size_t uv_stride;              /* 0: 2 * sizeof(float) */
     const uint32_t *indices;       /* 3 per triangle; NULL: vertices taken in threes */
     uint32_t triangle_count;
@@ -470,6 +486,10 @@ typedef struct rad_scene_desc {
     uint32_t flags;                /* rad_scene_flags */
     rad_emission_fn emission_lookup; /* optional: needed by materials with an emission_texture */
     void *emission_user;
+    rad_opacity_fn opacity_lookup; /* optional: needed by materials with an opacity_texture (alpha
+                                      cutouts); it and opacity_user must outlive the scene and
+                                      every BVH or Embree scene built from it */
+    void *opacity_user;
 } rad_scene_desc;
 
 /* The validated scene, flattened: one array of triangles with world positions. Read-only.
@@ -509,6 +529,8 @@ typedef struct rad_scene {
     uint32_t skipped_triangles;    /* degenerate triangles dropped (RAD_SCENE_SKIP_DEGENERATE) */
     rad_emission_fn emission_lookup;
     void *emission_user;
+    rad_opacity_fn opacity_lookup; /* NULL when no material is a cutout (see rad_scene_opaque) */
+    void *opacity_user;
     rad_allocator allocator;       /* private: the allocator that made it */
 } rad_scene;
 
@@ -536,6 +558,16 @@ RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b
    and direct light take it per point), so a texture shapes the light a surface sends. The
    value is not checked here; the methods check it (RAD_ERROR_NEGATIVE_EMISSION). */
 RAD_API void rad_scene_emission(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3]);
+
+/* 1 when the surface of triangle t exists at barycentrics (b1, b2): always for a material
+   without an opacity_texture, else when opacity_lookup at the interpolated uv is >= the
+   material's alpha_cutoff (0 for a NaN). 0 for a triangle out of range. This is the test a
+   raycaster applies to the hits on cutout triangles (>>api_rays, ALPHA CUTOUTS). */
+RAD_API int rad_scene_opaque(const rad_scene *scene, uint32_t triangle, float b1, float b2);
+
+/* 1 when triangle t's material is an alpha cutout (an opacity_texture the scene can look up):
+   only such triangles need rad_scene_opaque. 0 for a triangle out of range. */
+RAD_API int rad_scene_cutout(const rad_scene *scene, uint32_t triangle);
 
 /* A pinhole camera. fov_y_degrees is the full vertical field of view. */
 typedef struct rad_camera {
@@ -675,7 +707,16 @@ typedef struct rad_hit {
    two-sided sheet reports the side it sees, and an occlusion ray is blocked from either side.
    Triangles with twins[t] == RAD_NONE (and every triangle when twins is NULL) are hit from
    both sides. In Embree this is an intersection and an occlusion filter function on the
-   geometry that rejects the back of a twinned triangle (what rad_embree_create installs). */
+   geometry that rejects the back of a twinned triangle (what rad_embree_create installs).
+   ALPHA CUTOUTS. For a triangle t with rad_scene_cutout(scene, t), a hit at barycentrics
+   (b1, b2) counts only when rad_scene_opaque(scene, t, b1, b2) is 1; otherwise the ray goes
+   on as if the triangle were not there at that point (the next hit behind it is the closest
+   hit; an occlusion ray is blocked only by an opaque point). Test only the triangles
+   rad_scene_cutout names, so opaque geometry pays nothing. The built-in BVH marks cutout
+   triangles in its leaves and calls the scene's opacity_lookup only for them;
+   rad_embree_create installs filter functions that do the same. A raycaster of your own, or
+   a scene you pass to rad_embree_wrap, must apply this rule too (in Embree: an intersection
+   and an occlusion filter that set valid[i] = 0 where rad_scene_opaque is 0). */
 typedef struct rad_raycaster {
     void *user;
     /* out_occluded[i] = 1 when anything is hit with tmin < t < tmax, else 0. */
@@ -691,7 +732,9 @@ typedef struct rad_bvh rad_bvh;
    implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD). The
    subtrees below the top levels are built in parallel through ctx->parallel_for; the tree does
    not depend on the thread count. scene is borrowed only for the call (the BVH copies the
-   triangles). Errors: INVALID_ARGUMENT, OUT_OF_MEMORY, SIZE_OVERFLOW (2^29 triangles or more).
+   triangles, and the uvs, texture and cutoff of cutout triangles; the scene's opacity_lookup
+   and opacity_user are kept and must outlive the BVH). Errors: INVALID_ARGUMENT,
+   OUT_OF_MEMORY, SIZE_OVERFLOW (2^29 triangles or more).
    Cost: O(T log T). */
 RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out);
 RAD_API void rad_bvh_destroy(rad_bvh *bvh);
@@ -5001,6 +5044,15 @@ static rad_result rad__validate_materials(const rad_scene_desc *desc, const rad_
                      m->emission_texture);
             return RAD_ERROR_INVALID_ARGUMENT;
         }
+        if (m->opacity_texture != 0 && !desc->opacity_lookup) {
+            rad__log(c, RAD_LOG_ERROR, "material %u has opacity_texture %u but the scene has no opacity_lookup callback", i,
+                     m->opacity_texture);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (m->opacity_texture != 0 && !(m->alpha_cutoff >= 0.0f && m->alpha_cutoff <= 1.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "material %u: alpha_cutoff is %g, outside [0, 1]", i, (double)m->alpha_cutoff);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
     }
     return RAD_SUCCESS;
 }
@@ -5078,7 +5130,8 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
                      rad__mesh_name(m), t, mat, desc->material_count);
             return RAD_ERROR_MATERIAL_OUT_OF_RANGE;
         }
-        if ((desc->materials[mat].texture != 0 || desc->materials[mat].emission_texture != 0) && !m->uvs) {
+        if ((desc->materials[mat].texture != 0 || desc->materials[mat].emission_texture != 0 ||
+             desc->materials[mat].opacity_texture != 0) && !m->uvs) {
             rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u uses textured material %u but the mesh has no uvs", mi,
                      rad__mesh_name(m), t, mat);
             return RAD_ERROR_INVALID_ARGUMENT;
@@ -5181,6 +5234,11 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     s->albedo_user = desc->albedo_user;
     s->emission_lookup = desc->emission_lookup;
     s->emission_user = desc->emission_user;
+    for (mi = 0; mi < desc->material_count; ++mi)
+        if (desc->materials[mi].opacity_texture != 0) {
+            s->opacity_lookup = desc->opacity_lookup;
+            s->opacity_user = desc->opacity_user;
+        }
     s->positions = (float *)rad__alloc_array(&c.allocator, (size_t)n * 9u, sizeof(float));
     s->normals = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
     s->areas = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
@@ -5312,6 +5370,31 @@ RAD_API void rad_scene_emission(const rad_scene *scene, uint32_t triangle, float
     }
 }
 
+RAD_API int rad_scene_cutout(const rad_scene *scene, uint32_t triangle)
+{
+    if (!scene || triangle >= scene->triangle_count || !scene->opacity_lookup || !scene->uvs) return 0;
+    return scene->materials_table[scene->materials[triangle]].opacity_texture != 0;
+}
+
+/* the alpha cutoff of a material: 0 stands for glTF's default */
+static float rad__alpha_cutoff(const rad_material *m)
+{
+    return m->alpha_cutoff > 0.0f ? m->alpha_cutoff : 0.5f;
+}
+
+RAD_API int rad_scene_opaque(const rad_scene *scene, uint32_t triangle, float b1, float b2)
+{
+    const rad_material *m;
+    const float *uv;
+    float b0 = 1.0f - b1 - b2;
+    if (!scene || triangle >= scene->triangle_count) return 0;
+    if (!rad_scene_cutout(scene, triangle)) return 1;
+    m = &scene->materials_table[scene->materials[triangle]];
+    uv = scene->uvs + 6 * (size_t)triangle;
+    return scene->opacity_lookup(scene->opacity_user, m->opacity_texture, b0 * uv[0] + b1 * uv[2] + b2 * uv[4],
+                                 b0 * uv[1] + b1 * uv[3] + b2 * uv[5]) >= rad__alpha_cutoff(m);
+}
+
 /* 1 when triangle t can emit: its material's emission factor is not zero (a texture can
    only scale it) */
 static int rad__emits(const rad_scene *S, uint32_t t)
@@ -5394,10 +5477,10 @@ static const uint32_t rad__cornell_quad_indices[] = {
 };
 
 static const rad_material rad__cornell_materials[4] = {
-    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* white */
-    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* red */
-    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* green */
-    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0, 0, 0 }    /* light */
+    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f },    /* white */
+    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f },    /* red */
+    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f },    /* green */
+    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0, 0, 0, 0, 0.0f }    /* light */
 };
 
 #define RAD__CORNELL_MESH(name, first_vertex, quads, mat)                                                      \
@@ -6033,6 +6116,63 @@ typedef struct rad__tri4 {
 /* A lane's id bit for a triangle of a two-sided pair (rad_scene.twins): hit from its front
    only. Ids stay below 2^29, so the bit is free; one-sided scenes never set it. */
 #define RAD__BVH_FRONT_ONLY 0x80000000u
+/* A lane's id bit for an alpha-cutout triangle: a hit counts only where the opacity lookup
+   says the surface is there. Scenes without cutouts never set it, so opaque triangles never
+   reach the lookup. */
+#define RAD__BVH_CUTOUT 0x40000000u
+#define RAD__BVH_ID_BITS 0x1FFFFFFFu
+
+/* What a raycaster keeps of the scene's cutout triangles (the BVH and the Embree scene copy
+   the scene, which may be gone when they are queried): per triangle its record, and per
+   record the uvs, the opacity texture and the cutoff. */
+typedef struct rad__cutout_tri {
+    float uv[6];
+    uint32_t texture;
+    float cutoff;
+} rad__cutout_tri;
+typedef struct rad__cutout {
+    rad_opacity_fn lookup;
+    void *user;
+    uint32_t *slot;           /* per scene triangle: its record in tri, RAD_NONE when opaque */
+    rad__cutout_tri *tri;
+} rad__cutout;
+
+/* The cutout table of a scene into *out, NULL when it has no cutout triangle. */
+static rad_result rad__cutout_build(rad__ctx *c, const rad_scene *S, rad__cutout **out)
+{
+    uint32_t t, n = 0;
+    size_t bytes;
+    rad__cutout *k;
+    *out = NULL;
+    for (t = 0; t < S->triangle_count; ++t) n += (uint32_t)rad_scene_cutout(S, t);
+    if (n == 0) return RAD_SUCCESS;
+    bytes = sizeof(rad__cutout) + sizeof(uint32_t) * (size_t)S->triangle_count + sizeof(rad__cutout_tri) * (size_t)n;
+    k = (rad__cutout *)rad__alloc(&c->allocator, bytes);
+    if (!k) return RAD_ERROR_OUT_OF_MEMORY;
+    k->lookup = S->opacity_lookup;
+    k->user = S->opacity_user;
+    k->slot = (uint32_t *)(void *)(k + 1);
+    k->tri = (rad__cutout_tri *)(void *)(k->slot + S->triangle_count);
+    for (n = 0, t = 0; t < S->triangle_count; ++t) {
+        const rad_material *m = &S->materials_table[S->materials[t]];
+        if (!rad_scene_cutout(S, t)) { k->slot[t] = RAD_NONE; continue; }
+        memcpy(k->tri[n].uv, S->uvs + 6 * (size_t)t, sizeof(k->tri[n].uv));
+        k->tri[n].texture = m->opacity_texture;
+        k->tri[n].cutoff = rad__alpha_cutoff(m);
+        k->slot[t] = n++;
+    }
+    *out = k;
+    return RAD_SUCCESS;
+}
+
+/* rad_scene_opaque on the copy: 1 when triangle t (a cutout one) is there at (b1, b2) */
+static int rad__cutout_opaque(const rad__cutout *k, uint32_t t, float b1, float b2)
+{
+    const rad__cutout_tri *r = &k->tri[k->slot[t]];
+    float b0 = 1.0f - b1 - b2;
+    return k->lookup(k->user, r->texture, b0 * r->uv[0] + b1 * r->uv[2] + b2 * r->uv[4],
+                     b0 * r->uv[1] + b1 * r->uv[3] + b2 * r->uv[5]) >= r->cutoff;
+}
 
 struct rad_bvh {
     rad__bvhw *nodes;         /* in 'block', aligned to a cache line */
@@ -6043,6 +6183,7 @@ struct rad_bvh {
     void *block;              /* the allocation holding nodes and leaves */
     size_t block_bytes;
     rad_allocator allocator;
+    rad__cutout *cutout;      /* the cutout triangles, NULL when there are none */
 };
 
 #define RAD__BVH_BINS 16
@@ -6086,7 +6227,9 @@ static float rad__aabb_area(const rad__aabb *b)
 
 RAD_API void rad_bvh_destroy(rad_bvh *bvh)
 {
-    if (bvh) rad__free_object(bvh->allocator, bvh->block, bvh);
+    if (!bvh) return;
+    rad__free(&bvh->allocator, bvh->cutout);
+    rad__free_object(bvh->allocator, bvh->block, bvh);
 }
 
 RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
@@ -6495,6 +6638,14 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
     if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, scene->twins, order);
+    if (r == RAD_SUCCESS) r = rad__cutout_build(&c, scene, &b->cutout);
+    if (b->cutout) /* mark the cutout lanes */
+        for (i = 0; i < b->leaf_count; ++i) {
+            uint32_t j;
+            for (j = 0; j < 4; ++j)
+                if (b->leaves[i].id[j] != RAD_NONE && b->cutout->slot[b->leaves[i].id[j] & RAD__BVH_ID_BITS] != RAD_NONE)
+                    b->leaves[i].id[j] |= RAD__BVH_CUTOUT;
+        }
     {
         void *blocks[] = { refs, stack, task, order, tree };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
@@ -6514,6 +6665,7 @@ typedef struct rad__wray {
     int kx, ky, kz;
     float tmin, tmax;
     uint32_t near_off[3], far_off[3];
+    const rad__cutout *cut;   /* the BVH's cutout triangles (set by the caller), or NULL */
 } rad__wray;
 
 /* The set-up takes no branch on the direction: for incoherent rays (path-tracer bounces)
@@ -6558,6 +6710,7 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
     w->sz = 1.0f / w->d[w->kz];
     w->tmin = r->tmin;
     w->tmax = r->tmax;
+    w->cut = NULL;
 }
 
 #if !defined(RAD__SSE2)
@@ -6753,6 +6906,8 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
         T = (float)(((double)u[j] * (double)(w->sz * az[j]) + (double)v[j] * (double)(w->sz * bz[j]) +
                      (double)ww[j] * (double)(w->sz * cz[j])) / (double)det);
         if (!(T > w->tmin && T < *tmax)) continue;
+        if ((q->id[j] & RAD__BVH_CUTOUT) && !rad__cutout_opaque(w->cut, q->id[j] & RAD__BVH_ID_BITS, v[j] / det, ww[j] / det))
+            continue; /* a hole: the ray goes on */
         *tmax = *t_out = T;
         *b1 = v[j] / det;
         *b2 = ww[j] / det;
@@ -6768,6 +6923,7 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
         for (c = 0; c < 3; ++c)
             for (a = 0; a < 3; ++a) tri[3 * c + a] = q->v[c][a][j];
         if (!rad__wray_tri(w, tri, (q->id[j] & RAD__BVH_FRONT_ONLY) != 0, *tmax, &t, &c1, &c2)) continue;
+        if ((q->id[j] & RAD__BVH_CUTOUT) && !rad__cutout_opaque(w->cut, q->id[j] & RAD__BVH_ID_BITS, c1, c2)) continue;
         *tmax = *t_out = t;
         *b1 = c1;
         *b2 = c2;
@@ -6832,7 +6988,7 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
                     return 1;
                 }
                 hit->t = t;
-                hit->triangle = q->id[j] & ~RAD__BVH_FRONT_ONLY;
+                hit->triangle = q->id[j] & RAD__BVH_ID_BITS;
                 hit->b1 = b1;
                 hit->b2 = b2;
             }
@@ -6918,6 +7074,7 @@ static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t co
         out[i] = 0;
         if (!(rays[i].tmax > rays[i].tmin)) continue;
         rad__wray_init(&w, &rays[i]);
+        w.cut = bvh->cutout;
         /* the rays of one call come from one caller in order (a form-factor row, an image row,
            the shadow rays of neighbouring points), and consecutive ones are often stopped by
            the same triangles: the leaf that stopped the last occluded ray is tried first.
@@ -6954,6 +7111,7 @@ static rad_result rad__bvh_intersect(void *user, const rad_ray *rays, uint32_t c
         out[i].b1 = out[i].b2 = 0.0f;
         if (!(rays[i].tmax > rays[i].tmin)) continue;
         rad__wray_init(&w, &rays[i]);
+        w.cut = bvh->cutout;
         (void)rad__bvh_trace(bvh, &w, 0, &out[i], NULL, NULL);
     }
     return RAD_SUCCESS;
@@ -6982,11 +7140,14 @@ struct rad_embree {
     void *log_user;
     size_t memory;           /* device memory reported by the monitor (bytes, >= 0) */
     float *front_normals;    /* per triangle of a two-sided pair its normal, else 0 0 0; NULL
-                                without two-sided materials (no filter then) */
+                                without two-sided materials */
+    rad__cutout *cutout;     /* the cutout triangles; NULL without them (no filter when both
+                                this and front_normals are NULL) */
 };
 
-/* The filter of rad_embree_create's geometry when the scene has two-sided triangles: a hit on
-   the back of one (dot(dir, normal) >= 0) is rejected, so Embree goes on to its twin. */
+/* The filter of rad_embree_create's geometry when the scene has two-sided or cutout
+   triangles: a hit on the back of a two-sided one (dot(dir, normal) >= 0) is rejected, so
+   Embree goes on to its twin, and so is a hit in a cutout's hole, so Embree goes on behind. */
 static void rad__embree_front_filter(const struct RTCFilterFunctionNArguments *args)
 {
     /* the packets' structure-of-arrays layout of rtcore_ray.h (its accessors are C++ only):
@@ -6998,10 +7159,19 @@ static void rad__embree_front_filter(const struct RTCFilterFunctionNArguments *a
     for (i = 0; i < N; ++i) {
         const float *n;
         float d;
+        uint32_t t;
         if (args->valid[i] == 0) continue;
-        n = e->front_normals + 3 * (size_t)hit[5 * N + i];
-        d = ray[4 * N + i] * n[0] + ray[5 * N + i] * n[1] + ray[6 * N + i] * n[2];
-        if ((n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f) && !(d < 0.0f)) args->valid[i] = 0;
+        t = hit[5 * N + i];
+        if (e->front_normals) {
+            n = e->front_normals + 3 * (size_t)t;
+            d = ray[4 * N + i] * n[0] + ray[5 * N + i] * n[1] + ray[6 * N + i] * n[2];
+            if ((n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f) && !(d < 0.0f)) { args->valid[i] = 0; continue; }
+        }
+        /* barycentrics u, v at float rows 3 and 4 of the hit */
+        if (e->cutout && e->cutout->slot[t] != RAD_NONE &&
+            !rad__cutout_opaque(e->cutout, t, ((const float *)(const void *)args->hit)[3 * N + i],
+                                ((const float *)(const void *)args->hit)[4 * N + i]))
+            args->valid[i] = 0;
     }
 }
 
@@ -7037,6 +7207,7 @@ RAD_API void rad_embree_destroy(rad_embree *e)
     }
     rad__free(&a, e->first);
     rad__free(&a, e->front_normals);
+    rad__free(&a, e->cutout);
     rad__free(&a, e);
 }
 
@@ -7087,6 +7258,13 @@ RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *
             for (k = 0; k < 3; ++k)
                 e->front_normals[3 * (size_t)t + (size_t)k] = scene->twins[t] != RAD_NONE ? scene->normals[3 * (size_t)t + (size_t)k] : 0.0f;
         }
+    }
+    if (rad__cutout_build(&c, scene, &e->cutout) != RAD_SUCCESS) {
+        rtcReleaseGeometry(g);
+        rad_embree_destroy(e);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (e->front_normals || e->cutout) {
         rtcSetGeometryUserData(g, e);
         rtcSetGeometryIntersectFilterFunction(g, rad__embree_front_filter);
         rtcSetGeometryOccludedFilterFunction(g, rad__embree_front_filter);

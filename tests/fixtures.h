@@ -262,7 +262,7 @@ static inline int ff_world_make(const rad_scene_desc *desc, float max_edge, uint
     return 1;
 }
 
-static const rad_material ff_grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 };
+static const rad_material ff_grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f };
 
 static inline void ff_desc(rad_scene_desc *d, const rad_mesh_desc *meshes, uint32_t count)
 {
