@@ -593,7 +593,10 @@ RAD_API void rad_cornell_box(rad_scene_desc *desc, rad_camera *camera);
 typedef struct rad_patch {
     float centroid[3];
     float normal[3];
-    float area;
+    float area;           /* on an alpha cutout: the area times the opaque fraction (measured
+                             on a lattice of max(albedo_samples, 256) points), so the patch
+                             receives, reflects and emits on its opaque part only; albedo and
+                             emission are then means over its opaque points */
     float albedo[3];      /* mean albedo over the patch (texture-averaged when textured) */
     float emission[3];    /* emitted radiance L: the material's, averaged over the patch
                              like the albedo when it has an emission_texture */
@@ -5605,18 +5608,42 @@ static uint32_t rad__weld_vertex(rad__weld *w, float *vertices, uint32_t *nv, co
     return q;
 }
 
-/* Mean textured albedo over the sub-triangle with corner barycentrics lb (of triangle t). */
+/* The fewest lattice points a cutout patch's opaque fraction is measured with: an alpha
+   texture's holes are often finer than a patch, and a coarse lattice aliases with them. */
+#define RAD__CUTOUT_SAMPLES 256u
+
+/* The opaque fraction of the sub-triangle with corner barycentrics lb of cutout triangle t:
+   the share of a lattice of 'samples' points where rad_scene_opaque holds. */
+static float rad__patch_opacity(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples)
+{
+    uint32_t s, in = 0, side = rad__lattice_side(samples);
+    float c3[9]; /* the corners as 3-vectors (z = 0) for rad__lattice_point */
+    int k;
+    samples = side * side;
+    for (k = 0; k < 3; ++k) { c3[3 * k] = lb[k][0]; c3[3 * k + 1] = lb[k][1]; c3[3 * k + 2] = 0.0f; }
+    for (s = 0; s < samples; ++s) {
+        float q[3];
+        rad__lattice_point(c3, c3 + 3, c3 + 6, side, s, q);
+        in += (uint32_t)rad_scene_opaque(scene, t, q[0], q[1]);
+    }
+    return (float)in / (float)samples;
+}
+
+/* Mean textured albedo over the sub-triangle with corner barycentrics lb (of triangle t); on
+   a cutout, over its opaque points only (all of them when it has none). */
 static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples,
                                     const rad__ctx *c, float *out)
 {
     double acc[3] = { 0.0, 0.0, 0.0 };
-    uint32_t s;
-    int k;
+    uint32_t s, used = 0;
+    int k, cut = rad_scene_cutout(scene, t) && rad__patch_opacity(scene, t, lb, samples) > 0.0f;
     uint32_t side = rad__lattice_side(samples);
     samples = side * side;
     for (s = 0; s < samples; ++s) {
         float q[3], rgb[3];
         rad__lattice_point(lb[0], lb[1], lb[2], side, s, q); /* in the triangle's (b1, b2) plane */
+        if (cut && !rad_scene_opaque(scene, t, q[0], q[1])) continue; /* the same lattice: some are kept */
+        ++used;
         rad_scene_albedo(scene, t, q[0], q[1], rgb);
         for (k = 0; k < 3; ++k) {
             if (!rad__finite(rgb[k]) || rgb[k] < 0.0f || rgb[k] >= 1.0f) {
@@ -5627,29 +5654,32 @@ static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const fl
             acc[k] += rgb[k];
         }
     }
-    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)samples);
+    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)used);
     return RAD_SUCCESS;
 }
 
 /* Mean emission over the sub-triangle with corner barycentrics lb (of triangle t), the same
-   lattice as the albedo's: the patch sends the power its part of the texture sends. */
+   lattice as the albedo's (and like it over a cutout's opaque points): the patch sends the
+   power its part of the texture sends. */
 static rad_result rad__patch_emission(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples,
                                       const rad__ctx *c, float *out)
 {
     double acc[3] = { 0.0, 0.0, 0.0 };
-    uint32_t s, side = rad__lattice_side(samples);
+    uint32_t s, side = rad__lattice_side(samples), used = 0;
     float c3[9]; /* the corners as 3-vectors (z = 0) for rad__lattice_point */
     rad_result r;
-    int k;
+    int k, cut = rad_scene_cutout(scene, t) && rad__patch_opacity(scene, t, lb, samples) > 0.0f;
     samples = side * side;
     for (k = 0; k < 3; ++k) { c3[3 * k] = lb[k][0]; c3[3 * k + 1] = lb[k][1]; c3[3 * k + 2] = 0.0f; }
     for (s = 0; s < samples; ++s) {
         float q[3], rgb[3];
         rad__lattice_point(c3, c3 + 3, c3 + 6, side, s, q);
+        if (cut && !rad_scene_opaque(scene, t, q[0], q[1])) continue;
+        ++used;
         if ((r = rad__emission_at(scene, t, q[0], q[1], c, rgb)) != RAD_SUCCESS) return r;
         for (k = 0; k < 3; ++k) acc[k] += rgb[k];
     }
-    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)samples);
+    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)used);
     for (k = 0; k < 3; ++k)
         if (!rad__finite(out[k])) {
             rad__log(c, RAD_LOG_ERROR, "material %u: the mean textured emission on triangle %u overflows",
@@ -5766,6 +5796,14 @@ static rad_result rad__patches_fill(rad_patches *P, const rad_scene *scene, uint
                 }
                 if (r == RAD_SUCCESS && rad__emission_textured(scene, t))
                     r = rad__patch_emission(scene, t, (const float(*)[2])lb, albedo_samples, c, pt->emission);
+                if (rad_scene_cutout(scene, t)) {
+                    /* the patch stands for its opaque part: it receives, reflects and emits
+                       on that area only (a patch wholly in a hole keeps a sliver, so area
+                       ratios stay finite, and its light is negligible) */
+                    float f = rad__patch_opacity(scene, t, (const float(*)[2])lb,
+                                                 albedo_samples > RAD__CUTOUT_SAMPLES ? albedo_samples : RAD__CUTOUT_SAMPLES);
+                    pt->area *= f > 1e-6f ? f : 1e-6f;
+                }
                 P->areas[idx] = pt->area;
                 memcpy(P->albedo + 3 * (size_t)idx, pt->albedo, 3 * sizeof(float));
             }
