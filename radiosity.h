@@ -3759,7 +3759,10 @@ RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash);
 /* The two hashes of a signature, stable across platforms, byte orders and builds (only the
    scene's input values enter, as the little-endian bytes of their IEEE bit patterns, never
    values the library derives from them):
-     geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats;
+     geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats
+                 and, for a triangle of a cutout material (opacity_texture not 0), that
+                 material's opacity_texture (uint32) and alpha_cutoff (float), which decide
+                 where rays pass;
      materials = rad_hash64 of triangle_count, then per triangle its material's albedo[3],
                  emission[3] (floats) and texture (uint32), and its emission_texture (uint32)
                  when that is not 0, then 1 and the 6 uv floats per triangle when the scene
@@ -23782,7 +23785,15 @@ RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry
     if (out_materials) *out_materials = 0;
     if (!scene || !scene->positions || !scene->materials || !scene->materials_table) return RAD_ERROR_INVALID_ARGUMENT;
     g = rad__hash_words(g, &scene->triangle_count, 1);
-    g = rad__hash_words(g, scene->positions, 9u * (size_t)scene->triangle_count);
+    for (t = 0; t < scene->triangle_count; ++t) {
+        const uint32_t mi = scene->materials[t];
+        if (mi >= scene->material_count) return RAD_ERROR_INVALID_ARGUMENT;
+        g = rad__hash_words(g, scene->positions + 9u * (size_t)t, 9u);
+        if (scene->materials_table[mi].opacity_texture) { /* hashed only when set: older hashes stay valid */
+            g = rad__hash_words(g, &scene->materials_table[mi].opacity_texture, 1);
+            g = rad__hash_words(g, &scene->materials_table[mi].alpha_cutoff, 1);
+        }
+    }
     m = rad__hash_words(m, &scene->triangle_count, 1);
     for (t = 0; t < scene->triangle_count; ++t) {
         const uint32_t mi = scene->materials[t];
