@@ -5,8 +5,10 @@
 # canopy: the tool's default render (`rad render`, classic radiosity) against the path tracer
 # (`rad trace`, same cutouts), ratio of mean linear radiance and SSIM (`rad compare`), and the
 # same scene with the leaves opaque (alphaMode OPAQUE) to show what the cutouts change.
-# Never part of make test.
-#   bash tests/bench/cutout.sh build/rad [OUT.md]
+# METHODS (default: the tool's default only) adds rows for other --method values on the cutout
+# scene: hierarchical radiosity and virtual patches see through the holes but reflect over
+# the cards' full area (docs/methods/cutout.md). Never part of make test.
+#   [SPP=512] [METHODS="hierarchical aavp"] bash tests/bench/cutout.sh build/rad [OUT.md]
 set -eu
 RAD=$1
 OUT=${2:-/dev/stdout}
@@ -96,16 +98,21 @@ secs() {
     echo "| leaves | render (s) | trace (s) | mean render | mean trace | render / trace | SSIM |"
     echo "|---|---:|---:|---:|---:|---:|---:|"
 } >> "$OUT"
-for f in foliage foliage_opaque; do
+for f in foliage foliage_opaque ${METHODS:-}; do
+    m=""
+    scene=$f
+    case $f in foliage*) ;; *) m="--method $f" scene=foliage ;; esac
     # shellcheck disable=SC2086
-    "$RAD" render "$TMP/$f.gltf" $VIEW -o "$TMP/r.pfm" > "$TMP/r.txt" 2>&1
+    "$RAD" render "$TMP/$scene.gltf" $VIEW $m -o "$TMP/r.pfm" > "$TMP/r.txt" 2>&1
     # shellcheck disable=SC2086
-    "$RAD" trace "$TMP/$f.gltf" $VIEW --spp "$SPP" -o "$TMP/t.pfm" > "$TMP/t.txt" 2>&1
+    [ -n "$m" ] || "$RAD" trace "$TMP/$f.gltf" $VIEW --spp "$SPP" -o "$TMP/t.pfm" > "$TMP/t.txt" 2>&1
+    [ "$f" != foliage ] || cp "$TMP/t.pfm" "$TMP/t_cut.pfm"
+    [ -z "$m" ] || cp "$TMP/t_cut.pfm" "$TMP/t.pfm"
     "$RAD" compare "$TMP/r.pfm" "$TMP/t.pfm" > "$TMP/c.txt" 2> /dev/null || true
     mr=$(awk '/^mean:/ { print $2 }' "$TMP/c.txt")
     mt=$(awk '/^mean:/ { print $3 }' "$TMP/c.txt")
     ratio=$(awk '/^mean:/ { for (i = 1; i <= NF; ++i) if ($i == "=") print $(i + 1) }' "$TMP/c.txt")
     ssim=$(awk '/^SSIM/ { print $2 }' "$TMP/c.txt")
-    printf '| %s | %s | %s | %s | %s | %.4f | %.4f |\n' "$([ $f = foliage ] && echo "cutout (MASK)" || echo "opaque")" \
+    printf '| %s | %s | %s | %s | %s | %.4f | %.4f |\n' "$(case $f in foliage) echo "cutout (MASK)" ;; foliage_opaque) echo opaque ;; *) echo "cutout, --method $f" ;; esac)" \
         "$(secs "$TMP/r.txt")" "$(secs "$TMP/t.txt")" "${mr:--}" "${mt:--}" "${ratio:-0}" "${ssim:-0}" >> "$OUT"
 done
