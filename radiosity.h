@@ -152,6 +152,9 @@
          (rad_material.two_sided) becomes two scene triangles, one per side, back to back
          (rad_scene.twins): each side has its own patches and samples, so every method treats
          the two sides as independent surfaces.
+       - A material with an opacity_texture is an alpha cutout: the surface exists only where
+         rad_scene_desc.opacity_lookup gives alpha >= alpha_cutoff. Rays pass the holes, and
+         a patch's area is its opaque part (rad_patch.area).
        - Directions at infinity (environment maps, Preetham's sky, the sky transfer's bins):
          +Y is up, azimuth from +X towards +Z; rad_sun_direction puts east at +X and south at
          +Z (>>api_light, ENVIRONMENT MAP).
