@@ -5412,11 +5412,13 @@ static int rad__emits(const rad_scene *S, uint32_t t)
     return e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
 }
 
-/* 1 when triangle t's emission varies over it (an emission_texture the scene can look up) */
+/* 1 when triangle t's emission varies over it (an emission_texture the scene can look up, or
+   a cutout emitter, dark in its holes) */
 static int rad__emission_textured(const rad_scene *S, uint32_t t)
 {
     const rad_material *m = &S->materials_table[S->materials[t]];
-    return m->emission_texture != 0 && S->emission_lookup != NULL && S->uvs != NULL && rad__emits(S, t);
+    return ((m->emission_texture != 0 && S->emission_lookup != NULL && S->uvs != NULL) || rad_scene_cutout(S, t)) &&
+           rad__emits(S, t);
 }
 
 /* rad_scene_emission checked: NEGATIVE_EMISSION (logged with the material) when the lookup
@@ -5434,6 +5436,9 @@ static rad_result rad__emission_at(const rad_scene *S, uint32_t t, float b1, flo
                      mi, S->materials_table[mi].emission_texture, (double)out[k], k, t);
             return RAD_ERROR_NEGATIVE_EMISSION;
         }
+    /* a point in a cutout's hole emits nothing: every per-point emitter sampler gets the
+       emitter's power right without a test of its own */
+    if (rad_scene_cutout(S, t) && !rad_scene_opaque(S, t, b1, b2)) out[0] = out[1] = out[2] = 0.0f;
     return RAD_SUCCESS;
 }
 
@@ -5759,6 +5764,9 @@ static rad_result rad__patches_fill(rad_patches *P, const rad_scene *scene, uint
     uint32_t i, j, base = P->first_patch[t];
     float sub_area = scene->areas[t] / ((float)n * (float)n);
     rad_result r = RAD_SUCCESS;
+    /* a cutout takes its albedo, emission and opaque fraction on one finer lattice, so they
+       agree on where the surface is */
+    if (rad_scene_cutout(scene, t) && albedo_samples < RAD__CUTOUT_SAMPLES) albedo_samples = RAD__CUTOUT_SAMPLES;
     for (j = 0; j < n && r == RAD_SUCCESS; ++j)
         for (i = 0; i + j < n && r == RAD_SUCCESS; ++i) {
             int up;
@@ -5806,8 +5814,7 @@ static rad_result rad__patches_fill(rad_patches *P, const rad_scene *scene, uint
                     /* the patch stands for its opaque part: it receives, reflects and emits
                        on that area only (a patch wholly in a hole keeps a sliver, so area
                        ratios stay finite, and its light is negligible) */
-                    float f = rad__patch_opacity(scene, t, (const float(*)[2])lb,
-                                                 albedo_samples > RAD__CUTOUT_SAMPLES ? albedo_samples : RAD__CUTOUT_SAMPLES);
+                    float f = rad__patch_opacity(scene, t, (const float(*)[2])lb, albedo_samples);
                     pt->area *= f > 1e-6f ? f : 1e-6f;
                 }
                 P->areas[idx] = pt->area;
@@ -11181,6 +11188,10 @@ static rad_result rad__hr_sources(rad_hierarchical *h, uint32_t first, const rad
             if (rad__emission_textured(h->scene, h->el[i].tri) &&
                 (r = rad__patch_emission(h->scene, h->el[i].tri, (const float(*)[2])h->el[i].b, 16u, c, L)) != RAD_SUCCESS)
                 return r;
+            if (rad_scene_cutout(h->scene, h->el[i].tri)) { /* elements keep their full area: the mean counts the holes */
+                float f = rad__patch_opacity(h->scene, h->el[i].tri, (const float(*)[2])h->el[i].b, RAD__CUTOUT_SAMPLES);
+                for (k = 0; k < 3; ++k) L[k] *= f;
+            }
             for (k = 0; k < 3; ++k) h->el[i].E[k] = (float)RAD__PI * L[k];
         }
         return RAD_SUCCESS;
