@@ -5,7 +5,9 @@
 # y = 0.5, facing down, radiance 1), with a black screen at y = 0.25 over [-0.5, 1.5]^2 between
 # them whose base-colour texture's alpha is a checkerboard (cells of 4 texels, 64 x 64 texels
 # over the screen: half of it holes). The generator writes it as glTF (alphaMode given) and as
-# OBJ with map_d; the PNG is written with zlib by hand.
+# OBJ with map_d, and once more with the screen open and the emitter itself a MASK cutout of
+# the same checkerboard (cells of 1/16 over the unit emitter); the PNG is written with zlib by
+# hand.
 co_gen() { # co_gen DIR
     python3 - "$1" <<'PY'
 import base64, json, struct, sys, zlib
@@ -30,7 +32,7 @@ quads = [  # corners (counter-clockwise seen from the front), uvs
     ([(0, 0.5, 0), (1, 0.5, 0), (1, 0.5, 1), (0, 0.5, 1)], "light"),
     ([(-0.5, 0.25, -0.5), (1.5, 0.25, -0.5), (1.5, 0.25, 1.5), (-0.5, 0.25, 1.5)], "screen")]
 uv = [(0, 0), (1, 0), (1, 1), (0, 1)]
-def gltf(mode, factor_alpha, name):
+def gltf(mode, factor_alpha, name, light_mask=False):
     pos, tex, idx = [], [], []
     for q, _ in quads:
         for p in q: pos += p
@@ -41,11 +43,14 @@ def gltf(mode, factor_alpha, name):
               "baseColorTexture": {"index": 0}}, "alphaMode": mode}
     if mode == "MASK": screen["alphaCutoff"] = 0.5
     if factor_alpha < 1: del screen["pbrMetallicRoughness"]["baseColorTexture"]
+    light = {"name": "light", "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1]}
+    if light_mask:
+        light["alphaMode"] = "MASK"
+        light["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
     g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
          "nodes": [{"mesh": k, "name": quads[k][1]} for k in range(3)],
          "materials": [{"name": "floor", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}},
-                       {"name": "light", "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1]},
-                       screen],
+                       light, screen],
          "meshes": [{"name": quads[k][1], "primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2 + k,
                      "material": k}]} for k in range(3)],
          "images": [{"uri": "data:image/png;base64," + base64.b64encode(img).decode()}],
@@ -62,6 +67,7 @@ def gltf(mode, factor_alpha, name):
 gltf("MASK", 1.0, "mask.gltf")
 gltf("OPAQUE", 1.0, "opaque.gltf")
 gltf("BLEND", 0.3, "blend.gltf")  # a constant alpha below 0.5: the screen is all hole
+gltf("BLEND", 0.3, "lightmask.gltf", True)  # the open screen, and the emitter a checkerboard cutout
 with open(d + "/screen.mtl", "w") as f:
     f.write("newmtl floor\nKd 0.5 0.5 0.5\nnewmtl light\nKd 0 0 0\nKe 1 1 1\nnewmtl screen\nKd 0 0 0\nmap_d checker.png\n")
 with open(d + "/screen.obj", "w") as f:
@@ -99,10 +105,11 @@ else
         co_half=$(co_val $co_cmd "$TMP/cut/mask.gltf")
         co_obj=$(co_val $co_cmd "$TMP/cut/screen.obj")
         co_solid=$(co_val $co_cmd "$TMP/cut/opaque.gltf")
+        co_lamp=$(co_val $co_cmd "$TMP/cut/lightmask.gltf")
         co_expect=$(awk -v o="$co_open" 'BEGIN { printf "%.9g\n", o / 2 }')
         awk -v o="$co_open" 'BEGIN { exit !(o > 0.05) }' && close "$co_half" "$co_expect" 0.05 && close "$co_obj" "$co_expect" 0.05 &&
-            [ "$co_solid" = "0" ] &&
-            ok "cutout screen, rad $co_cmd: MASK $co_half and map_d $co_obj = half of open $co_open; OPAQUE $co_solid" ||
-            fail "cutout screen, rad $co_cmd" "MASK $co_half, map_d $co_obj, open (BLEND 0.3) $co_open, OPAQUE $co_solid; $(head -c 300 "$TMP/err.txt")"
+            [ "$co_solid" = "0" ] && close "$co_lamp" "$co_expect" 0.05 &&
+            ok "cutout screen, rad $co_cmd: MASK $co_half, map_d $co_obj and a MASK emitter $co_lamp = half of open $co_open; OPAQUE $co_solid" ||
+            fail "cutout screen, rad $co_cmd" "MASK $co_half, map_d $co_obj, MASK emitter $co_lamp, open (BLEND 0.3) $co_open, OPAQUE $co_solid; $(head -c 300 "$TMP/err.txt")"
     done
 fi
