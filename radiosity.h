@@ -10849,9 +10849,7 @@ static void rad__hr_node_point(const rad_hierarchical *h, uint32_t id, float u0,
     memcpy(n, nv, 3 * sizeof(float));
 }
 
-/* the element's albedo at its centroid; ALBEDO_RANGE when a texture callback leaves [0,1).
-   On a cutout it is scaled by the element's opaque fraction: the element keeps its full area,
-   so it reflects the power its opaque part reflects. */
+/* the element's albedo at its centroid; ALBEDO_RANGE when a texture callback leaves [0,1) */
 static rad_result rad__hr_albedo(const rad_hierarchical *h, rad__hr_elem *e, const rad__ctx *c)
 {
     int k;
@@ -10862,10 +10860,6 @@ static rad_result rad__hr_albedo(const rad_hierarchical *h, rad__hr_elem *e, con
                      (double)e->rho[k], e->tri, k);
             return RAD_ERROR_ALBEDO_RANGE;
         }
-    if (rad_scene_cutout(h->scene, e->tri)) {
-        float f = rad__patch_opacity(h->scene, e->tri, (const float(*)[2])e->b, RAD__CUTOUT_SAMPLES);
-        for (k = 0; k < 3; ++k) e->rho[k] *= f;
-    }
     return RAD_SUCCESS;
 }
 
