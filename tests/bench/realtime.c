@@ -429,7 +429,7 @@ int main(int argc, char **argv)
     snprintf(path, sizeof path, "%s/sponza.obj", dir);
     if (only && strcmp(only, "sponza")) {
     } else if (load_obj(path, &sponza)) {
-        rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0};
+        rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0, 0, 0.0f};
         rad_mesh_desc md;
         rad_scene_desc d;
         rad_light sun;
