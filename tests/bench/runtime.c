@@ -8,8 +8,9 @@
    frames the outputs are compared with a fresh rad_baker_run with the lights there (mean
    relative difference of the vertex light, the lightmap's valid texels and the probes), and at
    the end the light rests and the frames run until CONVERGED, compared again.
+   --orbit N: the point light turns once in N frames (default: --frames).
    Usage: runtime [--data DIR] [--res N] [--size N] [--probes N] [--frames N] [--budget MS]
-                  [--checks N] [--quick] [--append FILE.md] */
+                  [--checks N] [--orbit N] [--quick] [--append FILE.md] */
 #include "bench_common.h" /* first: it asks for POSIX clock_gettime */
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
@@ -58,10 +59,11 @@ static rad_baker_desc g_desc;
 static rad_baker_options g_opt;
 static rad_baker_light g_lights[2];
 static float g_centre[3], g_radius;
+static uint32_t g_orbit; /* frames per turn of the point light (0: --frames) */
 
 static void light_at(uint32_t frame, uint32_t frames, rad_light *out)
 {
-    float a = 6.2831853f * (float)frame / (float)frames;
+    float a = 6.2831853f * (float)frame / (float)(g_orbit ? g_orbit : frames);
     *out = g_lights[1].light;
     out->position[0] = g_centre[0] + g_radius * cosf(a);
     out->position[2] = g_centre[2] + g_radius * sinf(a);
@@ -112,10 +114,11 @@ int main(int argc, char **argv)
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--frames")) frames = (uint32_t)atoi(argv[++i]);
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--budget")) budget = atof(argv[++i]);
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--checks")) checks = (uint32_t)atoi(argv[++i]);
+        else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--orbit")) g_orbit = (uint32_t)atoi(argv[++i]);
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--append")) append = argv[++i];
         else if (!strcmp(argv[i], "--quick")) quick = 1;
         else return fprintf(stderr, "usage: runtime [--data DIR] [--res N] [--size N] [--probes N] [--frames N] "
-                                    "[--budget MS] [--checks N] [--quick] [--append FILE.md]\n"), 2;
+                                    "[--budget MS] [--checks N] [--orbit N] [--quick] [--append FILE.md]\n"), 2;
     }
     if (quick) res = res < 12 ? res : 12, size = size < 256 ? size : 256, nprobes = nprobes < 64 ? nprobes : 64,
                frames = frames < 20 ? frames : 20, checks = checks < 1 ? checks : 1;
@@ -196,10 +199,10 @@ int main(int argc, char **argv)
     check(rad_baker_runtime_create(&g_desc, &g_opt, R, NULL, NULL, &rt), "rad_baker_runtime_create");
     t_rt = now() - t, c_rt = cpu_now() - c;
     emit("%s (%u triangles), %u virtual patches (resolution %u), a %ux%u lightmap (%u charts), %u probes, a sun and a "
-         "point light circling in %u frames; bake %.1f s (CPU %.1f s), runtime create %.1f s (CPU %.1f s); load average "
+         "point light turning once in %u frames; bake %.1f s (CPU %.1f s), runtime create %.1f s (CPU %.1f s); load average "
          "at the start %s\n\n",
          have_sponza ? "Sponza" : "Cornell box", S->triangle_count, R->patch_count, R->vp_resolution, side, side, charts,
-         R->probe_count, frames, t_bake, c_bake, t_rt, c_rt, "(see below)");
+         R->probe_count, g_orbit ? g_orbit : frames, t_bake, c_bake, t_rt, c_rt, "(see below)");
     {
         FILE *la = fopen("/proc/loadavg", "r");
         char buf[128] = "?";
