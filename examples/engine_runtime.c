@@ -6,8 +6,8 @@
    temporal step; when it stops they refine until the outputs equal a bake with the lamp
    there (phase CONVERGED), after which a frame costs nothing. examples/engine_bake.c is the
    bake and the light layers; examples/realtime.c is the same loop written with the lower-
-   level calls. Prints what each frame did and checks that every value is finite and >= 0
-   (exit 1 if not). */
+   level calls. Prints what each frame did and checks that every vertex value is finite and
+   >= 0 and that the frames converge (exit 1 if not). */
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
 #include <math.h>
@@ -83,8 +83,7 @@ int main(void)
         }
         /* an engine uploads frame.vertex (and frame.probes) here */
         for (i = 0; i < baked->vertex_count; ++i) mean += frame.vertex[3 * i + 1];
-        bad += count_bad(frame.vertex, 3 * (size_t)baked->vertex_count) +
-               count_bad(frame.probes, 27 * (size_t)baked->probe_count) * 0u; /* SH coefficients may be negative */
+        bad += count_bad(frame.vertex, 3 * (size_t)baked->vertex_count); /* (SH coefficients may be negative) */
         if (f <= 3 || f % 6 == 0 || frame.phase == RAD_BAKER_RUNTIME_CONVERGED)
             printf("%5u  %-9s  %6u  %6u  %10.3f  %.5f\n", f, phase_name(frame.phase), frame.sweeps, frame.probes_refreshed,
                    frame.planned_ms, mean / baked->vertex_count);
