@@ -3321,10 +3321,11 @@ RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_coun
    per patch, history 'temporal_weight': noisy, and lagging about 1 / (1 - w) frames), and
    H_i = L_i / rho_i (the step estimates L_i = rho_i (F (E + L))_i; a channel with rho 0 takes
    its exact sparse row). Once the lights REST the shadows finish their round (ceil(M /
-   shadow_rays) frames), then REFINEMENT replaces the estimate by exact Jacobi sweeps on the
-   sparse F (H = F (E + L), L = rho H), rows taken from the budget, 'bounces' + 1 sweeps; then
-   the outputs equal a fresh bake with the lights there, to float rounding. A frame after that
-   with the same lights does nothing (CONVERGED).
+   shadow_rays) frames), then REFINEMENT runs exact Jacobi sweeps from L = 0 on the sparse F
+   (H = F (E + L), L = rho H), rows taken from the budget, 'bounces' + 1 sweeps, in planes of
+   its own (the frames keep the estimate until it ends); then the outputs equal a fresh bake
+   with the lights there, to float rounding. A frame after that with the same lights does
+   nothing (CONVERGED).
    BUDGET (budget_ms > 0; 0: no limit: every output refreshed and, at rest, refinement run to
    the end in that call). The plan is a cost model, never a clock: each stage's work counted in
    units (an entry read, a draw, a ray as 200) at 'work_per_ms' units per ms, so the same calls
