@@ -141,7 +141,7 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/temporal --append docs/BENCHMARKS.md
 	./$(BUILD)/shading --append docs/BENCHMARKS.md
 	./$(BUILD)/local --append docs/BENCHMARKS.md
-	./$(BUILD)/probes --sweep --append docs/BENCHMARKS.md
+	./$(BUILD)/probes --append docs/BENCHMARKS.md
 	./$(BUILD)/bench_lightmap --append docs/BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/realtime.sh $(BUILD) docs/BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/sponza.sh $(BUILD)/rad docs/BENCHMARKS.md

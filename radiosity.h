@@ -1,4 +1,4 @@
-/* radiosity.h - v0.3.0 - diffuse global illumination by the radiosity method
+/* radiosity.h - v0.4.0 - diffuse global illumination by the radiosity method
    public domain or MIT, your choice (see end of file)
 
    Do this:
@@ -152,6 +152,9 @@
          (rad_material.two_sided) becomes two scene triangles, one per side, back to back
          (rad_scene.twins): each side has its own patches and samples, so every method treats
          the two sides as independent surfaces.
+       - A material with an opacity_texture is an alpha cutout: the surface exists only where
+         rad_scene_desc.opacity_lookup gives alpha >= alpha_cutoff. Rays pass the holes, and
+         a patch's area is its opaque part (rad_patch.area).
        - Directions at infinity (environment maps, Preetham's sky, the sky transfer's bins):
          +Y is up, azimuth from +X towards +Z; rad_sun_direction puts east at +X and south at
          +Z (>>api_light, ENVIRONMENT MAP).
@@ -212,6 +215,9 @@
        occlusion rays; one-sided triangles are hit from either side as before. The BVH and
        the Embree backend do this; a raycaster of your own must too (an Embree scene you wrap
        with rad_embree_wrap needs the filter function described at >>api_rays).
+       Alpha cutouts (rad_material.opacity_texture): a hit on a cutout triangle counts only
+       where rad_scene_opaque says the surface exists; rays go on through the holes, for
+       closest hits and occlusion alike (>>api_rays, ALPHA CUTOUTS).
 
    8. EMBREE
        With RAD_EMBREE defined in the implementing file (and -lembree3), rad_embree_create
@@ -291,6 +297,9 @@
        - Start threads, touch the GPU itself, or keep global state.
 
   13. HISTORY
+       0.4.0  two-sided materials; emission textures; environment maps, Preetham's sky and
+              the sky transfer; the engine tier (rad_baker_*) with light layers; zero means
+              default in every option struct; RAD_FMA opt-in; hierarchical memory limit.
        0.3.0  hemicube form factors; stochastic radiosity; hierarchical radiosity with
               clustering; lightmaps; irradiance probes (SH L2, band 4, over patches or
               virtual patches); final gather; dynamic lights over virtual patches; sparse
@@ -312,9 +321,9 @@
 #include <stdint.h>
 
 #define RAD_VERSION_MAJOR 0
-#define RAD_VERSION_MINOR 3
+#define RAD_VERSION_MINOR 4
 #define RAD_VERSION_PATCH 0
-#define RAD_VERSION_STRING "0.3.0"
+#define RAD_VERSION_STRING "0.4.0"
 
 #ifndef RAD_API
 #  ifdef RADIOSITY_STATIC
@@ -424,6 +433,13 @@ typedef void (*rad_albedo_fn)(void *user, uint32_t texture, float u, float v, fl
    the material. */
 typedef void (*rad_emission_fn)(void *user, uint32_t texture, float u, float v, float out_rgb[3]);
 
+/* Opacity lookup by texture coordinate: returns the alpha (coverage) at (u, v) of 'texture'
+   (the material's opacity_texture id, never 0), in [0, 1]. Where it is below the material's
+   alpha_cutoff the surface is not there: rays pass through, and the point neither receives,
+   reflects nor emits (an alpha cutout). Must be thread-safe; it is called during ray
+   traversal, so it must be cheap. A NaN counts as transparent. */
+typedef float (*rad_opacity_fn)(void *user, uint32_t texture, float u, float v);
+
 typedef struct rad_material {
     float albedo[3];    /* diffuse reflectance, each channel in [0, 1) */
     float emission[3];  /* emitted RADIANCE L (W m^-2 sr^-1), >= 0; exitance is pi * L */
@@ -434,6 +450,11 @@ typedef struct rad_material {
                            'emission' (the factor) at each point (needs uvs on the mesh) */
     uint32_t two_sided; /* 0: one-sided, the back absorbs; non-zero: both sides receive,
                            reflect and emit, each on its own (see rad_scene.twins) */
+    uint32_t opacity_texture; /* 0: opaque everywhere; else an alpha cutout: passed to
+                           rad_scene_desc.opacity_lookup, and the surface exists only where
+                           the alpha is >= alpha_cutoff (needs uvs on the mesh) */
+    float alpha_cutoff; /* the cutout's threshold in [0, 1]; 0: 0.5 (glTF's default). Only
+                           read with an opacity_texture */
 } rad_material;
 
 typedef struct rad_mesh_desc {
@@ -443,7 +464,8 @@ typedef struct rad_mesh_desc {
     uint32_t vertex_count;
     const float *normals;          /* optional shading normals (unused by the solver) */
     size_t normal_stride;          /* 0: 3 * sizeof(float) */
-    const float *uvs;              /* optional u v, needed by materials with a texture or an emission_texture */
+    const float *uvs;              /* optional u v, needed by materials with a texture, an emission_texture
+                                      or an opacity_texture */
     size_t uv_stride;              /* 0: 2 * sizeof(float) */
     const uint32_t *indices;       /* 3 per triangle; NULL: vertices taken in threes */
     uint32_t triangle_count;
@@ -470,6 +492,10 @@ typedef struct rad_scene_desc {
     uint32_t flags;                /* rad_scene_flags */
     rad_emission_fn emission_lookup; /* optional: needed by materials with an emission_texture */
     void *emission_user;
+    rad_opacity_fn opacity_lookup; /* optional: needed by materials with an opacity_texture (alpha
+                                      cutouts); it and opacity_user must outlive the scene and
+                                      every BVH or Embree scene built from it */
+    void *opacity_user;
 } rad_scene_desc;
 
 /* The validated scene, flattened: one array of triangles with world positions. Read-only.
@@ -509,6 +535,8 @@ typedef struct rad_scene {
     uint32_t skipped_triangles;    /* degenerate triangles dropped (RAD_SCENE_SKIP_DEGENERATE) */
     rad_emission_fn emission_lookup;
     void *emission_user;
+    rad_opacity_fn opacity_lookup; /* NULL when no material is a cutout (see rad_scene_opaque) */
+    void *opacity_user;
     rad_allocator allocator;       /* private: the allocator that made it */
 } rad_scene;
 
@@ -537,6 +565,16 @@ RAD_API void rad_scene_albedo(const rad_scene *scene, uint32_t triangle, float b
    value is not checked here; the methods check it (RAD_ERROR_NEGATIVE_EMISSION). */
 RAD_API void rad_scene_emission(const rad_scene *scene, uint32_t triangle, float b1, float b2, float out_rgb[3]);
 
+/* 1 when the surface of triangle t exists at barycentrics (b1, b2): always for a material
+   without an opacity_texture, else when opacity_lookup at the interpolated uv is >= the
+   material's alpha_cutoff (0 for a NaN). 0 for a triangle out of range. This is the test a
+   raycaster applies to the hits on cutout triangles (>>api_rays, ALPHA CUTOUTS). */
+RAD_API int rad_scene_opaque(const rad_scene *scene, uint32_t triangle, float b1, float b2);
+
+/* 1 when triangle t's material is an alpha cutout (an opacity_texture the scene can look up):
+   only such triangles need rad_scene_opaque. 0 for a triangle out of range. */
+RAD_API int rad_scene_cutout(const rad_scene *scene, uint32_t triangle);
+
 /* A pinhole camera. fov_y_degrees is the full vertical field of view. */
 typedef struct rad_camera {
     float position[3];
@@ -561,7 +599,10 @@ RAD_API void rad_cornell_box(rad_scene_desc *desc, rad_camera *camera);
 typedef struct rad_patch {
     float centroid[3];
     float normal[3];
-    float area;
+    float area;           /* on an alpha cutout: the area times the opaque fraction (measured
+                             on a lattice of max(albedo_samples, 256) points), so the patch
+                             receives, reflects and emits on its opaque part only; albedo and
+                             emission are then means over its opaque points */
     float albedo[3];      /* mean albedo over the patch (texture-averaged when textured) */
     float emission[3];    /* emitted radiance L: the material's, averaged over the patch
                              like the albedo when it has an emission_texture */
@@ -675,7 +716,16 @@ typedef struct rad_hit {
    two-sided sheet reports the side it sees, and an occlusion ray is blocked from either side.
    Triangles with twins[t] == RAD_NONE (and every triangle when twins is NULL) are hit from
    both sides. In Embree this is an intersection and an occlusion filter function on the
-   geometry that rejects the back of a twinned triangle (what rad_embree_create installs). */
+   geometry that rejects the back of a twinned triangle (what rad_embree_create installs).
+   ALPHA CUTOUTS. For a triangle t with rad_scene_cutout(scene, t), a hit at barycentrics
+   (b1, b2) counts only when rad_scene_opaque(scene, t, b1, b2) is 1; otherwise the ray goes
+   on as if the triangle were not there at that point (the next hit behind it is the closest
+   hit; an occlusion ray is blocked only by an opaque point). Test only the triangles
+   rad_scene_cutout names, so opaque geometry pays nothing. The built-in BVH marks cutout
+   triangles in its leaves and calls the scene's opacity_lookup only for them;
+   rad_embree_create installs filter functions that do the same. A raycaster of your own, or
+   a scene you pass to rad_embree_wrap, must apply this rule too (in Embree: an intersection
+   and an occlusion filter that set valid[i] = 0 where rad_scene_opaque is 0). */
 typedef struct rad_raycaster {
     void *user;
     /* out_occluded[i] = 1 when anything is hit with tmin < t < tmax, else 0. */
@@ -691,7 +741,9 @@ typedef struct rad_bvh rad_bvh;
    implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD). The
    subtrees below the top levels are built in parallel through ctx->parallel_for; the tree does
    not depend on the thread count. scene is borrowed only for the call (the BVH copies the
-   triangles). Errors: INVALID_ARGUMENT, OUT_OF_MEMORY, SIZE_OVERFLOW (2^29 triangles or more).
+   triangles, and the uvs, texture and cutoff of cutout triangles; the scene's opacity_lookup
+   and opacity_user are kept and must outlive the BVH). Errors: INVALID_ARGUMENT,
+   OUT_OF_MEMORY, SIZE_OVERFLOW (2^29 triangles or more).
    Cost: O(T log T). */
 RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out);
 RAD_API void rad_bvh_destroy(rad_bvh *bvh);
@@ -3847,7 +3899,10 @@ RAD_API uint64_t rad_hash64(const void *data, size_t size, uint64_t hash);
 /* The two hashes of a signature, stable across platforms, byte orders and builds (only the
    scene's input values enter, as the little-endian bytes of their IEEE bit patterns, never
    values the library derives from them):
-     geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats;
+     geometry  = rad_hash64 of triangle_count (uint32), then per triangle its 9 position floats
+                 and, for a triangle of a cutout material (opacity_texture not 0), that
+                 material's opacity_texture (uint32) and alpha_cutoff (float), which decide
+                 where rays pass;
      materials = rad_hash64 of triangle_count, then per triangle its material's albedo[3],
                  emission[3] (floats) and texture (uint32), and its emission_texture (uint32)
                  when that is not 0, then 1 and the 6 uv floats per triangle when the scene
@@ -5135,6 +5190,15 @@ static rad_result rad__validate_materials(const rad_scene_desc *desc, const rad_
                      m->emission_texture);
             return RAD_ERROR_INVALID_ARGUMENT;
         }
+        if (m->opacity_texture != 0 && !desc->opacity_lookup) {
+            rad__log(c, RAD_LOG_ERROR, "material %u has opacity_texture %u but the scene has no opacity_lookup callback", i,
+                     m->opacity_texture);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (m->opacity_texture != 0 && !(m->alpha_cutoff >= 0.0f && m->alpha_cutoff <= 1.0f)) {
+            rad__log(c, RAD_LOG_ERROR, "material %u: alpha_cutoff is %g, outside [0, 1]", i, (double)m->alpha_cutoff);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
     }
     return RAD_SUCCESS;
 }
@@ -5212,7 +5276,8 @@ static rad_result rad__validate_mesh(const rad_scene_desc *desc, uint32_t mi, co
                      rad__mesh_name(m), t, mat, desc->material_count);
             return RAD_ERROR_MATERIAL_OUT_OF_RANGE;
         }
-        if ((desc->materials[mat].texture != 0 || desc->materials[mat].emission_texture != 0) && !m->uvs) {
+        if ((desc->materials[mat].texture != 0 || desc->materials[mat].emission_texture != 0 ||
+             desc->materials[mat].opacity_texture != 0) && !m->uvs) {
             rad__log(c, RAD_LOG_ERROR, "mesh %u '%s': triangle %u uses textured material %u but the mesh has no uvs", mi,
                      rad__mesh_name(m), t, mat);
             return RAD_ERROR_INVALID_ARGUMENT;
@@ -5315,6 +5380,11 @@ RAD_API rad_result rad_scene_create(const rad_scene_desc *desc, const rad_contex
     s->albedo_user = desc->albedo_user;
     s->emission_lookup = desc->emission_lookup;
     s->emission_user = desc->emission_user;
+    for (mi = 0; mi < desc->material_count; ++mi)
+        if (desc->materials[mi].opacity_texture != 0) {
+            s->opacity_lookup = desc->opacity_lookup;
+            s->opacity_user = desc->opacity_user;
+        }
     s->positions = (float *)rad__alloc_array(&c.allocator, (size_t)n * 9u, sizeof(float));
     s->normals = (float *)rad__alloc_array(&c.allocator, (size_t)n * 3u, sizeof(float));
     s->areas = (float *)rad__alloc_array(&c.allocator, n, sizeof(float));
@@ -5446,6 +5516,31 @@ RAD_API void rad_scene_emission(const rad_scene *scene, uint32_t triangle, float
     }
 }
 
+RAD_API int rad_scene_cutout(const rad_scene *scene, uint32_t triangle)
+{
+    if (!scene || triangle >= scene->triangle_count || !scene->opacity_lookup || !scene->uvs) return 0;
+    return scene->materials_table[scene->materials[triangle]].opacity_texture != 0;
+}
+
+/* the alpha cutoff of a material: 0 stands for glTF's default */
+static float rad__alpha_cutoff(const rad_material *m)
+{
+    return m->alpha_cutoff > 0.0f ? m->alpha_cutoff : 0.5f;
+}
+
+RAD_API int rad_scene_opaque(const rad_scene *scene, uint32_t triangle, float b1, float b2)
+{
+    const rad_material *m;
+    const float *uv;
+    float b0 = 1.0f - b1 - b2;
+    if (!scene || triangle >= scene->triangle_count) return 0;
+    if (!rad_scene_cutout(scene, triangle)) return 1;
+    m = &scene->materials_table[scene->materials[triangle]];
+    uv = scene->uvs + 6 * (size_t)triangle;
+    return scene->opacity_lookup(scene->opacity_user, m->opacity_texture, b0 * uv[0] + b1 * uv[2] + b2 * uv[4],
+                                 b0 * uv[1] + b1 * uv[3] + b2 * uv[5]) >= rad__alpha_cutoff(m);
+}
+
 /* 1 when triangle t can emit: its material's emission factor is not zero (a texture can
    only scale it) */
 static int rad__emits(const rad_scene *S, uint32_t t)
@@ -5454,11 +5549,13 @@ static int rad__emits(const rad_scene *S, uint32_t t)
     return e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
 }
 
-/* 1 when triangle t's emission varies over it (an emission_texture the scene can look up) */
+/* 1 when triangle t's emission varies over it (an emission_texture the scene can look up, or
+   a cutout emitter, dark in its holes) */
 static int rad__emission_textured(const rad_scene *S, uint32_t t)
 {
     const rad_material *m = &S->materials_table[S->materials[t]];
-    return m->emission_texture != 0 && S->emission_lookup != NULL && S->uvs != NULL && rad__emits(S, t);
+    return ((m->emission_texture != 0 && S->emission_lookup != NULL && S->uvs != NULL) || rad_scene_cutout(S, t)) &&
+           rad__emits(S, t);
 }
 
 /* rad_scene_emission checked: NEGATIVE_EMISSION (logged with the material) when the lookup
@@ -5476,6 +5573,9 @@ static rad_result rad__emission_at(const rad_scene *S, uint32_t t, float b1, flo
                      mi, S->materials_table[mi].emission_texture, (double)out[k], k, t);
             return RAD_ERROR_NEGATIVE_EMISSION;
         }
+    /* a point in a cutout's hole emits nothing: every per-point emitter sampler gets the
+       emitter's power right without a test of its own */
+    if (rad_scene_cutout(S, t) && !rad_scene_opaque(S, t, b1, b2)) out[0] = out[1] = out[2] = 0.0f;
     return RAD_SUCCESS;
 }
 
@@ -5528,10 +5628,10 @@ static const uint32_t rad__cornell_quad_indices[] = {
 };
 
 static const rad_material rad__cornell_materials[4] = {
-    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* white */
-    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* red */
-    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },    /* green */
-    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0, 0, 0 }    /* light */
+    { { 0.725f, 0.71f, 0.68f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f },    /* white */
+    { { 0.63f, 0.065f, 0.05f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f },    /* red */
+    { { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f },    /* green */
+    { { 0.78f, 0.78f, 0.78f }, { 17.0f, 12.0f, 4.0f }, 0, 0, 0, 0, 0.0f }    /* light */
 };
 
 #define RAD__CORNELL_MESH(name, first_vertex, quads, mat)                                                      \
@@ -5656,18 +5756,42 @@ static uint32_t rad__weld_vertex(rad__weld *w, float *vertices, uint32_t *nv, co
     return q;
 }
 
-/* Mean textured albedo over the sub-triangle with corner barycentrics lb (of triangle t). */
+/* The fewest lattice points a cutout patch's opaque fraction is measured with: an alpha
+   texture's holes are often finer than a patch, and a coarse lattice aliases with them. */
+#define RAD__CUTOUT_SAMPLES 256u
+
+/* The opaque fraction of the sub-triangle with corner barycentrics lb of cutout triangle t:
+   the share of a lattice of 'samples' points where rad_scene_opaque holds. */
+static float rad__patch_opacity(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples)
+{
+    uint32_t s, in = 0, side = rad__lattice_side(samples);
+    float c3[9]; /* the corners as 3-vectors (z = 0) for rad__lattice_point */
+    int k;
+    samples = side * side;
+    for (k = 0; k < 3; ++k) { c3[3 * k] = lb[k][0]; c3[3 * k + 1] = lb[k][1]; c3[3 * k + 2] = 0.0f; }
+    for (s = 0; s < samples; ++s) {
+        float q[3];
+        rad__lattice_point(c3, c3 + 3, c3 + 6, side, s, q);
+        in += (uint32_t)rad_scene_opaque(scene, t, q[0], q[1]);
+    }
+    return (float)in / (float)samples;
+}
+
+/* Mean textured albedo over the sub-triangle with corner barycentrics lb (of triangle t); on
+   a cutout, over its opaque points only (all of them when it has none). */
 static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples,
                                     const rad__ctx *c, float *out)
 {
     double acc[3] = { 0.0, 0.0, 0.0 };
-    uint32_t s;
-    int k;
+    uint32_t s, used = 0;
+    int k, cut = rad_scene_cutout(scene, t) && rad__patch_opacity(scene, t, lb, samples) > 0.0f;
     uint32_t side = rad__lattice_side(samples);
     samples = side * side;
     for (s = 0; s < samples; ++s) {
         float q[3], rgb[3];
         rad__lattice_point(lb[0], lb[1], lb[2], side, s, q); /* in the triangle's (b1, b2) plane */
+        if (cut && !rad_scene_opaque(scene, t, q[0], q[1])) continue; /* the same lattice: some are kept */
+        ++used;
         rad_scene_albedo(scene, t, q[0], q[1], rgb);
         for (k = 0; k < 3; ++k) {
             if (!rad__finite(rgb[k]) || rgb[k] < 0.0f || rgb[k] >= 1.0f) {
@@ -5678,29 +5802,32 @@ static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const fl
             acc[k] += rgb[k];
         }
     }
-    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)samples);
+    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)used);
     return RAD_SUCCESS;
 }
 
 /* Mean emission over the sub-triangle with corner barycentrics lb (of triangle t), the same
-   lattice as the albedo's: the patch sends the power its part of the texture sends. */
+   lattice as the albedo's (and like it over a cutout's opaque points): the patch sends the
+   power its part of the texture sends. */
 static rad_result rad__patch_emission(const rad_scene *scene, uint32_t t, const float lb[3][2], uint32_t samples,
                                       const rad__ctx *c, float *out)
 {
     double acc[3] = { 0.0, 0.0, 0.0 };
-    uint32_t s, side = rad__lattice_side(samples);
+    uint32_t s, side = rad__lattice_side(samples), used = 0;
     float c3[9]; /* the corners as 3-vectors (z = 0) for rad__lattice_point */
     rad_result r;
-    int k;
+    int k, cut = rad_scene_cutout(scene, t) && rad__patch_opacity(scene, t, lb, samples) > 0.0f;
     samples = side * side;
     for (k = 0; k < 3; ++k) { c3[3 * k] = lb[k][0]; c3[3 * k + 1] = lb[k][1]; c3[3 * k + 2] = 0.0f; }
     for (s = 0; s < samples; ++s) {
         float q[3], rgb[3];
         rad__lattice_point(c3, c3 + 3, c3 + 6, side, s, q);
+        if (cut && !rad_scene_opaque(scene, t, q[0], q[1])) continue;
+        ++used;
         if ((r = rad__emission_at(scene, t, q[0], q[1], c, rgb)) != RAD_SUCCESS) return r;
         for (k = 0; k < 3; ++k) acc[k] += rgb[k];
     }
-    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)samples);
+    for (k = 0; k < 3; ++k) out[k] = (float)(acc[k] / (double)used);
     for (k = 0; k < 3; ++k)
         if (!rad__finite(out[k])) {
             rad__log(c, RAD_LOG_ERROR, "material %u: the mean textured emission on triangle %u overflows",
@@ -5774,6 +5901,9 @@ static rad_result rad__patches_fill(rad_patches *P, const rad_scene *scene, uint
     uint32_t i, j, base = P->first_patch[t];
     float sub_area = scene->areas[t] / ((float)n * (float)n);
     rad_result r = RAD_SUCCESS;
+    /* a cutout takes its albedo, emission and opaque fraction on one finer lattice, so they
+       agree on where the surface is */
+    if (rad_scene_cutout(scene, t) && albedo_samples < RAD__CUTOUT_SAMPLES) albedo_samples = RAD__CUTOUT_SAMPLES;
     for (j = 0; j < n && r == RAD_SUCCESS; ++j)
         for (i = 0; i + j < n && r == RAD_SUCCESS; ++i) {
             int up;
@@ -5817,6 +5947,13 @@ static rad_result rad__patches_fill(rad_patches *P, const rad_scene *scene, uint
                 }
                 if (r == RAD_SUCCESS && rad__emission_textured(scene, t))
                     r = rad__patch_emission(scene, t, (const float(*)[2])lb, albedo_samples, c, pt->emission);
+                if (rad_scene_cutout(scene, t)) {
+                    /* the patch stands for its opaque part: it receives, reflects and emits
+                       on that area only (a patch wholly in a hole keeps a sliver, so area
+                       ratios stay finite, and its light is negligible) */
+                    float f = rad__patch_opacity(scene, t, (const float(*)[2])lb, albedo_samples);
+                    pt->area *= f > 1e-6f ? f : 1e-6f;
+                }
                 P->areas[idx] = pt->area;
                 memcpy(P->albedo + 3 * (size_t)idx, pt->albedo, 3 * sizeof(float));
             }
@@ -6167,6 +6304,63 @@ typedef struct rad__tri4 {
 /* A lane's id bit for a triangle of a two-sided pair (rad_scene.twins): hit from its front
    only. Ids stay below 2^29, so the bit is free; one-sided scenes never set it. */
 #define RAD__BVH_FRONT_ONLY 0x80000000u
+/* A lane's id bit for an alpha-cutout triangle: a hit counts only where the opacity lookup
+   says the surface is there. Scenes without cutouts never set it, so opaque triangles never
+   reach the lookup. */
+#define RAD__BVH_CUTOUT 0x40000000u
+#define RAD__BVH_ID_BITS 0x1FFFFFFFu
+
+/* What a raycaster keeps of the scene's cutout triangles (the BVH and the Embree scene copy
+   the scene, which may be gone when they are queried): per triangle its record, and per
+   record the uvs, the opacity texture and the cutoff. */
+typedef struct rad__cutout_tri {
+    float uv[6];
+    uint32_t texture;
+    float cutoff;
+} rad__cutout_tri;
+typedef struct rad__cutout {
+    rad_opacity_fn lookup;
+    void *user;
+    uint32_t *slot;           /* per scene triangle: its record in tri, RAD_NONE when opaque */
+    rad__cutout_tri *tri;
+} rad__cutout;
+
+/* The cutout table of a scene into *out, NULL when it has no cutout triangle. */
+static rad_result rad__cutout_build(rad__ctx *c, const rad_scene *S, rad__cutout **out)
+{
+    uint32_t t, n = 0;
+    size_t bytes;
+    rad__cutout *k;
+    *out = NULL;
+    for (t = 0; t < S->triangle_count; ++t) n += (uint32_t)rad_scene_cutout(S, t);
+    if (n == 0) return RAD_SUCCESS;
+    bytes = sizeof(rad__cutout) + sizeof(uint32_t) * (size_t)S->triangle_count + sizeof(rad__cutout_tri) * (size_t)n;
+    k = (rad__cutout *)rad__alloc(&c->allocator, bytes);
+    if (!k) return RAD_ERROR_OUT_OF_MEMORY;
+    k->lookup = S->opacity_lookup;
+    k->user = S->opacity_user;
+    k->slot = (uint32_t *)(void *)(k + 1);
+    k->tri = (rad__cutout_tri *)(void *)(k->slot + S->triangle_count);
+    for (n = 0, t = 0; t < S->triangle_count; ++t) {
+        const rad_material *m = &S->materials_table[S->materials[t]];
+        if (!rad_scene_cutout(S, t)) { k->slot[t] = RAD_NONE; continue; }
+        memcpy(k->tri[n].uv, S->uvs + 6 * (size_t)t, sizeof(k->tri[n].uv));
+        k->tri[n].texture = m->opacity_texture;
+        k->tri[n].cutoff = rad__alpha_cutoff(m);
+        k->slot[t] = n++;
+    }
+    *out = k;
+    return RAD_SUCCESS;
+}
+
+/* rad_scene_opaque on the copy: 1 when triangle t (a cutout one) is there at (b1, b2) */
+static int rad__cutout_opaque(const rad__cutout *k, uint32_t t, float b1, float b2)
+{
+    const rad__cutout_tri *r = &k->tri[k->slot[t]];
+    float b0 = 1.0f - b1 - b2;
+    return k->lookup(k->user, r->texture, b0 * r->uv[0] + b1 * r->uv[2] + b2 * r->uv[4],
+                     b0 * r->uv[1] + b1 * r->uv[3] + b2 * r->uv[5]) >= r->cutoff;
+}
 
 struct rad_bvh {
     rad__bvhw *nodes;         /* in 'block', aligned to a cache line */
@@ -6177,6 +6371,7 @@ struct rad_bvh {
     void *block;              /* the allocation holding nodes and leaves */
     size_t block_bytes;
     rad_allocator allocator;
+    rad__cutout *cutout;      /* the cutout triangles, NULL when there are none */
 };
 
 #define RAD__BVH_BINS 16
@@ -6220,7 +6415,9 @@ static float rad__aabb_area(const rad__aabb *b)
 
 RAD_API void rad_bvh_destroy(rad_bvh *bvh)
 {
-    if (bvh) rad__free_object(bvh->allocator, bvh->block, bvh);
+    if (!bvh) return;
+    rad__free(&bvh->allocator, bvh->cutout);
+    rad__free_object(bvh->allocator, bvh->block, bvh);
 }
 
 RAD_API size_t rad_bvh_memory(const rad_bvh *bvh)
@@ -6629,6 +6826,14 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
     if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, scene->twins, order);
+    if (r == RAD_SUCCESS) r = rad__cutout_build(&c, scene, &b->cutout);
+    if (b->cutout) /* mark the cutout lanes */
+        for (i = 0; i < b->leaf_count; ++i) {
+            uint32_t j;
+            for (j = 0; j < 4; ++j)
+                if (b->leaves[i].id[j] != RAD_NONE && b->cutout->slot[b->leaves[i].id[j] & RAD__BVH_ID_BITS] != RAD_NONE)
+                    b->leaves[i].id[j] |= RAD__BVH_CUTOUT;
+        }
     {
         void *blocks[] = { refs, stack, task, order, tree };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
@@ -6648,6 +6853,7 @@ typedef struct rad__wray {
     int kx, ky, kz;
     float tmin, tmax;
     uint32_t near_off[3], far_off[3];
+    const rad__cutout *cut;   /* the BVH's cutout triangles (set by the caller), or NULL */
 } rad__wray;
 
 /* The set-up takes no branch on the direction: for incoherent rays (path-tracer bounces)
@@ -6692,6 +6898,7 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
     w->sz = 1.0f / w->d[w->kz];
     w->tmin = r->tmin;
     w->tmax = r->tmax;
+    w->cut = NULL;
 }
 
 #if !defined(RAD__SSE2)
@@ -6887,6 +7094,8 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
         T = (float)(((double)u[j] * (double)(w->sz * az[j]) + (double)v[j] * (double)(w->sz * bz[j]) +
                      (double)ww[j] * (double)(w->sz * cz[j])) / (double)det);
         if (!(T > w->tmin && T < *tmax)) continue;
+        if ((q->id[j] & RAD__BVH_CUTOUT) && !rad__cutout_opaque(w->cut, q->id[j] & RAD__BVH_ID_BITS, v[j] / det, ww[j] / det))
+            continue; /* a hole: the ray goes on */
         *tmax = *t_out = T;
         *b1 = v[j] / det;
         *b2 = ww[j] / det;
@@ -6902,6 +7111,7 @@ RAD__HOT int rad__wray_tri4(const rad__wray *w, const rad__tri4 *q, uint32_t cou
         for (c = 0; c < 3; ++c)
             for (a = 0; a < 3; ++a) tri[3 * c + a] = q->v[c][a][j];
         if (!rad__wray_tri(w, tri, (q->id[j] & RAD__BVH_FRONT_ONLY) != 0, *tmax, &t, &c1, &c2)) continue;
+        if ((q->id[j] & RAD__BVH_CUTOUT) && !rad__cutout_opaque(w->cut, q->id[j] & RAD__BVH_ID_BITS, c1, c2)) continue;
         *tmax = *t_out = t;
         *b1 = c1;
         *b2 = c2;
@@ -6966,7 +7176,7 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
                     return 1;
                 }
                 hit->t = t;
-                hit->triangle = q->id[j] & ~RAD__BVH_FRONT_ONLY;
+                hit->triangle = q->id[j] & RAD__BVH_ID_BITS;
                 hit->b1 = b1;
                 hit->b2 = b2;
             }
@@ -7052,6 +7262,7 @@ static rad_result rad__bvh_occluded(void *user, const rad_ray *rays, uint32_t co
         out[i] = 0;
         if (!(rays[i].tmax > rays[i].tmin)) continue;
         rad__wray_init(&w, &rays[i]);
+        w.cut = bvh->cutout;
         /* the rays of one call come from one caller in order (a form-factor row, an image row,
            the shadow rays of neighbouring points), and consecutive ones are often stopped by
            the same triangles: the leaf that stopped the last occluded ray is tried first.
@@ -7088,6 +7299,7 @@ static rad_result rad__bvh_intersect(void *user, const rad_ray *rays, uint32_t c
         out[i].b1 = out[i].b2 = 0.0f;
         if (!(rays[i].tmax > rays[i].tmin)) continue;
         rad__wray_init(&w, &rays[i]);
+        w.cut = bvh->cutout;
         (void)rad__bvh_trace(bvh, &w, 0, &out[i], NULL, NULL);
     }
     return RAD_SUCCESS;
@@ -7116,11 +7328,14 @@ struct rad_embree {
     void *log_user;
     size_t memory;           /* device memory reported by the monitor (bytes, >= 0) */
     float *front_normals;    /* per triangle of a two-sided pair its normal, else 0 0 0; NULL
-                                without two-sided materials (no filter then) */
+                                without two-sided materials */
+    rad__cutout *cutout;     /* the cutout triangles; NULL without them (no filter when both
+                                this and front_normals are NULL) */
 };
 
-/* The filter of rad_embree_create's geometry when the scene has two-sided triangles: a hit on
-   the back of one (dot(dir, normal) >= 0) is rejected, so Embree goes on to its twin. */
+/* The filter of rad_embree_create's geometry when the scene has two-sided or cutout
+   triangles: a hit on the back of a two-sided one (dot(dir, normal) >= 0) is rejected, so
+   Embree goes on to its twin, and so is a hit in a cutout's hole, so Embree goes on behind. */
 static void rad__embree_front_filter(const struct RTCFilterFunctionNArguments *args)
 {
     /* the packets' structure-of-arrays layout of rtcore_ray.h (its accessors are C++ only):
@@ -7132,10 +7347,19 @@ static void rad__embree_front_filter(const struct RTCFilterFunctionNArguments *a
     for (i = 0; i < N; ++i) {
         const float *n;
         float d;
+        uint32_t t;
         if (args->valid[i] == 0) continue;
-        n = e->front_normals + 3 * (size_t)hit[5 * N + i];
-        d = ray[4 * N + i] * n[0] + ray[5 * N + i] * n[1] + ray[6 * N + i] * n[2];
-        if ((n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f) && !(d < 0.0f)) args->valid[i] = 0;
+        t = hit[5 * N + i];
+        if (e->front_normals) {
+            n = e->front_normals + 3 * (size_t)t;
+            d = ray[4 * N + i] * n[0] + ray[5 * N + i] * n[1] + ray[6 * N + i] * n[2];
+            if ((n[0] != 0.0f || n[1] != 0.0f || n[2] != 0.0f) && !(d < 0.0f)) { args->valid[i] = 0; continue; }
+        }
+        /* barycentrics u, v at float rows 3 and 4 of the hit */
+        if (e->cutout && e->cutout->slot[t] != RAD_NONE &&
+            !rad__cutout_opaque(e->cutout, t, ((const float *)(const void *)args->hit)[3 * N + i],
+                                ((const float *)(const void *)args->hit)[4 * N + i]))
+            args->valid[i] = 0;
     }
 }
 
@@ -7171,6 +7395,7 @@ RAD_API void rad_embree_destroy(rad_embree *e)
     }
     rad__free(&a, e->first);
     rad__free(&a, e->front_normals);
+    rad__free(&a, e->cutout);
     rad__free(&a, e);
 }
 
@@ -7221,6 +7446,13 @@ RAD_API rad_result rad_embree_create(const rad_scene *scene, const rad_context *
             for (k = 0; k < 3; ++k)
                 e->front_normals[3 * (size_t)t + (size_t)k] = scene->twins[t] != RAD_NONE ? scene->normals[3 * (size_t)t + (size_t)k] : 0.0f;
         }
+    }
+    if (rad__cutout_build(&c, scene, &e->cutout) != RAD_SUCCESS) {
+        rtcReleaseGeometry(g);
+        rad_embree_destroy(e);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (e->front_normals || e->cutout) {
         rtcSetGeometryUserData(g, e);
         rtcSetGeometryIntersectFilterFunction(g, rad__embree_front_filter);
         rtcSetGeometryOccludedFilterFunction(g, rad__embree_front_filter);
@@ -11093,6 +11325,10 @@ static rad_result rad__hr_sources(rad_hierarchical *h, uint32_t first, const rad
             if (rad__emission_textured(h->scene, h->el[i].tri) &&
                 (r = rad__patch_emission(h->scene, h->el[i].tri, (const float(*)[2])h->el[i].b, 16u, c, L)) != RAD_SUCCESS)
                 return r;
+            if (rad_scene_cutout(h->scene, h->el[i].tri)) { /* elements keep their full area: the mean counts the holes */
+                float f = rad__patch_opacity(h->scene, h->el[i].tri, (const float(*)[2])h->el[i].b, RAD__CUTOUT_SAMPLES);
+                for (k = 0; k < 3; ++k) L[k] *= f;
+            }
             for (k = 0; k < 3; ++k) h->el[i].E[k] = (float)RAD__PI * L[k];
         }
         return RAD_SUCCESS;
@@ -21477,99 +21713,69 @@ static rad_result rad__probes_pack(rad_probes *pr, const float *dense, uint32_t 
 #define RAD__PROBES_MAX_GRID (1u << 24)
 #define RAD__PROBES_CHUNK_FLOATS (1u << 22) /* dense scratch per chunk of probes (16 MiB) */
 
-/* rad_probes_create (patches) and rad_probes_create_vp (vp): the same placement, checks and
-   storage; only the gather of the weights differs (rad__pb_gather) */
-static rad_result rad__probes_create(const rad_patches *patches, const rad_virtual_patches *vp,
-                                     const rad_raycaster *raycaster, const rad_light *lights, uint32_t light_count,
-                                     const float *positions, uint32_t count, const rad_probe_options *options,
-                                     const float *B, const rad_context *ctx, rad_probes **out)
+/* rad__probes_create's first stage: the options (resolved by the caller) and the point list checked */
+static rad_result rad__probes_check(rad_probe_options *o, int vp, const float *positions, uint32_t count, rad__ctx *c)
 {
-    rad__ctx c;
-    rad__pb b;
-    rad__direct dv;
-    rad_probes *pr = NULL;
-    const rad_scene *S;
-    rad_result r = RAD_SUCCESS;
-    uint32_t i, T, N, per, first;
-    size_t cap = 0;
-    float ext[3], spacing = 0.0f;
-    int k;
-    rad__ctx_init(&c, ctx);
-    if (out) *out = NULL;
-    if ((vp ? !vp->scene : (!patches || !patches->scene)) || !raycaster || !raycaster->intersect || !raycaster->occluded ||
-        !out) {
-        if (vp && !vp->scene)
-            rad__log(&c, RAD_LOG_ERROR, "probes: the virtual patches have no scene (rad_vp_load with scene NULL)");
-        else
-            rad__log(&c, RAD_LOG_ERROR, "probes: NULL %s, raycaster (with intersect and occluded) or output",
-                     patches || !vp ? "patches" : "virtual patches");
+    if (o->patch_samples > RAD__MAX_SAMPLES) o->patch_samples = RAD__MAX_SAMPLES;
+    if (o->light_samples > RAD__MAX_SAMPLES) o->light_samples = RAD__MAX_SAMPLES;
+    if (o->rays > 65536u || (vp && o->vp_rays > 65536u)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: rays %u or vp_rays %u above 65536", o->rays, o->vp_rays);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    S = vp ? vp->scene : patches->scene;
-    N = vp ? vp->count : patches->count;
-    memset(&b, 0, sizeof(b));
-    if (options) b.o = *options; else memset(&b.o, 0, sizeof(b.o));
-    rad__probe_options_resolve(&b.o);
-    if (b.o.patch_samples > RAD__MAX_SAMPLES) b.o.patch_samples = RAD__MAX_SAMPLES;
-    if (b.o.light_samples > RAD__MAX_SAMPLES) b.o.light_samples = RAD__MAX_SAMPLES;
-    if (b.o.rays > 65536u || (vp && b.o.vp_rays > 65536u)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: rays %u or vp_rays %u above 65536", b.o.rays, b.o.vp_rays);
+    if (!(o->backface_fraction >= 0.0f && o->backface_fraction <= 1.0f)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)o->backface_fraction);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (!(b.o.backface_fraction >= 0.0f && b.o.backface_fraction <= 1.0f)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: backface_fraction %g outside [0, 1]", (double)b.o.backface_fraction);
+    if (o->weighting != RAD_PROBE_WEIGHT_NORMAL_FIT && o->weighting != RAD_PROBE_WEIGHT_NORMAL &&
+        o->weighting != RAD_PROBE_WEIGHT_PLAIN) {
+        rad__log(c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)o->weighting);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (b.o.weighting != RAD_PROBE_WEIGHT_NORMAL_FIT && b.o.weighting != RAD_PROBE_WEIGHT_NORMAL &&
-        b.o.weighting != RAD_PROBE_WEIGHT_PLAIN) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: unknown weighting %d", (int)b.o.weighting);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    if (!(b.o.ray_epsilon > 0.0f && b.o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)b.o.ray_epsilon,
+    if (!(o->ray_epsilon > 0.0f && o->ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: ray_epsilon %g must be in (0, %g]", (double)o->ray_epsilon,
                  (double)RAD__MAX_RAY_EPSILON);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (!rad__finite(b.o.spacing) || b.o.spacing < 0.0f || !rad__finite(b.o.max_move) || !rad__finite(b.o.clearance) ||
-        b.o.clearance < 0.0f) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: spacing %g and clearance %g must be finite and >= 0, max_move %g finite",
-                 (double)b.o.spacing, (double)b.o.clearance, (double)b.o.max_move);
+    if (!rad__finite(o->spacing) || o->spacing < 0.0f || !rad__finite(o->max_move) || !rad__finite(o->clearance) ||
+        o->clearance < 0.0f) {
+        rad__log(c, RAD_LOG_ERROR, "probes: spacing %g and clearance %g must be finite and >= 0, max_move %g finite",
+                 (double)o->spacing, (double)o->clearance, (double)o->max_move);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (b.o.flags & ~(uint32_t)(RAD_PROBES_DIRECT | RAD_PROBES_BAND4)) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: unknown flags 0x%x", b.o.flags);
+    if (o->flags & ~(uint32_t)(RAD_PROBES_DIRECT | RAD_PROBES_BAND4)) {
+        rad__log(c, RAD_LOG_ERROR, "probes: unknown flags 0x%x", o->flags);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (positions && count == 0) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: positions given with count 0");
+        rad__log(c, RAD_LOG_ERROR, "probes: positions given with count 0");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    /* the lights pass the checks of the direct-light code */
-    if (b.o.flags & RAD_PROBES_DIRECT) {
-        r = rad__direct_setup(&dv, S, raycaster, lights, light_count, NULL, &c);
-        if (r != RAD_SUCCESS) {
-            rad__log(&c, RAD_LOG_ERROR, "probes: the %u lights were refused (%s)", light_count, rad_result_string(r));
-            return r;
-        }
-    }
-    if (B) {
-        r = rad__check_input(&c, "probes", B, 3 * (size_t)N);
-        if (r != RAD_SUCCESS) return r;
-    }
+    return RAD_SUCCESS;
+}
+
+/* the second stage: the probes object with its positions (the given points, or a grid over the
+   scene's bounds at o->spacing) and the storage of its coefficients; *spacing_out is the grid's */
+static rad_result rad__probes_alloc(const rad_scene *S, uint32_t N, const float *positions, uint32_t count,
+                                    const rad_probe_options *o, rad__ctx *c, rad_probes **out, float *spacing_out)
+{
+    rad_probes *pr;
+    float ext[3], spacing = 0.0f;
+    uint32_t i;
+    int k;
     for (k = 0; k < 3; ++k) ext[k] = S->bounds_max[k] - S->bounds_min[k];
-    pr = (rad_probes *)rad__alloc_zero(&c.allocator, sizeof(rad_probes));
+    pr = (rad_probes *)rad__alloc_zero(&c->allocator, sizeof(rad_probes));
     if (!pr) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory");
+        rad__log(c, RAD_LOG_ERROR, "probes: out of memory");
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    pr->allocator = c.allocator;
+    pr->allocator = c->allocator;
     pr->patch_count = N;
     pr->h2 = 1e-6f * S->diagonal * S->diagonal;
-    pr->eps = b.o.ray_epsilon * S->diagonal;
+    pr->eps = o->ray_epsilon * S->diagonal;
     if (positions) {
         for (i = 0; i < count; ++i)
             if (!rad__finite3(positions + 3 * (size_t)i)) {
-                rad__log(&c, RAD_LOG_ERROR, "probes: position %u is not finite", i);
+                rad__log(c, RAD_LOG_ERROR, "probes: position %u is not finite", i);
                 rad_probes_destroy(pr);
                 return RAD_ERROR_NON_FINITE;
             }
@@ -21577,7 +21783,7 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     } else {
         double total = 1.0;
         float big = ext[0] > ext[1] ? (ext[0] > ext[2] ? ext[0] : ext[2]) : (ext[1] > ext[2] ? ext[1] : ext[2]);
-        spacing = b.o.spacing > 0.0f ? b.o.spacing : big / 8.0f;
+        spacing = o->spacing > 0.0f ? o->spacing : big / 8.0f;
         for (k = 0; k < 3; ++k) {
             double d = ceil((double)ext[k] / (double)spacing);
             if (d < 1.0) d = 1.0;
@@ -21585,7 +21791,7 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
             pr->dims[k] = total <= (double)RAD__PROBES_MAX_GRID ? (uint32_t)d : 0u;
         }
         if (total > (double)RAD__PROBES_MAX_GRID) {
-            rad__log(&c, RAD_LOG_ERROR, "probes: spacing %g gives %.0f probes over the bounds (at most %u): use a larger spacing",
+            rad__log(c, RAD_LOG_ERROR, "probes: spacing %g gives %.0f probes over the bounds (at most %u): use a larger spacing",
                      (double)spacing, total, RAD__PROBES_MAX_GRID);
             rad_probes_destroy(pr);
             return RAD_ERROR_SIZE_OVERFLOW;
@@ -21596,21 +21802,19 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
             pr->origin[k] = 0.5f * (S->bounds_min[k] + S->bounds_max[k]) - 0.5f * (float)(pr->dims[k] - 1u) * spacing;
         pr->count = pr->dims[0] * pr->dims[1] * pr->dims[2];
     }
-    pr->weighting = b.o.weighting;
-    pr->positions = (float *)rad__alloc_array(&c.allocator, pr->count, 3 * sizeof(float));
-    pr->states = (uint8_t *)rad__alloc_array(&c.allocator, pr->count, 1);
-    pr->coefficients = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
-    pr->direct = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
-    pr->first = (uint64_t *)rad__alloc_array(&c.allocator, (size_t)pr->count + 1u, sizeof(uint64_t));
-    b.nw = 9u;
-    if (b.o.flags & RAD_PROBES_BAND4) {
-        b.nw = 18u;
-        pr->band4 = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
-        pr->direct4 = (float *)rad__alloc_array(&c.allocator, pr->count, 27 * sizeof(float));
+    pr->weighting = o->weighting;
+    pr->positions = (float *)rad__alloc_array(&c->allocator, pr->count, 3 * sizeof(float));
+    pr->states = (uint8_t *)rad__alloc_array(&c->allocator, pr->count, 1);
+    pr->coefficients = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
+    pr->direct = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
+    pr->first = (uint64_t *)rad__alloc_array(&c->allocator, (size_t)pr->count + 1u, sizeof(uint64_t));
+    if (o->flags & RAD_PROBES_BAND4) {
+        pr->band4 = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
+        pr->direct4 = (float *)rad__alloc_array(&c->allocator, pr->count, 27 * sizeof(float));
     }
     if (!pr->positions || !pr->states || !pr->coefficients || !pr->direct || !pr->first ||
-        ((b.o.flags & RAD_PROBES_BAND4) && (!pr->band4 || !pr->direct4))) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for %u probes", pr->count);
+        ((o->flags & RAD_PROBES_BAND4) && (!pr->band4 || !pr->direct4))) {
+        rad__log(c, RAD_LOG_ERROR, "probes: out of memory for %u probes", pr->count);
         rad_probes_destroy(pr);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -21629,11 +21833,128 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     }
     memset(pr->direct, 0, sizeof(float) * 27 * (size_t)pr->count);
     if (pr->direct4) memset(pr->direct4, 0, sizeof(float) * 27 * (size_t)pr->count);
+    *spacing_out = spacing;
+    *out = pr;
+    return RAD_SUCCESS;
+}
+
+/* the third stage: each probe moved out of geometry (rad__pb_place), then the weights gathered
+   in chunks of probes into a dense scratch and packed to their non-zero entries */
+static rad_result rad__probes_weights(rad_probes *pr, rad__pb *b, float spacing, rad__ctx *c)
+{
+    const rad_scene *S = b->S;
+    rad_result r = RAD_SUCCESS;
+    uint32_t i, T, N = b->N, per, first;
+    size_t cap = 0;
     {
         float move_default = pr->grid ? 0.5f * spacing : 0.05f * S->diagonal;
-        b.max_move = b.o.max_move == 0.0f ? move_default : b.o.max_move;
-        b.clearance = b.o.clearance > 0.0f ? b.o.clearance : 0.2f * move_default;
+        b->max_move = b->o.max_move == 0.0f ? move_default : b->o.max_move;
+        b->clearance = b->o.clearance > 0.0f ? b->o.clearance : 0.2f * move_default;
     }
+    b->eps = b->o.ray_epsilon * S->diagonal;
+    b->pos = pr->positions;
+    b->states = pr->states;
+    b->direct = pr->direct;
+    b->direct4 = pr->direct4;
+    per = N ? (uint32_t)(RAD__PROBES_CHUNK_FLOATS / ((size_t)b->nw * N)) : pr->count;
+    if (per == 0) per = 1;
+    if (per > pr->count) per = pr->count;
+    T = c->tasks < pr->count ? c->tasks : pr->count;
+    b->rays = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
+    b->hits = (rad_hit *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
+    b->occ = (uint8_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 1);
+    b->target = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
+    b->w = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, b->nw * sizeof(float));
+    b->col = (float *)rad__alloc_array(&c->allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
+    b->emitters = (uint32_t *)rad__alloc_array(&c->allocator, S->triangle_count, sizeof(uint32_t));
+    b->dense = (float *)rad__alloc_array(&c->allocator, (size_t)per * b->nw, N ? (size_t)N * sizeof(float) : 1u);
+    if (!b->rays || !b->hits || !b->occ || !b->target || !b->w || !b->col || !b->emitters || !b->dense) {
+        rad__log(c, RAD_LOG_ERROR, "probes: out of memory for the ray buffers of %u tasks", T);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < S->triangle_count; ++i)
+            if (rad__emits(S, i)) b->emitters[b->emitter_count++] = i;
+        b->c = c;
+        r = rad__for_rows(c, pr->count, T, rad__pb_place, b);
+    }
+    for (first = 0; first < pr->count && r == RAD_SUCCESS; first += per) {
+        uint32_t m = pr->count - first < per ? pr->count - first : per, q;
+        memset(b->dense, 0, sizeof(float) * b->nw * (size_t)N * m);
+        b->first = first;
+        {
+            rad__ctx cc = *c;
+            uint32_t tt = T < m ? T : m;
+            cc.progress = NULL;
+            r = rad__for_rows(&cc, m, tt, rad__pb_gather_chunk, b);
+        }
+        for (q = 0; q < m && r == RAD_SUCCESS; ++q) {
+            pr->first[first + q] = pr->entries;
+            r = rad__probes_pack(pr, b->dense + (size_t)b->nw * N * q, N, b->nw, &cap);
+            if (r != RAD_SUCCESS)
+                rad__log(c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
+        }
+        if (r == RAD_SUCCESS && c->progress && c->progress(c->progress_user, (float)((double)(first + m) / (double)pr->count))) {
+            rad__log(c, RAD_LOG_INFO, "probes: cancelled by the progress callback after %u of %u probes", first + m, pr->count);
+            r = RAD_ERROR_CANCELLED;
+        }
+    }
+    pr->first[pr->count] = pr->entries;
+    {
+        void *blocks[] = { b->rays, b->hits, b->occ, b->target, b->w, b->col, b->emitters, b->dense };
+        rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
+    return r;
+}
+
+/* rad_probes_create (patches) and rad_probes_create_vp (vp): the same placement, checks and
+   storage; only the gather of the weights differs (rad__pb_gather) */
+static rad_result rad__probes_create(const rad_patches *patches, const rad_virtual_patches *vp,
+                                     const rad_raycaster *raycaster, const rad_light *lights, uint32_t light_count,
+                                     const float *positions, uint32_t count, const rad_probe_options *options,
+                                     const float *B, const rad_context *ctx, rad_probes **out)
+{
+    rad__ctx c;
+    rad__pb b;
+    rad__direct dv;
+    rad_probes *pr = NULL;
+    const rad_scene *S;
+    rad_result r = RAD_SUCCESS;
+    uint32_t N;
+    float spacing = 0.0f;
+    rad__ctx_init(&c, ctx);
+    if (out) *out = NULL;
+    if ((vp ? !vp->scene : (!patches || !patches->scene)) || !raycaster || !raycaster->intersect || !raycaster->occluded ||
+        !out) {
+        if (vp && !vp->scene)
+            rad__log(&c, RAD_LOG_ERROR, "probes: the virtual patches have no scene (rad_vp_load with scene NULL)");
+        else
+            rad__log(&c, RAD_LOG_ERROR, "probes: NULL %s, raycaster (with intersect and occluded) or output",
+                     patches || !vp ? "patches" : "virtual patches");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    S = vp ? vp->scene : patches->scene;
+    N = vp ? vp->count : patches->count;
+    memset(&b, 0, sizeof(b));
+    if (options) b.o = *options; else memset(&b.o, 0, sizeof(b.o));
+    rad__probe_options_resolve(&b.o);
+    r = rad__probes_check(&b.o, vp != NULL, positions, count, &c);
+    if (r != RAD_SUCCESS) return r;
+    /* the lights pass the checks of the direct-light code */
+    if (b.o.flags & RAD_PROBES_DIRECT) {
+        r = rad__direct_setup(&dv, S, raycaster, lights, light_count, NULL, &c);
+        if (r != RAD_SUCCESS) {
+            rad__log(&c, RAD_LOG_ERROR, "probes: the %u lights were refused (%s)", light_count, rad_result_string(r));
+            return r;
+        }
+    }
+    if (B) {
+        r = rad__check_input(&c, "probes", B, 3 * (size_t)N);
+        if (r != RAD_SUCCESS) return r;
+    }
+    b.nw = (b.o.flags & RAD_PROBES_BAND4) ? 18u : 9u;
+    r = rad__probes_alloc(S, N, positions, count, &b.o, &c, &pr, &spacing);
+    if (r != RAD_SUCCESS) return r;
     b.P = vp ? NULL : patches;
     b.V = vp;
     b.N = N;
@@ -21641,59 +21962,7 @@ static rad_result rad__probes_create(const rad_patches *patches, const rad_virtu
     b.rc = raycaster;
     b.lights = lights;
     b.light_count = (b.o.flags & RAD_PROBES_DIRECT) ? light_count : 0u;
-    b.eps = b.o.ray_epsilon * S->diagonal;
-    b.pos = pr->positions;
-    b.states = pr->states;
-    b.direct = pr->direct;
-    b.direct4 = pr->direct4;
-    per = N ? (uint32_t)(RAD__PROBES_CHUNK_FLOATS / ((size_t)b.nw * N)) : pr->count;
-    if (per == 0) per = 1;
-    if (per > pr->count) per = pr->count;
-    T = c.tasks < pr->count ? c.tasks : pr->count;
-    b.rays = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_ray));
-    b.hits = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(rad_hit));
-    b.occ = (uint8_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 1);
-    b.target = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, sizeof(uint32_t));
-    b.w = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, b.nw * sizeof(float));
-    b.col = (float *)rad__alloc_array(&c.allocator, (size_t)T * RAD__RAY_BATCH, 3 * sizeof(float));
-    b.emitters = (uint32_t *)rad__alloc_array(&c.allocator, S->triangle_count, sizeof(uint32_t));
-    b.dense = (float *)rad__alloc_array(&c.allocator, (size_t)per * b.nw, N ? (size_t)N * sizeof(float) : 1u);
-    if (!b.rays || !b.hits || !b.occ || !b.target || !b.w || !b.col || !b.emitters || !b.dense) {
-        rad__log(&c, RAD_LOG_ERROR, "probes: out of memory for the ray buffers of %u tasks", T);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-    }
-    if (r == RAD_SUCCESS) {
-        for (i = 0; i < S->triangle_count; ++i)
-            if (rad__emits(S, i)) b.emitters[b.emitter_count++] = i;
-        b.c = &c;
-        r = rad__for_rows(&c, pr->count, T, rad__pb_place, &b);
-    }
-    for (first = 0; first < pr->count && r == RAD_SUCCESS; first += per) {
-        uint32_t m = pr->count - first < per ? pr->count - first : per, q;
-        memset(b.dense, 0, sizeof(float) * b.nw * (size_t)N * m);
-        b.first = first;
-        {
-            rad__ctx cc = c;
-            uint32_t tt = T < m ? T : m;
-            cc.progress = NULL;
-            r = rad__for_rows(&cc, m, tt, rad__pb_gather_chunk, &b);
-        }
-        for (q = 0; q < m && r == RAD_SUCCESS; ++q) {
-            pr->first[first + q] = pr->entries;
-            r = rad__probes_pack(pr, b.dense + (size_t)b.nw * N * q, N, b.nw, &cap);
-            if (r != RAD_SUCCESS)
-                rad__log(&c, RAD_LOG_ERROR, "probes: %s for the weights of probe %u", rad_result_string(r), first + q);
-        }
-        if (r == RAD_SUCCESS && c.progress && c.progress(c.progress_user, (float)((double)(first + m) / (double)pr->count))) {
-            rad__log(&c, RAD_LOG_INFO, "probes: cancelled by the progress callback after %u of %u probes", first + m, pr->count);
-            r = RAD_ERROR_CANCELLED;
-        }
-    }
-    pr->first[pr->count] = pr->entries;
-    {
-        void *blocks[] = { b.rays, b.hits, b.occ, b.target, b.w, b.col, b.emitters, b.dense };
-        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
-    }
+    r = rad__probes_weights(pr, &b, spacing, &c);
     if (r == RAD_SUCCESS) r = rad__check_output(&c, "probes (direct light)", pr->direct, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS && pr->direct4) r = rad__check_output(&c, "probes (direct light, band 4)", pr->direct4, 27 * (size_t)pr->count);
     if (r == RAD_SUCCESS) {
@@ -24448,7 +24717,15 @@ RAD_API rad_result rad_scene_hash(const rad_scene *scene, uint64_t *out_geometry
     if (out_materials) *out_materials = 0;
     if (!scene || !scene->positions || !scene->materials || !scene->materials_table) return RAD_ERROR_INVALID_ARGUMENT;
     g = rad__hash_words(g, &scene->triangle_count, 1);
-    g = rad__hash_words(g, scene->positions, 9u * (size_t)scene->triangle_count);
+    for (t = 0; t < scene->triangle_count; ++t) {
+        const uint32_t mi = scene->materials[t];
+        if (mi >= scene->material_count) return RAD_ERROR_INVALID_ARGUMENT;
+        g = rad__hash_words(g, scene->positions + 9u * (size_t)t, 9u);
+        if (scene->materials_table[mi].opacity_texture) { /* hashed only when set: older hashes stay valid */
+            g = rad__hash_words(g, &scene->materials_table[mi].opacity_texture, 1);
+            g = rad__hash_words(g, &scene->materials_table[mi].alpha_cutoff, 1);
+        }
+    }
     m = rad__hash_words(m, &scene->triangle_count, 1);
     for (t = 0; t < scene->triangle_count; ++t) {
         const uint32_t mi = scene->materials[t];
@@ -25111,7 +25388,31 @@ static const char rad__glsl_0_0[] =
     "    uint flags;       // bit 0: add E (total)\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -25124,16 +25425,9 @@ static const char rad__glsl_0_0[] =
     "        float f = F[at + j];\n"
     "        acc += f * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {   // any group size, no subgroup assumption\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    precise vec3 o = sum * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -25164,7 +25458,31 @@ static const char rad__glsl_1_0[] =
     "    uint flags;       // bit 0: add E (total)\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -25178,16 +25496,9 @@ static const char rad__glsl_1_0[] =
     "        uint j = columns[k0 + e];\n"
     "        acc += values[k0 + e] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
+    "    precise vec3 o = sum * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -25220,7 +25531,31 @@ static const char rad__glsl_2_0[] =
     "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -25234,17 +25569,10 @@ static const char rad__glsl_2_0[] =
     "        uint e = 3u * (perm \? col_perm[j] : j);\n"
     "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
     "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    precise vec3 s = partial[0];\n"
+    "    precise vec3 s = sum;\n"
     "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
     "    outv[o] = s.x;\n"
     "    outv[o + 1u] = s.y;\n"
@@ -25276,7 +25604,31 @@ static const char rad__glsl_3_0[] =
     "    uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u \? v.y : v.x; }\n"
     "\n"
@@ -25293,17 +25645,10 @@ static const char rad__glsl_3_0[] =
     "        vec3 f = vec3(half_at(R[h >> 1u], h), half_at(G[h >> 1u], h), half_at(B[h >> 1u], h));\n"
     "        acc += f * vec3(E[e], E[e + 1u], E[e + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
     "    uint o = 3u * (perm \? row_perm[ip] : ip);\n"
-    "    precise vec3 s = partial[0];\n"
+    "    precise vec3 s = sum;\n"
     "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
     "    outv[o] = s.x;\n"
     "    outv[o + 1u] = s.y;\n"
@@ -25437,7 +25782,32 @@ static const char rad__glsl_5_0[] =
     "    uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n";
+static const char rad__glsl_5_1[] =
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -25458,23 +25828,15 @@ static const char rad__glsl_5_0[] =
     "    uint i = perm \? row_perm[y] : y;\n"
     "    precise vec3 s = vec3(0.0);\n"
     "    if ((pc.flags & 8u) != 0u) {\n"
-    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n";
-static const char rad__glsl_5_1[] =
+    "        uint k0 = out_off[i].x, count = out_off[i + 1u].x - k0;\n"
     "        for (uint k = k0 + lid; k < k0 + count; k += gl_WorkGroupSize.x) {\n"
     "            uint j = 3u * out_col[k];\n"
     "            s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);\n"
     "        }\n"
     "    }\n"
-    "    partial[lid] = acc + s;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc + s);\n"
     "    if (lid != 0u) return;\n"
-    "    precise vec3 o = partial[0];\n"
+    "    precise vec3 o = sum;\n"
     "    if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);\n"
     "    outv[3u * i] = o.x;\n"
     "    outv[3u * i + 1u] = o.y;\n"
@@ -25835,7 +26197,31 @@ static const char rad__glsl_8_0[] =
     "    uint flags;        // bit 0: add E (RAD_OUTPUT_TOTAL)\n"
     "} pc;\n"
     "\n"
-    "shared vec3 partial[gl_WorkGroupSize.x];\n"
+    "// reduce.glsl - the work-group sum shared by the gather and apply kernels (one copy of the\n"
+    "// reduction instead of one per kernel). Included after the kernel's layout(local_size...)\n"
+    "// line: glslangValidator resolves the #include (GL_GOOGLE_include_directive), and `make glsl`\n"
+    "// pastes this text in its place in the header's copy, so the embedded kernels need no includer.\n"
+    "\n"
+    "shared vec3 rad_partial[gl_WorkGroupSize.x];\n"
+    "\n"
+    "// The sum of v over the work group, returned to every invocation. Every invocation of the\n"
+    "// group must call it (it holds barriers), once per kernel run: a second call would overwrite\n"
+    "// rad_partial while slower invocations may still read the first result. The pairs are added\n"
+    "// in a fixed tree order, halving the width each step, so any group size works and no subgroup\n"
+    "// operation is assumed.\n"
+    "vec3 rad_group_sum(vec3 v)\n"
+    "{\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    rad_partial[lid] = v;\n"
+    "    barrier();\n"
+    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
+    "        uint h = (width + 1u) / 2u;\n"
+    "        if (lid < width - h) rad_partial[lid] += rad_partial[lid + h];\n"
+    "        barrier();\n"
+    "        width = h;\n"
+    "    }\n"
+    "    return rad_partial[0];\n"
+    "}\n"
     "\n"
     "void main()\n"
     "{\n"
@@ -25845,28 +26231,22 @@ static const char rad__glsl_8_0[] =
     "    if (i < pc.slot_offset || i - pc.slot_offset >= pc.slot_count) return; // another chunk's row\n"
     "    uint at = pc.base + (i - pc.slot_offset) * pc.m;\n"
     "    precise vec3 acc = vec3(0.0);\n"
-    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n"
+    "    for (uint j = lid; j < pc.end; j += gl_WorkGroupSize.x) {\n";
+static const char rad__glsl_8_1[] =
     "        uint p = lit_patch[j];\n"
     "        if (p == 0xFFFFFFFFu) continue;\n"
     "        acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[3u * p], E[3u * p + 1u], E[3u * p + 2u]);\n"
     "    }\n"
-    "    partial[lid] = acc;\n"
-    "    barrier();\n"
-    "    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {\n"
-    "        uint h = (width + 1u) / 2u;\n"
-    "        if (lid < width - h) partial[lid] += partial[lid + h];\n"
-    "        barrier();\n"
-    "        width = h;\n"
-    "    }\n"
+    "    vec3 sum = rad_group_sum(acc);\n"
     "    if (lid != 0u) return;\n"
     "    uint o = 3u * vis_patch[pc.row_offset + r];\n"
-    "    precise vec3 s = partial[0];\n"
+    "    precise vec3 s = sum;\n"
     "    if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);\n"
     "    outv[o] = s.x;\n"
     "    outv[o + 1u] = s.y;\n"
     "    outv[o + 2u] = s.z;\n"
     "}\n";
-static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0 };
+static const char *const rad__glsl_pieces_8[] = { rad__glsl_8_0, rad__glsl_8_1 };
 static const char rad__glsl_9_0[] =
     "#version 450\n"
     "// radiosity.h kernel RAD_GLSL_LOCAL_VECTORS: the small pre-pass of a local-matrix add\n"
@@ -26315,15 +26695,15 @@ static const char rad__glsl_13_0[] =
     "}\n";
 static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
-    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 2494u },
-    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 2706u },
-    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 2780u },
-    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 2666u },
+    { "gather_dense.comp", rad__glsl_pieces_0, 1u, 3364u },
+    { "gather_csr.comp", rad__glsl_pieces_1, 1u, 3620u },
+    { "mb_apply_float.comp", rad__glsl_pieces_2, 1u, 3694u },
+    { "mb_apply_half.comp", rad__glsl_pieces_3, 1u, 3580u },
     { "temporal_step.comp", rad__glsl_pieces_4, 2u, 4728u },
-    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 4704u },
+    { "mb_apply_blocks.comp", rad__glsl_pieces_5, 2u, 5618u },
     { "alias_build.comp", rad__glsl_pieces_6, 2u, 4700u },
-    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9441u },
-    { "local_apply.comp", rad__glsl_pieces_8, 1u, 3519u },
+    { "lighting.glsl", rad__glsl_pieces_7, 3u, 9447u },
+    { "local_apply.comp", rad__glsl_pieces_8, 2u, 4433u },
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },

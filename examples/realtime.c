@@ -91,7 +91,7 @@ int main(int argc, char **argv)
     uint32_t want = 2000, frames = 60, k = 10, rays = 0, nv = 0, nt = 0, f, i, m, total_vertices = 0, light_count = 1;
     float *pos = NULL, *E, *B, **vertex_out, centre[3], radius;
     uint32_t *idx = NULL;
-    rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0};
+    rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0, 0, 0.0f};
     rad_mesh_desc mesh;
     rad_scene_desc desc;
     rad_camera cam;

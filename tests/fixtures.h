@@ -40,12 +40,13 @@ static inline void rad_test_embree_raycaster(const rad_bvh *bvh, rad_raycaster *
         if (rad_test_embree_map[i].bvh == bvh) { rad_embree_raycaster(rad_test_embree_map[i].embree, out); return; }
         if (!rad_test_embree_map[i].bvh && slot == RAD_TEST_EMBREE_MAX) slot = i;
     }
-    /* two-sided scenes keep the BVH: this copy of the triangles has no twins array for
-       Embree's front-only filter (test_twosided.c checks Embree on them directly) */
+    /* two-sided and cutout scenes keep the BVH: this copy of the triangles has no twins array
+       for Embree's front-only filter and no uvs for its cutout filter (test_twosided.c and
+       test_cutout.c check Embree on them directly) */
     for (i = 0; i < bvh->leaf_count; ++i) {
         uint32_t j;
         for (j = 0; j < 4; ++j)
-            if (bvh->leaves[i].id[j] != RAD_NONE && (bvh->leaves[i].id[j] & RAD__BVH_FRONT_ONLY)) return;
+            if (bvh->leaves[i].id[j] != RAD_NONE && (bvh->leaves[i].id[j] & (RAD__BVH_FRONT_ONLY | RAD__BVH_CUTOUT))) return;
     }
     pos = (float *)malloc(sizeof(float) * 9 * bvh->tri_count);
     if (!pos || slot == RAD_TEST_EMBREE_MAX) { free(pos); printf("    FAIL embree map full\n"); rad_test_failures++; return; }
@@ -262,7 +263,7 @@ static inline int ff_world_make(const rad_scene_desc *desc, float max_edge, uint
     return 1;
 }
 
-static const rad_material ff_grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 };
+static const rad_material ff_grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f };
 
 static inline void ff_desc(rad_scene_desc *d, const rad_mesh_desc *meshes, uint32_t count)
 {

@@ -109,7 +109,7 @@ wanted() {
     local w=" ${RAD_TEST_STAGES:-$1} "
     case "$1" in
         build-unit) [ -n "${w##* unit-O2 *}" ] && [ -n "${w##* valgrind-1 *}" ] && [ -n "${w##* valgrind-2 *}" ] && [ -n "${w##* build-unit *}" ] && return 1 ;;
-        build-tool) [ -n "${w##* tool *}" ] && [ -n "${w##* report *}" ] && [ -n "${w##* dist *}" ] && [ -n "${w##* build-tool *}" ] && return 1 ;;
+        build-tool) [ -n "${w##* tool *}" ] && [ -n "${w##* report *}" ] && [ -n "${w##* dist *}" ] && [ -n "${w##* web *}" ] && [ -n "${w##* build-tool *}" ] && return 1 ;;
         *) [ -n "${w##* $1 *}" ] && return 1 ;;
     esac
     return 0
@@ -128,6 +128,9 @@ vk_ready || try_install mesa-vulkan-drivers libvulkan-dev glslang-tools
 # the Khronos validation layer: test_vulkan turns it on when installed and fails on its messages
 [ -f /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json ] || try_install vulkan-validationlayers
 have spirv-val || try_install spirv-tools
+# the web suite: Chromium and node/npm (three.js itself comes from npm into build/web, once)
+have chromium || try_install chromium
+{ have node && have npm; } || try_install npm
 { [ -f /usr/include/assimp/cimport.h ] && [ -f /usr/include/stb/stb_image.h ]; } || try_install libassimp-dev libstb-dev
 [ -f /usr/include/tinyexr.h ] || try_install libtinyexr-dev
 have clang || try_install clang libclang-rt-14-dev
@@ -356,6 +359,21 @@ s_examples() {
     fi
 }
 
+# ---- web: `rad lightmap -o x.glb` shown by three.js in headless Chromium (tests/web/run.sh)
+s_web() {
+    if ! have_tool_deps; then skip web "assimp or stb is not installed (packages libassimp-dev libstb-dev)"; return; fi
+    after build-tool
+    [ -x "$BUILD/rad" ] || { fail "web (no rad: the tool did not build)"; return; }
+    echo "== web: three.js shows the baked glb"
+    local out rc
+    out=$(bash tests/web/run.sh "$BUILD/rad" "$BUILD/web" 2>&1)
+    rc=$?
+    echo "$out" | grep -v '^skip:' | sed 's/^/  /'
+    if [ $rc = 77 ]; then skip web "$(echo "$out" | sed -n 's/^skip: //p' | tail -n 1)"
+    elif [ $rc = 0 ]; then pass "web (three.js in Chromium agrees with the tool)"
+    else fail web; fi
+}
+
 # ---- Vulkan: every GLSL kernel against the CPU path (lavapipe is enough)
 s_vulkan() {
     if ! vk_ready; then
@@ -570,6 +588,7 @@ stage unit-scalar s_unit_scalar
 stage unit-embree s_unit_embree
 stage unit-native s_unit_native
 stage vulkan s_vulkan
+stage web s_web
 stage report s_report
 stage clang s_clang
 stage unit-avx s_unit_avx

@@ -1145,7 +1145,7 @@ static double ff_hidden_source_F(const float *occ, const float *src, int whole)
 {
     static const float rec[12] = { -0.01f, 0, -0.01f, -0.01f, 0, 0.01f, 0.01f, 0, 0.01f, 0.01f, 0, -0.01f };
     static const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
-    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 };
+    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc mesh[3];
     rad_scene_desc d;
     rad_scene *S = NULL;

@@ -128,8 +128,8 @@ static double hl_mean_B(const rad_hierarchical *h, uint32_t first, uint32_t last
    ceiling within the cap's reach of the scene holding one copy. */
 static double hl_layers(uint32_t copies, rad_hierarchical_clustering cl, double *floor_B, double *bmax)
 {
-    static const rad_material mats[2] = { { { 0.85f, 0.85f, 0.85f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 },
-                                          { { 0.85f, 0.85f, 0.85f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0 } };
+    static const rad_material mats[2] = { { { 0.85f, 0.85f, 0.85f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f },
+                                          { { 0.85f, 0.85f, 0.85f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0, 0, 0.0f } };
     static const float o0[3] = { 0, 0, 0 }, o1[3] = { 0, 0.1f, 0 }, ux[3] = { 1, 0, 0 }, uz[3] = { 0, 0, 1 };
     hl_soup s;
     hl_world w;
@@ -225,7 +225,7 @@ static void hl_junk(hl_soup *s, uint32_t seed)
 /* the junk furnace's world; returns the walls' triangle count (0 on failure) */
 static uint32_t hl_junk_world(hl_world *w)
 {
-    static const rad_material mat = { { 0.8f, 0.8f, 0.8f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0 };
+    static const rad_material mat = { { 0.8f, 0.8f, 0.8f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0, 0, 0.0f };
     ff_quad q[6];
     hl_soup s;
     uint32_t f, walls;

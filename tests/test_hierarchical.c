@@ -55,7 +55,7 @@ static rad_hierarchical *hr_solve(const hr_world *w, double tol, rad_hierarchica
    tolerance shrinks; the mean over the surface holds the closed form. */
 static double hr_furnace(double tol, double *mean_abs, double *mean_B)
 {
-    static const rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 0.5f, 0.25f }, 0, 0, 0 };
+    static const rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 0.5f, 0.25f }, 0, 0, 0, 0, 0.0f };
     ff_quad q[6];
     rad_mesh_desc meshes[6];
     rad_scene_desc d;
@@ -638,7 +638,7 @@ static void hr_test_cluster_cornell(void)
 /* the closed unit cube of hr_furnace's material as a scene (the source of the tessellations) */
 static rad_scene *hr_cube_scene(void)
 {
-    static const rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 0.5f, 0.25f }, 0, 0, 0 };
+    static const rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 0.5f, 0.25f }, 0, 0, 0, 0, 0.0f };
     ff_quad q[6];
     rad_mesh_desc meshes[6];
     rad_scene_desc d;

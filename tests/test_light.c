@@ -525,7 +525,7 @@ static void li_test_partly_hidden_emitter(void)
     static const float visible[12] = { -1, 6, -1, 11, 6, -1, 11, 6, 11, -1, 6, 11 }; /* front faces down */
     float pos[72], p[3] = { 5.0f, 1e-4f, 5.0f }, n[3] = { 0.0f, 1.0f, 0.0f }, p2[3] = { 2.0f, 1e-4f, 7.0f }, out[3];
     uint32_t idx[36], mats[12], q;
-    rad_material m[2] = { { { 0.7f, 0.7f, 0.7f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 }, { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0 } };
+    rad_material m[2] = { { { 0.7f, 0.7f, 0.7f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f }, { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0, 0, 0.0f } };
     rad_mesh_desc mesh;
     rad_scene_desc d;
     rad_scene *S = NULL;
@@ -600,7 +600,7 @@ static void li_test_final_gather(void)
     const float heights[3] = { 0.1f, 0.5f, 0.9f };
     float pos[72], pts[9], nrm[9], out[9], out2[9], floor_d[3], fp[3] = { 0.5f, 0.0f, 0.5f }, up[3] = { 0, 1, 0 }, H[3];
     uint32_t idx[36], q, i, furnace;
-    rad_material grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 }, glow = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0 };
+    rad_material grey = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f }, glow = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0, 0, 0.0f };
     rad_light sun;
     rad_final_gather_options fo;
     rad_context ctx;

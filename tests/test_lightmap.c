@@ -215,7 +215,7 @@ static void lm_test_sh_uniform(void)
     lm_soup s;
     rad_mesh_desc m;
     rad_scene_desc d;
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f };
     rad_scene *S = NULL;
     rad_bvh *b = NULL;
     rad_raycaster rc;
@@ -609,7 +609,7 @@ static void lm_test_seam(void)
     const uint32_t lidx[6] = { 0, 1, 2, 0, 2, 3 };
     rad_mesh_desc m[2];
     rad_scene_desc d;
-    rad_material mats[2] = { { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 }, { { 0.5f, 0.5f, 0.5f }, { 5, 5, 5 }, 0, 0, 0 } };
+    rad_material mats[2] = { { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f }, { { 0.5f, 0.5f, 0.5f }, { 5, 5, 5 }, 0, 0, 0, 0, 0.0f } };
     rad_scene *S = NULL;
     rad_bvh *b = NULL;
     rad_raycaster rc;

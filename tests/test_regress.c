@@ -10,7 +10,7 @@ static void rg_test_point_light_overflow(void)
 {
     static const float quad[12] = { 0, 0, 0, 1e-15f, 0, 0, 1e-15f, 1e-15f, 0, 0, 1e-15f, 0 };
     static const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
-    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0 };
+    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc mesh;
     rad_scene_desc d;
     rad_scene *s = NULL;
@@ -48,7 +48,7 @@ static void rg_test_emission_overflow(void)
 {
     static const float quad[12] = { 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0 };
     static const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
-    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 3e38f, 0.0f, 0.0f }, 0, 0, 0 };
+    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 3e38f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc mesh;
     rad_scene_desc d;
     rad_scene *s = NULL;
@@ -82,7 +82,7 @@ static void rg_test_extreme_area_ratio(void)
     float tri[9] = { 0.0f, 0.0f, 1.0f, 0.0f, 4.5e-19f, 1.0f, 4.5e-19f, 0.0f, 1.0f };
     static const uint32_t qi[6] = { 0, 1, 2, 0, 2, 3 };
     static const uint32_t ti[3] = { 0, 1, 2 };
-    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0 };
+    rad_material m = { { 0.5f, 0.5f, 0.5f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc mesh[2];
     rad_scene_desc d;
     rad_scene *s = NULL;

@@ -344,7 +344,7 @@ static void sc_test_patch_counts_areas(void)
     /* one right triangle, legs 1, hypotenuse sqrt 2, and one 2 x 0.5 rectangle's triangles */
     float pos[] = { 0, 0, 0, 1, 0, 0, 0, 1, 0, /* tri 0 in xy plane, normal +z */
                     0, 0, 1, 2, 0, 1, 2, 0.5f, 1, 0, 0, 1, 2, 0.5f, 1, 0, 0.5f, 1 };
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc mesh;
     rad_scene_desc desc;
     rad_scene *scene = NULL;
@@ -504,7 +504,7 @@ static void sc_test_patch_welding(void)
 {
     static const float c[3] = { 0, 0, 0 }, ux[3] = { 1, 0, 0 }, uy[3] = { 0, 1, 0 }, uz[3] = { 0, 0, 1 };
     float floor_pos[12], wall_pos[12];
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc meshes[2];
     rad_scene_desc desc;
     rad_scene *scene = NULL;
@@ -562,7 +562,7 @@ static void sc_test_vertex_values(void)
 {
     static const float c[3] = { 0, 0, 0 }, ux[3] = { 1, 0, 0 }, uz[3] = { 0, 0, 1 };
     float pos[12];
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc mesh;
     rad_scene_desc desc;
     rad_scene *scene = NULL;
@@ -614,7 +614,7 @@ static void sc_test_vertex_irradiance(void)
 {
     static const float c[3] = { 0, 0, 0 }, ux[3] = { 1, 0, 0 }, uz[3] = { 0, 0, 1 };
     float pos[12];
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc mesh;
     rad_scene_desc desc;
     rad_scene *scene = NULL;

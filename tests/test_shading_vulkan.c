@@ -190,7 +190,7 @@ int main(int argc, char **argv)
 
     /* ---- SPIR-V ---- */
     snprintf(spv_path, sizeof(spv_path), "%s/build/lighting_eval.spv", root);
-    snprintf(cmd, sizeof(cmd), "mkdir -p '%s/build' && glslangValidator -V '%s/glsl/lighting_eval.comp' -o '%s' >/dev/null",
+    snprintf(cmd, sizeof(cmd), "mkdir -p '%s/build' && glslangValidator -V '%s/tools/glsl/lighting_eval.comp' -o '%s' >/dev/null",
              root, root, spv_path);
     if (system("glslangValidator --version >/dev/null 2>&1") != 0) {
         printf("skip: glslangValidator not found (package glslang-tools)\n");
@@ -198,7 +198,7 @@ int main(int argc, char **argv)
         goto fail;
     }
     if (system(cmd) != 0) {
-        printf("glslangValidator failed on %s/glsl/lighting_eval.comp\n", root);
+        printf("glslangValidator failed on %s/tools/glsl/lighting_eval.comp\n", root);
         goto fail;
     }
     fp = fopen(spv_path, "rb");

@@ -393,7 +393,7 @@ static void test_trace_sky(void)
 {
     static const float pos[12] = { -1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1 };
     static const uint32_t idx[6] = { 0, 2, 1, 0, 3, 2 };
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc m;
     rad_scene_desc d;
     rad_scene *s = NULL;
@@ -639,7 +639,7 @@ static void test_trace_point_light(void)
 {
     static const float pos[12] = { -1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1 };
     static const uint32_t idx[6] = { 0, 2, 1, 0, 3, 2 };
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f };
     rad_mesh_desc m;
     rad_scene_desc d;
     rad_scene *s = NULL;

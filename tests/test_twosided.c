@@ -18,7 +18,7 @@ static void ts_test_scene_pairs(void)
     ff_quad q;
     rad_mesh_desc m;
     rad_scene_desc d;
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1, 0, 0.0f };
     rad_scene *s = NULL;
     float nrm[12];
     uint32_t t;
@@ -106,7 +106,7 @@ static void ts_test_raycasters_report_the_side_seen(void)
     ff_quad q;
     rad_mesh_desc m;
     rad_scene_desc d;
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1, 0, 0.0f };
     int two;
     ff_quad_set(&q, 0, 0, 0, 1, 0, 0, 0, 1, 0);
     ts_quad_mesh(&m, &q, 0);
@@ -153,7 +153,7 @@ static void ts_test_embree_matches_bvh(void)
     ff_quad q[7];
     rad_mesh_desc m[7];
     rad_scene_desc d;
-    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1 };
+    rad_material mat = { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1, 0, 0.0f };
     rad_scene *s = NULL;
     rad_bvh *b = NULL;
     rad_embree *e = NULL;
@@ -274,9 +274,9 @@ static int ts_sheet_solve(const rad_material mats[3], double c, int middle, doub
    would stay black. */
 static void ts_test_sheet_closed_form(void)
 {
-    const rad_material mats[3] = { { { 0.6f, 0.6f, 0.6f }, { 0, 0, 0 }, 0, 0, 1 },
-                                   { { 0.0f, 0.0f, 0.0f }, { 2.0f, 2.0f, 2.0f }, 0, 0, 0 },
-                                   { { 0.0f, 0.0f, 0.0f }, { 0.5f, 0.5f, 0.5f }, 0, 0, 0 } };
+    const rad_material mats[3] = { { { 0.6f, 0.6f, 0.6f }, { 0, 0, 0 }, 0, 0, 1, 0, 0.0f },
+                                   { { 0.0f, 0.0f, 0.0f }, { 2.0f, 2.0f, 2.0f }, 0, 0, 0, 0, 0.0f },
+                                   { { 0.0f, 0.0f, 0.0f }, { 0.5f, 0.5f, 0.5f }, 0, 0, 0, 0, 0.0f } };
     const double c = 0.5, rho = 0.6, F = ff_c11(1.0, 1.0, c);
     double down = 0.0, up = 0.0;
     if (!ts_sheet_solve(mats, c, 1, &down, &up)) return;
@@ -289,9 +289,9 @@ static void ts_test_sheet_closed_form(void)
    nothing). */
 static void ts_test_sheet_emits_both_ways(void)
 {
-    const rad_material mats[3] = { { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 1 },
-                                   { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 },
-                                   { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0 } };
+    const rad_material mats[3] = { { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 1, 0, 0.0f },
+                                   { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f },
+                                   { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 0, 0, 0.0f } };
     const double c = 0.5, F = ff_c11(1.0, 1.0, c);
     double below = 0.0, above = 0.0;
     if (!ts_sheet_solve(mats, c, 0, &below, &above)) return;
@@ -557,7 +557,7 @@ static void ts_test_lightmap_reports_one_side(void)
     ff_quad q[2];
     rad_mesh_desc m[2];
     rad_scene_desc d;
-    rad_material mats[2] = { { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1 }, { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0 } };
+    rad_material mats[2] = { { { 0.5f, 0.5f, 0.5f }, { 0, 0, 0 }, 0, 0, 1, 0, 0.0f }, { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0, 0, 0.0f } };
     float nrm[12];
     int side, k;
     ff_quad_set(&q[0], 0, 0, 0, 1, 0, 0, 0, 1, 0);

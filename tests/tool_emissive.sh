@@ -37,7 +37,8 @@ if "$RAD" info "$TMP/em_info.gltf" > "$TMP/em_info.txt" 2> "$TMP/em_err.txt"; th
         "$TMP/em_light.txt" && ok "rad info: the lamp's emission factor, strength and texture" ||
         fail "rad info: the lamp's emission factor, strength and texture" "$(head -c 400 "$TMP/em_light.txt")"
     awk '/^material .*m0_white/ { on = 1; next } /^material/ { on = 0 } on' "$TMP/em_info.txt" > "$TMP/em_white.txt"
-    grep -q "doubleSided: true (used" "$TMP/em_white.txt" && grep -q "sides: two"  "$TMP/em_white.txt" && grep -q "alphaMode: MASK, alphaCutoff 0.25 (read" "$TMP/em_white.txt" &&
+    grep -q "doubleSided: true (used" "$TMP/em_white.txt" && grep -q "sides: two"  "$TMP/em_white.txt" && grep -q "alphaMode: MASK, alphaCutoff 0.25 (used" "$TMP/em_white.txt" &&
+        grep -q "cutout: none (opaque)" "$TMP/em_white.txt" &&
         grep -q "ignored: .*normalTexture (not diffuse)" "$TMP/em_white.txt" &&
         grep -q "ignored: .*KHR_materials_transmission (extension)" "$TMP/em_white.txt" &&
         grep -q "ignored: .*metallicFactor (not diffuse)" "$TMP/em_white.txt" &&

@@ -1356,9 +1356,11 @@ printf '{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "n
 source "$(dirname "${BASH_SOURCE[0]}")/tool_emissive.sh"
 
 . "$(dirname "${BASH_SOURCE[0]}")/tool_twosided.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/tool_cutout.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_env.sh"
 . "$(dirname "$0")/tool_reliability.sh"
 . "$(dirname "$0")/tool_hier_large.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/tool_glb.sh"
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

@@ -48,6 +48,9 @@ static void lightmap_usage(FILE *f)
                "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
                "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 4, as\n"
                "                        rad render's 16 samples)\n"
+               "  -o OUT.glb|OUT.gltf   the scene for engines: TEXCOORD_1, the lightmap as a PNG image named in each\n"
+               "                        material's extras, its HDR copy beside it, the view as a camera\n"
+               "                        (docs/engine-formats.md; RGB only, not --sh)\n"
                "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
                "                        the radiance of a white surface)\n"
                "  --threads N           worker threads (default: all cores)\n"
@@ -387,6 +390,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     int px_opts = 0, hr_opts = 0;
     const float *values = NULL;
     float exposure = 0.31830988f;
+    char *gltf_hdr = NULL, *gltf_bin = NULL; /* -o OUT.glb|gltf: the files beside it */
     memset(&bk, 0, sizeof bk);
     memset(&px, 0, sizeof px);
     tool_classic_options_default(&co);
@@ -510,20 +514,30 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
         fprintf(stderr, "rad lightmap: --render shades from the RGB lightmap: leave out --sh\n");
         return 2;
     }
+    if (tool_gltf_is_path(out_path) && sh) {
+        fprintf(stderr, "rad lightmap: a .glb or .gltf carries the RGB lightmap: leave out --sh\n");
+        return 2;
+    }
     if (tool_check_size("lightmap", width, height)) return 2;
-    if (tool_image_check_format("lightmap", out_path) || (render_path && tool_image_check_format("lightmap", render_path))) return 2;
+    if (tool_gltf_is_path(out_path)) {
+        gltf_hdr = tool_gltf_hdr_path(out_path);
+        gltf_bin = tool_gltf_bin_path(out_path);
+    }
+    if ((!gltf_hdr && tool_image_check_format("lightmap", out_path)) || (render_path && tool_image_check_format("lightmap", render_path))) return 2;
     {
         /* the files written: OUT (or its four SH layers) and the view; checked before the
            work, and again against every file the scene was read from once it is loaded */
         static const char *const tags[4] = {"L00", "L1m1", "L10", "L11"};
         char *layers[4] = {NULL, NULL, NULL, NULL};
-        const char *outs[5];
+        const char *outs[7];
         int n = 0, bad = 0, k;
         if (sh)
             for (k = 0; k < 4; ++k) outs[n++] = layers[k] = lightmap_tagged(out_path, tags[k]);
         else
             outs[n++] = out_path;
         if (render_path) outs[n++] = render_path;
+        if (gltf_hdr) outs[n++] = gltf_hdr;
+        if (gltf_bin) outs[n++] = gltf_bin;
         for (k = 0; k < n && !bad; ++k) bad = tool_check_output("lightmap", outs[k], &scene_path, 1);
         if (!bad) bad = tool_check_outputs("lightmap", outs, n, &scene_path, 1);
         tool_set_threads((int)threads);
@@ -533,7 +547,11 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             bad = 1;
         }
         for (k = 0; k < 4; ++k) free(layers[k]);
-        if (bad) return 1;
+        if (bad) {
+            free(gltf_hdr);
+            free(gltf_bin);
+            return 1;
+        }
     }
     if (tool_lightmap_bake("lightmap", &w, &co, width, height, !size_given, texel_samples, vis, gather, hemi_rays, sh,
                            force_unwrap, !sh, px.kind ? &px : NULL, &bk))
@@ -561,11 +579,28 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
                 break;
             }
             for (i = 0; i < (uint32_t)(width * height); ++i) memcpy(img.rgb + 3 * (size_t)i, values + (size_t)i * ch + 3 * l, 3 * sizeof(float));
-            if (tool_image_write_into(&set, paths[l] ? paths[l] : out_path, &img, exposure) != 0) {
+            if (tool_image_write_into(&set, paths[l] ? paths[l] : gltf_hdr ? gltf_hdr : out_path, &img, exposure) != 0) {
                 fprintf(stderr, "rad lightmap: %s\n", tool_output_error());
                 bad = 1;
             }
             tool_image_free(&img);
+        }
+        if (!bad && gltf_hdr) {
+            /* the scene for engines, its camera the view --render draws */
+            tool_gltf_lightmap gl;
+            rad_camera cam = bk.w.file.camera;
+            if (!bk.w.file.has_camera) tool_choose_camera("lightmap", bk.w.scene, &bk.w.rc, rw, rh, &cam);
+            if (!(cam.fov_y_degrees > 0.0f)) cam.fov_y_degrees = 45.0f;
+            memset(&gl, 0, sizeof gl);
+            gl.scene = bk.w.scene;
+            gl.mesh_scene = w.scene;
+            gl.material_names = w.file.material_names;
+            gl.camera = &cam;
+            gl.aspect = (float)rw / (float)rh;
+            gl.lightmap = lm;
+            gl.values = values;
+            gl.hdr_name = strrchr(gltf_hdr, '/') ? strrchr(gltf_hdr, '/') + 1 : gltf_hdr;
+            bad = tool_gltf_write("lightmap", out_path, &gl, &set);
         }
         if (!bad && render_path && lightmap_render(&bk.w, lm, values, rw, rh, (int)aa, render_path, exposure, &set)) {
             tool_output_set_abort(&set);
@@ -576,14 +611,17 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             bad = 1;
         }
         for (l = 0; l < layers; ++l) {
-            if (!bad) fprintf(stderr, "rad lightmap: wrote %s\n", paths[l] ? paths[l] : out_path);
+            if (!bad) fprintf(stderr, "rad lightmap: wrote %s\n", paths[l] ? paths[l] : gltf_hdr ? gltf_hdr : out_path);
             free(paths[l]);
         }
         if (bad) goto done;
+        if (gltf_hdr) fprintf(stderr, "rad lightmap: wrote %s%s%s\n", out_path, gltf_bin ? " and " : "", gltf_bin ? gltf_bin : "");
         if (render_path) fprintf(stderr, "rad lightmap: wrote the view %s\n", render_path);
     }
     code = 0;
 done:
+    free(gltf_hdr);
+    free(gltf_bin);
     tool_lightmap_bake_free(&bk);
     tool_close_world(&w);
     return code;

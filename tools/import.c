@@ -54,6 +54,10 @@ typedef struct imp_texture {
     int width, height;
     float *rgb;           /* linear */
     char path[256];
+    float *alpha;         /* the alpha channel when the image has one, else its first channel
+                             (a grey map_d), both as stored (not sRGB-decoded) */
+    int has_alpha;        /* 1 when the image has an alpha channel */
+    float alpha_scale;    /* an opacity texture's factor (glTF baseColorFactor alpha), else 1 */
 } imp_texture;
 
 typedef struct imp_group {
@@ -81,6 +85,7 @@ typedef struct imp_storage {
     uint32_t texture_count;
     char **material_reports;  /* per material: what the import used and ignored (rad info) */
     int any_emission_texture;
+    int any_cutout;
     char **inputs;          /* the files read: the scene, its MTL libraries, its textures */
     uint32_t input_count;
     int builtin;
@@ -183,6 +188,34 @@ static void emission_lookup(void *user, uint32_t texture, float u, float v, floa
     texture_sample((const imp_storage *)user, texture, u, v, 1e30f, out_rgb);
 }
 
+/* the opacity (alpha x factor) of an opacity texture, bilinear like texture_sample */
+static float opacity_lookup(void *user, uint32_t texture, float u, float v)
+{
+    const imp_storage *st = (const imp_storage *)user;
+    const imp_texture *t;
+    float x, y, fx, fy, a, b, d, e;
+    int x0, y0, x1, y1;
+    if (texture == 0 || texture > st->texture_count) return 1.0f;
+    t = &st->textures[texture - 1];
+    if (!(u == u)) u = 0.0f; /* NaN */
+    if (!(v == v)) v = 0.0f;
+    u -= floorf(u);
+    v -= floorf(v);
+    x = u * (float)t->width - 0.5f;
+    y = (1.0f - v) * (float)t->height - 0.5f;
+    fx = x - floorf(x);
+    fy = y - floorf(y);
+    x0 = (int)floorf(x);
+    y0 = (int)floorf(y);
+    x0 = ((x0 % t->width) + t->width) % t->width;
+    y0 = ((y0 % t->height) + t->height) % t->height;
+    x1 = (x0 + 1) % t->width;
+    y1 = (y0 + 1) % t->height;
+    a = t->alpha[(size_t)y0 * t->width + x0], b = t->alpha[(size_t)y0 * t->width + x1];
+    d = t->alpha[(size_t)y1 * t->width + x0], e = t->alpha[(size_t)y1 * t->width + x1];
+    return t->alpha_scale * ((1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e));
+}
+
 static void *xrealloc(void *p, size_t size)
 {
     void *q = realloc(p, size ? size : 1);
@@ -213,7 +246,7 @@ static void free_storage(imp_storage *st)
         free(st->groups[i].indices);
         free(st->groups[i].material_ids);
     }
-    for (i = 0; i < st->texture_count; ++i) free(st->textures[i].rgb);
+    for (i = 0; i < st->texture_count; ++i) free(st->textures[i].rgb), free(st->textures[i].alpha);
     for (i = 0; st->material_names && i < st->material_count; ++i) free(st->material_names[i]);
     for (i = 0; i < st->input_count; ++i) free(st->inputs[i]);
     free(st->inputs);
@@ -272,17 +305,19 @@ static uint32_t load_texture_as(imp_storage *st, const struct aiScene *sc, const
         if (idx < sc->mNumTextures) {
             const struct aiTexture *tex = sc->mTextures[idx];
             if (tex->mHeight == 0) {
-                px = stbi_load_from_memory((const unsigned char *)tex->pcData, (int)tex->mWidth, &w, &h, &comp, 3);
+                px = stbi_load_from_memory((const unsigned char *)tex->pcData, (int)tex->mWidth, &w, &h, &comp, 4);
             } else {
                 size_t k, n = (size_t)tex->mWidth * tex->mHeight;
                 w = (int)tex->mWidth;
                 h = (int)tex->mHeight;
-                px = (unsigned char *)malloc(3 * n);
+                comp = 4;
+                px = (unsigned char *)malloc(4 * n);
                 if (px)
                     for (k = 0; k < n; ++k) {
-                        px[3 * k] = tex->pcData[k].r;
-                        px[3 * k + 1] = tex->pcData[k].g;
-                        px[3 * k + 2] = tex->pcData[k].b;
+                        px[4 * k] = tex->pcData[k].r;
+                        px[4 * k + 1] = tex->pcData[k].g;
+                        px[4 * k + 2] = tex->pcData[k].b;
+                        px[4 * k + 3] = tex->pcData[k].a;
                     }
             }
         }
@@ -290,8 +325,8 @@ static uint32_t load_texture_as(imp_storage *st, const struct aiScene *sc, const
         for (i = 0; i < sc->mNumTextures && !px; ++i) /* embedded, named by its file name */
             if (sc->mTextures[i]->mHeight == 0 && !strcmp(sc->mTextures[i]->mFilename.data, tpath))
                 px = stbi_load_from_memory((const unsigned char *)sc->mTextures[i]->pcData, (int)sc->mTextures[i]->mWidth,
-                                           &w, &h, &comp, 3);
-        if (!px && (px = stbi_load(base_dir_join(file, tpath, full, sizeof full), &w, &h, &comp, 3)) != NULL)
+                                           &w, &h, &comp, 4);
+        if (!px && (px = stbi_load(base_dir_join(file, tpath, full, sizeof full), &w, &h, &comp, 4)) != NULL)
             add_input(st, full);
     }
     if (!px || w <= 0 || h <= 0) {
@@ -312,11 +347,18 @@ static uint32_t load_texture_as(imp_storage *st, const struct aiScene *sc, const
     t->width = w;
     t->height = h;
     t->rgb = (float *)xrealloc(NULL, sizeof(float) * 3 * (size_t)w * (size_t)h);
+    t->alpha = (float *)xrealloc(NULL, sizeof(float) * (size_t)w * (size_t)h);
+    t->has_alpha = comp == 2 || comp == 4;
+    t->alpha_scale = 1.0f;
     {
         float lut[256];
-        size_t k, n = 3 * (size_t)w * (size_t)h;
+        size_t k, n = (size_t)w * (size_t)h;
+        int ch;
         for (i = 0; i < 256; ++i) lut[i] = srgb_to_linear((float)i / 255.0f);
-        for (k = 0; k < n; ++k) t->rgb[k] = lut[px[k]];
+        for (k = 0; k < n; ++k) {
+            for (ch = 0; ch < 3; ++ch) t->rgb[3 * k + (size_t)ch] = lut[px[4 * k + (size_t)ch]];
+            t->alpha[k] = (float)px[4 * k + (t->has_alpha ? 3u : 0u)] / 255.0f;
+        }
     }
     stbi_image_free(px);
     return ++st->texture_count;
@@ -329,6 +371,46 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
 
 /* ---- materials --------------------------------------------------------------------------- */
 
+static const char *js_get(const char *o, const char *name);
+static void js_string(const char *v, char *out, size_t cap);
+
+/* A private opacity texture for a cutout: the alpha of image 'tpath' (its alpha channel;
+   without one, 1 when 'grey' is 0, else its first channel) times 'scale', or with tpath NULL
+   a single texel of alpha 'scale'. Returns its id, 0 when the image cannot be loaded. */
+static uint32_t opacity_texture(imp_storage *st, const struct aiScene *sc, const char *file, const char *tpath, float scale,
+                                int grey)
+{
+    char prefix[64];
+    uint32_t id;
+    imp_texture *t;
+    size_t q, n;
+    snprintf(prefix, sizeof prefix, "opacity:%g:%d:", (double)scale, grey);
+    if (tpath) {
+        id = load_texture_as(st, sc, file, tpath, prefix);
+        if (!id) return 0;
+    } else {
+        for (id = 0; id < st->texture_count; ++id)
+            if (!strcmp(st->textures[id].path, prefix)) return id + 1;
+        st->textures = (imp_texture *)xrealloc(st->textures, sizeof(imp_texture) * (st->texture_count + 1));
+        t = &st->textures[st->texture_count];
+        memset(t, 0, sizeof *t);
+        memcpy(t->path, prefix, strlen(prefix) + 1);
+        t->width = t->height = 1;
+        t->rgb = (float *)xrealloc(NULL, 3 * sizeof(float));
+        t->rgb[0] = t->rgb[1] = t->rgb[2] = 0.5f;
+        t->alpha = (float *)xrealloc(NULL, sizeof(float));
+        t->alpha[0] = 1.0f;
+        t->has_alpha = 1;
+        id = ++st->texture_count;
+    }
+    t = &st->textures[id - 1];
+    t->alpha_scale = scale;
+    n = (size_t)t->width * t->height;
+    if (!t->has_alpha && !grey)
+        for (q = 0; q < n; ++q) t->alpha[q] = 1.0f;
+    return id;
+}
+
 /* The largest emission (radiance) accepted: what the tool's other inputs allow (1e30). */
 #define EMISSION_MAX 1e30f
 /* no KHR_materials_emissive_strength in a glTF material (gltf_emissive_strength) */
@@ -338,8 +420,8 @@ static uint32_t load_texture(imp_storage *st, const struct aiScene *sc, const ch
    to become 0 without a word). *clamped: set to 1 when the albedo was clamped into
    [0, ALBEDO_MAX] (the warning waits until it is known which materials are used). */
 static int convert_material(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
-                            uint32_t index, double json_strength, rad_material *out, unsigned char *clamped_out, char *err,
-                            size_t errlen)
+                            uint32_t index, double json_strength, const char *gm, rad_material *out, unsigned char *clamped_out,
+                            char *err, size_t errlen)
 {
     struct aiColor4D c;
     struct aiString name, tpath;
@@ -347,10 +429,12 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
     ai_real fv;
     unsigned int one = 1;
     int k, have_base = 0, clamped = 0;
+    float base_alpha = 1.0f;
     memset(out, 0, sizeof *out);
     out->albedo[0] = out->albedo[1] = out->albedo[2] = 0.5f;
     if (aiGetMaterialColor(m, AI_MATKEY_BASE_COLOR, &c) == aiReturn_SUCCESS) {
         out->albedo[0] = c.r, out->albedo[1] = c.g, out->albedo[2] = c.b;
+        base_alpha = c.a;
         have_base = 1;
     }
     if (!have_base && aiGetMaterialColor(m, AI_MATKEY_COLOR_DIFFUSE, &c) == aiReturn_SUCCESS)
@@ -426,6 +510,8 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
                     memcpy(st->textures[st->texture_count].path, tag, sizeof tag);
                 }
                 st->textures[st->texture_count].rgb = (float *)xrealloc(NULL, sizeof(float) * 3 * n);
+                st->textures[st->texture_count].alpha = (float *)xrealloc(NULL, sizeof(float) * n);
+                memcpy(st->textures[st->texture_count].alpha, t->alpha, sizeof(float) * n);
                 for (q = 0; q < n; ++q)
                     for (k = 0; k < 3; ++k)
                         st->textures[st->texture_count].rgb[3 * q + k] = t->rgb[3 * q + k] * scale[k];
@@ -435,6 +521,42 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
             for (q = 0; q < 3 * n; ++q)
                 if (t->rgb[q] > ALBEDO_MAX) t->rgb[q] = ALBEDO_MAX, clamped = 1;
             out->texture = id;
+        }
+    }
+    /* Alpha cutouts. glTF alphaMode MASK: the surface is there where baseColorTexture alpha x
+       baseColorFactor alpha >= alphaCutoff (default 0.5); BLEND is approximated the same way
+       at 0.5 (partial transmission is not modelled). OBJ map_d: its alpha channel, else its
+       grey value, at 0.5; a constant d < 1 without map_d is not a cutout (reported, ignored). */
+    {
+        char mode[32] = "";
+        const char *v;
+        double cutoff = 0.5;
+        struct aiString bp;
+        int have_tex = aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) ==
+                           aiReturn_SUCCESS ||
+                       aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS;
+        if (gm && (v = js_get(gm, "alphaMode")) != NULL) js_string(v, mode, sizeof mode);
+        if (!strcmp(mode, "MASK") && (v = js_get(gm, "alphaCutoff")) != NULL) {
+            cutoff = strtod(v, NULL);
+            if (!(cutoff >= 0.0 && cutoff <= 1.0)) {
+                if (err && errlen)
+                    snprintf(err, errlen, "'%s': material %u '%s': alphaCutoff %g is out of range (want [0, 1])", file, index,
+                             name.data, cutoff);
+                return 1;
+            }
+        }
+        if ((!strcmp(mode, "MASK") || !strcmp(mode, "BLEND")) && cutoff > 0.0) {
+            if (!(base_alpha >= 0.0f && base_alpha <= 1.0f)) base_alpha = 1.0f;
+            /* a factor alone at or above the cutoff leaves nothing to cut */
+            if (have_tex || base_alpha < (float)cutoff)
+                out->opacity_texture = opacity_texture(st, sc, file, have_tex ? bp.data : NULL, base_alpha, 0);
+        } else if (!gm && aiGetMaterialTexture(m, aiTextureType_OPACITY, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) ==
+                              aiReturn_SUCCESS) {
+            out->opacity_texture = opacity_texture(st, sc, file, bp.data, 1.0f, 1);
+        }
+        if (out->opacity_texture) {
+            out->alpha_cutoff = (float)cutoff;
+            st->any_cutout = 1;
         }
     }
     for (k = 0; k < 3; ++k) {
@@ -753,7 +875,7 @@ static void gltf_report(const char *m, char **r)
         const char *c = js_get(m, "alphaCutoff");
         js_string(v, val, sizeof val);
         if (c) snprintf(cut, sizeof cut, ", alphaCutoff %g", strtod(c, NULL));
-        rep_add(r, "  alphaMode: %s%s (read; cutouts are not supported yet: the surface is opaque)", val, cut);
+        rep_add(r, "  alphaMode: %s%s (used: see cutout)", val, cut);
     }
     transform += gltf_has_transform(js_get(m, "emissiveTexture"));
     if (pbr) transform += gltf_has_transform(js_get(pbr, "baseColorTexture"));
@@ -1187,7 +1309,7 @@ static void material_report(imp_storage *st, const struct aiMaterial *am, uint32
     static const struct { enum aiTextureType type; const char *what; } other[] = {
         {aiTextureType_NORMALS, "normal map"}, {aiTextureType_HEIGHT, "bump/height map"},
         {aiTextureType_SPECULAR, "specular map"}, {aiTextureType_SHININESS, "shininess map"},
-        {aiTextureType_OPACITY, "opacity map (no cutouts)"}, {aiTextureType_AMBIENT, "ambient map"},
+        {aiTextureType_AMBIENT, "ambient map"},
         {aiTextureType_DISPLACEMENT, "displacement map"}, {aiTextureType_LIGHTMAP, "lightmap/occlusion map"},
         {aiTextureType_REFLECTION, "reflection map"}, {aiTextureType_METALNESS, "metalness map"},
         {aiTextureType_DIFFUSE_ROUGHNESS, "roughness map"}, {aiTextureType_UNKNOWN, "unknown-type map"}};
@@ -1213,6 +1335,14 @@ static void material_report(imp_storage *st, const struct aiMaterial *am, uint32
     }
     if (is_gltf && gm) gltf_report(gm, r);
     else if (is_gltf) rep_add(r, "  (not in the file's materials: the importer's default)%s%s", NULL, NULL);
+    if (!is_gltf && !m->opacity_texture) { /* a constant transparency is not a cutout */
+        ai_real d = 1;
+        unsigned int one = 1;
+        if (aiGetMaterialFloatArray(am, AI_MATKEY_OPACITY, &d, &one) == aiReturn_SUCCESS && d < 1) {
+            snprintf(buf, sizeof buf, "%g", (double)d);
+            rep_add(r, "  ignored: opacity d %s (a constant transparency is not a cutout: the surface is opaque)%s", buf, NULL);
+        }
+    }
     if (!is_gltf) /* other formats: the texture kinds assimp found that radiosity does not use */
         for (k = 0; k < sizeof other / sizeof other[0]; ++k)
             if (aiGetMaterialTextureCount(am, other[k].type) > 0 &&
@@ -1360,7 +1490,8 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
                 tool_free_scene(out);
                 return 1;
             }
-            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, gltf_emissive_strength(gm), &st->materials[i],
+            if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, gltf_emissive_strength(gm), json ? gm : NULL,
+                                 &st->materials[i],
                                  &clamped[i], err, errlen)) {
                 free(clamped);
                 free(json);
@@ -1424,7 +1555,8 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
         md->material_ids = g->material_ids;
         if (g->all_uv2) md->lightmap_uvs = g->uvs2;
         for (t = 0; t < g->triangle_count; ++t)
-            if (st->materials[g->material_ids[t]].texture || st->materials[g->material_ids[t]].emission_texture) {
+            if (st->materials[g->material_ids[t]].texture || st->materials[g->material_ids[t]].emission_texture ||
+                st->materials[g->material_ids[t]].opacity_texture) {
                 md->uvs = g->uvs; /* zeros when the file had none */
                 if (!g->any_uv) fprintf(stderr, "rad: warning: mesh '%s' has a textured material but no uvs\n", g->name);
                 break;
@@ -1449,13 +1581,28 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     out->desc.albedo_user = st;
     out->desc.emission_lookup = st->any_emission_texture ? emission_lookup : NULL;
     out->desc.emission_user = st;
+    out->desc.opacity_lookup = st->any_cutout ? opacity_lookup : NULL;
+    out->desc.opacity_user = st;
     out->desc.flags = RAD_SCENE_SKIP_DEGENERATE;
     for (i = 0; i < st->material_count; ++i) {
         if (tool_two_sided == TOOL_TWO_SIDED_ALL) st->materials[i].two_sided = 1;
         if (tool_two_sided == TOOL_TWO_SIDED_NONE) st->materials[i].two_sided = 0;
-        if (st->material_reports)
-            rep_add(&st->material_reports[i], "  sides: %s", st->materials[i].two_sided ? "two (each side receives, reflects and emits)"
-                                                                                      : "one (front counter-clockwise, the back absorbs)", NULL);
+        if (st->material_reports) {
+            const rad_material *m = &st->materials[i];
+            rep_add(&st->material_reports[i], "  sides: %s", m->two_sided ? "two (each side receives, reflects and emits)"
+                                                                          : "one (front counter-clockwise, the back absorbs)", NULL);
+            if (m->opacity_texture) {
+                char what[400];
+                const imp_texture *t = &st->textures[m->opacity_texture - 1];
+                const char *p = strchr(strchr(strchr(t->path, ':') + 1, ':') + 1, ':') + 1;
+                snprintf(what, sizeof what, "alpha %s%s%s x %g >= %g (rays pass the rest; patches keep their opaque part)",
+                         p[0] ? "of '" : "", p[0] ? p : "constant 1", p[0] ? (t->has_alpha ? "' (alpha channel)" : "' (grey)") : "",
+                         (double)t->alpha_scale, (double)m->alpha_cutoff);
+                rep_add(&st->material_reports[i], "  cutout: %s%s", what, NULL);
+            } else {
+                rep_add(&st->material_reports[i], "  cutout: none (opaque)%s%s", NULL, NULL);
+            }
+        }
     }
     warn_mixed_windings(st, path_or_name);
     add_input(st, path_or_name);

@@ -663,4 +663,27 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
                            int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
 
+/* ---- glTF output (gltf_write.c; the convention: docs/engine-formats.md) ------------------- */
+/* A baked RGB irradiance lightmap and the scene it was baked over, for engines */
+typedef struct tool_gltf_lightmap {
+    const rad_scene *scene;            /* the triangles, with the lightmap uvs the bake used */
+    const rad_scene *mesh_scene;       /* the same triangles in the same order whose meshes and
+                                          names group them (the scene before an unwrap), or NULL */
+    const char *const *material_names; /* scene->material_count names, or NULL */
+    const rad_camera *camera;          /* written as a camera node, or NULL */
+    float aspect;                      /* the view's width / height (0: left to the engine) */
+    const rad_lightmap *lightmap;
+    const float *values;               /* 3 floats a texel, dilated and stitched */
+    const char *hdr_name;              /* the HDR copy's file name as the extras name it, or NULL */
+} tool_gltf_lightmap;
+/* 1 for a .glb or .gltf name */
+int tool_gltf_is_path(const char *path);
+/* the HDR copy beside OUT.glb|gltf: OUT.lightmap.exr with OpenEXR support, else
+   OUT.lightmap.pfm; and for a .gltf its buffer OUT.bin (NULL for a .glb). malloc'd. */
+char *tool_gltf_hdr_path(const char *path);
+char *tool_gltf_bin_path(const char *path);
+/* Writes path (.glb: one file; .gltf: it and its .bin) into the set (committed by the
+   caller). 0, or 1 after printing "rad CMD: ..." (the set aborted). */
+int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap *in, tool_output_set *set);
+
 #endif

@@ -213,12 +213,13 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
         if (T->emitter_count) {
             uint32_t e = tool__pick_emitter(T, tool__rnd(seed, pixel, sample, dim + 0));
             uint32_t lt = T->emitters[e];
-            if (lt != tri) {
+            if (lt != tri) { /* a point in a cutout's hole emits nothing (skipped below) */
                 const float *lv = S->positions + 9 * (size_t)lt, *ln = S->normals + 3 * (size_t)lt;
                 float u1 = tool__rnd(seed, pixel, sample, dim + 1), u2 = tool__rnd(seed, pixel, sample, dim + 2);
                 float su = sqrtf(u1), b0 = 1.0f - su, bb1 = u2 * su, bb2 = 1.0f - b0 - bb1;
                 float q[3], d[3], d2, dist, cs, cl, lL[3];
                 rad_scene_emission(S, lt, bb1, bb2, lL); /* at the light's sample point: textures vary it */
+                if (!rad_scene_opaque(S, lt, bb1, bb2)) lL[0] = lL[1] = lL[2] = 0.0f;
                 for (k = 0; k < 3; ++k) {
                     q[k] = b0 * lv[k] + bb1 * lv[3 + k] + bb2 * lv[6 + k];
                     d[k] = q[k] - p[k];

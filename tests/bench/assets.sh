@@ -9,6 +9,7 @@
 # which is not part of this repository). Never part of make test.
 #   bash tests/bench/assets.sh build/rad OUT.md [DIR]
 set -eu
+. "$(dirname "${BASH_SOURCE[0]}")/machine.sh"
 RAD=$1
 OUT=$2
 DIR=${3:-${RAD_DATA_DIR:-}}
@@ -26,6 +27,7 @@ fi
     echo
     echo "## Emissive glTF assets against the path tracer"
     echo
+    bench_machine
     echo "\`rad render\` (default: classic radiosity, per-pixel direct light) and \`rad trace --spp 256\`, \`$SIZE\`,"
     echo "the file's camera or the default framing; ratio of mean linear radiance and SSIM (\`rad compare\`)."
     echo

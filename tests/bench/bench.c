@@ -424,6 +424,7 @@ int main(int argc, char **argv)
     rad_bvh_raycaster(bvh, &rc);
     rad_form_factor_options_default(&fopt);
     emit("## a) Form-factor bake, Cornell box\n\n");
+    emit_machine();
     emit("`rad_form_factors_dense` with `rad_form_factor_options_default` (method %s, samples %u%s, "
          "ray_epsilon %g%s), built-in BVH over the %u scene triangles. Time is the form-factor call "
          "only (patches and BVH are built before). Rays: `rays_cast`; pairs: `pairs_evaluated` "
@@ -515,6 +516,7 @@ int main(int argc, char **argv)
         g_str = bytes / t_str[0] / 1e9;
 
         emit("## b) One dense bounce vs a streaming read, N = %u\n\n", n);
+        emit_machine();
         emit("A synthetic random %u x %u float matrix (%.1f MB, entries in [0, 1/N)) wrapped in a dense "
              "`rad_matrix` view; RGB vectors of 3N floats. Best of %d timed runs each (after one untimed "
              "run), the three interleaved. GB/s counts the matrix bytes only (4 N^2). The streaming read "

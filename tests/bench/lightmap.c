@@ -118,8 +118,9 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--refresh-patches")) Rtarget = v;
         else if (!strcmp(argv[a], "--refresh-only")) refresh_only = v;
     }
-    emit("\n## Lightmaps: bake stages and the refresh (tests/bench/lightmap.c)\n\n"
-         "The Cornell box with one atlas cell per quad; the gather's noise is the texel-to-texel difference between two "
+    emit("\n## Lightmaps: bake stages and the refresh (tests/bench/lightmap.c)\n\n");
+    emit_machine();
+    emit("The Cornell box with one atlas cell per quad; the gather's noise is the texel-to-texel difference between two "
          "seeds; the refresh rebuilds the lightmap from a new patch solution (2 threads, and in the calling thread).\n\n"
          "| atlas | stage | time | note |\n|---|---|---|---|\n");
     rad_patch_options_default(&po);

@@ -422,6 +422,8 @@ int main(int argc, char **argv)
     g_ctx.parallel_for = serial_for;
     g_ctx.task_count = 1;
     emit("\n## Local multi-bounce matrix for large scenes\n\nCPU, 1 thread%s.\n", quick ? " (--quick)" : "");
+    emit("\n");
+    emit_machine();
     bench_large(grid, M);
     bench_error();
     emit("\n(tests/bench/local.c: %.0f s in all)\n", now() - t0);

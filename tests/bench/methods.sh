@@ -4,6 +4,7 @@
 # (the energy check), PSNR and SSIM (rad compare). Appends a table to the file given ($2).
 #   bash tests/bench/methods.sh build/rad docs/BENCHMARKS.md [--quick]
 set -eu
+. "$(dirname "${BASH_SOURCE[0]}")/machine.sh"
 RAD=$1
 OUT=$2
 QUICK=${3:-}
@@ -24,6 +25,7 @@ tref=$(elapsed "$t0" "$(seconds)")
     echo
     echo "## e) Every method against the path tracer, Cornell box"
     echo
+    bench_machine
     echo "\`rad render cornell --size $SIZE --method M\` with the method's defaults against"
     echo "\`rad trace cornell --spp $SPP\` ($tref s), $(nproc) threads. Mean = the ratio of mean linear"
     echo "radiance (1 = no light lost or gained); PSNR and SSIM on values clamped to [0, 1] (\`rad compare\`)."

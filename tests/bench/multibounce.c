@@ -802,6 +802,8 @@ int main(int argc, char **argv)
     }
     if (reorder) {
         emit("\n## Multi-bounce compression: reordering methods\n\nCPU, %d threads.\n", threads);
+        emit("\n");
+        emit_machine();
         if (reorder == 2) {
             if (reorder_search(1736)) return 1;
         } else {
@@ -812,6 +814,8 @@ int main(int argc, char **argv)
         return 0;
     }
     emit("\n## Multi-bounce matrix and block compression\n\nCPU, %d threads; Jacobi = rad_solve_jacobi (dense F, one pass per bounce).\n", threads);
+    emit("\n");
+    emit_machine();
     if (bench_size(1736)) return 1;
     if (!quick && bench_size(5485)) return 1;
     if (g_md) fclose(g_md);

@@ -253,6 +253,7 @@ int main(int argc, char **argv)
             }
         }
     emit("\n## Irradiance probes in the Cornell box (target: within 5%% at 95%% of test points)\n\n");
+    emit_machine();
     emit("`build/probes%s`: %u patches (direct light as the source, 64 Jacobi bounces), 4 spheres of radius 0.05 m, "
          "32 normals each; reference = rad_direct_irradiance (256 shadow rays) + 16384 cosine rays over the same patch "
          "solution. Relative error per point and channel.\n\n", quick ? " --quick" : "", P->count);

@@ -284,24 +284,25 @@ static void run_scene(const char *name, const rad_scene *scene, uint32_t target,
     emit("Build (best of 5, alternating): built-in BVH %.1f ms, %.0f KiB", tb * 1e3, rad_bvh_memory(bvh) / 1024.0);
     if (emb) emit("; Embree %.1f ms, %.0f KiB (Embree builds on all its threads)", te * 1e3, rad_embree_memory(emb) / 1024.0);
     emit(".\n\n");
-    emit("| rays | query | count | threads | BVH Mrays/s | Embree Mrays/s | BVH / Embree | answers differing |\n");
+    emit("| rays | query | count | 1 thread: BVH / Embree Mrays/s | ratio | 2 threads: BVH / Embree Mrays/s | ratio | answers differing |\n");
     emit("|---|---|---:|---:|---:|---:|---:|---:|\n");
     for (s = 0; s < 4 && (int)s < g_sets; ++s) {
         int q, th;
         for (q = 0; q < 2; ++q) {
             const rad_ray *rays = q ? sets[s].hit : sets[s].occ;
+            size_t most = 0;
             if (!rays || sets[s].n == 0) continue;
+            emit("| %s | %s | %zu |", sets[s].name, q ? "closest hit" : "occlusion", sets[s].n);
             for (th = 1; th <= 2; ++th) {
                 double ta, tbb;
                 size_t diff, pos;
                 compare(&rb, &re, rays, sets[s].n, th, q, reps, &ta, &tbb, &diff, &pos);
-                if (emb)
-                    emit("| %s | %s | %zu | %d | %.2f | %.2f | %.2f | %zu |\n", sets[s].name, q ? "closest hit" : "occlusion",
-                         sets[s].n, th, sets[s].n / ta * 1e-6, sets[s].n / tbb * 1e-6, tbb / ta, diff);
-                else
-                    emit("| %s | %s | %zu | %d | %.2f | - | - | - |\n", sets[s].name, q ? "closest hit" : "occlusion",
-                         sets[s].n, th, sets[s].n / ta * 1e-6);
+                if (diff > most) most = diff;
+                if (emb) emit(" %.2f / %.2f | %.2f |", sets[s].n / ta * 1e-6, sets[s].n / tbb * 1e-6, tbb / ta);
+                else emit(" %.2f / - | - |", sets[s].n / ta * 1e-6);
             }
+            if (emb) emit(" %zu |\n", most);
+            else emit(" - |\n");
         }
     }
     for (s = 0; s < 4; ++s) {
@@ -329,6 +330,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--only") && a + 1 < argc) g_only = argv[++a];
         else if (!strcmp(argv[a], "--sets") && a + 1 < argc) g_sets = atoi(argv[++a]);
     emit("\n## c) Ray queries: built-in BVH against Embree\n\n");
+    emit_machine();
     emit("Ray sets: *form-factor rows* are the occlusion rays of a sample of rows (rad_form_factor_rows, default "
          "options), replayed as closest-hit queries with tmax = infinity; *camera* are 512x512 pinhole rays "
          "(coherent; occlusion = any hit along the ray); *bounce* are cosine-distributed rays from the camera hits "

@@ -23,6 +23,7 @@
 #if !defined(_WIN32) && !defined(_POSIX_C_SOURCE)
 #  define _POSIX_C_SOURCE 199309L /* clock_gettime */
 #endif
+#include "bench_common.h" /* emit, emit_machine */
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
 #include <math.h>
@@ -32,20 +33,6 @@
 #include <string.h>
 #include <time.h>
 
-static FILE *g_md;
-static void emit(const char *fmt, ...)
-{
-    va_list a;
-    va_start(a, fmt);
-    vprintf(fmt, a);
-    va_end(a);
-    if (g_md) {
-        va_start(a, fmt);
-        vfprintf(g_md, fmt, a);
-        va_end(a);
-    }
-    fflush(stdout);
-}
 static double now_ms(void)
 {
     struct timespec t;
@@ -423,6 +410,7 @@ int main(int argc, char **argv)
     }
     if (append && !(g_md = fopen(append, "a"))) return fprintf(stderr, "bench_realtime: cannot open %s\n", append), 1;
     emit("\n## Real-time loop over AAVP (tests/bench/realtime.c%s)\n\n", quick ? ", quick" : "");
+    emit_machine();
     if (!dir || !dir[0]) {
         emit("Skipped: no data folder (pass --data DIR or set RAD_DATA_DIR to the meshes of docs/data.md).\n");
         return 0;
@@ -441,7 +429,7 @@ int main(int argc, char **argv)
     snprintf(path, sizeof path, "%s/sponza.obj", dir);
     if (only && strcmp(only, "sponza")) {
     } else if (load_obj(path, &sponza)) {
-        rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0};
+        rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0, 0, 0.0f};
         rad_mesh_desc md;
         rad_scene_desc d;
         rad_light sun;

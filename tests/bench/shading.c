@@ -65,6 +65,7 @@ int main(int argc, char **argv)
         }
         if (tm) strftime(date, sizeof(date), "%Y-%m-%d %H:%M UTC", tm);
         emit("\n## Lighting models: cost of one evaluation in C\n\n");
+        emit_machine();
         emit("Measured %s on %s (%s), compiled `-std=c99 -O3 -march=native`.\n\n", date, cpu,
 #ifdef __VERSION__
              "gcc/clang " __VERSION__

@@ -7,6 +7,7 @@
 # The mesh is a public model outside the repository (docs/data.md); without it the section
 # says it skipped.
 set -eu
+. "$(dirname "${BASH_SOURCE[0]}")/machine.sh"
 RAD=$1
 OUT=$2
 SPONZA="${RAD_DATA_DIR:-}/sponza.obj"
@@ -28,6 +29,7 @@ timed() { if [ -x /usr/bin/time ]; then /usr/bin/time -f "%e %M" -o "$TMP/time.t
     echo
     echo "## Sponza against the path tracer"
     echo
+    bench_machine
     echo "The Dabrovic Sponza atrium (66 453 triangles, one stone albedo), \`$CAMERA\`, lit by a sun"
     echo "(\`$SUN\`) or by a one-sided sky window above the open roof (\`$SKY\`), so most of the"
     echo "building sees bounced light only. \`rad bake --method M --vp-resolution R\` then"

@@ -16,7 +16,8 @@
    --csv path); if gnuplot is on the PATH, also temporal_error.png.
 
    Build: cc -std=c99 -O3 -march=native -fopenmp -I. tests/bench/temporal.c -o temporal -lm
-   Run:   temporal [--quick] [--sizes N,N,...] [--append FILE.md] [--csv FILE.csv]
+   Run:   temporal [--quick] [--detail] [--sizes N,N,...] [--append FILE.md] [--csv FILE.csv]
+          (--detail adds the table of where the step's time goes: ns per draw, huge pages)
           (--sizes: up to four patch-count targets instead of the published four; tools/report.sh) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
@@ -166,12 +167,13 @@ int main(int argc, char **argv)
     int custom = 0;
     static const double published_temporal[4] = { 0.02, 0.04, 0.06, 0.08 }, published_mv[4] = { 0.34, 2.94, 7.34, 12.01 };
     const char *csv_path = "temporal_error.csv";
-    int quick = 0, a, s, sizes, threads = 1;
+    int quick = 0, detail = 0, a, s, sizes, threads = 1;
     char rows_t1[4][512], rows_lag[4][512], rows_mem[4][256], rows_draw[4][256];
     double *series_f = NULL, *series_a = NULL;
     uint32_t series_n = 0;
     for (a = 1; a < argc; ++a) {
         if (!strcmp(argv[a], "--quick")) quick = 1;
+        else if (!strcmp(argv[a], "--detail")) detail = 1;
         else if (!strcmp(argv[a], "--append") && a + 1 < argc) g_md = fopen(argv[++a], "a");
         else if (!strcmp(argv[a], "--csv") && a + 1 < argc) csv_path = argv[++a];
         else if (!strcmp(argv[a], "--sizes") && a + 1 < argc) {
@@ -358,6 +360,7 @@ int main(int argc, char **argv)
         rad_scene_destroy(scene);
     }
     emit("\n## Temporal radiosity: alias-table sampling against the dense gather\n\n");
+    emit_machine();
     emit("CPU, timings on 1 thread (bake and lag runs on %d OpenMP threads). Cornell box, E = rho * direct light of the ceiling emitter; single bounce. "
          "Step = rad_temporal_step (compact alias tables, w = 0.998), MV = one dense RGB rad_matrix_multiply; "
          "times are medians (ms). Error = relative RMS against rho o (F E) after 3000 warm-up frames (mean of 100 frames). "
@@ -365,13 +368,15 @@ int main(int argc, char **argv)
     emit("| N (target) | step k=10 ms | step k=64 ms | MV ms | ratio k=10 | ratio k=64 | error k=10 | error k=64 | published step vs MV ms (ratio) |\n");
     emit("|---|---|---|---|---|---|---|---|---|\n");
     for (s = 0; s < sizes; ++s) emit("%s", rows_t1[s]);
-    emit("\nWhere the step's time goes (k = 10, 1 thread, median of 100 frames): nanoseconds per draw with the "
-         "library's tables (2 MiB aligned, MADV_HUGEPAGE on Linux) and with the same bins copied into plain malloc memory "
-         "(4 KiB pages when THP is in 'madvise' mode); huge-page MB backing each, from /proc/self/smaps (-1: not Linux); "
-         "the dense product's read rate for comparison.\n\n");
-    emit("| N | bins | huge pages (library) | ns per draw | huge pages (copy) | ns per draw (copy) | copy / library | MV read rate |\n");
-    emit("|---|---|---|---|---|---|---|---|\n");
-    for (s = 0; s < sizes; ++s) emit("%s", rows_draw[s]);
+    if (detail) {
+        emit("\nWhere the step's time goes (k = 10, 1 thread, median of 100 frames): nanoseconds per draw with the "
+             "library's tables (2 MiB aligned, MADV_HUGEPAGE on Linux) and with the same bins copied into plain malloc memory "
+             "(4 KiB pages when THP is in 'madvise' mode); huge-page MB backing each, from /proc/self/smaps (-1: not Linux); "
+             "the dense product's read rate for comparison.\n\n");
+        emit("| N | bins | huge pages (library) | ns per draw | huge pages (copy) | ns per draw (copy) | copy / library | MV read rate |\n");
+        emit("|---|---|---|---|---|---|---|---|\n");
+        for (s = 0; s < sizes; ++s) emit("%s", rows_draw[s]);
+    }
     emit("\nMemory: dense F (4 B per entry), its non-zeros as CSR (8 B per entry), the alias tables "
          "(bins over non-zeros + 1 environment bin per row, offsets, T_i).\n\n");
     emit("| N | non-zero | dense F | CSR F | tables | bytes per bin | table bytes per bin incl. offsets | F bake | table build |\n");

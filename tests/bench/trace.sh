@@ -4,6 +4,7 @@
 # clamped to [0,1]) and the time of one run. Appends a table to the file given ($2).
 #   bash tests/bench/trace.sh build/rad docs/BENCHMARKS.md
 set -eu
+. "$(dirname "${BASH_SOURCE[0]}")/machine.sh"
 RAD=$1
 OUT=$2
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/rad_trace_bench.XXXXXX")
@@ -12,6 +13,7 @@ trap 'rm -rf "$TMP"' EXIT
     echo
     echo "## d) Reference path tracer: noise against samples per pixel"
     echo
+    bench_machine
     echo "\`rad trace cornell --size 256x256\` (built-in BVH), two runs with seeds 1 and 2 compared by"
     echo "\`rad compare\` (MSE on linear values clamped to [0,1]); time of one run, $(nproc) threads."
     echo "Target: two seeds within 1e-4 MSE."

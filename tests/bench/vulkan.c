@@ -12,17 +12,11 @@
 #define _POSIX_C_SOURCE 199309L
 #endif
 #define RADIOSITY_IMPLEMENTATION
+#include "bench_common.h"
 #include "../../radiosity.h"
 #include "../vk_util.h"
 #include <time.h>
 #include <math.h>
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -110,6 +104,9 @@ int main(int argc, char **argv)
         md = fopen(append, "a");
         if (md) {
             fprintf(md, "\n## GLSL kernels on a Vulkan device (tests/bench/vulkan.c)\n\n");
+            g_md = md; /* emit_machine writes to stdout and to g_md */
+            emit_machine();
+            g_md = NULL;
             fprintf(md, "Device: %s. N = %u, random dense F (rows sum to 0.3..0.9), K = 1. GPU: wall time of one "
                         "dispatch with submit and wait (workgroup size %u), median of %d; CPU: the header's function, "
                         "same inputs, median of %d. On lavapipe both run on the same CPU cores.\n\n", V.props.deviceName, n, ls, reps, reps);

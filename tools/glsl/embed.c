@@ -9,6 +9,8 @@
    --check writes nothing and exits 1 when the header differs from what would be written (the
    test suite runs it, so a header older than its tools/glsl/ files fails the tests).
 
+   A kernel may include a shared piece of tools/glsl/ (`#include "reduce.glsl"`): the header's
+   copy holds the piece pasted in place (read_expanded), so users need no includer.
    Adding a kernel is one line in 'kernels' below (ids stay in table order: append at the end so
    the numbers users may have stored do not change). Plain C99, no dependencies: CI machines may
    lack Python. */
@@ -69,6 +71,52 @@ static char *read_all(const char *path, size_t *len)
     return b.p;
 }
 
+/* The source of a kernel as the header holds it: a line `#include "NAME"` is replaced by the
+   text of tools/glsl/NAME (one level: the includes are small shared pieces such as reduce.glsl)
+   and the `#extension GL_GOOGLE_include_directive` line that allowed it is dropped, so the
+   embedded kernels compile without an includer, as shaderc or a driver gets them from memory. */
+static char *read_expanded(const char *path, size_t *len)
+{
+    static const char ext[] = "#extension GL_GOOGLE_include_directive";
+    size_t n, at = 0;
+    char *src = read_all(path, &n);
+    buf out = { NULL, 0, 0 };
+    while (at < n) {
+        const char *nl = (const char *)memchr(src + at, '\n', n - at);
+        size_t ln = nl ? (size_t)(nl - (src + at)) + 1 : n - at;
+        const char *line = src + at;
+        if (ln >= sizeof(ext) - 1 && !memcmp(line, ext, sizeof(ext) - 1)) {
+            /* dropped */
+        } else if (ln > 10 && !memcmp(line, "#include \"", 10)) {
+            char inc[512];
+            const char *q = (const char *)memchr(line + 10, '"', ln - 10), *slash = strrchr(path, '/');
+            size_t dir = slash ? (size_t)(slash - path) + 1 : 0, name, ilen;
+            char *text;
+            if (!q || (name = (size_t)(q - (line + 10))) == 0 || dir + name >= sizeof(inc)) {
+                fprintf(stderr, "tools/glsl/embed: a malformed #include in '%s'\n", path);
+                exit(1);
+            }
+            memcpy(inc, path, dir);
+            memcpy(inc + dir, line + 10, name);
+            inc[dir + name] = 0;
+            text = read_all(inc, &ilen);
+            if (ilen == 0 || text[ilen - 1] != '\n' || !strncmp(text, "#include", 8) || strstr(text, "\n#include")) {
+                fprintf(stderr, "tools/glsl/embed: '%s' (included by '%s') is empty, lacks a final newline or includes again\n", inc, path);
+                exit(1);
+            }
+            put(&out, text, ilen);
+            free(text);
+        } else {
+            put(&out, line, ln);
+        }
+        at += ln;
+    }
+    free(src);
+    if (!out.p) put(&out, "", 0);
+    *len = out.n;
+    return out.p;
+}
+
 /* the part of 'path' after the last '/' */
 static const char *base_name(const char *path)
 {
@@ -122,7 +170,7 @@ static void gen_sources(buf *b)
     if (KERNELS > 64) { fprintf(stderr, "tools/glsl/embed: too many kernels\n"); exit(1); }
     for (k = 0; k < KERNELS; ++k) {
         size_t len, at = 0;
-        char *src = read_all(kernels[k].path, &len);
+        char *src = read_expanded(kernels[k].path, &len);
         unsigned piece = 0;
         if (len == 0 || src[len - 1] != '\n') {
             fprintf(stderr, "tools/glsl/embed: '%s' is empty or does not end with a newline\n", kernels[k].path);

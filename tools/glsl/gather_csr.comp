@@ -1,4 +1,5 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require   // reduce.glsl; `make glsl` inlines it
 // radiosity.h kernel RAD_GLSL_GATHER_CSR: one classic bounce with a CSR (sparse) form-factor matrix,
 //   out_i = rho_i * sum_k values[k] E_columns[k]  (+ E_i when flags bit 0 is set)
 // for rows i = row_offset .. row_offset + row_count - 1, ONE WORKGROUP PER ROW (dispatch
@@ -21,7 +22,7 @@ layout(push_constant) uniform Push {
     uint flags;       // bit 0: add E (total)
 } pc;
 
-shared vec3 partial[gl_WorkGroupSize.x];
+#include "reduce.glsl"                              // rad_group_sum
 
 void main()
 {
@@ -35,16 +36,9 @@ void main()
         uint j = columns[k0 + e];
         acc += values[k0 + e] * vec3(E[3u * j], E[3u * j + 1u], E[3u * j + 2u]);
     }
-    partial[lid] = acc;
-    barrier();
-    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {
-        uint h = (width + 1u) / 2u;
-        if (lid < width - h) partial[lid] += partial[lid + h];
-        barrier();
-        width = h;
-    }
+    vec3 sum = rad_group_sum(acc);
     if (lid != 0u) return;
-    precise vec3 o = partial[0] * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);
+    precise vec3 o = sum * vec3(rho[3u * i], rho[3u * i + 1u], rho[3u * i + 2u]);
     if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);
     outv[3u * i] = o.x;
     outv[3u * i + 1u] = o.y;

@@ -1,4 +1,5 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require   // reduce.glsl; `make glsl` inlines it
 // radiosity.h kernel RAD_GLSL_LOCAL_APPLY: the local multi-bounce apply of rad_local_apply
 // (docs/methods/local.md): for every visible entry r = row_offset .. row_offset + row_count - 1,
 // with slot i = vis_slot[r] and world patch p = vis_patch[r],
@@ -30,7 +31,7 @@ layout(push_constant) uniform Push {
     uint flags;        // bit 0: add E (RAD_OUTPUT_TOTAL)
 } pc;
 
-shared vec3 partial[gl_WorkGroupSize.x];
+#include "reduce.glsl"                              // rad_group_sum
 
 void main()
 {
@@ -45,17 +46,10 @@ void main()
         if (p == 0xFFFFFFFFu) continue;
         acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[3u * p], E[3u * p + 1u], E[3u * p + 2u]);
     }
-    partial[lid] = acc;
-    barrier();
-    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {
-        uint h = (width + 1u) / 2u;
-        if (lid < width - h) partial[lid] += partial[lid + h];
-        barrier();
-        width = h;
-    }
+    vec3 sum = rad_group_sum(acc);
     if (lid != 0u) return;
     uint o = 3u * vis_patch[pc.row_offset + r];
-    precise vec3 s = partial[0];
+    precise vec3 s = sum;
     if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);
     outv[o] = s.x;
     outv[o + 1u] = s.y;

@@ -1,4 +1,5 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require   // reduce.glsl; `make glsl` inlines it
 // radiosity.h kernel RAD_GLSL_MB_APPLY_BLOCKS: the multi-bounce apply from the block-compressed
 // matrix (rad_multibounce_blocks), as rad_multibounce_blocks_apply: the texture unit decodes the
 // blocks (texelFetch), each texel is multiplied by its tile's scale, the outliers are added
@@ -37,7 +38,7 @@ layout(push_constant) uniform Push {
     uint flags;         // bit 0: add E; bit 1: permuted; bit 2: BC1 (else BC4X3); bit 3: outliers bound
 } pc;
 
-shared vec3 partial[gl_WorkGroupSize.x];
+#include "reduce.glsl"                              // rad_group_sum
 
 void main()
 {
@@ -64,16 +65,9 @@ void main()
             s += vec3(out_val[3u * k], out_val[3u * k + 1u], out_val[3u * k + 2u]) * vec3(E[j], E[j + 1u], E[j + 2u]);
         }
     }
-    partial[lid] = acc + s;
-    barrier();
-    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {
-        uint h = (width + 1u) / 2u;
-        if (lid < width - h) partial[lid] += partial[lid + h];
-        barrier();
-        width = h;
-    }
+    vec3 sum = rad_group_sum(acc + s);
     if (lid != 0u) return;
-    precise vec3 o = partial[0];
+    precise vec3 o = sum;
     if ((pc.flags & 1u) != 0u) o += vec3(E[3u * i], E[3u * i + 1u], E[3u * i + 2u]);
     outv[3u * i] = o.x;
     outv[3u * i + 1u] = o.y;

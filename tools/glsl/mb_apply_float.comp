@@ -1,4 +1,5 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require   // reduce.glsl; `make glsl` inlines it
 // radiosity.h kernel RAD_GLSL_MB_APPLY_FLOAT: the multi-bounce apply L = F_mb E with float planes
 // (rad_multibounce with precision RAD_MB_FLOAT). Plane row i' (permuted order) is original row
 // row_perm[i'], plane column j' is original column col_perm[j'] (identity when flags bit 1 is clear):
@@ -23,7 +24,7 @@ layout(push_constant) uniform Push {
     uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound
 } pc;
 
-shared vec3 partial[gl_WorkGroupSize.x];
+#include "reduce.glsl"                              // rad_group_sum
 
 void main()
 {
@@ -37,17 +38,10 @@ void main()
         uint e = 3u * (perm ? col_perm[j] : j);
         acc += vec3(R[at + j], G[at + j], B[at + j]) * vec3(E[e], E[e + 1u], E[e + 2u]);
     }
-    partial[lid] = acc;
-    barrier();
-    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {
-        uint h = (width + 1u) / 2u;
-        if (lid < width - h) partial[lid] += partial[lid + h];
-        barrier();
-        width = h;
-    }
+    vec3 sum = rad_group_sum(acc);
     if (lid != 0u) return;
     uint o = 3u * (perm ? row_perm[ip] : ip);
-    precise vec3 s = partial[0];
+    precise vec3 s = sum;
     if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);
     outv[o] = s.x;
     outv[o + 1u] = s.y;

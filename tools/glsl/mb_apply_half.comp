@@ -1,4 +1,5 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require   // reduce.glsl; `make glsl` inlines it
 // radiosity.h kernel RAD_GLSL_MB_APPLY_HALF: the multi-bounce apply L = F_mb E with IEEE binary16
 // planes (rad_multibounce with precision RAD_MB_HALF), uploaded unchanged: two values per uint
 // word, the lower-addressed value in the low 16 bits (little-endian), so no 16-bit storage
@@ -22,7 +23,7 @@ layout(push_constant) uniform Push {
     uint flags;       // bit 0: add E (total); bit 1: row_perm / col_perm are bound
 } pc;
 
-shared vec3 partial[gl_WorkGroupSize.x];
+#include "reduce.glsl"                              // rad_group_sum
 
 float half_at(uint word, uint h) { vec2 v = unpackHalf2x16(word); return (h & 1u) != 0u ? v.y : v.x; }
 
@@ -39,17 +40,10 @@ void main()
         vec3 f = vec3(half_at(R[h >> 1u], h), half_at(G[h >> 1u], h), half_at(B[h >> 1u], h));
         acc += f * vec3(E[e], E[e + 1u], E[e + 2u]);
     }
-    partial[lid] = acc;
-    barrier();
-    for (uint width = gl_WorkGroupSize.x; width > 1u; ) {
-        uint h = (width + 1u) / 2u;
-        if (lid < width - h) partial[lid] += partial[lid + h];
-        barrier();
-        width = h;
-    }
+    vec3 sum = rad_group_sum(acc);
     if (lid != 0u) return;
     uint o = 3u * (perm ? row_perm[ip] : ip);
-    precise vec3 s = partial[0];
+    precise vec3 s = sum;
     if ((pc.flags & 1u) != 0u) s += vec3(E[o], E[o + 1u], E[o + 2u]);
     outv[o] = s.x;
     outv[o + 1u] = s.y;
