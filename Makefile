@@ -125,10 +125,14 @@ $(BUILD)/probes: tests/bench/probes.c tests/bench/bench_common.h radiosity.h | $
 $(BUILD)/bench_realtime: tests/bench/realtime.c radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/realtime.c -o $@ -lm
 
+# lights that move over a bake (rad_baker_runtime; Sponza from $(RAD_DATA_DIR), else the Cornell box)
+$(BUILD)/bench_runtime: tests/bench/runtime.c tests/bench/bench_common.h tests/bench/bench_scenes.h tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/runtime.c tools/unwrap.c -o $@ -lm
+
 $(BUILD)/rays: tests/bench/rays.c tests/bench/bench_common.h tests/bench/bench_scenes.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. tests/bench/rays.c -o $@ -lm $(EMBREE_LIB)
 
-bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime $(BUILD)/bench_lightmap
+bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime $(BUILD)/bench_lightmap $(BUILD)/bench_runtime
 	./$(BUILD)/bench docs/BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/rays --append docs/BENCHMARKS.md
 	bash tests/bench/trace.sh $(BUILD)/rad docs/BENCHMARKS.md
@@ -141,6 +145,7 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	./$(BUILD)/bench_lightmap --append docs/BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/realtime.sh $(BUILD) docs/BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/sponza.sh $(BUILD)/rad docs/BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/bench_runtime --append docs/BENCHMARKS.md
 
 bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md

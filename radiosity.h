@@ -3353,6 +3353,140 @@ RAD_API rad_result rad_baker_mix(rad_baker_result *result, const float *group_rg
 RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
                                        float *out, const rad_context *ctx);
 
+/* >>api_bake_runtime: lights that move, over a bake, one call per frame                    */
+
+/* rad_baker_runtime_create keeps what a bake needs to follow lights that MOVE (docs/methods/
+   bake.md, "Run time"): the layers of rad_baker_mix rescale the light a bake saw, but a light
+   at a new place needs a new direct term and new bounces. rad_baker_runtime_update takes the
+   lights of this frame (the same count and order as rad_baker_desc.lights, each at any new
+   place, direction, colour or cone; the emissive materials stay as baked) and refreshes the
+   vertex light, the lightmap and the probes (those the bake made, in its layouts: outputs of
+   all groups at scale 1, as rad_baker_mix with NULL) within a budget in milliseconds.
+   CLASSIC (the bake chose classic patches): create rebuilds the patches and F as the bake did
+   and folds 'bounces' bounces into the multi-bounce matrix (rad_multibounce_create, >>api_
+   multibounce: 12 N^2 bytes). A frame: rad_direct_patches with the lights, E (rad_sources,
+   RAD_SOURCE_DIRECT), L = F_mb E, B = E + L, H = F B (N^2 each): exact in one frame. Vertices
+   as the bake (rad_patches_vertex_irradiance, rad_patches_gather_mesh), the lightmap through
+   rad_lightmap_weights_create with the bake's lightmap as detail (so a light that moves keeps
+   the bake's sub-patch detail, not the new one's: the error the test states), probes through
+   the weights of rad_probes_create.
+   VIRTUAL PATCHES: create rebuilds the set at the bake's resolution with sparse rows, alias
+   tables over them (>>api_temporal), the lights' visibility cache (rad_vp_lights), gather
+   tables for the vertices, rad_lightmap_weights_create_vp and the probes' weights. While the
+   lights MOVE a frame is: E = rad_vp_lights_update (shadows re-tested round-robin,
+   'shadow_rays' per light), one rad_temporal_step in FEEDBACK mode ('temporal_samples' draws
+   per patch, history 'temporal_weight': noisy, and lagging about 1 / (1 - w) frames), and
+   H_i = L_i / rho_i (the step estimates L_i = rho_i (F (E + L))_i; a channel with rho 0 takes
+   its exact sparse row). Once the lights REST the shadows finish their round (ceil(M /
+   shadow_rays) frames), then REFINEMENT runs exact Jacobi sweeps from L = 0 on the sparse F
+   (H = F (E + L), L = rho H), rows taken from the budget, 'bounces' + 1 sweeps, in planes of
+   its own (the frames keep the estimate until it ends); then the outputs equal a fresh bake
+   with the lights there, to float rounding. A frame after that with the same lights does
+   nothing (CONVERGED).
+   BUDGET (budget_ms > 0; 0: no limit: every output refreshed and, at rest, refinement run to
+   the end in that call). The plan is a cost model, never a clock: each stage's work counted in
+   units (an entry read, a draw, a ray as 200) at 'work_per_ms' units per ms, so the same calls
+   give the same bits on any machine and thread count; raise work_per_ms where cores are many.
+   The solve part (lights, step, H) is always done. What is left goes to refinement (at rest,
+   half the remaining budget) and to the lightmap and probe rows, ROUND-ROBIN: each output
+   keeps a cursor and refreshes the next rows that fit (at least 1/64 of them per frame, so a
+   cycle ends within 64 frames even over budget), a new H restarting the count of rows still
+   stale; the lightmap's gutters are dilated (as rad_lightmap_dilate, 3 passes, bit for bit)
+   when a cycle ends. Vertex light is refreshed in full whenever H changed. rad_baker_frame
+   says what was done and what the model expected it to cost.
+   GPU (>>api_glsl; no Vulkan here): the same frame is, in one command buffer with a
+   compute-to-compute barrier between dispatches: E (the engine's own shadow maps, or
+   rad_vp_lights_update on the CPU, uploaded); RAD_GLSL_TEMPORAL_STEP on the alias tables
+   (rad_baker_runtime_view gives every array); RAD_GLSL_GATHER_CSR for H = F (E + L) over the
+   sparse rows (or H = L / rho in a trivial pass); RAD_GLSL_VP_GATHER at the vertices;
+   RAD_GLSL_LIGHTMAP_REFRESH (two passes) on the lightmap weights; RAD_GLSL_PROBE_UPDATE with
+   B = E + L. Classic: RAD_GLSL_MB_APPLY_FLOAT for L, RAD_GLSL_GATHER_DENSE for H, then the
+   last two. The gutter fill stays on the CPU (or the engine's own dilation).
+   Deterministic: the same calls give the same bits whatever the thread count. */
+
+typedef struct rad_baker_runtime_options {
+    uint32_t temporal_samples;  /* virtual patches: draws per patch and frame (0: 16) */
+    float temporal_weight;      /* virtual patches: history w while lights move, in [0, 1) (0: 0.75) */
+    uint32_t shadow_rays;       /* virtual patches: shadow rays per light and frame (0: an
+                                   eighth of the samples; RAD_BAKER_RUNTIME_ALL_RAYS: all) */
+    double work_per_ms;         /* the cost model's units per millisecond (0: 1e6, one core) */
+    uint32_t seed;              /* the temporal draws (any value) */
+} rad_baker_runtime_options;
+
+#define RAD_BAKER_RUNTIME_ALL_RAYS 0xFFFFFFFFu
+
+typedef enum rad_baker_runtime_phase {
+    RAD_BAKER_RUNTIME_CONVERGED = 0, /* nothing left to do: the outputs are the solution's */
+    RAD_BAKER_RUNTIME_MOVING = 1,    /* lights changed (or shadows settling): a temporal step */
+    RAD_BAKER_RUNTIME_REFINING = 2,  /* lights at rest: exact sweeps and output rows */
+    RAD_BAKER_RUNTIME_EXACT = 3      /* classic: the new solution in one frame */
+} rad_baker_runtime_phase;
+
+/* What rad_baker_runtime_update did, and the outputs (owned by the runtime, valid until the
+   next update or destroy; laid out as rad_baker_result's; NULL for those the bake lacks). */
+typedef struct rad_baker_frame {
+    const float *vertex;            /* 3 per vertex */
+    const float *lightmap;          /* 3 per texel */
+    const float *probes;            /* 27 per probe */
+    rad_baker_runtime_phase phase;
+    uint32_t frame;                 /* updates since create, this one included */
+    uint32_t lights_changed;        /* lights that differ from the last update's */
+    uint32_t sweeps;                /* full refinement sweeps since the lights last moved */
+    uint32_t rows_swept;            /* refinement rows this update */
+    uint32_t vertex_refreshed;      /* 1 when the vertex light was rewritten */
+    uint32_t lightmap_rows;         /* lightmap rows refreshed (of lightmap_rows_total) */
+    uint32_t lightmap_rows_total;
+    uint32_t probes_refreshed;      /* probes refreshed (of probe_count) */
+    uint32_t lightmap_stale;        /* rows still stale after this update (0: all current) */
+    uint32_t probes_stale;
+    uint64_t shadow_rays;           /* shadow rays cast */
+    double planned_ms;              /* the cost model's estimate of this update */
+    int over_budget;                /* the solve alone (or the 1/64 minimum) passed budget_ms */
+} rad_baker_frame;
+
+typedef struct rad_baker_runtime rad_baker_runtime;
+
+/* Fills the defaults each field's comment states; a zeroed struct means the same. */
+RAD_API void rad_baker_runtime_options_default(rad_baker_runtime_options *options);
+
+/* A runtime over 'result', which rad_baker_run made from 'desc' with 'bake_options' (both as
+   then, borrowed for the call: the runtime copies what it needs; NULL options as NULL then).
+   The outputs start as the bake's (its layers at scale 1) and the lights as desc's. options
+   and ctx may be NULL; ctx is COPIED and used by every update (its allocator, parallel_for and
+   logger must outlive the runtime). Errors: INVALID_ARGUMENT (NULL, a result of another desc
+   or options: its method, patch count or output sizes differ; bad options; more than
+   RAD_VP_LIGHTS_MAX lights over virtual patches), those of rad_baker_run's build, OUT_OF_
+   MEMORY. Cost: the bake's build (F or the set, texels, probes) plus 'bounces' + 1 sweeps. */
+RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const rad_baker_options *bake_options,
+                                            const rad_baker_result *result, const rad_baker_runtime_options *options,
+                                            const rad_context *ctx, rad_baker_runtime **out);
+RAD_API void rad_baker_runtime_destroy(rad_baker_runtime *runtime);
+
+/* One frame: 'lights' (light_count, the desc's count, in its order) and budget_ms (>= 0,
+   finite; 0: no limit). Fills *out (optional). On an error nothing changes. Errors:
+   INVALID_ARGUMENT (NULL runtime, lights NULL with a count, a negative or non-finite budget,
+   a bad light: rad_direct_irradiance's checks), SIZE_MISMATCH (light_count is not the desc's),
+   NON_FINITE (a light's colour, position, direction, distance or angle NaN or infinite; the
+   log names the light and field), NEGATIVE_EMISSION (a negative colour), RAYCAST_FAILED,
+   OUT_OF_MEMORY. Thread safety: one thread at a time per runtime. */
+RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *runtime, const rad_light *lights, uint32_t light_count,
+                                            double budget_ms, rad_baker_frame *out);
+
+/* The arrays the GLSL dispatch order above uploads (borrowed from the runtime; members for
+   the other method are NULL): the virtual patches' set (its sparse F, albedo, grid) and alias
+   tables, the lightmap weights, the probes, the classic F and multi-bounce matrix. */
+typedef struct rad_baker_runtime_view {
+    const rad_virtual_patches *vp;
+    const rad_alias_tables *tables;
+    const rad_patches *patches;
+    const rad_form_factors *form_factors;
+    const rad_multibounce *multibounce;
+    const rad_lightmap_weights *lightmap_weights;
+    const rad_probes *probes;
+    const float *E, *L, *H;         /* 3N each: this frame's source, indirect light, irradiance */
+} rad_baker_runtime_view;
+RAD_API rad_result rad_baker_runtime_view_get(const rad_baker_runtime *runtime, rad_baker_runtime_view *out);
+
 /* ======================================================================================== */
 /* >>api_skytransfer: relighting by a new sky without a re-bake                             */
 /* ======================================================================================== */
@@ -23027,6 +23161,754 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
         return r;
     }
     *out = b.R;
+    return RAD_SUCCESS;
+}
+
+/* >>bake_runtime: lights that move over a bake (rad_baker_runtime_*)                         */
+
+#define RAD__BRT_RAY 200.0      /* cost units of one shadow ray (an entry read is 1) */
+#define RAD__BRT_DRAW 6.0       /* of one temporal draw (a random read into the tables) */
+#define RAD__BRT_MIN_SHARE 64u  /* round-robin outputs: at least 1/64 of the rows per update */
+#define RAD__BRT_DILATE 3u      /* the bake's dilation passes */
+
+struct rad_baker_runtime {
+    rad__ctx c;
+    rad_context sub;               /* the caller's context, without progress */
+    rad_baker_method method;
+    rad_baker_runtime_options o;
+    rad_direct_options dopt;
+    uint32_t bounces, n, light_count, mesh_count, any_emits, settle;
+    rad_light *lights;             /* the last update's */
+    rad_scene *scene;
+    rad_bvh *bvh;
+    rad_raycaster rc;
+    /* classic */
+    rad_patches *patches;
+    rad_form_factors *ff;
+    rad_multibounce *mb;
+    float *row_sums, *pvertex;     /* S per patch; values per patch vertex */
+    rad_mesh_desc *meshes;         /* copies (indices and packed positions) for the vertex gather */
+    /* virtual patches */
+    rad_virtual_patches *vp;
+    rad_alias_tables *tables;
+    rad_temporal *temporal;
+    rad_vp_lights *vpl;
+    rad_vp_gather_table **gather;  /* per mesh */
+    /* both */
+    rad_lightmap *lm;
+    rad_lightmap_weights *lw;
+    rad_probes *probes;
+    float *planes;                 /* the 8 planes below, one block */
+    float *E, *L, *H, *B, *Ln, *Hn, *tmp, *X;   /* 3N each (Ln, Hn: the sweep in progress) */
+    float *lmV;                    /* 3 per lightmap-weights vertex */
+    uint32_t *dil_texel, *dil_first, *dil_src, dil_count; /* the gutter fill, pass by pass */
+    /* outputs, laid out as the result's */
+    float *vertex, *lightmap, *probe_out;
+    uint32_t vertex_count, *vertex_first, texels, probe_count;
+    /* progress */
+    uint32_t frame, rest, sweeps, sweep_row, lm_cursor, lm_stale, pr_cursor, pr_stale;
+    uint64_t nnz;
+};
+
+RAD_API void rad_baker_runtime_options_default(rad_baker_runtime_options *o)
+{
+    if (!o) return;
+    memset(o, 0, sizeof *o);
+    o->temporal_samples = 16;
+    o->temporal_weight = 0.75f;
+    o->shadow_rays = 0;
+    o->work_per_ms = 1e6;
+}
+
+RAD_API void rad_baker_runtime_destroy(rad_baker_runtime *rt)
+{
+    rad_allocator a;
+    uint32_t m;
+    if (!rt) return;
+    a = rt->c.allocator;
+    rad_probes_destroy(rt->probes);
+    rad_lightmap_weights_destroy(rt->lw);
+    rad_lightmap_destroy(rt->lm);
+    if (rt->gather)
+        for (m = 0; m < rt->mesh_count; ++m) rad_vp_gather_table_destroy(rt->gather[m]);
+    rad_vp_lights_destroy(rt->vpl);
+    rad_temporal_destroy(rt->temporal);
+    rad_alias_tables_destroy(rt->tables);
+    rad_vp_destroy(rt->vp);
+    rad_multibounce_destroy(rt->mb);
+    rad_form_factors_destroy(rt->ff);
+    rad_patches_destroy(rt->patches);
+    rad_bvh_destroy(rt->bvh);
+    rad_scene_destroy(rt->scene);
+    if (rt->meshes)
+        for (m = 0; m < rt->mesh_count; ++m) {
+            rad__free(&a, (void *)(uintptr_t)rt->meshes[m].indices);
+            rad__free(&a, (void *)(uintptr_t)rt->meshes[m].positions);
+        }
+    {
+        void *blocks[] = { rt->lights, rt->row_sums, rt->pvertex, rt->meshes, rt->gather, rt->planes, rt->lmV, rt->dil_texel,
+                           rt->dil_first, rt->dil_src, rt->vertex, rt->lightmap, rt->probe_out, rt->vertex_first, rt };
+        rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
+}
+
+/* The fill of rad_lightmap_dilate (3 passes) as a list: per filled texel, in the order the
+   dilation writes it, the neighbours it averages, so a refresh repeats it bit for bit. */
+static rad_result rad__brt_dilation(rad_baker_runtime *rt)
+{
+    const rad_lightmap *lm = rt->lm;
+    uint32_t W = lm->width, Hh = lm->height, pass, x, y, n = 0, e = 0, cap;
+    size_t texels = (size_t)W * Hh, i;
+    uint8_t *have = (uint8_t *)rad__alloc_array(&rt->c.allocator, texels, 2);
+    rad_result r = RAD_SUCCESS;
+    if (!have) return RAD_ERROR_OUT_OF_MEMORY;
+    for (i = 0, cap = 0; i < texels; ++i) {
+        have[i] = (lm->flags[i] & RAD_TEXEL_VALID) ? 1u : 0u;
+        cap += !have[i];
+    }
+    rt->dil_texel = (uint32_t *)rad__alloc_array(&rt->c.allocator, (size_t)cap + 1, sizeof(uint32_t));
+    rt->dil_first = (uint32_t *)rad__alloc_array(&rt->c.allocator, (size_t)cap + 1, sizeof(uint32_t));
+    rt->dil_src = (uint32_t *)rad__alloc_array(&rt->c.allocator, 8 * (size_t)cap + 1, sizeof(uint32_t));
+    if (!rt->dil_texel || !rt->dil_first || !rt->dil_src) r = RAD_ERROR_OUT_OF_MEMORY;
+    for (pass = 0; r == RAD_SUCCESS && pass < RAD__BRT_DILATE; ++pass) {
+        uint8_t *next = have + texels;
+        memcpy(next, have, texels);
+        for (y = 0; y < Hh; ++y)
+            for (x = 0; x < W; ++x) {
+                size_t ti = (size_t)y * W + x;
+                uint32_t e0 = e;
+                int dx, dy;
+                if (have[ti]) continue;
+                for (dy = -1; dy <= 1; ++dy)
+                    for (dx = -1; dx <= 1; ++dx) {
+                        int64_t nx = (int64_t)x + dx, ny = (int64_t)y + dy;
+                        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= (int64_t)W || ny >= (int64_t)Hh) continue;
+                        if (!have[(size_t)ny * W + (size_t)nx]) continue;
+                        rt->dil_src[e++] = (uint32_t)((size_t)ny * W + (size_t)nx);
+                    }
+                if (e == e0) continue;
+                rt->dil_first[n] = e0;
+                rt->dil_texel[n++] = (uint32_t)ti;
+                next[ti] = 1;
+            }
+        memcpy(have, next, texels);
+    }
+    if (rt->dil_first) rt->dil_first[n] = e;
+    rt->dil_count = n;
+    rad__free(&rt->c.allocator, have);
+    return r;
+}
+
+static void rad__brt_dilate(const rad_baker_runtime *rt, float *values)
+{
+    uint32_t i, e, ch;
+    for (i = 0; i < rt->dil_count; ++i) {
+        float acc[3] = { 0.0f, 0.0f, 0.0f };
+        uint32_t cnt = rt->dil_first[i + 1] - rt->dil_first[i];
+        for (e = rt->dil_first[i]; e < rt->dil_first[i + 1]; ++e)
+            for (ch = 0; ch < 3; ++ch) acc[ch] += values[3 * (size_t)rt->dil_src[e] + ch];
+        for (ch = 0; ch < 3; ++ch) values[3 * (size_t)rt->dil_texel[i] + ch] = acc[ch] / (float)cnt;
+    }
+}
+
+/* rows [first, first + count) of some per-row job, wrapping at 'total', over the tasks */
+typedef struct rad__brt_job {
+    rad_baker_runtime *rt;
+    uint32_t first, total, kind;   /* kind 0: lightmap rows, 1: probes, 2: a sweep, 3: exact H rows */
+    const float *x;                /* the vector the rows multiply */
+} rad__brt_job;
+
+static rad_result rad__brt_row(void *data, uint32_t k, uint32_t task)
+{
+    const rad__brt_job *j = (const rad__brt_job *)data;
+    rad_baker_runtime *rt = j->rt;
+    uint32_t i = (uint32_t)(((uint64_t)j->first + k) % j->total), c;
+    (void)task;
+    if (j->kind == 0) {
+        const rad_lightmap_weights *W = rt->lw;
+        rad__sparse_row3(W->entry_vertices, W->entry_weights, W->row_first[i], W->row_first[i + 1], rt->lmV,
+                         rt->lightmap + 3 * (size_t)W->row_texels[i]);
+    } else if (j->kind == 1) {
+        /* as rad_probes_update: the direct part, then the weights times B, in double */
+        const uint64_t *first;
+        const uint32_t *patch;
+        const float *w, *direct;
+        double acc[27];
+        uint64_t e;
+        int q;
+        rad_probes_weights(rt->probes, &first, &patch, &w, &direct);
+        for (q = 0; q < 27; ++q) acc[q] = direct[27 * (size_t)i + (size_t)q];
+        for (e = first[i]; e < first[i + 1]; ++e) {
+            const float *we = w + 9 * e, *b = rt->B + 3 * (size_t)patch[e];
+            for (q = 0; q < 9; ++q)
+                for (c = 0; c < 3; ++c) acc[3 * q + c] += (double)we[q] * b[c];
+        }
+        for (q = 0; q < 27; ++q) rt->probe_out[27 * (size_t)i + (size_t)q] = (float)acc[q];
+    } else {
+        const rad_matrix *F = &rt->vp->matrix;
+        float h[3];
+        rad__sparse_row3(F->columns, F->values, F->row_offsets[i], F->row_offsets[i + 1], j->x, h);
+        if (j->kind == 2) {
+            for (c = 0; c < 3; ++c) {
+                rt->Hn[3 * (size_t)i + c] = h[c];
+                rt->Ln[3 * (size_t)i + c] = rt->vp->albedo[3 * (size_t)i + c] * h[c];
+            }
+        } else {
+            for (c = 0; c < 3; ++c)
+                if (!(rt->vp->albedo[3 * (size_t)i + c] > 0.0f)) rt->H[3 * (size_t)i + c] = h[c];
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__brt_rows(rad_baker_runtime *rt, uint32_t kind, uint32_t first, uint32_t count, uint32_t total,
+                                const float *x)
+{
+    rad__brt_job j;
+    rad__ctx q = rt->c;
+    if (count == 0) return RAD_SUCCESS;
+    j.rt = rt;
+    j.kind = kind;
+    j.first = first;
+    j.total = total;
+    j.x = x;
+    q.progress = NULL;
+    return rad__for_rows(&q, count, q.tasks < count ? q.tasks : count, rad__brt_row, &j);
+}
+
+/* B = E + L into rt->B; tmp = E + L as the sweep's input */
+static void rad__brt_sum(rad_baker_runtime *rt, const float *L, float *out)
+{
+    size_t i;
+    for (i = 0; i < 3 * (size_t)rt->n; ++i) out[i] = rt->E[i] + L[i];
+}
+
+static void rad__brt_swap(float **a, float **b)
+{
+    float *t = *a;
+    *a = *b, *b = t;
+}
+
+/* REFINEMENT runs in its own planes, so the frames keep showing the last estimate until it
+   ends: X holds the sweep's L (from 0, as the bake's Jacobi), tmp = E + X for the sweep in
+   progress, the rows write Hn = F tmp and Ln = rho Hn; a sweep's end makes Ln the next X
+   (but the last, which only gives H). The end publishes L = X, H = Hn, B = E + L. */
+static void rad__brt_sweep_end(rad_baker_runtime *rt)
+{
+    if (rt->sweeps < rt->bounces) rad__brt_swap(&rt->X, &rt->Ln);
+    if (++rt->sweeps > rt->bounces) {
+        rad__brt_swap(&rt->H, &rt->Hn);
+        memcpy(rt->L, rt->X, 3 * sizeof(float) * rt->n);
+        rad__brt_sum(rt, rt->L, rt->B);
+    }
+}
+
+static rad_result rad__brt_sweep_start(rad_baker_runtime *rt)
+{
+    if (rt->sweeps == 0) memset(rt->X, 0, 3 * sizeof(float) * rt->n);
+    rad__brt_sum(rt, rt->X, rt->tmp);
+    return RAD_SUCCESS;
+}
+
+static rad_result rad__brt_fail(rad_baker_runtime *rt, rad_result r)
+{
+    rad_baker_runtime_destroy(rt);
+    return r;
+}
+
+/* The classic solution for 'lights': E, L = F_mb E, B, H = F B, built in the spare planes and
+   swapped in at the end, so that an error leaves the state as it was. */
+static rad_result rad__brt_classic_solve(rad_baker_runtime *rt, const rad_light *lights)
+{
+    size_t i;
+    rad_result r = rad_direct_patches(rt->patches, &rt->rc, lights, rt->light_count, &rt->dopt, rt->tmp, &rt->sub);
+    if (r == RAD_SUCCESS) r = rad_sources(rt->patches, RAD_SOURCE_DIRECT, rt->tmp, rt->Ln);
+    if (r == RAD_SUCCESS) r = rad_multibounce_apply(rt->mb, rt->Ln, rt->Hn, RAD_OUTPUT_INDIRECT, &rt->sub);
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < 3 * (size_t)rt->n; ++i) rt->tmp[i] = rt->Ln[i] + rt->Hn[i];
+        r = rad_matrix_multiply(&rt->ff->matrix, rt->tmp, rt->X, &rt->sub);
+    }
+    if (r != RAD_SUCCESS) return r;
+    rad__brt_swap(&rt->E, &rt->Ln);
+    rad__brt_swap(&rt->L, &rt->Hn);
+    rad__brt_swap(&rt->B, &rt->tmp);
+    rad__brt_swap(&rt->H, &rt->X);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const rad_baker_options *bake_options,
+                                            const rad_baker_result *R, const rad_baker_runtime_options *options,
+                                            const rad_context *ctx, rad_baker_runtime **out)
+{
+    rad__ctx c0;
+    rad_baker_runtime *rt;
+    rad_baker_options bo;
+    rad_result r;
+    uint32_t m, i, outputs;
+    size_t N3;
+    rad__ctx_init(&c0, ctx);
+    if (out) *out = NULL;
+    if (!desc || !R || !out) {
+        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: NULL desc, result or out");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (desc->light_count && !desc->lights) {
+        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: light_count %u with lights NULL", desc->light_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    rt = (rad_baker_runtime *)rad__alloc_zero(&c0.allocator, sizeof *rt);
+    if (!rt) return RAD_ERROR_OUT_OF_MEMORY;
+    rt->c = c0;
+    if (ctx) rt->sub = *ctx;
+    rt->sub.progress = NULL;
+    rad_baker_runtime_options_default(&rt->o);
+    if (options) {
+        if (options->temporal_samples) rt->o.temporal_samples = options->temporal_samples;
+        if (options->temporal_weight != 0.0f) rt->o.temporal_weight = options->temporal_weight;
+        rt->o.shadow_rays = options->shadow_rays;
+        if (options->work_per_ms != 0.0) rt->o.work_per_ms = options->work_per_ms;
+        rt->o.seed = options->seed;
+    }
+    if (!(rt->o.temporal_weight >= 0.0f && rt->o.temporal_weight < 1.0f) || !(rt->o.work_per_ms > 0.0) ||
+        !rad__finite((float)rt->o.work_per_ms) || rt->o.temporal_samples > RAD_TEMPORAL_MAX_SAMPLES) {
+        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: temporal_weight must be in [0, 1), work_per_ms finite and "
+                                     "> 0, temporal_samples at most %u", RAD_TEMPORAL_MAX_SAMPLES);
+        return rad__brt_fail(rt, RAD_ERROR_INVALID_ARGUMENT);
+    }
+    memset(&bo, 0, sizeof bo);
+    if (bake_options) bo = *bake_options;
+    if (!bo.patches) bo.patches = 512;
+    if (!bo.bounces) bo.bounces = 16;
+    if (!bo.ff_samples) bo.ff_samples = 16;
+    if (!bo.light_samples) bo.light_samples = 16;
+    if (!bo.lightmap_samples) bo.lightmap_samples = 4;
+    outputs = desc->outputs ? desc->outputs : (uint32_t)RAD_BAKER_VERTEX;
+    rt->method = R->method;
+    rt->bounces = bo.bounces;
+    rt->light_count = desc->light_count;
+    rt->mesh_count = desc->scene.mesh_count;
+    for (i = 0; i < desc->scene.material_count && desc->scene.materials; ++i) rt->any_emits |= rad__baker_emits(&desc->scene.materials[i]);
+    if (bo.method != RAD_BAKER_AUTO && bo.method != R->method) {
+        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: the result's method is not the one of the bake options: "
+                                     "other bake options");
+        return rad__brt_fail(rt, RAD_ERROR_INVALID_ARGUMENT);
+    }
+    if ((R->method != RAD_BAKER_CLASSIC && R->method != RAD_BAKER_VIRTUAL_PATCHES) || R->mesh_count != desc->scene.mesh_count ||
+        !(outputs & RAD_BAKER_VERTEX) != !R->vertex || !(outputs & RAD_BAKER_LIGHTMAP) != !R->lightmap ||
+        !(outputs & RAD_BAKER_PROBES) != !R->probes ||
+        (R->method == RAD_BAKER_VIRTUAL_PATCHES && desc->light_count > RAD_VP_LIGHTS_MAX)) {
+        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: the result is not a bake of this desc (method, meshes or "
+                                     "outputs differ), or more than %u lights over virtual patches", RAD_VP_LIGHTS_MAX);
+        return rad__brt_fail(rt, RAD_ERROR_INVALID_ARGUMENT);
+    }
+    rt->lights = (rad_light *)rad__alloc_array(&c0.allocator, desc->light_count ? desc->light_count : 1u, sizeof(rad_light));
+    if (!rt->lights) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
+    for (i = 0; i < desc->light_count; ++i) memcpy(&rt->lights[i], &desc->lights[i].light, sizeof(rad_light));
+    rad_direct_options_default(&rt->dopt);
+    rt->dopt.exclude_emitters = !rt->any_emits;
+    rt->dopt.light_samples = bo.light_samples;
+    rt->dopt.seed = bo.seed;
+
+    r = rad_scene_create(&desc->scene, &rt->sub, &rt->scene);
+    if (r == RAD_SUCCESS) r = rad_bvh_create(rt->scene, &rt->sub, &rt->bvh);
+    if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+    rad_bvh_raycaster(rt->bvh, &rt->rc);
+    if (R->method == RAD_BAKER_CLASSIC) {
+        rad_patch_options po;
+        rad_form_factor_options fo;
+        rad_multibounce_options mo;
+        rad_patch_options_default(&po);
+        po.target_count = bo.patches;
+        rad_form_factor_options_default(&fo);
+        fo.samples = bo.ff_samples;
+        fo.seed = bo.seed;
+        r = rad_patches_create(rt->scene, &po, &rt->sub, &rt->patches);
+        if (r == RAD_SUCCESS && rt->patches->count != R->patch_count) {
+            rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: %u patches, the result has %u: other bake options",
+                     rt->patches->count, R->patch_count);
+            r = RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (r == RAD_SUCCESS) r = rad_form_factors_dense(rt->patches, &rt->rc, &fo, &rt->sub, &rt->ff);
+        if (r == RAD_SUCCESS) {
+            memset(&mo, 0, sizeof mo);
+            mo.bounces = bo.bounces;
+            r = rad_multibounce_create(&rt->ff->matrix, rt->patches->albedo, &mo, &rt->sub, &rt->mb);
+        }
+        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+        rt->n = rt->patches->count;
+        rt->nnz = (uint64_t)rt->n * rt->n;
+    } else {
+        rad_vp_options vo;
+        rad_temporal_options to;
+        rad_vp_lights_options lo;
+        const rad_alias_tables *tp[1];
+        rad_vp_options_default(&vo);
+        vo.resolution = R->vp_resolution;
+        vo.storage = RAD_STORAGE_SPARSE;
+        r = rad_vp_create(rt->scene, &rt->rc, &vo, &rt->sub, &rt->vp);
+        if (r == RAD_SUCCESS && rt->vp->count != R->patch_count) {
+            rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: %u virtual patches, the result has %u: other bake options",
+                     rt->vp->count, R->patch_count);
+            r = RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (r == RAD_SUCCESS) r = rad_alias_tables_create(&rt->vp->matrix, RAD_ALIAS_AUTO, &rt->sub, &rt->tables);
+        if (r == RAD_SUCCESS) {
+            rad_temporal_options_default(&to);
+            to.mode = RAD_TEMPORAL_FEEDBACK;
+            to.samples = rt->o.temporal_samples;
+            to.weight = rt->o.temporal_weight > 0.0f ? rt->o.temporal_weight : -1.0f;
+            to.seed = rt->o.seed;
+            tp[0] = rt->tables;
+            r = rad_temporal_create(tp, 1, rt->vp->albedo, &to, &rt->sub, &rt->temporal);
+        }
+        if (r == RAD_SUCCESS) {
+            rad_vp_lights_options_default(&lo);
+            lo.direct = rt->dopt;
+            if (rt->o.shadow_rays == RAD_BAKER_RUNTIME_ALL_RAYS) lo.rays_per_frame = 0;
+            else lo.rays_per_frame = rt->o.shadow_rays ? rt->o.shadow_rays : (rt->vp->sample_count + 7u) / 8u;
+            if (lo.rays_per_frame >= rt->vp->sample_count) lo.rays_per_frame = 0;
+            rt->settle = lo.rays_per_frame ? (rt->vp->sample_count + lo.rays_per_frame - 1u) / lo.rays_per_frame : 1u;
+            r = rad_vp_lights_create(rt->vp, &rt->rc, &lo, &rt->sub, &rt->vpl);
+        }
+        if (r == RAD_SUCCESS && R->vertex) {
+            rt->gather = (rad_vp_gather_table **)rad__alloc_zero(&c0.allocator, sizeof(rad_vp_gather_table *) * (rt->mesh_count + 1u));
+            if (!rt->gather) r = RAD_ERROR_OUT_OF_MEMORY;
+            for (m = 0; r == RAD_SUCCESS && m < rt->mesh_count; ++m)
+                r = rad_vp_gather_table_mesh(rt->vp, &desc->scene.meshes[m], &rt->sub, &rt->gather[m]);
+        }
+        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+        rt->n = rt->vp->count;
+        rt->nnz = rt->vp->matrix.row_offsets[rt->n];
+    }
+    N3 = 3 * (size_t)rt->n;
+    rt->planes = (float *)rad__alloc_array(&c0.allocator, 8 * N3 + 1, sizeof(float));
+    if (!rt->planes) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
+    memset(rt->planes, 0, (8 * N3 + 1) * sizeof(float));
+    rt->E = rt->planes, rt->L = rt->E + N3, rt->H = rt->L + N3, rt->B = rt->H + N3, rt->Ln = rt->B + N3;
+    rt->Hn = rt->Ln + N3, rt->tmp = rt->Hn + N3, rt->X = rt->tmp + N3;
+
+    /* the solution for the baked lights: the state every later frame starts from */
+    if (R->method == RAD_BAKER_CLASSIC) {
+        r = rad__brt_classic_solve(rt, rt->lights);
+    } else {
+        r = rad_vp_lights_update(rt->vpl, rt->lights, rt->light_count, rt->E, &rt->sub);
+        rt->sweeps = 0;
+        while (r == RAD_SUCCESS && rt->sweeps <= rt->bounces) {
+            rad__brt_sweep_start(rt);
+            r = rad__brt_rows(rt, 2, 0, rt->n, rt->n, rt->tmp);
+            if (r == RAD_SUCCESS) rad__brt_sweep_end(rt);
+        }
+        /* the temporal history warmed on the baked light, so the first moving frame starts
+           from it rather than from 0: the feedback loses w + (1 - w) rho S of its error per
+           step, so 96 steps leave about 1e-3 at w = 0.75 (each step is N k draws: cheap next
+           to the build) */
+        for (i = 0; r == RAD_SUCCESS && i < 96u; ++i) r = rad_temporal_step(rt->temporal, rt->E, NULL, NULL);
+        rt->rest = rt->settle;
+    }
+    if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+
+    /* outputs: the bake's layers at scale 1, and what refreshes each */
+    if (R->vertex) {
+        rt->vertex_count = R->vertex_count;
+        rt->vertex_first = (uint32_t *)rad__alloc_array(&c0.allocator, (size_t)rt->mesh_count + 1, sizeof(uint32_t));
+        rt->vertex = (float *)rad__alloc_array(&c0.allocator, 3 * (size_t)R->vertex_count + 1, sizeof(float));
+        if (!rt->vertex || !rt->vertex_first) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
+        memcpy(rt->vertex_first, R->vertex_first, sizeof(uint32_t) * ((size_t)rt->mesh_count + 1));
+        r = rad_baker_mix_layers(R->vertex_layers, R->group_count, 3 * (size_t)R->vertex_count, NULL, rt->vertex, &rt->sub);
+        if (r == RAD_SUCCESS && R->method == RAD_BAKER_CLASSIC) {
+            /* the vertex gather reads the meshes each frame: keep their indices and positions */
+            rt->row_sums = (float *)rad__alloc_array(&c0.allocator, rt->n, sizeof(float));
+            rt->pvertex = (float *)rad__alloc_array(&c0.allocator, rt->patches->vertex_count, 3 * sizeof(float));
+            rt->meshes = (rad_mesh_desc *)rad__alloc_zero(&c0.allocator, sizeof(rad_mesh_desc) * (rt->mesh_count + 1u));
+            if (!rt->row_sums || !rt->pvertex || !rt->meshes) r = RAD_ERROR_OUT_OF_MEMORY;
+            for (i = 0; r == RAD_SUCCESS && i < 3 * rt->n; ++i) rt->tmp[i] = 1.0f;
+            if (r == RAD_SUCCESS) r = rad_matrix_multiply(&rt->ff->matrix, rt->tmp, rt->Hn, &rt->sub);
+            for (i = 0; r == RAD_SUCCESS && i < rt->n; ++i) rt->row_sums[i] = rt->Hn[3 * (size_t)i];
+            for (m = 0; r == RAD_SUCCESS && m < rt->mesh_count; ++m) {
+                const rad_mesh_desc *s = &desc->scene.meshes[m];
+                rad_mesh_desc *d = &rt->meshes[m];
+                size_t ps = s->position_stride ? s->position_stride : 3 * sizeof(float), ni = 3 * (size_t)s->triangle_count;
+                uint32_t *idx = NULL;
+                float *pos = NULL;
+                d->vertex_count = s->vertex_count;
+                d->triangle_count = s->triangle_count;
+                if (s->indices) {
+                    idx = (uint32_t *)rad__alloc_array(&c0.allocator, ni + 1, sizeof(uint32_t));
+                    if (idx) memcpy(idx, s->indices, ni * sizeof(uint32_t));
+                    d->indices = idx;
+                }
+                if (s->positions) {
+                    pos = (float *)rad__alloc_array(&c0.allocator, (size_t)s->vertex_count + 1, 3 * sizeof(float));
+                    for (i = 0; pos && i < s->vertex_count; ++i) memcpy(pos + 3 * (size_t)i, rad__strided(s->positions, ps, i), 3 * sizeof(float));
+                    d->positions = pos;
+                }
+                if ((s->indices && !idx) || (s->positions && !pos)) r = RAD_ERROR_OUT_OF_MEMORY;
+            }
+        }
+        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+    }
+    if (R->lightmap) {
+        rad_lightmap_options lo;
+        rt->texels = R->lightmap_width * R->lightmap_height;
+        rt->lightmap = (float *)rad__alloc_array(&c0.allocator, 3 * (size_t)rt->texels, sizeof(float));
+        if (!rt->lightmap) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
+        r = rad_baker_mix_layers(R->lightmap_layers, R->group_count, 3 * (size_t)rt->texels, NULL, rt->lightmap, &rt->sub);
+        rad_lightmap_options_default(&lo);
+        lo.width = R->lightmap_width;
+        lo.height = R->lightmap_height;
+        lo.samples = bo.lightmap_samples;
+        lo.seed = bo.seed;
+        if (r == RAD_SUCCESS) r = rad_lightmap_create(rt->scene, &rt->rc, &lo, &rt->sub, &rt->lm);
+        if (r == RAD_SUCCESS)
+            r = R->method == RAD_BAKER_CLASSIC ? rad_lightmap_weights_create(rt->lm, rt->patches, rt->lightmap, rt->H, &rt->sub, &rt->lw)
+                                               : rad_lightmap_weights_create_vp(rt->lm, rt->vp, &rt->sub, &rt->lw);
+        if (r == RAD_SUCCESS) {
+            rt->lmV = (float *)rad__alloc_array(&c0.allocator, (size_t)rt->lw->vertex_count + 1, 3 * sizeof(float));
+            r = rt->lmV ? rad__brt_dilation(rt) : RAD_ERROR_OUT_OF_MEMORY;
+        }
+        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+    }
+    if (R->probes) {
+        rad_probe_options po;
+        rad_probe_options_default(&po);
+        po.spacing = desc->probe_spacing;
+        r = R->method == RAD_BAKER_CLASSIC
+                ? rad_probes_create(rt->patches, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes)
+                : rad_probes_create_vp(rt->vp, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes);
+        if (r == RAD_SUCCESS && rad_probes_count(rt->probes) != R->probe_count) {
+            rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: %u probes, the result has %u", rad_probes_count(rt->probes),
+                     R->probe_count);
+            r = RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+        rt->probe_count = R->probe_count;
+        rt->probe_out = (float *)rad__alloc_array(&c0.allocator, 27 * (size_t)rt->probe_count + 1, sizeof(float));
+        if (!rt->probe_out) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
+        r = rad_baker_mix_layers(R->probe_layers, R->group_count, 27 * (size_t)rt->probe_count, NULL, rt->probe_out, &rt->sub);
+        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+    }
+    *out = rt;
+    return RAD_SUCCESS;
+}
+
+/* The checks of a frame's lights that need nothing built (the finer ones are the lights'). */
+static rad_result rad__brt_check_lights(const rad__ctx *c, const rad_light *lights, uint32_t count)
+{
+    static const char *names[] = { "color", "position", "direction", "min_distance", "inner_angle", "outer_angle" };
+    uint32_t i, k, f;
+    for (i = 0; i < count; ++i) {
+        const rad_light *l = &lights[i];
+        const float *v[6];
+        uint32_t len[6] = { 3, 3, 3, 1, 1, 1 };
+        v[0] = l->color, v[1] = l->position, v[2] = l->direction, v[3] = &l->min_distance, v[4] = &l->inner_angle;
+        v[5] = &l->outer_angle;
+        for (f = 0; f < 6; ++f)
+            for (k = 0; k < len[f]; ++k)
+                if (!rad__finite(v[f][k])) {
+                    rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_update: light %u has a non-finite %s", i, names[f]);
+                    return RAD_ERROR_NON_FINITE;
+                }
+        for (k = 0; k < 3; ++k)
+            if (l->color[k] < 0.0f) {
+                rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_update: light %u has a negative colour", i);
+                return RAD_ERROR_NEGATIVE_EMISSION;
+            }
+    }
+    return RAD_SUCCESS;
+}
+
+/* the vertex light from H */
+static rad_result rad__brt_vertex(rad_baker_runtime *rt)
+{
+    rad_result r = RAD_SUCCESS;
+    uint32_t m;
+    if (!rt->vertex) return RAD_SUCCESS;
+    if (rt->method == RAD_BAKER_CLASSIC) r = rad_patches_vertex_irradiance(rt->patches, rt->H, rt->row_sums, rt->pvertex, &rt->sub);
+    for (m = 0; r == RAD_SUCCESS && m < rt->mesh_count; ++m) {
+        float *o = rt->vertex + 3 * (size_t)rt->vertex_first[m];
+        r = rt->method == RAD_BAKER_CLASSIC ? rad_patches_gather_mesh(rt->patches, rt->pvertex, m, &rt->meshes[m], o, &rt->sub)
+                                            : rad_vp_gather_table_apply(rt->gather[m], rt->H, o, &rt->sub);
+    }
+    return r;
+}
+
+/* rows to refresh of an output with 'total' rows costing 'cost' units in all, from 'units' */
+static uint32_t rad__brt_share(uint32_t stale, uint32_t total, double cost, double units, int limited)
+{
+    double per = total ? cost / total : 0.0, fit;
+    uint32_t least = (total + RAD__BRT_MIN_SHARE - 1u) / RAD__BRT_MIN_SHARE, n;
+    if (!limited || stale == 0) return stale;
+    fit = per > 0.0 ? units / per : (double)stale;
+    n = fit >= (double)stale ? stale : (uint32_t)fit;
+    if (n < least) n = least;
+    return n < stale ? n : stale;
+}
+
+RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *rt, const rad_light *lights, uint32_t light_count,
+                                            double budget_ms, rad_baker_frame *out)
+{
+    rad_baker_frame f;
+    rad_result r;
+    uint32_t i, changed = 0, h_changed = 0, lm_rows, n;
+    double units, used = 0.0, lm_cost = 0.0, pr_cost = 0.0;
+    int limited = budget_ms > 0.0;
+    if (!rt) return RAD_ERROR_INVALID_ARGUMENT;
+    memset(&f, 0, sizeof f);
+    if (light_count != rt->light_count) {
+        rad__log(&rt->c, RAD_LOG_ERROR, "rad_baker_runtime_update: %u lights, the bake had %u (a runtime moves the baked lights; "
+                                        "switch one off with a zero colour)", light_count, rt->light_count);
+        return RAD_ERROR_SIZE_MISMATCH;
+    }
+    if ((light_count && !lights) || !(budget_ms >= 0.0) || budget_ms > 1e12) {
+        rad__log(&rt->c, RAD_LOG_ERROR, "rad_baker_runtime_update: lights NULL with a count, or budget_ms negative or not finite");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    r = rad__brt_check_lights(&rt->c, lights, light_count);
+    if (r != RAD_SUCCESS) return r;
+    for (i = 0; i < light_count; ++i) changed += memcmp(&lights[i], &rt->lights[i], sizeof(rad_light)) != 0;
+    units = budget_ms * rt->o.work_per_ms;
+    lm_rows = rt->lw ? rt->lw->row_count : 0u;
+    if (rt->lw) lm_cost = 3.0 * ((double)rt->lw->row_first[lm_rows] + rt->lw->vertex_first[rt->lw->vertex_count] + lm_rows);
+    if (rt->probes) pr_cost = 27.0 * (double)rad_probes_entry_count(rt->probes) + 27.0 * rt->probe_count;
+
+    if (rt->method == RAD_BAKER_CLASSIC) {
+        if (changed) {
+            /* exact in one frame */
+            r = rad__brt_classic_solve(rt, lights);
+            if (r != RAD_SUCCESS) return r;
+            f.shadow_rays = (uint64_t)rt->n * rt->dopt.light_samples * light_count;
+            used += RAD__BRT_RAY * (double)f.shadow_rays + 9.0 * (double)rt->nnz;
+            h_changed = 1;
+            f.phase = RAD_BAKER_RUNTIME_EXACT;
+        }
+    } else if (changed || rt->rest < rt->settle) {
+        /* moving, or the shadows of a light at rest still settling: a temporal frame */
+        r = rad_vp_lights_update(rt->vpl, lights, light_count, rt->tmp, &rt->sub);
+        if (r != RAD_SUCCESS) return r;
+        f.shadow_rays = rad_vp_lights_rays(rt->vpl);
+        r = rad_temporal_step(rt->temporal, rt->tmp, NULL, rt->Ln);
+        if (r != RAD_SUCCESS) return r;
+        rad__brt_swap(&rt->E, &rt->tmp);
+        rad__brt_swap(&rt->L, &rt->Ln);
+        for (i = 0; i < 3 * rt->n; ++i) {
+            float a = rt->vp->albedo[i];
+            rt->H[i] = a > 0.0f ? rt->L[i] / a : 0.0f;
+        }
+        /* a channel of albedo 0 has no estimate: its exact row (rare: black materials) */
+        rad__brt_sum(rt, rt->L, rt->B);
+        for (i = 0; i < rt->n; ++i) {
+            const float *a = rt->vp->albedo + 3 * (size_t)i;
+            if (!(a[0] > 0.0f && a[1] > 0.0f && a[2] > 0.0f)) {
+                r = rad__brt_rows(rt, 3, i, 1, rt->n, rt->B);
+                if (r != RAD_SUCCESS) return r;
+            }
+        }
+        used += RAD__BRT_RAY * (double)f.shadow_rays + 6.0 * rt->vp->sample_count * (light_count + 1.0) +
+                RAD__BRT_DRAW * (double)rt->n * rt->o.temporal_samples + 6.0 * rt->n;
+        rt->rest = changed ? 1u : rt->rest + 1u;
+        rt->sweeps = 0;
+        rt->sweep_row = 0;
+        h_changed = 1;
+        f.phase = RAD_BAKER_RUNTIME_MOVING;
+    } else if (rt->sweeps <= rt->bounces) {
+        /* at rest: exact Jacobi rows, half the budget left (all of it when no output is stale) */
+        double per = 3.0 * (double)rt->nnz / (rt->n ? rt->n : 1u) + 6.0;
+        uint32_t rows = rt->n - rt->sweep_row;
+        if (limited) {
+            double share = (units - used) * ((rt->lm_stale || rt->pr_stale) ? 0.5 : 1.0);
+            double fit = share > 0.0 ? share / per : 0.0;
+            uint32_t least = (rt->n + RAD__BRT_MIN_SHARE - 1u) / RAD__BRT_MIN_SHARE;
+            n = fit >= (double)rows ? rows : (uint32_t)fit;
+            if (n < least) n = least;
+            if (n > rows) n = rows;
+        } else {
+            n = rows;
+        }
+        f.phase = RAD_BAKER_RUNTIME_REFINING;
+        for (;;) {
+            if (rt->sweep_row == 0) rad__brt_sweep_start(rt);
+            r = rad__brt_rows(rt, 2, rt->sweep_row, n, rt->n, rt->tmp);
+            if (r != RAD_SUCCESS) return r;
+            f.rows_swept += n;
+            used += per * n;
+            rt->sweep_row += n;
+            if (rt->sweep_row < rt->n) break;
+            rt->sweep_row = 0;
+            rad__brt_sweep_end(rt);
+            if (limited || rt->sweeps > rt->bounces) break;
+            n = rt->n;
+        }
+        h_changed = rt->sweeps > rt->bounces; /* the new solution is out */
+    }
+    memcpy(rt->lights, lights, sizeof(rad_light) * light_count);
+
+    /* the outputs: vertex in full, lightmap and probe rows round-robin */
+    if (h_changed) {
+        r = rad__brt_vertex(rt);
+        if (r != RAD_SUCCESS) return r;
+        f.vertex_refreshed = rt->vertex != NULL;
+        used += rt->vertex ? 30.0 * rt->vertex_count : 0.0;
+        rt->lm_stale = lm_rows;
+        rt->pr_stale = rt->probe_count;
+    }
+    if (rt->lm_stale || rt->pr_stale) {
+        double left = units - used, want = (rt->lm_stale ? lm_cost * rt->lm_stale / lm_rows : 0.0) +
+                                           (rt->pr_stale ? pr_cost * rt->pr_stale / rt->probe_count : 0.0);
+        double part = !limited || want <= left ? 1.0 : (left > 0.0 ? left / want : 0.0);
+        if (rt->lm_stale) {
+            const rad_lightmap_weights *W = rt->lw;
+            n = rad__brt_share(rt->lm_stale, lm_rows, lm_cost, part * lm_cost * rt->lm_stale / lm_rows, limited);
+            for (i = 0; i < W->vertex_count; ++i)
+                rad__sparse_row3(W->vertex_patches, W->vertex_weights, W->vertex_first[i], W->vertex_first[i + 1], rt->H,
+                                 rt->lmV + 3 * (size_t)i);
+            r = rad__brt_rows(rt, 0, rt->lm_cursor, n, lm_rows, NULL);
+            if (r != RAD_SUCCESS) return r;
+            rt->lm_cursor = (uint32_t)(((uint64_t)rt->lm_cursor + n) % lm_rows);
+            rt->lm_stale -= n;
+            f.lightmap_rows = n;
+            used += lm_cost * n / lm_rows;
+            if (!rt->lm_stale) rad__brt_dilate(rt, rt->lightmap), used += 27.0 * rt->dil_count;
+        }
+        if (rt->pr_stale) {
+            n = rad__brt_share(rt->pr_stale, rt->probe_count, pr_cost, part * pr_cost * rt->pr_stale / rt->probe_count, limited);
+            r = rad__brt_rows(rt, 1, rt->pr_cursor, n, rt->probe_count, NULL);
+            if (r != RAD_SUCCESS) return r;
+            rt->pr_cursor = (uint32_t)(((uint64_t)rt->pr_cursor + n) % rt->probe_count);
+            rt->pr_stale -= n;
+            f.probes_refreshed = n;
+            used += pr_cost * n / rt->probe_count;
+        }
+        if (f.phase == RAD_BAKER_RUNTIME_CONVERGED) f.phase = RAD_BAKER_RUNTIME_REFINING;
+    }
+    f.frame = ++rt->frame;
+    f.lights_changed = changed;
+    f.sweeps = rt->sweeps;
+    f.lightmap_rows_total = lm_rows;
+    f.lightmap_stale = rt->lm_stale;
+    f.probes_stale = rt->pr_stale;
+    f.planned_ms = used / rt->o.work_per_ms;
+    f.over_budget = limited && used > units;
+    f.vertex = rt->vertex;
+    f.lightmap = rt->lightmap;
+    f.probes = rt->probe_out;
+    if (out) *out = f;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_runtime_view_get(const rad_baker_runtime *rt, rad_baker_runtime_view *out)
+{
+    if (!rt || !out) return RAD_ERROR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    out->vp = rt->vp;
+    out->tables = rt->tables;
+    out->patches = rt->patches;
+    out->form_factors = rt->ff;
+    out->multibounce = rt->mb;
+    out->lightmap_weights = rt->lw;
+    out->probes = rt->probes;
+    out->E = rt->E;
+    out->L = rt->L;
+    out->H = rt->H;
     return RAD_SUCCESS;
 }
 

@@ -300,6 +300,7 @@ s_examples() {
     fi
     compile_run quickstart $EX examples/quickstart.c $IMPL_SERIAL -o "$BUILD/quickstart" -lm
     compile_run engine_bake $EX examples/engine_bake.c $IMPL_SERIAL -o "$BUILD/engine_bake" -lm
+    compile_run engine_runtime $EX examples/engine_runtime.c $IMPL_SERIAL -o "$BUILD/engine_runtime" -lm
     compile_run learn_vertex_light $EX examples/learn_vertex_light.c $IMPL_SERIAL -o "$BUILD/learn_vertex_light" -lm
     if build lightmap-example $EX examples/lightmap.c $IMPL_OMP -o "$BUILD/lightmap" -lm &&
        "$BUILD/lightmap" --size 32 --patches 100 -o "$BUILD/lightmap-small.png" >"$BUILD/lightmap.out" 2>&1 &&

@@ -13,7 +13,7 @@ static const char *const df_covered[] = {
     "rad_hierarchical_options_default", "rad_multibounce_options_default", "rad_block_options_default",
     "rad_local_options_default", "rad_temporal_options_default", "rad_vp_options_default",
     "rad_vp_lights_options_default", "rad_lightmap_options_default", "rad_lightmap_gather_options_default",
-    "rad_probe_options_default", "rad_sky_transfer_options_default", NULL
+    "rad_probe_options_default", "rad_sky_transfer_options_default", "rad_baker_runtime_options_default", NULL
 };
 
 /* a and b hold the same bytes (n floats) */
@@ -479,6 +479,54 @@ static void df_sky_transfer(void)
     fx_world_free(&w);
 }
 
+/* the runtime over a bake: a zeroed and a default struct give the same frames, bit for bit
+   (a light that moves for a few frames on a budget, so that every field is used) */
+static void df_baker_runtime(void)
+{
+    rad_baker_desc d;
+    rad_baker_options o;
+    rad_baker_runtime_options z, dd;
+    rad_baker_result *R = NULL;
+    rad_baker_runtime *a = NULL, *b = NULL;
+    rad_baker_frame fa, fb;
+    rad_baker_light bl;
+    rad_light l;
+    int k;
+    memset(&d, 0, sizeof d);
+    rad_cornell_box(&d.scene, NULL);
+    memset(&bl, 0, sizeof bl);
+    bl.light.type = RAD_LIGHT_POINT;
+    bl.light.position[0] = 0.28f; bl.light.position[1] = 0.35f; bl.light.position[2] = 0.28f;
+    bl.light.color[0] = bl.light.color[1] = bl.light.color[2] = 0.05f;
+    d.lights = &bl;
+    d.light_count = 1;
+    d.outputs = RAD_BAKER_VERTEX | RAD_BAKER_PROBES;
+    d.probe_spacing = 0.25f;
+    memset(&o, 0, sizeof o);
+    o.method = RAD_BAKER_VIRTUAL_PATCHES;
+    o.vp_resolution = 5;
+    o.bounces = 4;
+    o.light_samples = 2;
+    memset(&z, 0, sizeof z);
+    rad_baker_runtime_options_default(&dd);
+    CHECK(dd.temporal_samples == 16 && dd.temporal_weight == 0.75f && dd.shadow_rays == 0 && dd.work_per_ms == 1e6);
+    CHECK_OK(rad_baker_run(&d, &o, NULL, &R));
+    if (R) CHECK_OK(rad_baker_runtime_create(&d, &o, R, &z, NULL, &a));
+    if (R) CHECK_OK(rad_baker_runtime_create(&d, &o, R, &dd, NULL, &b));
+    for (k = 1; a && b && k <= 12; ++k) {
+        l = bl.light;
+        l.position[0] += 0.01f * (float)(k < 6 ? k : 6);
+        CHECK_OK(rad_baker_runtime_update(a, &l, 1, 0.05, &fa));
+        CHECK_OK(rad_baker_runtime_update(b, &l, 1, 0.05, &fb));
+        CHECK(fa.phase == fb.phase && fa.probes_refreshed == fb.probes_refreshed && fa.shadow_rays == fb.shadow_rays);
+        CHECK(df_same(fa.vertex, fb.vertex, 3 * (size_t)R->vertex_count));
+        CHECK(df_same(fa.probes, fb.probes, 27 * (size_t)R->probe_count));
+    }
+    rad_baker_runtime_destroy(a);
+    rad_baker_runtime_destroy(b);
+    rad_baker_result_destroy(R);
+}
+
 /* the list tests/check_docs.sh compares with the header is well formed */
 static void df_list(void)
 {
@@ -504,6 +552,7 @@ static const rad_test_case tests_defaults[] = {
     { "defaults_lightmap", df_lightmap },
     { "defaults_probes", df_probes },
     { "defaults_sky_transfer", df_sky_transfer },
+    { "defaults_baker_runtime", df_baker_runtime },
     { NULL, NULL }
 };
 
