@@ -941,6 +941,24 @@ static imp_group *group_for(imp_storage *st, const char *name)
     return &st->groups[st->group_count++];
 }
 
+/* yfov (radians) of the perspective camera of the glTF node named 'name', 0 when none is found */
+static float gltf_camera_yfov(const char *json, const char *name)
+{
+    const char *nodes = js_get(json, "nodes"), *cams = js_get(json, "cameras"), *n, *v, *cam, *persp;
+    char nn[256];
+    unsigned i;
+    for (i = 0; nodes && cams && (n = js_at(nodes, i)) != NULL; ++i) {
+        if (!(v = js_get(n, "name"))) continue;
+        js_string(v, nn, sizeof nn);
+        if (strcmp(nn, name) || !(v = js_get(n, "camera"))) continue;
+        cam = js_at(cams, (unsigned)strtoul(v, NULL, 10));
+        persp = cam ? js_get(cam, "perspective") : NULL;
+        v = persp ? js_get(persp, "yfov") : NULL;
+        return v ? (float)strtod(v, NULL) : 0.0f;
+    }
+    return 0.0f;
+}
+
 typedef struct walk_state {
     imp_storage *st;
     const struct aiScene *sc;
@@ -948,6 +966,7 @@ typedef struct walk_state {
     int camera_done;
     unsigned unnamed;
     uint32_t bad_indices;  /* faces with an index past the mesh's vertices (dropped) */
+    const char *gltf;      /* the glTF JSON when the file is glTF (its cameras are read from it) */
 } walk_state;
 
 static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiNode *node, const struct aiMatrix4x4 *m)
@@ -1081,6 +1100,20 @@ static void walk(walk_state *ws, const struct aiNode *node, const struct aiMatri
             p[0] = c->mPosition.x, p[1] = c->mPosition.y, p[2] = c->mPosition.z;
             t[0] = c->mLookAt.x, t[1] = c->mLookAt.y, t[2] = c->mLookAt.z;
             u[0] = c->mUp.x, u[1] = c->mUp.y, u[2] = c->mUp.z;
+            aspect = c->mAspect > 0.0f ? c->mAspect : 1.0f;
+            /* mHorizontalFOV is half the horizontal angle */
+            ws->out->camera.fov_y_degrees = 2.0f * atanf(tanf(c->mHorizontalFOV) / aspect) * 57.29577951f;
+            if (ws->gltf) {
+                /* glTF: the camera sits at its node's origin looking along -Z, +Y up, with the
+                   vertical angle yfov. assimp 5.2 copies the node's translation into mPosition
+                   (applied twice with the node's matrix) and gives yfov x aspect as
+                   mHorizontalFOV (the whole angle), so both come from the file instead. */
+                float yfov = gltf_camera_yfov(ws->gltf, node->mName.data);
+                p[0] = p[1] = p[2] = 0.0f;
+                t[0] = t[1] = 0.0f, t[2] = -1.0f;
+                u[0] = 0.0f, u[1] = 1.0f, u[2] = 0.0f;
+                ws->out->camera.fov_y_degrees = (yfov > 0.0f ? yfov : c->mHorizontalFOV / aspect) * 57.29577951f;
+            }
             xform_point(&m, p, pos);
             xform_dir(&m, t, dir);
             xform_dir(&m, u, up);
@@ -1089,9 +1122,6 @@ static void walk(walk_state *ws, const struct aiNode *node, const struct aiMatri
             ws->out->camera.target[1] = pos[1] + dir[1];
             ws->out->camera.target[2] = pos[2] + dir[2];
             memcpy(ws->out->camera.up, up, sizeof up);
-            aspect = c->mAspect > 0.0f ? c->mAspect : 1.0f;
-            /* mHorizontalFOV is half the horizontal angle */
-            ws->out->camera.fov_y_degrees = 2.0f * atanf(tanf(c->mHorizontalFOV) / aspect) * 57.29577951f;
             ws->out->has_camera = 1;
             ws->camera_done = 1;
             break;
@@ -1371,7 +1401,6 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
             material_report(st, sc->mMaterials[i], i, json ? gm : NULL, json != NULL);
         } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
     }
-    free(json);
     /* geometry, lights, camera */
     memset(&id, 0, sizeof id);
     id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
@@ -1379,7 +1408,9 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     ws.st = st;
     ws.sc = sc;
     ws.out = out;
+    ws.gltf = json;
     walk(&ws, sc->mRootNode, &id);
+    free(json);
     aiReleaseImport(sc);
     /* One warning for the first clamped material, except assimp's default material when no
        triangle uses it: assimp adds one to every glTF (base colour 1, always clamped) and a
