@@ -1357,6 +1357,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/tool_emissive.sh"
 
 . "$(dirname "${BASH_SOURCE[0]}")/tool_twosided.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_env.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/tool_assets.sh"
 . "$(dirname "$0")/tool_reliability.sh"
 . "$(dirname "$0")/tool_hier_large.sh"
 
