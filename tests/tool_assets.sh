@@ -117,3 +117,19 @@ if "$RAD" trace "$AS_DIR/showcase.gltf" --env "$AS_DIR/showcase_sky.hdr" --size 
 else
     fail "rad trace with a glTF camera" "$(head -c 300 "$TMP/as_err.txt")"
 fi
+
+# KHR_texture_transform: two quads (an emissive texture, a base-colour texture under a white
+# sky) with the transform on their texture references render as the same quads with the
+# transform applied to their uvs instead; rad info says it was used.
+if "$RAD" trace "$AS_DIR/texture_transform.gltf" --sky 1 --camera 0,0.5,-3:0,0.5,0:0,1,0 --fov 40 --size 32x32 --spp 4 \
+        -o "$TMP/as_x1.pfm" > /dev/null 2> "$TMP/as_err.txt" &&
+    "$RAD" trace "$AS_DIR/texture_transform_baked.gltf" --sky 1 --camera 0,0.5,-3:0,0.5,0:0,1,0 --fov 40 --size 32x32 --spp 4 \
+        -o "$TMP/as_x2.pfm" > /dev/null 2>> "$TMP/as_err.txt" &&
+    "$RAD" info "$AS_DIR/texture_transform.gltf" > "$TMP/as_info.txt" 2>> "$TMP/as_err.txt"; then
+    as_s=$("$RAD" compare "$TMP/as_x1.pfm" "$TMP/as_x2.pfm" 2> /dev/null | awk '/^SSIM/ { print $2 }')
+    at_least "$as_s" 0.999 && [ "$(grep -c "KHR_texture_transform: used" "$TMP/as_info.txt")" = 2 ] &&
+        ok "KHR_texture_transform on emissive and base-colour textures: as the transformed uvs (SSIM $as_s)" ||
+        fail "KHR_texture_transform on emissive and base-colour textures" "SSIM $as_s; $(grep -c "KHR_texture_transform" "$TMP/as_info.txt") report lines"
+else
+    fail "rad trace of the texture transform quads" "$(head -c 300 "$TMP/as_err.txt")"
+fi

@@ -54,6 +54,8 @@ typedef struct imp_texture {
     int width, height;
     float *rgb;           /* linear */
     char path[256];
+    int has_xf;           /* glTF KHR_texture_transform: uv' = xf (u, v, 1) in glTF's uvs (v down) */
+    float xf[6];
 } imp_texture;
 
 typedef struct imp_group {
@@ -152,6 +154,13 @@ static void texture_sample(const imp_storage *st, uint32_t texture, float u, flo
     t = &st->textures[texture - 1];
     if (!(u == u)) u = 0.0f; /* NaN */
     if (!(v == v)) v = 0.0f;
+    if (t->has_xf) { /* the transform acts on glTF's uvs, whose v assimp turned into 1 - v */
+        float g = 1.0f - v, tu = t->xf[0] * u + t->xf[1] * g + t->xf[2];
+        v = 1.0f - (t->xf[3] * u + t->xf[4] * g + t->xf[5]);
+        u = tu;
+        if (!(u - u == 0.0f)) u = 0.0f; /* inf or NaN from a huge scale */
+        if (!(v - v == 0.0f)) v = 0.0f;
+    }
     u -= floorf(u);
     v -= floorf(v);
     x = u * (float)t->width - 0.5f;
@@ -266,7 +275,7 @@ static uint32_t load_texture_as(imp_storage *st, const struct aiScene *sc, const
     imp_texture *t;
     snprintf(key, sizeof key, "%s%s", prefix, tpath);
     for (i = 0; i < st->texture_count; ++i)
-        if (!strncmp(st->textures[i].path, key, sizeof st->textures[i].path - 1)) return i + 1;
+        if (!st->textures[i].has_xf && !strncmp(st->textures[i].path, key, sizeof st->textures[i].path - 1)) return i + 1;
     if (tpath[0] == '*') {
         unsigned idx = (unsigned)atoi(tpath + 1);
         if (idx < sc->mNumTextures) {
@@ -757,7 +766,7 @@ static void gltf_report(const char *m, char **r)
     }
     transform += gltf_has_transform(js_get(m, "emissiveTexture"));
     if (pbr) transform += gltf_has_transform(js_get(pbr, "baseColorTexture"));
-    if (transform) rep_add(r, "  KHR_texture_transform: ignored (textures are sampled at the untransformed uvs)%s%s", NULL, NULL);
+    if (transform) rep_add(r, "  KHR_texture_transform: used (offset, rotation, scale; a texCoord in it is ignored)%s%s", NULL, NULL);
     for (i = 0; (v = js_member(m, i, key, sizeof key)) != NULL; ++i) {
         for (j = 0; used[j] && strcmp(used[j], key); ++j) {}
         if (!used[j])
@@ -1204,6 +1213,59 @@ static const char *material_json(const char *json, uint32_t i, const char *name,
     return found;
 }
 
+/* KHR_texture_transform of texture-info object ti as the matrix of texture_sample, 0 when ti
+   has none. glTF: uv' = T(offset) R(rotation) S(scale) uv, R = [cos sin; -sin cos]. */
+static int gltf_texture_transform(const char *ti, float xf[6])
+{
+    const char *e = ti ? js_get(ti, "extensions") : NULL, *x = e ? js_get(e, "KHR_texture_transform") : NULL, *v;
+    float off[2] = {0, 0}, sc[2] = {1, 1}, r = 0.0f, c, s;
+    if (!x) return 0;
+    if ((v = js_get(x, "offset")) != NULL) js_floats(v, off, 2);
+    if ((v = js_get(x, "scale")) != NULL) js_floats(v, sc, 2);
+    if ((v = js_get(x, "rotation")) != NULL) r = (float)strtod(v, NULL);
+    c = cosf(r), s = sinf(r);
+    xf[0] = c * sc[0], xf[1] = s * sc[1], xf[2] = off[0];
+    xf[3] = -s * sc[0], xf[4] = c * sc[1], xf[5] = off[1];
+    return 1;
+}
+
+/* gives texture *id (index+1) the transform xf: a new entry (its own copy of the texels)
+   unless the texture already has exactly it */
+static void texture_with_transform(imp_storage *st, uint32_t *id, const float xf[6])
+{
+    imp_texture *t;
+    size_t n;
+    uint32_t i;
+    if (!*id) return;
+    for (i = 0; i < st->texture_count; ++i) { /* the same image and transform already made */
+        const imp_texture *o = &st->textures[i];
+        if (o->has_xf && !memcmp(o->xf, xf, sizeof o->xf) && o->rgb && st->textures[*id - 1].rgb &&
+            !strcmp(o->path, st->textures[*id - 1].path)) {
+            *id = i + 1;
+            return;
+        }
+    }
+    st->textures = (imp_texture *)xrealloc(st->textures, sizeof(imp_texture) * (st->texture_count + 1));
+    t = &st->textures[st->texture_count];
+    *t = st->textures[*id - 1];
+    n = 3 * (size_t)t->width * (size_t)t->height;
+    t->rgb = (float *)xrealloc(NULL, sizeof(float) * n);
+    memcpy(t->rgb, st->textures[*id - 1].rgb, sizeof(float) * n);
+    t->has_xf = 1;
+    memcpy(t->xf, xf, sizeof t->xf);
+    *id = ++st->texture_count;
+}
+
+/* KHR_texture_transform on glTF material gm's base-colour and emissive textures */
+static void gltf_apply_transforms(imp_storage *st, rad_material *m, const char *gm)
+{
+    const char *pbr = gm ? js_get(gm, "pbrMetallicRoughness") : NULL;
+    float xf[6];
+    if (m->texture && pbr && gltf_texture_transform(js_get(pbr, "baseColorTexture"), xf)) texture_with_transform(st, &m->texture, xf);
+    if (m->emission_texture && gltf_texture_transform(js_get(gm, "emissiveTexture"), xf))
+        texture_with_transform(st, &m->emission_texture, xf);
+}
+
 static const char *texture_name(const imp_storage *st, uint32_t id)
 {
     const char *p = id && id <= st->texture_count ? st->textures[id - 1].path : "";
@@ -1398,6 +1460,7 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
                 tool_free_scene(out);
                 return 1;
             }
+            gltf_apply_transforms(st, &st->materials[i], gm);
             material_report(st, sc->mMaterials[i], i, json ? gm : NULL, json != NULL);
         } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
     }
