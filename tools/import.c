@@ -12,7 +12,8 @@
    there is one and the mesh has uvs: sampled through the albedo callback), clamped into
    [0, 0.999] with a warning; emission = Ke / glTF emissiveFactor x KHR_materials_emissive_strength
    (read from the glTF JSON here: assimp 5.2 drops it), as radiance, times the emission
-   texture (map_Ke / emissiveTexture, sRGB-decoded, unclamped) through the emission callback.
+   texture (map_Ke / emissiveTexture, sRGB-decoded, unclamped) through the emission callback;
+   glTF's KHR_texture_transform on either texture is applied to the uvs in the lookup.
    What each material used and what it ignored is kept for `rad info` (material_reports).
    Lights: point, spot and directional lights of the file become rad_light (their node's
    transform applied). Camera: the file's first camera, else a default framing. */
