@@ -5,7 +5,8 @@ showcase_sky.hdr (default: this folder).
 A small room built the way shipped assets are built, for the README picture and the asset
 benchmark (tests/bench/showcase.sh, tests/bench/assets.sh):
 - walls and ceiling are single sheets with doubleSided: true, and two walls are wound
-  outwards (an exporter's mixed winding: doubleSided makes it harmless);
+  outwards (an exporter's mixed winding: doubleSided makes it harmless), their normals into
+  the room (the side a one-layer lightmap keeps);
 - a window opening in the left wall (x = -2), lit by showcase_sky.hdr, an equirectangular
   Radiance HDR made here: a blue gradient sky, a brown ground below the horizon and a small
   sun (3 degrees across) shining in through the window, about 50 degrees up;
@@ -143,32 +144,45 @@ def add_view(data):
     return len(views) - 1
 
 
-def add_mesh(name, mat, quads=(), tris=()):
+def face_normal(a, b, c):
+    u = [b[k] - a[k] for k in range(3)]
+    v = [c[k] - a[k] for k in range(3)]
+    n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+    ln = math.sqrt(sum(x * x for x in n))
+    return tuple(x / ln for x in n)
+
+
+def add_mesh(name, mat, quads=(), tris=(), normal=None):
     """quads: (p0, p1, p2, p3) counter-clockwise seen from the front, uvs 0..1 over each;
-    tris: ((p, uv), (p, uv), (p, uv))"""
-    P, UV, I = [], [], []
+    tris: ((p, uv), (p, uv), (p, uv)); normal: the shading normal of every vertex (as an
+    exporter writes it: the side meant to be seen), else each face's own"""
+    P, UV, N, I = [], [], [], []
     for q in quads:
         b = len(P)
         P += list(q)
         UV += [(0, 1), (1, 1), (1, 0), (0, 0)]  # glTF: v = 0 is the image's top row
+        N += [normal or face_normal(q[0], q[1], q[2])] * 4
         I += [b, b + 1, b + 2, b, b + 2, b + 3]
     for t in tris:
         b = len(P)
         for p, uv in t:
             P.append(p)
             UV.append(uv)
+        N += [normal or face_normal(t[0][0], t[1][0], t[2][0])] * 3
         I += [b, b + 1, b + 2]
     lo = [min(p[a] for p in P) for a in range(3)]
     hi = [max(p[a] for p in P) for a in range(3)]
     pv = add_view(b''.join(struct.pack('<3f', *p) for p in P))
     uv = add_view(b''.join(struct.pack('<2f', *t) for t in UV))
+    nv = add_view(b''.join(struct.pack('<3f', *n) for n in N))
     iv = add_view(b''.join(struct.pack('<I', i) for i in I))
     accessors.extend([{'bufferView': pv, 'componentType': 5126, 'count': len(P), 'type': 'VEC3', 'min': lo, 'max': hi},
                       {'bufferView': uv, 'componentType': 5126, 'count': len(P), 'type': 'VEC2'},
+                      {'bufferView': nv, 'componentType': 5126, 'count': len(P), 'type': 'VEC3'},
                       {'bufferView': iv, 'componentType': 5125, 'count': len(I), 'type': 'SCALAR'}])
-    a = len(accessors) - 3
-    meshes.append({'name': name, 'primitives': [{'attributes': {'POSITION': a, 'TEXCOORD_0': a + 1}, 'indices': a + 2,
-                                                 'material': mat}]})
+    a = len(accessors) - 4
+    meshes.append({'name': name, 'primitives': [{'attributes': {'POSITION': a, 'TEXCOORD_0': a + 1, 'NORMAL': a + 2},
+                                                 'indices': a + 3, 'material': mat}]})
     nodes.append({'name': name, 'mesh': len(meshes) - 1})
 
 
@@ -214,8 +228,8 @@ add_mesh('ceiling', ceiling, quads=[rect(1, Y1, X0, X1, Z0, Z1, True)])
 add_mesh('wall_window', plaster, quads=[rect(0, X0, 0.0, WY0, Z0, Z1), rect(0, X0, WY1, Y1, Z0, Z1),
                                         rect(0, X0, WY0, WY1, Z0, WZ0), rect(0, X0, WY0, WY1, WZ1, Z1)])
 # the right and back walls wound outwards (doubleSided: each side is a surface of its own)
-add_mesh('wall_right', plaster, quads=[rect(0, X1, 0.0, Y1, Z0, Z1)])
-add_mesh('wall_back', plaster, quads=[rect(2, Z1, X0, X1, 0.0, Y1)])
+add_mesh('wall_right', plaster, quads=[rect(0, X1, 0.0, Y1, Z0, Z1)], normal=(-1.0, 0.0, 0.0))
+add_mesh('wall_back', plaster, quads=[rect(2, Z1, X0, X1, 0.0, Y1)], normal=(0.0, 0.0, -1.0))
 add_mesh('wall_front', plaster, quads=[rect(2, Z0, X0, X1, 0.0, Y1)])
 
 # curtain: folds along z, hanging from near the ceiling to just above the floor, across the
@@ -228,7 +242,7 @@ for k in range(cols):
     xa = X0 + 0.16 + 0.07 * math.sin(2 * math.pi * folds * k / cols)
     xb = X0 + 0.16 + 0.07 * math.sin(2 * math.pi * folds * (k + 1) / cols)
     cq.append(((xa, cy0, za), (xb, cy0, zb), (xb, cy1, zb), (xa, cy1, za)))
-add_mesh('curtain', curtain, quads=cq)
+add_mesh('curtain', curtain, quads=cq, normal=(1.0, 0.0, 0.0))  # its room side
 
 # table and pot
 add_mesh('table', table, quads=box(0.5, 1.5, 0.0, 0.45, 0.6, 1.5))
