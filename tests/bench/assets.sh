@@ -12,7 +12,7 @@
 #     single-sheet walls and curtain, alpha-masked leaf cards, an emissive-textured screen)
 #     lit by its sky showcase_sky.hdr, and Blender's exported test scenes of
 #     tests/data/gltf-blender-io (doubleSided spheres, alpha mask and blend quads, 18 emissive
-#     spheres);
+#     spheres) and the Khronos sample model TextureTransformTest;
 #   - every .gltf / .glb in DIR (the third argument, else RAD_DATA_DIR) and its subfolders
 #     down to DIR/NAME/glTF*/ (the layout of the Khronos glTF sample assets) whose JSON has
 #     "emissive", "doubleSided" or "alphaMode": for instance the Khronos sample models
@@ -46,7 +46,8 @@ showcase.glb|$D/showcase.glb|--env $D/showcase_sky.hdr
 blender 01_single_vs_double_sided|$B/01_single_vs_double_sided/01_single_vs_double_sided.gltf|auto
 blender 01_alpha_mask|$B/01_alpha_mask/01_alpha_mask.gltf|auto
 blender 01_alpha_blend|$B/01_alpha_blend/01_alpha_blend.gltf|auto
-blender 14_emission_strength|$B/14_emission_strength/14_emission_strength.gltf|auto"
+blender 14_emission_strength|$B/14_emission_strength/14_emission_strength.gltf|auto
+khronos TextureTransformTest|$D/khronos/TextureTransformTest/TextureTransformTest.gltf|auto"
 if [ -n "$DIR" ] && [ -d "$DIR" ]; then
     for f in "$DIR"/*.gltf "$DIR"/*.glb "$DIR"/*/*.gltf "$DIR"/*/*.glb "$DIR"/*/glTF*/*.gltf "$DIR"/*/glTF*/*.glb; do
         [ -r "$f" ] && grep -aqE 'emissive|doubleSided|alphaMode' "$f" &&
