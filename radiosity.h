@@ -5530,10 +5530,12 @@ static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const fl
     uint32_t s;
     int k;
     uint32_t side = rad__lattice_side(samples);
+    /* the corners as 3-vectors with a zero third coordinate: rad__lattice_point reads three */
+    const float l0[3] = { lb[0][0], lb[0][1], 0.0f }, l1[3] = { lb[1][0], lb[1][1], 0.0f }, l2[3] = { lb[2][0], lb[2][1], 0.0f };
     samples = side * side;
     for (s = 0; s < samples; ++s) {
         float q[3], rgb[3];
-        rad__lattice_point(lb[0], lb[1], lb[2], side, s, q); /* in the triangle's (b1, b2) plane */
+        rad__lattice_point(l0, l1, l2, side, s, q); /* in the triangle's (b1, b2) plane */
         rad_scene_albedo(scene, t, q[0], q[1], rgb);
         for (k = 0; k < 3; ++k) {
             if (!rad__finite(rgb[k]) || rgb[k] < 0.0f || rgb[k] >= 1.0f) {
