@@ -5813,10 +5813,12 @@ static rad_result rad__patch_albedo(const rad_scene *scene, uint32_t t, const fl
     uint32_t s, used = 0;
     int k, cut = rad_scene_cutout(scene, t) && rad__patch_opacity(scene, t, lb, samples) > 0.0f;
     uint32_t side = rad__lattice_side(samples);
+    /* the corners as 3-vectors with a zero third coordinate: rad__lattice_point reads three */
+    const float l0[3] = { lb[0][0], lb[0][1], 0.0f }, l1[3] = { lb[1][0], lb[1][1], 0.0f }, l2[3] = { lb[2][0], lb[2][1], 0.0f };
     samples = side * side;
     for (s = 0; s < samples; ++s) {
         float q[3], rgb[3];
-        rad__lattice_point(lb[0], lb[1], lb[2], side, s, q); /* in the triangle's (b1, b2) plane */
+        rad__lattice_point(l0, l1, l2, side, s, q); /* in the triangle's (b1, b2) plane */
         if (cut && !rad_scene_opaque(scene, t, q[0], q[1])) continue; /* the same lattice: some are kept */
         ++used;
         rad_scene_albedo(scene, t, q[0], q[1], rgb);

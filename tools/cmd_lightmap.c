@@ -270,6 +270,28 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         mesh.triangle_count = w->scene->triangle_count;
         mesh.material_ids = w->scene->materials;
         mesh.lightmap_uvs = out->uvs;
+        if (w->scene->twins) {
+            /* a two-sided pair is two scene triangles, and the copy's two-sided materials pair
+               them again: the mesh takes the first side of each pair only (the side the
+               file's normals chose), else every sheet would be four coincident triangles */
+            const rad_scene *S = w->scene;
+            uint32_t t, k = 0;
+            float *pos = (float *)tool_calloc(9 * (size_t)S->triangle_count, sizeof(float));
+            float *tuv = S->uvs ? (float *)tool_calloc(6 * (size_t)S->triangle_count, sizeof(float)) : NULL;
+            uint32_t *mat = (uint32_t *)tool_calloc((size_t)S->triangle_count, sizeof(uint32_t));
+            for (t = 0; t < S->triangle_count; ++t) {
+                if (S->twins[t] != RAD_NONE && S->twins[t] < t) continue;
+                memcpy(pos + 9 * (size_t)k, S->positions + 9 * (size_t)t, 9 * sizeof(float));
+                if (tuv) memcpy(tuv + 6 * (size_t)k, S->uvs + 6 * (size_t)t, 6 * sizeof(float));
+                memmove(out->uvs + 6 * (size_t)k, out->uvs + 6 * (size_t)t, 6 * sizeof(float));
+                mat[k++] = S->materials[t];
+            }
+            mesh.positions = pos;
+            mesh.vertex_count = 3 * k;
+            mesh.uvs = tuv;
+            mesh.triangle_count = k;
+            mesh.material_ids = mat;
+        }
         desc = w->file.desc;
         desc.meshes = &mesh;
         desc.mesh_count = 1;
@@ -278,7 +300,13 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         out->own_scene = 1;
         out->w = w2;
         tool_context(&ctx, NULL);
-        if ((r = rad_scene_create(&desc, &ctx, &out->w.scene)) != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); goto fail; }
+        r = rad_scene_create(&desc, &ctx, &out->w.scene);
+        if (w->scene->twins) { /* the scene keeps copies */
+            free((void *)mesh.positions);
+            free((void *)mesh.uvs);
+            free((void *)mesh.material_ids);
+        }
+        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); goto fail; }
         if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { tool_fail(cmd, "rad_bvh_create", r); goto fail; }
         rad_bvh_raycaster(out->w.bvh, &out->w.rc);
     } else {

@@ -12,7 +12,8 @@
    there is one and the mesh has uvs: sampled through the albedo callback), clamped into
    [0, 0.999] with a warning; emission = Ke / glTF emissiveFactor x KHR_materials_emissive_strength
    (read from the glTF JSON here: assimp 5.2 drops it), as radiance, times the emission
-   texture (map_Ke / emissiveTexture, sRGB-decoded, unclamped) through the emission callback.
+   texture (map_Ke / emissiveTexture, sRGB-decoded, unclamped) through the emission callback;
+   glTF's KHR_texture_transform on either texture is applied to the uvs in the lookup.
    What each material used and what it ignored is kept for `rad info` (material_reports).
    Lights: point, spot and directional lights of the file become rad_light (their node's
    transform applied). Camera: the file's first camera, else a default framing. */
@@ -58,6 +59,8 @@ typedef struct imp_texture {
                              (a grey map_d), both as stored (not sRGB-decoded) */
     int has_alpha;        /* 1 when the image has an alpha channel */
     float alpha_scale;    /* an opacity texture's factor (glTF baseColorFactor alpha), else 1 */
+    int has_xf;           /* glTF KHR_texture_transform: uv' = xf (u, v, 1) in glTF's uvs (v down) */
+    float xf[6];
 } imp_texture;
 
 typedef struct imp_group {
@@ -146,6 +149,23 @@ static float srgb_to_linear(float c)
     return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
 }
 
+/* a lookup's uv: NaN read as 0, the texture's KHR_texture_transform applied, wrapped into [0, 1) */
+static void texture_uv(const imp_texture *t, float *pu, float *pv)
+{
+    float u = *pu, v = *pv;
+    if (!(u == u)) u = 0.0f; /* NaN */
+    if (!(v == v)) v = 0.0f;
+    if (t->has_xf) { /* the transform acts on glTF's uvs, whose v assimp turned into 1 - v */
+        float g = 1.0f - v, tu = t->xf[0] * u + t->xf[1] * g + t->xf[2];
+        v = 1.0f - (t->xf[3] * u + t->xf[4] * g + t->xf[5]);
+        u = tu;
+        if (!(u - u == 0.0f)) u = 0.0f; /* inf or NaN from a huge scale */
+        if (!(v - v == 0.0f)) v = 0.0f;
+    }
+    *pu = u - floorf(u);
+    *pv = v - floorf(v);
+}
+
 /* bilinear, repeat wrap, v up (assimp's convention: v = 0 is the bottom row of the image),
    clamped into [0, hi] */
 static void texture_sample(const imp_storage *st, uint32_t texture, float u, float v, float hi, float out_rgb[3])
@@ -155,10 +175,7 @@ static void texture_sample(const imp_storage *st, uint32_t texture, float u, flo
     int x0, y0, x1, y1, c;
     if (texture == 0 || texture > st->texture_count) { out_rgb[0] = out_rgb[1] = out_rgb[2] = 0.5f; return; }
     t = &st->textures[texture - 1];
-    if (!(u == u)) u = 0.0f; /* NaN */
-    if (!(v == v)) v = 0.0f;
-    u -= floorf(u);
-    v -= floorf(v);
+    texture_uv(t, &u, &v);
     x = u * (float)t->width - 0.5f;
     y = (1.0f - v) * (float)t->height - 0.5f;
     fx = x - floorf(x);
@@ -197,10 +214,7 @@ static float opacity_lookup(void *user, uint32_t texture, float u, float v)
     int x0, y0, x1, y1;
     if (texture == 0 || texture > st->texture_count) return 1.0f;
     t = &st->textures[texture - 1];
-    if (!(u == u)) u = 0.0f; /* NaN */
-    if (!(v == v)) v = 0.0f;
-    u -= floorf(u);
-    v -= floorf(v);
+    texture_uv(t, &u, &v);
     x = u * (float)t->width - 0.5f;
     y = (1.0f - v) * (float)t->height - 0.5f;
     fx = x - floorf(x);
@@ -299,7 +313,7 @@ static uint32_t load_texture_as(imp_storage *st, const struct aiScene *sc, const
     imp_texture *t;
     snprintf(key, sizeof key, "%s%s", prefix, tpath);
     for (i = 0; i < st->texture_count; ++i)
-        if (!strncmp(st->textures[i].path, key, sizeof st->textures[i].path - 1)) return i + 1;
+        if (!st->textures[i].has_xf && !strncmp(st->textures[i].path, key, sizeof st->textures[i].path - 1)) return i + 1;
     if (tpath[0] == '*') {
         unsigned idx = (unsigned)atoi(tpath + 1);
         if (idx < sc->mNumTextures) {
@@ -879,7 +893,7 @@ static void gltf_report(const char *m, char **r)
     }
     transform += gltf_has_transform(js_get(m, "emissiveTexture"));
     if (pbr) transform += gltf_has_transform(js_get(pbr, "baseColorTexture"));
-    if (transform) rep_add(r, "  KHR_texture_transform: ignored (textures are sampled at the untransformed uvs)%s%s", NULL, NULL);
+    if (transform) rep_add(r, "  KHR_texture_transform: used (offset, rotation, scale; a texCoord in it is ignored)%s%s", NULL, NULL);
     for (i = 0; (v = js_member(m, i, key, sizeof key)) != NULL; ++i) {
         for (j = 0; used[j] && strcmp(used[j], key); ++j) {}
         if (!used[j])
@@ -1063,6 +1077,24 @@ static imp_group *group_for(imp_storage *st, const char *name)
     return &st->groups[st->group_count++];
 }
 
+/* yfov (radians) of the perspective camera of the glTF node named 'name', 0 when none is found */
+static float gltf_camera_yfov(const char *json, const char *name)
+{
+    const char *nodes = js_get(json, "nodes"), *cams = js_get(json, "cameras"), *n, *v, *cam, *persp;
+    char nn[256];
+    unsigned i;
+    for (i = 0; nodes && cams && (n = js_at(nodes, i)) != NULL; ++i) {
+        if (!(v = js_get(n, "name"))) continue;
+        js_string(v, nn, sizeof nn);
+        if (strcmp(nn, name) || !(v = js_get(n, "camera"))) continue;
+        cam = js_at(cams, (unsigned)strtoul(v, NULL, 10));
+        persp = cam ? js_get(cam, "perspective") : NULL;
+        v = persp ? js_get(persp, "yfov") : NULL;
+        return v ? (float)strtod(v, NULL) : 0.0f;
+    }
+    return 0.0f;
+}
+
 typedef struct walk_state {
     imp_storage *st;
     const struct aiScene *sc;
@@ -1070,6 +1102,7 @@ typedef struct walk_state {
     int camera_done;
     unsigned unnamed;
     uint32_t bad_indices;  /* faces with an index past the mesh's vertices (dropped) */
+    const char *gltf;      /* the glTF JSON when the file is glTF (its cameras are read from it) */
 } walk_state;
 
 static void add_mesh(walk_state *ws, const struct aiMesh *mesh, const struct aiNode *node, const struct aiMatrix4x4 *m)
@@ -1203,6 +1236,20 @@ static void walk(walk_state *ws, const struct aiNode *node, const struct aiMatri
             p[0] = c->mPosition.x, p[1] = c->mPosition.y, p[2] = c->mPosition.z;
             t[0] = c->mLookAt.x, t[1] = c->mLookAt.y, t[2] = c->mLookAt.z;
             u[0] = c->mUp.x, u[1] = c->mUp.y, u[2] = c->mUp.z;
+            aspect = c->mAspect > 0.0f ? c->mAspect : 1.0f;
+            /* mHorizontalFOV is half the horizontal angle */
+            ws->out->camera.fov_y_degrees = 2.0f * atanf(tanf(c->mHorizontalFOV) / aspect) * 57.29577951f;
+            if (ws->gltf) {
+                /* glTF: the camera sits at its node's origin looking along -Z, +Y up, with the
+                   vertical angle yfov. assimp 5.2 copies the node's translation into mPosition
+                   (applied twice with the node's matrix) and gives yfov x aspect as
+                   mHorizontalFOV (the whole angle), so both come from the file instead. */
+                float yfov = gltf_camera_yfov(ws->gltf, node->mName.data);
+                p[0] = p[1] = p[2] = 0.0f;
+                t[0] = t[1] = 0.0f, t[2] = -1.0f;
+                u[0] = 0.0f, u[1] = 1.0f, u[2] = 0.0f;
+                ws->out->camera.fov_y_degrees = (yfov > 0.0f ? yfov : c->mHorizontalFOV / aspect) * 57.29577951f;
+            }
             xform_point(&m, p, pos);
             xform_dir(&m, t, dir);
             xform_dir(&m, u, up);
@@ -1211,9 +1258,6 @@ static void walk(walk_state *ws, const struct aiNode *node, const struct aiMatri
             ws->out->camera.target[1] = pos[1] + dir[1];
             ws->out->camera.target[2] = pos[2] + dir[2];
             memcpy(ws->out->camera.up, up, sizeof up);
-            aspect = c->mAspect > 0.0f ? c->mAspect : 1.0f;
-            /* mHorizontalFOV is half the horizontal angle */
-            ws->out->camera.fov_y_degrees = 2.0f * atanf(tanf(c->mHorizontalFOV) / aspect) * 57.29577951f;
             ws->out->has_camera = 1;
             ws->camera_done = 1;
             break;
@@ -1294,6 +1338,67 @@ static const char *material_json(const char *json, uint32_t i, const char *name,
         }
     }
     return found;
+}
+
+/* KHR_texture_transform of texture-info object ti as the matrix of texture_sample, 0 when ti
+   has none. glTF: uv' = T(offset) R(rotation) S(scale) uv, R = [cos sin; -sin cos]. */
+static int gltf_texture_transform(const char *ti, float xf[6])
+{
+    const char *e = ti ? js_get(ti, "extensions") : NULL, *x = e ? js_get(e, "KHR_texture_transform") : NULL, *v;
+    float off[2] = {0, 0}, sc[2] = {1, 1}, r = 0.0f, c, s;
+    if (!x) return 0;
+    if ((v = js_get(x, "offset")) != NULL) js_floats(v, off, 2);
+    if ((v = js_get(x, "scale")) != NULL) js_floats(v, sc, 2);
+    if ((v = js_get(x, "rotation")) != NULL) r = (float)strtod(v, NULL);
+    c = cosf(r), s = sinf(r);
+    xf[0] = c * sc[0], xf[1] = s * sc[1], xf[2] = off[0];
+    xf[3] = -s * sc[0], xf[4] = c * sc[1], xf[5] = off[1];
+    return 1;
+}
+
+/* gives texture *id (index+1) the transform xf: a new entry (its own copy of the texels)
+   unless the texture already has exactly it */
+static void texture_with_transform(imp_storage *st, uint32_t *id, const float xf[6])
+{
+    imp_texture *t;
+    size_t n;
+    uint32_t i;
+    if (!*id) return;
+    for (i = 0; i < st->texture_count; ++i) { /* the same image and transform already made */
+        const imp_texture *o = &st->textures[i];
+        if (o->has_xf && !memcmp(o->xf, xf, sizeof o->xf) && o->rgb && st->textures[*id - 1].rgb &&
+            !strcmp(o->path, st->textures[*id - 1].path)) {
+            *id = i + 1;
+            return;
+        }
+    }
+    st->textures = (imp_texture *)xrealloc(st->textures, sizeof(imp_texture) * (st->texture_count + 1));
+    t = &st->textures[st->texture_count];
+    *t = st->textures[*id - 1];
+    n = 3 * (size_t)t->width * (size_t)t->height;
+    t->rgb = (float *)xrealloc(NULL, sizeof(float) * n);
+    memcpy(t->rgb, st->textures[*id - 1].rgb, sizeof(float) * n);
+    if (t->alpha) { /* its own alpha too: every entry frees its own */
+        t->alpha = (float *)xrealloc(NULL, sizeof(float) * (n / 3));
+        memcpy(t->alpha, st->textures[*id - 1].alpha, sizeof(float) * (n / 3));
+    }
+    t->has_xf = 1;
+    memcpy(t->xf, xf, sizeof t->xf);
+    *id = ++st->texture_count;
+}
+
+/* KHR_texture_transform on glTF material gm's base-colour (with its alpha, the cutout's opacity)
+   and emissive textures */
+static void gltf_apply_transforms(imp_storage *st, rad_material *m, const char *gm)
+{
+    const char *pbr = gm ? js_get(gm, "pbrMetallicRoughness") : NULL;
+    float xf[6];
+    if (pbr && gltf_texture_transform(js_get(pbr, "baseColorTexture"), xf)) {
+        if (m->texture) texture_with_transform(st, &m->texture, xf);
+        if (m->opacity_texture) texture_with_transform(st, &m->opacity_texture, xf); /* the same image's alpha */
+    }
+    if (m->emission_texture && gltf_texture_transform(js_get(gm, "emissiveTexture"), xf))
+        texture_with_transform(st, &m->emission_texture, xf);
 }
 
 static const char *texture_name(const imp_storage *st, uint32_t id)
@@ -1499,10 +1604,10 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
                 tool_free_scene(out);
                 return 1;
             }
+            gltf_apply_transforms(st, &st->materials[i], gm);
             material_report(st, sc->mMaterials[i], i, json ? gm : NULL, json != NULL);
         } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
     }
-    free(json);
     /* geometry, lights, camera */
     memset(&id, 0, sizeof id);
     id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
@@ -1510,7 +1615,9 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     ws.st = st;
     ws.sc = sc;
     ws.out = out;
+    ws.gltf = json;
     walk(&ws, sc->mRootNode, &id);
+    free(json);
     aiReleaseImport(sc);
     /* One warning for the first clamped material, except assimp's default material when no
        triangle uses it: assimp adds one to every glTF (base colour 1, always clamped) and a
