@@ -641,54 +641,6 @@ static rad_virtual_patches *vp_build(const char *cmd, const tool_world *w, const
     return vp;
 }
 
-/* the patch count rad_vp_create would give at 'resolution' (rad_vp_count); 0 or 1 (printed) */
-static int vp_count(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points, uint32_t resolution,
-                    uint32_t *count)
-{
-    rad_vp_options vo;
-    rad_vp_counts cnt;
-    rad_context ctx;
-    rad_result r;
-    rad_vp_options_default(&vo);
-    vo.resolution = resolution;
-    vo.face_points = face_points;
-    vo.kind = kind;
-    tool_context(&ctx, NULL);
-    if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_count", r);
-    *count = cnt.patches;
-    return 0;
-}
-
-int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
-                              uint32_t max_patches, uint32_t start, uint32_t *out)
-{
-    /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build up
-       to the patches, without the form factors that take nearly all of its time). The count
-       grows about as R^2 (surface voxels): predict from the nearest count, count, narrow the
-       bracket [lo, hi) to adjacent resolutions. */
-    uint32_t lo = 0, hi = 4097, counts = 0, c = 0, res = start ? start : 16;
-    double tc = tool_seconds();
-    while (counts < 24 && hi - lo > 1) {
-        uint32_t next;
-        if (vp_count(cmd, w, kind, face_points, res, &c)) return 1;
-        ++counts;
-        if (c <= max_patches) lo = res;
-        else hi = res;
-        next = (uint32_t)((double)res * sqrt((double)max_patches / (double)(c ? c : 1)));
-        if (next <= lo) next = lo + 1;
-        if (next >= hi) next = hi - 1;
-        res = next;
-    }
-    if (lo == 0) {
-        fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd, max_patches);
-        return 1;
-    }
-    fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd, max_patches, lo,
-            counts, tool_seconds() - tc);
-    *out = lo;
-    return 0;
-}
-
 /* --proxy aavp|vp: the indirect radiosity L of the virtual patches by --method multibounce
    (F_mb of K bounces, float: L_K as Jacobi), temporal (alias tables over the CSR rows, or over
    F_mb's channels in --mode multibounce; --frames steps) or local (T of the M patches nearest
@@ -928,63 +880,8 @@ done:
     return rc;
 }
 
-/* --method vp|aavp: virtual patches, E at their samples, the classic solve on
-   their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
-   classic per-pixel render with H gathered at each sample's hit point. */
-/* --bake FILE with --method aavp|vp or --proxy: the set saved by rad bake --method aavp|vp
-   (rad_vp_load, checked against the scene's signature and the kind asked for) and its E into
-   *E_out; NULL with the error printed */
-int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_t size, const rad_scene *scene,
-                      rad_container **ct_out, rad_virtual_patches **vp_out, float **E_out)
-{
-    rad_container *ct = NULL;
-    rad_virtual_patches *vp = NULL;
-    const rad_section *vi, *se;
-    rad_context ctx;
-    rad_result r;
-    uint32_t i;
-    *ct_out = NULL;
-    *vp_out = NULL;
-    *E_out = NULL;
-    tool_context(&ctx, NULL);
-    if ((r = rad_container_create(data, size, &ctx, &ct)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' is damaged: %s\n", cmd, path, rad_result_string(r));
-        return 1;
-    }
-    vi = rad_container_find(ct, RAD_SECTION_VP_INFO, "vp");
-    if (!vi) {
-        fprintf(stderr, "rad %s: bake '%s' holds no virtual patches (bake them with --method aavp|vp)\n", cmd, path);
-        rad_container_destroy(ct);
-        return 1;
-    }
-    if ((r = rad_vp_load(ct, "vp", scene, &ctx, &vp)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' holds damaged virtual patches: %s\n", cmd, path, rad_result_string(r));
-        rad_container_destroy(ct);
-        return 1;
-    }
-    se = rad_container_find(ct, RAD_SECTION_VECTOR, "E");
-    if (!se || se->elem_size != 12 || se->count != vp->count) {
-        fprintf(stderr, "rad %s: bake '%s' holds no source vector E for its %u patches\n", cmd, path, vp->count);
-        rad_vp_destroy(vp);
-        rad_container_destroy(ct);
-        return 1;
-    }
-    *E_out = (float *)xmalloc(sizeof(float) * 3 * (size_t)vp->count);
-    memcpy(*E_out, se->data, sizeof(float) * 3 * (size_t)vp->count);
-    for (i = 0; i < 3 * vp->count; ++i)
-        if (!((*E_out)[i] >= 0.0f && (*E_out)[i] <= RAD_BAKE_VALUE_MAX)) {
-            fprintf(stderr, "rad %s: bake '%s': E entry %u is %g (not in [0, 1e30])\n", cmd, path, i, (double)(*E_out)[i]);
-            free(*E_out);
-            *E_out = NULL;
-            rad_vp_destroy(vp);
-            rad_container_destroy(ct);
-            return 1;
-        }
-    *ct_out = ct;
-    *vp_out = vp;
-    return 0;
-}
-
+/* --bake FILE with --method aavp|vp: tool_vp_bake_open, then checked against the scene's
+   signature, the options record and the kind asked for */
 static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, const tool_world *w, int clustered,
                                          float **E_out)
 {
@@ -1044,6 +941,9 @@ fail:
     return NULL;
 }
 
+/* --method vp|aavp: virtual patches, E at their samples, the classic solve on
+   their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
+   classic per-pixel render with H gathered at each sample's hit point. */
 static int render_vp_method(const char *cmd, const tool_world *w, const char *bake_path,
                             const tool_classic_options *o, const tool_method_options *mo, const rad_camera *cam,
                             int width, int height, uint32_t aa, uint32_t light_samples, float exposure, tool_image *img)

@@ -316,7 +316,8 @@ int tool_parse_bytes(const char *cmd, const char *opt, const char *text, double 
 /* MemAvailable of /proc/meminfo in bytes; 0 where unknown (then only --max-memory limits) */
 double tool_mem_available(void);
 struct tool_method_options;
-/* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice). */
+/* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice).
+   (methods.c: the costs are the methods') */
 void tool_dense_plan(tool_classic_options *o, const struct tool_method_options *mo, int bake);
 /* Before a dense build of n patches (lower_bound: n is the triangle count, the patches not made
    yet): 0 when the estimate fits the memory limit and TOOL_DENSE_MAX_SECONDS (or
@@ -600,7 +601,8 @@ typedef struct tool_unwrap_auto {
    names size_option and the smallest size that fits when the atlas is too small. */
 int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t *width, uint32_t *height,
                 const tool_unwrap_auto *autosize, float *out_uvs, uint32_t *out_charts);
-/* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
+/* ---- lightmap bakes (lightmap.c), shared by rad lightmap and rad render --method lightmap;
+   the virtual patches they and rad probes share (vp.c) --------------------------------- */
 /* --proxy aavp|vp: the indirect light from virtual patches instead of classic patches */
 typedef struct tool_lightmap_proxy {
     int kind;                /* TOOL_PROXY_AAVP, TOOL_PROXY_VP or TOOL_LIGHTMAP_HIERARCHICAL */
@@ -612,14 +614,14 @@ typedef struct tool_lightmap_proxy {
 } tool_lightmap_proxy;
 /* --vp-max-patches B: the finest voxel resolution whose set of 'kind' has at most B patches,
    found by counting (rad_vp_count) from 'start' (0: 16); prints the choice. 0, or 1 after
-   printing why (even resolution 1 gives more). (cmd_render.c) */
+   printing why (even resolution 1 gives more). */
 int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
                               uint32_t max_patches, uint32_t start, uint32_t *out);
 /* A bake of rad bake --method aavp|vp in memory (data, size: kept alive by the caller while
    *ct_out lives): its container, its set "vp" (rad_vp_load; scene may be NULL) and its source
    vector E (3 floats a patch, each in [0, RAD_BAKE_VALUE_MAX], malloc'd). The errors tell a
    damaged file, a bake without virtual patches and damaged virtual patches apart. 0, or 1
-   after printing why (nothing to free). (cmd_render.c) */
+   after printing why (nothing to free). */
 int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_t size, const rad_scene *scene,
                       rad_container **ct_out, rad_virtual_patches **vp_out, float **E_out);
 /* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth

@@ -1,0 +1,185 @@
+/* lightmap.c - the lightmap bake that rad lightmap and rad render --method lightmap share
+   (tool_lightmap_bake in tool.h): the solution (classic, virtual patches or hierarchical) over
+   the lightmapped world, then texels, gather, direct light, dilation and stitching. */
+#include "tool.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void tool_lightmap_bake_free(tool_lightmap_baked *b)
+{
+    free(b->values);
+    rad_lightmap_destroy(b->lm);
+    tool_classic_free(&b->cl);
+    rad_vp_destroy(b->vp);
+    rad_hierarchical_destroy(b->hr);
+    if (b->own_scene) {
+        rad_bvh_destroy(b->w.bvh);
+        rad_scene_destroy(b->w.scene);
+    }
+    free(b->uvs);
+    memset(b, 0, sizeof *b);
+}
+
+int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
+                           int height, int auto_size, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
+                           int force_unwrap, int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out)
+{
+    tool_classic_options co2 = *co;
+    float *vp_H = NULL;
+    double t_all = tool_seconds();
+    tool_world w2 = *world;
+    rad_lightmap_options lo;
+    rad_lightmap_gather_options go;
+    rad_lightmap_seam_stats st;
+    rad_context ctx;
+    rad_result r;
+    uint32_t ch;
+    double t0;
+    rad_mesh_desc mesh;
+    rad_scene_desc desc;
+    const tool_world *w = world;
+    memset(out, 0, sizeof *out);
+    if (proxy && sh) {
+        fprintf(stderr, "rad %s: --sh needs the classic gather (the virtual patches' gather has no direction): leave out --proxy\n", cmd);
+        return 1;
+    }
+    if (proxy && co->solver == TOOL_DIRECT) {
+        fprintf(stderr, "rad %s: --solver direct is for classic patches: with --proxy use jacobi or gauss-seidel\n", cmd);
+        return 1;
+    }
+    /* a scene too big for the dense classic build is refused before the unwrap, with the way out */
+    co2.dense_instead = "--proxy aavp or --proxy vp (the lightmap's indirect light from virtual patches: a few thousand "
+                        "whatever the triangle count; --vp-resolution R sets how many)";
+    co = &co2;
+    if (!proxy && tool_dense_check(cmd, co, w->scene->triangle_count, 1)) return 1;
+    /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
+    if (force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
+        if (!force_unwrap && w->scene->lightmap_uvs)
+            fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
+        uint32_t uw = (uint32_t)width, uh = (uint32_t)height;
+        tool_unwrap_auto au;
+        out->uvs = (float *)tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
+        /* the estimate: the texel records (flags, position, normal, sample index: 29 bytes),
+           the samples (position, normal, triangle, validity: 29 bytes each) and the values
+           with one working copy, plus an RGB image of the atlas */
+        au.max_side = TOOL_LIGHTMAP_AUTO_MAX;
+        au.bytes_per_texel = 29.0 + 29.0 * (texel_samples ? texel_samples : 4u) + 8.0 * (sh ? 12.0 : 3.0) + 12.0;
+        if (co->max_memory > 0.0) au.memory_limit = co->max_memory, au.memory_from = "--max-memory";
+        else au.memory_limit = tool_mem_available(), au.memory_from = "MemAvailable in /proc/meminfo";
+        if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, &uw, &uh,
+                        auto_size ? &au : NULL, out->uvs, NULL))
+            goto fail;
+        width = (int)uw;
+        height = (int)uh;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.name = "unwrapped";
+        mesh.positions = w->scene->positions;
+        mesh.vertex_count = 3 * w->scene->triangle_count;
+        mesh.uvs = w->scene->uvs;
+        mesh.triangle_count = w->scene->triangle_count;
+        mesh.material_ids = w->scene->materials;
+        mesh.lightmap_uvs = out->uvs;
+        desc = w->file.desc;
+        desc.meshes = &mesh;
+        desc.mesh_count = 1;
+        w2.scene = NULL;
+        w2.bvh = NULL;
+        out->own_scene = 1;
+        out->w = w2;
+        tool_context(&ctx, NULL);
+        if ((r = rad_scene_create(&desc, &ctx, &out->w.scene)) != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); goto fail; }
+        if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { tool_fail(cmd, "rad_bvh_create", r); goto fail; }
+        rad_bvh_raycaster(out->w.bvh, &out->w.rc);
+    } else {
+        out->w = w2;
+        fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
+    }
+    w = &out->w;
+    if (proxy && proxy->kind == TOOL_LIGHTMAP_HIERARCHICAL) {
+        tool_method_options mo;
+        rad_hierarchical_stats hs;
+        double th = tool_seconds();
+        tool_method_options_default(&mo);
+        mo.hr_eps = proxy->hr_eps;
+        if (tool_hierarchical_build(cmd, w, &mo, co->light_samples, &out->hr)) goto fail;
+        rad_hierarchical_get_stats(out->hr, &hs);
+        out->patches = hs.leaves;
+        out->solve_seconds = tool_seconds() - th;
+    } else if (proxy) {
+        if (tool_vp_proxy_solve(cmd, w, co, proxy, &out->vp, NULL, &vp_H, &out->solve_seconds)) goto fail;
+        out->patches = out->vp->count;
+    } else {
+        if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
+        out->patches = out->cl.patches->count;
+        out->solve_seconds = out->cl.solve_seconds;
+    }
+    /* the gather wants the total radiosity of the secondary sources: B = E + L */
+    t0 = tool_seconds();
+    rad_lightmap_options_default(&lo);
+    lo.width = (uint32_t)width;
+    lo.height = (uint32_t)height;
+    lo.samples = texel_samples;
+    tool_context(&ctx, "lightmap texels");
+    r = rad_lightmap_create(w->scene, &w->rc, &lo, &ctx, &out->lm);
+    tool_progress_end();
+    if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_create", r); goto fail; }
+    fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
+            out->lm->width, out->lm->height, out->lm->covered_texels, out->lm->valid_texels, out->lm->invalid_samples,
+            out->lm->sample_count);
+    if (out->lm->covered_texels == 0) {
+        /* nothing to gather into: the map would be all zero */
+        fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
+                        "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
+                cmd, out->lm->width, out->lm->height);
+        goto fail;
+    }
+    rad_lightmap_gather_options_default(&go);
+    go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
+    go.visibility_rays = vis;
+    go.hemisphere_rays = hemi_rays;
+    ch = rad_lightmap_channels(go.encoding);
+    out->values = (float *)tool_calloc((size_t)width * height * ch, sizeof(float));
+    if (proxy) {
+        tool_context(&ctx, "lightmap gather");
+        r = out->hr ? rad_lightmap_gather_hierarchical(out->lm, out->hr, RAD_HIERARCHICAL_GATHERED, out->values, &ctx)
+                    : rad_lightmap_gather_vp(out->lm, out->vp, vp_H, out->values, &ctx);
+        tool_progress_end();
+        if (r != RAD_SUCCESS) { tool_fail(cmd, out->hr ? "rad_lightmap_gather_hierarchical" : "rad_lightmap_gather_vp", r); goto fail; }
+    } else {
+        /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
+        if (gather < 0)
+            gather = (double)out->lm->sample_count * out->cl.patches->count > 2e7 ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
+        go.method = (rad_lightmap_gather_method)gather;
+        if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
+            fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, hemi_rays);
+        tool_context(&ctx, "lightmap gather");
+        r = rad_lightmap_gather(out->lm, out->cl.patches, out->cl.B, &w->rc, &go, out->values, &ctx);
+        tool_progress_end();
+        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
+    }
+    if (direct && !sh) {
+        rad_direct_options dopt;
+        rad_direct_options_default(&dopt);
+        dopt.exclude_emitters = 0;
+        dopt.light_samples = co->light_samples;
+        tool_context(&ctx, "lightmap direct");
+        r = rad_lightmap_direct(out->lm, &w->rc, w->file.lights, w->file.light_count, &dopt, out->values, &ctx);
+        tool_progress_end();
+        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_direct", r); goto fail; }
+    }
+    tool_context(&ctx, NULL);
+    if ((r = rad_lightmap_dilate(out->lm, ch, out->values, 0, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_dilate", r); goto fail; }
+    if ((r = rad_lightmap_stitch(out->lm, ch, out->values, 0, &st, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_stitch", r); goto fail; }
+    fprintf(stderr, "rad %s: lightmap baked in %.2f s (%.2f s with the %s solution; %ux%u, %.1f MiB of values); %u seams, "
+                    "largest jump %.4g before stitching, %.4g after\n", cmd, tool_seconds() - t0, tool_seconds() - t_all,
+            out->hr ? "hierarchical" : proxy ? "virtual-patch" : "classic", out->lm->width, out->lm->height,
+            (double)width * height * ch * sizeof(float) / 1048576.0, st.seams, (double)st.max_jump_before,
+            (double)st.max_jump_after);
+    free(vp_H);
+    return 0;
+fail:
+    free(vp_H);
+    tool_lightmap_bake_free(out);
+    return 1;
+}
