@@ -135,42 +135,63 @@ typedef struct isect_job {
     int failed;
 } isect_job;
 
-/* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
-static int render_shading = -1;
-/* --method vp|aavp: render_classic gathers H at each sample from these (P and Hv unused) */
-static const rad_virtual_patches *render_vp = NULL;
-static const float *render_vp_H = NULL;
-static double render_vp_gather_seconds = 0.0;
-/* --method hierarchical: render_classic looks H up at each sample's hit (smooth, halo-fixed) */
-static const rad_hierarchical *render_hr = NULL;
-static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out);
-/* --method lightmap: render_classic reads H at each sample's lightmap uv from this RGB
-   irradiance lightmap (bilinear; P and Hv unused) */
-static const rad_lightmap *render_lm = NULL;
-static const float *render_lm_values = NULL;
-static uint32_t render_lm_size = 256, render_lm_samples = 4, render_lm_vis = 2;
-static int render_lm_size_given = 0; /* else an unwrap too fine for 256 gets a larger atlas */
-/* --final-gather N: rays per pixel sample for one traced bounce (0: off; rad_final_gather) */
-static uint32_t render_final_gather = 0;
+/* What render_classic draws: the view and the per-pixel options of the command line */
+typedef struct render_view {
+    rad_camera cam;
+    int width, height;
+    uint32_t aa;             /* --aa: stratified samples per pixel */
+    uint32_t light_samples;  /* --pixel-light-samples */
+    float exposure;          /* --exposure (PNG frames of --sequence) */
+    int shading;             /* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
+    uint32_t final_gather;   /* --final-gather N: rays per sample for one traced bounce (0: off) */
+} render_view;
 
-typedef struct fg_lookup {
-    const rad_patches *P; /* classic: per-vertex H of the patches */
+/* Where render_classic takes the irradiance H from the secondary sources at a sample: the
+   first of vp (rad_vp_gather of vp_H), hr (the hierarchical solution's smooth lookup) and lm
+   (a bilinear lookup of the RGB irradiance lightmap lm_values at the sample's lightmap uv)
+   that is set, else the per-vertex Hv of the patches P. */
+typedef struct render_source {
+    const rad_patches *P;
     const float *Hv;
-} fg_lookup;
+    const rad_virtual_patches *vp;
+    const float *vp_H;
+    const rad_hierarchical *hr;
+    const rad_lightmap *lm;
+    const float *lm_values;
+    double gather_seconds;   /* out: the time spent in the gathers and lookups */
+} render_source;
+
+/* rad render's command line */
+typedef struct render_args {
+    const char *scene, *out, *bake; /* SCENE, -o, --bake */
+    tool_classic_options o;
+    tool_method_options mo;
+    render_view view;
+    int have_camera;         /* --camera given */
+    float fov;               /* --fov (0: the camera's) */
+    uint32_t spp;            /* --spp: pathtrace samples per pixel */
+    uint32_t threads;        /* --threads */
+    uint32_t lm_size, lm_samples, lm_vis; /* --lightmap-size, --texel-samples, --visibility-rays */
+    int lm_size_given;       /* else an unwrap too fine for lm_size gets a larger atlas */
+    int lightmap_opts;       /* one of those three was given */
+} render_args;
+
+static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, const uint32_t *valid, uint32_t count,
+                            float *out);
 
 /* H at the final gather's hits: the virtual patches' gather, or the patches' per-vertex H */
 static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *points, const float *normals, uint32_t count,
                                float *out)
 {
-    const fg_lookup *l = (const fg_lookup *)user;
+    const render_source *l = (const render_source *)user;
     uint32_t k;
     int i;
-    if (render_vp) {
+    if (l->vp) {
         rad_context quiet;
         tool_context(&quiet, NULL);
-        return rad_vp_gather(render_vp, render_vp_H, points, normals, count, out, &quiet);
+        return rad_vp_gather(l->vp, l->vp_H, points, normals, count, out, &quiet);
     }
-    if (render_hr) return hr_lookup(hits, NULL, count, out);
+    if (l->hr) return hr_lookup(l->hr, hits, NULL, count, out);
     for (k = 0; k < count; ++k) {
         float wts[3];
         uint32_t p = rad_patches_locate(l->P, hits[k].triangle, hits[k].b1, hits[k].b2, wts);
@@ -185,7 +206,8 @@ static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *poi
 }
 
 /* H of the hierarchical solution at hits[valid[k]] (valid NULL: hits[k]), k < count */
-static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out)
+static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, const uint32_t *valid, uint32_t count,
+                            float *out)
 {
     uint32_t *tris = (uint32_t *)xmalloc(sizeof(uint32_t) * (count ? count : 1u)), k;
     float *bary = (float *)xmalloc(sizeof(float) * 2 * (count ? count : 1u));
@@ -196,16 +218,20 @@ static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t
         bary[2 * k] = h->b1;
         bary[2 * k + 1] = h->b2;
     }
-    r = rad_hierarchical_lookup(render_hr, RAD_HIERARCHICAL_GATHERED, 1, tris, bary, count, out);
+    r = rad_hierarchical_lookup(hr, RAD_HIERARCHICAL_GATHERED, 1, tris, bary, count, out);
     free(tris);
     free(bary);
     return r;
 }
 
-static int render_classic(const tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
-                          int width, int height, uint32_t aa, uint32_t light_samples, tool_image *img)
+static int render_classic(const tool_world *w, const render_view *view, render_source *src, tool_image *img)
 {
     const rad_scene *scene = w->scene;
+    const rad_patches *P = src->P;
+    const float *Hv = src->Hv;
+    const rad_camera *cam = &view->cam;
+    int width = view->width, height = view->height;
+    uint32_t aa = view->aa, light_samples = view->light_samples;
     uint32_t strata, spp;
     size_t batch_cap, total = (size_t)width * height, done_px = 0;
     rad_ray *rays;
@@ -229,8 +255,8 @@ static int render_classic(const tool_world *w, const rad_patches *P, const float
     normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
     valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
-    if (render_vp || render_hr || render_lm || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    if (render_shading >= 0) {
+    if (src->vp || src->hr || src->lm || view->final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
+    if (view->shading >= 0) {
         shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
         shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
         shaded = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
@@ -310,37 +336,34 @@ static int render_classic(const tool_world *w, const rad_patches *P, const float
                 break;
             }
         }
-        if (render_final_gather && nvalid > 0) {
+        if (view->final_gather && nvalid > 0) {
             rad_final_gather_options fo;
-            fg_lookup lk;
             double tg = tool_seconds();
             rad_final_gather_options_default(&fo);
-            fo.rays = render_final_gather;
+            fo.rays = view->final_gather;
             fo.seed = (uint32_t)y0 * 0x9E3779B9u;
-            lk.P = P;
-            lk.Hv = Hv;
-            r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, &lk, points, normals,
+            r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, src, points, normals,
                                  nvalid, gathered, &quiet);
-            render_vp_gather_seconds += tool_seconds() - tg;
+            src->gather_seconds += tool_seconds() - tg;
             if (r != RAD_SUCCESS) {
                 result = tool_fail("render", "rad_final_gather", r);
                 break;
             }
-        } else if (render_lm && nvalid > 0) {
+        } else if (src->lm && nvalid > 0) {
             double tg = tool_seconds();
             for (k = 0; k < nvalid; ++k) {
                 const rad_hit *h = &hits[valid[k]];
                 const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
                 float u = t[0] + h->b1 * (t[2] - t[0]) + h->b2 * (t[4] - t[0]);
                 float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
-                rad_lightmap_sample(render_lm, 3, render_lm_values, u, v, gathered + 3 * k);
+                rad_lightmap_sample(src->lm, 3, src->lm_values, u, v, gathered + 3 * k);
             }
-            render_vp_gather_seconds += tool_seconds() - tg;
+            src->gather_seconds += tool_seconds() - tg;
         } else if (gathered && nvalid > 0) {
             double tg = tool_seconds();
-            r = render_hr ? hr_lookup(hits, valid, nvalid, gathered)
-                          : rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
-            render_vp_gather_seconds += tool_seconds() - tg;
+            r = src->hr ? hr_lookup(src->hr, hits, valid, nvalid, gathered)
+                        : rad_vp_gather(src->vp, src->vp_H, points, normals, nvalid, gathered, &quiet);
+            src->gather_seconds += tool_seconds() - tg;
             if (r != RAD_SUCCESS) {
                 result = tool_fail("render", "rad_vp_gather", r);
                 break;
@@ -353,7 +376,7 @@ static int render_classic(const tool_world *w, const rad_patches *P, const float
                 for (i = 0; i < 3; ++i) shade_v[3 * k + i] = -ry->dir[i] / len;
                 rad_scene_albedo(scene, hits[valid[k]].triangle, hits[valid[k]].b1, hits[valid[k]].b2, shade_a + 3 * k);
             }
-            if (tool_shade_direct(w, render_shading, light_samples, points, normals, shade_v, shade_a, nvalid, shaded)) {
+            if (tool_shade_direct(w, view->shading, light_samples, points, normals, shade_v, shade_a, nvalid, shaded)) {
                 result = 1;
                 break;
             }
@@ -458,11 +481,15 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
    product) or alias tables (--frames steps), then the classic pixel pipeline (per-pixel direct
    light + interpolated H). --sequence writes every --every-th frame (and the last) as a PNG. */
 static int render_method(const char *cmd, const tool_world *w, const rad_bake *bake, const char *bake_name,
-                         const tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
-                         uint32_t light_samples, float exposure, tool_image *img)
+                         const render_args *ra, tool_image *img)
 {
+    const tool_method_options *mo = &ra->mo;
+    const render_view *view = &ra->view;
+    int width = view->width, height = view->height;
+    float exposure = view->exposure;
     tool_indirect *m = NULL;
     const rad_patches *P = &bake->patches;
+    render_source src;
     uint32_t frames = mo->method == TOOL_TEMPORAL ? mo->frames : 1u, f;
     /* multibounce: the product is repeated (same result each time) so its time is a median */
     uint32_t reps = mo->method == TOOL_TEMPORAL ? frames : 9u;
@@ -473,6 +500,9 @@ static int render_method(const char *cmd, const tool_world *w, const rad_bake *b
     times = (double *)xmalloc(sizeof(double) * reps);
     H = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->count);
     Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
+    memset(&src, 0, sizeof src);
+    src.P = P;
+    src.Hv = Hv;
 #if defined(__unix__) || defined(__APPLE__)
     if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
 #endif
@@ -492,7 +522,7 @@ static int render_method(const char *cmd, const tool_world *w, const rad_bake *b
                 rc = 1;
             }
             if (rc == 0) rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
-            if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, &frame);
+            if (rc == 0) rc = render_classic(w, view, &src, &frame);
             if (rc == 0 && tool_image_write_png(path, &frame, exposure) != 0) {
                 fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
                 rc = 1;
@@ -513,7 +543,7 @@ static int render_method(const char *cmd, const tool_world *w, const rad_bake *b
             fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
         rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
     }
-    if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, img);
+    if (rc == 0) rc = render_classic(w, view, &src, img);
     if (rc == 0 && mo->sequence) {
         char path[4096];
         snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
@@ -554,11 +584,10 @@ static void bake_load_failed(const char *cmd, const char *path, rad_result r)
 }
 
 /* the bake (--bake, checked against the scene) or one made here, then render_method */
-static int render_with_method(const char *cmd, const tool_world *w, const char *bake_path,
-                              const tool_classic_options *o, const tool_method_options *mo,
-                              const rad_camera *cam, int width, int height, uint32_t aa, uint32_t light_samples,
-                              float exposure, tool_image *img)
+static int render_with_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
+    const char *bake_path = ra->bake;
+    const tool_method_options *mo = &ra->mo;
     rad_bake *bake = NULL;
     void *buf = NULL;
     size_t size = 0;
@@ -581,7 +610,7 @@ static int render_with_method(const char *cmd, const tool_world *w, const char *
             return 1;
         }
     } else {
-        if (tool_method_bake(cmd, w, o, mo, &buf, &size)) return 1;
+        if (tool_method_bake(cmd, w, &ra->o, mo, &buf, &size)) return 1;
         if ((r = rad_load_memory(buf, size, &ctx, &bake)) != RAD_SUCCESS) {
             free(buf);
             return tool_fail(cmd, "rad_load_memory", r);
@@ -589,7 +618,7 @@ static int render_with_method(const char *cmd, const tool_world *w, const char *
         bake_path = "(made here)";
     }
     bake->patches.scene = w->scene;
-    rc = render_method(cmd, w, bake, bake_path, mo, cam, width, height, aa, light_samples, exposure, img);
+    rc = render_method(cmd, w, bake, bake_path, ra, img);
     rad_bake_destroy(bake);
     free(buf);
     return rc;
@@ -766,11 +795,11 @@ done:
    per pixel from the moved light), and the last. The light ends where the last frame puts it,
    so the final image (rendered by the caller from E and L) is that frame. Stage times: their
    medians. */
-static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad_virtual_patches *vp, float *E,
-                                 const tool_method_options *mo, const rad_camera *cam, int width, int height,
-                                 uint32_t aa, uint32_t light_samples, uint32_t patch_light_samples, float exposure,
-                                 float *L, double *step_seconds)
+static int proxy_temporal_frames(const char *cmd, const tool_world *w, const render_args *ra,
+                                 const rad_virtual_patches *vp, float *E, float *L, double *step_seconds)
 {
+    const tool_method_options *mo = &ra->mo;
+    int width = ra->view.width, height = ra->view.height;
     rad_alias_tables *tables = NULL;
     const rad_alias_tables *tp1[1];
     rad_temporal *tp = NULL;
@@ -811,7 +840,7 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad
     rad_vp_lights_options_default(&lo);
     lo.rays_per_frame = mo->light_rays;
     lo.direct.exclude_emitters = 0;
-    lo.direct.light_samples = patch_light_samples; /* as rad_vp_sources got them for the still image */
+    lo.direct.light_samples = ra->o.light_samples; /* as rad_vp_sources got them for the still image */
 #if defined(__unix__) || defined(__APPLE__)
     if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
 #endif
@@ -841,6 +870,7 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad
         if (mo->sequence && (f % mo->every == 0 || f == frames)) { /* the last one too, as render_method */
             char path[4096];
             tool_image frame;
+            render_source src;
             memset(&frame, 0, sizeof frame);
             for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
             if ((r = rad_matrix_multiply(&vp->matrix, B, H, &ctx)) != RAD_SUCCESS) { what = "rad_matrix_multiply"; goto done; }
@@ -850,10 +880,11 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad
                 rc = 1;
                 goto done;
             }
-            render_vp = vp, render_vp_H = H;
-            rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, &frame);
-            render_vp = NULL, render_vp_H = NULL;
-            if (rc == 0 && tool_image_write_png(path, &frame, exposure) != 0) {
+            memset(&src, 0, sizeof src);
+            src.vp = vp;
+            src.vp_H = H;
+            rc = render_classic(w, &ra->view, &src, &frame);
+            if (rc == 0 && tool_image_write_png(path, &frame, ra->view.exposure) != 0) {
                 fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
                 rc = 1;
             }
@@ -944,11 +975,13 @@ fail:
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
-static int render_vp_method(const char *cmd, const tool_world *w, const char *bake_path,
-                            const tool_classic_options *o, const tool_method_options *mo, const rad_camera *cam,
-                            int width, int height, uint32_t aa, uint32_t light_samples, float exposure, tool_image *img)
+static int render_vp_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
+    const char *bake_path = ra->bake;
+    const tool_classic_options *o = &ra->o;
+    const tool_method_options *mo = &ra->mo;
     rad_virtual_patches *vp = NULL;
+    render_source src;
     rad_direct_options dopt;
     rad_solve_options so;
     rad_solve_stats stats;
@@ -1001,11 +1034,10 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
         t0 = tool_seconds();
         if (mo->proxy && mo->method == TOOL_TEMPORAL && (mo->light_path || mo->sequence)) {
             r = RAD_SUCCESS;
-            if (proxy_temporal_frames(cmd, w, vp, E, mo, cam, width, height, aa, light_samples, o->light_samples, exposure,
-                                      L, &t_step)) rc = 1;
+            if (proxy_temporal_frames(cmd, w, ra, vp, E, L, &t_step)) rc = 1;
         } else if (mo->proxy) {
             r = RAD_SUCCESS;
-            if (proxy_indirect(cmd, vp, E, mo, cam, L, &t_step)) rc = 1;
+            if (proxy_indirect(cmd, vp, E, mo, &ra->view.cam, L, &t_step)) rc = 1;
         } else if (mo->bounces == RAD_MB_INFINITE) {
             r = rad_solve_gauss_seidel(&sys, &so, L, &stats, &ctx);
             if (r == RAD_ERROR_NOT_CONVERGED) {
@@ -1026,10 +1058,11 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
         if (r != RAD_SUCCESS) rc = tool_fail(cmd, "solve", r);
     }
     if (rc == 0) {
-        render_vp = vp, render_vp_H = H, render_vp_gather_seconds = 0.0;
+        memset(&src, 0, sizeof src);
+        src.vp = vp;
+        src.vp_H = H;
         t0 = tool_seconds();
-        rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
-        render_vp = NULL, render_vp_H = NULL;
+        rc = render_classic(w, &ra->view, &src, img);
         /* one line for scripts: step = the solve (K bounces + H = F B) as classic's */
         if (rc == 0) {
             fprintf(stderr, "rad %s: timing: method=%s%s patches=%u frames=%u bounces=%s%.0u step_ms_median=%.6f "
@@ -1040,7 +1073,7 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
                     mo->proxy && mo->method == TOOL_TEMPORAL ? mo->frames : 1u,
                     mo->bounces == RAD_MB_INFINITE ? "inf" : "",
                     mo->bounces == RAD_MB_INFINITE ? 0u : mo->bounces,
-                    1e3 * t_step, 1e3 * t_step, 1e3 * t_build, 1e3 * t_E, 1e3 * render_vp_gather_seconds,
+                    1e3 * t_step, 1e3 * t_step, 1e3 * t_build, 1e3 * t_E, 1e3 * src.gather_seconds,
                     1e3 * (tool_seconds() - t0), res, (double)rad_vp_memory(vp) / 1048576.0, peak_rss_mib());
         }
     }
@@ -1054,21 +1087,20 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
 
 /* --method hierarchical: the solution (tool_hierarchical_build), then the classic render
    with H looked up at each sample */
-static int render_hr_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
-                            const tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
-                            uint32_t light_samples, tool_image *img)
+static int render_hr_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
     rad_hierarchical *h = NULL;
+    render_source src;
     rad_hierarchical_stats st;
     double t0 = tool_seconds(), t_solve;
     int rc;
-    if (tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) return 1;
+    if (tool_hierarchical_build(cmd, w, &ra->mo, ra->o.light_samples, &h)) return 1;
     t_solve = tool_seconds() - t0;
     rad_hierarchical_get_stats(h, &st);
-    render_hr = h;
+    memset(&src, 0, sizeof src);
+    src.hr = h;
     t0 = tool_seconds();
-    rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
-    render_hr = NULL;
+    rc = render_classic(w, &ra->view, &src, img);
     if (rc == 0)
         fprintf(stderr, "rad %s: timing: method=hierarchical patches=%u frames=1 step_ms_median=%.6f step_ms_min=%.6f "
                         "links=%llu kernels=%llu rays=%llu render_ms=%.1f\n",
@@ -1081,11 +1113,13 @@ static int render_hr_method(const char *cmd, const tool_world *w, const tool_cla
 /* --method local: the classic patches, F and E; a local matrix of capacity M over F's
    rows filled with the M patches nearest the camera (rad_local_rebuild), L = T E over P_Vis x
    P_Lit, H = L / rho (L = rho F (E + L) within the set), rendered as classic. */
-static int render_local_method(const char *cmd, const tool_world *w, const tool_classic_options *oc,
-                               const tool_method_options *mo, const rad_camera *cam, int width, int height,
-                               uint32_t aa, uint32_t light_samples, tool_image *img)
+static int render_local_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
-    tool_classic_options o = *oc;
+    tool_classic_options o = ra->o;
+    const tool_method_options *mo = &ra->mo;
+    const rad_camera *cam = &ra->view.cam;
+    int width = ra->view.width, height = ra->view.height;
+    render_source view_src;
     tool_classic sol;
     rad_local_options lo;
     rad_local *local = NULL;
@@ -1154,7 +1188,10 @@ static int render_local_method(const char *cmd, const tool_world *w, const tool_
         for (i = 0; i < 3 * n; ++i) H[i] = albedo[i] > 0.0f ? L[i] / albedo[i] : 0.0f;
         Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)sol.patches->vertex_count);
         rc = vertex_H(sol.patches, &sol.ff->matrix, H, Hv);
-        if (rc == 0) rc = render_classic(w, sol.patches, Hv, cam, width, height, aa, light_samples, img);
+        memset(&view_src, 0, sizeof view_src);
+        view_src.P = sol.patches;
+        view_src.Hv = Hv;
+        if (rc == 0) rc = render_classic(w, &ra->view, &view_src, img);
     }
     rad_local_destroy(local);
     free(areas);
@@ -1171,20 +1208,26 @@ static int render_local_method(const char *cmd, const tool_world *w, const tool_
 
 static int render_main(int argc, char **argv, tool_lights *lights)
 {
-    const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
-    tool_classic_options o;
-    tool_method_options mo;
+    const char *cmd = "render", *method;
+    render_args ra;
     tool_world w;
-    rad_camera cam;
     tool_image img;
     rad_context ctx;
-    int width = 512, height = 512, a, rc, have_cam = 0, pathtrace;
-    uint32_t aa = 16, spp = 64, seed = 0, threads = 0, pixel_light_samples = 16;
-    int lightmap_opts = 0;
-    float fov = 0.0f, exposure = 1.0f;
+    int a, rc, pathtrace;
+    uint32_t seed = 0;
     double t0 = tool_seconds();
+    /* the locals of the parse, as the option table will name them */
+    const char *scene_name = NULL, *out_path = NULL, *bake_path = NULL;
+    tool_classic_options o;
+    tool_method_options mo;
+    rad_camera cam;
+    int width = 512, height = 512, have_cam = 0, lightmap_opts = 0, lm_size_given = 0, shading = -1;
+    uint32_t aa = 16, spp = 64, threads = 0, pixel_light_samples = 16, lm_size = 256, lm_samples = 4, lm_vis = 2,
+             final_gather = 0;
+    float fov = 0.0f, exposure = 1.0f;
     tool_classic_options_default(&o);
     tool_method_options_default(&mo);
+    memset(&ra, 0, sizeof ra);
     memset(&img, 0, sizeof img);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
@@ -1230,20 +1273,20 @@ static int render_main(int argc, char **argv, tool_lights *lights)
             if (tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
             if (pixel_light_samples == 0 || pixel_light_samples > 65536) { fprintf(stderr, "rad %s: %s must be 1 to 65536\n", cmd, opt); return 2; }
         } else if (!strcmp(opt, "--lightmap-size") || !strcmp(opt, "--texel-samples") || !strcmp(opt, "--visibility-rays")) {
-            uint32_t *dst = opt[2] == 'l' ? &render_lm_size : opt[2] == 't' ? &render_lm_samples : &render_lm_vis;
+            uint32_t *dst = opt[2] == 'l' ? &lm_size : opt[2] == 't' ? &lm_samples : &lm_vis;
             uint32_t lo = opt[2] == 'l' ? 4u : 1u, hi = opt[2] == 'l' ? 16384u : opt[2] == 't' ? 16u : 64u;
             if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
             if (*dst < lo || *dst > hi) { fprintf(stderr, "rad %s: %s must be %u to %u\n", cmd, opt, lo, hi); return 2; }
-            if (opt[2] == 'l') render_lm_size_given = 1;
+            if (opt[2] == 'l') lm_size_given = 1;
             lightmap_opts = 1;
         } else if (!strcmp(opt, "--final-gather")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &render_final_gather)) return 2;
-            if (render_final_gather > 4096) { fprintf(stderr, "rad %s: %s is at most 4096\n", cmd, opt); return 2; }
+            if (tool_parse_uint(cmd, opt, argv[++a], &final_gather)) return 2;
+            if (final_gather > 4096) { fprintf(stderr, "rad %s: %s is at most 4096\n", cmd, opt); return 2; }
         } else if (!strcmp(opt, "--exposure")) {
             if (tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
             if (!(exposure > 0.0f)) { fprintf(stderr, "rad %s: --exposure must be > 0\n", cmd); return 2; }
         } else if (!strcmp(opt, "--shading")) {
-            if (tool_parse_shading(cmd, argv[++a], &render_shading)) return 2;
+            if (tool_parse_shading(cmd, argv[++a], &shading)) return 2;
         } else if (!strcmp(opt, "--threads")) {
             if (tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
         } else if (opt[0] == '-' && opt[1]) {
@@ -1262,7 +1305,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         fprintf(stderr, "rad %s: --lightmap-size, --texel-samples and --visibility-rays are for --method lightmap\n", cmd);
         return 2;
     }
-    if (mo.method == TOOL_LIGHTMAP && (bake_path || render_final_gather)) {
+    if (mo.method == TOOL_LIGHTMAP && (bake_path || final_gather)) {
         fprintf(stderr, "rad %s: --method lightmap bakes its own lightmap: %s is not used\n", cmd,
                 bake_path ? "--bake" : "--final-gather");
         return 2;
@@ -1271,7 +1314,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     method = tool_method_name(mo.method);
     seed = mo.seed;
     pathtrace = mo.method == TOOL_PATHTRACE;
-    if (pathtrace && render_shading >= 0) {
+    if (pathtrace && shading >= 0) {
         fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
@@ -1316,6 +1359,28 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         else tool_choose_camera(cmd, w.scene, &w.rc, width, height, &cam);
     } else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
     if (fov > 0.0f) cam.fov_y_degrees = fov;
+    ra.scene = scene_name;
+    ra.out = out_path;
+    ra.bake = bake_path;
+    ra.o = o;
+    ra.mo = mo;
+    ra.view.cam = cam;
+    ra.view.width = width;
+    ra.view.height = height;
+    ra.view.aa = aa;
+    ra.view.light_samples = pixel_light_samples;
+    ra.view.exposure = exposure;
+    ra.view.shading = shading;
+    ra.view.final_gather = final_gather;
+    ra.have_camera = have_cam;
+    ra.fov = fov;
+    ra.spp = spp;
+    ra.threads = threads;
+    ra.lm_size = lm_size;
+    ra.lm_samples = lm_samples;
+    ra.lm_vis = lm_vis;
+    ra.lm_size_given = lm_size_given;
+    ra.lightmap_opts = lightmap_opts;
     if (tool_image_alloc(&img, width, height) != 0) {
         fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
         tool_close_world(&w);
@@ -1324,24 +1389,25 @@ static int render_main(int argc, char **argv, tool_lights *lights)
 
     if (mo.method == TOOL_LIGHTMAP) {
         tool_lightmap_baked bk;
-        int lsz = (int)render_lm_size;
+        int lsz = (int)lm_size;
+        render_source src;
         tool_lightmap_proxy px;
         memset(&px, 0, sizeof px);
         px.kind = (int)mo.proxy;
         px.resolution = mo.vp_resolution;
         px.face_points = mo.face_points;
-        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, !render_lm_size_given, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0,
+        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, !lm_size_given, lm_samples, lm_vis, -1, 256, 0, 0, 0,
                                 mo.proxy ? &px : NULL, &bk);
         if (rc == 0) {
             fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                             "step_ms_min=%.6f\n",
                     cmd, mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : mo.proxy ? " proxy=aavp" : "", bk.patches, o.bounces,
                     1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
-            render_lm = bk.lm;
-            render_lm_values = bk.values;
-            rc = render_classic(&bk.w, bk.cl.patches, NULL, &cam, width, height, aa, pixel_light_samples, &img);
-            render_lm = NULL;
-            render_lm_values = NULL;
+            memset(&src, 0, sizeof src);
+            src.P = bk.cl.patches;
+            src.lm = bk.lm;
+            src.lm_values = bk.values;
+            rc = render_classic(&bk.w, &ra.view, &src, &img);
             tool_lightmap_bake_free(&bk);
         }
         if (rc) {
@@ -1351,11 +1417,10 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         }
     } else if ((mo.method >= TOOL_LOCAL && !(mo.method == TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
         rc = mo.method == TOOL_LOCAL && !mo.proxy
-                 ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
+                 ? render_local_method(cmd, &w, &ra, &img)
              : mo.method == TOOL_HIERARCHICAL
-                 ? render_hr_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
-                 : render_vp_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
-                                    &img);
+                 ? render_hr_method(cmd, &w, &ra, &img)
+                 : render_vp_method(cmd, &w, &ra, &img);
         if (rc) {
             tool_image_free(&img);
             tool_close_world(&w);
@@ -1363,8 +1428,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         }
     } else if (mo.method == TOOL_MULTIBOUNCE || mo.method == TOOL_TEMPORAL || mo.method == TOOL_STOCHASTIC ||
                mo.method == TOOL_HIERARCHICAL) { /* hierarchical here: from a bake (resampled onto its patches) */
-        rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
-                                &img);
+        rc = render_with_method(cmd, &w, &ra, &img);
         if (rc) {
             tool_image_free(&img);
             tool_close_world(&w);
@@ -1392,6 +1456,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         const rad_patches *P;
         const float *H;
         float *Hv, *Hmine = NULL;
+        render_source src;
         memset(&sol, 0, sizeof sol);
         if (bake_path) {
             const rad_section *hs;
@@ -1449,7 +1514,10 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         }
         Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
         rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
-        if (rc == 0) rc = render_classic(&w, P, Hv, &cam, width, height, aa, pixel_light_samples, &img);
+        memset(&src, 0, sizeof src);
+        src.P = P;
+        src.Hv = Hv;
+        if (rc == 0) rc = render_classic(&w, &ra.view, &src, &img);
         free(Hv);
         free(Hmine);
         rad_bake_destroy(bake);
