@@ -222,6 +222,46 @@ int tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t
 int tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
 double tool_seconds(void);
 
+/* ---- option tables (options.c) ------------------------------------------------------------ */
+/* A command's options as a table of tool_arg rows ending with a TOOL_ARG_END row: each row is an
+   option (its name, the value's placeholder, the field it fills in the options struct the
+   command passes, the range it accepts, its bit in the struct's 'given' mask) and its help
+   text, so that the parser and the --help of a command are the same table. */
+typedef enum tool_arg_kind {
+    TOOL_ARG_END = 0,  /* ends the table */
+    TOOL_ARG_TEXT,     /* no option: help text printed as it is (a heading, a paragraph) */
+    TOOL_ARG_FLAG,     /* no value: stores the int (int)lo in the field */
+    TOOL_ARG_UINT,     /* a whole number in [lo, hi] into a uint32_t */
+    TOOL_ARG_FLOAT,    /* a number in [lo, hi] (flags: either end open) into a float */
+    TOOL_ARG_STRING,   /* the text itself into a const char * */
+    TOOL_ARG_CHOICE,   /* one of the '|'-separated 'choices': values[i] (NULL: i) into a uint32_t */
+    TOOL_ARG_CUSTOM    /* 'parse' reads the value */
+} tool_arg_kind;
+enum { TOOL_ARG_LO_OPEN = 1, TOOL_ARG_HI_OPEN = 2, TOOL_ARG_NONEMPTY = 4 };
+typedef struct tool_arg tool_arg;
+/* parses 'value' of option t into field (the target's field); 0, or 2 after printing why */
+typedef int (*tool_arg_parse_fn)(const char *cmd, const tool_arg *t, const char *value, void *field);
+struct tool_arg {
+    tool_arg_kind kind;
+    const char *name;        /* "--k" */
+    const char *value;       /* its placeholder in the help ("K"; NULL for a flag) */
+    size_t field;            /* offsetof the field in the target struct */
+    double lo, hi;           /* UINT, FLOAT: the range; FLAG: lo is the value stored */
+    unsigned flags;          /* TOOL_ARG_LO_OPEN ... */
+    uint32_t given;          /* bits or-ed into *given when the option is taken */
+    const char *bad;         /* out of range: "rad CMD: NAME <bad>, not VALUE" */
+    const char *choices;     /* CHOICE: "a|b|c" */
+    const uint32_t *values;  /* CHOICE: the value of each choice (NULL: its index) */
+    tool_arg_parse_fn parse; /* CUSTOM */
+    unsigned where;          /* help only: the contexts that list it (0: every one) */
+    const char *help;        /* its text; lines after the first are indented to the first's column */
+};
+/* argv[*a] is an option of the table: parses it (and its value, advancing *a) into target and
+   returns 1; 0 when it is not one; 2 on a bad value or a missing one (message printed) */
+int tool_args_parse(const char *cmd, const tool_arg *table, void *target, uint32_t *given, int argc, char **argv, int *a);
+/* the table's help for the context 'where' (0: every row) into buf, truncated to size bytes */
+void tool_args_help_into(const tool_arg *table, unsigned where, char *buf, size_t size);
+
 /* ---- lights from the command line (lights.c) ------------------------------------------- */
 /* --area P:U:V:RGB: an emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB */
 typedef struct tool_area_light {
@@ -408,7 +448,7 @@ typedef struct tool_method_options {
     int reorder;              /* --reorder / --no-reorder (default on) */
     uint32_t reorder_samples; /* --reorder-samples N (0: exact, the default) */
     uint32_t tile;            /* --tile T: scales per T x T texels, 0: per matrix (default 64) */
-    rad_temporal_mode mode;   /* --mode feedback|single|multibounce (default feedback) */
+    uint32_t mode;            /* --mode feedback|single|multibounce: a rad_temporal_mode (default feedback) */
     uint32_t k;               /* --k K: draws per row and frame (default 10) */
     float w;                  /* --w W: a fixed blend weight (0.998 when --w is not given; unused then) */
     int adaptive;             /* --adaptive: per-row weight (the default; --w W turns it off) */
@@ -469,7 +509,9 @@ int tool_method_option(const char *cmd, int argc, char **argv, int *a, tool_meth
 /* After parsing: rejects options that do not apply to mo->method (and render-only options
    when !render), moves a finite --bounces into o->bounces for classic; 0 or 2 (printed). */
 int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool_classic_options *o);
+/* the help of the options above for rad render (render 1) or rad bake (0) */
 const char *tool_method_help(int render);
+enum { TOOL_METHOD_HELP_RENDER = 1, TOOL_METHOD_HELP_BAKE = 2 };
 const char *tool_method_name(tool_method method);
 /* --method hierarchical: rad_hierarchical_create and solve over the world with E = rho D at
    the elements' centroids (D: rad_direct_irradiance with light_samples shadow rays, emitters
