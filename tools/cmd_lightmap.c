@@ -122,10 +122,12 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     tool_classic_options co;
     tool_world w;
     tool_lightmap_baked bk;
+    tool_lightmap_request rq;
     const rad_lightmap *lm = NULL;
-    int width = 256, height = 256, size_given = 0, sh = 0, force_unwrap = 0, a, code = 1;
-    uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
-    int gather = -1; /* -1: by the work, else a rad_lightmap_gather_method */
+    int width = TOOL_LIGHTMAP_SIZE, height = TOOL_LIGHTMAP_SIZE, size_given = 0, sh = 0, force_unwrap = 0, a, code = 1;
+    uint32_t threads = 0, texel_samples = TOOL_LIGHTMAP_TEXEL_SAMPLES, vis = TOOL_LIGHTMAP_VISIBILITY_RAYS, i, ch,
+             hemi_rays = TOOL_LIGHTMAP_HEMISPHERE_RAYS;
+    int gather = TOOL_LIGHTMAP_GATHER_AUTO; /* else a rad_lightmap_gather_method */
     tool_lightmap_proxy px;
     int px_opts = 0, hr_opts = 0;
     const float *values = NULL;
@@ -278,9 +280,19 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
         for (k = 0; k < 4; ++k) free(layers[k]);
         if (bad) return 1;
     }
-    if (tool_lightmap_bake("lightmap", &w, &co, width, height, !size_given, texel_samples, vis, gather, hemi_rays, sh,
-                           force_unwrap, !sh, px.kind ? &px : NULL, &bk))
-        goto done;
+    tool_lightmap_request_default(&rq);
+    rq.width = width;
+    rq.height = height;
+    rq.auto_size = !size_given;
+    rq.texel_samples = texel_samples;
+    rq.visibility_rays = vis;
+    rq.gather = gather;
+    rq.hemisphere_rays = hemi_rays;
+    rq.sh = sh;
+    rq.force_unwrap = force_unwrap;
+    rq.direct = !sh;
+    rq.proxy = px.kind ? &px : NULL;
+    if (tool_lightmap_bake("lightmap", &w, &co, &rq, &bk)) goto done;
     width = (int)bk.lm->width; /* the unwrap may have chosen a larger atlas */
     height = (int)bk.lm->height;
     lm = bk.lm;

@@ -1389,15 +1389,20 @@ static int render_main(int argc, char **argv, tool_lights *lights)
 
     if (mo.method == TOOL_LIGHTMAP) {
         tool_lightmap_baked bk;
-        int lsz = (int)lm_size;
+        tool_lightmap_request rq;
         render_source src;
         tool_lightmap_proxy px;
         memset(&px, 0, sizeof px);
         px.kind = (int)mo.proxy;
         px.resolution = mo.vp_resolution;
         px.face_points = mo.face_points;
-        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, !lm_size_given, lm_samples, lm_vis, -1, 256, 0, 0, 0,
-                                mo.proxy ? &px : NULL, &bk);
+        tool_lightmap_request_default(&rq);
+        rq.width = rq.height = (int)lm_size;
+        rq.auto_size = !lm_size_given;
+        rq.texel_samples = lm_samples;
+        rq.visibility_rays = lm_vis;
+        rq.proxy = mo.proxy ? &px : NULL;
+        rc = tool_lightmap_bake(cmd, &w, &o, &rq, &bk);
         if (rc == 0) {
             fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                             "step_ms_min=%.6f\n",

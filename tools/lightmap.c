@@ -21,10 +21,22 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b)
     memset(b, 0, sizeof *b);
 }
 
-int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
-                           int height, int auto_size, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
-                           int force_unwrap, int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out)
+void tool_lightmap_request_default(tool_lightmap_request *rq)
 {
+    memset(rq, 0, sizeof *rq);
+    rq->width = rq->height = TOOL_LIGHTMAP_SIZE;
+    rq->texel_samples = TOOL_LIGHTMAP_TEXEL_SAMPLES;
+    rq->visibility_rays = TOOL_LIGHTMAP_VISIBILITY_RAYS;
+    rq->gather = TOOL_LIGHTMAP_GATHER_AUTO;
+    rq->hemisphere_rays = TOOL_LIGHTMAP_HEMISPHERE_RAYS;
+}
+
+int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co,
+                       const tool_lightmap_request *rq, tool_lightmap_baked *out)
+{
+    int width = rq->width, height = rq->height, gather = rq->gather, sh = rq->sh;
+    uint32_t texel_samples = rq->texel_samples, vis = rq->visibility_rays, hemi_rays = rq->hemisphere_rays;
+    const tool_lightmap_proxy *proxy = rq->proxy;
     tool_classic_options co2 = *co;
     float *vp_H = NULL;
     double t_all = tool_seconds();
@@ -54,8 +66,8 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     co = &co2;
     if (!proxy && tool_dense_check(cmd, co, w->scene->triangle_count, 1)) return 1;
     /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
-    if (force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
-        if (!force_unwrap && w->scene->lightmap_uvs)
+    if (rq->force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
+        if (!rq->force_unwrap && w->scene->lightmap_uvs)
             fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
         uint32_t uw = (uint32_t)width, uh = (uint32_t)height;
         tool_unwrap_auto au;
@@ -64,11 +76,11 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
            the samples (position, normal, triangle, validity: 29 bytes each) and the values
            with one working copy, plus an RGB image of the atlas */
         au.max_side = TOOL_LIGHTMAP_AUTO_MAX;
-        au.bytes_per_texel = 29.0 + 29.0 * (texel_samples ? texel_samples : 4u) + 8.0 * (sh ? 12.0 : 3.0) + 12.0;
+        au.bytes_per_texel = TOOL_LIGHTMAP_TEXEL_BYTES(texel_samples ? texel_samples : TOOL_LIGHTMAP_TEXEL_SAMPLES, sh ? 12u : 3u);
         if (co->max_memory > 0.0) au.memory_limit = co->max_memory, au.memory_from = "--max-memory";
         else au.memory_limit = tool_mem_available(), au.memory_from = "MemAvailable in /proc/meminfo";
         if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, &uw, &uh,
-                        auto_size ? &au : NULL, out->uvs, NULL))
+                        rq->auto_size ? &au : NULL, out->uvs, NULL))
             goto fail;
         width = (int)uw;
         height = (int)uh;
@@ -148,8 +160,10 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         if (r != RAD_SUCCESS) { tool_fail(cmd, out->hr ? "rad_lightmap_gather_hierarchical" : "rad_lightmap_gather_vp", r); goto fail; }
     } else {
         /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
-        if (gather < 0)
-            gather = (double)out->lm->sample_count * out->cl.patches->count > 2e7 ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
+        if (gather == TOOL_LIGHTMAP_GATHER_AUTO)
+            gather = (double)out->lm->sample_count * out->cl.patches->count > TOOL_LIGHTMAP_EXACT_MAX_PAIRS
+                         ? RAD_LIGHTMAP_GATHER_HEMISPHERE
+                         : RAD_LIGHTMAP_GATHER_EXACT;
         go.method = (rad_lightmap_gather_method)gather;
         if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
             fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, hemi_rays);
@@ -158,7 +172,7 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         tool_progress_end();
         if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
     }
-    if (direct && !sh) {
+    if (rq->direct && !sh) {
         rad_direct_options dopt;
         rad_direct_options_default(&dopt);
         dopt.exclude_emitters = 0;

@@ -689,22 +689,45 @@ typedef struct tool_lightmap_baked {
     float *uvs;              /* the unwrap's lightmap uvs, or NULL */
     int own_scene;           /* w.scene and w.bvh are ours */
 } tool_lightmap_baked;
-/* Solves the classic method (proxy NULL) or virtual patches (E = rho D at their samples, K
+/* rad lightmap's defaults: atlas side, sample points per texel, shadow rays per sample point
+   and patch, rays per texel of the hemisphere gather */
+#define TOOL_LIGHTMAP_SIZE 256
+#define TOOL_LIGHTMAP_TEXEL_SAMPLES 4u
+#define TOOL_LIGHTMAP_VISIBILITY_RAYS 2u
+#define TOOL_LIGHTMAP_HEMISPHERE_RAYS 256u
+/* tool_lightmap_request.gather: choose by the work, the exact gather up to this many
+   sample-patch pairs (its cost grows with them; the hemisphere gather's does not) */
+#define TOOL_LIGHTMAP_GATHER_AUTO (-1)
+#define TOOL_LIGHTMAP_EXACT_MAX_PAIRS 2e7
+/* bytes a texel of the bake holds at its peak, for the automatic atlas size's memory check:
+   the texel record and its samples' records, the gathered values (channels floats, twice) */
+#define TOOL_LIGHTMAP_TEXEL_BYTES(samples, channels) (29.0 + 29.0 * (double)(samples) + 8.0 * (double)(channels) + 12.0)
+/* What tool_lightmap_bake makes (tool_lightmap_request_default: the defaults above, RGB
+   without direct light, over the file's uv set, classic patches) */
+typedef struct tool_lightmap_request {
+    int width, height;           /* atlas texels */
+    int auto_size;               /* the user gave no size: an unwrap whose charts do not fit width x
+                                    height gets a larger atlas (tool_unwrap_auto; the bake's lm has
+                                    the size used) */
+    uint32_t texel_samples;      /* sample points per texel */
+    uint32_t visibility_rays;    /* shadow rays per sample point and patch */
+    int gather;                  /* a rad_lightmap_gather_method, or TOOL_LIGHTMAP_GATHER_AUTO */
+    uint32_t hemisphere_rays;    /* rays per texel of the hemisphere gather */
+    int sh;                      /* L1 SH of the indirect light instead of RGB irradiance */
+    int force_unwrap;            /* unwrap even when the file has a second uv set */
+    int direct;                  /* RGB: add the direct light of the lights and emitters per texel */
+    const tool_lightmap_proxy *proxy; /* the indirect light from a proxy (NULL: classic patches) */
+} tool_lightmap_request;
+void tool_lightmap_request_default(tool_lightmap_request *rq);
+/* Solves the classic method (rq->proxy NULL) or virtual patches (E = rho D at their samples, K
    Jacobi bounces of --bounces, Gauss-Seidel with --solver gauss-seidel, H = F (E + L)) over
-   the lightmapped world (the file's second uv set, else the unwrap) and bakes: texels, gather
-   (classic: of B, sh: L1 SH, else RGB irradiance; proxy: rad_lightmap_gather_vp of H, RGB
-   only), with direct != 0 and RGB the direct light of the lights and emitters added per
-   texel, dilation, stitching. Without a proxy a scene whose dense build would be refused is
-   refused before the unwrap, naming --proxy aavp. gather: a rad_lightmap_gather_method, or -1
-   to choose by the work (the hemisphere gather with hemisphere_rays rays a texel past 2e7
-   sample-patch pairs). auto_size: the user gave no size, so an unwrap whose charts do not fit
-   width x height gets a larger atlas (tool_unwrap_auto; out->lm has the size used). 0, or 1
-   after printing why (out freed). Free with
-   tool_lightmap_bake_free. */
-int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
-                           int height, int auto_size, uint32_t texel_samples, uint32_t visibility_rays, int gather,
-                           uint32_t hemisphere_rays, int sh, int force_unwrap,
-                           int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out);
+   the lightmapped world (the file's second uv set, else the unwrap) and bakes rq: texels,
+   gather (classic: of B, sh: L1 SH, else RGB irradiance; proxy: rad_lightmap_gather_vp of H,
+   RGB only), the direct light per texel when asked, dilation, stitching. Without a proxy a
+   scene whose dense build would be refused is refused before the unwrap, naming --proxy aavp.
+   0, or 1 after printing why (out freed). Free with tool_lightmap_bake_free. */
+int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co,
+                       const tool_lightmap_request *rq, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
 
 #endif
