@@ -52,44 +52,6 @@ static void *xmalloc(size_t size)
     return p;
 }
 
-static void render_usage(FILE *f)
-{
-    fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm|OUT.exr [--method classic|multibounce|temporal|local|stochastic|vp|aavp|hierarchical|lightmap|pathtrace] [options]\n"
-            "  -o FILE            output image: .pfm or .exr (linear radiance; .exr needs libtinyexr-dev at build) or .png\n"
-            "                     (sRGB, exposure applied)\n"
-            "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
-            "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
-            "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
-            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991), lightmap (classic,\n"
-            "                     or virtual patches with --proxy aavp|vp, baked into a lightmap, the indirect\n"
-            "                     light looked up per pixel)\n"
-            "  --bake FILE.radb   classic, multibounce, temporal, stochastic, hierarchical: use a bake of\n"
-            "                     that method made by\n"
-            "                     'rad bake' from this scene instead of computing it here\n"
-            "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
-            "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
-            "  --size WxH         image size (default 512x512; at most 2 GiB of image: 12 bytes a pixel)\n"
-            "  --aa N             radiosity methods: stratified samples per pixel, rounded down to a square (default 16, 1 to 65536)\n"
-            "  --spp N            pathtrace: samples per pixel (default 64)\n"
-            "  --seed S           pathtrace: random seed (default 0)\n"
-            "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
-            "  --pixel-light-samples N   radiosity methods: shadow rays per pixel sample and light (default 16, at most 65536)\n"
-            "  --final-gather N   classic, vp, aavp: trace the first bounce from each pixel sample with N\n"
-            "                     rays (direct light at the hits, the solution's irradiance there): the\n"
-            "                     indirect light of points a patch average misrepresents; default 0 (off)\n"
-            "  --shading MODEL    radiosity methods: lighting model for the analytic lights' direct term: none\n"
-            "                     (default: Lambert through the irradiance), lambert, half-lambert, banded,\n"
-            "                     phong, blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says\n"
-            "                     how it combines with the diffuse radiosity solution)\n"
-            "patch and classic solution options (ignored with --bake, which keeps its own):\n"
-            "%s"
-            "%s"
-            "%s"
-            "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            tool_classic_help(), tool_method_help(1), tool_light_help());
-}
-
 /* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
    S: the row sums of F (how much of its hemisphere each patch sees). */
 static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv)
@@ -167,14 +129,15 @@ typedef struct render_args {
     tool_classic_options o;
     tool_method_options mo;
     render_view view;
-    int have_camera;         /* --camera given */
     float fov;               /* --fov (0: the camera's) */
     uint32_t spp;            /* --spp: pathtrace samples per pixel */
     uint32_t threads;        /* --threads */
     uint32_t lm_size, lm_samples, lm_vis; /* --lightmap-size, --texel-samples, --visibility-rays */
-    int lm_size_given;       /* else an unwrap too fine for lm_size gets a larger atlas */
-    int lightmap_opts;       /* one of those three was given */
+    uint32_t given;          /* RENDER_GIVEN_* */
 } render_args;
+/* render_args.given: --camera; --lightmap-size (else an unwrap too fine for it gets a larger
+   atlas); one of the lightmap options */
+enum { RENDER_GIVEN_CAMERA = 1, RENDER_GIVEN_LM_SIZE = 2, RENDER_GIVEN_LM = 4 };
 
 static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, const uint32_t *valid, uint32_t count,
                             float *out);
@@ -1206,343 +1169,402 @@ static int render_local_method(const char *cmd, const tool_world *w, const rende
     return rc;
 }
 
-static int render_main(int argc, char **argv, tool_lights *lights)
+/* ---- the command line ------------------------------------------------------------------- */
+
+static int parse_camera(const char *cmd, const tool_arg *t, const char *v, void *field)
 {
-    const char *cmd = "render", *method;
-    render_args ra;
-    tool_world w;
-    tool_image img;
-    rad_context ctx;
-    int a, rc, pathtrace;
-    uint32_t seed = 0;
-    double t0 = tool_seconds();
-    /* the locals of the parse, as the option table will name them */
-    const char *scene_name = NULL, *out_path = NULL, *bake_path = NULL;
-    tool_classic_options o;
-    tool_method_options mo;
-    rad_camera cam;
-    int width = 512, height = 512, have_cam = 0, lightmap_opts = 0, lm_size_given = 0, shading = -1;
-    uint32_t aa = 16, spp = 64, threads = 0, pixel_light_samples = 16, lm_size = 256, lm_samples = 4, lm_vis = 2,
-             final_gather = 0;
-    float fov = 0.0f, exposure = 1.0f;
-    tool_classic_options_default(&o);
-    tool_method_options_default(&mo);
-    memset(&ra, 0, sizeof ra);
-    memset(&img, 0, sizeof img);
+    const char *why;
+    (void)t;
+    if (tool_parse_camera(v, (rad_camera *)field, &why)) {
+        fprintf(stderr, "rad %s: bad --camera '%s': %s\n", cmd, v, why);
+        return 2;
+    }
+    return 0;
+}
+
+/* --size WxH into render_view's width and height (field: width) */
+static int parse_size(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    render_view *view = (render_view *)((char *)field - offsetof(render_view, width));
+    (void)t;
+    if (tool_parse_size(v, &view->width, &view->height)) {
+        fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, v);
+        return 2;
+    }
+    return tool_check_size(cmd, view->width, view->height) ? 2 : 0;
+}
+
+static int parse_shading(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    (void)t;
+    return tool_parse_shading(cmd, v, (int *)field) ? 2 : 0;
+}
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+#define RA(f) offsetof(render_args, f)
+#define RA_UINT(name, val, f, lo, hi, given, bad, help) \
+    {TOOL_ARG_UINT, name, val, RA(f), lo, hi, 0, given, bad, NULL, NULL, NULL, 0, help}
+#define RA_CUSTOM(name, val, f, fn, given, help) \
+    {TOOL_ARG_CUSTOM, name, val, RA(f), 0, 0, 0, given, NULL, NULL, NULL, fn, 0, help}
+/* rad render's own options (the classic, method and light options are classic.c's,
+   methods.c's and lights.c's tables) */
+static const tool_arg render_table[] = {
+    {TOOL_ARG_STRING, "-o", "FILE", RA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "output image: .pfm or .exr (linear radiance; .exr needs libtinyexr-dev at build) or .png\n"
+     "(sRGB, exposure applied)"},
+    {TOOL_ARG_STRING, "--bake", "FILE.radb", RA(bake), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "classic, multibounce, temporal, stochastic, hierarchical, vp, aavp: use a bake of that\n"
+     "method made by 'rad bake' from this scene instead of computing it here"},
+    RA_CUSTOM("--camera", "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ", view.cam, parse_camera, RENDER_GIVEN_CAMERA,
+              "camera (default: the scene's)"),
+    {TOOL_ARG_FLOAT, "--fov", "DEG", RA(fov), 0.0, 180.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, 0, "must be in (0, 180)",
+     NULL, NULL, NULL, 0, "vertical field of view in degrees (default: the scene's)"},
+    RA_CUSTOM("--size", "WxH", view.width, parse_size, 0,
+              "image size (default 512x512; at most 2 GiB of image: 12 bytes a pixel)"),
+    RA_UINT("--aa", "N", view.aa, 1, 65536, 0, "must be 1 to 65536",
+            "radiosity methods: stratified samples per pixel, rounded down to a square (default 16, 1 to 65536)"),
+    RA_UINT("--spp", "N", spp, 1, 1048576, 0, "must be in 1..1048576", "pathtrace: samples per pixel (default 64)"),
+    {TOOL_ARG_FLOAT, "--exposure", "X", RA(view.exposure), 0.0, 1e30, TOOL_ARG_LO_OPEN, 0, "must be > 0", NULL, NULL,
+     NULL, 0, "scale before 8-bit sRGB encoding (PNG only; default 1)"},
+    RA_UINT("--pixel-light-samples", "N", view.light_samples, 1, 65536, 0, "must be 1 to 65536",
+            "radiosity methods: shadow rays per pixel sample and light (default 16, at most 65536)"),
+    RA_UINT("--final-gather", "N", view.final_gather, 0, 4096, 0, "is at most 4096",
+            "classic, vp, aavp: trace the first bounce from each pixel sample with N rays (direct\n"
+            "light at the hits, the solution's irradiance there): the indirect light of points a\n"
+            "patch average misrepresents; default 0 (off)"),
+    RA_CUSTOM("--shading", "MODEL", view.shading, parse_shading, 0,
+              "radiosity methods: lighting model for the analytic lights' direct term: none\n"
+              "(default: Lambert through the irradiance), lambert, half-lambert, banded, phong,\n"
+              "blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says how it combines\n"
+              "with the diffuse radiosity solution)"),
+    RA_CUSTOM("--threads", "N", threads, parse_threads, 0, "worker threads (default: all cores; at most 1024)"),
+    {TOOL_ARG_TEXT, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "lightmap (the classic solution baked into a lightmap over the second uv set, else the\n"
+     "automatic unwrap, as rad lightmap; direct light per pixel, the indirect light a bilinear\n"
+     "lookup of the lightmap; --proxy aavp|vp: the indirect light from virtual patches\n"
+     "(--vp-resolution R, --face-points P), for scenes the dense classic build cannot hold):\n"},
+    RA_UINT("--lightmap-size", "N", lm_size, 4, 16384, RENDER_GIVEN_LM_SIZE | RENDER_GIVEN_LM, "must be 4 to 16384",
+            "atlas side (default 256, or the least power of two to 4096 the unwrap's charts fit)"),
+    RA_UINT("--texel-samples", "N", lm_samples, 1, 16, RENDER_GIVEN_LM, "must be 1 to 16",
+            "sample points per texel (default 4), as rad lightmap"),
+    RA_UINT("--visibility-rays", "N", lm_vis, 1, 64, RENDER_GIVEN_LM, "must be 1 to 64",
+            "shadow rays per sample point and patch (default 2), as rad lightmap"),
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
+static void render_usage(FILE *f)
+{
+    static char own[8192];
+    tool_args_help_into(render_table, 0, own, sizeof own);
+    fprintf(f,
+            "usage: rad render SCENE -o OUT.png|OUT.pfm|OUT.exr [--method classic|multibounce|temporal|local|stochastic|vp|aavp|hierarchical|lightmap|pathtrace] [options]\n"
+            "%s"
+            "patch and classic solution options (ignored with --bake, which keeps its own):\n"
+            "%s"
+            "%s"
+            "%s",
+            own, tool_classic_help(), tool_method_help(1), tool_light_help());
+}
+
+static void render_args_default(render_args *ra)
+{
+    memset(ra, 0, sizeof *ra);
+    tool_classic_options_default(&ra->o);
+    tool_method_options_default(&ra->mo);
+    ra->view.width = ra->view.height = 512;
+    ra->view.aa = 16;
+    ra->view.light_samples = 16;
+    ra->view.exposure = 1.0f;
+    ra->view.shading = -1;
+    ra->spp = 64;
+    ra->lm_size = 256;
+    ra->lm_samples = 4;
+    ra->lm_vis = 2;
+}
+
+/* the command line into ra; -1: go on, else the exit code (--help: 0; bad usage: 2, printed) */
+static int render_parse(const char *cmd, int argc, char **argv, tool_lights *lights, render_args *ra)
+{
+    int a, rc;
+    render_args_default(ra);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
-        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { render_usage(stdout); return 0; }
-        rc = tool_method_option(cmd, argc, argv, &a, &mo); /* --method, --seed and the methods' options */
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        rc = tool_classic_option(cmd, argc, argv, &a, &o);
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        rc = tool_light_option(cmd, argc, argv, &a, lights);
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        if (opt[0] == '-' && opt[1] && a + 1 >= argc) {
-            fprintf(stderr, "rad %s: %s needs a value (or is unknown; see rad render --help)\n", cmd, opt);
-            return 2;
+        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) {
+            render_usage(stdout);
+            return 0;
         }
-        if (!strcmp(opt, "-o")) out_path = argv[++a];
-        else if (!strcmp(opt, "--bake")) bake_path = argv[++a];
-        else if (!strcmp(opt, "--camera")) {
-            const char *why;
-            if (tool_parse_camera(argv[++a], &cam, &why)) {
-                fprintf(stderr, "rad %s: bad --camera '%s': %s\n", cmd, argv[a], why);
-                return 2;
-            }
-            have_cam = 1;
-        } else if (!strcmp(opt, "--fov")) {
-            if (tool_parse_float(cmd, opt, argv[++a], &fov)) return 2;
-            if (!(fov > 0.0f && fov < 180.0f)) { fprintf(stderr, "rad %s: --fov must be in (0, 180)\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--size")) {
-            if (tool_parse_size(argv[++a], &width, &height)) {
-                fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, argv[a]);
-                return 2;
-            }
-            if (tool_check_size(cmd, width, height)) return 2;
-        } else if (!strcmp(opt, "--aa")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
-            if (aa == 0 || aa > 65536) { fprintf(stderr, "rad %s: --aa must be 1 to 65536\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--spp")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &spp)) return 2;
-            if (spp == 0 || spp > 1u << 20) { fprintf(stderr, "rad %s: --spp must be in 1..1048576\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--pixel-light-samples")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
-            if (pixel_light_samples == 0 || pixel_light_samples > 65536) { fprintf(stderr, "rad %s: %s must be 1 to 65536\n", cmd, opt); return 2; }
-        } else if (!strcmp(opt, "--lightmap-size") || !strcmp(opt, "--texel-samples") || !strcmp(opt, "--visibility-rays")) {
-            uint32_t *dst = opt[2] == 'l' ? &lm_size : opt[2] == 't' ? &lm_samples : &lm_vis;
-            uint32_t lo = opt[2] == 'l' ? 4u : 1u, hi = opt[2] == 'l' ? 16384u : opt[2] == 't' ? 16u : 64u;
-            if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
-            if (*dst < lo || *dst > hi) { fprintf(stderr, "rad %s: %s must be %u to %u\n", cmd, opt, lo, hi); return 2; }
-            if (opt[2] == 'l') lm_size_given = 1;
-            lightmap_opts = 1;
-        } else if (!strcmp(opt, "--final-gather")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &final_gather)) return 2;
-            if (final_gather > 4096) { fprintf(stderr, "rad %s: %s is at most 4096\n", cmd, opt); return 2; }
-        } else if (!strcmp(opt, "--exposure")) {
-            if (tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
-            if (!(exposure > 0.0f)) { fprintf(stderr, "rad %s: --exposure must be > 0\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--shading")) {
-            if (tool_parse_shading(cmd, argv[++a], &shading)) return 2;
-        } else if (!strcmp(opt, "--threads")) {
-            if (tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
-        } else if (opt[0] == '-' && opt[1]) {
+        /* --method, --seed and the methods' options first: their --bounces takes 'inf' */
+        if ((rc = tool_method_option(cmd, argc, argv, &a, &ra->mo)) == 0 &&
+            (rc = tool_classic_option(cmd, argc, argv, &a, &ra->o)) == 0 &&
+            (rc = tool_light_option(cmd, argc, argv, &a, lights)) == 0)
+            rc = tool_args_parse(cmd, render_table, ra, &ra->given, argc, argv, &a);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad render --help)\n", cmd, opt);
             return 2;
-        } else if (!scene_name) scene_name = opt;
-        else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
+        }
+        if (ra->scene) {
+            fprintf(stderr, "rad %s: more than one scene given\n", cmd);
+            return 2;
+        }
+        ra->scene = opt;
     }
-    if (!scene_name || !out_path) {
-        fprintf(stderr, "rad %s: %s\n", cmd, !scene_name ? "no scene given" : "no output file given (-o OUT.png|OUT.pfm)");
+    if (!ra->scene || !ra->out) {
+        fprintf(stderr, "rad %s: %s\n", cmd, !ra->scene ? "no scene given" : "no output file given (-o OUT.png|OUT.pfm)");
         render_usage(stderr);
         return 2;
     }
-    if (tool_method_check(cmd, 1, &mo, &o)) return 2;
-    if (lightmap_opts && mo.method != TOOL_LIGHTMAP) {
+    return -1;
+}
+
+/* the options that exclude each other, the output's format and place; 0, or the exit code */
+static int render_check(const char *cmd, render_args *ra)
+{
+    const tool_method_options *mo = &ra->mo;
+    const char *inputs[2];
+    if (tool_method_check(cmd, 1, &ra->mo, &ra->o)) return 2;
+    if ((ra->given & RENDER_GIVEN_LM) && mo->method != TOOL_LIGHTMAP) {
         fprintf(stderr, "rad %s: --lightmap-size, --texel-samples and --visibility-rays are for --method lightmap\n", cmd);
         return 2;
     }
-    if (mo.method == TOOL_LIGHTMAP && (bake_path || final_gather)) {
+    if (mo->method == TOOL_LIGHTMAP && (ra->bake || ra->view.final_gather)) {
         fprintf(stderr, "rad %s: --method lightmap bakes its own lightmap: %s is not used\n", cmd,
-                bake_path ? "--bake" : "--final-gather");
+                ra->bake ? "--bake" : "--final-gather");
         return 2;
     }
-    tool_dense_plan(&o, &mo, 0);
-    method = tool_method_name(mo.method);
-    seed = mo.seed;
-    pathtrace = mo.method == TOOL_PATHTRACE;
-    if (pathtrace && shading >= 0) {
+    tool_dense_plan(&ra->o, mo, 0);
+    if (mo->method == TOOL_PATHTRACE && ra->view.shading >= 0) {
         fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
-    if (mo.method == TOOL_LOCAL && !mo.proxy && bake_path) {
-        fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd, method);
+    if (mo->method == TOOL_LOCAL && !mo->proxy && ra->bake) {
+        fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd,
+                tool_method_name(mo->method));
         return 2;
     }
-    if (pathtrace && bake_path) {
+    if (mo->method == TOOL_PATHTRACE && ra->bake) {
         fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
     }
-    if (tool_image_check_format(cmd, out_path)) return 2;
-    {
-        const char *inputs[2];
-        inputs[0] = scene_name;
-        inputs[1] = bake_path;
-        if (tool_check_output(cmd, out_path, inputs, 2)) return 1;
-    }
-    tool_set_threads((int)threads);
-    if (tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
-    if (tool_check_outputs(cmd, &out_path, 1, w.file.input_files, (int)w.file.input_file_count)) {
-        tool_close_world(&w);
-        return 1;
-    }
-    {
-        uint32_t t, emitters = 0;
-        for (t = 0; t < w.scene->triangle_count; ++t) {
-            const float *Le = w.scene->materials_table[w.scene->materials[t]].emission;
-            if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) ++emitters;
-        }
-        if (!emitters && !w.file.light_count)
-            fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= TOOL_TEMPORAL || mo.method == TOOL_LOCAL || mo.method == TOOL_STOCHASTIC ||
-             mo.method == TOOL_LIGHTMAP) &&
-            !mo.proxy && !pathtrace && !bake_path &&
-            o.patches < w.scene->triangle_count)
-            fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
-                    cmd, o.patches, w.scene->triangle_count);
-    }
-    if (!have_cam) {
-        if (w.file.has_camera) cam = w.file.camera;
-        else tool_choose_camera(cmd, w.scene, &w.rc, width, height, &cam);
-    } else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
-    if (fov > 0.0f) cam.fov_y_degrees = fov;
-    ra.scene = scene_name;
-    ra.out = out_path;
-    ra.bake = bake_path;
-    ra.o = o;
-    ra.mo = mo;
-    ra.view.cam = cam;
-    ra.view.width = width;
-    ra.view.height = height;
-    ra.view.aa = aa;
-    ra.view.light_samples = pixel_light_samples;
-    ra.view.exposure = exposure;
-    ra.view.shading = shading;
-    ra.view.final_gather = final_gather;
-    ra.have_camera = have_cam;
-    ra.fov = fov;
-    ra.spp = spp;
-    ra.threads = threads;
-    ra.lm_size = lm_size;
-    ra.lm_samples = lm_samples;
-    ra.lm_vis = lm_vis;
-    ra.lm_size_given = lm_size_given;
-    ra.lightmap_opts = lightmap_opts;
-    if (tool_image_alloc(&img, width, height) != 0) {
-        fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
-        tool_close_world(&w);
-        return 1;
-    }
+    if (tool_image_check_format(cmd, ra->out)) return 2;
+    inputs[0] = ra->scene;
+    inputs[1] = ra->bake;
+    return tool_check_output(cmd, ra->out, inputs, 2) ? 1 : 0;
+}
 
-    if (mo.method == TOOL_LIGHTMAP) {
-        tool_lightmap_baked bk;
-        tool_lightmap_request rq;
-        render_source src;
-        tool_lightmap_proxy px;
-        memset(&px, 0, sizeof px);
-        px.kind = (int)mo.proxy;
-        px.resolution = mo.vp_resolution;
-        px.face_points = mo.face_points;
-        tool_lightmap_request_default(&rq);
-        rq.width = rq.height = (int)lm_size;
-        rq.auto_size = !lm_size_given;
-        rq.texel_samples = lm_samples;
-        rq.visibility_rays = lm_vis;
-        rq.proxy = mo.proxy ? &px : NULL;
-        rc = tool_lightmap_bake(cmd, &w, &o, &rq, &bk);
-        if (rc == 0) {
-            fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
-                            "step_ms_min=%.6f\n",
-                    cmd, mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : mo.proxy ? " proxy=aavp" : "", bk.patches, o.bounces,
-                    1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
-            memset(&src, 0, sizeof src);
-            src.P = bk.cl.patches;
-            src.lm = bk.lm;
-            src.lm_values = bk.values;
-            rc = render_classic(&bk.w, &ra.view, &src, &img);
-            tool_lightmap_bake_free(&bk);
-        }
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
-    } else if ((mo.method >= TOOL_LOCAL && !(mo.method == TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
-        rc = mo.method == TOOL_LOCAL && !mo.proxy
-                 ? render_local_method(cmd, &w, &ra, &img)
-             : mo.method == TOOL_HIERARCHICAL
-                 ? render_hr_method(cmd, &w, &ra, &img)
-                 : render_vp_method(cmd, &w, &ra, &img);
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
-    } else if (mo.method == TOOL_MULTIBOUNCE || mo.method == TOOL_TEMPORAL || mo.method == TOOL_STOCHASTIC ||
-               mo.method == TOOL_HIERARCHICAL) { /* hierarchical here: from a bake (resampled onto its patches) */
-        rc = render_with_method(cmd, &w, &ra, &img);
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
-    } else if (pathtrace) {
-        tool_trace_options to;
-        rad_result r;
-        tool_trace_options_default(&to);
-        to.width = width;
-        to.height = height;
-        to.spp = (int)spp;
-        to.seed = seed;
-        tool_context(&ctx, "path tracing");
-        r = (rad_result)tool_trace_image(w.scene, &w.rc, w.file.lights, w.file.light_count, &cam, &to, &ctx, &img);
-        tool_progress_end();
-        if (r != RAD_SUCCESS) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return tool_fail(cmd, "tool_trace_image", r);
-        }
-    } else {
-        tool_classic sol;
-        rad_bake *bake = NULL;
-        const rad_patches *P;
-        const float *H;
-        float *Hv, *Hmine = NULL;
-        render_source src;
-        memset(&sol, 0, sizeof sol);
-        if (bake_path) {
-            const rad_section *hs;
-            rad_result r;
-            tool_context(&ctx, NULL);
-            if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
-                bake_load_failed(cmd, bake_path, r);
-                tool_image_free(&img);
-                tool_close_world(&w);
-                return 1;
-            }
-            rc = bake_fits_scene(cmd, bake_path, bake, &w);
-            if (rc == 0 && (bake->F.rows == 0 || !bake->B)) {
-                fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B%s\n", cmd, bake_path,
-                        rad_container_find(bake->container, TOOL_SECTION_METHOD, "rad.method")
-                            ? " (it is a multibounce or temporal bake: render it with that --method)"
-                            : "");
-                rc = 1;
-            }
-            if (rc) {
-                rad_bake_destroy(bake);
-                tool_image_free(&img);
-                tool_close_world(&w);
-                return 1;
-            }
-            bake->patches.scene = w.scene;
-            P = &bake->patches;
-            hs = rad_container_find(bake->container, RAD_SECTION_VECTOR, "H");
-            if (hs && hs->elem_size == 12 && hs->count == P->count) {
-                H = (const float *)hs->data;
-            } else {
-                /* H = F (E + L) = F B */
-                Hmine = (float *)xmalloc(sizeof(float) * 3 * P->count);
-                if ((r = rad_matrix_multiply(&bake->F, bake->B, Hmine, &ctx)) != RAD_SUCCESS) {
-                    free(Hmine);
-                    rad_bake_destroy(bake);
-                    tool_image_free(&img);
-                    tool_close_world(&w);
-                    return tool_fail(cmd, "rad_matrix_multiply", r);
-                }
-                H = Hmine;
-            }
-            fprintf(stderr, "rad %s: bake '%s': %u patches\n", cmd, bake_path, P->count);
-        } else {
-            if (tool_classic_solve(cmd, &w, &o, &sol)) {
-                tool_image_free(&img);
-                tool_close_world(&w);
-                return 1;
-            }
-            P = sol.patches;
-            H = sol.H;
-            fprintf(stderr, "rad %s: timing: method=classic patches=%u frames=1 bounces=%u step_ms_median=%.6f "
-                            "step_ms_min=%.6f\n",
-                    cmd, P->count, o.bounces, 1e3 * sol.solve_seconds, 1e3 * sol.solve_seconds);
-        }
-        Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
-        rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
-        memset(&src, 0, sizeof src);
-        src.P = P;
-        src.Hv = Hv;
-        if (rc == 0) rc = render_classic(&w, &ra.view, &src, &img);
-        free(Hv);
-        free(Hmine);
-        rad_bake_destroy(bake);
-        tool_classic_free(&sol);
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
+/* the warnings about the scene, and the camera: --camera, else the file's, else one chosen */
+static void render_prepare(const char *cmd, const tool_world *w, render_args *ra)
+{
+    const tool_method_options *mo = &ra->mo;
+    rad_camera *cam = &ra->view.cam;
+    uint32_t t, emitters = 0;
+    for (t = 0; t < w->scene->triangle_count; ++t) {
+        const float *Le = w->scene->materials_table[w->scene->materials[t]].emission;
+        if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) ++emitters;
     }
-    if (tool_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
-        tool_image_free(&img);
+    if (!emitters && !w->file.light_count)
+        fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
+    if ((mo->method <= TOOL_TEMPORAL || mo->method == TOOL_LOCAL || mo->method == TOOL_STOCHASTIC ||
+         mo->method == TOOL_LIGHTMAP) &&
+        !mo->proxy && mo->method != TOOL_PATHTRACE && !ra->bake && ra->o.patches < w->scene->triangle_count)
+        fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
+                cmd, ra->o.patches, w->scene->triangle_count);
+    if (!(ra->given & RENDER_GIVEN_CAMERA)) {
+        if (w->file.has_camera) *cam = w->file.camera;
+        else tool_choose_camera(cmd, w->scene, &w->rc, ra->view.width, ra->view.height, cam);
+    } else cam->fov_y_degrees = w->file.camera.fov_y_degrees;
+    if (ra->fov > 0.0f) cam->fov_y_degrees = ra->fov;
+}
+
+/* --method lightmap: the lightmap bake (lightmap.c), then the classic render with H looked up
+   in the lightmap at each sample */
+static int render_lightmap_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    tool_lightmap_baked bk;
+    tool_lightmap_request rq;
+    tool_lightmap_proxy px;
+    render_source src;
+    int rc;
+    tool_lightmap_request_default(&rq);
+    rq.width = rq.height = (int)ra->lm_size;
+    rq.auto_size = !(ra->given & RENDER_GIVEN_LM_SIZE);
+    rq.texel_samples = ra->lm_samples;
+    rq.visibility_rays = ra->lm_vis;
+    memset(&px, 0, sizeof px);
+    px.kind = (int)ra->mo.proxy;
+    px.resolution = ra->mo.vp_resolution;
+    px.face_points = ra->mo.face_points;
+    rq.proxy = ra->mo.proxy ? &px : NULL;
+    if (tool_lightmap_bake(cmd, w, &ra->o, &rq, &bk)) return 1;
+    fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+                    "step_ms_min=%.6f\n",
+            cmd, ra->mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : ra->mo.proxy ? " proxy=aavp" : "", bk.patches,
+            ra->o.bounces, 1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
+    memset(&src, 0, sizeof src);
+    src.P = bk.cl.patches;
+    src.lm = bk.lm;
+    src.lm_values = bk.values;
+    rc = render_classic(&bk.w, &ra->view, &src, img);
+    tool_lightmap_bake_free(&bk);
+    return rc;
+}
+
+static int render_pathtrace(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    tool_trace_options to;
+    rad_context ctx;
+    rad_result r;
+    tool_trace_options_default(&to);
+    to.width = ra->view.width;
+    to.height = ra->view.height;
+    to.spp = (int)ra->spp;
+    to.seed = ra->mo.seed;
+    tool_context(&ctx, "path tracing");
+    r = (rad_result)tool_trace_image(w->scene, &w->rc, w->file.lights, w->file.light_count, &ra->view.cam, &to, &ctx, img);
+    tool_progress_end();
+    return r != RAD_SUCCESS ? tool_fail(cmd, "tool_trace_image", r) : 0;
+}
+
+/* --bake of the classic method: the bake checked against the scene, and its H (stored, or
+   F B); *bake_out and *H_owned (NULL when the bake holds H) to free. 0 or 1 (printed). */
+static int classic_bake_open(const char *cmd, const tool_world *w, const char *bake_path, rad_bake **bake_out,
+                             const float **H, float **H_owned)
+{
+    rad_bake *bake = NULL;
+    const rad_section *hs;
+    rad_context ctx;
+    rad_result r;
+    int rc;
+    *bake_out = NULL;
+    *H_owned = NULL;
+    tool_context(&ctx, NULL);
+    if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
+        bake_load_failed(cmd, bake_path, r);
+        return 1;
+    }
+    rc = bake_fits_scene(cmd, bake_path, bake, w);
+    if (rc == 0 && (bake->F.rows == 0 || !bake->B)) {
+        fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B%s\n", cmd, bake_path,
+                rad_container_find(bake->container, TOOL_SECTION_METHOD, "rad.method")
+                    ? " (it is a multibounce or temporal bake: render it with that --method)"
+                    : "");
+        rc = 1;
+    }
+    if (rc) {
+        rad_bake_destroy(bake);
+        return 1;
+    }
+    bake->patches.scene = w->scene;
+    hs = rad_container_find(bake->container, RAD_SECTION_VECTOR, "H");
+    if (hs && hs->elem_size == 12 && hs->count == bake->patches.count) {
+        *H = (const float *)hs->data;
+    } else {
+        /* H = F (E + L) = F B */
+        *H_owned = (float *)xmalloc(sizeof(float) * 3 * bake->patches.count);
+        if ((r = rad_matrix_multiply(&bake->F, bake->B, *H_owned, &ctx)) != RAD_SUCCESS) {
+            free(*H_owned);
+            *H_owned = NULL;
+            rad_bake_destroy(bake);
+            return tool_fail(cmd, "rad_matrix_multiply", r);
+        }
+        *H = *H_owned;
+    }
+    fprintf(stderr, "rad %s: bake '%s': %u patches\n", cmd, bake_path, bake->patches.count);
+    *bake_out = bake;
+    return 0;
+}
+
+/* --method classic: the solution (--bake, or solved here), per-vertex H, the classic render */
+static int render_classic_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    tool_classic sol;
+    rad_bake *bake = NULL;
+    const rad_patches *P;
+    const float *H = NULL;
+    float *Hv, *Hmine = NULL;
+    render_source src;
+    int rc;
+    memset(&sol, 0, sizeof sol);
+    if (ra->bake) {
+        if (classic_bake_open(cmd, w, ra->bake, &bake, &H, &Hmine)) return 1;
+        P = &bake->patches;
+    } else {
+        if (tool_classic_solve(cmd, w, &ra->o, &sol)) return 1;
+        P = sol.patches;
+        H = sol.H;
+        fprintf(stderr, "rad %s: timing: method=classic patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+                        "step_ms_min=%.6f\n",
+                cmd, P->count, ra->o.bounces, 1e3 * sol.solve_seconds, 1e3 * sol.solve_seconds);
+    }
+    Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
+    rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
+    memset(&src, 0, sizeof src);
+    src.P = P;
+    src.Hv = Hv;
+    if (rc == 0) rc = render_classic(w, &ra->view, &src, img);
+    free(Hv);
+    free(Hmine);
+    rad_bake_destroy(bake);
+    tool_classic_free(&sol);
+    return rc;
+}
+
+/* the image by the method asked for; 0 or 1 (printed) */
+static int render_image(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    const tool_method_options *mo = &ra->mo;
+    if (mo->method == TOOL_LIGHTMAP) return render_lightmap_method(cmd, w, ra, img);
+    if ((mo->method >= TOOL_LOCAL && !(mo->method == TOOL_HIERARCHICAL && ra->bake)) || mo->proxy)
+        return mo->method == TOOL_LOCAL && !mo->proxy ? render_local_method(cmd, w, ra, img)
+               : mo->method == TOOL_HIERARCHICAL      ? render_hr_method(cmd, w, ra, img)
+                                                      : render_vp_method(cmd, w, ra, img);
+    /* hierarchical here: from a bake (resampled onto its patches) */
+    if (mo->method == TOOL_MULTIBOUNCE || mo->method == TOOL_TEMPORAL || mo->method == TOOL_STOCHASTIC ||
+        mo->method == TOOL_HIERARCHICAL)
+        return render_with_method(cmd, w, ra, img);
+    if (mo->method == TOOL_PATHTRACE) return render_pathtrace(cmd, w, ra, img);
+    return render_classic_method(cmd, w, ra, img);
+}
+
+static int render_main(int argc, char **argv, tool_lights *lights)
+{
+    const char *cmd = "render";
+    render_args ra;
+    tool_world w;
+    tool_image img;
+    int rc;
+    double t0 = tool_seconds();
+    if ((rc = render_parse(cmd, argc, argv, lights, &ra)) >= 0) return rc;
+    if ((rc = render_check(cmd, &ra)) != 0) return rc;
+    tool_set_threads((int)ra.threads);
+    if (tool_open_world_lit(cmd, ra.scene, lights, &w)) return 1;
+    if (tool_check_outputs(cmd, &ra.out, 1, w.file.input_files, (int)w.file.input_file_count)) {
         tool_close_world(&w);
         return 1;
     }
-    printf("wrote %s (%dx%d, %s) in %.2f s\n", out_path, width, height, method, tool_seconds() - t0);
+    render_prepare(cmd, &w, &ra);
+    memset(&img, 0, sizeof img);
+    if (tool_image_alloc(&img, ra.view.width, ra.view.height) != 0) {
+        fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, ra.view.width, ra.view.height);
+        tool_close_world(&w);
+        return 1;
+    }
+    rc = render_image(cmd, &w, &ra, &img);
+    if (rc == 0 && tool_image_write(ra.out, &img, ra.view.exposure) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+        rc = 1;
+    }
+    if (rc == 0)
+        printf("wrote %s (%dx%d, %s) in %.2f s\n", ra.out, ra.view.width, ra.view.height, tool_method_name(ra.mo.method),
+               tool_seconds() - t0);
     tool_image_free(&img);
     tool_close_world(&w);
-    return 0;
+    return rc ? 1 : 0;
 }
 
 int tool_cmd_render(int argc, char **argv)
