@@ -615,216 +615,228 @@ static rad_result hierarchical_to_patches(const rad_hierarchical *h, const rad_s
     return RAD_SUCCESS;
 }
 
-int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_options *o,
-                         const tool_method_options *mo, void **out, size_t *out_size)
-{
-    tool_classic_options so = *o;
-    tool_classic c;
-    rad_context ctx;
-    rad_result r = RAD_SUCCESS;
-    rad_multibounce *mb = NULL;
-    rad_multibounce_blocks *blocks = NULL;
-    rad_alias_tables *tables[3] = {NULL, NULL, NULL};
-    rad_block_report report;
-    tool_bake_info info;
-    rad_bake_signature sig;
+/* tool_method_bake's state: what each stage builds, freed together by method_bake_free */
+typedef struct method_bake {
+    const char *cmd;
+    const tool_world *w;
+    const tool_method_options *mo;
+    tool_classic c;                /* patches, D and E (F unless no_form_factors) */
+    uint32_t n;
+    float *S;                      /* row sums of F */
+    float *L;                      /* stochastic, hierarchical: the solution */
+    rad_multibounce *mb;
+    rad_multibounce_blocks *blocks;
+    rad_alias_tables *tables[3];
     tool_method_info mi;
-    rad_container *ct = NULL;
-    rad_section *secs = NULL;
-    void *base = NULL, *dst = NULL;
-    size_t base_size = 0, dst_size = 0, bytes = 0;
-    uint32_t n, i, k = 0, count;
-    float *ones = NULL, *rows3 = NULL, *S = NULL, *L = NULL;
-    double t0;
-    const char *what = NULL;
-    int rc = 1;
+    size_t bytes;                  /* what the render reads (see tool_method_info) */
+    rad_result r;                  /* the failing call's result */
+} method_bake;
 
-    *out = NULL;
-    *out_size = 0;
-    so.sources_only = 1;
-    so.no_form_factors = mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL;
-    if (tool_classic_solve(cmd, w, &so, &c)) return 1;
-    n = c.patches->count;
+/* the row sums S of F for the halo correction: F times ones, or by rays without F */
+static const char *method_bake_rowsums(method_bake *b, int no_form_factors)
+{
+    uint32_t i, n = b->n;
+    float *ones, *rows3;
+    rad_context ctx;
+    b->S = (float *)tool_calloc(n, sizeof(float));
+    if (no_form_factors) {
+        b->r = stochastic_rowsums(b->w, b->c.patches, b->S);
+        return b->r != RAD_SUCCESS ? "row sums by rays" : NULL;
+    }
     tool_context(&ctx, NULL);
-
-    /* row sums of F for the halo correction */
     ones = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     rows3 = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-    S = (float *)tool_calloc(n, sizeof(float));
-    if (so.no_form_factors) {
-        if ((r = stochastic_rowsums(w, c.patches, S)) != RAD_SUCCESS) {
-            what = "row sums by rays";
-            goto fail;
-        }
-    } else {
-        for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
-        if ((r = rad_matrix_multiply(&c.ff->matrix, ones, rows3, &ctx)) != RAD_SUCCESS) {
-            what = "rad_matrix_multiply";
-            goto fail;
-        }
-        for (i = 0; i < n; ++i) S[i] = rows3[3 * i];
-    }
+    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
+    b->r = rad_matrix_multiply(&b->c.ff->matrix, ones, rows3, &ctx);
+    for (i = 0; i < n; ++i) b->S[i] = rows3[3 * i];
+    free(ones);
+    free(rows3);
+    return b->r != RAD_SUCCESS ? "rad_matrix_multiply" : NULL;
+}
 
-    memset(&mi, 0, sizeof mi);
-    mi.magic = TOOL_METHOD_MAGIC;
-    mi.method = (uint32_t)mo->method;
-    mi.bounces = mo->bounces;
-    mi.format = mo->format;
-    mi.outliers = mo->outliers;
-    mi.reorder = mo->reorder == RAD_REORDER_NONE ? 0u : (uint32_t)mo->reorder; /* the record: 0 is no reordering */
-    mi.reorder_samples = mo->reorder_samples;
-    mi.tile = mo->tile;
-    mi.mode = (uint32_t)mo->mode;
-    mi.k = mo->k;
-    mi.w = mo->w;
-    mi.adaptive = (uint32_t)mo->adaptive;
-    mi.seed = mo->seed;
+/* the rad.method record of mo (the stages add what they built) */
+static void method_bake_record(method_bake *b)
+{
+    const tool_method_options *mo = b->mo;
+    tool_method_info *mi = &b->mi;
+    memset(mi, 0, sizeof *mi);
+    mi->magic = TOOL_METHOD_MAGIC;
+    mi->method = (uint32_t)mo->method;
+    mi->bounces = mo->bounces;
+    mi->format = mo->format;
+    mi->outliers = mo->outliers;
+    mi->reorder = mo->reorder == RAD_REORDER_NONE ? 0u : (uint32_t)mo->reorder; /* the record: 0 is no reordering */
+    mi->reorder_samples = mo->reorder_samples;
+    mi->tile = mo->tile;
+    mi->mode = (uint32_t)mo->mode;
+    mi->k = mo->k;
+    mi->w = mo->w;
+    mi->adaptive = (uint32_t)mo->adaptive;
+    mi->seed = mo->seed;
     if (mo->method == TOOL_STOCHASTIC) {
-        mi.k = mo->sr_rays;
-        mi.bounces = mo->sr_iterations;
-        mi.mode = mo->sr_estimator;
+        mi->k = mo->sr_rays;
+        mi->bounces = mo->sr_iterations;
+        mi->mode = mo->sr_estimator;
     }
+}
 
-    t0 = tool_seconds();
-    if (mo->method == TOOL_MULTIBOUNCE ||
-        (mo->method == TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
-        rad_multibounce_options mbo;
-        rad_multibounce_options_default(&mbo);
-        mbo.bounces = mb_bounces(mo->bounces);
-        mbo.precision = mo->method == TOOL_MULTIBOUNCE && mo->format == TOOL_MB_HALF ? RAD_MB_HALF : RAD_MB_FLOAT;
-        tool_context(&ctx, "F_mb");
-        r = rad_multibounce_create(&c.ff->matrix, c.patches->albedo, &mbo, &ctx, &mb);
-        tool_progress_end();
-        tool_context(&ctx, NULL);
-        if (r != RAD_SUCCESS) {
-            what = "rad_multibounce_create";
-            goto fail;
-        }
-        if (mbo.bounces == RAD_MB_INFINITE)
-            fprintf(stderr, "rad %s: F_mb (inf bounces, %s) built in %.2f s\n", cmd,
-                    mbo.precision == RAD_MB_HALF ? "half" : "float", tool_seconds() - t0);
-        else
-            fprintf(stderr, "rad %s: F_mb (%u bounces: --bounces %u and the renderer's gather, %s) built in %.2f s\n",
-                    cmd, mbo.bounces, mo->bounces, mbo.precision == RAD_MB_HALF ? "half" : "float",
-                    tool_seconds() - t0);
+/* F_mb of --bounces K (K + 1 built: the renderer's gather), for multibounce and temporal --mode
+   multibounce */
+static const char *method_bake_fmb(method_bake *b, double t0)
+{
+    const tool_method_options *mo = b->mo;
+    rad_multibounce_options mbo;
+    rad_context ctx;
+    rad_multibounce_options_default(&mbo);
+    mbo.bounces = mb_bounces(mo->bounces);
+    mbo.precision = mo->method == TOOL_MULTIBOUNCE && mo->format == TOOL_MB_HALF ? RAD_MB_HALF : RAD_MB_FLOAT;
+    tool_context(&ctx, "F_mb");
+    b->r = rad_multibounce_create(&b->c.ff->matrix, b->c.patches->albedo, &mbo, &ctx, &b->mb);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "rad_multibounce_create";
+    if (mbo.bounces == RAD_MB_INFINITE)
+        fprintf(stderr, "rad %s: F_mb (inf bounces, %s) built in %.2f s\n", b->cmd,
+                mbo.precision == RAD_MB_HALF ? "half" : "float", tool_seconds() - t0);
+    else
+        fprintf(stderr, "rad %s: F_mb (%u bounces: --bounces %u and the renderer's gather, %s) built in %.2f s\n",
+                b->cmd, mbo.bounces, mo->bounces, mbo.precision == RAD_MB_HALF ? "half" : "float", tool_seconds() - t0);
+    return NULL;
+}
+
+/* multibounce: F_mb as stored: compressed (bc1, bc4x3) with its error report, or float/half */
+static const char *method_bake_store_fmb(method_bake *b)
+{
+    const tool_method_options *mo = b->mo;
+    rad_block_options bo;
+    rad_block_report report;
+    rad_context ctx;
+    double t1 = tool_seconds();
+    if (mo->format < TOOL_MB_BC1) {
+        b->bytes = (size_t)3 * b->n * b->n * (mo->format == TOOL_MB_HALF ? 2u : 4u);
+        fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", b->cmd, format_name(mo->format), (unsigned long)b->bytes);
+        return NULL;
     }
-    if (mo->method == TOOL_MULTIBOUNCE) {
-        if (mo->format >= TOOL_MB_BC1) {
-            rad_block_options bo;
-            double t1 = tool_seconds();
-            rad_block_options_default(&bo);
-            bo.format = mo->format == TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
-            bo.outlier_fraction = mo->outliers > 0.0f ? mo->outliers : -1.0f; /* --outliers 0: none */
-            bo.reorder = mo->reorder;
-            bo.reorder_samples = mo->reorder_samples;
-            bo.tile = mo->tile ? mo->tile : RAD_BLOCK_WHOLE_MATRIX; /* --tile 0: one scale per matrix */
-            memset(&report, 0, sizeof report);
-            tool_context(&ctx, "compression");
-            r = rad_multibounce_blocks_create(mb, &bo, &ctx, &blocks, &report);
-            tool_progress_end();
-            tool_context(&ctx, NULL);
-            if (r != RAD_SUCCESS) {
-                what = "rad_multibounce_blocks_create";
-                goto fail;
-            }
-            bytes = report.bytes_total;
-            mi.mse = (float)report.mse;
-            mi.max_abs_error = (float)report.max_abs_error;
-            mi.source_mean_square = (float)report.source_mean_square;
-            fprintf(stderr,
-                    "rad %s: compressed to %s in %.2f s: %lu bytes (blocks %lu, scales %lu, %llu outliers %lu, "
-                    "permutations %lu) vs %lu float F_mb, %.1fx; decoded-matrix RMS error %.3g (%.3g%% of the "
-                    "RMS entry), max %.3g\n",
-                    cmd, format_name(mo->format), tool_seconds() - t1, (unsigned long)report.bytes_total,
-                    (unsigned long)report.bytes_blocks, (unsigned long)report.bytes_scales,
-                    (unsigned long long)report.outlier_count, (unsigned long)report.bytes_outliers,
-                    (unsigned long)report.bytes_permutations, (unsigned long)report.bytes_float_mb,
-                    report.bytes_total ? (double)report.bytes_float_mb / (double)report.bytes_total : 0.0,
-                    sqrt(report.mse),
-                    report.source_mean_square > 0.0 ? 100.0 * sqrt(report.mse / report.source_mean_square) : 0.0,
-                    report.max_abs_error);
-        } else {
-            bytes = (size_t)3 * n * n * (mo->format == TOOL_MB_HALF ? 2u : 4u);
-            fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", cmd, format_name(mo->format), (unsigned long)bytes);
-        }
-    } else if (mo->method == TOOL_HIERARCHICAL) {
-        rad_hierarchical *h = NULL;
-        rad_hierarchical_stats st;
-        if (tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) goto fail;
-        L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-        r = hierarchical_to_patches(h, w->scene, c.patches, L);
-        rad_hierarchical_get_stats(h, &st);
-        rad_hierarchical_destroy(h);
-        if (r != RAD_SUCCESS) {
-            what = "rad_hierarchical_lookup";
-            goto fail;
-        }
-        bytes = (size_t)st.links; /* the record's byte count holds the links here */
-        mi.k = st.leaves;
-        mi.bounces = st.rounds;
-        mi.w = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5f;
-    } else if (mo->method == TOOL_STOCHASTIC) {
-        rad_stochastic_options sto;
-        rad_stochastic_stats st;
-        rad_stochastic_options_default(&sto);
-        sto.method = (rad_stochastic_method)mo->sr_estimator;
-        sto.rays = mo->sr_rays;
-        sto.iterations = mo->sr_iterations;
-        sto.seed = mo->seed;
-        L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-        tool_context(&ctx, "stochastic radiosity");
-        r = rad_solve_stochastic(c.patches, &w->rc, c.E, &sto, L, &st, &ctx);
-        tool_progress_end();
-        tool_context(&ctx, NULL);
-        if (r != RAD_SUCCESS) {
-            what = "rad_solve_stochastic";
-            goto fail;
-        }
-        bytes = (size_t)st.rays_cast; /* the record's byte count holds the rays cast here */
-        fprintf(stderr, "rad %s: stochastic radiosity (%s) in %.2f s: %u iterations, %llu rays, unshot %.2g\n", cmd,
-                sto.method == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", tool_seconds() - t0, st.iterations,
-                (unsigned long long)st.rays_cast, st.unshot);
+    rad_block_options_default(&bo);
+    bo.format = mo->format == TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
+    bo.outlier_fraction = mo->outliers > 0.0f ? mo->outliers : -1.0f; /* --outliers 0: none */
+    bo.reorder = mo->reorder;
+    bo.reorder_samples = mo->reorder_samples;
+    bo.tile = mo->tile ? mo->tile : RAD_BLOCK_WHOLE_MATRIX; /* --tile 0: one scale per matrix */
+    memset(&report, 0, sizeof report);
+    tool_context(&ctx, "compression");
+    b->r = rad_multibounce_blocks_create(b->mb, &bo, &ctx, &b->blocks, &report);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "rad_multibounce_blocks_create";
+    b->bytes = report.bytes_total;
+    b->mi.mse = (float)report.mse;
+    b->mi.max_abs_error = (float)report.max_abs_error;
+    b->mi.source_mean_square = (float)report.source_mean_square;
+    fprintf(stderr,
+            "rad %s: compressed to %s in %.2f s: %lu bytes (blocks %lu, scales %lu, %llu outliers %lu, "
+            "permutations %lu) vs %lu float F_mb, %.1fx; decoded-matrix RMS error %.3g (%.3g%% of the "
+            "RMS entry), max %.3g\n",
+            b->cmd, format_name(mo->format), tool_seconds() - t1, (unsigned long)report.bytes_total,
+            (unsigned long)report.bytes_blocks, (unsigned long)report.bytes_scales,
+            (unsigned long long)report.outlier_count, (unsigned long)report.bytes_outliers,
+            (unsigned long)report.bytes_permutations, (unsigned long)report.bytes_float_mb,
+            report.bytes_total ? (double)report.bytes_float_mb / (double)report.bytes_total : 0.0, sqrt(report.mse),
+            report.source_mean_square > 0.0 ? 100.0 * sqrt(report.mse / report.source_mean_square) : 0.0,
+            report.max_abs_error);
+    return NULL;
+}
+
+/* hierarchical: the solution resampled onto the patches as L = rho H (NULL: done; "": failed,
+   printed) */
+static const char *method_bake_hierarchical(method_bake *b, uint32_t light_samples)
+{
+    rad_hierarchical *h = NULL;
+    rad_hierarchical_stats st;
+    if (tool_hierarchical_build(b->cmd, b->w, b->mo, light_samples, &h)) return "";
+    b->L = (float *)tool_calloc(3 * (size_t)b->n, sizeof(float));
+    b->r = hierarchical_to_patches(h, b->w->scene, b->c.patches, b->L);
+    rad_hierarchical_get_stats(h, &st);
+    rad_hierarchical_destroy(h);
+    if (b->r != RAD_SUCCESS) return "rad_hierarchical_lookup";
+    b->bytes = (size_t)st.links; /* the record's byte count holds the links here */
+    b->mi.k = st.leaves;
+    b->mi.bounces = st.rounds;
+    b->mi.w = b->mo->hr_eps > 0.0f ? b->mo->hr_eps : 1e-5f;
+    return NULL;
+}
+
+static const char *method_bake_stochastic(method_bake *b, double t0)
+{
+    const tool_method_options *mo = b->mo;
+    rad_stochastic_options sto;
+    rad_stochastic_stats st;
+    rad_context ctx;
+    rad_stochastic_options_default(&sto);
+    sto.method = (rad_stochastic_method)mo->sr_estimator;
+    sto.rays = mo->sr_rays;
+    sto.iterations = mo->sr_iterations;
+    sto.seed = mo->seed;
+    b->L = (float *)tool_calloc(3 * (size_t)b->n, sizeof(float));
+    tool_context(&ctx, "stochastic radiosity");
+    b->r = rad_solve_stochastic(b->c.patches, &b->w->rc, b->c.E, &sto, b->L, &st, &ctx);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "rad_solve_stochastic";
+    b->bytes = (size_t)st.rays_cast; /* the record's byte count holds the rays cast here */
+    fprintf(stderr, "rad %s: stochastic radiosity (%s) in %.2f s: %u iterations, %llu rays, unshot %.2g\n", b->cmd,
+            sto.method == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", tool_seconds() - t0, st.iterations,
+            (unsigned long long)st.rays_cast, st.unshot);
+    return NULL;
+}
+
+/* temporal: alias tables over F's rows, or over F_mb's three channels in --mode multibounce */
+static const char *method_bake_alias(method_bake *b, double t0)
+{
+    uint32_t i, n = b->n;
+    uint64_t bins = 0, entries = 0;
+    rad_context ctx;
+    tool_context(&ctx, "alias tables");
+    b->r = RAD_SUCCESS;
+    if (b->mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
+        for (i = 0; i < 3 && b->r == RAD_SUCCESS; ++i)
+            b->r = rad_alias_tables_create_dense(b->mb->planes + (size_t)i * n * n, n, RAD_ALIAS_AUTO, &ctx, &b->tables[i]);
     } else {
-        tool_context(&ctx, "alias tables");
-        if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
-            for (i = 0; i < 3 && r == RAD_SUCCESS; ++i)
-                r = rad_alias_tables_create_dense(mb->planes + (size_t)i * n * n, n, RAD_ALIAS_AUTO, &ctx, &tables[i]);
-        } else {
-            r = rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, &ctx, &tables[0]);
-        }
-        tool_progress_end();
-        tool_context(&ctx, NULL);
-        if (r != RAD_SUCCESS) {
-            what = "alias tables";
-            goto fail;
-        }
-        {
-            uint64_t bins = 0, entries = 0;
-            for (i = 0; i < 3 && tables[i]; ++i) {
-                bytes += rad_alias_tables_memory(tables[i]);
-                bins += tables[i]->row_offsets[n];
-                entries += tables[i]->source_entries;
-            }
-            fprintf(stderr,
-                    "rad %s: alias tables (%s) built in %.2f s: %llu bins, %lu bytes (%.2f bytes per bin) from a "
-                    "%llu-entry float matrix (%lu bytes)\n",
-                    cmd, mode_name(mo->mode), tool_seconds() - t0, (unsigned long long)bins, (unsigned long)bytes,
-                    bins ? (double)bytes / (double)bins : 0.0, (unsigned long long)entries,
-                    (unsigned long)(entries * 4u));
-        }
+        b->r = rad_alias_tables_create(&b->c.ff->matrix, RAD_ALIAS_AUTO, &ctx, &b->tables[0]);
     }
-    mi.build_seconds = (float)(tool_seconds() - t0);
-    mi.bytes_lo = (uint32_t)((uint64_t)bytes & 0xFFFFFFFFu);
-    mi.bytes_hi = (uint32_t)((uint64_t)bytes >> 32);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "alias tables";
+    for (i = 0; i < 3 && b->tables[i]; ++i) {
+        b->bytes += rad_alias_tables_memory(b->tables[i]);
+        bins += b->tables[i]->row_offsets[n];
+        entries += b->tables[i]->source_entries;
+    }
+    fprintf(stderr,
+            "rad %s: alias tables (%s) built in %.2f s: %llu bins, %lu bytes (%.2f bytes per bin) from a "
+            "%llu-entry float matrix (%lu bytes)\n",
+            b->cmd, mode_name(b->mo->mode), tool_seconds() - t0, (unsigned long long)bins, (unsigned long)b->bytes,
+            bins ? (double)b->bytes / (double)bins : 0.0, (unsigned long long)entries, (unsigned long)(entries * 4u));
+    return NULL;
+}
 
-    /* patches and E (and D as a vector) from the library's writer, then ours */
-    if ((r = rad_save_memory(c.patches, NULL, c.E, NULL, &ctx, &base, &base_size)) != RAD_SUCCESS) {
+/* the container: patches and E (and D as a vector) from the library's writer, then ours */
+static const char *method_bake_write(method_bake *b, const tool_classic_options *o, void **out, size_t *out_size)
+{
+    const tool_method_options *mo = b->mo;
+    tool_bake_info info;
+    rad_bake_signature sig;
+    rad_container *ct = NULL;
+    rad_section *secs = NULL;
+    rad_context ctx;
+    void *base = NULL, *dst = NULL;
+    size_t base_size = 0, dst_size = 0;
+    uint32_t i, k = 0, count, n = b->n;
+    const char *what = NULL;
+    tool_context(&ctx, NULL);
+    if ((b->r = rad_save_memory(b->c.patches, NULL, b->c.E, NULL, &ctx, &base, &base_size)) != RAD_SUCCESS) {
         what = "rad_save_memory";
-        goto fail;
+        goto done;
     }
-    if ((r = rad_container_create(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
+    if ((b->r = rad_container_create(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
         what = "rad_container_create";
-        goto fail;
+        goto done;
     }
     count = rad_container_section_count(ct);
     secs = (rad_section *)tool_calloc((size_t)count + 4 + 3 * 3 + RAD_MB_MAX_SECTIONS, sizeof(rad_section));
@@ -837,63 +849,95 @@ int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_op
     info.solver = (uint32_t)o->solver;
     info.bounces = mo->bounces;
     info.light_samples = o->light_samples;
-    info.triangle_count = w->scene->triangle_count;
-    tool_sign_options(secs, k, &info, w, &sig);
-    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c.D;
+    info.triangle_count = b->w->scene->triangle_count;
+    tool_sign_options(secs, k, &info, b->w, &sig);
+    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = b->c.D;
     strcpy(secs[k++].name, "D");
-    secs[k].type = TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;
+    secs[k].type = TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = b->S;
     strcpy(secs[k++].name, "rad.rowsums");
     secs[k].type = TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
-    secs[k].type = TOOL_SECTION_METHOD, secs[k].elem_size = sizeof mi, secs[k].count = 1, secs[k].data = &mi;
+    secs[k].type = TOOL_SECTION_METHOD, secs[k].elem_size = sizeof b->mi, secs[k].count = 1, secs[k].data = &b->mi;
     strcpy(secs[k++].name, "rad.method");
     if (mo->method == TOOL_MULTIBOUNCE) {
         uint32_t added = 0;
-        r = blocks ? rad_multibounce_blocks_sections(blocks, "Fmb", secs + k, &added)
-                   : rad_multibounce_sections(mb, "Fmb", secs + k, &added);
-        if (r != RAD_SUCCESS) {
+        b->r = b->blocks ? rad_multibounce_blocks_sections(b->blocks, "Fmb", secs + k, &added)
+                         : rad_multibounce_sections(b->mb, "Fmb", secs + k, &added);
+        if (b->r != RAD_SUCCESS) {
             what = "multi-bounce sections";
-            goto fail;
+            goto done;
         }
         k += added;
     } else if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) {
-        secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = L;
+        secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = b->L;
         strcpy(secs[k++].name, "L");
     } else if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
         static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
-        for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(tables[i], names[i], secs + k, NULL);
+        for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(b->tables[i], names[i], secs + k, NULL);
     } else {
-        rad_alias_tables_sections(tables[0], "F", secs + k, NULL);
+        rad_alias_tables_sections(b->tables[0], "F", secs + k, NULL);
         k += 3;
     }
-    if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
+    if ((b->r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
         what = "rad_container_size";
-        goto fail;
+        goto done;
     }
     dst = tool_calloc(dst_size, 1);
-    if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
+    if ((b->r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
         what = "rad_container_write";
-        goto fail;
+        goto done;
     }
     *out = dst;
     *out_size = dst_size;
     dst = NULL;
-    rc = 0;
-fail:
-    if (what) tool_fail(cmd, what, r);
+done:
     free(dst);
     free(secs);
     rad_container_destroy(ct);
     rad_free_buffer(base, &ctx);
-    for (i = 0; i < 3; ++i) rad_alias_tables_destroy(tables[i]);
-    rad_multibounce_blocks_destroy(blocks);
-    rad_multibounce_destroy(mb);
-    free(ones);
-    free(rows3);
-    free(S);
-    free(L);
-    tool_classic_free(&c);
-    return rc;
+    return what;
+}
+
+int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                         const tool_method_options *mo, void **out, size_t *out_size)
+{
+    tool_classic_options so = *o;
+    method_bake b;
+    const char *what = NULL;
+    double t0;
+    uint32_t i;
+    *out = NULL;
+    *out_size = 0;
+    memset(&b, 0, sizeof b);
+    b.cmd = cmd;
+    b.w = w;
+    b.mo = mo;
+    so.sources_only = 1;
+    so.no_form_factors = mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL;
+    if (tool_classic_solve(cmd, w, &so, &b.c)) return 1;
+    b.n = b.c.patches->count;
+    what = method_bake_rowsums(&b, so.no_form_factors);
+    method_bake_record(&b);
+    t0 = tool_seconds();
+    if (!what && (mo->method == TOOL_MULTIBOUNCE || (mo->method == TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)))
+        what = method_bake_fmb(&b, t0);
+    if (!what)
+        what = mo->method == TOOL_MULTIBOUNCE     ? method_bake_store_fmb(&b)
+               : mo->method == TOOL_HIERARCHICAL ? method_bake_hierarchical(&b, o->light_samples)
+               : mo->method == TOOL_STOCHASTIC   ? method_bake_stochastic(&b, t0)
+                                                 : method_bake_alias(&b, t0);
+    b.mi.build_seconds = (float)(tool_seconds() - t0);
+    b.mi.bytes_lo = (uint32_t)((uint64_t)b.bytes & 0xFFFFFFFFu);
+    b.mi.bytes_hi = (uint32_t)((uint64_t)b.bytes >> 32);
+    if (!what) what = method_bake_write(&b, o, out, out_size);
+    if (what && *what) tool_fail(cmd, what, b.r);
+    for (i = 0; i < 3; ++i) rad_alias_tables_destroy(b.tables[i]);
+    rad_multibounce_blocks_destroy(b.blocks);
+    rad_multibounce_destroy(b.mb);
+    free(b.S);
+    free(b.L);
+    tool_classic_free(&b.c);
+    return what ? 1 : 0;
 }
 
 /* ---- render side ---------------------------------------------------------------------------- */
@@ -925,6 +969,114 @@ void tool_indirect_close(tool_indirect *m)
 
 const float *tool_indirect_rowsums(const tool_indirect *m) { return m->S; }
 
+/* stochastic and hierarchical bakes: their solution L, checked */
+static int indirect_open_solution(tool_indirect *m, const rad_container *ct, const char *bake_name,
+                                  const tool_method_info *mi, const tool_method_options *mo)
+{
+    const char *cmd = m->cmd;
+    uint32_t n = m->n;
+    const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
+    uint32_t i;
+    if (!ls || ls->elem_size != 12 || ls->count != n) {
+        fprintf(stderr, "rad %s: bake '%s' holds no solution L for its %u patches (vector section L)\n", cmd, bake_name, n);
+        return 1;
+    }
+    m->Ls = (const float *)ls->data;
+    for (i = 0; i < 3 * n; ++i)
+        if (!(m->Ls[i] >= 0.0f && m->Ls[i] <= RAD_BAKE_VALUE_MAX)) {
+            fprintf(stderr, "rad %s: bake '%s': vector L, value %u is %g (not in [0, 1e30])\n", cmd, bake_name, i,
+                    (double)m->Ls[i]);
+            return 1;
+        }
+    m->solve_seconds = mi->build_seconds;
+    if (mo->method == TOOL_HIERARCHICAL)
+        fprintf(stderr, "rad %s: hierarchical (--hr-eps %g: %u leaves, %llu links, resampled onto %u patches), solved in "
+                        "%.3f s\n", cmd, (double)mi->w, mi->k, (unsigned long long)(((uint64_t)mi->bytes_hi << 32) | mi->bytes_lo),
+                n, (double)mi->build_seconds);
+    else
+        fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
+                mi->mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
+                (unsigned long long)(((uint64_t)mi->bytes_hi << 32) | mi->bytes_lo), (double)mi->build_seconds);
+    return 0;
+}
+
+/* multibounce: F_mb (float, half or compressed) */
+static int indirect_open_fmb(tool_indirect *m, const rad_container *ct, const char *bake_name,
+                                  const tool_method_info *mi, const tool_method_options *mo)
+{
+    const char *cmd = m->cmd;
+    uint32_t n = m->n;
+    rad_result r;
+    (void)mo;
+    const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
+    uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;
+    if (kind > 3) {
+        fprintf(stderr, "rad %s: bake '%s' holds no multi-bounce matrix 'Fmb'\n", cmd, bake_name);
+        return 1;
+    }
+    r = kind >= 2 ? rad_multibounce_blocks_load(ct, "Fmb", &m->ctx, &m->blocks)
+                  : rad_multibounce_load(ct, "Fmb", &m->ctx, &m->mb);
+    if (r == RAD_SUCCESS && (kind >= 2 ? m->blocks->n : m->mb->n) != n) {
+        fprintf(stderr, "rad %s: bake '%s': F_mb is %u x %u for %u patches\n", cmd, bake_name,
+                kind >= 2 ? m->blocks->n : m->mb->n, kind >= 2 ? m->blocks->n : m->mb->n, n);
+        return 1;
+    }
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bake '%s': cannot open its multi-bounce matrix\n", cmd, bake_name);
+        return tool_fail(cmd, "rad_multibounce_load", r);
+    }
+    if (mi->bounces == RAD_MB_INFINITE)
+        fprintf(stderr, "rad %s: F_mb %s, bounces inf, %u patches\n", cmd, format_name(kind), n);
+    else
+        fprintf(stderr, "rad %s: F_mb %s, bounces %u (F_mb holds %u with the gather), %u patches\n", cmd,
+                format_name(kind), mi->bounces, mi->bounces + 1u, n);
+    return 0;
+}
+
+/* temporal: the alias tables and the temporal state, the render's --k, --w, --adaptive and
+   --seed over the bake's */
+static int indirect_open_temporal(tool_indirect *m, const rad_container *ct, const char *bake_name,
+                                  const tool_method_info *mi, const tool_method_options *mo)
+{
+    const char *cmd = m->cmd;
+    uint32_t n = m->n;
+    rad_result r;
+    static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
+    const rad_alias_tables *tp[3];
+    rad_temporal_options to;
+    uint32_t tcount = mi->mode == RAD_TEMPORAL_MULTIBOUNCE ? 3u : 1u, i;
+    for (i = 0; i < tcount; ++i) {
+        const char *name = tcount == 3 ? names[i] : "F";
+        if (!rad_container_find(ct, RAD_SECTION_TEMPORAL_BINS, name)) {
+            fprintf(stderr, "rad %s: bake '%s' holds no alias tables '%s'\n", cmd, bake_name, name);
+            return 1;
+        }
+        if ((r = rad_alias_tables_view(ct, name, &m->ctx, &m->tables[i])) != RAD_SUCCESS) {
+            return tool_fail(cmd, "rad_alias_tables_view", r);
+        }
+        if (m->tables[i].rows != n) {
+            fprintf(stderr, "rad %s: bake '%s': alias tables '%s' have %u rows for %u patches\n", cmd, bake_name,
+                    name, m->tables[i].rows, n);
+            return 1;
+        }
+        tp[i] = &m->tables[i];
+    }
+    rad_temporal_options_default(&to);
+    to.mode = (rad_temporal_mode)mi->mode;
+    to.samples = (mo->given & TOOL_OPT_K) ? mo->k : mi->k;
+    to.adaptive = (mo->given & TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & TOOL_OPT_W) ? 0 : (int)mi->adaptive;
+    to.weight = (mo->given & TOOL_OPT_W) ? mo->w : mi->w;
+    if (to.weight == 0.0f) to.weight = -1.0f; /* --w 0: no history (a weight of 0 is the default) */
+    to.seed = (mo->given & TOOL_OPT_SEED) ? mo->seed : mi->seed;
+    if ((r = rad_temporal_create(tp, tcount, m->albedo, &to, &m->ctx, &m->temporal)) != RAD_SUCCESS) {
+        return tool_fail(cmd, "rad_temporal_create", r);
+    }
+    fprintf(stderr, "rad %s: temporal, mode %s, k %u, %s%.4g, seed %u, %u patches\n", cmd, mode_name(mi->mode),
+            to.samples, to.adaptive ? "adaptive w, max " : "w ", (double)(to.adaptive ? to.weight_max : to.weight),
+            to.seed, n);
+    return 0;
+}
+
 int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
                            const tool_method_options *mo, tool_indirect **out)
 {
@@ -932,7 +1084,7 @@ int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *b
     const rad_section *s;
     tool_method_info mi;
     tool_indirect *m;
-    rad_result r;
+    int r;
     uint32_t n = bake->patches.count;
     const char *mname = tool_method_name(mo->method);
     *out = NULL;
@@ -987,95 +1139,12 @@ int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *b
     m->S = (const float *)s->data;
     m->L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     tool_context(&m->ctx, NULL);
-    if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) {
-        const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
-        uint32_t i;
-        if (!ls || ls->elem_size != 12 || ls->count != n) {
-            fprintf(stderr, "rad %s: bake '%s' holds no solution L for its %u patches (vector section L)\n", cmd, bake_name, n);
-            tool_indirect_close(m);
-            return 1;
-        }
-        m->Ls = (const float *)ls->data;
-        for (i = 0; i < 3 * n; ++i)
-            if (!(m->Ls[i] >= 0.0f && m->Ls[i] <= RAD_BAKE_VALUE_MAX)) {
-                fprintf(stderr, "rad %s: bake '%s': vector L, value %u is %g (not in [0, 1e30])\n", cmd, bake_name, i,
-                        (double)m->Ls[i]);
-                tool_indirect_close(m);
-                return 1;
-            }
-        m->solve_seconds = mi.build_seconds;
-        if (mo->method == TOOL_HIERARCHICAL)
-            fprintf(stderr, "rad %s: hierarchical (--hr-eps %g: %u leaves, %llu links, resampled onto %u patches), solved in "
-                            "%.3f s\n", cmd, (double)mi.w, mi.k, (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo),
-                    n, (double)mi.build_seconds);
-        else
-            fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
-                    mi.mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
-                    (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo), (double)mi.build_seconds);
-    } else if (mo->method == TOOL_MULTIBOUNCE) {
-        const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
-        uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;
-        if (kind > 3) {
-            fprintf(stderr, "rad %s: bake '%s' holds no multi-bounce matrix 'Fmb'\n", cmd, bake_name);
-            tool_indirect_close(m);
-            return 1;
-        }
-        r = kind >= 2 ? rad_multibounce_blocks_load(ct, "Fmb", &m->ctx, &m->blocks)
-                      : rad_multibounce_load(ct, "Fmb", &m->ctx, &m->mb);
-        if (r == RAD_SUCCESS && (kind >= 2 ? m->blocks->n : m->mb->n) != n) {
-            fprintf(stderr, "rad %s: bake '%s': F_mb is %u x %u for %u patches\n", cmd, bake_name,
-                    kind >= 2 ? m->blocks->n : m->mb->n, kind >= 2 ? m->blocks->n : m->mb->n, n);
-            tool_indirect_close(m);
-            return 1;
-        }
-        if (r != RAD_SUCCESS) {
-            tool_indirect_close(m);
-            fprintf(stderr, "rad %s: bake '%s': cannot open its multi-bounce matrix\n", cmd, bake_name);
-            return tool_fail(cmd, "rad_multibounce_load", r);
-        }
-        if (mi.bounces == RAD_MB_INFINITE)
-            fprintf(stderr, "rad %s: F_mb %s, bounces inf, %u patches\n", cmd, format_name(kind), n);
-        else
-            fprintf(stderr, "rad %s: F_mb %s, bounces %u (F_mb holds %u with the gather), %u patches\n", cmd,
-                    format_name(kind), mi.bounces, mi.bounces + 1u, n);
-    } else {
-        static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
-        const rad_alias_tables *tp[3];
-        rad_temporal_options to;
-        uint32_t tcount = mi.mode == RAD_TEMPORAL_MULTIBOUNCE ? 3u : 1u, i;
-        for (i = 0; i < tcount; ++i) {
-            const char *name = tcount == 3 ? names[i] : "F";
-            if (!rad_container_find(ct, RAD_SECTION_TEMPORAL_BINS, name)) {
-                fprintf(stderr, "rad %s: bake '%s' holds no alias tables '%s'\n", cmd, bake_name, name);
-                tool_indirect_close(m);
-                return 1;
-            }
-            if ((r = rad_alias_tables_view(ct, name, &m->ctx, &m->tables[i])) != RAD_SUCCESS) {
-                tool_indirect_close(m);
-                return tool_fail(cmd, "rad_alias_tables_view", r);
-            }
-            if (m->tables[i].rows != n) {
-                fprintf(stderr, "rad %s: bake '%s': alias tables '%s' have %u rows for %u patches\n", cmd, bake_name,
-                        name, m->tables[i].rows, n);
-                tool_indirect_close(m);
-                return 1;
-            }
-            tp[i] = &m->tables[i];
-        }
-        rad_temporal_options_default(&to);
-        to.mode = (rad_temporal_mode)mi.mode;
-        to.samples = (mo->given & TOOL_OPT_K) ? mo->k : mi.k;
-        to.adaptive = (mo->given & TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & TOOL_OPT_W) ? 0 : (int)mi.adaptive;
-        to.weight = (mo->given & TOOL_OPT_W) ? mo->w : mi.w;
-        if (to.weight == 0.0f) to.weight = -1.0f; /* --w 0: no history (a weight of 0 is the default) */
-        to.seed = (mo->given & TOOL_OPT_SEED) ? mo->seed : mi.seed;
-        if ((r = rad_temporal_create(tp, tcount, m->albedo, &to, &m->ctx, &m->temporal)) != RAD_SUCCESS) {
-            tool_indirect_close(m);
-            return tool_fail(cmd, "rad_temporal_create", r);
-        }
-        fprintf(stderr, "rad %s: temporal, mode %s, k %u, %s%.4g, seed %u, %u patches\n", cmd, mode_name(mi.mode),
-                to.samples, to.adaptive ? "adaptive w, max " : "w ", (double)(to.adaptive ? to.weight_max : to.weight),
-                to.seed, n);
+    if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) r = indirect_open_solution(m, ct, bake_name, &mi, mo);
+    else if (mo->method == TOOL_MULTIBOUNCE) r = indirect_open_fmb(m, ct, bake_name, &mi, mo);
+    else r = indirect_open_temporal(m, ct, bake_name, &mi, mo);
+    if (r) {
+        tool_indirect_close(m);
+        return 1;
     }
     *out = m;
     return 0;
