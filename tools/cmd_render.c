@@ -89,14 +89,6 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-typedef struct isect_job {
-    const rad_raycaster *rc;
-    const rad_ray *rays;
-    rad_hit *hits;
-    uint32_t count;
-    int failed;
-} isect_job;
-
 /* What render_classic draws: the view and the per-pixel options of the command line */
 typedef struct render_view {
     rad_camera cam;
@@ -187,201 +179,234 @@ static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, con
     return r;
 }
 
-static int render_classic(const tool_world *w, const render_view *view, render_source *src, tool_image *img)
+/* The camera samples of a band of rows in flight through render_classic: rays, hits, the
+   front-face hits among them (valid: their ray index) and what each stage computes there. */
+typedef struct pixel_batch {
+    uint32_t strata, spp;    /* samples per pixel: strata x strata */
+    size_t cap;              /* samples a batch holds */
+    int rows;                /* rows per batch */
+    rad_ray *rays;
+    rad_hit *hits;
+    float *points, *normals, *irr; /* per valid hit: position, normal, direct irradiance D */
+    float *gathered;         /* per valid hit: H from the source's gather or the final gather (or NULL) */
+    float *shade_v, *shade_a, *shaded; /* --shading: view direction, albedo, direct radiance */
+    uint32_t *valid;
+    uint32_t count, nvalid;
+} pixel_batch;
+
+/* The samples of a batch: 64K, at least one row */
+#define RENDER_BATCH_SAMPLES 65536u
+
+static void pixel_batch_alloc(pixel_batch *b, const render_view *view, const render_source *src)
+{
+    memset(b, 0, sizeof *b);
+    for (b->strata = 1; (b->strata + 1) * (b->strata + 1) <= view->aa; ++b->strata) {
+    }
+    b->spp = b->strata * b->strata;
+    b->rows = (int)(RENDER_BATCH_SAMPLES / ((size_t)view->width * b->spp));
+    if (b->rows < 1) b->rows = 1;
+    b->cap = (size_t)b->rows * view->width * b->spp;
+    b->rays = (rad_ray *)xmalloc(sizeof(rad_ray) * b->cap);
+    b->hits = (rad_hit *)xmalloc(sizeof(rad_hit) * b->cap);
+    b->points = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    b->normals = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    b->irr = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    b->valid = (uint32_t *)xmalloc(sizeof(uint32_t) * b->cap);
+    if (src->vp || src->hr || src->lm || view->final_gather) b->gathered = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    if (view->shading >= 0) {
+        b->shade_v = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+        b->shade_a = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+        b->shaded = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    }
+}
+
+static void pixel_batch_free(pixel_batch *b)
+{
+    free(b->rays);
+    free(b->hits);
+    free(b->points);
+    free(b->normals);
+    free(b->irr);
+    free(b->valid);
+    free(b->shade_v);
+    free(b->shade_a);
+    free(b->shaded);
+    free(b->gathered);
+}
+
+/* Rows y0..y1-1: the stratified camera rays, their hits (in parallel chunks: the raycaster is
+   thread-safe), the sky and environment seen by rays that leave the scene added to img, and
+   the front-face hits listed in b->valid with their points and normals. 0 or 1 (printed). */
+static int batch_primary(const tool_world *w, const render_view *view, pixel_batch *b, int y0, int y1,
+                         const float sky[3], tool_image *img)
+{
+    const rad_scene *scene = w->scene;
+    int x, y, chunk, nchunks, failed = 0;
+    uint32_t s, k, i;
+    b->count = b->nvalid = 0;
+    for (y = y0; y < y1; ++y)
+        for (x = 0; x < view->width; ++x)
+            for (s = 0; s < b->spp; ++s) {
+                float px = (float)x + ((float)(s % b->strata) + 0.5f) / (float)b->strata;
+                float py = (float)y + ((float)(s / b->strata) + 0.5f) / (float)b->strata;
+                rad_camera_ray(&view->cam, (uint32_t)view->width, (uint32_t)view->height, px, py, &b->rays[b->count++]);
+            }
+    nchunks = (int)((b->count + 4095) / 4096);
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+#endif
+    for (chunk = 0; chunk < nchunks; ++chunk) {
+        uint32_t cb = (uint32_t)chunk * 4096u, ce = cb + 4096u < b->count ? cb + 4096u : b->count;
+        if (w->rc.intersect(w->rc.user, b->rays + cb, ce - cb, b->hits + cb) != RAD_SUCCESS) failed |= 1;
+    }
+    if (failed) return tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
+    for (k = 0; k < b->count; ++k) {
+        uint32_t t = b->hits[k].triangle;
+        const float *v, *nt;
+        if (t == RAD_NONE || t >= scene->triangle_count) {
+            size_t pixel = (size_t)y0 * view->width + k / b->spp;
+            uint32_t l;
+            for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
+            /* and an environment map its radiance in the ray's direction */
+            for (l = 0; l < w->file.light_count; ++l)
+                if (w->file.lights[l].type == RAD_LIGHT_ENVIRONMENT) {
+                    float rgb[3];
+                    rad_environment_radiance(w->file.lights[l].environment, b->rays[k].dir, rgb);
+                    for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += w->file.lights[l].color[i] * rgb[i];
+                }
+            b->hits[k].triangle = RAD_NONE;
+            continue;
+        }
+        nt = scene->normals + 3 * (size_t)t;
+        if (nt[0] * b->rays[k].dir[0] + nt[1] * b->rays[k].dir[1] + nt[2] * b->rays[k].dir[2] >= 0.0f) {
+            b->hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
+            continue;
+        }
+        v = scene->positions + 9 * (size_t)t;
+        for (i = 0; i < 3; ++i) {
+            b->points[3 * b->nvalid + i] = v[i] + b->hits[k].b1 * (v[3 + i] - v[i]) + b->hits[k].b2 * (v[6 + i] - v[i]);
+            b->normals[3 * b->nvalid + i] = nt[i];
+        }
+        b->valid[b->nvalid++] = k;
+    }
+    return 0;
+}
+
+/* At the valid hits: the direct irradiance D, and H into b->gathered from the final gather,
+   the lightmap, or the virtual patches' or hierarchical gather (none: the caller interpolates
+   the patches' per-vertex H); the --shading model's direct radiance. 0 or 1 (printed). */
+static int batch_light(const tool_world *w, const render_view *view, render_source *src, pixel_batch *b, int y0)
+{
+    const rad_scene *scene = w->scene;
+    rad_direct_options dopt;
+    rad_context quiet;
+    rad_result r;
+    uint32_t k, i, n = b->nvalid;
+    double tg = tool_seconds();
+    if (n == 0) return 0;
+    tool_context(&quiet, NULL);
+    rad_direct_options_default(&dopt);
+    dopt.exclude_emitters = 0;
+    dopt.light_samples = view->light_samples;
+    r = rad_direct_irradiance(scene, &w->rc, w->file.lights, w->file.light_count, &dopt, b->points, b->normals, n, b->irr,
+                              &quiet);
+    if (r != RAD_SUCCESS) return tool_fail("render", "rad_direct_irradiance", r);
+    tg = tool_seconds();
+    if (view->final_gather) {
+        rad_final_gather_options fo;
+        rad_final_gather_options_default(&fo);
+        fo.rays = view->final_gather;
+        fo.seed = (uint32_t)y0 * 0x9E3779B9u;
+        r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, src, b->points,
+                             b->normals, n, b->gathered, &quiet);
+        if (r != RAD_SUCCESS) return tool_fail("render", "rad_final_gather", r);
+    } else if (src->lm) {
+        for (k = 0; k < n; ++k) {
+            const rad_hit *h = &b->hits[b->valid[k]];
+            const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
+            float u = t[0] + h->b1 * (t[2] - t[0]) + h->b2 * (t[4] - t[0]);
+            float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
+            rad_lightmap_sample(src->lm, 3, src->lm_values, u, v, b->gathered + 3 * k);
+        }
+    } else if (b->gathered) {
+        r = src->hr ? hr_lookup(src->hr, b->hits, b->valid, n, b->gathered)
+                    : rad_vp_gather(src->vp, src->vp_H, b->points, b->normals, n, b->gathered, &quiet);
+        if (r != RAD_SUCCESS) {
+            src->gather_seconds += tool_seconds() - tg;
+            return tool_fail("render", "rad_vp_gather", r);
+        }
+    }
+    if (b->gathered) src->gather_seconds += tool_seconds() - tg;
+    if (!b->shaded) return 0;
+    for (k = 0; k < n; ++k) {
+        const rad_ray *ry = &b->rays[b->valid[k]];
+        const rad_hit *h = &b->hits[b->valid[k]];
+        float len = sqrtf(ry->dir[0] * ry->dir[0] + ry->dir[1] * ry->dir[1] + ry->dir[2] * ry->dir[2]);
+        for (i = 0; i < 3; ++i) b->shade_v[3 * k + i] = -ry->dir[i] / len;
+        rad_scene_albedo(scene, h->triangle, h->b1, h->b2, b->shade_a + 3 * k);
+    }
+    return tool_shade_direct(w, view->shading, view->light_samples, b->points, b->normals, b->shade_v, b->shade_a, n,
+                             b->shaded);
+}
+
+/* each valid hit's radiance into its pixel: albedo / pi (D + H) (or the shading model's direct
+   radiance + albedo / pi H) plus what it emits */
+static void batch_accumulate(const tool_world *w, const render_source *src, const pixel_batch *b, int width, int y0,
+                             tool_image *img)
 {
     const rad_scene *scene = w->scene;
     const rad_patches *P = src->P;
     const float *Hv = src->Hv;
-    const rad_camera *cam = &view->cam;
-    int width = view->width, height = view->height;
-    uint32_t aa = view->aa, light_samples = view->light_samples;
-    uint32_t strata, spp;
-    size_t batch_cap, total = (size_t)width * height, done_px = 0;
-    rad_ray *rays;
-    rad_hit *hits;
-    float *points, *normals, *irr, *shade_v = NULL, *shade_a = NULL, *shaded = NULL, *gathered = NULL;
-    uint32_t *valid;
-    rad_direct_options dopt;
-    rad_context quiet;
-    int y0, rows_per_batch, result = 0;
-    float sky[3] = {0.0f, 0.0f, 0.0f};
     uint32_t k, i;
-    for (strata = 1; (strata + 1) * (strata + 1) <= aa; ++strata) {
+    for (k = 0; k < b->nvalid; ++k) {
+        uint32_t ray = b->valid[k];
+        size_t pixel = (size_t)y0 * width + ray / b->spp;
+        const rad_hit *h = &b->hits[ray];
+        float albedo[3], wts[3], emitted[3];
+        uint32_t p = b->gathered ? 0u : rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
+        const uint32_t *vi;
+        if (p == RAD_NONE) continue;
+        vi = b->gathered ? NULL : P->patches[p].vertices;
+        rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
+        rad_scene_emission(scene, h->triangle, h->b1, h->b2, emitted);
+        for (i = 0; i < 3; ++i) {
+            float hi = b->gathered ? b->gathered[3 * k + i]
+                                   : wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
+                                         wts[2] * Hv[3 * (size_t)vi[2] + i];
+            img->rgb[3 * pixel + i] += (b->shaded ? b->shaded[3 * k + i] + albedo[i] / PI_F * hi
+                                                  : albedo[i] / PI_F * (b->irr[3 * k + i] + hi)) + emitted[i];
+        }
     }
-    spp = strata * strata;
-    rows_per_batch = (int)(65536 / ((size_t)width * spp));
-    if (rows_per_batch < 1) rows_per_batch = 1;
-    batch_cap = (size_t)rows_per_batch * width * spp;
-    rays = (rad_ray *)xmalloc(sizeof(rad_ray) * batch_cap);
-    hits = (rad_hit *)xmalloc(sizeof(rad_hit) * batch_cap);
-    points = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
-    if (src->vp || src->hr || src->lm || view->final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    if (view->shading >= 0) {
-        shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-        shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-        shaded = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    }
-    rad_direct_options_default(&dopt);
-    dopt.exclude_emitters = 0;
-    dopt.light_samples = light_samples;
-    tool_context(&quiet, NULL);
+}
+
+/* The image of the radiosity methods: per sample the direct light D at the hit (shadow rays),
+   H from src, radiance albedo / pi (D + H) plus emission; each pixel the mean of its samples.
+   0 or 1 (printed). */
+static int render_classic(const tool_world *w, const render_view *view, render_source *src, tool_image *img)
+{
+    pixel_batch b;
+    size_t total = (size_t)view->width * view->height, done_px = 0, q;
+    float sky[3] = {0.0f, 0.0f, 0.0f}, inv;
+    uint32_t k, i;
+    int y0, result = 0;
+    pixel_batch_alloc(&b, view, src);
     /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
     for (k = 0; k < w->file.light_count; ++k)
         if (w->file.lights[k].type == RAD_LIGHT_SKY)
             for (i = 0; i < 3; ++i) sky[i] += w->file.lights[k].color[i] / PI_F;
-
-    for (y0 = 0; y0 < height && result == 0; y0 += rows_per_batch) {
-        int y1 = y0 + rows_per_batch < height ? y0 + rows_per_batch : height, chunk, nchunks;
-        uint32_t count = 0, nvalid = 0;
-        int x, y;
-        uint32_t s;
-        rad_result r;
-        for (y = y0; y < y1; ++y)
-            for (x = 0; x < width; ++x)
-                for (s = 0; s < spp; ++s) {
-                    float px = (float)x + ((float)(s % strata) + 0.5f) / (float)strata;
-                    float py = (float)y + ((float)(s / strata) + 0.5f) / (float)strata;
-                    rad_camera_ray(cam, (uint32_t)width, (uint32_t)height, px, py, &rays[count++]);
-                }
-        /* primary rays in parallel chunks (the raycaster is thread-safe) */
-        nchunks = (int)((count + 4095) / 4096);
-        {
-            int failed = 0;
-#ifdef _OPENMP
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
-#endif
-            for (chunk = 0; chunk < nchunks; ++chunk) {
-                uint32_t b = (uint32_t)chunk * 4096u, e = b + 4096u < count ? b + 4096u : count;
-                if (w->rc.intersect(w->rc.user, rays + b, e - b, hits + b) != RAD_SUCCESS) failed |= 1;
-            }
-            if (failed) {
-                result = tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
-                break;
-            }
-        }
-        for (k = 0; k < count; ++k) {
-            uint32_t t = hits[k].triangle;
-            const float *v, *nt;
-            if (t == RAD_NONE || t >= scene->triangle_count) {
-                size_t pixel = (size_t)y0 * width + k / spp;
-                uint32_t l;
-                for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
-                /* and an environment map its radiance in the ray's direction */
-                for (l = 0; l < w->file.light_count; ++l)
-                    if (w->file.lights[l].type == RAD_LIGHT_ENVIRONMENT) {
-                        float rgb[3];
-                        rad_environment_radiance(w->file.lights[l].environment, rays[k].dir, rgb);
-                        for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += w->file.lights[l].color[i] * rgb[i];
-                    }
-                hits[k].triangle = RAD_NONE;
-                continue;
-            }
-            nt = scene->normals + 3 * (size_t)t;
-            if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] >= 0.0f) {
-                hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
-                continue;
-            }
-            v = scene->positions + 9 * (size_t)t;
-            for (i = 0; i < 3; ++i) {
-                points[3 * nvalid + i] = v[i] + hits[k].b1 * (v[3 + i] - v[i]) + hits[k].b2 * (v[6 + i] - v[i]);
-                normals[3 * nvalid + i] = nt[i];
-            }
-            valid[nvalid++] = k;
-        }
-        if (nvalid > 0) {
-            r = rad_direct_irradiance(scene, &w->rc, w->file.lights, w->file.light_count, &dopt, points, normals, nvalid,
-                                      irr, &quiet);
-            if (r != RAD_SUCCESS) {
-                result = tool_fail("render", "rad_direct_irradiance", r);
-                break;
-            }
-        }
-        if (view->final_gather && nvalid > 0) {
-            rad_final_gather_options fo;
-            double tg = tool_seconds();
-            rad_final_gather_options_default(&fo);
-            fo.rays = view->final_gather;
-            fo.seed = (uint32_t)y0 * 0x9E3779B9u;
-            r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, src, points, normals,
-                                 nvalid, gathered, &quiet);
-            src->gather_seconds += tool_seconds() - tg;
-            if (r != RAD_SUCCESS) {
-                result = tool_fail("render", "rad_final_gather", r);
-                break;
-            }
-        } else if (src->lm && nvalid > 0) {
-            double tg = tool_seconds();
-            for (k = 0; k < nvalid; ++k) {
-                const rad_hit *h = &hits[valid[k]];
-                const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
-                float u = t[0] + h->b1 * (t[2] - t[0]) + h->b2 * (t[4] - t[0]);
-                float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
-                rad_lightmap_sample(src->lm, 3, src->lm_values, u, v, gathered + 3 * k);
-            }
-            src->gather_seconds += tool_seconds() - tg;
-        } else if (gathered && nvalid > 0) {
-            double tg = tool_seconds();
-            r = src->hr ? hr_lookup(src->hr, hits, valid, nvalid, gathered)
-                        : rad_vp_gather(src->vp, src->vp_H, points, normals, nvalid, gathered, &quiet);
-            src->gather_seconds += tool_seconds() - tg;
-            if (r != RAD_SUCCESS) {
-                result = tool_fail("render", "rad_vp_gather", r);
-                break;
-            }
-        }
-        if (shaded && nvalid > 0) {
-            for (k = 0; k < nvalid; ++k) {
-                const rad_ray *ry = &rays[valid[k]];
-                float len = sqrtf(ry->dir[0] * ry->dir[0] + ry->dir[1] * ry->dir[1] + ry->dir[2] * ry->dir[2]);
-                for (i = 0; i < 3; ++i) shade_v[3 * k + i] = -ry->dir[i] / len;
-                rad_scene_albedo(scene, hits[valid[k]].triangle, hits[valid[k]].b1, hits[valid[k]].b2, shade_a + 3 * k);
-            }
-            if (tool_shade_direct(w, view->shading, light_samples, points, normals, shade_v, shade_a, nvalid, shaded)) {
-                result = 1;
-                break;
-            }
-        }
-        for (k = 0; k < nvalid; ++k) {
-            uint32_t ray = valid[k];
-            size_t pixel = (size_t)y0 * width + ray / spp;
-            const rad_hit *h = &hits[ray];
-            float albedo[3], wts[3], emitted[3];
-            uint32_t p = gathered ? 0u : rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
-            const uint32_t *vi;
-            if (p == RAD_NONE) continue;
-            vi = gathered ? NULL : P->patches[p].vertices;
-            rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
-            rad_scene_emission(scene, h->triangle, h->b1, h->b2, emitted);
-            for (i = 0; i < 3; ++i) {
-                float hi = gathered ? gathered[3 * k + i]
-                                    : wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
-                                          wts[2] * Hv[3 * (size_t)vi[2] + i];
-                img->rgb[3 * pixel + i] += (shaded ? shaded[3 * k + i] + albedo[i] / PI_F * hi
-                                                   : albedo[i] / PI_F * (irr[3 * k + i] + hi)) + emitted[i];
-            }
-        }
-        done_px += (size_t)(y1 - y0) * width;
+    for (y0 = 0; y0 < view->height && result == 0; y0 += b.rows) {
+        int y1 = y0 + b.rows < view->height ? y0 + b.rows : view->height;
+        result = batch_primary(w, view, &b, y0, y1, sky, img);
+        if (result == 0) result = batch_light(w, view, src, &b, y0);
+        if (result) break;
+        batch_accumulate(w, src, &b, view->width, y0, img);
+        done_px += (size_t)(y1 - y0) * view->width;
         tool_progress((void *)(size_t)"render", (float)((double)done_px / (double)total));
     }
     tool_progress_end();
-    {
-        size_t q;
-        float inv = 1.0f / (float)spp;
-        for (q = 0; q < 3 * total; ++q) img->rgb[q] *= inv;
-    }
-    free(rays);
-    free(hits);
-    free(points);
-    free(normals);
-    free(irr);
-    free(valid);
-    free(shade_v);
-    free(shade_a);
-    free(shaded);
-    free(gathered);
+    inv = 1.0f / (float)b.spp;
+    for (q = 0; q < 3 * total; ++q) img->rgb[q] *= inv;
+    pixel_batch_free(&b);
     return result;
 }
 
