@@ -21,6 +21,90 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b)
     memset(b, 0, sizeof *b);
 }
 
+/* The world the lightmap is baked over, into out->w: the caller's (its file's second uv set), or a
+   copy over the automatic unwrap when a mesh has none or rq->force_unwrap (the atlas may grow:
+   *width, *height). 0, or 1 after printing why (the caller frees out). */
+static int lightmap_world(const char *cmd, const tool_world *w, const tool_classic_options *co,
+                          const tool_lightmap_request *rq, int *width, int *height, tool_lightmap_baked *out)
+{
+    tool_world w2 = *w;
+    rad_mesh_desc mesh;
+    rad_scene_desc desc;
+    rad_context ctx;
+    rad_result r;
+    /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
+    if (rq->force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
+        if (!rq->force_unwrap && w->scene->lightmap_uvs)
+            fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
+        uint32_t uw = (uint32_t)*width, uh = (uint32_t)*height;
+        tool_unwrap_auto au;
+        out->uvs = (float *)tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
+        /* the estimate: the texel records (flags, position, normal, sample index: 29 bytes),
+           the samples (position, normal, triangle, validity: 29 bytes each) and the values
+           with one working copy, plus an RGB image of the atlas */
+        au.max_side = TOOL_LIGHTMAP_AUTO_MAX;
+        au.bytes_per_texel = TOOL_LIGHTMAP_TEXEL_BYTES(rq->texel_samples ? rq->texel_samples : TOOL_LIGHTMAP_TEXEL_SAMPLES,
+                                                        rq->sh ? 12u : 3u);
+        if (co->max_memory > 0.0) au.memory_limit = co->max_memory, au.memory_from = "--max-memory";
+        else au.memory_limit = tool_mem_available(), au.memory_from = "MemAvailable in /proc/meminfo";
+        if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, &uw, &uh,
+                        rq->auto_size ? &au : NULL, out->uvs, NULL))
+            return 1;
+        *width = (int)uw;
+        *height = (int)uh;
+        memset(&mesh, 0, sizeof mesh);
+        mesh.name = "unwrapped";
+        mesh.positions = w->scene->positions;
+        mesh.vertex_count = 3 * w->scene->triangle_count;
+        mesh.uvs = w->scene->uvs;
+        mesh.triangle_count = w->scene->triangle_count;
+        mesh.material_ids = w->scene->materials;
+        mesh.lightmap_uvs = out->uvs;
+        desc = w->file.desc;
+        desc.meshes = &mesh;
+        desc.mesh_count = 1;
+        w2.scene = NULL;
+        w2.bvh = NULL;
+        out->own_scene = 1;
+        out->w = w2;
+        tool_context(&ctx, NULL);
+        if ((r = rad_scene_create(&desc, &ctx, &out->w.scene)) != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); return 1; }
+        if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { tool_fail(cmd, "rad_bvh_create", r); return 1; }
+        rad_bvh_raycaster(out->w.bvh, &out->w.rc);
+    } else {
+        out->w = w2;
+        fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
+    }
+    return 0;
+}
+
+/* The solution the texels gather: hierarchical, the proxy's virtual patches (their H into
+   *vp_H), or classic patches. 0, or 1 after printing why. */
+static int lightmap_solve(const char *cmd, const tool_classic_options *co, const tool_lightmap_proxy *proxy,
+                          tool_lightmap_baked *out, float **vp_H)
+{
+    const tool_world *w = &out->w;
+    if (proxy && proxy->kind == TOOL_LIGHTMAP_HIERARCHICAL) {
+        tool_method_options mo;
+        rad_hierarchical_stats hs;
+        double th = tool_seconds();
+        tool_method_options_default(&mo);
+        mo.hr_eps = proxy->hr_eps;
+        if (tool_hierarchical_build(cmd, w, &mo, co->light_samples, &out->hr)) return 1;
+        rad_hierarchical_get_stats(out->hr, &hs);
+        out->patches = hs.leaves;
+        out->solve_seconds = tool_seconds() - th;
+    } else if (proxy) {
+        if (tool_vp_proxy_solve(cmd, w, co, proxy, &out->vp, NULL, vp_H, &out->solve_seconds)) return 1;
+        out->patches = out->vp->count;
+    } else {
+        if (tool_classic_solve(cmd, w, co, &out->cl)) return 1;
+        out->patches = out->cl.patches->count;
+        out->solve_seconds = out->cl.solve_seconds;
+    }
+    return 0;
+}
+
 void tool_lightmap_request_default(tool_lightmap_request *rq)
 {
     memset(rq, 0, sizeof *rq);
@@ -40,7 +124,6 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     tool_classic_options co2 = *co;
     float *vp_H = NULL;
     double t_all = tool_seconds();
-    tool_world w2 = *world;
     rad_lightmap_options lo;
     rad_lightmap_gather_options go;
     rad_lightmap_seam_stats st;
@@ -48,8 +131,6 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     rad_result r;
     uint32_t ch;
     double t0;
-    rad_mesh_desc mesh;
-    rad_scene_desc desc;
     const tool_world *w = world;
     memset(out, 0, sizeof *out);
     if (proxy && sh) {
@@ -65,67 +146,9 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
                         "whatever the triangle count; --vp-resolution R sets how many)";
     co = &co2;
     if (!proxy && tool_dense_check(cmd, co, w->scene->triangle_count, 1)) return 1;
-    /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
-    if (rq->force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
-        if (!rq->force_unwrap && w->scene->lightmap_uvs)
-            fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
-        uint32_t uw = (uint32_t)width, uh = (uint32_t)height;
-        tool_unwrap_auto au;
-        out->uvs = (float *)tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
-        /* the estimate: the texel records (flags, position, normal, sample index: 29 bytes),
-           the samples (position, normal, triangle, validity: 29 bytes each) and the values
-           with one working copy, plus an RGB image of the atlas */
-        au.max_side = TOOL_LIGHTMAP_AUTO_MAX;
-        au.bytes_per_texel = TOOL_LIGHTMAP_TEXEL_BYTES(texel_samples ? texel_samples : TOOL_LIGHTMAP_TEXEL_SAMPLES, sh ? 12u : 3u);
-        if (co->max_memory > 0.0) au.memory_limit = co->max_memory, au.memory_from = "--max-memory";
-        else au.memory_limit = tool_mem_available(), au.memory_from = "MemAvailable in /proc/meminfo";
-        if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, &uw, &uh,
-                        rq->auto_size ? &au : NULL, out->uvs, NULL))
-            goto fail;
-        width = (int)uw;
-        height = (int)uh;
-        memset(&mesh, 0, sizeof mesh);
-        mesh.name = "unwrapped";
-        mesh.positions = w->scene->positions;
-        mesh.vertex_count = 3 * w->scene->triangle_count;
-        mesh.uvs = w->scene->uvs;
-        mesh.triangle_count = w->scene->triangle_count;
-        mesh.material_ids = w->scene->materials;
-        mesh.lightmap_uvs = out->uvs;
-        desc = w->file.desc;
-        desc.meshes = &mesh;
-        desc.mesh_count = 1;
-        w2.scene = NULL;
-        w2.bvh = NULL;
-        out->own_scene = 1;
-        out->w = w2;
-        tool_context(&ctx, NULL);
-        if ((r = rad_scene_create(&desc, &ctx, &out->w.scene)) != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); goto fail; }
-        if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { tool_fail(cmd, "rad_bvh_create", r); goto fail; }
-        rad_bvh_raycaster(out->w.bvh, &out->w.rc);
-    } else {
-        out->w = w2;
-        fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
-    }
+    if (lightmap_world(cmd, world, co, rq, &width, &height, out)) goto fail;
     w = &out->w;
-    if (proxy && proxy->kind == TOOL_LIGHTMAP_HIERARCHICAL) {
-        tool_method_options mo;
-        rad_hierarchical_stats hs;
-        double th = tool_seconds();
-        tool_method_options_default(&mo);
-        mo.hr_eps = proxy->hr_eps;
-        if (tool_hierarchical_build(cmd, w, &mo, co->light_samples, &out->hr)) goto fail;
-        rad_hierarchical_get_stats(out->hr, &hs);
-        out->patches = hs.leaves;
-        out->solve_seconds = tool_seconds() - th;
-    } else if (proxy) {
-        if (tool_vp_proxy_solve(cmd, w, co, proxy, &out->vp, NULL, &vp_H, &out->solve_seconds)) goto fail;
-        out->patches = out->vp->count;
-    } else {
-        if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
-        out->patches = out->cl.patches->count;
-        out->solve_seconds = out->cl.solve_seconds;
-    }
+    if (lightmap_solve(cmd, co, proxy, out, &vp_H)) goto fail;
     /* the gather wants the total radiosity of the secondary sources: B = E + L */
     t0 = tool_seconds();
     rad_lightmap_options_default(&lo);
