@@ -21,37 +21,121 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* rad lightmap's command line */
+typedef struct lightmap_args {
+    const char *scene, *out, *render; /* SCENE, -o, --render */
+    tool_classic_options co;
+    tool_lightmap_request rq;  /* --size, --sh, --texel-samples, --visibility-rays, --gather, ... */
+    tool_lightmap_proxy px;    /* --proxy and its options */
+    int rw, rh;                /* --render-size */
+    uint32_t aa;               /* --aa: N x N samples a pixel of --render */
+    float exposure;            /* --exposure */
+    uint32_t threads;
+    uint32_t given;            /* LIGHTMAP_GIVEN_* */
+} lightmap_args;
+enum { LIGHTMAP_GIVEN_SIZE = 1, LIGHTMAP_GIVEN_VP = 2, LIGHTMAP_GIVEN_HR = 4 };
+
+/* --size N|WxH into the request's width and height (field: width) */
+static int parse_atlas_size(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    tool_lightmap_request *rq = (tool_lightmap_request *)((char *)field - offsetof(tool_lightmap_request, width));
+    if (strchr(v, 'x')) {
+        if (tool_parse_size(v, &rq->width, &rq->height)) {
+            fprintf(stderr, "rad %s: bad --size '%s'\n", cmd, v);
+            return 2;
+        }
+    } else {
+        uint32_t n;
+        if (tool_parse_uint(cmd, t->name, v, &n)) return 2;
+        rq->width = rq->height = (int)(n > 16384u ? 16385u : n);
+    }
+    if (rq->width < 4 || rq->height < 4 || rq->width > 16384 || rq->height > 16384) {
+        fprintf(stderr, "rad %s: --size must be 4 to 16384 texels a side\n", cmd);
+        return 2;
+    }
+    return 0;
+}
+
+/* --render-size WxH into rw, rh (field: rw) */
+static int parse_render_size(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    lightmap_args *la = (lightmap_args *)((char *)field - offsetof(lightmap_args, rw));
+    (void)t;
+    if (tool_parse_size(v, &la->rw, &la->rh) || tool_check_size(cmd, la->rw, la->rh)) {
+        fprintf(stderr, "rad %s: bad --render-size '%s'\n", cmd, v);
+        return 2;
+    }
+    return 0;
+}
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+static const uint32_t proxy_values[] = {TOOL_PROXY_PATCHES, TOOL_PROXY_AAVP, TOOL_PROXY_VP, TOOL_LIGHTMAP_HIERARCHICAL};
+static const uint32_t gather_values[] = {RAD_LIGHTMAP_GATHER_EXACT, RAD_LIGHTMAP_GATHER_HEMISPHERE};
+#define LA(f) offsetof(lightmap_args, f)
+#define LA_UINT(name, val, f, lo, hi, given, bad, help) \
+    {TOOL_ARG_UINT, name, val, LA(f), lo, hi, 0, given, bad, NULL, NULL, NULL, 0, help}
+#define LA_FLAG(name, f, help) {TOOL_ARG_FLAG, name, NULL, LA(f), 1, 0, 0, 0, NULL, NULL, NULL, NULL, 0, help}
+#define LA_CUSTOM(name, val, f, fn, given, help) \
+    {TOOL_ARG_CUSTOM, name, val, LA(f), 0, 0, 0, given, NULL, NULL, NULL, fn, 0, help}
+/* rad lightmap's own options (the classic and light options are classic.c's and lights.c's) */
+static const tool_arg lightmap_table[] = {
+    {TOOL_ARG_STRING, "-o", "FILE", LA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "the lightmap: .pfm or .exr (linear irradiance, W m^-2) or .png (exposure applied)"},
+    LA_CUSTOM("--size", "N|WxH", rq.width, parse_atlas_size, LIGHTMAP_GIVEN_SIZE,
+              "atlas texels (default 256; with an unwrap whose charts do not fit, the smallest\n"
+              "power of two up to 4096 that they fit, said on stderr)"),
+    LA_FLAG("--sh", rq.sh,
+            "L1 spherical harmonics of the indirect light (4 PFM or EXR files OUT.L00.pfm\n"
+            "OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)"),
+    LA_UINT("--texel-samples", "N", rq.texel_samples, 1, 16, 0, "must be 1 to 16",
+            "sample points per texel, a square grid (default 4, at most 16)"),
+    LA_UINT("--visibility-rays", "N", rq.visibility_rays, 1, 64, 0, "must be 1 to 64",
+            "shadow rays per sample point and patch (default 2, at most 64)"),
+    {TOOL_ARG_CHOICE, "--gather", "M", LA(rq.gather), 0, 0, 0, 0, NULL, "exact|hemisphere", gather_values, NULL, 0,
+     "exact (every patch's form factor from every sample) or hemisphere (the brightest\n"
+     "patches exactly, the rest by rays; its cost does not grow with the patches); default:\n"
+     "hemisphere when samples x patches exceeds 2e7"},
+    LA_UINT("--hemisphere-rays", "N", rq.hemisphere_rays, 1, 65536, 0, "must be 1 to 65536",
+            "rays per texel of the hemisphere gather (default 256, at most 65536)"),
+    LA_FLAG("--unwrap", rq.force_unwrap, "unwrap even when the file has a second uv set"),
+    {TOOL_ARG_CHOICE, "--proxy", "P", LA(px.kind), 0, 0, 0, 0, NULL, "patches|aavp|vp|hierarchical", proxy_values, NULL, 0,
+     "the indirect light from patches (the classic solution, default), aavp or vp (virtual\n"
+     "patches: a few thousand unknowns whatever the triangle count, for real buildings; each\n"
+     "texel gathers their H at its sample points; RGB only, not --sh), or hierarchical (the\n"
+     "hierarchical solution's smooth lookup at each sample)"},
+    LA_UINT("--vp-resolution", "R", px.resolution, 1, 4096, LIGHTMAP_GIVEN_VP, "must be 1 to 4096",
+            "--proxy aavp|vp: voxels along the longest axis (default 16)"),
+    LA_UINT("--face-points", "P", px.face_points, 1, 4096, LIGHTMAP_GIVEN_VP, "must be 1 to 4096",
+            "--proxy aavp|vp: Hammersley points per voxel face (default 16)"),
+    {TOOL_ARG_FLOAT, "--hr-eps", "E", LA(px.hr_eps), 0.0, 1.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, LIGHTMAP_GIVEN_HR,
+     "must be in (0, 1)", NULL, NULL, NULL, 0,
+     "--proxy hierarchical: refinement tolerance (default 1e-5: coarser is faster on large scenes)"},
+    {TOOL_ARG_STRING, "--render", "VIEW", LA(render), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "also render the camera view shaded from the lightmap (.png, .pfm, .exr; not with --sh):\n"
+     "radiance = emission + albedo x irradiance / pi"},
+    LA_CUSTOM("--render-size", "WxH", rw, parse_render_size, 0, "its size (default 256x256)"),
+    LA_UINT("--aa", "N", aa, 1, 16, 0, "must be 1 to 16",
+            "--render: N x N samples a pixel (default 2: 4 samples; 4 gives rad render's 16)"),
+    {TOOL_ARG_FLOAT, "--exposure", "X", LA(exposure), 0.0, 1e30, TOOL_ARG_LO_OPEN, 0, "must be > 0", NULL, NULL, NULL, 0,
+     "PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi: the radiance of a\n"
+     "white surface)"},
+    LA_CUSTOM("--threads", "N", threads, parse_threads, 0, "worker threads (default: all cores)"),
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 static void lightmap_usage(FILE *f)
 {
+    static char own[8192];
+    tool_args_help_into(lightmap_table, 0, own, sizeof own);
     fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [options]\n"
                "  bakes the classic radiosity solution into a lightmap over the second uv set\n"
                "  (glTF TEXCOORD_1); meshes without one are unwrapped automatically (simple charts)\n"
-               "  --size N|WxH          atlas texels (default 256; with an unwrap whose charts do not fit,\n"
-               "                        the smallest power of two up to 4096 that they fit, said on stderr)\n"
-               "  --sh                  L1 spherical harmonics of the indirect light (4 PFM or EXR files\n"
-               "                        OUT.L00.pfm OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)\n"
-               "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
-               "  --visibility-rays N   shadow rays per sample point and patch (default 2, at most 64)\n"
-               "  --gather M            exact (every patch's form factor from every sample) or hemisphere\n"
-               "                        (the brightest patches exactly, the rest by rays; its cost does not\n"
-               "                        grow with the patches); default: hemisphere when samples x patches\n"
-               "                        exceeds 2e7\n"
-               "  --hemisphere-rays N   rays per texel of the hemisphere gather (default 256, at most 65536)\n"
-               "  --unwrap              unwrap even when the file has a second uv set\n"
-               "  --proxy P             the indirect light from patches (the classic solution, default), aavp or\n"
-               "                        vp (virtual patches: a few thousand unknowns whatever the triangle count,\n"
-               "                        for real buildings; each texel gathers their H at its sample points; RGB\n"
-               "                        only, not --sh); --vp-resolution R (default 16), --face-points P (default 16);\n"
-               "                        or hierarchical (the hierarchical solution's smooth lookup at each sample;\n"
-               "                        --hr-eps E, default 1e-5: coarser is faster on large scenes)\n"
-               "  --render VIEW         also render the camera view shaded from the lightmap (.png, .pfm, .exr;\n"
-               "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
-               "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 4, as\n"
-               "                        rad render's 16 samples)\n"
-               "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
-               "                        the radiance of a white surface)\n"
-               "  --threads N           worker threads (default: all cores)\n"
-               "%s%s", tool_classic_help(), tool_light_help());
+               "%s%s%s",
+            own, tool_classic_help(), tool_light_help());
 }
 
 /* a path with 'tag' inserted before the extension: a.pfm -> a.L00.pfm */
@@ -114,149 +198,93 @@ static int lightmap_is_png(const char *path)
     return n >= 4 && (!strcmp(path + n - 4, ".png") || !strcmp(path + n - 4, ".PNG"));
 }
 
-static int lightmap_main(int argc, char **argv, tool_lights *lights)
+/* the command line into la; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
+static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_args *la)
 {
-    const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
-    int rw = 256, rh = 256;
-    uint32_t aa = 2;
-    tool_classic_options co;
-    tool_world w;
-    tool_lightmap_baked bk;
-    tool_lightmap_request rq;
-    const rad_lightmap *lm = NULL;
-    int width = TOOL_LIGHTMAP_SIZE, height = TOOL_LIGHTMAP_SIZE, size_given = 0, sh = 0, force_unwrap = 0, a, code = 1;
-    uint32_t threads = 0, texel_samples = TOOL_LIGHTMAP_TEXEL_SAMPLES, vis = TOOL_LIGHTMAP_VISIBILITY_RAYS, i, ch,
-             hemi_rays = TOOL_LIGHTMAP_HEMISPHERE_RAYS;
-    int gather = TOOL_LIGHTMAP_GATHER_AUTO; /* else a rad_lightmap_gather_method */
-    tool_lightmap_proxy px;
-    int px_opts = 0, hr_opts = 0;
-    const float *values = NULL;
-    float exposure = 0.31830988f;
-    memset(&bk, 0, sizeof bk);
-    memset(&px, 0, sizeof px);
-    tool_classic_options_default(&co);
+    int a, k;
+    memset(la, 0, sizeof *la);
+    tool_classic_options_default(&la->co);
+    tool_lightmap_request_default(&la->rq);
+    la->rw = la->rh = 256;
+    la->aa = 2;
+    la->exposure = 0.31830988f; /* 1/pi */
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
-        int k;
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
             lightmap_usage(stdout);
             return 0;
         }
-        if ((k = tool_classic_option("lightmap", argc, argv, &a, &co)) != 0) {
-            if (k == 2) return 2;
-            continue;
-        }
-        if ((k = tool_light_option("lightmap", argc, argv, &a, lights)) != 0) {
-            if (k == 2) return 2;
-            continue;
-        }
-        if (!strcmp(o, "--sh")) { sh = 1; continue; }
-        if (!strcmp(o, "--proxy") && a + 1 < argc) {
-            const char *v = argv[++a];
-            if (!strcmp(v, "aavp")) px.kind = TOOL_PROXY_AAVP;
-            else if (!strcmp(v, "vp")) px.kind = TOOL_PROXY_VP;
-            else if (!strcmp(v, "hierarchical")) px.kind = TOOL_LIGHTMAP_HIERARCHICAL;
-            else if (!strcmp(v, "patches")) px.kind = TOOL_PROXY_PATCHES;
-            else { fprintf(stderr, "rad lightmap: unknown --proxy '%s' (patches, aavp, vp or hierarchical)\n", v); return 2; }
-            continue;
-        }
-        if ((!strcmp(o, "--vp-resolution") || !strcmp(o, "--face-points")) && a + 1 < argc) {
-            uint32_t *dst = o[2] == 'v' ? &px.resolution : &px.face_points, hi = 4096u;
-            if (tool_parse_uint("lightmap", o, argv[++a], dst)) return 2;
-            if (*dst == 0 || *dst > hi) { fprintf(stderr, "rad lightmap: %s must be 1 to %u\n", o, hi); return 2; }
-            px_opts = 1;
-            continue;
-        }
-        if (!strcmp(o, "--hr-eps") && a + 1 < argc) {
-            if (tool_parse_float("lightmap", o, argv[++a], &px.hr_eps)) return 2;
-            if (!(px.hr_eps > 0.0f && px.hr_eps < 1.0f)) { fprintf(stderr, "rad lightmap: --hr-eps must be in (0, 1)\n"); return 2; }
-            hr_opts = 1;
-            continue;
-        }
-        if (!strcmp(o, "--unwrap")) { force_unwrap = 1; continue; }
-        if (o[0] == '-' && strcmp(o, "-") != 0 && a + 1 >= argc) {
-            fprintf(stderr, "rad lightmap: %s needs a value (or is unknown; try rad lightmap --help)\n", o);
-            return 2;
-        }
-        if (!strcmp(o, "-o")) out_path = argv[++a];
-        else if (!strcmp(o, "--render")) render_path = argv[++a];
-        else if (!strcmp(o, "--render-size")) {
-            if (tool_parse_size(argv[++a], &rw, &rh) || tool_check_size("lightmap", rw, rh)) {
-                fprintf(stderr, "rad lightmap: bad --render-size '%s'\n", argv[a]);
-                return 2;
-            }
-        } else if (!strcmp(o, "--aa")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &aa)) return 2;
-            if (aa == 0 || aa > 16) { fprintf(stderr, "rad lightmap: --aa must be 1 to 16\n"); return 2; }
-        } else if (!strcmp(o, "--size")) {
-            const char *v = argv[++a];
-            size_given = 1;
-            if (strchr(v, 'x')) {
-                if (tool_parse_size(v, &width, &height)) { fprintf(stderr, "rad lightmap: bad --size '%s'\n", v); return 2; }
-            } else {
-                uint32_t n;
-                if (tool_parse_uint("lightmap", o, v, &n)) return 2;
-                width = height = (int)(n > 16384u ? 16385u : n);
-            }
-            if (width < 4 || height < 4 || width > 16384 || height > 16384) {
-                fprintf(stderr, "rad lightmap: --size must be 4 to 16384 texels a side\n");
-                return 2;
-            }
-        } else if (!strcmp(o, "--texel-samples")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &texel_samples)) return 2;
-            if (texel_samples == 0 || texel_samples > 16) { fprintf(stderr, "rad lightmap: --texel-samples must be 1 to 16\n"); return 2; }
-        } else if (!strcmp(o, "--visibility-rays")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &vis)) return 2;
-            if (vis == 0 || vis > 64) { fprintf(stderr, "rad lightmap: --visibility-rays must be 1 to 64\n"); return 2; }
-        } else if (!strcmp(o, "--gather")) {
-            const char *v = argv[++a];
-            if (v && !strcmp(v, "exact")) gather = RAD_LIGHTMAP_GATHER_EXACT;
-            else if (v && !strcmp(v, "hemisphere")) gather = RAD_LIGHTMAP_GATHER_HEMISPHERE;
-            else { fprintf(stderr, "rad lightmap: --gather must be exact or hemisphere\n"); return 2; }
-        } else if (!strcmp(o, "--hemisphere-rays")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &hemi_rays)) return 2;
-            if (hemi_rays == 0 || hemi_rays > 65536) { fprintf(stderr, "rad lightmap: --hemisphere-rays must be 1 to 65536\n"); return 2; }
-        } else if (!strcmp(o, "--exposure")) {
-            if (tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
-            if (!(exposure > 0.0f)) { fprintf(stderr, "rad lightmap: --exposure must be > 0\n"); return 2; }
-        } else if (!strcmp(o, "--threads")) {
-            if (tool_parse_threads("lightmap", o, argv[++a], &threads)) return 2;
-        } else if (o[0] == '-' && o[1]) {
+        if ((k = tool_classic_option("lightmap", argc, argv, &a, &la->co)) == 0 &&
+            (k = tool_light_option("lightmap", argc, argv, &a, lights)) == 0)
+            k = tool_args_parse("lightmap", lightmap_table, la, &la->given, argc, argv, &a);
+        if (k == 2) return 2;
+        if (k == 1) continue;
+        if (o[0] == '-' && o[1]) {
             fprintf(stderr, "rad lightmap: unknown option '%s' (try rad lightmap --help)\n", o);
             return 2;
-        } else if (!scene_path) {
-            scene_path = o;
-        } else {
-            fprintf(stderr, "rad lightmap: more than one scene ('%s', '%s')\n", scene_path, o);
+        }
+        if (la->scene) {
+            fprintf(stderr, "rad lightmap: more than one scene ('%s', '%s')\n", la->scene, o);
             return 2;
         }
+        la->scene = o;
     }
-    if (!scene_path || !out_path) {
+    if (!la->scene || !la->out) {
         lightmap_usage(stderr);
         return 2;
     }
-    if (px_opts && (!px.kind || px.kind == TOOL_LIGHTMAP_HIERARCHICAL)) {
+    if ((la->given & LIGHTMAP_GIVEN_VP) && (!la->px.kind || la->px.kind == TOOL_LIGHTMAP_HIERARCHICAL)) {
         fprintf(stderr, "rad lightmap: --vp-resolution and --face-points are for --proxy aavp|vp\n");
         return 2;
     }
-    if (hr_opts && px.kind != TOOL_LIGHTMAP_HIERARCHICAL) {
+    if ((la->given & LIGHTMAP_GIVEN_HR) && la->px.kind != TOOL_LIGHTMAP_HIERARCHICAL) {
         fprintf(stderr, "rad lightmap: --hr-eps is for --proxy hierarchical\n");
         return 2;
     }
-    if (px.kind && sh) {
+    if (la->px.kind && la->rq.sh) {
         fprintf(stderr, "rad lightmap: --sh needs the classic gather (the virtual patches' gather has no direction): leave out --proxy\n");
         return 2;
     }
-    if (sh && lightmap_is_png(out_path)) {
+    if (la->rq.sh && lightmap_is_png(la->out)) {
         fprintf(stderr, "rad lightmap: --sh writes PFM or EXR files (PNG cannot hold negative coefficients): use -o NAME.pfm or NAME.exr\n");
         return 2;
     }
-    if (sh && render_path) {
+    if (la->rq.sh && la->render) {
         fprintf(stderr, "rad lightmap: --render shades from the RGB lightmap: leave out --sh\n");
         return 2;
     }
-    if (tool_check_size("lightmap", width, height)) return 2;
-    if (tool_image_check_format("lightmap", out_path) || (render_path && tool_image_check_format("lightmap", render_path))) return 2;
+    if (tool_check_size("lightmap", la->rq.width, la->rq.height)) return 2;
+    if (tool_image_check_format("lightmap", la->out) || (la->render && tool_image_check_format("lightmap", la->render))) return 2;
+    return -1;
+}
+
+static int lightmap_main(int argc, char **argv, tool_lights *lights)
+{
+    lightmap_args la;
+    const char *scene_path, *out_path, *render_path;
+    int rw, rh;
+    uint32_t aa;
+    tool_world w;
+    tool_lightmap_baked bk;
+    tool_lightmap_request rq;
+    const rad_lightmap *lm = NULL;
+    int width, height, sh, code = 1;
+    uint32_t i, ch;
+    const float *values = NULL;
+    float exposure;
+    if ((code = lightmap_parse(argc, argv, lights, &la)) >= 0) return code;
+    code = 1;
+    memset(&bk, 0, sizeof bk);
+    scene_path = la.scene;
+    out_path = la.out;
+    render_path = la.render;
+    rw = la.rw;
+    rh = la.rh;
+    aa = la.aa;
+    width = la.rq.width;
+    height = la.rq.height;
+    sh = la.rq.sh;
+    exposure = la.exposure;
     {
         /* the files written: OUT (or its four SH layers) and the view; checked before the
            work, and again against every file the scene was read from once it is loaded */
@@ -271,7 +299,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
         if (render_path) outs[n++] = render_path;
         for (k = 0; k < n && !bad; ++k) bad = tool_check_output("lightmap", outs[k], &scene_path, 1);
         if (!bad) bad = tool_check_outputs("lightmap", outs, n, &scene_path, 1);
-        tool_set_threads((int)threads);
+        tool_set_threads((int)la.threads);
         if (!bad && tool_open_world_lit("lightmap", scene_path, lights, &w)) bad = 2;
         if (!bad && tool_check_outputs("lightmap", outs, n, w.file.input_files, (int)w.file.input_file_count)) {
             tool_close_world(&w);
@@ -280,19 +308,11 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
         for (k = 0; k < 4; ++k) free(layers[k]);
         if (bad) return 1;
     }
-    tool_lightmap_request_default(&rq);
-    rq.width = width;
-    rq.height = height;
-    rq.auto_size = !size_given;
-    rq.texel_samples = texel_samples;
-    rq.visibility_rays = vis;
-    rq.gather = gather;
-    rq.hemisphere_rays = hemi_rays;
-    rq.sh = sh;
-    rq.force_unwrap = force_unwrap;
+    rq = la.rq;
+    rq.auto_size = !(la.given & LIGHTMAP_GIVEN_SIZE);
     rq.direct = !sh;
-    rq.proxy = px.kind ? &px : NULL;
-    if (tool_lightmap_bake("lightmap", &w, &co, &rq, &bk)) goto done;
+    rq.proxy = la.px.kind ? &la.px : NULL;
+    if (tool_lightmap_bake("lightmap", &w, &la.co, &rq, &bk)) goto done;
     width = (int)bk.lm->width; /* the unwrap may have chosen a larger atlas */
     height = (int)bk.lm->height;
     lm = bk.lm;
