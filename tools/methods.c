@@ -269,13 +269,13 @@ static const tool_arg method_args[] = {
          "capacity: S = the M patches nearest the camera (default: every patch, up to 4096: T takes\n"
          "12 M^2 bytes, 192 MiB at 4096, and its rebuild 6 M^3 flops). L = T E over P_Vis x P_Lit:\n"
          "patches outside S (or not visible) get no indirect light and light outside S is not bounced"),
-    TEXT(R, "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement,\n"
-            "solved to convergence; --patches etc. and --bounces are not used; render only):\n"),
+    TEXT(0, "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement,\n"
+            "solved to convergence; --bounces is not used; a bake resamples it onto the patches):\n"),
     FLOAT("--hr-eps", "E", hr_eps, 0.0, 1.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, TOOL_OPT_HR_EPS,
-          "must be in (0, 1) (e.g. 1e-3)", R, "refinement tolerance, a fraction of the source power (default 1e-5)"),
+          "must be in (0, 1) (e.g. 1e-3)", 0, "refinement tolerance, a fraction of the source power (default 1e-5)"),
     FLOAT("--hr-min-area", "A", hr_min_area, 0.0, 1e30, TOOL_ARG_LO_OPEN, TOOL_OPT_HR_MIN_AREA,
-          "must be a positive area", R, "smallest element area, scene units^2 (default: total area / 10000)"),
-    CUSTOM("--hr-rays", "R", hr_rays, parse_hr_rays, TOOL_OPT_HR_RAYS, R,
+          "must be a positive area", 0, "smallest element area, scene units^2 (default: total area / 10000)"),
+    CUSTOM("--hr-rays", "R", hr_rays, parse_hr_rays, TOOL_OPT_HR_RAYS, 0,
            "points and visibility rays per link: 1, 4, 9 ... 64 (default 4)"),
     {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
 };
