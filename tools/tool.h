@@ -297,7 +297,7 @@ void tool_lights_release(void *storage);
 /* rad_hash64 of the lights' fields, continuing from h */
 uint64_t tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h);
 
-/* A scene ready for ray queries: the loaded file, the validated scene and its BVH. */
+/* A scene ready for ray queries: the loaded file, the validated scene and its BVH (world.c). */
 typedef struct tool_world {
     tool_scene file;      /* file.lights: the file's lights, then those of the command line */
     rad_scene *scene;
