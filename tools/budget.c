@@ -70,39 +70,6 @@ double tool_mem_available(void)
     return kb > 0.0 ? kb * 1024.0 : 0.0;
 }
 
-void tool_dense_plan(tool_classic_options *o, const tool_method_options *mo, int bake)
-{
-    double per = 4.0; /* F */
-    o->dense_local_m = 0;
-    o->dense_method = tool_method_name(mo->method);
-    o->dense_cubic = 0.0;
-    switch (mo->method) {
-    case TOOL_MULTIBOUNCE:
-        per += mo->format == TOOL_MB_HALF ? 22.0 : 28.0;
-        o->dense_cubic = 2.0 * ceil(log2((double)(mo->bounces > 1024u ? 1024u : mo->bounces) + 2.0));
-        break;
-    case TOOL_TEMPORAL:
-        if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
-            per += 28.0 + 3.0 * 12.0;
-            o->dense_cubic = 2.0 * ceil(log2((double)(mo->bounces > 1024u ? 1024u : mo->bounces) + 2.0));
-        } else {
-            per += 12.0;
-        }
-        break;
-    case TOOL_LOCAL:
-        o->dense_local_m = mo->local_m ? mo->local_m : TOOL_LOCAL_M_AUTO_MAX;
-        break;
-    default:
-        if (o->solver == TOOL_DIRECT) {
-            per += 8.0;
-            o->dense_cubic = 1.0 / 3.0;
-        }
-        if (bake) per += 8.0; /* the container buffer and the file's copy of F */
-        break;
-    }
-    o->dense_bytes_per_n2 = per;
-}
-
 static int threads_now(void)
 {
 #ifdef _OPENMP

@@ -20,66 +20,57 @@ void tool_classic_options_default(tool_classic_options *o)
     o->light_samples = 16;
 }
 
+static int parse_solver(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    tool_solver *s = (tool_solver *)field;
+    (void)t;
+    if (!strcmp(v, "jacobi")) *s = TOOL_JACOBI;
+    else if (!strcmp(v, "gauss-seidel") || !strcmp(v, "gs")) *s = TOOL_GAUSS_SEIDEL;
+    else if (!strcmp(v, "direct") || !strcmp(v, "lu")) *s = TOOL_DIRECT;
+    else {
+        fprintf(stderr, "rad %s: unknown solver '%s' (jacobi, gauss-seidel or direct)\n", cmd, v);
+        return 2;
+    }
+    return 0;
+}
+
+static int parse_memory(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_bytes(cmd, t->name, v, (double *)field);
+}
+
+#define CO(f) offsetof(tool_classic_options, f)
+/* The classic method's options (every command that builds patches): the parser and the help. */
+static const tool_arg classic_args[] = {
+    {TOOL_ARG_CUSTOM, "--solver", "S", CO(solver), 0, 0, 0, 0, NULL, NULL, NULL, parse_solver, 0,
+     "jacobi (default), gauss-seidel or direct (LU)"},
+    {TOOL_ARG_UINT, "--bounces", "K", CO(bounces), 0, 4294967295.0, 0, 0, "", NULL, NULL, NULL, 0,
+     "Jacobi bounces of indirect light (default 64)"},
+    {TOOL_ARG_UINT, "--patches", "N", CO(patches), 1, 4294967295.0, 0, 0, "must be > 0", NULL, NULL, NULL, 0,
+     "target patch count (default 2000)"},
+    {TOOL_ARG_FLOAT, "--max-edge", "L", CO(max_edge), 0, 1e30, 0, 0, "must be >= 0", NULL, NULL, NULL, 0,
+     "longest patch edge (default: no limit)"},
+    {TOOL_ARG_UINT, "--samples", "S", CO(samples), 1, 256, 0, 0, "must be 1 to 256", NULL, NULL, NULL, 0,
+     "form-factor points per patch pair (default 16, up to 256)"},
+    {TOOL_ARG_UINT, "--light-samples", "N", CO(light_samples), 1, 65536, 0, 0, "must be 1 to 65536", NULL, NULL, NULL, 0,
+     "shadow rays per point and light for the patches' direct light (default 16, at most 65536)"},
+    {TOOL_ARG_CUSTOM, "--max-memory", "SIZE", CO(max_memory), 0, 0, 0, 0, NULL, NULL, NULL, parse_memory, 0,
+     "refuse a dense N x N build estimated above SIZE (e.g. 8G; default: the\n"
+     "MemAvailable of /proc/meminfo); builds estimated over an hour are refused too"},
+    {TOOL_ARG_FLAG, "--force", NULL, CO(force), 1, 0, 0, 0, NULL, NULL, NULL, NULL, 0, "build it whatever the estimate"},
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 const char *tool_classic_help(void)
 {
-    return "  --solver S         jacobi (default), gauss-seidel or direct (LU)\n"
-           "  --bounces K        Jacobi bounces of indirect light (default 64)\n"
-           "  --patches N        target patch count (default 2000)\n"
-           "  --max-edge L       longest patch edge (default: no limit)\n"
-           "  --samples S        form-factor points per patch pair (default 16, up to 256)\n"
-           "  --light-samples N  shadow rays per point and light for the patches' direct light (default 16, at most 65536)\n"
-           "  --max-memory SIZE  refuse a dense N x N build estimated above SIZE (e.g. 8G; default: the\n"
-           "                     MemAvailable of /proc/meminfo); builds estimated over an hour are refused too\n"
-           "  --force            build it whatever the estimate\n";
+    static char buf[4096];
+    tool_args_help_into(classic_args, 0, buf, sizeof buf);
+    return buf;
 }
 
 int tool_classic_option(const char *cmd, int argc, char **argv, int *a, tool_classic_options *o)
 {
-    const char *opt = argv[*a];
-    static const char *const names[] = {"--solver", "--bounces", "--patches", "--max-edge", "--samples", "--light-samples",
-                                        "--max-memory"};
-    size_t i;
-    if (!strcmp(opt, "--force")) {
-        o->force = 1;
-        return 1;
-    }
-    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
-        if (!strcmp(opt, names[i])) break;
-    if (i == sizeof names / sizeof names[0]) return 0;
-    if (*a + 1 >= argc) {
-        fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-        return 2;
-    }
-    ++*a;
-    switch (i) {
-    case 0:
-        if (!strcmp(argv[*a], "jacobi")) o->solver = TOOL_JACOBI;
-        else if (!strcmp(argv[*a], "gauss-seidel") || !strcmp(argv[*a], "gs")) o->solver = TOOL_GAUSS_SEIDEL;
-        else if (!strcmp(argv[*a], "direct") || !strcmp(argv[*a], "lu")) o->solver = TOOL_DIRECT;
-        else {
-            fprintf(stderr, "rad %s: unknown solver '%s' (jacobi, gauss-seidel or direct)\n", cmd, argv[*a]);
-            return 2;
-        }
-        return 1;
-    case 1: return tool_parse_uint(cmd, opt, argv[*a], &o->bounces) ? 2 : 1;
-    case 2:
-        if (tool_parse_uint(cmd, opt, argv[*a], &o->patches)) return 2;
-        if (o->patches == 0) { fprintf(stderr, "rad %s: --patches must be > 0\n", cmd); return 2; }
-        return 1;
-    case 3:
-        if (tool_parse_float(cmd, opt, argv[*a], &o->max_edge)) return 2;
-        if (o->max_edge < 0.0f) { fprintf(stderr, "rad %s: --max-edge must be >= 0\n", cmd); return 2; }
-        return 1;
-    case 4:
-        if (tool_parse_uint(cmd, opt, argv[*a], &o->samples)) return 2;
-        if (o->samples == 0 || o->samples > 256) { fprintf(stderr, "rad %s: --samples must be 1 to 256\n", cmd); return 2; }
-        return 1;
-    case 6: return tool_parse_bytes(cmd, opt, argv[*a], &o->max_memory) ? 2 : 1;
-    default:
-        if (tool_parse_uint(cmd, opt, argv[*a], &o->light_samples)) return 2;
-        if (o->light_samples == 0 || o->light_samples > 65536) { fprintf(stderr, "rad %s: --light-samples must be 1 to 65536\n", cmd); return 2; }
-        return 1;
-    }
+    return tool_args_parse(cmd, classic_args, o, NULL, argc, argv, a);
 }
 
 void tool_classic_free(tool_classic *c)

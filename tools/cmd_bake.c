@@ -168,8 +168,44 @@ done:
     return rc;
 }
 
+static int parse_shard(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    (void)t;
+    return tool_parse_shard(cmd, v, (tool_shard_spec *)field) ? 2 : 0;
+}
+
+static int parse_rows(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    (void)t;
+    return tool_parse_rows(cmd, v, (tool_shard_spec *)field) ? 2 : 0;
+}
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+#define BA(f) offsetof(tool_bake_args, f)
+/* rad bake's own options (the classic, method and light options are their files' tables) */
+static const tool_arg bake_table[] = {
+    {TOOL_ARG_STRING, "-o", "FILE", BA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, "output file (required)"},
+    {TOOL_ARG_TEXT, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "  --method M         classic (default), multibounce, temporal, stochastic, hierarchical,\n"
+     "                     aavp or vp\n"},
+    {TOOL_ARG_CUSTOM, "--shard", "I/N", BA(shard), 0, 0, 0, 0, NULL, NULL, NULL, parse_shard, 0,
+     "classic: bake part I of N (0 <= I < N) into FILE; rad merge joins the N parts into the\n"
+     "bake itself (docs/distributed.md)"},
+    {TOOL_ARG_CUSTOM, "--rows", "A:B", BA(shard), 0, 0, 0, 0, NULL, NULL, NULL, parse_rows, 0,
+     "classic: bake the part holding rows A to B-1 (instead of --shard)"},
+    {TOOL_ARG_CUSTOM, "--threads", "N", BA(threads), 0, 0, 0, 0, NULL, NULL, NULL, parse_threads, 0,
+     "worker threads (default: all cores; at most 1024)"},
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 static void bake_usage(FILE *f)
 {
+    static char own[4096];
+    tool_args_help_into(bake_table, 0, own, sizeof own);
     fprintf(f, "usage: rad bake SCENE -o FILE.radb [--method classic|multibounce|temporal|stochastic|hierarchical|aavp|vp] [options]\n"
                "Computes patches, form factors and the patches' direct light E = rho D, then by method:\n"
                "  classic      the indirect solution L; saves patches, F, E, B = E + L (and L, H = F B, D)\n"
@@ -183,17 +219,8 @@ static void bake_usage(FILE *f)
                "               L = rho H; saved as the stochastic bake (patches, E, D, row sums by rays, L)\n"
                "  aavp, vp     virtual patches (--vp-resolution, --face-points) with sparse rows and\n"
                "               their E; rad render --method aavp|vp or --proxy aavp|vp --bake loads them\n"
-               "  -o FILE            output file (required)\n"
-               "  --method M         classic (default), multibounce, temporal, stochastic, hierarchical,\n"
-               "                     aavp or vp\n"
-               "%s"
-               "%s"
-               "%s"
-               "  --shard I/N        classic: bake part I of N (0 <= I < N) into FILE; rad merge joins the\n"
-               "                     N parts into the bake itself (docs/distributed.md)\n"
-               "  --rows A:B         classic: bake the part holding rows A to B-1 (instead of --shard)\n"
-               "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            tool_classic_help(), tool_method_help(0), tool_light_help());
+               "%s%s%s%s",
+            own, tool_classic_help(), tool_method_help(0), tool_light_help());
 }
 
 int tool_bake_parse(const char *cmd, int argc, char **argv, tool_bake_args *args)
@@ -214,19 +241,10 @@ int tool_bake_parse(const char *cmd, int argc, char **argv, tool_bake_args *args
         rc = tool_light_option(cmd, argc, argv, &a, &args->lights);
         if (rc == 2) return 2;
         if (rc == 1) continue;
-        if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--shard") || !strcmp(opt, "--rows")) &&
-            a + 1 >= argc) {
-            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-            return 2;
-        }
-        if (!strcmp(opt, "-o")) args->out = argv[++a];
-        else if (!strcmp(opt, "--threads")) {
-            if (tool_parse_threads(cmd, opt, argv[++a], &args->threads)) return 2;
-        } else if (!strcmp(opt, "--shard")) {
-            if (tool_parse_shard(cmd, argv[++a], &args->shard)) return 2;
-        } else if (!strcmp(opt, "--rows")) {
-            if (tool_parse_rows(cmd, argv[++a], &args->shard)) return 2;
-        } else if (opt[0] == '-' && opt[1]) {
+        rc = tool_args_parse(cmd, bake_table, args, NULL, argc, argv, &a);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad bake --help)\n", cmd, opt);
             return 2;
         } else if (!args->scene) args->scene = opt;

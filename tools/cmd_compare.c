@@ -54,92 +54,109 @@ static int report_nonfinite(const char *name, const char *path, const tool_image
     return 1;
 }
 
+/* rad compare's command line */
+typedef struct compare_args {
+    const char *a, *b, *diff, *png;
+    float exposure, scale, png_exposure; /* png_exposure 0: the same as exposure */
+} compare_args;
+
+static int parse_png(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    size_t l = strlen(v);
+    (void)t;
+    if (l < 4 || (strcmp(v + l - 4, ".png") && strcmp(v + l - 4, ".PNG"))) {
+        fprintf(stderr, "rad %s: --png wants a .png file, got '%s'\n", cmd, v);
+        return 2;
+    }
+    *(const char **)field = v;
+    return 0;
+}
+
+#define CA(f) offsetof(compare_args, f)
+#define CA_POSITIVE(name, val, f, help) \
+    {TOOL_ARG_FLOAT, name, val, CA(f), 0.0, 1e30, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, 0, "wants a positive number", NULL, \
+     NULL, NULL, 0, help}
+/* rad compare's options */
+static const tool_arg compare_table[] = {
+    CA_POSITIVE("--exposure", "E", exposure,
+                "multiply both images by E before the metrics clamp them to [0,1]\n"
+                "(default 1; for radiance above 1, e.g. E = 1 / the brightest value)"),
+    {TOOL_ARG_STRING, "--diff", "FILE", CA(diff), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "heat map of the per-pixel mean absolute difference (black: none)"},
+    CA_POSITIVE("--diff-scale", "X", scale, "the difference shown at the top of the colour scale (default: the largest)"),
+    {TOOL_ARG_CUSTOM, "--png", "FILE", CA(png), 0, 0, 0, 0, NULL, NULL, NULL, parse_png, 0,
+     "also write A as an 8-bit sRGB PNG (times E): one render gives both the .pfm the metrics\n"
+     "need and a picture (tools/report.sh)"},
+    CA_POSITIVE("--png-exposure", "X", png_exposure, "the PNG's exposure alone (default E), the metrics keep E"),
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 static void compare_usage(FILE *f)
 {
+    static char own[4096];
+    tool_args_help_into(compare_table, 0, own, sizeof own);
     fprintf(f, "usage: rad compare A B [--exposure E] [--diff OUT.png] [--diff-scale X] [--png OUT.png [--png-exposure X]]\n"
-               "  A, B          .pfm (linear float) or .png (8-bit sRGB, decoded to linear)\n"
-               "  --exposure E  multiply both images by E before the metrics clamp them to [0,1]\n"
-               "                (default 1; for radiance above 1, e.g. E = 1 / the brightest value)\n"
-               "  --diff FILE   heat map of the per-pixel mean absolute difference (black: none)\n"
-               "  --diff-scale X  the difference shown at the top of the colour scale (default: the largest)\n"
-               "  --png FILE    also write A as an 8-bit sRGB PNG (times E): one render gives both the\n"
-               "                .pfm the metrics need and a picture (tools/report.sh)\n"
-               "  --png-exposure X  the PNG's exposure alone (default E), the metrics keep E\n"
+               "  A, B               .pfm (linear float) or .png (8-bit sRGB, decoded to linear)\n"
+               "%s"
                "  prints MSE, PSNR (peak 1) and SSIM (11x11 Gaussian window, sigma 1.5, per channel,\n"
                "  averaged), all on linear values times E, clamped to [0,1]; and the mean linear\n"
                "  radiance of each (unclamped) with their ratio, the energy check against a reference\n"
                "  exit 1 when an image holds NaN or infinite values (counted on stderr and in a\n"
-               "  'nonfinite' line), or the images cannot be read or differ in size\n");
+               "  'nonfinite' line), or the images cannot be read or differ in size\n",
+            own);
 }
 
-int tool_cmd_compare(int argc, char **argv)
+/* the command line into ca; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
+static int compare_parse(int argc, char **argv, compare_args *ca)
 {
-    const char *pa = NULL, *pb = NULL, *diff = NULL, *png = NULL;
-    float scale = 0.0f, exposure = 1.0f, png_exposure = 0.0f; /* 0: the same as exposure */
-    tool_image a = { 0, 0, NULL }, b = { 0, 0, NULL };
-    char err[512];
-    double mse, psnr, ssim;
-    int i, bad;
+    int i, rc;
+    memset(ca, 0, sizeof *ca);
+    ca->exposure = 1.0f;
     for (i = 0; i < argc; ++i) {
         const char *s = argv[i];
         if (!strcmp(s, "-h") || !strcmp(s, "--help")) {
             compare_usage(stdout);
             return 0;
-        } else if (!strcmp(s, "--png") || !strcmp(s, "--exposure") || !strcmp(s, "--png-exposure")) {
-            if (i + 1 >= argc) {
-                fprintf(stderr, "rad compare: %s needs a value\n", s);
-                return 2;
-            }
-            if (!strcmp(s, "--png")) {
-                size_t l;
-                png = argv[++i];
-                l = strlen(png);
-                if (l < 4 || (strcmp(png + l - 4, ".png") && strcmp(png + l - 4, ".PNG"))) {
-                    fprintf(stderr, "rad compare: --png wants a .png file, got '%s'\n", png);
-                    return 2;
-                }
-            } else {
-                char *end;
-                float v = strtof(argv[++i], &end);
-                if (*end || !(v > 0.0f) || !(v < 1e30f)) {
-                    fprintf(stderr, "rad compare: %s wants a positive number, got '%s'\n", s, argv[i]);
-                    return 2;
-                }
-                if (!strcmp(s, "--exposure")) exposure = v;
-                else png_exposure = v;
-            }
-        } else if (!strcmp(s, "--diff") || !strcmp(s, "--diff-scale")) {
-            if (i + 1 >= argc) {
-                fprintf(stderr, "rad compare: %s needs a value\n", s);
-                return 2;
-            }
-            if (!strcmp(s, "--diff")) {
-                diff = argv[++i];
-            } else {
-                char *end;
-                scale = strtof(argv[++i], &end);
-                if (*end || !(scale > 0.0f && scale < 1e30f)) {
-                    fprintf(stderr, "rad compare: --diff-scale wants a positive number, got '%s'\n", argv[i]);
-                    return 2;
-                }
-            }
-        } else if (s[0] == '-' && s[1]) {
+        }
+        if ((rc = tool_args_parse("compare", compare_table, ca, NULL, argc, argv, &i)) == 2) return 2;
+        if (rc == 1) continue;
+        if (s[0] == '-' && s[1]) {
             fprintf(stderr, "rad compare: unknown option '%s'\n", s);
             compare_usage(stderr);
             return 2;
-        } else if (!pa) {
-            pa = s;
-        } else if (!pb) {
-            pb = s;
+        } else if (!ca->a) {
+            ca->a = s;
+        } else if (!ca->b) {
+            ca->b = s;
         } else {
             fprintf(stderr, "rad compare: too many images ('%s')\n", s);
             return 2;
         }
     }
-    if (!pa || !pb) {
+    if (!ca->a || !ca->b) {
         compare_usage(stderr);
         return 2;
     }
+    return -1;
+}
+
+int tool_cmd_compare(int argc, char **argv)
+{
+    compare_args ca;
+    const char *pa, *pb, *diff, *png;
+    float scale, exposure, png_exposure;
+    tool_image a = { 0, 0, NULL }, b = { 0, 0, NULL };
+    char err[512];
+    double mse, psnr, ssim;
+    int bad;
+    if ((bad = compare_parse(argc, argv, &ca)) >= 0) return bad;
+    pa = ca.a;
+    pb = ca.b;
+    diff = ca.diff;
+    png = ca.png;
+    scale = ca.scale;
+    exposure = ca.exposure;
+    png_exposure = ca.png_exposure;
     {
         const char *inputs[2];
         inputs[0] = pa;

@@ -5,21 +5,72 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* rad formfactors' command line */
+typedef struct ff_args {
+    uint32_t patches, samples, threads, hemicube_res;
+    float max_edge;
+    uint32_t method;                 /* a rad_ff_method */
+    tool_classic_options budget;     /* --max-memory, --force */
+} ff_args;
+
+static int parse_ff(const char *cmd, const tool_arg *t, const char *m, void *field)
+{
+    uint32_t *method = (uint32_t *)field;
+    (void)t;
+    if (!strcmp(m, "analytic")) *method = RAD_FF_ANALYTIC;
+    else if (!strcmp(m, "montecarlo") || !strcmp(m, "monte-carlo")) *method = RAD_FF_MONTE_CARLO;
+    else if (!strcmp(m, "hemicube")) *method = RAD_FF_HEMICUBE;
+    else {
+        fprintf(stderr, "rad %s: unknown --ff '%s' (analytic, montecarlo or hemicube)\n", cmd, m);
+        return 2;
+    }
+    return 0;
+}
+
+static int parse_memory(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_bytes(cmd, t->name, v, (double *)field);
+}
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+#define FA(f) offsetof(ff_args, f)
+/* rad formfactors' options */
+static const tool_arg ff_table[] = {
+    {TOOL_ARG_UINT, "--patches", "N", FA(patches), 0, 4294967295.0, 0, 0, "", NULL, NULL, NULL, 0,
+     "target patch count (default 2000)"},
+    {TOOL_ARG_FLOAT, "--max-edge", "L", FA(max_edge), -1e30, 1e30, 0, 0, "", NULL, NULL, NULL, 0,
+     "longest patch edge (default: no limit)"},
+    {TOOL_ARG_UINT, "--samples", "S", FA(samples), 0, 4294967295.0, 0, 0, "", NULL, NULL, NULL, 0,
+     "points per patch pair (default 16, up to 256; analytic and montecarlo)"},
+    {TOOL_ARG_CUSTOM, "--ff", "M", FA(method), 0, 0, 0, 0, NULL, NULL, NULL, parse_ff, 0,
+     "analytic (default: the point-to-polygon integral at S points of the other patch, one\n"
+     "visibility ray each), montecarlo (S point pairs) or hemicube (a hemicube at each patch\n"
+     "centroid with an item buffer; no rays)"},
+    {TOOL_ARG_UINT, "--hemicube-res", "R", FA(hemicube_res), 0, 4294967295.0, 0, 0, "", NULL, NULL, NULL, 0,
+     "cells across the hemicube's top face (default 128; even, 4 to 2048)"},
+    {TOOL_ARG_CUSTOM, "--max-memory", "SIZE", FA(budget.max_memory), 0, 0, 0, 0, NULL, NULL, NULL, parse_memory, 0,
+     "the dense build's limit (rad render --help)"},
+    {TOOL_ARG_FLAG, "--force", NULL, FA(budget.force), 1, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "build it whatever the estimate"},
+    {TOOL_ARG_CUSTOM, "--threads", "N", FA(threads), 0, 0, 0, 0, NULL, NULL, NULL, parse_threads, 0,
+     "worker threads (default: all cores; at most 1024)"},
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 static void formfactors_usage(FILE *f)
 {
+    static char own[4096];
+    tool_args_help_into(ff_table, 0, own, sizeof own);
     fprintf(f, "usage: rad formfactors SCENE [--patches N] [--max-edge L] [--samples S] [--ff M] [--hemicube-res R]\n"
                "                        [--max-memory SIZE] [--force] [--threads N]\n"
                "Prints one line 'FROM TO VALUE' per ordered pair of named objects: the area-weighted\n"
                "group form factor F_GH = sum_{i in G} A_i sum_{j in H} F_ij / sum_{i in G} A_i.\n"
-               "  --patches N   target patch count (default 2000)\n"
-               "  --max-edge L  longest patch edge (default: no limit)\n"
-               "  --samples S   points per patch pair (default 16, up to 256; analytic and montecarlo)\n"
-               "  --ff M        analytic (default: the point-to-polygon integral at S points of the other\n"
-               "                patch, one visibility ray each), montecarlo (S point pairs) or hemicube\n"
-               "                (a hemicube at each patch centroid with an item buffer; no rays)\n"
-               "  --hemicube-res R  cells across the hemicube's top face (default 128; even, 4 to 2048)\n"
-               "  --max-memory SIZE, --force   the dense build's limit (rad render --help)\n"
-               "  --threads N   worker threads (default: all cores; at most 1024)\n");
+               "%s",
+            own);
 }
 
 /* ---- formfactors ----------------------------------------------------------------------- */
@@ -27,9 +78,9 @@ static void formfactors_usage(FILE *f)
 int tool_cmd_formfactors(int argc, char **argv)
 {
     const char *scene_name = NULL, *cmd = "formfactors";
-    uint32_t patches_target = 2000, samples = 16, threads = 0, G, H, i, j, gc, hemicube_res = 0;
-    rad_ff_method ff_method = RAD_FF_ANALYTIC;
-    float max_edge = 0.0f;
+    uint32_t patches_target, samples, G, H, i, j, gc, hemicube_res;
+    rad_ff_method ff_method;
+    float max_edge;
     tool_world w;
     rad_patches *P = NULL;
     rad_form_factors *ff = NULL;
@@ -38,40 +89,32 @@ int tool_cmd_formfactors(int argc, char **argv)
     rad_context ctx;
     rad_result r;
     double *num, *den;
-    int a;
+    int a, rc;
+    ff_args fa;
     tool_classic_options budget;
-    tool_classic_options_default(&budget);
+    memset(&fa, 0, sizeof fa);
+    fa.patches = 2000;
+    fa.samples = 16;
+    fa.method = RAD_FF_ANALYTIC;
+    tool_classic_options_default(&fa.budget);
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
-        int need = !strcmp(o, "--patches") || !strcmp(o, "--samples") || !strcmp(o, "--threads") || !strcmp(o, "--max-edge") ||
-                   !strcmp(o, "--ff") || !strcmp(o, "--hemicube-res");
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) { formfactors_usage(stdout); return 0; }
-        if (!strcmp(o, "--force")) { budget.force = 1; continue; }
-        if (!strcmp(o, "--max-memory")) {
-            if (a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
-            if (tool_parse_bytes(cmd, o, argv[++a], &budget.max_memory)) return 2;
-            continue;
-        }
-        if (need && a + 1 >= argc) { fprintf(stderr, "rad %s: %s needs a value\n", cmd, o); return 2; }
-        if (!strcmp(o, "--patches")) { if (tool_parse_uint(cmd, o, argv[++a], &patches_target)) return 2; }
-        else if (!strcmp(o, "--samples")) { if (tool_parse_uint(cmd, o, argv[++a], &samples)) return 2; }
-        else if (!strcmp(o, "--threads")) { if (tool_parse_threads(cmd, o, argv[++a], &threads)) return 2; }
-        else if (!strcmp(o, "--max-edge")) { if (tool_parse_float(cmd, o, argv[++a], &max_edge)) return 2; }
-        else if (!strcmp(o, "--hemicube-res")) { if (tool_parse_uint(cmd, o, argv[++a], &hemicube_res)) return 2; }
-        else if (!strcmp(o, "--ff")) {
-            const char *m = argv[++a];
-            if (!strcmp(m, "analytic")) ff_method = RAD_FF_ANALYTIC;
-            else if (!strcmp(m, "montecarlo") || !strcmp(m, "monte-carlo")) ff_method = RAD_FF_MONTE_CARLO;
-            else if (!strcmp(m, "hemicube")) ff_method = RAD_FF_HEMICUBE;
-            else { fprintf(stderr, "rad %s: unknown --ff '%s' (analytic, montecarlo or hemicube)\n", cmd, m); return 2; }
-        }
-        else if (o[0] == '-' && o[1]) { fprintf(stderr, "rad %s: unknown option '%s'\n", cmd, o); return 2; }
+        if ((rc = tool_args_parse(cmd, ff_table, &fa, NULL, argc, argv, &a)) == 2) return 2;
+        if (rc == 1) continue;
+        if (o[0] == '-' && o[1]) { fprintf(stderr, "rad %s: unknown option '%s'\n", cmd, o); return 2; }
         else if (!scene_name) scene_name = o;
         else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
     }
+    patches_target = fa.patches;
+    samples = fa.samples;
+    hemicube_res = fa.hemicube_res;
+    max_edge = fa.max_edge;
+    ff_method = (rad_ff_method)fa.method;
+    budget = fa.budget;
     if (!scene_name) { fprintf(stderr, "rad %s: no scene given\n", cmd); formfactors_usage(stderr); return 2; }
     if (samples == 0 || max_edge < 0.0f) { fprintf(stderr, "rad %s: --samples must be > 0, --max-edge >= 0\n", cmd); return 2; }
-    tool_set_threads((int)threads);
+    tool_set_threads((int)fa.threads);
     budget.samples = samples;
     if (tool_open_world(cmd, scene_name, &w)) return 1;
     if (tool_dense_check(cmd, &budget, w.scene->triangle_count, 1)) {

@@ -21,40 +21,124 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* rad lightmap's command line */
+typedef struct lightmap_args {
+    const char *scene, *out, *render; /* SCENE, -o, --render */
+    tool_classic_options co;
+    tool_lightmap_request rq;  /* --size, --sh, --texel-samples, --visibility-rays, --gather, ... */
+    tool_lightmap_proxy px;    /* --proxy and its options */
+    int rw, rh;                /* --render-size */
+    uint32_t aa;               /* --aa: N x N samples a pixel of --render */
+    float exposure;            /* --exposure */
+    uint32_t threads;
+    uint32_t given;            /* LIGHTMAP_GIVEN_* */
+} lightmap_args;
+enum { LIGHTMAP_GIVEN_SIZE = 1, LIGHTMAP_GIVEN_VP = 2, LIGHTMAP_GIVEN_HR = 4 };
+
+/* --size N|WxH into the request's width and height (field: width) */
+static int parse_atlas_size(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    tool_lightmap_request *rq = (tool_lightmap_request *)((char *)field - offsetof(tool_lightmap_request, width));
+    if (strchr(v, 'x')) {
+        if (tool_parse_size(v, &rq->width, &rq->height)) {
+            fprintf(stderr, "rad %s: bad --size '%s'\n", cmd, v);
+            return 2;
+        }
+    } else {
+        uint32_t n;
+        if (tool_parse_uint(cmd, t->name, v, &n)) return 2;
+        rq->width = rq->height = (int)(n > 16384u ? 16385u : n);
+    }
+    if (rq->width < 4 || rq->height < 4 || rq->width > 16384 || rq->height > 16384) {
+        fprintf(stderr, "rad %s: --size must be 4 to 16384 texels a side\n", cmd);
+        return 2;
+    }
+    return 0;
+}
+
+/* --render-size WxH into rw, rh (field: rw) */
+static int parse_render_size(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    lightmap_args *la = (lightmap_args *)((char *)field - offsetof(lightmap_args, rw));
+    (void)t;
+    if (tool_parse_size(v, &la->rw, &la->rh) || tool_check_size(cmd, la->rw, la->rh)) {
+        fprintf(stderr, "rad %s: bad --render-size '%s'\n", cmd, v);
+        return 2;
+    }
+    return 0;
+}
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+static const uint32_t proxy_values[] = {TOOL_PROXY_PATCHES, TOOL_PROXY_AAVP, TOOL_PROXY_VP, TOOL_LIGHTMAP_HIERARCHICAL};
+static const uint32_t gather_values[] = {RAD_LIGHTMAP_GATHER_EXACT, RAD_LIGHTMAP_GATHER_HEMISPHERE};
+#define LA(f) offsetof(lightmap_args, f)
+#define LA_UINT(name, val, f, lo, hi, given, bad, help) \
+    {TOOL_ARG_UINT, name, val, LA(f), lo, hi, 0, given, bad, NULL, NULL, NULL, 0, help}
+#define LA_FLAG(name, f, help) {TOOL_ARG_FLAG, name, NULL, LA(f), 1, 0, 0, 0, NULL, NULL, NULL, NULL, 0, help}
+#define LA_CUSTOM(name, val, f, fn, given, help) \
+    {TOOL_ARG_CUSTOM, name, val, LA(f), 0, 0, 0, given, NULL, NULL, NULL, fn, 0, help}
+/* rad lightmap's own options (the classic and light options are classic.c's and lights.c's) */
+static const tool_arg lightmap_table[] = {
+    {TOOL_ARG_STRING, "-o", "FILE", LA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "the lightmap: .pfm or .exr (linear irradiance, W m^-2) or .png (exposure applied); or\n"
+     ".glb / .gltf: the scene for engines, with TEXCOORD_1, the lightmap as a PNG image named in\n"
+     "each material's extras, its HDR copy beside it and the view as a camera\n"
+     "(docs/engine-formats.md; RGB only, not --sh)"},
+    LA_CUSTOM("--size", "N|WxH", rq.width, parse_atlas_size, LIGHTMAP_GIVEN_SIZE,
+              "atlas texels (default 256; with an unwrap whose charts do not fit, the smallest\n"
+              "power of two up to 4096 that they fit, said on stderr)"),
+    LA_FLAG("--sh", rq.sh,
+            "L1 spherical harmonics of the indirect light (4 PFM or EXR files OUT.L00.pfm\n"
+            "OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)"),
+    LA_UINT("--texel-samples", "N", rq.texel_samples, 1, 16, 0, "must be 1 to 16",
+            "sample points per texel, a square grid (default 4, at most 16)"),
+    LA_UINT("--visibility-rays", "N", rq.visibility_rays, 1, 64, 0, "must be 1 to 64",
+            "shadow rays per sample point and patch (default 2, at most 64)"),
+    {TOOL_ARG_CHOICE, "--gather", "M", LA(rq.gather), 0, 0, 0, 0, NULL, "exact|hemisphere", gather_values, NULL, 0,
+     "exact (every patch's form factor from every sample) or hemisphere (the brightest\n"
+     "patches exactly, the rest by rays; its cost does not grow with the patches); default:\n"
+     "hemisphere when samples x patches exceeds 2e7"},
+    LA_UINT("--hemisphere-rays", "N", rq.hemisphere_rays, 1, 65536, 0, "must be 1 to 65536",
+            "rays per texel of the hemisphere gather (default 256, at most 65536)"),
+    LA_FLAG("--unwrap", rq.force_unwrap, "unwrap even when the file has a second uv set"),
+    {TOOL_ARG_CHOICE, "--proxy", "P", LA(px.kind), 0, 0, 0, 0, NULL, "patches|aavp|vp|hierarchical", proxy_values, NULL, 0,
+     "the indirect light from patches (the classic solution, default), aavp or vp (virtual\n"
+     "patches: a few thousand unknowns whatever the triangle count, for real buildings; each\n"
+     "texel gathers their H at its sample points; RGB only, not --sh), or hierarchical (the\n"
+     "hierarchical solution's smooth lookup at each sample)"},
+    LA_UINT("--vp-resolution", "R", px.resolution, 1, 4096, LIGHTMAP_GIVEN_VP, "must be 1 to 4096",
+            "--proxy aavp|vp: voxels along the longest axis (default 16)"),
+    LA_UINT("--face-points", "P", px.face_points, 1, 4096, LIGHTMAP_GIVEN_VP, "must be 1 to 4096",
+            "--proxy aavp|vp: Hammersley points per voxel face (default 16)"),
+    {TOOL_ARG_FLOAT, "--hr-eps", "E", LA(px.hr_eps), 0.0, 1.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, LIGHTMAP_GIVEN_HR,
+     "must be in (0, 1)", NULL, NULL, NULL, 0,
+     "--proxy hierarchical: refinement tolerance (default 1e-5: coarser is faster on large scenes)"},
+    {TOOL_ARG_STRING, "--render", "VIEW", LA(render), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "also render the camera view shaded from the lightmap (.png, .pfm, .exr; not with --sh):\n"
+     "radiance = emission + albedo x irradiance / pi"},
+    LA_CUSTOM("--render-size", "WxH", rw, parse_render_size, 0, "its size (default 256x256)"),
+    LA_UINT("--aa", "N", aa, 1, 16, 0, "must be 1 to 16",
+            "--render: N x N samples a pixel (default 2: 4 samples; 4 gives rad render's 16)"),
+    {TOOL_ARG_FLOAT, "--exposure", "X", LA(exposure), 0.0, 1e30, TOOL_ARG_LO_OPEN, 0, "must be > 0", NULL, NULL, NULL, 0,
+     "PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi: the radiance of a\n"
+     "white surface)"},
+    LA_CUSTOM("--threads", "N", threads, parse_threads, 0, "worker threads (default: all cores)"),
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 static void lightmap_usage(FILE *f)
 {
-    fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [options]\n"
+    static char own[8192];
+    tool_args_help_into(lightmap_table, 0, own, sizeof own);
+    fprintf(f, "usage: rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png|OUT.glb|OUT.gltf [options]\n"
                "  bakes the classic radiosity solution into a lightmap over the second uv set\n"
                "  (glTF TEXCOORD_1); meshes without one are unwrapped automatically (simple charts)\n"
-               "  --size N|WxH          atlas texels (default 256; with an unwrap whose charts do not fit,\n"
-               "                        the smallest power of two up to 4096 that they fit, said on stderr)\n"
-               "  --sh                  L1 spherical harmonics of the indirect light (4 PFM or EXR files\n"
-               "                        OUT.L00.pfm OUT.L1m1.pfm OUT.L10.pfm OUT.L11.pfm; see docs/methods/lightmap.md)\n"
-               "  --texel-samples N     sample points per texel, a square grid (default 4, at most 16)\n"
-               "  --visibility-rays N   shadow rays per sample point and patch (default 2, at most 64)\n"
-               "  --gather M            exact (every patch's form factor from every sample) or hemisphere\n"
-               "                        (the brightest patches exactly, the rest by rays; its cost does not\n"
-               "                        grow with the patches); default: hemisphere when samples x patches\n"
-               "                        exceeds 2e7\n"
-               "  --hemisphere-rays N   rays per texel of the hemisphere gather (default 256, at most 65536)\n"
-               "  --unwrap              unwrap even when the file has a second uv set\n"
-               "  --proxy P             the indirect light from patches (the classic solution, default), aavp or\n"
-               "                        vp (virtual patches: a few thousand unknowns whatever the triangle count,\n"
-               "                        for real buildings; each texel gathers their H at its sample points; RGB\n"
-               "                        only, not --sh); --vp-resolution R (default 16), --face-points P (default 16);\n"
-               "                        or hierarchical (the hierarchical solution's smooth lookup at each sample;\n"
-               "                        --hr-eps E, default 1e-5: coarser is faster on large scenes)\n"
-               "  --render VIEW         also render the camera view shaded from the lightmap (.png, .pfm, .exr;\n"
-               "                        not with --sh): radiance = emission + albedo x irradiance / pi\n"
-               "  --render-size WxH     its size (default 256x256); --aa N: N x N samples a pixel (default 4, as\n"
-               "                        rad render's 16 samples)\n"
-               "  -o OUT.glb|OUT.gltf   the scene for engines: TEXCOORD_1, the lightmap as a PNG image named in each\n"
-               "                        material's extras, its HDR copy beside it, the view as a camera\n"
-               "                        (docs/engine-formats.md; RGB only, not --sh)\n"
-               "  --exposure X          PNG only: scale of the irradiance before 8-bit sRGB (default 1/pi:\n"
-               "                        the radiance of a white surface)\n"
-               "  --threads N           worker threads (default: all cores)\n"
-               "%s%s", tool_classic_help(), tool_light_help());
+               "%s%s%s",
+            own, tool_classic_help(), tool_light_help());
 }
 
 /* a path with 'tag' inserted before the extension: a.pfm -> a.L00.pfm */
@@ -117,441 +201,104 @@ static int lightmap_is_png(const char *path)
     return n >= 4 && (!strcmp(path + n - 4, ".png") || !strcmp(path + n - 4, ".PNG"));
 }
 
-void tool_lightmap_bake_free(tool_lightmap_baked *b)
+/* the command line into la; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
+static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_args *la)
 {
-    free(b->values);
-    rad_lightmap_destroy(b->lm);
-    tool_classic_free(&b->cl);
-    rad_vp_destroy(b->vp);
-    rad_hierarchical_destroy(b->hr);
-    if (b->own_scene) {
-        rad_bvh_destroy(b->w.bvh);
-        rad_scene_destroy(b->w.scene);
-    }
-    free(b->uvs);
-    memset(b, 0, sizeof *b);
-}
-
-int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic_options *co, const tool_lightmap_proxy *px,
-                        rad_virtual_patches **vp_out, float **B_out, float **H_out, double *solve_seconds)
-{
-    rad_vp_options vo;
-    rad_direct_options dopt;
-    rad_solve_options so;
-    rad_system sys;
-    rad_context ctx;
-    rad_result r;
-    rad_virtual_patches *vp = NULL;
-    float *E, *L, *H = NULL;
-    uint32_t n, i;
-    double t0 = tool_seconds();
-    *vp_out = NULL;
-    if (B_out) *B_out = NULL;
-    if (H_out) *H_out = NULL;
-    rad_vp_options_default(&vo);
-    if (px->resolution) vo.resolution = px->resolution;
-    if (px->face_points) vo.face_points = px->face_points;
-    if (px->kind == TOOL_PROXY_VP) vo.kind = RAD_VP_CLUSTERED;
-    if (px->max_patches && tool_vp_resolution_within(cmd, w, vo.kind, vo.face_points, px->max_patches, 0, &vo.resolution))
-        return 1;
-    /* CSR rows: O(non-zeros), as rad render --proxy keeps them */
-    vo.storage = RAD_STORAGE_SPARSE;
-    tool_context(&ctx, "virtual patches");
-    r = rad_vp_create(w->scene, &w->rc, &vo, &ctx, &vp);
-    tool_progress_end();
-    if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_create", r);
-    n = vp->count;
-    fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches, %u voxels, %u samples, %.1f MiB, built in %.2f s\n",
-            cmd, px->kind == TOOL_PROXY_VP ? "vp" : "aavp", vo.resolution, n, vp->voxel_count, vp->sample_count,
-            (double)rad_vp_memory(vp) / 1048576.0, tool_seconds() - t0);
-    E = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-    L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-    rad_direct_options_default(&dopt);
-    dopt.exclude_emitters = 0;
-    dopt.light_samples = co->light_samples;
-    tool_context(&ctx, "direct light");
-    r = rad_vp_sources(vp, &w->rc, w->file.lights, w->file.light_count, &dopt, RAD_SOURCE_DIRECT, E, &ctx);
-    tool_progress_end();
-    if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_vp_sources", r); goto fail; }
-    t0 = tool_seconds();
-    rad_vp_system(&sys, vp, E);
-    rad_solve_options_default(&so);
-    so.output = RAD_OUTPUT_INDIRECT;
-    so.bounces = co->bounces;
-    tool_context(&ctx, NULL);
-    if (co->solver == TOOL_GAUSS_SEIDEL) {
-        r = rad_solve_gauss_seidel(&sys, &so, L, NULL, &ctx);
-        if (r == RAD_ERROR_NOT_CONVERGED) {
-            fprintf(stderr, "rad %s: warning: Gauss-Seidel did not converge\n", cmd);
-            r = RAD_SUCCESS;
-        }
-    } else if (co->bounces) {
-        r = rad_solve_jacobi(&sys, &so, L, NULL, &ctx);
-    } else {
-        memset(L, 0, sizeof(float) * 3 * (size_t)vp->count); /* --bounces 0: no indirect light */
-        r = RAD_SUCCESS;
-    }
-    if (r != RAD_SUCCESS) { tool_fail(cmd, "solve", r); goto fail; }
-    for (i = 0; i < 3 * n; ++i) L[i] += E[i];
-    if (H_out) {
-        H = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-        if ((r = rad_matrix_multiply(&vp->matrix, L, H, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_matrix_multiply", r); goto fail; }
-    }
-    if (solve_seconds) *solve_seconds = tool_seconds() - t0;
-    free(E);
-    if (B_out) *B_out = L; else free(L);
-    if (H_out) *H_out = H;
-    *vp_out = vp;
-    return 0;
-fail:
-    free(E);
-    free(L);
-    free(H);
-    rad_vp_destroy(vp);
-    return 1;
-}
-
-int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
-                           int height, int auto_size, uint32_t texel_samples, uint32_t vis, int gather, uint32_t hemi_rays, int sh,
-                           int force_unwrap, int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out)
-{
-    tool_classic_options co2 = *co;
-    float *vp_H = NULL;
-    double t_all = tool_seconds();
-    tool_world w2 = *world;
-    rad_lightmap_options lo;
-    rad_lightmap_gather_options go;
-    rad_lightmap_seam_stats st;
-    rad_context ctx;
-    rad_result r;
-    uint32_t ch;
-    double t0;
-    rad_mesh_desc mesh;
-    rad_scene_desc desc;
-    const tool_world *w = world;
-    memset(out, 0, sizeof *out);
-    if (proxy && sh) {
-        fprintf(stderr, "rad %s: --sh needs the classic gather (the virtual patches' gather has no direction): leave out --proxy\n", cmd);
-        return 1;
-    }
-    if (proxy && co->solver == TOOL_DIRECT) {
-        fprintf(stderr, "rad %s: --solver direct is for classic patches: with --proxy use jacobi or gauss-seidel\n", cmd);
-        return 1;
-    }
-    /* a scene too big for the dense classic build is refused before the unwrap, with the way out */
-    co2.dense_instead = "--proxy aavp or --proxy vp (the lightmap's indirect light from virtual patches: a few thousand "
-                        "whatever the triangle count; --vp-resolution R sets how many)";
-    co = &co2;
-    if (!proxy && tool_dense_check(cmd, co, w->scene->triangle_count, 1)) return 1;
-    /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
-    if (force_unwrap || !w->scene->lightmap_uvs || memchr(w->scene->lightmapped, 0, w->scene->triangle_count)) {
-        if (!force_unwrap && w->scene->lightmap_uvs)
-            fprintf(stderr, "rad %s: some meshes have no second uv set: unwrapping the whole scene\n", cmd);
-        uint32_t uw = (uint32_t)width, uh = (uint32_t)height;
-        tool_unwrap_auto au;
-        out->uvs = (float *)tool_calloc(6 * (size_t)w->scene->triangle_count, sizeof(float));
-        /* the estimate: the texel records (flags, position, normal, sample index: 29 bytes),
-           the samples (position, normal, triangle, validity: 29 bytes each) and the values
-           with one working copy, plus an RGB image of the atlas */
-        au.max_side = TOOL_LIGHTMAP_AUTO_MAX;
-        au.bytes_per_texel = 29.0 + 29.0 * (texel_samples ? texel_samples : 4u) + 8.0 * (sh ? 12.0 : 3.0) + 12.0;
-        if (co->max_memory > 0.0) au.memory_limit = co->max_memory, au.memory_from = "--max-memory";
-        else au.memory_limit = tool_mem_available(), au.memory_from = "MemAvailable in /proc/meminfo";
-        if (tool_unwrap(cmd, strcmp(cmd, "render") ? "--size" : "--lightmap-size", w->scene, &uw, &uh,
-                        auto_size ? &au : NULL, out->uvs, NULL))
-            goto fail;
-        width = (int)uw;
-        height = (int)uh;
-        memset(&mesh, 0, sizeof mesh);
-        mesh.name = "unwrapped";
-        mesh.positions = w->scene->positions;
-        mesh.vertex_count = 3 * w->scene->triangle_count;
-        mesh.uvs = w->scene->uvs;
-        mesh.triangle_count = w->scene->triangle_count;
-        mesh.material_ids = w->scene->materials;
-        mesh.lightmap_uvs = out->uvs;
-        if (w->scene->twins) {
-            /* a two-sided pair is two scene triangles, and the copy's two-sided materials pair
-               them again: the mesh takes the first side of each pair only (the side the
-               file's normals chose), else every sheet would be four coincident triangles */
-            const rad_scene *S = w->scene;
-            uint32_t t, k = 0;
-            float *pos = (float *)tool_calloc(9 * (size_t)S->triangle_count, sizeof(float));
-            float *tuv = S->uvs ? (float *)tool_calloc(6 * (size_t)S->triangle_count, sizeof(float)) : NULL;
-            uint32_t *mat = (uint32_t *)tool_calloc((size_t)S->triangle_count, sizeof(uint32_t));
-            for (t = 0; t < S->triangle_count; ++t) {
-                if (S->twins[t] != RAD_NONE && S->twins[t] < t) continue;
-                memcpy(pos + 9 * (size_t)k, S->positions + 9 * (size_t)t, 9 * sizeof(float));
-                if (tuv) memcpy(tuv + 6 * (size_t)k, S->uvs + 6 * (size_t)t, 6 * sizeof(float));
-                memmove(out->uvs + 6 * (size_t)k, out->uvs + 6 * (size_t)t, 6 * sizeof(float));
-                mat[k++] = S->materials[t];
-            }
-            mesh.positions = pos;
-            mesh.vertex_count = 3 * k;
-            mesh.uvs = tuv;
-            mesh.triangle_count = k;
-            mesh.material_ids = mat;
-        }
-        desc = w->file.desc;
-        desc.meshes = &mesh;
-        desc.mesh_count = 1;
-        w2.scene = NULL;
-        w2.bvh = NULL;
-        out->own_scene = 1;
-        out->w = w2;
-        tool_context(&ctx, NULL);
-        r = rad_scene_create(&desc, &ctx, &out->w.scene);
-        if (w->scene->twins) { /* the scene keeps copies */
-            free((void *)mesh.positions);
-            free((void *)mesh.uvs);
-            free((void *)mesh.material_ids);
-        }
-        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); goto fail; }
-        if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { tool_fail(cmd, "rad_bvh_create", r); goto fail; }
-        rad_bvh_raycaster(out->w.bvh, &out->w.rc);
-    } else {
-        out->w = w2;
-        fprintf(stderr, "rad %s: using the file's second uv set\n", cmd);
-    }
-    w = &out->w;
-    if (proxy && proxy->kind == TOOL_LIGHTMAP_HIERARCHICAL) {
-        tool_method_options mo;
-        rad_hierarchical_stats hs;
-        double th = tool_seconds();
-        tool_method_options_default(&mo);
-        mo.hr_eps = proxy->hr_eps;
-        if (tool_hierarchical_build(cmd, w, &mo, co->light_samples, &out->hr)) goto fail;
-        rad_hierarchical_get_stats(out->hr, &hs);
-        out->patches = hs.leaves;
-        out->solve_seconds = tool_seconds() - th;
-    } else if (proxy) {
-        if (tool_vp_proxy_solve(cmd, w, co, proxy, &out->vp, NULL, &vp_H, &out->solve_seconds)) goto fail;
-        out->patches = out->vp->count;
-    } else {
-        if (tool_classic_solve(cmd, w, co, &out->cl)) goto fail;
-        out->patches = out->cl.patches->count;
-        out->solve_seconds = out->cl.solve_seconds;
-    }
-    /* the gather wants the total radiosity of the secondary sources: B = E + L */
-    t0 = tool_seconds();
-    rad_lightmap_options_default(&lo);
-    lo.width = (uint32_t)width;
-    lo.height = (uint32_t)height;
-    lo.samples = texel_samples;
-    tool_context(&ctx, "lightmap texels");
-    r = rad_lightmap_create(w->scene, &w->rc, &lo, &ctx, &out->lm);
-    tool_progress_end();
-    if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_create", r); goto fail; }
-    fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
-            out->lm->width, out->lm->height, out->lm->covered_texels, out->lm->valid_texels, out->lm->invalid_samples,
-            out->lm->sample_count);
-    if (out->lm->covered_texels == 0) {
-        /* nothing to gather into: the map would be all zero */
-        fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
-                        "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
-                cmd, out->lm->width, out->lm->height);
-        goto fail;
-    }
-    rad_lightmap_gather_options_default(&go);
-    go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
-    go.visibility_rays = vis;
-    go.hemisphere_rays = hemi_rays;
-    ch = rad_lightmap_channels(go.encoding);
-    out->values = (float *)tool_calloc((size_t)width * height * ch, sizeof(float));
-    if (proxy) {
-        tool_context(&ctx, "lightmap gather");
-        r = out->hr ? rad_lightmap_gather_hierarchical(out->lm, out->hr, RAD_HIERARCHICAL_GATHERED, out->values, &ctx)
-                    : rad_lightmap_gather_vp(out->lm, out->vp, vp_H, out->values, &ctx);
-        tool_progress_end();
-        if (r != RAD_SUCCESS) { tool_fail(cmd, out->hr ? "rad_lightmap_gather_hierarchical" : "rad_lightmap_gather_vp", r); goto fail; }
-    } else {
-        /* the exact gather costs samples x patches form factors: past ~2e7 the rays win */
-        if (gather < 0)
-            gather = (double)out->lm->sample_count * out->cl.patches->count > 2e7 ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
-        go.method = (rad_lightmap_gather_method)gather;
-        if (go.method == RAD_LIGHTMAP_GATHER_HEMISPHERE)
-            fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, hemi_rays);
-        tool_context(&ctx, "lightmap gather");
-        r = rad_lightmap_gather(out->lm, out->cl.patches, out->cl.B, &w->rc, &go, out->values, &ctx);
-        tool_progress_end();
-        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_gather", r); goto fail; }
-    }
-    if (direct && !sh) {
-        rad_direct_options dopt;
-        rad_direct_options_default(&dopt);
-        dopt.exclude_emitters = 0;
-        dopt.light_samples = co->light_samples;
-        tool_context(&ctx, "lightmap direct");
-        r = rad_lightmap_direct(out->lm, &w->rc, w->file.lights, w->file.light_count, &dopt, out->values, &ctx);
-        tool_progress_end();
-        if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_direct", r); goto fail; }
-    }
-    tool_context(&ctx, NULL);
-    if ((r = rad_lightmap_dilate(out->lm, ch, out->values, 0, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_dilate", r); goto fail; }
-    if ((r = rad_lightmap_stitch(out->lm, ch, out->values, 0, &st, &ctx)) != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_stitch", r); goto fail; }
-    fprintf(stderr, "rad %s: lightmap baked in %.2f s (%.2f s with the %s solution; %ux%u, %.1f MiB of values); %u seams, "
-                    "largest jump %.4g before stitching, %.4g after\n", cmd, tool_seconds() - t0, tool_seconds() - t_all,
-            out->hr ? "hierarchical" : proxy ? "virtual-patch" : "classic", out->lm->width, out->lm->height,
-            (double)width * height * ch * sizeof(float) / 1048576.0, st.seams, (double)st.max_jump_before,
-            (double)st.max_jump_after);
-    free(vp_H);
-    return 0;
-fail:
-    free(vp_H);
-    tool_lightmap_bake_free(out);
-    return 1;
-}
-
-static int lightmap_main(int argc, char **argv, tool_lights *lights)
-{
-    const char *scene_path = NULL, *out_path = NULL, *render_path = NULL;
-    int rw = 256, rh = 256;
-    uint32_t aa = 2;
-    tool_classic_options co;
-    tool_world w;
-    tool_lightmap_baked bk;
-    const rad_lightmap *lm = NULL;
-    int width = 256, height = 256, size_given = 0, sh = 0, force_unwrap = 0, a, code = 1;
-    uint32_t threads = 0, texel_samples = 4, vis = 2, i, ch, hemi_rays = 256;
-    int gather = -1; /* -1: by the work, else a rad_lightmap_gather_method */
-    tool_lightmap_proxy px;
-    int px_opts = 0, hr_opts = 0;
-    const float *values = NULL;
-    float exposure = 0.31830988f;
-    char *gltf_hdr = NULL, *gltf_bin = NULL; /* -o OUT.glb|gltf: the files beside it */
-    memset(&bk, 0, sizeof bk);
-    memset(&px, 0, sizeof px);
-    tool_classic_options_default(&co);
+    int a, k;
+    memset(la, 0, sizeof *la);
+    tool_classic_options_default(&la->co);
+    tool_lightmap_request_default(&la->rq);
+    la->rw = la->rh = 256;
+    la->aa = 2;
+    la->exposure = 0.31830988f; /* 1/pi */
     for (a = 0; a < argc; ++a) {
         const char *o = argv[a];
-        int k;
         if (!strcmp(o, "--help") || !strcmp(o, "-h")) {
             lightmap_usage(stdout);
             return 0;
         }
-        if ((k = tool_classic_option("lightmap", argc, argv, &a, &co)) != 0) {
-            if (k == 2) return 2;
-            continue;
-        }
-        if ((k = tool_light_option("lightmap", argc, argv, &a, lights)) != 0) {
-            if (k == 2) return 2;
-            continue;
-        }
-        if (!strcmp(o, "--sh")) { sh = 1; continue; }
-        if (!strcmp(o, "--proxy") && a + 1 < argc) {
-            const char *v = argv[++a];
-            if (!strcmp(v, "aavp")) px.kind = TOOL_PROXY_AAVP;
-            else if (!strcmp(v, "vp")) px.kind = TOOL_PROXY_VP;
-            else if (!strcmp(v, "hierarchical")) px.kind = TOOL_LIGHTMAP_HIERARCHICAL;
-            else if (!strcmp(v, "patches")) px.kind = TOOL_PROXY_PATCHES;
-            else { fprintf(stderr, "rad lightmap: unknown --proxy '%s' (patches, aavp, vp or hierarchical)\n", v); return 2; }
-            continue;
-        }
-        if ((!strcmp(o, "--vp-resolution") || !strcmp(o, "--face-points")) && a + 1 < argc) {
-            uint32_t *dst = o[2] == 'v' ? &px.resolution : &px.face_points, hi = 4096u;
-            if (tool_parse_uint("lightmap", o, argv[++a], dst)) return 2;
-            if (*dst == 0 || *dst > hi) { fprintf(stderr, "rad lightmap: %s must be 1 to %u\n", o, hi); return 2; }
-            px_opts = 1;
-            continue;
-        }
-        if (!strcmp(o, "--hr-eps") && a + 1 < argc) {
-            if (tool_parse_float("lightmap", o, argv[++a], &px.hr_eps)) return 2;
-            if (!(px.hr_eps > 0.0f && px.hr_eps < 1.0f)) { fprintf(stderr, "rad lightmap: --hr-eps must be in (0, 1)\n"); return 2; }
-            hr_opts = 1;
-            continue;
-        }
-        if (!strcmp(o, "--unwrap")) { force_unwrap = 1; continue; }
-        if (o[0] == '-' && strcmp(o, "-") != 0 && a + 1 >= argc) {
-            fprintf(stderr, "rad lightmap: %s needs a value (or is unknown; try rad lightmap --help)\n", o);
-            return 2;
-        }
-        if (!strcmp(o, "-o")) out_path = argv[++a];
-        else if (!strcmp(o, "--render")) render_path = argv[++a];
-        else if (!strcmp(o, "--render-size")) {
-            if (tool_parse_size(argv[++a], &rw, &rh) || tool_check_size("lightmap", rw, rh)) {
-                fprintf(stderr, "rad lightmap: bad --render-size '%s'\n", argv[a]);
-                return 2;
-            }
-        } else if (!strcmp(o, "--aa")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &aa)) return 2;
-            if (aa == 0 || aa > 16) { fprintf(stderr, "rad lightmap: --aa must be 1 to 16\n"); return 2; }
-        } else if (!strcmp(o, "--size")) {
-            const char *v = argv[++a];
-            size_given = 1;
-            if (strchr(v, 'x')) {
-                if (tool_parse_size(v, &width, &height)) { fprintf(stderr, "rad lightmap: bad --size '%s'\n", v); return 2; }
-            } else {
-                uint32_t n;
-                if (tool_parse_uint("lightmap", o, v, &n)) return 2;
-                width = height = (int)(n > 16384u ? 16385u : n);
-            }
-            if (width < 4 || height < 4 || width > 16384 || height > 16384) {
-                fprintf(stderr, "rad lightmap: --size must be 4 to 16384 texels a side\n");
-                return 2;
-            }
-        } else if (!strcmp(o, "--texel-samples")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &texel_samples)) return 2;
-            if (texel_samples == 0 || texel_samples > 16) { fprintf(stderr, "rad lightmap: --texel-samples must be 1 to 16\n"); return 2; }
-        } else if (!strcmp(o, "--visibility-rays")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &vis)) return 2;
-            if (vis == 0 || vis > 64) { fprintf(stderr, "rad lightmap: --visibility-rays must be 1 to 64\n"); return 2; }
-        } else if (!strcmp(o, "--gather")) {
-            const char *v = argv[++a];
-            if (v && !strcmp(v, "exact")) gather = RAD_LIGHTMAP_GATHER_EXACT;
-            else if (v && !strcmp(v, "hemisphere")) gather = RAD_LIGHTMAP_GATHER_HEMISPHERE;
-            else { fprintf(stderr, "rad lightmap: --gather must be exact or hemisphere\n"); return 2; }
-        } else if (!strcmp(o, "--hemisphere-rays")) {
-            if (tool_parse_uint("lightmap", o, argv[++a], &hemi_rays)) return 2;
-            if (hemi_rays == 0 || hemi_rays > 65536) { fprintf(stderr, "rad lightmap: --hemisphere-rays must be 1 to 65536\n"); return 2; }
-        } else if (!strcmp(o, "--exposure")) {
-            if (tool_parse_float("lightmap", o, argv[++a], &exposure)) return 2;
-            if (!(exposure > 0.0f)) { fprintf(stderr, "rad lightmap: --exposure must be > 0\n"); return 2; }
-        } else if (!strcmp(o, "--threads")) {
-            if (tool_parse_threads("lightmap", o, argv[++a], &threads)) return 2;
-        } else if (o[0] == '-' && o[1]) {
+        if ((k = tool_classic_option("lightmap", argc, argv, &a, &la->co)) == 0 &&
+            (k = tool_light_option("lightmap", argc, argv, &a, lights)) == 0)
+            k = tool_args_parse("lightmap", lightmap_table, la, &la->given, argc, argv, &a);
+        if (k == 2) return 2;
+        if (k == 1) continue;
+        if (o[0] == '-' && o[1]) {
             fprintf(stderr, "rad lightmap: unknown option '%s' (try rad lightmap --help)\n", o);
             return 2;
-        } else if (!scene_path) {
-            scene_path = o;
-        } else {
-            fprintf(stderr, "rad lightmap: more than one scene ('%s', '%s')\n", scene_path, o);
+        }
+        if (la->scene) {
+            fprintf(stderr, "rad lightmap: more than one scene ('%s', '%s')\n", la->scene, o);
             return 2;
         }
+        la->scene = o;
     }
-    if (!scene_path || !out_path) {
+    if (!la->scene || !la->out) {
         lightmap_usage(stderr);
         return 2;
     }
-    if (px_opts && (!px.kind || px.kind == TOOL_LIGHTMAP_HIERARCHICAL)) {
+    if ((la->given & LIGHTMAP_GIVEN_VP) && (!la->px.kind || la->px.kind == TOOL_LIGHTMAP_HIERARCHICAL)) {
         fprintf(stderr, "rad lightmap: --vp-resolution and --face-points are for --proxy aavp|vp\n");
         return 2;
     }
-    if (hr_opts && px.kind != TOOL_LIGHTMAP_HIERARCHICAL) {
+    if ((la->given & LIGHTMAP_GIVEN_HR) && la->px.kind != TOOL_LIGHTMAP_HIERARCHICAL) {
         fprintf(stderr, "rad lightmap: --hr-eps is for --proxy hierarchical\n");
         return 2;
     }
-    if (px.kind && sh) {
+    if (la->px.kind && la->rq.sh) {
         fprintf(stderr, "rad lightmap: --sh needs the classic gather (the virtual patches' gather has no direction): leave out --proxy\n");
         return 2;
     }
-    if (sh && lightmap_is_png(out_path)) {
+    if (la->rq.sh && lightmap_is_png(la->out)) {
         fprintf(stderr, "rad lightmap: --sh writes PFM or EXR files (PNG cannot hold negative coefficients): use -o NAME.pfm or NAME.exr\n");
         return 2;
     }
-    if (sh && render_path) {
+    if (la->rq.sh && la->render) {
         fprintf(stderr, "rad lightmap: --render shades from the RGB lightmap: leave out --sh\n");
         return 2;
     }
-    if (tool_gltf_is_path(out_path) && sh) {
+    if (tool_gltf_is_path(la->out) && la->rq.sh) {
         fprintf(stderr, "rad lightmap: a .glb or .gltf carries the RGB lightmap: leave out --sh\n");
         return 2;
     }
-    if (tool_check_size("lightmap", width, height)) return 2;
-    if (tool_gltf_is_path(out_path)) {
-        gltf_hdr = tool_gltf_hdr_path(out_path);
-        gltf_bin = tool_gltf_bin_path(out_path);
+    if (tool_check_size("lightmap", la->rq.width, la->rq.height)) return 2;
+    if ((!tool_gltf_is_path(la->out) && tool_image_check_format("lightmap", la->out)) ||
+        (la->render && tool_image_check_format("lightmap", la->render)))
+        return 2;
+    return -1;
+}
+
+static int lightmap_main(int argc, char **argv, tool_lights *lights)
+{
+    lightmap_args la;
+    const char *scene_path, *out_path, *render_path;
+    int rw, rh;
+    uint32_t aa;
+    tool_world w;
+    tool_lightmap_baked bk;
+    tool_lightmap_request rq;
+    const rad_lightmap *lm = NULL;
+    int width, height, sh, code = 1;
+    uint32_t i, ch;
+    const float *values = NULL;
+    float exposure;
+    char *gltf_hdr = NULL, *gltf_bin = NULL; /* -o OUT.glb|gltf: the files beside it */
+    if ((code = lightmap_parse(argc, argv, lights, &la)) >= 0) return code;
+    code = 1;
+    memset(&bk, 0, sizeof bk);
+    if (tool_gltf_is_path(la.out)) {
+        gltf_hdr = tool_gltf_hdr_path(la.out);
+        gltf_bin = tool_gltf_bin_path(la.out);
     }
-    if ((!gltf_hdr && tool_image_check_format("lightmap", out_path)) || (render_path && tool_image_check_format("lightmap", render_path))) return 2;
+    scene_path = la.scene;
+    out_path = la.out;
+    render_path = la.render;
+    rw = la.rw;
+    rh = la.rh;
+    aa = la.aa;
+    width = la.rq.width;
+    height = la.rq.height;
+    sh = la.rq.sh;
+    exposure = la.exposure;
     {
         /* the files written: OUT (or its four SH layers) and the view; checked before the
            work, and again against every file the scene was read from once it is loaded */
@@ -568,7 +315,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
         if (gltf_bin) outs[n++] = gltf_bin;
         for (k = 0; k < n && !bad; ++k) bad = tool_check_output("lightmap", outs[k], &scene_path, 1);
         if (!bad) bad = tool_check_outputs("lightmap", outs, n, &scene_path, 1);
-        tool_set_threads((int)threads);
+        tool_set_threads((int)la.threads);
         if (!bad && tool_open_world_lit("lightmap", scene_path, lights, &w)) bad = 2;
         if (!bad && tool_check_outputs("lightmap", outs, n, w.file.input_files, (int)w.file.input_file_count)) {
             tool_close_world(&w);
@@ -581,9 +328,11 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             return 1;
         }
     }
-    if (tool_lightmap_bake("lightmap", &w, &co, width, height, !size_given, texel_samples, vis, gather, hemi_rays, sh,
-                           force_unwrap, !sh, px.kind ? &px : NULL, &bk))
-        goto done;
+    rq = la.rq;
+    rq.auto_size = !(la.given & LIGHTMAP_GIVEN_SIZE);
+    rq.direct = !sh;
+    rq.proxy = la.px.kind ? &la.px : NULL;
+    if (tool_lightmap_bake("lightmap", &w, &la.co, &rq, &bk)) goto done;
     width = (int)bk.lm->width; /* the unwrap may have chosen a larger atlas */
     height = (int)bk.lm->height;
     lm = bk.lm;

@@ -32,25 +32,130 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* rad probes' command line */
+typedef struct probes_args {
+    const char *scene, *out;
+    tool_classic_options o;
+    rad_probe_options po;
+    tool_lightmap_proxy px;  /* --proxy and the virtual patches' options */
+    uint32_t threads;
+    int indirect;            /* --indirect: only the indirect light */
+    int band4;               /* --band4 */
+    uint32_t given;          /* PROBES_GIVEN_* */
+} probes_args;
+enum { PROBES_GIVEN_VP = 1, PROBES_GIVEN_VP_RAYS = 2, PROBES_GIVEN_PATCH_SAMPLES = 4 };
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+static const uint32_t proxy_values[] = {TOOL_PROXY_PATCHES, TOOL_PROXY_AAVP, TOOL_PROXY_VP};
+#define PA(f) offsetof(probes_args, f)
+#define PA_UINT(name, val, f, lo, hi, given, bad, help) \
+    {TOOL_ARG_UINT, name, val, PA(f), lo, hi, 0, given, bad, NULL, NULL, NULL, 0, help}
+#define PA_FLAG(name, f, help) {TOOL_ARG_FLAG, name, NULL, PA(f), 1, 0, 0, 0, NULL, NULL, NULL, NULL, 0, help}
+/* rad probes' own options (the classic and light options are classic.c's and lights.c's) */
+static const tool_arg probes_table[] = {
+    {TOOL_ARG_STRING, "-o", "FILE", PA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "OUT.json (text) or OUT.bin (binary; layout in tools/cmd_probes.c)"},
+    {TOOL_ARG_FLOAT, "--spacing", "S", PA(po.spacing), 0.0, 1e30, TOOL_ARG_LO_OPEN, 0, "must be > 0", NULL, NULL, NULL, 0,
+     "grid spacing in scene units (default: the largest extent / 8)"},
+    PA_UINT("--rays", "R", po.rays, 1, 65536, 0, "must be in 1..65536",
+            "rays per probe for the inside-geometry test (default 256)"),
+    PA_UINT("--patch-samples", "N", po.patch_samples, 1, 256, PROBES_GIVEN_PATCH_SAMPLES, "must be in 1..256",
+            "points per patch for the probes' gather (default 4; classic patches)"),
+    PA_FLAG("--indirect", indirect, "only the indirect light (default: direct light too)"),
+    PA_FLAG("--band4", band4, "also band 4 (9 more coefficients per colour: sharper E(n) than L2)"),
+    {TOOL_ARG_CHOICE, "--proxy", "P", PA(px.kind), 0, 0, 0, 0, NULL, "patches|aavp|vp", proxy_values, NULL, 0,
+     "the light from classic patches (patches, the default) or from virtual patches, aavp or vp:\n"
+     "a few thousand unknowns whatever the triangle count, for real buildings (rad_probes_create_vp)"},
+    PA_UINT("--vp-resolution", "R", px.resolution, 1, 4096, PROBES_GIVEN_VP, "must be 1 to 4096",
+            "--proxy: voxels along the longest axis (default 16)"),
+    PA_UINT("--vp-max-patches", "B", px.max_patches, 1, 4294967295.0, PROBES_GIVEN_VP, "must be at least 1",
+            "--proxy: the finest resolution with at most B patches"),
+    PA_UINT("--face-points", "P", px.face_points, 1, 4096, PROBES_GIVEN_VP, "must be 1 to 4096",
+            "--proxy: Hammersley points per voxel face (default 16)"),
+    PA_UINT("--vp-rays", "N", po.vp_rays, 1, 65536, PROBES_GIVEN_VP_RAYS, "must be in 1..65536",
+            "--proxy: gather rays per probe (default 2048)"),
+    {TOOL_ARG_CUSTOM, "--threads", "N", PA(threads), 0, 0, 0, 0, NULL, NULL, NULL, parse_threads, 0,
+     "worker threads (default: all cores; at most 1024)"},
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 static void probes_usage(FILE *f)
 {
+    static char own[4096];
+    tool_args_help_into(probes_table, 0, own, sizeof own);
     fprintf(f, "usage: rad probes SCENE -o OUT.json|OUT.bin [--spacing S] [--rays R] [--indirect] [--proxy aavp|vp] [options]\n"
                "Solves the scene (classic radiosity, or virtual patches with --proxy; direct light as the source) and\n"
                "bakes SH L2 irradiance probes on a grid over its bounds: E(n) = sum_i E_i Y_i(n) (docs/methods/probes.md).\n"
-               "  -o FILE            OUT.json (text) or OUT.bin (binary; layout in tools/cmd_probes.c)\n"
-               "  --spacing S        grid spacing in scene units (default: the largest extent / 8)\n"
-               "  --rays R           rays per probe for the inside-geometry test (default 256)\n"
-               "  --patch-samples N  points per patch for the probes' gather (default 4; classic patches)\n"
-               "  --indirect         only the indirect light (default: direct light too)\n"
-               "  --band4            also band 4 (9 more coefficients per colour: sharper E(n) than L2)\n"
-               "  --proxy P          the light from classic patches (patches, the default) or from virtual patches,\n"
-               "                     aavp or vp: a few thousand unknowns whatever the triangle count, for real\n"
-               "                     buildings (rad_probes_create_vp); --vp-resolution R (default 16) or\n"
-               "                     --vp-max-patches B (the finest resolution with at most B patches),\n"
-               "                     --face-points P (default 16), --vp-rays N gather rays per probe (default 2048)\n"
-               "%s%s"
-               "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            tool_classic_help(), tool_light_help());
+               "%s%s%s",
+            own, tool_classic_help(), tool_light_help());
+}
+
+/* the command line into pa; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
+static int probes_parse(const char *cmd, int argc, char **argv, tool_lights *lights, probes_args *pa)
+{
+    int a, rc;
+    size_t len;
+    memset(pa, 0, sizeof *pa);
+    tool_classic_options_default(&pa->o);
+    rad_probe_options_default(&pa->po);
+    for (a = 0; a < argc; ++a) {
+        const char *opt = argv[a];
+        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) {
+            probes_usage(stdout);
+            return 0;
+        }
+        if ((rc = tool_classic_option(cmd, argc, argv, &a, &pa->o)) == 0 &&
+            (rc = tool_light_option(cmd, argc, argv, &a, lights)) == 0)
+            rc = tool_args_parse(cmd, probes_table, pa, &pa->given, argc, argv, &a);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        if (opt[0] == '-' && opt[1]) {
+            fprintf(stderr, "rad %s: unknown option '%s' (see rad probes --help)\n", cmd, opt);
+            return 2;
+        }
+        if (pa->scene) {
+            fprintf(stderr, "rad %s: more than one scene given\n", cmd);
+            return 2;
+        }
+        pa->scene = opt;
+    }
+    if (!pa->scene || !pa->out) {
+        fprintf(stderr, "rad %s: %s\n", cmd, !pa->scene ? "no scene given" : "no output file given (-o OUT.json|OUT.bin)");
+        probes_usage(stderr);
+        return 2;
+    }
+    if ((pa->given & PROBES_GIVEN_VP) && !pa->px.kind) {
+        fprintf(stderr, "rad %s: --vp-resolution, --vp-max-patches and --face-points are for --proxy aavp|vp\n", cmd);
+        return 2;
+    }
+    if (pa->px.resolution && pa->px.max_patches) {
+        fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
+        return 2;
+    }
+    if ((pa->given & PROBES_GIVEN_VP_RAYS) && !pa->px.kind) {
+        fprintf(stderr, "rad %s: --vp-rays is for --proxy aavp|vp (classic patches: --patch-samples)\n", cmd);
+        return 2;
+    }
+    if ((pa->given & PROBES_GIVEN_PATCH_SAMPLES) && pa->px.kind) {
+        fprintf(stderr, "rad %s: --patch-samples is for classic patches (with --proxy: --vp-rays)\n", cmd);
+        return 2;
+    }
+    if (pa->px.kind && pa->o.solver == TOOL_DIRECT) {
+        fprintf(stderr, "rad %s: --solver direct is for classic patches: with --proxy use jacobi or gauss-seidel\n", cmd);
+        return 2;
+    }
+    len = strlen(pa->out);
+    if (!(len >= 5 && !strcmp(pa->out + len - 5, ".json")) && !(len >= 4 && !strcmp(pa->out + len - 4, ".bin"))) {
+        fprintf(stderr, "rad %s: the output must end in .json or .bin: '%s'\n", cmd, pa->out);
+        return 2;
+    }
+    if (pa->band4) pa->po.flags |= RAD_PROBES_BAND4;
+    if (!pa->indirect) pa->po.flags |= RAD_PROBES_DIRECT;
+    return -1;
 }
 
 static const char *state_name(uint8_t s)
@@ -132,135 +237,42 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
 
 static int probes_main(int argc, char **argv, tool_lights *lights)
 {
-    const char *cmd = "probes", *scene_name = NULL, *out_path = NULL;
-    tool_classic_options o;
+    const char *cmd = "probes";
+    probes_args pa;
     tool_world w;
     tool_classic c;
-    tool_lightmap_proxy px;
     rad_virtual_patches *vp = NULL;
     float *vp_B = NULL;
-    rad_probe_options po;
     rad_probes *pr = NULL;
     rad_context ctx;
     tool_output out;
-    uint32_t threads = 0, i, counts[3] = {0, 0, 0};
+    uint32_t i, counts[3] = {0, 0, 0};
     double t0 = tool_seconds(), tp;
-    int a, rc, json, total = 1, px_opts = 0, vp_rays_given = 0, patch_samples_given = 0;
-    size_t len;
+    int rc, json, total;
     rad_result r;
-    tool_classic_options_default(&o);
-    rad_probe_options_default(&po);
-    memset(&px, 0, sizeof px);
     memset(&c, 0, sizeof c);
-    for (a = 0; a < argc; ++a) {
-        const char *opt = argv[a];
-        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { probes_usage(stdout); return 0; }
-        rc = tool_classic_option(cmd, argc, argv, &a, &o);
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        rc = tool_light_option(cmd, argc, argv, &a, lights);
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        if (!strcmp(opt, "--indirect")) { total = 0; continue; }
-        if (!strcmp(opt, "--band4")) { po.flags |= RAD_PROBES_BAND4; continue; }
-        if ((!strcmp(opt, "-o") || !strcmp(opt, "--threads") || !strcmp(opt, "--spacing") || !strcmp(opt, "--rays") ||
-             !strcmp(opt, "--patch-samples") || !strcmp(opt, "--proxy") || !strcmp(opt, "--vp-resolution") ||
-             !strcmp(opt, "--face-points") || !strcmp(opt, "--vp-rays") || !strcmp(opt, "--vp-max-patches")) &&
-            a + 1 >= argc) {
-            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-            return 2;
-        }
-        if (!strcmp(opt, "-o")) out_path = argv[++a];
-        else if (!strcmp(opt, "--threads")) { if (tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2; }
-        else if (!strcmp(opt, "--spacing")) {
-            if (tool_parse_float(cmd, opt, argv[++a], &po.spacing)) return 2;
-            if (!(po.spacing > 0.0f)) { fprintf(stderr, "rad %s: --spacing must be > 0\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--rays")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &po.rays)) return 2;
-            if (po.rays == 0 || po.rays > 65536) { fprintf(stderr, "rad %s: --rays must be in 1..65536\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--vp-rays")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &po.vp_rays)) return 2;
-            if (po.vp_rays == 0 || po.vp_rays > 65536) { fprintf(stderr, "rad %s: --vp-rays must be in 1..65536\n", cmd); return 2; }
-            vp_rays_given = 1;
-        } else if (!strcmp(opt, "--patch-samples")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &po.patch_samples)) return 2;
-            if (po.patch_samples == 0 || po.patch_samples > 256) {
-                fprintf(stderr, "rad %s: --patch-samples must be in 1..256\n", cmd);
-                return 2;
-            }
-            patch_samples_given = 1;
-        } else if (!strcmp(opt, "--proxy")) {
-            const char *v = argv[++a];
-            if (!strcmp(v, "aavp")) px.kind = TOOL_PROXY_AAVP;
-            else if (!strcmp(v, "vp")) px.kind = TOOL_PROXY_VP;
-            else if (!strcmp(v, "patches")) px.kind = TOOL_PROXY_PATCHES;
-            else { fprintf(stderr, "rad %s: unknown --proxy '%s' (patches, aavp or vp)\n", cmd, v); return 2; }
-        } else if (!strcmp(opt, "--vp-resolution") || !strcmp(opt, "--face-points")) {
-            uint32_t *dst = opt[2] == 'v' ? &px.resolution : &px.face_points;
-            if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
-            if (*dst == 0 || *dst > 4096u) { fprintf(stderr, "rad %s: %s must be 1 to 4096\n", cmd, opt); return 2; }
-            px_opts = 1;
-        } else if (!strcmp(opt, "--vp-max-patches")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &px.max_patches)) return 2;
-            if (px.max_patches == 0) { fprintf(stderr, "rad %s: --vp-max-patches must be at least 1\n", cmd); return 2; }
-            px_opts = 1;
-        } else if (opt[0] == '-' && opt[1]) {
-            fprintf(stderr, "rad %s: unknown option '%s' (see rad probes --help)\n", cmd, opt);
-            return 2;
-        } else if (!scene_name) scene_name = opt;
-        else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
-    }
-    if (!scene_name || !out_path) {
-        fprintf(stderr, "rad %s: %s\n", cmd, !scene_name ? "no scene given" : "no output file given (-o OUT.json|OUT.bin)");
-        probes_usage(stderr);
-        return 2;
-    }
-    if (px_opts && !px.kind) {
-        fprintf(stderr, "rad %s: --vp-resolution, --vp-max-patches and --face-points are for --proxy aavp|vp\n", cmd);
-        return 2;
-    }
-    if (px.resolution && px.max_patches) {
-        fprintf(stderr, "rad %s: --vp-resolution and --vp-max-patches exclude each other\n", cmd);
-        return 2;
-    }
-    if (vp_rays_given && !px.kind) {
-        fprintf(stderr, "rad %s: --vp-rays is for --proxy aavp|vp (classic patches: --patch-samples)\n", cmd);
-        return 2;
-    }
-    if (patch_samples_given && px.kind) {
-        fprintf(stderr, "rad %s: --patch-samples is for classic patches (with --proxy: --vp-rays)\n", cmd);
-        return 2;
-    }
-    if (px.kind && o.solver == TOOL_DIRECT) {
-        fprintf(stderr, "rad %s: --solver direct is for classic patches: with --proxy use jacobi or gauss-seidel\n", cmd);
-        return 2;
-    }
-    len = strlen(out_path);
-    json = len >= 5 && !strcmp(out_path + len - 5, ".json");
-    if (!json && !(len >= 4 && !strcmp(out_path + len - 4, ".bin"))) {
-        fprintf(stderr, "rad %s: the output must end in .json or .bin: '%s'\n", cmd, out_path);
-        return 2;
-    }
-    if (tool_check_output(cmd, out_path, &scene_name, 1)) return 1;
-    tool_set_threads((int)threads);
-    if (tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
+    if ((rc = probes_parse(cmd, argc, argv, lights, &pa)) >= 0) return rc;
+    json = strlen(pa.out) >= 5 && !strcmp(pa.out + strlen(pa.out) - 5, ".json");
+    total = !pa.indirect;
+    if (tool_check_output(cmd, pa.out, &pa.scene, 1)) return 1;
+    tool_set_threads((int)pa.threads);
+    if (tool_open_world_lit(cmd, pa.scene, lights, &w)) return 1;
     /* a scene too big for the dense classic build is refused with the way out */
-    o.dense_instead = "--proxy aavp or --proxy vp (the probes' light from virtual patches: a few thousand whatever the "
+    pa.o.dense_instead = "--proxy aavp or --proxy vp (the probes' light from virtual patches: a few thousand whatever the "
                       "triangle count; --vp-resolution R sets how many)";
-    if (px.kind) {
-        if (tool_vp_proxy_solve(cmd, &w, &o, &px, &vp, &vp_B, NULL, NULL)) {
+    if (pa.px.kind) {
+        if (tool_vp_proxy_solve(cmd, &w, &pa.o, &pa.px, &vp, &vp_B, NULL, NULL)) {
             tool_close_world(&w);
             return 1;
         }
-    } else if (tool_classic_solve(cmd, &w, &o, &c)) {
+    } else if (tool_classic_solve(cmd, &w, &pa.o, &c)) {
         tool_close_world(&w);
         return 1;
     }
-    if (total) po.flags |= RAD_PROBES_DIRECT;
     tool_context(&ctx, "probes");
     tp = tool_seconds();
-    r = vp ? rad_probes_create_vp(vp, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &po, vp_B, &ctx, &pr)
-           : rad_probes_create(c.patches, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &po, c.B, &ctx, &pr);
+    r = vp ? rad_probes_create_vp(vp, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &pa.po, vp_B, &ctx, &pr)
+           : rad_probes_create(c.patches, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &pa.po, c.B, &ctx, &pr);
     tool_progress_end();
     rc = 1;
     if (r != RAD_SUCCESS) {
@@ -269,7 +281,7 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
     }
     tp = tool_seconds() - tp;
     for (i = 0; i < rad_probes_count(pr); ++i) counts[rad_probes_states(pr)[i] % 3u]++;
-    if (tool_output_open(&out, out_path) != 0) {
+    if (tool_output_open(&out, pa.out) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
@@ -277,10 +289,10 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
         fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
-    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light%s%s\n", out_path,
+    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light%s%s\n", pa.out,
            rad_probes_count(pr), counts[RAD_PROBE_VALID], counts[RAD_PROBE_MOVED], counts[RAD_PROBE_DISABLED],
            (unsigned long)rad_probes_entry_count(pr), total ? "total" : "indirect", rad_probes_band4(pr) ? ", band 4" : "",
-           vp ? (px.kind == TOOL_PROXY_VP ? ", over vp virtual patches" : ", over aavp virtual patches") : "");
+           vp ? (pa.px.kind == TOOL_PROXY_VP ? ", over vp virtual patches" : ", over aavp virtual patches") : "");
     fprintf(stderr, "rad %s: probes gathered in %.2f s; done in %.2f s\n", cmd, tp, tool_seconds() - t0);
     rc = 0;
 done:

@@ -52,44 +52,6 @@ static void *xmalloc(size_t size)
     return p;
 }
 
-static void render_usage(FILE *f)
-{
-    fprintf(f,
-            "usage: rad render SCENE -o OUT.png|OUT.pfm|OUT.exr [--method classic|multibounce|temporal|local|stochastic|vp|aavp|hierarchical|lightmap|pathtrace] [options]\n"
-            "  -o FILE            output image: .pfm or .exr (linear radiance; .exr needs libtinyexr-dev at build) or .png\n"
-            "                     (sRGB, exposure applied)\n"
-            "  --method M         classic (default: radiosity + per-pixel direct light), multibounce (the\n"
-            "                     indirect light L = F_mb E), temporal (alias-table frames), pathtrace, local\n"
-            "                     (local matrix of the patches nearest the camera), vp or aavp (virtual patches),\n"
-            "                     hierarchical (quadtrees and links, Hanrahan et al. 1991), lightmap (classic,\n"
-            "                     or virtual patches with --proxy aavp|vp, baked into a lightmap, the indirect\n"
-            "                     light looked up per pixel)\n"
-            "  --bake FILE.radb   classic, multibounce, temporal, stochastic, hierarchical: use a bake of\n"
-            "                     that method made by\n"
-            "                     'rad bake' from this scene instead of computing it here\n"
-            "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
-            "  --fov DEG          vertical field of view in degrees (default: the scene's)\n"
-            "  --size WxH         image size (default 512x512; at most 2 GiB of image: 12 bytes a pixel)\n"
-            "  --aa N             radiosity methods: stratified samples per pixel, rounded down to a square (default 16, 1 to 65536)\n"
-            "  --spp N            pathtrace: samples per pixel (default 64)\n"
-            "  --seed S           pathtrace: random seed (default 0)\n"
-            "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
-            "  --pixel-light-samples N   radiosity methods: shadow rays per pixel sample and light (default 16, at most 65536)\n"
-            "  --final-gather N   classic, vp, aavp: trace the first bounce from each pixel sample with N\n"
-            "                     rays (direct light at the hits, the solution's irradiance there): the\n"
-            "                     indirect light of points a patch average misrepresents; default 0 (off)\n"
-            "  --shading MODEL    radiosity methods: lighting model for the analytic lights' direct term: none\n"
-            "                     (default: Lambert through the irradiance), lambert, half-lambert, banded,\n"
-            "                     phong, blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says\n"
-            "                     how it combines with the diffuse radiosity solution)\n"
-            "patch and classic solution options (ignored with --bake, which keeps its own):\n"
-            "%s"
-            "%s"
-            "%s"
-            "  --threads N        worker threads (default: all cores; at most 1024)\n",
-            tool_classic_help(), tool_method_help(1), tool_light_help());
-}
-
 /* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
    S: the row sums of F (how much of its hemisphere each patch sees). */
 static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv)
@@ -127,50 +89,64 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-typedef struct isect_job {
-    const rad_raycaster *rc;
-    const rad_ray *rays;
-    rad_hit *hits;
-    uint32_t count;
-    int failed;
-} isect_job;
+/* What render_classic draws: the view and the per-pixel options of the command line */
+typedef struct render_view {
+    rad_camera cam;
+    int width, height;
+    uint32_t aa;             /* --aa: stratified samples per pixel */
+    uint32_t light_samples;  /* --pixel-light-samples */
+    float exposure;          /* --exposure (PNG frames of --sequence) */
+    int shading;             /* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
+    uint32_t final_gather;   /* --final-gather N: rays per sample for one traced bounce (0: off) */
+} render_view;
 
-/* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
-static int render_shading = -1;
-/* --method vp|aavp: render_classic gathers H at each sample from these (P and Hv unused) */
-static const rad_virtual_patches *render_vp = NULL;
-static const float *render_vp_H = NULL;
-static double render_vp_gather_seconds = 0.0;
-/* --method hierarchical: render_classic looks H up at each sample's hit (smooth, halo-fixed) */
-static const rad_hierarchical *render_hr = NULL;
-static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out);
-/* --method lightmap: render_classic reads H at each sample's lightmap uv from this RGB
-   irradiance lightmap (bilinear; P and Hv unused) */
-static const rad_lightmap *render_lm = NULL;
-static const float *render_lm_values = NULL;
-static uint32_t render_lm_size = 256, render_lm_samples = 4, render_lm_vis = 2;
-static int render_lm_size_given = 0; /* else an unwrap too fine for 256 gets a larger atlas */
-/* --final-gather N: rays per pixel sample for one traced bounce (0: off; rad_final_gather) */
-static uint32_t render_final_gather = 0;
-
-typedef struct fg_lookup {
-    const rad_patches *P; /* classic: per-vertex H of the patches */
+/* Where render_classic takes the irradiance H from the secondary sources at a sample: the
+   first of vp (rad_vp_gather of vp_H), hr (the hierarchical solution's smooth lookup) and lm
+   (a bilinear lookup of the RGB irradiance lightmap lm_values at the sample's lightmap uv)
+   that is set, else the per-vertex Hv of the patches P. */
+typedef struct render_source {
+    const rad_patches *P;
     const float *Hv;
-} fg_lookup;
+    const rad_virtual_patches *vp;
+    const float *vp_H;
+    const rad_hierarchical *hr;
+    const rad_lightmap *lm;
+    const float *lm_values;
+    double gather_seconds;   /* out: the time spent in the gathers and lookups */
+} render_source;
+
+/* rad render's command line */
+typedef struct render_args {
+    const char *scene, *out, *bake; /* SCENE, -o, --bake */
+    tool_classic_options o;
+    tool_method_options mo;
+    render_view view;
+    float fov;               /* --fov (0: the camera's) */
+    uint32_t spp;            /* --spp: pathtrace samples per pixel */
+    uint32_t threads;        /* --threads */
+    uint32_t lm_size, lm_samples, lm_vis; /* --lightmap-size, --texel-samples, --visibility-rays */
+    uint32_t given;          /* RENDER_GIVEN_* */
+} render_args;
+/* render_args.given: --camera; --lightmap-size (else an unwrap too fine for it gets a larger
+   atlas); one of the lightmap options */
+enum { RENDER_GIVEN_CAMERA = 1, RENDER_GIVEN_LM_SIZE = 2, RENDER_GIVEN_LM = 4 };
+
+static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, const uint32_t *valid, uint32_t count,
+                            float *out);
 
 /* H at the final gather's hits: the virtual patches' gather, or the patches' per-vertex H */
 static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *points, const float *normals, uint32_t count,
                                float *out)
 {
-    const fg_lookup *l = (const fg_lookup *)user;
+    const render_source *l = (const render_source *)user;
     uint32_t k;
     int i;
-    if (render_vp) {
+    if (l->vp) {
         rad_context quiet;
         tool_context(&quiet, NULL);
-        return rad_vp_gather(render_vp, render_vp_H, points, normals, count, out, &quiet);
+        return rad_vp_gather(l->vp, l->vp_H, points, normals, count, out, &quiet);
     }
-    if (render_hr) return hr_lookup(hits, NULL, count, out);
+    if (l->hr) return hr_lookup(l->hr, hits, NULL, count, out);
     for (k = 0; k < count; ++k) {
         float wts[3];
         uint32_t p = rad_patches_locate(l->P, hits[k].triangle, hits[k].b1, hits[k].b2, wts);
@@ -185,7 +161,8 @@ static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *poi
 }
 
 /* H of the hierarchical solution at hits[valid[k]] (valid NULL: hits[k]), k < count */
-static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t count, float *out)
+static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, const uint32_t *valid, uint32_t count,
+                            float *out)
 {
     uint32_t *tris = (uint32_t *)xmalloc(sizeof(uint32_t) * (count ? count : 1u)), k;
     float *bary = (float *)xmalloc(sizeof(float) * 2 * (count ? count : 1u));
@@ -196,206 +173,240 @@ static rad_result hr_lookup(const rad_hit *hits, const uint32_t *valid, uint32_t
         bary[2 * k] = h->b1;
         bary[2 * k + 1] = h->b2;
     }
-    r = rad_hierarchical_lookup(render_hr, RAD_HIERARCHICAL_GATHERED, 1, tris, bary, count, out);
+    r = rad_hierarchical_lookup(hr, RAD_HIERARCHICAL_GATHERED, 1, tris, bary, count, out);
     free(tris);
     free(bary);
     return r;
 }
 
-static int render_classic(const tool_world *w, const rad_patches *P, const float *Hv, const rad_camera *cam,
-                          int width, int height, uint32_t aa, uint32_t light_samples, tool_image *img)
-{
-    const rad_scene *scene = w->scene;
-    uint32_t strata, spp;
-    size_t batch_cap, total = (size_t)width * height, done_px = 0;
+/* The camera samples of a band of rows in flight through render_classic: rays, hits, the
+   front-face hits among them (valid: their ray index) and what each stage computes there. */
+typedef struct pixel_batch {
+    uint32_t strata, spp;    /* samples per pixel: strata x strata */
+    size_t cap;              /* samples a batch holds */
+    int rows;                /* rows per batch */
     rad_ray *rays;
     rad_hit *hits;
-    float *points, *normals, *irr, *shade_v = NULL, *shade_a = NULL, *shaded = NULL, *gathered = NULL;
+    float *points, *normals, *irr; /* per valid hit: position, normal, direct irradiance D */
+    float *gathered;         /* per valid hit: H from the source's gather or the final gather (or NULL) */
+    float *shade_v, *shade_a, *shaded; /* --shading: view direction, albedo, direct radiance */
     uint32_t *valid;
+    uint32_t count, nvalid;
+} pixel_batch;
+
+/* The samples of a batch: 64K, at least one row */
+#define RENDER_BATCH_SAMPLES 65536u
+
+static void pixel_batch_alloc(pixel_batch *b, const render_view *view, const render_source *src)
+{
+    memset(b, 0, sizeof *b);
+    for (b->strata = 1; (b->strata + 1) * (b->strata + 1) <= view->aa; ++b->strata) {
+    }
+    b->spp = b->strata * b->strata;
+    b->rows = (int)(RENDER_BATCH_SAMPLES / ((size_t)view->width * b->spp));
+    if (b->rows < 1) b->rows = 1;
+    b->cap = (size_t)b->rows * view->width * b->spp;
+    b->rays = (rad_ray *)xmalloc(sizeof(rad_ray) * b->cap);
+    b->hits = (rad_hit *)xmalloc(sizeof(rad_hit) * b->cap);
+    b->points = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    b->normals = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    b->irr = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    b->valid = (uint32_t *)xmalloc(sizeof(uint32_t) * b->cap);
+    if (src->vp || src->hr || src->lm || view->final_gather) b->gathered = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    if (view->shading >= 0) {
+        b->shade_v = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+        b->shade_a = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+        b->shaded = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    }
+}
+
+static void pixel_batch_free(pixel_batch *b)
+{
+    free(b->rays);
+    free(b->hits);
+    free(b->points);
+    free(b->normals);
+    free(b->irr);
+    free(b->valid);
+    free(b->shade_v);
+    free(b->shade_a);
+    free(b->shaded);
+    free(b->gathered);
+}
+
+/* Rows y0..y1-1: the stratified camera rays, their hits (in parallel chunks: the raycaster is
+   thread-safe), the sky and environment seen by rays that leave the scene added to img, and
+   the front-face hits listed in b->valid with their points and normals. 0 or 1 (printed). */
+static int batch_primary(const tool_world *w, const render_view *view, pixel_batch *b, int y0, int y1,
+                         const float sky[3], tool_image *img)
+{
+    const rad_scene *scene = w->scene;
+    int x, y, chunk, nchunks, failed = 0;
+    uint32_t s, k, i;
+    b->count = b->nvalid = 0;
+    for (y = y0; y < y1; ++y)
+        for (x = 0; x < view->width; ++x)
+            for (s = 0; s < b->spp; ++s) {
+                float px = (float)x + ((float)(s % b->strata) + 0.5f) / (float)b->strata;
+                float py = (float)y + ((float)(s / b->strata) + 0.5f) / (float)b->strata;
+                rad_camera_ray(&view->cam, (uint32_t)view->width, (uint32_t)view->height, px, py, &b->rays[b->count++]);
+            }
+    nchunks = (int)((b->count + 4095) / 4096);
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+#endif
+    for (chunk = 0; chunk < nchunks; ++chunk) {
+        uint32_t cb = (uint32_t)chunk * 4096u, ce = cb + 4096u < b->count ? cb + 4096u : b->count;
+        if (w->rc.intersect(w->rc.user, b->rays + cb, ce - cb, b->hits + cb) != RAD_SUCCESS) failed |= 1;
+    }
+    if (failed) return tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
+    for (k = 0; k < b->count; ++k) {
+        uint32_t t = b->hits[k].triangle;
+        const float *v, *nt;
+        if (t == RAD_NONE || t >= scene->triangle_count) {
+            size_t pixel = (size_t)y0 * view->width + k / b->spp;
+            uint32_t l;
+            for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
+            /* and an environment map its radiance in the ray's direction */
+            for (l = 0; l < w->file.light_count; ++l)
+                if (w->file.lights[l].type == RAD_LIGHT_ENVIRONMENT) {
+                    float rgb[3];
+                    rad_environment_radiance(w->file.lights[l].environment, b->rays[k].dir, rgb);
+                    for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += w->file.lights[l].color[i] * rgb[i];
+                }
+            b->hits[k].triangle = RAD_NONE;
+            continue;
+        }
+        nt = scene->normals + 3 * (size_t)t;
+        if (nt[0] * b->rays[k].dir[0] + nt[1] * b->rays[k].dir[1] + nt[2] * b->rays[k].dir[2] >= 0.0f) {
+            b->hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
+            continue;
+        }
+        v = scene->positions + 9 * (size_t)t;
+        for (i = 0; i < 3; ++i) {
+            b->points[3 * b->nvalid + i] = v[i] + b->hits[k].b1 * (v[3 + i] - v[i]) + b->hits[k].b2 * (v[6 + i] - v[i]);
+            b->normals[3 * b->nvalid + i] = nt[i];
+        }
+        b->valid[b->nvalid++] = k;
+    }
+    return 0;
+}
+
+/* At the valid hits: the direct irradiance D, and H into b->gathered from the final gather,
+   the lightmap, or the virtual patches' or hierarchical gather (none: the caller interpolates
+   the patches' per-vertex H); the --shading model's direct radiance. 0 or 1 (printed). */
+static int batch_light(const tool_world *w, const render_view *view, render_source *src, pixel_batch *b, int y0)
+{
+    const rad_scene *scene = w->scene;
     rad_direct_options dopt;
     rad_context quiet;
-    int y0, rows_per_batch, result = 0;
-    float sky[3] = {0.0f, 0.0f, 0.0f};
-    uint32_t k, i;
-    for (strata = 1; (strata + 1) * (strata + 1) <= aa; ++strata) {
-    }
-    spp = strata * strata;
-    rows_per_batch = (int)(65536 / ((size_t)width * spp));
-    if (rows_per_batch < 1) rows_per_batch = 1;
-    batch_cap = (size_t)rows_per_batch * width * spp;
-    rays = (rad_ray *)xmalloc(sizeof(rad_ray) * batch_cap);
-    hits = (rad_hit *)xmalloc(sizeof(rad_hit) * batch_cap);
-    points = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    normals = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    irr = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    valid = (uint32_t *)xmalloc(sizeof(uint32_t) * batch_cap);
-    if (render_vp || render_hr || render_lm || render_final_gather) gathered = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    if (render_shading >= 0) {
-        shade_v = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-        shade_a = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-        shaded = (float *)xmalloc(sizeof(float) * 3 * batch_cap);
-    }
+    rad_result r;
+    uint32_t k, i, n = b->nvalid;
+    double tg = tool_seconds();
+    if (n == 0) return 0;
+    tool_context(&quiet, NULL);
     rad_direct_options_default(&dopt);
     dopt.exclude_emitters = 0;
-    dopt.light_samples = light_samples;
-    tool_context(&quiet, NULL);
+    dopt.light_samples = view->light_samples;
+    r = rad_direct_irradiance(scene, &w->rc, w->file.lights, w->file.light_count, &dopt, b->points, b->normals, n, b->irr,
+                              &quiet);
+    if (r != RAD_SUCCESS) return tool_fail("render", "rad_direct_irradiance", r);
+    tg = tool_seconds();
+    if (view->final_gather) {
+        rad_final_gather_options fo;
+        rad_final_gather_options_default(&fo);
+        fo.rays = view->final_gather;
+        fo.seed = (uint32_t)y0 * 0x9E3779B9u;
+        r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, src, b->points,
+                             b->normals, n, b->gathered, &quiet);
+        if (r != RAD_SUCCESS) return tool_fail("render", "rad_final_gather", r);
+    } else if (src->lm) {
+        for (k = 0; k < n; ++k) {
+            const rad_hit *h = &b->hits[b->valid[k]];
+            const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
+            float u = t[0] + h->b1 * (t[2] - t[0]) + h->b2 * (t[4] - t[0]);
+            float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
+            rad_lightmap_sample(src->lm, 3, src->lm_values, u, v, b->gathered + 3 * k);
+        }
+    } else if (b->gathered) {
+        r = src->hr ? hr_lookup(src->hr, b->hits, b->valid, n, b->gathered)
+                    : rad_vp_gather(src->vp, src->vp_H, b->points, b->normals, n, b->gathered, &quiet);
+        if (r != RAD_SUCCESS) {
+            src->gather_seconds += tool_seconds() - tg;
+            return tool_fail("render", "rad_vp_gather", r);
+        }
+    }
+    if (b->gathered) src->gather_seconds += tool_seconds() - tg;
+    if (!b->shaded) return 0;
+    for (k = 0; k < n; ++k) {
+        const rad_ray *ry = &b->rays[b->valid[k]];
+        const rad_hit *h = &b->hits[b->valid[k]];
+        float len = sqrtf(ry->dir[0] * ry->dir[0] + ry->dir[1] * ry->dir[1] + ry->dir[2] * ry->dir[2]);
+        for (i = 0; i < 3; ++i) b->shade_v[3 * k + i] = -ry->dir[i] / len;
+        rad_scene_albedo(scene, h->triangle, h->b1, h->b2, b->shade_a + 3 * k);
+    }
+    return tool_shade_direct(w, view->shading, view->light_samples, b->points, b->normals, b->shade_v, b->shade_a, n,
+                             b->shaded);
+}
+
+/* each valid hit's radiance into its pixel: albedo / pi (D + H) (or the shading model's direct
+   radiance + albedo / pi H) plus what it emits */
+static void batch_accumulate(const tool_world *w, const render_source *src, const pixel_batch *b, int width, int y0,
+                             tool_image *img)
+{
+    const rad_scene *scene = w->scene;
+    const rad_patches *P = src->P;
+    const float *Hv = src->Hv;
+    uint32_t k, i;
+    for (k = 0; k < b->nvalid; ++k) {
+        uint32_t ray = b->valid[k];
+        size_t pixel = (size_t)y0 * width + ray / b->spp;
+        const rad_hit *h = &b->hits[ray];
+        float albedo[3], wts[3], emitted[3];
+        uint32_t p = b->gathered ? 0u : rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
+        const uint32_t *vi;
+        if (p == RAD_NONE) continue;
+        vi = b->gathered ? NULL : P->patches[p].vertices;
+        rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
+        rad_scene_emission(scene, h->triangle, h->b1, h->b2, emitted);
+        for (i = 0; i < 3; ++i) {
+            float hi = b->gathered ? b->gathered[3 * k + i]
+                                   : wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
+                                         wts[2] * Hv[3 * (size_t)vi[2] + i];
+            img->rgb[3 * pixel + i] += (b->shaded ? b->shaded[3 * k + i] + albedo[i] / PI_F * hi
+                                                  : albedo[i] / PI_F * (b->irr[3 * k + i] + hi)) + emitted[i];
+        }
+    }
+}
+
+/* The image of the radiosity methods: per sample the direct light D at the hit (shadow rays),
+   H from src, radiance albedo / pi (D + H) plus emission; each pixel the mean of its samples.
+   0 or 1 (printed). */
+static int render_classic(const tool_world *w, const render_view *view, render_source *src, tool_image *img)
+{
+    pixel_batch b;
+    size_t total = (size_t)view->width * view->height, done_px = 0, q;
+    float sky[3] = {0.0f, 0.0f, 0.0f}, inv;
+    uint32_t k, i;
+    int y0, result = 0;
+    pixel_batch_alloc(&b, view, src);
     /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
     for (k = 0; k < w->file.light_count; ++k)
         if (w->file.lights[k].type == RAD_LIGHT_SKY)
             for (i = 0; i < 3; ++i) sky[i] += w->file.lights[k].color[i] / PI_F;
-
-    for (y0 = 0; y0 < height && result == 0; y0 += rows_per_batch) {
-        int y1 = y0 + rows_per_batch < height ? y0 + rows_per_batch : height, chunk, nchunks;
-        uint32_t count = 0, nvalid = 0;
-        int x, y;
-        uint32_t s;
-        rad_result r;
-        for (y = y0; y < y1; ++y)
-            for (x = 0; x < width; ++x)
-                for (s = 0; s < spp; ++s) {
-                    float px = (float)x + ((float)(s % strata) + 0.5f) / (float)strata;
-                    float py = (float)y + ((float)(s / strata) + 0.5f) / (float)strata;
-                    rad_camera_ray(cam, (uint32_t)width, (uint32_t)height, px, py, &rays[count++]);
-                }
-        /* primary rays in parallel chunks (the raycaster is thread-safe) */
-        nchunks = (int)((count + 4095) / 4096);
-        {
-            int failed = 0;
-#ifdef _OPENMP
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
-#endif
-            for (chunk = 0; chunk < nchunks; ++chunk) {
-                uint32_t b = (uint32_t)chunk * 4096u, e = b + 4096u < count ? b + 4096u : count;
-                if (w->rc.intersect(w->rc.user, rays + b, e - b, hits + b) != RAD_SUCCESS) failed |= 1;
-            }
-            if (failed) {
-                result = tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
-                break;
-            }
-        }
-        for (k = 0; k < count; ++k) {
-            uint32_t t = hits[k].triangle;
-            const float *v, *nt;
-            if (t == RAD_NONE || t >= scene->triangle_count) {
-                size_t pixel = (size_t)y0 * width + k / spp;
-                uint32_t l;
-                for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
-                /* and an environment map its radiance in the ray's direction */
-                for (l = 0; l < w->file.light_count; ++l)
-                    if (w->file.lights[l].type == RAD_LIGHT_ENVIRONMENT) {
-                        float rgb[3];
-                        rad_environment_radiance(w->file.lights[l].environment, rays[k].dir, rgb);
-                        for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += w->file.lights[l].color[i] * rgb[i];
-                    }
-                hits[k].triangle = RAD_NONE;
-                continue;
-            }
-            nt = scene->normals + 3 * (size_t)t;
-            if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] >= 0.0f) {
-                hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
-                continue;
-            }
-            v = scene->positions + 9 * (size_t)t;
-            for (i = 0; i < 3; ++i) {
-                points[3 * nvalid + i] = v[i] + hits[k].b1 * (v[3 + i] - v[i]) + hits[k].b2 * (v[6 + i] - v[i]);
-                normals[3 * nvalid + i] = nt[i];
-            }
-            valid[nvalid++] = k;
-        }
-        if (nvalid > 0) {
-            r = rad_direct_irradiance(scene, &w->rc, w->file.lights, w->file.light_count, &dopt, points, normals, nvalid,
-                                      irr, &quiet);
-            if (r != RAD_SUCCESS) {
-                result = tool_fail("render", "rad_direct_irradiance", r);
-                break;
-            }
-        }
-        if (render_final_gather && nvalid > 0) {
-            rad_final_gather_options fo;
-            fg_lookup lk;
-            double tg = tool_seconds();
-            rad_final_gather_options_default(&fo);
-            fo.rays = render_final_gather;
-            fo.seed = (uint32_t)y0 * 0x9E3779B9u;
-            lk.P = P;
-            lk.Hv = Hv;
-            r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, &lk, points, normals,
-                                 nvalid, gathered, &quiet);
-            render_vp_gather_seconds += tool_seconds() - tg;
-            if (r != RAD_SUCCESS) {
-                result = tool_fail("render", "rad_final_gather", r);
-                break;
-            }
-        } else if (render_lm && nvalid > 0) {
-            double tg = tool_seconds();
-            for (k = 0; k < nvalid; ++k) {
-                const rad_hit *h = &hits[valid[k]];
-                const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
-                float u = t[0] + h->b1 * (t[2] - t[0]) + h->b2 * (t[4] - t[0]);
-                float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
-                rad_lightmap_sample(render_lm, 3, render_lm_values, u, v, gathered + 3 * k);
-            }
-            render_vp_gather_seconds += tool_seconds() - tg;
-        } else if (gathered && nvalid > 0) {
-            double tg = tool_seconds();
-            r = render_hr ? hr_lookup(hits, valid, nvalid, gathered)
-                          : rad_vp_gather(render_vp, render_vp_H, points, normals, nvalid, gathered, &quiet);
-            render_vp_gather_seconds += tool_seconds() - tg;
-            if (r != RAD_SUCCESS) {
-                result = tool_fail("render", "rad_vp_gather", r);
-                break;
-            }
-        }
-        if (shaded && nvalid > 0) {
-            for (k = 0; k < nvalid; ++k) {
-                const rad_ray *ry = &rays[valid[k]];
-                float len = sqrtf(ry->dir[0] * ry->dir[0] + ry->dir[1] * ry->dir[1] + ry->dir[2] * ry->dir[2]);
-                for (i = 0; i < 3; ++i) shade_v[3 * k + i] = -ry->dir[i] / len;
-                rad_scene_albedo(scene, hits[valid[k]].triangle, hits[valid[k]].b1, hits[valid[k]].b2, shade_a + 3 * k);
-            }
-            if (tool_shade_direct(w, render_shading, light_samples, points, normals, shade_v, shade_a, nvalid, shaded)) {
-                result = 1;
-                break;
-            }
-        }
-        for (k = 0; k < nvalid; ++k) {
-            uint32_t ray = valid[k];
-            size_t pixel = (size_t)y0 * width + ray / spp;
-            const rad_hit *h = &hits[ray];
-            float albedo[3], wts[3], emitted[3];
-            uint32_t p = gathered ? 0u : rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
-            const uint32_t *vi;
-            if (p == RAD_NONE) continue;
-            vi = gathered ? NULL : P->patches[p].vertices;
-            rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
-            rad_scene_emission(scene, h->triangle, h->b1, h->b2, emitted);
-            for (i = 0; i < 3; ++i) {
-                float hi = gathered ? gathered[3 * k + i]
-                                    : wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
-                                          wts[2] * Hv[3 * (size_t)vi[2] + i];
-                img->rgb[3 * pixel + i] += (shaded ? shaded[3 * k + i] + albedo[i] / PI_F * hi
-                                                   : albedo[i] / PI_F * (irr[3 * k + i] + hi)) + emitted[i];
-            }
-        }
-        done_px += (size_t)(y1 - y0) * width;
+    for (y0 = 0; y0 < view->height && result == 0; y0 += b.rows) {
+        int y1 = y0 + b.rows < view->height ? y0 + b.rows : view->height;
+        result = batch_primary(w, view, &b, y0, y1, sky, img);
+        if (result == 0) result = batch_light(w, view, src, &b, y0);
+        if (result) break;
+        batch_accumulate(w, src, &b, view->width, y0, img);
+        done_px += (size_t)(y1 - y0) * view->width;
         tool_progress((void *)(size_t)"render", (float)((double)done_px / (double)total));
     }
     tool_progress_end();
-    {
-        size_t q;
-        float inv = 1.0f / (float)spp;
-        for (q = 0; q < 3 * total; ++q) img->rgb[q] *= inv;
-    }
-    free(rays);
-    free(hits);
-    free(points);
-    free(normals);
-    free(irr);
-    free(valid);
-    free(shade_v);
-    free(shade_a);
-    free(shaded);
-    free(gathered);
+    inv = 1.0f / (float)b.spp;
+    for (q = 0; q < 3 * total; ++q) img->rgb[q] *= inv;
+    pixel_batch_free(&b);
     return result;
 }
 
@@ -458,11 +469,15 @@ static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bak
    product) or alias tables (--frames steps), then the classic pixel pipeline (per-pixel direct
    light + interpolated H). --sequence writes every --every-th frame (and the last) as a PNG. */
 static int render_method(const char *cmd, const tool_world *w, const rad_bake *bake, const char *bake_name,
-                         const tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
-                         uint32_t light_samples, float exposure, tool_image *img)
+                         const render_args *ra, tool_image *img)
 {
+    const tool_method_options *mo = &ra->mo;
+    const render_view *view = &ra->view;
+    int width = view->width, height = view->height;
+    float exposure = view->exposure;
     tool_indirect *m = NULL;
     const rad_patches *P = &bake->patches;
+    render_source src;
     uint32_t frames = mo->method == TOOL_TEMPORAL ? mo->frames : 1u, f;
     /* multibounce: the product is repeated (same result each time) so its time is a median */
     uint32_t reps = mo->method == TOOL_TEMPORAL ? frames : 9u;
@@ -473,6 +488,9 @@ static int render_method(const char *cmd, const tool_world *w, const rad_bake *b
     times = (double *)xmalloc(sizeof(double) * reps);
     H = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->count);
     Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
+    memset(&src, 0, sizeof src);
+    src.P = P;
+    src.Hv = Hv;
 #if defined(__unix__) || defined(__APPLE__)
     if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
 #endif
@@ -492,7 +510,7 @@ static int render_method(const char *cmd, const tool_world *w, const rad_bake *b
                 rc = 1;
             }
             if (rc == 0) rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
-            if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, &frame);
+            if (rc == 0) rc = render_classic(w, view, &src, &frame);
             if (rc == 0 && tool_image_write_png(path, &frame, exposure) != 0) {
                 fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
                 rc = 1;
@@ -513,7 +531,7 @@ static int render_method(const char *cmd, const tool_world *w, const rad_bake *b
             fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
         rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
     }
-    if (rc == 0) rc = render_classic(w, P, Hv, cam, width, height, aa, light_samples, img);
+    if (rc == 0) rc = render_classic(w, view, &src, img);
     if (rc == 0 && mo->sequence) {
         char path[4096];
         snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
@@ -554,11 +572,10 @@ static void bake_load_failed(const char *cmd, const char *path, rad_result r)
 }
 
 /* the bake (--bake, checked against the scene) or one made here, then render_method */
-static int render_with_method(const char *cmd, const tool_world *w, const char *bake_path,
-                              const tool_classic_options *o, const tool_method_options *mo,
-                              const rad_camera *cam, int width, int height, uint32_t aa, uint32_t light_samples,
-                              float exposure, tool_image *img)
+static int render_with_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
+    const char *bake_path = ra->bake;
+    const tool_method_options *mo = &ra->mo;
     rad_bake *bake = NULL;
     void *buf = NULL;
     size_t size = 0;
@@ -581,7 +598,7 @@ static int render_with_method(const char *cmd, const tool_world *w, const char *
             return 1;
         }
     } else {
-        if (tool_method_bake(cmd, w, o, mo, &buf, &size)) return 1;
+        if (tool_method_bake(cmd, w, &ra->o, mo, &buf, &size)) return 1;
         if ((r = rad_load_memory(buf, size, &ctx, &bake)) != RAD_SUCCESS) {
             free(buf);
             return tool_fail(cmd, "rad_load_memory", r);
@@ -589,7 +606,7 @@ static int render_with_method(const char *cmd, const tool_world *w, const char *
         bake_path = "(made here)";
     }
     bake->patches.scene = w->scene;
-    rc = render_method(cmd, w, bake, bake_path, mo, cam, width, height, aa, light_samples, exposure, img);
+    rc = render_method(cmd, w, bake, bake_path, ra, img);
     rad_bake_destroy(bake);
     free(buf);
     return rc;
@@ -639,54 +656,6 @@ static rad_virtual_patches *vp_build(const char *cmd, const tool_world *w, const
                 100.0 * (double)vp->matrix.row_offsets[vp->count] / ((double)vp->count * (double)vp->count),
                 (double)rad_vp_memory(vp) / 1048576.0);
     return vp;
-}
-
-/* the patch count rad_vp_create would give at 'resolution' (rad_vp_count); 0 or 1 (printed) */
-static int vp_count(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points, uint32_t resolution,
-                    uint32_t *count)
-{
-    rad_vp_options vo;
-    rad_vp_counts cnt;
-    rad_context ctx;
-    rad_result r;
-    rad_vp_options_default(&vo);
-    vo.resolution = resolution;
-    vo.face_points = face_points;
-    vo.kind = kind;
-    tool_context(&ctx, NULL);
-    if ((r = rad_vp_count(w->scene, &w->rc, &vo, &ctx, &cnt)) != RAD_SUCCESS) return tool_fail(cmd, "rad_vp_count", r);
-    *count = cnt.patches;
-    return 0;
-}
-
-int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
-                              uint32_t max_patches, uint32_t start, uint32_t *out)
-{
-    /* The finest resolution within the budget, chosen by counting (rad_vp_count: the build up
-       to the patches, without the form factors that take nearly all of its time). The count
-       grows about as R^2 (surface voxels): predict from the nearest count, count, narrow the
-       bracket [lo, hi) to adjacent resolutions. */
-    uint32_t lo = 0, hi = 4097, counts = 0, c = 0, res = start ? start : 16;
-    double tc = tool_seconds();
-    while (counts < 24 && hi - lo > 1) {
-        uint32_t next;
-        if (vp_count(cmd, w, kind, face_points, res, &c)) return 1;
-        ++counts;
-        if (c <= max_patches) lo = res;
-        else hi = res;
-        next = (uint32_t)((double)res * sqrt((double)max_patches / (double)(c ? c : 1)));
-        if (next <= lo) next = lo + 1;
-        if (next >= hi) next = hi - 1;
-        res = next;
-    }
-    if (lo == 0) {
-        fprintf(stderr, "rad %s: --vp-max-patches %u: even resolution 1 gives more patches\n", cmd, max_patches);
-        return 1;
-    }
-    fprintf(stderr, "rad %s: --vp-max-patches %u: resolution %u from %u counts (%.2f s), one build\n", cmd, max_patches, lo,
-            counts, tool_seconds() - tc);
-    *out = lo;
-    return 0;
 }
 
 /* --proxy aavp|vp: the indirect radiosity L of the virtual patches by --method multibounce
@@ -814,11 +783,11 @@ done:
    per pixel from the moved light), and the last. The light ends where the last frame puts it,
    so the final image (rendered by the caller from E and L) is that frame. Stage times: their
    medians. */
-static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad_virtual_patches *vp, float *E,
-                                 const tool_method_options *mo, const rad_camera *cam, int width, int height,
-                                 uint32_t aa, uint32_t light_samples, uint32_t patch_light_samples, float exposure,
-                                 float *L, double *step_seconds)
+static int proxy_temporal_frames(const char *cmd, const tool_world *w, const render_args *ra,
+                                 const rad_virtual_patches *vp, float *E, float *L, double *step_seconds)
 {
+    const tool_method_options *mo = &ra->mo;
+    int width = ra->view.width, height = ra->view.height;
     rad_alias_tables *tables = NULL;
     const rad_alias_tables *tp1[1];
     rad_temporal *tp = NULL;
@@ -859,7 +828,7 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad
     rad_vp_lights_options_default(&lo);
     lo.rays_per_frame = mo->light_rays;
     lo.direct.exclude_emitters = 0;
-    lo.direct.light_samples = patch_light_samples; /* as rad_vp_sources got them for the still image */
+    lo.direct.light_samples = ra->o.light_samples; /* as rad_vp_sources got them for the still image */
 #if defined(__unix__) || defined(__APPLE__)
     if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
 #endif
@@ -889,6 +858,7 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad
         if (mo->sequence && (f % mo->every == 0 || f == frames)) { /* the last one too, as render_method */
             char path[4096];
             tool_image frame;
+            render_source src;
             memset(&frame, 0, sizeof frame);
             for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
             if ((r = rad_matrix_multiply(&vp->matrix, B, H, &ctx)) != RAD_SUCCESS) { what = "rad_matrix_multiply"; goto done; }
@@ -898,10 +868,11 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const rad
                 rc = 1;
                 goto done;
             }
-            render_vp = vp, render_vp_H = H;
-            rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, &frame);
-            render_vp = NULL, render_vp_H = NULL;
-            if (rc == 0 && tool_image_write_png(path, &frame, exposure) != 0) {
+            memset(&src, 0, sizeof src);
+            src.vp = vp;
+            src.vp_H = H;
+            rc = render_classic(w, &ra->view, &src, &frame);
+            if (rc == 0 && tool_image_write_png(path, &frame, ra->view.exposure) != 0) {
                 fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
                 rc = 1;
             }
@@ -928,63 +899,8 @@ done:
     return rc;
 }
 
-/* --method vp|aavp: virtual patches, E at their samples, the classic solve on
-   their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
-   classic per-pixel render with H gathered at each sample's hit point. */
-/* --bake FILE with --method aavp|vp or --proxy: the set saved by rad bake --method aavp|vp
-   (rad_vp_load, checked against the scene's signature and the kind asked for) and its E into
-   *E_out; NULL with the error printed */
-int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_t size, const rad_scene *scene,
-                      rad_container **ct_out, rad_virtual_patches **vp_out, float **E_out)
-{
-    rad_container *ct = NULL;
-    rad_virtual_patches *vp = NULL;
-    const rad_section *vi, *se;
-    rad_context ctx;
-    rad_result r;
-    uint32_t i;
-    *ct_out = NULL;
-    *vp_out = NULL;
-    *E_out = NULL;
-    tool_context(&ctx, NULL);
-    if ((r = rad_container_create(data, size, &ctx, &ct)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' is damaged: %s\n", cmd, path, rad_result_string(r));
-        return 1;
-    }
-    vi = rad_container_find(ct, RAD_SECTION_VP_INFO, "vp");
-    if (!vi) {
-        fprintf(stderr, "rad %s: bake '%s' holds no virtual patches (bake them with --method aavp|vp)\n", cmd, path);
-        rad_container_destroy(ct);
-        return 1;
-    }
-    if ((r = rad_vp_load(ct, "vp", scene, &ctx, &vp)) != RAD_SUCCESS) {
-        fprintf(stderr, "rad %s: bake '%s' holds damaged virtual patches: %s\n", cmd, path, rad_result_string(r));
-        rad_container_destroy(ct);
-        return 1;
-    }
-    se = rad_container_find(ct, RAD_SECTION_VECTOR, "E");
-    if (!se || se->elem_size != 12 || se->count != vp->count) {
-        fprintf(stderr, "rad %s: bake '%s' holds no source vector E for its %u patches\n", cmd, path, vp->count);
-        rad_vp_destroy(vp);
-        rad_container_destroy(ct);
-        return 1;
-    }
-    *E_out = (float *)xmalloc(sizeof(float) * 3 * (size_t)vp->count);
-    memcpy(*E_out, se->data, sizeof(float) * 3 * (size_t)vp->count);
-    for (i = 0; i < 3 * vp->count; ++i)
-        if (!((*E_out)[i] >= 0.0f && (*E_out)[i] <= RAD_BAKE_VALUE_MAX)) {
-            fprintf(stderr, "rad %s: bake '%s': E entry %u is %g (not in [0, 1e30])\n", cmd, path, i, (double)(*E_out)[i]);
-            free(*E_out);
-            *E_out = NULL;
-            rad_vp_destroy(vp);
-            rad_container_destroy(ct);
-            return 1;
-        }
-    *ct_out = ct;
-    *vp_out = vp;
-    return 0;
-}
-
+/* --bake FILE with --method aavp|vp: tool_vp_bake_open, then checked against the scene's
+   signature, the options record and the kind asked for */
 static rad_virtual_patches *vp_load_bake(const char *cmd, const char *path, const tool_world *w, int clustered,
                                          float **E_out)
 {
@@ -1044,11 +960,16 @@ fail:
     return NULL;
 }
 
-static int render_vp_method(const char *cmd, const tool_world *w, const char *bake_path,
-                            const tool_classic_options *o, const tool_method_options *mo, const rad_camera *cam,
-                            int width, int height, uint32_t aa, uint32_t light_samples, float exposure, tool_image *img)
+/* --method vp|aavp: virtual patches, E at their samples, the classic solve on
+   their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
+   classic per-pixel render with H gathered at each sample's hit point. */
+static int render_vp_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
+    const char *bake_path = ra->bake;
+    const tool_classic_options *o = &ra->o;
+    const tool_method_options *mo = &ra->mo;
     rad_virtual_patches *vp = NULL;
+    render_source src;
     rad_direct_options dopt;
     rad_solve_options so;
     rad_solve_stats stats;
@@ -1101,11 +1022,10 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
         t0 = tool_seconds();
         if (mo->proxy && mo->method == TOOL_TEMPORAL && (mo->light_path || mo->sequence)) {
             r = RAD_SUCCESS;
-            if (proxy_temporal_frames(cmd, w, vp, E, mo, cam, width, height, aa, light_samples, o->light_samples, exposure,
-                                      L, &t_step)) rc = 1;
+            if (proxy_temporal_frames(cmd, w, ra, vp, E, L, &t_step)) rc = 1;
         } else if (mo->proxy) {
             r = RAD_SUCCESS;
-            if (proxy_indirect(cmd, vp, E, mo, cam, L, &t_step)) rc = 1;
+            if (proxy_indirect(cmd, vp, E, mo, &ra->view.cam, L, &t_step)) rc = 1;
         } else if (mo->bounces == RAD_MB_INFINITE) {
             r = rad_solve_gauss_seidel(&sys, &so, L, &stats, &ctx);
             if (r == RAD_ERROR_NOT_CONVERGED) {
@@ -1126,10 +1046,11 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
         if (r != RAD_SUCCESS) rc = tool_fail(cmd, "solve", r);
     }
     if (rc == 0) {
-        render_vp = vp, render_vp_H = H, render_vp_gather_seconds = 0.0;
+        memset(&src, 0, sizeof src);
+        src.vp = vp;
+        src.vp_H = H;
         t0 = tool_seconds();
-        rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
-        render_vp = NULL, render_vp_H = NULL;
+        rc = render_classic(w, &ra->view, &src, img);
         /* one line for scripts: step = the solve (K bounces + H = F B) as classic's */
         if (rc == 0) {
             fprintf(stderr, "rad %s: timing: method=%s%s patches=%u frames=%u bounces=%s%.0u step_ms_median=%.6f "
@@ -1140,7 +1061,7 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
                     mo->proxy && mo->method == TOOL_TEMPORAL ? mo->frames : 1u,
                     mo->bounces == RAD_MB_INFINITE ? "inf" : "",
                     mo->bounces == RAD_MB_INFINITE ? 0u : mo->bounces,
-                    1e3 * t_step, 1e3 * t_step, 1e3 * t_build, 1e3 * t_E, 1e3 * render_vp_gather_seconds,
+                    1e3 * t_step, 1e3 * t_step, 1e3 * t_build, 1e3 * t_E, 1e3 * src.gather_seconds,
                     1e3 * (tool_seconds() - t0), res, (double)rad_vp_memory(vp) / 1048576.0, peak_rss_mib());
         }
     }
@@ -1154,21 +1075,20 @@ static int render_vp_method(const char *cmd, const tool_world *w, const char *ba
 
 /* --method hierarchical: the solution (tool_hierarchical_build), then the classic render
    with H looked up at each sample */
-static int render_hr_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
-                            const tool_method_options *mo, const rad_camera *cam, int width, int height, uint32_t aa,
-                            uint32_t light_samples, tool_image *img)
+static int render_hr_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
     rad_hierarchical *h = NULL;
+    render_source src;
     rad_hierarchical_stats st;
     double t0 = tool_seconds(), t_solve;
     int rc;
-    if (tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) return 1;
+    if (tool_hierarchical_build(cmd, w, &ra->mo, ra->o.light_samples, &h)) return 1;
     t_solve = tool_seconds() - t0;
     rad_hierarchical_get_stats(h, &st);
-    render_hr = h;
+    memset(&src, 0, sizeof src);
+    src.hr = h;
     t0 = tool_seconds();
-    rc = render_classic(w, NULL, NULL, cam, width, height, aa, light_samples, img);
-    render_hr = NULL;
+    rc = render_classic(w, &ra->view, &src, img);
     if (rc == 0)
         fprintf(stderr, "rad %s: timing: method=hierarchical patches=%u frames=1 step_ms_median=%.6f step_ms_min=%.6f "
                         "links=%llu kernels=%llu rays=%llu render_ms=%.1f\n",
@@ -1181,11 +1101,13 @@ static int render_hr_method(const char *cmd, const tool_world *w, const tool_cla
 /* --method local: the classic patches, F and E; a local matrix of capacity M over F's
    rows filled with the M patches nearest the camera (rad_local_rebuild), L = T E over P_Vis x
    P_Lit, H = L / rho (L = rho F (E + L) within the set), rendered as classic. */
-static int render_local_method(const char *cmd, const tool_world *w, const tool_classic_options *oc,
-                               const tool_method_options *mo, const rad_camera *cam, int width, int height,
-                               uint32_t aa, uint32_t light_samples, tool_image *img)
+static int render_local_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
-    tool_classic_options o = *oc;
+    tool_classic_options o = ra->o;
+    const tool_method_options *mo = &ra->mo;
+    const rad_camera *cam = &ra->view.cam;
+    int width = ra->view.width, height = ra->view.height;
+    render_source view_src;
     tool_classic sol;
     rad_local_options lo;
     rad_local *local = NULL;
@@ -1254,7 +1176,10 @@ static int render_local_method(const char *cmd, const tool_world *w, const tool_
         for (i = 0; i < 3 * n; ++i) H[i] = albedo[i] > 0.0f ? L[i] / albedo[i] : 0.0f;
         Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)sol.patches->vertex_count);
         rc = vertex_H(sol.patches, &sol.ff->matrix, H, Hv);
-        if (rc == 0) rc = render_classic(w, sol.patches, Hv, cam, width, height, aa, light_samples, img);
+        memset(&view_src, 0, sizeof view_src);
+        view_src.P = sol.patches;
+        view_src.Hv = Hv;
+        if (rc == 0) rc = render_classic(w, &ra->view, &view_src, img);
     }
     rad_local_destroy(local);
     free(areas);
@@ -1269,307 +1194,402 @@ static int render_local_method(const char *cmd, const tool_world *w, const tool_
     return rc;
 }
 
-static int render_main(int argc, char **argv, tool_lights *lights)
+/* ---- the command line ------------------------------------------------------------------- */
+
+static int parse_camera(const char *cmd, const tool_arg *t, const char *v, void *field)
 {
-    const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
-    tool_classic_options o;
-    tool_method_options mo;
-    tool_world w;
-    rad_camera cam;
-    tool_image img;
-    rad_context ctx;
-    int width = 512, height = 512, a, rc, have_cam = 0, pathtrace;
-    uint32_t aa = 16, spp = 64, seed = 0, threads = 0, pixel_light_samples = 16;
-    int lightmap_opts = 0;
-    float fov = 0.0f, exposure = 1.0f;
-    double t0 = tool_seconds();
-    tool_classic_options_default(&o);
-    tool_method_options_default(&mo);
-    memset(&img, 0, sizeof img);
+    const char *why;
+    (void)t;
+    if (tool_parse_camera(v, (rad_camera *)field, &why)) {
+        fprintf(stderr, "rad %s: bad --camera '%s': %s\n", cmd, v, why);
+        return 2;
+    }
+    return 0;
+}
+
+/* --size WxH into render_view's width and height (field: width) */
+static int parse_size(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    render_view *view = (render_view *)((char *)field - offsetof(render_view, width));
+    (void)t;
+    if (tool_parse_size(v, &view->width, &view->height)) {
+        fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, v);
+        return 2;
+    }
+    return tool_check_size(cmd, view->width, view->height) ? 2 : 0;
+}
+
+static int parse_shading(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    (void)t;
+    return tool_parse_shading(cmd, v, (int *)field) ? 2 : 0;
+}
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+#define RA(f) offsetof(render_args, f)
+#define RA_UINT(name, val, f, lo, hi, given, bad, help) \
+    {TOOL_ARG_UINT, name, val, RA(f), lo, hi, 0, given, bad, NULL, NULL, NULL, 0, help}
+#define RA_CUSTOM(name, val, f, fn, given, help) \
+    {TOOL_ARG_CUSTOM, name, val, RA(f), 0, 0, 0, given, NULL, NULL, NULL, fn, 0, help}
+/* rad render's own options (the classic, method and light options are classic.c's,
+   methods.c's and lights.c's tables) */
+static const tool_arg render_table[] = {
+    {TOOL_ARG_STRING, "-o", "FILE", RA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "output image: .pfm or .exr (linear radiance; .exr needs libtinyexr-dev at build) or .png\n"
+     "(sRGB, exposure applied)"},
+    {TOOL_ARG_STRING, "--bake", "FILE.radb", RA(bake), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "classic, multibounce, temporal, stochastic, hierarchical, vp, aavp: use a bake of that\n"
+     "method made by 'rad bake' from this scene instead of computing it here"},
+    RA_CUSTOM("--camera", "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ", view.cam, parse_camera, RENDER_GIVEN_CAMERA,
+              "camera (default: the scene's)"),
+    {TOOL_ARG_FLOAT, "--fov", "DEG", RA(fov), 0.0, 180.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, 0, "must be in (0, 180)",
+     NULL, NULL, NULL, 0, "vertical field of view in degrees (default: the scene's)"},
+    RA_CUSTOM("--size", "WxH", view.width, parse_size, 0,
+              "image size (default 512x512; at most 2 GiB of image: 12 bytes a pixel)"),
+    RA_UINT("--aa", "N", view.aa, 1, 65536, 0, "must be 1 to 65536",
+            "radiosity methods: stratified samples per pixel, rounded down to a square (default 16, 1 to 65536)"),
+    RA_UINT("--spp", "N", spp, 1, 1048576, 0, "must be in 1..1048576", "pathtrace: samples per pixel (default 64)"),
+    {TOOL_ARG_FLOAT, "--exposure", "X", RA(view.exposure), 0.0, 1e30, TOOL_ARG_LO_OPEN, 0, "must be > 0", NULL, NULL,
+     NULL, 0, "scale before 8-bit sRGB encoding (PNG only; default 1)"},
+    RA_UINT("--pixel-light-samples", "N", view.light_samples, 1, 65536, 0, "must be 1 to 65536",
+            "radiosity methods: shadow rays per pixel sample and light (default 16, at most 65536)"),
+    RA_UINT("--final-gather", "N", view.final_gather, 0, 4096, 0, "is at most 4096",
+            "classic, vp, aavp: trace the first bounce from each pixel sample with N rays (direct\n"
+            "light at the hits, the solution's irradiance there): the indirect light of points a\n"
+            "patch average misrepresents; default 0 (off)"),
+    RA_CUSTOM("--shading", "MODEL", view.shading, parse_shading, 0,
+              "radiosity methods: lighting model for the analytic lights' direct term: none\n"
+              "(default: Lambert through the irradiance), lambert, half-lambert, banded, phong,\n"
+              "blinn-phong, minnaert, oren-nayar, microfacet (tools/shading.c says how it combines\n"
+              "with the diffuse radiosity solution)"),
+    RA_CUSTOM("--threads", "N", threads, parse_threads, 0, "worker threads (default: all cores; at most 1024)"),
+    {TOOL_ARG_TEXT, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "lightmap (the classic solution baked into a lightmap over the second uv set, else the\n"
+     "automatic unwrap, as rad lightmap; direct light per pixel, the indirect light a bilinear\n"
+     "lookup of the lightmap; --proxy aavp|vp: the indirect light from virtual patches\n"
+     "(--vp-resolution R, --face-points P), for scenes the dense classic build cannot hold):\n"},
+    RA_UINT("--lightmap-size", "N", lm_size, 4, 16384, RENDER_GIVEN_LM_SIZE | RENDER_GIVEN_LM, "must be 4 to 16384",
+            "atlas side (default 256, or the least power of two to 4096 the unwrap's charts fit)"),
+    RA_UINT("--texel-samples", "N", lm_samples, 1, 16, RENDER_GIVEN_LM, "must be 1 to 16",
+            "sample points per texel (default 4), as rad lightmap"),
+    RA_UINT("--visibility-rays", "N", lm_vis, 1, 64, RENDER_GIVEN_LM, "must be 1 to 64",
+            "shadow rays per sample point and patch (default 2), as rad lightmap"),
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
+static void render_usage(FILE *f)
+{
+    static char own[8192];
+    tool_args_help_into(render_table, 0, own, sizeof own);
+    fprintf(f,
+            "usage: rad render SCENE -o OUT.png|OUT.pfm|OUT.exr [--method classic|multibounce|temporal|local|stochastic|vp|aavp|hierarchical|lightmap|pathtrace] [options]\n"
+            "%s"
+            "patch and classic solution options (ignored with --bake, which keeps its own):\n"
+            "%s"
+            "%s"
+            "%s",
+            own, tool_classic_help(), tool_method_help(1), tool_light_help());
+}
+
+static void render_args_default(render_args *ra)
+{
+    memset(ra, 0, sizeof *ra);
+    tool_classic_options_default(&ra->o);
+    tool_method_options_default(&ra->mo);
+    ra->view.width = ra->view.height = 512;
+    ra->view.aa = 16;
+    ra->view.light_samples = 16;
+    ra->view.exposure = 1.0f;
+    ra->view.shading = -1;
+    ra->spp = 64;
+    ra->lm_size = 256;
+    ra->lm_samples = 4;
+    ra->lm_vis = 2;
+}
+
+/* the command line into ra; -1: go on, else the exit code (--help: 0; bad usage: 2, printed) */
+static int render_parse(const char *cmd, int argc, char **argv, tool_lights *lights, render_args *ra)
+{
+    int a, rc;
+    render_args_default(ra);
     for (a = 0; a < argc; ++a) {
         const char *opt = argv[a];
-        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) { render_usage(stdout); return 0; }
-        rc = tool_method_option(cmd, argc, argv, &a, &mo); /* --method, --seed and the methods' options */
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        rc = tool_classic_option(cmd, argc, argv, &a, &o);
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        rc = tool_light_option(cmd, argc, argv, &a, lights);
-        if (rc == 2) return 2;
-        if (rc == 1) continue;
-        if (opt[0] == '-' && opt[1] && a + 1 >= argc) {
-            fprintf(stderr, "rad %s: %s needs a value (or is unknown; see rad render --help)\n", cmd, opt);
-            return 2;
+        if (!strcmp(opt, "--help") || !strcmp(opt, "-h")) {
+            render_usage(stdout);
+            return 0;
         }
-        if (!strcmp(opt, "-o")) out_path = argv[++a];
-        else if (!strcmp(opt, "--bake")) bake_path = argv[++a];
-        else if (!strcmp(opt, "--camera")) {
-            const char *why;
-            if (tool_parse_camera(argv[++a], &cam, &why)) {
-                fprintf(stderr, "rad %s: bad --camera '%s': %s\n", cmd, argv[a], why);
-                return 2;
-            }
-            have_cam = 1;
-        } else if (!strcmp(opt, "--fov")) {
-            if (tool_parse_float(cmd, opt, argv[++a], &fov)) return 2;
-            if (!(fov > 0.0f && fov < 180.0f)) { fprintf(stderr, "rad %s: --fov must be in (0, 180)\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--size")) {
-            if (tool_parse_size(argv[++a], &width, &height)) {
-                fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, argv[a]);
-                return 2;
-            }
-            if (tool_check_size(cmd, width, height)) return 2;
-        } else if (!strcmp(opt, "--aa")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &aa)) return 2;
-            if (aa == 0 || aa > 65536) { fprintf(stderr, "rad %s: --aa must be 1 to 65536\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--spp")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &spp)) return 2;
-            if (spp == 0 || spp > 1u << 20) { fprintf(stderr, "rad %s: --spp must be in 1..1048576\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--pixel-light-samples")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &pixel_light_samples)) return 2;
-            if (pixel_light_samples == 0 || pixel_light_samples > 65536) { fprintf(stderr, "rad %s: %s must be 1 to 65536\n", cmd, opt); return 2; }
-        } else if (!strcmp(opt, "--lightmap-size") || !strcmp(opt, "--texel-samples") || !strcmp(opt, "--visibility-rays")) {
-            uint32_t *dst = opt[2] == 'l' ? &render_lm_size : opt[2] == 't' ? &render_lm_samples : &render_lm_vis;
-            uint32_t lo = opt[2] == 'l' ? 4u : 1u, hi = opt[2] == 'l' ? 16384u : opt[2] == 't' ? 16u : 64u;
-            if (tool_parse_uint(cmd, opt, argv[++a], dst)) return 2;
-            if (*dst < lo || *dst > hi) { fprintf(stderr, "rad %s: %s must be %u to %u\n", cmd, opt, lo, hi); return 2; }
-            if (opt[2] == 'l') render_lm_size_given = 1;
-            lightmap_opts = 1;
-        } else if (!strcmp(opt, "--final-gather")) {
-            if (tool_parse_uint(cmd, opt, argv[++a], &render_final_gather)) return 2;
-            if (render_final_gather > 4096) { fprintf(stderr, "rad %s: %s is at most 4096\n", cmd, opt); return 2; }
-        } else if (!strcmp(opt, "--exposure")) {
-            if (tool_parse_float(cmd, opt, argv[++a], &exposure)) return 2;
-            if (!(exposure > 0.0f)) { fprintf(stderr, "rad %s: --exposure must be > 0\n", cmd); return 2; }
-        } else if (!strcmp(opt, "--shading")) {
-            if (tool_parse_shading(cmd, argv[++a], &render_shading)) return 2;
-        } else if (!strcmp(opt, "--threads")) {
-            if (tool_parse_threads(cmd, opt, argv[++a], &threads)) return 2;
-        } else if (opt[0] == '-' && opt[1]) {
+        /* --method, --seed and the methods' options first: their --bounces takes 'inf' */
+        if ((rc = tool_method_option(cmd, argc, argv, &a, &ra->mo)) == 0 &&
+            (rc = tool_classic_option(cmd, argc, argv, &a, &ra->o)) == 0 &&
+            (rc = tool_light_option(cmd, argc, argv, &a, lights)) == 0)
+            rc = tool_args_parse(cmd, render_table, ra, &ra->given, argc, argv, &a);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        if (opt[0] == '-' && opt[1]) {
             fprintf(stderr, "rad %s: unknown option '%s' (see rad render --help)\n", cmd, opt);
             return 2;
-        } else if (!scene_name) scene_name = opt;
-        else { fprintf(stderr, "rad %s: more than one scene given\n", cmd); return 2; }
+        }
+        if (ra->scene) {
+            fprintf(stderr, "rad %s: more than one scene given\n", cmd);
+            return 2;
+        }
+        ra->scene = opt;
     }
-    if (!scene_name || !out_path) {
-        fprintf(stderr, "rad %s: %s\n", cmd, !scene_name ? "no scene given" : "no output file given (-o OUT.png|OUT.pfm)");
+    if (!ra->scene || !ra->out) {
+        fprintf(stderr, "rad %s: %s\n", cmd, !ra->scene ? "no scene given" : "no output file given (-o OUT.png|OUT.pfm)");
         render_usage(stderr);
         return 2;
     }
-    if (tool_method_check(cmd, 1, &mo, &o)) return 2;
-    if (lightmap_opts && mo.method != TOOL_LIGHTMAP) {
+    return -1;
+}
+
+/* the options that exclude each other, the output's format and place; 0, or the exit code */
+static int render_check(const char *cmd, render_args *ra)
+{
+    const tool_method_options *mo = &ra->mo;
+    const char *inputs[2];
+    if (tool_method_check(cmd, 1, &ra->mo, &ra->o)) return 2;
+    if ((ra->given & RENDER_GIVEN_LM) && mo->method != TOOL_LIGHTMAP) {
         fprintf(stderr, "rad %s: --lightmap-size, --texel-samples and --visibility-rays are for --method lightmap\n", cmd);
         return 2;
     }
-    if (mo.method == TOOL_LIGHTMAP && (bake_path || render_final_gather)) {
+    if (mo->method == TOOL_LIGHTMAP && (ra->bake || ra->view.final_gather)) {
         fprintf(stderr, "rad %s: --method lightmap bakes its own lightmap: %s is not used\n", cmd,
-                bake_path ? "--bake" : "--final-gather");
+                ra->bake ? "--bake" : "--final-gather");
         return 2;
     }
-    tool_dense_plan(&o, &mo, 0);
-    method = tool_method_name(mo.method);
-    seed = mo.seed;
-    pathtrace = mo.method == TOOL_PATHTRACE;
-    if (pathtrace && render_shading >= 0) {
+    tool_dense_plan(&ra->o, mo, 0);
+    if (mo->method == TOOL_PATHTRACE && ra->view.shading >= 0) {
         fprintf(stderr, "rad %s: --shading is for the radiosity methods (the path tracer is Lambertian)\n", cmd);
         return 2;
     }
-    if (mo.method == TOOL_LOCAL && !mo.proxy && bake_path) {
-        fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd, method);
+    if (mo->method == TOOL_LOCAL && !mo->proxy && ra->bake) {
+        fprintf(stderr, "rad %s: --bake is not used by --method %s (it builds its data here)\n", cmd,
+                tool_method_name(mo->method));
         return 2;
     }
-    if (pathtrace && bake_path) {
+    if (mo->method == TOOL_PATHTRACE && ra->bake) {
         fprintf(stderr, "rad %s: --bake is for the radiosity methods (classic, multibounce, temporal), not pathtrace\n", cmd);
         return 2;
     }
-    if (tool_image_check_format(cmd, out_path)) return 2;
-    {
-        const char *inputs[2];
-        inputs[0] = scene_name;
-        inputs[1] = bake_path;
-        if (tool_check_output(cmd, out_path, inputs, 2)) return 1;
-    }
-    tool_set_threads((int)threads);
-    if (tool_open_world_lit(cmd, scene_name, lights, &w)) return 1;
-    if (tool_check_outputs(cmd, &out_path, 1, w.file.input_files, (int)w.file.input_file_count)) {
-        tool_close_world(&w);
-        return 1;
-    }
-    {
-        uint32_t t, emitters = 0;
-        for (t = 0; t < w.scene->triangle_count; ++t) {
-            const float *Le = w.scene->materials_table[w.scene->materials[t]].emission;
-            if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) ++emitters;
-        }
-        if (!emitters && !w.file.light_count)
-            fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
-        if ((mo.method <= TOOL_TEMPORAL || mo.method == TOOL_LOCAL || mo.method == TOOL_STOCHASTIC ||
-             mo.method == TOOL_LIGHTMAP) &&
-            !mo.proxy && !pathtrace && !bake_path &&
-            o.patches < w.scene->triangle_count)
-            fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
-                    cmd, o.patches, w.scene->triangle_count);
-    }
-    if (!have_cam) {
-        if (w.file.has_camera) cam = w.file.camera;
-        else tool_choose_camera(cmd, w.scene, &w.rc, width, height, &cam);
-    } else cam.fov_y_degrees = w.file.camera.fov_y_degrees;
-    if (fov > 0.0f) cam.fov_y_degrees = fov;
-    if (tool_image_alloc(&img, width, height) != 0) {
-        fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
-        tool_close_world(&w);
-        return 1;
-    }
+    if (tool_image_check_format(cmd, ra->out)) return 2;
+    inputs[0] = ra->scene;
+    inputs[1] = ra->bake;
+    return tool_check_output(cmd, ra->out, inputs, 2) ? 1 : 0;
+}
 
-    if (mo.method == TOOL_LIGHTMAP) {
-        tool_lightmap_baked bk;
-        int lsz = (int)render_lm_size;
-        tool_lightmap_proxy px;
-        memset(&px, 0, sizeof px);
-        px.kind = (int)mo.proxy;
-        px.resolution = mo.vp_resolution;
-        px.face_points = mo.face_points;
-        rc = tool_lightmap_bake(cmd, &w, &o, lsz, lsz, !render_lm_size_given, render_lm_samples, render_lm_vis, -1, 256, 0, 0, 0,
-                                mo.proxy ? &px : NULL, &bk);
-        if (rc == 0) {
-            fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
-                            "step_ms_min=%.6f\n",
-                    cmd, mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : mo.proxy ? " proxy=aavp" : "", bk.patches, o.bounces,
-                    1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
-            render_lm = bk.lm;
-            render_lm_values = bk.values;
-            rc = render_classic(&bk.w, bk.cl.patches, NULL, &cam, width, height, aa, pixel_light_samples, &img);
-            render_lm = NULL;
-            render_lm_values = NULL;
-            tool_lightmap_bake_free(&bk);
-        }
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
-    } else if ((mo.method >= TOOL_LOCAL && !(mo.method == TOOL_HIERARCHICAL && bake_path)) || mo.proxy) {
-        rc = mo.method == TOOL_LOCAL && !mo.proxy
-                 ? render_local_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
-             : mo.method == TOOL_HIERARCHICAL
-                 ? render_hr_method(cmd, &w, &o, &mo, &cam, width, height, aa, pixel_light_samples, &img)
-                 : render_vp_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
-                                    &img);
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
-    } else if (mo.method == TOOL_MULTIBOUNCE || mo.method == TOOL_TEMPORAL || mo.method == TOOL_STOCHASTIC ||
-               mo.method == TOOL_HIERARCHICAL) { /* hierarchical here: from a bake (resampled onto its patches) */
-        rc = render_with_method(cmd, &w, bake_path, &o, &mo, &cam, width, height, aa, pixel_light_samples, exposure,
-                                &img);
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
-    } else if (pathtrace) {
-        tool_trace_options to;
-        rad_result r;
-        tool_trace_options_default(&to);
-        to.width = width;
-        to.height = height;
-        to.spp = (int)spp;
-        to.seed = seed;
-        tool_context(&ctx, "path tracing");
-        r = (rad_result)tool_trace_image(w.scene, &w.rc, w.file.lights, w.file.light_count, &cam, &to, &ctx, &img);
-        tool_progress_end();
-        if (r != RAD_SUCCESS) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return tool_fail(cmd, "tool_trace_image", r);
-        }
-    } else {
-        tool_classic sol;
-        rad_bake *bake = NULL;
-        const rad_patches *P;
-        const float *H;
-        float *Hv, *Hmine = NULL;
-        memset(&sol, 0, sizeof sol);
-        if (bake_path) {
-            const rad_section *hs;
-            rad_result r;
-            tool_context(&ctx, NULL);
-            if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
-                bake_load_failed(cmd, bake_path, r);
-                tool_image_free(&img);
-                tool_close_world(&w);
-                return 1;
-            }
-            rc = bake_fits_scene(cmd, bake_path, bake, &w);
-            if (rc == 0 && (bake->F.rows == 0 || !bake->B)) {
-                fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B%s\n", cmd, bake_path,
-                        rad_container_find(bake->container, TOOL_SECTION_METHOD, "rad.method")
-                            ? " (it is a multibounce or temporal bake: render it with that --method)"
-                            : "");
-                rc = 1;
-            }
-            if (rc) {
-                rad_bake_destroy(bake);
-                tool_image_free(&img);
-                tool_close_world(&w);
-                return 1;
-            }
-            bake->patches.scene = w.scene;
-            P = &bake->patches;
-            hs = rad_container_find(bake->container, RAD_SECTION_VECTOR, "H");
-            if (hs && hs->elem_size == 12 && hs->count == P->count) {
-                H = (const float *)hs->data;
-            } else {
-                /* H = F (E + L) = F B */
-                Hmine = (float *)xmalloc(sizeof(float) * 3 * P->count);
-                if ((r = rad_matrix_multiply(&bake->F, bake->B, Hmine, &ctx)) != RAD_SUCCESS) {
-                    free(Hmine);
-                    rad_bake_destroy(bake);
-                    tool_image_free(&img);
-                    tool_close_world(&w);
-                    return tool_fail(cmd, "rad_matrix_multiply", r);
-                }
-                H = Hmine;
-            }
-            fprintf(stderr, "rad %s: bake '%s': %u patches\n", cmd, bake_path, P->count);
-        } else {
-            if (tool_classic_solve(cmd, &w, &o, &sol)) {
-                tool_image_free(&img);
-                tool_close_world(&w);
-                return 1;
-            }
-            P = sol.patches;
-            H = sol.H;
-            fprintf(stderr, "rad %s: timing: method=classic patches=%u frames=1 bounces=%u step_ms_median=%.6f "
-                            "step_ms_min=%.6f\n",
-                    cmd, P->count, o.bounces, 1e3 * sol.solve_seconds, 1e3 * sol.solve_seconds);
-        }
-        Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
-        rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
-        if (rc == 0) rc = render_classic(&w, P, Hv, &cam, width, height, aa, pixel_light_samples, &img);
-        free(Hv);
-        free(Hmine);
-        rad_bake_destroy(bake);
-        tool_classic_free(&sol);
-        if (rc) {
-            tool_image_free(&img);
-            tool_close_world(&w);
-            return 1;
-        }
+/* the warnings about the scene, and the camera: --camera, else the file's, else one chosen */
+static void render_prepare(const char *cmd, const tool_world *w, render_args *ra)
+{
+    const tool_method_options *mo = &ra->mo;
+    rad_camera *cam = &ra->view.cam;
+    uint32_t t, emitters = 0;
+    for (t = 0; t < w->scene->triangle_count; ++t) {
+        const float *Le = w->scene->materials_table[w->scene->materials[t]].emission;
+        if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) ++emitters;
     }
-    if (tool_image_write(out_path, &img, exposure) != 0) {
-        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
-        tool_image_free(&img);
+    if (!emitters && !w->file.light_count)
+        fprintf(stderr, "rad %s: warning: the scene has no emitters and no lights: the image is black\n", cmd);
+    if ((mo->method <= TOOL_TEMPORAL || mo->method == TOOL_LOCAL || mo->method == TOOL_STOCHASTIC ||
+         mo->method == TOOL_LIGHTMAP) &&
+        !mo->proxy && mo->method != TOOL_PATHTRACE && !ra->bake && ra->o.patches < w->scene->triangle_count)
+        fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
+                cmd, ra->o.patches, w->scene->triangle_count);
+    if (!(ra->given & RENDER_GIVEN_CAMERA)) {
+        if (w->file.has_camera) *cam = w->file.camera;
+        else tool_choose_camera(cmd, w->scene, &w->rc, ra->view.width, ra->view.height, cam);
+    } else cam->fov_y_degrees = w->file.camera.fov_y_degrees;
+    if (ra->fov > 0.0f) cam->fov_y_degrees = ra->fov;
+}
+
+/* --method lightmap: the lightmap bake (lightmap.c), then the classic render with H looked up
+   in the lightmap at each sample */
+static int render_lightmap_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    tool_lightmap_baked bk;
+    tool_lightmap_request rq;
+    tool_lightmap_proxy px;
+    render_source src;
+    int rc;
+    tool_lightmap_request_default(&rq);
+    rq.width = rq.height = (int)ra->lm_size;
+    rq.auto_size = !(ra->given & RENDER_GIVEN_LM_SIZE);
+    rq.texel_samples = ra->lm_samples;
+    rq.visibility_rays = ra->lm_vis;
+    memset(&px, 0, sizeof px);
+    px.kind = (int)ra->mo.proxy;
+    px.resolution = ra->mo.vp_resolution;
+    px.face_points = ra->mo.face_points;
+    rq.proxy = ra->mo.proxy ? &px : NULL;
+    if (tool_lightmap_bake(cmd, w, &ra->o, &rq, &bk)) return 1;
+    fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+                    "step_ms_min=%.6f\n",
+            cmd, ra->mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : ra->mo.proxy ? " proxy=aavp" : "", bk.patches,
+            ra->o.bounces, 1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
+    memset(&src, 0, sizeof src);
+    src.P = bk.cl.patches;
+    src.lm = bk.lm;
+    src.lm_values = bk.values;
+    rc = render_classic(&bk.w, &ra->view, &src, img);
+    tool_lightmap_bake_free(&bk);
+    return rc;
+}
+
+static int render_pathtrace(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    tool_trace_options to;
+    rad_context ctx;
+    rad_result r;
+    tool_trace_options_default(&to);
+    to.width = ra->view.width;
+    to.height = ra->view.height;
+    to.spp = (int)ra->spp;
+    to.seed = ra->mo.seed;
+    tool_context(&ctx, "path tracing");
+    r = (rad_result)tool_trace_image(w->scene, &w->rc, w->file.lights, w->file.light_count, &ra->view.cam, &to, &ctx, img);
+    tool_progress_end();
+    return r != RAD_SUCCESS ? tool_fail(cmd, "tool_trace_image", r) : 0;
+}
+
+/* --bake of the classic method: the bake checked against the scene, and its H (stored, or
+   F B); *bake_out and *H_owned (NULL when the bake holds H) to free. 0 or 1 (printed). */
+static int classic_bake_open(const char *cmd, const tool_world *w, const char *bake_path, rad_bake **bake_out,
+                             const float **H, float **H_owned)
+{
+    rad_bake *bake = NULL;
+    const rad_section *hs;
+    rad_context ctx;
+    rad_result r;
+    int rc;
+    *bake_out = NULL;
+    *H_owned = NULL;
+    tool_context(&ctx, NULL);
+    if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
+        bake_load_failed(cmd, bake_path, r);
+        return 1;
+    }
+    rc = bake_fits_scene(cmd, bake_path, bake, w);
+    if (rc == 0 && (bake->F.rows == 0 || !bake->B)) {
+        fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B%s\n", cmd, bake_path,
+                rad_container_find(bake->container, TOOL_SECTION_METHOD, "rad.method")
+                    ? " (it is a multibounce or temporal bake: render it with that --method)"
+                    : "");
+        rc = 1;
+    }
+    if (rc) {
+        rad_bake_destroy(bake);
+        return 1;
+    }
+    bake->patches.scene = w->scene;
+    hs = rad_container_find(bake->container, RAD_SECTION_VECTOR, "H");
+    if (hs && hs->elem_size == 12 && hs->count == bake->patches.count) {
+        *H = (const float *)hs->data;
+    } else {
+        /* H = F (E + L) = F B */
+        *H_owned = (float *)xmalloc(sizeof(float) * 3 * bake->patches.count);
+        if ((r = rad_matrix_multiply(&bake->F, bake->B, *H_owned, &ctx)) != RAD_SUCCESS) {
+            free(*H_owned);
+            *H_owned = NULL;
+            rad_bake_destroy(bake);
+            return tool_fail(cmd, "rad_matrix_multiply", r);
+        }
+        *H = *H_owned;
+    }
+    fprintf(stderr, "rad %s: bake '%s': %u patches\n", cmd, bake_path, bake->patches.count);
+    *bake_out = bake;
+    return 0;
+}
+
+/* --method classic: the solution (--bake, or solved here), per-vertex H, the classic render */
+static int render_classic_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    tool_classic sol;
+    rad_bake *bake = NULL;
+    const rad_patches *P;
+    const float *H = NULL;
+    float *Hv, *Hmine = NULL;
+    render_source src;
+    int rc;
+    memset(&sol, 0, sizeof sol);
+    if (ra->bake) {
+        if (classic_bake_open(cmd, w, ra->bake, &bake, &H, &Hmine)) return 1;
+        P = &bake->patches;
+    } else {
+        if (tool_classic_solve(cmd, w, &ra->o, &sol)) return 1;
+        P = sol.patches;
+        H = sol.H;
+        fprintf(stderr, "rad %s: timing: method=classic patches=%u frames=1 bounces=%u step_ms_median=%.6f "
+                        "step_ms_min=%.6f\n",
+                cmd, P->count, ra->o.bounces, 1e3 * sol.solve_seconds, 1e3 * sol.solve_seconds);
+    }
+    Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
+    rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
+    memset(&src, 0, sizeof src);
+    src.P = P;
+    src.Hv = Hv;
+    if (rc == 0) rc = render_classic(w, &ra->view, &src, img);
+    free(Hv);
+    free(Hmine);
+    rad_bake_destroy(bake);
+    tool_classic_free(&sol);
+    return rc;
+}
+
+/* the image by the method asked for; 0 or 1 (printed) */
+static int render_image(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    const tool_method_options *mo = &ra->mo;
+    if (mo->method == TOOL_LIGHTMAP) return render_lightmap_method(cmd, w, ra, img);
+    if ((mo->method >= TOOL_LOCAL && !(mo->method == TOOL_HIERARCHICAL && ra->bake)) || mo->proxy)
+        return mo->method == TOOL_LOCAL && !mo->proxy ? render_local_method(cmd, w, ra, img)
+               : mo->method == TOOL_HIERARCHICAL      ? render_hr_method(cmd, w, ra, img)
+                                                      : render_vp_method(cmd, w, ra, img);
+    /* hierarchical here: from a bake (resampled onto its patches) */
+    if (mo->method == TOOL_MULTIBOUNCE || mo->method == TOOL_TEMPORAL || mo->method == TOOL_STOCHASTIC ||
+        mo->method == TOOL_HIERARCHICAL)
+        return render_with_method(cmd, w, ra, img);
+    if (mo->method == TOOL_PATHTRACE) return render_pathtrace(cmd, w, ra, img);
+    return render_classic_method(cmd, w, ra, img);
+}
+
+static int render_main(int argc, char **argv, tool_lights *lights)
+{
+    const char *cmd = "render";
+    render_args ra;
+    tool_world w;
+    tool_image img;
+    int rc;
+    double t0 = tool_seconds();
+    if ((rc = render_parse(cmd, argc, argv, lights, &ra)) >= 0) return rc;
+    if ((rc = render_check(cmd, &ra)) != 0) return rc;
+    tool_set_threads((int)ra.threads);
+    if (tool_open_world_lit(cmd, ra.scene, lights, &w)) return 1;
+    if (tool_check_outputs(cmd, &ra.out, 1, w.file.input_files, (int)w.file.input_file_count)) {
         tool_close_world(&w);
         return 1;
     }
-    printf("wrote %s (%dx%d, %s) in %.2f s\n", out_path, width, height, method, tool_seconds() - t0);
+    render_prepare(cmd, &w, &ra);
+    memset(&img, 0, sizeof img);
+    if (tool_image_alloc(&img, ra.view.width, ra.view.height) != 0) {
+        fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, ra.view.width, ra.view.height);
+        tool_close_world(&w);
+        return 1;
+    }
+    rc = render_image(cmd, &w, &ra, &img);
+    if (rc == 0 && tool_image_write(ra.out, &img, ra.view.exposure) != 0) {
+        fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
+        rc = 1;
+    }
+    if (rc == 0)
+        printf("wrote %s (%dx%d, %s) in %.2f s\n", ra.out, ra.view.width, ra.view.height, tool_method_name(ra.mo.method),
+               tool_seconds() - t0);
     tool_image_free(&img);
     tool_close_world(&w);
-    return 0;
+    return rc ? 1 : 0;
 }
 
 int tool_cmd_render(int argc, char **argv)

@@ -14,21 +14,121 @@
 #include <omp.h>
 #endif
 
+/* rad trace's command line */
+typedef struct trace_args {
+    const char *scene, *out;
+    tool_trace_options opt;
+    rad_camera cam;          /* --camera (given: TRACE_GIVEN_CAMERA) */
+    float fov, exposure;
+    uint32_t threads;
+    uint32_t given;
+} trace_args;
+enum { TRACE_GIVEN_CAMERA = 1 };
+/* help contexts: --output is -o's other name, not listed */
+enum { TRACE_HELP = 1, TRACE_HIDDEN = 2 };
+
+static int parse_camera(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    const char *why;
+    (void)t;
+    if (tool_parse_camera(v, (rad_camera *)field, &why)) {
+        fprintf(stderr, "rad %s: bad --camera '%s': %s\n", cmd, v, why);
+        return 2;
+    }
+    return 0;
+}
+
+/* --size WxH into tool_trace_options' width and height (field: width) */
+static int parse_size(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    tool_trace_options *o = (tool_trace_options *)((char *)field - offsetof(tool_trace_options, width));
+    (void)t;
+    if (tool_parse_size(v, &o->width, &o->height) != 0 || o->width <= 0 || o->height <= 0) {
+        fprintf(stderr, "rad %s: --size wants WxH, got '%s'\n", cmd, v);
+        return 2;
+    }
+    return tool_check_size(cmd, o->width, o->height) ? 2 : 0;
+}
+
+static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
+}
+
+#define TA(f) offsetof(trace_args, f)
+#define TA_UINT(name, val, f, lo, hi, bad, help) {TOOL_ARG_UINT, name, val, TA(f), lo, hi, 0, 0, bad, NULL, NULL, NULL, 0, help}
+#define TA_CUSTOM(name, val, f, fn, given, help) {TOOL_ARG_CUSTOM, name, val, TA(f), 0, 0, 0, given, NULL, NULL, NULL, fn, 0, help}
+/* rad trace's options (the lights' are lights.c's table) */
+static const tool_arg trace_table[] = {
+    TA_CUSTOM("--camera", "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ", cam, parse_camera, TRACE_GIVEN_CAMERA,
+              "camera (default: the scene's camera)"),
+    {TOOL_ARG_FLOAT, "--fov", "DEG", TA(fov), 0.0, 180.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, 0, "wants degrees in (0, 180)",
+     NULL, NULL, NULL, 0, "vertical field of view (default: the scene's, else 45)"},
+    TA_CUSTOM("--size", "WxH", opt.width, parse_size, 0,
+              "image size (default 256x256; at most 2 GiB of image: 12 bytes a pixel)"),
+    TA_UINT("--spp", "N", opt.spp, 1, 16777216, "must be in 1..16777216", "samples per pixel (default 64)"),
+    TA_UINT("--seed", "S", opt.seed, 0, 4294967295.0, "", "random seed (default 0); same seed, same image on any thread count"),
+    TA_UINT("--max-depth", "N", opt.max_depth, 1, 100000, "must be in 1..100000", "path length cap (default 64)"),
+    TA_UINT("--rr-depth", "N", opt.rr_depth, 1, 100000, "must be in 1..100000",
+            "Russian roulette from this bounce on (default 16)"),
+    TA_CUSTOM("--threads", "N", threads, parse_threads, 0, "worker threads (default: all cores; at most 1024)"),
+    {TOOL_ARG_FLOAT, "--exposure", "X", TA(exposure), 0.0, 1e30, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, 0,
+     "wants a positive number", NULL, NULL, NULL, 0, "scale before 8-bit sRGB encoding (PNG only; default 1)"},
+    {TOOL_ARG_STRING, "-o", "FILE", TA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     ".pfm (linear float radiance) or .png (8-bit sRGB)"},
+    {TOOL_ARG_STRING, "--output", "FILE", TA(out), 0, 0, 0, 0, NULL, NULL, NULL, NULL, TRACE_HIDDEN, "as -o"},
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+
 static void trace_usage(FILE *f)
 {
+    static char own[4096];
+    tool_args_help_into(trace_table, TRACE_HELP, own, sizeof own);
     fprintf(f, "usage: rad trace SCENE -o OUT.pfm|OUT.png [options]\n"
                "  path-traced reference image (diffuse, next-event estimation + MIS); linear radiance\n"
-               "  --camera PX,PY,PZ:TX,TY,TZ:UX,UY,UZ   camera (default: the scene's camera)\n"
-               "  --fov DEG          vertical field of view (default: the scene's, else 45)\n"
-               "  --size WxH         image size (default 256x256; at most 2 GiB of image: 12 bytes a pixel)\n"
-               "  --spp N            samples per pixel (default 64)\n"
-               "  --seed S           random seed (default 0); same seed, same image on any thread count\n"
-               "  --max-depth N      path length cap (default 64)\n"
-               "  --rr-depth N       Russian roulette from this bounce on (default 16)\n"
-               "  --threads N        worker threads (default: all cores; at most 1024)\n"
-               "  --exposure X       scale before 8-bit sRGB encoding (PNG only; default 1)\n"
-               "  -o FILE            .pfm (linear float radiance) or .png (8-bit sRGB)\n"
-               "%s", tool_light_help());
+               "%s%s", own, tool_light_help());
+}
+
+/* the command line into ta; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
+static int trace_parse(int argc, char **argv, tool_lights *lights, trace_args *ta)
+{
+    int i, rc;
+    size_t n;
+    memset(ta, 0, sizeof *ta);
+    tool_trace_options_default(&ta->opt);
+    ta->exposure = 1.0f;
+    for (i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            trace_usage(stdout);
+            return 0;
+        }
+        if ((rc = tool_light_option("trace", argc, argv, &i, lights)) == 0)
+            rc = tool_args_parse("trace", trace_table, ta, &ta->given, argc, argv, &i);
+        if (rc == 2) return 2;
+        if (rc == 1) continue;
+        if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "rad trace: unknown option '%s'\n", a);
+            trace_usage(stderr);
+            return 2;
+        }
+        if (ta->scene) {
+            fprintf(stderr, "rad trace: more than one scene ('%s' and '%s')\n", ta->scene, a);
+            return 2;
+        }
+        ta->scene = a;
+    }
+    if (!ta->scene || !ta->out) {
+        trace_usage(stderr);
+        return 2;
+    }
+    n = strlen(ta->out);
+    if (n < 4 || (strcmp(ta->out + n - 4, ".pfm") && strcmp(ta->out + n - 4, ".png") && strcmp(ta->out + n - 4, ".PFM") &&
+                  strcmp(ta->out + n - 4, ".PNG"))) {
+        fprintf(stderr, "rad trace: -o wants a .pfm or .png file, got '%s'\n", ta->out);
+        return 2;
+    }
+    return -1;
 }
 
 static double trace_now(void)
@@ -40,24 +140,12 @@ static double trace_now(void)
 #endif
 }
 
-static int parse_int(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    long v;
-    if (!s || !*s) return -1;
-    v = strtol(s, &end, 10);
-    if (*end || v < lo || v > hi) return -1;
-    *out = v;
-    return 0;
-}
-
 static int trace_main(int argc, char **argv, tool_lights *lights)
 {
-    const char *scene_path = NULL, *out_path = NULL, *camera_text = NULL;
-    tool_trace_options opt;
-    float fov = 0.0f, exposure = 1.0f;
-    long threads = 0, v;
-    int i, code = 1;
+    trace_args ta;
+    const char *scene_path, *out_path;
+    float fov;
+    int code = 1;
     char err[512];
     tool_scene ts;
     rad_scene *scene = NULL;
@@ -69,103 +157,14 @@ static int trace_main(int argc, char **argv, tool_lights *lights)
     rad_result r;
     double t0, t1;
     void *light_storage = NULL;
-    int lr;
+    int pr;
 
-    tool_trace_options_default(&opt);
-    for (i = 0; i < argc; ++i) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            trace_usage(stdout);
-            return 0;
-        }
-        lr = tool_light_option("trace", argc, argv, &i, lights);
-        if (lr == 2) return 2;
-        if (lr == 1) continue;
-        if (a[0] != '-' || !a[1]) {
-            if (scene_path) {
-                fprintf(stderr, "rad trace: more than one scene ('%s' and '%s')\n", scene_path, a);
-                return 2;
-            }
-            scene_path = a;
-            continue;
-        }
-        if (!next) {
-            fprintf(stderr, "rad trace: %s needs a value\n", a);
-            return 2;
-        }
-        ++i;
-        if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            out_path = next;
-        } else if (!strcmp(a, "--camera")) {
-            camera_text = next;
-        } else if (!strcmp(a, "--fov")) {
-            char *end;
-            fov = strtof(next, &end);
-            if (*end || !(fov > 0.0f && fov < 180.0f)) {
-                fprintf(stderr, "rad trace: --fov wants degrees in (0, 180), got '%s'\n", next);
-                return 2;
-            }
-        } else if (!strcmp(a, "--size")) {
-            if (tool_parse_size(next, &opt.width, &opt.height) != 0 || opt.width <= 0 || opt.height <= 0) {
-                fprintf(stderr, "rad trace: --size wants WxH, got '%s'\n", next);
-                return 2;
-            }
-            if (tool_check_size("trace", opt.width, opt.height)) return 2;
-        } else if (!strcmp(a, "--spp")) {
-            if (parse_int(next, 1, 1L << 24, &v) != 0) {
-                fprintf(stderr, "rad trace: --spp wants a positive integer, got '%s'\n", next);
-                return 2;
-            }
-            opt.spp = (int)v;
-        } else if (!strcmp(a, "--seed")) {
-            if (parse_int(next, 0, 0xFFFFFFFFL, &v) != 0) {
-                fprintf(stderr, "rad trace: --seed wants an integer in [0, 2^32), got '%s'\n", next);
-                return 2;
-            }
-            opt.seed = (uint32_t)v;
-        } else if (!strcmp(a, "--max-depth")) {
-            if (parse_int(next, 1, 100000, &v) != 0) {
-                fprintf(stderr, "rad trace: --max-depth wants a positive integer, got '%s'\n", next);
-                return 2;
-            }
-            opt.max_depth = (int)v;
-        } else if (!strcmp(a, "--rr-depth")) {
-            if (parse_int(next, 1, 100000, &v) != 0) {
-                fprintf(stderr, "rad trace: --rr-depth wants a positive integer, got '%s'\n", next);
-                return 2;
-            }
-            opt.rr_depth = (int)v;
-        } else if (!strcmp(a, "--threads")) {
-            uint32_t t = 0;
-            if (tool_parse_threads("trace", a, next, &t)) return 2;
-            threads = (long)t;
-        } else if (!strcmp(a, "--exposure")) {
-            char *end;
-            exposure = strtof(next, &end);
-            if (*end || !(exposure > 0.0f && exposure < 1e30f)) {
-                fprintf(stderr, "rad trace: --exposure wants a positive number, got '%s'\n", next);
-                return 2;
-            }
-        } else {
-            fprintf(stderr, "rad trace: unknown option '%s'\n", a);
-            trace_usage(stderr);
-            return 2;
-        }
-    }
-    if (!scene_path || !out_path) {
-        trace_usage(stderr);
-        return 2;
-    }
-    {
-        size_t n = strlen(out_path);
-        if (n < 4 || (strcmp(out_path + n - 4, ".pfm") && strcmp(out_path + n - 4, ".png") &&
-                      strcmp(out_path + n - 4, ".PFM") && strcmp(out_path + n - 4, ".PNG"))) {
-            fprintf(stderr, "rad trace: -o wants a .pfm or .png file, got '%s'\n", out_path);
-            return 2;
-        }
-    }
+    if ((pr = trace_parse(argc, argv, lights, &ta)) >= 0) return pr;
+    scene_path = ta.scene;
+    out_path = ta.out;
+    fov = ta.fov;
     if (tool_check_output("trace", out_path, &scene_path, 1)) return 1;
-    tool_set_threads((int)threads);
+    tool_set_threads((int)ta.threads);
 
     memset(&ts, 0, sizeof(ts));
     if (tool_load_scene(scene_path, &ts, err, sizeof(err)) != 0) {
@@ -177,15 +176,8 @@ static int trace_main(int argc, char **argv, tool_lights *lights)
         tool_free_scene(&ts);
         return 1;
     }
-    if (camera_text) {
-        memset(&cam, 0, sizeof(cam));
-        const char *why;
-        if (tool_parse_camera(camera_text, &cam, &why) != 0) {
-            fprintf(stderr, "rad trace: bad --camera '%s': %s\n", camera_text, why);
-            tool_free_scene(&ts);
-            tool_lights_release(light_storage);
-            return 2;
-        }
+    if (ta.given & TRACE_GIVEN_CAMERA) {
+        cam = ta.cam;
         cam.fov_y_degrees = fov > 0.0f ? fov : (ts.has_camera ? ts.camera.fov_y_degrees : 45.0f);
     } else {
         cam = ts.camera;
@@ -207,8 +199,8 @@ static int trace_main(int argc, char **argv, tool_lights *lights)
         goto done;
     }
     rad_bvh_raycaster(bvh, &rc);
-    if (!camera_text && !ts.has_camera) {
-        tool_choose_camera("trace", scene, &rc, opt.width, opt.height, &cam);
+    if (!(ta.given & TRACE_GIVEN_CAMERA) && !ts.has_camera) {
+        tool_choose_camera("trace", scene, &rc, ta.opt.width, ta.opt.height, &cam);
         if (fov > 0.0f) cam.fov_y_degrees = fov;
     }
     {
@@ -218,21 +210,21 @@ static int trace_main(int argc, char **argv, tool_lights *lights)
             if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) ++emitters;
         }
         fprintf(stderr, "rad trace: %s: %u triangles, %u emissive, %u analytic lights; %dx%d, %d spp, seed %u\n",
-                scene_path, scene->triangle_count, emitters, ts.light_count, opt.width, opt.height, opt.spp,
-                opt.seed);
+                scene_path, scene->triangle_count, emitters, ts.light_count, ta.opt.width, ta.opt.height, ta.opt.spp,
+                ta.opt.seed);
         if (!emitters && !ts.light_count)
             fprintf(stderr, "rad trace: warning: the scene has no emitters and no lights: the image is black\n");
     }
     t0 = trace_now();
-    r = (rad_result)tool_trace_image(scene, &rc, ts.lights, ts.light_count, &cam, &opt, &ctx, &img);
+    r = (rad_result)tool_trace_image(scene, &rc, ts.lights, ts.light_count, &cam, &ta.opt, &ctx, &img);
     t1 = trace_now();
     if (r != RAD_SUCCESS) {
         fprintf(stderr, "rad trace: path tracing failed: %s\n", rad_result_string(r));
         goto done;
     }
     fprintf(stderr, "rad trace: %.2f s (%.3g samples/s)\n", t1 - t0,
-            (double)opt.width * (double)opt.height * (double)opt.spp / (t1 - t0 > 0.0 ? t1 - t0 : 1e-9));
-    if (tool_image_write(out_path, &img, exposure) != 0) {
+            (double)ta.opt.width * (double)ta.opt.height * (double)ta.opt.spp / (t1 - t0 > 0.0 ? t1 - t0 : 1e-9));
+    if (tool_image_write(out_path, &img, ta.exposure) != 0) {
         fprintf(stderr, "rad trace: %s\n", tool_output_error());
         goto done;
     }

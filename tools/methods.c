@@ -79,122 +79,236 @@ static const char *mode_name(uint32_t m)
     return m == RAD_TEMPORAL_SINGLE ? "single" : m == RAD_TEMPORAL_MULTIBOUNCE ? "multibounce" : "feedback";
 }
 
-static const char stochastic_help[] =
-    "stochastic (stochastic radiosity: the classic patches and E, no F; rays sample it, so the\n"
-    "solution is noisy and the noise falls as 1/sqrt(rays); docs/methods/stochastic.md):\n"
-    "  --sr-estimator E   jacobi (default: stochastic Jacobi, shooting) or walk (random walks,\n"
-    "                     collision estimator)\n"
-    "  --sr-rays N        rays of the first Jacobi iteration, later ones in proportion to their\n"
-    "                     power; walks per batch (default 64 per patch)\n"
-    "  --sr-iterations N  Jacobi: shooting iterations at most (default 256; they stop when the\n"
-    "                     unshot power is below 1e-4 of the source); walk: batches averaged (default 1)\n"
-    "  --seed S           generator seed (default 0; same seed, same image on any thread count)\n";
+/* --method: the names in tool_method order */
+static const char method_names[] = "classic|multibounce|temporal|pathtrace|stochastic|local|vp|aavp|hierarchical|lightmap";
 
-static const char light_path_help[] =
-    "  --light-path P     temporal --proxy aavp|vp: the last --point or --spot light moves, one step\n"
-    "                     per frame: line:X0,Y0,Z0:X1,Y1,Z1 (from the first point at frame 1 to\n"
-    "                     the second at the last) or circle:CX,CY,CZ:R (a horizontal circle, one\n"
-    "                     turn over the frames); E at the samples is updated every frame\n"
-    "                     (rad_vp_lights) and --sequence shows the light moving\n"
-    "  --light-rays N     with --light-path: shadow rays per light and frame, the samples re-tested\n"
-    "                     in turn (default 0: every sample every frame; shadows at most\n"
-    "                     samples / N frames old, the light's falloff exact every frame)\n";
+static int parse_method(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    int i = 0;
+    const char *p = method_names;
+    (void)t;
+    for (;;) {
+        const char *e = strchr(p, '|');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (strlen(v) == len && !strncmp(p, v, len)) break;
+        if (!e) {
+            fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal, stochastic%s)\n", cmd, v,
+                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp, aavp, hierarchical or lightmap");
+            return 2;
+        }
+        p = e + 1;
+        ++i;
+    }
+    *(tool_method *)field = (tool_method)i;
+    return 0;
+}
+
+static int parse_bounces(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    uint32_t *b = (uint32_t *)field;
+    if (!strcmp(v, "inf")) {
+        *b = RAD_MB_INFINITE;
+        return 0;
+    }
+    if (tool_parse_uint(cmd, t->name, v, b)) return 2;
+    if (*b >= 0xFFFFFFF0u) {
+        fprintf(stderr, "rad %s: --bounces %s is too large (use 'inf' for the full solution)\n", cmd, v);
+        return 2;
+    }
+    return 0;
+}
+
+static int parse_tile(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    uint32_t *tile = (uint32_t *)field;
+    if (tool_parse_uint(cmd, t->name, v, tile)) return 2;
+    if (*tile % 4 != 0) {
+        fprintf(stderr, "rad %s: --tile must be a multiple of 4 (0: one scale per matrix), not %s\n", cmd, v);
+        return 2;
+    }
+    return 0;
+}
+
+static int parse_hr_rays(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    uint32_t *r = (uint32_t *)field, n = 1;
+    if (tool_parse_uint(cmd, t->name, v, r)) return 2;
+    while (n * n < *r) ++n;
+    if (*r == 0 || *r > 64 || n * n != *r) {
+        fprintf(stderr, "rad %s: --hr-rays must be a square from 1 to 64 (1, 4, 9 ...), not %s\n", cmd, v);
+        return 2;
+    }
+    return 0;
+}
+
+/* --light-path line:P0:P1 or circle:C:R into mo->light_path and mo->path (field: light_path) */
+static int parse_light_path(const char *cmd, const tool_arg *t, const char *v, void *field)
+{
+    tool_method_options *mo = (tool_method_options *)((char *)field - offsetof(tool_method_options, light_path));
+    float *q = mo->path;
+    char tail;
+    int ok = 0;
+    (void)t;
+    memset(mo->path, 0, sizeof mo->path);
+    if (!strncmp(v, "line:", 5))
+        ok = sscanf(v + 5, "%f,%f,%f:%f,%f,%f%c", q, q + 1, q + 2, q + 3, q + 4, q + 5, &tail) == 6, mo->light_path = 1;
+    else if (!strncmp(v, "circle:", 7))
+        ok = sscanf(v + 7, "%f,%f,%f:%f%c", q, q + 1, q + 2, q + 3, &tail) == 4 && q[3] > 0.0f, mo->light_path = 2;
+    ok = ok && !tool_vector_problem(q, 0) && !tool_vector_problem(q + 3, 0); /* finite, within 1e30 */
+    if (!ok) {
+        fprintf(stderr, "rad %s: --light-path must be line:X0,Y0,Z0:X1,Y1,Z1 or circle:CX,CY,CZ:R (R > 0), not '%s'\n",
+                cmd, v);
+        return 2;
+    }
+    return 0;
+}
+
+static const uint32_t format_values[] = {TOOL_MB_FLOAT, TOOL_MB_HALF, TOOL_MB_BC1, TOOL_MB_BC4X3};
+static const uint32_t mode_values[] = {RAD_TEMPORAL_FEEDBACK, RAD_TEMPORAL_SINGLE, RAD_TEMPORAL_MULTIBOUNCE};
+static const uint32_t estimator_values[] = {RAD_STOCHASTIC_JACOBI, RAD_STOCHASTIC_WALK};
+static const uint32_t proxy_values[] = {TOOL_PROXY_PATCHES, TOOL_PROXY_AAVP, TOOL_PROXY_VP};
+
+/* the contexts of the help: rad render lists every option, rad bake those it bakes with */
+#define R TOOL_METHOD_HELP_RENDER
+#define B TOOL_METHOD_HELP_BAKE
+#define MO(f) offsetof(tool_method_options, f)
+#define TEXT(where, text) {TOOL_ARG_TEXT, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, where, text}
+#define UINT(name, val, f, lo, hi, bit, bad, where, help) \
+    {TOOL_ARG_UINT, name, val, MO(f), lo, hi, 0, bit, bad, NULL, NULL, NULL, where, help}
+#define FLOAT(name, val, f, lo, hi, flags, bit, bad, where, help) \
+    {TOOL_ARG_FLOAT, name, val, MO(f), lo, hi, flags, bit, bad, NULL, NULL, NULL, where, help}
+#define CHOICE(name, val, f, choices, values, bit, where, help) \
+    {TOOL_ARG_CHOICE, name, val, MO(f), 0, 0, 0, bit, NULL, choices, values, NULL, where, help}
+#define CUSTOM(name, val, f, fn, bit, where, help) \
+    {TOOL_ARG_CUSTOM, name, val, MO(f), 0, 0, 0, bit, NULL, NULL, NULL, fn, where, help}
+#define FLAG(name, f, v, bit, where, help) {TOOL_ARG_FLAG, name, NULL, MO(f), v, 0, 0, bit, NULL, NULL, NULL, NULL, where, help}
+
+/* The options of the methods (rad render and rad bake): the parser and the help. */
+static const tool_arg method_args[] = {
+    CUSTOM("--method", "M", method, parse_method, TOOL_OPT_METHOD, R,
+           "classic (default: radiosity + per-pixel direct light), multibounce (the indirect light\n"
+           "L = F_mb E), temporal (alias-table frames), stochastic, pathtrace, local (local matrix of\n"
+           "the patches nearest the camera), vp or aavp (virtual patches), hierarchical (quadtrees and\n"
+           "links, Hanrahan et al. 1991), lightmap (classic, or virtual patches with --proxy aavp|vp,\n"
+           "baked into a lightmap, the indirect light looked up per pixel)"),
+    TEXT(R, "multibounce and temporal (without --bake: baked here first; with --bake the bake's own):\n"),
+    TEXT(B, "multibounce:\n"),
+    CUSTOM("--bounces", "K|inf", bounces, parse_bounces, TOOL_OPT_BOUNCES, 0,
+           "multibounce, temporal --mode multibounce, vp, aavp, lightmap: bounces of the solution as\n"
+           "classic --bounces (F_mb holds K + 1, the renderer's gather: the image of K equals classic\n"
+           "--bounces K; inf: the full solution, Gauss-Seidel to 1e-6 for vp and aavp; default 64)"),
+    CHOICE("--format", "F", format, "float|half|bc1|bc4x3", format_values, TOOL_OPT_FORMAT, 0,
+           "multibounce: F_mb storage float, half, bc1 or bc4x3 (default)"),
+    FLOAT("--outliers", "P", outliers, 0.0, 1.0, TOOL_ARG_HI_OPEN, TOOL_OPT_OUTLIERS,
+          "must be a fraction in [0, 1) (e.g. 0.05)", 0,
+          "multibounce bc1/bc4x3: fraction of the entries kept exactly (default 0.05)"),
+    FLAG("--reorder", reorder, RAD_REORDER_MATCH, TOOL_OPT_REORDER, 0,
+         "multibounce bc1/bc4x3: row/column reordering (the default)"),
+    FLAG("--no-reorder", reorder, RAD_REORDER_NONE, TOOL_OPT_REORDER, 0, "no reordering"),
+    UINT("--reorder-samples", "N", reorder_samples, 0, 4294967295.0, TOOL_OPT_REORDER_SAMPLES, "", 0,
+         "reordering distances on N coordinates (default 0: all)"),
+    CUSTOM("--tile", "T", tile, parse_tile, TOOL_OPT_TILE, 0,
+           "multibounce bc1/bc4x3: scales per T x T texels (a multiple of 4), 0: per matrix (default 64)"),
+    TEXT(B, "temporal (alias tables; k, w, adaptive and seed are the render's defaults):\n"),
+    CHOICE("--mode", "M", mode, "feedback|single|multibounce", mode_values, TOOL_OPT_MODE, 0,
+           "temporal: feedback (default: samples E + B, converges to L_inf), single (one bounce) or\n"
+           "multibounce (alias tables over the channels of F_mb, with --bounces)"),
+    TEXT(R, "temporal (these override the bake's; the defaults give a still image within 0.001 SSIM\n"
+            "of classic on the Cornell box):\n"),
+    UINT("--frames", "N", frames, 1, 10000000, TOOL_OPT_FRAMES, "must be in 1..10000000", R,
+         "frames to step; the image shows the last (default 1024)"),
+    UINT("--k", "K", k, 1, 65536, TOOL_OPT_K, "must be in 1..65536", 0, "draws per patch and frame (default 10)"),
+    FLAG("--adaptive", adaptive, 1, TOOL_OPT_ADAPTIVE, 0,
+         "per-patch blend weight from the estimator's variance (the default: B is the running\n"
+         "mean of the frames at first, so it converges fast)"),
+    FLOAT("--w", "W", w, 0.0, 1.0, TOOL_ARG_HI_OPEN, TOOL_OPT_W, "must be in [0, 1)", 0,
+          "a fixed blend weight in [0, 1) instead (B starts at 0 and reaches 1 - W^N of the\n"
+          "solution after N frames: W 0.998 needs ~2300 for 99%)"),
+    UINT("--seed", "S", seed, 0, 4294967295.0, TOOL_OPT_SEED, "", 0,
+         "generator seed of temporal and stochastic (default 0; same seed, same image on any thread\n"
+         "count); also the path tracer's seed"),
+    {TOOL_ARG_STRING, "--sequence", "DIR", MO(sequence), 0, 0, TOOL_ARG_NONEMPTY, TOOL_OPT_SEQUENCE, "needs a directory",
+     NULL, NULL, NULL, R, "also write DIR/frame_NNNNN.png every --every N frames (and the last)"},
+    UINT("--every", "N", every, 1, 4294967295.0, TOOL_OPT_EVERY, "must be > 0", R, "with --sequence (default 1)"),
+    CUSTOM("--light-path", "P", light_path, parse_light_path, TOOL_OPT_LIGHT_PATH, R,
+           "temporal --proxy aavp|vp: the last --point or --spot light moves, one step per frame:\n"
+           "line:X0,Y0,Z0:X1,Y1,Z1 (from the first point at frame 1 to the second at the last) or\n"
+           "circle:CX,CY,CZ:R (a horizontal circle, one turn over the frames); E at the samples is\n"
+           "updated every frame (rad_vp_lights) and --sequence shows the light moving"),
+    UINT("--light-rays", "N", light_rays, 0, 4294967295.0, TOOL_OPT_LIGHT_RAYS, "", R,
+         "with --light-path: shadow rays per light and frame, the samples re-tested in turn\n"
+         "(default 0: every sample every frame; shadows at most samples / N frames old, the\n"
+         "light's falloff exact every frame)"),
+    TEXT(0, "stochastic (stochastic radiosity: the classic patches and E, no F; rays sample it, so the\n"
+            "solution is noisy and the noise falls as 1/sqrt(rays); docs/methods/stochastic.md):\n"),
+    CHOICE("--sr-estimator", "E", sr_estimator, "jacobi|walk", estimator_values, TOOL_OPT_SR_ESTIMATOR, 0,
+           "jacobi (default: stochastic Jacobi, shooting) or walk (random walks, collision estimator)"),
+    UINT("--sr-rays", "N", sr_rays, 1, 67108864, TOOL_OPT_SR_RAYS, "must be in 1..67108864", 0,
+         "rays of the first Jacobi iteration, later ones in proportion to their power; walks per\n"
+         "batch (default 64 per patch)"),
+    UINT("--sr-iterations", "N", sr_iterations, 1, 1000000, TOOL_OPT_SR_ITERATIONS, "must be in 1..1000000", 0,
+         "Jacobi: shooting iterations at most (default 256; they stop when the unshot power is below\n"
+         "1e-4 of the source); walk: batches averaged (default 1)"),
+    TEXT(0, "vp (clustered virtual patches) and aavp (axis-aligned virtual patches); any mesh size, no\n"
+            "per-triangle patches (--patches etc. are ignored); indirect light gathered per pixel from\n"
+            "the voxel grid:\n"),
+    UINT("--vp-resolution", "R", vp_resolution, 1, 1024, TOOL_OPT_VP_RESOLUTION, "must be in 1..1024", 0,
+         "voxels along the longest axis of the scene (default 16)"),
+    UINT("--vp-max-patches", "B", vp_max_patches, 1, 1000000, TOOL_OPT_VP_MAX_PATCHES, "must be in 1..1000000", R,
+         "the finest resolution whose patch count is at most B (replaces --vp-resolution; found\n"
+         "by counting at predicted resolutions, one build)"),
+    UINT("--face-points", "P", face_points, 1, 4096, TOOL_OPT_FACE_POINTS, "must be in 1..4096", 0,
+         "Hammersley points per voxel face (default 16)"),
+    CHOICE("--proxy", "P", proxy, "patches|aavp|vp", proxy_values, TOOL_OPT_PROXY, R,
+           "multibounce, temporal, local, lightmap: run over patches (default), aavp or vp (virtual\n"
+           "patches with sparse rows, built with --vp-resolution etc.; E at their samples, the\n"
+           "indirect light gathered per pixel as --method aavp)"),
+    TEXT(R, "local (local multi-bounce matrix; classic patches and F, T = (I - rho F_S)^-1 - I\n"
+            "of the set S, the full solution within S; render only):\n"),
+    UINT("--local-m", "M", local_m, 1, 1000000, TOOL_OPT_LOCAL_M, "must be in 1..1000000", R,
+         "capacity: S = the M patches nearest the camera (default: every patch, up to 4096: T takes\n"
+         "12 M^2 bytes, 192 MiB at 4096, and its rebuild 6 M^3 flops). L = T E over P_Vis x P_Lit:\n"
+         "patches outside S (or not visible) get no indirect light and light outside S is not bounced"),
+    TEXT(0, "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement,\n"
+            "solved to convergence; --bounces is not used; a bake resamples it onto the patches):\n"),
+    FLOAT("--hr-eps", "E", hr_eps, 0.0, 1.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, TOOL_OPT_HR_EPS,
+          "must be in (0, 1) (e.g. 1e-3)", 0, "refinement tolerance, a fraction of the source power (default 1e-5)"),
+    FLOAT("--hr-min-area", "A", hr_min_area, 0.0, 1e30, TOOL_ARG_LO_OPEN, TOOL_OPT_HR_MIN_AREA,
+          "must be a positive area", 0, "smallest element area, scene units^2 (default: total area / 10000)"),
+    CUSTOM("--hr-rays", "R", hr_rays, parse_hr_rays, TOOL_OPT_HR_RAYS, 0,
+           "points and visibility rays per link: 1, 4, 9 ... 64 (default 4)"),
+    {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
+};
+#undef R
+#undef B
 
 const char *tool_method_help(int render)
 {
-    static char buf[8192];
-    snprintf(buf, sizeof buf, render ? "multibounce and temporal (without --bake: baked here first; with --bake the bake's own):\n"
-                    "  --bounces K|inf    multibounce, temporal --mode multibounce: bounces of the patch solution\n"
-                    "                     (as classic: the image of K equals classic --bounces K; default 64)\n"
-                    "  --format F         multibounce: F_mb storage float, half, bc1 or bc4x3 (default)\n"
-                    "  --outliers P       multibounce bc1/bc4x3: fraction of entries kept exactly (default 0.05)\n"
-                    "  --reorder, --no-reorder   multibounce bc1/bc4x3: row/column reordering (default on)\n"
-                    "  --reorder-samples N   reordering distances on N coordinates (default 0: all)\n"
-                    "  --tile T           multibounce bc1/bc4x3: scales per T x T texels, 0: per matrix (default 64)\n"
-                    "  --mode M           temporal: feedback (default, converges to L_inf), single (one bounce)\n"
-                    "                     or multibounce (alias tables over the channels of F_mb)\n"
-                    "temporal (these override the bake's; the defaults give a still image within 0.001 SSIM\n"
-                    "of classic on the Cornell box):\n"
-                    "  --frames N         frames to step; the image shows the last (default 1024)\n"
-                    "  --k K              draws per patch and frame (default 10)\n"
-                    "  --adaptive         per-patch blend weight from the estimator's variance (the default: B is\n"
-                    "                     the running mean of the frames at first, so it converges fast)\n"
-                    "  --w W              a fixed blend weight in [0, 1) instead (B starts at 0 and reaches\n"
-                    "                     1 - W^N of the solution after N frames: W 0.998 needs ~2300 for 99%%)\n"
-                    "  --seed S           generator seed (default 0; also the path tracer's seed)\n"
-                    "  --sequence DIR     also write DIR/frame_NNNNN.png every --every N frames (default 1)\n"
-                    "vp (clustered virtual patches) and aavp (axis-aligned virtual patches); any mesh size, no\n"
-                    "per-triangle patches (--patches etc. are ignored); --bounces K|inf as classic (Jacobi; inf:\n"
-                    "Gauss-Seidel to 1e-6); indirect light gathered per pixel from the voxel grid:\n"
-                    "  --vp-resolution R  voxels along the longest axis of the scene (default 16)\n"
-                    "  --vp-max-patches B the finest resolution whose patch count is at most B (replaces\n"
-                    "                     --vp-resolution; found by building at predicted resolutions, <= 6 builds)\n"
-                    "  --face-points P    Hammersley points per voxel face (default 16)\n"
-                    "  --proxy P          multibounce, temporal, local, lightmap: run over patches (default), aavp or vp\n"
-                    "                     (virtual patches with sparse rows, built with --vp-resolution etc.;\n"
-                    "                     E at their samples, the indirect light gathered per pixel as --method aavp)\n"
-                    "%s"
-                    "local (local multi-bounce matrix; classic patches and F, T = (I - rho F_S)^-1 - I\n"
-                    "of the set S, the full solution within S; render only):\n"
-                    "  --local-m M        capacity: S = the M patches nearest the camera (default: every patch,\n"
-                    "                     up to 4096: T takes 12 M^2 bytes, 192 MiB at 4096, and its rebuild\n"
-                    "                     6 M^3 flops). L = T E over P_Vis x P_Lit: patches outside S (or not\n"
-                    "                     visible) get no indirect light and light outside S is not bounced\n"
-                    "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement, solved\n"
-                    "to convergence; --patches etc. and --bounces are not used; render only):\n"
-                    "  --hr-eps E         refinement tolerance, a fraction of the source power (default 1e-5)\n"
-                    "  --hr-min-area A    smallest element area, scene units^2 (default: total area / 10000)\n"
-                    "  --hr-rays R        points and visibility rays per link: 1, 4, 9 ... 64 (default 4)\n"
-                    "lightmap (the classic solution baked into a lightmap over the second uv set, else the\n"
-                    "automatic unwrap, as rad lightmap; direct light per pixel, the indirect light a bilinear\n"
-                    "lookup of the lightmap; render only):\n"
-                    "  --lightmap-size N  atlas side (default 256, or the least power of two to 4096 the\n"
-                    "                     unwrap's charts fit); --texel-samples N (default 4),\n"
-                    "                     --visibility-rays N (default 2) as rad lightmap; --proxy aavp|vp: the\n"
-                    "                     indirect light from virtual patches (--vp-resolution R, --face-points P),\n"
-                    "                     for scenes the dense classic build cannot hold\n"
-                    "%s"
-                  : "%.0smultibounce:\n"
-                    "  --bounces K|inf    bounces of the patch solution as classic --bounces (F_mb holds K+1,\n"
-                    "                     the renderer's gather; default 64)\n"
-                    "  --format F         F_mb storage: float, half, bc1 or bc4x3 (default)\n"
-                    "  --outliers P       bc1/bc4x3: fraction of the entries kept exactly (default 0.05)\n"
-                    "  --reorder, --no-reorder   bc1/bc4x3: row/column reordering (default on)\n"
-                    "  --reorder-samples N   reordering distances on N coordinates (default 0: all)\n"
-                    "  --tile T           bc1/bc4x3: scales per T x T texels (multiple of 4), 0: per matrix (default 64)\n"
-                    "temporal (alias tables; k, w, adaptive and seed are the render's defaults):\n"
-                    "  --mode M           feedback (default: samples E + B, converges to L_inf), single (one\n"
-                    "                     bounce) or multibounce (tables over F_mb's channels, with --bounces)\n"
-                    "  --k K              draws per patch and frame (default 10)\n"
-                    "  --adaptive         per-patch blend weight from the estimator's variance (default)\n"
-                    "  --w W              a fixed blend weight in [0, 1) instead of the adaptive one\n"
-                    "  --seed S           generator seed (default 0)\n"
-                    "%s", light_path_help, stochastic_help);
-    return buf;
+    static char buf[2][12288];
+    char *b = buf[render ? 0 : 1];
+    tool_args_help_into(method_args, render ? TOOL_METHOD_HELP_RENDER : TOOL_METHOD_HELP_BAKE, b, sizeof buf[0]);
+    return b;
 }
 
-/* --proxy patches|aavp|vp: 1 taken, 2 bad value, 0 not this option */
-static int proxy_option(const char *cmd, int argc, char **argv, int *a, tool_method_options *mo)
+int tool_method_option(const char *cmd, int argc, char **argv, int *a, tool_method_options *mo)
 {
-    const char *v;
-    if (strcmp(argv[*a], "--proxy")) return 0;
-    if (*a + 1 >= argc) {
-        fprintf(stderr, "rad %s: --proxy needs a value (patches, aavp or vp)\n", cmd);
-        return 2;
-    }
-    v = argv[++*a];
-    if (!strcmp(v, "patches")) mo->proxy = TOOL_PROXY_PATCHES;
-    else if (!strcmp(v, "aavp")) mo->proxy = TOOL_PROXY_AAVP;
-    else if (!strcmp(v, "vp")) mo->proxy = TOOL_PROXY_VP;
-    else {
-        fprintf(stderr, "rad %s: unknown --proxy '%s' (patches, aavp or vp)\n", cmd, v);
-        return 2;
-    }
-    mo->given |= TOOL_OPT_PROXY;
-    return 1;
+    return tool_args_parse(cmd, method_args, mo, &mo->given, argc, argv, a);
 }
 
-static const char *given_name(uint32_t bits);
+/* the first option of 'bits' that was given */
+static const char *given_name(uint32_t bits)
+{
+    static const char *const names[] = {"--bounces", "--format", "--outliers", "--reorder/--no-reorder",
+                                        "--reorder-samples", "--tile", "--mode", "--k", "--w", "--adaptive",
+                                        "--seed", "--frames", "--sequence", "--every", "--method",
+                                        "--vp-resolution", "--vp-max-patches", "--face-points", "--local-m",
+                                        "--sr-rays", "--sr-iterations", "--sr-estimator",
+                                        "--hr-eps", "--hr-min-area", "--hr-rays", "--light-path", "--light-rays"};
+    uint32_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (bits & (1u << i)) return names[i];
+    return "?";
+}
 
 /* --proxy aavp|vp: render only, with multibounce, temporal, local or lightmap; the proxy's F_mb is
    float and its frames are not written one by one, so the options for those are refused */
@@ -231,273 +345,6 @@ static int proxy_check(const char *cmd, int render, const tool_method_options *m
         return 2;
     }
     return 0;
-}
-
-int tool_method_option(const char *cmd, int argc, char **argv, int *a, tool_method_options *mo)
-{
-    static const char *const names[] = {"--method", "--bounces", "--format",    "--outliers", "--reorder-samples",
-                                        "--tile",   "--mode",    "--k",         "--w",        "--seed",
-                                        "--frames", "--sequence", "--every",    "--reorder",  "--no-reorder",
-                                        "--adaptive"};
-    const char *opt = argv[*a], *v;
-    size_t i;
-    if (!strcmp(opt, "--sr-rays") || !strcmp(opt, "--sr-iterations") || !strcmp(opt, "--sr-estimator")) {
-        int which = opt[5] == 'r' ? 0 : opt[5] == 'i' ? 1 : 2;
-        if (*a + 1 >= argc) {
-            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-            return 2;
-        }
-        v = argv[++*a];
-        if (which == 2) {
-            if (!strcmp(v, "jacobi")) mo->sr_estimator = RAD_STOCHASTIC_JACOBI;
-            else if (!strcmp(v, "walk")) mo->sr_estimator = RAD_STOCHASTIC_WALK;
-            else {
-                fprintf(stderr, "rad %s: unknown --sr-estimator '%s' (jacobi or walk)\n", cmd, v);
-                return 2;
-            }
-        } else {
-            uint32_t *dst = which ? &mo->sr_iterations : &mo->sr_rays, hi = which ? 1000000u : (1u << 26);
-            if (tool_parse_uint(cmd, opt, v, dst)) return 2;
-            if (*dst == 0 || *dst > hi) {
-                fprintf(stderr, "rad %s: %s must be in 1..%u, not %s\n", cmd, opt, hi, v);
-                return 2;
-            }
-        }
-        mo->given |= TOOL_OPT_SR_RAYS << which;
-        return 1;
-    }
-    if (!strcmp(opt, "--light-path") || !strcmp(opt, "--light-rays")) {
-        if (*a + 1 >= argc) {
-            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-            return 2;
-        }
-        v = argv[++*a];
-        if (opt[8] == 'r') {
-            if (tool_parse_uint(cmd, opt, v, &mo->light_rays)) return 2;
-            mo->given |= TOOL_OPT_LIGHT_RAYS;
-            return 1;
-        }
-        {
-            float *q = mo->path;
-            char tail;
-            int ok = 0;
-            memset(mo->path, 0, sizeof mo->path);
-            if (!strncmp(v, "line:", 5))
-                ok = sscanf(v + 5, "%f,%f,%f:%f,%f,%f%c", q, q + 1, q + 2, q + 3, q + 4, q + 5, &tail) == 6, mo->light_path = 1;
-            else if (!strncmp(v, "circle:", 7))
-                ok = sscanf(v + 7, "%f,%f,%f:%f%c", q, q + 1, q + 2, q + 3, &tail) == 4 && q[3] > 0.0f, mo->light_path = 2;
-            ok = ok && !tool_vector_problem(q, 0) && !tool_vector_problem(q + 3, 0); /* finite, within 1e30 */
-            if (!ok) {
-                fprintf(stderr, "rad %s: --light-path must be line:X0,Y0,Z0:X1,Y1,Z1 or circle:CX,CY,CZ:R (R > 0), not '%s'\n",
-                        cmd, v);
-                return 2;
-            }
-        }
-        mo->given |= TOOL_OPT_LIGHT_PATH;
-        return 1;
-    }
-    if (!strcmp(opt, "--hr-eps") || !strcmp(opt, "--hr-min-area") || !strcmp(opt, "--hr-rays")) {
-        if (*a + 1 >= argc) {
-            fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-            return 2;
-        }
-        v = argv[++*a];
-        if (opt[5] == 'r') {
-            uint32_t n = 1;
-            if (tool_parse_uint(cmd, opt, v, &mo->hr_rays)) return 2;
-            while (n * n < mo->hr_rays) ++n;
-            if (mo->hr_rays == 0 || mo->hr_rays > 64 || n * n != mo->hr_rays) {
-                fprintf(stderr, "rad %s: --hr-rays must be a square from 1 to 64 (1, 4, 9 ...), not %s\n", cmd, v);
-                return 2;
-            }
-            mo->given |= TOOL_OPT_HR_RAYS;
-        } else if (opt[5] == 'e') {
-            if (tool_parse_float(cmd, opt, v, &mo->hr_eps)) return 2;
-            if (!(mo->hr_eps > 0.0f && mo->hr_eps < 1.0f)) {
-                fprintf(stderr, "rad %s: --hr-eps must be in (0, 1) (e.g. 1e-3), not %s\n", cmd, v);
-                return 2;
-            }
-            mo->given |= TOOL_OPT_HR_EPS;
-        } else {
-            if (tool_parse_float(cmd, opt, v, &mo->hr_min_area)) return 2;
-            if (!(mo->hr_min_area > 0.0f) || mo->hr_min_area > 1e30f) {
-                fprintf(stderr, "rad %s: --hr-min-area must be a positive area, not %s\n", cmd, v);
-                return 2;
-            }
-            mo->given |= TOOL_OPT_HR_MIN_AREA;
-        }
-        return 1;
-    }
-    {
-        int pr = proxy_option(cmd, argc, argv, a, mo);
-        if (pr) return pr;
-    }
-    {
-        static const char *const extra[] = {"--vp-resolution", "--vp-max-patches", "--face-points", "--local-m"};
-        for (i = 0; i < 4; ++i)
-            if (!strcmp(opt, extra[i])) break;
-        if (i < 4) {
-            uint32_t *dst = i == 0 ? &mo->vp_resolution : i == 1 ? &mo->vp_max_patches
-                          : i == 2 ? &mo->face_points : &mo->local_m;
-            uint32_t hi = i == 0 ? 1024u : i == 1 ? 1000000u : i == 2 ? 4096u : 1000000u;
-            if (*a + 1 >= argc) {
-                fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-                return 2;
-            }
-            v = argv[++*a];
-            if (tool_parse_uint(cmd, opt, v, dst)) return 2;
-            if (*dst == 0 || *dst > hi) {
-                fprintf(stderr, "rad %s: %s must be in 1..%u, not %s\n", cmd, opt, hi, v);
-                return 2;
-            }
-            mo->given |= TOOL_OPT_VP_RESOLUTION << i;
-            return 1;
-        }
-    }
-    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
-        if (!strcmp(opt, names[i])) break;
-    if (i == sizeof names / sizeof names[0]) return 0;
-    if (i >= 13) { /* flags */
-        if (i == 15) mo->adaptive = 1, mo->given |= TOOL_OPT_ADAPTIVE;
-        else mo->reorder = i == 13 ? RAD_REORDER_MATCH : RAD_REORDER_NONE, mo->given |= TOOL_OPT_REORDER;
-        return 1;
-    }
-    if (*a + 1 >= argc) {
-        fprintf(stderr, "rad %s: %s needs a value\n", cmd, opt);
-        return 2;
-    }
-    v = argv[++*a];
-    switch (i) {
-    case 0:
-        if (!strcmp(v, "classic")) mo->method = TOOL_CLASSIC;
-        else if (!strcmp(v, "multibounce")) mo->method = TOOL_MULTIBOUNCE;
-        else if (!strcmp(v, "temporal")) mo->method = TOOL_TEMPORAL;
-        else if (!strcmp(v, "pathtrace")) mo->method = TOOL_PATHTRACE;
-        else if (!strcmp(v, "local")) mo->method = TOOL_LOCAL;
-        else if (!strcmp(v, "vp")) mo->method = TOOL_VP;
-        else if (!strcmp(v, "aavp")) mo->method = TOOL_AAVP;
-        else if (!strcmp(v, "stochastic")) mo->method = TOOL_STOCHASTIC;
-        else if (!strcmp(v, "hierarchical")) mo->method = TOOL_HIERARCHICAL;
-        else if (!strcmp(v, "lightmap")) mo->method = TOOL_LIGHTMAP;
-        else {
-            fprintf(stderr, "rad %s: unknown method '%s' (classic, multibounce, temporal, stochastic%s)\n", cmd, v,
-                    strcmp(cmd, "render") ? "" : ", pathtrace, local, vp, aavp, hierarchical or lightmap");
-            return 2;
-        }
-        mo->given |= TOOL_OPT_METHOD;
-        return 1;
-    case 1:
-        mo->given |= TOOL_OPT_BOUNCES;
-        if (!strcmp(v, "inf")) {
-            mo->bounces = RAD_MB_INFINITE;
-            return 1;
-        }
-        if (tool_parse_uint(cmd, opt, v, &mo->bounces)) return 2;
-        if (mo->bounces >= 0xFFFFFFF0u) {
-            fprintf(stderr, "rad %s: --bounces %s is too large (use 'inf' for the full solution)\n", cmd, v);
-            return 2;
-        }
-        return 1;
-    case 2: {
-        uint32_t f;
-        for (f = 0; f < 4; ++f)
-            if (!strcmp(v, format_name(f))) break;
-        if (f == 4) {
-            fprintf(stderr, "rad %s: unknown --format '%s' (float, half, bc1 or bc4x3)\n", cmd, v);
-            return 2;
-        }
-        mo->format = f;
-        mo->given |= TOOL_OPT_FORMAT;
-        return 1;
-    }
-    case 3:
-        if (tool_parse_float(cmd, opt, v, &mo->outliers)) return 2;
-        if (!(mo->outliers >= 0.0f && mo->outliers < 1.0f)) {
-            fprintf(stderr, "rad %s: --outliers must be a fraction in [0, 1) (e.g. 0.05), not %s\n", cmd, v);
-            return 2;
-        }
-        mo->given |= TOOL_OPT_OUTLIERS;
-        return 1;
-    case 4:
-        mo->given |= TOOL_OPT_REORDER_SAMPLES;
-        return tool_parse_uint(cmd, opt, v, &mo->reorder_samples) ? 2 : 1;
-    case 5:
-        if (tool_parse_uint(cmd, opt, v, &mo->tile)) return 2;
-        if (mo->tile % 4 != 0) {
-            fprintf(stderr, "rad %s: --tile must be a multiple of 4 (0: one scale per matrix), not %s\n", cmd, v);
-            return 2;
-        }
-        mo->given |= TOOL_OPT_TILE;
-        return 1;
-    case 6:
-        if (!strcmp(v, "feedback")) mo->mode = RAD_TEMPORAL_FEEDBACK;
-        else if (!strcmp(v, "single")) mo->mode = RAD_TEMPORAL_SINGLE;
-        else if (!strcmp(v, "multibounce")) mo->mode = RAD_TEMPORAL_MULTIBOUNCE;
-        else {
-            fprintf(stderr, "rad %s: unknown --mode '%s' (feedback, single or multibounce)\n", cmd, v);
-            return 2;
-        }
-        mo->given |= TOOL_OPT_MODE;
-        return 1;
-    case 7:
-        if (tool_parse_uint(cmd, opt, v, &mo->k)) return 2;
-        if (mo->k == 0 || mo->k > 65536) {
-            fprintf(stderr, "rad %s: --k must be in 1..65536, not %s\n", cmd, v);
-            return 2;
-        }
-        mo->given |= TOOL_OPT_K;
-        return 1;
-    case 8:
-        if (tool_parse_float(cmd, opt, v, &mo->w)) return 2;
-        if (!(mo->w >= 0.0f && mo->w < 1.0f)) {
-            fprintf(stderr, "rad %s: --w must be in [0, 1), not %s\n", cmd, v);
-            return 2;
-        }
-        mo->given |= TOOL_OPT_W;
-        return 1;
-    case 9:
-        mo->given |= TOOL_OPT_SEED;
-        return tool_parse_uint(cmd, opt, v, &mo->seed) ? 2 : 1;
-    case 10:
-        if (tool_parse_uint(cmd, opt, v, &mo->frames)) return 2;
-        if (mo->frames == 0 || mo->frames > 10000000u) {
-            fprintf(stderr, "rad %s: --frames must be in 1..10000000, not %s\n", cmd, v);
-            return 2;
-        }
-        mo->given |= TOOL_OPT_FRAMES;
-        return 1;
-    case 11:
-        if (!*v) {
-            fprintf(stderr, "rad %s: --sequence needs a directory\n", cmd);
-            return 2;
-        }
-        mo->sequence = v;
-        mo->given |= TOOL_OPT_SEQUENCE;
-        return 1;
-    default:
-        if (tool_parse_uint(cmd, opt, v, &mo->every)) return 2;
-        if (mo->every == 0) {
-            fprintf(stderr, "rad %s: --every must be > 0\n", cmd);
-            return 2;
-        }
-        mo->given |= TOOL_OPT_EVERY;
-        return 1;
-    }
-}
-
-/* the first option of 'bits' that was given */
-static const char *given_name(uint32_t bits)
-{
-    static const char *const names[] = {"--bounces", "--format", "--outliers", "--reorder/--no-reorder",
-                                        "--reorder-samples", "--tile", "--mode", "--k", "--w", "--adaptive",
-                                        "--seed", "--frames", "--sequence", "--every", "--method",
-                                        "--vp-resolution", "--vp-max-patches", "--face-points", "--local-m",
-                                        "--sr-rays", "--sr-iterations", "--sr-estimator",
-                                        "--hr-eps", "--hr-min-area", "--hr-rays", "--light-path", "--light-rays"};
-    uint32_t i;
-    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
-        if (bits & (1u << i)) return names[i];
-    return "?";
 }
 
 int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool_classic_options *o)
@@ -636,6 +483,41 @@ int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool
     return 0;
 }
 
+/* The dense build's cost per method (the check itself, tool_dense_check, is budget.c's: it
+   knows no method, so that budget.c, classic.c and methods.c call one way only). */
+void tool_dense_plan(tool_classic_options *o, const tool_method_options *mo, int bake)
+{
+    double per = 4.0; /* F */
+    o->dense_local_m = 0;
+    o->dense_method = tool_method_name(mo->method);
+    o->dense_cubic = 0.0;
+    switch (mo->method) {
+    case TOOL_MULTIBOUNCE:
+        per += mo->format == TOOL_MB_HALF ? 22.0 : 28.0;
+        o->dense_cubic = 2.0 * ceil(log2((double)(mo->bounces > 1024u ? 1024u : mo->bounces) + 2.0));
+        break;
+    case TOOL_TEMPORAL:
+        if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
+            per += 28.0 + 3.0 * 12.0;
+            o->dense_cubic = 2.0 * ceil(log2((double)(mo->bounces > 1024u ? 1024u : mo->bounces) + 2.0));
+        } else {
+            per += 12.0;
+        }
+        break;
+    case TOOL_LOCAL:
+        o->dense_local_m = mo->local_m ? mo->local_m : TOOL_LOCAL_M_AUTO_MAX;
+        break;
+    default:
+        if (o->solver == TOOL_DIRECT) {
+            per += 8.0;
+            o->dense_cubic = 1.0 / 3.0;
+        }
+        if (bake) per += 8.0; /* the container buffer and the file's copy of F */
+        break;
+    }
+    o->dense_bytes_per_n2 = per;
+}
+
 /* ---- bake ---------------------------------------------------------------------------------- */
 
 /* --method stochastic builds no F, so the row sums S_i = sum_j F_ij (the part of patch i's
@@ -733,216 +615,228 @@ static rad_result hierarchical_to_patches(const rad_hierarchical *h, const rad_s
     return RAD_SUCCESS;
 }
 
-int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_options *o,
-                         const tool_method_options *mo, void **out, size_t *out_size)
-{
-    tool_classic_options so = *o;
-    tool_classic c;
-    rad_context ctx;
-    rad_result r = RAD_SUCCESS;
-    rad_multibounce *mb = NULL;
-    rad_multibounce_blocks *blocks = NULL;
-    rad_alias_tables *tables[3] = {NULL, NULL, NULL};
-    rad_block_report report;
-    tool_bake_info info;
-    rad_bake_signature sig;
+/* tool_method_bake's state: what each stage builds, freed together by method_bake_free */
+typedef struct method_bake {
+    const char *cmd;
+    const tool_world *w;
+    const tool_method_options *mo;
+    tool_classic c;                /* patches, D and E (F unless no_form_factors) */
+    uint32_t n;
+    float *S;                      /* row sums of F */
+    float *L;                      /* stochastic, hierarchical: the solution */
+    rad_multibounce *mb;
+    rad_multibounce_blocks *blocks;
+    rad_alias_tables *tables[3];
     tool_method_info mi;
-    rad_container *ct = NULL;
-    rad_section *secs = NULL;
-    void *base = NULL, *dst = NULL;
-    size_t base_size = 0, dst_size = 0, bytes = 0;
-    uint32_t n, i, k = 0, count;
-    float *ones = NULL, *rows3 = NULL, *S = NULL, *L = NULL;
-    double t0;
-    const char *what = NULL;
-    int rc = 1;
+    size_t bytes;                  /* what the render reads (see tool_method_info) */
+    rad_result r;                  /* the failing call's result */
+} method_bake;
 
-    *out = NULL;
-    *out_size = 0;
-    so.sources_only = 1;
-    so.no_form_factors = mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL;
-    if (tool_classic_solve(cmd, w, &so, &c)) return 1;
-    n = c.patches->count;
+/* the row sums S of F for the halo correction: F times ones, or by rays without F */
+static const char *method_bake_rowsums(method_bake *b, int no_form_factors)
+{
+    uint32_t i, n = b->n;
+    float *ones, *rows3;
+    rad_context ctx;
+    b->S = (float *)tool_calloc(n, sizeof(float));
+    if (no_form_factors) {
+        b->r = stochastic_rowsums(b->w, b->c.patches, b->S);
+        return b->r != RAD_SUCCESS ? "row sums by rays" : NULL;
+    }
     tool_context(&ctx, NULL);
-
-    /* row sums of F for the halo correction */
     ones = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     rows3 = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-    S = (float *)tool_calloc(n, sizeof(float));
-    if (so.no_form_factors) {
-        if ((r = stochastic_rowsums(w, c.patches, S)) != RAD_SUCCESS) {
-            what = "row sums by rays";
-            goto fail;
-        }
-    } else {
-        for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
-        if ((r = rad_matrix_multiply(&c.ff->matrix, ones, rows3, &ctx)) != RAD_SUCCESS) {
-            what = "rad_matrix_multiply";
-            goto fail;
-        }
-        for (i = 0; i < n; ++i) S[i] = rows3[3 * i];
-    }
+    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
+    b->r = rad_matrix_multiply(&b->c.ff->matrix, ones, rows3, &ctx);
+    for (i = 0; i < n; ++i) b->S[i] = rows3[3 * i];
+    free(ones);
+    free(rows3);
+    return b->r != RAD_SUCCESS ? "rad_matrix_multiply" : NULL;
+}
 
-    memset(&mi, 0, sizeof mi);
-    mi.magic = TOOL_METHOD_MAGIC;
-    mi.method = (uint32_t)mo->method;
-    mi.bounces = mo->bounces;
-    mi.format = mo->format;
-    mi.outliers = mo->outliers;
-    mi.reorder = mo->reorder == RAD_REORDER_NONE ? 0u : (uint32_t)mo->reorder; /* the record: 0 is no reordering */
-    mi.reorder_samples = mo->reorder_samples;
-    mi.tile = mo->tile;
-    mi.mode = (uint32_t)mo->mode;
-    mi.k = mo->k;
-    mi.w = mo->w;
-    mi.adaptive = (uint32_t)mo->adaptive;
-    mi.seed = mo->seed;
+/* the rad.method record of mo (the stages add what they built) */
+static void method_bake_record(method_bake *b)
+{
+    const tool_method_options *mo = b->mo;
+    tool_method_info *mi = &b->mi;
+    memset(mi, 0, sizeof *mi);
+    mi->magic = TOOL_METHOD_MAGIC;
+    mi->method = (uint32_t)mo->method;
+    mi->bounces = mo->bounces;
+    mi->format = mo->format;
+    mi->outliers = mo->outliers;
+    mi->reorder = mo->reorder == RAD_REORDER_NONE ? 0u : (uint32_t)mo->reorder; /* the record: 0 is no reordering */
+    mi->reorder_samples = mo->reorder_samples;
+    mi->tile = mo->tile;
+    mi->mode = (uint32_t)mo->mode;
+    mi->k = mo->k;
+    mi->w = mo->w;
+    mi->adaptive = (uint32_t)mo->adaptive;
+    mi->seed = mo->seed;
     if (mo->method == TOOL_STOCHASTIC) {
-        mi.k = mo->sr_rays;
-        mi.bounces = mo->sr_iterations;
-        mi.mode = mo->sr_estimator;
+        mi->k = mo->sr_rays;
+        mi->bounces = mo->sr_iterations;
+        mi->mode = mo->sr_estimator;
     }
+}
 
-    t0 = tool_seconds();
-    if (mo->method == TOOL_MULTIBOUNCE ||
-        (mo->method == TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)) {
-        rad_multibounce_options mbo;
-        rad_multibounce_options_default(&mbo);
-        mbo.bounces = mb_bounces(mo->bounces);
-        mbo.precision = mo->method == TOOL_MULTIBOUNCE && mo->format == TOOL_MB_HALF ? RAD_MB_HALF : RAD_MB_FLOAT;
-        tool_context(&ctx, "F_mb");
-        r = rad_multibounce_create(&c.ff->matrix, c.patches->albedo, &mbo, &ctx, &mb);
-        tool_progress_end();
-        tool_context(&ctx, NULL);
-        if (r != RAD_SUCCESS) {
-            what = "rad_multibounce_create";
-            goto fail;
-        }
-        if (mbo.bounces == RAD_MB_INFINITE)
-            fprintf(stderr, "rad %s: F_mb (inf bounces, %s) built in %.2f s\n", cmd,
-                    mbo.precision == RAD_MB_HALF ? "half" : "float", tool_seconds() - t0);
-        else
-            fprintf(stderr, "rad %s: F_mb (%u bounces: --bounces %u and the renderer's gather, %s) built in %.2f s\n",
-                    cmd, mbo.bounces, mo->bounces, mbo.precision == RAD_MB_HALF ? "half" : "float",
-                    tool_seconds() - t0);
+/* F_mb of --bounces K (K + 1 built: the renderer's gather), for multibounce and temporal --mode
+   multibounce */
+static const char *method_bake_fmb(method_bake *b, double t0)
+{
+    const tool_method_options *mo = b->mo;
+    rad_multibounce_options mbo;
+    rad_context ctx;
+    rad_multibounce_options_default(&mbo);
+    mbo.bounces = mb_bounces(mo->bounces);
+    mbo.precision = mo->method == TOOL_MULTIBOUNCE && mo->format == TOOL_MB_HALF ? RAD_MB_HALF : RAD_MB_FLOAT;
+    tool_context(&ctx, "F_mb");
+    b->r = rad_multibounce_create(&b->c.ff->matrix, b->c.patches->albedo, &mbo, &ctx, &b->mb);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "rad_multibounce_create";
+    if (mbo.bounces == RAD_MB_INFINITE)
+        fprintf(stderr, "rad %s: F_mb (inf bounces, %s) built in %.2f s\n", b->cmd,
+                mbo.precision == RAD_MB_HALF ? "half" : "float", tool_seconds() - t0);
+    else
+        fprintf(stderr, "rad %s: F_mb (%u bounces: --bounces %u and the renderer's gather, %s) built in %.2f s\n",
+                b->cmd, mbo.bounces, mo->bounces, mbo.precision == RAD_MB_HALF ? "half" : "float", tool_seconds() - t0);
+    return NULL;
+}
+
+/* multibounce: F_mb as stored: compressed (bc1, bc4x3) with its error report, or float/half */
+static const char *method_bake_store_fmb(method_bake *b)
+{
+    const tool_method_options *mo = b->mo;
+    rad_block_options bo;
+    rad_block_report report;
+    rad_context ctx;
+    double t1 = tool_seconds();
+    if (mo->format < TOOL_MB_BC1) {
+        b->bytes = (size_t)3 * b->n * b->n * (mo->format == TOOL_MB_HALF ? 2u : 4u);
+        fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", b->cmd, format_name(mo->format), (unsigned long)b->bytes);
+        return NULL;
     }
-    if (mo->method == TOOL_MULTIBOUNCE) {
-        if (mo->format >= TOOL_MB_BC1) {
-            rad_block_options bo;
-            double t1 = tool_seconds();
-            rad_block_options_default(&bo);
-            bo.format = mo->format == TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
-            bo.outlier_fraction = mo->outliers > 0.0f ? mo->outliers : -1.0f; /* --outliers 0: none */
-            bo.reorder = mo->reorder;
-            bo.reorder_samples = mo->reorder_samples;
-            bo.tile = mo->tile ? mo->tile : RAD_BLOCK_WHOLE_MATRIX; /* --tile 0: one scale per matrix */
-            memset(&report, 0, sizeof report);
-            tool_context(&ctx, "compression");
-            r = rad_multibounce_blocks_create(mb, &bo, &ctx, &blocks, &report);
-            tool_progress_end();
-            tool_context(&ctx, NULL);
-            if (r != RAD_SUCCESS) {
-                what = "rad_multibounce_blocks_create";
-                goto fail;
-            }
-            bytes = report.bytes_total;
-            mi.mse = (float)report.mse;
-            mi.max_abs_error = (float)report.max_abs_error;
-            mi.source_mean_square = (float)report.source_mean_square;
-            fprintf(stderr,
-                    "rad %s: compressed to %s in %.2f s: %lu bytes (blocks %lu, scales %lu, %llu outliers %lu, "
-                    "permutations %lu) vs %lu float F_mb, %.1fx; decoded-matrix RMS error %.3g (%.3g%% of the "
-                    "RMS entry), max %.3g\n",
-                    cmd, format_name(mo->format), tool_seconds() - t1, (unsigned long)report.bytes_total,
-                    (unsigned long)report.bytes_blocks, (unsigned long)report.bytes_scales,
-                    (unsigned long long)report.outlier_count, (unsigned long)report.bytes_outliers,
-                    (unsigned long)report.bytes_permutations, (unsigned long)report.bytes_float_mb,
-                    report.bytes_total ? (double)report.bytes_float_mb / (double)report.bytes_total : 0.0,
-                    sqrt(report.mse),
-                    report.source_mean_square > 0.0 ? 100.0 * sqrt(report.mse / report.source_mean_square) : 0.0,
-                    report.max_abs_error);
-        } else {
-            bytes = (size_t)3 * n * n * (mo->format == TOOL_MB_HALF ? 2u : 4u);
-            fprintf(stderr, "rad %s: F_mb %s: %lu bytes\n", cmd, format_name(mo->format), (unsigned long)bytes);
-        }
-    } else if (mo->method == TOOL_HIERARCHICAL) {
-        rad_hierarchical *h = NULL;
-        rad_hierarchical_stats st;
-        if (tool_hierarchical_build(cmd, w, mo, o->light_samples, &h)) goto fail;
-        L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-        r = hierarchical_to_patches(h, w->scene, c.patches, L);
-        rad_hierarchical_get_stats(h, &st);
-        rad_hierarchical_destroy(h);
-        if (r != RAD_SUCCESS) {
-            what = "rad_hierarchical_lookup";
-            goto fail;
-        }
-        bytes = (size_t)st.links; /* the record's byte count holds the links here */
-        mi.k = st.leaves;
-        mi.bounces = st.rounds;
-        mi.w = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5f;
-    } else if (mo->method == TOOL_STOCHASTIC) {
-        rad_stochastic_options sto;
-        rad_stochastic_stats st;
-        rad_stochastic_options_default(&sto);
-        sto.method = (rad_stochastic_method)mo->sr_estimator;
-        sto.rays = mo->sr_rays;
-        sto.iterations = mo->sr_iterations;
-        sto.seed = mo->seed;
-        L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
-        tool_context(&ctx, "stochastic radiosity");
-        r = rad_solve_stochastic(c.patches, &w->rc, c.E, &sto, L, &st, &ctx);
-        tool_progress_end();
-        tool_context(&ctx, NULL);
-        if (r != RAD_SUCCESS) {
-            what = "rad_solve_stochastic";
-            goto fail;
-        }
-        bytes = (size_t)st.rays_cast; /* the record's byte count holds the rays cast here */
-        fprintf(stderr, "rad %s: stochastic radiosity (%s) in %.2f s: %u iterations, %llu rays, unshot %.2g\n", cmd,
-                sto.method == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", tool_seconds() - t0, st.iterations,
-                (unsigned long long)st.rays_cast, st.unshot);
+    rad_block_options_default(&bo);
+    bo.format = mo->format == TOOL_MB_BC1 ? RAD_BLOCK_BC1 : RAD_BLOCK_BC4X3;
+    bo.outlier_fraction = mo->outliers > 0.0f ? mo->outliers : -1.0f; /* --outliers 0: none */
+    bo.reorder = mo->reorder;
+    bo.reorder_samples = mo->reorder_samples;
+    bo.tile = mo->tile ? mo->tile : RAD_BLOCK_WHOLE_MATRIX; /* --tile 0: one scale per matrix */
+    memset(&report, 0, sizeof report);
+    tool_context(&ctx, "compression");
+    b->r = rad_multibounce_blocks_create(b->mb, &bo, &ctx, &b->blocks, &report);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "rad_multibounce_blocks_create";
+    b->bytes = report.bytes_total;
+    b->mi.mse = (float)report.mse;
+    b->mi.max_abs_error = (float)report.max_abs_error;
+    b->mi.source_mean_square = (float)report.source_mean_square;
+    fprintf(stderr,
+            "rad %s: compressed to %s in %.2f s: %lu bytes (blocks %lu, scales %lu, %llu outliers %lu, "
+            "permutations %lu) vs %lu float F_mb, %.1fx; decoded-matrix RMS error %.3g (%.3g%% of the "
+            "RMS entry), max %.3g\n",
+            b->cmd, format_name(mo->format), tool_seconds() - t1, (unsigned long)report.bytes_total,
+            (unsigned long)report.bytes_blocks, (unsigned long)report.bytes_scales,
+            (unsigned long long)report.outlier_count, (unsigned long)report.bytes_outliers,
+            (unsigned long)report.bytes_permutations, (unsigned long)report.bytes_float_mb,
+            report.bytes_total ? (double)report.bytes_float_mb / (double)report.bytes_total : 0.0, sqrt(report.mse),
+            report.source_mean_square > 0.0 ? 100.0 * sqrt(report.mse / report.source_mean_square) : 0.0,
+            report.max_abs_error);
+    return NULL;
+}
+
+/* hierarchical: the solution resampled onto the patches as L = rho H (NULL: done; "": failed,
+   printed) */
+static const char *method_bake_hierarchical(method_bake *b, uint32_t light_samples)
+{
+    rad_hierarchical *h = NULL;
+    rad_hierarchical_stats st;
+    if (tool_hierarchical_build(b->cmd, b->w, b->mo, light_samples, &h)) return "";
+    b->L = (float *)tool_calloc(3 * (size_t)b->n, sizeof(float));
+    b->r = hierarchical_to_patches(h, b->w->scene, b->c.patches, b->L);
+    rad_hierarchical_get_stats(h, &st);
+    rad_hierarchical_destroy(h);
+    if (b->r != RAD_SUCCESS) return "rad_hierarchical_lookup";
+    b->bytes = (size_t)st.links; /* the record's byte count holds the links here */
+    b->mi.k = st.leaves;
+    b->mi.bounces = st.rounds;
+    b->mi.w = b->mo->hr_eps > 0.0f ? b->mo->hr_eps : 1e-5f;
+    return NULL;
+}
+
+static const char *method_bake_stochastic(method_bake *b, double t0)
+{
+    const tool_method_options *mo = b->mo;
+    rad_stochastic_options sto;
+    rad_stochastic_stats st;
+    rad_context ctx;
+    rad_stochastic_options_default(&sto);
+    sto.method = (rad_stochastic_method)mo->sr_estimator;
+    sto.rays = mo->sr_rays;
+    sto.iterations = mo->sr_iterations;
+    sto.seed = mo->seed;
+    b->L = (float *)tool_calloc(3 * (size_t)b->n, sizeof(float));
+    tool_context(&ctx, "stochastic radiosity");
+    b->r = rad_solve_stochastic(b->c.patches, &b->w->rc, b->c.E, &sto, b->L, &st, &ctx);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "rad_solve_stochastic";
+    b->bytes = (size_t)st.rays_cast; /* the record's byte count holds the rays cast here */
+    fprintf(stderr, "rad %s: stochastic radiosity (%s) in %.2f s: %u iterations, %llu rays, unshot %.2g\n", b->cmd,
+            sto.method == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", tool_seconds() - t0, st.iterations,
+            (unsigned long long)st.rays_cast, st.unshot);
+    return NULL;
+}
+
+/* temporal: alias tables over F's rows, or over F_mb's three channels in --mode multibounce */
+static const char *method_bake_alias(method_bake *b, double t0)
+{
+    uint32_t i, n = b->n;
+    uint64_t bins = 0, entries = 0;
+    rad_context ctx;
+    tool_context(&ctx, "alias tables");
+    b->r = RAD_SUCCESS;
+    if (b->mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
+        for (i = 0; i < 3 && b->r == RAD_SUCCESS; ++i)
+            b->r = rad_alias_tables_create_dense(b->mb->planes + (size_t)i * n * n, n, RAD_ALIAS_AUTO, &ctx, &b->tables[i]);
     } else {
-        tool_context(&ctx, "alias tables");
-        if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
-            for (i = 0; i < 3 && r == RAD_SUCCESS; ++i)
-                r = rad_alias_tables_create_dense(mb->planes + (size_t)i * n * n, n, RAD_ALIAS_AUTO, &ctx, &tables[i]);
-        } else {
-            r = rad_alias_tables_create(&c.ff->matrix, RAD_ALIAS_AUTO, &ctx, &tables[0]);
-        }
-        tool_progress_end();
-        tool_context(&ctx, NULL);
-        if (r != RAD_SUCCESS) {
-            what = "alias tables";
-            goto fail;
-        }
-        {
-            uint64_t bins = 0, entries = 0;
-            for (i = 0; i < 3 && tables[i]; ++i) {
-                bytes += rad_alias_tables_memory(tables[i]);
-                bins += tables[i]->row_offsets[n];
-                entries += tables[i]->source_entries;
-            }
-            fprintf(stderr,
-                    "rad %s: alias tables (%s) built in %.2f s: %llu bins, %lu bytes (%.2f bytes per bin) from a "
-                    "%llu-entry float matrix (%lu bytes)\n",
-                    cmd, mode_name(mo->mode), tool_seconds() - t0, (unsigned long long)bins, (unsigned long)bytes,
-                    bins ? (double)bytes / (double)bins : 0.0, (unsigned long long)entries,
-                    (unsigned long)(entries * 4u));
-        }
+        b->r = rad_alias_tables_create(&b->c.ff->matrix, RAD_ALIAS_AUTO, &ctx, &b->tables[0]);
     }
-    mi.build_seconds = (float)(tool_seconds() - t0);
-    mi.bytes_lo = (uint32_t)((uint64_t)bytes & 0xFFFFFFFFu);
-    mi.bytes_hi = (uint32_t)((uint64_t)bytes >> 32);
+    tool_progress_end();
+    if (b->r != RAD_SUCCESS) return "alias tables";
+    for (i = 0; i < 3 && b->tables[i]; ++i) {
+        b->bytes += rad_alias_tables_memory(b->tables[i]);
+        bins += b->tables[i]->row_offsets[n];
+        entries += b->tables[i]->source_entries;
+    }
+    fprintf(stderr,
+            "rad %s: alias tables (%s) built in %.2f s: %llu bins, %lu bytes (%.2f bytes per bin) from a "
+            "%llu-entry float matrix (%lu bytes)\n",
+            b->cmd, mode_name(b->mo->mode), tool_seconds() - t0, (unsigned long long)bins, (unsigned long)b->bytes,
+            bins ? (double)b->bytes / (double)bins : 0.0, (unsigned long long)entries, (unsigned long)(entries * 4u));
+    return NULL;
+}
 
-    /* patches and E (and D as a vector) from the library's writer, then ours */
-    if ((r = rad_save_memory(c.patches, NULL, c.E, NULL, &ctx, &base, &base_size)) != RAD_SUCCESS) {
+/* the container: patches and E (and D as a vector) from the library's writer, then ours */
+static const char *method_bake_write(method_bake *b, const tool_classic_options *o, void **out, size_t *out_size)
+{
+    const tool_method_options *mo = b->mo;
+    tool_bake_info info;
+    rad_bake_signature sig;
+    rad_container *ct = NULL;
+    rad_section *secs = NULL;
+    rad_context ctx;
+    void *base = NULL, *dst = NULL;
+    size_t base_size = 0, dst_size = 0;
+    uint32_t i, k = 0, count, n = b->n;
+    const char *what = NULL;
+    tool_context(&ctx, NULL);
+    if ((b->r = rad_save_memory(b->c.patches, NULL, b->c.E, NULL, &ctx, &base, &base_size)) != RAD_SUCCESS) {
         what = "rad_save_memory";
-        goto fail;
+        goto done;
     }
-    if ((r = rad_container_create(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
+    if ((b->r = rad_container_create(base, base_size, &ctx, &ct)) != RAD_SUCCESS) {
         what = "rad_container_create";
-        goto fail;
+        goto done;
     }
     count = rad_container_section_count(ct);
     secs = (rad_section *)tool_calloc((size_t)count + 4 + 3 * 3 + RAD_MB_MAX_SECTIONS, sizeof(rad_section));
@@ -955,63 +849,95 @@ int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_op
     info.solver = (uint32_t)o->solver;
     info.bounces = mo->bounces;
     info.light_samples = o->light_samples;
-    info.triangle_count = w->scene->triangle_count;
-    tool_sign_options(secs, k, &info, w, &sig);
-    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = c.D;
+    info.triangle_count = b->w->scene->triangle_count;
+    tool_sign_options(secs, k, &info, b->w, &sig);
+    secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = b->c.D;
     strcpy(secs[k++].name, "D");
-    secs[k].type = TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = S;
+    secs[k].type = TOOL_SECTION_ROWSUMS, secs[k].elem_size = 4, secs[k].count = n, secs[k].data = b->S;
     strcpy(secs[k++].name, "rad.rowsums");
     secs[k].type = TOOL_SECTION_OPTIONS, secs[k].elem_size = sizeof info, secs[k].count = 1, secs[k].data = &info;
     strcpy(secs[k++].name, "rad.options");
-    secs[k].type = TOOL_SECTION_METHOD, secs[k].elem_size = sizeof mi, secs[k].count = 1, secs[k].data = &mi;
+    secs[k].type = TOOL_SECTION_METHOD, secs[k].elem_size = sizeof b->mi, secs[k].count = 1, secs[k].data = &b->mi;
     strcpy(secs[k++].name, "rad.method");
     if (mo->method == TOOL_MULTIBOUNCE) {
         uint32_t added = 0;
-        r = blocks ? rad_multibounce_blocks_sections(blocks, "Fmb", secs + k, &added)
-                   : rad_multibounce_sections(mb, "Fmb", secs + k, &added);
-        if (r != RAD_SUCCESS) {
+        b->r = b->blocks ? rad_multibounce_blocks_sections(b->blocks, "Fmb", secs + k, &added)
+                         : rad_multibounce_sections(b->mb, "Fmb", secs + k, &added);
+        if (b->r != RAD_SUCCESS) {
             what = "multi-bounce sections";
-            goto fail;
+            goto done;
         }
         k += added;
     } else if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) {
-        secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = L;
+        secs[k].type = RAD_SECTION_VECTOR, secs[k].elem_size = 12, secs[k].count = n, secs[k].data = b->L;
         strcpy(secs[k++].name, "L");
     } else if (mo->mode == RAD_TEMPORAL_MULTIBOUNCE) {
         static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
-        for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(tables[i], names[i], secs + k, NULL);
+        for (i = 0; i < 3; ++i, k += 3) rad_alias_tables_sections(b->tables[i], names[i], secs + k, NULL);
     } else {
-        rad_alias_tables_sections(tables[0], "F", secs + k, NULL);
+        rad_alias_tables_sections(b->tables[0], "F", secs + k, NULL);
         k += 3;
     }
-    if ((r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
+    if ((b->r = rad_container_size(secs, k, &dst_size)) != RAD_SUCCESS) {
         what = "rad_container_size";
-        goto fail;
+        goto done;
     }
     dst = tool_calloc(dst_size, 1);
-    if ((r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
+    if ((b->r = rad_container_write(secs, k, dst, dst_size)) != RAD_SUCCESS) {
         what = "rad_container_write";
-        goto fail;
+        goto done;
     }
     *out = dst;
     *out_size = dst_size;
     dst = NULL;
-    rc = 0;
-fail:
-    if (what) tool_fail(cmd, what, r);
+done:
     free(dst);
     free(secs);
     rad_container_destroy(ct);
     rad_free_buffer(base, &ctx);
-    for (i = 0; i < 3; ++i) rad_alias_tables_destroy(tables[i]);
-    rad_multibounce_blocks_destroy(blocks);
-    rad_multibounce_destroy(mb);
-    free(ones);
-    free(rows3);
-    free(S);
-    free(L);
-    tool_classic_free(&c);
-    return rc;
+    return what;
+}
+
+int tool_method_bake(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                         const tool_method_options *mo, void **out, size_t *out_size)
+{
+    tool_classic_options so = *o;
+    method_bake b;
+    const char *what = NULL;
+    double t0;
+    uint32_t i;
+    *out = NULL;
+    *out_size = 0;
+    memset(&b, 0, sizeof b);
+    b.cmd = cmd;
+    b.w = w;
+    b.mo = mo;
+    so.sources_only = 1;
+    so.no_form_factors = mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL;
+    if (tool_classic_solve(cmd, w, &so, &b.c)) return 1;
+    b.n = b.c.patches->count;
+    what = method_bake_rowsums(&b, so.no_form_factors);
+    method_bake_record(&b);
+    t0 = tool_seconds();
+    if (!what && (mo->method == TOOL_MULTIBOUNCE || (mo->method == TOOL_TEMPORAL && mo->mode == RAD_TEMPORAL_MULTIBOUNCE)))
+        what = method_bake_fmb(&b, t0);
+    if (!what)
+        what = mo->method == TOOL_MULTIBOUNCE     ? method_bake_store_fmb(&b)
+               : mo->method == TOOL_HIERARCHICAL ? method_bake_hierarchical(&b, o->light_samples)
+               : mo->method == TOOL_STOCHASTIC   ? method_bake_stochastic(&b, t0)
+                                                 : method_bake_alias(&b, t0);
+    b.mi.build_seconds = (float)(tool_seconds() - t0);
+    b.mi.bytes_lo = (uint32_t)((uint64_t)b.bytes & 0xFFFFFFFFu);
+    b.mi.bytes_hi = (uint32_t)((uint64_t)b.bytes >> 32);
+    if (!what) what = method_bake_write(&b, o, out, out_size);
+    if (what && *what) tool_fail(cmd, what, b.r);
+    for (i = 0; i < 3; ++i) rad_alias_tables_destroy(b.tables[i]);
+    rad_multibounce_blocks_destroy(b.blocks);
+    rad_multibounce_destroy(b.mb);
+    free(b.S);
+    free(b.L);
+    tool_classic_free(&b.c);
+    return what ? 1 : 0;
 }
 
 /* ---- render side ---------------------------------------------------------------------------- */
@@ -1043,6 +969,114 @@ void tool_indirect_close(tool_indirect *m)
 
 const float *tool_indirect_rowsums(const tool_indirect *m) { return m->S; }
 
+/* stochastic and hierarchical bakes: their solution L, checked */
+static int indirect_open_solution(tool_indirect *m, const rad_container *ct, const char *bake_name,
+                                  const tool_method_info *mi, const tool_method_options *mo)
+{
+    const char *cmd = m->cmd;
+    uint32_t n = m->n;
+    const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
+    uint32_t i;
+    if (!ls || ls->elem_size != 12 || ls->count != n) {
+        fprintf(stderr, "rad %s: bake '%s' holds no solution L for its %u patches (vector section L)\n", cmd, bake_name, n);
+        return 1;
+    }
+    m->Ls = (const float *)ls->data;
+    for (i = 0; i < 3 * n; ++i)
+        if (!(m->Ls[i] >= 0.0f && m->Ls[i] <= RAD_BAKE_VALUE_MAX)) {
+            fprintf(stderr, "rad %s: bake '%s': vector L, value %u is %g (not in [0, 1e30])\n", cmd, bake_name, i,
+                    (double)m->Ls[i]);
+            return 1;
+        }
+    m->solve_seconds = mi->build_seconds;
+    if (mo->method == TOOL_HIERARCHICAL)
+        fprintf(stderr, "rad %s: hierarchical (--hr-eps %g: %u leaves, %llu links, resampled onto %u patches), solved in "
+                        "%.3f s\n", cmd, (double)mi->w, mi->k, (unsigned long long)(((uint64_t)mi->bytes_hi << 32) | mi->bytes_lo),
+                n, (double)mi->build_seconds);
+    else
+        fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
+                mi->mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
+                (unsigned long long)(((uint64_t)mi->bytes_hi << 32) | mi->bytes_lo), (double)mi->build_seconds);
+    return 0;
+}
+
+/* multibounce: F_mb (float, half or compressed) */
+static int indirect_open_fmb(tool_indirect *m, const rad_container *ct, const char *bake_name,
+                                  const tool_method_info *mi, const tool_method_options *mo)
+{
+    const char *cmd = m->cmd;
+    uint32_t n = m->n;
+    rad_result r;
+    (void)mo;
+    const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
+    uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;
+    if (kind > 3) {
+        fprintf(stderr, "rad %s: bake '%s' holds no multi-bounce matrix 'Fmb'\n", cmd, bake_name);
+        return 1;
+    }
+    r = kind >= 2 ? rad_multibounce_blocks_load(ct, "Fmb", &m->ctx, &m->blocks)
+                  : rad_multibounce_load(ct, "Fmb", &m->ctx, &m->mb);
+    if (r == RAD_SUCCESS && (kind >= 2 ? m->blocks->n : m->mb->n) != n) {
+        fprintf(stderr, "rad %s: bake '%s': F_mb is %u x %u for %u patches\n", cmd, bake_name,
+                kind >= 2 ? m->blocks->n : m->mb->n, kind >= 2 ? m->blocks->n : m->mb->n, n);
+        return 1;
+    }
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad %s: bake '%s': cannot open its multi-bounce matrix\n", cmd, bake_name);
+        return tool_fail(cmd, "rad_multibounce_load", r);
+    }
+    if (mi->bounces == RAD_MB_INFINITE)
+        fprintf(stderr, "rad %s: F_mb %s, bounces inf, %u patches\n", cmd, format_name(kind), n);
+    else
+        fprintf(stderr, "rad %s: F_mb %s, bounces %u (F_mb holds %u with the gather), %u patches\n", cmd,
+                format_name(kind), mi->bounces, mi->bounces + 1u, n);
+    return 0;
+}
+
+/* temporal: the alias tables and the temporal state, the render's --k, --w, --adaptive and
+   --seed over the bake's */
+static int indirect_open_temporal(tool_indirect *m, const rad_container *ct, const char *bake_name,
+                                  const tool_method_info *mi, const tool_method_options *mo)
+{
+    const char *cmd = m->cmd;
+    uint32_t n = m->n;
+    rad_result r;
+    static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
+    const rad_alias_tables *tp[3];
+    rad_temporal_options to;
+    uint32_t tcount = mi->mode == RAD_TEMPORAL_MULTIBOUNCE ? 3u : 1u, i;
+    for (i = 0; i < tcount; ++i) {
+        const char *name = tcount == 3 ? names[i] : "F";
+        if (!rad_container_find(ct, RAD_SECTION_TEMPORAL_BINS, name)) {
+            fprintf(stderr, "rad %s: bake '%s' holds no alias tables '%s'\n", cmd, bake_name, name);
+            return 1;
+        }
+        if ((r = rad_alias_tables_view(ct, name, &m->ctx, &m->tables[i])) != RAD_SUCCESS) {
+            return tool_fail(cmd, "rad_alias_tables_view", r);
+        }
+        if (m->tables[i].rows != n) {
+            fprintf(stderr, "rad %s: bake '%s': alias tables '%s' have %u rows for %u patches\n", cmd, bake_name,
+                    name, m->tables[i].rows, n);
+            return 1;
+        }
+        tp[i] = &m->tables[i];
+    }
+    rad_temporal_options_default(&to);
+    to.mode = (rad_temporal_mode)mi->mode;
+    to.samples = (mo->given & TOOL_OPT_K) ? mo->k : mi->k;
+    to.adaptive = (mo->given & TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & TOOL_OPT_W) ? 0 : (int)mi->adaptive;
+    to.weight = (mo->given & TOOL_OPT_W) ? mo->w : mi->w;
+    if (to.weight == 0.0f) to.weight = -1.0f; /* --w 0: no history (a weight of 0 is the default) */
+    to.seed = (mo->given & TOOL_OPT_SEED) ? mo->seed : mi->seed;
+    if ((r = rad_temporal_create(tp, tcount, m->albedo, &to, &m->ctx, &m->temporal)) != RAD_SUCCESS) {
+        return tool_fail(cmd, "rad_temporal_create", r);
+    }
+    fprintf(stderr, "rad %s: temporal, mode %s, k %u, %s%.4g, seed %u, %u patches\n", cmd, mode_name(mi->mode),
+            to.samples, to.adaptive ? "adaptive w, max " : "w ", (double)(to.adaptive ? to.weight_max : to.weight),
+            to.seed, n);
+    return 0;
+}
+
 int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *bake,
                            const tool_method_options *mo, tool_indirect **out)
 {
@@ -1050,7 +1084,7 @@ int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *b
     const rad_section *s;
     tool_method_info mi;
     tool_indirect *m;
-    rad_result r;
+    int r;
     uint32_t n = bake->patches.count;
     const char *mname = tool_method_name(mo->method);
     *out = NULL;
@@ -1105,95 +1139,12 @@ int tool_indirect_open(const char *cmd, const char *bake_name, const rad_bake *b
     m->S = (const float *)s->data;
     m->L = (float *)tool_calloc(3 * (size_t)n, sizeof(float));
     tool_context(&m->ctx, NULL);
-    if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) {
-        const rad_section *ls = rad_container_find(ct, RAD_SECTION_VECTOR, "L");
-        uint32_t i;
-        if (!ls || ls->elem_size != 12 || ls->count != n) {
-            fprintf(stderr, "rad %s: bake '%s' holds no solution L for its %u patches (vector section L)\n", cmd, bake_name, n);
-            tool_indirect_close(m);
-            return 1;
-        }
-        m->Ls = (const float *)ls->data;
-        for (i = 0; i < 3 * n; ++i)
-            if (!(m->Ls[i] >= 0.0f && m->Ls[i] <= RAD_BAKE_VALUE_MAX)) {
-                fprintf(stderr, "rad %s: bake '%s': vector L, value %u is %g (not in [0, 1e30])\n", cmd, bake_name, i,
-                        (double)m->Ls[i]);
-                tool_indirect_close(m);
-                return 1;
-            }
-        m->solve_seconds = mi.build_seconds;
-        if (mo->method == TOOL_HIERARCHICAL)
-            fprintf(stderr, "rad %s: hierarchical (--hr-eps %g: %u leaves, %llu links, resampled onto %u patches), solved in "
-                            "%.3f s\n", cmd, (double)mi.w, mi.k, (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo),
-                    n, (double)mi.build_seconds);
-        else
-            fprintf(stderr, "rad %s: stochastic (%s), %u patches, %llu rays, solved in %.3f s\n", cmd,
-                    mi.mode == RAD_STOCHASTIC_WALK ? "walk" : "jacobi", n,
-                    (unsigned long long)(((uint64_t)mi.bytes_hi << 32) | mi.bytes_lo), (double)mi.build_seconds);
-    } else if (mo->method == TOOL_MULTIBOUNCE) {
-        const rad_section *is = rad_container_find(ct, RAD_SECTION_MB_INFO, "Fmb");
-        uint32_t kind = is && is->elem_size == 4 && is->count == 16 ? ((const uint32_t *)is->data)[1] : 99u;
-        if (kind > 3) {
-            fprintf(stderr, "rad %s: bake '%s' holds no multi-bounce matrix 'Fmb'\n", cmd, bake_name);
-            tool_indirect_close(m);
-            return 1;
-        }
-        r = kind >= 2 ? rad_multibounce_blocks_load(ct, "Fmb", &m->ctx, &m->blocks)
-                      : rad_multibounce_load(ct, "Fmb", &m->ctx, &m->mb);
-        if (r == RAD_SUCCESS && (kind >= 2 ? m->blocks->n : m->mb->n) != n) {
-            fprintf(stderr, "rad %s: bake '%s': F_mb is %u x %u for %u patches\n", cmd, bake_name,
-                    kind >= 2 ? m->blocks->n : m->mb->n, kind >= 2 ? m->blocks->n : m->mb->n, n);
-            tool_indirect_close(m);
-            return 1;
-        }
-        if (r != RAD_SUCCESS) {
-            tool_indirect_close(m);
-            fprintf(stderr, "rad %s: bake '%s': cannot open its multi-bounce matrix\n", cmd, bake_name);
-            return tool_fail(cmd, "rad_multibounce_load", r);
-        }
-        if (mi.bounces == RAD_MB_INFINITE)
-            fprintf(stderr, "rad %s: F_mb %s, bounces inf, %u patches\n", cmd, format_name(kind), n);
-        else
-            fprintf(stderr, "rad %s: F_mb %s, bounces %u (F_mb holds %u with the gather), %u patches\n", cmd,
-                    format_name(kind), mi.bounces, mi.bounces + 1u, n);
-    } else {
-        static const char *const names[3] = {"Fmb.r", "Fmb.g", "Fmb.b"};
-        const rad_alias_tables *tp[3];
-        rad_temporal_options to;
-        uint32_t tcount = mi.mode == RAD_TEMPORAL_MULTIBOUNCE ? 3u : 1u, i;
-        for (i = 0; i < tcount; ++i) {
-            const char *name = tcount == 3 ? names[i] : "F";
-            if (!rad_container_find(ct, RAD_SECTION_TEMPORAL_BINS, name)) {
-                fprintf(stderr, "rad %s: bake '%s' holds no alias tables '%s'\n", cmd, bake_name, name);
-                tool_indirect_close(m);
-                return 1;
-            }
-            if ((r = rad_alias_tables_view(ct, name, &m->ctx, &m->tables[i])) != RAD_SUCCESS) {
-                tool_indirect_close(m);
-                return tool_fail(cmd, "rad_alias_tables_view", r);
-            }
-            if (m->tables[i].rows != n) {
-                fprintf(stderr, "rad %s: bake '%s': alias tables '%s' have %u rows for %u patches\n", cmd, bake_name,
-                        name, m->tables[i].rows, n);
-                tool_indirect_close(m);
-                return 1;
-            }
-            tp[i] = &m->tables[i];
-        }
-        rad_temporal_options_default(&to);
-        to.mode = (rad_temporal_mode)mi.mode;
-        to.samples = (mo->given & TOOL_OPT_K) ? mo->k : mi.k;
-        to.adaptive = (mo->given & TOOL_OPT_ADAPTIVE) ? 1 : (mo->given & TOOL_OPT_W) ? 0 : (int)mi.adaptive;
-        to.weight = (mo->given & TOOL_OPT_W) ? mo->w : mi.w;
-        if (to.weight == 0.0f) to.weight = -1.0f; /* --w 0: no history (a weight of 0 is the default) */
-        to.seed = (mo->given & TOOL_OPT_SEED) ? mo->seed : mi.seed;
-        if ((r = rad_temporal_create(tp, tcount, m->albedo, &to, &m->ctx, &m->temporal)) != RAD_SUCCESS) {
-            tool_indirect_close(m);
-            return tool_fail(cmd, "rad_temporal_create", r);
-        }
-        fprintf(stderr, "rad %s: temporal, mode %s, k %u, %s%.4g, seed %u, %u patches\n", cmd, mode_name(mi.mode),
-                to.samples, to.adaptive ? "adaptive w, max " : "w ", (double)(to.adaptive ? to.weight_max : to.weight),
-                to.seed, n);
+    if (mo->method == TOOL_STOCHASTIC || mo->method == TOOL_HIERARCHICAL) r = indirect_open_solution(m, ct, bake_name, &mi, mo);
+    else if (mo->method == TOOL_MULTIBOUNCE) r = indirect_open_fmb(m, ct, bake_name, &mi, mo);
+    else r = indirect_open_temporal(m, ct, bake_name, &mi, mo);
+    if (r) {
+        tool_indirect_close(m);
+        return 1;
     }
     *out = m;
     return 0;

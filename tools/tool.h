@@ -222,6 +222,46 @@ int tool_parse_uint(const char *cmd, const char *opt, const char *text, uint32_t
 int tool_parse_float(const char *cmd, const char *opt, const char *text, float *out);
 double tool_seconds(void);
 
+/* ---- option tables (options.c) ------------------------------------------------------------ */
+/* A command's options as a table of tool_arg rows ending with a TOOL_ARG_END row: each row is an
+   option (its name, the value's placeholder, the field it fills in the options struct the
+   command passes, the range it accepts, its bit in the struct's 'given' mask) and its help
+   text, so that the parser and the --help of a command are the same table. */
+typedef enum tool_arg_kind {
+    TOOL_ARG_END = 0,  /* ends the table */
+    TOOL_ARG_TEXT,     /* no option: help text printed as it is (a heading, a paragraph) */
+    TOOL_ARG_FLAG,     /* no value: stores the int (int)lo in the field */
+    TOOL_ARG_UINT,     /* a whole number in [lo, hi] into a uint32_t */
+    TOOL_ARG_FLOAT,    /* a number in [lo, hi] (flags: either end open) into a float */
+    TOOL_ARG_STRING,   /* the text itself into a const char * */
+    TOOL_ARG_CHOICE,   /* one of the '|'-separated 'choices': values[i] (NULL: i) into a uint32_t */
+    TOOL_ARG_CUSTOM    /* 'parse' reads the value */
+} tool_arg_kind;
+enum { TOOL_ARG_LO_OPEN = 1, TOOL_ARG_HI_OPEN = 2, TOOL_ARG_NONEMPTY = 4 };
+typedef struct tool_arg tool_arg;
+/* parses 'value' of option t into field (the target's field); 0, or 2 after printing why */
+typedef int (*tool_arg_parse_fn)(const char *cmd, const tool_arg *t, const char *value, void *field);
+struct tool_arg {
+    tool_arg_kind kind;
+    const char *name;        /* "--k" */
+    const char *value;       /* its placeholder in the help ("K"; NULL for a flag) */
+    size_t field;            /* offsetof the field in the target struct */
+    double lo, hi;           /* UINT, FLOAT: the range; FLAG: lo is the value stored */
+    unsigned flags;          /* TOOL_ARG_LO_OPEN ... */
+    uint32_t given;          /* bits or-ed into *given when the option is taken */
+    const char *bad;         /* out of range: "rad CMD: NAME <bad>, not VALUE" */
+    const char *choices;     /* CHOICE: "a|b|c" */
+    const uint32_t *values;  /* CHOICE: the value of each choice (NULL: its index) */
+    tool_arg_parse_fn parse; /* CUSTOM */
+    unsigned where;          /* help only: the contexts that list it (0: every one) */
+    const char *help;        /* its text; lines after the first are indented to the first's column */
+};
+/* argv[*a] is an option of the table: parses it (and its value, advancing *a) into target and
+   returns 1; 0 when it is not one; 2 on a bad value or a missing one (message printed) */
+int tool_args_parse(const char *cmd, const tool_arg *table, void *target, uint32_t *given, int argc, char **argv, int *a);
+/* the table's help for the context 'where' (0: every row) into buf, truncated to size bytes */
+void tool_args_help_into(const tool_arg *table, unsigned where, char *buf, size_t size);
+
 /* ---- lights from the command line (lights.c) ------------------------------------------- */
 /* --area P:U:V:RGB: an emissive parallelogram P, P+U, P+U+V, P+V of radiance RGB */
 typedef struct tool_area_light {
@@ -257,7 +297,7 @@ void tool_lights_release(void *storage);
 /* rad_hash64 of the lights' fields, continuing from h */
 uint64_t tool_lights_hash(const rad_light *lights, uint32_t count, uint64_t h);
 
-/* A scene ready for ray queries: the loaded file, the validated scene and its BVH. */
+/* A scene ready for ray queries: the loaded file, the validated scene and its BVH (world.c). */
 typedef struct tool_world {
     tool_scene file;      /* file.lights: the file's lights, then those of the command line */
     rad_scene *scene;
@@ -316,7 +356,8 @@ int tool_parse_bytes(const char *cmd, const char *opt, const char *text, double 
 /* MemAvailable of /proc/meminfo in bytes; 0 where unknown (then only --max-memory limits) */
 double tool_mem_available(void);
 struct tool_method_options;
-/* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice). */
+/* Fills o's dense_* fields for the method of mo (bake: a classic bake also writes F twice).
+   (methods.c: the costs are the methods') */
 void tool_dense_plan(tool_classic_options *o, const struct tool_method_options *mo, int bake);
 /* Before a dense build of n patches (lower_bound: n is the triangle count, the patches not made
    yet): 0 when the estimate fits the memory limit and TOOL_DENSE_MAX_SECONDS (or
@@ -407,7 +448,7 @@ typedef struct tool_method_options {
     int reorder;              /* --reorder / --no-reorder (default on) */
     uint32_t reorder_samples; /* --reorder-samples N (0: exact, the default) */
     uint32_t tile;            /* --tile T: scales per T x T texels, 0: per matrix (default 64) */
-    rad_temporal_mode mode;   /* --mode feedback|single|multibounce (default feedback) */
+    uint32_t mode;            /* --mode feedback|single|multibounce: a rad_temporal_mode (default feedback) */
     uint32_t k;               /* --k K: draws per row and frame (default 10) */
     float w;                  /* --w W: a fixed blend weight (0.998 when --w is not given; unused then) */
     int adaptive;             /* --adaptive: per-row weight (the default; --w W turns it off) */
@@ -468,7 +509,9 @@ int tool_method_option(const char *cmd, int argc, char **argv, int *a, tool_meth
 /* After parsing: rejects options that do not apply to mo->method (and render-only options
    when !render), moves a finite --bounces into o->bounces for classic; 0 or 2 (printed). */
 int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool_classic_options *o);
+/* the help of the options above for rad render (render 1) or rad bake (0) */
 const char *tool_method_help(int render);
+enum { TOOL_METHOD_HELP_RENDER = 1, TOOL_METHOD_HELP_BAKE = 2 };
 const char *tool_method_name(tool_method method);
 /* --method hierarchical: rad_hierarchical_create and solve over the world with E = rho D at
    the elements' centroids (D: rad_direct_irradiance with light_samples shadow rays, emitters
@@ -600,7 +643,8 @@ typedef struct tool_unwrap_auto {
    names size_option and the smallest size that fits when the atlas is too small. */
 int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t *width, uint32_t *height,
                 const tool_unwrap_auto *autosize, float *out_uvs, uint32_t *out_charts);
-/* ---- lightmap bakes (cmd_lightmap.c), shared by rad lightmap and rad render --method lightmap */
+/* ---- lightmap bakes (lightmap.c), shared by rad lightmap and rad render --method lightmap;
+   the virtual patches they and rad probes share (vp.c) --------------------------------- */
 /* --proxy aavp|vp: the indirect light from virtual patches instead of classic patches */
 typedef struct tool_lightmap_proxy {
     int kind;                /* TOOL_PROXY_AAVP, TOOL_PROXY_VP or TOOL_LIGHTMAP_HIERARCHICAL */
@@ -612,14 +656,14 @@ typedef struct tool_lightmap_proxy {
 } tool_lightmap_proxy;
 /* --vp-max-patches B: the finest voxel resolution whose set of 'kind' has at most B patches,
    found by counting (rad_vp_count) from 'start' (0: 16); prints the choice. 0, or 1 after
-   printing why (even resolution 1 gives more). (cmd_render.c) */
+   printing why (even resolution 1 gives more). */
 int tool_vp_resolution_within(const char *cmd, const tool_world *w, rad_vp_kind kind, uint32_t face_points,
                               uint32_t max_patches, uint32_t start, uint32_t *out);
 /* A bake of rad bake --method aavp|vp in memory (data, size: kept alive by the caller while
    *ct_out lives): its container, its set "vp" (rad_vp_load; scene may be NULL) and its source
    vector E (3 floats a patch, each in [0, RAD_BAKE_VALUE_MAX], malloc'd). The errors tell a
    damaged file, a bake without virtual patches and damaged virtual patches apart. 0, or 1
-   after printing why (nothing to free). (cmd_render.c) */
+   after printing why (nothing to free). */
 int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_t size, const rad_scene *scene,
                       rad_container **ct_out, rad_virtual_patches **vp_out, float **E_out);
 /* rad lightmap --proxy hierarchical: the indirect light from the hierarchical solution's smooth
@@ -645,22 +689,45 @@ typedef struct tool_lightmap_baked {
     float *uvs;              /* the unwrap's lightmap uvs, or NULL */
     int own_scene;           /* w.scene and w.bvh are ours */
 } tool_lightmap_baked;
-/* Solves the classic method (proxy NULL) or virtual patches (E = rho D at their samples, K
+/* rad lightmap's defaults: atlas side, sample points per texel, shadow rays per sample point
+   and patch, rays per texel of the hemisphere gather */
+#define TOOL_LIGHTMAP_SIZE 256
+#define TOOL_LIGHTMAP_TEXEL_SAMPLES 4u
+#define TOOL_LIGHTMAP_VISIBILITY_RAYS 2u
+#define TOOL_LIGHTMAP_HEMISPHERE_RAYS 256u
+/* tool_lightmap_request.gather: choose by the work, the exact gather up to this many
+   sample-patch pairs (its cost grows with them; the hemisphere gather's does not) */
+#define TOOL_LIGHTMAP_GATHER_AUTO (-1)
+#define TOOL_LIGHTMAP_EXACT_MAX_PAIRS 2e7
+/* bytes a texel of the bake holds at its peak, for the automatic atlas size's memory check:
+   the texel record and its samples' records, the gathered values (channels floats, twice) */
+#define TOOL_LIGHTMAP_TEXEL_BYTES(samples, channels) (29.0 + 29.0 * (double)(samples) + 8.0 * (double)(channels) + 12.0)
+/* What tool_lightmap_bake makes (tool_lightmap_request_default: the defaults above, RGB
+   without direct light, over the file's uv set, classic patches) */
+typedef struct tool_lightmap_request {
+    int width, height;           /* atlas texels */
+    int auto_size;               /* the user gave no size: an unwrap whose charts do not fit width x
+                                    height gets a larger atlas (tool_unwrap_auto; the bake's lm has
+                                    the size used) */
+    uint32_t texel_samples;      /* sample points per texel */
+    uint32_t visibility_rays;    /* shadow rays per sample point and patch */
+    int gather;                  /* a rad_lightmap_gather_method, or TOOL_LIGHTMAP_GATHER_AUTO */
+    uint32_t hemisphere_rays;    /* rays per texel of the hemisphere gather */
+    int sh;                      /* L1 SH of the indirect light instead of RGB irradiance */
+    int force_unwrap;            /* unwrap even when the file has a second uv set */
+    int direct;                  /* RGB: add the direct light of the lights and emitters per texel */
+    const tool_lightmap_proxy *proxy; /* the indirect light from a proxy (NULL: classic patches) */
+} tool_lightmap_request;
+void tool_lightmap_request_default(tool_lightmap_request *rq);
+/* Solves the classic method (rq->proxy NULL) or virtual patches (E = rho D at their samples, K
    Jacobi bounces of --bounces, Gauss-Seidel with --solver gauss-seidel, H = F (E + L)) over
-   the lightmapped world (the file's second uv set, else the unwrap) and bakes: texels, gather
-   (classic: of B, sh: L1 SH, else RGB irradiance; proxy: rad_lightmap_gather_vp of H, RGB
-   only), with direct != 0 and RGB the direct light of the lights and emitters added per
-   texel, dilation, stitching. Without a proxy a scene whose dense build would be refused is
-   refused before the unwrap, naming --proxy aavp. gather: a rad_lightmap_gather_method, or -1
-   to choose by the work (the hemisphere gather with hemisphere_rays rays a texel past 2e7
-   sample-patch pairs). auto_size: the user gave no size, so an unwrap whose charts do not fit
-   width x height gets a larger atlas (tool_unwrap_auto; out->lm has the size used). 0, or 1
-   after printing why (out freed). Free with
-   tool_lightmap_bake_free. */
-int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co, int width,
-                           int height, int auto_size, uint32_t texel_samples, uint32_t visibility_rays, int gather,
-                           uint32_t hemisphere_rays, int sh, int force_unwrap,
-                           int direct, const tool_lightmap_proxy *proxy, tool_lightmap_baked *out);
+   the lightmapped world (the file's second uv set, else the unwrap) and bakes rq: texels,
+   gather (classic: of B, sh: L1 SH, else RGB irradiance; proxy: rad_lightmap_gather_vp of H,
+   RGB only), the direct light per texel when asked, dilation, stitching. Without a proxy a
+   scene whose dense build would be refused is refused before the unwrap, naming --proxy aavp.
+   0, or 1 after printing why (out freed). Free with tool_lightmap_bake_free. */
+int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co,
+                       const tool_lightmap_request *rq, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
 
 /* ---- glTF output (gltf_write.c; the convention: docs/engine-formats.md) ------------------- */

@@ -103,23 +103,19 @@ static void uw_bytes(char *buf, size_t len, double b)
     else snprintf(buf, len, "%.0f MiB", b / 1048576.0);
 }
 
-int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t *width_io, uint32_t *height_io,
-                const tool_unwrap_auto *autosize, float *out_uvs, uint32_t *out_charts)
+/* The triangles' neighbours over shared edges (positions equal, either winding) as CSR:
+   *first_out (T + 1 offsets) and *adj_out, malloc'd; 0, or 1 when out of memory (the caller
+   frees what was set). */
+static int uw_adjacency(const rad_scene *scene, uint32_t **first_out, uint32_t **adj_out)
 {
-    uint32_t width = *width_io, height = *height_io;
-    uint32_t T = scene->triangle_count, t, i, nch = 0, *chart = NULL, *queue = NULL, *first = NULL, *adj = NULL;
-    uint32_t *deg = NULL;
-    uw_edge *edges = NULL;
-    uw_chart *charts = NULL;
-    float (*frame)[6] = NULL;  /* per chart: the two axes of its plane */
+    uint32_t T = scene->triangle_count, t, i, *deg = NULL, *first = NULL, *adj = NULL;
     size_t ne = 3 * (size_t)T, k;
-    double area = 0.0, lo, hi, s;
-    int ok = 0, it;
+    uw_edge *edges = NULL;
+    int ok = 0;
+    *first_out = *adj_out = NULL;
     edges = (uw_edge *)malloc(sizeof(uw_edge) * ne);
-    chart = (uint32_t *)malloc(sizeof(uint32_t) * T);
-    queue = (uint32_t *)malloc(sizeof(uint32_t) * T);
     deg = (uint32_t *)calloc((size_t)T + 1, sizeof(uint32_t));
-    if (!edges || !chart || !queue || !deg) goto done;
+    if (!edges || !deg) goto done;
     /* adjacency over shared edges: sorted edge records, equal neighbours are adjacent */
     for (t = 0; t < T; ++t)
         for (i = 0; i < 3; ++i) {
@@ -136,11 +132,11 @@ int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene
             deg[edges[k].tri]++;
             deg[edges[k + 1].tri]++;
         }
-    first = (uint32_t *)malloc(sizeof(uint32_t) * ((size_t)T + 1));
+    *first_out = first = (uint32_t *)malloc(sizeof(uint32_t) * ((size_t)T + 1));
     if (!first) goto done;
     first[0] = 0;
     for (t = 0; t < T; ++t) first[t + 1] = first[t] + deg[t];
-    adj = (uint32_t *)malloc(sizeof(uint32_t) * (first[T] ? first[T] : 1u));
+    *adj_out = adj = (uint32_t *)malloc(sizeof(uint32_t) * (first[T] ? first[T] : 1u));
     if (!adj) goto done;
     memset(deg, 0, sizeof(uint32_t) * T);
     for (k = 0; k + 1 < ne; ++k)
@@ -149,6 +145,58 @@ int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene
             adj[first[a] + deg[a]++] = b;
             adj[first[b] + deg[b]++] = a;
         }
+    ok = 1;
+done:
+    free(edges);
+    free(deg);
+    return ok ? 0 : 1;
+}
+
+/* No size given and the charts do not fit *width x *height: the smallest square power of two
+   that packs them, within autosize's cap and memory, into *width and *height (said on stderr);
+   0, or 1 after printing why not. */
+static int uw_autosize(const char *cmd, const char *size_option, uw_chart *charts, uint32_t nch,
+                       const tool_unwrap_auto *autosize, uint32_t *width, uint32_t *height)
+{
+    /* no size given: the smallest square power of two that packs, within the cap and memory */
+    uint32_t side = uw_fitting_side(charts, nch, *width > *height ? *width : *height, autosize->max_side);
+    double bytes = side ? (double)side * side * autosize->bytes_per_texel : 0.0;
+    char bbuf[32], lbuf[32];
+    if (!side) {
+        uint32_t need = uw_fitting_side(charts, nch, 2u * autosize->max_side, 16384u);
+        fprintf(stderr, "rad %s: %u charts do not fit a %ux%u atlas, the largest the tool picks by itself", cmd, nch,
+                autosize->max_side, autosize->max_side);
+        if (need) fprintf(stderr, ": give %s %u (it fits) or a mesh with its own lightmap uvs\n", size_option, need);
+        else fprintf(stderr, ", nor the largest allowed (16384): give the meshes their own lightmap uvs\n");
+        return 1;
+    }
+    if (autosize->memory_limit > 0.0 && bytes > autosize->memory_limit) {
+        uw_bytes(bbuf, sizeof bbuf, bytes);
+        uw_bytes(lbuf, sizeof lbuf, autosize->memory_limit);
+        fprintf(stderr, "rad %s: %u charts need a %ux%u atlas, about %s of texels and samples; only %s may be used (%s): "
+                        "give the meshes their own lightmap uvs\n",
+                cmd, nch, side, side, bbuf, lbuf, autosize->memory_from ? autosize->memory_from : "the memory limit");
+        return 1;
+    }
+    uw_bytes(bbuf, sizeof bbuf, bytes);
+    fprintf(stderr, "rad %s: %u charts do not fit the default %ux%u atlas: using %ux%u (about %s; %s N sets it)\n", cmd,
+            nch, *width, *height, side, side, bbuf, size_option);
+    *width = *height = side;
+    return 0;
+}
+
+int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene, uint32_t *width_io, uint32_t *height_io,
+                const tool_unwrap_auto *autosize, float *out_uvs, uint32_t *out_charts)
+{
+    uint32_t width = *width_io, height = *height_io;
+    uint32_t T = scene->triangle_count, t, i, nch = 0, *chart = NULL, *queue = NULL, *first = NULL, *adj = NULL;
+    uw_chart *charts = NULL;
+    float (*frame)[6] = NULL;  /* per chart: the two axes of its plane */
+    double area = 0.0, lo, hi, s;
+    int ok = 0, it;
+    chart = (uint32_t *)malloc(sizeof(uint32_t) * T);
+    queue = (uint32_t *)malloc(sizeof(uint32_t) * T);
+    if (!chart || !queue || uw_adjacency(scene, &first, &adj)) goto done;
     /* charts */
     for (t = 0; t < T; ++t) chart[t] = UINT32_MAX;
     charts = (uw_chart *)malloc(sizeof(uw_chart) * (T ? T : 1u));
@@ -198,32 +246,9 @@ int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene
     }
     /* the largest scale that packs: bisection below the one that fills the atlas exactly */
     qsort(charts, nch, sizeof(uw_chart), uw_by_height);
-    if (autosize && !uw_pack(charts, nch, UNWRAP_TINY, width, height)) {
-        /* no size given: the smallest square power of two that packs, within the cap and memory */
-        uint32_t side = uw_fitting_side(charts, nch, width > height ? width : height, autosize->max_side);
-        double bytes = side ? (double)side * side * autosize->bytes_per_texel : 0.0;
-        char bbuf[32], lbuf[32];
-        if (!side) {
-            uint32_t need = uw_fitting_side(charts, nch, 2u * autosize->max_side, 16384u);
-            fprintf(stderr, "rad %s: %u charts do not fit a %ux%u atlas, the largest the tool picks by itself", cmd, nch,
-                    autosize->max_side, autosize->max_side);
-            if (need) fprintf(stderr, ": give %s %u (it fits) or a mesh with its own lightmap uvs\n", size_option, need);
-            else fprintf(stderr, ", nor the largest allowed (16384): give the meshes their own lightmap uvs\n");
-            goto done;
-        }
-        if (autosize->memory_limit > 0.0 && bytes > autosize->memory_limit) {
-            uw_bytes(bbuf, sizeof bbuf, bytes);
-            uw_bytes(lbuf, sizeof lbuf, autosize->memory_limit);
-            fprintf(stderr, "rad %s: %u charts need a %ux%u atlas, about %s of texels and samples; only %s may be used (%s): "
-                            "give the meshes their own lightmap uvs\n",
-                    cmd, nch, side, side, bbuf, lbuf, autosize->memory_from ? autosize->memory_from : "the memory limit");
-            goto done;
-        }
-        uw_bytes(bbuf, sizeof bbuf, bytes);
-        fprintf(stderr, "rad %s: %u charts do not fit the default %ux%u atlas: using %ux%u (about %s; %s N sets it)\n", cmd,
-                nch, width, height, side, side, bbuf, size_option);
-        width = height = side;
-    }
+    if (autosize && !uw_pack(charts, nch, UNWRAP_TINY, width, height) &&
+        uw_autosize(cmd, size_option, charts, nch, autosize, &width, &height))
+        goto done;
     hi = area > 0.0 ? sqrt((double)width * height / area) : 1.0;
     lo = UNWRAP_TINY;
     if (!uw_pack(charts, nch, UNWRAP_TINY, width, height)) {
@@ -263,10 +288,8 @@ int tool_unwrap(const char *cmd, const char *size_option, const rad_scene *scene
     fprintf(stderr, "rad %s: unwrapped %u triangles into %u charts, %.1f texels per unit\n", cmd, T, nch, s);
     ok = 1;
 done:
-    free(edges);
     free(chart);
     free(queue);
-    free(deg);
     free(first);
     free(adj);
     free(charts);
