@@ -6295,42 +6295,100 @@ static void rad__bvh_task(void *data, uint32_t i)
     j->task_leaves[i] = rad__bvh_build_sub(j->tree, j->refs, ni, j->task_depth[i], 2u * j->tree[ni].first);
 }
 
-/* The children of the wide node over binary node 'bi': opens the largest inner child until
-   there are RAD__BVH_W (or only leaves). Returns their count. */
-static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, uint32_t bi, uint32_t *slots)
+/* The collapse into wide nodes chooses which binary nodes become a wide node's children by
+   the SAH cost of the wide tree, computed bottom-up (as in Ylitie, Karras, Laine 2017): a
+   greedy collapse that opens the largest child first leaves many small subtrees as wide nodes
+   of two leaves, a whole node visit for what the parent had room for. cost[W bi + j - 1] is
+   the least cost of binary node bi's subtree given at most j slots of its parent: one slot
+   (a leaf, or a wide node of its own) or its two children's slots shared out between them.
+   Costs are areas times the cost of a visit; a wide node's test and a leaf's SIMD pass cost
+   about alike. */
+#define RAD__BVH_COST_NODE 1.0f
+#define RAD__BVH_COST_LEAF 1.0f
+
+static float rad__bvh_node_area(const rad__bvh_node *q)
 {
-    uint32_t ns = 0, k;
-    if (bin[bi].count) {
-        slots[ns++] = bi; /* a leaf root (tiny scenes) */
-    } else {
-        slots[ns++] = bin[bi].first;
-        slots[ns++] = bin[bi].first + 1;
-        while (ns < RAD__BVH_W) {
-            float best = -1.0f;
-            uint32_t bk = RAD__BVH_W;
-            for (k = 0; k < ns; ++k) {
-                const rad__bvh_node *q = &bin[slots[k]];
-                float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
-                float area = dx * dy + dy * dz + dz * dx;
-                if (q->count == 0 && area > best) { best = area; bk = k; }
-            }
-            if (bk == RAD__BVH_W) break;
-            slots[ns++] = bin[slots[bk]].first + 1;
-            slots[bk] = bin[slots[bk]].first;
+    float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
+    return dx * dy + dy * dz + dz * dx;
+}
+
+/* the least cost of binary inner node bi's children in at most j slots, and the left child's
+   share of them (the first of equal costs) */
+static float rad__bvhw_share(const rad__bvh_node *bin, const float *cost, uint32_t bi, uint32_t j, uint32_t *left)
+{
+    const float *cl = cost + (size_t)RAD__BVH_W * bin[bi].first, *cr = cl + RAD__BVH_W;
+    float best = cl[0] + cr[j - 2];
+    uint32_t k;
+    *left = 1;
+    for (k = 2; k < j; ++k) {
+        float c = cl[k - 1] + cr[j - k - 1];
+        if (c < best) { best = c; *left = k; }
+    }
+    return best;
+}
+
+/* Fills cost for the subtree under 'root'; 'list' has room for one entry per binary node,
+   'stack' as rad__bvhw_collapse's. */
+static void rad__bvhw_costs(const rad__bvh_node *bin, uint32_t root, uint32_t *stack, uint32_t *list, float *cost)
+{
+    uint32_t sp = 0, nl = 0, i, j, k;
+    stack[sp++] = root;
+    while (sp > 0) { /* pre-order, so the list read backwards puts children before parents */
+        uint32_t bi = stack[--sp];
+        list[nl++] = bi;
+        if (!bin[bi].count) { stack[sp++] = bin[bi].first; stack[sp++] = bin[bi].first + 1; }
+    }
+    for (i = nl; i-- > 0;) {
+        uint32_t bi = list[i];
+        float *c = cost + (size_t)RAD__BVH_W * bi, area = rad__bvh_node_area(&bin[bi]);
+        if (bin[bi].count) {
+            for (j = 0; j < RAD__BVH_W; ++j) c[j] = RAD__BVH_COST_LEAF * area;
+            continue;
         }
+        c[0] = RAD__BVH_COST_NODE * area + rad__bvhw_share(bin, cost, bi, RAD__BVH_W, &k);
+        for (j = 2; j <= RAD__BVH_W; ++j) {
+            float open = rad__bvhw_share(bin, cost, bi, j, &k);
+            c[j - 1] = open < c[0] ? open : c[0];
+        }
+    }
+}
+
+/* The children of the wide node over binary node 'bi' (a leaf root in tiny scenes is its own
+   child), in left-to-right order of the binary tree, as the costs share the slots out.
+   Returns their count. */
+static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, const float *cost, uint32_t bi, uint32_t *slots)
+{
+    uint32_t st[2 * RAD__BVH_W], sp = 0, ns = 0, k;
+    if (bin[bi].count) {
+        slots[ns++] = bi;
+        return ns;
+    }
+    (void)rad__bvhw_share(bin, cost, bi, RAD__BVH_W, &k);
+    st[sp++] = bin[bi].first + 1; st[sp++] = RAD__BVH_W - k;
+    st[sp++] = bin[bi].first; st[sp++] = k;
+    while (sp > 0) {
+        uint32_t j = st[--sp], q = st[--sp];
+        /* one slot, or opened where sharing its children out costs less (as the costs chose) */
+        if (j == 1 || bin[q].count || !(rad__bvhw_share(bin, cost, q, j, &k) < cost[(size_t)RAD__BVH_W * q])) {
+            slots[ns++] = q;
+            continue;
+        }
+        st[sp++] = bin[q].first + 1; st[sp++] = j - k;
+        st[sp++] = bin[q].first; st[sp++] = k;
     }
     return ns;
 }
 
 /* Wide nodes and leaves the collapse of the binary tree under 'root' makes ('stack' as there). */
-static void rad__bvhw_count(const rad__bvh_node *bin, uint32_t root, uint32_t *stack, uint32_t *nodes, uint32_t *leaves)
+static void rad__bvhw_count(const rad__bvh_node *bin, const float *cost, uint32_t root, uint32_t *stack, uint32_t *nodes,
+                            uint32_t *leaves)
 {
     uint32_t sp = 0;
     *nodes = 1;
     *leaves = 0;
     stack[sp++] = root;
     while (sp > 0) {
-        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(bin, stack[--sp], slots), k;
+        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(bin, cost, stack[--sp], slots), k;
         for (k = 0; k < ns; ++k) {
             if (bin[slots[k]].count) {
                 ++*leaves;
@@ -6345,8 +6403,8 @@ static void rad__bvhw_count(const rad__bvh_node *bin, uint32_t root, uint32_t *s
 /* Collapses the binary tree 'bin' into RAD__BVH_W-wide nodes: each wide node opens the largest
    inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
    entries per leaf. */
-static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t root, uint32_t *stack,
-                                     const float *positions, const uint32_t *twins, const uint32_t *order)
+static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, const float *cost, uint32_t root,
+                                     uint32_t *stack, const float *positions, const uint32_t *twins, const uint32_t *order)
 {
     uint32_t sp = 0;
     b->node_count = 1;
@@ -6355,7 +6413,7 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
     while (sp > 0) {
         uint32_t n4 = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns = 0, k;
         rad__bvhw *node = &b->nodes[n4];
-        ns = rad__bvhw_slots(bin, bi, slots);
+        ns = rad__bvhw_slots(bin, cost, bi, slots);
         for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
@@ -6461,6 +6519,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__bref *refs = NULL;
     uint32_t n, i, leaves, nodes;
     uint32_t *stack = NULL, *task = NULL, *order = NULL;
+    float *cost = NULL;
     rad_result r;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -6482,21 +6541,23 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         stack = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 4u, sizeof(uint32_t));
         task = (uint32_t *)rad__alloc_array(&c.allocator, 3u * (size_t)n, sizeof(uint32_t));
         order = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+        cost = (float *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 2u, RAD__BVH_W * sizeof(float));
     }
-    if (!tree || !refs || !stack || !task || !order) {
+    if (!tree || !refs || !stack || !task || !order || !cost) {
         rad__free(&c.allocator, refs); rad__free(&c.allocator, stack); rad__free(&c.allocator, tree);
-        rad__free(&c.allocator, task); rad__free(&c.allocator, order);
+        rad__free(&c.allocator, task); rad__free(&c.allocator, order); rad__free(&c.allocator, cost);
         rad_bvh_destroy(b);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     (void)rad__bvh_build_binary(&c, tree, refs, n, stack, task);
     for (i = 0; i < n; ++i) order[i] = refs[i].id;
     /* Stage 3, the wide nodes and leaves, counted first so the block holds just them */
-    rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
+    rad__bvhw_costs(tree, 2u * n, stack, task, cost);
+    rad__bvhw_count(tree, cost, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
-    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, scene->twins, order);
+    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, cost, 2u * n, stack, scene->positions, scene->twins, order);
     {
-        void *blocks[] = { refs, stack, task, order, tree };
+        void *blocks[] = { refs, stack, task, order, tree, cost };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
     if (r != RAD_SUCCESS) { rad_bvh_destroy(b); return r; }
