@@ -6353,12 +6353,20 @@ static void rad__bvhw_costs(const rad__bvh_node *bin, uint32_t root, uint32_t *s
     }
 }
 
+/* the triangles under binary node bi: its subtree covers one range of the build's order */
+static uint32_t rad__bvh_tri_count(const rad__bvh_node *bin, uint32_t bi)
+{
+    uint32_t lo = bi, hi = bi;
+    while (!bin[lo].count) lo = bin[lo].first;
+    while (!bin[hi].count) hi = bin[hi].first + 1;
+    return bin[hi].first + bin[hi].count - bin[lo].first;
+}
+
 /* The children of the wide node over binary node 'bi' (a leaf root in tiny scenes is its own
-   child), in left-to-right order of the binary tree, as the costs share the slots out.
-   Returns their count. */
+   child), as the costs share the slots out. Returns their count. */
 static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, const float *cost, uint32_t bi, uint32_t *slots)
 {
-    uint32_t st[2 * RAD__BVH_W], sp = 0, ns = 0, k;
+    uint32_t st[2 * RAD__BVH_W], cnt[RAD__BVH_W], sp = 0, ns = 0, k;
     if (bin[bi].count) {
         slots[ns++] = bi;
         return ns;
@@ -6375,6 +6383,16 @@ static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, const float *cost, uin
         }
         st[sp++] = bin[q].first + 1; st[sp++] = j - k;
         st[sp++] = bin[q].first; st[sp++] = k;
+    }
+    /* fewest triangles first (stable): occlusion takes the children in slot order, and a
+       subtree of few triangles under a box the ray enters holds large ones (walls, floors,
+       pillars), the likeliest to stop it */
+    for (k = 0; k < ns; ++k) cnt[k] = rad__bvh_tri_count(bin, slots[k]);
+    for (k = 1; k < ns; ++k) {
+        uint32_t ck = cnt[k], sk = slots[k], i = k;
+        for (; i > 0 && ck < cnt[i - 1]; --i) { cnt[i] = cnt[i - 1]; slots[i] = slots[i - 1]; }
+        cnt[i] = ck;
+        slots[i] = sk;
     }
     return ns;
 }
