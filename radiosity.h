@@ -6312,13 +6312,29 @@ static float rad__bvh_node_area(const rad__bvh_node *q)
     return dx * dy + dy * dz + dz * dx;
 }
 
+/* The costs of the collapse: 'pos' numbers the binary tree's inner nodes, and cost[W pos[bi]
+   + j - 1] is the cost with j slots of inner node bi (a leaf's is its area at any j, not
+   stored: most binary nodes are leaves). */
+typedef struct rad__bvhw_dp {
+    const rad__bvh_node *bin;
+    uint32_t *pos;
+    float *cost;
+} rad__bvhw_dp;
+
+static float rad__bvhw_cost(const rad__bvhw_dp *dp, uint32_t bi, uint32_t j)
+{
+    if (dp->bin[bi].count) return RAD__BVH_COST_LEAF * rad__bvh_node_area(&dp->bin[bi]);
+    return dp->cost[(size_t)RAD__BVH_W * dp->pos[bi] + j - 1];
+}
+
 /* the least cost of binary inner node bi's children in at most j slots, and the left child's
    share of them (the first of equal costs) */
-static float rad__bvhw_share(const rad__bvh_node *bin, const float *cost, uint32_t bi, uint32_t j, uint32_t *left)
+static float rad__bvhw_share(const rad__bvhw_dp *dp, uint32_t bi, uint32_t j, uint32_t *left)
 {
-    const float *cl = cost + (size_t)RAD__BVH_W * bin[bi].first, *cr = cl + RAD__BVH_W;
-    float best = cl[0] + cr[j - 2];
-    uint32_t k;
+    float cl[RAD__BVH_W], cr[RAD__BVH_W], best;
+    uint32_t k, l = dp->bin[bi].first;
+    for (k = 1; k < j; ++k) { cl[k - 1] = rad__bvhw_cost(dp, l, k); cr[k - 1] = rad__bvhw_cost(dp, l + 1, k); }
+    best = cl[0] + cr[j - 2];
     *left = 1;
     for (k = 2; k < j; ++k) {
         float c = cl[k - 1] + cr[j - k - 1];
@@ -6327,11 +6343,12 @@ static float rad__bvhw_share(const rad__bvh_node *bin, const float *cost, uint32
     return best;
 }
 
-/* Fills cost for the subtree under 'root'; 'list' has room for one entry per binary node,
-   'stack' as rad__bvhw_collapse's. */
-static void rad__bvhw_costs(const rad__bvh_node *bin, uint32_t root, uint32_t *stack, uint32_t *list, float *cost)
+/* Fills the costs for the subtree under 'root'; 'list' has room for one entry per binary
+   node, 'stack' as rad__bvhw_collapse's. */
+static void rad__bvhw_costs(rad__bvhw_dp *dp, uint32_t root, uint32_t *stack, uint32_t *list)
 {
-    uint32_t sp = 0, nl = 0, i, j, k;
+    const rad__bvh_node *bin = dp->bin;
+    uint32_t sp = 0, nl = 0, ni = 0, i, j, k;
     stack[sp++] = root;
     while (sp > 0) { /* pre-order, so the list read backwards puts children before parents */
         uint32_t bi = stack[--sp];
@@ -6340,14 +6357,13 @@ static void rad__bvhw_costs(const rad__bvh_node *bin, uint32_t root, uint32_t *s
     }
     for (i = nl; i-- > 0;) {
         uint32_t bi = list[i];
-        float *c = cost + (size_t)RAD__BVH_W * bi, area = rad__bvh_node_area(&bin[bi]);
-        if (bin[bi].count) {
-            for (j = 0; j < RAD__BVH_W; ++j) c[j] = RAD__BVH_COST_LEAF * area;
-            continue;
-        }
-        c[0] = RAD__BVH_COST_NODE * area + rad__bvhw_share(bin, cost, bi, RAD__BVH_W, &k);
+        float *c;
+        if (bin[bi].count) continue;
+        dp->pos[bi] = ni;
+        c = dp->cost + (size_t)RAD__BVH_W * ni++;
+        c[0] = RAD__BVH_COST_NODE * rad__bvh_node_area(&bin[bi]) + rad__bvhw_share(dp, bi, RAD__BVH_W, &k);
         for (j = 2; j <= RAD__BVH_W; ++j) {
-            float open = rad__bvhw_share(bin, cost, bi, j, &k);
+            float open = rad__bvhw_share(dp, bi, j, &k);
             c[j - 1] = open < c[0] ? open : c[0];
         }
     }
@@ -6364,20 +6380,21 @@ static uint32_t rad__bvh_tri_count(const rad__bvh_node *bin, uint32_t bi)
 
 /* The children of the wide node over binary node 'bi' (a leaf root in tiny scenes is its own
    child), as the costs share the slots out. Returns their count. */
-static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, const float *cost, uint32_t bi, uint32_t *slots)
+static uint32_t rad__bvhw_slots(const rad__bvhw_dp *dp, uint32_t bi, uint32_t *slots)
 {
+    const rad__bvh_node *bin = dp->bin;
     uint32_t st[2 * RAD__BVH_W], cnt[RAD__BVH_W], sp = 0, ns = 0, k;
     if (bin[bi].count) {
         slots[ns++] = bi;
         return ns;
     }
-    (void)rad__bvhw_share(bin, cost, bi, RAD__BVH_W, &k);
+    (void)rad__bvhw_share(dp, bi, RAD__BVH_W, &k);
     st[sp++] = bin[bi].first + 1; st[sp++] = RAD__BVH_W - k;
     st[sp++] = bin[bi].first; st[sp++] = k;
     while (sp > 0) {
         uint32_t j = st[--sp], q = st[--sp];
         /* one slot, or opened where sharing its children out costs less (as the costs chose) */
-        if (j == 1 || bin[q].count || !(rad__bvhw_share(bin, cost, q, j, &k) < cost[(size_t)RAD__BVH_W * q])) {
+        if (j == 1 || bin[q].count || !(rad__bvhw_share(dp, q, j, &k) < rad__bvhw_cost(dp, q, 1))) {
             slots[ns++] = q;
             continue;
         }
@@ -6398,15 +6415,15 @@ static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, const float *cost, uin
 }
 
 /* Wide nodes and leaves the collapse of the binary tree under 'root' makes ('stack' as there). */
-static void rad__bvhw_count(const rad__bvh_node *bin, const float *cost, uint32_t root, uint32_t *stack, uint32_t *nodes,
-                            uint32_t *leaves)
+static void rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack, uint32_t *nodes, uint32_t *leaves)
 {
+    const rad__bvh_node *bin = dp->bin;
     uint32_t sp = 0;
     *nodes = 1;
     *leaves = 0;
     stack[sp++] = root;
     while (sp > 0) {
-        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(bin, cost, stack[--sp], slots), k;
+        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(dp, stack[--sp], slots), k;
         for (k = 0; k < ns; ++k) {
             if (bin[slots[k]].count) {
                 ++*leaves;
@@ -6421,9 +6438,10 @@ static void rad__bvhw_count(const rad__bvh_node *bin, const float *cost, uint32_
 /* Collapses the binary tree 'bin' into RAD__BVH_W-wide nodes: each wide node opens the largest
    inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
    entries per leaf. */
-static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, const float *cost, uint32_t root,
-                                     uint32_t *stack, const float *positions, const uint32_t *twins, const uint32_t *order)
+static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack,
+                                     const float *positions, const uint32_t *twins, const uint32_t *order)
 {
+    const rad__bvh_node *bin = dp->bin;
     uint32_t sp = 0;
     b->node_count = 1;
     stack[sp++] = root; /* binary node */
@@ -6431,7 +6449,7 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, const
     while (sp > 0) {
         uint32_t n4 = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns = 0, k;
         rad__bvhw *node = &b->nodes[n4];
-        ns = rad__bvhw_slots(bin, cost, bi, slots);
+        ns = rad__bvhw_slots(dp, bi, slots);
         for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
@@ -6536,8 +6554,9 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__bvh_node *tree = NULL;
     rad__bref *refs = NULL;
     uint32_t n, i, leaves, nodes;
-    uint32_t *stack = NULL, *task = NULL, *order = NULL;
+    uint32_t *stack = NULL, *task = NULL, *order = NULL, *pos = NULL;
     float *cost = NULL;
+    rad__bvhw_dp dp;
     rad_result r;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -6559,23 +6578,29 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         stack = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 4u, sizeof(uint32_t));
         task = (uint32_t *)rad__alloc_array(&c.allocator, 3u * (size_t)n, sizeof(uint32_t));
         order = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
-        cost = (float *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 2u, RAD__BVH_W * sizeof(float));
+        /* inner nodes: fewer than n; the numbering is sparse over the tree's 4 n + 2 slots */
+        cost = (float *)rad__alloc_array(&c.allocator, n, RAD__BVH_W * sizeof(float));
+        pos = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 2u, sizeof(uint32_t));
     }
-    if (!tree || !refs || !stack || !task || !order || !cost) {
+    if (!tree || !refs || !stack || !task || !order || !cost || !pos) {
         rad__free(&c.allocator, refs); rad__free(&c.allocator, stack); rad__free(&c.allocator, tree);
         rad__free(&c.allocator, task); rad__free(&c.allocator, order); rad__free(&c.allocator, cost);
+        rad__free(&c.allocator, pos);
         rad_bvh_destroy(b);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     (void)rad__bvh_build_binary(&c, tree, refs, n, stack, task);
     for (i = 0; i < n; ++i) order[i] = refs[i].id;
     /* Stage 3, the wide nodes and leaves, counted first so the block holds just them */
-    rad__bvhw_costs(tree, 2u * n, stack, task, cost);
-    rad__bvhw_count(tree, cost, 2u * n, stack, &nodes, &leaves);
+    dp.bin = tree;
+    dp.pos = pos;
+    dp.cost = cost;
+    rad__bvhw_costs(&dp, 2u * n, stack, task);
+    rad__bvhw_count(&dp, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
-    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, cost, 2u * n, stack, scene->positions, scene->twins, order);
+    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, &dp, 2u * n, stack, scene->positions, scene->twins, order);
     {
-        void *blocks[] = { refs, stack, task, order, tree, cost };
+        void *blocks[] = { refs, stack, task, order, tree, cost, pos };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
     if (r != RAD_SUCCESS) { rad_bvh_destroy(b); return r; }
