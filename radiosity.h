@@ -6331,14 +6331,12 @@ static float rad__bvhw_cost(const rad__bvhw_dp *dp, uint32_t bi, uint32_t j)
    share of them (the first of equal costs) */
 static float rad__bvhw_share(const rad__bvhw_dp *dp, uint32_t bi, uint32_t j, uint32_t *left)
 {
-    float cl[RAD__BVH_W], cr[RAD__BVH_W], best;
+    float best = 0.0f;
     uint32_t k, l = dp->bin[bi].first;
-    for (k = 1; k < j; ++k) { cl[k - 1] = rad__bvhw_cost(dp, l, k); cr[k - 1] = rad__bvhw_cost(dp, l + 1, k); }
-    best = cl[0] + cr[j - 2];
     *left = 1;
-    for (k = 2; k < j; ++k) {
-        float c = cl[k - 1] + cr[j - k - 1];
-        if (c < best) { best = c; *left = k; }
+    for (k = 1; k < j; ++k) {
+        float c = rad__bvhw_cost(dp, l, k) + rad__bvhw_cost(dp, l + 1, j - k);
+        if (k == 1 || c < best) { best = c; *left = k; }
     }
     return best;
 }
