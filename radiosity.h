@@ -688,7 +688,8 @@ typedef struct rad_bvh rad_bvh;
 
 /* Builds the BVH over the scene's triangles: binned SAH down to leaves of at most 4 triangles
    (stored side by side and tested together with SIMD), collapsed to 8-wide nodes when the
-   implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD). The
+   implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD), by the
+   least SAH cost of the wide tree, each node's children fewest triangles first. The
    subtrees below the top levels are built in parallel through ctx->parallel_for; the tree does
    not depend on the thread count. scene is borrowed only for the call (the BVH copies the
    triangles). Errors: INVALID_ARGUMENT, OUT_OF_MEMORY, SIZE_OVERFLOW (2^29 triangles or more).
@@ -6433,9 +6434,8 @@ static void rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *sta
     }
 }
 
-/* Collapses the binary tree 'bin' into RAD__BVH_W-wide nodes: each wide node opens the largest
-   inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
-   entries per leaf. */
+/* Collapses the binary tree into RAD__BVH_W-wide nodes, each with the children
+   rad__bvhw_slots gives it. 'stack' has room for 4 entries per leaf. */
 static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack,
                                      const float *positions, const uint32_t *twins, const uint32_t *order)
 {
