@@ -6299,9 +6299,9 @@ static void rad__bvh_task(void *data, uint32_t i)
 /* The collapse into wide nodes chooses which binary nodes become a wide node's children by
    the SAH cost of the wide tree, computed bottom-up (as in Ylitie, Karras, Laine 2017): a
    greedy collapse that opens the largest child first leaves many small subtrees as wide nodes
-   of two leaves, a whole node visit for what the parent had room for. cost[W bi + j - 1] is
-   the least cost of binary node bi's subtree given at most j slots of its parent: one slot
-   (a leaf, or a wide node of its own) or its two children's slots shared out between them.
+   of two leaves, a whole node visit for what the parent had room for. For each binary node
+   the least cost of its subtree given at most j slots of its parent: one slot (a leaf, or a
+   wide node of its own) or its two children's slots shared out between them.
    Costs are areas times the cost of a visit; a wide node's test and a leaf's SIMD pass cost
    about alike. */
 #define RAD__BVH_COST_NODE 1.0f
