@@ -738,7 +738,8 @@ typedef struct rad_bvh rad_bvh;
 
 /* Builds the BVH over the scene's triangles: binned SAH down to leaves of at most 4 triangles
    (stored side by side and tested together with SIMD), collapsed to 8-wide nodes when the
-   implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD). The
+   implementing file is compiled with AVX, else 4-wide (SSE; scalar under RAD_NO_SIMD), by the
+   least SAH cost of the wide tree, each node's children fewest triangles first. The
    subtrees below the top levels are built in parallel through ctx->parallel_for; the tree does
    not depend on the thread count. scene is borrowed only for the call (the BVH copies the
    triangles, and the uvs, texture and cutoff of cutout triangles; the scene's opacity_lookup
@@ -6655,42 +6656,133 @@ static void rad__bvh_task(void *data, uint32_t i)
     j->task_leaves[i] = rad__bvh_build_sub(j->tree, j->refs, ni, j->task_depth[i], 2u * j->tree[ni].first);
 }
 
-/* The children of the wide node over binary node 'bi': opens the largest inner child until
-   there are RAD__BVH_W (or only leaves). Returns their count. */
-static uint32_t rad__bvhw_slots(const rad__bvh_node *bin, uint32_t bi, uint32_t *slots)
+/* The collapse into wide nodes chooses which binary nodes become a wide node's children by
+   the SAH cost of the wide tree, computed bottom-up (as in Ylitie, Karras, Laine 2017): a
+   greedy collapse that opens the largest child first leaves many small subtrees as wide nodes
+   of two leaves, a whole node visit for what the parent had room for. For each binary node
+   the least cost of its subtree given at most j slots of its parent: one slot (a leaf, or a
+   wide node of its own) or its two children's slots shared out between them.
+   Costs are areas times the cost of a visit; a wide node's test and a leaf's SIMD pass cost
+   about alike. */
+#define RAD__BVH_COST_NODE 1.0f
+#define RAD__BVH_COST_LEAF 1.0f
+
+static float rad__bvh_node_area(const rad__bvh_node *q)
 {
-    uint32_t ns = 0, k;
-    if (bin[bi].count) {
-        slots[ns++] = bi; /* a leaf root (tiny scenes) */
-    } else {
-        slots[ns++] = bin[bi].first;
-        slots[ns++] = bin[bi].first + 1;
-        while (ns < RAD__BVH_W) {
-            float best = -1.0f;
-            uint32_t bk = RAD__BVH_W;
-            for (k = 0; k < ns; ++k) {
-                const rad__bvh_node *q = &bin[slots[k]];
-                float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
-                float area = dx * dy + dy * dz + dz * dx;
-                if (q->count == 0 && area > best) { best = area; bk = k; }
-            }
-            if (bk == RAD__BVH_W) break;
-            slots[ns++] = bin[slots[bk]].first + 1;
-            slots[bk] = bin[slots[bk]].first;
+    float dx = q->bmax[0] - q->bmin[0], dy = q->bmax[1] - q->bmin[1], dz = q->bmax[2] - q->bmin[2];
+    return dx * dy + dy * dz + dz * dx;
+}
+
+/* The costs of the collapse: 'pos' numbers the binary tree's inner nodes, and cost[W pos[bi]
+   + j - 1] is the cost with j slots of inner node bi (a leaf's is its area at any j, not
+   stored: most binary nodes are leaves). */
+typedef struct rad__bvhw_dp {
+    const rad__bvh_node *bin;
+    uint32_t *pos;
+    float *cost;
+} rad__bvhw_dp;
+
+static float rad__bvhw_cost(const rad__bvhw_dp *dp, uint32_t bi, uint32_t j)
+{
+    if (dp->bin[bi].count) return RAD__BVH_COST_LEAF * rad__bvh_node_area(&dp->bin[bi]);
+    return dp->cost[(size_t)RAD__BVH_W * dp->pos[bi] + j - 1];
+}
+
+/* the least cost of binary inner node bi's children in at most j slots, and the left child's
+   share of them (the first of equal costs) */
+static float rad__bvhw_share(const rad__bvhw_dp *dp, uint32_t bi, uint32_t j, uint32_t *left)
+{
+    float best = 0.0f;
+    uint32_t k, l = dp->bin[bi].first;
+    *left = 1;
+    for (k = 1; k < j; ++k) {
+        float c = rad__bvhw_cost(dp, l, k) + rad__bvhw_cost(dp, l + 1, j - k);
+        if (k == 1 || c < best) { best = c; *left = k; }
+    }
+    return best;
+}
+
+/* Fills the costs for the subtree under 'root'; 'list' has room for one entry per binary
+   node, 'stack' as rad__bvhw_collapse's. */
+static void rad__bvhw_costs(rad__bvhw_dp *dp, uint32_t root, uint32_t *stack, uint32_t *list)
+{
+    const rad__bvh_node *bin = dp->bin;
+    uint32_t sp = 0, nl = 0, ni = 0, i, j, k;
+    stack[sp++] = root;
+    while (sp > 0) { /* pre-order, so the list read backwards puts children before parents */
+        uint32_t bi = stack[--sp];
+        list[nl++] = bi;
+        if (!bin[bi].count) { stack[sp++] = bin[bi].first; stack[sp++] = bin[bi].first + 1; }
+    }
+    for (i = nl; i-- > 0;) {
+        uint32_t bi = list[i];
+        float *c;
+        if (bin[bi].count) continue;
+        dp->pos[bi] = ni;
+        c = dp->cost + (size_t)RAD__BVH_W * ni++;
+        c[0] = RAD__BVH_COST_NODE * rad__bvh_node_area(&bin[bi]) + rad__bvhw_share(dp, bi, RAD__BVH_W, &k);
+        for (j = 2; j <= RAD__BVH_W; ++j) {
+            float open = rad__bvhw_share(dp, bi, j, &k);
+            c[j - 1] = open < c[0] ? open : c[0];
         }
+    }
+}
+
+/* the triangles under binary node bi: its subtree covers one range of the build's order */
+static uint32_t rad__bvh_tri_count(const rad__bvh_node *bin, uint32_t bi)
+{
+    uint32_t lo = bi, hi = bi;
+    while (!bin[lo].count) lo = bin[lo].first;
+    while (!bin[hi].count) hi = bin[hi].first + 1;
+    return bin[hi].first + bin[hi].count - bin[lo].first;
+}
+
+/* The children of the wide node over binary node 'bi' (a leaf root in tiny scenes is its own
+   child), as the costs share the slots out. Returns their count. */
+static uint32_t rad__bvhw_slots(const rad__bvhw_dp *dp, uint32_t bi, uint32_t *slots)
+{
+    const rad__bvh_node *bin = dp->bin;
+    uint32_t st[2 * RAD__BVH_W], cnt[RAD__BVH_W], sp = 0, ns = 0, k;
+    if (bin[bi].count) {
+        slots[ns++] = bi;
+        return ns;
+    }
+    (void)rad__bvhw_share(dp, bi, RAD__BVH_W, &k);
+    st[sp++] = bin[bi].first + 1; st[sp++] = RAD__BVH_W - k;
+    st[sp++] = bin[bi].first; st[sp++] = k;
+    while (sp > 0) {
+        uint32_t j = st[--sp], q = st[--sp];
+        /* one slot, or opened where sharing its children out costs less (as the costs chose) */
+        if (j == 1 || bin[q].count || !(rad__bvhw_share(dp, q, j, &k) < rad__bvhw_cost(dp, q, 1))) {
+            slots[ns++] = q;
+            continue;
+        }
+        st[sp++] = bin[q].first + 1; st[sp++] = j - k;
+        st[sp++] = bin[q].first; st[sp++] = k;
+    }
+    /* fewest triangles first (stable): occlusion takes the children in slot order, and a
+       subtree of few triangles under a box the ray enters holds large ones (walls, floors,
+       pillars), the likeliest to stop it */
+    for (k = 0; k < ns; ++k) cnt[k] = rad__bvh_tri_count(bin, slots[k]);
+    for (k = 1; k < ns; ++k) {
+        uint32_t ck = cnt[k], sk = slots[k], i = k;
+        for (; i > 0 && ck < cnt[i - 1]; --i) { cnt[i] = cnt[i - 1]; slots[i] = slots[i - 1]; }
+        cnt[i] = ck;
+        slots[i] = sk;
     }
     return ns;
 }
 
 /* Wide nodes and leaves the collapse of the binary tree under 'root' makes ('stack' as there). */
-static void rad__bvhw_count(const rad__bvh_node *bin, uint32_t root, uint32_t *stack, uint32_t *nodes, uint32_t *leaves)
+static void rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack, uint32_t *nodes, uint32_t *leaves)
 {
+    const rad__bvh_node *bin = dp->bin;
     uint32_t sp = 0;
     *nodes = 1;
     *leaves = 0;
     stack[sp++] = root;
     while (sp > 0) {
-        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(bin, stack[--sp], slots), k;
+        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(dp, stack[--sp], slots), k;
         for (k = 0; k < ns; ++k) {
             if (bin[slots[k]].count) {
                 ++*leaves;
@@ -6702,12 +6794,12 @@ static void rad__bvhw_count(const rad__bvh_node *bin, uint32_t root, uint32_t *s
     }
 }
 
-/* Collapses the binary tree 'bin' into RAD__BVH_W-wide nodes: each wide node opens the largest
-   inner child of its binary node until it has RAD__BVH_W children. 'stack' has room for 4
-   entries per leaf. */
-static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint32_t root, uint32_t *stack,
+/* Collapses the binary tree into RAD__BVH_W-wide nodes, each with the children
+   rad__bvhw_slots gives it. 'stack' has room for 4 entries per leaf. */
+static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack,
                                      const float *positions, const uint32_t *twins, const uint32_t *order)
 {
+    const rad__bvh_node *bin = dp->bin;
     uint32_t sp = 0;
     b->node_count = 1;
     stack[sp++] = root; /* binary node */
@@ -6715,7 +6807,7 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvh_node *bin, uint3
     while (sp > 0) {
         uint32_t n4 = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns = 0, k;
         rad__bvhw *node = &b->nodes[n4];
-        ns = rad__bvhw_slots(bin, bi, slots);
+        ns = rad__bvhw_slots(dp, bi, slots);
         for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
             if (k >= ns) {
@@ -6820,7 +6912,9 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     rad__bvh_node *tree = NULL;
     rad__bref *refs = NULL;
     uint32_t n, i, leaves, nodes;
-    uint32_t *stack = NULL, *task = NULL, *order = NULL;
+    uint32_t *stack = NULL, *task = NULL, *order = NULL, *pos = NULL;
+    float *cost = NULL;
+    rad__bvhw_dp dp;
     rad_result r;
     rad__ctx_init(&c, ctx);
     if (!out) return RAD_ERROR_INVALID_ARGUMENT;
@@ -6842,19 +6936,27 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
         stack = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 4u, sizeof(uint32_t));
         task = (uint32_t *)rad__alloc_array(&c.allocator, 3u * (size_t)n, sizeof(uint32_t));
         order = (uint32_t *)rad__alloc_array(&c.allocator, n, sizeof(uint32_t));
+        /* inner nodes: fewer than n; the numbering is sparse over the tree's 4 n + 2 slots */
+        cost = (float *)rad__alloc_array(&c.allocator, n, RAD__BVH_W * sizeof(float));
+        pos = (uint32_t *)rad__alloc_array(&c.allocator, 4u * (size_t)n + 2u, sizeof(uint32_t));
     }
-    if (!tree || !refs || !stack || !task || !order) {
+    if (!tree || !refs || !stack || !task || !order || !cost || !pos) {
         rad__free(&c.allocator, refs); rad__free(&c.allocator, stack); rad__free(&c.allocator, tree);
-        rad__free(&c.allocator, task); rad__free(&c.allocator, order);
+        rad__free(&c.allocator, task); rad__free(&c.allocator, order); rad__free(&c.allocator, cost);
+        rad__free(&c.allocator, pos);
         rad_bvh_destroy(b);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     (void)rad__bvh_build_binary(&c, tree, refs, n, stack, task);
     for (i = 0; i < n; ++i) order[i] = refs[i].id;
     /* Stage 3, the wide nodes and leaves, counted first so the block holds just them */
-    rad__bvhw_count(tree, 2u * n, stack, &nodes, &leaves);
+    dp.bin = tree;
+    dp.pos = pos;
+    dp.cost = cost;
+    rad__bvhw_costs(&dp, 2u * n, stack, task);
+    rad__bvhw_count(&dp, 2u * n, stack, &nodes, &leaves);
     r = rad__bvh_block(&c, b, nodes, leaves);
-    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, tree, 2u * n, stack, scene->positions, scene->twins, order);
+    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, &dp, 2u * n, stack, scene->positions, scene->twins, order);
     if (r == RAD_SUCCESS) r = rad__cutout_build(&c, scene, &b->cutout);
     if (b->cutout) /* mark the cutout lanes */
         for (i = 0; i < b->leaf_count; ++i) {
@@ -6864,7 +6966,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
                     b->leaves[i].id[j] |= RAD__BVH_CUTOUT;
         }
     {
-        void *blocks[] = { refs, stack, task, order, tree };
+        void *blocks[] = { refs, stack, task, order, tree, cost, pos };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
     if (r != RAD_SUCCESS) { rad_bvh_destroy(b); return r; }
