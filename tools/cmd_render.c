@@ -1269,6 +1269,35 @@ static int render_local_method(const char *cmd, const tool_world *w, const tool_
     return rc;
 }
 
+/* No --method (and no --bake): the library's plan picks classic or AAVP and the resolution
+   from the scene and the budget (rad_baker_plan), and says so before the work. */
+static int render_default_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                                 tool_method_options *mo)
+{
+    rad_baker_options bo;
+    rad_baker_choice plan;
+    rad_context ctx;
+    rad_result r;
+    memset(&bo, 0, sizeof bo);
+    bo.max_memory = o->max_memory;
+    bo.patches = o->patches;
+    bo.ff_samples = o->samples;
+    bo.bounces = o->bounces;
+    bo.light_samples = o->light_samples;
+    tool_context(&ctx, NULL);
+    if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
+    if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
+        mo->method = TOOL_AAVP;
+        mo->vp_resolution = plan.vp_resolution;
+    }
+    if (plan.method == RAD_BAKER_VIRTUAL_PATCHES)
+        fprintf(stderr, "rad %s: no --method given: chose aavp at --vp-resolution %u (give --method to choose)\n", cmd,
+                plan.vp_resolution);
+    else
+        fprintf(stderr, "rad %s: no --method given: chose classic (give --method to choose)\n", cmd);
+    return 0;
+}
+
 static int render_main(int argc, char **argv, tool_lights *lights)
 {
     const char *cmd = "render", *scene_name = NULL, *out_path = NULL, *bake_path = NULL, *method;
@@ -1395,6 +1424,13 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     if (tool_check_outputs(cmd, &out_path, 1, w.file.input_files, (int)w.file.input_file_count)) {
         tool_close_world(&w);
         return 1;
+    }
+    if (!(mo.given & TOOL_OPT_METHOD) && !bake_path) {
+        if (render_default_method(cmd, &w, &o, &mo)) {
+            tool_close_world(&w);
+            return 1;
+        }
+        method = tool_method_name(mo.method);
     }
     {
         uint32_t t, emitters = 0;
