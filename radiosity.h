@@ -22289,7 +22289,7 @@ static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *r
     if (!cum) return RAD_ERROR_OUT_OF_MEMORY;
     for (k = 0; k < T; ++k) cum[k] = total += (double)S->areas[k];
     for (k = 0; k < RAD__PLAN_RAYS; k += BATCH) {
-        uint32_t m = RAD__PLAN_RAYS - k < BATCH ? RAD__PLAN_RAYS - k : BATCH;
+        uint32_t m = RAD__PLAN_RAYS - k < (uint32_t)BATCH ? RAD__PLAN_RAYS - k : (uint32_t)BATCH;
         for (j = 0; j < m; ++j) {
             uint32_t s = k + j, h = rad__hash(seed ^ rad__hash(s + 0x9E3779B9u)), h2 = rad__hash(h + 1u), h3 = rad__hash(h + 2u);
             double u = ((double)s + (double)(h >> 8) / 16777216.0) / (double)RAD__PLAN_RAYS * total;
@@ -22352,7 +22352,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
     const rad_scene *S = in->scene;
     const rad_baker_options *o = &in->o;
     double budget = o->max_memory, seconds_budget = o->max_seconds, N, bytes = 0.0, secs = 0.0, longest = 0.0;
-    char bb[32], lb[32], tb[32], sb[32], why[256];
+    char bb[32], lb[32], tb[32], sb[32], why[256], text[1024];
     rad_patches *patches = NULL;
     rad_result r;
     int k, classic_fits = 0;
@@ -22458,7 +22458,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
         P->over_budget = time_over;
         rad__baker_bytes(bb, sizeof bb, bytes);
         rad__baker_time(tb, sizeof tb, secs);
-        snprintf(P->reason, sizeof P->reason,
+        snprintf(text, sizeof text,
                  "virtual patches: %smean free path %.3g (%.0f%% of rays leave the scene) asks for resolution %u; "
                  "resolution %u%s gives %u patches (%u samples), about %s and %s of CPU%s",
                  o->method == RAD_BAKER_VIRTUAL_PATCHES ? "(asked for) " : why, (double)P->free_path,
@@ -22467,6 +22467,10 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
                  : P->budget_limited                    ? " (all the budget of max_memory and max_seconds allows)"
                                                         : "",
                  cnt.patches, cnt.samples, bb, tb, time_over ? ", over the time budget even so" : "");
+        {
+            size_t len = strlen(text); /* the words that fit; P was zeroed, so the rest stays 0 */
+            memcpy(P->reason, text, len < sizeof P->reason ? len : sizeof P->reason - 1);
+        }
     }
     return RAD_SUCCESS;
 }

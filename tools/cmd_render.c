@@ -1270,7 +1270,9 @@ static int render_local_method(const char *cmd, const tool_world *w, const tool_
 }
 
 /* No --method (and no --bake): the library's plan picks classic or AAVP and the resolution
-   from the scene and the budget (rad_baker_plan), and says so before the work. */
+   from the scene and the budget (rad_baker_plan), and says so before the work. A
+   virtual-patch method (or proxy) without --vp-resolution or --vp-max-patches takes the
+   plan's resolution the same way. */
 static int render_default_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
                                  tool_method_options *mo)
 {
@@ -1278,7 +1280,9 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     rad_baker_choice plan;
     rad_context ctx;
     rad_result r;
+    int chosen = !(mo->given & TOOL_OPT_METHOD);
     memset(&bo, 0, sizeof bo);
+    bo.method = chosen ? RAD_BAKER_AUTO : RAD_BAKER_VIRTUAL_PATCHES;
     bo.max_memory = o->max_memory;
     bo.patches = o->patches;
     bo.ff_samples = o->samples;
@@ -1287,10 +1291,12 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     tool_context(&ctx, NULL);
     if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
     if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
-        mo->method = TOOL_AAVP;
+        if (chosen) mo->method = TOOL_AAVP;
         mo->vp_resolution = plan.vp_resolution;
     }
-    if (plan.method == RAD_BAKER_VIRTUAL_PATCHES)
+    if (!chosen)
+        fprintf(stderr, "rad %s: no --vp-resolution given: resolution %u from the scene\n", cmd, plan.vp_resolution);
+    else if (plan.method == RAD_BAKER_VIRTUAL_PATCHES)
         fprintf(stderr, "rad %s: no --method given: chose aavp at --vp-resolution %u (give --method to choose)\n", cmd,
                 plan.vp_resolution);
     else
@@ -1425,7 +1431,10 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         tool_close_world(&w);
         return 1;
     }
-    if (!(mo.given & TOOL_OPT_METHOD) && !bake_path) {
+    if (!bake_path && (!(mo.given & TOOL_OPT_METHOD) ||
+                       ((mo.method == TOOL_AAVP || mo.method == TOOL_VP || mo.proxy == TOOL_PROXY_AAVP ||
+                         mo.proxy == TOOL_PROXY_VP) &&
+                        !(mo.given & (TOOL_OPT_VP_RESOLUTION | TOOL_OPT_VP_MAX_PATCHES))))) {
         if (render_default_method(cmd, &w, &o, &mo)) {
             tool_close_world(&w);
             return 1;
