@@ -126,7 +126,7 @@ const char *tool_method_help(int render)
                     "vp (clustered virtual patches) and aavp (axis-aligned virtual patches); any mesh size, no\n"
                     "per-triangle patches (--patches etc. are ignored); --bounces K|inf as classic (Jacobi; inf:\n"
                     "Gauss-Seidel to 1e-6); indirect light gathered per pixel from the voxel grid:\n"
-                    "  --vp-resolution R  voxels along the longest axis of the scene (default 16)\n"
+                    "  --vp-resolution R  voxels along the longest axis of the scene (render: the scene's; else 16)\n"
                     "  --vp-max-patches B the finest resolution whose patch count is at most B (replaces\n"
                     "                     --vp-resolution; found by building at predicted resolutions, <= 6 builds)\n"
                     "  --face-points P    Hammersley points per voxel face (default 16)\n"

@@ -5,7 +5,7 @@
 #   sponza-sun    the same under a sun
 #   sponza-point  the same lit by a point light in the middle of the court
 #   open-room     a generated room lit through a ceiling opening by an emitter larger than the
-#                 opening (tests/data/open_room.sh, about 10 000 triangles)
+#                 opening (tests/data/open_room.sh, 11 202 triangles)
 #   interior      a furnished interior: RAD_DATA_DIR/interior.obj (with its .mtl) when there is
 #                 one, and its light in RAD_DATA_DIR/interior.lights (rad options, one line)
 # One markdown table to the file given ($2): the ratio of mean linear radiance (1 = no light

@@ -3,8 +3,8 @@
 # 0.7) with a 1.6 x 1.6 opening in the middle of its ceiling, a 0.8 block on the floor, and a
 # one-sided emissive panel 3 x 3 (radiance 5) 0.4 above the opening, facing down: an emitter
 # larger than the opening it lights the room through, so most of it is hidden from any point
-# inside. Each quad is cut into N x N cells (two triangles each): N 1 gives 26 triangles,
-# N 20 about 10 000.
+# inside. Each quad but the panel is cut into N x N cells (two triangles each): N 1 gives 30
+# triangles, N 20 11 202.
 #   bash tests/data/open_room.sh OUT N
 set -eu
 OUT=$1
@@ -16,8 +16,8 @@ newmtl lamp
 Kd 0 0 0
 Ke 5 5 5
 MTL
-awk -v n="$N" -v mtl="$(basename "$OUT").mtl" '
-function quad(px, py, pz, ux, uy, uz, vx, vy, vz,   i, j, a) {
+awk -v N="$N" -v mtl="$(basename "$OUT").mtl" '
+function quad(px, py, pz, ux, uy, uz, vx, vy, vz, n,   i, j, a) {
     # the cells of p + s u + t v, wound so that the normal is u x v
     for (j = 0; j <= n; ++j)
         for (i = 0; i <= n; ++i)
@@ -34,20 +34,20 @@ BEGIN {
     print "mtllib " mtl
     print "o room"
     print "usemtl wall"
-    quad(0, 0, 0, 0, 0, 4, 4, 0, 0)            # floor, facing +y
-    quad(0, 0, 0, 0, 3, 0, 0, 0, 4)            # x = 0, facing +x
-    quad(4, 0, 0, 0, 0, 4, 0, 3, 0)            # x = 4, facing -x
-    quad(0, 0, 0, 4, 0, 0, 0, 3, 0)            # z = 0, facing +z
-    quad(0, 0, 4, 0, 3, 0, 4, 0, 0)            # z = 4, facing -z
-    quad(0, 3, 0, 4, 0, 0, 0, 0, 1.2)          # the ceiling around the opening, facing -y
-    quad(0, 3, 2.8, 4, 0, 0, 0, 0, 1.2)
-    quad(0, 3, 1.2, 1.2, 0, 0, 0, 0, 1.6)
-    quad(2.8, 3, 1.2, 1.2, 0, 0, 0, 0, 1.6)
-    quad(2.6, 0.8, 0.6, 0, 0, 0.8, 0.8, 0, 0)  # the block: top, then four sides facing out
-    quad(2.6, 0, 0.6, 0, 0, 0.8, 0, 0.8, 0)
-    quad(3.4, 0, 0.6, 0, 0.8, 0, 0, 0, 0.8)
-    quad(2.6, 0, 0.6, 0, 0.8, 0, 0.8, 0, 0)
-    quad(2.6, 0, 1.4, 0.8, 0, 0, 0, 0.8, 0)
+    quad(0, 0, 0, 0, 0, 4, 4, 0, 0, N)            # floor, facing +y
+    quad(0, 0, 0, 0, 3, 0, 0, 0, 4, N)            # x = 0, facing +x
+    quad(4, 0, 0, 0, 0, 4, 0, 3, 0, N)            # x = 4, facing -x
+    quad(0, 0, 0, 4, 0, 0, 0, 3, 0, N)            # z = 0, facing +z
+    quad(0, 0, 4, 0, 3, 0, 4, 0, 0, N)            # z = 4, facing -z
+    quad(0, 3, 0, 4, 0, 0, 0, 0, 1.2, N)          # the ceiling around the opening, facing -y
+    quad(0, 3, 2.8, 4, 0, 0, 0, 0, 1.2, N)
+    quad(0, 3, 1.2, 1.2, 0, 0, 0, 0, 1.6, N)
+    quad(2.8, 3, 1.2, 1.2, 0, 0, 0, 0, 1.6, N)
+    quad(2.6, 0.8, 0.6, 0, 0, 0.8, 0.8, 0, 0, N)  # the block: top, then four sides facing out
+    quad(2.6, 0, 0.6, 0, 0, 0.8, 0, 0.8, 0, N)
+    quad(3.4, 0, 0.6, 0, 0.8, 0, 0, 0, 0.8, N)
+    quad(2.6, 0, 0.6, 0, 0.8, 0, 0.8, 0, 0, N)
+    quad(2.6, 0, 1.4, 0.8, 0, 0, 0, 0.8, 0, N)
     print "usemtl lamp"
-    quad(0.5, 3.4, 0.5, 3, 0, 0, 0, 0, 3)      # the panel above the opening, facing -y
+    quad(0.5, 3.4, 0.5, 3, 0, 0, 0, 0, 3, 1)      # the panel above the opening, facing -y
 }' > "$OUT.obj"
