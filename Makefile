@@ -146,6 +146,7 @@ bench: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/t
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/realtime.sh $(BUILD) docs/BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/sponza.sh $(BUILD)/rad docs/BENCHMARKS.md
 	RAD_DATA_DIR=$(RAD_DATA_DIR) ./$(BUILD)/bench_runtime --append docs/BENCHMARKS.md
+	RAD_DATA_DIR=$(RAD_DATA_DIR) bash tests/bench/scenes.sh $(BUILD)/rad docs/BENCHMARKS.md
 
 bench-quick: $(BUILD)/bench $(BUILD)/rays $(BUILD)/rad $(BUILD)/multibounce $(BUILD)/temporal $(BUILD)/shading $(BUILD)/local $(BUILD)/probes $(BUILD)/bench_realtime
 	./$(BUILD)/bench --quick $(BUILD)/BENCHMARKS-quick.md

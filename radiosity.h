@@ -3222,13 +3222,28 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    at the finest resolution from vp_resolution down whose estimate fits the memory budget,
    the same Jacobi bounces on rad_vp_system, rad_vp_gather_mesh, rad_lightmap_gather_vp and
    rad_probes_create_vp. AUTO takes CLASSIC when its estimate fits both max_memory and
-   max_seconds, else VIRTUAL PATCHES. ESTIMATE: classic 4 N^2 bytes of F plus 300 per patch,
-   time N^2 ff_samples / 3e6 s (the measured form-factor rate of one thread) plus the bounces
-   and the lightmap gather; virtual patches (counted first by rad_vp_count) 4 N^2 plus 100
-   bytes per sample and 48 N per task, time M^2 / 1.5e8 s for M samples; both add the output
-   layers, about 30 bytes per texel and lightmap sample, and 40 per probe and patch (the
-   probes' weights, at most). Rough: within a factor of a few. The estimate and the choice are logged
-   (RAD_LOG_INFO) before the work and returned in the result (method, reason, numbers).
+   max_seconds, else VIRTUAL PATCHES.
+   PLAN (rad_baker_plan, which rad_baker_run calls): the resolution of the virtual patches
+   comes from the scene, not a fixed count. Their energy error comes from averaging inside a
+   voxel (irradiance that changes across it, walls it straddles), so the voxels must be small
+   beside the distance light travels between surfaces, and the error weighs in the image as
+   much as light is exchanged: the plan measures the scene's mean free path lambda (4096
+   cosine rays from points spread over the surface by area, the mean distance to the next
+   surface over the rays that meet one) and the fraction f of those rays that meet one, and
+   asks for resolution 6.5 L f / lambda (L the longest side of the bounds; 4 to 256), the rate
+   measured on Sponza to bring the energy within 2-3% of the path tracer (docs/methods/bake.md).
+   A closed room gets about 10 voxels per side, an object in the open few. Then the budget: while the estimate is over
+   max_memory or max_seconds, the resolution shrinks (the matrix and the sample pairs grow
+   as its fourth power), and the reason says the budget, not the scene, set it
+   (rad_baker_choice.budget_limited). A non-zero vp_resolution replaces the scene's.
+   ESTIMATE: classic 4 N^2 bytes of F plus 300 per patch, time N^2 ff_samples / 3e6 s (the
+   measured form-factor rate of one thread) plus the bounces and the lightmap gather; virtual
+   patches (counted first by rad_vp_count) 4 N^2 plus 100 bytes per sample and 48 N per task,
+   time M^2 / 1.5e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the output layers, about 30 bytes per texel and lightmap
+   sample, and 40 per probe and patch (the probes' weights, at most). Times are CPU seconds
+   (one thread's; divide by the threads for the wall time). Rough: within a factor of a few.
+   The estimate and the choice are logged (RAD_LOG_INFO) before the work and returned in the
+   result (method, reason, numbers, plan).
    SOURCE. Direct light is each group's source (RAD_SOURCE_DIRECT): the lights of the group
    and the emissive triangles whose material is in the group (rad_baker_desc.material_groups),
    reflected once (E = rho D) and then bounced. Emission itself and direct light are NOT in
@@ -3289,15 +3304,35 @@ typedef struct rad_baker_desc {
 typedef struct rad_baker_options {
     rad_baker_method method;         /* RAD_BAKER_AUTO (0) */
     double max_memory;              /* bytes the bake may hold (0: 1 GiB) */
-    double max_seconds;             /* time AUTO allows the classic method (0: 600) */
+    double max_seconds;             /* CPU seconds the bake may take (0: 600): AUTO's choice and
+                                       the resolution of the virtual patches respect it */
     uint32_t patches;               /* classic: target patch count (0: 512) */
-    uint32_t vp_resolution;         /* virtual patches: the finest resolution tried (0: 16) */
+    uint32_t vp_resolution;         /* virtual patches: the finest resolution tried (0: what
+                                       the scene needs, PLAN above) */
     uint32_t bounces;               /* Jacobi bounces (0: 16) */
     uint32_t ff_samples;            /* form-factor samples per patch pair (0: 16) */
     uint32_t light_samples;         /* shadow rays per area light and point (0: 16) */
     uint32_t lightmap_samples;      /* sub-points per texel (0: 4) */
     uint32_t seed;                  /* decorrelates the sampling (any value) */
 } rad_baker_options;
+
+/* What the plan chose, and why (PLAN above). */
+typedef struct rad_baker_choice {
+    rad_baker_method method;        /* CLASSIC or VIRTUAL_PATCHES */
+    uint32_t patch_count;           /* classic: the patches; virtual patches: counted */
+    uint32_t vp_resolution;         /* virtual patches: the resolution to build (0 for classic) */
+    uint32_t vp_samples;            /* virtual patches: their samples (M) */
+    uint32_t needed_resolution;     /* what the mean free path asks for */
+    float free_path;                /* the mean free path, scene units */
+    float escaped;                  /* the fraction of its rays that left the scene */
+    int budget_limited;             /* 1: max_memory or max_seconds held the resolution below
+                                       needed_resolution (or vp_resolution) */
+    int over_budget;                /* 1: the estimate passes max_seconds even so (the coarsest
+                                       set, or a forced classic method) */
+    double estimated_bytes;         /* peak */
+    double estimated_seconds;       /* CPU seconds */
+    char reason[512];               /* the choice in a sentence with the numbers */
+} rad_baker_choice;
 
 /* What rad_baker_run returns; destroy with rad_baker_result_destroy. Read-only except through
    rad_baker_mix (which rewrites vertex, lightmap and probes). */
@@ -3327,6 +3362,7 @@ typedef struct rad_baker_result {
     float *probes;                  /* 27 per probe */
     float *probe_layers;            /* group_count planes of 27 * probe_count */
     rad_allocator allocator;        /* private */
+    rad_baker_choice plan;          /* the whole plan (method, reason and estimates are also above) */
 } rad_baker_result;
 
 /* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
@@ -3340,6 +3376,19 @@ typedef struct rad_baker_result {
 RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_options *options, const rad_context *ctx,
                             rad_baker_result **out);
 RAD_API void rad_baker_result_destroy(rad_baker_result *result);
+
+/* The plan rad_baker_run would make for 'scene' (PLAN and ESTIMATE above), without the bake:
+   the method (options->method, AUTO by default), the resolution of the virtual patches and
+   the cost, for per-vertex output and one light group (rad_baker_run adds its outputs' sizes
+   to the same rule). raycaster: intersect() casts the free-path rays (borrowed for the call).
+   options and ctx may be NULL. The reason is logged (RAD_LOG_INFO). Deterministic: the same
+   plan for the same scene, options and task count (ctx's tasks enter the memory estimate only).
+   Errors: INVALID_ARGUMENT (NULL, an unknown method, a negative or non-finite budget),
+   OUT_OF_MEMORY (also: max_memory is below the coarsest bake, or classic was asked for and
+   does not fit), RAYCAST_FAILED. Cost: 4096 rays, rad_vp_count once or a few times (face rays
+   of the candidate voxels), and rad_patches_create when classic may fit. */
+RAD_API rad_result rad_baker_plan(const rad_scene *scene, const rad_raycaster *raycaster, const rad_baker_options *options,
+                                  const rad_context *ctx, rad_baker_choice *out);
 
 /* Rewrites the result's outputs (vertex, lightmap, probes; those it has) as
    sum_g group_rgb[3g + c] layer_g per channel c. group_rgb: 3 * group_count floats (NULL: all
@@ -22851,24 +22900,252 @@ static double rad__baker_output_bytes(const rad__baker *b, uint32_t probes)
     return per * ((double)b->R->group_count + 1.0) + fixed;
 }
 
-/* The probes' weights: 40 bytes per (probe, patch) pair a probe sees; all of them, at most. */
-static double rad__baker_probe_bytes(const rad__baker *b, uint32_t probes, double patches)
+/* ---- the plan (rad_baker_plan): the method, the resolution and the estimates ---- */
+
+#define RAD__PLAN_RAYS 4096u            /* cosine rays that measure the mean free path */
+#define RAD__PLAN_VOXELS_PER_PATH 6.5   /* voxels along one mean free path (PLAN in >>api_bake) */
+#define RAD__PLAN_MIN_RESOLUTION 4u
+#define RAD__PLAN_MAX_RESOLUTION 256u
+
+/* What a plan needs besides the scene: the filled options and the outputs' share. */
+typedef struct rad__plan_in {
+    const rad_scene *scene;
+    const rad_raycaster *rc;
+    rad_baker_options o;            /* every 0 replaced by its default, but vp_resolution */
+    double outputs_bytes;           /* the layers, mixed outputs and texels */
+    double probes;                  /* probes whose weights are counted (0: no probes) */
+    double texels;                  /* lightmap samples gathered per group (0: no lightmap) */
+    uint32_t groups;
+    uint32_t tasks;
+    const char *who;                /* the public function named in messages */
+} rad__plan_in;
+
+/* Fills the option defaults rad_baker_run and rad_baker_plan share; vp_resolution 0 stays 0
+   (the plan takes it from the scene). */
+static void rad__baker_options_fill(rad_baker_options *o, const rad_baker_options *given)
 {
-    return (b->outputs & RAD_BAKER_PROBES) ? 40.0 * (double)probes * patches : 0.0;
+    if (given) *o = *given;
+    else memset(o, 0, sizeof *o);
+    if (o->max_memory == 0.0) o->max_memory = 1073741824.0;
+    if (o->max_seconds == 0.0) o->max_seconds = 600.0;
+    if (!o->patches) o->patches = 512;
+    if (!o->bounces) o->bounces = 16;
+    if (!o->ff_samples) o->ff_samples = 16;
+    if (!o->light_samples) o->light_samples = 16;
+    if (!o->lightmap_samples) o->lightmap_samples = 4;
 }
 
-/* AUTO's choice and the estimates; the patches (classic) are built here, the rest later. */
+/* The mean free path: the mean distance a cosine ray leaving the surface (points drawn by
+   area, stratified) travels to the next surface, over the rays that meet one (the light that
+   leaves the scene is not exchanged, so its distance says nothing of the voxels needed); the
+   diagonal when none does. The same numbers for any thread count: one thread, hashed from
+   the seed. */
+static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *rc, const rad_allocator *a, uint32_t seed,
+                                      float *path, float *escaped)
+{
+    enum { BATCH = 256 };
+    rad_ray rays[BATCH];
+    rad_hit hits[BATCH];
+    uint32_t T = S->triangle_count, k, j, esc = 0;
+    double *cum = (double *)rad__alloc_array(a, T, sizeof(double)), total = 0.0, sum = 0.0;
+    double diag = (double)S->diagonal, eps = 1e-5 * diag;
+    if (!cum) return RAD_ERROR_OUT_OF_MEMORY;
+    for (k = 0; k < T; ++k) cum[k] = total += (double)S->areas[k];
+    for (k = 0; k < RAD__PLAN_RAYS; k += BATCH) {
+        uint32_t m = RAD__PLAN_RAYS - k < (uint32_t)BATCH ? RAD__PLAN_RAYS - k : (uint32_t)BATCH;
+        for (j = 0; j < m; ++j) {
+            uint32_t s = k + j, h = rad__hash(seed ^ rad__hash(s + 0x9E3779B9u)), h2 = rad__hash(h + 1u), h3 = rad__hash(h + 2u);
+            double u = ((double)s + (double)(h >> 8) / 16777216.0) / (double)RAD__PLAN_RAYS * total;
+            uint32_t lo = 0, hi = T - 1, t;
+            float r1, r2, t1[3], t2[3], dir[3], ph, c;
+            const float *v, *n;
+            int q;
+            while (lo < hi) { /* the first triangle whose running area reaches u */
+                uint32_t mid = lo + (hi - lo) / 2;
+                if (cum[mid] < u) lo = mid + 1;
+                else hi = mid;
+            }
+            t = lo;
+            v = S->positions + 9 * (size_t)t;
+            n = S->normals + 3 * (size_t)t;
+            r1 = (float)sqrt((double)(h2 >> 8) / 16777216.0);
+            r2 = (float)(h3 >> 8) / 16777216.0f;
+            rad__tangent_frame(n, t1, t2);
+            c = (float)(h2 & 0xFFu) / 256.0f + (float)(h3 & 0xFFu) / 65536.0f; /* cos^2 of the polar angle */
+            ph = (float)(2.0 * RAD__PI) * ((float)((h >> 4) & 0xFFFu) / 4096.0f);
+            for (q = 0; q < 3; ++q) {
+                float p = (1.0f - r1) * v[q] + r1 * (1.0f - r2) * v[3 + q] + r1 * r2 * v[6 + q];
+                dir[q] = t1[q] * (float)sqrt(1.0 - c) * (float)cos((double)ph) + t2[q] * (float)sqrt(1.0 - c) * (float)sin((double)ph) +
+                         n[q] * (float)sqrt((double)c);
+                rays[j].origin[q] = p + (float)eps * n[q];
+                rays[j].dir[q] = dir[q];
+            }
+            rays[j].tmin = 0.0f;
+            rays[j].tmax = (float)(4.0 * diag);
+        }
+        if (rc->intersect(rc->user, rays, m, hits) != RAD_SUCCESS) {
+            rad__free(a, cum);
+            return RAD_ERROR_RAYCAST_FAILED;
+        }
+        for (j = 0; j < m; ++j) {
+            if (hits[j].triangle == RAD_NONE || !((double)hits[j].t < diag)) ++esc;
+            else sum += (double)hits[j].t;
+        }
+    }
+    rad__free(a, cum);
+    *path = esc < RAD__PLAN_RAYS ? (float)(sum / (double)(RAD__PLAN_RAYS - esc)) : (float)diag;
+    *escaped = (float)esc / (float)RAD__PLAN_RAYS;
+    return RAD_SUCCESS;
+}
+
+/* The cost of virtual patches at counts 'cnt' (PLAN in >>api_bake). */
+static void rad__plan_vp_cost(const rad__plan_in *in, const rad_vp_counts *cnt, double *bytes, double *secs)
+{
+    double n = (double)cnt->patches, M = (double)cnt->samples;
+    *bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)in->tasks + in->outputs_bytes + 40.0 * in->probes * n;
+    *secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 16.0 * M / RAD__BAKER_RAY_RATE +
+            6.0 * n * n * in->o.bounces * in->groups / RAD__BAKER_FLOP_RATE + in->texels * 8.0 * in->groups / RAD__BAKER_RAY_RATE;
+}
+
+/* AUTO's choice, the resolution and the estimates into *P; with 'keep' (classic) the patches
+   counted on the way are handed over instead of freed. */
+static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, rad__ctx *c, rad_baker_choice *P,
+                                rad_patches **keep)
+{
+    const rad_scene *S = in->scene;
+    const rad_baker_options *o = &in->o;
+    double budget = o->max_memory, seconds_budget = o->max_seconds, N, bytes = 0.0, secs = 0.0, longest = 0.0;
+    char bb[32], lb[32], tb[32], sb[32], why[256], text[1024];
+    rad_patches *patches = NULL;
+    rad_result r;
+    int k, classic_fits = 0;
+    memset(P, 0, sizeof *P);
+    for (k = 0; k < 3; ++k)
+        if ((double)(S->bounds_max[k] - S->bounds_min[k]) > longest) longest = (double)(S->bounds_max[k] - S->bounds_min[k]);
+    r = rad__plan_free_path(S, in->rc, &c->allocator, o->seed, &P->free_path, &P->escaped);
+    if (r != RAD_SUCCESS) return r;
+    {
+        double need = ceil(RAD__PLAN_VOXELS_PER_PATH * longest * (1.0 - (double)P->escaped) /
+                           (P->free_path > 0.0f ? (double)P->free_path : longest));
+        if (!(need >= RAD__PLAN_MIN_RESOLUTION)) need = RAD__PLAN_MIN_RESOLUTION;
+        if (need > RAD__PLAN_MAX_RESOLUTION) need = RAD__PLAN_MAX_RESOLUTION;
+        P->needed_resolution = (uint32_t)need;
+    }
+    rad__baker_bytes(lb, sizeof lb, budget);
+    rad__baker_time(sb, sizeof sb, seconds_budget);
+    why[0] = 0;
+    if (o->method != RAD_BAKER_VIRTUAL_PATCHES) {
+        rad_patch_options po;
+        rad_patch_options_default(&po);
+        po.target_count = o->patches;
+        N = (double)(S->triangle_count > o->patches ? S->triangle_count : o->patches);
+        bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N;
+        if (bytes <= budget) {
+            /* the patch count is only near the target: count them before the final estimate */
+            r = rad_patches_create(S, &po, sub, &patches);
+            if (r != RAD_SUCCESS) return r;
+            N = (double)patches->count;
+            bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N;
+        }
+        secs = N * N * o->ff_samples / RAD__BAKER_FF_RATE + 6.0 * N * N * o->bounces * in->groups / RAD__BAKER_FLOP_RATE +
+               in->texels * N * 4.0 / RAD__BAKER_RAY_RATE * (in->texels * N > 5e7 ? 5e7 / (in->texels * N) : 1.0) * in->groups;
+        classic_fits = bytes <= budget && secs <= seconds_budget;
+        rad__baker_time(tb, sizeof tb, secs);
+        rad__baker_bytes(bb, sizeof bb, bytes);
+        if (o->method == RAD_BAKER_CLASSIC && bytes > budget) {
+            rad_patches_destroy(patches);
+            rad__log(c, RAD_LOG_ERROR,
+                     "%s: the classic bake of %lu patches needs about %s, over the budget of %s (max_memory); "
+                     "use RAD_BAKER_AUTO or RAD_BAKER_VIRTUAL_PATCHES, or a larger budget",
+                     in->who, (unsigned long)N, bb, lb);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        if (o->method == RAD_BAKER_CLASSIC || classic_fits) {
+            P->method = RAD_BAKER_CLASSIC;
+            P->patch_count = (uint32_t)N;
+            P->estimated_bytes = bytes;
+            P->estimated_seconds = secs;
+            P->over_budget = !classic_fits;
+            snprintf(P->reason, sizeof P->reason,
+                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s of CPU, %s the budget of %s "
+                     "and %s",
+                     S->triangle_count, P->patch_count, bb, tb, classic_fits ? "within" : "over (forced)", lb, sb);
+            if (keep) *keep = patches;
+            else rad_patches_destroy(patches);
+            return RAD_SUCCESS;
+        }
+        snprintf(why, sizeof why, "classic would need %lu patches, about %s and %s of CPU (budget %s and %s); ",
+                 (unsigned long)N, bb, tb, lb, sb);
+        rad_patches_destroy(patches);
+    }
+    {
+        rad_vp_options vo;
+        rad_vp_counts cnt;
+        uint32_t res = o->vp_resolution ? o->vp_resolution : P->needed_resolution, tries;
+        int time_over = 0;
+        rad_vp_options_default(&vo);
+        for (tries = 0;; ++tries) {
+            double f;
+            uint32_t next;
+            vo.resolution = res;
+            r = rad_vp_count(S, in->rc, &vo, sub, &cnt);
+            if (r != RAD_SUCCESS) return r;
+            rad__plan_vp_cost(in, &cnt, &bytes, &secs);
+            time_over = secs > seconds_budget;
+            if (bytes <= budget && !time_over) break;
+            if (res <= 2 || tries >= 12) {
+                rad__baker_bytes(bb, sizeof bb, bytes);
+                if (bytes > budget) {
+                    rad__log(c, RAD_LOG_ERROR,
+                             "%s: the budget of %s (max_memory) is too small for any bake: %sthe coarsest virtual "
+                             "patches tried (resolution %u, %u patches) need about %s",
+                             in->who, lb, why, res, cnt.patches, bb);
+                    return RAD_ERROR_OUT_OF_MEMORY;
+                }
+                break; /* over the time budget only: the coarsest set, said so in the reason */
+            }
+            /* the patches grow as R^2 and the matrix and the sample pairs as R^4 */
+            f = budget / bytes < seconds_budget / secs ? budget / bytes : seconds_budget / secs;
+            f = 0.97 * pow(f, 0.25);
+            next = (uint32_t)((double)res * f);
+            if (next >= res) next = res - 1;
+            res = next < 2u ? 2u : next;
+            P->budget_limited = 1;
+        }
+        P->method = RAD_BAKER_VIRTUAL_PATCHES;
+        P->vp_resolution = res;
+        P->patch_count = cnt.patches;
+        P->vp_samples = cnt.samples;
+        P->estimated_bytes = bytes;
+        P->estimated_seconds = secs;
+        P->over_budget = time_over;
+        rad__baker_bytes(bb, sizeof bb, bytes);
+        rad__baker_time(tb, sizeof tb, secs);
+        snprintf(text, sizeof text,
+                 "virtual patches: %smean free path %.3g (%.0f%% of rays leave the scene) asks for resolution %u; "
+                 "resolution %u%s gives %u patches (%u samples), about %s and %s of CPU%s",
+                 o->method == RAD_BAKER_VIRTUAL_PATCHES ? "(asked for) " : why, (double)P->free_path,
+                 100.0 * (double)P->escaped, P->needed_resolution, res,
+                 o->vp_resolution && !P->budget_limited ? " (vp_resolution)"
+                 : P->budget_limited                    ? " (all the budget of max_memory and max_seconds allows)"
+                                                        : "",
+                 cnt.patches, cnt.samples, bb, tb, time_over ? ", over the time budget even so" : "");
+        {
+            size_t len = strlen(text); /* the words that fit; P was zeroed, so the rest stays 0 */
+            memcpy(P->reason, text, len < sizeof P->reason ? len : sizeof P->reason - 1);
+        }
+    }
+    return RAD_SUCCESS;
+}
+
+/* rad_baker_run's plan: the outputs' sizes, then rad__plan_run with the patches kept. */
 static rad_result rad__baker_plan(rad__baker *b)
 {
     rad_baker_result *R = b->R;
     const rad_scene *S = b->scene;
-    double budget = b->o.max_memory, seconds_budget = b->o.max_seconds, N, bytes = 0.0, secs = 0.0, texels;
-    double samples = (double)b->o.ff_samples;
     uint32_t probes_guess = b->d->probe_positions ? b->d->probe_count : 0u;
-    char bb[32], lb[32], tb[32], why[256];
+    rad__plan_in in;
     rad_result r;
-    int classic_fits = 0;
-    texels = (b->outputs & RAD_BAKER_LIGHTMAP) ? (double)R->lightmap_width * R->lightmap_height * b->o.lightmap_samples : 0.0;
     if (!b->d->probe_positions) { /* the grid rad_probes_create lays: about extent / spacing + 1 per axis */
         double ext = 0.0, sp = b->d->probe_spacing, count = 1.0;
         int k;
@@ -22879,91 +23156,58 @@ static rad_result rad__baker_plan(rad__baker *b)
         probes_guess = count < 16777216.0 ? (uint32_t)count : 16777216u;
     }
     b->outputs_bytes = rad__baker_output_bytes(b, probes_guess);
-    why[0] = 0;
-    if (b->o.method != RAD_BAKER_VIRTUAL_PATCHES) {
-        rad_patch_options po;
-        rad_patch_options_default(&po);
-        po.target_count = b->o.patches;
-        N = (double)(S->triangle_count > b->o.patches ? S->triangle_count : b->o.patches);
-        bytes = 4.0 * N * N + 300.0 * N + b->outputs_bytes + rad__baker_probe_bytes(b, probes_guess, N);
-        if (bytes <= budget) {
-            /* the patch count is only near the target: count them before the final estimate */
-            r = rad_patches_create(S, &po, &b->sub, &b->patches);
-            if (r != RAD_SUCCESS) return r;
-            N = (double)b->patches->count;
-            bytes = 4.0 * N * N + 300.0 * N + b->outputs_bytes + rad__baker_probe_bytes(b, probes_guess, N);
-        }
-        secs = N * N * samples / RAD__BAKER_FF_RATE + 6.0 * N * N * b->o.bounces * R->group_count / RAD__BAKER_FLOP_RATE +
-               texels * N * 4.0 / RAD__BAKER_RAY_RATE * (texels * N > 5e7 ? 5e7 / (texels * N) : 1.0) * R->group_count;
-        classic_fits = bytes <= budget && secs <= seconds_budget;
-        rad__baker_time(tb, sizeof tb, secs);
-        rad__baker_bytes(bb, sizeof bb, bytes);
-        rad__baker_bytes(lb, sizeof lb, budget);
-        if (b->o.method == RAD_BAKER_CLASSIC && bytes > budget) {
-            rad_patches_destroy(b->patches);
-            b->patches = NULL;
-            rad__log(&b->c, RAD_LOG_ERROR,
-                     "rad_baker_run: the classic bake of %lu patches needs about %s, over the budget of %s (max_memory); "
-                     "use RAD_BAKER_AUTO or RAD_BAKER_VIRTUAL_PATCHES, or a larger budget",
-                     (unsigned long)N, bb, lb);
-            return RAD_ERROR_OUT_OF_MEMORY;
-        }
-        if (b->o.method == RAD_BAKER_CLASSIC || classic_fits) {
-            R->method = RAD_BAKER_CLASSIC;
-            R->patch_count = (uint32_t)N;
-            R->estimated_bytes = bytes;
-            R->estimated_seconds = secs;
-            snprintf(R->reason, sizeof R->reason,
-                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s per thread, %s the budget of %s "
-                     "and %lu s",
-                     S->triangle_count, R->patch_count, bb, tb, classic_fits ? "within" : "over (forced)", lb,
-                     (unsigned long)(seconds_budget < 1e9 ? seconds_budget : 1e9));
-            return RAD_SUCCESS;
-        }
-        snprintf(why, sizeof why, "classic would need %lu patches, about %s and %s per thread (budget %s, %lu s); ",
-                 (unsigned long)N, bb, tb, lb, (unsigned long)(seconds_budget < 1e9 ? seconds_budget : 1e9));
-        rad_patches_destroy(b->patches);
-        b->patches = NULL;
-    }
-    {
-        rad_vp_options vo;
-        rad_vp_counts cnt;
-        uint32_t res = b->o.vp_resolution;
-        rad_vp_options_default(&vo);
-        for (;;) {
-            double M, n;
-            vo.resolution = res;
-            r = rad_vp_count(S, &b->rc, &vo, &b->sub, &cnt);
-            if (r != RAD_SUCCESS) return r;
-            n = (double)cnt.patches;
-            M = (double)cnt.samples;
-            bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)b->c.tasks + b->outputs_bytes + rad__baker_probe_bytes(b, probes_guess, n);
-            secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 6.0 * n * n * b->o.bounces * R->group_count / RAD__BAKER_FLOP_RATE;
-            if (bytes <= budget) break;
-            if (res <= 2) {
-                rad__baker_bytes(bb, sizeof bb, bytes);
-                rad__baker_bytes(lb, sizeof lb, budget);
-                rad__log(&b->c, RAD_LOG_ERROR,
-                         "rad_baker_run: the budget of %s (max_memory) is too small for any bake: %sthe coarsest virtual "
-                         "patches (resolution %u, %u patches) need about %s",
-                         lb, why, res, cnt.patches, bb);
-                return RAD_ERROR_OUT_OF_MEMORY;
-            }
-            res = res * 3u / 4u;
-            if (res < 2) res = 2;
-        }
-        R->method = RAD_BAKER_VIRTUAL_PATCHES;
-        R->vp_resolution = res;
-        R->patch_count = cnt.patches;
-        R->estimated_bytes = bytes;
-        R->estimated_seconds = secs;
-        rad__baker_bytes(bb, sizeof bb, bytes);
-        rad__baker_bytes(lb, sizeof lb, budget);
-        rad__baker_time(tb, sizeof tb, secs);
-        snprintf(R->reason, sizeof R->reason, "virtual patches: %sresolution %u gives %u patches (%u samples), about %s and %s per thread",
-                 b->o.method == RAD_BAKER_VIRTUAL_PATCHES ? "(asked for) " : why, res, cnt.patches, cnt.samples, bb, tb);
-    }
+    memset(&in, 0, sizeof in);
+    in.scene = S;
+    in.rc = &b->rc;
+    in.o = b->o;
+    in.outputs_bytes = b->outputs_bytes;
+    in.probes = (b->outputs & RAD_BAKER_PROBES) ? (double)probes_guess : 0.0;
+    in.texels = (b->outputs & RAD_BAKER_LIGHTMAP) ? (double)R->lightmap_width * R->lightmap_height * b->o.lightmap_samples : 0.0;
+    in.groups = R->group_count;
+    in.tasks = b->c.tasks;
+    in.who = "rad_baker_run";
+    r = rad__plan_run(&in, &b->sub, &b->c, &R->plan, &b->patches);
+    if (r != RAD_SUCCESS) return r;
+    R->method = R->plan.method;
+    R->patch_count = R->plan.patch_count;
+    R->vp_resolution = R->plan.vp_resolution;
+    R->estimated_bytes = R->plan.estimated_bytes;
+    R->estimated_seconds = R->plan.estimated_seconds;
+    memcpy(R->reason, R->plan.reason, sizeof R->reason);
     return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_plan(const rad_scene *scene, const rad_raycaster *raycaster, const rad_baker_options *options,
+                                  const rad_context *ctx, rad_baker_choice *out)
+{
+    rad__ctx c;
+    rad__plan_in in;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!scene || !raycaster || !raycaster->intersect || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_plan: NULL scene, raycaster (or its intersect) or out");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    memset(out, 0, sizeof *out);
+    memset(&in, 0, sizeof in);
+    rad__baker_options_fill(&in.o, options);
+    if (in.o.method > RAD_BAKER_VIRTUAL_PATCHES) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_plan: unknown method %d", (int)in.o.method);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(in.o.max_memory > 0.0 && in.o.max_memory < 1e30) || !(in.o.max_seconds > 0.0 && in.o.max_seconds < 1e30)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_plan: max_memory and max_seconds must be finite and >= 0");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    in.scene = scene;
+    in.rc = raycaster;
+    in.groups = 1;
+    in.tasks = c.tasks;
+    in.outputs_bytes = 12.0 * 2.0 * (double)scene->triangle_count * 3.0; /* vertex light, layer and mix: at most 3 vertices a triangle */
+    in.who = "rad_baker_plan";
+    r = rad__plan_run(&in, ctx, &c, out, NULL);
+    if (r == RAD_SUCCESS) rad__log(&c, RAD_LOG_INFO, "rad_baker_plan: %s", out->reason);
+    return r;
 }
 
 /* The lights of group g into b->lights; returns their count. */
@@ -23215,15 +23459,7 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
     *out = NULL;
     b.d = desc;
     b.outputs = desc->outputs ? desc->outputs : (uint32_t)RAD_BAKER_VERTEX;
-    if (options) b.o = *options;
-    if (b.o.max_memory == 0.0) b.o.max_memory = 1073741824.0;
-    if (b.o.max_seconds == 0.0) b.o.max_seconds = 600.0;
-    if (!b.o.patches) b.o.patches = 512;
-    if (!b.o.vp_resolution) b.o.vp_resolution = 16;
-    if (!b.o.bounces) b.o.bounces = 16;
-    if (!b.o.ff_samples) b.o.ff_samples = 16;
-    if (!b.o.light_samples) b.o.light_samples = 16;
-    if (!b.o.lightmap_samples) b.o.lightmap_samples = 4;
+    rad__baker_options_fill(&b.o, options);
     if (ctx) b.sub = *ctx;
     b.prog.fn = ctx ? ctx->progress : NULL;
     b.prog.user = ctx ? ctx->progress_user : NULL;

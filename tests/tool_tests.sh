@@ -1362,6 +1362,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/tool_emissive.sh"
 . "$(dirname "$0")/tool_reliability.sh"
 . "$(dirname "$0")/tool_hier_large.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_glb.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/tool_defaults.sh"
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

@@ -1194,6 +1194,41 @@ static int render_local_method(const char *cmd, const tool_world *w, const rende
     return rc;
 }
 
+/* No --method (and no --bake): the library's plan picks classic or AAVP and the resolution
+   from the scene and the budget (rad_baker_plan), and says so before the work. A
+   virtual-patch method (or proxy) without --vp-resolution or --vp-max-patches takes the
+   plan's resolution the same way. */
+static int render_default_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
+                                 tool_method_options *mo)
+{
+    rad_baker_options bo;
+    rad_baker_choice plan;
+    rad_context ctx;
+    rad_result r;
+    int chosen = !(mo->given & TOOL_OPT_METHOD);
+    memset(&bo, 0, sizeof bo);
+    bo.method = chosen ? RAD_BAKER_AUTO : RAD_BAKER_VIRTUAL_PATCHES;
+    bo.max_memory = o->max_memory;
+    bo.patches = o->patches;
+    bo.ff_samples = o->samples;
+    bo.bounces = o->bounces;
+    bo.light_samples = o->light_samples;
+    tool_context(&ctx, NULL);
+    if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
+    if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
+        if (chosen) mo->method = TOOL_AAVP;
+        mo->vp_resolution = plan.vp_resolution;
+    }
+    if (!chosen)
+        fprintf(stderr, "rad %s: no --vp-resolution given: resolution %u from the scene\n", cmd, plan.vp_resolution);
+    else if (plan.method == RAD_BAKER_VIRTUAL_PATCHES)
+        fprintf(stderr, "rad %s: no --method given: chose aavp at --vp-resolution %u (give --method to choose)\n", cmd,
+                plan.vp_resolution);
+    else
+        fprintf(stderr, "rad %s: no --method given: chose classic (give --method to choose)\n", cmd);
+    return 0;
+}
+
 /* ---- the command line ------------------------------------------------------------------- */
 
 static int parse_camera(const char *cmd, const tool_arg *t, const char *v, void *field)
@@ -1569,6 +1604,14 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     tool_set_threads((int)ra.threads);
     if (tool_open_world_lit(cmd, ra.scene, lights, &w)) return 1;
     if (tool_check_outputs(cmd, &ra.out, 1, w.file.input_files, (int)w.file.input_file_count)) {
+        tool_close_world(&w);
+        return 1;
+    }
+    if (!ra.bake && (!(ra.mo.given & TOOL_OPT_METHOD) ||
+                     ((ra.mo.method == TOOL_AAVP || ra.mo.method == TOOL_VP || ra.mo.proxy == TOOL_PROXY_AAVP ||
+                       ra.mo.proxy == TOOL_PROXY_VP) &&
+                      !(ra.mo.given & (TOOL_OPT_VP_RESOLUTION | TOOL_OPT_VP_MAX_PATCHES)))) &&
+        render_default_method(cmd, &w, &ra.o, &ra.mo)) {
         tool_close_world(&w);
         return 1;
     }

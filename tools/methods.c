@@ -186,7 +186,9 @@ static const uint32_t proxy_values[] = {TOOL_PROXY_PATCHES, TOOL_PROXY_AAVP, TOO
 /* The options of the methods (rad render and rad bake): the parser and the help. */
 static const tool_arg method_args[] = {
     CUSTOM("--method", "M", method, parse_method, TOOL_OPT_METHOD, R,
-           "classic (default: radiosity + per-pixel direct light), multibounce (the indirect light\n"
+           "default (render): classic, or aavp at the scene's resolution when the dense matrix would\n"
+           "not fit 1 GiB or 10 CPU-minutes (rad_baker_plan, said on stderr before the work);\n"
+           "classic (radiosity + per-pixel direct light), multibounce (the indirect light\n"
            "L = F_mb E), temporal (alias-table frames), stochastic, pathtrace, local (local matrix of\n"
            "the patches nearest the camera), vp or aavp (virtual patches), hierarchical (quadtrees and\n"
            "links, Hanrahan et al. 1991), lightmap (classic, or virtual patches with --proxy aavp|vp,\n"
@@ -253,7 +255,7 @@ static const tool_arg method_args[] = {
             "per-triangle patches (--patches etc. are ignored); indirect light gathered per pixel from\n"
             "the voxel grid:\n"),
     UINT("--vp-resolution", "R", vp_resolution, 1, 1024, TOOL_OPT_VP_RESOLUTION, "must be in 1..1024", 0,
-         "voxels along the longest axis of the scene (default 16)"),
+         "voxels along the longest axis of the scene (render: measured from the scene; else 16)"),
     UINT("--vp-max-patches", "B", vp_max_patches, 1, 1000000, TOOL_OPT_VP_MAX_PATCHES, "must be in 1..1000000", R,
          "the finest resolution whose patch count is at most B (replaces --vp-resolution; found\n"
          "by counting at predicted resolutions, one build)"),
