@@ -393,7 +393,10 @@ int main(int argc, char **argv)
     strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", gmtime(&started));
 
     emit("# radiosity.h benchmarks\n\n");
-    emit("Written by `tests/bench/bench.c`%s. Every number below was measured in this run.\n\n",
+    emit("Written by `make bench`%s: this head (the machine of sections a and b) from tests/bench/bench.c, then\n"
+         "each bench appends its section with its own machine line. Compare ratios measured side by side;\n"
+         "absolute times move 2-3x with the shared machine's load. What was tried and the detail tables\n"
+         "are in [docs/performance-notes.md](performance-notes.md).\n\n",
          quick ? " in `--quick` mode (small cases only)" : "");
     emit("| | |\n|---|---|\n");
     emit("| library | radiosity.h %s |\n", RAD_VERSION_STRING);
@@ -424,7 +427,6 @@ int main(int argc, char **argv)
     rad_bvh_raycaster(bvh, &rc);
     rad_form_factor_options_default(&fopt);
     emit("## a) Form-factor bake, Cornell box\n\n");
-    emit_machine();
     emit("`rad_form_factors_dense` with `rad_form_factor_options_default` (method %s, samples %u%s, "
          "ray_epsilon %g%s), built-in BVH over the %u scene triangles. Time is the form-factor call "
          "only (patches and BVH are built before). Rays: `rays_cast`; pairs: `pairs_evaluated` "
@@ -516,7 +518,6 @@ int main(int argc, char **argv)
         g_str = bytes / t_str[0] / 1e9;
 
         emit("## b) One dense bounce vs a streaming read, N = %u\n\n", n);
-        emit_machine();
         emit("A synthetic random %u x %u float matrix (%.1f MB, entries in [0, 1/N)) wrapped in a dense "
              "`rad_matrix` view; RGB vectors of 3N floats. Best of %d timed runs each (after one untimed "
              "run), the three interleaved. GB/s counts the matrix bytes only (4 N^2). The streaming read "

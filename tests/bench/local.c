@@ -407,11 +407,12 @@ static void bench_error(void)
 
 int main(int argc, char **argv)
 {
-    int i, quick = 0;
+    int i, quick = 0, detail = 0;
     uint32_t M = 4096, grid = 8;
     double t0 = now();
     for (i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
+        else if (!strcmp(argv[i], "--detail")) detail = 1; /* the error table against the full solution */
         else if (!strcmp(argv[i], "--append") && i + 1 < argc) {
             g_md = fopen(argv[++i], "a");
             if (!g_md) { fprintf(stderr, "cannot open %s\n", argv[i]); return 1; }
@@ -425,7 +426,7 @@ int main(int argc, char **argv)
     emit("\n");
     emit_machine();
     bench_large(grid, M);
-    bench_error();
+    if (detail) bench_error();
     emit("\n(tests/bench/local.c: %.0f s in all)\n", now() - t0);
     if (g_md) fclose(g_md);
     return 0;

@@ -15,7 +15,8 @@
    Each of these also with RAD_PROBES_BAND4 (band 4 stored beside L2, rows marked "band 4").
 
    Build: cc -std=c99 -O2 -fopenmp -I. tests/bench/probes.c -o build/probes -lm
-   Run:   probes [--quick] [--half-spacing] [--sweep] [--proxy] [--append FILE.md]
+   Run:   probes [--quick] [--detail] [--half-spacing] [--sweep] [--proxy] [--append FILE.md]
+          (--detail adds the table of total light, direct included, before the indirect one)
    --proxy adds the points read from probes over AAVP and VP (rad_probes_create_vp) of the box at
    resolution 16 (8 with --quick), against the same classic reference.
    The grid rows come three times: with the default weighting of rad_probes_sample
@@ -119,10 +120,13 @@ static int cmp(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+static int g_silent; /* report() prints nothing (the total-light rows without --detail) */
+
 /* share within 5%, median and 95th percentile of the relative errors (over points and channels) */
 static void report(const char *what, double *err, int n)
 {
     int i, within = 0;
+    if (g_silent) return;
     for (i = 0; i < n; ++i) within += err[i] <= 0.05;
     qsort(err, (size_t)n, sizeof(double), cmp);
     emit("| %s | %d | %.1f%% | %.2f%% | %.2f%% |\n", what, n, 100.0 * within / n, 100.0 * err[n / 2], 100.0 * err[(n * 95) / 100]);
@@ -199,7 +203,7 @@ static void proxy_rows(rad_vp_kind kind, uint32_t resolution, float (*ref)[SPHER
 int main(int argc, char **argv)
 {
     static const float centres[SPHERES][3] = {{0.15f, 0.35f, 0.15f}, {0.40f, 0.45f, 0.15f}, {0.278f, 0.25f, 0.10f}, {0.15f, 0.30f, 0.42f}};
-    int quick = 0, half = 0, sweep = 0, proxy = 0, a, s, i, c, mode, w;
+    int quick = 0, half = 0, sweep = 0, proxy = 0, detail = 0, a, s, i, c, mode, w;
     char name[128];
     const char *append = NULL;
     rad_scene_desc d;
@@ -217,6 +221,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--append") && a + 1 < argc) append = argv[++a];
         else if (!strcmp(argv[a], "--patch-samples") && a + 1 < argc) psamples = (uint32_t)atoi(argv[++a]);
         else if (!strcmp(argv[a], "--half-spacing")) half = 1;
+        else if (!strcmp(argv[a], "--detail")) detail = 1; /* the total-light table too */
         else if (!strcmp(argv[a], "--sweep")) sweep = 1;
         else if (!strcmp(argv[a], "--proxy")) proxy = 1;
     }
@@ -257,8 +262,9 @@ int main(int argc, char **argv)
     emit("`build/probes%s`: %u patches (direct light as the source, 64 Jacobi bounces), 4 spheres of radius 0.05 m, "
          "32 normals each; reference = rad_direct_irradiance (256 shadow rays) + 16384 cosine rays over the same patch "
          "solution. Relative error per point and channel.\n\n", quick ? " --quick" : "", P->count);
-    emit("| probes, light | values | within 5%% | median error | 95th percentile |\n|---|---|---|---|---|\n");
+    if (detail) emit("| probes, light | values | within 5%% | median error | 95th percentile |\n|---|---|---|---|---|\n");
     for (mode = 0; mode < 2; ++mode) {
+        g_silent = mode == 0 && !detail;
         rad_probe_options o;
         rad_probes *pc = NULL, *pg = NULL;
         double t0, tc, tu;
@@ -335,10 +341,11 @@ int main(int argc, char **argv)
             o.spacing = 0.0f;
         }
         o.weighting = RAD_PROBE_WEIGHT_NORMAL_FIT;
+        g_silent = 0;
         if (mode == 0)
-            emit("\nGrid of %u probes: create %.2f s, update from a solution %.3f ms (%lu entries), 2 threads.\n\n"
+            emit("%sGrid of %u probes: create %.2f s, update from a solution %.3f ms (%lu entries), 2 threads.\n\n"
                  "| probes, light | values | within 5%% | median error | 95th percentile |\n|---|---|---|---|---|\n",
-                 rad_probes_count(pg), tc, 1e3 * tu, (unsigned long)rad_probes_entry_count(pg));
+                 detail ? "\n" : "", rad_probes_count(pg), tc, 1e3 * tu, (unsigned long)rad_probes_entry_count(pg));
         rad_probes_destroy(pc);
         rad_probes_destroy(pg);
     }

@@ -17,7 +17,8 @@
 
    Build: cc -std=c99 -O3 -march=native -fopenmp -I. tests/bench/temporal.c -o temporal -lm
    Run:   temporal [--quick] [--detail] [--sizes N,N,...] [--append FILE.md] [--csv FILE.csv]
-          (--detail adds the table of where the step's time goes: ns per draw, huge pages)
+          (--detail adds the tables of where the step's time goes, ns per draw and huge pages, and
+          of the memory of F, its CSR form and the tables, and the lag after a light jump)
           (--sizes: up to four patch-count targets instead of the published four; tools/report.sh) */
 #include "bench_common.h"
 #define RADIOSITY_IMPLEMENTATION
@@ -377,15 +378,19 @@ int main(int argc, char **argv)
         emit("|---|---|---|---|---|---|---|---|\n");
         for (s = 0; s < sizes; ++s) emit("%s", rows_draw[s]);
     }
-    emit("\nMemory: dense F (4 B per entry), its non-zeros as CSR (8 B per entry), the alias tables "
-         "(bins over non-zeros + 1 environment bin per row, offsets, T_i).\n\n");
-    emit("| N | non-zero | dense F | CSR F | tables | bytes per bin | table bytes per bin incl. offsets | F bake | table build |\n");
-    emit("|---|---|---|---|---|---|---|---|---|\n");
-    for (s = 0; s < sizes; ++s) emit("%s", rows_mem[s]);
-    emit("\nLag after a light jump (a point light switched on; frames until 90%% of the change, k = 10) and steady "
-         "noise before it (relative RMS against the exact result, mean of 200 frames). Adaptive: noise targets 0.01 and 0.005.\n\n");
-    emit("| N | lag w=0.998 | noise w=0.998 | lag adaptive 0.01 | noise adaptive 0.01 | lag adaptive 0.005 | noise adaptive 0.005 |\n|---|---|---|---|---|---|---|\n");
-    for (s = 0; s < sizes; ++s) emit("%s", rows_lag[s]);
+    if (detail) {
+        emit("\nMemory: dense F (4 B per entry), its non-zeros as CSR (8 B per entry), the alias tables "
+             "(bins over non-zeros + 1 environment bin per row, offsets, T_i).\n\n");
+        emit("| N | non-zero | dense F | CSR F | tables | bytes per bin | table bytes per bin incl. offsets | F bake | table build |\n");
+        emit("|---|---|---|---|---|---|---|---|---|\n");
+        for (s = 0; s < sizes; ++s) emit("%s", rows_mem[s]);
+    }
+    if (detail) {
+        emit("\nLag after a light jump (a point light switched on; frames until 90%% of the change, k = 10) and steady "
+             "noise before it (relative RMS against the exact result, mean of 200 frames). Adaptive: noise targets 0.01 and 0.005.\n\n");
+        emit("| N | lag w=0.998 | noise w=0.998 | lag adaptive 0.01 | noise adaptive 0.01 | lag adaptive 0.005 | noise adaptive 0.005 |\n|---|---|---|---|---|---|---|\n");
+        for (s = 0; s < sizes; ++s) emit("%s", rows_lag[s]);
+    }
     if (series_f) {
         FILE *f = fopen(csv_path, "w");
         if (f) {
