@@ -532,8 +532,13 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
                 id = ++st->texture_count;
                 t = &st->textures[id - 1];
             }
+            /* a white texel (255 in 8 bits) is 1 and becomes 0.999 silently: only a factor that
+               lifts texels above 1 is worth the warning */
             for (q = 0; q < 3 * n; ++q)
-                if (t->rgb[q] > ALBEDO_MAX) t->rgb[q] = ALBEDO_MAX, clamped = 1;
+                if (t->rgb[q] > ALBEDO_MAX) {
+                    if (t->rgb[q] > 1.0f) clamped = 1;
+                    t->rgb[q] = ALBEDO_MAX;
+                }
             out->texture = id;
         }
     }
@@ -575,7 +580,10 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
     }
     for (k = 0; k < 3; ++k) {
         if (!(out->albedo[k] >= 0.0f)) out->albedo[k] = 0.0f, clamped = 1;
-        if (out->albedo[k] > ALBEDO_MAX) out->albedo[k] = ALBEDO_MAX, clamped = 1;
+        if (out->albedo[k] > ALBEDO_MAX) { /* a textured material's factor 1 (the glTF default) is no news */
+            if (!out->texture || out->albedo[k] > 1.0f) clamped = 1;
+            out->albedo[k] = ALBEDO_MAX;
+        }
     }
     *clamped_out = (unsigned char)clamped;
     return 0;
