@@ -20093,77 +20093,103 @@ static rad_result rad__lm_valid_row(void *data, uint32_t row, uint32_t task)
     return RAD_SUCCESS;
 }
 
-RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
-                                       const rad_lightmap_options *options, const rad_context *ctx, rad_lightmap **out)
-{
-    rad__ctx c;
+/* rad_lightmap_create's state between its stages: the resolved options, the sizes, the
+   lightmap being built and the scratch of the rasterization (freed at the end) */
+typedef struct rad__lm_build {
     rad_lightmap_options o;
-    rad_lightmap *lm = NULL;
-    uint32_t W, H, n, S, t, x, y, i, total = 0;
+    rad_lightmap *lm;
+    uint32_t W, H, n, S, total;
     size_t texels, slots;
-    uint32_t *slot_tri = NULL, *fb_tri = NULL;
-    float *slot_b = NULL, *fb_b = NULL, *fb_d = NULL;
-    rad__lm_valid v;
-    rad_result r = RAD_SUCCESS;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
+    uint32_t *slot_tri, *fb_tri;
+    float *slot_b, *fb_b, *fb_d;
+} rad__lm_build;
+
+/* rad_lightmap_create's first stage: the scene, the raycaster and the options checked, and the
+   texel and sample-slot counts derived from them */
+static rad_result rad__lightmap_check(const rad_scene *scene, const rad_raycaster *raycaster,
+                                      const rad_lightmap_options *options, rad__ctx *c, rad__lm_build *lb)
+{
+    rad_lightmap_options *o = &lb->o;
+    uint32_t n;
     if (!scene || !raycaster || !raycaster->intersect) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: NULL scene or raycaster (with intersect)");
+        rad__log(c, RAD_LOG_ERROR, "lightmap: NULL scene or raycaster (with intersect)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!scene->lightmap_uvs || !scene->lightmapped) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: no mesh of the scene has lightmap_uvs");
+        rad__log(c, RAD_LOG_ERROR, "lightmap: no mesh of the scene has lightmap_uvs");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (options) o = *options; else memset(&o, 0, sizeof(o));
-    rad__lightmap_options_resolve(&o);
-    if (o.width > RAD__LM_MAX_SIDE || o.height > RAD__LM_MAX_SIDE || o.samples > RAD__LM_MAX_SUB ||
-        o.validity_rays > 1024u || !(o.backface_limit > 0.0f && o.backface_limit <= 1.0f) ||
-        !(o.ray_epsilon > 0.0f && o.ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: an option is out of range (size %ux%u, at most %u; samples %u, at most %u; "
-                 "validity_rays %u, at most 1024; backface_limit %g in (0, 1]; ray_epsilon %g in (0, %g])", o.width, o.height,
-                 RAD__LM_MAX_SIDE, o.samples, RAD__LM_MAX_SUB, o.validity_rays, (double)o.backface_limit,
-                 (double)o.ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
+    if (options) *o = *options; else memset(o, 0, sizeof(*o));
+    rad__lightmap_options_resolve(o);
+    if (o->width > RAD__LM_MAX_SIDE || o->height > RAD__LM_MAX_SIDE || o->samples > RAD__LM_MAX_SUB ||
+        o->validity_rays > 1024u || !(o->backface_limit > 0.0f && o->backface_limit <= 1.0f) ||
+        !(o->ray_epsilon > 0.0f && o->ray_epsilon <= RAD__MAX_RAY_EPSILON)) {
+        rad__log(c, RAD_LOG_ERROR, "lightmap: an option is out of range (size %ux%u, at most %u; samples %u, at most %u; "
+                 "validity_rays %u, at most 1024; backface_limit %g in (0, 1]; ray_epsilon %g in (0, %g])", o->width, o->height,
+                 RAD__LM_MAX_SIDE, o->samples, RAD__LM_MAX_SUB, o->validity_rays, (double)o->backface_limit,
+                 (double)o->ray_epsilon, (double)RAD__MAX_RAY_EPSILON);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    W = o.width;
-    H = o.height;
-    n = rad__lattice_side(o.samples);
+    lb->W = o->width;
+    lb->H = o->height;
+    n = rad__lattice_side(o->samples);
     if (n * n > RAD__LM_MAX_SUB) n = 4;
-    S = n * n;
-    texels = (size_t)W * H;
-    if ((uint64_t)texels * S > RAD__LM_MAX_SLOTS) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: %ux%u texels of %u samples pass the limit of 2^28 sample slots", W, H, S);
+    lb->n = n;
+    lb->S = n * n;
+    lb->texels = (size_t)lb->W * lb->H;
+    if ((uint64_t)lb->texels * lb->S > RAD__LM_MAX_SLOTS) {
+        rad__log(c, RAD_LOG_ERROR, "lightmap: %ux%u texels of %u samples pass the limit of 2^28 sample slots", lb->W, lb->H,
+                 lb->S);
         return RAD_ERROR_SIZE_OVERFLOW;
     }
-    slots = texels * S;
-    lm = (rad_lightmap *)rad__alloc_zero(&c.allocator, sizeof(rad_lightmap));
+    lb->slots = lb->texels * lb->S;
+    return RAD_SUCCESS;
+}
+
+/* the second stage: the lightmap with its per-texel arrays, and the rasterization's scratch
+   (a triangle and barycentrics per sample slot, a fallback point per texel) set to empty */
+static rad_result rad__lightmap_alloc(const rad_scene *scene, rad__ctx *c, rad__lm_build *lb)
+{
+    rad_lightmap *lm;
+    size_t texels = lb->texels, slots = lb->slots;
+    uint32_t i;
+    lm = (rad_lightmap *)rad__alloc_zero(&c->allocator, sizeof(rad_lightmap));
     if (!lm) return RAD_ERROR_OUT_OF_MEMORY;
-    lm->allocator = c.allocator;
-    lm->width = W;
-    lm->height = H;
+    lb->lm = lm;
+    lm->allocator = c->allocator;
+    lm->width = lb->W;
+    lm->height = lb->H;
     lm->scene = scene;
-    lm->flags = (uint8_t *)rad__alloc_array(&c.allocator, texels, 1);
-    lm->positions = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
-    lm->normals = (float *)rad__alloc_array(&c.allocator, texels, 3 * sizeof(float));
-    lm->sample_first = (uint32_t *)rad__alloc_array(&c.allocator, texels + 1, sizeof(uint32_t));
-    slot_tri = (uint32_t *)rad__alloc_array(&c.allocator, slots, sizeof(uint32_t));
-    slot_b = (float *)rad__alloc_array(&c.allocator, slots, 2 * sizeof(float));
-    fb_tri = (uint32_t *)rad__alloc_array(&c.allocator, texels, sizeof(uint32_t));
-    fb_b = (float *)rad__alloc_array(&c.allocator, texels, 2 * sizeof(float));
-    fb_d = (float *)rad__alloc_array(&c.allocator, texels, sizeof(float));
-    if (!lm->flags || !lm->positions || !lm->normals || !lm->sample_first || !slot_tri || !slot_b || !fb_tri || !fb_b || !fb_d) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %ux%u texels", W, H);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-        goto done;
+    lm->flags = (uint8_t *)rad__alloc_array(&c->allocator, texels, 1);
+    lm->positions = (float *)rad__alloc_array(&c->allocator, texels, 3 * sizeof(float));
+    lm->normals = (float *)rad__alloc_array(&c->allocator, texels, 3 * sizeof(float));
+    lm->sample_first = (uint32_t *)rad__alloc_array(&c->allocator, texels + 1, sizeof(uint32_t));
+    lb->slot_tri = (uint32_t *)rad__alloc_array(&c->allocator, slots, sizeof(uint32_t));
+    lb->slot_b = (float *)rad__alloc_array(&c->allocator, slots, 2 * sizeof(float));
+    lb->fb_tri = (uint32_t *)rad__alloc_array(&c->allocator, texels, sizeof(uint32_t));
+    lb->fb_b = (float *)rad__alloc_array(&c->allocator, texels, 2 * sizeof(float));
+    lb->fb_d = (float *)rad__alloc_array(&c->allocator, texels, sizeof(float));
+    if (!lm->flags || !lm->positions || !lm->normals || !lm->sample_first || !lb->slot_tri || !lb->slot_b || !lb->fb_tri ||
+        !lb->fb_b || !lb->fb_d) {
+        rad__log(c, RAD_LOG_ERROR, "lightmap: out of memory for %ux%u texels", lb->W, lb->H);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
     memset(lm->flags, 0, texels);
     memset(lm->positions, 0, texels * 3 * sizeof(float));
     memset(lm->normals, 0, texels * 3 * sizeof(float));
-    for (i = 0; i < slots; ++i) slot_tri[i] = RAD_NONE;
-    for (i = 0; i < texels; ++i) { fb_tri[i] = RAD_NONE; fb_d[i] = FLT_MAX; }
-    /* rasterize: serial, each triangle over the texels of its uv bounds */
+    for (i = 0; i < slots; ++i) lb->slot_tri[i] = RAD_NONE;
+    for (i = 0; i < texels; ++i) { lb->fb_tri[i] = RAD_NONE; lb->fb_d[i] = FLT_MAX; }
+    return RAD_SUCCESS;
+}
+
+/* the third stage, serial: each triangle rasterized over the texels of its uv bounds, marking the
+   covered texels, the sample slots it holds first and each empty texel's closest point */
+static void rad__lightmap_raster(const rad_scene *scene, rad__lm_build *lb)
+{
+    rad_lightmap *lm = lb->lm;
+    uint32_t W = lb->W, H = lb->H, n = lb->n, S = lb->S, t, x, y;
+    uint32_t *slot_tri = lb->slot_tri, *fb_tri = lb->fb_tri;
+    float *slot_b = lb->slot_b, *fb_b = lb->fb_b, *fb_d = lb->fb_d;
     for (t = 0; t < scene->triangle_count; ++t) {
         double tu[6], mnx, mny, mxx, mxy;
         int64_t x0, x1, y0, y1;
@@ -20220,43 +20246,61 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
                 }
             }
     }
-    /* the samples, texel by texel */
+}
+
+/* the fourth stage: the samples counted texel by texel (the filled slots, else the fallback
+   point) and their arrays allocated */
+static rad_result rad__lightmap_samples(rad__ctx *c, rad__lm_build *lb)
+{
+    rad_lightmap *lm = lb->lm;
+    size_t texels = lb->texels;
+    uint32_t S = lb->S, i, total = 0;
     for (i = 0; i < texels; ++i) {
         uint32_t m = 0, s;
         lm->sample_first[i] = total;
         if (!(lm->flags[i] & RAD_TEXEL_COVERED)) continue;
-        for (s = 0; s < S; ++s) if (slot_tri[(size_t)i * S + s] != RAD_NONE) ++m;
-        if (m == 0 && fb_tri[i] != RAD_NONE) m = 1;
-        if ((uint64_t)total + m >= (uint64_t)RAD_NONE) { r = RAD_ERROR_SIZE_OVERFLOW; goto done; }
+        for (s = 0; s < S; ++s) if (lb->slot_tri[(size_t)i * S + s] != RAD_NONE) ++m;
+        if (m == 0 && lb->fb_tri[i] != RAD_NONE) m = 1;
+        if ((uint64_t)total + m >= (uint64_t)RAD_NONE) return RAD_ERROR_SIZE_OVERFLOW;
         total += m;
     }
+    lb->total = total;
     lm->sample_first[texels] = total;
     lm->sample_count = total;
-    lm->sample_positions = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
-    lm->sample_normals = (float *)rad__alloc_array(&c.allocator, total ? total : 1u, 3 * sizeof(float));
-    lm->sample_triangles = (uint32_t *)rad__alloc_array(&c.allocator, total ? total : 1u, sizeof(uint32_t));
-    lm->sample_valid = (uint8_t *)rad__alloc_array(&c.allocator, total ? total : 1u, 1);
+    lm->sample_positions = (float *)rad__alloc_array(&c->allocator, total ? total : 1u, 3 * sizeof(float));
+    lm->sample_normals = (float *)rad__alloc_array(&c->allocator, total ? total : 1u, 3 * sizeof(float));
+    lm->sample_triangles = (uint32_t *)rad__alloc_array(&c->allocator, total ? total : 1u, sizeof(uint32_t));
+    lm->sample_valid = (uint8_t *)rad__alloc_array(&c->allocator, total ? total : 1u, 1);
     if (!lm->sample_positions || !lm->sample_normals || !lm->sample_triangles || !lm->sample_valid) {
-        rad__log(&c, RAD_LOG_ERROR, "lightmap: out of memory for %u samples", total);
-        r = RAD_ERROR_OUT_OF_MEMORY;
-        goto done;
+        rad__log(c, RAD_LOG_ERROR, "lightmap: out of memory for %u samples", total);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
+    return RAD_SUCCESS;
+}
+
+/* the fifth stage: each sample's point, normal and triangle, the points on a triangle's border
+   moved slightly inwards */
+static void rad__lightmap_points(const rad_scene *scene, rad__lm_build *lb)
+{
+    rad_lightmap *lm = lb->lm;
+    size_t texels = lb->texels;
+    uint32_t S = lb->S, i;
     for (i = 0; i < texels; ++i) {
         uint32_t at = lm->sample_first[i], s, m = lm->sample_first[i + 1] - at, j = 0;
         for (s = 0; s < S && j < m; ++s) {
             size_t si = (size_t)i * S + s;
-            uint32_t tt = slot_tri[si];
+            uint32_t tt = lb->slot_tri[si];
             float b1, b2;
             const float *P;
             int k;
             if (tt == RAD_NONE && !(s == S - 1 && j == 0)) continue;
             if (tt == RAD_NONE) { /* no sub-point inside: the fallback point */
-                tt = fb_tri[i];
-                b1 = fb_b[2 * (size_t)i];
-                b2 = fb_b[2 * (size_t)i + 1];
+                tt = lb->fb_tri[i];
+                b1 = lb->fb_b[2 * (size_t)i];
+                b2 = lb->fb_b[2 * (size_t)i + 1];
             } else {
-                b1 = slot_b[2 * si];
-                b2 = slot_b[2 * si + 1];
+                b1 = lb->slot_b[2 * si];
+                b2 = lb->slot_b[2 * si + 1];
             }
             P = scene->positions + 9 * (size_t)tt;
             {
@@ -20271,7 +20315,7 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
                     lm->sample_normals[3 * (size_t)(at + j) + k] = scene->normals[3 * (size_t)tt + k];
                 }
                 len = rad__len(dc);
-                step = 4.0f * o.ray_epsilon * scene->diagonal;
+                step = 4.0f * lb->o.ray_epsilon * scene->diagonal;
                 if (len > 0.0f) {
                     if (step > 0.5f * len) step = 0.5f * len;
                     for (k = 0; k < 3; ++k) X[k] += dc[k] * (step / len);
@@ -20281,32 +20325,48 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
             ++j;
         }
     }
-    /* validity */
+}
+
+/* the sixth stage: each sample's validity from the back faces its rays hit, in parallel over
+   groups of samples */
+static rad_result rad__lightmap_validity(const rad_scene *scene, const rad_raycaster *raycaster, rad__ctx *c,
+                                         rad__lm_build *lb)
+{
+    rad_lightmap *lm = lb->lm;
+    uint32_t total = lb->total, i;
+    rad__lm_valid v;
+    rad_result r = RAD_SUCCESS;
     memset(&v, 0, sizeof(v));
     v.lm = lm;
     v.rc = raycaster;
-    v.rays = o.validity_rays;
-    v.limit = (uint32_t)floor((double)o.backface_limit * o.validity_rays + 1e-9);
-    v.seed = o.seed;
-    v.eps = o.ray_epsilon * scene->diagonal;
+    v.rays = lb->o.validity_rays;
+    v.limit = (uint32_t)floor((double)lb->o.backface_limit * lb->o.validity_rays + 1e-9);
+    v.seed = lb->o.seed;
+    v.eps = lb->o.ray_epsilon * scene->diagonal;
     if (total > 0) {
-        uint32_t rows = (total + RAD__LM_GROUP - 1) / RAD__LM_GROUP, T = c.tasks < rows ? c.tasks : rows;
-        v.ray_buf = (rad_ray *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_ray));
-        v.hit_buf = (rad_hit *)rad__alloc_array(&c.allocator, (size_t)T * v.rays, sizeof(rad_hit));
-        v.rays_cast = (uint64_t *)rad__alloc_array(&c.allocator, T, sizeof(uint64_t));
+        uint32_t rows = (total + RAD__LM_GROUP - 1) / RAD__LM_GROUP, T = c->tasks < rows ? c->tasks : rows;
+        v.ray_buf = (rad_ray *)rad__alloc_array(&c->allocator, (size_t)T * v.rays, sizeof(rad_ray));
+        v.hit_buf = (rad_hit *)rad__alloc_array(&c->allocator, (size_t)T * v.rays, sizeof(rad_hit));
+        v.rays_cast = (uint64_t *)rad__alloc_array(&c->allocator, T, sizeof(uint64_t));
         if (!v.ray_buf || !v.hit_buf || !v.rays_cast) {
             r = RAD_ERROR_OUT_OF_MEMORY;
         } else {
             memset(v.rays_cast, 0, sizeof(uint64_t) * T);
-            r = rad__for_rows(&c, rows, T, rad__lm_valid_row, &v);
+            r = rad__for_rows(c, rows, T, rad__lm_valid_row, &v);
             for (i = 0; i < T; ++i) lm->rays_cast += v.rays_cast[i];
         }
-        rad__free(&c.allocator, v.ray_buf);
-        rad__free(&c.allocator, v.hit_buf);
-        rad__free(&c.allocator, v.rays_cast);
-        if (r != RAD_SUCCESS) goto done;
+        rad__free(&c->allocator, v.ray_buf);
+        rad__free(&c->allocator, v.hit_buf);
+        rad__free(&c->allocator, v.rays_cast);
     }
-    /* texel position and normal */
+    return r;
+}
+
+/* the last stage: each covered texel's position and normal, the mean of its valid samples (of
+   all of them when none is valid), and the lightmap's counts */
+static void rad__lightmap_texels(rad_lightmap *lm, size_t texels)
+{
+    uint32_t i;
     for (i = 0; i < texels; ++i) {
         uint32_t s, a = lm->sample_first[i], b = lm->sample_first[i + 1], any = 0;
         float cnt = 0.0f, *P = lm->positions + 3 * (size_t)i, *N = lm->normals + 3 * (size_t)i;
@@ -20330,17 +20390,40 @@ RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycast
         if (rad__len(N) > 0.0f) rad__normalize(N);
         else memcpy(N, lm->sample_normals + 3 * (size_t)a, 3 * sizeof(float));
     }
-done:
+}
+
+RAD_API rad_result rad_lightmap_create(const rad_scene *scene, const rad_raycaster *raycaster,
+                                       const rad_lightmap_options *options, const rad_context *ctx, rad_lightmap **out)
+{
+    rad__ctx c;
+    rad__lm_build lb;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    memset(&lb, 0, sizeof(lb));
+    r = rad__lightmap_check(scene, raycaster, options, &c, &lb);
+    if (r != RAD_SUCCESS) return r;
+    r = rad__lightmap_alloc(scene, &c, &lb);
+    if (r == RAD_SUCCESS) {
+        rad__lightmap_raster(scene, &lb);
+        r = rad__lightmap_samples(&c, &lb);
+    }
+    if (r == RAD_SUCCESS) {
+        rad__lightmap_points(scene, &lb);
+        r = rad__lightmap_validity(scene, raycaster, &c, &lb);
+    }
+    if (r == RAD_SUCCESS) rad__lightmap_texels(lb.lm, lb.texels);
     {
-        void *blocks[] = { slot_tri, slot_b, fb_tri, fb_b, fb_d };
+        void *blocks[] = { lb.slot_tri, lb.slot_b, lb.fb_tri, lb.fb_b, lb.fb_d };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
     if (r != RAD_SUCCESS) {
         if (r == RAD_ERROR_SIZE_OVERFLOW) rad__log(&c, RAD_LOG_ERROR, "lightmap: more than 2^32 - 2 samples");
-        rad_lightmap_destroy(lm);
+        rad_lightmap_destroy(lb.lm);
         return r;
     }
-    *out = lm;
+    *out = lb.lm;
     return RAD_SUCCESS;
 }
 
@@ -23776,31 +23859,28 @@ static rad_result rad__brt_classic_solve(rad_baker_runtime *rt, const rad_light 
     return RAD_SUCCESS;
 }
 
-RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const rad_baker_options *bake_options,
-                                            const rad_baker_result *R, const rad_baker_runtime_options *options,
-                                            const rad_context *ctx, rad_baker_runtime **out)
+/* rad_baker_runtime_create's first stage: the arguments checked that need nothing built */
+static rad_result rad__brt_check_args(const rad_baker_desc *desc, const rad_baker_result *R, rad_baker_runtime **out,
+                                      const rad__ctx *c)
 {
-    rad__ctx c0;
-    rad_baker_runtime *rt;
-    rad_baker_options bo;
-    rad_result r;
-    uint32_t m, i, outputs;
-    size_t N3;
-    rad__ctx_init(&c0, ctx);
-    if (out) *out = NULL;
     if (!desc || !R || !out) {
-        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: NULL desc, result or out");
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: NULL desc, result or out");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (desc->light_count && !desc->lights) {
-        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: light_count %u with lights NULL", desc->light_count);
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: light_count %u with lights NULL", desc->light_count);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    rt = (rad_baker_runtime *)rad__alloc_zero(&c0.allocator, sizeof *rt);
-    if (!rt) return RAD_ERROR_OUT_OF_MEMORY;
-    rt->c = c0;
-    if (ctx) rt->sub = *ctx;
-    rt->sub.progress = NULL;
+    return RAD_SUCCESS;
+}
+
+/* the second stage: the runtime options and the bake options resolved (a zero field to its
+   default), checked, and the result checked to be a bake of this desc with these options */
+static rad_result rad__brt_options(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_options *bake_options,
+                                   const rad_baker_result *R, const rad_baker_runtime_options *options,
+                                   rad_baker_options *bo, const rad__ctx *c)
+{
+    uint32_t i, outputs;
     rad_baker_runtime_options_default(&rt->o);
     if (options) {
         if (options->temporal_samples) rt->o.temporal_samples = options->temporal_samples;
@@ -23811,123 +23891,157 @@ RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const ra
     }
     if (!(rt->o.temporal_weight >= 0.0f && rt->o.temporal_weight < 1.0f) || !(rt->o.work_per_ms > 0.0) ||
         !rad__finite((float)rt->o.work_per_ms) || rt->o.temporal_samples > RAD_TEMPORAL_MAX_SAMPLES) {
-        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: temporal_weight must be in [0, 1), work_per_ms finite and "
-                                     "> 0, temporal_samples at most %u", RAD_TEMPORAL_MAX_SAMPLES);
-        return rad__brt_fail(rt, RAD_ERROR_INVALID_ARGUMENT);
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: temporal_weight must be in [0, 1), work_per_ms finite and "
+                                   "> 0, temporal_samples at most %u", RAD_TEMPORAL_MAX_SAMPLES);
+        return RAD_ERROR_INVALID_ARGUMENT;
     }
-    memset(&bo, 0, sizeof bo);
-    if (bake_options) bo = *bake_options;
-    if (!bo.patches) bo.patches = 512;
-    if (!bo.bounces) bo.bounces = 16;
-    if (!bo.ff_samples) bo.ff_samples = 16;
-    if (!bo.light_samples) bo.light_samples = 16;
-    if (!bo.lightmap_samples) bo.lightmap_samples = 4;
+    memset(bo, 0, sizeof *bo);
+    if (bake_options) *bo = *bake_options;
+    if (!bo->patches) bo->patches = 512;
+    if (!bo->bounces) bo->bounces = 16;
+    if (!bo->ff_samples) bo->ff_samples = 16;
+    if (!bo->light_samples) bo->light_samples = 16;
+    if (!bo->lightmap_samples) bo->lightmap_samples = 4;
     outputs = desc->outputs ? desc->outputs : (uint32_t)RAD_BAKER_VERTEX;
     rt->method = R->method;
-    rt->bounces = bo.bounces;
+    rt->bounces = bo->bounces;
     rt->light_count = desc->light_count;
     rt->mesh_count = desc->scene.mesh_count;
     for (i = 0; i < desc->scene.material_count && desc->scene.materials; ++i) rt->any_emits |= rad__baker_emits(&desc->scene.materials[i]);
-    if (bo.method != RAD_BAKER_AUTO && bo.method != R->method) {
-        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: the result's method is not the one of the bake options: "
-                                     "other bake options");
-        return rad__brt_fail(rt, RAD_ERROR_INVALID_ARGUMENT);
+    if (bo->method != RAD_BAKER_AUTO && bo->method != R->method) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: the result's method is not the one of the bake options: "
+                                   "other bake options");
+        return RAD_ERROR_INVALID_ARGUMENT;
     }
     if ((R->method != RAD_BAKER_CLASSIC && R->method != RAD_BAKER_VIRTUAL_PATCHES) || R->mesh_count != desc->scene.mesh_count ||
         !(outputs & RAD_BAKER_VERTEX) != !R->vertex || !(outputs & RAD_BAKER_LIGHTMAP) != !R->lightmap ||
         !(outputs & RAD_BAKER_PROBES) != !R->probes ||
         (R->method == RAD_BAKER_VIRTUAL_PATCHES && desc->light_count > RAD_VP_LIGHTS_MAX)) {
-        rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: the result is not a bake of this desc (method, meshes or "
-                                     "outputs differ), or more than %u lights over virtual patches", RAD_VP_LIGHTS_MAX);
-        return rad__brt_fail(rt, RAD_ERROR_INVALID_ARGUMENT);
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: the result is not a bake of this desc (method, meshes or "
+                                   "outputs differ), or more than %u lights over virtual patches", RAD_VP_LIGHTS_MAX);
+        return RAD_ERROR_INVALID_ARGUMENT;
     }
-    rt->lights = (rad_light *)rad__alloc_array(&c0.allocator, desc->light_count ? desc->light_count : 1u, sizeof(rad_light));
-    if (!rt->lights) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
+    return RAD_SUCCESS;
+}
+
+/* the third stage: the baked lights copied, the direct-light options set, and the scene with
+   its BVH built from the desc */
+static rad_result rad__brt_alloc(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_options *bo,
+                                 const rad__ctx *c)
+{
+    rad_result r;
+    uint32_t i;
+    rt->lights = (rad_light *)rad__alloc_array(&c->allocator, desc->light_count ? desc->light_count : 1u, sizeof(rad_light));
+    if (!rt->lights) return RAD_ERROR_OUT_OF_MEMORY;
     for (i = 0; i < desc->light_count; ++i) memcpy(&rt->lights[i], &desc->lights[i].light, sizeof(rad_light));
     rad_direct_options_default(&rt->dopt);
     rt->dopt.exclude_emitters = !rt->any_emits;
-    rt->dopt.light_samples = bo.light_samples;
-    rt->dopt.seed = bo.seed;
+    rt->dopt.light_samples = bo->light_samples;
+    rt->dopt.seed = bo->seed;
 
     r = rad_scene_create(&desc->scene, &rt->sub, &rt->scene);
     if (r == RAD_SUCCESS) r = rad_bvh_create(rt->scene, &rt->sub, &rt->bvh);
-    if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+    if (r != RAD_SUCCESS) return r;
     rad_bvh_raycaster(rt->bvh, &rt->rc);
-    if (R->method == RAD_BAKER_CLASSIC) {
-        rad_patch_options po;
-        rad_form_factor_options fo;
-        rad_multibounce_options mo;
-        rad_patch_options_default(&po);
-        po.target_count = bo.patches;
-        rad_form_factor_options_default(&fo);
-        fo.samples = bo.ff_samples;
-        fo.seed = bo.seed;
-        r = rad_patches_create(rt->scene, &po, &rt->sub, &rt->patches);
-        if (r == RAD_SUCCESS && rt->patches->count != R->patch_count) {
-            rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: %u patches, the result has %u: other bake options",
-                     rt->patches->count, R->patch_count);
-            r = RAD_ERROR_INVALID_ARGUMENT;
-        }
-        if (r == RAD_SUCCESS) r = rad_form_factors_dense(rt->patches, &rt->rc, &fo, &rt->sub, &rt->ff);
-        if (r == RAD_SUCCESS) {
-            memset(&mo, 0, sizeof mo);
-            mo.bounces = bo.bounces;
-            r = rad_multibounce_create(&rt->ff->matrix, rt->patches->albedo, &mo, &rt->sub, &rt->mb);
-        }
-        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
-        rt->n = rt->patches->count;
-        rt->nnz = (uint64_t)rt->n * rt->n;
-    } else {
-        rad_vp_options vo;
-        rad_temporal_options to;
-        rad_vp_lights_options lo;
-        const rad_alias_tables *tp[1];
-        rad_vp_options_default(&vo);
-        vo.resolution = R->vp_resolution;
-        vo.storage = RAD_STORAGE_SPARSE;
-        r = rad_vp_create(rt->scene, &rt->rc, &vo, &rt->sub, &rt->vp);
-        if (r == RAD_SUCCESS && rt->vp->count != R->patch_count) {
-            rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: %u virtual patches, the result has %u: other bake options",
-                     rt->vp->count, R->patch_count);
-            r = RAD_ERROR_INVALID_ARGUMENT;
-        }
-        if (r == RAD_SUCCESS) r = rad_alias_tables_create(&rt->vp->matrix, RAD_ALIAS_AUTO, &rt->sub, &rt->tables);
-        if (r == RAD_SUCCESS) {
-            rad_temporal_options_default(&to);
-            to.mode = RAD_TEMPORAL_FEEDBACK;
-            to.samples = rt->o.temporal_samples;
-            to.weight = rt->o.temporal_weight > 0.0f ? rt->o.temporal_weight : -1.0f;
-            to.seed = rt->o.seed;
-            tp[0] = rt->tables;
-            r = rad_temporal_create(tp, 1, rt->vp->albedo, &to, &rt->sub, &rt->temporal);
-        }
-        if (r == RAD_SUCCESS) {
-            rad_vp_lights_options_default(&lo);
-            lo.direct = rt->dopt;
-            if (rt->o.shadow_rays == RAD_BAKER_RUNTIME_ALL_RAYS) lo.rays_per_frame = 0;
-            else lo.rays_per_frame = rt->o.shadow_rays ? rt->o.shadow_rays : (rt->vp->sample_count + 7u) / 8u;
-            if (lo.rays_per_frame >= rt->vp->sample_count) lo.rays_per_frame = 0;
-            rt->settle = lo.rays_per_frame ? (rt->vp->sample_count + lo.rays_per_frame - 1u) / lo.rays_per_frame : 1u;
-            r = rad_vp_lights_create(rt->vp, &rt->rc, &lo, &rt->sub, &rt->vpl);
-        }
-        if (r == RAD_SUCCESS && R->vertex) {
-            rt->gather = (rad_vp_gather_table **)rad__alloc_zero(&c0.allocator, sizeof(rad_vp_gather_table *) * (rt->mesh_count + 1u));
-            if (!rt->gather) r = RAD_ERROR_OUT_OF_MEMORY;
-            for (m = 0; r == RAD_SUCCESS && m < rt->mesh_count; ++m)
-                r = rad_vp_gather_table_mesh(rt->vp, &desc->scene.meshes[m], &rt->sub, &rt->gather[m]);
-        }
-        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
-        rt->n = rt->vp->count;
-        rt->nnz = rt->vp->matrix.row_offsets[rt->n];
+    return RAD_SUCCESS;
+}
+
+/* the fourth stage for the classic method: the patches (as many as the result's), their dense
+   form factors and the multibounce operator */
+static rad_result rad__brt_build_classic(rad_baker_runtime *rt, const rad_baker_result *R, const rad_baker_options *bo,
+                                         const rad__ctx *c)
+{
+    rad_patch_options po;
+    rad_form_factor_options fo;
+    rad_multibounce_options mo;
+    rad_result r;
+    rad_patch_options_default(&po);
+    po.target_count = bo->patches;
+    rad_form_factor_options_default(&fo);
+    fo.samples = bo->ff_samples;
+    fo.seed = bo->seed;
+    r = rad_patches_create(rt->scene, &po, &rt->sub, &rt->patches);
+    if (r == RAD_SUCCESS && rt->patches->count != R->patch_count) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: %u patches, the result has %u: other bake options",
+                 rt->patches->count, R->patch_count);
+        r = RAD_ERROR_INVALID_ARGUMENT;
     }
-    N3 = 3 * (size_t)rt->n;
-    rt->planes = (float *)rad__alloc_array(&c0.allocator, 8 * N3 + 1, sizeof(float));
-    if (!rt->planes) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
+    if (r == RAD_SUCCESS) r = rad_form_factors_dense(rt->patches, &rt->rc, &fo, &rt->sub, &rt->ff);
+    if (r == RAD_SUCCESS) {
+        memset(&mo, 0, sizeof mo);
+        mo.bounces = bo->bounces;
+        r = rad_multibounce_create(&rt->ff->matrix, rt->patches->albedo, &mo, &rt->sub, &rt->mb);
+    }
+    if (r != RAD_SUCCESS) return r;
+    rt->n = rt->patches->count;
+    rt->nnz = (uint64_t)rt->n * rt->n;
+    return RAD_SUCCESS;
+}
+
+/* the fourth stage for virtual patches: the patches (as many as the result's), their alias
+   tables, the temporal estimator, the lights' shadow-ray schedule and the vertex gather tables */
+static rad_result rad__brt_build_vp(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_result *R,
+                                    const rad__ctx *c)
+{
+    rad_vp_options vo;
+    rad_temporal_options to;
+    rad_vp_lights_options lo;
+    const rad_alias_tables *tp[1];
+    rad_result r;
+    uint32_t m;
+    rad_vp_options_default(&vo);
+    vo.resolution = R->vp_resolution;
+    vo.storage = RAD_STORAGE_SPARSE;
+    r = rad_vp_create(rt->scene, &rt->rc, &vo, &rt->sub, &rt->vp);
+    if (r == RAD_SUCCESS && rt->vp->count != R->patch_count) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: %u virtual patches, the result has %u: other bake options",
+                 rt->vp->count, R->patch_count);
+        r = RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (r == RAD_SUCCESS) r = rad_alias_tables_create(&rt->vp->matrix, RAD_ALIAS_AUTO, &rt->sub, &rt->tables);
+    if (r == RAD_SUCCESS) {
+        rad_temporal_options_default(&to);
+        to.mode = RAD_TEMPORAL_FEEDBACK;
+        to.samples = rt->o.temporal_samples;
+        to.weight = rt->o.temporal_weight > 0.0f ? rt->o.temporal_weight : -1.0f;
+        to.seed = rt->o.seed;
+        tp[0] = rt->tables;
+        r = rad_temporal_create(tp, 1, rt->vp->albedo, &to, &rt->sub, &rt->temporal);
+    }
+    if (r == RAD_SUCCESS) {
+        rad_vp_lights_options_default(&lo);
+        lo.direct = rt->dopt;
+        if (rt->o.shadow_rays == RAD_BAKER_RUNTIME_ALL_RAYS) lo.rays_per_frame = 0;
+        else lo.rays_per_frame = rt->o.shadow_rays ? rt->o.shadow_rays : (rt->vp->sample_count + 7u) / 8u;
+        if (lo.rays_per_frame >= rt->vp->sample_count) lo.rays_per_frame = 0;
+        rt->settle = lo.rays_per_frame ? (rt->vp->sample_count + lo.rays_per_frame - 1u) / lo.rays_per_frame : 1u;
+        r = rad_vp_lights_create(rt->vp, &rt->rc, &lo, &rt->sub, &rt->vpl);
+    }
+    if (r == RAD_SUCCESS && R->vertex) {
+        rt->gather = (rad_vp_gather_table **)rad__alloc_zero(&c->allocator, sizeof(rad_vp_gather_table *) * (rt->mesh_count + 1u));
+        if (!rt->gather) r = RAD_ERROR_OUT_OF_MEMORY;
+        for (m = 0; r == RAD_SUCCESS && m < rt->mesh_count; ++m)
+            r = rad_vp_gather_table_mesh(rt->vp, &desc->scene.meshes[m], &rt->sub, &rt->gather[m]);
+    }
+    if (r != RAD_SUCCESS) return r;
+    rt->n = rt->vp->count;
+    rt->nnz = rt->vp->matrix.row_offsets[rt->n];
+    return RAD_SUCCESS;
+}
+
+/* the fifth stage: the eight solution planes, and the solution for the baked lights in them,
+   the state every later frame starts from */
+static rad_result rad__brt_solve(rad_baker_runtime *rt, const rad_baker_result *R, const rad__ctx *c)
+{
+    rad_result r;
+    uint32_t i;
+    size_t N3 = 3 * (size_t)rt->n;
+    rt->planes = (float *)rad__alloc_array(&c->allocator, 8 * N3 + 1, sizeof(float));
+    if (!rt->planes) return RAD_ERROR_OUT_OF_MEMORY;
     memset(rt->planes, 0, (8 * N3 + 1) * sizeof(float));
     rt->E = rt->planes, rt->L = rt->E + N3, rt->H = rt->L + N3, rt->B = rt->H + N3, rt->Ln = rt->B + N3;
     rt->Hn = rt->Ln + N3, rt->tmp = rt->Hn + N3, rt->X = rt->tmp + N3;
 
-    /* the solution for the baked lights: the state every later frame starts from */
     if (R->method == RAD_BAKER_CLASSIC) {
         r = rad__brt_classic_solve(rt, rt->lights);
     } else {
@@ -23945,88 +24059,139 @@ RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const ra
         for (i = 0; r == RAD_SUCCESS && i < 96u; ++i) r = rad_temporal_step(rt->temporal, rt->E, NULL, NULL);
         rt->rest = rt->settle;
     }
-    if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+    return r;
+}
 
+/* the classic vertex output's per-frame gather reads the meshes: their patch row sums, and a
+   copy of each mesh's indices and positions */
+static rad_result rad__brt_keep_meshes(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad__ctx *c)
+{
+    rad_result r = RAD_SUCCESS;
+    uint32_t m, i;
+    rt->row_sums = (float *)rad__alloc_array(&c->allocator, rt->n, sizeof(float));
+    rt->pvertex = (float *)rad__alloc_array(&c->allocator, rt->patches->vertex_count, 3 * sizeof(float));
+    rt->meshes = (rad_mesh_desc *)rad__alloc_zero(&c->allocator, sizeof(rad_mesh_desc) * (rt->mesh_count + 1u));
+    if (!rt->row_sums || !rt->pvertex || !rt->meshes) r = RAD_ERROR_OUT_OF_MEMORY;
+    for (i = 0; r == RAD_SUCCESS && i < 3 * rt->n; ++i) rt->tmp[i] = 1.0f;
+    if (r == RAD_SUCCESS) r = rad_matrix_multiply(&rt->ff->matrix, rt->tmp, rt->Hn, &rt->sub);
+    for (i = 0; r == RAD_SUCCESS && i < rt->n; ++i) rt->row_sums[i] = rt->Hn[3 * (size_t)i];
+    for (m = 0; r == RAD_SUCCESS && m < rt->mesh_count; ++m) {
+        const rad_mesh_desc *s = &desc->scene.meshes[m];
+        rad_mesh_desc *d = &rt->meshes[m];
+        size_t ps = s->position_stride ? s->position_stride : 3 * sizeof(float), ni = 3 * (size_t)s->triangle_count;
+        uint32_t *idx = NULL;
+        float *pos = NULL;
+        d->vertex_count = s->vertex_count;
+        d->triangle_count = s->triangle_count;
+        if (s->indices) {
+            idx = (uint32_t *)rad__alloc_array(&c->allocator, ni + 1, sizeof(uint32_t));
+            if (idx) memcpy(idx, s->indices, ni * sizeof(uint32_t));
+            d->indices = idx;
+        }
+        if (s->positions) {
+            pos = (float *)rad__alloc_array(&c->allocator, (size_t)s->vertex_count + 1, 3 * sizeof(float));
+            for (i = 0; pos && i < s->vertex_count; ++i) memcpy(pos + 3 * (size_t)i, rad__strided(s->positions, ps, i), 3 * sizeof(float));
+            d->positions = pos;
+        }
+        if ((s->indices && !idx) || (s->positions && !pos)) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    return r;
+}
+
+/* the vertex output: the bake's layers mixed at scale 1, and for the classic method what its
+   per-frame gather reads */
+static rad_result rad__brt_out_vertex(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_result *R,
+                                      const rad__ctx *c)
+{
+    rad_result r;
+    rt->vertex_count = R->vertex_count;
+    rt->vertex_first = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)rt->mesh_count + 1, sizeof(uint32_t));
+    rt->vertex = (float *)rad__alloc_array(&c->allocator, 3 * (size_t)R->vertex_count + 1, sizeof(float));
+    if (!rt->vertex || !rt->vertex_first) return RAD_ERROR_OUT_OF_MEMORY;
+    memcpy(rt->vertex_first, R->vertex_first, sizeof(uint32_t) * ((size_t)rt->mesh_count + 1));
+    r = rad_baker_mix_layers(R->vertex_layers, R->group_count, 3 * (size_t)R->vertex_count, NULL, rt->vertex, &rt->sub);
+    if (r == RAD_SUCCESS && R->method == RAD_BAKER_CLASSIC) r = rad__brt_keep_meshes(rt, desc, c);
+    return r;
+}
+
+/* the lightmap output: the bake's layers mixed at scale 1, the lightmap's texels rebuilt with
+   the bake's options, their weights over the patches and the dilation of the empty texels */
+static rad_result rad__brt_out_lightmap(rad_baker_runtime *rt, const rad_baker_result *R, const rad_baker_options *bo,
+                                        const rad__ctx *c)
+{
+    rad_lightmap_options lo;
+    rad_result r;
+    rt->texels = R->lightmap_width * R->lightmap_height;
+    rt->lightmap = (float *)rad__alloc_array(&c->allocator, 3 * (size_t)rt->texels, sizeof(float));
+    if (!rt->lightmap) return RAD_ERROR_OUT_OF_MEMORY;
+    r = rad_baker_mix_layers(R->lightmap_layers, R->group_count, 3 * (size_t)rt->texels, NULL, rt->lightmap, &rt->sub);
+    rad_lightmap_options_default(&lo);
+    lo.width = R->lightmap_width;
+    lo.height = R->lightmap_height;
+    lo.samples = bo->lightmap_samples;
+    lo.seed = bo->seed;
+    if (r == RAD_SUCCESS) r = rad_lightmap_create(rt->scene, &rt->rc, &lo, &rt->sub, &rt->lm);
+    if (r == RAD_SUCCESS)
+        r = R->method == RAD_BAKER_CLASSIC ? rad_lightmap_weights_create(rt->lm, rt->patches, rt->lightmap, rt->H, &rt->sub, &rt->lw)
+                                           : rad_lightmap_weights_create_vp(rt->lm, rt->vp, &rt->sub, &rt->lw);
+    if (r == RAD_SUCCESS) {
+        rt->lmV = (float *)rad__alloc_array(&c->allocator, (size_t)rt->lw->vertex_count + 1, 3 * sizeof(float));
+        r = rt->lmV ? rad__brt_dilation(rt) : RAD_ERROR_OUT_OF_MEMORY;
+    }
+    return r;
+}
+
+/* the probe output: the probes rebuilt at the desc's points or spacing (as many as the
+   result's), and the bake's layers mixed at scale 1 */
+static rad_result rad__brt_out_probes(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_result *R,
+                                      const rad__ctx *c)
+{
+    rad_probe_options po;
+    rad_result r;
+    rad_probe_options_default(&po);
+    po.spacing = desc->probe_spacing;
+    r = R->method == RAD_BAKER_CLASSIC
+            ? rad_probes_create(rt->patches, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes)
+            : rad_probes_create_vp(rt->vp, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes);
+    if (r == RAD_SUCCESS && rad_probes_count(rt->probes) != R->probe_count) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: %u probes, the result has %u", rad_probes_count(rt->probes),
+                 R->probe_count);
+        r = RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (r != RAD_SUCCESS) return r;
+    rt->probe_count = R->probe_count;
+    rt->probe_out = (float *)rad__alloc_array(&c->allocator, 27 * (size_t)rt->probe_count + 1, sizeof(float));
+    if (!rt->probe_out) return RAD_ERROR_OUT_OF_MEMORY;
+    return rad_baker_mix_layers(R->probe_layers, R->group_count, 27 * (size_t)rt->probe_count, NULL, rt->probe_out, &rt->sub);
+}
+
+RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const rad_baker_options *bake_options,
+                                            const rad_baker_result *R, const rad_baker_runtime_options *options,
+                                            const rad_context *ctx, rad_baker_runtime **out)
+{
+    rad__ctx c0;
+    rad_baker_runtime *rt;
+    rad_baker_options bo;
+    rad_result r;
+    rad__ctx_init(&c0, ctx);
+    if (out) *out = NULL;
+    r = rad__brt_check_args(desc, R, out, &c0);
+    if (r != RAD_SUCCESS) return r;
+    rt = (rad_baker_runtime *)rad__alloc_zero(&c0.allocator, sizeof *rt);
+    if (!rt) return RAD_ERROR_OUT_OF_MEMORY;
+    rt->c = c0;
+    if (ctx) rt->sub = *ctx;
+    rt->sub.progress = NULL;
+    r = rad__brt_options(rt, desc, bake_options, R, options, &bo, &c0);
+    if (r == RAD_SUCCESS) r = rad__brt_alloc(rt, desc, &bo, &c0);
+    if (r == RAD_SUCCESS)
+        r = R->method == RAD_BAKER_CLASSIC ? rad__brt_build_classic(rt, R, &bo, &c0) : rad__brt_build_vp(rt, desc, R, &c0);
+    if (r == RAD_SUCCESS) r = rad__brt_solve(rt, R, &c0);
     /* outputs: the bake's layers at scale 1, and what refreshes each */
-    if (R->vertex) {
-        rt->vertex_count = R->vertex_count;
-        rt->vertex_first = (uint32_t *)rad__alloc_array(&c0.allocator, (size_t)rt->mesh_count + 1, sizeof(uint32_t));
-        rt->vertex = (float *)rad__alloc_array(&c0.allocator, 3 * (size_t)R->vertex_count + 1, sizeof(float));
-        if (!rt->vertex || !rt->vertex_first) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
-        memcpy(rt->vertex_first, R->vertex_first, sizeof(uint32_t) * ((size_t)rt->mesh_count + 1));
-        r = rad_baker_mix_layers(R->vertex_layers, R->group_count, 3 * (size_t)R->vertex_count, NULL, rt->vertex, &rt->sub);
-        if (r == RAD_SUCCESS && R->method == RAD_BAKER_CLASSIC) {
-            /* the vertex gather reads the meshes each frame: keep their indices and positions */
-            rt->row_sums = (float *)rad__alloc_array(&c0.allocator, rt->n, sizeof(float));
-            rt->pvertex = (float *)rad__alloc_array(&c0.allocator, rt->patches->vertex_count, 3 * sizeof(float));
-            rt->meshes = (rad_mesh_desc *)rad__alloc_zero(&c0.allocator, sizeof(rad_mesh_desc) * (rt->mesh_count + 1u));
-            if (!rt->row_sums || !rt->pvertex || !rt->meshes) r = RAD_ERROR_OUT_OF_MEMORY;
-            for (i = 0; r == RAD_SUCCESS && i < 3 * rt->n; ++i) rt->tmp[i] = 1.0f;
-            if (r == RAD_SUCCESS) r = rad_matrix_multiply(&rt->ff->matrix, rt->tmp, rt->Hn, &rt->sub);
-            for (i = 0; r == RAD_SUCCESS && i < rt->n; ++i) rt->row_sums[i] = rt->Hn[3 * (size_t)i];
-            for (m = 0; r == RAD_SUCCESS && m < rt->mesh_count; ++m) {
-                const rad_mesh_desc *s = &desc->scene.meshes[m];
-                rad_mesh_desc *d = &rt->meshes[m];
-                size_t ps = s->position_stride ? s->position_stride : 3 * sizeof(float), ni = 3 * (size_t)s->triangle_count;
-                uint32_t *idx = NULL;
-                float *pos = NULL;
-                d->vertex_count = s->vertex_count;
-                d->triangle_count = s->triangle_count;
-                if (s->indices) {
-                    idx = (uint32_t *)rad__alloc_array(&c0.allocator, ni + 1, sizeof(uint32_t));
-                    if (idx) memcpy(idx, s->indices, ni * sizeof(uint32_t));
-                    d->indices = idx;
-                }
-                if (s->positions) {
-                    pos = (float *)rad__alloc_array(&c0.allocator, (size_t)s->vertex_count + 1, 3 * sizeof(float));
-                    for (i = 0; pos && i < s->vertex_count; ++i) memcpy(pos + 3 * (size_t)i, rad__strided(s->positions, ps, i), 3 * sizeof(float));
-                    d->positions = pos;
-                }
-                if ((s->indices && !idx) || (s->positions && !pos)) r = RAD_ERROR_OUT_OF_MEMORY;
-            }
-        }
-        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
-    }
-    if (R->lightmap) {
-        rad_lightmap_options lo;
-        rt->texels = R->lightmap_width * R->lightmap_height;
-        rt->lightmap = (float *)rad__alloc_array(&c0.allocator, 3 * (size_t)rt->texels, sizeof(float));
-        if (!rt->lightmap) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
-        r = rad_baker_mix_layers(R->lightmap_layers, R->group_count, 3 * (size_t)rt->texels, NULL, rt->lightmap, &rt->sub);
-        rad_lightmap_options_default(&lo);
-        lo.width = R->lightmap_width;
-        lo.height = R->lightmap_height;
-        lo.samples = bo.lightmap_samples;
-        lo.seed = bo.seed;
-        if (r == RAD_SUCCESS) r = rad_lightmap_create(rt->scene, &rt->rc, &lo, &rt->sub, &rt->lm);
-        if (r == RAD_SUCCESS)
-            r = R->method == RAD_BAKER_CLASSIC ? rad_lightmap_weights_create(rt->lm, rt->patches, rt->lightmap, rt->H, &rt->sub, &rt->lw)
-                                               : rad_lightmap_weights_create_vp(rt->lm, rt->vp, &rt->sub, &rt->lw);
-        if (r == RAD_SUCCESS) {
-            rt->lmV = (float *)rad__alloc_array(&c0.allocator, (size_t)rt->lw->vertex_count + 1, 3 * sizeof(float));
-            r = rt->lmV ? rad__brt_dilation(rt) : RAD_ERROR_OUT_OF_MEMORY;
-        }
-        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
-    }
-    if (R->probes) {
-        rad_probe_options po;
-        rad_probe_options_default(&po);
-        po.spacing = desc->probe_spacing;
-        r = R->method == RAD_BAKER_CLASSIC
-                ? rad_probes_create(rt->patches, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes)
-                : rad_probes_create_vp(rt->vp, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes);
-        if (r == RAD_SUCCESS && rad_probes_count(rt->probes) != R->probe_count) {
-            rad__log(&c0, RAD_LOG_ERROR, "rad_baker_runtime_create: %u probes, the result has %u", rad_probes_count(rt->probes),
-                     R->probe_count);
-            r = RAD_ERROR_INVALID_ARGUMENT;
-        }
-        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
-        rt->probe_count = R->probe_count;
-        rt->probe_out = (float *)rad__alloc_array(&c0.allocator, 27 * (size_t)rt->probe_count + 1, sizeof(float));
-        if (!rt->probe_out) return rad__brt_fail(rt, RAD_ERROR_OUT_OF_MEMORY);
-        r = rad_baker_mix_layers(R->probe_layers, R->group_count, 27 * (size_t)rt->probe_count, NULL, rt->probe_out, &rt->sub);
-        if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
-    }
+    if (r == RAD_SUCCESS && R->vertex) r = rad__brt_out_vertex(rt, desc, R, &c0);
+    if (r == RAD_SUCCESS && R->lightmap) r = rad__brt_out_lightmap(rt, R, &bo, &c0);
+    if (r == RAD_SUCCESS && R->probes) r = rad__brt_out_probes(rt, desc, R, &c0);
+    if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
     *out = rt;
     return RAD_SUCCESS;
 }
