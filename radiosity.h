@@ -18546,36 +18546,38 @@ static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size
     return r;
 }
 
-static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+/* the working state of rad__vp_build_run that passes from one stage to the next; every block
+   here is freed by its single cleanup */
+typedef struct rad__vp_stage {
+    uint64_t *cand;              /* candidate voxel keys (step 1) */
+    double *cand_area;           /* 6 per candidate: the exact clipped area on each axis */
+    uint32_t ncand, M, N;        /* candidates, samples, patches */
+    uint32_t cap;                /* capacity of the growing sample arrays */
+    uint32_t *tri_count;         /* per triangle: its samples */
+    uint32_t *cand_first;        /* per candidate + 1: its first sample */
+    uint32_t *voxel_cand;        /* per non-empty voxel: its candidate */
+    uint32_t *s_tri, *s_vox;     /* per sample: triangle, candidate */
+    float *s_pos, *s_bary;       /* per sample: position, barycentrics */
+} rad__vp_stage;
+
+/* step 2: the face rays of the candidate voxels, chunk by chunk, their hits appended as samples in voxel order */
+static rad_result rad__vp_samples(rad__vp_build *b, rad__vp_stage *st, const rad__ctx *c)
 {
     rad_virtual_patches *vp = b->vp;
     const rad_scene *S = b->S;
     const rad_allocator *A = &vp->allocator;
-    uint64_t *cand = NULL;
-    uint32_t ncand = 0, P = b->o.face_points, cap = 0, M = 0, chunk, begin, v, i, a, N = 0;
-    uint32_t *tri_count = NULL, *s_tri = NULL, *s_vox = NULL, *cand_first = NULL, *voxel_cand = NULL;
-    double *cand_area = NULL;
-    float *s_pos = NULL, *s_bary = NULL;
-    size_t bytes;
+    uint32_t ncand = st->ncand, P = b->o.face_points, M = 0, chunk, begin, v;
     rad_result r = RAD_SUCCESS;
     int k;
-
-    /* 1. candidate voxels and their exact areas */
-    r = rad__vp_candidates(b, c, &cand, &ncand, &cand_area);
-    if (r != RAD_SUCCESS) return r;
-    vp->candidate_voxels = ncand;
-    b->cand = cand;
-
-    /* 2. face rays, chunk by chunk; samples appended in voxel order */
     chunk = RAD__VP_CHUNK_RAYS / (6u * P);
     if (chunk < 1) chunk = 1;
     if (chunk > ncand) chunk = ncand;
     b->hits = (rad_hit *)rad__alloc_array(A, (size_t)chunk * 6u * P, sizeof(rad_hit));
     b->rays = (rad_ray *)rad__alloc_array(A, (size_t)b->tasks * RAD__RAY_BATCH, sizeof(rad_ray));
-    tri_count = (uint32_t *)rad__alloc_array(A, S->triangle_count, sizeof(uint32_t));
-    cand_first = (uint32_t *)rad__alloc_array(A, (size_t)ncand + 1u, sizeof(uint32_t));
-    if (!b->hits || !b->rays || !tri_count || !cand_first) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
-    memset(tri_count, 0, sizeof(uint32_t) * S->triangle_count);
+    st->tri_count = (uint32_t *)rad__alloc_array(A, S->triangle_count, sizeof(uint32_t));
+    st->cand_first = (uint32_t *)rad__alloc_array(A, (size_t)ncand + 1u, sizeof(uint32_t));
+    if (!b->hits || !b->rays || !st->tri_count || !st->cand_first) return RAD_ERROR_OUT_OF_MEMORY;
+    memset(st->tri_count, 0, sizeof(uint32_t) * S->triangle_count);
     for (begin = 0; begin < ncand && r == RAD_SUCCESS; begin += chunk) {
         uint32_t cnt = ncand - begin < chunk ? ncand - begin : chunk, h;
         rad__ctx cc = *c;
@@ -18585,7 +18587,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         if (r != RAD_SUCCESS) break;
         vp->face_rays += (uint64_t)cnt * 6u * P;
         for (v = 0; v < cnt; ++v) {
-            cand_first[begin + v] = M;
+            st->cand_first[begin + v] = M;
             for (h = 0; h < 6u * P; ++h) {
                 const rad_hit *hit = &b->hits[(size_t)v * 6u * P + h];
                 const float *tv;
@@ -18593,36 +18595,46 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
                 if (hit->triangle == RAD_NONE || hit->triangle >= S->triangle_count) continue;
                 if (M == 0xFFFFFFFEu) {
                     rad__log(c, RAD_LOG_ERROR, "virtual patches: more than 2^32 - 2 samples (use fewer face points)");
-                    r = RAD_ERROR_SIZE_OVERFLOW;
-                    goto done;
+                    return RAD_ERROR_SIZE_OVERFLOW;
                 }
-                if (!rad__vp_grow(b, &cap, M + 1u, &s_pos, &s_tri, &s_vox, &s_bary)) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+                if (!rad__vp_grow(b, &st->cap, M + 1u, &st->s_pos, &st->s_tri, &st->s_vox, &st->s_bary))
+                    return RAD_ERROR_OUT_OF_MEMORY;
                 tv = S->positions + 9 * (size_t)hit->triangle;
                 b0 = 1.0f - hit->b1 - hit->b2;
-                for (k = 0; k < 3; ++k) s_pos[3 * (size_t)M + k] = b0 * tv[k] + hit->b1 * tv[3 + k] + hit->b2 * tv[6 + k];
-                s_bary[2 * (size_t)M] = hit->b1;
-                s_bary[2 * (size_t)M + 1] = hit->b2;
-                s_tri[M] = hit->triangle;
-                s_vox[M] = begin + v;
-                tri_count[hit->triangle]++;
+                for (k = 0; k < 3; ++k)
+                    st->s_pos[3 * (size_t)M + k] = b0 * tv[k] + hit->b1 * tv[3 + k] + hit->b2 * tv[6 + k];
+                st->s_bary[2 * (size_t)M] = hit->b1;
+                st->s_bary[2 * (size_t)M + 1] = hit->b2;
+                st->s_tri[M] = hit->triangle;
+                st->s_vox[M] = begin + v;
+                st->tri_count[hit->triangle]++;
                 ++M;
             }
         }
         if (c->progress && c->progress(c->progress_user, 0.1f * (float)(begin + cnt) / (float)ncand)) r = RAD_ERROR_CANCELLED;
     }
-    if (r != RAD_SUCCESS) goto done;
-    cand_first[ncand] = M;
+    if (r != RAD_SUCCESS) return r;
+    st->cand_first[ncand] = M;
     rad__free(A, b->hits);
     b->hits = NULL;
     if (M == 0) {
         rad__log(c, RAD_LOG_ERROR, "virtual patches: no face ray hit the scene (%u candidate voxels)", ncand);
-        r = RAD_ERROR_EMPTY_SCENE;
-        goto done;
+        return RAD_ERROR_EMPTY_SCENE;
     }
+    st->M = M;
+    return RAD_SUCCESS;
+}
 
-    /* 3. non-empty voxels, samples and their split weights */
-    for (v = 0; v < ncand; ++v)
-        if (cand_first[v + 1] > cand_first[v]) vp->voxel_count++;
+/* step 3: the non-empty voxels, and each sample's normal, albedo (checked), area share and split weights */
+static rad_result rad__vp_voxels(rad__vp_build *b, rad__vp_stage *st, const rad__ctx *c)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_scene *S = b->S;
+    const rad_allocator *A = &vp->allocator;
+    uint32_t M = st->M, v, i;
+    int k;
+    for (v = 0; v < st->ncand; ++v)
+        if (st->cand_first[v + 1] > st->cand_first[v]) vp->voxel_count++;
     vp->sample_count = M;
     vp->voxel_keys = (uint64_t *)rad__alloc_array(A, vp->voxel_count, sizeof(uint64_t));
     vp->voxel_first = (uint32_t *)rad__alloc_array(A, (size_t)vp->voxel_count + 1u, sizeof(uint32_t));
@@ -18633,43 +18645,47 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     vp->sample_areas = (float *)rad__alloc_array(A, M, sizeof(float));
     vp->sample_weights = (float *)rad__alloc_array(A, M, 6 * sizeof(float));
     b->sample_voxel = (uint32_t *)rad__alloc_array(A, M, sizeof(uint32_t));
-    voxel_cand = (uint32_t *)rad__alloc_array(A, vp->voxel_count, sizeof(uint32_t));
+    st->voxel_cand = (uint32_t *)rad__alloc_array(A, vp->voxel_count, sizeof(uint32_t));
     if (!vp->voxel_keys || !vp->voxel_first || !vp->sample_first || !vp->voxel_patch || !vp->sample_normals ||
-        !vp->sample_albedo || !vp->sample_areas || !vp->sample_weights || !b->sample_voxel || !voxel_cand) {
-        r = RAD_ERROR_OUT_OF_MEMORY;
-        goto done;
-    }
-    for (v = 0, i = 0; v < ncand; ++v) {
+        !vp->sample_albedo || !vp->sample_areas || !vp->sample_weights || !b->sample_voxel || !st->voxel_cand)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    for (v = 0, i = 0; v < st->ncand; ++v) {
         uint32_t s;
-        if (cand_first[v + 1] == cand_first[v]) continue;
-        vp->voxel_keys[i] = cand[v];
-        voxel_cand[i] = v;
-        vp->sample_first[i] = cand_first[v];
-        for (s = cand_first[v]; s < cand_first[v + 1]; ++s) b->sample_voxel[s] = i;
+        if (st->cand_first[v + 1] == st->cand_first[v]) continue;
+        vp->voxel_keys[i] = st->cand[v];
+        st->voxel_cand[i] = v;
+        vp->sample_first[i] = st->cand_first[v];
+        for (s = st->cand_first[v]; s < st->cand_first[v + 1]; ++s) b->sample_voxel[s] = i;
         ++i;
     }
     vp->sample_first[vp->voxel_count] = M;
-    vp->sample_positions = s_pos;
-    vp->sample_triangles = s_tri;
-    s_pos = NULL;
-    s_tri = NULL;
+    vp->sample_positions = st->s_pos;
+    vp->sample_triangles = st->s_tri;
+    st->s_pos = NULL;
+    st->s_tri = NULL;
     for (i = 0; i < M; ++i) {
         uint32_t tr = vp->sample_triangles[i];
         memcpy(vp->sample_normals + 3 * (size_t)i, S->normals + 3 * (size_t)tr, 3 * sizeof(float));
-        rad_scene_albedo(S, tr, s_bary[2 * (size_t)i], s_bary[2 * (size_t)i + 1], vp->sample_albedo + 3 * (size_t)i);
+        rad_scene_albedo(S, tr, st->s_bary[2 * (size_t)i], st->s_bary[2 * (size_t)i + 1], vp->sample_albedo + 3 * (size_t)i);
         for (k = 0; k < 3; ++k)
             if (!(vp->sample_albedo[3 * (size_t)i + k] >= 0.0f && vp->sample_albedo[3 * (size_t)i + k] < 1.0f)) {
                 rad__log(c, RAD_LOG_ERROR, "virtual patches: the albedo of triangle %u is outside [0, 1)", tr);
-                r = RAD_ERROR_ALBEDO_RANGE;
-                goto done;
+                return RAD_ERROR_ALBEDO_RANGE;
             }
-        vp->sample_areas[i] = S->areas[tr] / (float)tri_count[tr];
+        vp->sample_areas[i] = S->areas[tr] / (float)st->tri_count[tr];
         rad__vp_weights(b->o.weights, vp->sample_normals + 3 * (size_t)i, vp->sample_weights + 6 * (size_t)i);
     }
+    return RAD_SUCCESS;
+}
 
-    /* 4. patches: one per voxel and axis with samples; the weights of its samples are scaled
-       so that the patch area is the exact clipped area of the voxel's surface on that axis
-       (clustered: one per cluster, every sample scaled by its voxel's area correction) */
+/* step 4: the patches numbered (one per voxel and axis with samples, or per cluster) and the sample
+   weights scaled so that each voxel's patches have the exact clipped area of its surface */
+static rad_result rad__vp_patches(rad__vp_build *b, rad__vp_stage *st, const rad__ctx *c)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_allocator *A = &vp->allocator;
+    uint32_t M = st->M, N = 0, v, i, a;
+    rad_result r;
     if (b->o.kind == RAD_VP_CLUSTERED) {
         uint32_t T = b->tasks < vp->voxel_count ? b->tasks : vp->voxel_count, s;
         rad__ctx cc = *c;
@@ -18685,17 +18701,17 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
             if (vp->sample_first[v + 1] - vp->sample_first[v] > b->nmax) b->nmax = vp->sample_first[v + 1] - vp->sample_first[v];
         b->cper = 2 * (size_t)b->nmax * b->kc + (size_t)b->nmax * b->nmax + 9 * (size_t)b->nmax;
         b->cscratch = (double *)rad__alloc_array(A, (size_t)T, b->cper * sizeof(double));
-        if (!b->vscale || !b->eff || !b->slot || !b->ncl || !b->cols || !b->cscratch) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+        if (!b->vscale || !b->eff || !b->slot || !b->ncl || !b->cols || !b->cscratch) return RAD_ERROR_OUT_OF_MEMORY;
         for (v = 0; v < vp->voxel_count; ++v) {
             double have = 0.0, exact = 0.0;
-            for (a = 0; a < 6; ++a) exact += cand_area[6 * (size_t)voxel_cand[v] + a];
+            for (a = 0; a < 6; ++a) exact += st->cand_area[6 * (size_t)st->voxel_cand[v] + a];
             for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) have += (double)vp->sample_areas[s];
             b->vscale[v] = have > 0.0 && exact > 0.0 ? (float)(exact / have) : 1.0f;
             for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) b->eff[s] = vp->sample_areas[s] * b->vscale[v];
         }
         for (i = 0; i < b->kc; ++i) b->cols[i] = (uint32_t)(((uint64_t)2 * i + 1) * M / (2 * (uint64_t)b->kc));
         r = rad__for_rows(&cc, vp->voxel_count, T, rad__vp_cluster_row, b);
-        if (r != RAD_SUCCESS) goto done;
+        if (r != RAD_SUCCESS) return r;
         for (v = 0; v < vp->voxel_count; ++v) {
             vp->voxel_first[v] = N;
             for (a = 0; a < 6; ++a) vp->voxel_patch[6 * (size_t)v + a] = a < b->ncl[v] ? N++ : RAD_NONE;
@@ -18710,7 +18726,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
         vp->voxel_first[v] = N;
         for (a = 0; a < 6; ++a) {
             uint32_t s;
-            double have = 0.0, exact = cand_area[6 * (size_t)voxel_cand[v] + a];
+            double have = 0.0, exact = st->cand_area[6 * (size_t)st->voxel_cand[v] + a];
             for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s)
                 have += (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
             if (have > 0.0 && exact > 0.0) {
@@ -18720,30 +18736,39 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
             vp->voxel_patch[6 * (size_t)v + a] = have > 0.0 ? N++ : RAD_NONE;
         }
     }
-    rad__free(A, cand_area);
-    cand_area = NULL;
-    rad__free(A, voxel_cand);
-    voxel_cand = NULL;
+    rad__free(A, st->cand_area);
+    st->cand_area = NULL;
+    rad__free(A, st->voxel_cand);
+    st->voxel_cand = NULL;
     b->eff = (float *)rad__alloc_array(A, M, sizeof(float));
-    if (!b->eff) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    if (!b->eff) return RAD_ERROR_OUT_OF_MEMORY;
     for (i = 0; i < M; ++i) {
         const float *w = vp->sample_weights + 6 * (size_t)i;
         b->eff[i] = vp->sample_areas[i] * (w[0] + w[1] + w[2] + w[3] + w[4] + w[5]);
     }
     vp->voxel_first[vp->voxel_count] = N;
     vp->count = N;
-    if (b->count_only) goto done;
-    if (!rad__mul3(N, N, sizeof(float), &bytes)) {
+    st->N = N;
+    return RAD_SUCCESS;
+}
+
+/* step 4, continued: each patch's area, mean albedo, normal, axis and voxel; *bytes the size of its N x N matrix */
+static rad_result rad__vp_patch_attrs(rad__vp_build *b, const rad__vp_stage *st, const rad__ctx *c, size_t *bytes)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_allocator *A = &vp->allocator;
+    uint32_t N = st->N, v, a;
+    int k;
+    if (!rad__mul3(N, N, sizeof(float), bytes)) {
         rad__log(c, RAD_LOG_ERROR, "virtual patches: the %u x %u matrix does not fit in memory (use bigger voxels)", N, N);
-        r = RAD_ERROR_SIZE_OVERFLOW;
-        goto done;
+        return RAD_ERROR_SIZE_OVERFLOW;
     }
     vp->areas = (float *)rad__alloc_array(A, N, sizeof(float));
     vp->albedo = (float *)rad__alloc_array(A, N, 3 * sizeof(float));
     vp->normals = (float *)rad__alloc_array(A, N, 3 * sizeof(float));
     vp->axis = (uint8_t *)rad__alloc_array(A, N, 1);
     vp->voxel = (uint32_t *)rad__alloc_array(A, N, sizeof(uint32_t));
-    if (!vp->areas || !vp->albedo || !vp->normals || !vp->axis || !vp->voxel) { r = RAD_ERROR_OUT_OF_MEMORY; goto done; }
+    if (!vp->areas || !vp->albedo || !vp->normals || !vp->axis || !vp->voxel) return RAD_ERROR_OUT_OF_MEMORY;
     for (v = 0; v < vp->voxel_count; ++v)
         for (a = 0; a < 6; ++a) {
             uint32_t p = vp->voxel_patch[6 * (size_t)v + a], s;
@@ -18773,25 +18798,49 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
             vp->axis[p] = (uint8_t)a;
             vp->voxel[p] = v;
         }
+    return RAD_SUCCESS;
+}
 
-    /* 5. form factors, one row voxel per task */
-    rad__free(A, s_bary);
-    s_bary = NULL;
-    rad__free(A, tri_count);
-    tri_count = NULL;
-    rad__free(A, cand);
-    cand = NULL;
-    b->cand = NULL;
-    rad__free(A, cand_first);
-    cand_first = NULL;
-    r = rad__vp_form_factors(b, c, bytes);
-done:
+/* the whole build: the stages in order (candidates, samples, voxels, patches, their attributes,
+   form factors), then the one cleanup of every scratch block */
+static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
+{
+    rad_virtual_patches *vp = b->vp;
+    const rad_allocator *A = &vp->allocator;
+    rad__vp_stage st;
+    size_t bytes = 0;
+    rad_result r;
+
+    memset(&st, 0, sizeof(st));
+    /* 1. candidate voxels and their exact areas */
+    r = rad__vp_candidates(b, c, &st.cand, &st.ncand, &st.cand_area);
+    if (r != RAD_SUCCESS) return r;
+    vp->candidate_voxels = st.ncand;
+    b->cand = st.cand;
+    /* 2. face rays; 3. non-empty voxels and samples; 4. patches (rad_vp_count stops here) */
+    r = rad__vp_samples(b, &st, c);
+    if (r == RAD_SUCCESS) r = rad__vp_voxels(b, &st, c);
+    if (r == RAD_SUCCESS) r = rad__vp_patches(b, &st, c);
+    if (r == RAD_SUCCESS && !b->count_only) r = rad__vp_patch_attrs(b, &st, c, &bytes);
+    /* 5. form factors, one row voxel per task, once the sample scratch is freed */
+    if (r == RAD_SUCCESS && !b->count_only) {
+        rad__free(A, st.s_bary);
+        st.s_bary = NULL;
+        rad__free(A, st.tri_count);
+        st.tri_count = NULL;
+        rad__free(A, st.cand);
+        st.cand = NULL;
+        b->cand = NULL;
+        rad__free(A, st.cand_first);
+        st.cand_first = NULL;
+        r = rad__vp_form_factors(b, c, bytes);
+    }
     if (b->o.storage == RAD_STORAGE_SPARSE) rad__free(A, b->P); /* the chunk buffer (NULL once used) */
     {
-        void *blocks[] = { cand, cand_area, voxel_cand, cand_first, tri_count, s_pos, s_tri, s_vox, s_bary, b->hits,
-                           b->rays, b->occ, b->ray_i, b->ray_j, b->ray_g, b->rays_cast, b->acc, b->pairs, b->eff,
-                           b->rowf, b->share, b->share_hits, b->target, b->dscale, b->dnext, b->vscale, b->cols,
-                           b->cscratch, b->slot, b->ncl, b->sample_voxel };
+        void *blocks[] = { st.cand, st.cand_area, st.voxel_cand, st.cand_first, st.tri_count, st.s_pos, st.s_tri,
+                           st.s_vox, st.s_bary, b->hits, b->rays, b->occ, b->ray_i, b->ray_j, b->ray_g, b->rays_cast,
+                           b->acc, b->pairs, b->eff, b->rowf, b->share, b->share_hits, b->target, b->dscale, b->dnext,
+                           b->vscale, b->cols, b->cscratch, b->slot, b->ncl, b->sample_voxel };
         rad__free_each(*A, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
     return r;
