@@ -430,6 +430,48 @@ static uint32_t opacity_texture(imp_storage *st, const struct aiScene *sc, const
 /* no KHR_materials_emissive_strength in a glTF material (gltf_emissive_strength) */
 #define GLTF_NO_STRENGTH (-1e300)
 
+/* Alpha cutouts of material m, a stage of convert_material (1 on a bad alphaCutoff, with err).
+   glTF alphaMode MASK: the surface is there where baseColorTexture alpha x
+   baseColorFactor alpha >= alphaCutoff (default 0.5); BLEND is approximated the same way
+   at 0.5 (partial transmission is not modelled). OBJ map_d: its alpha channel, else its
+   grey value, at 0.5; a constant d < 1 without map_d is not a cutout (reported, ignored). */
+static int material_cutout(imp_storage *st, const struct aiScene *sc, const char *file, const struct aiMaterial *m,
+                           uint32_t index, const char *mname, const char *gm, float base_alpha, rad_material *out, char *err,
+                           size_t errlen)
+{
+    char mode[32] = "";
+    const char *v;
+    double cutoff = 0.5;
+    struct aiString bp;
+    int have_tex = aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) ==
+                       aiReturn_SUCCESS ||
+                   aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS;
+    if (gm && (v = js_get(gm, "alphaMode")) != NULL) js_string(v, mode, sizeof mode);
+    if (!strcmp(mode, "MASK") && (v = js_get(gm, "alphaCutoff")) != NULL) {
+        cutoff = strtod(v, NULL);
+        if (!(cutoff >= 0.0 && cutoff <= 1.0)) {
+            if (err && errlen)
+                snprintf(err, errlen, "'%s': material %u '%s': alphaCutoff %g is out of range (want [0, 1])", file, index,
+                         mname, cutoff);
+            return 1;
+        }
+    }
+    if ((!strcmp(mode, "MASK") || !strcmp(mode, "BLEND")) && cutoff > 0.0) {
+        if (!(base_alpha >= 0.0f && base_alpha <= 1.0f)) base_alpha = 1.0f;
+        /* a factor alone at or above the cutoff leaves nothing to cut */
+        if (have_tex || base_alpha < (float)cutoff)
+            out->opacity_texture = opacity_texture(st, sc, file, have_tex ? bp.data : NULL, base_alpha, 0);
+    } else if (!gm && aiGetMaterialTexture(m, aiTextureType_OPACITY, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) ==
+                          aiReturn_SUCCESS) {
+        out->opacity_texture = opacity_texture(st, sc, file, bp.data, 1.0f, 1);
+    }
+    if (out->opacity_texture) {
+        out->alpha_cutoff = (float)cutoff;
+        st->any_cutout = 1;
+    }
+    return 0;
+}
+
 /* 0, or 1 with the reason in err (a negative, NaN, infinite or overflowing emission: it used
    to become 0 without a word). *clamped: set to 1 when the albedo was clamped into
    [0, ALBEDO_MAX] (the warning waits until it is known which materials are used). */
@@ -542,42 +584,7 @@ static int convert_material(imp_storage *st, const struct aiScene *sc, const cha
             out->texture = id;
         }
     }
-    /* Alpha cutouts. glTF alphaMode MASK: the surface is there where baseColorTexture alpha x
-       baseColorFactor alpha >= alphaCutoff (default 0.5); BLEND is approximated the same way
-       at 0.5 (partial transmission is not modelled). OBJ map_d: its alpha channel, else its
-       grey value, at 0.5; a constant d < 1 without map_d is not a cutout (reported, ignored). */
-    {
-        char mode[32] = "";
-        const char *v;
-        double cutoff = 0.5;
-        struct aiString bp;
-        int have_tex = aiGetMaterialTexture(m, aiTextureType_BASE_COLOR, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) ==
-                           aiReturn_SUCCESS ||
-                       aiGetMaterialTexture(m, aiTextureType_DIFFUSE, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS;
-        if (gm && (v = js_get(gm, "alphaMode")) != NULL) js_string(v, mode, sizeof mode);
-        if (!strcmp(mode, "MASK") && (v = js_get(gm, "alphaCutoff")) != NULL) {
-            cutoff = strtod(v, NULL);
-            if (!(cutoff >= 0.0 && cutoff <= 1.0)) {
-                if (err && errlen)
-                    snprintf(err, errlen, "'%s': material %u '%s': alphaCutoff %g is out of range (want [0, 1])", file, index,
-                             name.data, cutoff);
-                return 1;
-            }
-        }
-        if ((!strcmp(mode, "MASK") || !strcmp(mode, "BLEND")) && cutoff > 0.0) {
-            if (!(base_alpha >= 0.0f && base_alpha <= 1.0f)) base_alpha = 1.0f;
-            /* a factor alone at or above the cutoff leaves nothing to cut */
-            if (have_tex || base_alpha < (float)cutoff)
-                out->opacity_texture = opacity_texture(st, sc, file, have_tex ? bp.data : NULL, base_alpha, 0);
-        } else if (!gm && aiGetMaterialTexture(m, aiTextureType_OPACITY, 0, &bp, NULL, NULL, NULL, NULL, NULL, NULL) ==
-                              aiReturn_SUCCESS) {
-            out->opacity_texture = opacity_texture(st, sc, file, bp.data, 1.0f, 1);
-        }
-        if (out->opacity_texture) {
-            out->alpha_cutoff = (float)cutoff;
-            st->any_cutout = 1;
-        }
-    }
+    if (material_cutout(st, sc, file, m, index, name.data, gm, base_alpha, out, err, errlen)) return 1;
     for (k = 0; k < 3; ++k) {
         if (!(out->albedo[k] >= 0.0f)) out->albedo[k] = 0.0f, clamped = 1;
         if (out->albedo[k] > ALBEDO_MAX) { /* a textured material's factor 1 (the glTF default) is no news */
