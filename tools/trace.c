@@ -425,13 +425,54 @@ static void tool__trace_task(void *data, uint32_t index)
     if (!tool__trace_row(T, (int)(T->row0 + index))) T->failed = 1;
 }
 
+/* emitters and their selection probabilities (by power), as a CDF for next-event estimation */
+static int tool__trace_emitters(tool__tracer *T)
+{
+    const rad_scene *S = T->S;
+    uint32_t t, e;
+    double total = 0.0;
+    for (t = 0; t < S->triangle_count; ++t) {
+        const float *Le = S->materials_table[S->materials[t]].emission;
+        if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) T->emitter_count++;
+    }
+    T->select_pdf = (float *)calloc(S->triangle_count, sizeof(float));
+    if (!T->select_pdf) return RAD_ERROR_OUT_OF_MEMORY;
+    if (T->emitter_count) {
+        T->emitters = (uint32_t *)malloc(sizeof(uint32_t) * T->emitter_count);
+        T->cdf = (double *)malloc(sizeof(double) * (T->emitter_count + 1u));
+        if (!T->emitters || !T->cdf) {
+            free(T->emitters);
+            free(T->cdf);
+            free(T->select_pdf);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        for (t = 0, e = 0; t < S->triangle_count; ++t) {
+            const float *Le = S->materials_table[S->materials[t]].emission;
+            if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
+                double pw = TOOL__TPI * (double)S->areas[t] * ((double)Le[0] + (double)Le[1] + (double)Le[2]);
+                T->emitters[e] = t;
+                T->cdf[e] = total;
+                total += pw;
+                ++e;
+            }
+        }
+        for (e = 0; e < T->emitter_count; ++e) {
+            double pw = (e + 1 < T->emitter_count ? T->cdf[e + 1] : total) - T->cdf[e];
+            T->select_pdf[T->emitters[e]] = (float)(pw / total);
+            T->cdf[e] /= total;
+        }
+        T->cdf[T->emitter_count] = 1.0;
+    }
+    return RAD_SUCCESS;
+}
+
 int tool_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
                     const rad_camera *camera, const tool_trace_options *options, const rad_context *ctx,
                     tool_image *out)
 {
     tool__tracer T;
-    uint32_t t, e, l;
-    double total = 0.0, run = 0.0;
+    uint32_t l;
+    double run = 0.0;
     int y, batch, result = RAD_SUCCESS, s;
     if (!scene || !rc || !rc->intersect || !rc->occluded || !camera || !out || (light_count && !lights))
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -472,39 +513,8 @@ int tool_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_
         if (tool_image_alloc(out, T.o.width, T.o.height) != 0) return RAD_ERROR_OUT_OF_MEMORY;
     }
     T.out = out;
-    /* emitters and their selection probabilities */
-    for (t = 0; t < scene->triangle_count; ++t) {
-        const float *Le = scene->materials_table[scene->materials[t]].emission;
-        if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) T.emitter_count++;
-    }
-    T.select_pdf = (float *)calloc(scene->triangle_count, sizeof(float));
-    if (!T.select_pdf) return RAD_ERROR_OUT_OF_MEMORY;
-    if (T.emitter_count) {
-        T.emitters = (uint32_t *)malloc(sizeof(uint32_t) * T.emitter_count);
-        T.cdf = (double *)malloc(sizeof(double) * (T.emitter_count + 1u));
-        if (!T.emitters || !T.cdf) {
-            free(T.emitters);
-            free(T.cdf);
-            free(T.select_pdf);
-            return RAD_ERROR_OUT_OF_MEMORY;
-        }
-        for (t = 0, e = 0; t < scene->triangle_count; ++t) {
-            const float *Le = scene->materials_table[scene->materials[t]].emission;
-            if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
-                double pw = TOOL__TPI * (double)scene->areas[t] * ((double)Le[0] + (double)Le[1] + (double)Le[2]);
-                T.emitters[e] = t;
-                T.cdf[e] = total;
-                total += pw;
-                ++e;
-            }
-        }
-        for (e = 0; e < T.emitter_count; ++e) {
-            double pw = (e + 1 < T.emitter_count ? T.cdf[e + 1] : total) - T.cdf[e];
-            T.select_pdf[T.emitters[e]] = (float)(pw / total);
-            T.cdf[e] /= total;
-        }
-        T.cdf[T.emitter_count] = 1.0;
-    }
+    result = tool__trace_emitters(&T);
+    if (result != RAD_SUCCESS) return result;
     /* rows in batches; progress and cancellation between batches on the calling thread */
     batch = T.o.height / 64;
     if (batch < 1) batch = 1;
