@@ -157,12 +157,207 @@ static int tool__visible(const tool__tracer *T, const float *p, const float *n, 
     return !occ;
 }
 
+/* an escaping ray gathers the sky and each environment map, MIS-weighted against their sampling */
+static void tool__trace_escape(const tool__tracer *T, const rad_ray *ray, int depth, float prev_pdf, const float *thr,
+                               float *L)
+{
+    uint32_t l;
+    int k;
+    for (k = 0; k < 3; ++k) L[k] += thr[k] * T->sky[k];
+    for (l = 0; l < T->env_count; ++l) {
+        const rad_light *li = T->env[l];
+        float rgb[3], w = depth > 0 ? tool__mis(prev_pdf, rad_environment_pdf(li->environment, ray->dir)) : 1.0f;
+        rad_environment_radiance(li->environment, ray->dir, rgb);
+        for (k = 0; k < 3; ++k) L[k] += thr[k] * li->color[k] * rgb[k] * w;
+    }
+}
+
+/* a hit emitter adds its emission, MIS-weighted against next-event estimation after the first bounce */
+static void tool__trace_emitted(const tool__tracer *T, const rad_hit *hit, uint32_t tri, float cosi, int depth,
+                                float prev_pdf, const float *thr, float *L)
+{
+    const rad_scene *S = T->S;
+    const float *Le;
+    float Lt[3];
+    int k;
+    Le = S->materials_table[S->materials[tri]].emission;
+    if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
+        float w = 1.0f;
+        rad_scene_emission(S, tri, hit->b1, hit->b2, Lt); /* the factor times the emission texture there */
+        Le = Lt;
+        if (depth > 0) {
+            float pl = T->select_pdf[tri] / S->areas[tri] * hit->t * hit->t / cosi;
+            w = tool__mis(prev_pdf, pl);
+        }
+        for (k = 0; k < 3; ++k) L[k] += thr[k] * Le[k] * w;
+    }
+}
+
+/* next-event estimation towards one point of one area light; returns 0 when a ray query failed */
+static int tool__trace_nee_area(const tool__tracer *T, uint32_t pixel, uint32_t sample, uint32_t dim, uint32_t tri,
+                                const float *p, const float *n, const float *albedo, const float *thr, float *L, int *ok)
+{
+    const rad_scene *S = T->S;
+    const uint32_t seed = T->o.seed;
+    int k;
+    uint32_t e = tool__pick_emitter(T, tool__rnd(seed, pixel, sample, dim + 0));
+    uint32_t lt = T->emitters[e];
+    if (lt != tri) { /* a point in a cutout's hole emits nothing (skipped below) */
+        const float *lv = S->positions + 9 * (size_t)lt, *ln = S->normals + 3 * (size_t)lt;
+        float u1 = tool__rnd(seed, pixel, sample, dim + 1), u2 = tool__rnd(seed, pixel, sample, dim + 2);
+        float su = sqrtf(u1), b0 = 1.0f - su, bb1 = u2 * su, bb2 = 1.0f - b0 - bb1;
+        float q[3], d[3], d2, dist, cs, cl, lL[3];
+        rad_scene_emission(S, lt, bb1, bb2, lL); /* at the light's sample point: textures vary it */
+        if (!rad_scene_opaque(S, lt, bb1, bb2)) lL[0] = lL[1] = lL[2] = 0.0f;
+        for (k = 0; k < 3; ++k) {
+            q[k] = b0 * lv[k] + bb1 * lv[3 + k] + bb2 * lv[6 + k];
+            d[k] = q[k] - p[k];
+        }
+        d2 = tool__tdot(d, d);
+        if (d2 > 0.0f) {
+            dist = sqrtf(d2);
+            cs = tool__tdot(d, n) / dist;
+            cl = -tool__tdot(d, ln) / dist;
+            if (cs > 0.0f && cl > 0.0f && tool__visible(T, p, n, q, ln, NULL, ok)) {
+                float pl = T->select_pdf[lt] / S->areas[lt] * d2 / cl; /* solid angle */
+                float pb = cs / (float)TOOL__TPI;
+                float f = tool__mis(pl, pb) * cs / ((float)TOOL__TPI * pl);
+                for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * lL[k] * f;
+            }
+            if (!*ok) return 0;
+        }
+    }
+    return 1;
+}
+
+/* environment maps: one direction from each map's distribution; returns 0 when a ray query failed */
+static int tool__trace_nee_env(const tool__tracer *T, uint32_t pixel, uint32_t sample, uint32_t dim, const float *p,
+                               const float *n, const float *albedo, const float *thr, float *L, int *ok)
+{
+    const uint32_t seed = T->o.seed;
+    int k;
+    uint32_t l;
+    for (l = 0; l < T->env_count; ++l) {
+        const rad_light *li = T->env[l];
+        float dd[3], rgb[3], pe, cs, f;
+        pe = rad_environment_sample(li->environment, tool__rnd(seed, pixel, sample, dim + 6),
+                                    tool__rnd(seed, pixel, sample, dim + 7), dd);
+        if (!(pe > 0.0f)) continue;
+        cs = tool__tdot(dd, n);
+        if (!(cs > 0.0f)) continue;
+        if (!tool__visible(T, p, n, NULL, NULL, dd, ok)) {
+            if (!*ok) return 0;
+            continue;
+        }
+        rad_environment_radiance(li->environment, dd, rgb);
+        f = tool__mis(pe, cs / (float)TOOL__TPI) * cs / ((float)TOOL__TPI * pe);
+        for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * li->color[k] * rgb[k] * f;
+    }
+    return 1;
+}
+
+/* delta lights (no MIS): each directional, point and spot light that sees p; returns 0 when a ray query failed */
+static int tool__trace_nee_delta(const tool__tracer *T, const float *p, const float *n, const float *albedo,
+                                 const float *thr, float *L, int *ok)
+{
+    const rad_scene *S = T->S;
+    int k;
+    uint32_t l;
+    for (l = 0; l < T->light_count; ++l) {
+        const rad_light *li = &T->lights[l];
+        float w[3], dd[3], cs;
+        if (li->type == RAD_LIGHT_DIRECTIONAL) {
+            float len;
+            for (k = 0; k < 3; ++k) dd[k] = -li->direction[k];
+            len = sqrtf(tool__tdot(dd, dd));
+            if (!(len > 0.0f)) continue;
+            for (k = 0; k < 3; ++k) dd[k] /= len;
+            cs = tool__tdot(dd, n);
+            if (!(cs > 0.0f)) continue;
+            for (k = 0; k < 3; ++k) w[k] = li->color[k] * cs;
+            if (!tool__visible(T, p, n, NULL, NULL, dd, ok)) {
+                if (!*ok) return 0;
+                continue;
+            }
+        } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
+            float dist, dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * S->diagonal;
+            for (k = 0; k < 3; ++k) dd[k] = li->position[k] - p[k];
+            dist = sqrtf(tool__tdot(dd, dd));
+            if (!(dist > 0.0f)) continue;
+            cs = tool__tdot(dd, n) / dist;
+            if (!(cs > 0.0f)) continue;
+            dc = dist > md ? dist : md;
+            atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
+            if (li->type == RAD_LIGHT_SPOT) {
+                float axis[3], alen, ca, ci = cosf(li->inner_angle), co = cosf(li->outer_angle), s;
+                for (k = 0; k < 3; ++k) axis[k] = li->direction[k];
+                alen = sqrtf(tool__tdot(axis, axis));
+                if (!(alen > 0.0f)) continue;
+                ca = -tool__tdot(dd, axis) / (dist * alen);
+                if (ci > co) {
+                    s = (ca - co) / (ci - co);
+                    s = s < 0.0f ? 0.0f : (s > 1.0f ? 1.0f : s);
+                    atten *= s * s * (3.0f - 2.0f * s);
+                } else if (!(ca >= co)) {
+                    atten = 0.0f;
+                }
+                if (!(atten > 0.0f)) continue;
+            }
+            for (k = 0; k < 3; ++k) w[k] = li->color[k] * cs * atten;
+            if (!tool__visible(T, p, n, li->position, NULL, NULL, ok)) {
+                if (!*ok) return 0;
+                continue;
+            }
+        } else {
+            continue; /* sky and maps: above and on escaping rays */
+        }
+        /* reflected radiance = albedo / pi * irradiance */
+        for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * w[k] / (float)TOOL__TPI;
+    }
+    return 1;
+}
+
+/* continues the path with a cosine-weighted direction and Russian roulette; returns 0 when the path ends */
+static int tool__trace_bounce(const tool__tracer *T, uint32_t pixel, uint32_t sample, uint32_t dim, int depth,
+                              const float *p, const float *n, const float *albedo, rad_ray *ray, float *thr,
+                              float *prev_pdf)
+{
+    const uint32_t seed = T->o.seed;
+    float t1[3], t2[3];
+    int k;
+    /* the throughput gains the albedo */
+    {
+        float u1 = tool__rnd(seed, pixel, sample, dim + 3), u2 = tool__rnd(seed, pixel, sample, dim + 4);
+        float r = sqrtf(u1), ph = 2.0f * (float)TOOL__TPI * u2, cz = sqrtf(1.0f - u1 > 0.0f ? 1.0f - u1 : 0.0f);
+        float cx = r * cosf(ph), cy = r * sinf(ph), len;
+        tool__basis(n, t1, t2);
+        for (k = 0; k < 3; ++k) {
+            ray->origin[k] = p[k] + n[k] * T->eps;
+            ray->dir[k] = t1[k] * cx + t2[k] * cy + n[k] * cz;
+        }
+        len = sqrtf(tool__tdot(ray->dir, ray->dir));
+        for (k = 0; k < 3; ++k) ray->dir[k] /= len;
+        ray->tmin = 0.0f;
+        ray->tmax = FLT_MAX;
+        *prev_pdf = cz / (float)TOOL__TPI;
+        if (!(*prev_pdf > 0.0f)) return 0;
+        for (k = 0; k < 3; ++k) thr[k] *= albedo[k];
+    }
+    if (depth + 1 >= T->o.rr_depth) {
+        float q = thr[0] > thr[1] ? thr[0] : thr[1];
+        q = q > thr[2] ? q : thr[2];
+        if (q > 0.95f) q = 0.95f;
+        if (!(tool__rnd(seed, pixel, sample, dim + 5) < q)) return 0;
+        for (k = 0; k < 3; ++k) thr[k] /= q;
+    }
+    return 1;
+}
+
 /* radiance of one camera sample; *ok = 0 when a ray query failed */
 static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t sample, float px, float py,
                               double *acc, int *ok)
 {
     const rad_scene *S = T->S;
-    const uint32_t seed = T->o.seed;
     rad_ray ray;
     float thr[3] = { 1.0f, 1.0f, 1.0f }, L[3] = { 0.0f, 0.0f, 0.0f };
     float prev_pdf = 0.0f; /* solid-angle density of the BSDF sample that made 'ray' (0: camera) */
@@ -171,22 +366,14 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
     for (depth = 0; depth < T->o.max_depth; ++depth) {
         rad_hit hit;
         const float *v, *n;
-        const float *Le;
-        float p[3], albedo[3], cosi, t1[3], t2[3], Lt[3];
+        float p[3], albedo[3], cosi;
         uint32_t tri, dim = (uint32_t)depth * TOOL__DIMS_PER_BOUNCE;
         if (T->rc->intersect(T->rc->user, &ray, 1, &hit) != RAD_SUCCESS) {
             *ok = 0;
             return;
         }
         if (hit.triangle == RAD_NONE || hit.triangle >= S->triangle_count) {
-            uint32_t l;
-            for (k = 0; k < 3; ++k) L[k] += thr[k] * T->sky[k];
-            for (l = 0; l < T->env_count; ++l) {
-                const rad_light *li = T->env[l];
-                float rgb[3], w = depth > 0 ? tool__mis(prev_pdf, rad_environment_pdf(li->environment, ray.dir)) : 1.0f;
-                rad_environment_radiance(li->environment, ray.dir, rgb);
-                for (k = 0; k < 3; ++k) L[k] += thr[k] * li->color[k] * rgb[k] * w;
-            }
+            tool__trace_escape(T, &ray, depth, prev_pdf, thr, L);
             break;
         }
         tri = hit.triangle;
@@ -195,150 +382,14 @@ static void tool__trace_sample(const tool__tracer *T, uint32_t pixel, uint32_t s
         cosi = -tool__tdot(ray.dir, n); /* ray.dir is unit */
         if (!(cosi > 0.0f)) break;     /* back face: one-sided, black */
         for (k = 0; k < 3; ++k) p[k] = v[k] + hit.b1 * (v[3 + k] - v[k]) + hit.b2 * (v[6 + k] - v[k]);
-        Le = S->materials_table[S->materials[tri]].emission;
-        if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
-            float w = 1.0f;
-            rad_scene_emission(S, tri, hit.b1, hit.b2, Lt); /* the factor times the emission texture there */
-            Le = Lt;
-            if (depth > 0) {
-                float pl = T->select_pdf[tri] / S->areas[tri] * hit.t * hit.t / cosi;
-                w = tool__mis(prev_pdf, pl);
-            }
-            for (k = 0; k < 3; ++k) L[k] += thr[k] * Le[k] * w;
-        }
+        tool__trace_emitted(T, &hit, tri, cosi, depth, prev_pdf, thr, L);
         if (depth + 1 >= T->o.max_depth) break;
         rad_scene_albedo(S, tri, hit.b1, hit.b2, albedo);
         if (!(albedo[0] > 0.0f || albedo[1] > 0.0f || albedo[2] > 0.0f)) break;
-        /* next-event estimation: one area light */
-        if (T->emitter_count) {
-            uint32_t e = tool__pick_emitter(T, tool__rnd(seed, pixel, sample, dim + 0));
-            uint32_t lt = T->emitters[e];
-            if (lt != tri) { /* a point in a cutout's hole emits nothing (skipped below) */
-                const float *lv = S->positions + 9 * (size_t)lt, *ln = S->normals + 3 * (size_t)lt;
-                float u1 = tool__rnd(seed, pixel, sample, dim + 1), u2 = tool__rnd(seed, pixel, sample, dim + 2);
-                float su = sqrtf(u1), b0 = 1.0f - su, bb1 = u2 * su, bb2 = 1.0f - b0 - bb1;
-                float q[3], d[3], d2, dist, cs, cl, lL[3];
-                rad_scene_emission(S, lt, bb1, bb2, lL); /* at the light's sample point: textures vary it */
-                if (!rad_scene_opaque(S, lt, bb1, bb2)) lL[0] = lL[1] = lL[2] = 0.0f;
-                for (k = 0; k < 3; ++k) {
-                    q[k] = b0 * lv[k] + bb1 * lv[3 + k] + bb2 * lv[6 + k];
-                    d[k] = q[k] - p[k];
-                }
-                d2 = tool__tdot(d, d);
-                if (d2 > 0.0f) {
-                    dist = sqrtf(d2);
-                    cs = tool__tdot(d, n) / dist;
-                    cl = -tool__tdot(d, ln) / dist;
-                    if (cs > 0.0f && cl > 0.0f && tool__visible(T, p, n, q, ln, NULL, ok)) {
-                        float pl = T->select_pdf[lt] / S->areas[lt] * d2 / cl; /* solid angle */
-                        float pb = cs / (float)TOOL__TPI;
-                        float f = tool__mis(pl, pb) * cs / ((float)TOOL__TPI * pl);
-                        for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * lL[k] * f;
-                    }
-                    if (!*ok) return;
-                }
-            }
-        }
-        /* environment maps: one direction from each map's distribution */
-        {
-            uint32_t l;
-            for (l = 0; l < T->env_count; ++l) {
-                const rad_light *li = T->env[l];
-                float dd[3], rgb[3], pe, cs, f;
-                pe = rad_environment_sample(li->environment, tool__rnd(seed, pixel, sample, dim + 6),
-                                            tool__rnd(seed, pixel, sample, dim + 7), dd);
-                if (!(pe > 0.0f)) continue;
-                cs = tool__tdot(dd, n);
-                if (!(cs > 0.0f)) continue;
-                if (!tool__visible(T, p, n, NULL, NULL, dd, ok)) {
-                    if (!*ok) return;
-                    continue;
-                }
-                rad_environment_radiance(li->environment, dd, rgb);
-                f = tool__mis(pe, cs / (float)TOOL__TPI) * cs / ((float)TOOL__TPI * pe);
-                for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * li->color[k] * rgb[k] * f;
-            }
-        }
-        /* delta lights (no MIS) */
-        if (T->has_delta) {
-            uint32_t l;
-            for (l = 0; l < T->light_count; ++l) {
-                const rad_light *li = &T->lights[l];
-                float w[3], dd[3], cs;
-                if (li->type == RAD_LIGHT_DIRECTIONAL) {
-                    float len;
-                    for (k = 0; k < 3; ++k) dd[k] = -li->direction[k];
-                    len = sqrtf(tool__tdot(dd, dd));
-                    if (!(len > 0.0f)) continue;
-                    for (k = 0; k < 3; ++k) dd[k] /= len;
-                    cs = tool__tdot(dd, n);
-                    if (!(cs > 0.0f)) continue;
-                    for (k = 0; k < 3; ++k) w[k] = li->color[k] * cs;
-                    if (!tool__visible(T, p, n, NULL, NULL, dd, ok)) {
-                        if (!*ok) return;
-                        continue;
-                    }
-                } else if (li->type == RAD_LIGHT_POINT || li->type == RAD_LIGHT_SPOT) {
-                    float dist, dc, atten, md = li->min_distance > 0.0f ? li->min_distance : 1e-6f * S->diagonal;
-                    for (k = 0; k < 3; ++k) dd[k] = li->position[k] - p[k];
-                    dist = sqrtf(tool__tdot(dd, dd));
-                    if (!(dist > 0.0f)) continue;
-                    cs = tool__tdot(dd, n) / dist;
-                    if (!(cs > 0.0f)) continue;
-                    dc = dist > md ? dist : md;
-                    atten = li->falloff == RAD_FALLOFF_LINEAR ? 1.0f / dc : 1.0f / (dc * dc);
-                    if (li->type == RAD_LIGHT_SPOT) {
-                        float axis[3], alen, ca, ci = cosf(li->inner_angle), co = cosf(li->outer_angle), s;
-                        for (k = 0; k < 3; ++k) axis[k] = li->direction[k];
-                        alen = sqrtf(tool__tdot(axis, axis));
-                        if (!(alen > 0.0f)) continue;
-                        ca = -tool__tdot(dd, axis) / (dist * alen);
-                        if (ci > co) {
-                            s = (ca - co) / (ci - co);
-                            s = s < 0.0f ? 0.0f : (s > 1.0f ? 1.0f : s);
-                            atten *= s * s * (3.0f - 2.0f * s);
-                        } else if (!(ca >= co)) {
-                            atten = 0.0f;
-                        }
-                        if (!(atten > 0.0f)) continue;
-                    }
-                    for (k = 0; k < 3; ++k) w[k] = li->color[k] * cs * atten;
-                    if (!tool__visible(T, p, n, li->position, NULL, NULL, ok)) {
-                        if (!*ok) return;
-                        continue;
-                    }
-                } else {
-                    continue; /* sky and maps: above and on escaping rays */
-                }
-                /* reflected radiance = albedo / pi * irradiance */
-                for (k = 0; k < 3; ++k) L[k] += thr[k] * albedo[k] * w[k] / (float)TOOL__TPI;
-            }
-        }
-        /* continue with a cosine-weighted direction: the throughput gains the albedo */
-        {
-            float u1 = tool__rnd(seed, pixel, sample, dim + 3), u2 = tool__rnd(seed, pixel, sample, dim + 4);
-            float r = sqrtf(u1), ph = 2.0f * (float)TOOL__TPI * u2, cz = sqrtf(1.0f - u1 > 0.0f ? 1.0f - u1 : 0.0f);
-            float cx = r * cosf(ph), cy = r * sinf(ph), len;
-            tool__basis(n, t1, t2);
-            for (k = 0; k < 3; ++k) {
-                ray.origin[k] = p[k] + n[k] * T->eps;
-                ray.dir[k] = t1[k] * cx + t2[k] * cy + n[k] * cz;
-            }
-            len = sqrtf(tool__tdot(ray.dir, ray.dir));
-            for (k = 0; k < 3; ++k) ray.dir[k] /= len;
-            ray.tmin = 0.0f;
-            ray.tmax = FLT_MAX;
-            prev_pdf = cz / (float)TOOL__TPI;
-            if (!(prev_pdf > 0.0f)) break;
-            for (k = 0; k < 3; ++k) thr[k] *= albedo[k];
-        }
-        if (depth + 1 >= T->o.rr_depth) {
-            float q = thr[0] > thr[1] ? thr[0] : thr[1];
-            q = q > thr[2] ? q : thr[2];
-            if (q > 0.95f) q = 0.95f;
-            if (!(tool__rnd(seed, pixel, sample, dim + 5) < q)) break;
-            for (k = 0; k < 3; ++k) thr[k] /= q;
-        }
+        if (T->emitter_count && !tool__trace_nee_area(T, pixel, sample, dim, tri, p, n, albedo, thr, L, ok)) return;
+        if (!tool__trace_nee_env(T, pixel, sample, dim, p, n, albedo, thr, L, ok)) return;
+        if (T->has_delta && !tool__trace_nee_delta(T, p, n, albedo, thr, L, ok)) return;
+        if (!tool__trace_bounce(T, pixel, sample, dim, depth, p, n, albedo, &ray, thr, &prev_pdf)) break;
     }
     for (k = 0; k < 3; ++k)
         if (L[k] == L[k] && L[k] < FLT_MAX) acc[k] += (double)L[k]; /* a NaN/Inf sample is dropped */
@@ -374,13 +425,54 @@ static void tool__trace_task(void *data, uint32_t index)
     if (!tool__trace_row(T, (int)(T->row0 + index))) T->failed = 1;
 }
 
+/* emitters and their selection probabilities (by power), as a CDF for next-event estimation */
+static int tool__trace_emitters(tool__tracer *T)
+{
+    const rad_scene *S = T->S;
+    uint32_t t, e;
+    double total = 0.0;
+    for (t = 0; t < S->triangle_count; ++t) {
+        const float *Le = S->materials_table[S->materials[t]].emission;
+        if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) T->emitter_count++;
+    }
+    T->select_pdf = (float *)calloc(S->triangle_count, sizeof(float));
+    if (!T->select_pdf) return RAD_ERROR_OUT_OF_MEMORY;
+    if (T->emitter_count) {
+        T->emitters = (uint32_t *)malloc(sizeof(uint32_t) * T->emitter_count);
+        T->cdf = (double *)malloc(sizeof(double) * (T->emitter_count + 1u));
+        if (!T->emitters || !T->cdf) {
+            free(T->emitters);
+            free(T->cdf);
+            free(T->select_pdf);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        for (t = 0, e = 0; t < S->triangle_count; ++t) {
+            const float *Le = S->materials_table[S->materials[t]].emission;
+            if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
+                double pw = TOOL__TPI * (double)S->areas[t] * ((double)Le[0] + (double)Le[1] + (double)Le[2]);
+                T->emitters[e] = t;
+                T->cdf[e] = total;
+                total += pw;
+                ++e;
+            }
+        }
+        for (e = 0; e < T->emitter_count; ++e) {
+            double pw = (e + 1 < T->emitter_count ? T->cdf[e + 1] : total) - T->cdf[e];
+            T->select_pdf[T->emitters[e]] = (float)(pw / total);
+            T->cdf[e] /= total;
+        }
+        T->cdf[T->emitter_count] = 1.0;
+    }
+    return RAD_SUCCESS;
+}
+
 int tool_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_light *lights, uint32_t light_count,
                     const rad_camera *camera, const tool_trace_options *options, const rad_context *ctx,
                     tool_image *out)
 {
     tool__tracer T;
-    uint32_t t, e, l;
-    double total = 0.0, run = 0.0;
+    uint32_t l;
+    double run = 0.0;
     int y, batch, result = RAD_SUCCESS, s;
     if (!scene || !rc || !rc->intersect || !rc->occluded || !camera || !out || (light_count && !lights))
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -421,39 +513,8 @@ int tool_trace_image(const rad_scene *scene, const rad_raycaster *rc, const rad_
         if (tool_image_alloc(out, T.o.width, T.o.height) != 0) return RAD_ERROR_OUT_OF_MEMORY;
     }
     T.out = out;
-    /* emitters and their selection probabilities */
-    for (t = 0; t < scene->triangle_count; ++t) {
-        const float *Le = scene->materials_table[scene->materials[t]].emission;
-        if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) T.emitter_count++;
-    }
-    T.select_pdf = (float *)calloc(scene->triangle_count, sizeof(float));
-    if (!T.select_pdf) return RAD_ERROR_OUT_OF_MEMORY;
-    if (T.emitter_count) {
-        T.emitters = (uint32_t *)malloc(sizeof(uint32_t) * T.emitter_count);
-        T.cdf = (double *)malloc(sizeof(double) * (T.emitter_count + 1u));
-        if (!T.emitters || !T.cdf) {
-            free(T.emitters);
-            free(T.cdf);
-            free(T.select_pdf);
-            return RAD_ERROR_OUT_OF_MEMORY;
-        }
-        for (t = 0, e = 0; t < scene->triangle_count; ++t) {
-            const float *Le = scene->materials_table[scene->materials[t]].emission;
-            if (Le[0] > 0.0f || Le[1] > 0.0f || Le[2] > 0.0f) {
-                double pw = TOOL__TPI * (double)scene->areas[t] * ((double)Le[0] + (double)Le[1] + (double)Le[2]);
-                T.emitters[e] = t;
-                T.cdf[e] = total;
-                total += pw;
-                ++e;
-            }
-        }
-        for (e = 0; e < T.emitter_count; ++e) {
-            double pw = (e + 1 < T.emitter_count ? T.cdf[e + 1] : total) - T.cdf[e];
-            T.select_pdf[T.emitters[e]] = (float)(pw / total);
-            T.cdf[e] /= total;
-        }
-        T.cdf[T.emitter_count] = 1.0;
-    }
+    result = tool__trace_emitters(&T);
+    if (result != RAD_SUCCESS) return result;
     /* rows in batches; progress and cancellation between batches on the calling thread */
     batch = T.o.height / 64;
     if (batch < 1) batch = 1;
