@@ -528,6 +528,35 @@ static void gw_json_materials(const char *cmd, const char *path, const tool_gltf
     *pjs = js;
 }
 
+/* The files: a GLB (header, JSON chunk, BIN chunk), or the .bin then the .gltf (file takes over js);
+   0 when written, 1 out of memory, 2 an output error. */
+static int gw_files(const char *path, int glb, const char *bin_path, gw_buf *js, const gw_buf *bin, gw_buf *file,
+                    tool_output_set *set)
+{
+    tool_output o;
+    if (glb) {
+        gw_u32(file, 0x46546C67u); /* "glTF" */
+        gw_u32(file, 2u);
+        gw_u32(file, (uint32_t)(12u + 8u + js->size + 8u + bin->size));
+        gw_u32(file, (uint32_t)js->size);
+        gw_u32(file, 0x4E4F534Au); /* "JSON" */
+        gw_put(file, js->data, js->size);
+        gw_u32(file, (uint32_t)bin->size);
+        gw_u32(file, 0x004E4942u); /* "BIN\0" */
+        gw_put(file, bin->data, bin->size);
+        if (file->failed) return 1;
+    } else {
+        if (tool_output_open(&o, bin_path) != 0) return 2;
+        errno = 0;
+        if (tool_output_set_add(set, &o, fwrite(bin->data, 1, bin->size, o.f) == bin->size) != 0) return 2;
+        *file = *js;
+        memset(js, 0, sizeof *js);
+    }
+    if (tool_output_open(&o, path) != 0) return 2;
+    if (tool_output_set_add(set, &o, fwrite(file->data, 1, file->size, o.f) == file->size) != 0) return 2;
+    return 0;
+}
+
 int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap *in, tool_output_set *set)
 {
     const rad_scene *s = in->scene;
@@ -543,7 +572,6 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
     int glb = gw_has_ext(path, ".glb"), ok = 0;
     uint32_t views_per_prim = 4u, png_view; /* POSITION, NORMAL, TEXCOORD_1, TEXCOORD_0 */
     char *bin_path = NULL;
-    tool_output o;
     memset(&bin, 0, sizeof bin);
     memset(&js, 0, sizeof js);
     memset(&png, 0, sizeof png);
@@ -594,26 +622,11 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
     }
 
     /* the files */
-    if (glb) {
-        gw_u32(&file, 0x46546C67u); /* "glTF" */
-        gw_u32(&file, 2u);
-        gw_u32(&file, (uint32_t)(12u + 8u + js.size + 8u + bin.size));
-        gw_u32(&file, (uint32_t)js.size);
-        gw_u32(&file, 0x4E4F534Au); /* "JSON" */
-        gw_put(&file, js.data, js.size);
-        gw_u32(&file, (uint32_t)bin.size);
-        gw_u32(&file, 0x004E4942u); /* "BIN\0" */
-        gw_put(&file, bin.data, bin.size);
-        if (file.failed) goto oom;
-    } else {
-        if (tool_output_open(&o, bin_path) != 0) goto io;
-        errno = 0;
-        if (tool_output_set_add(set, &o, fwrite(bin.data, 1, bin.size, o.f) == bin.size) != 0) goto io;
-        file = js;
-        memset(&js, 0, sizeof js);
+    switch (gw_files(path, glb, bin_path, &js, &bin, &file, set)) {
+    case 1: goto oom;
+    case 2: goto io;
+    default: break;
     }
-    if (tool_output_open(&o, path) != 0) goto io;
-    if (tool_output_set_add(set, &o, fwrite(file.data, 1, file.size, o.f) == file.size) != 0) goto io;
     ok = 1;
     goto done;
 oom:
