@@ -259,56 +259,32 @@ static int gw_tri_cmp(const void *pa, const void *pb)
     return a < b ? -1 : a > b;
 }
 
-int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap *in, tool_output_set *set)
+/* The lightmap as 8-bit sRGB of irradiance / scale, scale the atlas's largest value, PNG-encoded into png. */
+static int gw_encode_lightmap(const tool_gltf_lightmap *in, size_t n_texels, unsigned char **ppx, gw_buf *png, float *pscale)
 {
-    const rad_scene *s = in->scene;
-    /* the meshes (and their names) that group the triangles */
-    const rad_scene *ms = in->mesh_scene && in->mesh_scene->triangle_count == s->triangle_count ? in->mesh_scene : s;
     const rad_lightmap *lm = in->lightmap;
-    gw_buf bin, js, png, file;
-    uint32_t *order = NULL, i, k, t, prim, mesh, nprim = 0, nmesh = 0, texel;
-    uint32_t *run_start = NULL, *run_count = NULL, *prim_mesh = NULL;
-    size_t n_texels = (size_t)lm->width * lm->height, vbytes;
-    unsigned char *px = NULL;
+    unsigned char *px;
     float scale = 0.0f;
-    int glb = gw_has_ext(path, ".glb"), ok = 0, warned = 0;
-    uint32_t views_per_prim = 4u, png_view; /* POSITION, NORMAL, TEXCOORD_1, TEXCOORD_0 */
-    char *bin_path = NULL;
-    tool_output o;
-    memset(&bin, 0, sizeof bin);
-    memset(&js, 0, sizeof js);
-    memset(&png, 0, sizeof png);
-    memset(&file, 0, sizeof file);
-    if (!s->lightmap_uvs) {
-        fprintf(stderr, "rad %s: cannot write '%s': the baked scene has no lightmap uvs\n", cmd, path);
-        return 1;
-    }
-    /* POSITION, NORMAL, TEXCOORD_1 and TEXCOORD_0: 40 bytes a vertex, 3 vertices a triangle;
-       a GLB's chunk lengths and a glTF accessor's offsets are 32-bit */
-    vbytes = (size_t)40 * 3u * s->triangle_count;
-    if ((double)vbytes + 4.0 * (double)n_texels > 4.0e9) {
-        fprintf(stderr, "rad %s: cannot write '%s': %u triangles and a %ux%u lightmap pass the 4 GB a glTF buffer holds\n",
-                cmd, path, s->triangle_count, lm->width, lm->height);
-        return 1;
-    }
-
-    /* the lightmap as 8-bit sRGB of irradiance / scale, scale the atlas's largest value */
+    uint32_t i, texel;
     for (i = 0; i < 3 * (uint32_t)n_texels; ++i)
         if (in->values[i] > scale) scale = in->values[i];
     if (!(scale > 0.0f)) scale = 1.0f;
-    px = (unsigned char *)malloc(3 * n_texels);
-    if (!px) goto oom;
+    *pscale = scale;
+    px = *ppx = (unsigned char *)malloc(3 * n_texels);
+    if (!px) return 1;
     for (texel = 0; texel < 3 * (uint32_t)n_texels; ++texel) px[texel] = tool_image_srgb8(in->values[texel] / scale);
-    if (!stbi_write_png_to_func(gw_png_sink, &png, (int)lm->width, (int)lm->height, 3, px, (int)lm->width * 3) || png.failed)
-        goto oom;
+    if (!stbi_write_png_to_func(gw_png_sink, png, (int)lm->width, (int)lm->height, 3, px, (int)lm->width * 3) || png->failed)
+        return 1;
     free(px);
-    px = NULL;
+    *ppx = NULL;
+    return 0;
+}
 
-    /* primitives: runs of one mesh and material */
-    order = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
-    run_start = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
-    run_count = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
-    prim_mesh = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
+/* Sorts the triangles by mesh and material and cuts them into primitives: runs of one mesh and material. */
+static void gw_primitives(const rad_scene *s, const rad_scene *ms, uint32_t *order, uint32_t *run_start, uint32_t *run_count,
+                          uint32_t *prim_mesh, uint32_t *pnprim, uint32_t *pnmesh)
+{
+    uint32_t t, nprim = 0, nmesh = 0;
     for (t = 0; t < s->triangle_count; ++t) order[t] = t;
     gw_sort_meshes = ms->meshes;
     gw_sort_materials = s->materials;
@@ -322,8 +298,17 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
         }
         ++run_count[nprim - 1];
     }
+    *pnprim = nprim;
+    *pnmesh = nmesh;
+}
 
-    /* the binary buffer: per primitive its attribute arrays, then the PNG */
+/* The binary buffer: per primitive its attribute arrays (each in its own tightly packed view), then the PNG. */
+static void gw_binary(const rad_scene *s, const uint32_t *order, const uint32_t *run_start, const uint32_t *run_count,
+                      uint32_t nprim, const gw_buf *png, gw_buf *pbin, size_t *poff_n, size_t *poff_uv1, size_t *poff_uv0,
+                      uint32_t *ppng_view)
+{
+    gw_buf bin = *pbin;
+    uint32_t i, k, t, prim;
     for (prim = 0; prim < nprim; ++prim)
         for (k = 0; k < run_count[prim]; ++k) {
             t = order[run_start[prim] + k];
@@ -365,148 +350,266 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
                     }
                 }
             }
-        png_view = (uint32_t)bin.size;
-        gw_put(&bin, png.data, png.size);
+        *ppng_view = (uint32_t)bin.size;
+        gw_put(&bin, png->data, png->size);
         gw_align4(&bin, 0);
+        *poff_n = off_n;
+        *poff_uv1 = off_uv1;
+        *poff_uv0 = off_uv0;
+    }
+    *pbin = bin;
+}
+
+/* The JSON's asset (with the lightmap's extras), scene, nodes (one per mesh, then the camera) and camera. */
+static void gw_json_nodes(const char *cmd, const tool_gltf_lightmap *in, const rad_scene *ms, const uint32_t *prim_mesh,
+                          uint32_t nprim, uint32_t nmesh, float scale, gw_buf *pjs)
+{
+    const rad_scene *s = in->scene;
+    const rad_lightmap *lm = in->lightmap;
+    gw_buf js = *pjs;
+    uint32_t mesh, prim;
+    gw_printf(&js, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"radiosity.h rad %s (%s)\"",
+              cmd, RAD_VERSION_STRING);
+    gw_printf(&js, ",\"extras\":{\"RAD_lightmap\":{\"width\":%u,\"height\":%u,\"encoding\":\"srgb\",\"scale\":%.9g,"
+                   "\"quantity\":\"irradiance\",\"texture\":0,\"texCoord\":1",
+              lm->width, lm->height, (double)scale);
+    if (in->hdr_name) { gw_printf(&js, ",\"hdr\":"); gw_string(&js, in->hdr_name); }
+    gw_printf(&js, "}}}");
+    gw_printf(&js, ",\"extensionsUsed\":[\"KHR_materials_emissive_strength\"]");
+    gw_printf(&js, ",\"scene\":0,\"scenes\":[{\"nodes\":[");
+    for (mesh = 0; mesh < nmesh; ++mesh) gw_printf(&js, "%s%u", mesh ? "," : "", mesh);
+    if (in->camera) gw_printf(&js, "%s%u", nmesh ? "," : "", nmesh);
+    gw_printf(&js, "]}]");
+    /* nodes: one per mesh, then the camera */
+    gw_printf(&js, ",\"nodes\":[");
+    for (mesh = 0, prim = 0; mesh < nmesh; ++mesh) {
+        uint32_t id = prim_mesh[prim];
+        gw_printf(&js, "%s{\"mesh\":%u", mesh ? "," : "", mesh);
+        if (ms->mesh_names && id < ms->mesh_count && ms->mesh_names[id] && ms->mesh_names[id][0]) {
+            gw_printf(&js, ",\"name\":");
+            gw_string(&js, ms->mesh_names[id]);
+        }
+        gw_printf(&js, "}");
+        while (prim < nprim && prim_mesh[prim] == id) ++prim;
+    }
+    if (in->camera) {
+        double q[4];
+        const rad_camera *c = in->camera;
+        if (!gw_camera_rotation(c, q)) q[0] = q[1] = q[2] = 0.0, q[3] = 1.0;
+        gw_printf(&js, "%s{\"camera\":0,\"name\":\"rad view\",\"translation\":[%.9g,%.9g,%.9g],\"rotation\":[%.9g,%.9g,%.9g,%.9g]}",
+                  nmesh ? "," : "", (double)c->position[0], (double)c->position[1], (double)c->position[2], q[0], q[1], q[2],
+                  q[3]);
+    }
+    gw_printf(&js, "]");
+    if (in->camera) {
+        double diag = s->diagonal > 0.0f ? (double)s->diagonal : 1.0;
+        gw_printf(&js, ",\"cameras\":[{\"name\":\"rad view\",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g,\"zfar\":%.9g",
+                  (double)in->camera->fov_y_degrees * 3.14159265358979323846 / 180.0, 1e-3 * diag, 1e2 * diag);
+        if (in->aspect > 0.0f) gw_printf(&js, ",\"aspectRatio\":%.9g", (double)in->aspect);
+        gw_printf(&js, "}}]");
+    }
+    *pjs = js;
+}
+
+/* The JSON's meshes with their primitives, the buffer views (one per accessor, then the PNG) and the accessors. */
+static void gw_json_meshes(const rad_scene *s, const uint32_t *order, const uint32_t *run_start, const uint32_t *run_count,
+                           const uint32_t *prim_mesh, uint32_t nprim, uint32_t nmesh, uint32_t views_per_prim, size_t off_n,
+                           size_t off_uv1, size_t off_uv0, uint32_t png_view, const gw_buf *png, gw_buf *pjs)
+{
+    gw_buf js = *pjs;
+    uint32_t i, k, prim, mesh;
+    /* meshes and their primitives; accessors 4 per primitive:
+       POSITION, NORMAL, TEXCOORD_1, TEXCOORD_0 */
+    gw_printf(&js, ",\"meshes\":[");
+    for (mesh = 0, prim = 0; mesh < nmesh; ++mesh) {
+        uint32_t id = prim_mesh[prim], first = 1;
+        gw_printf(&js, "%s{\"primitives\":[", mesh ? "," : "");
+        for (; prim < nprim && prim_mesh[prim] == id; ++prim, first = 0) {
+            uint32_t a = views_per_prim * prim;
+            /* TEXCOORD_0 first: assimp reads the sets in the order written and refuses a gap */
+            gw_printf(&js, "%s{\"attributes\":{\"POSITION\":%u,\"NORMAL\":%u,\"TEXCOORD_0\":%u,\"TEXCOORD_1\":%u}",
+                      first ? "" : ",", a, a + 1, a + 3, a + 2);
+            gw_printf(&js, ",\"material\":%u,\"mode\":4}", s->materials[order[run_start[prim]]]);
+        }
+        gw_printf(&js, "]}");
+    }
+    gw_printf(&js, "]");
+    /* buffer views: one per accessor (the arrays above, primitive by primitive), then the PNG */
+    gw_printf(&js, ",\"bufferViews\":[");
+    {
+        size_t done = 0; /* triangles written before this primitive */
+        for (prim = 0; prim < nprim; ++prim) {
+            size_t c = run_count[prim];
+            gw_printf(&js, "%s{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}", prim ? "," : "",
+                      (unsigned long)(36u * done), (unsigned long)(36u * c));
+            gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
+                      (unsigned long)(off_n + 36u * done), (unsigned long)(36u * c));
+            gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
+                      (unsigned long)(off_uv1 + 24u * done), (unsigned long)(24u * c));
+            gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
+                          (unsigned long)(off_uv0 + 24u * done), (unsigned long)(24u * c));
+            done += c;
+        }
+        gw_printf(&js, "%s{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu}", nprim ? "," : "", (unsigned long)png_view,
+                  (unsigned long)png->size);
+    }
+    gw_printf(&js, "]");
+    /* accessors: POSITION carries its bounds (the spec requires min and max) */
+    gw_printf(&js, ",\"accessors\":[");
+    for (prim = 0; prim < nprim; ++prim) {
+        float lo[3], hi[3];
+        uint32_t c = 3u * run_count[prim];
+        for (i = 0; i < 3; ++i) lo[i] = hi[i] = s->positions[9 * (size_t)order[run_start[prim]] + i];
+        for (k = 0; k < run_count[prim]; ++k) {
+            const float *p = s->positions + 9 * (size_t)order[run_start[prim] + k];
+            for (i = 0; i < 9; ++i) {
+                if (p[i] < lo[i % 3]) lo[i % 3] = p[i];
+                if (p[i] > hi[i % 3]) hi[i % 3] = p[i];
+            }
+        }
+        gw_printf(&js, "%s{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\",\"min\":[%.9g,%.9g,%.9g],"
+                       "\"max\":[%.9g,%.9g,%.9g]}",
+                  prim ? "," : "", views_per_prim * prim, c, (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0],
+                  (double)hi[1], (double)hi[2]);
+        gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\"}", views_per_prim * prim + 1, c);
+        gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", views_per_prim * prim + 2, c);
+        gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", views_per_prim * prim + 3, c);
+    }
+    gw_printf(&js, "]");
+    *pjs = js;
+}
+
+/* The JSON's lightmap sampler, image and texture, and the materials (constant colours naming the lightmap). */
+static void gw_json_materials(const char *cmd, const char *path, const tool_gltf_lightmap *in, uint32_t nprim,
+                              uint32_t views_per_prim, float scale, gw_buf *pjs)
+{
+    const rad_scene *s = in->scene;
+    gw_buf js = *pjs;
+    uint32_t k;
+    int warned = 0;
+    /* the lightmap: clamped, linear, no mipmaps (mip levels would mix neighbouring charts) */
+    gw_printf(&js, ",\"samplers\":[{\"magFilter\":9729,\"minFilter\":9729,\"wrapS\":33071,\"wrapT\":33071}]");
+    gw_printf(&js, ",\"images\":[{\"bufferView\":%u,\"mimeType\":\"image/png\",\"name\":\"lightmap\"}]",
+              views_per_prim * nprim);
+    gw_printf(&js, ",\"textures\":[{\"sampler\":0,\"source\":0,\"name\":\"lightmap\"}]");
+    /* materials: constant colours, each naming the lightmap in its extras */
+    gw_printf(&js, ",\"materials\":[");
+    for (k = 0; k < s->material_count; ++k) {
+        const rad_material *m = &s->materials_table[k];
+        float em = m->emission[0];
+        if (m->emission[1] > em) em = m->emission[1];
+        if (m->emission[2] > em) em = m->emission[2];
+        if (m->texture && !warned) {
+            fprintf(stderr, "rad %s: warning: '%s' carries the materials' constant colours: base-colour textures are not "
+                            "copied (the lightmap holds irradiance, so the engine's own textures apply)\n", cmd, path);
+            warned = 1;
+        }
+        gw_printf(&js, "%s{", k ? "," : "");
+        if (in->material_names && in->material_names[k] && in->material_names[k][0]) {
+            gw_printf(&js, "\"name\":");
+            gw_string(&js, in->material_names[k]);
+            gw_printf(&js, ",");
+        }
+        gw_printf(&js, "\"pbrMetallicRoughness\":{\"baseColorFactor\":[%.9g,%.9g,%.9g,1],\"metallicFactor\":0,"
+                       "\"roughnessFactor\":1}",
+                  (double)m->albedo[0], (double)m->albedo[1], (double)m->albedo[2]);
+        if (em > 0.0f) {
+            float f = em > 1.0f ? em : 1.0f;
+            gw_printf(&js, ",\"emissiveFactor\":[%.9g,%.9g,%.9g]", (double)(m->emission[0] / f), (double)(m->emission[1] / f),
+                      (double)(m->emission[2] / f));
+            if (f > 1.0f) gw_printf(&js, ",\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}}", (double)f);
+        }
+        gw_printf(&js, ",\"extras\":{\"RAD_lightmap\":{\"texture\":0,\"texCoord\":1,\"encoding\":\"srgb\",\"scale\":%.9g",
+                  (double)scale);
+        if (in->hdr_name) { gw_printf(&js, ",\"hdr\":"); gw_string(&js, in->hdr_name); }
+        gw_printf(&js, "}}}");
+    }
+    gw_printf(&js, "]");
+    *pjs = js;
+}
+
+/* The files: a GLB (header, JSON chunk, BIN chunk), or the .bin then the .gltf (file takes over js);
+   0 when written, 1 out of memory, 2 an output error. */
+static int gw_files(const char *path, int glb, const char *bin_path, gw_buf *js, const gw_buf *bin, gw_buf *file,
+                    tool_output_set *set)
+{
+    tool_output o;
+    if (glb) {
+        gw_u32(file, 0x46546C67u); /* "glTF" */
+        gw_u32(file, 2u);
+        gw_u32(file, (uint32_t)(12u + 8u + js->size + 8u + bin->size));
+        gw_u32(file, (uint32_t)js->size);
+        gw_u32(file, 0x4E4F534Au); /* "JSON" */
+        gw_put(file, js->data, js->size);
+        gw_u32(file, (uint32_t)bin->size);
+        gw_u32(file, 0x004E4942u); /* "BIN\0" */
+        gw_put(file, bin->data, bin->size);
+        if (file->failed) return 1;
+    } else {
+        if (tool_output_open(&o, bin_path) != 0) return 2;
+        errno = 0;
+        if (tool_output_set_add(set, &o, fwrite(bin->data, 1, bin->size, o.f) == bin->size) != 0) return 2;
+        *file = *js;
+        memset(js, 0, sizeof *js);
+    }
+    if (tool_output_open(&o, path) != 0) return 2;
+    if (tool_output_set_add(set, &o, fwrite(file->data, 1, file->size, o.f) == file->size) != 0) return 2;
+    return 0;
+}
+
+int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap *in, tool_output_set *set)
+{
+    const rad_scene *s = in->scene;
+    /* the meshes (and their names) that group the triangles */
+    const rad_scene *ms = in->mesh_scene && in->mesh_scene->triangle_count == s->triangle_count ? in->mesh_scene : s;
+    const rad_lightmap *lm = in->lightmap;
+    gw_buf bin, js, png, file;
+    uint32_t *order = NULL, nprim = 0, nmesh = 0;
+    uint32_t *run_start = NULL, *run_count = NULL, *prim_mesh = NULL;
+    size_t n_texels = (size_t)lm->width * lm->height, vbytes;
+    unsigned char *px = NULL;
+    float scale = 0.0f;
+    int glb = gw_has_ext(path, ".glb"), ok = 0;
+    uint32_t views_per_prim = 4u, png_view; /* POSITION, NORMAL, TEXCOORD_1, TEXCOORD_0 */
+    char *bin_path = NULL;
+    memset(&bin, 0, sizeof bin);
+    memset(&js, 0, sizeof js);
+    memset(&png, 0, sizeof png);
+    memset(&file, 0, sizeof file);
+    if (!s->lightmap_uvs) {
+        fprintf(stderr, "rad %s: cannot write '%s': the baked scene has no lightmap uvs\n", cmd, path);
+        return 1;
+    }
+    /* POSITION, NORMAL, TEXCOORD_1 and TEXCOORD_0: 40 bytes a vertex, 3 vertices a triangle;
+       a GLB's chunk lengths and a glTF accessor's offsets are 32-bit */
+    vbytes = (size_t)40 * 3u * s->triangle_count;
+    if ((double)vbytes + 4.0 * (double)n_texels > 4.0e9) {
+        fprintf(stderr, "rad %s: cannot write '%s': %u triangles and a %ux%u lightmap pass the 4 GB a glTF buffer holds\n",
+                cmd, path, s->triangle_count, lm->width, lm->height);
+        return 1;
+    }
+
+    /* the lightmap as 8-bit sRGB of irradiance / scale, scale the atlas's largest value */
+    if (gw_encode_lightmap(in, n_texels, &px, &png, &scale)) goto oom;
+
+    /* primitives: runs of one mesh and material */
+    order = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
+    run_start = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
+    run_count = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
+    prim_mesh = (uint32_t *)tool_calloc(s->triangle_count, sizeof(uint32_t));
+    gw_primitives(s, ms, order, run_start, run_count, prim_mesh, &nprim, &nmesh);
+
+    /* the binary buffer: per primitive its attribute arrays, then the PNG */
+    {
+        size_t off_n, off_uv1, off_uv0;
+        gw_binary(s, order, run_start, run_count, nprim, &png, &bin, &off_n, &off_uv1, &off_uv0, &png_view);
         if (bin.failed) goto oom;
 
         /* the JSON */
-        gw_printf(&js, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"radiosity.h rad %s (%s)\"",
-                  cmd, RAD_VERSION_STRING);
-        gw_printf(&js, ",\"extras\":{\"RAD_lightmap\":{\"width\":%u,\"height\":%u,\"encoding\":\"srgb\",\"scale\":%.9g,"
-                       "\"quantity\":\"irradiance\",\"texture\":0,\"texCoord\":1",
-                  lm->width, lm->height, (double)scale);
-        if (in->hdr_name) { gw_printf(&js, ",\"hdr\":"); gw_string(&js, in->hdr_name); }
-        gw_printf(&js, "}}}");
-        gw_printf(&js, ",\"extensionsUsed\":[\"KHR_materials_emissive_strength\"]");
-        gw_printf(&js, ",\"scene\":0,\"scenes\":[{\"nodes\":[");
-        for (mesh = 0; mesh < nmesh; ++mesh) gw_printf(&js, "%s%u", mesh ? "," : "", mesh);
-        if (in->camera) gw_printf(&js, "%s%u", nmesh ? "," : "", nmesh);
-        gw_printf(&js, "]}]");
-        /* nodes: one per mesh, then the camera */
-        gw_printf(&js, ",\"nodes\":[");
-        for (mesh = 0, prim = 0; mesh < nmesh; ++mesh) {
-            uint32_t id = prim_mesh[prim];
-            gw_printf(&js, "%s{\"mesh\":%u", mesh ? "," : "", mesh);
-            if (ms->mesh_names && id < ms->mesh_count && ms->mesh_names[id] && ms->mesh_names[id][0]) {
-                gw_printf(&js, ",\"name\":");
-                gw_string(&js, ms->mesh_names[id]);
-            }
-            gw_printf(&js, "}");
-            while (prim < nprim && prim_mesh[prim] == id) ++prim;
-        }
-        if (in->camera) {
-            double q[4];
-            const rad_camera *c = in->camera;
-            if (!gw_camera_rotation(c, q)) q[0] = q[1] = q[2] = 0.0, q[3] = 1.0;
-            gw_printf(&js, "%s{\"camera\":0,\"name\":\"rad view\",\"translation\":[%.9g,%.9g,%.9g],\"rotation\":[%.9g,%.9g,%.9g,%.9g]}",
-                      nmesh ? "," : "", (double)c->position[0], (double)c->position[1], (double)c->position[2], q[0], q[1], q[2],
-                      q[3]);
-        }
-        gw_printf(&js, "]");
-        if (in->camera) {
-            double diag = s->diagonal > 0.0f ? (double)s->diagonal : 1.0;
-            gw_printf(&js, ",\"cameras\":[{\"name\":\"rad view\",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g,\"zfar\":%.9g",
-                      (double)in->camera->fov_y_degrees * 3.14159265358979323846 / 180.0, 1e-3 * diag, 1e2 * diag);
-            if (in->aspect > 0.0f) gw_printf(&js, ",\"aspectRatio\":%.9g", (double)in->aspect);
-            gw_printf(&js, "}}]");
-        }
-        /* meshes and their primitives; accessors 4 per primitive:
-           POSITION, NORMAL, TEXCOORD_1, TEXCOORD_0 */
-        gw_printf(&js, ",\"meshes\":[");
-        for (mesh = 0, prim = 0; mesh < nmesh; ++mesh) {
-            uint32_t id = prim_mesh[prim], first = 1;
-            gw_printf(&js, "%s{\"primitives\":[", mesh ? "," : "");
-            for (; prim < nprim && prim_mesh[prim] == id; ++prim, first = 0) {
-                uint32_t a = views_per_prim * prim;
-                /* TEXCOORD_0 first: assimp reads the sets in the order written and refuses a gap */
-                gw_printf(&js, "%s{\"attributes\":{\"POSITION\":%u,\"NORMAL\":%u,\"TEXCOORD_0\":%u,\"TEXCOORD_1\":%u}",
-                          first ? "" : ",", a, a + 1, a + 3, a + 2);
-                gw_printf(&js, ",\"material\":%u,\"mode\":4}", s->materials[order[run_start[prim]]]);
-            }
-            gw_printf(&js, "]}");
-        }
-        gw_printf(&js, "]");
-        /* buffer views: one per accessor (the arrays above, primitive by primitive), then the PNG */
-        gw_printf(&js, ",\"bufferViews\":[");
-        {
-            size_t done = 0; /* triangles written before this primitive */
-            for (prim = 0; prim < nprim; ++prim) {
-                size_t c = run_count[prim];
-                gw_printf(&js, "%s{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}", prim ? "," : "",
-                          (unsigned long)(36u * done), (unsigned long)(36u * c));
-                gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
-                          (unsigned long)(off_n + 36u * done), (unsigned long)(36u * c));
-                gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
-                          (unsigned long)(off_uv1 + 24u * done), (unsigned long)(24u * c));
-                gw_printf(&js, ",{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu,\"target\":34962}",
-                              (unsigned long)(off_uv0 + 24u * done), (unsigned long)(24u * c));
-                done += c;
-            }
-            gw_printf(&js, "%s{\"buffer\":0,\"byteOffset\":%lu,\"byteLength\":%lu}", nprim ? "," : "", (unsigned long)png_view,
-                      (unsigned long)png.size);
-        }
-        gw_printf(&js, "]");
-        /* accessors: POSITION carries its bounds (the spec requires min and max) */
-        gw_printf(&js, ",\"accessors\":[");
-        for (prim = 0; prim < nprim; ++prim) {
-            float lo[3], hi[3];
-            uint32_t c = 3u * run_count[prim];
-            for (i = 0; i < 3; ++i) lo[i] = hi[i] = s->positions[9 * (size_t)order[run_start[prim]] + i];
-            for (k = 0; k < run_count[prim]; ++k) {
-                const float *p = s->positions + 9 * (size_t)order[run_start[prim] + k];
-                for (i = 0; i < 9; ++i) {
-                    if (p[i] < lo[i % 3]) lo[i % 3] = p[i];
-                    if (p[i] > hi[i % 3]) hi[i % 3] = p[i];
-                }
-            }
-            gw_printf(&js, "%s{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\",\"min\":[%.9g,%.9g,%.9g],"
-                           "\"max\":[%.9g,%.9g,%.9g]}",
-                      prim ? "," : "", views_per_prim * prim, c, (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0],
-                      (double)hi[1], (double)hi[2]);
-            gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC3\"}", views_per_prim * prim + 1, c);
-            gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", views_per_prim * prim + 2, c);
-            gw_printf(&js, ",{\"bufferView\":%u,\"componentType\":5126,\"count\":%u,\"type\":\"VEC2\"}", views_per_prim * prim + 3, c);
-        }
-        gw_printf(&js, "]");
-        /* the lightmap: clamped, linear, no mipmaps (mip levels would mix neighbouring charts) */
-        gw_printf(&js, ",\"samplers\":[{\"magFilter\":9729,\"minFilter\":9729,\"wrapS\":33071,\"wrapT\":33071}]");
-        gw_printf(&js, ",\"images\":[{\"bufferView\":%u,\"mimeType\":\"image/png\",\"name\":\"lightmap\"}]",
-                  views_per_prim * nprim);
-        gw_printf(&js, ",\"textures\":[{\"sampler\":0,\"source\":0,\"name\":\"lightmap\"}]");
-        /* materials: constant colours, each naming the lightmap in its extras */
-        gw_printf(&js, ",\"materials\":[");
-        for (k = 0; k < s->material_count; ++k) {
-            const rad_material *m = &s->materials_table[k];
-            float em = m->emission[0];
-            if (m->emission[1] > em) em = m->emission[1];
-            if (m->emission[2] > em) em = m->emission[2];
-            if (m->texture && !warned) {
-                fprintf(stderr, "rad %s: warning: '%s' carries the materials' constant colours: base-colour textures are not "
-                                "copied (the lightmap holds irradiance, so the engine's own textures apply)\n", cmd, path);
-                warned = 1;
-            }
-            gw_printf(&js, "%s{", k ? "," : "");
-            if (in->material_names && in->material_names[k] && in->material_names[k][0]) {
-                gw_printf(&js, "\"name\":");
-                gw_string(&js, in->material_names[k]);
-                gw_printf(&js, ",");
-            }
-            gw_printf(&js, "\"pbrMetallicRoughness\":{\"baseColorFactor\":[%.9g,%.9g,%.9g,1],\"metallicFactor\":0,"
-                           "\"roughnessFactor\":1}",
-                      (double)m->albedo[0], (double)m->albedo[1], (double)m->albedo[2]);
-            if (em > 0.0f) {
-                float f = em > 1.0f ? em : 1.0f;
-                gw_printf(&js, ",\"emissiveFactor\":[%.9g,%.9g,%.9g]", (double)(m->emission[0] / f), (double)(m->emission[1] / f),
-                          (double)(m->emission[2] / f));
-                if (f > 1.0f) gw_printf(&js, ",\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}}", (double)f);
-            }
-            gw_printf(&js, ",\"extras\":{\"RAD_lightmap\":{\"texture\":0,\"texCoord\":1,\"encoding\":\"srgb\",\"scale\":%.9g",
-                      (double)scale);
-            if (in->hdr_name) { gw_printf(&js, ",\"hdr\":"); gw_string(&js, in->hdr_name); }
-            gw_printf(&js, "}}}");
-        }
-        gw_printf(&js, "]");
+        gw_json_nodes(cmd, in, ms, prim_mesh, nprim, nmesh, scale, &js);
+        gw_json_meshes(s, order, run_start, run_count, prim_mesh, nprim, nmesh, views_per_prim, off_n, off_uv1, off_uv0,
+                       png_view, &png, &js);
+        gw_json_materials(cmd, path, in, nprim, views_per_prim, scale, &js);
         gw_printf(&js, ",\"buffers\":[{\"byteLength\":%lu", (unsigned long)bin.size);
         if (!glb) {
             bin_path = tool_gltf_bin_path(path);
@@ -519,26 +622,11 @@ int tool_gltf_write(const char *cmd, const char *path, const tool_gltf_lightmap 
     }
 
     /* the files */
-    if (glb) {
-        gw_u32(&file, 0x46546C67u); /* "glTF" */
-        gw_u32(&file, 2u);
-        gw_u32(&file, (uint32_t)(12u + 8u + js.size + 8u + bin.size));
-        gw_u32(&file, (uint32_t)js.size);
-        gw_u32(&file, 0x4E4F534Au); /* "JSON" */
-        gw_put(&file, js.data, js.size);
-        gw_u32(&file, (uint32_t)bin.size);
-        gw_u32(&file, 0x004E4942u); /* "BIN\0" */
-        gw_put(&file, bin.data, bin.size);
-        if (file.failed) goto oom;
-    } else {
-        if (tool_output_open(&o, bin_path) != 0) goto io;
-        errno = 0;
-        if (tool_output_set_add(set, &o, fwrite(bin.data, 1, bin.size, o.f) == bin.size) != 0) goto io;
-        file = js;
-        memset(&js, 0, sizeof js);
+    switch (gw_files(path, glb, bin_path, &js, &bin, &file, set)) {
+    case 1: goto oom;
+    case 2: goto io;
+    default: break;
     }
-    if (tool_output_open(&o, path) != 0) goto io;
-    if (tool_output_set_add(set, &o, fwrite(file.data, 1, file.size, o.f) == file.size) != 0) goto io;
     ok = 1;
     goto done;
 oom:

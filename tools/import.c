@@ -1507,40 +1507,34 @@ int tool_two_sided_parse(const char *text, tool_two_sided_mode *out)
     return 0;
 }
 
-int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen)
+/* The built-in Cornell box ("cornell"): rad_cornell_box's static tables, copied only when --two-sided all sets the flag. */
+static int load_cornell(tool_scene *out, char *err, size_t errlen)
+{
+    imp_storage *st;
+    uint32_t i;
+    st = (imp_storage *)calloc(1, sizeof *st);
+    if (!st) return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
+    static const char *const cornell_names[4] = {"white", "red", "green", "light"};
+    st->builtin = 1;
+    rad_cornell_box(&out->desc, &out->camera);
+    if (out->desc.material_count == 4) out->material_names = cornell_names;
+    out->has_camera = 1;
+    out->storage = st;
+    if (tool_two_sided == TOOL_TWO_SIDED_ALL) {
+        /* the built-in materials are static: a copy takes the flag */
+        st->material_count = out->desc.material_count;
+        st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
+        memcpy(st->materials, out->desc.materials, sizeof(rad_material) * st->material_count);
+        for (i = 0; i < st->material_count; ++i) st->materials[i].two_sided = 1;
+        out->desc.materials = st->materials;
+    }
+    return 0;
+}
+
+/* Imports the file with assimp, or NULL with err saying why (unread extensions, a broken file, no meshes). */
+static const struct aiScene *import_checked(const char *path_or_name, char *err, size_t errlen)
 {
     const struct aiScene *sc;
-    imp_storage *st;
-    walk_state ws;
-    struct aiMatrix4x4 id;
-    uint32_t i, k, tris = 0;
-    unsigned char *clamped = NULL;
-    char *json = NULL;
-    float bmin[3] = {1e30f, 1e30f, 1e30f}, bmax[3] = {-1e30f, -1e30f, -1e30f};
-    memset(out, 0, sizeof *out);
-    if (!path_or_name || !*path_or_name) {
-        set_err(err, errlen, "no scene given%s%s", NULL, NULL);
-        return 1;
-    }
-    if (!strcmp(path_or_name, "cornell")) {
-        st = (imp_storage *)calloc(1, sizeof *st);
-        if (!st) return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
-        static const char *const cornell_names[4] = {"white", "red", "green", "light"};
-        st->builtin = 1;
-        rad_cornell_box(&out->desc, &out->camera);
-        if (out->desc.material_count == 4) out->material_names = cornell_names;
-        out->has_camera = 1;
-        out->storage = st;
-        if (tool_two_sided == TOOL_TWO_SIDED_ALL) {
-            /* the built-in materials are static: a copy takes the flag */
-            st->material_count = out->desc.material_count;
-            st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
-            memcpy(st->materials, out->desc.materials, sizeof(rad_material) * st->material_count);
-            for (i = 0; i < st->material_count; ++i) st->materials[i].two_sided = 1;
-            out->desc.materials = st->materials;
-        }
-        return 0;
-    }
     sc = import_logged(path_or_name, aiProcess_Triangulate | aiProcess_SortByPType); /* welding: weld_mesh */
     if (!sc) {
         char exts[512];
@@ -1552,25 +1546,26 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
                      path_or_name, aiGetErrorString(), ne > 1 ? "s" : "", exts, aiGetVersionMajor(), aiGetVersionMinor(),
                      aiGetVersionPatch());
         else set_err(err, errlen, "cannot import '%s': %s", path_or_name, aiGetErrorString());
-        return 1;
+        return NULL;
     }
     if (g_log.fatal[0]) {
         set_err(err, errlen, "'%s' is broken: assimp: %s", path_or_name, g_log.fatal);
         aiReleaseImport(sc);
-        return 1;
+        return NULL;
     }
     if (!sc->mRootNode || sc->mNumMeshes == 0) {
         set_err(err, errlen, "'%s' has no meshes%s", path_or_name, NULL);
         aiReleaseImport(sc);
-        return 1;
+        return NULL;
     }
-    st = (imp_storage *)calloc(1, sizeof *st);
-    if (!st) {
-        aiReleaseImport(sc);
-        return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
-    }
-    out->storage = st;
-    /* materials */
+    return sc;
+}
+
+/* Allocates the per-material tables (materials, names, winding counts, reports) and returns the clamped flags. */
+static unsigned char *material_tables(imp_storage *st, const struct aiScene *sc, tool_scene *out)
+{
+    unsigned char *clamped;
+    uint32_t i;
     st->material_count = sc->mNumMaterials ? sc->mNumMaterials : 1;
     st->materials = (rad_material *)xrealloc(NULL, sizeof(rad_material) * st->material_count);
     memset(st->materials, 0, sizeof(rad_material) * st->material_count);
@@ -1591,7 +1586,14 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
     st->material_reports = (char **)xrealloc(NULL, sizeof(char *) * st->material_count);
     memset(st->material_reports, 0, sizeof(char *) * st->material_count);
     out->material_reports = (const char *const *)st->material_reports;
-    json = gltf_json(path_or_name);
+    return clamped;
+}
+
+/* Converts every material (grey for assimp's missing one); 1 with err set when one cannot be told or converted. */
+static int convert_materials(imp_storage *st, const struct aiScene *sc, const char *path_or_name, const char *json,
+                             unsigned char *clamped, char *err, size_t errlen)
+{
+    uint32_t i;
     for (i = 0; i < st->material_count; ++i) {
         if (i < sc->mNumMaterials) {
             int ambiguous = 0;
@@ -1604,40 +1606,27 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
                         "factor but another KHR_materials_emissive_strength: which is which cannot be told (give the "
                         "materials names)",
                         path_or_name, n);
-                free(clamped);
-                free(json);
-                aiReleaseImport(sc);
-                tool_free_scene(out);
                 return 1;
             }
             if (convert_material(st, sc, path_or_name, sc->mMaterials[i], i, gltf_emissive_strength(gm), json ? gm : NULL,
                                  &st->materials[i],
                                  &clamped[i], err, errlen)) {
-                free(clamped);
-                free(json);
-                aiReleaseImport(sc);
-                tool_free_scene(out);
                 return 1;
             }
             gltf_apply_transforms(st, &st->materials[i], gm);
             material_report(st, sc->mMaterials[i], i, json ? gm : NULL, json != NULL);
         } else st->materials[i].albedo[0] = st->materials[i].albedo[1] = st->materials[i].albedo[2] = 0.5f;
     }
-    /* geometry, lights, camera */
-    memset(&id, 0, sizeof id);
-    id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
-    memset(&ws, 0, sizeof ws);
-    ws.st = st;
-    ws.sc = sc;
-    ws.out = out;
-    ws.gltf = json;
-    walk(&ws, sc->mRootNode, &id);
-    free(json);
-    aiReleaseImport(sc);
-    /* One warning for the first clamped material, except assimp's default material when no
-       triangle uses it: assimp adds one to every glTF (base colour 1, always clamped) and a
-       "DefaultMaterial" to every OBJ, and warned about it where the file's own materials
-       were fine. */
+    return 0;
+}
+
+/* One warning for the first clamped material, except assimp's default material when no
+   triangle uses it: assimp adds one to every glTF (base colour 1, always clamped) and a
+   "DefaultMaterial" to every OBJ, and warned about it where the file's own materials
+   were fine. Frees clamped. */
+static void warn_clamped(imp_storage *st, unsigned char *clamped)
+{
+    uint32_t i;
     {
         unsigned char *used = (unsigned char *)xrealloc(NULL, st->material_count);
         uint32_t g, t;
@@ -1656,13 +1645,13 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
         free(used);
         free(clamped);
     }
-    if (ws.bad_indices) {
-        char n[32];
-        snprintf(n, sizeof n, "%u", ws.bad_indices);
-        set_err(err, errlen, "'%s' is broken: %s faces have an index past their mesh's vertices", path_or_name, n);
-        tool_free_scene(out);
-        return 1;
-    }
+}
+
+/* One rad_mesh_desc per imported group (uvs only where a textured material needs them); returns the triangle count and
+   grows bmin/bmax over the vertices. */
+static uint32_t build_meshes(imp_storage *st, float bmin[3], float bmax[3])
+{
+    uint32_t i, k, tris = 0;
     st->meshes = (rad_mesh_desc *)xrealloc(NULL, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
     memset(st->meshes, 0, sizeof(rad_mesh_desc) * (st->group_count ? st->group_count : 1));
     for (i = 0; i < st->group_count; ++i) {
@@ -1690,22 +1679,13 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
             if (v > bmax[k % 3]) bmax[k % 3] = v;
         }
     }
-    if (tris == 0) {
-        set_err(err, errlen, "'%s' has no triangles%s", path_or_name, NULL);
-        tool_free_scene(out);
-        return 1;
-    }
-    out->desc.meshes = st->meshes;
-    out->desc.mesh_count = st->group_count;
-    out->desc.materials = st->materials;
-    out->desc.material_count = st->material_count;
-    out->desc.albedo_lookup = st->texture_count ? albedo_lookup : NULL;
-    out->desc.albedo_user = st;
-    out->desc.emission_lookup = st->any_emission_texture ? emission_lookup : NULL;
-    out->desc.emission_user = st;
-    out->desc.opacity_lookup = st->any_cutout ? opacity_lookup : NULL;
-    out->desc.opacity_user = st;
-    out->desc.flags = RAD_SCENE_SKIP_DEGENERATE;
+    return tris;
+}
+
+/* Applies --two-sided to every material and adds its sides and cutout to the material's report. */
+static void finish_materials(imp_storage *st)
+{
+    uint32_t i;
     for (i = 0; i < st->material_count; ++i) {
         if (tool_two_sided == TOOL_TWO_SIDED_ALL) st->materials[i].two_sided = 1;
         if (tool_two_sided == TOOL_TWO_SIDED_NONE) st->materials[i].two_sided = 0;
@@ -1726,6 +1706,79 @@ int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t
             }
         }
     }
+}
+
+int tool_load_scene(const char *path_or_name, tool_scene *out, char *err, size_t errlen)
+{
+    const struct aiScene *sc;
+    imp_storage *st;
+    walk_state ws;
+    struct aiMatrix4x4 id;
+    uint32_t tris = 0;
+    unsigned char *clamped = NULL;
+    char *json = NULL;
+    float bmin[3] = {1e30f, 1e30f, 1e30f}, bmax[3] = {-1e30f, -1e30f, -1e30f};
+    memset(out, 0, sizeof *out);
+    if (!path_or_name || !*path_or_name) {
+        set_err(err, errlen, "no scene given%s%s", NULL, NULL);
+        return 1;
+    }
+    if (!strcmp(path_or_name, "cornell")) return load_cornell(out, err, errlen);
+    sc = import_checked(path_or_name, err, errlen);
+    if (!sc) return 1;
+    st = (imp_storage *)calloc(1, sizeof *st);
+    if (!st) {
+        aiReleaseImport(sc);
+        return set_err(err, errlen, "out of memory%s%s", NULL, NULL), 1;
+    }
+    out->storage = st;
+    /* materials */
+    clamped = material_tables(st, sc, out);
+    json = gltf_json(path_or_name);
+    if (convert_materials(st, sc, path_or_name, json, clamped, err, errlen)) {
+        free(clamped);
+        free(json);
+        aiReleaseImport(sc);
+        tool_free_scene(out);
+        return 1;
+    }
+    /* geometry, lights, camera */
+    memset(&id, 0, sizeof id);
+    id.a1 = id.b2 = id.c3 = id.d4 = 1.0f;
+    memset(&ws, 0, sizeof ws);
+    ws.st = st;
+    ws.sc = sc;
+    ws.out = out;
+    ws.gltf = json;
+    walk(&ws, sc->mRootNode, &id);
+    free(json);
+    aiReleaseImport(sc);
+    warn_clamped(st, clamped);
+    if (ws.bad_indices) {
+        char n[32];
+        snprintf(n, sizeof n, "%u", ws.bad_indices);
+        set_err(err, errlen, "'%s' is broken: %s faces have an index past their mesh's vertices", path_or_name, n);
+        tool_free_scene(out);
+        return 1;
+    }
+    tris = build_meshes(st, bmin, bmax);
+    if (tris == 0) {
+        set_err(err, errlen, "'%s' has no triangles%s", path_or_name, NULL);
+        tool_free_scene(out);
+        return 1;
+    }
+    out->desc.meshes = st->meshes;
+    out->desc.mesh_count = st->group_count;
+    out->desc.materials = st->materials;
+    out->desc.material_count = st->material_count;
+    out->desc.albedo_lookup = st->texture_count ? albedo_lookup : NULL;
+    out->desc.albedo_user = st;
+    out->desc.emission_lookup = st->any_emission_texture ? emission_lookup : NULL;
+    out->desc.emission_user = st;
+    out->desc.opacity_lookup = st->any_cutout ? opacity_lookup : NULL;
+    out->desc.opacity_user = st;
+    out->desc.flags = RAD_SCENE_SKIP_DEGENERATE;
+    finish_materials(st);
     warn_mixed_windings(st, path_or_name);
     add_input(st, path_or_name);
     add_obj_mtllibs(st, path_or_name);
