@@ -1051,11 +1051,17 @@ bake|--method multibounce|--method multibounce needs
 formfactors|--ff analytic|the form factors need
 EOF2
 # the exact patch count is checked too: 32 triangles, --patches 3000 (about 3000 patches, 34 MiB)
-"$RAD" render cornell --patches 3000 --max-memory 16M --size 8x8 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
+"$RAD" render cornell --method classic --patches 3000 --max-memory 16M --size 8x8 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 1 ] && grep -q "needs a dense [0-9]* x [0-9]* form-factor matrix ([0-9]* patches)" "$TMP/err.txt" &&
-    ok "render --patches 3000 --max-memory 16M is refused once the patches are counted" ||
-    fail "render --patches 3000 --max-memory 16M is refused once the patches are counted" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+    ok "render --method classic --patches 3000 --max-memory 16M is refused once the patches are counted" ||
+    fail "render --method classic --patches 3000 --max-memory 16M is refused once the patches are counted" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+# without --method the plan takes virtual patches within the budget instead, and says so first
+"$RAD" render cornell --patches 3000 --max-memory 16M --size 8x8 --aa 1 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 0 ] && grep -q "no --method given: chose aavp at --vp-resolution [0-9]*" "$TMP/err.txt" &&
+    ok "render --patches 3000 --max-memory 16M without --method chooses aavp within the budget" ||
+    fail "render --patches 3000 --max-memory 16M without --method chooses aavp within the budget" "exit $rc: $(head -c 300 "$TMP/err.txt")"
 "$RAD" render cornell --patches 50 --max-memory 16M --size 8x8 --aa 1 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt" &&
     "$RAD" formfactors "$TMP/grid.obj" --patches 1 --max-memory 16M --force > /dev/null 2>> "$TMP/err.txt" &&
     ok "a build within --max-memory runs, and --force runs one beyond it" ||
