@@ -155,6 +155,8 @@ static int rooms_scene(uint32_t nx, uint32_t nz, rad_scene_desc *desc, rooms_geo
         g->mats[i].texture = 0;
         g->mats[i].two_sided = 0;
         g->mats[i].emission_texture = 0;
+        g->mats[i].opacity_texture = 0;
+        g->mats[i].alpha_cutoff = 0.0f;
     }
     for (r = 0; r < nz && ok; ++r) {
         float z0 = rooms__row_z(r), z1 = z0 + ROOMS_R, dz = z0 + 0.5f * ROOMS_R;

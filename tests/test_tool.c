@@ -349,6 +349,8 @@ static void test_trace_furnace(void)
             mats[f].texture = 0;
             mats[f].two_sided = 0;
             mats[f].emission_texture = 0;
+            mats[f].opacity_texture = 0;
+            mats[f].alpha_cutoff = 0.0f;
         }
     s = box_scene(mats);
     CHECK(s != NULL);
@@ -468,6 +470,8 @@ static void test_trace_vs_radiosity(void)
             mats[f].texture = 0;
             mats[f].two_sided = 0;
             mats[f].emission_texture = 0;
+            mats[f].opacity_texture = 0;
+            mats[f].alpha_cutoff = 0.0f;
         }
     s = box_scene(mats);
     CHECK(s != NULL);

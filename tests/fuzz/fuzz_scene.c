@@ -53,6 +53,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         mats[m].texture = 0;
         mats[m].two_sided = 0;
         mats[m].emission_texture = 0;
+        mats[m].opacity_texture = 0;
+        mats[m].alpha_cutoff = 0.0f;
     }
     for (m = 0; m < nm; ++m) {
         uint32_t nv = rd8(&r) % 49, nt = rd8(&r) % 33, use_ids = rd8(&r) & 1u;
