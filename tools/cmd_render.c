@@ -1437,7 +1437,8 @@ static void render_prepare(const char *cmd, const tool_world *w, render_args *ra
     if (!(ra->given & RENDER_GIVEN_CAMERA)) {
         if (w->file.has_camera) *cam = w->file.camera;
         else tool_choose_camera(cmd, w->scene, &w->rc, ra->view.width, ra->view.height, cam);
-    } else cam->fov_y_degrees = w->file.camera.fov_y_degrees;
+    } else /* --camera: the file's field of view, else 45 degrees, as rad trace takes it */
+        cam->fov_y_degrees = w->file.has_camera ? w->file.camera.fov_y_degrees : 45.0f;
     if (ra->fov > 0.0f) cam->fov_y_degrees = ra->fov;
 }
 
