@@ -3314,6 +3314,9 @@ typedef struct rad_baker_options {
     uint32_t light_samples;         /* shadow rays per area light and point (0: 16) */
     uint32_t lightmap_samples;      /* sub-points per texel (0: 4) */
     uint32_t seed;                  /* decorrelates the sampling (any value) */
+    uint32_t sky_bands;             /* SKY LAYERS (above): SH bands 0 .. sky_bands - 1 of the sky's
+                                       bounced light, sky_bands^2 layers (0: none; at most 4) */
+    uint32_t sky_rays;              /* sky layers: cosine rays per point (0: 64; at most 4096) */
 } rad_baker_options;
 
 /* What the plan chose, and why (PLAN above). */
@@ -3361,6 +3364,9 @@ typedef struct rad_baker_result {
     float probe_spacing;
     float *probes;                  /* 27 per probe */
     float *probe_layers;            /* group_count planes of 27 * probe_count */
+    uint32_t sky_count;             /* sky layers (sky_bands^2): planes group_count to group_count +
+                                       sky_count - 1 of vertex_layers, lightmap_layers and
+                                       probe_layers, after the groups' */
     rad_allocator allocator;        /* private */
     rad_baker_choice plan;          /* the whole plan (method, reason and estimates are also above) */
 } rad_baker_result;
@@ -3395,6 +3401,24 @@ RAD_API rad_result rad_baker_plan(const rad_scene *scene, const rad_raycaster *r
    1, the plain sum), finite. Errors: INVALID_ARGUMENT (NULL result), NON_FINITE (a scale).
    Cost: one pass over the layers whose scale is not 0 0 0, parallel through ctx. */
 RAD_API rad_result rad_baker_mix(rad_baker_result *result, const float *group_rgb, const rad_context *ctx);
+
+/* Rewrites the outputs as rad_baker_mix with the sky added: sum_g group_rgb[3g + c] layer_g +
+   sum_k sky_sh[3k + c] sky layer k (SKY LAYERS above). sky_sh: 3 sky_count floats, the sky's
+   radiance in SH, l_k = int L(w) Y_k(w) dw per channel (rad_sky_project_sh), finite; NULL: no
+   sky (as rad_baker_mix). group_rgb as rad_baker_mix's (NULL: all 1; pass zeros for a bake
+   whose groups should stay dark). Errors: INVALID_ARGUMENT (NULL result, or sky_sh given for a
+   result without sky layers), NON_FINITE (a scale or coefficient; the log names it). Cost: one
+   pass over the layers whose scale is not 0 0 0, parallel through ctx. */
+RAD_API rad_result rad_baker_mix_sky(rad_baker_result *result, const float *group_rgb, const float *sky_sh,
+                                     const rad_context *ctx);
+
+/* The SH coefficients of an environment map for rad_baker_mix_sky: l_k = int L(w) Y_k(w) dw
+   for the bands^2 real spherical harmonics of bands 0 .. bands - 1 (the basis and order of
+   RAD_SKY_BASIS_SH, >>api_skytransfer), summed over the map's pixels (centre direction, solid
+   angle), times 'scale' (RGB; NULL: 1): 3 bands^2 floats, coefficient k channel c at 3k + c.
+   A constant sky of radiance L gives l_0 = sqrt(4 pi) L and 0 else. Errors: INVALID_ARGUMENT
+   (NULL env or out, bands not 1 to 4), NON_FINITE (a scale). */
+RAD_API rad_result rad_sky_project_sh(const rad_environment *env, uint32_t bands, const float scale[3], float *out);
 
 /* The kernel of rad_baker_mix on any planar layers: out[i] = sum_g group_rgb[3g + i mod 3]
    layers[g count3 + i] for i < count3, the groups with scale 0 0 0 skipped (out is 0 when
@@ -3521,6 +3545,20 @@ RAD_API void rad_baker_runtime_destroy(rad_baker_runtime *runtime);
    OUT_OF_MEMORY. Thread safety: one thread at a time per runtime. */
 RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *runtime, const rad_light *lights, uint32_t light_count,
                                             double budget_ms, rad_baker_frame *out);
+
+/* GROUP SCALES: from the next update on, each light of group g (rad_baker_light.group) shines
+   with its colour times group_rgb[3g + c] and each emissive material of group g
+   (rad_baker_desc.material_groups) emits its emission times the same, as rad_baker_mix scales
+   the group's layer: with the baked lights, the outputs converge to rad_baker_mix's with these
+   scales (a dimmer, a colour, 0 to switch a group off, per frame). group_rgb: 3 group_count
+   floats (the result's groups), finite and >= 0; NULL: all 1 (as baked). An emitting group's
+   new scale is a new source, solved as a moved light is (classic: exact in that update;
+   virtual patches: temporal steps, then refinement); a light's scale shows in
+   rad_baker_frame.lights_changed. Errors: INVALID_ARGUMENT (NULL runtime), NON_FINITE (a
+   scale NaN or infinite), NEGATIVE_EMISSION (a scale < 0); on an error nothing changes.
+   Cost: O(group_count); the emitters' light per group was traced at create (12 N bytes per
+   emitting group). Thread safety: one thread at a time per runtime, as updates. */
+RAD_API rad_result rad_baker_runtime_set_groups(rad_baker_runtime *runtime, const float *group_rgb);
 
 /* The arrays the GLSL dispatch order above uploads (borrowed from the runtime; members for
    the other method are NULL): the virtual patches' set (its sparse F, albedo, grid) and alias
@@ -22702,6 +22740,7 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
    share cache sets, and eight streams and the output then evict each other (8 groups into
    1024 x 1024: 3.5 ms with 4 streams, 14 ms with 8) */
 #define RAD__BAKER_MIX_STREAMS 4u
+#define RAD__BAKER_MAX_PLANES (RAD_BAKER_MAX_GROUPS + 16u) /* the groups' layers and the sky's */
 
 /* The user's progress seen through one stage: fractions of the stage map onto [lo, hi] of
    the whole bake, and a cancel is remembered. */
@@ -22750,7 +22789,7 @@ static void rad__baker_mix_task(void *data, uint32_t index)
 {
     const rad__baker_mix_job *J = (const rad__baker_mix_job *)data;
     size_t b = (size_t)index * RAD__BAKER_MIX_CHUNK, e = b + RAD__BAKER_MIX_CHUNK, j;
-    const float *lay[RAD_BAKER_MAX_GROUPS], *sc[RAD_BAKER_MAX_GROUPS];
+    const float *lay[RAD__BAKER_MAX_PLANES], *sc[RAD__BAKER_MAX_PLANES];
     uint32_t g, g0, na = 0;
     float *o = J->out;
     if (e > J->count3) e = J->count3;
@@ -22799,28 +22838,24 @@ static void rad__baker_mix_task(void *data, uint32_t index)
     }
 }
 
-RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
-                                        float *out, const rad_context *ctx)
+/* rad_baker_mix_layers on up to RAD__BAKER_MAX_PLANES planes (the groups', then the sky's);
+   planes 0 writes zeros. */
+static rad_result rad__baker_mix_planes(const float *layers, uint32_t planes, size_t count3, const float *rgb, float *out,
+                                        const rad_context *ctx, rad__ctx *c)
 {
-    rad__ctx c;
     rad__baker_mix_job J;
-    float pattern[12 * RAD_BAKER_MAX_GROUPS];
-    uint8_t active[RAD_BAKER_MAX_GROUPS];
+    float pattern[12 * RAD__BAKER_MAX_PLANES];
+    uint8_t active[RAD__BAKER_MAX_PLANES];
     size_t tasks;
     uint32_t g;
     int k;
-    rad__ctx_init(&c, ctx);
-    if (!layers || !out || group_count == 0 || group_count > RAD_BAKER_MAX_GROUPS || count3 % 3u) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix_layers: NULL layers or out, %u groups (1 to %u), or %lu floats (not RGB)",
-                 group_count, RAD_BAKER_MAX_GROUPS, (unsigned long)count3);
-        return RAD_ERROR_INVALID_ARGUMENT;
-    }
-    for (g = 0; g < group_count; ++g) {
+    (void)ctx;
+    for (g = 0; g < planes; ++g) {
         active[g] = 0;
         for (k = 0; k < 12; ++k) {
-            float s = group_rgb ? group_rgb[3 * g + (uint32_t)(k % 3)] : 1.0f;
+            float s = rgb ? rgb[3 * g + (uint32_t)(k % 3)] : 1.0f;
             if (!rad__finite(s)) {
-                rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix: the scale of group %u is not finite", g);
+                rad__log(c, RAD_LOG_ERROR, "rad_baker_mix: the scale of layer %u is not finite", g);
                 return RAD_ERROR_NON_FINITE;
             }
             pattern[12 * g + (uint32_t)k] = s;
@@ -22828,31 +22863,77 @@ RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_coun
         }
     }
     if (count3 == 0) return RAD_SUCCESS;
+    if (planes == 0) {
+        memset(out, 0, count3 * sizeof(float));
+        return RAD_SUCCESS;
+    }
     J.layers = layers;
     J.out = out;
     J.count3 = count3;
-    J.groups = group_count;
+    J.groups = planes;
     J.pattern = pattern;
     J.active = active;
     tasks = (count3 + RAD__BAKER_MIX_CHUNK - 1) / RAD__BAKER_MIX_CHUNK;
     if (tasks > 0xFFFFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
     if (tasks == 1) rad__baker_mix_task(&J, 0);
-    else c.parallel_for(c.parallel_user, (uint32_t)tasks, rad__baker_mix_task, &J);
+    else c->parallel_for(c->parallel_user, (uint32_t)tasks, rad__baker_mix_task, &J);
     return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
+                                        float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    if (!layers || !out || group_count == 0 || group_count > RAD_BAKER_MAX_GROUPS || count3 % 3u) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix_layers: NULL layers or out, %u groups (1 to %u), or %lu floats (not RGB)",
+                 group_count, RAD_BAKER_MAX_GROUPS, (unsigned long)count3);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return rad__baker_mix_planes(layers, group_count, count3, group_rgb, out, ctx, &c);
+}
+
+RAD_API rad_result rad_baker_mix_sky(rad_baker_result *R, const float *group_rgb, const float *sky_sh, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_result r = RAD_SUCCESS;
+    float rgb[3 * RAD__BAKER_MAX_PLANES];
+    uint32_t G, K, i, planes;
+    rad__ctx_init(&c, ctx);
+    if (!R) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix: NULL result");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (sky_sh && R->sky_count == 0) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix_sky: sky coefficients for a bake without sky layers (bake with "
+                                    "rad_baker_options.sky_bands)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    G = R->group_count;
+    K = sky_sh ? R->sky_count : 0u;
+    for (i = 0; i < 3 * G; ++i) rgb[i] = group_rgb ? group_rgb[i] : 1.0f;
+    for (i = 0; i < 3 * K; ++i) {
+        if (!rad__finite(sky_sh[i])) {
+            rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix_sky: sky coefficient %u channel %u is not finite", i / 3, i % 3);
+            return RAD_ERROR_NON_FINITE;
+        }
+        rgb[3 * G + i] = sky_sh[i];
+    }
+    /* without a sky the sky planes (after the groups') are simply not read */
+    planes = G + K;
+    if (R->vertex_layers)
+        r = rad__baker_mix_planes(R->vertex_layers, planes, 3 * (size_t)R->vertex_count, rgb, R->vertex, ctx, &c);
+    if (r == RAD_SUCCESS && R->lightmap_layers)
+        r = rad__baker_mix_planes(R->lightmap_layers, planes, 3 * (size_t)R->lightmap_width * R->lightmap_height, rgb,
+                                  R->lightmap, ctx, &c);
+    if (r == RAD_SUCCESS && R->probe_layers)
+        r = rad__baker_mix_planes(R->probe_layers, planes, 27 * (size_t)R->probe_count, rgb, R->probes, ctx, &c);
+    return r;
 }
 
 RAD_API rad_result rad_baker_mix(rad_baker_result *R, const float *group_rgb, const rad_context *ctx)
 {
-    rad_result r = RAD_SUCCESS;
-    if (!R) return RAD_ERROR_INVALID_ARGUMENT;
-    if (R->vertex_layers)
-        r = rad_baker_mix_layers(R->vertex_layers, R->group_count, 3 * (size_t)R->vertex_count, group_rgb, R->vertex, ctx);
-    if (r == RAD_SUCCESS && R->lightmap_layers)
-        r = rad_baker_mix_layers(R->lightmap_layers, R->group_count, 3 * (size_t)R->lightmap_width * R->lightmap_height,
-                                 group_rgb, R->lightmap, ctx);
-    if (r == RAD_SUCCESS && R->probe_layers)
-        r = rad_baker_mix_layers(R->probe_layers, R->group_count, 27 * (size_t)R->probe_count, group_rgb, R->probes, ctx);
-    return r;
+    return rad_baker_mix_sky(R, group_rgb, NULL, ctx);
 }
 
 RAD_API void rad_baker_result_destroy(rad_baker_result *R)
@@ -22909,6 +22990,8 @@ typedef struct rad__baker {
     float *row_sums;               /* classic: S, the row sums of F */
     float *work;                   /* D, E, L, B, H (3N each) and the vertex values */
     uint8_t *group_emits;          /* per group: some emissive material is in it */
+    float *sky_T;                  /* sky layers: per patch (classic) or sample (virtual patches),
+                                      RAD__SKY_SH floats: int Y_k V cos dw */
     uint32_t emissive_groups;
     double outputs_bytes;
     uint32_t outputs;              /* rad_baker_desc.outputs, 0 made RAD_BAKER_VERTEX */
@@ -22929,6 +23012,7 @@ static void rad__baker_free(rad__baker *b)
     rad__free(a, b->row_sums);
     rad__free(a, b->work);
     rad__free(a, b->group_emits);
+    rad__free(a, b->sky_T);
 }
 
 static int rad__baker_emits(const rad_material *m)
@@ -22986,8 +23070,14 @@ static rad_result rad__baker_check(rad__baker *b)
         }
         if (g + 1 > groups) groups = g + 1;
     }
-    if (d->light_count == 0 && emitters == 0) {
-        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: nothing emits light (no lights and no material with emission > 0)");
+    if (b->o.sky_bands > 4 || b->o.sky_rays > 4096u) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: sky_bands %u (0 to 4) or sky_rays %u (at most 4096)", b->o.sky_bands,
+                 b->o.sky_rays);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (d->light_count == 0 && emitters == 0 && b->o.sky_bands == 0) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: nothing emits light (no lights, no material with emission > 0 and no "
+                                       "sky layers)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     for (i = 0; i < d->scene.mesh_count; ++i) lightmapped += d->scene.meshes[i].lightmap_uvs != NULL;
@@ -23004,6 +23094,7 @@ static rad_result rad__baker_check(rad__baker *b)
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     b->R->group_count = d->group_count ? d->group_count : groups;
+    b->R->sky_count = b->o.sky_bands * b->o.sky_bands;
     b->group_emits = (uint8_t *)rad__alloc_zero(&b->c.allocator, RAD_BAKER_MAX_GROUPS);
     if (!b->group_emits) return RAD_ERROR_OUT_OF_MEMORY;
     for (i = 0; i < d->scene.material_count; ++i)
@@ -23029,7 +23120,7 @@ static double rad__baker_output_bytes(const rad__baker *b, uint32_t probes)
         fixed += 30.0 * texels * (1.0 + (double)b->o.lightmap_samples);
     }
     if (b->outputs & RAD_BAKER_PROBES) per += 108.0 * (double)probes;
-    return per * ((double)b->R->group_count + 1.0) + fixed;
+    return per * ((double)b->R->group_count + b->R->sky_count + 1.0) + fixed;
 }
 
 /* ---- the plan (rad_baker_plan): the method, the resolution and the estimates ---- */
@@ -23065,6 +23156,7 @@ static void rad__baker_options_fill(rad_baker_options *o, const rad_baker_option
     if (!o->ff_samples) o->ff_samples = 16;
     if (!o->light_samples) o->light_samples = 16;
     if (!o->lightmap_samples) o->lightmap_samples = 4;
+    if (!o->sky_rays) o->sky_rays = 64;
 }
 
 /* The mean free path: the mean distance a cosine ray leaving the surface (points drawn by
@@ -23440,7 +23532,7 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
     rad_baker_result *R = b->R;
     const rad_allocator *a = &b->c.allocator;
     const rad_baker_desc *d = b->d;
-    size_t G = R->group_count, n;
+    size_t G = (size_t)R->group_count + R->sky_count, n;
     uint32_t m;
     R->mesh_count = d->scene.mesh_count;
     if (b->outputs & RAD_BAKER_VERTEX) {
@@ -23486,20 +23578,26 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
     return RAD_SUCCESS;
 }
 
-/* One group's layer: its source, the bounces, and each output from the solution. */
+#define RAD__SKY_SH 16u /* SH basis functions the sky transfer traces (bands 0..3) */
+/* The sky layers' transfer into b->sky_T (>>skytransfer, below). */
+static rad_result rad__baker_sky_transfer(rad__baker *b);
+
+/* One layer (plane g: a group's below group_count, sky basis function g - group_count
+   after): its source, the bounces, and each output from the solution. */
 static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi)
 {
     rad_baker_result *R = b->R;
     rad_scene view;
-    const rad_scene *Sg = rad__baker_group_scene(b, g, &view);
-    uint32_t nl = rad__baker_group_lights(b, g), n = R->patch_count, m;
+    int sky = g >= R->group_count;
+    const rad_scene *Sg = sky ? b->scene : rad__baker_group_scene(b, g, &view);
+    uint32_t nl = sky ? 0u : rad__baker_group_lights(b, g), n = R->patch_count, m, k = sky ? g - R->group_count : 0u;
     size_t i, N3 = 3 * (size_t)n;
     float *D = b->work, *E = D + N3, *L = E + N3, *B = L + N3, *H = B + N3, *V = H + N3;
     rad_direct_options dopt;
     rad_solve_options so;
     rad_system sys;
     rad_result r;
-    if (nl == 0 && !b->group_emits[g]) return RAD_SUCCESS; /* nothing in the group: a zero layer */
+    if (!sky && nl == 0 && !b->group_emits[g]) return RAD_SUCCESS; /* nothing in the group: a zero layer */
     /* the group's share of the progress: source 30%, bounces 20%, vertices 10%, lightmap 35% */
 #define RAD__BAKER_PART(a, z) if (rad__baker_stage(&b->prog, lo + (hi - lo) * (a), lo + (hi - lo) * (z))) return RAD_ERROR_CANCELLED
     RAD__BAKER_PART(0.0f, 0.3f);
@@ -23510,7 +23608,24 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     rad_solve_options_default(&so);
     so.bounces = b->o.bounces;
     so.output = RAD_OUTPUT_INDIRECT;
-    if (R->method == RAD_BAKER_CLASSIC) {
+    if (sky && !b->sky_T) {
+        r = rad__baker_sky_transfer(b);
+        if (r != RAD_SUCCESS) return r;
+    }
+    if (sky && R->method == RAD_BAKER_CLASSIC) {
+        /* E = rho D with D the patch's irradiance from Y_k (negative where Y_k is) */
+        for (i = 0; i < N3; ++i) E[i] = b->patches->albedo[i] * b->sky_T[RAD__SKY_SH * (i / 3) + k];
+        rad_system_init(&sys, &b->ff->matrix, b->patches, E);
+    } else if (sky) {
+        const rad_virtual_patches *vp = b->vp;
+        float *v = (float *)rad__alloc_array(&b->c.allocator, vp->sample_count, 3 * sizeof(float));
+        if (!v) return RAD_ERROR_OUT_OF_MEMORY;
+        for (i = 0; i < 3 * (size_t)vp->sample_count; ++i) v[i] = vp->sample_albedo[i] * b->sky_T[RAD__SKY_SH * (i / 3) + k];
+        r = rad_vp_from_samples(vp, v, E);
+        rad__free(&b->c.allocator, v);
+        if (r != RAD_SUCCESS) return r;
+        rad_vp_system(&sys, vp, E);
+    } else if (R->method == RAD_BAKER_CLASSIC) {
         rad_patches pg = *b->patches; /* the same patches seen on the group's scene view */
         pg.scene = Sg;
         r = rad_direct_patches(&pg, &b->rc, b->lights, nl, &dopt, D, &b->sub);
@@ -23619,8 +23734,9 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
         r = rad__baker_build(&b);
     }
     if (r == RAD_SUCCESS) r = rad__baker_alloc_outputs(&b);
-    for (g = 0; r == RAD_SUCCESS && g < b.R->group_count; ++g) {
-        float lo = 0.6f + 0.4f * (float)g / (float)b.R->group_count, hi = 0.6f + 0.4f * (float)(g + 1) / (float)b.R->group_count;
+    for (g = 0; r == RAD_SUCCESS && g < b.R->group_count + b.R->sky_count; ++g) {
+        float planes = (float)(b.R->group_count + b.R->sky_count);
+        float lo = 0.6f + 0.4f * (float)g / planes, hi = 0.6f + 0.4f * (float)(g + 1) / planes;
         r = rad__baker_group(&b, g, lo, hi);
     }
     if (r == RAD_SUCCESS) r = rad_baker_mix(b.R, NULL, &b.sub);
@@ -23650,7 +23766,14 @@ struct rad_baker_runtime {
     rad_baker_runtime_options o;
     rad_direct_options dopt;
     uint32_t bounces, n, light_count, mesh_count, any_emits, settle;
-    rad_light *lights;             /* the last update's */
+    rad_light *lights;             /* the last update's, each colour times its group's scale */
+    rad_light *eff;                /* this update's, scaled likewise */
+    uint32_t group_count, *light_group; /* the bake's groups, and each light's */
+    float *scale;                  /* 3 per group: rad_baker_runtime_set_groups's (1 at create) */
+    float *emit;                   /* per group with emitters, 3N: their direct light with scale 1
+                                      (classic: D; virtual patches: E), else NULL */
+    uint8_t *group_emits;          /* per group: some emissive material is in it */
+    int emit_dirty;                /* an emitting group's scale changed since the last solve */
     rad_scene *scene;
     rad_bvh *bvh;
     rad_raycaster rc;
@@ -23718,7 +23841,7 @@ RAD_API void rad_baker_runtime_destroy(rad_baker_runtime *rt)
             rad__free(&a, (void *)(uintptr_t)rt->meshes[m].positions);
         }
     {
-        void *blocks[] = { rt->lights, rt->row_sums, rt->pvertex, rt->meshes, rt->gather, rt->planes, rt->lmV, rt->dil_texel,
+        void *blocks[] = { rt->lights, rt->eff, rt->light_group, rt->scale, rt->emit, rt->group_emits, rt->row_sums, rt->pvertex, rt->meshes, rt->gather, rt->planes, rt->lmV, rt->dil_texel,
                            rt->dil_first, rt->dil_src, rt->vertex, rt->lightmap, rt->probe_out, rt->vertex_first, rt };
         rad__free_each(a, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
@@ -23888,12 +24011,27 @@ static rad_result rad__brt_fail(rad_baker_runtime *rt, rad_result r)
     return r;
 }
 
+/* x += sum_g scale_g o emit_g over the emitting groups, in group order (the emitters' part of
+   D for classic patches, of E for virtual patches) */
+static void rad__brt_add_emission(rad_baker_runtime *rt, float *x)
+{
+    size_t i, N3 = 3 * (size_t)rt->n;
+    uint32_t g;
+    if (!rt->emit) return;
+    for (g = 0; g < rt->group_count; ++g) {
+        const float *e = rt->emit + (size_t)g * N3, *s = rt->scale + 3 * (size_t)g;
+        if (!rt->group_emits[g]) continue;
+        for (i = 0; i < N3; ++i) x[i] += s[i % 3] * e[i];
+    }
+}
+
 /* The classic solution for 'lights': E, L = F_mb E, B, H = F B, built in the spare planes and
    swapped in at the end, so that an error leaves the state as it was. */
 static rad_result rad__brt_classic_solve(rad_baker_runtime *rt, const rad_light *lights)
 {
     size_t i;
     rad_result r = rad_direct_patches(rt->patches, &rt->rc, lights, rt->light_count, &rt->dopt, rt->tmp, &rt->sub);
+    if (r == RAD_SUCCESS) rad__brt_add_emission(rt, rt->tmp);
     if (r == RAD_SUCCESS) r = rad_sources(rt->patches, RAD_SOURCE_DIRECT, rt->tmp, rt->Ln);
     if (r == RAD_SUCCESS) r = rad_multibounce_apply(rt->mb, rt->Ln, rt->Hn, RAD_OUTPUT_INDIRECT, &rt->sub);
     if (r == RAD_SUCCESS) {
@@ -23984,7 +24122,7 @@ static rad_result rad__brt_alloc(rad_baker_runtime *rt, const rad_baker_desc *de
     if (!rt->lights) return RAD_ERROR_OUT_OF_MEMORY;
     for (i = 0; i < desc->light_count; ++i) memcpy(&rt->lights[i], &desc->lights[i].light, sizeof(rad_light));
     rad_direct_options_default(&rt->dopt);
-    rt->dopt.exclude_emitters = !rt->any_emits;
+    rt->dopt.exclude_emitters = 1; /* the emitters' light is added per group (rt->emit) */
     rt->dopt.light_samples = bo->light_samples;
     rt->dopt.seed = bo->seed;
 
@@ -24078,6 +24216,78 @@ static rad_result rad__brt_build_vp(rad_baker_runtime *rt, const rad_baker_desc 
     return RAD_SUCCESS;
 }
 
+/* the groups: each light's, the scales (1), and per group with emitters their direct light
+   alone, on a view of the scene whose materials emit only that group's light */
+static rad_result rad__brt_groups(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_result *R,
+                                 const rad__ctx *c)
+{
+    size_t N3 = 3 * (size_t)rt->n;
+    uint32_t i, g, G = R->group_count ? R->group_count : 1u;
+    rad_material *masked = NULL;
+    rad_result r = RAD_SUCCESS;
+    rt->group_count = R->group_count;
+    rt->eff = (rad_light *)rad__alloc_array(&c->allocator, desc->light_count ? desc->light_count : 1u, sizeof(rad_light));
+    rt->light_group = (uint32_t *)rad__alloc_array(&c->allocator, desc->light_count ? desc->light_count : 1u, sizeof(uint32_t));
+    rt->scale = (float *)rad__alloc_array(&c->allocator, G, 3 * sizeof(float));
+    rt->group_emits = (uint8_t *)rad__alloc_zero(&c->allocator, G);
+    if (!rt->eff || !rt->light_group || !rt->scale || !rt->group_emits) return RAD_ERROR_OUT_OF_MEMORY;
+    for (i = 0; i < 3 * G; ++i) rt->scale[i] = 1.0f;
+    for (i = 0; i < desc->light_count; ++i) {
+        rt->light_group[i] = desc->lights[i].group;
+        if (rt->light_group[i] >= G) {
+            rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: light %u is in group %u, the result has %u groups: not a "
+                                       "bake of this desc", i, rt->light_group[i], R->group_count);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    for (i = 0; i < rt->scene->material_count; ++i)
+        if (rad__baker_emits(&rt->scene->materials_table[i])) {
+            g = desc->material_groups ? desc->material_groups[i] : 0u;
+            if (g >= G) {
+                rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: emissive material %u is in group %u, the result has %u "
+                                           "groups: not a bake of this desc", i, g, R->group_count);
+                return RAD_ERROR_INVALID_ARGUMENT;
+            }
+            rt->group_emits[g] = 1;
+        }
+    if (!rt->any_emits) return RAD_SUCCESS;
+    rt->emit = (float *)rad__alloc_array(&c->allocator, (size_t)G * N3 + 1, sizeof(float));
+    masked = (rad_material *)rad__alloc_array(&c->allocator, rt->scene->material_count, sizeof(rad_material));
+    if (!rt->emit || !masked) r = RAD_ERROR_OUT_OF_MEMORY;
+    for (g = 0; r == RAD_SUCCESS && g < G; ++g) {
+        rad_scene view = *rt->scene;
+        rad_direct_options dopt = rt->dopt;
+        float *out = rt->emit + (size_t)g * N3;
+        if (!rt->group_emits[g]) continue;
+        for (i = 0; i < rt->scene->material_count; ++i) {
+            masked[i] = rt->scene->materials_table[i];
+            if ((desc->material_groups ? desc->material_groups[i] : 0u) != g)
+                masked[i].emission[0] = masked[i].emission[1] = masked[i].emission[2] = 0.0f;
+        }
+        view.materials_table = masked;
+        dopt.exclude_emitters = 0;
+        if (rt->method == RAD_BAKER_CLASSIC) {
+            rad_patches pg = *rt->patches;
+            pg.scene = &view;
+            r = rad_direct_patches(&pg, &rt->rc, rt->lights, 0, &dopt, out, &rt->sub);
+        } else {
+            const rad_virtual_patches *vp = rt->vp;
+            float *v = (float *)rad__alloc_array(&c->allocator, vp->sample_count, 3 * sizeof(float));
+            size_t k;
+            r = v ? rad_direct_irradiance(&view, &rt->rc, rt->lights, 0, &dopt, vp->sample_positions, vp->sample_normals,
+                                          vp->sample_count, v, &rt->sub)
+                  : RAD_ERROR_OUT_OF_MEMORY;
+            if (r == RAD_SUCCESS) {
+                for (k = 0; k < 3 * (size_t)vp->sample_count; ++k) v[k] *= vp->sample_albedo[k];
+                r = rad_vp_from_samples(vp, v, out);
+            }
+            rad__free(&c->allocator, v);
+        }
+    }
+    rad__free(&c->allocator, masked);
+    return r;
+}
+
 /* the fifth stage: the eight solution planes, and the solution for the baked lights in them,
    the state every later frame starts from */
 static rad_result rad__brt_solve(rad_baker_runtime *rt, const rad_baker_result *R, const rad__ctx *c)
@@ -24095,6 +24305,7 @@ static rad_result rad__brt_solve(rad_baker_runtime *rt, const rad_baker_result *
         r = rad__brt_classic_solve(rt, rt->lights);
     } else {
         r = rad_vp_lights_update(rt->vpl, rt->lights, rt->light_count, rt->E, &rt->sub);
+        if (r == RAD_SUCCESS) rad__brt_add_emission(rt, rt->E);
         rt->sweeps = 0;
         while (r == RAD_SUCCESS && rt->sweeps <= rt->bounces) {
             rad__brt_sweep_start(rt);
@@ -24235,6 +24446,7 @@ RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const ra
     if (r == RAD_SUCCESS) r = rad__brt_alloc(rt, desc, &bo, &c0);
     if (r == RAD_SUCCESS)
         r = R->method == RAD_BAKER_CLASSIC ? rad__brt_build_classic(rt, R, &bo, &c0) : rad__brt_build_vp(rt, desc, R, &c0);
+    if (r == RAD_SUCCESS) r = rad__brt_groups(rt, desc, R, &c0);
     if (r == RAD_SUCCESS) r = rad__brt_solve(rt, R, &c0);
     /* outputs: the bake's layers at scale 1, and what refreshes each */
     if (r == RAD_SUCCESS && R->vertex) r = rad__brt_out_vertex(rt, desc, R, &c0);
@@ -24305,7 +24517,7 @@ RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *rt, const rad_lig
     rad_result r;
     uint32_t i, changed = 0, h_changed = 0, lm_rows, n;
     double units, used = 0.0, lm_cost = 0.0, pr_cost = 0.0;
-    int limited = budget_ms > 0.0;
+    int limited = budget_ms > 0.0, moved;
     if (!rt) return RAD_ERROR_INVALID_ARGUMENT;
     memset(&f, 0, sizeof f);
     if (light_count != rt->light_count) {
@@ -24319,26 +24531,34 @@ RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *rt, const rad_lig
     }
     r = rad__brt_check_lights(&rt->c, lights, light_count);
     if (r != RAD_SUCCESS) return r;
-    for (i = 0; i < light_count; ++i) changed += memcmp(&lights[i], &rt->lights[i], sizeof(rad_light)) != 0;
+    for (i = 0; i < light_count; ++i) {
+        const float *s = rt->scale + 3 * (size_t)rt->light_group[i];
+        int k;
+        rt->eff[i] = lights[i];
+        for (k = 0; k < 3; ++k) rt->eff[i].color[k] = lights[i].color[k] * s[k];
+        changed += memcmp(&rt->eff[i], &rt->lights[i], sizeof(rad_light)) != 0;
+    }
+    moved = changed || rt->emit_dirty;
     units = budget_ms * rt->o.work_per_ms;
     lm_rows = rt->lw ? rt->lw->row_count : 0u;
     if (rt->lw) lm_cost = 3.0 * ((double)rt->lw->row_first[lm_rows] + rt->lw->vertex_first[rt->lw->vertex_count] + lm_rows);
     if (rt->probes) pr_cost = 27.0 * (double)rad_probes_entry_count(rt->probes) + 27.0 * rt->probe_count;
 
     if (rt->method == RAD_BAKER_CLASSIC) {
-        if (changed) {
+        if (moved) {
             /* exact in one frame */
-            r = rad__brt_classic_solve(rt, lights);
+            r = rad__brt_classic_solve(rt, rt->eff);
             if (r != RAD_SUCCESS) return r;
             f.shadow_rays = (uint64_t)rt->n * rt->dopt.light_samples * light_count;
             used += RAD__BRT_RAY * (double)f.shadow_rays + 9.0 * (double)rt->nnz;
             h_changed = 1;
             f.phase = RAD_BAKER_RUNTIME_EXACT;
         }
-    } else if (changed || rt->rest < rt->settle) {
+    } else if (moved || rt->rest < rt->settle) {
         /* moving, or the shadows of a light at rest still settling: a temporal frame */
-        r = rad_vp_lights_update(rt->vpl, lights, light_count, rt->tmp, &rt->sub);
+        r = rad_vp_lights_update(rt->vpl, rt->eff, light_count, rt->tmp, &rt->sub);
         if (r != RAD_SUCCESS) return r;
+        rad__brt_add_emission(rt, rt->tmp);
         f.shadow_rays = rad_vp_lights_rays(rt->vpl);
         r = rad_temporal_step(rt->temporal, rt->tmp, NULL, rt->Ln);
         if (r != RAD_SUCCESS) return r;
@@ -24359,7 +24579,7 @@ RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *rt, const rad_lig
         }
         used += RAD__BRT_RAY * (double)f.shadow_rays + 6.0 * rt->vp->sample_count * (light_count + 1.0) +
                 RAD__BRT_DRAW * (double)rt->n * rt->o.temporal_samples + 6.0 * rt->n;
-        rt->rest = changed ? 1u : rt->rest + 1u;
+        rt->rest = moved ? 1u : rt->rest + 1u;
         rt->sweeps = 0;
         rt->sweep_row = 0;
         h_changed = 1;
@@ -24394,7 +24614,8 @@ RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *rt, const rad_lig
         }
         h_changed = rt->sweeps > rt->bounces; /* the new solution is out */
     }
-    memcpy(rt->lights, lights, sizeof(rad_light) * light_count);
+    memcpy(rt->lights, rt->eff, sizeof(rad_light) * light_count);
+    rt->emit_dirty = 0;
 
     /* the outputs: vertex in full, lightmap and probe rows round-robin */
     if (h_changed) {
@@ -24446,6 +24667,31 @@ RAD_API rad_result rad_baker_runtime_update(rad_baker_runtime *rt, const rad_lig
     f.lightmap = rt->lightmap;
     f.probes = rt->probe_out;
     if (out) *out = f;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_runtime_set_groups(rad_baker_runtime *rt, const float *group_rgb)
+{
+    uint32_t i, G;
+    if (!rt) return RAD_ERROR_INVALID_ARGUMENT;
+    G = rt->group_count ? rt->group_count : 1u;
+    for (i = 0; group_rgb && i < 3 * rt->group_count; ++i) {
+        if (!rad__finite(group_rgb[i])) {
+            rad__log(&rt->c, RAD_LOG_ERROR, "rad_baker_runtime_set_groups: the scale of group %u channel %u is not finite", i / 3,
+                     i % 3);
+            return RAD_ERROR_NON_FINITE;
+        }
+        if (group_rgb[i] < 0.0f) {
+            rad__log(&rt->c, RAD_LOG_ERROR, "rad_baker_runtime_set_groups: the scale of group %u channel %u is negative "
+                                            "(%g): lights cannot take light away", i / 3, i % 3, (double)group_rgb[i]);
+            return RAD_ERROR_NEGATIVE_EMISSION;
+        }
+    }
+    for (i = 0; i < 3 * G; ++i) {
+        float s = group_rgb && i < 3 * rt->group_count ? group_rgb[i] : 1.0f;
+        if (s != rt->scale[i] && rt->group_emits[i / 3]) rt->emit_dirty = 1;
+        rt->scale[i] = s;
+    }
     return RAD_SUCCESS;
 }
 
@@ -24577,6 +24823,117 @@ static rad_result rad__st_row(void *data, uint32_t row, uint32_t task)
     }
     /* int Y V cos dw = pi E[Y V] over cosine-distributed directions */
     for (k = 0; k < j->K; ++k) j->T[(size_t)j->K * row + k] = (float)(RAD__PI * acc[k] / ((double)S * R));
+    return RAD_SUCCESS;
+}
+
+/* The sky layers' T at virtual-patch samples: one point each (the sample, its unit normal),
+   o.rays cosine rays, as rad__st_row does per lattice point. */
+typedef struct rad__st_points {
+    const float *pos, *nrm;
+    const rad_raycaster *rc;
+    uint32_t rays, seed;
+    float eps;
+    rad_ray *buf;              /* rays per task */
+    uint8_t *occ;
+    float *T;                  /* RAD__SKY_SH per point */
+} rad__st_points;
+
+static rad_result rad__st_point_row(void *data, uint32_t row, uint32_t task)
+{
+    rad__st_points *j = (rad__st_points *)data;
+    rad_ray *rays = j->buf + (size_t)task * j->rays;
+    uint8_t *occ = j->occ + (size_t)task * j->rays;
+    double acc[RAD__SKY_SH];
+    float n[3], t1[3], t2[3], len;
+    uint32_t r, k, h = rad__hash(j->seed ^ rad__hash(row * 0x9E3779B9u + 0x51u));
+    int c;
+    for (c = 0; c < 3; ++c) n[c] = j->nrm[3 * (size_t)row + (size_t)c];
+    len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (k = 0; k < RAD__SKY_SH; ++k) acc[k] = 0.0;
+    if (!(len > 0.0f)) { /* a degenerate sample sees no sky */
+        for (k = 0; k < RAD__SKY_SH; ++k) j->T[RAD__SKY_SH * (size_t)row + k] = 0.0f;
+        return RAD_SUCCESS;
+    }
+    for (c = 0; c < 3; ++c) n[c] /= len;
+    rad__tangent_frame(n, t1, t2);
+    for (r = 0; r < j->rays; ++r) {
+        rad__cosine_dir(n, t1, t2, r, j->rays, h, rays[r].dir);
+        for (c = 0; c < 3; ++c) rays[r].origin[c] = j->pos[3 * (size_t)row + (size_t)c] + n[c] * j->eps;
+        rays[r].tmin = 0.0f;
+        rays[r].tmax = FLT_MAX;
+    }
+    if (j->rc->occluded(j->rc->user, rays, j->rays, occ) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
+    for (r = 0; r < j->rays; ++r) {
+        float y[16];
+        if (occ[r]) continue;
+        rad__sky_sh(rays[r].dir, y);
+        for (k = 0; k < RAD__SKY_SH; ++k) acc[k] += (double)y[k];
+    }
+    for (k = 0; k < RAD__SKY_SH; ++k) j->T[RAD__SKY_SH * (size_t)row + k] = (float)(RAD__PI * acc[k] / (double)j->rays);
+    return RAD_SUCCESS;
+}
+
+/* The sky layers' source (SKY LAYERS in >>api_bake): T_k = int Y_k V cos dw, the mean over a
+   classic patch's 16 lattice points (rad__st_row) or at each virtual-patch sample. */
+static rad_result rad__baker_sky_transfer(rad__baker *b)
+{
+    uint32_t count = b->R->method == RAD_BAKER_CLASSIC ? b->patches->count : b->vp->sample_count, T;
+    float eps = 1e-5f * b->scene->diagonal;
+    rad_result r;
+    T = b->c.tasks < count ? b->c.tasks : count;
+    if (T == 0) T = 1;
+    b->sky_T = (float *)rad__alloc_array(&b->c.allocator, (size_t)count + 1, RAD__SKY_SH * sizeof(float));
+    if (!b->sky_T) return RAD_ERROR_OUT_OF_MEMORY;
+    if (b->R->method == RAD_BAKER_CLASSIC) {
+        rad__st_job j;
+        memset(&j, 0, sizeof j);
+        j.o.basis = RAD_SKY_BASIS_SH;
+        j.o.samples = 16;
+        j.o.rays = b->o.sky_rays;
+        j.o.seed = b->o.seed;
+        j.K = RAD__SKY_SH;
+        j.P = b->patches, j.rc = &b->rc, j.eps = eps, j.T = b->sky_T;
+        j.rays = (rad_ray *)rad__alloc_array(&b->c.allocator, (size_t)T * j.o.samples * j.o.rays, sizeof(rad_ray));
+        j.occ = (uint8_t *)rad__alloc_array(&b->c.allocator, (size_t)T * j.o.samples * j.o.rays, 1);
+        r = j.rays && j.occ ? rad__for_rows(&b->c, count, T, rad__st_row, &j) : RAD_ERROR_OUT_OF_MEMORY;
+        rad__free(&b->c.allocator, j.rays);
+        rad__free(&b->c.allocator, j.occ);
+    } else {
+        rad__st_points j;
+        j.pos = b->vp->sample_positions, j.nrm = b->vp->sample_normals, j.rc = &b->rc;
+        j.rays = b->o.sky_rays, j.seed = b->o.seed, j.eps = eps, j.T = b->sky_T;
+        j.buf = (rad_ray *)rad__alloc_array(&b->c.allocator, (size_t)T * j.rays, sizeof(rad_ray));
+        j.occ = (uint8_t *)rad__alloc_array(&b->c.allocator, (size_t)T * j.rays, 1);
+        r = j.buf && j.occ ? rad__for_rows(&b->c, count, T, rad__st_point_row, &j) : RAD_ERROR_OUT_OF_MEMORY;
+        rad__free(&b->c.allocator, j.buf);
+        rad__free(&b->c.allocator, j.occ);
+    }
+    return r;
+}
+
+RAD_API rad_result rad_sky_project_sh(const rad_environment *e, uint32_t bands, const float scale[3], float *out)
+{
+    double acc[3 * RAD__SKY_SH];
+    uint32_t i, j, k, K;
+    int ch;
+    if (!e || !out || bands < 1 || bands > 4) return RAD_ERROR_INVALID_ARGUMENT;
+    if (scale && !(rad__finite(scale[0]) && rad__finite(scale[1]) && rad__finite(scale[2]))) return RAD_ERROR_NON_FINITE;
+    K = bands * bands;
+    memset(acc, 0, sizeof acc);
+    for (i = 0; i < e->h; ++i) {
+        double th = RAD__PI * ((double)i + 0.5) / (double)e->h;
+        double dw = 2.0 * RAD__PI / (double)e->w * ((double)e->cos_edge[i] - (double)e->cos_edge[i + 1]);
+        for (j = 0; j < e->w; ++j) {
+            double ph = 2.0 * RAD__PI * ((double)j + 0.5) / (double)e->w + (double)e->rotation;
+            float d[3], y[16], rgb[3];
+            d[0] = (float)(sin(th) * cos(ph)), d[1] = (float)cos(th), d[2] = (float)(sin(th) * sin(ph));
+            rad_environment_radiance(e, d, rgb);
+            rad__sky_sh(d, y);
+            for (k = 0; k < K; ++k)
+                for (ch = 0; ch < 3; ++ch) acc[3 * k + (uint32_t)ch] += (double)y[k] * rgb[ch] * dw;
+        }
+    }
+    for (k = 0; k < 3u * K; ++k) out[k] = (float)(acc[k] * (scale ? (double)scale[k % 3u] : 1.0));
     return RAD_SUCCESS;
 }
 
