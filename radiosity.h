@@ -3261,6 +3261,22 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    rad_baker_mix writes the outputs as sum_g scale_g o layer_g for any RGB scale per group (a
    dimmer, a colour, 0 to switch a group off), at memory speed, without a new bake; a group's
    layer equals the layer of a bake with only that group's lights and emitters, bit for bit.
+   SKY LAYERS (rad_baker_options.sky_bands = b, 1 to 4): the bounced light of a sky that
+   changes (time of day) without a re-bake. With the sky's radiance L(w) ~ sum_k l_k Y_k(w) over
+   the b^2 real spherical harmonics of bands 0 .. b - 1 (RAD_SKY_BASIS_SH's basis and order,
+   >>api_skytransfer), each basis function is one more layer: its source at a point is
+   D_k = int Y_k(w) V(w) cos dw (V: 1 where the ray escapes; 'sky_rays' cosine rays from each
+   of a classic patch's 16 lattice points, or from each virtual-patch sample), E = rho D_k
+   (negative where Y_k is: the system is linear), then the same bounces and outputs as a
+   group's. The planes follow the groups' (plane group_count + k; sky_count = b^2), each
+   equal to a sky-only bake's bit for bit. rad_baker_mix_sky takes the groups' scales and the
+   sky's coefficients l_k (RGB; rad_sky_project_sh projects a map) and writes every output in
+   one pass; rad_baker_run's outputs and rad_baker_mix leave the sky out (coefficients 0). Two
+   bands hold a constant and a linear gradient sky exactly (the test: within 0.5% of a bake
+   with that sky as an ordinary light, the noise of both); a sharper sky loses its detail above
+   band b - 1 (docs/methods/environment.md), and a sun is a light of a group. A bake may hold
+   only the sky (no lights, no emitters: group_count 0). Memory: b^2 more layers. The runtime
+   (>>api_bake_runtime) does not carry the sky layers.
    PROGRESS AND CANCEL. ctx->progress sees one fraction over the whole bake (build about 60%,
    then the groups); a non-zero return stops the bake with RAD_ERROR_CANCELLED and frees
    everything. Deterministic: the same bits whatever the thread count. */
@@ -3373,8 +3389,8 @@ typedef struct rad_baker_result {
 
 /* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
    result. Errors (the logger names the cause): INVALID_ARGUMENT (NULL, an unknown method or
-   output bit, a group >= RAD_BAKER_MAX_GROUPS or >= group_count, nothing that emits: no light
-   and no emissive material, a lightmap without any lightmap_uvs, a negative or non-finite
+   output bit, a group >= RAD_BAKER_MAX_GROUPS or >= group_count, nothing that emits: no light,
+   no emissive material and no sky layers, sky_bands above 4 or sky_rays above 4096, a lightmap without any lightmap_uvs, a negative or non-finite
    budget), the scene's errors (rad_scene_create: a bad mesh, material or value), the lights'
    (rad_direct_irradiance), OUT_OF_MEMORY (also: the budget is too small for the smallest bake
    of the method, or an allocation failed), CANCELLED, RAYCAST_FAILED. Thread safety:
@@ -3433,7 +3449,8 @@ RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_coun
    bake.md, "Run time"): the layers of rad_baker_mix rescale the light a bake saw, but a light
    at a new place needs a new direct term and new bounces. rad_baker_runtime_update takes the
    lights of this frame (the same count and order as rad_baker_desc.lights, each at any new
-   place, direction, colour or cone; the emissive materials stay as baked) and refreshes the
+   place, direction, colour or cone; the emissive materials as baked, each group's lights and
+   emitters times the scale rad_baker_runtime_set_groups gave it) and refreshes the
    vertex light, the lightmap and the probes (those the bake made, in its layouts: outputs of
    all groups at scale 1, as rad_baker_mix with NULL) within a budget in milliseconds.
    CLASSIC (the bake chose classic patches): create rebuilds the patches and F as the bake did
