@@ -3277,6 +3277,14 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    band b - 1 (docs/methods/environment.md), and a sun is a light of a group. A bake may hold
    only the sky (no lights, no emitters: group_count 0). Memory: b^2 more layers. The runtime
    (>>api_bake_runtime) does not carry the sky layers.
+   KEEP (rad_baker_options.keep): the bake's solver objects stay in the result (the scene and
+   its BVH, the patches and F or the virtual patches, the lightmap's texels, the probes'
+   weights) instead of being freed (a runtime is meant to follow), and rad_baker_runtime_create BORROWS them rather than
+   building them again, so the result must outlive the runtimes made from it. Virtual patches
+   are then built with sparse rows (RAD_STORAGE_SPARSE, what the runtime needs: the outputs
+   may differ from a bake without keep by float rounding, 7e-8 in the test; 8 bytes per
+   non-zero instead of 4 N^2 in all). rad_baker_result_destroy frees them. Memory: what the build held, for the result's
+   life.
    PROGRESS AND CANCEL. ctx->progress sees one fraction over the whole bake (build about 60%,
    then the groups); a non-zero return stops the bake with RAD_ERROR_CANCELLED and frees
    everything. Deterministic: the same bits whatever the thread count. */
@@ -3333,7 +3341,12 @@ typedef struct rad_baker_options {
     uint32_t sky_bands;             /* SKY LAYERS (above): SH bands 0 .. sky_bands - 1 of the sky's
                                        bounced light, sky_bands^2 layers (0: none; at most 4) */
     uint32_t sky_rays;              /* sky layers: cosine rays per point (0: 64; at most 4096) */
+    int keep;                       /* non-zero: the result keeps the solver objects for
+                                       rad_baker_runtime_create (KEEP above) */
 } rad_baker_options;
+
+/* What rad_baker_options.keep keeps (private). */
+typedef struct rad_baker_kept rad_baker_kept;
 
 /* What the plan chose, and why (PLAN above). */
 typedef struct rad_baker_choice {
@@ -3383,6 +3396,7 @@ typedef struct rad_baker_result {
     uint32_t sky_count;             /* sky layers (sky_bands^2): planes group_count to group_count +
                                        sky_count - 1 of vertex_layers, lightmap_layers and
                                        probe_layers, after the groups' */
+    rad_baker_kept *kept;           /* private: the solver objects (options.keep), else NULL */
     rad_allocator allocator;        /* private */
     rad_baker_choice plan;          /* the whole plan (method, reason and estimates are also above) */
 } rad_baker_result;
@@ -3547,7 +3561,11 @@ RAD_API void rad_baker_runtime_options_default(rad_baker_runtime_options *option
    logger must outlive the runtime). Errors: INVALID_ARGUMENT (NULL, a result of another desc
    or options: its method, patch count or output sizes differ; bad options; more than
    RAD_VP_LIGHTS_MAX lights over virtual patches), those of rad_baker_run's build, OUT_OF_
-   MEMORY. Cost: the bake's build (F or the set, texels, probes) plus 'bounces' + 1 sweeps. */
+   MEMORY. Cost: the bake's build (F or the set, texels, probes) plus 'bounces' + 1 sweeps;
+   for a result baked with rad_baker_options.keep (KEEP in >>api_bake) the scene, BVH,
+   patches and F or virtual patches, texels and probes' weights are BORROWED from the result
+   (which must then outlive the runtime), leaving the multi-bounce matrix or the alias tables,
+   the lights' visibility, the gather tables and the lightmap weights to build. */
 RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const rad_baker_options *bake_options,
                                             const rad_baker_result *result, const rad_baker_runtime_options *options,
                                             const rad_context *ctx, rad_baker_runtime **out);
@@ -22953,11 +22971,31 @@ RAD_API rad_result rad_baker_mix(rad_baker_result *R, const float *group_rgb, co
     return rad_baker_mix_sky(R, group_rgb, NULL, ctx);
 }
 
+struct rad_baker_kept {
+    rad_scene *scene;
+    rad_bvh *bvh;
+    rad_patches *patches;          /* classic */
+    rad_form_factors *ff;
+    rad_virtual_patches *vp;       /* virtual patches (sparse rows) */
+    rad_lightmap *lm;              /* NULL without a lightmap */
+    rad_probes *probes;            /* NULL without probes */
+};
+
 RAD_API void rad_baker_result_destroy(rad_baker_result *R)
 {
     rad_allocator a;
     if (!R) return;
     a = R->allocator;
+    if (R->kept) {
+        rad_probes_destroy(R->kept->probes);
+        rad_lightmap_destroy(R->kept->lm);
+        rad_vp_destroy(R->kept->vp);
+        rad_form_factors_destroy(R->kept->ff);
+        rad_patches_destroy(R->kept->patches);
+        rad_bvh_destroy(R->kept->bvh);
+        rad_scene_destroy(R->kept->scene);
+        rad__free(&a, R->kept);
+    }
     rad__free(&a, R->vertex_first);
     rad__free(&a, R->vertex);
     rad__free(&a, R->vertex_layers);
@@ -23508,6 +23546,7 @@ static rad_result rad__baker_build(rad__baker *b)
         rad_vp_options vo;
         rad_vp_options_default(&vo);
         vo.resolution = R->vp_resolution;
+        if (b->o.keep) vo.storage = RAD_STORAGE_SPARSE; /* the runtime's rows */
         r = rad_vp_create(b->scene, &b->rc, &vo, &b->sub, &b->vp);
         if (r != RAD_SUCCESS) return r;
         n = b->vp->count;
@@ -23759,6 +23798,18 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
     if (r == RAD_SUCCESS) r = rad_baker_mix(b.R, NULL, &b.sub);
     if (r == RAD_SUCCESS && b.prog.fn && b.prog.fn(b.prog.user, 1.0f)) r = RAD_ERROR_CANCELLED;
     if (r != RAD_SUCCESS && b.prog.cancelled) r = RAD_ERROR_CANCELLED;
+    if (r == RAD_SUCCESS && b.o.keep) {
+        /* the solver objects move into the result (KEEP in >>api_bake) */
+        rad_baker_kept *k = (rad_baker_kept *)rad__alloc_zero(&b.c.allocator, sizeof *k);
+        if (!k) {
+            r = RAD_ERROR_OUT_OF_MEMORY;
+        } else {
+            k->scene = b.scene, k->bvh = b.bvh, k->patches = b.patches, k->ff = b.ff, k->vp = b.vp, k->lm = b.lm;
+            k->probes = b.probes;
+            b.scene = NULL, b.bvh = NULL, b.patches = NULL, b.ff = NULL, b.vp = NULL, b.lm = NULL, b.probes = NULL;
+            b.R->kept = k;
+        }
+    }
     rad__baker_free(&b);
     if (r != RAD_SUCCESS) {
         if (r == RAD_ERROR_CANCELLED) rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: cancelled by the progress callback");
@@ -23791,6 +23842,8 @@ struct rad_baker_runtime {
                                       (classic: D; virtual patches: E), else NULL */
     uint8_t *group_emits;          /* per group: some emissive material is in it */
     int emit_dirty;                /* an emitting group's scale changed since the last solve */
+    const rad_baker_kept *kept;    /* the result's solver objects, borrowed (during create only) */
+    rad_baker_kept borrowed;       /* which of ours are the result's (never freed here) */
     rad_scene *scene;
     rad_bvh *bvh;
     rad_raycaster rc;
@@ -23838,6 +23891,14 @@ RAD_API void rad_baker_runtime_destroy(rad_baker_runtime *rt)
     uint32_t m;
     if (!rt) return;
     a = rt->c.allocator;
+    /* borrowed from the result: not ours to free */
+    if (rt->probes == rt->borrowed.probes) rt->probes = NULL;
+    if (rt->lm == rt->borrowed.lm) rt->lm = NULL;
+    if (rt->vp == rt->borrowed.vp) rt->vp = NULL;
+    if (rt->ff == rt->borrowed.ff) rt->ff = NULL;
+    if (rt->patches == rt->borrowed.patches) rt->patches = NULL;
+    if (rt->bvh == rt->borrowed.bvh) rt->bvh = NULL;
+    if (rt->scene == rt->borrowed.scene) rt->scene = NULL;
     rad_probes_destroy(rt->probes);
     rad_lightmap_weights_destroy(rt->lw);
     rad_lightmap_destroy(rt->lm);
@@ -24143,8 +24204,13 @@ static rad_result rad__brt_alloc(rad_baker_runtime *rt, const rad_baker_desc *de
     rt->dopt.light_samples = bo->light_samples;
     rt->dopt.seed = bo->seed;
 
-    r = rad_scene_create(&desc->scene, &rt->sub, &rt->scene);
-    if (r == RAD_SUCCESS) r = rad_bvh_create(rt->scene, &rt->sub, &rt->bvh);
+    if (rt->kept) {
+        rt->scene = rt->kept->scene, rt->bvh = rt->kept->bvh;
+        r = RAD_SUCCESS;
+    } else {
+        r = rad_scene_create(&desc->scene, &rt->sub, &rt->scene);
+        if (r == RAD_SUCCESS) r = rad_bvh_create(rt->scene, &rt->sub, &rt->bvh);
+    }
     if (r != RAD_SUCCESS) return r;
     rad_bvh_raycaster(rt->bvh, &rt->rc);
     return RAD_SUCCESS;
@@ -24164,13 +24230,15 @@ static rad_result rad__brt_build_classic(rad_baker_runtime *rt, const rad_baker_
     rad_form_factor_options_default(&fo);
     fo.samples = bo->ff_samples;
     fo.seed = bo->seed;
-    r = rad_patches_create(rt->scene, &po, &rt->sub, &rt->patches);
+    if (rt->kept && rt->kept->patches && rt->kept->ff) rt->patches = rt->kept->patches, r = RAD_SUCCESS;
+    else r = rad_patches_create(rt->scene, &po, &rt->sub, &rt->patches);
     if (r == RAD_SUCCESS && rt->patches->count != R->patch_count) {
         rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: %u patches, the result has %u: other bake options",
                  rt->patches->count, R->patch_count);
         r = RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (r == RAD_SUCCESS) r = rad_form_factors_dense(rt->patches, &rt->rc, &fo, &rt->sub, &rt->ff);
+    if (r == RAD_SUCCESS && rt->patches == (rt->kept ? rt->kept->patches : NULL)) rt->ff = rt->kept->ff;
+    else if (r == RAD_SUCCESS) r = rad_form_factors_dense(rt->patches, &rt->rc, &fo, &rt->sub, &rt->ff);
     if (r == RAD_SUCCESS) {
         memset(&mo, 0, sizeof mo);
         mo.bounces = bo->bounces;
@@ -24196,7 +24264,8 @@ static rad_result rad__brt_build_vp(rad_baker_runtime *rt, const rad_baker_desc 
     rad_vp_options_default(&vo);
     vo.resolution = R->vp_resolution;
     vo.storage = RAD_STORAGE_SPARSE;
-    r = rad_vp_create(rt->scene, &rt->rc, &vo, &rt->sub, &rt->vp);
+    if (rt->kept && rt->kept->vp && rt->kept->vp->matrix.storage == RAD_STORAGE_SPARSE) rt->vp = rt->kept->vp, r = RAD_SUCCESS;
+    else r = rad_vp_create(rt->scene, &rt->rc, &vo, &rt->sub, &rt->vp);
     if (r == RAD_SUCCESS && rt->vp->count != R->patch_count) {
         rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: %u virtual patches, the result has %u: other bake options",
                  rt->vp->count, R->patch_count);
@@ -24407,7 +24476,8 @@ static rad_result rad__brt_out_lightmap(rad_baker_runtime *rt, const rad_baker_r
     lo.height = R->lightmap_height;
     lo.samples = bo->lightmap_samples;
     lo.seed = bo->seed;
-    if (r == RAD_SUCCESS) r = rad_lightmap_create(rt->scene, &rt->rc, &lo, &rt->sub, &rt->lm);
+    if (r == RAD_SUCCESS && rt->kept && rt->kept->lm) rt->lm = rt->kept->lm;
+    else if (r == RAD_SUCCESS) r = rad_lightmap_create(rt->scene, &rt->rc, &lo, &rt->sub, &rt->lm);
     if (r == RAD_SUCCESS)
         r = R->method == RAD_BAKER_CLASSIC ? rad_lightmap_weights_create(rt->lm, rt->patches, rt->lightmap, rt->H, &rt->sub, &rt->lw)
                                            : rad_lightmap_weights_create_vp(rt->lm, rt->vp, &rt->sub, &rt->lw);
@@ -24427,9 +24497,13 @@ static rad_result rad__brt_out_probes(rad_baker_runtime *rt, const rad_baker_des
     rad_result r;
     rad_probe_options_default(&po);
     po.spacing = desc->probe_spacing;
-    r = R->method == RAD_BAKER_CLASSIC
-            ? rad_probes_create(rt->patches, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes)
-            : rad_probes_create_vp(rt->vp, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes);
+    if (rt->kept && rt->kept->probes) rt->probes = rt->kept->probes, r = RAD_SUCCESS;
+    else
+        r = R->method == RAD_BAKER_CLASSIC
+                ? rad_probes_create(rt->patches, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub,
+                                    &rt->probes)
+                : rad_probes_create_vp(rt->vp, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub,
+                                       &rt->probes);
     if (r == RAD_SUCCESS && rad_probes_count(rt->probes) != R->probe_count) {
         rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: %u probes, the result has %u", rad_probes_count(rt->probes),
                  R->probe_count);
@@ -24457,6 +24531,8 @@ RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const ra
     rt = (rad_baker_runtime *)rad__alloc_zero(&c0.allocator, sizeof *rt);
     if (!rt) return RAD_ERROR_OUT_OF_MEMORY;
     rt->c = c0;
+    rt->kept = R->kept;
+    if (R->kept) rt->borrowed = *R->kept;
     if (ctx) rt->sub = *ctx;
     rt->sub.progress = NULL;
     r = rad__brt_options(rt, desc, bake_options, R, options, &bo, &c0);
@@ -24470,6 +24546,7 @@ RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const ra
     if (r == RAD_SUCCESS && R->lightmap) r = rad__brt_out_lightmap(rt, R, &bo, &c0);
     if (r == RAD_SUCCESS && R->probes) r = rad__brt_out_probes(rt, desc, R, &c0);
     if (r != RAD_SUCCESS) return rad__brt_fail(rt, r);
+    rt->kept = NULL;
     *out = rt;
     return RAD_SUCCESS;
 }

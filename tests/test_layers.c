@@ -476,6 +476,84 @@ static void ly_test_runtime_groups_bad_input(void)
     rad_baker_result_destroy(R);
 }
 
+/* options.keep: the runtime borrows the bake's solver objects instead of building them; its
+   frames then equal, bit for bit, those of a runtime that built its own from a bake without
+   keep (the two rooms with a lightmap, a light moved to convergence, both methods: the objects
+   are the same, and after a move nothing of the bake's outputs is left but the classic
+   lightmap's detail, the same bake there), and with the baked lights the outputs are the
+   bake's. Virtual patches kept have sparse rows: that bake differs from the dense one by
+   float rounding (measured below 1e-6). */
+static void ly_test_keep(void)
+{
+    int pass;
+    for (pass = 0; pass < 2; ++pass) {
+        lm_soup room, wall, lamp;
+        rad_mesh_desc meshes[3];
+        rad_material mats[2];
+        rad_baker_desc d;
+        rad_baker_light bl;
+        rad_baker_options o;
+        rad_baker_result *R = NULL, *K = NULL;
+        rad_baker_runtime *a = NULL, *b = NULL;
+        rad_baker_frame fa, fb;
+        rad_light moved;
+        int k;
+        memset(&d, 0, sizeof d);
+        fx_two_rooms(&room, &wall, &lamp, meshes, &d.scene, mats);
+        memset(&bl, 0, sizeof bl);
+        bl.light.type = RAD_LIGHT_POINT;
+        bl.light.position[0] = 1.3f, bl.light.position[1] = 0.7f, bl.light.position[2] = 0.3f;
+        bl.light.color[0] = bl.light.color[1] = bl.light.color[2] = 1.0f;
+        d.lights = &bl;
+        d.light_count = 1;
+        d.outputs = RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES;
+        d.lightmap_width = 32;
+        d.lightmap_height = 16;
+        d.probe_spacing = 0.4f;
+        memset(&o, 0, sizeof o);
+        o.method = pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC;
+        o.patches = rad_test_quick() ? 80u : 150u;
+        o.vp_resolution = rad_test_quick() ? 5u : 7u;
+        o.ff_samples = 4;
+        o.bounces = 8;
+        o.light_samples = 4;
+        o.lightmap_samples = 1;
+        CHECK_OK(rad_baker_run(&d, &o, NULL, &R));
+        o.keep = 1;
+        CHECK_OK(rad_baker_run(&d, &o, NULL, &K));
+        if (!R || !K) goto next;
+        CHECK(R->kept == NULL && K->kept != NULL);
+        if (!pass) CHECK(memcmp(R->vertex, K->vertex, 3 * sizeof(float) * R->vertex_count) == 0); /* classic: the same bake */
+        if (getenv("RAD_TEST_VERBOSE"))
+            printf("    keep, %s: the bake's vertices differ by %.3g\n", pass ? "virtual patches" : "classic",
+                   ly_rel(K->vertex, R->vertex, 3 * (size_t)R->vertex_count, NULL));
+        CHECK(ly_rel(K->vertex, R->vertex, 3 * (size_t)R->vertex_count, NULL) < 1e-5);
+        CHECK_OK(rad_baker_runtime_create(&d, &o, K, NULL, NULL, &a));
+        o.keep = 0;
+        CHECK_OK(rad_baker_runtime_create(&d, &o, R, NULL, NULL, &b)); /* builds its own */
+        if (!a || !b) goto next;
+        CHECK_OK(rad_baker_runtime_update(a, &bl.light, 1, 0.0, &fa));
+        CHECK(fa.phase == RAD_BAKER_RUNTIME_CONVERGED);
+        CHECK(memcmp(fa.vertex, K->vertex, 3 * sizeof(float) * K->vertex_count) == 0);
+        moved = bl.light;
+        moved.position[0] = 1.75f, moved.position[1] = 0.35f;
+        for (k = 0; k < 50; ++k) {
+            CHECK_OK(rad_baker_runtime_update(a, &moved, 1, 0.0, &fa));
+            CHECK_OK(rad_baker_runtime_update(b, &moved, 1, 0.0, &fb));
+            if (fa.phase == RAD_BAKER_RUNTIME_CONVERGED) break;
+        }
+        CHECK(fa.phase == RAD_BAKER_RUNTIME_CONVERGED && fb.phase == RAD_BAKER_RUNTIME_CONVERGED);
+        CHECK(memcmp(fa.vertex, fb.vertex, 3 * sizeof(float) * K->vertex_count) == 0);
+        CHECK(memcmp(fa.lightmap, fb.lightmap, 3 * sizeof(float) * K->lightmap_width * K->lightmap_height) == 0);
+        CHECK(memcmp(fa.probes, fb.probes, 27 * sizeof(float) * K->probe_count) == 0);
+    next:
+        rad_baker_runtime_destroy(a);
+        rad_baker_runtime_destroy(b);
+        rad_baker_result_destroy(R);
+        rad_baker_result_destroy(K);
+    }
+}
+
 static const rad_test_case tests_layers[] = {
     { "layers_sky_against_light", ly_test_sky_against_light },
     { "layers_sky_planes", ly_test_sky_planes },
@@ -483,6 +561,7 @@ static const rad_test_case tests_layers[] = {
     { "layers_sky_bad_input", ly_test_sky_bad_input },
     { "layers_runtime_groups", ly_test_runtime_groups },
     { "layers_runtime_groups_bad_input", ly_test_runtime_groups_bad_input },
+    { "layers_keep", ly_test_keep },
     { NULL, NULL }
 };
 
