@@ -3,7 +3,9 @@
    moves. The meshes are the built-in Cornell box's (any rad_mesh_desc works), lit by its
    emissive ceiling light (light group 0) and one point light of the engine's (group 1).
    rad_baker_run picks the method for the scene and the budget, logs its estimate, and returns
-   one layer per group; rad_baker_mix then dims or tints each group without a new bake.
+   one layer per group; rad_baker_mix then dims or tints each group without a new bake. Two
+   sky bands (options.sky_bands) add the sky through the box's open front as four SH layers:
+   rad_baker_mix_sky relights them by any sky, here a bluish gradient, brighter at the zenith.
    examples/learn_vertex_light.c does the per-vertex part step by step with the lower-level
    calls. Prints the mean per mesh, then after a mix, and checks that every value is finite
    and >= 0 (exit 1 if not). */
@@ -70,6 +72,7 @@ int main(void)
 
     memset(&options, 0, sizeof options);           /* zero: the defaults (1 GiB, 600 s, ...) */
     options.patches = 800;
+    options.sky_bands = 2;                         /* bands 0..1 of the sky: 4 more layers */
     memset(&ctx, 0, sizeof ctx);
     ctx.log = on_log;
     ctx.progress = on_progress;
@@ -87,6 +90,22 @@ int main(void)
     r = rad_baker_mix(result, mix, NULL);          /* vertices and probes again, no new bake */
     if (r == RAD_SUCCESS) bad += print_means(&desc, result, "ceiling at 50%, lamp warm and at 200%:");
     else fprintf(stderr, "rad_baker_mix: %s\n", rad_result_string(r));
+    if (r == RAD_SUCCESS) {
+        /* the sky L(w) = (0.6 + 0.4 y) (0.5 0.7 1.0), y up: its SH coefficients in closed form,
+           l_0 = sqrt(4 pi) a and l_1 = sqrt(4 pi / 3) b per channel (Y_1 is the y band; an
+           engine projects its own sky map with rad_sky_project_sh) */
+        const float tint[3] = { 0.5f, 0.7f, 1.0f };
+        float sky[12];
+        int c;
+        memset(sky, 0, sizeof sky);
+        for (c = 0; c < 3; ++c) {
+            sky[c] = 3.5449077f * 0.6f * tint[c];
+            sky[3 + c] = 2.0466534f * 0.4f * tint[c];
+        }
+        r = rad_baker_mix_sky(result, mix, sky, NULL);
+        if (r == RAD_SUCCESS) bad += print_means(&desc, result, "the same, and a blue sky through the open front:");
+        else fprintf(stderr, "rad_baker_mix_sky: %s\n", rad_result_string(r));
+    }
     if (bad) fprintf(stderr, "%u values not finite or negative\n", bad);
     rad_baker_result_destroy(result);
     return r == RAD_SUCCESS && bad == 0 ? 0 : 1;

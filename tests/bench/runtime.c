@@ -9,8 +9,13 @@
    relative difference of the vertex light, the lightmap's valid texels and the probes), and at
    the end the light rests and the frames run until CONVERGED, compared again.
    --orbit N: the point light turns once in N frames (default: --frames).
+   The bake keeps its solver objects (rad_baker_options.keep) and the runtime is created twice:
+   building its own (a copy of the result without them) and borrowing the kept ones.
+   First, the layer mix on one core: 8 groups into a 1024 x 1024 lightmap (rad_baker_mix_layers,
+   CPU ms per call, the median of 15), and 17 planes (8 groups and 9 sky layers: the pass of
+   rad_baker_mix_sky, the same kernel); --mix-only stops after it.
    Usage: runtime [--data DIR] [--res N] [--size N] [--probes N] [--frames N] [--budget MS]
-                  [--checks N] [--orbit N] [--quick] [--append FILE.md] */
+                  [--checks N] [--orbit N] [--quick] [--mix-only] [--append FILE.md] */
 #include "bench_common.h" /* first: it asks for POSIX clock_gettime */
 #define RADIOSITY_IMPLEMENTATION
 #include "radiosity.h"
@@ -69,6 +74,35 @@ static void light_at(uint32_t frame, uint32_t frames, rad_light *out)
     out->position[2] = g_centre[2] + g_radius * sinf(a);
 }
 
+static void serial_for(void *user, uint32_t count, rad_task_fn fn, void *data)
+{
+    uint32_t i;
+    (void)user;
+    for (i = 0; i < count; ++i) fn(data, i);
+}
+
+/* The mix of 'planes' layers of a 1024 x 1024 RGB lightmap on one core: CPU ms per call, the
+   median of 15 after one warm-up call. */
+static double mix_ms(uint32_t planes, float *layers, float *out)
+{
+    rad_context ctx;
+    float rgb[3 * 80];
+    double ms[15];
+    size_t count3 = 3u * 1024u * 1024u;
+    uint32_t i, k;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.parallel_for = serial_for;
+    ctx.task_count = 1;
+    for (i = 0; i < 3 * planes; ++i) rgb[i] = 0.5f + 0.01f * (float)i;
+    for (k = 0; k < 16; ++k) {
+        double c = cpu_now();
+        check(rad_baker_mix_layers(layers, planes, count3, rgb, out, &ctx), "rad_baker_mix_layers");
+        if (k) ms[k - 1] = 1e3 * (cpu_now() - c);
+    }
+    qsort(ms, 15, sizeof(double), cmp_double);
+    return ms[7];
+}
+
 /* the runtime's frame against a fresh bake with the lights of that frame */
 static void compare_bake(const rad_baker_frame *f, const rad_light *lights, const char *what)
 {
@@ -93,8 +127,8 @@ int main(int argc, char **argv)
 {
     const char *dir = getenv("RAD_DATA_DIR"), *append = NULL;
     uint32_t res = 27, size = 1024, nprobes = 512, frames = 60, checks = 2, i, k, nv = 0, nt = 0, charts = 0;
-    double budget = 16.0, t, c, t_bake, c_bake, t_rt, c_rt, *wall, *cpu, sum_plan = 0.0, lm_share = 0.0, pr_share = 0.0;
-    int quick = 0, have_sponza;
+    double budget = 16.0, t, c, t_bake, c_bake, t_rt, c_rt, t_kept, c_kept, *wall, *cpu, sum_plan = 0.0, lm_share = 0.0, pr_share = 0.0;
+    int quick = 0, have_sponza, mix_only = 0;
     char path[4096];
     float *pos = NULL, *uvs = NULL, *probe_at;
     uint32_t *idx = NULL, side, over = 0;
@@ -117,13 +151,26 @@ int main(int argc, char **argv)
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--orbit")) g_orbit = (uint32_t)atoi(argv[++i]);
         else if (i + 1 < (uint32_t)argc && !strcmp(argv[i], "--append")) append = argv[++i];
         else if (!strcmp(argv[i], "--quick")) quick = 1;
+        else if (!strcmp(argv[i], "--mix-only")) mix_only = 1;
         else return fprintf(stderr, "usage: runtime [--data DIR] [--res N] [--size N] [--probes N] [--frames N] "
-                                    "[--budget MS] [--checks N] [--orbit N] [--quick] [--append FILE.md]\n"), 2;
+                                    "[--budget MS] [--checks N] [--orbit N] [--quick] [--mix-only] [--append FILE.md]\n"), 2;
     }
     if (quick) res = res < 12 ? res : 12, size = size < 256 ? size : 256, nprobes = nprobes < 64 ? nprobes : 64,
                frames = frames < 20 ? frames : 20, checks = checks < 1 ? checks : 1;
     if (frames < 2 || nprobes < 1 || size < 16) return fprintf(stderr, "runtime: --frames >= 2, --probes >= 1, --size >= 16\n"), 2;
     if (append && !(g_md = fopen(append, "a"))) return fprintf(stderr, "runtime: cannot open %s\n", append), 1;
+    {
+        size_t n = 3u * 1024u * 1024u, j;
+        float *layers = (float *)malloc(17 * n * sizeof(float)), *out = (float *)malloc(n * sizeof(float));
+        if (!layers || !out) return fprintf(stderr, "runtime: out of memory for the mix\n"), 1;
+        for (j = 0; j < 17 * n; ++j) layers[j] = (float)(j % 1009) * 1e-3f;
+        emit("\n### Mixing light layers (rad_baker_mix_layers, one core)\n\n");
+        emit("8 groups into a 1024x1024 RGB lightmap: %.2f ms CPU (median of 15); 8 groups and 9 sky layers "
+             "(rad_baker_mix_sky's pass): %.2f ms\n",
+             mix_ms(8, layers, out), mix_ms(17, layers, out));
+        free(layers), free(out);
+        if (mix_only) return 0;
+    }
     snprintf(path, sizeof path, "%s/sponza.obj", dir ? dir : ".");
     have_sponza = dir && bench_load_obj(path, &pos, &nv, &idx, &nt);
 
@@ -192,17 +239,29 @@ int main(int argc, char **argv)
     g_opt.max_memory = 4.0 * 1073741824.0;
 
     emit("\n### Moving lights over a bake (rad_baker_runtime)\n\n");
-    t = now(), c = cpu_now();
-    check(rad_baker_run(&g_desc, &g_opt, NULL, &R), "rad_baker_run");
-    t_bake = now() - t, c_bake = cpu_now() - c;
-    t = now(), c = cpu_now();
-    check(rad_baker_runtime_create(&g_desc, &g_opt, R, NULL, NULL, &rt), "rad_baker_runtime_create");
-    t_rt = now() - t, c_rt = cpu_now() - c;
+    {
+        rad_baker_options keep = g_opt;
+        rad_baker_result plain;
+        keep.keep = 1;
+        t = now(), c = cpu_now();
+        check(rad_baker_run(&g_desc, &keep, NULL, &R), "rad_baker_run");
+        t_bake = now() - t, c_bake = cpu_now() - c;
+        /* the runtime building its own objects: the result without the kept ones */
+        plain = *R;
+        plain.kept = NULL;
+        t = now(), c = cpu_now();
+        check(rad_baker_runtime_create(&g_desc, &g_opt, &plain, NULL, NULL, &rt), "rad_baker_runtime_create");
+        t_rt = now() - t, c_rt = cpu_now() - c;
+        rad_baker_runtime_destroy(rt);
+        t = now(), c = cpu_now();
+        check(rad_baker_runtime_create(&g_desc, &g_opt, R, NULL, NULL, &rt), "rad_baker_runtime_create (kept)");
+        t_kept = now() - t, c_kept = cpu_now() - c;
+    }
     emit("%s (%u triangles), %u virtual patches (resolution %u), a %ux%u lightmap (%u charts), %u probes, a sun and a "
-         "point light turning once in %u frames; bake %.1f s (CPU %.1f s), runtime create %.1f s (CPU %.1f s); load average "
-         "at the start %s\n\n",
+         "point light turning once in %u frames; bake %.1f s (CPU %.1f s), runtime create %.1f s (CPU %.1f s), from the "
+         "objects the bake kept (rad_baker_options.keep) %.1f s (CPU %.1f s); load average at the start %s\n\n",
          have_sponza ? "Sponza" : "Cornell box", S->triangle_count, R->patch_count, R->vp_resolution, side, side, charts,
-         R->probe_count, g_orbit ? g_orbit : frames, t_bake, c_bake, t_rt, c_rt, "(see below)");
+         R->probe_count, g_orbit ? g_orbit : frames, t_bake, c_bake, t_rt, c_rt, t_kept, c_kept, "(see below)");
     {
         FILE *la = fopen("/proc/loadavg", "r");
         char buf[128] = "?";
