@@ -554,6 +554,77 @@ static void ly_test_keep(void)
     }
 }
 
+/* An allocator that fails from the n-th allocation on, and counts what is still held. */
+typedef struct ly_alloc {
+    long left, held;
+} ly_alloc;
+
+static void *ly_alloc_fn(void *user, size_t size)
+{
+    ly_alloc *a = (ly_alloc *)user;
+    void *p;
+    if (a->left-- <= 0) return NULL;
+    p = malloc(size);
+    if (p) ++a->held;
+    return p;
+}
+
+static void ly_free_fn(void *user, void *p)
+{
+    ly_alloc *a = (ly_alloc *)user;
+    if (p) --a->held, free(p);
+}
+
+/* Every allocation of a bake with sky layers and keep, then of a runtime borrowing its objects
+   with an emitting group, failed in turn: OUT_OF_MEMORY, nothing held after, never a crash. */
+static void ly_test_out_of_memory(void)
+{
+    int pass;
+    for (pass = 0; pass < 2; ++pass) {
+        rad_baker_desc d;
+        rad_mesh_desc meshes[16];
+        rad_material mats[17];
+        uint32_t groups[17];
+        rad_baker_light bl;
+        rad_baker_options o;
+        rad_context ctx;
+        ly_alloc al;
+        long n, runs = 0;
+        int done = 0;
+        ly_glow_box(&d, meshes, mats, groups, &bl);
+        memset(&o, 0, sizeof o);
+        o.method = pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC;
+        o.patches = 40;
+        o.vp_resolution = 4;
+        o.ff_samples = 1;
+        o.bounces = 2;
+        o.light_samples = 1;
+        o.sky_bands = 2;
+        o.sky_rays = 4;
+        o.keep = 1;
+        memset(&ctx, 0, sizeof ctx);
+        ctx.allocator.alloc = ly_alloc_fn;
+        ctx.allocator.free = ly_free_fn;
+        ctx.allocator.user = &al;
+        for (n = 0; !done && n < 1000000; n += n < 24 ? 1 : n / 6) {
+            rad_baker_result *R = NULL;
+            rad_baker_runtime *rt = NULL;
+            rad_result r;
+            al.left = n, al.held = 0;
+            r = rad_baker_run(&d, &o, &ctx, &R);
+            if (r == RAD_SUCCESS) r = rad_baker_runtime_create(&d, &o, R, NULL, &ctx, &rt);
+            if (r == RAD_SUCCESS) done = 1;
+            else CHECK(r == RAD_ERROR_OUT_OF_MEMORY);
+            rad_baker_runtime_destroy(rt);
+            rad_baker_result_destroy(R);
+            CHECK(al.held == 0);
+            ++runs;
+        }
+        CHECK(done && runs > 10);
+        if (getenv("RAD_TEST_VERBOSE")) printf("    %s: %ld runs, success at %ld allocations\n", pass ? "virtual patches" : "classic", runs, n);
+    }
+}
+
 static const rad_test_case tests_layers[] = {
     { "layers_sky_against_light", ly_test_sky_against_light },
     { "layers_sky_planes", ly_test_sky_planes },
@@ -562,6 +633,7 @@ static const rad_test_case tests_layers[] = {
     { "layers_runtime_groups", ly_test_runtime_groups },
     { "layers_runtime_groups_bad_input", ly_test_runtime_groups_bad_input },
     { "layers_keep", ly_test_keep },
+    { "layers_out_of_memory", ly_test_out_of_memory },
     { NULL, NULL }
 };
 
