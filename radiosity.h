@@ -23804,9 +23804,9 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
         if (!k) {
             r = RAD_ERROR_OUT_OF_MEMORY;
         } else {
-            k->scene = b.scene, k->bvh = b.bvh, k->patches = b.patches, k->ff = b.ff, k->vp = b.vp, k->lm = b.lm;
-            k->probes = b.probes;
-            b.scene = NULL, b.bvh = NULL, b.patches = NULL, b.ff = NULL, b.vp = NULL, b.lm = NULL, b.probes = NULL;
+            k->scene = b.scene, k->bvh = b.bvh, k->ff = b.ff, k->vp = b.vp, k->lm = b.lm, k->probes = b.probes;
+            if (b.R->method == RAD_BAKER_CLASSIC) k->patches = b.patches, b.patches = NULL; /* else the plan's: freed */
+            b.scene = NULL, b.bvh = NULL, b.ff = NULL, b.vp = NULL, b.lm = NULL, b.probes = NULL;
             b.R->kept = k;
         }
     }
