@@ -23442,7 +23442,7 @@ static rad_result rad__baker_plan(rad__baker *b)
     in.outputs_bytes = b->outputs_bytes;
     in.probes = (b->outputs & RAD_BAKER_PROBES) ? (double)probes_guess : 0.0;
     in.texels = (b->outputs & RAD_BAKER_LIGHTMAP) ? (double)R->lightmap_width * R->lightmap_height * b->o.lightmap_samples : 0.0;
-    in.groups = R->group_count;
+    in.groups = R->group_count + R->sky_count; /* a sky layer costs what a group does */
     in.tasks = b->c.tasks;
     in.who = "rad_baker_run";
     r = rad__plan_run(&in, &b->sub, &b->c, &R->plan, &b->patches);
