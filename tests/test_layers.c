@@ -432,6 +432,71 @@ static void ly_test_runtime_groups(void)
     }
 }
 
+/* The same on the two rooms with a lightmap (the lamp's emission group 0, a point light in the
+   other room group 1): vertices, valid texels and probes within 1e-4 of rad_baker_mix (measured
+   2e-8 to 1.3e-7, the classic lightmap included). */
+static void ly_test_runtime_groups_lightmap(void)
+{
+    int pass, step;
+    for (pass = 0; pass < 2; ++pass) {
+        lm_soup room, wall, lamp;
+        rad_mesh_desc meshes[3];
+        rad_material mats[2];
+        rad_baker_desc d;
+        rad_baker_light bl;
+        rad_baker_options o;
+        rad_baker_result *R = NULL;
+        rad_baker_runtime *rt = NULL;
+        rad_baker_frame f;
+        uint32_t groups[2] = { 0, 0 };
+        memset(&d, 0, sizeof d);
+        fx_two_rooms(&room, &wall, &lamp, meshes, &d.scene, mats);
+        memset(&bl, 0, sizeof bl);
+        bl.light.type = RAD_LIGHT_POINT;
+        bl.light.position[0] = 1.3f, bl.light.position[1] = 0.7f, bl.light.position[2] = 0.3f;
+        bl.light.color[0] = bl.light.color[1] = bl.light.color[2] = 1.0f;
+        bl.group = 1;
+        d.lights = &bl;
+        d.light_count = 1;
+        d.material_groups = groups;
+        d.outputs = RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES;
+        d.lightmap_width = 32;
+        d.lightmap_height = 16;
+        d.probe_spacing = 0.4f;
+        memset(&o, 0, sizeof o);
+        o.method = pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC;
+        o.patches = rad_test_quick() ? 80u : 150u;
+        o.vp_resolution = rad_test_quick() ? 5u : 7u;
+        o.ff_samples = 4;
+        o.bounces = 8;
+        o.light_samples = 4;
+        o.lightmap_samples = 1;
+        CHECK_OK(rad_baker_run(&d, &o, NULL, &R));
+        if (R) CHECK_OK(rad_baker_runtime_create(&d, &o, R, NULL, NULL, &rt));
+        for (step = 0; rt && step < 2; ++step) {
+            static const float sc[2][6] = { { 0.2f, 0.2f, 0.2f, 1, 1, 1 }, { 1, 0.5f, 0.2f, 0, 0, 0 } };
+            double ev, el, ep;
+            int k;
+            CHECK_OK(rad_baker_runtime_set_groups(rt, sc[step]));
+            for (k = 0; k < 60; ++k) {
+                CHECK_OK(rad_baker_runtime_update(rt, &bl.light, 1, 0.0, &f));
+                if (f.phase == RAD_BAKER_RUNTIME_CONVERGED) break;
+            }
+            CHECK(f.phase == RAD_BAKER_RUNTIME_CONVERGED);
+            CHECK_OK(rad_baker_mix(R, sc[step], NULL));
+            ev = ly_rel(f.vertex, R->vertex, 3 * (size_t)R->vertex_count, NULL);
+            el = ly_rel(f.lightmap, R->lightmap, 3 * (size_t)R->lightmap_width * R->lightmap_height, R->lightmap_flags);
+            ep = ly_rel(f.probes, R->probes, 27 * (size_t)R->probe_count, NULL);
+            if (!(ev < 1e-4 && el < 1e-4 && ep < 1e-4) || getenv("RAD_TEST_VERBOSE"))
+                printf("    two rooms, %s, scales %d: vertex %.3g, lightmap %.3g, probes %.3g\n",
+                       pass ? "virtual patches" : "classic", step, ev, el, ep);
+            CHECK(ev < 1e-4 && el < 1e-4 && ep < 1e-4);
+        }
+        rad_baker_runtime_destroy(rt);
+        rad_baker_result_destroy(R);
+    }
+}
+
 static void ly_test_runtime_groups_bad_input(void)
 {
     rad_baker_desc d;
@@ -631,6 +696,7 @@ static const rad_test_case tests_layers[] = {
     { "layers_sky_project", ly_test_project },
     { "layers_sky_bad_input", ly_test_sky_bad_input },
     { "layers_runtime_groups", ly_test_runtime_groups },
+    { "layers_runtime_groups_lightmap", ly_test_runtime_groups_lightmap },
     { "layers_runtime_groups_bad_input", ly_test_runtime_groups_bad_input },
     { "layers_keep", ly_test_keep },
     { "layers_out_of_memory", ly_test_out_of_memory },
