@@ -24186,6 +24186,11 @@ static rad_result rad__brt_options(rad_baker_runtime *rt, const rad_baker_desc *
                                    "outputs differ), or more than %u lights over virtual patches", RAD_VP_LIGHTS_MAX);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (R->group_count == 0) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: the result has no light groups (a bake of the sky layers "
+                                   "alone): a runtime follows lights and emitters, and the sky is relit by rad_baker_mix_sky");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     return RAD_SUCCESS;
 }
 

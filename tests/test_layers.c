@@ -202,6 +202,10 @@ static void ly_test_sky_planes(void)
         CHECK_OK(rad_baker_run(&d, &o, &ctx, &C));
         if (!A || !B || !C) goto next;
         CHECK(A->group_count == 2 && A->sky_count == 9 && B->group_count == 0 && B->sky_count == 9);
+        {
+            rad_baker_runtime *rt = NULL; /* a sky-only bake has nothing a runtime follows */
+            CHECK(rad_baker_runtime_create(&sky, &o, B, NULL, NULL, &rt) == RAD_ERROR_INVALID_ARGUMENT && !rt);
+        }
         K = A->sky_count;
         nv = 3 * (size_t)A->vertex_count, nl = 3 * (size_t)A->lightmap_width * A->lightmap_height;
         np = 27 * (size_t)A->probe_count;

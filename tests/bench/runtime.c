@@ -132,7 +132,7 @@ int main(int argc, char **argv)
     char path[4096];
     float *pos = NULL, *uvs = NULL, *probe_at;
     uint32_t *idx = NULL, side, over = 0;
-    rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0};
+    rad_material stone = {{0.7f, 0.68f, 0.63f}, {0.0f, 0.0f, 0.0f}, 0, 0, 0, 0, 0.0f};
     rad_scene_desc sd;
     rad_mesh_desc mesh, flat;
     rad_scene *S = NULL;
