@@ -11060,15 +11060,23 @@ typedef struct rad__hr_cluster {
     float c[3], radius, area;
     float m2[6];         /* the members' second moments about c (rad__hr_tri_m2) */
     float B[3], bmax;    /* area-weighted mean B of the members, and their largest channel */
+    float axis[3], cone_cos, cone_sin; /* a cone holding every member's normal (half angle) */
     uint32_t child[2], lo, hi, parent;
 } rad__hr_cluster;
 
-/* a link into a cluster, by receiver (the gather's per-member pass): F and the unit direction
-   u from the receiver's centre to the source's */
+/* a link into a cluster, by receiver (the gather): F, the unit direction u from the
+   receiver's centre to the source's, and how u meets the receiver's normal cone
+   (RAD__HR_IN_*) */
 typedef struct rad__hr_in {
     float u[3], F;
-    uint32_t s;
+    uint32_t s, kind;
 } rad__hr_in;
+#define RAD__HR_IN_BEHIND 0u /* every member faces away from u: no light */
+#define RAD__HR_IN_FRONT 1u  /* every member faces u: n . u >= 0, the cosine exact as a vector */
+#define RAD__HR_IN_MIXED 2u  /* both: the clamped cosine by its quadratic (Legendre) fit */
+/* per cluster and per channel (B's three and the form factors' S): the vector sum of the
+   FRONT links' F B u (3), then of the MIXED links F B (1), F B u (3) and F B u u^T (6) */
+#define RAD__HR_ACC 13u
 
 struct rad_hierarchical {
     const rad_scene *scene;
@@ -11088,6 +11096,7 @@ struct rad_hierarchical {
     double *cum_area;        /* cum_area[i]: the area of perm[0, i) */
     rad__hr_in *in;          /* links into clusters, grouped by receiver: in_first[c] .. in_first[c + 1] */
     uint32_t *in_first;
+    double *acc;             /* RAD__HR_ACC x 4 per cluster: what the gather hands down the tree */
     rad_hierarchical_stats st;
     int state;           /* 0 created, 1 solved, -1 a solve failed */
     uint32_t round;      /* the round under way, and the progress reported so far */
@@ -11131,7 +11140,7 @@ RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
 {
     if (h) {
         void *blocks[] = { h->el, h->links, h->leaf, h->leaf_of, h->leaf_vert, h->vert_B, h->vert_H, h->cl,
-                           h->perm, h->tri_parent, h->cum_area, h->in, h->in_first, h };
+                           h->perm, h->tri_parent, h->cum_area, h->in, h->in_first, h->acc, h };
         rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
 }
@@ -11208,6 +11217,12 @@ static void rad__hr_node(const rad_hierarchical *h, uint32_t id, float *c, float
         if (B) *B = b;
         if (bmax) *bmax = b[0] > b[1] ? (b[0] > b[2] ? b[0] : b[2]) : (b[1] > b[2] ? b[1] : b[2]);
     }
+}
+
+/* node id's mean B (what rad__hr_node gives, without the geometry) */
+static const float *rad__hr_B(const rad_hierarchical *h, uint32_t id)
+{
+    return rad__hr_is_cl(id) ? h->cl[id & ~RAD__HR_CL].B : h->el[id].B;
 }
 
 /* the clusters' B and bmax from their children's, bottom up (children have larger indices) */
@@ -11420,6 +11435,22 @@ static rad_result rad__hr_build_clusters(rad_hierarchical *h, const rad__ctx *c)
             }
         cl->radius = (float)sqrt((double)r2) * (1.0f + 1e-6f);
         cl->area = (float)(h->cum_area[cl->hi] - h->cum_area[cl->lo]);
+        { /* the normal cone: about the area-weighted mean normal, out to the widest member */
+            double a[3] = { 0.0, 0.0, 0.0 }, l;
+            float cmin = 1.0f;
+            for (j = cl->lo; j < cl->hi; ++j)
+                for (m = 0; m < 3; ++m) a[m] += (double)S->areas[h->perm[j]] * (double)S->normals[3 * (size_t)h->perm[j] + m];
+            l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            for (m = 0; m < 3; ++m) cl->axis[m] = l > 0.0 ? (float)(a[m] / l) : (m == 2 ? 1.0f : 0.0f);
+            for (j = cl->lo; j < cl->hi; ++j) {
+                float q = rad__dot(cl->axis, S->normals + 3 * (size_t)h->perm[j]);
+                if (q < cmin) cmin = q;
+            }
+            cmin -= 1e-4f; /* rounding: a member on the cone's edge stays inside */
+            if (cmin < -1.0f || !(l > 0.0)) cmin = -1.0f;
+            cl->cone_cos = cmin;
+            cl->cone_sin = (float)sqrt(1.0 - (double)cmin * (double)cmin);
+        }
         {
             double m2[6] = { 0, 0, 0, 0, 0, 0 };
             for (j = cl->lo; j < cl->hi; ++j)
@@ -12130,6 +12161,21 @@ static rad_result rad__hr_build_in(rad_hierarchical *h, const rad__ctx *c)
         rad__normalize(e->u);
         e->F = lk->F;
         e->s = lk->s;
+        { /* the cone's half angle t and the angle g between axis and u: every member faces u
+             when g + t <= pi/2, every one faces away when g - t >= pi/2 */
+            const rad__hr_cluster *q = &h->cl[cr];
+            float cg = rad__dot(q->axis, e->u);
+            e->kind = q->cone_cos >= 0.0f && cg >= q->cone_sin    ? RAD__HR_IN_FRONT
+                      : q->cone_cos >= 0.0f && cg <= -q->cone_sin ? RAD__HR_IN_BEHIND
+                                                                  : RAD__HR_IN_MIXED;
+        }
+    }
+    if (!h->acc) {
+        h->acc = (double *)rad__alloc_array(&h->allocator, (size_t)h->ncl, 4u * RAD__HR_ACC * sizeof(double));
+        if (!h->acc) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the clusters' gather");
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
     }
     for (i = h->ncl; i > 0; --i) h->in_first[i] = h->in_first[i - 1u];
     h->in_first[0] = 0;
@@ -12138,35 +12184,74 @@ static rad_result rad__hr_build_in(rad_hierarchical *h, const rad__ctx *c)
 
 typedef struct rad__hr_gather {
     rad_hierarchical *h;
-    uint32_t tasks;
+    uint32_t tasks, phase;
 } rad__hr_gather;
 
-/* Each scene triangle (the root of its quadtree) gathers over the links into the clusters
-   above it, by its own cosine to each source: a task writes only its own triangles. */
+/* The gather into clusters in O(links + clusters + triangles) (a walk of every member per
+   link costs the members times the links, most of a large scene's solve). Phase 0, per
+   cluster: its links' sums (RAD__HR_ACC per channel, channel 3 the form factors alone): a link
+   whose direction u every member faces adds F B u, which a member's n dots into its exact
+   F B (n . u); one some members face and some do not adds to the sums of the quadratic
+   (Legendre, to degree 2) fit of the clamped cosine max(0, t) ~ 3/32 + t / 2 + 15/32 t^2,
+   t = n . u, which keeps the mean over all normals; one every member faces away from adds
+   nothing. Phase 1 (the caller) hands the sums down the tree; phase 2, per scene triangle:
+   its own n applied to the sums of the cluster above it. A task writes only its own range. */
 static void rad__hr_gather_task(void *data, uint32_t task)
 {
     const rad__hr_gather *g = (const rad__hr_gather *)data;
     rad_hierarchical *h = g->h;
-    uint32_t T = h->scene->triangle_count, i;
-    uint32_t b = (uint32_t)((uint64_t)T * task / g->tasks), e = (uint32_t)((uint64_t)T * (task + 1u) / g->tasks);
+    uint32_t n = g->phase == 0 ? h->ncl : h->scene->triangle_count, i, j, k, q;
+    uint32_t b = (uint32_t)((uint64_t)n * task / g->tasks), e = (uint32_t)((uint64_t)n * (task + 1u) / g->tasks);
     for (i = b; i < e; ++i) {
-        rad__hr_elem *el = &h->el[i];
-        double G[3] = { 0.0, 0.0, 0.0 }, S = 0.0;
-        uint32_t a, j, k;
-        for (a = h->tri_parent[i]; a != RAD_NONE; a = h->cl[a].parent)
-            for (j = h->in_first[a]; j < h->in_first[a + 1u]; ++j) {
+        if (g->phase == 0) {
+            double *a = h->acc + (size_t)i * 4u * RAD__HR_ACC;
+            memset(a, 0, 4u * RAD__HR_ACC * sizeof(double));
+            for (j = h->in_first[i]; j < h->in_first[i + 1u]; ++j) {
                 const rad__hr_in *in = &h->in[j];
-                float cs = rad__dot(el->n, in->u);
                 const float *B;
-                double f;
-                if (!(cs > 0.0f)) continue;
-                f = (double)in->F * (double)cs;
-                rad__hr_node(h, in->s, NULL, NULL, NULL, &B, NULL);
-                for (k = 0; k < 3; ++k) G[k] += f * (double)B[k];
-                S += f;
+                double w[4], u[3];
+                if (in->kind == RAD__HR_IN_BEHIND || !(in->F > 0.0f)) continue;
+                B = rad__hr_B(h, in->s);
+                for (k = 0; k < 3; ++k) {
+                    w[k] = (double)in->F * (double)B[k];
+                    u[k] = (double)in->u[k];
+                }
+                w[3] = (double)in->F;
+                for (k = 0; k < 4; ++k) {
+                    double *ak = a + k * RAD__HR_ACC;
+                    if (in->kind == RAD__HR_IN_FRONT) {
+                        for (q = 0; q < 3; ++q) ak[q] += w[k] * u[q];
+                        continue;
+                    }
+                    ak[3] += w[k];
+                    for (q = 0; q < 3; ++q) ak[4 + q] += w[k] * u[q];
+                    ak[7] += w[k] * u[0] * u[0];
+                    ak[8] += w[k] * u[1] * u[1];
+                    ak[9] += w[k] * u[2] * u[2];
+                    ak[10] += w[k] * u[0] * u[1];
+                    ak[11] += w[k] * u[0] * u[2];
+                    ak[12] += w[k] * u[1] * u[2];
+                }
             }
-        for (k = 0; k < 3; ++k) el->G[k] += G[k];
-        el->S += S;
+        } else {
+            rad__hr_elem *el = &h->el[i];
+            const double *a;
+            double N[3], G[4];
+            if (h->tri_parent[i] == RAD_NONE) continue;
+            a = h->acc + (size_t)h->tri_parent[i] * 4u * RAD__HR_ACC;
+            for (q = 0; q < 3; ++q) N[q] = (double)el->n[q];
+            for (k = 0; k < 4; ++k) {
+                const double *ak = a + k * RAD__HR_ACC;
+                double front = N[0] * ak[0] + N[1] * ak[1] + N[2] * ak[2];
+                double lin = N[0] * ak[4] + N[1] * ak[5] + N[2] * ak[6];
+                double quad = N[0] * N[0] * ak[7] + N[1] * N[1] * ak[8] + N[2] * N[2] * ak[9] +
+                              2.0 * (N[0] * N[1] * ak[10] + N[0] * N[2] * ak[11] + N[1] * N[2] * ak[12]);
+                double mixed = (3.0 / 32.0) * ak[3] + 0.5 * lin + (15.0 / 32.0) * quad;
+                G[k] = (front > 0.0 ? front : 0.0) + (mixed > 0.0 ? mixed : 0.0);
+            }
+            for (k = 0; k < 3; ++k) el->G[k] += G[k];
+            el->S += G[3];
+        }
     }
 }
 
@@ -12194,7 +12279,7 @@ static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *
         const float *B;
         if (rad__hr_is_cl(lk->r)) continue; /* below, per member */
         er = &h->el[lk->r];
-        rad__hr_node(h, lk->s, NULL, NULL, NULL, &B, NULL);
+        B = rad__hr_B(h, lk->s);
         for (k = 0; k < 3; ++k) er->G[k] += (double)lk->F * (double)B[k];
         er->S += (double)lk->F;
     }
@@ -12202,6 +12287,16 @@ static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *
         rad__hr_gather g;
         uint32_t T = h->scene->triangle_count;
         g.h = h;
+        g.phase = 0;
+        g.tasks = (h->ncl + 1023u) / 1024u < c->tasks ? (h->ncl + 1023u) / 1024u : c->tasks;
+        if (g.tasks == 0) g.tasks = 1;
+        c->parallel_for(c->parallel_user, g.tasks, rad__hr_gather_task, &g);
+        for (i = 1; i < h->ncl; ++i) { /* down the tree: parents come first */
+            double *a = h->acc + (size_t)i * 4u * RAD__HR_ACC;
+            const double *p = h->acc + (size_t)h->cl[i].parent * 4u * RAD__HR_ACC;
+            for (k = 0; k < 4u * RAD__HR_ACC; ++k) a[k] += p[k];
+        }
+        g.phase = 2;
         g.tasks = (T + 1023u) / 1024u < c->tasks ? (T + 1023u) / 1024u : c->tasks;
         if (g.tasks == 0) g.tasks = 1;
         c->parallel_for(c->parallel_user, g.tasks, rad__hr_gather_task, &g);
