@@ -1350,7 +1350,8 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
      3. gather and push-pull (Jacobi): G_r = sum over r's links of F_rs B_s; pushed down
         (an element receives what its ancestors gathered), B = E + rho G at the leaves,
         pulled up as area-weighted means; repeated until B changes by less than 1e-6 of
-        max B. A leaf whose form factors (its ancestors' included) sum past 1.2, which
+        max B (1e-3 in a round whose refinement changed links, except the last round: its B
+        only guides the next refinement). A leaf whose form factors (its ancestors' included) sum past 1.2, which
         coincident duplicate surfaces, overlapping sources that one visibility ray each
         both pass, and cluster estimates can give, has G scaled to that sum 1.2 (lower where
         rho times 1.2 passes 0.999): otherwise the sweeps can grow B without bound;
@@ -1370,11 +1371,14 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    bound on the power it carries, max_c(B) of the source's members times A_r
    min(1, A_s / (pi g^2)), exceeds tolerance * P; links reaching two elements go on as in
    step 2. Such a link's F: the source's projected area toward the receiver, the sum over its
-   member triangles of A_j max(0, n_j . w) (w from centre to centre, d apart), over pi d^2,
-   times the weighted share of visibility rays between area-sampled member points that nothing
-   blocks. An element receiver takes its own cosine; a cluster receiver hands the irradiance
-   straight to its member triangles, each by its own cosine to the source (so a cluster lit
-   from one side lights only the triangles facing that side), before the push. Reentrant; the
+   member triangles of A_j max(0, n_j . w) (w from centre to centre, d apart), over pi (d^2 +
+   the ends' area spread across w), times the share of visibility rays between area-sampled member points that face each
+   other along their segment (weighted by those two cosines) that nothing blocks. An element receiver takes its own cosine; a cluster receiver hands the irradiance
+   to its member triangles, each by its own cosine to the source (so a cluster lit from one
+   side lights only the triangles facing that side), before the push: exactly where every
+   member's normal faces the source (a cone of the members' normals says so), else by the
+   quadratic fit 3/32 + t/2 + 15/32 t^2 of the clamped cosine t = n . w (its Legendre series
+   to degree 2), so the gather is O(links + clusters + triangles) a sweep. Reentrant; the
    solve uses ctx->parallel_for for the links' form factors and the clusters' gather; after it
    the accessors and lookups only read (any threads at once). Progress is reported after each
    level of refinement and each sweep (cancel stops either within that step); memory_limit
@@ -1458,15 +1462,15 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
                                            const rad_hierarchical_options *options, const rad_context *ctx,
                                            rad_hierarchical **out);
 /* Runs the solve (steps 1 to 4 above). Can be called once. ctx: logging, progress (after each
-   refinement level and each sweep, rising through max_iterations rounds, 1 at the end;
-   cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
+   refinement level, each 2^20 links of a level and each sweep; round k within [1 - 2^-k,
+   1 - 2^-(k+1)), so the first round is the first half; 1 at the end; cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
    twice), RAYCAST_FAILED, NON_FINITE (a source value), NEGATIVE_EMISSION (the source gave
    E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000; or a form factor
    or B of the solver's own that is not finite, logged as "internal"), CANCELLED,
    OUT_OF_MEMORY. After an error the object can only be destroyed.
    Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep; with
-   clustering also O(members of the source) projections per cluster link evaluated and, per
-   sweep, per triangle the links into the clusters above it. */
+   clustering also O(members of the source) projections per cluster link evaluated and
+   O(clusters + triangles) per sweep. */
 RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx);
 RAD_API void rad_hierarchical_destroy(rad_hierarchical *h);
 
@@ -11028,6 +11032,7 @@ done:
 #define RAD__HR_DEFAULT_ROUNDS 16u
 #define RAD__HR_MAX_SWEEPS 1000u
 #define RAD__HR_SWEEP_TOLERANCE 1e-6
+#define RAD__HR_ROUND_TOLERANCE 1e-3 /* the sweeps of a round that is not the last */
 #define RAD__HR_SOURCE_BATCH 4096u
 #define RAD__HR_ROW_CAP 1.2      /* largest form-factor sum a leaf gathers over */
 #define RAD__HR_MAX_GAIN 0.999   /* largest rho times that sum */
@@ -11115,11 +11120,14 @@ static void rad__hierarchical_options_resolve(rad_hierarchical_options *o)
     if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
 }
 
-/* Reports progress (round + within) / max_iterations, never going back; 1 when the caller
-   asked to stop (logged, naming the step). */
+/* Reports progress, 'within' the round under way from 0 to 1, never going back; 1 when the
+   caller asked to stop (logged, naming the step). */
 static int rad__hr_progress(rad_hierarchical *h, const rad__ctx *c, double within, const char *step)
 {
-    float f = (float)(((double)h->round + (within < 0.0 ? 0.0 : within > 1.0 ? 1.0 : within)) / (double)h->o.max_iterations);
+    /* round k holds [1 - 2^-k, 1 - 2^-(k+1)): the first round, most of a large scene's work,
+       half of the bar (a share of 1 / max_iterations left it near 0% for most of the solve) */
+    double w = within < 0.0 ? 0.0 : within > 1.0 ? 1.0 : within;
+    float f = h->round >= h->o.max_iterations ? 1.0f : (float)(1.0 - ldexp(1.0 - 0.5 * w, -(int)h->round));
     if (!c->progress) return 0;
     if (f < h->reported) f = h->reported;
     if (f > 1.0f) f = 1.0f;
@@ -11788,15 +11796,19 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
     for (a = 0; a < 4u * K && got < K; ++a) {
         uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s ^ rad__hash(a + 0x632be5abu))));
         uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
-        float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2;
+        float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2, dd[3];
         rad__hr_node_point(h, lk->r, (float)(h1 >> 8) / 16777216.0f, (float)(h2 & 0xFFFFu) / 65536.0f,
                            (float)(h2 >> 16) / 65536.0f, x, n1);
         rad__hr_node_point(h, lk->s, (float)(h3 >> 8) / 16777216.0f, (float)(h1 & 0xFFu) / 256.0f + (float)(h3 & 0xFFu) / 65536.0f,
                            (float)((h3 >> 8) & 0xFFFFu) / 65536.0f, y, n2);
-        c1 = -rad__dot(n1, w);
-        c2 = rad__dot(n2, w);
+        /* the pair's own cosines along its segment: a pair that faces along the centre line
+           but not along its segment would count as blocked (its ray leaves through its own
+           surface) while the opposite pairs were never drawn */
+        rad__sub(dd, y, x);
+        c1 = rad__dot(n1, dd);
+        c2 = -rad__dot(n2, dd);
         if (!(c1 > 0.0f && c2 > 0.0f)) continue;
-        wt[got] = c1 * c2;
+        wt[got] = c1 * c2 / rad__dot(dd, dd);
         wsum += (double)wt[got];
         ++got;
     }
@@ -12096,7 +12108,17 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
                 r = e == l.s ? rad__hr_push(h, &next, l.r, ch, c) : rad__hr_push(h, &next, ch, l.s, c);
             }
         }
-        if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, next.a, next.n, c);
+        { /* a level of millions of links in chunks, so that the progress moves through it */
+            size_t at, chunk = (size_t)1 << 20;
+            for (at = 0; at < next.n && r == RAD_SUCCESS; at += chunk) {
+                size_t n = next.n - at < chunk ? next.n - at : chunk;
+                r = rad__hr_evaluate(h, next.a + at, n, c);
+                if (r == RAD_SUCCESS && at + n < next.n &&
+                    rad__hr_progress(h, c, 0.5 * (1.0 - level_share + 0.5 * level_share * (double)(at + n) / (double)next.n),
+                                     "refinement"))
+                    r = RAD_ERROR_CANCELLED;
+            }
+        }
         {
             uint64_t held = (uint64_t)h->cap_el * sizeof(rad__hr_elem) + (uint64_t)(keep.cap + cand.cap + next.cap) * sizeof(rad__hr_link);
             if (held > h->st.peak_bytes) h->st.peak_bytes = held;
@@ -12504,17 +12526,21 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
         int changed = 0;
         h->round = round;
         uint32_t first = h->nel, s;
-        double res = 0.0;
+        double res = 0.0, tol;
         r = rad__hr_refine(h, &changed, &c);
         if (r == RAD_SUCCESS) r = rad__hr_sources(h, first, &c);
         if (r == RAD_SUCCESS && h->cl) r = rad__hr_build_in(h, &c);
         if (r != RAD_SUCCESS) break;
+        /* a round that refined and is not the last only feeds the next refinement, whose
+           oracle needs B to a few per cent: its sweeps stop at RAD__HR_ROUND_TOLERANCE, and the
+           last round (no link refined, or max_iterations) goes on to RAD__HR_SWEEP_TOLERANCE */
+        tol = changed && round + 1u < h->o.max_iterations ? RAD__HR_ROUND_TOLERANCE : RAD__HR_SWEEP_TOLERANCE;
         for (s = 0; s < RAD__HR_MAX_SWEEPS; ++s) {
             if ((r = rad__hr_sweep(h, &c, &res)) != RAD_SUCCESS) break;
             h->st.sweeps++;
-            if (res < RAD__HR_SWEEP_TOLERANCE) break;
-            /* the sweeps: the other half, by how far the change has fallen toward 1e-6 */
-            if (rad__hr_progress(h, &c, res > 0.0 ? 0.5 + 0.5 * log(res) / log(RAD__HR_SWEEP_TOLERANCE) : 1.0, "sweeps")) {
+            if (res < tol) break;
+            /* the sweeps: the other half, by how far the change has fallen toward tol */
+            if (rad__hr_progress(h, &c, res > 0.0 ? 0.5 + 0.5 * log(res) / log(tol) : 1.0, "sweeps")) {
                 r = RAD_ERROR_CANCELLED;
                 break;
             }

@@ -274,11 +274,12 @@ static const tool_arg method_args[] = {
     TEXT(0, "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement,\n"
             "solved to convergence; --bounces is not used; a bake resamples it onto the patches):\n"),
     FLOAT("--hr-eps", "E", hr_eps, 0.0, 1.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, TOOL_OPT_HR_EPS,
-          "must be in (0, 1) (e.g. 1e-3)", 0, "refinement tolerance, a fraction of the source power (default 1e-5)"),
+          "must be in (0, 1) (e.g. 1e-3)", 0, "refinement tolerance, a fraction of the source power (default 1e-7 per triangle,\n"
+          "from 1e-5 to 1e-2)"),
     FLOAT("--hr-min-area", "A", hr_min_area, 0.0, 1e30, TOOL_ARG_LO_OPEN, TOOL_OPT_HR_MIN_AREA,
           "must be a positive area", 0, "smallest element area, scene units^2 (default: total area / 10000)"),
     CUSTOM("--hr-rays", "R", hr_rays, parse_hr_rays, TOOL_OPT_HR_RAYS, 0,
-           "points and visibility rays per link: 1, 4, 9 ... 64 (default 4)"),
+           "points and visibility rays per link: 1, 4, 9 ... 64 (default 4; 1 from 10^5 triangles)"),
     {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
 };
 #undef R
@@ -1212,11 +1213,19 @@ int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_met
     double t0 = tool_seconds();
     *out = NULL;
     rad_hierarchical_options_default(&ho);
-    /* finer than the library's teaching default: a still image as close to the path tracer as
-       classic's at a small part of its rays (docs/performance-notes.md, hierarchical radiosity) */
-    ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
+    /* finer than the library's teaching default on small scenes: a still image as close to the
+       path tracer as classic's at a small part of its rays (docs/performance-notes.md,
+       hierarchical radiosity); the links grow with the triangles at one tolerance, so a large
+       scene takes a coarser one (1e-7 per triangle, 1e-5 to 1e-2) and one ray per link, which
+       keeps 10^5 triangles and more to minutes and under 1 GiB */
+    {
+        uint32_t T = w->scene->triangle_count;
+        double eps = 1e-7 * (double)T;
+        ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : eps < 1e-5 ? 1e-5 : eps > 1e-2 ? 1e-2 : eps;
+        if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
+        else if (T >= 100000u) ho.visibility_rays = 1;
+    }
     ho.min_area = mo->hr_min_area;
-    if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
     /* a large scene at a fine tolerance refines coarser once its elements and links reach
        1.5 GiB instead of growing until the machine runs out */
     ho.memory_limit = (uint64_t)1536u << 20;
