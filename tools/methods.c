@@ -579,6 +579,13 @@ static uint32_t mb_bounces(uint32_t bounces)
     return bounces == RAD_MB_INFINITE ? RAD_MB_INFINITE : bounces + 1u;
 }
 
+/* --hr-eps, or the default for T scene triangles (tool_hierarchical_build says why) */
+static double hr_tolerance(const tool_method_options *mo, uint32_t T)
+{
+    double eps = 1e-7 * (double)T;
+    return mo->hr_eps > 0.0f ? (double)mo->hr_eps : eps < 1e-5 ? 1e-5 : eps > 1e-2 ? 1e-2 : eps;
+}
+
 /* --method hierarchical baked: the solution's H resampled onto the bake's patches, as the
    stochastic bake's L = rho H (the mean of the leaf values at the patch's centroid and half
    way from it to each corner) */
@@ -763,7 +770,7 @@ static const char *method_bake_hierarchical(method_bake *b, uint32_t light_sampl
     b->bytes = (size_t)st.links; /* the record's byte count holds the links here */
     b->mi.k = st.leaves;
     b->mi.bounces = st.rounds;
-    b->mi.w = b->mo->hr_eps > 0.0f ? b->mo->hr_eps : 1e-5f;
+    b->mi.w = (float)hr_tolerance(b->mo, b->w->scene->triangle_count);
     return NULL;
 }
 
@@ -1218,13 +1225,9 @@ int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_met
        hierarchical radiosity); the links grow with the triangles at one tolerance, so a large
        scene takes a coarser one (1e-7 per triangle, 1e-5 to 1e-2) and one ray per link, which
        keeps 10^5 triangles and more to minutes and under 1 GiB */
-    {
-        uint32_t T = w->scene->triangle_count;
-        double eps = 1e-7 * (double)T;
-        ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : eps < 1e-5 ? 1e-5 : eps > 1e-2 ? 1e-2 : eps;
-        if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
-        else if (T >= 100000u) ho.visibility_rays = 1;
-    }
+    ho.tolerance = hr_tolerance(mo, w->scene->triangle_count);
+    if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
+    else if (w->scene->triangle_count >= 100000u) ho.visibility_rays = 1;
     ho.min_area = mo->hr_min_area;
     /* a large scene at a fine tolerance refines coarser once its elements and links reach
        1.5 GiB instead of growing until the machine runs out */
