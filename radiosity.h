@@ -1350,7 +1350,8 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
      3. gather and push-pull (Jacobi): G_r = sum over r's links of F_rs B_s; pushed down
         (an element receives what its ancestors gathered), B = E + rho G at the leaves,
         pulled up as area-weighted means; repeated until B changes by less than 1e-6 of
-        max B. A leaf whose form factors (its ancestors' included) sum past 1.2, which
+        max B (1e-3 in a round whose refinement changed links, except the last round: its B
+        only guides the next refinement). A leaf whose form factors (its ancestors' included) sum past 1.2, which
         coincident duplicate surfaces, overlapping sources that one visibility ray each
         both pass, and cluster estimates can give, has G scaled to that sum 1.2 (lower where
         rho times 1.2 passes 0.999): otherwise the sweeps can grow B without bound;
@@ -1370,11 +1371,14 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    bound on the power it carries, max_c(B) of the source's members times A_r
    min(1, A_s / (pi g^2)), exceeds tolerance * P; links reaching two elements go on as in
    step 2. Such a link's F: the source's projected area toward the receiver, the sum over its
-   member triangles of A_j max(0, n_j . w) (w from centre to centre, d apart), over pi d^2,
-   times the weighted share of visibility rays between area-sampled member points that nothing
-   blocks. An element receiver takes its own cosine; a cluster receiver hands the irradiance
-   straight to its member triangles, each by its own cosine to the source (so a cluster lit
-   from one side lights only the triangles facing that side), before the push. Reentrant; the
+   member triangles of A_j max(0, n_j . w) (w from centre to centre, d apart), over pi (d^2 +
+   the ends' area spread across w), times the share of visibility rays between area-sampled member points that face each
+   other along their segment (weighted by those two cosines) that nothing blocks. An element receiver takes its own cosine; a cluster receiver hands the irradiance
+   to its member triangles, each by its own cosine to the source (so a cluster lit from one
+   side lights only the triangles facing that side), before the push: exactly where every
+   member's normal faces the source (a cone of the members' normals says so), else by the
+   quadratic fit 3/32 + t/2 + 15/32 t^2 of the clamped cosine t = n . w (its Legendre series
+   to degree 2), so the gather is O(links + clusters + triangles) a sweep. Reentrant; the
    solve uses ctx->parallel_for for the links' form factors and the clusters' gather; after it
    the accessors and lookups only read (any threads at once). Progress is reported after each
    level of refinement and each sweep (cancel stops either within that step); memory_limit
@@ -1458,15 +1462,15 @@ RAD_API rad_result rad_hierarchical_create(const rad_scene *scene, const rad_ray
                                            const rad_hierarchical_options *options, const rad_context *ctx,
                                            rad_hierarchical **out);
 /* Runs the solve (steps 1 to 4 above). Can be called once. ctx: logging, progress (after each
-   refinement level and each sweep, rising through max_iterations rounds, 1 at the end;
-   cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
+   refinement level, each 2^20 links of a level and each sweep; round k within [1 - 2^-k,
+   1 - 2^-(k+1)), so the first round is the first half; 1 at the end; cancel gives CANCELLED), the allocator is create's. Errors: INVALID_ARGUMENT (called
    twice), RAYCAST_FAILED, NON_FINITE (a source value), NEGATIVE_EMISSION (the source gave
    E < 0), NOT_CONVERGED (the sweeps of a round did not reach 1e-6 in 1000; or a form factor
    or B of the solver's own that is not finite, logged as "internal"), CANCELLED,
    OUT_OF_MEMORY. After an error the object can only be destroyed.
    Cost: O(links * visibility_rays) kernels and rays, O(links + elements) per sweep; with
-   clustering also O(members of the source) projections per cluster link evaluated and, per
-   sweep, per triangle the links into the clusters above it. */
+   clustering also O(members of the source) projections per cluster link evaluated and
+   O(clusters + triangles) per sweep. */
 RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context *ctx);
 RAD_API void rad_hierarchical_destroy(rad_hierarchical *h);
 
@@ -11101,6 +11105,7 @@ done:
 #define RAD__HR_DEFAULT_ROUNDS 16u
 #define RAD__HR_MAX_SWEEPS 1000u
 #define RAD__HR_SWEEP_TOLERANCE 1e-6
+#define RAD__HR_ROUND_TOLERANCE 1e-3 /* the sweeps of a round that is not the last */
 #define RAD__HR_SOURCE_BATCH 4096u
 #define RAD__HR_ROW_CAP 1.2      /* largest form-factor sum a leaf gathers over */
 #define RAD__HR_MAX_GAIN 0.999   /* largest rho times that sum */
@@ -11133,15 +11138,23 @@ typedef struct rad__hr_cluster {
     float c[3], radius, area;
     float m2[6];         /* the members' second moments about c (rad__hr_tri_m2) */
     float B[3], bmax;    /* area-weighted mean B of the members, and their largest channel */
+    float axis[3], cone_cos, cone_sin; /* a cone holding every member's normal (half angle) */
     uint32_t child[2], lo, hi, parent;
 } rad__hr_cluster;
 
-/* a link into a cluster, by receiver (the gather's per-member pass): F and the unit direction
-   u from the receiver's centre to the source's */
+/* a link into a cluster, by receiver (the gather): F, the unit direction u from the
+   receiver's centre to the source's, and how u meets the receiver's normal cone
+   (RAD__HR_IN_*) */
 typedef struct rad__hr_in {
     float u[3], F;
-    uint32_t s;
+    uint32_t s, kind;
 } rad__hr_in;
+#define RAD__HR_IN_BEHIND 0u /* every member faces away from u: no light */
+#define RAD__HR_IN_FRONT 1u  /* every member faces u: n . u >= 0, the cosine exact as a vector */
+#define RAD__HR_IN_MIXED 2u  /* both: the clamped cosine by its quadratic (Legendre) fit */
+/* per cluster and per channel (B's three and the form factors' S): the vector sum of the
+   FRONT links' F B u (3), then of the MIXED links F B (1), F B u (3) and F B u u^T (6) */
+#define RAD__HR_ACC 13u
 
 struct rad_hierarchical {
     const rad_scene *scene;
@@ -11161,6 +11174,7 @@ struct rad_hierarchical {
     double *cum_area;        /* cum_area[i]: the area of perm[0, i) */
     rad__hr_in *in;          /* links into clusters, grouped by receiver: in_first[c] .. in_first[c + 1] */
     uint32_t *in_first;
+    double *acc;             /* RAD__HR_ACC x 4 per cluster: what the gather hands down the tree */
     rad_hierarchical_stats st;
     int state;           /* 0 created, 1 solved, -1 a solve failed */
     uint32_t round;      /* the round under way, and the progress reported so far */
@@ -11179,11 +11193,14 @@ static void rad__hierarchical_options_resolve(rad_hierarchical_options *o)
     if (o->ray_epsilon == 0.0f) o->ray_epsilon = 1e-5f;
 }
 
-/* Reports progress (round + within) / max_iterations, never going back; 1 when the caller
-   asked to stop (logged, naming the step). */
+/* Reports progress, 'within' the round under way from 0 to 1, never going back; 1 when the
+   caller asked to stop (logged, naming the step). */
 static int rad__hr_progress(rad_hierarchical *h, const rad__ctx *c, double within, const char *step)
 {
-    float f = (float)(((double)h->round + (within < 0.0 ? 0.0 : within > 1.0 ? 1.0 : within)) / (double)h->o.max_iterations);
+    /* round k holds [1 - 2^-k, 1 - 2^-(k+1)): the first round, most of a large scene's work,
+       half of the bar (a share of 1 / max_iterations left it near 0% for most of the solve) */
+    double w = within < 0.0 ? 0.0 : within > 1.0 ? 1.0 : within;
+    float f = h->round >= h->o.max_iterations ? 1.0f : (float)(1.0 - ldexp(1.0 - 0.5 * w, -(int)h->round));
     if (!c->progress) return 0;
     if (f < h->reported) f = h->reported;
     if (f > 1.0f) f = 1.0f;
@@ -11204,7 +11221,7 @@ RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
 {
     if (h) {
         void *blocks[] = { h->el, h->links, h->leaf, h->leaf_of, h->leaf_vert, h->vert_B, h->vert_H, h->cl,
-                           h->perm, h->tri_parent, h->cum_area, h->in, h->in_first, h };
+                           h->perm, h->tri_parent, h->cum_area, h->in, h->in_first, h->acc, h };
         rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
 }
@@ -11281,6 +11298,12 @@ static void rad__hr_node(const rad_hierarchical *h, uint32_t id, float *c, float
         if (B) *B = b;
         if (bmax) *bmax = b[0] > b[1] ? (b[0] > b[2] ? b[0] : b[2]) : (b[1] > b[2] ? b[1] : b[2]);
     }
+}
+
+/* node id's mean B (what rad__hr_node gives, without the geometry) */
+static const float *rad__hr_B(const rad_hierarchical *h, uint32_t id)
+{
+    return rad__hr_is_cl(id) ? h->cl[id & ~RAD__HR_CL].B : h->el[id].B;
 }
 
 /* the clusters' B and bmax from their children's, bottom up (children have larger indices) */
@@ -11493,6 +11516,22 @@ static rad_result rad__hr_build_clusters(rad_hierarchical *h, const rad__ctx *c)
             }
         cl->radius = (float)sqrt((double)r2) * (1.0f + 1e-6f);
         cl->area = (float)(h->cum_area[cl->hi] - h->cum_area[cl->lo]);
+        { /* the normal cone: about the area-weighted mean normal, out to the widest member */
+            double a[3] = { 0.0, 0.0, 0.0 }, l;
+            float cmin = 1.0f;
+            for (j = cl->lo; j < cl->hi; ++j)
+                for (m = 0; m < 3; ++m) a[m] += (double)S->areas[h->perm[j]] * (double)S->normals[3 * (size_t)h->perm[j] + m];
+            l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            for (m = 0; m < 3; ++m) cl->axis[m] = l > 0.0 ? (float)(a[m] / l) : (m == 2 ? 1.0f : 0.0f);
+            for (j = cl->lo; j < cl->hi; ++j) {
+                float q = rad__dot(cl->axis, S->normals + 3 * (size_t)h->perm[j]);
+                if (q < cmin) cmin = q;
+            }
+            cmin -= 1e-4f; /* rounding: a member on the cone's edge stays inside */
+            if (cmin < -1.0f || !(l > 0.0)) cmin = -1.0f;
+            cl->cone_cos = cmin;
+            cl->cone_sin = (float)sqrt(1.0 - (double)cmin * (double)cmin);
+        }
         {
             double m2[6] = { 0, 0, 0, 0, 0, 0 };
             for (j = cl->lo; j < cl->hi; ++j)
@@ -11830,15 +11869,19 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
     for (a = 0; a < 4u * K && got < K; ++a) {
         uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s ^ rad__hash(a + 0x632be5abu))));
         uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
-        float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2;
+        float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2, dd[3];
         rad__hr_node_point(h, lk->r, (float)(h1 >> 8) / 16777216.0f, (float)(h2 & 0xFFFFu) / 65536.0f,
                            (float)(h2 >> 16) / 65536.0f, x, n1);
         rad__hr_node_point(h, lk->s, (float)(h3 >> 8) / 16777216.0f, (float)(h1 & 0xFFu) / 256.0f + (float)(h3 & 0xFFu) / 65536.0f,
                            (float)((h3 >> 8) & 0xFFFFu) / 65536.0f, y, n2);
-        c1 = -rad__dot(n1, w);
-        c2 = rad__dot(n2, w);
+        /* the pair's own cosines along its segment: a pair that faces along the centre line
+           but not along its segment would count as blocked (its ray leaves through its own
+           surface) while the opposite pairs were never drawn */
+        rad__sub(dd, y, x);
+        c1 = rad__dot(n1, dd);
+        c2 = -rad__dot(n2, dd);
         if (!(c1 > 0.0f && c2 > 0.0f)) continue;
-        wt[got] = c1 * c2;
+        wt[got] = c1 * c2 / rad__dot(dd, dd);
         wsum += (double)wt[got];
         ++got;
     }
@@ -12138,7 +12181,17 @@ static rad_result rad__hr_refine(rad_hierarchical *h, int *changed, const rad__c
                 r = e == l.s ? rad__hr_push(h, &next, l.r, ch, c) : rad__hr_push(h, &next, ch, l.s, c);
             }
         }
-        if (r == RAD_SUCCESS) r = rad__hr_evaluate(h, next.a, next.n, c);
+        { /* a level of millions of links in chunks, so that the progress moves through it */
+            size_t at, chunk = (size_t)1 << 20;
+            for (at = 0; at < next.n && r == RAD_SUCCESS; at += chunk) {
+                size_t n = next.n - at < chunk ? next.n - at : chunk;
+                r = rad__hr_evaluate(h, next.a + at, n, c);
+                if (r == RAD_SUCCESS && at + n < next.n &&
+                    rad__hr_progress(h, c, 0.5 * (1.0 - level_share + 0.5 * level_share * (double)(at + n) / (double)next.n),
+                                     "refinement"))
+                    r = RAD_ERROR_CANCELLED;
+            }
+        }
         {
             uint64_t held = (uint64_t)h->cap_el * sizeof(rad__hr_elem) + (uint64_t)(keep.cap + cand.cap + next.cap) * sizeof(rad__hr_link);
             if (held > h->st.peak_bytes) h->st.peak_bytes = held;
@@ -12203,6 +12256,21 @@ static rad_result rad__hr_build_in(rad_hierarchical *h, const rad__ctx *c)
         rad__normalize(e->u);
         e->F = lk->F;
         e->s = lk->s;
+        { /* the cone's half angle t and the angle g between axis and u: every member faces u
+             when g + t <= pi/2, every one faces away when g - t >= pi/2 */
+            const rad__hr_cluster *q = &h->cl[cr];
+            float cg = rad__dot(q->axis, e->u);
+            e->kind = q->cone_cos >= 0.0f && cg >= q->cone_sin    ? RAD__HR_IN_FRONT
+                      : q->cone_cos >= 0.0f && cg <= -q->cone_sin ? RAD__HR_IN_BEHIND
+                                                                  : RAD__HR_IN_MIXED;
+        }
+    }
+    if (!h->acc) {
+        h->acc = (double *)rad__alloc_array(&h->allocator, (size_t)h->ncl, 4u * RAD__HR_ACC * sizeof(double));
+        if (!h->acc) {
+            rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the clusters' gather");
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
     }
     for (i = h->ncl; i > 0; --i) h->in_first[i] = h->in_first[i - 1u];
     h->in_first[0] = 0;
@@ -12211,35 +12279,74 @@ static rad_result rad__hr_build_in(rad_hierarchical *h, const rad__ctx *c)
 
 typedef struct rad__hr_gather {
     rad_hierarchical *h;
-    uint32_t tasks;
+    uint32_t tasks, phase;
 } rad__hr_gather;
 
-/* Each scene triangle (the root of its quadtree) gathers over the links into the clusters
-   above it, by its own cosine to each source: a task writes only its own triangles. */
+/* The gather into clusters in O(links + clusters + triangles) (a walk of every member per
+   link costs the members times the links, most of a large scene's solve). Phase 0, per
+   cluster: its links' sums (RAD__HR_ACC per channel, channel 3 the form factors alone): a link
+   whose direction u every member faces adds F B u, which a member's n dots into its exact
+   F B (n . u); one some members face and some do not adds to the sums of the quadratic
+   (Legendre, to degree 2) fit of the clamped cosine max(0, t) ~ 3/32 + t / 2 + 15/32 t^2,
+   t = n . u, which keeps the mean over all normals; one every member faces away from adds
+   nothing. Phase 1 (the caller) hands the sums down the tree; phase 2, per scene triangle:
+   its own n applied to the sums of the cluster above it. A task writes only its own range. */
 static void rad__hr_gather_task(void *data, uint32_t task)
 {
     const rad__hr_gather *g = (const rad__hr_gather *)data;
     rad_hierarchical *h = g->h;
-    uint32_t T = h->scene->triangle_count, i;
-    uint32_t b = (uint32_t)((uint64_t)T * task / g->tasks), e = (uint32_t)((uint64_t)T * (task + 1u) / g->tasks);
+    uint32_t n = g->phase == 0 ? h->ncl : h->scene->triangle_count, i, j, k, q;
+    uint32_t b = (uint32_t)((uint64_t)n * task / g->tasks), e = (uint32_t)((uint64_t)n * (task + 1u) / g->tasks);
     for (i = b; i < e; ++i) {
-        rad__hr_elem *el = &h->el[i];
-        double G[3] = { 0.0, 0.0, 0.0 }, S = 0.0;
-        uint32_t a, j, k;
-        for (a = h->tri_parent[i]; a != RAD_NONE; a = h->cl[a].parent)
-            for (j = h->in_first[a]; j < h->in_first[a + 1u]; ++j) {
+        if (g->phase == 0) {
+            double *a = h->acc + (size_t)i * 4u * RAD__HR_ACC;
+            memset(a, 0, 4u * RAD__HR_ACC * sizeof(double));
+            for (j = h->in_first[i]; j < h->in_first[i + 1u]; ++j) {
                 const rad__hr_in *in = &h->in[j];
-                float cs = rad__dot(el->n, in->u);
                 const float *B;
-                double f;
-                if (!(cs > 0.0f)) continue;
-                f = (double)in->F * (double)cs;
-                rad__hr_node(h, in->s, NULL, NULL, NULL, &B, NULL);
-                for (k = 0; k < 3; ++k) G[k] += f * (double)B[k];
-                S += f;
+                double w[4], u[3];
+                if (in->kind == RAD__HR_IN_BEHIND || !(in->F > 0.0f)) continue;
+                B = rad__hr_B(h, in->s);
+                for (k = 0; k < 3; ++k) {
+                    w[k] = (double)in->F * (double)B[k];
+                    u[k] = (double)in->u[k];
+                }
+                w[3] = (double)in->F;
+                for (k = 0; k < 4; ++k) {
+                    double *ak = a + k * RAD__HR_ACC;
+                    if (in->kind == RAD__HR_IN_FRONT) {
+                        for (q = 0; q < 3; ++q) ak[q] += w[k] * u[q];
+                        continue;
+                    }
+                    ak[3] += w[k];
+                    for (q = 0; q < 3; ++q) ak[4 + q] += w[k] * u[q];
+                    ak[7] += w[k] * u[0] * u[0];
+                    ak[8] += w[k] * u[1] * u[1];
+                    ak[9] += w[k] * u[2] * u[2];
+                    ak[10] += w[k] * u[0] * u[1];
+                    ak[11] += w[k] * u[0] * u[2];
+                    ak[12] += w[k] * u[1] * u[2];
+                }
             }
-        for (k = 0; k < 3; ++k) el->G[k] += G[k];
-        el->S += S;
+        } else {
+            rad__hr_elem *el = &h->el[i];
+            const double *a;
+            double N[3], G[4];
+            if (h->tri_parent[i] == RAD_NONE) continue;
+            a = h->acc + (size_t)h->tri_parent[i] * 4u * RAD__HR_ACC;
+            for (q = 0; q < 3; ++q) N[q] = (double)el->n[q];
+            for (k = 0; k < 4; ++k) {
+                const double *ak = a + k * RAD__HR_ACC;
+                double front = N[0] * ak[0] + N[1] * ak[1] + N[2] * ak[2];
+                double lin = N[0] * ak[4] + N[1] * ak[5] + N[2] * ak[6];
+                double quad = N[0] * N[0] * ak[7] + N[1] * N[1] * ak[8] + N[2] * N[2] * ak[9] +
+                              2.0 * (N[0] * N[1] * ak[10] + N[0] * N[2] * ak[11] + N[1] * N[2] * ak[12]);
+                double mixed = (3.0 / 32.0) * ak[3] + 0.5 * lin + (15.0 / 32.0) * quad;
+                G[k] = (front > 0.0 ? front : 0.0) + (mixed > 0.0 ? mixed : 0.0);
+            }
+            for (k = 0; k < 3; ++k) el->G[k] += G[k];
+            el->S += G[3];
+        }
     }
 }
 
@@ -12267,7 +12374,7 @@ static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *
         const float *B;
         if (rad__hr_is_cl(lk->r)) continue; /* below, per member */
         er = &h->el[lk->r];
-        rad__hr_node(h, lk->s, NULL, NULL, NULL, &B, NULL);
+        B = rad__hr_B(h, lk->s);
         for (k = 0; k < 3; ++k) er->G[k] += (double)lk->F * (double)B[k];
         er->S += (double)lk->F;
     }
@@ -12275,6 +12382,16 @@ static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *
         rad__hr_gather g;
         uint32_t T = h->scene->triangle_count;
         g.h = h;
+        g.phase = 0;
+        g.tasks = (h->ncl + 1023u) / 1024u < c->tasks ? (h->ncl + 1023u) / 1024u : c->tasks;
+        if (g.tasks == 0) g.tasks = 1;
+        c->parallel_for(c->parallel_user, g.tasks, rad__hr_gather_task, &g);
+        for (i = 1; i < h->ncl; ++i) { /* down the tree: parents come first */
+            double *a = h->acc + (size_t)i * 4u * RAD__HR_ACC;
+            const double *p = h->acc + (size_t)h->cl[i].parent * 4u * RAD__HR_ACC;
+            for (k = 0; k < 4u * RAD__HR_ACC; ++k) a[k] += p[k];
+        }
+        g.phase = 2;
         g.tasks = (T + 1023u) / 1024u < c->tasks ? (T + 1023u) / 1024u : c->tasks;
         if (g.tasks == 0) g.tasks = 1;
         c->parallel_for(c->parallel_user, g.tasks, rad__hr_gather_task, &g);
@@ -12482,17 +12599,21 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
         int changed = 0;
         h->round = round;
         uint32_t first = h->nel, s;
-        double res = 0.0;
+        double res = 0.0, tol;
         r = rad__hr_refine(h, &changed, &c);
         if (r == RAD_SUCCESS) r = rad__hr_sources(h, first, &c);
         if (r == RAD_SUCCESS && h->cl) r = rad__hr_build_in(h, &c);
         if (r != RAD_SUCCESS) break;
+        /* a round that refined and is not the last only feeds the next refinement, whose
+           oracle needs B to a few per cent: its sweeps stop at RAD__HR_ROUND_TOLERANCE, and the
+           last round (no link refined, or max_iterations) goes on to RAD__HR_SWEEP_TOLERANCE */
+        tol = changed && round + 1u < h->o.max_iterations ? RAD__HR_ROUND_TOLERANCE : RAD__HR_SWEEP_TOLERANCE;
         for (s = 0; s < RAD__HR_MAX_SWEEPS; ++s) {
             if ((r = rad__hr_sweep(h, &c, &res)) != RAD_SUCCESS) break;
             h->st.sweeps++;
-            if (res < RAD__HR_SWEEP_TOLERANCE) break;
-            /* the sweeps: the other half, by how far the change has fallen toward 1e-6 */
-            if (rad__hr_progress(h, &c, res > 0.0 ? 0.5 + 0.5 * log(res) / log(RAD__HR_SWEEP_TOLERANCE) : 1.0, "sweeps")) {
+            if (res < tol) break;
+            /* the sweeps: the other half, by how far the change has fallen toward tol */
+            if (rad__hr_progress(h, &c, res > 0.0 ? 0.5 + 0.5 * log(res) / log(tol) : 1.0, "sweeps")) {
                 r = RAD_ERROR_CANCELLED;
                 break;
             }

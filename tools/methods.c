@@ -274,11 +274,12 @@ static const tool_arg method_args[] = {
     TEXT(0, "hierarchical (Hanrahan et al. 1991: quadtrees on the triangles, links by BF refinement,\n"
             "solved to convergence; --bounces is not used; a bake resamples it onto the patches):\n"),
     FLOAT("--hr-eps", "E", hr_eps, 0.0, 1.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, TOOL_OPT_HR_EPS,
-          "must be in (0, 1) (e.g. 1e-3)", 0, "refinement tolerance, a fraction of the source power (default 1e-5)"),
+          "must be in (0, 1) (e.g. 1e-3)", 0, "refinement tolerance, a fraction of the source power (default 1e-7 per triangle,\n"
+          "from 1e-5 to 1e-2)"),
     FLOAT("--hr-min-area", "A", hr_min_area, 0.0, 1e30, TOOL_ARG_LO_OPEN, TOOL_OPT_HR_MIN_AREA,
           "must be a positive area", 0, "smallest element area, scene units^2 (default: total area / 10000)"),
     CUSTOM("--hr-rays", "R", hr_rays, parse_hr_rays, TOOL_OPT_HR_RAYS, 0,
-           "points and visibility rays per link: 1, 4, 9 ... 64 (default 4)"),
+           "points and visibility rays per link: 1, 4, 9 ... 64 (default 4; 1 from 10^5 triangles)"),
     {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
 };
 #undef R
@@ -578,6 +579,13 @@ static uint32_t mb_bounces(uint32_t bounces)
     return bounces == RAD_MB_INFINITE ? RAD_MB_INFINITE : bounces + 1u;
 }
 
+/* --hr-eps, or the default for T scene triangles (tool_hierarchical_build says why) */
+static double hr_tolerance(const tool_method_options *mo, uint32_t T)
+{
+    double eps = 1e-7 * (double)T;
+    return mo->hr_eps > 0.0f ? (double)mo->hr_eps : eps < 1e-5 ? 1e-5 : eps > 1e-2 ? 1e-2 : eps;
+}
+
 /* --method hierarchical baked: the solution's H resampled onto the bake's patches, as the
    stochastic bake's L = rho H (the mean of the leaf values at the patch's centroid and half
    way from it to each corner) */
@@ -762,7 +770,7 @@ static const char *method_bake_hierarchical(method_bake *b, uint32_t light_sampl
     b->bytes = (size_t)st.links; /* the record's byte count holds the links here */
     b->mi.k = st.leaves;
     b->mi.bounces = st.rounds;
-    b->mi.w = b->mo->hr_eps > 0.0f ? b->mo->hr_eps : 1e-5f;
+    b->mi.w = (float)hr_tolerance(b->mo, b->w->scene->triangle_count);
     return NULL;
 }
 
@@ -1212,11 +1220,15 @@ int tool_hierarchical_build(const char *cmd, const tool_world *w, const tool_met
     double t0 = tool_seconds();
     *out = NULL;
     rad_hierarchical_options_default(&ho);
-    /* finer than the library's teaching default: a still image as close to the path tracer as
-       classic's at a small part of its rays (docs/performance-notes.md, hierarchical radiosity) */
-    ho.tolerance = mo->hr_eps > 0.0f ? mo->hr_eps : 1e-5;
-    ho.min_area = mo->hr_min_area;
+    /* finer than the library's teaching default on small scenes: a still image as close to the
+       path tracer as classic's at a small part of its rays (docs/performance-notes.md,
+       hierarchical radiosity); the links grow with the triangles at one tolerance, so a large
+       scene takes a coarser one (1e-7 per triangle, 1e-5 to 1e-2) and one ray per link, which
+       keeps 10^5 triangles and more to minutes and under 1 GiB */
+    ho.tolerance = hr_tolerance(mo, w->scene->triangle_count);
     if (mo->hr_rays) ho.visibility_rays = mo->hr_rays;
+    else if (w->scene->triangle_count >= 100000u) ho.visibility_rays = 1;
+    ho.min_area = mo->hr_min_area;
     /* a large scene at a fine tolerance refines coarser once its elements and links reach
        1.5 GiB instead of growing until the machine runs out */
     ho.memory_limit = (uint64_t)1536u << 20;
