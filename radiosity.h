@@ -6942,9 +6942,8 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
     return leaves;
 }
 
-/* The room for 'nodes' wide nodes and 'leaves' leaves, in one block whose nodes start on a
-   64-byte boundary: a 256-byte node then spans four cache lines, not five, and the
-   traversal's time goes mostly to loading nodes and leaves. */
+/* The room for the collapse's 'nodes' wide nodes and 'leaves' leaves, in one block (which
+   rad__bvh_interleave then lays out for the traversal). */
 static rad_result rad__bvh_block(rad__ctx *c, rad_bvh *b, uint32_t nodes, uint32_t leaves)
 {
     size_t nodes_bytes, leaves_bytes;
@@ -6977,6 +6976,7 @@ static rad_result rad__bvh_interleave(rad__ctx *c, rad_bvh *b, void *tmp)
         off[i] = (uint32_t)units;
         units += (sizeof(rad__bvhw) + nl * sizeof(rad__tri4) + 63u) / 64u;
         if (units >= RAD__BVH4_LEAF) { /* child words hold offsets / 64 below 2^31 */
+            rad__log(c, RAD_LOG_ERROR, "the built-in BVH's tree exceeds 2^31 cache lines");
             rad__free(&c->allocator, off);
             rad__free(&c->allocator, tmp);
             return RAD_ERROR_SIZE_OVERFLOW;
@@ -7091,7 +7091,8 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
    enters a box by (lo for a positive direction, hi for a negative one) and of the plane it
    leaves by, so each box test takes no min/max to order them. */
 typedef struct rad__wray {
-    float o[3], d[3], inv[3], invw[3];
+    float o[3], d[3], inv[3];
+    float invw[3];            /* inv widened by 1 + 2 gamma_3, for the slab test's far planes */
     float sx, sy, sz;
     int kx, ky, kz;
     float tmin, tmax;
@@ -7220,7 +7221,9 @@ static int rad__wray_tri(const rad__wray *w, const float *v, int front_only, flo
    of each axis is read at w->near_off, the exit plane at w->far_off (the same values a
    min/max of the two would pick, since rounding is monotonic). Each slab's far distance is
    widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
-   through shared vertices on box faces). */
+   through shared vertices on box faces): the far planes take the reciprocal times that
+   factor (w->invw), which bounds the same roundings as widening the product, one multiply
+   less per axis. */
 static int rad__bvhw_boxes(const rad__bvhw *n, const rad__wray *w, float tmax, float *tnear)
 {
     const char *base = (const char *)n;
@@ -7242,7 +7245,7 @@ static int rad__bvhw_boxes(const rad__bvhw *n, const rad__wray *w, float tmax, f
         float t0 = w->tmin, t1 = tmax * 1.0000004f + 1e-30f;
         for (a = 0; a < 3; ++a) {
             float x = (((const float *)(const void *)(base + w->near_off[a]))[k] - w->o[a]) * w->inv[a];
-            float y = (((const float *)(const void *)(base + w->far_off[a]))[k] - w->o[a]) * w->inv[a] * 1.0000004f;
+            float y = (((const float *)(const void *)(base + w->far_off[a]))[k] - w->o[a]) * w->invw[a];
             if (x > t0) t0 = x;
             if (y < t1) t1 = y;
         }
