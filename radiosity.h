@@ -6445,10 +6445,14 @@ typedef struct rad__bvh_node {
 #endif
 typedef struct rad__bvhw {
     float lo[3][RAD__BVH_W], hi[3][RAD__BVH_W]; /* per axis, per child */
-    uint32_t child[RAD__BVH_W]; /* RAD__BVH4_LEAF | leaf block for a leaf, else node index */
-    uint32_t count[RAD__BVH_W]; /* triangles of a leaf child (1 to 4) */
+    /* an inner child: the byte offset of its node in the tree / 64; a leaf: RAD__BVH4_LEAF |
+       (triangles - 1) << 29 | the byte offset of its triangles from this node (while the
+       build collapses the tree: their leaf block) */
+    uint32_t child[RAD__BVH_W];
 } rad__bvhw;
 #define RAD__BVH4_LEAF 0x80000000u
+#define RAD__BVH_LEAF_AT(ch) ((ch) & 0x1FFFFFFFu)
+#define RAD__BVH_LEAF_COUNT(ch) ((((ch) >> 29) & 3u) + 1u)
 
 /* A leaf's triangles (at most four) side by side, so one SIMD pass tests them all: lane j of
    v[c][a] is coordinate a of vertex c of triangle j. Unused lanes are zero (id RAD_NONE) and
@@ -6519,9 +6523,13 @@ static int rad__cutout_opaque(const rad__cutout *k, uint32_t t, float b1, float 
 }
 
 struct rad_bvh {
-    rad__bvhw *nodes;         /* in 'block', aligned to a cache line */
+    /* the traversal's tree, in 'block' from a cache line on: each wide node followed by the
+       triangles of its leaf children, so a node and its leaves share pages and neighbouring
+       cache lines; nodes start on 64-byte boundaries */
+    const unsigned char *tree;
+    rad__bvhw *nodes;         /* while building: the wide nodes, */
     uint32_t node_count;
-    rad__tri4 *leaves;        /* in 'block', after the nodes */
+    rad__tri4 *leaves;        /* and the leaves, apart */
     uint32_t leaf_count;
     uint32_t tri_count;
     void *block;              /* the allocation holding nodes and leaves */
@@ -6940,7 +6948,6 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvhw_dp *dp, uint32_
                 /* an inverted box, which the slab test never enters */
                 for (a = 0; a < 3; ++a) { node->lo[a][k] = FLT_MAX; node->hi[a][k] = -FLT_MAX; }
                 node->child[k] = RAD_NONE;
-                node->count[k] = 0;
                 continue;
             }
             for (a = 0; a < 3; ++a) { node->lo[a][k] = bin[slots[k]].bmin[a]; node->hi[a][k] = bin[slots[k]].bmax[a]; }
@@ -6956,12 +6963,10 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvhw_dp *dp, uint32_
                     q->id[j] = order[bin[slots[k]].first + j];
                     if (twins && twins[q->id[j]] != RAD_NONE) q->id[j] |= RAD__BVH_FRONT_ONLY;
                 }
-                node->child[k] = RAD__BVH4_LEAF | b->leaf_count++;
-                node->count[k] = bin[slots[k]].count;
+                node->child[k] = RAD__BVH4_LEAF | (bin[slots[k]].count - 1u) << 29 | b->leaf_count++;
             } else {
                 uint32_t m = b->node_count++;
                 node->child[k] = m;
-                node->count[k] = 0;
                 stack[sp++] = slots[k];
                 stack[sp++] = m;
                 node = &b->nodes[n4];
@@ -7014,9 +7019,8 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
     return leaves;
 }
 
-/* The room for 'nodes' wide nodes and 'leaves' leaves, in one block whose nodes start on a
-   64-byte boundary: a 256-byte node then spans four cache lines, not five, and the
-   traversal's time goes mostly to loading nodes and leaves. */
+/* The room for the collapse's 'nodes' wide nodes and 'leaves' leaves, in one block (which
+   rad__bvh_interleave then lays out for the traversal). */
 static rad_result rad__bvh_block(rad__ctx *c, rad_bvh *b, uint32_t nodes, uint32_t leaves)
 {
     size_t nodes_bytes, leaves_bytes;
@@ -7028,6 +7032,59 @@ static rad_result rad__bvh_block(rad__ctx *c, rad_bvh *b, uint32_t nodes, uint32
     if (!b->block) return RAD_ERROR_OUT_OF_MEMORY;
     b->nodes = (rad__bvhw *)(void *)((char *)b->block + ((64u - (uintptr_t)b->block % 64u) % 64u));
     b->leaves = (rad__tri4 *)(void *)(b->nodes + nodes);
+    return RAD_SUCCESS;
+}
+
+/* The traversal's tree from the collapse's separate nodes and leaves (b->nodes, b->leaves in
+   'tmp', freed here): node i at 64 off[i] bytes, its leaves' triangles right after it in slot
+   order, the next node at the next 64-byte boundary. A node visit and the leaf tests that
+   follow it then read neighbouring lines (which the hardware prefetches with the node)
+   instead of a second array megabytes away. */
+static rad_result rad__bvh_interleave(rad__ctx *c, rad_bvh *b, void *tmp)
+{
+    uint32_t *off, i, k;
+    size_t units = 0;
+    unsigned char *tree;
+    off = (uint32_t *)rad__alloc_array(&c->allocator, b->node_count, sizeof(uint32_t));
+    if (!off) { rad__free(&c->allocator, tmp); return RAD_ERROR_OUT_OF_MEMORY; }
+    for (i = 0; i < b->node_count; ++i) {
+        uint32_t nl = 0;
+        for (k = 0; k < RAD__BVH_W; ++k) nl += b->nodes[i].child[k] != RAD_NONE && (b->nodes[i].child[k] & RAD__BVH4_LEAF);
+        off[i] = (uint32_t)units;
+        units += (sizeof(rad__bvhw) + nl * sizeof(rad__tri4) + 63u) / 64u;
+        if (units >= RAD__BVH4_LEAF) { /* child words hold offsets / 64 below 2^31 */
+            rad__log(c, RAD_LOG_ERROR, "the built-in BVH's tree exceeds 2^31 cache lines");
+            rad__free(&c->allocator, off);
+            rad__free(&c->allocator, tmp);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
+    }
+    b->block_bytes = units * 64u + 64u;
+    b->block = rad__alloc(&c->allocator, b->block_bytes);
+    if (!b->block) { rad__free(&c->allocator, off); rad__free(&c->allocator, tmp); return RAD_ERROR_OUT_OF_MEMORY; }
+    tree = (unsigned char *)b->block + ((64u - (uintptr_t)b->block % 64u) % 64u);
+    memset(tree, 0, units * 64u); /* the padding too */
+    for (i = 0; i < b->node_count; ++i) {
+        rad__bvhw *node = (rad__bvhw *)(void *)(tree + (size_t)off[i] * 64u);
+        size_t at = sizeof(rad__bvhw);
+        *node = b->nodes[i];
+        for (k = 0; k < RAD__BVH_W; ++k) {
+            uint32_t ch = node->child[k];
+            if (ch == RAD_NONE) continue;
+            if (!(ch & RAD__BVH4_LEAF)) {
+                node->child[k] = off[ch];
+                continue;
+            }
+            memcpy((unsigned char *)node + at, &b->leaves[RAD__BVH_LEAF_AT(ch)], sizeof(rad__tri4));
+            node->child[k] = (ch & ~0x1FFFFFFFu) | (uint32_t)at;
+            at += sizeof(rad__tri4);
+        }
+    }
+    rad__free(&c->allocator, off);
+    rad__free(&c->allocator, tmp);
+    b->tree = tree;
+    b->nodes = NULL;
+    b->leaves = NULL;
     return RAD_SUCCESS;
 }
 
@@ -7084,13 +7141,19 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     r = rad__bvh_block(&c, b, nodes, leaves);
     if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, &dp, 2u * n, stack, scene->positions, scene->twins, order);
     if (r == RAD_SUCCESS) r = rad__cutout_build(&c, scene, &b->cutout);
-    if (b->cutout) /* mark the cutout lanes */
+    if (r == RAD_SUCCESS && b->cutout) /* mark the cutout lanes */
         for (i = 0; i < b->leaf_count; ++i) {
             uint32_t j;
             for (j = 0; j < 4; ++j)
                 if (b->leaves[i].id[j] != RAD_NONE && b->cutout->slot[b->leaves[i].id[j] & RAD__BVH_ID_BITS] != RAD_NONE)
                     b->leaves[i].id[j] |= RAD__BVH_CUTOUT;
         }
+    if (r == RAD_SUCCESS) {
+        void *tmp = b->block; /* the collapse's arrays, replaced by the interleaved tree */
+        b->block = NULL;
+        b->block_bytes = 0;
+        r = rad__bvh_interleave(&c, b, tmp);
+    }
     {
         void *blocks[] = { refs, stack, task, order, tree, cost, pos };
         rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
@@ -7106,6 +7169,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
    leaves by, so each box test takes no min/max to order them. */
 typedef struct rad__wray {
     float o[3], d[3], inv[3];
+    float invw[3];            /* inv widened by 1 + 2 gamma_3, for the slab test's far planes */
     float sx, sy, sz;
     int kx, ky, kz;
     float tmin, tmax;
@@ -7129,6 +7193,7 @@ static void rad__wray_init(rad__wray *w, const rad_ray *r)
         w->o[k] = r->origin[k];
         w->d[k] = r->dir[k];
         w->inv[k] = 1.0f / d;
+        w->invw[k] = w->inv[k] * 1.0000004f;
         /* the sign bit of inv: the choice of inv >= 0 but for inv = -0 (d = -inf), where
            both planes give t = 0 alike */
         memcpy(&sign, &w->inv[k], sizeof(sign));
@@ -7233,20 +7298,22 @@ static int rad__wray_tri(const rad__wray *w, const float *v, int front_only, flo
    of each axis is read at w->near_off, the exit plane at w->far_off (the same values a
    min/max of the two would pick, since rounding is monotonic). Each slab's far distance is
    widened by 1 + 2 gamma_3 (Ize 2013), so rounding never culls a box the ray touches (rays
-   through shared vertices on box faces). */
+   through shared vertices on box faces): the far planes take the reciprocal times that
+   factor (w->invw), which bounds the same roundings as widening the product, one multiply
+   less per axis. */
 static int rad__bvhw_boxes(const rad__bvhw *n, const rad__wray *w, float tmax, float *tnear)
 {
     const char *base = (const char *)n;
 #if defined(RAD__SSE2)
-    rad__vf t0 = rad__bv_set1(w->tmin), t1 = rad__bv_set1(tmax * 1.0000004f + 1e-30f), widen = rad__bv_set1(1.0000004f);
+    rad__vf x[3], y[3], t0, t1;
     int a;
     for (a = 0; a < 3; ++a) {
-        rad__vf oa = rad__bv_set1(w->o[a]), ia = rad__bv_set1(w->inv[a]);
-        rad__vf x = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->near_off[a])), oa), ia);
-        rad__vf y = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->far_off[a])), oa), ia);
-        t0 = rad__bv_max(t0, x);
-        t1 = rad__bv_min(t1, rad__bv_mul(y, widen));
+        rad__vf oa = rad__bv_set1(w->o[a]);
+        x[a] = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->near_off[a])), oa), rad__bv_set1(w->inv[a]));
+        y[a] = rad__bv_mul(rad__bv_sub(rad__bv_load((const float *)(const void *)(base + w->far_off[a])), oa), rad__bv_set1(w->invw[a]));
     }
+    t0 = rad__bv_max(rad__bv_max(x[0], x[1]), rad__bv_max(x[2], rad__bv_set1(w->tmin)));
+    t1 = rad__bv_min(rad__bv_min(y[0], y[1]), rad__bv_min(y[2], rad__bv_set1(tmax * 1.0000004f + 1e-30f)));
     rad__vf_store(tnear, t0);
     return rad__bv_le_mask(t0, t1);
 #else
@@ -7255,7 +7322,7 @@ static int rad__bvhw_boxes(const rad__bvhw *n, const rad__wray *w, float tmax, f
         float t0 = w->tmin, t1 = tmax * 1.0000004f + 1e-30f;
         for (a = 0; a < 3; ++a) {
             float x = (((const float *)(const void *)(base + w->near_off[a]))[k] - w->o[a]) * w->inv[a];
-            float y = (((const float *)(const void *)(base + w->far_off[a]))[k] - w->o[a]) * w->inv[a] * 1.0000004f;
+            float y = (((const float *)(const void *)(base + w->far_off[a]))[k] - w->o[a]) * w->invw[a];
             if (x > t0) t0 = x;
             if (y < t1) t1 = y;
         }
@@ -7410,7 +7477,7 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
     float stack_t[(RAD__BVH_W - 1) * RAD__BVH_STACK], tmax = w->tmax;
     int found = 0;
     for (;;) {
-        const rad__bvhw *n = &bvh->nodes[cur];
+        const rad__bvhw *n = (const rad__bvhw *)(const void *)(bvh->tree + (size_t)cur * 64u);
         float tn[RAD__BVH_W];
         uint32_t mask = (uint32_t)rad__bvhw_boxes(n, w, tmax, tn), leaves = mask & (uint32_t)rad__bvhw_leaf_bits(n);
         uint32_t inner = mask & ~leaves, k;
@@ -7423,13 +7490,13 @@ static int rad__bvh_trace(const rad_bvh *bvh, const rad__wray *w, int any, rad_h
             leaves &= leaves - 1;
             ch = n->child[k];
             if (ch == RAD_NONE) continue; /* empty slots hold inverted boxes: never entered */
-            q = &bvh->leaves[ch & ~RAD__BVH4_LEAF];
-            j = rad__wray_tri4(w, q, n->count[k], any, &tmax, &t, &b1, &b2);
+            q = (const rad__tri4 *)(const void *)((const unsigned char *)n + RAD__BVH_LEAF_AT(ch));
+            j = rad__wray_tri4(w, q, RAD__BVH_LEAF_COUNT(ch), any, &tmax, &t, &b1, &b2);
             if (j >= 0) {
                 found = 1;
                 if (any) {
                     *hit_leaf = q;
-                    *hit_count = n->count[k];
+                    *hit_count = RAD__BVH_LEAF_COUNT(ch);
                     return 1;
                 }
                 hit->t = t;

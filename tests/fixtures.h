@@ -28,8 +28,32 @@ static inline void rad__bvh_destroy_real(rad_bvh *bvh) { rad_bvh_destroy(bvh); }
 #define RAD_TEST_EMBREE_MAX 256
 static struct { const rad_bvh *bvh; rad_embree *embree; } rad_test_embree_map[RAD_TEST_EMBREE_MAX];
 
+/* The BVH's leaves (each wide node is followed by its leaves' triangles), by a walk of its
+   tree; *count of them in a malloc'ed array, NULL when out of memory. */
+static inline const rad__tri4 **rad_test_bvh_leaves(const rad_bvh *bvh, uint32_t *count)
+{
+    const rad__tri4 **out = (const rad__tri4 **)malloc(sizeof(*out) * (bvh->leaf_count + 1u));
+    uint32_t *stack = (uint32_t *)malloc(sizeof(uint32_t) * (bvh->node_count + 1u)), sp = 0, k;
+    *count = 0;
+    if (!out || !stack) { free(out); free(stack); return NULL; }
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const rad__bvhw *n = (const rad__bvhw *)(const void *)(bvh->tree + (size_t)stack[--sp] * 64u);
+        for (k = 0; k < RAD__BVH_W; ++k) {
+            uint32_t ch = n->child[k];
+            if (ch == RAD_NONE) continue;
+            if (ch & RAD__BVH4_LEAF) out[(*count)++] = (const rad__tri4 *)(const void *)((const unsigned char *)n + RAD__BVH_LEAF_AT(ch));
+            else stack[sp++] = ch;
+        }
+    }
+    free(stack);
+    return out;
+}
+
 static inline void rad_test_embree_raycaster(const rad_bvh *bvh, rad_raycaster *out)
 {
+    const rad__tri4 **leaves;
+    uint32_t nleaves;
     rad_scene fake;
     float *pos;
     uint32_t i, slot = RAD_TEST_EMBREE_MAX;
@@ -43,21 +67,24 @@ static inline void rad_test_embree_raycaster(const rad_bvh *bvh, rad_raycaster *
     /* two-sided and cutout scenes keep the BVH: this copy of the triangles has no twins array
        for Embree's front-only filter and no uvs for its cutout filter (test_twosided.c and
        test_cutout.c check Embree on them directly) */
-    for (i = 0; i < bvh->leaf_count; ++i) {
+    leaves = rad_test_bvh_leaves(bvh, &nleaves);
+    if (!leaves) { printf("    FAIL out of memory\n"); rad_test_failures++; return; }
+    for (i = 0; i < nleaves; ++i) {
         uint32_t j;
         for (j = 0; j < 4; ++j)
-            if (bvh->leaves[i].id[j] != RAD_NONE && (bvh->leaves[i].id[j] & (RAD__BVH_FRONT_ONLY | RAD__BVH_CUTOUT))) return;
+            if (leaves[i]->id[j] != RAD_NONE && (leaves[i]->id[j] & (RAD__BVH_FRONT_ONLY | RAD__BVH_CUTOUT))) { free((void *)leaves); return; }
     }
     pos = (float *)malloc(sizeof(float) * 9 * bvh->tri_count);
-    if (!pos || slot == RAD_TEST_EMBREE_MAX) { free(pos); printf("    FAIL embree map full\n"); rad_test_failures++; return; }
-    for (i = 0; i < bvh->leaf_count; ++i) { /* the BVH's own copy of the triangles, lane by lane */
-        const rad__tri4 *q = &bvh->leaves[i];
+    if (!pos || slot == RAD_TEST_EMBREE_MAX) { free(pos); free((void *)leaves); printf("    FAIL embree map full\n"); rad_test_failures++; return; }
+    for (i = 0; i < nleaves; ++i) { /* the BVH's own copy of the triangles, lane by lane */
+        const rad__tri4 *q = leaves[i];
         uint32_t j, c, a;
         for (j = 0; j < 4; ++j)
             if (q->id[j] != RAD_NONE)
                 for (c = 0; c < 3; ++c)
                     for (a = 0; a < 3; ++a) pos[9 * (size_t)q->id[j] + 3 * c + a] = q->v[c][a][j];
     }
+    free((void *)leaves);
     memset(&fake, 0, sizeof(fake));
     fake.positions = pos;
     fake.triangle_count = bvh->tri_count;
