@@ -2338,7 +2338,13 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    merged rows and columns are exactly these merge rules applied to the whole sample matrix, with
    visibility. E is the area-weighted mean over the cluster's own samples (rad_vp_from_samples;
    DEPARTURE: Shcherbakov 2025 (ch. 5) weights every sample of the voxel by max(0, N_j . n_i), which does not
-   conserve the samples' power) and gathering uses w_j = max(0, N_j . n), normalized.
+   conserve the samples' power) and gathering uses w_j = A_j max(0, N_j . n), normalized
+   (DEPARTURE: the area factor; a point facing n lies in cluster j about as often as j's area
+   times the agreement of the normals, and by normal alone a small cluster with extreme light,
+   the crevice where two bodies touch, gave that light to the whole voxel). DEPARTURE (area
+   correction): each sample keeps AAVP's per-axis correction of step 4, the voxel's total then
+   made exact, so the clustered set holds the axis-aligned set's area per axis and its source
+   power (one factor per voxel let the samples the face rays happen to hit stand for it all).
    LIMITS: light leaks through walls thinner than a voxel (the filter blends voxels on both
    sides when the normal finds patches in both); a point whose 2x2x2 neighbourhood holds no
    patch facing its normal gets 0. */
@@ -2494,7 +2500,7 @@ RAD_API rad_result rad_vp_sources(const rad_virtual_patches *vp, const rad_rayca
 
 /* Gathering at one surface point p with unit normal n (docs/methods/virtual-patches.md): in each
    voxel of the 2x2x2 block around p (by voxel centres), L(v) = sum_a w_a(n) x_a / sum_a w_a(n)
-   over v's patches (w_a the split weights of rad_vp_weights; clustered: w_j = max(0, N_j . n));
+   over v's patches (w_a the split weights of rad_vp_weights; clustered: w_j = A_j max(0, N_j . n));
    voxels missing or with no patch
    facing n are skipped, and L = sum_v t_v L(v) / sum_v t_v with the trilinear weights t_v.
    values: 3N floats per patch (B, L or H); out: 3 floats. Returns the number of voxels that
@@ -3222,8 +3228,8 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    per-vertex irradiance without dark halos (rad_patches_vertex_irradiance with the row sums
    of F) gathered per mesh (rad_patches_gather_mesh), the lightmap by rad_lightmap_gather
    (exact, or the hemisphere gather when valid samples x patches passes 5e7) and probes by
-   rad_probes_create. VIRTUAL PATCHES: axis-aligned virtual patches (rad_vp_create, dense F)
-   at the finest resolution from vp_resolution down whose estimate fits the memory budget,
+   rad_probes_create. VIRTUAL PATCHES: virtual patches of the kind vp_kind (axis-aligned by
+   default; rad_vp_create, dense F) at the finest resolution from vp_resolution down whose estimate fits the memory budget,
    the same Jacobi bounces on rad_vp_system, rad_vp_gather_mesh, rad_lightmap_gather_vp and
    rad_probes_create_vp. AUTO takes CLASSIC when its estimate fits both max_memory and
    max_seconds, else VIRTUAL PATCHES.
@@ -3242,7 +3248,8 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    (rad_baker_choice.budget_limited). A non-zero vp_resolution replaces the scene's.
    ESTIMATE: classic 4 N^2 bytes of F plus 300 per patch, time N^2 ff_samples / 3e6 s (the
    measured form-factor rate of one thread) plus the bounces and the lightmap gather; virtual
-   patches (counted first by rad_vp_count) 4 N^2 plus 100 bytes per sample and 48 N per task,
+   patches (counted first by rad_vp_count, of the kind vp_kind: a clustered set has up to 6
+   patches a voxel, often about twice the axis-aligned count) 4 N^2 plus 100 bytes per sample and 48 N per task,
    time M^2 / 1.5e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the output layers, about 30 bytes per texel and lightmap
    sample, and 40 per probe and patch (the probes' weights, at most). Times are CPU seconds
    (one thread's; divide by the threads for the wall time). Rough: within a factor of a few.
@@ -3347,6 +3354,10 @@ typedef struct rad_baker_options {
     uint32_t sky_rays;              /* sky layers: cosine rays per point (0: 64; at most 4096) */
     int keep;                       /* non-zero: the result keeps the solver objects for
                                        rad_baker_runtime_create (KEEP above) */
+    rad_vp_kind vp_kind;            /* virtual patches: the kind the plan counts and the bake
+                                       builds (0: RAD_VP_AXIS_ALIGNED; RAD_VP_CLUSTERED holds
+                                       up to 6 patches a voxel where AAVP merges them by axis,
+                                       so the same resolution may give more patches) */
 } rad_baker_options;
 
 /* What rad_baker_options.keep keeps (private). */
@@ -3358,6 +3369,7 @@ typedef struct rad_baker_choice {
     uint32_t patch_count;           /* classic: the patches; virtual patches: counted */
     uint32_t vp_resolution;         /* virtual patches: the resolution to build (0 for classic) */
     uint32_t vp_samples;            /* virtual patches: their samples (M) */
+    rad_vp_kind vp_kind;            /* virtual patches: the kind counted (options->vp_kind) */
     uint32_t needed_resolution;     /* what the mean free path asks for */
     float free_path;                /* the mean free path, scene units */
     float escaped;                  /* the fraction of its rays that left the scene */
@@ -4240,14 +4252,14 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        a full set: rank 2, or after a drop): at most 9.7e-7 relative from rad_local_add's
        planes (exact and first-order), the float pre-pass against the CPU's double u, v, s.
    RAD_GLSL_VP_GATHER      virtual-patch gathering at surface points (vertices, G-buffer
-       texels), as rad_vp_gather: split-weight (or, clustered, N . n) normal weights in each
+       texels), as rad_vp_gather: split-weight (or, clustered, A N . n) normal weights in each
        voxel of the 2x2x2 block, trilinear weights across the voxels, voxels missing or with no
        patch facing n skipped (>>api_vp). Push: rad_glsl_vp_gather_push (the grid of the
        rad_virtual_patches); flags RAD_GLSL_VP_COSINE (weights RAD_VP_WEIGHTS_COSINE),
        _CLUSTERED. ONE INVOCATION PER POINT. 0: points (3 floats each)  1: unit normals
        (3 each)  2: values per patch (3N: B, L or H)  3: voxel_keys (voxel_count uint64, as
-       uvec2)  4: voxel_patch (6 per voxel)  5: patch normals (3N; read only when CLUSTERED,
-       else bind any buffer)  6: out (3 per point). Chunks: bindings 0, 1 and 6 hold the
+       uvec2)  4: voxel_patch (6 per voxel)  5: patch normals times areas (3N: A_a N_a, the
+       weight of rad_vp_gather; read only when CLUSTERED, else bind any buffer)  6: out (3 per point). Chunks: bindings 0, 1 and 6 hold the
        chunk's points from element base (bind the three at the same offset). The grid
        coordinate is computed as a float pair (TwoSum / Dekker products: the CPU uses double),
        because its float rounding, about 1e-7 dims absolute, is large against small trilinear
@@ -18964,11 +18976,29 @@ static rad_result rad__vp_patches(rad__vp_build *b, rad__vp_stage *st, const rad
         b->cscratch = (double *)rad__alloc_array(A, (size_t)T, b->cper * sizeof(double));
         if (!b->vscale || !b->eff || !b->slot || !b->ncl || !b->cols || !b->cscratch) return RAD_ERROR_OUT_OF_MEMORY;
         for (v = 0; v < vp->voxel_count; ++v) {
-            double have = 0.0, exact = 0.0;
-            for (a = 0; a < 6; ++a) exact += st->cand_area[6 * (size_t)st->voxel_cand[v] + a];
-            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) have += (double)vp->sample_areas[s];
-            b->vscale[v] = have > 0.0 && exact > 0.0 ? (float)(exact / have) : 1.0f;
-            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) b->eff[s] = vp->sample_areas[s] * b->vscale[v];
+            /* The axis-aligned correction per axis, then the voxel's total: one factor for the
+               whole voxel would let the few triangles the face rays hit stand for all of its
+               surface, and they are not a fair draw (two touching spheres: the samples crowd
+               at the contact, where the light is brightest, and the clusters there took most
+               of the voxel's area). Per axis, as AAVP, each direction keeps its exact area. */
+            double have[6] = { 0, 0, 0, 0, 0, 0 }, scale[6], exact = 0.0, sum = 0.0, fix;
+            const double *ex = st->cand_area + 6 * (size_t)st->voxel_cand[v];
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s)
+                for (a = 0; a < 6; ++a) have[a] += (double)vp->sample_weights[6 * (size_t)s + a] * (double)vp->sample_areas[s];
+            for (a = 0; a < 6; ++a) {
+                exact += ex[a];
+                scale[a] = have[a] > 0.0 && ex[a] > 0.0 ? ex[a] / have[a] : 1.0;
+            }
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                double w = 0.0;
+                for (a = 0; a < 6; ++a) w += (double)vp->sample_weights[6 * (size_t)s + a] * scale[a];
+                b->eff[s] = (float)((double)vp->sample_areas[s] * w);
+                sum += (double)b->eff[s];
+            }
+            /* an axis with area but no sample: its area goes to the voxel's samples evenly */
+            fix = sum > 0.0 && exact > 0.0 ? exact / sum : 1.0;
+            for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) b->eff[s] = (float)((double)b->eff[s] * fix);
+            b->vscale[v] = (float)fix;
         }
         for (i = 0; i < b->kc; ++i) b->cols[i] = (uint32_t)(((uint64_t)2 * i + 1) * M / (2 * (uint64_t)b->kc));
         r = rad__for_rows(&cc, vp->voxel_count, T, rad__vp_cluster_row, b);
@@ -18977,8 +19007,9 @@ static rad_result rad__vp_patches(rad__vp_build *b, rad__vp_stage *st, const rad
             vp->voxel_first[v] = N;
             for (a = 0; a < 6; ++a) vp->voxel_patch[6 * (size_t)v + a] = a < b->ncl[v] ? N++ : RAD_NONE;
             for (s = vp->sample_first[v]; s < vp->sample_first[v + 1]; ++s) {
+                float wt = vp->sample_areas[s] > 0.0f ? b->eff[s] / vp->sample_areas[s] : b->vscale[v];
                 for (a = 0; a < 6; ++a) vp->sample_weights[6 * (size_t)s + a] = 0.0f;
-                vp->sample_weights[6 * (size_t)s + b->slot[s]] = b->vscale[v];
+                vp->sample_weights[6 * (size_t)s + b->slot[s]] = wt;
             }
         }
         rad__free(A, b->eff);
@@ -19323,7 +19354,14 @@ static float rad__vp_face_weight(const rad_virtual_patches *vp, uint32_t v, uint
 {
     *q = vp->voxel_patch[6 * (size_t)v + a];
     if (*q == RAD_NONE) return 0.0f;
-    return vp->kind == RAD_VP_CLUSTERED ? rad__dot(vp->normals + 3 * (size_t)*q, n) : w[a];
+    if (vp->kind != RAD_VP_CLUSTERED) return w[a];
+    {
+        /* a point of this voxel facing n lies in cluster q about as often as q's area times
+           how well their normals agree: by normal alone a small cluster with extreme light
+           (the crevice where two bodies touch) would give it to the whole voxel */
+        float d = rad__dot(vp->normals + 3 * (size_t)*q, n);
+        return d > 0.0f ? d * vp->areas[*q] : 0.0f;
+    }
 }
 
 /* The patches of voxel v that face normal n (w: the axis weights of n): their patches in q,
@@ -23268,8 +23306,8 @@ static rad_result rad__baker_check(rad__baker *b)
 {
     const rad_baker_desc *d = b->d;
     uint32_t i, groups = 0, emitters = 0, lightmapped = 0;
-    if (b->o.method > RAD_BAKER_VIRTUAL_PATCHES) {
-        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown method %d", (int)b->o.method);
+    if (b->o.method > RAD_BAKER_VIRTUAL_PATCHES || (b->o.vp_kind != RAD_VP_AXIS_ALIGNED && b->o.vp_kind != RAD_VP_CLUSTERED)) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown method %d or vp_kind %d", (int)b->o.method, (int)b->o.vp_kind);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!(b->o.max_memory >= 0.0 && b->o.max_memory < 1e30) || !(b->o.max_seconds >= 0.0 && b->o.max_seconds < 1e30)) {
@@ -23551,6 +23589,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
         uint32_t res = o->vp_resolution ? o->vp_resolution : P->needed_resolution, tries;
         int time_over = 0;
         rad_vp_options_default(&vo);
+        vo.kind = o->vp_kind; /* the kind that will be built: clustered sets count more patches */
         for (tries = 0;; ++tries) {
             double f;
             uint32_t next;
@@ -23580,6 +23619,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
             P->budget_limited = 1;
         }
         P->method = RAD_BAKER_VIRTUAL_PATCHES;
+        P->vp_kind = o->vp_kind;
         P->vp_resolution = res;
         P->patch_count = cnt.patches;
         P->vp_samples = cnt.samples;
@@ -23589,8 +23629,9 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
         rad__baker_bytes(bb, sizeof bb, bytes);
         rad__baker_time(tb, sizeof tb, secs);
         snprintf(text, sizeof text,
-                 "virtual patches: %smean free path %.3g (%.0f%% of rays leave the scene) asks for resolution %u; "
+                 "%svirtual patches: %smean free path %.3g (%.0f%% of rays leave the scene) asks for resolution %u; "
                  "resolution %u%s gives %u patches (%u samples), about %s and %s of CPU%s",
+                 o->vp_kind == RAD_VP_CLUSTERED ? "clustered " : "",
                  o->method == RAD_BAKER_VIRTUAL_PATCHES ? "(asked for) " : why, (double)P->free_path,
                  100.0 * (double)P->escaped, P->needed_resolution, res,
                  o->vp_resolution && !P->budget_limited ? " (vp_resolution)"
@@ -23658,8 +23699,8 @@ RAD_API rad_result rad_baker_plan(const rad_scene *scene, const rad_raycaster *r
     memset(out, 0, sizeof *out);
     memset(&in, 0, sizeof in);
     rad__baker_options_fill(&in.o, options);
-    if (in.o.method > RAD_BAKER_VIRTUAL_PATCHES) {
-        rad__log(&c, RAD_LOG_ERROR, "rad_baker_plan: unknown method %d", (int)in.o.method);
+    if (in.o.method > RAD_BAKER_VIRTUAL_PATCHES || (in.o.vp_kind != RAD_VP_AXIS_ALIGNED && in.o.vp_kind != RAD_VP_CLUSTERED)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_plan: unknown method %d or vp_kind %d", (int)in.o.method, (int)in.o.vp_kind);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (!(in.o.max_memory > 0.0 && in.o.max_memory < 1e30) || !(in.o.max_seconds > 0.0 && in.o.max_seconds < 1e30)) {
@@ -23735,6 +23776,7 @@ static rad_result rad__baker_build(rad__baker *b)
         rad_vp_options_default(&vo);
         vo.resolution = R->vp_resolution;
         if (b->o.keep) vo.storage = RAD_STORAGE_SPARSE; /* the runtime's rows */
+        vo.kind = b->o.vp_kind; /* the kind the plan counted */
         r = rad_vp_create(b->scene, &b->rc, &vo, &b->sub, &b->vp);
         if (r != RAD_SUCCESS) return r;
         n = b->vp->count;
@@ -24456,6 +24498,7 @@ static rad_result rad__brt_build_vp(rad_baker_runtime *rt, const rad_baker_desc 
     uint32_t m;
     rad_vp_options_default(&vo);
     vo.resolution = R->vp_resolution;
+    vo.kind = R->plan.vp_kind; /* the bake's kind, so the patch count matches */
     vo.storage = RAD_STORAGE_SPARSE;
     if (rt->kept && rt->kept->vp && rt->kept->vp->matrix.storage == RAD_STORAGE_SPARSE) rt->vp = rt->kept->vp, r = RAD_SUCCESS;
     else r = rad_vp_create(rt->scene, &rt->rc, &vo, &rt->sub, &rt->vp);
@@ -27796,7 +27839,8 @@ static const char rad__glsl_11_0[] =
     "// x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),\n"
     "//   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0\n"
     "// (axis-aligned: w_a the split weights of n, max(0, +-n_k)^2 or max(0, +-n_k) normalized to\n"
-    "// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = N_a . n); voxels outside the grid,\n"
+    "// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = (A_a N_a) . n, binding 5 holding\n"
+    "// each patch's normal times its area); voxels outside the grid,\n"
     "// empty or with no patch facing n are skipped, and\n"
     "//   out_i = sum_v t_v L(v) / sum_v t_v       (t_v the trilinear weights; 0 when no voxel is used;\n"
     "//   the plain mean of the used L(v) when their t_v sum to 0)\n"
@@ -27811,7 +27855,7 @@ static const char rad__glsl_11_0[] =
     "layout(std430, set = 0, binding = 2) readonly buffer Values { float X[]; };       // 3 N, per patch\n"
     "layout(std430, set = 0, binding = 3) readonly buffer VoxelKeys { uvec2 keys[]; }; // voxel_count uint64\n"
     "layout(std430, set = 0, binding = 4) readonly buffer VoxelPatch { uint vpatch[]; }; // 6 per voxel, or ~0u\n"
-    "layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N (clustered only)\n"
+    "layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N: A_a N_a (clustered only)\n"
     "layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };             // 3 per point\n"
     "layout(push_constant) uniform Push {\n"
     "    float origin_x, origin_y, origin_z;   // rad_virtual_patches.origin\n"
@@ -27855,9 +27899,9 @@ static const char rad__glsl_11_0[] =
     "    precise float q = a * b;\n"
     "    precise float e = ((ah * bh - q) + ah * bl + al * bh) + al * bl;\n"
     "    return vec2(q, e);\n"
-    "}\n"
-    "// (p - o) / s - 1/2 as an unevaluated float pair (hi, lo), to about 1e-14 relative\n";
+    "}\n";
 static const char rad__glsl_11_1[] =
+    "// (p - o) / s - 1/2 as an unevaluated float pair (hi, lo), to about 1e-14 relative\n"
     "vec2 grid_coordinate(float p, float o, float s)\n"
     "{\n"
     "    vec2 d = two_sum(p, -o);                      // p - o exactly\n"
@@ -28060,7 +28104,7 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_apply.comp", rad__glsl_pieces_8, 2u, 4433u },
     { "local_vectors.comp", rad__glsl_pieces_9, 2u, 6673u },
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
-    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7417u },
+    { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7489u },
     { "probe_update.comp", rad__glsl_pieces_12, 1u, 2832u },
     { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
 };

@@ -1173,7 +1173,14 @@ static void vp_run(const rad_virtual_patches *vp, const float *values, const flo
     ok &= vk_buffer(&g_vk, &bX, 3 * (VkDeviceSize)count * 4, values);
     ok &= vk_buffer(&g_vk, &bK, (VkDeviceSize)vp->voxel_count * 8, vp->voxel_keys);
     ok &= vk_buffer(&g_vk, &bV, 6 * (VkDeviceSize)vp->voxel_count * 4, vp->voxel_patch);
-    ok &= vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, vp->normals);
+    {
+        /* binding 5: the clustered weight's normals times the patch areas */
+        float *an = (float *)malloc(sizeof(float) * 3 * (size_t)count);
+        uint32_t e;
+        for (e = 0; an && e < 3 * count; ++e) an[e] = vp->normals[e] * vp->areas[e / 3];
+        ok &= an != NULL && vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, an);
+        free(an);
+    }
     ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)npts * 4, NULL);
     if (ok) memset(bO.map, 0xFF, 3 * (size_t)npts * 4); /* NaN: every point must be written */
     chunks(npts, cut);

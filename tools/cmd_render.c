@@ -1213,6 +1213,8 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     bo.ff_samples = o->samples;
     bo.bounces = o->bounces;
     bo.light_samples = o->light_samples;
+    /* count the kind that will be built: a clustered set has more patches at one resolution */
+    bo.vp_kind = !chosen && (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
     tool_context(&ctx, NULL);
     if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
     if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
@@ -1220,7 +1222,9 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
         mo->vp_resolution = plan.vp_resolution;
     }
     if (!chosen)
-        fprintf(stderr, "rad %s: no --vp-resolution given: resolution %u from the scene\n", cmd, plan.vp_resolution);
+        fprintf(stderr, "rad %s: no --vp-resolution given: resolution %u from the scene (%u %s patches, about %.0f MiB)\n",
+                cmd, plan.vp_resolution, plan.patch_count, bo.vp_kind == RAD_VP_CLUSTERED ? "vp" : "aavp",
+                plan.estimated_bytes / 1048576.0);
     else if (plan.method == RAD_BAKER_VIRTUAL_PATCHES)
         fprintf(stderr, "rad %s: no --method given: chose aavp at --vp-resolution %u (give --method to choose)\n", cmd,
                 plan.vp_resolution);

@@ -5,7 +5,8 @@
 // x = (p - origin) / voxel_size - 1/2 clamped to [-2, dims + 1], base = floor(x), g = x - base),
 //   L(v) = sum_a w_a x_a / sum_a w_a over v's patches a with w_a > 0
 // (axis-aligned: w_a the split weights of n, max(0, +-n_k)^2 or max(0, +-n_k) normalized to
-// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = N_a . n); voxels outside the grid,
+// sum 1 (flags bit 0: cosine); clustered, flags bit 1: w_a = (A_a N_a) . n, binding 5 holding
+// each patch's normal times its area); voxels outside the grid,
 // empty or with no patch facing n are skipped, and
 //   out_i = sum_v t_v L(v) / sum_v t_v       (t_v the trilinear weights; 0 when no voxel is used;
 //   the plain mean of the used L(v) when their t_v sum to 0)
@@ -20,7 +21,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Normals { float Nrm[]; };  
 layout(std430, set = 0, binding = 2) readonly buffer Values { float X[]; };       // 3 N, per patch
 layout(std430, set = 0, binding = 3) readonly buffer VoxelKeys { uvec2 keys[]; }; // voxel_count uint64
 layout(std430, set = 0, binding = 4) readonly buffer VoxelPatch { uint vpatch[]; }; // 6 per voxel, or ~0u
-layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N (clustered only)
+layout(std430, set = 0, binding = 5) readonly buffer PatchNormals { float PN[]; }; // 3 N: A_a N_a (clustered only)
 layout(std430, set = 0, binding = 6) buffer Output { float outv[]; };             // 3 per point
 layout(push_constant) uniform Push {
     float origin_x, origin_y, origin_z;   // rad_virtual_patches.origin
