@@ -3258,6 +3258,18 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    LIGHT LAYERS. Light adds: the system is linear in its source, so each group g is solved on
    its own and kept as a layer (vertex_layers, lightmap_layers, probe_layers: group_count
    planes, plane g at g times the output's float count, each laid out as the output).
+   SOLUTION (RAD_BAKER_SOLUTION). The outputs above are sampled where the bake chose (vertices,
+   texels, probes); a renderer that lights each pixel itself (direct light per pixel, as the
+   examples and the rad tool do) wants the bounced irradiance H at the point each pixel sees.
+   With this bit the result keeps what the method's own final gather reads, and
+   rad_baker_irradiance evaluates it at any surface points: CLASSIC keeps the patches (and the
+   scene they index) and the per-vertex irradiance without dark halos of each group
+   (rad_patches_vertex_irradiance with the row sums of F, as the vertex output), read at a
+   point of scene triangle t at barycentrics (b1, b2) by rad_patches_locate's weights (the
+   triangle numbering of rad_scene_create on desc->scene); VIRTUAL PATCHES keep the set and
+   each group's H = F B per patch, read by rad_vp_gather at the point and its normal. Cost:
+   3 floats per patch vertex (classic; F itself is freed) or the set and 3 floats per patch
+   (virtual patches), times group_count + 1. The kept layers mix with the others.
    rad_baker_mix writes the outputs as sum_g scale_g o layer_g for any RGB scale per group (a
    dimmer, a colour, 0 to switch a group off), at memory speed, without a new bake; a group's
    layer equals the layer of a bake with only that group's lights and emitters, bit for bit.
@@ -3276,8 +3288,11 @@ typedef enum rad_baker_method {
 typedef enum rad_baker_outputs {
     RAD_BAKER_VERTEX = 1,           /* bounced irradiance per mesh vertex */
     RAD_BAKER_LIGHTMAP = 2,         /* an RGB irradiance lightmap over the lightmap_uvs */
-    RAD_BAKER_PROBES = 4            /* SH L2 irradiance probes */
+    RAD_BAKER_PROBES = 4,           /* SH L2 irradiance probes */
+    RAD_BAKER_SOLUTION = 8          /* keep the solution for rad_baker_irradiance (SOLUTION below) */
 } rad_baker_outputs;
+
+typedef struct rad_baker_solution rad_baker_solution; /* private: what RAD_BAKER_SOLUTION keeps */
 
 /* A light and the group it belongs to (group < RAD_BAKER_MAX_GROUPS). */
 typedef struct rad_baker_light {
@@ -3363,6 +3378,7 @@ typedef struct rad_baker_result {
     float *probe_layers;            /* group_count planes of 27 * probe_count */
     rad_allocator allocator;        /* private */
     rad_baker_choice plan;          /* the whole plan (method, reason and estimates are also above) */
+    rad_baker_solution *solution;   /* RAD_BAKER_SOLUTION, else NULL: read by rad_baker_irradiance */
 } rad_baker_result;
 
 /* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
@@ -3390,11 +3406,24 @@ RAD_API void rad_baker_result_destroy(rad_baker_result *result);
 RAD_API rad_result rad_baker_plan(const rad_scene *scene, const rad_raycaster *raycaster, const rad_baker_options *options,
                                   const rad_context *ctx, rad_baker_choice *out);
 
-/* Rewrites the result's outputs (vertex, lightmap, probes; those it has) as
+/* Rewrites the result's outputs (vertex, lightmap, probes, the kept solution; those it has) as
    sum_g group_rgb[3g + c] layer_g per channel c. group_rgb: 3 * group_count floats (NULL: all
    1, the plain sum), finite. Errors: INVALID_ARGUMENT (NULL result), NON_FINITE (a scale).
    Cost: one pass over the layers whose scale is not 0 0 0, parallel through ctx. */
 RAD_API rad_result rad_baker_mix(rad_baker_result *result, const float *group_rgb, const rad_context *ctx);
+
+/* The bounced irradiance H (W m^-2, RGB, the mix of rad_baker_mix; all groups at scale 1
+   after rad_baker_run) at 'count' surface points of a result baked with RAD_BAKER_SOLUTION
+   (SOLUTION above): point i at points[3i] with unit normal normals[3i] on the scene triangle
+   hits[i].triangle at barycentrics hits[i].b1, hits[i].b2 (a hit of a ray cast on the scene
+   of desc->scene: classic reads the triangle and barycentrics, virtual patches the point and
+   normal; give all three). A triangle out of range (RAD_NONE) gets 0. out: 3 * count floats.
+   Errors: INVALID_ARGUMENT (NULL result, hits, points, normals or out with count > 0, a result
+   without RAD_BAKER_SOLUTION), NON_FINITE (virtual patches: a point or normal NaN or infinite).
+   Thread safety: reentrant (the result is only read). Cost: O(1) per point (classic: three
+   vertex values; virtual patches: rad_vp_gather_point, in parallel through ctx). */
+RAD_API rad_result rad_baker_irradiance(const rad_baker_result *result, const rad_hit *hits, const float *points,
+                                        const float *normals, uint32_t count, float *out, const rad_context *ctx);
 
 /* The kernel of rad_baker_mix on any planar layers: out[i] = sum_g group_rgb[3g + i mod 3]
    layers[g count3 + i] for i < count3, the groups with scale 0 0 0 skipped (out is 0 when
@@ -22841,10 +22870,36 @@ RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_coun
     return RAD_SUCCESS;
 }
 
+/* What RAD_BAKER_SOLUTION keeps (SOLUTION in >>api_bake): the method's objects and, per
+   group, the values its final gather reads (classic: per patch vertex; virtual patches: per
+   patch), with their mix. */
+struct rad_baker_solution {
+    rad_scene *scene;              /* classic: the scene the patches were made on */
+    rad_patches *patches;          /* classic */
+    rad_virtual_patches *vp;       /* virtual patches */
+    size_t count3;                 /* floats per layer */
+    float *values;                 /* the mix */
+    float *layers;                 /* group_count planes of count3 */
+};
+
+static void rad__baker_solution_destroy(const rad_allocator *a, rad_baker_solution *s)
+{
+    if (!s) return;
+    rad_patches_destroy(s->patches);
+    rad_vp_destroy(s->vp);
+    rad_scene_destroy(s->scene);
+    rad__free(a, s->values);
+    rad__free(a, s->layers);
+    rad__free(a, s);
+}
+
 RAD_API rad_result rad_baker_mix(rad_baker_result *R, const float *group_rgb, const rad_context *ctx)
 {
     rad_result r = RAD_SUCCESS;
     if (!R) return RAD_ERROR_INVALID_ARGUMENT;
+    if (R->solution)
+        r = rad_baker_mix_layers(R->solution->layers, R->group_count, R->solution->count3, group_rgb, R->solution->values, ctx);
+    if (r != RAD_SUCCESS) return r;
     if (R->vertex_layers)
         r = rad_baker_mix_layers(R->vertex_layers, R->group_count, 3 * (size_t)R->vertex_count, group_rgb, R->vertex, ctx);
     if (r == RAD_SUCCESS && R->lightmap_layers)
@@ -22870,7 +22925,40 @@ RAD_API void rad_baker_result_destroy(rad_baker_result *R)
     rad__free(&a, R->probe_states);
     rad__free(&a, R->probes);
     rad__free(&a, R->probe_layers);
+    rad__baker_solution_destroy(&a, R->solution);
     rad__free(&a, R);
+}
+
+RAD_API rad_result rad_baker_irradiance(const rad_baker_result *R, const rad_hit *hits, const float *points,
+                                        const float *normals, uint32_t count, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_baker_solution *s;
+    uint32_t i, k;
+    rad__ctx_init(&c, ctx);
+    if (!R || (count && (!hits || !points || !normals || !out))) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_irradiance: NULL result, hits, points, normals or out");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(s = R->solution)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_irradiance: the result keeps no solution (bake with RAD_BAKER_SOLUTION)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s->vp) return count ? rad_vp_gather(s->vp, s->values, points, normals, count, out, ctx) : RAD_SUCCESS;
+    for (i = 0; i < count; ++i) {
+        float w[3];
+        uint32_t p = rad_patches_locate(s->patches, hits[i].triangle, hits[i].b1, hits[i].b2, w);
+        const uint32_t *v;
+        if (p == RAD_NONE) {
+            out[3 * (size_t)i] = out[3 * (size_t)i + 1] = out[3 * (size_t)i + 2] = 0.0f;
+            continue;
+        }
+        v = s->patches->patches[p].vertices;
+        for (k = 0; k < 3; ++k)
+            out[3 * (size_t)i + k] = w[0] * s->values[3 * (size_t)v[0] + k] + w[1] * s->values[3 * (size_t)v[1] + k] +
+                                     w[2] * s->values[3 * (size_t)v[2] + k];
+    }
+    return RAD_SUCCESS;
 }
 
 static void rad__baker_bytes(char *buf, size_t len, double b)
@@ -22949,7 +23037,7 @@ static rad_result rad__baker_check(rad__baker *b)
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: max_memory and max_seconds must be finite and >= 0");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (d->outputs & ~(uint32_t)(RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES)) {
+    if (d->outputs & ~(uint32_t)(RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES | RAD_BAKER_SOLUTION)) {
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown output bits 0x%x", d->outputs);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
@@ -23467,6 +23555,15 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
         memset(R->lightmap_layers, 0, n * G * sizeof(float));
         memcpy(R->lightmap_flags, b->lm->flags, n / 3);
     }
+    if (b->outputs & RAD_BAKER_SOLUTION) {
+        R->solution = (rad_baker_solution *)rad__alloc_zero(a, sizeof(rad_baker_solution));
+        if (!R->solution) return RAD_ERROR_OUT_OF_MEMORY;
+        R->solution->count3 = 3 * (size_t)(R->method == RAD_BAKER_CLASSIC ? b->patches->vertex_count : R->patch_count);
+        R->solution->values = (float *)rad__alloc_array(a, R->solution->count3, sizeof(float));
+        R->solution->layers = (float *)rad__alloc_array(a, R->solution->count3 * G, sizeof(float));
+        if (!R->solution->values || !R->solution->layers) return RAD_ERROR_OUT_OF_MEMORY;
+        memset(R->solution->layers, 0, R->solution->count3 * G * sizeof(float));
+    }
     if (b->probes) {
         R->probe_count = rad_probes_count(b->probes);
         n = 27 * (size_t)R->probe_count;
@@ -23539,9 +23636,14 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     r = rad_matrix_multiply(R->method == RAD_BAKER_CLASSIC ? &b->ff->matrix : &b->vp->matrix, B, H, &b->sub);
     if (r != RAD_SUCCESS) return r;
     RAD__BAKER_PART(0.5f, 0.6f);
+    if (R->method == RAD_BAKER_CLASSIC && (R->vertex_layers || R->solution))
+        r = rad_patches_vertex_irradiance(b->patches, H, b->row_sums, V, &b->sub);
+    if (r == RAD_SUCCESS && R->solution) /* the values the final gather reads */
+        memcpy(R->solution->layers + (size_t)g * R->solution->count3, R->method == RAD_BAKER_CLASSIC ? V : H,
+               R->solution->count3 * sizeof(float));
+    if (r != RAD_SUCCESS) return r;
     if (R->vertex_layers) {
         float *out = R->vertex_layers + (size_t)g * 3 * R->vertex_count;
-        if (R->method == RAD_BAKER_CLASSIC) r = rad_patches_vertex_irradiance(b->patches, H, b->row_sums, V, &b->sub);
         for (m = 0; r == RAD_SUCCESS && m < R->mesh_count; ++m) {
             const rad_mesh_desc *mesh = &b->d->scene.meshes[m];
             float *o = out + 3 * (size_t)R->vertex_first[m];
@@ -23624,6 +23726,17 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
         r = rad__baker_group(&b, g, lo, hi);
     }
     if (r == RAD_SUCCESS) r = rad_baker_mix(b.R, NULL, &b.sub);
+    if (r == RAD_SUCCESS && b.R->solution) { /* the solution keeps the objects its gather reads */
+        if (b.R->method == RAD_BAKER_CLASSIC) {
+            b.R->solution->patches = b.patches;
+            b.R->solution->scene = b.scene;
+            b.patches = NULL;
+            b.scene = NULL;
+        } else {
+            b.R->solution->vp = b.vp;
+            b.vp = NULL;
+        }
+    }
     if (r == RAD_SUCCESS && b.prog.fn && b.prog.fn(b.prog.user, 1.0f)) r = RAD_ERROR_CANCELLED;
     if (r != RAD_SUCCESS && b.prog.cancelled) r = RAD_ERROR_CANCELLED;
     rad__baker_free(&b);
