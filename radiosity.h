@@ -3255,6 +3255,13 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    0 at v = 0 (>>api_lightmap TEXELS), dilated into the gutters. Probes (RAD_BAKER_PROBES): 27
    floats per probe (SH L2 irradiance, >>api_probes WHAT IS STORED) at the given points or on
    a grid over the scene bounds; sample them with rad_sh9_irradiance.
+   PROBE OPTIONS (rad_baker_desc.probe_options, >>api_probes; NULL: rad_probe_options_default).
+   Their spacing is replaced by probe_spacing when that is not 0. Two flags change the output:
+   RAD_PROBES_DIRECT adds to each group's layer the direct light of its lights and emitters at
+   the probes (rad_probes_create with them: the probes then hold all the light, as the
+   probes of rad probes do by default; each group's probes are then placed and weighed once
+   more); RAD_PROBES_BAND4 also fills probe_band4 (27 floats per probe, rad_sh_l4_irradiance)
+   and its layers, mixed as the others. rad_baker_runtime_create refuses both flags.
    LIGHT LAYERS. Light adds: the system is linear in its source, so each group g is solved on
    its own and kept as a layer (vertex_layers, lightmap_layers, probe_layers: group_count
    planes, plane g at g times the output's float count, each laid out as the output).
@@ -3313,6 +3320,7 @@ typedef struct rad_baker_desc {
     const float *probe_positions;   /* probe_count points, 3 floats each; NULL: a grid */
     uint32_t probe_count;
     float probe_spacing;            /* the grid's spacing (0: the largest extent / 8) */
+    const rad_probe_options *probe_options; /* NULL: the defaults (PROBE OPTIONS above) */
 } rad_baker_desc;
 
 /* How to bake. A zeroed struct means every default. */
@@ -3376,6 +3384,8 @@ typedef struct rad_baker_result {
     float probe_spacing;
     float *probes;                  /* 27 per probe */
     float *probe_layers;            /* group_count planes of 27 * probe_count */
+    float *probe_band4;             /* 27 per probe with RAD_PROBES_BAND4 (PROBE OPTIONS), else NULL */
+    float *probe_band4_layers;      /* group_count planes of 27 * probe_count */
     rad_allocator allocator;        /* private */
     rad_baker_choice plan;          /* the whole plan (method, reason and estimates are also above) */
     rad_baker_solution *solution;   /* RAD_BAKER_SOLUTION, else NULL: read by rad_baker_irradiance */
@@ -22907,6 +22917,9 @@ RAD_API rad_result rad_baker_mix(rad_baker_result *R, const float *group_rgb, co
                                  group_rgb, R->lightmap, ctx);
     if (r == RAD_SUCCESS && R->probe_layers)
         r = rad_baker_mix_layers(R->probe_layers, R->group_count, 27 * (size_t)R->probe_count, group_rgb, R->probes, ctx);
+    if (r == RAD_SUCCESS && R->probe_band4_layers)
+        r = rad_baker_mix_layers(R->probe_band4_layers, R->group_count, 27 * (size_t)R->probe_count, group_rgb,
+                                 R->probe_band4, ctx);
     return r;
 }
 
@@ -22925,6 +22938,8 @@ RAD_API void rad_baker_result_destroy(rad_baker_result *R)
     rad__free(&a, R->probe_states);
     rad__free(&a, R->probes);
     rad__free(&a, R->probe_layers);
+    rad__free(&a, R->probe_band4);
+    rad__free(&a, R->probe_band4_layers);
     rad__baker_solution_destroy(&a, R->solution);
     rad__free(&a, R);
 }
@@ -23022,6 +23037,14 @@ static void rad__baker_free(rad__baker *b)
 static int rad__baker_emits(const rad_material *m)
 {
     return m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f;
+}
+
+/* The probes' options of a desc (PROBE OPTIONS in >>api_bake). */
+static void rad__baker_probe_options(const rad_baker_desc *d, rad_probe_options *po)
+{
+    if (d->probe_options) *po = *d->probe_options;
+    else rad_probe_options_default(po);
+    if (d->probe_spacing != 0.0f) po->spacing = d->probe_spacing;
 }
 
 /* The checks that need nothing built: groups, outputs, budget, something that emits. */
@@ -23367,8 +23390,11 @@ static rad_result rad__baker_plan(rad__baker *b)
     rad__plan_in in;
     rad_result r;
     if (!b->d->probe_positions) { /* the grid rad_probes_create lays: about extent / spacing + 1 per axis */
-        double ext = 0.0, sp = b->d->probe_spacing, count = 1.0;
+        rad_probe_options po;
+        double ext = 0.0, sp, count = 1.0;
         int k;
+        rad__baker_probe_options(b->d, &po);
+        sp = po.spacing;
         for (k = 0; k < 3; ++k)
             if (S->bounds_max[k] - S->bounds_min[k] > ext) ext = S->bounds_max[k] - S->bounds_min[k];
         if (!(sp > 0.0)) sp = ext / 8.0;
@@ -23440,11 +23466,13 @@ static uint32_t rad__baker_group_lights(rad__baker *b, uint32_t g)
 }
 
 /* A view of the scene whose materials emit only group g's light (the geometry is the same,
-   so the BVH, patches and texels built on the scene serve it unchanged). */
-static const rad_scene *rad__baker_group_scene(rad__baker *b, uint32_t g, rad_scene *view)
+   so the BVH, patches and texels built on the scene serve it unchanged). A group without
+   emitters gets the scene itself (its direct light excludes the emitters), unless 'strict'
+   (the probes' direct term, which reads the emitters off the scene). */
+static const rad_scene *rad__baker_group_scene(rad__baker *b, uint32_t g, rad_scene *view, int strict)
 {
     uint32_t i;
-    if (!b->group_emits[g] || b->emissive_groups <= 1) return b->scene;
+    if (!b->emissive_groups || (b->group_emits[g] ? b->emissive_groups <= 1 : !strict)) return b->scene;
     *view = *b->scene;
     for (i = 0; i < b->scene->material_count; ++i) {
         b->masked[i] = b->scene->materials_table[i];
@@ -23506,8 +23534,8 @@ static rad_result rad__baker_build(rad__baker *b)
     if (b->outputs & RAD_BAKER_PROBES) {
         rad_probe_options po;
         if (rad__baker_stage(&b->prog, 0.55f, 0.6f)) return RAD_ERROR_CANCELLED;
-        rad_probe_options_default(&po);
-        po.spacing = b->d->probe_spacing;
+        rad__baker_probe_options(b->d, &po);
+        po.flags &= ~(uint32_t)RAD_PROBES_DIRECT; /* the placement and weights: the groups add their direct light */
         r = R->method == RAD_BAKER_CLASSIC
                 ? rad_probes_create(b->patches, &b->rc, NULL, 0, b->d->probe_positions, b->d->probe_count, &po, NULL, &b->sub,
                                     &b->probes)
@@ -23573,6 +23601,12 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
         R->probe_states = (uint8_t *)rad__alloc_array(a, R->probe_count, 1);
         if (!R->probes || !R->probe_layers || !R->probe_positions || !R->probe_states) return RAD_ERROR_OUT_OF_MEMORY;
         memset(R->probe_layers, 0, n * G * sizeof(float));
+        if (rad_probes_band4(b->probes)) {
+            R->probe_band4 = (float *)rad__alloc_array(a, n, sizeof(float));
+            R->probe_band4_layers = (float *)rad__alloc_array(a, n * G, sizeof(float));
+            if (!R->probe_band4 || !R->probe_band4_layers) return RAD_ERROR_OUT_OF_MEMORY;
+            memset(R->probe_band4_layers, 0, n * G * sizeof(float));
+        }
         memcpy(R->probe_positions, rad_probes_positions(b->probes), 3 * sizeof(float) * R->probe_count);
         memcpy(R->probe_states, rad_probes_states(b->probes), R->probe_count);
         if (!rad_probes_grid(b->probes, R->probe_grid, R->probe_origin, &R->probe_spacing)) {
@@ -23588,7 +23622,7 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
 {
     rad_baker_result *R = b->R;
     rad_scene view;
-    const rad_scene *Sg = rad__baker_group_scene(b, g, &view);
+    const rad_scene *Sg = rad__baker_group_scene(b, g, &view, 0);
     uint32_t nl = rad__baker_group_lights(b, g), n = R->patch_count, m;
     size_t i, N3 = 3 * (size_t)n;
     float *D = b->work, *E = D + N3, *L = E + N3, *B = L + N3, *H = B + N3, *V = H + N3;
@@ -23670,10 +23704,41 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     RAD__BAKER_PART(0.95f, 1.0f);
 #undef RAD__BAKER_PART
     if (R->probe_layers) {
-        r = rad_probes_update(b->probes, B, &b->sub);
+        rad_probe_options po;
+        rad_probes *own = NULL, *pr = b->probes;
+        rad__baker_probe_options(b->d, &po);
+        if (po.flags & RAD_PROBES_DIRECT) {
+            /* the group's direct light at the probes comes with their creation, from its lights
+               and (through the scene view) its emitters */
+            rad_scene strict;
+            const rad_scene *Sp = rad__baker_group_scene(b, g, &strict, 1);
+            if (R->method == RAD_BAKER_CLASSIC) {
+                rad_patches pg = *b->patches;
+                pg.scene = Sp;
+                r = rad_probes_create(&pg, &b->rc, b->lights, nl, b->d->probe_positions, b->d->probe_count, &po, B, &b->sub, &own);
+            } else {
+                rad_virtual_patches vg = *b->vp;
+                vg.scene = Sp;
+                r = rad_probes_create_vp(&vg, &b->rc, b->lights, nl, b->d->probe_positions, b->d->probe_count, &po, B, &b->sub,
+                                         &own);
+            }
+            if (r == RAD_SUCCESS && rad_probes_count(own) != R->probe_count) { /* placement does not depend on light */
+                rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: the probes of group %u were placed otherwise", g);
+                r = RAD_ERROR_INVALID_ARGUMENT;
+            }
+            pr = own;
+        } else {
+            r = rad_probes_update(pr, B, &b->sub);
+        }
+        if (r == RAD_SUCCESS) {
+            memcpy(R->probe_layers + (size_t)g * 27 * R->probe_count, rad_probes_coefficients(pr),
+                   27 * sizeof(float) * R->probe_count);
+            if (R->probe_band4_layers)
+                memcpy(R->probe_band4_layers + (size_t)g * 27 * R->probe_count, rad_probes_band4(pr),
+                       27 * sizeof(float) * R->probe_count);
+        }
+        rad_probes_destroy(own);
         if (r != RAD_SUCCESS) return r;
-        memcpy(R->probe_layers + (size_t)g * 27 * R->probe_count, rad_probes_coefficients(b->probes),
-               27 * sizeof(float) * R->probe_count);
     }
     return RAD_SUCCESS;
 }
@@ -24310,8 +24375,12 @@ static rad_result rad__brt_out_probes(rad_baker_runtime *rt, const rad_baker_des
 {
     rad_probe_options po;
     rad_result r;
-    rad_probe_options_default(&po);
-    po.spacing = desc->probe_spacing;
+    rad__baker_probe_options(desc, &po);
+    if (po.flags & (RAD_PROBES_DIRECT | RAD_PROBES_BAND4)) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: probe_options with RAD_PROBES_DIRECT or RAD_PROBES_BAND4 "
+                                   "(the runtime refreshes the bounced light of L2 probes only)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     r = R->method == RAD_BAKER_CLASSIC
             ? rad_probes_create(rt->patches, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes)
             : rad_probes_create_vp(rt->vp, &rt->rc, NULL, 0, desc->probe_positions, desc->probe_count, &po, NULL, &rt->sub, &rt->probes);

@@ -210,6 +210,42 @@ int tool_classic_solve(const char *cmd, const tool_world *w, const tool_classic_
     return 0;
 }
 
+int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method,
+                   uint32_t bounces, uint32_t vp_resolution, rad_baker_desc *d, rad_baker_result **out)
+{
+    rad_baker_options bo;
+    rad_baker_light *bl;
+    rad_context ctx;
+    rad_result r;
+    uint32_t i;
+    *out = NULL;
+    if (method == RAD_BAKER_CLASSIC && tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
+    bl = (rad_baker_light *)tool_calloc(w->file.light_count ? w->file.light_count : 1u, sizeof *bl);
+    for (i = 0; i < w->file.light_count; ++i) bl[i].light = w->file.lights[i];
+    d->scene = w->file.desc;
+    d->lights = bl;
+    d->light_count = w->file.light_count;
+    d->group_count = 1;
+    memset(&bo, 0, sizeof bo);
+    bo.method = method;
+    /* classic: the tool's memory limit (the plan refuses what does not fit); virtual patches at
+       a resolution chosen already (the command line's, or the plan's): no limit to shrink it */
+    bo.max_memory = o->force || vp_resolution ? 1e29 : o->max_memory > 0.0 ? o->max_memory : tool_mem_available();
+    bo.max_seconds = o->force || vp_resolution ? 1e29 : 64.0 * TOOL_DENSE_MAX_SECONDS; /* CPU seconds, many threads */
+    bo.patches = o->patches;
+    bo.ff_samples = o->samples;
+    bo.bounces = bounces;
+    bo.light_samples = o->light_samples;
+    bo.vp_resolution = vp_resolution;
+    tool_context(&ctx, "bake");
+    r = rad_baker_run(d, &bo, &ctx, out);
+    tool_progress_end();
+    free(bl);
+    if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_run", r);
+    fprintf(stderr, "rad %s: %s\n", cmd, (*out)->reason);
+    return 0;
+}
+
 void tool_bake_info_fill(tool_bake_info *info, const tool_world *w, const tool_classic_options *o)
 {
     memset(info, 0, sizeof *info);

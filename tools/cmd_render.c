@@ -1609,50 +1609,27 @@ static int render_baked(const char *cmd, const tool_world *w, const render_args 
 {
     const tool_method_options *mo = &ra->mo;
     int classic = mo->method == TOOL_CLASSIC;
-    uint32_t res = mo->vp_resolution, i;
+    uint32_t res = mo->vp_resolution, bounces = classic ? ra->o.bounces : mo->bounces;
     rad_baker_desc d;
-    rad_baker_options bo;
-    rad_baker_light *bl;
     rad_baker_result *R = NULL;
     render_source src;
-    rad_context ctx;
-    rad_result r;
     double t0;
     int rc;
-    if (classic && tool_dense_check(cmd, &ra->o, w->scene->triangle_count, 1)) return 1;
     if (!classic && (mo->given & TOOL_OPT_VP_MAX_PATCHES) &&
         tool_vp_resolution_within(cmd, w, RAD_VP_AXIS_ALIGNED, mo->face_points, mo->vp_max_patches, mo->vp_resolution, &res))
         return 1;
-    bl = (rad_baker_light *)tool_calloc(w->file.light_count ? w->file.light_count : 1u, sizeof *bl);
-    for (i = 0; i < w->file.light_count; ++i) bl[i].light = w->file.lights[i];
     memset(&d, 0, sizeof d);
-    d.scene = w->file.desc;
-    d.lights = bl;
-    d.light_count = w->file.light_count;
-    d.group_count = 1;
     d.outputs = RAD_BAKER_SOLUTION;
-    memset(&bo, 0, sizeof bo);
-    bo.method = classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES;
-    bo.max_memory = bo.max_seconds = 1e29; /* the tool's own checks (tool_dense_check, the plan) came first */
-    bo.patches = ra->o.patches;
-    bo.ff_samples = ra->o.samples;
-    bo.bounces = classic ? ra->o.bounces : mo->bounces;
-    bo.light_samples = ra->o.light_samples;
-    bo.vp_resolution = res;
-    tool_context(&ctx, "bake");
     t0 = tool_seconds();
-    r = rad_baker_run(&d, &bo, &ctx, &R);
-    tool_progress_end();
-    free(bl);
-    if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_run", r);
+    if (tool_baker_run(cmd, w, &ra->o, classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES, bounces, classic ? 0u : res, &d, &R))
+        return 1;
     t0 = tool_seconds() - t0;
-    fprintf(stderr, "rad %s: %s\n", cmd, R->reason);
     if (!classic)
         fprintf(stderr, "rad %s: aavp virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
                 R->vp_resolution, R->patch_count);
     /* one line for scripts: the step is the whole bake here (form factors or set, source, bounces) */
     fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=1 bounces=%u step_ms_median=%.6f step_ms_min=%.6f%s%.0u\n",
-            cmd, classic ? "classic" : "aavp", R->patch_count, bo.bounces, 1e3 * t0, 1e3 * t0,
+            cmd, classic ? "classic" : "aavp", R->patch_count, bounces, 1e3 * t0, 1e3 * t0,
             classic ? "" : " resolution=", classic ? 0u : R->vp_resolution);
     memset(&src, 0, sizeof src);
     src.baker = R;
