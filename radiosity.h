@@ -3397,8 +3397,10 @@ typedef struct rad_baker_result {
    and no emissive material, a lightmap without any lightmap_uvs, a negative or non-finite
    budget), the scene's errors (rad_scene_create: a bad mesh, material or value), the lights'
    (rad_direct_irradiance), OUT_OF_MEMORY (also: the budget is too small for the smallest bake
-   of the method, or an allocation failed), CANCELLED, RAYCAST_FAILED. Thread safety:
-   reentrant; parallel through ctx->parallel_for. Cost: see ESTIMATE above. */
+   of the method, or an allocation failed), SIZE_OVERFLOW (a probe grid of more than 2^24
+   probes, before any work), the probes' errors (rad_probes_create: bad probe_options),
+   CANCELLED, RAYCAST_FAILED. Thread safety: reentrant; parallel through ctx->parallel_for.
+   Cost: see ESTIMATE above. */
 RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_options *options, const rad_context *ctx,
                             rad_baker_result **out);
 RAD_API void rad_baker_result_destroy(rad_baker_result *result);
@@ -22979,7 +22981,8 @@ RAD_API rad_result rad_baker_irradiance(const rad_baker_result *R, const rad_hit
 static void rad__baker_bytes(char *buf, size_t len, double b)
 {
     if (b < 1073741824.0) snprintf(buf, len, "%.1f MiB", b / 1048576.0);
-    else snprintf(buf, len, "%.1f GiB", b / 1073741824.0);
+    else if (b < 1e18) snprintf(buf, len, "%.1f GiB", b / 1073741824.0);
+    else snprintf(buf, len, "no limit"); /* a budget set out of the way */
 }
 
 static void rad__baker_time(char *buf, size_t len, double s)
@@ -22988,7 +22991,8 @@ static void rad__baker_time(char *buf, size_t len, double s)
     else if (s < 7200.0) snprintf(buf, len, "%.0f minutes", s / 60.0);
     else if (s < 172800.0) snprintf(buf, len, "%.1f hours", s / 3600.0);
     else if (s < 1e9) snprintf(buf, len, "%.0f days", s / 86400.0);
-    else snprintf(buf, len, "ages");
+    else if (s < 1e18) snprintf(buf, len, "ages");
+    else snprintf(buf, len, "no limit"); /* a budget set out of the way */
 }
 
 /* Everything one bake holds while it runs; freed in one place. */
@@ -23399,6 +23403,11 @@ static rad_result rad__baker_plan(rad__baker *b)
             if (S->bounds_max[k] - S->bounds_min[k] > ext) ext = S->bounds_max[k] - S->bounds_min[k];
         if (!(sp > 0.0)) sp = ext / 8.0;
         for (k = 0; k < 3; ++k) count *= sp > 0.0 ? ceil((S->bounds_max[k] - S->bounds_min[k]) / sp) + 1.0 : 1.0;
+        if (b->outputs & RAD_BAKER_PROBES && !(count <= 16777216.0)) { /* rad_probes_create's limit, named before any work */
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: a probe spacing of %g gives a grid of %.0f probes, more than "
+                     "2^24: give a larger spacing", sp, count);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
         probes_guess = count < 16777216.0 ? (uint32_t)count : 16777216u;
     }
     b->outputs_bytes = rad__baker_output_bytes(b, probes_guess);

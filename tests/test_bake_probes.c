@@ -176,6 +176,12 @@ static void bp_test_bad_input(void)
     d.probe_options = &pd;
     CHECK_RESULT(rad_baker_run(&d, &o, NULL, &R), RAD_ERROR_INVALID_ARGUMENT);
     CHECK(R == NULL);
+    /* a grid past rad_probes_create's 2^24 probes is named before any work */
+    bp_probe_options(&pd, 0);
+    d.probe_spacing = 1e-4f;
+    CHECK_RESULT(rad_baker_run(&d, &o, NULL, &R), RAD_ERROR_SIZE_OVERFLOW);
+    CHECK(R == NULL);
+    d.probe_spacing = 0.0f;
     /* the runtime refreshes the bounced L2 light only: DIRECT and band 4 are refused */
     bp_probe_options(&pd, RAD_PROBES_DIRECT);
     CHECK_OK(rad_baker_run(&d, &o, NULL, &R));

@@ -286,13 +286,7 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
     /* a scene too big for the dense classic build is refused with the way out */
     pa.o.dense_instead = "--proxy aavp or --proxy vp (the probes' light from virtual patches: a few thousand whatever the "
                       "triangle count; --vp-resolution R sets how many)";
-    rc = w.file.light_count ? 0 : 1; /* the engine tier refuses a scene where nothing emits */
-    for (i = 0; rc && i < w.file.desc.material_count; ++i) {
-        const float *e = w.file.desc.materials[i].emission;
-        rc = !(e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f);
-    }
-    rc = rc ? -1 : probes_baked(cmd, &w, &pa, &R);
-    if (rc == 1) {
+    if (probes_baked(cmd, &w, &pa, &R) == 1) {
         tool_close_world(&w);
         return 1;
     }

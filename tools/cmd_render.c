@@ -1589,22 +1589,18 @@ static int render_classic_method(const char *cmd, const tool_world *w, const ren
    on the patches as made, or AAVP at the default face points, solved here (no --bake). The
    rest (other solvers, --bounces 0 or inf, --max-edge, clustered patches, proxies, the
    teaching methods) keeps its own path. */
-static int render_by_baker(const tool_world *w, const render_args *ra)
+static int render_by_baker(const render_args *ra)
 {
     const tool_method_options *mo = &ra->mo;
     const tool_classic_options *o = &ra->o;
-    uint32_t m, emits = w->file.light_count > 0;
-    for (m = 0; m < w->file.desc.material_count; ++m) {
-        const float *e = w->file.desc.materials[m].emission;
-        emits |= e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
-    }
-    if (ra->bake || mo->proxy || !emits) return 0; /* the tier refuses a scene where nothing emits */
+    if (ra->bake || mo->proxy) return 0;
     if (mo->method == TOOL_CLASSIC) return o->solver == TOOL_JACOBI && o->bounces > 0 && o->max_edge == 0.0f;
     return mo->method == TOOL_AAVP && mo->face_points == 16u && mo->bounces > 0 && mo->bounces != RAD_MB_INFINITE;
 }
 
 /* The engine tier's bake of the scene and the lights (one group), keeping its solution, and
-   the per-pixel render with H from the tier's final gather at each sample. */
+   the per-pixel render with H from the tier's final gather at each sample. 0 or 1 (printed);
+   -1 when nothing emits (the tier refuses that: the caller's own path draws it). */
 static int render_baked(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
     const tool_method_options *mo = &ra->mo;
@@ -1621,8 +1617,9 @@ static int render_baked(const char *cmd, const tool_world *w, const render_args 
     memset(&d, 0, sizeof d);
     d.outputs = RAD_BAKER_SOLUTION;
     t0 = tool_seconds();
-    if (tool_baker_run(cmd, w, &ra->o, classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES, bounces, classic ? 0u : res, &d, &R))
-        return 1;
+    if ((rc = tool_baker_run(cmd, w, &ra->o, classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES, bounces,
+                             classic ? 0u : res, &d, &R)) != 0)
+        return rc;
     t0 = tool_seconds() - t0;
     if (!classic)
         fprintf(stderr, "rad %s: aavp virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
@@ -1642,7 +1639,8 @@ static int render_baked(const char *cmd, const tool_world *w, const render_args 
 static int render_image(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
     const tool_method_options *mo = &ra->mo;
-    if (render_by_baker(w, ra)) return render_baked(cmd, w, ra, img);
+    int rc;
+    if (render_by_baker(ra) && (rc = render_baked(cmd, w, ra, img)) >= 0) return rc;
     if (mo->method == TOOL_LIGHTMAP) return render_lightmap_method(cmd, w, ra, img);
     if ((mo->method >= TOOL_LOCAL && !(mo->method == TOOL_HIERARCHICAL && ra->bake)) || mo->proxy)
         return mo->method == TOOL_LOCAL && !mo->proxy ? render_local_method(cmd, w, ra, img)
