@@ -23314,9 +23314,12 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
             P->estimated_seconds = secs;
             P->over_budget = !classic_fits;
             snprintf(P->reason, sizeof P->reason,
-                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s of CPU, %s the budget of %s "
-                     "and %s",
-                     S->triangle_count, P->patch_count, bb, tb, classic_fits ? "within" : "over (forced)", lb, sb);
+                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s of CPU, %s%s%s%s%s",
+                     S->triangle_count, P->patch_count, bb, tb, classic_fits ? "within" : "over (forced)",
+                     budget >= 1e18 && seconds_budget >= 1e18 ? " no budget" : " the budget of ",
+                     budget >= 1e18 && seconds_budget >= 1e18 ? "" : lb,
+                     budget >= 1e18 && seconds_budget >= 1e18 ? "" : " and ",
+                     budget >= 1e18 && seconds_budget >= 1e18 ? "" : sb);
             if (keep) *keep = patches;
             else rad_patches_destroy(patches);
             return RAD_SUCCESS;
