@@ -3266,9 +3266,28 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    0 at v = 0 (>>api_lightmap TEXELS), dilated into the gutters. Probes (RAD_BAKER_PROBES): 27
    floats per probe (SH L2 irradiance, >>api_probes WHAT IS STORED) at the given points or on
    a grid over the scene bounds; sample them with rad_sh9_irradiance.
+   PROBE OPTIONS (rad_baker_desc.probe_options, >>api_probes; NULL: rad_probe_options_default).
+   Their spacing is replaced by probe_spacing when that is not 0. Two flags change the output:
+   RAD_PROBES_DIRECT adds to each group's layer the direct light of its lights and emitters at
+   the probes (rad_probes_create with them: the probes then hold all the light, as the
+   probes of rad probes do by default; each group's probes are then placed and weighed once
+   more); RAD_PROBES_BAND4 also fills probe_band4 (27 floats per probe, rad_sh_l4_irradiance)
+   and its layers, mixed as the others. rad_baker_runtime_create refuses both flags.
    LIGHT LAYERS. Light adds: the system is linear in its source, so each group g is solved on
    its own and kept as a layer (vertex_layers, lightmap_layers, probe_layers: group_count
    planes, plane g at g times the output's float count, each laid out as the output).
+   SOLUTION (RAD_BAKER_SOLUTION). The outputs above are sampled where the bake chose (vertices,
+   texels, probes); a renderer that lights each pixel itself (direct light per pixel, as the
+   examples and the rad tool do) wants the bounced irradiance H at the point each pixel sees.
+   With this bit the result keeps what the method's own final gather reads, and
+   rad_baker_irradiance evaluates it at any surface points: CLASSIC keeps the patches (and the
+   scene they index) and the per-vertex irradiance without dark halos of each group
+   (rad_patches_vertex_irradiance with the row sums of F, as the vertex output), read at a
+   point of scene triangle t at barycentrics (b1, b2) by rad_patches_locate's weights (the
+   triangle numbering of rad_scene_create on desc->scene); VIRTUAL PATCHES keep the set and
+   each group's H = F B per patch, read by rad_vp_gather at the point and its normal. Cost:
+   3 floats per patch vertex (classic; F itself is freed) or the set and 3 floats per patch
+   (virtual patches), times group_count + 1. The kept layers mix with the others.
    rad_baker_mix writes the outputs as sum_g scale_g o layer_g for any RGB scale per group (a
    dimmer, a colour, 0 to switch a group off), at memory speed, without a new bake; a group's
    layer equals the layer of a bake with only that group's lights and emitters, bit for bit.
@@ -3287,14 +3306,16 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    with that sky as an ordinary light, the noise of both); a sharper sky loses its detail above
    band b - 1 (docs/methods/environment.md), and a sun is a light of a group. A bake may hold
    only the sky (no lights, no emitters: group_count 0). Memory: b^2 more layers. The runtime
-   (>>api_bake_runtime) does not carry the sky layers.
+   (>>api_bake_runtime), the kept SOLUTION and the band-4 probes do not carry the sky layers
+   (sky layers with RAD_PROBES_DIRECT or RAD_PROBES_BAND4 probes are refused).
    KEEP (rad_baker_options.keep): the bake's solver objects stay in the result (the scene and
    its BVH, the patches and F or the virtual patches, the lightmap's texels, the probes'
    weights) instead of being freed (a runtime is meant to follow), and rad_baker_runtime_create BORROWS them rather than
    building them again, so the result must outlive the runtimes made from it. Virtual patches
    are then built with sparse rows (RAD_STORAGE_SPARSE, what the runtime needs: the outputs
    may differ from a bake without keep by float rounding, 7e-8 in the test; 8 bytes per
-   non-zero instead of 4 N^2 in all). rad_baker_result_destroy frees them. Memory: what the build held, for the result's
+   non-zero instead of 4 N^2 in all). rad_baker_result_destroy frees them. With RAD_BAKER_SOLUTION too, the solution
+   reads the same kept objects. Memory: what the build held, for the result's
    life.
    PROGRESS AND CANCEL. ctx->progress sees one fraction over the whole bake (build about 60%,
    then the groups); a non-zero return stops the bake with RAD_ERROR_CANCELLED and frees
@@ -3311,8 +3332,11 @@ typedef enum rad_baker_method {
 typedef enum rad_baker_outputs {
     RAD_BAKER_VERTEX = 1,           /* bounced irradiance per mesh vertex */
     RAD_BAKER_LIGHTMAP = 2,         /* an RGB irradiance lightmap over the lightmap_uvs */
-    RAD_BAKER_PROBES = 4            /* SH L2 irradiance probes */
+    RAD_BAKER_PROBES = 4,           /* SH L2 irradiance probes */
+    RAD_BAKER_SOLUTION = 8          /* keep the solution for rad_baker_irradiance (SOLUTION below) */
 } rad_baker_outputs;
+
+typedef struct rad_baker_solution rad_baker_solution; /* private: what RAD_BAKER_SOLUTION keeps */
 
 /* A light and the group it belongs to (group < RAD_BAKER_MAX_GROUPS). */
 typedef struct rad_baker_light {
@@ -3333,6 +3357,7 @@ typedef struct rad_baker_desc {
     const float *probe_positions;   /* probe_count points, 3 floats each; NULL: a grid */
     uint32_t probe_count;
     float probe_spacing;            /* the grid's spacing (0: the largest extent / 8) */
+    const rad_probe_options *probe_options; /* NULL: the defaults (PROBE OPTIONS above) */
 } rad_baker_desc;
 
 /* How to bake. A zeroed struct means every default. */
@@ -3413,8 +3438,11 @@ typedef struct rad_baker_result {
                                        sky_count - 1 of vertex_layers, lightmap_layers and
                                        probe_layers, after the groups' */
     rad_baker_kept *kept;           /* private: the solver objects (options.keep), else NULL */
+    float *probe_band4;             /* 27 per probe with RAD_PROBES_BAND4 (PROBE OPTIONS), else NULL */
+    float *probe_band4_layers;      /* group_count planes of 27 * probe_count */
     rad_allocator allocator;        /* private */
     rad_baker_choice plan;          /* the whole plan (method, reason and estimates are also above) */
+    rad_baker_solution *solution;   /* RAD_BAKER_SOLUTION, else NULL: read by rad_baker_irradiance */
 } rad_baker_result;
 
 /* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
@@ -3423,8 +3451,10 @@ typedef struct rad_baker_result {
    no emissive material and no sky layers, sky_bands above 4 or sky_rays above 4096, a lightmap without any lightmap_uvs, a negative or non-finite
    budget), the scene's errors (rad_scene_create: a bad mesh, material or value), the lights'
    (rad_direct_irradiance), OUT_OF_MEMORY (also: the budget is too small for the smallest bake
-   of the method, or an allocation failed), CANCELLED, RAYCAST_FAILED. Thread safety:
-   reentrant; parallel through ctx->parallel_for. Cost: see ESTIMATE above. */
+   of the method, or an allocation failed), SIZE_OVERFLOW (a probe grid of more than 2^24
+   probes, before any work), the probes' errors (rad_probes_create: bad probe_options),
+   CANCELLED, RAYCAST_FAILED. Thread safety: reentrant; parallel through ctx->parallel_for.
+   Cost: see ESTIMATE above. */
 RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_options *options, const rad_context *ctx,
                             rad_baker_result **out);
 RAD_API void rad_baker_result_destroy(rad_baker_result *result);
@@ -3442,7 +3472,7 @@ RAD_API void rad_baker_result_destroy(rad_baker_result *result);
 RAD_API rad_result rad_baker_plan(const rad_scene *scene, const rad_raycaster *raycaster, const rad_baker_options *options,
                                   const rad_context *ctx, rad_baker_choice *out);
 
-/* Rewrites the result's outputs (vertex, lightmap, probes; those it has) as
+/* Rewrites the result's outputs (vertex, lightmap, probes, the kept solution; those it has) as
    sum_g group_rgb[3g + c] layer_g per channel c. group_rgb: 3 * group_count floats (NULL: all
    1, the plain sum), finite. Errors: INVALID_ARGUMENT (NULL result), NON_FINITE (a scale).
    Cost: one pass over the layers whose scale is not 0 0 0, parallel through ctx. */
@@ -3465,6 +3495,19 @@ RAD_API rad_result rad_baker_mix_sky(rad_baker_result *result, const float *grou
    A constant sky of radiance L gives l_0 = sqrt(4 pi) L and 0 else. Errors: INVALID_ARGUMENT
    (NULL env or out, bands not 1 to 4), NON_FINITE (a scale). */
 RAD_API rad_result rad_sky_project_sh(const rad_environment *env, uint32_t bands, const float scale[3], float *out);
+
+/* The bounced irradiance H (W m^-2, RGB, the mix of rad_baker_mix; all groups at scale 1
+   after rad_baker_run) at 'count' surface points of a result baked with RAD_BAKER_SOLUTION
+   (SOLUTION above): point i at points[3i] with unit normal normals[3i] on the scene triangle
+   hits[i].triangle at barycentrics hits[i].b1, hits[i].b2 (a hit of a ray cast on the scene
+   of desc->scene: classic reads the triangle and barycentrics, virtual patches the point and
+   normal; give all three). A triangle out of range (RAD_NONE) gets 0. out: 3 * count floats.
+   Errors: INVALID_ARGUMENT (NULL result, hits, points, normals or out with count > 0, a result
+   without RAD_BAKER_SOLUTION), NON_FINITE (virtual patches: a point or normal NaN or infinite).
+   Thread safety: reentrant (the result is only read). Cost: O(1) per point (classic: three
+   vertex values; virtual patches: rad_vp_gather_point, in parallel through ctx). */
+RAD_API rad_result rad_baker_irradiance(const rad_baker_result *result, const rad_hit *hits, const float *points,
+                                        const float *normals, uint32_t count, float *out, const rad_context *ctx);
 
 /* The kernel of rad_baker_mix on any planar layers: out[i] = sum_g group_rgb[3g + i mod 3]
    layers[g count3 + i] for i < count3, the groups with scale 0 0 0 skipped (out is 0 when
@@ -23141,6 +23184,32 @@ static rad_result rad__baker_mix_planes(const float *layers, uint32_t planes, si
     return RAD_SUCCESS;
 }
 
+/* What RAD_BAKER_SOLUTION keeps (SOLUTION in >>api_bake): the method's objects and, per
+   group, the values its final gather reads (classic: per patch vertex; virtual patches: per
+   patch), with their mix. With rad_baker_options.keep the objects are the kept ones (borrowed). */
+struct rad_baker_solution {
+    rad_scene *scene;              /* classic: the scene the patches were made on */
+    rad_patches *patches;          /* classic */
+    rad_virtual_patches *vp;       /* virtual patches */
+    int borrowed;                  /* the objects belong to rad_baker_result.kept */
+    size_t count3;                 /* floats per layer */
+    float *values;                 /* the mix */
+    float *layers;                 /* group_count planes of count3 */
+};
+
+static void rad__baker_solution_destroy(const rad_allocator *a, rad_baker_solution *s)
+{
+    if (!s) return;
+    if (!s->borrowed) {
+        rad_patches_destroy(s->patches);
+        rad_vp_destroy(s->vp);
+        rad_scene_destroy(s->scene);
+    }
+    rad__free(a, s->values);
+    rad__free(a, s->layers);
+    rad__free(a, s);
+}
+
 RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
                                         float *out, const rad_context *ctx)
 {
@@ -23189,6 +23258,11 @@ RAD_API rad_result rad_baker_mix_sky(rad_baker_result *R, const float *group_rgb
                                   R->lightmap, ctx, &c);
     if (r == RAD_SUCCESS && R->probe_layers)
         r = rad__baker_mix_planes(R->probe_layers, planes, 27 * (size_t)R->probe_count, rgb, R->probes, ctx, &c);
+    /* the kept solution and band 4 hold the groups' planes only (no sky) */
+    if (r == RAD_SUCCESS && R->solution && G)
+        r = rad__baker_mix_planes(R->solution->layers, G, R->solution->count3, rgb, R->solution->values, ctx, &c);
+    if (r == RAD_SUCCESS && R->probe_band4_layers && G)
+        r = rad__baker_mix_planes(R->probe_band4_layers, G, 27 * (size_t)R->probe_count, rgb, R->probe_band4, ctx, &c);
     return r;
 }
 
@@ -23232,13 +23306,49 @@ RAD_API void rad_baker_result_destroy(rad_baker_result *R)
     rad__free(&a, R->probe_states);
     rad__free(&a, R->probes);
     rad__free(&a, R->probe_layers);
+    rad__free(&a, R->probe_band4);
+    rad__free(&a, R->probe_band4_layers);
+    rad__baker_solution_destroy(&a, R->solution);
     rad__free(&a, R);
+}
+
+RAD_API rad_result rad_baker_irradiance(const rad_baker_result *R, const rad_hit *hits, const float *points,
+                                        const float *normals, uint32_t count, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    const rad_baker_solution *s;
+    uint32_t i, k;
+    rad__ctx_init(&c, ctx);
+    if (!R || (count && (!hits || !points || !normals || !out))) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_irradiance: NULL result, hits, points, normals or out");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(s = R->solution)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_irradiance: the result keeps no solution (bake with RAD_BAKER_SOLUTION)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s->vp) return count ? rad_vp_gather(s->vp, s->values, points, normals, count, out, ctx) : RAD_SUCCESS;
+    for (i = 0; i < count; ++i) {
+        float w[3];
+        uint32_t p = rad_patches_locate(s->patches, hits[i].triangle, hits[i].b1, hits[i].b2, w);
+        const uint32_t *v;
+        if (p == RAD_NONE) {
+            out[3 * (size_t)i] = out[3 * (size_t)i + 1] = out[3 * (size_t)i + 2] = 0.0f;
+            continue;
+        }
+        v = s->patches->patches[p].vertices;
+        for (k = 0; k < 3; ++k)
+            out[3 * (size_t)i + k] = w[0] * s->values[3 * (size_t)v[0] + k] + w[1] * s->values[3 * (size_t)v[1] + k] +
+                                     w[2] * s->values[3 * (size_t)v[2] + k];
+    }
+    return RAD_SUCCESS;
 }
 
 static void rad__baker_bytes(char *buf, size_t len, double b)
 {
     if (b < 1073741824.0) snprintf(buf, len, "%.1f MiB", b / 1048576.0);
-    else snprintf(buf, len, "%.1f GiB", b / 1073741824.0);
+    else if (b < 1e18) snprintf(buf, len, "%.1f GiB", b / 1073741824.0);
+    else snprintf(buf, len, "no limit"); /* a budget set out of the way */
 }
 
 static void rad__baker_time(char *buf, size_t len, double s)
@@ -23247,7 +23357,8 @@ static void rad__baker_time(char *buf, size_t len, double s)
     else if (s < 7200.0) snprintf(buf, len, "%.0f minutes", s / 60.0);
     else if (s < 172800.0) snprintf(buf, len, "%.1f hours", s / 3600.0);
     else if (s < 1e9) snprintf(buf, len, "%.0f days", s / 86400.0);
-    else snprintf(buf, len, "ages");
+    else if (s < 1e18) snprintf(buf, len, "ages");
+    else snprintf(buf, len, "no limit"); /* a budget set out of the way */
 }
 
 /* Everything one bake holds while it runs; freed in one place. */
@@ -23301,6 +23412,14 @@ static int rad__baker_emits(const rad_material *m)
     return m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f;
 }
 
+/* The probes' options of a desc (PROBE OPTIONS in >>api_bake). */
+static void rad__baker_probe_options(const rad_baker_desc *d, rad_probe_options *po)
+{
+    if (d->probe_options) *po = *d->probe_options;
+    else rad_probe_options_default(po);
+    if (d->probe_spacing != 0.0f) po->spacing = d->probe_spacing;
+}
+
 /* The checks that need nothing built: groups, outputs, budget, something that emits. */
 static rad_result rad__baker_check(rad__baker *b)
 {
@@ -23314,7 +23433,7 @@ static rad_result rad__baker_check(rad__baker *b)
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: max_memory and max_seconds must be finite and >= 0");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (d->outputs & ~(uint32_t)(RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES)) {
+    if (d->outputs & ~(uint32_t)(RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES | RAD_BAKER_SOLUTION)) {
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown output bits 0x%x", d->outputs);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
@@ -23354,6 +23473,12 @@ static rad_result rad__baker_check(rad__baker *b)
     if (b->o.sky_bands > 4 || b->o.sky_rays > 4096u) {
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: sky_bands %u (0 to 4) or sky_rays %u (at most 4096)", b->o.sky_bands,
                  b->o.sky_rays);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (b->o.sky_bands && (b->outputs & RAD_BAKER_PROBES) && d->probe_options &&
+        (d->probe_options->flags & (RAD_PROBES_DIRECT | RAD_PROBES_BAND4))) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: sky layers with probe_options RAD_PROBES_DIRECT or RAD_PROBES_BAND4 "
+                                       "(the sky's planes hold the bounced light of L2 probes only)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     if (d->light_count == 0 && emitters == 0 && b->o.sky_bands == 0) {
@@ -23572,9 +23697,12 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
             P->estimated_seconds = secs;
             P->over_budget = !classic_fits;
             snprintf(P->reason, sizeof P->reason,
-                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s of CPU, %s the budget of %s "
-                     "and %s",
-                     S->triangle_count, P->patch_count, bb, tb, classic_fits ? "within" : "over (forced)", lb, sb);
+                     "classic: %u triangles, %u patches; dense F and outputs about %s and %s of CPU, %s%s%s%s%s",
+                     S->triangle_count, P->patch_count, bb, tb, classic_fits ? "within" : "over (forced)",
+                     budget >= 1e18 && seconds_budget >= 1e18 ? " no budget" : " the budget of ",
+                     budget >= 1e18 && seconds_budget >= 1e18 ? "" : lb,
+                     budget >= 1e18 && seconds_budget >= 1e18 ? "" : " and ",
+                     budget >= 1e18 && seconds_budget >= 1e18 ? "" : sb);
             if (keep) *keep = patches;
             else rad_patches_destroy(patches);
             return RAD_SUCCESS;
@@ -23655,12 +23783,20 @@ static rad_result rad__baker_plan(rad__baker *b)
     rad__plan_in in;
     rad_result r;
     if (!b->d->probe_positions) { /* the grid rad_probes_create lays: about extent / spacing + 1 per axis */
-        double ext = 0.0, sp = b->d->probe_spacing, count = 1.0;
+        rad_probe_options po;
+        double ext = 0.0, sp, count = 1.0;
         int k;
+        rad__baker_probe_options(b->d, &po);
+        sp = po.spacing;
         for (k = 0; k < 3; ++k)
             if (S->bounds_max[k] - S->bounds_min[k] > ext) ext = S->bounds_max[k] - S->bounds_min[k];
         if (!(sp > 0.0)) sp = ext / 8.0;
         for (k = 0; k < 3; ++k) count *= sp > 0.0 ? ceil((S->bounds_max[k] - S->bounds_min[k]) / sp) + 1.0 : 1.0;
+        if (b->outputs & RAD_BAKER_PROBES && !(count <= 16777216.0)) { /* rad_probes_create's limit, named before any work */
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: a probe spacing of %g gives a grid of %.0f probes, more than "
+                     "2^24: give a larger spacing", sp, count);
+            return RAD_ERROR_SIZE_OVERFLOW;
+        }
         probes_guess = count < 16777216.0 ? (uint32_t)count : 16777216u;
     }
     b->outputs_bytes = rad__baker_output_bytes(b, probes_guess);
@@ -23728,11 +23864,13 @@ static uint32_t rad__baker_group_lights(rad__baker *b, uint32_t g)
 }
 
 /* A view of the scene whose materials emit only group g's light (the geometry is the same,
-   so the BVH, patches and texels built on the scene serve it unchanged). */
-static const rad_scene *rad__baker_group_scene(rad__baker *b, uint32_t g, rad_scene *view)
+   so the BVH, patches and texels built on the scene serve it unchanged). A group without
+   emitters gets the scene itself (its direct light excludes the emitters), unless 'strict'
+   (the probes' direct term, which reads the emitters off the scene). */
+static const rad_scene *rad__baker_group_scene(rad__baker *b, uint32_t g, rad_scene *view, int strict)
 {
     uint32_t i;
-    if (!b->group_emits[g] || b->emissive_groups <= 1) return b->scene;
+    if (!b->emissive_groups || (b->group_emits[g] ? b->emissive_groups <= 1 : !strict)) return b->scene;
     *view = *b->scene;
     for (i = 0; i < b->scene->material_count; ++i) {
         b->masked[i] = b->scene->materials_table[i];
@@ -23796,8 +23934,8 @@ static rad_result rad__baker_build(rad__baker *b)
     if (b->outputs & RAD_BAKER_PROBES) {
         rad_probe_options po;
         if (rad__baker_stage(&b->prog, 0.55f, 0.6f)) return RAD_ERROR_CANCELLED;
-        rad_probe_options_default(&po);
-        po.spacing = b->d->probe_spacing;
+        rad__baker_probe_options(b->d, &po);
+        po.flags &= ~(uint32_t)RAD_PROBES_DIRECT; /* the placement and weights: the groups add their direct light */
         r = R->method == RAD_BAKER_CLASSIC
                 ? rad_probes_create(b->patches, &b->rc, NULL, 0, b->d->probe_positions, b->d->probe_count, &po, NULL, &b->sub,
                                     &b->probes)
@@ -23845,6 +23983,15 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
         memset(R->lightmap_layers, 0, n * G * sizeof(float));
         memcpy(R->lightmap_flags, b->lm->flags, n / 3);
     }
+    if (b->outputs & RAD_BAKER_SOLUTION) {
+        R->solution = (rad_baker_solution *)rad__alloc_zero(a, sizeof(rad_baker_solution));
+        if (!R->solution) return RAD_ERROR_OUT_OF_MEMORY;
+        R->solution->count3 = 3 * (size_t)(R->method == RAD_BAKER_CLASSIC ? b->patches->vertex_count : R->patch_count);
+        R->solution->values = (float *)rad__alloc_array(a, R->solution->count3, sizeof(float));
+        R->solution->layers = (float *)rad__alloc_array(a, R->solution->count3 * G, sizeof(float));
+        if (!R->solution->values || !R->solution->layers) return RAD_ERROR_OUT_OF_MEMORY;
+        memset(R->solution->layers, 0, R->solution->count3 * G * sizeof(float));
+    }
     if (b->probes) {
         R->probe_count = rad_probes_count(b->probes);
         n = 27 * (size_t)R->probe_count;
@@ -23854,6 +24001,12 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
         R->probe_states = (uint8_t *)rad__alloc_array(a, R->probe_count, 1);
         if (!R->probes || !R->probe_layers || !R->probe_positions || !R->probe_states) return RAD_ERROR_OUT_OF_MEMORY;
         memset(R->probe_layers, 0, n * G * sizeof(float));
+        if (rad_probes_band4(b->probes)) {
+            R->probe_band4 = (float *)rad__alloc_array(a, n, sizeof(float));
+            R->probe_band4_layers = (float *)rad__alloc_array(a, n * G, sizeof(float));
+            if (!R->probe_band4 || !R->probe_band4_layers) return RAD_ERROR_OUT_OF_MEMORY;
+            memset(R->probe_band4_layers, 0, n * G * sizeof(float));
+        }
         memcpy(R->probe_positions, rad_probes_positions(b->probes), 3 * sizeof(float) * R->probe_count);
         memcpy(R->probe_states, rad_probes_states(b->probes), R->probe_count);
         if (!rad_probes_grid(b->probes, R->probe_grid, R->probe_origin, &R->probe_spacing)) {
@@ -23875,7 +24028,7 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     rad_baker_result *R = b->R;
     rad_scene view;
     int sky = g >= R->group_count;
-    const rad_scene *Sg = sky ? b->scene : rad__baker_group_scene(b, g, &view);
+    const rad_scene *Sg = sky ? b->scene : rad__baker_group_scene(b, g, &view, 0);
     uint32_t nl = sky ? 0u : rad__baker_group_lights(b, g), n = R->patch_count, m, k = sky ? g - R->group_count : 0u;
     size_t i, N3 = 3 * (size_t)n;
     float *D = b->work, *E = D + N3, *L = E + N3, *B = L + N3, *H = B + N3, *V = H + N3;
@@ -23940,9 +24093,14 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     r = rad_matrix_multiply(R->method == RAD_BAKER_CLASSIC ? &b->ff->matrix : &b->vp->matrix, B, H, &b->sub);
     if (r != RAD_SUCCESS) return r;
     RAD__BAKER_PART(0.5f, 0.6f);
+    if (R->method == RAD_BAKER_CLASSIC && (R->vertex_layers || R->solution))
+        r = rad_patches_vertex_irradiance(b->patches, H, b->row_sums, V, &b->sub);
+    if (r == RAD_SUCCESS && R->solution && g < R->group_count) /* the values the final gather reads (no sky) */
+        memcpy(R->solution->layers + (size_t)g * R->solution->count3, R->method == RAD_BAKER_CLASSIC ? V : H,
+               R->solution->count3 * sizeof(float));
+    if (r != RAD_SUCCESS) return r;
     if (R->vertex_layers) {
         float *out = R->vertex_layers + (size_t)g * 3 * R->vertex_count;
-        if (R->method == RAD_BAKER_CLASSIC) r = rad_patches_vertex_irradiance(b->patches, H, b->row_sums, V, &b->sub);
         for (m = 0; r == RAD_SUCCESS && m < R->mesh_count; ++m) {
             const rad_mesh_desc *mesh = &b->d->scene.meshes[m];
             float *o = out + 3 * (size_t)R->vertex_first[m];
@@ -23969,10 +24127,41 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     RAD__BAKER_PART(0.95f, 1.0f);
 #undef RAD__BAKER_PART
     if (R->probe_layers) {
-        r = rad_probes_update(b->probes, B, &b->sub);
+        rad_probe_options po;
+        rad_probes *own = NULL, *pr = b->probes;
+        rad__baker_probe_options(b->d, &po);
+        if (po.flags & RAD_PROBES_DIRECT) {
+            /* the group's direct light at the probes comes with their creation, from its lights
+               and (through the scene view) its emitters */
+            rad_scene strict;
+            const rad_scene *Sp = rad__baker_group_scene(b, g, &strict, 1);
+            if (R->method == RAD_BAKER_CLASSIC) {
+                rad_patches pg = *b->patches;
+                pg.scene = Sp;
+                r = rad_probes_create(&pg, &b->rc, b->lights, nl, b->d->probe_positions, b->d->probe_count, &po, B, &b->sub, &own);
+            } else {
+                rad_virtual_patches vg = *b->vp;
+                vg.scene = Sp;
+                r = rad_probes_create_vp(&vg, &b->rc, b->lights, nl, b->d->probe_positions, b->d->probe_count, &po, B, &b->sub,
+                                         &own);
+            }
+            if (r == RAD_SUCCESS && rad_probes_count(own) != R->probe_count) { /* placement does not depend on light */
+                rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: the probes of group %u were placed otherwise", g);
+                r = RAD_ERROR_INVALID_ARGUMENT;
+            }
+            pr = own;
+        } else {
+            r = rad_probes_update(pr, B, &b->sub);
+        }
+        if (r == RAD_SUCCESS) {
+            memcpy(R->probe_layers + (size_t)g * 27 * R->probe_count, rad_probes_coefficients(pr),
+                   27 * sizeof(float) * R->probe_count);
+            if (R->probe_band4_layers)
+                memcpy(R->probe_band4_layers + (size_t)g * 27 * R->probe_count, rad_probes_band4(pr),
+                       27 * sizeof(float) * R->probe_count);
+        }
+        rad_probes_destroy(own);
         if (r != RAD_SUCCESS) return r;
-        memcpy(R->probe_layers + (size_t)g * 27 * R->probe_count, rad_probes_coefficients(b->probes),
-               27 * sizeof(float) * R->probe_count);
     }
     return RAD_SUCCESS;
 }
@@ -24038,6 +24227,21 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
             if (b.R->method == RAD_BAKER_CLASSIC) k->patches = b.patches, b.patches = NULL; /* else the plan's: freed */
             b.scene = NULL, b.bvh = NULL, b.ff = NULL, b.vp = NULL, b.lm = NULL, b.probes = NULL;
             b.R->kept = k;
+        }
+    }
+    if (r == RAD_SUCCESS && b.R->solution) { /* the solution keeps the objects its gather reads */
+        rad_baker_solution *so = b.R->solution;
+        if (b.R->kept) { /* the kept objects serve both (borrowed) */
+            so->borrowed = 1;
+            so->patches = b.R->kept->patches, so->scene = b.R->kept->scene, so->vp = b.R->kept->vp;
+            if (b.R->method == RAD_BAKER_CLASSIC) so->vp = NULL;
+            else so->patches = NULL, so->scene = NULL;
+        } else if (b.R->method == RAD_BAKER_CLASSIC) {
+            so->patches = b.patches, so->scene = b.scene;
+            b.patches = NULL, b.scene = NULL;
+        } else {
+            so->vp = b.vp;
+            b.vp = NULL;
         }
     }
     rad__baker_free(&b);
@@ -24731,8 +24935,12 @@ static rad_result rad__brt_out_probes(rad_baker_runtime *rt, const rad_baker_des
 {
     rad_probe_options po;
     rad_result r;
-    rad_probe_options_default(&po);
-    po.spacing = desc->probe_spacing;
+    rad__baker_probe_options(desc, &po);
+    if (po.flags & (RAD_PROBES_DIRECT | RAD_PROBES_BAND4)) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: probe_options with RAD_PROBES_DIRECT or RAD_PROBES_BAND4 "
+                                   "(the runtime refreshes the bounced light of L2 probes only)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (rt->kept && rt->kept->probes) rt->probes = rt->kept->probes, r = RAD_SUCCESS;
     else
         r = R->method == RAD_BAKER_CLASSIC

@@ -546,7 +546,7 @@ static void bk_test_bad_input(void)
     bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_uvs");
     /* unknown method and output bits, a negative budget */
     bad = d;
-    bad.outputs = 8;
+    bad.outputs = 16; /* the bit after RAD_BAKER_SOLUTION */
     bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "output");
     o.method = (rad_baker_method)7;
     bk_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "method");

@@ -210,6 +210,53 @@ int tool_classic_solve(const char *cmd, const tool_world *w, const tool_classic_
     return 0;
 }
 
+int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method,
+                   uint32_t bounces, uint32_t vp_resolution, rad_baker_desc *d, rad_baker_result **out)
+{
+    rad_baker_options bo;
+    rad_baker_light *bl;
+    rad_context ctx;
+    rad_result r;
+    uint32_t i, emits = w->file.light_count > 0;
+    *out = NULL;
+    for (i = 0; i < w->file.desc.material_count; ++i) {
+        const float *e = w->file.desc.materials[i].emission;
+        emits |= e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
+    }
+    if (!emits) return -1; /* the tier refuses a scene where nothing emits: the caller's own path draws it black */
+    if (method == RAD_BAKER_CLASSIC && tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
+    memset(&bo, 0, sizeof bo);
+    bo.method = method;
+    /* the tool's own checks decide (tool_dense_check on the counted patches, --force; the
+       resolution of virtual patches is the command line's or the plan's already): the tier's
+       budget is set out of the way */
+    bo.max_memory = bo.max_seconds = 1e29;
+    bo.patches = o->patches;
+    bo.ff_samples = o->samples;
+    bo.bounces = bounces;
+    bo.light_samples = o->light_samples;
+    bo.vp_resolution = vp_resolution;
+    if (method == RAD_BAKER_CLASSIC) {
+        rad_baker_choice plan;
+        memset(&ctx, 0, sizeof ctx); /* quiet: the run logs the same plan */
+        if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
+        if (tool_dense_check(cmd, o, plan.patch_count, 0)) return 1;
+    }
+    bl = (rad_baker_light *)tool_calloc(w->file.light_count ? w->file.light_count : 1u, sizeof *bl);
+    for (i = 0; i < w->file.light_count; ++i) bl[i].light = w->file.lights[i];
+    d->scene = w->file.desc;
+    d->lights = bl;
+    d->light_count = w->file.light_count;
+    d->group_count = 1;
+    tool_context(&ctx, "bake");
+    r = rad_baker_run(d, &bo, &ctx, out);
+    tool_progress_end();
+    free(bl);
+    if (r != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_run", r);
+    fprintf(stderr, "rad %s: %s\n", cmd, (*out)->reason);
+    return 0;
+}
+
 void tool_bake_info_fill(tool_bake_info *info, const tool_world *w, const tool_classic_options *o)
 {
     memset(info, 0, sizeof *info);

@@ -177,15 +177,23 @@ static int put_f32(FILE *f, float x)
     return put_u32(f, v);
 }
 
+/* What the file holds: the probes of the engine tier's result or of a rad_probes. */
+typedef struct probes_view {
+    uint32_t n, dims[3];
+    float origin[3], spacing;
+    const float *pos, *co, *b4;
+    const uint8_t *st;
+} probes_view;
+
 /* 1 when every write succeeded */
-static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
+static int write_probes(FILE *f, int json, const probes_view *v, int total)
 {
-    uint32_t n = rad_probes_count(pr), i, dims[3] = {0, 0, 0}, k;
-    float origin[3] = {0, 0, 0}, spacing = 0.0f;
-    const float *pos = rad_probes_positions(pr), *co = rad_probes_coefficients(pr), *b4 = rad_probes_band4(pr);
-    const uint8_t *st = rad_probes_states(pr);
+    uint32_t n = v->n, i, k;
+    const uint32_t *dims = v->dims;
+    const float *origin = v->origin, spacing = v->spacing;
+    const float *pos = v->pos, *co = v->co, *b4 = v->b4;
+    const uint8_t *st = v->st;
     int ok = 1;
-    rad_probes_grid(pr, dims, origin, &spacing);
     if (json) {
         ok &= fprintf(f, "{\n  \"format\": \"radiosity.h probes\",\n  \"version\": 1,\n"
                          "  \"basis\": \"real SH L2, irradiance coefficients E_i (W/m^2): E(n) = sum_i E_i Y_i(n), "
@@ -235,6 +243,21 @@ static int write_probes(FILE *f, int json, const rad_probes *pr, int total)
     return ok;
 }
 
+/* The classic probes by the engine tier: one bake of the scene and its lights with the
+   probes' options (RAD_PROBES_DIRECT unless --indirect, band 4), for the solver and patches
+   it offers (Jacobi bounces on the patches as made); 1 (printed) on failure, -1 when the
+   command line asks for what it does not offer. */
+static int probes_baked(const char *cmd, const tool_world *w, const probes_args *pa, rad_baker_result **out)
+{
+    rad_baker_desc d;
+    *out = NULL;
+    if (pa->px.kind || pa->o.solver != TOOL_JACOBI || pa->o.bounces == 0 || pa->o.max_edge != 0.0f) return -1;
+    memset(&d, 0, sizeof d);
+    d.outputs = RAD_BAKER_PROBES;
+    d.probe_options = &pa->po;
+    return tool_baker_run(cmd, w, &pa->o, RAD_BAKER_CLASSIC, pa->o.bounces, 0, &d, out);
+}
+
 static int probes_main(int argc, char **argv, tool_lights *lights)
 {
     const char *cmd = "probes";
@@ -244,6 +267,9 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
     rad_virtual_patches *vp = NULL;
     float *vp_B = NULL;
     rad_probes *pr = NULL;
+    rad_baker_result *R = NULL;
+    probes_view v;
+    char weights[64] = "";
     rad_context ctx;
     tool_output out;
     uint32_t i, counts[3] = {0, 0, 0};
@@ -260,7 +286,13 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
     /* a scene too big for the dense classic build is refused with the way out */
     pa.o.dense_instead = "--proxy aavp or --proxy vp (the probes' light from virtual patches: a few thousand whatever the "
                       "triangle count; --vp-resolution R sets how many)";
-    if (pa.px.kind) {
+    if (probes_baked(cmd, &w, &pa, &R) == 1) {
+        tool_close_world(&w);
+        return 1;
+    }
+    if (R) {
+        /* the tier's result */
+    } else if (pa.px.kind) {
         if (tool_vp_proxy_solve(cmd, &w, &pa.o, &pa.px, &vp, &vp_B, NULL, NULL)) {
             tool_close_world(&w);
             return 1;
@@ -271,8 +303,9 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
     }
     tool_context(&ctx, "probes");
     tp = tool_seconds();
-    r = vp ? rad_probes_create_vp(vp, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &pa.po, vp_B, &ctx, &pr)
-           : rad_probes_create(c.patches, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &pa.po, c.B, &ctx, &pr);
+    r = R   ? RAD_SUCCESS
+        : vp ? rad_probes_create_vp(vp, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &pa.po, vp_B, &ctx, &pr)
+             : rad_probes_create(c.patches, &w.rc, w.file.lights, w.file.light_count, NULL, 0, &pa.po, c.B, &ctx, &pr);
     tool_progress_end();
     rc = 1;
     if (r != RAD_SUCCESS) {
@@ -280,22 +313,42 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
         goto done;
     }
     tp = tool_seconds() - tp;
-    for (i = 0; i < rad_probes_count(pr); ++i) counts[rad_probes_states(pr)[i] % 3u]++;
+    memset(&v, 0, sizeof v);
+    if (R) {
+        v.n = R->probe_count;
+        memcpy(v.dims, R->probe_grid, sizeof v.dims);
+        memcpy(v.origin, R->probe_origin, sizeof v.origin);
+        v.spacing = R->probe_spacing;
+        v.pos = R->probe_positions;
+        v.co = R->probes;
+        v.b4 = R->probe_band4;
+        v.st = R->probe_states;
+    } else {
+        v.n = rad_probes_count(pr);
+        rad_probes_grid(pr, v.dims, v.origin, &v.spacing);
+        v.pos = rad_probes_positions(pr);
+        v.co = rad_probes_coefficients(pr);
+        v.b4 = rad_probes_band4(pr);
+        v.st = rad_probes_states(pr);
+    }
+    for (i = 0; i < v.n; ++i) counts[v.st[i] % 3u]++;
     if (tool_output_open(&out, pa.out) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
-    if (tool_output_commit(&out, write_probes(out.f, json, pr, total)) != 0) {
+    if (tool_output_commit(&out, write_probes(out.f, json, &v, total)) != 0) {
         fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
         goto done;
     }
-    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled), %lu weights, %s light%s%s\n", pa.out,
-           rad_probes_count(pr), counts[RAD_PROBE_VALID], counts[RAD_PROBE_MOVED], counts[RAD_PROBE_DISABLED],
-           (unsigned long)rad_probes_entry_count(pr), total ? "total" : "indirect", rad_probes_band4(pr) ? ", band 4" : "",
+    if (pr) snprintf(weights, sizeof weights, ", %lu weights", (unsigned long)rad_probes_entry_count(pr));
+    printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled)%s, %s light%s%s\n", pa.out, v.n,
+           counts[RAD_PROBE_VALID], counts[RAD_PROBE_MOVED], counts[RAD_PROBE_DISABLED], weights,
+           total ? "total" : "indirect", v.b4 ? ", band 4" : "",
            vp ? (pa.px.kind == TOOL_PROXY_VP ? ", over vp virtual patches" : ", over aavp virtual patches") : "");
     fprintf(stderr, "rad %s: probes gathered in %.2f s; done in %.2f s\n", cmd, tp, tool_seconds() - t0);
     rc = 0;
 done:
+    rad_baker_result_destroy(R);
     rad_probes_destroy(pr);
     free(vp_B);
     rad_vp_destroy(vp);

@@ -101,9 +101,10 @@ typedef struct render_view {
 } render_view;
 
 /* Where render_classic takes the irradiance H from the secondary sources at a sample: the
-   first of vp (rad_vp_gather of vp_H), hr (the hierarchical solution's smooth lookup) and lm
-   (a bilinear lookup of the RGB irradiance lightmap lm_values at the sample's lightmap uv)
-   that is set, else the per-vertex Hv of the patches P. */
+   first of baker (the engine tier's own final gather, rad_baker_irradiance), vp (rad_vp_gather
+   of vp_H), hr (the hierarchical solution's smooth lookup) and lm (a bilinear lookup of the
+   RGB irradiance lightmap lm_values at the sample's lightmap uv) that is set, else the
+   per-vertex Hv of the patches P. */
 typedef struct render_source {
     const rad_patches *P;
     const float *Hv;
@@ -112,6 +113,7 @@ typedef struct render_source {
     const rad_hierarchical *hr;
     const rad_lightmap *lm;
     const float *lm_values;
+    const rad_baker_result *baker; /* the engine tier's kept solution (rad_baker_irradiance) */
     double gather_seconds;   /* out: the time spent in the gathers and lookups */
 } render_source;
 
@@ -189,6 +191,7 @@ typedef struct pixel_batch {
     rad_hit *hits;
     float *points, *normals, *irr; /* per valid hit: position, normal, direct irradiance D */
     float *gathered;         /* per valid hit: H from the source's gather or the final gather (or NULL) */
+    rad_hit *vhits;          /* per valid hit: its hit (rad_baker_irradiance) */
     float *shade_v, *shade_a, *shaded; /* --shading: view direction, albedo, direct radiance */
     uint32_t *valid;
     uint32_t count, nvalid;
@@ -212,7 +215,9 @@ static void pixel_batch_alloc(pixel_batch *b, const render_view *view, const ren
     b->normals = (float *)xmalloc(sizeof(float) * 3 * b->cap);
     b->irr = (float *)xmalloc(sizeof(float) * 3 * b->cap);
     b->valid = (uint32_t *)xmalloc(sizeof(uint32_t) * b->cap);
-    if (src->vp || src->hr || src->lm || view->final_gather) b->gathered = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    if (src->vp || src->hr || src->lm || src->baker || view->final_gather)
+        b->gathered = (float *)xmalloc(sizeof(float) * 3 * b->cap);
+    if (src->baker) b->vhits = (rad_hit *)xmalloc(sizeof(rad_hit) * b->cap);
     if (view->shading >= 0) {
         b->shade_v = (float *)xmalloc(sizeof(float) * 3 * b->cap);
         b->shade_a = (float *)xmalloc(sizeof(float) * 3 * b->cap);
@@ -232,6 +237,7 @@ static void pixel_batch_free(pixel_batch *b)
     free(b->shade_a);
     free(b->shaded);
     free(b->gathered);
+    free(b->vhits);
 }
 
 /* Rows y0..y1-1: the stratified camera rays, their hits (in parallel chunks: the raycaster is
@@ -328,6 +334,10 @@ static int batch_light(const tool_world *w, const render_view *view, render_sour
             float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
             rad_lightmap_sample(src->lm, 3, src->lm_values, u, v, b->gathered + 3 * k);
         }
+    } else if (src->baker) {
+        for (k = 0; k < n; ++k) b->vhits[k] = b->hits[b->valid[k]];
+        r = rad_baker_irradiance(src->baker, b->vhits, b->points, b->normals, n, b->gathered, &quiet);
+        if (r != RAD_SUCCESS) return tool_fail("render", "rad_baker_irradiance", r);
     } else if (b->gathered) {
         r = src->hr ? hr_lookup(src->hr, b->hits, b->valid, n, b->gathered)
                     : rad_vp_gather(src->vp, src->vp_H, b->points, b->normals, n, b->gathered, &quiet);
@@ -1579,10 +1589,62 @@ static int render_classic_method(const char *cmd, const tool_world *w, const ren
     return rc;
 }
 
+/* Whether the engine tier bakes the choice on the command line: classic with Jacobi bounces
+   on the patches as made, or AAVP at the default face points, solved here (no --bake). The
+   rest (other solvers, --bounces 0 or inf, --max-edge, clustered patches, proxies, the
+   teaching methods) keeps its own path. */
+static int render_by_baker(const render_args *ra)
+{
+    const tool_method_options *mo = &ra->mo;
+    const tool_classic_options *o = &ra->o;
+    if (ra->bake || mo->proxy) return 0;
+    if (mo->method == TOOL_CLASSIC) return o->solver == TOOL_JACOBI && o->bounces > 0 && o->max_edge == 0.0f;
+    return mo->method == TOOL_AAVP && mo->face_points == 16u && mo->bounces > 0 && mo->bounces != RAD_MB_INFINITE;
+}
+
+/* The engine tier's bake of the scene and the lights (one group), keeping its solution, and
+   the per-pixel render with H from the tier's final gather at each sample. 0 or 1 (printed);
+   -1 when nothing emits (the tier refuses that: the caller's own path draws it). */
+static int render_baked(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+{
+    const tool_method_options *mo = &ra->mo;
+    int classic = mo->method == TOOL_CLASSIC;
+    uint32_t res = mo->vp_resolution, bounces = classic ? ra->o.bounces : mo->bounces;
+    rad_baker_desc d;
+    rad_baker_result *R = NULL;
+    render_source src;
+    double t0;
+    int rc;
+    if (!classic && (mo->given & TOOL_OPT_VP_MAX_PATCHES) &&
+        tool_vp_resolution_within(cmd, w, RAD_VP_AXIS_ALIGNED, mo->face_points, mo->vp_max_patches, mo->vp_resolution, &res))
+        return 1;
+    memset(&d, 0, sizeof d);
+    d.outputs = RAD_BAKER_SOLUTION;
+    t0 = tool_seconds();
+    if ((rc = tool_baker_run(cmd, w, &ra->o, classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES, bounces,
+                             classic ? 0u : res, &d, &R)) != 0)
+        return rc;
+    t0 = tool_seconds() - t0;
+    if (!classic)
+        fprintf(stderr, "rad %s: aavp virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
+                R->vp_resolution, R->patch_count);
+    /* one line for scripts: the step is the whole bake here (form factors or set, source, bounces) */
+    fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=1 bounces=%u step_ms_median=%.6f step_ms_min=%.6f%s%.0u\n",
+            cmd, classic ? "classic" : "aavp", R->patch_count, bounces, 1e3 * t0, 1e3 * t0,
+            classic ? "" : " resolution=", classic ? 0u : R->vp_resolution);
+    memset(&src, 0, sizeof src);
+    src.baker = R;
+    rc = render_classic(w, &ra->view, &src, img);
+    rad_baker_result_destroy(R);
+    return rc;
+}
+
 /* the image by the method asked for; 0 or 1 (printed) */
 static int render_image(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
 {
     const tool_method_options *mo = &ra->mo;
+    int rc;
+    if (render_by_baker(ra) && (rc = render_baked(cmd, w, ra, img)) >= 0) return rc;
     if (mo->method == TOOL_LIGHTMAP) return render_lightmap_method(cmd, w, ra, img);
     if ((mo->method >= TOOL_LOCAL && !(mo->method == TOOL_HIERARCHICAL && ra->bake)) || mo->proxy)
         return mo->method == TOOL_LOCAL && !mo->proxy ? render_local_method(cmd, w, ra, img)

@@ -405,6 +405,15 @@ typedef struct tool_bake_info {
     uint32_t triangle_count; /* of the scene baked */
 } tool_bake_info;
 /* the rad.options record of a bake of w with o */
+/* The engine tier's bake of the world's scene and lights (one group): d->outputs (and
+   d->probe_options) as given, the rest of d filled here; the classic options (patches,
+   samples, light samples) become the baker's, with 'method', 'bounces' and 'vp_resolution'
+   (0: the plan's). A classic bake is refused as tool_dense_check refuses it (at least one
+   patch per triangle, then the patches the plan counts); the tier's own budget is not used.
+   Prints the plan's reason;
+   0, 1 after printing why, or -1 (nothing done) when nothing in the world emits. */
+int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method,
+                   uint32_t bounces, uint32_t vp_resolution, rad_baker_desc *d, rad_baker_result **out);
 void tool_bake_info_fill(tool_bake_info *info, const tool_world *w, const tool_classic_options *o);
 /* The hash of a rad.options record and of the lights given on the command line (w's lights
    past file_light_count; none: the hash of the record alone, as before those options), kept
