@@ -1,4 +1,4 @@
-/* radiosity.h - v0.4.0 - diffuse global illumination by the radiosity method
+/* radiosity.h - v0.5.0 - diffuse global illumination by the radiosity method
    public domain or MIT, your choice (see end of file)
 
    Do this:
@@ -297,6 +297,9 @@
        - Start threads, touch the GPU itself, or keep global state.
 
   13. HISTORY
+       0.5.0  alpha cutouts; the baker's plan measured from the scene (rad_baker_plan); lights
+              that move over a bake (rad_baker_runtime_*); stratified direct light by solid
+              angle; the BVH collapsed by SAH cost.
        0.4.0  two-sided materials; emission textures; environment maps, Preetham's sky and
               the sky transfer; the engine tier (rad_baker_*) with light layers; zero means
               default in every option struct; RAD_FMA opt-in; hierarchical memory limit.
@@ -321,9 +324,9 @@
 #include <stdint.h>
 
 #define RAD_VERSION_MAJOR 0
-#define RAD_VERSION_MINOR 4
+#define RAD_VERSION_MINOR 5
 #define RAD_VERSION_PATCH 0
-#define RAD_VERSION_STRING "0.4.0"
+#define RAD_VERSION_STRING "0.5.0"
 
 #ifndef RAD_API
 #  ifdef RADIOSITY_STATIC
