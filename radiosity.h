@@ -3254,7 +3254,9 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    patches (counted first by rad_vp_count, of the kind vp_kind: a clustered set has up to 6
    patches a voxel, often about twice the axis-aligned count) 4 N^2 plus 100 bytes per sample and 48 N per task,
    time M^2 / 1.5e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the output layers, about 30 bytes per texel and lightmap
-   sample, and 40 per probe and patch (the probes' weights, at most). Times are CPU seconds
+   sample, 40 per probe and patch (the probes' weights, at most), and with RAD_BAKER_SOLUTION
+   12 (group_count + 1) per patch vertex (classic) or patch (virtual patches); keep's sparse
+   rows (8 bytes a non-zero) are counted as the dense F they replace. Times are CPU seconds
    (one thread's; divide by the threads for the wall time). Rough: within a factor of a few.
    The estimate and the choice are logged (RAD_LOG_INFO) before the work and returned in the
    result (method, reason, numbers, plan).
@@ -23547,6 +23549,7 @@ typedef struct rad__plan_in {
     double outputs_bytes;           /* the layers, mixed outputs and texels */
     double probes;                  /* probes whose weights are counted (0: no probes) */
     double texels;                  /* lightmap samples gathered per group (0: no lightmap) */
+    double per_patch;               /* bytes kept per patch (or patch vertex) by RAD_BAKER_SOLUTION */
     uint32_t groups;
     uint32_t tasks;
     const char *who;                /* the public function named in messages */
@@ -23635,7 +23638,8 @@ static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *r
 static void rad__plan_vp_cost(const rad__plan_in *in, const rad_vp_counts *cnt, double *bytes, double *secs)
 {
     double n = (double)cnt->patches, M = (double)cnt->samples;
-    *bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)in->tasks + in->outputs_bytes + 40.0 * in->probes * n;
+    *bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)in->tasks + in->outputs_bytes + 40.0 * in->probes * n +
+             in->per_patch * n;
     *secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 16.0 * M / RAD__BAKER_RAY_RATE +
             6.0 * n * n * in->o.bounces * in->groups / RAD__BAKER_FLOP_RATE + in->texels * 8.0 * in->groups / RAD__BAKER_RAY_RATE;
 }
@@ -23672,13 +23676,13 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
         rad_patch_options_default(&po);
         po.target_count = o->patches;
         N = (double)(S->triangle_count > o->patches ? S->triangle_count : o->patches);
-        bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N;
+        bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N + in->per_patch * N;
         if (bytes <= budget) {
             /* the patch count is only near the target: count them before the final estimate */
             r = rad_patches_create(S, &po, sub, &patches);
             if (r != RAD_SUCCESS) return r;
             N = (double)patches->count;
-            bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N;
+            bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N + in->per_patch * patches->vertex_count;
         }
         secs = N * N * o->ff_samples / RAD__BAKER_FF_RATE + 6.0 * N * N * o->bounces * in->groups / RAD__BAKER_FLOP_RATE +
                in->texels * N * 4.0 / RAD__BAKER_RAY_RATE * (in->texels * N > 5e7 ? 5e7 / (in->texels * N) : 1.0) * in->groups;
@@ -23811,6 +23815,7 @@ static rad_result rad__baker_plan(rad__baker *b)
     in.probes = (b->outputs & RAD_BAKER_PROBES) ? (double)probes_guess : 0.0;
     in.texels = (b->outputs & RAD_BAKER_LIGHTMAP) ? (double)R->lightmap_width * R->lightmap_height * b->o.lightmap_samples : 0.0;
     in.groups = R->group_count + R->sky_count; /* a sky layer costs what a group does */
+    in.per_patch = (b->outputs & RAD_BAKER_SOLUTION) ? 12.0 * ((double)R->group_count + 1.0) : 0.0;
     in.tasks = b->c.tasks;
     in.who = "rad_baker_run";
     r = rad__plan_run(&in, &b->sub, &b->c, &R->plan, &b->patches);

@@ -276,11 +276,33 @@ static void bs_test_keep(void)
     rad_scene_destroy(S);
 }
 
+/* The estimate counts what the solution keeps: 12 (groups + 1) bytes per virtual patch. */
+static void bs_test_estimate(void)
+{
+    bs_box b;
+    rad_baker_options o;
+    rad_baker_result *A = NULL, *B = NULL;
+    bs_box_make(&b, 1.0f, 0.5f);
+    bs_options(&o, RAD_BAKER_VIRTUAL_PATCHES);
+    b.desc.outputs = RAD_BAKER_VERTEX;
+    CHECK_OK(rad_baker_run(&b.desc, &o, NULL, &A));
+    b.desc.outputs = RAD_BAKER_VERTEX | RAD_BAKER_SOLUTION;
+    CHECK_OK(rad_baker_run(&b.desc, &o, NULL, &B));
+    if (A && B) {
+        double want = 12.0 * (A->group_count + 1.0) * A->patch_count;
+        CHECK(A->patch_count == B->patch_count);
+        CHECK_NEAR(B->estimated_bytes - A->estimated_bytes, want, 1e-6 * want);
+    }
+    rad_baker_result_destroy(A);
+    rad_baker_result_destroy(B);
+}
+
 static const rad_test_case tests_bake_solution[] = {
     { "bake_solution_closed_form", bs_test_closed_form },
     { "bake_solution_corners_and_mix", bs_test_corners_and_mix },
     { "bake_solution_bad_input", bs_test_bad_input },
     { "bake_solution_keep", bs_test_keep },
+    { "bake_solution_estimate", bs_test_estimate },
     { NULL, NULL }
 };
 
