@@ -1175,10 +1175,11 @@ static void vp_run(const rad_virtual_patches *vp, const float *values, const flo
     ok &= vk_buffer(&g_vk, &bV, 6 * (VkDeviceSize)vp->voxel_count * 4, vp->voxel_patch);
     {
         /* binding 5: the clustered weight's normals times the patch areas */
-        float *an = (float *)malloc(sizeof(float) * 3 * (size_t)count);
+        float *an = vp->normals && vp->areas ? (float *)malloc(sizeof(float) * 3 * (size_t)count) : NULL;
         uint32_t e;
         for (e = 0; an && e < 3 * count; ++e) an[e] = vp->normals[e] * vp->areas[e / 3];
-        ok &= an != NULL && vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, an);
+        /* axis-aligned sets have no normals: the binding is unread, uploaded as before */
+        ok &= (an != NULL || !vp->normals || !vp->areas) && vk_buffer(&g_vk, &bPN, 3 * (VkDeviceSize)count * 4, an ? an : vp->normals);
         free(an);
     }
     ok &= vk_buffer(&g_vk, &bO, 3 * (VkDeviceSize)npts * 4, NULL);
@@ -1220,7 +1221,7 @@ static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_siz
     rad_virtual_patches vp;
     uint64_t keys[5 * 4 * 6];
     uint32_t vpatch[6 * 5 * 4 * 6], c, a, count = 0, i;
-    float normals[3 * 6 * 5 * 4 * 6], *values = NULL, *pts = (float *)malloc(3 * (size_t)npts * 4);
+    float normals[3 * 6 * 5 * 4 * 6], areas[6 * 5 * 4 * 6], *values = NULL, *pts = (float *)malloc(3 * (size_t)npts * 4);
     float *nrm = (float *)malloc(3 * (size_t)npts * 4);
     memset(&vp, 0, sizeof(vp));
     vp.origin[0] = -1.0f; vp.origin[1] = 0.5f; vp.origin[2] = 2.0f;
@@ -1234,6 +1235,7 @@ static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_siz
             *slot = RAD_NONE;
             if (frand() < 0.3f) continue;
             *slot = count;
+            areas[count] = 0.2f + frand(); /* the clustered gather weighs by area */
             if (kind == RAD_VP_CLUSTERED) {
                 float x = frand() - 0.5f, y = frand() - 0.5f, z = frand() - 0.5f, l = sqrtf(x * x + y * y + z * z) + 1e-6f;
                 normals[3 * count] = x / l; normals[3 * count + 1] = y / l; normals[3 * count + 2] = z / l;
@@ -1249,6 +1251,7 @@ static void vp_case(rad_vp_kind kind, rad_vp_weights weights, uint32_t local_siz
     vp.voxel_keys = keys;
     vp.voxel_patch = vpatch;
     vp.normals = normals;
+    vp.areas = areas;
     vp.kind = kind;
     vp.weights = weights;
     values = random_vector(3 * (size_t)count, 0.1f);
