@@ -436,6 +436,24 @@ static void ly_test_runtime_groups(void)
     }
 }
 
+/* The two rooms' outputs (a 32 x 16 lightmap, probes every 0.4) and small bake options,
+   classic (pass 0) or virtual patches (pass 1), for the runtime tests. */
+static void ly_rooms_bake(rad_baker_desc *d, rad_baker_options *o, int pass)
+{
+    d->outputs = RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES;
+    d->lightmap_width = 32;
+    d->lightmap_height = 16;
+    d->probe_spacing = 0.4f;
+    memset(o, 0, sizeof *o);
+    o->method = pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC;
+    o->patches = rad_test_quick() ? 80u : 150u;
+    o->vp_resolution = rad_test_quick() ? 5u : 7u;
+    o->ff_samples = 4;
+    o->bounces = 8;
+    o->light_samples = 4;
+    o->lightmap_samples = 1;
+}
+
 /* The same on the two rooms with a lightmap (the lamp's emission group 0, a point light in the
    other room group 1): vertices, valid texels and probes within 1e-4 of rad_baker_mix (measured
    2e-8 to 1.3e-7, the classic lightmap included). */
@@ -463,18 +481,7 @@ static void ly_test_runtime_groups_lightmap(void)
         d.lights = &bl;
         d.light_count = 1;
         d.material_groups = groups;
-        d.outputs = RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES;
-        d.lightmap_width = 32;
-        d.lightmap_height = 16;
-        d.probe_spacing = 0.4f;
-        memset(&o, 0, sizeof o);
-        o.method = pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC;
-        o.patches = rad_test_quick() ? 80u : 150u;
-        o.vp_resolution = rad_test_quick() ? 5u : 7u;
-        o.ff_samples = 4;
-        o.bounces = 8;
-        o.light_samples = 4;
-        o.lightmap_samples = 1;
+        ly_rooms_bake(&d, &o, pass);
         CHECK_OK(rad_baker_run(&d, &o, NULL, &R));
         if (R) CHECK_OK(rad_baker_runtime_create(&d, &o, R, NULL, NULL, &rt));
         for (step = 0; rt && step < 2; ++step) {
@@ -575,18 +582,7 @@ static void ly_test_keep(void)
         bl.light.color[0] = bl.light.color[1] = bl.light.color[2] = 1.0f;
         d.lights = &bl;
         d.light_count = 1;
-        d.outputs = RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES;
-        d.lightmap_width = 32;
-        d.lightmap_height = 16;
-        d.probe_spacing = 0.4f;
-        memset(&o, 0, sizeof o);
-        o.method = pass ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC;
-        o.patches = rad_test_quick() ? 80u : 150u;
-        o.vp_resolution = rad_test_quick() ? 5u : 7u;
-        o.ff_samples = 4;
-        o.bounces = 8;
-        o.light_samples = 4;
-        o.lightmap_samples = 1;
+        ly_rooms_bake(&d, &o, pass);
         CHECK_OK(rad_baker_run(&d, &o, NULL, &R));
         o.keep = 1;
         CHECK_OK(rad_baker_run(&d, &o, NULL, &K));
