@@ -6506,8 +6506,7 @@ typedef struct rad__bvh_node {
 typedef struct rad__bvhw {
     float lo[3][RAD__BVH_W], hi[3][RAD__BVH_W]; /* per axis, per child */
     /* an inner child: the byte offset of its node in the tree / 64; a leaf: RAD__BVH4_LEAF |
-       (triangles - 1) << 29 | the byte offset of its triangles from this node (while the
-       build collapses the tree: their leaf block) */
+       (triangles - 1) << 29 | the byte offset of its triangles from this node */
     uint32_t child[RAD__BVH_W];
 } rad__bvhw;
 #define RAD__BVH4_LEAF 0x80000000u
@@ -6587,12 +6586,8 @@ struct rad_bvh {
        triangles of its leaf children, so a node and its leaves share pages and neighbouring
        cache lines; nodes start on 64-byte boundaries */
     const unsigned char *tree;
-    rad__bvhw *nodes;         /* while building: the wide nodes, */
-    uint32_t node_count;
-    rad__tri4 *leaves;        /* and the leaves, apart */
-    uint32_t leaf_count;
     uint32_t tri_count;
-    void *block;              /* the allocation holding nodes and leaves */
+    void *block;              /* the allocation holding the tree */
     size_t block_bytes;
     rad_allocator allocator;
     rad__cutout *cutout;      /* the cutout triangles, NULL when there are none */
@@ -6967,40 +6962,50 @@ static uint32_t rad__bvhw_slots(const rad__bvhw_dp *dp, uint32_t bi, uint32_t *s
     return ns;
 }
 
-/* Wide nodes and leaves the collapse of the binary tree under 'root' makes ('stack' as there). */
-static void rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack, uint32_t *nodes, uint32_t *leaves)
+/* The 64-byte lines the wide node over binary node 'bi' takes with its leaves' triangles. */
+static uint32_t rad__bvhw_units(const rad__bvhw_dp *dp, uint32_t bi)
+{
+    uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(dp, bi, slots), k, nl = 0;
+    for (k = 0; k < ns; ++k) nl += dp->bin[slots[k]].count != 0;
+    return (uint32_t)((sizeof(rad__bvhw) + nl * sizeof(rad__tri4) + 63u) / 64u);
+}
+
+/* The 64-byte lines of the whole traversal tree the collapse of the binary tree under 'root'
+   makes ('stack' as there). */
+static size_t rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack)
 {
     const rad__bvh_node *bin = dp->bin;
     uint32_t sp = 0;
-    *nodes = 1;
-    *leaves = 0;
+    size_t units = 0;
     stack[sp++] = root;
     while (sp > 0) {
-        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(dp, stack[--sp], slots), k;
+        uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(dp, stack[--sp], slots), k, nl = 0;
         for (k = 0; k < ns; ++k) {
-            if (bin[slots[k]].count) {
-                ++*leaves;
-            } else {
-                ++*nodes;
-                stack[sp++] = slots[k];
-            }
+            if (bin[slots[k]].count) ++nl;
+            else stack[sp++] = slots[k];
         }
+        units += (sizeof(rad__bvhw) + nl * sizeof(rad__tri4) + 63u) / 64u;
     }
+    return units;
 }
 
 /* Collapses the binary tree into RAD__BVH_W-wide nodes, each with the children
-   rad__bvhw_slots gives it. 'stack' has room for 4 entries per leaf. */
-static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack,
-                                     const float *positions, const uint32_t *twins, const uint32_t *order)
+   rad__bvhw_slots gives it, written straight into the traversal's layout in 'tree' (zeroed,
+   the lines rad__bvhw_count gave): node after node in the order they are made, each followed
+   by its leaves' triangles in slot order and starting on a 64-byte line, so a node visit and
+   the leaf tests that follow it read neighbouring lines (which the hardware prefetches with
+   the node) instead of a second array megabytes away. 'stack' has room for 4 entries per leaf. */
+static void rad__bvhw_collapse(const rad_bvh *b, const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack,
+                               unsigned char *tree, const float *positions, const uint32_t *twins, const uint32_t *order)
 {
     const rad__bvh_node *bin = dp->bin;
-    uint32_t sp = 0;
-    b->node_count = 1;
+    uint32_t sp = 0, next = rad__bvhw_units(dp, root);
     stack[sp++] = root; /* binary node */
-    stack[sp++] = 0; /* its 4-wide node */
+    stack[sp++] = 0;    /* its wide node's first line */
     while (sp > 0) {
-        uint32_t n4 = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns = 0, k;
-        rad__bvhw *node = &b->nodes[n4];
+        uint32_t line = stack[--sp], bi = stack[--sp], slots[RAD__BVH_W], ns, k;
+        rad__bvhw *node = (rad__bvhw *)(void *)(tree + (size_t)line * 64u);
+        uint32_t at = (uint32_t)sizeof(rad__bvhw);
         ns = rad__bvhw_slots(dp, bi, slots);
         for (k = 0; k < RAD__BVH_W; ++k) {
             int a;
@@ -7012,28 +7017,28 @@ static rad_result rad__bvhw_collapse(rad_bvh *b, const rad__bvhw_dp *dp, uint32_
             }
             for (a = 0; a < 3; ++a) { node->lo[a][k] = bin[slots[k]].bmin[a]; node->hi[a][k] = bin[slots[k]].bmax[a]; }
             if (bin[slots[k]].count) {
-                rad__tri4 *q = &b->leaves[b->leaf_count];
+                rad__tri4 *q = (rad__tri4 *)(void *)((unsigned char *)node + at);
                 uint32_t j, c;
-                memset(q, 0, sizeof(*q));
                 for (j = 0; j < 4; ++j) q->id[j] = RAD_NONE;
                 for (j = 0; j < bin[slots[k]].count; ++j) {
-                    const float *v = positions + 9 * (size_t)order[bin[slots[k]].first + j];
+                    uint32_t id = order[bin[slots[k]].first + j];
+                    const float *v = positions + 9 * (size_t)id;
                     for (c = 0; c < 3; ++c)
                         for (a = 0; a < 3; ++a) q->v[c][a][j] = v[3 * c + (uint32_t)a];
-                    q->id[j] = order[bin[slots[k]].first + j];
-                    if (twins && twins[q->id[j]] != RAD_NONE) q->id[j] |= RAD__BVH_FRONT_ONLY;
+                    q->id[j] = id;
+                    if (twins && twins[id] != RAD_NONE) q->id[j] |= RAD__BVH_FRONT_ONLY;
+                    if (b->cutout && b->cutout->slot[id] != RAD_NONE) q->id[j] |= RAD__BVH_CUTOUT;
                 }
-                node->child[k] = RAD__BVH4_LEAF | (bin[slots[k]].count - 1u) << 29 | b->leaf_count++;
+                node->child[k] = RAD__BVH4_LEAF | (bin[slots[k]].count - 1u) << 29 | at;
+                at += (uint32_t)sizeof(rad__tri4);
             } else {
-                uint32_t m = b->node_count++;
-                node->child[k] = m;
+                node->child[k] = next;
                 stack[sp++] = slots[k];
-                stack[sp++] = m;
-                node = &b->nodes[n4];
+                stack[sp++] = next;
+                next += rad__bvhw_units(dp, slots[k]);
             }
         }
     }
-    return RAD_SUCCESS;
 }
 
 /* Stage 2 of the build: the binary SAH tree over refs[0, m). The top levels one node at a
@@ -7079,82 +7084,14 @@ static uint32_t rad__bvh_build_binary(rad__ctx *c, rad__bvh_node *tree, rad__bre
     return leaves;
 }
 
-/* The room for the collapse's 'nodes' wide nodes and 'leaves' leaves, in one block (which
-   rad__bvh_interleave then lays out for the traversal). */
-static rad_result rad__bvh_block(rad__ctx *c, rad_bvh *b, uint32_t nodes, uint32_t leaves)
-{
-    size_t nodes_bytes, leaves_bytes;
-    if (!rad__mul(nodes, sizeof(rad__bvhw), &nodes_bytes) || !rad__mul(leaves, sizeof(rad__tri4), &leaves_bytes) ||
-        nodes_bytes + leaves_bytes < nodes_bytes || nodes_bytes + leaves_bytes > (size_t)-1 - 64u)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    b->block_bytes = nodes_bytes + leaves_bytes + 64u;
-    b->block = rad__alloc(&c->allocator, b->block_bytes);
-    if (!b->block) return RAD_ERROR_OUT_OF_MEMORY;
-    b->nodes = (rad__bvhw *)(void *)((char *)b->block + ((64u - (uintptr_t)b->block % 64u) % 64u));
-    b->leaves = (rad__tri4 *)(void *)(b->nodes + nodes);
-    return RAD_SUCCESS;
-}
-
-/* The traversal's tree from the collapse's separate nodes and leaves (b->nodes, b->leaves in
-   'tmp', freed here): node i at 64 off[i] bytes, its leaves' triangles right after it in slot
-   order, the next node at the next 64-byte boundary. A node visit and the leaf tests that
-   follow it then read neighbouring lines (which the hardware prefetches with the node)
-   instead of a second array megabytes away. */
-static rad_result rad__bvh_interleave(rad__ctx *c, rad_bvh *b, void *tmp)
-{
-    uint32_t *off, i, k;
-    size_t units = 0;
-    unsigned char *tree;
-    off = (uint32_t *)rad__alloc_array(&c->allocator, b->node_count, sizeof(uint32_t));
-    if (!off) { rad__free(&c->allocator, tmp); return RAD_ERROR_OUT_OF_MEMORY; }
-    for (i = 0; i < b->node_count; ++i) {
-        uint32_t nl = 0;
-        for (k = 0; k < RAD__BVH_W; ++k) nl += b->nodes[i].child[k] != RAD_NONE && (b->nodes[i].child[k] & RAD__BVH4_LEAF);
-        off[i] = (uint32_t)units;
-        units += (sizeof(rad__bvhw) + nl * sizeof(rad__tri4) + 63u) / 64u;
-        if (units >= RAD__BVH4_LEAF) { /* child words hold offsets / 64 below 2^31 */
-            rad__log(c, RAD_LOG_ERROR, "the built-in BVH's tree exceeds 2^31 cache lines");
-            rad__free(&c->allocator, off);
-            rad__free(&c->allocator, tmp);
-            return RAD_ERROR_SIZE_OVERFLOW;
-        }
-    }
-    b->block_bytes = units * 64u + 64u;
-    b->block = rad__alloc(&c->allocator, b->block_bytes);
-    if (!b->block) { rad__free(&c->allocator, off); rad__free(&c->allocator, tmp); return RAD_ERROR_OUT_OF_MEMORY; }
-    tree = (unsigned char *)b->block + ((64u - (uintptr_t)b->block % 64u) % 64u);
-    memset(tree, 0, units * 64u); /* the padding too */
-    for (i = 0; i < b->node_count; ++i) {
-        rad__bvhw *node = (rad__bvhw *)(void *)(tree + (size_t)off[i] * 64u);
-        size_t at = sizeof(rad__bvhw);
-        *node = b->nodes[i];
-        for (k = 0; k < RAD__BVH_W; ++k) {
-            uint32_t ch = node->child[k];
-            if (ch == RAD_NONE) continue;
-            if (!(ch & RAD__BVH4_LEAF)) {
-                node->child[k] = off[ch];
-                continue;
-            }
-            memcpy((unsigned char *)node + at, &b->leaves[RAD__BVH_LEAF_AT(ch)], sizeof(rad__tri4));
-            node->child[k] = (ch & ~0x1FFFFFFFu) | (uint32_t)at;
-            at += sizeof(rad__tri4);
-        }
-    }
-    rad__free(&c->allocator, off);
-    rad__free(&c->allocator, tmp);
-    b->tree = tree;
-    b->nodes = NULL;
-    b->leaves = NULL;
-    return RAD_SUCCESS;
-}
-
 RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx, rad_bvh **out)
 {
     rad__ctx c;
     rad_bvh *b;
     rad__bvh_node *tree = NULL;
     rad__bref *refs = NULL;
-    uint32_t n, i, leaves, nodes;
+    uint32_t n, i;
+    size_t units;
     uint32_t *stack = NULL, *task = NULL, *order = NULL, *pos = NULL;
     float *cost = NULL;
     rad__bvhw_dp dp;
@@ -7197,22 +7134,22 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     dp.pos = pos;
     dp.cost = cost;
     rad__bvhw_costs(&dp, 2u * n, stack, task);
-    rad__bvhw_count(&dp, 2u * n, stack, &nodes, &leaves);
-    r = rad__bvh_block(&c, b, nodes, leaves);
-    if (r == RAD_SUCCESS) r = rad__bvhw_collapse(b, &dp, 2u * n, stack, scene->positions, scene->twins, order);
-    if (r == RAD_SUCCESS) r = rad__cutout_build(&c, scene, &b->cutout);
-    if (r == RAD_SUCCESS && b->cutout) /* mark the cutout lanes */
-        for (i = 0; i < b->leaf_count; ++i) {
-            uint32_t j;
-            for (j = 0; j < 4; ++j)
-                if (b->leaves[i].id[j] != RAD_NONE && b->cutout->slot[b->leaves[i].id[j] & RAD__BVH_ID_BITS] != RAD_NONE)
-                    b->leaves[i].id[j] |= RAD__BVH_CUTOUT;
-        }
+    units = rad__bvhw_count(&dp, 2u * n, stack);
+    r = rad__cutout_build(&c, scene, &b->cutout);
+    if (r == RAD_SUCCESS && units >= RAD__BVH4_LEAF) { /* child words hold line numbers below 2^31 */
+        rad__log(&c, RAD_LOG_ERROR, "the built-in BVH's tree exceeds 2^31 cache lines");
+        r = RAD_ERROR_SIZE_OVERFLOW;
+    }
     if (r == RAD_SUCCESS) {
-        void *tmp = b->block; /* the collapse's arrays, replaced by the interleaved tree */
-        b->block = NULL;
-        b->block_bytes = 0;
-        r = rad__bvh_interleave(&c, b, tmp);
+        b->block_bytes = units * 64u + 64u;
+        b->block = rad__alloc(&c.allocator, b->block_bytes);
+        if (!b->block) r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r == RAD_SUCCESS) {
+        unsigned char *t = (unsigned char *)b->block + ((64u - (uintptr_t)b->block % 64u) % 64u);
+        memset(t, 0, units * 64u); /* the padding and the unused lanes too */
+        rad__bvhw_collapse(b, &dp, 2u * n, stack, t, scene->positions, scene->twins, order);
+        b->tree = t;
     }
     {
         void *blocks[] = { refs, stack, task, order, tree, cost, pos };
