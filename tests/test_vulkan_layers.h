@@ -3,7 +3,7 @@
    g_vk, frand, compare, chunks, T_CHECK). */
 
 /* Random planar layers of 'texels' RGB texels, 'groups' planes: a plane with scale 0 0 0 (skipped
-   by both), one with a single zero channel, negative and large scales, layers with zeros and a
+   by both: NaNs in it must not reach the output), one with a single zero channel, negative and large scales, layers with zeros and a
    wide range of magnitudes. The GPU mixes them in three row chunks times two plane chunks (the
    second with RAD_GLSL_LAYER_ACCUMULATE), each bound at an offset; the output starts as NaN, so
    every float must be written. Both sum in the same order without fused products: the test asks
@@ -25,7 +25,8 @@ static void layer_mix_case(uint32_t groups, uint32_t texels, uint32_t local_size
     }
     for (g = 0; g < groups; ++g)
         for (i = 0; i < 3; ++i) scales[3 * g + i] = 2.0f * frand() - 0.4f;
-    scales[3] = scales[4] = scales[5] = 0.0f;   /* group 1: skipped */
+    scales[3] = scales[4] = scales[5] = 0.0f;   /* group 1: skipped, so its NaN below is never read */
+    layers[stride + 7] = layers[stride + stride - 1] = (float)NAN;
     scales[3 * 2 + 1] = 0.0f;                   /* group 2: only its green off */
     scales[0] *= 250.0f;                        /* group 0: a bright light */
     T_CHECK(rad_baker_mix_layers(layers, groups, stride, scales, cpu, NULL) == RAD_SUCCESS);
