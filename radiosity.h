@@ -4191,9 +4191,9 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
      ONE WORKGROUP PER ROW: dispatch row_count groups in x (at most
      maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
      invocations read the row at consecutive addresses with a stride of the group size and sum
-     in shared memory (12 bytes per invocation). The temporal step, the alias build and
-     VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
-     (LOCAL_VECTORS: per row or column, see its entry).
+     in shared memory (12 bytes per invocation). The temporal step, the alias build,
+     VP_GATHER and LAYER_MIX run ONE INVOCATION PER ROW (point; LAYER_MIX: float):
+     ceil(row_count / size) groups (LOCAL_VECTORS: per row or column, see its entry).
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
      checked at compile time).
