@@ -129,6 +129,10 @@ $(BUILD)/bench_realtime: tests/bench/realtime.c radiosity.h | $(BUILD)
 $(BUILD)/bench_runtime: tests/bench/runtime.c tests/bench/bench_common.h tests/bench/bench_scenes.h tools/unwrap.c tools/tool.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) -I. tests/bench/runtime.c tools/unwrap.c -o $@ -lm
 
+# ways to mix 8 light layers on one core, side by side (x86-64 with AVX2 and F16C; not in make bench)
+$(BUILD)/bench_layer_mix: tests/bench/layer_mix.c tests/bench/bench_common.h radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O3 -march=native -I. tests/bench/layer_mix.c -o $@ -lm
+
 $(BUILD)/rays: tests/bench/rays.c tests/bench/bench_common.h tests/bench/bench_scenes.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. tests/bench/rays.c -o $@ -lm $(EMBREE_LIB)
 

@@ -4191,9 +4191,9 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
      ONE WORKGROUP PER ROW: dispatch row_count groups in x (at most
      maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
      invocations read the row at consecutive addresses with a stride of the group size and sum
-     in shared memory (12 bytes per invocation). The temporal step, the alias build and
-     VP_GATHER run ONE INVOCATION PER ROW (point): ceil(row_count / size) groups
-     (LOCAL_VECTORS: per row or column, see its entry).
+     in shared memory (12 bytes per invocation). The temporal step, the alias build,
+     VP_GATHER and LAYER_MIX run ONE INVOCATION PER ROW (point; LAYER_MIX: float):
+     ceil(row_count / size) groups (LOCAL_VECTORS: per row or column, see its entry).
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
      checked at compile time).
@@ -4331,7 +4331,22 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        (row_count + 1)  7: entry_vertices  8: entry_weights (entry e at element e - entry_base
        in pass 1)  9: the lightmap (3 per texel; only texels with a row written). A pass reads
        none of the other's bindings among 0..3 and 5..9: bind any buffer there. Matches the
-       CPU to 1e-5 (tests/test_vulkan.c). */
+       CPU to 1e-5 (tests/test_vulkan.c).
+   RAD_GLSL_LAYER_MIX      the baker's light layers mixed where the lightmap lives, as
+       rad_baker_mix_layers (>>api_baker): out[i] = sum_g scale[3g + i mod 3] layer_g[i] over
+       planar float layers (rad_baker_result's vertex_layers, lightmap_layers or probe_layers
+       uploaded unchanged; the sky layers are the planes after the groups', their scales the
+       sky's coefficients as in rad_baker_mix_sky). Push: rad_glsl_layer_mix_push; flags
+       RAD_GLSL_LAYER_ACCUMULATE. ONE INVOCATION PER FLOAT (row = one float of a plane).
+       0: the layers, float g * stride + i (over all planes) at element (g * stride + i) - base
+       (base: the low 32 bits of that index at element 0)  1: scales (3 per plane, bound whole)
+       2: out (stride floats; the chunk's floats written). Planes with scale 0 0 0 are skipped and
+       the others added in increasing order without fused multiply-adds (GLSL precise), the
+       CPU's order: a float mix equals the CPU's to rounding (measured equal bit for bit on
+       lavapipe, tests/test_vulkan_layers.h). CHUNKS of planes: 8 layers of a 1024 x 1024 map
+       are 96 MiB, near lavapipe's 128 MiB range; bind planes [plane_offset, plane_offset +
+       plane_count) and dispatch the later chunks with ACCUMULATE (out += their sum), after a
+       compute-to-compute barrier. */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -4349,7 +4364,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_VP_GATHER         = 11, /* tools/glsl/vp_gather.comp */
     RAD_GLSL_PROBE_UPDATE      = 12, /* tools/glsl/probe_update.comp */
     RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* tools/glsl/lightmap_refresh.comp */
-    RAD_GLSL_COUNT = 14
+    RAD_GLSL_LAYER_MIX         = 14, /* tools/glsl/layer_mix.comp */
+    RAD_GLSL_COUNT = 15
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -4373,6 +4389,7 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
 #define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
 #define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
+#define RAD_GLSL_LAYER_ACCUMULATE 1u       /* layer mix: out += the planes' sum (later plane chunks) */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -4450,6 +4467,13 @@ typedef struct rad_glsl_lightmap_refresh_push {
     uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
     uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
 } rad_glsl_lightmap_refresh_push;
+typedef struct rad_glsl_layer_mix_push {
+    uint32_t row_offset, row_count; /* the floats of a plane mixed by this dispatch */
+    uint32_t stride;               /* floats per plane (rad_baker_mix_layers' count3) */
+    uint32_t plane_offset, plane_count; /* the planes mixed by this dispatch */
+    uint32_t base;                 /* low 32 bits of the index g * stride + i at element 0 of binding 0 */
+    uint32_t flags;                /* RAD_GLSL_LAYER_ACCUMULATE */
+} rad_glsl_layer_mix_push;
 
 /* The file name of kernel 'id' ("gather_dense.comp"), or NULL for an unknown id. Pure. */
 RAD_API const char *rad_glsl_name(rad_glsl_id id);
@@ -26896,6 +26920,9 @@ typedef char rad__check_glsl_probe_update_push[(sizeof(rad_glsl_probe_update_pus
                                                offsetof(rad_glsl_probe_update_push, weight_base) == 12) ? 1 : -1];
 typedef char rad__check_glsl_lightmap_refresh_push[(sizeof(rad_glsl_lightmap_refresh_push) == 16 &&
                                                    offsetof(rad_glsl_lightmap_refresh_push, entry_base) == 12) ? 1 : -1];
+typedef char rad__check_glsl_layer_mix_push[(sizeof(rad_glsl_layer_mix_push) == 28 &&
+                                            offsetof(rad_glsl_layer_mix_push, base) == 20 &&
+                                            offsetof(rad_glsl_layer_mix_push, flags) == 24) ? 1 : -1];
 typedef char rad__check_glsl_vp_gather_push[(sizeof(rad_glsl_vp_gather_push) == 56 &&
                                              offsetof(rad_glsl_vp_gather_push, dims) == 24 &&
                                              offsetof(rad_glsl_vp_gather_push, row_offset) == 40 &&
@@ -28245,6 +28272,51 @@ static const char rad__glsl_13_0[] =
     "    }\n"
     "}\n";
 static const char *const rad__glsl_pieces_13[] = { rad__glsl_13_0 };
+static const char rad__glsl_14_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LAYER_MIX: the baker's light layers mixed, as rad_baker_mix_layers\n"
+    "// (docs/methods/bake.md, \"light layers\"):\n"
+    "//   out[i] = sum over planes g of scale[3 g + i mod 3] layer_g[i]\n"
+    "// on planar float layers (plane g holds stride floats, RGB interleaved: rad_baker_result's\n"
+    "// vertex_layers, lightmap_layers or probe_layers uploaded unchanged). The sky layers of\n"
+    "// rad_baker_mix_sky are more planes after the groups' (their scales: the sky's coefficients).\n"
+    "// ONE INVOCATION PER FLOAT: floats i = row_offset .. row_offset + row_count - 1 of planes\n"
+    "// g = plane_offset .. plane_offset + plane_count - 1. A plane whose three scales are 0 is\n"
+    "// skipped, and the planes are added in increasing order to a float sum that starts at 0 (or, with\n"
+    "// RAD_GLSL_LAYER_ACCUMULATE, at out[i]): the CPU's order, so a dispatch per few planes\n"
+    "// (layers larger than one storage-buffer range) adds up to what one dispatch over all gives.\n"
+    "// Binding 0 holds the float g * stride + i (an index over all planes) at element\n"
+    "// (g * stride + i) - base, with base the low 32 bits of that index at its element 0 (uint\n"
+    "// arithmetic wraps: only the difference matters, and a bound range is < 2^32 floats).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer Layers { float layers[]; };\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Scales { float scales[]; };  // 3 per plane\n"
+    "layout(std430, set = 0, binding = 2) buffer Output { float mixed[]; };            // stride floats\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;   // first float of this dispatch (an index into a plane)\n"
+    "    uint row_count;    // floats in this dispatch\n"
+    "    uint stride;       // floats per plane (3 x vertices, texels or 9 x probes)\n"
+    "    uint plane_offset; // first plane mixed by this dispatch (scales[3 plane_offset] is its scale)\n"
+    "    uint plane_count;  // planes mixed by this dispatch\n"
+    "    uint base;         // low 32 bits of the index g * stride + i at element 0 of binding 0\n"
+    "    uint flags;        // RAD_GLSL_LAYER_ACCUMULATE (1): add to out instead of overwriting it\n"
+    "} pc;\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint i = pc.row_offset + r, c = i % 3u;\n"
+    "    // precise: no fused multiply-add, each product rounded as the CPU's is\n"
+    "    precise float acc = (pc.flags & 1u) != 0u \? mixed[i] : 0.0;\n"
+    "    for (uint q = 0u; q < pc.plane_count; ++q) {\n"
+    "        uint g = pc.plane_offset + q;\n"
+    "        if (scales[3u * g] == 0.0 && scales[3u * g + 1u] == 0.0 && scales[3u * g + 2u] == 0.0) continue;\n"
+    "        acc += layers[g * pc.stride + i - pc.base] * scales[3u * g + c];\n"
+    "    }\n"
+    "    mixed[i] = acc;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_14[] = { rad__glsl_14_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 3364u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 3620u },
@@ -28259,7 +28331,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "local_update.comp", rad__glsl_pieces_10, 1u, 3425u },
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7489u },
     { "probe_update.comp", rad__glsl_pieces_12, 1u, 2832u },
-    { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u }
+    { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u },
+    { "layer_mix.comp", rad__glsl_pieces_14, 1u, 2687u }
 };
 /* >>glsl end */
 

@@ -1710,6 +1710,9 @@ static void test_push_mirrors(void)
         MM(rad_glsl_vp_gather_push, base), MM(rad_glsl_vp_gather_push, flags), { NULL, 0 } };
     static const mirror_member probe[] = { MM(rad_glsl_probe_update_push, row_offset), MM(rad_glsl_probe_update_push, row_count),
         MM(rad_glsl_probe_update_push, entry_base), MM(rad_glsl_probe_update_push, weight_base), { NULL, 0 } };
+    static const mirror_member lmix[] = { MM(rad_glsl_layer_mix_push, row_offset), MM(rad_glsl_layer_mix_push, row_count),
+        MM(rad_glsl_layer_mix_push, stride), MM(rad_glsl_layer_mix_push, plane_offset), MM(rad_glsl_layer_mix_push, plane_count),
+        MM(rad_glsl_layer_mix_push, base), MM(rad_glsl_layer_mix_push, flags), { NULL, 0 } };
     static const mirror_member lmr[] = { MM(rad_glsl_lightmap_refresh_push, pass), MM(rad_glsl_lightmap_refresh_push, row_offset),
         MM(rad_glsl_lightmap_refresh_push, row_count), MM(rad_glsl_lightmap_refresh_push, entry_base), { NULL, 0 } };
     g_worst_what = "push-constant block, bytes";
@@ -1726,6 +1729,7 @@ static void test_push_mirrors(void)
     check_mirror(RAD_GLSL_VP_GATHER, vpg, sizeof(rad_glsl_vp_gather_push));
     check_mirror(RAD_GLSL_PROBE_UPDATE, probe, sizeof(rad_glsl_probe_update_push));
     check_mirror(RAD_GLSL_LIGHTMAP_REFRESH, lmr, sizeof(rad_glsl_lightmap_refresh_push));
+    check_mirror(RAD_GLSL_LAYER_MIX, lmix, sizeof(rad_glsl_layer_mix_push));
     /* every kernel (.comp; includes have no push block) has its mirror checked above */
     {
         uint32_t id;
@@ -1780,6 +1784,10 @@ static void test_lighting_include(void)
     free(inc);
 }
 
+/* ---- the baker's light layers mixed: tests/test_vulkan_layers.h ------------------------------- */
+
+#include "test_vulkan_layers.h"
+
 /* ---- the harness ---------------------------------------------------------------------------- */
 
 typedef struct vk_test { const char *name; void (*fn)(void); } vk_test;
@@ -1797,6 +1805,7 @@ static const vk_test g_tests[] = {
     { "vk_vp_gather_trilinear_skipping", test_vp_gather },
     { "vk_probe_update", test_probe_update },
     { "vk_lightmap_refresh", test_lightmap_refresh },
+    { "vk_layer_mix_chunked_accumulate", test_layer_mix },
     { NULL, NULL }
 };
 

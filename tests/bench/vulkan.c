@@ -1,10 +1,12 @@
 /* vulkan.c - time per dispatch of the GLSL kernels on the Vulkan device the loader finds first
    (Mesa's lavapipe on a machine without a GPU), next to the CPU path on the same inputs.
 
-       vulkan [--n N] [--reps R] [--local SIZE] [--append FILE.md]
+       vulkan [--n N] [--reps R] [--local SIZE] [--map SIZE] [--append FILE.md]
 
    Inputs: a random N x N form-factor-like matrix (rows sum to 0.3..0.9), K = 1 so the
-   multi-bounce matrix is rho o F (building it costs nothing), E with half its entries zero.
+   multi-bounce matrix is rho o F (building it costs nothing), E with half its entries zero;
+   for the layer mix, 8 random light layers of a --map x --map RGB lightmap (at most 1024: the
+   8 layers are bound whole, 96 MiB, under lavapipe's 128 MiB storage range) and RGB scales.
    Each GPU time is the wall time of one dispatch including submit and wait (what a frame
    would pay), the median of R runs; the CPU time is the median of R calls of the CPU function
    with the header's default parallel_for. */
@@ -48,7 +50,7 @@ static void row(const char *what, double gpu_s, double cpu_s, double bytes)
 
 int main(int argc, char **argv)
 {
-    uint32_t n = 2048, i, j, c, ls = 128;
+    uint32_t n = 2048, i, j, c, ls = 128, map = 1024;
     int reps = 15, r, a;
     const char *append = NULL;
     float *F, *E, *rho, *out;
@@ -65,9 +67,11 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[a], "--reps") && a + 1 < argc) reps = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--append") && a + 1 < argc) append = argv[++a];
         else if (!strcmp(argv[a], "--local") && a + 1 < argc) ls = (uint32_t)atoi(argv[++a]);
-        else { fprintf(stderr, "usage: vulkan [--n N] [--reps R] [--local SIZE] [--append FILE.md]\n"); return 2; }
+        else if (!strcmp(argv[a], "--map") && a + 1 < argc) map = (uint32_t)atoi(argv[++a]);
+        else { fprintf(stderr, "usage: vulkan [--n N] [--reps R] [--local SIZE] [--map SIZE] [--append FILE.md]\n"); return 2; }
     }
     if (reps < 1) reps = 1;
+    if (map < 1 || map > 1024) map = 1024;
     (void)vk_chunk; (void)vk_image_blocks; (void)vk_image_free; /* helpers of the tests this program does not need */
     if (!vk_init(&V, dir)) return 1;
     F = (float *)malloc((size_t)n * n * 4);
@@ -208,6 +212,41 @@ int main(int argc, char **argv)
         vk_buffer_free(&V, &bOff); vk_buffer_free(&V, &bBins); vk_buffer_free(&V, &bTot); vk_buffer_free(&V, &bE);
         vk_buffer_free(&V, &bR); vk_buffer_free(&V, &bB0); vk_buffer_free(&V, &bB1);
         vk_kernel_destroy(&V, &k);
+    }
+    /* the baker's light layers: 8 groups into a map x map RGB lightmap, one invocation per float */
+    {
+        vk_kernel k;
+        vk_buf bL, bS, bO;
+        vk_range rg[3];
+        rad_glsl_layer_mix_push pc;
+        size_t count3 = 3 * (size_t)map * map, q;
+        uint32_t groups = 8;
+        float *layers = (float *)malloc(count3 * groups * 4), *mixed = (float *)malloc(count3 * 4), scales[24];
+        if (!layers || !mixed || !vk_kernel_create(&V, &k, RAD_GLSL_LAYER_MIX, 0, 3, sizeof(pc), ls)) return 1;
+        for (q = 0; q < count3 * groups; ++q) layers[q] = frand();
+        for (q = 0; q < 24; ++q) scales[q] = 0.2f + frand();
+        vk_buffer(&V, &bL, count3 * groups * 4, layers);
+        vk_buffer(&V, &bS, sizeof(scales), scales);
+        vk_buffer(&V, &bO, count3 * 4, NULL);
+        rg[0] = vk_whole(&bL); rg[1] = vk_whole(&bS); rg[2] = vk_whole(&bO);
+        memset(&pc, 0, sizeof(pc));
+        pc.row_count = (uint32_t)count3; pc.stride = (uint32_t)count3; pc.plane_count = groups;
+        for (r = 0; r < reps; ++r) {
+            double t0 = now();
+            vk_dispatch(&V, &k, rg, &pc, pc.row_count);
+            tg[r] = now() - t0;
+            t0 = now();
+            rad_baker_mix_layers(layers, groups, count3, scales, mixed, NULL);
+            tc[r] = now() - t0;
+        }
+        {
+            char what[64];
+            snprintf(what, sizeof(what), "layer mix 8 x %u^2 (rad_baker_mix_layers)", map);
+            row(what, median(tg, reps), median(tc, reps), 4.0 * (double)count3 * groups);
+        }
+        vk_buffer_free(&V, &bL); vk_buffer_free(&V, &bS); vk_buffer_free(&V, &bO);
+        vk_kernel_destroy(&V, &k);
+        free(layers); free(mixed);
     }
     if (md) {
         fprintf(md, "\nMB read: the matrix bytes one product reads (temporal: bins and E values touched by the draws).\n");

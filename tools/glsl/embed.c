@@ -37,6 +37,7 @@ static const kernel kernels[] = {
     { "RAD_GLSL_VP_GATHER", "tools/glsl/vp_gather.comp" },
     { "RAD_GLSL_PROBE_UPDATE", "tools/glsl/probe_update.comp" },
     { "RAD_GLSL_LIGHTMAP_REFRESH", "tools/glsl/lightmap_refresh.comp" },
+    { "RAD_GLSL_LAYER_MIX", "tools/glsl/layer_mix.comp" },
 };
 #define KERNELS (sizeof(kernels) / sizeof(kernels[0]))
 
