@@ -1373,9 +1373,9 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    a cluster into its two children, an element as above) while the spheres overlap or its
    bound on the power it carries, max_c(B) of the source's members times A_r
    min(1, A_s / (pi g^2)), exceeds tolerance * P; links reaching two elements go on as in
-   step 2. Such a link's power bound for refinement: the source's projected area toward the
-   receiver, the sum over its member triangles of A_j max(0, n_j . w) (w from centre to
-   centre, d apart), over pi (d^2 + the ends' area spread across w). Its F: the double
+   step 2. Such a link's F without visibility (skip_visibility): the source's projected area
+   toward the receiver, the sum over its member triangles of A_j max(0, n_j . w) (w from
+   centre to centre, d apart), over pi (d^2 + the ends' area spread across w). With it: the double
    integral of cos cos V / (pi r^2) estimated from 4 x visibility_rays pairs of points drawn
    by area on both ends, one ray for each pair that faces along its segment (for a cluster
    receiver, scaled so that the power its members get through the gather below is that
@@ -11978,11 +11978,12 @@ static rad_result rad__hr_flush(rad__hr_eval *ev, uint32_t task, uint32_t n)
     return RAD_SUCCESS;
 }
 
-/* A link with a cluster at an end (>>api_hierarchical): Fu (what the oracle weighs) from the
-   source's projected area toward the receiver over pi d^2 (times the receiver element's
-   cosine); F, with visibility, from 4K pairs of points drawn by area on both ends, a ray for
-   each that faces along its segment. Ends whose spheres overlap get F 0: the oracle refines
-   them whatever F says. Queues rays on the task's batch. */
+/* A link with a cluster at an end (>>api_hierarchical): Fu, unoccluded (the memory limit's
+   test, and F without visibility), from the source's projected area toward the receiver over
+   pi d^2 (times the receiver element's cosine); F, with visibility, from 4K pairs of points
+   drawn by area on both ends, a ray for each that faces along its segment. Ends whose
+   spheres overlap get F 0: the oracle refines them whatever F says. Queues rays on the
+   task's batch. */
 static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l, uint32_t *nrays)
 {
     rad_hierarchical *h = ev->h;
