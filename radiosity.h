@@ -1373,10 +1373,13 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    a cluster into its two children, an element as above) while the spheres overlap or its
    bound on the power it carries, max_c(B) of the source's members times A_r
    min(1, A_s / (pi g^2)), exceeds tolerance * P; links reaching two elements go on as in
-   step 2. Such a link's F: the source's projected area toward the receiver, the sum over its
-   member triangles of A_j max(0, n_j . w) (w from centre to centre, d apart), over pi (d^2 +
-   the ends' area spread across w), times the share of visibility rays between area-sampled member points that face each
-   other along their segment (weighted by those two cosines) that nothing blocks. An element receiver takes its own cosine; a cluster receiver hands the irradiance
+   step 2. Such a link's F without visibility (skip_visibility): the source's projected area
+   toward the receiver, the sum over its member triangles of A_j max(0, n_j . w) (w from
+   centre to centre, d apart), over pi (d^2 + the ends' area spread across w). With it: the double
+   integral of cos cos V / (pi r^2) estimated from 4 x visibility_rays pairs of points drawn
+   by area on both ends, one ray for each pair that faces along its segment (for a cluster
+   receiver, scaled so that the power its members get through the gather below is that
+   integral's). An element receiver's F carries its own cosines; a cluster receiver hands the irradiance
    to its member triangles, each by its own cosine to the source (so a cluster lit from one
    side lights only the triangles facing that side), before the push: exactly where every
    member's normal faces the source (a cone of the members' normals says so), else by the
@@ -11455,6 +11458,28 @@ static double rad__hr_projected(const rad_hierarchical *h, uint32_t id, const fl
     return p;
 }
 
+/* What the clusters' gather (rad__hr_gather_task) hands cluster id's members, area-weighted,
+   for unit F from unit direction u: the sum of A g(n . u), g the clamped cosine where the
+   normal cone says every member faces u, else its quadratic fit (0 where every one faces
+   away), so that a link's F can be set to deliver a given power. */
+static double rad__hr_received(const rad_hierarchical *h, uint32_t id, const float *u, uint64_t *count)
+{
+    const rad__hr_cluster *cl = &h->cl[id & ~RAD__HR_CL];
+    float cg = rad__dot(cl->axis, u);
+    double p = 0.0;
+    uint32_t j;
+    int front = cl->cone_cos >= 0.0f && cg >= cl->cone_sin;
+    if (cl->cone_cos >= 0.0f && cg <= -cl->cone_sin) return 0.0;
+    for (j = cl->lo; j < cl->hi; ++j) {
+        uint32_t t = h->perm[j];
+        double c = (double)rad__dot(h->scene->normals + 3 * (size_t)t, u);
+        double g = front ? c : (3.0 / 32.0) + 0.5 * c + (15.0 / 32.0) * c * c;
+        if (g > 0.0) p += (double)h->scene->areas[t] * g;
+    }
+    *count += cl->hi - cl->lo;
+    return p;
+}
+
 /* a point p of node id and its normal n: on the element, or on a member triangle picked by
    area (u0) ; (u1, u2) place it on the triangle */
 static void rad__hr_node_point(const rad_hierarchical *h, uint32_t id, float u0, float u1, float u2, float *p, float *n)
@@ -11914,20 +11939,19 @@ static rad_result rad__hr_flush(rad__hr_eval *ev, uint32_t task, uint32_t n)
     return RAD_SUCCESS;
 }
 
-/* A link with a cluster at an end (>>api_hierarchical): F from the source's projected area
-   toward the receiver over pi d^2 (times the receiver element's cosine), and K rays between
-   points drawn on both ends by area, each weighted by its two member cosines to the centre
-   line; the link's F is the weighted share that arrives. Ends whose spheres overlap get F 0:
-   the oracle refines them whatever F says. Queues rays on the task's batch. */
+/* A link with a cluster at an end (>>api_hierarchical): Fu, unoccluded (the memory limit's
+   test, and F without visibility), from the source's projected area toward the receiver over
+   pi d^2 (times the receiver element's cosine); F, with visibility, from 4K pairs of points
+   drawn by area on both ends, a ray for each that faces along its segment. Ends whose
+   spheres overlap get F 0: the oracle refines them whatever F says. Queues rays on the
+   task's batch. */
 static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l, uint32_t *nrays)
 {
     rad_hierarchical *h = ev->h;
     rad__hr_link *lk = &ev->links[l];
     size_t base = (size_t)task * RAD__RAY_BATCH;
-    uint32_t K = h->nside * h->nside, a, got = 0, k;
-    float cr[3], cs[3], rr, rs, w[3], d, fu, wt[RAD__HR_MAX_RAYS], xs[3 * RAD__HR_MAX_RAYS], ys[3 * RAD__HR_MAX_RAYS];
-    float nx[3 * RAD__HR_MAX_RAYS], ny[3 * RAD__HR_MAX_RAYS];
-    double wsum = 0.0;
+    uint32_t K = h->nside * h->nside, a, k;
+    float cr[3], cs[3], rr, rs, w[3], d, fu;
     lk->F = lk->Fu = lk->Fd = 0.0f;
     rad__hr_node(h, lk->r, cr, &rr, NULL, NULL, NULL);
     rad__hr_node(h, lk->s, cs, &rs, NULL, NULL, NULL);
@@ -11953,38 +11977,51 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
         lk->F = fu;
         return RAD_SUCCESS;
     }
-    /* up to 4K draws for K pairs that face each other */
-    for (a = 0; a < 4u * K && got < K; ++a) {
-        uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s ^ rad__hash(a + 0x632be5abu))));
-        uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
-        float *x = xs + 3 * got, *y = ys + 3 * got, *n1 = nx + 3 * got, *n2 = ny + 3 * got, c1, c2, dd[3];
-        rad__hr_node_point(h, lk->r, (float)(h1 >> 8) / 16777216.0f, (float)(h2 & 0xFFFFu) / 65536.0f,
-                           (float)(h2 >> 16) / 65536.0f, x, n1);
-        rad__hr_node_point(h, lk->s, (float)(h3 >> 8) / 16777216.0f, (float)(h1 & 0xFFu) / 256.0f + (float)(h3 & 0xFFu) / 65536.0f,
-                           (float)((h3 >> 8) & 0xFFFFu) / 65536.0f, y, n2);
-        /* the pair's own cosines along its segment: a pair that faces along the centre line
-           but not along its segment would count as blocked (its ray leaves through its own
-           surface) while the opposite pairs were never drawn */
-        rad__sub(dd, y, x);
-        c1 = rad__dot(n1, dd);
-        c2 = -rad__dot(n2, dd);
-        if (!(c1 > 0.0f && c2 > 0.0f)) continue;
-        wt[got] = c1 * c2 / rad__dot(dd, dd);
-        wsum += (double)wt[got];
-        ++got;
-    }
-    if (!(wsum > 0.0)) { /* no facing pair found: nothing known of visibility */
-        lk->F = fu;
-        return RAD_SUCCESS;
-    }
-    for (a = 0; a < got; ++a) {
-        rad__segment_ray(ev->rays + base + *nrays, xs + 3 * a, nx + 3 * a, ys + 3 * a, ny + 3 * a, h->ray_eps);
-        ev->w[base + *nrays] = (float)((double)fu * (double)wt[a] / wsum);
-        ev->idx[base + *nrays] = l;
-        if (++*nrays == RAD__RAY_BATCH) {
-            rad_result r = rad__hr_flush(ev, task, *nrays);
-            *nrays = 0;
-            if (r != RAD_SUCCESS) return r;
+    /* F with visibility: the double integral of cos cos V / (pi r^2) over both ends by 4K
+       pairs drawn by area, a ray for each pair that faces along its segment. Not fu times
+       the visible share of the facing pairs: fu takes every cosine along the centre line,
+       which between near clusters of an interior (arcades, floors, walls) is far from the
+       pairs' own, and the facing pairs' share does not weigh them by what they carry */
+    {
+        uint32_t M = 4u * K;
+        float ar, as;
+        double scale, cap = 1.0 / (double)M;
+        rad__hr_node(h, lk->r, NULL, NULL, &ar, NULL, NULL);
+        rad__hr_node(h, lk->s, NULL, NULL, &as, NULL, NULL);
+        scale = (double)as / (RAD__PI * (double)M);
+        if (rad__hr_is_cl(lk->r)) { /* the receiving members' power over what the gather hands them per unit F */
+            float u[3];
+            double got_r;
+            for (k = 0; k < 3; ++k) u[k] = -w[k];
+            got_r = rad__hr_received(h, lk->r, u, &ev->proj[task]);
+            if (!(got_r > 0.0)) return RAD_SUCCESS;
+            scale *= (double)ar / got_r;
+        }
+        for (a = 0; a < M; ++a) {
+            uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(lk->r * 0x9E3779B9u ^ rad__hash(lk->s ^ rad__hash(a + 0x632be5abu))));
+            uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
+            float x[3], y[3], n1[3], n2[3], c1, c2, dd[3], r2;
+            double wv;
+            rad__hr_node_point(h, lk->r, (float)(h1 >> 8) / 16777216.0f, (float)(h2 & 0xFFFFu) / 65536.0f,
+                               (float)(h2 >> 16) / 65536.0f, x, n1);
+            rad__hr_node_point(h, lk->s, (float)(h3 >> 8) / 16777216.0f, (float)(h1 & 0xFFu) / 256.0f + (float)(h3 & 0xFFu) / 65536.0f,
+                               (float)((h3 >> 8) & 0xFFFFu) / 65536.0f, y, n2);
+            rad__sub(dd, y, x);
+            c1 = rad__dot(n1, dd);
+            c2 = -rad__dot(n2, dd);
+            r2 = rad__dot(dd, dd);
+            if (!(c1 > 0.0f && c2 > 0.0f && r2 > 0.0f)) continue;
+            /* c1 c2 / r2^2 is cos cos / r^2; one pair carries at most its 1 / M of F <= 1 */
+            wv = scale * (double)c1 * (double)c2 / ((double)r2 * (double)r2);
+            if (wv > cap) wv = cap;
+            rad__segment_ray(ev->rays + base + *nrays, x, n1, y, n2, h->ray_eps);
+            ev->w[base + *nrays] = (float)wv;
+            ev->idx[base + *nrays] = l;
+            if (++*nrays == RAD__RAY_BATCH) {
+                rad_result r = rad__hr_flush(ev, task, *nrays);
+                *nrays = 0;
+                if (r != RAD_SUCCESS) return r;
+            }
         }
     }
     return RAD_SUCCESS;
