@@ -1,6 +1,8 @@
 /* lightmap.c - the lightmap bake that rad lightmap and rad render --method lightmap share
-   (tool_lightmap_bake in tool.h): the solution (classic, virtual patches or hierarchical) over
-   the lightmapped world, then texels, gather, direct light, dilation and stitching. */
+   (tool_lightmap_bake in tool.h): the lightmapped world (the file's second uv set or the
+   unwrap), then the engine tier's bake (rad_baker_run with its lightmap options) where it
+   offers the solution asked for, else the tool's own steps: the solution (classic, virtual
+   patches or hierarchical), texels, gather, direct light, dilation and stitching. */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>

@@ -741,7 +741,9 @@ void tool_lightmap_request_default(tool_lightmap_request *rq);
    gather (classic: of B, sh: L1 SH, else RGB irradiance; proxy: rad_lightmap_gather_vp of H,
    RGB only), the direct light per texel when asked, dilation, stitching. Without a proxy a
    scene whose dense build would be refused is refused before the unwrap, naming --proxy aavp.
-   0, or 1 after printing why (out freed). Free with tool_lightmap_bake_free. */
+   Jacobi on the patches as made and aavp|vp at the default face points bake through the
+   engine tier (rad_baker_run, the same bits; out->baked holds it). 0, or 1 after printing
+   why (out freed). Free with tool_lightmap_bake_free. */
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co,
                        const tool_lightmap_request *rq, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
