@@ -3274,6 +3274,19 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    0 at v = 0 (>>api_lightmap TEXELS), dilated into the gutters. Probes (RAD_BAKER_PROBES): 27
    floats per probe (SH L2 irradiance, >>api_probes WHAT IS STORED) at the given points or on
    a grid over the scene bounds; sample them with rad_sh9_irradiance.
+   LIGHTMAP OPTIONS (a baker of its own lightmaps, as the rad tool is, wants the texels'
+   light whole). rad_baker_desc.lightmap_gather replaces the classic gather's options
+   (>>api_lightmap GATHER: visibility_rays, hemisphere_rays, exact_ratio, seed, method, and
+   encoding: RAD_LIGHTMAP_SH_L1 makes lightmap and its layers 12 floats per texel,
+   lightmap_channels; virtual patches gather RGB only, so the SH encoding with them is
+   refused). Its method is taken as given unless rad_baker_options.lightmap_exact_pairs is set,
+   which picks it by valid samples x patches as the default rule does at 5e7.
+   RAD_BAKER_LIGHTMAP_DIRECT adds to each group's layer, before dilation, the direct light of
+   its lights and emitters per texel (rad_lightmap_direct with light_samples; RGB only, and not
+   with sky layers): the lightmap then holds all the light but emission. RAD_BAKER_LIGHTMAP_STITCH
+   runs rad_lightmap_stitch on each layer after its dilation (lightmap_seams reports it; the
+   layers still add: the stitch is a linear projection). rad_baker_runtime_create refuses
+   these options (its lightmap is the RGB bounced light).
    PROBE OPTIONS (rad_baker_desc.probe_options, >>api_probes; NULL: rad_probe_options_default).
    Their spacing is replaced by probe_spacing when that is not 0. Two flags change the output:
    RAD_PROBES_DIRECT adds to each group's layer the direct light of its lights and emitters at
@@ -3344,6 +3357,12 @@ typedef enum rad_baker_outputs {
     RAD_BAKER_SOLUTION = 8          /* keep the solution for rad_baker_irradiance (SOLUTION below) */
 } rad_baker_outputs;
 
+/* rad_baker_desc.lightmap_flags (LIGHTMAP OPTIONS above) */
+typedef enum rad_baker_lightmap_flags {
+    RAD_BAKER_LIGHTMAP_DIRECT = 1,  /* each group's layer also holds its direct light per texel */
+    RAD_BAKER_LIGHTMAP_STITCH = 2   /* each layer's seams stitched after dilation */
+} rad_baker_lightmap_flags;
+
 typedef struct rad_baker_solution rad_baker_solution; /* private: what RAD_BAKER_SOLUTION keeps */
 
 /* A light and the group it belongs to (group < RAD_BAKER_MAX_GROUPS). */
@@ -3366,6 +3385,9 @@ typedef struct rad_baker_desc {
     uint32_t probe_count;
     float probe_spacing;            /* the grid's spacing (0: the largest extent / 8) */
     const rad_probe_options *probe_options; /* NULL: the defaults (PROBE OPTIONS above) */
+    const rad_lightmap_gather_options *lightmap_gather; /* classic's lightmap gather (LIGHTMAP
+                                       OPTIONS above; NULL: the defaults and the automatic method) */
+    uint32_t lightmap_flags;        /* rad_baker_lightmap_flags bits (LIGHTMAP OPTIONS above) */
 } rad_baker_desc;
 
 /* How to bake. A zeroed struct means every default. */
@@ -3391,6 +3413,9 @@ typedef struct rad_baker_options {
                                        builds (0: RAD_VP_AXIS_ALIGNED; RAD_VP_CLUSTERED holds
                                        up to 6 patches a voxel where AAVP merges them by axis,
                                        so the same resolution may give more patches) */
+    double lightmap_exact_pairs;    /* classic lightmap: the exact gather up to this many valid
+                                       samples x patches, the hemisphere gather above (0: 5e7
+                                       without rad_baker_desc.lightmap_gather, else its method) */
 } rad_baker_options;
 
 /* What rad_baker_options.keep keeps (private). */
@@ -3451,6 +3476,10 @@ typedef struct rad_baker_result {
     rad_allocator allocator;        /* private */
     rad_baker_choice plan;          /* the whole plan (method, reason and estimates are also above) */
     rad_baker_solution *solution;   /* RAD_BAKER_SOLUTION, else NULL: read by rad_baker_irradiance */
+    uint32_t lightmap_channels;     /* floats per texel of lightmap and its layers: 3, or 12 with
+                                       the SH encoding (LIGHTMAP OPTIONS above); 0 without one */
+    rad_lightmap_seam_stats lightmap_seams; /* RAD_BAKER_LIGHTMAP_STITCH: the seams, and the
+                                       largest jumps before and after over the layers */
 } rad_baker_result;
 
 /* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
@@ -3466,6 +3495,11 @@ typedef struct rad_baker_result {
 RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_options *options, const rad_context *ctx,
                             rad_baker_result **out);
 RAD_API void rad_baker_result_destroy(rad_baker_result *result);
+
+/* The texels the lightmap was gathered at (>>api_lightmap: positions, normals, samples, flags;
+   for rad_lightmap_sample and rad_lightmap_direct) when the result keeps the solver objects
+   (rad_baker_options.keep), else NULL. Owned by the result; its scene is the kept one. */
+RAD_API const rad_lightmap *rad_baker_result_lightmap(const rad_baker_result *result);
 
 /* The plan rad_baker_run would make for 'scene' (PLAN and ESTIMATE above), without the bake:
    the method (options->method, AUTO by default), the resolution of the virtual patches and
@@ -23257,8 +23291,8 @@ RAD_API rad_result rad_baker_mix_sky(rad_baker_result *R, const float *group_rgb
     if (R->vertex_layers)
         r = rad__baker_mix_planes(R->vertex_layers, planes, 3 * (size_t)R->vertex_count, rgb, R->vertex, ctx, &c);
     if (r == RAD_SUCCESS && R->lightmap_layers)
-        r = rad__baker_mix_planes(R->lightmap_layers, planes, 3 * (size_t)R->lightmap_width * R->lightmap_height, rgb,
-                                  R->lightmap, ctx, &c);
+        r = rad__baker_mix_planes(R->lightmap_layers, planes, (size_t)R->lightmap_channels * R->lightmap_width * R->lightmap_height,
+                                  rgb, R->lightmap, ctx, &c);
     if (r == RAD_SUCCESS && R->probe_layers)
         r = rad__baker_mix_planes(R->probe_layers, planes, 27 * (size_t)R->probe_count, rgb, R->probes, ctx, &c);
     /* the kept solution and band 4 hold the groups' planes only (no sky) */
@@ -23283,6 +23317,11 @@ struct rad_baker_kept {
     rad_lightmap *lm;              /* NULL without a lightmap */
     rad_probes *probes;            /* NULL without probes */
 };
+
+RAD_API const rad_lightmap *rad_baker_result_lightmap(const rad_baker_result *R)
+{
+    return R && R->kept ? R->kept->lm : NULL;
+}
 
 RAD_API void rad_baker_result_destroy(rad_baker_result *R)
 {
@@ -23502,6 +23541,28 @@ static rad_result rad__baker_check(rad__baker *b)
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: probe_spacing must be finite and >= 0");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (b->outputs & RAD_BAKER_LIGHTMAP) {
+        b->R->lightmap_channels = d->lightmap_gather ? rad_lightmap_channels(d->lightmap_gather->encoding) : 3u;
+        if (!b->R->lightmap_channels || (d->lightmap_flags & ~(uint32_t)(RAD_BAKER_LIGHTMAP_DIRECT | RAD_BAKER_LIGHTMAP_STITCH))) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown lightmap_gather encoding or lightmap_flags 0x%x",
+                     d->lightmap_flags);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if ((d->lightmap_flags & RAD_BAKER_LIGHTMAP_DIRECT) && (b->R->lightmap_channels != 3u || b->o.sky_bands)) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: RAD_BAKER_LIGHTMAP_DIRECT adds RGB irradiance: not with the SH "
+                                           "encoding or sky layers");
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if (b->R->lightmap_channels != 3u && b->o.method == RAD_BAKER_VIRTUAL_PATCHES) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: the SH lightmap encoding needs the classic gather (virtual "
+                                           "patches gather RGB irradiance)");
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+    }
+    if (!(b->o.lightmap_exact_pairs >= 0.0 && b->o.lightmap_exact_pairs < 1e30)) {
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: lightmap_exact_pairs must be finite and >= 0");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     b->R->group_count = d->group_count ? d->group_count : groups;
     b->R->sky_count = b->o.sky_bands * b->o.sky_bands;
     b->group_emits = (uint8_t *)rad__alloc_zero(&b->c.allocator, RAD_BAKER_MAX_GROUPS);
@@ -23525,7 +23586,7 @@ static double rad__baker_output_bytes(const rad__baker *b, uint32_t probes)
     if (b->outputs & RAD_BAKER_VERTEX)
         for (m = 0; m < d->scene.mesh_count; ++m) per += 12.0 * (double)d->scene.meshes[m].vertex_count;
     if (b->outputs & RAD_BAKER_LIGHTMAP) {
-        per += 12.0 * texels;
+        per += 4.0 * b->R->lightmap_channels * texels;
         fixed += 30.0 * texels * (1.0 + (double)b->o.lightmap_samples);
     }
     if (b->outputs & RAD_BAKER_PROBES) per += 108.0 * (double)probes;
@@ -23981,13 +24042,14 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
         memset(R->vertex_layers, 0, n * G * sizeof(float));
     }
     if (b->lm) {
-        n = 3 * (size_t)R->lightmap_width * R->lightmap_height;
+        size_t texels = (size_t)R->lightmap_width * R->lightmap_height;
+        n = R->lightmap_channels * texels;
         R->lightmap = (float *)rad__alloc_array(a, n, sizeof(float));
         R->lightmap_layers = (float *)rad__alloc_array(a, n * G, sizeof(float));
-        R->lightmap_flags = (uint8_t *)rad__alloc_array(a, n / 3, 1);
+        R->lightmap_flags = (uint8_t *)rad__alloc_array(a, texels, 1);
         if (!R->lightmap || !R->lightmap_layers || !R->lightmap_flags) return RAD_ERROR_OUT_OF_MEMORY;
         memset(R->lightmap_layers, 0, n * G * sizeof(float));
-        memcpy(R->lightmap_flags, b->lm->flags, n / 3);
+        memcpy(R->lightmap_flags, b->lm->flags, texels);
     }
     if (b->outputs & RAD_BAKER_SOLUTION) {
         R->solution = (rad_baker_solution *)rad__alloc_zero(a, sizeof(rad_baker_solution));
@@ -24117,17 +24179,46 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     }
     RAD__BAKER_PART(0.6f, 0.95f);
     if (R->lightmap_layers) {
-        float *out = R->lightmap_layers + (size_t)g * 3 * R->lightmap_width * R->lightmap_height;
+        uint32_t ch = R->lightmap_channels, flags = b->d->lightmap_flags;
+        float *out = R->lightmap_layers + (size_t)g * ch * R->lightmap_width * R->lightmap_height;
         if (R->method == RAD_BAKER_CLASSIC) {
             rad_lightmap_gather_options go;
-            rad_lightmap_gather_options_default(&go);
-            go.seed = b->o.seed;
-            if ((double)b->lm->sample_count * n > 5e7) go.method = RAD_LIGHTMAP_GATHER_HEMISPHERE;
+            double pairs = b->o.lightmap_exact_pairs;
+            if (b->d->lightmap_gather) {
+                go = *b->d->lightmap_gather;
+            } else {
+                rad_lightmap_gather_options_default(&go);
+                go.seed = b->o.seed;
+                if (pairs == 0.0) pairs = 5e7;
+            }
+            /* the exact gather costs valid samples x patches form factors: past 'pairs' the rays win */
+            if (pairs > 0.0)
+                go.method = (double)b->lm->sample_count * n > pairs ? RAD_LIGHTMAP_GATHER_HEMISPHERE : RAD_LIGHTMAP_GATHER_EXACT;
             r = rad_lightmap_gather(b->lm, b->patches, B, &b->rc, &go, out, &b->sub);
         } else {
             r = rad_lightmap_gather_vp(b->lm, b->vp, H, out, &b->sub);
         }
-        if (r == RAD_SUCCESS) r = rad_lightmap_dilate(b->lm, 3, out, 0, &b->sub);
+        if (r == RAD_SUCCESS && !sky && (flags & RAD_BAKER_LIGHTMAP_DIRECT)) {
+            /* the group's lights, and its emitters through the strict view (the source above
+               may have left them out) */
+            rad_scene strict;
+            const rad_scene *Sd = rad__baker_group_scene(b, g, &strict, 1);
+            rad_lightmap lg = *b->lm;
+            lg.scene = Sd;
+            dopt.exclude_emitters = 0;
+            r = rad_lightmap_direct(&lg, &b->rc, b->lights, nl, &dopt, out, &b->sub);
+        }
+        if (r == RAD_SUCCESS) r = rad_lightmap_dilate(b->lm, ch, out, 0, &b->sub);
+        if (r == RAD_SUCCESS && (flags & RAD_BAKER_LIGHTMAP_STITCH)) {
+            rad_lightmap_seam_stats st;
+            r = rad_lightmap_stitch(b->lm, ch, out, 0, &st, &b->sub);
+            if (r == RAD_SUCCESS) {
+                R->lightmap_seams.seams = st.seams;
+                R->lightmap_seams.sample_pairs = st.sample_pairs;
+                if (st.max_jump_before > R->lightmap_seams.max_jump_before) R->lightmap_seams.max_jump_before = st.max_jump_before;
+                if (st.max_jump_after > R->lightmap_seams.max_jump_after) R->lightmap_seams.max_jump_after = st.max_jump_after;
+            }
+        }
         if (r != RAD_SUCCESS) return r;
     }
     RAD__BAKER_PART(0.95f, 1.0f);
@@ -24210,6 +24301,11 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
         if (!b.masked || !b.lights) r = RAD_ERROR_OUT_OF_MEMORY;
     }
     if (r == RAD_SUCCESS) r = rad__baker_plan(&b);
+    if (r == RAD_SUCCESS && b.R->lightmap_channels > 3u && b.R->method != RAD_BAKER_CLASSIC) {
+        rad__log(&b.c, RAD_LOG_ERROR, "rad_baker_run: the SH lightmap encoding needs the classic gather, but the plan took "
+                                      "virtual patches (%s): set method RAD_BAKER_CLASSIC or raise the budget", b.R->reason);
+        r = RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (r == RAD_SUCCESS) {
         rad__log(&b.c, RAD_LOG_INFO, "rad_baker_run: %s; light groups: %u", b.R->reason, b.R->group_count);
         r = rad__baker_build(&b);
@@ -24574,6 +24670,12 @@ static rad_result rad__brt_check_args(const rad_baker_desc *desc, const rad_bake
     }
     if (desc->light_count && !desc->lights) {
         rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: light_count %u with lights NULL", desc->light_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (desc->lightmap_gather || desc->lightmap_flags || R->lightmap_channels > 3u) {
+        /* its lightmap is the RGB bounced light refreshed from the patches */
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: the desc's lightmap_gather or lightmap_flags (the runtime "
+                                   "refreshes the default RGB lightmap of bounced light only)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     return RAD_SUCCESS;

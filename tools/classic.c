@@ -211,7 +211,8 @@ int tool_classic_solve(const char *cmd, const tool_world *w, const tool_classic_
 }
 
 int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method,
-                   uint32_t bounces, uint32_t vp_resolution, rad_baker_desc *d, rad_baker_result **out)
+                   uint32_t bounces, uint32_t vp_resolution, const rad_baker_options *base, rad_baker_desc *d,
+                   rad_baker_result **out)
 {
     rad_baker_options bo;
     rad_baker_light *bl;
@@ -225,7 +226,8 @@ int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_opti
     }
     if (!emits) return -1; /* the tier refuses a scene where nothing emits: the caller's own path draws it black */
     if (method == RAD_BAKER_CLASSIC && tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
-    memset(&bo, 0, sizeof bo);
+    if (base) bo = *base;
+    else memset(&bo, 0, sizeof bo);
     bo.method = method;
     /* the tool's own checks decide (tool_dense_check on the counted patches, --force; the
        resolution of virtual patches is the command line's or the plan's already): the tier's

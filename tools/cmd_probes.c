@@ -255,7 +255,7 @@ static int probes_baked(const char *cmd, const tool_world *w, const probes_args 
     memset(&d, 0, sizeof d);
     d.outputs = RAD_BAKER_PROBES;
     d.probe_options = &pa->po;
-    return tool_baker_run(cmd, w, &pa->o, RAD_BAKER_CLASSIC, pa->o.bounces, 0, &d, out);
+    return tool_baker_run(cmd, w, &pa->o, RAD_BAKER_CLASSIC, pa->o.bounces, 0, NULL, &d, out);
 }
 
 static int probes_main(int argc, char **argv, tool_lights *lights)

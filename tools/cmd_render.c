@@ -1622,7 +1622,7 @@ static int render_baked(const char *cmd, const tool_world *w, const render_args 
     d.outputs = RAD_BAKER_SOLUTION;
     t0 = tool_seconds();
     if ((rc = tool_baker_run(cmd, w, &ra->o, classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES, bounces,
-                             classic ? 0u : res, &d, &R)) != 0)
+                             classic ? 0u : res, NULL, &d, &R)) != 0)
         return rc;
     t0 = tool_seconds() - t0;
     if (!classic)

@@ -1,6 +1,8 @@
 /* lightmap.c - the lightmap bake that rad lightmap and rad render --method lightmap share
-   (tool_lightmap_bake in tool.h): the solution (classic, virtual patches or hierarchical) over
-   the lightmapped world, then texels, gather, direct light, dilation and stitching. */
+   (tool_lightmap_bake in tool.h): the lightmapped world (the file's second uv set or the
+   unwrap), then the engine tier's bake (rad_baker_run with its lightmap options) where it
+   offers the solution asked for, else the tool's own steps: the solution (classic, virtual
+   patches or hierarchical), texels, gather, direct light, dilation and stitching. */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,7 +11,8 @@
 void tool_lightmap_bake_free(tool_lightmap_baked *b)
 {
     free(b->values);
-    rad_lightmap_destroy(b->lm);
+    rad_lightmap_destroy(b->own_lm);
+    rad_baker_result_destroy(b->baked);
     tool_classic_free(&b->cl);
     rad_vp_destroy(b->vp);
     rad_hierarchical_destroy(b->hr);
@@ -18,6 +21,9 @@ void tool_lightmap_bake_free(tool_lightmap_baked *b)
         rad_scene_destroy(b->w.scene);
     }
     free(b->uvs);
+    free(b->mesh_positions);
+    free(b->mesh_uvs);
+    free(b->mesh_materials);
     memset(b, 0, sizeof *b);
 }
 
@@ -29,7 +35,6 @@ static int lightmap_world(const char *cmd, const tool_world *w, const tool_class
 {
     tool_world w2 = *w;
     rad_mesh_desc mesh;
-    rad_scene_desc desc;
     rad_context ctx;
     rad_result r;
     /* the lightmap uv set: the file's, or an unwrap into a copy of the scene */
@@ -76,26 +81,22 @@ static int lightmap_world(const char *cmd, const tool_world *w, const tool_class
                 memmove(out->uvs + 6 * (size_t)k, out->uvs + 6 * (size_t)t, 6 * sizeof(float));
                 mat[k++] = S->materials[t];
             }
-            mesh.positions = pos;
+            mesh.positions = out->mesh_positions = pos;
             mesh.vertex_count = 3 * k;
-            mesh.uvs = tuv;
+            mesh.uvs = out->mesh_uvs = tuv;
             mesh.triangle_count = k;
-            mesh.material_ids = mat;
+            mesh.material_ids = out->mesh_materials = mat;
         }
-        desc = w->file.desc;
-        desc.meshes = &mesh;
-        desc.mesh_count = 1;
+        /* the copy's file names the unwrapped mesh: the engine tier bakes it (kept until freed) */
+        out->mesh = mesh;
+        w2.file.desc.meshes = &out->mesh;
+        w2.file.desc.mesh_count = 1;
         w2.scene = NULL;
         w2.bvh = NULL;
         out->own_scene = 1;
         out->w = w2;
         tool_context(&ctx, NULL);
-        r = rad_scene_create(&desc, &ctx, &out->w.scene);
-        if (w->scene->twins) { /* the scene keeps copies */
-            free((void *)mesh.positions);
-            free((void *)mesh.uvs);
-            free((void *)mesh.material_ids);
-        }
+        r = rad_scene_create(&out->w.file.desc, &ctx, &out->w.scene);
         if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_scene_create", r); return 1; }
         if ((r = rad_bvh_create(out->w.scene, &ctx, &out->w.bvh)) != RAD_SUCCESS) { tool_fail(cmd, "rad_bvh_create", r); return 1; }
         rad_bvh_raycaster(out->w.bvh, &out->w.rc);
@@ -130,6 +131,80 @@ static int lightmap_solve(const char *cmd, const tool_classic_options *co, const
         out->patches = out->cl.patches->count;
         out->solve_seconds = out->cl.solve_seconds;
     }
+    return 0;
+}
+
+/* The bake by the engine tier (rad_baker_run over out->w's file, keep: the texels stay in the
+   result) for what it offers: Jacobi bounces on the patches as made, or aavp|vp proxies at the
+   default face points; the gather options, the direct light per texel and the stitching are
+   the tier's lightmap options. 0, 1 after printing why (the caller frees out), or -1 when the
+   request is not one of those (nothing done). */
+static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, const tool_lightmap_request *rq, int width,
+                            int height, tool_lightmap_baked *out)
+{
+    const tool_lightmap_proxy *px = rq->proxy;
+    rad_vp_options vo;
+    rad_baker_desc d;
+    rad_baker_options bo;
+    rad_lightmap_gather_options go;
+    rad_baker_result *R = NULL;
+    const rad_lightmap *lm;
+    size_t n;
+    double t0 = tool_seconds();
+    int rc;
+    if (co->solver != TOOL_JACOBI || co->bounces == 0 || co->max_edge != 0.0f) return -1;
+    rad_vp_options_default(&vo);
+    if (px && ((px->kind != TOOL_PROXY_AAVP && px->kind != TOOL_PROXY_VP) || (px->face_points && px->face_points != vo.face_points)))
+        return -1;
+    memset(&bo, 0, sizeof bo);
+    bo.keep = 1; /* the texels for the caller; a proxy's rows sparse, as tool_vp_proxy_solve builds them */
+    bo.lightmap_samples = rq->texel_samples;
+    if (px) {
+        if (px->resolution) vo.resolution = px->resolution;
+        bo.vp_kind = px->kind == TOOL_PROXY_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+        if (px->max_patches && tool_vp_resolution_within(cmd, &out->w, bo.vp_kind, vo.face_points, px->max_patches, 0, &vo.resolution))
+            return 1;
+    }
+    rad_lightmap_gather_options_default(&go);
+    go.encoding = rq->sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
+    go.visibility_rays = rq->visibility_rays;
+    go.hemisphere_rays = rq->hemisphere_rays;
+    if (rq->gather == TOOL_LIGHTMAP_GATHER_AUTO) bo.lightmap_exact_pairs = TOOL_LIGHTMAP_EXACT_MAX_PAIRS;
+    else go.method = (rad_lightmap_gather_method)rq->gather;
+    memset(&d, 0, sizeof d);
+    d.outputs = RAD_BAKER_LIGHTMAP;
+    d.lightmap_width = (uint32_t)width;
+    d.lightmap_height = (uint32_t)height;
+    d.lightmap_gather = &go;
+    d.lightmap_flags = RAD_BAKER_LIGHTMAP_STITCH | (rq->direct && !rq->sh ? RAD_BAKER_LIGHTMAP_DIRECT : 0u);
+    rc = tool_baker_run(cmd, &out->w, co, px ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC, co->bounces,
+                        px ? vo.resolution : 0u, &bo, &d, &R);
+    if (rc) return rc;
+    out->baked = R;
+    out->lm = lm = rad_baker_result_lightmap(R);
+    out->patches = R->patch_count;
+    out->solve_seconds = tool_seconds() - t0; /* the whole bake: the tier does not split it */
+    if (px)
+        fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
+                px->kind == TOOL_PROXY_VP ? "vp" : "aavp", R->vp_resolution, R->patch_count);
+    fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
+            lm->width, lm->height, lm->covered_texels, lm->valid_texels, lm->invalid_samples, lm->sample_count);
+    if (lm->covered_texels == 0) {
+        fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
+                        "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
+                cmd, lm->width, lm->height);
+        return 1;
+    }
+    if (!px && (rq->gather == RAD_LIGHTMAP_GATHER_HEMISPHERE ||
+                (rq->gather == TOOL_LIGHTMAP_GATHER_AUTO && (double)lm->sample_count * R->patch_count > bo.lightmap_exact_pairs)))
+        fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, rq->hemisphere_rays);
+    n = (size_t)R->lightmap_channels * lm->width * lm->height;
+    out->values = (float *)tool_calloc(n, sizeof(float));
+    memcpy(out->values, R->lightmap, n * sizeof(float));
+    fprintf(stderr, "rad %s: lightmap baked in %.2f s with the engine tier's %s bake (%ux%u, %.1f MiB of values); %u seams, "
+                    "largest jump %.4g before stitching, %.4g after\n",
+            cmd, out->solve_seconds, px ? "virtual-patch" : "classic", lm->width, lm->height, (double)n * sizeof(float) / 1048576.0,
+            R->lightmap_seams.seams, (double)R->lightmap_seams.max_jump_before, (double)R->lightmap_seams.max_jump_after);
     return 0;
 }
 
@@ -176,6 +251,11 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     if (!proxy && tool_dense_check(cmd, co, w->scene->triangle_count, 1)) return 1;
     if (lightmap_world(cmd, world, co, rq, &width, &height, out)) goto fail;
     w = &out->w;
+    {
+        int k = lightmap_by_tier(cmd, co, rq, width, height, out);
+        if (k > 0) goto fail;
+        if (k == 0) return 0;
+    }
     if (lightmap_solve(cmd, co, proxy, out, &vp_H)) goto fail;
     /* the gather wants the total radiosity of the secondary sources: B = E + L */
     t0 = tool_seconds();
@@ -184,7 +264,8 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     lo.height = (uint32_t)height;
     lo.samples = texel_samples;
     tool_context(&ctx, "lightmap texels");
-    r = rad_lightmap_create(w->scene, &w->rc, &lo, &ctx, &out->lm);
+    r = rad_lightmap_create(w->scene, &w->rc, &lo, &ctx, &out->own_lm);
+    out->lm = out->own_lm;
     tool_progress_end();
     if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_create", r); goto fail; }
     fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,

@@ -410,10 +410,12 @@ typedef struct tool_bake_info {
    samples, light samples) become the baker's, with 'method', 'bounces' and 'vp_resolution'
    (0: the plan's). A classic bake is refused as tool_dense_check refuses it (at least one
    patch per triangle, then the patches the plan counts); the tier's own budget is not used.
-   Prints the plan's reason;
+   Prints the plan's reason; 'base' (may be NULL: zeros) gives the baker's options the
+   command line does not set (keep, lightmap_samples, vp_kind, ...).
    0, 1 after printing why, or -1 (nothing done) when nothing in the world emits. */
 int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method,
-                   uint32_t bounces, uint32_t vp_resolution, rad_baker_desc *d, rad_baker_result **out);
+                   uint32_t bounces, uint32_t vp_resolution, const rad_baker_options *base, rad_baker_desc *d,
+                   rad_baker_result **out);
 void tool_bake_info_fill(tool_bake_info *info, const tool_world *w, const tool_classic_options *o);
 /* The hash of a rad.options record and of the lights given on the command line (w's lights
    past file_light_count; none: the hash of the record alone, as before those options), kept
@@ -693,9 +695,14 @@ typedef struct tool_lightmap_baked {
     rad_hierarchical *hr;    /* --proxy hierarchical: the solution (of w.scene), or NULL */
     uint32_t patches;        /* unknowns of the solution: classic patches or virtual patches */
     double solve_seconds;    /* the solve (K bounces and H = F B) */
-    rad_lightmap *lm;
+    const rad_lightmap *lm;  /* own_lm, or the engine tier's (baked) */
+    rad_lightmap *own_lm;
+    rad_baker_result *baked; /* the engine tier's bake (kept objects), or NULL */
     float *values;           /* width * height * (3 or 12) floats, dilated and stitched */
     float *uvs;              /* the unwrap's lightmap uvs, or NULL */
+    rad_mesh_desc mesh;      /* the unwrap's mesh (w.file.desc of a copy names it) */
+    float *mesh_positions, *mesh_uvs; /* its arrays when it drops two-sided twins, or NULL */
+    uint32_t *mesh_materials;
     int own_scene;           /* w.scene and w.bvh are ours */
 } tool_lightmap_baked;
 /* rad lightmap's defaults: atlas side, sample points per texel, shadow rays per sample point
@@ -734,7 +741,9 @@ void tool_lightmap_request_default(tool_lightmap_request *rq);
    gather (classic: of B, sh: L1 SH, else RGB irradiance; proxy: rad_lightmap_gather_vp of H,
    RGB only), the direct light per texel when asked, dilation, stitching. Without a proxy a
    scene whose dense build would be refused is refused before the unwrap, naming --proxy aavp.
-   0, or 1 after printing why (out freed). Free with tool_lightmap_bake_free. */
+   Jacobi on the patches as made and aavp|vp at the default face points bake through the
+   engine tier (rad_baker_run, the same bits; out->baked holds it). 0, or 1 after printing
+   why (out freed). Free with tool_lightmap_bake_free. */
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co,
                        const tool_lightmap_request *rq, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
