@@ -3253,10 +3253,10 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    measured form-factor rate of one thread) plus the bounces and the lightmap gather; virtual
    patches (counted first by rad_vp_count, of the kind vp_kind: a clustered set has up to 6
    patches a voxel, often about twice the axis-aligned count) 4 N^2 plus 100 bytes per sample and 48 N per task,
-   time M^2 / 1.5e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the direct light of
+   time M^2 / 3e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the direct light of
    emitting triangles at every point it is computed at (M samples, or 16 per classic patch): the plan's points count the
    emitters in front of them and the shadow rays those above their plane take (light_samples each, up to 4 times that),
-   at 2e7 tests and 2e6 rays a second, which on a scene of thousands of small emitters is most of the bake; both add the output layers, about 30 bytes per texel and lightmap
+   at 4e7 tests and 4e6 rays a second, which on a scene of thousands of small emitters is most of the bake; both add the output layers, about 30 bytes per texel and lightmap
    sample, 40 per probe and patch (the probes' weights, at most), and with RAD_BAKER_SOLUTION
    12 (group_count + 1) per patch vertex (classic) or patch (virtual patches); keep's sparse
    rows (8 bytes a non-zero) are counted as the dense F they replace. Times are CPU seconds
@@ -22983,11 +22983,11 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
 #define RAD__BAKER_FF_RATE 3e6         /* form-factor sample pairs per second and thread (measured) */
 #define RAD__BAKER_FLOP_RATE 2e9       /* solver flops per second and thread */
 #define RAD__BAKER_RAY_RATE 5e6        /* shadow rays per second and thread */
-#define RAD__BAKER_VP_KERNEL_RATE 1.5e8 /* virtual-patch sample pairs per second and thread (measured) */
+#define RAD__BAKER_VP_KERNEL_RATE 3e8   /* virtual-patch sample pairs per second and thread (Sponza at resolution 28) */
 /* the direct light of emitting triangles at one point (rad__direct_point), per thread (measured) */
 #define RAD__BAKER_EMITTER_SCAN_RATE 4e8   /* emitters passed over (behind the point) per second */
-#define RAD__BAKER_EMITTER_TEST_RATE 2e7   /* emitters in front: the analytic form factor */
-#define RAD__BAKER_EMITTER_RAY_RATE 2e6    /* their shadow rays, each a point sampled on a spherical triangle */
+#define RAD__BAKER_EMITTER_TEST_RATE 4e7   /* emitters in front: the analytic form factor */
+#define RAD__BAKER_EMITTER_RAY_RATE 4e6    /* their shadow rays, each a point sampled on a spherical triangle */
 #define RAD__BAKER_MIX_CHUNK 24576u    /* floats per mix task (96 KiB, a multiple of 12) */
 /* layers read side by side in one pass: planes a power-of-two size apart (a 1024 x 1024 map's)
    share cache sets, and eight streams and the output then evict each other (8 groups into
