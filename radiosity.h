@@ -3256,7 +3256,10 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    measured form-factor rate of one thread) plus the bounces and the lightmap gather; virtual
    patches (counted first by rad_vp_count, of the kind vp_kind: a clustered set has up to 6
    patches a voxel, often about twice the axis-aligned count) 4 N^2 plus 100 bytes per sample and 48 N per task,
-   time M^2 / 1.5e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the output layers, about 30 bytes per texel and lightmap
+   time M^2 / 3e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the direct light of
+   emitting triangles at every point it is computed at (M samples, or 16 per classic patch): the plan's points count the
+   emitters in front of them and the shadow rays those above their plane take (light_samples each, up to 4 times that),
+   at 4e7 tests and 4e6 rays a second, which on a scene of thousands of small emitters is most of the bake; both add the output layers, about 30 bytes per texel and lightmap
    sample, 40 per probe and patch (the probes' weights, at most), and with RAD_BAKER_SOLUTION
    12 (group_count + 1) per patch vertex (classic) or patch (virtual patches); keep's sparse
    rows (8 bytes a non-zero) are counted as the dense F they replace. Times are CPU seconds
@@ -23075,7 +23078,11 @@ RAD_API int rad_probes_grid(const rad_probes *pr, uint32_t dims[3], float origin
 #define RAD__BAKER_FF_RATE 3e6         /* form-factor sample pairs per second and thread (measured) */
 #define RAD__BAKER_FLOP_RATE 2e9       /* solver flops per second and thread */
 #define RAD__BAKER_RAY_RATE 5e6        /* shadow rays per second and thread */
-#define RAD__BAKER_VP_KERNEL_RATE 1.5e8 /* virtual-patch sample pairs per second and thread (measured) */
+#define RAD__BAKER_VP_KERNEL_RATE 3e8   /* virtual-patch sample pairs per second and thread (Sponza at resolution 28) */
+/* the direct light of emitting triangles at one point (rad__direct_point), per thread (measured) */
+#define RAD__BAKER_EMITTER_SCAN_RATE 4e8   /* emitters passed over (behind the point) per second */
+#define RAD__BAKER_EMITTER_TEST_RATE 4e7   /* emitters in front: the analytic form factor */
+#define RAD__BAKER_EMITTER_RAY_RATE 4e6    /* their shadow rays, each a point sampled on a spherical triangle */
 #define RAD__BAKER_MIX_CHUNK 24576u    /* floats per mix task (96 KiB, a multiple of 12) */
 /* layers read side by side in one pass: planes a power-of-two size apart (a 1024 x 1024 map's)
    share cache sets, and eight streams and the output then evict each other (8 groups into
@@ -23599,6 +23606,8 @@ static double rad__baker_output_bytes(const rad__baker *b, uint32_t probes)
 #define RAD__PLAN_VOXELS_PER_PATH 6.5   /* voxels along one mean free path (PLAN in >>api_bake) */
 #define RAD__PLAN_MIN_RESOLUTION 4u
 #define RAD__PLAN_MAX_RESOLUTION 256u
+#define RAD__PLAN_EMITTER_STEP 64u      /* one plan point in this many counts its emitters' work */
+#define RAD__PLAN_DIRECT_POINTS 16.0    /* rad_direct_patches' points per patch (rad_direct_options' default) */
 
 /* What a plan needs besides the scene: the filled options and the outputs' share. */
 typedef struct rad__plan_in {
@@ -23636,16 +23645,25 @@ static void rad__baker_options_fill(rad_baker_options *o, const rad_baker_option
    diagonal when none does. The same numbers for any thread count: one thread, hashed from
    the seed. */
 static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *rc, const rad_allocator *a, uint32_t seed,
-                                      float *path, float *escaped)
+                                      uint32_t light_samples, float *path, float *escaped, double *emitter_cost)
 {
     enum { BATCH = 256 };
     rad_ray rays[BATCH];
     rad_hit hits[BATCH];
-    uint32_t T = S->triangle_count, k, j, esc = 0;
-    double *cum = (double *)rad__alloc_array(a, T, sizeof(double)), total = 0.0, sum = 0.0;
+    uint32_t T = S->triangle_count, k, j, esc = 0, E = 0, stride = 1, probes = 0;
+    double *cum = (double *)rad__alloc_array(a, T, sizeof(double)), total = 0.0, sum = 0.0, front = 0.0, lit_rays = 0.0;
     double diag = (double)S->diagonal, eps = 1e-5 * diag;
-    if (!cum) return RAD_ERROR_OUT_OF_MEMORY;
+    uint32_t *emitters = (uint32_t *)rad__alloc_array(a, T, sizeof(uint32_t));
+    if (!cum || !emitters) {
+        rad__free(a, cum);
+        rad__free(a, emitters);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
     for (k = 0; k < T; ++k) cum[k] = total += (double)S->areas[k];
+    for (k = 0; k < T; ++k)
+        if (rad__emits(S, k)) emitters[E++] = k;
+    /* the emitters of every RAD__PLAN_EMITTER_STEP-th point are counted, at most about 2^20 tests */
+    while ((double)(RAD__PLAN_RAYS / RAD__PLAN_EMITTER_STEP) * (double)E / (double)stride > 1048576.0) stride *= 2u;
     for (k = 0; k < RAD__PLAN_RAYS; k += BATCH) {
         uint32_t m = RAD__PLAN_RAYS - k < (uint32_t)BATCH ? RAD__PLAN_RAYS - k : (uint32_t)BATCH;
         for (j = 0; j < m; ++j) {
@@ -23675,11 +23693,30 @@ static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *r
                 rays[j].origin[q] = p + (float)eps * n[q];
                 rays[j].dir[q] = dir[q];
             }
+            if (E > 0 && s % RAD__PLAN_EMITTER_STEP == 0) {
+                /* the work of the direct light of emitting triangles at this point, as
+                   rad__direct_point does it: the emitters in front of it, and the shadow rays
+                   those above its plane take */
+                double P[3], N[3];
+                uint32_t l;
+                for (q = 0; q < 3; ++q) P[q] = (double)rays[j].origin[q] - eps * (double)n[q], N[q] = (double)n[q];
+                for (l = 0; l < E; l += stride) {
+                    const float *tv = S->positions + 9 * (size_t)emitters[l], *tn = S->normals + 3 * (size_t)emitters[l];
+                    float dv[3], F;
+                    for (q = 0; q < 3; ++q) dv[q] = (float)P[q] - tv[q];
+                    if (!(rad__dot(dv, tn) > 0.0f)) continue;
+                    front += (double)stride;
+                    F = (float)fabs(rad__ff_point_tri(P, N, tv));
+                    if (F > 0.0f) lit_rays += (double)stride * (double)rad__emitter_rays(light_samples, F);
+                }
+                ++probes;
+            }
             rays[j].tmin = 0.0f;
             rays[j].tmax = (float)(4.0 * diag);
         }
         if (rc->intersect(rc->user, rays, m, hits) != RAD_SUCCESS) {
             rad__free(a, cum);
+            rad__free(a, emitters);
             return RAD_ERROR_RAYCAST_FAILED;
         }
         for (j = 0; j < m; ++j) {
@@ -23688,19 +23725,25 @@ static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *r
         }
     }
     rad__free(a, cum);
+    rad__free(a, emitters);
+    *emitter_cost = probes ? ((double)E / RAD__BAKER_EMITTER_SCAN_RATE + front / RAD__BAKER_EMITTER_TEST_RATE +
+                              lit_rays / RAD__BAKER_EMITTER_RAY_RATE) / (double)probes
+                           : 0.0;
     *path = esc < RAD__PLAN_RAYS ? (float)(sum / (double)(RAD__PLAN_RAYS - esc)) : (float)diag;
     *escaped = (float)esc / (float)RAD__PLAN_RAYS;
     return RAD_SUCCESS;
 }
 
 /* The cost of virtual patches at counts 'cnt' (PLAN in >>api_bake). */
-static void rad__plan_vp_cost(const rad__plan_in *in, const rad_vp_counts *cnt, double *bytes, double *secs)
+static void rad__plan_vp_cost(const rad__plan_in *in, const rad_vp_counts *cnt, double emitter_cost, double *bytes,
+                              double *secs)
 {
     double n = (double)cnt->patches, M = (double)cnt->samples;
     *bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)in->tasks + in->outputs_bytes + 40.0 * in->probes * n +
              in->per_patch * n;
     *secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 16.0 * M / RAD__BAKER_RAY_RATE +
-            6.0 * n * n * in->o.bounces * in->groups / RAD__BAKER_FLOP_RATE + in->texels * 8.0 * in->groups / RAD__BAKER_RAY_RATE;
+            6.0 * n * n * in->o.bounces * in->groups / RAD__BAKER_FLOP_RATE + in->texels * 8.0 * in->groups / RAD__BAKER_RAY_RATE +
+            M * emitter_cost; /* the emitters' direct light at every sample */
 }
 
 /* AUTO's choice, the resolution and the estimates into *P; with 'keep' (classic) the patches
@@ -23710,7 +23753,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
 {
     const rad_scene *S = in->scene;
     const rad_baker_options *o = &in->o;
-    double budget = o->max_memory, seconds_budget = o->max_seconds, N, bytes = 0.0, secs = 0.0, longest = 0.0;
+    double budget = o->max_memory, seconds_budget = o->max_seconds, N, bytes = 0.0, secs = 0.0, longest = 0.0, emitter_cost = 0.0;
     char bb[32], lb[32], tb[32], sb[32], why[256], text[1024];
     rad_patches *patches = NULL;
     rad_result r;
@@ -23718,7 +23761,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
     memset(P, 0, sizeof *P);
     for (k = 0; k < 3; ++k)
         if ((double)(S->bounds_max[k] - S->bounds_min[k]) > longest) longest = (double)(S->bounds_max[k] - S->bounds_min[k]);
-    r = rad__plan_free_path(S, in->rc, &c->allocator, o->seed, &P->free_path, &P->escaped);
+    r = rad__plan_free_path(S, in->rc, &c->allocator, o->seed, o->light_samples, &P->free_path, &P->escaped, &emitter_cost);
     if (r != RAD_SUCCESS) return r;
     {
         double need = ceil(RAD__PLAN_VOXELS_PER_PATH * longest * (1.0 - (double)P->escaped) /
@@ -23744,7 +23787,8 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
             bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N + in->per_patch * patches->vertex_count;
         }
         secs = N * N * o->ff_samples / RAD__BAKER_FF_RATE + 6.0 * N * N * o->bounces * in->groups / RAD__BAKER_FLOP_RATE +
-               in->texels * N * 4.0 / RAD__BAKER_RAY_RATE * (in->texels * N > 5e7 ? 5e7 / (in->texels * N) : 1.0) * in->groups;
+               in->texels * N * 4.0 / RAD__BAKER_RAY_RATE * (in->texels * N > 5e7 ? 5e7 / (in->texels * N) : 1.0) * in->groups +
+               N * RAD__PLAN_DIRECT_POINTS * emitter_cost; /* rad_direct_patches' points per patch */
         classic_fits = bytes <= budget && secs <= seconds_budget;
         rad__baker_time(tb, sizeof tb, secs);
         rad__baker_bytes(bb, sizeof bb, bytes);
@@ -23790,7 +23834,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
             vo.resolution = res;
             r = rad_vp_count(S, in->rc, &vo, sub, &cnt);
             if (r != RAD_SUCCESS) return r;
-            rad__plan_vp_cost(in, &cnt, &bytes, &secs);
+            rad__plan_vp_cost(in, &cnt, emitter_cost, &bytes, &secs);
             time_over = secs > seconds_budget;
             if (bytes <= budget && !time_over) break;
             if (res <= 2 || tries >= 12) {

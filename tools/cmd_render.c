@@ -1228,16 +1228,32 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     tool_context(&ctx, NULL);
     if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
     if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
+        /* The virtual patches' CPU follows the scene's size: 4 minutes per 100 000 triangles
+           (at least ten seconds; Sponza's resolutions fit), so that a small scene whose mean
+           free path asks for a fine set (touching objects, thousands of emitting triangles)
+           is not baked for minutes; the library's 10 minutes above still decide between
+           classic and virtual patches. */
+        double size_budget = 240.0 * (double)w->scene->triangle_count / 1e5;
+        if (size_budget < 10.0) size_budget = 10.0;
+        if (plan.estimated_seconds > size_budget) {
+            bo.method = RAD_BAKER_VIRTUAL_PATCHES;
+            bo.max_seconds = size_budget;
+            if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
+        }
+    }
+    if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
         if (chosen) mo->method = TOOL_AAVP;
         mo->vp_resolution = plan.vp_resolution;
     }
     if (!chosen)
-        fprintf(stderr, "rad %s: no --vp-resolution given: resolution %u from the scene (%u %s patches, about %.0f MiB)\n",
+        fprintf(stderr, "rad %s: no --vp-resolution given: resolution %u from the scene (%u %s patches, about %.0f MiB and "
+                "%.0f s of CPU for the bake)\n",
                 cmd, plan.vp_resolution, plan.patch_count, bo.vp_kind == RAD_VP_CLUSTERED ? "vp" : "aavp",
-                plan.estimated_bytes / 1048576.0);
+                plan.estimated_bytes / 1048576.0, plan.estimated_seconds);
     else if (plan.method == RAD_BAKER_VIRTUAL_PATCHES)
-        fprintf(stderr, "rad %s: no --method given: chose aavp at --vp-resolution %u (give --method to choose)\n", cmd,
-                plan.vp_resolution);
+        fprintf(stderr, "rad %s: no --method given: chose aavp at --vp-resolution %u (about %.0f MiB and %.0f s of CPU for "
+                "the bake; give --method to choose)\n", cmd, plan.vp_resolution, plan.estimated_bytes / 1048576.0,
+                plan.estimated_seconds);
     else
         fprintf(stderr, "rad %s: no --method given: chose classic (give --method to choose)\n", cmd);
     return 0;

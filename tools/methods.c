@@ -187,7 +187,8 @@ static const uint32_t proxy_values[] = {TOOL_PROXY_PATCHES, TOOL_PROXY_AAVP, TOO
 static const tool_arg method_args[] = {
     CUSTOM("--method", "M", method, parse_method, TOOL_OPT_METHOD, R,
            "default (render): classic, or aavp at the scene's resolution when the dense matrix would\n"
-           "not fit 1 GiB or 10 CPU-minutes (rad_baker_plan, said on stderr before the work);\n"
+           "not fit 1 GiB or 10 CPU-minutes (rad_baker_plan, said on stderr before the work; the\n"
+           "resolution within 4 CPU-minutes of bake per 100k triangles, at least 10 s);\n"
            "classic (radiosity + per-pixel direct light), multibounce (the indirect light\n"
            "L = F_mb E), temporal (alias-table frames), stochastic, pathtrace, local (local matrix of\n"
            "the patches nearest the camera), vp or aavp (virtual patches), hierarchical (quadtrees and\n"
