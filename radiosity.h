@@ -6650,6 +6650,8 @@ struct rad_bvh {
        triangles of its leaf children, so a node and its leaves share pages and neighbouring
        cache lines; nodes start on 64-byte boundaries */
     const unsigned char *tree;
+    uint32_t node_count;      /* wide nodes in the tree */
+    uint32_t leaf_count;      /* leaves (blocks of up to four triangles) */
     uint32_t tri_count;
     void *block;              /* the allocation holding the tree */
     size_t block_bytes;
@@ -7035,12 +7037,13 @@ static uint32_t rad__bvhw_units(const rad__bvhw_dp *dp, uint32_t bi)
 }
 
 /* The 64-byte lines of the whole traversal tree the collapse of the binary tree under 'root'
-   makes ('stack' as there). */
-static size_t rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack)
+   makes ('stack' as there), and its wide nodes and leaves. */
+static size_t rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *stack, uint32_t *nodes, uint32_t *leaves)
 {
     const rad__bvh_node *bin = dp->bin;
     uint32_t sp = 0;
     size_t units = 0;
+    *nodes = *leaves = 0;
     stack[sp++] = root;
     while (sp > 0) {
         uint32_t slots[RAD__BVH_W], ns = rad__bvhw_slots(dp, stack[--sp], slots), k, nl = 0;
@@ -7049,6 +7052,8 @@ static size_t rad__bvhw_count(const rad__bvhw_dp *dp, uint32_t root, uint32_t *s
             else stack[sp++] = slots[k];
         }
         units += (sizeof(rad__bvhw) + nl * sizeof(rad__tri4) + 63u) / 64u;
+        ++*nodes;
+        *leaves += nl;
     }
     return units;
 }
@@ -7198,7 +7203,7 @@ RAD_API rad_result rad_bvh_create(const rad_scene *scene, const rad_context *ctx
     dp.pos = pos;
     dp.cost = cost;
     rad__bvhw_costs(&dp, 2u * n, stack, task);
-    units = rad__bvhw_count(&dp, 2u * n, stack);
+    units = rad__bvhw_count(&dp, 2u * n, stack, &b->node_count, &b->leaf_count);
     r = rad__cutout_build(&c, scene, &b->cutout);
     if (r == RAD_SUCCESS && units >= RAD__BVH4_LEAF) { /* child words hold line numbers below 2^31 */
         rad__log(&c, RAD_LOG_ERROR, "the built-in BVH's tree exceeds 2^31 cache lines");
