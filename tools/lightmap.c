@@ -134,6 +134,19 @@ static int lightmap_solve(const char *cmd, const tool_classic_options *co, const
     return 0;
 }
 
+/* Prints the texels' counts; 1 after printing why when the uv set covers none (nothing to
+   gather into: the map would be all zero). */
+static int lightmap_texels_report(const char *cmd, const rad_lightmap *lm)
+{
+    fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
+            lm->width, lm->height, lm->covered_texels, lm->valid_texels, lm->invalid_samples, lm->sample_count);
+    if (lm->covered_texels > 0) return 0;
+    fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
+                    "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
+            cmd, lm->width, lm->height);
+    return 1;
+}
+
 /* The bake by the engine tier (rad_baker_run over out->w's file, keep: the texels stay in the
    result) for what it offers: Jacobi bounces on the patches as made, or aavp|vp proxies at the
    default face points; the gather options, the direct light per texel and the stitching are
@@ -187,14 +200,7 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
     if (px)
         fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
                 px->kind == TOOL_PROXY_VP ? "vp" : "aavp", R->vp_resolution, R->patch_count);
-    fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
-            lm->width, lm->height, lm->covered_texels, lm->valid_texels, lm->invalid_samples, lm->sample_count);
-    if (lm->covered_texels == 0) {
-        fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
-                        "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
-                cmd, lm->width, lm->height);
-        return 1;
-    }
+    if (lightmap_texels_report(cmd, lm)) return 1;
     if (!px && (rq->gather == RAD_LIGHTMAP_GATHER_HEMISPHERE ||
                 (rq->gather == TOOL_LIGHTMAP_GATHER_AUTO && (double)lm->sample_count * R->patch_count > bo.lightmap_exact_pairs)))
         fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, rq->hemisphere_rays);
@@ -268,16 +274,7 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
     out->lm = out->own_lm;
     tool_progress_end();
     if (r != RAD_SUCCESS) { tool_fail(cmd, "rad_lightmap_create", r); goto fail; }
-    fprintf(stderr, "rad %s: %ux%u texels, %u covered, %u valid, %u of %u samples inside or behind geometry\n", cmd,
-            out->lm->width, out->lm->height, out->lm->covered_texels, out->lm->valid_texels, out->lm->invalid_samples,
-            out->lm->sample_count);
-    if (out->lm->covered_texels == 0) {
-        /* nothing to gather into: the map would be all zero */
-        fprintf(stderr, "rad %s: the lightmap uv set covers no texel of the %ux%u atlas (its triangles are degenerate "
-                        "in uv or lie outside [0,1]): fix the file's second uv set or give --unwrap\n",
-                cmd, out->lm->width, out->lm->height);
-        goto fail;
-    }
+    if (lightmap_texels_report(cmd, out->lm)) goto fail;
     rad_lightmap_gather_options_default(&go);
     go.encoding = sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
     go.visibility_rays = vis;
