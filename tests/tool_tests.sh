@@ -342,6 +342,24 @@ if "$RAD" render "$TMP/closedbox.obj" --size 16x16 --patches 50 --aa 1 -o "$TMP/
 else
     fail "render: a closed room without a camera is seen from inside" "$(head -c 300 "$TMP/err.txt")"
 fi
+# the same room inside an outer shell facing out (a building's walls with both sides modelled,
+# as Sponza): the outside views see only the shell, so the camera goes inside
+{ cat "$TMP/closedbox.obj"; printf 'o shell\n'
+  for v in "-a y0 -a" "a y0 -a" "a y0 a" "-a y0 a"  "-a y1 -a" "-a y1 a" "a y1 a" "a y1 -a" \
+           "-a y0 -a" "-a y1 -a" "a y1 -a" "a y0 -a"  "-a y0 a" "a y0 a" "a y1 a" "-a y1 a" \
+           "-a y0 -a" "-a y0 a" "-a y1 a" "-a y1 -a"  "a y0 -a" "a y1 -a" "a y1 a" "a y0 a"; do
+      echo "v $v" | sed 's/-a/-1.05/g; s/ a/ 1.05/g; s/y0/-0.05/; s/y1/2.05/'
+  done
+  for f in 29 33 37 41 45 49; do echo "f $f $((f + 1)) $((f + 2)) $((f + 3))"; done; } > "$TMP/shellbox.obj"
+if "$RAD" render "$TMP/shellbox.obj" --size 16x16 --patches 50 --aa 1 -o "$TMP/shellbox.pfm" > /dev/null 2> "$TMP/err.txt"; then
+    p=$(psnr_of "$TMP/black16.pfm" "$TMP/shellbox.pfm")
+    grep -q "no camera: bounds .*; chose --camera .* (inside the bounds" "$TMP/err.txt" && [ -n "$p" ] && [ "$p" != inf ] &&
+        awk -v p="$p" 'BEGIN { exit !(p + 0 < 40) }' &&
+        ok "render: a room inside an outer shell is seen from inside, not as the shell (PSNR $p dB against black)" ||
+        fail "render: a room inside an outer shell is seen from inside" "PSNR '$p': $(grep 'no camera' "$TMP/err.txt" | head -c 300)"
+else
+    fail "render: a room inside an outer shell is seen from inside" "$(head -c 300 "$TMP/err.txt")"
+fi
 
 # --shading: the built-in box has only an area light, which stays Lambertian whatever the
 # model, so a microfacet render equals the default one up to float rounding

@@ -57,16 +57,28 @@ void tool_close_world(tool_world *w)
 /* ---- a camera for a scene that has none ------------------------------------------------ */
 
 /* How much of a candidate view sees the front of surfaces: a grid of camera rays, counting the
-   hits on front faces and on back faces (the patches are one-sided: a back face renders black). */
+   hits on front faces and on back faces (the patches are one-sided: a back face renders black),
+   and the front hits within 3% of the bounds' depth of the side of the bounds facing the camera
+   (the shell: a building seen from outside shows its outer wall, not what it holds). */
 static void camera_score(const rad_scene *scene, const rad_raycaster *rc, const rad_camera *cam, int width, int height,
-                         uint32_t *front, uint32_t *back)
+                         uint32_t *front, uint32_t *back, uint32_t *shell)
 {
     enum { GRID = 24 };
     rad_ray rays[GRID * GRID];
     rad_hit hits[GRID * GRID];
     uint32_t n = 0, k;
     int x, y;
-    *front = *back = 0;
+    const float *v = cam->target, *p = cam->position;
+    float dir[3], len, near_side = 0.0f, depth = 0.0f;
+    *front = *back = *shell = 0;
+    for (k = 0; k < 3; ++k) dir[k] = v[k] - p[k];
+    len = sqrtf(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    for (k = 0; k < 3 && len > 0.0f; ++k) {
+        dir[k] /= len;
+        /* the view directions are along the axes: the side facing the camera and the depth */
+        near_side += dir[k] * (dir[k] > 0.0f ? scene->bounds_min[k] : scene->bounds_max[k]);
+        depth += fabsf(dir[k]) * (scene->bounds_max[k] - scene->bounds_min[k]);
+    }
     for (y = 0; y < GRID; ++y)
         for (x = 0; x < GRID; ++x)
             rad_camera_ray(cam, (uint32_t)width, (uint32_t)height, ((float)x + 0.5f) * (float)width / GRID,
@@ -76,9 +88,21 @@ static void camera_score(const rad_scene *scene, const rad_raycaster *rc, const 
         const float *nt;
         if (hits[k].triangle == RAD_NONE || hits[k].triangle >= scene->triangle_count) continue;
         nt = scene->normals + 3 * (size_t)hits[k].triangle;
-        if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] < 0.0f) ++*front;
-        else ++*back;
+        if (nt[0] * rays[k].dir[0] + nt[1] * rays[k].dir[1] + nt[2] * rays[k].dir[2] < 0.0f) {
+            float along = 0.0f;
+            int j;
+            ++*front;
+            for (j = 0; j < 3; ++j) along += dir[j] * (rays[k].origin[j] + hits[k].t * rays[k].dir[j]);
+            if (along - near_side < 0.03f * depth) ++*shell;
+        } else
+            ++*back;
     }
+}
+
+/* the bounds' extent along candidate i's axis */
+static float view_depth(const float *ext, int i)
+{
+    return ext[(i % 6) / 2 == 0 ? 2 : (i % 6) / 2 == 1 ? 0 : 1];
 }
 
 void tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_raycaster *rc, int width, int height,
@@ -91,7 +115,7 @@ void tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_rayca
     const float *lo = scene->bounds_min, *hi = scene->bounds_max;
     float c[3], ext[3], r = 0.0f, d, fov = 39.3077f;
     rad_camera cand[12];
-    uint32_t front[12], back[12], best_front = 0;
+    uint32_t front[12], back[12], shell[12], best_front = 0;
     int i, k, pick = -1;
     for (k = 0; k < 3; ++k) {
         c[k] = 0.5f * (lo[k] + hi[k]);
@@ -113,7 +137,7 @@ void tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_rayca
         }
         q->up[0] = 0.0f, q->up[1] = v[1] != 0.0f ? 0.0f : 1.0f, q->up[2] = v[1] != 0.0f ? 1.0f : 0.0f;
         q->fov_y_degrees = i < 6 ? fov : 75.0f; /* inside: wide, to see the room around the far wall */
-        camera_score(scene, rc, q, width, height, &front[i], &back[i]);
+        camera_score(scene, rc, q, width, height, &front[i], &back[i], &shell[i]);
     }
     /* a view qualifies when nine in ten of its hits are front faces; outside views come first
        (the first qualifying one seeing at least half as much as the best of them), then the
@@ -122,6 +146,16 @@ void tool_choose_camera(const char *cmd, const rad_scene *scene, const rad_rayca
         if (front[i] > 0 && 10u * front[i] >= 9u * (front[i] + back[i]) && front[i] > best_front) best_front = front[i];
     for (i = 0; i < 6 && pick < 0 && best_front; ++i)
         if (front[i] > 0 && 10u * front[i] >= 9u * (front[i] + back[i]) && 2u * front[i] >= best_front) pick = i;
+    /* an outside view of a shell (three in four of its front hits on the outer side) gives way
+       to an inside view that qualifies: Sponza's outer wall is not what its user wants to see */
+    if (pick >= 0 && 4u * shell[pick] >= 3u * front[pick]) {
+        int in = -1;
+        for (i = 6; i < 12; ++i)
+            if (front[i] > 0 && 10u * front[i] >= 9u * (front[i] + back[i]) &&
+                (in < 0 || front[i] > front[in] || (front[i] == front[in] && view_depth(ext, i) > view_depth(ext, in))))
+                in = i; /* the most seen; of equals, the longest view (down a nave, not across it) */
+        if (in >= 0) pick = in;
+    }
     for (i = 6; i < 12 && pick < 0; ++i)
         if (front[i] > 0 && 10u * front[i] >= 9u * (front[i] + back[i]) &&
             (pick < 0 || front[i] > front[pick]))
