@@ -2301,7 +2301,7 @@ RAD_API const float *rad_temporal_weights(const rad_temporal *temporal);
    serves both directions, so reciprocity is unchanged. The pair list of one voxel pair is
    thinned systematically beyond 16384 entries.
    MEMORY (peak, through ctx's allocator): the N x N float matrix (sparse rows: see SPARSE
-   ROWS), about 100 bytes per sample,
+   ROWS), about 130 bytes per sample (32 of them the kernel's planes),
    T x (6 N doubles + 1024 rays + 16384 12-byte pair records) of task scratch (T = the
    context's task count, at most the voxel count), 4 bytes per triangle, 16 bytes per
    triangle-voxel overlap and 64 per candidate voxel, the face-ray hits of a chunk of
@@ -3255,7 +3255,7 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    ESTIMATE: classic 4 N^2 bytes of F plus 300 per patch, time N^2 ff_samples / 3e6 s (the
    measured form-factor rate of one thread) plus the bounces and the lightmap gather; virtual
    patches (counted first by rad_vp_count, of the kind vp_kind: a clustered set has up to 6
-   patches a voxel, often about twice the axis-aligned count) 4 N^2 plus 100 bytes per sample and 48 N per task,
+   patches a voxel, often about twice the axis-aligned count) 4 N^2 plus 132 bytes per sample and 48 N per task,
    time M^2 / 3e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the direct light of
    emitting triangles at every point it is computed at (M samples, or 16 per classic patch): the plan's points count the
    emitters in front of them and the shadow rays those above their plane take (light_samples each, up to 4 times that),
@@ -17917,6 +17917,10 @@ typedef struct rad__vp_build {
     size_t cper;                 /* doubles per task */
     uint8_t *slot, *ncl;         /* per sample: cluster slot; per voxel: cluster count */
     struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
+    float *soa;                  /* sampled visibility: 8 M, the samples' x, y, z, normal x, y, z,
+                                    area and eff as planes, for the kernel four pairs at a time */
+    float *gbuf;                 /* sampled visibility: gmax per task, one span's kernels */
+    uint32_t gmax;               /* the most samples in one voxel */
     uint64_t *rays_cast;         /* per task */
     float *P;                    /* N x N, or (sparse rows) the rows of a chunk of voxels */
     uint32_t voxel_base, p_base; /* sparse rows: the chunk's first voxel and first patch */
@@ -17986,6 +17990,40 @@ static inline float rad__vp_pair_kernel(const rad__vp_build *b, uint32_t i, uint
     d2 = rad__dot(d, d);
     fl = (ei > ej ? ei : ej) / (float)RAD__PI;
     return (vp->sample_areas[i] * (ci / d2)) * (vp->sample_areas[j] * (cj / (d2 > fl ? d2 : fl))) / (float)RAD__PI;
+}
+
+/* rad__vp_pair_kernel of sample i against samples j0 .. j1 - 1 into g[0 .. j1 - j0): four
+   pairs at a time from the planes in b->soa, each lane doing the scalar kernel's operations in
+   its order (so the same values), the pairs that do not face each other masked to 0 */
+static void rad__vp_kernel_span(const rad__vp_build *b, uint32_t i, uint32_t j0, uint32_t j1, float *g)
+{
+    uint32_t j = j0;
+#if defined(RAD__SSE2)
+    const rad_virtual_patches *vp = b->vp;
+    const size_t M = vp->sample_count;
+    const float *X = b->soa, *Y = X + M, *Z = Y + M, *NX = Z + M, *NY = NX + M, *NZ = NY + M, *AR = NZ + M, *EF = AR + M;
+    const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
+    __m128 px = _mm_set1_ps(pi_[0]), py = _mm_set1_ps(pi_[1]), pz = _mm_set1_ps(pi_[2]);
+    __m128 nx = _mm_set1_ps(ni[0]), ny = _mm_set1_ps(ni[1]), nz = _mm_set1_ps(ni[2]);
+    __m128 ai = _mm_set1_ps(vp->sample_areas[i]), ei = _mm_set1_ps(b->eff[i]), pi4 = _mm_set1_ps((float)RAD__PI);
+    __m128 zero = _mm_setzero_ps(), sign = _mm_set1_ps(-0.0f);
+    for (; j + 4 <= j1; j += 4) {
+        __m128 dx = _mm_sub_ps(_mm_loadu_ps(X + j), px), dy = _mm_sub_ps(_mm_loadu_ps(Y + j), py);
+        __m128 dz = _mm_sub_ps(_mm_loadu_ps(Z + j), pz);
+        __m128 ci = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, nx), _mm_mul_ps(dy, ny)), _mm_mul_ps(dz, nz));
+        __m128 cj = _mm_xor_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, _mm_loadu_ps(NX + j)), _mm_mul_ps(dy, _mm_loadu_ps(NY + j))),
+                                          _mm_mul_ps(dz, _mm_loadu_ps(NZ + j))),
+                               sign);
+        __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+        /* max(a, b) is a > b ? a : b, the scalar kernel's selects */
+        __m128 fl = _mm_div_ps(_mm_max_ps(ei, _mm_loadu_ps(EF + j)), pi4);
+        __m128 v = _mm_div_ps(_mm_mul_ps(_mm_mul_ps(ai, _mm_div_ps(ci, d2)),
+                                         _mm_mul_ps(_mm_loadu_ps(AR + j), _mm_div_ps(cj, _mm_max_ps(d2, fl)))),
+                              pi4);
+        _mm_storeu_ps(g + (j - j0), _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(ci, zero), _mm_cmpgt_ps(cj, zero)), v));
+    }
+#endif
+    for (; j < j1; ++j) g[j - j0] = rad__vp_pair_kernel(b, i, j);
 }
 
 /* the shadow ray between samples i and j, both ends lifted off their surfaces */
@@ -18106,9 +18144,12 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
         for (i = vp->sample_first[u]; i < vp->sample_first[u + 1]; ++i) {
             const float *wi = vp->sample_weights + 6 * (size_t)i;
             double t6[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; /* sum_j g_ij w_jc */
-            for (j = (v == u ? i + 1 : vp->sample_first[v]); j < vp->sample_first[v + 1]; ++j) {
+            uint32_t j0 = v == u ? i + 1 : vp->sample_first[v];
+            float *gs = b->gbuf + (size_t)task * b->gmax;
+            rad__vp_kernel_span(b, i, j0, vp->sample_first[v + 1], gs);
+            for (j = j0; j < vp->sample_first[v + 1]; ++j) {
                 const float *wj = vp->sample_weights + 6 * (size_t)j;
-                float g = rad__vp_pair_kernel(b, i, j);
+                float g = gs[j - j0];
                 uint32_t c;
                 if (!(g > 0.0f)) continue;
                 for (c = 0; c < 6; ++c) t6[c] += (double)g * (double)wj[c];
@@ -18885,6 +18926,25 @@ static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size
                         b->target[vp->voxel_patch[6 * (size_t)v2 + a2]] += (double)w * (double)vp->sample_areas[s2] * (double)b->share[s2];
                 }
     }
+    if (b->o.visibility_rays > 0) {
+        /* the kernel's planes, from the samples' final eff (step 6 buries some) */
+        size_t M = vp->sample_count, s3;
+        b->gmax = 1;
+        for (v = 0; v < vp->voxel_count; ++v)
+            if (vp->sample_first[v + 1] - vp->sample_first[v] > b->gmax) b->gmax = vp->sample_first[v + 1] - vp->sample_first[v];
+        b->soa = (float *)rad__alloc_array(A, 8 * (M ? M : 1), sizeof(float));
+        b->gbuf = (float *)rad__alloc_array(A, (size_t)T * b->gmax, sizeof(float));
+        if (!b->soa || !b->gbuf) return RAD_ERROR_OUT_OF_MEMORY;
+        for (s3 = 0; s3 < M; ++s3) {
+            int k3;
+            for (k3 = 0; k3 < 3; ++k3) {
+                b->soa[(size_t)k3 * M + s3] = vp->sample_positions[3 * s3 + (size_t)k3];
+                b->soa[(size_t)(3 + k3) * M + s3] = vp->sample_normals[3 * s3 + (size_t)k3];
+            }
+            b->soa[6 * M + s3] = vp->sample_areas[s3];
+            b->soa[7 * M + s3] = b->eff[s3];
+        }
+    }
     /* progress of this stage maps to [0.1, 1] */
     if (c->progress && c->progress(c->progress_user, 0.1f)) return RAD_ERROR_CANCELLED;
     if (b->o.storage == RAD_STORAGE_SPARSE) {
@@ -19219,7 +19279,7 @@ static rad_result rad__vp_build_run(rad__vp_build *b, const rad__ctx *c)
     {
         void *blocks[] = { st.cand, st.cand_area, st.voxel_cand, st.cand_first, st.tri_count, st.s_pos, st.s_tri,
                            st.s_vox, st.s_bary, b->hits, b->rays, b->occ, b->ray_i, b->ray_j, b->ray_g, b->rays_cast,
-                           b->acc, b->pairs, b->eff, b->rowf, b->share, b->share_hits, b->target, b->dscale, b->dnext,
+                           b->acc, b->pairs, b->soa, b->gbuf, b->eff, b->rowf, b->share, b->share_hits, b->target, b->dscale, b->dnext,
                            b->vscale, b->cols, b->cscratch, b->slot, b->ncl, b->sample_voxel };
         rad__free_each(*A, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
@@ -23744,7 +23804,7 @@ static void rad__plan_vp_cost(const rad__plan_in *in, const rad_vp_counts *cnt, 
                               double *secs)
 {
     double n = (double)cnt->patches, M = (double)cnt->samples;
-    *bytes = 4.0 * n * n + 100.0 * M + 48.0 * n * (double)in->tasks + in->outputs_bytes + 40.0 * in->probes * n +
+    *bytes = 4.0 * n * n + 132.0 * M + 48.0 * n * (double)in->tasks + in->outputs_bytes + 40.0 * in->probes * n +
              in->per_patch * n;
     *secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 16.0 * M / RAD__BAKER_RAY_RATE +
             6.0 * n * n * in->o.bounces * in->groups / RAD__BAKER_FLOP_RATE + in->texels * 8.0 * in->groups / RAD__BAKER_RAY_RATE +
