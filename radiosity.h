@@ -17918,7 +17918,7 @@ typedef struct rad__vp_build {
     uint8_t *slot, *ncl;         /* per sample: cluster slot; per voxel: cluster count */
     struct rad__vp_pair *pairs;  /* RAD__VP_PAIRS per task (sampled visibility) */
     float *soa;                  /* sampled visibility: 8 M, the samples' x, y, z, normal x, y, z,
-                                    area and eff as planes, for the kernel four pairs at a time */
+                                    area and eff / pi as planes, for the kernel four pairs at a time */
     float *gbuf;                 /* sampled visibility: gmax per task, one span's kernels */
     uint32_t gmax;               /* the most samples in one voxel */
     uint64_t *rays_cast;         /* per task */
@@ -18005,7 +18005,7 @@ static void rad__vp_kernel_span(const rad__vp_build *b, uint32_t i, uint32_t j0,
     const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
     __m128 px = _mm_set1_ps(pi_[0]), py = _mm_set1_ps(pi_[1]), pz = _mm_set1_ps(pi_[2]);
     __m128 nx = _mm_set1_ps(ni[0]), ny = _mm_set1_ps(ni[1]), nz = _mm_set1_ps(ni[2]);
-    __m128 ai = _mm_set1_ps(vp->sample_areas[i]), ei = _mm_set1_ps(b->eff[i]), pi4 = _mm_set1_ps((float)RAD__PI);
+    __m128 ai = _mm_set1_ps(vp->sample_areas[i]), ei = _mm_set1_ps(b->eff[i] / (float)RAD__PI), pi4 = _mm_set1_ps((float)RAD__PI);
     __m128 zero = _mm_setzero_ps(), sign = _mm_set1_ps(-0.0f);
     for (; j + 4 <= j1; j += 4) {
         __m128 dx = _mm_sub_ps(_mm_loadu_ps(X + j), px), dy = _mm_sub_ps(_mm_loadu_ps(Y + j), py);
@@ -18015,8 +18015,9 @@ static void rad__vp_kernel_span(const rad__vp_build *b, uint32_t i, uint32_t j0,
                                           _mm_mul_ps(dz, _mm_loadu_ps(NZ + j))),
                                sign);
         __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-        /* max(a, b) is a > b ? a : b, the scalar kernel's selects */
-        __m128 fl = _mm_div_ps(_mm_max_ps(ei, _mm_loadu_ps(EF + j)), pi4);
+        /* max(a, b) is a > b ? a : b, the scalar kernel's selects; the planes hold eff / pi,
+           whose max is the rounded max(eff_i, eff_j) / pi (rounding is monotonic) */
+        __m128 fl = _mm_max_ps(ei, _mm_loadu_ps(EF + j));
         __m128 v = _mm_div_ps(_mm_mul_ps(_mm_mul_ps(ai, _mm_div_ps(ci, d2)),
                                          _mm_mul_ps(_mm_loadu_ps(AR + j), _mm_div_ps(cj, _mm_max_ps(d2, fl)))),
                               pi4);
@@ -18942,7 +18943,7 @@ static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size
                 b->soa[(size_t)(3 + k3) * M + s3] = vp->sample_normals[3 * s3 + (size_t)k3];
             }
             b->soa[6 * M + s3] = vp->sample_areas[s3];
-            b->soa[7 * M + s3] = b->eff[s3];
+            b->soa[7 * M + s3] = b->eff[s3] / (float)RAD__PI;
         }
     }
     /* progress of this stage maps to [0.1, 1] */
