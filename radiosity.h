@@ -17993,7 +17993,7 @@ static inline float rad__vp_pair_kernel(const rad__vp_build *b, uint32_t i, uint
 }
 
 /* rad__vp_pair_kernel of sample i against samples j0 .. j1 - 1 into g[0 .. j1 - j0): four
-   pairs at a time from the planes in b->soa, each lane doing the scalar kernel's operations in
+   (AVX: eight) pairs at a time from the planes in b->soa, each lane doing the scalar kernel's operations in
    its order (so the same values), the pairs that do not face each other masked to 0 */
 static void rad__vp_kernel_span(const rad__vp_build *b, uint32_t i, uint32_t j0, uint32_t j1, float *g)
 {
@@ -18007,6 +18007,31 @@ static void rad__vp_kernel_span(const rad__vp_build *b, uint32_t i, uint32_t j0,
     __m128 nx = _mm_set1_ps(ni[0]), ny = _mm_set1_ps(ni[1]), nz = _mm_set1_ps(ni[2]);
     __m128 ai = _mm_set1_ps(vp->sample_areas[i]), ei = _mm_set1_ps(b->eff[i] / (float)RAD__PI), pi4 = _mm_set1_ps((float)RAD__PI);
     __m128 zero = _mm_setzero_ps(), sign = _mm_set1_ps(-0.0f);
+#if defined(RAD__AVX)
+    {
+        /* the same, eight pairs at a time */
+        __m256 px8 = _mm256_set1_ps(pi_[0]), py8 = _mm256_set1_ps(pi_[1]), pz8 = _mm256_set1_ps(pi_[2]);
+        __m256 nx8 = _mm256_set1_ps(ni[0]), ny8 = _mm256_set1_ps(ni[1]), nz8 = _mm256_set1_ps(ni[2]);
+        __m256 ai8 = _mm256_set1_ps(vp->sample_areas[i]), ei8 = _mm256_set1_ps(b->eff[i] / (float)RAD__PI);
+        __m256 pi8 = _mm256_set1_ps((float)RAD__PI), zero8 = _mm256_setzero_ps(), sign8 = _mm256_set1_ps(-0.0f);
+        for (; j + 8 <= j1; j += 8) {
+            __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(X + j), px8), dy = _mm256_sub_ps(_mm256_loadu_ps(Y + j), py8);
+            __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(Z + j), pz8);
+            __m256 ci = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, nx8), _mm256_mul_ps(dy, ny8)), _mm256_mul_ps(dz, nz8));
+            __m256 cj = _mm256_xor_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, _mm256_loadu_ps(NX + j)),
+                                                                  _mm256_mul_ps(dy, _mm256_loadu_ps(NY + j))),
+                                                    _mm256_mul_ps(dz, _mm256_loadu_ps(NZ + j))),
+                                      sign8);
+            __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+            __m256 fl = _mm256_max_ps(ei8, _mm256_loadu_ps(EF + j));
+            __m256 v = _mm256_div_ps(_mm256_mul_ps(_mm256_mul_ps(ai8, _mm256_div_ps(ci, d2)),
+                                                   _mm256_mul_ps(_mm256_loadu_ps(AR + j), _mm256_div_ps(cj, _mm256_max_ps(d2, fl)))),
+                                     pi8);
+            __m256 ok = _mm256_and_ps(_mm256_cmp_ps(ci, zero8, _CMP_GT_OQ), _mm256_cmp_ps(cj, zero8, _CMP_GT_OQ));
+            _mm256_storeu_ps(g + (j - j0), _mm256_and_ps(ok, v));
+        }
+    }
+#endif
     for (; j + 4 <= j1; j += 4) {
         __m128 dx = _mm_sub_ps(_mm_loadu_ps(X + j), px), dy = _mm_sub_ps(_mm_loadu_ps(Y + j), py);
         __m128 dz = _mm_sub_ps(_mm_loadu_ps(Z + j), pz);
