@@ -18269,14 +18269,27 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
     return RAD_SUCCESS;
 }
 
-/* mirror P into the columns left of each row's voxel, then divide by the row's area */
-static rad_result rad__vp_mirror_row(void *data, uint32_t p, uint32_t task)
+/* mirror P into the columns left of each row's voxel, for rows 64 blk .. 64 blk + 63: the
+   column c of those rows is read as one run of row c (a row at a time read the column with a
+   stride of N floats, a cache miss per entry) */
+#define RAD__VP_MIRROR_ROWS 64u
+static rad_result rad__vp_mirror_block(void *data, uint32_t blk, uint32_t task)
 {
     rad__vp_build *b = (rad__vp_build *)data;
     const rad_virtual_patches *vp = b->vp;
-    uint32_t N = vp->count, pf = vp->voxel_first[vp->voxel[p]], c;
+    uint32_t N = vp->count, p0 = blk * RAD__VP_MIRROR_ROWS, p1 = p0 + RAD__VP_MIRROR_ROWS, most = 0, p, c;
+    uint32_t pf[RAD__VP_MIRROR_ROWS];
     (void)task;
-    for (c = 0; c < pf; ++c) b->P[(size_t)p * N + c] = b->P[(size_t)c * N + p];
+    if (p1 > N) p1 = N;
+    for (p = p0; p < p1; ++p) {
+        pf[p - p0] = vp->voxel_first[vp->voxel[p]];
+        if (pf[p - p0] > most) most = pf[p - p0];
+    }
+    for (c = 0; c < most; ++c) {
+        const float *col = b->P + (size_t)c * N;
+        for (p = p0; p < p1; ++p)
+            if (c < pf[p - p0]) b->P[(size_t)p * N + c] = col[p];
+    }
     return RAD_SUCCESS;
 }
 
@@ -18982,7 +18995,7 @@ static rad_result rad__vp_form_factors(rad__vp_build *b, const rad__ctx *c, size
     for (i = 0; i < T; ++i) vp->pair_rays += b->rays_cast[i];
     if (r == RAD_SUCCESS) {
         cc.progress = NULL;
-        r = rad__for_rows(&cc, N, T, rad__vp_mirror_row, b);
+        r = rad__for_rows(&cc, (N + RAD__VP_MIRROR_ROWS - 1) / RAD__VP_MIRROR_ROWS, T, rad__vp_mirror_block, b);
         if (r == RAD_SUCCESS) r = rad__vp_match(b, &cc, T);
         if (r == RAD_SUCCESS && !b->o.keep_row_sums) r = rad__for_rows(&cc, N, T, rad__vp_rowsum_row, b);
         else if (r == RAD_SUCCESS)
