@@ -18169,31 +18169,40 @@ static rad_result rad__vp_ff_row_sampled(void *data, uint32_t u, uint32_t task)
         memset(p0, 0, sizeof(p0));
         for (i = vp->sample_first[u]; i < vp->sample_first[u + 1]; ++i) {
             const float *wi = vp->sample_weights + 6 * (size_t)i;
-            double t6[6] = { 0.0, 0.0, 0.0, 0.0, 0.0, 0.0 }; /* sum_j g_ij w_jc */
+            /* sum_j g_ij w_jc in six named sums (an array indexed in a loop went through
+               memory at every pair) */
+            double t6[6], t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0;
             uint32_t j0 = v == u ? i + 1 : vp->sample_first[v];
             float *gs = b->gbuf + (size_t)task * b->gmax;
             rad__vp_kernel_span(b, i, j0, vp->sample_first[v + 1], gs);
             for (j = j0; j < vp->sample_first[v + 1]; ++j) {
                 const float *wj = vp->sample_weights + 6 * (size_t)j;
                 float g = gs[j - j0];
-                uint32_t c;
+                double gd;
                 if (!(g > 0.0f)) continue;
-                for (c = 0; c < 6; ++c) t6[c] += (double)g * (double)wj[c];
+                gd = (double)g;
+                t0 += gd * (double)wj[0];
+                t1 += gd * (double)wj[1];
+                t2 += gd * (double)wj[2];
+                t3 += gd * (double)wj[3];
+                t4 += gd * (double)wj[4];
+                t5 += gd * (double)wj[5];
                 if (b->o.skip_visibility) continue;
-                /* the pair list, thinned systematically when full */
-                if (seen++ % stride != 0) continue;
+                /* the pair list, thinned systematically when full (stride a power of two) */
+                if ((seen++ & (stride - 1u)) != 0) continue;
                 if (n == RAD__VP_PAIRS) {
                     uint32_t q;
                     for (q = 0; q < n / 2; ++q) list[q] = list[2 * q];
                     n /= 2;
                     stride *= 2;
-                    if ((seen - 1) % stride != 0) continue;
+                    if (((seen - 1) & (stride - 1u)) != 0) continue;
                 }
                 list[n].i = i;
                 list[n].j = j;
                 list[n].g = g;
                 ++n;
             }
+            t6[0] = t0, t6[1] = t1, t6[2] = t2, t6[3] = t3, t6[4] = t4, t6[5] = t5;
             for (a = 0; a < 6; ++a)
                 if (wi[a] > 0.0f)
                     for (j = 0; j < 6; ++j) p0[6 * a + j] += (double)wi[a] * t6[j];
