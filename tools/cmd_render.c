@@ -1331,8 +1331,9 @@ static const tool_arg render_table[] = {
     RA_UINT("--final-gather", "N", view.final_gather, 0, 4096, RENDER_GIVEN_FINAL_GATHER, "is at most 4096",
             "classic, vp, aavp: trace the first bounce from each pixel sample with N rays (direct\n"
             "light at the hits, the solution's irradiance there): the indirect light of points a\n"
-            "patch average misrepresents; default: vp and aavp 16 while the image's samples times\n"
-            "16 stay within 2^22 rays, else the rays that fit (off below 4: noise), the rest 0 (off)"),
+            "patch average misrepresents; default: vp, aavp and --proxy (no --sequence) 16 while the\n"
+            "image's samples times 16 stay within 2^22 rays, else the rays that fit (off below 4:\n"
+            "noise), else 0 (off)"),
     RA_CUSTOM("--shading", "MODEL", view.shading, parse_shading, 0,
               "radiosity methods: lighting model for the analytic lights' direct term: none\n"
               "(default: Lambert through the irradiance), lambert, half-lambert, banded, phong,\n"
@@ -1457,8 +1458,8 @@ static int render_check(const char *cmd, render_args *ra)
 /* --final-gather's default for the virtual patches: a voxel's patch averages the light over
    every sample in it, crevices included, so the open surfaces a camera sees got 10% too little
    first bounce on Sponza; 16 traced rays per pixel sample restore it. The rays are capped at
-   2^22 a frame (about 8 CPU-seconds on Sponza, an eighth of its bake), and fewer than 4 are
-   not worth their noise. */
+   2^22 a frame (about 8 CPU-seconds on Sponza, an eighth of its bake), fewer than 4 are not
+   worth their noise, and a --sequence (a frame every few steps) keeps the option's 0. */
 static uint32_t auto_final_gather(const render_view *v)
 {
     uint32_t side = 1, rays;
@@ -1721,7 +1722,8 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         return 1;
     }
     render_prepare(cmd, &w, &ra);
-    if (!(ra.given & RENDER_GIVEN_FINAL_GATHER) && !ra.mo.proxy && (ra.mo.method == TOOL_AAVP || ra.mo.method == TOOL_VP) &&
+    if (!(ra.given & RENDER_GIVEN_FINAL_GATHER) && ra.mo.method != TOOL_LIGHTMAP &&
+        !ra.mo.sequence && (ra.mo.method == TOOL_AAVP || ra.mo.method == TOOL_VP || ra.mo.proxy) &&
         (ra.view.final_gather = auto_final_gather(&ra.view)) != 0)
         fprintf(stderr, "rad %s: --final-gather %u (the virtual patches' default at %dx%d; --final-gather 0: off)\n", cmd,
                 ra.view.final_gather, ra.view.width, ra.view.height);
