@@ -1399,6 +1399,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/tool_emissive.sh"
 . "$(dirname "$0")/tool_hier_large.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_glb.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_defaults.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/tool_final_gather.sh"
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]
