@@ -3289,7 +3289,14 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    with sky layers): the lightmap then holds all the light but emission. RAD_BAKER_LIGHTMAP_STITCH
    runs rad_lightmap_stitch on each layer after its dilation (lightmap_seams reports it; the
    layers still add: the stitch is a linear projection). rad_baker_runtime_create refuses
-   these options (its lightmap is the RGB bounced light).
+   these options (its lightmap is the RGB bounced light). RAD_BAKER_LIGHTMAP_RGB9E5 also keeps
+   the groups' lightmap layers packed, 4 bytes a texel (lightmap_rgb9e5, RGB9E5 in >>api_baker,
+   rounded to 2^-9 of each texel's largest channel, after dilation and stitch): rad_baker_mix_
+   layers_rgb9e5 mixes them reading a third of the bytes, and a GPU samples them as RGB9E5
+   textures. RAD_BAKER_LIGHTMAP_RGB9E5_ONLY keeps only them (lightmap_layers NULL: the float
+   planes are freed once packed); rad_baker_mix then mixes the lightmap from them. Both are RGB
+   only (not with the SH encoding); _ONLY not with sky layers (they stay float). The runtime
+   takes both, and mixes its lightmap from the packed layers.
    PROBE OPTIONS (rad_baker_desc.probe_options, >>api_probes; NULL: rad_probe_options_default).
    Their spacing is replaced by probe_spacing when that is not 0. Two flags change the output:
    RAD_PROBES_DIRECT adds to each group's layer the direct light of its lights and emitters at
@@ -3363,7 +3370,9 @@ typedef enum rad_baker_outputs {
 /* rad_baker_desc.lightmap_flags (LIGHTMAP OPTIONS above) */
 typedef enum rad_baker_lightmap_flags {
     RAD_BAKER_LIGHTMAP_DIRECT = 1,  /* each group's layer also holds its direct light per texel */
-    RAD_BAKER_LIGHTMAP_STITCH = 2   /* each layer's seams stitched after dilation */
+    RAD_BAKER_LIGHTMAP_STITCH = 2,  /* each layer's seams stitched after dilation */
+    RAD_BAKER_LIGHTMAP_RGB9E5 = 4,  /* the groups' layers also packed, 4 bytes a texel (RGB9E5 below) */
+    RAD_BAKER_LIGHTMAP_RGB9E5_ONLY = 8 /* packed instead: lightmap_layers is NULL */
 } rad_baker_lightmap_flags;
 
 typedef struct rad_baker_solution rad_baker_solution; /* private: what RAD_BAKER_SOLUTION keeps */
@@ -3483,6 +3492,9 @@ typedef struct rad_baker_result {
                                        the SH encoding (LIGHTMAP OPTIONS above); 0 without one */
     rad_lightmap_seam_stats lightmap_seams; /* RAD_BAKER_LIGHTMAP_STITCH: the seams, and the
                                        largest jumps before and after over the layers */
+    uint32_t *lightmap_rgb9e5;      /* RAD_BAKER_LIGHTMAP_RGB9E5(_ONLY): group_count planes of
+                                       width * height texels, one uint32 RGB9E5 each (RGB9E5
+                                       below), plane g at g width height; no sky planes. Else NULL */
 } rad_baker_result;
 
 /* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
@@ -3560,6 +3572,31 @@ RAD_API rad_result rad_baker_irradiance(const rad_baker_result *result, const ra
    count3 not a multiple of 3, group_count 0), NON_FINITE (a scale). */
 RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_count, size_t count3, const float *group_rgb,
                                        float *out, const rad_context *ctx);
+
+/* RGB9E5: an RGB texel in 4 bytes, the shared-exponent format of GL_EXT_texture_shared_exponent
+   (GL_RGB9_E5, VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: a GPU samples these planes as they are). Bits
+   0-8 red, 9-17 green, 18-26 blue (9-bit mantissas, no hidden bit), 27-31 the exponent e (bias
+   15): channel = mantissa 2^(e - 24). No sign: 0 to RAD_RGB9E5_MAX. Packing rounds each channel
+   to the nearest step of the largest channel's scale, so |unpacked - clamped| <= 2^-9 times
+   the largest channel (and <= 2^-25 below 2^-16). Light layers are irradiance (>= 0); the sky
+   layers are SH coefficients that go negative, and stay float.
+   rad_rgb9e5_pack: 'count' texels, 3 floats each, into out (count words); negatives become 0,
+   values above RAD_RGB9E5_MAX become it. Errors: INVALID_ARGUMENT (NULL with count > 0),
+   NON_FINITE (a NaN or infinite channel; the log names the first texel and channel).
+   rad_rgb9e5_unpack: the inverse (exact: every packed value is a float). */
+#define RAD_RGB9E5_MAX 65408.0f  /* 511 / 512 2^16 */
+RAD_API rad_result rad_rgb9e5_pack(const float *rgb, size_t count, uint32_t *out, const rad_context *ctx);
+RAD_API void rad_rgb9e5_unpack(const uint32_t *packed, size_t count, float *rgb);
+
+/* rad_baker_mix_layers on RGB9E5 layers (rad_baker_result.lightmap_rgb9e5): out[3t + c] =
+   sum_g group_rgb[3g + c] unpack(layers[g texel_count + t])_c for t < texel_count, the groups
+   with scale 0 0 0 skipped, added in the same order: the same bits as rad_baker_mix_layers on
+   the unpacked layers (without RAD_FMA). group_rgb NULL: all 1. Reads 4 bytes per texel and
+   group where the float layers take 12 (docs/performance-notes.md, "Packed light layers").
+   Errors: INVALID_ARGUMENT (NULL, group_count 0 or above RAD_BAKER_MAX_GROUPS), NON_FINITE (a
+   scale). Cost: one pass, parallel through ctx. */
+RAD_API rad_result rad_baker_mix_layers_rgb9e5(const uint32_t *layers, uint32_t group_count, size_t texel_count,
+                                              const float *group_rgb, float *out, const rad_context *ctx);
 
 /* >>api_bake_runtime: lights that move, over a bake, one call per frame                    */
 
@@ -23380,6 +23417,227 @@ RAD_API rad_result rad_baker_mix_layers(const float *layers, uint32_t group_coun
     return rad__baker_mix_planes(layers, group_count, count3, group_rgb, out, ctx, &c);
 }
 
+/* RGB9E5 (>>api_baker): a channel of float bits b (>= 0, at most RAD_RGB9E5_MAX) at shared
+   exponent e, rounded half up: (m + 2^(s-1)) >> s with m the 24-bit significand and s >= 15 */
+static uint32_t rad__rgb9e5_channel(uint32_t b, uint32_t e)
+{
+    uint32_t E = b >> 23, m = b & 0x7FFFFFu, s;
+    if (E) m |= 0x800000u;
+    else E = 1u;
+    s = 126u + e - E;
+    return s > 25u ? 0u : (m + (1u << (s - 1u))) >> s;
+}
+
+static uint32_t rad__rgb9e5_pack1(const float *rgb)
+{
+    uint32_t b[3], top = 0, e, k;
+    int ex;
+    for (k = 0; k < 3; ++k) {
+        memcpy(&b[k], &rgb[k], sizeof(uint32_t));
+        if (b[k] >> 31) b[k] = 0;                     /* negative (and -0): 0 */
+        if (b[k] > 0x477F8000u) b[k] = 0x477F8000u;   /* RAD_RGB9E5_MAX */
+        if (b[k] > top) top = b[k];                   /* non-negative floats order as their bits */
+    }
+    /* the exponent that holds the largest channel below 512 steps, one more when it rounds up to 512 */
+    ex = (int)(top >> 23) - 127;
+    e = (uint32_t)((ex < -16 ? -16 : ex) + 16);
+    if (rad__rgb9e5_channel(top, e) == 512u) ++e;
+    return e << 27 | rad__rgb9e5_channel(b[2], e) << 18 | rad__rgb9e5_channel(b[1], e) << 9 | rad__rgb9e5_channel(b[0], e);
+}
+
+RAD_API rad_result rad_rgb9e5_pack(const float *rgb, size_t count, uint32_t *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    size_t t;
+    uint32_t k;
+    rad__ctx_init(&c, ctx);
+    if (count && (!rgb || !out)) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_rgb9e5_pack: NULL rgb or out");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    for (t = 0; t < count; ++t) {
+        for (k = 0; k < 3; ++k)
+            if (!rad__finite(rgb[3 * t + k])) {
+                rad__log(&c, RAD_LOG_ERROR, "rad_rgb9e5_pack: texel %lu channel %u is not finite (%g)", (unsigned long)t, k,
+                         (double)rgb[3 * t + k]);
+                return RAD_ERROR_NON_FINITE;
+            }
+        out[t] = rad__rgb9e5_pack1(rgb + 3 * t);
+    }
+    return RAD_SUCCESS;
+}
+
+/* one channel unpacked: the mantissa field in place (mask) times 2^(e - 24 - its shift), both exact */
+static float rad__rgb9e5_bits(uint32_t u) { float f; memcpy(&f, &u, sizeof(f)); return f; }
+#define RAD__RGB9E5_R(u) ((float)(int32_t)((u) & 0x1FFu) * rad__rgb9e5_bits((((u) >> 4) & 0x0F800000u) + (103u << 23)))
+#define RAD__RGB9E5_G(u) ((float)(int32_t)((u) & 0x3FE00u) * rad__rgb9e5_bits((((u) >> 4) & 0x0F800000u) + (94u << 23)))
+#define RAD__RGB9E5_B(u) ((float)(int32_t)((u) & 0x7FC0000u) * rad__rgb9e5_bits((((u) >> 4) & 0x0F800000u) + (85u << 23)))
+
+RAD_API void rad_rgb9e5_unpack(const uint32_t *packed, size_t count, float *rgb)
+{
+    size_t t;
+    if (!packed || !rgb) return;
+    for (t = 0; t < count; ++t) {
+        uint32_t u = packed[t];
+        rgb[3 * t] = RAD__RGB9E5_R(u);
+        rgb[3 * t + 1] = RAD__RGB9E5_G(u);
+        rgb[3 * t + 2] = RAD__RGB9E5_B(u);
+    }
+}
+
+#define RAD__RGB9E5_BLOCK 64u   /* texels a block: three accumulator planes of 256 bytes in L1 */
+
+typedef struct rad__rgb9e5_mix_job {
+    const uint32_t *layers;
+    float *out;
+    size_t texels;
+    uint32_t groups;
+    const float *rgb;       /* 3 per group */
+    const uint8_t *active;
+} rad__rgb9e5_mix_job;
+
+/* A block of texels: the channels accumulate in three planes (so each loop over the texels is
+   plain lanes that -O2 vectorizes: masks, shifts, int-to-float, multiplies), four groups per
+   pass over them, then interleave into RGB. Each term is unpack(layer) * scale, added in
+   increasing group order from 0: the float kernel's operations on the unpacked values. */
+static void rad__rgb9e5_mix_block(const uint32_t *const *lay, const float *const *sc, uint32_t na, size_t t0, size_t n,
+                                  float *out)
+{
+    float ar[RAD__RGB9E5_BLOCK], ag[RAD__RGB9E5_BLOCK], ab[RAD__RGB9E5_BLOCK];
+    size_t t;
+    uint32_t g;
+    for (t = 0; t < RAD__RGB9E5_BLOCK; ++t) ar[t] = ag[t] = ab[t] = 0.0f;
+    if (n == RAD__RGB9E5_BLOCK) {
+        for (g = 0; g + 4 <= na; g += 4) {
+            const uint32_t *w0 = lay[g] + t0, *w1 = lay[g + 1] + t0, *w2 = lay[g + 2] + t0, *w3 = lay[g + 3] + t0;
+            const float *s0 = sc[g], *s1 = sc[g + 1], *s2 = sc[g + 2], *s3 = sc[g + 3];
+            for (t = 0; t < RAD__RGB9E5_BLOCK; ++t) {
+                uint32_t u0 = w0[t], u1 = w1[t], u2 = w2[t], u3 = w3[t];
+                float r = ar[t], gg = ag[t], b = ab[t], p;
+                p = RAD__RGB9E5_R(u0) * s0[0]; r += p;
+                p = RAD__RGB9E5_G(u0) * s0[1]; gg += p;
+                p = RAD__RGB9E5_B(u0) * s0[2]; b += p;
+                p = RAD__RGB9E5_R(u1) * s1[0]; r += p;
+                p = RAD__RGB9E5_G(u1) * s1[1]; gg += p;
+                p = RAD__RGB9E5_B(u1) * s1[2]; b += p;
+                p = RAD__RGB9E5_R(u2) * s2[0]; r += p;
+                p = RAD__RGB9E5_G(u2) * s2[1]; gg += p;
+                p = RAD__RGB9E5_B(u2) * s2[2]; b += p;
+                p = RAD__RGB9E5_R(u3) * s3[0]; r += p;
+                p = RAD__RGB9E5_G(u3) * s3[1]; gg += p;
+                p = RAD__RGB9E5_B(u3) * s3[2]; b += p;
+                ar[t] = r, ag[t] = gg, ab[t] = b;
+            }
+        }
+        for (; g < na; ++g) { /* the groups left, one at a time (a fixed count: vectorized too) */
+            const uint32_t *w = lay[g] + t0;
+            float sr = sc[g][0], sg = sc[g][1], sb = sc[g][2], p;
+            for (t = 0; t < RAD__RGB9E5_BLOCK; ++t) {
+                uint32_t u = w[t];
+                p = RAD__RGB9E5_R(u) * sr; ar[t] += p;
+                p = RAD__RGB9E5_G(u) * sg; ag[t] += p;
+                p = RAD__RGB9E5_B(u) * sb; ab[t] += p;
+            }
+        }
+    } else {
+        for (g = 0; g < na; ++g) { /* a short last block */
+            const uint32_t *w = lay[g] + t0;
+            float sr = sc[g][0], sg = sc[g][1], sb = sc[g][2], p;
+            for (t = 0; t < n; ++t) {
+                uint32_t u = w[t];
+                p = RAD__RGB9E5_R(u) * sr; ar[t] += p;
+                p = RAD__RGB9E5_G(u) * sg; ag[t] += p;
+                p = RAD__RGB9E5_B(u) * sb; ab[t] += p;
+            }
+        }
+    }
+    t = 0;
+#if defined(RAD__SSE2)
+    /* the three planes interleaved four texels at a time (compilers leave this loop scalar at
+       -O2); moves only, so the same bits as the loop below */
+    for (; t + 4 <= n; t += 4) {
+        __m128 r = _mm_loadu_ps(ar + t), gv = _mm_loadu_ps(ag + t), b = _mm_loadu_ps(ab + t);
+        __m128 rg0 = _mm_unpacklo_ps(r, gv), rg1 = _mm_unpackhi_ps(r, gv);
+        __m128 br = _mm_shuffle_ps(b, r, _MM_SHUFFLE(1, 1, 0, 0)), br2 = _mm_shuffle_ps(b, r, _MM_SHUFFLE(3, 3, 2, 2));
+        _mm_storeu_ps(out + 3 * t, _mm_shuffle_ps(rg0, br, _MM_SHUFFLE(2, 0, 1, 0)));
+        _mm_storeu_ps(out + 3 * t + 4, _mm_shuffle_ps(_mm_unpacklo_ps(gv, b), rg1, _MM_SHUFFLE(1, 0, 3, 2)));
+        _mm_storeu_ps(out + 3 * t + 8, _mm_shuffle_ps(br2, _mm_unpackhi_ps(gv, b), _MM_SHUFFLE(3, 2, 2, 0)));
+    }
+#endif
+    for (; t < n; ++t) {
+        out[3 * t] = ar[t];
+        out[3 * t + 1] = ag[t];
+        out[3 * t + 2] = ab[t];
+    }
+}
+
+static void rad__rgb9e5_mix_task(void *data, uint32_t index)
+{
+    const rad__rgb9e5_mix_job *J = (const rad__rgb9e5_mix_job *)data;
+    size_t b = (size_t)index * (RAD__BAKER_MIX_CHUNK / 3u), e = b + RAD__BAKER_MIX_CHUNK / 3u, t;
+    const uint32_t *lay[RAD_BAKER_MAX_GROUPS];
+    const float *sc[RAD_BAKER_MAX_GROUPS];
+    uint32_t g, na = 0;
+    if (e > J->texels) e = J->texels;
+    for (g = 0; g < J->groups; ++g)
+        if (J->active[g]) {
+            lay[na] = J->layers + (size_t)g * J->texels;
+            sc[na++] = J->rgb + 3 * (size_t)g;
+        }
+    for (t = b; t < e; t += RAD__RGB9E5_BLOCK) {
+        size_t n = e - t < RAD__RGB9E5_BLOCK ? e - t : RAD__RGB9E5_BLOCK;
+        rad__rgb9e5_mix_block(lay, sc, na, t, n, J->out + 3 * t);
+    }
+}
+
+/* the mix of packed layers, the arguments checked */
+static rad_result rad__rgb9e5_mix(const uint32_t *layers, uint32_t groups, size_t texels, const float *group_rgb, float *out,
+                                  rad__ctx *c)
+{
+    rad__rgb9e5_mix_job J;
+    float rgb[3 * RAD_BAKER_MAX_GROUPS];
+    uint8_t active[RAD_BAKER_MAX_GROUPS];
+    size_t tasks;
+    uint32_t g, k;
+    for (g = 0; g < groups; ++g) {
+        active[g] = 0;
+        for (k = 0; k < 3; ++k) {
+            float s = group_rgb ? group_rgb[3 * g + k] : 1.0f;
+            if (!rad__finite(s)) {
+                rad__log(c, RAD_LOG_ERROR, "rad_baker_mix_layers_rgb9e5: the scale of group %u channel %u is not finite", g, k);
+                return RAD_ERROR_NON_FINITE;
+            }
+            rgb[3 * g + k] = s;
+            active[g] |= s != 0.0f;
+        }
+    }
+    if (texels == 0) return RAD_SUCCESS;
+    J.layers = layers;
+    J.out = out;
+    J.texels = texels;
+    J.groups = groups;
+    J.rgb = rgb;
+    J.active = active;
+    tasks = (texels + RAD__BAKER_MIX_CHUNK / 3u - 1) / (RAD__BAKER_MIX_CHUNK / 3u);
+    if (tasks > 0xFFFFFFFFu) return RAD_ERROR_SIZE_OVERFLOW;
+    if (tasks == 1) rad__rgb9e5_mix_task(&J, 0);
+    else c->parallel_for(c->parallel_user, (uint32_t)tasks, rad__rgb9e5_mix_task, &J);
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_mix_layers_rgb9e5(const uint32_t *layers, uint32_t group_count, size_t texel_count,
+                                              const float *group_rgb, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad__ctx_init(&c, ctx);
+    if (!layers || !out || group_count == 0 || group_count > RAD_BAKER_MAX_GROUPS) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_mix_layers_rgb9e5: NULL layers or out, or %u groups (1 to %u)", group_count,
+                 RAD_BAKER_MAX_GROUPS);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return rad__rgb9e5_mix(layers, group_count, texel_count, group_rgb, out, &c);
+}
+
 RAD_API rad_result rad_baker_mix_sky(rad_baker_result *R, const float *group_rgb, const float *sky_sh, const rad_context *ctx)
 {
     rad__ctx c;
@@ -23413,6 +23671,8 @@ RAD_API rad_result rad_baker_mix_sky(rad_baker_result *R, const float *group_rgb
     if (r == RAD_SUCCESS && R->lightmap_layers)
         r = rad__baker_mix_planes(R->lightmap_layers, planes, (size_t)R->lightmap_channels * R->lightmap_width * R->lightmap_height,
                                   rgb, R->lightmap, ctx, &c);
+    else if (r == RAD_SUCCESS && R->lightmap_rgb9e5 && G) /* RAD_BAKER_LIGHTMAP_RGB9E5_ONLY: no sky layers */
+        r = rad__rgb9e5_mix(R->lightmap_rgb9e5, G, (size_t)R->lightmap_width * R->lightmap_height, rgb, R->lightmap, &c);
     if (r == RAD_SUCCESS && R->probe_layers)
         r = rad__baker_mix_planes(R->probe_layers, planes, 27 * (size_t)R->probe_count, rgb, R->probes, ctx, &c);
     /* the kept solution and band 4 hold the groups' planes only (no sky) */
@@ -23463,6 +23723,7 @@ RAD_API void rad_baker_result_destroy(rad_baker_result *R)
     rad__free(&a, R->vertex_layers);
     rad__free(&a, R->lightmap);
     rad__free(&a, R->lightmap_layers);
+    rad__free(&a, R->lightmap_rgb9e5);
     rad__free(&a, R->lightmap_flags);
     rad__free(&a, R->probe_positions);
     rad__free(&a, R->probe_states);
@@ -23663,7 +23924,9 @@ static rad_result rad__baker_check(rad__baker *b)
     }
     if (b->outputs & RAD_BAKER_LIGHTMAP) {
         b->R->lightmap_channels = d->lightmap_gather ? rad_lightmap_channels(d->lightmap_gather->encoding) : 3u;
-        if (!b->R->lightmap_channels || (d->lightmap_flags & ~(uint32_t)(RAD_BAKER_LIGHTMAP_DIRECT | RAD_BAKER_LIGHTMAP_STITCH))) {
+        if (!b->R->lightmap_channels ||
+            (d->lightmap_flags & ~(uint32_t)(RAD_BAKER_LIGHTMAP_DIRECT | RAD_BAKER_LIGHTMAP_STITCH | RAD_BAKER_LIGHTMAP_RGB9E5 |
+                                             RAD_BAKER_LIGHTMAP_RGB9E5_ONLY))) {
             rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown lightmap_gather encoding or lightmap_flags 0x%x",
                      d->lightmap_flags);
             return RAD_ERROR_INVALID_ARGUMENT;
@@ -23671,6 +23934,16 @@ static rad_result rad__baker_check(rad__baker *b)
         if ((d->lightmap_flags & RAD_BAKER_LIGHTMAP_DIRECT) && (b->R->lightmap_channels != 3u || b->o.sky_bands)) {
             rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: RAD_BAKER_LIGHTMAP_DIRECT adds RGB irradiance: not with the SH "
                                            "encoding or sky layers");
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if ((d->lightmap_flags & (RAD_BAKER_LIGHTMAP_RGB9E5 | RAD_BAKER_LIGHTMAP_RGB9E5_ONLY)) && b->R->lightmap_channels != 3u) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: RAD_BAKER_LIGHTMAP_RGB9E5 packs RGB irradiance: not the SH encoding "
+                                           "(its coefficients go negative)");
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
+        if ((d->lightmap_flags & RAD_BAKER_LIGHTMAP_RGB9E5_ONLY) && b->o.sky_bands) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: RAD_BAKER_LIGHTMAP_RGB9E5_ONLY with sky layers (their SH "
+                                           "coefficients go negative and stay float: use RAD_BAKER_LIGHTMAP_RGB9E5)");
             return RAD_ERROR_INVALID_ARGUMENT;
         }
         if (b->R->lightmap_channels != 3u && b->o.method == RAD_BAKER_VIRTUAL_PATCHES) {
@@ -24420,6 +24693,24 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     return RAD_SUCCESS;
 }
 
+/* RAD_BAKER_LIGHTMAP_RGB9E5(_ONLY): the groups' lightmap layers packed (the sky's stay float),
+   and with _ONLY the float planes freed */
+static rad_result rad__baker_pack_lightmap(rad__baker *b)
+{
+    rad_baker_result *R = b->R;
+    size_t texels = (size_t)R->lightmap_width * R->lightmap_height;
+    rad_result r;
+    R->lightmap_rgb9e5 = (uint32_t *)rad__alloc_array(&b->c.allocator, texels * (R->group_count ? R->group_count : 1u),
+                                                      sizeof(uint32_t));
+    if (!R->lightmap_rgb9e5) return RAD_ERROR_OUT_OF_MEMORY;
+    r = rad_rgb9e5_pack(R->lightmap_layers, texels * R->group_count, R->lightmap_rgb9e5, &b->sub);
+    if (r == RAD_SUCCESS && (b->d->lightmap_flags & RAD_BAKER_LIGHTMAP_RGB9E5_ONLY)) {
+        rad__free(&b->c.allocator, R->lightmap_layers);
+        R->lightmap_layers = NULL;
+    }
+    return r;
+}
+
 RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_options *options, const rad_context *ctx,
                                  rad_baker_result **out)
 {
@@ -24473,6 +24764,8 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
         float lo = 0.6f + 0.4f * (float)g / planes, hi = 0.6f + 0.4f * (float)(g + 1) / planes;
         r = rad__baker_group(&b, g, lo, hi);
     }
+    if (r == RAD_SUCCESS && b.R->lightmap_layers && (desc->lightmap_flags & (RAD_BAKER_LIGHTMAP_RGB9E5 | RAD_BAKER_LIGHTMAP_RGB9E5_ONLY)))
+        r = rad__baker_pack_lightmap(&b);
     if (r == RAD_SUCCESS) r = rad_baker_mix(b.R, NULL, &b.sub);
     if (r == RAD_SUCCESS && b.prog.fn && b.prog.fn(b.prog.user, 1.0f)) r = RAD_ERROR_CANCELLED;
     if (r != RAD_SUCCESS && b.prog.cancelled) r = RAD_ERROR_CANCELLED;
@@ -24829,7 +25122,8 @@ static rad_result rad__brt_check_args(const rad_baker_desc *desc, const rad_bake
         rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: light_count %u with lights NULL", desc->light_count);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
-    if (desc->lightmap_gather || desc->lightmap_flags || R->lightmap_channels > 3u) {
+    if (desc->lightmap_gather || (desc->lightmap_flags & ~(uint32_t)(RAD_BAKER_LIGHTMAP_RGB9E5 | RAD_BAKER_LIGHTMAP_RGB9E5_ONLY)) ||
+        R->lightmap_channels > 3u) {
         /* its lightmap is the RGB bounced light refreshed from the patches */
         rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: the desc's lightmap_gather or lightmap_flags (the runtime "
                                    "refreshes the default RGB lightmap of bounced light only)");
@@ -25175,7 +25469,11 @@ static rad_result rad__brt_out_lightmap(rad_baker_runtime *rt, const rad_baker_r
     rt->texels = R->lightmap_width * R->lightmap_height;
     rt->lightmap = (float *)rad__alloc_array(&c->allocator, 3 * (size_t)rt->texels, sizeof(float));
     if (!rt->lightmap) return RAD_ERROR_OUT_OF_MEMORY;
-    r = rad_baker_mix_layers(R->lightmap_layers, R->group_count, 3 * (size_t)rt->texels, NULL, rt->lightmap, &rt->sub);
+    /* the packed layers when the bake kept them (RAD_BAKER_LIGHTMAP_RGB9E5): what the engine mixes */
+    if (R->lightmap_rgb9e5)
+        r = rad_baker_mix_layers_rgb9e5(R->lightmap_rgb9e5, R->group_count, rt->texels, NULL, rt->lightmap, &rt->sub);
+    else
+        r = rad_baker_mix_layers(R->lightmap_layers, R->group_count, 3 * (size_t)rt->texels, NULL, rt->lightmap, &rt->sub);
     rad_lightmap_options_default(&lo);
     lo.width = R->lightmap_width;
     lo.height = R->lightmap_height;

@@ -297,7 +297,7 @@ static void blm_test_refusals(void)
     o.sky_bands = 1;
     blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "sky layers");
     o.sky_bands = 0;
-    s.d.lightmap_flags = 8;
+    s.d.lightmap_flags = 64; /* no such bit (8 is RAD_BAKER_LIGHTMAP_RGB9E5_ONLY) */
     blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_flags");
     s.d.lightmap_flags = 0;
     go.encoding = (rad_lightmap_encoding)7;

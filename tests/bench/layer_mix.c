@@ -195,7 +195,22 @@ static float read_half(const mix_in *m)
     return r[0] + r[7];
 }
 
-enum { V_LIB, V_READ, V_F4, V_F4NT, V_F4PF, V_F8PADNT, V_F8PF, V_H4, V_H8, V_H8NT, V_H8PF, V_H8PF2, V_H4PF, V_H1, V_H2PF, V_HREAD, V_SPANS, V_COUNT };
+/* the bound of RGB9E5 layers: read the packed words once, write nothing */
+static uint32_t read_packed(const uint32_t *const *pl, uint32_t groups, size_t texels)
+{
+    __m256i a0 = _mm256_setzero_si256(), a1 = a0;
+    uint32_t r[8], g;
+    size_t j;
+    for (g = 0; g < groups; ++g)
+        for (j = 0; j + 16 <= texels; j += 16) {
+            a0 = _mm256_xor_si256(a0, _mm256_loadu_si256((const __m256i *)(pl[g] + j)));
+            a1 = _mm256_xor_si256(a1, _mm256_loadu_si256((const __m256i *)(pl[g] + j + 8)));
+        }
+    _mm256_storeu_si256((__m256i *)r, _mm256_xor_si256(a0, a1));
+    return r[0] ^ r[7];
+}
+
+enum { V_LIB, V_READ, V_F4, V_F4NT, V_F4PF, V_F8PADNT, V_F8PF, V_H4, V_H8, V_H8NT, V_H8PF, V_H8PF2, V_H4PF, V_H1, V_H2PF, V_HREAD, V_SPANS, V_PACKED, V_PREAD, V_COUNT };
 static const char *const names[V_COUNT] = {
     "rad_baker_mix_layers (float, 4 planes a pass)", "read the float layers only (bound)",
     "float, 4 a pass, AVX (the header's loop, 8 lanes)", "float, 4 a pass, streaming stores", "float, 4, streaming, prefetch 2 KiB ahead", "float, 8 a pass, padded apart, streaming",
@@ -204,6 +219,7 @@ static const char *const names[V_COUNT] = {
     "half, 8, streaming, prefetch 1 KiB ahead", "half, 8, streaming, prefetch 2 KiB ahead", "half, 4 a pass, streaming, prefetch 1 KiB",
     "half, 1 a pass, streaming", "half, 2 a pass, streaming, prefetch 1 KiB",
     "read the half layers only (bound)", "float, chart texels only (coverage)",
+    "rad_baker_mix_layers_rgb9e5 (RGB9E5 layers, 4 bytes a texel)", "read the RGB9E5 layers only (bound)",
 };
 
 int main(int argc, char **argv)
@@ -213,6 +229,8 @@ int main(int argc, char **argv)
     size_t count3 = 3u * MAP * MAP, i, pad = 0;
     float *cont, *padded, *out, *ref, pattern[24 * MAXG], rgb[3 * MAXG], sink = 0.0f;
     uint16_t *halves;
+    uint32_t *packed, psink = 0;
+    const uint32_t *pl[MAXG];
     const float *fl[MAXG], *flp[MAXG];
     const uint16_t *hl[MAXG];
     uint32_t *span;
@@ -232,11 +250,12 @@ int main(int argc, char **argv)
     cont = (float *)alloc_big(count3 * groups * sizeof(float));
     padded = (float *)alloc_big((count3 + 4096) * groups * sizeof(float));
     halves = (uint16_t *)alloc_big(count3 * groups * sizeof(uint16_t));
+    packed = (uint32_t *)alloc_big(count3 / 3 * groups * sizeof(uint32_t));
     out = (float *)alloc_big(count3 * sizeof(float)); /* streaming stores: 32-byte aligned */
     ref = (float *)malloc(count3 * sizeof(float));
     span = (uint32_t *)malloc(2 * (count3 / 24 + 1) * sizeof(uint32_t));
     for (v = 0; v < V_COUNT; ++v) t[v] = (double *)malloc(reps * sizeof(double));
-    if (!cont || !padded || !halves || !out || !ref || !span || !t[V_COUNT - 1]) return 1;
+    if (!cont || !padded || !halves || !packed || !out || !ref || !span || !t[V_COUNT - 1]) return 1;
     /* light layers of plausible magnitudes (0..4 W m^-2, a fifth zero) */
     srand(7);
     for (i = 0; i < count3 * groups; ++i) cont[i] = rand() % 5 == 0 ? 0.0f : 4.0f * (float)rand() / (float)RAND_MAX;
@@ -247,6 +266,8 @@ int main(int argc, char **argv)
         memcpy(padded + pad, fl[g], count3 * sizeof(float));
         hl[g] = halves + g * count3;
         for (i = 0; i < count3; ++i) halves[g * count3 + i] = rad_half_from_float(fl[g][i]);
+        pl[g] = packed + g * (count3 / 3);
+        if (rad_rgb9e5_pack(fl[g], count3 / 3, packed + g * (count3 / 3), NULL) != RAD_SUCCESS) return 1;
         for (i = 0; i < 3; ++i) rgb[3 * g + i] = 0.3f + 0.1f * (float)((g + i) % 7);
         for (i = 0; i < 24; ++i) pattern[24 * g + i] = rgb[3 * g + i % 3];
     }
@@ -286,9 +307,11 @@ int main(int argc, char **argv)
             case V_H2PF: mix_half(&m, out, 2, 1, 512); break;
             case V_HREAD: sink += read_half(&m); break;
             case V_SPANS: mix_spans(&m, out); break;
+            case V_PACKED: rad_baker_mix_layers_rgb9e5(packed, groups, count3 / 3, rgb, out, &ctx); break;
+            case V_PREAD: psink ^= read_packed(pl, groups, count3 / 3); break;
             }
             if (r) t[v][r - 1] = 1e3 * (cpu_seconds() - c0);
-            if (r == 0 && v != V_READ && v != V_HREAD) { /* the difference from the header's mix, in the warm-up round */
+            if (r == 0 && v != V_READ && v != V_HREAD && v != V_PREAD) { /* the difference from the header's mix, in the warm-up round */
                 size_t n = v == V_SPANS ? 0 : count3, s, k;
                 for (k = 0; k < n; ++k) {
                     double d = fabs((double)out[k] - ref[k]) / (fabs(ref[k]) > 1e-3 ? fabs(ref[k]) : 1e-3);
@@ -306,14 +329,15 @@ int main(int argc, char **argv)
            MAP, MAP, reps, coverage, g_huge ? "huge" : "4 KiB");
     printf("| variant | best ms | median ms | MB moved | max rel. diff |\n|---|---:|---:|---:|---:|\n");
     for (v = 0; v < V_COUNT; ++v) {
-        double mb = (double)count3 * groups * (v >= V_H4 && v <= V_HREAD ? 2.0 : 4.0);
-        int ro = v == V_READ || v == V_HREAD;
+        double mb = (double)count3 * groups * (v >= V_H4 && v <= V_HREAD ? 2.0 : v >= V_PACKED ? 4.0 / 3.0 : 4.0);
+        int ro = v == V_READ || v == V_HREAD || v == V_PREAD;
         if (v == V_SPANS) mb *= coverage;
-        if (!ro) mb += (double)count3 * 4.0 * (v == V_SPANS ? coverage : 1.0) * (v == V_LIB || v == V_F4 || v == V_H4 || v == V_H8 || v == V_SPANS ? 2.0 : 1.0);
+        if (!ro) mb += (double)count3 * 4.0 * (v == V_SPANS ? coverage : 1.0) * (v == V_LIB || v == V_F4 || v == V_H4 || v == V_H8 || v == V_SPANS || v == V_PACKED ? 2.0 : 1.0);
         qsort(t[v], reps, sizeof(double), cmp_d);
         if (ro) printf("| %s | %.2f | %.2f | %.0f | - |\n", names[v], t[v][0], t[v][reps / 2], mb / 1e6);
         else printf("| %s | %.2f | %.2f | %.0f | %.1e |\n", names[v], t[v][0], t[v][reps / 2], mb / 1e6, err[v]);
     }
-    if (sink == 12345.0f) printf("%g\n", (double)sink);
+    printf("rad_baker_mix_layers_rgb9e5 / rad_baker_mix_layers (medians, this run): %.2f\n", t[V_PACKED][reps / 2] / t[V_LIB][reps / 2]);
+    if (sink == 12345.0f || psink == 12345u) printf("%g\n", (double)sink);
     return 0;
 }
