@@ -1,11 +1,11 @@
 /* test_hier_source.c - hierarchical radiosity (>>api_hierarchical): what a link from a cluster
    carries when the cluster's members differ, the case of a thin roof lit on top whose cluster
-   sent the lit top's radiosity down into the interior. Its names are prefixed hs_. */
+   sent the lit top's radiosity down into the interior. Its names are prefixed hsrc_. */
 #include "fixtures.h"
 
 /* the unit square [x0, x0 + 1] x [0, 1] at height z, cut g x g into triangles, facing +z (up)
    or -z, appended to v (9 floats a triangle); returns the triangles added */
-static uint32_t hs_square(float *v, float x0, float z, int up, uint32_t g)
+static uint32_t hsrc_square(float *v, float x0, float z, int up, uint32_t g)
 {
     uint32_t i, j, n = 0, c;
     for (i = 0; i < g; ++i)
@@ -27,7 +27,7 @@ static uint32_t hs_square(float *v, float x0, float z, int up, uint32_t g)
 }
 
 /* the area-weighted mean B (channel 0) of the leaves on scene triangles [t0, t1) */
-static double hs_mean_B(const rad_hierarchical *h, uint32_t t0, uint32_t t1)
+static double hsrc_mean_B(const rad_hierarchical *h, uint32_t t0, uint32_t t1)
 {
     rad_hierarchical_stats st;
     float *C, *B;
@@ -68,7 +68,7 @@ static double hs_mean_B(const rad_hierarchical *h, uint32_t t0, uint32_t t1)
    clusters hold both faces, and a link that carried their mean B sent half of the top's
    radiosity down: the floor's B came out 4.5 times the unclustered solve's (all pairs of
    triangles, the independent answer). Within 25% of it now. */
-static void hs_test_thin_roof(void)
+static void hsrc_test_thin_roof(void)
 {
     const uint32_t g = 4, per = 2u * g * g;
     float *v = (float *)malloc(sizeof(float) * 9u * 5u * per);
@@ -83,12 +83,12 @@ static void hs_test_thin_roof(void)
         return;
     }
     /* triangles: floor [0, 2 per), lamp [2 per, 3 per), roof underside, roof top */
-    n += hs_square(v + 9u * n, -1.0f, 0.0f, 1, g);
-    n += hs_square(v + 9u * n, 1.0f, 0.0f, 1, g);
-    n += hs_square(v + 9u * n, 0.0f, 0.0f, 1, g);
+    n += hsrc_square(v + 9u * n, -1.0f, 0.0f, 1, g);
+    n += hsrc_square(v + 9u * n, 1.0f, 0.0f, 1, g);
+    n += hsrc_square(v + 9u * n, 0.0f, 0.0f, 1, g);
     for (i = 2u * per; i < 3u * per; ++i) ids[i] = 1;
-    n += hs_square(v + 9u * n, 0.0f, 1.0f, 0, g);
-    n += hs_square(v + 9u * n, 0.0f, 1.02f, 1, g);
+    n += hsrc_square(v + 9u * n, 0.0f, 1.0f, 0, g);
+    n += hsrc_square(v + 9u * n, 0.0f, 1.02f, 1, g);
     for (i = 4u * per; i < 5u * per; ++i) ids[i] = 2;
     memset(mats, 0, sizeof(mats));
     for (i = 0; i < 3; ++i) {
@@ -129,10 +129,10 @@ static void hs_test_thin_roof(void)
             rad_hierarchical_stats st;
             rad_hierarchical_get_stats(h, &st);
             if (pass == 1) CHECK(st.cluster_links > 0);
-            floor_B[pass] = hs_mean_B(h, 0, 2u * per);
+            floor_B[pass] = hsrc_mean_B(h, 0, 2u * per);
             printf("    thin roof, clustering %s: %llu links (%llu at clusters), floor B %.5f, underside %.5f\n",
                    pass == 0 ? "off" : "on", (unsigned long long)st.links, (unsigned long long)st.cluster_links,
-                   floor_B[pass], hs_mean_B(h, 3u * per, 4u * per));
+                   floor_B[pass], hsrc_mean_B(h, 3u * per, 4u * per));
         }
         rad_hierarchical_destroy(h);
         rad_bvh_destroy(bvh);
@@ -148,7 +148,7 @@ static void hs_test_thin_roof(void)
 }
 
 static const rad_test_case tests_hier_source[] = {
-    { "hier_source_thin_roof", hs_test_thin_roof },
+    { "hier_source_thin_roof", hsrc_test_thin_roof },
     { NULL, NULL }
 };
 RAD_TEST_MAIN(tests_hier_source)
