@@ -1379,7 +1379,11 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    integral of cos cos V / (pi r^2) estimated from 4 x visibility_rays pairs of points drawn
    by area on both ends, one ray for each pair that faces along its segment (for a cluster
    receiver, scaled so that the power its members get through the gather below is that
-   integral's). An element receiver's F carries its own cosines; a cluster receiver hands the irradiance
+   integral's). A link from a cluster carries the B of one of the source's member triangles,
+   drawn among the pairs whose ray arrives in proportion to what each carries (the cluster's
+   mean B without visibility, or where none arrives): so the light sent is that of the members
+   the receiver sees and that face it, not the mean of all of them (a thin roof lit on top
+   would send the top's light down through its underside). An element receiver's F carries its own cosines; a cluster receiver hands the irradiance
    to its member triangles, each by its own cosine to the source (so a cluster lit from one
    side lights only the triangles facing that side), before the push: exactly where every
    member's normal faces the source (a cone of the members' normals says so), else by the
@@ -11294,10 +11298,12 @@ typedef struct rad__hr_elem {
 } rad__hr_elem;
 
 /* receiver r gathers from source s: F with visibility, Fu unoccluded, Fd the spread (largest
-   minus smallest) of the unoccluded point-to-triangle values over r's points */
+   minus smallest) of the unoccluded point-to-triangle values over r's points; m, for a cluster
+   source, the member triangle whose B the link carries (RAD_NONE: the cluster's mean B) */
 typedef struct rad__hr_link {
     uint32_t r, s;
     float F, Fu, Fd;
+    uint32_t m;
 } rad__hr_link;
 
 /* A volume cluster: members perm[lo, hi) (the scene triangles under it); children are node
@@ -11317,7 +11323,7 @@ typedef struct rad__hr_cluster {
    (RAD__HR_IN_*) */
 typedef struct rad__hr_in {
     float u[3], F;
-    uint32_t s, kind;
+    uint32_t s, kind, m; /* m: the link's member (rad__hr_link) */
 } rad__hr_in;
 #define RAD__HR_IN_BEHIND 0u /* every member faces away from u: no light */
 #define RAD__HR_IN_FRONT 1u  /* every member faces u: n . u >= 0, the cosine exact as a vector */
@@ -11476,6 +11482,13 @@ static const float *rad__hr_B(const rad_hierarchical *h, uint32_t id)
     return rad__hr_is_cl(id) ? h->cl[id & ~RAD__HR_CL].B : h->el[id].B;
 }
 
+/* the B a link carries from source s: its member m's (the scene triangle's root element) where
+   the link has one, else s's mean */
+static const float *rad__hr_link_B(const rad_hierarchical *h, uint32_t s, uint32_t m)
+{
+    return m != RAD_NONE ? h->el[m].B : rad__hr_B(h, s);
+}
+
 /* the clusters' B and bmax from their children's, bottom up (children have larger indices) */
 static void rad__hr_cluster_pull(rad_hierarchical *h)
 {
@@ -11560,8 +11573,10 @@ static double rad__hr_received(const rad_hierarchical *h, uint32_t id, const flo
 }
 
 /* a point p of node id and its normal n: on the element, or on a member triangle picked by
-   area (u0) ; (u1, u2) place it on the triangle */
-static void rad__hr_node_point(const rad_hierarchical *h, uint32_t id, float u0, float u1, float u2, float *p, float *n)
+   area (u0) ; (u1, u2) place it on the triangle. *member: that scene triangle (RAD_NONE for
+   an element). */
+static void rad__hr_node_point(const rad_hierarchical *h, uint32_t id, float u0, float u1, float u2, float *p, float *n,
+                               uint32_t *member)
 {
     const float *v, *nv;
     if (rad__hr_is_cl(id)) {
@@ -11575,9 +11590,11 @@ static void rad__hr_node_point(const rad_hierarchical *h, uint32_t id, float u0,
         }
         v = h->scene->positions + 9 * (size_t)h->perm[lo];
         nv = h->scene->normals + 3 * (size_t)h->perm[lo];
+        *member = h->perm[lo];
     } else {
         v = h->el[id].v;
         nv = h->el[id].n;
+        *member = RAD_NONE;
     }
     rad__triangle_point(v, v + 3, v + 6, u1, u2, p);
     memcpy(n, nv, 3 * sizeof(float));
@@ -12002,6 +12019,7 @@ typedef struct rad__hr_eval {
     uint8_t *occ;
     float *w;
     size_t *idx;
+    uint32_t *mem;       /* per ray: the source member its pair drew (RAD_NONE: none) */
     uint64_t *kernels, *rays_cast, *proj;
     rad_result *results;
 } rad__hr_eval;
@@ -12014,7 +12032,23 @@ static rad_result rad__hr_flush(rad__hr_eval *ev, uint32_t task, uint32_t n)
     if (ev->h->rc.occluded(ev->h->rc.user, ev->rays + base, n, ev->occ + base) != RAD_SUCCESS) return RAD_ERROR_RAYCAST_FAILED;
     ev->rays_cast[task] += n;
     for (k = 0; k < n; ++k)
-        if (!ev->occ[base + k]) ev->links[ev->idx[base + k]].F += ev->w[base + k];
+        if (!ev->occ[base + k]) {
+            rad__hr_link *lk = &ev->links[ev->idx[base + k]];
+            uint32_t m = ev->mem[base + k];
+            float w = ev->w[base + k];
+            lk->F += w;
+            /* one member per link, drawn among the pairs that arrive in proportion to what
+               each carries (a reservoir of one): in expectation the link carries the B of
+               the source's members weighted by their visible, facing share, not the mean of
+               all its members, whose hidden and turned-away ones (the dark underside of a roof
+               lit on top, faces inside the cluster) are not what the receiver sees */
+            if (m != RAD_NONE && w > 0.0f) {
+                uint32_t wb, u; /* from the pair itself, so that the draw does not depend on the threads */
+                memcpy(&wb, &w, sizeof(wb));
+                u = rad__hash(m ^ rad__hash(lk->r ^ rad__hash(lk->s ^ rad__hash(wb + 0x2545f491u))));
+                if ((double)(u >> 8) / 16777216.0 * (double)lk->F < (double)w) lk->m = m;
+            }
+        }
     return RAD_SUCCESS;
 }
 
@@ -12032,6 +12066,7 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
     uint32_t K = h->nside * h->nside, a, k;
     float cr[3], cs[3], rr, rs, w[3], d, fu;
     lk->F = lk->Fu = lk->Fd = 0.0f;
+    lk->m = RAD_NONE;
     rad__hr_node(h, lk->r, cr, &rr, NULL, NULL, NULL);
     rad__hr_node(h, lk->s, cs, &rs, NULL, NULL, NULL);
     rad__sub(w, cr, cs);
@@ -12081,10 +12116,11 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
             uint32_t h2 = rad__hash(h1 ^ 0x85ebca6bu), h3 = rad__hash(h2 ^ 0xc2b2ae35u);
             float x[3], y[3], n1[3], n2[3], c1, c2, dd[3], r2;
             double wv;
+            uint32_t mr, ms;
             rad__hr_node_point(h, lk->r, (float)(h1 >> 8) / 16777216.0f, (float)(h2 & 0xFFFFu) / 65536.0f,
-                               (float)(h2 >> 16) / 65536.0f, x, n1);
+                               (float)(h2 >> 16) / 65536.0f, x, n1, &mr);
             rad__hr_node_point(h, lk->s, (float)(h3 >> 8) / 16777216.0f, (float)(h1 & 0xFFu) / 256.0f + (float)(h3 & 0xFFu) / 65536.0f,
-                               (float)((h3 >> 8) & 0xFFFFu) / 65536.0f, y, n2);
+                               (float)((h3 >> 8) & 0xFFFFu) / 65536.0f, y, n2, &ms);
             rad__sub(dd, y, x);
             c1 = rad__dot(n1, dd);
             c2 = -rad__dot(n2, dd);
@@ -12096,6 +12132,7 @@ static rad_result rad__hr_eval_cluster(rad__hr_eval *ev, uint32_t task, size_t l
             rad__segment_ray(ev->rays + base + *nrays, x, n1, y, n2, h->ray_eps);
             ev->w[base + *nrays] = (float)wv;
             ev->idx[base + *nrays] = l;
+            ev->mem[base + *nrays] = ms;
             if (++*nrays == RAD__RAY_BATCH) {
                 rad_result r = rad__hr_flush(ev, task, *nrays);
                 *nrays = 0;
@@ -12173,6 +12210,7 @@ static void rad__hr_eval_task(void *data, uint32_t task)
             rad__segment_ray(ev->rays + base + nrays, xs + 3 * s, er->n, ys + 3 * s, es->n, h->ray_eps);
             ev->w[base + nrays] = (float)w;
             ev->idx[base + nrays] = l;
+            ev->mem[base + nrays] = RAD_NONE;
             if (++nrays == RAD__RAY_BATCH) {
                 r = rad__hr_flush(ev, task, nrays);
                 nrays = 0;
@@ -12200,11 +12238,12 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
     ev.occ = (uint8_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, 1);
     ev.w = (float *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(float));
     ev.idx = (size_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(size_t));
+    ev.mem = (uint32_t *)rad__alloc_array(&h->allocator, tasks * RAD__RAY_BATCH, sizeof(uint32_t));
     ev.kernels = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
     ev.rays_cast = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
     ev.proj = (uint64_t *)rad__alloc_array(&h->allocator, tasks, sizeof(uint64_t));
     ev.results = (rad_result *)rad__alloc_array(&h->allocator, tasks, sizeof(rad_result));
-    if (!ev.rays || !ev.occ || !ev.w || !ev.idx || !ev.kernels || !ev.rays_cast || !ev.proj || !ev.results) {
+    if (!ev.rays || !ev.occ || !ev.w || !ev.idx || !ev.mem || !ev.kernels || !ev.rays_cast || !ev.proj || !ev.results) {
         rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the link evaluation scratch");
         r = RAD_ERROR_OUT_OF_MEMORY;
     } else {
@@ -12236,7 +12275,7 @@ static rad_result rad__hr_evaluate(rad_hierarchical *h, rad__hr_link *links, siz
             }
     }
     {
-        void *blocks[] = { ev.rays, ev.occ, ev.w, ev.idx, ev.kernels, ev.rays_cast, ev.proj, ev.results };
+        void *blocks[] = { ev.rays, ev.occ, ev.w, ev.idx, ev.mem, ev.kernels, ev.rays_cast, ev.proj, ev.results };
         rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
     return r;
@@ -12278,6 +12317,7 @@ static rad_result rad__hr_push(rad_hierarchical *h, rad__hr_list *L, uint32_t r,
     L->a[L->n].r = r;
     L->a[L->n].s = s;
     L->a[L->n].F = L->a[L->n].Fu = L->a[L->n].Fd = 0.0f;
+    L->a[L->n].m = RAD_NONE;
     L->n++;
     return RAD_SUCCESS;
 }
@@ -12460,6 +12500,7 @@ static rad_result rad__hr_build_in(rad_hierarchical *h, const rad__ctx *c)
         rad__normalize(e->u);
         e->F = lk->F;
         e->s = lk->s;
+        e->m = lk->m;
         { /* the cone's half angle t and the angle g between axis and u: every member faces u
              when g + t <= pi/2, every one faces away when g - t >= pi/2 */
             const rad__hr_cluster *q = &h->cl[cr];
@@ -12510,7 +12551,7 @@ static void rad__hr_gather_task(void *data, uint32_t task)
                 const float *B;
                 double w[4], u[3];
                 if (in->kind == RAD__HR_IN_BEHIND || !(in->F > 0.0f)) continue;
-                B = rad__hr_B(h, in->s);
+                B = rad__hr_link_B(h, in->s, in->m);
                 for (k = 0; k < 3; ++k) {
                     w[k] = (double)in->F * (double)B[k];
                     u[k] = (double)in->u[k];
@@ -12578,7 +12619,7 @@ static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *
         const float *B;
         if (rad__hr_is_cl(lk->r)) continue; /* below, per member */
         er = &h->el[lk->r];
-        B = rad__hr_B(h, lk->s);
+        B = rad__hr_link_B(h, lk->s, lk->m);
         for (k = 0; k < 3; ++k) er->G[k] += (double)lk->F * (double)B[k];
         er->S += (double)lk->F;
     }
