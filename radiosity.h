@@ -18083,14 +18083,14 @@ static void rad__vp_kernel_span(const rad__vp_build *b, uint32_t i, uint32_t j0,
     const float *pi_ = vp->sample_positions + 3 * (size_t)i, *ni = vp->sample_normals + 3 * (size_t)i;
     __m128 px = _mm_set1_ps(pi_[0]), py = _mm_set1_ps(pi_[1]), pz = _mm_set1_ps(pi_[2]);
     __m128 nx = _mm_set1_ps(ni[0]), ny = _mm_set1_ps(ni[1]), nz = _mm_set1_ps(ni[2]);
-    __m128 ai = _mm_set1_ps(vp->sample_areas[i]), ei = _mm_set1_ps(b->eff[i] / (float)RAD__PI), pi4 = _mm_set1_ps((float)RAD__PI);
+    __m128 ai = _mm_set1_ps(vp->sample_areas[i]), ei = _mm_set1_ps(EF[i]), pi4 = _mm_set1_ps((float)RAD__PI);
     __m128 zero = _mm_setzero_ps(), sign = _mm_set1_ps(-0.0f);
 #if defined(RAD__AVX)
     {
         /* the same, eight pairs at a time */
         __m256 px8 = _mm256_set1_ps(pi_[0]), py8 = _mm256_set1_ps(pi_[1]), pz8 = _mm256_set1_ps(pi_[2]);
         __m256 nx8 = _mm256_set1_ps(ni[0]), ny8 = _mm256_set1_ps(ni[1]), nz8 = _mm256_set1_ps(ni[2]);
-        __m256 ai8 = _mm256_set1_ps(vp->sample_areas[i]), ei8 = _mm256_set1_ps(b->eff[i] / (float)RAD__PI);
+        __m256 ai8 = _mm256_set1_ps(vp->sample_areas[i]), ei8 = _mm256_set1_ps(EF[i]);
         __m256 pi8 = _mm256_set1_ps((float)RAD__PI), zero8 = _mm256_setzero_ps(), sign8 = _mm256_set1_ps(-0.0f);
         for (; j + 8 <= j1; j += 8) {
             __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(X + j), px8), dy = _mm256_sub_ps(_mm256_loadu_ps(Y + j), py8);
