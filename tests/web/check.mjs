@@ -2,7 +2,7 @@
 //                          [[--tol T2] [--mean-tol M2] --ref VIEW2.png ...]
 //
 // Shows FILE.glb in headless Chromium through tests/web/index.html (three.js from
-// build/web/node_modules), screenshots it into SHOT.png, and compares the screenshot with each
+// build/web/node_modules), writes the canvas it drew into SHOT.png, and compares it with each
 // reference view the rad tool drew of the same camera: both decoded from sRGB to linear, the
 // luminance (Rec. 709 weights) averaged over a 4x4 grid of regions, and every region's mean
 // must be within --tol (relative; a region darker than 0.01 is compared against 0.01) of the
@@ -61,6 +61,31 @@ function readPng(file) {
     }
     return { w, h, ch, px };
 }
+// an RGBA PNG of WebGL's pixels (rows bottom first), so the file shows what was compared
+function writePng(file, w, h, rgba) {
+    const raw = Buffer.alloc(h * (w * 4 + 1));
+    for (let y = 0; y < h; ++y) rgba.copy(raw, y * (w * 4 + 1) + 1, (h - 1 - y) * w * 4, (h - y) * w * 4);
+    const crcTable = Array.from({ length: 256 }, (_, n) => {
+        let c = n;
+        for (let k = 0; k < 8; ++k) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+        return c >>> 0;
+    });
+    const chunk = (kind, body) => {
+        const head = Buffer.alloc(8), tail = Buffer.alloc(4), typed = Buffer.concat([Buffer.from(kind, 'latin1'), body]);
+        let c = 0xffffffff;
+        for (const b of typed) c = crcTable[(c ^ b) & 255] ^ (c >>> 8);
+        head.writeUInt32BE(body.length, 0);
+        head.write(kind, 4, 'latin1');
+        tail.writeUInt32BE((c ^ 0xffffffff) >>> 0, 0);
+        return Buffer.concat([head, body, tail]);
+    };
+    const ihdr = Buffer.alloc(13);
+    ihdr.writeUInt32BE(w, 0);
+    ihdr.writeUInt32BE(h, 4);
+    ihdr[8] = 8; ihdr[9] = 6; // 8-bit RGBA, filter and interlace bytes 0
+    fs.writeFileSync(file, Buffer.concat([Buffer.from([0x89, 0x50, 0x4e, 0x47, 13, 10, 26, 10]), chunk('IHDR', ihdr),
+                                          chunk('IDAT', zlib.deflateSync(raw)), chunk('IEND', Buffer.alloc(0))]));
+}
 const lin = (c) => { c /= 255; return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4); };
 function regions(img, n = 4) {
     const sum = new Array(n * n).fill(0), cnt = new Array(n * n).fill(0);
@@ -79,10 +104,22 @@ function regions(img, n = 4) {
 const root = process.cwd();
 const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json',
                 '.glb': 'model/gltf-binary', '.png': 'image/png' };
-let status = null;
+let status = null, canvas = null;
 const server = http.createServer((req, res) => {
     const u = new URL(req.url, 'http://127.0.0.1');
     if (u.pathname === '/status') { status = u.searchParams.get('s'); res.end('ok'); return; }
+    if (u.pathname === '/pixels' && req.method === 'POST') {
+        const parts = [];
+        req.on('data', (d) => parts.push(d));
+        req.on('end', () => {
+            const px = Buffer.concat(parts);
+            const good = Number(u.searchParams.get('w')) === W && Number(u.searchParams.get('h')) === H && px.length === W * H * 4;
+            if (good) canvas = px;
+            res.writeHead(good ? 200 : 400);
+            res.end();
+        });
+        return;
+    }
     const file = u.pathname === '/scene.glb' ? path.resolve(args.glb) : path.join(root, path.normalize(decodeURIComponent(u.pathname)));
     if (u.pathname !== '/scene.glb' && !file.startsWith(root + path.sep)) { res.writeHead(403); res.end(); return; }
     fs.readFile(file, (err, data) => {
@@ -95,9 +132,11 @@ await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
 const url = `http://127.0.0.1:${server.address().port}/tests/web/index.html?glb=/scene.glb&w=${W}&h=${H}&report=1${args.aa ? `&aa=${args.aa}` : ""}`;
 fs.rmSync(args.out, { force: true });
 // SwiftShader: WebGL on the CPU, so no GPU is needed; the virtual time budget lets the
-// screenshot wait for the page's fetches and first frames
+// browser wait for the page's fetches and first frames. Chromium's own screenshot only keeps the
+// browser up that long (a side file, removed): the compared view is the canvas the page posts.
+const side = path.resolve(args.out) + '.browser.png';
 const flags = ['--headless', '--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-               '--hide-scrollbars', `--window-size=${W},${H}`, '--virtual-time-budget=30000', `--screenshot=${path.resolve(args.out)}`, url];
+               '--hide-scrollbars', `--window-size=${W},${H}`, '--virtual-time-budget=30000', `--screenshot=${side}`, url];
 const rc = await new Promise((ok) => {
     const p = spawn(chromium, flags, { stdio: ['ignore', 'ignore', 'pipe'] });
     let err = '';
@@ -108,14 +147,16 @@ const rc = await new Promise((ok) => {
 });
 server.close();
 console.log(`page: ${status === null ? 'said nothing (did the modules load? is build/web/node_modules/three there?)' : status}`);
-if (rc !== 0 || !fs.existsSync(args.out)) { console.log(`FAIL chromium exited ${rc} without a screenshot`); process.exit(1); }
-if (status !== 'ready') { console.log('FAIL the page did not draw the scene'); process.exit(1); }
+fs.rmSync(side, { force: true });
+if (rc !== 0) { console.log(`FAIL chromium exited ${rc}`); process.exit(1); }
+if (status !== 'ready' || canvas === null) { console.log('FAIL the page did not draw the scene'); process.exit(1); }
+writePng(args.out, W, H, canvas);
 
 const shot = regions(readPng(args.out));
 let bad = 0;
 for (const { file: ref, tol, meanTol } of args.ref) {
     const img = readPng(ref);
-    if (img.w !== W || img.h !== H) { console.log(`FAIL ${ref} is ${img.w}x${img.h}, the screenshot ${W}x${H}`); bad = 1; continue; }
+    if (img.w !== W || img.h !== H) { console.log(`FAIL ${ref} is ${img.w}x${img.h}, the view ${W}x${H}`); bad = 1; continue; }
     const r = regions(img);
     const rel = r.map((m, k) => Math.abs(shot[k] - m) / Math.max(m, 0.01));
     const worst = Math.max(...rel), k = rel.indexOf(worst), mean = rel.reduce((a, b) => a + b) / rel.length;

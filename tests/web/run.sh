@@ -8,8 +8,8 @@
 # the registry, use that copy. Prints "ok ..." / "FAIL ..." lines; exit 0 pass, 1 fail, 77 skip
 # with the reason on the last line as "skip: ...".
 #
-# The measure: the screenshot (drawn without MSAA: WebGL resolves it in sRGB, which darkens
-# edges, while the tool averages linear radiance) and each view decoded from sRGB to linear,
+# The measure: the canvas three.js drew, read back by the page (drawn without MSAA: WebGL
+# resolves it in sRGB, which darkens edges, while the tool averages linear radiance) and each view decoded from sRGB to linear,
 # luminance (Rec. 709) averaged over a 4x4 grid of regions (tests/web/check.mjs):
 #   - `rad lightmap --render`: the same lightmap texels shaded by the tool (radiance = emission +
 #     albedo x bilinear lightmap / pi), so the difference is the glb's encoding and three.js:
@@ -56,5 +56,5 @@ out=$(node tests/web/check.mjs --glb "$WORK/cornell.glb" --out "$WORK/three-view
 rc=$?
 echo "$out" | sed -E 's/^(ok|FAIL) +/\1    three.js vs /; s/^page:/      page:/'
 [ $rc = 0 ] || failed=1
-echo "      screenshot: $WORK/three-view.png"
+echo "      three.js view: $WORK/three-view.png"
 exit $failed

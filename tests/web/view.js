@@ -6,7 +6,8 @@
 // Lambert material), as
 // `rad render --method lightmap` does. No tone mapping: the output is sRGB of the clamped
 // radiance, as the tool's PNGs are (exposure 1). The title says "ready" once drawn, or
-// "error: ..." when something failed.
+// "error: ..." when something failed; with ?report=1 the drawn pixels (RGBA, bottom row first)
+// go to the server as POST /pixels before it says "ready".
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 
@@ -54,10 +55,25 @@ async function main() {
     const camera = gltf.cameras[0];
     camera.aspect = width / height;
     camera.updateProjectionMatrix();
-    let frames = 0;
+    // The view is read from the drawing buffer right after a frame is drawn, not from the
+    // browser's screenshot: under load the compositor can hand the screenshot a canvas it has not
+    // shown yet (all black). A black read is drawn again, up to 60 frames.
+    const gl = renderer.getContext();
+    let frames = 0, busy = false;
     renderer.setAnimationLoop(() => {
+        if (busy) return;
         renderer.render(gltf.scene, camera);
-        if (++frames === 3) say('ready');
+        if (++frames < 3) return;
+        const px = new Uint8Array(width * height * 4);
+        gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, px);
+        if (!px.some((v, i) => (i & 3) !== 3 && v !== 0) && frames < 60) return;
+        busy = true;
+        renderer.setAnimationLoop(null);
+        if (frames >= 60) { say('error: the canvas stayed black for 60 frames'); return; }
+        if (!query.get('report')) { say('ready'); return; }
+        fetch(`/pixels?w=${width}&h=${height}`, { method: 'POST', body: px })
+            .then((r) => say(r.ok ? 'ready' : 'error: the server refused the pixels'))
+            .catch((e) => say('error: sending the pixels: ' + e.message));
     });
 }
 
