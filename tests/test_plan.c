@@ -94,6 +94,28 @@ static void pl_test_scales_with_scene(void)
     CHECK(!cube.budget_limited && !corridor.budget_limited);
 }
 
+/* vp_voxels_per_path scales what the mean free path asks for: 6.5 given is the default, half
+   of it asks for half the resolution (each rounded up), the path itself unchanged */
+static void pl_test_voxels_per_path(void)
+{
+    pl_world w;
+    rad_baker_options o;
+    rad_baker_choice def, same, half;
+    pl_vp_options(&o);
+    CHECK(pl_box(&w, 8.0f, 1.0f, 1.0f, 1.0f, 6));
+    CHECK_OK(rad_baker_plan(w.scene, &w.rc, &o, NULL, &def));
+    o.vp_voxels_per_path = 6.5f;
+    CHECK_OK(rad_baker_plan(w.scene, &w.rc, &o, NULL, &same));
+    o.vp_voxels_per_path = 3.25f;
+    CHECK_OK(rad_baker_plan(w.scene, &w.rc, &o, NULL, &half));
+    pl_free(&w);
+    CHECK(memcmp(&def, &same, sizeof def) == 0);
+    CHECK(half.free_path == def.free_path && half.escaped == def.escaped);
+    CHECK(def.needed_resolution >= 20);
+    CHECK(2 * half.needed_resolution >= def.needed_resolution && 2 * half.needed_resolution <= def.needed_resolution + 2);
+    CHECK(half.patch_count < def.patch_count && half.estimated_seconds < def.estimated_seconds);
+}
+
 /* one quad in the open: every ray leaves, nothing is exchanged, the coarsest resolution */
 static void pl_test_open_scene(void)
 {
@@ -224,12 +246,20 @@ static void pl_test_bad_input(void)
     memset(&o, 0, sizeof o);
     o.max_seconds = HUGE_VAL;
     CHECK_RESULT(rad_baker_plan(w.scene, &w.rc, &o, NULL, &p), RAD_ERROR_INVALID_ARGUMENT);
+    memset(&o, 0, sizeof o);
+    o.vp_voxels_per_path = -1.0f;
+    CHECK_RESULT(rad_baker_plan(w.scene, &w.rc, &o, NULL, &p), RAD_ERROR_INVALID_ARGUMENT);
+    o.vp_voxels_per_path = 65.0f;
+    CHECK_RESULT(rad_baker_plan(w.scene, &w.rc, &o, NULL, &p), RAD_ERROR_INVALID_ARGUMENT);
+    o.vp_voxels_per_path = (float)NAN;
+    CHECK_RESULT(rad_baker_plan(w.scene, &w.rc, &o, NULL, &p), RAD_ERROR_INVALID_ARGUMENT);
     pl_free(&w);
 }
 
 static const rad_test_case tests_plan[] = {
     { "plan_deterministic", pl_test_deterministic },
     { "plan_scales_with_scene", pl_test_scales_with_scene },
+    { "plan_voxels_per_path", pl_test_voxels_per_path },
     { "plan_open_scene", pl_test_open_scene },
     { "plan_budgets", pl_test_budgets },
     { "plan_auto", pl_test_auto },

@@ -1215,7 +1215,7 @@ static int render_local_method(const char *cmd, const tool_world *w, const rende
    virtual-patch method (or proxy) without --vp-resolution or --vp-max-patches takes the
    plan's resolution the same way. */
 static int render_default_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
-                                 tool_method_options *mo)
+                                 tool_method_options *mo, float voxels_per_path)
 {
     rad_baker_options bo;
     rad_baker_choice plan;
@@ -1229,6 +1229,7 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     bo.ff_samples = o->samples;
     bo.bounces = o->bounces;
     bo.light_samples = o->light_samples;
+    bo.vp_voxels_per_path = voxels_per_path;
     /* count the kind that will be built: a clustered set has more patches at one resolution */
     bo.vp_kind = !chosen && (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
     tool_context(&ctx, NULL);
@@ -1703,7 +1704,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     render_args ra;
     tool_world w;
     tool_image img;
-    int rc;
+    int rc, traced;
     double t0 = tool_seconds();
     if ((rc = render_parse(cmd, argc, argv, lights, &ra)) >= 0) return rc;
     if ((rc = render_check(cmd, &ra)) != 0) return rc;
@@ -1713,11 +1714,16 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         tool_close_world(&w);
         return 1;
     }
+    /* a render that will trace the first bounce (the final gather, given or by default) meets
+       the patches' average one bounce later: the plan asks for 4 voxels a mean free path, not 6.5 */
+    traced = (ra.given & RENDER_GIVEN_FINAL_GATHER)
+                 ? ra.view.final_gather != 0
+                 : ra.mo.method != TOOL_LIGHTMAP && !ra.mo.sequence && auto_final_gather(&ra.view) != 0;
     if (!ra.bake && (!(ra.mo.given & TOOL_OPT_METHOD) ||
                      ((ra.mo.method == TOOL_AAVP || ra.mo.method == TOOL_VP || ra.mo.proxy == TOOL_PROXY_AAVP ||
                        ra.mo.proxy == TOOL_PROXY_VP) &&
                       !(ra.mo.given & (TOOL_OPT_VP_RESOLUTION | TOOL_OPT_VP_MAX_PATCHES)))) &&
-        render_default_method(cmd, &w, &ra.o, &ra.mo)) {
+        render_default_method(cmd, &w, &ra.o, &ra.mo, traced ? 4.0f : 0.0f)) {
         tool_close_world(&w);
         return 1;
     }
