@@ -8107,6 +8107,8 @@ typedef struct rad__direct {
     float *ray_w;                /* 3 per ray */
     uint32_t *ray_slot;
     double *acc;                 /* 3 * RAD__DIRECT_GROUP per task */
+    float *pool_f;               /* emitter_count per task: the form factors of the emitters a point sees */
+    uint32_t *pool_e;            /* emitter_count per task: those emitters */
     /* job */
     const float *points, *normals;
     uint32_t count;
@@ -8705,12 +8707,106 @@ static void rad__sph_tri_sample(const rad__sph_tri *s, double u1, double u2, dou
    the image while a small one costs what it did; a power of two, so that the neighbouring
    points of a row (which mostly take the same count) cover whole blocks of the sequence. */
 #define RAD__EMITTER_RAYS_MAX 4u
+/* A point whose emitters would take more than RAD__EMITTER_POOL x L rays draws that many among
+   them instead (rad__direct_point). */
+#define RAD__EMITTER_POOL 16u
 static uint32_t rad__emitter_rays(uint32_t L, float F)
 {
     double f = (double)F * (double)RAD__EMITTER_RAYS_MAX;
     uint32_t m = 1u;
     while (m < RAD__EMITTER_RAYS_MAX && (double)m < f) m *= 2u;
     return m * L > RAD__MAX_SAMPLES ? (L > RAD__MAX_SAMPLES ? L : RAD__MAX_SAMPLES) : m * L;
+}
+
+/* The direct light of emitting triangle t, of form factor F at p, by ne shadow rays, its
+   weight times 'boost' (1, or what the many-emitter draw of rad__direct_point asks). */
+static rad_result rad__direct_emitter(rad__direct *d, uint32_t task, uint32_t *nrays, const float *p, const float *n,
+                                      uint32_t t, float F, uint32_t ne, float boost, uint32_t slot, float scale,
+                                      uint32_t seed, uint32_t index)
+{
+    uint32_t h1, h2, nst = 0, s, base = index * ne;
+    const float *tv = d->S->positions + 9 * (size_t)t, *tn = d->S->normals + 3 * (size_t)t;
+    const float *Le = d->S->materials_table[d->S->materials[t]].emission;
+    int textured = rad__emission_textured(d->S, t), m;
+    float w[3], Ls[3 * RAD__MAX_SAMPLES], ys[3 * RAD__MAX_SAMPLES];
+    double P[3], N[3], ks[RAD__MAX_SAMPLES], ksum;
+    double q[4][3], hq[3], area = 0.0, tnd[3], plane;
+    rad__sph_tri st[2];
+    rad_result r;
+    int k;
+    for (k = 0; k < 3; ++k) P[k] = p[k], N[k] = n[k];
+    for (k = 0; k < 3; ++k) w[k] = (float)RAD__PI * Le[k] * F * boost;
+    h1 = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
+    h2 = rad__hash(h1 ^ 0x3c6ef372u);
+    /* The triangle's part above p's plane as one or two spherical triangles seen from p;
+       sampled uniformly in solid angle, a ray's share of the form factor is its cosine
+       at p, so the shares of the visible rays measure the light of the visible part
+       (the analytic F times that ratio). Too thin or too far to map: area samples
+       weighted by the whole kernel cos cos / r^2 instead, which is then nearly
+       constant over the triangle. */
+    m = rad__clip_tri(P, N, tv, hq, q);
+    if (m >= 3) {
+        double u[4][3], len;
+        int i, ok = 1;
+        for (i = 0; i < m && ok; ++i) {
+            len = sqrt(rad__ddot(q[i], q[i]));
+            ok = len > 0.0;
+            for (k = 0; k < 3 && ok; ++k) u[i][k] = q[i][k] / len;
+        }
+        for (i = 0; i + 2 < m && ok; ++i) ok = rad__sph_tri_setup(&st[i], u[0], u[i + 1], u[i + 2]);
+        if (ok) {
+            nst = (uint32_t)(m - 2);
+            area = st[0].area + (nst > 1 ? st[1].area : 0.0);
+        }
+    }
+    for (k = 0; k < 3; ++k) tnd[k] = tn[k];
+    plane = ((double)tv[0] - P[0]) * tnd[0] + ((double)tv[1] - P[1]) * tnd[1] + ((double)tv[2] - P[2]) * tnd[2];
+    ksum = 0.0;
+    for (s = 0; s < ne; ++s) {
+        float u1, u2, *y = ys + 3 * s, b1, b2;
+        double kern;
+        rad__sobol2(base + s, h1, h2, &u1, &u2);
+        if (nst > 0) {
+            double x = (double)u1 * area, dir[3], dn;
+            const rad__sph_tri *sp = &st[0];
+            if (nst > 1 && x >= st[0].area) x -= st[0].area, sp = &st[1];
+            rad__sph_tri_sample(sp, x / sp->area, (double)u2, dir);
+            dn = rad__ddot(dir, tnd);
+            kern = dn < 0.0 ? rad__ddot(dir, N) : 0.0;
+            for (k = 0; k < 3; ++k) y[k] = (float)(P[k] + dir[k] * (dn < 0.0 ? plane / dn : 0.0));
+            if (textured) rad__barycentric(tv, y, &b1, &b2);
+        } else {
+            float dy[3], r2y, su;
+            rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
+            su = (float)sqrt((double)u1);
+            b1 = u2 * su, b2 = su * (1.0f - u2);
+            rad__sub(dy, y, p);
+            r2y = rad__dot(dy, dy);
+            kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
+        }
+        /* With an emission texture each ray also carries the radiance at its point
+           (relative to the factor Le): F times the share-weighted mean of the texture,
+           so the emitter's power follows its texture. */
+        if (textured) {
+            float e[3];
+            rad_result re = rad__emission_at(d->S, t, b1, b2, d->c, e);
+            if (re != RAD_SUCCESS) return re;
+            for (k = 0; k < 3; ++k) Ls[3 * s + k] = Le[k] > 0.0f ? e[k] / Le[k] : 0.0f;
+        }
+        ks[s] = kern > 0.0 ? kern : 0.0;
+        ksum += ks[s];
+    }
+    for (s = 0; s < ne; ++s) {
+        float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)ne, ws[3];
+        if (!(share > 0.0f)) continue;
+        if (textured) {
+            for (k = 0; k < 3; ++k) ws[k] = w[k] * Ls[3 * s + k];
+            if (!(ws[0] > 0.0f || ws[1] > 0.0f || ws[2] > 0.0f)) continue; /* a black texel sends nothing */
+        }
+        r = rad__direct_ray(d, task, nrays, p, n, ys + 3 * s, tn, NULL, textured ? ws : w, scale * share, slot);
+        if (r != RAD_SUCCESS) return r;
+    }
+    return RAD_SUCCESS;
 }
 
 /* all lights at one point into slot, each contribution times 'scale'; 'seed' scrambles the
@@ -8751,93 +8847,56 @@ static rad_result rad__direct_point(rad__direct *d, uint32_t task, uint32_t *nra
             if (r != RAD_SUCCESS) return r;
         }
     }
-    if (!d->o.exclude_emitters) {
-        double P[3], N[3], ks[RAD__MAX_SAMPLES], ksum;
-        float ys[3 * RAD__MAX_SAMPLES];
-        for (k = 0; k < 3; ++k) { P[k] = p[k]; N[k] = n[k]; }
+    if (!d->o.exclude_emitters && d->emitter_count) {
+        /* The emitters in front of p and their form factors. When their rays would pass
+           RAD__EMITTER_POOL x L (thousands of small emissive triangles), the point draws that
+           many rays among them instead, each emitter's count in proportion to its unshadowed
+           light (stratified), its weight scaled back by the inverse of the draw's odds: the
+           same expected light, and a cost that no longer grows with the tessellation. */
+        float *pf = d->pool_f + (size_t)task * d->emitter_count;
+        uint32_t *pe = d->pool_e + (size_t)task * d->emitter_count, seen = 0, pool = RAD__EMITTER_POOL * L, e;
+        double P[3], N[3], W = 0.0, rays = 0.0;
+        if (pool > RAD__MAX_SAMPLES) pool = RAD__MAX_SAMPLES;
+        for (k = 0; k < 3; ++k) P[k] = p[k], N[k] = n[k];
         for (l = 0; l < d->emitter_count; ++l) {
-            uint32_t t = d->emitters[l], h1, h2, ne, nst = 0;
+            uint32_t t = d->emitters[l];
             const float *tv = d->S->positions + 9 * (size_t)t, *tn = d->S->normals + 3 * (size_t)t;
-            const float *Le = d->S->materials_table[d->S->materials[t]].emission;
-            int textured = rad__emission_textured(d->S, t), m;
-            float dv[3], F, w[3], Ls[3 * RAD__MAX_SAMPLES];
-            double q[4][3], hq[3], area = 0.0, tnd[3], plane;
-            rad__sph_tri st[2];
+            float dv[3], F;
             rad__sub(dv, p, tv);
             if (!(rad__dot(dv, tn) > 0.0f)) continue; /* behind the emitter, or on its plane */
             F = (float)fabs(rad__ff_point_tri(P, N, tv));
             if (!(F > 0.0f)) continue;
-            for (k = 0; k < 3; ++k) w[k] = (float)RAD__PI * Le[k] * F;
-            ne = rad__emitter_rays(L, F);
-            base = index * ne;
-            h1 = rad__hash(seed ^ rad__hash(t + 0x68e31da4u));
-            h2 = rad__hash(h1 ^ 0x3c6ef372u);
-            /* The triangle's part above p's plane as one or two spherical triangles seen from p;
-               sampled uniformly in solid angle, a ray's share of the form factor is its cosine
-               at p, so the shares of the visible rays measure the light of the visible part
-               (the analytic F times that ratio). Too thin or too far to map: area samples
-               weighted by the whole kernel cos cos / r^2 instead, which is then nearly
-               constant over the triangle. */
-            m = rad__clip_tri(P, N, tv, hq, q);
-            if (m >= 3) {
-                double u[4][3], len;
-                int i, ok = 1;
-                for (i = 0; i < m && ok; ++i) {
-                    len = sqrt(rad__ddot(q[i], q[i]));
-                    ok = len > 0.0;
-                    for (k = 0; k < 3 && ok; ++k) u[i][k] = q[i][k] / len;
-                }
-                for (i = 0; i + 2 < m && ok; ++i) ok = rad__sph_tri_setup(&st[i], u[0], u[i + 1], u[i + 2]);
-                if (ok) {
-                    nst = (uint32_t)(m - 2);
-                    area = st[0].area + (nst > 1 ? st[1].area : 0.0);
-                }
+            pe[seen] = t;
+            pf[seen++] = F;
+            rays += (double)rad__emitter_rays(L, F);
+        }
+        if (rays <= (double)pool) {
+            for (e = 0; e < seen; ++e) {
+                r = rad__direct_emitter(d, task, nrays, p, n, pe[e], pf[e], rad__emitter_rays(L, pf[e]), 1.0f, slot, scale,
+                                        seed, index);
+                if (r != RAD_SUCCESS) return r;
             }
-            for (k = 0; k < 3; ++k) tnd[k] = tn[k];
-            plane = ((double)tv[0] - P[0]) * tnd[0] + ((double)tv[1] - P[1]) * tnd[1] + ((double)tv[2] - P[2]) * tnd[2];
-            ksum = 0.0;
-            for (s = 0; s < ne; ++s) {
-                float u1, u2, *y = ys + 3 * s, b1, b2;
-                double kern;
-                rad__sobol2(base + s, h1, h2, &u1, &u2);
-                if (nst > 0) {
-                    double x = (double)u1 * area, dir[3], dn;
-                    const rad__sph_tri *sp = &st[0];
-                    if (nst > 1 && x >= st[0].area) x -= st[0].area, sp = &st[1];
-                    rad__sph_tri_sample(sp, x / sp->area, (double)u2, dir);
-                    dn = rad__ddot(dir, tnd);
-                    kern = dn < 0.0 ? rad__ddot(dir, N) : 0.0;
-                    for (k = 0; k < 3; ++k) y[k] = (float)(P[k] + dir[k] * (dn < 0.0 ? plane / dn : 0.0));
-                    if (textured) rad__barycentric(tv, y, &b1, &b2);
-                } else {
-                    float dy[3], r2y, su;
-                    rad__triangle_point(tv, tv + 3, tv + 6, u1, u2, y);
-                    su = (float)sqrt((double)u1);
-                    b1 = u2 * su, b2 = su * (1.0f - u2);
-                    rad__sub(dy, y, p);
-                    r2y = rad__dot(dy, dy);
-                    kern = r2y > 0.0f ? (double)rad__dot(dy, n) * -(double)rad__dot(dy, tn) / ((double)r2y * (double)r2y) : 0.0;
-                }
-                /* With an emission texture each ray also carries the radiance at its point
-                   (relative to the factor Le): F times the share-weighted mean of the texture,
-                   so the emitter's power follows its texture. */
-                if (textured) {
-                    float e[3];
-                    rad_result re = rad__emission_at(d->S, t, b1, b2, d->c, e);
-                    if (re != RAD_SUCCESS) return re;
-                    for (k = 0; k < 3; ++k) Ls[3 * s + k] = Le[k] > 0.0f ? e[k] / Le[k] : 0.0f;
-                }
-                ks[s] = kern > 0.0 ? kern : 0.0;
-                ksum += ks[s];
+        } else {
+            double c = 0.0, u0 = (double)(rad__hash(seed ^ rad__hash(index + 0x2545f491u)) >> 8) / 16777216.0;
+            uint32_t drawn = 0;
+            for (e = 0; e < seen; ++e) {
+                const float *Le = d->S->materials_table[d->S->materials[pe[e]]].emission;
+                W += (double)pf[e] * ((double)Le[0] + (double)Le[1] + (double)Le[2]);
             }
-            for (s = 0; s < ne; ++s) {
-                float share = ksum > 0.0 ? (float)(ks[s] / ksum) : 1.0f / (float)ne, ws[3];
-                if (!(share > 0.0f)) continue;
-                if (textured) {
-                    for (k = 0; k < 3; ++k) ws[k] = w[k] * Ls[3 * s + k];
-                    if (!(ws[0] > 0.0f || ws[1] > 0.0f || ws[2] > 0.0f)) continue; /* a black texel sends nothing */
-                }
-                r = rad__direct_ray(d, task, nrays, p, n, ys + 3 * s, tn, NULL, textured ? ws : w, scale * share, slot);
+            for (e = 0; e < seen && W > 0.0; ++e) {
+                const float *Le = d->S->materials_table[d->S->materials[pe[e]]].emission;
+                double we = (double)pf[e] * ((double)Le[0] + (double)Le[1] + (double)Le[2]), upto;
+                uint32_t m;
+                if (!(we > 0.0)) continue;
+                c += we;
+                /* draws j with (j + u0) / pool * W below c, less those already given */
+                upto = e + 1 == seen ? (double)pool : ceil(c / W * (double)pool - u0);
+                if (upto > (double)pool) upto = (double)pool;
+                m = upto > (double)drawn ? (uint32_t)upto - drawn : 0u;
+                if (m == 0) continue;
+                drawn += m;
+                r = rad__direct_emitter(d, task, nrays, p, n, pe[e], pf[e], m, (float)((double)m * W / ((double)pool * we)),
+                                        slot, scale, seed, index);
                 if (r != RAD_SUCCESS) return r;
             }
         }
@@ -8902,10 +8961,12 @@ static rad_result rad__direct_run(rad__direct *d, const rad__ctx *c, uint32_t ro
             if (rad__emits(d->S, t)) d->emitters[ne++] = t;
         d->emitter_count = ne;
         d->c = c;
-        r = rad__for_rows(c, rows, T, rad__direct_row, d);
+        d->pool_f = (float *)rad__alloc_array(&c->allocator, (size_t)T * (ne ? ne : 1u), sizeof(float));
+        d->pool_e = (uint32_t *)rad__alloc_array(&c->allocator, (size_t)T * (ne ? ne : 1u), sizeof(uint32_t));
+        r = d->pool_f && d->pool_e ? rad__for_rows(c, rows, T, rad__direct_row, d) : RAD_ERROR_OUT_OF_MEMORY;
     }
     {
-        void *blocks[] = { d->rays, d->occ, d->ray_w, d->ray_slot, d->acc, d->emitters };
+        void *blocks[] = { d->rays, d->occ, d->ray_w, d->ray_slot, d->acc, d->emitters, d->pool_f, d->pool_e };
         rad__free_each(c->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
     return r;
@@ -24137,7 +24198,7 @@ static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *r
                 /* the work of the direct light of emitting triangles at this point, as
                    rad__direct_point does it: the emitters in front of it, and the shadow rays
                    those above its plane take */
-                double P[3], N[3];
+                double P[3], N[3], point_rays = 0.0, pool = (double)RAD__EMITTER_POOL * (double)light_samples;
                 uint32_t l;
                 for (q = 0; q < 3; ++q) P[q] = (double)rays[j].origin[q] - eps * (double)n[q], N[q] = (double)n[q];
                 for (l = 0; l < E; l += stride) {
@@ -24147,8 +24208,10 @@ static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *r
                     if (!(rad__dot(dv, tn) > 0.0f)) continue;
                     front += (double)stride;
                     F = (float)fabs(rad__ff_point_tri(P, N, tv));
-                    if (F > 0.0f) lit_rays += (double)stride * (double)rad__emitter_rays(light_samples, F);
+                    if (F > 0.0f) point_rays += (double)stride * (double)rad__emitter_rays(light_samples, F);
                 }
+                if (pool > (double)RAD__MAX_SAMPLES) pool = (double)RAD__MAX_SAMPLES;
+                lit_rays += point_rays < pool ? point_rays : pool; /* many emitters share one draw */
                 ++probes;
             }
             rays[j].tmin = 0.0f;

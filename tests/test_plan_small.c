@@ -104,8 +104,8 @@ static void ps_test_emitters_cost(void)
     ps_free(&w);
     CHECK(dark.patch_count == lit.patch_count && dark.vp_samples == lit.vp_samples);
     CHECK(dark.estimated_bytes == lit.estimated_bytes);
-    /* 3 emitting spheres of 400 triangles: about a hundred emitters lit per sample, 16 rays
-       each, against the kernel sums of a few thousand samples */
+    /* 3 emitting spheres of 400 triangles: about a hundred emitters lit per sample (their
+       tests and the rays drawn among them) against the kernel sums of a few thousand samples */
     CHECK(lit.estimated_seconds > 2.0 * dark.estimated_seconds);
 }
 
@@ -129,16 +129,18 @@ static void ps_test_estimate_monotone(void)
 static void ps_test_budget_counts_emitters(void)
 {
     ps_world w;
-    rad_baker_choice lit, dark, free_plan;
+    rad_baker_choice lit, dark, free_plan, free_dark;
     double budget;
-    CHECK(ps_row(&w, 6, 1.0f, 1));
-    CHECK(ps_plan(&w, 24, 0.0, &free_plan));
-    budget = free_plan.estimated_seconds / 4.0;
-    CHECK(ps_plan(&w, 24, budget, &lit));
-    ps_free(&w);
     CHECK(ps_row(&w, 6, 1.0f, 0));
+    CHECK(ps_plan(&w, 24, 0.0, &free_dark));
+    budget = 1.5 * free_dark.estimated_seconds;
     CHECK(ps_plan(&w, 24, budget, &dark));
     ps_free(&w);
+    CHECK(ps_row(&w, 6, 1.0f, 1));
+    CHECK(ps_plan(&w, 24, 0.0, &free_plan));
+    CHECK(ps_plan(&w, 24, budget, &lit));
+    ps_free(&w);
+    CHECK(free_plan.estimated_seconds > budget);
     CHECK(!free_plan.budget_limited && free_plan.vp_resolution == 24);
     CHECK(lit.budget_limited && lit.vp_resolution < 24 && lit.estimated_seconds <= budget);
     CHECK(strstr(lit.reason, "budget") != NULL);
