@@ -4454,7 +4454,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_PROBE_UPDATE      = 12, /* tools/glsl/probe_update.comp */
     RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* tools/glsl/lightmap_refresh.comp */
     RAD_GLSL_LAYER_MIX         = 14, /* tools/glsl/layer_mix.comp */
-    RAD_GLSL_COUNT = 15
+    RAD_GLSL_LAYER_MIX_RGB9E5  = 15, /* tools/glsl/layer_mix_rgb9e5.comp */
+    RAD_GLSL_COUNT = 16
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -28972,6 +28973,71 @@ static const char rad__glsl_14_0[] =
     "    mixed[i] = acc;\n"
     "}\n";
 static const char *const rad__glsl_pieces_14[] = { rad__glsl_14_0 };
+static const char rad__glsl_15_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LAYER_MIX_RGB9E5: the baker's light layers mixed from packed\n"
+    "// RGB9E5 planes, as rad_baker_mix_layers_rgb9e5 (docs/methods/bake.md, \"light layers\"):\n"
+    "//   out[3 t + c] = sum over planes g of scale[3 g + c] unpack(layer_g[t])_c\n"
+    "// on planar RGB9E5 layers (plane g holds stride words, one per texel: rad_baker_result's\n"
+    "// lightmap_rgb9e5 uploaded unchanged), written as float RGB (3 per texel), the output of\n"
+    "// RAD_GLSL_LAYER_MIX on the unpacked layers.\n"
+    "// ONE INVOCATION PER TEXEL: texels t = row_offset .. row_offset + row_count - 1 of planes\n"
+    "// g = plane_offset .. plane_offset + plane_count - 1; each word is read once for its three\n"
+    "// channels. A plane whose three scales are 0 is skipped, and the planes are added in increasing\n"
+    "// order to a float sum that starts at 0 (or, with RAD_GLSL_LAYER_ACCUMULATE, at out): the CPU's\n"
+    "// order, so a dispatch per few planes adds up to what one dispatch over all gives.\n"
+    "// Binding 0 holds the word g * stride + t (an index over all planes) at element\n"
+    "// (g * stride + t) - base, with base the low 32 bits of that index at its element 0 (uint\n"
+    "// arithmetic wraps: only the difference matters, and a bound range is < 2^32 words).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer Layers { uint layers[]; };   // RGB9E5 words\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Scales { float scales[]; };  // 3 per plane\n"
+    "layout(std430, set = 0, binding = 2) buffer Output { float mixed[]; };            // 3 x stride floats\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;   // first texel of this dispatch (an index into a plane)\n"
+    "    uint row_count;    // texels in this dispatch\n"
+    "    uint stride;       // texels (words) per plane: rad_baker_mix_layers_rgb9e5's texel_count\n"
+    "    uint plane_offset; // first plane mixed by this dispatch (scales[3 plane_offset] is its scale)\n"
+    "    uint plane_count;  // planes mixed by this dispatch\n"
+    "    uint base;         // low 32 bits of the index g * stride + t at element 0 of binding 0\n"
+    "    uint flags;        // RAD_GLSL_LAYER_ACCUMULATE (1): add to out instead of overwriting it\n"
+    "} pc;\n"
+    "\n"
+    "// One channel as rad_rgb9e5_unpack computes it: the 9-bit mantissa field left in place (mask),\n"
+    "// converted to float, times the power of two 2^(e - 24 - shift) built from the exponent bits\n"
+    "// (bits 27-31 moved to the float's exponent field plus 127 - 24 - shift). Both factors and\n"
+    "// their product are exact floats (no denormals, no rounding), so any device gets the CPU's bits.\n"
+    "float rgb9e5_channel(uint u, uint mask, uint bias)\n"
+    "{\n"
+    "    return float(u & mask) * uintBitsToFloat(((u >> 4u) & 0x0F800000u) + (bias << 23u));\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint t = pc.row_offset + r;\n"
+    "    // precise: no fused multiply-add and no dropped \"0 +\", each product and sum rounded as the CPU's\n"
+    "    precise float ar = 0.0, ag = 0.0, ab = 0.0;\n"
+    "    if ((pc.flags & 1u) != 0u) {\n"
+    "        ar = mixed[3u * t];\n"
+    "        ag = mixed[3u * t + 1u];\n"
+    "        ab = mixed[3u * t + 2u];\n"
+    "    }\n"
+    "    for (uint q = 0u; q < pc.plane_count; ++q) {\n"
+    "        uint g = pc.plane_offset + q;\n"
+    "        float sr = scales[3u * g], sg = scales[3u * g + 1u], sb = scales[3u * g + 2u];\n"
+    "        if (sr == 0.0 && sg == 0.0 && sb == 0.0) continue;\n"
+    "        uint u = layers[g * pc.stride + t - pc.base];\n"
+    "        ar += rgb9e5_channel(u, 0x1FFu, 103u) * sr;     // red: bits 0-8, 2^(e - 24)\n"
+    "        ag += rgb9e5_channel(u, 0x3FE00u, 94u) * sg;    // green: bits 9-17, 2^(e - 33)\n"
+    "        ab += rgb9e5_channel(u, 0x7FC0000u, 85u) * sb;  // blue: bits 18-26, 2^(e - 42)\n"
+    "    }\n"
+    "    mixed[3u * t] = ar;\n"
+    "    mixed[3u * t + 1u] = ag;\n"
+    "    mixed[3u * t + 2u] = ab;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_15[] = { rad__glsl_15_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 3364u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 3620u },
@@ -28987,7 +29053,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7489u },
     { "probe_update.comp", rad__glsl_pieces_12, 1u, 2832u },
     { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u },
-    { "layer_mix.comp", rad__glsl_pieces_14, 1u, 2687u }
+    { "layer_mix.comp", rad__glsl_pieces_14, 1u, 2687u },
+    { "layer_mix_rgb9e5.comp", rad__glsl_pieces_15, 1u, 3719u }
 };
 /* >>glsl end */
 
