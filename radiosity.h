@@ -256,8 +256,9 @@
        float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
        step (the same random draws as the CPU), the alias-table build for streamed rows, and
        the local multi-bounce matrix's apply and add (rank-1 update, rank-2 when evicting) on
-       a matrix kept resident on the GPU, virtual-patch gathering at surface points, and the
-       irradiance-probe update;
+       a matrix kept resident on the GPU, virtual-patch gathering at surface points, the
+       irradiance-probe update, the lightmap refresh, and the light-layer mix (float or
+       RGB9E5 layers);
        RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
@@ -3606,7 +3607,8 @@ RAD_API void rad_rgb9e5_unpack(const uint32_t *packed, size_t count, float *rgb)
    the unpacked layers (without RAD_FMA). group_rgb NULL: all 1. Reads 4 bytes per texel and
    group where the float layers take 12 (docs/performance-notes.md, "Packed light layers").
    Errors: INVALID_ARGUMENT (NULL, group_count 0 or above RAD_BAKER_MAX_GROUPS), NON_FINITE (a
-   scale). Cost: one pass, parallel through ctx. */
+   scale). Cost: one pass, parallel through ctx. On the GPU: RAD_GLSL_LAYER_MIX_RGB9E5 (>>api_glsl),
+   the same bits. */
 RAD_API rad_result rad_baker_mix_layers_rgb9e5(const uint32_t *layers, uint32_t group_count, size_t texel_count,
                                               const float *group_rgb, float *out, const rad_context *ctx);
 
@@ -4281,7 +4283,8 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
      maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
      invocations read the row at consecutive addresses with a stride of the group size and sum
      in shared memory (12 bytes per invocation). The temporal step, the alias build,
-     VP_GATHER and LAYER_MIX run ONE INVOCATION PER ROW (point; LAYER_MIX: float):
+     VP_GATHER and the LAYER_MIX kernels run ONE INVOCATION PER ROW (point; LAYER_MIX: float;
+     LAYER_MIX_RGB9E5: texel):
      ceil(row_count / size) groups (LOCAL_VECTORS: per row or column, see its entry).
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
@@ -4435,7 +4438,19 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        lavapipe, tests/test_vulkan_layers.h). CHUNKS of planes: 8 layers of a 1024 x 1024 map
        are 96 MiB, near lavapipe's 128 MiB range; bind planes [plane_offset, plane_offset +
        plane_count) and dispatch the later chunks with ACCUMULATE (out += their sum), after a
-       compute-to-compute barrier. */
+       compute-to-compute barrier.
+   RAD_GLSL_LAYER_MIX_RGB9E5  the same mix from packed RGB9E5 layers, as rad_baker_mix_layers_rgb9e5
+       (>>api_baker): out[3t + c] = sum_g scale[3g + c] unpack(layer_g[t])_c, float RGB out
+       (rad_baker_result.lightmap_rgb9e5 uploaded unchanged: 4 bytes a texel and layer where the
+       float layers take 12). Push: rad_glsl_layer_mix_push with row_offset, row_count, stride
+       and base in TEXELS (words; stride: texels per plane); flags RAD_GLSL_LAYER_ACCUMULATE. ONE
+       INVOCATION PER TEXEL (its word read once for three channels). 0: the layers, word
+       g * stride + t at element (g * stride + t) - base  1: scales (3 per plane, bound whole)
+       2: out (3 x stride floats; the chunk's texels written). Each channel unpacks exactly as
+       rad_rgb9e5_unpack (mantissa field times a power of two, both exact), then planes are skipped
+       and added as in LAYER_MIX: equal to the CPU's bit for bit on lavapipe, which
+       tests/test_vulkan_layers_rgb9e5.h asserts. Chunks of planes as in LAYER_MIX (8 packed
+       layers of a 2048 x 2048 map are 128 MiB, all of lavapipe's range). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -4479,7 +4494,7 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
 #define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
 #define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
-#define RAD_GLSL_LAYER_ACCUMULATE 1u       /* layer mix: out += the planes' sum (later plane chunks) */
+#define RAD_GLSL_LAYER_ACCUMULATE 1u       /* layer mixes: out += the planes' sum (later plane chunks) */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -4557,9 +4572,9 @@ typedef struct rad_glsl_lightmap_refresh_push {
     uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
     uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
 } rad_glsl_lightmap_refresh_push;
-typedef struct rad_glsl_layer_mix_push {
-    uint32_t row_offset, row_count; /* the floats of a plane mixed by this dispatch */
-    uint32_t stride;               /* floats per plane (rad_baker_mix_layers' count3) */
+typedef struct rad_glsl_layer_mix_push {   /* RAD_GLSL_LAYER_MIX and _RGB9E5 (rows in texels) */
+    uint32_t row_offset, row_count; /* the floats (RGB9E5: texels) of a plane mixed by this dispatch */
+    uint32_t stride;               /* floats per plane (count3; RGB9E5: texel_count) */
     uint32_t plane_offset, plane_count; /* the planes mixed by this dispatch */
     uint32_t base;                 /* low 32 bits of the index g * stride + i at element 0 of binding 0 */
     uint32_t flags;                /* RAD_GLSL_LAYER_ACCUMULATE */
