@@ -4447,10 +4447,11 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        INVOCATION PER TEXEL (its word read once for three channels). 0: the layers, word
        g * stride + t at element (g * stride + t) - base  1: scales (3 per plane, bound whole)
        2: out (3 x stride floats; the chunk's texels written). Each channel unpacks exactly as
-       rad_rgb9e5_unpack (mantissa field times a power of two, both exact), then planes are skipped
-       and added as in LAYER_MIX: equal to the CPU's bit for bit on lavapipe, which
-       tests/test_vulkan_layers_rgb9e5.h asserts. Chunks of planes as in LAYER_MIX (8 packed
-       layers of a 2048 x 2048 map are 128 MiB, all of lavapipe's range). */
+       rad_rgb9e5_unpack (mantissa field times a power of two, both exact), then planes are
+       skipped and added as in LAYER_MIX: equal bit for bit to the CPU's (built without
+       RAD_FMA) on lavapipe, which tests/test_vulkan_layers_rgb9e5.h asserts. Chunks of planes
+       as in LAYER_MIX (8 packed layers of a 2048 x 2048 map are 128 MiB, all of lavapipe's
+       range). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
