@@ -256,8 +256,9 @@
        float, half and BC1 / 3xBC4 textures (with outliers and permutations), the temporal
        step (the same random draws as the CPU), the alias-table build for streamed rows, and
        the local multi-bounce matrix's apply and add (rank-1 update, rank-2 when evicting) on
-       a matrix kept resident on the GPU, virtual-patch gathering at surface points, and the
-       irradiance-probe update;
+       a matrix kept resident on the GPU, virtual-patch gathering at surface points, the
+       irradiance-probe update, the lightmap refresh, and the light-layer mix (float or
+       RGB9E5 layers);
        RAD_GLSL_LIGHTING is the include with every lighting model (>>api_shading).
        Descriptor set 0 of std430 buffers (plus combined image samplers for the textures),
        push constants mirrored by the rad_glsl_*_push structs, workgroup x size from
@@ -3606,7 +3607,8 @@ RAD_API void rad_rgb9e5_unpack(const uint32_t *packed, size_t count, float *rgb)
    the unpacked layers (without RAD_FMA). group_rgb NULL: all 1. Reads 4 bytes per texel and
    group where the float layers take 12 (docs/performance-notes.md, "Packed light layers").
    Errors: INVALID_ARGUMENT (NULL, group_count 0 or above RAD_BAKER_MAX_GROUPS), NON_FINITE (a
-   scale). Cost: one pass, parallel through ctx. */
+   scale). Cost: one pass, parallel through ctx. On the GPU: RAD_GLSL_LAYER_MIX_RGB9E5 (>>api_glsl),
+   the same bits. */
 RAD_API rad_result rad_baker_mix_layers_rgb9e5(const uint32_t *layers, uint32_t group_count, size_t texel_count,
                                               const float *group_rgb, float *out, const rad_context *ctx);
 
@@ -4281,7 +4283,8 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
      maxComputeWorkGroupCount[0], 65535 guaranteed: chunk longer runs); the group's
      invocations read the row at consecutive addresses with a stride of the group size and sum
      in shared memory (12 bytes per invocation). The temporal step, the alias build,
-     VP_GATHER and LAYER_MIX run ONE INVOCATION PER ROW (point; LAYER_MIX: float):
+     VP_GATHER and the LAYER_MIX kernels run ONE INVOCATION PER ROW (point; LAYER_MIX: float;
+     LAYER_MIX_RGB9E5: texel):
      ceil(row_count / size) groups (LOCAL_VECTORS: per row or column, see its entry).
    - Push constants: one block per kernel, at most 64 bytes (Vulkan guarantees 128), mirrored
      by the rad_glsl_*_push structs below (only 4-byte members, no padding; sizes and offsets
@@ -4435,7 +4438,20 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
        lavapipe, tests/test_vulkan_layers.h). CHUNKS of planes: 8 layers of a 1024 x 1024 map
        are 96 MiB, near lavapipe's 128 MiB range; bind planes [plane_offset, plane_offset +
        plane_count) and dispatch the later chunks with ACCUMULATE (out += their sum), after a
-       compute-to-compute barrier. */
+       compute-to-compute barrier.
+   RAD_GLSL_LAYER_MIX_RGB9E5  the same mix from packed RGB9E5 layers, as rad_baker_mix_layers_rgb9e5
+       (>>api_baker): out[3t + c] = sum_g scale[3g + c] unpack(layer_g[t])_c, float RGB out
+       (rad_baker_result.lightmap_rgb9e5 uploaded unchanged: 4 bytes a texel and layer where the
+       float layers take 12). Push: rad_glsl_layer_mix_push with row_offset, row_count, stride
+       and base in TEXELS (words; stride: texels per plane); flags RAD_GLSL_LAYER_ACCUMULATE. ONE
+       INVOCATION PER TEXEL (its word read once for three channels). 0: the layers, word
+       g * stride + t at element (g * stride + t) - base  1: scales (3 per plane, bound whole)
+       2: out (3 x stride floats; the chunk's texels written). Each channel unpacks exactly as
+       rad_rgb9e5_unpack (mantissa field times a power of two, both exact), then planes are
+       skipped and added as in LAYER_MIX: equal bit for bit to the CPU's (built without
+       RAD_FMA) on lavapipe, which tests/test_vulkan_layers_rgb9e5.h asserts. Chunks of planes
+       as in LAYER_MIX (8 packed layers of a 2048 x 2048 map are 128 MiB, all of lavapipe's
+       range). */
 
 /* >>glsl ids begin */
 typedef enum rad_glsl_id {
@@ -4454,7 +4470,8 @@ typedef enum rad_glsl_id {
     RAD_GLSL_PROBE_UPDATE      = 12, /* tools/glsl/probe_update.comp */
     RAD_GLSL_LIGHTMAP_REFRESH  = 13, /* tools/glsl/lightmap_refresh.comp */
     RAD_GLSL_LAYER_MIX         = 14, /* tools/glsl/layer_mix.comp */
-    RAD_GLSL_COUNT = 15
+    RAD_GLSL_LAYER_MIX_RGB9E5  = 15, /* tools/glsl/layer_mix_rgb9e5.comp */
+    RAD_GLSL_COUNT = 16
 } rad_glsl_id;
 /* >>glsl ids end */
 
@@ -4478,7 +4495,7 @@ typedef enum rad_glsl_id {
 #define RAD_GLSL_LOCAL_WORK_FLOATS(m) (12u * (uint64_t)(m) + 12u)
 #define RAD_GLSL_LIGHTMAP_PASS_VERTICES 0u /* lightmap refresh: V = vertex values of H */
 #define RAD_GLSL_LIGHTMAP_PASS_TEXELS 1u   /* lightmap refresh: the texel rows from V */
-#define RAD_GLSL_LAYER_ACCUMULATE 1u       /* layer mix: out += the planes' sum (later plane chunks) */
+#define RAD_GLSL_LAYER_ACCUMULATE 1u       /* layer mixes: out += the planes' sum (later plane chunks) */
 
 /* Push-constant mirrors (C layout == GLSL layout; all members 4 bytes). */
 typedef struct rad_glsl_gather_dense_push {
@@ -4556,9 +4573,9 @@ typedef struct rad_glsl_lightmap_refresh_push {
     uint32_t row_offset, row_count; /* the vertices (pass 0) or rows (pass 1) of this dispatch */
     uint32_t entry_base;           /* the entry at element 0 of the pass's entry bindings */
 } rad_glsl_lightmap_refresh_push;
-typedef struct rad_glsl_layer_mix_push {
-    uint32_t row_offset, row_count; /* the floats of a plane mixed by this dispatch */
-    uint32_t stride;               /* floats per plane (rad_baker_mix_layers' count3) */
+typedef struct rad_glsl_layer_mix_push {   /* RAD_GLSL_LAYER_MIX and _RGB9E5 (rows in texels) */
+    uint32_t row_offset, row_count; /* the floats (RGB9E5: texels) of a plane mixed by this dispatch */
+    uint32_t stride;               /* floats per plane (count3; RGB9E5: texel_count) */
     uint32_t plane_offset, plane_count; /* the planes mixed by this dispatch */
     uint32_t base;                 /* low 32 bits of the index g * stride + i at element 0 of binding 0 */
     uint32_t flags;                /* RAD_GLSL_LAYER_ACCUMULATE */
@@ -29035,6 +29052,71 @@ static const char rad__glsl_14_0[] =
     "    mixed[i] = acc;\n"
     "}\n";
 static const char *const rad__glsl_pieces_14[] = { rad__glsl_14_0 };
+static const char rad__glsl_15_0[] =
+    "#version 450\n"
+    "// radiosity.h kernel RAD_GLSL_LAYER_MIX_RGB9E5: the baker's light layers mixed from packed\n"
+    "// RGB9E5 planes, as rad_baker_mix_layers_rgb9e5 (docs/methods/bake.md, \"light layers\"):\n"
+    "//   out[3 t + c] = sum over planes g of scale[3 g + c] unpack(layer_g[t])_c\n"
+    "// on planar RGB9E5 layers (plane g holds stride words, one per texel: rad_baker_result's\n"
+    "// lightmap_rgb9e5 uploaded unchanged), written as float RGB (3 per texel), the output of\n"
+    "// RAD_GLSL_LAYER_MIX on the unpacked layers.\n"
+    "// ONE INVOCATION PER TEXEL: texels t = row_offset .. row_offset + row_count - 1 of planes\n"
+    "// g = plane_offset .. plane_offset + plane_count - 1; each word is read once for its three\n"
+    "// channels. A plane whose three scales are 0 is skipped, and the planes are added in increasing\n"
+    "// order to a float sum that starts at 0 (or, with RAD_GLSL_LAYER_ACCUMULATE, at out): the CPU's\n"
+    "// order, so a dispatch per few planes adds up to what one dispatch over all gives.\n"
+    "// Binding 0 holds the word g * stride + t (an index over all planes) at element\n"
+    "// (g * stride + t) - base, with base the low 32 bits of that index at its element 0 (uint\n"
+    "// arithmetic wraps: only the difference matters, and a bound range is < 2^32 words).\n"
+    "layout(local_size_x_id = 0) in;\n"
+    "layout(std430, set = 0, binding = 0) readonly buffer Layers { uint layers[]; };   // RGB9E5 words\n"
+    "layout(std430, set = 0, binding = 1) readonly buffer Scales { float scales[]; };  // 3 per plane\n"
+    "layout(std430, set = 0, binding = 2) buffer Output { float mixed[]; };            // 3 x stride floats\n"
+    "layout(push_constant) uniform Push {\n"
+    "    uint row_offset;   // first texel of this dispatch (an index into a plane)\n"
+    "    uint row_count;    // texels in this dispatch\n"
+    "    uint stride;       // texels (words) per plane: rad_baker_mix_layers_rgb9e5's texel_count\n"
+    "    uint plane_offset; // first plane mixed by this dispatch (scales[3 plane_offset] is its scale)\n"
+    "    uint plane_count;  // planes mixed by this dispatch\n"
+    "    uint base;         // low 32 bits of the index g * stride + t at element 0 of binding 0\n"
+    "    uint flags;        // RAD_GLSL_LAYER_ACCUMULATE (1): add to out instead of overwriting it\n"
+    "} pc;\n"
+    "\n"
+    "// One channel as rad_rgb9e5_unpack computes it: the 9-bit mantissa field left in place (mask),\n"
+    "// converted to float, times the power of two 2^(e - 24 - shift) built from the exponent bits\n"
+    "// (bits 27-31 moved to the float's exponent field plus 127 - 24 - shift). Both factors and\n"
+    "// their product are exact floats (no denormals, no rounding), so any device gets the CPU's bits.\n"
+    "float rgb9e5_channel(uint u, uint mask, uint bias)\n"
+    "{\n"
+    "    return float(u & mask) * uintBitsToFloat(((u >> 4u) & 0x0F800000u) + (bias << 23u));\n"
+    "}\n"
+    "\n"
+    "void main()\n"
+    "{\n"
+    "    uint r = gl_GlobalInvocationID.x;\n"
+    "    if (r >= pc.row_count) return;\n"
+    "    uint t = pc.row_offset + r;\n"
+    "    // precise: no fused multiply-add and no dropped \"0 +\", each product and sum rounded as the CPU's\n"
+    "    precise float ar = 0.0, ag = 0.0, ab = 0.0;\n"
+    "    if ((pc.flags & 1u) != 0u) {\n"
+    "        ar = mixed[3u * t];\n"
+    "        ag = mixed[3u * t + 1u];\n"
+    "        ab = mixed[3u * t + 2u];\n"
+    "    }\n"
+    "    for (uint q = 0u; q < pc.plane_count; ++q) {\n"
+    "        uint g = pc.plane_offset + q;\n"
+    "        float sr = scales[3u * g], sg = scales[3u * g + 1u], sb = scales[3u * g + 2u];\n"
+    "        if (sr == 0.0 && sg == 0.0 && sb == 0.0) continue;\n"
+    "        uint u = layers[g * pc.stride + t - pc.base];\n"
+    "        ar += rgb9e5_channel(u, 0x1FFu, 103u) * sr;     // red: bits 0-8, 2^(e - 24)\n"
+    "        ag += rgb9e5_channel(u, 0x3FE00u, 94u) * sg;    // green: bits 9-17, 2^(e - 33)\n"
+    "        ab += rgb9e5_channel(u, 0x7FC0000u, 85u) * sb;  // blue: bits 18-26, 2^(e - 42)\n"
+    "    }\n"
+    "    mixed[3u * t] = ar;\n"
+    "    mixed[3u * t + 1u] = ag;\n"
+    "    mixed[3u * t + 2u] = ab;\n"
+    "}\n";
+static const char *const rad__glsl_pieces_15[] = { rad__glsl_15_0 };
 static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "gather_dense.comp", rad__glsl_pieces_0, 1u, 3364u },
     { "gather_csr.comp", rad__glsl_pieces_1, 1u, 3620u },
@@ -29050,7 +29132,8 @@ static const rad__glsl_entry rad__glsl_table[RAD_GLSL_COUNT] = {
     { "vp_gather.comp", rad__glsl_pieces_11, 2u, 7489u },
     { "probe_update.comp", rad__glsl_pieces_12, 1u, 2832u },
     { "lightmap_refresh.comp", rad__glsl_pieces_13, 1u, 3391u },
-    { "layer_mix.comp", rad__glsl_pieces_14, 1u, 2687u }
+    { "layer_mix.comp", rad__glsl_pieces_14, 1u, 2687u },
+    { "layer_mix_rgb9e5.comp", rad__glsl_pieces_15, 1u, 3719u }
 };
 /* >>glsl end */
 

@@ -1730,6 +1730,7 @@ static void test_push_mirrors(void)
     check_mirror(RAD_GLSL_PROBE_UPDATE, probe, sizeof(rad_glsl_probe_update_push));
     check_mirror(RAD_GLSL_LIGHTMAP_REFRESH, lmr, sizeof(rad_glsl_lightmap_refresh_push));
     check_mirror(RAD_GLSL_LAYER_MIX, lmix, sizeof(rad_glsl_layer_mix_push));
+    check_mirror(RAD_GLSL_LAYER_MIX_RGB9E5, lmix, sizeof(rad_glsl_layer_mix_push));
     /* every kernel (.comp; includes have no push block) has its mirror checked above */
     {
         uint32_t id;
@@ -1784,9 +1785,10 @@ static void test_lighting_include(void)
     free(inc);
 }
 
-/* ---- the baker's light layers mixed: tests/test_vulkan_layers.h ------------------------------- */
+/* ---- the baker's light layers mixed: tests/test_vulkan_layers.h, _rgb9e5.h (packed layers) ---- */
 
 #include "test_vulkan_layers.h"
+#include "test_vulkan_layers_rgb9e5.h"
 
 /* ---- the harness ---------------------------------------------------------------------------- */
 
@@ -1806,6 +1808,7 @@ static const vk_test g_tests[] = {
     { "vk_probe_update", test_probe_update },
     { "vk_lightmap_refresh", test_lightmap_refresh },
     { "vk_layer_mix_chunked_accumulate", test_layer_mix },
+    { "vk_layer_mix_rgb9e5_bit_equal", test_layer_mix_rgb9e5 },
     { NULL, NULL }
 };
 

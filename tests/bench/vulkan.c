@@ -6,7 +6,8 @@
    Inputs: a random N x N form-factor-like matrix (rows sum to 0.3..0.9), K = 1 so the
    multi-bounce matrix is rho o F (building it costs nothing), E with half its entries zero;
    for the layer mix, 8 random light layers of a --map x --map RGB lightmap (at most 1024: the
-   8 layers are bound whole, 96 MiB, under lavapipe's 128 MiB storage range) and RGB scales.
+   8 layers are bound whole, 96 MiB, under lavapipe's 128 MiB storage range) and RGB scales,
+   and the same 8 layers packed as RGB9E5 (rad_rgb9e5_pack of random floats, 32 MiB).
    Each GPU time is the wall time of one dispatch including submit and wait (what a frame
    would pay), the median of R runs; the CPU time is the median of R calls of the CPU function
    with the header's default parallel_for. */
@@ -247,6 +248,45 @@ int main(int argc, char **argv)
         vk_buffer_free(&V, &bL); vk_buffer_free(&V, &bS); vk_buffer_free(&V, &bO);
         vk_kernel_destroy(&V, &k);
         free(layers); free(mixed);
+    }
+    /* the same 8 groups packed as RGB9E5 (4 bytes a texel), one invocation per texel */
+    {
+        vk_kernel k;
+        vk_buf bL, bS, bO;
+        vk_range rg[3];
+        rad_glsl_layer_mix_push pc;
+        size_t texels = (size_t)map * map, q;
+        uint32_t groups = 8;
+        float *rgb = (float *)malloc(3 * texels * 4), *mixed = (float *)malloc(3 * texels * 4), scales[24];
+        uint32_t *packed = (uint32_t *)malloc(texels * groups * 4);
+        if (!rgb || !mixed || !packed || !vk_kernel_create(&V, &k, RAD_GLSL_LAYER_MIX_RGB9E5, 0, 3, sizeof(pc), ls)) return 1;
+        for (c = 0; c < groups; ++c) { /* one plane at a time: the float layers of all 8 would be 96 MiB more */
+            for (q = 0; q < 3 * texels; ++q) rgb[q] = frand();
+            if (rad_rgb9e5_pack(rgb, texels, packed + c * texels, NULL) != RAD_SUCCESS) return 1;
+        }
+        for (q = 0; q < 24; ++q) scales[q] = 0.2f + frand();
+        vk_buffer(&V, &bL, texels * groups * 4, packed);
+        vk_buffer(&V, &bS, sizeof(scales), scales);
+        vk_buffer(&V, &bO, 3 * texels * 4, NULL);
+        rg[0] = vk_whole(&bL); rg[1] = vk_whole(&bS); rg[2] = vk_whole(&bO);
+        memset(&pc, 0, sizeof(pc));
+        pc.row_count = (uint32_t)texels; pc.stride = (uint32_t)texels; pc.plane_count = groups;
+        for (r = 0; r < reps; ++r) {
+            double t0 = now();
+            vk_dispatch(&V, &k, rg, &pc, pc.row_count);
+            tg[r] = now() - t0;
+            t0 = now();
+            rad_baker_mix_layers_rgb9e5(packed, groups, texels, scales, mixed, NULL);
+            tc[r] = now() - t0;
+        }
+        {
+            char what[64];
+            snprintf(what, sizeof(what), "layer mix RGB9E5 8 x %u^2 (rad_baker_mix_layers_rgb9e5)", map);
+            row(what, median(tg, reps), median(tc, reps), 4.0 * (double)texels * groups);
+        }
+        vk_buffer_free(&V, &bL); vk_buffer_free(&V, &bS); vk_buffer_free(&V, &bO);
+        vk_kernel_destroy(&V, &k);
+        free(rgb); free(mixed); free(packed);
     }
     if (md) {
         fprintf(md, "\nMB read: the matrix bytes one product reads (temporal: bins and E values touched by the draws).\n");

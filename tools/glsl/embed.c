@@ -38,6 +38,7 @@ static const kernel kernels[] = {
     { "RAD_GLSL_PROBE_UPDATE", "tools/glsl/probe_update.comp" },
     { "RAD_GLSL_LIGHTMAP_REFRESH", "tools/glsl/lightmap_refresh.comp" },
     { "RAD_GLSL_LAYER_MIX", "tools/glsl/layer_mix.comp" },
+    { "RAD_GLSL_LAYER_MIX_RGB9E5", "tools/glsl/layer_mix_rgb9e5.comp" },
 };
 #define KERNELS (sizeof(kernels) / sizeof(kernels[0]))
 
