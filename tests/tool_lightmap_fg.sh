@@ -14,7 +14,7 @@ if "$RAD" trace "$TMP/lfg_room.obj" $LFG_VIEW --spp 256 -o "$TMP/lfg_ref.pfm" > 
     "$RAD" render "$TMP/lfg_room.obj" $LFG_VIEW $LFG_LM --final-gather 0 -o "$TMP/lfg_0.pfm" > /dev/null 2>&1; then
     r=$("$RAD" compare "$TMP/lfg_d.pfm" "$TMP/lfg_ref.pfm" 2> /dev/null | sed -n 's/.*A \/ B = //p')
     r0=$("$RAD" compare "$TMP/lfg_0.pfm" "$TMP/lfg_ref.pfm" 2> /dev/null | sed -n 's/.*A \/ B = //p')
-    close "$r" 1 0.03 && ! close "$r0" 1 0.04 && grep -q "final gather of the first bounce, 16 rays a texel" "$TMP/lfg_err.txt" &&
+    close "$r" 1 0.03 && ! close "$r0" 1 0.04 && grep -q "final gather of the first bounce, 32 rays a texel" "$TMP/lfg_err.txt" &&
         ok "render --method lightmap --proxy aavp traces the first bounce per texel: room under an opening $r of the trace (without: $r0)" ||
         fail "render --method lightmap --proxy aavp traces the first bounce per texel" "room under an opening $r of the trace (without: $r0)"
 else

@@ -107,7 +107,7 @@ static const tool_arg lightmap_table[] = {
     LA_UINT("--final-gather", "N", rq.final_gather, 0, 4096, 0, "is at most 4096",
             "trace the first bounce from each texel with N rays (direct light at the hits, the\n"
             "solution's irradiance there) instead of reading it off the patches' averages\n"
-            "(default: 16 with --proxy aavp|vp, 0 with the classic patches; the engine tier's\n"
+            "(default: 32 with --proxy aavp|vp, 0 with the classic patches; the engine tier's\n"
             "bakes: Jacobi, aavp|vp at the default --face-points or the patches; not --sh)"),
     LA_FLAG("--unwrap", rq.force_unwrap, "unwrap even when the file has a second uv set"),
     {TOOL_ARG_CHOICE, "--proxy", "P", LA(px.kind), 0, 0, 0, 0, NULL, "patches|aavp|vp|hierarchical", proxy_values, NULL, 0,

@@ -1333,7 +1333,7 @@ static const tool_arg render_table[] = {
             "light at the hits, the solution's irradiance there): the indirect light of points a\n"
             "patch average misrepresents; default: vp, aavp and --proxy (no --sequence) 16 while the\n"
             "image's samples times 16 stay within 2^22 rays, else the rays that fit (off below 4:\n"
-            "noise), else 0 (off). lightmap: N rays per texel of the bake instead (default: 16 with\n"
+            "noise), else 0 (off). lightmap: N rays per texel of the bake instead (default: 32 with\n"
             "--proxy aavp|vp, else 0), as rad lightmap --final-gather"),
     RA_CUSTOM("--shading", "MODEL", view.shading, parse_shading, 0,
               "radiosity methods: lighting model for the analytic lights' direct term: none\n"

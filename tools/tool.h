@@ -741,7 +741,7 @@ typedef struct tool_lightmap_request {
    aavp|vp (their voxel averages miss the first bounce, as the renderer's final gather found),
    none for the classic patches */
 #define TOOL_LIGHTMAP_FINAL_GATHER_AUTO 0xFFFFFFFFu
-#define TOOL_LIGHTMAP_FINAL_GATHER 16u
+#define TOOL_LIGHTMAP_FINAL_GATHER 32u
 void tool_lightmap_request_default(tool_lightmap_request *rq);
 /* Solves the classic method (rq->proxy NULL) or virtual patches (E = rho D at their samples, K
    Jacobi bounces of --bounces, Gauss-Seidel with --solver gauss-seidel, H = F (E + L)) over
