@@ -2829,7 +2829,7 @@ RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lightmap, const rad_r
                                        const rad_direct_options *options, float *out, const rad_context *ctx);
 
 /* FINAL GATHER PER TEXEL: the indirect irradiance of each texel traced one bounce further
-   than a solution's patch averages (rad_final_gather of >>api_direct at the texel's valid
+   than a solution's patch averages (rad_final_gather of >>api_light at the texel's valid
    samples: rho (D + H) at the hits of cosine rays, H from the caller's lookup of the
    solution), for the same reason the renderer's final gather exists: a patch (or voxel)
    averages its light over surfaces the texel does not see, too little on open floors, too
@@ -3315,9 +3315,9 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    light samples, seed the bake's seed plus the group): the group's lights and emitters
    light the hits, its solution's irradiance H (rad_vp_gather for virtual patches, the
    patches' per-vertex H for classic) is looked up there. The first bounce is then traced
-   per texel instead of read off the patches' averages. RGB only (refused with
-   the SH encoding); the sky layers keep the plain gather; the runtime refuses such a bake. RAD_BAKER_LIGHTMAP_STITCH
-   runs rad_lightmap_stitch on each layer after its dilation (lightmap_seams reports it; the
+   per texel instead of read off the patches' averages. RGB only (refused with the SH
+   encoding); the sky layers keep the plain gather; the runtime refuses such a bake.
+   RAD_BAKER_LIGHTMAP_STITCH runs rad_lightmap_stitch on each layer after its dilation (lightmap_seams reports it; the
    layers still add: the stitch is a linear projection). rad_baker_runtime_create refuses
    these options (its lightmap is the RGB bounced light). RAD_BAKER_LIGHTMAP_RGB9E5 also keeps
    the groups' lightmap layers packed, 4 bytes a texel (lightmap_rgb9e5, RGB9E5 in >>api_baker,

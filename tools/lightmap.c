@@ -274,6 +274,9 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
                         "the default --face-points, or the classic patches without --max-edge\n", cmd);
         goto fail;
     }
+    if (proxy && proxy->kind != TOOL_LIGHTMAP_HIERARCHICAL && rq->final_gather == TOOL_LIGHTMAP_FINAL_GATHER_AUTO)
+        fprintf(stderr, "rad %s: no final gather per texel off the engine tier's bake: the texels read the voxel averages "
+                        "(--solver jacobi and the default --face-points trace the first bounce)\n", cmd);
     if (lightmap_solve(cmd, co, proxy, out, &vp_H)) goto fail;
     /* the gather wants the total radiosity of the secondary sources: B = E + L */
     t0 = tool_seconds();
