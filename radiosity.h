@@ -2829,6 +2829,25 @@ RAD_API rad_result rad_lightmap_direct(const rad_lightmap *lightmap, const rad_r
                                        const rad_light *lights, uint32_t light_count,
                                        const rad_direct_options *options, float *out, const rad_context *ctx);
 
+/* FINAL GATHER PER TEXEL: the indirect irradiance of each texel traced one bounce further
+   than a solution's patch averages (rad_final_gather of >>api_light at the texel's valid
+   samples: rho (D + H) at the hits of cosine rays, H from the caller's lookup of the
+   solution), for the same reason the renderer's final gather exists: a patch (or voxel)
+   averages its light over surfaces the texel does not see, too little on open floors, too
+   much on the faces beside a bright opening. options->rays is per TEXEL: each of its v
+   valid samples traces ceil(rays / v) (rad_final_gather with that count, seeded by
+   options->seed and v), and the texel holds the mean of its samples. Every texel is
+   written (0 without a valid sample: fill those with rad_lightmap_dilate); RGB irradiance,
+   3 floats per texel. The lights and the emitters of lightmap->scene light the hits (pass a
+   lightmap whose scene is a view emitting only one group's light to bake that group).
+   Errors: those of rad_final_gather, OUT_OF_MEMORY. Cost: rays closest-hit rays per texel
+   (ceil rounds up), a direct-light evaluation and a lookup at each front-facing hit.
+   Reentrant; parallel through ctx->parallel_for; deterministic whatever the thread count. */
+RAD_API rad_result rad_lightmap_final_gather(const rad_lightmap *lightmap, const rad_raycaster *raycaster,
+                                             const rad_light *lights, uint32_t light_count,
+                                             const rad_final_gather_options *options, rad_gather_lookup_fn lookup,
+                                             void *lookup_user, float *out, const rad_context *ctx);
+
 /* DILATION. Every texel without RAD_TEXEL_VALID gets the mean of its 8 neighbours that have a
    value (valid, or filled by an earlier pass), pass after pass: 'passes' passes (0: until
    every texel reachable is filled), so the gutters between charts and invalid texels hold
@@ -3296,8 +3315,15 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    which picks it by valid samples x patches as the default rule does at 5e7.
    RAD_BAKER_LIGHTMAP_DIRECT adds to each group's layer, before dilation, the direct light of
    its lights and emitters per texel (rad_lightmap_direct with light_samples; RGB only, and not
-   with sky layers): the lightmap then holds all the light but emission. RAD_BAKER_LIGHTMAP_STITCH
-   runs rad_lightmap_stitch on each layer after its dilation (lightmap_seams reports it; the
+   with sky layers): the lightmap then holds all the light but emission.
+   rad_baker_options.lightmap_final_gather = R replaces each group's gather (classic or virtual
+   patches) by rad_lightmap_final_gather with R rays per texel (rad_final_gather's default
+   light samples, seed the bake's seed plus the group): the group's lights and emitters
+   light the hits, its solution's irradiance H (rad_vp_gather for virtual patches, the
+   patches' per-vertex H for classic) is looked up there. The first bounce is then traced
+   per texel instead of read off the patches' averages. RGB only (refused with the SH
+   encoding); the sky layers keep the plain gather; the runtime refuses such a bake.
+   RAD_BAKER_LIGHTMAP_STITCH runs rad_lightmap_stitch on each layer after its dilation (lightmap_seams reports it; the
    layers still add: the stitch is a linear projection). rad_baker_runtime_create refuses
    these options (its lightmap is the RGB bounced light). RAD_BAKER_LIGHTMAP_RGB9E5 also keeps
    the groups' lightmap layers packed, 4 bytes a texel (lightmap_rgb9e5, RGB9E5 in >>api_baker,
@@ -3441,6 +3467,8 @@ typedef struct rad_baker_options {
     float vp_voxels_per_path;       /* virtual patches: the voxels along one mean free path the
                                        plan asks for (0: 6.5; PLAN above; 4 when the first bounce
                                        is traced in front of the solution, rad_final_gather) */
+    uint32_t lightmap_final_gather; /* rays per texel of a final gather in front of the solution
+                                       (LIGHTMAP OPTIONS above; 0: none; at most 4096) */
 } rad_baker_options;
 
 /* What rad_baker_options.keep keeps (private). */
@@ -21491,6 +21519,97 @@ done:
     return r;
 }
 
+RAD_API rad_result rad_lightmap_final_gather(const rad_lightmap *lm, const rad_raycaster *raycaster,
+                                             const rad_light *lights, uint32_t light_count,
+                                             const rad_final_gather_options *options, rad_gather_lookup_fn lookup,
+                                             void *lookup_user, float *out, const rad_context *ctx)
+{
+    rad__ctx c;
+    rad_final_gather_options o;
+    rad_context quiet;
+    float *pts = NULL, *nrm = NULL, *G = NULL;
+    uint32_t *sel = NULL, *nv = NULL, i, s, v, most = 0, done = 0, valid = 0, texels;
+    rad_result r = RAD_SUCCESS;
+    rad__ctx_init(&c, ctx);
+    if (!lm || !out) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap final gather: NULL lightmap or output");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (options) o = *options; else memset(&o, 0, sizeof(o));
+    rad__final_gather_options_resolve(&o);
+    if (o.rays > 4096u) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap final gather: rays %u per texel (at most 4096)", o.rays);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    texels = lm->width * lm->height;
+    nv = (uint32_t *)rad__alloc_array(&c.allocator, (size_t)texels + 1, sizeof(uint32_t));
+    pts = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    nrm = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    G = (float *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, 3 * sizeof(float));
+    sel = (uint32_t *)rad__alloc_array(&c.allocator, lm->sample_count ? lm->sample_count : 1u, sizeof(uint32_t));
+    if (!nv || !pts || !nrm || !G || !sel) {
+        rad__log(&c, RAD_LOG_ERROR, "lightmap final gather: out of memory for %u samples", lm->sample_count);
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (i = 0; i < texels; ++i) {
+        nv[i] = 0;
+        for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) nv[i] += lm->sample_valid[s] ? 1u : 0u;
+        if (nv[i] > most) most = nv[i];
+        valid += nv[i];
+    }
+    /* the inner calls report no progress: this one counts the samples gathered */
+    if (ctx) quiet = *ctx;
+    else memset(&quiet, 0, sizeof(quiet));
+    quiet.progress = NULL;
+    /* the texels with v valid samples together: their samples trace the same ray count */
+    for (v = 1; v <= most && r == RAD_SUCCESS; ++v) {
+        rad_final_gather_options ov = o;
+        uint32_t m = 0;
+        for (i = 0; i < texels; ++i) {
+            if (nv[i] != v) continue;
+            for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s) {
+                if (!lm->sample_valid[s]) continue;
+                memcpy(pts + 3 * (size_t)m, lm->sample_positions + 3 * (size_t)s, 3 * sizeof(float));
+                memcpy(nrm + 3 * (size_t)m, lm->sample_normals + 3 * (size_t)s, 3 * sizeof(float));
+                sel[m++] = s;
+            }
+        }
+        if (m == 0) continue;
+        ov.rays = (o.rays + v - 1) / v;
+        ov.seed = rad__hash(o.seed + 0x9E3779B9u * v);
+        r = rad_final_gather(lm->scene, raycaster, lights, light_count, &ov, lookup, lookup_user, pts, nrm, m, G, &quiet);
+        if (r != RAD_SUCCESS) break;
+        /* each sample's value back to its place in the sample order (pts is free again) */
+        for (i = 0; i < m; ++i) memcpy(pts + 3 * (size_t)sel[i], G + 3 * (size_t)i, 3 * sizeof(float));
+        for (i = 0; i < texels; ++i) {
+            double sum[3] = { 0.0, 0.0, 0.0 };
+            uint32_t k;
+            if (nv[i] != v) continue;
+            for (s = lm->sample_first[i]; s < lm->sample_first[i + 1]; ++s)
+                if (lm->sample_valid[s])
+                    for (k = 0; k < 3; ++k) sum[k] += pts[3 * (size_t)s + k];
+            for (k = 0; k < 3; ++k) out[3 * (size_t)i + k] = (float)(sum[k] / (double)v);
+        }
+        done += m;
+        if (c.progress && c.progress(c.progress_user, (float)((double)done / (double)valid))) {
+            rad__log(&c, RAD_LOG_INFO, "lightmap final gather: cancelled by the progress callback");
+            r = RAD_ERROR_CANCELLED;
+        }
+    }
+    if (r == RAD_SUCCESS) {
+        for (i = 0; i < texels; ++i)
+            if (nv[i] == 0) out[3 * (size_t)i] = out[3 * (size_t)i + 1] = out[3 * (size_t)i + 2] = 0.0f;
+        r = rad__check_output(&c, "lightmap final gather", out, 3 * (size_t)texels);
+    }
+done:
+    {
+        void *blocks[] = { nv, pts, nrm, G, sel };
+        rad__free_each(c.allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
+    }
+    return r;
+}
+
 RAD_API rad_result rad_lightmap_dilate(const rad_lightmap *lm, uint32_t channels, float *values, uint32_t passes,
                                        const rad_context *ctx)
 {
@@ -24073,6 +24192,11 @@ static rad_result rad__baker_check(rad__baker *b)
                                            "(its coefficients go negative)");
             return RAD_ERROR_INVALID_ARGUMENT;
         }
+        if (b->o.lightmap_final_gather > 4096u || (b->o.lightmap_final_gather && b->R->lightmap_channels != 3u)) {
+            rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: lightmap_final_gather %u: at most 4096 rays a texel, and RGB "
+                                           "irradiance only (not the SH encoding)", b->o.lightmap_final_gather);
+            return RAD_ERROR_INVALID_ARGUMENT;
+        }
         if ((d->lightmap_flags & RAD_BAKER_LIGHTMAP_RGB9E5_ONLY) && b->o.sky_bands) {
             rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: RAD_BAKER_LIGHTMAP_RGB9E5_ONLY with sky layers (their SH "
                                            "coefficients go negative and stay float: use RAD_BAKER_LIGHTMAP_RGB9E5)");
@@ -24660,6 +24784,37 @@ static rad_result rad__baker_alloc_outputs(rad__baker *b)
 /* The sky layers' transfer into b->sky_T (>>skytransfer, below). */
 static rad_result rad__baker_sky_transfer(rad__baker *b);
 
+/* What the lightmap's final gather looks up: the group's H of the virtual patches, or its
+   per-vertex H of the classic patches */
+typedef struct rad__baker_fg_lookup {
+    rad__baker *b;
+    const float *H;
+} rad__baker_fg_lookup;
+
+static rad_result rad__baker_fg_lookup_fn(void *user, const rad_hit *hits, const float *points, const float *normals,
+                                          uint32_t count, float *out)
+{
+    const rad__baker_fg_lookup *lk = (const rad__baker_fg_lookup *)user;
+    const rad_patches *P = lk->b->patches;
+    uint32_t i, k;
+    if (lk->b->R->method != RAD_BAKER_CLASSIC) {
+        rad_context quiet = lk->b->sub;
+        quiet.progress = NULL;
+        return rad_vp_gather(lk->b->vp, lk->H, points, normals, count, out, &quiet);
+    }
+    for (i = 0; i < count; ++i) {
+        float w[3];
+        uint32_t p = rad_patches_locate(P, hits[i].triangle, hits[i].b1, hits[i].b2, w);
+        const uint32_t *vi;
+        if (p == RAD_NONE) { out[3 * (size_t)i] = out[3 * (size_t)i + 1] = out[3 * (size_t)i + 2] = 0.0f; continue; }
+        vi = P->patches[p].vertices;
+        for (k = 0; k < 3; ++k)
+            out[3 * (size_t)i + k] = w[0] * lk->H[3 * (size_t)vi[0] + k] + w[1] * lk->H[3 * (size_t)vi[1] + k] +
+                                     w[2] * lk->H[3 * (size_t)vi[2] + k];
+    }
+    return RAD_SUCCESS;
+}
+
 /* One layer (plane g: a group's below group_count, sky basis function g - group_count
    after): its source, the bounces, and each output from the solution. */
 static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi)
@@ -24732,7 +24887,7 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     r = rad_matrix_multiply(R->method == RAD_BAKER_CLASSIC ? &b->ff->matrix : &b->vp->matrix, B, H, &b->sub);
     if (r != RAD_SUCCESS) return r;
     RAD__BAKER_PART(0.5f, 0.6f);
-    if (R->method == RAD_BAKER_CLASSIC && (R->vertex_layers || R->solution))
+    if (R->method == RAD_BAKER_CLASSIC && (R->vertex_layers || R->solution || (R->lightmap_layers && b->o.lightmap_final_gather)))
         r = rad_patches_vertex_irradiance(b->patches, H, b->row_sums, V, &b->sub);
     if (r == RAD_SUCCESS && R->solution && g < R->group_count) /* the values the final gather reads (no sky) */
         memcpy(R->solution->layers + (size_t)g * R->solution->count3, R->method == RAD_BAKER_CLASSIC ? V : H,
@@ -24752,7 +24907,20 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
     if (R->lightmap_layers) {
         uint32_t ch = R->lightmap_channels, flags = b->d->lightmap_flags;
         float *out = R->lightmap_layers + (size_t)g * ch * R->lightmap_width * R->lightmap_height;
-        if (R->method == RAD_BAKER_CLASSIC) {
+        if (!sky && b->o.lightmap_final_gather) {
+            /* the group's lights and emitters light the hits; its H is looked up there */
+            rad_scene strict;
+            rad_lightmap lg = *b->lm;
+            rad_final_gather_options fo;
+            rad__baker_fg_lookup lk;
+            lg.scene = rad__baker_group_scene(b, g, &strict, 1);
+            rad_final_gather_options_default(&fo);
+            fo.rays = b->o.lightmap_final_gather;
+            fo.seed = b->o.seed + g;
+            lk.b = b;
+            lk.H = R->method == RAD_BAKER_CLASSIC ? V : H;
+            r = rad_lightmap_final_gather(&lg, &b->rc, b->lights, nl, &fo, rad__baker_fg_lookup_fn, &lk, out, &b->sub);
+        } else if (R->method == RAD_BAKER_CLASSIC) {
             rad_lightmap_gather_options go;
             double pairs = b->o.lightmap_exact_pairs;
             if (b->d->lightmap_gather) {
@@ -25296,6 +25464,12 @@ static rad_result rad__brt_options(rad_baker_runtime *rt, const rad_baker_desc *
     }
     memset(bo, 0, sizeof *bo);
     if (bake_options) *bo = *bake_options;
+    if (bo->lightmap_final_gather) {
+        /* the runtime refreshes its lightmap linearly from H: a traced bounce is not that */
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: a bake with lightmap_final_gather (the runtime refreshes "
+                                   "the plain lightmap gather only)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (!bo->patches) bo->patches = 512;
     if (!bo->bounces) bo->bounces = 16;
     if (!bo->ff_samples) bo->ff_samples = 16;

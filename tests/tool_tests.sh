@@ -1400,6 +1400,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/tool_emissive.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_glb.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_defaults.sh"
 . "$(dirname "${BASH_SOURCE[0]}")/tool_final_gather.sh"
+. "$(dirname "${BASH_SOURCE[0]}")/tool_lightmap_fg.sh"
 
 echo "$passes passed, $failures failed"
 [ $failures -eq 0 ]

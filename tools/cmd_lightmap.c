@@ -1,7 +1,7 @@
 /* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
 
    rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [--size N|WxH] [--sh] [--texel-samples N] [--proxy aavp|vp]
-                [--visibility-rays N] [--gather exact|hemisphere] [--hemisphere-rays N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
+                [--visibility-rays N] [--gather exact|hemisphere] [--hemisphere-rays N] [--final-gather N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
                 [classic options] [--threads N] [--exposure X]
 
    The classic solution (classic.c: patches, F, direct light as the source, B = E + L), or with
@@ -104,6 +104,11 @@ static const tool_arg lightmap_table[] = {
      "hemisphere when samples x patches exceeds 2e7"},
     LA_UINT("--hemisphere-rays", "N", rq.hemisphere_rays, 1, 65536, 0, "must be 1 to 65536",
             "rays per texel of the hemisphere gather (default 256, at most 65536)"),
+    LA_UINT("--final-gather", "N", rq.final_gather, 0, 4096, 0, "is at most 4096",
+            "trace the first bounce from each texel with N rays (direct light at the hits, the\n"
+            "solution's irradiance there) instead of reading it off the patches' averages\n"
+            "(default: 32 with --proxy aavp|vp, 0 with the classic patches; the engine tier's\n"
+            "bakes: Jacobi, aavp|vp at the default --face-points or the patches; not --sh)"),
     LA_FLAG("--unwrap", rq.force_unwrap, "unwrap even when the file has a second uv set"),
     {TOOL_ARG_CHOICE, "--proxy", "P", LA(px.kind), 0, 0, 0, 0, NULL, "patches|aavp|vp|hierarchical", proxy_values, NULL, 0,
      "the indirect light from patches (the classic solution, default), aavp or vp (virtual\n"
@@ -246,6 +251,10 @@ static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_a
     }
     if (la->px.kind && la->rq.sh) {
         fprintf(stderr, "rad lightmap: --sh needs the classic gather (the virtual patches' gather has no direction): leave out --proxy\n");
+        return 2;
+    }
+    if (la->rq.sh && la->rq.final_gather != TOOL_LIGHTMAP_FINAL_GATHER_AUTO && la->rq.final_gather) {
+        fprintf(stderr, "rad lightmap: --final-gather gathers RGB irradiance: leave out --sh\n");
         return 2;
     }
     if (la->rq.sh && lightmap_is_png(la->out)) {

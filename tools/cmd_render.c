@@ -1334,7 +1334,8 @@ static const tool_arg render_table[] = {
             "light at the hits, the solution's irradiance there): the indirect light of points a\n"
             "patch average misrepresents; default: vp, aavp and --proxy (no --sequence) 16 while the\n"
             "image's samples times 16 stay within 2^22 rays, else the rays that fit (off below 4:\n"
-            "noise), else 0 (off)"),
+            "noise), else 0 (off). lightmap: N rays per texel of the bake instead (default: 32 with\n"
+            "--proxy aavp|vp, else 0), as rad lightmap --final-gather"),
     RA_CUSTOM("--shading", "MODEL", view.shading, parse_shading, 0,
               "radiosity methods: lighting model for the analytic lights' direct term: none\n"
               "(default: Lambert through the irradiance), lambert, half-lambert, banded, phong,\n"
@@ -1431,9 +1432,8 @@ static int render_check(const char *cmd, render_args *ra)
         fprintf(stderr, "rad %s: --lightmap-size, --texel-samples and --visibility-rays are for --method lightmap\n", cmd);
         return 2;
     }
-    if (mo->method == TOOL_LIGHTMAP && (ra->bake || ra->view.final_gather)) {
-        fprintf(stderr, "rad %s: --method lightmap bakes its own lightmap: %s is not used\n", cmd,
-                ra->bake ? "--bake" : "--final-gather");
+    if (mo->method == TOOL_LIGHTMAP && ra->bake) {
+        fprintf(stderr, "rad %s: --method lightmap bakes its own lightmap: --bake is not used\n", cmd);
         return 2;
     }
     tool_dense_plan(&ra->o, mo, 0);
@@ -1504,6 +1504,7 @@ static int render_lightmap_method(const char *cmd, const tool_world *w, const re
     tool_lightmap_request rq;
     tool_lightmap_proxy px;
     render_source src;
+    render_view view;
     int rc;
     tool_lightmap_request_default(&rq);
     rq.width = rq.height = (int)ra->lm_size;
@@ -1515,6 +1516,7 @@ static int render_lightmap_method(const char *cmd, const tool_world *w, const re
     px.resolution = ra->mo.vp_resolution;
     px.face_points = ra->mo.face_points;
     rq.proxy = ra->mo.proxy ? &px : NULL;
+    if (ra->given & RENDER_GIVEN_FINAL_GATHER) rq.final_gather = ra->view.final_gather;
     if (tool_lightmap_bake(cmd, w, &ra->o, &rq, &bk)) return 1;
     fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                     "step_ms_min=%.6f\n",
@@ -1524,7 +1526,9 @@ static int render_lightmap_method(const char *cmd, const tool_world *w, const re
     src.P = bk.cl.patches;
     src.lm = bk.lm;
     src.lm_values = bk.values;
-    rc = render_classic(&bk.w, &ra->view, &src, img);
+    view = ra->view;
+    view.final_gather = 0; /* --final-gather was the texels' */
+    rc = render_classic(&bk.w, &view, &src, img);
     tool_lightmap_bake_free(&bk);
     return rc;
 }

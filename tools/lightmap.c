@@ -172,6 +172,9 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
     memset(&bo, 0, sizeof bo);
     bo.keep = 1; /* the texels for the caller; a proxy's rows sparse, as tool_vp_proxy_solve builds them */
     bo.lightmap_samples = rq->texel_samples;
+    bo.lightmap_final_gather = rq->final_gather != TOOL_LIGHTMAP_FINAL_GATHER_AUTO ? rq->final_gather
+                               : px                                               ? TOOL_LIGHTMAP_FINAL_GATHER
+                                                                                  : 0u;
     if (px) {
         if (px->resolution) vo.resolution = px->resolution;
         bo.vp_kind = px->kind == TOOL_PROXY_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
@@ -200,8 +203,11 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
     if (px)
         fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
                 px->kind == TOOL_PROXY_VP ? "vp" : "aavp", R->vp_resolution, R->patch_count);
+    if (bo.lightmap_final_gather)
+        fprintf(stderr, "rad %s: final gather of the first bounce, %u rays a texel%s\n", cmd, bo.lightmap_final_gather,
+                rq->final_gather == TOOL_LIGHTMAP_FINAL_GATHER_AUTO ? " (the virtual patches' default; --final-gather 0: off)" : "");
     if (lightmap_texels_report(cmd, lm)) return 1;
-    if (!px && (rq->gather == RAD_LIGHTMAP_GATHER_HEMISPHERE ||
+    if (!px && !bo.lightmap_final_gather && (rq->gather == RAD_LIGHTMAP_GATHER_HEMISPHERE ||
                 (rq->gather == TOOL_LIGHTMAP_GATHER_AUTO && (double)lm->sample_count * R->patch_count > bo.lightmap_exact_pairs)))
         fprintf(stderr, "rad %s: hemisphere gather, %u rays a texel (--gather exact for the exact one)\n", cmd, rq->hemisphere_rays);
     n = (size_t)R->lightmap_channels * lm->width * lm->height;
@@ -222,6 +228,7 @@ void tool_lightmap_request_default(tool_lightmap_request *rq)
     rq->visibility_rays = TOOL_LIGHTMAP_VISIBILITY_RAYS;
     rq->gather = TOOL_LIGHTMAP_GATHER_AUTO;
     rq->hemisphere_rays = TOOL_LIGHTMAP_HEMISPHERE_RAYS;
+    rq->final_gather = TOOL_LIGHTMAP_FINAL_GATHER_AUTO;
 }
 
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co,
@@ -262,6 +269,14 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         if (k > 0) goto fail;
         if (k == 0) return 0;
     }
+    if (rq->final_gather != TOOL_LIGHTMAP_FINAL_GATHER_AUTO && rq->final_gather) {
+        fprintf(stderr, "rad %s: --final-gather is for the engine tier's bakes: --solver jacobi with --proxy aavp|vp at "
+                        "the default --face-points, or the classic patches without --max-edge\n", cmd);
+        goto fail;
+    }
+    if (proxy && proxy->kind != TOOL_LIGHTMAP_HIERARCHICAL && rq->final_gather == TOOL_LIGHTMAP_FINAL_GATHER_AUTO)
+        fprintf(stderr, "rad %s: no final gather per texel off the engine tier's bake: the texels read the voxel averages "
+                        "(--solver jacobi and the default --face-points trace the first bounce)\n", cmd);
     if (lightmap_solve(cmd, co, proxy, out, &vp_H)) goto fail;
     /* the gather wants the total radiosity of the secondary sources: B = E + L */
     t0 = tool_seconds();

@@ -733,7 +733,15 @@ typedef struct tool_lightmap_request {
     int force_unwrap;            /* unwrap even when the file has a second uv set */
     int direct;                  /* RGB: add the direct light of the lights and emitters per texel */
     const tool_lightmap_proxy *proxy; /* the indirect light from a proxy (NULL: classic patches) */
+    uint32_t final_gather;       /* rays per texel of the final gather in front of the solution
+                                    (rad_baker_options.lightmap_final_gather; 0: none), or
+                                    TOOL_LIGHTMAP_FINAL_GATHER_AUTO; the engine tier's bakes only */
 } tool_lightmap_request;
+/* tool_lightmap_request.final_gather: TOOL_LIGHTMAP_FINAL_GATHER rays per texel with --proxy
+   aavp|vp (their voxel averages miss the first bounce, as the renderer's final gather found),
+   none for the classic patches */
+#define TOOL_LIGHTMAP_FINAL_GATHER_AUTO 0xFFFFFFFFu
+#define TOOL_LIGHTMAP_FINAL_GATHER 32u
 void tool_lightmap_request_default(tool_lightmap_request *rq);
 /* Solves the classic method (rq->proxy NULL) or virtual patches (E = rho D at their samples, K
    Jacobi bounces of --bounces, Gauss-Seidel with --solver gauss-seidel, H = F (E + L)) over
