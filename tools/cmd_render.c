@@ -1718,11 +1718,12 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         tool_close_world(&w);
         return 1;
     }
-    /* a render that will trace the first bounce (the final gather, given or by default) meets
-       the patches' average one bounce later: the plan asks for 4 voxels a mean free path, not 6.5 */
-    traced = (ra.given & RENDER_GIVEN_FINAL_GATHER)
-                 ? ra.view.final_gather != 0
-                 : ra.mo.method != TOOL_LIGHTMAP && !ra.mo.sequence && auto_final_gather(&ra.view) != 0;
+    /* a render that will trace the first bounce (the final gather at its pixels, or at the
+       lightmap's texels over virtual patches; given or by default) meets the patches' average
+       one bounce later: the plan asks for 4 voxels a mean free path, not 6.5 */
+    traced = (ra.given & RENDER_GIVEN_FINAL_GATHER) ? ra.view.final_gather != 0
+             : ra.mo.method == TOOL_LIGHTMAP        ? ra.mo.proxy == TOOL_PROXY_AAVP || ra.mo.proxy == TOOL_PROXY_VP
+                                                    : !ra.mo.sequence && auto_final_gather(&ra.view) != 0;
     if (!ra.bake && (!(ra.mo.given & TOOL_OPT_METHOD) ||
                      ((ra.mo.method == TOOL_AAVP || ra.mo.method == TOOL_VP || ra.mo.proxy == TOOL_PROXY_AAVP ||
                        ra.mo.proxy == TOOL_PROXY_VP) &&
