@@ -1389,7 +1389,11 @@ RAD_API rad_result rad_solve_stochastic(const rad_patches *patches, const rad_ra
    side lights only the triangles facing that side), before the push: exactly where every
    member's normal faces the source (a cone of the members' normals says so), else by the
    quadratic fit 3/32 + t/2 + 15/32 t^2 of the clamped cosine t = n . w (its Legendre series
-   to degree 2), so the gather is O(links + clusters + triangles) a sweep. Reentrant; the
+   to degree 2), each member's share also weighted by its openness past that cluster (with
+   visibility: of 16 cosine rays from the member, the share that ends outside the cluster's
+   bounding sphere or nowhere, cast once per scene triangle at the start of the solve), so a
+   member hidden behind others of its cluster does not take the light its visible neighbours
+   receive; the gather is O(links + triangles x tree depth) a sweep. Reentrant; the
    solve uses ctx->parallel_for for the links' form factors and the clusters' gather; after it
    the accessors and lookups only read (any threads at once). Progress is reported after each
    level of refinement and each sweep (cancel stops either within that step); memory_limit
@@ -11397,6 +11401,7 @@ done:
 #define RAD__HR_SOURCE_BATCH 4096u
 #define RAD__HR_ROW_CAP 1.2      /* largest form-factor sum a leaf gathers over */
 #define RAD__HR_MAX_GAIN 0.999   /* largest rho times that sum */
+#define RAD__HR_OPEN_RAYS 16u    /* rays per scene triangle for its openness past each cluster above it */
 
 /* One quadtree node. Children are 4 consecutive elements, made after their parent, so index
    order is a top-down order and its reverse a bottom-up one. */
@@ -11461,6 +11466,10 @@ struct rad_hierarchical {
     float *vert_B, *vert_H;
     rad__hr_cluster *cl;     /* NULL without clustering */
     uint32_t ncl, *perm, *tri_parent;
+    uint8_t *cl_depth;       /* per cluster: its depth in the tree (the root 0) */
+    uint8_t *open;           /* per scene triangle and cluster depth: of RAD__HR_OPEN_RAYS cosine rays from
+                                the triangle, how many end outside that ancestor's sphere (NULL: no visibility) */
+    uint32_t open_levels;    /* the deepest cluster's depth + 1 (open's stride) */
     double *cum_area;        /* cum_area[i]: the area of perm[0, i) */
     rad__hr_in *in;          /* links into clusters, grouped by receiver: in_first[c] .. in_first[c + 1] */
     uint32_t *in_first;
@@ -11511,7 +11520,7 @@ RAD_API void rad_hierarchical_destroy(rad_hierarchical *h)
 {
     if (h) {
         void *blocks[] = { h->el, h->links, h->leaf, h->leaf_of, h->leaf_vert, h->vert_B, h->vert_H, h->cl,
-                           h->perm, h->tri_parent, h->cum_area, h->in, h->in_first, h->acc, h };
+                           h->perm, h->tri_parent, h->cum_area, h->in, h->in_first, h->acc, h->cl_depth, h->open, h };
         rad__free_each(h->allocator, blocks, sizeof(blocks) / sizeof(blocks[0]));
     }
 }
@@ -11680,6 +11689,7 @@ static double rad__hr_received(const rad_hierarchical *h, uint32_t id, const flo
         uint32_t t = h->perm[j];
         double c = (double)rad__dot(h->scene->normals + 3 * (size_t)t, u);
         double g = front ? c : (3.0 / 32.0) + 0.5 * c + (15.0 / 32.0) * c * c;
+        if (h->open) g *= (double)h->open[(size_t)t * h->open_levels + h->cl_depth[id & ~RAD__HR_CL]] / (double)RAD__HR_OPEN_RAYS;
         if (g > 0.0) p += (double)h->scene->areas[t] * g;
     }
     *count += cl->hi - cl->lo;
@@ -12636,6 +12646,98 @@ static rad_result rad__hr_build_in(rad_hierarchical *h, const rad__ctx *c)
     return RAD_SUCCESS;
 }
 
+typedef struct rad__hr_open_job {
+    rad_hierarchical *h;
+    uint32_t tasks;
+    rad_result *results;
+} rad__hr_open_job;
+
+/* Per scene triangle, RAD__HR_OPEN_RAYS cosine rays from points on it (hashed from the
+   triangle: any thread count gives the same bits), and per cluster above it how many of
+   them end outside that cluster's sphere or nowhere: the share of its hemisphere that sees
+   past the cluster, where a link into the cluster brings its light from. */
+static void rad__hr_open_task(void *data, uint32_t task)
+{
+    rad__hr_open_job *job = (rad__hr_open_job *)data;
+    rad_hierarchical *h = job->h;
+    uint32_t T = h->scene->triangle_count, i, q, cc;
+    uint32_t b = (uint32_t)((uint64_t)T * task / job->tasks), e = (uint32_t)((uint64_t)T * (task + 1u) / job->tasks);
+    rad_ray rays[RAD__HR_OPEN_RAYS];
+    rad_hit hits[RAD__HR_OPEN_RAYS];
+    job->results[task] = RAD_SUCCESS;
+    for (i = b; i < e; ++i) {
+        const float *v = h->scene->positions + 9 * (size_t)i, *n = h->scene->normals + 3 * (size_t)i;
+        float t1[3], t2[3];
+        int k;
+        rad__tangent_frame(n, t1, t2);
+        for (q = 0; q < RAD__HR_OPEN_RAYS; ++q) {
+            uint32_t h1 = rad__hash(h->o.seed ^ rad__hash(i * RAD__HR_OPEN_RAYS + q + 0x5bd1e995u)), h2 = rad__hash(h1);
+            float p[3];
+            double a = ((double)q + (double)(h2 & 0xFFFFu) / 65536.0) / (double)RAD__HR_OPEN_RAYS;
+            double ph = 2.0 * RAD__PI * (double)(h2 >> 16) / 65536.0, sr = sqrt(a), cz = sqrt(1.0 - a);
+            rad__triangle_point(v, v + 3, v + 6, (float)(h1 & 0xFFFFu) / 65536.0f, (float)(h1 >> 16) / 65536.0f, p);
+            for (k = 0; k < 3; ++k) {
+                rays[q].origin[k] = p[k] + h->ray_eps * n[k];
+                rays[q].dir[k] = (float)(sr * cos(ph) * (double)t1[k] + sr * sin(ph) * (double)t2[k] + cz * (double)n[k]);
+            }
+            rays[q].tmin = 0.0f;
+            rays[q].tmax = FLT_MAX;
+        }
+        if (h->rc.intersect(h->rc.user, rays, RAD__HR_OPEN_RAYS, hits) != RAD_SUCCESS) {
+            job->results[task] = RAD_ERROR_RAYCAST_FAILED;
+            return;
+        }
+        for (cc = h->tri_parent[i]; cc != RAD_NONE; cc = h->cl[cc].parent) {
+            const rad__hr_cluster *C = &h->cl[cc];
+            uint32_t out = 0;
+            for (q = 0; q < RAD__HR_OPEN_RAYS; ++q) {
+                float x[3], d[3];
+                if (hits[q].triangle == RAD_NONE) { ++out; continue; }
+                for (k = 0; k < 3; ++k) x[k] = rays[q].origin[k] + hits[q].t * rays[q].dir[k];
+                rad__sub(d, x, C->c);
+                if (rad__dot(d, d) > C->radius * C->radius) ++out;
+            }
+            h->open[(size_t)i * h->open_levels + h->cl_depth[cc]] = (uint8_t)out;
+        }
+    }
+}
+
+static rad_result rad__hr_openness(rad_hierarchical *h, const rad__ctx *c)
+{
+    uint32_t T = h->scene->triangle_count, i, depth = 0;
+    rad__hr_open_job job;
+    rad_result r = RAD_SUCCESS;
+    h->cl_depth = (uint8_t *)rad__alloc_array(&h->allocator, h->ncl ? h->ncl : 1u, 1);
+    if (!h->cl_depth) goto oom;
+    for (i = 0; i < h->ncl; ++i) { /* parents come first */
+        uint32_t d = i == 0 ? 0u : (uint32_t)h->cl_depth[h->cl[i].parent] + 1u;
+        if (d > 255u) return RAD_SUCCESS; /* a degenerate tree: the cosine split alone (open stays NULL) */
+        h->cl_depth[i] = (uint8_t)d;
+        if (d > depth) depth = d;
+    }
+    h->open_levels = depth + 1u;
+    h->open = (uint8_t *)rad__alloc_array(&h->allocator, T, h->open_levels);
+    job.tasks = (T + 1023u) / 1024u < c->tasks ? (T + 1023u) / 1024u : c->tasks;
+    if (job.tasks == 0) job.tasks = 1;
+    job.h = h;
+    job.results = (rad_result *)rad__alloc_array(&h->allocator, job.tasks, sizeof(rad_result));
+    if (!h->open || !job.results) {
+        rad__free(&h->allocator, job.results);
+        goto oom;
+    }
+    memset(h->open, RAD__HR_OPEN_RAYS, (size_t)T * h->open_levels);
+    c->parallel_for(c->parallel_user, job.tasks, rad__hr_open_task, &job);
+    for (i = 0; i < job.tasks; ++i)
+        if (job.results[i] != RAD_SUCCESS && r == RAD_SUCCESS) r = job.results[i];
+    rad__free(&h->allocator, job.results);
+    if (r != RAD_SUCCESS) rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: the raycaster failed");
+    h->st.rays_cast += (uint64_t)T * RAD__HR_OPEN_RAYS;
+    return r;
+oom:
+    rad__log(c, RAD_LOG_ERROR, "rad_hierarchical_solve: out of memory for the triangles' openness");
+    return RAD_ERROR_OUT_OF_MEMORY;
+}
+
 typedef struct rad__hr_gather {
     rad_hierarchical *h;
     uint32_t tasks, phase;
@@ -12689,22 +12791,28 @@ static void rad__hr_gather_task(void *data, uint32_t task)
             }
         } else {
             rad__hr_elem *el = &h->el[i];
-            const double *a;
             double N[3], G[4];
-            if (h->tri_parent[i] == RAD_NONE) continue;
-            a = h->acc + (size_t)h->tri_parent[i] * 4u * RAD__HR_ACC;
+            uint32_t cc;
             for (q = 0; q < 3; ++q) N[q] = (double)el->n[q];
-            for (k = 0; k < 4; ++k) {
-                const double *ak = a + k * RAD__HR_ACC;
-                double front = N[0] * ak[0] + N[1] * ak[1] + N[2] * ak[2];
-                double lin = N[0] * ak[4] + N[1] * ak[5] + N[2] * ak[6];
-                double quad = N[0] * N[0] * ak[7] + N[1] * N[1] * ak[8] + N[2] * N[2] * ak[9] +
-                              2.0 * (N[0] * N[1] * ak[10] + N[0] * N[2] * ak[11] + N[1] * N[2] * ak[12]);
-                double mixed = (3.0 / 32.0) * ak[3] + 0.5 * lin + (15.0 / 32.0) * quad;
-                G[k] = (front > 0.0 ? front : 0.0) + (mixed > 0.0 ? mixed : 0.0);
+            /* with openness each cluster above the triangle weighs its sums by what the
+               triangle sees past that cluster; without, the sums were handed down (phase 1)
+               and the parent's hold them all */
+            for (cc = h->tri_parent[i]; cc != RAD_NONE; cc = h->open ? h->cl[cc].parent : RAD_NONE) {
+                const double *a = h->acc + (size_t)cc * 4u * RAD__HR_ACC;
+                double ow = h->open ? (double)h->open[(size_t)i * h->open_levels + h->cl_depth[cc]] / (double)RAD__HR_OPEN_RAYS : 1.0;
+                if (!(ow > 0.0)) continue;
+                for (k = 0; k < 4; ++k) {
+                    const double *ak = a + k * RAD__HR_ACC;
+                    double front = N[0] * ak[0] + N[1] * ak[1] + N[2] * ak[2];
+                    double lin = N[0] * ak[4] + N[1] * ak[5] + N[2] * ak[6];
+                    double quad = N[0] * N[0] * ak[7] + N[1] * N[1] * ak[8] + N[2] * N[2] * ak[9] +
+                                  2.0 * (N[0] * N[1] * ak[10] + N[0] * N[2] * ak[11] + N[1] * N[2] * ak[12]);
+                    double mixed = (3.0 / 32.0) * ak[3] + 0.5 * lin + (15.0 / 32.0) * quad;
+                    G[k] = ow * ((front > 0.0 ? front : 0.0) + (mixed > 0.0 ? mixed : 0.0));
+                }
+                for (k = 0; k < 3; ++k) el->G[k] += G[k];
+                el->S += G[3];
             }
-            for (k = 0; k < 3; ++k) el->G[k] += G[k];
-            el->S += G[3];
         }
     }
 }
@@ -12745,7 +12853,7 @@ static rad_result rad__hr_sweep(rad_hierarchical *h, const rad__ctx *c, double *
         g.tasks = (h->ncl + 1023u) / 1024u < c->tasks ? (h->ncl + 1023u) / 1024u : c->tasks;
         if (g.tasks == 0) g.tasks = 1;
         c->parallel_for(c->parallel_user, g.tasks, rad__hr_gather_task, &g);
-        for (i = 1; i < h->ncl; ++i) { /* down the tree: parents come first */
+        for (i = h->open ? h->ncl : 1u; i < h->ncl; ++i) { /* down the tree: parents come first */
             double *a = h->acc + (size_t)i * 4u * RAD__HR_ACC;
             const double *p = h->acc + (size_t)h->cl[i].parent * 4u * RAD__HR_ACC;
             for (k = 0; k < 4u * RAD__HR_ACC; ++k) a[k] += p[k];
@@ -12942,6 +13050,7 @@ RAD_API rad_result rad_hierarchical_solve(rad_hierarchical *h, const rad_context
         memcpy(e->B, e->E, sizeof(e->B));
     }
     h->eps_abs = h->o.tolerance * P;
+    if (h->cl && !h->o.skip_visibility && (r = rad__hr_openness(h, &c)) != RAD_SUCCESS) return r;
     memset(&L, 0, sizeof(L));
     if (h->cl) { /* one link, the root cluster to itself */
         rad__hr_cluster_pull(h);
