@@ -740,4 +740,66 @@ static inline int fx_classic_jacobi8(const rad_scene *S, const rad_raycaster *rc
     return 1;
 }
 
+/* ---- hierarchical radiosity scenes (test_hier_source.c, test_hier_open.c) --------------- */
+
+/* (hierarchical tests) the unit square [x0, x0 + 1] x [0, 1] at height z, cut g x g into
+   triangles, facing +z (up) or -z, appended to v (9 floats a triangle); returns the triangles
+   added */
+static inline uint32_t fx_square_grid(float *v, float x0, float z, int up, uint32_t g)
+{
+    uint32_t i, j, n = 0, c;
+    for (i = 0; i < g; ++i)
+        for (j = 0; j < g; ++j) {
+            float q[4][3];
+            static const int tri[2][3] = { { 0, 1, 2 }, { 0, 2, 3 } };
+            q[0][0] = q[3][0] = x0 + (float)i / (float)g;
+            q[1][0] = q[2][0] = x0 + (float)(i + 1u) / (float)g;
+            q[0][1] = q[1][1] = (float)j / (float)g;
+            q[2][1] = q[3][1] = (float)(j + 1u) / (float)g;
+            for (c = 0; c < 4; ++c) q[c][2] = z;
+            for (c = 0; c < 2; ++c) { /* counter-clockwise seen from +z; swapped for -z */
+                int k, o[3] = { tri[c][0], up ? tri[c][1] : tri[c][2], up ? tri[c][2] : tri[c][1] };
+                for (k = 0; k < 3; ++k) memcpy(v + 9u * n + 3u * (uint32_t)k, q[o[k]], 3 * sizeof(float));
+                ++n;
+            }
+        }
+    return n;
+}
+
+/* (hierarchical tests) the area-weighted mean B (channel 0) of the leaves on scene triangles
+   [t0, t1) */
+static inline double fx_hier_mean_B(const rad_hierarchical *h, uint32_t t0, uint32_t t1)
+{
+    rad_hierarchical_stats st;
+    float *C, *B;
+    uint32_t *T, i, nl;
+    double a = 0.0, s = 0.0;
+    rad_hierarchical_get_stats(h, &st);
+    nl = st.leaves;
+    C = (float *)malloc(sizeof(float) * 9u * nl);
+    B = (float *)malloc(sizeof(float) * 3u * nl);
+    T = (uint32_t *)malloc(sizeof(uint32_t) * nl);
+    if (C && B && T && rad_hierarchical_leaves(h, 0, nl, C, T, B, NULL) == RAD_SUCCESS) {
+        for (i = 0; i < nl; ++i) {
+            double e1[3], e2[3], x, y, z;
+            int k;
+            if (T[i] < t0 || T[i] >= t1) continue;
+            for (k = 0; k < 3; ++k) {
+                e1[k] = (double)C[9 * i + 3 + k] - (double)C[9 * i + k];
+                e2[k] = (double)C[9 * i + 6 + k] - (double)C[9 * i + k];
+            }
+            x = e1[1] * e2[2] - e1[2] * e2[1];
+            y = e1[2] * e2[0] - e1[0] * e2[2];
+            z = e1[0] * e2[1] - e1[1] * e2[0];
+            x = 0.5 * sqrt(x * x + y * y + z * z);
+            a += x;
+            s += x * (double)B[3 * i];
+        }
+    }
+    free(C);
+    free(B);
+    free(T);
+    return a > 0.0 ? s / a : -1.0;
+}
+
 #endif

@@ -1,6 +1,6 @@
 /* test_hier_open.c - hierarchical radiosity (>>api_hierarchical): how a cluster receiver splits
    a link's light among its members when some of them are hidden behind others. Uses the
-   helpers of test_hier_source.c (hsrc_square, hsrc_mean_B). Its names are prefixed hopen_. */
+   fixtures (fx_square_grid, fx_hier_mean_B). Its names are prefixed hopen_. */
 #include "fixtures.h"
 
 /* 1. A shelf of two plates facing down, 1 and 1.05 above a lamp on the floor (each plate three
@@ -24,10 +24,10 @@ static void hopen_test_shelf(void)
         return;
     }
     /* triangles: the lamp [0, per), the lower plate [per, 4 per), the upper plate [4 per, 7 per) */
-    n += hsrc_square(v + 9u * n, 0.0f, 0.0f, 1, g);
+    n += fx_square_grid(v + 9u * n, 0.0f, 0.0f, 1, g);
     for (i = 0; i < per; ++i) ids[i] = 1;
-    for (i = 0; i < 3; ++i) n += hsrc_square(v + 9u * n, (float)i - 1.0f, 1.0f, 0, g);
-    for (i = 0; i < 3; ++i) n += hsrc_square(v + 9u * n, (float)i - 1.0f, 1.05f, 0, g);
+    for (i = 0; i < 3; ++i) n += fx_square_grid(v + 9u * n, (float)i - 1.0f, 1.0f, 0, g);
+    for (i = 0; i < 3; ++i) n += fx_square_grid(v + 9u * n, (float)i - 1.0f, 1.05f, 0, g);
     memset(mats, 0, sizeof(mats));
     for (i = 0; i < 3; ++i) {
         mats[0].albedo[i] = 0.5f;
@@ -66,10 +66,10 @@ static void hopen_test_shelf(void)
             rad_hierarchical_stats st;
             rad_hierarchical_get_stats(h, &st);
             if (pass == 1) CHECK(st.cluster_links > 0);
-            lower_B[pass] = hsrc_mean_B(h, per, 4u * per);
+            lower_B[pass] = fx_hier_mean_B(h, per, 4u * per);
             printf("    shelf, clustering %s: %llu links (%llu at clusters), lower plate B %.5f, upper %.5f\n",
                    pass == 0 ? "off" : "on", (unsigned long long)st.links, (unsigned long long)st.cluster_links,
-                   lower_B[pass], hsrc_mean_B(h, 4u * per, 7u * per));
+                   lower_B[pass], fx_hier_mean_B(h, 4u * per, 7u * per));
         }
         rad_hierarchical_destroy(h);
         rad_bvh_destroy(bvh);
