@@ -1,24 +1,10 @@
-/* cmd_render.c - `rad render`: an image of a scene by the classic radiosity method (per-pixel
-   direct light + indirect light from the patches) or by path tracing.
+/* cmd_render.c - `rad render`: the command line, the camera, the method (the library's plan
+   when none is given) and the image written. The engine tier bakes the production methods
+   (classic and virtual patches, rad_baker_run) and the pixels read its solution
+   (rad_baker_irradiance); pixels.c draws every radiosity image; render_methods.c holds the
+   teaching methods step by step over the method-level calls (multibounce, temporal,
+   stochastic, hierarchical, local, --bake files); lightmap.c the lightmap bake.
 
-   Classic (direct light as the source, as examples/cornell.c): a camera ray per sample finds the surface;
-   the direct irradiance D is computed at that point with shadow rays (rad_direct_irradiance:
-   the emissive triangles analytically times the unoccluded fraction, plus the file's analytic
-   lights); H = F (E + L) = F B, the irradiance from the secondary sources, is smoothed to the
-   patch vertices and interpolated; the sample's radiance is albedo/pi * (D + H), plus the
-   emitted radiance where the ray sees the front of an emitter. Each pixel is the box-filtered
-   mean of --aa stratified samples. The solution is computed in memory, or loaded from a bake
-   (--bake FILE.radb: its patches, F, E and B, checked against the scene).
-
-   Multibounce and temporal (render_with_method, render_method): the same pixels, with the
-   patches' H from methods.c (L = F_mb E, or the temporal frames, H = L / rho) and the halo
-   correction from the bake's row sums of F.
-
-   Local (render_local_method; Shcherbakov 2025, ch. 4, in docs/references.md): the classic patches, F and E; a rad_local of capacity
-   --local-m M (default: every patch, up to TOOL_LOCAL_M_AUTO_MAX) filled with the M patches
-   nearest the camera (rad_local_nearest, one
-   rad_local_rebuild), L = T E over P_Vis x P_Lit (rad_local_visible, rad_local_lit), H = L / rho
-   and the classic render; patches outside the set or not visible get no indirect light.
    Virtual patches (render_vp_method; Shcherbakov 2025, ch. 5): rad_vp_create (vp: RAD_VP_CLUSTERED, aavp:
    RAD_VP_AXIS_ALIGNED) at --vp-resolution or at the finest resolution within --vp-max-patches,
    E = rad_vp_sources, Jacobi --bounces K (inf: Gauss-Seidel), H = F (E + L) per patch, and the
@@ -41,592 +27,6 @@
 #endif
 
 #define PI_F 3.14159265358979323846f
-
-static void *xmalloc(size_t size)
-{
-    void *p = malloc(size ? size : 1);
-    if (!p) {
-        fprintf(stderr, "rad render: out of memory (%lu bytes)\n", (unsigned long)size);
-        exit(1);
-    }
-    return p;
-}
-
-/* Per-vertex H without dark halos where a patch is partly covered (rad_patches_vertex_irradiance).
-   S: the row sums of F (how much of its hemisphere each patch sees). */
-static int vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv)
-{
-    rad_context ctx;
-    rad_result r;
-    tool_context(&ctx, NULL);
-    r = rad_patches_vertex_irradiance(P, H, S, Hv, &ctx);
-    return r == RAD_SUCCESS ? 0 : tool_fail("render", "per-vertex H", r);
-}
-
-/* the same with the row sums computed from F */
-static int vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, float *Hv)
-{
-    uint32_t n = P->count, i;
-    float *ones = (float *)xmalloc(sizeof(float) * 3 * n), *rs = (float *)xmalloc(sizeof(float) * 3 * n);
-    float *S = (float *)xmalloc(sizeof(float) * n);
-    rad_context ctx;
-    rad_result r;
-    int rc;
-    tool_context(&ctx, NULL);
-    for (i = 0; i < 3 * n; ++i) ones[i] = 1.0f;
-    r = rad_matrix_multiply(F, ones, rs, &ctx);
-    for (i = 0; i < n; ++i) S[i] = rs[3 * i];
-    rc = r == RAD_SUCCESS ? vertex_H_rowsums(P, S, H, Hv) : tool_fail("render", "per-vertex H", r);
-    free(ones);
-    free(rs);
-    free(S);
-    return rc;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* What render_classic draws: the view and the per-pixel options of the command line */
-typedef struct render_view {
-    rad_camera cam;
-    int width, height;
-    uint32_t aa;             /* --aa: stratified samples per pixel */
-    uint32_t light_samples;  /* --pixel-light-samples */
-    float exposure;          /* --exposure (PNG frames of --sequence) */
-    int shading;             /* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
-    uint32_t final_gather;   /* --final-gather N: rays per sample for one traced bounce (0: off) */
-} render_view;
-
-/* Where render_classic takes the irradiance H from the secondary sources at a sample: the
-   first of baker (the engine tier's own final gather, rad_baker_irradiance), vp (rad_vp_gather
-   of vp_H), hr (the hierarchical solution's smooth lookup) and lm (a bilinear lookup of the
-   RGB irradiance lightmap lm_values at the sample's lightmap uv) that is set, else the
-   per-vertex Hv of the patches P. */
-typedef struct render_source {
-    const rad_patches *P;
-    const float *Hv;
-    const rad_virtual_patches *vp;
-    const float *vp_H;
-    const rad_hierarchical *hr;
-    const rad_lightmap *lm;
-    const float *lm_values;
-    const rad_baker_result *baker; /* the engine tier's kept solution (rad_baker_irradiance) */
-    double gather_seconds;   /* out: the time spent in the gathers and lookups */
-} render_source;
-
-/* rad render's command line */
-typedef struct render_args {
-    const char *scene, *out, *bake; /* SCENE, -o, --bake */
-    tool_classic_options o;
-    tool_method_options mo;
-    render_view view;
-    float fov;               /* --fov (0: the camera's) */
-    uint32_t spp;            /* --spp: pathtrace samples per pixel */
-    uint32_t threads;        /* --threads */
-    uint32_t lm_size, lm_samples, lm_vis; /* --lightmap-size, --texel-samples, --visibility-rays */
-    uint32_t given;          /* RENDER_GIVEN_* */
-} render_args;
-/* render_args.given: --camera; --lightmap-size (else an unwrap too fine for it gets a larger
-   atlas); one of the lightmap options */
-enum { RENDER_GIVEN_CAMERA = 1, RENDER_GIVEN_LM_SIZE = 2, RENDER_GIVEN_LM = 4, RENDER_GIVEN_FINAL_GATHER = 8 };
-
-static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, const uint32_t *valid, uint32_t count,
-                            float *out);
-
-/* H at the final gather's hits: the virtual patches' gather, or the patches' per-vertex H */
-static rad_result fg_lookup_fn(void *user, const rad_hit *hits, const float *points, const float *normals, uint32_t count,
-                               float *out)
-{
-    const render_source *l = (const render_source *)user;
-    uint32_t k;
-    int i;
-    if (l->vp) {
-        rad_context quiet;
-        tool_context(&quiet, NULL);
-        return rad_vp_gather(l->vp, l->vp_H, points, normals, count, out, &quiet);
-    }
-    if (l->hr) return hr_lookup(l->hr, hits, NULL, count, out);
-    if (l->baker) {
-        /* the engine tier's solution: without this the hits got no bounced light at all */
-        rad_context quiet;
-        tool_context(&quiet, NULL);
-        return rad_baker_irradiance(l->baker, hits, points, normals, count, out, &quiet);
-    }
-    for (k = 0; k < count; ++k) {
-        float wts[3];
-        uint32_t p = rad_patches_locate(l->P, hits[k].triangle, hits[k].b1, hits[k].b2, wts);
-        const uint32_t *vi;
-        if (p == RAD_NONE) { out[3 * k] = out[3 * k + 1] = out[3 * k + 2] = 0.0f; continue; }
-        vi = l->P->patches[p].vertices;
-        for (i = 0; i < 3; ++i)
-            out[3 * k + i] = wts[0] * l->Hv[3 * (size_t)vi[0] + i] + wts[1] * l->Hv[3 * (size_t)vi[1] + i] +
-                             wts[2] * l->Hv[3 * (size_t)vi[2] + i];
-    }
-    return RAD_SUCCESS;
-}
-
-/* H of the hierarchical solution at hits[valid[k]] (valid NULL: hits[k]), k < count */
-static rad_result hr_lookup(const rad_hierarchical *hr, const rad_hit *hits, const uint32_t *valid, uint32_t count,
-                            float *out)
-{
-    uint32_t *tris = (uint32_t *)xmalloc(sizeof(uint32_t) * (count ? count : 1u)), k;
-    float *bary = (float *)xmalloc(sizeof(float) * 2 * (count ? count : 1u));
-    rad_result r;
-    for (k = 0; k < count; ++k) {
-        const rad_hit *h = &hits[valid ? valid[k] : k];
-        tris[k] = h->triangle;
-        bary[2 * k] = h->b1;
-        bary[2 * k + 1] = h->b2;
-    }
-    r = rad_hierarchical_lookup(hr, RAD_HIERARCHICAL_GATHERED, 1, tris, bary, count, out);
-    free(tris);
-    free(bary);
-    return r;
-}
-
-/* The camera samples of a band of rows in flight through render_classic: rays, hits, the
-   front-face hits among them (valid: their ray index) and what each stage computes there. */
-typedef struct pixel_batch {
-    uint32_t strata, spp;    /* samples per pixel: strata x strata */
-    size_t cap;              /* samples a batch holds */
-    int rows;                /* rows per batch */
-    rad_ray *rays;
-    rad_hit *hits;
-    float *points, *normals, *irr; /* per valid hit: position, normal, direct irradiance D */
-    float *gathered;         /* per valid hit: H from the source's gather or the final gather (or NULL) */
-    rad_hit *vhits;          /* per valid hit: its hit (rad_baker_irradiance) */
-    float *shade_v, *shade_a, *shaded; /* --shading: view direction, albedo, direct radiance */
-    uint32_t *valid;
-    uint32_t count, nvalid;
-} pixel_batch;
-
-/* The samples of a batch: 64K, at least one row */
-#define RENDER_BATCH_SAMPLES 65536u
-
-static void pixel_batch_alloc(pixel_batch *b, const render_view *view, const render_source *src)
-{
-    memset(b, 0, sizeof *b);
-    for (b->strata = 1; (b->strata + 1) * (b->strata + 1) <= view->aa; ++b->strata) {
-    }
-    b->spp = b->strata * b->strata;
-    b->rows = (int)(RENDER_BATCH_SAMPLES / ((size_t)view->width * b->spp));
-    if (b->rows < 1) b->rows = 1;
-    b->cap = (size_t)b->rows * view->width * b->spp;
-    b->rays = (rad_ray *)xmalloc(sizeof(rad_ray) * b->cap);
-    b->hits = (rad_hit *)xmalloc(sizeof(rad_hit) * b->cap);
-    b->points = (float *)xmalloc(sizeof(float) * 3 * b->cap);
-    b->normals = (float *)xmalloc(sizeof(float) * 3 * b->cap);
-    b->irr = (float *)xmalloc(sizeof(float) * 3 * b->cap);
-    b->valid = (uint32_t *)xmalloc(sizeof(uint32_t) * b->cap);
-    if (src->vp || src->hr || src->lm || src->baker || view->final_gather)
-        b->gathered = (float *)xmalloc(sizeof(float) * 3 * b->cap);
-    if (src->baker) b->vhits = (rad_hit *)xmalloc(sizeof(rad_hit) * b->cap);
-    if (view->shading >= 0) {
-        b->shade_v = (float *)xmalloc(sizeof(float) * 3 * b->cap);
-        b->shade_a = (float *)xmalloc(sizeof(float) * 3 * b->cap);
-        b->shaded = (float *)xmalloc(sizeof(float) * 3 * b->cap);
-    }
-}
-
-static void pixel_batch_free(pixel_batch *b)
-{
-    free(b->rays);
-    free(b->hits);
-    free(b->points);
-    free(b->normals);
-    free(b->irr);
-    free(b->valid);
-    free(b->shade_v);
-    free(b->shade_a);
-    free(b->shaded);
-    free(b->gathered);
-    free(b->vhits);
-}
-
-/* Rows y0..y1-1: the stratified camera rays, their hits (in parallel chunks: the raycaster is
-   thread-safe), the sky and environment seen by rays that leave the scene added to img, and
-   the front-face hits listed in b->valid with their points and normals. 0 or 1 (printed). */
-static int batch_primary(const tool_world *w, const render_view *view, pixel_batch *b, int y0, int y1,
-                         const float sky[3], tool_image *img)
-{
-    const rad_scene *scene = w->scene;
-    int x, y, chunk, nchunks, failed = 0;
-    uint32_t s, k, i;
-    b->count = b->nvalid = 0;
-    for (y = y0; y < y1; ++y)
-        for (x = 0; x < view->width; ++x)
-            for (s = 0; s < b->spp; ++s) {
-                float px = (float)x + ((float)(s % b->strata) + 0.5f) / (float)b->strata;
-                float py = (float)y + ((float)(s / b->strata) + 0.5f) / (float)b->strata;
-                rad_camera_ray(&view->cam, (uint32_t)view->width, (uint32_t)view->height, px, py, &b->rays[b->count++]);
-            }
-    nchunks = (int)((b->count + 4095) / 4096);
-#ifdef _OPENMP
-#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
-#endif
-    for (chunk = 0; chunk < nchunks; ++chunk) {
-        uint32_t cb = (uint32_t)chunk * 4096u, ce = cb + 4096u < b->count ? cb + 4096u : b->count;
-        if (w->rc.intersect(w->rc.user, b->rays + cb, ce - cb, b->hits + cb) != RAD_SUCCESS) failed |= 1;
-    }
-    if (failed) return tool_fail("render", "ray intersection", RAD_ERROR_RAYCAST_FAILED);
-    for (k = 0; k < b->count; ++k) {
-        uint32_t t = b->hits[k].triangle;
-        const float *v, *nt;
-        if (t == RAD_NONE || t >= scene->triangle_count) {
-            size_t pixel = (size_t)y0 * view->width + k / b->spp;
-            uint32_t l;
-            for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += sky[i];
-            /* and an environment map its radiance in the ray's direction */
-            for (l = 0; l < w->file.light_count; ++l)
-                if (w->file.lights[l].type == RAD_LIGHT_ENVIRONMENT) {
-                    float rgb[3];
-                    rad_environment_radiance(w->file.lights[l].environment, b->rays[k].dir, rgb);
-                    for (i = 0; i < 3; ++i) img->rgb[3 * pixel + i] += w->file.lights[l].color[i] * rgb[i];
-                }
-            b->hits[k].triangle = RAD_NONE;
-            continue;
-        }
-        nt = scene->normals + 3 * (size_t)t;
-        if (nt[0] * b->rays[k].dir[0] + nt[1] * b->rays[k].dir[1] + nt[2] * b->rays[k].dir[2] >= 0.0f) {
-            b->hits[k].triangle = RAD_NONE; /* back face: patches are one-sided, black */
-            continue;
-        }
-        v = scene->positions + 9 * (size_t)t;
-        for (i = 0; i < 3; ++i) {
-            b->points[3 * b->nvalid + i] = v[i] + b->hits[k].b1 * (v[3 + i] - v[i]) + b->hits[k].b2 * (v[6 + i] - v[i]);
-            b->normals[3 * b->nvalid + i] = nt[i];
-        }
-        b->valid[b->nvalid++] = k;
-    }
-    return 0;
-}
-
-/* At the valid hits: the direct irradiance D, and H into b->gathered from the final gather,
-   the lightmap, or the virtual patches' or hierarchical gather (none: the caller interpolates
-   the patches' per-vertex H); the --shading model's direct radiance. 0 or 1 (printed). */
-static int batch_light(const tool_world *w, const render_view *view, render_source *src, pixel_batch *b, int y0)
-{
-    const rad_scene *scene = w->scene;
-    rad_direct_options dopt;
-    rad_context quiet;
-    rad_result r;
-    uint32_t k, i, n = b->nvalid;
-    double tg = tool_seconds();
-    if (n == 0) return 0;
-    tool_context(&quiet, NULL);
-    rad_direct_options_default(&dopt);
-    dopt.exclude_emitters = 0;
-    dopt.light_samples = view->light_samples;
-    r = rad_direct_irradiance(scene, &w->rc, w->file.lights, w->file.light_count, &dopt, b->points, b->normals, n, b->irr,
-                              &quiet);
-    if (r != RAD_SUCCESS) return tool_fail("render", "rad_direct_irradiance", r);
-    tg = tool_seconds();
-    if (view->final_gather) {
-        rad_final_gather_options fo;
-        rad_final_gather_options_default(&fo);
-        fo.rays = view->final_gather;
-        fo.seed = (uint32_t)y0 * 0x9E3779B9u;
-        r = rad_final_gather(scene, &w->rc, w->file.lights, w->file.light_count, &fo, fg_lookup_fn, src, b->points,
-                             b->normals, n, b->gathered, &quiet);
-        if (r != RAD_SUCCESS) return tool_fail("render", "rad_final_gather", r);
-    } else if (src->lm) {
-        for (k = 0; k < n; ++k) {
-            const rad_hit *h = &b->hits[b->valid[k]];
-            const float *t = scene->lightmap_uvs + 6 * (size_t)h->triangle;
-            float u = t[0] + h->b1 * (t[2] - t[0]) + h->b2 * (t[4] - t[0]);
-            float v = t[1] + h->b1 * (t[3] - t[1]) + h->b2 * (t[5] - t[1]);
-            rad_lightmap_sample(src->lm, 3, src->lm_values, u, v, b->gathered + 3 * k);
-        }
-    } else if (src->baker) {
-        for (k = 0; k < n; ++k) b->vhits[k] = b->hits[b->valid[k]];
-        r = rad_baker_irradiance(src->baker, b->vhits, b->points, b->normals, n, b->gathered, &quiet);
-        if (r != RAD_SUCCESS) return tool_fail("render", "rad_baker_irradiance", r);
-    } else if (b->gathered) {
-        r = src->hr ? hr_lookup(src->hr, b->hits, b->valid, n, b->gathered)
-                    : rad_vp_gather(src->vp, src->vp_H, b->points, b->normals, n, b->gathered, &quiet);
-        if (r != RAD_SUCCESS) {
-            src->gather_seconds += tool_seconds() - tg;
-            return tool_fail("render", "rad_vp_gather", r);
-        }
-    }
-    if (b->gathered) src->gather_seconds += tool_seconds() - tg;
-    if (!b->shaded) return 0;
-    for (k = 0; k < n; ++k) {
-        const rad_ray *ry = &b->rays[b->valid[k]];
-        const rad_hit *h = &b->hits[b->valid[k]];
-        float len = sqrtf(ry->dir[0] * ry->dir[0] + ry->dir[1] * ry->dir[1] + ry->dir[2] * ry->dir[2]);
-        for (i = 0; i < 3; ++i) b->shade_v[3 * k + i] = -ry->dir[i] / len;
-        rad_scene_albedo(scene, h->triangle, h->b1, h->b2, b->shade_a + 3 * k);
-    }
-    return tool_shade_direct(w, view->shading, view->light_samples, b->points, b->normals, b->shade_v, b->shade_a, n,
-                             b->shaded);
-}
-
-/* each valid hit's radiance into its pixel: albedo / pi (D + H) (or the shading model's direct
-   radiance + albedo / pi H) plus what it emits */
-static void batch_accumulate(const tool_world *w, const render_source *src, const pixel_batch *b, int width, int y0,
-                             tool_image *img)
-{
-    const rad_scene *scene = w->scene;
-    const rad_patches *P = src->P;
-    const float *Hv = src->Hv;
-    uint32_t k, i;
-    for (k = 0; k < b->nvalid; ++k) {
-        uint32_t ray = b->valid[k];
-        size_t pixel = (size_t)y0 * width + ray / b->spp;
-        const rad_hit *h = &b->hits[ray];
-        float albedo[3], wts[3], emitted[3];
-        uint32_t p = b->gathered ? 0u : rad_patches_locate(P, h->triangle, h->b1, h->b2, wts);
-        const uint32_t *vi;
-        if (p == RAD_NONE) continue;
-        vi = b->gathered ? NULL : P->patches[p].vertices;
-        rad_scene_albedo(scene, h->triangle, h->b1, h->b2, albedo);
-        rad_scene_emission(scene, h->triangle, h->b1, h->b2, emitted);
-        for (i = 0; i < 3; ++i) {
-            float hi = b->gathered ? b->gathered[3 * k + i]
-                                   : wts[0] * Hv[3 * (size_t)vi[0] + i] + wts[1] * Hv[3 * (size_t)vi[1] + i] +
-                                         wts[2] * Hv[3 * (size_t)vi[2] + i];
-            img->rgb[3 * pixel + i] += (b->shaded ? b->shaded[3 * k + i] + albedo[i] / PI_F * hi
-                                                  : albedo[i] / PI_F * (b->irr[3 * k + i] + hi)) + emitted[i];
-        }
-    }
-}
-
-/* The image of the radiosity methods: per sample the direct light D at the hit (shadow rays),
-   H from src, radiance albedo / pi (D + H) plus emission; each pixel the mean of its samples.
-   0 or 1 (printed). */
-static int render_classic(const tool_world *w, const render_view *view, render_source *src, tool_image *img)
-{
-    pixel_batch b;
-    size_t total = (size_t)view->width * view->height, done_px = 0, q;
-    float sky[3] = {0.0f, 0.0f, 0.0f}, inv;
-    uint32_t k, i;
-    int y0, result = 0;
-    pixel_batch_alloc(&b, view, src);
-    /* a camera ray that leaves the scene sees the sky's radiance E_0 / pi, as in rad trace */
-    for (k = 0; k < w->file.light_count; ++k)
-        if (w->file.lights[k].type == RAD_LIGHT_SKY)
-            for (i = 0; i < 3; ++i) sky[i] += w->file.lights[k].color[i] / PI_F;
-    for (y0 = 0; y0 < view->height && result == 0; y0 += b.rows) {
-        int y1 = y0 + b.rows < view->height ? y0 + b.rows : view->height;
-        result = batch_primary(w, view, &b, y0, y1, sky, img);
-        if (result == 0) result = batch_light(w, view, src, &b, y0);
-        if (result) break;
-        batch_accumulate(w, src, &b, view->width, y0, img);
-        done_px += (size_t)(y1 - y0) * view->width;
-        tool_progress((void *)(size_t)"render", (float)((double)done_px / (double)total));
-    }
-    tool_progress_end();
-    inv = 1.0f / (float)b.spp;
-    for (q = 0; q < 3 * total; ++q) img->rgb[q] *= inv;
-    pixel_batch_free(&b);
-    return result;
-}
-
-/* the bake's options section, or NULL */
-static const tool_bake_info *bake_info(const rad_bake *bake)
-{
-    const rad_section *s = rad_container_find(bake->container, TOOL_SECTION_OPTIONS, "rad.options");
-    const tool_bake_info *info;
-    if (!s || s->elem_size != sizeof(tool_bake_info) || s->count != 1) return NULL;
-    info = (const tool_bake_info *)s->data;
-    return info->magic == 0x52414442u ? info : NULL;
-}
-
-/* 0 when a loaded bake was made from this scene (rad_bake_matches_scene: its triangle count,
-   geometry and materials, and its options section is the one it was baked with; then the
-   patch count its options give on this scene); else 1 with a message */
-static int bake_fits_scene(const char *cmd, const char *bake_path, const rad_bake *bake, const tool_world *w)
-{
-    const tool_bake_info *info = bake_info(bake);
-    rad_context ctx;
-    rad_result r;
-    int rc = 0;
-    tool_context(&ctx, NULL);
-    if ((r = rad_bake_matches_scene(bake, w->scene, info ? tool_options_hash(info, w) : 0u, &ctx)) != RAD_SUCCESS) {
-        /* the same options without this command line's lights: then only the lights differ */
-        tool_world bare = *w;
-        bare.file_light_count = w->file.light_count;
-        if (info && rad_bake_matches_scene(bake, w->scene, tool_options_hash(info, &bare), NULL) == RAD_SUCCESS)
-            fprintf(stderr, "rad %s: bake '%s' was made with other lights than this command line's --sun, --sky, "
-                            "--point and --spot: give the bake's light options, or render without --bake\n",
-                    cmd, bake_path);
-        else
-            fprintf(stderr, "rad %s: bake '%s' does not fit this scene (%s)%s\n", cmd, bake_path, rad_result_string(r),
-                    info ? "; the options hash covers --sun, --sky, --point and --spot: give the bake's own" : "");
-        rc = 1;
-    } else if (info) {
-        /* the same patch options on this scene must give the same patches */
-        rad_patch_options po;
-        rad_patches *check = NULL;
-        rad_patch_options_default(&po);
-        po.target_count = info->patches;
-        po.max_edge = info->max_edge;
-        if ((r = rad_patches_create(w->scene, &po, &ctx, &check)) != RAD_SUCCESS) {
-            rc = tool_fail(cmd, "rad_patches_create", r);
-        } else if (check->count != bake->patches.count) {
-            fprintf(stderr, "rad %s: bake '%s' has %u patches; this scene with its options (--patches %u) gives %u: "
-                            "not the scene it was baked from\n",
-                    cmd, bake_path, bake->patches.count, info->patches, check->count);
-            rc = 1;
-        }
-        rad_patches_destroy(check);
-    } else {
-        fprintf(stderr, "rad %s: warning: bake '%s' has no rad.options section; its patches are used as they are\n", cmd,
-                bake_path);
-    }
-    return rc;
-}
-
-/* --method multibounce|temporal: the patches' indirect light from the bake's F_mb (one
-   product) or alias tables (--frames steps), then the classic pixel pipeline (per-pixel direct
-   light + interpolated H). --sequence writes every --every-th frame (and the last) as a PNG. */
-static int render_method(const char *cmd, const tool_world *w, const rad_bake *bake, const char *bake_name,
-                         const render_args *ra, tool_image *img)
-{
-    const tool_method_options *mo = &ra->mo;
-    const render_view *view = &ra->view;
-    int width = view->width, height = view->height;
-    float exposure = view->exposure;
-    tool_indirect *m = NULL;
-    const rad_patches *P = &bake->patches;
-    render_source src;
-    uint32_t frames = mo->method == TOOL_TEMPORAL ? mo->frames : 1u, f;
-    /* multibounce: the product is repeated (same result each time) so its time is a median */
-    uint32_t reps = mo->method == TOOL_TEMPORAL ? frames : 9u;
-    double t = 0.0, sum = 0.0, tmin = 1e300, tmax = 0.0, *times;
-    float *H, *Hv;
-    int rc = 0;
-    if (tool_indirect_open(cmd, bake_name, bake, mo, &m)) return 1;
-    times = (double *)xmalloc(sizeof(double) * reps);
-    H = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->count);
-    Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
-    memset(&src, 0, sizeof src);
-    src.P = P;
-    src.Hv = Hv;
-#if defined(__unix__) || defined(__APPLE__)
-    if (mo->sequence) mkdir(mo->sequence, 0777); /* may exist; a failure shows when writing */
-#endif
-    for (f = 1; f <= frames && rc == 0; ++f) {
-        rc = tool_indirect_step(m, H, &t);
-        times[f - 1] = t;
-        sum += t;
-        if (t < tmin) tmin = t;
-        if (t > tmax) tmax = t;
-        if (rc == 0 && mo->sequence && f % mo->every == 0 && f != frames) { /* the last one: below */
-            char path[4096];
-            tool_image frame;
-            memset(&frame, 0, sizeof frame);
-            snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, f);
-            if (tool_image_alloc(&frame, width, height) != 0) {
-                fprintf(stderr, "rad %s: out of memory for a %dx%d image\n", cmd, width, height);
-                rc = 1;
-            }
-            if (rc == 0) rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
-            if (rc == 0) rc = render_classic(w, view, &src, &frame);
-            if (rc == 0 && tool_image_write_png(path, &frame, exposure) != 0) {
-                fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
-                rc = 1;
-            }
-            tool_image_free(&frame);
-        }
-    }
-    for (f = frames + 1; f <= reps && rc == 0; ++f) rc = tool_indirect_step(m, H, &times[f - 1]);
-    if (rc == 0) {
-        qsort(times, reps, sizeof(double), cmp_double);
-        /* one line for scripts (tools/report.sh): the method's per-frame work alone */
-        fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=%u step_ms_median=%.6f step_ms_min=%.6f\n", cmd,
-                tool_method_name(mo->method), P->count, reps, 1e3 * times[reps / 2], 1e3 * times[0]);
-        if (mo->method == TOOL_TEMPORAL)
-            fprintf(stderr, "rad %s: %u frames, temporal step %.3f ms per frame (min %.3f, max %.3f), %.3f s in all\n",
-                    cmd, frames, 1e3 * sum / frames, 1e3 * tmin, 1e3 * tmax, sum);
-        else if (mo->method == TOOL_MULTIBOUNCE)
-            fprintf(stderr, "rad %s: L = F_mb E in %.3f ms\n", cmd, 1e3 * sum);
-        rc = vertex_H_rowsums(P, tool_indirect_rowsums(m), H, Hv);
-    }
-    if (rc == 0) rc = render_classic(w, view, &src, img);
-    if (rc == 0 && mo->sequence) {
-        char path[4096];
-        snprintf(path, sizeof path, "%s/frame_%05u.png", mo->sequence, frames);
-        if (tool_image_write_png(path, img, exposure) != 0) {
-            fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
-            rc = 1;
-        }
-    }
-    free(H);
-    free(Hv);
-    free(times);
-    tool_indirect_close(m);
-    return rc;
-}
-
-/* Why rad_load_file refused a bake: an intact virtual-patch bake (which holds no classic
-   patches) is another method's data, not a damaged file. */
-static void bake_load_failed(const char *cmd, const char *path, rad_result r)
-{
-    void *data = NULL;
-    size_t size = 0;
-    rad_container *ct = NULL;
-    rad_context ctx;
-    memset(&ctx, 0, sizeof ctx); /* no log: the load has said what it found */
-    if (r == RAD_ERROR_CORRUPT || r == RAD_ERROR_INVALID_ARGUMENT || r == RAD_ERROR_VERSION) {
-        if (tool_read_file(NULL, NULL, path, &data, &size) == 0 && rad_container_create(data, size, &ctx, &ct) == RAD_SUCCESS &&
-            rad_container_find(ct, RAD_SECTION_VP_INFO, NULL) && !rad_container_find(ct, RAD_SECTION_PATCHES, NULL)) {
-            fprintf(stderr, "rad %s: bake '%s' holds virtual patches (rad bake --method aavp|vp), not classic patches: "
-                            "render it with --method aavp or vp\n", cmd, path);
-            rad_container_destroy(ct);
-            free(data);
-            return;
-        }
-        rad_container_destroy(ct);
-        free(data);
-    }
-    fprintf(stderr, "rad %s: cannot load bake '%s': %s\n", cmd, path, rad_result_string(r));
-}
-
-/* the bake (--bake, checked against the scene) or one made here, then render_method */
-static int render_with_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
-{
-    const char *bake_path = ra->bake;
-    const tool_method_options *mo = &ra->mo;
-    rad_bake *bake = NULL;
-    void *buf = NULL;
-    size_t size = 0;
-    rad_context ctx;
-    rad_result r;
-    int rc;
-    tool_context(&ctx, NULL);
-    if (bake_path) {
-        if (mo->given & (TOOL_OPT_MB_BUILD | TOOL_OPT_BOUNCES | TOOL_OPT_MODE | TOOL_OPT_SR |
-                         (mo->method == TOOL_STOCHASTIC ? TOOL_OPT_SEED : 0u)))
-            fprintf(stderr, "rad %s: warning: the bake '%s' fixes --bounces, --format, --outliers, --reorder, --tile, "
-                            "--mode, --sr-* (and the stochastic solve's --seed); those given here are ignored\n",
-                    cmd, bake_path);
-        if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
-            bake_load_failed(cmd, bake_path, r);
-            return 1;
-        }
-        if (bake_fits_scene(cmd, bake_path, bake, w)) {
-            rad_bake_destroy(bake);
-            return 1;
-        }
-    } else {
-        if (tool_method_bake(cmd, w, &ra->o, mo, &buf, &size)) return 1;
-        if ((r = rad_load_memory(buf, size, &ctx, &bake)) != RAD_SUCCESS) {
-            free(buf);
-            return tool_fail(cmd, "rad_load_memory", r);
-        }
-        bake_path = "(made here)";
-    }
-    bake->patches.scene = w->scene;
-    rc = render_method(cmd, w, bake, bake_path, ra, img);
-    rad_bake_destroy(bake);
-    free(buf);
-    return rc;
-}
 
 /* peak resident set of the process in MiB (0 where unknown) */
 static double peak_rss_mib(void)
@@ -732,14 +132,14 @@ static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const 
         to.weight = mo->w > 0.0f ? mo->w : -1.0f; /* --w 0: no history */
         to.seed = mo->seed;
         if ((r = rad_temporal_create(tp3, count, vp->albedo, &to, &ctx, &tp)) != RAD_SUCCESS) { what = "rad_temporal_create"; goto done; }
-        steps = (double *)xmalloc(sizeof(double) * mo->frames);
+        steps = (double *)tool_malloc(sizeof(double) * mo->frames);
         for (f = 0; f < mo->frames; ++f) {
             double ts = tool_seconds();
             if ((r = rad_temporal_step(tp, E, NULL, NULL)) != RAD_SUCCESS) { what = "rad_temporal_step"; goto done; }
             steps[f] = tool_seconds() - ts;
         }
         memcpy(L, rad_temporal_indirect(tp), sizeof(float) * 3 * (size_t)n);
-        qsort(steps, mo->frames, sizeof(double), cmp_double);
+        qsort(steps, mo->frames, sizeof(double), tool_cmp_double);
         *step_seconds = steps[mo->frames / 2];
         fprintf(stderr, "rad %s: temporal over %u virtual patches: %u frames, k %u, tables %.1f MiB, step %.3f ms (median)\n",
                 cmd, n, mo->frames, mo->k, (double)(rad_alias_tables_memory(tables[0]) * count) / 1048576.0,
@@ -748,9 +148,9 @@ static int proxy_indirect(const char *cmd, const rad_virtual_patches *vp, const 
         rad_row_source src;
         rad_local_options lo;
         uint32_t m = mo->local_m ? mo->local_m : (n < TOOL_LOCAL_M_AUTO_MAX ? n : TOOL_LOCAL_M_AUTO_MAX);
-        proxy_near *d2 = (proxy_near *)xmalloc(sizeof(proxy_near) * (size_t)n);
+        proxy_near *d2 = (proxy_near *)tool_malloc(sizeof(proxy_near) * (size_t)n);
         if (m > n) m = n;
-        order = (uint32_t *)xmalloc(sizeof(uint32_t) * (size_t)n);
+        order = (uint32_t *)tool_malloc(sizeof(uint32_t) * (size_t)n);
         for (i = 0; i < n; ++i) {
             uint32_t c[3], k;
             uint64_t key = vp->voxel_keys[vp->voxel[i]];
@@ -799,7 +199,7 @@ done:
    per pixel from the moved light), and the last. The light ends where the last frame puts it,
    so the final image (rendered by the caller from E and L) is that frame. Stage times: their
    medians. */
-static int proxy_temporal_frames(const char *cmd, const tool_world *w, const render_args *ra,
+static int proxy_temporal_frames(const char *cmd, const tool_world *w, const tool_render_args *ra,
                                  const rad_virtual_patches *vp, float *E, float *L, double *step_seconds)
 {
     const tool_method_options *mo = &ra->mo;
@@ -815,8 +215,8 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const ren
     rad_result r = RAD_SUCCESS;
     const char *what = NULL;
     uint32_t n = vp->count, f, i, frames = mo->frames;
-    double *te = (double *)xmalloc(sizeof(double) * frames), *ts = (double *)xmalloc(sizeof(double) * frames);
-    float *B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n), *H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    double *te = (double *)tool_malloc(sizeof(double) * frames), *ts = (double *)tool_malloc(sizeof(double) * frames);
+    float *B = (float *)tool_malloc(sizeof(float) * 3 * (size_t)n), *H = (float *)tool_malloc(sizeof(float) * 3 * (size_t)n);
     uint64_t rays = 0;
     int rc = 0;
     tool_context(&ctx, NULL);
@@ -874,7 +274,7 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const ren
         if (mo->sequence && (f % mo->every == 0 || f == frames)) { /* the last one too, as render_method */
             char path[4096];
             tool_image frame;
-            render_source src;
+            tool_render_source src;
             memset(&frame, 0, sizeof frame);
             for (i = 0; i < 3 * n; ++i) B[i] = E[i] + L[i];
             if ((r = rad_matrix_multiply(&vp->matrix, B, H, &ctx)) != RAD_SUCCESS) { what = "rad_matrix_multiply"; goto done; }
@@ -887,7 +287,7 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const ren
             memset(&src, 0, sizeof src);
             src.vp = vp;
             src.vp_H = H;
-            rc = render_classic(w, &ra->view, &src, &frame);
+            rc = tool_render_pixels(w, &ra->view, &src, &frame);
             if (rc == 0 && tool_image_write_png(path, &frame, ra->view.exposure) != 0) {
                 fprintf(stderr, "rad %s: %s\n", cmd, tool_output_error());
                 rc = 1;
@@ -896,8 +296,8 @@ static int proxy_temporal_frames(const char *cmd, const tool_world *w, const ren
             if (rc) goto done;
         }
     }
-    qsort(te, frames, sizeof(double), cmp_double);
-    qsort(ts, frames, sizeof(double), cmp_double);
+    qsort(te, frames, sizeof(double), tool_cmp_double);
+    qsort(ts, frames, sizeof(double), tool_cmp_double);
     *step_seconds = ts[frames / 2];
     fprintf(stderr, "rad %s: temporal over %u virtual patches, %u frames%s: E update %.3f ms (median; %.0f shadow rays per "
                     "frame), temporal step %.3f ms (median)\n",
@@ -979,13 +379,13 @@ fail:
 /* --method vp|aavp: virtual patches, E at their samples, the classic solve on
    their matrix (Jacobi K bounces; inf: Gauss-Seidel), H = F (E + L) per patch, and the
    classic per-pixel render with H gathered at each sample's hit point. */
-static int render_vp_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+static int render_vp_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     const char *bake_path = ra->bake;
     const tool_classic_options *o = &ra->o;
     const tool_method_options *mo = &ra->mo;
     rad_virtual_patches *vp = NULL;
-    render_source src;
+    tool_render_source src;
     rad_direct_options dopt;
     rad_solve_options so;
     rad_solve_stats stats;
@@ -1014,10 +414,10 @@ static int render_vp_method(const char *cmd, const tool_world *w, const render_a
     }
     t_build = tool_seconds() - t0;
     n = vp->count;
-    if (!E) E = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
-    L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
-    B = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
-    H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
+    if (!E) E = (float *)tool_malloc(sizeof(float) * 3 * (size_t)n);
+    L = (float *)tool_malloc(sizeof(float) * 3 * (size_t)n);
+    B = (float *)tool_malloc(sizeof(float) * 3 * (size_t)n);
+    H = (float *)tool_malloc(sizeof(float) * 3 * (size_t)n);
     rad_direct_options_default(&dopt);
     dopt.exclude_emitters = 0;
     dopt.light_samples = o->light_samples;
@@ -1066,7 +466,7 @@ static int render_vp_method(const char *cmd, const tool_world *w, const render_a
         src.vp = vp;
         src.vp_H = H;
         t0 = tool_seconds();
-        rc = render_classic(w, &ra->view, &src, img);
+        rc = tool_render_pixels(w, &ra->view, &src, img);
         /* one line for scripts: step = the solve (K bounces + H = F B) as classic's */
         if (rc == 0) {
             fprintf(stderr, "rad %s: timing: method=%s%s patches=%u frames=%u bounces=%s%.0u step_ms_median=%.6f "
@@ -1086,127 +486,6 @@ static int render_vp_method(const char *cmd, const tool_world *w, const render_a
     free(B);
     free(H);
     rad_vp_destroy(vp);
-    return rc;
-}
-
-/* --method hierarchical: the solution (tool_hierarchical_build), then the classic render
-   with H looked up at each sample */
-static int render_hr_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
-{
-    rad_hierarchical *h = NULL;
-    render_source src;
-    rad_hierarchical_stats st;
-    double t0 = tool_seconds(), t_solve;
-    int rc;
-    if (tool_hierarchical_build(cmd, w, &ra->mo, ra->o.light_samples, &h)) return 1;
-    t_solve = tool_seconds() - t0;
-    rad_hierarchical_get_stats(h, &st);
-    memset(&src, 0, sizeof src);
-    src.hr = h;
-    t0 = tool_seconds();
-    rc = render_classic(w, &ra->view, &src, img);
-    if (rc == 0)
-        fprintf(stderr, "rad %s: timing: method=hierarchical patches=%u frames=1 step_ms_median=%.6f step_ms_min=%.6f "
-                        "links=%llu kernels=%llu rays=%llu render_ms=%.1f\n",
-                cmd, st.leaves, 1e3 * t_solve, 1e3 * t_solve, (unsigned long long)st.links,
-                (unsigned long long)st.kernel_evaluations, (unsigned long long)st.rays_cast, 1e3 * (tool_seconds() - t0));
-    rad_hierarchical_destroy(h);
-    return rc;
-}
-
-/* --method local: the classic patches, F and E; a local matrix of capacity M over F's
-   rows filled with the M patches nearest the camera (rad_local_rebuild), L = T E over P_Vis x
-   P_Lit, H = L / rho (L = rho F (E + L) within the set), rendered as classic. */
-static int render_local_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
-{
-    tool_classic_options o = ra->o;
-    const tool_method_options *mo = &ra->mo;
-    const rad_camera *cam = &ra->view.cam;
-    int width = ra->view.width, height = ra->view.height;
-    render_source view_src;
-    tool_classic sol;
-    rad_local_options lo;
-    rad_local *local = NULL;
-    rad_row_source src;
-    rad_context ctx;
-    rad_result r;
-    uint32_t n, m, i, c, nvis = 0, nlit = 0;
-    uint32_t *set = NULL, *vis = NULL, *lit = NULL;
-    float *areas = NULL, *albedo = NULL, *L = NULL, *H = NULL, *Hv = NULL;
-    double t0, t_rebuild = 0.0, times[9];
-    int rc = 0, k;
-    o.sources_only = 1;
-    if (tool_classic_solve(cmd, w, &o, &sol)) return 1;
-    n = sol.patches->count;
-    if (mo->local_m == 0) { /* the default: the whole scene when it is small enough */
-        m = n < TOOL_LOCAL_M_AUTO_MAX ? n : TOOL_LOCAL_M_AUTO_MAX;
-        if (m < n)
-            fprintf(stderr, "rad %s: warning: the default --local-m covers %u of the %u patches (the nearest to the "
-                            "camera; the others get no indirect light): give --local-m %u for all of them\n",
-                    cmd, m, n, n);
-    } else {
-        m = mo->local_m < n ? mo->local_m : n;
-        if (mo->local_m > n)
-            fprintf(stderr, "rad %s: --local-m %u is more than the %u patches: using %u\n", cmd, mo->local_m, n, n);
-    }
-    areas = (float *)xmalloc(sizeof(float) * n);
-    albedo = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
-    L = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
-    H = (float *)xmalloc(sizeof(float) * 3 * (size_t)n);
-    set = (uint32_t *)xmalloc(sizeof(uint32_t) * m);
-    vis = (uint32_t *)xmalloc(sizeof(uint32_t) * m);
-    lit = (uint32_t *)xmalloc(sizeof(uint32_t) * m);
-    for (i = 0; i < n; ++i) {
-        areas[i] = sol.patches->patches[i].area;
-        for (c = 0; c < 3; ++c) albedo[3 * i + c] = sol.patches->patches[i].albedo[c];
-    }
-    for (i = 0; i < 3 * n; ++i) L[i] = 0.0f;
-    tool_context(&ctx, NULL);
-    rad_local_options_default(&lo);
-    lo.capacity = m;
-    r = rad_row_source_matrix(&sol.ff->matrix, areas, albedo, &src);
-    if (r == RAD_SUCCESS) r = rad_local_create(&src, &lo, &ctx, &local);
-    if (r == RAD_SUCCESS) r = rad_local_nearest(sol.patches, cam->position, m, set, &ctx);
-    if (r == RAD_SUCCESS) {
-        t0 = tool_seconds();
-        r = rad_local_rebuild(local, set, m, &ctx);
-        t_rebuild = tool_seconds() - t0;
-    }
-    if (r == RAD_SUCCESS)
-        r = rad_local_visible(sol.patches, &w->rc, cam, (float)width / (float)height, set, m, vis, &nvis, &ctx);
-    if (r == RAD_SUCCESS) r = rad_local_lit(sol.E, set, m, 0.0f, lit, &nlit);
-    for (k = 0; k < 9 && r == RAD_SUCCESS; ++k) {
-        t0 = tool_seconds();
-        r = rad_local_apply(local, sol.E, vis, nvis, lit, nlit, L, RAD_OUTPUT_INDIRECT, &ctx);
-        times[k] = tool_seconds() - t0;
-    }
-    if (r != RAD_SUCCESS) rc = tool_fail(cmd, "local matrix", r);
-    if (rc == 0) {
-        qsort(times, 9, sizeof(double), cmp_double);
-        fprintf(stderr, "rad %s: local matrix: M = %u of %u patches, |P_Vis| = %u, |P_Lit| = %u, %.1f MiB\n", cmd, m,
-                n, nvis, nlit, (double)rad_local_memory(local) / 1048576.0);
-        fprintf(stderr, "rad %s: timing: method=local patches=%u frames=9 step_ms_median=%.6f step_ms_min=%.6f "
-                        "rebuild_ms=%.3f local_m=%u visible=%u lit=%u\n",
-                cmd, n, 1e3 * times[4], 1e3 * times[0], 1e3 * t_rebuild, m, nvis, nlit);
-        /* H = L / rho: the irradiance from the secondary sources (0 where rho is 0) */
-        for (i = 0; i < 3 * n; ++i) H[i] = albedo[i] > 0.0f ? L[i] / albedo[i] : 0.0f;
-        Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)sol.patches->vertex_count);
-        rc = vertex_H(sol.patches, &sol.ff->matrix, H, Hv);
-        memset(&view_src, 0, sizeof view_src);
-        view_src.P = sol.patches;
-        view_src.Hv = Hv;
-        if (rc == 0) rc = render_classic(w, &ra->view, &view_src, img);
-    }
-    rad_local_destroy(local);
-    free(areas);
-    free(albedo);
-    free(L);
-    free(H);
-    free(Hv);
-    free(set);
-    free(vis);
-    free(lit);
-    tool_classic_free(&sol);
     return rc;
 }
 
@@ -1279,10 +558,10 @@ static int parse_camera(const char *cmd, const tool_arg *t, const char *v, void 
     return 0;
 }
 
-/* --size WxH into render_view's width and height (field: width) */
+/* --size WxH into tool_render_view's width and height (field: width) */
 static int parse_size(const char *cmd, const tool_arg *t, const char *v, void *field)
 {
-    render_view *view = (render_view *)((char *)field - offsetof(render_view, width));
+    tool_render_view *view = (tool_render_view *)((char *)field - offsetof(tool_render_view, width));
     (void)t;
     if (tool_parse_size(v, &view->width, &view->height)) {
         fprintf(stderr, "rad %s: bad size '%s' (want WxH, e.g. 512x512)\n", cmd, v);
@@ -1302,7 +581,7 @@ static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void
     return tool_parse_threads(cmd, t->name, v, (uint32_t *)field) ? 2 : 0;
 }
 
-#define RA(f) offsetof(render_args, f)
+#define RA(f) offsetof(tool_render_args, f)
 #define RA_UINT(name, val, f, lo, hi, given, bad, help) \
     {TOOL_ARG_UINT, name, val, RA(f), lo, hi, 0, given, bad, NULL, NULL, NULL, 0, help}
 #define RA_CUSTOM(name, val, f, fn, given, help) \
@@ -1316,7 +595,7 @@ static const tool_arg render_table[] = {
     {TOOL_ARG_STRING, "--bake", "FILE.radb", RA(bake), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
      "classic, multibounce, temporal, stochastic, hierarchical, vp, aavp: use a bake of that\n"
      "method made by 'rad bake' from this scene instead of computing it here"},
-    RA_CUSTOM("--camera", "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ", view.cam, parse_camera, RENDER_GIVEN_CAMERA,
+    RA_CUSTOM("--camera", "PX,PY,PZ:TX,TY,TZ:UX,UY,UZ", view.cam, parse_camera, TOOL_RENDER_GIVEN_CAMERA,
               "camera (default: the scene's)"),
     {TOOL_ARG_FLOAT, "--fov", "DEG", RA(fov), 0.0, 180.0, TOOL_ARG_LO_OPEN | TOOL_ARG_HI_OPEN, 0, "must be in (0, 180)",
      NULL, NULL, NULL, 0, "vertical field of view in degrees (default: the scene's)"},
@@ -1329,7 +608,7 @@ static const tool_arg render_table[] = {
      NULL, 0, "scale before 8-bit sRGB encoding (PNG only; default 1)"},
     RA_UINT("--pixel-light-samples", "N", view.light_samples, 1, 65536, 0, "must be 1 to 65536",
             "radiosity methods: shadow rays per pixel sample and light (default 16, at most 65536)"),
-    RA_UINT("--final-gather", "N", view.final_gather, 0, 4096, RENDER_GIVEN_FINAL_GATHER, "is at most 4096",
+    RA_UINT("--final-gather", "N", view.final_gather, 0, 4096, TOOL_RENDER_GIVEN_FINAL_GATHER, "is at most 4096",
             "classic, vp, aavp: trace the first bounce from each pixel sample with N rays (direct\n"
             "light at the hits, the solution's irradiance there): the indirect light of points a\n"
             "patch average misrepresents; default: vp, aavp and --proxy (no --sequence) 16 while the\n"
@@ -1347,11 +626,11 @@ static const tool_arg render_table[] = {
      "automatic unwrap, as rad lightmap; direct light per pixel, the indirect light a bilinear\n"
      "lookup of the lightmap; --proxy aavp|vp: the indirect light from virtual patches\n"
      "(--vp-resolution R, --face-points P), for scenes the dense classic build cannot hold):\n"},
-    RA_UINT("--lightmap-size", "N", lm_size, 4, 16384, RENDER_GIVEN_LM_SIZE | RENDER_GIVEN_LM, "must be 4 to 16384",
+    RA_UINT("--lightmap-size", "N", lm_size, 4, 16384, TOOL_RENDER_GIVEN_LM_SIZE | TOOL_RENDER_GIVEN_LM, "must be 4 to 16384",
             "atlas side (default 256, or the least power of two to 4096 the unwrap's charts fit)"),
-    RA_UINT("--texel-samples", "N", lm_samples, 1, 16, RENDER_GIVEN_LM, "must be 1 to 16",
+    RA_UINT("--texel-samples", "N", lm_samples, 1, 16, TOOL_RENDER_GIVEN_LM, "must be 1 to 16",
             "sample points per texel (default 4), as rad lightmap"),
-    RA_UINT("--visibility-rays", "N", lm_vis, 1, 64, RENDER_GIVEN_LM, "must be 1 to 64",
+    RA_UINT("--visibility-rays", "N", lm_vis, 1, 64, TOOL_RENDER_GIVEN_LM, "must be 1 to 64",
             "shadow rays per sample point and patch (default 2), as rad lightmap"),
     {TOOL_ARG_END, NULL, NULL, 0, 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0, NULL}
 };
@@ -1370,7 +649,7 @@ static void render_usage(FILE *f)
             own, tool_classic_help(), tool_method_help(1), tool_light_help());
 }
 
-static void render_args_default(render_args *ra)
+static void render_args_default(tool_render_args *ra)
 {
     memset(ra, 0, sizeof *ra);
     tool_classic_options_default(&ra->o);
@@ -1387,7 +666,7 @@ static void render_args_default(render_args *ra)
 }
 
 /* the command line into ra; -1: go on, else the exit code (--help: 0; bad usage: 2, printed) */
-static int render_parse(const char *cmd, int argc, char **argv, tool_lights *lights, render_args *ra)
+static int render_parse(const char *cmd, int argc, char **argv, tool_lights *lights, tool_render_args *ra)
 {
     int a, rc;
     render_args_default(ra);
@@ -1423,12 +702,12 @@ static int render_parse(const char *cmd, int argc, char **argv, tool_lights *lig
 }
 
 /* the options that exclude each other, the output's format and place; 0, or the exit code */
-static int render_check(const char *cmd, render_args *ra)
+static int render_check(const char *cmd, tool_render_args *ra)
 {
     const tool_method_options *mo = &ra->mo;
     const char *inputs[2];
     if (tool_method_check(cmd, 1, &ra->mo, &ra->o)) return 2;
-    if ((ra->given & RENDER_GIVEN_LM) && mo->method != TOOL_LIGHTMAP) {
+    if ((ra->given & TOOL_RENDER_GIVEN_LM) && mo->method != TOOL_LIGHTMAP) {
         fprintf(stderr, "rad %s: --lightmap-size, --texel-samples and --visibility-rays are for --method lightmap\n", cmd);
         return 2;
     }
@@ -1461,7 +740,7 @@ static int render_check(const char *cmd, render_args *ra)
    first bounce on Sponza; 16 traced rays per pixel sample restore it. The rays are capped at
    2^22 a frame (about 8 CPU-seconds on Sponza, an eighth of its bake), fewer than 4 are not
    worth their noise, and a --sequence (a frame every few steps) keeps the option's 0. */
-static uint32_t auto_final_gather(const render_view *v)
+static uint32_t auto_final_gather(const tool_render_view *v)
 {
     uint32_t side = 1, rays;
     double samples;
@@ -1472,7 +751,7 @@ static uint32_t auto_final_gather(const render_view *v)
 }
 
 /* the warnings about the scene, and the camera: --camera, else the file's, else one chosen */
-static void render_prepare(const char *cmd, const tool_world *w, render_args *ra)
+static void render_prepare(const char *cmd, const tool_world *w, tool_render_args *ra)
 {
     const tool_method_options *mo = &ra->mo;
     rad_camera *cam = &ra->view.cam;
@@ -1488,7 +767,7 @@ static void render_prepare(const char *cmd, const tool_world *w, render_args *ra
         !mo->proxy && mo->method != TOOL_PATHTRACE && !ra->bake && ra->o.patches < w->scene->triangle_count)
         fprintf(stderr, "rad %s: note: --patches %u is below the %u triangles: every triangle is at least one patch\n",
                 cmd, ra->o.patches, w->scene->triangle_count);
-    if (!(ra->given & RENDER_GIVEN_CAMERA)) {
+    if (!(ra->given & TOOL_RENDER_GIVEN_CAMERA)) {
         if (w->file.has_camera) *cam = w->file.camera;
         else tool_choose_camera(cmd, w->scene, &w->rc, ra->view.width, ra->view.height, cam);
     } else /* --camera: the file's field of view, else 45 degrees, as rad trace takes it */
@@ -1498,17 +777,17 @@ static void render_prepare(const char *cmd, const tool_world *w, render_args *ra
 
 /* --method lightmap: the lightmap bake (lightmap.c), then the classic render with H looked up
    in the lightmap at each sample */
-static int render_lightmap_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+static int render_lightmap_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     tool_lightmap_baked bk;
     tool_lightmap_request rq;
     tool_lightmap_proxy px;
-    render_source src;
-    render_view view;
+    tool_render_source src;
+    tool_render_view view;
     int rc;
     tool_lightmap_request_default(&rq);
     rq.width = rq.height = (int)ra->lm_size;
-    rq.auto_size = !(ra->given & RENDER_GIVEN_LM_SIZE);
+    rq.auto_size = !(ra->given & TOOL_RENDER_GIVEN_LM_SIZE);
     rq.texel_samples = ra->lm_samples;
     rq.visibility_rays = ra->lm_vis;
     memset(&px, 0, sizeof px);
@@ -1516,7 +795,7 @@ static int render_lightmap_method(const char *cmd, const tool_world *w, const re
     px.resolution = ra->mo.vp_resolution;
     px.face_points = ra->mo.face_points;
     rq.proxy = ra->mo.proxy ? &px : NULL;
-    if (ra->given & RENDER_GIVEN_FINAL_GATHER) rq.final_gather = ra->view.final_gather;
+    if (ra->given & TOOL_RENDER_GIVEN_FINAL_GATHER) rq.final_gather = ra->view.final_gather;
     if (tool_lightmap_bake(cmd, w, &ra->o, &rq, &bk)) return 1;
     fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                     "step_ms_min=%.6f\n",
@@ -1528,12 +807,12 @@ static int render_lightmap_method(const char *cmd, const tool_world *w, const re
     src.lm_values = bk.values;
     view = ra->view;
     view.final_gather = 0; /* --final-gather was the texels' */
-    rc = render_classic(&bk.w, &view, &src, img);
+    rc = tool_render_pixels(&bk.w, &view, &src, img);
     tool_lightmap_bake_free(&bk);
     return rc;
 }
 
-static int render_pathtrace(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+static int render_pathtrace(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     tool_trace_options to;
     rad_context ctx;
@@ -1563,10 +842,10 @@ static int classic_bake_open(const char *cmd, const tool_world *w, const char *b
     *H_owned = NULL;
     tool_context(&ctx, NULL);
     if ((r = rad_load_file(bake_path, &ctx, &bake)) != RAD_SUCCESS) {
-        bake_load_failed(cmd, bake_path, r);
+        tool_bake_load_failed(cmd, bake_path, r);
         return 1;
     }
-    rc = bake_fits_scene(cmd, bake_path, bake, w);
+    rc = tool_bake_fits_scene(cmd, bake_path, bake, w);
     if (rc == 0 && (bake->F.rows == 0 || !bake->B)) {
         fprintf(stderr, "rad %s: bake '%s' holds no form factors or no solution B%s\n", cmd, bake_path,
                 rad_container_find(bake->container, TOOL_SECTION_METHOD, "rad.method")
@@ -1584,7 +863,7 @@ static int classic_bake_open(const char *cmd, const tool_world *w, const char *b
         *H = (const float *)hs->data;
     } else {
         /* H = F (E + L) = F B */
-        *H_owned = (float *)xmalloc(sizeof(float) * 3 * bake->patches.count);
+        *H_owned = (float *)tool_malloc(sizeof(float) * 3 * bake->patches.count);
         if ((r = rad_matrix_multiply(&bake->F, bake->B, *H_owned, &ctx)) != RAD_SUCCESS) {
             free(*H_owned);
             *H_owned = NULL;
@@ -1599,14 +878,14 @@ static int classic_bake_open(const char *cmd, const tool_world *w, const char *b
 }
 
 /* --method classic: the solution (--bake, or solved here), per-vertex H, the classic render */
-static int render_classic_method(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+static int render_classic_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     tool_classic sol;
     rad_bake *bake = NULL;
     const rad_patches *P;
     const float *H = NULL;
     float *Hv, *Hmine = NULL;
-    render_source src;
+    tool_render_source src;
     int rc;
     memset(&sol, 0, sizeof sol);
     if (ra->bake) {
@@ -1620,12 +899,12 @@ static int render_classic_method(const char *cmd, const tool_world *w, const ren
                         "step_ms_min=%.6f\n",
                 cmd, P->count, ra->o.bounces, 1e3 * sol.solve_seconds, 1e3 * sol.solve_seconds);
     }
-    Hv = (float *)xmalloc(sizeof(float) * 3 * (size_t)P->vertex_count);
-    rc = vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
+    Hv = (float *)tool_malloc(sizeof(float) * 3 * (size_t)P->vertex_count);
+    rc = tool_vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
     memset(&src, 0, sizeof src);
     src.P = P;
     src.Hv = Hv;
-    if (rc == 0) rc = render_classic(w, &ra->view, &src, img);
+    if (rc == 0) rc = tool_render_pixels(w, &ra->view, &src, img);
     free(Hv);
     free(Hmine);
     rad_bake_destroy(bake);
@@ -1637,7 +916,7 @@ static int render_classic_method(const char *cmd, const tool_world *w, const ren
    on the patches as made, or AAVP at the default face points, solved here (no --bake). The
    rest (other solvers, --bounces 0 or inf, --max-edge, clustered patches, proxies, the
    teaching methods) keeps its own path. */
-static int render_by_baker(const render_args *ra)
+static int render_by_baker(const tool_render_args *ra)
 {
     const tool_method_options *mo = &ra->mo;
     const tool_classic_options *o = &ra->o;
@@ -1649,14 +928,14 @@ static int render_by_baker(const render_args *ra)
 /* The engine tier's bake of the scene and the lights (one group), keeping its solution, and
    the per-pixel render with H from the tier's final gather at each sample. 0 or 1 (printed);
    -1 when nothing emits (the tier refuses that: the caller's own path draws it). */
-static int render_baked(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+static int render_baked(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     const tool_method_options *mo = &ra->mo;
     int classic = mo->method == TOOL_CLASSIC;
     uint32_t res = mo->vp_resolution, bounces = classic ? ra->o.bounces : mo->bounces;
     rad_baker_desc d;
     rad_baker_result *R = NULL;
-    render_source src;
+    tool_render_source src;
     double t0;
     int rc;
     if (!classic && (mo->given & TOOL_OPT_VP_MAX_PATCHES) &&
@@ -1678,26 +957,26 @@ static int render_baked(const char *cmd, const tool_world *w, const render_args 
             classic ? "" : " resolution=", classic ? 0u : R->vp_resolution);
     memset(&src, 0, sizeof src);
     src.baker = R;
-    rc = render_classic(w, &ra->view, &src, img);
+    rc = tool_render_pixels(w, &ra->view, &src, img);
     rad_baker_result_destroy(R);
     return rc;
 }
 
 /* the image by the method asked for; 0 or 1 (printed) */
-static int render_image(const char *cmd, const tool_world *w, const render_args *ra, tool_image *img)
+static int render_image(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     const tool_method_options *mo = &ra->mo;
     int rc;
     if (render_by_baker(ra) && (rc = render_baked(cmd, w, ra, img)) >= 0) return rc;
     if (mo->method == TOOL_LIGHTMAP) return render_lightmap_method(cmd, w, ra, img);
     if ((mo->method >= TOOL_LOCAL && !(mo->method == TOOL_HIERARCHICAL && ra->bake)) || mo->proxy)
-        return mo->method == TOOL_LOCAL && !mo->proxy ? render_local_method(cmd, w, ra, img)
-               : mo->method == TOOL_HIERARCHICAL      ? render_hr_method(cmd, w, ra, img)
+        return mo->method == TOOL_LOCAL && !mo->proxy ? tool_render_local_method(cmd, w, ra, img)
+               : mo->method == TOOL_HIERARCHICAL      ? tool_render_hr_method(cmd, w, ra, img)
                                                       : render_vp_method(cmd, w, ra, img);
     /* hierarchical here: from a bake (resampled onto its patches) */
     if (mo->method == TOOL_MULTIBOUNCE || mo->method == TOOL_TEMPORAL || mo->method == TOOL_STOCHASTIC ||
         mo->method == TOOL_HIERARCHICAL)
-        return render_with_method(cmd, w, ra, img);
+        return tool_render_with_method(cmd, w, ra, img);
     if (mo->method == TOOL_PATHTRACE) return render_pathtrace(cmd, w, ra, img);
     return render_classic_method(cmd, w, ra, img);
 }
@@ -1705,7 +984,7 @@ static int render_image(const char *cmd, const tool_world *w, const render_args 
 static int render_main(int argc, char **argv, tool_lights *lights)
 {
     const char *cmd = "render";
-    render_args ra;
+    tool_render_args ra;
     tool_world w;
     tool_image img;
     int rc, traced;
@@ -1721,7 +1000,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
     /* a render that will trace the first bounce (the final gather at its pixels, or at the
        lightmap's texels over virtual patches; given or by default) meets the patches' average
        one bounce later: the plan asks for 4 voxels a mean free path, not 6.5 */
-    traced = (ra.given & RENDER_GIVEN_FINAL_GATHER) ? ra.view.final_gather != 0
+    traced = (ra.given & TOOL_RENDER_GIVEN_FINAL_GATHER) ? ra.view.final_gather != 0
              : ra.mo.method == TOOL_LIGHTMAP        ? ra.mo.proxy == TOOL_PROXY_AAVP || ra.mo.proxy == TOOL_PROXY_VP
                                                     : !ra.mo.sequence && auto_final_gather(&ra.view) != 0;
     if (!ra.bake && (!(ra.mo.given & TOOL_OPT_METHOD) ||
@@ -1733,7 +1012,7 @@ static int render_main(int argc, char **argv, tool_lights *lights)
         return 1;
     }
     render_prepare(cmd, &w, &ra);
-    if (!(ra.given & RENDER_GIVEN_FINAL_GATHER) && ra.mo.method != TOOL_LIGHTMAP &&
+    if (!(ra.given & TOOL_RENDER_GIVEN_FINAL_GATHER) && ra.mo.method != TOOL_LIGHTMAP &&
         !ra.mo.sequence && (ra.mo.method == TOOL_AAVP || ra.mo.method == TOOL_VP || ra.mo.proxy) &&
         (ra.view.final_gather = auto_final_gather(&ra.view)) != 0)
         fprintf(stderr, "rad %s: --final-gather %u (the virtual patches' default at %dx%d; --final-gather 0: off)\n", cmd,

@@ -123,6 +123,22 @@ void *tool_calloc(size_t n, size_t size)
     return p;
 }
 
+int tool_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+void *tool_malloc(size_t size)
+{
+    void *p = malloc(size ? size : 1);
+    if (!p) {
+        fprintf(stderr, "rad: out of memory (%lu bytes)\n", (unsigned long)size);
+        exit(1);
+    }
+    return p;
+}
+
 int tool_fail(const char *cmd, const char *what, rad_result r)
 {
     tool_progress_end();

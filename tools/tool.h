@@ -213,6 +213,10 @@ void tool_progress_end(void);
 int tool_fail(const char *cmd, const char *what, rad_result r);
 /* calloc of n elements (at least one) that prints and exits on failure */
 void *tool_calloc(size_t n, size_t size);
+/* qsort order of doubles, ascending */
+int tool_cmp_double(const void *a, const void *b);
+/* malloc (at least one byte) that prints and exits on failure */
+void *tool_malloc(size_t size);
 /* The whole file into *data (malloc'd, free with free()) and *size; 0, or 1 after printing
    "rad CMD: cannot read WHAT 'PATH': <the system's reason>" (or that it is empty; cmd NULL:
    nothing printed). */
@@ -755,6 +759,69 @@ void tool_lightmap_request_default(tool_lightmap_request *rq);
 int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_classic_options *co,
                        const tool_lightmap_request *rq, tool_lightmap_baked *out);
 void tool_lightmap_bake_free(tool_lightmap_baked *b);
+
+/* ---- rad render's pieces: the pixels (pixels.c) and the teaching methods (render_methods.c) - */
+/* What tool_render_pixels draws: the view and the per-pixel options of the command line */
+typedef struct tool_render_view {
+    rad_camera cam;
+    int width, height;
+    uint32_t aa;             /* --aa: stratified samples per pixel */
+    uint32_t light_samples;  /* --pixel-light-samples */
+    float exposure;          /* --exposure (PNG frames of --sequence) */
+    int shading;             /* --shading: a rad_shading_model, or -1 for none (tools/shading.c) */
+    uint32_t final_gather;   /* --final-gather N: rays per sample for one traced bounce (0: off) */
+} tool_render_view;
+
+/* Where tool_render_pixels takes the irradiance H from the secondary sources at a sample: the
+   first of baker (the engine tier's own final gather, rad_baker_irradiance), vp (rad_vp_gather
+   of vp_H), hr (the hierarchical solution's smooth lookup) and lm (a bilinear lookup of the
+   RGB irradiance lightmap lm_values at the sample's lightmap uv) that is set, else the
+   per-vertex Hv of the patches P. */
+typedef struct tool_render_source {
+    const rad_patches *P;
+    const float *Hv;
+    const rad_virtual_patches *vp;
+    const float *vp_H;
+    const rad_hierarchical *hr;
+    const rad_lightmap *lm;
+    const float *lm_values;
+    const rad_baker_result *baker; /* the engine tier's kept solution (rad_baker_irradiance) */
+    double gather_seconds;   /* out: the time spent in the gathers and lookups */
+} tool_render_source;
+
+/* rad render's command line */
+typedef struct tool_render_args {
+    const char *scene, *out, *bake; /* SCENE, -o, --bake */
+    tool_classic_options o;
+    tool_method_options mo;
+    tool_render_view view;
+    float fov;               /* --fov (0: the camera's) */
+    uint32_t spp;            /* --spp: pathtrace samples per pixel */
+    uint32_t threads;        /* --threads */
+    uint32_t lm_size, lm_samples, lm_vis; /* --lightmap-size, --texel-samples, --visibility-rays */
+    uint32_t given;          /* TOOL_RENDER_GIVEN_* */
+} tool_render_args;
+/* tool_render_args.given: --camera; --lightmap-size (else an unwrap too fine for it gets a larger
+   atlas); one of the lightmap options */
+enum { TOOL_RENDER_GIVEN_CAMERA = 1, TOOL_RENDER_GIVEN_LM_SIZE = 2, TOOL_RENDER_GIVEN_LM = 4, TOOL_RENDER_GIVEN_FINAL_GATHER = 8 };
+/* The image of the radiosity methods: per sample the direct light D at the hit (shadow rays),
+   H from src, radiance albedo / pi (D + H) plus emission; each pixel the mean of its samples,
+   added into img (zeroed by the caller). 0 or 1 (printed). */
+int tool_render_pixels(const tool_world *w, const tool_render_view *view, tool_render_source *src, tool_image *img);
+/* Per-vertex H of the patches without dark halos where a patch is partly covered
+   (rad_patches_vertex_irradiance): S the row sums of F, or F itself. 0 or 1 (printed). */
+int tool_vertex_H_rowsums(const rad_patches *P, const float *S, const float *H, float *Hv);
+int tool_vertex_H(const rad_patches *P, const rad_matrix *F, const float *H, float *Hv);
+/* --method multibounce|temporal|stochastic, and hierarchical from a bake: the bake (--bake,
+   checked against the scene) or one made here, then the patches' H and the pixels */
+int tool_render_with_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img);
+/* --method hierarchical (no bake) and --method local */
+int tool_render_hr_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img);
+int tool_render_local_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img);
+/* 0 when a loaded bake was made from this scene and these options, else 1 (printed) */
+int tool_bake_fits_scene(const char *cmd, const char *bake_path, const rad_bake *bake, const tool_world *w);
+/* why rad_load_file refused a bake, printed */
+void tool_bake_load_failed(const char *cmd, const char *path, rad_result r);
 
 /* ---- glTF output (gltf_write.c; the convention: docs/engine-formats.md) ------------------- */
 /* A baked RGB irradiance lightmap and the scene it was baked over, for engines */
