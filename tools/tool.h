@@ -440,7 +440,7 @@ int tool_parse_shading(const char *cmd, const char *text, int *out_model);
 int tool_shade_direct(const tool_world *w, int model, uint32_t light_samples, const float *points,
                           const float *normals, const float *views, const float *albedos, uint32_t count,
                           float *out_rgb);
-/* ---- the multi-bounce and temporal methods (methods.c) ------------------------------------ */
+/* ---- the teaching methods: options (methods.c), bakes (method_bake.c) ------------------------------ */
 typedef enum tool_method {
     TOOL_CLASSIC = 0, TOOL_MULTIBOUNCE = 1, TOOL_TEMPORAL = 2, TOOL_PATHTRACE = 3,
     TOOL_STOCHASTIC = 4, /* bakes store the value: the render-only methods after it are never stored */
@@ -528,6 +528,9 @@ int tool_method_check(const char *cmd, int render, tool_method_options *mo, tool
 const char *tool_method_help(int render);
 enum { TOOL_METHOD_HELP_RENDER = 1, TOOL_METHOD_HELP_BAKE = 2 };
 const char *tool_method_name(tool_method method);
+/* the names of a multibounce --format (tool_mb_format) and a temporal --mode (rad_temporal_mode) */
+const char *tool_mb_format_name(uint32_t format);
+const char *tool_temporal_mode_name(uint32_t mode);
 /* --method hierarchical: rad_hierarchical_create and solve over the world with E = rho D at
    the elements' centroids (D: rad_direct_irradiance with light_samples shadow rays, emitters
    included, as the classic patches' D) and mo's --hr-* options; prints the counts and the
