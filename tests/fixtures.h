@@ -767,8 +767,8 @@ static inline uint32_t fx_square_grid(float *v, float x0, float z, int up, uint3
 }
 
 /* (hierarchical tests) the area-weighted mean B (channel 0) of the leaves on scene triangles
-   [t0, t1) */
-static inline double fx_hier_mean_B(const rad_hierarchical *h, uint32_t t0, uint32_t t1)
+   [t0, t1), -1 when they have no area; their area into *area when not NULL */
+static inline double fx_hier_mean_B_area(const rad_hierarchical *h, uint32_t t0, uint32_t t1, double *area)
 {
     rad_hierarchical_stats st;
     float *C, *B;
@@ -799,7 +799,61 @@ static inline double fx_hier_mean_B(const rad_hierarchical *h, uint32_t t0, uint
     free(C);
     free(B);
     free(T);
+    if (area) *area = a;
     return a > 0.0 ? s / a : -1.0;
+}
+
+static inline double fx_hier_mean_B(const rad_hierarchical *h, uint32_t t0, uint32_t t1)
+{
+    return fx_hier_mean_B_area(h, t0, t1, NULL);
+}
+
+/* (hierarchical tests) one mesh of n triangles (9 floats each in v, material ids), its scene,
+   BVH and hierarchical solution at the given clustering, tolerance and visibility rays; the
+   failures are CHECKs, what was made is in w (NULL beyond the step that failed) */
+typedef struct fx_hier_world {
+    rad_scene *scene;
+    rad_bvh *bvh;
+    rad_hierarchical *h;
+} fx_hier_world;
+
+static inline void fx_hier_build(const float *v, uint32_t n, const uint32_t *ids, const rad_material *mats,
+                                 uint32_t material_count, rad_hierarchical_clustering clustering, double tolerance,
+                                 uint32_t visibility_rays, fx_hier_world *w)
+{
+    rad_mesh_desc m;
+    rad_scene_desc d;
+    rad_raycaster rc;
+    rad_hierarchical_options o;
+    memset(w, 0, sizeof(*w));
+    memset(&m, 0, sizeof(m));
+    m.positions = v;
+    m.vertex_count = 3u * n;
+    m.triangle_count = n;
+    m.material_ids = ids;
+    memset(&d, 0, sizeof(d));
+    d.meshes = &m;
+    d.mesh_count = 1;
+    d.materials = mats;
+    d.material_count = material_count;
+    CHECK_OK(rad_scene_create(&d, NULL, &w->scene));
+    if (w->scene) CHECK_OK(rad_bvh_create(w->scene, NULL, &w->bvh));
+    if (!w->bvh) return;
+    rad_bvh_raycaster(w->bvh, &rc);
+    rad_hierarchical_options_default(&o);
+    o.clustering = clustering;
+    o.tolerance = tolerance;
+    o.visibility_rays = visibility_rays;
+    CHECK_OK(rad_hierarchical_create(w->scene, &rc, &o, NULL, &w->h));
+    if (w->h) CHECK_OK(rad_hierarchical_solve(w->h, NULL));
+}
+
+static inline void fx_hier_world_free(fx_hier_world *w)
+{
+    rad_hierarchical_destroy(w->h);
+    rad_bvh_destroy(w->bvh);
+    rad_scene_destroy(w->scene);
+    memset(w, 0, sizeof(*w));
 }
 
 #endif

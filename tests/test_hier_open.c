@@ -34,34 +34,12 @@ static void hopen_test_shelf(void)
         mats[1].emission[i] = 1.0f;
     }
     for (pass = 0; pass < 2; ++pass) {
-        rad_mesh_desc m;
-        rad_scene_desc d;
-        rad_scene *scene = NULL;
-        rad_bvh *bvh = NULL;
-        rad_raycaster rc;
-        rad_hierarchical *h = NULL;
-        rad_hierarchical_options o;
-        memset(&m, 0, sizeof(m));
-        m.positions = v;
-        m.vertex_count = 3u * n;
-        m.triangle_count = n;
-        m.material_ids = ids;
-        memset(&d, 0, sizeof(d));
-        d.meshes = &m;
-        d.mesh_count = 1;
-        d.materials = mats;
-        d.material_count = 2;
-        CHECK_OK(rad_scene_create(&d, NULL, &scene));
-        if (scene) CHECK_OK(rad_bvh_create(scene, NULL, &bvh));
-        if (bvh) {
-            rad_bvh_raycaster(bvh, &rc);
-            rad_hierarchical_options_default(&o);
-            o.clustering = pass == 0 ? RAD_HIERARCHICAL_CLUSTER_OFF : RAD_HIERARCHICAL_CLUSTER_ON;
-            o.tolerance = 0.5; /* coarse: the links into the shelf stay at clusters holding both plates */
-            o.visibility_rays = 16;
-            CHECK_OK(rad_hierarchical_create(scene, &rc, &o, NULL, &h));
-            if (h) CHECK_OK(rad_hierarchical_solve(h, NULL));
-        }
+        fx_hier_world w;
+        rad_hierarchical *h;
+        /* coarse: the links into the shelf stay at clusters holding both plates */
+        fx_hier_build(v, n, ids, mats, 2, pass == 0 ? RAD_HIERARCHICAL_CLUSTER_OFF : RAD_HIERARCHICAL_CLUSTER_ON, 0.5,
+                      16, &w);
+        h = w.h;
         if (h) {
             rad_hierarchical_stats st;
             rad_hierarchical_get_stats(h, &st);
@@ -71,9 +49,7 @@ static void hopen_test_shelf(void)
                    pass == 0 ? "off" : "on", (unsigned long long)st.links, (unsigned long long)st.cluster_links,
                    lower_B[pass], fx_hier_mean_B(h, 4u * per, 7u * per));
         }
-        rad_hierarchical_destroy(h);
-        rad_bvh_destroy(bvh);
-        rad_scene_destroy(scene);
+        fx_hier_world_free(&w);
     }
     CHECK(lower_B[0] > 0.0 && lower_B[1] > 0.0);
     if (lower_B[0] > 0.0 && lower_B[1] > 0.0) {
