@@ -856,4 +856,82 @@ static inline void fx_hier_world_free(fx_hier_world *w)
     memset(w, 0, sizeof(*w));
 }
 
+/* quad q of an indexed mesh: its corners c (4 x 3 floats) into pos at 12 q, its two triangles
+   into idx at 6 q, wound so that their normal points along 'want' */
+static inline void fx_quad_wound(float *pos, uint32_t *idx, uint32_t q, const float *c, const float *want)
+{
+    float e1[3], e2[3], n[3];
+    uint32_t k, b = 4 * q;
+    for (k = 0; k < 12; ++k) pos[12 * q + k] = c[k];
+    for (k = 0; k < 3; ++k) {
+        e1[k] = c[3 + k] - c[k];
+        e2[k] = c[6 + k] - c[k];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    if (n[0] * want[0] + n[1] * want[1] + n[2] * want[2] > 0.0f) {
+        idx[6 * q] = b; idx[6 * q + 1] = b + 1; idx[6 * q + 2] = b + 2;
+        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 2; idx[6 * q + 5] = b + 3;
+    } else {
+        idx[6 * q] = b; idx[6 * q + 1] = b + 2; idx[6 * q + 2] = b + 1;
+        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 3; idx[6 * q + 5] = b + 2;
+    }
+}
+
+/* (direct-light tests) a 10 x 5 x 10 box open at the top, walls facing in (albedo 0.7), under a
+   40 x 40 emitter of radiance 1 at y = 6 facing down (with_emitter; its triangles 10 and 11),
+   or without it (for a sky). The floor's centre sees the emitter only through the opening. */
+typedef struct fx_open_box {
+    float pos[72];
+    uint32_t idx[36], mats[12];
+    rad_material m[2];
+    rad_mesh_desc mesh;
+    rad_scene_desc desc;
+    rad_scene *S;
+    rad_bvh *bvh;
+    rad_raycaster rc;
+} fx_open_box;
+
+/* 1, or 0 when the scene or its BVH failed (free it all the same) */
+static inline int fx_open_box_make(fx_open_box *w, int with_emitter)
+{
+    static const float quads[6][12] = {
+        { 0, 0, 0, 0, 0, 10, 10, 0, 10, 10, 0, 0 },       /* floor */
+        { 0, 0, 0, 10, 0, 0, 10, 5, 0, 0, 5, 0 },         /* walls */
+        { 0, 0, 10, 10, 0, 10, 10, 5, 10, 0, 5, 10 },
+        { 0, 0, 0, 0, 0, 10, 0, 5, 10, 0, 5, 0 },
+        { 10, 0, 0, 10, 0, 10, 10, 5, 10, 10, 5, 0 },
+        { -15, 6, -15, 25, 6, -15, 25, 6, 25, -15, 6, 25 } /* the emitter */
+    };
+    static const float wants[6][3] = { { 0, 1, 0 }, { 0, 0, 1 }, { 0, 0, -1 }, { 1, 0, 0 }, { -1, 0, 0 }, { 0, -1, 0 } };
+    uint32_t q;
+    memset(w, 0, sizeof(*w));
+    for (q = 0; q < 6; ++q) fx_quad_wound(w->pos, w->idx, q, quads[q], wants[q]);
+    for (q = 0; q < 12; ++q) w->mats[q] = q >= 10 ? 1u : 0u;
+    w->m[0].albedo[0] = w->m[0].albedo[1] = w->m[0].albedo[2] = 0.7f;
+    w->m[1].emission[0] = w->m[1].emission[1] = w->m[1].emission[2] = 1.0f;
+    w->mesh.positions = w->pos;
+    w->mesh.vertex_count = 24;
+    w->mesh.indices = w->idx;
+    w->mesh.triangle_count = with_emitter ? 12u : 10u;
+    w->mesh.material_ids = w->mats;
+    w->desc.meshes = &w->mesh;
+    w->desc.mesh_count = 1;
+    w->desc.materials = w->m;
+    w->desc.material_count = 2;
+    if (rad_scene_create(&w->desc, NULL, &w->S) != RAD_SUCCESS) return 0;
+    if (rad_bvh_create(w->S, NULL, &w->bvh) != RAD_SUCCESS) return 0;
+    rad_bvh_raycaster(w->bvh, &w->rc);
+    return 1;
+}
+
+static inline void fx_open_box_free(fx_open_box *w)
+{
+    rad_bvh_destroy(w->bvh);
+    rad_scene_destroy(w->S);
+    w->bvh = NULL;
+    w->S = NULL;
+}
+
 #endif

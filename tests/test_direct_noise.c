@@ -100,81 +100,12 @@ static void dn_test_sphere_sampler(void)
     }
 }
 
-/* ---- the open box under a large emitter (the scene of light_partly_hidden_emitter) ---- */
-
-typedef struct dn_world {
-    float pos[72];
-    uint32_t idx[36], mats[12];
-    rad_material m[2];
-    rad_mesh_desc mesh;
-    rad_scene_desc desc;
-    rad_scene *S;
-    rad_bvh *bvh;
-    rad_raycaster rc;
-} dn_world;
-
-static void dn_quad(float *pos, uint32_t *idx, uint32_t q, const float *c, const float *want)
-{
-    float e1[3], e2[3], n[3];
-    uint32_t k, b = 4 * q;
-    for (k = 0; k < 12; ++k) pos[12 * q + k] = c[k];
-    for (k = 0; k < 3; ++k) { e1[k] = c[3 + k] - c[k]; e2[k] = c[6 + k] - c[k]; }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    if (n[0] * want[0] + n[1] * want[1] + n[2] * want[2] > 0.0f) {
-        idx[6 * q] = b; idx[6 * q + 1] = b + 1; idx[6 * q + 2] = b + 2;
-        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 2; idx[6 * q + 5] = b + 3;
-    } else {
-        idx[6 * q] = b; idx[6 * q + 1] = b + 2; idx[6 * q + 2] = b + 1;
-        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 3; idx[6 * q + 5] = b + 2;
-    }
-}
-
-/* A 10 x 5 x 10 box open at the top, walls facing in, under a 40 x 40 emitter of radiance 1
-   at y = 6 facing down (with_emitter), or without it (for a sky). */
-static int dn_world_make(dn_world *w, int with_emitter)
-{
-    static const float quads[6][12] = {
-        { 0, 0, 0, 0, 0, 10, 10, 0, 10, 10, 0, 0 },
-        { 0, 0, 0, 10, 0, 0, 10, 5, 0, 0, 5, 0 },
-        { 0, 0, 10, 10, 0, 10, 10, 5, 10, 0, 5, 10 },
-        { 0, 0, 0, 0, 0, 10, 0, 5, 10, 0, 5, 0 },
-        { 10, 0, 0, 10, 0, 10, 10, 5, 10, 10, 5, 0 },
-        { -15, 6, -15, 25, 6, -15, 25, 6, 25, -15, 6, 25 }
-    };
-    static const float wants[6][3] = { { 0, 1, 0 }, { 0, 0, 1 }, { 0, 0, -1 }, { 1, 0, 0 }, { -1, 0, 0 }, { 0, -1, 0 } };
-    uint32_t q;
-    memset(w, 0, sizeof(*w));
-    for (q = 0; q < 6; ++q) dn_quad(w->pos, w->idx, q, quads[q], wants[q]);
-    for (q = 0; q < 12; ++q) w->mats[q] = q >= 10 ? 1u : 0u;
-    w->m[0].albedo[0] = w->m[0].albedo[1] = w->m[0].albedo[2] = 0.7f;
-    w->m[1].emission[0] = w->m[1].emission[1] = w->m[1].emission[2] = 1.0f;
-    w->mesh.positions = w->pos;
-    w->mesh.vertex_count = 24;
-    w->mesh.indices = w->idx;
-    w->mesh.triangle_count = with_emitter ? 12u : 10u;
-    w->mesh.material_ids = w->mats;
-    w->desc.meshes = &w->mesh;
-    w->desc.mesh_count = 1;
-    w->desc.materials = w->m;
-    w->desc.material_count = 2;
-    if (rad_scene_create(&w->desc, NULL, &w->S) != RAD_SUCCESS) return 0;
-    if (rad_bvh_create(w->S, NULL, &w->bvh) != RAD_SUCCESS) return 0;
-    rad_bvh_raycaster(w->bvh, &w->rc);
-    return 1;
-}
-
-static void dn_world_free(dn_world *w)
-{
-    rad_bvh_destroy(w->bvh);
-    rad_scene_destroy(w->S);
-}
+/* ---- the open box under a large emitter (fx_open_box, the scene of light_partly_hidden_emitter) ---- */
 
 /* The estimator this library used before: L points uniform in area on each emitter triangle
    (Hammersley, rotated by a hash of the seed per point), each shadow ray's share of pi L F
    its kernel cos cos / r^2 over the kernel's sum. Kept here as the yardstick. */
-static float dn_old_estimate(const dn_world *w, const float *p, const float *n, uint32_t L, uint32_t seed)
+static float dn_old_estimate(const fx_open_box *w, const float *p, const float *n, uint32_t L, uint32_t seed)
 {
     rad_ray rays[2 * 64];
     uint8_t occ[2 * 64];
@@ -239,7 +170,7 @@ static void dn_clusters(float *pts, float *nrm, double *ref, int sky)
 
 /* the relative spread across seeds of the clusters' means and their mean over the reference,
    for the library (old == 0) or the earlier estimator */
-static void dn_spread(const dn_world *w, const rad_light *sky, int old, uint32_t seeds, double *rel_sd, double *mean_ratio)
+static void dn_spread(const fx_open_box *w, const rad_light *sky, int old, uint32_t seeds, double *rel_sd, double *mean_ratio)
 {
     float *pts = (float *)malloc(sizeof(float) * 3 * DN_C * DN_G), *nrm = (float *)malloc(sizeof(float) * 3 * DN_C * DN_G);
     float *out = (float *)malloc(sizeof(float) * 3 * DN_C * DN_G);
@@ -282,11 +213,11 @@ done:
 
 static void dn_test_partly_hidden_noise(void)
 {
-    dn_world w;
+    fx_open_box w;
     double sd_new, sd_old, m_new, m_old;
-    if (!dn_world_make(&w, 1)) {
+    if (!fx_open_box_make(&w, 1)) {
         CHECK(0);
-        dn_world_free(&w);
+        fx_open_box_free(&w);
         return;
     }
     dn_spread(&w, NULL, 0, 6, &sd_new, &m_new);
@@ -300,7 +231,7 @@ static void dn_test_partly_hidden_noise(void)
     /* the earlier estimator was also biased low here (its ratio over a handful of effective
        samples): the new mean is nearer the closed form */
     CHECK(fabs(m_new - 1.0) < fabs(m_old - 1.0));
-    dn_world_free(&w);
+    fx_open_box_free(&w);
 }
 
 /* Under a constant sky the floor sees it through the opening only: the mean of the clusters is
@@ -308,12 +239,12 @@ static void dn_test_partly_hidden_noise(void)
    its spread low. */
 static void dn_test_sky_through_opening(void)
 {
-    dn_world w;
+    fx_open_box w;
     rad_light sky;
     double sd, m;
-    if (!dn_world_make(&w, 0)) {
+    if (!fx_open_box_make(&w, 0)) {
         CHECK(0);
-        dn_world_free(&w);
+        fx_open_box_free(&w);
         return;
     }
     memset(&sky, 0, sizeof(sky));
@@ -323,7 +254,7 @@ static void dn_test_sky_through_opening(void)
     printf("    sky through the opening: relative sd %.4f, mean / closed form %.4f\n", sd, m);
     CHECK(sd >= 0.0 && sd < 0.025); /* one rotation per point stays above this */
     CHECK_REL(m, 1.0, 0.005);
-    dn_world_free(&w);
+    fx_open_box_free(&w);
 }
 
 /* An emitter that nothing hides gives pi L F exactly for any seed, even one filling most of
@@ -331,15 +262,15 @@ static void dn_test_sky_through_opening(void)
    nothing; the result does not depend on the task order. */
 static void dn_test_unoccluded_exact(void)
 {
-    dn_world w;
+    fx_open_box w;
     const float pts[9] = { 5, 5.5f, 5, -10, 5.9f, 20, 30, 5.5f, 5 }, nrm[9] = { 0, 1, 0, 0.3f, 1, 0.2f, -1, 1, 0 };
     float out[9], out2[9];
     rad_direct_options o;
     rad_context ctx;
     uint32_t sd, i;
-    if (!dn_world_make(&w, 1)) {
+    if (!fx_open_box_make(&w, 1)) {
         CHECK(0);
-        dn_world_free(&w);
+        fx_open_box_free(&w);
         return;
     }
     rad_direct_options_default(&o);
@@ -363,7 +294,7 @@ static void dn_test_unoccluded_exact(void)
     o.seed = 3;
     CHECK_OK(rad_direct_irradiance(w.S, &w.rc, NULL, 0, &o, pts, nrm, 3, out2, &ctx));
     CHECK(memcmp(out, out2, sizeof(out)) == 0);
-    dn_world_free(&w);
+    fx_open_box_free(&w);
 }
 
 /* rad__emitter_rays: L for a small emitter, more (a power of two times L, at most 4 L and 256)

@@ -20,23 +20,10 @@ typedef struct dp_world {
     uint32_t emitters;
 } dp_world;
 
-/* quad q: corners c (4 x 3), wound so its normal is along 'want' */
+/* quad q: corners c (4 x 3), wound so its normal is along 'want', of material mat */
 static void dp_quad(dp_world *w, uint32_t q, const float *c, const float *want, uint32_t mat)
 {
-    float e1[3], e2[3], n[3];
-    uint32_t k, b = 4 * q;
-    for (k = 0; k < 12; ++k) w->pos[12 * q + k] = c[k];
-    for (k = 0; k < 3; ++k) e1[k] = c[3 + k] - c[k], e2[k] = c[6 + k] - c[k];
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    if (n[0] * want[0] + n[1] * want[1] + n[2] * want[2] > 0.0f) {
-        uint32_t t[6] = { b, b + 1, b + 2, b, b + 2, b + 3 };
-        for (k = 0; k < 6; ++k) w->idx[6 * q + k] = t[k];
-    } else {
-        uint32_t t[6] = { b, b + 2, b + 1, b, b + 3, b + 2 };
-        for (k = 0; k < 6; ++k) w->idx[6 * q + k] = t[k];
-    }
+    fx_quad_wound(w->pos, w->idx, q, c, want);
     w->mats[2 * q] = w->mats[2 * q + 1] = mat;
 }
 

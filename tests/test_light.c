@@ -493,66 +493,19 @@ done:
    opening projected from the point onto the emitter's plane), so its irradiance is pi L F of
    that square, in closed form. With equal shares per shadow ray the estimate was the whole
    emitter's F times the fraction of rays that get through, a fifth of the answer here. */
-static void li_box_quad(float *pos, uint32_t *idx, uint32_t q, const float *c, const float *want)
-{
-    float e1[3], e2[3], n[3];
-    uint32_t k, b = 4 * q;
-    for (k = 0; k < 12; ++k) pos[12 * q + k] = c[k];
-    for (k = 0; k < 3; ++k) { e1[k] = c[3 + k] - c[k]; e2[k] = c[6 + k] - c[k]; }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    if (n[0] * want[0] + n[1] * want[1] + n[2] * want[2] > 0.0f) {
-        idx[6 * q] = b; idx[6 * q + 1] = b + 1; idx[6 * q + 2] = b + 2;
-        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 2; idx[6 * q + 5] = b + 3;
-    } else {
-        idx[6 * q] = b; idx[6 * q + 1] = b + 2; idx[6 * q + 2] = b + 1;
-        idx[6 * q + 3] = b; idx[6 * q + 4] = b + 3; idx[6 * q + 5] = b + 2;
-    }
-}
-
 static void li_test_partly_hidden_emitter(void)
 {
-    static const float quads[6][12] = {
-        { 0, 0, 0, 0, 0, 10, 10, 0, 10, 10, 0, 0 },      /* floor */
-        { 0, 0, 0, 10, 0, 0, 10, 5, 0, 0, 5, 0 },        /* walls */
-        { 0, 0, 10, 10, 0, 10, 10, 5, 10, 0, 5, 10 },
-        { 0, 0, 0, 0, 0, 10, 0, 5, 10, 0, 5, 0 },
-        { 10, 0, 0, 10, 0, 10, 10, 5, 10, 10, 5, 0 },
-        { -15, 6, -15, 25, 6, -15, 25, 6, 25, -15, 6, 25 } /* the emitter */
-    };
-    static const float wants[6][3] = { { 0, 1, 0 }, { 0, 0, 1 }, { 0, 0, -1 }, { 1, 0, 0 }, { -1, 0, 0 }, { 0, -1, 0 } };
     static const float visible[12] = { -1, 6, -1, 11, 6, -1, 11, 6, 11, -1, 6, 11 }; /* front faces down */
-    float pos[72], p[3] = { 5.0f, 1e-4f, 5.0f }, n[3] = { 0.0f, 1.0f, 0.0f }, p2[3] = { 2.0f, 1e-4f, 7.0f }, out[3];
-    uint32_t idx[36], mats[12], q;
-    rad_material m[2] = { { { 0.7f, 0.7f, 0.7f }, { 0.0f, 0.0f, 0.0f }, 0, 0, 0, 0, 0.0f }, { { 0.0f, 0.0f, 0.0f }, { 1.0f, 1.0f, 1.0f }, 0, 0, 0, 0, 0.0f } };
-    rad_mesh_desc mesh;
-    rad_scene_desc d;
-    rad_scene *S = NULL;
-    rad_bvh *b = NULL;
-    rad_raycaster rc;
+    float p[3] = { 5.0f, 1e-4f, 5.0f }, n[3] = { 0.0f, 1.0f, 0.0f }, p2[3] = { 2.0f, 1e-4f, 7.0f }, out[3];
+    uint32_t q;
+    fx_open_box w;
     rad_direct_options o;
-    for (q = 0; q < 6; ++q) li_box_quad(pos, idx, q, quads[q], wants[q]);
-    for (q = 0; q < 12; ++q) mats[q] = q >= 10 ? 1u : 0u;
-    memset(&mesh, 0, sizeof(mesh));
-    mesh.positions = pos;
-    mesh.vertex_count = 24;
-    mesh.indices = idx;
-    mesh.triangle_count = 12;
-    mesh.material_ids = mats;
-    memset(&d, 0, sizeof(d));
-    d.meshes = &mesh;
-    d.mesh_count = 1;
-    d.materials = m;
-    d.material_count = 2;
-    CHECK_OK(rad_scene_create(&d, NULL, &S));
-    if (S) CHECK_OK(rad_bvh_create(S, NULL, &b));
-    if (b) {
+    CHECK(fx_open_box_make(&w, 1));
+    if (w.bvh) {
         float ref, ref2, vis2[12];
-        rad_bvh_raycaster(b, &rc);
         rad_direct_options_default(&o);
         o.light_samples = 256;
-        CHECK_OK(rad_direct_irradiance(S, &rc, NULL, 0, &o, p, n, 1, out, NULL));
+        CHECK_OK(rad_direct_irradiance(w.S, &w.rc, NULL, 0, &o, p, n, 1, out, NULL));
         ref = (float)RAD__PI * rad_ff_point_polygon(p, n, visible, 4);
         printf("    floor centre: %.5f, visible square %.5f (ratio %.4f)\n", (double)out[0], (double)ref, (double)(out[0] / ref));
         CHECK_REL(out[0], ref, 0.03);
@@ -562,13 +515,12 @@ static void li_test_partly_hidden_emitter(void)
             vis2[3 * q + 1] = 6.0f;
             vis2[3 * q + 2] = p2[2] + ((visible[3 * q + 2] < 0.0f ? 0.0f : 10.0f) - p2[2]) * 1.2f;
         }
-        CHECK_OK(rad_direct_irradiance(S, &rc, NULL, 0, &o, p2, n, 1, out, NULL));
+        CHECK_OK(rad_direct_irradiance(w.S, &w.rc, NULL, 0, &o, p2, n, 1, out, NULL));
         ref2 = (float)RAD__PI * rad_ff_point_polygon(p2, n, vis2, 4);
         printf("    off centre: %.5f, visible rectangle %.5f (ratio %.4f)\n", (double)out[0], (double)ref2, (double)(out[0] / ref2));
         CHECK_REL(out[0], ref2, 0.03);
     }
-    rad_bvh_destroy(b);
-    rad_scene_destroy(S);
+    fx_open_box_free(&w);
 }
 
 /* the lookup of li_test_final_gather: a constant H, or an error */
@@ -604,7 +556,7 @@ static void li_test_final_gather(void)
     rad_light sun;
     rad_final_gather_options fo;
     rad_context ctx;
-    for (q = 0; q < 6; ++q) li_box_quad(pos, idx, q, quads[q], wants[q]);
+    for (q = 0; q < 6; ++q) fx_quad_wound(pos, idx, q, quads[q], wants[q]);
     for (i = 0; i < 3; ++i) { /* on the wall x = 0, facing +x */
         pts[3 * i] = 0.0f; pts[3 * i + 1] = heights[i]; pts[3 * i + 2] = 0.5f;
         nrm[3 * i] = 1.0f; nrm[3 * i + 1] = 0.0f; nrm[3 * i + 2] = 0.0f;
