@@ -3380,8 +3380,8 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    (>>api_bake_runtime), the kept SOLUTION and the band-4 probes do not carry the sky layers
    (sky layers with RAD_PROBES_DIRECT or RAD_PROBES_BAND4 probes are refused).
    KEEP (rad_baker_options.keep): the bake's solver objects stay in the result (the scene and
-   its BVH (none with rad_baker_desc.raycaster), the patches and F or the virtual patches, the lightmap's texels, the probes'
-   weights) instead of being freed (a runtime is meant to follow), and rad_baker_runtime_create BORROWS them rather than
+   its BVH (none with rad_baker_desc.raycaster), the patches and F or the virtual patches,
+   the lightmap's texels, the probes' weights) instead of being freed (a runtime is meant to follow), and rad_baker_runtime_create BORROWS them rather than
    building them again, so the result must outlive the runtimes made from it. Virtual patches
    are then built with sparse rows (RAD_STORAGE_SPARSE, what the runtime needs: the outputs
    may differ from a bake without keep by float rounding, 7e-8 in the test; 8 bytes per
@@ -25643,7 +25643,7 @@ static rad_result rad__brt_options(rad_baker_runtime *rt, const rad_baker_desc *
 }
 
 /* the third stage: the baked lights copied, the direct-light options set, and the scene with
-   its BVH built from the desc */
+   its ray caster (the desc's, or a BVH) */
 static rad_result rad__brt_alloc(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_options *bo,
                                  const rad__ctx *c)
 {
