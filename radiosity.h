@@ -3380,14 +3380,26 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    (>>api_bake_runtime), the kept SOLUTION and the band-4 probes do not carry the sky layers
    (sky layers with RAD_PROBES_DIRECT or RAD_PROBES_BAND4 probes are refused).
    KEEP (rad_baker_options.keep): the bake's solver objects stay in the result (the scene and
-   its BVH, the patches and F or the virtual patches, the lightmap's texels, the probes'
-   weights) instead of being freed (a runtime is meant to follow), and rad_baker_runtime_create BORROWS them rather than
+   its BVH (none with rad_baker_desc.raycaster), the patches and F or the virtual patches,
+   the lightmap's texels, the probes' weights) instead of being freed (a runtime is meant to follow), and rad_baker_runtime_create BORROWS them rather than
    building them again, so the result must outlive the runtimes made from it. Virtual patches
    are then built with sparse rows (RAD_STORAGE_SPARSE, what the runtime needs: the outputs
    may differ from a bake without keep by float rounding, 7e-8 in the test; 8 bytes per
    non-zero instead of 4 N^2 in all). rad_baker_result_destroy frees them. With RAD_BAKER_SOLUTION too, the solution
    reads the same kept objects. Memory: what the build held, for the result's
    life.
+   RAYCASTER (rad_baker_desc.raycaster). NULL: the bake builds the built-in BVH over the
+   scene it makes from desc->scene (rad_bvh_create) and frees it. An engine with a tracer of
+   its own (Embree, its BVH, a world it already built) passes it instead and no BVH is built.
+   Both callbacks are called (closest hits and occlusion), from several tasks at once. The
+   caster must answer for the triangles of rad_scene_create on desc->scene, numbered as it
+   numbers them (the meshes in order, each mesh's triangles in order, degenerate ones skipped,
+   a two-sided material's twins as it adds them), over the same positions, with the rules of
+   >>api_rays (TWO-SIDED TRIANGLES, ALPHA CUTOUTS); a caster built by rad_bvh_create or
+   rad_embree_create on such a scene does. The library cannot check this (a caster has no
+   triangle count): another scene gives wrong light, not an error. With the built-in BVH over
+   that scene the outputs are the same bits as with NULL. The table is copied and its user
+   object borrowed for the call (for rad_baker_runtime_create: for the runtime's life).
    PROGRESS AND CANCEL. ctx->progress sees one fraction over the whole bake (build about 60%,
    then the groups); a non-zero return stops the bake with RAD_ERROR_CANCELLED and frees
    everything. Deterministic: the same bits whatever the thread count. */
@@ -3440,6 +3452,8 @@ typedef struct rad_baker_desc {
     const rad_lightmap_gather_options *lightmap_gather; /* classic's lightmap gather (LIGHTMAP
                                        OPTIONS above; NULL: the defaults and the automatic method) */
     uint32_t lightmap_flags;        /* rad_baker_lightmap_flags bits (LIGHTMAP OPTIONS above) */
+    const rad_raycaster *raycaster; /* the caller's ray queries over desc->scene (RAYCASTER
+                                       above; NULL: the built-in BVH, built by the call) */
 } rad_baker_desc;
 
 /* How to bake. A zeroed struct means every default. */
@@ -3546,7 +3560,7 @@ typedef struct rad_baker_result {
    result. Errors (the logger names the cause): INVALID_ARGUMENT (NULL, an unknown method or
    output bit, a group >= RAD_BAKER_MAX_GROUPS or >= group_count, nothing that emits: no light,
    no emissive material and no sky layers, sky_bands above 4 or sky_rays above 4096, a lightmap without any lightmap_uvs, a negative or non-finite
-   budget), the scene's errors (rad_scene_create: a bad mesh, material or value), the lights'
+   budget, a desc->raycaster without occluded or intersect), the scene's errors (rad_scene_create: a bad mesh, material or value), the lights'
    (rad_direct_irradiance), OUT_OF_MEMORY (also: the budget is too small for the smallest bake
    of the method, or an allocation failed), SIZE_OVERFLOW (a probe grid of more than 2^24
    probes, before any work), the probes' errors (rad_probes_create: bad probe_options),
@@ -3747,12 +3761,17 @@ RAD_API void rad_baker_runtime_options_default(rad_baker_runtime_options *option
    and ctx may be NULL; ctx is COPIED and used by every update (its allocator, parallel_for and
    logger must outlive the runtime). Errors: INVALID_ARGUMENT (NULL, a result of another desc
    or options: its method, patch count or output sizes differ; bad options; more than
-   RAD_VP_LIGHTS_MAX lights over virtual patches), those of rad_baker_run's build, OUT_OF_
+   RAD_VP_LIGHTS_MAX lights over virtual patches; a desc->raycaster without occluded or
+   intersect), those of rad_baker_run's build, OUT_OF_
    MEMORY. Cost: the bake's build (F or the set, texels, probes) plus 'bounces' + 1 sweeps;
    for a result baked with rad_baker_options.keep (KEEP in >>api_bake) the scene, BVH,
    patches and F or virtual patches, texels and probes' weights are BORROWED from the result
    (which must then outlive the runtime), leaving the multi-bounce matrix or the alias tables,
-   the lights' visibility, the gather tables and the lightmap weights to build. */
+   the lights' visibility, the gather tables and the lightmap weights to build. desc->raycaster
+   (RAYCASTER in >>api_bake): the runtime casts every ray of create and of its updates through
+   it and builds no BVH; the table is copied, its user object borrowed for the runtime's life.
+   NULL: the kept BVH, or one the runtime builds (also when the bake had a caster of its own);
+   a runtime may take another caster than its bake did, over the same triangles. */
 RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const rad_baker_options *bake_options,
                                             const rad_baker_result *result, const rad_baker_runtime_options *options,
                                             const rad_context *ctx, rad_baker_runtime **out);
@@ -24224,6 +24243,12 @@ static rad_result rad__baker_check(rad__baker *b)
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: light_count %u with lights NULL", d->light_count);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (d->raycaster && (!d->raycaster->occluded || !d->raycaster->intersect)) {
+        /* the tier casts both kinds (free paths, form factors, shadows, texels, probes) */
+        rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: desc->raycaster has no %s callback (the bake calls occluded and "
+                                       "intersect)", d->raycaster->occluded ? "intersect" : "occluded");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (!d->scene.meshes || d->scene.mesh_count == 0 || (d->scene.material_count && !d->scene.materials)) {
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: the scene has no meshes (or material_count without materials)");
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -25158,9 +25183,10 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
     r = rad__baker_check(&b);
     if (r == RAD_SUCCESS && rad__baker_stage(&b.prog, 0.0f, 0.02f)) r = RAD_ERROR_CANCELLED;
     if (r == RAD_SUCCESS) r = rad_scene_create(&desc->scene, &b.sub, &b.scene);
-    if (r == RAD_SUCCESS) r = rad_bvh_create(b.scene, &b.sub, &b.bvh);
+    if (r == RAD_SUCCESS && !desc->raycaster) r = rad_bvh_create(b.scene, &b.sub, &b.bvh);
     if (r == RAD_SUCCESS) {
-        rad_bvh_raycaster(b.bvh, &b.rc);
+        if (desc->raycaster) b.rc = *desc->raycaster; /* the caller's, over the same numbering (RAYCASTER) */
+        else rad_bvh_raycaster(b.bvh, &b.rc);
         b.masked = (rad_material *)rad__alloc_array(&b.c.allocator, b.scene->material_count ? b.scene->material_count : 1u,
                                                     sizeof(rad_material));
         b.lights = (rad_light *)rad__alloc_array(&b.c.allocator, desc->light_count ? desc->light_count : 1u, sizeof(rad_light));
@@ -25540,6 +25566,11 @@ static rad_result rad__brt_check_args(const rad_baker_desc *desc, const rad_bake
         rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: light_count %u with lights NULL", desc->light_count);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (desc->raycaster && (!desc->raycaster->occluded || !desc->raycaster->intersect)) {
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: desc->raycaster has no %s callback (the runtime calls "
+                                   "occluded and intersect)", desc->raycaster->occluded ? "intersect" : "occluded");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (desc->lightmap_gather || (desc->lightmap_flags & ~(uint32_t)(RAD_BAKER_LIGHTMAP_RGB9E5 | RAD_BAKER_LIGHTMAP_RGB9E5_ONLY)) ||
         R->lightmap_channels > 3u) {
         /* its lightmap is the RGB bounced light refreshed from the patches */
@@ -25612,7 +25643,7 @@ static rad_result rad__brt_options(rad_baker_runtime *rt, const rad_baker_desc *
 }
 
 /* the third stage: the baked lights copied, the direct-light options set, and the scene with
-   its BVH built from the desc */
+   its ray caster (the desc's, or a BVH) */
 static rad_result rad__brt_alloc(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_options *bo,
                                  const rad__ctx *c)
 {
@@ -25631,10 +25662,13 @@ static rad_result rad__brt_alloc(rad_baker_runtime *rt, const rad_baker_desc *de
         r = RAD_SUCCESS;
     } else {
         r = rad_scene_create(&desc->scene, &rt->sub, &rt->scene);
-        if (r == RAD_SUCCESS) r = rad_bvh_create(rt->scene, &rt->sub, &rt->bvh);
     }
+    /* the desc's caster serves every update; else the kept BVH, or one of our own (also over
+       a kept scene whose bake had a caller's caster and kept no BVH) */
+    if (r == RAD_SUCCESS && !desc->raycaster && !rt->bvh) r = rad_bvh_create(rt->scene, &rt->sub, &rt->bvh);
     if (r != RAD_SUCCESS) return r;
-    rad_bvh_raycaster(rt->bvh, &rt->rc);
+    if (desc->raycaster) rt->rc = *desc->raycaster;
+    else rad_bvh_raycaster(rt->bvh, &rt->rc);
     return RAD_SUCCESS;
 }
 

@@ -247,6 +247,9 @@ int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_opti
     bl = (rad_baker_light *)tool_calloc(w->file.light_count ? w->file.light_count : 1u, sizeof *bl);
     for (i = 0; i < w->file.light_count; ++i) bl[i].light = w->file.lights[i];
     d->scene = w->file.desc;
+    /* the world's BVH is over rad_scene_create of this same description: the tier casts
+       through it instead of building a second one (RAYCASTER in >>api_bake) */
+    d->raycaster = &w->rc;
     d->lights = bl;
     d->light_count = w->file.light_count;
     d->group_count = 1;
