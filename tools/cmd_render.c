@@ -1237,6 +1237,7 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     bo.vp_voxels_per_path = voxels_per_path;
     /* count the kind that will be built: a clustered set has more patches at one resolution */
     bo.vp_kind = !chosen && (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    bo.vp_face_points = mo->face_points; /* and with the face points it will be built with */
     tool_context(&ctx, NULL);
     if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
     if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
