@@ -24233,7 +24233,6 @@ static void rad__baker_probe_options(const rad_baker_desc *d, rad_probe_options 
     if (d->probe_spacing != 0.0f) po->spacing = d->probe_spacing;
 }
 
-/* The checks that need nothing built: groups, outputs, budget, something that emits. */
 /* The solver and the patch options rad_baker_run and rad_baker_plan share (SOLVER and METHOD
    in >>api_bake); 'who' names the call in the messages. */
 static rad_result rad__baker_solver_check(const rad__ctx *c, const rad_baker_options *o, const char *who)
@@ -24260,6 +24259,7 @@ static rad_result rad__baker_solver_check(const rad__ctx *c, const rad_baker_opt
     return RAD_SUCCESS;
 }
 
+/* The checks that need nothing built: groups, outputs, budget, something that emits. */
 static rad_result rad__baker_check(rad__baker *b)
 {
     const rad_baker_desc *d = b->d;
