@@ -2,8 +2,8 @@
    rad_baker_options.solver, max_edge, vp_face_points): each solver's per-vertex light against
    the same calls made by hand (bit for bit), Gauss-Seidel and LU against each other and
    Jacobi approaching them, no bounce giving H = F E, the plan counting with max_edge and face
-   points, and the refusals. Included by test_main.c after the implementation: every name is
-   static and prefixed bsv_. */
+   points, the runtime following such a bake, and the refusals. Included by test_main.c after
+   the implementation: every name is static and prefixed bsv_. */
 #include "fixtures.h"
 
 /* the Cornell box's point lamp of the other baker tests */
@@ -397,11 +397,35 @@ static void bsv_test_refusals(void)
     rad_baker_result_destroy(R);
 }
 
+/* the runtime rebuilds the bake's objects (no keep) with its max_edge and face points: the
+   same patch counts, so it follows the bake */
+static void bsv_test_runtime(void)
+{
+    rad_baker_desc d;
+    rad_baker_light bl;
+    rad_baker_options o;
+    int k;
+    bsv_desc(&d, &bl);
+    for (k = 0; k < 2; ++k) {
+        rad_baker_result *R = NULL;
+        rad_baker_runtime *rt = NULL;
+        bsv_options(&o, k ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC, RAD_BAKER_SOLVE_JACOBI);
+        o.vp_resolution = 4;
+        o.vp_face_points = 4;
+        CHECK_OK(rad_baker_run(&d, &o, NULL, &R));
+        if (R) CHECK_OK(rad_baker_runtime_create(&d, &o, R, NULL, NULL, &rt));
+        CHECK(rt != NULL);
+        rad_baker_runtime_destroy(rt);
+        rad_baker_result_destroy(R);
+    }
+}
+
 static const rad_test_case tests_baker_solver[] = {
     { "baker_solver_classic", bsv_test_classic },
     { "baker_solver_vp", bsv_test_vp },
     { "baker_solver_plan", bsv_test_plan },
     { "baker_solver_refusals", bsv_test_refusals },
+    { "baker_solver_runtime", bsv_test_runtime },
     { NULL, NULL }
 };
 
