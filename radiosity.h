@@ -3257,16 +3257,26 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    and the budget, estimates and logs the cost before the work, solves, and returns the
    bounced light per vertex, per lightmap texel and per probe, one layer per light group.
    METHOD (rad_baker_options.method, RAD_BAKER_AUTO by default). CLASSIC: rad_patches_create
-   (about 'patches' patches, at least one per triangle), dense form factors
-   (rad_form_factors_dense, 'ff_samples' per pair), Jacobi bounces (rad_solve_jacobi), the
+   (about 'patches' patches, at least one per triangle, none with an edge above max_edge when
+   that is set), dense form factors (rad_form_factors_dense, 'ff_samples' per pair), the
+   bounces by the SOLVER below (Jacobi, rad_solve_jacobi, by default), the
    per-vertex irradiance without dark halos (rad_patches_vertex_irradiance with the row sums
    of F) gathered per mesh (rad_patches_gather_mesh), the lightmap by rad_lightmap_gather
    (exact, or the hemisphere gather when valid samples x patches passes 5e7) and probes by
    rad_probes_create. VIRTUAL PATCHES: virtual patches of the kind vp_kind (axis-aligned by
-   default; rad_vp_create, dense F) at the finest resolution from vp_resolution down whose estimate fits the memory budget,
-   the same Jacobi bounces on rad_vp_system, rad_vp_gather_mesh, rad_lightmap_gather_vp and
+   default; rad_vp_create with vp_face_points, dense F) at the finest resolution from vp_resolution down whose estimate fits the memory budget,
+   the same solve on rad_vp_system, rad_vp_gather_mesh, rad_lightmap_gather_vp and
    rad_probes_create_vp. AUTO takes CLASSIC when its estimate fits both max_memory and
    max_seconds, else VIRTUAL PATCHES.
+   SOLVER (rad_baker_options.solver): the same system B = E + rho F B per layer, solved for
+   its indirect part L by one of rad_solve_jacobi ('bounces' bounces: the default, and the
+   only one the runtime, >>api_bake_runtime, folds into its operator), rad_solve_gauss_seidel
+   (sweeps until the solvers' default tolerance: every bounce; a sweep limit reached is
+   logged as a warning and the bake goes on with the last sweep, which is close), or
+   rad_solve_direct (LU in double: every bounce, exactly; for classic only: its N^2 doubles
+   are beyond any set of virtual patches worth a bake, so with them it is refused); or none
+   (RAD_BAKER_SOLVE_NONE: L = 0, so H = F E is the first bounce of the direct light alone, a
+   view of one bounce). The outputs are then made from B = E + L as for Jacobi.
    PLAN (rad_baker_plan, which rad_baker_run calls): the resolution of the virtual patches
    comes from the scene, not a fixed count. Their energy error comes from averaging inside a
    voxel (irradiance that changes across it, walls it straddles), so the voxels must be small
@@ -3286,8 +3296,11 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    as its fourth power), and the reason says the budget, not the scene, set it
    (rad_baker_choice.budget_limited). A non-zero vp_resolution replaces the scene's.
    ESTIMATE: classic 4 N^2 bytes of F plus 300 per patch, time N^2 ff_samples / 3e6 s (the
-   measured form-factor rate of one thread) plus the bounces and the lightmap gather; virtual
-   patches (counted first by rad_vp_count, of the kind vp_kind: a clustered set has up to 6
+   measured form-factor rate of one thread) plus the bounces (6 N^2 flops each at 2e9 a
+   second, per layer; a Gauss-Seidel sweep counts as a bounce and 'bounces' of them are
+   counted; none without a solve; the direct solver instead 2 N^3 flops a layer and 8 N^2
+   bytes more, its double matrix) and the lightmap gather; virtual
+   patches (counted first by rad_vp_count, of the kind vp_kind and with vp_face_points: a clustered set has up to 6
    patches a voxel, often about twice the axis-aligned count) 4 N^2 plus 132 bytes per sample and 48 N per task,
    time M^2 / 3e8 s for M samples plus 16 share rays per sample at 5e6 rays a second; both add the direct light of
    emitting triangles at every point it is computed at (M samples, or 16 per classic patch): the plan's points count the
@@ -3298,7 +3311,8 @@ RAD_API void rad_sh_l4_irradiance(const float coefficients[27], const float band
    rows (8 bytes a non-zero) are counted as the dense F they replace. Times are CPU seconds
    (one thread's; divide by the threads for the wall time). Rough: within a factor of a few.
    The estimate and the choice are logged (RAD_LOG_INFO) before the work and returned in the
-   result (method, reason, numbers, plan).
+   result (method, reason, numbers, plan). The classic count is of the patches rad_patches_create
+   makes with 'patches' and max_edge, which the bake then uses.
    SOURCE. Direct light is each group's source (RAD_SOURCE_DIRECT): the lights of the group
    and the emissive triangles whose material is in the group (rad_baker_desc.material_groups),
    reflected once (E = rho D) and then bounced. Emission itself and direct light are NOT in
@@ -3427,6 +3441,14 @@ typedef enum rad_baker_lightmap_flags {
     RAD_BAKER_LIGHTMAP_RGB9E5_ONLY = 8 /* packed instead: lightmap_layers is NULL */
 } rad_baker_lightmap_flags;
 
+/* rad_baker_options.solver (SOLVER above): how each layer's indirect light L is found */
+typedef enum rad_baker_solver {
+    RAD_BAKER_SOLVE_JACOBI = 0,     /* 'bounces' Jacobi bounces (rad_solve_jacobi) */
+    RAD_BAKER_SOLVE_GAUSS_SEIDEL = 1, /* sweeps to the solvers' tolerance: every bounce (rad_solve_gauss_seidel) */
+    RAD_BAKER_SOLVE_DIRECT = 2,     /* LU in double (rad_solve_direct): every bounce; classic only */
+    RAD_BAKER_SOLVE_NONE = 3        /* no bounce: L = 0, H = F E (the first bounce of the direct light) */
+} rad_baker_solver;
+
 typedef struct rad_baker_solution rad_baker_solution; /* private: what RAD_BAKER_SOLUTION keeps */
 
 /* A light and the group it belongs to (group < RAD_BAKER_MAX_GROUPS). */
@@ -3465,7 +3487,8 @@ typedef struct rad_baker_options {
     uint32_t patches;               /* classic: target patch count (0: 512) */
     uint32_t vp_resolution;         /* virtual patches: the finest resolution tried (0: what
                                        the scene needs, PLAN above) */
-    uint32_t bounces;               /* Jacobi bounces (0: 16) */
+    uint32_t bounces;               /* Jacobi bounces (0: 16; RAD_BAKER_SOLVE_GAUSS_SEIDEL's estimate
+                                       counts as many sweeps) */
     uint32_t ff_samples;            /* form-factor samples per patch pair (0: 16) */
     uint32_t light_samples;         /* shadow rays per area light and point (0: 16) */
     uint32_t lightmap_samples;      /* sub-points per texel (0: 4) */
@@ -3487,6 +3510,13 @@ typedef struct rad_baker_options {
                                        is traced in front of the solution, rad_final_gather) */
     uint32_t lightmap_final_gather; /* rays per texel of a final gather in front of the solution
                                        (LIGHTMAP OPTIONS above; 0: none; at most 4096) */
+    rad_baker_solver solver;        /* how the bounces are solved (SOLVER above; 0:
+                                       RAD_BAKER_SOLVE_JACOBI, 'bounces' bounces) */
+    float max_edge;                 /* classic: the longest patch edge, rad_patch_options.max_edge
+                                       (0: no limit; finite and >= 0) */
+    uint32_t vp_face_points;        /* virtual patches: rad_vp_options.face_points, the rays per
+                                       voxel face that find the patches (0: its default, 16; at
+                                       most 4096) */
 } rad_baker_options;
 
 /* What rad_baker_options.keep keeps (private). */
@@ -3560,7 +3590,10 @@ typedef struct rad_baker_result {
    result. Errors (the logger names the cause): INVALID_ARGUMENT (NULL, an unknown method or
    output bit, a group >= RAD_BAKER_MAX_GROUPS or >= group_count, nothing that emits: no light,
    no emissive material and no sky layers, sky_bands above 4 or sky_rays above 4096, a lightmap without any lightmap_uvs, a negative or non-finite
-   budget, a desc->raycaster without occluded or intersect), the scene's errors (rad_scene_create: a bad mesh, material or value), the lights'
+   budget, a desc->raycaster without occluded or intersect, an unknown solver,
+   RAD_BAKER_SOLVE_DIRECT with virtual patches (asked for or chosen by AUTO), a max_edge
+   negative or not finite, vp_face_points above 4096), the scene's errors (rad_scene_create: a
+   bad mesh, material or value), the lights'
    (rad_direct_irradiance), OUT_OF_MEMORY (also: the budget is too small for the smallest bake
    of the method, or an allocation failed), SIZE_OVERFLOW (a probe grid of more than 2^24
    probes, before any work), the probes' errors (rad_probes_create: bad probe_options),
@@ -3581,7 +3614,8 @@ RAD_API const rad_lightmap *rad_baker_result_lightmap(const rad_baker_result *re
    to the same rule). raycaster: intersect() casts the free-path rays (borrowed for the call).
    options and ctx may be NULL. The reason is logged (RAD_LOG_INFO). Deterministic: the same
    plan for the same scene, options and task count (ctx's tasks enter the memory estimate only).
-   Errors: INVALID_ARGUMENT (NULL, an unknown method, a negative or non-finite budget),
+   Errors: INVALID_ARGUMENT (NULL, an unknown method or solver, a negative or non-finite budget
+   or max_edge, vp_face_points above 4096, RAD_BAKER_SOLVE_DIRECT with virtual patches),
    OUT_OF_MEMORY (also: max_memory is below the coarsest bake, or classic was asked for and
    does not fit), RAYCAST_FAILED. Cost: 4096 rays, rad_vp_count once or a few times (face rays
    of the candidate voxels), and rad_patches_create when classic may fit. */
@@ -3762,7 +3796,10 @@ RAD_API void rad_baker_runtime_options_default(rad_baker_runtime_options *option
    logger must outlive the runtime). Errors: INVALID_ARGUMENT (NULL, a result of another desc
    or options: its method, patch count or output sizes differ; bad options; more than
    RAD_VP_LIGHTS_MAX lights over virtual patches; a desc->raycaster without occluded or
-   intersect), those of rad_baker_run's build, OUT_OF_
+   intersect; a bake whose solver is not
+   RAD_BAKER_SOLVE_JACOBI: the runtime refreshes 'bounces' Jacobi bounces, so a Gauss-Seidel,
+   direct or no-bounce bake is not what it would keep up; its max_edge and vp_face_points are
+   honoured), those of rad_baker_run's build, OUT_OF_
    MEMORY. Cost: the bake's build (F or the set, texels, probes) plus 'bounces' + 1 sweeps;
    for a result baked with rad_baker_options.keep (KEEP in >>api_bake) the scene, BVH,
    patches and F or virtual patches, texels and probes' weights are BORROWED from the result
@@ -24217,6 +24254,32 @@ static void rad__baker_probe_options(const rad_baker_desc *d, rad_probe_options 
     if (d->probe_spacing != 0.0f) po->spacing = d->probe_spacing;
 }
 
+/* The solver and the patch options rad_baker_run and rad_baker_plan share (SOLVER and METHOD
+   in >>api_bake); 'who' names the call in the messages. */
+static rad_result rad__baker_solver_check(const rad__ctx *c, const rad_baker_options *o, const char *who)
+{
+    if ((unsigned)o->solver > (unsigned)RAD_BAKER_SOLVE_NONE) {
+        rad__log(c, RAD_LOG_ERROR, "%s: unknown solver %d (RAD_BAKER_SOLVE_JACOBI, _GAUSS_SEIDEL, _DIRECT or _NONE)", who,
+                 (int)o->solver);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (o->solver == RAD_BAKER_SOLVE_DIRECT && o->method == RAD_BAKER_VIRTUAL_PATCHES) {
+        rad__log(c, RAD_LOG_ERROR, "%s: RAD_BAKER_SOLVE_DIRECT is for the classic method only (its LU holds N^2 doubles): "
+                                   "use RAD_BAKER_SOLVE_GAUSS_SEIDEL for every bounce of virtual patches", who);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!(o->max_edge >= 0.0f) || !rad__finite(o->max_edge)) {
+        rad__log(c, RAD_LOG_ERROR, "%s: max_edge %g must be finite and >= 0 (0: no limit)", who, (double)o->max_edge);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (o->vp_face_points > 4096u) {
+        rad__log(c, RAD_LOG_ERROR, "%s: vp_face_points %u is above 4096 (rad_vp_create's limit; 0: its default)", who,
+                 o->vp_face_points);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    return RAD_SUCCESS;
+}
+
 /* The checks that need nothing built: groups, outputs, budget, something that emits. */
 static rad_result rad__baker_check(rad__baker *b)
 {
@@ -24235,6 +24298,7 @@ static rad_result rad__baker_check(rad__baker *b)
                  (double)b->o.vp_voxels_per_path);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (rad__baker_solver_check(&b->c, &b->o, "rad_baker_run") != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     if (d->outputs & ~(uint32_t)(RAD_BAKER_VERTEX | RAD_BAKER_LIGHTMAP | RAD_BAKER_PROBES | RAD_BAKER_SOLUTION)) {
         rad__log(&b->c, RAD_LOG_ERROR, "rad_baker_run: unknown output bits 0x%x", d->outputs);
         return RAD_ERROR_INVALID_ARGUMENT;
@@ -24512,15 +24576,29 @@ static rad_result rad__plan_free_path(const rad_scene *S, const rad_raycaster *r
     return RAD_SUCCESS;
 }
 
+/* The CPU seconds of the solve over all layers on n patches, and the bytes it adds (ESTIMATE
+   in >>api_bake): 'bounces' products (Jacobi bounces or Gauss-Seidel sweeps), none, or LU. */
+static double rad__plan_solve_seconds(const rad__plan_in *in, double n, double *extra_bytes)
+{
+    *extra_bytes = 0.0;
+    if (in->o.solver == RAD_BAKER_SOLVE_NONE) return 0.0;
+    if (in->o.solver == RAD_BAKER_SOLVE_DIRECT) {
+        *extra_bytes = 8.0 * n * n;
+        return 2.0 * n * n * n * in->groups / RAD__BAKER_FLOP_RATE;
+    }
+    return 6.0 * n * n * in->o.bounces * in->groups / RAD__BAKER_FLOP_RATE;
+}
+
 /* The cost of virtual patches at counts 'cnt' (PLAN in >>api_bake). */
 static void rad__plan_vp_cost(const rad__plan_in *in, const rad_vp_counts *cnt, double emitter_cost, double *bytes,
                               double *secs)
 {
-    double n = (double)cnt->patches, M = (double)cnt->samples;
+    double n = (double)cnt->patches, M = (double)cnt->samples, solve_bytes;
+    double solve = rad__plan_solve_seconds(in, n, &solve_bytes);
     *bytes = 4.0 * n * n + 132.0 * M + 48.0 * n * (double)in->tasks + in->outputs_bytes + 40.0 * in->probes * n +
-             in->per_patch * n;
+             in->per_patch * n + solve_bytes;
     *secs = M * M / RAD__BAKER_VP_KERNEL_RATE + 16.0 * M / RAD__BAKER_RAY_RATE +
-            6.0 * n * n * in->o.bounces * in->groups / RAD__BAKER_FLOP_RATE + in->texels * 8.0 * in->groups / RAD__BAKER_RAY_RATE +
+            solve + in->texels * 8.0 * in->groups / RAD__BAKER_RAY_RATE +
             M * emitter_cost; /* the emitters' direct light at every sample */
 }
 
@@ -24554,18 +24632,24 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
     why[0] = 0;
     if (o->method != RAD_BAKER_VIRTUAL_PATCHES) {
         rad_patch_options po;
+        double solve_bytes, solve;
         rad_patch_options_default(&po);
         po.target_count = o->patches;
+        po.max_edge = o->max_edge;
         N = (double)(S->triangle_count > o->patches ? S->triangle_count : o->patches);
-        bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N + in->per_patch * N;
+        solve = rad__plan_solve_seconds(in, N, &solve_bytes);
+        bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N + in->per_patch * N + solve_bytes;
         if (bytes <= budget) {
-            /* the patch count is only near the target: count them before the final estimate */
+            /* the patch count is only near the target (and max_edge may split more): count them
+               before the final estimate */
             r = rad_patches_create(S, &po, sub, &patches);
             if (r != RAD_SUCCESS) return r;
             N = (double)patches->count;
-            bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N + in->per_patch * patches->vertex_count;
+            solve = rad__plan_solve_seconds(in, N, &solve_bytes);
+            bytes = 4.0 * N * N + 300.0 * N + in->outputs_bytes + 40.0 * in->probes * N + in->per_patch * patches->vertex_count +
+                    solve_bytes;
         }
-        secs = N * N * o->ff_samples / RAD__BAKER_FF_RATE + 6.0 * N * N * o->bounces * in->groups / RAD__BAKER_FLOP_RATE +
+        secs = N * N * o->ff_samples / RAD__BAKER_FF_RATE + solve +
                in->texels * N * 4.0 / RAD__BAKER_RAY_RATE * (in->texels * N > 5e7 ? 5e7 / (in->texels * N) : 1.0) * in->groups +
                N * RAD__PLAN_DIRECT_POINTS * emitter_cost; /* rad_direct_patches' points per patch */
         classic_fits = bytes <= budget && secs <= seconds_budget;
@@ -24600,6 +24684,12 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
                  (unsigned long)N, bb, tb, lb, sb);
         rad_patches_destroy(patches);
     }
+    if (o->solver == RAD_BAKER_SOLVE_DIRECT) { /* AUTO's way to virtual patches (asked for: refused before) */
+        rad__log(c, RAD_LOG_ERROR, "%s: RAD_BAKER_SOLVE_DIRECT is for the classic method only, but %sthe plan takes "
+                                   "virtual patches: set method RAD_BAKER_CLASSIC, raise the budget or use "
+                                   "RAD_BAKER_SOLVE_GAUSS_SEIDEL", in->who, why);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     {
         rad_vp_options vo;
         rad_vp_counts cnt;
@@ -24607,6 +24697,7 @@ static rad_result rad__plan_run(const rad__plan_in *in, const rad_context *sub, 
         int time_over = 0;
         rad_vp_options_default(&vo);
         vo.kind = o->vp_kind; /* the kind that will be built: clustered sets count more patches */
+        vo.face_points = o->vp_face_points; /* fewer rays a face find fewer patches */
         for (tries = 0;; ++tries) {
             double f;
             uint32_t next;
@@ -24739,6 +24830,7 @@ RAD_API rad_result rad_baker_plan(const rad_scene *scene, const rad_raycaster *r
                  (double)in.o.vp_voxels_per_path);
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (rad__baker_solver_check(&c, &in.o, "rad_baker_plan") != RAD_SUCCESS) return RAD_ERROR_INVALID_ARGUMENT;
     in.scene = scene;
     in.rc = raycaster;
     in.groups = 1;
@@ -24811,6 +24903,7 @@ static rad_result rad__baker_build(rad__baker *b)
         vo.resolution = R->vp_resolution;
         if (b->o.keep) vo.storage = RAD_STORAGE_SPARSE; /* the runtime's rows */
         vo.kind = b->o.vp_kind; /* the kind the plan counted */
+        vo.face_points = b->o.vp_face_points;
         r = rad_vp_create(b->scene, &b->rc, &vo, &b->sub, &b->vp);
         if (r != RAD_SUCCESS) return r;
         n = b->vp->count;
@@ -25015,7 +25108,21 @@ static rad_result rad__baker_group(rad__baker *b, uint32_t g, float lo, float hi
         rad_vp_system(&sys, vp, E);
     }
     RAD__BAKER_PART(0.3f, 0.5f);
-    r = rad_solve_jacobi(&sys, &so, L, NULL, &b->sub);
+    if (b->o.solver == RAD_BAKER_SOLVE_GAUSS_SEIDEL) {
+        rad_solve_stats st;
+        r = rad_solve_gauss_seidel(&sys, &so, L, &st, &b->sub);
+        if (r == RAD_ERROR_NOT_CONVERGED) { /* the last sweep is close: the bake goes on (SOLVER in >>api_bake) */
+            rad__log(&b->c, RAD_LOG_WARNING, "rad_baker_run: plane %u: Gauss-Seidel did not converge (residual %g after %u "
+                                             "sweeps); the bake goes on with the last sweep", g, st.residual, st.iterations);
+            r = RAD_SUCCESS;
+        }
+    } else if (b->o.solver == RAD_BAKER_SOLVE_DIRECT) {
+        r = rad_solve_direct(&sys, &so, L, &b->sub);
+    } else if (b->o.solver == RAD_BAKER_SOLVE_NONE) {
+        memset(L, 0, N3 * sizeof(float)); /* no bounce: H = F E */
+    } else {
+        r = rad_solve_jacobi(&sys, &so, L, NULL, &b->sub);
+    }
     if (r != RAD_SUCCESS) return r;
     for (i = 0; i < N3; ++i) B[i] = E[i] + L[i];
     r = rad_matrix_multiply(R->method == RAD_BAKER_CLASSIC ? &b->ff->matrix : &b->vp->matrix, B, H, &b->sub);
@@ -25610,6 +25717,13 @@ static rad_result rad__brt_options(rad_baker_runtime *rt, const rad_baker_desc *
                                    "the plain lightmap gather only)");
         return RAD_ERROR_INVALID_ARGUMENT;
     }
+    if (bo->solver != RAD_BAKER_SOLVE_JACOBI) {
+        /* its operator folds 'bounces' Jacobi bounces (rad_multibounce_create): another solver's
+           bake would not be what it refreshes */
+        rad__log(c, RAD_LOG_ERROR, "rad_baker_runtime_create: a bake with solver %d (the runtime follows "
+                                   "RAD_BAKER_SOLVE_JACOBI bakes only: its operator is 'bounces' Jacobi bounces)", (int)bo->solver);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
     if (!bo->patches) bo->patches = 512;
     if (!bo->bounces) bo->bounces = 16;
     if (!bo->ff_samples) bo->ff_samples = 16;
@@ -25683,6 +25797,7 @@ static rad_result rad__brt_build_classic(rad_baker_runtime *rt, const rad_baker_
     rad_result r;
     rad_patch_options_default(&po);
     po.target_count = bo->patches;
+    po.max_edge = bo->max_edge; /* the bake's patches */
     rad_form_factor_options_default(&fo);
     fo.samples = bo->ff_samples;
     fo.seed = bo->seed;
@@ -25709,7 +25824,7 @@ static rad_result rad__brt_build_classic(rad_baker_runtime *rt, const rad_baker_
 /* the fourth stage for virtual patches: the patches (as many as the result's), their alias
    tables, the temporal estimator, the lights' shadow-ray schedule and the vertex gather tables */
 static rad_result rad__brt_build_vp(rad_baker_runtime *rt, const rad_baker_desc *desc, const rad_baker_result *R,
-                                    const rad__ctx *c)
+                                    const rad_baker_options *bo, const rad__ctx *c)
 {
     rad_vp_options vo;
     rad_temporal_options to;
@@ -25720,6 +25835,7 @@ static rad_result rad__brt_build_vp(rad_baker_runtime *rt, const rad_baker_desc 
     rad_vp_options_default(&vo);
     vo.resolution = R->vp_resolution;
     vo.kind = R->plan.vp_kind; /* the bake's kind, so the patch count matches */
+    vo.face_points = bo->vp_face_points;
     vo.storage = RAD_STORAGE_SPARSE;
     if (rt->kept && rt->kept->vp && rt->kept->vp->matrix.storage == RAD_STORAGE_SPARSE) rt->vp = rt->kept->vp, r = RAD_SUCCESS;
     else r = rad_vp_create(rt->scene, &rt->rc, &vo, &rt->sub, &rt->vp);
@@ -26003,7 +26119,7 @@ RAD_API rad_result rad_baker_runtime_create(const rad_baker_desc *desc, const ra
     r = rad__brt_options(rt, desc, bake_options, R, options, &bo, &c0);
     if (r == RAD_SUCCESS) r = rad__brt_alloc(rt, desc, &bo, &c0);
     if (r == RAD_SUCCESS)
-        r = R->method == RAD_BAKER_CLASSIC ? rad__brt_build_classic(rt, R, &bo, &c0) : rad__brt_build_vp(rt, desc, R, &c0);
+        r = R->method == RAD_BAKER_CLASSIC ? rad__brt_build_classic(rt, R, &bo, &c0) : rad__brt_build_vp(rt, desc, R, &bo, &c0);
     if (r == RAD_SUCCESS) r = rad__brt_groups(rt, desc, R, &c0);
     if (r == RAD_SUCCESS) r = rad__brt_solve(rt, R, &c0);
     /* outputs: the bake's layers at scale 1, and what refreshes each */

@@ -220,12 +220,13 @@ int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_opti
     rad_result r;
     uint32_t i, emits = w->file.light_count > 0;
     *out = NULL;
+    /* a dense build over the budget is refused first, lit or not (as the tool's own solve does) */
+    if (method == RAD_BAKER_CLASSIC && tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
     for (i = 0; i < w->file.desc.material_count; ++i) {
         const float *e = w->file.desc.materials[i].emission;
         emits |= e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
     }
     if (!emits) return -1; /* the tier refuses a scene where nothing emits: the caller's own path draws it black */
-    if (method == RAD_BAKER_CLASSIC && tool_dense_check(cmd, o, w->scene->triangle_count, 1)) return 1;
     if (base) bo = *base;
     else memset(&bo, 0, sizeof bo);
     bo.method = method;
@@ -238,6 +239,15 @@ int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_opti
     bo.bounces = bounces;
     bo.light_samples = o->light_samples;
     bo.vp_resolution = vp_resolution;
+    /* the solve of the command line: classic's --solver, else --bounces 0 (no bounce) or inf
+       (every bounce, by Gauss-Seidel; its estimate counts the default sweeps) */
+    bo.solver = method == RAD_BAKER_CLASSIC && o->solver == TOOL_GAUSS_SEIDEL ? RAD_BAKER_SOLVE_GAUSS_SEIDEL
+                : method == RAD_BAKER_CLASSIC && o->solver == TOOL_DIRECT      ? RAD_BAKER_SOLVE_DIRECT
+                : bounces == 0                                                  ? RAD_BAKER_SOLVE_NONE
+                : bounces == RAD_MB_INFINITE                                    ? RAD_BAKER_SOLVE_GAUSS_SEIDEL
+                                                                                : RAD_BAKER_SOLVE_JACOBI;
+    if (bounces == RAD_MB_INFINITE) bo.bounces = 0;
+    bo.max_edge = o->max_edge;
     if (method == RAD_BAKER_CLASSIC) {
         rad_baker_choice plan;
         memset(&ctx, 0, sizeof ctx); /* quiet: the run logs the same plan */

@@ -5,14 +5,18 @@
    teaching methods step by step over the method-level calls (multibounce, temporal,
    stochastic, hierarchical, local, --bake files); lightmap.c the lightmap bake.
 
-   Virtual patches (render_vp_method; Shcherbakov 2025, ch. 5): rad_vp_create (vp: RAD_VP_CLUSTERED, aavp:
-   RAD_VP_AXIS_ALIGNED) at --vp-resolution or at the finest resolution within --vp-max-patches,
-   E = rad_vp_sources, Jacobi --bounces K (inf: Gauss-Seidel), H = F (E + L) per patch, and the
-   classic per-pixel render with H gathered at each sample's hit point (rad_vp_gather per batch).
+   Classic and virtual patches in memory (render_baked): the engine tier's bake with the
+   command line's --solver, --bounces (0: none, inf: Gauss-Seidel), --max-edge and
+   --face-points, its H read at each sample by rad_baker_irradiance. Virtual patches
+   (Shcherbakov 2025, ch. 5; vp: RAD_VP_CLUSTERED, aavp: RAD_VP_AXIS_ALIGNED) at --vp-resolution
+   or at the finest resolution within --vp-max-patches; from --bake or under --proxy
+   render_vp_method: E of the bake or rad_vp_sources, the same solve or the proxy's method,
+   H = F (E + L) per patch, gathered at each sample's hit point (rad_vp_gather per batch).
 
    Every radiosity method prints one line for scripts (tools/report.sh) on stderr:
    "rad render: timing: method=M patches=N frames=F [bounces=K ]step_ms_median=X step_ms_min=Y",
-   the method's own per-frame work: the classic solve (K Jacobi bounces), one F_mb E product
+   the method's own per-frame work: the engine tier's whole bake (classic, vp and aavp in
+   memory; plus resolution), the solve of a --bake file (K Jacobi bounces), one F_mb E product
    (median of 9), one temporal step (median over the frames), one local apply L = T E (median
    of 9; plus rebuild_ms), or the virtual patches' solve + H (plus build_ms, sources_ms,
    gather_ms, render_ms, resolution, vp_mib and peak_rss_mib). */
@@ -511,6 +515,7 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     bo.vp_voxels_per_path = voxels_per_path;
     /* count the kind that will be built: a clustered set has more patches at one resolution */
     bo.vp_kind = !chosen && (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    bo.vp_face_points = mo->face_points; /* and with the face points it will be built with */
     tool_context(&ctx, NULL);
     if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
     if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
@@ -877,84 +882,76 @@ static int classic_bake_open(const char *cmd, const tool_world *w, const char *b
     return 0;
 }
 
-/* --method classic: the solution (--bake, or solved here), per-vertex H, the classic render */
+/* --method classic --bake: the bake's solution, per-vertex H, the classic render */
 static int render_classic_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
-    tool_classic sol;
     rad_bake *bake = NULL;
-    const rad_patches *P;
     const float *H = NULL;
     float *Hv, *Hmine = NULL;
     tool_render_source src;
     int rc;
-    memset(&sol, 0, sizeof sol);
-    if (ra->bake) {
-        if (classic_bake_open(cmd, w, ra->bake, &bake, &H, &Hmine)) return 1;
-        P = &bake->patches;
-    } else {
-        if (tool_classic_solve(cmd, w, &ra->o, &sol)) return 1;
-        P = sol.patches;
-        H = sol.H;
-        fprintf(stderr, "rad %s: timing: method=classic patches=%u frames=1 bounces=%u step_ms_median=%.6f "
-                        "step_ms_min=%.6f\n",
-                cmd, P->count, ra->o.bounces, 1e3 * sol.solve_seconds, 1e3 * sol.solve_seconds);
-    }
-    Hv = (float *)tool_malloc(sizeof(float) * 3 * (size_t)P->vertex_count);
-    rc = tool_vertex_H(P, bake ? &bake->F : &sol.ff->matrix, H, Hv);
+    if (classic_bake_open(cmd, w, ra->bake, &bake, &H, &Hmine)) return 1;
+    Hv = (float *)tool_malloc(sizeof(float) * 3 * (size_t)bake->patches.vertex_count);
+    rc = tool_vertex_H(&bake->patches, &bake->F, H, Hv);
     memset(&src, 0, sizeof src);
-    src.P = P;
+    src.P = &bake->patches;
     src.Hv = Hv;
     if (rc == 0) rc = tool_render_pixels(w, &ra->view, &src, img);
     free(Hv);
     free(Hmine);
     rad_bake_destroy(bake);
-    tool_classic_free(&sol);
     return rc;
 }
 
-/* Whether the engine tier bakes the choice on the command line: classic with Jacobi bounces
-   on the patches as made, or AAVP at the default face points, solved here (no --bake). The
-   rest (other solvers, --bounces 0 or inf, --max-edge, clustered patches, proxies, the
-   teaching methods) keeps its own path. */
+/* Whether the engine tier bakes the choice on the command line: classic (any --solver,
+   --bounces 0, --max-edge) and aavp or vp (any --face-points, --bounces K, 0 or inf), solved
+   here. Bakes read with --bake, the proxies and the teaching methods keep their own paths. */
 static int render_by_baker(const tool_render_args *ra)
 {
     const tool_method_options *mo = &ra->mo;
-    const tool_classic_options *o = &ra->o;
     if (ra->bake || mo->proxy) return 0;
-    if (mo->method == TOOL_CLASSIC) return o->solver == TOOL_JACOBI && o->bounces > 0 && o->max_edge == 0.0f;
-    return mo->method == TOOL_AAVP && mo->face_points == 16u && mo->bounces > 0 && mo->bounces != RAD_MB_INFINITE;
+    return mo->method == TOOL_CLASSIC || mo->method == TOOL_AAVP || mo->method == TOOL_VP;
 }
 
 /* The engine tier's bake of the scene and the lights (one group), keeping its solution, and
-   the per-pixel render with H from the tier's final gather at each sample. 0 or 1 (printed);
-   -1 when nothing emits (the tier refuses that: the caller's own path draws it). */
+   the per-pixel render with H from the tier's final gather at each sample. 0 or 1 (printed).
+   Where nothing emits (the tier refuses that) the image stays black, as any solve of no light. */
 static int render_baked(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     const tool_method_options *mo = &ra->mo;
     int classic = mo->method == TOOL_CLASSIC;
-    uint32_t res = mo->vp_resolution, bounces = classic ? ra->o.bounces : mo->bounces;
+    uint32_t res = mo->vp_resolution, bounces = classic ? ra->o.bounces : mo->bounces, patches = 0;
+    rad_baker_options bo;
     rad_baker_desc d;
     rad_baker_result *R = NULL;
     tool_render_source src;
+    char kb[16];
     double t0;
     int rc;
+    memset(&bo, 0, sizeof bo);
+    bo.vp_kind = mo->method == TOOL_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    bo.vp_face_points = mo->face_points;
     if (!classic && (mo->given & TOOL_OPT_VP_MAX_PATCHES) &&
-        tool_vp_resolution_within(cmd, w, RAD_VP_AXIS_ALIGNED, mo->face_points, mo->vp_max_patches, mo->vp_resolution, &res))
+        tool_vp_resolution_within(cmd, w, bo.vp_kind, mo->face_points, mo->vp_max_patches, mo->vp_resolution, &res))
         return 1;
     memset(&d, 0, sizeof d);
     d.outputs = RAD_BAKER_SOLUTION;
     t0 = tool_seconds();
-    if ((rc = tool_baker_run(cmd, w, &ra->o, classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES, bounces,
-                             classic ? 0u : res, NULL, &d, &R)) != 0)
-        return rc;
+    rc = tool_baker_run(cmd, w, &ra->o, classic ? RAD_BAKER_CLASSIC : RAD_BAKER_VIRTUAL_PATCHES, bounces,
+                        classic ? 0u : res, &bo, &d, &R);
+    if (rc > 0) return rc;
     t0 = tool_seconds() - t0;
-    if (!classic)
-        fprintf(stderr, "rad %s: aavp virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
-                R->vp_resolution, R->patch_count);
+    if (R) patches = R->patch_count;
+    if (R && !classic)
+        fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
+                tool_method_name(mo->method), R->vp_resolution, R->patch_count);
     /* one line for scripts: the step is the whole bake here (form factors or set, source, bounces) */
-    fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=1 bounces=%u step_ms_median=%.6f step_ms_min=%.6f%s%.0u\n",
-            cmd, classic ? "classic" : "aavp", R->patch_count, bounces, 1e3 * t0, 1e3 * t0,
-            classic ? "" : " resolution=", classic ? 0u : R->vp_resolution);
+    if (bounces == RAD_MB_INFINITE) snprintf(kb, sizeof kb, "inf");
+    else snprintf(kb, sizeof kb, "%u", bounces);
+    fprintf(stderr, "rad %s: timing: method=%s patches=%u frames=1 bounces=%s step_ms_median=%.6f step_ms_min=%.6f%s%.0u\n",
+            cmd, tool_method_name(mo->method), patches, kb, 1e3 * t0, 1e3 * t0, classic ? "" : " resolution=",
+            R && !classic ? R->vp_resolution : 0u);
+    if (!R) return 0; /* nothing emits: black (render_prepare said so) */
     memset(&src, 0, sizeof src);
     src.baker = R;
     rc = tool_render_pixels(w, &ra->view, &src, img);
@@ -966,8 +963,7 @@ static int render_baked(const char *cmd, const tool_world *w, const tool_render_
 static int render_image(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img)
 {
     const tool_method_options *mo = &ra->mo;
-    int rc;
-    if (render_by_baker(ra) && (rc = render_baked(cmd, w, ra, img)) >= 0) return rc;
+    if (render_by_baker(ra)) return render_baked(cmd, w, ra, img);
     if (mo->method == TOOL_LIGHTMAP) return render_lightmap_method(cmd, w, ra, img);
     if ((mo->method >= TOOL_LOCAL && !(mo->method == TOOL_HIERARCHICAL && ra->bake)) || mo->proxy)
         return mo->method == TOOL_LOCAL && !mo->proxy ? tool_render_local_method(cmd, w, ra, img)

@@ -411,11 +411,12 @@ typedef struct tool_bake_info {
 /* the rad.options record of a bake of w with o */
 /* The engine tier's bake of the world's scene and lights (one group): d->outputs (and
    d->probe_options) as given, the rest of d filled here; the classic options (patches,
-   samples, light samples) become the baker's, with 'method', 'bounces' and 'vp_resolution'
+   max edge, samples, light samples, and --solver for classic) become the baker's, with
+   'method', 'bounces' (0: no bounce; RAD_MB_INFINITE: Gauss-Seidel) and 'vp_resolution'
    (0: the plan's). A classic bake is refused as tool_dense_check refuses it (at least one
    patch per triangle, then the patches the plan counts); the tier's own budget is not used.
    Prints the plan's reason; 'base' (may be NULL: zeros) gives the baker's options the
-   command line does not set (keep, lightmap_samples, vp_kind, ...).
+   command line does not set (keep, lightmap_samples, vp_kind, vp_face_points, ...).
    0, 1 after printing why, or -1 (nothing done) when nothing in the world emits. */
 int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method,
                    uint32_t bounces, uint32_t vp_resolution, const rad_baker_options *base, rad_baker_desc *d,
