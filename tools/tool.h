@@ -822,6 +822,10 @@ int tool_render_with_method(const char *cmd, const tool_world *w, const tool_ren
 /* --method hierarchical (no bake) and --method local */
 int tool_render_hr_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img);
 int tool_render_local_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img);
+/* --method aavp|vp from a --bake file or under a --proxy (multibounce, temporal, its frames), and
+   --method classic from a --bake file */
+int tool_render_vp_method(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img);
+int tool_render_classic_bake(const char *cmd, const tool_world *w, const tool_render_args *ra, tool_image *img);
 /* 0 when a loaded bake was made from this scene and these options, else 1 (printed) */
 int tool_bake_fits_scene(const char *cmd, const char *bake_path, const rad_bake *bake, const tool_world *w);
 /* why rad_load_file refused a bake, printed */
