@@ -5392,6 +5392,7 @@ static uint32_t rad__lattice_side(uint32_t samples)
 #define RAD__E_CRC 32u
 #define RAD__E_NAME 40u
 
+#define RAD__CRC_SLICE_MIN 16384u /* bytes from which the tables of slicing by 8 pay for themselves */
 static uint32_t rad__crc32(const void *data, size_t size)
 {
     static const uint32_t nibble[16] = { 0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
@@ -5399,8 +5400,28 @@ static uint32_t rad__crc32(const void *data, size_t size)
                                          0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
     const unsigned char *p = (const unsigned char *)data;
     uint32_t c = 0xFFFFFFFFu;
-    size_t i;
-    for (i = 0; i < size; ++i) {
+    size_t i = 0;
+    if (size >= RAD__CRC_SLICE_MIN) {
+        /* slicing by 8 (Kounavis and Berry 2005): eight lookups per 8 bytes that do not wait on
+           each other, where the nibble loop's four do; the tables (8 KiB) are built here, in
+           some microseconds, so that no static state needs a thread-safe first use */
+        uint32_t t[8][256], k, j;
+        for (k = 0; k < 256; ++k) {
+            uint32_t x = k;
+            for (j = 0; j < 8; ++j) x = (x >> 1) ^ (0xEDB88320u & (0u - (x & 1u)));
+            t[0][k] = x;
+        }
+        for (k = 0; k < 256; ++k)
+            for (j = 1; j < 8; ++j) t[j][k] = (t[j - 1][k] >> 8) ^ t[0][t[j - 1][k] & 255u];
+        for (; i + 8 <= size; i += 8) {
+            const unsigned char *q = p + i;
+            uint32_t lo = c ^ ((uint32_t)q[0] | (uint32_t)q[1] << 8 | (uint32_t)q[2] << 16 | (uint32_t)q[3] << 24);
+            uint32_t hi = (uint32_t)q[4] | (uint32_t)q[5] << 8 | (uint32_t)q[6] << 16 | (uint32_t)q[7] << 24;
+            c = t[7][lo & 255u] ^ t[6][(lo >> 8) & 255u] ^ t[5][(lo >> 16) & 255u] ^ t[4][lo >> 24] ^ t[3][hi & 255u] ^
+                t[2][(hi >> 8) & 255u] ^ t[1][(hi >> 16) & 255u] ^ t[0][hi >> 24];
+        }
+    }
+    for (; i < size; ++i) {
         c ^= p[i];
         c = (c >> 4) ^ nibble[c & 15u];
         c = (c >> 4) ^ nibble[c & 15u];
