@@ -246,7 +246,9 @@
        application's options; rad_bake_matches_scene refuses a bake of another scene
        (RAD_ERROR_SCENE_MISMATCH, naming what differs). New section types never change the
        container version: a bake without a signature still loads. Applications add their own
-       sections (types >= RAD_SECTION_USER) through rad_container_write.
+       sections (types >= RAD_SECTION_USER) through rad_container_write. The engine tier's
+       result goes into a container the same way (rad_baker_result_save_memory and _load_memory,
+       SAVE AND LOAD in >>api_bake).
 
   10. GLSL
        The GPU paths are GLSL 4.50 compute kernels embedded as text (>>api_glsl): get one with
@@ -3679,8 +3681,8 @@ RAD_API rad_result rad_baker_mix_layers_rgb9e5(const uint32_t *layers, uint32_t 
    NON_FINITE, CORRUPT, SIZE_OVERFLOW, OUT_OF_MEMORY. Cost: one pass over the layers. */
 RAD_API rad_result rad_baker_result_save_memory(const rad_baker_result *result, const rad_context *ctx, void **out,
                                                 size_t *out_size);
-/* Loads a saved result: 'size' bytes at 'data' (borrowed for the call: every array is
-   copied, so the bytes may be freed after) into a new result *out (destroy it with
+/* Loads a saved result: 'size' bytes at 'data' (8-byte aligned, as rad_container_create
+   wants; borrowed for the call: every array is copied, so the bytes may be freed after) into a new result *out (destroy it with
    rad_baker_result_destroy), its outputs mixed with all scales 1. Every size is checked
    against the metadata before it is used or anything of its size allocated, then every value
    (VALUES of >>api_container; the probe states are rad_probe_state values, vertex_first

@@ -5,7 +5,8 @@
    the bake's, and the same group colours and sky mix to the same bits; a loaded result saves
    to the same bytes, matches its scene and not another, is refused by rad_baker_irradiance,
    and a runtime over it gives the frames of a runtime over the bake. Refused with the specific
-   error, never a crash: every prefix of a file (a coarse sweep), a flipped byte, a wrong
+   error, never a crash: every prefix of a file (a coarse sweep), a flipped byte, bytes off an
+   8-byte boundary, a wrong
    container or layout version, a section whose count or element size disagrees with the
    metadata, a missing section, a NaN, a bad probe state or index, a classic bake, and a few
    hundred random byte flips (raw, and behind valid checksums). Included by test_main.c after
@@ -410,6 +411,15 @@ static void bs_test_refusals(void)
         buf[63] = (unsigned char)(crc >> 24);
     }
     CHECK_RESULT(rad_baker_result_load_memory(buf, n, &quiet, &B), RAD_ERROR_VERSION);
+    /* bytes off an 8-byte boundary: the container's rule, INVALID_ARGUMENT */
+    {
+        unsigned char *odd = (unsigned char *)malloc(n + 8);
+        if (odd) {
+            memcpy(odd + 1, f, n);
+            CHECK_RESULT(rad_baker_result_load_memory(odd + 1, n, &quiet, &B), RAD_ERROR_INVALID_ARGUMENT);
+            free(odd);
+        }
+    }
     free(buf);
     /* NULLs, and a classic bake's file */
     CHECK_RESULT(rad_baker_result_load_memory(NULL, n, &quiet, &B), RAD_ERROR_INVALID_ARGUMENT);
