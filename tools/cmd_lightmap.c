@@ -248,6 +248,7 @@ static int lightmap_is_png(const char *path)
 /* the command line into la; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
 static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_args *la)
 {
+    rad_vp_options vo;
     int a, k;
     memset(la, 0, sizeof *la);
     tool_classic_options_default(&la->co);
@@ -308,8 +309,9 @@ static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_a
         fprintf(stderr, "rad lightmap: a .glb or .gltf carries the RGB lightmap: leave out --sh\n");
         return 2;
     }
+    rad_vp_options_default(&vo);
     if (la->layers && (la->co.solver != TOOL_JACOBI || la->co.bounces == 0 || la->co.max_edge != 0.0f ||
-                       la->px.kind == TOOL_LIGHTMAP_HIERARCHICAL)) {
+                       la->px.kind == TOOL_LIGHTMAP_HIERARCHICAL || (la->px.face_points && la->px.face_points != vo.face_points))) {
         fprintf(stderr, "rad lightmap: --layers saves the engine tier's bake, and these options bake without it: use "
                         "--solver jacobi, no --max-edge, the patches or --proxy aavp|vp at the default --face-points\n");
         return 2;
