@@ -133,6 +133,10 @@ $(BUILD)/bench_runtime: tests/bench/runtime.c tests/bench/bench_common.h tests/b
 $(BUILD)/bench_layer_mix: tests/bench/layer_mix.c tests/bench/bench_common.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native -I. tests/bench/layer_mix.c -o $@ -lm
 
+# the cost of saving and loading an engine-tier result (synthetic 1024 x 1024, 8 groups; not in make bench)
+$(BUILD)/bench_baker_save: tests/bench/baker_save.c radiosity.h | $(BUILD)
+	$(CC) -std=c99 $(WARN) -O2 -I. tests/bench/baker_save.c -o $@ -lm
+
 $(BUILD)/rays: tests/bench/rays.c tests/bench/bench_common.h tests/bench/bench_scenes.h radiosity.h | $(BUILD)
 	$(CC) -std=c99 $(WARN) -O3 -march=native $(OPENMP) $(EMBREE) -I. tests/bench/rays.c -o $@ -lm $(EMBREE_LIB)
 

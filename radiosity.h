@@ -246,7 +246,9 @@
        application's options; rad_bake_matches_scene refuses a bake of another scene
        (RAD_ERROR_SCENE_MISMATCH, naming what differs). New section types never change the
        container version: a bake without a signature still loads. Applications add their own
-       sections (types >= RAD_SECTION_USER) through rad_container_write.
+       sections (types >= RAD_SECTION_USER) through rad_container_write. The engine tier's
+       result goes into a container the same way (rad_baker_result_save_memory and _load_memory,
+       SAVE AND LOAD in >>api_bake).
 
   10. GLSL
        The GPU paths are GLSL 4.50 compute kernels embedded as text (>>api_glsl): get one with
@@ -3584,6 +3586,8 @@ typedef struct rad_baker_result {
     uint32_t *lightmap_rgb9e5;      /* RAD_BAKER_LIGHTMAP_RGB9E5(_ONLY): group_count planes of
                                        width * height texels, one uint32 RGB9E5 each (RGB9E5
                                        below), plane g at g width height; no sky planes. Else NULL */
+    uint64_t scene_hash[2];         /* rad_scene_hash of the scene baked: geometry, materials (SAVE
+                                       AND LOAD below; 0 0: not recorded) */
 } rad_baker_result;
 
 /* Bakes 'desc' (borrowed for the call); options and ctx may be NULL. *out receives an owning
@@ -3691,6 +3695,67 @@ RAD_API void rad_rgb9e5_unpack(const uint32_t *packed, size_t count, float *rgb)
    the same bits. */
 RAD_API rad_result rad_baker_mix_layers_rgb9e5(const uint32_t *layers, uint32_t group_count, size_t texel_count,
                                               const float *group_rgb, float *out, const rad_context *ctx);
+
+/* SAVE AND LOAD: a result as one file of the container (>>api_container), so that an engine
+   bakes in its editor and mixes the layers in its game without a new bake and without a
+   serializer of its own (docs/methods/bake.md, "Saving a bake"; the layout in docs/engine-
+   formats.md). What is SAVED: the metadata (method, patch_count, vp_resolution, the estimates
+   and the whole plan with its reason, group_count, sky_count, the meshes' vertex_first, the
+   lightmap's size, channels and seam statistics, the probes' count, grid, origin and
+   spacing), the scene hashes (scene_hash, in a RAD_SECTION_SIGNATURE section as
+   rad_save_memory writes it) and each layer once: vertex_layers, lightmap_layers,
+   lightmap_flags, lightmap_rgb9e5, probe_positions, probe_states, probe_layers and
+   probe_band4_layers, those the result has. The mixed outputs (vertex, lightmap, probes,
+   probe_band4) are NOT saved: loading mixes them again with all scales 1 (rad_baker_mix with
+   NULL, as rad_baker_run ends), which gives the bake's bits. NOT SAVED either: the solver
+   objects of rad_baker_options.keep and the solution of RAD_BAKER_SOLUTION (a loaded result
+   has kept and solution NULL: rad_baker_irradiance refuses it, rad_baker_result_lightmap
+   gives NULL, and rad_baker_runtime_create builds its objects from its desc as for a result
+   baked without keep). A loaded result is accepted by rad_baker_mix, rad_baker_mix_sky and
+   rad_baker_result_destroy as a baked one.
+   SECTIONS (types 64..79 of >>api_container): RAD_SECTION_BAKER_INFO (64 uint32 words, the
+   metadata; word 0 the layout version RAD_BAKER_RESULT_VERSION), RAD_SECTION_BAKER_REASON
+   (the reason, chars with the NUL), one section per array (elements: floats, uint32 words or
+   bytes as the field holds them). VERSIONING: RAD_BAKER_RESULT_VERSION changes when a section
+   of this list changes meaning (a reader refuses another with RAD_ERROR_VERSION); new
+   sections and info words (now 0) are added without a change, and readers skip those they do
+   not know. */
+#define RAD_BAKER_RESULT_VERSION 1u
+
+/* Saves 'result' (SAVE AND LOAD above) into a new buffer *out of *out_size bytes, allocated
+   with ctx's allocator (free it with rad_free_buffer). Values a loader would refuse (VALUES of
+   >>api_container: a float not finite or beyond RAD_BAKE_VALUE_MAX) are refused here, the log
+   naming the array and entry. Errors: INVALID_ARGUMENT (NULL, a result without a layer),
+   NON_FINITE, CORRUPT, SIZE_OVERFLOW, OUT_OF_MEMORY. Cost: one pass over the layers. */
+RAD_API rad_result rad_baker_result_save_memory(const rad_baker_result *result, const rad_context *ctx, void **out,
+                                                size_t *out_size);
+/* Loads a saved result: 'size' bytes at 'data' (8-byte aligned, as rad_container_create
+   wants; borrowed for the call: every array is copied, so the bytes may be freed after) into a new result *out (destroy it with
+   rad_baker_result_destroy), its outputs mixed with all scales 1. Every size is checked
+   against the metadata before it is used or anything of its size allocated, then every value
+   (VALUES of >>api_container; the probe states are rad_probe_state values, vertex_first
+   ascends from 0 to vertex_count). Errors (the log names the section): the container's
+   (TRUNCATED, CORRUPT, VERSION), INVALID_ARGUMENT (NULL, or a container without a
+   BAKER_INFO section: a classic bake loads with rad_load_memory), VERSION (another
+   RAD_BAKER_RESULT_VERSION), CORRUPT (metadata out of range, a missing section, an element
+   size or an index wrong), SIZE_MISMATCH (a section's count is not what the metadata says),
+   NON_FINITE, OUT_OF_MEMORY. Cost: one pass over the file and the mix. */
+RAD_API rad_result rad_baker_result_load_memory(const void *data, size_t size, const rad_context *ctx,
+                                                rad_baker_result **out);
+/* RAD_SUCCESS when 'result' was baked from 'scene' (rad_scene_create on the desc's scene):
+   the same rad_scene_hash geometry and materials as scene_hash. Otherwise SCENE_MISMATCH, the
+   log saying which differ with both hashes. A result without hashes (0 0) is not checked (a
+   warning through the log). Errors: INVALID_ARGUMENT (NULL), SCENE_MISMATCH. Cost:
+   O(triangles). */
+RAD_API rad_result rad_baker_result_matches_scene(const rad_baker_result *result, const rad_scene *scene,
+                                                  const rad_context *ctx);
+#ifndef RAD_NO_STDIO
+/* The same through a file, written and read as rad_save_file and rad_load_file do theirs (a
+   temporary file renamed over path; the header checked before the rest is read). Errors: those
+   above, IO. */
+RAD_API rad_result rad_baker_result_save_file(const char *path, const rad_baker_result *result, const rad_context *ctx);
+RAD_API rad_result rad_baker_result_load_file(const char *path, const rad_context *ctx, rad_baker_result **out);
+#endif
 
 /* >>api_bake_runtime: lights that move, over a bake, one call per frame                    */
 
@@ -4220,6 +4285,18 @@ typedef enum rad_section_type {
     RAD_SECTION_VP_SAMPLE_AREAS = 53,      /* M floats */
     RAD_SECTION_VP_SAMPLE_WEIGHTS = 54,    /* 6 M floats */
     RAD_SECTION_VP_SAMPLE_TRIANGLES = 55,  /* M uint32 */
+    /* the engine tier's result (SAVE AND LOAD in >>api_bake), 64..79 */
+    RAD_SECTION_BAKER_INFO = 64,           /* 64 uint32: the metadata (rad_baker_result_save_memory) */
+    RAD_SECTION_BAKER_REASON = 65,         /* chars with the NUL: "reason", and "plan" when it differs */
+    RAD_SECTION_BAKER_VERTEX_FIRST = 66,   /* mesh_count + 1 uint32 */
+    RAD_SECTION_BAKER_VERTEX_LAYERS = 67,  /* planes x 3 vertex_count floats */
+    RAD_SECTION_BAKER_LIGHTMAP_LAYERS = 68,/* planes x channels x texels floats */
+    RAD_SECTION_BAKER_LIGHTMAP_FLAGS = 69, /* texels bytes: RAD_TEXEL_* */
+    RAD_SECTION_BAKER_LIGHTMAP_RGB9E5 = 70,/* group_count x texels uint32 */
+    RAD_SECTION_BAKER_PROBE_POSITIONS = 71,/* 3 probe_count floats */
+    RAD_SECTION_BAKER_PROBE_STATES = 72,   /* probe_count bytes: rad_probe_state */
+    RAD_SECTION_BAKER_PROBE_LAYERS = 73,   /* planes x 27 probe_count floats */
+    RAD_SECTION_BAKER_PROBE_BAND4 = 74,    /* group_count x 27 probe_count floats */
     RAD_SECTION_USER = 0x10000       /* types from here up are the application's own */
 } rad_section_type;
 
@@ -5373,6 +5450,7 @@ static uint32_t rad__lattice_side(uint32_t samples)
 #define RAD__E_CRC 32u
 #define RAD__E_NAME 40u
 
+#define RAD__CRC_SLICE_MIN 16384u /* bytes from which the tables of slicing by 8 pay for themselves */
 static uint32_t rad__crc32(const void *data, size_t size)
 {
     static const uint32_t nibble[16] = { 0x00000000u, 0x1DB71064u, 0x3B6E20C8u, 0x26D930ACu, 0x76DC4190u, 0x6B6B51F4u,
@@ -5380,8 +5458,28 @@ static uint32_t rad__crc32(const void *data, size_t size)
                                          0x9B64C2B0u, 0x86D3D2D4u, 0xA00AE278u, 0xBDBDF21Cu };
     const unsigned char *p = (const unsigned char *)data;
     uint32_t c = 0xFFFFFFFFu;
-    size_t i;
-    for (i = 0; i < size; ++i) {
+    size_t i = 0;
+    if (size >= RAD__CRC_SLICE_MIN) {
+        /* slicing by 8 (Kounavis and Berry 2005): eight lookups per 8 bytes that do not wait on
+           each other, where the nibble loop's four do; the tables (8 KiB) are built here, in
+           some microseconds, so that no static state needs a thread-safe first use */
+        uint32_t t[8][256], k, j;
+        for (k = 0; k < 256; ++k) {
+            uint32_t x = k;
+            for (j = 0; j < 8; ++j) x = (x >> 1) ^ (0xEDB88320u & (0u - (x & 1u)));
+            t[0][k] = x;
+        }
+        for (k = 0; k < 256; ++k)
+            for (j = 1; j < 8; ++j) t[j][k] = (t[j - 1][k] >> 8) ^ t[0][t[j - 1][k] & 255u];
+        for (; i + 8 <= size; i += 8) {
+            const unsigned char *q = p + i;
+            uint32_t lo = c ^ ((uint32_t)q[0] | (uint32_t)q[1] << 8 | (uint32_t)q[2] << 16 | (uint32_t)q[3] << 24);
+            uint32_t hi = (uint32_t)q[4] | (uint32_t)q[5] << 8 | (uint32_t)q[6] << 16 | (uint32_t)q[7] << 24;
+            c = t[7][lo & 255u] ^ t[6][(lo >> 8) & 255u] ^ t[5][(lo >> 16) & 255u] ^ t[4][lo >> 24] ^ t[3][hi & 255u] ^
+                t[2][(hi >> 8) & 255u] ^ t[1][(hi >> 16) & 255u] ^ t[0][hi >> 24];
+        }
+    }
+    for (; i < size; ++i) {
         c ^= p[i];
         c = (c >> 4) ^ nibble[c & 15u];
         c = (c >> 4) ^ nibble[c & 15u];
@@ -25318,6 +25416,8 @@ RAD_API rad_result rad_baker_run(const rad_baker_desc *desc, const rad_baker_opt
     if (r == RAD_SUCCESS && b.R->lightmap_layers && (desc->lightmap_flags & (RAD_BAKER_LIGHTMAP_RGB9E5 | RAD_BAKER_LIGHTMAP_RGB9E5_ONLY)))
         r = rad__baker_pack_lightmap(&b);
     if (r == RAD_SUCCESS) r = rad_baker_mix(b.R, NULL, &b.sub);
+    /* what a saved result is checked against (SAVE AND LOAD in >>api_bake) */
+    if (r == RAD_SUCCESS) r = rad_scene_hash(b.scene, &b.R->scene_hash[0], &b.R->scene_hash[1]);
     if (r == RAD_SUCCESS && b.prog.fn && b.prog.fn(b.prog.user, 1.0f)) r = RAD_ERROR_CANCELLED;
     if (r != RAD_SUCCESS && b.prog.cancelled) r = RAD_ERROR_CANCELLED;
     if (r == RAD_SUCCESS && b.o.keep) {
@@ -27377,7 +27477,10 @@ RAD_API const char *rad_section_type_name(uint32_t type)
         "TEMPORAL_ROW_OFFSETS", "TEMPORAL_BINS", "TEMPORAL_TOTALS", NULL, NULL, NULL, NULL, NULL,
         "VP_INFO", "VP_AREAS", "VP_ALBEDO", "VP_NORMALS", "VP_AXIS", "VP_VOXEL", "VP_VOXEL_KEYS", "VP_VOXEL_FIRST",
         "VP_VOXEL_PATCH", "VP_SAMPLE_FIRST", "VP_SAMPLE_POSITIONS", "VP_SAMPLE_NORMALS", "VP_SAMPLE_ALBEDO",
-        "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES"
+        "VP_SAMPLE_AREAS", "VP_SAMPLE_WEIGHTS", "VP_SAMPLE_TRIANGLES", NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL,
+        "BAKER_INFO", "BAKER_REASON", "BAKER_VERTEX_FIRST", "BAKER_VERTEX_LAYERS", "BAKER_LIGHTMAP_LAYERS",
+        "BAKER_LIGHTMAP_FLAGS", "BAKER_LIGHTMAP_RGB9E5", "BAKER_PROBE_POSITIONS", "BAKER_PROBE_STATES",
+        "BAKER_PROBE_LAYERS", "BAKER_PROBE_BAND4"
     };
     if (type >= RAD_SECTION_USER) return "USER";
     return type < sizeof(names) / sizeof(names[0]) ? names[type] : NULL;
@@ -27989,25 +28092,22 @@ RAD_API rad_result rad_save_file(const char *path, const rad_patches *patches, c
     return r;
 }
 
-RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out)
+/* A container file read whole into a new buffer (ctx's allocator): the header first, so a
+   folder, a file of another kind or a truncated one is refused before anything of its size is
+   allocated or read. Errors: IO, TRUNCATED, CORRUPT, OUT_OF_MEMORY (logged). */
+static rad_result rad__read_container_file(const rad__ctx *cc, const char *path, void **out_buf, size_t *out_len)
 {
-    rad__ctx c;
+    rad__ctx c = *cc;
     FILE *f;
     long len;
     void *buf;
     unsigned char head[RAD__HEADER_BYTES];
     size_t got;
-    rad__ctx_init(&c, ctx);
-    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
     f = fopen(path, "rb");
     if (!f) {
         rad__log(&c, RAD_LOG_ERROR, "cannot open '%s'", path);
         return RAD_ERROR_IO;
     }
-    /* the header first: a folder, a file of another kind or a truncated bake is refused
-       before anything of its size is allocated or read */
     got = fread(head, 1, sizeof(head), f);
     if (got < sizeof(head)) {
         int err = ferror(f);
@@ -28045,7 +28145,532 @@ RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_b
         return RAD_ERROR_IO;
     }
     fclose(f);
-    return rad__load(buf, (size_t)len, buf, &c, ctx, out);
+    *out_buf = buf;
+    *out_len = (size_t)len;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_load_file(const char *path, const rad_context *ctx, rad_bake **out)
+{
+    rad__ctx c;
+    void *buf = NULL;
+    size_t len = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out) return RAD_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!path) return RAD_ERROR_INVALID_ARGUMENT;
+    if ((r = rad__read_container_file(&c, path, &buf, &len)) != RAD_SUCCESS) return r;
+    return rad__load(buf, len, buf, &c, ctx, out);
+}
+#endif
+
+/* ======================================================================================== */
+/* >>bake_save: the engine tier's result in a container (SAVE AND LOAD in >>api_bake)        */
+/* ======================================================================================== */
+
+#define RAD__BRS_WORDS 64u /* words of RAD_SECTION_BAKER_INFO */
+/* BAKER_INFO word 19: which arrays the file holds */
+#define RAD__BRS_VERTEX 1u        /* vertex_first and vertex_layers */
+#define RAD__BRS_LIGHTMAP 2u      /* lightmap_flags (and a lightmap mixed on load) */
+#define RAD__BRS_LM_LAYERS 4u     /* lightmap_layers */
+#define RAD__BRS_RGB9E5 8u        /* lightmap_rgb9e5 */
+#define RAD__BRS_PROBES 16u       /* probe_positions, probe_states, probe_layers */
+#define RAD__BRS_BAND4 32u        /* probe_band4_layers */
+
+static void rad__brs_putf(uint32_t *w, float x) { memcpy(w, &x, 4); }
+static void rad__brs_putd(uint32_t *w, double x) { memcpy(w, &x, 8); }
+static float rad__brs_getf(const uint32_t *w) { float x; memcpy(&x, w, 4); return x; }
+static double rad__brs_getd(const uint32_t *w) { double x; memcpy(&x, w, 8); return x; }
+
+/* a * b in 64 bits, 0 when it overflows */
+static int rad__brs_mul(uint64_t a, uint64_t b, uint64_t *out)
+{
+    if (a && b > 0xFFFFFFFFFFFFFFFFull / a) return 0;
+    *out = a * b;
+    return 1;
+}
+
+/* The metadata into 64 words (the layout of BAKER_INFO, documented in docs/engine-formats.md). */
+static void rad__brs_info(const rad_baker_result *R, uint32_t flags, uint32_t *w)
+{
+    const rad_baker_choice *p = &R->plan;
+    memset(w, 0, RAD__BRS_WORDS * sizeof(uint32_t));
+    w[0] = RAD_BAKER_RESULT_VERSION;
+    w[1] = (uint32_t)R->method;
+    w[2] = R->patch_count;
+    w[3] = R->vp_resolution;
+    w[4] = R->group_count;
+    w[5] = R->sky_count;
+    w[6] = R->mesh_count;
+    w[7] = R->vertex_count;
+    w[8] = R->lightmap_width;
+    w[9] = R->lightmap_height;
+    w[10] = R->lightmap_channels;
+    w[11] = R->probe_count;
+    w[12] = R->probe_grid[0], w[13] = R->probe_grid[1], w[14] = R->probe_grid[2];
+    rad__brs_putf(w + 15, R->probe_origin[0]);
+    rad__brs_putf(w + 16, R->probe_origin[1]);
+    rad__brs_putf(w + 17, R->probe_origin[2]);
+    rad__brs_putf(w + 18, R->probe_spacing);
+    w[19] = flags;
+    w[20] = R->lightmap_seams.seams;
+    w[21] = R->lightmap_seams.sample_pairs;
+    rad__brs_putf(w + 22, R->lightmap_seams.max_jump_before);
+    rad__brs_putf(w + 23, R->lightmap_seams.max_jump_after);
+    rad__brs_putd(w + 24, R->estimated_bytes);
+    rad__brs_putd(w + 26, R->estimated_seconds);
+    w[28] = (uint32_t)p->method;
+    w[29] = p->patch_count;
+    w[30] = p->vp_resolution;
+    w[31] = p->vp_samples;
+    w[32] = (uint32_t)p->vp_kind;
+    w[33] = p->needed_resolution;
+    rad__brs_putf(w + 34, p->free_path);
+    rad__brs_putf(w + 35, p->escaped);
+    w[36] = (uint32_t)p->budget_limited;
+    w[37] = (uint32_t)p->over_budget;
+    rad__brs_putd(w + 38, p->estimated_bytes);
+    rad__brs_putd(w + 40, p->estimated_seconds);
+}
+
+/* a reason string's length with its NUL, at most 512 */
+static uint32_t rad__brs_strlen(const char *s)
+{
+    uint32_t n = 0;
+    while (n < 511u && s[n]) ++n;
+    return n + 1u;
+}
+
+RAD_API rad_result rad_baker_result_save_memory(const rad_baker_result *R, const rad_context *ctx, void **out,
+                                                size_t *out_size)
+{
+    rad__ctx c;
+    rad_section s[16];
+    rad_bake_signature sig;
+    uint32_t info[RAD__BRS_WORDS], n = 0, planes, flags = 0;
+    char reason[512], plan[512];
+    uint64_t texels, nv = 0, nl = 0, np = 0;
+    size_t bytes;
+    void *buf;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out || !out_size || !R) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_save_memory: NULL result, out or out_size");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    *out_size = 0;
+    planes = R->group_count + R->sky_count;
+    texels = (uint64_t)R->lightmap_width * R->lightmap_height;
+    if (planes == 0 || R->group_count > RAD_BAKER_MAX_GROUPS || R->sky_count > 16u ||
+        (!R->vertex_layers && !R->lightmap_layers && !R->lightmap_rgb9e5 && !R->probe_layers) ||
+        (R->vertex_layers && !R->vertex_first) || ((R->lightmap_layers || R->lightmap_rgb9e5) && !R->lightmap_flags) ||
+        (R->lightmap_layers && R->lightmap_channels != 3u && R->lightmap_channels != 12u) ||
+        (R->lightmap_rgb9e5 && (R->group_count == 0 || R->lightmap_channels != 3u)) ||
+        (R->probe_layers && (!R->probe_positions || !R->probe_states)) ||
+        (R->probe_band4_layers && (!R->probe_layers || R->group_count == 0))) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_save_memory: not a result of rad_baker_run (%u groups, %u sky layers, "
+                                    "no layer, or an array missing beside its layers)", R->group_count, R->sky_count);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    /* what the loader would refuse is not written */
+    if (R->vertex_layers) {
+        nv = 3u * (uint64_t)R->vertex_count * planes;
+        flags |= RAD__BRS_VERTEX;
+        if ((r = rad__check_values(&c, "vertex_layers (BAKER_VERTEX_LAYERS)", R->vertex_layers, nv, 0)) != RAD_SUCCESS) return r;
+    }
+    if (R->lightmap_layers || R->lightmap_rgb9e5) {
+        flags |= RAD__BRS_LIGHTMAP | (R->lightmap_rgb9e5 ? RAD__BRS_RGB9E5 : 0u);
+        if (R->lightmap_layers) {
+            flags |= RAD__BRS_LM_LAYERS;
+            nl = (uint64_t)R->lightmap_channels * texels * planes;
+            if ((r = rad__check_values(&c, "lightmap_layers (BAKER_LIGHTMAP_LAYERS)", R->lightmap_layers, nl, 0)) != RAD_SUCCESS)
+                return r;
+        }
+    }
+    if (R->probe_layers) {
+        float g[4];
+        flags |= RAD__BRS_PROBES | (R->probe_band4_layers ? RAD__BRS_BAND4 : 0u);
+        np = 27u * (uint64_t)R->probe_count;
+        memcpy(g, R->probe_origin, sizeof(float) * 3);
+        g[3] = R->probe_spacing;
+        if ((r = rad__check_values(&c, "the probe grid (BAKER_INFO)", g, 4, 0)) != RAD_SUCCESS ||
+            (r = rad__check_values(&c, "probe_positions (BAKER_PROBE_POSITIONS)", R->probe_positions, 3u * (uint64_t)R->probe_count, 0)) != RAD_SUCCESS ||
+            (r = rad__check_values(&c, "probe_layers (BAKER_PROBE_LAYERS)", R->probe_layers, np * planes, 0)) != RAD_SUCCESS)
+            return r;
+        if (R->probe_band4_layers &&
+            (r = rad__check_values(&c, "probe_band4_layers (BAKER_PROBE_BAND4)", R->probe_band4_layers, np * R->group_count, 0)) != RAD_SUCCESS)
+            return r;
+    }
+    rad__brs_info(R, flags, info);
+    memset(reason, 0, sizeof reason);
+    memset(plan, 0, sizeof plan);
+    memcpy(reason, R->reason, rad__brs_strlen(R->reason) - 1u);
+    memcpy(plan, R->plan.reason, rad__brs_strlen(R->plan.reason) - 1u);
+    rad__section(&s[n++], RAD_SECTION_BAKER_INFO, 4, RAD__BRS_WORDS, info, "info");
+    rad__section(&s[n++], RAD_SECTION_BAKER_REASON, 1, rad__brs_strlen(reason), reason, "reason");
+    if (strcmp(reason, plan) != 0) rad__section(&s[n++], RAD_SECTION_BAKER_REASON, 1, rad__brs_strlen(plan), plan, "plan");
+    if (R->scene_hash[0] || R->scene_hash[1]) {
+        memset(&sig, 0, sizeof sig);
+        sig.geometry = R->scene_hash[0];
+        sig.materials = R->scene_hash[1];
+        rad__section(&s[n++], RAD_SECTION_SIGNATURE, (uint32_t)sizeof sig, 1, &sig, "signature");
+    }
+    if (flags & RAD__BRS_VERTEX) {
+        rad__section(&s[n++], RAD_SECTION_BAKER_VERTEX_FIRST, 4, (uint64_t)R->mesh_count + 1u, R->vertex_first, "vertex_first");
+        rad__section(&s[n++], RAD_SECTION_BAKER_VERTEX_LAYERS, 4, nv, R->vertex_layers, "vertex_layers");
+    }
+    if (flags & RAD__BRS_LIGHTMAP) rad__section(&s[n++], RAD_SECTION_BAKER_LIGHTMAP_FLAGS, 1, texels, R->lightmap_flags, "lightmap_flags");
+    if (flags & RAD__BRS_LM_LAYERS) rad__section(&s[n++], RAD_SECTION_BAKER_LIGHTMAP_LAYERS, 4, nl, R->lightmap_layers, "lightmap_layers");
+    if (flags & RAD__BRS_RGB9E5)
+        rad__section(&s[n++], RAD_SECTION_BAKER_LIGHTMAP_RGB9E5, 4, texels * R->group_count, R->lightmap_rgb9e5, "lightmap_rgb9e5");
+    if (flags & RAD__BRS_PROBES) {
+        rad__section(&s[n++], RAD_SECTION_BAKER_PROBE_POSITIONS, 12, R->probe_count, R->probe_positions, "probe_positions");
+        rad__section(&s[n++], RAD_SECTION_BAKER_PROBE_STATES, 1, R->probe_count, R->probe_states, "probe_states");
+        rad__section(&s[n++], RAD_SECTION_BAKER_PROBE_LAYERS, 4, np * planes, R->probe_layers, "probe_layers");
+    }
+    if (flags & RAD__BRS_BAND4)
+        rad__section(&s[n++], RAD_SECTION_BAKER_PROBE_BAND4, 4, np * R->group_count, R->probe_band4_layers, "probe_band4_layers");
+    if ((r = rad_container_size(s, n, &bytes)) != RAD_SUCCESS) return r;
+    buf = rad__alloc(&c.allocator, bytes);
+    if (!buf) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_save_memory: out of memory for %llu bytes", (unsigned long long)bytes);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if ((r = rad_container_write(s, n, buf, bytes)) != RAD_SUCCESS) {
+        rad__free(&c.allocator, buf);
+        return r;
+    }
+    *out = buf;
+    *out_size = bytes;
+    return RAD_SUCCESS;
+}
+
+/* The section of 'type' and 'name', checked for its element size (CORRUPT) and count
+   (SIZE_MISMATCH) before anything reads it; a missing one is CORRUPT when required. */
+static rad_result rad__brs_find(const rad__ctx *c, const rad_container *ct, uint32_t type, const char *name, uint32_t elem_size,
+                                uint64_t count, int required, const rad_section **out)
+{
+    const rad_section *s = rad_container_find(ct, type, name);
+    *out = NULL;
+    if (!s) {
+        if (!required) return RAD_SUCCESS;
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: the %s section ('%s') is missing", rad_section_type_name(type), name);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (s->elem_size != elem_size) {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: the %s section has %u-byte elements, expected %u", rad_section_type_name(type),
+                 s->elem_size, elem_size);
+        return RAD_ERROR_CORRUPT;
+    }
+    if (s->count != count) {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: the %s section holds %llu elements, its metadata (BAKER_INFO) asks for %llu",
+                 rad_section_type_name(type), (unsigned long long)s->count, (unsigned long long)count);
+        return RAD_ERROR_SIZE_MISMATCH;
+    }
+    *out = s;
+    return RAD_SUCCESS;
+}
+
+/* a checked section's bytes copied into a new array (sizes bounded by the file: no count
+   reaches here unchecked) */
+static rad_result rad__brs_copy(const rad__ctx *c, const rad_section *s, void **dst)
+{
+    size_t bytes = (size_t)(s->count * s->elem_size);
+    *dst = rad__alloc(&c->allocator, bytes ? bytes : 1u);
+    if (!*dst) return RAD_ERROR_OUT_OF_MEMORY;
+    if (bytes) memcpy(*dst, s->data, bytes);
+    return RAD_SUCCESS;
+}
+
+/* a reason section (optional): 1 to 512 chars, the last a NUL */
+static rad_result rad__brs_reason(const rad__ctx *c, const rad_container *ct, const char *name, char *dst)
+{
+    const rad_section *s = rad_container_find(ct, RAD_SECTION_BAKER_REASON, name);
+    if (!s) return RAD_SUCCESS;
+    if (s->elem_size != 1u || s->count == 0 || s->count > 512u || ((const char *)s->data)[s->count - 1] != '\0') {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: the BAKER_REASON section '%s' is not a string of at most 511 chars", name);
+        return RAD_ERROR_CORRUPT;
+    }
+    memcpy(dst, s->data, (size_t)s->count);
+    return RAD_SUCCESS;
+}
+
+/* The metadata of BAKER_INFO into R, every field checked against what rad_baker_run can make. */
+static rad_result rad__brs_read_info(const rad__ctx *c, const rad_container *ct, rad_baker_result *R, uint32_t *flags)
+{
+    const rad_section *s = rad_container_find(ct, RAD_SECTION_BAKER_INFO, NULL);
+    uint32_t w[RAD__BRS_WORDS], planes;
+    float g[4];
+    rad_result r;
+    if (!s) {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: the container has no BAKER_INFO section (not a saved rad_baker_result; "
+                                   "a classic bake loads with rad_load_memory)");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (s->elem_size != 4u || s->count < RAD__BRS_WORDS) {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: the BAKER_INFO section holds %llu elements of %u bytes, expected at least "
+                 "%u words", (unsigned long long)s->count, s->elem_size, RAD__BRS_WORDS);
+        return RAD_ERROR_CORRUPT;
+    }
+    memcpy(w, s->data, sizeof w);
+    if (w[0] != RAD_BAKER_RESULT_VERSION) {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: layout version %u in BAKER_INFO, this reader knows %u", w[0],
+                 RAD_BAKER_RESULT_VERSION);
+        return RAD_ERROR_VERSION;
+    }
+    R->method = (rad_baker_method)w[1];
+    R->patch_count = w[2];
+    R->vp_resolution = w[3];
+    R->group_count = w[4];
+    R->sky_count = w[5];
+    R->mesh_count = w[6];
+    R->vertex_count = w[7];
+    R->lightmap_width = w[8];
+    R->lightmap_height = w[9];
+    R->lightmap_channels = w[10];
+    R->probe_count = w[11];
+    R->probe_grid[0] = w[12], R->probe_grid[1] = w[13], R->probe_grid[2] = w[14];
+    R->probe_origin[0] = g[0] = rad__brs_getf(w + 15);
+    R->probe_origin[1] = g[1] = rad__brs_getf(w + 16);
+    R->probe_origin[2] = g[2] = rad__brs_getf(w + 17);
+    R->probe_spacing = g[3] = rad__brs_getf(w + 18);
+    *flags = w[19];
+    R->lightmap_seams.seams = w[20];
+    R->lightmap_seams.sample_pairs = w[21];
+    R->lightmap_seams.max_jump_before = rad__brs_getf(w + 22);
+    R->lightmap_seams.max_jump_after = rad__brs_getf(w + 23);
+    R->estimated_bytes = rad__brs_getd(w + 24);
+    R->estimated_seconds = rad__brs_getd(w + 26);
+    R->plan.method = (rad_baker_method)w[28];
+    R->plan.patch_count = w[29];
+    R->plan.vp_resolution = w[30];
+    R->plan.vp_samples = w[31];
+    R->plan.vp_kind = (rad_vp_kind)w[32];
+    R->plan.needed_resolution = w[33];
+    R->plan.free_path = rad__brs_getf(w + 34);
+    R->plan.escaped = rad__brs_getf(w + 35);
+    R->plan.budget_limited = (int)w[36];
+    R->plan.over_budget = (int)w[37];
+    R->plan.estimated_bytes = rad__brs_getd(w + 38);
+    R->plan.estimated_seconds = rad__brs_getd(w + 40);
+    planes = R->group_count + R->sky_count;
+    if ((w[1] != RAD_BAKER_CLASSIC && w[1] != RAD_BAKER_VIRTUAL_PATCHES) || R->group_count > RAD_BAKER_MAX_GROUPS ||
+        R->sky_count > 16u || planes == 0 || R->mesh_count == 0xFFFFFFFFu ||
+        !(*flags & (RAD__BRS_VERTEX | RAD__BRS_LIGHTMAP | RAD__BRS_PROBES)) ||
+        ((*flags & RAD__BRS_LIGHTMAP) && !(*flags & (RAD__BRS_LM_LAYERS | RAD__BRS_RGB9E5))) ||
+        ((*flags & (RAD__BRS_LM_LAYERS | RAD__BRS_RGB9E5)) && !(*flags & RAD__BRS_LIGHTMAP)) ||
+        ((*flags & RAD__BRS_LM_LAYERS) && R->lightmap_channels != 3u && R->lightmap_channels != 12u) ||
+        ((*flags & RAD__BRS_RGB9E5) && (R->lightmap_channels != 3u || R->group_count == 0)) ||
+        ((*flags & RAD__BRS_RGB9E5) && !(*flags & RAD__BRS_LM_LAYERS) && R->sky_count) ||
+        ((*flags & RAD__BRS_BAND4) && (!(*flags & RAD__BRS_PROBES) || R->group_count == 0))) {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: BAKER_INFO holds what rad_baker_run never makes (method %u, %u groups, "
+                 "%u sky layers, outputs 0x%x, %u lightmap channels)", w[1], R->group_count, R->sky_count, *flags,
+                 R->lightmap_channels);
+        return RAD_ERROR_CORRUPT;
+    }
+    if ((*flags & RAD__BRS_PROBES) && (r = rad__check_values(c, "the probe grid's origin and spacing (BAKER_INFO)", g, 4, 0)) != RAD_SUCCESS)
+        return r;
+    if ((*flags & RAD__BRS_PROBES) && (R->probe_grid[0] || R->probe_grid[1] || R->probe_grid[2]) &&
+        (uint64_t)R->probe_grid[0] * R->probe_grid[1] * R->probe_grid[2] != R->probe_count) {
+        rad__log(c, RAD_LOG_ERROR, "engine-tier result: a probe grid of %u x %u x %u for %u probes (BAKER_INFO)", R->probe_grid[0],
+                 R->probe_grid[1], R->probe_grid[2], R->probe_count);
+        return RAD_ERROR_CORRUPT;
+    }
+    if ((r = rad__brs_reason(c, ct, "reason", R->reason)) != RAD_SUCCESS) return r;
+    if ((r = rad__brs_reason(c, ct, "plan", R->plan.reason)) != RAD_SUCCESS) return r;
+    if (!rad_container_find(ct, RAD_SECTION_BAKER_REASON, "plan")) memcpy(R->plan.reason, R->reason, sizeof R->reason);
+    return RAD_SUCCESS;
+}
+
+/* The arrays of the sections into R: each count checked against the metadata (the counts
+   that bound the others first), copied, its values checked, then the mixed outputs made. */
+static rad_result rad__brs_fill(const rad__ctx *c, const rad_container *ct, rad_baker_result *R)
+{
+    const rad_section *s;
+    uint32_t flags = 0, planes, m;
+    uint64_t texels = 0, n;
+    rad_result r;
+    if ((r = rad__brs_read_info(c, ct, R, &flags)) != RAD_SUCCESS) return r;
+    planes = R->group_count + R->sky_count;
+    if ((r = rad__brs_find(c, ct, RAD_SECTION_SIGNATURE, NULL, (uint32_t)sizeof(rad_bake_signature), 1, 0, &s)) != RAD_SUCCESS)
+        return r;
+    if (s) {
+        rad_bake_signature sig;
+        memcpy(&sig, s->data, sizeof sig);
+        R->scene_hash[0] = sig.geometry;
+        R->scene_hash[1] = sig.materials;
+    }
+    if (flags & RAD__BRS_VERTEX) {
+        const uint32_t *vf;
+        if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_VERTEX_FIRST, "vertex_first", 4, (uint64_t)R->mesh_count + 1u, 1, &s)) != RAD_SUCCESS ||
+            (r = rad__brs_copy(c, s, (void **)&R->vertex_first)) != RAD_SUCCESS)
+            return r;
+        vf = R->vertex_first;
+        for (m = 0; m < R->mesh_count && vf[m] <= vf[m + 1]; ++m) {}
+        if (vf[0] != 0 || m < R->mesh_count || vf[R->mesh_count] != R->vertex_count) {
+            rad__log(c, RAD_LOG_ERROR, "engine-tier result: BAKER_VERTEX_FIRST does not ascend from 0 to the %u vertices of BAKER_INFO",
+                     R->vertex_count);
+            return RAD_ERROR_CORRUPT;
+        }
+        n = 3u * (uint64_t)R->vertex_count * planes;
+        if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_VERTEX_LAYERS, "vertex_layers", 4, n, 1, &s)) != RAD_SUCCESS ||
+            (r = rad__brs_copy(c, s, (void **)&R->vertex_layers)) != RAD_SUCCESS ||
+            (r = rad__check_values(c, "vertex_layers (BAKER_VERTEX_LAYERS)", R->vertex_layers, n, 0)) != RAD_SUCCESS)
+            return r;
+        R->vertex = (float *)rad__alloc_array(&c->allocator, 3u * (size_t)R->vertex_count + 1u, sizeof(float));
+        if (!R->vertex) return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (flags & RAD__BRS_LIGHTMAP) {
+        /* the flags' count bounds the texels by the file's size before any product of them */
+        texels = (uint64_t)R->lightmap_width * R->lightmap_height;
+        if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_LIGHTMAP_FLAGS, "lightmap_flags", 1, texels, 1, &s)) != RAD_SUCCESS ||
+            (r = rad__brs_copy(c, s, (void **)&R->lightmap_flags)) != RAD_SUCCESS)
+            return r;
+        if (!rad__brs_mul(texels, (uint64_t)R->lightmap_channels * planes, &n)) n = 0xFFFFFFFFFFFFFFFFull; /* no section holds it */
+        if (flags & RAD__BRS_LM_LAYERS) {
+            if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_LIGHTMAP_LAYERS, "lightmap_layers", 4, n, 1, &s)) != RAD_SUCCESS ||
+                (r = rad__brs_copy(c, s, (void **)&R->lightmap_layers)) != RAD_SUCCESS ||
+                (r = rad__check_values(c, "lightmap_layers (BAKER_LIGHTMAP_LAYERS)", R->lightmap_layers, n, 0)) != RAD_SUCCESS)
+                return r;
+        }
+        if (flags & RAD__BRS_RGB9E5) { /* every word unpacks to a finite value: nothing to check */
+            if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_LIGHTMAP_RGB9E5, "lightmap_rgb9e5", 4, texels * R->group_count, 1, &s)) != RAD_SUCCESS ||
+                (r = rad__brs_copy(c, s, (void **)&R->lightmap_rgb9e5)) != RAD_SUCCESS)
+                return r;
+        }
+        R->lightmap = (float *)rad__alloc_array(&c->allocator, (size_t)R->lightmap_channels * (size_t)texels + 1u, sizeof(float));
+        if (!R->lightmap) return RAD_ERROR_OUT_OF_MEMORY;
+    } else {
+        R->lightmap_channels = 0;
+    }
+    if (flags & RAD__BRS_PROBES) {
+        uint32_t i;
+        if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_PROBE_POSITIONS, "probe_positions", 12, R->probe_count, 1, &s)) != RAD_SUCCESS ||
+            (r = rad__brs_copy(c, s, (void **)&R->probe_positions)) != RAD_SUCCESS ||
+            (r = rad__check_values(c, "probe_positions (BAKER_PROBE_POSITIONS)", R->probe_positions, 3u * (uint64_t)R->probe_count, 0)) != RAD_SUCCESS ||
+            (r = rad__brs_find(c, ct, RAD_SECTION_BAKER_PROBE_STATES, "probe_states", 1, R->probe_count, 1, &s)) != RAD_SUCCESS ||
+            (r = rad__brs_copy(c, s, (void **)&R->probe_states)) != RAD_SUCCESS)
+            return r;
+        for (i = 0; i < R->probe_count; ++i)
+            if (R->probe_states[i] > (uint8_t)RAD_PROBE_MOVED) {
+                rad__log(c, RAD_LOG_ERROR, "engine-tier result: BAKER_PROBE_STATES: probe %u has state %u (not a rad_probe_state)", i,
+                         R->probe_states[i]);
+                return RAD_ERROR_CORRUPT;
+            }
+        n = 27u * (uint64_t)R->probe_count;
+        if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_PROBE_LAYERS, "probe_layers", 4, n * planes, 1, &s)) != RAD_SUCCESS ||
+            (r = rad__brs_copy(c, s, (void **)&R->probe_layers)) != RAD_SUCCESS ||
+            (r = rad__check_values(c, "probe_layers (BAKER_PROBE_LAYERS)", R->probe_layers, n * planes, 0)) != RAD_SUCCESS)
+            return r;
+        R->probes = (float *)rad__alloc_array(&c->allocator, (size_t)n + 1u, sizeof(float));
+        if (!R->probes) return RAD_ERROR_OUT_OF_MEMORY;
+        if (flags & RAD__BRS_BAND4) {
+            if ((r = rad__brs_find(c, ct, RAD_SECTION_BAKER_PROBE_BAND4, "probe_band4_layers", 4, n * R->group_count, 1, &s)) != RAD_SUCCESS ||
+                (r = rad__brs_copy(c, s, (void **)&R->probe_band4_layers)) != RAD_SUCCESS ||
+                (r = rad__check_values(c, "probe_band4_layers (BAKER_PROBE_BAND4)", R->probe_band4_layers, n * R->group_count, 0)) != RAD_SUCCESS)
+                return r;
+            R->probe_band4 = (float *)rad__alloc_array(&c->allocator, (size_t)n + 1u, sizeof(float));
+            if (!R->probe_band4) return RAD_ERROR_OUT_OF_MEMORY;
+        }
+    } else {
+        R->probe_count = 0;
+    }
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_result_load_memory(const void *data, size_t size, const rad_context *ctx, rad_baker_result **out)
+{
+    rad__ctx c;
+    rad_container *ct = NULL;
+    rad_baker_result *R;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out || !data) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_load_memory: NULL data or out");
+        if (out) *out = NULL;
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    if ((r = rad_container_create(data, size, ctx, &ct)) != RAD_SUCCESS) return r;
+    R = (rad_baker_result *)rad__alloc_zero(&c.allocator, sizeof *R);
+    if (!R) {
+        rad_container_destroy(ct);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    R->allocator = c.allocator;
+    r = rad__brs_fill(&c, ct, R);
+    rad_container_destroy(ct);
+    /* the outputs as rad_baker_run leaves them: every group at scale 1, the sky left out */
+    if (r == RAD_SUCCESS) r = rad_baker_mix(R, NULL, ctx);
+    if (r != RAD_SUCCESS) {
+        if (r == RAD_ERROR_OUT_OF_MEMORY) rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_load_memory: out of memory");
+        rad_baker_result_destroy(R);
+        return r;
+    }
+    *out = R;
+    return RAD_SUCCESS;
+}
+
+RAD_API rad_result rad_baker_result_matches_scene(const rad_baker_result *R, const rad_scene *scene, const rad_context *ctx)
+{
+    rad__ctx c;
+    uint64_t g = 0, m = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!R || !scene) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_matches_scene: NULL result or scene");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if (!R->scene_hash[0] && !R->scene_hash[1]) {
+        rad__log(&c, RAD_LOG_WARNING, "rad_baker_result_matches_scene: the result records no scene hashes: not checked");
+        return RAD_SUCCESS;
+    }
+    if ((r = rad_scene_hash(scene, &g, &m)) != RAD_SUCCESS) return r;
+    if (g == R->scene_hash[0] && m == R->scene_hash[1]) return RAD_SUCCESS;
+    rad__log(&c, RAD_LOG_ERROR, "the bake was made from another scene: the %s differ (bake / scene hashes: geometry %016llx / "
+             "%016llx, materials %016llx / %016llx)", g != R->scene_hash[0] && m != R->scene_hash[1] ? "geometry and materials"
+             : g != R->scene_hash[0] ? "geometry" : "materials", (unsigned long long)R->scene_hash[0], (unsigned long long)g,
+             (unsigned long long)R->scene_hash[1], (unsigned long long)m);
+    return RAD_ERROR_SCENE_MISMATCH;
+}
+
+#ifndef RAD_NO_STDIO
+RAD_API rad_result rad_baker_result_save_file(const char *path, const rad_baker_result *R, const rad_context *ctx)
+{
+    rad__ctx c;
+    void *buf = NULL;
+    size_t size = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!path) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_save_file: NULL path");
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    if ((r = rad_baker_result_save_memory(R, ctx, &buf, &size)) != RAD_SUCCESS) return r;
+    r = rad__write_file_atomic(&c, path, buf, size);
+    rad__free(&c.allocator, buf);
+    return r;
+}
+
+RAD_API rad_result rad_baker_result_load_file(const char *path, const rad_context *ctx, rad_baker_result **out)
+{
+    rad__ctx c;
+    void *buf = NULL;
+    size_t len = 0;
+    rad_result r;
+    rad__ctx_init(&c, ctx);
+    if (!out || !path) {
+        rad__log(&c, RAD_LOG_ERROR, "rad_baker_result_load_file: NULL path or out");
+        if (out) *out = NULL;
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    if ((r = rad__read_container_file(&c, path, &buf, &len)) != RAD_SUCCESS) return r;
+    r = rad_baker_result_load_memory(buf, len, ctx, out);
+    rad__free(&c.allocator, buf);
+    return r;
 }
 #endif
 

@@ -53,8 +53,9 @@
 #include "test_lightmap_fg.c"
 #include "test_baker_raycaster.c"
 #include "test_baker_solver.c"
+#include "test_baker_save.c"
 
-static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_hemicube, tests_hierarchical, tests_solve, tests_stochastic, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_vp_runtime, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl, tests_probes, tests_lightmap, tests_rel, tests_defaults, tests_emissive, tests_twosided, tests_cutout, tests_env, tests_bake, tests_runtime, tests_hier_large, tests_hier_scale, tests_hier_energy, tests_hier_source, tests_hier_open, tests_direct_noise, tests_direct_pool, tests_plan, tests_layers, tests_vp_accuracy, tests_bake_solution, tests_bake_probes, tests_baker_lightmap, tests_plan_small, tests_rgb9e5, tests_lightmap_fg, tests_baker_raycaster, tests_baker_solver };
+static const rad_test_case *const rad_test_tables[] = { tests_scene, tests_formfactor, tests_hemicube, tests_hierarchical, tests_solve, tests_stochastic, tests_light, tests_embree, tests_container, tests_multibounce, tests_temporal, tests_local, tests_vp, tests_vp_runtime, tests_regress, tests_robust, tests_api, tests_alloc, tests_shading, tests_glsl, tests_probes, tests_lightmap, tests_rel, tests_defaults, tests_emissive, tests_twosided, tests_cutout, tests_env, tests_bake, tests_runtime, tests_hier_large, tests_hier_scale, tests_hier_energy, tests_hier_source, tests_hier_open, tests_direct_noise, tests_direct_pool, tests_plan, tests_layers, tests_vp_accuracy, tests_bake_solution, tests_bake_probes, tests_baker_lightmap, tests_plan_small, tests_rgb9e5, tests_lightmap_fg, tests_baker_raycaster, tests_baker_solver, tests_baker_save };
 
 int main(int argc, char **argv)
 {

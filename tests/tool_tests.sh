@@ -1216,6 +1216,34 @@ if "$RAD" lightmap cornell -o "$TMP/lm.pfm" --size 32 --patches 100 --texel-samp
 else
     fail "lightmap of the Cornell box" "$(head -c 300 "$TMP/err.txt")"
 fi
+# --layers: the engine tier's bake as one file (rad_baker_result_save_memory); rad info loads
+# it as an engine would (rad_baker_result_load_memory) and describes its groups, sizes and the
+# plan's reason; a damaged or cut copy exits 1; options that bake without the tier are refused
+if "$RAD" lightmap cornell -o "$TMP/lml.pfm" --layers "$TMP/lml.radr" --size 32 --patches 100 --texel-samples 1 \
+    --visibility-rays 1 > /dev/null 2> "$TMP/err.txt" && "$RAD" info "$TMP/lml.radr" > "$TMP/info.txt" 2>&1; then
+    grep -q "engine-tier bake: classic, [0-9]* patches, 1 light groups, 0 sky layers" "$TMP/info.txt" &&
+        grep -q "lightmap: 32 x 32, RGB, float layers" "$TMP/info.txt" && grep -q "plan: classic: 32 triangles" "$TMP/info.txt" &&
+        grep -q "BAKER_LIGHTMAP_LAYERS" "$TMP/info.txt" && grep -q "checksums: all OK" "$TMP/info.txt" &&
+        ok "lightmap --layers writes the tier's bake and rad info describes it" ||
+        fail "lightmap --layers writes the tier's bake and rad info describes it" "$(head -c 600 "$TMP/info.txt")"
+    cp "$TMP/lml.radr" "$TMP/bad.radr"
+    printf '\125' | dd of="$TMP/bad.radr" bs=1 seek=3000 conv=notrunc 2> /dev/null
+    head -c 5000 "$TMP/lml.radr" > "$TMP/cut.radr"
+    "$RAD" info "$TMP/bad.radr" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    "$RAD" info "$TMP/cut.radr" > /dev/null 2>> "$TMP/err.txt"
+    rc2=$?
+    [ $rc -eq 1 ] && [ $rc2 -eq 1 ] && grep -q "checksum" "$TMP/err.txt" && grep -q "truncated" "$TMP/err.txt" &&
+        ok "rad info refuses a damaged or cut --layers file" ||
+        fail "rad info refuses a damaged or cut --layers file" "exit $rc $rc2: $(head -c 400 "$TMP/err.txt")"
+else
+    fail "lightmap --layers" "$(head -c 300 "$TMP/err.txt") $(head -c 300 "$TMP/info.txt" 2> /dev/null)"
+fi
+"$RAD" lightmap cornell -o "$TMP/lmg.pfm" --layers "$TMP/lmg.radr" --solver gauss-seidel > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 2 ] && [ ! -e "$TMP/lmg.radr" ] && [ ! -e "$TMP/lmg.pfm" ] && grep -q "engine tier's bake" "$TMP/err.txt" &&
+    ok "lightmap --layers refuses options that bake without the tier" ||
+    fail "lightmap --layers refuses options that bake without the tier" "exit $rc: $(head -c 300 "$TMP/err.txt")"
 # OpenEXR (tinyexr): the same bake written as .exr reads back (through tinyexr) equal to the
 # PFM, value for value; a rad built without tinyexr refuses .exr with a message naming the package
 "$RAD" lightmap cornell -o "$TMP/lm.exr" --size 32 --patches 100 --texel-samples 1 --visibility-rays 1 > /dev/null 2> "$TMP/err.txt"

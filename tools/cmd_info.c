@@ -1,6 +1,9 @@
 /* cmd_info.c - `rad info FILE.radb`: what a baked-data container holds, after checking it
    (rad_container_create validates every size, offset and checksum; rad_load_memory every
    index). A damaged file gives the loader's error and detail and exit code 1.
+   A saved engine-tier bake (rad lightmap --layers, rad_baker_result_save_memory) is loaded
+   as an engine loads it (rad_baker_result_load_memory) and described: its groups, sizes and
+   the plan's reason.
    `rad info SCENE`: the imported scene, and per material what the importer used, read and
    ignored, so that nothing of a material is dropped without a word. */
 #include "tool.h"
@@ -24,6 +27,35 @@ static const char *type_name(uint32_t type)
 
 /* The method's data opened and checked exactly as rad render opens it (tool_indirect_open:
    the row sums, L, the k of the record, the temporal state ...); 0, or 1 (printed). */
+/* A saved rad_baker_result, loaded and described; 0, or 1 when it does not load (printed). */
+static int baker_info(const char *path, const void *data, size_t len, const rad_context *ctx)
+{
+    rad_baker_result *R = NULL;
+    rad_result r = rad_baker_result_load_memory(data, len, ctx, &R);
+    if (r != RAD_SUCCESS) {
+        fprintf(stderr, "rad info: '%s' holds an engine-tier bake that does not load: %s\n", path, rad_result_string(r));
+        return 1;
+    }
+    printf("engine-tier bake: %s, %u patches%s, %u light groups, %u sky layers\n",
+           R->method == RAD_BAKER_CLASSIC ? "classic" : "virtual patches", R->patch_count,
+           R->method == RAD_BAKER_CLASSIC ? "" : " (virtual)", R->group_count, R->sky_count);
+    if (R->vertex_layers) printf("  vertices: %u in %u meshes\n", R->vertex_count, R->mesh_count);
+    if (R->lightmap)
+        printf("  lightmap: %u x %u, %s%s%s\n", R->lightmap_width, R->lightmap_height,
+               R->lightmap_channels == 12 ? "L1 SH (12 floats a texel)" : "RGB", R->lightmap_layers ? ", float layers" : "",
+               R->lightmap_rgb9e5 ? ", RGB9E5 layers" : "");
+    if (R->probes)
+        printf("  probes: %u (grid %u x %u x %u)%s\n", R->probe_count, R->probe_grid[0], R->probe_grid[1], R->probe_grid[2],
+               R->probe_band4 ? ", band 4" : "");
+    printf("  plan: %s\n", R->reason);
+    if (R->scene_hash[0] || R->scene_hash[1])
+        printf("  scene: geometry %016llx, materials %016llx\n", (unsigned long long)R->scene_hash[0],
+               (unsigned long long)R->scene_hash[1]);
+    printf("checksums: all OK; every section agrees with the metadata\n");
+    rad_baker_result_destroy(R);
+    return 0;
+}
+
 static int method_open(const char *path, const rad_bake *bake, uint32_t method)
 {
     tool_method_options mo;
@@ -213,6 +245,12 @@ int tool_cmd_info(int argc, char **argv)
         const rad_section *s = rad_container_section(ct, i);
         printf("  %-3u %-20s %-14s %9u %12llu %14llu  OK\n", i, type_name(s->type), s->name[0] ? s->name : "-",
                s->elem_size, (unsigned long long)s->count, (unsigned long long)s->count * s->elem_size);
+    }
+    if (rad_container_find(ct, RAD_SECTION_BAKER_INFO, NULL)) {
+        int rc = baker_info(path, data, len, &ctx);
+        rad_container_destroy(ct);
+        free(data);
+        return rc;
     }
     {
         /* a virtual-patch bake (rad bake --method aavp|vp): its info record, no classic patches */

@@ -1,6 +1,6 @@
 /* cmd_lightmap.c - rad lightmap: a lightmap of a scene over its second uv set.
 
-   rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [--size N|WxH] [--sh] [--texel-samples N] [--proxy aavp|vp]
+   rad lightmap SCENE -o OUT.pfm|OUT.exr|OUT.png [--layers OUT.radr] [--size N|WxH] [--sh] [--texel-samples N] [--proxy aavp|vp]
                 [--visibility-rays N] [--gather exact|hemisphere] [--hemisphere-rays N] [--final-gather N] [--unwrap] [--render VIEW.png|.pfm [--render-size WxH] [--aa N]]
                 [classic options] [--threads N] [--exposure X]
 
@@ -15,7 +15,9 @@
    negative coefficients). .exr is 32-bit float OpenEXR (image.c, tinyexr). Then dilation into the gutters and seam stitching. --render draws
    the scene's camera view (or the one rad trace would choose) shaded from the lightmap alone:
    radiance = emission + albedo x bilinear lightmap irradiance / pi, N x N samples a pixel, to
-   compare with `rad trace` (rad compare). */
+   compare with `rad trace` (rad compare). --layers saves the engine tier's bake itself
+   (rad_baker_result_save_memory: its light layers and metadata) for an engine's
+   rad_baker_result_load_file; `rad info` describes it. */
 #include "tool.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,6 +26,7 @@
 /* rad lightmap's command line */
 typedef struct lightmap_args {
     const char *scene, *out, *render; /* SCENE, -o, --render */
+    const char *layers;        /* --layers */
     tool_classic_options co;
     tool_lightmap_request rq;  /* --size, --sh, --texel-samples, --visibility-rays, --gather, ... */
     tool_lightmap_proxy px;    /* --proxy and its options */
@@ -88,6 +91,11 @@ static const tool_arg lightmap_table[] = {
      ".glb / .gltf: the scene for engines, with TEXCOORD_1, the lightmap as a PNG image named in\n"
      "each material's extras, its HDR copy beside it and the view as a camera\n"
      "(docs/engine-formats.md; RGB only, not --sh)"},
+    {TOOL_ARG_STRING, "--layers", "FILE", LA(layers), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
+     "also save the engine tier's bake as one file (.radr: its light layers and metadata,\n"
+     "rad_baker_result_load_file mixes them again; docs/engine-formats.md); rad info FILE\n"
+     "describes it. Needs the tier's bake: --solver jacobi, no --max-edge, the patches or\n"
+     "--proxy aavp|vp at the default --face-points"},
     LA_CUSTOM("--size", "N|WxH", rq.width, parse_atlas_size, LIGHTMAP_GIVEN_SIZE,
               "atlas texels (default 256; with an unwrap whose charts do not fit, the smallest\n"
               "power of two up to 4096 that they fit, said on stderr)"),
@@ -200,6 +208,37 @@ static int lightmap_render(const tool_world *w, const rad_lightmap *lm, const fl
     return 0;
 }
 
+/* the engine tier's result (rad_baker_result_save_memory) into the set at path; 0, or 1 after
+   printing why (the set aborted) */
+static int lightmap_write_layers(const char *path, const rad_baker_result *R, tool_output_set *set)
+{
+    rad_context ctx;
+    tool_output o;
+    void *buf = NULL;
+    size_t size = 0;
+    rad_result r;
+    int ok;
+    tool_context(&ctx, NULL);
+    if ((r = rad_baker_result_save_memory(R, &ctx, &buf, &size)) != RAD_SUCCESS) {
+        fprintf(stderr, "rad lightmap: cannot save the bake: %s\n", rad_result_string(r));
+        tool_output_set_abort(set);
+        return 1;
+    }
+    if (tool_output_open(&o, path) != 0) {
+        fprintf(stderr, "rad lightmap: %s\n", tool_output_error());
+        rad_free_buffer(buf, &ctx);
+        tool_output_set_abort(set);
+        return 1;
+    }
+    ok = fwrite(buf, 1, size, o.f) == size;
+    rad_free_buffer(buf, &ctx);
+    if (tool_output_set_add(set, &o, ok) != 0) {
+        fprintf(stderr, "rad lightmap: %s\n", tool_output_error());
+        return 1;
+    }
+    return 0;
+}
+
 static int lightmap_is_png(const char *path)
 {
     size_t n = strlen(path);
@@ -209,6 +248,7 @@ static int lightmap_is_png(const char *path)
 /* the command line into la; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
 static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_args *la)
 {
+    rad_vp_options vo;
     int a, k;
     memset(la, 0, sizeof *la);
     tool_classic_options_default(&la->co);
@@ -269,6 +309,13 @@ static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_a
         fprintf(stderr, "rad lightmap: a .glb or .gltf carries the RGB lightmap: leave out --sh\n");
         return 2;
     }
+    rad_vp_options_default(&vo);
+    if (la->layers && (la->co.solver != TOOL_JACOBI || la->co.bounces == 0 || la->co.max_edge != 0.0f ||
+                       la->px.kind == TOOL_LIGHTMAP_HIERARCHICAL || (la->px.face_points && la->px.face_points != vo.face_points))) {
+        fprintf(stderr, "rad lightmap: --layers saves the engine tier's bake, and these options bake without it: use "
+                        "--solver jacobi, no --max-edge, the patches or --proxy aavp|vp at the default --face-points\n");
+        return 2;
+    }
     if (tool_check_size("lightmap", la->rq.width, la->rq.height)) return 2;
     if ((!tool_gltf_is_path(la->out) && tool_image_check_format("lightmap", la->out)) ||
         (la->render && tool_image_check_format("lightmap", la->render)))
@@ -313,13 +360,14 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
            work, and again against every file the scene was read from once it is loaded */
         static const char *const tags[4] = {"L00", "L1m1", "L10", "L11"};
         char *layers[4] = {NULL, NULL, NULL, NULL};
-        const char *outs[7];
+        const char *outs[8];
         int n = 0, bad = 0, k;
         if (sh)
             for (k = 0; k < 4; ++k) outs[n++] = layers[k] = lightmap_tagged(out_path, tags[k]);
         else
             outs[n++] = out_path;
         if (render_path) outs[n++] = render_path;
+        if (la.layers) outs[n++] = la.layers;
         if (gltf_hdr) outs[n++] = gltf_hdr;
         if (gltf_bin) outs[n++] = gltf_bin;
         for (k = 0; k < n && !bad; ++k) bad = tool_check_output("lightmap", outs[k], &scene_path, 1);
@@ -342,6 +390,11 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     rq.direct = !sh;
     rq.proxy = la.px.kind ? &la.px : NULL;
     if (tool_lightmap_bake("lightmap", &w, &la.co, &rq, &bk)) goto done;
+    if (la.layers && !bk.baked) {
+        fprintf(stderr, "rad lightmap: --layers saves the engine tier's bake, and these options bake without it: use "
+                        "--solver jacobi, no --max-edge, the patches or --proxy aavp|vp at the default --face-points\n");
+        goto done;
+    }
     width = (int)bk.lm->width; /* the unwrap may have chosen a larger atlas */
     height = (int)bk.lm->height;
     lm = bk.lm;
@@ -388,6 +441,7 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
             gl.hdr_name = strrchr(gltf_hdr, '/') ? strrchr(gltf_hdr, '/') + 1 : gltf_hdr;
             bad = tool_gltf_write("lightmap", out_path, &gl, &set);
         }
+        if (!bad && la.layers && lightmap_write_layers(la.layers, bk.baked, &set)) bad = 1;
         if (!bad && render_path && lightmap_render(&bk.w, lm, values, rw, rh, (int)aa, render_path, exposure, &set)) {
             tool_output_set_abort(&set);
             bad = 1;
@@ -403,6 +457,9 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
         if (bad) goto done;
         if (gltf_hdr) fprintf(stderr, "rad lightmap: wrote %s%s%s\n", out_path, gltf_bin ? " and " : "", gltf_bin ? gltf_bin : "");
         if (render_path) fprintf(stderr, "rad lightmap: wrote the view %s\n", render_path);
+        if (la.layers)
+            fprintf(stderr, "rad lightmap: wrote the engine tier's bake %s (light groups: %u; rad info describes it)\n", la.layers,
+                    bk.baked->group_count);
     }
     code = 0;
 done:
