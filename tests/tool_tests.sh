@@ -1185,12 +1185,23 @@ bad "probes --vp-resolution with --vp-max-patches" "exclude each other" probes c
     fail "probes --vp-max-patches" "'$n': $(head -c 300 "$TMP/err.txt")"
 bad "probes --vp-rays without --proxy" "--vp-rays is for --proxy" probes cornell -o "$TMP/x.json" --vp-rays 64
 bad "probes --patch-samples with --proxy" "--patch-samples is for classic patches" probes cornell -o "$TMP/x.json" --proxy aavp --patch-samples 4
-# too big for the dense build: refused at once, naming --proxy aavp
-"$RAD" probes "$TMP/grid.obj" --max-memory 16M -o "$TMP/g.json" > /dev/null 2> "$TMP/err.txt"
+# too big for the dense build with --proxy patches: refused at once, naming --proxy aavp
+"$RAD" probes "$TMP/grid.obj" --max-memory 16M --proxy patches -o "$TMP/g.json" > /dev/null 2> "$TMP/err.txt"
 rc=$?
 [ $rc -eq 1 ] && grep -q -- "use --proxy aavp or --proxy vp" "$TMP/err.txt" && [ ! -e "$TMP/g.json" ] &&
-    ok "probes: a scene too big for the dense build is refused, naming --proxy aavp" ||
-    fail "probes: a scene too big for the dense build is refused naming --proxy aavp" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+    ok "probes --proxy patches: a scene too big for the dense build is refused, naming --proxy aavp" ||
+    fail "probes --proxy patches: a scene too big for the dense build is refused naming --proxy aavp" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+# without --proxy the plan takes virtual patches there, and says so
+"$RAD" probes "$TMP/grid.obj" --max-memory 16M -o "$TMP/g.json" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 0 ] && grep -q -- "no --proxy given: the probes' light from aavp virtual patches" "$TMP/err.txt" && [ -s "$TMP/g.json" ] &&
+    ok "probes without --proxy: the plan takes aavp where the dense build would not fit" ||
+    fail "probes without --proxy: the plan takes aavp where the dense build would not fit" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+"$RAD" lightmap "$TMP/grid.obj" --max-memory 16M --size 64 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
+rc=$?
+[ $rc -eq 0 ] && grep -q -- "no --proxy given: the lightmap's indirect light from aavp virtual patches" "$TMP/err.txt" && [ -s "$TMP/g.pfm" ] &&
+    ok "lightmap without --proxy: the plan takes aavp where the dense build would not fit" ||
+    fail "lightmap without --proxy: the plan takes aavp where the dense build would not fit" "exit $rc: $(head -c 300 "$TMP/err.txt")"
 
 # ---- a new user's first runs: what the tool says ------------------------------------------
 # every method the render command parses is named by rad help (the list from render --help's usage line)

@@ -210,6 +210,60 @@ int tool_classic_solve(const char *cmd, const tool_world *w, const tool_classic_
     return 0;
 }
 
+int tool_plan(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method, rad_vp_kind kind,
+              uint32_t face_points, float voxels_per_path, rad_baker_choice *plan)
+{
+    rad_baker_options bo;
+    rad_context ctx;
+    rad_result r;
+    memset(&bo, 0, sizeof bo);
+    bo.method = method;
+    bo.max_memory = o->max_memory;
+    bo.patches = o->patches;
+    bo.ff_samples = o->samples;
+    bo.bounces = o->bounces;
+    bo.light_samples = o->light_samples;
+    bo.vp_voxels_per_path = voxels_per_path;
+    bo.vp_kind = kind;
+    bo.vp_face_points = face_points;
+    tool_context(&ctx, NULL);
+    if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
+    if (plan->method == RAD_BAKER_VIRTUAL_PATCHES) {
+        /* The virtual patches' CPU follows the scene's size: 4 minutes per 100 000 triangles
+           (at least ten seconds; Sponza's resolutions fit), so that a small scene whose mean
+           free path asks for a fine set (touching objects, thousands of emitting triangles)
+           is not baked for minutes; the library's 10 minutes above still decide between
+           classic and virtual patches. */
+        double size_budget = 240.0 * (double)w->scene->triangle_count / 1e5;
+        if (size_budget < 10.0) size_budget = 10.0;
+        if (plan->estimated_seconds > size_budget) {
+            bo.method = RAD_BAKER_VIRTUAL_PATCHES;
+            bo.max_seconds = size_budget;
+            if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
+        }
+    }
+    return 0;
+}
+
+int tool_plan_proxy(const char *cmd, const tool_world *w, const tool_classic_options *o, float voxels_per_path,
+                    const char *what, int *kind, uint32_t *resolution)
+{
+    rad_baker_choice plan;
+    if (tool_plan(cmd, w, o, RAD_BAKER_AUTO, RAD_VP_AXIS_ALIGNED, 0, voxels_per_path, &plan)) return 1;
+    if (plan.method != RAD_BAKER_VIRTUAL_PATCHES) {
+        fprintf(stderr, "rad %s: no --proxy given: the classic patches (%u, within the plan's budget; --proxy aavp|vp to "
+                        "choose)\n", cmd, plan.patch_count);
+        return 0;
+    }
+    *kind = TOOL_PROXY_AAVP;
+    *resolution = plan.vp_resolution;
+    fprintf(stderr, "rad %s: no --proxy given: %s from aavp virtual patches at --vp-resolution %u (%u patches, about "
+                    "%.0f MiB and %.0f s of CPU for the bake; the classic patches' dense build would not fit; --proxy "
+                    "patches to insist)\n",
+            cmd, what, plan.vp_resolution, plan.patch_count, plan.estimated_bytes / 1048576.0, plan.estimated_seconds);
+    return 0;
+}
+
 int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method,
                    uint32_t bounces, uint32_t vp_resolution, const rad_baker_options *base, rad_baker_desc *d,
                    rad_baker_result **out)

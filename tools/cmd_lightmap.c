@@ -36,7 +36,7 @@ typedef struct lightmap_args {
     uint32_t threads;
     uint32_t given;            /* LIGHTMAP_GIVEN_* */
 } lightmap_args;
-enum { LIGHTMAP_GIVEN_SIZE = 1, LIGHTMAP_GIVEN_VP = 2, LIGHTMAP_GIVEN_HR = 4 };
+enum { LIGHTMAP_GIVEN_SIZE = 1, LIGHTMAP_GIVEN_VP = 2, LIGHTMAP_GIVEN_HR = 4, LIGHTMAP_GIVEN_PROXY = 8 };
 
 /* --size N|WxH into the request's width and height (field: width) */
 static int parse_atlas_size(const char *cmd, const tool_arg *t, const char *v, void *field)
@@ -118,7 +118,7 @@ static const tool_arg lightmap_table[] = {
             "(default: 32 with --proxy aavp|vp, 0 with the classic patches; the engine tier's\n"
             "bakes: Jacobi, aavp|vp at the default --face-points or the patches; not --sh)"),
     LA_FLAG("--unwrap", rq.force_unwrap, "unwrap even when the file has a second uv set"),
-    {TOOL_ARG_CHOICE, "--proxy", "P", LA(px.kind), 0, 0, 0, 0, NULL, "patches|aavp|vp|hierarchical", proxy_values, NULL, 0,
+    {TOOL_ARG_CHOICE, "--proxy", "P", LA(px.kind), 0, 0, 0, LIGHTMAP_GIVEN_PROXY, NULL, "patches|aavp|vp|hierarchical", proxy_values, NULL, 0,
      "the indirect light from patches (the classic solution, default), aavp or vp (virtual\n"
      "patches: a few thousand unknowns whatever the triangle count, for real buildings; each\n"
      "texel gathers their H at its sample points; RGB only, not --sh), or hierarchical (the\n"
@@ -388,6 +388,13 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     rq = la.rq;
     rq.auto_size = !(la.given & LIGHTMAP_GIVEN_SIZE);
     rq.direct = !sh;
+    /* no --proxy (and RGB: the SH gather is the patches'): the plan keeps the classic patches
+       or takes virtual patches where their dense build would not fit; a traced first bounce
+       (the proxies' default) lets it ask for 4 voxels a mean free path */
+    if (!(la.given & LIGHTMAP_GIVEN_PROXY) && !sh &&
+        tool_plan_proxy("lightmap", &w, &la.co, rq.final_gather == TOOL_LIGHTMAP_FINAL_GATHER_AUTO || rq.final_gather ? 4.0f : 0.0f,
+                        "the lightmap's indirect light", &la.px.kind, &la.px.resolution))
+        goto done;
     rq.proxy = la.px.kind ? &la.px : NULL;
     if (tool_lightmap_bake("lightmap", &w, &la.co, &rq, &bk)) goto done;
     if (la.layers && !bk.baked) {

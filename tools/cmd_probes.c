@@ -43,7 +43,7 @@ typedef struct probes_args {
     int band4;               /* --band4 */
     uint32_t given;          /* PROBES_GIVEN_* */
 } probes_args;
-enum { PROBES_GIVEN_VP = 1, PROBES_GIVEN_VP_RAYS = 2, PROBES_GIVEN_PATCH_SAMPLES = 4 };
+enum { PROBES_GIVEN_VP = 1, PROBES_GIVEN_VP_RAYS = 2, PROBES_GIVEN_PATCH_SAMPLES = 4, PROBES_GIVEN_PROXY = 8 };
 
 static int parse_threads(const char *cmd, const tool_arg *t, const char *v, void *field)
 {
@@ -67,7 +67,7 @@ static const tool_arg probes_table[] = {
             "points per patch for the probes' gather (default 4; classic patches)"),
     PA_FLAG("--indirect", indirect, "only the indirect light (default: direct light too)"),
     PA_FLAG("--band4", band4, "also band 4 (9 more coefficients per colour: sharper E(n) than L2)"),
-    {TOOL_ARG_CHOICE, "--proxy", "P", PA(px.kind), 0, 0, 0, 0, NULL, "patches|aavp|vp", proxy_values, NULL, 0,
+    {TOOL_ARG_CHOICE, "--proxy", "P", PA(px.kind), 0, 0, 0, PROBES_GIVEN_PROXY, NULL, "patches|aavp|vp", proxy_values, NULL, 0,
      "the light from classic patches (patches, the default) or from virtual patches, aavp or vp:\n"
      "a few thousand unknowns whatever the triangle count, for real buildings (rad_probes_create_vp)"},
     PA_UINT("--vp-resolution", "R", px.resolution, 1, 4096, PROBES_GIVEN_VP, "must be 1 to 4096",
@@ -283,6 +283,13 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
     if (tool_check_output(cmd, pa.out, &pa.scene, 1)) return 1;
     tool_set_threads((int)pa.threads);
     if (tool_open_world_lit(cmd, pa.scene, lights, &w)) return 1;
+    /* no --proxy: the plan keeps the classic patches or takes virtual patches where their dense
+       build would not fit */
+    if (!(pa.given & PROBES_GIVEN_PROXY) &&
+        tool_plan_proxy(cmd, &w, &pa.o, 0.0f, "the probes' light", &pa.px.kind, &pa.px.resolution)) {
+        tool_close_world(&w);
+        return 1;
+    }
     /* a scene too big for the dense classic build is refused with the way out */
     pa.o.dense_instead = "--proxy aavp or --proxy vp (the probes' light from virtual patches: a few thousand whatever the "
                       "triangle count; --vp-resolution R sets how many)";

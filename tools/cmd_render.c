@@ -29,38 +29,14 @@
 static int render_default_method(const char *cmd, const tool_world *w, const tool_classic_options *o,
                                  tool_method_options *mo, float voxels_per_path)
 {
-    rad_baker_options bo;
     rad_baker_choice plan;
-    rad_context ctx;
-    rad_result r;
     int chosen = !(mo->given & TOOL_OPT_METHOD);
-    memset(&bo, 0, sizeof bo);
-    bo.method = chosen ? RAD_BAKER_AUTO : RAD_BAKER_VIRTUAL_PATCHES;
-    bo.max_memory = o->max_memory;
-    bo.patches = o->patches;
-    bo.ff_samples = o->samples;
-    bo.bounces = o->bounces;
-    bo.light_samples = o->light_samples;
-    bo.vp_voxels_per_path = voxels_per_path;
-    /* count the kind that will be built: a clustered set has more patches at one resolution */
-    bo.vp_kind = !chosen && (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
-    bo.vp_face_points = mo->face_points; /* and with the face points it will be built with */
-    tool_context(&ctx, NULL);
-    if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
-    if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
-        /* The virtual patches' CPU follows the scene's size: 4 minutes per 100 000 triangles
-           (at least ten seconds; Sponza's resolutions fit), so that a small scene whose mean
-           free path asks for a fine set (touching objects, thousands of emitting triangles)
-           is not baked for minutes; the library's 10 minutes above still decide between
-           classic and virtual patches. */
-        double size_budget = 240.0 * (double)w->scene->triangle_count / 1e5;
-        if (size_budget < 10.0) size_budget = 10.0;
-        if (plan.estimated_seconds > size_budget) {
-            bo.method = RAD_BAKER_VIRTUAL_PATCHES;
-            bo.max_seconds = size_budget;
-            if ((r = rad_baker_plan(w->scene, &w->rc, &bo, &ctx, &plan)) != RAD_SUCCESS) return tool_fail(cmd, "rad_baker_plan", r);
-        }
-    }
+    /* count the kind that will be built (a clustered set has more patches at one resolution),
+       with the face points it will be built with */
+    rad_vp_kind kind = !chosen && (mo->method == TOOL_VP || mo->proxy == TOOL_PROXY_VP) ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    if (tool_plan(cmd, w, o, chosen ? RAD_BAKER_AUTO : RAD_BAKER_VIRTUAL_PATCHES, kind, mo->face_points, voxels_per_path,
+                  &plan))
+        return 1;
     if (plan.method == RAD_BAKER_VIRTUAL_PATCHES) {
         if (chosen) mo->method = TOOL_AAVP;
         mo->vp_resolution = plan.vp_resolution;
@@ -68,7 +44,7 @@ static int render_default_method(const char *cmd, const tool_world *w, const too
     if (!chosen)
         fprintf(stderr, "rad %s: no --vp-resolution given: resolution %u from the scene (%u %s patches, about %.0f MiB and "
                 "%.0f s of CPU for the bake)\n",
-                cmd, plan.vp_resolution, plan.patch_count, bo.vp_kind == RAD_VP_CLUSTERED ? "vp" : "aavp",
+                cmd, plan.vp_resolution, plan.patch_count, kind == RAD_VP_CLUSTERED ? "vp" : "aavp",
                 plan.estimated_bytes / 1048576.0, plan.estimated_seconds);
     else if (plan.method == RAD_BAKER_VIRTUAL_PATCHES)
         fprintf(stderr, "rad %s: no --method given: chose aavp at --vp-resolution %u (about %.0f MiB and %.0f s of CPU for "
@@ -328,12 +304,18 @@ static int render_lightmap_method(const char *cmd, const tool_world *w, const to
     px.kind = (int)ra->mo.proxy;
     px.resolution = ra->mo.vp_resolution;
     px.face_points = ra->mo.face_points;
-    rq.proxy = ra->mo.proxy ? &px : NULL;
+    /* no --proxy: the plan keeps the classic patches or takes virtual patches (whose texels
+       trace the first bounce unless --final-gather 0) where the dense build would not fit */
+    if (!(ra->mo.given & TOOL_OPT_PROXY) &&
+        tool_plan_proxy(cmd, w, &ra->o, (ra->given & TOOL_RENDER_GIVEN_FINAL_GATHER) && !ra->view.final_gather ? 0.0f : 4.0f,
+                        "the lightmap's indirect light", &px.kind, &px.resolution))
+        return 1;
+    rq.proxy = px.kind ? &px : NULL;
     if (ra->given & TOOL_RENDER_GIVEN_FINAL_GATHER) rq.final_gather = ra->view.final_gather;
     if (tool_lightmap_bake(cmd, w, &ra->o, &rq, &bk)) return 1;
     fprintf(stderr, "rad %s: timing: method=lightmap%s patches=%u frames=1 bounces=%u step_ms_median=%.6f "
                     "step_ms_min=%.6f\n",
-            cmd, ra->mo.proxy == TOOL_PROXY_VP ? " proxy=vp" : ra->mo.proxy ? " proxy=aavp" : "", bk.patches,
+            cmd, px.kind == TOOL_PROXY_VP ? " proxy=vp" : px.kind ? " proxy=aavp" : "", bk.patches,
             ra->o.bounces, 1e3 * bk.solve_seconds, 1e3 * bk.solve_seconds);
     memset(&src, 0, sizeof src);
     src.P = bk.cl.patches;

@@ -175,6 +175,8 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
     bo.lightmap_final_gather = rq->final_gather != TOOL_LIGHTMAP_FINAL_GATHER_AUTO ? rq->final_gather
                                : px                                               ? TOOL_LIGHTMAP_FINAL_GATHER
                                                                                   : 0u;
+    /* the plan's message names the voxels a path it asked for: 4 when the texels trace the first bounce */
+    bo.vp_voxels_per_path = bo.lightmap_final_gather ? 4.0f : 0.0f;
     if (px) {
         if (px->resolution) vo.resolution = px->resolution;
         bo.vp_kind = px->kind == TOOL_PROXY_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;

@@ -409,6 +409,17 @@ typedef struct tool_bake_info {
     uint32_t triangle_count; /* of the scene baked */
 } tool_bake_info;
 /* the rad.options record of a bake of w with o */
+/* The library's plan (rad_baker_plan with the command line's patch, solve and memory options)
+   for 'method' (AUTO: classic or virtual patches; VIRTUAL_PATCHES: the resolution), counting
+   'kind' at 'face_points' (0: the default) and 'voxels_per_path' (0: 6.5); the virtual
+   patches' CPU held within 4 minutes per 100 000 triangles (at least 10 s). 0 or 1 (printed). */
+int tool_plan(const char *cmd, const tool_world *w, const tool_classic_options *o, rad_baker_method method, rad_vp_kind kind,
+              uint32_t face_points, float voxels_per_path, rad_baker_choice *plan);
+/* No --proxy given to rad lightmap or rad probes: the plan keeps the classic patches, or sets
+   *kind to TOOL_PROXY_AAVP and *resolution to its resolution; says which ('what' names the
+   output). 0 or 1 (printed). */
+int tool_plan_proxy(const char *cmd, const tool_world *w, const tool_classic_options *o, float voxels_per_path,
+                    const char *what, int *kind, uint32_t *resolution);
 /* The engine tier's bake of the world's scene and lights (one group): d->outputs (and
    d->probe_options) as given, the rest of d filled here; the classic options (patches,
    max edge, samples, light samples, and --solver for classic) become the baker's, with
