@@ -1197,11 +1197,6 @@ rc=$?
 [ $rc -eq 0 ] && grep -q -- "no --proxy given: the probes' light from aavp virtual patches" "$TMP/err.txt" && [ -s "$TMP/g.json" ] &&
     ok "probes without --proxy: the plan takes aavp where the dense build would not fit" ||
     fail "probes without --proxy: the plan takes aavp where the dense build would not fit" "exit $rc: $(head -c 300 "$TMP/err.txt")"
-"$RAD" lightmap "$TMP/grid.obj" --max-memory 16M --size 64 -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
-rc=$?
-[ $rc -eq 0 ] && grep -q -- "no --proxy given: the lightmap's indirect light from aavp virtual patches" "$TMP/err.txt" && [ -s "$TMP/g.pfm" ] &&
-    ok "lightmap without --proxy: the plan takes aavp where the dense build would not fit" ||
-    fail "lightmap without --proxy: the plan takes aavp where the dense build would not fit" "exit $rc: $(head -c 300 "$TMP/err.txt")"
 
 # ---- a new user's first runs: what the tool says ------------------------------------------
 # every method the render command parses is named by rad help (the list from render --help's usage line)
@@ -1359,13 +1354,19 @@ bad "lightmap --proxy with --sh" "--sh needs the classic gather" lightmap cornel
 bad "lightmap --vp-resolution without --proxy" "--vp-resolution and --face-points are for --proxy" lightmap cornell -o "$TMP/x.pfm" --vp-resolution 4
 bad "lightmap --proxy sideways" "unknown --proxy 'sideways'" lightmap cornell -o "$TMP/x.pfm" --proxy sideways
 bad "render --method lightmap --proxy --vp-max-patches" "give --vp-resolution" render cornell --method lightmap --proxy aavp --vp-max-patches 100 -o "$TMP/x.pfm"
-# too big for the dense build: refused at once (before the unwrap), naming --proxy aavp
+# too big for the dense build with --proxy patches: refused at once (before the unwrap), naming
+# --proxy aavp; without --proxy the plan takes aavp and says so
 for args in "lightmap" "render --method lightmap"; do
-    "$RAD" $args "$TMP/grid.obj" --max-memory 16M -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
+    "$RAD" $args "$TMP/grid.obj" --max-memory 16M --proxy patches -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
     rc=$?
     [ $rc -eq 1 ] && grep -q -- "use --proxy aavp or --proxy vp" "$TMP/err.txt" && ! grep -q "unwrapped" "$TMP/err.txt" &&
-        ok "$args: a lightmap too big for the dense build is refused before the unwrap, naming --proxy aavp" ||
-        fail "$args: a lightmap too big for the dense build is refused naming --proxy aavp" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+        ok "$args --proxy patches: a lightmap too big for the dense build is refused before the unwrap, naming --proxy aavp" ||
+        fail "$args --proxy patches: a lightmap too big for the dense build is refused naming --proxy aavp" "exit $rc: $(head -c 300 "$TMP/err.txt")"
+    "$RAD" $args "$TMP/grid.obj" --max-memory 16M -o "$TMP/g.pfm" > /dev/null 2> "$TMP/err.txt"
+    rc=$?
+    [ $rc -eq 0 ] && grep -q -- "no --proxy given: the lightmap's indirect light from aavp virtual patches" "$TMP/err.txt" &&
+        ok "$args without --proxy: the plan takes aavp where the dense build would not fit" ||
+        fail "$args without --proxy: the plan takes aavp where the dense build would not fit" "exit $rc: $(head -c 300 "$TMP/err.txt")"
 done
 # an unwrap of many small charts (3000 separate triangles: each chart costs at least 5 x 5
 # texels with its gutters, 2601 fit 256 x 256): with no size given the tool picks the smallest
