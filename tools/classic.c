@@ -295,11 +295,12 @@ int tool_baker_run(const char *cmd, const tool_world *w, const tool_classic_opti
     bo.vp_resolution = vp_resolution;
     /* the solve of the command line: classic's --solver, else --bounces 0 (no bounce) or inf
        (every bounce, by Gauss-Seidel; its estimate counts the default sweeps) */
-    bo.solver = method == RAD_BAKER_CLASSIC && o->solver == TOOL_GAUSS_SEIDEL ? RAD_BAKER_SOLVE_GAUSS_SEIDEL
-                : method == RAD_BAKER_CLASSIC && o->solver == TOOL_DIRECT      ? RAD_BAKER_SOLVE_DIRECT
-                : bounces == 0                                                  ? RAD_BAKER_SOLVE_NONE
-                : bounces == RAD_MB_INFINITE                                    ? RAD_BAKER_SOLVE_GAUSS_SEIDEL
-                                                                                : RAD_BAKER_SOLVE_JACOBI;
+    if (!(base && base->solver)) /* else the caller's (a proxy's Gauss-Seidel) */
+        bo.solver = method == RAD_BAKER_CLASSIC && o->solver == TOOL_GAUSS_SEIDEL ? RAD_BAKER_SOLVE_GAUSS_SEIDEL
+                    : method == RAD_BAKER_CLASSIC && o->solver == TOOL_DIRECT      ? RAD_BAKER_SOLVE_DIRECT
+                    : bounces == 0                                                  ? RAD_BAKER_SOLVE_NONE
+                    : bounces == RAD_MB_INFINITE                                    ? RAD_BAKER_SOLVE_GAUSS_SEIDEL
+                                                                                    : RAD_BAKER_SOLVE_JACOBI;
     if (bounces == RAD_MB_INFINITE) bo.bounces = 0;
     bo.max_edge = o->max_edge;
     if (method == RAD_BAKER_CLASSIC) {

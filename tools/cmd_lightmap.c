@@ -94,8 +94,8 @@ static const tool_arg lightmap_table[] = {
     {TOOL_ARG_STRING, "--layers", "FILE", LA(layers), 0, 0, 0, 0, NULL, NULL, NULL, NULL, 0,
      "also save the engine tier's bake as one file (.radr: its light layers and metadata,\n"
      "rad_baker_result_load_file mixes them again; docs/engine-formats.md); rad info FILE\n"
-     "describes it. Needs the tier's bake: --solver jacobi, no --max-edge, the patches or\n"
-     "--proxy aavp|vp at the default --face-points"},
+     "describes it. Needs the tier's bake: the patches or --proxy aavp|vp, and a scene\n"
+     "that emits light"},
     LA_CUSTOM("--size", "N|WxH", rq.width, parse_atlas_size, LIGHTMAP_GIVEN_SIZE,
               "atlas texels (default 256; with an unwrap whose charts do not fit, the smallest\n"
               "power of two up to 4096 that they fit, said on stderr)"),
@@ -116,7 +116,7 @@ static const tool_arg lightmap_table[] = {
             "trace the first bounce from each texel with N rays (direct light at the hits, the\n"
             "solution's irradiance there) instead of reading it off the patches' averages\n"
             "(default: 32 with --proxy aavp|vp, 0 with the classic patches; the engine tier's\n"
-            "bakes: Jacobi, aavp|vp at the default --face-points or the patches; not --sh)"),
+            "bakes: the patches or --proxy aavp|vp; not --sh)"),
     LA_FLAG("--unwrap", rq.force_unwrap, "unwrap even when the file has a second uv set"),
     {TOOL_ARG_CHOICE, "--proxy", "P", LA(px.kind), 0, 0, 0, LIGHTMAP_GIVEN_PROXY, NULL, "patches|aavp|vp|hierarchical", proxy_values, NULL, 0,
      "the indirect light from patches (the classic solution, default), aavp or vp (virtual\n"
@@ -248,7 +248,6 @@ static int lightmap_is_png(const char *path)
 /* the command line into la; -1: go on, else the exit code (--help 0; bad usage 2, printed) */
 static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_args *la)
 {
-    rad_vp_options vo;
     int a, k;
     memset(la, 0, sizeof *la);
     tool_classic_options_default(&la->co);
@@ -309,11 +308,9 @@ static int lightmap_parse(int argc, char **argv, tool_lights *lights, lightmap_a
         fprintf(stderr, "rad lightmap: a .glb or .gltf carries the RGB lightmap: leave out --sh\n");
         return 2;
     }
-    rad_vp_options_default(&vo);
-    if (la->layers && (la->co.solver != TOOL_JACOBI || la->co.bounces == 0 || la->co.max_edge != 0.0f ||
-                       la->px.kind == TOOL_LIGHTMAP_HIERARCHICAL || (la->px.face_points && la->px.face_points != vo.face_points))) {
-        fprintf(stderr, "rad lightmap: --layers saves the engine tier's bake, and these options bake without it: use "
-                        "--solver jacobi, no --max-edge, the patches or --proxy aavp|vp at the default --face-points\n");
+    if (la->layers && la->px.kind == TOOL_LIGHTMAP_HIERARCHICAL) {
+        fprintf(stderr, "rad lightmap: --layers saves the engine tier's bake, and --proxy hierarchical bakes without it: "
+                        "use the patches or --proxy aavp|vp\n");
         return 2;
     }
     if (tool_check_size("lightmap", la->rq.width, la->rq.height)) return 2;
@@ -398,8 +395,8 @@ static int lightmap_main(int argc, char **argv, tool_lights *lights)
     rq.proxy = la.px.kind ? &la.px : NULL;
     if (tool_lightmap_bake("lightmap", &w, &la.co, &rq, &bk)) goto done;
     if (la.layers && !bk.baked) {
-        fprintf(stderr, "rad lightmap: --layers saves the engine tier's bake, and these options bake without it: use "
-                        "--solver jacobi, no --max-edge, the patches or --proxy aavp|vp at the default --face-points\n");
+        fprintf(stderr, "rad lightmap: --layers saves the engine tier's bake, and this one was made without it (nothing "
+                        "in the scene emits light)\n");
         goto done;
     }
     width = (int)bk.lm->width; /* the unwrap may have chosen a larger atlas */

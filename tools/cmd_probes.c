@@ -249,13 +249,27 @@ static int write_probes(FILE *f, int json, const probes_view *v, int total)
    command line asks for what it does not offer. */
 static int probes_baked(const char *cmd, const tool_world *w, const probes_args *pa, rad_baker_result **out)
 {
+    const tool_lightmap_proxy *px = &pa->px;
     rad_baker_desc d;
+    rad_baker_options bo;
+    rad_vp_options vo;
     *out = NULL;
-    if (pa->px.kind || pa->o.solver != TOOL_JACOBI || pa->o.bounces == 0 || pa->o.max_edge != 0.0f) return -1;
+    memset(&bo, 0, sizeof bo);
+    rad_vp_options_default(&vo);
+    if (px->kind) {
+        if (px->face_points) vo.face_points = px->face_points;
+        if (px->resolution) vo.resolution = px->resolution;
+        bo.vp_kind = px->kind == TOOL_PROXY_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+        bo.vp_face_points = vo.face_points;
+        if (pa->o.solver == TOOL_GAUSS_SEIDEL) bo.solver = RAD_BAKER_SOLVE_GAUSS_SEIDEL;
+        if (px->max_patches && tool_vp_resolution_within(cmd, w, bo.vp_kind, vo.face_points, px->max_patches, 0, &vo.resolution))
+            return 1;
+    }
     memset(&d, 0, sizeof d);
     d.outputs = RAD_BAKER_PROBES;
     d.probe_options = &pa->po;
-    return tool_baker_run(cmd, w, &pa->o, RAD_BAKER_CLASSIC, pa->o.bounces, 0, NULL, &d, out);
+    return tool_baker_run(cmd, w, &pa->o, px->kind ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC, pa->o.bounces,
+                          px->kind ? vo.resolution : 0u, &bo, &d, out);
 }
 
 static int probes_main(int argc, char **argv, tool_lights *lights)

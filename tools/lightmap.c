@@ -165,11 +165,13 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
     size_t n;
     double t0 = tool_seconds();
     int rc;
-    if (co->solver != TOOL_JACOBI || co->bounces == 0 || co->max_edge != 0.0f) return -1;
     rad_vp_options_default(&vo);
-    if (px && ((px->kind != TOOL_PROXY_AAVP && px->kind != TOOL_PROXY_VP) || (px->face_points && px->face_points != vo.face_points)))
-        return -1;
+    if (px && px->kind != TOOL_PROXY_AAVP && px->kind != TOOL_PROXY_VP) return -1;
     memset(&bo, 0, sizeof bo);
+    if (px && px->face_points) vo.face_points = px->face_points;
+    bo.vp_face_points = vo.face_points;
+    /* the proxies' Gauss-Seidel (classic's solvers come with the options: tool_baker_run) */
+    if (px && co->solver == TOOL_GAUSS_SEIDEL) bo.solver = RAD_BAKER_SOLVE_GAUSS_SEIDEL;
     bo.keep = 1; /* the texels for the caller; a proxy's rows sparse, as tool_vp_proxy_solve builds them */
     bo.lightmap_samples = rq->texel_samples;
     bo.lightmap_final_gather = rq->final_gather != TOOL_LIGHTMAP_FINAL_GATHER_AUTO ? rq->final_gather
@@ -272,13 +274,13 @@ int tool_lightmap_bake(const char *cmd, const tool_world *world, const tool_clas
         if (k == 0) return 0;
     }
     if (rq->final_gather != TOOL_LIGHTMAP_FINAL_GATHER_AUTO && rq->final_gather) {
-        fprintf(stderr, "rad %s: --final-gather is for the engine tier's bakes: --solver jacobi with --proxy aavp|vp at "
-                        "the default --face-points, or the classic patches without --max-edge\n", cmd);
+        fprintf(stderr, "rad %s: --final-gather is for the engine tier's bakes: the patches or --proxy aavp|vp in a "
+                        "scene that emits light\n", cmd);
         goto fail;
     }
     if (proxy && proxy->kind != TOOL_LIGHTMAP_HIERARCHICAL && rq->final_gather == TOOL_LIGHTMAP_FINAL_GATHER_AUTO)
         fprintf(stderr, "rad %s: no final gather per texel off the engine tier's bake: the texels read the voxel averages "
-                        "(--solver jacobi and the default --face-points trace the first bounce)\n", cmd);
+                        "(the engine tier's bakes trace the first bounce)\n", cmd);
     if (lightmap_solve(cmd, co, proxy, out, &vp_H)) goto fail;
     /* the gather wants the total radiosity of the secondary sources: B = E + L */
     t0 = tool_seconds();
