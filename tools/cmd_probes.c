@@ -312,7 +312,9 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
         return 1;
     }
     if (R) {
-        /* the tier's result */
+        if (pa.px.kind)
+            fprintf(stderr, "rad %s: %s virtual patches at resolution %u: %u patches (the engine tier's bake)\n", cmd,
+                    pa.px.kind == TOOL_PROXY_VP ? "vp" : "aavp", R->vp_resolution, R->patch_count);
     } else if (pa.px.kind) {
         if (tool_vp_proxy_solve(cmd, &w, &pa.o, &pa.px, &vp, &vp_B, NULL, NULL)) {
             tool_close_world(&w);
@@ -365,7 +367,7 @@ static int probes_main(int argc, char **argv, tool_lights *lights)
     printf("wrote %s: %u probes (%u valid, %u moved out of geometry, %u disabled)%s, %s light%s%s\n", pa.out, v.n,
            counts[RAD_PROBE_VALID], counts[RAD_PROBE_MOVED], counts[RAD_PROBE_DISABLED], weights,
            total ? "total" : "indirect", v.b4 ? ", band 4" : "",
-           vp ? (pa.px.kind == TOOL_PROXY_VP ? ", over vp virtual patches" : ", over aavp virtual patches") : "");
+           pa.px.kind ? (pa.px.kind == TOOL_PROXY_VP ? ", over vp virtual patches" : ", over aavp virtual patches") : "");
     fprintf(stderr, "rad %s: probes gathered in %.2f s; done in %.2f s\n", cmd, tp, tool_seconds() - t0);
     rc = 0;
 done:
