@@ -934,4 +934,43 @@ static inline void fx_open_box_free(fx_open_box *w)
     w->S = NULL;
 }
 
+/* (baker tests) the last error a context logged, and how many */
+typedef struct fx_err_log {
+    int errors;
+    char last[512];
+} fx_err_log;
+
+static inline void fx_err_log_fn(void *user, rad_log_level level, const char *msg)
+{
+    fx_err_log *l = (fx_err_log *)user;
+    if (level == RAD_LOG_ERROR) {
+        l->errors++;
+        strncpy(l->last, msg, sizeof(l->last) - 1);
+        l->last[sizeof(l->last) - 1] = 0;
+    }
+}
+
+/* (baker tests) one bad bake: the expected code, no result, a logged error holding 'word'
+   (NULL: any), nothing leaked */
+static inline void fx_baker_expect(const rad_baker_desc *d, const rad_baker_options *o, rad_result want, const char *word)
+{
+    rad_context ctx;
+    sc_alloc_state st;
+    fx_err_log lg;
+    rad_baker_result *R = NULL;
+    memset(&st, 0, sizeof st);
+    memset(&lg, 0, sizeof lg);
+    sc_ctx_alloc(&ctx, &st);
+    ctx.log = fx_err_log_fn;
+    ctx.log_user = &lg;
+    CHECK_RESULT(rad_baker_run(d, o, &ctx, &R), want);
+    CHECK(R == NULL);
+    CHECK(lg.errors > 0);
+    if (word && !strstr(lg.last, word)) {
+        printf("    log '%s' lacks '%s'\n", lg.last, word);
+        CHECK(!"the log names the problem");
+    }
+    CHECK(st.live_bytes == 0);
+}
+
 #endif

@@ -462,39 +462,6 @@ done:
     rad_baker_result_destroy(B);
 }
 
-typedef struct bk_log { int errors; char last[512]; } bk_log;
-static void bk_log_fn(void *user, rad_log_level level, const char *msg)
-{
-    bk_log *l = (bk_log *)user;
-    if (level == RAD_LOG_ERROR) {
-        l->errors++;
-        strncpy(l->last, msg, sizeof(l->last) - 1);
-        l->last[sizeof(l->last) - 1] = 0;
-    }
-}
-
-/* one bad bake: the expected code, a logged message holding 'word', nothing leaked */
-static void bk_expect(const rad_baker_desc *d, const rad_baker_options *o, rad_result want, const char *word)
-{
-    rad_context ctx;
-    sc_alloc_state st;
-    bk_log lg;
-    rad_baker_result *R = NULL;
-    memset(&st, 0, sizeof st);
-    memset(&lg, 0, sizeof lg);
-    sc_ctx_alloc(&ctx, &st);
-    ctx.log = bk_log_fn;
-    ctx.log_user = &lg;
-    CHECK_RESULT(rad_baker_run(d, o, &ctx, &R), want);
-    CHECK(R == NULL);
-    CHECK(lg.errors > 0);
-    if (word && !strstr(lg.last, word)) {
-        printf("    log '%s' lacks '%s'\n", lg.last, word);
-        CHECK(!"the log names the problem");
-    }
-    CHECK(st.live_bytes == 0);
-}
-
 static void bk_test_bad_input(void)
 {
     rad_baker_desc d, bad;
@@ -524,35 +491,35 @@ static void bk_test_bad_input(void)
     bad.scene.materials = mats;
     bad.lights = NULL;
     bad.light_count = 0;
-    bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "nothing emits");
+    fx_baker_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "nothing emits");
     /* a light beyond the groups */
     bad = d;
     bad.group_count = 1;
     bl.group = 1;
-    bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "group");
+    fx_baker_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "group");
     bl.group = RAD_BAKER_MAX_GROUPS;
     bad.group_count = 0;
-    bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "group");
+    fx_baker_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "group");
     bl.group = 0;
     /* an emissive material beyond the groups */
     for (i = 0; i < 16; ++i) groups[i] = 3;
     bad = d;
     bad.material_groups = groups;
     bad.group_count = 2;
-    bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "emissive material");
+    fx_baker_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "emissive material");
     /* a lightmap, but no mesh has lightmap uvs */
     bad = d;
     bad.outputs = RAD_BAKER_LIGHTMAP;
-    bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_uvs");
+    fx_baker_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_uvs");
     /* unknown method and output bits, a negative budget */
     bad = d;
     bad.outputs = 16; /* the bit after RAD_BAKER_SOLUTION */
-    bk_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "output");
+    fx_baker_expect(&bad, &o, RAD_ERROR_INVALID_ARGUMENT, "output");
     o.method = (rad_baker_method)7;
-    bk_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "method");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "method");
     bk_options(&o, RAD_BAKER_AUTO);
     o.max_memory = -1.0;
-    bk_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "max_memory");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "max_memory");
     bk_options(&o, RAD_BAKER_AUTO);
     /* a bad mesh: an index out of range, a NaN position (the scene's own errors) */
     CHECK(d.scene.mesh_count <= 16);
@@ -562,7 +529,7 @@ static void bk_test_bad_input(void)
     meshes[0].indices = idx;
     meshes[0].triangle_count = 2;
     meshes[0].vertex_count = 4;
-    bk_expect(&bad, &o, RAD_ERROR_INDEX_OUT_OF_RANGE, NULL);
+    fx_baker_expect(&bad, &o, RAD_ERROR_INDEX_OUT_OF_RANGE, NULL);
     meshes[0] = d.scene.meshes[0];
     {
         float pos[12];
@@ -571,18 +538,18 @@ static void bk_test_bad_input(void)
         meshes[0].positions = pos;
         meshes[0].position_stride = 0;
         meshes[0].vertex_count = 4;
-        bk_expect(&bad, &o, RAD_ERROR_NON_FINITE, NULL);
+        fx_baker_expect(&bad, &o, RAD_ERROR_NON_FINITE, NULL);
     }
     /* a bad light: a NaN colour */
     bl.light.color[1] = NAN;
-    bk_expect(&d, &o, RAD_ERROR_NON_FINITE, NULL);
+    fx_baker_expect(&d, &o, RAD_ERROR_NON_FINITE, NULL);
     bk_lamp(&bl.light);
     /* a budget too small for any bake, and a classic bake forced over the budget */
     o.max_memory = 4096.0;
-    bk_expect(&d, &o, RAD_ERROR_OUT_OF_MEMORY, "too small");
+    fx_baker_expect(&d, &o, RAD_ERROR_OUT_OF_MEMORY, "too small");
     bk_options(&o, RAD_BAKER_CLASSIC);
     o.max_memory = 65536.0;
-    bk_expect(&d, &o, RAD_ERROR_OUT_OF_MEMORY, "budget");
+    fx_baker_expect(&d, &o, RAD_ERROR_OUT_OF_MEMORY, "budget");
     /* the mix: NULL, a NaN scale */
     CHECK_RESULT(rad_baker_mix(NULL, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
     CHECK_RESULT(rad_baker_mix_layers(lm_scale, 1, 1, NULL, lm_scale, NULL), RAD_ERROR_INVALID_ARGUMENT);

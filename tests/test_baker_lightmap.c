@@ -10,40 +10,6 @@ static int blm_same_bits(const float *a, const float *b, size_t n)
     return memcmp(a, b, n * sizeof(float)) == 0;
 }
 
-typedef struct blm_log {
-    int errors;
-    char last[512];
-} blm_log;
-
-static void blm_log_fn(void *user, rad_log_level level, const char *msg)
-{
-    blm_log *l = (blm_log *)user;
-    if (level == RAD_LOG_ERROR) {
-        l->errors++;
-        strncpy(l->last, msg, sizeof(l->last) - 1);
-        l->last[sizeof(l->last) - 1] = 0;
-    }
-}
-
-/* one bad bake: the expected code, a logged message holding 'word', nothing leaked */
-static void blm_expect(const rad_baker_desc *d, const rad_baker_options *o, rad_result want, const char *word)
-{
-    rad_context ctx;
-    sc_alloc_state st;
-    blm_log lg;
-    rad_baker_result *R = NULL;
-    memset(&st, 0, sizeof st);
-    memset(&lg, 0, sizeof lg);
-    sc_ctx_alloc(&ctx, &st);
-    ctx.log = blm_log_fn;
-    ctx.log_user = &lg;
-    CHECK_RESULT(rad_baker_run(d, o, &ctx, &R), want);
-    CHECK(R == NULL);
-    CHECK(lg.errors > 0 && strstr(lg.last, word) != NULL);
-    if (!strstr(lg.last, word)) printf("    log '%s' lacks '%s'\n", lg.last, word);
-    CHECK(st.live_bytes == 0);
-}
-
 /* A floor of two triangles whose lightmap charts meet at one seam (the diagonal; the second
    side mirrored at half the texel density, as lm_test_seam), a lamp above it and a point
    light, all in group 0. The arrays live in *s. */
@@ -282,35 +248,35 @@ static void blm_test_refusals(void)
     rad_baker_result *R = NULL;
     rad_baker_runtime *rt = NULL;
     rad_context ctx;
-    blm_log lg;
+    fx_err_log lg;
     blm_scene_make(&s);
     blm_options(&o);
     rad_lightmap_gather_options_default(&go);
     s.d.lightmap_gather = &go;
     go.encoding = RAD_LIGHTMAP_SH_L1;
     o.method = RAD_BAKER_VIRTUAL_PATCHES;
-    blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "SH lightmap encoding");
+    fx_baker_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "SH lightmap encoding");
     o.method = RAD_BAKER_CLASSIC;
     s.d.lightmap_flags = RAD_BAKER_LIGHTMAP_DIRECT;
-    blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "RAD_BAKER_LIGHTMAP_DIRECT");
+    fx_baker_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "RAD_BAKER_LIGHTMAP_DIRECT");
     go.encoding = RAD_LIGHTMAP_IRRADIANCE;
     o.sky_bands = 1;
-    blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "sky layers");
+    fx_baker_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "sky layers");
     o.sky_bands = 0;
     s.d.lightmap_flags = 64; /* no such bit (8 is RAD_BAKER_LIGHTMAP_RGB9E5_ONLY) */
-    blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_flags");
+    fx_baker_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_flags");
     s.d.lightmap_flags = 0;
     go.encoding = (rad_lightmap_encoding)7;
-    blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "encoding");
+    fx_baker_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "encoding");
     go.encoding = RAD_LIGHTMAP_IRRADIANCE;
     o.lightmap_exact_pairs = -1.0;
-    blm_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_exact_pairs");
+    fx_baker_expect(&s.d, &o, RAD_ERROR_INVALID_ARGUMENT, "lightmap_exact_pairs");
     o.lightmap_exact_pairs = 0.0;
     s.d.lightmap_flags = RAD_BAKER_LIGHTMAP_STITCH;
     CHECK_OK(rad_baker_run(&s.d, &o, NULL, &R));
     memset(&ctx, 0, sizeof ctx);
     memset(&lg, 0, sizeof lg);
-    ctx.log = blm_log_fn;
+    ctx.log = fx_err_log_fn;
     ctx.log_user = &lg;
     if (R) {
         CHECK_RESULT(rad_baker_runtime_create(&s.d, &o, R, NULL, &ctx, &rt), RAD_ERROR_INVALID_ARGUMENT);

@@ -224,21 +224,6 @@ static void brc_test_runtime(void)
     brc_world_free(&w);
 }
 
-typedef struct brc_log {
-    int errors;
-    char last[512];
-} brc_log;
-
-static void brc_log_fn(void *user, rad_log_level level, const char *msg)
-{
-    brc_log *l = (brc_log *)user;
-    if (level == RAD_LOG_ERROR) {
-        l->errors++;
-        strncpy(l->last, msg, sizeof(l->last) - 1);
-        l->last[sizeof(l->last) - 1] = 0;
-    }
-}
-
 /* a caster without a callback the tier calls: INVALID_ARGUMENT, the log naming it, no leak */
 static void brc_test_refused(void)
 {
@@ -250,7 +235,7 @@ static void brc_test_refused(void)
     rad_raycaster bad;
     rad_context ctx;
     sc_alloc_state st;
-    brc_log lg;
+    fx_err_log lg;
     int which;
     brc_make(&s);
     brc_options(&o, RAD_BAKER_CLASSIC);
@@ -266,7 +251,7 @@ static void brc_test_refused(void)
         memset(&st, 0, sizeof st);
         memset(&lg, 0, sizeof lg);
         sc_ctx_alloc(&ctx, &st);
-        ctx.log = brc_log_fn;
+        ctx.log = fx_err_log_fn;
         ctx.log_user = &lg;
         s.d.raycaster = &bad;
         R = (rad_baker_result *)(uintptr_t)1;
@@ -285,7 +270,7 @@ static void brc_test_refused(void)
         s.d.raycaster = &bad;
         memset(&lg, 0, sizeof lg);
         memset(&ctx, 0, sizeof ctx);
-        ctx.log = brc_log_fn;
+        ctx.log = fx_err_log_fn;
         ctx.log_user = &lg;
         CHECK_RESULT(rad_baker_runtime_create(&s.d, &o, ok, NULL, &ctx, &rt), RAD_ERROR_INVALID_ARGUMENT);
         CHECK(rt == NULL);

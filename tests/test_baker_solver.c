@@ -317,42 +317,6 @@ done:
     rad_scene_destroy(S);
 }
 
-typedef struct bsv_log {
-    int errors;
-    char last[512];
-} bsv_log;
-
-static void bsv_log_fn(void *user, rad_log_level level, const char *msg)
-{
-    bsv_log *l = (bsv_log *)user;
-    if (level == RAD_LOG_ERROR) {
-        l->errors++;
-        strncpy(l->last, msg, sizeof(l->last) - 1);
-        l->last[sizeof(l->last) - 1] = 0;
-    }
-}
-
-/* one bad bake: the expected code, a logged message holding 'word', nothing leaked */
-static void bsv_expect(const rad_baker_desc *d, const rad_baker_options *o, const char *word)
-{
-    rad_context ctx;
-    sc_alloc_state st;
-    bsv_log lg;
-    rad_baker_result *R = NULL;
-    memset(&st, 0, sizeof st);
-    memset(&lg, 0, sizeof lg);
-    sc_ctx_alloc(&ctx, &st);
-    ctx.log = bsv_log_fn;
-    ctx.log_user = &lg;
-    CHECK_RESULT(rad_baker_run(d, o, &ctx, &R), RAD_ERROR_INVALID_ARGUMENT);
-    CHECK(R == NULL && lg.errors > 0);
-    if (word && !strstr(lg.last, word)) {
-        printf("    log '%s' lacks '%s'\n", lg.last, word);
-        CHECK(!"the log names the problem");
-    }
-    CHECK(st.live_bytes == 0);
-}
-
 static void bsv_test_refusals(void)
 {
     rad_baker_desc d;
@@ -361,33 +325,33 @@ static void bsv_test_refusals(void)
     rad_baker_result *R = NULL;
     rad_baker_runtime *rt = NULL;
     rad_context ctx;
-    bsv_log lg;
+    fx_err_log lg;
     bsv_desc(&d, &bl);
     bsv_options(&o, RAD_BAKER_VIRTUAL_PATCHES, RAD_BAKER_SOLVE_DIRECT);
     o.vp_resolution = 4;
-    bsv_expect(&d, &o, "RAD_BAKER_SOLVE_DIRECT");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "RAD_BAKER_SOLVE_DIRECT");
     /* AUTO that the budget sends to virtual patches: refused too */
     o.method = RAD_BAKER_AUTO;
     o.max_memory = 4096.0 * 4096.0;
     o.patches = 4000;
-    bsv_expect(&d, &o, "RAD_BAKER_SOLVE_DIRECT");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "RAD_BAKER_SOLVE_DIRECT");
     bsv_options(&o, RAD_BAKER_CLASSIC, (rad_baker_solver)7);
-    bsv_expect(&d, &o, "unknown solver");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "unknown solver");
     bsv_options(&o, RAD_BAKER_CLASSIC, RAD_BAKER_SOLVE_JACOBI);
     o.max_edge = -0.1f;
-    bsv_expect(&d, &o, "max_edge");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "max_edge");
     o.max_edge = (float)HUGE_VAL;
-    bsv_expect(&d, &o, "max_edge");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "max_edge");
     o.max_edge = 0.0f;
     o.vp_face_points = 5000;
-    bsv_expect(&d, &o, "vp_face_points");
+    fx_baker_expect(&d, &o, RAD_ERROR_INVALID_ARGUMENT, "vp_face_points");
     /* the runtime folds Jacobi bounces: another solver's bake is refused by name */
     o.vp_face_points = 0;
     o.solver = RAD_BAKER_SOLVE_GAUSS_SEIDEL;
     CHECK_OK(rad_baker_run(&d, &o, NULL, &R));
     memset(&ctx, 0, sizeof ctx);
     memset(&lg, 0, sizeof lg);
-    ctx.log = bsv_log_fn;
+    ctx.log = fx_err_log_fn;
     ctx.log_user = &lg;
     if (R) {
         CHECK_RESULT(rad_baker_runtime_create(&d, &o, R, NULL, &ctx, &rt), RAD_ERROR_INVALID_ARGUMENT);

@@ -5,21 +5,6 @@
    name is static and prefixed lfg_. */
 #include "fixtures.h"
 
-typedef struct lfg_log {
-    int errors;
-    char last[512];
-} lfg_log;
-
-static void lfg_log_fn(void *user, rad_log_level level, const char *msg)
-{
-    lfg_log *l = (lfg_log *)user;
-    if (level == RAD_LOG_ERROR) {
-        l->errors++;
-        strncpy(l->last, msg, sizeof(l->last) - 1);
-        l->last[sizeof(l->last) - 1] = 0;
-    }
-}
-
 /* The inside of a unit box (4 x 4 cells a face), each face a cell of a 3 x 2 lightmap atlas,
    lit by a point light under the ceiling; the arrays live in *s. */
 typedef struct lfg_scene {
@@ -141,13 +126,13 @@ static void lfg_test_refusals(void)
     rad_baker_result *R = NULL;
     rad_baker_runtime *rt = NULL;
     rad_context ctx;
-    lfg_log lg;
+    fx_err_log lg;
     float out[3];
     lfg_scene_make(&s);
     lfg_options(&o, RAD_BAKER_CLASSIC);
     memset(&ctx, 0, sizeof ctx);
     memset(&lg, 0, sizeof lg);
-    ctx.log = lfg_log_fn;
+    ctx.log = fx_err_log_fn;
     ctx.log_user = &lg;
     o.lightmap_final_gather = 5000;
     CHECK_RESULT(rad_baker_run(&s.d, &o, &ctx, &R), RAD_ERROR_INVALID_ARGUMENT);

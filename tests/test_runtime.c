@@ -264,18 +264,7 @@ static void rtm_test_deterministic(void)
     }
 }
 
-typedef struct rtm_log { int errors; char last[512]; } rtm_log;
-static void rtm_log_fn(void *user, rad_log_level level, const char *msg)
-{
-    rtm_log *l = (rtm_log *)user;
-    if (level == RAD_LOG_ERROR) {
-        l->errors++;
-        strncpy(l->last, msg, sizeof(l->last) - 1);
-        l->last[sizeof(l->last) - 1] = 0;
-    }
-}
-
-static void rtm_expect(rad_baker_runtime *rt, rtm_log *lg, const rad_light *l, uint32_t n, double budget, rad_result want,
+static void rtm_expect(rad_baker_runtime *rt, fx_err_log *lg, const rad_light *l, uint32_t n, double budget, rad_result want,
                        const char *word)
 {
     rad_baker_frame f;
@@ -297,14 +286,14 @@ static void rtm_test_bad_input(void)
     rad_baker_runtime *rt = NULL;
     rad_baker_frame f;
     rad_context ctx;
-    rtm_log lg;
+    fx_err_log lg;
     sc_alloc_state st;
     rad_light two[2], l;
     float *before = NULL;
     memset(&lg, 0, sizeof lg);
     memset(&st, 0, sizeof st);
     sc_ctx_alloc(&ctx, &st);
-    ctx.log = rtm_log_fn;
+    ctx.log = fx_err_log_fn;
     ctx.log_user = &lg;
     rtm_make(&s, 0);
     rtm_options(&o, RAD_BAKER_VIRTUAL_PATCHES);
