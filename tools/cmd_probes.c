@@ -252,25 +252,15 @@ static int probes_baked(const char *cmd, const tool_world *w, const probes_args 
     const tool_lightmap_proxy *px = &pa->px;
     rad_baker_desc d;
     rad_baker_options bo;
-    rad_vp_options vo;
+    uint32_t res = 0;
     *out = NULL;
     memset(&bo, 0, sizeof bo);
-    rad_vp_options_default(&vo);
-    if (px->kind) {
-        if (px->face_points) vo.face_points = px->face_points;
-        if (px->resolution) vo.resolution = px->resolution;
-        bo.vp_kind = px->kind == TOOL_PROXY_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
-        bo.vp_face_points = vo.face_points;
-        bo.keep = 1; /* sparse rows, as the tool's own proxies build them: the dense set's bounces cost half as much again on Sponza */
-        if (pa->o.solver == TOOL_GAUSS_SEIDEL) bo.solver = RAD_BAKER_SOLVE_GAUSS_SEIDEL;
-        if (px->max_patches && tool_vp_resolution_within(cmd, w, bo.vp_kind, vo.face_points, px->max_patches, 0, &vo.resolution))
-            return 1;
-    }
+    if (px->kind && tool_vp_proxy_options(cmd, w, &pa->o, px, &bo, &res)) return 1;
     memset(&d, 0, sizeof d);
     d.outputs = RAD_BAKER_PROBES;
     d.probe_options = &pa->po;
     return tool_baker_run(cmd, w, &pa->o, px->kind ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC, pa->o.bounces,
-                          px->kind ? vo.resolution : 0u, &bo, &d, out);
+                          res, &bo, &d, out);
 }
 
 static int probes_main(int argc, char **argv, tool_lights *lights)

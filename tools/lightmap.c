@@ -156,7 +156,6 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
                             int height, tool_lightmap_baked *out)
 {
     const tool_lightmap_proxy *px = rq->proxy;
-    rad_vp_options vo;
     rad_baker_desc d;
     rad_baker_options bo;
     rad_lightmap_gather_options go;
@@ -165,26 +164,17 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
     size_t n;
     double t0 = tool_seconds();
     int rc;
-    rad_vp_options_default(&vo);
+    uint32_t res = 0;
     if (px && px->kind != TOOL_PROXY_AAVP && px->kind != TOOL_PROXY_VP) return -1;
     memset(&bo, 0, sizeof bo);
-    if (px && px->face_points) vo.face_points = px->face_points;
-    bo.vp_face_points = vo.face_points;
-    /* the proxies' Gauss-Seidel (classic's solvers come with the options: tool_baker_run) */
-    if (px && co->solver == TOOL_GAUSS_SEIDEL) bo.solver = RAD_BAKER_SOLVE_GAUSS_SEIDEL;
-    bo.keep = 1; /* the texels for the caller; a proxy's rows sparse, as tool_vp_proxy_solve builds them */
+    if (px && tool_vp_proxy_options(cmd, &out->w, co, px, &bo, &res)) return 1;
+    bo.keep = 1; /* the texels for the caller */
     bo.lightmap_samples = rq->texel_samples;
     bo.lightmap_final_gather = rq->final_gather != TOOL_LIGHTMAP_FINAL_GATHER_AUTO ? rq->final_gather
                                : px                                               ? TOOL_LIGHTMAP_FINAL_GATHER
                                                                                   : 0u;
     /* the plan's message names the voxels a path it asked for: 4 when the texels trace the first bounce */
     bo.vp_voxels_per_path = bo.lightmap_final_gather ? 4.0f : 0.0f;
-    if (px) {
-        if (px->resolution) vo.resolution = px->resolution;
-        bo.vp_kind = px->kind == TOOL_PROXY_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
-        if (px->max_patches && tool_vp_resolution_within(cmd, &out->w, bo.vp_kind, vo.face_points, px->max_patches, 0, &vo.resolution))
-            return 1;
-    }
     rad_lightmap_gather_options_default(&go);
     go.encoding = rq->sh ? RAD_LIGHTMAP_SH_L1 : RAD_LIGHTMAP_IRRADIANCE;
     go.visibility_rays = rq->visibility_rays;
@@ -198,7 +188,7 @@ static int lightmap_by_tier(const char *cmd, const tool_classic_options *co, con
     d.lightmap_gather = &go;
     d.lightmap_flags = RAD_BAKER_LIGHTMAP_STITCH | (rq->direct && !rq->sh ? RAD_BAKER_LIGHTMAP_DIRECT : 0u);
     rc = tool_baker_run(cmd, &out->w, co, px ? RAD_BAKER_VIRTUAL_PATCHES : RAD_BAKER_CLASSIC, co->bounces,
-                        px ? vo.resolution : 0u, &bo, &d, &R);
+                        res, &bo, &d, &R);
     if (rc) return rc;
     out->baked = R;
     out->lm = lm = rad_baker_result_lightmap(R);

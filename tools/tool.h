@@ -707,6 +707,11 @@ int tool_vp_bake_open(const char *cmd, const char *path, const void *data, size_
    built. 0, or 1 after printing why (nothing left to free). */
 int tool_vp_proxy_solve(const char *cmd, const tool_world *w, const tool_classic_options *co, const tool_lightmap_proxy *px,
                         rad_virtual_patches **vp_out, float **B_out, float **H_out, double *solve_seconds);
+/* --proxy aavp|vp as the engine tier's options: the kind, face points, sparse rows (keep, as
+   tool_vp_proxy_solve builds them) and --solver gauss-seidel into bo, and the resolution
+   (px's, the finest within px->max_patches, or the default) into *resolution. 0 or 1 (printed). */
+int tool_vp_proxy_options(const char *cmd, const tool_world *w, const tool_classic_options *co, const tool_lightmap_proxy *px,
+                          rad_baker_options *bo, uint32_t *resolution);
 typedef struct tool_lightmap_baked {
     tool_world w;        /* the world baked: the caller's, or a copy over an unwrapped scene */
     tool_classic cl;     /* the classic solution gathered (patches of w.scene), or zero with a proxy */

@@ -187,3 +187,18 @@ fail:
     rad_vp_destroy(vp);
     return 1;
 }
+
+int tool_vp_proxy_options(const char *cmd, const tool_world *w, const tool_classic_options *co, const tool_lightmap_proxy *px,
+                          rad_baker_options *bo, uint32_t *resolution)
+{
+    rad_vp_options vo;
+    rad_vp_options_default(&vo);
+    if (px->face_points) vo.face_points = px->face_points;
+    if (px->resolution) vo.resolution = px->resolution;
+    bo->vp_kind = px->kind == TOOL_PROXY_VP ? RAD_VP_CLUSTERED : RAD_VP_AXIS_ALIGNED;
+    bo->vp_face_points = vo.face_points;
+    bo->keep = 1;
+    if (co->solver == TOOL_GAUSS_SEIDEL) bo->solver = RAD_BAKER_SOLVE_GAUSS_SEIDEL;
+    *resolution = vo.resolution;
+    return px->max_patches && tool_vp_resolution_within(cmd, w, bo->vp_kind, vo.face_points, px->max_patches, 0, resolution);
+}
